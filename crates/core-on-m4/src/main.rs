@@ -1,0 +1,303 @@
+//! monitor-core on the Cortex-M4F instruction set (QEMU `mps2-an386`, semihosting).
+//!
+//! 1. Replays the embedded log (`data/replay.bin`, generated on the host by
+//!    `cargo run --manifest-path tools/fwtool/Cargo.toml -- gen-replay`) through
+//!    `Monitor::update` and compares the outputs at every checkpoint with the host's
+//!    (`data/expected.bin`). Tolerance: 6e-4 absolute + 1e-4 relative. Both sides run the
+//!    same f32 code with micromath's trigonometry, so differences come only from
+//!    instruction selection (no fused multiply-add on either side by default) and stay
+//!    far below micromath's own 6e-4 error; the bound allows for that error once.
+//!    Lamps and the fault flag must match exactly.
+//! 2. Counts instructions per sample for angle+Park, the speed estimate, the residuals
+//!    and the whole pipeline. QEMU runs with `-icount shift=0` (virtual time advances one
+//!    step per executed instruction); SysTick is read around each loop and calibrated
+//!    against a loop of a known instruction count, and the cost of the loop itself
+//!    (decoding the sample) is subtracted.
+//! 3. Prints `name=value` lines and exits 0, or non-zero on any mismatch.
+#![no_std]
+#![no_main]
+
+mod scenario;
+
+use core::fmt::Write;
+use core::hint::black_box;
+
+use cortex_m::peripheral::syst::SystClkSource;
+use cortex_m_rt::entry;
+use monitor_core::angle::RotorFluxCurrentModel;
+use monitor_core::encoder::MtSpeed;
+use monitor_core::frames::{clarke, park, SinCos};
+use monitor_core::residuals::{residuals, Operating};
+use monitor_core::Monitor;
+use scenario::Check;
+
+static REPLAY: &[u8] = include_bytes!("../data/replay.bin");
+static EXPECTED: &[u8] = include_bytes!("../data/expected.bin");
+
+/// Absolute tolerance: one micromath sin/cos error (6e-4) on a quantity of order one.
+const ATOL: f32 = 6e-4;
+/// Relative tolerance for large quantities (speeds in rad/s).
+const RTOL: f32 = 1e-4;
+
+mod semihosting {
+    //! The two semihosting calls this program needs (ARM semihosting, `bkpt 0xAB`).
+    const SYS_WRITE0: u32 = 0x04;
+    const SYS_EXIT: u32 = 0x18;
+    const ADP_STOPPED_APPLICATION_EXIT: u32 = 0x2_0026;
+    const ADP_STOPPED_RUNTIME_ERROR_UNKNOWN: u32 = 0x2_0023;
+
+    fn call(op: u32, arg: u32) -> u32 {
+        let r: u32;
+        // SAFETY: a semihosting request traps to the debugger/QEMU; r0/r1 carry the
+        // operation and the argument as the ARM semihosting specification says.
+        unsafe {
+            core::arch::asm!("bkpt #0xab", inout("r0") op => r, in("r1") arg, options(nostack));
+        }
+        r
+    }
+
+    /// Write a NUL-terminated byte string to the host's stdout.
+    pub fn write0(s: &[u8]) {
+        if s.last() == Some(&0) {
+            call(SYS_WRITE0, s.as_ptr() as u32);
+        }
+    }
+
+    /// Exit QEMU: status 0 on success, 1 otherwise.
+    pub fn exit(ok: bool) -> ! {
+        let reason = if ok {
+            ADP_STOPPED_APPLICATION_EXIT
+        } else {
+            ADP_STOPPED_RUNTIME_ERROR_UNKNOWN
+        };
+        call(SYS_EXIT, reason);
+        loop {
+            cortex_m::asm::nop();
+        }
+    }
+}
+
+/// Fixed buffer for formatted lines.
+struct Line {
+    buf: [u8; 200],
+    len: usize,
+}
+
+impl Write for Line {
+    fn write_str(&mut self, s: &str) -> core::fmt::Result {
+        for &b in s.as_bytes() {
+            if self.len + 1 < self.buf.len() {
+                self.buf[self.len] = b;
+                self.len += 1;
+            }
+        }
+        Ok(())
+    }
+}
+
+macro_rules! println {
+    ($($arg:tt)*) => {{
+        let mut l = Line { buf: [0; 200], len: 0 };
+        let _ = write!(l, $($arg)*);
+        let _ = l.write_str("\n");
+        l.buf[l.len] = 0;
+        semihosting::write0(&l.buf[..=l.len]);
+    }};
+}
+
+/// SysTick as a 24-bit down counter; elapsed ticks between two readings.
+fn elapsed(start: u32, end: u32) -> u32 {
+    start.wrapping_sub(end) & 0x00FF_FFFF
+}
+
+fn now() -> u32 {
+    cortex_m::peripheral::SYST::get_current()
+}
+
+/// Run `f` and return the SysTick ticks it took (must stay below 2^24 ticks).
+fn measure(mut f: impl FnMut()) -> u32 {
+    let t0 = now();
+    f();
+    elapsed(t0, now())
+}
+
+/// A loop of exactly `2 * n` instructions (`subs`, `bne`) plus a few around it.
+fn known_loop(n: u32) {
+    // SAFETY: pure register arithmetic.
+    unsafe {
+        core::arch::asm!("1:", "subs {0}, #1", "bne 1b", inout(reg) n => _, options(nomem, nostack));
+    }
+}
+
+#[entry]
+fn main() -> ! {
+    let Some(mut cp) = cortex_m::Peripherals::take() else {
+        semihosting::exit(false)
+    };
+    cp.SYST.set_clock_source(SystClkSource::Core);
+    cp.SYST.set_reload(0x00FF_FFFF);
+    cp.SYST.clear_current();
+    cp.SYST.enable_counter();
+
+    let n = scenario::u32_at(REPLAY, 4) as usize;
+    let checks = scenario::u32_at(EXPECTED, 4) as usize;
+    let spacing = scenario::u32_at(EXPECTED, 8) as usize;
+    if n == 0 || spacing == 0 || checks * spacing > n || REPLAY.get(0..4) != Some(b"RPL1") {
+        println!("error=bad embedded data");
+        semihosting::exit(false);
+    }
+    println!("samples={}", n);
+
+    // --- calibration: SysTick ticks per instruction -----------------------------------
+    const CAL_N: u32 = 200_000;
+    let t_cal = measure(|| known_loop(black_box(CAL_N))) as f32;
+    let t_cal0 = measure(|| known_loop(black_box(1))) as f32;
+    let ticks_per_instr = (t_cal - t_cal0) / (2.0 * (CAL_N - 1) as f32);
+    if !(ticks_per_instr > 0.0) {
+        println!("error=SysTick does not advance (run QEMU with -icount shift=0)");
+        semihosting::exit(false);
+    }
+    let per_sample = |ticks: u32, base: u32, count: usize| -> f32 {
+        (ticks as f32 - base as f32) / ticks_per_instr / count as f32
+    };
+
+    // --- correctness: replay and compare ----------------------------------------------
+    let cfg = scenario::config();
+    let Ok(mut monitor) = Monitor::new(cfg) else {
+        println!("error=config rejected");
+        semihosting::exit(false);
+    };
+    let mut ok = true;
+    let mut max_abs = 0.0f32;
+    let mut j = 0usize;
+    for k in 0..n {
+        let out = monitor.update(&scenario::sample(REPLAY, k));
+        if j < checks && k + 1 == (j + 1) * spacing {
+            let got = Check::of(&out);
+            let want = Check::read(EXPECTED, j);
+            for (g, w) in got.values.iter().zip(want.values) {
+                let d = (g - w).abs();
+                max_abs = max_abs.max(if w.abs() > 1.0 { d / w.abs() } else { d });
+                if !(d <= ATOL + RTOL * w.abs()) {
+                    ok = false;
+                    println!("mismatch checkpoint={} got={} want={}", j, g, w);
+                }
+            }
+            if got.lamps != want.lamps || got.fault != want.fault {
+                ok = false;
+                println!(
+                    "mismatch checkpoint={} lamps got={:04b} want={:04b}",
+                    j, got.lamps, want.lamps
+                );
+            }
+            j += 1;
+        }
+    }
+    println!("checkpoints={}", j);
+    println!("max_deviation={:e}", max_abs);
+
+    // --- instruction counts --------------------------------------------------------------
+    let base = measure(|| {
+        for k in 0..n {
+            black_box(scenario::sample(REPLAY, k));
+        }
+    });
+
+    let m = &cfg.motor;
+    let dt = 1.0 / cfg.sample_rate_hz;
+    let imr_min = 0.05 * cfg.v_phase_peak / (core::f32::consts::TAU * cfg.supply_hz * m.ls_h);
+    let mut rfo = RotorFluxCurrentModel::new(dt, m.rr_ohm, m.lr_h, imr_min);
+    let wr = black_box(150.0f32);
+    // Angle + Park as Monitor::update does it: the frame's sin/cos advanced by a small
+    // rotation per sample (SinCos::rotated), resynchronised by one sin/cos per block.
+    let dec = cfg.decimation as usize;
+    let mut sc = SinCos::from_angle(rfo.theta());
+    let t_park = measure(|| {
+        for k in 0..n {
+            let s = scenario::sample(REPLAY, k);
+            let v = clarke(s.v_abc);
+            let i = clarke(s.i_abc);
+            if k % dec == 0 {
+                sc = SinCos::from_angle(rfo.theta());
+            }
+            let i_dq = park(i, sc);
+            rfo.update(i_dq, wr);
+            let v_dq = park(v, sc);
+            // The negative-sequence rotation shares the same sin/cos.
+            let n_dq = park(i, sc.negated());
+            sc = sc.rotated(rfo.omega_rad_s() * dt);
+            black_box((v_dq, i_dq, n_dq));
+        }
+    });
+
+    let mut mt = MtSpeed::new(&cfg.encoder, cfg.tick_hz);
+    let t_speed = measure(|| {
+        for k in 0..n {
+            let s = scenario::sample(REPLAY, k);
+            black_box(mt.update(s.encoder_count, s.timestamp_ticks));
+        }
+    });
+
+    let t_res = measure(|| {
+        for k in 0..n {
+            let s = scenario::sample(REPLAY, k);
+            let op = Operating {
+                iqs: s.i_abc.a,
+                i_f: 3.0 + s.i_abc.b,
+                vqs: s.v_abc.a,
+                wr: 300.0 + s.i_abc.c,
+            };
+            black_box(residuals(m, op, None));
+        }
+    });
+
+    let Ok(mut monitor) = Monitor::new(cfg) else {
+        semihosting::exit(false);
+    };
+    let t_all = measure(|| {
+        for k in 0..n {
+            black_box(monitor.update(&scenario::sample(REPLAY, k)));
+        }
+    });
+
+    // Split fast and slow path: total(d) = fast + slow / d, measured at d and d/2.
+    let mut cfg_half = cfg;
+    cfg_half.decimation = (cfg.decimation / 2).max(1);
+    let Ok(mut monitor) = Monitor::new(cfg_half) else {
+        semihosting::exit(false);
+    };
+    let t_half = measure(|| {
+        for k in 0..n {
+            black_box(monitor.update(&scenario::sample(REPLAY, k)));
+        }
+    });
+    let d = f32::from(cfg.decimation);
+    let dh = f32::from(cfg_half.decimation);
+    let (all, half) = (per_sample(t_all, base, n), per_sample(t_half, base, n));
+    let slow = if d > dh { (half - all) / (1.0 / dh - 1.0 / d) } else { 0.0 };
+    let fast = all - slow / d;
+
+    println!("ticks_per_instruction={}", ticks_per_instr);
+    println!("angle_park={:.0}", per_sample(t_park, base, n));
+    println!("speed_estimate={:.0}", per_sample(t_speed, base, n));
+    println!("residuals_per_call={:.0}", per_sample(t_res, base, n));
+    println!(
+        "residuals_per_sample={:.0}",
+        per_sample(t_res, base, n) / f32::from(cfg.decimation)
+    );
+    println!(
+        "monitor_output_bytes={}",
+        core::mem::size_of::<monitor_core::MonitorOutput>()
+    );
+    println!("fast_path={:.0}", fast);
+    println!("slow_path_per_call={:.0}", slow);
+    println!("whole_pipeline={:.0}", per_sample(t_all, base, n));
+    println!("result={}", if ok { "pass" } else { "FAIL" });
+    semihosting::exit(ok)
+}
+
+#[panic_handler]
+fn panic(_: &core::panic::PanicInfo) -> ! {
+    semihosting::write0(b"panic\n\0");
+    semihosting::exit(false)
+}

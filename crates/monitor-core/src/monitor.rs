@@ -1,0 +1,925 @@
+//! The per-sample drive monitor: one type that runs on the board and on the host.
+//!
+//! Pipeline for every sample (10 kHz by default):
+//! 1. check the sample (finite, inside the sensor ranges, ADC not saturated, currents and
+//!    voltages summing to about zero, encoder not jumping): an impossible reading is held
+//!    out of the filters and lights the matching sensor-fault candidate;
+//! 2. Clarke of voltages and currents; the frame angle from the configured source
+//!    ([`AngleSource`]); Park of both (one sin/cos evaluation per sample);
+//! 3. encoder speed by the M/T method; electrical speed `wr = Np wm`;
+//! 4. second-order filters of `Iqs, i_ds, Vqs, wr` (values and derivatives);
+//! 5. positive/negative-sequence separation of the currents.
+//!
+//! Every `decimation` samples (1 kHz by default) the slow path evaluates the residuals
+//! (eq. 37, or eq. 36 with [`ResidualForm::Full`]), normalises them, feeds commissioning or
+//! the lamp logic, and matches the lamps against Table 1. The residuals act on quantities
+//! filtered at `filter_hz` (10 Hz), so evaluating them at 1 kHz loses nothing.
+
+use crate::angle::{AngleSource, RotorFluxCurrentModel, SrfPll, ZeroCrossing};
+use crate::encoder::{EncoderConfig, MtSpeed};
+use crate::filter::{LowPass, Svf};
+use crate::sequence::sequence_result;
+use crate::frames::{clarke, park, Abc, Dq, SinCos};
+use crate::residuals::{residuals, Derivatives, MotorModel, Normaliser, Operating};
+use crate::sequence::{asymmetry_correction_rad, Unbalance};
+use crate::signature::{match_signature, Diagnosis, Fault, FAULT_COUNT, TABLE1};
+use crate::threshold::{Calibration, Lamps, ThresholdConfig, Welford};
+use crate::ConfigError;
+use core::f32::consts::TAU;
+
+/// One sample from the sensors.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Sample {
+    /// Phase-to-neutral voltages [V].
+    pub v_abc: Abc,
+    /// Phase currents [A].
+    pub i_abc: Abc,
+    /// Raw encoder counter (free running, `EncoderConfig::counter_bits` wide).
+    pub encoder_count: u32,
+    /// Free-running timestamp in ticks of `MonitorConfig::tick_hz` (wraps).
+    pub timestamp_ticks: u32,
+    /// A voltage channel's ADC was at its end stop.
+    pub v_saturated: bool,
+    /// A current channel's ADC was at its end stop.
+    pub i_saturated: bool,
+}
+
+/// Which form of the residuals the lamps act on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ResidualForm {
+    /// Eq. (37): derivative terms dropped (the paper's choice; false alarms in transients).
+    #[default]
+    Steady,
+    /// Eq. (36): with filtered first and second derivatives.
+    Full,
+}
+
+/// Plausibility limits for the sensors.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SensorLimits {
+    /// Largest believable |phase voltage| [V] (the measurement range), > 0.
+    pub v_max: f32,
+    /// Largest believable |phase current| [A] (the measurement range), > 0.
+    pub i_max: f32,
+    /// Largest believable |mechanical speed| [rad/s], > 0.
+    pub max_speed_rad_s: f32,
+    /// Mean |ia+ib+ic| over mean max(|ia|,|ib|,|ic|) above which a current sensor is
+    /// declared faulty (3-wire machine: the sum is zero), 0 < x (default 0.25).
+    pub current_sum_frac: f32,
+    /// The same for the voltages; 0 disables the check (a machine with its neutral
+    /// connected can have a zero-sequence voltage). Default 0.25.
+    pub voltage_sum_frac: f32,
+}
+
+/// Everything the monitor needs. Build with [`MonitorConfig::new`], adjust fields, and
+/// [`MonitorConfig::validate`] (also done by [`Monitor::new`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MonitorConfig {
+    /// Nominal machine parameters.
+    pub motor: MotorModel,
+    /// Frame angle source.
+    pub angle_source: AngleSource,
+    /// Residual form for the lamps.
+    pub residual_form: ResidualForm,
+    /// Sample rate [Hz], 100..=100 000.
+    pub sample_rate_hz: f32,
+    /// Timestamp tick rate [Hz], >= sample rate.
+    pub tick_hz: f32,
+    /// Nominal supply frequency [Hz], 1..=400.
+    pub supply_hz: f32,
+    /// Nominal peak phase voltage [V] (sqrt(2/3) V_ll,rms), > 0.
+    pub v_phase_peak: f32,
+    /// Encoder.
+    pub encoder: EncoderConfig,
+    /// Corner of the d-q filters [Hz], > 0 and < supply_hz / 2 (default 5 Hz).
+    pub filter_hz: f32,
+    /// Slow path every `decimation` samples, 1..=1000 and at least 6 blocks per supply
+    /// period (default 25: 400 Hz at 10 kHz, fine up to 66 Hz supplies).
+    pub decimation: u16,
+    /// Thresholds and lamp timing.
+    pub thresholds: ThresholdConfig,
+    /// Sensor plausibility limits.
+    pub limits: SensorLimits,
+    /// Time after start (and after a sensor fault clears) before lamps are evaluated [s].
+    pub settle_s: f32,
+    /// Lamps are evaluated only while |V| > this fraction of `v_phase_peak` (default 0.3).
+    pub min_voltage_frac: f32,
+    /// SRF-PLL bandwidth [Hz] (default 20).
+    pub pll_bw_hz: f32,
+    /// Negative-sequence filter corner [Hz] (default 2).
+    pub sequence_hz: f32,
+    /// Smallest |I2|/|I1| for which a suspect phase is named (default 0.005).
+    pub unbalance_min_ratio: f32,
+    /// Residual floor as a fraction of the no-load term sums (default 0.02).
+    pub floor_fraction: f32,
+    /// Quasi-steady-state gate [1/s]: while any of Iqs, i_ds, Vqs, wr changes faster than
+    /// this fraction of itself per second (filtered derivative), and for `gate_hold_s`
+    /// after, commissioning does not learn and lamp timers hold. The steady-state residuals
+    /// of eq. (37) describe the machine only in steady state (the paper: "false alarms in
+    /// transients"). 0 disables the gate. Default 0.1 /s: above the derivative noise of the
+    /// 5 Hz filters on 0.1 %-noise sensors (~0.03 /s), below a 5 % supply step's flux
+    /// transient (~0.5 /s) and a 30 % load step's (~0.15 /s).
+    pub steady_gate_per_s: f32,
+    /// How long the gate stays closed after the last fast change [s] (default 0.5).
+    pub gate_hold_s: f32,
+}
+
+impl MonitorConfig {
+    /// Defaults for a motor on a supply of `supply_hz` and `v_ll_rms`, sampled at
+    /// `sample_rate_hz`, with microsecond timestamps and a 32-bit encoder counter.
+    pub fn new(motor: MotorModel, supply_hz: f32, v_ll_rms: f32, sample_rate_hz: f32) -> Self {
+        let v_phase_peak = v_ll_rms * 0.816_496_6;
+        MonitorConfig {
+            motor,
+            angle_source: AngleSource::RotorFlux,
+            residual_form: ResidualForm::Steady,
+            sample_rate_hz,
+            tick_hz: 1_000_000.0,
+            supply_hz,
+            v_phase_peak,
+            encoder: EncoderConfig::default(),
+            filter_hz: 5.0,
+            decimation: 25,
+            thresholds: ThresholdConfig::default(),
+            limits: SensorLimits {
+                v_max: 2.0 * v_phase_peak,
+                i_max: 1000.0,
+                max_speed_rad_s: 2.0 * TAU * supply_hz,
+                current_sum_frac: 0.25,
+                voltage_sum_frac: 0.25,
+            },
+            settle_s: 1.0,
+            min_voltage_frac: 0.3,
+            pll_bw_hz: 20.0,
+            sequence_hz: 2.0,
+            unbalance_min_ratio: 0.005,
+            floor_fraction: 0.02,
+            steady_gate_per_s: 0.1,
+            gate_hold_s: 0.5,
+        }
+    }
+
+    /// Rejects a configuration that cannot work (see each field's range).
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        self.motor.validate()?;
+        let dt = 1.0 / self.sample_rate_hz;
+        let fin = |x: f32| x.is_finite() && x > 0.0;
+        if !(fin(self.sample_rate_hz) && (100.0..=100_000.0).contains(&self.sample_rate_hz)) {
+            return Err(ConfigError::SampleRate);
+        }
+        if !(fin(self.tick_hz) && self.tick_hz >= self.sample_rate_hz) {
+            return Err(ConfigError::SampleRate);
+        }
+        if !(fin(self.supply_hz) && (1.0..=400.0).contains(&self.supply_hz) && fin(self.v_phase_peak)) {
+            return Err(ConfigError::Supply);
+        }
+        if self.supply_hz * 8.0 > self.sample_rate_hz {
+            return Err(ConfigError::SampleRate);
+        }
+        if self.decimation == 0 || self.decimation > 1000 {
+            return Err(ConfigError::Decimation);
+        }
+        // The d-q filters run once per block of `decimation` samples.
+        let slow_dt = dt * f32::from(self.decimation);
+        if !(fin(self.filter_hz) && self.filter_hz < self.supply_hz * 0.5 && TAU * self.filter_hz * slow_dt <= 0.2) {
+            return Err(ConfigError::Filter);
+        }
+        if !(fin(self.sequence_hz) && self.sequence_hz < self.supply_hz * 0.5 && TAU * self.sequence_hz * slow_dt <= 0.2)
+            || !fin(self.pll_bw_hz)
+        {
+            return Err(ConfigError::Filter);
+        }
+        // The block average feeds filters that must see the 2f ripple (negative sequence)
+        // well below their Nyquist frequency: at least 6 blocks per supply period (slow
+        // rate >= 6 f, so 2f <= 1/3 of it).
+        if self.sample_rate_hz / f32::from(self.decimation) < 6.0 * self.supply_hz {
+            return Err(ConfigError::Decimation);
+        }
+        let e = &self.encoder;
+        if e.counts_per_rev == 0
+            || !(8..=32).contains(&e.counter_bits)
+            || !fin(e.min_window_s)
+            || !(e.timeout_s > e.min_window_s)
+        {
+            return Err(ConfigError::Encoder);
+        }
+        // Counts per sample at max speed must stay below half the counter range.
+        let max_counts = self.limits.max_speed_rad_s / TAU * e.counts_per_rev as f32 * dt;
+        let half = if e.counter_bits >= 32 { 2.1e9 } else { (1u32 << (e.counter_bits - 1)) as f32 };
+        if !(max_counts < half) {
+            return Err(ConfigError::Encoder);
+        }
+        let l = &self.limits;
+        if !(fin(l.v_max) && fin(l.i_max) && fin(l.max_speed_rad_s) && fin(l.current_sum_frac))
+            || !(l.voltage_sum_frac.is_finite() && l.voltage_sum_frac >= 0.0)
+        {
+            return Err(ConfigError::Limits);
+        }
+        if !(self.settle_s.is_finite() && self.settle_s >= 0.0)
+            || !(self.min_voltage_frac.is_finite() && (0.0..1.0).contains(&self.min_voltage_frac))
+            || !(self.unbalance_min_ratio.is_finite() && self.unbalance_min_ratio >= 0.0)
+            || !fin(self.floor_fraction)
+            || !(self.steady_gate_per_s.is_finite() && self.steady_gate_per_s >= 0.0)
+            || !(self.gate_hold_s.is_finite() && self.gate_hold_s >= 0.0)
+        {
+            return Err(ConfigError::Limits);
+        }
+        self.thresholds.validate()
+    }
+}
+
+/// Sensor-fault flags from impossible readings.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct SensorFlags {
+    /// A current reading was impossible (NaN, out of range, saturated, sum not zero).
+    pub current: bool,
+    /// A voltage reading was impossible.
+    pub voltage: bool,
+    /// The encoder jumped faster than the maximum speed allows.
+    pub speed: bool,
+}
+
+impl SensorFlags {
+    /// Any flag set.
+    pub fn any(&self) -> bool {
+        self.current || self.voltage || self.speed
+    }
+}
+
+/// Commissioning state.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Commissioning {
+    /// No calibration: fixed thresholds are in use.
+    #[default]
+    NotCommissioned,
+    /// Learning; the fraction done in [0, 1].
+    Learning(f32),
+    /// Calibrated thresholds are in use.
+    Commissioned,
+}
+
+/// Everything the monitor reports after a sample.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MonitorOutput {
+    /// Normalised residuals r1..r4 (dimensionless, [-1, 1]) from the last slow-path run.
+    pub residuals: [f32; 4],
+    /// Residual lamps r1..r4.
+    pub lamps: [bool; 4],
+    /// Sensor faults seen from impossible readings (held for one second).
+    pub sensor_fault: SensorFlags,
+    /// Fault candidates and probabilities.
+    pub diagnosis: Diagnosis,
+    /// Any lamp or sensor fault.
+    pub fault_detected: bool,
+    /// Filtered model quantities in the chosen frame.
+    pub operating: Operating,
+    /// Mechanical speed from the encoder [rad/s].
+    pub speed_rad_s: f32,
+    /// Frame angular frequency [rad/s] (supply frequency in steady state).
+    pub frame_omega_rad_s: f32,
+    /// True while lamps are being evaluated (voltage present, settled, quasi-steady, not
+    /// commissioning).
+    pub evaluating: bool,
+    /// False while the operating point is changing (see `steady_gate_per_s`).
+    pub quasi_steady: bool,
+    /// Commissioning state.
+    pub commissioning: Commissioning,
+    /// Negative-sequence analysis of the currents.
+    pub unbalance: Unbalance,
+}
+
+impl MonitorOutput {
+    /// The most probable fault candidate and its probability.
+    pub fn top(&self) -> Option<(Fault, f32)> {
+        self.diagnosis.top()
+    }
+}
+
+/// The drive monitor. Construction validates the configuration; [`Monitor::update`] never
+/// panics and never allocates.
+///
+/// Cost structure (see the README's instruction counts): the per-sample fast path does the
+/// plausibility check, the M/T speed, Clarke, one sin/cos, three Park rotations and five
+/// accumulations; the d-q quantities are block-averaged over `decimation` samples (a
+/// boxcar anti-alias filter with nulls at multiples of the slow rate) and everything else
+/// runs once per block.
+#[derive(Debug, Clone)]
+pub struct Monitor {
+    cfg: MonitorConfig,
+    zc: ZeroCrossing,
+    pll: SrfPll,
+    rfo: RotorFluxCurrentModel,
+    mt: MtSpeed,
+    /// sin/cos of the frame angle, advanced by small rotations between resyncs.
+    sc: SinCos,
+    dt: f32,
+    v_max_bits: u32,
+    i_max_bits: u32,
+    block_sat: u8,
+    block_vmax: u32,
+    block_imax: u32,
+    // Block accumulators (fast path).
+    acc: [f32; 5],
+    acc_n: u16,
+    // Slow-path filters.
+    f_iqs: Svf,
+    f_ids: Svf,
+    f_vqs: Svf,
+    f_wr: Svf,
+    f_nd: Svf,
+    f_nq: Svf,
+    vmag: LowPass,
+    isum: LowPass,
+    imax: LowPass,
+    vsum: LowPass,
+    vmax: LowPass,
+    norm: Normaliser,
+    lamps: Lamps,
+    welford: Welford,
+    commission_total: u32,
+    commission_left: u32,
+    settle_left: u32,
+    settle_blocks: u32,
+    hold_blocks: u32,
+    sensor_hold: [u32; 3],
+    report_countdown: u16,
+    report_every: u16,
+    gate_left: u32,
+    gate_blocks: u32,
+    gate_floor: [f32; 3],
+    max_step: u32,
+    np: f32,
+    matched_lamps: Option<[bool; 4]>,
+    out: MonitorOutput,
+}
+
+/// Index of the block accumulators.
+const ACC_ID: usize = 0;
+const ACC_IQ: usize = 1;
+const ACC_VQ: usize = 2;
+const ACC_ND: usize = 3;
+const ACC_NQ: usize = 4;
+
+impl Monitor {
+    /// Builds a monitor.
+    ///
+    /// # Errors
+    /// The first [`ConfigError`] found by [`MonitorConfig::validate`].
+    pub fn new(cfg: MonitorConfig) -> Result<Self, ConfigError> {
+        cfg.validate()?;
+        let dt = 1.0 / cfg.sample_rate_hz;
+        let dec = f32::from(cfg.decimation);
+        let slow_dt = dt * dec;
+        let slow_hz = cfg.sample_rate_hz / dec;
+        let m = &cfg.motor;
+        let imr_min = 0.05 * cfg.v_phase_peak / (TAU * cfg.supply_hz * m.ls_h);
+        let reference = Operating {
+            iqs: 0.0,
+            i_f: cfg.v_phase_peak / (TAU * cfg.supply_hz * m.ls_h),
+            vqs: cfg.v_phase_peak,
+            wr: TAU * cfg.supply_hz,
+        };
+        let sum_lp = 5.0f32.min(0.2 * slow_hz);
+        Ok(Monitor {
+            zc: ZeroCrossing::new(dt, cfg.supply_hz, 0.2 * cfg.supply_hz, 4.0 * cfg.supply_hz, 0.02 * cfg.v_phase_peak),
+            pll: SrfPll::new(dt, cfg.supply_hz, cfg.pll_bw_hz, cfg.v_phase_peak),
+            rfo: RotorFluxCurrentModel::new(dt, m.rr_ohm, m.lr_h, imr_min),
+            mt: MtSpeed::new(&cfg.encoder, cfg.tick_hz),
+            sc: SinCos::default(),
+            dt,
+            v_max_bits: cfg.limits.v_max.to_bits(),
+            i_max_bits: cfg.limits.i_max.to_bits(),
+            block_sat: 0,
+            block_vmax: 0,
+            block_imax: 0,
+            acc: [0.0; 5],
+            acc_n: 0,
+            f_iqs: Svf::new(cfg.filter_hz, slow_dt),
+            f_ids: Svf::new(cfg.filter_hz, slow_dt),
+            f_vqs: Svf::new(cfg.filter_hz, slow_dt),
+            f_wr: Svf::new(cfg.filter_hz, slow_dt),
+            f_nd: Svf::new(cfg.sequence_hz, slow_dt),
+            f_nq: Svf::new(cfg.sequence_hz, slow_dt),
+            vmag: LowPass::new(sum_lp, slow_dt),
+            isum: LowPass::new(sum_lp, slow_dt),
+            imax: LowPass::new(sum_lp, slow_dt),
+            vsum: LowPass::new(sum_lp, slow_dt),
+            vmax: LowPass::new(sum_lp, slow_dt),
+            norm: Normaliser::new(m, reference, cfg.floor_fraction),
+            lamps: Lamps::new(cfg.thresholds),
+            welford: Welford::default(),
+            commission_total: 0,
+            commission_left: 0,
+            settle_left: (cfg.settle_s * slow_hz) as u32,
+            settle_blocks: (cfg.settle_s * slow_hz) as u32,
+            hold_blocks: slow_hz as u32,
+            sensor_hold: [0; 3],
+            report_countdown: 0,
+            report_every: ((0.1 * slow_hz) as u16).max(1),
+            gate_left: 0,
+            gate_blocks: (cfg.gate_hold_s * slow_hz) as u32,
+            // Floors of the relative rates: magnetising current, 10 % voltage, 10 % speed.
+            gate_floor: [reference.i_f, 0.1 * cfg.v_phase_peak, 0.1 * TAU * cfg.supply_hz],
+            // Largest believable counter step per sample (validated to fit the counter).
+            max_step: (cfg.limits.max_speed_rad_s / TAU * cfg.encoder.counts_per_rev as f32 * dt) as u32 + 2,
+            np: m.np(),
+            matched_lamps: None,
+            out: MonitorOutput::default(),
+            cfg,
+        })
+    }
+
+    /// The fault signature matrix the lamps are matched against: the physical one for
+    /// rotor-flux orientation, the paper's Table 1 for voltage orientation (see
+    /// [`crate::signature`]).
+    pub fn signatures(&self) -> &'static [[bool; 4]; FAULT_COUNT] {
+        match self.cfg.angle_source {
+            AngleSource::RotorFlux => &crate::signature::ROTOR_FLUX_SIGNATURES,
+            AngleSource::Pll | AngleSource::ZeroCrossing => &TABLE1,
+        }
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &MonitorConfig {
+        &self.cfg
+    }
+
+    /// Starts learning the healthy statistics over the next `duration_s` seconds of
+    /// evaluated running (time without voltage or during settling does not count). Lamps
+    /// stay off while learning. A non-positive or non-finite duration is ignored.
+    pub fn start_commissioning(&mut self, duration_s: f32) {
+        if !(duration_s.is_finite() && duration_s > 0.0) {
+            return;
+        }
+        let slow_hz = self.cfg.sample_rate_hz / f32::from(self.cfg.decimation);
+        let n = (duration_s * slow_hz).clamp(1.0, 4.0e9) as u32;
+        self.welford = Welford::default();
+        self.commission_total = n;
+        self.commission_left = n;
+        self.lamps.reset();
+    }
+
+    /// The calibration in use, if commissioned.
+    pub fn calibration(&self) -> Option<Calibration> {
+        self.lamps.calibration()
+    }
+
+    /// Installs a stored calibration.
+    ///
+    /// # Errors
+    /// [`ConfigError::Calibration`] when a value is not finite or out of range; the monitor
+    /// then keeps its previous thresholds.
+    pub fn set_calibration(&mut self, cal: Calibration) -> Result<(), ConfigError> {
+        if !cal.is_valid() {
+            return Err(ConfigError::Calibration);
+        }
+        self.lamps.set_calibration(Some(cal));
+        self.commission_left = 0;
+        Ok(())
+    }
+
+    /// Forgets the calibration (back to fixed thresholds).
+    pub fn clear_calibration(&mut self) {
+        self.lamps.set_calibration(None);
+    }
+
+    /// The last output.
+    pub fn output(&self) -> &MonitorOutput {
+        &self.out
+    }
+
+    /// Processes one sample and returns the updated output. Never panics: a non-finite,
+    /// out-of-range or saturated reading is held out of the estimators and flags its sensor.
+    pub fn update(&mut self, s: &Sample) -> &MonitorOutput {
+        // Plausibility is checked once per block (slow path): the ADC flags are collected
+        // here, the values' range and finiteness are checked on the block's extremes there.
+        // A NaN or absurd reading poisons only its own block, which is then discarded.
+        self.block_sat |= u8::from(s.i_saturated) | (u8::from(s.v_saturated) << 1);
+        let m = 0x7fff_ffffu32;
+        let vb = (s.v_abc.a.to_bits() & m).max(s.v_abc.b.to_bits() & m).max(s.v_abc.c.to_bits() & m);
+        let ib = (s.i_abc.a.to_bits() & m).max(s.i_abc.b.to_bits() & m).max(s.i_abc.c.to_bits() & m);
+        self.block_vmax = self.block_vmax.max(vb);
+        self.block_imax = self.block_imax.max(ib);
+        let speed = self.mt.update_checked(s.encoder_count, s.timestamp_ticks, self.max_step);
+        let wm = match speed {
+            Some(w) => w,
+            None => {
+                self.flag([false, false, true]);
+                // A jump is not motion: keep the last speed.
+                self.out.speed_rad_s
+            }
+        };
+        self.out.speed_rad_s = wm;
+        let wr = wm * self.np;
+
+        let v = clarke(s.v_abc);
+        let i = clarke(s.i_abc);
+        // One trig evaluation per block; between resyncs the frame's sin/cos is advanced by
+        // small rotations (SinCos::rotated) at the estimator's frequency.
+        let sc = match self.cfg.angle_source {
+            AngleSource::ZeroCrossing => SinCos::from_angle(self.zc.update(s.v_abc.a)),
+            AngleSource::Pll => {
+                let sc_pll = self.sc;
+                let w = self.pll.update(v, sc_pll);
+                self.sc = sc_pll.rotated(w * self.dt);
+                sc_pll.minus_quarter_turn()
+            }
+            AngleSource::RotorFlux => self.sc,
+        };
+        let i_dq: Dq = park(i, sc);
+        if self.cfg.angle_source == AngleSource::RotorFlux {
+            self.rfo.update(i_dq, wr);
+            self.sc = sc.rotated(self.rfo.omega_rad_s() * self.dt);
+        }
+        let v_q = -v.alpha * sc.sin + v.beta * sc.cos;
+        let n = park(i, sc.negated());
+        self.acc[ACC_ID] += i_dq.d;
+        self.acc[ACC_IQ] += i_dq.q;
+        self.acc[ACC_VQ] += v_q;
+        self.acc[ACC_ND] += n.d;
+        self.acc[ACC_NQ] += n.q;
+        self.acc_n += 1;
+        if self.acc_n >= self.cfg.decimation {
+            self.slow_path(s, wr);
+        }
+        &self.out
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn flag(&mut self, bad: [bool; 3]) {
+        for (h, b) in self.sensor_hold.iter_mut().zip(bad) {
+            if b {
+                *h = self.hold_blocks.max(1);
+            }
+        }
+        self.out.sensor_fault = SensorFlags {
+            current: self.sensor_hold[0] > 0,
+            voltage: self.sensor_hold[1] > 0,
+            speed: self.sensor_hold[2] > 0,
+        };
+        let sf = self.out.sensor_fault;
+        // An impossible reading names its sensor outright.
+        let mut p = [0.0f32; FAULT_COUNT];
+        let n = [sf.current, sf.voltage, sf.speed].iter().filter(|x| **x).count().max(1) as f32;
+        for (flag, fault) in [
+            (sf.current, Fault::CurrentSensor),
+            (sf.voltage, Fault::VoltageSensor),
+            (sf.speed, Fault::SpeedSensor),
+        ] {
+            if flag {
+                if let Some(x) = p.get_mut(fault.index()) {
+                    *x = 1.0 / n;
+                }
+            }
+        }
+        self.out.diagnosis = Diagnosis {
+            probabilities: p,
+            exact: true,
+        };
+        self.out.fault_detected = true;
+    }
+
+    /// Discards the current block after an impossible reading and restarts the angle
+    /// estimators if a bad value reached them.
+    #[cold]
+    #[inline(never)]
+    fn discard_block(&mut self) {
+        self.acc = [0.0; 5];
+        self.acc_n = 0;
+        self.settle_left = self.settle_blocks;
+        let dt = 1.0 / self.cfg.sample_rate_hz;
+        let m = &self.cfg.motor;
+        if !(self.rfo.theta().is_finite() && self.rfo.imr().is_finite() && self.rfo.omega_rad_s().is_finite()) {
+            let imr_min = 0.05 * self.cfg.v_phase_peak / (TAU * self.cfg.supply_hz * m.ls_h);
+            self.rfo = RotorFluxCurrentModel::new(dt, m.rr_ohm, m.lr_h, imr_min);
+        }
+        if !(self.pll.theta_pll().is_finite() && self.pll.omega_rad_s().is_finite()) {
+            self.pll = SrfPll::new(dt, self.cfg.supply_hz, self.cfg.pll_bw_hz, self.cfg.v_phase_peak);
+        }
+        self.zc = ZeroCrossing::new(dt, self.cfg.supply_hz, 0.2 * self.cfg.supply_hz, 4.0 * self.cfg.supply_hz, 0.02 * self.cfg.v_phase_peak);
+        self.sc = SinCos::default();
+    }
+
+
+    // Kept out of line so the per-sample path does not carry its register pressure.
+    #[inline(never)]
+    fn slow_path(&mut self, s: &Sample, wr: f32) {
+        // Plausibility of the block: saturation flags, range (NaN and inf fail, see update).
+        let i_bad = (self.block_sat & 1 != 0) | (self.block_imax > self.i_max_bits);
+        let v_bad = (self.block_sat & 2 != 0) | (self.block_vmax > self.v_max_bits);
+        self.block_sat = 0;
+        self.block_imax = 0;
+        self.block_vmax = 0;
+        if i_bad | v_bad {
+            self.flag([i_bad, v_bad, false]);
+            self.discard_block();
+            return;
+        }
+        // Resynchronise the frame's sin/cos with the estimator's angle.
+        match self.cfg.angle_source {
+            AngleSource::Pll => self.sc = SinCos::from_angle(self.pll.theta_pll()),
+            AngleSource::RotorFlux => self.sc = SinCos::from_angle(self.rfo.theta()),
+            AngleSource::ZeroCrossing => {}
+        }
+        let k = 1.0 / f32::from(self.acc_n.max(1));
+        let a = self.acc;
+        self.acc = [0.0; 5];
+        self.acc_n = 0;
+        let (ids, iqs, vqs) = (a[ACC_ID] * k, a[ACC_IQ] * k, a[ACC_VQ] * k);
+        self.f_iqs.update(iqs);
+        self.f_ids.update(ids);
+        self.f_vqs.update(vqs);
+        self.f_wr.update(wr);
+        self.f_nd.update(a[ACC_ND] * k);
+        self.f_nq.update(a[ACC_NQ] * k);
+        self.out.frame_omega_rad_s = match self.cfg.angle_source {
+            AngleSource::ZeroCrossing => self.zc.omega_rad_s(),
+            AngleSource::Pll => self.pll.omega_rad_s(),
+            AngleSource::RotorFlux => self.rfo.omega_rad_s(),
+        };
+
+        // Voltage magnitude (frame independent) and sum checks, on this block's last sample
+        // (3-wire machine: ia + ib + ic = 0).
+        let vab = clarke(s.v_abc);
+        self.vmag.update(crate::fast_hypot(vab.alpha, vab.beta));
+        let l = self.cfg.limits;
+        let i = s.i_abc;
+        self.isum.update((i.a + i.b + i.c).abs());
+        self.imax.update(crate::maxf(crate::maxf(i.a.abs(), i.b.abs()), i.c.abs()));
+        let i_bad = self.isum.y > l.current_sum_frac * self.imax.y + 1e-3 * l.i_max;
+        let mut v_bad = false;
+        if l.voltage_sum_frac > 0.0 {
+            let v = s.v_abc;
+            self.vsum.update((v.a + v.b + v.c).abs());
+            self.vmax.update(crate::maxf(crate::maxf(v.a.abs(), v.b.abs()), v.c.abs()));
+            v_bad = self.vsum.y > l.voltage_sum_frac * self.vmax.y + 1e-3 * l.v_max;
+        }
+        if i_bad | v_bad {
+            self.flag([i_bad, v_bad, false]);
+        }
+        let was_flagged = self.out.sensor_fault.any();
+        for h in self.sensor_hold.iter_mut() {
+            *h = h.saturating_sub(1);
+        }
+        self.out.sensor_fault = SensorFlags {
+            current: self.sensor_hold[0] > 0,
+            voltage: self.sensor_hold[1] > 0,
+            speed: self.sensor_hold[2] > 0,
+        };
+        if was_flagged && !self.out.sensor_fault.any() {
+            self.out.diagnosis = Diagnosis::default();
+        }
+        self.settle_left = self.settle_left.saturating_sub(1);
+
+        let op = Operating {
+            iqs: self.f_iqs.y,
+            i_f: self.f_ids.y,
+            vqs: self.f_vqs.y,
+            wr: self.f_wr.y,
+        };
+        self.out.operating = op;
+        let d = match self.cfg.residual_form {
+            ResidualForm::Steady => None,
+            ResidualForm::Full => Some(Derivatives {
+                diqs: self.f_iqs.dy,
+                ddiqs: self.f_iqs.ddy(iqs),
+                dwr: self.f_wr.dy,
+                ddwr: self.f_wr.ddy(wr),
+                dvqs: self.f_vqs.dy,
+            }),
+        };
+        let raw = residuals(&self.cfg.motor, op, d);
+        let Some(rn) = self.norm.apply(&raw) else {
+            return;
+        };
+        self.out.residuals = rn;
+        // Quasi-steady-state gate on the filtered derivatives.
+        let g = self.cfg.steady_gate_per_s;
+        if g > 0.0 {
+            let [fi, fv, fw] = self.gate_floor;
+            let fast = self.f_iqs.dy.abs() > g * (self.f_iqs.y.abs() + fi)
+                || self.f_ids.dy.abs() > g * (self.f_ids.y.abs() + fi)
+                || self.f_vqs.dy.abs() > g * (self.f_vqs.y.abs() + fv)
+                || self.f_wr.dy.abs() > g * (self.f_wr.y.abs() + fw);
+            if fast {
+                self.gate_left = self.gate_blocks.max(1);
+            } else {
+                self.gate_left = self.gate_left.saturating_sub(1);
+            }
+        }
+        self.out.quasi_steady = self.gate_left == 0;
+        let running = self.settle_left == 0
+            && self.vmag.y > self.cfg.min_voltage_frac * self.cfg.v_phase_peak
+            && !self.out.sensor_fault.any();
+        if self.commission_left > 0 {
+            if running && self.out.quasi_steady {
+                self.welford.push(rn);
+                self.commission_left -= 1;
+                if self.commission_left == 0 {
+                    self.lamps.set_calibration(Some(self.welford.calibration()));
+                }
+            }
+            self.out.lamps = [false; 4];
+        } else if running && self.out.quasi_steady {
+            let slow_dt = f32::from(self.cfg.decimation) / self.cfg.sample_rate_hz;
+            self.out.lamps = self.lamps.update(rn, slow_dt);
+        }
+        self.out.evaluating = running && self.out.quasi_steady && self.commission_left == 0;
+        self.out.commissioning = if self.commission_left > 0 {
+            let total = self.commission_total.max(1) as f32;
+            Commissioning::Learning(1.0 - self.commission_left as f32 / total)
+        } else if self.lamps.calibration().is_some() {
+            Commissioning::Commissioned
+        } else {
+            Commissioning::NotCommissioned
+        };
+        if self.out.sensor_fault.any() {
+            self.matched_lamps = None;
+        } else if self.matched_lamps != Some(self.out.lamps) {
+            // Matching only when the lamps change.
+            self.out.diagnosis = match_signature(self.out.lamps, self.signatures());
+            self.matched_lamps = Some(self.out.lamps);
+        }
+        // Negative sequence: ten times a second is plenty for a 2 Hz filter.
+        if self.report_countdown == 0 {
+            self.report_countdown = self.report_every;
+            let we = self.out.frame_omega_rad_s;
+            let slip = if we.abs() > 1.0 { 1.0 - op.wr / we } else { 0.0 };
+            let corr = asymmetry_correction_rad(&self.cfg.motor, we.abs().max(1.0), slip);
+            self.out.unbalance = sequence_result(
+                (self.f_ids.y, self.f_iqs.y),
+                (self.f_nd.y, self.f_nq.y),
+                corr,
+                self.cfg.unbalance_min_ratio,
+            );
+        }
+        self.report_countdown -= 1;
+        self.out.fault_detected = self.out.sensor_fault.any() || self.out.lamps.iter().any(|x| *x);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn motor() -> MotorModel {
+        let w = TAU * 60.0;
+        MotorModel {
+            rs_ohm: 0.435,
+            rr_ohm: 0.816,
+            ls_h: (26.13 + 0.754) / w,
+            lr_h: (26.13 + 0.754) / w,
+            lm_h: 26.13 / w,
+            pole_pairs: 2,
+            j_kgm2: 0.089,
+            b_nms: 0.002,
+            bl_nms: 0.045,
+        }
+    }
+
+    fn monitor(src: AngleSource) -> Monitor {
+        let mut cfg = MonitorConfig::new(motor(), 60.0, 220.0, 10_000.0);
+        cfg.angle_source = src;
+        cfg.limits.i_max = 200.0;
+        match Monitor::new(cfg) {
+            Ok(m) => m,
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    /// A balanced supply and a balanced current lagging by 30 degrees, shaft at 1750 rpm.
+    fn healthy(k: u32) -> Sample {
+        let t = k as f32 * 1e-4;
+        let w = TAU * 60.0 * t;
+        let v = 179.6;
+        let i = 10.0;
+        let ph = |x: f32| [x.cos(), (x - TAU / 3.0).cos(), (x + TAU / 3.0).cos()];
+        let (pv, pi) = (ph(w), ph(w - 0.5));
+        let wm = 1750.0 / 60.0 * TAU;
+        Sample {
+            v_abc: Abc { a: v * pv[0], b: v * pv[1], c: v * pv[2] },
+            i_abc: Abc { a: i * pi[0], b: i * pi[1], c: i * pi[2] },
+            encoder_count: (wm * t / TAU * 4096.0) as u32,
+            timestamp_ticks: (t * 1e6) as u32,
+            v_saturated: false,
+            i_saturated: false,
+        }
+    }
+
+    #[test]
+    fn bad_configuration_is_rejected_when_built() {
+        let good = MonitorConfig::new(motor(), 60.0, 220.0, 10_000.0);
+        assert!(Monitor::new(good).is_ok());
+        let mut c = good;
+        c.motor.lm_h = c.motor.ls_h * 1.1;
+        assert_eq!(Monitor::new(c).err(), Some(ConfigError::MotorParameter));
+        let mut c = good;
+        c.sample_rate_hz = 300.0;
+        assert_eq!(Monitor::new(c).err(), Some(ConfigError::SampleRate));
+        let mut c = good;
+        c.encoder.counter_bits = 40;
+        assert_eq!(Monitor::new(c).err(), Some(ConfigError::Encoder));
+        let mut c = good;
+        c.thresholds.hysteresis = 0.0;
+        assert_eq!(Monitor::new(c).err(), Some(ConfigError::Threshold));
+        let mut c = good;
+        c.filter_hz = f32::NAN;
+        assert_eq!(Monitor::new(c).err(), Some(ConfigError::Filter));
+    }
+
+    #[test]
+    fn nan_current_names_the_current_sensor() {
+        let mut m = monitor(AngleSource::Pll);
+        for k in 0..20_000 {
+            m.update(&healthy(k));
+        }
+        // Flagged at the end of the block that held the bad reading (25 samples = 2.5 ms).
+        let mut s = healthy(20_000);
+        s.i_abc.b = f32::NAN;
+        m.update(&s);
+        let mut o = *m.output();
+        for k in 20_001..20_026 {
+            o = *m.update(&healthy(k));
+        }
+        assert!(o.sensor_fault.current && o.fault_detected);
+        assert_eq!(o.top(), Some((Fault::CurrentSensor, 1.0)));
+        // A disconnected phase (reads 0) breaks ia + ib + ic = 0 and is caught too.
+        let mut m = monitor(AngleSource::Pll);
+        let mut last = MonitorOutput::default();
+        for k in 0..5_000 {
+            let mut s = healthy(k);
+            s.i_abc.c = 0.0;
+            last = *m.update(&s);
+        }
+        assert!(last.sensor_fault.current);
+        // And a saturated voltage ADC names the voltage sensor.
+        let mut s = healthy(5_000);
+        s.v_saturated = true;
+        let mut m = monitor(AngleSource::Pll);
+        m.update(&s);
+        for k in 5_001..5_026 {
+            m.update(&healthy(k));
+        }
+        assert_eq!(m.output().top(), Some((Fault::VoltageSensor, 1.0)));
+    }
+
+    #[test]
+    fn encoder_jump_names_the_speed_sensor() {
+        let mut m = monitor(AngleSource::RotorFlux);
+        for k in 0..1000 {
+            m.update(&healthy(k));
+        }
+        let mut s = healthy(1000);
+        s.encoder_count = s.encoder_count.wrapping_add(1 << 30);
+        assert!(m.update(&s).sensor_fault.speed);
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        #[test]
+        fn monitor_never_panics_and_stays_finite(
+            vals in proptest::collection::vec(
+                prop_oneof![
+                    Just(f32::NAN), Just(f32::INFINITY), Just(f32::NEG_INFINITY), Just(f32::MAX),
+                    Just(-f32::MAX), Just(0.0f32), -1e6f32..1e6, -300f32..300.0,
+                ], 6..60),
+            counts in proptest::collection::vec(any::<u32>(), 1..20),
+            src in prop_oneof![Just(AngleSource::RotorFlux), Just(AngleSource::Pll), Just(AngleSource::ZeroCrossing)],
+        ) {
+            let mut m = monitor(src);
+            m.start_commissioning(0.01);
+            let mut bad_in_block = false;
+            for k in 0..3000u32 {
+                let s = if k % 3 == 0 {
+                    let j = k as usize;
+                    let g = |o: usize| vals[(j + o) % vals.len()];
+                    Sample {
+                        v_abc: Abc { a: g(0), b: g(1), c: g(2) },
+                        i_abc: Abc { a: g(3), b: g(4), c: g(5) },
+                        encoder_count: counts[j % counts.len()],
+                        timestamp_ticks: k.wrapping_mul(100),
+                        v_saturated: k % 7 == 0,
+                        i_saturated: false,
+                    }
+                } else {
+                    healthy(k)
+                };
+                let o = *m.update(&s);
+                prop_assert!(o.residuals.iter().all(|r| r.is_finite() && r.abs() <= 1.0));
+                prop_assert!(o.diagnosis.probabilities.iter().all(|p| p.is_finite()));
+                prop_assert!(o.speed_rad_s.is_finite());
+                bad_in_block |= !(s.v_abc.a.is_finite() && s.v_abc.b.is_finite() && s.v_abc.c.is_finite()
+                    && s.i_abc.a.is_finite() && s.i_abc.b.is_finite() && s.i_abc.c.is_finite());
+                // Checked at the end of each 25-sample block.
+                if k % 25 == 24 {
+                    if bad_in_block {
+                        prop_assert!(o.sensor_fault.any() && o.top().is_some_and(|(f, _)| f.is_sensor()));
+                    }
+                    bad_in_block = false;
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,221 @@
+//! Negative-sequence analysis of the phase currents: how unbalanced, and which phase.
+//!
+//! The current vector of a machine with a (small) asymmetry is
+//! `i(t) = I1 e^{j w t} + conj(I2) e^{-j w t}` with the symmetrical-component phasors
+//! `I1 = (Ia + a Ib + a^2 Ic)/3`, `I2 = (Ia + a^2 Ib + a Ic)/3`, `a = e^{j 2pi/3}`.
+//! Park with any angle `theta` that turns at the supply frequency and low-pass filtering
+//! give `P = I1 e^{-j theta0}` and, with `-theta`, `N = conj(I2) e^{j theta0}`; so
+//! `I2/I1 = conj(N)/P` whatever the angle's offset `theta0`.
+//!
+//! Suspect phase: an impedance change `dZ` in phase k of a star-connected machine with an
+//! isolated neutral on a balanced supply drives, to first order, `I2 = -dZ I1 a^k / (3 Z2)`
+//! (k = 0, 1, 2 for a, b, c; Z2 = negative-sequence impedance). Shorted turns reduce the
+//! phase's whole impedance, `dZ ~ -eps Z1`, so `I2/I1 ~ (eps/3)(Z1/Z2) a^k`: the angle of
+//! `I2/I1` minus `arg(Z1/Z2)` is a multiple of 120 degrees that names the phase. `Z1 = Z(s)`
+//! and `Z2 = Z(2 - s)` come from the T-equivalent circuit at the present slip
+//! ([`asymmetry_correction_rad`]). The angle depends strongly on load (Z1 is mostly
+//! inductive at no load, mostly resistive at full load), which is why the correction is
+//! computed at the operating point. A supply unbalance gives a negative sequence too; this
+//! analysis cannot tell the two apart without the voltages (see the host's `explain`).
+
+use crate::filter::Svf;
+use crate::frames::{park, AlphaBeta, SinCos};
+use crate::residuals::MotorModel;
+use micromath::F32Ext;
+
+/// A phase of the machine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Phase {
+    /// Phase a.
+    A,
+    /// Phase b.
+    B,
+    /// Phase c.
+    C,
+}
+
+impl Phase {
+    /// "a", "b" or "c".
+    pub fn name(self) -> &'static str {
+        match self {
+            Phase::A => "a",
+            Phase::B => "b",
+            Phase::C => "c",
+        }
+    }
+}
+
+/// Result of the negative-sequence analysis.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Unbalance {
+    /// |I2| / |I1|, dimensionless, >= 0.
+    pub negative_sequence_ratio: f32,
+    /// arg(I2/I1) [rad], in (-pi, pi].
+    pub angle_rad: f32,
+    /// The phase whose winding the asymmetry points at; None below the ratio threshold.
+    pub suspect_phase: Option<Phase>,
+}
+
+/// Streaming positive/negative-sequence separation.
+#[derive(Debug, Clone, Copy)]
+pub struct SequenceAnalyzer {
+    pd: Svf,
+    pq: Svf,
+    nd: Svf,
+    nq: Svf,
+}
+
+impl SequenceAnalyzer {
+    /// Critically damped second-order filters with corner `fc_hz` (default 2 Hz): the
+    /// other sequence appears at twice the supply frequency and is attenuated by
+    /// `(fc / 2f)^2` (1.6e-3 at 50 Hz), so a 10:1 positive sequence leaks less than 2 % into
+    /// a negative-sequence reading.
+    pub fn new(fc_hz: f32, dt_s: f32) -> Self {
+        let f = Svf::new(fc_hz, dt_s);
+        SequenceAnalyzer {
+            pd: f,
+            pq: f,
+            nd: f,
+            nq: f,
+        }
+    }
+
+    /// Feeds the current vector and the sin/cos of an angle turning at the supply frequency.
+    #[inline]
+    pub fn update(&mut self, i: AlphaBeta, sc: SinCos) {
+        let p = park(i, sc);
+        let n = park(i, sc.negated());
+        self.pd.update(p.d);
+        self.pq.update(p.q);
+        self.nd.update(n.d);
+        self.nq.update(n.q);
+    }
+
+    /// |I1|, the positive-sequence current magnitude (phase peak) [A].
+    pub fn positive_magnitude(&self) -> f32 {
+        crate::fast_hypot(self.pd.y, self.pq.y)
+    }
+
+    /// Ratio, angle and suspect phase, given the model correction `arg(Z1/Z2)` and the
+    /// ratio below which no phase is named.
+    pub fn result(&self, correction_rad: f32, min_ratio: f32) -> Unbalance {
+        sequence_result((self.pd.y, self.pq.y), (self.nd.y, self.nq.y), correction_rad, min_ratio)
+    }
+}
+
+/// Ratio, angle and suspect phase from the filtered Park components `P = (pd, pq)` (frame
+/// at +theta) and `N = (nd, nq)` (at -theta): `I2/I1 = conj(N)/P` (module docs).
+pub fn sequence_result(p: (f32, f32), n: (f32, f32), correction_rad: f32, min_ratio: f32) -> Unbalance {
+    let p2 = p.0 * p.0 + p.1 * p.1;
+    let n2 = n.0 * n.0 + n.1 * n.1;
+    if !(p2 > 1e-12 && n2.is_finite()) {
+        return Unbalance::default();
+    }
+    let ratio = crate::sqrt(n2 / p2);
+    let angle = crate::frames::wrap_angle(F32Ext::atan2(-n.1, n.0) - F32Ext::atan2(p.1, p.0));
+    let suspect = if ratio >= min_ratio {
+        let third = core::f32::consts::TAU / 3.0;
+        let k = F32Ext::round(crate::frames::wrap_angle(angle - correction_rad) / third) as i32;
+        Some(match k.rem_euclid(3) {
+            0 => Phase::A,
+            1 => Phase::B,
+            _ => Phase::C,
+        })
+    } else {
+        None
+    };
+    Unbalance {
+        negative_sequence_ratio: ratio,
+        angle_rad: angle,
+        suspect_phase: suspect,
+    }
+}
+
+/// Impedance of the T-equivalent circuit per phase at slip `s` and supply `we` [rad/s]:
+/// `Z = Rs + j we Lls + (j we Lm || (Rr/s + j we Llr))`, as (re, im) [ohm].
+/// `s` is kept at least 1e-4 in magnitude.
+pub fn equivalent_impedance(m: &MotorModel, we: f32, s: f32) -> (f32, f32) {
+    let s = if s.abs() < 1e-4 { 1e-4f32.copysign(s) } else { s };
+    let xm = we * m.lm_h;
+    let (rr, xr) = (m.rr_ohm / s, we * (m.lr_h - m.lm_h));
+    // (j xm)(rr + j xr) / (rr + j (xm + xr))
+    let (nr, ni) = (-xm * xr, xm * rr);
+    let (dr, di) = (rr, xm + xr);
+    let den = dr * dr + di * di;
+    let (pr, pi) = if den > 0.0 {
+        ((nr * dr + ni * di) / den, (ni * dr - nr * di) / den)
+    } else {
+        (0.0, 0.0)
+    };
+    (m.rs_ohm + pr, we * (m.ls_h - m.lm_h) + pi)
+}
+
+/// `arg(Z1/Z2) = arg Z(s) - arg Z(2 - s)` [rad]: the angle between a winding asymmetry's
+/// negative-sequence current and the phase it sits in (module docs).
+pub fn asymmetry_correction_rad(m: &MotorModel, we: f32, s: f32) -> f32 {
+    let z1 = equivalent_impedance(m, we, s);
+    let z2 = equivalent_impedance(m, we, 2.0 - s);
+    crate::frames::wrap_angle(F32Ext::atan2(z1.1, z1.0) - F32Ext::atan2(z2.1, z2.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frames::{clarke, Abc};
+    use core::f32::consts::TAU;
+
+    #[test]
+    fn ratio_and_angle_of_a_known_unbalance() {
+        // Phase currents with I1 = 10, I2 = 1 at +40 degrees relative to I1 (phasor convention
+        // I2 = (Ia + a^2 Ib + a Ic)/3).
+        let dt = 1e-4;
+        let mut s = SequenceAnalyzer::new(2.0, dt);
+        let w = TAU * 50.0;
+        let phi2 = 40f32.to_radians();
+        for k in 0..40000 {
+            let t = k as f32 * dt;
+            let ph = |shift: f32, neg: bool| {
+                if neg {
+                    (w * t + phi2 - shift).cos()
+                } else {
+                    (w * t + shift).cos()
+                }
+            };
+            // Positive sequence: a, b = a lagging 120, c = leading 120. Negative: b leads.
+            let i = Abc {
+                a: 10.0 * ph(0.0, false) + ph(0.0, true),
+                b: 10.0 * ph(-TAU / 3.0, false) + ph(-TAU / 3.0, true),
+                c: 10.0 * ph(TAU / 3.0, false) + ph(TAU / 3.0, true),
+            };
+            let theta = w * t + 0.3;
+            s.update(clarke(i), SinCos { sin: theta.sin(), cos: theta.cos() });
+        }
+        let u = s.result(0.0, 0.01);
+        assert!((u.negative_sequence_ratio - 0.1).abs() < 0.003, "{u:?}");
+        assert!((u.angle_rad - phi2).abs() < 0.03, "{u:?}");
+        assert_eq!(u.suspect_phase, Some(Phase::A));
+    }
+
+    #[test]
+    fn correction_follows_the_equivalent_circuit() {
+        let w = 2.0 * core::f32::consts::PI * 60.0;
+        let m = MotorModel {
+            rs_ohm: 0.435,
+            rr_ohm: 0.816,
+            ls_h: (26.13 + 0.754) / w,
+            lr_h: (26.13 + 0.754) / w,
+            lm_h: 26.13 / w,
+            pole_pairs: 2,
+            j_kgm2: 0.089,
+            b_nms: 0.002,
+            bl_nms: 0.045,
+        };
+        // No load: Z1 ~ Rs + j Xs is nearly inductive; Z2 ~ Rs + Rr/2 + j(Xls + Xlr).
+        let z1 = equivalent_impedance(&m, w, 1e-4);
+        assert!((z1.1 - 26.884).abs() < 0.05 && z1.0 < 0.6, "{z1:?}");
+        let c0 = asymmetry_correction_rad(&m, w, 0.001);
+        let c5 = asymmetry_correction_rad(&m, w, 0.05);
+        // The correction falls with load as Z1 turns resistive.
+        assert!(c0 > c5 + 0.3, "{c0} {c5}");
+    }
+}

@@ -1,0 +1,113 @@
+//! Discrepancy-analysis benchmark (DESIGN.md §4): `compare` + `explain` on a 1 h log at
+//! 10 kHz (36 M samples), goal <= 10 s on 2 cores with bounded memory.
+//!
+//! Run: `cargo bench -p sim-host --bench analysis` (release profile). The log is generated
+//! once with the simulator (2.2 kW motor, thermal drift with a 20 min time constant,
+//! default sensors) into `$ANALYSIS_BENCH_LOG` (default `/tmp/sim-host-bench-1h.csv`,
+//! about 2.9 GB) and reused. `ANALYSIS_BENCH_SECONDS` shortens the log (default 3600).
+//! Prints wall times of the read (parse + decimate + frame), `compare`, `explain`, and the
+//! peak resident memory (VmHWM).
+
+use sim_host::analysis::{prep::ReadOptions, Analysis, Options};
+use sim_host::log::{Channels, LogWriter};
+use sim_host::params::ParamFile;
+use sim_host::sim::{self, Effect, Scenario, SensorSpec};
+use std::path::PathBuf;
+use std::time::Instant;
+
+fn peak_rss_mb() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines().find(|l| l.starts_with("VmHWM:")).and_then(|l| {
+                l.split_whitespace()
+                    .nth(1)
+                    .and_then(|v| v.parse::<f64>().ok())
+            })
+        })
+        .map(|kb| kb / 1024.0)
+        .unwrap_or(f64::NAN)
+}
+
+fn main() {
+    let secs: f64 = std::env::var("ANALYSIS_BENCH_SECONDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(3600.0);
+    let path = PathBuf::from(
+        std::env::var("ANALYSIS_BENCH_LOG")
+            .unwrap_or_else(|_| format!("/tmp/sim-host-bench-{}s.csv", secs as u64)),
+    );
+    let p = ParamFile::reference_2p2kw();
+    if !path.exists() {
+        let mut s = Scenario::steady(secs, 10_000.0);
+        s.sensors = SensorSpec::default();
+        s.effects = vec![Effect::ThermalDrift {
+            rise_k: Some(60.0),
+            tau_s: 1200.0_f64.min(secs / 3.0),
+            at_s: 0.0,
+            r_th_k_per_w: None,
+            alpha_per_k: 0.00393,
+            rotor: true,
+        }];
+        let t = Instant::now();
+        let mut w = LogWriter::create(
+            &path,
+            Channels {
+                voltages: true,
+                speed: true,
+                encoder: false,
+            },
+        )
+        .expect("create log");
+        sim::simulate(&p, &s, |r| {
+            let mut r = *r;
+            r.enc_count = None;
+            w.write_row(&r).expect("write row");
+        })
+        .expect("simulate");
+        w.finish().expect("finish log");
+        eprintln!(
+            "generated {} in {:.1} s",
+            path.display(),
+            t.elapsed().as_secs_f64()
+        );
+    }
+    let size = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+    let t0 = Instant::now();
+    let a = Analysis::load(
+        &path,
+        p,
+        ReadOptions {
+            from_s: 1.0,
+            to_s: f64::INFINITY,
+        },
+        &mut |_| {},
+    )
+    .expect("load");
+    let t_read = t0.elapsed().as_secs_f64();
+    let opts = Options {
+        effects: vec![],
+        fit_base: true,
+    };
+    let t1 = Instant::now();
+    let c = a.compare(&opts).expect("compare");
+    let t_cmp = t1.elapsed().as_secs_f64();
+    let t2 = Instant::now();
+    let e = a.explain(&opts, &|_| {}).expect("explain");
+    let t_exp = t2.elapsed().as_secs_f64();
+    println!(
+        "analysis bench: {} rows ({:.2} GB), {} threads: read+frame {:.2} s, compare {:.2} s, explain {:.2} s, total {:.2} s; peak RSS {:.0} MB; working samples {}; error {:.4}, top {:?}",
+        a.data.rows,
+        size as f64 / 1e9,
+        rayon::current_num_threads(),
+        t_read,
+        t_cmp,
+        t_exp,
+        t_read + t_cmp + t_exp,
+        peak_rss_mb(),
+        a.data.len(),
+        c.report.normalized_rms_error,
+        e.report.ranking.first().map(|r| (&r.effect, r.explained_fraction))
+    );
+}

@@ -1,0 +1,924 @@
+//! The effect library: named physical effects the simplified model can be extended with.
+//!
+//! Every effect implements [`Effect`]: its DESIGN.md name, a physical description, its
+//! parameters with units, the way it changes the model equations (in words and in code:
+//! [`Effect::apply`] writes its contribution into [`Terms`]) and a sentence a drives
+//! engineer understands for fitted values ([`Effect::describe`]).
+//!
+//! | name | parameters | model change |
+//! |---|---|---|
+//! | `thermal_drift` | rise_k [K], tau_s [s] | Rs, Rr x (1 + 0.00393 dT(t)), dT = rise (1 - e^{-t/tau}) |
+//! | `saturation` | psi_sat_wb [Wb], exponent [-] | Lm = Lm0 / (1 + (Lm i_f / psi_sat)^n) |
+//! | `iron_loss` | g_fe_s [S] (= 1/Rfe) | I_qs += omega_s Ls i_f / Rfe (core-loss current) |
+//! | `coulomb_friction` | torque_nm [N m] | load += Tc tanh(w_m / 1 rad/s) |
+//! | `windage` | k_nms2 [N m s^2/rad^2] | load += k w_m abs(w_m) |
+//! | `load_torque` | level_1..level_k [N m] | load += piecewise-constant T_L(t) (steps found in the data) |
+//! | `supply_unbalance` | y_re, y_im [-] | i_neg = (y_re + j y_im) v_neg / conj(Z2), Z2 from the nominal parameters |
+//! | `phase_asymmetry` | c_re, c_im [-] | i_neg = (c_re + j c_im) conj(i_pos) |
+//! | `flux_dynamics` | tau_r_s [s] | psi_r/Lm = phi, dphi/dt = (i_f - phi)/tau_r; slip and torque from phi |
+//! | `current_dynamics` | la_h [H] | La dI_qs/dt = V_qs - Ra I_qs - Psi omega_r (eq. 28's derivative term) |
+
+use super::model::{Nominal, Terms};
+use super::prep::{Prepared, C64};
+
+/// Copper temperature coefficient of resistance [1/K] (0.393 %/K at 20 C).
+pub const ALPHA_CU_PER_K: f64 = 0.00393;
+
+/// One parameter of an effect.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ParamSpec {
+    /// Name (JSON key).
+    pub name: &'static str,
+    /// Unit.
+    pub unit: &'static str,
+    /// What it is.
+    pub description: &'static str,
+}
+
+/// What a log must carry for an effect to be fitted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Needs {
+    /// Needs the phase voltages (all model-based effects: the model is driven by V_qs).
+    pub voltages: bool,
+    /// Needs the measured speed.
+    pub speed: bool,
+}
+
+/// Data-dependent set-up of an effect: initial values, bounds and scales of its parameters
+/// (same order as the names), plus any precomputed data (for example load-step times).
+#[derive(Debug, Clone, Default)]
+pub struct Setup {
+    /// Parameter names (for `load_torque` one per segment).
+    pub names: Vec<String>,
+    /// Units, parallel to `names`.
+    pub units: Vec<&'static str>,
+    /// Initial values.
+    pub init: Vec<f64>,
+    /// Lower bounds.
+    pub lo: Vec<f64>,
+    /// Upper bounds.
+    pub hi: Vec<f64>,
+    /// Typical magnitudes (finite-difference steps and conditioning).
+    pub scale: Vec<f64>,
+    /// Effect-specific precomputed numbers.
+    pub data: Vec<f64>,
+}
+
+impl Setup {
+    fn push(&mut self, name: &str, unit: &'static str, init: f64, lo: f64, hi: f64, scale: f64) {
+        self.names.push(name.to_string());
+        self.units.push(unit);
+        self.init.push(init);
+        self.lo.push(lo);
+        self.hi.push(hi);
+        self.scale.push(scale);
+    }
+}
+
+/// A physical effect of the library.
+pub trait Effect: Send + Sync {
+    /// DESIGN.md name (`thermal_drift`, ...).
+    fn name(&self) -> &'static str;
+    /// Physical description, one or two sentences.
+    fn description(&self) -> &'static str;
+    /// How the effect changes the model equations (text with the equation).
+    fn equations(&self) -> &'static str;
+    /// Parameters with units (documentation; [`Effect::setup`] gives the data-dependent list).
+    fn parameters(&self) -> &'static [ParamSpec];
+    /// Channels the log must have.
+    fn needs(&self) -> Needs {
+        Needs {
+            voltages: true,
+            speed: false,
+        }
+    }
+    /// Prepares the fit on this data: initial values, bounds, precomputed data.
+    ///
+    /// # Errors
+    /// A one-line reason when the effect cannot be fitted on this log.
+    fn setup(&self, d: &Prepared, n: &Nominal) -> Result<Setup, String>;
+    /// Writes the effect's contribution for parameter values `p` into `terms`.
+    fn apply(&self, s: &Setup, p: &[f64], d: &Prepared, n: &Nominal, terms: &mut Terms);
+    /// The fitted values in words a drives engineer understands.
+    fn describe(&self, s: &Setup, p: &[f64], d: &Prepared, n: &Nominal) -> String;
+}
+
+fn duration(d: &Prepared) -> f64 {
+    match (d.t_s.first(), d.t_s.last()) {
+        (Some(a), Some(b)) => (b - a).max(d.dt_s),
+        _ => 1.0,
+    }
+}
+
+fn rated_flux_wb(d: &Prepared) -> f64 {
+    // |V|/omega_s over the log (median-free: mean of positive-sequence values).
+    let mut s = 0.0;
+    let mut c = 0.0;
+    for k in 0..d.len() {
+        if d.omega_s[k].abs() > 1.0 {
+            s += (d.vq[k].hypot(d.vd[k])) / d.omega_s[k].abs();
+            c += 1.0;
+        }
+    }
+    if c > 0.0 {
+        s / c
+    } else {
+        1.0
+    }
+}
+
+fn sync_speed_mech(d: &Prepared, n: &Nominal) -> f64 {
+    let mut m = 0.0f64;
+    for &w in &d.omega_s {
+        m = m.max(w.abs());
+    }
+    (m / n.np).max(1.0)
+}
+
+/// Negative-sequence impedance of the machine at supply angular frequency `w` (rotor at
+/// about synchronous speed, so the rotor branch sees slip 2): positive-frequency form
+/// `Rs + j w Lls + (j w Lm) || (Rr/2 + j w Llr)`; the negative-sequence current is
+/// `v_neg / conj(Z2)`.
+pub fn z2_neg(n: &Nominal, w: f64) -> C64 {
+    let w = w.abs().max(1.0);
+    let zm = C64::new(0.0, w * n.lm_h);
+    let zr = C64::new(n.rr_ohm / 2.0, w * n.llr_h);
+    C64::new(n.rs_ohm, w * n.lls_h) + zm * zr / (zm + zr)
+}
+
+/// Stator self impedance `Rs + j w Ls` of one winding.
+pub fn z_self(n: &Nominal, w: f64) -> C64 {
+    C64::new(n.rs_ohm, w.abs() * n.ls_h)
+}
+
+/// Winding temperature rise: Rs and Rr follow copper's coefficient.
+pub struct ThermalDrift;
+/// Main-flux saturation.
+pub struct Saturation;
+/// Core loss.
+pub struct IronLoss;
+/// Dry friction.
+pub struct CoulombFriction;
+/// Fan / windage torque.
+pub struct Windage;
+/// Load as a torque input.
+pub struct LoadTorque;
+/// Negative-sequence supply voltage.
+pub struct SupplyUnbalance;
+/// One stator winding differs.
+pub struct PhaseAsymmetry;
+/// Rotor flux not constant.
+pub struct FluxDynamics;
+/// Stator current transient (La dI/dt).
+pub struct CurrentDynamics;
+
+impl Effect for ThermalDrift {
+    fn name(&self) -> &'static str {
+        "thermal_drift"
+    }
+    fn description(&self) -> &'static str {
+        "The windings heat up with load, so the stator and rotor resistances rise (copper: +0.393 %/K; 20 -> 90 C is +27 %)."
+    }
+    fn equations(&self) -> &'static str {
+        "Rs(t), Rr(t) = R (1 + 0.00393 dT(t)), dT(t) = rise_k (1 - exp(-(t - t0)/tau_s)); Ra = Rs + (Ls/Lr) Rr in eq. (28) follows."
+    }
+    fn parameters(&self) -> &'static [ParamSpec] {
+        &[
+            ParamSpec {
+                name: "rise_k",
+                unit: "K",
+                description: "final winding temperature rise",
+            },
+            ParamSpec {
+                name: "tau_s",
+                unit: "s",
+                description: "thermal time constant",
+            },
+        ]
+    }
+    fn setup(&self, d: &Prepared, _n: &Nominal) -> Result<Setup, String> {
+        let t = duration(d);
+        let mut s = Setup::default();
+        s.push("rise_k", "K", 10.0, -100.0, 400.0, 20.0);
+        s.push("tau_s", "s", t / 3.0, t / 200.0, 20.0 * t, t / 3.0);
+        Ok(s)
+    }
+    fn apply(&self, _s: &Setup, p: &[f64], d: &Prepared, _n: &Nominal, terms: &mut Terms) {
+        let t0 = d.t_s.first().copied().unwrap_or(0.0);
+        let tau = p[1].max(1e-6);
+        terms.r_factor = d
+            .t_s
+            .iter()
+            .map(|t| 1.0 + ALPHA_CU_PER_K * p[0] * (1.0 - (-(t - t0) / tau).exp()))
+            .collect();
+    }
+    fn describe(&self, _s: &Setup, p: &[f64], d: &Prepared, _n: &Nominal) -> String {
+        let t = duration(d);
+        let dt_end = p[0] * (1.0 - (-t / p[1].max(1e-6)).exp());
+        format!(
+            "winding resistance {} {:.0} % over the run ({:.0} s), consistent with about {:.0} K of {} (copper 0.393 %/K); thermal time constant about {:.3} s",
+            if dt_end >= 0.0 { "rises" } else { "falls" },
+            (ALPHA_CU_PER_K * dt_end * 100.0).abs(),
+            t,
+            dt_end.abs(),
+            if dt_end >= 0.0 { "heating" } else { "cooling" },
+            p[1]
+        )
+    }
+}
+
+/// Lm / Lm0 for magnetising current `im` [A]: solves x (1 + (x a)^n) = 1, a = Lm0 im / psi_sat.
+fn sat_factor(lm0: f64, im: f64, psi_sat: f64, nexp: f64) -> f64 {
+    let a = (lm0 * im.abs() / psi_sat.max(1e-9)).max(0.0);
+    if a < 1e-6 {
+        return 1.0;
+    }
+    let an = a.powf(nexp);
+    let mut x = 1.0f64;
+    for _ in 0..30 {
+        let xn = x.powf(nexp);
+        let f = x + x * xn * an - 1.0;
+        let fp = 1.0 + (nexp + 1.0) * xn * an;
+        let nx = (x - f / fp).clamp(1e-3, 1.0);
+        if (nx - x).abs() < 1e-12 {
+            x = nx;
+            break;
+        }
+        x = nx;
+    }
+    x
+}
+
+impl Effect for Saturation {
+    fn name(&self) -> &'static str {
+        "saturation"
+    }
+    fn description(&self) -> &'static str {
+        "The iron of the main flux path saturates: the magnetising inductance Lm falls as the magnetising current (the flux level) rises."
+    }
+    fn equations(&self) -> &'static str {
+        "Lm(i_f) = Lm0 / (1 + (Lm(i_f) i_f / psi_sat)^n), solved per sample; Ls = Lls + Lm and Kf (Lm^2/Lr) in eqs. (28)-(29) follow."
+    }
+    fn parameters(&self) -> &'static [ParamSpec] {
+        &[
+            ParamSpec {
+                name: "psi_sat_wb",
+                unit: "Wb",
+                description: "flux linkage at which Lm has halved",
+            },
+            ParamSpec {
+                name: "exponent",
+                unit: "1",
+                description: "sharpness of the saturation knee",
+            },
+        ]
+    }
+    fn setup(&self, d: &Prepared, _n: &Nominal) -> Result<Setup, String> {
+        let psi = rated_flux_wb(d);
+        let mut s = Setup::default();
+        s.push(
+            "psi_sat_wb",
+            "Wb",
+            1.2 * psi,
+            0.5 * psi,
+            5.0 * psi,
+            0.2 * psi,
+        );
+        s.push("exponent", "1", 7.0, 2.0, 14.0, 2.0);
+        s.data.push(psi);
+        Ok(s)
+    }
+    fn apply(&self, _s: &Setup, p: &[f64], d: &Prepared, n: &Nominal, terms: &mut Terms) {
+        terms.lm_factor = d
+            .i_f
+            .iter()
+            .map(|&i| sat_factor(n.lm_h, i, p[0], p[1]))
+            .collect();
+    }
+    fn describe(&self, s: &Setup, p: &[f64], d: &Prepared, n: &Nominal) -> String {
+        let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+        for &i in &d.i_f {
+            let x = sat_factor(n.lm_h, i, p[0], p[1]);
+            lo = lo.min(x);
+            hi = hi.max(x);
+        }
+        format!(
+            "magnetising inductance falls with flux: Lm is {:.0} % to {:.0} % of its unsaturated value over this log (saturation flux {:.2} Wb = {:.2} x the rated flux, knee exponent {:.1})",
+            lo * 100.0,
+            hi * 100.0,
+            p[0],
+            p[0] / s.data.first().copied().unwrap_or(1.0),
+            p[1]
+        )
+    }
+}
+
+impl Effect for IronLoss {
+    fn name(&self) -> &'static str {
+        "iron_loss"
+    }
+    fn description(&self) -> &'static str {
+        "Eddy-current and hysteresis losses in the core draw a current in phase with the air-gap voltage, modelled as a resistance Rfe across the magnetising branch."
+    }
+    fn equations(&self) -> &'static str {
+        "I_qs(measured) = I_qs(torque, eq. 28) + omega_s Ls i_f / Rfe; only the torque part drives eq. (29)."
+    }
+    fn parameters(&self) -> &'static [ParamSpec] {
+        &[ParamSpec {
+            name: "g_fe_s",
+            unit: "S",
+            description: "core-loss conductance 1/Rfe",
+        }]
+    }
+    fn setup(&self, d: &Prepared, n: &Nominal) -> Result<Setup, String> {
+        let w = sync_speed_mech(d, n) * n.np;
+        let xm = w * n.lm_h;
+        let mut s = Setup::default();
+        s.push(
+            "g_fe_s",
+            "S",
+            1.0 / (100.0 * xm),
+            -0.2 / xm,
+            1.0 / xm,
+            0.02 / xm,
+        );
+        s.data.push(xm);
+        Ok(s)
+    }
+    fn apply(&self, _s: &Setup, p: &[f64], _d: &Prepared, _n: &Nominal, terms: &mut Terms) {
+        terms.g_fe_s = p[0];
+    }
+    fn describe(&self, s: &Setup, p: &[f64], d: &Prepared, n: &Nominal) -> String {
+        let xm = s.data.first().copied().unwrap_or(1.0);
+        let psi = rated_flux_wb(d);
+        let w = sync_speed_mech(d, n) * n.np;
+        let p_fe = 1.5 * (w * psi).powi(2) * p[0];
+        if p[0] <= 0.0 {
+            return "no core loss found (fitted conductance not positive)".into();
+        }
+        format!(
+            "core loss resistance Rfe about {:.0} ohm ({:.0} x Xm), about {:.0} W of iron loss at the highest supply frequency of the log",
+            1.0 / p[0],
+            1.0 / (p[0] * xm),
+            p_fe
+        )
+    }
+}
+
+impl Effect for CoulombFriction {
+    fn name(&self) -> &'static str {
+        "coulomb_friction"
+    }
+    fn description(&self) -> &'static str {
+        "Dry friction (bearings, seals, brushes): a constant torque opposing rotation whatever the speed."
+    }
+    fn equations(&self) -> &'static str {
+        "J dw_m/dt = Kf I_qs - (B + Bl) w_m - Tc tanh(w_m / 1 rad/s)  (eq. 29 plus a constant friction torque)."
+    }
+    fn parameters(&self) -> &'static [ParamSpec] {
+        &[ParamSpec {
+            name: "torque_nm",
+            unit: "N m",
+            description: "dry friction torque Tc",
+        }]
+    }
+    fn needs(&self) -> Needs {
+        Needs {
+            voltages: true,
+            speed: false,
+        }
+    }
+    fn setup(&self, _d: &Prepared, n: &Nominal) -> Result<Setup, String> {
+        let t = n.torque_scale_nm;
+        let mut s = Setup::default();
+        s.push("torque_nm", "N m", 0.01 * t, -0.1 * t, t, 0.05 * t);
+        Ok(s)
+    }
+    fn apply(&self, _s: &Setup, p: &[f64], _d: &Prepared, _n: &Nominal, terms: &mut Terms) {
+        terms.coulomb_nm = p[0];
+    }
+    fn describe(&self, _s: &Setup, p: &[f64], _d: &Prepared, n: &Nominal) -> String {
+        format!(
+            "constant friction torque of about {:.2} N m ({:.1} % of the rated torque estimate {:.1} N m), independent of speed",
+            p[0],
+            100.0 * p[0] / n.torque_scale_nm,
+            n.torque_scale_nm
+        )
+    }
+}
+
+impl Effect for Windage {
+    fn name(&self) -> &'static str {
+        "windage"
+    }
+    fn description(&self) -> &'static str {
+        "Fan and air drag: a load torque growing with the square of speed."
+    }
+    fn equations(&self) -> &'static str {
+        "J dw_m/dt = Kf I_qs - (B + Bl) w_m - k w_m |w_m|  (eq. 29 plus a quadratic drag)."
+    }
+    fn parameters(&self) -> &'static [ParamSpec] {
+        &[ParamSpec {
+            name: "k_nms2",
+            unit: "N m s^2/rad^2",
+            description: "windage coefficient k",
+        }]
+    }
+    fn setup(&self, d: &Prepared, n: &Nominal) -> Result<Setup, String> {
+        let w = sync_speed_mech(d, n);
+        let k = n.torque_scale_nm / (w * w);
+        let mut s = Setup::default();
+        s.push(
+            "k_nms2",
+            "N m s^2/rad^2",
+            0.01 * k,
+            -0.1 * k,
+            2.0 * k,
+            0.05 * k,
+        );
+        s.data.push(w);
+        Ok(s)
+    }
+    fn apply(&self, _s: &Setup, p: &[f64], _d: &Prepared, _n: &Nominal, terms: &mut Terms) {
+        terms.windage_nms2 = p[0];
+    }
+    fn describe(&self, s: &Setup, p: &[f64], _d: &Prepared, n: &Nominal) -> String {
+        let w = s.data.first().copied().unwrap_or(1.0);
+        format!(
+            "speed-squared drag k = {:.3e} N m s^2/rad^2: {:.2} N m at synchronous speed ({:.1} % of the rated torque estimate)",
+            p[0],
+            p[0] * w * w,
+            100.0 * p[0] * w * w / n.torque_scale_nm
+        )
+    }
+}
+
+/// Torque observer: Te(measured I_qs, i_f) - J dw_m/dt, low-passed at 10 Hz, then with
+/// the best viscous line c1 w_m (through the origin) removed, segmented into constant levels by binary
+/// segmentation (minimum segment 0.1 s or 5 % of the log; a split must move the level by
+/// more than 3 % of the rated torque estimate, and the supply must hold still around it).
+/// Returns (segment start time, observer level) pairs, flattened.
+fn load_steps(d: &Prepared, n: &Nominal) -> Vec<f64> {
+    let len = d.len();
+    if d.omega_r.len() != len || len < 20 {
+        return vec![];
+    }
+    let dt = d.dt_s;
+    let lmr = n.lm_h * n.lm_h / n.lr_h;
+    let mut obs = Vec::with_capacity(len);
+    let a = 1.0 - (-2.0 * std::f64::consts::PI * 10.0 * dt).exp();
+    let (mut s1, mut s2) = (0.0, 0.0);
+    let mut wprev = d.omega_r[0] / n.np;
+    let mut w_lp = Vec::with_capacity(len);
+    for k in 0..len {
+        let wm = d.omega_r[k] / n.np;
+        let te = 1.5 * n.np * lmr * d.i_f[k] * d.iq_pos[k];
+        let acc = (wm - wprev) / dt;
+        wprev = wm;
+        let x = te - n.j_kgm2 * acc;
+        if k == 0 {
+            s1 = x;
+            s2 = x;
+        }
+        s1 += a * (x - s1);
+        s2 += a * (s1 - s2);
+        obs.push(s2);
+        w_lp.push(wm);
+    }
+    // Remove the best viscous line through the origin (the paper's Bl*omega): what is
+    // left is load torque the viscous model cannot describe.
+    let (sww, swx) = w_lp
+        .iter()
+        .zip(&obs)
+        .fold((0.0, 0.0), |acc, (w, x)| (acc.0 + w * w, acc.1 + w * x));
+    let c1 = if sww > 0.0 { swx / sww } else { 0.0 };
+    let r: Vec<f64> = obs.iter().zip(&w_lp).map(|(x, w)| x - c1 * w).collect();
+    let min_len = ((0.1 / dt) as usize).max(len / 10).max(2);
+    let thresh = 0.03 * n.torque_scale_nm;
+    let mut cum = vec![0.0; len + 1];
+    for k in 0..len {
+        cum[k + 1] = cum[k] + r[k];
+    }
+    let mean = |a: usize, b: usize| (cum[b] - cum[a]) / (b - a) as f64;
+    // A load step is a torque change while the supply holds still: splits where the supply
+    // frequency or voltage moves by more than 1 % within +/- half a minimum segment are
+    // refused (speed sweeps change the friction torque, not the load).
+    let vmag: Vec<f64> = (0..len).map(|k| d.vq[k].hypot(d.vd[k])).collect();
+    let cum_of = |x: &[f64]| {
+        let mut c = vec![0.0; x.len() + 1];
+        for k in 0..x.len() {
+            c[k + 1] = c[k] + x[k];
+        }
+        c
+    };
+    let cw = cum_of(&d.omega_s);
+    let cv = cum_of(&vmag);
+    let half = (min_len / 2).max(1);
+    let supply_steady = |kk: usize| {
+        let a = kk.saturating_sub(half);
+        let b = (kk + half).min(len);
+        if kk <= a || b <= kk {
+            return true;
+        }
+        let m = |c: &[f64], x: usize, y: usize| (c[y] - c[x]) / (y - x) as f64;
+        let (w1, w2) = (m(&cw, a, kk), m(&cw, kk, b));
+        let (v1, v2) = (m(&cv, a, kk), m(&cv, kk, b));
+        (w1 - w2).abs() <= 0.01 * w1.abs().max(w2.abs()).max(1e-9)
+            && (v1 - v2).abs() <= 0.01 * v1.abs().max(v2.abs()).max(1e-9)
+    };
+    let mut segs = vec![(0usize, len)];
+    for _ in 0..6 {
+        let mut best: Option<(usize, usize, f64)> = None;
+        for (si, &(a0, b0)) in segs.iter().enumerate() {
+            if b0 - a0 < 2 * min_len {
+                continue;
+            }
+            let step = ((b0 - a0) / 400).max(1);
+            let mut kk = a0 + min_len;
+            while kk <= b0 - min_len {
+                let ml = mean(a0, kk);
+                let mr = mean(kk, b0);
+                let gain = (ml - mr).powi(2) * ((kk - a0) * (b0 - kk)) as f64 / (b0 - a0) as f64;
+                if (ml - mr).abs() > thresh
+                    && best.map(|b| gain > b.2).unwrap_or(true)
+                    && supply_steady(kk)
+                {
+                    best = Some((si, kk, gain));
+                }
+                kk += step;
+            }
+        }
+        match best {
+            Some((si, kk, _)) => {
+                let (a0, b0) = segs[si];
+                segs[si] = (a0, kk);
+                segs.insert(si + 1, (kk, b0));
+            }
+            None => break,
+        }
+    }
+    segs.iter()
+        .flat_map(|&(a0, b0)| [d.t_s[a0], mean(a0, b0)])
+        .collect()
+}
+
+impl Effect for LoadTorque {
+    fn name(&self) -> &'static str {
+        "load_torque"
+    }
+    fn description(&self) -> &'static str {
+        "The load is a torque imposed by the driven machine (possibly switched in steps), not the paper's viscous Bl*omega."
+    }
+    fn equations(&self) -> &'static str {
+        "J dw_m/dt = Kf I_qs - (B + Bl) w_m - T_L(t), T_L piecewise constant; the step times come from a torque observer on the measured speed and current, the levels are fitted."
+    }
+    fn parameters(&self) -> &'static [ParamSpec] {
+        &[ParamSpec {
+            name: "level_k",
+            unit: "N m",
+            description: "load torque in segment k (one parameter per detected segment)",
+        }]
+    }
+    fn needs(&self) -> Needs {
+        Needs {
+            voltages: true,
+            speed: true,
+        }
+    }
+    fn setup(&self, d: &Prepared, n: &Nominal) -> Result<Setup, String> {
+        if d.omega_r.is_empty() {
+            return Err(
+                "needs the speed column wm_rad_s (the torque observer uses the measured speed)"
+                    .into(),
+            );
+        }
+        let pairs = load_steps(d, n);
+        let steps: Vec<f64> = pairs.iter().step_by(2).copied().collect();
+        let levels: Vec<f64> = pairs.iter().skip(1).step_by(2).copied().collect();
+        if steps.len() < 2 {
+            return Err("no change of load torque found in the log: a constant load torque is the same equation as coulomb_friction at positive speed, so it is left to that effect".into());
+        }
+        let t = n.torque_scale_nm;
+        let mut s = Setup::default();
+        // Initial levels: the observer's mean torque beyond the viscous line per segment.
+        for (k, (&ts, &lv)) in steps.iter().zip(&levels).enumerate() {
+            s.push(
+                &format!("level_{}_from_{:.2}_s", k + 1, ts),
+                "N m",
+                lv.clamp(-3.0 * t, 3.0 * t),
+                -3.0 * t,
+                3.0 * t,
+                0.2 * t,
+            );
+        }
+        s.data = steps;
+        Ok(s)
+    }
+    fn apply(&self, s: &Setup, p: &[f64], d: &Prepared, _n: &Nominal, terms: &mut Terms) {
+        let mut seg = 0usize;
+        let load: Vec<f64> = d
+            .t_s
+            .iter()
+            .map(|&t| {
+                while seg + 1 < s.data.len() && t >= s.data[seg + 1] {
+                    seg += 1;
+                }
+                p.get(seg).copied().unwrap_or(0.0)
+            })
+            .collect();
+        if terms.load_nm.len() == load.len() {
+            for (a, b) in terms.load_nm.iter_mut().zip(load) {
+                *a += b;
+            }
+        } else {
+            terms.load_nm = load;
+        }
+    }
+    fn describe(&self, s: &Setup, p: &[f64], _d: &Prepared, _n: &Nominal) -> String {
+        let parts: Vec<String> = s
+            .data
+            .iter()
+            .zip(p)
+            .map(|(t, v)| format!("{v:.2} N m from {t:.2} s"))
+            .collect();
+        format!(
+            "load behaves as a torque input (on top of the refitted viscous term): {}",
+            parts.join(", ")
+        )
+    }
+}
+
+impl Effect for SupplyUnbalance {
+    fn name(&self) -> &'static str {
+        "supply_unbalance"
+    }
+    fn description(&self) -> &'static str {
+        "The supply voltages are not balanced: a negative-sequence voltage drives a negative-sequence current through the machine's small negative-sequence impedance (2f ripple in the d-q frame)."
+    }
+    fn equations(&self) -> &'static str {
+        "i_abc = balanced model current + i_neg, i_neg = (y_re + j y_im) v_neg / conj(Z2(omega_s)), Z2 = Rs + j w Lls + (j w Lm)||(Rr/2 + j w Llr); the balanced model is driven by the positive-sequence V_qs."
+    }
+    fn parameters(&self) -> &'static [ParamSpec] {
+        &[
+            ParamSpec {
+                name: "y_re",
+                unit: "1",
+                description:
+                    "real part of the negative-sequence admittance relative to nominal 1/Z2",
+            },
+            ParamSpec {
+                name: "y_im",
+                unit: "1",
+                description:
+                    "imaginary part of the negative-sequence admittance relative to nominal 1/Z2",
+            },
+        ]
+    }
+    fn setup(&self, _d: &Prepared, _n: &Nominal) -> Result<Setup, String> {
+        let mut s = Setup::default();
+        s.push("y_re", "1", 0.5, -5.0, 5.0, 0.2);
+        s.push("y_im", "1", 0.0, -5.0, 5.0, 0.2);
+        Ok(s)
+    }
+    fn apply(&self, _s: &Setup, p: &[f64], d: &Prepared, n: &Nominal, terms: &mut Terms) {
+        let y = C64::new(p[0], p[1]);
+        let add: Vec<C64> = (0..d.len())
+            .map(|k| y * d.v_neg[k] / z2_neg(n, d.omega_s[k]).conj())
+            .collect();
+        add_neg(terms, add);
+    }
+    fn describe(&self, _s: &Setup, p: &[f64], d: &Prepared, n: &Nominal) -> String {
+        let (mut vn, mut vp) = (0.0, 0.0);
+        for k in 0..d.len() {
+            vn += d.v_neg[k].norm_sqr();
+            vp += d.vq[k] * d.vq[k] + d.vd[k] * d.vd[k];
+        }
+        let ratio = (vn / vp.max(1e-12)).sqrt();
+        let w = sync_speed_mech(d, n) * n.np;
+        let z = z2_neg(n, w).norm() / C64::new(p[0], p[1]).norm().max(1e-9);
+        format!(
+            "supply voltage unbalance of {:.1} % (negative sequence / positive sequence); the machine's negative-sequence impedance is about {:.1} ohm (nominal {:.1} ohm)",
+            100.0 * ratio,
+            z,
+            z2_neg(n, w).norm()
+        )
+    }
+}
+
+fn add_neg(terms: &mut Terms, add: Vec<C64>) {
+    if terms.i_neg.len() == add.len() {
+        for (a, b) in terms.i_neg.iter_mut().zip(add) {
+            *a += b;
+        }
+    } else {
+        terms.i_neg = add;
+    }
+}
+
+/// Maps a fitted phase-asymmetry coefficient `c` (i_neg = c conj(i_pos)) to the suspect
+/// phase and the relative winding-impedance change mu (positive = turns lost, as in an
+/// inter-turn short): c = (mu/3) conj(Zs/Z2) e^{-j 2 th_k}, th_k = 0, 120, 240 deg (the
+/// sign of the angle checked against the simulator's phase_asymmetry in phase b).
+pub fn asymmetry_phase(c: C64, n: &Nominal, w: f64) -> (char, f64) {
+    let f = (z_self(n, w) / z2_neg(n, w)).conj();
+    let wv = c * 3.0 / f;
+    let mut best = ('a', 0.0, f64::INFINITY);
+    for (k, name) in ['a', 'b', 'c'].iter().enumerate() {
+        let th = 2.0 * std::f64::consts::PI / 3.0 * k as f64;
+        for sign in [1.0, -1.0] {
+            let target = C64::from_polar(sign, -2.0 * th);
+            let ang = (wv / target).arg().abs();
+            if ang < best.2 {
+                best = (*name, sign * wv.norm(), ang);
+            }
+        }
+    }
+    (best.0, best.1)
+}
+
+impl Effect for PhaseAsymmetry {
+    fn name(&self) -> &'static str {
+        "phase_asymmetry"
+    }
+    fn description(&self) -> &'static str {
+        "One stator winding differs from the other two (inter-turn short, bad joint): the machine draws a negative-sequence current proportional to its load current even from a balanced supply."
+    }
+    fn equations(&self) -> &'static str {
+        "i_abc = balanced model current + i_neg, i_neg = (c_re + j c_im) conj(i_pos): a winding change dZ in phase k gives c = (dZ/3Zs...) e^{j 2 th_k} conj(Zs/Z2) mu/3."
+    }
+    fn parameters(&self) -> &'static [ParamSpec] {
+        &[
+            ParamSpec {
+                name: "c_re",
+                unit: "1",
+                description: "real part of i_neg / conj(i_pos)",
+            },
+            ParamSpec {
+                name: "c_im",
+                unit: "1",
+                description: "imaginary part of i_neg / conj(i_pos)",
+            },
+        ]
+    }
+    fn needs(&self) -> Needs {
+        Needs {
+            voltages: false,
+            speed: false,
+        }
+    }
+    fn setup(&self, _d: &Prepared, _n: &Nominal) -> Result<Setup, String> {
+        let mut s = Setup::default();
+        s.push("c_re", "1", 0.01, -1.0, 1.0, 0.02);
+        s.push("c_im", "1", 0.0, -1.0, 1.0, 0.02);
+        Ok(s)
+    }
+    fn apply(&self, _s: &Setup, p: &[f64], d: &Prepared, _n: &Nominal, terms: &mut Terms) {
+        let c = C64::new(p[0], p[1]);
+        let add: Vec<C64> = (0..d.len())
+            .map(|k| c * (d.i_ab[k] - d.i_neg[k]).conj())
+            .collect();
+        add_neg(terms, add);
+    }
+    fn describe(&self, _s: &Setup, p: &[f64], d: &Prepared, n: &Nominal) -> String {
+        let w = sync_speed_mech(d, n) * n.np;
+        let (ph, mu) = asymmetry_phase(C64::new(p[0], p[1]), n, w);
+        format!(
+            "phase {} winding differs: negative-sequence current {:.1} % of the positive-sequence current; fits about {:.1} % of that winding's impedance {} (an inter-turn short removes turns)",
+            ph,
+            100.0 * C64::new(p[0], p[1]).norm(),
+            100.0 * mu.abs(),
+            if mu >= 0.0 { "lost" } else { "added" }
+        )
+    }
+}
+
+impl Effect for FluxDynamics {
+    fn name(&self) -> &'static str {
+        "flux_dynamics"
+    }
+    fn description(&self) -> &'static str {
+        "The rotor flux cannot change instantly: it follows the magnetising current with the rotor time constant Lr/Rr, so after a start or a supply step the model's Psi = Ls i_f is wrong for a few hundred ms."
+    }
+    fn equations(&self) -> &'static str {
+        "phi = psi_r/Lm, dphi/dt = (i_f - phi)/tau_r; Psi' = sigma Ls i_f + (Lm^2/Lr) phi replaces Ls i_f in eq. (28), the slip term Rr (Ls/Lr) becomes Rr Psi'/(Lr phi), Kf uses phi instead of i_f."
+    }
+    fn parameters(&self) -> &'static [ParamSpec] {
+        &[ParamSpec {
+            name: "tau_r_s",
+            unit: "s",
+            description: "rotor time constant Lr/Rr",
+        }]
+    }
+    fn setup(&self, _d: &Prepared, n: &Nominal) -> Result<Setup, String> {
+        let tau = n.lr_h / n.rr_ohm;
+        let mut s = Setup::default();
+        s.push("tau_r_s", "s", tau, 0.3 * tau, 3.0 * tau, 0.2 * tau);
+        s.data.push(tau);
+        Ok(s)
+    }
+    fn apply(&self, _s: &Setup, p: &[f64], _d: &Prepared, _n: &Nominal, terms: &mut Terms) {
+        terms.tau_r_s = Some(p[0]);
+    }
+    fn describe(&self, s: &Setup, p: &[f64], _d: &Prepared, _n: &Nominal) -> String {
+        format!(
+            "rotor flux lags the magnetising current with a rotor time constant of {:.0} ms (nominal Lr/Rr = {:.0} ms): the model's constant-flux assumption fails in transients",
+            1000.0 * p[0],
+            1000.0 * s.data.first().copied().unwrap_or(0.0)
+        )
+    }
+}
+
+impl Effect for CurrentDynamics {
+    fn name(&self) -> &'static str {
+        "current_dynamics"
+    }
+    fn description(&self) -> &'static str {
+        "The stator current cannot jump: the transient inductance La = sigma Ls delays I_qs by Ta = La/Ra (a few ms) after every voltage change."
+    }
+    fn equations(&self) -> &'static str {
+        "La dI_qs/dt = V_qs - Ra I_qs - Psi omega_r (eq. 28 with its derivative term) instead of the quasi-static I_qs = (V_qs - Psi omega_r)/Ra."
+    }
+    fn parameters(&self) -> &'static [ParamSpec] {
+        &[ParamSpec {
+            name: "la_h",
+            unit: "H",
+            description: "transient inductance La = sigma Ls",
+        }]
+    }
+    fn setup(&self, _d: &Prepared, n: &Nominal) -> Result<Setup, String> {
+        let mut s = Setup::default();
+        s.push(
+            "la_h",
+            "H",
+            n.la_h,
+            0.3 * n.la_h,
+            3.0 * n.la_h,
+            0.2 * n.la_h,
+        );
+        s.data.push(n.la_h);
+        Ok(s)
+    }
+    fn apply(&self, _s: &Setup, p: &[f64], _d: &Prepared, _n: &Nominal, terms: &mut Terms) {
+        terms.la_h = Some(p[0]);
+    }
+    fn describe(&self, s: &Setup, p: &[f64], _d: &Prepared, n: &Nominal) -> String {
+        format!(
+            "stator current lags voltage changes: La = {:.1} mH (nominal sigma Ls = {:.1} mH), electrical time constant about {:.1} ms",
+            1000.0 * p[0],
+            1000.0 * s.data.first().copied().unwrap_or(0.0),
+            1000.0 * p[0] / n.ra_ohm
+        )
+    }
+}
+
+/// The whole library, in DESIGN.md order.
+pub fn library() -> Vec<Box<dyn Effect>> {
+    vec![
+        Box::new(ThermalDrift),
+        Box::new(Saturation),
+        Box::new(IronLoss),
+        Box::new(CoulombFriction),
+        Box::new(Windage),
+        Box::new(LoadTorque),
+        Box::new(SupplyUnbalance),
+        Box::new(PhaseAsymmetry),
+        Box::new(FluxDynamics),
+        Box::new(CurrentDynamics),
+    ]
+}
+
+/// Looks an effect up by name.
+pub fn by_name(name: &str) -> Option<Box<dyn Effect>> {
+    library().into_iter().find(|e| e.name() == name)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn saturation_factor_solves_its_equation() {
+        let x = sat_factor(0.245, 4.0, 1.0, 6.0);
+        let a = 0.245 * 4.0 / 1.0;
+        assert!((x * (1.0 + (x * a).powf(6.0)) - 1.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn library_has_the_ten_design_names() {
+        let names: Vec<_> = library().iter().map(|e| e.name()).collect();
+        for n in [
+            "thermal_drift",
+            "saturation",
+            "iron_loss",
+            "coulomb_friction",
+            "windage",
+            "load_torque",
+            "supply_unbalance",
+            "phase_asymmetry",
+            "flux_dynamics",
+            "current_dynamics",
+        ] {
+            assert!(names.contains(&n), "{n}");
+        }
+    }
+}

@@ -1,0 +1,238 @@
+//! Levenberg-Marquardt fit of the base parameters and the effects' parameters.
+//!
+//! Output-error fit: the model is simulated over the log for every trial parameter vector
+//! and the residuals are the per-channel errors divided by each channel's RMS (the same
+//! weighting as `normalized_rms_error`), on the training samples only (held-back windows
+//! are used by `explain` to rank honestly). Base parameters carry weak Gaussian priors
+//! around their nominal values (sd 15 % for Ra and Ls, 30 % for J, 50 % for B+Bl, each scaled by
+//! [`PRIOR_WEIGHT`] so that one sd costs as much as a 0.01 normalized error), so a
+//! parameter the data cannot identify stays near nominal instead of wandering. The Jacobian
+//! is by forward differences (one simulation per parameter, in parallel with rayon);
+//! bounds are enforced by clamping.
+
+use super::effects::{Effect, Setup};
+use super::metrics::Weights;
+use super::model::{simulate, BaseParams, Nominal, Prediction, Terms};
+use super::prep::Prepared;
+use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
+
+/// An effect set up on the data, with its parameter values.
+pub struct ActiveEffect<'a> {
+    /// The library entry.
+    pub effect: &'a dyn Effect,
+    /// Its data-dependent set-up.
+    pub setup: Setup,
+}
+
+/// Result of a fit.
+#[derive(Debug, Clone)]
+pub struct FitResult {
+    /// Fitted base parameters.
+    pub base: BaseParams,
+    /// Fitted parameters of each effect, in the order given.
+    pub effect_params: Vec<Vec<f64>>,
+    /// Final cost (half the sum of squared weighted residuals, priors included).
+    pub cost: f64,
+    /// Iterations used.
+    pub iterations: usize,
+}
+
+/// Weight of the base parameters' priors relative to the data (whose residuals are scaled
+/// so that their sum of squares is the squared normalized error).
+pub const PRIOR_WEIGHT: f64 = 0.01;
+
+/// Number of base parameters.
+pub const N_BASE: usize = 4;
+
+struct Problem<'a> {
+    d: &'a Prepared,
+    n: &'a Nominal,
+    effects: &'a [ActiveEffect<'a>],
+    w: &'a Weights,
+    btot_scale: f64,
+    fit_base: bool,
+}
+
+impl Problem<'_> {
+    fn unpack(&self, x: &[f64]) -> (BaseParams, Terms) {
+        let base = BaseParams {
+            ra_scale: x[0],
+            ls_scale: x[1],
+            btot_nms: x[2],
+            j_scale: x[3],
+        };
+        let mut terms = Terms::default();
+        let mut o = N_BASE;
+        for e in self.effects {
+            let k = e.setup.init.len();
+            e.effect
+                .apply(&e.setup, &x[o..o + k], self.d, self.n, &mut terms);
+            o += k;
+        }
+        (base, terms)
+    }
+
+    fn predict(&self, x: &[f64]) -> Prediction {
+        let (b, t) = self.unpack(x);
+        simulate(self.d, self.n, &b, &t)
+    }
+
+    fn residuals(&self, x: &[f64]) -> Vec<f64> {
+        let p = self.predict(x);
+        let mut r = self.w.residuals(self.d, &p, true);
+        if self.fit_base {
+            // Weak: a 15 % deviation of Ra costs as much as a 0.01 normalized error.
+            r.push(PRIOR_WEIGHT * (x[0] - 1.0) / 0.15);
+            r.push(PRIOR_WEIGHT * (x[1] - 1.0) / 0.15);
+            r.push(PRIOR_WEIGHT * (x[2] - self.n.btot_nms) / (0.5 * self.btot_scale));
+            r.push(PRIOR_WEIGHT * (x[3] - 1.0) / 0.3);
+        }
+        r
+    }
+}
+
+/// Scale of B+Bl for conditioning and its prior: the larger of the nominal value and the
+/// viscous coefficient that would carry 20 % of the rated torque at synchronous speed.
+pub fn btot_scale(n: &Nominal, d: &Prepared) -> f64 {
+    let wmax = d.omega_s.iter().fold(0.0f64, |a, &w| a.max(w.abs())) / n.np;
+    n.btot_nms.max(0.2 * n.torque_scale_nm / wmax.max(1.0))
+}
+
+/// Fits base parameters (unless `fit_base` is false: nominal values are kept) and the
+/// effects' parameters, starting from `start` (base) and each set-up's `init`.
+pub fn fit(
+    d: &Prepared,
+    n: &Nominal,
+    effects: &[ActiveEffect<'_>],
+    w: &Weights,
+    start: &BaseParams,
+    fit_base: bool,
+    max_iter: usize,
+) -> FitResult {
+    let bs = btot_scale(n, d);
+    let prob = Problem {
+        d,
+        n,
+        effects,
+        w,
+        btot_scale: bs,
+        fit_base,
+    };
+    let mut x = vec![
+        start.ra_scale,
+        start.ls_scale,
+        start.btot_nms,
+        start.j_scale,
+    ];
+    let mut lo = vec![0.3, 0.5, 0.0, 0.2];
+    let mut hi = vec![3.0, 2.0, 50.0 * bs, 5.0];
+    let mut scale = vec![0.05, 0.05, 0.2 * bs, 0.1];
+    for e in effects {
+        x.extend_from_slice(&e.setup.init);
+        lo.extend_from_slice(&e.setup.lo);
+        hi.extend_from_slice(&e.setup.hi);
+        scale.extend_from_slice(&e.setup.scale);
+    }
+    let free: Vec<usize> = (0..x.len()).filter(|&i| fit_base || i >= N_BASE).collect();
+    let mut r = prob.residuals(&x);
+    let mut cost = 0.5 * r.iter().map(|v| v * v).sum::<f64>();
+    let mut lambda = 1e-3;
+    let mut it = 0;
+    let mut small_steps = 0;
+    while it < max_iter && !free.is_empty() {
+        it += 1;
+        // Jacobian by forward differences, one column per free parameter, in parallel.
+        let cols: Vec<Vec<f64>> = free
+            .par_iter()
+            .map(|&i| {
+                let h = 1e-4 * scale[i].max(1e-3 * x[i].abs());
+                let mut xp = x.clone();
+                let dir = if xp[i] + h > hi[i] { -1.0 } else { 1.0 };
+                xp[i] += dir * h;
+                let rp = prob.residuals(&xp);
+                rp.iter()
+                    .zip(&r)
+                    .map(|(a, b)| (a - b) / (dir * h))
+                    .collect()
+            })
+            .collect();
+        let m = free.len();
+        let mut jtj = DMatrix::<f64>::zeros(m, m);
+        let mut jtr = DVector::<f64>::zeros(m);
+        for a in 0..m {
+            for b in a..m {
+                let s: f64 = cols[a].iter().zip(&cols[b]).map(|(u, v)| u * v).sum();
+                jtj[(a, b)] = s;
+                jtj[(b, a)] = s;
+            }
+            jtr[a] = cols[a].iter().zip(&r).map(|(u, v)| u * v).sum();
+        }
+        let mut improved = false;
+        for _ in 0..8 {
+            let mut aug = jtj.clone();
+            for a in 0..m {
+                aug[(a, a)] += lambda * jtj[(a, a)].max(1e-12) + 1e-12;
+            }
+            let step = match aug.cholesky() {
+                Some(ch) => ch.solve(&(-&jtr)),
+                None => {
+                    lambda *= 10.0;
+                    continue;
+                }
+            };
+            let mut xn = x.clone();
+            for (a, &i) in free.iter().enumerate() {
+                xn[i] = (x[i] + step[a]).clamp(lo[i], hi[i]);
+            }
+            let rn = prob.residuals(&xn);
+            let cn = 0.5 * rn.iter().map(|v| v * v).sum::<f64>();
+            if cn.is_finite() && cn < cost {
+                let rel = (cost - cn) / cost.max(1e-300);
+                x = xn;
+                r = rn;
+                cost = cn;
+                lambda = (lambda / 3.0).max(1e-9);
+                improved = true;
+                if rel < 1e-7 {
+                    small_steps += 1;
+                } else {
+                    small_steps = 0;
+                }
+                break;
+            }
+            lambda *= 8.0;
+        }
+        if !improved || small_steps >= 2 {
+            break;
+        }
+    }
+    let (base, _) = prob.unpack(&x);
+    let mut effect_params = Vec::new();
+    let mut o = N_BASE;
+    for e in effects {
+        let k = e.setup.init.len();
+        effect_params.push(x[o..o + k].to_vec());
+        o += k;
+    }
+    FitResult {
+        base,
+        effect_params,
+        cost,
+        iterations: it,
+    }
+}
+
+/// Simulates the model with fitted values.
+pub fn predict(
+    d: &Prepared,
+    n: &Nominal,
+    effects: &[ActiveEffect<'_>],
+    f: &FitResult,
+) -> Prediction {
+    let mut terms = Terms::default();
+    for (e, p) in effects.iter().zip(&f.effect_params) {
+        e.effect.apply(&e.setup, p, d, n, &mut terms);
+    }
+    simulate(d, n, &f.base, &terms)
+}

@@ -1,0 +1,464 @@
+//! Error measures: per-channel RMS error, `normalized_rms_error`, worst windows, error
+//! spectrum and the noise floor.
+//!
+//! Channels: `iqs_A` (I_qs, rotor-flux frame), `omega_r_rad_s` (electrical rotor speed,
+//! when the log has `wm_rad_s`), `ia_A`, `ib_A`, `ic_A` (phase currents). Each channel's
+//! RMS error is divided by that channel's measured RMS; `normalized_rms_error` is the mean
+//! over the channels present (DESIGN.md §3).
+
+use super::model::Prediction;
+use super::prep::{inverse_clarke, Prepared, C64};
+use serde::Serialize;
+
+/// Channel names, in order.
+pub const CHANNELS: [&str; 5] = ["iqs_A", "omega_r_rad_s", "ia_A", "ib_A", "ic_A"];
+
+/// Per-channel normalisation and the training mask of a fit.
+#[derive(Debug, Clone)]
+pub struct Weights {
+    /// 1 / RMS of each measured channel (0 for an absent channel).
+    pub inv_rms: [f64; 5],
+    /// Samples used by the fit (held-back windows are false).
+    pub train: Vec<bool>,
+    /// Use every `stride`-th sample in the fit's residuals.
+    pub stride: usize,
+}
+
+fn phase_currents(d: &Prepared, k: usize, i_ab: C64) -> [f64; 3] {
+    inverse_clarke(i_ab, d.i0[k])
+}
+
+/// Measured values of the five channels at sample k (omega_r = 0 if absent).
+pub fn measured(d: &Prepared, k: usize) -> [f64; 5] {
+    let ph = phase_currents(d, k, d.i_ab[k]);
+    [
+        d.iq[k],
+        d.omega_r.get(k).copied().unwrap_or(0.0),
+        ph[0],
+        ph[1],
+        ph[2],
+    ]
+}
+
+/// Predicted values of the five channels at sample k.
+pub fn predicted(d: &Prepared, p: &Prediction, k: usize) -> [f64; 5] {
+    let ph = phase_currents(d, k, p.i_ab[k]);
+    [p.iq[k], p.omega_r[k], ph[0], ph[1], ph[2]]
+}
+
+impl Weights {
+    /// Weights from the measured channel RMS; `holdout` = number of interleaved windows
+    /// (0 = train on everything; n > 0: the log is cut into 2n windows and every second
+    /// one is held back).
+    pub fn new(d: &Prepared, holdout: usize, max_fit_samples: usize) -> Self {
+        let mut s = [0.0f64; 5];
+        for k in 0..d.len() {
+            let m = measured(d, k);
+            for c in 0..5 {
+                s[c] += m[c] * m[c];
+            }
+        }
+        let n = d.len().max(1) as f64;
+        let mut inv = [0.0; 5];
+        for c in 0..5 {
+            let rms = (s[c] / n).sqrt();
+            inv[c] = if rms > 1e-9 && (c != 1 || d.channels.speed) {
+                1.0 / rms
+            } else {
+                0.0
+            };
+        }
+        let len = d.len();
+        let train = if holdout == 0 {
+            vec![true; len]
+        } else {
+            let nw = 2 * holdout;
+            (0..len)
+                .map(|k| (k * nw / len.max(1)).is_multiple_of(2))
+                .collect()
+        };
+        Weights {
+            inv_rms: inv,
+            train,
+            stride: (len / max_fit_samples.max(1)).max(1),
+        }
+    }
+
+    /// Number of channels present.
+    pub fn n_channels(&self) -> usize {
+        self.inv_rms.iter().filter(|&&v| v > 0.0).count()
+    }
+
+    /// Weighted residuals (training samples when `train_only`), scaled so that the sum of
+    /// squares is comparable to `normalized_rms_error`^2 times the channel count.
+    pub fn residuals(&self, d: &Prepared, p: &Prediction, train_only: bool) -> Vec<f64> {
+        let mut r = Vec::with_capacity(5 * d.len() / self.stride + 5);
+        let n_used = (0..d.len())
+            .step_by(self.stride)
+            .filter(|&k| !train_only || self.train[k])
+            .count()
+            .max(1) as f64;
+        let norm = 1.0 / n_used.sqrt();
+        for k in (0..d.len()).step_by(self.stride) {
+            if train_only && !self.train[k] {
+                continue;
+            }
+            if p.iq.len() <= k {
+                for c in 0..5 {
+                    if self.inv_rms[c] > 0.0 {
+                        r.push(1e3);
+                    }
+                }
+                continue;
+            }
+            let m = measured(d, k);
+            let q = predicted(d, p, k);
+            for c in 0..5 {
+                if self.inv_rms[c] > 0.0 {
+                    let e = (q[c] - m[c]) * self.inv_rms[c] * norm;
+                    r.push(if e.is_finite() { e } else { 1e3 });
+                }
+            }
+        }
+        r
+    }
+}
+
+/// RMS error of one channel.
+#[derive(Debug, Clone, Serialize)]
+pub struct ChannelError {
+    /// Channel name (`iqs_A`, ...).
+    pub channel: String,
+    /// RMS of the error (model - measured), in the channel's unit.
+    pub rms_error: f64,
+    /// RMS of the measured signal.
+    pub rms_measured: f64,
+    /// rms_error / rms_measured.
+    pub normalized: f64,
+}
+
+/// Channel errors over a set of samples.
+#[derive(Debug, Clone, Serialize)]
+pub struct ErrorSummary {
+    /// Per channel.
+    pub channels: Vec<ChannelError>,
+    /// Mean of the channels' normalised errors.
+    pub normalized_rms_error: f64,
+}
+
+/// Errors over the samples where `mask` is true (all when `None`).
+pub fn errors(d: &Prepared, p: &Prediction, mask: Option<&[bool]>) -> ErrorSummary {
+    let mut se = [0.0f64; 5];
+    let mut sm = [0.0f64; 5];
+    let mut n = 0.0;
+    for k in 0..d.len().min(p.iq.len()) {
+        if let Some(m) = mask {
+            if !m[k] {
+                continue;
+            }
+        }
+        let a = measured(d, k);
+        let b = predicted(d, p, k);
+        for c in 0..5 {
+            se[c] += (b[c] - a[c]).powi(2);
+            sm[c] += a[c] * a[c];
+        }
+        n += 1.0;
+    }
+    let n = f64::max(n, 1.0);
+    let mut channels = Vec::new();
+    let mut sum = 0.0;
+    for c in 0..5 {
+        if c == 1 && !d.channels.speed {
+            continue;
+        }
+        let rms_e = (se[c] / n).sqrt();
+        let rms_m = (sm[c] / n).sqrt();
+        let norm = if rms_m > 0.0 { rms_e / rms_m } else { 0.0 };
+        sum += norm;
+        channels.push(ChannelError {
+            channel: CHANNELS[c].to_string(),
+            rms_error: rms_e,
+            rms_measured: rms_m,
+            normalized: norm,
+        });
+    }
+    let nc = channels.len().max(1) as f64;
+    ErrorSummary {
+        channels,
+        normalized_rms_error: sum / nc,
+    }
+}
+
+/// Noise floor: the `normalized_rms_error` a perfect model would show on this log, from a
+/// robust (median absolute deviation) estimate of each channel's white noise on the
+/// second difference: sigma = 1.4826 MAD(x[k+1] - 2x[k] + x[k-1]) / sqrt(6). Phase
+/// currents take sigma(I_qs) / sqrt(2): the predicted phase currents reuse the measured
+/// I_ds, so only the q-axis noise shows in their error, spread over the rotating phase.
+pub fn noise_floor(d: &Prepared, w: &Weights) -> f64 {
+    fn sigma(x: &[f64]) -> f64 {
+        if x.len() < 5 {
+            return 0.0;
+        }
+        let mut dd: Vec<f64> = x
+            .windows(3)
+            .map(|v| (v[2] - 2.0 * v[1] + v[0]).abs())
+            .collect();
+        let mid = dd.len() / 2;
+        let (_, m, _) = dd.select_nth_unstable_by(mid, |a, b| a.total_cmp(b));
+        1.4826 * *m / 6f64.sqrt()
+    }
+    let s_iq = sigma(&d.iq);
+    let s_w = sigma(&d.omega_r);
+    let s_ph = s_iq / 2f64.sqrt();
+    let s = [s_iq, s_w, s_ph, s_ph, s_ph];
+    let mut sum = 0.0;
+    let mut c = 0.0;
+    for k in 0..5 {
+        if w.inv_rms[k] > 0.0 {
+            sum += s[k] * w.inv_rms[k];
+            c += 1.0;
+        }
+    }
+    if c > 0.0 {
+        sum / c
+    } else {
+        0.0
+    }
+}
+
+/// In-place radix-2 FFT (length a power of two).
+pub fn fft(x: &mut [C64]) {
+    let n = x.len();
+    if n < 2 {
+        return;
+    }
+    let mut j = 0;
+    for i in 1..n {
+        let mut bit = n >> 1;
+        while j & bit != 0 {
+            j ^= bit;
+            bit >>= 1;
+        }
+        j |= bit;
+        if i < j {
+            x.swap(i, j);
+        }
+    }
+    let mut len = 2;
+    while len <= n {
+        let ang = -2.0 * std::f64::consts::PI / len as f64;
+        let wl = C64::new(ang.cos(), ang.sin());
+        for start in (0..n).step_by(len) {
+            let mut w = C64::new(1.0, 0.0);
+            for k in 0..len / 2 {
+                let u = x[start + k];
+                let v = x[start + k + len / 2] * w;
+                x[start + k] = u + v;
+                x[start + k + len / 2] = u - v;
+                w *= wl;
+            }
+        }
+        len <<= 1;
+    }
+}
+
+/// Amplitude spectrum (Hann window, averaged over segments of up to 8192 samples):
+/// (frequency [Hz], amplitude) pairs up to Nyquist.
+pub fn spectrum(x: &[f64], dt: f64) -> Vec<(f64, f64)> {
+    let mut n = 1usize;
+    while n * 2 <= x.len().min(8192) {
+        n *= 2;
+    }
+    if n < 16 {
+        return vec![];
+    }
+    let segs = (x.len() / n).max(1);
+    let mut acc = vec![0.0; n / 2];
+    let win: Vec<f64> = (0..n)
+        .map(|k| 0.5 - 0.5 * (2.0 * std::f64::consts::PI * k as f64 / n as f64).cos())
+        .collect();
+    for s in 0..segs {
+        let seg = &x[s * n..(s + 1) * n];
+        let mean = seg.iter().sum::<f64>() / n as f64;
+        let mut buf: Vec<C64> = seg
+            .iter()
+            .zip(&win)
+            .map(|(v, w)| C64::new((v - mean) * w, 0.0))
+            .collect();
+        fft(&mut buf);
+        for k in 0..n / 2 {
+            acc[k] += buf[k].norm() * 4.0 / n as f64;
+        }
+    }
+    (0..n / 2)
+        .map(|k| (k as f64 / (n as f64 * dt), acc[k] / segs as f64))
+        .collect()
+}
+
+/// Dominant frequency of a signal segment [Hz]: the largest bin of the Hann-windowed
+/// spectrum, with the mean (DC) compared against it: returns 0 when the mean dominates.
+pub fn dominant_frequency(x: &[f64], dt: f64) -> f64 {
+    if x.len() < 16 {
+        return 0.0;
+    }
+    let n = x.len();
+    let mean = x.iter().sum::<f64>() / n as f64;
+    // Hann window, zero-padded to at least 4x the length (bin spacing well below 2f).
+    let mut m = 1usize;
+    while m < 4 * n {
+        m *= 2;
+    }
+    let mut buf = vec![C64::new(0.0, 0.0); m];
+    let mut wsum = 0.0;
+    for k in 0..n {
+        let w = 0.5 - 0.5 * (2.0 * std::f64::consts::PI * k as f64 / n as f64).cos();
+        wsum += w;
+        buf[k] = C64::new((x[k] - mean) * w, 0.0);
+    }
+    fft(&mut buf);
+    let mut best = (0.0, 0.0);
+    for k in 1..m / 2 {
+        let a = buf[k].norm() * 2.0 / wsum.max(1e-12);
+        if a > best.1 {
+            best = (k as f64 / (m as f64 * dt), a);
+        }
+    }
+    if mean.abs() > best.1 {
+        0.0
+    } else {
+        best.0
+    }
+}
+
+/// A time span where the model fails most.
+#[derive(Debug, Clone, Serialize)]
+pub struct WorstWindow {
+    /// Start [s].
+    pub t_start_s: f64,
+    /// End [s].
+    pub t_end_s: f64,
+    /// `normalized_rms_error` in this window (channels normalised by their whole-log RMS).
+    pub normalized_rms_error: f64,
+    /// Operating condition in the window.
+    pub condition: Condition,
+    /// Dominant frequency of the I_qs error here [Hz] (0 = a steady offset).
+    pub dominant_error_hz: f64,
+    /// That frequency in words ("2f ripple (100 Hz = 2 x supply)", "offset", ...).
+    pub error_kind: String,
+}
+
+/// Operating condition of a window (means over the window).
+#[derive(Debug, Clone, Serialize)]
+pub struct Condition {
+    /// Mechanical speed [rpm] (null without speed).
+    pub speed_rpm: Option<f64>,
+    /// Load (torque-producing) current I_qs [A].
+    pub load_current_a: f64,
+    /// Positive-sequence voltage amplitude [V peak, phase].
+    pub voltage_v: f64,
+    /// Voltage as a percentage of the parameter file's rated value.
+    pub voltage_percent: f64,
+    /// Supply (frame) frequency [Hz].
+    pub supply_hz: f64,
+    /// Time since the log's first row [s] (the motor start for a log that starts with it).
+    pub time_since_start_s: f64,
+}
+
+/// Names an error frequency relative to the supply frequency.
+pub fn error_kind(f: f64, fs: f64) -> String {
+    if f < 1e-9 {
+        return "steady offset".into();
+    }
+    if f < 5.0 {
+        return format!("slow drift ({f:.1} Hz)");
+    }
+    for (m, name) in [(1.0, "1f"), (2.0, "2f ripple"), (6.0, "6f")] {
+        if fs > 1.0 && (f - m * fs).abs() < 0.12 * fs {
+            return format!("{name} ({f:.0} Hz = {m:.0} x supply {fs:.0} Hz)");
+        }
+    }
+    format!("{f:.0} Hz")
+}
+
+/// Per-window errors: window start/end [s], window error, condition, plus the error
+/// signal of I_qs; and the `count` worst windows (non-adjacent).
+pub fn windows(
+    d: &Prepared,
+    p: &Prediction,
+    w: &Weights,
+    v_rated: f64,
+    np: f64,
+    n_windows: usize,
+    count: usize,
+) -> (Vec<WorstWindow>, Vec<WorstWindow>) {
+    let len = d.len().min(p.iq.len());
+    let nw = n_windows.clamp(1, len.max(1));
+    let t0 = d.log_start_s;
+    let nc = w.n_channels().max(1) as f64;
+    let mut all = Vec::new();
+    for wi in 0..nw {
+        let a = wi * len / nw;
+        let b = ((wi + 1) * len / nw).max(a + 1).min(len);
+        let mut se = [0.0f64; 5];
+        let (mut sw, mut siq, mut sv, mut sf) = (0.0, 0.0, 0.0, 0.0);
+        let mut err_iq = Vec::with_capacity(b - a);
+        for k in a..b {
+            let m = measured(d, k);
+            let q = predicted(d, p, k);
+            for c in 0..5 {
+                se[c] += (q[c] - m[c]).powi(2);
+            }
+            err_iq.push(q[0] - m[0]);
+            sw += d.omega_r.get(k).copied().unwrap_or(0.0);
+            siq += d.iq[k];
+            if !d.vq.is_empty() {
+                sv += d.vq[k].hypot(d.vd[k]);
+            }
+            sf += d.omega_s[k];
+        }
+        let n = (b - a) as f64;
+        let mut e = 0.0;
+        for c in 0..5 {
+            e += (se[c] / n).sqrt() * w.inv_rms[c];
+        }
+        let fsup = sf / n / (2.0 * std::f64::consts::PI);
+        let f = dominant_frequency(&err_iq, d.dt_s);
+        all.push(WorstWindow {
+            t_start_s: d.t_s[a],
+            t_end_s: d.t_s[b - 1],
+            normalized_rms_error: e / nc,
+            condition: Condition {
+                speed_rpm: if d.channels.speed {
+                    Some(sw / n / np * 60.0 / (2.0 * std::f64::consts::PI))
+                } else {
+                    None
+                },
+                load_current_a: siq / n,
+                voltage_v: sv / n,
+                voltage_percent: 100.0 * (sv / n) / v_rated.max(1e-9),
+                supply_hz: fsup,
+                time_since_start_s: d.t_s[a] - t0,
+            },
+            dominant_error_hz: f,
+            error_kind: error_kind(f, fsup.abs()),
+        });
+    }
+    let mut idx: Vec<usize> = (0..all.len()).collect();
+    idx.sort_by(|&a, &b| {
+        all[b]
+            .normalized_rms_error
+            .total_cmp(&all[a].normalized_rms_error)
+    });
+    let mut picked: Vec<usize> = Vec::new();
+    for i in idx {
+        if picked.len() >= count {
+            break;
+        }
+        if picked.iter().all(|&j| (j as isize - i as isize).abs() > 1) {
+            picked.push(i);
+        }
+    }
+    let worst = picked.iter().map(|&i| all[i].clone()).collect();
+    (worst, all)
+}

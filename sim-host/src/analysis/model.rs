@@ -1,0 +1,234 @@
+//! The paper's simplified model (eqs. 23-29), driven by measured inputs, with effects.
+//!
+//! Base model (rotor-flux frame, DESIGN.md §2), per working sample:
+//! ```text
+//!   Psi   = Ls i_f                        (i_f = measured positive-sequence I_ds, smoothed)
+//!   I_qs  = (V_qs - Psi omega_r) / Ra     (eq. 23/28 with La dI_qs/dt dropped: see below)
+//!   J dw_m/dt = Kf I_qs - (B + Bl) w_m,   Kf = (3/2) Np (Lm^2/Lr) i_f,  omega_r = Np w_m  (eq. 29)
+//! ```
+//! The La dI_qs/dt term of eq. (28) is the library effect `current_dynamics`, and the
+//! assumption psi_r = Lm i_f is lifted by `flux_dynamics`: the full-order machine always has
+//! both, but the steady-state parity equations (37) drop both, and on steady data neither
+//! matters; treating them as effects lets `explain` name them when transients dominate.
+//!
+//! The mechanical equation is integrated semi-implicitly (the speed dependence of the
+//! quasi-static torque is taken at the new speed), so the step is stable at any working rate.
+//! Effects enter through [`Terms`]: per-sample series computed from the measured inputs
+//! (resistance factor, magnetising-inductance factor, extra load torque, negative-sequence
+//! current) and a speed-dependent extra torque evaluated inside the loop.
+
+use super::prep::{Prepared, C64};
+use crate::params::ParamFile;
+
+/// Nominal machine constants the model needs, from the parameter file.
+#[derive(Debug, Clone, Copy)]
+pub struct Nominal {
+    /// Rs [ohm].
+    pub rs_ohm: f64,
+    /// Rr referred to the stator [ohm].
+    pub rr_ohm: f64,
+    /// Rotor resistance term of Ra: (Ls/Lr) Rr [ohm].
+    pub rr_a_ohm: f64,
+    /// Ra = Rs + (Ls/Lr) Rr [ohm].
+    pub ra_ohm: f64,
+    /// Stator leakage Lls [H].
+    pub lls_h: f64,
+    /// Rotor leakage Llr [H].
+    pub llr_h: f64,
+    /// Lm [H].
+    pub lm_h: f64,
+    /// Ls [H].
+    pub ls_h: f64,
+    /// Lr [H].
+    pub lr_h: f64,
+    /// La = sigma Ls [H].
+    pub la_h: f64,
+    /// Pole pairs.
+    pub np: f64,
+    /// J [kg m^2].
+    pub j_kgm2: f64,
+    /// B + Bl [N m s/rad] (shaft).
+    pub btot_nms: f64,
+    /// Rated torque estimate [N m]: Kf at nominal flux times the current at 3 % slip, or
+    /// at least Bl times synchronous speed. Used for scales only.
+    pub torque_scale_nm: f64,
+}
+
+impl Nominal {
+    /// Derives the constants from a parameter file.
+    pub fn from_params(p: &ParamFile) -> Self {
+        let m = &p.motor;
+        let rr_a = m.ls_h / m.lr_h * m.rr_ohm;
+        let np = m.pole_pairs();
+        let ws = p.supply.omega_rad_s();
+        let i_f = p.supply.v_phase_peak() / (ws * m.ls_h);
+        let kf = 1.5 * np * m.lm_h * m.lm_h / m.lr_h * i_f;
+        // Current at 3 % slip: slip frequency = (Rr/Lr) iq/if.
+        let iq = 0.03 * ws * m.lr_h / m.rr_ohm * i_f;
+        let t_rated = (kf * iq).max(m.bl_nms * ws / np).max(1e-3);
+        Nominal {
+            rs_ohm: m.rs_ohm,
+            rr_ohm: m.rr_ohm,
+            rr_a_ohm: rr_a,
+            ra_ohm: m.rs_ohm + rr_a,
+            lls_h: m.lls_h(),
+            llr_h: m.llr_h(),
+            lm_h: m.lm_h,
+            ls_h: m.ls_h,
+            lr_h: m.lr_h,
+            la_h: m.sigma() * m.ls_h,
+            np,
+            j_kgm2: m.j_kgm2,
+            btot_nms: m.b_nms + m.bl_nms,
+            torque_scale_nm: t_rated,
+        }
+    }
+}
+
+/// The base parameters the data identify, refitted with every effect set.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BaseParams {
+    /// Ra relative to nominal (1 = nominal).
+    pub ra_scale: f64,
+    /// Ls (the Psi = Ls i_f coefficient) relative to nominal.
+    pub ls_scale: f64,
+    /// B + Bl [N m s/rad] (shaft).
+    pub btot_nms: f64,
+    /// Inertia J relative to nominal.
+    pub j_scale: f64,
+}
+
+impl BaseParams {
+    /// Nominal values.
+    pub fn nominal(n: &Nominal) -> Self {
+        BaseParams {
+            ra_scale: 1.0,
+            ls_scale: 1.0,
+            btot_nms: n.btot_nms,
+            j_scale: 1.0,
+        }
+    }
+}
+
+/// Per-sample contributions of the effects to the model equations. Neutral values
+/// (no effect) are 1 for factors, 0 for additive terms, `None` for the dynamics.
+#[derive(Debug, Clone, Default)]
+pub struct Terms {
+    /// Multiplies Rs and Rr (winding temperature); empty = 1.
+    pub r_factor: Vec<f64>,
+    /// Multiplies Lm (saturation); empty = 1.
+    pub lm_factor: Vec<f64>,
+    /// Extra load torque on the shaft [N m] (speed independent); empty = 0.
+    pub load_nm: Vec<f64>,
+    /// Predicted negative-sequence current, stationary frame [A]; empty = 0.
+    pub i_neg: Vec<C64>,
+    /// Core-loss conductance 1/Rfe [S].
+    pub g_fe_s: f64,
+    /// Coulomb friction torque [N m] (tanh(w_m / 1 rad/s) shape).
+    pub coulomb_nm: f64,
+    /// Windage coefficient [N m s^2/rad^2]: torque k w_m |w_m|.
+    pub windage_nms2: f64,
+    /// Rotor time constant Lr/Rr [s] when `flux_dynamics` is on.
+    pub tau_r_s: Option<f64>,
+    /// La [H] when `current_dynamics` is on.
+    pub la_h: Option<f64>,
+}
+
+/// Model outputs over the working series.
+#[derive(Debug, Clone, Default)]
+pub struct Prediction {
+    /// Predicted I_qs [A] (all sequences, including core-loss current).
+    pub iq: Vec<f64>,
+    /// Predicted omega_r [rad/s] (electrical).
+    pub omega_r: Vec<f64>,
+    /// Predicted current vector, stationary frame [A].
+    pub i_ab: Vec<C64>,
+}
+
+/// Runs the model over the prepared data.
+///
+/// Initial state from the measurement at the first sample: w_m = measured speed (0 without
+/// a speed column), I_qs = measured, the normalised rotor flux phi = i_f.
+pub fn simulate(d: &Prepared, n: &Nominal, b: &BaseParams, t: &Terms) -> Prediction {
+    let len = d.len();
+    let mut out = Prediction {
+        iq: Vec::with_capacity(len),
+        omega_r: Vec::with_capacity(len),
+        i_ab: Vec::with_capacity(len),
+    };
+    if len == 0 || d.vq.len() != len {
+        return out;
+    }
+    let dt = d.dt_s;
+    let j = (n.j_kgm2 * b.j_scale).max(1e-9);
+    let btot = b.btot_nms.max(0.0);
+    let rs0 = n.rs_ohm * b.ra_scale;
+    let rr0 = n.rr_a_ohm * b.ra_scale;
+    let mut wm = d.omega_r.first().map(|w| w / n.np).unwrap_or(0.0);
+    let mut iq_state = d.iq_pos[0];
+    let mut phi = d.i_f[0];
+    let i_f_ref = d.id.iter().fold(0.0f64, |a, &x| a.max(x.abs())).max(1e-6);
+    let flux_decay = t.tau_r_s.map(|tau| (-dt / tau.max(1e-5)).exp());
+    for k in 0..len {
+        let rf = t.r_factor.get(k).copied().unwrap_or(1.0);
+        let mf = t.lm_factor.get(k).copied().unwrap_or(1.0);
+        let rs = rs0 * rf;
+        let rr = rr0 * rf;
+        let lm = n.lm_h * mf;
+        let ls = b.ls_scale * (n.lls_h + lm);
+        let lmr = lm * lm / (n.llr_h + lm);
+        let i_f = d.i_f[k];
+        let id_raw = d.id[k];
+        let vq = d.vq[k];
+        // Flux: phi = psi_r / Lm [A].
+        let (psi_p, rden, phi_t) = match flux_decay {
+            Some(a) => {
+                // The rotor flux follows the raw I_ds (its own lag filters the noise).
+                phi = id_raw + (phi - id_raw) * a;
+                // sigma Ls part with the raw I_ds (fast), the rotor part through phi.
+                let psi_p = (ls - b.ls_scale * lmr) * id_raw + b.ls_scale * lmr * phi;
+                let phi_c = if phi.abs() < 0.05 * i_f_ref {
+                    0.05 * i_f_ref * if phi < 0.0 { -1.0 } else { 1.0 }
+                } else {
+                    phi
+                };
+                let rden = rs + rr * psi_p / (ls * phi_c);
+                (psi_p, rden.clamp(0.2 * (rs + rr), 50.0 * (rs + rr)), phi)
+            }
+            None => (ls * i_f, rs + rr, i_f),
+        };
+        let kt = 1.5 * n.np * lmr * phi_t; // Te = kt * iq  [N m/A]
+        let extra = |w: f64| {
+            t.coulomb_nm * (w / 1.0).tanh()
+                + t.windage_nms2 * w * w.abs()
+                + t.load_nm.get(k).copied().unwrap_or(0.0)
+        };
+        let iq;
+        match t.la_h {
+            Some(la) => {
+                let iq_ss = (vq - psi_p * n.np * wm) / rden;
+                let a = (-dt * rden / la.max(1e-6)).exp();
+                iq_state = iq_ss + (iq_state - iq_ss) * a;
+                iq = iq_state;
+                let te = kt * iq;
+                wm = (j * wm + dt * (te - extra(wm))) / (j + dt * btot);
+            }
+            None => {
+                // Te = kt (vq - psi_p Np wm)/rden, linear in wm: implicit.
+                let a = kt * vq / rden;
+                let bb = kt * psi_p * n.np / rden;
+                wm = (j * wm + dt * (a - extra(wm))) / (j + dt * (bb + btot));
+                iq = (vq - psi_p * n.np * wm) / rden;
+            }
+        }
+        let i_fe = t.g_fe_s * d.omega_s[k] * ls * i_f;
+        let iq_pos = iq + i_fe;
+        let rot = C64::new(d.theta[k].cos(), d.theta[k].sin());
+        let ineg = t.i_neg.get(k).copied().unwrap_or_default();
+        let i_ab = C64::new(id_raw, iq_pos) * rot + ineg;
+        out.iq.push(iq_pos + (ineg * rot.conj()).im);
+        out.omega_r.push(n.np * wm);
+        out.i_ab.push(i_ab);
+    }
+    out
+}

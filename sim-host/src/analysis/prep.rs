@@ -1,0 +1,581 @@
+//! From a log to the synchronous-frame signals the simplified model needs.
+//!
+//! Three stages:
+//! 1. **Stream and decimate** ([`decimate_log`]): rows are read one at a time, Clarke
+//!    transformed (amplitude invariant, as `monitor_core::frames`) and block-averaged to a
+//!    working rate of about 2 kHz (never below 1 kHz, at most [`MAX_WORK_SAMPLES`]
+//!    samples), so memory is bounded by the working series, not the log.
+//! 2. **Rotor-flux frame** ([`frame`]): the stator flux is the leaky integral of
+//!    `v - Rs i` (voltage model; the leak, [`FLUX_LEAK_RAD_S`], removes drift at a phase
+//!    error of `leak/omega`, 0.2 degrees at 50 Hz), the rotor flux is
+//!    `psi_r = (Lr/Lm) (psi_s - sigma Ls i)`, and its angle is the Park angle. DESIGN.md §2:
+//!    in this frame the paper's model (23) is exact in steady state, in a voltage-oriented
+//!    frame it is not. Current-only logs use the nominal supply angle `2 pi f t` instead.
+//! 3. **Sequence separation**: the negative-sequence part of `x_alphabeta` is
+//!    `e^{-j theta} LPF(e^{+j theta} x)` (three first-order low-passes at
+//!    [`SEQ_LPF_HZ`]), the positive-sequence part is the rest. The balanced-machine model
+//!    is driven by the positive-sequence voltage and `i_f` = positive-sequence `i_ds`.
+
+use crate::log::{Channels, LogError, LogReader};
+use crate::params::ParamFile;
+use nalgebra::Complex;
+use std::path::Path;
+
+/// Complex number used for space vectors: `re` = alpha (or d), `im` = beta (or q).
+pub type C64 = Complex<f64>;
+
+/// Upper bound on the number of samples of the working (decimated) series.
+pub const MAX_WORK_SAMPLES: usize = 4_000_000;
+/// Target working rate [Hz] when the log is short enough.
+pub const TARGET_RATE_HZ: f64 = 2000.0;
+/// Leak of the voltage-model flux integrator [rad/s].
+pub const FLUX_LEAK_RAD_S: f64 = 1.0;
+/// Corner of the zero-phase smoothing of the frame angle [Hz].
+pub const THETA_SMOOTH_HZ: f64 = 20.0;
+/// Corner of the zero-phase smoothing of i_f [Hz].
+pub const I_F_SMOOTH_HZ: f64 = 10.0;
+/// Corner of the sequence-separation low-passes [Hz].
+pub const SEQ_LPF_HZ: f64 = 4.0;
+
+/// Block-averaged stationary-frame signals (the working series).
+#[derive(Debug, Clone, Default)]
+pub struct Decimated {
+    /// Block-centre times [s].
+    pub t_s: Vec<f64>,
+    /// Stator voltage vector (alpha, beta) [V]; empty for current-only logs.
+    pub v_ab: Vec<[f32; 2]>,
+    /// Stator current vector (alpha, beta) [A].
+    pub i_ab: Vec<[f32; 2]>,
+    /// Zero-sequence current (ia+ib+ic)/3 [A] (kept for the phase-current channels).
+    pub i0: Vec<f32>,
+    /// Mechanical speed [rad/s]; empty when the log has no `wm_rad_s`.
+    pub wm: Vec<f32>,
+    /// Which optional channels the log has.
+    pub channels: Channels,
+    /// Rows read from the log (after the time window).
+    pub rows: u64,
+    /// Log sample rate [Hz] (mean).
+    pub log_rate_hz: f64,
+    /// Decimation factor (log rows per working sample).
+    pub factor: usize,
+    /// Time of the log's first row [s] (before any time window): "time since start".
+    pub log_start_s: f64,
+}
+
+/// Time window and limits for reading a log.
+#[derive(Debug, Clone, Copy)]
+pub struct ReadOptions {
+    /// Ignore rows before this time [s].
+    pub from_s: f64,
+    /// Ignore rows after this time [s].
+    pub to_s: f64,
+}
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        ReadOptions {
+            from_s: f64::NEG_INFINITY,
+            to_s: f64::INFINITY,
+        }
+    }
+}
+
+/// Amplitude-invariant Clarke transform of a phase triple: (alpha, beta, zero).
+pub fn clarke(x: [f64; 3]) -> (f64, f64, f64) {
+    let zero = (x[0] + x[1] + x[2]) / 3.0;
+    let alpha = x[0] - zero;
+    let beta = (x[1] - x[2]) / 3f64.sqrt();
+    (alpha, beta, zero)
+}
+
+/// Inverse Clarke transform: phase a, b, c from (alpha, beta) plus a zero-sequence part.
+pub fn inverse_clarke(ab: C64, zero: f64) -> [f64; 3] {
+    let s = 3f64.sqrt() / 2.0;
+    [
+        ab.re + zero,
+        -0.5 * ab.re + s * ab.im + zero,
+        -0.5 * ab.re - s * ab.im + zero,
+    ]
+}
+
+/// Streams a log and block-averages it to the working rate.
+///
+/// `progress` is called with the fraction of the file read (0..1), at most a few hundred
+/// times. Errors are the log reader's (one line, naming the file, line and column), or
+/// [`LogError::Empty`] when the time window holds fewer than 16 rows.
+pub fn decimate_log(
+    path: &Path,
+    opts: ReadOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Decimated, LogError> {
+    let file_len = std::fs::metadata(path)
+        .map_err(|source| LogError::Io {
+            path: path.display().to_string(),
+            source,
+        })?
+        .len()
+        .max(1);
+    // First pass over a few rows: sample period and bytes per row, to choose the factor.
+    let (dt_s, est_rows) = {
+        let mut r = LogReader::open(path)?;
+        let mut first = None;
+        let mut last = 0.0;
+        let mut n = 0u64;
+        while let Some(row) = r.next_row()? {
+            if first.is_none() {
+                first = Some(row.t_s);
+            }
+            last = row.t_s;
+            n += 1;
+            if n >= 200 {
+                break;
+            }
+        }
+        let dt = match first {
+            Some(f) if n > 1 => (last - f) / (n - 1) as f64,
+            _ => {
+                return Err(LogError::Empty {
+                    path: path.display().to_string(),
+                })
+            }
+        };
+        // Bytes per row estimated from the file's first 64 KiB.
+        let head = {
+            use std::io::Read;
+            let mut buf = vec![0u8; 65536];
+            let mut f = std::fs::File::open(path).map_err(|source| LogError::Io {
+                path: path.display().to_string(),
+                source,
+            })?;
+            let k = f.read(&mut buf).unwrap_or(0);
+            buf.truncate(k);
+            buf
+        };
+        let lines = head.iter().filter(|&&b| b == b'\n').count().max(1);
+        let est = file_len as f64 / (head.len() as f64 / lines as f64);
+        (dt, est)
+    };
+    if !(dt_s.is_finite() && dt_s > 0.0) {
+        return Err(LogError::Csv {
+            path: path.display().to_string(),
+            line: 0,
+            message: "cannot determine the sample period from t_s".into(),
+        });
+    }
+    let log_rate = 1.0 / dt_s;
+    let mut factor = ((log_rate / TARGET_RATE_HZ).floor() as usize).max(1);
+    let est_window_rows = est_rows; // an upper bound when a time window is given
+    while est_window_rows / factor as f64 > MAX_WORK_SAMPLES as f64
+        && log_rate / (factor as f64 + 1.0) >= 1000.0
+    {
+        factor += 1;
+    }
+    let ch = LogReader::open(path)?.channels();
+    let mut d = Decimated {
+        channels: ch,
+        factor,
+        log_rate_hz: log_rate,
+        ..Default::default()
+    };
+    let cap = (est_window_rows / factor as f64) as usize + 16;
+    d.t_s.reserve(cap.min(MAX_WORK_SAMPLES + 16));
+    let mut acc = Acc::default();
+    let mut first_t: Option<f64> = None;
+    let fast = super::fastcsv::for_each_row(path, progress, &mut |row| {
+        let t = row[0];
+        first_t.get_or_insert(t);
+        if t < opts.from_s {
+            return true;
+        }
+        if t > opts.to_s {
+            return false;
+        }
+        let mut o = 4;
+        let v = if ch.voltages {
+            o += 3;
+            Some([row[4], row[5], row[6]])
+        } else {
+            None
+        };
+        let w = if ch.speed { Some(row[o]) } else { None };
+        acc.push(&mut d, t, [row[1], row[2], row[3]], v, w);
+        true
+    })?;
+    if !fast {
+        // The exact reader: same result, or the error naming line and column.
+        d.t_s.clear();
+        d.i_ab.clear();
+        d.i0.clear();
+        d.v_ab.clear();
+        d.wm.clear();
+        acc = Acc::default();
+        let mut r = LogReader::open(path)?;
+        first_t = None;
+        while let Some(row) = r.next_row()? {
+            first_t.get_or_insert(row.t_s);
+            if row.t_s < opts.from_s {
+                continue;
+            }
+            if row.t_s > opts.to_s {
+                break;
+            }
+            acc.push(&mut d, row.t_s, row.i_abc, row.v_abc, row.wm_rad_s);
+        }
+    }
+    let rows = acc.rows;
+    d.log_start_s = first_t.unwrap_or(0.0);
+    d.rows = rows;
+    if d.t_s.len() < 16 {
+        return Err(LogError::Empty {
+            path: format!(
+                "{} (in the selected time window, too few rows)",
+                path.display()
+            ),
+        });
+    }
+    progress(1.0);
+    Ok(d)
+}
+
+#[derive(Default)]
+struct Acc {
+    sum: [f64; 7],
+    k: usize,
+    rows: u64,
+}
+
+impl Acc {
+    fn push(
+        &mut self,
+        d: &mut Decimated,
+        t: f64,
+        i: [f64; 3],
+        v: Option<[f64; 3]>,
+        w: Option<f64>,
+    ) {
+        self.rows += 1;
+        let (ia, ib, i0) = clarke(i);
+        let a = &mut self.sum;
+        a[0] += t;
+        a[1] += ia;
+        a[2] += ib;
+        a[3] += i0;
+        if let Some(v) = v {
+            let (va, vb, _) = clarke(v);
+            a[4] += va;
+            a[5] += vb;
+        }
+        if let Some(w) = w {
+            a[6] += w;
+        }
+        self.k += 1;
+        if self.k == d.factor {
+            let inv = 1.0 / self.k as f64;
+            d.t_s.push(a[0] * inv);
+            d.i_ab.push([(a[1] * inv) as f32, (a[2] * inv) as f32]);
+            d.i0.push((a[3] * inv) as f32);
+            if d.channels.voltages {
+                d.v_ab.push([(a[4] * inv) as f32, (a[5] * inv) as f32]);
+            }
+            if d.channels.speed {
+                d.wm.push((a[6] * inv) as f32);
+            }
+            *a = [0.0; 7];
+            self.k = 0;
+        }
+    }
+}
+
+/// Synchronous-frame working signals: the model's inputs and the measured outputs.
+#[derive(Debug, Clone, Default)]
+pub struct Prepared {
+    /// Times [s].
+    pub t_s: Vec<f64>,
+    /// Working sample period [s] (mean).
+    pub dt_s: f64,
+    /// Park angle of the frame [rad] (unwrapped).
+    pub theta: Vec<f64>,
+    /// Frame angular speed omega_s [rad/s] (electrical).
+    pub omega_s: Vec<f64>,
+    /// Positive-sequence V_ds [V] (zero-length for current-only logs).
+    pub vd: Vec<f64>,
+    /// Positive-sequence V_qs [V], the model input (eq. 28).
+    pub vq: Vec<f64>,
+    /// Positive-sequence I_ds [A].
+    pub id: Vec<f64>,
+    /// i_f of the model [A]: I_ds smoothed without phase shift (forward-backward low-pass at
+    /// [`I_F_SMOOTH_HZ`]); eq. (18) takes i_f constant, and the raw I_ds would carry sensor
+    /// noise into Psi omega_r with a gain Ls omega / Ra of about 10.
+    pub i_f: Vec<f64>,
+    /// Measured I_qs [A] (all sequences), the model output to predict.
+    pub iq: Vec<f64>,
+    /// Positive-sequence measured I_qs [A].
+    pub iq_pos: Vec<f64>,
+    /// Measured current vector, stationary frame [A].
+    pub i_ab: Vec<C64>,
+    /// Zero-sequence current [A].
+    pub i0: Vec<f64>,
+    /// Negative-sequence voltage vector, stationary frame [V] (zeros when no voltages).
+    pub v_neg: Vec<C64>,
+    /// Negative-sequence current vector, stationary frame [A].
+    pub i_neg: Vec<C64>,
+    /// Measured electrical rotor speed omega_r = Np wm [rad/s]; empty without speed.
+    pub omega_r: Vec<f64>,
+    /// Which optional channels the log has.
+    pub channels: Channels,
+    /// Rows of the log analysed.
+    pub rows: u64,
+    /// Log sample rate [Hz].
+    pub log_rate_hz: f64,
+    /// Time of the log's first row [s].
+    pub log_start_s: f64,
+}
+
+impl Prepared {
+    /// Number of working samples.
+    pub fn len(&self) -> usize {
+        self.t_s.len()
+    }
+    /// True when there are no samples.
+    pub fn is_empty(&self) -> bool {
+        self.t_s.is_empty()
+    }
+    /// True when the log can drive the model (voltages present).
+    pub fn has_model_inputs(&self) -> bool {
+        self.channels.voltages
+    }
+}
+
+/// Zero-phase low-pass: a first-order filter run forward then backward, twice
+/// (fourth-order magnitude, no delay), each pass started at the end value.
+pub fn zero_phase_lpf(x: &[f64], dt: f64, fc: f64) -> Vec<f64> {
+    let a = 1.0 - (-2.0 * std::f64::consts::PI * fc * dt).exp();
+    let mut y = x.to_vec();
+    for _ in 0..2 {
+        let mut s = y.first().copied().unwrap_or(0.0);
+        for v in y.iter_mut() {
+            s += a * (*v - s);
+            *v = s;
+        }
+        let mut s = y.last().copied().unwrap_or(0.0);
+        for v in y.iter_mut().rev() {
+            s += a * (*v - s);
+            *v = s;
+        }
+    }
+    y
+}
+
+fn lpf3(x: &[C64], dt: f64, fc: f64, init_len: usize) -> Vec<C64> {
+    let a = 1.0 - (-2.0 * std::f64::consts::PI * fc * dt).exp();
+    // Initial state: the mean over the first `init_len` samples (whole supply periods, so
+    // the positive sequence, at 2 omega in this frame, averages out).
+    let m = init_len.clamp(1, x.len().max(1));
+    let init = x.iter().take(m).fold(C64::new(0.0, 0.0), |acc, v| acc + v) / m as f64;
+    let mut s = [init; 3];
+    x.iter()
+        .map(|&v| {
+            s[0] += a * (v - s[0]);
+            s[1] += a * (s[0] - s[1]);
+            s[2] += a * (s[1] - s[2]);
+            s[2]
+        })
+        .collect()
+}
+
+/// Builds the rotor-flux frame and the d-q signals from the working series.
+///
+/// `p` gives the parameters of the flux estimator (Rs, sigma Ls, Lr/Lm) and, for
+/// current-only logs, the supply frequency of the frame. Pole pairs convert the measured
+/// mechanical speed to electrical omega_r.
+pub fn frame(d: &Decimated, p: &ParamFile) -> Prepared {
+    let n = d.t_s.len();
+    let dt = if n > 1 {
+        (d.t_s[n - 1] - d.t_s[0]) / (n - 1) as f64
+    } else {
+        1e-3
+    };
+    let m = &p.motor;
+    let i_ab: Vec<C64> = d
+        .i_ab
+        .iter()
+        .map(|x| C64::new(x[0] as f64, x[1] as f64))
+        .collect();
+    let v_ab: Vec<C64> = d
+        .v_ab
+        .iter()
+        .map(|x| C64::new(x[0] as f64, x[1] as f64))
+        .collect();
+    let mut theta = Vec::with_capacity(n);
+    if d.channels.voltages {
+        // Voltage-model rotor flux with a leaky (trapezoidal) integrator.
+        let sls = m.sigma() * m.ls_h;
+        let kr = m.lr_h / m.lm_h;
+        let decay = (-FLUX_LEAK_RAD_S * dt).exp();
+        // Initial stator flux: zero when the log starts de-energised (a start from
+        // standstill), otherwise the value that makes the flux zero-mean over the first two
+        // nominal supply periods (a log that starts mid-run).
+        let w0 = p.supply.omega_rad_s();
+        let n_per = ((2.0 * 2.0 * std::f64::consts::PI / w0) / dt)
+            .round()
+            .max(1.0) as usize;
+        let n_per = n_per.min(n);
+        let i_rms_all = (i_ab.iter().map(|x| x.norm_sqr()).sum::<f64>() / n as f64).sqrt();
+        let n_head = ((0.002 / dt).ceil() as usize).clamp(1, n);
+        let i_rms_head =
+            (i_ab[..n_head].iter().map(|x| x.norm_sqr()).sum::<f64>() / n_head as f64).sqrt();
+        let mut psi_s = C64::new(0.0, 0.0);
+        if i_rms_head > 0.02 * i_rms_all {
+            let mut acc = C64::new(0.0, 0.0);
+            let mut sum = C64::new(0.0, 0.0);
+            for k in 1..n_per {
+                acc += (v_ab[k] - i_ab[k] * m.rs_ohm + v_ab[k - 1] - i_ab[k - 1] * m.rs_ohm)
+                    * (0.5 * dt);
+                sum += acc;
+            }
+            psi_s = -sum / n_per as f64;
+        }
+        let mut prev_e = v_ab[0] - i_ab[0] * m.rs_ohm;
+        let mut unwrapped = 0.0f64;
+        let mut prev_ang: Option<f64> = None;
+        for k in 0..n {
+            let e = v_ab[k] - i_ab[k] * m.rs_ohm;
+            if k > 0 {
+                psi_s = psi_s * decay + (e + prev_e) * (0.5 * dt);
+            }
+            prev_e = e;
+            let psi_r = (psi_s - i_ab[k] * sls) * kr;
+            let ang = if psi_r.norm() > 1e-6 {
+                psi_r.im.atan2(psi_r.re)
+            } else {
+                // No flux yet: follow the nominal supply.
+                prev_ang.map(|a| a + w0 * dt).unwrap_or(0.0)
+            };
+            match prev_ang {
+                None => unwrapped = ang,
+                Some(pa) => {
+                    let mut da = ang - pa;
+                    da = (da + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI)
+                        - std::f64::consts::PI;
+                    unwrapped += da;
+                }
+            }
+            prev_ang = Some(ang);
+            theta.push(unwrapped);
+        }
+    } else {
+        let w0 = p.supply.omega_rad_s();
+        theta.extend(d.t_s.iter().map(|t| w0 * t));
+    }
+    // The voltage-model angle carries a 2f wobble when the machine or the supply is
+    // unbalanced; the frame follows its zero-phase smoothed version (20 Hz), which keeps
+    // start-up and step transients and makes the sequence separation clean.
+    // (Smoothing the angle's increments and summing them back avoids the end effects a
+    // filter has on a ramp.)
+    if d.channels.voltages && n > 2 {
+        let inc: Vec<f64> = theta.windows(2).map(|w| w[1] - w[0]).collect();
+        let inc = zero_phase_lpf(&inc, dt, THETA_SMOOTH_HZ);
+        let mut th = theta[0];
+        // Keep the mean angle: offset so that the smoothed angle has the raw one's mean.
+        let mut smooth = Vec::with_capacity(n);
+        smooth.push(th);
+        for v in inc {
+            th += v;
+            smooth.push(th);
+        }
+        let off = theta.iter().zip(&smooth).map(|(a, b)| a - b).sum::<f64>() / n as f64;
+        theta = smooth.into_iter().map(|v| v + off).collect();
+    }
+    // Frame speed: central difference of the unwrapped angle, low-passed (20 Hz).
+    let mut omega_s = vec![0.0; n];
+    for k in 0..n {
+        let (a, b) = (k.saturating_sub(1), (k + 1).min(n - 1));
+        if b > a {
+            omega_s[k] = (theta[b] - theta[a]) / (d.t_s[b] - d.t_s[a]);
+        }
+    }
+    let a = 1.0 - (-2.0 * std::f64::consts::PI * 20.0 * dt).exp();
+    let mut s = omega_s.first().copied().unwrap_or(0.0);
+    let mut s2 = s;
+    for w in omega_s.iter_mut() {
+        s += a * (*w - s);
+        s2 += a * (s - s2);
+        *w = s2;
+    }
+    // Sequence separation.
+    let rot: Vec<C64> = theta
+        .iter()
+        .map(|&th| C64::new(th.cos(), th.sin()))
+        .collect();
+    let w_first = omega_s.iter().take(64).sum::<f64>() / omega_s.len().clamp(1, 64) as f64;
+    let period = 2.0 * std::f64::consts::PI / w_first.abs().max(1.0);
+    let init_len = ((2.0 * period / dt).round() as usize).max(1);
+    let neg = |x: &[C64]| -> Vec<C64> {
+        let shifted: Vec<C64> = x.iter().zip(&rot).map(|(v, r)| v * r).collect();
+        let f = lpf3(&shifted, dt, SEQ_LPF_HZ, init_len);
+        f.iter().zip(&rot).map(|(v, r)| v * r.conj()).collect()
+    };
+    let i_neg = neg(&i_ab);
+    let v_neg = if d.channels.voltages {
+        neg(&v_ab)
+    } else {
+        vec![C64::new(0.0, 0.0); n]
+    };
+    let mut vd = Vec::new();
+    let mut vq = Vec::new();
+    if d.channels.voltages {
+        for k in 0..n {
+            let v = (v_ab[k] - v_neg[k]) * rot[k].conj();
+            vd.push(v.re);
+            vq.push(v.im);
+        }
+    }
+    let mut id = Vec::with_capacity(n);
+    let mut iq = Vec::with_capacity(n);
+    let mut iq_pos = Vec::with_capacity(n);
+    for k in 0..n {
+        let ip = (i_ab[k] - i_neg[k]) * rot[k].conj();
+        let it = i_ab[k] * rot[k].conj();
+        id.push(ip.re);
+        iq_pos.push(ip.im);
+        iq.push(it.im);
+    }
+    let np = m.pole_pairs();
+    let i_f = zero_phase_lpf(&id, dt, I_F_SMOOTH_HZ);
+    Prepared {
+        i_f,
+        t_s: d.t_s.clone(),
+        dt_s: dt,
+        theta,
+        omega_s,
+        vd,
+        vq,
+        id,
+        iq,
+        iq_pos,
+        i_ab,
+        i0: d.i0.iter().map(|&x| x as f64).collect(),
+        v_neg,
+        i_neg,
+        omega_r: d.wm.iter().map(|&w| w as f64 * np).collect(),
+        channels: d.channels,
+        rows: d.rows,
+        log_rate_hz: d.log_rate_hz,
+        log_start_s: d.log_start_s,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clarke_round_trip() {
+        let x = [1.0, -0.3, -0.4];
+        let (a, b, z) = clarke(x);
+        let y = inverse_clarke(C64::new(a, b), z);
+        for k in 0..3 {
+            assert!((x[k] - y[k]).abs() < 1e-12);
+        }
+    }
+}

@@ -1,0 +1,218 @@
+//! The sensor chain: transducer faults, gain/offset errors, white noise, ADC, encoder.
+
+use super::scenario::{FaultKind, FaultSpec, SensorFaultMode, SensorSpec};
+use super::Truth;
+use crate::log::Row;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
+
+/// Transducer fault state of one channel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum ChanFault {
+    None,
+    Gain(f64),
+    Offset(f64),
+    Zero,
+    Stuck,
+}
+
+impl ChanFault {
+    fn from_spec(f: &FaultSpec) -> Self {
+        match f.mode {
+            Some(SensorFaultMode::Gain) => ChanFault::Gain(1.0 + f.change.unwrap_or(0.0)),
+            Some(SensorFaultMode::Offset) => ChanFault::Offset(f.offset.unwrap_or(0.0)),
+            Some(SensorFaultMode::Disconnected) => ChanFault::Zero,
+            Some(SensorFaultMode::Stuck) => ChanFault::Stuck,
+            None => ChanFault::None,
+        }
+    }
+}
+
+/// One ADC channel's static chain.
+#[derive(Debug, Clone, Copy)]
+struct Adc {
+    gain: f64,
+    offset: f64,
+    sigma: f64,
+    lsb: f64,
+    code_min: f64,
+    code_max: f64,
+    quantise: bool,
+}
+
+impl Adc {
+    #[inline(always)]
+    fn read(&self, x: f64, rng: &mut ChaCha8Rng) -> f64 {
+        let mut y = self.gain * x + self.offset;
+        if self.sigma > 0.0 {
+            let n: f64 = StandardNormal.sample(rng);
+            y += self.sigma * n;
+        }
+        if self.quantise {
+            (y / self.lsb).round().clamp(self.code_min, self.code_max) * self.lsb
+        } else {
+            y
+        }
+    }
+}
+
+/// The resolved sensor chain with its state (faults, held values, encoder).
+pub(crate) struct Sensors {
+    v_adc: Adc,
+    i_adc: Adc,
+    w_sigma: f64,
+    rng: ChaCha8Rng,
+    counts_per_rad: f64,
+    v_fault: [ChanFault; 3],
+    i_fault: [ChanFault; 3],
+    w_fault: ChanFault,
+    v_last: [f64; 3],
+    i_last: [f64; 3],
+    w_last: f64,
+    theta_prev: f64,
+    theta_sensed: f64,
+    voltages: bool,
+    speed: bool,
+    encoder: bool,
+    /// Ranges in effect [V], [A] (for the summary).
+    pub v_range_v: f64,
+    pub i_range_a: f64,
+    pub noise_v: f64,
+    pub noise_i: f64,
+}
+
+impl Sensors {
+    pub fn new(spec: &SensorSpec, v_range_v: f64, i_range_a: f64, seed: u64) -> Self {
+        let half = f64::from(1u32 << (spec.adc_bits - 1));
+        let noise_v = spec.noise_v.unwrap_or(5e-4 * v_range_v);
+        let noise_i = spec.noise_i.unwrap_or(5e-4 * i_range_a);
+        let mk = |range: f64, gain_err: f64, offset: f64, sigma: f64| Adc {
+            gain: if spec.ideal { 1.0 } else { 1.0 + gain_err },
+            offset: if spec.ideal { 0.0 } else { offset },
+            sigma: if spec.ideal { 0.0 } else { sigma },
+            lsb: range / half,
+            code_min: -half,
+            code_max: half - 1.0,
+            quantise: !spec.ideal,
+        };
+        Sensors {
+            v_adc: mk(v_range_v, spec.v_gain_error, spec.v_offset_v, noise_v),
+            i_adc: mk(i_range_a, spec.i_gain_error, spec.i_offset_a, noise_i),
+            w_sigma: if spec.ideal { 0.0 } else { spec.noise_w_rad_s },
+            rng: ChaCha8Rng::seed_from_u64(seed),
+            counts_per_rad: 4.0 * f64::from(spec.encoder_lines) / (2.0 * std::f64::consts::PI),
+            v_fault: [ChanFault::None; 3],
+            i_fault: [ChanFault::None; 3],
+            w_fault: ChanFault::None,
+            v_last: [0.0; 3],
+            i_last: [0.0; 3],
+            w_last: 0.0,
+            theta_prev: 0.0,
+            theta_sensed: 0.0,
+            voltages: spec.voltages,
+            speed: spec.speed,
+            encoder: spec.encoder,
+            v_range_v,
+            i_range_a,
+            noise_v: if spec.ideal { 0.0 } else { noise_v },
+            noise_i: if spec.ideal { 0.0 } else { noise_i },
+        }
+    }
+
+    /// Switches a sensor fault on.
+    pub fn apply_fault(&mut self, f: &FaultSpec) {
+        let cf = ChanFault::from_spec(f);
+        let target = match f.kind {
+            FaultKind::CurrentSensor => &mut self.i_fault,
+            FaultKind::VoltageSensor => &mut self.v_fault,
+            FaultKind::SpeedSensor => {
+                self.w_fault = cf;
+                return;
+            }
+            _ => return,
+        };
+        match f.phase {
+            Some(p) => target[p.index()] = cf,
+            None => *target = [cf; 3],
+        }
+    }
+
+    /// Sensor readings of the true state `tr`; `dt_s` is the time since the previous call.
+    pub fn measure(&mut self, tr: &Truth, dt_s: f64) -> Row {
+        let mut v = [0.0; 3];
+        if self.voltages {
+            for (k, out) in v.iter_mut().enumerate() {
+                *out = Self::chan(
+                    self.v_fault[k],
+                    tr.v_abc[k],
+                    &mut self.v_last[k],
+                    &self.v_adc,
+                    &mut self.rng,
+                );
+            }
+        }
+        let mut i = [0.0; 3];
+        for (k, out) in i.iter_mut().enumerate() {
+            *out = Self::chan(
+                self.i_fault[k],
+                tr.i_abc[k],
+                &mut self.i_last[k],
+                &self.i_adc,
+                &mut self.rng,
+            );
+        }
+        let wm = if self.speed {
+            let x = match self.w_fault {
+                ChanFault::None => tr.wm_rad_s,
+                ChanFault::Gain(g) => g * tr.wm_rad_s,
+                ChanFault::Offset(o) => tr.wm_rad_s + o,
+                ChanFault::Zero => 0.0,
+                ChanFault::Stuck => self.w_last,
+            };
+            let y = if self.w_sigma > 0.0 && self.w_fault != ChanFault::Stuck {
+                let n: f64 = StandardNormal.sample(&mut self.rng);
+                x + self.w_sigma * n
+            } else {
+                x
+            };
+            self.w_last = y;
+            Some(y)
+        } else {
+            None
+        };
+        let dth = tr.theta_m_rad - self.theta_prev;
+        self.theta_prev = tr.theta_m_rad;
+        match self.w_fault {
+            ChanFault::None => self.theta_sensed += dth,
+            ChanFault::Gain(g) => self.theta_sensed += g * dth,
+            ChanFault::Offset(o) => self.theta_sensed += dth + o * dt_s,
+            ChanFault::Zero | ChanFault::Stuck => {}
+        }
+        let enc = if self.encoder {
+            Some((self.theta_sensed * self.counts_per_rad).floor() as i64)
+        } else {
+            None
+        };
+        Row {
+            t_s: tr.t_s,
+            v_abc: if self.voltages { Some(v) } else { None },
+            i_abc: i,
+            wm_rad_s: wm,
+            enc_count: enc,
+        }
+    }
+
+    #[inline(always)]
+    fn chan(f: ChanFault, x: f64, last: &mut f64, adc: &Adc, rng: &mut ChaCha8Rng) -> f64 {
+        let y = match f {
+            ChanFault::None => adc.read(x, rng),
+            ChanFault::Gain(g) => adc.read(g * x, rng),
+            ChanFault::Offset(o) => adc.read(x + o, rng),
+            ChanFault::Zero => adc.read(0.0, rng),
+            ChanFault::Stuck => *last,
+        };
+        *last = y;
+        y
+    }
+}

@@ -1,0 +1,307 @@
+//! The board: analog front-end scaling, encoder, sample rate and the pin map.
+//!
+//! Everything that depends on how the NUCLEO-G474RE is wired to the drive lives in this
+//! one file. The scaling part is plain arithmetic and builds on the host (it is tested
+//! there); the pin assignment at the bottom only exists for `target_os = "none"`.
+//!
+//! # Analog front end (default: isolated measurement board)
+//!
+//! Each of the six channels is an isolated amplifier whose output spans the STM32's
+//! 0..3.3 V ADC input range linearly:
+//!
+//! | quantity | range at the motor | ADC input | code |
+//! |---|---|---|---|
+//! | phase-to-neutral voltage `va, vb, vc` | -400 V .. +400 V | 0 .. 3.3 V | 0 .. 4095 |
+//! | phase current `ia, ib, ic` | -10 A .. +10 A | 0 .. 3.3 V | 0 .. 4095 |
+//!
+//! So zero volts / zero amperes sit at mid-scale, code 2047.5, and
+//! `x = (code - offset) * PER_LSB`. The constants below derive the factors from these
+//! ranges; change the ranges here (and only here) for another front end. Codes 0 and
+//! 4095 mean the input is at or beyond the rail: the true value is unknown, so such a
+//! sample is flagged `adc_saturated` and the core does not trust it.
+//!
+//! # Pin map (NUCLEO-G474RE, Arduino/Morpho headers)
+//!
+//! | function | pin | peripheral | notes |
+//! |---|---|---|---|
+//! | `va` | PA0 (A0) | ADC1_IN1 | ADC1 rank 1 |
+//! | `vb` | PA1 (A1) | ADC1_IN2 | ADC1 rank 2 |
+//! | `vc` | PC0 (A5) | ADC1_IN6 | ADC1 rank 3 |
+//! | `ia` | PC1 (A4) | ADC2_IN7 | ADC2 rank 1, converted together with `va` |
+//! | `ib` | PC2 (CN7-35) | ADC2_IN8 | ADC2 rank 2, together with `vb` |
+//! | `ic` | PC3 (CN7-37) | ADC2_IN9 | ADC2 rank 3, together with `vc` |
+//! | encoder A / B | PB6 / PB7 | TIM4_CH1 / TIM4_CH2 | quadrature x4, 1024 lines |
+//! | sample trigger | (internal) | TIM1 TRGO | both ADCs, rising edge |
+//! | run / healthy lamp | PA5 | LD2 (green, on board) | |
+//! | r1 lamp | PB8 | GPIO out | |
+//! | r2 lamp | PB9 | GPIO out | |
+//! | r3 lamp | PB10 | GPIO out | |
+//! | r4 lamp | PB12 | GPIO out | |
+//! | fault lamp | PB13 | GPIO out | also blinks the top candidate |
+//! | commissioning button | PC13 | B1 (blue, on board), EXTI13 | pressed = high (pull-down) |
+//! | defmt log | SWD (ST-LINK) | RTT | |
+//!
+//! LEDs on PB8..PB13 are external: pin -> 330 ohm -> LED anode, cathode to GND
+//! (about 4 mA at 3.3 V). The commissioning record lives in the last 2 KiB flash page,
+//! see [`RECORD_FLASH_OFFSET`].
+
+/// Resolution of the STM32G4 ADC in bits (12-bit mode).
+pub const ADC_BITS: u32 = 12;
+/// Largest ADC code: `2^ADC_BITS - 1 = 4095`.
+pub const ADC_MAX_CODE: u16 = (1 << ADC_BITS) - 1;
+/// ADC reference voltage on the NUCLEO-G474RE (VREF+ tied to VDDA = 3.3 V).
+pub const ADC_VREF_V: f32 = 3.3;
+/// Code of a zero-volt / zero-ampere input for a bipolar front end that maps
+/// `-full_scale..+full_scale` onto `0..ADC_MAX_CODE`: `4095 / 2 = 2047.5`.
+pub const MID_SCALE_CODE: f32 = ADC_MAX_CODE as f32 / 2.0;
+
+/// Full-scale phase voltage of the voltage channels, volts (the front end maps
+/// `-VOLTAGE_FULL_SCALE_V..+VOLTAGE_FULL_SCALE_V` onto 0..3.3 V).
+pub const VOLTAGE_FULL_SCALE_V: f32 = 400.0;
+/// Full-scale phase current of the current channels, amperes.
+pub const CURRENT_FULL_SCALE_A: f32 = 10.0;
+
+/// Volts at the motor per ADC code: `2 * 400 V / 4095 LSB = 0.195 36 V/LSB`.
+pub const VOLT_PER_LSB: f32 = 2.0 * VOLTAGE_FULL_SCALE_V / ADC_MAX_CODE as f32;
+/// Amperes at the motor per ADC code: `2 * 10 A / 4095 LSB = 4.884 mA/LSB`.
+pub const AMP_PER_LSB: f32 = 2.0 * CURRENT_FULL_SCALE_A / ADC_MAX_CODE as f32;
+
+/// Sample (trigger) rate of the six channels by default, hertz.
+pub const DEFAULT_SAMPLE_RATE_HZ: u32 = 10_000;
+/// Encoder lines per mechanical revolution.
+pub const ENCODER_LINES: u32 = 1024;
+/// Encoder counts per mechanical revolution with x4 quadrature decoding:
+/// `4 * 1024 = 4096`.
+pub const ENCODER_COUNTS_PER_REV: u32 = 4 * ENCODER_LINES;
+
+/// Offset of the commissioning record from the start of flash (0x0800_0000), bytes:
+/// the last 2 KiB page of bank 2 (dual-bank mode), `0x0807_F800`. `memory.x` keeps the
+/// last 4 KiB out of the linker's reach so code can never land there. Writing bank 2
+/// while code runs from bank 1 does not stall instruction fetches.
+pub const RECORD_FLASH_OFFSET: u32 = 0x0007_F800;
+/// Size of the flash page that holds the record (erase granularity, dual-bank mode).
+pub const RECORD_PAGE_SIZE: u32 = 2048;
+
+/// Raw 12-bit code of a voltage channel, exactly as the ADC wrote it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct VoltageCode(pub u16);
+
+/// Raw 12-bit code of a current channel, exactly as the ADC wrote it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CurrentCode(pub u16);
+
+/// True when a code sits on a rail (0 or >= 4095): the input is at or beyond the
+/// converter's range and the value is not known.
+#[inline]
+pub const fn is_saturated_code(code: u16) -> bool {
+    code == 0 || code >= ADC_MAX_CODE
+}
+
+/// Linear map of one channel from ADC code to a physical unit:
+/// `x = (code - offset_code) * per_lsb`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ChannelScale {
+    /// Code that corresponds to zero (volts or amperes), in LSB (may be fractional).
+    pub offset_code: f32,
+    /// Physical units per LSB (V/LSB or A/LSB); may be negative for an inverting stage.
+    pub per_lsb: f32,
+}
+
+impl ChannelScale {
+    /// Default voltage channel: zero at mid-scale, [`VOLT_PER_LSB`].
+    pub const VOLTAGE: Self = Self {
+        offset_code: MID_SCALE_CODE,
+        per_lsb: VOLT_PER_LSB,
+    };
+    /// Default current channel: zero at mid-scale, [`AMP_PER_LSB`].
+    pub const CURRENT: Self = Self {
+        offset_code: MID_SCALE_CODE,
+        per_lsb: AMP_PER_LSB,
+    };
+
+    /// Physical value of `code`: `(code - offset_code) * per_lsb`.
+    #[inline]
+    pub fn apply(&self, code: u16) -> f32 {
+        (f32::from(code) - self.offset_code) * self.per_lsb
+    }
+
+    /// Nearest ADC code for a physical value, clamped to `0..=4095` (the inverse of
+    /// [`apply`](Self::apply); used by the host tests to quantize simulated signals).
+    pub fn code_of(&self, value: f32) -> u16 {
+        if self.per_lsb == 0.0 || !value.is_finite() {
+            return self.offset_code.clamp(0.0, ADC_MAX_CODE as f32) as u16;
+        }
+        let code = value / self.per_lsb + self.offset_code + 0.5;
+        // `as` saturates for out-of-range floats; clamp keeps the 12-bit range.
+        code.clamp(0.0, ADC_MAX_CODE as f32) as u16
+    }
+}
+
+/// Scaling of all six analog channels (per-channel so a measured offset can be trimmed).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrontEnd {
+    /// Phase voltages a, b, c.
+    pub voltage: [ChannelScale; 3],
+    /// Phase currents a, b, c.
+    pub current: [ChannelScale; 3],
+}
+
+impl FrontEnd {
+    /// The default isolated measurement board (+-400 V, +-10 A onto 0..3.3 V).
+    pub const DEFAULT: Self = Self {
+        voltage: [ChannelScale::VOLTAGE; 3],
+        current: [ChannelScale::CURRENT; 3],
+    };
+}
+
+impl Default for FrontEnd {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+/// Hardware pin assignment (target only): the single place where pins are chosen.
+#[cfg(target_os = "none")]
+pub mod pins {
+    use embassy_stm32::peripherals as p;
+    use embassy_stm32::Peri;
+
+    /// ADC1 scan sequence pins: `va`, `vb`, `vc` (ranks 1..3).
+    pub struct VoltagePins {
+        /// `va` on PA0.
+        pub a: Peri<'static, p::PA0>,
+        /// `vb` on PA1.
+        pub b: Peri<'static, p::PA1>,
+        /// `vc` on PC0.
+        pub c: Peri<'static, p::PC0>,
+    }
+
+    /// ADC2 scan sequence pins: `ia`, `ib`, `ic` (ranks 1..3).
+    pub struct CurrentPins {
+        /// `ia` on PC1.
+        pub a: Peri<'static, p::PC1>,
+        /// `ib` on PC2.
+        pub b: Peri<'static, p::PC2>,
+        /// `ic` on PC3.
+        pub c: Peri<'static, p::PC3>,
+    }
+
+    /// Panel lamp pins in [`crate::panel::Lamp`] order.
+    pub struct LampPins {
+        /// Run / healthy lamp, PA5 (LD2).
+        pub run: Peri<'static, p::PA5>,
+        /// r1 lamp, PB8.
+        pub r1: Peri<'static, p::PB8>,
+        /// r2 lamp, PB9.
+        pub r2: Peri<'static, p::PB9>,
+        /// r3 lamp, PB10.
+        pub r3: Peri<'static, p::PB10>,
+        /// r4 lamp, PB12.
+        pub r4: Peri<'static, p::PB12>,
+        /// Fault lamp, PB13.
+        pub fault: Peri<'static, p::PB13>,
+    }
+
+    /// All board resources the firmware uses, split out of `embassy_stm32::Peripherals`.
+    pub struct Board {
+        /// ADC1 (voltages).
+        pub adc1: Peri<'static, p::ADC1>,
+        /// ADC2 (currents).
+        pub adc2: Peri<'static, p::ADC2>,
+        /// DMA channel for ADC1's ring buffer.
+        pub adc1_dma: Peri<'static, p::DMA1_CH1>,
+        /// DMA channel for ADC2's ring buffer.
+        pub adc2_dma: Peri<'static, p::DMA1_CH2>,
+        /// Sample trigger timer (TRGO on update).
+        pub trigger_timer: Peri<'static, p::TIM1>,
+        /// Voltage inputs.
+        pub voltage: VoltagePins,
+        /// Current inputs.
+        pub current: CurrentPins,
+        /// Encoder timer.
+        pub encoder_timer: Peri<'static, p::TIM4>,
+        /// Encoder A (TIM4_CH1).
+        pub encoder_a: Peri<'static, p::PB6>,
+        /// Encoder B (TIM4_CH2).
+        pub encoder_b: Peri<'static, p::PB7>,
+        /// Panel lamps.
+        pub lamps: LampPins,
+        /// User button B1.
+        pub button: Peri<'static, p::PC13>,
+        /// EXTI line of the button.
+        pub button_exti: Peri<'static, p::EXTI13>,
+        /// Flash controller (commissioning record).
+        pub flash: Peri<'static, p::FLASH>,
+        /// Independent watchdog.
+        pub iwdg: Peri<'static, p::IWDG>,
+    }
+
+    impl Board {
+        /// Take the board's resources out of the HAL's peripheral set.
+        pub fn take(p: embassy_stm32::Peripherals) -> Self {
+            Self {
+                adc1: p.ADC1,
+                adc2: p.ADC2,
+                adc1_dma: p.DMA1_CH1,
+                adc2_dma: p.DMA1_CH2,
+                trigger_timer: p.TIM1,
+                voltage: VoltagePins {
+                    a: p.PA0,
+                    b: p.PA1,
+                    c: p.PC0,
+                },
+                current: CurrentPins {
+                    a: p.PC1,
+                    b: p.PC2,
+                    c: p.PC3,
+                },
+                encoder_timer: p.TIM4,
+                encoder_a: p.PB6,
+                encoder_b: p.PB7,
+                lamps: LampPins {
+                    run: p.PA5,
+                    r1: p.PB8,
+                    r2: p.PB9,
+                    r3: p.PB10,
+                    r4: p.PB12,
+                    fault: p.PB13,
+                },
+                button: p.PC13,
+                button_exti: p.EXTI13,
+                flash: p.FLASH,
+                iwdg: p.IWDG,
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mid_scale_is_zero_and_rails_are_full_scale() {
+        let v = ChannelScale::VOLTAGE;
+        assert!(v.apply(2047).abs() < 0.2 && v.apply(2048).abs() < 0.2);
+        assert!((v.apply(0) + 400.0).abs() < 1e-3);
+        assert!((v.apply(4095) - 400.0).abs() < 1e-3);
+        let i = ChannelScale::CURRENT;
+        assert!((i.apply(4095) - 10.0).abs() < 1e-4);
+    }
+
+    #[test]
+    fn code_of_inverts_apply_within_half_lsb() {
+        let v = ChannelScale::VOLTAGE;
+        for k in -39..=39 {
+            let x = k as f32 * 10.0;
+            let back = v.apply(v.code_of(x));
+            assert!(
+                (back - x).abs() <= VOLT_PER_LSB / 2.0 + 1e-3,
+                "{x} -> {back}"
+            );
+        }
+        assert_eq!(v.code_of(1e6), ADC_MAX_CODE);
+        assert_eq!(v.code_of(-1e6), 0);
+        assert!(is_saturated_code(0) && is_saturated_code(4095) && !is_saturated_code(1));
+    }
+}

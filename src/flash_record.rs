@@ -1,0 +1,282 @@
+//! The commissioning record kept in flash: encode, decode, version and checksum.
+//!
+//! The record stores the healthy-residual statistics learned during commissioning
+//! (per residual r1..r4: mean and spread, in the core's normalized units). It is written
+//! to the page at [`crate::board::RECORD_FLASH_OFFSET`] and read back at boot. Anything
+//! that is not a complete, current-version record with a matching CRC and sane values
+//! is rejected with a [`RecordError`], and the firmware then runs "not commissioned".
+//!
+//! # Layout (little endian, [`RECORD_LEN`] = 48 bytes, a multiple of the G4's 8-byte
+//! flash write unit)
+//!
+//! | bytes | field |
+//! |---|---|
+//! | 0..4 | magic `b"DMCR"` |
+//! | 4..6 | format version, `u16` ([`RECORD_VERSION`]) |
+//! | 6..8 | payload length in bytes, `u16` (= 32) |
+//! | 8..24 | `mean[0..4]`, `f32` each |
+//! | 24..40 | `spread[0..4]`, `f32` each |
+//! | 40..44 | reserved, zero |
+//! | 44..48 | CRC-32 (IEEE 802.3, reflected, as zlib) of bytes 0..44 |
+//!
+//! Erased flash reads as all `0xFF`; that is reported as [`RecordError::Erased`].
+
+/// Magic bytes at the start of a record.
+pub const RECORD_MAGIC: [u8; 4] = *b"DMCR";
+/// Current record format version. Bump it whenever the layout or the meaning of the
+/// stored numbers changes (for example a new normalization in the core): old records
+/// are then rejected instead of misread.
+pub const RECORD_VERSION: u16 = 1;
+/// Encoded record length in bytes.
+pub const RECORD_LEN: usize = 48;
+const PAYLOAD_LEN: u16 = 32;
+const CRC_OFFSET: usize = 44;
+
+/// Learned healthy statistics of the four residuals, as stored in flash.
+///
+/// `mean[k]` and `spread[k]` are in the core's normalized residual units; `spread` must
+/// be finite and >= 0, `mean` finite (the core checks its tighter ranges when the record
+/// is applied with `Monitor::set_calibration`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CalibrationRecord {
+    /// Mean of each residual r1..r4 over the commissioning run.
+    pub mean: [f32; 4],
+    /// Spread (standard deviation) of each residual r1..r4 over the commissioning run, >= 0.
+    pub spread: [f32; 4],
+}
+
+/// Why a stored record was rejected.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum RecordError {
+    /// Fewer than [`RECORD_LEN`] bytes were given.
+    Truncated,
+    /// The page is erased (all `0xFF`): never commissioned.
+    Erased,
+    /// The magic bytes do not match: not a record of this firmware.
+    BadMagic,
+    /// A record of another format version (the stored version is given).
+    UnsupportedVersion(u16),
+    /// The payload length field does not match this version's layout.
+    BadLength,
+    /// The CRC does not match: the record is corrupt (bit flip, torn write).
+    BadChecksum,
+    /// CRC is fine but a value is not usable (non-finite, or spread < 0).
+    InvalidValue,
+}
+
+impl core::fmt::Display for RecordError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Truncated => f.write_str("record truncated"),
+            Self::Erased => f.write_str("no record (erased flash)"),
+            Self::BadMagic => f.write_str("bad record magic"),
+            Self::UnsupportedVersion(v) => write!(f, "unsupported record version {v}"),
+            Self::BadLength => f.write_str("bad record payload length"),
+            Self::BadChecksum => f.write_str("record checksum mismatch"),
+            Self::InvalidValue => f.write_str("record holds an unusable value"),
+        }
+    }
+}
+
+#[cfg(target_os = "none")]
+impl defmt::Format for RecordError {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        match self {
+            Self::Truncated => defmt::write!(f, "Truncated"),
+            Self::Erased => defmt::write!(f, "Erased"),
+            Self::BadMagic => defmt::write!(f, "BadMagic"),
+            Self::UnsupportedVersion(v) => defmt::write!(f, "UnsupportedVersion({=u16})", v),
+            Self::BadLength => defmt::write!(f, "BadLength"),
+            Self::BadChecksum => defmt::write!(f, "BadChecksum"),
+            Self::InvalidValue => defmt::write!(f, "InvalidValue"),
+        }
+    }
+}
+
+/// CRC-32 (IEEE 802.3 polynomial 0x04C1_1DB7, reflected, init and final XOR
+/// 0xFFFF_FFFF; the same as zlib's `crc32`). Bitwise, no table: 48 bytes take a few
+/// microseconds, and it runs only at boot and after commissioning.
+///
+/// Check value: `crc32(b"123456789") == 0xCBF4_3926`.
+pub fn crc32(data: &[u8]) -> u32 {
+    let mut crc = 0xFFFF_FFFFu32;
+    for &byte in data {
+        crc ^= u32::from(byte);
+        for _ in 0..8 {
+            let mask = (crc & 1).wrapping_neg();
+            crc = (crc >> 1) ^ (0xEDB8_8320 & mask);
+        }
+    }
+    !crc
+}
+
+fn values_ok(rec: &CalibrationRecord) -> bool {
+    rec.mean.iter().all(|m| m.is_finite()) && rec.spread.iter().all(|s| s.is_finite() && *s >= 0.0)
+}
+
+impl From<monitor_core::Calibration> for CalibrationRecord {
+    fn from(c: monitor_core::Calibration) -> Self {
+        Self {
+            mean: c.mean,
+            spread: c.spread,
+        }
+    }
+}
+
+impl From<CalibrationRecord> for monitor_core::Calibration {
+    fn from(r: CalibrationRecord) -> Self {
+        Self {
+            mean: r.mean,
+            spread: r.spread,
+        }
+    }
+}
+
+impl CalibrationRecord {
+    /// Encode into the flash layout described in the module docs.
+    ///
+    /// # Errors
+    /// [`RecordError::InvalidValue`] if a value is non-finite or a spread is negative
+    /// (such a record would be rejected at the next boot anyway).
+    pub fn encode(&self) -> Result<[u8; RECORD_LEN], RecordError> {
+        if !values_ok(self) {
+            return Err(RecordError::InvalidValue);
+        }
+        let mut out = [0u8; RECORD_LEN];
+        let mut w = Writer {
+            buf: &mut out,
+            pos: 0,
+        };
+        w.put(&RECORD_MAGIC);
+        w.put(&RECORD_VERSION.to_le_bytes());
+        w.put(&PAYLOAD_LEN.to_le_bytes());
+        for v in self.mean.iter().chain(self.spread.iter()) {
+            w.put(&v.to_le_bytes());
+        }
+        let (body, crc_field) = out.split_at_mut(CRC_OFFSET);
+        let crc = crc32(body);
+        for (dst, src) in crc_field.iter_mut().zip(crc.to_le_bytes()) {
+            *dst = src;
+        }
+        Ok(out)
+    }
+
+    /// Decode and validate a record read from flash. Only the first [`RECORD_LEN`]
+    /// bytes are looked at; extra bytes (the rest of the page) are ignored.
+    ///
+    /// # Errors
+    /// See [`RecordError`]; checks run in the order truncated, erased, magic, version,
+    /// length, checksum, values.
+    pub fn decode(bytes: &[u8]) -> Result<Self, RecordError> {
+        let rec = bytes.get(..RECORD_LEN).ok_or(RecordError::Truncated)?;
+        if rec.iter().all(|&b| b == 0xFF) {
+            return Err(RecordError::Erased);
+        }
+        let mut r = Reader { buf: rec, pos: 0 };
+        if r.take::<4>() != RECORD_MAGIC {
+            return Err(RecordError::BadMagic);
+        }
+        let version = u16::from_le_bytes(r.take::<2>());
+        if version != RECORD_VERSION {
+            return Err(RecordError::UnsupportedVersion(version));
+        }
+        if u16::from_le_bytes(r.take::<2>()) != PAYLOAD_LEN {
+            return Err(RecordError::BadLength);
+        }
+        let stored_crc = u32::from_le_bytes(
+            Reader {
+                buf: rec,
+                pos: CRC_OFFSET,
+            }
+            .take::<4>(),
+        );
+        let body = rec.get(..CRC_OFFSET).ok_or(RecordError::Truncated)?;
+        if crc32(body) != stored_crc {
+            return Err(RecordError::BadChecksum);
+        }
+        let mut out = Self {
+            mean: [0.0; 4],
+            spread: [0.0; 4],
+        };
+        for m in out.mean.iter_mut() {
+            *m = f32::from_le_bytes(r.take::<4>());
+        }
+        for s in out.spread.iter_mut() {
+            *s = f32::from_le_bytes(r.take::<4>());
+        }
+        if !values_ok(&out) {
+            return Err(RecordError::InvalidValue);
+        }
+        Ok(out)
+    }
+}
+
+/// Sequential writer into a fixed buffer; silently stops at the end (the layout is
+/// fixed and fits, so that never happens; no panic path either way).
+struct Writer<'a> {
+    buf: &'a mut [u8],
+    pos: usize,
+}
+
+impl Writer<'_> {
+    fn put(&mut self, bytes: &[u8]) {
+        if let Some(dst) = self.buf.get_mut(self.pos..self.pos + bytes.len()) {
+            dst.copy_from_slice(bytes);
+        }
+        self.pos += bytes.len();
+    }
+}
+
+/// Sequential reader; reads past the end yield zeros (callers check the length first).
+struct Reader<'a> {
+    buf: &'a [u8],
+    pos: usize,
+}
+
+impl Reader<'_> {
+    fn take<const N: usize>(&mut self) -> [u8; N] {
+        let mut out = [0u8; N];
+        if let Some(src) = self.buf.get(self.pos..self.pos + N) {
+            out.copy_from_slice(src);
+        }
+        self.pos += N;
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> CalibrationRecord {
+        CalibrationRecord {
+            mean: [0.01, -0.02, 0.003, 0.0],
+            spread: [0.05, 0.04, 0.06, 0.07],
+        }
+    }
+
+    #[test]
+    fn crc_check_value() {
+        assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
+        assert_eq!(crc32(b""), 0);
+    }
+
+    #[test]
+    fn round_trip() {
+        let bytes = sample().encode().unwrap();
+        assert_eq!(CalibrationRecord::decode(&bytes), Ok(sample()));
+        let mut page = [0xFFu8; 2048];
+        page[..RECORD_LEN].copy_from_slice(&bytes);
+        assert_eq!(CalibrationRecord::decode(&page), Ok(sample()));
+    }
+
+    #[test]
+    fn rejects_invalid_values_on_encode() {
+        let mut r = sample();
+        r.spread[2] = -1.0;
+        assert_eq!(r.encode(), Err(RecordError::InvalidValue));
+        r.spread[2] = f32::NAN;
+        assert_eq!(r.encode(), Err(RecordError::InvalidValue));
+    }
+}

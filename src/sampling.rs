@@ -1,0 +1,176 @@
+//! One trigger's ADC codes and encoder count -> the core's [`Sample`].
+//!
+//! The ADCs deliver, per trigger, three voltage codes (ADC1) and three current codes
+//! (ADC2); the encoder timer delivers its 16-bit counter. [`SampleBuilder`] scales the
+//! codes with the board's [`FrontEnd`], flags rail codes as saturated, passes the raw
+//! counter on (the core unwraps it, `EncoderConfig::counter_bits = 16`) and stamps the
+//! sample with a free-running timestamp in ticks of [`TICK_HZ`].
+//!
+//! Timestamps: samples are taken by a hardware timer at an exact rate, so the timestamp of
+//! sample `n` is `n * ticks_per_sample` (wrapping `u32`). When samples were lost (a DMA
+//! overrun), the firmware calls [`SampleBuilder::resync`] with the current time so the gap
+//! shows up in the timestamps instead of silently compressing time.
+
+use crate::board::{is_saturated_code, CurrentCode, FrontEnd, VoltageCode};
+use monitor_core::{Abc, Sample};
+
+/// Timestamp tick rate, Hz (1 MHz: one tick per microsecond; wraps after 71.6 min,
+/// which the core's wrapping differences handle).
+pub const TICK_HZ: u32 = 1_000_000;
+
+/// Raw readings of one trigger.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RawFrame {
+    /// Voltage codes of phases a, b, c (ADC1 ranks 1..3).
+    pub v: [VoltageCode; 3],
+    /// Current codes of phases a, b, c (ADC2 ranks 1..3).
+    pub i: [CurrentCode; 3],
+    /// TIM4 counter (x4 quadrature, 16 bit, wraps).
+    pub encoder_count: u16,
+}
+
+/// Why a sampling configuration was rejected.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SamplingError {
+    /// The rate is 0, above 100 kHz, or does not divide [`TICK_HZ`] (timestamps would
+    /// drift).
+    Rate,
+}
+
+/// Converts [`RawFrame`]s to [`Sample`]s. No panics, no allocation.
+#[derive(Clone, Copy, Debug)]
+pub struct SampleBuilder {
+    front_end: FrontEnd,
+    ticks_per_sample: u32,
+    next_ticks: u32,
+}
+
+impl SampleBuilder {
+    /// A builder for `sample_rate_hz` (must divide [`TICK_HZ`], 1..=100 000 Hz).
+    ///
+    /// # Errors
+    /// [`SamplingError::Rate`] otherwise.
+    pub fn new(front_end: FrontEnd, sample_rate_hz: u32) -> Result<Self, SamplingError> {
+        if sample_rate_hz == 0
+            || sample_rate_hz > 100_000
+            || !TICK_HZ.is_multiple_of(sample_rate_hz)
+        {
+            return Err(SamplingError::Rate);
+        }
+        Ok(Self {
+            front_end,
+            ticks_per_sample: TICK_HZ / sample_rate_hz,
+            next_ticks: 0,
+        })
+    }
+
+    /// Ticks between two samples.
+    pub fn ticks_per_sample(&self) -> u32 {
+        self.ticks_per_sample
+    }
+
+    /// Timestamp the next sample will get.
+    pub fn next_timestamp(&self) -> u32 {
+        self.next_ticks
+    }
+
+    /// Continue the timestamps from `now_ticks` (after lost samples).
+    pub fn resync(&mut self, now_ticks: u32) {
+        self.next_ticks = now_ticks;
+    }
+
+    /// Skip `n` sample periods (samples known to be lost).
+    pub fn skip(&mut self, n: u32) {
+        self.next_ticks = self
+            .next_ticks
+            .wrapping_add(n.wrapping_mul(self.ticks_per_sample));
+    }
+
+    /// Scale one frame and stamp it.
+    #[inline]
+    pub fn build(&mut self, raw: &RawFrame) -> Sample {
+        let [va, vb, vc] = raw.v;
+        let [ia, ib, ic] = raw.i;
+        let [sva, svb, svc] = self.front_end.voltage;
+        let [sia, sib, sic] = self.front_end.current;
+        let ts = self.next_ticks;
+        self.next_ticks = ts.wrapping_add(self.ticks_per_sample);
+        Sample {
+            v_abc: Abc {
+                a: sva.apply(va.0),
+                b: svb.apply(vb.0),
+                c: svc.apply(vc.0),
+            },
+            i_abc: Abc {
+                a: sia.apply(ia.0),
+                b: sib.apply(ib.0),
+                c: sic.apply(ic.0),
+            },
+            encoder_count: u32::from(raw.encoder_count),
+            timestamp_ticks: ts,
+            v_saturated: raw.v.iter().any(|c| is_saturated_code(c.0)),
+            i_saturated: raw.i.iter().any(|c| is_saturated_code(c.0)),
+        }
+    }
+
+    /// The inverse used by simulations: quantize physical values to the codes this front
+    /// end would produce (clamped to the 12-bit range, so out-of-range values saturate).
+    pub fn quantize(&self, v_abc: Abc, i_abc: Abc, encoder_count: u32) -> RawFrame {
+        let [sva, svb, svc] = self.front_end.voltage;
+        let [sia, sib, sic] = self.front_end.current;
+        RawFrame {
+            v: [
+                VoltageCode(sva.code_of(v_abc.a)),
+                VoltageCode(svb.code_of(v_abc.b)),
+                VoltageCode(svc.code_of(v_abc.c)),
+            ],
+            i: [
+                CurrentCode(sia.code_of(i_abc.a)),
+                CurrentCode(sib.code_of(i_abc.b)),
+                CurrentCode(sic.code_of(i_abc.c)),
+            ],
+            // The hardware counter is 16 bits wide.
+            encoder_count: (encoder_count & 0xFFFF) as u16,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rate_must_divide_tick() {
+        assert!(SampleBuilder::new(FrontEnd::DEFAULT, 10_000).is_ok());
+        assert_eq!(
+            SampleBuilder::new(FrontEnd::DEFAULT, 7_000).err(),
+            Some(SamplingError::Rate)
+        );
+        assert!(SampleBuilder::new(FrontEnd::DEFAULT, 0).is_err());
+    }
+
+    #[test]
+    fn timestamps_and_saturation() {
+        let mut b = SampleBuilder::new(FrontEnd::DEFAULT, 10_000).unwrap();
+        b.resync(u32::MAX - 50);
+        let raw = b.quantize(
+            Abc {
+                a: 100.0,
+                b: -50.0,
+                c: -50.0,
+            },
+            Abc {
+                a: 20.0,
+                b: 0.0,
+                c: -1.0,
+            },
+            70_000,
+        );
+        let s = b.build(&raw);
+        assert_eq!(s.timestamp_ticks, u32::MAX - 50);
+        assert!((s.v_abc.a - 100.0).abs() < 0.1);
+        assert!(s.i_saturated && !s.v_saturated);
+        assert_eq!(s.encoder_count, 70_000 & 0xFFFF);
+        assert_eq!(b.build(&raw).timestamp_ticks, 49);
+    }
+}

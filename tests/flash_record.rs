@@ -1,0 +1,81 @@
+//! A stored commissioning record that is not exactly what the firmware wrote is never
+//! used: every single-bit flip, a wrong version, a truncated record, an erased page and
+//! values the core would reject all come back as errors.
+
+use drive_monitor::app::{Command, SamplePath};
+use drive_monitor::flash_record::{
+    crc32, CalibrationRecord, RecordError, RECORD_LEN, RECORD_VERSION,
+};
+
+fn record() -> CalibrationRecord {
+    CalibrationRecord {
+        mean: [0.01, -0.02, 0.003, 0.0],
+        spread: [0.05, 0.04, 0.06, 0.07],
+    }
+}
+
+#[test]
+fn every_single_bit_flip_is_rejected() {
+    let good = record().encode().unwrap();
+    for bit in 0..RECORD_LEN * 8 {
+        let mut bad = good;
+        bad[bit / 8] ^= 1 << (bit % 8);
+        let r = CalibrationRecord::decode(&bad);
+        assert!(r.is_err(), "bit {bit} flipped and still accepted: {r:?}");
+    }
+}
+
+#[test]
+fn wrong_version_is_rejected_even_with_a_valid_crc() {
+    let mut bad = record().encode().unwrap();
+    bad[4..6].copy_from_slice(&(RECORD_VERSION + 1).to_le_bytes());
+    let crc = crc32(&bad[..44]);
+    bad[44..48].copy_from_slice(&crc.to_le_bytes());
+    assert_eq!(
+        CalibrationRecord::decode(&bad),
+        Err(RecordError::UnsupportedVersion(RECORD_VERSION + 1))
+    );
+}
+
+#[test]
+fn truncated_erased_and_torn_records_are_rejected() {
+    let good = record().encode().unwrap();
+    for len in 0..RECORD_LEN {
+        assert_eq!(
+            CalibrationRecord::decode(&good[..len]),
+            Err(RecordError::Truncated)
+        );
+    }
+    assert_eq!(
+        CalibrationRecord::decode(&[0xFF; 2048]),
+        Err(RecordError::Erased)
+    );
+    // Torn write: the first 16 bytes made it, the rest is still erased.
+    let mut torn = [0xFFu8; RECORD_LEN];
+    torn[..16].copy_from_slice(&good[..16]);
+    assert_eq!(
+        CalibrationRecord::decode(&torn),
+        Err(RecordError::BadChecksum)
+    );
+    assert_eq!(
+        CalibrationRecord::decode(&[0u8; RECORD_LEN]),
+        Err(RecordError::BadMagic)
+    );
+}
+
+#[test]
+fn values_out_of_the_cores_range_are_not_applied() {
+    // CRC-valid but the core's calibration range excludes it (|mean| > 1).
+    let rec = CalibrationRecord {
+        mean: [5.0, 0.0, 0.0, 0.0],
+        spread: [0.1; 4],
+    };
+    let bytes = rec.encode().unwrap();
+    let decoded = CalibrationRecord::decode(&bytes).unwrap();
+    let mut path = SamplePath::for_board(10_000).unwrap();
+    assert!(path.command(Command::SetCalibration(decoded)).is_err());
+    assert!(path.monitor().calibration().is_none());
+    // And a good one is applied.
+    assert!(path.command(Command::SetCalibration(record())).is_ok());
+    assert!(path.monitor().calibration().is_some());
+}
