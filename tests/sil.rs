@@ -77,7 +77,7 @@ impl Rig {
                 self.sup.handle(Event::SaveDone(ok), now_ms);
             }
         }
-        if k % PANEL_EVERY == 0 {
+        if k.is_multiple_of(PANEL_EVERY) {
             self.sup.handle(Event::Tick, now_ms);
             self.panel = panel::render(&self.sup.panel_input(&self.last), now_ms);
             self.fault_trace.push(self.panel.is_on(Lamp::Fault));

@@ -6,6 +6,9 @@
 //! `CARGO_TARGET_DIR=... cargo bench -p sim-host --bench throughput`.
 //! (`sim-host bench` reports the same figure plus CSV writing and accuracy.)
 
+// criterion_group! generates an undocumented public function.
+#![allow(missing_docs)]
+
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use sim_host::params::ParamFile;
 use sim_host::sim::{simulate, Scenario, SensorSpec};

@@ -9,5 +9,6 @@ pub mod log;
 pub mod params;
 pub mod progress;
 pub mod replay;
+pub mod service;
 pub mod sim;
 pub mod table1;

@@ -421,21 +421,30 @@ impl LogWriter {
     /// Appends one row. Channels the writer was not created with are skipped; a channel it
     /// was created with but the row lacks is written as 0.
     pub fn write_row(&mut self, r: &Row) -> Result<(), LogError> {
-        use std::fmt::Write as _;
+        // ryu: shortest round-trip formatting, an order of magnitude faster than `{:e}`.
+        // Time keeps f64 precision (1e-4 s steps over hours); the channels are written at
+        // f32 precision (7 significant digits), far finer than any ADC.
         let l = &mut self.line;
         l.clear();
-        let _ = write!(l, "{}", r.t_s);
+        push_f64(l, r.t_s);
         if self.channels.voltages {
             let v = r.v_abc.unwrap_or_default();
-            let _ = write!(l, ",{:.6e},{:.6e},{:.6e}", v[0], v[1], v[2]);
+            for x in v {
+                l.push(',');
+                push_f32(l, x as f32);
+            }
         }
-        let i = r.i_abc;
-        let _ = write!(l, ",{:.6e},{:.6e},{:.6e}", i[0], i[1], i[2]);
+        for x in r.i_abc {
+            l.push(',');
+            push_f32(l, x as f32);
+        }
         if self.channels.speed {
-            let _ = write!(l, ",{:.6e}", r.wm_rad_s.unwrap_or_default());
+            l.push(',');
+            push_f32(l, r.wm_rad_s.unwrap_or_default() as f32);
         }
         if self.channels.encoder {
-            let _ = write!(l, ",{}", r.enc_count.unwrap_or_default());
+            l.push(',');
+            l.push_str(itoa_i64(r.enc_count.unwrap_or_default()).as_str());
         }
         l.push('\n');
         self.out
@@ -461,6 +470,26 @@ impl LogWriter {
         }
         Ok(())
     }
+}
+
+fn push_f64(l: &mut String, x: f64) {
+    if x.is_finite() {
+        l.push_str(ryu::Buffer::new().format_finite(x));
+    } else {
+        l.push_str("NaN");
+    }
+}
+
+fn push_f32(l: &mut String, x: f32) {
+    if x.is_finite() {
+        l.push_str(ryu::Buffer::new().format_finite(x));
+    } else {
+        l.push_str("NaN");
+    }
+}
+
+fn itoa_i64(x: i64) -> String {
+    x.to_string()
 }
 
 /// Writes `bytes` to `path` atomically (temporary file in the same folder, then rename).

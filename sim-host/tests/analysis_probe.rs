@@ -67,3 +67,45 @@ fn probe() {
         }
     }
 }
+
+/// Read-speed probe (ignored): `ANALYSIS_BENCH_LOG=... cargo test --test analysis_probe read_speed -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn read_speed() {
+    let path =
+        std::env::var("ANALYSIS_BENCH_LOG").unwrap_or("/tmp/sim-host-bench-3600s.csv".into());
+    let t = std::time::Instant::now();
+    let mut n = 0u64;
+    let ok = sim_host::analysis::fastcsv::for_each_row(
+        std::path::Path::new(&path),
+        &mut |_| {},
+        &mut |_| {
+            n += 1;
+            true
+        },
+    )
+    .unwrap();
+    println!(
+        "parse only: {n} rows in {:.2} s (fast path {ok})",
+        t.elapsed().as_secs_f64()
+    );
+    let t = std::time::Instant::now();
+    let d = sim_host::analysis::prep::decimate_log(
+        std::path::Path::new(&path),
+        Default::default(),
+        &mut |_| {},
+    )
+    .unwrap();
+    println!(
+        "decimate: {} samples in {:.2} s",
+        d.t_s.len(),
+        t.elapsed().as_secs_f64()
+    );
+    let t = std::time::Instant::now();
+    let p = sim_host::analysis::prep::frame(&d, &sim_host::params::ParamFile::reference_2p2kw());
+    println!(
+        "frame: {} samples in {:.2} s",
+        p.len(),
+        t.elapsed().as_secs_f64()
+    );
+}

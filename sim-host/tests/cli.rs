@@ -14,8 +14,13 @@ fn repo() -> PathBuf {
 
 fn json(args: &[&str]) -> serde_json::Value {
     let o = bin().args(args).output().expect("run");
-    assert!(o.status.success(), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
-    serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{args:?}: stdout is not one JSON document: {e}"))
+    assert!(
+        o.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    serde_json::from_slice(&o.stdout)
+        .unwrap_or_else(|e| panic!("{args:?}: stdout is not one JSON document: {e}"))
 }
 
 /// Runs a command that must fail; returns its one-line message.
@@ -23,7 +28,11 @@ fn fails(args: &[&str]) -> String {
     let o = bin().args(args).output().expect("run");
     assert!(!o.status.success(), "{args:?} should fail");
     let err = String::from_utf8_lossy(&o.stderr).trim().to_string();
-    assert_eq!(err.lines().count(), 1, "{args:?}: message is not one line:\n{err}");
+    assert_eq!(
+        err.lines().count(),
+        1,
+        "{args:?}: message is not one line:\n{err}"
+    );
     assert!(o.stdout.is_empty(), "{args:?}: wrote to stdout on failure");
     err
 }
@@ -46,7 +55,10 @@ fn demo_names_the_injected_fault() {
     // The human timeline shows the lamps and the candidates.
     let o = bin().arg("demo").output().expect("run");
     let text = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success() && text.contains("FAULT: b 50 % / bl 50 %"), "{text}");
+    assert!(
+        o.status.success() && text.contains("FAULT: b 50 % / bl 50 %"),
+        "{text}"
+    );
 }
 
 #[test]
@@ -95,7 +107,12 @@ fn simulate_then_diagnose_finds_the_fault() {
     }
     let t = d["first_detection_s"].as_f64().expect("detected");
     assert!(t > 5.0, "{t}");
-    let names: Vec<&str> = d["candidates"].as_array().expect("list").iter().filter_map(|c| c["fault"].as_str()).collect();
+    let names: Vec<&str> = d["candidates"]
+        .as_array()
+        .expect("list")
+        .iter()
+        .filter_map(|c| c["fault"].as_str())
+        .collect();
     assert!(names.contains(&"lr"), "{names:?}");
     assert!(d["unbalance"]["negative_sequence_ratio"].is_number());
     assert!(d["unbalance"].get("suspect_phase").is_some());
@@ -104,7 +121,10 @@ fn simulate_then_diagnose_finds_the_fault() {
 #[test]
 fn diagnose_runs_on_the_independent_motulator_log() {
     let data = repo().join("../shared/data");
-    let (p, csv) = (data.join("motulator_2p2kw_dol.toml"), data.join("motulator_2p2kw_dol.csv"));
+    let (p, csv) = (
+        data.join("motulator_2p2kw_dol.toml"),
+        data.join("motulator_2p2kw_dol.csv"),
+    );
     if !csv.exists() {
         eprintln!("skipped: {} not present", csv.display());
         return;
@@ -122,7 +142,12 @@ fn diagnose_runs_on_the_independent_motulator_log() {
     // friction (Bl) change: r2, r3, r4 light and B/Bl are named, r1 stays dark.
     assert_eq!(d["lamps"]["r1"], false);
     assert_eq!(d["lamps"]["r2"], true);
-    let names: Vec<&str> = d["candidates"].as_array().expect("list").iter().filter_map(|c| c["fault"].as_str()).collect();
+    let names: Vec<&str> = d["candidates"]
+        .as_array()
+        .expect("list")
+        .iter()
+        .filter_map(|c| c["fault"].as_str())
+        .collect();
     assert_eq!(names, vec!["b", "bl"]);
     let t = d["first_detection_s"].as_f64().expect("detected");
     assert!(t > 2.5, "{t}");
@@ -150,11 +175,26 @@ fn diagnose_on_a_current_only_log_still_gives_the_unbalance() {
         "--json",
     ]);
     let header = std::fs::read_to_string(&csv).expect("csv");
-    assert!(header.starts_with("t_s,ia_A,ib_A,ic_A\n"), "{}", &header[..40]);
-    let d = json(&["diagnose", "--params", params.to_str().expect("utf8"), csv.to_str().expect("utf8"), "--json"]);
+    assert!(
+        header.starts_with("t_s,ia_A,ib_A,ic_A\n"),
+        "{}",
+        &header[..40]
+    );
+    let d = json(&[
+        "diagnose",
+        "--params",
+        params.to_str().expect("utf8"),
+        csv.to_str().expect("utf8"),
+        "--json",
+    ]);
     assert_eq!(d["unbalance"]["suspect_phase"], "b", "{}", d["unbalance"]);
     let skipped = d["skipped"].as_array().expect("skipped");
-    assert!(skipped.iter().any(|s| s.as_str().is_some_and(|s| s.contains("va_V"))), "{skipped:?}");
+    assert!(
+        skipped
+            .iter()
+            .any(|s| s.as_str().is_some_and(|s| s.contains("va_V"))),
+        "{skipped:?}"
+    );
 }
 
 #[test]
@@ -162,33 +202,84 @@ fn bad_csv_inputs_give_one_line_errors_naming_the_problem() {
     let dir = tempfile::tempdir().expect("tmp");
     let params = write(dir.path(), "p.toml", PARAMS_3HP);
     let p = params.to_str().expect("utf8");
-    let missing = write(dir.path(), "missing.csv", "t_s,va_V,vb_V,vc_V,ia_A,ib_A,wm_rad_s\n0,1,2,3,4,5,6\n");
+    let missing = write(
+        dir.path(),
+        "missing.csv",
+        "t_s,va_V,vb_V,vc_V,ia_A,ib_A,wm_rad_s\n0,1,2,3,4,5,6\n",
+    );
     let e = fails(&["diagnose", "--params", p, missing.to_str().expect("utf8")]);
     assert!(e.contains("ic_A") && e.contains("missing column"), "{e}");
-    let nonnum = write(dir.path(), "nonnum.csv", "t_s,ia_A,ib_A,ic_A\n0,1,2,-3\n0.0001,1,x2,-3\n");
+    let nonnum = write(
+        dir.path(),
+        "nonnum.csv",
+        "t_s,ia_A,ib_A,ic_A\n0,1,2,-3\n0.0001,1,x2,-3\n",
+    );
     let e = fails(&["diagnose", "--params", p, nonnum.to_str().expect("utf8")]);
-    assert!(e.contains("ib_A") && e.contains("line 3") && e.contains("not a number"), "{e}");
-    let backwards = write(dir.path(), "back.csv", "t_s,ia_A,ib_A,ic_A\n0,1,2,-3\n0.0001,1,2,-3\n0.00005,1,2,-3\n");
+    assert!(
+        e.contains("ib_A") && e.contains("line 3") && e.contains("not a number"),
+        "{e}"
+    );
+    let backwards = write(
+        dir.path(),
+        "back.csv",
+        "t_s,ia_A,ib_A,ic_A\n0,1,2,-3\n0.0001,1,2,-3\n0.00005,1,2,-3\n",
+    );
     let e = fails(&["diagnose", "--params", p, backwards.to_str().expect("utf8")]);
-    assert!(e.contains("does not increase") && e.contains("line 4"), "{e}");
+    assert!(
+        e.contains("does not increase") && e.contains("line 4"),
+        "{e}"
+    );
     let e = fails(&["diagnose", "--params", p, "no/such/file.csv"]);
     assert!(e.contains("no/such/file.csv"), "{e}");
-    let e = fails(&["diagnose", "--params", p, missing.to_str().expect("utf8"), "--commission", "4:2"]);
+    let e = fails(&[
+        "diagnose",
+        "--params",
+        p,
+        missing.to_str().expect("utf8"),
+        "--commission",
+        "4:2",
+    ]);
     assert!(e.contains("START"), "{e}");
 }
 
 #[test]
 fn bad_toml_inputs_give_one_line_errors_naming_the_key() {
     let dir = tempfile::tempdir().expect("tmp");
-    let csv = write(dir.path(), "ok.csv", "t_s,ia_A,ib_A,ic_A\n0,1,2,-3\n0.0001,1,2,-3\n");
-    let unknown = write(dir.path(), "u.toml", &PARAMS_3HP.replace("rs_ohm", "rs_ohms"));
-    let e = fails(&["diagnose", "--params", unknown.to_str().expect("utf8"), csv.to_str().expect("utf8")]);
+    let csv = write(
+        dir.path(),
+        "ok.csv",
+        "t_s,ia_A,ib_A,ic_A\n0,1,2,-3\n0.0001,1,2,-3\n",
+    );
+    let unknown = write(
+        dir.path(),
+        "u.toml",
+        &PARAMS_3HP.replace("rs_ohm", "rs_ohms"),
+    );
+    let e = fails(&[
+        "diagnose",
+        "--params",
+        unknown.to_str().expect("utf8"),
+        csv.to_str().expect("utf8"),
+    ]);
     assert!(e.contains("rs_ohms"), "{e}");
-    let missing = write(dir.path(), "m.toml", &PARAMS_3HP.replace("j_kgm2 = 0.089\n", ""));
-    let e = fails(&["diagnose", "--params", missing.to_str().expect("utf8"), csv.to_str().expect("utf8")]);
+    let missing = write(
+        dir.path(),
+        "m.toml",
+        &PARAMS_3HP.replace("j_kgm2 = 0.089\n", ""),
+    );
+    let e = fails(&[
+        "diagnose",
+        "--params",
+        missing.to_str().expect("utf8"),
+        csv.to_str().expect("utf8"),
+    ]);
     assert!(e.contains("j_kgm2"), "{e}");
     let params = write(dir.path(), "p.toml", PARAMS_3HP);
-    let sc = write(dir.path(), "s.toml", "duration_s = 1.0\nsample_rate_hz = 10000.0\nseeed = 3\n");
+    let sc = write(
+        dir.path(),
+        "s.toml",
+        "duration_s = 1.0\nsample_rate_hz = 10000.0\nseeed = 3\n",
+    );
     let out = dir.path().join("o.csv");
     let e = fails(&[
         "simulate",
@@ -216,11 +307,19 @@ fn bad_toml_inputs_give_one_line_errors_naming_the_key() {
 
 #[test]
 fn every_command_has_a_help_that_teaches() {
-    for cmd in ["demo", "simulate", "diagnose", "table1", "compare", "explain", "bench"] {
+    for cmd in [
+        "demo", "simulate", "diagnose", "table1", "compare", "explain", "bench",
+    ] {
         let o = bin().args([cmd, "--help"]).output().expect("run");
         let text = String::from_utf8_lossy(&o.stdout);
         assert!(o.status.success(), "{cmd} --help failed");
-        assert!(text.contains("--json"), "{cmd} --help does not mention --json");
-        assert!(text.contains("sim-host "), "{cmd} --help shows no example command line:\n{text}");
+        assert!(
+            text.contains("--json"),
+            "{cmd} --help does not mention --json"
+        );
+        assert!(
+            text.contains("sim-host "),
+            "{cmd} --help shows no example command line:\n{text}"
+        );
     }
 }

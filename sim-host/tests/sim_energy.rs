@@ -14,11 +14,11 @@ fn balance(p: &ParamFile, effects: Vec<Effect>) -> f64 {
     let dt = 1.0 / rate;
     let mut worst = 0.0f64;
     let mut p_max = 0.0f64;
-    let w = |k: usize| tr[k].stored_energy_j;
-    for k in 2..tr.len() - 2 {
-        // Fourth-order central difference.
-        let dw = (-w(k + 2) + 8.0 * w(k + 1) - 8.0 * w(k - 1) + w(k - 2)) / (12.0 * dt);
-        let t = &tr[k];
+    // Fourth-order central difference of the stored energy over windows of five samples.
+    for win in tr.windows(5) {
+        let w = |j: usize| win[j].stored_energy_j;
+        let dw = (-w(4) + 8.0 * w(3) - 8.0 * w(1) + w(0)) / (12.0 * dt);
+        let t = &win[2];
         let res = t.p_in_w - t.p_cu_w - t.p_fe_w - t.p_mech_w - dw;
         worst = worst.max(res.abs());
         p_max = p_max.max(t.p_in_w.abs());

@@ -17,9 +17,9 @@
 //! rising zero crossing of `va = V cos(theta_v)` is at `theta_v = -pi/2`, so the Park angle
 //! there is `theta = theta_v - pi/2 = -pi`.
 
-use crate::frames::{wrap_angle, AlphaBeta, Dq, SinCos};
 #[cfg(test)]
 use crate::frames::park;
+use crate::frames::{wrap_angle, AlphaBeta, Dq, SinCos};
 use core::f32::consts::{FRAC_PI_2, PI, TAU};
 
 /// Which angle the residuals are computed in.
@@ -135,7 +135,11 @@ impl SrfPll {
             kp: 2.0 * 0.707 * wn,
             ki: wn * wn,
             w0: TAU * f0_hz,
-            inv_v: if v_nominal > 0.0 { 1.0 / v_nominal } else { 0.0 },
+            inv_v: if v_nominal > 0.0 {
+                1.0 / v_nominal
+            } else {
+                0.0
+            },
             integ: 0.0,
             omega: TAU * f0_hz,
             theta_pll: 0.0,
@@ -148,8 +152,14 @@ impl SrfPll {
         // q component only: V_q = -alpha sin + beta cos.
         let e = (-v.alpha * sc_pll.sin + v.beta * sc_pll.cos) * self.inv_v;
         // max/min rather than clamp: no panic path, NaN-safe (NaN input leaves the bound).
-        self.integ = crate::minf(crate::maxf(self.integ + self.ki * e * self.dt, -self.w0), self.w0);
-        self.omega = crate::minf(crate::maxf(self.w0 + self.integ + self.kp * e, 0.0), 2.0 * self.w0);
+        self.integ = crate::minf(
+            crate::maxf(self.integ + self.ki * e * self.dt, -self.w0),
+            self.w0,
+        );
+        self.omega = crate::minf(
+            crate::maxf(self.w0 + self.integ + self.kp * e, 0.0),
+            2.0 * self.w0,
+        );
         self.theta_pll = wrap_angle(self.theta_pll + self.omega * self.dt);
         self.omega
     }

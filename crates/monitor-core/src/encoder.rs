@@ -122,7 +122,8 @@ impl MtSpeed {
             self.last_edge_ticks = ticks;
             let span = ticks.wrapping_sub(self.win_start_ticks);
             if span >= self.min_window_ticks && span > 0 {
-                self.speed_rad_s = self.acc as f32 * self.rad_per_count / (span as f32 * self.s_per_tick);
+                self.speed_rad_s =
+                    self.acc as f32 * self.rad_per_count / (span as f32 * self.s_per_tick);
                 self.acc = 0;
                 self.win_start_ticks = ticks;
             }
@@ -150,7 +151,9 @@ impl MtSpeed {
     /// `None` is returned (the caller flags the speed sensor). One counter difference per
     /// call.
     pub fn update_checked(&mut self, count: u32, ticks: u32, max_step: u32) -> Option<f32> {
-        if self.started && counter_delta(count, self.last_count, self.bits).unsigned_abs() > max_step {
+        if self.started
+            && counter_delta(count, self.last_count, self.bits).unsigned_abs() > max_step
+        {
             self.started = false;
             self.acc = 0;
             self.update(count, ticks);
@@ -184,7 +187,11 @@ mod tests {
             let t = k as f64 / fs as f64;
             let pos = (speed as f64 * t / core::f64::consts::TAU * 4096.0).floor() as i64;
             let raw = (start_count as i64 + pos) as u32;
-            let raw = if bits < 32 { raw & ((1u32 << bits) - 1) } else { raw };
+            let raw = if bits < 32 {
+                raw & ((1u32 << bits) - 1)
+            } else {
+                raw
+            };
             let ticks = start_tick.wrapping_add((t * tick_hz as f64) as u32);
             out = mt.update(raw, ticks);
         }

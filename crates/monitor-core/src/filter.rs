@@ -106,7 +106,11 @@ mod tests {
         }
         assert!((f.dy - 3.0).abs() < 0.01, "{}", f.dy);
         // Semi-implicit Euler: discretisation error ~ wc dt relative to the 2 wc x' terms.
-        assert!(f.ddy(x).abs() < 0.02 * 2.0 * core::f32::consts::TAU * 10.0 * 3.0, "{}", f.ddy(x));
+        assert!(
+            f.ddy(x).abs() < 0.02 * 2.0 * core::f32::consts::TAU * 10.0 * 3.0,
+            "{}",
+            f.ddy(x)
+        );
         let lag = 2.0 / (core::f32::consts::TAU * 10.0) * 3.0;
         assert!((x - f.y - lag).abs() < 0.01);
     }

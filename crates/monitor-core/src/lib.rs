@@ -21,7 +21,15 @@
 // `!(x > 0.0)` is deliberate throughout: it is true for NaN, so bad values are rejected.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::nonminimal_bool)]
 // Tests may index, unwrap and panic: that is how they fail.
-#![cfg_attr(test, allow(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing))]
+#![cfg_attr(
+    test,
+    allow(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic,
+        clippy::indexing_slicing
+    )
+)]
 
 pub mod angle;
 pub mod encoder;
@@ -37,7 +45,8 @@ pub use angle::AngleSource;
 pub use encoder::EncoderConfig;
 pub use frames::{Abc, AlphaBeta, Dq, SinCos};
 pub use monitor::{
-    Commissioning, Monitor, MonitorConfig, MonitorOutput, ResidualForm, Sample, SensorFlags, SensorLimits,
+    Commissioning, Monitor, MonitorConfig, MonitorOutput, ResidualForm, Sample, SensorFlags,
+    SensorLimits,
 };
 pub use residuals::{MotorModel, Operating};
 pub use sequence::{Phase, Unbalance};
@@ -71,11 +80,17 @@ pub enum ConfigError {
 impl core::fmt::Display for ConfigError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.write_str(match self {
-            ConfigError::MotorParameter => "motor parameter out of range (all positive, Lm^2 < Ls*Lr)",
-            ConfigError::SampleRate => "sample rate out of range (100 Hz..100 kHz, >= 8x supply, ticks >= samples)",
+            ConfigError::MotorParameter => {
+                "motor parameter out of range (all positive, Lm^2 < Ls*Lr)"
+            }
+            ConfigError::SampleRate => {
+                "sample rate out of range (100 Hz..100 kHz, >= 8x supply, ticks >= samples)"
+            }
             ConfigError::Supply => "supply frequency or voltage out of range",
             ConfigError::Filter => "filter corner out of range",
-            ConfigError::Decimation => "decimation must be 1..=1000 and leave >= 6 blocks per supply period",
+            ConfigError::Decimation => {
+                "decimation must be 1..=1000 and leave >= 6 blocks per supply period"
+            }
             ConfigError::Encoder => "encoder configuration impossible",
             ConfigError::Limits => "sensor limits or timing out of range",
             ConfigError::Threshold => "threshold configuration out of range",

@@ -18,9 +18,9 @@
 use crate::angle::{AngleSource, RotorFluxCurrentModel, SrfPll, ZeroCrossing};
 use crate::encoder::{EncoderConfig, MtSpeed};
 use crate::filter::{LowPass, Svf};
-use crate::sequence::sequence_result;
 use crate::frames::{clarke, park, Abc, Dq, SinCos};
 use crate::residuals::{residuals, Derivatives, MotorModel, Normaliser, Operating};
+use crate::sequence::sequence_result;
 use crate::sequence::{asymmetry_correction_rad, Unbalance};
 use crate::signature::{match_signature, Diagnosis, Fault, FAULT_COUNT, TABLE1};
 use crate::threshold::{Calibration, Lamps, ThresholdConfig, Welford};
@@ -122,6 +122,10 @@ pub struct MonitorConfig {
     pub steady_gate_per_s: f32,
     /// How long the gate stays closed after the last fast change [s] (default 0.5).
     pub gate_hold_s: f32,
+    /// Longest the gate may stay closed [s] (default 5): an operating point that never
+    /// settles is itself abnormal (for example a frame detuned by a sensor fault keeps the
+    /// d-q quantities oscillating), so after this the lamps are evaluated regardless.
+    pub gate_timeout_s: f32,
 }
 
 impl MonitorConfig {
@@ -156,6 +160,7 @@ impl MonitorConfig {
             floor_fraction: 0.02,
             steady_gate_per_s: 0.1,
             gate_hold_s: 0.5,
+            gate_timeout_s: 5.0,
         }
     }
 
@@ -170,7 +175,10 @@ impl MonitorConfig {
         if !(fin(self.tick_hz) && self.tick_hz >= self.sample_rate_hz) {
             return Err(ConfigError::SampleRate);
         }
-        if !(fin(self.supply_hz) && (1.0..=400.0).contains(&self.supply_hz) && fin(self.v_phase_peak)) {
+        if !(fin(self.supply_hz)
+            && (1.0..=400.0).contains(&self.supply_hz)
+            && fin(self.v_phase_peak))
+        {
             return Err(ConfigError::Supply);
         }
         if self.supply_hz * 8.0 > self.sample_rate_hz {
@@ -181,10 +189,15 @@ impl MonitorConfig {
         }
         // The d-q filters run once per block of `decimation` samples.
         let slow_dt = dt * f32::from(self.decimation);
-        if !(fin(self.filter_hz) && self.filter_hz < self.supply_hz * 0.5 && TAU * self.filter_hz * slow_dt <= 0.2) {
+        if !(fin(self.filter_hz)
+            && self.filter_hz < self.supply_hz * 0.5
+            && TAU * self.filter_hz * slow_dt <= 0.2)
+        {
             return Err(ConfigError::Filter);
         }
-        if !(fin(self.sequence_hz) && self.sequence_hz < self.supply_hz * 0.5 && TAU * self.sequence_hz * slow_dt <= 0.2)
+        if !(fin(self.sequence_hz)
+            && self.sequence_hz < self.supply_hz * 0.5
+            && TAU * self.sequence_hz * slow_dt <= 0.2)
             || !fin(self.pll_bw_hz)
         {
             return Err(ConfigError::Filter);
@@ -205,7 +218,11 @@ impl MonitorConfig {
         }
         // Counts per sample at max speed must stay below half the counter range.
         let max_counts = self.limits.max_speed_rad_s / TAU * e.counts_per_rev as f32 * dt;
-        let half = if e.counter_bits >= 32 { 2.1e9 } else { (1u32 << (e.counter_bits - 1)) as f32 };
+        let half = if e.counter_bits >= 32 {
+            2.1e9
+        } else {
+            (1u32 << (e.counter_bits - 1)) as f32
+        };
         if !(max_counts < half) {
             return Err(ConfigError::Encoder);
         }
@@ -221,6 +238,7 @@ impl MonitorConfig {
             || !fin(self.floor_fraction)
             || !(self.steady_gate_per_s.is_finite() && self.steady_gate_per_s >= 0.0)
             || !(self.gate_hold_s.is_finite() && self.gate_hold_s >= 0.0)
+            || !(self.gate_timeout_s.is_finite() && self.gate_timeout_s > self.gate_hold_s)
         {
             return Err(ConfigError::Limits);
         }
@@ -346,6 +364,8 @@ pub struct Monitor {
     report_every: u16,
     gate_left: u32,
     gate_blocks: u32,
+    gate_closed_for: u32,
+    gate_timeout_blocks: u32,
     gate_floor: [f32; 3],
     max_step: u32,
     np: f32,
@@ -381,7 +401,13 @@ impl Monitor {
         };
         let sum_lp = 5.0f32.min(0.2 * slow_hz);
         Ok(Monitor {
-            zc: ZeroCrossing::new(dt, cfg.supply_hz, 0.2 * cfg.supply_hz, 4.0 * cfg.supply_hz, 0.02 * cfg.v_phase_peak),
+            zc: ZeroCrossing::new(
+                dt,
+                cfg.supply_hz,
+                0.2 * cfg.supply_hz,
+                4.0 * cfg.supply_hz,
+                0.02 * cfg.v_phase_peak,
+            ),
             pll: SrfPll::new(dt, cfg.supply_hz, cfg.pll_bw_hz, cfg.v_phase_peak),
             rfo: RotorFluxCurrentModel::new(dt, m.rr_ohm, m.lr_h, imr_min),
             mt: MtSpeed::new(&cfg.encoder, cfg.tick_hz),
@@ -418,10 +444,18 @@ impl Monitor {
             report_every: ((0.1 * slow_hz) as u16).max(1),
             gate_left: 0,
             gate_blocks: (cfg.gate_hold_s * slow_hz) as u32,
+            gate_closed_for: 0,
+            gate_timeout_blocks: (cfg.gate_timeout_s * slow_hz) as u32,
             // Floors of the relative rates: magnetising current, 10 % voltage, 10 % speed.
-            gate_floor: [reference.i_f, 0.1 * cfg.v_phase_peak, 0.1 * TAU * cfg.supply_hz],
+            gate_floor: [
+                reference.i_f,
+                0.1 * cfg.v_phase_peak,
+                0.1 * TAU * cfg.supply_hz,
+            ],
             // Largest believable counter step per sample (validated to fit the counter).
-            max_step: (cfg.limits.max_speed_rad_s / TAU * cfg.encoder.counts_per_rev as f32 * dt) as u32 + 2,
+            max_step: (cfg.limits.max_speed_rad_s / TAU * cfg.encoder.counts_per_rev as f32 * dt)
+                as u32
+                + 2,
             np: m.np(),
             matched_lamps: None,
             out: MonitorOutput::default(),
@@ -496,11 +530,17 @@ impl Monitor {
         // A NaN or absurd reading poisons only its own block, which is then discarded.
         self.block_sat |= u8::from(s.i_saturated) | (u8::from(s.v_saturated) << 1);
         let m = 0x7fff_ffffu32;
-        let vb = (s.v_abc.a.to_bits() & m).max(s.v_abc.b.to_bits() & m).max(s.v_abc.c.to_bits() & m);
-        let ib = (s.i_abc.a.to_bits() & m).max(s.i_abc.b.to_bits() & m).max(s.i_abc.c.to_bits() & m);
+        let vb = (s.v_abc.a.to_bits() & m)
+            .max(s.v_abc.b.to_bits() & m)
+            .max(s.v_abc.c.to_bits() & m);
+        let ib = (s.i_abc.a.to_bits() & m)
+            .max(s.i_abc.b.to_bits() & m)
+            .max(s.i_abc.c.to_bits() & m);
         self.block_vmax = self.block_vmax.max(vb);
         self.block_imax = self.block_imax.max(ib);
-        let speed = self.mt.update_checked(s.encoder_count, s.timestamp_ticks, self.max_step);
+        let speed = self
+            .mt
+            .update_checked(s.encoder_count, s.timestamp_ticks, self.max_step);
         let wm = match speed {
             Some(w) => w,
             None => {
@@ -561,7 +601,11 @@ impl Monitor {
         let sf = self.out.sensor_fault;
         // An impossible reading names its sensor outright.
         let mut p = [0.0f32; FAULT_COUNT];
-        let n = [sf.current, sf.voltage, sf.speed].iter().filter(|x| **x).count().max(1) as f32;
+        let n = [sf.current, sf.voltage, sf.speed]
+            .iter()
+            .filter(|x| **x)
+            .count()
+            .max(1) as f32;
         for (flag, fault) in [
             (sf.current, Fault::CurrentSensor),
             (sf.voltage, Fault::VoltageSensor),
@@ -590,17 +634,30 @@ impl Monitor {
         self.settle_left = self.settle_blocks;
         let dt = 1.0 / self.cfg.sample_rate_hz;
         let m = &self.cfg.motor;
-        if !(self.rfo.theta().is_finite() && self.rfo.imr().is_finite() && self.rfo.omega_rad_s().is_finite()) {
+        if !(self.rfo.theta().is_finite()
+            && self.rfo.imr().is_finite()
+            && self.rfo.omega_rad_s().is_finite())
+        {
             let imr_min = 0.05 * self.cfg.v_phase_peak / (TAU * self.cfg.supply_hz * m.ls_h);
             self.rfo = RotorFluxCurrentModel::new(dt, m.rr_ohm, m.lr_h, imr_min);
         }
         if !(self.pll.theta_pll().is_finite() && self.pll.omega_rad_s().is_finite()) {
-            self.pll = SrfPll::new(dt, self.cfg.supply_hz, self.cfg.pll_bw_hz, self.cfg.v_phase_peak);
+            self.pll = SrfPll::new(
+                dt,
+                self.cfg.supply_hz,
+                self.cfg.pll_bw_hz,
+                self.cfg.v_phase_peak,
+            );
         }
-        self.zc = ZeroCrossing::new(dt, self.cfg.supply_hz, 0.2 * self.cfg.supply_hz, 4.0 * self.cfg.supply_hz, 0.02 * self.cfg.v_phase_peak);
+        self.zc = ZeroCrossing::new(
+            dt,
+            self.cfg.supply_hz,
+            0.2 * self.cfg.supply_hz,
+            4.0 * self.cfg.supply_hz,
+            0.02 * self.cfg.v_phase_peak,
+        );
         self.sc = SinCos::default();
     }
-
 
     // Kept out of line so the per-sample path does not carry its register pressure.
     #[inline(never)]
@@ -646,13 +703,15 @@ impl Monitor {
         let l = self.cfg.limits;
         let i = s.i_abc;
         self.isum.update((i.a + i.b + i.c).abs());
-        self.imax.update(crate::maxf(crate::maxf(i.a.abs(), i.b.abs()), i.c.abs()));
+        self.imax
+            .update(crate::maxf(crate::maxf(i.a.abs(), i.b.abs()), i.c.abs()));
         let i_bad = self.isum.y > l.current_sum_frac * self.imax.y + 1e-3 * l.i_max;
         let mut v_bad = false;
         if l.voltage_sum_frac > 0.0 {
             let v = s.v_abc;
             self.vsum.update((v.a + v.b + v.c).abs());
-            self.vmax.update(crate::maxf(crate::maxf(v.a.abs(), v.b.abs()), v.c.abs()));
+            self.vmax
+                .update(crate::maxf(crate::maxf(v.a.abs(), v.b.abs()), v.c.abs()));
             v_bad = self.vsum.y > l.voltage_sum_frac * self.vmax.y + 1e-3 * l.v_max;
         }
         if i_bad | v_bad {
@@ -708,7 +767,13 @@ impl Monitor {
                 self.gate_left = self.gate_left.saturating_sub(1);
             }
         }
-        self.out.quasi_steady = self.gate_left == 0;
+        if self.gate_left == 0 {
+            self.gate_closed_for = 0;
+        } else {
+            self.gate_closed_for = self.gate_closed_for.saturating_add(1);
+        }
+        self.out.quasi_steady =
+            self.gate_left == 0 || self.gate_closed_for > self.gate_timeout_blocks;
         let running = self.settle_left == 0
             && self.vmag.y > self.cfg.min_voltage_frac * self.cfg.v_phase_peak
             && !self.out.sensor_fault.any();
@@ -745,7 +810,11 @@ impl Monitor {
         if self.report_countdown == 0 {
             self.report_countdown = self.report_every;
             let we = self.out.frame_omega_rad_s;
-            let slip = if we.abs() > 1.0 { 1.0 - op.wr / we } else { 0.0 };
+            let slip = if we.abs() > 1.0 {
+                1.0 - op.wr / we
+            } else {
+                0.0
+            };
             let corr = asymmetry_correction_rad(&self.cfg.motor, we.abs().max(1.0), slip);
             self.out.unbalance = sequence_result(
                 (self.f_ids.y, self.f_iqs.y),
@@ -799,8 +868,16 @@ mod tests {
         let (pv, pi) = (ph(w), ph(w - 0.5));
         let wm = 1750.0 / 60.0 * TAU;
         Sample {
-            v_abc: Abc { a: v * pv[0], b: v * pv[1], c: v * pv[2] },
-            i_abc: Abc { a: i * pi[0], b: i * pi[1], c: i * pi[2] },
+            v_abc: Abc {
+                a: v * pv[0],
+                b: v * pv[1],
+                c: v * pv[2],
+            },
+            i_abc: Abc {
+                a: i * pi[0],
+                b: i * pi[1],
+                c: i * pi[2],
+            },
             encoder_count: (wm * t / TAU * 4096.0) as u32,
             timestamp_ticks: (t * 1e6) as u32,
             v_saturated: false,

@@ -86,7 +86,11 @@ impl MotorModel {
         if pos.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
             return Err(E);
         }
-        if !(self.b_nms.is_finite() && self.b_nms >= 0.0 && self.bl_nms.is_finite() && self.bl_nms >= 0.0) {
+        if !(self.b_nms.is_finite()
+            && self.b_nms >= 0.0
+            && self.bl_nms.is_finite()
+            && self.bl_nms >= 0.0)
+        {
             return Err(E);
         }
         if self.pole_pairs == 0 || self.ls_h < self.lm_h || self.lr_h < self.lm_h {
@@ -206,11 +210,7 @@ impl Normaliser {
     pub fn apply(&self, r: &Residuals) -> Option<[f32; 4]> {
         let mut out = [0.0f32; 4];
         for (k, o) in out.iter_mut().enumerate() {
-            let (x, t, f) = (
-                *r.r.get(k)?,
-                *r.terms.get(k)?,
-                *self.floor.get(k)?,
-            );
+            let (x, t, f) = (*r.r.get(k)?, *r.terms.get(k)?, *self.floor.get(k)?);
             let v = x / (t + f);
             if !v.is_finite() {
                 return None;
@@ -246,7 +246,11 @@ mod tests {
     fn steady_point(m: &MotorModel, vph_peak: f64, we: f64, s: f64) -> Operating {
         // Equivalent circuit: Z = Rs + j we Lls + (j we Lm || (Rr/s + j we Llr)).
         let (rs, rr) = (m.rs_ohm as f64, m.rr_ohm as f64);
-        let (lm, lls, llr) = (m.lm_h as f64, (m.ls_h - m.lm_h) as f64, (m.lr_h - m.lm_h) as f64);
+        let (lm, lls, llr) = (
+            m.lm_h as f64,
+            (m.ls_h - m.lm_h) as f64,
+            (m.lr_h - m.lm_h) as f64,
+        );
         let c = |re: f64, im: f64| (re, im);
         let mul = |a: (f64, f64), b: (f64, f64)| (a.0 * b.0 - a.1 * b.1, a.0 * b.1 + a.1 * b.0);
         let div = |a: (f64, f64), b: (f64, f64)| {
@@ -261,7 +265,7 @@ mod tests {
         let is = div(c(vph_peak, 0.0), z); // stator current phasor, voltage on the real axis
         let im_ = div(mul(is, zr), add(zm, zr)); // magnetising current
         let ir = (is.0 - im_.0, is.1 - im_.1); // into the rotor branch
-        // Rotor flux psi_r = Lm im + Llr * (-ir)?  psi_r = Lm (is + ir') + Llr ir' with ir' = -ir.
+                                               // Rotor flux psi_r = Lm im + Llr * (-ir)?  psi_r = Lm (is + ir') + Llr ir' with ir' = -ir.
         let psir = (lm * im_.0 - llr * ir.0, lm * im_.1 - llr * ir.1);
         let ang = psir.1.atan2(psir.0);
         // Rotate so the rotor flux is on +d: multiply by e^{-j ang}.
@@ -283,7 +287,12 @@ mod tests {
             let op = steady_point(&m, 179.6, 377.0, s);
             let r = residuals(&m, op, None);
             // Only r1 is purely electrical; the mechanical balance needs the matching load.
-            assert!(r.r[0].abs() < 1e-4 * r.terms[0], "s={s} r1={} terms={}", r.r[0], r.terms[0]);
+            assert!(
+                r.r[0].abs() < 1e-4 * r.terms[0],
+                "s={s} r1={} terms={}",
+                r.r[0],
+                r.terms[0]
+            );
             // Vqs in rotor-flux orientation is not |V|: the voltage leads q by a load angle.
             assert!(op.vqs < 179.7 && op.i_f > 0.0);
         }
@@ -301,10 +310,19 @@ mod tests {
         };
         let r = residuals(&m, op, None);
         for k in 0..4 {
-            assert!(r.r[k].abs() < 1e-3 * r.terms[k], "r{} = {} of {}", k + 1, r.r[k], r.terms[k]);
+            assert!(
+                r.r[k].abs() < 1e-3 * r.terms[k],
+                "r{} = {} of {}",
+                k + 1,
+                r.r[k],
+                r.terms[k]
+            );
         }
         // And r3, r4 are the combinations (B+Bl) r1 - Psi r2 and Kf Np r1 + Ra r2.
-        let op2 = Operating { vqs: op.vqs * 1.1, ..op };
+        let op2 = Operating {
+            vqs: op.vqs * 1.1,
+            ..op
+        };
         let r = residuals(&m, op2, None);
         let bb = m.b_nms + m.bl_nms;
         let psi = m.ls_h * op.i_f;
@@ -333,8 +351,19 @@ mod tests {
             let dwr = (kfnp * iq - bb * wr) / j;
             let ddiq = (-ra * diq - psi * dwr) / la;
             let ddwr = (kfnp * diq - bb * dwr) / j;
-            let op = Operating { iqs: iq, i_f, vqs: vq, wr };
-            let d = Derivatives { diqs: diq, ddiqs: ddiq, dwr, ddwr, dvqs: 0.0 };
+            let op = Operating {
+                iqs: iq,
+                i_f,
+                vqs: vq,
+                wr,
+            };
+            let d = Derivatives {
+                diqs: diq,
+                ddiqs: ddiq,
+                dwr,
+                ddwr,
+                dvqs: 0.0,
+            };
             let full = residuals(&m, op, Some(d));
             let steady = residuals(&m, op, None);
             for k in 0..4 {

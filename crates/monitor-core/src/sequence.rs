@@ -99,13 +99,23 @@ impl SequenceAnalyzer {
     /// Ratio, angle and suspect phase, given the model correction `arg(Z1/Z2)` and the
     /// ratio below which no phase is named.
     pub fn result(&self, correction_rad: f32, min_ratio: f32) -> Unbalance {
-        sequence_result((self.pd.y, self.pq.y), (self.nd.y, self.nq.y), correction_rad, min_ratio)
+        sequence_result(
+            (self.pd.y, self.pq.y),
+            (self.nd.y, self.nq.y),
+            correction_rad,
+            min_ratio,
+        )
     }
 }
 
 /// Ratio, angle and suspect phase from the filtered Park components `P = (pd, pq)` (frame
 /// at +theta) and `N = (nd, nq)` (at -theta): `I2/I1 = conj(N)/P` (module docs).
-pub fn sequence_result(p: (f32, f32), n: (f32, f32), correction_rad: f32, min_ratio: f32) -> Unbalance {
+pub fn sequence_result(
+    p: (f32, f32),
+    n: (f32, f32),
+    correction_rad: f32,
+    min_ratio: f32,
+) -> Unbalance {
     let p2 = p.0 * p.0 + p.1 * p.1;
     let n2 = n.0 * n.0 + n.1 * n.1;
     if !(p2 > 1e-12 && n2.is_finite()) {
@@ -135,7 +145,11 @@ pub fn sequence_result(p: (f32, f32), n: (f32, f32), correction_rad: f32, min_ra
 /// `Z = Rs + j we Lls + (j we Lm || (Rr/s + j we Llr))`, as (re, im) [ohm].
 /// `s` is kept at least 1e-4 in magnitude.
 pub fn equivalent_impedance(m: &MotorModel, we: f32, s: f32) -> (f32, f32) {
-    let s = if s.abs() < 1e-4 { 1e-4f32.copysign(s) } else { s };
+    let s = if s.abs() < 1e-4 {
+        1e-4f32.copysign(s)
+    } else {
+        s
+    };
     let xm = we * m.lm_h;
     let (rr, xr) = (m.rr_ohm / s, we * (m.lr_h - m.lm_h));
     // (j xm)(rr + j xr) / (rr + j (xm + xr))
@@ -188,7 +202,13 @@ mod tests {
                 c: 10.0 * ph(TAU / 3.0, false) + ph(TAU / 3.0, true),
             };
             let theta = w * t + 0.3;
-            s.update(clarke(i), SinCos { sin: theta.sin(), cos: theta.cos() });
+            s.update(
+                clarke(i),
+                SinCos {
+                    sin: theta.sin(),
+                    cos: theta.cos(),
+                },
+            );
         }
         let u = s.result(0.0, 0.01);
         assert!((u.negative_sequence_ratio - 0.1).abs() < 0.003, "{u:?}");

@@ -100,21 +100,24 @@ impl Fault {
 
     /// True for the sensor faults.
     pub fn is_sensor(self) -> bool {
-        matches!(self, Fault::CurrentSensor | Fault::VoltageSensor | Fault::SpeedSensor)
+        matches!(
+            self,
+            Fault::CurrentSensor | Fault::VoltageSensor | Fault::SpeedSensor
+        )
     }
 }
 
 /// The paper's Table 1, rows in [`Fault::ALL`] order, columns r1..r4.
 pub const TABLE1: [[bool; 4]; FAULT_COUNT] = [
-    [true, false, false, true],  // Rs
-    [true, false, false, true],  // Rr
-    [true, false, true, true],   // Ls
-    [true, true, true, true],    // Lr
-    [false, true, true, true],   // B
-    [false, true, true, true],   // Bl
-    [true, true, true, false],   // current sensor (Iqs)
-    [true, false, true, true],   // voltage sensor (Vqs)
-    [true, true, false, true],   // speed sensor (omega_r)
+    [true, false, false, true], // Rs
+    [true, false, false, true], // Rr
+    [true, false, true, true],  // Ls
+    [true, true, true, true],   // Lr
+    [false, true, true, true],  // B
+    [false, true, true, true],  // Bl
+    [true, true, true, false],  // current sensor (Iqs)
+    [true, false, true, true],  // voltage sensor (Vqs)
+    [true, true, false, true],  // speed sensor (omega_r)
 ];
 
 /// Physical signatures for rotor-flux orientation (module docs), rows in [`Fault::ALL`]
@@ -210,7 +213,11 @@ mod tests {
         assert!((d.probabilities[Fault::Rs.index()] - 1.0 / 3.0).abs() < 1e-6);
         // A dark r4 on a friction fault still names B/Bl (distance one).
         let d = match_signature([false, true, true, false], &ROTOR_FLUX_SIGNATURES);
-        assert!(!d.exact && d.probabilities[Fault::B.index()] == 0.5 && d.probabilities[Fault::Bl.index()] == 0.5);
+        assert!(
+            !d.exact
+                && d.probabilities[Fault::B.index()] == 0.5
+                && d.probabilities[Fault::Bl.index()] == 0.5
+        );
     }
 
     #[test]

@@ -24,8 +24,13 @@ pub struct Calibration {
 impl Calibration {
     /// True when every value is finite and every spread is >= 0 and the means are in [-1, 1].
     pub fn is_valid(&self) -> bool {
-        self.mean.iter().all(|m| m.is_finite() && (-1.0..=1.0).contains(m))
-            && self.spread.iter().all(|s| s.is_finite() && *s >= 0.0 && *s <= 2.0)
+        self.mean
+            .iter()
+            .all(|m| m.is_finite() && (-1.0..=1.0).contains(m))
+            && self
+                .spread
+                .iter()
+                .all(|s| s.is_finite() && *s >= 0.0 && *s <= 2.0)
     }
 }
 
@@ -62,8 +67,14 @@ impl Default for ThresholdConfig {
 impl ThresholdConfig {
     /// Checks ranges.
     pub fn validate(&self) -> Result<(), crate::ConfigError> {
-        let ok = self.fixed.iter().all(|x| x.is_finite() && *x > 0.0 && *x <= 1.0)
-            && self.min_band.iter().all(|x| x.is_finite() && *x > 0.0 && *x <= 1.0)
+        let ok = self
+            .fixed
+            .iter()
+            .all(|x| x.is_finite() && *x > 0.0 && *x <= 1.0)
+            && self
+                .min_band
+                .iter()
+                .all(|x| x.is_finite() && *x > 0.0 && *x <= 1.0)
             && self.k_sigma.is_finite()
             && self.k_sigma > 0.0
             && self.debounce_s.is_finite()
@@ -175,9 +186,11 @@ impl Lamps {
         for k in 0..4 {
             let (c, w) = self.band(k);
             let dev = (r.get(k).copied().unwrap_or(0.0) - c).abs();
-            let (Some(out), Some(inn), Some(lit)) =
-                (self.out_s.get_mut(k), self.in_s.get_mut(k), self.lit.get_mut(k))
-            else {
+            let (Some(out), Some(inn), Some(lit)) = (
+                self.out_s.get_mut(k),
+                self.in_s.get_mut(k),
+                self.lit.get_mut(k),
+            ) else {
                 continue;
             };
             if dev > w {
@@ -213,7 +226,10 @@ mod tests {
     fn debounce_and_hysteresis() {
         let cfg = ThresholdConfig::default();
         let mut l = Lamps::new(cfg);
-        l.set_calibration(Some(Calibration { mean: [0.0; 4], spread: [0.001; 4] }));
+        l.set_calibration(Some(Calibration {
+            mean: [0.0; 4],
+            spread: [0.001; 4],
+        }));
         // Band is max(6*0.001, 0.002) = 0.006.
         let dt = 0.01;
         for _ in 0..20 {

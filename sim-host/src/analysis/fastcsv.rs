@@ -123,6 +123,106 @@ struct Cols {
     nfields: usize,
 }
 
+/// Parses a decimal number starting at `i` (spaces allowed around it); returns the value
+/// and the index of its terminator (',' or a line end or the end of the block), or `None`.
+#[inline]
+fn parse_at(b: &[u8], mut i: usize) -> Option<(f64, usize)> {
+    let n = b.len();
+    while i < n && b[i] == b' ' {
+        i += 1;
+    }
+    let mut neg = false;
+    if i < n && (b[i] == b'-' || b[i] == b'+') {
+        neg = b[i] == b'-';
+        i += 1;
+    }
+    let mut mant: u64 = 0;
+    let mut digits = 0u32;
+    let mut exp10: i32 = 0;
+    let mut any = false;
+    while i < n {
+        let c = b[i].wrapping_sub(b'0');
+        if c > 9 {
+            break;
+        }
+        any = true;
+        if digits < 19 {
+            mant = mant * 10 + c as u64;
+            if mant > 0 {
+                digits += 1;
+            }
+        } else {
+            exp10 += 1;
+        }
+        i += 1;
+    }
+    if i < n && b[i] == b'.' {
+        i += 1;
+        while i < n {
+            let c = b[i].wrapping_sub(b'0');
+            if c > 9 {
+                break;
+            }
+            any = true;
+            if digits < 19 {
+                mant = mant * 10 + c as u64;
+                if mant > 0 {
+                    digits += 1;
+                }
+                exp10 -= 1;
+            }
+            i += 1;
+        }
+    }
+    if !any {
+        return None;
+    }
+    if i < n && (b[i] == b'e' || b[i] == b'E') {
+        i += 1;
+        let mut eneg = false;
+        if i < n && (b[i] == b'-' || b[i] == b'+') {
+            eneg = b[i] == b'-';
+            i += 1;
+        }
+        let mut e: i32 = 0;
+        let mut ed = false;
+        while i < n {
+            let c = b[i].wrapping_sub(b'0');
+            if c > 9 {
+                break;
+            }
+            e = e.saturating_mul(10).saturating_add(c as i32);
+            ed = true;
+            i += 1;
+        }
+        if !ed {
+            return None;
+        }
+        exp10 += if eneg { -e } else { e };
+    }
+    while i < n && (b[i] == b' ' || b[i] == b'\r') {
+        i += 1;
+    }
+    if i < n && b[i] != b',' && b[i] != b'\n' {
+        return None;
+    }
+    let m = mant as f64;
+    let v = if exp10 == 0 {
+        m
+    } else if (0..=22).contains(&exp10) {
+        m * POW10[exp10 as usize]
+    } else if (-22..0).contains(&exp10) {
+        m / POW10[(-exp10) as usize]
+    } else {
+        m * 10f64.powi(exp10)
+    };
+    Some((if neg { -v } else { v }, i))
+}
+
+fn is_blank(line: &[u8]) -> bool {
+    line.iter().all(|&b| b == b'\r' || b == b' ')
+}
+
 fn parse_block(block: &[u8], cols: &Cols, out: &mut Vec<f64>) -> bool {
     let k = cols.idx.len();
     let mut slot_of = vec![usize::MAX; cols.nfields];
@@ -134,54 +234,51 @@ fn parse_block(block: &[u8], cols: &Cols, out: &mut Vec<f64>) -> bool {
     let mut row = [0f64; 16];
     let n = block.len();
     let mut pos = 0;
-    // One pass over the bytes: fields end at ',' or a line end; only wanted columns are
-    // parsed.
+    // One pass: wanted fields are parsed where they stand, others skipped to the next ','.
     while pos < n {
-        let mut field = 0;
-        let mut start = pos;
         let line_start = pos;
+        let mut i = pos;
+        let mut field = 0;
+        let mut ok = true;
         loop {
-            let mut e = start;
-            while e < n && block[e] != b',' && block[e] != b'\n' {
-                e += 1;
-            }
-            if field < cols.nfields {
-                let sl = slot_of[field];
-                if sl != usize::MAX {
-                    match parse_f64(&block[start..e]) {
-                        Some(v) => row[sl] = v,
-                        None => {
-                            // An empty (or "\r") line is skipped; anything else is refused.
-                            let line = &block[line_start..e];
-                            if field == 0
-                                && (e >= n || block[e] == b'\n')
-                                && line.iter().all(|&b| b == b'\r' || b == b' ')
-                            {
-                                break;
-                            }
-                            return false;
+            let sl = if field < cols.nfields {
+                slot_of[field]
+            } else {
+                usize::MAX
+            };
+            if sl != usize::MAX {
+                match parse_at(block, i) {
+                    Some((v, e)) => {
+                        row[sl] = v;
+                        i = e;
+                    }
+                    None => {
+                        ok = false;
+                        while i < n && block[i] != b'\n' {
+                            i += 1;
                         }
                     }
                 }
+            } else {
+                while i < n && block[i] != b',' && block[i] != b'\n' {
+                    i += 1;
+                }
             }
             field += 1;
-            if e >= n || block[e] == b'\n' {
-                pos = e + 1;
-                if field != cols.nfields {
-                    let line = &block[line_start..e];
-                    if line.iter().all(|&b| b == b'\r' || b == b' ') {
-                        break;
-                    }
-                    return false;
-                }
-                out.extend_from_slice(&row[..k]);
+            if i >= n || block[i] == b'\n' {
                 break;
             }
-            start = e + 1;
+            i += 1; // past ','
         }
-        if pos <= line_start {
-            pos = line_start + 1;
+        let line_end = i.min(n);
+        pos = line_end + 1;
+        if !ok || field != cols.nfields {
+            if is_blank(&block[line_start..line_end]) {
+                continue;
+            }
+            return false;
         }
+        out.extend_from_slice(&row[..k]);
     }
     true
 }

@@ -46,7 +46,7 @@ use serde::Serialize;
 use std::path::Path;
 
 /// A candidate explaining less than this fraction of the held-back error is not claimed.
-pub const EXPLAINED_MIN: f64 = 0.3;
+pub const EXPLAINED_MIN: f64 = 0.5;
 /// A baseline within this factor of the noise floor has nothing left to explain
 /// (1.12 = a model error beyond the noise of half the noise floor).
 pub const NOISE_MARGIN: f64 = 1.12;

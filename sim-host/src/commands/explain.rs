@@ -13,7 +13,7 @@ Every library effect not yet in the model (thermal_drift, saturation, iron_loss,
 coulomb_friction, windage, load_torque, supply_unbalance, phase_asymmetry, flux_dynamics, \
 current_dynamics) is added in turn and fitted together with the base parameters (Ra, Ls, \
 B+Bl, J). Candidates are ranked by the error on held-back time windows the fit never saw, \
-so an effect that only fits noise does not win. When no candidate explains at least 30 % of \
+so an effect that only fits noise does not win. When no candidate explains at least 50 % of \
 the held-back error, or the error is already near the noise floor, the answer is \
 `unexplained: true` rather than a wrong name.\n\n\
 Workflow:\n  sim-host compare --params motor.toml run.csv          # where does the model fail?\n  \
