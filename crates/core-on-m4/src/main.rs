@@ -274,7 +274,11 @@ fn main() -> ! {
     let d = f32::from(cfg.decimation);
     let dh = f32::from(cfg_half.decimation);
     let (all, half) = (per_sample(t_all, base, n), per_sample(t_half, base, n));
-    let slow = if d > dh { (half - all) / (1.0 / dh - 1.0 / d) } else { 0.0 };
+    let slow = if d > dh {
+        (half - all) / (1.0 / dh - 1.0 / d)
+    } else {
+        0.0
+    };
     let fast = all - slow / d;
 
     println!("ticks_per_instruction={}", ticks_per_instr);
