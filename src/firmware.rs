@@ -214,7 +214,7 @@ async fn sample_task(hw: SampleHw, mut path: SamplePath) {
             } else if result.learning_failed {
                 let _ = LEARN.try_send(LearnEvent::Failed);
             }
-            if samples % STATUS_EVERY == 0 {
+            if samples.is_multiple_of(STATUS_EVERY) {
                 STATUS.signal(Status {
                     output: result.output,
                     samples,
