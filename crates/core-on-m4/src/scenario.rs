@@ -1,5 +1,5 @@
-//! Shared between the QEMU program and its host-side generator (`tools/fwtool`,
-//! `gen-replay`): the monitor configuration of the replay and the binary formats of the
+//! Shared between the QEMU program and its host-side generator (the root test
+//! `tests/qemu_replay_data.rs`, which simulates the log with sim-host): the monitor configuration of the replay and the binary formats of the
 //! embedded log (`data/replay.bin`) and of the host's expected outputs
 //! (`data/expected.bin`). `no_std`, depends only on `monitor_core`.
 //!
@@ -57,6 +57,9 @@ pub fn config() -> MonitorConfig {
     c.limits.v_max = 400.0;
     c.limits.i_max = 10.0;
     c.settle_s = 0.05;
+    // A 1.2 s replay: a short quasi-steady gate so the lamps get to act within it.
+    c.gate_hold_s = 0.1;
+    c.gate_timeout_s = 0.4;
     c
 }
 

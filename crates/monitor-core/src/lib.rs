@@ -15,6 +15,24 @@
 //!
 //! Source: the paper in `shared/seed` ("the paper"); corrections in DESIGN.md §2 and in the
 //! module docs ([`residuals`] lists the typos).
+//!
+//! ```
+//! use monitor_core::{Abc, Fault, Monitor, MonitorConfig, MotorModel, Sample};
+//! // The DESIGN.md 3 hp motor on 220 V, 60 Hz, sampled at 10 kHz.
+//! let motor = MotorModel {
+//!     rs_ohm: 0.435, rr_ohm: 0.816, ls_h: 0.0713, lr_h: 0.0713, lm_h: 0.0693,
+//!     pole_pairs: 2, j_kgm2: 0.089, b_nms: 0.002, bl_nms: 0.045,
+//! };
+//! let mut monitor = Monitor::new(MonitorConfig::new(motor, 60.0, 220.0, 10_000.0))
+//!     .expect("a valid configuration");
+//! // A NaN current is an impossible reading: no panic, the current sensor is named
+//! // at the end of the 25-sample block.
+//! let bad = Sample { i_abc: Abc { a: f32::NAN, b: 0.0, c: 0.0 }, ..Sample::default() };
+//! for _ in 0..25 {
+//!     monitor.update(&bad);
+//! }
+//! assert_eq!(monitor.output().top(), Some((Fault::CurrentSensor, 1.0)));
+//! ```
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -52,6 +70,28 @@ pub use residuals::{MotorModel, Operating};
 pub use sequence::{Phase, Unbalance};
 pub use signature::{Diagnosis, Fault, FAULT_COUNT, ROTOR_FLUX_SIGNATURES, TABLE1};
 pub use threshold::{Calibration, ThresholdConfig};
+
+#[cfg(test)]
+pub(crate) mod testing {
+    //! Shared test fixtures.
+    use crate::MotorModel;
+
+    /// The DESIGN.md 3 hp textbook machine: Xls = Xlr = 0.754 ohm, Xm = 26.13 ohm at 60 Hz.
+    pub(crate) fn motor_3hp() -> MotorModel {
+        let w = 2.0 * core::f32::consts::PI * 60.0;
+        MotorModel {
+            rs_ohm: 0.435,
+            rr_ohm: 0.816,
+            ls_h: (26.13 + 0.754) / w,
+            lr_h: (26.13 + 0.754) / w,
+            lm_h: 26.13 / w,
+            pole_pairs: 2,
+            j_kgm2: 0.089,
+            b_nms: 0.002,
+            bl_nms: 0.045,
+        }
+    }
+}
 
 /// A configuration the monitor cannot run with, found when it is built. Small and `Copy`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -833,20 +833,7 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
-    fn motor() -> MotorModel {
-        let w = TAU * 60.0;
-        MotorModel {
-            rs_ohm: 0.435,
-            rr_ohm: 0.816,
-            ls_h: (26.13 + 0.754) / w,
-            lr_h: (26.13 + 0.754) / w,
-            lm_h: 26.13 / w,
-            pole_pairs: 2,
-            j_kgm2: 0.089,
-            b_nms: 0.002,
-            bl_nms: 0.045,
-        }
-    }
+    use crate::testing::motor_3hp as motor;
 
     fn monitor(src: AngleSource) -> Monitor {
         let mut cfg = MonitorConfig::new(motor(), 60.0, 220.0, 10_000.0);

@@ -225,21 +225,7 @@ impl Normaliser {
 mod tests {
     use super::*;
 
-    /// The 3 hp textbook machine (DESIGN.md §3).
-    pub(crate) fn motor_3hp() -> MotorModel {
-        let w = 2.0 * core::f32::consts::PI * 60.0;
-        MotorModel {
-            rs_ohm: 0.435,
-            rr_ohm: 0.816,
-            ls_h: (26.13 + 0.754) / w,
-            lr_h: (26.13 + 0.754) / w,
-            lm_h: 26.13 / w,
-            pole_pairs: 2,
-            j_kgm2: 0.089,
-            b_nms: 0.002,
-            bl_nms: 0.045,
-        }
-    }
+    use crate::testing::motor_3hp;
 
     /// Exact steady state of the T-equivalent circuit in rotor-flux orientation at slip s:
     /// solves for the operating point from the equivalent circuit in f64.

@@ -219,17 +219,7 @@ mod tests {
     #[test]
     fn correction_follows_the_equivalent_circuit() {
         let w = 2.0 * core::f32::consts::PI * 60.0;
-        let m = MotorModel {
-            rs_ohm: 0.435,
-            rr_ohm: 0.816,
-            ls_h: (26.13 + 0.754) / w,
-            lr_h: (26.13 + 0.754) / w,
-            lm_h: 26.13 / w,
-            pole_pairs: 2,
-            j_kgm2: 0.089,
-            b_nms: 0.002,
-            bl_nms: 0.045,
-        };
+        let m = crate::testing::motor_3hp();
         // No load: Z1 ~ Rs + j Xs is nearly inductive; Z2 ~ Rs + Rr/2 + j(Xls + Xlr).
         let z1 = equivalent_impedance(&m, w, 1e-4);
         assert!((z1.1 - 26.884).abs() < 0.05 && z1.0 < 0.6, "{z1:?}");

@@ -7,9 +7,11 @@
 //!   vector table is at 0x0 (the mps2-an386 layout, not the G474's), and run it on
 //!   `qemu-system-arm -M mps2-an386 -cpu cortex-m4 -icount shift=0` with semihosting.
 //!   Exits with QEMU's status (non-zero on any mismatch) and after 300 s at the latest.
-//! - `gen-replay`: regenerate `crates/core-on-m4/data/{replay,expected}.bin` from a
-//!   synthetic steady-state log of the 2.2 kW reference motor run through the host build
-//!   of monitor-core.
+//!
+//! The QEMU program's data (`crates/core-on-m4/data/{replay,expected}.bin`) is a log from
+//! the sim-host simulator and the host build's answers to it; the root test
+//! `tests/qemu_replay_data.rs` checks it is current and regenerates it with
+//! `REGENERATE_QEMU_DATA=1 cargo test --test qemu_replay_data`.
 //!
 //! Cargo runs this tool with the workspace root as the directory of the alias call; the
 //! tool locates the root from its own manifest directory, so it works from anywhere.
@@ -17,10 +19,6 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode, Stdio};
 use std::time::{Duration, Instant};
-
-#[path = "../../../crates/core-on-m4/src/scenario.rs"]
-#[allow(dead_code)]
-mod scenario;
 
 const TARGET: &str = "thumbv7em-none-eabihf";
 const FLASH_GOAL: u64 = 64 * 1024;
@@ -195,79 +193,12 @@ fn qemu_core() -> Result<ExitCode, String> {
     }
 }
 
-/// Synthetic steady state of the 2.2 kW motor: 400 V / 50 Hz supply, 5 A peak current
-/// lagging 35 degrees, 4 % slip (150.8 rad/s mechanical), quantized by the board's front
-/// end, the encoder counting 4096 per revolution into a 16-bit counter. From sample
-/// 2500 on, the current amplitude rises by 30 % (the lamps then have something to do).
-fn gen_replay() -> Result<(), String> {
-    use std::f64::consts::TAU;
-    const N: usize = 4000;
-    const SPACING: usize = 100;
-    let fs = f64::from(scenario::SAMPLE_RATE_HZ);
-    let vp = 400.0 * (2.0f64 / 3.0).sqrt();
-    let wm = TAU * 50.0 / 2.0 * 0.96;
-    let code = |x: f64, per_lsb: f32| -> u16 {
-        (x / f64::from(per_lsb) + f64::from(scenario::MID) + 0.5).clamp(0.0, 4095.0) as u16
-    };
-    let mut replay = Vec::with_capacity(scenario::REPLAY_HEADER + N * scenario::SAMPLE_BYTES);
-    replay.extend_from_slice(b"RPL1");
-    replay.extend_from_slice(&(N as u32).to_le_bytes());
-    for k in 0..N {
-        let t = k as f64 / fs;
-        let th = TAU * 50.0 * t;
-        let ip = if k >= 2500 { 6.5 } else { 5.0 };
-        let phi = 35f64.to_radians();
-        let ph = [0.0, -TAU / 3.0, TAU / 3.0];
-        let mut words = [0u16; 7];
-        for (n, p) in ph.iter().enumerate() {
-            words[n] = code(vp * (th + p).cos(), scenario::VOLT_PER_LSB);
-            words[3 + n] = code(ip * (th + p - phi).cos(), scenario::AMP_PER_LSB);
-        }
-        words[6] = ((wm * t / TAU * 4096.0).floor() as u64 & 0xFFFF) as u16;
-        for w in words {
-            replay.extend_from_slice(&w.to_le_bytes());
-        }
-    }
-    let mut monitor =
-        monitor_core::Monitor::new(scenario::config()).map_err(|e| format!("config: {e}"))?;
-    let mut expected = Vec::new();
-    expected.extend_from_slice(b"EXP1");
-    expected.extend_from_slice(&((N / SPACING) as u32).to_le_bytes());
-    expected.extend_from_slice(&(SPACING as u32).to_le_bytes());
-    let mut lamp_changes = 0;
-    let mut last_lamps = 0;
-    for k in 0..N {
-        let out = monitor.update(&scenario::sample(&replay, k));
-        if (k + 1) % SPACING == 0 {
-            let c = scenario::Check::of(&out);
-            if c.lamps != last_lamps {
-                lamp_changes += 1;
-                last_lamps = c.lamps;
-            }
-            expected.extend_from_slice(&c.bytes());
-        }
-    }
-    let dir = root().join("crates/core-on-m4/data");
-    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    std::fs::write(dir.join("replay.bin"), &replay).map_err(|e| e.to_string())?;
-    std::fs::write(dir.join("expected.bin"), &expected).map_err(|e| e.to_string())?;
-    println!(
-        "wrote {} samples ({} bytes) and {} checkpoints ({} bytes); lamp changes: {lamp_changes}",
-        N,
-        replay.len(),
-        N / SPACING,
-        expected.len()
-    );
-    Ok(())
-}
-
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let result = match args.first().map(String::as_str) {
         Some("fw") => fw(args.iter().any(|a| a == "--check")).map(|()| ExitCode::SUCCESS),
         Some("qemu-core") => qemu_core(),
-        Some("gen-replay") => gen_replay().map(|()| ExitCode::SUCCESS),
-        _ => Err("usage: fwtool fw [--check] | qemu-core | gen-replay".into()),
+        _ => Err("usage: fwtool fw [--check] | qemu-core".into()),
     };
     match result {
         Ok(code) => code,
