@@ -5,8 +5,8 @@
 use std::{env, fs, path::PathBuf};
 
 fn main() {
-    let out = PathBuf::from(env::var_os("OUT_DIR").expect("OUT_DIR"));
-    fs::copy("memory.x", out.join("memory.x")).expect("copy memory.x");
+    let out = PathBuf::from(env::var_os("OUT_DIR").expect("OUT_DIR")); // ok: build script
+    fs::copy("memory.x", out.join("memory.x")).expect("copy memory.x"); // ok: build script
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed=memory.x");
     println!("cargo:rerun-if-changed=build.rs");

@@ -217,7 +217,7 @@ mod tests {
         #[test]
         fn park_with_normalised_sincos_is_exact_inverse(a in -1e3f32..1e3, b in -1e3f32..1e3, x in -1f32..1.0, y in -1f32..1.0) {
             prop_assume!(x * x + y * y > 1e-4);
-            let sc = SinCos::from_vector(x, y, 1e-3).unwrap();
+            let sc = SinCos::from_vector(x, y, 1e-3).unwrap(); // ok: test
             let v = AlphaBeta { alpha: a, beta: b };
             let back = inverse_park(park(v, sc), sc);
             let tol = 1e-5 * (a.abs() + b.abs()) + 1e-4;

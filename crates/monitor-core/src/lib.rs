@@ -24,7 +24,7 @@
 //!     pole_pairs: 2, j_kgm2: 0.089, b_nms: 0.002, bl_nms: 0.045,
 //! };
 //! let mut monitor = Monitor::new(MonitorConfig::new(motor, 60.0, 220.0, 10_000.0))
-//!     .expect("a valid configuration");
+//!     .expect("a valid configuration"); // ok: doc example
 //! // A NaN current is an impossible reading: no panic, the current sensor is named
 //! // at the end of the 25-sample block.
 //! let bad = Sample { i_abc: Abc { a: f32::NAN, b: 0.0, c: 0.0 }, ..Sample::default() };

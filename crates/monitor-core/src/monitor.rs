@@ -841,7 +841,7 @@ mod tests {
         cfg.limits.i_max = 200.0;
         match Monitor::new(cfg) {
             Ok(m) => m,
-            Err(e) => panic!("{e}"),
+            Err(e) => panic!("{e}"), // ok: test
         }
     }
 
