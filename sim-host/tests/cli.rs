@@ -250,30 +250,24 @@ fn bad_toml_inputs_give_one_line_errors_naming_the_key() {
         "ok.csv",
         "t_s,ia_A,ib_A,ic_A\n0,1,2,-3\n0.0001,1,2,-3\n",
     );
-    let unknown = write(
-        dir.path(),
-        "u.toml",
-        &PARAMS_3HP.replace("rs_ohm", "rs_ohms"),
-    );
-    let e = fails(&[
-        "diagnose",
-        "--params",
-        unknown.to_str().expect("utf8"),
-        csv.to_str().expect("utf8"),
-    ]);
-    assert!(e.contains("rs_ohms"), "{e}");
-    let missing = write(
-        dir.path(),
-        "m.toml",
-        &PARAMS_3HP.replace("j_kgm2 = 0.089\n", ""),
-    );
-    let e = fails(&[
-        "diagnose",
-        "--params",
-        missing.to_str().expect("utf8"),
-        csv.to_str().expect("utf8"),
-    ]);
-    assert!(e.contains("j_kgm2"), "{e}");
+    // An unknown key and a missing key in the parameter file, each named.
+    for (name, text, key) in [
+        ("u.toml", PARAMS_3HP.replace("rs_ohm", "rs_ohms"), "rs_ohms"),
+        (
+            "m.toml",
+            PARAMS_3HP.replace("j_kgm2 = 0.089\n", ""),
+            "j_kgm2",
+        ),
+    ] {
+        let p = write(dir.path(), name, &text);
+        let e = fails(&[
+            "diagnose",
+            "--params",
+            p.to_str().expect("utf8"),
+            csv.to_str().expect("utf8"),
+        ]);
+        assert!(e.contains(key), "{e}");
+    }
     let params = write(dir.path(), "p.toml", PARAMS_3HP);
     let sc = write(
         dir.path(),

@@ -18,97 +18,14 @@ use std::path::Path;
 
 const BLOCK: usize = 8 << 20;
 
-/// Parses one decimal number; `None` if the text is not a plain decimal.
+/// Parses one decimal number; `None` if the text is not a plain decimal (spaces around
+/// it and a trailing `\r` allowed). The same scanner as the block parser ([`parse_at`]),
+/// required to consume the whole slice.
 pub fn parse_f64(s: &[u8]) -> Option<f64> {
-    let mut i = 0;
-    let n = s.len();
-    while i < n && s[i] == b' ' {
-        i += 1;
+    match parse_at(s, 0)? {
+        (v, end) if end == s.len() => Some(v),
+        _ => None,
     }
-    let mut end = n;
-    while end > i && (s[end - 1] == b' ' || s[end - 1] == b'\r') {
-        end -= 1;
-    }
-    if i >= end {
-        return None;
-    }
-    let neg = match s[i] {
-        b'-' => {
-            i += 1;
-            true
-        }
-        b'+' => {
-            i += 1;
-            false
-        }
-        _ => false,
-    };
-    let mut mant: u64 = 0;
-    let mut digits = 0u32;
-    let mut exp10: i32 = 0;
-    let mut any = false;
-    while i < end && s[i].is_ascii_digit() {
-        any = true;
-        if digits < 19 {
-            mant = mant * 10 + (s[i] - b'0') as u64;
-            if mant > 0 {
-                digits += 1;
-            }
-        } else {
-            exp10 += 1;
-        }
-        i += 1;
-    }
-    if i < end && s[i] == b'.' {
-        i += 1;
-        while i < end && s[i].is_ascii_digit() {
-            any = true;
-            if digits < 19 {
-                mant = mant * 10 + (s[i] - b'0') as u64;
-                if mant > 0 {
-                    digits += 1;
-                }
-                exp10 -= 1;
-            }
-            i += 1;
-        }
-    }
-    if !any {
-        return None;
-    }
-    if i < end && (s[i] == b'e' || s[i] == b'E') {
-        i += 1;
-        let mut eneg = false;
-        if i < end && (s[i] == b'-' || s[i] == b'+') {
-            eneg = s[i] == b'-';
-            i += 1;
-        }
-        let mut e: i32 = 0;
-        let mut ed = false;
-        while i < end && s[i].is_ascii_digit() {
-            e = e.saturating_mul(10).saturating_add((s[i] - b'0') as i32);
-            ed = true;
-            i += 1;
-        }
-        if !ed {
-            return None;
-        }
-        exp10 += if eneg { -e } else { e };
-    }
-    if i != end {
-        return None;
-    }
-    let m = mant as f64;
-    let v = if exp10 == 0 {
-        m
-    } else if (0..=22).contains(&exp10) {
-        m * POW10[exp10 as usize]
-    } else if (-22..0).contains(&exp10) {
-        m / POW10[(-exp10) as usize]
-    } else {
-        m * 10f64.powi(exp10)
-    };
-    Some(if neg { -v } else { v })
 }
 
 const POW10: [f64; 23] = [
