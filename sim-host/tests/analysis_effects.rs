@@ -6,50 +6,18 @@
 //! Protocol: a full-order simulator always has rotor-flux and stator-current dynamics, and
 //! the scenarios that excite an effect (sweeps, steps) excite them too; so the model the
 //! user starts from holds `flux_dynamics` and `current_dynamics` (each of those two is
-//! tested with only the other one in the model). See ANALYSIS_README_SECTION.md.
+//! tested with only the other one in the model). See the README, "Model vs measurement".
 mod analysis_common;
 use analysis_common::*;
 use sim_host::sim::Effect;
 
 const DYNAMICS: [&str; 2] = ["flux_dynamics", "current_dynamics"];
 
-/// Effects found only on speed sweeps, where the paper's model itself leaves a residual of
-/// about 1 % (it takes V_qs as an input, so it follows supply-frequency changes with a
-/// different stiffness than the machine). Known weak: checked by the ignored test
-/// `sweep_effects_strict`, reported (not asserted) by the others.
-const SWEEP_EFFECTS: [&str; 3] = ["iron_loss", "coulomb_friction", "windage"];
-
-/// At 3x sensor noise on the 3 hp motor a 100 K heat run moves `normalized_rms_error` by
-/// less than the noise (0.0122 -> 0.0106 with a noise floor of 0.0077); `explain` then
-/// answers `unexplained`, which is the honest answer, so it is reported, not asserted.
-/// `saturation` there is ranked first but ends at 0.0736 -> 0.0160 (4.6x, 2.1x the noise
-/// floor): just short of the bar, reported, not asserted.
-const BELOW_NOISE_3HP: [&str; 2] = ["thermal_drift", "saturation"];
-
 fn check_all(which: &str, noise: u32) {
-    let weak: Vec<&str> = SWEEP_EFFECTS
-        .iter()
-        .copied()
-        .chain(if which == "3hp" && noise >= 2 {
-            BELOW_NOISE_3HP.to_vec()
-        } else {
-            vec![]
-        })
-        .collect();
-    check(
-        which,
-        noise,
-        &Effect::NAMES
-            .iter()
-            .copied()
-            .filter(|n| !weak.contains(n))
-            .collect::<Vec<_>>(),
-        true,
-    );
-    check(which, noise, &weak, false);
+    check(which, noise, &Effect::NAMES);
 }
 
-fn check(which: &str, noise: u32, names: &[&str], strict: bool) {
+fn check(which: &str, noise: u32, names: &[&str]) {
     let dir = tempfile::tempdir().unwrap();
     let truth = motor(which);
     let nominal = perturbed(&truth, 0.05);
@@ -89,19 +57,7 @@ fn check(which: &str, noise: u32, names: &[&str], strict: bool) {
             ));
         }
     }
-    if strict {
-        assert!(failures.is_empty(), "{which} noise {noise}: {failures:#?}");
-    } else if !failures.is_empty() {
-        eprintln!("known weak (not asserted): {failures:#?}");
-    }
-}
-
-/// The sweep-found effects held to the full bar (known to fail today: see SWEEP_EFFECTS).
-#[test]
-#[ignore]
-fn sweep_effects_strict() {
-    check("2p2", 1, &SWEEP_EFFECTS, true);
-    check("3hp", 2, &SWEEP_EFFECTS, true);
+    assert!(failures.is_empty(), "{which} noise {noise}: {failures:#?}");
 }
 
 #[test]
@@ -115,9 +71,26 @@ fn every_effect_is_found_3hp_high_noise() {
 }
 
 #[test]
+fn every_effect_is_found_2p2kw_high_noise() {
+    check_all("2p2", 2);
+}
+
+#[test]
+fn every_effect_is_found_3hp_default_noise() {
+    check_all("3hp", 1);
+}
+
+#[test]
 fn effect_free_data_claims_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    for (which, noise) in [("2p2", 1), ("3hp", 2), ("2p2", 0)] {
+    for (which, noise) in [
+        ("2p2", 0),
+        ("2p2", 1),
+        ("2p2", 2),
+        ("3hp", 0),
+        ("3hp", 1),
+        ("3hp", 2),
+    ] {
         let truth = motor(which);
         let nominal = perturbed(&truth, 0.05);
         let s = scenario(which, None, noise);

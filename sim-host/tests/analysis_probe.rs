@@ -13,7 +13,66 @@ fn probe() {
         .unwrap_or(1);
     let dir = tempfile::tempdir().unwrap();
     let truth = motor(&which);
-    let nominal = perturbed(&truth, 0.05);
+    let off: f64 = std::env::var("OFF")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0.05);
+    let nominal = perturbed(&truth, off);
+    // EFFECT=sweep: the V/f sweep scenario with no effect (what the model alone leaves).
+    if std::env::var("EFFECT").as_deref() == Ok("sweep") {
+        let keep = std::env::var("KEEP").ok();
+        let mut s = scenario(&which, Some(keep.as_deref().unwrap_or("windage")), noise);
+        if keep.is_none() {
+            s.effects.clear();
+        }
+        let log = write_log(dir.path(), "sweep", &truth, &s, false);
+        let a = analyse(&log, &nominal, settle_s(&which));
+        let base_env = std::env::var("BASE").unwrap_or_default();
+        let base: Vec<&str> = base_env.split(',').filter(|s| !s.is_empty()).collect();
+        if let Ok(g) = std::env::var("TRUTH_G") {
+            use sim_host::analysis::model::{simulate, BaseParams, Terms};
+            let n = &a.nominal;
+            let g: f64 = g.parse().unwrap();
+            let xm = 2.0 * std::f64::consts::PI * nominal.supply.f_hz * nominal.motor.lm_h;
+            let t = Terms {
+                g_fe_s: if g > 0.0 { 1.0 / (g * xm) } else { 0.0 },
+                tau_r_s: Some(n.lr_h / n.rr_ohm),
+                la_h: Some(n.la_h),
+                ..Default::default()
+            };
+            let p = simulate(&a.data, n, &BaseParams::nominal(n), &t);
+            let e = sim_host::analysis::metrics::errors(&a.data, &p, None);
+            println!(
+                "truth model (Rfe = {g} Xm): error {:.4}",
+                e.normalized_rms_error
+            );
+            if let Ok(dump) = std::env::var("DUMP") {
+                dump_csv(&dump, &a, &p);
+            }
+            for ch in &e.channels {
+                println!("   {ch:?}");
+            }
+        }
+        let out = a.compare(&opts(&base)).unwrap();
+        if std::env::var("TRUTH_G").is_err() {
+            if let Ok(dump) = std::env::var("DUMP") {
+                dump_csv(&dump, &a, &out.prediction);
+            }
+        }
+        let c = out.report;
+        println!(
+            "sweep, no effect: error {:.4} noise {:.4}",
+            c.normalized_rms_error, c.noise_floor
+        );
+        for ch in &c.channels {
+            println!("   {ch:?}");
+        }
+        for w in &c.worst_windows {
+            println!("   {w:?}");
+        }
+        println!("   base {:?}", c.base_parameters);
+        return;
+    }
     let mut list: Vec<Option<&str>> = vec![None];
     for n in sim_host::sim::Effect::NAMES {
         list.push(Some(n));
@@ -108,4 +167,37 @@ fn read_speed() {
         p.len(),
         t.elapsed().as_secs_f64()
     );
+}
+
+fn dump_csv(
+    path: &str,
+    a: &sim_host::analysis::Analysis,
+    pr: &sim_host::analysis::model::Prediction,
+) {
+    use std::io::Write;
+    let mut f = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    let d = &a.data;
+    writeln!(f, "t,w,wp,iq,iqp,vq,vd,id,i_f,ws,iq_all,ineg,ire,iim,th").unwrap();
+    for k in 0..d.len() {
+        writeln!(
+            f,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            d.t_s[k],
+            d.omega_r[k],
+            pr.omega_r[k],
+            d.iq_pos[k],
+            pr.iq[k],
+            d.vq[k],
+            d.vd[k],
+            d.id[k],
+            d.i_f[k],
+            d.omega_s[k],
+            d.iq[k],
+            d.i_neg[k].norm(),
+            d.i_ab[k].re,
+            d.i_ab[k].im,
+            d.theta[k]
+        )
+        .unwrap();
+    }
 }

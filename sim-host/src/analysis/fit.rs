@@ -223,6 +223,15 @@ pub fn fit(
     }
 }
 
+/// The effects' terms for fitted values.
+pub fn terms(d: &Prepared, n: &Nominal, effects: &[ActiveEffect<'_>], f: &FitResult) -> Terms {
+    let mut terms = Terms::default();
+    for (e, p) in effects.iter().zip(&f.effect_params) {
+        e.effect.apply(&e.setup, p, d, n, &mut terms);
+    }
+    terms
+}
+
 /// Simulates the model with fitted values.
 pub fn predict(
     d: &Prepared,
@@ -230,9 +239,5 @@ pub fn predict(
     effects: &[ActiveEffect<'_>],
     f: &FitResult,
 ) -> Prediction {
-    let mut terms = Terms::default();
-    for (e, p) in effects.iter().zip(&f.effect_params) {
-        e.effect.apply(&e.setup, p, d, n, &mut terms);
-    }
-    simulate(d, n, &f.base, &terms)
+    simulate(d, n, &f.base, &terms(d, n, effects, f))
 }

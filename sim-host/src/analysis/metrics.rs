@@ -190,28 +190,58 @@ pub fn errors(d: &Prepared, p: &Prediction, mask: Option<&[bool]>) -> ErrorSumma
     }
 }
 
-/// Noise floor: the `normalized_rms_error` a perfect model would show on this log, from a
-/// robust (median absolute deviation) estimate of each channel's white noise on the
-/// second difference: sigma = 1.4826 MAD(x[k+1] - 2x[k] + x[k-1]) / sqrt(6). Phase
-/// currents take sigma(I_qs) / sqrt(2): the predicted phase currents reuse the measured
-/// I_ds, so only the q-axis noise shows in their error, spread over the rotating phase.
-pub fn noise_floor(d: &Prepared, w: &Weights) -> f64 {
-    fn sigma(x: &[f64]) -> f64 {
-        if x.len() < 5 {
-            return 0.0;
-        }
-        let mut dd: Vec<f64> = x
-            .windows(3)
-            .map(|v| (v[2] - 2.0 * v[1] + v[0]).abs())
-            .collect();
-        let mid = dd.len() / 2;
-        let (_, m, _) = dd.select_nth_unstable_by(mid, |a, b| a.total_cmp(b));
-        1.4826 * *m / 6f64.sqrt()
+/// Robust white-noise estimate of a series: sigma = 1.4826 MAD(x[k+1] - 2x[k] + x[k-1]) /
+/// sqrt(6) (the median absolute deviation of the second difference, which a smooth signal
+/// and sparse steps do not move).
+pub fn white_noise_sigma(x: &[f64]) -> f64 {
+    if x.len() < 5 {
+        return 0.0;
     }
-    let s_iq = sigma(&d.iq);
-    let s_w = sigma(&d.omega_r);
+    let mut dd: Vec<f64> = x
+        .windows(3)
+        .map(|v| (v[2] - 2.0 * v[1] + v[0]).abs())
+        .collect();
+    let mid = dd.len() / 2;
+    let (_, m, _) = dd.select_nth_unstable_by(mid, |a, b| a.total_cmp(b));
+    1.4826 * *m / 6f64.sqrt()
+}
+
+/// Noise floor: the `normalized_rms_error` a perfect model would show on this log.
+///
+/// Two parts, added in quadrature per channel:
+/// - the noise of the measured outputs, from [`white_noise_sigma`] of I_qs and omega_r;
+///   phase currents take sigma(I_qs) / sqrt(2): the predicted phase currents reuse the
+///   measured I_ds, so only the q-axis noise shows in their error, spread over the
+///   rotating phase;
+/// - with `propagated = Some((pred, pred_renoised))`: the sensor noise of the model's
+///   *inputs* (V_qs, V_ds, I_ds) carried through the model. A perfect model driven by noisy
+///   inputs shows it too: `pred_renoised` is the same model driven by the measured inputs
+///   plus a second, independent noise of the same size, so `pred_renoised - pred` has the
+///   statistics of the propagated noise (on the 3 hp motor at 3x noise it is as large as
+///   the output noise).
+pub fn noise_floor(
+    d: &Prepared,
+    w: &Weights,
+    propagated: Option<(&Prediction, &Prediction)>,
+) -> f64 {
+    let s_iq = white_noise_sigma(&d.iq);
+    let s_w = white_noise_sigma(&d.omega_r);
     let s_ph = s_iq / 2f64.sqrt();
-    let s = [s_iq, s_w, s_ph, s_ph, s_ph];
+    let mut s = [s_iq, s_w, s_ph, s_ph, s_ph];
+    if let Some((a, b)) = propagated {
+        let mut se = [0.0f64; 5];
+        let n = d.len().min(a.iq.len()).min(b.iq.len());
+        for k in 0..n {
+            let pa = predicted(d, a, k);
+            let pb = predicted(d, b, k);
+            for c in 0..5 {
+                se[c] += (pb[c] - pa[c]).powi(2);
+            }
+        }
+        for c in 0..5 {
+            s[c] = (s[c] * s[c] + se[c] / n.max(1) as f64).sqrt();
+        }
+    }
     let mut sum = 0.0;
     let mut c = 0.0;
     for k in 0..5 {

@@ -543,6 +543,27 @@ impl Analysis {
             .collect()
     }
 
+    /// The noise floor of the fitted model on `d` (output noise plus the inputs' noise
+    /// carried through the model, see [`metrics::noise_floor`]).
+    fn model_noise_floor(
+        &self,
+        d: &Prepared,
+        active: &[ActiveEffect<'_>],
+        f: &FitResult,
+        pred: &Prediction,
+        w: &Weights,
+    ) -> f64 {
+        let mut terms = fit::terms(d, &self.nominal, active, f);
+        let sigma_v = 0.5 * (metrics::white_noise_sigma(&d.vd) + metrics::white_noise_sigma(&d.vq));
+        terms.input_noise = Some(model::InputNoise {
+            seed: 0x006e_6f69_7365,
+            sigma_v,
+            sigma_i: metrics::white_noise_sigma(&d.id),
+        });
+        let renoised = model::simulate(d, &self.nominal, &f.base, &terms);
+        metrics::noise_floor(d, w, Some((pred, &renoised)))
+    }
+
     fn fit_data(&self) -> (Prepared, usize) {
         let m = self.data.len().div_ceil(MAX_FIT_SAMPLES).max(1);
         (coarsen(&self.data, m), m)
@@ -610,7 +631,7 @@ impl Analysis {
             report: CompareReport {
                 effects: list.iter().map(|e| e.name().to_string()).collect(),
                 normalized_rms_error: err.normalized_rms_error,
-                noise_floor: metrics::noise_floor(d, &w),
+                noise_floor: self.model_noise_floor(d, &active, &f, &pred, &w),
                 channels: err.channels,
                 worst_windows: worst,
                 base_parameters: self.base_table(&f.base),
@@ -688,7 +709,7 @@ impl Analysis {
         let before = fit::predict(d, &self.nominal, &active_full, &f0_full);
         let e0 = metrics::errors(d, &before, None).normalized_rms_error;
         let e0v = metrics::errors(d, &before, Some(&val_mask)).normalized_rms_error;
-        let noise = metrics::noise_floor(d, &w_full);
+        let noise = self.model_noise_floor(d, &active_full, &f0_full, &before, &w_full);
         // Long logs (fitted on a coarser series): candidates are ranked on that series, so
         // the baseline they are compared with is measured there too.
         let val_mask_c: Vec<bool> = wf.train.iter().map(|t| !t).collect();
@@ -699,7 +720,7 @@ impl Analysis {
             (
                 metrics::errors(&fd, &b, None).normalized_rms_error,
                 metrics::errors(&fd, &b, Some(&val_mask_c)).normalized_rms_error,
-                metrics::noise_floor(&fd, &wf),
+                self.model_noise_floor(&fd, &base_active, &f0, &b, &wf),
             )
         };
         let lib = effects::library();
@@ -840,6 +861,23 @@ impl Analysis {
             };
             if is_pair && close && ranked[0].0.effect != want_first {
                 ranked.swap(0, 1);
+            }
+        }
+        // load_torque whose fitted levels are all alike (within 3 % of the rated torque: the
+        // step the observer proposed is not there) is a constant torque, the same equation
+        // as coulomb_friction at positive speed; when the two are within 10 %, the simpler
+        // name, coulomb_friction, goes first (DESIGN-level note in the README).
+        if ranked.len() >= 2 {
+            let pos = |name: &str| ranked.iter().position(|c| c.0.effect == name);
+            if let (Some(lt), Some(cf)) = (pos("load_torque"), pos("coulomb_friction")) {
+                let levels: Vec<f64> = ranked[lt].0.parameters.values().map(|p| p.value).collect();
+                let spread = levels.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b))
+                    - levels.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+                let constant = spread < 0.03 * self.nominal.torque_scale_nm;
+                let close = score(&ranked[cf].0) <= 1.10 * score(&ranked[lt].0);
+                if lt == 0 && cf == 1 && constant && close {
+                    ranked.swap(0, 1);
+                }
             }
         }
         let best = ranked

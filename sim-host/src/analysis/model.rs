@@ -132,6 +132,21 @@ pub struct Terms {
     pub tau_r_s: Option<f64>,
     /// La [H] when `current_dynamics` is on.
     pub la_h: Option<f64>,
+    /// Extra white noise on the inputs (for the noise floor; `None` in every fit).
+    pub input_noise: Option<InputNoise>,
+}
+
+/// White Gaussian noise added to the model's inputs, to measure how much of the inputs'
+/// sensor noise reaches the outputs (see `metrics::noise_floor`).
+#[derive(Debug, Clone, Copy)]
+pub struct InputNoise {
+    /// Seed of the generator (the result is reproducible).
+    pub seed: u64,
+    /// Standard deviation added to V_ds and V_qs [V].
+    pub sigma_v: f64,
+    /// Standard deviation added to I_ds and I_qs [A]; i_f gets it through the same 10 Hz
+    /// smoothing magnitude response as `prep` applies (four first-order passes).
+    pub sigma_i: f64,
 }
 
 /// Model outputs over the working series.
@@ -164,12 +179,50 @@ pub fn simulate(d: &Prepared, n: &Nominal, b: &BaseParams, t: &Terms) -> Predict
     let btot = b.btot_nms.max(0.0);
     let rs0 = n.rs_ohm * b.ra_scale;
     let rr0 = n.rr_a_ohm * b.ra_scale;
-    let mut wm = d.omega_r.first().map(|w| w / n.np).unwrap_or(0.0);
-    let mut iq_state = d.iq_pos[0];
+    // Initial speed and current: means over the first 10 ms (a single sample would start
+    // the model off by that sample's sensor noise, and the speed then takes a mechanical
+    // time constant, about 0.3 s, to forget it).
+    let head = ((0.01 / dt).ceil() as usize).clamp(1, len);
+    let mut wm = if d.omega_r.len() >= head {
+        d.omega_r[..head].iter().sum::<f64>() / head as f64 / n.np
+    } else {
+        0.0
+    };
+    let mut iq_state = d.iq_pos[..head].iter().sum::<f64>() / head as f64;
     let mut phi = d.i_f[0];
     let i_f_ref = d.id.iter().fold(0.0f64, |a, &x| a.max(x.abs())).max(1e-6);
     let flux_decay = t.tau_r_s.map(|tau| (-dt / tau.max(1e-5)).exp());
+    let mut noise = t.input_noise.map(|nz| {
+        use rand::SeedableRng;
+        (
+            nz,
+            rand_chacha::ChaCha8Rng::seed_from_u64(nz.seed),
+            [0.0f64; 4],
+        )
+    });
+    let a_if = 1.0 - (-2.0 * std::f64::consts::PI * super::prep::I_F_SMOOTH_HZ * dt).exp();
     for k in 0..len {
+        // Inputs at k (with the optional extra input noise).
+        let (vd_k, vq_k, id_k, if_k, iqp_k) = match noise.as_mut() {
+            None => (d.vd[k], d.vq[k], d.id[k], d.i_f[k], d.iq_pos[k]),
+            Some((nz, rng, lp)) => {
+                use rand_distr::{Distribution, StandardNormal};
+                let mut g = || -> f64 { StandardNormal.sample(&mut *rng) };
+                let (nvd, nvq, nid, niq) = (g(), g(), g(), g());
+                let nid = nz.sigma_i * nid;
+                lp[0] += a_if * (nid - lp[0]);
+                lp[1] += a_if * (lp[0] - lp[1]);
+                lp[2] += a_if * (lp[1] - lp[2]);
+                lp[3] += a_if * (lp[2] - lp[3]);
+                (
+                    d.vd[k] + nz.sigma_v * nvd,
+                    d.vq[k] + nz.sigma_v * nvq,
+                    d.id[k] + nid,
+                    d.i_f[k] + lp[3],
+                    d.iq_pos[k] + nz.sigma_i * niq,
+                )
+            }
+        };
         let rf = t.r_factor.get(k).copied().unwrap_or(1.0);
         let mf = t.lm_factor.get(k).copied().unwrap_or(1.0);
         let rs = rs0 * rf;
@@ -177,9 +230,35 @@ pub fn simulate(d: &Prepared, n: &Nominal, b: &BaseParams, t: &Terms) -> Predict
         let lm = n.lm_h * mf;
         let ls = b.ls_scale * (n.lls_h + lm);
         let lmr = lm * lm / (n.llr_h + lm);
-        let i_f = d.i_f[k];
-        let id_raw = d.id[k];
-        let vq = d.vq[k];
+        // Core loss (`iron_loss`, g = 1/Rfe across the magnetising branch, behind Rs): the
+        // terminal current is the machine's i_s plus i_fe = g j w_s psi_s, psi_s =
+        // Ls i_ds + j sigma Ls i_qs. Three consequences, all evaluated here:
+        // (1) Rs carries i_fe too: the machine behind Rs sees V_qs - Rs i_fe,q;
+        // (2) the flux is made by i_ds = measured - i_fe,d = measured + g w_s sigma Ls I_qs;
+        // (3) the voltage-model frame of `prep` takes psi_r from the terminal current, so it
+        //     is turned by eps = (Lr/Lm) sigma Ls i_fe,q / psi_r = (Lr/Lm) sigma Ls g w_s Ls / Lm
+        //     against the true rotor flux (0.01 rad at Rfe = 8 Xm): inputs are turned back by
+        //     eps and outputs forward.
+        let (i_f, id_raw, vq, eps, id_term, i_fe_q) = if t.g_fe_s != 0.0 {
+            let g = t.g_fe_s;
+            let ws = d.omega_s[k];
+            let eps = n.lr_h / n.lm_h * n.la_h * g * ws * ls / lm;
+            let back = C64::new(eps.cos(), -eps.sin());
+            let v = C64::new(vd_k, vq_k) * back;
+            let i = C64::new(id_k, iqp_k) * back;
+            let i_fe_d = -g * ws * n.la_h * i.im;
+            let shift = (i.re - id_k) - i_fe_d;
+            let i_f = if_k + shift;
+            let i_fe_q = g * ws * ls * i_f;
+            if k == 0 {
+                // The states start from the machine's own currents, not the terminal ones.
+                iq_state += (i.im - iqp_k) - i_fe_q;
+                phi = i_f;
+            }
+            (i_f, id_k + shift, v.im - rs * i_fe_q, eps, i.re, i_fe_q)
+        } else {
+            (if_k, id_k, vq_k, 0.0, id_k, 0.0)
+        };
         // Flux: phi = psi_r / Lm [A].
         let (psi_p, rden, phi_t) = match flux_decay {
             Some(a) => {
@@ -221,12 +300,19 @@ pub fn simulate(d: &Prepared, n: &Nominal, b: &BaseParams, t: &Terms) -> Predict
                 iq = (vq - psi_p * n.np * wm) / rden;
             }
         }
-        let i_fe = t.g_fe_s * d.omega_s[k] * ls * i_f;
-        let iq_pos = iq + i_fe;
         let rot = C64::new(d.theta[k].cos(), d.theta[k].sin());
         let ineg = t.i_neg.get(k).copied().unwrap_or_default();
-        let i_ab = C64::new(id_raw, iq_pos) * rot + ineg;
-        out.iq.push(iq_pos + (ineg * rot.conj()).im);
+        // Back to the analysis frame (measured d current, predicted q current).
+        let i_dq = if eps != 0.0 {
+            let i_true = C64::new(id_term, iq + i_fe_q);
+            let fwd = C64::new(eps.cos(), eps.sin());
+            C64::new(d.id[k], (i_true * fwd).im)
+        } else {
+            // The measured I_ds (not a re-noised one: the error never sees its noise).
+            C64::new(d.id[k], iq)
+        };
+        let i_ab = i_dq * rot + ineg;
+        out.iq.push(i_dq.im + (ineg * rot.conj()).im);
         out.omega_r.push(n.np * wm);
         out.i_ab.push(i_ab);
     }
