@@ -193,7 +193,13 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         println!("{}", serde_json::to_string_pretty(r)?);
         return Ok(());
     }
-    println!("compare {}", c.log.display());
+    print_text(&c.log, r);
+    Ok(())
+}
+
+/// Prints a `compare` result as text (what `compare` without `--json` shows).
+pub fn print_text(log: &Path, r: &crate::analysis::CompareReport) {
+    println!("compare {}", log.display());
     println!(
         "  model: {}",
         if r.effects.is_empty() {
@@ -249,5 +255,4 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         println!("  skipped: {s}");
     }
     println!("  unbalance: {}", r.unbalance.summary);
-    Ok(())
 }
