@@ -6,7 +6,8 @@
 //! default sensors) into `$ANALYSIS_BENCH_LOG` (default `/tmp/sim-host-bench-<seconds>s.csv`,
 //! about 3.3 GB for 1 h) and reused. `ANALYSIS_BENCH_SECONDS` shortens the log (default 3600).
 //! Prints wall times of the read (parse + decimate + frame), `compare`, `explain`, the
-//! peak resident memory (VmHWM, also right after the read) and the CPU time of each stage.
+//! peak resident memory (VmHWM, also after the read and after `compare`) and the CPU time of
+//! each stage.
 
 use sim_host::analysis::{prep::ReadOptions, Analysis, Options};
 use sim_host::log::{Channels, LogWriter};
@@ -115,12 +116,16 @@ fn main() {
     let c = a.compare(&opts).expect("compare");
     let t_cmp = t1.elapsed().as_secs_f64();
     let c_cmp = cpu_s() - c0 - c_read;
+    let rss_cmp = peak_rss_mb();
+    // As `explain --compare` does: compare's result is reported, then dropped.
+    let cmp_error = c.report.normalized_rms_error;
+    drop(c);
     let t2 = Instant::now();
     let e = a.explain(&opts, &|_| {}).expect("explain");
     let t_exp = t2.elapsed().as_secs_f64();
     let c_exp = cpu_s() - c0 - c_read - c_cmp;
     println!(
-        "analysis bench: {} rows ({:.2} GB), {} threads: read+frame {:.2} s, compare {:.2} s, explain {:.2} s, total {:.2} s; peak RSS {:.0} MB (after read {:.0} MB); working samples {}; error {:.4}, top {:?}",
+        "analysis bench: {} rows ({:.2} GB), {} threads: read+frame {:.2} s, compare {:.2} s, explain {:.2} s, total {:.2} s; peak RSS {:.0} MB (after read {:.0} MB, after compare {:.0} MB); working samples {}; error {:.4}, top {:?}",
         a.data.rows,
         size as f64 / 1e9,
         rayon::current_num_threads(),
@@ -130,8 +135,9 @@ fn main() {
         t_read + t_cmp + t_exp,
         peak_rss_mb(),
         rss_read,
+        rss_cmp,
         a.data.len(),
-        c.report.normalized_rms_error,
+        cmp_error,
         e.report.ranking.first().map(|r| (&r.effect, r.explained_fraction))
     );
     println!(

@@ -517,10 +517,12 @@ fn load_steps(d: &Prepared, n: &Nominal) -> Vec<f64> {
     let mut obs = Vec::with_capacity(len);
     let a = 1.0 - (-2.0 * std::f64::consts::PI * 10.0 * dt).exp();
     let (mut s1, mut s2) = (0.0, 0.0);
-    let mut wprev = d.omega_r[0] / n.np;
-    let mut w_lp = Vec::with_capacity(len);
+    // (Few series of the log's length: this also runs on the full working series of a long
+    // log, so w_m is recomputed where needed rather than stored.)
+    let w_at = |k: usize| d.omega_r[k] / n.np;
+    let mut wprev = w_at(0);
     for k in 0..len {
-        let wm = d.omega_r[k] / n.np;
+        let wm = w_at(k);
         let te = 1.5 * n.np * lmr * d.i_f[k] * d.iq_pos[k];
         let acc = (wm - wprev) / dt;
         wprev = wm;
@@ -532,36 +534,35 @@ fn load_steps(d: &Prepared, n: &Nominal) -> Vec<f64> {
         s1 += a * (x - s1);
         s2 += a * (s1 - s2);
         obs.push(s2);
-        w_lp.push(wm);
     }
     // Remove the best viscous line through the origin (the paper's Bl*omega): what is
     // left is load torque the viscous model cannot describe.
-    let (sww, swx) = w_lp
-        .iter()
-        .zip(&obs)
-        .fold((0.0, 0.0), |acc, (w, x)| (acc.0 + w * w, acc.1 + w * x));
+    let (sww, swx) = obs.iter().enumerate().fold((0.0, 0.0), |acc, (k, x)| {
+        let w = w_at(k);
+        (acc.0 + w * w, acc.1 + w * x)
+    });
     let c1 = if sww > 0.0 { swx / sww } else { 0.0 };
-    let r: Vec<f64> = obs.iter().zip(&w_lp).map(|(x, w)| x - c1 * w).collect();
     let min_len = ((0.1 / dt) as usize).max(len / 10).max(2);
     let thresh = 0.03 * n.torque_scale_nm;
+    // Cumulative sum of the residual torque obs - c1 w_m.
     let mut cum = vec![0.0; len + 1];
     for k in 0..len {
-        cum[k + 1] = cum[k] + r[k];
+        cum[k + 1] = cum[k] + (obs[k] - c1 * w_at(k));
     }
+    drop(obs);
     let mean = |a: usize, b: usize| (cum[b] - cum[a]) / (b - a) as f64;
     // A load step is a torque change while the supply holds still: splits where the supply
     // frequency or voltage moves by more than 1 % within +/- half a minimum segment are
     // refused (speed sweeps change the friction torque, not the load).
-    let vmag: Vec<f64> = (0..len).map(|k| d.vq[k].hypot(d.vd[k])).collect();
-    let cum_of = |x: &[f64]| {
-        let mut c = vec![0.0; x.len() + 1];
-        for k in 0..x.len() {
-            c[k + 1] = c[k] + x[k];
+    let cum_of = |x: &dyn Fn(usize) -> f64| {
+        let mut c = vec![0.0; len + 1];
+        for k in 0..len {
+            c[k + 1] = c[k] + x(k);
         }
         c
     };
-    let cw = cum_of(&d.omega_s);
-    let cv = cum_of(&vmag);
+    let cw = cum_of(&|k| d.omega_s[k]);
+    let cv = cum_of(&|k| d.vq[k].hypot(d.vd[k]));
     let half = (min_len / 2).max(1);
     let supply_steady = |kk: usize| {
         let a = kk.saturating_sub(half);
