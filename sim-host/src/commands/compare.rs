@@ -175,7 +175,12 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         fit_base: !c.no_fit,
     };
     let out = a.compare(&opts)?;
-    let charts = report::compare_charts(&a.data, &out);
+    // Charts only when something is written (they thin copies of the full series).
+    let charts = if c.plot.is_some() || c.report.is_some() {
+        report::compare_charts(&a.data, &out)
+    } else {
+        Vec::new()
+    };
     if let Some(dir) = &c.plot {
         report::write_charts(dir, &charts).map_err(anyhow::Error::msg)?;
     }

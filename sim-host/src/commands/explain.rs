@@ -66,7 +66,12 @@ pub fn run(args: &ExplainArgs) -> anyhow::Result<()> {
     let pbc = pb.clone();
     let out = a.explain(&opts, &move |f| pbc.set_position((f * 1000.0) as u64))?;
     pb.finish_and_clear();
-    let charts = report::explain_charts(&a.data, &out.before, out.after.as_ref());
+    // Charts only when something is written (they thin copies of the full series).
+    let charts = if c.plot.is_some() || c.report.is_some() {
+        report::explain_charts(&a.data, &out.before, out.after.as_ref())
+    } else {
+        Vec::new()
+    };
     if let Some(dir) = &c.plot {
         report::write_charts(dir, &charts).map_err(anyhow::Error::msg)?;
     }
