@@ -3,10 +3,11 @@
 //!
 //! Run: `cargo bench -p sim-host --bench analysis` (release profile). The log is generated
 //! once with the simulator (2.2 kW motor, thermal drift with a 20 min time constant,
-//! default sensors) into `$ANALYSIS_BENCH_LOG` (default `/tmp/sim-host-bench-1h.csv`,
-//! about 2.9 GB) and reused. `ANALYSIS_BENCH_SECONDS` shortens the log (default 3600).
-//! Prints wall times of the read (parse + decimate + frame), `compare`, `explain`, and the
-//! peak resident memory (VmHWM).
+//! default sensors) into `$ANALYSIS_BENCH_LOG` (default `/tmp/sim-host-bench-<seconds>s.csv`,
+//! about 3.3 GB for 1 h) and reused. `ANALYSIS_BENCH_SECONDS` shortens the log (default 3600).
+//! Prints wall times of the read (parse + decimate + frame), `compare`, `explain`, the
+//! peak resident memory (VmHWM, also after the read and after `compare`) and the CPU time of
+//! each stage.
 
 use sim_host::analysis::{prep::ReadOptions, Analysis, Options};
 use sim_host::log::{Channels, LogWriter};
@@ -26,6 +27,24 @@ fn peak_rss_mb() -> f64 {
             })
         })
         .map(|kb| kb / 1024.0)
+        .unwrap_or(f64::NAN)
+}
+
+/// CPU time (user + system) of this process so far [s], from /proc/self/stat (clock ticks
+/// of 10 ms); NaN where unavailable. With the wall times it tells a shared machine's
+/// interference apart from the work itself.
+fn cpu_s() -> f64 {
+    std::fs::read_to_string("/proc/self/stat")
+        .ok()
+        .and_then(|s| {
+            // Fields after the command name (which is in parentheses): utime is the 14th
+            // field of the line, stime the 15th.
+            let rest = &s[s.rfind(')')? + 2..];
+            let f: Vec<&str> = rest.split_whitespace().collect();
+            let ut: f64 = f.get(11)?.parse().ok()?;
+            let st: f64 = f.get(12)?.parse().ok()?;
+            Some((ut + st) / 100.0)
+        })
         .unwrap_or(f64::NAN)
 }
 
@@ -74,6 +93,7 @@ fn main() {
         );
     }
     let size = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+    let c0 = cpu_s();
     let t0 = Instant::now();
     let a = Analysis::load(
         &path,
@@ -86,6 +106,8 @@ fn main() {
     )
     .expect("load");
     let t_read = t0.elapsed().as_secs_f64();
+    let c_read = cpu_s() - c0;
+    let rss_read = peak_rss_mb();
     let opts = Options {
         effects: vec![],
         fit_base: true,
@@ -93,11 +115,17 @@ fn main() {
     let t1 = Instant::now();
     let c = a.compare(&opts).expect("compare");
     let t_cmp = t1.elapsed().as_secs_f64();
+    let c_cmp = cpu_s() - c0 - c_read;
+    let rss_cmp = peak_rss_mb();
+    // As `explain --compare` does: compare's result is reported, then dropped.
+    let cmp_error = c.report.normalized_rms_error;
+    drop(c);
     let t2 = Instant::now();
     let e = a.explain(&opts, &|_| {}).expect("explain");
     let t_exp = t2.elapsed().as_secs_f64();
+    let c_exp = cpu_s() - c0 - c_read - c_cmp;
     println!(
-        "analysis bench: {} rows ({:.2} GB), {} threads: read+frame {:.2} s, compare {:.2} s, explain {:.2} s, total {:.2} s; peak RSS {:.0} MB; working samples {}; error {:.4}, top {:?}",
+        "analysis bench: {} rows ({:.2} GB), {} threads: read+frame {:.2} s, compare {:.2} s, explain {:.2} s, total {:.2} s; peak RSS {:.0} MB (after read {:.0} MB, after compare {:.0} MB); working samples {}; error {:.4}, top {:?}",
         a.data.rows,
         size as f64 / 1e9,
         rayon::current_num_threads(),
@@ -106,8 +134,14 @@ fn main() {
         t_exp,
         t_read + t_cmp + t_exp,
         peak_rss_mb(),
+        rss_read,
+        rss_cmp,
         a.data.len(),
-        c.report.normalized_rms_error,
+        cmp_error,
         e.report.ranking.first().map(|r| (&r.effect, r.explained_fraction))
+    );
+    println!(
+        "CPU time (user + system): read+frame {c_read:.2} s, compare {c_cmp:.2} s, explain {c_exp:.2} s, total {:.2} s",
+        c_read + c_cmp + c_exp
     );
 }

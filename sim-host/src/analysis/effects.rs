@@ -229,24 +229,69 @@ impl Effect for ThermalDrift {
 
 /// Lm / Lm0 for magnetising current `im` [A]: solves x (1 + (x a)^n) = 1, a = Lm0 im / psi_sat.
 fn sat_factor(lm0: f64, im: f64, psi_sat: f64, nexp: f64) -> f64 {
+    sat_factor_from(lm0, im, psi_sat, nexp, 1.0)
+}
+
+/// [`sat_factor`] by Newton's method from the guess `x0`, to |dx| < 1e-12. Solved for
+/// y = x a: g(y) = y + y^(n+1) - a = 0 (convex and increasing, one power per step).
+fn sat_factor_from(lm0: f64, im: f64, psi_sat: f64, nexp: f64, x0: f64) -> f64 {
     let a = (lm0 * im.abs() / psi_sat.max(1e-9)).max(0.0);
     if a < 1e-6 {
         return 1.0;
     }
-    let an = a.powf(nexp);
-    let mut x = 1.0f64;
+    let (lo, hi) = (1e-3 * a, a);
+    let mut y = (x0.clamp(1e-3, 1.0) * a).clamp(lo, hi);
     for _ in 0..30 {
-        let xn = x.powf(nexp);
-        let f = x + x * xn * an - 1.0;
-        let fp = 1.0 + (nexp + 1.0) * xn * an;
-        let nx = (x - f / fp).clamp(1e-3, 1.0);
-        if (nx - x).abs() < 1e-12 {
-            x = nx;
+        let yn = y.powf(nexp);
+        let g = y + y * yn - a;
+        let gp = 1.0 + (nexp + 1.0) * yn;
+        let ny = (y - g / gp).clamp(lo, hi);
+        if (ny - y).abs() < 1e-12 * a {
+            y = ny;
             break;
         }
-        x = nx;
+        y = ny;
     }
-    x
+    y / a
+}
+
+/// [`sat_factor`] for every sample of `i_f`. The current changes little between samples,
+/// so each solve starts from the previous one moved along the tangent (dy/da = 1/g'(y)),
+/// a guess within about (da)^2 of the root; a Newton step shorter than 1e-7 a then leaves
+/// an error below about 1e-13 (quadratic convergence) and ends the solve. Where the guess
+/// is poor (the first sample, a jump), the iteration goes on as in [`sat_factor_from`].
+fn sat_factors(lm0: f64, i_f: &[f64], psi_sat: f64, nexp: f64) -> Vec<f64> {
+    let k = lm0 / psi_sat.max(1e-9);
+    // Previous sample: a, y and 1/g'(y) (None: no usable previous solve).
+    let mut prev: Option<(f64, f64, f64)> = None;
+    i_f.iter()
+        .map(|&i| {
+            let a = (k * i.abs()).max(0.0);
+            if a < 1e-6 {
+                prev = None;
+                return 1.0;
+            }
+            let (lo, hi) = (1e-3 * a, a);
+            let mut y = match prev {
+                Some((pa, py, inv_gp)) => (py + (a - pa) * inv_gp).clamp(lo, hi),
+                None => a,
+            };
+            let mut inv_gp = 1.0;
+            for it in 0..30 {
+                let yn = y.powf(nexp);
+                let g = y + y * yn - a;
+                inv_gp = 1.0 / (1.0 + (nexp + 1.0) * yn);
+                let ny = (y - g * inv_gp).clamp(lo, hi);
+                let step = (ny - y).abs();
+                y = ny;
+                if step < 1e-12 * a || (it == 0 && prev.is_some() && step < 1e-7 * a) {
+                    break;
+                }
+            }
+            prev = Some((a, y, inv_gp));
+            y / a
+        })
+        .collect()
 }
 
 impl Effect for Saturation {
@@ -289,19 +334,23 @@ impl Effect for Saturation {
         Ok(s)
     }
     fn apply(&self, _s: &Setup, p: &[f64], d: &Prepared, n: &Nominal, terms: &mut Terms) {
-        terms.lm_factor = d
-            .i_f
-            .iter()
-            .map(|&i| sat_factor(n.lm_h, i, p[0], p[1]))
-            .collect();
+        terms.lm_factor = sat_factors(n.lm_h, &d.i_f, p[0], p[1]);
     }
     fn describe(&self, s: &Setup, p: &[f64], d: &Prepared, n: &Nominal) -> String {
-        let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+        // The factor falls monotonically with |i_f|: its extremes are at the extremes of |i_f|.
+        let (mut imin, mut imax) = (f64::INFINITY, f64::NEG_INFINITY);
         for &i in &d.i_f {
-            let x = sat_factor(n.lm_h, i, p[0], p[1]);
-            lo = lo.min(x);
-            hi = hi.max(x);
+            imin = imin.min(i.abs());
+            imax = imax.max(i.abs());
         }
+        let (lo, hi) = if imax >= imin {
+            (
+                sat_factor(n.lm_h, imax, p[0], p[1]),
+                sat_factor(n.lm_h, imin, p[0], p[1]),
+            )
+        } else {
+            (f64::INFINITY, 0.0)
+        };
         format!(
             "magnetising inductance falls with flux: Lm is {:.0} % to {:.0} % of its unsaturated value over this log (saturation flux {:.2} Wb = {:.2} x the rated flux, knee exponent {:.1})",
             lo * 100.0,
@@ -468,10 +517,12 @@ fn load_steps(d: &Prepared, n: &Nominal) -> Vec<f64> {
     let mut obs = Vec::with_capacity(len);
     let a = 1.0 - (-2.0 * std::f64::consts::PI * 10.0 * dt).exp();
     let (mut s1, mut s2) = (0.0, 0.0);
-    let mut wprev = d.omega_r[0] / n.np;
-    let mut w_lp = Vec::with_capacity(len);
+    // (Few series of the log's length: this also runs on the full working series of a long
+    // log, so w_m is recomputed where needed rather than stored.)
+    let w_at = |k: usize| d.omega_r[k] / n.np;
+    let mut wprev = w_at(0);
     for k in 0..len {
-        let wm = d.omega_r[k] / n.np;
+        let wm = w_at(k);
         let te = 1.5 * n.np * lmr * d.i_f[k] * d.iq_pos[k];
         let acc = (wm - wprev) / dt;
         wprev = wm;
@@ -483,36 +534,35 @@ fn load_steps(d: &Prepared, n: &Nominal) -> Vec<f64> {
         s1 += a * (x - s1);
         s2 += a * (s1 - s2);
         obs.push(s2);
-        w_lp.push(wm);
     }
     // Remove the best viscous line through the origin (the paper's Bl*omega): what is
     // left is load torque the viscous model cannot describe.
-    let (sww, swx) = w_lp
-        .iter()
-        .zip(&obs)
-        .fold((0.0, 0.0), |acc, (w, x)| (acc.0 + w * w, acc.1 + w * x));
+    let (sww, swx) = obs.iter().enumerate().fold((0.0, 0.0), |acc, (k, x)| {
+        let w = w_at(k);
+        (acc.0 + w * w, acc.1 + w * x)
+    });
     let c1 = if sww > 0.0 { swx / sww } else { 0.0 };
-    let r: Vec<f64> = obs.iter().zip(&w_lp).map(|(x, w)| x - c1 * w).collect();
     let min_len = ((0.1 / dt) as usize).max(len / 10).max(2);
     let thresh = 0.03 * n.torque_scale_nm;
+    // Cumulative sum of the residual torque obs - c1 w_m.
     let mut cum = vec![0.0; len + 1];
     for k in 0..len {
-        cum[k + 1] = cum[k] + r[k];
+        cum[k + 1] = cum[k] + (obs[k] - c1 * w_at(k));
     }
+    drop(obs);
     let mean = |a: usize, b: usize| (cum[b] - cum[a]) / (b - a) as f64;
     // A load step is a torque change while the supply holds still: splits where the supply
     // frequency or voltage moves by more than 1 % within +/- half a minimum segment are
     // refused (speed sweeps change the friction torque, not the load).
-    let vmag: Vec<f64> = (0..len).map(|k| d.vq[k].hypot(d.vd[k])).collect();
-    let cum_of = |x: &[f64]| {
-        let mut c = vec![0.0; x.len() + 1];
-        for k in 0..x.len() {
-            c[k + 1] = c[k] + x[k];
+    let cum_of = |x: &dyn Fn(usize) -> f64| {
+        let mut c = vec![0.0; len + 1];
+        for k in 0..len {
+            c[k + 1] = c[k] + x(k);
         }
         c
     };
-    let cw = cum_of(&d.omega_s);
-    let cv = cum_of(&vmag);
+    let cw = cum_of(&|k| d.omega_s[k]);
+    let cv = cum_of(&|k| d.vq[k].hypot(d.vd[k]));
     let half = (min_len / 2).max(1);
     let supply_steady = |kk: usize| {
         let a = kk.saturating_sub(half);
@@ -901,6 +951,26 @@ mod tests {
         let x = sat_factor(0.245, 4.0, 1.0, 6.0);
         let a = 0.245 * 4.0 / 1.0;
         assert!((x * (1.0 + (x * a).powf(6.0)) - 1.0).abs() < 1e-9);
+        // Warm starts from anywhere reach the same root.
+        for x0 in [1.0, 0.9, 0.5, 0.01] {
+            let y = sat_factor_from(0.245, 4.0, 1.0, 6.0, x0);
+            assert!((x - y).abs() < 1e-12, "{x0}: {x} vs {y}");
+        }
+        let v = sat_factors(0.245, &[0.0, 1.0, 4.0, -4.0, 8.0, 3.9], 1.0, 6.0);
+        for (i, y) in [0.0, 1.0, 4.0, -4.0, 8.0, 3.9].iter().zip(v) {
+            assert!((sat_factor(0.245, *i, 1.0, 6.0) - y).abs() < 1e-12);
+        }
+        // A slowly varying current (the warm-started solves end after one step).
+        for nexp in [2.0, 7.0, 14.0] {
+            let i_f: Vec<f64> = (0..2000)
+                .map(|k| 4.0 + 0.5 * (k as f64 * 0.01).sin())
+                .collect();
+            let v = sat_factors(0.245, &i_f, 0.9, nexp);
+            for (i, y) in i_f.iter().zip(v) {
+                let x = sat_factor(0.245, *i, 0.9, nexp);
+                assert!((x - y).abs() < 1e-12 * x, "{nexp} {i}: {x} vs {y}");
+            }
+        }
     }
 
     #[test]

@@ -11,9 +11,9 @@
 //! bounds are enforced by clamping.
 
 use super::effects::{Effect, Setup};
-use super::metrics::Weights;
-use super::model::{simulate, BaseParams, Nominal, Prediction, Terms};
-use super::prep::Prepared;
+use super::metrics::{measured, predicted, Weights};
+use super::model::{rotations, simulate, simulate_rot, BaseParams, Nominal, Prediction, Terms};
+use super::prep::{Prepared, C64};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
@@ -52,16 +52,27 @@ struct Problem<'a> {
     w: &'a Weights,
     btot_scale: f64,
     fit_base: bool,
+    /// Frame rotations of `d` (the same for every simulation).
+    rot: Vec<C64>,
+    /// The training samples the residuals use, with their measured channels (fixed).
+    targets: Vec<(usize, [f64; 5])>,
+    /// 1/sqrt(number of targets).
+    norm: f64,
 }
 
 impl Problem<'_> {
-    fn unpack(&self, x: &[f64]) -> (BaseParams, Terms) {
-        let base = BaseParams {
+    fn base(x: &[f64]) -> BaseParams {
+        BaseParams {
             ra_scale: x[0],
             ls_scale: x[1],
             btot_nms: x[2],
             j_scale: x[3],
-        };
+        }
+    }
+
+    /// The effects' contributions for the effect parameters in `x` (the base parameters do
+    /// not enter them).
+    fn terms(&self, x: &[f64]) -> Terms {
         let mut terms = Terms::default();
         let mut o = N_BASE;
         for e in self.effects {
@@ -70,17 +81,33 @@ impl Problem<'_> {
                 .apply(&e.setup, &x[o..o + k], self.d, self.n, &mut terms);
             o += k;
         }
-        (base, terms)
-    }
-
-    fn predict(&self, x: &[f64]) -> Prediction {
-        let (b, t) = self.unpack(x);
-        simulate(self.d, self.n, &b, &t)
+        terms
     }
 
     fn residuals(&self, x: &[f64]) -> Vec<f64> {
-        let p = self.predict(x);
-        let mut r = self.w.residuals(self.d, &p, true);
+        self.residuals_with(x, &self.terms(x))
+    }
+
+    /// The same residuals as [`Weights::residuals`] on the training samples (the measured
+    /// side precomputed), plus the priors; `terms` must be [`Problem::terms`] of `x`.
+    fn residuals_with(&self, x: &[f64], terms: &Terms) -> Vec<f64> {
+        let p = simulate_rot(self.d, &self.rot, self.n, &Self::base(x), terms);
+        let inv = &self.w.inv_rms;
+        let nc = self.w.n_channels();
+        let mut r = Vec::with_capacity(nc * self.targets.len() + N_BASE);
+        for (k, m) in &self.targets {
+            if p.iq.len() <= *k {
+                r.extend(std::iter::repeat_n(1e3, nc));
+                continue;
+            }
+            let q = predicted(self.d, &p, *k);
+            for c in 0..5 {
+                if inv[c] > 0.0 {
+                    let e = (q[c] - m[c]) * inv[c] * self.norm;
+                    r.push(if e.is_finite() { e } else { 1e3 });
+                }
+            }
+        }
         if self.fit_base {
             // Weak: a 15 % deviation of Ra costs as much as a 0.01 normalized error.
             r.push(PRIOR_WEIGHT * (x[0] - 1.0) / 0.15);
@@ -111,6 +138,11 @@ pub fn fit(
     max_iter: usize,
 ) -> FitResult {
     let bs = btot_scale(n, d);
+    let targets: Vec<(usize, [f64; 5])> = (0..d.len())
+        .step_by(w.stride)
+        .filter(|&k| w.train[k])
+        .map(|k| (k, measured(d, k)))
+        .collect();
     let prob = Problem {
         d,
         n,
@@ -118,6 +150,9 @@ pub fn fit(
         w,
         btot_scale: bs,
         fit_base,
+        rot: rotations(d),
+        norm: 1.0 / (targets.len().max(1) as f64).sqrt(),
+        targets,
     };
     let mut x = vec![
         start.ra_scale,
@@ -135,7 +170,10 @@ pub fn fit(
         scale.extend_from_slice(&e.setup.scale);
     }
     let free: Vec<usize> = (0..x.len()).filter(|&i| fit_base || i >= N_BASE).collect();
-    let mut r = prob.residuals(&x);
+    // The effects' terms at the current point: the Jacobian columns of the base parameters
+    // reuse them (only the effects' own columns and trial steps recompute them).
+    let mut terms_x = prob.terms(&x);
+    let mut r = prob.residuals_with(&x, &terms_x);
     let mut cost = 0.5 * r.iter().map(|v| v * v).sum::<f64>();
     let mut lambda = 1e-3;
     let mut it = 0;
@@ -150,7 +188,11 @@ pub fn fit(
                 let mut xp = x.clone();
                 let dir = if xp[i] + h > hi[i] { -1.0 } else { 1.0 };
                 xp[i] += dir * h;
-                let rp = prob.residuals(&xp);
+                let rp = if i < N_BASE {
+                    prob.residuals_with(&xp, &terms_x)
+                } else {
+                    prob.residuals(&xp)
+                };
                 rp.iter()
                     .zip(&r)
                     .map(|(a, b)| (a - b) / (dir * h))
@@ -185,12 +227,14 @@ pub fn fit(
             for (a, &i) in free.iter().enumerate() {
                 xn[i] = (x[i] + step[a]).clamp(lo[i], hi[i]);
             }
-            let rn = prob.residuals(&xn);
+            let tn = prob.terms(&xn);
+            let rn = prob.residuals_with(&xn, &tn);
             let cn = 0.5 * rn.iter().map(|v| v * v).sum::<f64>();
             if cn.is_finite() && cn < cost {
                 let rel = (cost - cn) / cost.max(1e-300);
                 x = xn;
                 r = rn;
+                terms_x = tn;
                 cost = cn;
                 lambda = (lambda / 3.0).max(1e-9);
                 improved = true;
@@ -207,7 +251,7 @@ pub fn fit(
             break;
         }
     }
-    let (base, _) = prob.unpack(&x);
+    let base = Problem::base(&x);
     let mut effect_params = Vec::new();
     let mut o = N_BASE;
     for e in effects {

@@ -290,30 +290,44 @@ fn needs_ok(n: Needs, d: &Prepared) -> Result<(), String> {
 
 /// Block-averages a working series by `m` (for fitting long logs).
 fn coarsen(d: &Prepared, m: usize) -> Prepared {
+    use rayon::prelude::*;
     if m <= 1 {
         return d.clone();
     }
     let avg = |x: &[f64]| -> Vec<f64> {
-        x.chunks_exact(m)
+        x.par_chunks_exact(m)
             .map(|c| c.iter().sum::<f64>() / m as f64)
             .collect()
     };
     // Rotating vectors are averaged in the frame they are constant in (sign +1: the
     // positive-sequence d-q frame, -1: the negative-sequence frame) and rotated back with
     // the block's mean angle; a plain average over a supply period would cancel them.
+    // One pass for the three vectors: each sample's rotation is computed once.
     let theta_c = avg(&d.theta);
-    let avgc = |x: &[C64], sign: f64| -> Vec<C64> {
-        x.chunks_exact(m)
-            .zip(d.theta.chunks_exact(m))
-            .zip(&theta_c)
-            .map(|((c, th), &tc)| {
-                let s = c.iter().zip(th).fold(C64::new(0.0, 0.0), |a, (v, &t)| {
-                    a + v * C64::from_polar(1.0, -sign * t)
-                });
-                s / m as f64 * C64::from_polar(1.0, sign * tc)
-            })
-            .collect()
-    };
+    let zero = C64::new(0.0, 0.0);
+    let has_v = d.v_neg.len() == d.len();
+    let rotated: Vec<(C64, C64, C64)> = d
+        .theta
+        .par_chunks_exact(m)
+        .enumerate()
+        .zip(&theta_c)
+        .map(|((b, th), &tc)| {
+            let (mut si, mut sv, mut sn) = (zero, zero, zero);
+            for (j, &t) in th.iter().enumerate() {
+                let k = b * m + j;
+                let r = C64::from_polar(1.0, -t); // e^{-j theta}
+                let rc = r.conj(); // e^{+j theta}
+                si += d.i_ab[k] * r;
+                if has_v {
+                    sv += d.v_neg[k] * rc;
+                }
+                sn += d.i_neg[k] * rc;
+            }
+            let back = C64::from_polar(1.0, tc);
+            let mf = m as f64;
+            (si / mf * back, sv / mf * back.conj(), sn / mf * back.conj())
+        })
+        .collect();
     Prepared {
         t_s: avg(&d.t_s),
         dt_s: d.dt_s * m as f64,
@@ -325,10 +339,14 @@ fn coarsen(d: &Prepared, m: usize) -> Prepared {
         i_f: avg(&d.i_f),
         iq: avg(&d.iq),
         iq_pos: avg(&d.iq_pos),
-        i_ab: avgc(&d.i_ab, 1.0),
+        i_ab: rotated.iter().map(|r| r.0).collect(),
         i0: avg(&d.i0),
-        v_neg: avgc(&d.v_neg, -1.0),
-        i_neg: avgc(&d.i_neg, -1.0),
+        v_neg: if has_v {
+            rotated.iter().map(|r| r.1).collect()
+        } else {
+            vec![]
+        },
+        i_neg: rotated.iter().map(|r| r.2).collect(),
         omega_r: avg(&d.omega_r),
         channels: d.channels,
         rows: d.rows,

@@ -165,6 +165,43 @@ pub struct Prediction {
 /// Initial state from the measurement at the first sample: w_m = measured speed (0 without
 /// a speed column), I_qs = measured, the normalised rotor flux phi = i_f.
 pub fn simulate(d: &Prepared, n: &Nominal, b: &BaseParams, t: &Terms) -> Prediction {
+    simulate_with(d, n, b, t, |k| C64::new(d.theta[k].cos(), d.theta[k].sin()))
+}
+
+/// The frame rotation `e^{j theta_k}` of every sample of `d` (what [`simulate_rot`] takes).
+pub fn rotations(d: &Prepared) -> Vec<C64> {
+    d.theta
+        .iter()
+        .map(|th| {
+            let (s, c) = th.sin_cos();
+            C64::new(c, s)
+        })
+        .collect()
+}
+
+/// [`simulate`] with the frame rotations precomputed ([`rotations`] of the same data), for
+/// the many simulations of a fit.
+pub fn simulate_rot(
+    d: &Prepared,
+    rot: &[C64],
+    n: &Nominal,
+    b: &BaseParams,
+    t: &Terms,
+) -> Prediction {
+    if rot.len() != d.len() {
+        return simulate(d, n, b, t);
+    }
+    simulate_with(d, n, b, t, |k| rot[k])
+}
+
+#[inline(always)]
+fn simulate_with(
+    d: &Prepared,
+    n: &Nominal,
+    b: &BaseParams,
+    t: &Terms,
+    rot_at: impl Fn(usize) -> C64,
+) -> Prediction {
     let len = d.len();
     let mut out = Prediction {
         iq: Vec::with_capacity(len),
@@ -278,9 +315,13 @@ pub fn simulate(d: &Prepared, n: &Nominal, b: &BaseParams, t: &Terms) -> Predict
         };
         let kt = 1.5 * n.np * lmr * phi_t; // Te = kt * iq  [N m/A]
         let extra = |w: f64| {
-            t.coulomb_nm * (w / 1.0).tanh()
-                + t.windage_nms2 * w * w.abs()
-                + t.load_nm.get(k).copied().unwrap_or(0.0)
+            // (No tanh when there is no dry friction: 0 x tanh(w) is 0.)
+            let coulomb = if t.coulomb_nm != 0.0 {
+                t.coulomb_nm * (w / 1.0).tanh()
+            } else {
+                0.0
+            };
+            coulomb + t.windage_nms2 * w * w.abs() + t.load_nm.get(k).copied().unwrap_or(0.0)
         };
         let iq;
         match t.la_h {
@@ -300,7 +341,7 @@ pub fn simulate(d: &Prepared, n: &Nominal, b: &BaseParams, t: &Terms) -> Predict
                 iq = (vq - psi_p * n.np * wm) / rden;
             }
         }
-        let rot = C64::new(d.theta[k].cos(), d.theta[k].sin());
+        let rot = rot_at(k);
         let ineg = t.i_neg.get(k).copied().unwrap_or_default();
         // Back to the analysis frame (measured d current, predicted q current).
         let i_dq = if eps != 0.0 {

@@ -175,7 +175,12 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         fit_base: !c.no_fit,
     };
     let out = a.compare(&opts)?;
-    let charts = report::compare_charts(&a.data, &out);
+    // Charts only when something is written (they thin copies of the full series).
+    let charts = if c.plot.is_some() || c.report.is_some() {
+        report::compare_charts(&a.data, &out)
+    } else {
+        Vec::new()
+    };
     if let Some(dir) = &c.plot {
         report::write_charts(dir, &charts).map_err(anyhow::Error::msg)?;
     }
@@ -193,7 +198,13 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         println!("{}", serde_json::to_string_pretty(r)?);
         return Ok(());
     }
-    println!("compare {}", c.log.display());
+    print_text(&c.log, r);
+    Ok(())
+}
+
+/// Prints a `compare` result as text (what `compare` without `--json` shows).
+pub fn print_text(log: &Path, r: &crate::analysis::CompareReport) {
+    println!("compare {}", log.display());
     println!(
         "  model: {}",
         if r.effects.is_empty() {
@@ -249,5 +260,4 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         println!("  skipped: {s}");
     }
     println!("  unbalance: {}", r.unbalance.summary);
-    Ok(())
 }

@@ -1,6 +1,6 @@
 //! `sim-host explain`: which physical effect is missing from the model.
 
-use super::compare::{check_outputs, human_number, load, progress_bar, Common};
+use super::compare::{self, check_outputs, human_number, load, progress_bar, Common};
 use crate::analysis::{report, Options};
 use std::path::PathBuf;
 
@@ -18,6 +18,7 @@ the held-back error, or the error is already near the noise floor, the answer is
 `unexplained: true` rather than a wrong name.\n\n\
 Workflow:\n  sim-host compare --params motor.toml run.csv          # where does the model fail?\n  \
 sim-host explain --params motor.toml run.csv          # which effect is missing?\n  \
+sim-host explain --compare --params motor.toml run.csv  # both, reading a long log once\n  \
 sim-host compare --params motor.toml run.csv --effects load_torque   # the error falls\n  \
 sim-host explain --params motor.toml run.csv --effects load_torque   # anything else?\n\n\
 JSON (--json): baseline_normalized_rms_error, ranking [{effect, normalized_rms_error, \
@@ -28,6 +29,11 @@ pub struct ExplainArgs {
     /// Shared options.
     #[command(flatten)]
     pub common: Common,
+    /// Also run `compare` on the same read of the log and print its result first: one read
+    /// of a long log instead of two. With --json the output is {"compare": ..., "explain":
+    /// ...}; --plot and --report get explain's charts and report.
+    #[arg(long)]
+    pub compare: bool,
 }
 
 /// Runs `explain`.
@@ -39,15 +45,33 @@ pub fn run(args: &ExplainArgs) -> anyhow::Result<()> {
     let c = &args.common;
     check_outputs(c)?;
     let a = load(c)?;
-    let pb = progress_bar(a.data.len() > 50_000, "explain: fitting candidates");
     let opts = Options {
         effects: c.effect_list(),
         fit_base: !c.no_fit,
     };
+    // compare's result is printed (or kept as JSON) before explain runs, and its prediction
+    // dropped, so memory stays at explain's.
+    let compared = if args.compare {
+        let out = a.compare(&opts)?;
+        if c.json {
+            Some(serde_json::to_value(&out.report)?)
+        } else {
+            compare::print_text(&c.log, &out.report);
+            None
+        }
+    } else {
+        None
+    };
+    let pb = progress_bar(a.data.len() > 50_000, "explain: fitting candidates");
     let pbc = pb.clone();
     let out = a.explain(&opts, &move |f| pbc.set_position((f * 1000.0) as u64))?;
     pb.finish_and_clear();
-    let charts = report::explain_charts(&a.data, &out.before, out.after.as_ref());
+    // Charts only when something is written (they thin copies of the full series).
+    let charts = if c.plot.is_some() || c.report.is_some() {
+        report::explain_charts(&a.data, &out.before, out.after.as_ref())
+    } else {
+        Vec::new()
+    };
     if let Some(dir) = &c.plot {
         report::write_charts(dir, &charts).map_err(anyhow::Error::msg)?;
     }
@@ -62,7 +86,16 @@ pub fn run(args: &ExplainArgs) -> anyhow::Result<()> {
     }
     let r = &out.report;
     if c.json {
-        println!("{}", serde_json::to_string_pretty(r)?);
+        match compared {
+            Some(cmp) => println!(
+                "{}",
+                serde_json::to_string_pretty(&serde_json::json!({
+                    "compare": cmp,
+                    "explain": r,
+                }))?
+            ),
+            None => println!("{}", serde_json::to_string_pretty(r)?),
+        }
         return Ok(());
     }
     println!("explain {}", c.log.display());
