@@ -137,6 +137,10 @@ impl LogReader {
         })?;
         let mut rdr = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
+            // Rows end at '\n' only; a CRLF file's '\r' is trimmed as whitespace. (With the
+            // default CRLF terminator the csv crate reports lines one too low in CRLF files,
+            // so an error would name the wrong line.)
+            .terminator(csv::Terminator::Any(b'\n'))
             .from_reader(BufReader::with_capacity(1 << 20, f));
         let headers = rdr
             .headers()

@@ -219,6 +219,32 @@ fn bad_csv_inputs_give_one_line_errors_naming_the_problem() {
         e.contains("ib_A") && e.contains("line 3") && e.contains("not a number"),
         "{e}"
     );
+    // The same from a Windows editor (CRLF line ends): the same line number, and a
+    // good CRLF log reads.
+    let crlf = write(
+        dir.path(),
+        "crlf.csv",
+        "t_s,ia_A,ib_A,ic_A\r\n0,1,2,-3\r\n0.0001,1,x2,-3\r\n",
+    );
+    let e = fails(&["diagnose", "--params", p, crlf.to_str().expect("utf8")]);
+    assert!(e.contains("ib_A") && e.contains("line 3"), "{e}");
+    let mut good = String::from("t_s,ia_A,ib_A,ic_A\r\n");
+    for k in 0..2000 {
+        let t = k as f64 * 1e-4;
+        let w = 2.0 * std::f64::consts::PI * 60.0 * t;
+        let i = |ph: f64| 10.0 * (w - ph).cos();
+        let tp = 2.0 * std::f64::consts::PI / 3.0;
+        good += &format!("{t},{},{},{}\r\n", i(0.0), i(tp), i(-tp));
+    }
+    let good = write(dir.path(), "good_crlf.csv", &good);
+    let v = json(&[
+        "diagnose",
+        "--params",
+        p,
+        good.to_str().expect("utf8"),
+        "--json",
+    ]);
+    assert!(v.get("unbalance").is_some(), "{v}");
     let backwards = write(
         dir.path(),
         "back.csv",

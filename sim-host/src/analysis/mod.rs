@@ -767,6 +767,9 @@ impl Analysis {
                 skipped.push(format!("{}: {m}", c.name()));
             } else if let Err(m) = needs_ok(c.needs(), d) {
                 skipped.push(format!("{}: {m}", c.name()));
+            } else if let Err(m) = c.setup(&fd, &self.nominal) {
+                // e.g. load_torque on a log without a load change: say so, do not drop it.
+                skipped.push(format!("{}: {m}", c.name()));
             }
         }
         let done = std::sync::atomic::AtomicUsize::new(0);
