@@ -58,11 +58,13 @@ pub const MIN_MODEL_ERROR: f64 = 0.004;
 /// Fraction of the model error beyond the sensor noise that a candidate removes:
 /// `1 - S_with / S_base`, `S = sqrt(max(E^2 - N^2, 0))` (E the held-back error, N the
 /// noise floor), clamped to 0..1. A candidate that brings the error down to the noise floor
-/// explains everything there was to explain.
+/// explains everything there was to explain. When the baseline's excess `S_base` is below
+/// half the noise floor (the baseline within [`NOISE_MARGIN`] of it) there is nothing to
+/// explain and the fraction is 0: a ratio of two noise-sized numbers means nothing.
 pub fn explained_fraction(e_base: f64, e_with: f64, noise: f64) -> f64 {
     let s = |e: f64| (e * e - noise * noise).max(0.0).sqrt();
     let sb = s(e_base);
-    if sb <= 0.0 {
+    if sb <= 0.0 || sb < 0.5 * noise {
         return 0.0;
     }
     (1.0 - s(e_with) / sb).clamp(0.0, 1.0)
@@ -975,4 +977,23 @@ fn align(active: &[ActiveEffect<'_>], mut f: FitResult) -> FitResult {
         }
     }
     f
+}
+
+#[cfg(test)]
+mod tests {
+    use super::explained_fraction;
+
+    #[test]
+    fn explained_fraction_of_the_excess_over_noise() {
+        // Baseline 5x the noise, candidate at the noise floor: everything explained.
+        assert!((explained_fraction(0.05, 0.01, 0.01) - 1.0).abs() < 1e-12);
+        // Candidate halves the excess: sqrt(0.05^2 - 0.01^2) -> half of it.
+        let sb = (0.05f64.powi(2) - 0.01f64.powi(2)).sqrt();
+        let e_with = ((0.5 * sb).powi(2) + 0.01f64.powi(2)).sqrt();
+        assert!((explained_fraction(0.05, e_with, 0.01) - 0.5).abs() < 1e-9);
+        // A baseline within the noise margin has nothing to explain.
+        assert_eq!(explained_fraction(0.0105, 0.0100, 0.0100), 0.0);
+        // A candidate that makes things worse explains nothing.
+        assert_eq!(explained_fraction(0.05, 0.06, 0.01), 0.0);
+    }
 }
