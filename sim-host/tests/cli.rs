@@ -209,25 +209,17 @@ fn bad_csv_inputs_give_one_line_errors_naming_the_problem() {
     );
     let e = fails(&["diagnose", "--params", p, missing.to_str().expect("utf8")]);
     assert!(e.contains("ic_A") && e.contains("missing column"), "{e}");
-    let nonnum = write(
-        dir.path(),
-        "nonnum.csv",
-        "t_s,ia_A,ib_A,ic_A\n0,1,2,-3\n0.0001,1,x2,-3\n",
-    );
-    let e = fails(&["diagnose", "--params", p, nonnum.to_str().expect("utf8")]);
-    assert!(
-        e.contains("ib_A") && e.contains("line 3") && e.contains("not a number"),
-        "{e}"
-    );
-    // The same from a Windows editor (CRLF line ends): the same line number, and a
-    // good CRLF log reads.
-    let crlf = write(
-        dir.path(),
-        "crlf.csv",
-        "t_s,ia_A,ib_A,ic_A\r\n0,1,2,-3\r\n0.0001,1,x2,-3\r\n",
-    );
-    let e = fails(&["diagnose", "--params", p, crlf.to_str().expect("utf8")]);
-    assert!(e.contains("ib_A") && e.contains("line 3"), "{e}");
+    // LF, and the same from a Windows editor (CRLF): the same line number.
+    for (name, eol) in [("nonnum.csv", "\n"), ("crlf.csv", "\r\n")] {
+        let text = ["t_s,ia_A,ib_A,ic_A", "0,1,2,-3", "0.0001,1,x2,-3", ""].join(eol);
+        let bad = write(dir.path(), name, &text);
+        let e = fails(&["diagnose", "--params", p, bad.to_str().expect("utf8")]);
+        assert!(
+            e.contains("ib_A") && e.contains("line 3") && e.contains("not a number"),
+            "{name}: {e}"
+        );
+    }
+    // A good CRLF log reads.
     let mut good = String::from("t_s,ia_A,ib_A,ic_A\r\n");
     for k in 0..2000 {
         let t = k as f64 * 1e-4;

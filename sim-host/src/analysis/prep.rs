@@ -373,6 +373,12 @@ pub fn zero_phase_lpf(x: &[f64], dt: f64, fc: f64) -> Vec<f64> {
     y
 }
 
+/// Hann weight of sample `k` of `n` (unnormalised, 0..2): the weighted mean of a rotating
+/// vector over a few whole turns is zero even when the sample grid cuts the last turn short.
+fn hann(k: usize, n: usize) -> f64 {
+    1.0 - (2.0 * std::f64::consts::PI * (k as f64 + 0.5) / n.max(1) as f64).cos()
+}
+
 /// Third-order low-pass (three first-order stages at `fc`) of the demodulated signal
 /// `x = c + P e^{j omega k}`: a slowly varying part `c` (what the filter is for) plus a
 /// rotating remainder at `omega` [rad/sample] (the other sequence).
@@ -387,7 +393,7 @@ fn lpf3(x: &[C64], dt: f64, fc: f64, init_len: usize, omega: f64) -> Vec<C64> {
     let m = init_len.clamp(1, x.len().max(1));
     let (mut sum, mut wsum) = (C64::new(0.0, 0.0), 0.0);
     for (k, v) in x.iter().take(m).enumerate() {
-        let w = 1.0 - (2.0 * std::f64::consts::PI * (k as f64 + 0.5) / m as f64).cos();
+        let w = hann(k, m);
         sum += v * w;
         wsum += w;
     }
@@ -464,7 +470,7 @@ pub fn frame(d: &Decimated, p: &ParamFile) -> Prepared {
                     acc += (v_ab[k] - i_ab[k] * m.rs_ohm + v_ab[k - 1] - i_ab[k - 1] * m.rs_ohm)
                         * (0.5 * dt);
                 }
-                let w = 1.0 - (2.0 * std::f64::consts::PI * (k as f64 + 0.5) / n_per as f64).cos();
+                let w = hann(k, n_per);
                 sum += acc * w;
                 wsum += w;
             }
