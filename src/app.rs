@@ -4,51 +4,45 @@
 //! - [`SamplePath`] runs in the high-priority sample task: [`RawFrame`] -> [`Sample`] ->
 //!   [`Monitor::update`], applies [`Command`]s between samples, and reports when the core
 //!   finished learning. Bounded work, no panics, no allocation.
-//! - [`Supervisor`] runs in thread mode: the commissioning state machine and the mapping
-//!   of the latest [`MonitorOutput`] to the [`panel`](crate::panel).
+//! - Thread mode runs the commissioning procedure
+//!   ([`CommissioningProcedure`](crate::commissioning::CommissioningProcedure)) and maps
+//!   the latest [`MonitorOutput`] to the panel ([`PanelInput::from_output`]).
 //!
-//! The host tests (`tests/sil.rs`) drive exactly these two types with simulated data.
+//! The host tests (`tests/sil.rs`) drive exactly these types with simulated data.
+//!
+//! [`Sample`]: monitor_core::Sample
+//! [`MonitorOutput`]: monitor_core::MonitorOutput
+//! [`PanelInput::from_output`]: crate::panel::PanelInput::from_output
 
 use crate::board::{self, FrontEnd};
-use crate::commissioning::{Action, Commissioning, Event};
 use crate::flash_record::CalibrationRecord;
-use crate::panel::{Mode, PanelInput};
-use crate::sampling::{RawFrame, SampleBuilder, SamplingError, TICK_HZ};
+use crate::sampling::{AdcSampler, RawFrame, SamplingError, TICK_HZ};
 use monitor_core::{
-    Commissioning as CoreCommissioning, ConfigError, Monitor, MonitorConfig, MonitorOutput,
-    MotorModel,
+    CommissioningState, ConfigError, Monitor, MonitorConfig, MonitorOutput, MotorModel,
+    ReferenceMachine,
 };
 
-/// Supply frequency of the default drive, Hz.
-pub const SUPPLY_HZ: f32 = 50.0;
-/// Line-to-line RMS supply voltage of the default drive, V.
-pub const SUPPLY_V_LL_RMS: f32 = 400.0;
+/// The machine the firmware monitors by default: DESIGN.md's "2.2 kW" reference machine
+/// (`monitor_core::reference::MOTOR_2P2KW`: 400 V, 50 Hz, 4 poles, Gamma model, Bl for the
+/// rated 14.6 N m near rated speed). Edit here for another machine.
+pub const DEFAULT_MACHINE: ReferenceMachine = monitor_core::reference::MOTOR_2P2KW;
 
-/// The motor the firmware monitors by default: DESIGN.md's "2.2 kW" reference machine
-/// (400 V, 50 Hz, 4 poles, Gamma model: Rs 3.7 ohm, Rr 2.5 ohm, Ls = Lm = 0.245 H,
-/// Lr 0.268 H, J 0.015 kg m^2, B 0.005 N m s/rad, Bl 0.0975 N m s/rad so that Bl*omega is
-/// the rated 14.6 N m near rated speed). Edit here for another machine.
-pub const DEFAULT_MOTOR: MotorModel = MotorModel {
-    rs_ohm: 3.7,
-    rr_ohm: 2.5,
-    ls_h: 0.245,
-    lr_h: 0.268,
-    lm_h: 0.245,
-    pole_pairs: 2,
-    j_kgm2: 0.015,
-    b_nms: 0.005,
-    bl_nms: 0.0975,
-};
+/// The default machine in the core's precision.
+pub fn default_motor() -> MotorModel {
+    DEFAULT_MACHINE.motor.model()
+}
 
-/// Core configuration for the board: [`DEFAULT_MOTOR`] on 400 V / 50 Hz, sampled at
+/// Core configuration for the board: [`DEFAULT_MACHINE`] on its rated supply, sampled at
 /// `sample_rate_hz`, 1 MHz timestamps, a 16-bit x4 encoder counter with
 /// [`board::ENCODER_COUNTS_PER_REV`] counts per revolution, and sensor limits equal to the
-/// front end's full scale (a reading beyond it cannot be real).
-pub fn monitor_config(sample_rate_hz: u32) -> MonitorConfig {
+/// front end's full scale (a reading beyond it cannot be real). (The host's configuration
+/// for replaying a log is `sim_host::replay::monitor_config_for_log`.)
+pub fn board_monitor_config(sample_rate_hz: u32) -> MonitorConfig {
+    let supply = DEFAULT_MACHINE.supply;
     let mut cfg = MonitorConfig::new(
-        DEFAULT_MOTOR,
-        SUPPLY_HZ,
-        SUPPLY_V_LL_RMS,
+        default_motor(),
+        supply.f_hz as f32,
+        supply.v_ll_rms as f32,
         sample_rate_hz as f32,
     );
     cfg.tick_hz = TICK_HZ as f32;
@@ -95,7 +89,7 @@ pub struct SampleResult {
 #[derive(Clone, Debug)]
 pub struct SamplePath {
     monitor: Monitor,
-    builder: SampleBuilder,
+    sampler: AdcSampler,
     learning: Learning,
 }
 
@@ -122,7 +116,7 @@ impl SamplePath {
     ) -> Result<Self, AppError> {
         Ok(Self {
             monitor: Monitor::new(cfg).map_err(AppError::Config)?,
-            builder: SampleBuilder::new(front_end, sample_rate_hz).map_err(AppError::Sampling)?,
+            sampler: AdcSampler::new(front_end, sample_rate_hz).map_err(AppError::Sampling)?,
             learning: Learning::Idle,
         })
     }
@@ -133,7 +127,7 @@ impl SamplePath {
     /// As [`SamplePath::new`].
     pub fn for_board(sample_rate_hz: u32) -> Result<Self, AppError> {
         Self::new(
-            monitor_config(sample_rate_hz),
+            board_monitor_config(sample_rate_hz),
             FrontEnd::DEFAULT,
             sample_rate_hz,
         )
@@ -155,14 +149,14 @@ impl SamplePath {
         }
     }
 
-    /// The sample builder (for timestamp resynchronisation after lost samples).
-    pub fn sampler_mut(&mut self) -> &mut SampleBuilder {
-        &mut self.builder
+    /// The ADC sampler (for timestamp resynchronisation after lost samples).
+    pub fn sampler_mut(&mut self) -> &mut AdcSampler {
+        &mut self.sampler
     }
 
-    /// The sample builder.
-    pub fn sampler(&self) -> &SampleBuilder {
-        &self.builder
+    /// The ADC sampler.
+    pub fn sampler(&self) -> &AdcSampler {
+        &self.sampler
     }
 
     /// The core monitor.
@@ -173,17 +167,17 @@ impl SamplePath {
     /// Process one trigger's readings.
     #[inline]
     pub fn on_frame(&mut self, raw: &RawFrame) -> SampleResult {
-        let sample = self.builder.build(raw);
+        let sample = self.sampler.build(raw);
         let output = *self.monitor.update(&sample);
         let mut learned = None;
         let mut learning_failed = false;
-        let core_learning = matches!(output.commissioning, CoreCommissioning::Learning(_));
+        let core_learning = matches!(output.commissioning, CommissioningState::Learning(_));
         if self.learning == Learning::Requested && core_learning {
             self.learning = Learning::Running;
         } else if self.learning == Learning::Running && !core_learning {
             self.learning = Learning::Idle;
             match (output.commissioning, self.monitor.calibration()) {
-                (CoreCommissioning::Commissioned, Some(cal)) => learned = Some(cal.into()),
+                (CommissioningState::Commissioned, Some(cal)) => learned = Some(cal.into()),
                 _ => learning_failed = true,
             }
         }
@@ -195,50 +189,13 @@ impl SamplePath {
     }
 }
 
-/// Thread-mode side: commissioning and the panel.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Supervisor {
-    commissioning: Commissioning,
-}
-
-impl Supervisor {
-    /// A supervisor whose commissioning runs learn for `duration_s` seconds.
-    pub fn new(duration_s: f32) -> Self {
-        Self {
-            commissioning: Commissioning::new(duration_s),
-        }
-    }
-
-    /// The commissioning state machine.
-    pub fn commissioning(&self) -> &Commissioning {
-        &self.commissioning
-    }
-
-    /// Feed a commissioning event; returns what to do.
-    pub fn handle(&mut self, event: Event, now_ms: u32) -> Action {
-        self.commissioning.handle(event, now_ms)
-    }
-
-    /// Panel inputs for the latest core output.
-    pub fn panel_input(&self, out: &MonitorOutput) -> PanelInput {
-        let mode: Mode = self.commissioning.panel_mode();
-        PanelInput {
-            mode,
-            residual_lamps: out.lamps,
-            fault_detected: out.fault_detected,
-            input_invalid: out.sensor_fault.any() && !out.lamps.iter().any(|l| *l),
-            top_candidate: out.top().map(|(f, _)| f.index() as u8),
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn board_config_is_valid() {
-        assert!(monitor_config(board::DEFAULT_SAMPLE_RATE_HZ)
+        assert!(board_monitor_config(board::DEFAULT_SAMPLE_RATE_HZ)
             .validate()
             .is_ok());
         assert!(SamplePath::for_board(board::DEFAULT_SAMPLE_RATE_HZ).is_ok());

@@ -81,14 +81,15 @@ pub enum Action {
     Save(CalibrationRecord),
 }
 
-/// The commissioning state machine.
+/// The commissioning procedure: the button-learn-store state machine of thread mode (the
+/// core's `monitor_core::CommissioningState` says whether the monitor itself is learning).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Commissioning {
+pub struct CommissioningProcedure {
     state: State,
     duration_s: f32,
 }
 
-impl Commissioning {
+impl CommissioningProcedure {
     /// Default learning time, s: 10 s at 10 kHz = 100 000 samples of healthy running.
     pub const DEFAULT_DURATION_S: f32 = 10.0;
     /// Extra time allowed beyond the learning duration before giving up, ms.
@@ -194,7 +195,7 @@ mod tests {
 
     #[test]
     fn happy_path() {
-        let mut c = Commissioning::new(2.0);
+        let mut c = CommissioningProcedure::new(2.0);
         assert_eq!(c.handle(Event::RecordLoaded(false), 0), Action::None);
         assert_eq!(c.panel_mode(), Mode::NotCommissioned);
         assert_eq!(
@@ -213,7 +214,7 @@ mod tests {
 
     #[test]
     fn timeout_and_storage_failure() {
-        let mut c = Commissioning::new(1.0);
+        let mut c = CommissioningProcedure::new(1.0);
         c.handle(Event::ButtonPressed, u32::MAX - 100);
         c.handle(Event::Tick, 5000);
         assert!(matches!(c.state(), State::Learning { .. }));

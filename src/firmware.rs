@@ -34,11 +34,11 @@ use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 use embassy_time::{with_timeout, Duration, Instant, Ticker, Timer};
 
-use drive_monitor::app::{Command, SamplePath, Supervisor};
+use drive_monitor::app::{Command, SamplePath};
 use drive_monitor::board::{self, pins::Board, CurrentCode, VoltageCode};
-use drive_monitor::commissioning::{Action, Commissioning, Event};
+use drive_monitor::commissioning::{Action, CommissioningProcedure, Event};
 use drive_monitor::flash_record::{CalibrationRecord, RECORD_LEN};
-use drive_monitor::panel::{self, Lamp, Mode, PanelLamps};
+use drive_monitor::panel::{self, Lamp, Mode, PanelInput, PanelLamps};
 use drive_monitor::sampling::RawFrame;
 use monitor_core::{Fault, MonitorOutput};
 
@@ -330,14 +330,7 @@ fn clock_config() -> embassy_stm32::Config {
 async fn main(_spawner: Spawner) {
     let p = embassy_stm32::init(clock_config());
     info!("drive-monitor {} starting", env!("CARGO_PKG_VERSION"));
-
-    // Why did we reset? A watchdog reset means the previous run panicked or hung.
-    let csr = pac::RCC.csr().read();
-    let watchdog_reset = csr.iwdgrstf();
-    pac::RCC.csr().modify(|w| w.set_rmvf(true));
-    if watchdog_reset {
-        error!("previous run ended in a watchdog reset (panic or hang): see its log");
-    }
+    let watchdog_reset = previous_run_reset_by_watchdog();
 
     // Cycle counter for the per-sample cost shown in the log.
     if let Some(mut cp) = cortex_m::Peripherals::take() {
@@ -357,18 +350,9 @@ async fn main(_spawner: Spawner) {
         Ok(p) => p,
         Err(_) => panic!("monitor configuration rejected"),
     };
-    let mut sup = Supervisor::new(Commissioning::DEFAULT_DURATION_S);
-    let loaded = match load_record(&mut flash) {
-        Some(rec) => match path.command(Command::SetCalibration(rec)) {
-            Ok(()) => true,
-            Err(_) => {
-                warn!("stored calibration out of the core's range: ignored");
-                false
-            }
-        },
-        None => false,
-    };
-    sup.handle(Event::RecordLoaded(loaded), 0);
+    let mut procedure = CommissioningProcedure::new(CommissioningProcedure::DEFAULT_DURATION_S);
+    let loaded = install_stored_calibration(&mut flash, &mut path);
+    procedure.handle(Event::RecordLoaded(loaded), 0);
     info!("commissioned: {}", loaded);
 
     // High-priority executor for the sample path.
@@ -407,36 +391,18 @@ async fn main(_spawner: Spawner) {
             .is_ok();
         if pressed && now_ms.wrapping_sub(last_press_ms) > 300 {
             last_press_ms = now_ms;
-            info!("button: start commissioning");
-            if let Action::StartLearning { duration_s } = sup.handle(Event::ButtonPressed, now_ms) {
-                if COMMANDS
-                    .try_send(Command::StartCommissioning { duration_s })
-                    .is_err()
-                {
-                    warn!("command queue full");
-                }
-            }
+            start_commissioning(&mut procedure, now_ms);
         }
-
         while let Ok(ev) = LEARN.try_receive() {
-            let action = match ev {
-                LearnEvent::Done(rec) => sup.handle(Event::LearningDone(rec), now_ms),
-                LearnEvent::Failed => sup.handle(Event::LearningFailed, now_ms),
-            };
-            if let Action::Save(rec) = action {
-                wdg.pet();
-                let ok = store_record(&mut flash, &rec);
-                info!("commissioning record stored: {}", ok);
-                sup.handle(Event::SaveDone(ok), now_ms);
-            }
+            wdg.pet();
+            finish_learning(&mut procedure, &mut flash, ev, now_ms);
         }
-        sup.handle(Event::Tick, now_ms);
+        procedure.handle(Event::Tick, now_ms);
 
         if let Some(s) = STATUS.try_take() {
             last = s;
         }
-
-        let mut input = sup.panel_input(&last.output);
+        let mut input = PanelInput::from_output(procedure.panel_mode(), &last.output);
         if watchdog_reset && now_ms < 5_000 {
             input.mode = Mode::Failed;
         }
@@ -445,43 +411,107 @@ async fn main(_spawner: Spawner) {
         log_div += 1;
         if log_div >= 2 {
             log_div = 0;
-            let o = &last.output;
-            let top = o.top();
-            let (top_name, top_p) = match top {
-                Some((f, p)) => (f.name(), p),
-                None => ("none", 0.0),
-            };
-            let second = o
-                .diagnosis
-                .probabilities
-                .iter()
-                .zip(Fault::ALL)
-                .filter(|(_, f)| Some(*f) != top.map(|t| t.0))
-                .fold(None::<(Fault, f32)>, |best, (p, f)| match best {
-                    Some((_, bp)) if bp >= *p => best,
-                    _ if *p > 0.0 => Some((f, *p)),
-                    _ => best,
-                });
-            let (second_name, second_p) = second.map_or(("none", 0.0), |(f, p)| (f.name(), p));
-            info!(
-                "r={} lamps={} fault={=bool} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s mode={=str} overruns={=u32} samples={=u32} max_cyc={=u32}",
-                o.residuals,
-                o.lamps,
-                o.fault_detected,
-                top_name,
-                top_p,
-                second_name,
-                second_p,
-                o.speed_rad_s,
-                mode_name(sup.commissioning().panel_mode()),
-                OVERRUNS.load(Ordering::Relaxed),
-                last.samples,
-                last.max_update_cycles,
-            );
+            log_status(&last, procedure.panel_mode());
         }
-
         ticker.next().await;
     }
+}
+
+/// Whether the previous run ended in a watchdog reset (a panic or a hang); clears the
+/// reset flags.
+fn previous_run_reset_by_watchdog() -> bool {
+    let csr = pac::RCC.csr().read();
+    let watchdog_reset = csr.iwdgrstf();
+    pac::RCC.csr().modify(|w| w.set_rmvf(true));
+    if watchdog_reset {
+        error!("previous run ended in a watchdog reset (panic or hang): see its log");
+    }
+    watchdog_reset
+}
+
+/// Reads the commissioning record and gives it to the core; true when one was installed.
+fn install_stored_calibration(
+    flash: &mut Flash<'static, embassy_stm32::flash::Blocking>,
+    path: &mut SamplePath,
+) -> bool {
+    match load_record(flash) {
+        Some(rec) => match path.command(Command::SetCalibration(rec)) {
+            Ok(()) => true,
+            Err(_) => {
+                warn!("stored calibration out of the core's range: ignored");
+                false
+            }
+        },
+        None => false,
+    }
+}
+
+/// The button was pressed: starts learning unless the procedure is busy.
+fn start_commissioning(procedure: &mut CommissioningProcedure, now_ms: u32) {
+    info!("button: start commissioning");
+    if let Action::StartLearning { duration_s } = procedure.handle(Event::ButtonPressed, now_ms) {
+        if COMMANDS
+            .try_send(Command::StartCommissioning { duration_s })
+            .is_err()
+        {
+            warn!("command queue full");
+        }
+    }
+}
+
+/// The sample task finished learning: stores the record when the procedure asks for it.
+fn finish_learning(
+    procedure: &mut CommissioningProcedure,
+    flash: &mut Flash<'static, embassy_stm32::flash::Blocking>,
+    ev: LearnEvent,
+    now_ms: u32,
+) {
+    let action = match ev {
+        LearnEvent::Done(rec) => procedure.handle(Event::LearningDone(rec), now_ms),
+        LearnEvent::Failed => procedure.handle(Event::LearningFailed, now_ms),
+    };
+    if let Action::Save(rec) = action {
+        let ok = store_record(flash, &rec);
+        info!("commissioning record stored: {}", ok);
+        procedure.handle(Event::SaveDone(ok), now_ms);
+    }
+}
+
+/// The defmt status line: residuals, lamps, the two top candidates, speed, mode, counters.
+fn log_status(last: &Status, mode: Mode) {
+    let o = &last.output;
+    let top = o.top();
+    let (top_name, top_p) = match top {
+        Some((f, p)) => (f.name(), p),
+        None => ("none", 0.0),
+    };
+    let second = o
+        .diagnosis
+        .probabilities
+        .iter()
+        .zip(Fault::ALL)
+        .filter(|(_, f)| Some(*f) != top.map(|t| t.0))
+        .fold(None::<(Fault, f32)>, |best, (p, f)| match best {
+            Some((_, bp)) if bp >= *p => best,
+            _ if *p > 0.0 => Some((f, *p)),
+            _ => best,
+        });
+    let (second_name, second_p) = second.map_or(("none", 0.0), |(f, p)| (f.name(), p));
+    info!(
+        "r={} lamps={} fault={=bool} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s mode={=str} overruns={=u32} samples={=u32} max_cyc={=u32}",
+        o.residuals,
+        o.lamps,
+        o.fault_detected,
+        top_name,
+        top_p,
+        second_name,
+        second_p,
+        o.speed_rad_s,
+        mode_name(mode),
+        OVERRUNS.load(Ordering::Relaxed),
+        last.samples,
+        last.max_update_cycles,
+    );
 }
 
 /// Panic: put the panel into the "monitor failed" pattern (RUN off, all others on), log

@@ -11,7 +11,7 @@
 //! - [`app`]: the glue that runs the core per sample and turns its output into lamps.
 //!
 //! The hardware tasks (ADC/DMA, encoder, flash, watchdog, panic handler) are in
-//! `src/main.rs` and only exist for `target_os = "none"`.
+//! `src/firmware.rs` (included by `src/main.rs`) and only exist for `target_os = "none"`.
 #![cfg_attr(target_os = "none", no_std)]
 
 pub mod app;

@@ -121,6 +121,21 @@ pub struct PanelInput {
     pub top_candidate: Option<u8>,
 }
 
+impl PanelInput {
+    /// The panel's inputs for the latest core output in `mode`: the residual lamps, the
+    /// fault lamp, "input invalid" when a sensor fault is flagged with no residual lamp
+    /// lit, and the top candidate's blink code.
+    pub fn from_output(mode: Mode, out: &monitor_core::MonitorOutput) -> Self {
+        PanelInput {
+            mode,
+            residual_lamps: out.lamps,
+            fault_detected: out.fault_detected,
+            input_invalid: out.sensor_fault.any() && !out.lamps.iter().any(|l| *l),
+            top_candidate: out.top().map(|(f, _)| f.index() as u8),
+        }
+    }
+}
+
 /// Blink code of a candidate index: `index + 1` (1..=9).
 pub const fn blink_code(candidate_index: u8) -> u8 {
     candidate_index.saturating_add(1)

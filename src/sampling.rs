@@ -1,14 +1,14 @@
 //! One trigger's ADC codes and encoder count -> the core's [`Sample`].
 //!
 //! The ADCs deliver, per trigger, three voltage codes (ADC1) and three current codes
-//! (ADC2); the encoder timer delivers its 16-bit counter. [`SampleBuilder`] scales the
+//! (ADC2); the encoder timer delivers its 16-bit counter. [`AdcSampler`] scales the
 //! codes with the board's [`FrontEnd`], flags rail codes as saturated, passes the raw
 //! counter on (the core unwraps it, `EncoderConfig::counter_bits = 16`) and stamps the
 //! sample with a free-running timestamp in ticks of [`TICK_HZ`].
 //!
 //! Timestamps: samples are taken by a hardware timer at an exact rate, so the timestamp of
 //! sample `n` is `n * ticks_per_sample` (wrapping `u32`). When samples were lost (a DMA
-//! overrun), the firmware calls [`SampleBuilder::resync`] with the current time so the gap
+//! overrun), the firmware calls [`AdcSampler::resync`] with the current time so the gap
 //! shows up in the timestamps instead of silently compressing time.
 
 use crate::board::{is_saturated_code, CurrentCode, FrontEnd, VoltageCode};
@@ -37,15 +37,17 @@ pub enum SamplingError {
     Rate,
 }
 
-/// Converts [`RawFrame`]s to [`Sample`]s. No panics, no allocation.
+/// Converts [`RawFrame`]s (ADC codes and the encoder counter) to [`Sample`]s: the
+/// firmware's sampler (the host's counterpart for log rows is `sim_host::replay::LogSampler`).
+/// No panics, no allocation.
 #[derive(Clone, Copy, Debug)]
-pub struct SampleBuilder {
+pub struct AdcSampler {
     front_end: FrontEnd,
     ticks_per_sample: u32,
     next_ticks: u32,
 }
 
-impl SampleBuilder {
+impl AdcSampler {
     /// A builder for `sample_rate_hz` (must divide [`TICK_HZ`], 1..=100 000 Hz).
     ///
     /// # Errors
@@ -69,21 +71,9 @@ impl SampleBuilder {
         self.ticks_per_sample
     }
 
-    /// Timestamp the next sample will get.
-    pub fn next_timestamp(&self) -> u32 {
-        self.next_ticks
-    }
-
     /// Continue the timestamps from `now_ticks` (after lost samples).
     pub fn resync(&mut self, now_ticks: u32) {
         self.next_ticks = now_ticks;
-    }
-
-    /// Skip `n` sample periods (samples known to be lost).
-    pub fn skip(&mut self, n: u32) {
-        self.next_ticks = self
-            .next_ticks
-            .wrapping_add(n.wrapping_mul(self.ticks_per_sample));
     }
 
     /// Scale one frame and stamp it.
@@ -141,17 +131,17 @@ mod tests {
 
     #[test]
     fn rate_must_divide_tick() {
-        assert!(SampleBuilder::new(FrontEnd::DEFAULT, 10_000).is_ok());
+        assert!(AdcSampler::new(FrontEnd::DEFAULT, 10_000).is_ok());
         assert_eq!(
-            SampleBuilder::new(FrontEnd::DEFAULT, 7_000).err(),
+            AdcSampler::new(FrontEnd::DEFAULT, 7_000).err(),
             Some(SamplingError::Rate)
         );
-        assert!(SampleBuilder::new(FrontEnd::DEFAULT, 0).is_err());
+        assert!(AdcSampler::new(FrontEnd::DEFAULT, 0).is_err());
     }
 
     #[test]
     fn timestamps_and_saturation() {
-        let mut b = SampleBuilder::new(FrontEnd::DEFAULT, 10_000).unwrap();
+        let mut b = AdcSampler::new(FrontEnd::DEFAULT, 10_000).unwrap();
         b.resync(u32::MAX - 50);
         let raw = b.quantize(
             Abc {

@@ -16,9 +16,10 @@
 #[allow(dead_code, missing_docs)]
 mod scenario;
 
+use monitor_core::Fault;
 use monitor_core::Monitor;
 use sim_host::params::ParamFile;
-use sim_host::sim::{simulate, FaultKind, FaultSpec, LoadKind, LoadSpec, Scenario};
+use sim_host::sim::{simulate, FaultSpec, LoadKind, LoadSpec, Scenario};
 use std::path::PathBuf;
 
 const START_S: f64 = 2.0;
@@ -35,7 +36,7 @@ fn generate() -> (Vec<u8>, Vec<u8>) {
         steps: vec![],
     };
     sc.faults
-        .push(FaultSpec::parametric(FaultKind::Rr, START_S + 0.3, 0.5));
+        .push(FaultSpec::parametric(Fault::Rr, START_S + 0.3, 0.5));
     let mut replay = Vec::with_capacity(scenario::REPLAY_HEADER + SAMPLES * scenario::SAMPLE_BYTES);
     replay.extend_from_slice(b"RPL1");
     replay.extend_from_slice(&(SAMPLES as u32).to_le_bytes());

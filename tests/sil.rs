@@ -6,16 +6,17 @@
 //! 0-1.5 s run-up; button at 1.5 s -> 1 s of learning -> record "written" to a fake flash
 //! page; 4.0 s: Rs +50 %; 6.5 s end.
 
-use drive_monitor::app::{Command, SamplePath, Supervisor};
+use drive_monitor::app::{Command, SamplePath};
 use drive_monitor::board::{self, RECORD_PAGE_SIZE};
-use drive_monitor::commissioning::{Action, Event, State};
+use drive_monitor::commissioning::{Action, CommissioningProcedure, Event, State};
 use drive_monitor::flash_record::{CalibrationRecord, RECORD_LEN};
-use drive_monitor::panel::{self, Lamp, Mode, PanelLamps};
+use drive_monitor::panel::{self, Lamp, Mode, PanelInput, PanelLamps};
 use drive_monitor::sampling::RawFrame;
+use monitor_core::Fault;
 use monitor_core::{Abc, MonitorOutput};
 use sim_host::params::ParamFile;
 use sim_host::sim::simulate_to_vec;
-use sim_host::sim::{FaultKind, FaultSpec, Scenario};
+use sim_host::sim::{FaultSpec, Scenario};
 
 const FS: u32 = board::DEFAULT_SAMPLE_RATE_HZ;
 const PANEL_EVERY: usize = 500; // 50 ms at 10 kHz, as in the firmware
@@ -24,7 +25,7 @@ const PANEL_EVERY: usize = 500; // 50 ms at 10 kHz, as in the firmware
 /// commissioning, a fake flash page.
 struct Rig {
     path: SamplePath,
-    sup: Supervisor,
+    procedure: CommissioningProcedure,
     flash: [u8; RECORD_PAGE_SIZE as usize],
     last: MonitorOutput,
     panel: PanelLamps,
@@ -34,15 +35,15 @@ struct Rig {
 impl Rig {
     fn boot(flash: [u8; RECORD_PAGE_SIZE as usize]) -> Self {
         let mut path = SamplePath::for_board(FS).unwrap();
-        let mut sup = Supervisor::new(1.0);
+        let mut procedure = CommissioningProcedure::new(1.0);
         let loaded = match CalibrationRecord::decode(&flash) {
             Ok(rec) => path.command(Command::SetCalibration(rec)).is_ok(),
             Err(_) => false,
         };
-        sup.handle(Event::RecordLoaded(loaded), 0);
+        procedure.handle(Event::RecordLoaded(loaded), 0);
         Rig {
             path,
-            sup,
+            procedure,
             flash,
             last: MonitorOutput::default(),
             panel: PanelLamps::default(),
@@ -51,7 +52,8 @@ impl Rig {
     }
 
     fn press(&mut self, now_ms: u32) {
-        if let Action::StartLearning { duration_s } = self.sup.handle(Event::ButtonPressed, now_ms)
+        if let Action::StartLearning { duration_s } =
+            self.procedure.handle(Event::ButtonPressed, now_ms)
         {
             self.path
                 .command(Command::StartCommissioning { duration_s })
@@ -69,17 +71,20 @@ impl Rig {
             _ => None,
         };
         if let Some(ev) = ev {
-            if let Action::Save(rec) = self.sup.handle(ev, now_ms) {
+            if let Action::Save(rec) = self.procedure.handle(ev, now_ms) {
                 let bytes = rec.encode().unwrap();
                 self.flash = [0xFF; RECORD_PAGE_SIZE as usize];
                 self.flash[..RECORD_LEN].copy_from_slice(&bytes);
                 let ok = CalibrationRecord::decode(&self.flash) == Ok(rec);
-                self.sup.handle(Event::SaveDone(ok), now_ms);
+                self.procedure.handle(Event::SaveDone(ok), now_ms);
             }
         }
         if k.is_multiple_of(PANEL_EVERY) {
-            self.sup.handle(Event::Tick, now_ms);
-            self.panel = panel::render(&self.sup.panel_input(&self.last), now_ms);
+            self.procedure.handle(Event::Tick, now_ms);
+            self.panel = panel::render(
+                &PanelInput::from_output(self.procedure.panel_mode(), &self.last),
+                now_ms,
+            );
             self.fault_trace.push(self.panel.is_on(Lamp::Fault));
         }
     }
@@ -126,12 +131,12 @@ fn commission_then_detect_rs_fault_on_the_panel() {
     let mut scenario = Scenario::steady(6.5, f64::from(FS));
     scenario
         .faults
-        .push(FaultSpec::parametric(FaultKind::Rs, 4.0, 0.5));
+        .push(FaultSpec::parametric(Fault::Rs, 4.0, 0.5));
     let frames = frames(&scenario);
     assert!(frames.len() >= 64_000, "{} samples", frames.len());
 
     let mut rig = Rig::boot([0xFF; RECORD_PAGE_SIZE as usize]);
-    assert_eq!(rig.sup.commissioning().panel_mode(), Mode::NotCommissioned);
+    assert_eq!(rig.procedure.panel_mode(), Mode::NotCommissioned);
     let mut before_fault = None;
     for (k, raw) in frames.iter().enumerate() {
         if k == 15_000 {
@@ -139,7 +144,7 @@ fn commission_then_detect_rs_fault_on_the_panel() {
         }
         rig.step(raw, k);
         if k == 39_500 {
-            before_fault = Some((rig.last, rig.panel, rig.sup.commissioning().state()));
+            before_fault = Some((rig.last, rig.panel, rig.procedure.state()));
         }
     }
 
@@ -160,7 +165,7 @@ fn commission_then_detect_rs_fault_on_the_panel() {
     let out = rig.last;
     assert!(out.fault_detected, "Rs +50 % not detected: {out:?}");
     assert!(out.lamps.iter().any(|l| *l));
-    let input = rig.sup.panel_input(&out);
+    let input = PanelInput::from_output(rig.procedure.panel_mode(), &out);
     let now = panel::render(&input, 0);
     for (k, l) in [Lamp::R1, Lamp::R2, Lamp::R3, Lamp::R4]
         .into_iter()
@@ -179,7 +184,7 @@ fn commission_then_detect_rs_fault_on_the_panel() {
 
     // The stored record brings the next boot up commissioned.
     let rig2 = Rig::boot(rig.flash);
-    assert_eq!(rig2.sup.commissioning().state(), State::Commissioned);
+    assert_eq!(rig2.procedure.state(), State::Commissioned);
 }
 
 #[test]
@@ -203,8 +208,14 @@ fn saturated_adc_lights_the_fault_lamp_steadily() {
         rig.step(&q.quantize(v, i, 0), k);
     }
     assert!(rig.last.sensor_fault.current);
-    let p = panel::render(&rig.sup.panel_input(&rig.last), 0);
+    let p = panel::render(
+        &PanelInput::from_output(rig.procedure.panel_mode(), &rig.last),
+        0,
+    );
     assert!(p.is_on(Lamp::Fault));
-    let p2 = panel::render(&rig.sup.panel_input(&rig.last), 777);
+    let p2 = panel::render(
+        &PanelInput::from_output(rig.procedure.panel_mode(), &rig.last),
+        777,
+    );
     assert!(p2.is_on(Lamp::Fault), "steady, not blinking");
 }

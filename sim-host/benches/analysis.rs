@@ -12,7 +12,7 @@
 use sim_host::analysis::{prep::ReadOptions, Analysis, Options};
 use sim_host::log::{Channels, LogWriter};
 use sim_host::params::ParamFile;
-use sim_host::sim::{self, Effect, Scenario, SensorSpec};
+use sim_host::sim::{self, EffectSpec, Scenario, SensorSpec};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -61,7 +61,7 @@ fn main() {
     if !path.exists() {
         let mut s = Scenario::steady(secs, 10_000.0);
         s.sensors = SensorSpec::default();
-        s.effects = vec![Effect::ThermalDrift {
+        s.effects = vec![EffectSpec::ThermalDrift {
             rise_k: Some(60.0),
             tau_s: 1200.0_f64.min(secs / 3.0),
             at_s: 0.0,

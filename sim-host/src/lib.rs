@@ -1,14 +1,50 @@
-//! Host harness for the drive monitor: the induction-motor simulator with fault and effect
-//! injection ([`sim`]), measurement logs ([`log`]), the parameter file ([`params`]), replay of
-//! logs through the no_std core ([`replay`]) and the model-vs-measurement workflow
-//! ([`analysis`]).
+//! Host harness for the drive monitor (the library; the command line is `src/main.rs` and
+//! `src/cli/`).
+//!
+//! - [`sim`]: the induction-motor simulator with fault and effect injection;
+//! - [`log`]: measurement logs (the one reader and writer, the sample-rate estimate);
+//! - [`params`]: the parameter file;
+//! - [`replay`]: logs through the no_std core (`diagnose`);
+//! - [`fault_signatures`]: the paper's Table 1 end to end (`table1`);
+//! - [`service_profile`]: the healthy service profile of the false-alarm and
+//!   detection-limit studies;
+//! - [`demo`]: the main job (`demo`);
+//! - [`analysis`]: the model-vs-measurement workflow (`compare`, `explain`);
+//! - [`bench`]: the simulator and core figures of `bench`.
+//!
+//! The vocabulary (faults, effect names, phases, motor parameters, reference machines)
+//! is the core's (`monitor_core`), shared with the firmware. Functions return values and
+//! `thiserror` errors; rendering (text, JSON, HTML, plots) is the binary's.
 
 pub mod analysis;
-pub mod commands;
+pub mod bench;
+pub mod demo;
+pub mod fault_signatures;
 pub mod log;
 pub mod params;
-pub mod progress;
 pub mod replay;
-pub mod service;
+pub mod service_profile;
 pub mod sim;
-pub mod table1;
+
+/// Errors of the runs that simulate a motor and replay it through the core (Table 1, the
+/// service profile, the demo, the benchmarks).
+#[derive(Debug, thiserror::Error)]
+pub enum ExperimentError {
+    /// The simulator refused the scenario or diverged.
+    #[error(transparent)]
+    Sim(#[from] sim::SimError),
+    /// The core refused the replay's configuration.
+    #[error(transparent)]
+    Replay(#[from] replay::ReplayError),
+    /// Writing a file failed.
+    #[error(transparent)]
+    Log(#[from] log::LogError),
+    /// Creating a temporary folder failed.
+    #[error("cannot create a temporary folder: {0}")]
+    Io(#[from] std::io::Error),
+}
+
+/// Folds a multi-line message onto one line (CLI errors are one line).
+pub fn one_line(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}

@@ -1,41 +1,17 @@
 //! `sim-host`: the drive monitor's host tool. See `sim-host --help`.
+//!
+//! The binary owns the command line and the rendering (`cli`): clap parses the arguments,
+//! each command turns them into the library's domain types at once, calls the library
+//! (`sim_host`), and renders the result as text, JSON or HTML/plots (`cli::render`).
+//! Errors reach `main` as one `anyhow` chain and leave as one line on stderr, exit code 2.
 
-use clap::{Parser, Subcommand};
-use sim_host::commands::{bench, compare, demo, diagnose, explain, simulate, table1};
+mod cli;
+
+use clap::Parser;
 use std::process::ExitCode;
 
-#[derive(Parser)]
-#[command(
-    name = "sim-host",
-    version,
-    about = "Induction-motor drive monitor, host side: simulator, log replay through the core, model-vs-measurement",
-    long_about = "The host side of the drive monitor. It simulates 3-phase induction motors with \
-faults and physical effects, replays measurement logs through exactly the core code the firmware runs \
-(Clarke/Park, synchronous angle, M/T encoder speed, parity-equation residuals of the paper's simplified \
-D-Q model, fault signature matching), and compares the model with measurements to show where it fails \
-and which physical effect is missing.\n\nStart with:\n  sim-host demo\n  sim-host table1\n  \
-sim-host simulate --params P.toml --scenario S.toml --out D.csv\n  sim-host diagnose --params P.toml \
-D.csv --commission 2:4\n  sim-host compare --params P.toml D.csv\n  sim-host explain --params P.toml \
-D.csv\n\nEvery command takes --json (one JSON document on stdout; progress and logs on stderr)."
-)]
-struct Cli {
-    #[command(subcommand)]
-    cmd: Cmd,
-}
-
-#[derive(Subcommand)]
-enum Cmd {
-    Demo(demo::DemoArgs),
-    Simulate(simulate::SimulateArgs),
-    Diagnose(diagnose::DiagnoseArgs),
-    Table1(table1::Table1Args),
-    Compare(compare::CompareArgs),
-    Explain(explain::ExplainArgs),
-    Bench(bench::BenchArgs),
-}
-
 fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let args = match cli::Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {
             use clap::error::ErrorKind;
@@ -57,23 +33,10 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let r = match &cli.cmd {
-        Cmd::Demo(a) => demo::run(a),
-        Cmd::Simulate(a) => simulate::run(a),
-        Cmd::Diagnose(a) => diagnose::run(a),
-        Cmd::Table1(a) => table1::run(a),
-        Cmd::Compare(a) => compare::run(a),
-        Cmd::Explain(a) => explain::run(a),
-        Cmd::Bench(a) => bench::run(a),
-    };
-    match r {
+    match cli::run(args.cmd) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            let msg = format!("{e:#}");
-            eprintln!(
-                "error: {}",
-                msg.split_whitespace().collect::<Vec<_>>().join(" ")
-            );
+            eprintln!("error: {}", sim_host::one_line(&format!("{e:#}")));
             ExitCode::from(2)
         }
     }

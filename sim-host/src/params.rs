@@ -16,7 +16,14 @@
 //! f_hz = 60.0      # supply frequency [Hz]
 //! ```
 //! Unknown keys are an error (a typo must not pass silently) and a missing key is named.
+//!
+//! The sections are the core's [`MotorParameters`] and [`SupplyParameters`] (one type for
+//! the firmware, the simulator and the analysis); this module only reads and checks the
+//! file. What each part needs is derived from them in one place:
+//! [`MotorParameters::model`] (the core and the analysis), the simulator's machine
+//! (`crate::sim`) and the analysis's constants (`crate::analysis::simplified_model::MachineConstants`).
 
+use monitor_core::{MotorParameters, ReferenceMachine, SupplyParameters};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -40,47 +47,13 @@ pub enum ParamError {
         message: String,
     },
     /// A value is outside its physical range.
-    #[error("bad parameter file {path}: {message}")]
+    #[error("bad parameter file {path}: {source}")]
     Range {
         /// The file.
         path: String,
-        /// Which value and why.
-        message: String,
+        /// Which key and what it must satisfy.
+        source: monitor_core::ConfigError,
     },
-}
-
-/// Nominal T-equivalent motor parameters, per phase, referred to the stator.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MotorParams {
-    /// Stator resistance Rs [ohm], > 0.
-    pub rs_ohm: f64,
-    /// Rotor resistance Rr referred to the stator [ohm], > 0.
-    pub rr_ohm: f64,
-    /// Stator self inductance Ls = Lls + Lm [H], >= Lm.
-    pub ls_h: f64,
-    /// Rotor self inductance Lr = Llr + Lm [H], >= Lm.
-    pub lr_h: f64,
-    /// Magnetising inductance Lm [H], > 0, with Lm^2 < Ls Lr.
-    pub lm_h: f64,
-    /// Number of poles (even, >= 2). Pole pairs Np = poles / 2.
-    pub poles: u32,
-    /// Inertia J of rotor and load [kg m^2], > 0.
-    pub j_kgm2: f64,
-    /// Viscous friction B of the machine, on the shaft [N m s/rad], >= 0.
-    pub b_nms: f64,
-    /// Viscous load coefficient Bl, on the shaft [N m s/rad], >= 0 (the paper's load model).
-    pub bl_nms: f64,
-}
-
-/// The supply the motor is connected to.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SupplyParams {
-    /// Line-to-line RMS voltage [V], > 0.
-    pub v_ll_rms: f64,
-    /// Frequency [Hz], > 0.
-    pub f_hz: f64,
 }
 
 /// A whole parameter file: `[motor]` and `[supply]`.
@@ -88,95 +61,33 @@ pub struct SupplyParams {
 #[serde(deny_unknown_fields)]
 pub struct ParamFile {
     /// Nominal machine parameters.
-    pub motor: MotorParams,
+    pub motor: MotorParameters,
     /// Nominal supply.
-    pub supply: SupplyParams,
-}
-
-impl MotorParams {
-    /// Pole pairs Np = poles / 2.
-    pub fn pole_pairs(&self) -> f64 {
-        f64::from(self.poles / 2)
-    }
-    /// Leakage coefficient sigma = 1 - Lm^2 / (Ls Lr).
-    pub fn sigma(&self) -> f64 {
-        1.0 - self.lm_h * self.lm_h / (self.ls_h * self.lr_h)
-    }
-    /// Stator leakage inductance Lls = Ls - Lm [H] (zero for a Gamma-model machine).
-    pub fn lls_h(&self) -> f64 {
-        self.ls_h - self.lm_h
-    }
-    /// Rotor leakage inductance Llr = Lr - Lm [H].
-    pub fn llr_h(&self) -> f64 {
-        self.lr_h - self.lm_h
-    }
-    /// Checks physical ranges; the message names the offending key.
-    pub fn check(&self) -> Result<(), String> {
-        let pos = [
-            ("rs_ohm", self.rs_ohm),
-            ("rr_ohm", self.rr_ohm),
-            ("ls_h", self.ls_h),
-            ("lr_h", self.lr_h),
-            ("lm_h", self.lm_h),
-            ("j_kgm2", self.j_kgm2),
-        ];
-        for (k, v) in pos {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(format!("motor.{k} must be a positive number, got {v}"));
-            }
-        }
-        for (k, v) in [("b_nms", self.b_nms), ("bl_nms", self.bl_nms)] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(format!("motor.{k} must be >= 0, got {v}"));
-            }
-        }
-        if self.poles < 2 || !self.poles.is_multiple_of(2) {
-            return Err(format!(
-                "motor.poles must be even and >= 2, got {}",
-                self.poles
-            ));
-        }
-        if self.ls_h < self.lm_h || self.lr_h < self.lm_h {
-            return Err(
-                "motor.ls_h and motor.lr_h must be >= motor.lm_h (self = leakage + magnetising)"
-                    .into(),
-            );
-        }
-        if self.lm_h * self.lm_h >= self.ls_h * self.lr_h {
-            return Err(
-                "Lm^2 must be < Ls*Lr (sigma > 0): give at least one leakage inductance".into(),
-            );
-        }
-        Ok(())
-    }
-}
-
-impl SupplyParams {
-    /// Peak phase-to-neutral voltage sqrt(2/3) * V_ll,rms [V].
-    pub fn v_phase_peak(&self) -> f64 {
-        self.v_ll_rms * (2.0f64 / 3.0).sqrt()
-    }
-    /// Angular frequency 2 pi f [rad/s].
-    pub fn omega_rad_s(&self) -> f64 {
-        2.0 * std::f64::consts::PI * self.f_hz
-    }
+    pub supply: SupplyParameters,
 }
 
 impl ParamFile {
     /// Parses TOML text; `origin` names the source in messages.
+    ///
+    /// # Errors
+    /// [`ParamError::Toml`] for malformed TOML or an unknown or missing key,
+    /// [`ParamError::Range`] for a value out of range; both name the key.
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Self, ParamError> {
         let p: ParamFile = toml::from_str(text).map_err(|e| ParamError::Toml {
             path: origin.to_string(),
-            message: one_line(e.message()),
+            message: crate::one_line(e.message()),
         })?;
-        p.check().map_err(|message| ParamError::Range {
+        p.check().map_err(|source| ParamError::Range {
             path: origin.to_string(),
-            message,
+            source,
         })?;
         Ok(p)
     }
 
     /// Reads and checks a parameter file.
+    ///
+    /// # Errors
+    /// [`ParamError::Io`] when unreadable, else as [`ParamFile::from_toml_str`].
     pub fn load(path: &Path) -> Result<Self, ParamError> {
         let text = std::fs::read_to_string(path).map_err(|source| ParamError::Io {
             path: path.display().to_string(),
@@ -186,107 +97,75 @@ impl ParamFile {
     }
 
     /// Checks ranges of both sections.
-    pub fn check(&self) -> Result<(), String> {
-        self.motor.check()?;
-        for (k, v) in [
-            ("v_ll_rms", self.supply.v_ll_rms),
-            ("f_hz", self.supply.f_hz),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(format!("supply.{k} must be a positive number, got {v}"));
-            }
-        }
-        Ok(())
+    ///
+    /// # Errors
+    /// The first value out of range, naming its key (`motor.rs_ohm`, `supply.f_hz`, ...).
+    pub fn check(&self) -> Result<(), monitor_core::ConfigError> {
+        self.motor.validate()?;
+        self.supply.validate()
     }
 
-    /// Serialises to TOML text.
+    /// Serialises to TOML text (the file format above).
     pub fn to_toml_string(&self) -> String {
         toml::to_string_pretty(self).unwrap_or_default()
     }
 
-    /// DESIGN.md reference "2.2 kW" machine: 400 V, 50 Hz, 4 poles, Gamma model
-    /// (no stator leakage). `bl_nms` is chosen so that Bl*omega gives the rated 14.6 N m at
-    /// about 1430 rpm (149.7 rad/s): 14.6 / 149.7 = 0.0975 N m s/rad.
+    /// The parameter file of a reference machine ([`monitor_core::reference`]).
+    pub fn from_reference(m: &ReferenceMachine) -> Self {
+        ParamFile {
+            motor: m.motor,
+            supply: m.supply,
+        }
+    }
+
+    /// DESIGN.md's "2.2 kW" machine ([`monitor_core::reference::MOTOR_2P2KW`]).
     pub fn reference_2p2kw() -> Self {
-        ParamFile {
-            motor: MotorParams {
-                rs_ohm: 3.7,
-                rr_ohm: 2.5,
-                ls_h: 0.245,
-                lr_h: 0.268,
-                lm_h: 0.245,
-                poles: 4,
-                j_kgm2: 0.015,
-                b_nms: 0.005,
-                bl_nms: 0.0975,
-            },
-            supply: SupplyParams {
-                v_ll_rms: 400.0,
-                f_hz: 50.0,
-            },
-        }
+        Self::from_reference(&monitor_core::reference::MOTOR_2P2KW)
     }
 
-    /// DESIGN.md reference "3 hp" textbook machine: 220 V, 60 Hz, 4 poles,
-    /// Xls = Xlr = 0.754 ohm and Xm = 26.13 ohm at 60 Hz, so Lls = Llr = 0.754/(2 pi 60)
-    /// = 2.0 mH and Lm = 26.13/(2 pi 60) = 69.3 mH; B and Bl as in DESIGN.md's example file.
+    /// DESIGN.md's "3 hp" textbook machine ([`monitor_core::reference::MOTOR_3HP`]).
     pub fn reference_3hp() -> Self {
-        let w = 2.0 * std::f64::consts::PI * 60.0;
-        let lm = 26.13 / w;
-        let ll = 0.754 / w;
-        ParamFile {
-            motor: MotorParams {
-                rs_ohm: 0.435,
-                rr_ohm: 0.816,
-                ls_h: lm + ll,
-                lr_h: lm + ll,
-                lm_h: lm,
-                poles: 4,
-                j_kgm2: 0.089,
-                b_nms: 0.002,
-                bl_nms: 0.045,
-            },
-            supply: SupplyParams {
-                v_ll_rms: 220.0,
-                f_hz: 60.0,
-            },
-        }
+        Self::from_reference(&monitor_core::reference::MOTOR_3HP)
     }
-}
-
-/// Folds a multi-line message onto one line.
-pub fn one_line(s: &str) -> String {
-    s.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    const DESIGN_EXAMPLE: &str = "[motor]\nrs_ohm = 0.435\nrr_ohm = 0.816\nls_h = 0.0713\nlr_h = 0.0713\nlm_h = 0.0693\npoles = 4\nj_kgm2 = 0.089\nb_nms = 0.002\nbl_nms = 0.045\n[supply]\nv_ll_rms = 220.0\nf_hz = 60.0\n";
+
     #[test]
     fn design_example_parses() {
-        let text = "[motor]\nrs_ohm = 0.435\nrr_ohm = 0.816\nls_h = 0.0713\nlr_h = 0.0713\nlm_h = 0.0693\npoles = 4\nj_kgm2 = 0.089\nb_nms = 0.002\nbl_nms = 0.045\n[supply]\nv_ll_rms = 220.0\nf_hz = 60.0\n";
-        let p = ParamFile::from_toml_str(text, "x").unwrap();
+        let p = ParamFile::from_toml_str(DESIGN_EXAMPLE, "x").unwrap();
         assert_eq!(p.motor.poles, 4);
         assert!((p.supply.v_phase_peak() - 179.63).abs() < 0.01);
     }
 
     #[test]
-    fn unknown_and_missing_keys_are_named() {
-        let bad = "[motor]\nrs_ohm = 0.435\nrr_ohm = 0.816\nls_h = 0.0713\nlr_h = 0.0713\nlm_h = 0.0693\npoles = 4\nj_kgm2 = 0.089\nb_nms = 0.002\nbl_nms = 0.045\nrs_ohms = 1.0\n[supply]\nv_ll_rms = 220.0\nf_hz = 60.0\n";
-        let e = ParamFile::from_toml_str(bad, "x").unwrap_err().to_string();
+    fn unknown_missing_and_bad_keys_are_named() {
+        let bad = DESIGN_EXAMPLE.replace("bl_nms = 0.045\n", "bl_nms = 0.045\nrs_ohms = 1.0\n");
+        let e = ParamFile::from_toml_str(&bad, "x").unwrap_err().to_string();
         assert!(e.contains("rs_ohms"), "{e}");
-        let missing = "[motor]\nrs_ohm = 0.435\nrr_ohm = 0.816\nls_h = 0.0713\nlr_h = 0.0713\nlm_h = 0.0693\npoles = 4\nj_kgm2 = 0.089\nb_nms = 0.002\n[supply]\nv_ll_rms = 220.0\nf_hz = 60.0\n";
-        let e = ParamFile::from_toml_str(missing, "x")
+        let missing = DESIGN_EXAMPLE.replace("bl_nms = 0.045\n", "");
+        let e = ParamFile::from_toml_str(&missing, "x")
             .unwrap_err()
             .to_string();
         assert!(e.contains("bl_nms"), "{e}");
         assert!(!e.contains('\n'));
+        let negative = DESIGN_EXAMPLE.replace("rr_ohm = 0.816", "rr_ohm = -0.816");
+        let e = ParamFile::from_toml_str(&negative, "x")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("motor.rr_ohm must be positive"), "{e}");
     }
 
     #[test]
-    fn reference_motors_are_valid() {
-        ParamFile::reference_2p2kw().check().unwrap();
-        ParamFile::reference_3hp().check().unwrap();
+    fn reference_motors_are_valid_and_round_trip() {
+        for p in [ParamFile::reference_2p2kw(), ParamFile::reference_3hp()] {
+            p.check().unwrap();
+            let back = ParamFile::from_toml_str(&p.to_toml_string(), "x").unwrap();
+            assert_eq!(back, p);
+        }
     }
 }

@@ -1,55 +1,52 @@
 //! Replay of a measurement log through the no_std core: exactly the code the firmware
-//! runs ([`monitor_core::Monitor`]), fed row by row.
+//! runs ([`monitor_core::Monitor`]), fed row by row; what `sim-host diagnose` runs
+//! ([`diagnose_file`]).
 //!
-//! The host converts each CSV row into a core [`Sample`]: voltages and currents as f32,
+//! The host converts each CSV row into a core [`Sample`] ([`LogSampler`], the host's
+//! counterpart of the firmware's ADC sampler): voltages and currents as f32,
 //! the encoder count (from `enc_count`, or synthesised by integrating `wm_rad_s` on a
 //! 4096-count disc when the log has only a speed column), and a 1 MHz timestamp.
 //! Logs without voltages or without speed cannot feed the residuals (every residual of
 //! eq. 37 needs Vqs or omega_r); for those only the negative-sequence analysis runs, on an
 //! angle from an SRF-PLL locked to the currents, and the report says what was skipped and
-//! why.
+//! why. The faulty phase is named by the core's one method
+//! ([`monitor_core::sequence::suspect_phase`]), with the slip estimated from the current
+//! magnitude where the log has no speed.
 
-use crate::log::{Channels, Row};
+use crate::log::{Channels, LogError, LogFile, Row, RowSink};
 use crate::params::ParamFile;
 use monitor_core::angle::SrfPll;
 use monitor_core::frames::{clarke, SinCos};
-use monitor_core::sequence::{asymmetry_correction_rad, SequenceAnalyzer};
+use monitor_core::sequence::{asymmetry_correction_rad, slip_for_current, SequenceAnalyzer};
 use monitor_core::{
-    Abc, AngleSource, Fault, Monitor, MonitorConfig, MonitorOutput, MotorModel, ResidualForm,
-    Sample,
+    Abc, AngleSource, CommissioningState, ConfigError, Fault, Monitor, MonitorConfig,
+    MonitorOutput, ResidualForm, Sample,
 };
 use serde::Serialize;
+use std::path::Path;
 
 /// Timestamp tick rate used for replays [Hz].
 pub const TICK_HZ: f64 = 1.0e6;
 /// Counts per revolution of the synthesised encoder (1024 lines x 4).
 pub const COUNTS_PER_REV: u32 = 4096;
 
-/// Errors from setting up a replay.
+/// Errors from setting up or running a replay.
 #[derive(Debug, thiserror::Error)]
 pub enum ReplayError {
     /// The core rejected the configuration built from the parameter file and the log.
-    #[error("cannot configure the monitor: {0}")]
-    Config(String),
+    #[error("cannot configure the monitor: {source} (sample rate {sample_rate_hz:.1} Hz)")]
+    Config {
+        /// The field and what it must satisfy.
+        source: ConfigError,
+        /// The log's sample rate.
+        sample_rate_hz: f64,
+    },
     /// A bad option.
     #[error("{0}")]
     Option(String),
-}
-
-/// The core's view of the parameter file (f32).
-pub fn motor_model(p: &ParamFile) -> MotorModel {
-    let m = &p.motor;
-    MotorModel {
-        rs_ohm: m.rs_ohm as f32,
-        rr_ohm: m.rr_ohm as f32,
-        ls_h: m.ls_h as f32,
-        lr_h: m.lr_h as f32,
-        lm_h: m.lm_h as f32,
-        pole_pairs: (m.poles / 2).min(255) as u8,
-        j_kgm2: m.j_kgm2 as f32,
-        b_nms: m.b_nms as f32,
-        bl_nms: m.bl_nms as f32,
-    }
+    /// Reading the log failed.
+    #[error(transparent)]
+    Log(#[from] LogError),
 }
 
 /// Replay options.
@@ -68,7 +65,7 @@ pub struct ReplayOptions {
 impl Default for ReplayOptions {
     fn default() -> Self {
         ReplayOptions {
-            angle_source: AngleSource::RotorFlux,
+            angle_source: AngleSource::RotorFluxCurrentModel,
             residual_form: ResidualForm::Steady,
             commission: None,
             timeline_step_s: 0.1,
@@ -76,12 +73,18 @@ impl Default for ReplayOptions {
     }
 }
 
-/// Builds the monitor configuration for a parameter file and a sample rate. The sensor
-/// limits are generous (4x the nominal phase peak voltage, 10x the rated-ish current
-/// scale) because a log does not say its ADC ranges.
-pub fn monitor_config(p: &ParamFile, sample_rate_hz: f64, opts: &ReplayOptions) -> MonitorConfig {
+/// The monitor configuration for replaying a log: the parameter file's machine and supply
+/// at the log's sample rate, 1 MHz timestamps. The sensor limits are generous (twice the
+/// simulator's default ADC ranges, [`crate::sim::default_ranges`]) because a log does not
+/// say its ADC ranges. (The firmware's configuration is `drive_monitor::app`'s
+/// `board_monitor_config`.)
+pub fn monitor_config_for_log(
+    p: &ParamFile,
+    sample_rate_hz: f64,
+    opts: &ReplayOptions,
+) -> MonitorConfig {
     let mut cfg = MonitorConfig::new(
-        motor_model(p),
+        p.motor.model(),
         p.supply.f_hz as f32,
         p.supply.v_ll_rms as f32,
         sample_rate_hz as f32,
@@ -95,14 +98,15 @@ pub fn monitor_config(p: &ParamFile, sample_rate_hz: f64, opts: &ReplayOptions) 
     cfg
 }
 
-/// Converts log rows to core samples, synthesising encoder counts from speed if needed.
+/// Converts log rows to core samples, synthesising encoder counts from speed if needed
+/// (the host's counterpart of the firmware's `drive_monitor::sampling::AdcSampler`).
 #[derive(Debug, Clone, Default)]
-pub struct SampleMaker {
+pub struct LogSampler {
     theta_m: f64,
     last_t: Option<f64>,
 }
 
-impl SampleMaker {
+impl LogSampler {
     /// The core sample for `row` (voltages 0 when the log has none).
     pub fn sample(&mut self, row: &Row) -> Sample {
         let count = match (row.enc_count, row.wm_rad_s) {
@@ -163,9 +167,9 @@ pub struct TimelinePoint {
     pub negative_sequence_ratio: f32,
 }
 
-/// A fault candidate.
+/// A fault candidate of the signature matching.
 #[derive(Debug, Clone, Serialize, PartialEq)]
-pub struct Candidate {
+pub struct FaultCandidate {
     /// DESIGN.md fault name.
     pub fault: String,
     /// Probability.
@@ -191,7 +195,7 @@ pub struct DiagnoseReport {
     /// Final lamps `{"r1":bool,..}`.
     pub lamps: std::collections::BTreeMap<String, bool>,
     /// Final fault candidates, most probable first.
-    pub candidates: Vec<Candidate>,
+    pub candidates: Vec<FaultCandidate>,
     /// First time a lamp lit or a sensor fault was seen [s], or null.
     pub first_detection_s: Option<f64>,
     /// Negative-sequence analysis of the currents.
@@ -215,7 +219,7 @@ pub struct DiagnoseReport {
 /// Streaming replay: feed rows, then [`Replay::finish`].
 pub struct Replay {
     monitor: Option<Monitor>,
-    maker: SampleMaker,
+    sampler: LogSampler,
     opts: ReplayOptions,
     params: ParamFile,
     channels: Channels,
@@ -253,22 +257,22 @@ impl Replay {
                 )));
             }
         }
-        let cfg = monitor_config(params, sample_rate_hz, &opts);
+        let cfg = monitor_config_for_log(params, sample_rate_hz, &opts);
+        let config_error = |source| ReplayError::Config {
+            source,
+            sample_rate_hz,
+        };
         let can_residuals = channels.voltages && (channels.speed || channels.encoder);
         let monitor = if can_residuals {
-            Some(Monitor::new(cfg).map_err(|e| {
-                ReplayError::Config(format!("{e} (sample rate {sample_rate_hz:.1} Hz)"))
-            })?)
+            Some(Monitor::new(cfg).map_err(config_error)?)
         } else {
-            cfg.validate().map_err(|e| {
-                ReplayError::Config(format!("{e} (sample rate {sample_rate_hz:.1} Hz)"))
-            })?;
+            cfg.validate().map_err(config_error)?;
             None
         };
         let dt = (1.0 / sample_rate_hz) as f32;
         Ok(Replay {
             monitor,
-            maker: SampleMaker::default(),
+            sampler: LogSampler::default(),
             opts,
             params: *params,
             channels,
@@ -318,7 +322,7 @@ impl Replay {
                 }
             }
         }
-        let s = self.maker.sample(row);
+        let s = self.sampler.sample(row);
         let out = *mon.update(&s);
         if out.evaluating {
             for (m, r) in self.max_abs.iter_mut().zip(out.residuals) {
@@ -346,10 +350,7 @@ impl Replay {
                 top_probability: top.map(|(_, p)| p).unwrap_or(0.0),
                 speed_rad_s: out.speed_rad_s,
                 evaluating: out.evaluating,
-                commissioning: matches!(
-                    out.commissioning,
-                    monitor_core::Commissioning::Learning(_)
-                ),
+                commissioning: matches!(out.commissioning, CommissioningState::Learning(_)),
                 quasi_steady: out.quasi_steady,
                 negative_sequence_ratio: out.unbalance.negative_sequence_ratio,
             });
@@ -379,7 +380,7 @@ impl Replay {
             );
         }
         let unbalance = if self.monitor.is_some() {
-            let m = motor_model(&self.params);
+            let m = self.params.motor.model();
             let we = out.frame_omega_rad_s.abs().max(1.0);
             let slip = 1.0 - out.operating.wr / we;
             UnbalanceReport {
@@ -391,11 +392,11 @@ impl Replay {
         } else {
             current_only_unbalance(&self.params, &self.seq, self.pll.omega_rad_s())
         };
-        let mut candidates: Vec<Candidate> = Fault::ALL
+        let mut candidates: Vec<FaultCandidate> = Fault::ALL
             .iter()
             .zip(out.diagnosis.probabilities)
             .filter(|(_, p)| *p > 0.0)
-            .map(|(f, p)| Candidate {
+            .map(|(f, p)| FaultCandidate {
                 fault: f.name().to_string(),
                 probability: p,
             })
@@ -426,30 +427,22 @@ impl Replay {
 }
 
 /// Current-only unbalance: the slip is not measured, so it is estimated from the current
-/// magnitude: the slip at which the equivalent circuit on the parameter file's supply draws
-/// the measured |I1| (bisection on 0..0.5; no load -> s ~ 0).
+/// magnitude ([`slip_for_current`] on the parameter file's supply); the phase is then named
+/// as the monitor names it.
 fn current_only_unbalance(p: &ParamFile, seq: &SequenceAnalyzer, omega: f32) -> UnbalanceReport {
-    let m = motor_model(p);
+    let m = p.motor.model();
     let we = if omega > 1.0 {
         omega
     } else {
         p.supply.omega_rad_s() as f32
     };
     let u0 = seq.result(0.0, 0.0);
-    let i1 = seq.positive_magnitude();
-    let vpk = p.supply.v_phase_peak() as f32;
-    let (mut lo, mut hi) = (1e-4f32, 0.5f32);
-    for _ in 0..40 {
-        let mid = 0.5 * (lo + hi);
-        let z = monitor_core::sequence::equivalent_impedance(&m, we, mid);
-        let i = vpk / (z.0 * z.0 + z.1 * z.1).sqrt();
-        if i < i1 {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    let slip = 0.5 * (lo + hi);
+    let slip = slip_for_current(
+        &m,
+        p.supply.v_phase_peak() as f32,
+        we,
+        seq.positive_magnitude(),
+    );
     let corr = asymmetry_correction_rad(&m, we, slip);
     let u = seq.result(corr, 0.005);
     UnbalanceReport {
@@ -465,31 +458,142 @@ pub fn angle_source_name(a: AngleSource) -> &'static str {
     match a {
         AngleSource::ZeroCrossing => "zero-crossing",
         AngleSource::Pll => "pll",
-        AngleSource::RotorFlux => "rotor-flux",
+        AngleSource::RotorFluxCurrentModel => "rotor-flux",
     }
 }
 
 /// Replays whole rows (in memory) and returns the report.
 ///
 /// # Errors
-/// As [`Replay::new`].
+/// As [`Replay::new`]; [`ReplayError::Option`] for fewer than two rows.
 pub fn diagnose_rows(
     params: &ParamFile,
     channels: Channels,
     rows: &[Row],
     opts: ReplayOptions,
 ) -> Result<DiagnoseReport, ReplayError> {
-    let fs = match (rows.first(), rows.last()) {
-        (Some(a), Some(b)) if rows.len() > 1 => (rows.len() - 1) as f64 / (b.t_s - a.t_s),
-        _ => {
-            return Err(ReplayError::Option(
-                "the log needs at least two rows".into(),
-            ))
-        }
-    };
+    let times: Vec<f64> = rows
+        .iter()
+        .take(crate::log::RATE_ESTIMATE_ROWS)
+        .map(|r| r.t_s)
+        .collect();
+    let fs = crate::log::sample_rate_hz(&times)
+        .ok_or_else(|| ReplayError::Option("the log needs at least two rows".into()))?;
     let mut r = Replay::new(params, channels, fs, opts)?;
     for row in rows {
         r.push(row);
     }
     Ok(r.finish())
+}
+
+/// A log replayed by [`diagnose_file`].
+#[derive(Debug, Clone)]
+pub struct Diagnosed {
+    /// The report (`diagnose --json`).
+    pub report: DiagnoseReport,
+    /// The log's sample rate ([`crate::log::sample_rate_hz`]) [Hz].
+    pub sample_rate_hz: f64,
+}
+
+/// Streams a log file through the core (`sim-host diagnose`): the first rows give the
+/// sample rate, the monitor is configured for it, and every row is replayed, with bounded
+/// memory whatever the log's length.
+///
+/// # Errors
+/// [`ReplayError::Log`] naming the file, line and column; [`ReplayError::Option`] for a log
+/// of fewer than two rows; [`ReplayError::Config`] when the core rejects the configuration.
+pub fn diagnose_file(
+    params: &ParamFile,
+    path: &Path,
+    opts: ReplayOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Diagnosed, ReplayError> {
+    let file = LogFile::open(path)?;
+    let mut sink = StreamingReplay {
+        params,
+        shown: file.shown(),
+        channels: file.channels(),
+        opts,
+        head: Vec::new(),
+        replay: None,
+        error: None,
+    };
+    file.for_each_row(progress, &mut sink)?;
+    if let Some(e) = sink.error {
+        return Err(e);
+    }
+    if sink.replay.is_none() {
+        // Fewer rows than the rate estimate wants: start on what there is.
+        sink.start()?;
+    }
+    let sample_rate_hz = sink.sample_rate_hz()?;
+    match sink.replay {
+        Some(replay) => Ok(Diagnosed {
+            report: replay.finish(),
+            sample_rate_hz,
+        }),
+        None => Err(sink.too_short()),
+    }
+}
+
+/// The replay of a streamed log: holds the first rows until the sample rate is known.
+struct StreamingReplay<'a> {
+    params: &'a ParamFile,
+    shown: &'a str,
+    channels: Channels,
+    opts: ReplayOptions,
+    head: Vec<Row>,
+    replay: Option<Replay>,
+    error: Option<ReplayError>,
+}
+
+impl StreamingReplay<'_> {
+    fn sample_rate_hz(&self) -> Result<f64, ReplayError> {
+        let times: Vec<f64> = self.head.iter().map(|r| r.t_s).collect();
+        crate::log::sample_rate_hz(&times).ok_or_else(|| self.too_short())
+    }
+
+    fn too_short(&self) -> ReplayError {
+        ReplayError::Option(format!(
+            "{}: the log needs at least two data rows",
+            self.shown
+        ))
+    }
+
+    /// Configures the monitor for the rate of the rows held and replays them.
+    fn start(&mut self) -> Result<(), ReplayError> {
+        let fs = self.sample_rate_hz()?;
+        let mut r = Replay::new(self.params, self.channels, fs, self.opts)?;
+        for row in &self.head {
+            r.push(row);
+        }
+        self.replay = Some(r);
+        Ok(())
+    }
+}
+
+impl RowSink for StreamingReplay<'_> {
+    fn row(&mut self, row: &Row) -> bool {
+        if let Some(r) = self.replay.as_mut() {
+            r.push(row);
+            return true;
+        }
+        self.head.push(*row);
+        if self.head.len() < crate::log::RATE_ESTIMATE_ROWS {
+            return true;
+        }
+        match self.start() {
+            Ok(()) => true,
+            Err(e) => {
+                self.error = Some(e);
+                false
+            }
+        }
+    }
+
+    fn restart(&mut self) {
+        self.head.clear();
+        self.replay = None;
+        self.error = None;
+    }
 }

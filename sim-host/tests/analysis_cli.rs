@@ -238,8 +238,8 @@ fn current_only_log_through_the_binary() {
     let dir = tempfile::tempdir().unwrap();
     let truth = motor("2p2");
     let mut s = scenario("2p2", None, 1);
-    s.effects = vec![sim_host::sim::Effect::PhaseAsymmetry {
-        phase: sim_host::sim::Phase::C,
+    s.effects = vec![sim_host::sim::EffectSpec::PhaseAsymmetry {
+        phase: monitor_core::Phase::C,
         fraction: 0.05,
     }];
     let log = write_log(dir.path(), "i_only", &truth, &s, true);

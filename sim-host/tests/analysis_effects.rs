@@ -9,12 +9,14 @@
 //! tested with only the other one in the model). See the README, "Model vs measurement".
 mod analysis_common;
 use analysis_common::*;
-use sim_host::sim::Effect;
+use monitor_core::EffectKind;
+use sim_host::sim::EffectSpec;
 
 const DYNAMICS: [&str; 2] = ["flux_dynamics", "current_dynamics"];
 
 fn check_all(which: &str, noise: u32) {
-    check(which, noise, &Effect::NAMES);
+    let names: Vec<&str> = EffectKind::ALL.iter().map(|k| k.name()).collect();
+    check(which, noise, &names);
 }
 
 fn check(which: &str, noise: u32, names: &[&str]) {
@@ -34,7 +36,7 @@ fn check(which: &str, noise: u32, names: &[&str]) {
         let top = ex
             .ranking
             .first()
-            .map(|c| c.effect.clone())
+            .map(|c| c.effect.name())
             .unwrap_or_default();
         let before = a.compare(&opts(&base)).unwrap().report;
         let after = a.compare(&opts(&with)).unwrap().report;
@@ -116,7 +118,7 @@ fn effect_free_data_claims_nothing() {
             ex.noise_floor
         );
         assert!(
-            ex.unexplained || best < sim_host::analysis::EXPLAINED_MIN,
+            ex.unexplained || best < sim_host::analysis::explain::EXPLAINED_MIN,
             "{which}/{noise}: claimed {:?}",
             ex.ranking.first().map(|c| &c.effect)
         );
@@ -129,8 +131,8 @@ fn current_only_log_gets_the_unbalance_analysis() {
     let truth = motor("2p2");
     let nominal = perturbed(&truth, 0.05);
     let mut s = scenario("2p2", Some("phase_asymmetry"), 1);
-    s.effects = vec![Effect::PhaseAsymmetry {
-        phase: sim_host::sim::Phase::B,
+    s.effects = vec![EffectSpec::PhaseAsymmetry {
+        phase: monitor_core::Phase::B,
         fraction: 0.05,
     }];
     let log = write_log(dir.path(), "asym_b", &truth, &s, true);
@@ -175,7 +177,12 @@ fn motulator_log_points_at_load_torque() {
     let a = analyse(&log, &p, 0.8);
     let ex = a.explain(&opts(&[]), &|_| {}).unwrap().report;
     eprintln!("{}", ex.verdict);
-    assert_eq!(ex.ranking[0].effect, "load_torque", "{}", ex.verdict);
+    assert_eq!(
+        ex.ranking[0].effect,
+        EffectKind::LoadTorque,
+        "{}",
+        ex.verdict
+    );
     assert!(!ex.unexplained);
     let before = a.compare(&opts(&[])).unwrap().report.normalized_rms_error;
     let after = a

@@ -30,11 +30,11 @@ fn probe() {
         let base_env = std::env::var("BASE").unwrap_or_default();
         let base: Vec<&str> = base_env.split(',').filter(|s| !s.is_empty()).collect();
         if let Ok(g) = std::env::var("TRUTH_G") {
-            use sim_host::analysis::model::{simulate, BaseParams, Terms};
-            let n = &a.nominal;
+            use sim_host::analysis::simplified_model::{simulate, BaseParams, EffectTerms};
+            let n = &a.constants;
             let g: f64 = g.parse().unwrap();
             let xm = 2.0 * std::f64::consts::PI * nominal.supply.f_hz * nominal.motor.lm_h;
-            let t = Terms {
+            let t = EffectTerms {
                 g_fe_s: if g > 0.0 { 1.0 / (g * xm) } else { 0.0 },
                 tau_r_s: Some(n.lr_h / n.rr_ohm),
                 la_h: Some(n.la_h),
@@ -74,8 +74,8 @@ fn probe() {
         return;
     }
     let mut list: Vec<Option<&str>> = vec![None];
-    for n in sim_host::sim::Effect::NAMES {
-        list.push(Some(n));
+    for n in monitor_core::EffectKind::ALL {
+        list.push(Some(n.name()));
     }
     for e in list {
         if let Some(o) = &only {
@@ -134,18 +134,23 @@ fn read_speed() {
     let path =
         std::env::var("ANALYSIS_BENCH_LOG").unwrap_or("/tmp/sim-host-bench-3600s.csv".into());
     let t = std::time::Instant::now();
-    let mut n = 0u64;
-    let ok = sim_host::analysis::fastcsv::for_each_row(
-        std::path::Path::new(&path),
-        &mut |_| {},
-        &mut |_| {
-            n += 1;
+    /// Counts rows.
+    struct Count(u64);
+    impl sim_host::log::RowSink for Count {
+        fn row(&mut self, _: &sim_host::log::Row) -> bool {
+            self.0 += 1;
             true
-        },
-    )
-    .unwrap();
+        }
+        fn restart(&mut self) {
+            self.0 = 0;
+        }
+    }
+    let file = sim_host::log::LogFile::open(std::path::Path::new(&path)).unwrap();
+    let mut n = Count(0);
+    file.for_each_row(&mut |_| {}, &mut n).unwrap();
     println!(
-        "parse only: {n} rows in {:.2} s (fast path {ok})",
+        "parse only: {} rows in {:.2} s",
+        n.0,
         t.elapsed().as_secs_f64()
     );
     let t = std::time::Instant::now();
@@ -161,7 +166,10 @@ fn read_speed() {
         t.elapsed().as_secs_f64()
     );
     let t = std::time::Instant::now();
-    let p = sim_host::analysis::prep::frame(&d, &sim_host::params::ParamFile::reference_2p2kw());
+    let p = sim_host::analysis::prep::voltage_model_flux_frame(
+        &d,
+        &sim_host::params::ParamFile::reference_2p2kw(),
+    );
     println!(
         "frame: {} samples in {:.2} s",
         p.len(),
@@ -172,7 +180,7 @@ fn read_speed() {
 fn dump_csv(
     path: &str,
     a: &sim_host::analysis::Analysis,
-    pr: &sim_host::analysis::model::Prediction,
+    pr: &sim_host::analysis::simplified_model::Prediction,
 ) {
     use std::io::Write;
     let mut f = std::io::BufWriter::new(std::fs::File::create(path).unwrap());

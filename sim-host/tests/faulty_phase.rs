@@ -3,10 +3,11 @@
 //! reference motors. The analysis only sees the sensor rows; it is not told the phase.
 
 use monitor_core::AngleSource;
+use monitor_core::Phase;
 use rayon::prelude::*;
 use sim_host::params::ParamFile;
 use sim_host::replay::{diagnose_rows, ReplayOptions};
-use sim_host::sim::{simulate_to_vec, Effect, LoadKind, LoadSpec, Phase, Scenario, SensorSpec};
+use sim_host::sim::{simulate_to_vec, EffectSpec, LoadKind, LoadSpec, Scenario, SensorSpec};
 
 fn run(params: &ParamFile, load_nm: f64, phase: Phase, fraction: f64) -> (Option<String>, f32) {
     let mut sc = Scenario::steady(4.0, 10_000.0);
@@ -17,10 +18,11 @@ fn run(params: &ParamFile, load_nm: f64, phase: Phase, fraction: f64) -> (Option
         bl_nms: None,
         steps: vec![],
     };
-    sc.effects.push(Effect::PhaseAsymmetry { phase, fraction });
+    sc.effects
+        .push(EffectSpec::PhaseAsymmetry { phase, fraction });
     let rows = simulate_to_vec(params, &sc).expect("simulate");
     let opts = ReplayOptions {
-        angle_source: AngleSource::RotorFlux,
+        angle_source: AngleSource::RotorFluxCurrentModel,
         ..ReplayOptions::default()
     };
     let rep = diagnose_rows(params, sc.sensors.channels(), &rows, opts).expect("replay");

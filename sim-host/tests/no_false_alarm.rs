@@ -3,9 +3,10 @@
 //! noise light no lamp. The profile is `sim_host::service` (commissioned over its first
 //! cycle of steps, because to the paper's model a load change is a Bl change).
 
+use monitor_core::Fault;
 use sim_host::params::ParamFile;
-use sim_host::service::watch;
-use sim_host::sim::{FaultKind, FaultSpec};
+use sim_host::service_profile::watch;
+use sim_host::sim::FaultSpec;
 
 #[test]
 fn sixty_seconds_of_healthy_service_light_no_lamp() {
@@ -35,11 +36,7 @@ fn the_same_service_with_a_fault_does_light_a_lamp() {
         (ParamFile::reference_3hp(), 7),
         (ParamFile::reference_2p2kw(), 11),
     ] {
-        for (kind, change) in [
-            (FaultKind::Rr, 0.5),
-            (FaultKind::Ls, 0.5),
-            (FaultKind::Lr, -0.5),
-        ] {
+        for (kind, change) in [(Fault::Rr, 0.5), (Fault::Ls, 0.5), (Fault::Lr, -0.5)] {
             let fault = FaultSpec::parametric(kind, 50.0, change);
             let w = watch(&params, seed, 70.0, Some(fault)).expect("run");
             let first = w.first_alarm_s.unwrap_or(f64::NAN);

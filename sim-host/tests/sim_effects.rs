@@ -2,9 +2,10 @@
 //! of the changed machine, the thermal law, the saturation law, symmetrical components of
 //! the supply, torque balances of the friction laws.
 
+use monitor_core::{EffectKind, Fault};
 use sim_host::params::ParamFile;
 use sim_host::sim::{
-    self, Effect, FaultKind, FaultSpec, LoadKind, Scenario, SensorSpec, SteadyLoad, Truth,
+    self, EffectSpec, FaultSpec, LoadKind, Scenario, SensorSpec, SteadyLoad, Truth,
 };
 
 fn run(p: &ParamFile, sc: &Scenario) -> Vec<Truth> {
@@ -28,7 +29,7 @@ fn mean(tr: &[Truth], n: usize, f: impl Fn(&Truth) -> f64) -> f64 {
 }
 
 /// A parametric fault ends in the analytic steady state of the changed machine.
-fn fault_steady(p: &ParamFile, kind: FaultKind, change: f64, changed: ParamFile, rate: f64) {
+fn fault_steady(p: &ParamFile, kind: Fault, change: f64, changed: ParamFile, rate: f64) {
     let mut sc = Scenario::steady(4.0, rate);
     sc.faults.push(FaultSpec::parametric(kind, 1.5, change));
     let tr = run(p, &sc);
@@ -49,16 +50,16 @@ fn sim_fault_rs_rr_b_bl_reach_the_changed_steady_state() {
     let p = ParamFile::reference_2p2kw();
     let mut c = p;
     c.motor.rs_ohm *= 1.5;
-    fault_steady(&p, FaultKind::Rs, 0.5, c, 10_000.0);
+    fault_steady(&p, Fault::Rs, 0.5, c, 10_000.0);
     let mut c = p;
     c.motor.rr_ohm *= 0.5;
-    fault_steady(&p, FaultKind::Rr, -0.5, c, 10_000.0);
+    fault_steady(&p, Fault::Rr, -0.5, c, 10_000.0);
     let mut c = p;
     c.motor.bl_nms *= 1.5;
-    fault_steady(&p, FaultKind::Bl, 0.5, c, 10_000.0);
+    fault_steady(&p, Fault::Bl, 0.5, c, 10_000.0);
     let mut c = p;
     c.motor.b_nms *= 3.0;
-    fault_steady(&p, FaultKind::B, 2.0, c, 10_000.0);
+    fault_steady(&p, Fault::B, 2.0, c, 10_000.0);
 }
 
 #[test]
@@ -66,25 +67,25 @@ fn sim_fault_ls_lr_change_leakage_inductances() {
     // 3 hp (T model): ls/lr scale the leakage, the self inductances follow.
     let p = ParamFile::reference_3hp();
     let mut c = p;
-    c.motor.ls_h = p.motor.lm_h + 1.5 * p.motor.lls_h();
-    fault_steady(&p, FaultKind::Ls, 0.5, c, 12_000.0);
+    c.motor.ls_h = p.motor.lm_h + 1.5 * p.motor.model::<f64>().lls_h();
+    fault_steady(&p, Fault::Ls, 0.5, c, 12_000.0);
     let mut c = p;
-    c.motor.lr_h = p.motor.lm_h + 0.5 * p.motor.llr_h();
-    fault_steady(&p, FaultKind::Lr, -0.5, c, 12_000.0);
+    c.motor.lr_h = p.motor.lm_h + 0.5 * p.motor.model::<f64>().llr_h();
+    fault_steady(&p, Fault::Lr, -0.5, c, 12_000.0);
     // 2.2 kW (Gamma model, Lls = 0): ls scales Ls = Lm, the rotor leakage is kept.
     let p = ParamFile::reference_2p2kw();
     let mut c = p;
     c.motor.lm_h *= 0.5;
     c.motor.ls_h = c.motor.lm_h;
-    c.motor.lr_h = c.motor.lm_h + p.motor.llr_h();
-    fault_steady(&p, FaultKind::Ls, -0.5, c, 10_000.0);
+    c.motor.lr_h = c.motor.lm_h + p.motor.model::<f64>().llr_h();
+    fault_steady(&p, Fault::Ls, -0.5, c, 10_000.0);
 }
 
 #[test]
 fn sim_thermal_drift_follows_the_copper_law() {
     let p = ParamFile::reference_2p2kw();
     let mut sc = Scenario::steady(2.0, 1000.0);
-    sc.effects.push(Effect::ThermalDrift {
+    sc.effects.push(EffectSpec::ThermalDrift {
         rise_k: Some(60.0),
         tau_s: 0.5,
         at_s: 0.2,
@@ -104,7 +105,7 @@ fn sim_thermal_drift_follows_the_copper_law() {
     }
     // Loss-driven: the rise approaches r_th * P_loss.
     let mut sc = Scenario::steady(3.0, 1000.0);
-    sc.effects.push(Effect::ThermalDrift {
+    sc.effects.push(EffectSpec::ThermalDrift {
         rise_k: None,
         tau_s: 0.3,
         at_s: 0.0,
@@ -125,7 +126,8 @@ fn sim_saturation_obeys_its_law_and_raises_the_no_load_current() {
         let rate = 12_000.0 * p.supply.f_hz / 60.0;
         let base = Scenario::steady(2.0, rate);
         let mut sat = base.clone();
-        sat.effects.push(Effect::by_name("saturation").unwrap());
+        sat.effects
+            .push(EffectSpec::with_defaults(EffectKind::Saturation));
         let tr0 = run(&p, &base);
         let tr1 = run(&p, &sat);
         let psi_sat = 1.3 * p.supply.v_phase_peak() / p.supply.omega_rad_s();
@@ -148,7 +150,7 @@ fn sim_saturation_obeys_its_law_and_raises_the_no_load_current() {
 fn sim_supply_unbalance_gives_the_stated_negative_sequence() {
     let p = ParamFile::reference_2p2kw();
     let mut sc = Scenario::steady(0.2, 10_000.0);
-    sc.effects.push(Effect::SupplyUnbalance {
+    sc.effects.push(EffectSpec::SupplyUnbalance {
         fraction: 0.04,
         angle_deg: 30.0,
     });
@@ -178,8 +180,8 @@ fn sim_supply_unbalance_gives_the_stated_negative_sequence() {
 fn sim_phase_asymmetry_unbalances_the_currents_towards_the_faulty_phase() {
     let p = ParamFile::reference_3hp();
     let mut sc = Scenario::steady(3.0, 12_000.0);
-    sc.effects.push(Effect::PhaseAsymmetry {
-        phase: sim::Phase::B,
+    sc.effects.push(EffectSpec::PhaseAsymmetry {
+        phase: monitor_core::Phase::B,
         fraction: 0.1,
     });
     let tr = run(&p, &sc);
@@ -207,11 +209,11 @@ fn sim_friction_laws_balance_the_torque() {
     let mut sc = Scenario::steady(3.0, 10_000.0);
     sc.load.kind = LoadKind::Torque;
     sc.load.torque_nm = Some(5.0);
-    sc.effects.push(Effect::CoulombFriction {
+    sc.effects.push(EffectSpec::CoulombFriction {
         torque_nm: Some(1.0),
         omega0_rad_s: 1.0,
     });
-    sc.effects.push(Effect::Windage { k_nms2: Some(1e-4) });
+    sc.effects.push(EffectSpec::Windage { k_nms2: Some(1e-4) });
     let tr = run(&p, &sc);
     let n = 2000;
     let te = mean(&tr, n, |t| t.te_nm);
@@ -227,7 +229,7 @@ fn sim_friction_laws_balance_the_torque() {
 fn sim_load_torque_effect_replaces_the_viscous_load() {
     let p = ParamFile::reference_2p2kw();
     let mut sc = Scenario::steady(3.0, 10_000.0);
-    sc.effects.push(Effect::LoadTorque {
+    sc.effects.push(EffectSpec::LoadTorque {
         torque_nm: Some(10.0),
     });
     let tr = run(&p, &sc);
@@ -243,9 +245,10 @@ fn sim_every_effect_name_exists_and_changes_the_output_or_is_documented_noop() {
     let mut base = Scenario::steady(1.0, 5_000.0);
     base.sensors = SensorSpec::ideal();
     let r0 = sim::simulate_to_vec(&p, &base).unwrap();
-    for name in Effect::NAMES {
+    for kind in EffectKind::ALL {
+        let name = kind.name();
         let mut sc = base.clone();
-        sc.effects.push(Effect::by_name(name).unwrap());
+        sc.effects.push(EffectSpec::with_defaults(kind));
         let r = sim::simulate_to_vec(&p, &sc).unwrap();
         let diff = r0
             .iter()
@@ -258,5 +261,5 @@ fn sim_every_effect_name_exists_and_changes_the_output_or_is_documented_noop() {
             assert!(diff > 0.01, "{name} makes no visible difference ({diff} A)");
         }
     }
-    assert!(Effect::by_name("thermal_drfit").is_err());
+    assert_eq!(EffectKind::from_name("thermal_drfit"), None);
 }

@@ -2,10 +2,11 @@
 //! losses + air-gap mechanical power + d/dt (stored magnetic energy), through a
 //! direct-on-line start (large transients), with dW/dt by fourth-order central differences (20 kHz).
 
+use monitor_core::{EffectKind, Phase};
 use sim_host::params::ParamFile;
-use sim_host::sim::{self, Effect, Phase, Scenario, Truth};
+use sim_host::sim::{self, EffectSpec, Scenario, Truth};
 
-fn balance(p: &ParamFile, effects: Vec<Effect>) -> f64 {
+fn balance(p: &ParamFile, effects: Vec<EffectSpec>) -> f64 {
     let rate = 20_000.0;
     let mut sc = Scenario::steady(0.6, rate);
     sc.effects = effects;
@@ -40,8 +41,8 @@ fn sim_energy_balance_3hp() {
 #[test]
 fn sim_energy_balance_with_iron_loss_and_asymmetry() {
     let eff = vec![
-        Effect::by_name("iron_loss").unwrap(),
-        Effect::PhaseAsymmetry {
+        EffectSpec::with_defaults(EffectKind::IronLoss),
+        EffectSpec::PhaseAsymmetry {
             phase: Phase::B,
             fraction: 0.08,
         },

@@ -1,8 +1,10 @@
 //! Sensor chain: noise statistics, quantisation, reproducibility, encoder, sensor faults.
 
+use monitor_core::Fault;
+use monitor_core::Phase;
 use sim_host::log::Row;
 use sim_host::params::ParamFile;
-use sim_host::sim::{self, FaultKind, FaultSpec, Phase, Scenario, SensorFaultMode, SensorSpec};
+use sim_host::sim::{self, FaultSpec, Scenario, SensorFaultMode, SensorSpec};
 
 fn pair(sensors: SensorSpec, faults: Vec<FaultSpec>, seed: u64) -> (Vec<Row>, Vec<Row>) {
     let p = ParamFile::reference_2p2kw();
@@ -118,10 +120,10 @@ fn sim_sensor_faults_one_phase_gain_stuck_disconnected() {
     let faults = vec![
         FaultSpec {
             phase: Some(Phase::A),
-            ..FaultSpec::sensor_gain(FaultKind::CurrentSensor, 0.5, 0.5)
+            ..FaultSpec::sensor_gain(Fault::CurrentSensor, 0.5, 0.5)
         },
         FaultSpec {
-            kind: FaultKind::VoltageSensor,
+            kind: Fault::VoltageSensor,
             at_s: 0.5,
             change: None,
             mode: Some(SensorFaultMode::Stuck),
@@ -129,7 +131,7 @@ fn sim_sensor_faults_one_phase_gain_stuck_disconnected() {
             phase: Some(Phase::C),
         },
         FaultSpec {
-            kind: FaultKind::SpeedSensor,
+            kind: Fault::SpeedSensor,
             at_s: 0.7,
             change: None,
             mode: Some(SensorFaultMode::Disconnected),

@@ -21,7 +21,7 @@ fn run(p: &ParamFile, torque_nm: f64, duration_s: f64, rate: f64) -> (f64, f64, 
     let n_total = (duration_s * rate).round() as usize;
     let (mut sq, mut te, mut slip, mut cnt) = (0.0, 0.0, 0.0, 0usize);
     let mut k = 0usize;
-    let np = p.motor.pole_pairs();
+    let np = p.motor.model::<f64>().np();
     sim::simulate_with_truth(p, &sc, |row, tr| {
         if k >= n_total - n_keep {
             sq += row.i_abc.iter().map(|i| i * i).sum::<f64>() / 3.0;

@@ -28,7 +28,7 @@ use monitor_core::angle::RotorFluxCurrentModel;
 use monitor_core::encoder::MtSpeed;
 use monitor_core::frames::{clarke, park, SinCos};
 use monitor_core::residuals::{residuals, Operating};
-use monitor_core::Monitor;
+use monitor_core::{Monitor, MonitorConfig};
 use scenario::Check;
 
 static REPLAY: &[u8] = include_bytes!("../data/replay.bin");
@@ -148,7 +148,16 @@ fn main() -> ! {
     }
     println!("samples={}", n);
 
-    // --- calibration: SysTick ticks per instruction -----------------------------------
+    let ticks_per_instr = calibrate();
+    let cfg = scenario::config();
+    let ok = replay_matches_host(&cfg, n, checks, spacing);
+    count_instructions(&cfg, n, ticks_per_instr);
+    println!("result={}", if ok { "pass" } else { "FAIL" });
+    semihosting::exit(ok)
+}
+
+/// SysTick ticks per instruction, from a loop of known length.
+fn calibrate() -> f32 {
     const CAL_N: u32 = 200_000;
     let t_cal = measure(|| known_loop(black_box(CAL_N))) as f32;
     let t_cal0 = measure(|| known_loop(black_box(1))) as f32;
@@ -157,13 +166,13 @@ fn main() -> ! {
         println!("error=SysTick does not advance (run QEMU with -icount shift=0)");
         semihosting::exit(false);
     }
-    let per_sample = |ticks: u32, base: u32, count: usize| -> f32 {
-        (ticks as f32 - base as f32) / ticks_per_instr / count as f32
-    };
+    ticks_per_instr
+}
 
-    // --- correctness: replay and compare ----------------------------------------------
-    let cfg = scenario::config();
-    let Ok(mut monitor) = Monitor::new(cfg) else {
+/// Replays the embedded samples through `Monitor` and compares the checkpoints with the
+/// host's results; prints the mismatches and the largest deviation.
+fn replay_matches_host(cfg: &MonitorConfig, n: usize, checks: usize, spacing: usize) -> bool {
+    let Ok(mut monitor) = Monitor::new(*cfg) else {
         println!("error=config rejected");
         semihosting::exit(false);
     };
@@ -195,8 +204,16 @@ fn main() -> ! {
     }
     println!("checkpoints={}", j);
     println!("max_deviation={:e}", max_abs);
+    ok
+}
 
-    // --- instruction counts --------------------------------------------------------------
+/// Counts the instructions per sample of the pipeline's parts and of the whole
+/// `Monitor::update`, and prints them.
+fn count_instructions(cfg: &MonitorConfig, n: usize, ticks_per_instr: f32) {
+    let cfg = *cfg;
+    let per_sample = |ticks: u32, base: u32, count: usize| -> f32 {
+        (ticks as f32 - base as f32) / ticks_per_instr / count as f32
+    };
     let base = measure(|| {
         for k in 0..n {
             black_box(scenario::sample(REPLAY, k));
@@ -296,8 +313,6 @@ fn main() -> ! {
     println!("fast_path={:.0}", fast);
     println!("slow_path_per_call={:.0}", slow);
     println!("whole_pipeline={:.0}", per_sample(t_all, base, n));
-    println!("result={}", if ok { "pass" } else { "FAIL" });
-    semihosting::exit(ok)
 }
 
 #[panic_handler]

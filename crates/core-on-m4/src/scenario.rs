@@ -33,24 +33,17 @@ pub const AMP_PER_LSB: f32 = 20.0 / 4095.0;
 /// Zero code.
 pub const MID: f32 = 4095.0 / 2.0;
 
-/// The 2.2 kW reference machine of DESIGN.md (Bl for 14.6 N m near rated speed).
-pub const MOTOR: MotorModel = MotorModel {
-    rs_ohm: 3.7,
-    rr_ohm: 2.5,
-    ls_h: 0.245,
-    lr_h: 0.268,
-    lm_h: 0.245,
-    pole_pairs: 2,
-    j_kgm2: 0.015,
-    b_nms: 0.005,
-    bl_nms: 0.0975,
-};
+/// The 2.2 kW reference machine of DESIGN.md (Bl for 14.6 N m near rated speed), in the
+/// core's precision.
+pub fn motor() -> MotorModel {
+    monitor_core::reference::MOTOR_2P2KW.motor.model()
+}
 
 /// Monitor configuration of the replay: the firmware's settings (16-bit encoder
 /// counter, 4096 counts/rev, 1 MHz ticks) with a short settling time so the slow path
 /// and the lamp logic run within the replay.
 pub fn config() -> MonitorConfig {
-    let mut c = MonitorConfig::new(MOTOR, 50.0, 400.0, SAMPLE_RATE_HZ);
+    let mut c = MonitorConfig::new(motor(), 50.0, 400.0, SAMPLE_RATE_HZ);
     c.tick_hz = 1_000_000.0;
     c.encoder.counter_bits = 16;
     c.encoder.counts_per_rev = 4096;

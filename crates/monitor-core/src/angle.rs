@@ -29,9 +29,12 @@ pub enum AngleSource {
     ZeroCrossing,
     /// SRF-PLL on the measured voltages.
     Pll,
-    /// Rotor-flux angle from the current model (encoder speed, nominal rotor parameters).
+    /// Rotor-flux angle from the current model ([`RotorFluxCurrentModel`]: measured
+    /// currents, encoder speed, nominal Rr, Lr, Lm). The host's model-vs-measurement
+    /// analysis uses a different rotor-flux estimator, the voltage model, which needs no
+    /// speed and no rotor parameters; the two are named apart everywhere.
     #[default]
-    RotorFlux,
+    RotorFluxCurrentModel,
 }
 
 /// Phase-a rising zero-crossing detector with frequency estimate (the paper's method).

@@ -97,15 +97,6 @@ impl MtSpeed {
         }
     }
 
-    /// Counter change since the previous sample (0 on the first sample).
-    pub fn step_counts(&self, count: u32) -> i32 {
-        if self.started {
-            counter_delta(count, self.last_count, self.bits)
-        } else {
-            0
-        }
-    }
-
     /// Feeds one sample: raw counter and timestamp. Returns the mechanical speed [rad/s].
     pub fn update(&mut self, count: u32, ticks: u32) -> f32 {
         if !self.started {

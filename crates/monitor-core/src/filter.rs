@@ -70,12 +70,6 @@ impl Svf {
         }
     }
 
-    /// Starts the filter at a steady value `x` (no start-up transient).
-    pub fn reset_to(&mut self, x: f32) {
-        self.y = x;
-        self.dy = 0.0;
-    }
-
     /// Feeds one sample.
     #[inline]
     pub fn update(&mut self, x: f32) {

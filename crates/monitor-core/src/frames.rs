@@ -1,7 +1,9 @@
-//! Reference frames and the Clarke/Park transforms.
+//! Reference frames and the Clarke/Park transforms, the one implementation for the board
+//! (`f32`) and the host (`f64`).
 //!
 //! One type per frame ([`Abc`], [`AlphaBeta`], [`Dq`]) so a signature says which frame a
-//! value is in. The Clarke transform is amplitude invariant: a balanced set
+//! value is in; each is generic over the scalar ([`Real`]: `f32` on the board, the default,
+//! and `f64` in the host's analysis). The Clarke transform is amplitude invariant: a balanced set
 //! `x_a = X cos(theta)`, `x_b = X cos(theta - 2pi/3)`, `x_c = X cos(theta + 2pi/3)` becomes the
 //! vector `X (cos theta, sin theta)`, so d-q magnitudes equal phase peak values.
 //!
@@ -10,56 +12,215 @@
 //! rotor flux lies on +d and the stator voltage is close to +q; in voltage orientation (the
 //! paper's phase-a zero-crossing method, section 4) the voltage lies exactly on +q, so
 //! `V_ds = 0` and `V_qs = |V|`, matching the paper's model where `V_qs` is the input (eq. 32).
+//!
+//! The host's analysis writes space vectors as complex numbers; there the Park transform
+//! is the product `x_dq = x_alphabeta e^{-j theta}`, the same transform as [`park`].
 
+use core::ops::{Add, Div, Mul, Neg, Sub};
 use micromath::F32Ext;
 
-/// 1/sqrt(3).
-const INV_SQRT3: f32 = 0.577_350_26;
-/// sqrt(3)/2.
-const SQRT3_2: f32 = 0.866_025_4;
+/// The scalar of the frame types and of [`crate::MotorModel`]: `f32` (the board, the
+/// default) or `f64` (the host).
+pub trait Real:
+    Copy
+    + Default
+    + PartialOrd
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    /// 0.
+    const ZERO: Self;
+    /// 1.
+    const ONE: Self;
+    /// 3/2.
+    const THREE_HALVES: Self;
+    /// 1/3.
+    const ONE_THIRD: Self;
+    /// 1/2.
+    const HALF: Self;
+    /// 2.
+    const TWO: Self;
+    /// 1/sqrt(3).
+    const INV_SQRT3: Self;
+    /// sqrt(3)/2.
+    const SQRT3_2: Self;
+    /// The nearest value of `x` (rounding for `f32`).
+    fn from_f64(x: f64) -> Self;
+    /// `n` exactly.
+    fn from_u8(n: u8) -> Self;
+    /// Neither infinite nor NaN.
+    fn is_finite(self) -> bool;
+}
+
+impl Real for f32 {
+    const ZERO: f32 = 0.0;
+    const ONE: f32 = 1.0;
+    const THREE_HALVES: f32 = 1.5;
+    const ONE_THIRD: f32 = 1.0 / 3.0;
+    const HALF: f32 = 0.5;
+    const TWO: f32 = 2.0;
+    const INV_SQRT3: f32 = 0.577_350_26;
+    const SQRT3_2: f32 = 0.866_025_4;
+    #[inline]
+    fn from_f64(x: f64) -> f32 {
+        x as f32
+    }
+    #[inline]
+    fn from_u8(n: u8) -> f32 {
+        f32::from(n)
+    }
+    #[inline]
+    fn is_finite(self) -> bool {
+        f32::is_finite(self)
+    }
+}
+
+impl Real for f64 {
+    const ZERO: f64 = 0.0;
+    const ONE: f64 = 1.0;
+    const THREE_HALVES: f64 = 1.5;
+    const ONE_THIRD: f64 = 1.0 / 3.0;
+    const HALF: f64 = 0.5;
+    const TWO: f64 = 2.0;
+    const INV_SQRT3: f64 = 0.577_350_269_189_625_8;
+    const SQRT3_2: f64 = 0.866_025_403_784_438_6;
+    #[inline]
+    fn from_f64(x: f64) -> f64 {
+        x
+    }
+    #[inline]
+    fn from_u8(n: u8) -> f64 {
+        f64::from(n)
+    }
+    #[inline]
+    fn is_finite(self) -> bool {
+        f64::is_finite(self)
+    }
+}
+
+/// A phase of the three-phase system (the machine's windings, the supply's lines).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum Phase {
+    /// Phase a (on the alpha axis).
+    A,
+    /// Phase b (120 electrical degrees behind a).
+    B,
+    /// Phase c.
+    C,
+}
+
+impl Phase {
+    /// The three phases in order.
+    pub const ALL: [Phase; 3] = [Phase::A, Phase::B, Phase::C];
+
+    /// "a", "b" or "c".
+    pub fn name(self) -> &'static str {
+        match self {
+            Phase::A => "a",
+            Phase::B => "b",
+            Phase::C => "c",
+        }
+    }
+
+    /// 0, 1, 2 for a, b, c: the index `k` of the winding axis at `k 2pi/3`.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// The phase whose axis is `k` thirds of a turn from phase a (any integer, taken
+    /// modulo 3).
+    pub fn from_turns(k: i32) -> Phase {
+        match k.rem_euclid(3) {
+            0 => Phase::A,
+            1 => Phase::B,
+            _ => Phase::C,
+        }
+    }
+}
 
 /// Phase quantities a, b, c (volts or amperes, instantaneous).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Abc {
+pub struct Abc<T = f32> {
     /// Phase a.
-    pub a: f32,
+    pub a: T,
     /// Phase b.
-    pub b: f32,
+    pub b: T,
     /// Phase c.
-    pub c: f32,
+    pub c: T,
+}
+
+impl<T: Copy> Abc<T> {
+    /// From `[a, b, c]`.
+    pub fn from_array(x: [T; 3]) -> Self {
+        Abc {
+            a: x[0],
+            b: x[1],
+            c: x[2],
+        }
+    }
+
+    /// As `[a, b, c]`.
+    pub fn to_array(self) -> [T; 3] {
+        [self.a, self.b, self.c]
+    }
+
+    /// The value of one phase.
+    pub fn phase(self, p: Phase) -> T {
+        match p {
+            Phase::A => self.a,
+            Phase::B => self.b,
+            Phase::C => self.c,
+        }
+    }
 }
 
 /// Stationary two-axis frame (alpha on phase a), amplitude-invariant scaling.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct AlphaBeta {
+pub struct AlphaBeta<T = f32> {
     /// Alpha component (along phase a).
-    pub alpha: f32,
+    pub alpha: T,
     /// Beta component (90 electrical degrees ahead of alpha).
-    pub beta: f32,
+    pub beta: T,
 }
 
 /// Synchronous (rotating) d-q frame.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Dq {
+pub struct Dq<T = f32> {
     /// Direct-axis component.
-    pub d: f32,
+    pub d: T,
     /// Quadrature-axis component (90 electrical degrees ahead of d).
-    pub q: f32,
+    pub q: T,
 }
 
 /// A precomputed sine/cosine pair of a frame angle, so one trig evaluation serves several
 /// transforms.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SinCos {
+pub struct SinCos<T = f32> {
     /// sin(theta).
-    pub sin: f32,
+    pub sin: T,
     /// cos(theta).
-    pub cos: f32,
+    pub cos: T,
 }
 
 impl Default for SinCos {
     fn default() -> Self {
         SinCos { sin: 0.0, cos: 1.0 }
+    }
+}
+
+impl<T: Real> SinCos<T> {
+    /// The angle rotated by -90 degrees: (sin(t - pi/2), cos(t - pi/2)) = (-cos t, sin t).
+    #[inline]
+    pub fn minus_quarter_turn(self) -> Self {
+        SinCos {
+            sin: -self.cos,
+            cos: self.sin,
+        }
     }
 }
 
@@ -86,14 +247,6 @@ impl SinCos {
         })
     }
 
-    /// The angle rotated by -90 degrees: (sin(t - pi/2), cos(t - pi/2)) = (-cos t, sin t).
-    pub fn minus_quarter_turn(self) -> Self {
-        SinCos {
-            sin: -self.cos,
-            cos: self.sin,
-        }
-    }
-
     /// The angle advanced by a small step `delta_rad` (|delta| <= 0.1 rad), by rotation
     /// with the truncated series `cos d = 1 - d^2/2 + d^4/24`, `sin d = d - d^3/6 + d^5/120`:
     /// truncation error below 2e-10 per step for |d| <= 0.1, plus f32 rounding. About ten
@@ -111,6 +264,7 @@ impl SinCos {
     }
 
     /// The negated angle: (sin(-t), cos(-t)).
+    #[inline]
     pub fn negated(self) -> Self {
         SinCos {
             sin: -self.sin,
@@ -121,27 +275,38 @@ impl SinCos {
 
 /// Clarke transform, amplitude invariant:
 /// `alpha = (2a - b - c)/3`, `beta = (b - c)/sqrt(3)`.
-/// Any zero-sequence part `(a+b+c)/3` is discarded.
-pub fn clarke(x: Abc) -> AlphaBeta {
+/// Any zero-sequence part `(a+b+c)/3` is discarded (see [`zero_sequence`]).
+#[inline]
+pub fn clarke<T: Real>(x: Abc<T>) -> AlphaBeta<T> {
     AlphaBeta {
-        alpha: (2.0 * x.a - x.b - x.c) * (1.0 / 3.0),
-        beta: (x.b - x.c) * INV_SQRT3,
+        alpha: (T::TWO * x.a - x.b - x.c) * T::ONE_THIRD,
+        beta: (x.b - x.c) * T::INV_SQRT3,
     }
 }
 
-/// Inverse Clarke transform (zero sequence set to 0):
-/// `a = alpha`, `b = -alpha/2 + sqrt(3)/2 beta`, `c = -alpha/2 - sqrt(3)/2 beta`.
-pub fn inverse_clarke(x: AlphaBeta) -> Abc {
+/// The zero-sequence part `(a + b + c)/3` that [`clarke`] discards (zero for the currents
+/// of a star-connected machine with an isolated neutral; a current sensor's offset shows
+/// here).
+#[inline]
+pub fn zero_sequence<T: Real>(x: Abc<T>) -> T {
+    (x.a + x.b + x.c) * T::ONE_THIRD
+}
+
+/// Inverse Clarke transform plus a zero-sequence part `x0` (0 for a balanced set):
+/// `a = alpha + x0`, `b = -alpha/2 + sqrt(3)/2 beta + x0`, `c = -alpha/2 - sqrt(3)/2 beta + x0`.
+#[inline]
+pub fn inverse_clarke<T: Real>(x: AlphaBeta<T>, x0: T) -> Abc<T> {
     Abc {
-        a: x.alpha,
-        b: -0.5 * x.alpha + SQRT3_2 * x.beta,
-        c: -0.5 * x.alpha - SQRT3_2 * x.beta,
+        a: x.alpha + x0,
+        b: -T::HALF * x.alpha + T::SQRT3_2 * x.beta + x0,
+        c: -T::HALF * x.alpha - T::SQRT3_2 * x.beta + x0,
     }
 }
 
 /// Park transform into the frame at angle theta:
 /// `d = alpha cos + beta sin`, `q = -alpha sin + beta cos`.
-pub fn park(x: AlphaBeta, sc: SinCos) -> Dq {
+#[inline]
+pub fn park<T: Real>(x: AlphaBeta<T>, sc: SinCos<T>) -> Dq<T> {
     Dq {
         d: x.alpha * sc.cos + x.beta * sc.sin,
         q: -x.alpha * sc.sin + x.beta * sc.cos,
@@ -149,7 +314,8 @@ pub fn park(x: AlphaBeta, sc: SinCos) -> Dq {
 }
 
 /// Inverse Park transform: `alpha = d cos - q sin`, `beta = d sin + q cos`.
-pub fn inverse_park(x: Dq, sc: SinCos) -> AlphaBeta {
+#[inline]
+pub fn inverse_park<T: Real>(x: Dq<T>, sc: SinCos<T>) -> AlphaBeta<T> {
     AlphaBeta {
         alpha: x.d * sc.cos - x.q * sc.sin,
         beta: x.d * sc.sin + x.q * sc.cos,
@@ -237,7 +403,7 @@ mod tests {
         #[test]
         fn clarke_then_inverse_keeps_zero_sum_sets(a in -1e3f32..1e3, b in -1e3f32..1e3) {
             let x = Abc { a, b, c: -a - b };
-            let y = inverse_clarke(clarke(x));
+            let y = inverse_clarke(clarke(x), 0.0);
             prop_assert!((y.a - x.a).abs() < 1e-3 && (y.b - x.b).abs() < 1e-3 && (y.c - x.c).abs() < 1e-3);
         }
 

@@ -16,13 +16,16 @@
 //! Source: the paper in `shared/seed` ("the paper"); corrections in DESIGN.md §2 and in the
 //! module docs ([`residuals`] lists the typos).
 //!
+//! The crate also holds the vocabulary every part of the workspace shares: [`Fault`] (Table
+//! 1's faults), [`EffectKind`] (the effect library's names), [`Phase`], the parameter
+//! file's [`MotorParameters`] with its one conversion to [`MotorModel`], and DESIGN.md's
+//! [`reference`] machines. With the `serde` feature (the host enables it) they serialise
+//! under their DESIGN.md names.
+//!
 //! ```
-//! use monitor_core::{Abc, Fault, Monitor, MonitorConfig, MotorModel, Sample};
+//! use monitor_core::{reference, Abc, Fault, Monitor, MonitorConfig, Sample};
 //! // The DESIGN.md 3 hp motor on 220 V, 60 Hz, sampled at 10 kHz.
-//! let motor = MotorModel {
-//!     rs_ohm: 0.435, rr_ohm: 0.816, ls_h: 0.0713, lr_h: 0.0713, lm_h: 0.0693,
-//!     pole_pairs: 2, j_kgm2: 0.089, b_nms: 0.002, bl_nms: 0.045,
-//! };
+//! let motor = reference::MOTOR_3HP.motor.model();
 //! let mut monitor = Monitor::new(MonitorConfig::new(motor, 60.0, 220.0, 10_000.0))
 //!     .expect("a valid configuration"); // ok: doc example
 //! // A NaN current is an impossible reading: no panic, the current sensor is named
@@ -50,9 +53,12 @@
 )]
 
 pub mod angle;
+pub mod effect;
 pub mod encoder;
+pub mod error;
 pub mod filter;
 pub mod frames;
+pub mod machine;
 pub mod monitor;
 pub mod residuals;
 pub mod sequence;
@@ -60,84 +66,19 @@ pub mod signature;
 pub mod threshold;
 
 pub use angle::AngleSource;
+pub use effect::EffectKind;
 pub use encoder::EncoderConfig;
-pub use frames::{Abc, AlphaBeta, Dq, SinCos};
+pub use error::{ConfigCheck, ConfigError, ConfigErrorKind};
+pub use frames::{Abc, AlphaBeta, Dq, Phase, Real, SinCos};
+pub use machine::{reference, MotorModel, MotorParameters, ReferenceMachine, SupplyParameters};
 pub use monitor::{
-    Commissioning, Monitor, MonitorConfig, MonitorOutput, ResidualForm, Sample, SensorFlags,
+    CommissioningState, Monitor, MonitorConfig, MonitorOutput, ResidualForm, Sample, SensorFlags,
     SensorLimits,
 };
-pub use residuals::{MotorModel, Operating};
-pub use sequence::{Phase, Unbalance};
+pub use residuals::Operating;
+pub use sequence::NegativeSequence;
 pub use signature::{Diagnosis, Fault, FAULT_COUNT, ROTOR_FLUX_SIGNATURES, TABLE1};
 pub use threshold::{Calibration, ThresholdConfig};
-
-#[cfg(test)]
-pub(crate) mod testing {
-    //! Shared test fixtures.
-    use crate::MotorModel;
-
-    /// The DESIGN.md 3 hp textbook machine: Xls = Xlr = 0.754 ohm, Xm = 26.13 ohm at 60 Hz.
-    pub(crate) fn motor_3hp() -> MotorModel {
-        let w = 2.0 * core::f32::consts::PI * 60.0;
-        MotorModel {
-            rs_ohm: 0.435,
-            rr_ohm: 0.816,
-            ls_h: (26.13 + 0.754) / w,
-            lr_h: (26.13 + 0.754) / w,
-            lm_h: 26.13 / w,
-            pole_pairs: 2,
-            j_kgm2: 0.089,
-            b_nms: 0.002,
-            bl_nms: 0.045,
-        }
-    }
-}
-
-/// A configuration the monitor cannot run with, found when it is built. Small and `Copy`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[non_exhaustive]
-pub enum ConfigError {
-    /// A motor parameter is not positive/finite, or Lm^2 >= Ls Lr.
-    MotorParameter,
-    /// Sample or tick rate out of range, or below 8x the supply frequency.
-    SampleRate,
-    /// Supply frequency or voltage out of range.
-    Supply,
-    /// A filter corner is not positive or too high for the supply or sample rate.
-    Filter,
-    /// Decimation outside 1..=1000, or fewer than 6 blocks per supply period.
-    Decimation,
-    /// Encoder settings impossible (zero counts, counter width, windows, max speed).
-    Encoder,
-    /// Sensor limits or timing not positive/finite.
-    Limits,
-    /// Threshold settings out of range.
-    Threshold,
-    /// A stored calibration holds non-finite or out-of-range values.
-    Calibration,
-}
-
-impl core::fmt::Display for ConfigError {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str(match self {
-            ConfigError::MotorParameter => {
-                "motor parameter out of range (all positive, Lm^2 < Ls*Lr)"
-            }
-            ConfigError::SampleRate => {
-                "sample rate out of range (100 Hz..100 kHz, >= 8x supply, ticks >= samples)"
-            }
-            ConfigError::Supply => "supply frequency or voltage out of range",
-            ConfigError::Filter => "filter corner out of range",
-            ConfigError::Decimation => {
-                "decimation must be 1..=1000 and leave >= 6 blocks per supply period"
-            }
-            ConfigError::Encoder => "encoder configuration impossible",
-            ConfigError::Limits => "sensor limits or timing out of range",
-            ConfigError::Threshold => "threshold configuration out of range",
-            ConfigError::Calibration => "calibration values not finite or out of range",
-        })
-    }
-}
 
 /// The larger of two floats in two instructions (`vcmp` + conditional move). The
 /// Cortex-M4F has no `vmaxnm`, so `f32::max` becomes a call to the C `fmaxf`; this does
@@ -181,5 +122,16 @@ pub fn sqrt(x: f32) -> f32 {
         0.5 * (y + x / y)
     } else {
         y
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod testing {
+    //! Shared test fixtures.
+    use crate::MotorModel;
+
+    /// The DESIGN.md 3 hp textbook machine in the core's precision.
+    pub(crate) fn motor_3hp() -> MotorModel {
+        crate::reference::MOTOR_3HP.motor.model()
     }
 }

@@ -10,21 +10,23 @@
 //! 4. second-order filters of `Iqs, i_ds, Vqs, wr` (values and derivatives);
 //! 5. positive/negative-sequence separation of the currents.
 //!
-//! Every `decimation` samples (1 kHz by default) the slow path evaluates the residuals
+//! Every `decimation` samples (400 Hz by default: 25 samples at 10 kHz) the slow path
+//! evaluates the residuals
 //! (eq. 37, or eq. 36 with [`ResidualForm::Full`]), normalises them, feeds commissioning or
 //! the lamp logic, and matches the lamps against Table 1. The residuals act on quantities
-//! filtered at `filter_hz` (10 Hz), so evaluating them at 1 kHz loses nothing.
+//! filtered at `filter_hz` (5 Hz by default), so evaluating them at 400 Hz loses nothing.
 
 use crate::angle::{AngleSource, RotorFluxCurrentModel, SrfPll, ZeroCrossing};
 use crate::encoder::{EncoderConfig, MtSpeed};
+use crate::error::{ensure, ConfigCheck::*, ConfigError};
 use crate::filter::{LowPass, Svf};
 use crate::frames::{clarke, park, Abc, Dq, SinCos};
-use crate::residuals::{residuals, Derivatives, MotorModel, Normaliser, Operating};
+use crate::machine::MotorModel;
+use crate::residuals::{residuals, Derivatives, Normaliser, Operating};
 use crate::sequence::sequence_result;
-use crate::sequence::{asymmetry_correction_rad, Unbalance};
-use crate::signature::{match_signature, Diagnosis, Fault, FAULT_COUNT, TABLE1};
+use crate::sequence::{asymmetry_correction_rad, NegativeSequence};
+use crate::signature::{match_signature, Diagnosis, Fault, FAULT_COUNT};
 use crate::threshold::{Calibration, Lamps, ThresholdConfig, Welford};
-use crate::ConfigError;
 use core::f32::consts::TAU;
 
 /// One sample from the sensors.
@@ -135,7 +137,7 @@ impl MonitorConfig {
         let v_phase_peak = v_ll_rms * 0.816_496_6;
         MonitorConfig {
             motor,
-            angle_source: AngleSource::RotorFlux,
+            angle_source: AngleSource::RotorFluxCurrentModel,
             residual_form: ResidualForm::Steady,
             sample_rate_hz,
             tick_hz: 1_000_000.0,
@@ -165,85 +167,106 @@ impl MonitorConfig {
     }
 
     /// Rejects a configuration that cannot work (see each field's range).
+    ///
+    /// # Errors
+    /// The first [`ConfigError`] found, naming its field (e.g. `sample_rate_hz`,
+    /// `limits.i_max`, `motor.rs_ohm`).
     pub fn validate(&self) -> Result<(), ConfigError> {
         self.motor.validate()?;
-        let dt = 1.0 / self.sample_rate_hz;
-        let fin = |x: f32| x.is_finite() && x > 0.0;
-        if !(fin(self.sample_rate_hz) && (100.0..=100_000.0).contains(&self.sample_rate_hz)) {
-            return Err(ConfigError::SampleRate);
-        }
-        if !(fin(self.tick_hz) && self.tick_hz >= self.sample_rate_hz) {
-            return Err(ConfigError::SampleRate);
-        }
-        if !(fin(self.supply_hz)
-            && (1.0..=400.0).contains(&self.supply_hz)
-            && fin(self.v_phase_peak))
-        {
-            return Err(ConfigError::Supply);
-        }
-        if self.supply_hz * 8.0 > self.sample_rate_hz {
-            return Err(ConfigError::SampleRate);
-        }
-        if self.decimation == 0 || self.decimation > 1000 {
-            return Err(ConfigError::Decimation);
-        }
-        // The d-q filters run once per block of `decimation` samples.
-        let slow_dt = dt * f32::from(self.decimation);
-        if !(fin(self.filter_hz)
-            && self.filter_hz < self.supply_hz * 0.5
-            && TAU * self.filter_hz * slow_dt <= 0.2)
-        {
-            return Err(ConfigError::Filter);
-        }
-        if !(fin(self.sequence_hz)
-            && self.sequence_hz < self.supply_hz * 0.5
-            && TAU * self.sequence_hz * slow_dt <= 0.2)
-            || !fin(self.pll_bw_hz)
-        {
-            return Err(ConfigError::Filter);
-        }
+        self.validate_rates()?;
+        self.validate_filters()?;
+        self.validate_encoder()?;
+        self.validate_limits()?;
+        self.thresholds.validate()
+    }
+
+    fn validate_rates(&self) -> Result<(), ConfigError> {
+        ensure(
+            positive(self.sample_rate_hz) && (100.0..=100_000.0).contains(&self.sample_rate_hz),
+            SampleRate,
+        )?;
+        ensure(
+            positive(self.tick_hz) && self.tick_hz >= self.sample_rate_hz,
+            TickRate,
+        )?;
+        ensure(
+            positive(self.supply_hz) && (1.0..=400.0).contains(&self.supply_hz),
+            SupplyHz,
+        )?;
+        ensure(positive(self.v_phase_peak), PhasePeakVoltage)?;
+        ensure(
+            self.supply_hz * 8.0 <= self.sample_rate_hz,
+            SampleRateVsSupply,
+        )?;
+        ensure((1..=1000).contains(&self.decimation), Decimation)?;
         // The block average feeds filters that must see the 2f ripple (negative sequence)
         // well below their Nyquist frequency: at least 6 blocks per supply period (slow
         // rate >= 6 f, so 2f <= 1/3 of it).
-        if self.sample_rate_hz / f32::from(self.decimation) < 6.0 * self.supply_hz {
-            return Err(ConfigError::Decimation);
-        }
+        ensure(
+            self.sample_rate_hz / f32::from(self.decimation) >= 6.0 * self.supply_hz,
+            BlocksPerPeriod,
+        )
+    }
+
+    fn validate_filters(&self) -> Result<(), ConfigError> {
+        // The d-q filters run once per block of `decimation` samples.
+        let slow_dt = f32::from(self.decimation.max(1)) / self.sample_rate_hz;
+        let corner_ok =
+            |fc: f32| positive(fc) && fc < self.supply_hz * 0.5 && TAU * fc * slow_dt <= 0.2;
+        ensure(corner_ok(self.filter_hz), FilterCorner)?;
+        ensure(corner_ok(self.sequence_hz), SequenceCorner)?;
+        ensure(positive(self.pll_bw_hz), PllBandwidth)
+    }
+
+    fn validate_encoder(&self) -> Result<(), ConfigError> {
         let e = &self.encoder;
-        if e.counts_per_rev == 0
-            || !(8..=32).contains(&e.counter_bits)
-            || !fin(e.min_window_s)
-            || !(e.timeout_s > e.min_window_s)
-        {
-            return Err(ConfigError::Encoder);
-        }
+        ensure(e.counts_per_rev > 0, EncoderCounts)?;
+        ensure((8..=32).contains(&e.counter_bits), EncoderCounterBits)?;
+        ensure(positive(e.min_window_s), EncoderMinWindow)?;
+        ensure(e.timeout_s > e.min_window_s, EncoderTimeout)?;
         // Counts per sample at max speed must stay below half the counter range.
-        let max_counts = self.limits.max_speed_rad_s / TAU * e.counts_per_rev as f32 * dt;
+        let max_counts =
+            self.limits.max_speed_rad_s / TAU * e.counts_per_rev as f32 / self.sample_rate_hz;
         let half = if e.counter_bits >= 32 {
             2.1e9
         } else {
             (1u32 << (e.counter_bits - 1)) as f32
         };
-        if !(max_counts < half) {
-            return Err(ConfigError::Encoder);
-        }
-        let l = &self.limits;
-        if !(fin(l.v_max) && fin(l.i_max) && fin(l.max_speed_rad_s) && fin(l.current_sum_frac))
-            || !(l.voltage_sum_frac.is_finite() && l.voltage_sum_frac >= 0.0)
-        {
-            return Err(ConfigError::Limits);
-        }
-        if !(self.settle_s.is_finite() && self.settle_s >= 0.0)
-            || !(self.min_voltage_frac.is_finite() && (0.0..1.0).contains(&self.min_voltage_frac))
-            || !(self.unbalance_min_ratio.is_finite() && self.unbalance_min_ratio >= 0.0)
-            || !fin(self.floor_fraction)
-            || !(self.steady_gate_per_s.is_finite() && self.steady_gate_per_s >= 0.0)
-            || !(self.gate_hold_s.is_finite() && self.gate_hold_s >= 0.0)
-            || !(self.gate_timeout_s.is_finite() && self.gate_timeout_s > self.gate_hold_s)
-        {
-            return Err(ConfigError::Limits);
-        }
-        self.thresholds.validate()
+        ensure(max_counts < half, EncoderMaxStep)
     }
+
+    fn validate_limits(&self) -> Result<(), ConfigError> {
+        let l = &self.limits;
+        let at_least_0 = |x: f32| x.is_finite() && x >= 0.0;
+        for (ok, check) in [
+            (positive(l.v_max), VoltageLimit),
+            (positive(l.i_max), CurrentLimit),
+            (positive(l.max_speed_rad_s), SpeedLimit),
+            (positive(l.current_sum_frac), CurrentSumFraction),
+            (at_least_0(l.voltage_sum_frac), VoltageSumFraction),
+            (at_least_0(self.settle_s), SettleTime),
+            (
+                self.min_voltage_frac.is_finite() && (0.0..1.0).contains(&self.min_voltage_frac),
+                MinVoltageFraction,
+            ),
+            (at_least_0(self.unbalance_min_ratio), UnbalanceMinRatio),
+            (positive(self.floor_fraction), FloorFraction),
+            (at_least_0(self.steady_gate_per_s), SteadyGate),
+            (at_least_0(self.gate_hold_s), GateHold),
+            (
+                self.gate_timeout_s.is_finite() && self.gate_timeout_s > self.gate_hold_s,
+                GateTimeout,
+            ),
+        ] {
+            ensure(ok, check)?;
+        }
+        Ok(())
+    }
+}
+
+/// Positive and finite.
+fn positive(x: f32) -> bool {
+    x.is_finite() && x > 0.0
 }
 
 /// Sensor-fault flags from impossible readings.
@@ -266,7 +289,7 @@ impl SensorFlags {
 
 /// Commissioning state.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub enum Commissioning {
+pub enum CommissioningState {
     /// No calibration: fixed thresholds are in use.
     #[default]
     NotCommissioned,
@@ -301,9 +324,9 @@ pub struct MonitorOutput {
     /// False while the operating point is changing (see `steady_gate_per_s`).
     pub quasi_steady: bool,
     /// Commissioning state.
-    pub commissioning: Commissioning,
+    pub commissioning: CommissioningState,
     /// Negative-sequence analysis of the currents.
-    pub unbalance: Unbalance,
+    pub unbalance: NegativeSequence,
 }
 
 impl MonitorOutput {
@@ -467,10 +490,7 @@ impl Monitor {
     /// rotor-flux orientation, the paper's Table 1 for voltage orientation (see
     /// [`crate::signature`]).
     pub fn signatures(&self) -> &'static [[bool; 4]; FAULT_COUNT] {
-        match self.cfg.angle_source {
-            AngleSource::RotorFlux => &crate::signature::ROTOR_FLUX_SIGNATURES,
-            AngleSource::Pll | AngleSource::ZeroCrossing => &TABLE1,
-        }
+        crate::signature::signatures_for(self.cfg.angle_source)
     }
 
     /// The configuration in use.
@@ -501,11 +521,11 @@ impl Monitor {
     /// Installs a stored calibration.
     ///
     /// # Errors
-    /// [`ConfigError::Calibration`] when a value is not finite or out of range; the monitor
+    /// [`crate::ConfigErrorKind::Calibration`] when a value is not finite or out of range; the monitor
     /// then keeps its previous thresholds.
     pub fn set_calibration(&mut self, cal: Calibration) -> Result<(), ConfigError> {
         if !cal.is_valid() {
-            return Err(ConfigError::Calibration);
+            return Err(ConfigError::new(Calibration));
         }
         self.lamps.set_calibration(Some(cal));
         self.commission_left = 0;
@@ -564,10 +584,10 @@ impl Monitor {
                 self.sc = sc_pll.rotated(w * self.dt);
                 sc_pll.minus_quarter_turn()
             }
-            AngleSource::RotorFlux => self.sc,
+            AngleSource::RotorFluxCurrentModel => self.sc,
         };
         let i_dq: Dq = park(i, sc);
-        if self.cfg.angle_source == AngleSource::RotorFlux {
+        if self.cfg.angle_source == AngleSource::RotorFluxCurrentModel {
             self.rfo.update(i_dq, wr);
             self.sc = sc.rotated(self.rfo.omega_rad_s() * self.dt);
         }
@@ -593,11 +613,7 @@ impl Monitor {
                 *h = self.hold_blocks.max(1);
             }
         }
-        self.out.sensor_fault = SensorFlags {
-            current: self.sensor_hold[0] > 0,
-            voltage: self.sensor_hold[1] > 0,
-            speed: self.sensor_hold[2] > 0,
-        };
+        self.out.sensor_fault = self.held_sensor_flags();
         let sf = self.out.sensor_fault;
         // An impossible reading names its sensor outright.
         let mut p = [0.0f32; FAULT_COUNT];
@@ -659,7 +675,8 @@ impl Monitor {
         self.sc = SinCos::default();
     }
 
-    // Kept out of line so the per-sample path does not carry its register pressure.
+    // Kept out of line so the per-sample path does not carry its register pressure. The
+    // steps are separate functions for reading; each is inlined here.
     #[inline(never)]
     fn slow_path(&mut self, s: &Sample, wr: f32) {
         // Plausibility of the block: saturation flags, range (NaN and inf fail, see update).
@@ -673,10 +690,55 @@ impl Monitor {
             self.discard_block();
             return;
         }
-        // Resynchronise the frame's sin/cos with the estimator's angle.
+        let iqs = self.filter_block(wr);
+        self.check_sums(s);
+        let op = Operating {
+            iqs: self.f_iqs.y,
+            i_f: self.f_ids.y,
+            vqs: self.f_vqs.y,
+            wr: self.f_wr.y,
+        };
+        self.out.operating = op;
+        let d = match self.cfg.residual_form {
+            ResidualForm::Steady => None,
+            ResidualForm::Full => Some(Derivatives {
+                diqs: self.f_iqs.dy,
+                ddiqs: self.f_iqs.ddy(iqs),
+                dwr: self.f_wr.dy,
+                ddwr: self.f_wr.ddy(wr),
+                dvqs: self.f_vqs.dy,
+            }),
+        };
+        let raw = residuals(&self.cfg.motor, op, d);
+        let Some(rn) = self.norm.apply(&raw) else {
+            return;
+        };
+        self.out.residuals = rn;
+        self.update_gate();
+        self.update_lamps(rn);
+        if self.out.sensor_fault.any() {
+            self.matched_lamps = None;
+        } else if self.matched_lamps != Some(self.out.lamps) {
+            // Matching only when the lamps change.
+            self.out.diagnosis = match_signature(self.out.lamps, self.signatures());
+            self.matched_lamps = Some(self.out.lamps);
+        }
+        // Negative sequence: ten times a second is plenty for a 2 Hz filter.
+        if self.report_countdown == 0 {
+            self.report_countdown = self.report_every;
+            self.update_negative_sequence(op.wr);
+        }
+        self.report_countdown -= 1;
+        self.out.fault_detected = self.out.sensor_fault.any() || self.out.lamps.iter().any(|x| *x);
+    }
+
+    /// Ends the block: resynchronises the frame's sin/cos with the estimator's angle, feeds
+    /// the block means to the d-q filters and returns the block's mean I_qs.
+    #[inline(always)]
+    fn filter_block(&mut self, wr: f32) -> f32 {
         match self.cfg.angle_source {
             AngleSource::Pll => self.sc = SinCos::from_angle(self.pll.theta_pll()),
-            AngleSource::RotorFlux => self.sc = SinCos::from_angle(self.rfo.theta()),
+            AngleSource::RotorFluxCurrentModel => self.sc = SinCos::from_angle(self.rfo.theta()),
             AngleSource::ZeroCrossing => {}
         }
         let k = 1.0 / f32::from(self.acc_n.max(1));
@@ -693,11 +755,15 @@ impl Monitor {
         self.out.frame_omega_rad_s = match self.cfg.angle_source {
             AngleSource::ZeroCrossing => self.zc.omega_rad_s(),
             AngleSource::Pll => self.pll.omega_rad_s(),
-            AngleSource::RotorFlux => self.rfo.omega_rad_s(),
+            AngleSource::RotorFluxCurrentModel => self.rfo.omega_rad_s(),
         };
+        iqs
+    }
 
-        // Voltage magnitude (frame independent) and sum checks, on this block's last sample
-        // (3-wire machine: ia + ib + ic = 0).
+    /// Voltage magnitude (frame independent) and the sum checks on this block's last sample
+    /// (3-wire machine: ia + ib + ic = 0); ages the sensor-fault hold and the settling time.
+    #[inline(always)]
+    fn check_sums(&mut self, s: &Sample) {
         let vab = clarke(s.v_abc);
         self.vmag.update(crate::fast_hypot(vab.alpha, vab.beta));
         let l = self.cfg.limits;
@@ -721,39 +787,26 @@ impl Monitor {
         for h in self.sensor_hold.iter_mut() {
             *h = h.saturating_sub(1);
         }
-        self.out.sensor_fault = SensorFlags {
-            current: self.sensor_hold[0] > 0,
-            voltage: self.sensor_hold[1] > 0,
-            speed: self.sensor_hold[2] > 0,
-        };
+        self.out.sensor_fault = self.held_sensor_flags();
         if was_flagged && !self.out.sensor_fault.any() {
             self.out.diagnosis = Diagnosis::default();
         }
         self.settle_left = self.settle_left.saturating_sub(1);
+    }
 
-        let op = Operating {
-            iqs: self.f_iqs.y,
-            i_f: self.f_ids.y,
-            vqs: self.f_vqs.y,
-            wr: self.f_wr.y,
-        };
-        self.out.operating = op;
-        let d = match self.cfg.residual_form {
-            ResidualForm::Steady => None,
-            ResidualForm::Full => Some(Derivatives {
-                diqs: self.f_iqs.dy,
-                ddiqs: self.f_iqs.ddy(iqs),
-                dwr: self.f_wr.dy,
-                ddwr: self.f_wr.ddy(wr),
-                dvqs: self.f_vqs.dy,
-            }),
-        };
-        let raw = residuals(&self.cfg.motor, op, d);
-        let Some(rn) = self.norm.apply(&raw) else {
-            return;
-        };
-        self.out.residuals = rn;
-        // Quasi-steady-state gate on the filtered derivatives.
+    /// The sensor faults still within their hold time.
+    #[inline(always)]
+    fn held_sensor_flags(&self) -> SensorFlags {
+        SensorFlags {
+            current: self.sensor_hold[0] > 0,
+            voltage: self.sensor_hold[1] > 0,
+            speed: self.sensor_hold[2] > 0,
+        }
+    }
+
+    /// Quasi-steady-state gate on the filtered derivatives (`steady_gate_per_s`).
+    #[inline(always)]
+    fn update_gate(&mut self) {
         let g = self.cfg.steady_gate_per_s;
         if g > 0.0 {
             let [fi, fv, fw] = self.gate_floor;
@@ -774,6 +827,12 @@ impl Monitor {
         }
         self.out.quasi_steady =
             self.gate_left == 0 || self.gate_closed_for > self.gate_timeout_blocks;
+    }
+
+    /// Commissioning (learning the healthy statistics) or the lamp logic, on the normalised
+    /// residuals `rn`, while the motor runs settled and quasi-steady.
+    #[inline(always)]
+    fn update_lamps(&mut self, rn: [f32; 4]) {
         let running = self.settle_left == 0
             && self.vmag.y > self.cfg.min_voltage_frac * self.cfg.v_phase_peak
             && !self.out.sensor_fault.any();
@@ -793,38 +852,27 @@ impl Monitor {
         self.out.evaluating = running && self.out.quasi_steady && self.commission_left == 0;
         self.out.commissioning = if self.commission_left > 0 {
             let total = self.commission_total.max(1) as f32;
-            Commissioning::Learning(1.0 - self.commission_left as f32 / total)
+            CommissioningState::Learning(1.0 - self.commission_left as f32 / total)
         } else if self.lamps.calibration().is_some() {
-            Commissioning::Commissioned
+            CommissioningState::Commissioned
         } else {
-            Commissioning::NotCommissioned
+            CommissioningState::NotCommissioned
         };
-        if self.out.sensor_fault.any() {
-            self.matched_lamps = None;
-        } else if self.matched_lamps != Some(self.out.lamps) {
-            // Matching only when the lamps change.
-            self.out.diagnosis = match_signature(self.out.lamps, self.signatures());
-            self.matched_lamps = Some(self.out.lamps);
-        }
-        // Negative sequence: ten times a second is plenty for a 2 Hz filter.
-        if self.report_countdown == 0 {
-            self.report_countdown = self.report_every;
-            let we = self.out.frame_omega_rad_s;
-            let slip = if we.abs() > 1.0 {
-                1.0 - op.wr / we
-            } else {
-                0.0
-            };
-            let corr = asymmetry_correction_rad(&self.cfg.motor, we.abs().max(1.0), slip);
-            self.out.unbalance = sequence_result(
-                (self.f_ids.y, self.f_iqs.y),
-                (self.f_nd.y, self.f_nq.y),
-                corr,
-                self.cfg.unbalance_min_ratio,
-            );
-        }
-        self.report_countdown -= 1;
-        self.out.fault_detected = self.out.sensor_fault.any() || self.out.lamps.iter().any(|x| *x);
+    }
+
+    /// The negative-sequence result with the faulty-phase correction at the present slip
+    /// (electrical rotor speed `wr`).
+    #[inline(always)]
+    fn update_negative_sequence(&mut self, wr: f32) {
+        let we = self.out.frame_omega_rad_s;
+        let slip = if we.abs() > 1.0 { 1.0 - wr / we } else { 0.0 };
+        let corr = asymmetry_correction_rad(&self.cfg.motor, we.abs().max(1.0), slip);
+        self.out.unbalance = sequence_result(
+            (self.f_ids.y, self.f_iqs.y),
+            (self.f_nd.y, self.f_nq.y),
+            corr,
+            self.cfg.unbalance_min_ratio,
+        );
     }
 }
 
@@ -878,19 +926,34 @@ mod tests {
         assert!(Monitor::new(good).is_ok());
         let mut c = good;
         c.motor.lm_h = c.motor.ls_h * 1.1;
-        assert_eq!(Monitor::new(c).err(), Some(ConfigError::MotorParameter));
+        assert_eq!(
+            Monitor::new(c).err().map(|e| e.kind()),
+            Some(crate::ConfigErrorKind::MotorParameter)
+        );
         let mut c = good;
         c.sample_rate_hz = 300.0;
-        assert_eq!(Monitor::new(c).err(), Some(ConfigError::SampleRate));
+        assert_eq!(
+            Monitor::new(c).err().map(|e| e.kind()),
+            Some(crate::ConfigErrorKind::SampleRate)
+        );
         let mut c = good;
         c.encoder.counter_bits = 40;
-        assert_eq!(Monitor::new(c).err(), Some(ConfigError::Encoder));
+        assert_eq!(
+            Monitor::new(c).err().map(|e| e.kind()),
+            Some(crate::ConfigErrorKind::Encoder)
+        );
         let mut c = good;
         c.thresholds.hysteresis = 0.0;
-        assert_eq!(Monitor::new(c).err(), Some(ConfigError::Threshold));
+        assert_eq!(
+            Monitor::new(c).err().map(|e| e.kind()),
+            Some(crate::ConfigErrorKind::Threshold)
+        );
         let mut c = good;
         c.filter_hz = f32::NAN;
-        assert_eq!(Monitor::new(c).err(), Some(ConfigError::Filter));
+        assert_eq!(
+            Monitor::new(c).err().map(|e| e.kind()),
+            Some(crate::ConfigErrorKind::Filter)
+        );
     }
 
     #[test]
@@ -931,7 +994,7 @@ mod tests {
 
     #[test]
     fn encoder_jump_names_the_speed_sensor() {
-        let mut m = monitor(AngleSource::RotorFlux);
+        let mut m = monitor(AngleSource::RotorFluxCurrentModel);
         for k in 0..1000 {
             m.update(&healthy(k));
         }
@@ -950,7 +1013,7 @@ mod tests {
                     Just(-f32::MAX), Just(0.0f32), -1e6f32..1e6, -300f32..300.0,
                 ], 6..60),
             counts in proptest::collection::vec(any::<u32>(), 1..20),
-            src in prop_oneof![Just(AngleSource::RotorFlux), Just(AngleSource::Pll), Just(AngleSource::ZeroCrossing)],
+            src in prop_oneof![Just(AngleSource::RotorFluxCurrentModel), Just(AngleSource::Pll), Just(AngleSource::ZeroCrossing)],
         ) {
             let mut m = monitor(src);
             m.start_commissioning(0.01);

@@ -1,6 +1,7 @@
 //! The simplified D-Q model and its parity-equation residuals (paper section 3).
 //!
-//! Symbols (DESIGN.md §2): `Ra = Rs + (Ls/Lr) Rr` (eq. 24), `La = sigma Ls`,
+//! Symbols (DESIGN.md §2, computed by [`MotorModel`]'s methods): `Ra = Rs + (Ls/Lr) Rr`
+//! (eq. 24), `La = sigma Ls`,
 //! `Psi = Ls i_f` (the paper prints `Psi = Ls` and `i_f = Ls i_ds` under eq. 34: both are
 //! typos; the coefficient of omega_r in eq. 28 is `Ls i_f`), `Kf = 3/2 Np Lm^2/Lr i_f`
 //! (eq. 25 with `P/2 = Np`), `k1 = Psi Kf Np + Ra (B+Bl)`, `k2 = La (B+Bl) + J Ra` (eq. 35).
@@ -28,80 +29,7 @@
 //! healthy machine in steady state in rotor-flux orientation, and comparable across motors,
 //! which is what the thresholds act on.
 
-/// Nominal machine parameters for the core (f32, SI). Self inductances include leakage.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MotorModel {
-    /// Stator resistance Rs [ohm], > 0.
-    pub rs_ohm: f32,
-    /// Rotor resistance Rr referred to the stator [ohm], > 0.
-    pub rr_ohm: f32,
-    /// Stator self inductance Ls [H], > Lm or = Lm with Lr > Lm.
-    pub ls_h: f32,
-    /// Rotor self inductance Lr [H].
-    pub lr_h: f32,
-    /// Magnetising inductance Lm [H], Lm^2 < Ls Lr.
-    pub lm_h: f32,
-    /// Pole pairs Np (poles / 2), >= 1.
-    pub pole_pairs: u8,
-    /// Inertia J [kg m^2], > 0.
-    pub j_kgm2: f32,
-    /// Machine friction B on the shaft [N m s/rad], >= 0.
-    pub b_nms: f32,
-    /// Load friction Bl on the shaft [N m s/rad], >= 0.
-    pub bl_nms: f32,
-}
-
-impl MotorModel {
-    /// Leakage coefficient sigma = 1 - Lm^2/(Ls Lr).
-    pub fn sigma(&self) -> f32 {
-        1.0 - self.lm_h * self.lm_h / (self.ls_h * self.lr_h)
-    }
-    /// Ra = Rs + (Ls/Lr) Rr [ohm] (eq. 24).
-    pub fn ra_ohm(&self) -> f32 {
-        self.rs_ohm + self.ls_h / self.lr_h * self.rr_ohm
-    }
-    /// La = sigma Ls [H] (transient inductance).
-    pub fn la_h(&self) -> f32 {
-        self.sigma() * self.ls_h
-    }
-    /// Np as f32.
-    pub fn np(&self) -> f32 {
-        f32::from(self.pole_pairs)
-    }
-    /// Kf / i_f = 3/2 Np Lm^2/Lr [N m/A^2] (eq. 25 without the i_f factor).
-    pub fn kf_per_if(&self) -> f32 {
-        1.5 * self.np() * self.lm_h * self.lm_h / self.lr_h
-    }
-    /// Checks ranges; returns the first problem.
-    pub fn validate(&self) -> Result<(), crate::ConfigError> {
-        use crate::ConfigError::MotorParameter as E;
-        let pos = [
-            self.rs_ohm,
-            self.rr_ohm,
-            self.ls_h,
-            self.lr_h,
-            self.lm_h,
-            self.j_kgm2,
-        ];
-        if pos.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
-            return Err(E);
-        }
-        if !(self.b_nms.is_finite()
-            && self.b_nms >= 0.0
-            && self.bl_nms.is_finite()
-            && self.bl_nms >= 0.0)
-        {
-            return Err(E);
-        }
-        if self.pole_pairs == 0 || self.ls_h < self.lm_h || self.lr_h < self.lm_h {
-            return Err(E);
-        }
-        if !(self.sigma() > 1e-4) {
-            return Err(E);
-        }
-        Ok(())
-    }
-}
+use crate::machine::MotorModel;
 
 /// The model's inputs and outputs at one instant, in the chosen d-q frame.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]

@@ -17,37 +17,20 @@
 //! inductive at no load, mostly resistive at full load), which is why the correction is
 //! computed at the operating point. A supply unbalance gives a negative sequence too; this
 //! analysis cannot tell the two apart without the voltages (see the host's `explain`).
+//!
+//! This is the workspace's one faulty-phase method ([`suspect_phase`]): the monitor, the
+//! host's replay of current-only logs and the host's model-vs-measurement analysis all
+//! name the phase with it. Where the slip is not measured (a log with currents only),
+//! [`slip_for_current`] estimates it from the current magnitude.
 
 use crate::filter::Svf;
-use crate::frames::{park, AlphaBeta, SinCos};
-use crate::residuals::MotorModel;
+use crate::frames::{park, AlphaBeta, Phase, SinCos};
+use crate::machine::MotorModel;
 use micromath::F32Ext;
 
-/// A phase of the machine.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Phase {
-    /// Phase a.
-    A,
-    /// Phase b.
-    B,
-    /// Phase c.
-    C,
-}
-
-impl Phase {
-    /// "a", "b" or "c".
-    pub fn name(self) -> &'static str {
-        match self {
-            Phase::A => "a",
-            Phase::B => "b",
-            Phase::C => "c",
-        }
-    }
-}
-
-/// Result of the negative-sequence analysis.
+/// Result of the negative-sequence analysis of the currents.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Unbalance {
+pub struct NegativeSequence {
     /// |I2| / |I1|, dimensionless, >= 0.
     pub negative_sequence_ratio: f32,
     /// arg(I2/I1) [rad], in (-pi, pi].
@@ -98,7 +81,7 @@ impl SequenceAnalyzer {
 
     /// Ratio, angle and suspect phase, given the model correction `arg(Z1/Z2)` and the
     /// ratio below which no phase is named.
-    pub fn result(&self, correction_rad: f32, min_ratio: f32) -> Unbalance {
+    pub fn result(&self, correction_rad: f32, min_ratio: f32) -> NegativeSequence {
         sequence_result(
             (self.pd.y, self.pq.y),
             (self.nd.y, self.nq.y),
@@ -115,30 +98,65 @@ pub fn sequence_result(
     n: (f32, f32),
     correction_rad: f32,
     min_ratio: f32,
-) -> Unbalance {
+) -> NegativeSequence {
     let p2 = p.0 * p.0 + p.1 * p.1;
     let n2 = n.0 * n.0 + n.1 * n.1;
     if !(p2 > 1e-12 && n2.is_finite()) {
-        return Unbalance::default();
+        return NegativeSequence::default();
     }
     let ratio = crate::sqrt(n2 / p2);
     let angle = crate::frames::wrap_angle(F32Ext::atan2(-n.1, n.0) - F32Ext::atan2(p.1, p.0));
-    let suspect = if ratio >= min_ratio {
-        let third = core::f32::consts::TAU / 3.0;
-        let k = F32Ext::round(crate::frames::wrap_angle(angle - correction_rad) / third) as i32;
-        Some(match k.rem_euclid(3) {
-            0 => Phase::A,
-            1 => Phase::B,
-            _ => Phase::C,
-        })
-    } else {
-        None
-    };
-    Unbalance {
+    let suspect = (ratio >= min_ratio).then(|| suspect_phase(angle, correction_rad));
+    NegativeSequence {
         negative_sequence_ratio: ratio,
         angle_rad: angle,
         suspect_phase: suspect,
     }
+}
+
+/// The phase a winding asymmetry sits in (module docs): the angle of `I2/I1` [rad] minus
+/// the correction `arg(Z1/Z2)` ([`asymmetry_correction_rad`]) rounded to the nearest
+/// multiple of 120 degrees, `k` thirds of a turn naming phase `k` (a, b, c). Assumes the
+/// winding lost impedance (shorted turns), the common fault; any finite angles.
+pub fn suspect_phase(i2_over_i1_angle_rad: f32, correction_rad: f32) -> Phase {
+    let third = core::f32::consts::TAU / 3.0;
+    let k = F32Ext::round(crate::frames::wrap_angle(i2_over_i1_angle_rad - correction_rad) / third)
+        as i32;
+    Phase::from_turns(k)
+}
+
+/// Fraction `eps` of a winding's impedance that an asymmetry with `|I2/I1| = ratio` has
+/// lost, from the first-order relation of the module docs, `|I2/I1| = (eps/3) |Z1/Z2|`,
+/// with `Z1 = Z(s)` and `Z2 = Z(2 - s)` at supply `we` [rad/s] and slip `s`.
+pub fn winding_change_fraction(m: &MotorModel, we: f32, s: f32, ratio: f32) -> f32 {
+    let z1 = equivalent_impedance(m, we, s);
+    let z2 = equivalent_impedance(m, we, 2.0 - s);
+    let z1n = crate::fast_hypot(z1.0, z1.1);
+    if !(z1n > 0.0) {
+        return 0.0;
+    }
+    3.0 * ratio * crate::fast_hypot(z2.0, z2.1) / z1n
+}
+
+/// The slip at which the equivalent circuit on a supply of peak phase voltage `v_peak` [V]
+/// and angular frequency `we` [rad/s] draws the positive-sequence current magnitude
+/// `i1_peak` [A] (phase peak): bisection on 1e-4..0.5 (40 steps, to 5e-13 of the range).
+/// For logs without a speed column, where the slip that [`asymmetry_correction_rad`] needs
+/// is not measured; a current below the no-load current gives about 1e-4 (no load), one
+/// above the current at 50 % slip gives 0.5.
+pub fn slip_for_current(m: &MotorModel, v_peak: f32, we: f32, i1_peak: f32) -> f32 {
+    let (mut lo, mut hi) = (1e-4f32, 0.5f32);
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        let z = equivalent_impedance(m, we, mid);
+        let i = v_peak / crate::fast_hypot(z.0, z.1);
+        if i < i1_peak {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
 }
 
 /// Impedance of the T-equivalent circuit per phase at slip `s` and supply `we` [rad/s]:

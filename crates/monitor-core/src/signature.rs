@@ -27,8 +27,11 @@
 //!     error detunes the frame; with voltage orientation (PLL, zero crossing) the paper's
 //!     `1 1 0 1` is reproduced.
 
-/// The faults of Table 1.
+/// The faults of Table 1, the workspace's one fault vocabulary (the simulator injects
+/// them, the core names them, the command line and JSON reports use [`Fault::name`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum Fault {
     /// Stator resistance Rs.
     Rs,
@@ -48,6 +51,12 @@ pub enum Fault {
     VoltageSensor,
     /// Speed sensor (omega_r).
     SpeedSensor,
+}
+
+impl core::fmt::Display for Fault {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 /// Number of faults in Table 1.
@@ -133,6 +142,15 @@ pub const ROTOR_FLUX_SIGNATURES: [[bool; 4]; FAULT_COUNT] = [
     [true, false, true, true], // voltage sensor
     [true, true, true, true],  // speed sensor (encoder)
 ];
+
+/// The fault signature matrix for a frame: the physical one ([`ROTOR_FLUX_SIGNATURES`])
+/// in rotor-flux orientation, the paper's [`TABLE1`] in voltage orientation (module docs).
+pub fn signatures_for(angle_source: crate::AngleSource) -> &'static [[bool; 4]; FAULT_COUNT] {
+    match angle_source {
+        crate::AngleSource::RotorFluxCurrentModel => &ROTOR_FLUX_SIGNATURES,
+        crate::AngleSource::Pll | crate::AngleSource::ZeroCrossing => &TABLE1,
+    }
+}
 
 /// Result of matching lamps against Table 1.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

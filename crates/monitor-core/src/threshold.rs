@@ -66,28 +66,25 @@ impl Default for ThresholdConfig {
 
 impl ThresholdConfig {
     /// Checks ranges.
+    ///
+    /// # Errors
+    /// [`crate::ConfigErrorKind::Threshold`] naming the first field out of range.
     pub fn validate(&self) -> Result<(), crate::ConfigError> {
-        let ok = self
-            .fixed
-            .iter()
-            .all(|x| x.is_finite() && *x > 0.0 && *x <= 1.0)
-            && self
-                .min_band
-                .iter()
-                .all(|x| x.is_finite() && *x > 0.0 && *x <= 1.0)
-            && self.k_sigma.is_finite()
-            && self.k_sigma > 0.0
-            && self.debounce_s.is_finite()
-            && self.debounce_s >= 0.0
-            && self.release_s.is_finite()
-            && self.release_s >= 0.0
-            && self.hysteresis > 0.0
-            && self.hysteresis <= 1.0;
-        if ok {
-            Ok(())
-        } else {
-            Err(crate::ConfigError::Threshold)
-        }
+        use crate::error::{ensure, ConfigCheck::*};
+        let fraction = |x: &f32| x.is_finite() && *x > 0.0 && *x <= 1.0;
+        let time = |x: f32| x.is_finite() && x >= 0.0;
+        ensure(self.fixed.iter().all(fraction), ThresholdFixed)?;
+        ensure(self.min_band.iter().all(fraction), ThresholdMinBand)?;
+        ensure(
+            self.k_sigma.is_finite() && self.k_sigma > 0.0,
+            ThresholdKSigma,
+        )?;
+        ensure(time(self.debounce_s), ThresholdDebounce)?;
+        ensure(time(self.release_s), ThresholdRelease)?;
+        ensure(
+            self.hysteresis > 0.0 && self.hysteresis <= 1.0,
+            ThresholdHysteresis,
+        )
     }
 }
 

@@ -1,9 +1,11 @@
 //! The effect library: named physical effects the simplified model can be extended with.
 //!
-//! Every effect implements [`Effect`]: its DESIGN.md name, a physical description, its
-//! parameters with units, the way it changes the model equations (in words and in code:
-//! [`Effect::apply`] writes its contribution into [`Terms`]) and a sentence a drives
-//! engineer understands for fitted values ([`Effect::describe`]).
+//! Every effect implements [`EffectModel`]: which [`EffectKind`] it is (its DESIGN.md
+//! name), a physical description, its parameters with units, the way it changes the model
+//! equations (in words and in code: [`EffectModel::apply`] writes its contribution into
+//! [`EffectTerms`]) and a sentence a drives engineer understands for fitted values
+//! ([`EffectModel::describe`]). [`model_of`] gives the model of a kind. (The simulator
+//! injects the same effects with `crate::sim::EffectSpec`.)
 //!
 //! | name | parameters | model change |
 //! |---|---|---|
@@ -18,8 +20,9 @@
 //! | `flux_dynamics` | tau_r_s [s] | psi_r/Lm = phi, dphi/dt = (i_f - phi)/tau_r; slip and torque from phi |
 //! | `current_dynamics` | la_h [H] | La dI_qs/dt = V_qs - Ra I_qs - Psi omega_r (eq. 28's derivative term) |
 
-use super::model::{Nominal, Terms};
 use super::prep::{Prepared, C64};
+use super::simplified_model::{EffectTerms, MachineConstants};
+use monitor_core::EffectKind;
 
 /// Copper temperature coefficient of resistance [1/K] (0.393 %/K at 20 C).
 pub const ALPHA_CU_PER_K: f64 = 0.00393;
@@ -47,7 +50,7 @@ pub struct Needs {
 /// Data-dependent set-up of an effect: initial values, bounds and scales of its parameters
 /// (same order as the names), plus any precomputed data (for example load-step times).
 #[derive(Debug, Clone, Default)]
-pub struct Setup {
+pub struct FitSetup {
     /// Parameter names (for `load_torque` one per segment).
     pub names: Vec<String>,
     /// Units, parallel to `names`.
@@ -64,7 +67,7 @@ pub struct Setup {
     pub data: Vec<f64>,
 }
 
-impl Setup {
+impl FitSetup {
     fn push(&mut self, name: &str, unit: &'static str, init: f64, lo: f64, hi: f64, scale: f64) {
         self.names.push(name.to_string());
         self.units.push(unit);
@@ -75,15 +78,15 @@ impl Setup {
     }
 }
 
-/// A physical effect of the library.
-pub trait Effect: Send + Sync {
-    /// DESIGN.md name (`thermal_drift`, ...).
-    fn name(&self) -> &'static str;
+/// How a physical effect of the library changes the simplified model.
+pub trait EffectModel: Send + Sync {
+    /// Which effect (its DESIGN.md name is `kind().name()`).
+    fn kind(&self) -> EffectKind;
     /// Physical description, one or two sentences.
     fn description(&self) -> &'static str;
     /// How the effect changes the model equations (text with the equation).
     fn equations(&self) -> &'static str;
-    /// Parameters with units (documentation; [`Effect::setup`] gives the data-dependent list).
+    /// Parameters with units (documentation; [`EffectModel::setup`] gives the data-dependent list).
     fn parameters(&self) -> &'static [ParamSpec];
     /// Channels the log must have.
     fn needs(&self) -> Needs {
@@ -96,11 +99,18 @@ pub trait Effect: Send + Sync {
     ///
     /// # Errors
     /// A one-line reason when the effect cannot be fitted on this log.
-    fn setup(&self, d: &Prepared, n: &Nominal) -> Result<Setup, String>;
+    fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String>;
     /// Writes the effect's contribution for parameter values `p` into `terms`.
-    fn apply(&self, s: &Setup, p: &[f64], d: &Prepared, n: &Nominal, terms: &mut Terms);
+    fn apply(
+        &self,
+        s: &FitSetup,
+        p: &[f64],
+        d: &Prepared,
+        n: &MachineConstants,
+        terms: &mut EffectTerms,
+    );
     /// The fitted values in words a drives engineer understands.
-    fn describe(&self, s: &Setup, p: &[f64], d: &Prepared, n: &Nominal) -> String;
+    fn describe(&self, s: &FitSetup, p: &[f64], d: &Prepared, n: &MachineConstants) -> String;
 }
 
 fn duration(d: &Prepared) -> f64 {
@@ -127,7 +137,7 @@ fn rated_flux_wb(d: &Prepared) -> f64 {
     }
 }
 
-fn sync_speed_mech(d: &Prepared, n: &Nominal) -> f64 {
+fn sync_speed_mech(d: &Prepared, n: &MachineConstants) -> f64 {
     let mut m = 0.0f64;
     for &w in &d.omega_s {
         m = m.max(w.abs());
@@ -139,16 +149,11 @@ fn sync_speed_mech(d: &Prepared, n: &Nominal) -> f64 {
 /// about synchronous speed, so the rotor branch sees slip 2): positive-frequency form
 /// `Rs + j w Lls + (j w Lm) || (Rr/2 + j w Llr)`; the negative-sequence current is
 /// `v_neg / conj(Z2)`.
-pub fn z2_neg(n: &Nominal, w: f64) -> C64 {
+pub fn z2_neg(n: &MachineConstants, w: f64) -> C64 {
     let w = w.abs().max(1.0);
     let zm = C64::new(0.0, w * n.lm_h);
     let zr = C64::new(n.rr_ohm / 2.0, w * n.llr_h);
     C64::new(n.rs_ohm, w * n.lls_h) + zm * zr / (zm + zr)
-}
-
-/// Stator self impedance `Rs + j w Ls` of one winding.
-pub fn z_self(n: &Nominal, w: f64) -> C64 {
-    C64::new(n.rs_ohm, w.abs() * n.ls_h)
 }
 
 /// Winding temperature rise: Rs and Rr follow copper's coefficient.
@@ -172,9 +177,9 @@ pub struct FluxDynamics;
 /// Stator current transient (La dI/dt).
 pub struct CurrentDynamics;
 
-impl Effect for ThermalDrift {
-    fn name(&self) -> &'static str {
-        "thermal_drift"
+impl EffectModel for ThermalDrift {
+    fn kind(&self) -> EffectKind {
+        EffectKind::ThermalDrift
     }
     fn description(&self) -> &'static str {
         "The windings heat up with load, so the stator and rotor resistances rise (copper: +0.393 %/K; 20 -> 90 C is +27 %)."
@@ -196,14 +201,21 @@ impl Effect for ThermalDrift {
             },
         ]
     }
-    fn setup(&self, d: &Prepared, _n: &Nominal) -> Result<Setup, String> {
+    fn setup(&self, d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, String> {
         let t = duration(d);
-        let mut s = Setup::default();
+        let mut s = FitSetup::default();
         s.push("rise_k", "K", 10.0, -100.0, 400.0, 20.0);
         s.push("tau_s", "s", t / 3.0, t / 200.0, 20.0 * t, t / 3.0);
         Ok(s)
     }
-    fn apply(&self, _s: &Setup, p: &[f64], d: &Prepared, _n: &Nominal, terms: &mut Terms) {
+    fn apply(
+        &self,
+        _s: &FitSetup,
+        p: &[f64],
+        d: &Prepared,
+        _n: &MachineConstants,
+        terms: &mut EffectTerms,
+    ) {
         let t0 = d.t_s.first().copied().unwrap_or(0.0);
         let tau = p[1].max(1e-6);
         terms.r_factor = d
@@ -212,7 +224,7 @@ impl Effect for ThermalDrift {
             .map(|t| 1.0 + ALPHA_CU_PER_K * p[0] * (1.0 - (-(t - t0) / tau).exp()))
             .collect();
     }
-    fn describe(&self, _s: &Setup, p: &[f64], d: &Prepared, _n: &Nominal) -> String {
+    fn describe(&self, _s: &FitSetup, p: &[f64], d: &Prepared, _n: &MachineConstants) -> String {
         let t = duration(d);
         let dt_end = p[0] * (1.0 - (-t / p[1].max(1e-6)).exp());
         format!(
@@ -294,9 +306,9 @@ fn sat_factors(lm0: f64, i_f: &[f64], psi_sat: f64, nexp: f64) -> Vec<f64> {
         .collect()
 }
 
-impl Effect for Saturation {
-    fn name(&self) -> &'static str {
-        "saturation"
+impl EffectModel for Saturation {
+    fn kind(&self) -> EffectKind {
+        EffectKind::Saturation
     }
     fn description(&self) -> &'static str {
         "The iron of the main flux path saturates: the magnetising inductance Lm falls as the magnetising current (the flux level) rises."
@@ -318,9 +330,9 @@ impl Effect for Saturation {
             },
         ]
     }
-    fn setup(&self, d: &Prepared, _n: &Nominal) -> Result<Setup, String> {
+    fn setup(&self, d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, String> {
         let psi = rated_flux_wb(d);
-        let mut s = Setup::default();
+        let mut s = FitSetup::default();
         s.push(
             "psi_sat_wb",
             "Wb",
@@ -333,10 +345,17 @@ impl Effect for Saturation {
         s.data.push(psi);
         Ok(s)
     }
-    fn apply(&self, _s: &Setup, p: &[f64], d: &Prepared, n: &Nominal, terms: &mut Terms) {
+    fn apply(
+        &self,
+        _s: &FitSetup,
+        p: &[f64],
+        d: &Prepared,
+        n: &MachineConstants,
+        terms: &mut EffectTerms,
+    ) {
         terms.lm_factor = sat_factors(n.lm_h, &d.i_f, p[0], p[1]);
     }
-    fn describe(&self, s: &Setup, p: &[f64], d: &Prepared, n: &Nominal) -> String {
+    fn describe(&self, s: &FitSetup, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
         // The factor falls monotonically with |i_f|: its extremes are at the extremes of |i_f|.
         let (mut imin, mut imax) = (f64::INFINITY, f64::NEG_INFINITY);
         for &i in &d.i_f {
@@ -362,9 +381,9 @@ impl Effect for Saturation {
     }
 }
 
-impl Effect for IronLoss {
-    fn name(&self) -> &'static str {
-        "iron_loss"
+impl EffectModel for IronLoss {
+    fn kind(&self) -> EffectKind {
+        EffectKind::IronLoss
     }
     fn description(&self) -> &'static str {
         "Eddy-current and hysteresis losses in the core draw a current in phase with the air-gap voltage, modelled as a resistance Rfe across the magnetising branch."
@@ -379,10 +398,10 @@ impl Effect for IronLoss {
             description: "core-loss conductance 1/Rfe",
         }]
     }
-    fn setup(&self, d: &Prepared, n: &Nominal) -> Result<Setup, String> {
+    fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String> {
         let w = sync_speed_mech(d, n) * n.np;
         let xm = w * n.lm_h;
-        let mut s = Setup::default();
+        let mut s = FitSetup::default();
         s.push(
             "g_fe_s",
             "S",
@@ -394,10 +413,17 @@ impl Effect for IronLoss {
         s.data.push(xm);
         Ok(s)
     }
-    fn apply(&self, _s: &Setup, p: &[f64], _d: &Prepared, _n: &Nominal, terms: &mut Terms) {
+    fn apply(
+        &self,
+        _s: &FitSetup,
+        p: &[f64],
+        _d: &Prepared,
+        _n: &MachineConstants,
+        terms: &mut EffectTerms,
+    ) {
         terms.g_fe_s = p[0];
     }
-    fn describe(&self, s: &Setup, p: &[f64], d: &Prepared, n: &Nominal) -> String {
+    fn describe(&self, s: &FitSetup, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
         let xm = s.data.first().copied().unwrap_or(1.0);
         let psi = rated_flux_wb(d);
         let w = sync_speed_mech(d, n) * n.np;
@@ -414,9 +440,9 @@ impl Effect for IronLoss {
     }
 }
 
-impl Effect for CoulombFriction {
-    fn name(&self) -> &'static str {
-        "coulomb_friction"
+impl EffectModel for CoulombFriction {
+    fn kind(&self) -> EffectKind {
+        EffectKind::CoulombFriction
     }
     fn description(&self) -> &'static str {
         "Dry friction (bearings, seals, brushes): a constant torque opposing rotation whatever the speed."
@@ -437,16 +463,23 @@ impl Effect for CoulombFriction {
             speed: false,
         }
     }
-    fn setup(&self, _d: &Prepared, n: &Nominal) -> Result<Setup, String> {
+    fn setup(&self, _d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String> {
         let t = n.torque_scale_nm;
-        let mut s = Setup::default();
+        let mut s = FitSetup::default();
         s.push("torque_nm", "N m", 0.01 * t, -0.1 * t, t, 0.05 * t);
         Ok(s)
     }
-    fn apply(&self, _s: &Setup, p: &[f64], _d: &Prepared, _n: &Nominal, terms: &mut Terms) {
+    fn apply(
+        &self,
+        _s: &FitSetup,
+        p: &[f64],
+        _d: &Prepared,
+        _n: &MachineConstants,
+        terms: &mut EffectTerms,
+    ) {
         terms.coulomb_nm = p[0];
     }
-    fn describe(&self, _s: &Setup, p: &[f64], _d: &Prepared, n: &Nominal) -> String {
+    fn describe(&self, _s: &FitSetup, p: &[f64], _d: &Prepared, n: &MachineConstants) -> String {
         format!(
             "constant friction torque of about {:.2} N m ({:.1} % of the rated torque estimate {:.1} N m), independent of speed",
             p[0],
@@ -456,9 +489,9 @@ impl Effect for CoulombFriction {
     }
 }
 
-impl Effect for Windage {
-    fn name(&self) -> &'static str {
-        "windage"
+impl EffectModel for Windage {
+    fn kind(&self) -> EffectKind {
+        EffectKind::Windage
     }
     fn description(&self) -> &'static str {
         "Fan and air drag: a load torque growing with the square of speed."
@@ -473,10 +506,10 @@ impl Effect for Windage {
             description: "windage coefficient k",
         }]
     }
-    fn setup(&self, d: &Prepared, n: &Nominal) -> Result<Setup, String> {
+    fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String> {
         let w = sync_speed_mech(d, n);
         let k = n.torque_scale_nm / (w * w);
-        let mut s = Setup::default();
+        let mut s = FitSetup::default();
         s.push(
             "k_nms2",
             "N m s^2/rad^2",
@@ -488,10 +521,17 @@ impl Effect for Windage {
         s.data.push(w);
         Ok(s)
     }
-    fn apply(&self, _s: &Setup, p: &[f64], _d: &Prepared, _n: &Nominal, terms: &mut Terms) {
+    fn apply(
+        &self,
+        _s: &FitSetup,
+        p: &[f64],
+        _d: &Prepared,
+        _n: &MachineConstants,
+        terms: &mut EffectTerms,
+    ) {
         terms.windage_nms2 = p[0];
     }
-    fn describe(&self, s: &Setup, p: &[f64], _d: &Prepared, n: &Nominal) -> String {
+    fn describe(&self, s: &FitSetup, p: &[f64], _d: &Prepared, n: &MachineConstants) -> String {
         let w = s.data.first().copied().unwrap_or(1.0);
         format!(
             "speed-squared drag k = {:.3e} N m s^2/rad^2: {:.2} N m at synchronous speed ({:.1} % of the rated torque estimate)",
@@ -507,7 +547,7 @@ impl Effect for Windage {
 /// segmentation (minimum segment 0.1 s or 5 % of the log; a split must move the level by
 /// more than 3 % of the rated torque estimate, and the supply must hold still around it).
 /// Returns (segment start time, observer level) pairs, flattened.
-fn load_steps(d: &Prepared, n: &Nominal) -> Vec<f64> {
+fn load_steps(d: &Prepared, n: &MachineConstants) -> Vec<f64> {
     let len = d.len();
     if d.omega_r.len() != len || len < 20 {
         return vec![];
@@ -612,9 +652,9 @@ fn load_steps(d: &Prepared, n: &Nominal) -> Vec<f64> {
         .collect()
 }
 
-impl Effect for LoadTorque {
-    fn name(&self) -> &'static str {
-        "load_torque"
+impl EffectModel for LoadTorque {
+    fn kind(&self) -> EffectKind {
+        EffectKind::LoadTorque
     }
     fn description(&self) -> &'static str {
         "The load is a torque imposed by the driven machine (possibly switched in steps), not the paper's viscous Bl*omega."
@@ -635,7 +675,7 @@ impl Effect for LoadTorque {
             speed: true,
         }
     }
-    fn setup(&self, d: &Prepared, n: &Nominal) -> Result<Setup, String> {
+    fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String> {
         if d.omega_r.is_empty() {
             return Err(
                 "needs the speed column wm_rad_s (the torque observer uses the measured speed)"
@@ -649,7 +689,7 @@ impl Effect for LoadTorque {
             return Err("no change of load torque found in the log: a constant load torque is the same equation as coulomb_friction at positive speed, so it is left to that effect".into());
         }
         let t = n.torque_scale_nm;
-        let mut s = Setup::default();
+        let mut s = FitSetup::default();
         // Initial levels: the observer's mean torque beyond the viscous line per segment.
         for (k, (&ts, &lv)) in steps.iter().zip(&levels).enumerate() {
             s.push(
@@ -664,7 +704,14 @@ impl Effect for LoadTorque {
         s.data = steps;
         Ok(s)
     }
-    fn apply(&self, s: &Setup, p: &[f64], d: &Prepared, _n: &Nominal, terms: &mut Terms) {
+    fn apply(
+        &self,
+        s: &FitSetup,
+        p: &[f64],
+        d: &Prepared,
+        _n: &MachineConstants,
+        terms: &mut EffectTerms,
+    ) {
         let mut seg = 0usize;
         let load: Vec<f64> = d
             .t_s
@@ -684,7 +731,7 @@ impl Effect for LoadTorque {
             terms.load_nm = load;
         }
     }
-    fn describe(&self, s: &Setup, p: &[f64], _d: &Prepared, _n: &Nominal) -> String {
+    fn describe(&self, s: &FitSetup, p: &[f64], _d: &Prepared, _n: &MachineConstants) -> String {
         let parts: Vec<String> = s
             .data
             .iter()
@@ -698,9 +745,9 @@ impl Effect for LoadTorque {
     }
 }
 
-impl Effect for SupplyUnbalance {
-    fn name(&self) -> &'static str {
-        "supply_unbalance"
+impl EffectModel for SupplyUnbalance {
+    fn kind(&self) -> EffectKind {
+        EffectKind::SupplyUnbalance
     }
     fn description(&self) -> &'static str {
         "The supply voltages are not balanced: a negative-sequence voltage drives a negative-sequence current through the machine's small negative-sequence impedance (2f ripple in the d-q frame)."
@@ -724,20 +771,27 @@ impl Effect for SupplyUnbalance {
             },
         ]
     }
-    fn setup(&self, _d: &Prepared, _n: &Nominal) -> Result<Setup, String> {
-        let mut s = Setup::default();
+    fn setup(&self, _d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, String> {
+        let mut s = FitSetup::default();
         s.push("y_re", "1", 0.5, -5.0, 5.0, 0.2);
         s.push("y_im", "1", 0.0, -5.0, 5.0, 0.2);
         Ok(s)
     }
-    fn apply(&self, _s: &Setup, p: &[f64], d: &Prepared, n: &Nominal, terms: &mut Terms) {
+    fn apply(
+        &self,
+        _s: &FitSetup,
+        p: &[f64],
+        d: &Prepared,
+        n: &MachineConstants,
+        terms: &mut EffectTerms,
+    ) {
         let y = C64::new(p[0], p[1]);
         let add: Vec<C64> = (0..d.len())
             .map(|k| y * d.v_neg[k] / z2_neg(n, d.omega_s[k]).conj())
             .collect();
         add_neg(terms, add);
     }
-    fn describe(&self, _s: &Setup, p: &[f64], d: &Prepared, n: &Nominal) -> String {
+    fn describe(&self, _s: &FitSetup, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
         let (mut vn, mut vp) = (0.0, 0.0);
         for k in 0..d.len() {
             vn += d.v_neg[k].norm_sqr();
@@ -755,7 +809,7 @@ impl Effect for SupplyUnbalance {
     }
 }
 
-fn add_neg(terms: &mut Terms, add: Vec<C64>) {
+fn add_neg(terms: &mut EffectTerms, add: Vec<C64>) {
     if terms.i_neg.len() == add.len() {
         for (a, b) in terms.i_neg.iter_mut().zip(add) {
             *a += b;
@@ -765,30 +819,30 @@ fn add_neg(terms: &mut Terms, add: Vec<C64>) {
     }
 }
 
-/// Maps a fitted phase-asymmetry coefficient `c` (i_neg = c conj(i_pos)) to the suspect
-/// phase and the relative winding-impedance change mu (positive = turns lost, as in an
-/// inter-turn short): c = (mu/3) conj(Zs/Z2) e^{-j 2 th_k}, th_k = 0, 120, 240 deg (the
-/// sign of the angle checked against the simulator's phase_asymmetry in phase b).
-pub fn asymmetry_phase(c: C64, n: &Nominal, w: f64) -> (char, f64) {
-    let f = (z_self(n, w) / z2_neg(n, w)).conj();
-    let wv = c * 3.0 / f;
-    let mut best = ('a', 0.0, f64::INFINITY);
-    for (k, name) in ['a', 'b', 'c'].iter().enumerate() {
-        let th = 2.0 * std::f64::consts::PI / 3.0 * k as f64;
-        for sign in [1.0, -1.0] {
-            let target = C64::from_polar(sign, -2.0 * th);
-            let ang = (wv / target).arg().abs();
-            if ang < best.2 {
-                best = (*name, sign * wv.norm(), ang);
-            }
-        }
-    }
-    (best.0, best.1)
+/// The winding asymmetry a fitted `c` (i_neg = c conj(i_pos)) points at, named by the
+/// workspace's one faulty-phase method (`monitor_core::sequence`): in the core's phasor
+/// convention `I2/I1 = conj(c)`; the correction `arg(Z1/Z2)` is taken at the slip of the
+/// log's mean operating point `slip` and supply `w` [rad/s]. Returns the phase and the
+/// fraction of that winding's impedance lost (the first-order size of the asymmetry).
+pub fn asymmetry_phase(
+    c: C64,
+    n: &MachineConstants,
+    w: f64,
+    slip: f64,
+) -> (monitor_core::Phase, f64) {
+    use monitor_core::sequence::{
+        asymmetry_correction_rad, suspect_phase, winding_change_fraction,
+    };
+    let (we, s) = (w.abs().max(1.0) as f32, slip as f32);
+    let corr = asymmetry_correction_rad(&n.core_model, we, s);
+    let phase = suspect_phase(-(c.arg() as f32), corr);
+    let eps = winding_change_fraction(&n.core_model, we, s, c.norm() as f32);
+    (phase, f64::from(eps))
 }
 
-impl Effect for PhaseAsymmetry {
-    fn name(&self) -> &'static str {
-        "phase_asymmetry"
+impl EffectModel for PhaseAsymmetry {
+    fn kind(&self) -> EffectKind {
+        EffectKind::PhaseAsymmetry
     }
     fn description(&self) -> &'static str {
         "One stator winding differs from the other two (inter-turn short, bad joint): the machine draws a negative-sequence current proportional to its load current even from a balanced supply."
@@ -816,35 +870,42 @@ impl Effect for PhaseAsymmetry {
             speed: false,
         }
     }
-    fn setup(&self, _d: &Prepared, _n: &Nominal) -> Result<Setup, String> {
-        let mut s = Setup::default();
+    fn setup(&self, _d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, String> {
+        let mut s = FitSetup::default();
         s.push("c_re", "1", 0.01, -1.0, 1.0, 0.02);
         s.push("c_im", "1", 0.0, -1.0, 1.0, 0.02);
         Ok(s)
     }
-    fn apply(&self, _s: &Setup, p: &[f64], d: &Prepared, _n: &Nominal, terms: &mut Terms) {
+    fn apply(
+        &self,
+        _s: &FitSetup,
+        p: &[f64],
+        d: &Prepared,
+        _n: &MachineConstants,
+        terms: &mut EffectTerms,
+    ) {
         let c = C64::new(p[0], p[1]);
         let add: Vec<C64> = (0..d.len())
             .map(|k| c * (d.i_ab[k] - d.i_neg[k]).conj())
             .collect();
         add_neg(terms, add);
     }
-    fn describe(&self, _s: &Setup, p: &[f64], d: &Prepared, n: &Nominal) -> String {
-        let w = sync_speed_mech(d, n) * n.np;
-        let (ph, mu) = asymmetry_phase(C64::new(p[0], p[1]), n, w);
+    fn describe(&self, _s: &FitSetup, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
+        let (w, slip) = super::unbalance::operating_point(d, n);
+        let c = C64::new(p[0], p[1]);
+        let (ph, eps) = asymmetry_phase(c, n, w, slip);
         format!(
-            "phase {} winding differs: negative-sequence current {:.1} % of the positive-sequence current; fits about {:.1} % of that winding's impedance {} (an inter-turn short removes turns)",
-            ph,
-            100.0 * C64::new(p[0], p[1]).norm(),
-            100.0 * mu.abs(),
-            if mu >= 0.0 { "lost" } else { "added" }
+            "phase {} winding differs: negative-sequence current {:.1} % of the positive-sequence current; fits about {:.1} % of that winding's impedance lost (an inter-turn short removes turns)",
+            ph.name(),
+            100.0 * c.norm(),
+            100.0 * eps,
         )
     }
 }
 
-impl Effect for FluxDynamics {
-    fn name(&self) -> &'static str {
-        "flux_dynamics"
+impl EffectModel for FluxDynamics {
+    fn kind(&self) -> EffectKind {
+        EffectKind::FluxDynamics
     }
     fn description(&self) -> &'static str {
         "The rotor flux cannot change instantly: it follows the magnetising current with the rotor time constant Lr/Rr, so after a start or a supply step the model's Psi = Ls i_f is wrong for a few hundred ms."
@@ -859,17 +920,24 @@ impl Effect for FluxDynamics {
             description: "rotor time constant Lr/Rr",
         }]
     }
-    fn setup(&self, _d: &Prepared, n: &Nominal) -> Result<Setup, String> {
+    fn setup(&self, _d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String> {
         let tau = n.lr_h / n.rr_ohm;
-        let mut s = Setup::default();
+        let mut s = FitSetup::default();
         s.push("tau_r_s", "s", tau, 0.3 * tau, 3.0 * tau, 0.2 * tau);
         s.data.push(tau);
         Ok(s)
     }
-    fn apply(&self, _s: &Setup, p: &[f64], _d: &Prepared, _n: &Nominal, terms: &mut Terms) {
+    fn apply(
+        &self,
+        _s: &FitSetup,
+        p: &[f64],
+        _d: &Prepared,
+        _n: &MachineConstants,
+        terms: &mut EffectTerms,
+    ) {
         terms.tau_r_s = Some(p[0]);
     }
-    fn describe(&self, s: &Setup, p: &[f64], _d: &Prepared, _n: &Nominal) -> String {
+    fn describe(&self, s: &FitSetup, p: &[f64], _d: &Prepared, _n: &MachineConstants) -> String {
         format!(
             "rotor flux lags the magnetising current with a rotor time constant of {:.0} ms (nominal Lr/Rr = {:.0} ms): the model's constant-flux assumption fails in transients",
             1000.0 * p[0],
@@ -878,9 +946,9 @@ impl Effect for FluxDynamics {
     }
 }
 
-impl Effect for CurrentDynamics {
-    fn name(&self) -> &'static str {
-        "current_dynamics"
+impl EffectModel for CurrentDynamics {
+    fn kind(&self) -> EffectKind {
+        EffectKind::CurrentDynamics
     }
     fn description(&self) -> &'static str {
         "The stator current cannot jump: the transient inductance La = sigma Ls delays I_qs by Ta = La/Ra (a few ms) after every voltage change."
@@ -895,8 +963,8 @@ impl Effect for CurrentDynamics {
             description: "transient inductance La = sigma Ls",
         }]
     }
-    fn setup(&self, _d: &Prepared, n: &Nominal) -> Result<Setup, String> {
-        let mut s = Setup::default();
+    fn setup(&self, _d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String> {
+        let mut s = FitSetup::default();
         s.push(
             "la_h",
             "H",
@@ -908,10 +976,17 @@ impl Effect for CurrentDynamics {
         s.data.push(n.la_h);
         Ok(s)
     }
-    fn apply(&self, _s: &Setup, p: &[f64], _d: &Prepared, _n: &Nominal, terms: &mut Terms) {
+    fn apply(
+        &self,
+        _s: &FitSetup,
+        p: &[f64],
+        _d: &Prepared,
+        _n: &MachineConstants,
+        terms: &mut EffectTerms,
+    ) {
         terms.la_h = Some(p[0]);
     }
-    fn describe(&self, s: &Setup, p: &[f64], _d: &Prepared, n: &Nominal) -> String {
+    fn describe(&self, s: &FitSetup, p: &[f64], _d: &Prepared, n: &MachineConstants) -> String {
         format!(
             "stator current lags voltage changes: La = {:.1} mH (nominal sigma Ls = {:.1} mH), electrical time constant about {:.1} ms",
             1000.0 * p[0],
@@ -921,25 +996,25 @@ impl Effect for CurrentDynamics {
     }
 }
 
-/// The whole library, in DESIGN.md order.
-pub fn library() -> Vec<Box<dyn Effect>> {
-    vec![
-        Box::new(ThermalDrift),
-        Box::new(Saturation),
-        Box::new(IronLoss),
-        Box::new(CoulombFriction),
-        Box::new(Windage),
-        Box::new(LoadTorque),
-        Box::new(SupplyUnbalance),
-        Box::new(PhaseAsymmetry),
-        Box::new(FluxDynamics),
-        Box::new(CurrentDynamics),
-    ]
+/// The model of an effect of the library.
+pub fn model_of(kind: EffectKind) -> Box<dyn EffectModel> {
+    match kind {
+        EffectKind::ThermalDrift => Box::new(ThermalDrift),
+        EffectKind::Saturation => Box::new(Saturation),
+        EffectKind::IronLoss => Box::new(IronLoss),
+        EffectKind::CoulombFriction => Box::new(CoulombFriction),
+        EffectKind::Windage => Box::new(Windage),
+        EffectKind::LoadTorque => Box::new(LoadTorque),
+        EffectKind::SupplyUnbalance => Box::new(SupplyUnbalance),
+        EffectKind::PhaseAsymmetry => Box::new(PhaseAsymmetry),
+        EffectKind::FluxDynamics => Box::new(FluxDynamics),
+        EffectKind::CurrentDynamics => Box::new(CurrentDynamics),
+    }
 }
 
-/// Looks an effect up by name.
-pub fn by_name(name: &str) -> Option<Box<dyn Effect>> {
-    library().into_iter().find(|e| e.name() == name)
+/// The whole library, in DESIGN.md order.
+pub fn library() -> Vec<Box<dyn EffectModel>> {
+    EffectKind::ALL.into_iter().map(model_of).collect()
 }
 
 #[cfg(test)]
@@ -974,21 +1049,10 @@ mod tests {
     }
 
     #[test]
-    fn library_has_the_ten_design_names() {
-        let names: Vec<_> = library().iter().map(|e| e.name()).collect();
-        for n in [
-            "thermal_drift",
-            "saturation",
-            "iron_loss",
-            "coulomb_friction",
-            "windage",
-            "load_torque",
-            "supply_unbalance",
-            "phase_asymmetry",
-            "flux_dynamics",
-            "current_dynamics",
-        ] {
-            assert!(names.contains(&n), "{n}");
+    fn every_effect_kind_has_its_model() {
+        for kind in EffectKind::ALL {
+            assert_eq!(model_of(kind).kind(), kind);
         }
+        assert_eq!(library().len(), EffectKind::ALL.len());
     }
 }

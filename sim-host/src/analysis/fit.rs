@@ -10,19 +10,21 @@
 //! is by forward differences (one simulation per parameter, in parallel with rayon);
 //! bounds are enforced by clamping.
 
-use super::effects::{Effect, Setup};
+use super::effects::{EffectModel, FitSetup};
 use super::metrics::{measured, predicted, Weights};
-use super::model::{rotations, simulate, simulate_rot, BaseParams, Nominal, Prediction, Terms};
 use super::prep::{Prepared, C64};
+use super::simplified_model::{
+    rotations, simulate, simulate_rot, BaseParams, EffectTerms, MachineConstants, Prediction,
+};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
 /// An effect set up on the data, with its parameter values.
 pub struct ActiveEffect<'a> {
     /// The library entry.
-    pub effect: &'a dyn Effect,
+    pub effect: &'a dyn EffectModel,
     /// Its data-dependent set-up.
-    pub setup: Setup,
+    pub setup: FitSetup,
 }
 
 /// Result of a fit.
@@ -32,10 +34,6 @@ pub struct FitResult {
     pub base: BaseParams,
     /// Fitted parameters of each effect, in the order given.
     pub effect_params: Vec<Vec<f64>>,
-    /// Final cost (half the sum of squared weighted residuals, priors included).
-    pub cost: f64,
-    /// Iterations used.
-    pub iterations: usize,
 }
 
 /// Weight of the base parameters' priors relative to the data (whose residuals are scaled
@@ -47,7 +45,7 @@ pub const N_BASE: usize = 4;
 
 struct Problem<'a> {
     d: &'a Prepared,
-    n: &'a Nominal,
+    n: &'a MachineConstants,
     effects: &'a [ActiveEffect<'a>],
     w: &'a Weights,
     btot_scale: f64,
@@ -72,8 +70,8 @@ impl Problem<'_> {
 
     /// The effects' contributions for the effect parameters in `x` (the base parameters do
     /// not enter them).
-    fn terms(&self, x: &[f64]) -> Terms {
-        let mut terms = Terms::default();
+    fn terms(&self, x: &[f64]) -> EffectTerms {
+        let mut terms = EffectTerms::default();
         let mut o = N_BASE;
         for e in self.effects {
             let k = e.setup.init.len();
@@ -90,7 +88,7 @@ impl Problem<'_> {
 
     /// The same residuals as [`Weights::residuals`] on the training samples (the measured
     /// side precomputed), plus the priors; `terms` must be [`Problem::terms`] of `x`.
-    fn residuals_with(&self, x: &[f64], terms: &Terms) -> Vec<f64> {
+    fn residuals_with(&self, x: &[f64], terms: &EffectTerms) -> Vec<f64> {
         let p = simulate_rot(self.d, &self.rot, self.n, &Self::base(x), terms);
         let inv = &self.w.inv_rms;
         let nc = self.w.n_channels();
@@ -121,7 +119,7 @@ impl Problem<'_> {
 
 /// Scale of B+Bl for conditioning and its prior: the larger of the nominal value and the
 /// viscous coefficient that would carry 20 % of the rated torque at synchronous speed.
-pub fn btot_scale(n: &Nominal, d: &Prepared) -> f64 {
+pub fn btot_scale(n: &MachineConstants, d: &Prepared) -> f64 {
     let wmax = d.omega_s.iter().fold(0.0f64, |a, &w| a.max(w.abs())) / n.np;
     n.btot_nms.max(0.2 * n.torque_scale_nm / wmax.max(1.0))
 }
@@ -130,7 +128,7 @@ pub fn btot_scale(n: &Nominal, d: &Prepared) -> f64 {
 /// effects' parameters, starting from `start` (base) and each set-up's `init`.
 pub fn fit(
     d: &Prepared,
-    n: &Nominal,
+    n: &MachineConstants,
     effects: &[ActiveEffect<'_>],
     w: &Weights,
     start: &BaseParams,
@@ -170,46 +168,57 @@ pub fn fit(
         scale.extend_from_slice(&e.setup.scale);
     }
     let free: Vec<usize> = (0..x.len()).filter(|&i| fit_base || i >= N_BASE).collect();
+    let bounds = Bounds { lo, hi, scale };
+    let x = levenberg_marquardt(&prob, x, &bounds, &free, max_iter);
+    let base = Problem::base(&x);
+    let mut effect_params = Vec::new();
+    let mut o = N_BASE;
+    for e in effects {
+        let k = e.setup.init.len();
+        effect_params.push(x[o..o + k].to_vec());
+        o += k;
+    }
+    FitResult {
+        base,
+        effect_params,
+    }
+}
+
+/// Bounds and typical magnitudes of the parameter vector.
+struct Bounds {
+    lo: Vec<f64>,
+    hi: Vec<f64>,
+    scale: Vec<f64>,
+}
+
+/// Half the sum of squares.
+fn cost_of(r: &[f64]) -> f64 {
+    0.5 * r.iter().map(|v| v * v).sum::<f64>()
+}
+
+/// Levenberg-Marquardt from `x` over the `free` parameters, at most `max_iter` iterations
+/// (ends earlier when a step no longer lowers the cost, or lowers it by less than 1e-7
+/// twice in a row). Returns the parameter vector.
+fn levenberg_marquardt(
+    prob: &Problem<'_>,
+    mut x: Vec<f64>,
+    b: &Bounds,
+    free: &[usize],
+    max_iter: usize,
+) -> Vec<f64> {
     // The effects' terms at the current point: the Jacobian columns of the base parameters
     // reuse them (only the effects' own columns and trial steps recompute them).
     let mut terms_x = prob.terms(&x);
     let mut r = prob.residuals_with(&x, &terms_x);
-    let mut cost = 0.5 * r.iter().map(|v| v * v).sum::<f64>();
+    let mut cost = cost_of(&r);
     let mut lambda = 1e-3;
-    let mut it = 0;
     let mut small_steps = 0;
-    while it < max_iter && !free.is_empty() {
-        it += 1;
-        // Jacobian by forward differences, one column per free parameter, in parallel.
-        let cols: Vec<Vec<f64>> = free
-            .par_iter()
-            .map(|&i| {
-                let h = 1e-4 * scale[i].max(1e-3 * x[i].abs());
-                let mut xp = x.clone();
-                let dir = if xp[i] + h > hi[i] { -1.0 } else { 1.0 };
-                xp[i] += dir * h;
-                let rp = if i < N_BASE {
-                    prob.residuals_with(&xp, &terms_x)
-                } else {
-                    prob.residuals(&xp)
-                };
-                rp.iter()
-                    .zip(&r)
-                    .map(|(a, b)| (a - b) / (dir * h))
-                    .collect()
-            })
-            .collect();
-        let m = free.len();
-        let mut jtj = DMatrix::<f64>::zeros(m, m);
-        let mut jtr = DVector::<f64>::zeros(m);
-        for a in 0..m {
-            for b in a..m {
-                let s: f64 = cols[a].iter().zip(&cols[b]).map(|(u, v)| u * v).sum();
-                jtj[(a, b)] = s;
-                jtj[(b, a)] = s;
-            }
-            jtr[a] = cols[a].iter().zip(&r).map(|(u, v)| u * v).sum();
+    for _ in 0..max_iter {
+        if free.is_empty() {
+            break;
         }
+        let (jtj, jtr) = normal_equations(prob, &x, &r, &terms_x, b, free);
+        let m = free.len();
         let mut improved = false;
         for _ in 0..8 {
             let mut aug = jtj.clone();
@@ -225,11 +234,11 @@ pub fn fit(
             };
             let mut xn = x.clone();
             for (a, &i) in free.iter().enumerate() {
-                xn[i] = (x[i] + step[a]).clamp(lo[i], hi[i]);
+                xn[i] = (x[i] + step[a]).clamp(b.lo[i], b.hi[i]);
             }
             let tn = prob.terms(&xn);
             let rn = prob.residuals_with(&xn, &tn);
-            let cn = 0.5 * rn.iter().map(|v| v * v).sum::<f64>();
+            let cn = cost_of(&rn);
             if cn.is_finite() && cn < cost {
                 let rel = (cost - cn) / cost.max(1e-300);
                 x = xn;
@@ -251,25 +260,56 @@ pub fn fit(
             break;
         }
     }
-    let base = Problem::base(&x);
-    let mut effect_params = Vec::new();
-    let mut o = N_BASE;
-    for e in effects {
-        let k = e.setup.init.len();
-        effect_params.push(x[o..o + k].to_vec());
-        o += k;
+    x
+}
+
+/// `J^T J` and `J^T r` at `x`, the Jacobian by forward differences, one column per free
+/// parameter, in parallel.
+fn normal_equations(
+    prob: &Problem<'_>,
+    x: &[f64],
+    r: &[f64],
+    terms_x: &EffectTerms,
+    b: &Bounds,
+    free: &[usize],
+) -> (DMatrix<f64>, DVector<f64>) {
+    let cols: Vec<Vec<f64>> = free
+        .par_iter()
+        .map(|&i| {
+            let h = 1e-4 * b.scale[i].max(1e-3 * x[i].abs());
+            let mut xp = x.to_vec();
+            let dir = if xp[i] + h > b.hi[i] { -1.0 } else { 1.0 };
+            xp[i] += dir * h;
+            let rp = if i < N_BASE {
+                prob.residuals_with(&xp, terms_x)
+            } else {
+                prob.residuals(&xp)
+            };
+            rp.iter().zip(r).map(|(a, b)| (a - b) / (dir * h)).collect()
+        })
+        .collect();
+    let m = free.len();
+    let mut jtj = DMatrix::<f64>::zeros(m, m);
+    let mut jtr = DVector::<f64>::zeros(m);
+    for a in 0..m {
+        for c in a..m {
+            let s: f64 = cols[a].iter().zip(&cols[c]).map(|(u, v)| u * v).sum();
+            jtj[(a, c)] = s;
+            jtj[(c, a)] = s;
+        }
+        jtr[a] = cols[a].iter().zip(r).map(|(u, v)| u * v).sum();
     }
-    FitResult {
-        base,
-        effect_params,
-        cost,
-        iterations: it,
-    }
+    (jtj, jtr)
 }
 
 /// The effects' terms for fitted values.
-pub fn terms(d: &Prepared, n: &Nominal, effects: &[ActiveEffect<'_>], f: &FitResult) -> Terms {
-    let mut terms = Terms::default();
+pub fn terms(
+    d: &Prepared,
+    n: &MachineConstants,
+    effects: &[ActiveEffect<'_>],
+    f: &FitResult,
+) -> EffectTerms {
+    let mut terms = EffectTerms::default();
     for (e, p) in effects.iter().zip(&f.effect_params) {
         e.effect.apply(&e.setup, p, d, n, &mut terms);
     }
@@ -279,7 +319,7 @@ pub fn terms(d: &Prepared, n: &Nominal, effects: &[ActiveEffect<'_>], f: &FitRes
 /// Simulates the model with fitted values.
 pub fn predict(
     d: &Prepared,
-    n: &Nominal,
+    n: &MachineConstants,
     effects: &[ActiveEffect<'_>],
     f: &FitResult,
 ) -> Prediction {

@@ -6,8 +6,8 @@
 //! RMS error is divided by that channel's measured RMS; `normalized_rms_error` is the mean
 //! over the channels present (DESIGN.md §3).
 
-use super::model::Prediction;
-use super::prep::{inverse_clarke, Prepared, C64};
+use super::prep::{phase_values, Prepared, C64};
+use super::simplified_model::Prediction;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -26,7 +26,7 @@ pub struct Weights {
 }
 
 fn phase_currents(d: &Prepared, k: usize, i_ab: C64) -> [f64; 3] {
-    inverse_clarke(i_ab, d.i0[k])
+    phase_values(i_ab, d.i0[k])
 }
 
 /// Measured values of the five channels at sample k (omega_r = 0 if absent).

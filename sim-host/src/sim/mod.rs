@@ -19,6 +19,9 @@
 //! paper) or `torque` T_load = T(t) (an active torque, also at standstill), plus
 //! `coulomb_friction` and `windage` when enabled.
 //!
+//! The machine's equations are in [`machine`](self) (private): this module resolves the
+//! scenario (effects, events, parameter changes) and runs the integration loop.
+//!
 //! Integration: classic fixed-step RK4, an integer number of steps per output sample
 //! (h <= `max_step_s`, default 100 us), the supply phasor rotated incrementally (no trig per
 //! step). Accuracy on the 2.2 kW reference start (10 kHz, h = 100 us) against a 100x finer
@@ -54,7 +57,7 @@
 //! phase = "a"                # optional (voltage/current only); default all three phases
 //!
 //! [[effects]]
-//! name = "thermal_drift"     # see `Effect` for every effect and its parameters
+//! name = "thermal_drift"     # see `EffectSpec` for every effect and its parameters
 //! rise_k = 60.0
 //!
 //! [sensors]                  # optional; see `SensorSpec`
@@ -76,7 +79,7 @@
 //! see [`SensorFaultMode`].
 //!
 //! # Effects
-//! See [`Effect`]: `thermal_drift`, `saturation`, `iron_loss`, `coulomb_friction`, `windage`,
+//! See [`EffectSpec`]: `thermal_drift`, `saturation`, `iron_loss`, `coulomb_friction`, `windage`,
 //! `load_torque`, `supply_unbalance`, `phase_asymmetry`; `flux_dynamics` and
 //! `current_dynamics` are properties of the full-order model (always present), so enabling
 //! them is a no-op for generation.
@@ -85,22 +88,24 @@
 //! Other code gets only [`Row`]s of sensor readings ([`simulate`]); the true state
 //! ([`Truth`]) is available to tests through [`simulate_with_truth`] and never enters a row.
 
-mod model;
+mod machine;
 mod scenario;
 mod sensors;
 mod steady;
 
 pub use scenario::{
-    Effect, FaultKind, FaultSpec, LoadKind, LoadSpec, LoadStep, Phase, Scenario, SensorFaultMode,
-    SensorSpec, SupplySpec, SupplyStep, DEFAULT_MAX_STEP_S,
+    EffectSpec, FaultSpec, LoadKind, LoadSpec, LoadStep, Scenario, SensorFaultMode, SensorSpec,
+    SupplySpec, SupplyStep, DEFAULT_MAX_STEP_S,
 };
 pub use steady::{
     solve_slip, solve_slip_at, steady_state, steady_state_at, SteadyLoad, SteadyState,
 };
 
 use crate::log::{Channels, Row};
-use crate::params::{MotorParams, ParamFile};
-use model::{LoadLaw, Model, SatLaw, Sym2};
+use crate::params::ParamFile;
+use machine::{LoadLaw, Machine, SatLaw, Sym2};
+use monitor_core::frames::{inverse_clarke, AlphaBeta};
+use monitor_core::{Fault, MotorParameters};
 use sensors::Sensors;
 use std::f64::consts::PI;
 
@@ -241,7 +246,7 @@ impl SensorSpec {
 /// v: 1.2 x phase peak rounded up to 50 V (400 V for the 2.2 kW motor, 250 V for 3 hp);
 /// i: 2 x the analytic locked-rotor peak current rounded up to 5 A (a direct-on-line start,
 /// whose first peaks exceed the steady locked-rotor peak, does not clip).
-pub fn default_ranges(m: &MotorParams, v_ll_rms: f64, f_hz: f64) -> (f64, f64) {
+pub fn default_ranges(m: &MotorParameters, v_ll_rms: f64, f_hz: f64) -> (f64, f64) {
     let vpk = v_ll_rms * (2.0f64 / 3.0).sqrt();
     let v = (1.2 * vpk / 50.0).ceil() * 50.0;
     let lr = steady_state_at(m, v_ll_rms, f_hz, 1.0);
@@ -273,9 +278,9 @@ pub fn simulate_to_vec(params: &ParamFile, scenario: &Scenario) -> Result<Vec<Ro
     Ok(rows)
 }
 
-/// Resolved effect parameters.
+/// The effects of a scenario, resolved to the numbers the machine and the loop need.
 #[derive(Debug, Clone, Default)]
-struct Effects {
+struct ResolvedEffects {
     thermal: Option<Thermal>,
     sat: Option<SatLaw>,
     rfe: Option<f64>,
@@ -296,15 +301,94 @@ struct Thermal {
     rotor: bool,
 }
 
-/// Multiplicative parameter modifications in effect.
+impl ResolvedEffects {
+    /// Resolves the scenario's effects: defaults that depend on the machine and supply
+    /// (rated flux `vpk0 / we0`, rated torque `t_rated`, synchronous speed `w_sync`).
+    fn new(
+        scenario: &Scenario,
+        m: &MotorParameters,
+        (vpk0, we0): (f64, f64),
+        (t_rated, w_sync, bl_base): (f64, f64, f64),
+    ) -> Result<Self, SimError> {
+        let mut eff = ResolvedEffects::default();
+        for e in &scenario.effects {
+            match *e {
+                EffectSpec::ThermalDrift {
+                    rise_k,
+                    tau_s,
+                    at_s,
+                    r_th_k_per_w,
+                    alpha_per_k,
+                    rotor,
+                } => {
+                    eff.thermal = Some(Thermal {
+                        rise_k: if r_th_k_per_w.is_some() {
+                            None
+                        } else {
+                            Some(rise_k.unwrap_or(60.0))
+                        },
+                        tau_s,
+                        at_s,
+                        r_th: r_th_k_per_w.unwrap_or(0.0),
+                        alpha: alpha_per_k,
+                        rotor,
+                    })
+                }
+                EffectSpec::Saturation {
+                    psi_sat_wb,
+                    psi_sat_ratio,
+                    exponent,
+                } => {
+                    eff.sat = Some(SatLaw {
+                        psi_sat_wb: psi_sat_wb.unwrap_or(psi_sat_ratio * vpk0 / we0),
+                        exponent,
+                    })
+                }
+                EffectSpec::IronLoss {
+                    rfe_ohm,
+                    rfe_over_xm,
+                } => eff.rfe = Some(rfe_ohm.unwrap_or(rfe_over_xm * we0 * m.lm_h)),
+                EffectSpec::CoulombFriction {
+                    torque_nm,
+                    omega0_rad_s,
+                } => eff.coulomb = Some((torque_nm.unwrap_or(0.02 * t_rated), omega0_rad_s)),
+                EffectSpec::Windage { k_nms2 } => {
+                    eff.windage = k_nms2.unwrap_or(0.05 * t_rated / (w_sync * w_sync))
+                }
+                EffectSpec::LoadTorque { torque_nm } => {
+                    if scenario.load.kind == LoadKind::Torque {
+                        return Err(SimError::Invalid {
+                            key: "effects.load_torque".into(),
+                            message: "the load is already a torque load (load.kind = \"torque\")"
+                                .into(),
+                        });
+                    }
+                    eff.load_torque = Some(torque_nm.unwrap_or(bl_base * w_sync));
+                }
+                EffectSpec::SupplyUnbalance {
+                    fraction,
+                    angle_deg,
+                } => eff.unbalance = Some((fraction, angle_deg.to_radians())),
+                EffectSpec::PhaseAsymmetry { phase, fraction } => {
+                    eff.asym = Some((phase.index(), fraction))
+                }
+                EffectSpec::FluxDynamics {} | EffectSpec::CurrentDynamics {} => {}
+            }
+        }
+        Ok(eff)
+    }
+}
+
+/// Multiplicative parameter changes in effect (faults, load steps, winding temperature).
 #[derive(Debug, Clone, Copy)]
-struct Mods {
+struct ParameterScales {
     rs: f64,
     rr: f64,
     lls: f64,
     llr: f64,
     b: f64,
     bl: f64,
+    /// Thermal factors of the stator and rotor resistances.
     th_s: f64,
     th_r: f64,
     /// Viscous load: Bl scale from load steps. Torque load: torque [N m].
@@ -312,9 +396,9 @@ struct Mods {
     torque_nm: f64,
 }
 
-impl Default for Mods {
+impl Default for ParameterScales {
     fn default() -> Self {
-        Mods {
+        ParameterScales {
             rs: 1.0,
             rr: 1.0,
             lls: 1.0,
@@ -329,20 +413,39 @@ impl Default for Mods {
     }
 }
 
-struct Setup<'a> {
-    m: &'a MotorParams,
-    eff: Effects,
+impl ParameterScales {
+    /// Applies a parametric fault (sensor faults act on the sensors, not here).
+    fn apply_fault(&mut self, f: &FaultSpec) {
+        let k = 1.0 + f.change.unwrap_or(0.0);
+        match f.kind {
+            Fault::Rs => self.rs *= k,
+            Fault::Rr => self.rr *= k,
+            Fault::Ls => self.lls *= k,
+            Fault::Lr => self.llr *= k,
+            Fault::B => self.b *= k,
+            Fault::Bl => self.bl *= k,
+            Fault::CurrentSensor | Fault::VoltageSensor | Fault::SpeedSensor => {}
+        }
+    }
+}
+
+/// Builds the [`Machine`] for the parameter file's motor, the resolved effects and the
+/// parameter changes in effect.
+struct MachineBuilder<'a> {
+    m: &'a MotorParameters,
+    eff: ResolvedEffects,
     torque_load: bool,
     bl_base: f64,
 }
 
-impl Setup<'_> {
-    fn build(&self, md: &Mods) -> Result<Model, String> {
+impl MachineBuilder<'_> {
+    fn build(&self, md: &ParameterScales) -> Result<Machine, String> {
         let m = self.m;
+        let model = m.model::<f64>();
         let rs = m.rs_ohm * md.rs * md.th_s;
         let rr = m.rr_ohm * md.rr * md.th_r;
-        let gamma_s = m.lls_h() <= 1e-9 * m.lm_h;
-        let gamma_r = m.llr_h() <= 1e-9 * m.lm_h;
+        let gamma_s = model.lls_h() <= 1e-9 * m.lm_h;
+        let gamma_r = model.llr_h() <= 1e-9 * m.lm_h;
         let mut lm = m.lm_h;
         if gamma_s {
             lm *= md.lls;
@@ -350,8 +453,8 @@ impl Setup<'_> {
         if gamma_r {
             lm *= md.llr;
         }
-        let lls = if gamma_s { 0.0 } else { m.lls_h() * md.lls };
-        let llr = if gamma_r { 0.0 } else { m.llr_h() * md.llr };
+        let lls = if gamma_s { 0.0 } else { model.lls_h() * md.lls };
+        let llr = if gamma_r { 0.0 } else { model.llr_h() * md.llr };
         let t_mat = match self.eff.asym {
             Some((ph, mu)) => {
                 Sym2::scalar_minus_rank1(1.0, 2.0 / 3.0 * mu, ph as f64 * 2.0 * PI / 3.0)
@@ -376,7 +479,7 @@ impl Setup<'_> {
                 windage: self.eff.windage,
             }
         };
-        Model::new(
+        Machine::new(
             rs,
             t_mat,
             lls,
@@ -385,56 +488,117 @@ impl Setup<'_> {
             lm,
             self.eff.sat,
             self.eff.rfe,
-            m.pole_pairs(),
+            model.np(),
             m.j_kgm2,
             m.b_nms * md.b,
             load,
         )
     }
+
+    /// The scenario key a machine that cannot be built is blamed on.
+    fn blamed_key(&self) -> &'static str {
+        if self.eff.asym.is_some() {
+            "effects.phase_asymmetry"
+        } else {
+            "faults"
+        }
+    }
 }
 
+/// Something the scenario switches at an output sample.
 #[derive(Debug, Clone, Copy)]
-enum Ev {
+enum ScenarioEvent {
     Supply(SupplyStep),
     Load(LoadStep),
     Fault(FaultSpec),
 }
 
-fn apply_param_fault(md: &mut Mods, f: &FaultSpec) {
-    let k = 1.0 + f.change.unwrap_or(0.0);
-    match f.kind {
-        FaultKind::Rs => md.rs *= k,
-        FaultKind::Rr => md.rr *= k,
-        FaultKind::Ls => md.lls *= k,
-        FaultKind::Lr => md.llr *= k,
-        FaultKind::B => md.b *= k,
-        FaultKind::Bl => md.bl *= k,
-        _ => {}
+/// The stiff supply: positive-sequence unit phasor `p`, rotated by `e^{j we h/2}` twice per
+/// integrator step (no trig per step), plus a negative sequence with `supply_unbalance`.
+struct Supply {
+    vpk0: f64,
+    vpk: f64,
+    we: f64,
+    h: f64,
+    /// Negative-sequence fraction and its angle's cos and sin.
+    kn: f64,
+    cn: f64,
+    sn: f64,
+    p: [f64; 2],
+    rot: [f64; 2],
+}
+
+impl Supply {
+    fn new(vpk0: f64, we0: f64, h: f64, unbalance: Option<(f64, f64)>) -> Self {
+        let (kn, cn, sn) = match unbalance {
+            Some((k, phi)) => (k, phi.cos(), phi.sin()),
+            None => (0.0, 1.0, 0.0),
+        };
+        Supply {
+            vpk0,
+            vpk: vpk0,
+            we: we0,
+            h,
+            kn,
+            cn,
+            sn,
+            p: [1.0, 0.0],
+            rot: [(0.5 * we0 * h).cos(), (0.5 * we0 * h).sin()],
+        }
+    }
+
+    fn step(&mut self, s: &SupplyStep) {
+        if let Some(v) = s.v_scale {
+            self.vpk = self.vpk0 * v;
+        }
+        if let Some(f) = s.f_hz {
+            self.we = 2.0 * PI * f;
+            self.rot = [
+                (0.5 * self.we * self.h).cos(),
+                (0.5 * self.we * self.h).sin(),
+            ];
+        }
+    }
+
+    /// Voltage vector (alpha, beta) for the unit phasor `p`.
+    #[inline(always)]
+    fn voltage(&self, p: [f64; 2]) -> [f64; 2] {
+        let (kn, cn, sn) = (self.kn, self.cn, self.sn);
+        [
+            self.vpk * (p[0] + kn * (cn * p[0] + sn * p[1])),
+            self.vpk * (p[1] + kn * (sn * p[0] - cn * p[1])),
+        ]
+    }
+
+    #[inline(always)]
+    fn rotate(p: [f64; 2], r: [f64; 2]) -> [f64; 2] {
+        [p[0] * r[0] - p[1] * r[1], p[0] * r[1] + p[1] * r[0]]
+    }
+
+    /// Integrates `machine` over one output sample (`nsub` steps of `h`).
+    fn integrate(&mut self, machine: &Machine, x: &mut [f64; 6], nsub: u32) {
+        for _ in 0..nsub {
+            let pm = Self::rotate(self.p, self.rot);
+            let pe = Self::rotate(pm, self.rot);
+            machine.rk4(
+                x,
+                self.h,
+                self.voltage(self.p),
+                self.voltage(pm),
+                self.voltage(pe),
+            );
+            self.p = pe;
+        }
+        // Renormalise |p| = 1 (first-order Newton step: no sqrt, |p| drifts by ~1e-16/step).
+        let norm = 1.5 - 0.5 * (self.p[0] * self.p[0] + self.p[1] * self.p[1]);
+        self.p = [self.p[0] * norm, self.p[1] * norm];
     }
 }
 
-/// [`simulate`] that also hands the true state to the callback (for tests; see [`Truth`]).
-///
-/// # Errors
-/// As [`simulate`].
-pub fn simulate_with_truth(
-    params: &ParamFile,
-    scenario: &Scenario,
-    mut on_row: impl FnMut(&Row, &Truth),
-) -> Result<SimSummary, SimError> {
-    scenario.validate()?;
-    params.check().map_err(|message| SimError::Invalid {
-        key: "params".into(),
-        message,
-    })?;
+/// The rated torque the effects' defaults scale with: Bl x synchronous speed for a viscous
+/// load, the largest torque of a torque load (falling back to the file's Bl).
+fn rated_torque(params: &ParamFile, scenario: &Scenario, w_sync: f64, bl_base: f64) -> f64 {
     let m = &params.motor;
-    let v_ll = scenario.supply.v_ll_rms.unwrap_or(params.supply.v_ll_rms);
-    let f0 = scenario.supply.f_hz.unwrap_or(params.supply.f_hz);
-    let np = m.pole_pairs();
-    let vpk0 = v_ll * (2.0f64 / 3.0).sqrt();
-    let we0 = 2.0 * PI * f0;
-    let bl_base = scenario.load.bl_nms.unwrap_or(m.bl_nms);
-    let w_sync = we0 / np;
     let mut t_rated = bl_base * w_sync;
     if scenario.load.kind == LoadKind::Torque {
         t_rated = scenario
@@ -448,269 +612,253 @@ pub fn simulate_with_truth(
     if t_rated <= 0.0 {
         t_rated = m.bl_nms * w_sync;
     }
+    t_rated
+}
 
-    // Resolve effects.
-    let mut eff = Effects::default();
-    for e in &scenario.effects {
-        match *e {
-            Effect::ThermalDrift {
-                rise_k,
-                tau_s,
-                at_s,
-                r_th_k_per_w,
-                alpha_per_k,
-                rotor,
-            } => {
-                eff.thermal = Some(Thermal {
-                    rise_k: if r_th_k_per_w.is_some() {
-                        None
-                    } else {
-                        Some(rise_k.unwrap_or(60.0))
-                    },
-                    tau_s,
-                    at_s,
-                    r_th: r_th_k_per_w.unwrap_or(0.0),
-                    alpha: alpha_per_k,
-                    rotor,
-                })
-            }
-            Effect::Saturation {
-                psi_sat_wb,
-                psi_sat_ratio,
-                exponent,
-            } => {
-                eff.sat = Some(SatLaw {
-                    psi_sat_wb: psi_sat_wb.unwrap_or(psi_sat_ratio * vpk0 / we0),
-                    exponent,
-                })
-            }
-            Effect::IronLoss {
-                rfe_ohm,
-                rfe_over_xm,
-            } => eff.rfe = Some(rfe_ohm.unwrap_or(rfe_over_xm * we0 * m.lm_h)),
-            Effect::CoulombFriction {
-                torque_nm,
-                omega0_rad_s,
-            } => eff.coulomb = Some((torque_nm.unwrap_or(0.02 * t_rated), omega0_rad_s)),
-            Effect::Windage { k_nms2 } => {
-                eff.windage = k_nms2.unwrap_or(0.05 * t_rated / (w_sync * w_sync))
-            }
-            Effect::LoadTorque { torque_nm } => {
-                if scenario.load.kind == LoadKind::Torque {
-                    return Err(SimError::Invalid {
-                        key: "effects.load_torque".into(),
-                        message: "the load is already a torque load (load.kind = \"torque\")"
-                            .into(),
-                    });
-                }
-                eff.load_torque = Some(torque_nm.unwrap_or(bl_base * w_sync));
-            }
-            Effect::SupplyUnbalance {
-                fraction,
-                angle_deg,
-            } => eff.unbalance = Some((fraction, angle_deg.to_radians())),
-            Effect::PhaseAsymmetry { phase, fraction } => {
-                eff.asym = Some((phase.index(), fraction))
-            }
-            Effect::FluxDynamics {} | Effect::CurrentDynamics {} => {}
-        }
-    }
-    let torque_load = scenario.load.kind == LoadKind::Torque || eff.load_torque.is_some();
-    let mut md = Mods {
-        torque_nm: eff.load_torque.or(scenario.load.torque_nm).unwrap_or(0.0),
-        ..Mods::default()
-    };
-    let setup = Setup {
-        m,
-        eff,
-        torque_load,
-        bl_base,
-    };
-
-    // Timing and events.
+/// The scenario's supply steps, load steps and faults at their output-sample indices.
+fn scenario_events(scenario: &Scenario) -> Vec<(u64, ScenarioEvent)> {
     let rate = scenario.sample_rate_hz;
-    let dt = 1.0 / rate;
-    let n = (scenario.duration_s * rate).round() as u64;
-    let hmax = scenario.max_step_s.unwrap_or(DEFAULT_MAX_STEP_S);
-    let nsub = ((dt / hmax) * (1.0 - 1e-12)).ceil().max(1.0) as u32;
-    let h = dt / f64::from(nsub);
     let idx = |t: f64| (t * rate - 1e-9).ceil().max(0.0) as u64;
-    let mut events: Vec<(u64, Ev)> = Vec::new();
+    let mut events: Vec<(u64, ScenarioEvent)> = Vec::new();
     events.extend(
         scenario
             .supply
             .steps
             .iter()
-            .map(|s| (idx(s.t_s), Ev::Supply(*s))),
+            .map(|s| (idx(s.t_s), ScenarioEvent::Supply(*s))),
     );
     events.extend(
         scenario
             .load
             .steps
             .iter()
-            .map(|s| (idx(s.t_s), Ev::Load(*s))),
+            .map(|s| (idx(s.t_s), ScenarioEvent::Load(*s))),
     );
-    events.extend(scenario.faults.iter().map(|f| (idx(f.at_s), Ev::Fault(*f))));
+    events.extend(
+        scenario
+            .faults
+            .iter()
+            .map(|f| (idx(f.at_s), ScenarioEvent::Fault(*f))),
+    );
     events.sort_by_key(|e| e.0);
+    events
+}
 
-    // Check every parameter set the run will pass through, before the first row.
-    let invalid = |key: &str, message: String| SimError::Invalid {
-        key: key.to_string(),
-        message,
-    };
-    let key_of = || {
-        if setup.eff.asym.is_some() {
-            "effects.phase_asymmetry"
-        } else {
-            "faults"
-        }
-    };
-    let mut model = setup.build(&md).map_err(|e| invalid(key_of(), e))?;
-    {
-        let mut scratch = md;
+/// [`simulate`] that also hands the true state to the callback (for tests; see [`Truth`]).
+///
+/// # Errors
+/// As [`simulate`].
+pub fn simulate_with_truth(
+    params: &ParamFile,
+    scenario: &Scenario,
+    on_row: impl FnMut(&Row, &Truth),
+) -> Result<SimSummary, SimError> {
+    scenario.validate()?;
+    params.check().map_err(|e| SimError::Invalid {
+        key: "params".into(),
+        message: e.to_string(),
+    })?;
+    Run::new(params, scenario)?.run(on_row)
+}
+
+/// One simulation run: the resolved scenario and the state of the loop.
+struct Run<'a> {
+    scenario: &'a Scenario,
+    builder: MachineBuilder<'a>,
+    scales: ParameterScales,
+    events: Vec<(u64, ScenarioEvent)>,
+    machine: Machine,
+    sensors: Sensors,
+    supply: Supply,
+    /// Output rows, RK4 steps per row, output period [s].
+    n: u64,
+    nsub: u32,
+    dt: f64,
+    np: f64,
+}
+
+impl<'a> Run<'a> {
+    /// Resolves the scenario and checks every parameter set the run will pass through,
+    /// before the first row.
+    fn new(params: &'a ParamFile, scenario: &'a Scenario) -> Result<Self, SimError> {
+        let m = &params.motor;
+        let v_ll = scenario.supply.v_ll_rms.unwrap_or(params.supply.v_ll_rms);
+        let f0 = scenario.supply.f_hz.unwrap_or(params.supply.f_hz);
+        let np = m.model::<f64>().np();
+        let vpk0 = v_ll * (2.0f64 / 3.0).sqrt();
+        let we0 = 2.0 * PI * f0;
+        let bl_base = scenario.load.bl_nms.unwrap_or(m.bl_nms);
+        let w_sync = we0 / np;
+        let t_rated = rated_torque(params, scenario, w_sync, bl_base);
+        let eff = ResolvedEffects::new(scenario, m, (vpk0, we0), (t_rated, w_sync, bl_base))?;
+        let torque_load = scenario.load.kind == LoadKind::Torque || eff.load_torque.is_some();
+        let scales = ParameterScales {
+            torque_nm: eff.load_torque.or(scenario.load.torque_nm).unwrap_or(0.0),
+            ..ParameterScales::default()
+        };
+        let builder = MachineBuilder {
+            m,
+            eff,
+            torque_load,
+            bl_base,
+        };
+        let rate = scenario.sample_rate_hz;
+        let dt = 1.0 / rate;
+        let hmax = scenario.max_step_s.unwrap_or(DEFAULT_MAX_STEP_S);
+        let nsub = ((dt / hmax) * (1.0 - 1e-12)).ceil().max(1.0) as u32;
+        let h = dt / f64::from(nsub);
+        let events = scenario_events(scenario);
+        let invalid = |message: String| SimError::Invalid {
+            key: builder.blamed_key().to_string(),
+            message,
+        };
+        let machine = builder.build(&scales).map_err(invalid)?;
+        let mut scratch = scales;
         for (_, ev) in &events {
-            if let Ev::Fault(f) = ev {
-                apply_param_fault(&mut scratch, f);
-                setup.build(&scratch).map_err(|e| invalid(key_of(), e))?;
+            if let ScenarioEvent::Fault(f) = ev {
+                scratch.apply_fault(f);
+                builder.build(&scratch).map_err(invalid)?;
             }
         }
+        let (dv, di) = default_ranges(m, v_ll, f0);
+        let sp = &scenario.sensors;
+        let sensors = Sensors::new(
+            sp,
+            sp.v_range_v.unwrap_or(dv),
+            sp.i_range_a.unwrap_or(di),
+            scenario.seed,
+        );
+        let supply = Supply::new(vpk0, we0, h, builder.eff.unbalance);
+        Ok(Run {
+            scenario,
+            builder,
+            scales,
+            events,
+            machine,
+            sensors,
+            supply,
+            n: (scenario.duration_s * rate).round() as u64,
+            nsub,
+            dt,
+            np,
+        })
     }
 
-    let (dv, di) = default_ranges(m, v_ll, f0);
-    let sp = &scenario.sensors;
-    let mut sensors = Sensors::new(
-        sp,
-        sp.v_range_v.unwrap_or(dv),
-        sp.i_range_a.unwrap_or(di),
-        scenario.seed,
-    );
-
-    // Supply state: positive-sequence unit phasor p, rotated by e^{j we h/2} twice per step.
-    let mut vpk = vpk0;
-    let mut we = we0;
-    let (kn, cn, sn) = match setup.eff.unbalance {
-        Some((k, phi)) => (k, phi.cos(), phi.sin()),
-        None => (0.0, 1.0, 0.0),
-    };
-    let mut p = [1.0f64, 0.0f64];
-    let mut rot = [(0.5 * we * h).cos(), (0.5 * we * h).sin()];
-    let sv = |p: [f64; 2], vpk: f64| -> [f64; 2] {
-        [
-            vpk * (p[0] + kn * (cn * p[0] + sn * p[1])),
-            vpk * (p[1] + kn * (sn * p[0] - cn * p[1])),
-        ]
-    };
-    let rotate = |p: [f64; 2], r: [f64; 2]| [p[0] * r[0] - p[1] * r[1], p[0] * r[1] + p[1] * r[0]];
-
-    let mut x = [0.0f64; 6];
-    let mut ev_i = 0usize;
-    let mut dtemp = 0.0f64;
-    let mut max_i2 = 0.0f64;
-    let mut last_p_loss = 0.0f64;
-    let s3 = 3f64.sqrt() / 2.0;
-    for k in 0..n {
-        let t = k as f64 * dt;
+    /// Applies the events due at output sample `k`; true when the machine must be rebuilt.
+    fn apply_events(&mut self, k: u64, next_event: &mut usize) -> bool {
         let mut rebuild = false;
-        while ev_i < events.len() && events[ev_i].0 <= k {
-            match events[ev_i].1 {
-                Ev::Supply(s) => {
-                    if let Some(v) = s.v_scale {
-                        vpk = vpk0 * v;
-                    }
-                    if let Some(f) = s.f_hz {
-                        we = 2.0 * PI * f;
-                        rot = [(0.5 * we * h).cos(), (0.5 * we * h).sin()];
-                    }
-                }
-                Ev::Load(s) => {
+        while *next_event < self.events.len() && self.events[*next_event].0 <= k {
+            match self.events[*next_event].1 {
+                ScenarioEvent::Supply(s) => self.supply.step(&s),
+                ScenarioEvent::Load(s) => {
                     if let Some(tq) = s.torque_nm {
-                        md.torque_nm = tq;
+                        self.scales.torque_nm = tq;
                     }
                     if let Some(b) = s.bl_scale {
-                        md.bl_scale = b;
+                        self.scales.bl_scale = b;
                     }
                     rebuild = true;
                 }
-                Ev::Fault(f) => {
+                ScenarioEvent::Fault(f) => {
                     if f.kind.is_sensor() {
-                        sensors.apply_fault(&f);
+                        self.sensors.apply_fault(&f);
                     } else {
-                        apply_param_fault(&mut md, &f);
+                        self.scales.apply_fault(&f);
                         rebuild = true;
                     }
                 }
             }
-            ev_i += 1;
+            *next_event += 1;
         }
-        if let Some(th) = setup.eff.thermal {
-            let new = match th.rise_k {
-                Some(rise) if t >= th.at_s => rise * (1.0 - (-(t - th.at_s) / th.tau_s).exp()),
-                Some(_) => 0.0,
-                None if t >= th.at_s => {
-                    let target = th.r_th * last_p_loss;
-                    target + (dtemp - target) * (-dt / th.tau_s).exp()
-                }
-                None => 0.0,
-            };
-            if new != dtemp || k == 0 {
+        rebuild
+    }
+
+    /// The winding temperature rise at time `t` (`thermal_drift`), from the previous one and
+    /// the last output sample's losses; `None` when it did not change.
+    fn temperature_rise(&self, t: f64, k: u64, dtemp: f64, last_p_loss: f64) -> Option<f64> {
+        let th = self.builder.eff.thermal?;
+        let new = match th.rise_k {
+            Some(rise) if t >= th.at_s => rise * (1.0 - (-(t - th.at_s) / th.tau_s).exp()),
+            Some(_) => 0.0,
+            None if t >= th.at_s => {
+                let target = th.r_th * last_p_loss;
+                target + (dtemp - target) * (-self.dt / th.tau_s).exp()
+            }
+            None => 0.0,
+        };
+        (new != dtemp || k == 0).then_some(new)
+    }
+
+    fn run(mut self, mut on_row: impl FnMut(&Row, &Truth)) -> Result<SimSummary, SimError> {
+        let mut x = [0.0f64; 6];
+        let mut next_event = 0usize;
+        let mut dtemp = 0.0f64;
+        let mut max_i2 = 0.0f64;
+        let mut last_p_loss = 0.0f64;
+        for k in 0..self.n {
+            let t = k as f64 * self.dt;
+            let mut rebuild = self.apply_events(k, &mut next_event);
+            if let Some(new) = self.temperature_rise(t, k, dtemp, last_p_loss) {
                 dtemp = new;
-                md.th_s = 1.0 + th.alpha * dtemp;
-                md.th_r = if th.rotor { md.th_s } else { 1.0 };
+                let alpha = self.builder.eff.thermal.map(|th| th.alpha).unwrap_or(0.0);
+                let rotor = self.builder.eff.thermal.is_some_and(|th| th.rotor);
+                self.scales.th_s = 1.0 + alpha * dtemp;
+                self.scales.th_r = if rotor { self.scales.th_s } else { 1.0 };
                 rebuild = true;
             }
+            if rebuild {
+                let nm = self
+                    .builder
+                    .build(&self.scales)
+                    .map_err(|message| SimError::Invalid {
+                        key: self.builder.blamed_key().to_string(),
+                        message,
+                    })?;
+                nm.take_guess(&self.machine);
+                self.machine = nm;
+            }
+            // Outputs at t.
+            let v = self.supply.voltage(self.supply.p);
+            let tr = truth(&self.machine, &x, v, t, self.supply.we, dtemp);
+            last_p_loss = tr.p_cu_w + tr.p_fe_w;
+            max_i2 = max_i2.max(tr.i_ab[0] * tr.i_ab[0] + tr.i_ab[1] * tr.i_ab[1]);
+            let row = self.sensors.measure(&tr, self.dt);
+            on_row(&row, &tr);
+            // Integrate to t + dt.
+            self.supply.integrate(&self.machine, &mut x, self.nsub);
+            if !(x[0].is_finite() && x[2].is_finite() && x[4].is_finite()) {
+                return Err(SimError::Diverged { t_s: t + self.dt });
+            }
         }
-        if rebuild {
-            let nm = setup.build(&md).map_err(|e| invalid(key_of(), e))?;
-            nm.take_guess(&model);
-            model = nm;
-        }
+        Ok(self.summary(x[4], max_i2.sqrt()))
+    }
 
-        // Outputs at t.
-        let v = sv(p, vpk);
-        let tr = truth(&model, &x, v, t, we, dtemp, s3);
-        last_p_loss = tr.p_cu_w + tr.p_fe_w;
-        max_i2 = max_i2.max(tr.i_ab[0] * tr.i_ab[0] + tr.i_ab[1] * tr.i_ab[1]);
-        let row = sensors.measure(&tr, dt);
-        on_row(&row, &tr);
-
-        // Integrate to t + dt.
-        for _ in 0..nsub {
-            let pm = rotate(p, rot);
-            let pe = rotate(pm, rot);
-            model.rk4(&mut x, h, sv(p, vpk), sv(pm, vpk), sv(pe, vpk));
-            p = pe;
-        }
-        // Renormalise |p| = 1 (first-order Newton step: no sqrt, |p| drifts by ~1e-16/step).
-        let norm = 1.5 - 0.5 * (p[0] * p[0] + p[1] * p[1]);
-        p = [p[0] * norm, p[1] * norm];
-        if !(x[0].is_finite() && x[2].is_finite() && x[4].is_finite()) {
-            return Err(SimError::Diverged { t_s: t + dt });
+    fn summary(&self, wm: f64, max_abs_current_a: f64) -> SimSummary {
+        let sc = self.scenario;
+        SimSummary {
+            rows: self.n,
+            duration_s: sc.duration_s,
+            sample_rate_hz: sc.sample_rate_hz,
+            step_s: self.supply.h,
+            substeps_per_sample: self.nsub,
+            v_range_v: self.sensors.v_range_v,
+            i_range_a: self.sensors.i_range_a,
+            noise_v: self.sensors.noise_v,
+            noise_i: self.sensors.noise_i,
+            final_wm_rad_s: wm,
+            final_slip: 1.0 - self.np * wm / self.supply.we,
+            max_abs_current_a,
+            effects: sc
+                .effects
+                .iter()
+                .map(|e| e.kind().name().to_string())
+                .collect(),
+            faults: sc.faults.len(),
         }
     }
-    let wm = x[4];
-    Ok(SimSummary {
-        rows: n,
-        duration_s: scenario.duration_s,
-        sample_rate_hz: rate,
-        step_s: h,
-        substeps_per_sample: nsub,
-        v_range_v: sensors.v_range_v,
-        i_range_a: sensors.i_range_a,
-        noise_v: sensors.noise_v,
-        noise_i: sensors.noise_i,
-        final_wm_rad_s: wm,
-        final_slip: 1.0 - np * wm / we,
-        max_abs_current_a: max_i2.sqrt(),
-        effects: scenario
-            .effects
-            .iter()
-            .map(|e| e.name().to_string())
-            .collect(),
-        faults: scenario.faults.len(),
-    })
 }
 
-fn truth(model: &Model, x: &[f64; 6], v: [f64; 2], t: f64, we: f64, dtemp: f64, s3: f64) -> Truth {
+fn truth(model: &Machine, x: &[f64; 6], v: [f64; 2], t: f64, we: f64, dtemp: f64) -> Truth {
     let psp = [x[0], x[1]];
     let pr = [x[2], x[3]];
     let c = model.currents(psp, pr);
@@ -718,7 +866,16 @@ fn truth(model: &Model, x: &[f64; 6], v: [f64; 2], t: f64, we: f64, dtemp: f64, 
     let ps = model.t_mat.mul(psp);
     let u = model.u(v, is);
     let it = [is[0] + u[0] * model.inv_rfe, is[1] + u[1] * model.inv_rfe];
-    let abc = |a: [f64; 2]| [a[0], -0.5 * a[0] + s3 * a[1], -0.5 * a[0] - s3 * a[1]];
+    let abc = |a: [f64; 2]| {
+        inverse_clarke(
+            AlphaBeta {
+                alpha: a[0],
+                beta: a[1],
+            },
+            0.0,
+        )
+        .to_array()
+    };
     let te = model.torque(pr, c.i_r);
     let wm = x[4];
     Truth {

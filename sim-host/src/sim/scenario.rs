@@ -3,6 +3,7 @@
 //! See the module documentation of [`crate::sim`] for the TOML format.
 
 use super::SimError;
+use monitor_core::{EffectKind, Fault, Phase};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -38,7 +39,7 @@ pub struct Scenario {
     pub faults: Vec<FaultSpec>,
     /// Physical effects (on for the whole run unless the effect has its own `at_s`).
     #[serde(default)]
-    pub effects: Vec<Effect>,
+    pub effects: Vec<EffectSpec>,
     /// Sensor chain (ADC, errors, noise, encoder). Default: [`SensorSpec::default`].
     #[serde(default)]
     pub sensors: SensorSpec,
@@ -123,43 +124,6 @@ pub struct LoadStep {
     pub bl_scale: Option<f64>,
 }
 
-/// Fault names (DESIGN.md §3).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum FaultKind {
-    /// Stator resistance Rs x (1 + change).
-    Rs,
-    /// Rotor resistance Rr x (1 + change).
-    Rr,
-    /// Stator LEAKAGE inductance Lls x (1 + change); Ls = Lls + Lm follows (PSIM convention).
-    /// For a Gamma-model machine (Lls = 0) the stator inductance Ls = Lm itself is scaled
-    /// (Lm x (1 + change), the rotor leakage kept, so Lr = Llr + Lm follows).
-    Ls,
-    /// Rotor LEAKAGE inductance Llr x (1 + change); Lr = Llr + Lm follows. For a machine with
-    /// Llr = 0, Lm is scaled instead (as for `ls`).
-    Lr,
-    /// Machine friction B x (1 + change).
-    B,
-    /// Load coefficient Bl x (1 + change); for a torque load, the load torque x (1 + change).
-    Bl,
-    /// Current sensor(s): `mode` gain / offset / disconnected / stuck.
-    CurrentSensor,
-    /// Voltage sensor(s): `mode` gain / offset / disconnected / stuck.
-    VoltageSensor,
-    /// Speed sensor: acts on `wm_rad_s` and on the encoder count.
-    SpeedSensor,
-}
-
-impl FaultKind {
-    /// True for the sensor faults.
-    pub fn is_sensor(self) -> bool {
-        matches!(
-            self,
-            FaultKind::CurrentSensor | FaultKind::VoltageSensor | FaultKind::SpeedSensor
-        )
-    }
-}
-
 /// What a sensor fault does to the reading x.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -174,40 +138,23 @@ pub enum SensorFaultMode {
     Stuck,
 }
 
-/// A phase of the three-phase system.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Phase {
-    /// Phase a (alpha axis).
-    A,
-    /// Phase b.
-    B,
-    /// Phase c.
-    C,
-}
-
-impl Phase {
-    /// 0, 1, 2 for a, b, c.
-    pub fn index(self) -> usize {
-        match self {
-            Phase::A => 0,
-            Phase::B => 1,
-            Phase::C => 2,
-        }
-    }
-}
-
 /// One fault, switched on at the first output sample at or after `at_s` and kept on.
 ///
-/// Parametric faults (`rs, rr, ls, lr, b, bl`) need `change` (relative, > -1; +0.5 = +50 %).
+/// Parametric faults (`rs, rr, ls, lr, b, bl`) need `change` (relative, > -1; +0.5 = +50 %):
+/// `rs`, `rr`, `b`: the value x (1 + change). `ls`, `lr`: the LEAKAGE inductance x (1 +
+/// change), the self inductance follows (PSIM's convention, DESIGN.md §2); for a machine
+/// without that leakage (the Gamma-model 2.2 kW reference has Lls = 0) Lm itself is scaled
+/// (the other leakage kept, so both self inductances follow). `bl`: Bl x (1 + change), or
+/// the load torque for a torque load. The speed sensor fault acts on `wm_rad_s` and on the
+/// encoder count.
 /// Sensor faults need `mode`; `gain` needs `change`, `offset` needs `offset`; `phase`
 /// (voltage and current sensors only) restricts the fault to one phase (default: all three).
 /// Several faults of the same kind compose multiplicatively.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FaultSpec {
-    /// Which fault.
-    pub kind: FaultKind,
+    /// Which fault (DESIGN.md name).
+    pub kind: Fault,
     /// Switch-on time [s], >= 0.
     pub at_s: f64,
     /// Relative change (parametric faults, sensor gain).
@@ -226,7 +173,7 @@ pub struct FaultSpec {
 
 impl FaultSpec {
     /// A parametric fault (`rs, rr, ls, lr, b, bl`) with relative `change` at `at_s`.
-    pub fn parametric(kind: FaultKind, at_s: f64, change: f64) -> Self {
+    pub fn parametric(kind: Fault, at_s: f64, change: f64) -> Self {
         FaultSpec {
             kind,
             at_s,
@@ -236,8 +183,19 @@ impl FaultSpec {
             phase: None,
         }
     }
+    /// Table 1's kind of fault of relative size `change` at `at_s`: a parametric change,
+    /// or for a sensor a gain error on all its channels (the reading is (1 + change)
+    /// times the true value).
+    pub fn at_change(kind: Fault, at_s: f64, change: f64) -> Self {
+        if kind.is_sensor() {
+            Self::sensor_gain(kind, at_s, change)
+        } else {
+            Self::parametric(kind, at_s, change)
+        }
+    }
+
     /// A sensor gain fault: the reading is (1 + change) times the true value.
-    pub fn sensor_gain(kind: FaultKind, at_s: f64, change: f64) -> Self {
+    pub fn sensor_gain(kind: Fault, at_s: f64, change: f64) -> Self {
         FaultSpec {
             mode: Some(SensorFaultMode::Gain),
             ..Self::parametric(kind, at_s, change)
@@ -245,7 +203,7 @@ impl FaultSpec {
     }
 }
 
-/// Main-flux saturation law parameters; see [`Effect::Saturation`].
+/// Main-flux saturation law parameters; see [`EffectSpec::Saturation`].
 fn d_sat_exp() -> f64 {
     6.0
 }
@@ -277,13 +235,14 @@ fn d_phase_a() -> Phase {
     Phase::A
 }
 
-/// Physical effects (DESIGN.md §3 effect library), `[[effects]] name = "..."`.
+/// A physical effect to inject, with its parameters: `[[effects]] name = "..."`, the name
+/// an [`EffectKind`] (DESIGN.md §3 effect library).
 ///
 /// Each variant lists its parameters (TOML keys) with units and defaults. The defaults make a
 /// visible but realistic difference on the reference motors.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "name", rename_all = "snake_case", deny_unknown_fields)]
-pub enum Effect {
+pub enum EffectSpec {
     /// Winding temperature rise dT [K] above the parameter file's temperature:
     /// Rs = Rs0 (1 + alpha dT), Rr = Rr0 (1 + alpha dT) (copper alpha = 0.00393 /K;
     /// 20 -> 90 C is +27 %). First-order thermal model, one lumped winding temperature:
@@ -402,48 +361,154 @@ pub enum Effect {
     CurrentDynamics {},
 }
 
-impl Effect {
-    /// The effect's name as in DESIGN.md (`thermal_drift`, `saturation`, ...).
-    pub fn name(&self) -> &'static str {
+impl EffectSpec {
+    /// Which effect.
+    pub fn kind(&self) -> EffectKind {
         match self {
-            Effect::ThermalDrift { .. } => "thermal_drift",
-            Effect::Saturation { .. } => "saturation",
-            Effect::IronLoss { .. } => "iron_loss",
-            Effect::CoulombFriction { .. } => "coulomb_friction",
-            Effect::Windage { .. } => "windage",
-            Effect::LoadTorque { .. } => "load_torque",
-            Effect::SupplyUnbalance { .. } => "supply_unbalance",
-            Effect::PhaseAsymmetry { .. } => "phase_asymmetry",
-            Effect::FluxDynamics {} => "flux_dynamics",
-            Effect::CurrentDynamics {} => "current_dynamics",
+            EffectSpec::ThermalDrift { .. } => EffectKind::ThermalDrift,
+            EffectSpec::Saturation { .. } => EffectKind::Saturation,
+            EffectSpec::IronLoss { .. } => EffectKind::IronLoss,
+            EffectSpec::CoulombFriction { .. } => EffectKind::CoulombFriction,
+            EffectSpec::Windage { .. } => EffectKind::Windage,
+            EffectSpec::LoadTorque { .. } => EffectKind::LoadTorque,
+            EffectSpec::SupplyUnbalance { .. } => EffectKind::SupplyUnbalance,
+            EffectSpec::PhaseAsymmetry { .. } => EffectKind::PhaseAsymmetry,
+            EffectSpec::FluxDynamics {} => EffectKind::FluxDynamics,
+            EffectSpec::CurrentDynamics {} => EffectKind::CurrentDynamics,
         }
     }
 
-    /// The effect with all its parameters at their defaults, by DESIGN.md name.
-    ///
-    /// # Errors
-    /// [`SimError::Invalid`] for an unknown name.
-    pub fn by_name(name: &str) -> Result<Effect, SimError> {
-        let text = format!("name = \"{name}\"");
-        toml::from_str::<Effect>(&text).map_err(|e| SimError::Invalid {
-            key: "effects.name".into(),
-            message: crate::params::one_line(e.message()),
-        })
+    /// The effect with every parameter at its default (as `name = "<kind>"` alone in a
+    /// scenario file gives it).
+    pub fn with_defaults(kind: EffectKind) -> EffectSpec {
+        match kind {
+            EffectKind::ThermalDrift => EffectSpec::ThermalDrift {
+                rise_k: None,
+                tau_s: d_tau_s(),
+                at_s: 0.0,
+                r_th_k_per_w: None,
+                alpha_per_k: d_alpha(),
+                rotor: d_true(),
+            },
+            EffectKind::Saturation => EffectSpec::Saturation {
+                psi_sat_wb: None,
+                psi_sat_ratio: d_sat_ratio(),
+                exponent: d_sat_exp(),
+            },
+            EffectKind::IronLoss => EffectSpec::IronLoss {
+                rfe_ohm: None,
+                rfe_over_xm: d_iron_ratio(),
+            },
+            EffectKind::CoulombFriction => EffectSpec::CoulombFriction {
+                torque_nm: None,
+                omega0_rad_s: d_coulomb_w(),
+            },
+            EffectKind::Windage => EffectSpec::Windage { k_nms2: None },
+            EffectKind::LoadTorque => EffectSpec::LoadTorque { torque_nm: None },
+            EffectKind::SupplyUnbalance => EffectSpec::SupplyUnbalance {
+                fraction: d_unb(),
+                angle_deg: 0.0,
+            },
+            EffectKind::PhaseAsymmetry => EffectSpec::PhaseAsymmetry {
+                phase: d_phase_a(),
+                fraction: d_asym(),
+            },
+            EffectKind::FluxDynamics => EffectSpec::FluxDynamics {},
+            EffectKind::CurrentDynamics => EffectSpec::CurrentDynamics {},
+        }
     }
 
-    /// All effect names of DESIGN.md's library.
-    pub const NAMES: [&'static str; 10] = [
-        "thermal_drift",
-        "saturation",
-        "iron_loss",
-        "coulomb_friction",
-        "windage",
-        "load_torque",
-        "supply_unbalance",
-        "phase_asymmetry",
-        "flux_dynamics",
-        "current_dynamics",
-    ];
+    /// Checks the parameters' ranges.
+    ///
+    /// # Errors
+    /// [`SimError::Invalid`] naming the key (`effects.<name>.<parameter>`).
+    pub fn validate(&self) -> Result<(), SimError> {
+        let k = |p: &str| format!("effects.{}.{p}", self.kind().name());
+        let fraction = |key: &str, f: f64| {
+            if f.is_finite() && (0.0..=0.5).contains(&f) {
+                Ok(())
+            } else {
+                invalid(key, format!("must be in 0..0.5, got {f}"))
+            }
+        };
+        match self {
+            EffectSpec::ThermalDrift {
+                rise_k,
+                tau_s,
+                at_s,
+                r_th_k_per_w,
+                alpha_per_k,
+                ..
+            } => {
+                if let Some(r) = rise_k {
+                    if !r.is_finite() || *r < -200.0 {
+                        return invalid(&k("rise_k"), format!("must be finite, >= -200, got {r}"));
+                    }
+                }
+                if rise_k.is_some() && r_th_k_per_w.is_some() {
+                    return invalid(&k("rise_k"), "give rise_k or r_th_k_per_w, not both".into());
+                }
+                positive(&k("tau_s"), *tau_s)?;
+                not_negative(&k("at_s"), *at_s)?;
+                if let Some(r) = r_th_k_per_w {
+                    not_negative(&k("r_th_k_per_w"), *r)?;
+                }
+                not_negative(&k("alpha_per_k"), *alpha_per_k)
+            }
+            EffectSpec::Saturation {
+                psi_sat_wb,
+                psi_sat_ratio,
+                exponent,
+            } => {
+                if let Some(p) = psi_sat_wb {
+                    positive(&k("psi_sat_wb"), *p)?;
+                }
+                positive(&k("psi_sat_ratio"), *psi_sat_ratio)?;
+                positive(&k("exponent"), *exponent)
+            }
+            EffectSpec::IronLoss {
+                rfe_ohm,
+                rfe_over_xm,
+            } => {
+                if let Some(r) = rfe_ohm {
+                    positive(&k("rfe_ohm"), *r)?;
+                }
+                positive(&k("rfe_over_xm"), *rfe_over_xm)
+            }
+            EffectSpec::CoulombFriction {
+                torque_nm,
+                omega0_rad_s,
+            } => {
+                if let Some(t) = torque_nm {
+                    not_negative(&k("torque_nm"), *t)?;
+                }
+                positive(&k("omega0_rad_s"), *omega0_rad_s)
+            }
+            EffectSpec::Windage { k_nms2 } => match k_nms2 {
+                Some(v) => not_negative(&k("k_nms2"), *v),
+                None => Ok(()),
+            },
+            EffectSpec::LoadTorque { torque_nm } => match torque_nm {
+                Some(t) if !t.is_finite() => {
+                    invalid(&k("torque_nm"), format!("must be finite, got {t}"))
+                }
+                _ => Ok(()),
+            },
+            EffectSpec::SupplyUnbalance {
+                fraction: f,
+                angle_deg,
+            } => {
+                fraction(&k("fraction"), *f)?;
+                if angle_deg.is_finite() {
+                    Ok(())
+                } else {
+                    invalid(&k("angle_deg"), "must be finite".into())
+                }
+            }
+            EffectSpec::PhaseAsymmetry { fraction: f, .. } => fraction(&k("fraction"), *f),
+            EffectSpec::FluxDynamics {} | EffectSpec::CurrentDynamics {} => Ok(()),
+        }
+    }
 }
 
 /// Sensor chain: transducer (gain and offset error), white Gaussian noise, ADC quantisation
@@ -594,7 +659,7 @@ impl Scenario {
             let at = line.map(|l| format!("line {l}: ")).unwrap_or_default();
             SimError::Toml {
                 path: origin.to_string(),
-                message: format!("{at}{}", crate::params::one_line(e.message())),
+                message: format!("{at}{}", crate::one_line(e.message())),
             }
         })?;
         s.validate()?;
@@ -624,251 +689,228 @@ impl Scenario {
     /// # Errors
     /// [`SimError::Invalid`] naming the key.
     pub fn validate(&self) -> Result<(), SimError> {
-        let bad = |key: &str, message: String| {
-            Err(SimError::Invalid {
-                key: key.to_string(),
-                message,
-            })
-        };
-        let pos = |key: &str, v: f64| -> Result<(), SimError> {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                bad(key, format!("must be a positive number, got {v}"))
-            }
-        };
-        let nonneg = |key: &str, v: f64| -> Result<(), SimError> {
-            if v.is_finite() && v >= 0.0 {
-                Ok(())
-            } else {
-                bad(key, format!("must be >= 0, got {v}"))
-            }
-        };
-        pos("duration_s", self.duration_s)?;
-        pos("sample_rate_hz", self.sample_rate_hz)?;
+        positive("duration_s", self.duration_s)?;
+        positive("sample_rate_hz", self.sample_rate_hz)?;
         if self.duration_s * self.sample_rate_hz > 1.0e10 {
-            return bad("duration_s", "more than 1e10 samples".into());
+            return invalid("duration_s", "more than 1e10 samples".into());
         }
         if let Some(h) = self.max_step_s {
-            pos("max_step_s", h)?;
+            positive("max_step_s", h)?;
         }
-        if let Some(v) = self.supply.v_ll_rms {
-            pos("supply.v_ll_rms", v)?;
+        self.supply.validate()?;
+        self.load.validate()?;
+        for f in &self.faults {
+            f.validate()?;
         }
-        if let Some(f) = self.supply.f_hz {
-            pos("supply.f_hz", f)?;
+        for e in &self.effects {
+            e.validate()?;
         }
-        for st in &self.supply.steps {
-            nonneg("supply.steps.t_s", st.t_s)?;
+        self.sensors.validate()
+    }
+}
+
+impl SupplySpec {
+    /// Checks the supply overrides and steps.
+    ///
+    /// # Errors
+    /// [`SimError::Invalid`] naming the key.
+    pub fn validate(&self) -> Result<(), SimError> {
+        if let Some(v) = self.v_ll_rms {
+            positive("supply.v_ll_rms", v)?;
+        }
+        if let Some(f) = self.f_hz {
+            positive("supply.f_hz", f)?;
+        }
+        for st in &self.steps {
+            not_negative("supply.steps.t_s", st.t_s)?;
             if st.v_scale.is_none() && st.f_hz.is_none() {
-                return bad("supply.steps", "a step needs v_scale or f_hz".into());
+                return invalid("supply.steps", "a step needs v_scale or f_hz".into());
             }
             if let Some(v) = st.v_scale {
-                pos("supply.steps.v_scale", v)?;
+                positive("supply.steps.v_scale", v)?;
             }
             if let Some(f) = st.f_hz {
-                pos("supply.steps.f_hz", f)?;
+                positive("supply.steps.f_hz", f)?;
             }
         }
-        match self.load.kind {
+        Ok(())
+    }
+}
+
+impl LoadSpec {
+    /// Checks that the load's values and steps fit its kind.
+    ///
+    /// # Errors
+    /// [`SimError::Invalid`] naming the key.
+    pub fn validate(&self) -> Result<(), SimError> {
+        match self.kind {
             LoadKind::Viscous => {
-                if self.load.torque_nm.is_some() {
-                    return bad("load.torque_nm", "only for kind = \"torque\"".into());
+                if self.torque_nm.is_some() {
+                    return invalid("load.torque_nm", "only for kind = \"torque\"".into());
                 }
-                if let Some(b) = self.load.bl_nms {
-                    nonneg("load.bl_nms", b)?;
+                if let Some(b) = self.bl_nms {
+                    not_negative("load.bl_nms", b)?;
                 }
             }
             LoadKind::Torque => {
-                if self.load.bl_nms.is_some() {
-                    return bad("load.bl_nms", "only for kind = \"viscous\"".into());
+                if self.bl_nms.is_some() {
+                    return invalid("load.bl_nms", "only for kind = \"viscous\"".into());
                 }
-                if let Some(t) = self.load.torque_nm {
+                if let Some(t) = self.torque_nm {
                     if !t.is_finite() {
-                        return bad("load.torque_nm", format!("must be finite, got {t}"));
+                        return invalid("load.torque_nm", format!("must be finite, got {t}"));
                     }
                 }
             }
         }
-        for st in &self.load.steps {
-            nonneg("load.steps.t_s", st.t_s)?;
-            match (self.load.kind, st.torque_nm, st.bl_scale) {
+        for st in &self.steps {
+            not_negative("load.steps.t_s", st.t_s)?;
+            match (self.kind, st.torque_nm, st.bl_scale) {
                 (LoadKind::Torque, Some(t), None) if t.is_finite() => {}
-                (LoadKind::Viscous, None, Some(b)) => nonneg("load.steps.bl_scale", b)?,
+                (LoadKind::Viscous, None, Some(b)) => not_negative("load.steps.bl_scale", b)?,
                 (LoadKind::Torque, _, _) => {
-                    return bad(
+                    return invalid(
                         "load.steps",
                         "a torque load's step needs a finite torque_nm (and no bl_scale)".into(),
                     )
                 }
                 (LoadKind::Viscous, _, _) => {
-                    return bad(
+                    return invalid(
                         "load.steps",
                         "a viscous load's step needs bl_scale (and no torque_nm)".into(),
                     )
                 }
             }
         }
-        for f in &self.faults {
-            nonneg("faults.at_s", f.at_s)?;
-            if f.kind.is_sensor() {
-                let Some(mode) = f.mode else {
-                    return bad(
-                        "faults.mode",
-                        "a sensor fault needs mode = gain|offset|disconnected|stuck".into(),
-                    );
-                };
-                match mode {
-                    SensorFaultMode::Gain => match f.change {
-                        Some(c) if c.is_finite() => {}
-                        _ => return bad("faults.change", "mode = \"gain\" needs change".into()),
-                    },
-                    SensorFaultMode::Offset => match f.offset {
-                        Some(o) if o.is_finite() => {}
-                        _ => return bad("faults.offset", "mode = \"offset\" needs offset".into()),
-                    },
-                    _ => {}
-                }
-                if f.phase.is_some() && f.kind == FaultKind::SpeedSensor {
-                    return bad("faults.phase", "the speed sensor has no phases".into());
-                }
-            } else {
-                if f.mode.is_some() || f.offset.is_some() || f.phase.is_some() {
-                    return bad(
-                        "faults.mode",
-                        "mode/offset/phase are for sensor faults only".into(),
-                    );
-                }
-                match f.change {
-                    Some(c) if c.is_finite() && c > -1.0 => {}
-                    Some(c) => return bad("faults.change", format!("must be > -1, got {c}")),
-                    None => return bad("faults.change", "a parametric fault needs change".into()),
-                }
+        Ok(())
+    }
+}
+
+impl FaultSpec {
+    /// Checks that the fault has what its kind needs.
+    ///
+    /// # Errors
+    /// [`SimError::Invalid`] naming the key.
+    pub fn validate(&self) -> Result<(), SimError> {
+        not_negative("faults.at_s", self.at_s)?;
+        if !self.kind.is_sensor() {
+            if self.mode.is_some() || self.offset.is_some() || self.phase.is_some() {
+                return invalid(
+                    "faults.mode",
+                    "mode/offset/phase are for sensor faults only".into(),
+                );
             }
+            return match self.change {
+                Some(c) if c.is_finite() && c > -1.0 => Ok(()),
+                Some(c) => invalid("faults.change", format!("must be > -1, got {c}")),
+                None => invalid("faults.change", "a parametric fault needs change".into()),
+            };
         }
-        for e in &self.effects {
-            let k = |p: &str| format!("effects.{}.{p}", e.name());
-            match e {
-                Effect::ThermalDrift {
-                    rise_k,
-                    tau_s,
-                    at_s,
-                    r_th_k_per_w,
-                    alpha_per_k,
-                    ..
-                } => {
-                    if let Some(r) = rise_k {
-                        if !r.is_finite() || *r < -200.0 {
-                            return bad(&k("rise_k"), format!("must be finite, >= -200, got {r}"));
-                        }
-                    }
-                    if rise_k.is_some() && r_th_k_per_w.is_some() {
-                        return bad(&k("rise_k"), "give rise_k or r_th_k_per_w, not both".into());
-                    }
-                    pos(&k("tau_s"), *tau_s)?;
-                    nonneg(&k("at_s"), *at_s)?;
-                    if let Some(r) = r_th_k_per_w {
-                        nonneg(&k("r_th_k_per_w"), *r)?;
-                    }
-                    nonneg(&k("alpha_per_k"), *alpha_per_k)?;
-                }
-                Effect::Saturation {
-                    psi_sat_wb,
-                    psi_sat_ratio,
-                    exponent,
-                } => {
-                    if let Some(p) = psi_sat_wb {
-                        pos(&k("psi_sat_wb"), *p)?;
-                    }
-                    pos(&k("psi_sat_ratio"), *psi_sat_ratio)?;
-                    pos(&k("exponent"), *exponent)?;
-                }
-                Effect::IronLoss {
-                    rfe_ohm,
-                    rfe_over_xm,
-                } => {
-                    if let Some(r) = rfe_ohm {
-                        pos(&k("rfe_ohm"), *r)?;
-                    }
-                    pos(&k("rfe_over_xm"), *rfe_over_xm)?;
-                }
-                Effect::CoulombFriction {
-                    torque_nm,
-                    omega0_rad_s,
-                } => {
-                    if let Some(t) = torque_nm {
-                        nonneg(&k("torque_nm"), *t)?;
-                    }
-                    pos(&k("omega0_rad_s"), *omega0_rad_s)?;
-                }
-                Effect::Windage { k_nms2 } => {
-                    if let Some(v) = k_nms2 {
-                        nonneg(&k("k_nms2"), *v)?;
-                    }
-                }
-                Effect::LoadTorque { torque_nm } => {
-                    if let Some(t) = torque_nm {
-                        if !t.is_finite() {
-                            return bad(&k("torque_nm"), format!("must be finite, got {t}"));
-                        }
-                    }
-                }
-                Effect::SupplyUnbalance {
-                    fraction,
-                    angle_deg,
-                } => {
-                    if !(fraction.is_finite() && (0.0..=0.5).contains(fraction)) {
-                        return bad(&k("fraction"), format!("must be in 0..0.5, got {fraction}"));
-                    }
-                    if !angle_deg.is_finite() {
-                        return bad(&k("angle_deg"), "must be finite".into());
-                    }
-                }
-                Effect::PhaseAsymmetry { fraction, .. } => {
-                    if !(fraction.is_finite() && (0.0..=0.5).contains(fraction)) {
-                        return bad(&k("fraction"), format!("must be in 0..0.5, got {fraction}"));
-                    }
-                }
-                Effect::FluxDynamics {} | Effect::CurrentDynamics {} => {}
+        let Some(mode) = self.mode else {
+            return invalid(
+                "faults.mode",
+                "a sensor fault needs mode = gain|offset|disconnected|stuck".into(),
+            );
+        };
+        match mode {
+            SensorFaultMode::Gain if !self.change.is_some_and(f64::is_finite) => {
+                return invalid("faults.change", "mode = \"gain\" needs change".into())
             }
+            SensorFaultMode::Offset if !self.offset.is_some_and(f64::is_finite) => {
+                return invalid("faults.offset", "mode = \"offset\" needs offset".into())
+            }
+            _ => {}
         }
-        let s = &self.sensors;
-        if !(2..=24).contains(&s.adc_bits) {
-            return bad(
+        if self.phase.is_some() && self.kind == Fault::SpeedSensor {
+            return invalid("faults.phase", "the speed sensor has no phases".into());
+        }
+        Ok(())
+    }
+}
+
+impl SensorSpec {
+    /// Checks the sensor chain's ranges.
+    ///
+    /// # Errors
+    /// [`SimError::Invalid`] naming the key.
+    pub fn validate(&self) -> Result<(), SimError> {
+        if !(2..=24).contains(&self.adc_bits) {
+            return invalid(
                 "sensors.adc_bits",
-                format!("must be 2..=24, got {}", s.adc_bits),
+                format!("must be 2..=24, got {}", self.adc_bits),
             );
         }
         for (key, v) in [
-            ("sensors.v_range_v", s.v_range_v),
-            ("sensors.i_range_a", s.i_range_a),
+            ("sensors.v_range_v", self.v_range_v),
+            ("sensors.i_range_a", self.i_range_a),
         ] {
             if let Some(v) = v {
-                pos(key, v)?;
+                positive(key, v)?;
             }
         }
         for (key, v) in [
-            ("sensors.noise_v", s.noise_v),
-            ("sensors.noise_i", s.noise_i),
+            ("sensors.noise_v", self.noise_v),
+            ("sensors.noise_i", self.noise_i),
         ] {
             if let Some(v) = v {
-                nonneg(key, v)?;
+                not_negative(key, v)?;
             }
         }
-        nonneg("sensors.noise_w_rad_s", s.noise_w_rad_s)?;
+        not_negative("sensors.noise_w_rad_s", self.noise_w_rad_s)?;
         for (key, v) in [
-            ("sensors.v_gain_error", s.v_gain_error),
-            ("sensors.v_offset_v", s.v_offset_v),
-            ("sensors.i_gain_error", s.i_gain_error),
-            ("sensors.i_offset_a", s.i_offset_a),
+            ("sensors.v_gain_error", self.v_gain_error),
+            ("sensors.v_offset_v", self.v_offset_v),
+            ("sensors.i_gain_error", self.i_gain_error),
+            ("sensors.i_offset_a", self.i_offset_a),
         ] {
             if !v.is_finite() {
-                return bad(key, format!("must be finite, got {v}"));
+                return invalid(key, format!("must be finite, got {v}"));
             }
         }
-        if s.encoder_lines == 0 {
-            return bad("sensors.encoder_lines", "must be >= 1".into());
+        if self.encoder_lines == 0 {
+            return invalid("sensors.encoder_lines", "must be >= 1".into());
         }
         Ok(())
+    }
+}
+
+/// `Err(SimError::Invalid)` for `key`.
+fn invalid(key: &str, message: String) -> Result<(), SimError> {
+    Err(SimError::Invalid {
+        key: key.to_string(),
+        message,
+    })
+}
+
+/// Checks `v` is positive and finite.
+fn positive(key: &str, v: f64) -> Result<(), SimError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        invalid(key, format!("must be a positive number, got {v}"))
+    }
+}
+
+/// Checks `v` is finite and >= 0.
+fn not_negative(key: &str, v: f64) -> Result<(), SimError> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        invalid(key, format!("must be >= 0, got {v}"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_effect_kind_parses_with_defaults() {
+        for kind in EffectKind::ALL {
+            let text = format!("name = \"{}\"", kind.name());
+            let parsed: EffectSpec = toml::from_str(&text).unwrap();
+            assert_eq!(parsed, EffectSpec::with_defaults(kind));
+            assert_eq!(parsed.kind(), kind);
+        }
     }
 }

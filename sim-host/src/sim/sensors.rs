@@ -1,8 +1,9 @@
 //! The sensor chain: transducer faults, gain/offset errors, white noise, ADC, encoder.
 
-use super::scenario::{FaultKind, FaultSpec, SensorFaultMode, SensorSpec};
+use super::scenario::{FaultSpec, SensorFaultMode, SensorSpec};
 use super::Truth;
 use crate::log::Row;
+use monitor_core::Fault;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -124,9 +125,9 @@ impl Sensors {
     pub fn apply_fault(&mut self, f: &FaultSpec) {
         let cf = ChanFault::from_spec(f);
         let target = match f.kind {
-            FaultKind::CurrentSensor => &mut self.i_fault,
-            FaultKind::VoltageSensor => &mut self.v_fault,
-            FaultKind::SpeedSensor => {
+            Fault::CurrentSensor => &mut self.i_fault,
+            Fault::VoltageSensor => &mut self.v_fault,
+            Fault::SpeedSensor => {
                 self.w_fault = cf;
                 return;
             }

@@ -10,7 +10,8 @@
 //! of the simulator without effects (iron loss, saturation, unbalance are not included).
 
 use super::SimError;
-use crate::params::{MotorParams, ParamFile};
+use crate::params::ParamFile;
+use monitor_core::MotorParameters;
 use nalgebra::Complex;
 
 /// Steady operating point of the T-equivalent circuit at a given slip.
@@ -77,17 +78,18 @@ pub fn steady_state(params: &ParamFile, slip: f64) -> SteadyState {
 
 /// Steady state at slip `slip` for an explicit supply (line-to-line RMS voltage [V],
 /// frequency [Hz]).
-pub fn steady_state_at(m: &MotorParams, v_ll_rms: f64, f_hz: f64, slip: f64) -> SteadyState {
+pub fn steady_state_at(m: &MotorParameters, v_ll_rms: f64, f_hz: f64, slip: f64) -> SteadyState {
     let we = 2.0 * std::f64::consts::PI * f_hz;
-    let np = m.pole_pairs();
+    let model = m.model::<f64>();
+    let np = model.np();
     let v = Complex::new(v_ll_rms / 3f64.sqrt(), 0.0);
-    let zs = Complex::new(m.rs_ohm, we * m.lls_h());
+    let zs = Complex::new(m.rs_ohm, we * model.lls_h());
     let zm = Complex::new(0.0, we * m.lm_h);
     let (is, ir, im, torque) = if slip == 0.0 {
         let is = v / (zs + zm);
         (is, Complex::new(0.0, 0.0), is, 0.0)
     } else {
-        let zr = Complex::new(m.rr_ohm / slip, we * m.llr_h());
+        let zr = Complex::new(m.rr_ohm / slip, we * model.llr_h());
         let zp = zm * zr / (zm + zr);
         let is = v / (zs + zp);
         let e = is * zp;
@@ -132,7 +134,7 @@ pub fn solve_slip(params: &ParamFile, load: SteadyLoad) -> Result<SteadyState, S
 /// # Errors
 /// As [`solve_slip`].
 pub fn solve_slip_at(
-    m: &MotorParams,
+    m: &MotorParameters,
     v_ll_rms: f64,
     f_hz: f64,
     load: SteadyLoad,

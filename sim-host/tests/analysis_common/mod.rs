@@ -2,10 +2,13 @@
 //! never told what was injected) and run the analysis through the library or the binary.
 #![allow(dead_code, missing_docs)]
 
+use monitor_core::EffectKind;
 use sim_host::analysis::{prep::ReadOptions, Analysis, Options};
 use sim_host::log::{Channels, Log};
 use sim_host::params::ParamFile;
-use sim_host::sim::{self, Effect, LoadKind, LoadSpec, LoadStep, Scenario, SensorSpec, SupplyStep};
+use sim_host::sim::{
+    self, EffectSpec, LoadKind, LoadSpec, LoadStep, Scenario, SensorSpec, SupplyStep,
+};
 use std::path::{Path, PathBuf};
 
 /// Nominal parameters deliberately off: every electrical and mechanical value scaled by
@@ -67,7 +70,7 @@ pub fn scenario(which: &str, effect: Option<&str>, noise: u32) -> Scenario {
     // Default operating scenario: the paper's viscous load, constant (a load change is a
     // `bl` fault or a torque load for the paper's model, so effect scenarios add their own).
     let Some(name) = effect else { return s };
-    let mut e = Effect::by_name(name).expect("library name");
+    let mut e = EffectSpec::with_defaults(EffectKind::from_name(name).expect("library name"));
     match name {
         "saturation" => {
             // A slow supply-voltage sweep (variac-like staircase, 0.2 % steps): the flux
@@ -87,7 +90,7 @@ pub fn scenario(which: &str, effect: Option<&str>, noise: u32) -> Scenario {
             // A heat run: 100 K rise (class F insulation allows 105 K) with the simulator's
             // accelerated 3 s time constant.
             s.duration_s = 8.0;
-            if let Effect::ThermalDrift { rise_k, .. } = &mut e {
+            if let EffectSpec::ThermalDrift { rise_k, .. } = &mut e {
                 *rise_k = Some(100.0);
             }
         }
@@ -105,17 +108,17 @@ pub fn scenario(which: &str, effect: Option<&str>, noise: u32) -> Scenario {
             );
             if name == "iron_loss" {
                 // A lossy core (Rfe = 8 Xm): visible at rated load over a speed sweep.
-                if let Effect::IronLoss { rfe_over_xm, .. } = &mut e {
+                if let EffectSpec::IronLoss { rfe_over_xm, .. } = &mut e {
                     *rfe_over_xm = 8.0;
                 }
             }
             if name == "windage" {
-                if let Effect::Windage { k_nms2 } = &mut e {
+                if let EffectSpec::Windage { k_nms2 } = &mut e {
                     *k_nms2 = Some(if which == "3hp" { 5.0e-5 } else { 1.2e-4 });
                 }
             }
             if name == "coulomb_friction" {
-                if let Effect::CoulombFriction { torque_nm, .. } = &mut e {
+                if let EffectSpec::CoulombFriction { torque_nm, .. } = &mut e {
                     *torque_nm = Some(if which == "3hp" { 1.5 } else { 1.0 });
                 }
             }
@@ -248,7 +251,10 @@ pub fn analyse(log: &Path, p: &ParamFile, from: f64) -> Analysis {
 
 pub fn opts(effects: &[&str]) -> Options {
     Options {
-        effects: effects.iter().map(|s| s.to_string()).collect(),
+        effects: effects
+            .iter()
+            .map(|s| EffectKind::from_name(s).expect("library name"))
+            .collect(),
         fit_base: true,
     }
 }

@@ -1,6 +1,7 @@
 //! `fwtool`: the host helper behind the cargo aliases (see `.cargo/config.toml`).
 //!
-//! - `fw [--check]`: build the release firmware ELF for `thumbv7em-none-eabihf`, then
+//! - `fw [--check]`: build the firmware ELF (the workspace's `firmware` profile: fat LTO,
+//!   one codegen unit, debug info) for `thumbv7em-none-eabihf`, then
 //!   read its section table and print flash and static RAM use against the goals
 //!   (64 KiB flash, 16 KiB RAM). `--check` exits 1 when a goal is missed.
 //! - `qemu-core`: build `crates/core-on-m4` for `thumbv7em-none-eabihf`, check that its
@@ -88,13 +89,16 @@ fn fw(check: bool) -> Result<(), String> {
     let root = root();
     run(cargo().current_dir(&root).args([
         "build",
-        "--release",
+        "--profile",
+        "firmware",
         "--target",
         TARGET,
         "-p",
         "drive-monitor",
     ]))?;
-    let elf_path = target_dir(&root).join(TARGET).join("release/drive-monitor");
+    let elf_path = target_dir(&root)
+        .join(TARGET)
+        .join("firmware/drive-monitor");
     let elf = std::fs::read(&elf_path).map_err(|e| format!("{}: {e}", elf_path.display()))?;
     let (mut flash, mut ram) = (0u64, 0u64);
     println!("{:<16} {:>8} {:>10}", "section", "bytes", "address");

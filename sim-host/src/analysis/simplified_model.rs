@@ -1,0 +1,462 @@
+//! The paper's simplified model (eqs. 23-29), driven by measured inputs, with effects: the
+//! model `compare` and `explain` test against a log. (The simulator's full-order machine
+//! is `crate::sim`'s; the core evaluates the same simplified model's residuals.)
+//!
+//! Base model (rotor-flux frame, DESIGN.md §2), per working sample:
+//! ```text
+//!   Psi   = Ls i_f                        (i_f = measured positive-sequence I_ds, smoothed)
+//!   I_qs  = (V_qs - Psi omega_r) / Ra     (eq. 23/28 with La dI_qs/dt dropped: see below)
+//!   J dw_m/dt = Kf I_qs - (B + Bl) w_m,   Kf = (3/2) Np (Lm^2/Lr) i_f,  omega_r = Np w_m  (eq. 29)
+//! ```
+//! The La dI_qs/dt term of eq. (28) is the library effect `current_dynamics`, and the
+//! assumption psi_r = Lm i_f is lifted by `flux_dynamics`: the full-order machine always has
+//! both, but the steady-state parity equations (37) drop both, and on steady data neither
+//! matters; treating them as effects lets `explain` name them when transients dominate.
+//!
+//! The mechanical equation is integrated semi-implicitly (the speed dependence of the
+//! quasi-static torque is taken at the new speed), so the step is stable at any working rate.
+//! Effects enter through [`EffectTerms`]: per-sample series computed from the measured inputs
+//! (resistance factor, magnetising-inductance factor, extra load torque, negative-sequence
+//! current) and a speed-dependent extra torque evaluated inside the loop.
+
+use super::prep::{Prepared, C64};
+use crate::params::ParamFile;
+
+/// The machine constants the simplified model and the effects need: the parameter file's
+/// nominal values and what [`monitor_core::MotorModel`] derives from them (Ra, La, the
+/// leakages), plus a rated-torque scale. Built by [`MachineConstants::from_params`].
+#[derive(Debug, Clone, Copy)]
+pub struct MachineConstants {
+    /// Rs [ohm].
+    pub rs_ohm: f64,
+    /// Rr referred to the stator [ohm].
+    pub rr_ohm: f64,
+    /// Rotor resistance term of Ra: (Ls/Lr) Rr [ohm].
+    pub rr_a_ohm: f64,
+    /// Ra = Rs + (Ls/Lr) Rr [ohm].
+    pub ra_ohm: f64,
+    /// Stator leakage Lls [H].
+    pub lls_h: f64,
+    /// Rotor leakage Llr [H].
+    pub llr_h: f64,
+    /// Lm [H].
+    pub lm_h: f64,
+    /// Ls [H].
+    pub ls_h: f64,
+    /// Lr [H].
+    pub lr_h: f64,
+    /// La = sigma Ls [H].
+    pub la_h: f64,
+    /// Pole pairs.
+    pub np: f64,
+    /// J [kg m^2].
+    pub j_kgm2: f64,
+    /// B + Bl [N m s/rad] (shaft).
+    pub btot_nms: f64,
+    /// Rated torque estimate [N m]: Kf at nominal flux times the current at 3 % slip, or
+    /// at least Bl times synchronous speed. Used for scales only.
+    pub torque_scale_nm: f64,
+    /// The core's model of the machine (f32), for the computations the analysis shares
+    /// with the monitor (the faulty-phase method).
+    pub core_model: monitor_core::MotorModel,
+    /// The parameter file's peak phase voltage [V].
+    pub v_phase_peak: f64,
+}
+
+impl MachineConstants {
+    /// Derives the constants from a parameter file.
+    pub fn from_params(p: &ParamFile) -> Self {
+        let m = p.motor.model::<f64>();
+        let np = m.np();
+        let ws = p.supply.omega_rad_s();
+        let i_f = p.supply.v_phase_peak() / (ws * m.ls_h);
+        let kf = m.kf_per_if() * i_f;
+        // Current at 3 % slip: slip frequency = (Rr/Lr) iq/if.
+        let iq = 0.03 * ws * m.lr_h / m.rr_ohm * i_f;
+        let t_rated = (kf * iq).max(m.bl_nms * ws / np).max(1e-3);
+        MachineConstants {
+            rs_ohm: m.rs_ohm,
+            rr_ohm: m.rr_ohm,
+            rr_a_ohm: m.rr_referred_ohm(),
+            ra_ohm: m.ra_ohm(),
+            lls_h: m.lls_h(),
+            llr_h: m.llr_h(),
+            lm_h: m.lm_h,
+            ls_h: m.ls_h,
+            lr_h: m.lr_h,
+            la_h: m.la_h(),
+            np,
+            j_kgm2: m.j_kgm2,
+            btot_nms: m.b_nms + m.bl_nms,
+            torque_scale_nm: t_rated,
+            core_model: p.motor.model(),
+            v_phase_peak: p.supply.v_phase_peak(),
+        }
+    }
+}
+
+/// The base parameters the data identify, refitted with every effect set.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BaseParams {
+    /// Ra relative to nominal (1 = nominal).
+    pub ra_scale: f64,
+    /// Ls (the Psi = Ls i_f coefficient) relative to nominal.
+    pub ls_scale: f64,
+    /// B + Bl [N m s/rad] (shaft).
+    pub btot_nms: f64,
+    /// Inertia J relative to nominal.
+    pub j_scale: f64,
+}
+
+impl BaseParams {
+    /// The nominal values.
+    pub fn nominal(n: &MachineConstants) -> Self {
+        BaseParams {
+            ra_scale: 1.0,
+            ls_scale: 1.0,
+            btot_nms: n.btot_nms,
+            j_scale: 1.0,
+        }
+    }
+}
+
+/// Per-sample contributions of the effects to the model equations. Neutral values
+/// (no effect) are 1 for factors, 0 for additive terms, `None` for the dynamics.
+#[derive(Debug, Clone, Default)]
+pub struct EffectTerms {
+    /// Multiplies Rs and Rr (winding temperature); empty = 1.
+    pub r_factor: Vec<f64>,
+    /// Multiplies Lm (saturation); empty = 1.
+    pub lm_factor: Vec<f64>,
+    /// Extra load torque on the shaft [N m] (speed independent); empty = 0.
+    pub load_nm: Vec<f64>,
+    /// Predicted negative-sequence current, stationary frame [A]; empty = 0.
+    pub i_neg: Vec<C64>,
+    /// Core-loss conductance 1/Rfe [S].
+    pub g_fe_s: f64,
+    /// Coulomb friction torque [N m] (tanh(w_m / 1 rad/s) shape).
+    pub coulomb_nm: f64,
+    /// Windage coefficient [N m s^2/rad^2]: torque k w_m |w_m|.
+    pub windage_nms2: f64,
+    /// Rotor time constant Lr/Rr [s] when `flux_dynamics` is on.
+    pub tau_r_s: Option<f64>,
+    /// La [H] when `current_dynamics` is on.
+    pub la_h: Option<f64>,
+    /// Extra white noise on the inputs (for the noise floor; `None` in every fit).
+    pub input_noise: Option<InputNoise>,
+}
+
+/// White Gaussian noise added to the model's inputs, to measure how much of the inputs'
+/// sensor noise reaches the outputs (see `metrics::noise_floor`).
+#[derive(Debug, Clone, Copy)]
+pub struct InputNoise {
+    /// Seed of the generator (the result is reproducible).
+    pub seed: u64,
+    /// Standard deviation added to V_ds and V_qs [V].
+    pub sigma_v: f64,
+    /// Standard deviation added to I_ds and I_qs [A]; i_f gets it through the same 10 Hz
+    /// smoothing magnitude response as `prep` applies (four first-order passes).
+    pub sigma_i: f64,
+}
+
+/// Model outputs over the working series.
+#[derive(Debug, Clone, Default)]
+pub struct Prediction {
+    /// Predicted I_qs [A] (all sequences, including core-loss current).
+    pub iq: Vec<f64>,
+    /// Predicted omega_r [rad/s] (electrical).
+    pub omega_r: Vec<f64>,
+    /// Predicted current vector, stationary frame [A].
+    pub i_ab: Vec<C64>,
+}
+
+/// Runs the model over the prepared data.
+///
+/// Initial state from the measurement at the first sample: w_m = measured speed (0 without
+/// a speed column), I_qs = measured, the normalised rotor flux phi = i_f.
+pub fn simulate(d: &Prepared, n: &MachineConstants, b: &BaseParams, t: &EffectTerms) -> Prediction {
+    simulate_with(d, n, b, t, |k| C64::new(d.theta[k].cos(), d.theta[k].sin()))
+}
+
+/// The frame rotation `e^{j theta_k}` of every sample of `d` (what [`simulate_rot`] takes).
+pub fn rotations(d: &Prepared) -> Vec<C64> {
+    d.theta
+        .iter()
+        .map(|th| {
+            let (s, c) = th.sin_cos();
+            C64::new(c, s)
+        })
+        .collect()
+}
+
+/// [`simulate`] with the frame rotations precomputed ([`rotations`] of the same data), for
+/// the many simulations of a fit.
+pub fn simulate_rot(
+    d: &Prepared,
+    rot: &[C64],
+    n: &MachineConstants,
+    b: &BaseParams,
+    t: &EffectTerms,
+) -> Prediction {
+    if rot.len() != d.len() {
+        return simulate(d, n, b, t);
+    }
+    simulate_with(d, n, b, t, |k| rot[k])
+}
+
+/// The model's inputs at one working sample: V_ds, V_qs, I_ds, i_f, positive-sequence I_qs.
+#[derive(Debug, Clone, Copy)]
+struct Inputs {
+    vd: f64,
+    vq: f64,
+    id: f64,
+    i_f: f64,
+    iq_pos: f64,
+}
+
+/// The measured inputs, with [`InputNoise`] added when the terms ask for it.
+struct InputSource<'a> {
+    d: &'a Prepared,
+    noise: Option<(InputNoise, rand_chacha::ChaCha8Rng, [f64; 4])>,
+    /// Step of the four first-order passes that smooth the noise added to i_f.
+    a_if: f64,
+}
+
+impl<'a> InputSource<'a> {
+    fn new(d: &'a Prepared, t: &EffectTerms) -> Self {
+        let noise = t.input_noise.map(|nz| {
+            use rand::SeedableRng;
+            (
+                nz,
+                rand_chacha::ChaCha8Rng::seed_from_u64(nz.seed),
+                [0.0f64; 4],
+            )
+        });
+        let a_if = 1.0 - (-2.0 * std::f64::consts::PI * super::prep::I_F_SMOOTH_HZ * d.dt_s).exp();
+        InputSource { d, noise, a_if }
+    }
+
+    #[inline(always)]
+    fn at(&mut self, k: usize) -> Inputs {
+        let d = self.d;
+        match self.noise.as_mut() {
+            None => Inputs {
+                vd: d.vd[k],
+                vq: d.vq[k],
+                id: d.id[k],
+                i_f: d.i_f[k],
+                iq_pos: d.iq_pos[k],
+            },
+            Some((nz, rng, lp)) => {
+                use rand_distr::{Distribution, StandardNormal};
+                let mut g = || -> f64 { StandardNormal.sample(&mut *rng) };
+                let (nvd, nvq, nid, niq) = (g(), g(), g(), g());
+                let nid = nz.sigma_i * nid;
+                let a_if = self.a_if;
+                lp[0] += a_if * (nid - lp[0]);
+                lp[1] += a_if * (lp[0] - lp[1]);
+                lp[2] += a_if * (lp[1] - lp[2]);
+                lp[3] += a_if * (lp[2] - lp[3]);
+                Inputs {
+                    vd: d.vd[k] + nz.sigma_v * nvd,
+                    vq: d.vq[k] + nz.sigma_v * nvq,
+                    id: d.id[k] + nid,
+                    i_f: d.i_f[k] + lp[3],
+                    iq_pos: d.iq_pos[k] + nz.sigma_i * niq,
+                }
+            }
+        }
+    }
+}
+
+/// The machine behind the core-loss conductance (`iron_loss`) at one sample.
+#[derive(Debug, Clone, Copy)]
+struct CoreLoss {
+    /// Flux-making current of the machine [A].
+    i_f: f64,
+    /// I_ds without the smoothing, for the flux dynamics [A].
+    id_raw: f64,
+    /// V_qs the machine behind Rs sees [V].
+    vq: f64,
+    /// Tilt of the voltage-model frame against the rotor flux [rad].
+    eps: f64,
+    /// I_ds of the machine in the rotor-flux frame [A].
+    id_term: f64,
+    /// q part of the core-loss current [A].
+    i_fe_q: f64,
+    /// The machine's own I_qs minus the terminal one (start of the current state) [A].
+    iq_shift: f64,
+}
+
+/// Core loss (`iron_loss`, g = 1/Rfe across the magnetising branch, behind Rs): the
+/// terminal current is the machine's i_s plus i_fe = g j w_s psi_s, psi_s =
+/// Ls i_ds + j sigma Ls i_qs. Three consequences, all evaluated here:
+/// (1) Rs carries i_fe too: the machine behind Rs sees V_qs - Rs i_fe,q;
+/// (2) the flux is made by i_ds = measured - i_fe,d = measured + g w_s sigma Ls I_qs;
+/// (3) the voltage-model frame of `prep` takes psi_r from the terminal current, so it
+///     is turned by eps = (Lr/Lm) sigma Ls i_fe,q / psi_r = (Lr/Lm) sigma Ls g w_s Ls / Lm
+///     against the true rotor flux (0.01 rad at Rfe = 8 Xm): inputs are turned back by
+///     eps and outputs forward.
+#[inline(always)]
+fn core_loss(
+    g: f64,
+    ws: f64,
+    n: &MachineConstants,
+    ls: f64,
+    lm: f64,
+    rs: f64,
+    x: Inputs,
+) -> CoreLoss {
+    let eps = n.lr_h / n.lm_h * n.la_h * g * ws * ls / lm;
+    let back = C64::new(eps.cos(), -eps.sin());
+    let v = C64::new(x.vd, x.vq) * back;
+    let i = C64::new(x.id, x.iq_pos) * back;
+    let i_fe_d = -g * ws * n.la_h * i.im;
+    let shift = (i.re - x.id) - i_fe_d;
+    let i_f = x.i_f + shift;
+    let i_fe_q = g * ws * ls * i_f;
+    CoreLoss {
+        i_f,
+        id_raw: x.id + shift,
+        vq: v.im - rs * i_fe_q,
+        eps,
+        id_term: i.re,
+        i_fe_q,
+        iq_shift: (i.im - x.iq_pos) - i_fe_q,
+    }
+}
+
+/// Initial speed [rad/s, mechanical] and I_qs [A]: means over the first 10 ms (a single
+/// sample would start the model off by that sample's sensor noise, and the speed then
+/// takes a mechanical time constant, about 0.3 s, to forget it).
+fn initial_state(d: &Prepared, n: &MachineConstants) -> (f64, f64) {
+    let len = d.len();
+    let head = ((0.01 / d.dt_s).ceil() as usize).clamp(1, len);
+    let wm = if d.omega_r.len() >= head {
+        d.omega_r[..head].iter().sum::<f64>() / head as f64 / n.np
+    } else {
+        0.0
+    };
+    let iq = d.iq_pos[..head].iter().sum::<f64>() / head as f64;
+    (wm, iq)
+}
+
+#[inline(always)]
+fn simulate_with(
+    d: &Prepared,
+    n: &MachineConstants,
+    b: &BaseParams,
+    t: &EffectTerms,
+    rot_at: impl Fn(usize) -> C64,
+) -> Prediction {
+    let len = d.len();
+    let mut out = Prediction {
+        iq: Vec::with_capacity(len),
+        omega_r: Vec::with_capacity(len),
+        i_ab: Vec::with_capacity(len),
+    };
+    if len == 0 || d.vq.len() != len {
+        return out;
+    }
+    let dt = d.dt_s;
+    let j = (n.j_kgm2 * b.j_scale).max(1e-9);
+    let btot = b.btot_nms.max(0.0);
+    let rs0 = n.rs_ohm * b.ra_scale;
+    let rr0 = n.rr_a_ohm * b.ra_scale;
+    let (mut wm, mut iq_state) = initial_state(d, n);
+    let mut phi = d.i_f[0];
+    let i_f_ref = d.id.iter().fold(0.0f64, |a, &x| a.max(x.abs())).max(1e-6);
+    let flux_decay = t.tau_r_s.map(|tau| (-dt / tau.max(1e-5)).exp());
+    let mut inputs = InputSource::new(d, t);
+    for k in 0..len {
+        let x = inputs.at(k);
+        let rf = t.r_factor.get(k).copied().unwrap_or(1.0);
+        let mf = t.lm_factor.get(k).copied().unwrap_or(1.0);
+        let rs = rs0 * rf;
+        let rr = rr0 * rf;
+        let lm = n.lm_h * mf;
+        let ls = b.ls_scale * (n.lls_h + lm);
+        let lmr = lm * lm / (n.llr_h + lm);
+        let cl = if t.g_fe_s != 0.0 {
+            let cl = core_loss(t.g_fe_s, d.omega_s[k], n, ls, lm, rs, x);
+            if k == 0 {
+                // The states start from the machine's own currents, not the terminal ones.
+                iq_state += cl.iq_shift;
+                phi = cl.i_f;
+            }
+            cl
+        } else {
+            CoreLoss {
+                i_f: x.i_f,
+                id_raw: x.id,
+                vq: x.vq,
+                eps: 0.0,
+                id_term: x.id,
+                i_fe_q: 0.0,
+                iq_shift: 0.0,
+            }
+        };
+        // Flux: phi = psi_r / Lm [A].
+        let (psi_p, rden, phi_t) = match flux_decay {
+            Some(a) => {
+                // The rotor flux follows the raw I_ds (its own lag filters the noise).
+                phi = cl.id_raw + (phi - cl.id_raw) * a;
+                // sigma Ls part with the raw I_ds (fast), the rotor part through phi.
+                let psi_p = (ls - b.ls_scale * lmr) * cl.id_raw + b.ls_scale * lmr * phi;
+                let phi_c = if phi.abs() < 0.05 * i_f_ref {
+                    0.05 * i_f_ref * if phi < 0.0 { -1.0 } else { 1.0 }
+                } else {
+                    phi
+                };
+                let rden = rs + rr * psi_p / (ls * phi_c);
+                (psi_p, rden.clamp(0.2 * (rs + rr), 50.0 * (rs + rr)), phi)
+            }
+            None => (ls * cl.i_f, rs + rr, cl.i_f),
+        };
+        let kt = 1.5 * n.np * lmr * phi_t; // Te = kt * iq  [N m/A]
+        let extra = |w: f64| {
+            // (No tanh when there is no dry friction: 0 x tanh(w) is 0.)
+            let coulomb = if t.coulomb_nm != 0.0 {
+                t.coulomb_nm * (w / 1.0).tanh()
+            } else {
+                0.0
+            };
+            coulomb + t.windage_nms2 * w * w.abs() + t.load_nm.get(k).copied().unwrap_or(0.0)
+        };
+        let vq = cl.vq;
+        let iq;
+        match t.la_h {
+            Some(la) => {
+                let iq_ss = (vq - psi_p * n.np * wm) / rden;
+                let a = (-dt * rden / la.max(1e-6)).exp();
+                iq_state = iq_ss + (iq_state - iq_ss) * a;
+                iq = iq_state;
+                let te = kt * iq;
+                wm = (j * wm + dt * (te - extra(wm))) / (j + dt * btot);
+            }
+            None => {
+                // Te = kt (vq - psi_p Np wm)/rden, linear in wm: implicit.
+                let a = kt * vq / rden;
+                let bb = kt * psi_p * n.np / rden;
+                wm = (j * wm + dt * (a - extra(wm))) / (j + dt * (bb + btot));
+                iq = (vq - psi_p * n.np * wm) / rden;
+            }
+        }
+        let rot = rot_at(k);
+        let ineg = t.i_neg.get(k).copied().unwrap_or_default();
+        // Back to the analysis frame (measured d current, predicted q current).
+        let i_dq = if cl.eps != 0.0 {
+            let i_true = C64::new(cl.id_term, iq + cl.i_fe_q);
+            let fwd = C64::new(cl.eps.cos(), cl.eps.sin());
+            C64::new(d.id[k], (i_true * fwd).im)
+        } else {
+            // The measured I_ds (not a re-noised one: the error never sees its noise).
+            C64::new(d.id[k], iq)
+        };
+        let i_ab = i_dq * rot + ineg;
+        out.iq.push(i_dq.im + (ineg * rot.conj()).im);
+        out.omega_r.push(n.np * wm);
+        out.i_ab.push(i_ab);
+    }
+    out
+}

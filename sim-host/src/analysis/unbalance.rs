@@ -1,0 +1,158 @@
+//! The negative-sequence (unbalance / faulty-phase) analysis of `compare` and `explain`.
+//! It needs only the currents, so it runs on current-only logs too.
+//!
+//! The current and voltage unbalance are the RMS negative- over positive-sequence parts of
+//! the working series (the first 10 % left out as start-up). A supply unbalance `v2/v1`
+//! drives `i2/i1 = (v2/v1) |Z1| / |Z2|` (Z1 = V1/I1 the positive-sequence impedance, Z2 the
+//! machine's negative-sequence impedance); where that accounts for at least half the current
+//! unbalance, no winding is suspect. Otherwise the phase is named by the workspace's one
+//! faulty-phase method (`monitor_core::sequence::suspect_phase`, as the monitor and
+//! `diagnose` name it): the fitted `i_neg = c conj(i_pos)` gives `I2/I1 = conj(c)`, whose
+//! angle minus `arg(Z1/Z2)` at the log's operating slip points at the winding. The slip is
+//! the measured one (`1 - omega_r/omega_s`), or, without a speed column, the one at which
+//! the equivalent circuit draws the measured current (`monitor_core::sequence::slip_for_current`).
+
+use super::prep::{Prepared, C64};
+use super::simplified_model::MachineConstants;
+use serde::Serialize;
+
+/// Unbalance / faulty-phase analysis (JSON key `unbalance` of `compare` and `explain`).
+#[derive(Debug, Clone, Serialize)]
+pub struct UnbalanceAnalysis {
+    /// RMS negative-sequence current / RMS positive-sequence current.
+    pub negative_sequence_ratio: f64,
+    /// Same for the voltages (null without voltage columns).
+    pub voltage_negative_sequence_ratio: Option<f64>,
+    /// Phase whose winding most likely differs ("a"/"b"/"c"), null when balanced
+    /// (ratio below 1 %) or when the voltage unbalance explains the current unbalance.
+    pub suspect_phase: Option<String>,
+    /// RMS phase currents [A] a, b, c.
+    pub phase_rms_a: [f64; 3],
+    /// In words.
+    pub summary: String,
+}
+
+/// Sums over the analysed part of the series.
+#[derive(Default)]
+struct SequenceSums {
+    /// Sums of |i_neg|^2, |i_pos|^2, i_neg i_pos, |v_neg|^2, |v_pos|^2.
+    i_neg2: f64,
+    i_pos2: f64,
+    cross: C64,
+    v_neg2: f64,
+    v_pos2: f64,
+    /// Sums of the squared phase currents.
+    phase2: [f64; 3],
+    /// Sums of omega_s, omega_r and |i_pos|.
+    omega_s: f64,
+    omega_r: f64,
+    i_pos: f64,
+    count: f64,
+}
+
+impl SequenceSums {
+    /// Sums from sample `from` on (the analyses skip the first 10 %, the start-up).
+    fn new(d: &Prepared, from: usize) -> Self {
+        let mut s = SequenceSums::default();
+        for k in from..d.len() {
+            let ineg = d.i_neg[k];
+            let ipos = d.i_ab[k] - ineg;
+            s.i_neg2 += ineg.norm_sqr();
+            s.i_pos2 += ipos.norm_sqr();
+            // LS for i_neg = c conj(i_pos): c = sum(i_neg i_pos)/sum|i_pos|^2.
+            s.cross += ineg * ipos;
+            s.i_pos += ipos.norm();
+            let abc = super::prep::phase_values(d.i_ab[k], d.i0[k]);
+            for c in 0..3 {
+                s.phase2[c] += abc[c] * abc[c];
+            }
+            if d.channels.voltages {
+                s.v_neg2 += d.v_neg[k].norm_sqr();
+                s.v_pos2 += d.vq[k] * d.vq[k] + d.vd[k] * d.vd[k];
+            }
+            s.omega_s += d.omega_s[k];
+            s.omega_r += d.omega_r.get(k).copied().unwrap_or(0.0);
+        }
+        s.count = (d.len() - from).max(1) as f64;
+        s
+    }
+}
+
+/// The analysis of a working series with the machine's constants.
+pub fn analyse(d: &Prepared, n: &MachineConstants) -> UnbalanceAnalysis {
+    let s = SequenceSums::new(d, d.len() / 10);
+    let ratio = (s.i_neg2 / s.i_pos2.max(1e-12)).sqrt();
+    let vratio = d
+        .channels
+        .voltages
+        .then(|| (s.v_neg2 / s.v_pos2.max(1e-12)).sqrt());
+    let c = s.cross / s.i_pos2.max(1e-12);
+    let w = s.omega_s / s.count;
+    let z1 = (s.v_pos2 / s.i_pos2.max(1e-12)).sqrt();
+    let z2 = super::effects::z2_neg(n, w).norm().max(1e-9);
+    let supply_explains = vratio
+        .map(|v| v > 0.002 && v * z1 / z2 > 0.5 * ratio)
+        .unwrap_or(false);
+    let phase_rms_a = s.phase2.map(|p| (p / s.count).sqrt());
+    let slip = operating_slip(d, n, &s);
+    let (phase, eps) = super::effects::asymmetry_phase(c, n, w, slip);
+    let suspect = (ratio > 0.01 && !supply_explains).then_some(phase);
+    let summary = match (suspect, supply_explains) {
+        (Some(p), _) => {
+            let mean_rms = phase_rms_a.iter().sum::<f64>() / 3.0;
+            let dev = phase_rms_a[p.index()] - mean_rms;
+            format!(
+                "negative-sequence current {:.1} % of positive sequence{}: phase {} winding differs (the negative sequence fits about {:.1} % of its impedance lost, as by shorted turns; its current is {:.1} % {} the mean)",
+                100.0 * ratio,
+                if d.channels.voltages { "" } else { " (current-only log: supply assumed balanced, from the parameter file)" },
+                p.name(),
+                100.0 * eps,
+                100.0 * dev.abs() / mean_rms.max(1e-12),
+                if dev > 0.0 { "above" } else { "below" },
+            )
+        }
+        (None, true) => format!(
+            "negative-sequence current {:.1} %, caused by the supply's {:.1} % voltage unbalance (no winding suspected)",
+            100.0 * ratio,
+            100.0 * vratio.unwrap_or(0.0)
+        ),
+        (None, false) => format!("currents balanced (negative sequence {:.2} %)", 100.0 * ratio),
+    };
+    UnbalanceAnalysis {
+        negative_sequence_ratio: ratio,
+        voltage_negative_sequence_ratio: vratio,
+        suspect_phase: suspect.map(|p| p.name().to_string()),
+        phase_rms_a,
+        summary,
+    }
+}
+
+/// The log's mean supply angular frequency [rad/s] and slip over its last 90 % (module
+/// docs), for naming the phase of a winding asymmetry.
+pub fn operating_point(d: &Prepared, n: &MachineConstants) -> (f64, f64) {
+    let s = SequenceSums::new(d, d.len() / 10);
+    (s.omega_s / s.count, operating_slip(d, n, &s))
+}
+
+/// The mean slip of the analysed part: measured, or from the current magnitude when the
+/// log has no speed (module docs).
+fn operating_slip(d: &Prepared, n: &MachineConstants, s: &SequenceSums) -> f64 {
+    let w = s.omega_s / s.count;
+    if w.abs() <= 1.0 {
+        return 0.0;
+    }
+    if d.channels.speed {
+        return 1.0 - (s.omega_r / s.count) / w;
+    }
+    let v_pk = if d.channels.voltages {
+        (s.v_pos2 / s.count).sqrt()
+    } else {
+        n.v_phase_peak
+    };
+    f64::from(monitor_core::sequence::slip_for_current(
+        &n.core_model,
+        v_pk as f32,
+        w.abs() as f32,
+        (s.i_pos / s.count) as f32,
+    ))
+}

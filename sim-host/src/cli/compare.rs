@@ -1,0 +1,208 @@
+//! `sim-host compare` and `sim-host explain`: the paper's simplified model against a
+//! measurement log ([`sim_host::analysis`]).
+
+use super::output_guard::OutputGuard;
+use super::{progress, render};
+use anyhow::Context as _;
+use monitor_core::EffectKind;
+use sim_host::analysis::{prep::ReadOptions, Analysis, Options};
+use std::path::PathBuf;
+
+/// Options shared by `compare` and `explain`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct Common {
+    /// Parameter file (TOML, DESIGN.md §3) with the user's nominal motor and supply values.
+    #[arg(long)]
+    pub params: PathBuf,
+    /// Measurement log (CSV: t_s, va_V, vb_V, vc_V, ia_A, ib_A, ic_A, wm_rad_s; t_s and the
+    /// currents are the minimum).
+    pub log: PathBuf,
+    /// Effects already in the model, comma separated (e.g. `thermal_drift,load_torque`).
+    #[arg(long, value_delimiter = ',', value_parser = super::parse_effect)]
+    pub effects: Vec<EffectKind>,
+    /// Print one JSON document on stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// Write the plots (SVG with labels, PNG without text) into this folder.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<PathBuf>,
+    /// Write a one-page HTML report (report.html plus the plots) into this folder.
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
+    /// Analyse from this time on [s] (e.g. to leave a start-up out).
+    #[arg(long, value_name = "SECONDS")]
+    pub from: Option<f64>,
+    /// Analyse up to this time [s].
+    #[arg(long, value_name = "SECONDS")]
+    pub to: Option<f64>,
+    /// Keep the nominal base parameters (do not refit Ra, Ls, B+Bl, J).
+    #[arg(long)]
+    pub no_fit: bool,
+}
+
+impl Common {
+    /// The analysis options.
+    fn options(&self) -> Options {
+        Options {
+            effects: self.effects.clone(),
+            fit_base: !self.no_fit,
+        }
+    }
+
+    /// Refuses outputs that would overwrite an input, and a window that ends before it
+    /// starts, before anything is read or written.
+    fn check(&self, charts: &[&str]) -> anyhow::Result<()> {
+        let guard = OutputGuard::new(&[&self.log, &self.params]);
+        let mut files = render::charts::file_names(charts);
+        if let Some(dir) = &self.plot {
+            guard.check_folder(dir, &files)?;
+        }
+        if let Some(dir) = &self.report {
+            files.push(render::html::REPORT_FILE.to_string());
+            guard.check_folder(dir, &files)?;
+        }
+        if let (Some(a), Some(b)) = (self.from, self.to) {
+            if b <= a {
+                anyhow::bail!("--to ({b}) must be after --from ({a})");
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads the parameter file and the log (with a progress bar for large logs).
+    fn load(&self) -> anyhow::Result<Analysis> {
+        let params = sim_host::params::ParamFile::load(&self.params)?;
+        let big = std::fs::metadata(&self.log)
+            .map(|m| m.len() > 20_000_000)
+            .unwrap_or(false);
+        let pb = progress::bar(progress::FRACTION_STEPS, "reading log", big);
+        let opts = ReadOptions {
+            from_s: self.from.unwrap_or(f64::NEG_INFINITY),
+            to_s: self.to.unwrap_or(f64::INFINITY),
+        };
+        let a = Analysis::load(&self.log, params, opts, &mut |f| {
+            progress::set_fraction(&pb, f)
+        })
+        .context("cannot analyse the log")?;
+        pb.finish_and_clear();
+        Ok(a)
+    }
+}
+
+/// Arguments of `compare`.
+#[derive(clap::Args, Debug, Clone)]
+#[command(
+    about = "Compare the paper's simplified model with a measurement log: where does it fail?",
+    long_about = "Compare the paper's simplified induction-motor model (eqs. 28-29) with a measurement.\n\n\
+The model is driven by the measured voltage (V_qs in a rotor-flux frame estimated from the \
+voltages: the voltage model, which needs no speed and no rotor parameters) and predicts \
+I_qs, the rotor speed omega_r and the phase currents. The parameters the data identify \
+(Ra, Ls, B+Bl, J) are refitted, because nominal values are never exact. The output gives \
+the RMS error per channel, normalized_rms_error (each channel's RMS error over its RMS, \
+averaged), the noise floor, and the worst time windows with their operating condition \
+(speed, load current, voltage, time since start) and the dominant frequency of the error.\n\n\
+Workflow:\n  sim-host compare --params motor.toml run.csv --report out/   # where does it fail?\n  \
+sim-host explain --params motor.toml run.csv                  # which effect is missing?\n  \
+sim-host compare --params motor.toml run.csv --effects thermal_drift   # the error falls\n\n\
+Current-only logs (t_s, ia_A, ib_A, ic_A) get the unbalance / faulty-phase analysis; the \
+model prediction needs the voltages and is skipped with a note.\n\n\
+JSON (--json): effects, normalized_rms_error, noise_floor, channels [{channel, rms_error, \
+rms_measured, normalized}], worst_windows [{t_start_s, t_end_s, normalized_rms_error, \
+condition{speed_rpm, load_current_a, voltage_v, voltage_percent, supply_hz, \
+time_since_start_s}, dominant_error_hz, error_kind}], base_parameters, fitted_effects, \
+skipped, unbalance, data."
+)]
+pub struct CompareArgs {
+    /// Shared options.
+    #[command(flatten)]
+    pub common: Common,
+}
+
+/// Arguments of `explain`.
+#[derive(clap::Args, Debug, Clone)]
+#[command(
+    about = "Rank the physical effects that could explain the model's error",
+    long_about = "Rank the physical effects missing from the paper's simplified model.\n\n\
+Every library effect not yet in the model (thermal_drift, saturation, iron_loss, \
+coulomb_friction, windage, load_torque, supply_unbalance, phase_asymmetry, flux_dynamics, \
+current_dynamics) is added in turn and fitted together with the base parameters (Ra, Ls, \
+B+Bl, J). Candidates are ranked by the error on held-back time windows the fit never saw, \
+so an effect that only fits noise does not win. When no candidate explains at least 50 % of \
+the held-back error, or the error is already near the noise floor, the answer is \
+`unexplained: true` rather than a wrong name.\n\n\
+Workflow:\n  sim-host compare --params motor.toml run.csv          # where does the model fail?\n  \
+sim-host explain --params motor.toml run.csv          # which effect is missing?\n  \
+sim-host explain --compare --params motor.toml run.csv  # both, reading a long log once\n  \
+sim-host compare --params motor.toml run.csv --effects load_torque   # the error falls\n  \
+sim-host explain --params motor.toml run.csv --effects load_torque   # anything else?\n\n\
+JSON (--json): baseline_normalized_rms_error, ranking [{effect, normalized_rms_error, \
+explained_fraction, validation_normalized_rms_error, n_parameters, parameters, summary}], \
+unexplained, verdict, skipped, unbalance, noise_floor."
+)]
+pub struct ExplainArgs {
+    /// Shared options.
+    #[command(flatten)]
+    pub common: Common,
+    /// Also run `compare` on the same read of the log and print its result first: one read
+    /// of a long log instead of two. With --json the output is {"compare": ..., "explain":
+    /// ...}; --plot and --report get explain's charts and report.
+    #[arg(long)]
+    pub compare: bool,
+}
+
+/// Runs `compare`.
+///
+/// # Errors
+/// Bad parameter file, unreadable or malformed log, an effect the log cannot carry, an
+/// output that is an input or is not writable; each a one-line message.
+pub fn run_compare(args: &CompareArgs) -> anyhow::Result<()> {
+    let c = &args.common;
+    c.check(&render::charts::COMPARE)?;
+    let a = c.load()?;
+    let out = a.compare(&c.options())?;
+    render::html::write_compare(c.plot.as_deref(), c.report.as_deref(), &c.log, &a, &out)?;
+    if c.json {
+        render::json::print(&out.report)
+    } else {
+        render::text::compare(&c.log, &out.report)
+    }
+}
+
+/// Runs `explain` (and `compare` first with `--compare`).
+///
+/// # Errors
+/// As [`run_compare`].
+pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
+    let c = &args.common;
+    c.check(&render::charts::EXPLAIN)?;
+    let a = c.load()?;
+    let opts = c.options();
+    // compare's result is printed (or kept for the JSON document) before explain runs, and
+    // its prediction dropped, so memory stays at explain's.
+    let compared = if args.compare {
+        let out = a.compare(&opts)?;
+        if !c.json {
+            render::text::compare(&c.log, &out.report)?;
+        }
+        Some(out.report)
+    } else {
+        None
+    };
+    let pb = progress::bar(
+        progress::FRACTION_STEPS,
+        "explain: fitting candidates",
+        a.data.len() > 50_000,
+    );
+    let pbc = pb.clone();
+    let out = a.explain(&opts, &move |f| progress::set_fraction(&pbc, f))?;
+    pb.finish_and_clear();
+    render::html::write_explain(c.plot.as_deref(), c.report.as_deref(), &c.log, &a, &out)?;
+    match (c.json, compared) {
+        (true, Some(cmp)) => render::json::print(&render::json::ExplainWithCompare {
+            compare: &cmp,
+            explain: &out.report,
+        }),
+        (true, None) => render::json::print(&out.report),
+        (false, _) => render::text::explain(&c.log, &out.report),
+    }
+}

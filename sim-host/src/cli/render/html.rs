@@ -1,0 +1,176 @@
+//! The HTML renderer: the one-page report of `compare` and `explain`, and the chart files
+//! of `--plot` and `--report`.
+//!
+//! The report embeds the SVG charts inline, so `report.html` is one self-contained file;
+//! the PNG copies sit beside it for slides and tickets. Every file is written atomically.
+
+use super::{charts, plot};
+use plot::Chart;
+use sim_host::analysis::compare::CompareOutput;
+use sim_host::analysis::explain::ExplainOutput;
+use sim_host::analysis::Analysis;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The report page's file name in `--report DIR`.
+pub const REPORT_FILE: &str = "report.html";
+
+/// Writes the charts into `dir` (created if needed); returns (stem, svg) pairs.
+fn write_charts(dir: &Path, charts: &[Chart]) -> anyhow::Result<Vec<(String, String)>> {
+    std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
+    let mut v = Vec::new();
+    for c in charts {
+        let (svg, _) = plot::write(dir, c).map_err(anyhow::Error::msg)?;
+        v.push((c.stem.to_string(), svg));
+    }
+    Ok(v)
+}
+
+/// Writes the chart files into `plot` and the report (its own copy of the charts) into
+/// `report`, each when given. Charts are only built when something is written (they thin
+/// copies of the full series).
+fn write_outputs(
+    plot: Option<&Path>,
+    report: Option<&Path>,
+    charts: impl FnOnce() -> Vec<Chart<'static>>,
+    page: impl FnOnce(&[(String, String)]) -> String,
+) -> anyhow::Result<()> {
+    if plot.is_none() && report.is_none() {
+        return Ok(());
+    }
+    let charts = charts();
+    if let Some(dir) = plot {
+        write_charts(dir, &charts)?;
+    }
+    if let Some(dir) = report {
+        let svgs = write_charts(dir, &charts)?;
+        let path = dir.join(REPORT_FILE);
+        sim_host::log::write_atomic(&path, page(&svgs).as_bytes())
+            .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
+        eprintln!("report: {}", path.display());
+    }
+    Ok(())
+}
+
+/// `compare --plot DIR --report DIR`.
+pub fn write_compare(
+    plot: Option<&Path>,
+    report: Option<&Path>,
+    log: &Path,
+    a: &Analysis,
+    out: &CompareOutput,
+) -> anyhow::Result<()> {
+    let log = log.display().to_string();
+    write_outputs(
+        plot,
+        report,
+        || charts::compare_charts(&a.data, out),
+        |svgs| compare_html(&log, out, svgs),
+    )
+}
+
+/// `explain --plot DIR --report DIR`.
+pub fn write_explain(
+    plot: Option<&Path>,
+    report: Option<&Path>,
+    log: &Path,
+    a: &Analysis,
+    out: &ExplainOutput,
+) -> anyhow::Result<()> {
+    let log = log.display().to_string();
+    write_outputs(
+        plot,
+        report,
+        || charts::explain_charts(&a.data, &out.before, out.after.as_ref()),
+        |svgs| explain_html(&log, out, svgs),
+    )
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+const STYLE: &str = "body{font-family:sans-serif;max-width:1000px;margin:2em auto;color:#222}table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #bbb;padding:4px 8px;text-align:right}th{background:#eee}td.l,th.l{text-align:left}.v{font-size:1.2em;background:#f4f4dc;padding:.6em;border-left:4px solid #cc4}";
+
+/// The `compare` report page.
+fn compare_html(log: &str, out: &CompareOutput, charts: &[(String, String)]) -> String {
+    let r = &out.report;
+    let mut h = String::new();
+    let _ = write!(h, "<!doctype html><html><head><meta charset=utf-8><title>compare: {}</title><style>{STYLE}</style></head><body>", esc(log));
+    let _ = write!(h, "<h1>Model vs measurement</h1><p>Log <code>{}</code>: {} rows at {:.0} Hz ({:.2} s), analysed at {:.0} Hz in the {}.</p>", esc(log), r.data.rows, r.data.log_rate_hz, r.data.duration_s, r.data.working_rate_hz, esc(&r.data.frame));
+    let eff = if r.effects.is_empty() {
+        "none (the paper's model, eqs. 28-29)".to_string()
+    } else {
+        effect_list(&r.effects)
+    };
+    let _ = write!(h, "<p class=v>Effects in the model: <b>{}</b>. Normalized RMS error <b>{:.4}</b> (noise floor {:.4}: a perfect model would score about this).</p>", esc(&eff), r.normalized_rms_error, r.noise_floor);
+    for s in &r.skipped {
+        let _ = write!(h, "<p><i>{}</i></p>", esc(s));
+    }
+    h.push_str("<h2>Error per channel</h2><table><tr><th class=l>channel</th><th>RMS error</th><th>RMS measured</th><th>normalized</th></tr>");
+    for c in &r.channels {
+        let _ = write!(
+            h,
+            "<tr><td class=l>{}</td><td>{:.4}</td><td>{:.4}</td><td>{:.4}</td></tr>",
+            c.channel, c.rms_error, c.rms_measured, c.normalized
+        );
+    }
+    h.push_str("</table><h2>Where the model fails most</h2><table><tr><th>from [s]</th><th>to [s]</th><th>error</th><th>speed [rpm]</th><th>load I_qs [A]</th><th>voltage [%]</th><th>supply [Hz]</th><th>since start [s]</th><th class=l>error is mostly</th></tr>");
+    for w in &r.worst_windows {
+        let _ = write!(h, "<tr><td>{:.2}</td><td>{:.2}</td><td>{:.4}</td><td>{}</td><td>{:.2}</td><td>{:.1}</td><td>{:.1}</td><td>{:.2}</td><td class=l>{}</td></tr>", w.t_start_s, w.t_end_s, w.normalized_rms_error, w.condition.speed_rpm.map(|s| format!("{s:.0}")).unwrap_or("-".into()), w.condition.load_current_a, w.condition.voltage_percent, w.condition.supply_hz, w.condition.time_since_start_s, esc(&w.error_kind));
+    }
+    h.push_str("</table><h2>Fitted parameters</h2><p>Nominal values are never exact; the parameters the data identify are refitted.</p><table><tr><th class=l>parameter</th><th>fitted</th><th>nominal</th><th class=l>unit</th></tr>");
+    for (k, v) in &r.base_parameters {
+        let _ = write!(
+            h,
+            "<tr><td class=l>{}</td><td>{:.5}</td><td>{:.5}</td><td class=l>{}</td></tr>",
+            k,
+            v.value,
+            v.nominal.unwrap_or(f64::NAN),
+            esc(&v.unit)
+        );
+    }
+    h.push_str("</table>");
+    for e in &r.fitted_effects {
+        let _ = write!(h, "<p><b>{}</b>: {}</p>", e.effect, esc(&e.summary));
+    }
+    let _ = write!(h, "<h2>Unbalance</h2><p>{}</p>", esc(&r.unbalance.summary));
+    for (stem, svg) in charts {
+        let _ = write!(h, "<h3>{stem}</h3>{svg}");
+    }
+    h.push_str("<p>Next step: <code>sim-host explain</code> ranks the physical effects that could remove this error.</p></body></html>");
+    h
+}
+
+/// The `explain` report page.
+fn explain_html(log: &str, out: &ExplainOutput, charts: &[(String, String)]) -> String {
+    let r = &out.report;
+    let mut h = String::new();
+    let _ = write!(h, "<!doctype html><html><head><meta charset=utf-8><title>explain: {}</title><style>{STYLE}</style></head><body>", esc(log));
+    let _ = write!(h, "<h1>Which physical effect is missing?</h1><p>Log <code>{}</code>. Effects already in the model: {}.</p>", esc(log), if r.effects.is_empty() { "none".into() } else { effect_list(&r.effects) });
+    let _ = write!(h, "<p class=v>{}</p>", esc(&r.verdict));
+    let _ = write!(h, "<p>Error of the model as configured: {:.4} (whole log), {:.4} on the held-back windows the fits never saw; noise floor {:.4}. Each candidate below was added to the model and fitted together with the base parameters; ranking is by the held-back error, so an effect that only fits noise does not win.</p>", r.baseline_normalized_rms_error, r.baseline_validation_normalized_rms_error, r.noise_floor);
+    h.push_str("<table><tr><th>rank</th><th class=l>effect</th><th>error</th><th>held-back error</th><th>explained</th><th>params</th><th class=l>fitted, in words</th></tr>");
+    for (i, c) in r.ranking.iter().enumerate() {
+        let _ = write!(h, "<tr><td>{}</td><td class=l>{}</td><td>{:.4}</td><td>{:.4}</td><td>{:.0} %</td><td>{}</td><td class=l>{}</td></tr>", i + 1, c.effect, c.normalized_rms_error, c.validation_normalized_rms_error, 100.0 * c.explained_fraction, c.n_parameters, esc(&c.summary));
+    }
+    h.push_str("</table>");
+    if let Some(c) = r.ranking.first() {
+        let _ = write!(h, "<h2>Before / after</h2><table><tr><th class=l>model</th><th>normalized RMS error</th></tr><tr><td class=l>as configured</td><td>{:.4}</td></tr><tr><td class=l>+ {}</td><td>{:.4}</td></tr></table>", r.baseline_normalized_rms_error, c.effect, c.normalized_rms_error);
+    }
+    for s in &r.skipped {
+        let _ = write!(h, "<p><i>skipped: {}</i></p>", esc(s));
+    }
+    let _ = write!(h, "<h2>Unbalance</h2><p>{}</p>", esc(&r.unbalance.summary));
+    for (stem, svg) in charts {
+        let _ = write!(h, "<h3>{stem}</h3>{svg}");
+    }
+    h.push_str("</body></html>");
+    h
+}
+
+fn effect_list(e: &[monitor_core::EffectKind]) -> String {
+    e.iter().map(|e| e.name()).collect::<Vec<_>>().join(", ")
+}

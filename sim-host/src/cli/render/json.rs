@@ -1,0 +1,115 @@
+//! The JSON renderer: every command's `--json` document, printed the one way.
+
+use serde::Serialize;
+use sim_host::analysis::compare::CompareReport;
+use sim_host::analysis::explain::ExplainReport;
+use sim_host::bench::{BenchFigures, DetectionLimit};
+use sim_host::demo::DemoRun;
+use sim_host::fault_signatures::Table1Row;
+use sim_host::replay::{FaultCandidate, TimelinePoint};
+use sim_host::sim::SimSummary;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Prints `v` as one pretty JSON document on stdout.
+///
+/// # Errors
+/// Serialisation or stdout errors.
+pub fn print<T: Serialize + ?Sized>(v: &T) -> anyhow::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    serde_json::to_writer_pretty(&mut out, v)?;
+    writeln!(out)?;
+    Ok(())
+}
+
+/// `demo --json`.
+#[derive(Serialize)]
+pub struct DemoReport<'a> {
+    fault_injected: &'static str,
+    change: f64,
+    fault_at_s: f64,
+    first_detection_s: Option<f64>,
+    named: &'a [FaultCandidate],
+    correct_fault_among_candidates: bool,
+    lamps: &'a BTreeMap<String, bool>,
+    timeline: &'a [TimelinePoint],
+}
+
+/// The `demo --json` document of a run.
+pub fn demo(run: &DemoRun) -> DemoReport<'_> {
+    DemoReport {
+        fault_injected: run.fault.name(),
+        change: run.change,
+        fault_at_s: run.fault_at_s,
+        first_detection_s: run.report.first_detection_s,
+        named: &run.report.candidates,
+        correct_fault_among_candidates: run.correct_fault_named(),
+        lamps: &run.report.lamps,
+        timeline: &run.report.timeline,
+    }
+}
+
+/// `simulate --json`: the summary with the output path and the wall time.
+#[derive(Serialize)]
+pub struct SimulateReport<'a> {
+    out: String,
+    wall_s: f64,
+    #[serde(flatten)]
+    summary: &'a SimSummary,
+}
+
+/// The `simulate --json` document.
+pub fn simulate<'a>(out: &Path, wall_s: f64, summary: &'a SimSummary) -> SimulateReport<'a> {
+    SimulateReport {
+        out: out.display().to_string(),
+        wall_s,
+        summary,
+    }
+}
+
+/// `table1`'s result (the JSON document; the text table is drawn from it too).
+#[derive(Serialize)]
+pub struct Table1Report {
+    /// The motor.
+    pub motor: String,
+    /// The frame's CLI name.
+    pub angle_source: String,
+    /// The 18 rows.
+    pub rows: Vec<Table1Row>,
+    /// Rows equal to the paper's.
+    pub matches_paper: usize,
+}
+
+impl Table1Report {
+    /// The report of `rows` measured on `motor` in the frame of `angle`.
+    pub fn new(motor: String, angle: monitor_core::AngleSource, rows: Vec<Table1Row>) -> Self {
+        let matches_paper = rows.iter().filter(|r| r.signature == r.paper).count();
+        Table1Report {
+            motor,
+            angle_source: sim_host::replay::angle_source_name(angle).into(),
+            rows,
+            matches_paper,
+        }
+    }
+}
+
+/// `explain --compare --json`: both documents.
+#[derive(Serialize)]
+pub struct ExplainWithCompare<'a> {
+    /// `compare`'s document.
+    pub compare: &'a CompareReport,
+    /// `explain`'s document.
+    pub explain: &'a ExplainReport,
+}
+
+/// `bench --json`.
+#[derive(Serialize)]
+pub struct BenchReport<'a> {
+    /// The timings and accuracy.
+    #[serde(flatten)]
+    pub figures: &'a BenchFigures,
+    /// With `--detection`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub detection_limits: Option<&'a [DetectionLimit]>,
+}

@@ -1,0 +1,9 @@
+//! One renderer per output format, as a CLI tool keeps its exporters: [`text`] (the human
+//! tables), [`json`] (one document on stdout), [`html`] (the report page and the chart
+//! files), with the chart sets in [`charts`] drawn by [`plot`].
+
+pub mod charts;
+pub mod html;
+pub mod json;
+pub mod plot;
+pub mod text;

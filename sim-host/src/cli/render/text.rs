@@ -1,0 +1,455 @@
+//! The text renderer: the human tables of every command, written to stdout (a closed pipe
+//! is an error, not a panic).
+
+use super::json::Table1Report;
+use sim_host::analysis::compare::CompareReport;
+use sim_host::analysis::explain::ExplainReport;
+use sim_host::bench::{BenchFigures, DetectionLimit, Spread};
+use sim_host::demo::{DemoRun, MonitorState};
+use sim_host::replay::{Diagnosed, TimelinePoint};
+use sim_host::sim::SimSummary;
+use std::io::Write;
+use std::path::Path;
+
+/// A lamp as a character: lit or dark.
+fn lamp(on: bool) -> &'static str {
+    if on {
+        "●"
+    } else {
+        "○"
+    }
+}
+
+/// A number for the tables (NaN as "-").
+fn number(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x:.4}")
+    } else {
+        "-".into()
+    }
+}
+
+/// The demo's timeline and conclusion.
+pub fn demo(run: &DemoRun) -> anyhow::Result<()> {
+    let mut out = std::io::stdout().lock();
+    writeln!(
+        out,
+        "3 hp induction motor, 220 V 60 Hz, direct-on-line start, viscous load; 12-bit sensors with noise.\n\
+         Commissioning 2.0-4.0 s learns the healthy residuals; at {:.1} s: {} {:+.0} %.\n",
+        run.fault_at_s,
+        run.fault.name(),
+        100.0 * run.change
+    )?;
+    writeln!(out, "  time   speed rpm   r1 r2 r3 r4   state")?;
+    for p in &run.points {
+        let state = match &p.state {
+            MonitorState::Commissioning(x) => format!("commissioning {:3.0} %", 100.0 * x),
+            MonitorState::Transient => "transient".to_string(),
+            MonitorState::Starting => "starting".to_string(),
+            MonitorState::Healthy => "healthy".to_string(),
+            MonitorState::Fault(c) => {
+                let names: Vec<String> = c
+                    .iter()
+                    .map(|(f, p)| format!("{} {:.0} %", f.name(), 100.0 * p))
+                    .collect();
+                format!("FAULT: {}", names.join(" / "))
+            }
+        };
+        let mark = if p.fault_injected {
+            "  <- fault injected"
+        } else {
+            ""
+        };
+        let l = p.lamps.map(lamp);
+        writeln!(
+            out,
+            "{:5.2} s  {:7.0}     {}  {}  {}  {}   {state}{mark}",
+            p.t_s, p.speed_rpm, l[0], l[1], l[2], l[3]
+        )?;
+    }
+    writeln!(out)?;
+    match run.report.first_detection_s {
+        Some(t) => writeln!(
+            out,
+            "detected {:.2} s after the fault was injected",
+            t - run.fault_at_s
+        )?,
+        None => writeln!(out, "no fault detected")?,
+    }
+    let named: Vec<String> = run
+        .report
+        .candidates
+        .iter()
+        .map(|c| format!("{} ({:.0} %)", c.fault, 100.0 * c.probability))
+        .collect();
+    writeln!(
+        out,
+        "fault candidates: {}{}",
+        if named.is_empty() {
+            "none".into()
+        } else {
+            named.join(", ")
+        },
+        if run.correct_fault_named() {
+            "  — the injected fault is named"
+        } else {
+            ""
+        }
+    )?;
+    if run.report.candidates.len() == 2 {
+        writeln!(
+            out,
+            "(two faults share one signature in the paper's Table 1, so each gets 50 %: the parity \
+             equations cannot tell them apart)"
+        )?;
+    }
+    Ok(())
+}
+
+/// `simulate`'s one-line summary.
+pub fn simulate(path: &Path, wall_s: f64, s: &SimSummary) -> anyhow::Result<()> {
+    writeln!(
+        std::io::stdout().lock(),
+        "wrote {} rows ({} s at {} Hz) to {} in {:.2} s; final speed {:.2} rad/s, slip {:.4}",
+        s.rows,
+        s.duration_s,
+        s.sample_rate_hz,
+        path.display(),
+        wall_s,
+        s.final_wm_rad_s,
+        s.final_slip
+    )?;
+    Ok(())
+}
+
+/// The state column of a `diagnose` timeline point.
+fn diagnose_state(p: &TimelinePoint) -> String {
+    if p.commissioning {
+        "learning".to_string()
+    } else if !p.quasi_steady {
+        "transient (lamps hold)".to_string()
+    } else if !p.evaluating {
+        "settling".to_string()
+    } else {
+        p.top
+            .as_ref()
+            .map(|t| format!("{t} {:.0} %", 100.0 * p.top_probability))
+            .unwrap_or_else(|| "healthy".into())
+    }
+}
+
+/// `diagnose`'s timeline, lamps, candidates and unbalance.
+pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
+    let rep = &d.report;
+    let mut out = std::io::stdout().lock();
+    writeln!(
+        out,
+        "diagnose {} ({} rows, {:.0} Hz, angle: {})",
+        log.display(),
+        rep.rows,
+        d.sample_rate_hz,
+        rep.angle_source
+    )?;
+    match rep.commission {
+        Some((a, b)) => writeln!(
+            out,
+            "thresholds: learned over {a}..{b} s (mean +/- k*spread)"
+        )?,
+        None => writeln!(out, "thresholds: fixed (no --commission window given)")?,
+    }
+    for s in &rep.skipped {
+        writeln!(out, "skipped: {s}")?;
+    }
+    if rep.skipped.is_empty() {
+        writeln!(
+            out,
+            "\n  time    speed   r1      r2      r3      r4      lamps     top candidate"
+        )?;
+        for p in &rep.timeline {
+            let lamps: String = p.lamps.iter().map(|l| lamp(*l)).collect();
+            let r = p.residuals;
+            writeln!(
+                out,
+                "{:6.2} s {:6.1} {:+.4} {:+.4} {:+.4} {:+.4}  {lamps}  {}",
+                p.t_s,
+                p.speed_rad_s,
+                r[0],
+                r[1],
+                r[2],
+                r[3],
+                diagnose_state(p)
+            )?;
+        }
+        let lit: Vec<&str> = rep
+            .lamps
+            .iter()
+            .filter(|(_, v)| **v)
+            .map(|(k, _)| k.as_str())
+            .collect();
+        writeln!(
+            out,
+            "\nfinal lamps: {}",
+            if lit.is_empty() {
+                "none".to_string()
+            } else {
+                lit.join(" ")
+            }
+        )?;
+        match rep.first_detection_s {
+            Some(t) => writeln!(out, "first detection: {t:.2} s")?,
+            None => writeln!(out, "first detection: none")?,
+        }
+        let c: Vec<String> = rep
+            .candidates
+            .iter()
+            .map(|c| format!("{} {:.0} %", c.fault, 100.0 * c.probability))
+            .collect();
+        writeln!(
+            out,
+            "candidates: {}",
+            if c.is_empty() {
+                "none".to_string()
+            } else {
+                c.join(", ")
+            }
+        )?;
+    }
+    let u = &rep.unbalance;
+    writeln!(
+        out,
+        "unbalance: |I2|/|I1| = {:.2} %, suspect phase: {}",
+        100.0 * u.negative_sequence_ratio,
+        u.suspect_phase.as_deref().unwrap_or("none")
+    )?;
+    Ok(())
+}
+
+/// `table1`'s measured signatures beside the paper's and the physical ones.
+pub fn table1(t: &Table1Report) -> anyhow::Result<()> {
+    let mut out = std::io::stdout().lock();
+    writeln!(
+        out,
+        "Table 1 end to end — {}, angle: {}",
+        t.motor, t.angle_source
+    )?;
+    writeln!(out, "fault           change   measured r1 r2 r3 r4   paper r1 r2 r3 r4   physics r1 r2 r3 r4   candidates")?;
+    let bits = |s: &[u8; 4]| s.map(|b| if b == 1 { "I" } else { "0" });
+    for r in &t.rows {
+        let (m, p, e) = (bits(&r.signature), bits(&r.paper), bits(&r.expected));
+        let diff = if r.signature == r.paper { " " } else { "*" };
+        let cands: Vec<String> = r
+            .candidates
+            .iter()
+            .map(|(f, p)| format!("{f} {:.0}%", 100.0 * p))
+            .collect();
+        writeln!(
+            out,
+            "{:<15} {:+5.0} %        {}  {}  {}  {}          {}  {}  {}  {} {diff}          {}  {}  {}  {}   {}",
+            r.fault,
+            100.0 * r.change,
+            m[0],
+            m[1],
+            m[2],
+            m[3],
+            p[0],
+            p[1],
+            p[2],
+            p[3],
+            e[0],
+            e[1],
+            e[2],
+            e[3],
+            if cands.is_empty() { "none".to_string() } else { cands.join(", ") }
+        )?;
+    }
+    let phys = t.rows.iter().filter(|r| r.signature == r.expected).count();
+    writeln!(
+        out,
+        "\n{} of {n} rows equal the paper's Table 1, {phys} of {n} the physically expected signature \
+         ('I' = residual moves; '*' = differs from the paper; see the README for why).",
+        t.matches_paper,
+        n = t.rows.len()
+    )?;
+    Ok(())
+}
+
+/// The effects of a model, as the text tables name it: `bare` without effects, else
+/// `prefix` and the names joined by `sep`.
+fn model_name(effects: &[monitor_core::EffectKind], bare: &str, prefix: &str, sep: &str) -> String {
+    if effects.is_empty() {
+        bare.to_string()
+    } else {
+        let names: Vec<&str> = effects.iter().map(|e| e.name()).collect();
+        format!("{prefix}{}", names.join(sep))
+    }
+}
+
+/// `compare`'s errors, worst windows and fitted values.
+pub fn compare(log: &Path, r: &CompareReport) -> anyhow::Result<()> {
+    let mut out = std::io::stdout().lock();
+    writeln!(out, "compare {}", log.display())?;
+    writeln!(
+        out,
+        "  model: {}",
+        model_name(
+            &r.effects,
+            "paper's simplified model (eqs. 28-29)",
+            "paper's model + ",
+            " + "
+        )
+    )?;
+    writeln!(
+        out,
+        "  normalized_rms_error {}   (noise floor {})",
+        number(r.normalized_rms_error),
+        number(r.noise_floor)
+    )?;
+    for ch in &r.channels {
+        writeln!(
+            out,
+            "  {:<14} rms error {:>10.4}  of rms {:>10.4}  ({:.2} %)",
+            ch.channel,
+            ch.rms_error,
+            ch.rms_measured,
+            100.0 * ch.normalized
+        )?;
+    }
+    if !r.worst_windows.is_empty() {
+        writeln!(out, "  worst windows:")?;
+        for w in &r.worst_windows {
+            writeln!(
+                out,
+                "    {:>7.2}-{:<7.2} s  error {:.4}  speed {} rpm, I_qs {:.2} A, voltage {:.0} %, {:.1} Hz, {:.2} s after start; error mostly {}",
+                w.t_start_s,
+                w.t_end_s,
+                w.normalized_rms_error,
+                w.condition.speed_rpm.map(|s| format!("{s:.0}")).unwrap_or("-".into()),
+                w.condition.load_current_a,
+                w.condition.voltage_percent,
+                w.condition.supply_hz,
+                w.condition.time_since_start_s,
+                w.error_kind
+            )?;
+        }
+    }
+    for e in &r.fitted_effects {
+        writeln!(out, "  {}: {}", e.effect, e.summary)?;
+    }
+    for (k, v) in &r.base_parameters {
+        writeln!(
+            out,
+            "  fitted {:<14} {:>12.5} {} (nominal {:.5})",
+            k,
+            v.value,
+            v.unit,
+            v.nominal.unwrap_or(f64::NAN)
+        )?;
+    }
+    for s in &r.skipped {
+        writeln!(out, "  skipped: {s}")?;
+    }
+    writeln!(out, "  unbalance: {}", r.unbalance.summary)?;
+    Ok(())
+}
+
+/// `explain`'s ranking and verdict.
+pub fn explain(log: &Path, r: &ExplainReport) -> anyhow::Result<()> {
+    let mut out = std::io::stdout().lock();
+    writeln!(out, "explain {}", log.display())?;
+    writeln!(
+        out,
+        "  model as configured: {}; error {} (held-back {}), noise floor {}",
+        model_name(&r.effects, "paper's model", "", ","),
+        number(r.baseline_normalized_rms_error),
+        number(r.baseline_validation_normalized_rms_error),
+        number(r.noise_floor)
+    )?;
+    writeln!(
+        out,
+        "  {:<4} {:<18} {:>10} {:>10} {:>10}  fitted",
+        "rank", "effect", "error", "held-back", "explained"
+    )?;
+    for (i, k) in r.ranking.iter().enumerate() {
+        writeln!(
+            out,
+            "  {:<4} {:<18} {:>10} {:>10} {:>9.0}%  {}",
+            i + 1,
+            k.effect.name(),
+            number(k.normalized_rms_error),
+            number(k.validation_normalized_rms_error),
+            100.0 * k.explained_fraction,
+            k.summary
+        )?;
+    }
+    for s in &r.skipped {
+        writeln!(out, "  skipped: {s}")?;
+    }
+    writeln!(out, "  unbalance: {}", r.unbalance.summary)?;
+    writeln!(out, "{}", r.verdict)?;
+    Ok(())
+}
+
+/// A timing as "median (min-max)".
+fn spread(s: &Spread, decimals: usize) -> String {
+    format!(
+        "{:.d$} ({:.d$}-{:.d$})",
+        s.median,
+        s.min,
+        s.max,
+        d = decimals
+    )
+}
+
+/// `bench`'s figures and, with `--detection`, the detection limits.
+pub fn bench(f: &BenchFigures, limits: Option<&[DetectionLimit]>) -> anyhow::Result<()> {
+    let mut out = std::io::stdout().lock();
+    writeln!(
+        out,
+        "reference scenario: 2.2 kW, direct-on-line, 14.6 N m from 2.5 s, 10 s at 10 kHz ({} rows); median (range) of {} runs",
+        f.rows, f.repeat
+    )?;
+    writeln!(
+        out,
+        "simulator, in memory : {} simulated s per wall s",
+        spread(&f.sim_in_memory_s_per_s, 0)
+    )?;
+    writeln!(
+        out,
+        "simulator, CSV writes: {} simulated s per wall s",
+        spread(&f.sim_with_csv_s_per_s, 0)
+    )?;
+    writeln!(
+        out,
+        "accuracy             : max |i| error {:.2e} A against a 100x finer step (step {:.0} us)",
+        f.max_current_error_a,
+        f.step_s * 1e6
+    )?;
+    writeln!(
+        out,
+        "core Monitor         : {} ns per sample (host)",
+        spread(&f.monitor_ns_per_sample, 1)
+    )?;
+    writeln!(
+        out,
+        "(motulator 0.5.0 reference, DESIGN.md: 5.14 simulated s per wall s with DOP853 at the same accuracy)"
+    )?;
+    if let Some(limits) = limits {
+        writeln!(out, "\nsmallest change detected within 10 s, service profile with load and supply steps, zero false alarms:")?;
+        writeln!(out, "motor   fault            increase  decrease")?;
+        let pct = |x: Option<f64>| {
+            x.map(|v| format!("{:7.1} %", 100.0 * v))
+                .unwrap_or_else(|| "  > 90 %".into())
+        };
+        for l in limits {
+            writeln!(
+                out,
+                "{:<7} {:<15} {}  {}",
+                l.motor,
+                l.fault,
+                pct(l.smallest_increase),
+                pct(l.smallest_decrease)
+            )?;
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,138 @@
+//! The exact reader: row by row through the `csv` crate (quoting, any field count checks),
+//! slow but with messages that name the line and column. Behind the fast path.
+
+use super::reader::{ColumnMap, LogFile};
+use super::{Column, LogError, Row};
+use std::fs::File;
+use std::io::BufReader;
+
+/// Streams the data rows of a [`LogFile`].
+pub(super) struct ExactRows {
+    shown: String,
+    rdr: csv::Reader<BufReader<File>>,
+    columns: ColumnMap,
+    record: csv::ByteRecord,
+    prev_t: Option<f64>,
+}
+
+impl ExactRows {
+    /// Opens the file and skips its header line.
+    pub fn new(log: &LogFile) -> Result<Self, LogError> {
+        let shown = log.shown().to_string();
+        let f = File::open(log.path()).map_err(|source| LogError::Io {
+            path: shown.clone(),
+            source,
+        })?;
+        let mut rdr = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .has_headers(false)
+            // Rows end at '\n' only; a CRLF file's '\r' is trimmed as whitespace. (With the
+            // default CRLF terminator the csv crate reports lines one too low in CRLF files,
+            // so an error would name the wrong line.)
+            .terminator(csv::Terminator::Any(b'\n'))
+            .from_reader(BufReader::with_capacity(1 << 20, f));
+        let mut record = csv::ByteRecord::new();
+        // The header (already parsed by `LogFile::open`).
+        rdr.read_byte_record(&mut record)
+            .map_err(|e| csv_error(&shown, &e))?;
+        Ok(ExactRows {
+            shown,
+            rdr,
+            columns: *log.columns(),
+            record,
+            prev_t: None,
+        })
+    }
+
+    /// Bytes read so far.
+    pub fn byte_offset(&self) -> u64 {
+        self.rdr.position().byte()
+    }
+
+    fn cell(&self, c: Column, line: u64) -> Result<Option<f64>, LogError> {
+        let Some(col) = self.columns.of(c) else {
+            return Ok(None);
+        };
+        let raw = self.record.get(col).unwrap_or(b"");
+        let s = std::str::from_utf8(raw).unwrap_or("");
+        s.parse::<f64>()
+            .map(Some)
+            .map_err(|_| LogError::NotNumeric {
+                path: self.shown.clone(),
+                line,
+                column: self.columns.name_of_field(col),
+                cell: s.chars().take(40).collect(),
+            })
+    }
+
+    /// Reads the next row; `Ok(None)` at the end of the file.
+    ///
+    /// # Errors
+    /// [`LogError::NotNumeric`], [`LogError::TimeNotIncreasing`] or [`LogError::Csv`],
+    /// each naming the line.
+    pub fn next_row(&mut self) -> Result<Option<Row>, LogError> {
+        match self.rdr.read_byte_record(&mut self.record) {
+            Ok(false) => return Ok(None),
+            Ok(true) => {}
+            Err(e) => return Err(csv_error(&self.shown, &e)),
+        }
+        let line = self.record.position().map(|p| p.line()).unwrap_or(0);
+        let t = self.cell(Column::Time, line)?.unwrap_or(f64::NAN);
+        if !t.is_finite() {
+            return Err(LogError::NotNumeric {
+                path: self.shown.clone(),
+                line,
+                column: Column::Time.name().into(),
+                cell: t.to_string(),
+            });
+        }
+        if let Some(prev) = self.prev_t {
+            if t <= prev {
+                return Err(LogError::TimeNotIncreasing {
+                    path: self.shown.clone(),
+                    line,
+                    t,
+                    prev,
+                });
+            }
+        }
+        self.prev_t = Some(t);
+        let mut v = [0.0f64; 9];
+        v[0] = t;
+        // Currents first: a row with several bad cells names the required column.
+        for c in [
+            Column::Ia,
+            Column::Ib,
+            Column::Ic,
+            Column::Va,
+            Column::Vb,
+            Column::Vc,
+            Column::Speed,
+            Column::Encoder,
+        ] {
+            v[c as usize] = self.cell(c, line)?.unwrap_or(0.0);
+        }
+        Ok(Some(row_from_values(&v, &self.columns)))
+    }
+}
+
+/// The row of the values of every schema column (in [`Column::ALL`] order; absent columns
+/// are ignored) for a log with `columns`.
+pub(super) fn row_from_values(v: &[f64; 9], columns: &ColumnMap) -> Row {
+    let has = |c: Column| columns.of(c).is_some();
+    Row {
+        t_s: v[0],
+        v_abc: has(Column::Va).then_some([v[1], v[2], v[3]]),
+        i_abc: [v[4], v[5], v[6]],
+        wm_rad_s: has(Column::Speed).then_some(v[7]),
+        enc_count: has(Column::Encoder).then_some(v[8].round() as i64),
+    }
+}
+
+fn csv_error(shown: &str, e: &csv::Error) -> LogError {
+    LogError::Csv {
+        path: shown.to_string(),
+        line: e.position().map(|p| p.line()).unwrap_or(0),
+        message: crate::one_line(&e.to_string()),
+    }
+}

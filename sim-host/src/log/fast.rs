@@ -1,0 +1,484 @@
+//! The fast path of [`super::LogFile::for_each_row`]: a parallel, bounded-memory CSV number
+//! reader for long logs.
+//!
+//! The header was parsed by [`super::LogFile::open`] (one column map for both paths).
+//! Data are read in 4 MiB blocks cut at line ends (`memchr`); the numbers are
+//! parsed by `fast-float2` (correctly rounded, the same values as `str::parse::<f64>`), the
+//! blocks of a batch in parallel (rayon), and the rows are handed over in file order. Reading
+//! the next batch, parsing the current one and handing over the previous one overlap, and
+//! the buffers are reused, so memory stays at a few tens of MB whatever the log's length.
+//!
+//! Any cell the fast path does not accept (quotes, tabs, text), a wrong field count, or time
+//! not increasing makes [`for_each_row`] return `Ok(false)`: the caller then re-reads with
+//! the exact reader, whose message names the line and column.
+
+use super::exact::row_from_values;
+use super::reader::LogFile;
+use super::{Column, LogError, Row};
+use rayon::prelude::*;
+use std::fs::File;
+use std::io::{Read, Seek, SeekFrom};
+
+/// Bytes per block (one parallel work item).
+pub(super) const BLOCK_BYTES: usize = 4 << 20;
+/// Largest number of parsed columns (every column of the schema).
+const MAX_COLS: usize = 9;
+/// Marker of a column that is not parsed.
+const SKIP: usize = usize::MAX;
+
+/// Which field of a line goes to which slot of the row.
+#[derive(Debug, Clone)]
+struct Cols {
+    /// For each field of the line, its slot in the row or [`SKIP`].
+    slot_of: Vec<usize>,
+    /// Slots per row.
+    width: usize,
+}
+
+impl Cols {
+    /// Slot `j` holds field `idx[j]` of each line of `nfields` fields.
+    fn new(idx: &[usize], nfields: usize) -> Self {
+        let mut slot_of = vec![SKIP; nfields];
+        for (j, &c) in idx.iter().enumerate() {
+            if c < nfields {
+                slot_of[c] = j;
+            }
+        }
+        Cols {
+            slot_of,
+            width: idx.len(),
+        }
+    }
+}
+
+/// Parses the line starting at `i` into `row`; returns the index after its line end, or
+/// `None` when a field is not a number or the field count is wrong. One pass: fields are
+/// parsed where they stand, the parser's end must be a `,` or the line end (`\n`, `\r\n`,
+/// or the end of the block), spaces around a number are allowed.
+#[inline]
+fn parse_line(b: &[u8], mut i: usize, cols: &Cols, row: &mut [f64; MAX_COLS]) -> Option<usize> {
+    let n = b.len();
+    for (field, &slot) in cols.slot_of.iter().enumerate() {
+        if field > 0 {
+            if i >= n || b[i] != b',' {
+                return None;
+            }
+            i += 1;
+        }
+        if slot == SKIP {
+            i += memchr::memchr2(b',', b'\n', &b[i..]).unwrap_or(n - i);
+            if i > 0 && i < n && b[i] == b'\n' && b[i - 1] == b'\r' {
+                i -= 1;
+            }
+            continue;
+        }
+        while i < n && b[i] == b' ' {
+            i += 1;
+        }
+        let (v, k) = fast_float2::parse_partial::<f64, _>(&b[i..]).ok()?;
+        row[slot] = v;
+        i += k;
+        while i < n && b[i] == b' ' {
+            i += 1;
+        }
+    }
+    if i < n && b[i] == b'\r' {
+        i += 1;
+    }
+    if i == n {
+        Some(n)
+    } else if b[i] == b'\n' {
+        Some(i + 1)
+    } else {
+        None
+    }
+}
+
+/// Parses a block of whole lines; the rows' first `cols.width` values are appended to
+/// `out`. Empty lines are skipped. False at the first line the fast path does not accept.
+fn parse_block(block: &[u8], cols: &Cols, out: &mut Vec<f64>) -> bool {
+    // The row width as a constant, so that handing a row over is a few moves.
+    match cols.width {
+        4 => parse_block_w::<4>(block, cols, out),
+        5 => parse_block_w::<5>(block, cols, out),
+        6 => parse_block_w::<6>(block, cols, out),
+        7 => parse_block_w::<7>(block, cols, out),
+        8 => parse_block_w::<8>(block, cols, out),
+        9 => parse_block_w::<9>(block, cols, out),
+        _ => parse_block_w::<0>(block, cols, out),
+    }
+}
+
+/// [`parse_block`] for rows of `W` values (`W` = 0: any width).
+fn parse_block_w<const W: usize>(block: &[u8], cols: &Cols, out: &mut Vec<f64>) -> bool {
+    let mut row = [0f64; MAX_COLS];
+    let n = block.len();
+    let mut i = 0;
+    while i < n {
+        match block[i] {
+            b'\n' => {
+                i += 1;
+                continue;
+            }
+            b'\r' if i + 1 >= n || block[i + 1] == b'\n' => {
+                i += 2;
+                continue;
+            }
+            _ => {}
+        }
+        match parse_line(block, i, cols, &mut row) {
+            Some(e) => i = e,
+            None => return false,
+        }
+        if W > 0 {
+            out.extend_from_slice(&row[..W]);
+        } else {
+            out.extend_from_slice(&row[..cols.width]);
+        }
+    }
+    true
+}
+
+/// Sequential reader of line-aligned blocks, reusing its buffers.
+struct BlockReader {
+    f: File,
+    /// Bytes per block.
+    block: usize,
+    /// Bytes after the last line end of the previous block.
+    carry: Vec<u8>,
+    /// Free buffers.
+    pool: Vec<Vec<u8>>,
+    eof: bool,
+}
+
+impl BlockReader {
+    /// Reads up to `count` blocks; an empty result at the end of the file.
+    fn batch(&mut self, count: usize) -> std::io::Result<(Vec<Vec<u8>>, u64)> {
+        let mut blocks = Vec::with_capacity(count);
+        let mut bytes = 0u64;
+        while blocks.len() < count && !self.eof {
+            let mut buf = self
+                .pool
+                .pop()
+                .unwrap_or_else(|| Vec::with_capacity(self.block + 4096));
+            buf.clear();
+            buf.append(&mut self.carry);
+            let k = (&mut self.f)
+                .take(self.block as u64)
+                .read_to_end(&mut buf)?;
+            bytes += k as u64;
+            if k < self.block {
+                self.eof = true;
+            }
+            if self.eof {
+                if buf.is_empty() {
+                    self.pool.push(buf);
+                } else {
+                    blocks.push(buf);
+                }
+                break;
+            }
+            match memchr::memrchr(b'\n', &buf) {
+                Some(p) => {
+                    self.carry.extend_from_slice(&buf[p + 1..]);
+                    buf.truncate(p + 1);
+                    blocks.push(buf);
+                }
+                // A line longer than a block: keep reading it.
+                None => self.carry = buf,
+            }
+        }
+        Ok((blocks, bytes))
+    }
+}
+
+/// Streams the data rows of `log` in file order, parsing in parallel, `block` bytes per
+/// work item. `on_row` returns false to stop early. `progress` gets the fraction of the
+/// file read. Returns `Ok(false)` when the fast path gave up (see the module documentation).
+///
+/// # Errors
+/// I/O errors.
+pub(super) fn for_each_row(
+    log: &LogFile,
+    block: usize,
+    progress: &mut dyn FnMut(f64),
+    on_row: &mut dyn FnMut(&Row) -> bool,
+) -> Result<bool, LogError> {
+    let io = |source| LogError::Io {
+        path: log.shown().to_string(),
+        source,
+    };
+    let mut f = File::open(log.path()).map_err(io)?;
+    f.seek(SeekFrom::Start(log.header_bytes())).map_err(io)?;
+    let total = log.len_bytes().max(1) as f64;
+    // The present columns, in `Column::ALL` order: slot j of a parsed row is column
+    // `present[j]`.
+    let columns = log.columns();
+    let present: Vec<usize> = (0..Column::ALL.len())
+        .filter(|&c| columns.field[c].is_some())
+        .collect();
+    let idx: Vec<usize> = present.iter().filter_map(|&c| columns.field[c]).collect();
+    let cols = Cols::new(&idx, columns.n_fields);
+    let width = cols.width;
+    let to_row = |slots: &[f64]| {
+        let mut v = [0.0f64; 9];
+        for (&c, &x) in present.iter().zip(slots) {
+            v[c] = x;
+        }
+        row_from_values(&v, columns)
+    };
+    let mut reader = BlockReader {
+        f,
+        block: block.max(1),
+        carry: Vec::new(),
+        pool: Vec::new(),
+        eof: false,
+    };
+    let per_batch = rayon::current_num_threads().max(1) * 2;
+    let mut read_bytes = log.header_bytes();
+    let mut prev_t = f64::NEG_INFINITY;
+    // Pipeline: read batch k+1 (one task) | parse batch k (parallel) | hand over batch k-1
+    // (this thread, so `on_row` need not be Send).
+    let (mut to_parse, b) = reader.batch(per_batch).map_err(io)?;
+    read_bytes += b;
+    let mut to_hand: Option<Vec<Option<Vec<f64>>>> = None;
+    let mut outs: Vec<Vec<f64>> = Vec::new();
+    loop {
+        if to_parse.is_empty() && to_hand.is_none() {
+            return Ok(true);
+        }
+        let mut next: Option<std::io::Result<(Vec<Vec<u8>>, u64)>> = None;
+        let mut parsed: Option<Vec<Option<Vec<f64>>>> = None;
+        let mut verdict: Option<bool> = None;
+        let mut free_outs: Vec<Vec<f64>> = Vec::new();
+        rayon::in_place_scope(|s| {
+            if !reader.eof {
+                let (rd, nx) = (&mut reader, &mut next);
+                s.spawn(move |_| *nx = Some(rd.batch(per_batch)));
+            }
+            if !to_parse.is_empty() {
+                let bufs: Vec<Vec<f64>> = (0..to_parse.len())
+                    .map(|_| outs.pop().unwrap_or_default())
+                    .collect();
+                let (blocks, cols, pr) = (&to_parse, &cols, &mut parsed);
+                s.spawn(move |_| {
+                    *pr = Some(
+                        blocks
+                            .par_iter()
+                            .zip(bufs.into_par_iter())
+                            .map(|(b, mut out)| {
+                                out.clear();
+                                out.reserve(b.len() / 8);
+                                parse_block(b, cols, &mut out).then_some(out)
+                            })
+                            .collect(),
+                    );
+                });
+            }
+            if let Some(batch) = to_hand.take() {
+                for p in batch {
+                    let Some(v) = p else {
+                        verdict = Some(false);
+                        return;
+                    };
+                    for slots in v.chunks_exact(width) {
+                        let t = slots[0];
+                        if t <= prev_t || !t.is_finite() {
+                            verdict = Some(false);
+                            return;
+                        }
+                        prev_t = t;
+                        if !on_row(&to_row(slots)) {
+                            verdict = Some(true);
+                            return;
+                        }
+                    }
+                    free_outs.push(v);
+                }
+            }
+        });
+        if let Some(v) = verdict {
+            return Ok(v);
+        }
+        outs.append(&mut free_outs);
+        progress((read_bytes as f64 / total).min(1.0));
+        reader.pool.append(&mut to_parse);
+        to_hand = parsed;
+        match next {
+            Some(r) => {
+                let (blocks, b) = r.map_err(io)?;
+                to_parse = blocks;
+                read_bytes += b;
+            }
+            None => to_parse = Vec::new(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    #[test]
+    fn blocks_pick_columns_and_skip_empty_lines() {
+        let cols = Cols::new(&[0, 2], 3);
+        let mut out = vec![];
+        assert!(parse_block(
+            b"1,2,3\n4, 5 ,6\r\n\n\r\n7,8,9",
+            &cols,
+            &mut out
+        ));
+        assert_eq!(out, vec![1.0, 3.0, 4.0, 6.0, 7.0, 9.0]);
+        let mut out = vec![];
+        assert!(!parse_block(b"1,2\n", &cols, &mut out));
+        assert!(!parse_block(b"1,2,3,4\n", &cols, &mut out));
+        assert!(!parse_block(b"1,x,y\n", &cols, &mut out));
+        assert!(!parse_block(b"1,2,3x\n", &cols, &mut out));
+        assert!(!parse_block(b"1,2,\"3\"\n", &cols, &mut out));
+    }
+
+    #[test]
+    fn line_ends_and_skipped_columns() {
+        let cols = Cols::new(&[0, 1], 3);
+        let mut out = vec![];
+        assert!(parse_block(b"1,2,a\r\n3,4,b\n5,6,c\r", &cols, &mut out));
+        assert_eq!(out, vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+        let cols = Cols::new(&[1, 2], 3);
+        let mut out = vec![];
+        assert!(parse_block(
+            b"x,1,2\r\ny,3, 4 \r\n\r\nz,5,6",
+            &cols,
+            &mut out
+        ));
+        assert_eq!(out, vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+        assert!(!parse_block(b"x,1,2\rz,5,6", &cols, &mut out));
+        assert!(!parse_block(b"x,1,2 3\n", &cols, &mut out));
+        assert!(!parse_block(b"   \n", &cols, &mut out));
+    }
+
+    /// The rows of a log through the exact reader.
+    fn exact(path: &Path) -> Vec<Row> {
+        let log = LogFile::open(path).unwrap();
+        let mut r = super::super::exact::ExactRows::new(&log).unwrap();
+        let mut v = vec![];
+        while let Some(row) = r.next_row().unwrap() {
+            v.push(row);
+        }
+        v
+    }
+
+    fn fast(path: &Path, block: usize) -> (bool, Vec<Row>) {
+        let log = LogFile::open(path).unwrap();
+        let mut v = vec![];
+        let ok = for_each_row(&log, block, &mut |_| {}, &mut |r| {
+            v.push(*r);
+            true
+        })
+        .unwrap();
+        (ok, v)
+    }
+
+    #[test]
+    fn same_rows_as_the_exact_reader_whatever_the_block_size() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.csv");
+        let mut text = String::from("t_s,va_V,vb_V,vc_V,ia_A,ib_A,ic_A,wm_rad_s,enc_count\n");
+        for k in 0..500 {
+            let t = k as f64 * 1e-4;
+            text.push_str(&format!(
+                "{t},{},{:e},-1.5e2,{},{},{},{},{}\n",
+                300.0 * (t * 314.0).sin(),
+                -2.5 * t,
+                k % 7,
+                0.1 * k as f64,
+                -3.25,
+                1e-9 * k as f64,
+                k * 3
+            ));
+        }
+        for t in [text.clone(), text.replace('\n', "\r\n")] {
+            std::fs::write(&path, &t).unwrap();
+            let want = exact(&path);
+            assert_eq!(want.len(), 500);
+            assert_eq!(want[499].enc_count, Some(1497));
+            for block in [1, 7, 64, 1000, 1 << 20] {
+                let (ok, got) = fast(&path, block);
+                assert!(ok, "block {block}");
+                assert_eq!(got, want, "block {block}");
+            }
+        }
+        std::fs::write(&path, &text).unwrap();
+        // Stopping early.
+        let log = LogFile::open(&path).unwrap();
+        let mut n = 0;
+        let ok = for_each_row(&log, 64, &mut |_| {}, &mut |_| {
+            n += 1;
+            n < 10
+        })
+        .unwrap();
+        assert!(ok);
+        assert_eq!(n, 10);
+        // Anything the fast path does not take: it gives up (the caller re-reads exactly).
+        for bad in [
+            "0.06,x,0,0,0,0,0,0,0",     // not a number
+            "0.06,\"1\",0,0,0,0,0,0,0", // quoted
+            "0.00001,0,0,0,0,0,0,0,0",  // time not increasing
+            "inf,0,0,0,0,0,0,0,0",      // time not finite
+            "0.06,1,2",                 // too few fields
+            "0.06,0,0,0,0,0,0,0,0,0",   // too many
+            "0.06,0,0,0,0,0,0,0,zz",    // enc_count not a number
+        ] {
+            let t = format!("{text}{bad}\n0.07,0,0,0,0,0,0,0,0\n");
+            std::fs::write(&path, &t).unwrap();
+            for block in [64, 1 << 20] {
+                assert!(!fast(&path, block).0, "{bad} block {block}");
+            }
+            // ... where the exact reader (behind `LogFile::for_each_row`) names the line,
+            // except for the quotes, which it accepts.
+            let log = LogFile::open(&path).unwrap();
+            let mut rows: Vec<Row> = Vec::new();
+            let res = log.for_each_row(&mut |_| {}, &mut rows);
+            if bad.contains('"') {
+                assert_eq!(res.unwrap(), 502);
+                assert_eq!(rows.len(), 502, "the sink was restarted");
+            } else {
+                let e = res.unwrap_err().to_string();
+                assert!(e.contains("line 502"), "{bad}: {e}");
+            }
+        }
+    }
+
+    #[test]
+    fn parses_like_std() {
+        let cols = Cols::new(&[0], 1);
+        for s in [
+            "0",
+            "-0",
+            "1.5",
+            "326.5986",
+            "-163.2993",
+            "5.072449e-09",
+            "1e3",
+            "+2.5E+2",
+            "0.0001",
+            "0.00030000000000000003",
+            "12345678901234567890",
+            "1.",
+            ".5",
+            "inf",
+            "-infinity",
+            " 2.5 \r",
+        ] {
+            let mut out = vec![];
+            assert!(parse_block(s.as_bytes(), &cols, &mut out), "{s}");
+            let b: f64 = s.trim().parse().unwrap();
+            assert_eq!(out[0].to_bits(), b.to_bits(), "{s}");
+        }
+        for s in ["-", "abc", "1.2.3", "1e", "1,2", "1 2"] {
+            let mut out = vec![];
+            assert!(!parse_block(s.as_bytes(), &cols, &mut out), "{s}");
+            assert!(s.parse::<f64>().is_err(), "{s}");
+        }
+    }
+}

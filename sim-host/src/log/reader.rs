@@ -1,0 +1,239 @@
+//! [`LogFile`]: a log opened once, its header parsed once, its rows streamed by the fast
+//! path with the exact reader behind it.
+
+use super::{exact, fast, Channels, Column, LogError, Row};
+use std::io::{BufRead, BufReader, Read};
+use std::path::{Path, PathBuf};
+
+/// Receives the rows of [`LogFile::for_each_row`].
+pub trait RowSink {
+    /// One row, in file order; return false to stop reading.
+    fn row(&mut self, row: &Row) -> bool;
+    /// Forget every row received so far: the rows will come again from the first one (the
+    /// fast path met something it does not accept and the exact reader takes over).
+    fn restart(&mut self);
+}
+
+/// Collects every row.
+impl RowSink for Vec<Row> {
+    fn row(&mut self, row: &Row) -> bool {
+        self.push(*row);
+        true
+    }
+    fn restart(&mut self) {
+        self.clear();
+    }
+}
+
+/// Where each schema column sits in a line: `field[c]` is the field index of
+/// [`Column::ALL`]`[c]`, `None` when the log lacks it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct ColumnMap {
+    pub field: [Option<usize>; 9],
+    /// Fields per line (the header's).
+    pub n_fields: usize,
+}
+
+impl ColumnMap {
+    /// The header name of field `i` (for messages).
+    pub fn name_of_field(&self, i: usize) -> String {
+        Column::ALL
+            .iter()
+            .zip(self.field)
+            .find(|(_, f)| *f == Some(i))
+            .map(|(c, _)| c.name().to_string())
+            .unwrap_or_else(|| format!("#{i}"))
+    }
+
+    /// The field index of a present column.
+    pub fn of(&self, c: Column) -> Option<usize> {
+        self.field[c as usize]
+    }
+}
+
+/// A log opened for reading: its path, columns and size. Cheap to keep; every read pass
+/// opens the file anew.
+#[derive(Debug, Clone)]
+pub struct LogFile {
+    path: PathBuf,
+    shown: String,
+    columns: ColumnMap,
+    channels: Channels,
+    len_bytes: u64,
+    header_bytes: u64,
+    est_rows: f64,
+}
+
+/// Bytes of the file's head read to estimate the bytes per row.
+const HEAD_BYTES: usize = 1 << 16;
+
+impl LogFile {
+    /// Opens a log, parses and checks its header, and estimates its number of rows from the
+    /// size of the first rows.
+    ///
+    /// # Errors
+    /// [`LogError::Io`] if unreadable, [`LogError::Csv`] for a malformed header,
+    /// [`LogError::MissingColumn`] if `t_s` or a current is missing, or if only some of the
+    /// three voltages are present.
+    pub fn open(path: &Path) -> Result<Self, LogError> {
+        let shown = path.display().to_string();
+        let io = |source| LogError::Io {
+            path: shown.clone(),
+            source,
+        };
+        let f = std::fs::File::open(path).map_err(io)?;
+        let len_bytes = f.metadata().map_err(io)?.len();
+        let mut r = BufReader::new(f);
+        let mut header = Vec::new();
+        r.read_until(b'\n', &mut header).map_err(io)?;
+        let mut head = Vec::with_capacity(HEAD_BYTES);
+        r.take(HEAD_BYTES as u64)
+            .read_to_end(&mut head)
+            .map_err(io)?;
+        let columns = parse_header(&header, &shown)?;
+        let has = |c: Column| columns.of(c).is_some();
+        let channels = Channels {
+            voltages: has(Column::Va),
+            speed: has(Column::Speed),
+            encoder: has(Column::Encoder),
+        };
+        let lines = head.iter().filter(|&&b| b == b'\n').count().max(1);
+        let bytes_per_row = (head.len() as f64 / lines as f64).max(1.0);
+        Ok(LogFile {
+            path: path.to_path_buf(),
+            shown,
+            columns,
+            channels,
+            len_bytes,
+            header_bytes: header.len() as u64,
+            est_rows: len_bytes.saturating_sub(header.len() as u64) as f64 / bytes_per_row,
+        })
+    }
+
+    /// Which optional channels the log has.
+    pub fn channels(&self) -> Channels {
+        self.channels
+    }
+
+    /// The file's path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The path as shown in messages.
+    pub fn shown(&self) -> &str {
+        &self.shown
+    }
+
+    /// Estimated number of data rows (from the file size and the first rows' length).
+    pub fn estimated_rows(&self) -> f64 {
+        self.est_rows
+    }
+
+    /// Streams every data row in file order into `sink` (bounded memory), until the end or
+    /// until the sink returns false. `progress` gets the fraction of the file read, at most
+    /// a few hundred times. Returns the number of rows handed over.
+    ///
+    /// The rows are parsed in parallel by the fast path; if it meets anything it does not
+    /// accept (quotes, text, a wrong field count, time not increasing), the sink is told to
+    /// [`RowSink::restart`] and the exact reader reads the log again from the start: the
+    /// same rows, or the error naming the line and column.
+    ///
+    /// # Errors
+    /// [`LogError::Io`], [`LogError::NotNumeric`], [`LogError::TimeNotIncreasing`] or
+    /// [`LogError::Csv`], each naming the file and, for a bad row, the line and column.
+    pub fn for_each_row(
+        &self,
+        progress: &mut dyn FnMut(f64),
+        sink: &mut dyn RowSink,
+    ) -> Result<u64, LogError> {
+        let mut handed = 0u64;
+        let accepted = fast::for_each_row(self, fast::BLOCK_BYTES, progress, &mut |row| {
+            handed += 1;
+            sink.row(row)
+        })?;
+        if accepted {
+            return Ok(handed);
+        }
+        sink.restart();
+        let mut rows = exact::ExactRows::new(self)?;
+        let mut handed = 0u64;
+        while let Some(row) = rows.next_row()? {
+            handed += 1;
+            if !sink.row(&row) {
+                break;
+            }
+            if handed.is_multiple_of(65_536) {
+                progress((rows.byte_offset() as f64 / self.len_bytes.max(1) as f64).min(1.0));
+            }
+        }
+        Ok(handed)
+    }
+
+    pub(super) fn columns(&self) -> &ColumnMap {
+        &self.columns
+    }
+
+    pub(super) fn len_bytes(&self) -> u64 {
+        self.len_bytes
+    }
+
+    pub(super) fn header_bytes(&self) -> u64 {
+        self.header_bytes
+    }
+}
+
+/// Parses the header line (CSV quoting allowed, names trimmed) into the column map.
+fn parse_header(line: &[u8], shown: &str) -> Result<ColumnMap, LogError> {
+    let mut rdr = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .has_headers(false)
+        .terminator(csv::Terminator::Any(b'\n'))
+        .from_reader(line);
+    let mut rec = csv::StringRecord::new();
+    let ok = rdr.read_record(&mut rec).map_err(|e| LogError::Csv {
+        path: shown.to_string(),
+        line: 1,
+        message: crate::one_line(&e.to_string()),
+    })?;
+    if !ok {
+        return Err(LogError::Empty {
+            path: shown.to_string(),
+        });
+    }
+    let find = |c: Column| rec.iter().position(|h| h == c.name());
+    let mut field = [None; 9];
+    for (f, c) in field.iter_mut().zip(Column::ALL) {
+        *f = find(c);
+    }
+    let map = ColumnMap {
+        field,
+        n_fields: rec.len(),
+    };
+    let missing = |c: Column, why: &str| LogError::MissingColumn {
+        path: shown.to_string(),
+        column: c.name().to_string(),
+        why: why.to_string(),
+    };
+    if map.of(Column::Time).is_none() {
+        return Err(missing(Column::Time, "every analysis needs the time"));
+    }
+    for c in [Column::Ia, Column::Ib, Column::Ic] {
+        if map.of(c).is_none() {
+            return Err(missing(
+                c,
+                "the phase currents are the minimum a log must carry",
+            ));
+        }
+    }
+    let volts = [Column::Va, Column::Vb, Column::Vc].map(|c| map.of(c).is_some());
+    if volts.iter().any(|v| *v) {
+        if let Some(k) = volts.iter().position(|v| !v) {
+            return Err(missing(
+                [Column::Va, Column::Vb, Column::Vc][k],
+                "the voltages come as all three phases or none",
+            ));
+        }
+    }
+    Ok(map)
+}

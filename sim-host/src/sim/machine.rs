@@ -1,0 +1,366 @@
+//! The full-order T-equivalent machine the simulator integrates, in the stationary
+//! alpha-beta frame (amplitude-invariant Clarke).
+//!
+//! States x = [psi_s'_alpha, psi_s'_beta, psi_r_alpha, psi_r_beta, omega_m, theta_m]
+//! (flux linkages [Wb], mechanical speed [rad/s], mechanical angle [rad]):
+//! ```text
+//!   dpsi_s'/dt = T^-1 u,      (I + R_s/Rfe) u = v_s - R_s i_s   (u = v_s - R_s i_s without iron loss)
+//!   dpsi_r/dt  = -Rr i_r + J omega_r psi_r,   J = [[0,-1],[1,0]],  omega_r = Np omega_m
+//!   psi_s' = Lls i_s' + psi_m,  psi_r = Llr i_r + psi_m,  psi_m = Lm (i_s' + i_r)
+//!   i_s = T^-1 i_s',  psi_s = T psi_s',  R_s = Rs T
+//!   T_e = (3/2) Np (psi_r_beta i_r_alpha - psi_r_alpha i_r_beta)   (= (3/2) Np psi_s x i_s)
+//!   J_m domega_m/dt = T_e - B omega_m - T_load(omega_m, t),   dtheta_m/dt = omega_m
+//! ```
+//! T is the stator turns matrix: I for a healthy machine; with a fraction mu of phase k's
+//! turns shorted out (`phase_asymmetry`), the abc turns diag(1 - mu e_k) seen in alpha-beta
+//! with an isolated neutral is T = I - (2/3) mu u_k u_k^T, u_k = (cos th_k, sin th_k),
+//! th_k = 0, 2pi/3, 4pi/3. The winding's MMF is T i_s and the flux it links is T times the
+//! field's, so in the primed variables (i_s' = T i_s, psi_s' = T^-1 psi_s) the machine is the
+//! symmetric T-equivalent; the faulty phase's resistance falls as (1 - mu) and its self
+//! inductance as (1 - mu)^2. Currents from fluxes: i_s' = (psi_s' - (Lm/Lr) psi_r) / M,
+//! M = Lls + Lm Llr / Lr, i_r = (psi_r - Lm i_s')/Lr, Lr = Llr + Lm.
+
+use std::cell::Cell;
+
+/// Symmetric 2x2 matrix [[a, b], [b, c]].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Sym2 {
+    pub a: f64,
+    pub b: f64,
+    pub c: f64,
+}
+
+impl Sym2 {
+    pub fn scalar(x: f64) -> Self {
+        Sym2 { a: x, b: 0.0, c: x }
+    }
+    /// x I - k u u^T with u = (cos th, sin th).
+    pub fn scalar_minus_rank1(x: f64, k: f64, th: f64) -> Self {
+        let (s, c) = th.sin_cos();
+        Sym2 {
+            a: x - k * c * c,
+            b: -k * c * s,
+            c: x - k * s * s,
+        }
+    }
+    #[inline(always)]
+    pub fn mul(&self, v: [f64; 2]) -> [f64; 2] {
+        [self.a * v[0] + self.b * v[1], self.b * v[0] + self.c * v[1]]
+    }
+    pub fn scale(&self, k: f64) -> Self {
+        Sym2 {
+            a: self.a * k,
+            b: self.b * k,
+            c: self.c * k,
+        }
+    }
+    pub fn is_pos_def(&self) -> bool {
+        self.a > 0.0 && self.a * self.c - self.b * self.b > 0.0
+    }
+    pub fn inv(&self) -> Sym2 {
+        let d = self.a * self.c - self.b * self.b;
+        Sym2 {
+            a: self.c / d,
+            b: -self.b / d,
+            c: self.a / d,
+        }
+    }
+    /// Quadratic form v^T S v.
+    pub fn quad(&self, v: [f64; 2]) -> f64 {
+        let w = self.mul(v);
+        v[0] * w[0] + v[1] * w[1]
+    }
+}
+
+/// Main-flux saturation law Lm = lm0 / (1 + (|psi_m| / psi_sat)^n).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SatLaw {
+    pub psi_sat_wb: f64,
+    pub exponent: f64,
+}
+
+/// Load torque law (without the machine's own B omega).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct LoadLaw {
+    /// Viscous coefficient [N m s/rad].
+    pub bl_nms: f64,
+    /// Constant torque [N m].
+    pub torque_nm: f64,
+    /// Coulomb friction torque [N m] and 1/omega_0 [s/rad].
+    pub coulomb_nm: f64,
+    pub inv_w0: f64,
+    /// Windage k [N m s^2/rad^2].
+    pub windage: f64,
+}
+
+impl LoadLaw {
+    #[inline(always)]
+    pub fn torque(&self, wm: f64) -> f64 {
+        let mut t = self.bl_nms * wm + self.torque_nm;
+        if self.coulomb_nm != 0.0 {
+            t += self.coulomb_nm * (wm * self.inv_w0).tanh();
+        }
+        if self.windage != 0.0 {
+            t += self.windage * wm * wm.abs();
+        }
+        t
+    }
+}
+
+/// Everything the derivative needs, precomputed (rebuilt when a parameter changes).
+#[derive(Debug, Clone)]
+pub(crate) struct Machine {
+    /// Stator resistance of the healthy phases [ohm].
+    pub rs: f64,
+    /// Stator resistance matrix Rs T [ohm].
+    pub r_s: Sym2,
+    /// Stator turns matrix T and its inverse; `asym` = T != I.
+    pub t_mat: Sym2,
+    pub tinv: Sym2,
+    pub asym: bool,
+    pub lls: f64,
+    pub llr: f64,
+    pub rr: f64,
+    /// Unsaturated (or constant) magnetising inductance [H].
+    pub lm0: f64,
+    pub sat: Option<SatLaw>,
+    /// 1/Rfe [S], 0 without iron loss, and (I + R_s/Rfe)^-1.
+    pub inv_rfe: f64,
+    pub k_fe: Sym2,
+    pub np: f64,
+    pub inv_j: f64,
+    pub b: f64,
+    pub load: LoadLaw,
+    // Linear-case derived constants.
+    minv: f64,
+    kr: f64,
+    inv_lr: f64,
+    /// Warm start of the saturation iteration.
+    lm_guess: Cell<f64>,
+}
+
+/// Currents and magnetising inductance at a state.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Currents {
+    /// Primed stator current i_s' = T i_s (the winding's MMF current) [A].
+    pub i_s: [f64; 2],
+    /// Rotor current [A].
+    pub i_r: [f64; 2],
+    /// Magnetising inductance in effect [H].
+    pub lm: f64,
+}
+
+impl Machine {
+    /// Builds the model; `Err` names what is not physical.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        rs: f64,
+        t_mat: Sym2,
+        lls: f64,
+        llr: f64,
+        rr: f64,
+        lm0: f64,
+        sat: Option<SatLaw>,
+        rfe: Option<f64>,
+        np: f64,
+        j: f64,
+        b: f64,
+        load: LoadLaw,
+    ) -> Result<Machine, String> {
+        let (minv, kr, inv_lr) = Self::linear(lls, llr, lm0)?;
+        if !t_mat.is_pos_def() {
+            return Err("the stator turns matrix is not positive definite".into());
+        }
+        let r_s = t_mat.scale(rs);
+        let asym = t_mat != Sym2::scalar(1.0);
+        let inv_rfe = rfe.map(|r| 1.0 / r).unwrap_or(0.0);
+        let k = Sym2 {
+            a: 1.0 + r_s.a * inv_rfe,
+            b: r_s.b * inv_rfe,
+            c: 1.0 + r_s.c * inv_rfe,
+        };
+        Ok(Machine {
+            rs,
+            r_s,
+            t_mat,
+            tinv: t_mat.inv(),
+            asym,
+            lls,
+            llr,
+            rr,
+            lm0,
+            sat,
+            inv_rfe,
+            k_fe: k.inv(),
+            np,
+            inv_j: 1.0 / j,
+            b,
+            load,
+            minv,
+            kr,
+            inv_lr,
+            lm_guess: Cell::new(lm0),
+        })
+    }
+
+    fn linear(lls: f64, llr: f64, lm: f64) -> Result<(f64, f64, f64), String> {
+        let lr = llr + lm;
+        let m = lls + lm * llr / lr;
+        if !(m > 0.0 && lr > 0.0 && lm > 0.0 && lls >= 0.0) {
+            return Err(format!(
+                "the inductance matrix is not positive definite (Lls = {lls} H, Lm = {lm} H, \
+                 Llr = {llr} H)"
+            ));
+        }
+        Ok((1.0 / m, lm / lr, 1.0 / lr))
+    }
+
+    /// Carries the saturation warm start over from a previous model.
+    pub fn take_guess(&self, other: &Machine) {
+        self.lm_guess.set(other.lm_guess.get());
+    }
+
+    #[inline(always)]
+    fn currents_lin(&self, ps: [f64; 2], pr: [f64; 2]) -> ([f64; 2], [f64; 2]) {
+        let is = [
+            (ps[0] - self.kr * pr[0]) * self.minv,
+            (ps[1] - self.kr * pr[1]) * self.minv,
+        ];
+        let ir = [
+            (pr[0] - self.lm0 * is[0]) * self.inv_lr,
+            (pr[1] - self.lm0 * is[1]) * self.inv_lr,
+        ];
+        (is, ir)
+    }
+
+    fn currents_at_lm(&self, ps: [f64; 2], pr: [f64; 2], lm: f64) -> ([f64; 2], [f64; 2], f64) {
+        let lr = self.llr + lm;
+        let minv = 1.0 / (self.lls + lm * self.llr / lr);
+        let kr = lm / lr;
+        let is = [(ps[0] - kr * pr[0]) * minv, (ps[1] - kr * pr[1]) * minv];
+        let ir = [(pr[0] - lm * is[0]) / lr, (pr[1] - lm * is[1]) / lr];
+        let psi_m = lm * (is[0] + ir[0]).hypot(is[1] + ir[1]);
+        (is, ir, psi_m)
+    }
+
+    /// Currents from flux linkages (exact solution of the saturation law when enabled:
+    /// secant iteration on Lm to 1e-13 relative).
+    #[inline(always)]
+    pub fn currents(&self, ps: [f64; 2], pr: [f64; 2]) -> Currents {
+        let Some(sat) = self.sat else {
+            let (i_s, i_r) = self.currents_lin(ps, pr);
+            return Currents {
+                i_s,
+                i_r,
+                lm: self.lm0,
+            };
+        };
+        let law = |psi_m: f64| self.lm0 / (1.0 + (psi_m / sat.psi_sat_wb).powf(sat.exponent));
+        let lo = 1e-3 * self.lm0;
+        let tol = 1e-13 * self.lm0;
+        let g = |lm: f64| {
+            let (_, _, pm) = self.currents_at_lm(ps, pr, lm);
+            lm - law(pm)
+        };
+        let mut x0 = self.lm_guess.get().clamp(lo, self.lm0);
+        let mut g0 = g(x0);
+        let mut x1 = (x0 - g0).clamp(lo, self.lm0);
+        if g0.abs() > tol {
+            for _ in 0..60 {
+                let g1 = g(x1);
+                if g1.abs() <= tol || g1 == g0 {
+                    break;
+                }
+                let x2 = (x1 - g1 * (x1 - x0) / (g1 - g0)).clamp(lo, self.lm0);
+                x0 = x1;
+                g0 = g1;
+                x1 = x2;
+            }
+        } else {
+            x1 = x0;
+        }
+        self.lm_guess.set(x1);
+        let (i_s, i_r, _) = self.currents_at_lm(ps, pr, x1);
+        Currents { i_s, i_r, lm: x1 }
+    }
+
+    /// Real stator (branch) current i_s = T^-1 i_s'.
+    #[inline(always)]
+    pub fn real_is(&self, i_s_primed: [f64; 2]) -> [f64; 2] {
+        if self.asym {
+            self.tinv.mul(i_s_primed)
+        } else {
+            i_s_primed
+        }
+    }
+
+    /// Voltage behind Rs (= dpsi_s/dt) for supply voltage `v` and real branch current `i_s`.
+    #[inline(always)]
+    pub fn u(&self, v: [f64; 2], i_s: [f64; 2]) -> [f64; 2] {
+        let ri = if self.asym {
+            self.r_s.mul(i_s)
+        } else {
+            [self.rs * i_s[0], self.rs * i_s[1]]
+        };
+        let e = [v[0] - ri[0], v[1] - ri[1]];
+        if self.inv_rfe == 0.0 {
+            e
+        } else {
+            self.k_fe.mul(e)
+        }
+    }
+
+    /// Electromagnetic torque [N m].
+    #[inline(always)]
+    pub fn torque(&self, pr: [f64; 2], ir: [f64; 2]) -> f64 {
+        1.5 * self.np * (pr[1] * ir[0] - pr[0] * ir[1])
+    }
+
+    /// dx/dt at state `x` with supply voltage `v` (alpha-beta, V).
+    #[inline(always)]
+    pub fn deriv(&self, x: &[f64; 6], v: [f64; 2]) -> [f64; 6] {
+        let ps = [x[0], x[1]];
+        let pr = [x[2], x[3]];
+        let wm = x[4];
+        let c = self.currents(ps, pr);
+        let mut u = self.u(v, self.real_is(c.i_s));
+        if self.asym {
+            u = self.tinv.mul(u);
+        }
+        let wr = self.np * wm;
+        let te = self.torque(pr, c.i_r);
+        let tl = self.load.torque(wm);
+        [
+            u[0],
+            u[1],
+            -self.rr * c.i_r[0] - wr * pr[1],
+            -self.rr * c.i_r[1] + wr * pr[0],
+            (te - self.b * wm - tl) * self.inv_j,
+            wm,
+        ]
+    }
+
+    /// One classic RK4 step of length `h` with the supply at the start, middle and end.
+    #[inline(always)]
+    pub fn rk4(&self, x: &mut [f64; 6], h: f64, v0: [f64; 2], vm: [f64; 2], v1: [f64; 2]) {
+        let k1 = self.deriv(x, v0);
+        let mut y = [0.0; 6];
+        let h2 = 0.5 * h;
+        for i in 0..6 {
+            y[i] = x[i] + h2 * k1[i];
+        }
+        let k2 = self.deriv(&y, vm);
+        for i in 0..6 {
+            y[i] = x[i] + h2 * k2[i];
+        }
+        let k3 = self.deriv(&y, vm);
+        for i in 0..6 {
+            y[i] = x[i] + h * k3[i];
+        }
+        let k4 = self.deriv(&y, v1);
+        let h6 = h / 6.0;
+        for i in 0..6 {
+            x[i] += h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
+        }
+    }
+}
