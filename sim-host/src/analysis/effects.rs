@@ -457,12 +457,6 @@ impl EffectModel for CoulombFriction {
             description: "dry friction torque Tc",
         }]
     }
-    fn needs(&self) -> Needs {
-        Needs {
-            voltages: true,
-            speed: false,
-        }
-    }
     fn setup(&self, _d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String> {
         let t = n.torque_scale_nm;
         let mut s = FitSetup::default();
