@@ -136,7 +136,7 @@ impl SamplePath {
     /// Apply a command.
     ///
     /// # Errors
-    /// [`ConfigError::Calibration`] when a stored calibration is out of the core's range
+    /// [`monitor_core::ConfigErrorKind::Calibration`] when a stored calibration is out of the core's range
     /// (the monitor keeps its previous thresholds).
     pub fn command(&mut self, cmd: Command) -> Result<(), ConfigError> {
         match cmd {

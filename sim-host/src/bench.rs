@@ -190,7 +190,7 @@ pub struct DetectionLimit {
 }
 
 /// Bisects, per fault and sign, the smallest change that lights a lamp within 10 s of its
-/// onset at 50 s in the service profile ([`crate::service`]), after checking that the
+/// onset at 50 s in the service profile ([`crate::service_profile`]), after checking that the
 /// healthy profile itself raises no alarm.
 ///
 /// # Errors

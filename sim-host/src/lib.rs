@@ -10,7 +10,7 @@
 //!   detection-limit studies;
 //! - [`demo`]: the main job (`demo`);
 //! - [`analysis`]: the model-vs-measurement workflow (`compare`, `explain`);
-//! - [`bench`]: the simulator and core figures of `bench`.
+//! - [`bench`](mod@bench): the simulator and core figures of `bench`.
 //!
 //! The vocabulary (faults, effect names, phases, motor parameters, reference machines)
 //! is the core's (`monitor_core`), shared with the firmware. Functions return values and

@@ -81,3 +81,45 @@ fn balanced_machine_names_no_phase() {
     assert_eq!(rep.unbalance.suspect_phase, None, "{:?}", rep.unbalance);
     assert!(rep.unbalance.negative_sequence_ratio < 0.005);
 }
+
+#[test]
+fn diagnose_and_the_analysis_name_the_same_phase() {
+    // One faulty-phase method for the whole workspace: the monitor (diagnose) and the
+    // model-vs-measurement analysis (compare/explain) agree on the same log.
+    use sim_host::analysis::{prep::ReadOptions, Analysis};
+    use sim_host::log::Log;
+    let dir = tempfile::tempdir().unwrap();
+    let p = ParamFile::reference_2p2kw();
+    for (phase, name) in [(Phase::B, "b"), (Phase::C, "c")] {
+        let mut sc = Scenario::steady(4.0, 10_000.0);
+        sc.sensors = SensorSpec::default();
+        sc.load = LoadSpec {
+            kind: LoadKind::Torque,
+            torque_nm: Some(14.6),
+            bl_nms: None,
+            steps: vec![],
+        };
+        sc.effects.push(EffectSpec::PhaseAsymmetry {
+            phase,
+            fraction: 0.05,
+        });
+        let rows = simulate_to_vec(&p, &sc).expect("simulate");
+        let rep = diagnose_rows(&p, sc.sensors.channels(), &rows, ReplayOptions::default())
+            .expect("replay");
+        let path = dir.path().join(format!("{name}.csv"));
+        Log {
+            channels: sc.sensors.channels(),
+            rows,
+        }
+        .write(&path)
+        .expect("write");
+        let opts = ReadOptions {
+            from_s: 1.5,
+            to_s: f64::INFINITY,
+        };
+        let a = Analysis::load(&path, p, opts, &mut |_| {}).expect("analysis");
+        let u = a.unbalance();
+        assert_eq!(rep.unbalance.suspect_phase.as_deref(), Some(name));
+        assert_eq!(u.suspect_phase.as_deref(), Some(name), "{}", u.summary);
+    }
+}

@@ -19,7 +19,7 @@
 //! The crate also holds the vocabulary every part of the workspace shares: [`Fault`] (Table
 //! 1's faults), [`EffectKind`] (the effect library's names), [`Phase`], the parameter
 //! file's [`MotorParameters`] with its one conversion to [`MotorModel`], and DESIGN.md's
-//! [`reference`] machines. With the `serde` feature (the host enables it) they serialise
+//! [`reference`](mod@reference) machines. With the `serde` feature (the host enables it) they serialise
 //! under their DESIGN.md names.
 //!
 //! ```

@@ -9,7 +9,7 @@
 //!   board and `f64` in the host's analysis and simulator. [`MotorParameters::model`] is the
 //!   one conversion; the derived quantities (sigma, Ra, La, Kf/i_f, leakages) are computed
 //!   only by [`MotorModel`]'s methods.
-//! - [`reference`]: DESIGN.md's reference machines.
+//! - [`reference`](mod@reference): DESIGN.md's reference machines.
 //!
 //! Symbols (DESIGN.md §2): self inductances include leakage, `Ls = Lls + Lm`,
 //! `Lr = Llr + Lm`; `sigma = 1 - Lm^2/(Ls Lr)`; `Ra = Rs + (Ls/Lr) Rr` (eq. 24);
@@ -279,8 +279,8 @@ mod tests {
     #[test]
     fn reference_machines_are_valid_and_match_design() {
         for m in [MOTOR_2P2KW, MOTOR_3HP] {
-            m.motor.validate().unwrap();
-            m.supply.validate().unwrap();
+            assert_eq!(m.motor.validate(), Ok(()), "{}", m.name);
+            assert_eq!(m.supply.validate(), Ok(()), "{}", m.name);
         }
         // 3 hp: Xm = 26.13 ohm and Xls = 0.754 ohm at 60 Hz.
         let m = MOTOR_3HP.motor;
@@ -314,17 +314,17 @@ mod tests {
     fn bad_parameters_name_their_key() {
         let mut p = MOTOR_2P2KW.motor;
         p.rr_ohm = -1.0;
-        assert_eq!(p.validate().unwrap_err().field(), "motor.rr_ohm");
+        assert_eq!(p.validate().map_err(|e| e.field()), Err("motor.rr_ohm"));
         let mut p = MOTOR_2P2KW.motor;
         p.poles = 3;
-        assert_eq!(p.validate().unwrap_err().field(), "motor.poles");
+        assert_eq!(p.validate().map_err(|e| e.field()), Err("motor.poles"));
         let mut p = MOTOR_2P2KW.motor;
         p.lr_h = p.lm_h; // no leakage at all: sigma = 0
-        assert_eq!(p.validate().unwrap_err().field(), "motor.lm_h");
+        assert_eq!(p.validate().map_err(|e| e.field()), Err("motor.lm_h"));
         let s = SupplyParameters {
             v_ll_rms: f64::NAN,
             f_hz: 50.0,
         };
-        assert_eq!(s.validate().unwrap_err().field(), "supply.v_ll_rms");
+        assert_eq!(s.validate().map_err(|e| e.field()), Err("supply.v_ll_rms"));
     }
 }

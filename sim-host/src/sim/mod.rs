@@ -25,7 +25,7 @@
 //! Integration: classic fixed-step RK4, an integer number of steps per output sample
 //! (h <= `max_step_s`, default 100 us), the supply phasor rotated incrementally (no trig per
 //! step). Accuracy on the 2.2 kW reference start (10 kHz, h = 100 us) against a 100x finer
-//! run: see [`bench_reference`] (max current error about 1e-5 A).
+//! run: see `crate::bench` (max current error about 1e-6 A).
 //!
 //! # Scenario TOML
 //! ```toml
