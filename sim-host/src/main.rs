@@ -36,8 +36,22 @@ fn main() -> ExitCode {
     match cli::run(args.cmd) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", sim_host::one_line(&format!("{e:#}")));
+            eprintln!("error: {}", one_line_error(&e));
             ExitCode::from(2)
         }
     }
+}
+
+/// The error and its causes on one line; a cause whose text the message already holds
+/// (many errors quote their source) is not repeated.
+fn one_line_error(e: &anyhow::Error) -> String {
+    let mut msg = e.to_string();
+    for cause in e.chain().skip(1) {
+        let c = cause.to_string();
+        if !msg.contains(&c) {
+            msg.push_str(": ");
+            msg.push_str(&c);
+        }
+    }
+    sim_host::one_line(&msg)
 }

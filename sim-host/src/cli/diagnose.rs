@@ -4,7 +4,7 @@
 use super::{progress, render, AngleArg, ResidualArg};
 use clap::Args;
 use sim_host::params::ParamFile;
-use sim_host::replay::{diagnose_file, ReplayOptions};
+use sim_host::replay::{diagnose_file, ReplayError, ReplayOptions};
 use std::path::PathBuf;
 
 /// Arguments of `diagnose`.
@@ -65,6 +65,11 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
     let bar = progress::bar(progress::FRACTION_STEPS, "reading log", big);
     let d = diagnose_file(&params, &args.log, opts, &mut |f| {
         progress::set_fraction(&bar, f)
+    })
+    .map_err(|e| match e {
+        // Log errors name the file already; the monitor's configuration does not.
+        ReplayError::Config { .. } => anyhow::Error::new(e).context(args.log.display().to_string()),
+        e => e.into(),
     })?;
     bar.finish_and_clear();
     if args.json {
