@@ -108,6 +108,16 @@ impl ZeroCrossing {
     pub fn locked(&self) -> bool {
         self.locked
     }
+
+    /// Advances the angle over `elapsed_s` without a measurement (samples missing from the
+    /// stream) at the present frequency estimate; the next crossing is still measured from
+    /// the last one. Non-finite or negative values are ignored.
+    pub fn skip(&mut self, elapsed_s: f32) {
+        if elapsed_s > 0.0 && elapsed_s.is_finite() {
+            self.since_crossing_s += elapsed_s;
+            self.theta = wrap_angle(self.theta + self.omega * elapsed_s);
+        }
+    }
 }
 
 /// Synchronous-reference-frame PLL. The internal angle `theta_pll` tracks the voltage
@@ -165,6 +175,14 @@ impl SrfPll {
         );
         self.theta_pll = wrap_angle(self.theta_pll + self.omega * self.dt);
         self.omega
+    }
+
+    /// Advances the angle over `elapsed_s` at the present frequency, without a measurement
+    /// (samples missing from the stream). Non-finite or negative values are ignored.
+    pub fn skip(&mut self, elapsed_s: f32) {
+        if elapsed_s > 0.0 && elapsed_s.is_finite() {
+            self.theta_pll = wrap_angle(self.theta_pll + self.omega * elapsed_s);
+        }
     }
 
     /// The PLL's own angle (voltage on +d) [rad].
@@ -229,6 +247,16 @@ impl RotorFluxCurrentModel {
         self.omega = omega_r + slip;
         self.theta = wrap_angle(self.theta + self.omega * self.dt);
         self.theta
+    }
+
+    /// Advances the model over `elapsed_s` without new currents (samples missing from the
+    /// stream): the magnetising current and the frame frequency are held and the angle
+    /// advances at that frequency, the best guess over a short gap. Non-finite or negative
+    /// values are ignored.
+    pub fn skip(&mut self, elapsed_s: f32) {
+        if elapsed_s > 0.0 && elapsed_s.is_finite() {
+            self.theta = wrap_angle(self.theta + self.omega * elapsed_s);
+        }
     }
 
     /// Present angle [rad].

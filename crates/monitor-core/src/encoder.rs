@@ -75,14 +75,18 @@ pub struct MtSpeed {
     win_start_ticks: u32,
     last_edge_ticks: u32,
     speed_rad_s: f32,
+    max_speed_rad_s: f32,
 }
 
 impl MtSpeed {
-    /// Builds the estimator; `tick_hz` is the timestamp rate. Invalid settings are caught by
-    /// [`crate::MonitorConfig::validate`].
-    pub fn new(cfg: &EncoderConfig, tick_hz: f32) -> Self {
+    /// Builds the estimator; `tick_hz` is the timestamp rate, `max_speed_rad_s` the largest
+    /// believable |speed| (a window whose estimate exceeds it is discarded and the previous
+    /// estimate kept: timestamps that stalled while the encoder counted, not motion).
+    /// Invalid settings are caught by [`crate::MonitorConfig::validate`].
+    pub fn new(cfg: &EncoderConfig, tick_hz: f32, max_speed_rad_s: f32) -> Self {
         let cpr = cfg.counts_per_rev.max(1) as f32;
         MtSpeed {
+            max_speed_rad_s,
             rad_per_count: TAU / cpr,
             s_per_tick: 1.0 / tick_hz,
             bits: cfg.counter_bits,
@@ -113,8 +117,12 @@ impl MtSpeed {
             self.last_edge_ticks = ticks;
             let span = ticks.wrapping_sub(self.win_start_ticks);
             if span >= self.min_window_ticks && span > 0 {
-                self.speed_rad_s =
-                    self.acc as f32 * self.rad_per_count / (span as f32 * self.s_per_tick);
+                let w = self.acc as f32 * self.rad_per_count / (span as f32 * self.s_per_tick);
+                // Beyond the largest believable speed the time base, not the shaft, is
+                // wrong (a stalled timer): the window is dropped, the estimate held.
+                if w.abs() <= self.max_speed_rad_s {
+                    self.speed_rad_s = w;
+                }
                 self.acc = 0;
                 self.win_start_ticks = ticks;
             }
@@ -137,20 +145,39 @@ impl MtSpeed {
         self.speed_rad_s
     }
 
-    /// Like [`MtSpeed::update`], but a step of more than `max_step` counts since the
-    /// previous sample is not taken as motion: the estimator restarts from this reading and
-    /// `None` is returned (the caller flags the speed sensor). One counter difference per
-    /// call.
-    pub fn update_checked(&mut self, count: u32, ticks: u32, max_step: u32) -> Option<f32> {
-        if self.started
-            && counter_delta(count, self.last_count, self.bits).unsigned_abs() > max_step
-        {
-            self.started = false;
-            self.acc = 0;
-            self.update(count, ticks);
-            return None;
+    /// Like [`MtSpeed::update`], but a step of more than `max_step` counts per sample
+    /// period `ticks_per_sample` is not taken as motion: the estimator restarts from this
+    /// reading and `None` is returned (the caller flags the speed sensor). Samples missing
+    /// from the stream (a gap since the last counter change) allow a proportionally larger
+    /// step. One counter difference per call.
+    pub fn update_checked(
+        &mut self,
+        count: u32,
+        ticks: u32,
+        max_step: u32,
+        ticks_per_sample: u32,
+    ) -> Option<f32> {
+        if self.started {
+            let step = counter_delta(count, self.last_count, self.bits).unsigned_abs();
+            if step > max_step && !self.step_fits_gap(step, ticks, max_step, ticks_per_sample) {
+                self.started = false;
+                self.acc = 0;
+                self.update(count, ticks);
+                return None;
+            }
         }
         Some(self.update(count, ticks))
+    }
+
+    /// Whether a large counter step is motion over a gap in the samples: the time since the
+    /// last counter change holds enough sample periods for it.
+    #[cold]
+    fn step_fits_gap(&self, step: u32, ticks: u32, max_step: u32, ticks_per_sample: u32) -> bool {
+        let periods = ticks.wrapping_sub(self.last_edge_ticks) / ticks_per_sample.max(1);
+        // A stalled or backward clock gives 0 or a wrapped, absurd count of periods.
+        periods > 1
+            && periods < (1 << 24)
+            && u64::from(step) <= u64::from(max_step) * u64::from(periods)
     }
 
     /// Last speed estimate, mechanical [rad/s].
@@ -171,7 +198,7 @@ mod tests {
         };
         let fs = 10_000.0f32;
         let tick_hz = 1_000_000.0;
-        let mut mt = MtSpeed::new(&cfg, tick_hz);
+        let mut mt = MtSpeed::new(&cfg, tick_hz, 1.0e4);
         let n = (seconds * fs) as u32;
         let mut out = 0.0;
         for k in 0..n {
@@ -214,7 +241,7 @@ mod tests {
     #[test]
     fn direction_change_and_stop() {
         let cfg = EncoderConfig::default();
-        let mut mt = MtSpeed::new(&cfg, 10_000.0);
+        let mut mt = MtSpeed::new(&cfg, 10_000.0, 1.0e4);
         // 10 counts per sample (153 rad/s) for 0.2 s, then backwards for 0.2 s, then stop.
         let mut c: i64 = 0;
         let mut t: u32 = 0;

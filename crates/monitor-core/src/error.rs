@@ -74,6 +74,7 @@ pub enum ConfigCheck {
     SteadyGate,
     GateHold,
     GateTimeout,
+    MaxBridgedGap,
     ThresholdFixed,
     ThresholdMinBand,
     ThresholdKSigma,
@@ -123,6 +124,7 @@ impl ConfigCheck {
             SteadyGate => "steady_gate_per_s",
             GateHold => "gate_hold_s",
             GateTimeout => "gate_timeout_s",
+            MaxBridgedGap => "max_bridged_gap_s",
             ThresholdFixed => "thresholds.fixed",
             ThresholdMinBand => "thresholds.min_band",
             ThresholdKSigma => "thresholds.k_sigma",
@@ -141,7 +143,9 @@ impl ConfigCheck {
             | PllBandwidth | EncoderMinWindow | VoltageLimit | CurrentLimit | SpeedLimit
             | CurrentSumFraction | FloorFraction | ThresholdKSigma => "be positive and finite",
             MotorB | MotorBl | VoltageSumFraction | SettleTime | UnbalanceMinRatio
-            | SteadyGate | GateHold | ThresholdDebounce | ThresholdRelease => "be >= 0",
+            | SteadyGate | GateHold | MaxBridgedGap | ThresholdDebounce | ThresholdRelease => {
+                "be >= 0"
+            }
             MotorPoles => "be even and 2..=254",
             MotorLsBelowLm | MotorLrBelowLm => {
                 "be >= motor.lm_h (self = leakage + magnetising)"
@@ -187,7 +191,7 @@ impl ConfigCheck {
             | EncoderMaxStep => K::Encoder,
             VoltageLimit | CurrentLimit | SpeedLimit | CurrentSumFraction | VoltageSumFraction
             | SettleTime | MinVoltageFraction | UnbalanceMinRatio | FloorFraction | SteadyGate
-            | GateHold | GateTimeout => K::Limits,
+            | GateHold | GateTimeout | MaxBridgedGap => K::Limits,
             ThresholdFixed | ThresholdMinBand | ThresholdKSigma | ThresholdDebounce
             | ThresholdRelease | ThresholdHysteresis => K::Threshold,
             Calibration => K::Calibration,

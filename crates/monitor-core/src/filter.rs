@@ -70,6 +70,12 @@ impl Svf {
         }
     }
 
+    /// Forgets the state (value and derivative back to zero), keeping the corner.
+    pub fn reset(&mut self) {
+        self.y = 0.0;
+        self.dy = 0.0;
+    }
+
     /// Feeds one sample.
     #[inline]
     pub fn update(&mut self, x: f32) {
