@@ -318,7 +318,9 @@ impl Replay {
             if !self.commission_started && t >= a {
                 self.commission_started = true;
                 if let Some((a, b)) = self.opts.commission {
-                    mon.start_commissioning((b - a) as f32);
+                    // Replay::new checked the window (END > START); a window the core still
+                    // refuses (shorter than f32 resolves) leaves the fixed thresholds.
+                    let _ = mon.start_commissioning((b - a) as f32);
                 }
             }
         }

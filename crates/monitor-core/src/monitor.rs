@@ -17,6 +17,7 @@
 //! filtered at `filter_hz` (5 Hz by default), so evaluating them at 400 Hz loses nothing.
 
 use crate::angle::{AngleSource, RotorFluxCurrentModel, SrfPll, ZeroCrossing};
+use crate::commissioning::{CommissioningError, CommissioningRun, Install, Learner};
 use crate::encoder::{EncoderConfig, MtSpeed};
 use crate::error::{ensure, ConfigCheck::*, ConfigError};
 use crate::filter::{LowPass, Svf};
@@ -26,7 +27,7 @@ use crate::residuals::{residuals, Derivatives, Normaliser, Operating};
 use crate::sequence::sequence_result;
 use crate::sequence::{asymmetry_correction_rad, NegativeSequence};
 use crate::signature::{match_signature, Diagnosis, Fault, FAULT_COUNT};
-use crate::threshold::{Calibration, Lamps, ThresholdConfig, Welford};
+use crate::threshold::{Calibration, Lamps, ThresholdConfig};
 use core::f32::consts::TAU;
 
 /// One sample from the sensors.
@@ -287,13 +288,15 @@ impl SensorFlags {
     }
 }
 
-/// Commissioning state.
+/// Commissioning state: which thresholds are in force, or that a run is active (the run
+/// itself, with its id, progress and outcome: [`Monitor::commissioning`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum CommissioningState {
     /// No calibration: fixed thresholds are in use.
     #[default]
     NotCommissioned,
-    /// Learning; the fraction done in [0, 1].
+    /// A run is active; the fraction of its evaluated blocks learned, in [0, 1] (1 while
+    /// the learned calibration awaits storage). Lamps are held off.
     Learning(f32),
     /// Calibrated thresholds are in use.
     Commissioned,
@@ -327,6 +330,11 @@ pub struct MonitorOutput {
     pub commissioning: CommissioningState,
     /// Negative-sequence analysis of the currents.
     pub unbalance: NegativeSequence,
+    /// With [`AngleSource::ZeroCrossing`]: whether the detector has measured a valid supply
+    /// period since it (re)started (until then the frame turns at the nominal frequency
+    /// from an arbitrary phase, so the d-q quantities mean nothing). `None` with the other
+    /// angle sources.
+    pub zero_crossing_locked: Option<bool>,
 }
 
 impl MonitorOutput {
@@ -376,9 +384,7 @@ pub struct Monitor {
     vmax: LowPass,
     norm: Normaliser,
     lamps: Lamps,
-    welford: Welford,
-    commission_total: u32,
-    commission_left: u32,
+    learner: Learner,
     settle_left: u32,
     settle_blocks: u32,
     hold_blocks: u32,
@@ -456,9 +462,7 @@ impl Monitor {
             vmax: LowPass::new(sum_lp, slow_dt),
             norm: Normaliser::new(m, reference, cfg.floor_fraction),
             lamps: Lamps::new(cfg.thresholds),
-            welford: Welford::default(),
-            commission_total: 0,
-            commission_left: 0,
+            learner: Learner::default(),
             settle_left: (cfg.settle_s * slow_hz) as u32,
             settle_blocks: (cfg.settle_s * slow_hz) as u32,
             hold_blocks: slow_hz as u32,
@@ -481,7 +485,11 @@ impl Monitor {
                 + 2,
             np: m.np(),
             matched_lamps: None,
-            out: MonitorOutput::default(),
+            out: MonitorOutput {
+                zero_crossing_locked: (cfg.angle_source == AngleSource::ZeroCrossing)
+                    .then_some(false),
+                ..MonitorOutput::default()
+            },
             cfg,
         })
     }
@@ -498,19 +506,82 @@ impl Monitor {
         &self.cfg
     }
 
-    /// Starts learning the healthy statistics over the next `duration_s` seconds of
-    /// evaluated running (time without voltage or during settling does not count). Lamps
-    /// stay off while learning. A non-positive or non-finite duration is ignored.
-    pub fn start_commissioning(&mut self, duration_s: f32) {
-        if !(duration_s.is_finite() && duration_s > 0.0) {
-            return;
-        }
+    /// Starts a commissioning run that learns the healthy statistics over the next
+    /// `duration_s` seconds of evaluated running (see [`crate::commissioning`]: time without
+    /// voltage, settling, with a sensor fault or with the quasi-steady gate closed does not
+    /// count) and puts them into force when done ([`Install::OnCompletion`]). Lamps stay
+    /// off while learning; [`MonitorOutput::commissioning`] says `Learning` from the next
+    /// slow-path block on. Returns the run's id.
+    ///
+    /// # Errors
+    /// As [`Monitor::start_commissioning_with`].
+    pub fn start_commissioning(&mut self, duration_s: f32) -> Result<u16, CommissioningError> {
+        self.start_commissioning_with(duration_s, Install::OnCompletion)
+    }
+
+    /// Starts a commissioning run as [`Monitor::start_commissioning`], with the learned
+    /// calibration put into force as `install` says. Returns the run's id.
+    ///
+    /// # Errors
+    /// [`CommissioningError::Duration`] for a non-finite or non-positive `duration_s` (or
+    /// one longer than `u32::MAX` blocks); [`CommissioningError::Busy`] while a run is
+    /// learning or awaiting storage. Nothing changes then.
+    pub fn start_commissioning_with(
+        &mut self,
+        duration_s: f32,
+        install: Install,
+    ) -> Result<u16, CommissioningError> {
         let slow_hz = self.cfg.sample_rate_hz / f32::from(self.cfg.decimation);
-        let n = (duration_s * slow_hz).clamp(1.0, 4.0e9) as u32;
-        self.welford = Welford::default();
-        self.commission_total = n;
-        self.commission_left = n;
+        let id = self.learner.start(duration_s, slow_hz, install)?;
         self.lamps.reset();
+        Ok(id)
+    }
+
+    /// Cancels run `run_id` if it is still learning: it ends
+    /// [`Failed(Cancelled)`](crate::CommissioningFailure::Cancelled) and the thresholds in
+    /// force before it stay. Returns false (and changes nothing) when that run is not
+    /// learning: another run, or it has learned already (a run awaiting storage is ended
+    /// by [`Monitor::calibration_stored`], so a late cancel cannot leave a stored record
+    /// that the monitor does not use).
+    pub fn cancel_commissioning(&mut self, run_id: u16) -> bool {
+        let cancelled = self.learner.cancel(run_id);
+        if cancelled {
+            self.refresh_commissioning_state();
+        }
+        cancelled
+    }
+
+    /// Reports what the calibration store holds after storing run `run_id`'s calibration
+    /// (read back after the write; `None`: no usable record). The thresholds in force
+    /// become exactly `stored` (`None`: the fixed thresholds), so the monitor and its store
+    /// agree whatever happened. If that run was awaiting storage it ends
+    /// [`Done`](crate::RunStage::Done) when `stored` is the calibration it learned, else
+    /// [`Failed(NotStored)`](crate::CommissioningFailure::NotStored).
+    ///
+    /// # Errors
+    /// [`ConfigErrorKind::Calibration`](crate::ConfigErrorKind::Calibration) when `stored`
+    /// is out of range (the fixed thresholds are put in force, as for no record). A report
+    /// for an older run changes no run but still puts `stored` into force.
+    pub fn calibration_stored(
+        &mut self,
+        run_id: u16,
+        stored: Option<Calibration>,
+    ) -> Result<(), ConfigError> {
+        let usable = stored.filter(Calibration::is_valid);
+        // A stale report leaves the runs alone; the store's content is what counts.
+        let _ = self.learner.stored(run_id, usable);
+        self.lamps.set_calibration(usable);
+        self.refresh_commissioning_state();
+        match (stored, usable) {
+            (Some(_), None) => Err(ConfigError::new(Calibration)),
+            _ => Ok(()),
+        }
+    }
+
+    /// The latest commissioning run: id, stage (learning, awaiting storage, done or failed
+    /// with the reason) and progress in evaluated blocks.
+    pub fn commissioning(&self) -> CommissioningRun {
+        self.learner.run()
     }
 
     /// The calibration in use, if commissioned.
@@ -518,23 +589,40 @@ impl Monitor {
         self.lamps.calibration()
     }
 
-    /// Installs a stored calibration.
+    /// Installs a stored calibration (at boot: the record read from flash). A run that is
+    /// still active ends [`Failed(Superseded)`](crate::CommissioningFailure::Superseded).
     ///
     /// # Errors
     /// [`crate::ConfigErrorKind::Calibration`] when a value is not finite or out of range; the monitor
-    /// then keeps its previous thresholds.
+    /// then keeps its previous thresholds (and an active run goes on).
     pub fn set_calibration(&mut self, cal: Calibration) -> Result<(), ConfigError> {
         if !cal.is_valid() {
             return Err(ConfigError::new(Calibration));
         }
+        self.learner.supersede();
         self.lamps.set_calibration(Some(cal));
-        self.commission_left = 0;
+        self.refresh_commissioning_state();
         Ok(())
     }
 
-    /// Forgets the calibration (back to fixed thresholds).
+    /// Forgets the calibration (back to fixed thresholds); an active run ends
+    /// [`Failed(Superseded)`](crate::CommissioningFailure::Superseded).
     pub fn clear_calibration(&mut self) {
+        self.learner.supersede();
         self.lamps.set_calibration(None);
+        self.refresh_commissioning_state();
+    }
+
+    /// `out.commissioning` from the run and the thresholds in force (after a change).
+    fn refresh_commissioning_state(&mut self) {
+        let run = self.learner.run();
+        self.out.commissioning = if run.stage.is_active() {
+            CommissioningState::Learning(run.fraction_done())
+        } else if self.lamps.calibration().is_some() {
+            CommissioningState::Commissioned
+        } else {
+            CommissioningState::NotCommissioned
+        };
     }
 
     /// The last output.
@@ -739,7 +827,7 @@ impl Monitor {
         match self.cfg.angle_source {
             AngleSource::Pll => self.sc = SinCos::from_angle(self.pll.theta_pll()),
             AngleSource::RotorFluxCurrentModel => self.sc = SinCos::from_angle(self.rfo.theta()),
-            AngleSource::ZeroCrossing => {}
+            AngleSource::ZeroCrossing => self.out.zero_crossing_locked = Some(self.zc.locked()),
         }
         let k = 1.0 / f32::from(self.acc_n.max(1));
         let a = self.acc;
@@ -836,28 +924,20 @@ impl Monitor {
         let running = self.settle_left == 0
             && self.vmag.y > self.cfg.min_voltage_frac * self.cfg.v_phase_peak
             && !self.out.sensor_fault.any();
-        if self.commission_left > 0 {
-            if running && self.out.quasi_steady {
-                self.welford.push(rn);
-                self.commission_left -= 1;
-                if self.commission_left == 0 {
-                    self.lamps.set_calibration(Some(self.welford.calibration()));
+        if self.learner.is_active() {
+            // Learning on evaluated blocks, or the learned calibration awaiting storage.
+            if running && self.out.quasi_steady && self.learner.is_learning() {
+                if let Some(cal) = self.learner.learn(rn) {
+                    self.lamps.set_calibration(Some(cal));
                 }
             }
+            self.refresh_commissioning_state();
             self.out.lamps = [false; 4];
         } else if running && self.out.quasi_steady {
             let slow_dt = f32::from(self.cfg.decimation) / self.cfg.sample_rate_hz;
             self.out.lamps = self.lamps.update(rn, slow_dt);
         }
-        self.out.evaluating = running && self.out.quasi_steady && self.commission_left == 0;
-        self.out.commissioning = if self.commission_left > 0 {
-            let total = self.commission_total.max(1) as f32;
-            CommissioningState::Learning(1.0 - self.commission_left as f32 / total)
-        } else if self.lamps.calibration().is_some() {
-            CommissioningState::Commissioned
-        } else {
-            CommissioningState::NotCommissioned
-        };
+        self.out.evaluating = running && self.out.quasi_steady && !self.learner.is_active();
     }
 
     /// The negative-sequence result with the faulty-phase correction at the present slip
@@ -1016,7 +1096,7 @@ mod tests {
             src in prop_oneof![Just(AngleSource::RotorFluxCurrentModel), Just(AngleSource::Pll), Just(AngleSource::ZeroCrossing)],
         ) {
             let mut m = monitor(src);
-            m.start_commissioning(0.01);
+            prop_assert!(m.start_commissioning(0.01).is_ok());
             let mut bad_in_block = false;
             for k in 0..3000u32 {
                 let s = if k % 3 == 0 {
