@@ -104,6 +104,7 @@ pub fn watch(
         angle_source: AngleSource::RotorFluxCurrentModel,
         residual_form: ResidualForm::Steady,
         commission: Some(COMMISSION),
+        allow_incomplete: false,
         timeline_step_s: 1.0,
     };
     let mut replay = Replay::new(params, sc.sensors.channels(), sc.sample_rate_hz, opts)?;

@@ -154,8 +154,10 @@ fn read_speed() {
         t.elapsed().as_secs_f64()
     );
     let t = std::time::Instant::now();
-    let d = sim_host::analysis::prep::decimate_log(
+    let params = sim_host::params::ParamFile::reference_2p2kw();
+    let (d, _) = sim_host::analysis::prep::decimate_log(
         std::path::Path::new(&path),
+        &params,
         Default::default(),
         &mut |_| {},
     )
@@ -166,10 +168,7 @@ fn read_speed() {
         t.elapsed().as_secs_f64()
     );
     let t = std::time::Instant::now();
-    let p = sim_host::analysis::prep::voltage_model_flux_frame(
-        &d,
-        &sim_host::params::ParamFile::reference_2p2kw(),
-    );
+    let p = sim_host::analysis::prep::voltage_model_flux_frame(&d, &params);
     println!(
         "frame: {} samples in {:.2} s",
         p.len(),

@@ -242,11 +242,24 @@ fn bad_csv_inputs_give_one_line_errors_naming_the_problem() {
         "back.csv",
         "t_s,ia_A,ib_A,ic_A\n0,1,2,-3\n0.0001,1,2,-3\n0.00005,1,2,-3\n",
     );
-    let e = fails(&["diagnose", "--params", p, backwards.to_str().expect("utf8")]);
-    assert!(
-        e.contains("does not increase") && e.contains("line 4"),
-        "{e}"
-    );
+    // A time that goes back is no longer fatal: the data-quality stage drops the row,
+    // counts it and warns.
+    let o = bin()
+        .args([
+            "diagnose",
+            "--params",
+            p,
+            backwards.to_str().expect("utf8"),
+            "--json",
+        ])
+        .output()
+        .expect("run");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
+    assert_eq!(v["data_quality"]["repeated_or_backward_rows"], 1, "{v}");
+    assert_eq!(v["rows"], 2, "{v}");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("warning: 1 rows dropped"), "{err}");
     let e = fails(&["diagnose", "--params", p, "no/such/file.csv"]);
     assert!(e.contains("no/such/file.csv"), "{e}");
     let e = fails(&[

@@ -10,7 +10,9 @@
 //! - the text tables of `demo`, `table1`, `diagnose` and `compare`: byte for byte.
 //!
 //! Fields that changed on purpose are listed in [`INTENDED`] with the reason; they are not
-//! compared. The motulator log's cases run when `../shared/data` is there.
+//! compared. Keys added since ([`ADDED`]) and the text lines that report them are skipped;
+//! two documents were regenerated for issue 8 (the golden README says which and why). The
+//! motulator log's cases run when `../shared/data` is there.
 
 use std::path::{Path, PathBuf};
 
@@ -55,6 +57,16 @@ const INTENDED: [(&str, &str, &str); 8] = [
         ".unbalance.correction_deg",
         "within 1e-4 degrees",
     ),
+];
+
+/// Keys added since the golden outputs were taken (issue 8: the data-quality stage's
+/// report, what commissioning did, the verdict, the range note beside a lamp).
+const ADDED: [&str; 5] = [
+    "data_quality",
+    "commissioning",
+    "verdict",
+    "verdict_withheld_because",
+    "range_note",
 ];
 
 fn golden() -> PathBuf {
@@ -110,6 +122,28 @@ fn compare(a: &serde_json::Value, b: &serde_json::Value, path: &str, out: &mut V
     }
 }
 
+/// A text table without what issue 8 added or reworded: the data-quality lines, the
+/// commissioning report (the thresholds line included), the range notes beside the
+/// lamps and the verdict.
+fn without_added_lines(text: &str) -> String {
+    const ADDED_LINES: [&str; 9] = [
+        "data quality:",
+        "  done:",
+        "  NOT TRUSTED",
+        "thresholds:",
+        "  learned ",
+        "  first quasi-steady point",
+        "  the thresholds are fixed",
+        "note at ",
+        "verdict:",
+    ];
+    text.lines()
+        .filter(|l| !ADDED_LINES.iter().any(|a| l.starts_with(a)))
+        .map(|l| l.split("  [").next().unwrap_or(l))
+        .map(|l| format!("{l}\n"))
+        .collect()
+}
+
 fn fnv1a(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
         (h ^ u64::from(*b)).wrapping_mul(0x0000_0100_0000_01b3)
@@ -145,7 +179,10 @@ fn outputs_match_the_binary_before_the_rework() {
         let mut diffs = Vec::new();
         compare(&before, &now, "", &mut diffs);
         diffs.retain(|d| {
-            !INTENDED
+            !ADDED
+                .iter()
+                .any(|k| d.contains(&format!(".{k}: in one document only")))
+                && !INTENDED
                 .iter()
                 .any(|(f, p, _)| *f == name && d.starts_with(&format!("{p}:")))
                 // The output path and the wall time of `simulate` are not results.
@@ -234,6 +271,9 @@ fn outputs_match_the_binary_before_the_rework() {
             &asym,
             "--commission",
             "2:2.9",
+            // The window is never learned (the asymmetric machine is not quasi-steady long
+            // enough): an error since issue 8, reported with this flag.
+            "--allow-incomplete",
         ]),
     );
     check_json(
@@ -355,6 +395,10 @@ fn outputs_match_the_binary_before_the_rework() {
     for (name, args) in texts {
         let (out, _) = run(&args);
         let before = std::fs::read(golden().join(format!("{name}.txt"))).unwrap();
+        let (out, before) = (
+            without_added_lines(&String::from_utf8_lossy(&out)).into_bytes(),
+            without_added_lines(&String::from_utf8_lossy(&before)).into_bytes(),
+        );
         if out != before {
             failures.push(format!(
                 "{name}.txt differs:\n{}",

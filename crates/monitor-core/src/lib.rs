@@ -53,6 +53,7 @@
 )]
 
 pub mod angle;
+pub mod commissioning;
 pub mod effect;
 pub mod encoder;
 pub mod error;
@@ -66,6 +67,9 @@ pub mod signature;
 pub mod threshold;
 
 pub use angle::AngleSource;
+pub use commissioning::{
+    CommissioningError, CommissioningFailure, CommissioningRun, Install, RunStage,
+};
 pub use effect::EffectKind;
 pub use encoder::EncoderConfig;
 pub use error::{ConfigCheck, ConfigError, ConfigErrorKind};

@@ -17,6 +17,7 @@
 //! filtered at `filter_hz` (5 Hz by default), so evaluating them at 400 Hz loses nothing.
 
 use crate::angle::{AngleSource, RotorFluxCurrentModel, SrfPll, ZeroCrossing};
+use crate::commissioning::{CommissioningError, CommissioningRun, Install, Learner};
 use crate::encoder::{EncoderConfig, MtSpeed};
 use crate::error::{ensure, ConfigCheck::*, ConfigError};
 use crate::filter::{LowPass, Svf};
@@ -26,7 +27,7 @@ use crate::residuals::{residuals, Derivatives, Normaliser, Operating};
 use crate::sequence::sequence_result;
 use crate::sequence::{asymmetry_correction_rad, NegativeSequence};
 use crate::signature::{match_signature, Diagnosis, Fault, FAULT_COUNT};
-use crate::threshold::{Calibration, Lamps, ThresholdConfig, Welford};
+use crate::threshold::{Calibration, Lamps, ThresholdConfig};
 use core::f32::consts::TAU;
 
 /// One sample from the sensors.
@@ -327,13 +328,15 @@ impl SensorFlags {
     }
 }
 
-/// Commissioning state.
+/// Commissioning state: which thresholds are in force, or that a run is active (the run
+/// itself, with its id, progress and outcome: [`Monitor::commissioning`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum CommissioningState {
     /// No calibration: fixed thresholds are in use.
     #[default]
     NotCommissioned,
-    /// Learning; the fraction done in [0, 1].
+    /// A run is active; the fraction of its evaluated blocks learned, in [0, 1] (1 while
+    /// the learned calibration awaits storage). Lamps are held off.
     Learning(f32),
     /// Calibrated thresholds are in use.
     Commissioned,
@@ -386,6 +389,11 @@ pub struct MonitorOutput {
     pub unbalance: NegativeSequence,
     /// Gaps bridged, timing faults and recoveries so far.
     pub timing: TimingEvents,
+    /// With [`AngleSource::ZeroCrossing`]: whether the detector has measured a valid supply
+    /// period since it (re)started (until then the frame turns at the nominal frequency
+    /// from an arbitrary phase, so the d-q quantities mean nothing). `None` with the other
+    /// angle sources.
+    pub zero_crossing_locked: Option<bool>,
 }
 
 impl MonitorOutput {
@@ -435,9 +443,7 @@ pub struct Monitor {
     vmax: LowPass,
     norm: Normaliser,
     lamps: Lamps,
-    welford: Welford,
-    commission_total: u32,
-    commission_left: u32,
+    learner: Learner,
     settle_left: u32,
     settle_blocks: u32,
     hold_blocks: u32,
@@ -459,6 +465,14 @@ pub struct Monitor {
     /// Expected ticks per block and the longest gap bridged, in ticks.
     block_ticks: u32,
     max_gap_ticks: u32,
+    /// Timestamp of the previous sample; a later one more than `sample_gap_ticks` after it
+    /// starts a gap, bridged at once ([`Monitor::bridge_samples`]) up to
+    /// `max_sample_gap_ticks`.
+    last_sample_ticks: u32,
+    sample_gap_ticks: u32,
+    max_sample_gap_ticks: u32,
+    /// Ticks of the current block already bridged sample by sample.
+    bridged_ticks: u32,
     np: f32,
     matched_lamps: Option<[bool; 4]>,
     out: MonitorOutput,
@@ -524,9 +538,7 @@ impl Monitor {
             vmax: LowPass::new(sum_lp, slow_dt),
             norm: Normaliser::new(m, reference, cfg.floor_fraction),
             lamps: Lamps::new(cfg.thresholds),
-            welford: Welford::default(),
-            commission_total: 0,
-            commission_left: 0,
+            learner: Learner::default(),
             settle_left: (cfg.settle_s * slow_hz) as u32,
             settle_blocks: (cfg.settle_s * slow_hz) as u32,
             hold_blocks: slow_hz as u32,
@@ -553,9 +565,17 @@ impl Monitor {
             block_ticks_span: (cfg.tick_hz * dt) as u32,
             block_ticks: (cfg.tick_hz * slow_dt + 0.5) as u32,
             max_gap_ticks: (cfg.tick_hz * (slow_dt + cfg.max_bridged_gap_s)) as u32,
+            last_sample_ticks: 0,
+            sample_gap_ticks: (cfg.tick_hz * dt * 1.5) as u32,
+            max_sample_gap_ticks: (cfg.tick_hz * (dt + cfg.max_bridged_gap_s)) as u32,
+            bridged_ticks: 0,
             np: m.np(),
             matched_lamps: None,
-            out: MonitorOutput::default(),
+            out: MonitorOutput {
+                zero_crossing_locked: (cfg.angle_source == AngleSource::ZeroCrossing)
+                    .then_some(false),
+                ..MonitorOutput::default()
+            },
             cfg,
         })
     }
@@ -572,19 +592,82 @@ impl Monitor {
         &self.cfg
     }
 
-    /// Starts learning the healthy statistics over the next `duration_s` seconds of
-    /// evaluated running (time without voltage or during settling does not count). Lamps
-    /// stay off while learning. A non-positive or non-finite duration is ignored.
-    pub fn start_commissioning(&mut self, duration_s: f32) {
-        if !(duration_s.is_finite() && duration_s > 0.0) {
-            return;
-        }
+    /// Starts a commissioning run that learns the healthy statistics over the next
+    /// `duration_s` seconds of evaluated running (see [`crate::commissioning`]: time without
+    /// voltage, settling, with a sensor fault or with the quasi-steady gate closed does not
+    /// count) and puts them into force when done ([`Install::OnCompletion`]). Lamps stay
+    /// off while learning; [`MonitorOutput::commissioning`] says `Learning` from the next
+    /// slow-path block on. Returns the run's id.
+    ///
+    /// # Errors
+    /// As [`Monitor::start_commissioning_with`].
+    pub fn start_commissioning(&mut self, duration_s: f32) -> Result<u16, CommissioningError> {
+        self.start_commissioning_with(duration_s, Install::OnCompletion)
+    }
+
+    /// Starts a commissioning run as [`Monitor::start_commissioning`], with the learned
+    /// calibration put into force as `install` says. Returns the run's id.
+    ///
+    /// # Errors
+    /// [`CommissioningError::Duration`] for a non-finite or non-positive `duration_s` (or
+    /// one longer than `u32::MAX` blocks); [`CommissioningError::Busy`] while a run is
+    /// learning or awaiting storage. Nothing changes then.
+    pub fn start_commissioning_with(
+        &mut self,
+        duration_s: f32,
+        install: Install,
+    ) -> Result<u16, CommissioningError> {
         let slow_hz = self.cfg.sample_rate_hz / f32::from(self.cfg.decimation);
-        let n = (duration_s * slow_hz).clamp(1.0, 4.0e9) as u32;
-        self.welford = Welford::default();
-        self.commission_total = n;
-        self.commission_left = n;
+        let id = self.learner.start(duration_s, slow_hz, install)?;
         self.lamps.reset();
+        Ok(id)
+    }
+
+    /// Cancels run `run_id` if it is still learning: it ends
+    /// [`Failed(Cancelled)`](crate::CommissioningFailure::Cancelled) and the thresholds in
+    /// force before it stay. Returns false (and changes nothing) when that run is not
+    /// learning: another run, or it has learned already (a run awaiting storage is ended
+    /// by [`Monitor::calibration_stored`], so a late cancel cannot leave a stored record
+    /// that the monitor does not use).
+    pub fn cancel_commissioning(&mut self, run_id: u16) -> bool {
+        let cancelled = self.learner.cancel(run_id);
+        if cancelled {
+            self.refresh_commissioning_state();
+        }
+        cancelled
+    }
+
+    /// Reports what the calibration store holds after storing run `run_id`'s calibration
+    /// (read back after the write; `None`: no usable record). The thresholds in force
+    /// become exactly `stored` (`None`: the fixed thresholds), so the monitor and its store
+    /// agree whatever happened. If that run was awaiting storage it ends
+    /// [`Done`](crate::RunStage::Done) when `stored` is the calibration it learned, else
+    /// [`Failed(NotStored)`](crate::CommissioningFailure::NotStored).
+    ///
+    /// # Errors
+    /// [`ConfigErrorKind::Calibration`](crate::ConfigErrorKind::Calibration) when `stored`
+    /// is out of range (the fixed thresholds are put in force, as for no record). A report
+    /// for an older run changes no run but still puts `stored` into force.
+    pub fn calibration_stored(
+        &mut self,
+        run_id: u16,
+        stored: Option<Calibration>,
+    ) -> Result<(), ConfigError> {
+        let usable = stored.filter(Calibration::is_valid);
+        // A stale report leaves the runs alone; the store's content is what counts.
+        let _ = self.learner.stored(run_id, usable);
+        self.lamps.set_calibration(usable);
+        self.refresh_commissioning_state();
+        match (stored, usable) {
+            (Some(_), None) => Err(ConfigError::new(Calibration)),
+            _ => Ok(()),
+        }
+    }
+
+    /// The latest commissioning run: id, stage (learning, awaiting storage, done or failed
+    /// with the reason) and progress in evaluated blocks.
+    pub fn commissioning(&self) -> CommissioningRun {
+        self.learner.run()
     }
 
     /// The calibration in use, if commissioned.
@@ -592,23 +675,40 @@ impl Monitor {
         self.lamps.calibration()
     }
 
-    /// Installs a stored calibration.
+    /// Installs a stored calibration (at boot: the record read from flash). A run that is
+    /// still active ends [`Failed(Superseded)`](crate::CommissioningFailure::Superseded).
     ///
     /// # Errors
     /// [`crate::ConfigErrorKind::Calibration`] when a value is not finite or out of range; the monitor
-    /// then keeps its previous thresholds.
+    /// then keeps its previous thresholds (and an active run goes on).
     pub fn set_calibration(&mut self, cal: Calibration) -> Result<(), ConfigError> {
         if !cal.is_valid() {
             return Err(ConfigError::new(Calibration));
         }
+        self.learner.supersede();
         self.lamps.set_calibration(Some(cal));
-        self.commission_left = 0;
+        self.refresh_commissioning_state();
         Ok(())
     }
 
-    /// Forgets the calibration (back to fixed thresholds).
+    /// Forgets the calibration (back to fixed thresholds); an active run ends
+    /// [`Failed(Superseded)`](crate::CommissioningFailure::Superseded).
     pub fn clear_calibration(&mut self) {
+        self.learner.supersede();
         self.lamps.set_calibration(None);
+        self.refresh_commissioning_state();
+    }
+
+    /// `out.commissioning` from the run and the thresholds in force (after a change).
+    fn refresh_commissioning_state(&mut self) {
+        let run = self.learner.run();
+        self.out.commissioning = if run.stage.is_active() {
+            CommissioningState::Learning(run.fraction_done())
+        } else if self.lamps.calibration().is_some() {
+            CommissioningState::Commissioned
+        } else {
+            CommissioningState::NotCommissioned
+        };
     }
 
     /// The last output.
@@ -632,6 +732,11 @@ impl Monitor {
             .max(s.i_abc.c.to_bits() & m);
         self.block_vmax = self.block_vmax.max(vb);
         self.block_imax = self.block_imax.max(ib);
+        let since = s.timestamp_ticks.wrapping_sub(self.last_sample_ticks);
+        self.last_sample_ticks = s.timestamp_ticks;
+        if since > self.sample_gap_ticks {
+            self.bridge_samples(since);
+        }
         let speed = self.mt.update_checked(
             s.encoder_count,
             s.timestamp_ticks,
@@ -832,9 +937,44 @@ impl Monitor {
     /// periods), else the elapsed ticks (a gap, a stalled or a backward clock).
     #[inline(always)]
     fn block_timing(&mut self, ticks: u32) -> Option<u32> {
+        let bridged = core::mem::take(&mut self.bridged_ticks);
         let prev = self.block_end_ticks.replace(ticks)?;
-        let elapsed = ticks.wrapping_sub(prev);
+        let elapsed = ticks.wrapping_sub(prev).wrapping_sub(bridged);
         (elapsed.wrapping_sub(self.block_ticks_lo) > self.block_ticks_span).then_some(elapsed)
+    }
+
+    /// Samples missing before this one (`since` ticks after the previous sample, more than
+    /// 1.5 sample periods): a gap up to `max_bridged_gap_s` is bridged at once, before this
+    /// sample is transformed, by advancing the frame's estimators over the missing time, so
+    /// the samples after the gap are already in the right frame (bridged at the block's
+    /// end, the rotor-flux model would take the rest of the block's currents in a frame
+    /// behind by the gap's angle, and its flux would need a rotor time constant to
+    /// recover). The block's length check then leaves the bridged ticks out. A longer gap
+    /// or a wrapped (backward) clock is left to the block's check, which restarts.
+    #[cold]
+    #[inline(never)]
+    fn bridge_samples(&mut self, since: u32) {
+        if since > self.max_sample_gap_ticks {
+            return;
+        }
+        let missing = since - self.ticks_per_sample.min(since);
+        self.bridged_ticks = self.bridged_ticks.saturating_add(missing);
+        let t = &mut self.out.timing;
+        t.gaps_bridged = t.gaps_bridged.saturating_add(1);
+        self.skip_estimators(missing as f32 / self.cfg.tick_hz);
+    }
+
+    /// Advances the frame's estimators over `missing_s` seconds without samples and puts
+    /// the frame's sin/cos on the new angle.
+    fn skip_estimators(&mut self, missing_s: f32) {
+        self.rfo.skip(missing_s);
+        self.pll.skip(missing_s);
+        self.zc.skip(missing_s);
+        match self.cfg.angle_source {
+            AngleSource::Pll => self.sc = SinCos::from_angle(self.pll.theta_pll()),
+            AngleSource::RotorFluxCurrentModel => self.sc = SinCos::from_angle(self.rfo.theta()),
+            AngleSource::ZeroCrossing => {}
+        }
     }
 
     /// A block whose timestamps are off: the block is left out of the filters; a gap up to
@@ -850,16 +990,7 @@ impl Monitor {
         if elapsed_ticks > self.block_ticks && elapsed_ticks <= self.max_gap_ticks {
             t.gaps_bridged = t.gaps_bridged.saturating_add(1);
             let missing_s = (elapsed_ticks - self.block_ticks) as f32 / self.cfg.tick_hz;
-            self.rfo.skip(missing_s);
-            self.pll.skip(missing_s);
-            self.zc.skip(missing_s);
-            match self.cfg.angle_source {
-                AngleSource::Pll => self.sc = SinCos::from_angle(self.pll.theta_pll()),
-                AngleSource::RotorFluxCurrentModel => {
-                    self.sc = SinCos::from_angle(self.rfo.theta())
-                }
-                AngleSource::ZeroCrossing => {}
-            }
+            self.skip_estimators(missing_s);
         } else {
             t.timing_faults = t.timing_faults.saturating_add(1);
             self.settle_left = self.settle_blocks;
@@ -897,7 +1028,7 @@ impl Monitor {
         match self.cfg.angle_source {
             AngleSource::Pll => self.sc = SinCos::from_angle(self.pll.theta_pll()),
             AngleSource::RotorFluxCurrentModel => self.sc = SinCos::from_angle(self.rfo.theta()),
-            AngleSource::ZeroCrossing => {}
+            AngleSource::ZeroCrossing => self.out.zero_crossing_locked = Some(self.zc.locked()),
         }
         let k = 1.0 / f32::from(self.acc_n.max(1));
         let a = self.acc;
@@ -994,28 +1125,20 @@ impl Monitor {
         let running = self.settle_left == 0
             && self.vmag.y > self.cfg.min_voltage_frac * self.cfg.v_phase_peak
             && !self.out.sensor_fault.any();
-        if self.commission_left > 0 {
-            if running && self.out.quasi_steady {
-                self.welford.push(rn);
-                self.commission_left -= 1;
-                if self.commission_left == 0 {
-                    self.lamps.set_calibration(Some(self.welford.calibration()));
+        if self.learner.is_active() {
+            // Learning on evaluated blocks, or the learned calibration awaiting storage.
+            if running && self.out.quasi_steady && self.learner.is_learning() {
+                if let Some(cal) = self.learner.learn(rn) {
+                    self.lamps.set_calibration(Some(cal));
                 }
             }
+            self.refresh_commissioning_state();
             self.out.lamps = [false; 4];
         } else if running && self.out.quasi_steady {
             let slow_dt = f32::from(self.cfg.decimation) / self.cfg.sample_rate_hz;
             self.out.lamps = self.lamps.update(rn, slow_dt);
         }
-        self.out.evaluating = running && self.out.quasi_steady && self.commission_left == 0;
-        self.out.commissioning = if self.commission_left > 0 {
-            let total = self.commission_total.max(1) as f32;
-            CommissioningState::Learning(1.0 - self.commission_left as f32 / total)
-        } else if self.lamps.calibration().is_some() {
-            CommissioningState::Commissioned
-        } else {
-            CommissioningState::NotCommissioned
-        };
+        self.out.evaluating = running && self.out.quasi_steady && !self.learner.is_active();
     }
 
     /// The negative-sequence result with the faulty-phase correction at the present slip
@@ -1174,7 +1297,7 @@ mod tests {
             src in prop_oneof![Just(AngleSource::RotorFluxCurrentModel), Just(AngleSource::Pll), Just(AngleSource::ZeroCrossing)],
         ) {
             let mut m = monitor(src);
-            m.start_commissioning(0.01);
+            prop_assert!(m.start_commissioning(0.01).is_ok());
             let mut bad_in_block = false;
             for k in 0..3000u32 {
                 let s = if k % 3 == 0 {

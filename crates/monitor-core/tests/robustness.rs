@@ -89,7 +89,7 @@ fn commissioned(fs: f32) -> (Monitor, Healthy, u64) {
     let mut m = Monitor::new(config(fs)).unwrap();
     let mut k = 0;
     run(&mut m, &h, &mut k, (2.0 * fs) as u64);
-    m.start_commissioning(2.0);
+    assert!(m.start_commissioning(2.0).is_ok());
     run(&mut m, &h, &mut k, (3.0 * fs) as u64);
     assert_eq!(m.output().commissioning, CommissioningState::Commissioned);
     (m, h, k)

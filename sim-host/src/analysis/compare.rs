@@ -30,6 +30,8 @@ pub struct CompareReport {
     pub unbalance: UnbalanceAnalysis,
     /// Rows read, working rate, frame.
     pub data: DataInfo,
+    /// What the data-quality stage found and what the analysis did about it.
+    pub data_quality: crate::log::quality::DataQuality,
 }
 
 /// Everything `compare` computed, for plots and the report.
@@ -66,6 +68,7 @@ impl Analysis {
                     skipped,
                     unbalance,
                     data: info,
+                    data_quality: self.quality.clone(),
                 },
                 prediction: Prediction::default(),
                 all_windows: vec![],
@@ -113,6 +116,7 @@ impl Analysis {
                 skipped,
                 unbalance,
                 data: info,
+                data_quality: self.quality.clone(),
             },
             prediction: pred,
             all_windows: all,

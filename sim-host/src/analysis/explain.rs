@@ -85,6 +85,8 @@ pub struct ExplainReport {
     pub unbalance: UnbalanceAnalysis,
     /// Facts about the data.
     pub data: DataInfo,
+    /// What the data-quality stage found and what the analysis did about it.
+    pub data_quality: crate::log::quality::DataQuality,
 }
 
 /// Everything `explain` computed.
@@ -156,7 +158,12 @@ impl Analysis {
         let configured = resolve(&opts.effects);
         let names: Vec<EffectKind> = configured.iter().map(|e| e.kind()).collect();
         if !d.channels.voltages {
-            return Ok(explain_current_only(names, unbalance, info));
+            return Ok(withhold_if_untrusted(explain_current_only(
+                names,
+                unbalance,
+                info,
+                self.quality.clone(),
+            )));
         }
         let base = self.baseline(&configured, opts)?;
         let lib = effects::library();
@@ -215,7 +222,7 @@ impl Analysis {
                 )
             })
         };
-        Ok(ExplainOutput {
+        Ok(withhold_if_untrusted(ExplainOutput {
             report: ExplainReport {
                 effects: names,
                 baseline_normalized_rms_error: base.error,
@@ -227,10 +234,11 @@ impl Analysis {
                 skipped,
                 unbalance,
                 data: info,
+                data_quality: self.quality.clone(),
             },
             before: base.before,
             after,
-        })
+        }))
     }
 
     /// Fits the configured model and measures it on the whole log, on the held-back
@@ -402,10 +410,28 @@ impl Analysis {
 }
 
 /// `explain` on a log without voltages: the model cannot run; only the unbalance analysis.
+/// A verdict never rests on data the data-quality stage rejected: when the stage does not
+/// trust the log, the ranking stays in the report but the verdict says why no effect is
+/// named, and no effect is added.
+fn withhold_if_untrusted(mut out: ExplainOutput) -> ExplainOutput {
+    let q = &out.report.data_quality;
+    if q.trusted {
+        return out;
+    }
+    out.report.verdict = format!(
+        "could not judge: the data-quality stage does not trust this log ({}); the ranking below is not a verdict",
+        q.not_trusted_because.join("; ")
+    );
+    out.report.unexplained = true;
+    out.after = None;
+    out
+}
+
 fn explain_current_only(
     names: Vec<EffectKind>,
     unbalance: UnbalanceAnalysis,
     info: DataInfo,
+    quality: crate::log::quality::DataQuality,
 ) -> ExplainOutput {
     let skipped = EffectKind::ALL
         .iter()
@@ -432,6 +458,7 @@ fn explain_current_only(
             skipped,
             unbalance,
             data: info,
+            data_quality: quality,
         },
         before: Prediction::default(),
         after: None,

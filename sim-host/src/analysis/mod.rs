@@ -99,6 +99,8 @@ pub struct Analysis {
     pub constants: MachineConstants,
     /// The parameter file.
     pub params: crate::params::ParamFile,
+    /// What the data-quality stage found in the log and what the analysis did about it.
+    pub quality: crate::log::quality::DataQuality,
 }
 
 /// Options shared by `compare` and `explain`.
@@ -249,12 +251,13 @@ impl Analysis {
         opts: ReadOptions,
         progress: &mut dyn FnMut(f64),
     ) -> Result<Self, AnalysisError> {
-        let dec = prep::decimate_log(log, opts, progress)?;
+        let (dec, quality) = prep::decimate_log(log, &params, opts, progress)?;
         let data = prep::voltage_model_flux_frame(&dec, &params);
         Ok(Analysis {
             data,
             constants: MachineConstants::from_params(&params),
             params,
+            quality,
         })
     }
 

@@ -85,6 +85,7 @@ impl Common {
         })
         .context("cannot analyse the log")?;
         pb.finish_and_clear();
+        render::text::quality_warnings(&a.quality);
         Ok(a)
     }
 }
@@ -110,7 +111,9 @@ JSON (--json): effects, normalized_rms_error, noise_floor, channels [{channel, r
 rms_measured, normalized}], worst_windows [{t_start_s, t_end_s, normalized_rms_error, \
 condition{speed_rpm, load_current_a, voltage_v, voltage_percent, supply_hz, \
 time_since_start_s}, dominant_error_hz, error_kind}], base_parameters, fitted_effects, \
-skipped, unbalance, data."
+skipped, unbalance, data, data_quality (what the data-quality stage found in the log: gaps, \
+dropped samples, bad cells, segments, and what was done; the longest regular segment is \
+analysed)."
 )]
 pub struct CompareArgs {
     /// Shared options.
@@ -137,7 +140,8 @@ sim-host compare --params motor.toml run.csv --effects load_torque   # the error
 sim-host explain --params motor.toml run.csv --effects load_torque   # anything else?\n\n\
 JSON (--json): baseline_normalized_rms_error, ranking [{effect, normalized_rms_error, \
 explained_fraction, validation_normalized_rms_error, n_parameters, parameters, summary}], \
-unexplained, verdict, skipped, unbalance, noise_floor."
+unexplained, verdict, skipped, unbalance, noise_floor, data_quality. When the data-quality \
+stage does not trust the log the verdict says \"could not judge\" and why."
 )]
 pub struct ExplainArgs {
     /// Shared options.

@@ -20,7 +20,15 @@ over that part of the log (seconds) and the lamps use mean +/- k*spread with deb
 hysteresis.\n\nThe frame (--angle rotor-flux, the default) is the core's current-model rotor-flux \
 angle (encoder speed, nominal Rr and Lr); compare/explain use a voltage-model rotor-flux estimate \
 instead.\n\nLogs with only t_s and the three currents still get the unbalance analysis (the \
-supply is taken from the parameter file).\n\nExample:\n  sim-host diagnose --params motor.toml \
+supply is taken from the parameter file).\n\nAny sample rate from 1 kHz to 50 kHz works (at \
+least 8 samples per supply period). Every row first passes the data-quality stage: dropped \
+samples and short gaps are bridged with the real elapsed time, long gaps restart the \
+monitor's estimators, repeated or backward times are dropped, bad cells (NaN, inf, out of \
+range) are held out, time in ms or us is recognised; the report's data_quality says what \
+was found and done, and the verdict is withheld when the log cannot be trusted.\n\n\
+Commissioning: a window the log does not complete is an error unless --allow-incomplete. \
+The learned thresholds hold only over the load and voltage range seen while learning: \
+commission over healthy running that covers the whole range.\n\nExample:\n  sim-host diagnose --params motor.toml \
 log.csv --commission 2:4"
 )]
 pub struct DiagnoseArgs {
@@ -29,9 +37,15 @@ pub struct DiagnoseArgs {
     pub params: PathBuf,
     /// Measurement log (CSV).
     pub log: PathBuf,
-    /// Learn healthy thresholds over START:END seconds of the log.
+    /// Learn healthy thresholds over START:END seconds of the log (healthy running that
+    /// covers the load and voltage range to be monitored).
     #[arg(long, value_name = "START:END", value_parser = super::parse_window)]
     pub commission: Option<(f64, f64)>,
+    /// Report even when the --commission window was not learned (the log ends first, or
+    /// the motor was not quasi-steady long enough); the fixed thresholds are used and the
+    /// verdict is withheld.
+    #[arg(long)]
+    pub allow_incomplete: bool,
     /// Frame angle source.
     #[arg(long, value_enum, default_value_t = AngleArg::RotorFlux)]
     pub angle: AngleArg,
@@ -57,6 +71,7 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         angle_source: args.angle.into(),
         residual_form: args.residuals.into(),
         commission: args.commission,
+        allow_incomplete: args.allow_incomplete,
         timeline_step_s: args.timeline_step.max(1e-4),
     };
     let big = std::fs::metadata(&args.log)
@@ -72,6 +87,7 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         e => e.into(),
     })?;
     bar.finish_and_clear();
+    render::text::quality_warnings(&d.report.data_quality);
     if args.json {
         render::json::print(&d.report)
     } else {

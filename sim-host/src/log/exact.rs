@@ -1,5 +1,7 @@
 //! The exact reader: row by row through the `csv` crate (quoting, any field count checks),
-//! slow but with messages that name the line and column. Behind the fast path.
+//! slow but with messages that name the line and column. Behind the fast path. Like it, it
+//! hands over non-finite numbers and times that do not increase (the data-quality stage
+//! judges them); text that is not a number is an error.
 
 use super::reader::{ColumnMap, LogFile};
 use super::{Column, LogError, Row};
@@ -12,7 +14,6 @@ pub(super) struct ExactRows {
     rdr: csv::Reader<BufReader<File>>,
     columns: ColumnMap,
     record: csv::ByteRecord,
-    prev_t: Option<f64>,
 }
 
 impl ExactRows {
@@ -40,7 +41,6 @@ impl ExactRows {
             rdr,
             columns: *log.columns(),
             record,
-            prev_t: None,
         })
     }
 
@@ -68,8 +68,7 @@ impl ExactRows {
     /// Reads the next row; `Ok(None)` at the end of the file.
     ///
     /// # Errors
-    /// [`LogError::NotNumeric`], [`LogError::TimeNotIncreasing`] or [`LogError::Csv`],
-    /// each naming the line.
+    /// [`LogError::NotNumeric`] or [`LogError::Csv`], each naming the line.
     pub fn next_row(&mut self) -> Result<Option<Row>, LogError> {
         match self.rdr.read_byte_record(&mut self.record) {
             Ok(false) => return Ok(None),
@@ -78,25 +77,6 @@ impl ExactRows {
         }
         let line = self.record.position().map(|p| p.line()).unwrap_or(0);
         let t = self.cell(Column::Time, line)?.unwrap_or(f64::NAN);
-        if !t.is_finite() {
-            return Err(LogError::NotNumeric {
-                path: self.shown.clone(),
-                line,
-                column: Column::Time.name().into(),
-                cell: t.to_string(),
-            });
-        }
-        if let Some(prev) = self.prev_t {
-            if t <= prev {
-                return Err(LogError::TimeNotIncreasing {
-                    path: self.shown.clone(),
-                    line,
-                    t,
-                    prev,
-                });
-            }
-        }
-        self.prev_t = Some(t);
         let mut v = [0.0f64; 9];
         v[0] = t;
         // Currents first: a row with several bad cells names the required column.

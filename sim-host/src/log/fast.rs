@@ -8,9 +8,10 @@
 //! the next batch, parsing the current one and handing over the previous one overlap, and
 //! the buffers are reused, so memory stays at a few tens of MB whatever the log's length.
 //!
-//! Any cell the fast path does not accept (quotes, tabs, text), a wrong field count, or time
-//! not increasing makes [`for_each_row`] return `Ok(false)`: the caller then re-reads with
-//! the exact reader, whose message names the line and column.
+//! Any cell the fast path does not accept (quotes, tabs, text) or a wrong field count makes
+//! [`for_each_row`] return `Ok(false)`: the caller then re-reads with the exact reader,
+//! whose message names the line and column. Numbers that are not finite ("NaN", "inf") and
+//! times that do not increase are handed over: the data-quality stage judges them.
 
 use super::exact::row_from_values;
 use super::reader::LogFile;
@@ -193,8 +194,8 @@ impl BlockReader {
 }
 
 /// Streams the data rows of `log` in file order, parsing in parallel, `block` bytes per
-/// work item. `on_row` returns false to stop early. `progress` gets the fraction of the
-/// file read. Returns `Ok(false)` when the fast path gave up (see the module documentation).
+/// work item. `on_row` returns false to stop early. `progress` gets the fraction of the file read.
+/// Returns `Ok(false)` when the fast path gave up (see the module documentation).
 ///
 /// # Errors
 /// I/O errors.
@@ -236,7 +237,6 @@ pub(super) fn for_each_row(
     };
     let per_batch = rayon::current_num_threads().max(1) * 2;
     let mut read_bytes = log.header_bytes();
-    let mut prev_t = f64::NEG_INFINITY;
     // Pipeline: read batch k+1 (one task) | parse batch k (parallel) | hand over batch k-1
     // (this thread, so `on_row` need not be Send).
     let (mut to_parse, b) = reader.batch(per_batch).map_err(io)?;
@@ -282,12 +282,6 @@ pub(super) fn for_each_row(
                         return;
                     };
                     for slots in v.chunks_exact(width) {
-                        let t = slots[0];
-                        if t <= prev_t || !t.is_finite() {
-                            verdict = Some(false);
-                            return;
-                        }
-                        prev_t = t;
                         if !on_row(&to_row(slots)) {
                             verdict = Some(true);
                             return;
@@ -423,8 +417,6 @@ mod tests {
         for bad in [
             "0.06,x,0,0,0,0,0,0,0",     // not a number
             "0.06,\"1\",0,0,0,0,0,0,0", // quoted
-            "0.00001,0,0,0,0,0,0,0,0",  // time not increasing
-            "inf,0,0,0,0,0,0,0,0",      // time not finite
             "0.06,1,2",                 // too few fields
             "0.06,0,0,0,0,0,0,0,0,0",   // too many
             "0.06,0,0,0,0,0,0,0,zz",    // enc_count not a number
@@ -447,6 +439,25 @@ mod tests {
                 assert!(e.contains("line 502"), "{bad}: {e}");
             }
         }
+    }
+
+    #[test]
+    fn times_that_do_not_increase_and_nan_cells_are_handed_over() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.csv");
+        std::fs::write(
+            &path,
+            "t_s,ia_A,ib_A,ic_A\n0,1,2,3\n0,1,2,3\n-1,NaN,inf,3\nnan,1,2,3\n",
+        )
+        .unwrap();
+        let (ok, rows) = fast(&path, 1 << 20);
+        assert!(ok);
+        assert_eq!(rows.len(), 4);
+        assert_eq!(rows[2].t_s, -1.0);
+        assert!(rows[2].i_abc[0].is_nan() && rows[2].i_abc[1].is_infinite());
+        assert!(rows[3].t_s.is_nan());
+        // (NaN is not equal to itself: compare the printed rows.)
+        assert_eq!(format!("{rows:?}"), format!("{:?}", exact(&path)));
     }
 
     #[test]

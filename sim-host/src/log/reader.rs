@@ -135,13 +135,15 @@ impl LogFile {
     /// a few hundred times. Returns the number of rows handed over.
     ///
     /// The rows are parsed in parallel by the fast path; if it meets anything it does not
-    /// accept (quotes, text, a wrong field count, time not increasing), the sink is told to
+    /// accept (quotes, text, a wrong field count), the sink is told to
     /// [`RowSink::restart`] and the exact reader reads the log again from the start: the
-    /// same rows, or the error naming the line and column.
+    /// same rows, or the error naming the line and column. Non-finite numbers and times
+    /// that do not increase are handed over as they are: judging them is the data-quality
+    /// stage's ([`super::quality`]).
     ///
     /// # Errors
-    /// [`LogError::Io`], [`LogError::NotNumeric`], [`LogError::TimeNotIncreasing`] or
-    /// [`LogError::Csv`], each naming the file and, for a bad row, the line and column.
+    /// [`LogError::Io`], [`LogError::NotNumeric`] or [`LogError::Csv`], each naming the
+    /// file and, for a bad row, the line and column.
     pub fn for_each_row(
         &self,
         progress: &mut dyn FnMut(f64),
@@ -197,8 +199,33 @@ fn parse_header(line: &[u8], shown: &str) -> Result<ColumnMap, LogError> {
         message: crate::one_line(&e.to_string()),
     })?;
     if !ok {
-        return Err(LogError::Empty {
+        return Err(LogError::NotALog {
             path: shown.to_string(),
+            why: "the file is empty: line 1 must be the header (t_s, ia_A, ib_A, ic_A, ...)"
+                .to_string(),
+        });
+    }
+    if rec.iter().all(|h| h.is_empty()) {
+        return Err(LogError::NotALog {
+            path: shown.to_string(),
+            why: "the file is empty: line 1 must be the header (t_s, ia_A, ib_A, ic_A, ...)"
+                .to_string(),
+        });
+    }
+    if rec.len() == 1 {
+        if let Some(sep) = [';', '\t', '|'].into_iter().find(|c| rec[0].contains(*c)) {
+            return Err(LogError::NotALog {
+                path: shown.to_string(),
+                why: format!(
+                    "the fields are separated by {sep:?}: the log must be comma-separated (DESIGN.md \u{a7}3)"
+                ),
+            });
+        }
+    }
+    if rec.get(0).is_some_and(|h| h.parse::<f64>().is_ok()) {
+        return Err(LogError::NotALog {
+            path: shown.to_string(),
+            why: "line 1 holds numbers: it must be the header naming the columns (t_s, ia_A, ib_A, ic_A, ...)".to_string(),
         });
     }
     let find = |c: Column| rec.iter().position(|h| h == c.name());

@@ -6,7 +6,8 @@ use sim_host::analysis::compare::CompareReport;
 use sim_host::analysis::explain::ExplainReport;
 use sim_host::bench::{BenchFigures, DetectionLimit, Spread};
 use sim_host::demo::{DemoRun, MonitorState};
-use sim_host::replay::{Diagnosed, TimelinePoint};
+use sim_host::log::quality::DataQuality;
+use sim_host::replay::{CommissioningReport, Diagnosed, TimelinePoint, Verdict};
 use sim_host::sim::SimSummary;
 use std::io::Write;
 use std::path::Path;
@@ -150,13 +151,8 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
         d.sample_rate_hz,
         rep.angle_source
     )?;
-    match rep.commission {
-        Some((a, b)) => writeln!(
-            out,
-            "thresholds: learned over {a}..{b} s (mean +/- k*spread)"
-        )?,
-        None => writeln!(out, "thresholds: fixed (no --commission window given)")?,
-    }
+    data_quality(&mut out, &rep.data_quality)?;
+    commissioning(&mut out, &rep.commissioning)?;
     for s in &rep.skipped {
         writeln!(out, "skipped: {s}")?;
     }
@@ -170,14 +166,18 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
             let r = p.residuals;
             writeln!(
                 out,
-                "{:6.2} s {:6.1} {:+.4} {:+.4} {:+.4} {:+.4}  {lamps}  {}",
+                "{:6.2} s {:6.1} {:+.4} {:+.4} {:+.4} {:+.4}  {lamps}  {}{}",
                 p.t_s,
                 p.speed_rad_s,
                 r[0],
                 r[1],
                 r[2],
                 r[3],
-                diagnose_state(p)
+                diagnose_state(p),
+                p.range_note
+                    .as_ref()
+                    .map(|n| format!("  [{n}]"))
+                    .unwrap_or_default()
             )?;
         }
         let lit: Vec<&str> = rep
@@ -221,7 +221,76 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
         100.0 * u.negative_sequence_ratio,
         u.suspect_phase.as_deref().unwrap_or("none")
     )?;
+    for n in &rep.commissioning.outside_range {
+        writeln!(out, "note at {:.2} s: {}", n.t_s, n.note)?;
+    }
+    match rep.verdict {
+        Verdict::Fault => writeln!(out, "verdict: FAULT")?,
+        Verdict::Healthy => writeln!(out, "verdict: healthy")?,
+        Verdict::CouldNotJudge => writeln!(
+            out,
+            "verdict: could not judge: {}",
+            rep.verdict_withheld_because.join("; ")
+        )?,
+    }
     Ok(())
+}
+
+/// The data-quality stage's finding in one line, and what was done about it.
+fn data_quality(out: &mut impl Write, q: &DataQuality) -> anyhow::Result<()> {
+    writeln!(out, "data quality: {}", q.summary())?;
+    for a in &q.actions {
+        writeln!(out, "  done: {a}")?;
+    }
+    if !q.trusted {
+        writeln!(out, "  NOT TRUSTED: {}", q.not_trusted_because.join("; "))?;
+    }
+    Ok(())
+}
+
+/// What `diagnose` did about its thresholds.
+fn commissioning(out: &mut impl Write, c: &CommissioningReport) -> anyhow::Result<()> {
+    writeln!(out, "thresholds: {}", c.thresholds)?;
+    if c.state == "learned" {
+        let span = |s: Option<[f32; 2]>, u: &str| {
+            s.map(|[a, b]| format!("{a:.1}..{b:.1} {u}"))
+                .unwrap_or_else(|| "-".into())
+        };
+        writeln!(
+            out,
+            "  learned {:.2} s of evaluated running; load current Iqs {}, voltage Vqs {}",
+            c.seconds_evaluated,
+            span(c.load_current_a, "A"),
+            span(c.voltage_v, "V")
+        )?;
+    }
+    if let Some(p) = &c.first_quasi_steady {
+        let r = p.residuals;
+        writeln!(
+            out,
+            "  first quasi-steady point {:.2} s: r1..r4 = {:+.4} {:+.4} {:+.4} {:+.4}",
+            p.t_s, r[0], r[1], r[2], r[3]
+        )?;
+    }
+    if let Some(a) = &c.advice {
+        writeln!(out, "  {a}")?;
+    }
+    Ok(())
+}
+
+/// The data-quality stage's warnings on stderr, one line each.
+pub fn quality_warnings(q: &DataQuality) {
+    let mut err = std::io::stderr().lock();
+    for w in &q.warnings {
+        let _ = writeln!(err, "warning: {w}");
+    }
+    if !q.trusted {
+        let _ = writeln!(
+            err,
+            "warning: no verdict from this log: {}",
+            q.not_trusted_because.join("; ")
+        );
+    }
 }
 
 /// `table1`'s measured signatures beside the paper's and the physical ones.
@@ -288,6 +357,7 @@ fn model_name(effects: &[monitor_core::EffectKind], bare: &str, prefix: &str, se
 pub fn compare(log: &Path, r: &CompareReport) -> anyhow::Result<()> {
     let mut out = std::io::stdout().lock();
     writeln!(out, "compare {}", log.display())?;
+    data_quality(&mut out, &r.data_quality)?;
     writeln!(
         out,
         "  model: {}",
@@ -356,6 +426,7 @@ pub fn compare(log: &Path, r: &CompareReport) -> anyhow::Result<()> {
 pub fn explain(log: &Path, r: &ExplainReport) -> anyhow::Result<()> {
     let mut out = std::io::stdout().lock();
     writeln!(out, "explain {}", log.display())?;
+    data_quality(&mut out, &r.data_quality)?;
     writeln!(
         out,
         "  model as configured: {}; error {} (held-back {}), noise floor {}",

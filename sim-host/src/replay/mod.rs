@@ -12,9 +12,25 @@
 //! why. The faulty phase is named by the core's one method
 //! ([`monitor_core::sequence::suspect_phase`]), with the slip estimated from the current
 //! magnitude where the log has no speed.
+//!
+//! Every row reaches the replay through the data-quality stage ([`crate::log::quality`],
+//! [`diagnose_file`], [`diagnose_rows`]): times in seconds, repeated and backward rows
+//! dropped, gaps passed on with their real elapsed time (the core bridges the short ones
+//! and restarts its estimators after the long ones), bad cells flagged (the core holds
+//! them out, the current-only analysis skips them). What the stage found is the report's
+//! `data_quality`; what commissioning did is its `commissioning` ([`commission`]).
 
+mod commission;
+
+pub use commission::{grace_s, CommissioningReport, RangeNote, SteadyPoint};
+
+use crate::log::quality::{
+    BadCells, CellLimits, CleanSink, DataQuality, QualityStage, SegmentBreak, TimeBase,
+    MAX_BRIDGED_GAP_S,
+};
 use crate::log::{Channels, LogError, LogFile, Row, RowSink};
 use crate::params::ParamFile;
+use commission::CommissionTracker;
 use monitor_core::angle::SrfPll;
 use monitor_core::frames::{clarke, SinCos};
 use monitor_core::sequence::{asymmetry_correction_rad, slip_for_current, SequenceAnalyzer};
@@ -44,6 +60,12 @@ pub enum ReplayError {
     /// A bad option.
     #[error("{0}")]
     Option(String),
+    /// The commissioning window was not learned (and `--allow-incomplete` was not given).
+    #[error("{why}: give a window inside the log's healthy running, or --allow-incomplete to report with the fixed thresholds")]
+    IncompleteCommissioning {
+        /// What happened.
+        why: String,
+    },
     /// Reading the log failed.
     #[error(transparent)]
     Log(#[from] LogError),
@@ -58,6 +80,8 @@ pub struct ReplayOptions {
     pub residual_form: ResidualForm,
     /// Commissioning window [start, end) in log seconds; None = fixed thresholds.
     pub commission: Option<(f64, f64)>,
+    /// Report a commissioning window that was not learned instead of refusing.
+    pub allow_incomplete: bool,
     /// Timeline resolution [s] (one point per interval).
     pub timeline_step_s: f64,
 }
@@ -68,6 +92,7 @@ impl Default for ReplayOptions {
             angle_source: AngleSource::RotorFluxCurrentModel,
             residual_form: ResidualForm::Steady,
             commission: None,
+            allow_incomplete: false,
             timeline_step_s: 0.1,
         }
     }
@@ -165,6 +190,9 @@ pub struct TimelinePoint {
     pub quasi_steady: bool,
     /// |I2|/|I1|.
     pub negative_sequence_ratio: f32,
+    /// Beside a lit r2..r4 lamp: the operating point has left the commissioned range.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub range_note: Option<String>,
 }
 
 /// A fault candidate of the signature matching.
@@ -189,9 +217,14 @@ pub struct UnbalanceReport {
     pub correction_deg: f32,
 }
 
-/// What `diagnose` reports (DESIGN.md §3 JSON keys).
+/// What `diagnose` reports (DESIGN.md §3 JSON keys, plus `verdict`, `data_quality` and
+/// `commissioning`).
 #[derive(Debug, Clone, Serialize)]
 pub struct DiagnoseReport {
+    /// `fault`, `healthy` or `could not judge` ([`Verdict`]).
+    pub verdict: Verdict,
+    /// Why the verdict could not be given (empty otherwise).
+    pub verdict_withheld_because: Vec<String>,
     /// Final lamps `{"r1":bool,..}`.
     pub lamps: std::collections::BTreeMap<String, bool>,
     /// Final fault candidates, most probable first.
@@ -206,14 +239,30 @@ pub struct DiagnoseReport {
     pub skipped: Vec<String>,
     /// Angle source used.
     pub angle_source: String,
-    /// Commissioning window used, if any [s].
+    /// Commissioning window asked for, if any [s].
     pub commission: Option<(f64, f64)>,
+    /// What commissioning did (state, window used, range covered).
+    pub commissioning: CommissioningReport,
+    /// What the data-quality stage found and did.
+    pub data_quality: DataQuality,
     /// Rows replayed.
     pub rows: u64,
     /// Largest |normalised residual| while evaluating, r1..r4.
     pub max_abs_residual: [f32; 4],
     /// Timeline (one point per `timeline_step_s`).
     pub timeline: Vec<TimelinePoint>,
+}
+
+/// `diagnose`'s overall answer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// A lamp lit or a sensor fault was seen.
+    Fault,
+    /// Evaluated, and no lamp lit.
+    Healthy,
+    /// The data or the setup does not allow an answer (see `verdict_withheld_because`).
+    CouldNotJudge,
 }
 
 /// Streaming replay: feed rows, then [`Replay::finish`].
@@ -223,12 +272,16 @@ pub struct Replay {
     opts: ReplayOptions,
     params: ParamFile,
     channels: Channels,
-    commission_started: bool,
+    commission: CommissionTracker,
+    k_sigma: f32,
+    i_max: f64,
     rows: u64,
+    evaluated: bool,
     first_detection: Option<f64>,
     detections: Vec<(String, f64)>,
     timeline: Vec<TimelinePoint>,
     next_point: f64,
+    dt_s: f64,
     max_abs: [f32; 4],
     last: MonitorOutput,
     t0: Option<f64>,
@@ -243,7 +296,7 @@ impl Replay {
     /// # Errors
     /// [`ReplayError::Config`] when the core rejects the configuration (e.g. a sample rate
     /// below 8x the supply frequency); [`ReplayError::Option`] for a commissioning window
-    /// with end <= start.
+    /// that is not `0 <= START < END`, both finite.
     pub fn new(
         params: &ParamFile,
         channels: Channels,
@@ -251,9 +304,9 @@ impl Replay {
         opts: ReplayOptions,
     ) -> Result<Self, ReplayError> {
         if let Some((a, b)) = opts.commission {
-            if !(b > a && a >= 0.0) {
+            if !(b > a && a >= 0.0 && b.is_finite()) {
                 return Err(ReplayError::Option(format!(
-                    "--commission {a}:{b}: the window must be START:END with 0 <= START < END (seconds)"
+                    "--commission {a}:{b}: the window must be START:END with 0 <= START < END, both finite (seconds)"
                 )));
             }
         }
@@ -276,12 +329,16 @@ impl Replay {
             opts,
             params: *params,
             channels,
-            commission_started: false,
+            commission: CommissionTracker::new(opts.commission, &cfg),
+            k_sigma: cfg.thresholds.k_sigma,
+            i_max: f64::from(cfg.limits.i_max),
             rows: 0,
+            evaluated: false,
             first_detection: None,
             detections: Vec::new(),
             timeline: Vec::new(),
             next_point: 0.0,
+            dt_s: 1.0 / sample_rate_hz,
             max_abs: [0.0; 4],
             last: MonitorOutput::default(),
             t0: None,
@@ -303,27 +360,29 @@ impl Replay {
         let t0 = *self.t0.get_or_insert(row.t_s);
         let t = row.t_s - t0;
         let Some(mon) = self.monitor.as_mut() else {
-            // Current-only: PLL on the current vector, sequence analysis.
-            let i = clarke(Abc {
-                a: row.i_abc[0] as f32,
-                b: row.i_abc[1] as f32,
-                c: row.i_abc[2] as f32,
-            });
-            let sc = SinCos::from_angle(self.pll.theta_pll());
-            self.pll.update(i, sc);
-            self.seq.update(i, sc);
+            // Current-only: PLL on the current vector, sequence analysis; a row with a bad
+            // current is skipped (the monitor holds such samples out itself).
+            if row
+                .i_abc
+                .iter()
+                .all(|x| x.is_finite() && x.abs() <= self.i_max)
+            {
+                let i = clarke(Abc {
+                    a: row.i_abc[0] as f32,
+                    b: row.i_abc[1] as f32,
+                    c: row.i_abc[2] as f32,
+                });
+                let sc = SinCos::from_angle(self.pll.theta_pll());
+                self.pll.update(i, sc);
+                self.seq.update(i, sc);
+            }
             return self.last;
         };
-        if let Some((a, _)) = self.opts.commission {
-            if !self.commission_started && t >= a {
-                self.commission_started = true;
-                if let Some((a, b)) = self.opts.commission {
-                    mon.start_commissioning((b - a) as f32);
-                }
-            }
-        }
+        self.commission.before(mon, t);
         let s = self.sampler.sample(row);
         let out = *mon.update(&s);
+        let range_note = self.commission.after(mon, t, &out);
+        self.evaluated |= out.evaluating;
         if out.evaluating {
             for (m, r) in self.max_abs.iter_mut().zip(out.residuals) {
                 *m = m.max(r.abs());
@@ -339,21 +398,11 @@ impl Replay {
                 }
             }
         }
-        if t >= self.next_point {
+        // The sample nearest each timeline step (half a sample early counts: the data-quality
+        // stage's sample clock may put the sample at the step a hair before it).
+        if t + 0.5 * self.dt_s >= self.next_point {
             self.next_point += self.opts.timeline_step_s;
-            let top = out.top();
-            self.timeline.push(TimelinePoint {
-                t_s: t,
-                residuals: out.residuals,
-                lamps: out.lamps,
-                top: top.map(|(f, _)| f.name().to_string()),
-                top_probability: top.map(|(_, p)| p).unwrap_or(0.0),
-                speed_rad_s: out.speed_rad_s,
-                evaluating: out.evaluating,
-                commissioning: matches!(out.commissioning, CommissioningState::Learning(_)),
-                quasi_steady: out.quasi_steady,
-                negative_sequence_ratio: out.unbalance.negative_sequence_ratio,
-            });
+            self.timeline.push(timeline_point(t, &out, range_note));
         }
         self.last = out;
         out
@@ -364,7 +413,13 @@ impl Replay {
         self.monitor.as_ref().and_then(|m| m.calibration())
     }
 
-    /// Ends the replay and builds the report.
+    /// True when a commissioning window was asked for and not learned.
+    pub fn commissioning_incomplete(&self) -> bool {
+        self.monitor.is_some() && self.commission.incomplete()
+    }
+
+    /// Ends the replay and builds the report (`data_quality` left at its default for the
+    /// caller to fill).
     pub fn finish(self) -> DiagnoseReport {
         let out = self.last;
         let mut skipped = Vec::new();
@@ -410,7 +465,30 @@ impl Replay {
                 )
             })
             .collect();
+        let mut withheld = skipped.clone();
+        if self.monitor.is_some() && !self.evaluated && self.first_detection.is_none() {
+            withheld.push(
+                "the lamps were never evaluated (the motor never ran settled and quasi-steady with voltage)"
+                    .to_string(),
+            );
+        }
+        if let Some(why) = self.commission.why_incomplete() {
+            withheld.push(why);
+        }
+        let verdict = if !withheld.is_empty() {
+            Verdict::CouldNotJudge
+        } else if self.first_detection.is_some() {
+            Verdict::Fault
+        } else {
+            Verdict::Healthy
+        };
         DiagnoseReport {
+            verdict,
+            verdict_withheld_because: if verdict == Verdict::CouldNotJudge {
+                withheld
+            } else {
+                Vec::new()
+            },
             lamps,
             candidates,
             first_detection_s: self.first_detection,
@@ -419,10 +497,30 @@ impl Replay {
             skipped,
             angle_source: angle_source_name(self.opts.angle_source).to_string(),
             commission: self.opts.commission,
+            commissioning: self.commission.report(self.k_sigma),
+            data_quality: DataQuality::default(),
             rows: self.rows,
             max_abs_residual: self.max_abs,
             timeline: self.timeline,
         }
+    }
+}
+
+/// The timeline point of an output at `t`.
+fn timeline_point(t: f64, out: &MonitorOutput, range_note: Option<String>) -> TimelinePoint {
+    let top = out.top();
+    TimelinePoint {
+        t_s: t,
+        residuals: out.residuals,
+        lamps: out.lamps,
+        top: top.map(|(f, _)| f.name().to_string()),
+        top_probability: top.map(|(_, p)| p).unwrap_or(0.0),
+        speed_rad_s: out.speed_rad_s,
+        evaluating: out.evaluating,
+        commissioning: matches!(out.commissioning, CommissioningState::Learning(_)),
+        quasi_steady: out.quasi_steady,
+        negative_sequence_ratio: out.unbalance.negative_sequence_ratio,
+        range_note,
     }
 }
 
@@ -462,46 +560,46 @@ pub fn angle_source_name(a: AngleSource) -> &'static str {
     }
 }
 
-/// Replays whole rows (in memory) and returns the report.
+/// A log replayed by [`diagnose_file`] or [`diagnose_rows`].
+#[derive(Debug, Clone)]
+pub struct Diagnosed {
+    /// The report (`diagnose --json`), `data_quality` included.
+    pub report: DiagnoseReport,
+    /// The log's nominal sample rate (the data-quality stage's) [Hz].
+    pub sample_rate_hz: f64,
+}
+
+/// Replays rows held in memory, through the data-quality stage, and returns the report.
 ///
 /// # Errors
-/// As [`Replay::new`]; [`ReplayError::Option`] for fewer than two rows.
+/// As [`diagnose_file`].
 pub fn diagnose_rows(
     params: &ParamFile,
     channels: Channels,
     rows: &[Row],
     opts: ReplayOptions,
 ) -> Result<DiagnoseReport, ReplayError> {
-    let times: Vec<f64> = rows
-        .iter()
-        .take(crate::log::RATE_ESTIMATE_ROWS)
-        .map(|r| r.t_s)
-        .collect();
-    let fs = crate::log::sample_rate_hz(&times)
-        .ok_or_else(|| ReplayError::Option("the log needs at least two rows".into()))?;
-    let mut r = Replay::new(params, channels, fs, opts)?;
-    for row in rows {
-        r.push(row);
-    }
-    Ok(r.finish())
+    replay_through_quality(params, channels, "the log", opts, |stage| {
+        for r in rows {
+            if !stage.row(r) {
+                break;
+            }
+        }
+        Ok(())
+    })
+    .map(|d| d.report)
 }
 
-/// A log replayed by [`diagnose_file`].
-#[derive(Debug, Clone)]
-pub struct Diagnosed {
-    /// The report (`diagnose --json`).
-    pub report: DiagnoseReport,
-    /// The log's sample rate ([`crate::log::sample_rate_hz`]) [Hz].
-    pub sample_rate_hz: f64,
-}
-
-/// Streams a log file through the core (`sim-host diagnose`): the first rows give the
-/// sample rate, the monitor is configured for it, and every row is replayed, with bounded
-/// memory whatever the log's length.
+/// Streams a log file through the data-quality stage and the core (`sim-host
+/// diagnose`): the stage's time base configures the monitor, and every row is replayed,
+/// with bounded memory whatever the log's length.
 ///
 /// # Errors
-/// [`ReplayError::Log`] naming the file, line and column; [`ReplayError::Option`] for a log
-/// of fewer than two rows; [`ReplayError::Config`] when the core rejects the configuration.
+/// [`ReplayError::Log`] naming the file, line and column, or the stage's time-base
+/// errors (a log without rows or sampled below 8 samples per supply period, with the rate
+/// needed); [`ReplayError::Config`] when the core rejects the configuration;
+/// [`ReplayError::IncompleteCommissioning`] for a window not learned without
+/// `allow_incomplete`.
 pub fn diagnose_file(
     params: &ParamFile,
     path: &Path,
@@ -509,81 +607,140 @@ pub fn diagnose_file(
     progress: &mut dyn FnMut(f64),
 ) -> Result<Diagnosed, ReplayError> {
     let file = LogFile::open(path)?;
-    let mut sink = StreamingReplay {
+    replay_through_quality(params, file.channels(), file.shown(), opts, |stage| {
+        file.for_each_row(progress, stage).map(|_| ())
+    })
+}
+
+/// Runs `feed` into the data-quality stage in front of a replay; builds the report.
+fn replay_through_quality(
+    params: &ParamFile,
+    channels: Channels,
+    shown: &str,
+    opts: ReplayOptions,
+    feed: impl FnOnce(&mut dyn RowSink) -> Result<(), LogError>,
+) -> Result<Diagnosed, ReplayError> {
+    let mut sink = ReplaySink {
         params,
-        shown: file.shown(),
-        channels: file.channels(),
+        channels,
         opts,
-        head: Vec::new(),
         replay: None,
+        rate_hz: 0.0,
+        other_rate: false,
+        rows_other_rate: 0,
+        restarts: 0,
+        burst: Vec::new(),
+        burst_forwarded: false,
+        short_bursts: 0,
+        long_bursts: 0,
         error: None,
     };
-    file.for_each_row(progress, &mut sink)?;
+    let mut stage = QualityStage::new(&mut sink, CellLimits::for_params(params), shown);
+    let read = feed(&mut stage);
+    let quality = stage.finish();
     if let Some(e) = sink.error {
         return Err(e);
     }
-    if sink.replay.is_none() {
-        // Fewer rows than the rate estimate wants: start on what there is.
-        sink.start()?;
+    read?;
+    let mut quality = quality?;
+    let Some(replay) = sink.replay.take() else {
+        return Err(ReplayError::Option(format!("{shown}: no rows to replay")));
+    };
+    if replay.commissioning_incomplete() && !opts.allow_incomplete {
+        let why = replay.commission.why_incomplete().unwrap_or_default();
+        return Err(ReplayError::IncompleteCommissioning { why });
     }
-    let sample_rate_hz = sink.sample_rate_hz()?;
-    match sink.replay {
-        Some(replay) => Ok(Diagnosed {
-            report: replay.finish(),
-            sample_rate_hz,
-        }),
-        None => Err(sink.too_short()),
+    let can_residuals = replay.monitor.is_some();
+    let mut report = replay.finish();
+    describe_actions(&mut quality, can_residuals, &sink);
+    if !quality.trusted {
+        report.verdict = Verdict::CouldNotJudge;
+        report.verdict_withheld_because.extend(
+            quality
+                .not_trusted_because
+                .iter()
+                .map(|w| format!("data quality: {w}")),
+        );
+    }
+    report.data_quality = quality;
+    Ok(Diagnosed {
+        report,
+        sample_rate_hz: sink.rate_hz,
+    })
+}
+
+/// What `diagnose` did about what the stage found, in the report's `actions`.
+fn describe_actions(q: &mut DataQuality, monitor: bool, sink: &ReplaySink<'_>) {
+    let who = if monitor {
+        "the monitor"
+    } else {
+        "the unbalance analysis"
+    };
+    if q.gaps_bridged > 0 {
+        q.actions.push(format!(
+            "short gaps: {who} advanced its estimators over the real elapsed time"
+        ));
+    }
+    if q.long_gaps > 0 || q.clock_resets > 0 {
+        q.actions.push(format!(
+            "long gaps and clock resets: {who} restarted its estimators and settled again"
+        ));
+    }
+    if sink.short_bursts > 0 {
+        q.actions.push(format!(
+            "{} bursts of bad cells up to {MAX_BRIDGED_GAP_S} s: left out, bridged like gaps",
+            sink.short_bursts
+        ));
+    }
+    if sink.long_bursts > 0 {
+        q.actions.push(format!(
+            "{} bursts of bad cells longer than {MAX_BRIDGED_GAP_S} s: given to {who}, which holds them out and flags the sensor",
+            sink.long_bursts
+        ));
+    }
+    if q.repeated_or_backward_rows + q.non_finite_times > 0 {
+        q.actions
+            .push("rows with a repeated, backward or unreadable time: dropped".to_string());
+    }
+    if sink.rows_other_rate > 0 {
+        q.actions.push(format!(
+            "{} rows at another sample rate not diagnosed (the monitor runs at {:.0} Hz)",
+            sink.rows_other_rate, sink.rate_hz
+        ));
+        q.warnings.push(format!(
+            "{} rows at another sample rate were not diagnosed",
+            sink.rows_other_rate
+        ));
     }
 }
 
-/// The replay of a streamed log: holds the first rows until the sample rate is known.
-struct StreamingReplay<'a> {
+/// The replay behind the data-quality stage: configured when the stage knows the time
+/// base; rows of segments at another sample rate are counted, not replayed (the monitor's
+/// configuration follows from one rate).
+struct ReplaySink<'a> {
     params: &'a ParamFile,
-    shown: &'a str,
     channels: Channels,
     opts: ReplayOptions,
-    head: Vec<Row>,
     replay: Option<Replay>,
+    rate_hz: f64,
+    other_rate: bool,
+    rows_other_rate: u64,
+    restarts: u64,
+    burst: Vec<Row>,
+    burst_forwarded: bool,
+    short_bursts: u64,
+    long_bursts: u64,
     error: Option<ReplayError>,
 }
 
-impl StreamingReplay<'_> {
-    fn sample_rate_hz(&self) -> Result<f64, ReplayError> {
-        let times: Vec<f64> = self.head.iter().map(|r| r.t_s).collect();
-        crate::log::sample_rate_hz(&times).ok_or_else(|| self.too_short())
-    }
-
-    fn too_short(&self) -> ReplayError {
-        ReplayError::Option(format!(
-            "{}: the log needs at least two data rows",
-            self.shown
-        ))
-    }
-
-    /// Configures the monitor for the rate of the rows held and replays them.
-    fn start(&mut self) -> Result<(), ReplayError> {
-        let fs = self.sample_rate_hz()?;
-        let mut r = Replay::new(self.params, self.channels, fs, self.opts)?;
-        for row in &self.head {
-            r.push(row);
-        }
-        self.replay = Some(r);
-        Ok(())
-    }
-}
-
-impl RowSink for StreamingReplay<'_> {
-    fn row(&mut self, row: &Row) -> bool {
-        if let Some(r) = self.replay.as_mut() {
-            r.push(row);
-            return true;
-        }
-        self.head.push(*row);
-        if self.head.len() < crate::log::RATE_ESTIMATE_ROWS {
-            return true;
-        }
-        match self.start() {
-            Ok(()) => true,
+impl CleanSink for ReplaySink<'_> {
+    fn begin(&mut self, base: &TimeBase) -> bool {
+        self.rate_hz = base.sample_rate_hz;
+        match Replay::new(self.params, self.channels, base.sample_rate_hz, self.opts) {
+            Ok(r) => {
+                self.replay = Some(r);
+                true
+            }
             Err(e) => {
                 self.error = Some(e);
                 false
@@ -591,9 +748,57 @@ impl RowSink for StreamingReplay<'_> {
         }
     }
 
+    fn row(&mut self, row: &Row, bad: BadCells) -> bool {
+        if self.other_rate {
+            self.rows_other_rate += 1;
+            return true;
+        }
+        let Some(r) = self.replay.as_mut() else {
+            return true;
+        };
+        if bad.any() && !self.burst_forwarded {
+            // A glitch burst is held until it ends (dropped: the monitor bridges it like a
+            // gap) or outlasts the longest gap bridged (a sensor that has failed: the rows
+            // go to the monitor, which holds them out and flags the sensor).
+            self.burst.push(*row);
+            if self.burst.len() as f64 <= MAX_BRIDGED_GAP_S * self.rate_hz {
+                return true;
+            }
+            self.burst_forwarded = true;
+            self.long_bursts += 1;
+            for b in self.burst.drain(..) {
+                r.push(&b);
+            }
+            return true;
+        }
+        if !bad.any() {
+            self.short_bursts += u64::from(!self.burst.is_empty() && !self.burst_forwarded);
+            self.burst.clear();
+            self.burst_forwarded = false;
+        }
+        r.push(row);
+        true
+    }
+
+    fn new_segment(&mut self, why: SegmentBreak) -> bool {
+        match why {
+            SegmentBreak::RateChange(r) => {
+                self.other_rate = (r / self.rate_hz - 1.0).abs() > 0.02;
+            }
+            SegmentBreak::Gap(_) | SegmentBreak::ClockReset => self.restarts += 1,
+        }
+        true
+    }
+
     fn restart(&mut self) {
-        self.head.clear();
         self.replay = None;
+        self.other_rate = false;
+        self.rows_other_rate = 0;
+        self.restarts = 0;
+        self.burst.clear();
+        self.burst_forwarded = false;
+        self.short_bursts = 0;
+        self.long_bursts = 0;
         self.error = None;
     }
 }

@@ -1,0 +1,993 @@
+//! The data-quality stage: every row of a log passes here before `diagnose`, `compare` or
+//! `explain` sees it ([`QualityStage`], a [`RowSink`] in front of the command's own sink,
+//! a [`CleanSink`]). It judges the log as a data-acquisition system wrote it, with gaps,
+//! glitches and bad cells, across the whole log (not its first rows), and reports what it
+//! found ([`DataQuality`], JSON key `data_quality`).
+//!
+//! **Time base.** The sample period is the median interval of the first [`HEAD_ROWS`]
+//! rows ([`super::sample_rate_hz`], robust to dropped samples among them). The time unit
+//! is chosen from the phase-a current: its zero crossings must repeat at about the supply
+//! frequency; a log whose `t_s` is in milliseconds or microseconds is rescaled
+//! ([`TimeUnit`]). Without alternating current (a log at standstill) the unit is seconds
+//! unless seconds would give fewer than [`MIN_SAMPLES_PER_PERIOD`] samples per supply
+//! period. Then each interval between rows is classified against the period `T`
+//! (tolerance [`INTERVAL_TOLERANCE`]` T`):
+//! - about `T`: a normal row;
+//! - about `m T` (m >= 2) and at most [`MAX_BRIDGED_GAP_S`]: `m - 1` dropped samples, a
+//!   short gap, bridged downstream with the real elapsed time (the core's estimators and
+//!   the M/T speed advance over it; the analysis interpolates the working series across
+//!   it);
+//! - longer than [`MAX_BRIDGED_GAP_S`]: a long gap, the start of a new segment
+//!   ([`SegmentBreak::Gap`]);
+//! - zero or negative (a repeated or backward time): the row is dropped; a run of
+//!   [`RATE_CHANGE_RUN`] such rows that are regular among themselves is a clock reset and
+//!   starts a new segment;
+//! - one row off the grid whose successor is back on it (`t[k+1] - t[k-1] = 2 T`): a
+//!   timestamp glitch; its time is corrected to `t[k-1] + T`;
+//! - anything else: an irregular interval, kept with its real time;
+//! - [`RATE_CHANGE_RUN`] consecutive off-period intervals that agree within 5 %: a change
+//!   of sample rate, a new segment at the new rate.
+//!
+//! Rows on the grid (one or `m` periods on) are put on a smoothed sample clock: the
+//! clock advances by whole periods and moves [`CLOCK_GAIN`] of the way to each row's own
+//! time, so timestamp jitter (a software clock) does not reach the estimators, and a
+//! clock a little off the estimated period is followed. A row within [`CLOCK_EXACT`] of a
+//! period of the clock, and every row off the grid, keeps its own time.
+//!
+//! **Cells.** A cell that is not finite or lies beyond [`CellLimits`] (far beyond what the
+//! machine could draw or the supply could give) is bad ([`BadCells`]); consecutive rows
+//! with bad cells form a glitch burst. The stage counts them and hands the rows on,
+//! flagged: the monitor holds such samples out as the firmware does with impossible ADC
+//! readings, the analysis drops them and bridges the hole like dropped samples.
+//!
+//! **Supply frequency.** The median period of the phase-a current's zero crossings is
+//! compared with the parameter file's supply frequency; a difference over
+//! [`SUPPLY_MISMATCH`] is a warning (a V/f drive running below base speed also gives one).
+//!
+//! **Trust.** [`DataQuality::trusted`] is false when more than [`MAX_BAD_FRACTION`] of
+//! the rows were dropped or held out, the timestamps are irregular on more than
+//! [`MAX_BAD_FRACTION`] of the intervals, or more than [`MAX_DROPPED_FRACTION`] of the
+//! samples are missing: the commands then withhold their verdict and say why.
+
+use super::{Column, LogError, Row, RowSink};
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// Rows whose intervals set the nominal sample period and time unit.
+pub const HEAD_ROWS: usize = 2048;
+/// An interval within this fraction of a period of `m T` counts as `m` periods.
+pub const INTERVAL_TOLERANCE: f64 = 0.25;
+/// Longest stretch of missing samples bridged [s]; longer gaps split the log into
+/// segments. The same as the core's default `MonitorConfig::max_bridged_gap_s`.
+pub const MAX_BRIDGED_GAP_S: f64 = 0.1;
+/// Consecutive off-period intervals that, agreeing within 5 %, make a change of sample
+/// rate (or, backward, a clock reset).
+pub const RATE_CHANGE_RUN: usize = 64;
+/// Samples per supply period below which no analysis is possible (the core's limit,
+/// `MonitorConfig::validate`).
+pub const MIN_SAMPLES_PER_PERIOD: f64 = 8.0;
+/// Relative difference between the current's frequency and the supply frequency that is
+/// warned about.
+pub const SUPPLY_MISMATCH: f64 = 0.2;
+/// Fraction of rows dropped or held out (or of intervals irregular) beyond which no
+/// verdict is given.
+pub const MAX_BAD_FRACTION: f64 = 0.05;
+/// Stretches of rows with unusable time beyond which their share counts against trust.
+pub const MAX_DROP_RUNS: u64 = 3;
+/// Fraction of missing samples (bridged gaps) beyond which no verdict is given.
+pub const MAX_DROPPED_FRACTION: f64 = 0.10;
+/// Gain of the timestamp smoothing: each row on the grid moves the sample clock this
+/// fraction of the way to its own time (a first-order loop: jitter falls by about
+/// `sqrt(2 / gain)`, a clock off the estimated period by `e` lags `e / gain` periods).
+pub const CLOCK_GAIN: f64 = 1.0 / 32.0;
+/// Distance from the sample clock (fraction of a period) within which a row keeps its own
+/// time: printed-time rounding, not jitter.
+pub const CLOCK_EXACT: f64 = 0.01;
+/// Timestamp jitter (RMS, fraction of a period) above which the report warns.
+pub const JITTER_WARN: f64 = 0.02;
+/// Entries kept in the lists of the report (long gaps, rate changes).
+const LIST_CAP: usize = 20;
+
+/// The unit of a log's `t_s` column as the stage reads it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TimeUnit {
+    /// Seconds, as the schema says.
+    #[default]
+    S,
+    /// Milliseconds.
+    Ms,
+    /// Microseconds.
+    Us,
+}
+
+impl TimeUnit {
+    /// Seconds per unit.
+    pub fn seconds(self) -> f64 {
+        match self {
+            TimeUnit::S => 1.0,
+            TimeUnit::Ms => 1e-3,
+            TimeUnit::Us => 1e-6,
+        }
+    }
+
+    /// "s", "ms" or "us".
+    pub fn name(self) -> &'static str {
+        match self {
+            TimeUnit::S => "s",
+            TimeUnit::Ms => "ms",
+            TimeUnit::Us => "us",
+        }
+    }
+}
+
+/// Limits beyond which a cell is bad: magnitudes no sensor of this machine should report.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CellLimits {
+    /// Largest |phase voltage| [V].
+    pub v_max: f64,
+    /// Largest |phase current| [A].
+    pub i_max: f64,
+    /// Largest |mechanical speed| [rad/s].
+    pub wm_max: f64,
+    /// Supply frequency of the parameter file [Hz].
+    pub supply_hz: f64,
+}
+
+impl CellLimits {
+    /// The limits the replay's monitor uses ([`crate::replay::monitor_config_for_log`]:
+    /// twice the simulator's ADC ranges, twice the synchronous speed) for a parameter file.
+    pub fn for_params(p: &crate::params::ParamFile) -> Self {
+        let cfg = crate::replay::monitor_config_for_log(
+            p,
+            (p.supply.f_hz * 100.0).max(1000.0),
+            &crate::replay::ReplayOptions::default(),
+        );
+        CellLimits {
+            v_max: f64::from(cfg.limits.v_max),
+            i_max: f64::from(cfg.limits.i_max),
+            wm_max: f64::from(cfg.limits.max_speed_rad_s),
+            supply_hz: p.supply.f_hz,
+        }
+    }
+}
+
+/// The bad cells of a row: one bit per [`Column`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct BadCells(u16);
+
+impl BadCells {
+    /// True when any cell is bad.
+    pub fn any(self) -> bool {
+        self.0 != 0
+    }
+    /// True when the cell of `c` is bad.
+    pub fn has(self, c: Column) -> bool {
+        self.0 & (1 << c as u16) != 0
+    }
+    fn set(&mut self, c: Column) {
+        self.0 |= 1 << c as u16;
+    }
+
+    /// The bad cells of `row` against `lim`.
+    pub fn of(row: &Row, lim: &CellLimits) -> Self {
+        let mut b = BadCells::default();
+        let bad = |x: f64, max: f64| !x.is_finite() || x.abs() > max;
+        if let Some(v) = row.v_abc {
+            for (x, c) in v.iter().zip([Column::Va, Column::Vb, Column::Vc]) {
+                if bad(*x, lim.v_max) {
+                    b.set(c);
+                }
+            }
+        }
+        for (x, c) in row.i_abc.iter().zip([Column::Ia, Column::Ib, Column::Ic]) {
+            if bad(*x, lim.i_max) {
+                b.set(c);
+            }
+        }
+        if row.wm_rad_s.is_some_and(|w| bad(w, lim.wm_max)) {
+            b.set(Column::Speed);
+        }
+        b
+    }
+}
+
+/// What the stage knows once it has seen the first rows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TimeBase {
+    /// Unit of the log's `t_s`.
+    pub unit: TimeUnit,
+    /// Nominal sample rate [Hz].
+    pub sample_rate_hz: f64,
+    /// Time of the first row [s] (in seconds, after the unit).
+    pub t0_s: f64,
+}
+
+/// Why a new segment starts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SegmentBreak {
+    /// A gap longer than [`MAX_BRIDGED_GAP_S`] [s].
+    Gap(f64),
+    /// The sample rate changed to this [Hz].
+    RateChange(f64),
+    /// The time went back (the acquisition clock restarted).
+    ClockReset,
+}
+
+/// Receives the rows the stage passes: times in seconds, in order, each row's bad cells
+/// flagged.
+pub trait CleanSink {
+    /// Called once, before the first row. Return false to stop.
+    fn begin(&mut self, base: &TimeBase) -> bool;
+    /// One row (time strictly after the previous row's within a segment). Return false
+    /// to stop.
+    fn row(&mut self, row: &Row, bad: BadCells) -> bool;
+    /// The next row starts a new segment. Return false to stop.
+    fn new_segment(&mut self, why: SegmentBreak) -> bool;
+    /// Forget everything: the rows come again from the first one.
+    fn restart(&mut self);
+}
+
+/// A change of sample rate found in the log.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct RateChange {
+    /// Where [s since the first row].
+    pub at_s: f64,
+    /// The new rate [Hz].
+    pub rate_hz: f64,
+}
+
+/// What the data-quality stage found and what was done (JSON key `data_quality`). Times
+/// are seconds since the log's first row.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct DataQuality {
+    /// Rows in the log.
+    pub rows_read: u64,
+    /// Rows passed on (not dropped for their time).
+    pub rows_passed: u64,
+    /// Unit the `t_s` column was read in.
+    pub time_unit: TimeUnit,
+    /// Nominal sample rate [Hz] (median interval of the first rows).
+    pub sample_rate_hz: f64,
+    /// From the first row to the last [s].
+    pub duration_s: f64,
+    /// Samples missing in short gaps (bridged).
+    pub dropped_samples: u64,
+    /// Short gaps (one or more samples missing, at most [`MAX_BRIDGED_GAP_S`]) bridged.
+    pub gaps_bridged: u64,
+    /// Longest bridged gap [s].
+    pub longest_bridged_gap_s: f64,
+    /// Gaps longer than [`MAX_BRIDGED_GAP_S`] (each starts a segment).
+    pub long_gaps: u64,
+    /// The first long gaps, `[from, to]` [s].
+    pub long_gap_spans: Vec<[f64; 2]>,
+    /// Segments of regular time base.
+    pub segments: u64,
+    /// Changes of sample rate.
+    pub rate_changes: Vec<RateChange>,
+    /// Clock resets (time went back for good).
+    pub clock_resets: u64,
+    /// Rows dropped because their time repeats or goes back.
+    pub repeated_or_backward_rows: u64,
+    /// Rows dropped because their time is not a number.
+    pub non_finite_times: u64,
+    /// Single timestamps off the grid, corrected.
+    pub timestamp_glitches: u64,
+    /// Intervals that are no whole number of periods (kept with their real time).
+    pub irregular_intervals: u64,
+    /// RMS distance of the timestamps from the smoothed sample clock [s].
+    pub timestamp_jitter_rms_s: f64,
+    /// Bad cells per column (not finite or beyond the limits).
+    pub bad_cells: BTreeMap<String, u64>,
+    /// Rows with at least one bad cell.
+    pub bad_rows: u64,
+    /// Runs of consecutive rows with bad cells.
+    pub glitch_bursts: u64,
+    /// Longest such run [s].
+    pub longest_burst_s: f64,
+    /// Rows in bursts up to [`MAX_BRIDGED_GAP_S`] long (glitches; a longer burst is a
+    /// sensor that failed, a finding of its own).
+    pub rows_in_short_bursts: u64,
+    /// Stretches of consecutive rows dropped for their time (a stalled clock is one).
+    pub time_drop_runs: u64,
+    /// Frequency of the phase-a current (median zero-crossing period) [Hz], if it
+    /// alternates.
+    pub current_frequency_hz: Option<f64>,
+    /// What the command did about what was found.
+    pub actions: Vec<String>,
+    /// What the user should know (also printed on stderr).
+    pub warnings: Vec<String>,
+    /// False when the command's verdict would rest on data the stage rejected.
+    pub trusted: bool,
+    /// Why not trusted.
+    pub not_trusted_because: Vec<String>,
+}
+
+impl DataQuality {
+    /// Fills `warnings`, `trusted` and `not_trusted_because` from the counts.
+    fn assess(&mut self, supply_hz: f64) {
+        let mut warn = Vec::new();
+        let mut distrust = Vec::new();
+        let rows = self.rows_read.max(1) as f64;
+        if self.time_unit != TimeUnit::S {
+            warn.push(format!(
+                "t_s is in {} (the currents alternate at the supply frequency only so): read as {}",
+                self.time_unit.name(),
+                self.time_unit.name()
+            ));
+        }
+        let dropped_time = self.repeated_or_backward_rows + self.non_finite_times;
+        if dropped_time > 0 {
+            warn.push(format!(
+                "{} rows dropped: time repeats or goes back ({}) or is not a number ({})",
+                dropped_time, self.repeated_or_backward_rows, self.non_finite_times
+            ));
+        }
+        // A few long stretches of unusable time are gaps (the estimators restart after
+        // them); many scattered ones leave no stretch of the log to trust.
+        if dropped_time as f64 / rows > MAX_BAD_FRACTION && self.time_drop_runs > MAX_DROP_RUNS {
+            distrust.push(format!(
+                "{:.1} % of the rows have an unusable time",
+                100.0 * dropped_time as f64 / rows
+            ));
+        }
+        if self.gaps_bridged > 0 {
+            warn.push(format!(
+                "{} samples missing in {} gaps (longest {:.4} s), bridged with the real elapsed time",
+                self.dropped_samples, self.gaps_bridged, self.longest_bridged_gap_s
+            ));
+        }
+        let expected = self.rows_passed as f64 + self.dropped_samples as f64;
+        if self.dropped_samples as f64 / expected.max(1.0) > MAX_DROPPED_FRACTION {
+            distrust.push(format!(
+                "{:.1} % of the samples are missing",
+                100.0 * self.dropped_samples as f64 / expected.max(1.0)
+            ));
+        }
+        if self.long_gaps > 0 || self.clock_resets > 0 || !self.rate_changes.is_empty() {
+            warn.push(format!(
+                "the log falls into {} segments ({} gaps over {} s, {} rate changes, {} clock resets)",
+                self.segments,
+                self.long_gaps,
+                MAX_BRIDGED_GAP_S,
+                self.rate_changes.len(),
+                self.clock_resets
+            ));
+        }
+        if self.timestamp_glitches > 0 {
+            warn.push(format!(
+                "{} timestamps off the sample grid corrected",
+                self.timestamp_glitches
+            ));
+        }
+        if self.timestamp_jitter_rms_s * self.sample_rate_hz > JITTER_WARN {
+            warn.push(format!(
+                "the timestamps jitter by {:.1} us RMS ({:.0} % of a period): smoothed onto the sample clock",
+                1e6 * self.timestamp_jitter_rms_s,
+                100.0 * self.timestamp_jitter_rms_s * self.sample_rate_hz
+            ));
+        }
+        if self.irregular_intervals > 0 {
+            warn.push(format!(
+                "{} intervals are no whole number of sample periods",
+                self.irregular_intervals
+            ));
+        }
+        if self.irregular_intervals as f64 / rows > MAX_BAD_FRACTION {
+            distrust.push(format!(
+                "the timestamps are irregular on {:.1} % of the intervals",
+                100.0 * self.irregular_intervals as f64 / rows
+            ));
+        }
+        if self.bad_rows > 0 {
+            let cells: Vec<String> = self
+                .bad_cells
+                .iter()
+                .map(|(c, n)| format!("{c} {n}"))
+                .collect();
+            warn.push(format!(
+                "{} rows with cells not finite or out of range ({}) in {} bursts (longest {:.4} s), held out",
+                self.bad_rows,
+                cells.join(", "),
+                self.glitch_bursts,
+                self.longest_burst_s
+            ));
+        }
+        if self.rows_in_short_bursts as f64 / rows > MAX_BAD_FRACTION {
+            distrust.push(format!(
+                "{:.1} % of the rows have bad cells, in short glitches all through the log",
+                100.0 * self.rows_in_short_bursts as f64 / rows
+            ));
+        }
+        if let Some(f) = self.current_frequency_hz {
+            if (f / supply_hz - 1.0).abs() > SUPPLY_MISMATCH {
+                warn.push(format!(
+                    "the currents alternate at {f:.1} Hz but the parameter file's supply is {supply_hz} Hz: check f_hz (a V/f drive below base speed also shows this)"
+                ));
+            }
+        }
+        self.trusted = distrust.is_empty();
+        self.warnings = warn;
+        self.not_trusted_because = distrust;
+    }
+
+    /// One line for the text output: "clean" or what was found.
+    pub fn summary(&self) -> String {
+        if self.warnings.is_empty() {
+            return format!(
+                "clean ({} rows at {:.0} Hz, time in {})",
+                self.rows_read,
+                self.sample_rate_hz,
+                self.time_unit.name()
+            );
+        }
+        format!(
+            "{} rows at {:.0} Hz: {}",
+            self.rows_read,
+            self.sample_rate_hz,
+            self.warnings.join("; ")
+        )
+    }
+}
+
+/// The median of the positive finite values of `x` (reordered), `None` when there is none.
+pub(super) fn median_positive(x: &mut Vec<f64>) -> Option<f64> {
+    x.retain(|v| v.is_finite() && *v > 0.0);
+    if x.is_empty() {
+        return None;
+    }
+    x.sort_by(f64::total_cmp);
+    Some(x[x.len() / 2])
+}
+
+/// Zero crossings of one signal with hysteresis (a tenth of its recent peak): the
+/// periods between positive-going crossings.
+#[derive(Debug, Clone, Default)]
+struct CrossingCounter {
+    peak: f64,
+    positive: Option<bool>,
+    last_rise: Option<f64>,
+    periods: Vec<f64>,
+    last_t: Option<f64>,
+}
+
+/// Periods kept for the median (a day at 50 Hz is 4.3 million).
+const MAX_PERIODS: usize = 1 << 20;
+
+impl CrossingCounter {
+    fn push(&mut self, t: f64, x: f64, decay_s: f64) {
+        if !x.is_finite() {
+            return;
+        }
+        let dt = self.last_t.map_or(0.0, |l| (t - l).max(0.0));
+        self.last_t = Some(t);
+        self.peak = (self.peak * (1.0 - dt / decay_s).max(0.0)).max(x.abs());
+        let h = 0.1 * self.peak;
+        let now = if x > h {
+            Some(true)
+        } else if x < -h {
+            Some(false)
+        } else {
+            self.positive
+        };
+        if now == Some(true) && self.positive == Some(false) {
+            if let Some(r) = self.last_rise {
+                if self.periods.len() < MAX_PERIODS {
+                    self.periods.push(t - r);
+                }
+            }
+            self.last_rise = Some(t);
+        }
+        self.positive = now;
+    }
+
+    /// The median period (in the times' unit), from at least two whole periods.
+    fn median_period(&self) -> Option<f64> {
+        if self.periods.len() < 2 {
+            return None;
+        }
+        median_positive(&mut self.periods.clone())
+    }
+}
+
+/// The time unit and the nominal period [s] of the first rows.
+///
+/// # Errors
+/// [`LogError::NoTimeBase`] without two increasing finite times; [`LogError::RateTooLow`]
+/// when the rate in the chosen unit gives fewer than [`MIN_SAMPLES_PER_PERIOD`] samples per
+/// supply period.
+fn time_base(head: &[Row], supply_hz: f64, shown: &str) -> Result<(TimeUnit, f64), LogError> {
+    let times: Vec<f64> = head.iter().map(|r| r.t_s).collect();
+    let Some(period_file) = super::sample_rate_hz(&times).map(|r| 1.0 / r) else {
+        return Err(LogError::NoTimeBase {
+            path: shown.to_string(),
+        });
+    };
+    let mut cc = CrossingCounter::default();
+    let span = head.last().map_or(0.0, |r| r.t_s) - head.first().map_or(0.0, |r| r.t_s);
+    for r in head {
+        cc.push(r.t_s, r.i_abc[0], span.abs().max(f64::MIN_POSITIVE));
+    }
+    let units = [TimeUnit::S, TimeUnit::Ms, TimeUnit::Us];
+    let unit = match cc.median_period() {
+        // The unit in which the current alternates nearest the supply frequency.
+        Some(p) => units
+            .into_iter()
+            .min_by(|a, b| {
+                let miss = |u: TimeUnit| (1.0 / (p * u.seconds()) / supply_hz).ln().abs();
+                miss(*a).total_cmp(&miss(*b))
+            })
+            .unwrap_or_default(),
+        // No alternating current: seconds, unless that is too slow to be a log.
+        None => units
+            .into_iter()
+            .find(|u| 1.0 / (period_file * u.seconds()) >= MIN_SAMPLES_PER_PERIOD * supply_hz)
+            .unwrap_or_default(),
+    };
+    let period = period_file * unit.seconds();
+    let rate = 1.0 / period;
+    if rate < MIN_SAMPLES_PER_PERIOD * supply_hz {
+        return Err(LogError::RateTooLow {
+            path: shown.to_string(),
+            rate_hz: rate,
+            supply_hz,
+            needed_hz: MIN_SAMPLES_PER_PERIOD * supply_hz,
+        });
+    }
+    Ok((unit, period))
+}
+
+/// The stage as a [`RowSink`] in front of a [`CleanSink`]; see the module documentation.
+/// After the read, [`QualityStage::finish`] gives the report.
+pub struct QualityStage<'a, S: CleanSink> {
+    sink: &'a mut S,
+    limits: CellLimits,
+    shown: String,
+    head: Vec<Row>,
+    base: Option<TimeBase>,
+    period: f64,
+    last_t: f64,
+    pending: Option<Row>,
+    off_run: Vec<f64>,
+    off_run_counts: (u64, u64),
+    back_run: (usize, f64),
+    burst: Option<(f64, f64)>,
+    crossings: CrossingCounter,
+    jitter: (f64, u64),
+    dropping: bool,
+    q: DataQuality,
+    error: Option<LogError>,
+    stopped: bool,
+}
+
+impl<'a, S: CleanSink> QualityStage<'a, S> {
+    /// A stage for the log shown as `shown` in messages, judging cells against `limits`.
+    pub fn new(sink: &'a mut S, limits: CellLimits, shown: &str) -> Self {
+        QualityStage {
+            sink,
+            limits,
+            shown: shown.to_string(),
+            head: Vec::new(),
+            base: None,
+            period: 0.0,
+            last_t: f64::NEG_INFINITY,
+            pending: None,
+            off_run: Vec::new(),
+            off_run_counts: (0, 0),
+            back_run: (0, f64::NAN),
+            burst: None,
+            crossings: CrossingCounter::default(),
+            jitter: (0.0, 0),
+            dropping: false,
+            q: DataQuality::default(),
+            error: None,
+            stopped: false,
+        }
+    }
+
+    /// Ends the read (settles the rows still held) and returns the report.
+    ///
+    /// # Errors
+    /// [`LogError::Empty`] for a log without rows; the time-base errors of the first rows
+    /// ([`LogError::NoTimeBase`], [`LogError::RateTooLow`]).
+    pub fn finish(mut self) -> Result<DataQuality, LogError> {
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        if self.base.is_none() && !self.stopped {
+            if self.head.is_empty() {
+                return Err(LogError::Empty { path: self.shown });
+            }
+            self.start();
+            if let Some(e) = self.error.take() {
+                return Err(e);
+            }
+        }
+        if let Some(p) = self.pending.take() {
+            if !self.stopped {
+                self.settle(p);
+            }
+        }
+        self.end_burst();
+        if let Some(b) = self.base {
+            self.q.duration_s = (self.last_t - b.t0_s).max(0.0);
+        }
+        self.q.current_frequency_hz = self.crossings.median_period().map(|p| 1.0 / p);
+        self.q.timestamp_jitter_rms_s = (self.jitter.0 / self.jitter.1.max(1) as f64).sqrt();
+        self.q.assess(self.limits.supply_hz);
+        Ok(self.q)
+    }
+
+    /// Sets the time base from the rows held and passes them on.
+    fn start(&mut self) {
+        let (unit, period) = match time_base(&self.head, self.limits.supply_hz, &self.shown) {
+            Ok(b) => b,
+            Err(e) => {
+                self.error = Some(e);
+                self.stopped = true;
+                return;
+            }
+        };
+        let t0 = self
+            .head
+            .iter()
+            .map(|r| r.t_s * unit.seconds())
+            .find(|t| t.is_finite())
+            .unwrap_or(0.0);
+        let base = TimeBase {
+            unit,
+            sample_rate_hz: 1.0 / period,
+            t0_s: t0,
+        };
+        self.base = Some(base);
+        self.period = period;
+        self.q.time_unit = unit;
+        self.q.sample_rate_hz = base.sample_rate_hz;
+        self.q.segments = 1;
+        if !self.sink.begin(&base) {
+            self.stopped = true;
+            return;
+        }
+        let head = std::mem::take(&mut self.head);
+        self.q.rows_read = 0;
+        for r in &head {
+            if !self.ingest(*r) {
+                self.stopped = true;
+                return;
+            }
+        }
+    }
+
+    /// One raw row (time in the log's unit).
+    fn ingest(&mut self, mut r: Row) -> bool {
+        self.q.rows_read += 1;
+        r.t_s *= self.q.time_unit.seconds();
+        if !r.t_s.is_finite() {
+            self.q.non_finite_times += 1;
+            self.note_dropped();
+            return true;
+        }
+        if self.last_t == f64::NEG_INFINITY {
+            return self.emit(r);
+        }
+        if let Some(p) = self.pending.take() {
+            let tol = INTERVAL_TOLERANCE * self.period;
+            if (r.t_s - self.last_t - 2.0 * self.period).abs() <= tol {
+                // p was one glitched timestamp between two rows on the grid.
+                self.q.timestamp_glitches += 1;
+                let fixed = Row {
+                    t_s: self.last_t + self.period,
+                    ..p
+                };
+                if !self.emit(fixed) {
+                    return false;
+                }
+            } else if !self.settle(p) {
+                return false;
+            }
+        }
+        let d = r.t_s - self.last_t;
+        if (d - self.period).abs() <= INTERVAL_TOLERANCE * self.period {
+            self.off_run.clear();
+            self.off_run_counts = (0, 0);
+            self.back_run.0 = 0;
+            return self.emit_on_clock(r, 1.0);
+        }
+        self.pending = Some(r);
+        true
+    }
+
+    /// A row whose interval is off the period and is not a single glitch: classify it.
+    fn settle(&mut self, p: Row) -> bool {
+        let d = p.t_s - self.last_t;
+        if d <= 0.0 {
+            return self.backward(p);
+        }
+        self.back_run.0 = 0;
+        if d > MAX_BRIDGED_GAP_S {
+            self.q.long_gaps += 1;
+            if self.q.long_gap_spans.len() < LIST_CAP {
+                let t0 = self.base.map_or(0.0, |b| b.t0_s);
+                self.q.long_gap_spans.push([self.last_t - t0, p.t_s - t0]);
+            }
+            self.off_run.clear();
+            self.off_run_counts = (0, 0);
+            return self.new_segment(SegmentBreak::Gap(d)) && self.emit(p);
+        }
+        let m = (d / self.period).round();
+        if m >= 2.0 && (d - m * self.period).abs() <= INTERVAL_TOLERANCE * self.period {
+            self.q.dropped_samples += m as u64 - 1;
+            self.q.gaps_bridged += 1;
+            self.q.longest_bridged_gap_s = self.q.longest_bridged_gap_s.max(d - self.period);
+            self.off_run_counts.0 += 1;
+        } else {
+            self.q.irregular_intervals += 1;
+            self.off_run_counts.1 += 1;
+        }
+        self.off_run.push(d);
+        if self.off_run.len() >= RATE_CHANGE_RUN && !self.rate_change(p.t_s) {
+            return false;
+        }
+        if m >= 2.0 && (d - m * self.period).abs() <= INTERVAL_TOLERANCE * self.period {
+            self.emit_on_clock(p, m)
+        } else {
+            self.emit(p)
+        }
+    }
+
+    /// Emits a row `m` periods after the last one on the smoothed sample clock: its time
+    /// moves the clock [`CLOCK_GAIN`] of the way to its own. A row within
+    /// [`CLOCK_EXACT`] of a period of the clock keeps its own time (a clean log passes
+    /// unchanged, to the last bit).
+    fn emit_on_clock(&mut self, r: Row, m: f64) -> bool {
+        let predicted = self.last_t + m * self.period;
+        let err = r.t_s - predicted;
+        self.jitter.0 += err * err;
+        self.jitter.1 += 1;
+        if err.abs() <= CLOCK_EXACT * self.period {
+            return self.emit(r);
+        }
+        self.emit(Row {
+            t_s: predicted + CLOCK_GAIN * err,
+            ..r
+        })
+    }
+
+    /// After [`RATE_CHANGE_RUN`] off-period intervals: if they agree, the rate changed.
+    fn rate_change(&mut self, t: f64) -> bool {
+        let mut run = std::mem::take(&mut self.off_run);
+        let counts = std::mem::take(&mut self.off_run_counts);
+        let Some(med) = median_positive(&mut run) else {
+            return true;
+        };
+        if !run.iter().all(|d| (d / med - 1.0).abs() <= 0.05) {
+            return true;
+        }
+        // Not drops nor irregular intervals: the new period.
+        self.q.dropped_samples -= self.q.dropped_samples.min(counts.0);
+        self.q.gaps_bridged -= self.q.gaps_bridged.min(counts.0);
+        self.q.irregular_intervals -= self.q.irregular_intervals.min(counts.1);
+        self.period = med;
+        if self.q.rate_changes.len() < LIST_CAP {
+            let t0 = self.base.map_or(0.0, |b| b.t0_s);
+            self.q.rate_changes.push(RateChange {
+                at_s: t - t0 - med * run.len() as f64,
+                rate_hz: 1.0 / med,
+            });
+        }
+        self.new_segment(SegmentBreak::RateChange(1.0 / med))
+    }
+
+    /// A row whose time repeats or goes back: dropped, unless a run of them is regular
+    /// among itself (the clock restarted).
+    fn backward(&mut self, p: Row) -> bool {
+        let (n, prev) = self.back_run;
+        let regular = (p.t_s - prev - self.period).abs() <= INTERVAL_TOLERANCE * self.period;
+        self.back_run = (if regular { n + 1 } else { 0 }, p.t_s);
+        self.q.repeated_or_backward_rows += 1;
+        self.note_dropped();
+        if self.back_run.0 + 1 < RATE_CHANGE_RUN {
+            return true;
+        }
+        self.q.repeated_or_backward_rows -= RATE_CHANGE_RUN as u64 - 1;
+        self.q.clock_resets += 1;
+        self.back_run.0 = 0;
+        self.off_run.clear();
+        self.off_run_counts = (0, 0);
+        self.new_segment(SegmentBreak::ClockReset) && self.emit(p)
+    }
+
+    fn new_segment(&mut self, why: SegmentBreak) -> bool {
+        self.q.segments += 1;
+        self.sink.new_segment(why)
+    }
+
+    /// Passes a row on: cells judged, bursts and crossings tracked.
+    fn emit(&mut self, r: Row) -> bool {
+        self.last_t = r.t_s;
+        self.dropping = false;
+        self.q.rows_passed += 1;
+        let bad = BadCells::of(&r, &self.limits);
+        if bad.any() {
+            self.q.bad_rows += 1;
+            for c in Column::ALL {
+                if bad.has(c) {
+                    *self.q.bad_cells.entry(c.name().to_string()).or_insert(0) += 1;
+                }
+            }
+            let start = self.burst.map_or(r.t_s, |b| b.0);
+            self.burst = Some((start, r.t_s));
+        } else {
+            self.end_burst();
+            self.crossings.push(r.t_s, r.i_abc[0], 1.0);
+        }
+        self.sink.row(&r, bad)
+    }
+
+    /// A row dropped for its time: counts the stretches of them.
+    fn note_dropped(&mut self) {
+        if !self.dropping {
+            self.dropping = true;
+            self.q.time_drop_runs += 1;
+        }
+    }
+
+    fn end_burst(&mut self) {
+        if let Some((a, b)) = self.burst.take() {
+            let length = b - a + self.period;
+            self.q.glitch_bursts += 1;
+            self.q.longest_burst_s = self.q.longest_burst_s.max(length);
+            if length <= MAX_BRIDGED_GAP_S {
+                self.q.rows_in_short_bursts += (length / self.period).round() as u64;
+            }
+        }
+    }
+}
+
+impl<S: CleanSink> RowSink for QualityStage<'_, S> {
+    fn row(&mut self, row: &Row) -> bool {
+        if self.stopped {
+            return false;
+        }
+        if self.base.is_some() {
+            let go = self.ingest(*row);
+            self.stopped = !go;
+            return go;
+        }
+        self.head.push(*row);
+        if self.head.len() >= HEAD_ROWS {
+            self.start();
+        }
+        !self.stopped
+    }
+
+    fn restart(&mut self) {
+        self.sink.restart();
+        self.head.clear();
+        self.base = None;
+        self.last_t = f64::NEG_INFINITY;
+        self.pending = None;
+        self.off_run.clear();
+        self.off_run_counts = (0, 0);
+        self.back_run = (0, f64::NAN);
+        self.burst = None;
+        self.crossings = CrossingCounter::default();
+        self.jitter = (0.0, 0);
+        self.dropping = false;
+        self.q = DataQuality::default();
+        self.error = None;
+        self.stopped = false;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Collects what the stage passes on.
+    #[derive(Default)]
+    struct Collect {
+        base: Option<TimeBase>,
+        rows: Vec<(Row, BadCells)>,
+        breaks: Vec<(usize, SegmentBreak)>,
+    }
+
+    impl CleanSink for Collect {
+        fn begin(&mut self, base: &TimeBase) -> bool {
+            self.base = Some(*base);
+            true
+        }
+        fn row(&mut self, row: &Row, bad: BadCells) -> bool {
+            self.rows.push((*row, bad));
+            true
+        }
+        fn new_segment(&mut self, why: SegmentBreak) -> bool {
+            self.breaks.push((self.rows.len(), why));
+            true
+        }
+        fn restart(&mut self) {
+            *self = Collect::default();
+        }
+    }
+
+    const LIMITS: CellLimits = CellLimits {
+        v_max: 1000.0,
+        i_max: 100.0,
+        wm_max: 1000.0,
+        supply_hz: 50.0,
+    };
+
+    /// A 50 Hz three-phase row at time `t` (10 A peak).
+    fn row(t: f64) -> Row {
+        let w = std::f64::consts::TAU * 50.0 * t;
+        let ph = |k: f64| 10.0 * (w - k * std::f64::consts::TAU / 3.0).cos();
+        Row {
+            t_s: t,
+            v_abc: Some([300.0 * w.cos(), 0.0, 0.0]),
+            i_abc: [ph(0.0), ph(1.0), ph(2.0)],
+            wm_rad_s: Some(150.0),
+            enc_count: None,
+        }
+    }
+
+    /// Runs `times` (in the file's unit, rows built at `times * unit`) through the stage.
+    fn run(times: &[f64], unit: f64) -> (Collect, DataQuality) {
+        let mut sink = Collect::default();
+        let mut stage = QualityStage::new(&mut sink, LIMITS, "t.csv");
+        for &t in times {
+            let mut r = row(t * unit);
+            r.t_s = t;
+            assert!(stage.row(&r));
+        }
+        let q = stage.finish().unwrap();
+        (sink, q)
+    }
+
+    fn grid(n: usize, fs: f64) -> Vec<f64> {
+        (0..n).map(|k| k as f64 / fs).collect()
+    }
+
+    #[test]
+    fn a_clean_log_passes_unchanged() {
+        let t = grid(20_000, 10_000.0);
+        let (c, q) = run(&t, 1.0);
+        assert_eq!(c.rows.len(), t.len());
+        assert!(c
+            .rows
+            .iter()
+            .zip(&t)
+            .all(|((r, _), t)| (r.t_s - t).abs() < 1e-12));
+        assert!(q.trusted && q.warnings.is_empty(), "{q:?}");
+        assert!((q.sample_rate_hz - 10_000.0).abs() < 1e-6);
+        assert!((q.current_frequency_hz.unwrap() - 50.0).abs() < 0.5);
+    }
+
+    #[test]
+    fn jittered_timestamps_go_onto_the_sample_clock() {
+        // +/- 20 % of a period, uniform (a software timestamp), deterministic.
+        let mut x = 1u64;
+        let t: Vec<f64> = grid(50_000, 10_000.0)
+            .into_iter()
+            .map(|t| {
+                x = x
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                t + 2e-5 * ((x >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0)
+            })
+            .collect();
+        let (c, q) = run(&t, 1.0);
+        assert_eq!(c.rows.len(), t.len());
+        assert_eq!(q.irregular_intervals + q.timestamp_glitches, 0, "{q:?}");
+        // The clock's distance from the true sample times: a fifth of the raw jitter's.
+        let err: Vec<f64> = c
+            .rows
+            .iter()
+            .enumerate()
+            .skip(200)
+            .map(|(k, (r, _))| r.t_s - k as f64 * 1e-4)
+            .collect();
+        let rms = (err.iter().map(|e| e * e).sum::<f64>() / err.len() as f64).sqrt();
+        assert!(rms < 0.2 * 11.5e-6, "clock error {rms} s RMS");
+        assert!(q.timestamp_jitter_rms_s > 1e-5 && q.trusted);
+    }
+}

@@ -1,0 +1,315 @@
+//! What `diagnose` did about its thresholds (JSON key `commissioning`): whether a
+//! `--commission START:END` window was learned, over which part of the log, how many
+//! seconds of it the core could evaluate, and which operating range it covered; without
+//! a window, how far each residual sat from zero against the fixed thresholds.
+//!
+//! The core learns over *evaluated* running (`monitor_core::commissioning`: blocks with
+//! the quasi-steady gate closed do not count), so a window of `END - START` seconds may
+//! need a little longer in log time. The replay starts the run at `START` and lets it
+//! finish up to [`grace_s`] after `END`; a run still learning then, or at the end of the
+//! log, is *incomplete*: it is cancelled (the fixed thresholds stay in force) and
+//! `diagnose` refuses to give a verdict unless `--allow-incomplete`.
+//!
+//! The learned healthy means hold only near the operating point they were learned at
+//! (DESIGN.md: to the paper's model a load change is a Bl change, a voltage change moves
+//! the residuals' means). While an r2/r3/r4 lamp is lit the tracker compares the load
+//! current `Iqs` and the voltage `Vqs` with their span during learning and says when they
+//! have left it ([`RangeNote`]).
+
+use monitor_core::{CommissioningState, Monitor, MonitorConfig, MonitorOutput, RunStage};
+use serde::Serialize;
+
+/// How long after the window's end a run may still finish [s]: half the window, at least
+/// one second.
+pub fn grace_s(start_s: f64, end_s: f64) -> f64 {
+    (0.5 * (end_s - start_s)).max(1.0)
+}
+
+/// Departure from the commissioned range that is reported (fraction of the range's
+/// largest magnitude).
+const RANGE_MARGIN: f32 = 0.05;
+
+/// The commissioning part of `diagnose`'s report.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct CommissioningReport {
+    /// `learned`, `incomplete` or `none`.
+    pub state: &'static str,
+    /// The window asked for, `[START, END]` [s], if any.
+    pub requested: Option<[f64; 2]>,
+    /// The part of the log the run actually spanned, from its start to its end (or to
+    /// where it was cancelled, or to the end of the log) [s]; null if it never started.
+    pub window: Option<[f64; 2]>,
+    /// Seconds of evaluated running learned.
+    pub seconds_evaluated: f64,
+    /// Seconds of evaluated running the window asked for.
+    pub seconds_needed: f64,
+    /// Span of the load (torque) current Iqs while learning, `[min, max]` [A].
+    pub load_current_a: Option<[f32; 2]>,
+    /// Span of the voltage Vqs while learning, `[min, max]` [V].
+    pub voltage_v: Option<[f32; 2]>,
+    /// Which thresholds the lamps used, in words.
+    pub thresholds: String,
+    /// Without commissioning: the first quasi-steady point and the residuals there.
+    pub first_quasi_steady: Option<SteadyPoint>,
+    /// Times a lit r2/r3/r4 lamp met an operating point outside the learned range.
+    pub outside_range: Vec<RangeNote>,
+    /// What the user should do or know, if anything.
+    pub advice: Option<String>,
+}
+
+/// The residuals at one time.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct SteadyPoint {
+    /// Time since the log's start [s].
+    pub t_s: f64,
+    /// Normalised residuals r1..r4 (the fixed thresholds act on |r|).
+    pub residuals: [f32; 4],
+}
+
+/// An operating point outside the commissioned range while a lamp was lit.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct RangeNote {
+    /// First time [s].
+    pub t_s: f64,
+    /// What left the range, by how much, and what it means.
+    pub note: String,
+}
+
+/// Follows a replay's commissioning (see the module documentation).
+#[derive(Debug, Clone)]
+pub(super) struct CommissionTracker {
+    requested: Option<(f64, f64)>,
+    run_id: Option<u16>,
+    started_at: Option<f64>,
+    ended_at: Option<f64>,
+    cancelled: bool,
+    slow_hz: f64,
+    fixed: [f32; 4],
+    iqs: Option<[f32; 2]>,
+    vqs: Option<[f32; 2]>,
+    first_steady: Option<SteadyPoint>,
+    notes: Vec<RangeNote>,
+    noted: u8,
+    last_t: f64,
+    learned: (u32, u32),
+}
+
+fn widen(span: &mut Option<[f32; 2]>, x: f32) {
+    if !x.is_finite() {
+        return;
+    }
+    let s = span.get_or_insert([x, x]);
+    s[0] = s[0].min(x);
+    s[1] = s[1].max(x);
+}
+
+/// How far `x` lies outside `span`, as a signed fraction of the span's largest magnitude
+/// (positive above, negative below), `None` inside or within the margin.
+fn outside(span: [f32; 2], x: f32) -> Option<f32> {
+    let scale = span[0].abs().max(span[1].abs()).max(1e-6);
+    let f = if x > span[1] {
+        (x - span[1]) / scale
+    } else if x < span[0] {
+        (x - span[0]) / scale
+    } else {
+        0.0
+    };
+    (f.abs() > RANGE_MARGIN).then_some(f)
+}
+
+impl CommissionTracker {
+    pub(super) fn new(requested: Option<(f64, f64)>, cfg: &MonitorConfig) -> Self {
+        CommissionTracker {
+            requested,
+            run_id: None,
+            started_at: None,
+            ended_at: None,
+            cancelled: false,
+            slow_hz: f64::from(cfg.sample_rate_hz) / f64::from(cfg.decimation.max(1)),
+            fixed: cfg.thresholds.fixed,
+            iqs: None,
+            vqs: None,
+            first_steady: None,
+            notes: Vec::new(),
+            noted: 0,
+            last_t: 0.0,
+            learned: (0, 0),
+        }
+    }
+
+    /// Before the sample at `t` [s since the log's start]: starts the run at the window's
+    /// start, cancels it when it is still learning past the grace time.
+    pub(super) fn before(&mut self, mon: &mut Monitor, t: f64) {
+        self.last_t = t;
+        let Some((a, b)) = self.requested else {
+            return;
+        };
+        if self.started_at.is_none() && t >= a {
+            self.started_at = Some(t);
+            self.run_id = mon.start_commissioning((b - a) as f32).ok();
+        }
+        if let Some(id) = self.run_id {
+            if self.ended_at.is_none()
+                && t > b + grace_s(a, b)
+                && mon.commissioning().stage == RunStage::Learning
+                && mon.cancel_commissioning(id)
+            {
+                self.ended_at = Some(t);
+                self.cancelled = true;
+            }
+        }
+    }
+
+    /// After the sample: records the learning range, the run's end, the first
+    /// quasi-steady point; returns a note when a lit r2..r4 lamp meets an operating point
+    /// outside the learned range.
+    pub(super) fn after(&mut self, mon: &Monitor, t: f64, out: &MonitorOutput) -> Option<String> {
+        let run = mon.commissioning();
+        if self.run_id == Some(run.id) {
+            self.learned = (run.blocks_learned, run.blocks_needed);
+            if run.stage == RunStage::Done && self.ended_at.is_none() {
+                self.ended_at = Some(t);
+            }
+        }
+        if matches!(out.commissioning, CommissioningState::Learning(_)) && out.quasi_steady {
+            widen(&mut self.iqs, out.operating.iqs);
+            widen(&mut self.vqs, out.operating.vqs);
+        }
+        if self.requested.is_none() && self.first_steady.is_none() && out.evaluating {
+            self.first_steady = Some(SteadyPoint {
+                t_s: t,
+                residuals: out.residuals,
+            });
+        }
+        let learned = out.commissioning == CommissioningState::Commissioned;
+        if !(learned && out.lamps.iter().skip(1).any(|l| *l)) {
+            return None;
+        }
+        self.range_note(t, out)
+    }
+
+    fn range_note(&mut self, t: f64, out: &MonitorOutput) -> Option<String> {
+        let mut said = Vec::new();
+        let checks = [
+            (
+                self.iqs,
+                out.operating.iqs,
+                "load (Iqs)",
+                "to the paper's model a load change is a Bl change",
+            ),
+            (
+                self.vqs,
+                out.operating.vqs,
+                "voltage (Vqs)",
+                "the learned healthy means hold only at the voltage they were learned at",
+            ),
+        ];
+        for (k, (span, x, what, meaning)) in checks.into_iter().enumerate() {
+            let Some(f) = span.and_then(|s| outside(s, x)) else {
+                continue;
+            };
+            let dir = if f > 0.0 { "above" } else { "below" };
+            let s = span.unwrap_or_default();
+            let note = format!(
+                "{what} {x:.2} is {:.0} % {dir} the commissioned range {:.2}..{:.2}: {meaning}",
+                100.0 * f.abs(),
+                s[0],
+                s[1]
+            );
+            let bit = 1u8 << (2 * k + usize::from(f > 0.0));
+            if self.noted & bit == 0 {
+                self.noted |= bit;
+                self.notes.push(RangeNote {
+                    t_s: t,
+                    note: note.clone(),
+                });
+            }
+            said.push(note);
+        }
+        (!said.is_empty()).then(|| said.join("; "))
+    }
+
+    /// True when a window was asked for and not learned.
+    pub(super) fn incomplete(&self) -> bool {
+        self.requested.is_some() && !self.learned_ok()
+    }
+
+    fn learned_ok(&self) -> bool {
+        !self.cancelled && self.ended_at.is_some() && self.learned.0 >= self.learned.1
+    }
+
+    /// Why the window is incomplete, in one line (for the error and the report).
+    pub(super) fn why_incomplete(&self) -> Option<String> {
+        let (a, b) = self.requested?;
+        if self.learned_ok() {
+            return None;
+        }
+        let end = self.last_t;
+        Some(match self.started_at {
+            None => format!(
+                "--commission {a}:{b}: the log ends at {end:.2} s, before the window starts"
+            ),
+            Some(_) => format!(
+                "--commission {a}:{b}: learned {:.2} s of the {:.2} s of evaluated running asked for by {:.2} s ({}); the lamps were off while learning",
+                self.seconds(self.learned.0),
+                b - a,
+                self.ended_at.unwrap_or(end),
+                if self.cancelled {
+                    "the window held too little quasi-steady running with usable data"
+                } else {
+                    "the log ended first"
+                }
+            ),
+        })
+    }
+
+    fn seconds(&self, blocks: u32) -> f64 {
+        f64::from(blocks) / self.slow_hz.max(1e-9)
+    }
+
+    /// The report at the end of the replay.
+    pub(super) fn report(&self, k_sigma: f32) -> CommissioningReport {
+        let fixed = format!(
+            "fixed: |r| > {:.1} % against the nominal parameters",
+            100.0 * self.fixed[0]
+        );
+        let (state, thresholds, advice) = match self.requested {
+            None => (
+                "none",
+                fixed,
+                Some(
+                    "the thresholds are fixed against the parameter file's nominal values; a real motor's parameters differ by 10-30 %, so commission (--commission START:END) over healthy running that covers the whole load and voltage range"
+                        .to_string(),
+                ),
+            ),
+            Some((a, _)) if self.learned_ok() => (
+                "learned",
+                format!(
+                    "learned over {a}..{:.2} s: mean +/- {k_sigma} spreads",
+                    self.ended_at.unwrap_or(self.last_t)
+                ),
+                None,
+            ),
+            Some(_) => (
+                "incomplete",
+                format!("{fixed} (commissioning incomplete)"),
+                self.why_incomplete(),
+            ),
+        };
+        CommissioningReport {
+            state,
+            requested: self.requested.map(|(a, b)| [a, b]),
+            window: self
+                .started_at
+                .map(|s| [s, self.ended_at.unwrap_or(self.last_t)]),
+            seconds_evaluated: self.seconds(self.learned.0),
+            seconds_needed: self.requested.map_or(0.0, |(a, b)| b - a),
+            load_current_a: self.iqs,
+            voltage_v: self.vqs,
+            thresholds,
+            first_quasi_steady: self.first_steady,
+            outside_range: self.notes.clone(),
+            advice,
+        }
+    }
+}
