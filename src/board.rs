@@ -434,4 +434,37 @@ mod tests {
         assert_eq!(v.code_of(-1e6), 0);
         assert!(is_saturated_code(0) && is_saturated_code(4095) && !is_saturated_code(1));
     }
+
+    #[test]
+    fn pin_names_parse_and_print_back() {
+        let pb12 = GpioPin {
+            port: Port::B,
+            number: 12,
+        };
+        assert_eq!(GpioPin::parse("PB12"), Some(pb12));
+        assert_eq!(pb12.to_string(), "PB12");
+        for bad in ["", "P", "PA", "PB16", "PB20", "PH1", "XA1", "PA1x", "pa1"] {
+            assert_eq!(GpioPin::parse(bad), None, "{bad}");
+        }
+        for port in ['A', 'B', 'C', 'D', 'E', 'F', 'G'] {
+            for n in 0..16 {
+                let name = format!("P{port}{n}");
+                assert_eq!(GpioPin::parse(&name).unwrap().to_string(), name);
+            }
+        }
+    }
+
+    #[test]
+    fn the_lamp_table_has_one_pin_per_lamp_in_panel_order() {
+        for (k, lamp) in Lamp::ALL.into_iter().enumerate() {
+            assert_eq!(lamp as usize, k);
+            assert!(!lamp.label().is_empty() && lamp.meaning().starts_with(lamp.label()));
+            for other in Lamp::ALL.into_iter().skip(k + 1) {
+                assert_ne!(lamp.pin(), other.pin(), "{lamp:?} and {other:?}");
+            }
+        }
+        assert_eq!(Lamp::ALL.first(), Some(&Lamp::Run));
+        assert_eq!(Lamp::ALL.last(), Some(&Lamp::Fault));
+        assert_eq!(Lamp::ALL.get(1..5), Some(&Lamp::RESIDUALS[..]));
+    }
 }
