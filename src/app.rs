@@ -93,9 +93,48 @@ impl Settings {
 
     /// Samples between two status hand-overs to thread mode: `sample_rate_hz / 100`, so
     /// the status comes at 100 Hz (at least every sample).
-    pub fn status_every(&self) -> u32 {
-        (self.sample_rate_hz / 100).max(1)
+    pub const fn status_every(&self) -> u32 {
+        let n = self.sample_rate_hz / 100;
+        if n == 0 {
+            1
+        } else {
+            n
+        }
     }
+
+    /// Checks the ranges of the fields (a `const fn`: the firmware checks its settings at
+    /// compile time). Whether the core accepts the sample rate for the machine (at least
+    /// 8 times the supply frequency, enough slow-path blocks per period) is checked when
+    /// the sample path is built ([`SamplePath::for_board`]).
+    ///
+    /// # Errors
+    /// [`SettingsError`] naming the first field out of range.
+    pub const fn validate(&self) -> Result<(), SettingsError> {
+        let rate = self.sample_rate_hz;
+        if rate == 0 || !rate.is_multiple_of(100) || !TICK_HZ.is_multiple_of(rate) {
+            return Err(SettingsError::SampleRate);
+        }
+        let d = self.commissioning_duration_s;
+        if !(d > 0.0 && d < f32::INFINITY) {
+            return Err(SettingsError::CommissioningDuration);
+        }
+        if self.commissioning_stall_ms == 0 {
+            return Err(SettingsError::CommissioningStall);
+        }
+        Ok(())
+    }
+}
+
+/// A [`Settings`] field out of range.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SettingsError {
+    /// `sample_rate_hz` is 0, not a multiple of 100, or does not divide the 1 MHz
+    /// timestamp clock.
+    SampleRate,
+    /// `commissioning_duration_s` is not finite and positive.
+    CommissioningDuration,
+    /// `commissioning_stall_ms` is 0.
+    CommissioningStall,
 }
 
 impl Default for Settings {
@@ -479,6 +518,30 @@ pub fn carry_out<S: RecordStore>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn settings_out_of_range_are_named() {
+        assert_eq!(Settings::DEFAULT.validate(), Ok(()));
+        for rate in [0, 7_000, 10_050, 3_000_000] {
+            let s = Settings {
+                sample_rate_hz: rate,
+                ..Settings::DEFAULT
+            };
+            assert_eq!(s.validate(), Err(SettingsError::SampleRate), "{rate}");
+        }
+        for d in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+            let s = Settings {
+                commissioning_duration_s: d,
+                ..Settings::DEFAULT
+            };
+            assert_eq!(s.validate(), Err(SettingsError::CommissioningDuration));
+        }
+        let s = Settings {
+            commissioning_stall_ms: 0,
+            ..Settings::DEFAULT
+        };
+        assert_eq!(s.validate(), Err(SettingsError::CommissioningStall));
+    }
 
     #[test]
     fn board_config_is_valid() {

@@ -65,6 +65,7 @@ bind_interrupts!(struct Irqs {
 /// rate goes through `SamplePath::for_board`, that is `app::board_monitor_config`, the
 /// same configuration function the host tests use.
 const SETTINGS: Settings = Settings::DEFAULT;
+const _: () = assert!(SETTINGS.validate().is_ok(), "SETTINGS out of range");
 /// Samples per DMA half buffer: 1, so every sample is processed as it arrives and the
 /// encoder is read within microseconds of the conversion.
 const SAMPLES_PER_HALF: usize = 1;
