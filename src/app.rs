@@ -1,31 +1,47 @@
-//! The firmware's application logic, hardware-free: what runs per sample and what the
-//! slow (thread-mode) side does with the results.
+//! The firmware's application logic, hardware-free: what runs per sample, what the sample
+//! task hands over, and what thread mode does with it.
 //!
 //! - [`SamplePath`] runs in the high-priority sample task: [`RawFrame`] -> [`Sample`] ->
-//!   [`Monitor::update`], applies [`Command`]s between samples, and reports when the core
-//!   finished learning. Bounded work, no panics, no allocation.
-//! - Thread mode runs the commissioning procedure
-//!   ([`CommissioningProcedure`](crate::commissioning::CommissioningProcedure)) and maps
-//!   the latest [`MonitorOutput`] to the panel ([`PanelInput::from_output`]).
+//!   [`Monitor::update`], and applies [`Command`]s between samples. Bounded work, no
+//!   panics, no allocation, no copy of the core's output per sample: every
+//!   [`Settings::status_every`] samples the task hands thread mode a small
+//!   [`MonitorStatus`] ([`SamplePath::status`]).
+//! - [`Supervisor`] runs in thread mode every [`PANEL_PERIOD_MS`]: the button, the
+//!   commissioning procedure ([`CommissioningProcedure`]), the liveness watch
+//!   ([`SampleWatch`]: the watchdog is petted only while samples flow), and the panel.
+//!   [`carry_out`] turns its actions into commands, storing the learned calibration first.
 //!
-//! The host tests (`tests/sil.rs`) drive exactly these types with simulated data.
+//! The host tests (`tests/sil.rs`) drive exactly these types with simulated data; the
+//! firmware (`src/firmware.rs`) only adds the hardware around them.
 //!
 //! [`Sample`]: monitor_core::Sample
-//! [`MonitorOutput`]: monitor_core::MonitorOutput
-//! [`PanelInput::from_output`]: crate::panel::PanelInput::from_output
 
 use crate::board::{self, FrontEnd};
-use crate::flash_record::CalibrationRecord;
+use crate::commissioning::{Action, CommissioningProcedure, RunEnd};
+use crate::flash_record::{self, CalibrationRecord, RecordStore, Stored};
+use crate::liveness::{LivenessChange, SampleWatch};
+use crate::panel::{self, Mode, PanelInput, PanelLamps};
+use crate::reset_record::PreviousRun;
 use crate::sampling::{AdcSampler, RawFrame, SamplingError, TICK_HZ};
 use monitor_core::{
-    CommissioningState, ConfigError, Monitor, MonitorConfig, MonitorOutput, MotorModel,
-    ReferenceMachine,
+    CommissioningError, CommissioningRun, ConfigError, Fault, Install, Monitor, MonitorConfig,
+    MotorModel, ReferenceMachine, SensorFlags,
 };
 
 /// The machine the firmware monitors by default: DESIGN.md's "2.2 kW" reference machine
 /// (`monitor_core::reference::MOTOR_2P2KW`: 400 V, 50 Hz, 4 poles, Gamma model, Bl for the
 /// rated 14.6 N m near rated speed). Edit here for another machine.
 pub const DEFAULT_MACHINE: ReferenceMachine = monitor_core::reference::MOTOR_2P2KW;
+
+/// Thread mode's period (button, commissioning, liveness, panel), ms.
+pub const PANEL_PERIOD_MS: u32 = 50;
+/// Independent watchdog timeout, ms: the MCU resets this long after the last pet.
+pub const WATCHDOG_TIMEOUT_MS: u32 = 500;
+/// How long the panel shows "monitor failed" after a reset by a panic, a stalled sample
+/// path or a hang, ms.
+pub const FAILED_BOOT_SHOW_MS: u32 = 5_000;
+/// Button debounce: presses closer together than this count once, ms.
+pub const BUTTON_DEBOUNCE_MS: u32 = 300;
 
 /// The default machine in the core's precision.
 pub fn default_motor() -> MotorModel {
@@ -53,6 +69,80 @@ pub fn board_monitor_config(sample_rate_hz: u32) -> MonitorConfig {
     cfg
 }
 
+/// The firmware's settings: what a user may change without touching the code paths.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    /// Sample (trigger) rate of the six channels, Hz: must divide the 1 MHz timestamp clock
+    /// and be a multiple of 100 (the status rate), and the core must accept it (at least
+    /// 8x the supply frequency, see `MonitorConfig`). Default 10 kHz.
+    pub sample_rate_hz: u32,
+    /// Seconds of evaluated running one commissioning run learns, > 0. Default 10 s.
+    pub commissioning_duration_s: f32,
+    /// A commissioning run that learns no evaluated block for this long is cancelled, ms.
+    /// Default 3 s ([`CommissioningProcedure::DEFAULT_STALL_TIMEOUT_MS`]).
+    pub commissioning_stall_ms: u32,
+}
+
+impl Settings {
+    /// The defaults: 10 kHz, 10 s of learning, 3 s stall time.
+    pub const DEFAULT: Settings = Settings {
+        sample_rate_hz: board::DEFAULT_SAMPLE_RATE_HZ,
+        commissioning_duration_s: CommissioningProcedure::DEFAULT_DURATION_S,
+        commissioning_stall_ms: CommissioningProcedure::DEFAULT_STALL_TIMEOUT_MS,
+    };
+
+    /// Samples between two status hand-overs to thread mode: `sample_rate_hz / 100`, so
+    /// the status comes at 100 Hz (at least every sample).
+    pub const fn status_every(&self) -> u32 {
+        let n = self.sample_rate_hz / 100;
+        if n == 0 {
+            1
+        } else {
+            n
+        }
+    }
+
+    /// Checks the ranges of the fields (a `const fn`: the firmware checks its settings at
+    /// compile time). Whether the core accepts the sample rate for the machine (at least
+    /// 8 times the supply frequency, enough slow-path blocks per period) is checked when
+    /// the sample path is built ([`SamplePath::for_board`]).
+    ///
+    /// # Errors
+    /// [`SettingsError`] naming the first field out of range.
+    pub const fn validate(&self) -> Result<(), SettingsError> {
+        let rate = self.sample_rate_hz;
+        if rate == 0 || !rate.is_multiple_of(100) || !TICK_HZ.is_multiple_of(rate) {
+            return Err(SettingsError::SampleRate);
+        }
+        let d = self.commissioning_duration_s;
+        if !(d > 0.0 && d < f32::INFINITY) {
+            return Err(SettingsError::CommissioningDuration);
+        }
+        if self.commissioning_stall_ms == 0 {
+            return Err(SettingsError::CommissioningStall);
+        }
+        Ok(())
+    }
+}
+
+/// A [`Settings`] field out of range.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SettingsError {
+    /// `sample_rate_hz` is 0, not a multiple of 100, or does not divide the 1 MHz
+    /// timestamp clock.
+    SampleRate,
+    /// `commissioning_duration_s` is not finite and positive.
+    CommissioningDuration,
+    /// `commissioning_stall_ms` is 0.
+    CommissioningStall,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
 /// Why the application could not be built.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum AppError {
@@ -65,24 +155,99 @@ pub enum AppError {
 /// Requests from thread mode to the sample task (applied between two samples).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Command {
-    /// Start learning the healthy thresholds for `duration_s` seconds.
+    /// Start a commissioning run of `duration_s` seconds of evaluated running; the learned
+    /// calibration goes into force once stored ([`Install::AfterStorage`]).
     StartCommissioning {
         /// Learning time, s (> 0).
         duration_s: f32,
     },
-    /// Install a calibration read from flash.
+    /// Cancel run `run` if it is still learning.
+    CancelCommissioning {
+        /// The run's id.
+        run: u16,
+    },
+    /// The flash holds `stored` after storing run `run`'s calibration (read back): the
+    /// core puts exactly that into force (`None`: the default thresholds) and ends the run.
+    CalibrationStored {
+        /// The run's id.
+        run: u16,
+        /// The record read back (`None`: no valid record).
+        stored: Option<CalibrationRecord>,
+    },
+    /// Install a calibration read from flash at boot.
     SetCalibration(CalibrationRecord),
 }
 
-/// Result of one sample.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SampleResult {
-    /// The core's output after this sample.
-    pub output: MonitorOutput,
-    /// `Some` exactly once, on the sample where learning finished: the learned values.
-    pub learned: Option<CalibrationRecord>,
-    /// `true` exactly once if learning ended without a calibration.
-    pub learning_failed: bool,
+/// Why the core did not carry out a [`Command`] as asked.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CommandError {
+    /// A start was refused.
+    Commissioning(CommissioningError),
+    /// A cancel found that run not learning (it had ended or learned already).
+    NotLearning,
+    /// A stored or stored-back calibration is out of the core's range (the default
+    /// thresholds are in force for `CalibrationStored`; the previous ones for
+    /// `SetCalibration`).
+    Calibration(ConfigError),
+}
+
+impl CommandError {
+    /// A short description for logs.
+    pub fn describe(&self) -> &'static str {
+        match self {
+            CommandError::Commissioning(CommissioningError::Duration) => {
+                "commissioning refused: bad duration"
+            }
+            CommandError::Commissioning(CommissioningError::Busy) => {
+                "commissioning refused: a run is active"
+            }
+            CommandError::Commissioning(CommissioningError::StaleRun) => {
+                "commissioning report for an older run"
+            }
+            CommandError::NotLearning => "cancel: the run is not learning",
+            CommandError::Calibration(_) => "calibration out of the core's range",
+        }
+    }
+}
+
+impl Command {
+    /// A short name for logs.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Command::StartCommissioning { .. } => "start-commissioning",
+            Command::CancelCommissioning { .. } => "cancel-commissioning",
+            Command::CalibrationStored { .. } => "calibration-stored",
+            Command::SetCalibration(_) => "set-calibration",
+        }
+    }
+}
+
+/// What the sample task hands thread mode: the little the panel, the supervision and the
+/// log line need, built every [`Settings::status_every`] samples.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct MonitorStatus {
+    /// Samples processed since boot (wrapping): the liveness signal.
+    pub samples: u32,
+    /// Normalised residuals r1..r4.
+    pub residuals: [f32; 4],
+    /// Residual lamps r1..r4 as the core decided them.
+    pub residual_lamps: [bool; 4],
+    /// The core detected a fault (a lamp or a sensor fault).
+    pub fault_detected: bool,
+    /// Sensor faults from impossible readings.
+    pub sensor_fault: SensorFlags,
+    /// The most probable fault candidate and its probability.
+    pub top: Option<(Fault, f32)>,
+    /// The second most probable candidate (probability > 0), for the log.
+    pub second: Option<(Fault, f32)>,
+    /// Mechanical speed from the encoder, rad/s.
+    pub speed_rad_s: f32,
+    /// The zero-crossing detector's lock (`None` with other angle sources).
+    pub zero_crossing_locked: Option<bool>,
+    /// Learned thresholds are in force (else the default ones).
+    pub commissioned: bool,
+    /// The latest commissioning run.
+    pub run: CommissioningRun,
 }
 
 /// The per-sample path: scaling, the core, commands.
@@ -90,18 +255,7 @@ pub struct SampleResult {
 pub struct SamplePath {
     monitor: Monitor,
     sampler: AdcSampler,
-    learning: Learning,
-}
-
-/// Where a requested learning run stands, as seen from the outputs.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Learning {
-    /// Not learning.
-    Idle,
-    /// Requested; the core reports `Learning` from its next slow-path run on.
-    Requested,
-    /// The core reported `Learning`; its end is the result.
-    Running,
+    samples: u32,
 }
 
 impl SamplePath {
@@ -117,11 +271,12 @@ impl SamplePath {
         Ok(Self {
             monitor: Monitor::new(cfg).map_err(AppError::Config)?,
             sampler: AdcSampler::new(front_end, sample_rate_hz).map_err(AppError::Sampling)?,
-            learning: Learning::Idle,
+            samples: 0,
         })
     }
 
-    /// The default board setup at `sample_rate_hz`.
+    /// The board setup at `sample_rate_hz` (the [`Settings`] value): the configuration of
+    /// [`board_monitor_config`] and the default front end.
     ///
     /// # Errors
     /// As [`SamplePath::new`].
@@ -136,16 +291,25 @@ impl SamplePath {
     /// Apply a command.
     ///
     /// # Errors
-    /// [`monitor_core::ConfigErrorKind::Calibration`] when a stored calibration is out of the core's range
-    /// (the monitor keeps its previous thresholds).
-    pub fn command(&mut self, cmd: Command) -> Result<(), ConfigError> {
+    /// [`CommandError`] when the core refused or could not do what was asked (see there
+    /// for what is in force then).
+    pub fn command(&mut self, cmd: Command) -> Result<(), CommandError> {
+        let m = &mut self.monitor;
         match cmd {
-            Command::StartCommissioning { duration_s } => {
-                self.monitor.start_commissioning(duration_s);
-                self.learning = Learning::Requested;
-                Ok(())
-            }
-            Command::SetCalibration(rec) => self.monitor.set_calibration(rec.into()),
+            Command::StartCommissioning { duration_s } => m
+                .start_commissioning_with(duration_s, Install::AfterStorage)
+                .map(|_| ())
+                .map_err(CommandError::Commissioning),
+            Command::CancelCommissioning { run } => m
+                .cancel_commissioning(run)
+                .then_some(())
+                .ok_or(CommandError::NotLearning),
+            Command::CalibrationStored { run, stored } => m
+                .calibration_stored(run, stored.map(Into::into))
+                .map_err(CommandError::Calibration),
+            Command::SetCalibration(rec) => m
+                .set_calibration(rec.into())
+                .map_err(CommandError::Calibration),
         }
     }
 
@@ -164,27 +328,189 @@ impl SamplePath {
         &self.monitor
     }
 
+    /// Samples processed since boot (wrapping).
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
     /// Process one trigger's readings.
     #[inline]
-    pub fn on_frame(&mut self, raw: &RawFrame) -> SampleResult {
+    pub fn on_frame(&mut self, raw: &RawFrame) {
         let sample = self.sampler.build(raw);
-        let output = *self.monitor.update(&sample);
-        let mut learned = None;
-        let mut learning_failed = false;
-        let core_learning = matches!(output.commissioning, CommissioningState::Learning(_));
-        if self.learning == Learning::Requested && core_learning {
-            self.learning = Learning::Running;
-        } else if self.learning == Learning::Running && !core_learning {
-            self.learning = Learning::Idle;
-            match (output.commissioning, self.monitor.calibration()) {
-                (CommissioningState::Commissioned, Some(cal)) => learned = Some(cal.into()),
-                _ => learning_failed = true,
+        self.monitor.update(&sample);
+        self.samples = self.samples.wrapping_add(1);
+    }
+
+    /// The status for thread mode, from the latest output.
+    pub fn status(&self) -> MonitorStatus {
+        let o = self.monitor.output();
+        let top = o.top();
+        let second = o
+            .diagnosis
+            .probabilities
+            .iter()
+            .zip(Fault::ALL)
+            .filter(|(p, f)| **p > 0.0 && Some(*f) != top.map(|t| t.0))
+            .fold(None::<(Fault, f32)>, |best, (p, f)| match best {
+                Some((_, bp)) if bp >= *p => best,
+                _ => Some((f, *p)),
+            });
+        MonitorStatus {
+            samples: self.samples,
+            residuals: o.residuals,
+            residual_lamps: o.lamps,
+            fault_detected: o.fault_detected,
+            sensor_fault: o.sensor_fault,
+            top,
+            second,
+            speed_rad_s: o.speed_rad_s,
+            zero_crossing_locked: o.zero_crossing_locked,
+            commissioned: self.monitor.calibration().is_some(),
+            run: self.monitor.commissioning(),
+        }
+    }
+}
+
+/// What thread mode does after one [`Supervisor::tick`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tick {
+    /// Pet the watchdog (samples flow).
+    pub pet_watchdog: bool,
+    /// The panel mode shown.
+    pub mode: Mode,
+    /// The lamps to show.
+    pub lamps: PanelLamps,
+    /// The commissioning action to carry out ([`carry_out`]).
+    pub action: Action,
+    /// A commissioning run (or a start request) ended: log it.
+    pub run_ended: Option<RunEnd>,
+    /// The sample path's liveness changed: log it (and write or clear the reset record).
+    pub liveness: Option<LivenessChange>,
+}
+
+/// Thread mode's logic: button, commissioning procedure, liveness watch and panel.
+#[derive(Clone, Copy, Debug)]
+pub struct Supervisor {
+    procedure: CommissioningProcedure,
+    watch: SampleWatch,
+    latest: MonitorStatus,
+    failed_until_ms: Option<u32>,
+    last_press_ms: Option<u32>,
+}
+
+impl Supervisor {
+    /// A supervisor for `settings`, booting at `now_ms` after `previous` (a failed previous
+    /// run shows "monitor failed" for [`FAILED_BOOT_SHOW_MS`]), with the sample path's
+    /// `status` before sampling starts (so the panel shows the record loaded at boot from
+    /// the first period on).
+    pub fn new(
+        settings: &Settings,
+        previous: PreviousRun,
+        now_ms: u32,
+        status: MonitorStatus,
+    ) -> Self {
+        Self {
+            procedure: CommissioningProcedure::new(
+                settings.commissioning_duration_s,
+                settings.commissioning_stall_ms,
+            ),
+            watch: SampleWatch::new(settings.sample_rate_hz, now_ms),
+            latest: status,
+            failed_until_ms: previous
+                .failed()
+                .then(|| now_ms.wrapping_add(FAILED_BOOT_SHOW_MS)),
+            last_press_ms: None,
+        }
+    }
+
+    /// The latest status from the sample task.
+    pub fn latest(&self) -> &MonitorStatus {
+        &self.latest
+    }
+
+    /// The commissioning procedure.
+    pub fn procedure(&self) -> &CommissioningProcedure {
+        &self.procedure
+    }
+
+    /// One period at `now_ms`: `status` is the sample task's latest status if a new one
+    /// came, `button` whether the button was pressed since the last tick.
+    pub fn tick(&mut self, now_ms: u32, status: Option<MonitorStatus>, button: bool) -> Tick {
+        if let Some(s) = status {
+            self.latest = s;
+        }
+        let watch = self.watch.poll(self.latest.samples, now_ms);
+        let pressed = button
+            && self
+                .last_press_ms
+                .is_none_or(|t| now_ms.wrapping_sub(t) >= BUTTON_DEBOUNCE_MS);
+        if button {
+            self.last_press_ms = Some(now_ms);
+        }
+        let mut action = Action::None;
+        let mut run_ended = None;
+        if !watch.stalled {
+            if pressed {
+                action = self.procedure.button(&self.latest.run, now_ms);
+            }
+            if action == Action::None {
+                let step = self.procedure.on_status(&self.latest.run, now_ms);
+                action = step.action;
+                run_ended = step.ended;
             }
         }
-        SampleResult {
-            output,
-            learned,
-            learning_failed,
+        // The wrapping clock has reached `t` when `now - t` is "small" (less than half the
+        // clock's range).
+        if self
+            .failed_until_ms
+            .is_some_and(|t| now_ms.wrapping_sub(t) < u32::MAX / 2)
+        {
+            self.failed_until_ms = None;
+        }
+        let mode = if self.failed_until_ms.is_some() {
+            Mode::Failed
+        } else if watch.stalled {
+            Mode::SamplingStalled
+        } else if self.latest.run.stage.is_active() {
+            Mode::Commissioning
+        } else if self.latest.commissioned {
+            Mode::Commissioned
+        } else {
+            Mode::NotCommissioned
+        };
+        let failed = self.procedure.last_failure().is_some();
+        let input = PanelInput::from_status(mode, &self.latest, failed);
+        Tick {
+            pet_watchdog: watch.pet_watchdog,
+            mode,
+            lamps: panel::render(&input, now_ms),
+            action,
+            run_ended,
+            liveness: watch.change,
+        }
+    }
+}
+
+/// Carries out a commissioning [`Action`]: the command for the sample task, after storing
+/// the calibration in `store` for [`Action::Store`] (erase, write, read back: the command
+/// reports what the store holds, whatever failed). Also returns the storage result.
+pub fn carry_out<S: RecordStore>(
+    action: Action,
+    store: &mut S,
+) -> (Option<Command>, Option<Stored<S::Error>>) {
+    match action {
+        Action::None => (None, None),
+        Action::Start { duration_s } => (Some(Command::StartCommissioning { duration_s }), None),
+        Action::Cancel { run } => (Some(Command::CancelCommissioning { run }), None),
+        Action::Store { run, record } => {
+            let stored = flash_record::store(store, &record);
+            (
+                Some(Command::CalibrationStored {
+                    run,
+                    stored: stored.read_back,
+                }),
+                Some(stored),
+            )
         }
     }
 }
@@ -194,10 +520,45 @@ mod tests {
     use super::*;
 
     #[test]
+    fn settings_out_of_range_are_named() {
+        assert_eq!(Settings::DEFAULT.validate(), Ok(()));
+        for rate in [0, 7_000, 10_050, 3_000_000] {
+            let s = Settings {
+                sample_rate_hz: rate,
+                ..Settings::DEFAULT
+            };
+            assert_eq!(s.validate(), Err(SettingsError::SampleRate), "{rate}");
+        }
+        for d in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+            let s = Settings {
+                commissioning_duration_s: d,
+                ..Settings::DEFAULT
+            };
+            assert_eq!(s.validate(), Err(SettingsError::CommissioningDuration));
+        }
+        let s = Settings {
+            commissioning_stall_ms: 0,
+            ..Settings::DEFAULT
+        };
+        assert_eq!(s.validate(), Err(SettingsError::CommissioningStall));
+    }
+
+    #[test]
     fn board_config_is_valid() {
-        assert!(board_monitor_config(board::DEFAULT_SAMPLE_RATE_HZ)
-            .validate()
-            .is_ok());
-        assert!(SamplePath::for_board(board::DEFAULT_SAMPLE_RATE_HZ).is_ok());
+        let s = Settings::DEFAULT;
+        assert!(board_monitor_config(s.sample_rate_hz).validate().is_ok());
+        assert!(SamplePath::for_board(s.sample_rate_hz).is_ok());
+        assert_eq!(s.status_every(), 100);
+        // The stall time is shorter than the core's gate timeout (see the procedure).
+        let gate_ms = board_monitor_config(s.sample_rate_hz).gate_timeout_s * 1000.0;
+        assert!((s.commissioning_stall_ms as f32) < gate_ms);
+    }
+
+    #[test]
+    fn another_sample_rate_goes_through_the_same_configuration() {
+        let path = SamplePath::for_board(20_000).unwrap();
+        assert_eq!(path.monitor().config().sample_rate_hz, 20_000.0);
+        assert_eq!(path.sampler().ticks_per_sample(), 50);
+        assert!(SamplePath::for_board(7_000).is_err());
     }
 }

@@ -32,18 +32,21 @@
 //! | `ic` | PC3 (CN7-37) | ADC2_IN9 | ADC2 rank 3, together with `vc` |
 //! | encoder A / B | PB6 / PB7 | TIM4_CH1 / TIM4_CH2 | quadrature x4, 1024 lines |
 //! | sample trigger | (internal) | TIM1 TRGO | both ADCs, rising edge |
-//! | run / healthy lamp | PA5 | LD2 (green, on board) | |
-//! | r1 lamp | PB8 | GPIO out | |
-//! | r2 lamp | PB9 | GPIO out | |
-//! | r3 lamp | PB10 | GPIO out | |
-//! | r4 lamp | PB12 | GPIO out | |
-//! | fault lamp | PB13 | GPIO out | also blinks the top candidate |
+//! | RUN lamp | PA5 | LD2 (green, on board) | [`Lamp::Run`] |
+//! | r1 lamp | PB8 | GPIO out | [`Lamp::R1`] |
+//! | r2 lamp | PB9 | GPIO out | [`Lamp::R2`] |
+//! | r3 lamp | PB10 | GPIO out | [`Lamp::R3`] |
+//! | r4 lamp | PB12 | GPIO out | [`Lamp::R4`] |
+//! | FAULT lamp | PB13 | GPIO out | [`Lamp::Fault`], also blinks the top candidate |
 //! | commissioning button | PC13 | B1 (blue, on board), EXTI13 | pressed = high (pull-down) |
 //! | defmt log | SWD (ST-LINK) | RTT | |
 //!
-//! LEDs on PB8..PB13 are external: pin -> 330 ohm -> LED anode, cathode to GND
-//! (about 4 mA at 3.3 V). The commissioning record lives in the last 2 KiB flash page,
-//! see [`RECORD_FLASH_OFFSET`].
+//! The lamp rows repeat the lamp table below (`panel_lamps!`, the one definition of each
+//! lamp's pin, label and meaning, from which [`Lamp`], the firmware's lamp pins and the
+//! panic handler's pins are generated); a test (`tests/panel_docs.rs`) checks that these
+//! rows and the README's pin map agree with it. The LEDs other than LD2 are external:
+//! pin -> 330 ohm -> LED anode, cathode to GND (about 4 mA at 3.3 V). The commissioning
+//! record lives in the last 2 KiB flash page, see [`RECORD_FLASH_OFFSET`].
 
 /// Resolution of the STM32G4 ADC in bits (12-bit mode).
 pub const ADC_BITS: u32 = 12;
@@ -81,6 +84,154 @@ pub const ENCODER_COUNTS_PER_REV: u32 = 4 * ENCODER_LINES;
 pub const RECORD_FLASH_OFFSET: u32 = 0x0007_F800;
 /// Size of the flash page that holds the record (erase granularity, dual-bank mode).
 pub const RECORD_PAGE_SIZE: u32 = 2048;
+
+/// A GPIO port of the STM32G474 (`A` = GPIOA, ...).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Port {
+    /// GPIOA.
+    A,
+    /// GPIOB.
+    B,
+    /// GPIOC.
+    C,
+    /// GPIOD.
+    D,
+    /// GPIOE.
+    E,
+    /// GPIOF.
+    F,
+    /// GPIOG.
+    G,
+}
+
+/// A GPIO pin: port and pin number (0..=15), written `PA5` as in the datasheet.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GpioPin {
+    /// The port.
+    pub port: Port,
+    /// The pin number within the port, 0..=15.
+    pub number: u8,
+}
+
+impl GpioPin {
+    /// The pin named `name` (`"PA5"`, `"PB12"`: `P`, port letter A..G, number 0..=15), or
+    /// `None` for anything else. A `const fn`, so the lamp table's names are checked when
+    /// the firmware is compiled.
+    pub const fn parse(name: &str) -> Option<GpioPin> {
+        let (port, digits) = match name.as_bytes() {
+            [b'P', port, digits @ ..] => (*port, digits),
+            _ => return None,
+        };
+        let port = match port {
+            b'A' => Port::A,
+            b'B' => Port::B,
+            b'C' => Port::C,
+            b'D' => Port::D,
+            b'E' => Port::E,
+            b'F' => Port::F,
+            b'G' => Port::G,
+            _ => return None,
+        };
+        let number = match digits {
+            [d @ b'0'..=b'9'] => *d - b'0',
+            [b'1', d @ b'0'..=b'5'] => 10 + (*d - b'0'),
+            _ => return None,
+        };
+        Some(GpioPin { port, number })
+    }
+}
+
+impl core::fmt::Display for GpioPin {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let port = match self.port {
+            Port::A => 'A',
+            Port::B => 'B',
+            Port::C => 'C',
+            Port::D => 'D',
+            Port::E => 'E',
+            Port::F => 'F',
+            Port::G => 'G',
+        };
+        write!(f, "P{port}{}", self.number)
+    }
+}
+
+/// Number of panel lamps.
+pub const LAMP_COUNT: usize = 6;
+
+/// Generates [`Lamp`] (with its pin, label and meaning) and, for the target, the macro that
+/// takes the lamp pins out of the HAL's peripheral set, from one table.
+macro_rules! panel_lamps {
+    ($($lamp:ident = $index:literal: $pin:ident, $label:literal, $meaning:literal;)*) => {
+        /// One lamp of the panel. Its pin, label and meaning are defined once, in the lamp
+        /// table of `board.rs`; the patterns it shows are [`crate::panel`]'s.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+        pub enum Lamp {
+            $(
+                #[doc = $meaning]
+                $lamp = $index,
+            )*
+        }
+
+        impl Lamp {
+            /// All lamps, in the order of the panel (RUN, r1..r4, FAULT).
+            pub const ALL: [Lamp; LAMP_COUNT] = [$(Lamp::$lamp),*];
+
+            /// The pin that drives the lamp (high = lit).
+            pub const fn pin(self) -> GpioPin {
+                match self {
+                    $(Lamp::$lamp => match GpioPin::parse(stringify!($pin)) {
+                        Some(pin) => pin,
+                        // Unreachable: `LAMP_PINS_ARE_VALID` rejects a bad name at compile time.
+                        None => GpioPin { port: Port::A, number: 0 },
+                    },)*
+                }
+            }
+
+            /// The lamp's name on the panel (`RUN`, `r1`..`r4`, `FAULT`).
+            pub const fn label(self) -> &'static str {
+                match self {
+                    $(Lamp::$lamp => $label,)*
+                }
+            }
+
+            /// What a lit lamp means (the patterns are in [`crate::panel`]).
+            pub const fn meaning(self) -> &'static str {
+                match self {
+                    $(Lamp::$lamp => $meaning,)*
+                }
+            }
+        }
+
+        /// Every name in the lamp table is a pin (a compile-time check).
+        const LAMP_PINS_ARE_VALID: bool = $(GpioPin::parse(stringify!($pin)).is_some() &&)* true;
+        const _: () = assert!(LAMP_PINS_ARE_VALID, "a lamp pin in board.rs is not a pin name");
+
+        /// `take_lamp_pins!(p)`: the lamp pins out of `embassy_stm32::Peripherals` `p`, in
+        /// [`Lamp::ALL`] order, as `[Peri<'static, AnyPin>; LAMP_COUNT]`.
+        #[cfg(target_os = "none")]
+        macro_rules! take_lamp_pins {
+            ($p:ident) => {
+                [$($p.$pin.into()),*]
+            };
+        }
+    };
+}
+
+// The lamp table: the one place where a lamp's pin, label and meaning are written.
+panel_lamps! {
+    Run = 0: PA5, "RUN", "RUN: the monitor is alive; its blink pattern says what it does (LD2 on the board).";
+    R1 = 1: PB8, "r1", "r1: residual r1 beyond its threshold.";
+    R2 = 2: PB9, "r2", "r2: residual r2 beyond its threshold.";
+    R3 = 3: PB10, "r3", "r3: residual r3 beyond its threshold.";
+    R4 = 4: PB12, "r4", "r4: residual r4 beyond its threshold.";
+    Fault = 5: PB13, "FAULT", "FAULT: a fault detected; blinks the top candidate's code.";
+}
+
+impl Lamp {
+    /// The residual lamps r1..r4, in residual order.
+    pub const RESIDUALS: [Lamp; 4] = [Lamp::R1, Lamp::R2, Lamp::R3, Lamp::R4];
+}
 
 /// Raw 12-bit code of a voltage channel, exactly as the ADC wrote it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -163,6 +314,8 @@ impl Default for FrontEnd {
 /// Hardware pin assignment (target only): the single place where pins are chosen.
 #[cfg(target_os = "none")]
 pub mod pins {
+    use super::LAMP_COUNT;
+    use embassy_stm32::gpio::AnyPin;
     use embassy_stm32::peripherals as p;
     use embassy_stm32::Peri;
 
@@ -184,22 +337,6 @@ pub mod pins {
         pub b: Peri<'static, p::PC2>,
         /// `ic` on PC3.
         pub c: Peri<'static, p::PC3>,
-    }
-
-    /// Panel lamp pins in [`crate::panel::Lamp`] order.
-    pub struct LampPins {
-        /// Run / healthy lamp, PA5 (LD2).
-        pub run: Peri<'static, p::PA5>,
-        /// r1 lamp, PB8.
-        pub r1: Peri<'static, p::PB8>,
-        /// r2 lamp, PB9.
-        pub r2: Peri<'static, p::PB9>,
-        /// r3 lamp, PB10.
-        pub r3: Peri<'static, p::PB10>,
-        /// r4 lamp, PB12.
-        pub r4: Peri<'static, p::PB12>,
-        /// Fault lamp, PB13.
-        pub fault: Peri<'static, p::PB13>,
     }
 
     /// All board resources the firmware uses, split out of `embassy_stm32::Peripherals`.
@@ -224,8 +361,8 @@ pub mod pins {
         pub encoder_a: Peri<'static, p::PB6>,
         /// Encoder B (TIM4_CH2).
         pub encoder_b: Peri<'static, p::PB7>,
-        /// Panel lamps.
-        pub lamps: LampPins,
+        /// Panel lamp pins in [`super::Lamp::ALL`] order (the lamp table).
+        pub lamps: [Peri<'static, AnyPin>; LAMP_COUNT],
         /// User button B1.
         pub button: Peri<'static, p::PC13>,
         /// EXTI line of the button.
@@ -258,14 +395,7 @@ pub mod pins {
                 encoder_timer: p.TIM4,
                 encoder_a: p.PB6,
                 encoder_b: p.PB7,
-                lamps: LampPins {
-                    run: p.PA5,
-                    r1: p.PB8,
-                    r2: p.PB9,
-                    r3: p.PB10,
-                    r4: p.PB12,
-                    fault: p.PB13,
-                },
+                lamps: take_lamp_pins!(p),
                 button: p.PC13,
                 button_exti: p.EXTI13,
                 flash: p.FLASH,
@@ -303,5 +433,38 @@ mod tests {
         assert_eq!(v.code_of(1e6), ADC_MAX_CODE);
         assert_eq!(v.code_of(-1e6), 0);
         assert!(is_saturated_code(0) && is_saturated_code(4095) && !is_saturated_code(1));
+    }
+
+    #[test]
+    fn pin_names_parse_and_print_back() {
+        let pb12 = GpioPin {
+            port: Port::B,
+            number: 12,
+        };
+        assert_eq!(GpioPin::parse("PB12"), Some(pb12));
+        assert_eq!(pb12.to_string(), "PB12");
+        for bad in ["", "P", "PA", "PB16", "PB20", "PH1", "XA1", "PA1x", "pa1"] {
+            assert_eq!(GpioPin::parse(bad), None, "{bad}");
+        }
+        for port in ['A', 'B', 'C', 'D', 'E', 'F', 'G'] {
+            for n in 0..16 {
+                let name = format!("P{port}{n}");
+                assert_eq!(GpioPin::parse(&name).unwrap().to_string(), name);
+            }
+        }
+    }
+
+    #[test]
+    fn the_lamp_table_has_one_pin_per_lamp_in_panel_order() {
+        for (k, lamp) in Lamp::ALL.into_iter().enumerate() {
+            assert_eq!(lamp as usize, k);
+            assert!(!lamp.label().is_empty() && lamp.meaning().starts_with(lamp.label()));
+            for other in Lamp::ALL.into_iter().skip(k + 1) {
+                assert_ne!(lamp.pin(), other.pin(), "{lamp:?} and {other:?}");
+            }
+        }
+        assert_eq!(Lamp::ALL.first(), Some(&Lamp::Run));
+        assert_eq!(Lamp::ALL.last(), Some(&Lamp::Fault));
+        assert_eq!(Lamp::ALL.get(1..5), Some(&Lamp::RESIDUALS[..]));
     }
 }

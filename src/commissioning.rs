@@ -1,183 +1,375 @@
-//! Commissioning state machine: button -> learn healthy thresholds -> store in flash.
+//! The commissioning procedure of thread mode: the button starts (or cancels) a run, the
+//! result is stored in flash, and a run that makes no progress is cancelled.
 //!
-//! Pure logic (no hardware, no core types): the firmware feeds it [`Event`]s and carries
-//! out the returned [`Action`]. The same machine runs in the host tests.
+//! The core owns the run (`monitor_core::commissioning`: start, progress in evaluated
+//! blocks, cancel, the learned calibration, failure reasons). This procedure only
+//! - turns a button press into a start request (or, during learning, a cancel),
+//! - watches the run's progress in the status the sample task sends, and cancels the run
+//!   when no evaluated block was learned for `stall_timeout_ms` (the motor stopped, or the
+//!   operating point does not settle),
+//! - stores the learned calibration when the core asks for it
+//!   ([`RunStage::AwaitingStorage`]) and reports what the flash holds afterwards
+//!   ([`crate::app::Command::CalibrationStored`]), so the core puts exactly the stored
+//!   record into force,
+//! - remembers why the last attempt failed, for the panel and the log.
+//!
+//! It holds no copy of the thresholds in force and no clock of its own for the learning:
+//! the panel's "commissioned or not" comes from the core, whose thresholds always equal the
+//! flash record (a test drives every path and checks the three agree).
 //!
 //! ```text
-//!  boot ──RecordLoaded(ok)──► Commissioned ◄──────── SaveDone(ok) ──┐
-//!    └───RecordLoaded(err)─► NotCommissioned                        │
-//!  any idle state ──ButtonPressed──► Learning ──LearningDone(rec)──► Saving
-//!                     (StartLearning)   │  (Save(rec))                  │
-//!                                       └─LearningFailed / timeout─► Failed ◄─ SaveDone(err)
+//!  Idle ──button──► Requested ──core reports a new run──► Following(run)
+//!   ▲                  │ no new run within 1 s: Failed(NotStarted)     │ Learning: progress? else after the stall time: Cancel
+//!   │                  ▼                                               │ AwaitingStorage: Store (again after 1 s if still waiting)
+//!   └──────────────────┴──── Done / Failed(reason) / cancelled ◄───────┘
 //! ```
 //!
-//! While learning or saving, button presses are ignored (debounce and no double start).
-//! A failed commissioning never makes a half-learned record valid: the previous
-//! thresholds (learned or default) stay in force in RAM and in flash.
+//! Pure logic (no hardware): the firmware and the host tests feed it the latest
+//! [`CommissioningRun`] and button presses and carry out the returned [`Action`].
 
 use crate::flash_record::CalibrationRecord;
-use crate::panel::Mode;
+use monitor_core::{CommissioningFailure, CommissioningRun, RunStage};
 
-/// Where commissioning stands.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum State {
-    /// No valid record: the core uses its default thresholds.
-    NotCommissioned,
-    /// The core is learning; started at `started_ms`.
-    Learning {
-        /// Time the learning started, ms (wrapping clock).
-        started_ms: u32,
+/// Why the last commissioning attempt failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Failure {
+    /// The core did not start a run within [`CommissioningProcedure::START_TIMEOUT_MS`]
+    /// (it refused the duration, or a run was still active).
+    NotStarted,
+    /// No evaluated block for the stall time: the procedure cancelled the run.
+    Stalled,
+    /// The core ended the run for this reason.
+    Core(CommissioningFailure),
+}
+
+impl Failure {
+    /// A short name for logs.
+    pub fn name(self) -> &'static str {
+        match self {
+            Failure::NotStarted => "not-started",
+            Failure::Stalled => "no-progress",
+            Failure::Core(why) => why.name(),
+        }
+    }
+}
+
+/// How a run the procedure followed ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RunEnd {
+    /// Learned, stored, and in force.
+    Commissioned {
+        /// The run's id.
+        run: u16,
     },
-    /// Learning finished; the record is being written.
-    Saving,
-    /// A valid record is in force.
-    Commissioned,
-    /// The last attempt failed; `why` says why.
+    /// Cancelled with the button: the thresholds in force before stay, nothing failed.
+    CancelledByUser {
+        /// The run's id.
+        run: u16,
+    },
+    /// Failed; the thresholds the core reports are in force (the ones before the run, or
+    /// what the flash held after a failed write).
     Failed {
-        /// Reason of the failure.
+        /// The run's id (`None` when no run was started).
+        run: Option<u16>,
+        /// Why.
         why: Failure,
     },
 }
 
-/// Why a commissioning attempt failed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Failure {
-    /// The core rejected the start or produced no calibration.
-    Learning,
-    /// Learning did not finish within the expected time.
-    Timeout,
-    /// Writing or verifying the flash record failed.
-    Storage,
-}
-
-/// Inputs of the state machine.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Event {
-    /// Result of reading the record at boot (`true` = a valid record was applied).
-    RecordLoaded(bool),
-    /// The user button was pressed.
-    ButtonPressed,
-    /// The core finished learning with this calibration.
-    LearningDone(CalibrationRecord),
-    /// The core could not learn (or rejected the start).
-    LearningFailed,
-    /// Result of writing the record (`true` = written and read back equal).
-    SaveDone(bool),
-    /// Periodic tick (checks the timeout).
-    Tick,
-}
-
-/// What the firmware has to do after an event.
+/// What the firmware has to do.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Action {
     /// Nothing.
     None,
-    /// Tell the core to start learning for `duration_s` seconds.
-    StartLearning {
+    /// Ask the core to start a run of `duration_s` seconds of evaluated running, installed
+    /// after storage ([`crate::app::Command::StartCommissioning`]).
+    Start {
         /// Learning time, s.
         duration_s: f32,
     },
-    /// Write this record to flash (then report [`Event::SaveDone`]).
-    Save(CalibrationRecord),
+    /// Ask the core to cancel run `run` ([`crate::app::Command::CancelCommissioning`]).
+    Cancel {
+        /// The run's id.
+        run: u16,
+    },
+    /// Store `record` (run `run`'s calibration) in flash, read it back and report the
+    /// result to the core ([`crate::app::Command::CalibrationStored`]).
+    Store {
+        /// The run's id.
+        run: u16,
+        /// The calibration to store.
+        record: CalibrationRecord,
+    },
 }
 
-/// The commissioning procedure: the button-learn-store state machine of thread mode (the
-/// core's `monitor_core::CommissioningState` says whether the monitor itself is learning).
+/// The result of feeding the procedure.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Step {
+    /// What to do now.
+    pub action: Action,
+    /// A followed run (or a start request) ended at this step.
+    pub ended: Option<RunEnd>,
+}
+
+impl Step {
+    const NOTHING: Step = Step {
+        action: Action::None,
+        ended: None,
+    };
+
+    fn act(action: Action) -> Step {
+        Step {
+            action,
+            ended: None,
+        }
+    }
+}
+
+/// Who asked for a cancel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum CancelReason {
+    User,
+    Stalled,
+}
+
+/// What the procedure is doing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Tracking {
+    Idle,
+    /// A start was requested at `since_ms`; the core's latest run was `previous_run`.
+    Requested {
+        previous_run: u16,
+        since_ms: u32,
+    },
+    /// Following run `run`.
+    Following {
+        run: u16,
+        started_ms: u32,
+        /// Progress last seen, and when it last changed.
+        blocks: u32,
+        progress_ms: u32,
+        /// A cancel sent: why and when.
+        cancel: Option<(CancelReason, u32)>,
+        /// When the calibration was last handed over for storage.
+        stored_ms: Option<u32>,
+    },
+}
+
+/// The procedure (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CommissioningProcedure {
-    state: State,
     duration_s: f32,
+    stall_timeout_ms: u32,
+    tracking: Tracking,
+    last_failure: Option<Failure>,
 }
 
 impl CommissioningProcedure {
-    /// Default learning time, s: 10 s at 10 kHz = 100 000 samples of healthy running.
+    /// Default learning time, s: 10 s of evaluated running = 4000 slow-path blocks.
     pub const DEFAULT_DURATION_S: f32 = 10.0;
-    /// Extra time allowed beyond the learning duration before giving up, ms.
-    pub const TIMEOUT_MARGIN_MS: u32 = 5_000;
+    /// Default stall time, ms: a run that learns no evaluated block for 3 s is cancelled.
+    /// Longer than a load or supply step keeps the quasi-steady gate closed (its hold is
+    /// 0.5 s), shorter than the gate's 5 s timeout, after which the core would learn on an
+    /// operating point that does not settle.
+    pub const DEFAULT_STALL_TIMEOUT_MS: u32 = 3_000;
+    /// Time the core has to start a requested run, ms.
+    pub const START_TIMEOUT_MS: u32 = 1_000;
+    /// A press within this time after a start does not cancel the run (a bouncing or
+    /// doubled press), ms.
+    pub const CANCEL_GUARD_MS: u32 = 1_000;
+    /// A cancel or a storage report the core has not acted on is repeated after this, ms.
+    pub const RETRY_MS: u32 = 1_000;
 
-    /// A machine in `NotCommissioned` that learns for `duration_s` seconds
-    /// (non-finite or non-positive values fall back to [`Self::DEFAULT_DURATION_S`]).
-    pub fn new(duration_s: f32) -> Self {
-        let duration_s = if duration_s.is_finite() && duration_s > 0.0 {
-            duration_s
-        } else {
-            Self::DEFAULT_DURATION_S
-        };
+    /// A procedure that asks for runs of `duration_s` seconds of evaluated running and
+    /// cancels a run after `stall_timeout_ms` without progress. (The core refuses a
+    /// non-finite or non-positive duration: the attempt then fails with
+    /// [`Failure::NotStarted`].)
+    pub fn new(duration_s: f32, stall_timeout_ms: u32) -> Self {
         Self {
-            state: State::NotCommissioned,
             duration_s,
+            stall_timeout_ms,
+            tracking: Tracking::Idle,
+            last_failure: None,
         }
     }
 
-    /// Current state.
-    pub fn state(&self) -> State {
-        self.state
-    }
-
-    /// Learning duration, s.
+    /// Learning duration asked for, s.
     pub fn duration_s(&self) -> f32 {
         self.duration_s
     }
 
-    /// Panel mode for this state.
-    pub fn panel_mode(&self) -> Mode {
-        match self.state {
-            State::NotCommissioned => Mode::NotCommissioned,
-            State::Learning { .. } | State::Saving => Mode::Commissioning,
-            State::Commissioned => Mode::Commissioned,
-            State::Failed { .. } => Mode::CommissioningFailed,
-        }
+    /// Why the last attempt failed (`None` after a success, a cancel with the button, or
+    /// a new start).
+    pub fn last_failure(&self) -> Option<Failure> {
+        self.last_failure
     }
 
-    /// Advance with `event` at time `now_ms`; returns what the firmware must do.
-    pub fn handle(&mut self, event: Event, now_ms: u32) -> Action {
-        match (self.state, event) {
-            (_, Event::RecordLoaded(ok)) => {
-                self.state = if ok {
-                    State::Commissioned
-                } else {
-                    State::NotCommissioned
+    /// True from a start request until the run has ended.
+    pub fn busy(&self) -> bool {
+        self.tracking != Tracking::Idle
+    }
+
+    /// The button was pressed at `now_ms`: start a run, or cancel the one that is learning.
+    /// `run` is the core's latest run as last reported.
+    pub fn button(&mut self, run: &CommissioningRun, now_ms: u32) -> Action {
+        match &mut self.tracking {
+            Tracking::Idle => {
+                self.tracking = Tracking::Requested {
+                    previous_run: run.id,
+                    since_ms: now_ms,
                 };
-                Action::None
-            }
-            (State::Learning { .. } | State::Saving, Event::ButtonPressed) => Action::None,
-            (_, Event::ButtonPressed) => {
-                self.state = State::Learning { started_ms: now_ms };
-                Action::StartLearning {
+                self.last_failure = None;
+                Action::Start {
                     duration_s: self.duration_s,
                 }
             }
-            (State::Learning { .. }, Event::LearningDone(rec)) => {
-                self.state = State::Saving;
-                Action::Save(rec)
+            Tracking::Following {
+                run: id,
+                started_ms,
+                cancel,
+                stored_ms: None,
+                ..
+            } if cancel.is_none() && now_ms.wrapping_sub(*started_ms) >= Self::CANCEL_GUARD_MS => {
+                *cancel = Some((CancelReason::User, now_ms));
+                Action::Cancel { run: *id }
             }
-            (State::Learning { .. }, Event::LearningFailed) => {
-                self.state = State::Failed {
-                    why: Failure::Learning,
-                };
-                Action::None
-            }
-            (State::Learning { started_ms }, Event::Tick) => {
-                let limit_ms = (self.duration_s * 1000.0) as u32 + Self::TIMEOUT_MARGIN_MS;
-                if now_ms.wrapping_sub(started_ms) > limit_ms {
-                    self.state = State::Failed {
-                        why: Failure::Timeout,
-                    };
-                }
-                Action::None
-            }
-            (State::Saving, Event::SaveDone(ok)) => {
-                self.state = if ok {
-                    State::Commissioned
-                } else {
-                    State::Failed {
-                        why: Failure::Storage,
-                    }
-                };
-                Action::None
-            }
-            // Stale or out-of-order events are ignored.
             _ => Action::None,
+        }
+    }
+
+    /// The latest status reported `run` at `now_ms` (call it every panel period).
+    pub fn on_status(&mut self, run: &CommissioningRun, now_ms: u32) -> Step {
+        match self.tracking {
+            Tracking::Idle if run.stage.is_active() => {
+                // A run the procedure did not ask for (none should exist): follow it.
+                self.follow(run, now_ms);
+                self.following(run, now_ms)
+            }
+            Tracking::Idle => Step::NOTHING,
+            Tracking::Requested {
+                previous_run,
+                since_ms,
+            } => {
+                if run.id != previous_run {
+                    self.follow(run, now_ms);
+                    self.following(run, now_ms)
+                } else if now_ms.wrapping_sub(since_ms) > Self::START_TIMEOUT_MS {
+                    self.end(RunEnd::Failed {
+                        run: None,
+                        why: Failure::NotStarted,
+                    })
+                } else {
+                    Step::NOTHING
+                }
+            }
+            Tracking::Following { run: id, .. } if id != run.id => {
+                // A newer run replaced the one followed (it cannot end any more).
+                self.follow(run, now_ms);
+                self.following(run, now_ms)
+            }
+            Tracking::Following { .. } => self.following(run, now_ms),
+        }
+    }
+
+    fn follow(&mut self, run: &CommissioningRun, now_ms: u32) {
+        self.tracking = Tracking::Following {
+            run: run.id,
+            started_ms: now_ms,
+            blocks: run.blocks_learned,
+            progress_ms: now_ms,
+            cancel: None,
+            stored_ms: None,
+        };
+    }
+
+    fn following(&mut self, run: &CommissioningRun, now_ms: u32) -> Step {
+        let Tracking::Following {
+            run: id,
+            started_ms,
+            mut blocks,
+            mut progress_ms,
+            mut cancel,
+            mut stored_ms,
+        } = self.tracking
+        else {
+            return Step::NOTHING;
+        };
+        let since = |t: u32| now_ms.wrapping_sub(t);
+        let step = match run.stage {
+            RunStage::Learning if run.blocks_learned != blocks => {
+                blocks = run.blocks_learned;
+                progress_ms = now_ms;
+                Step::NOTHING
+            }
+            RunStage::Learning => {
+                let due = match cancel {
+                    None => since(progress_ms) >= self.stall_timeout_ms,
+                    Some((_, sent_ms)) => since(sent_ms) >= Self::RETRY_MS,
+                };
+                if due {
+                    let reason = cancel.map_or(CancelReason::Stalled, |(r, _)| r);
+                    cancel = Some((reason, now_ms));
+                    Step::act(Action::Cancel { run: id })
+                } else {
+                    Step::NOTHING
+                }
+            }
+            RunStage::AwaitingStorage(cal) => {
+                if stored_ms.is_some_and(|t| since(t) < Self::RETRY_MS) {
+                    Step::NOTHING
+                } else {
+                    stored_ms = Some(now_ms);
+                    Step::act(Action::Store {
+                        run: id,
+                        record: cal.into(),
+                    })
+                }
+            }
+            RunStage::Done => return self.end(RunEnd::Commissioned { run: id }),
+            RunStage::Failed(CommissioningFailure::Cancelled) => {
+                return self.end(match cancel {
+                    Some((CancelReason::User, _)) => RunEnd::CancelledByUser { run: id },
+                    Some((CancelReason::Stalled, _)) => RunEnd::Failed {
+                        run: Some(id),
+                        why: Failure::Stalled,
+                    },
+                    None => RunEnd::Failed {
+                        run: Some(id),
+                        why: Failure::Core(CommissioningFailure::Cancelled),
+                    },
+                })
+            }
+            RunStage::Failed(why) => {
+                return self.end(RunEnd::Failed {
+                    run: Some(id),
+                    why: Failure::Core(why),
+                })
+            }
+            RunStage::Idle => {
+                self.tracking = Tracking::Idle;
+                return Step::NOTHING;
+            }
+        };
+        self.tracking = Tracking::Following {
+            run: id,
+            started_ms,
+            blocks,
+            progress_ms,
+            cancel,
+            stored_ms,
+        };
+        step
+    }
+
+    fn end(&mut self, end: RunEnd) -> Step {
+        self.tracking = Tracking::Idle;
+        self.last_failure = match end {
+            RunEnd::Failed { why, .. } => Some(why),
+            RunEnd::Commissioned { .. } | RunEnd::CancelledByUser { .. } => None,
+        };
+        Step {
+            action: Action::None,
+            ended: Some(end),
         }
     }
 }
@@ -185,49 +377,142 @@ impl CommissioningProcedure {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use monitor_core::Calibration;
 
-    fn rec() -> CalibrationRecord {
-        CalibrationRecord {
+    fn run(id: u16, stage: RunStage, blocks: u32) -> CommissioningRun {
+        CommissioningRun {
+            id,
+            stage,
+            blocks_learned: blocks,
+            blocks_needed: 100,
+        }
+    }
+
+    fn cal() -> Calibration {
+        Calibration {
             mean: [0.0; 4],
-            spread: [1.0; 4],
+            spread: [0.01; 4],
         }
     }
 
     #[test]
-    fn happy_path() {
-        let mut c = CommissioningProcedure::new(2.0);
-        assert_eq!(c.handle(Event::RecordLoaded(false), 0), Action::None);
-        assert_eq!(c.panel_mode(), Mode::NotCommissioned);
-        assert_eq!(
-            c.handle(Event::ButtonPressed, 10),
-            Action::StartLearning { duration_s: 2.0 }
-        );
-        assert_eq!(c.handle(Event::ButtonPressed, 20), Action::None);
-        assert_eq!(
-            c.handle(Event::LearningDone(rec()), 2010),
-            Action::Save(rec())
-        );
-        assert_eq!(c.panel_mode(), Mode::Commissioning);
-        c.handle(Event::SaveDone(true), 2020);
-        assert_eq!(c.state(), State::Commissioned);
+    fn start_progress_store_done() {
+        let mut p = CommissioningProcedure::new(2.0, 3_000);
+        let idle = CommissioningRun::default();
+        assert_eq!(p.button(&idle, 0), Action::Start { duration_s: 2.0 });
+        assert!(p.busy());
+        assert_eq!(p.button(&idle, 10), Action::None, "no double start");
+        assert_eq!(p.on_status(&idle, 50), Step::NOTHING);
+        // Progress keeps it going however long it takes.
+        for k in 0..100u32 {
+            let s = p.on_status(&run(1, RunStage::Learning, k), 100 + 1000 * k);
+            assert_eq!(s, Step::NOTHING);
+        }
+        let awaiting = run(1, RunStage::AwaitingStorage(cal()), 100);
+        let store = Action::Store {
+            run: 1,
+            record: cal().into(),
+        };
+        assert_eq!(p.on_status(&awaiting, 200_000).action, store);
+        assert_eq!(p.on_status(&awaiting, 200_050).action, Action::None);
+        assert_eq!(p.button(&awaiting, 200_100), Action::None, "storing");
+        assert_eq!(p.on_status(&awaiting, 201_100).action, store, "retried");
+        let s = p.on_status(&run(1, RunStage::Done, 100), 201_150);
+        assert_eq!(s.ended, Some(RunEnd::Commissioned { run: 1 }));
+        assert!(!p.busy() && p.last_failure().is_none());
     }
 
     #[test]
-    fn timeout_and_storage_failure() {
-        let mut c = CommissioningProcedure::new(1.0);
-        c.handle(Event::ButtonPressed, u32::MAX - 100);
-        c.handle(Event::Tick, 5000);
-        assert!(matches!(c.state(), State::Learning { .. }));
-        c.handle(Event::Tick, 6000);
+    fn no_progress_cancels_and_the_core_says_when_it_is_done() {
+        let mut p = CommissioningProcedure::new(2.0, 3_000);
+        p.button(&run(7, RunStage::Done, 0), 0);
+        p.on_status(&run(8, RunStage::Learning, 0), 50);
+        p.on_status(&run(8, RunStage::Learning, 5), 1_000);
         assert_eq!(
-            c.state(),
-            State::Failed {
-                why: Failure::Timeout
-            }
+            p.on_status(&run(8, RunStage::Learning, 5), 3_950).action,
+            Action::None
         );
-        c.handle(Event::ButtonPressed, 7000);
-        c.handle(Event::LearningDone(rec()), 8000);
-        c.handle(Event::SaveDone(false), 8001);
-        assert_eq!(c.panel_mode(), Mode::CommissioningFailed);
+        let s = p.on_status(&run(8, RunStage::Learning, 5), 4_000);
+        assert_eq!(s.action, Action::Cancel { run: 8 });
+        assert_eq!(
+            p.on_status(&run(8, RunStage::Learning, 5), 4_050).action,
+            Action::None
+        );
+        assert_eq!(
+            p.on_status(&run(8, RunStage::Learning, 5), 5_000).action,
+            Action::Cancel { run: 8 },
+            "repeated while the core still learns"
+        );
+        let s = p.on_status(
+            &run(8, RunStage::Failed(CommissioningFailure::Cancelled), 5),
+            5_050,
+        );
+        assert_eq!(
+            s.ended,
+            Some(RunEnd::Failed {
+                run: Some(8),
+                why: Failure::Stalled
+            })
+        );
+        assert_eq!(p.last_failure(), Some(Failure::Stalled));
+        // The core may have learned meanwhile: then the result is stored after all.
+        p.button(
+            &run(8, RunStage::Failed(CommissioningFailure::Cancelled), 5),
+            6_000,
+        );
+        assert_eq!(p.last_failure(), None, "a new start clears it");
+        p.on_status(&run(9, RunStage::Learning, 0), 6_050);
+        assert_eq!(
+            p.on_status(&run(9, RunStage::Learning, 0), 9_050).action,
+            Action::Cancel { run: 9 }
+        );
+        let s = p.on_status(&run(9, RunStage::AwaitingStorage(cal()), 100), 9_100);
+        assert!(matches!(s.action, Action::Store { run: 9, .. }));
+    }
+
+    #[test]
+    fn the_button_cancels_a_learning_run_and_refused_starts_fail() {
+        let mut p = CommissioningProcedure::new(10.0, 3_000);
+        p.button(&CommissioningRun::default(), 0);
+        p.on_status(&run(1, RunStage::Learning, 0), 50);
+        assert_eq!(
+            p.button(&run(1, RunStage::Learning, 0), 500),
+            Action::None,
+            "too soon after the start"
+        );
+        assert_eq!(
+            p.button(&run(1, RunStage::Learning, 3), 1_500),
+            Action::Cancel { run: 1 }
+        );
+        let s = p.on_status(
+            &run(1, RunStage::Failed(CommissioningFailure::Cancelled), 3),
+            1_550,
+        );
+        assert_eq!(s.ended, Some(RunEnd::CancelledByUser { run: 1 }));
+        assert_eq!(p.last_failure(), None, "a cancel is not a failure");
+        // The core never starts: NotStarted after a second.
+        let before = run(1, RunStage::Failed(CommissioningFailure::Cancelled), 3);
+        p.button(&before, 2_000);
+        assert_eq!(p.on_status(&before, 2_900).ended, None);
+        let s = p.on_status(&before, 3_050);
+        assert_eq!(
+            s.ended,
+            Some(RunEnd::Failed {
+                run: None,
+                why: Failure::NotStarted
+            })
+        );
+        // Not stored: the core's reason.
+        p.button(&before, 4_000);
+        p.on_status(&run(2, RunStage::AwaitingStorage(cal()), 100), 4_050);
+        let s = p.on_status(
+            &run(2, RunStage::Failed(CommissioningFailure::NotStored), 100),
+            4_100,
+        );
+        assert_eq!(
+            p.last_failure(),
+            Some(Failure::Core(CommissioningFailure::NotStored))
+        );
+        assert!(s.ended.is_some() && !p.busy());
     }
 }

@@ -2,18 +2,26 @@
 //!
 //! Tasks and priorities:
 //! - `sample_task` on an interrupt executor (UART4 vector, NVIC priority P1, above thread
-//!   mode): TIM1 TRGO triggers ADC1 (va, vb, vc) and ADC2 (ia, ib, ic) at the sample rate;
-//!   each ADC fills a DMA ring of two samples, so every sample wakes the task (half- and
-//!   full-transfer interrupts). The task reads the encoder counter (TIM4), builds the
-//!   `Sample` and runs `Monitor::update` on it. Overruns (the DMA lapped the reader) are
-//!   counted, logged, and the two rings are resynchronised with the trigger stopped.
-//! - `main` in thread mode: boot (clocks, watchdog, flash record), then a 50 ms loop that
-//!   pets the watchdog, watches the button, drives the commissioning state machine and
-//!   the panel, and logs a status line every 100 ms.
+//!   mode): TIM1 TRGO triggers ADC1 (va, vb, vc) and ADC2 (ia, ib, ic) at the sample rate
+//!   of [`SETTINGS`]; each ADC fills a DMA ring of two samples, so every sample wakes the
+//!   task (half- and full-transfer interrupts). The task reads the encoder counter (TIM4)
+//!   and runs `SamplePath::on_frame` (scaling and `Monitor::update`). Every wait for ADC
+//!   data has a timeout ([`AdcWait`]): when it expires the acquisition is restarted.
+//!   Overruns (the DMA lapped the reader) are counted, logged, and the two rings are
+//!   resynchronised with the trigger stopped. Every `status_every` samples the task hands
+//!   thread mode a small `MonitorStatus`.
+//! - `main` in thread mode: boot (clocks, watchdog, why the previous run ended, flash
+//!   record), then every 50 ms `Supervisor::tick`: button, commissioning procedure, the
+//!   watch on the sample counter (the watchdog is petted only while samples flow), panel;
+//!   it carries out the commissioning action (storing the record in flash) and logs a
+//!   status line every 100 ms.
+//! - The panic handler: "monitor failed" on the panel, the reason into the reset record
+//!   (RAM that survives the reset), then it waits for the watchdog.
 //!
 //! Communication: `COMMANDS` (Channel, thread -> sample task), `STATUS` (Signal, latest
-//! output, sample task -> thread, 100 Hz), `LEARN` (Channel, learning finished/failed).
+//! status, sample task -> thread, 100 Hz).
 
+use core::mem::MaybeUninit;
 use core::sync::atomic::{AtomicU32, Ordering};
 
 use defmt::{error, info, warn};
@@ -21,7 +29,7 @@ use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, Spawner};
 use embassy_stm32::adc::{Adc, AdcChannel, AdcConfig, Exten, RingBufferedAdc, SampleTime};
 use embassy_stm32::exti::{self, ExtiInput};
-use embassy_stm32::flash::Flash;
+use embassy_stm32::flash::{Blocking, Flash};
 use embassy_stm32::gpio::{Level, Output, Pull, Speed};
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::time::Hertz;
@@ -32,15 +40,19 @@ use embassy_stm32::{bind_interrupts, dma, interrupt, pac, peripherals, triggers,
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
-use embassy_time::{with_timeout, Duration, Instant, Ticker, Timer};
+use embassy_time::{with_deadline, with_timeout, Duration, Instant, Timer};
 
-use drive_monitor::app::{Command, SamplePath};
-use drive_monitor::board::{self, pins::Board, CurrentCode, VoltageCode};
-use drive_monitor::commissioning::{Action, CommissioningProcedure, Event};
-use drive_monitor::flash_record::{CalibrationRecord, RECORD_LEN};
-use drive_monitor::panel::{self, Lamp, Mode, PanelInput, PanelLamps};
+use drive_monitor::app::{
+    carry_out, Command, MonitorStatus, SamplePath, Settings, Supervisor, PANEL_PERIOD_MS,
+    WATCHDOG_TIMEOUT_MS,
+};
+use drive_monitor::board::{self, pins::Board, CurrentCode, Lamp, Port, VoltageCode, LAMP_COUNT};
+use drive_monitor::commissioning::RunEnd;
+use drive_monitor::flash_record::{self, LoadError, RecordStore, StoreError, RECORD_LEN};
+use drive_monitor::liveness::{AdcWait, LivenessChange};
+use drive_monitor::panel::PanelLamps;
+use drive_monitor::reset_record::{PreviousRun, ResetCause, ResetRecord, RESET_RECORD_LEN};
 use drive_monitor::sampling::RawFrame;
-use monitor_core::{Fault, MonitorOutput};
 
 bind_interrupts!(struct Irqs {
     DMA1_CHANNEL1 => dma::InterruptHandler<peripherals::DMA1_CH1>;
@@ -48,8 +60,12 @@ bind_interrupts!(struct Irqs {
     EXTI15_10 => exti::InterruptHandler<interrupt::typelevel::EXTI15_10>;
 });
 
-/// Sample rate, Hz (must divide 1 MHz; TIM1 at 170 MHz divides it exactly for 10 kHz).
-const SAMPLE_RATE_HZ: u32 = board::DEFAULT_SAMPLE_RATE_HZ;
+/// The firmware's settings: the sample rate (10 kHz; it must divide 1 MHz, and TIM1 at
+/// 170 MHz divides it exactly for 10 kHz), the commissioning time and stall time. The
+/// rate goes through `SamplePath::for_board`, that is `app::board_monitor_config`, the
+/// same configuration function the host tests use.
+const SETTINGS: Settings = Settings::DEFAULT;
+const _: () = assert!(SETTINGS.validate().is_ok(), "SETTINGS out of range");
 /// Samples per DMA half buffer: 1, so every sample is processed as it arrives and the
 /// encoder is read within microseconds of the conversion.
 const SAMPLES_PER_HALF: usize = 1;
@@ -57,33 +73,53 @@ const SAMPLES_PER_HALF: usize = 1;
 const CHANNELS: usize = 3;
 /// DMA ring length per ADC, in 16-bit words (two halves).
 const RING_LEN: usize = 2 * SAMPLES_PER_HALF * CHANNELS;
-/// Status to thread mode every this many samples (10 kHz / 100 = 100 Hz).
-const STATUS_EVERY: u32 = 100;
-/// Independent watchdog timeout, us. The thread loop pets it every 50 ms.
-const WATCHDOG_TIMEOUT_US: u32 = 500_000;
-/// Panel refresh period, ms.
-const PANEL_PERIOD_MS: u64 = 50;
+/// Longest wait for a command slot in the queue, ms (the sample task empties it at every
+/// sample).
+const COMMAND_SEND_TIMEOUT_MS: u64 = 100;
 
-/// Latest state from the sample task.
+/// What the sample task hands thread mode.
 #[derive(Clone, Copy)]
 struct Status {
-    output: MonitorOutput,
-    samples: u32,
+    monitor: MonitorStatus,
     max_update_cycles: u32,
-}
-
-/// Outcome of a learning run, from the sample task.
-#[derive(Clone, Copy)]
-enum LearnEvent {
-    Done(CalibrationRecord),
-    Failed,
 }
 
 static COMMANDS: Channel<CriticalSectionRawMutex, Command, 4> = Channel::new();
 static STATUS: Signal<CriticalSectionRawMutex, Status> = Signal::new();
-static LEARN: Channel<CriticalSectionRawMutex, LearnEvent, 2> = Channel::new();
 static OVERRUNS: AtomicU32 = AtomicU32::new(0);
+static RESTARTS: AtomicU32 = AtomicU32::new(0);
 static EXECUTOR_HIGH: InterruptExecutor = InterruptExecutor::new();
+
+/// The reset record: RAM in cortex-m-rt's `.uninit` section, which the start-up code
+/// neither zeroes nor initialises, so it keeps its content across a reset.
+// The one placed item of the firmware: `.uninit` is cortex-m-rt's NOLOAD section in RAM.
+#[allow(unsafe_code)]
+#[link_section = ".uninit.RESET_RECORD"]
+static mut RESET_RECORD: MaybeUninit<[u8; RESET_RECORD_LEN]> = MaybeUninit::uninit();
+
+/// The reset record's bytes (whatever they are: power-on garbage fails the record's check).
+#[allow(unsafe_code)]
+fn read_reset_record() -> [u8; RESET_RECORD_LEN] {
+    // SAFETY: a plain byte array read through a raw pointer, volatile so the compiler makes
+    // no assumption about its (possibly never written) content; the only other accesses
+    // are the writes below, from thread mode and from the panic handler with interrupts
+    // off, never concurrent with this read at boot.
+    unsafe { core::ptr::read_volatile(core::ptr::addr_of!(RESET_RECORD).cast()) }
+}
+
+/// Overwrites the reset record.
+#[allow(unsafe_code)]
+fn write_reset_record(bytes: &[u8; RESET_RECORD_LEN]) {
+    // SAFETY: as in `read_reset_record`; thread mode and the panic handler (interrupts
+    // off, never returns) are the only writers and cannot interleave with each other
+    // except by the panic handler overwriting, which is what it should do.
+    unsafe {
+        core::ptr::write_volatile(
+            core::ptr::addr_of_mut!(RESET_RECORD).cast::<[u8; RESET_RECORD_LEN]>(),
+            *bytes,
+        )
+    }
+}
 
 #[interrupt]
 #[allow(unsafe_code)]
@@ -111,6 +147,34 @@ fn now_us() -> u32 {
     Instant::now().as_micros() as u32
 }
 
+/// The acquisition: trigger timer and the two ring-buffered ADCs.
+struct Acquisition {
+    trigger: HwTimer<'static, peripherals::TIM1>,
+    adc1: RingBufferedAdc<'static, peripherals::ADC1>,
+    adc2: RingBufferedAdc<'static, peripherals::ADC2>,
+}
+
+impl Acquisition {
+    /// Restarts both rings with the trigger stopped, so that ADC1 and ADC2 start again on
+    /// the same conversion, and continues the timestamps from now (the gap shows).
+    async fn restart(&mut self, path: &mut SamplePath, stop_dma: bool) {
+        self.trigger.stop();
+        if stop_dma {
+            self.adc1.stop();
+            self.adc2.stop();
+        }
+        Timer::after_micros(20).await;
+        self.adc1.clear();
+        self.adc2.clear();
+        if stop_dma {
+            self.adc1.start();
+            self.adc2.start();
+        }
+        path.sampler_mut().resync(now_us());
+        self.trigger.start();
+    }
+}
+
 #[embassy_executor::task]
 async fn sample_task(hw: SampleHw, mut path: SamplePath) {
     static RING1: static_cell::StaticCell<[u16; RING_LEN]> = static_cell::StaticCell::new();
@@ -122,13 +186,13 @@ async fn sample_task(hw: SampleHw, mut path: SamplePath) {
 
     // Sample trigger: TIM1 update event -> TRGO -> both ADCs (rising edge).
     let trigger = HwTimer::new(hw.tim1);
-    trigger.set_frequency(Hertz(SAMPLE_RATE_HZ), RoundTo::Slower);
+    trigger.set_frequency(Hertz(SETTINGS.sample_rate_hz), RoundTo::Slower);
     trigger.set_master_mode(MasterMode::UPDATE);
 
     // 24.5 ADC cycles sampling time: enough for a low-impedance isolated amplifier output.
     let st = SampleTime::CYCLES24_5;
     let adc1 = Adc::new(hw.adc1, AdcConfig::default());
-    let mut adc1: RingBufferedAdc<'static, peripherals::ADC1> = adc1.into_ring_buffered(
+    let adc1: RingBufferedAdc<'static, peripherals::ADC1> = adc1.into_ring_buffered(
         hw.dma1,
         ring1,
         Irqs,
@@ -142,7 +206,7 @@ async fn sample_task(hw: SampleHw, mut path: SamplePath) {
         Exten::RISING_EDGE,
     );
     let adc2 = Adc::new(hw.adc2, AdcConfig::default());
-    let mut adc2: RingBufferedAdc<'static, peripherals::ADC2> = adc2.into_ring_buffered(
+    let adc2: RingBufferedAdc<'static, peripherals::ADC2> = adc2.into_ring_buffered(
         hw.dma2,
         ring2,
         Irqs,
@@ -155,40 +219,59 @@ async fn sample_task(hw: SampleHw, mut path: SamplePath) {
         triggers::TIM1_TRGO,
         Exten::RISING_EDGE,
     );
-    adc1.start();
-    adc2.start();
+    let mut acq = Acquisition {
+        trigger,
+        adc1,
+        adc2,
+    };
+    acq.adc1.start();
+    acq.adc2.start();
     path.sampler_mut().resync(now_us());
-    trigger.start();
-    info!("sampling at {=u32} Hz", SAMPLE_RATE_HZ);
+    acq.trigger.start();
+    info!("sampling at {=u32} Hz", SETTINGS.sample_rate_hz);
 
+    let mut wait = AdcWait::new(SETTINGS.sample_rate_hz);
+    let timeout = Duration::from_micros(u64::from(wait.timeout_us()));
+    let status_every = SETTINGS.status_every();
     let mut half1 = [0u16; SAMPLES_PER_HALF * CHANNELS];
     let mut half2 = [0u16; SAMPLES_PER_HALF * CHANNELS];
-    let mut samples: u32 = 0;
     let mut max_cycles: u32 = 0;
     loop {
-        let r1 = adc1.read(&mut half1).await;
-        let r2 = adc2.read(&mut half2).await;
-        if r1.is_err() || r2.is_err() {
-            // Samples were lost: count, log, resynchronise both rings with the trigger
-            // stopped so that ADC1 and ADC2 restart on the same conversion.
+        let read = with_timeout(timeout, async {
+            let r1 = acq.adc1.read(&mut half1).await;
+            let r2 = acq.adc2.read(&mut half2).await;
+            (r1.is_ok(), r2.is_ok())
+        })
+        .await;
+        let Ok((ok1, ok2)) = read else {
+            // No data within the timeout: the DMA or the trigger stalled. Restart the
+            // acquisition (thread mode shows the stall and stops petting the watchdog
+            // until samples flow again).
+            let restart = wait.timed_out();
+            RESTARTS.fetch_add(1, Ordering::Relaxed);
+            if restart.log {
+                error!(
+                    "no ADC data for {=u32} us: restarting sampling (attempt {=u32})",
+                    wait.timeout_us(),
+                    restart.attempt
+                );
+            }
+            acq.restart(&mut path, true).await;
+            continue;
+        };
+        if let Some(n) = wait.data() {
+            warn!("sampling resumed after {=u32} restarts", n);
+        }
+        if !(ok1 && ok2) {
+            // Samples were lost: count, log, resynchronise both rings.
             let n = OVERRUNS.fetch_add(1, Ordering::Relaxed) + 1;
-            warn!(
-                "ADC DMA overrun #{=u32} (adc1 {} adc2 {})",
-                n,
-                r1.is_err(),
-                r2.is_err()
-            );
-            trigger.stop();
-            Timer::after_micros(20).await;
-            adc1.clear();
-            adc2.clear();
-            path.sampler_mut().resync(now_us());
-            trigger.start();
+            warn!("ADC DMA overrun #{=u32} (adc1 {} adc2 {})", n, !ok1, !ok2);
+            acq.restart(&mut path, false).await;
             continue;
         }
         while let Ok(cmd) = COMMANDS.try_receive() {
-            if path.command(cmd).is_err() {
-                warn!("core rejected a command");
+            if let Err(e) = path.command(cmd) {
+                warn!("core refused a command: {=str}", e.describe());
             }
         }
         let encoder_count = qei.count();
@@ -205,19 +288,12 @@ async fn sample_task(hw: SampleHw, mut path: SamplePath) {
                 encoder_count,
             };
             let t0 = cortex_m::peripheral::DWT::cycle_count();
-            let result = path.on_frame(&raw);
+            path.on_frame(&raw);
             let dt = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t0);
             max_cycles = max_cycles.max(dt);
-            samples = samples.wrapping_add(1);
-            if let Some(rec) = result.learned {
-                let _ = LEARN.try_send(LearnEvent::Done(rec));
-            } else if result.learning_failed {
-                let _ = LEARN.try_send(LearnEvent::Failed);
-            }
-            if samples.is_multiple_of(STATUS_EVERY) {
+            if path.samples().is_multiple_of(status_every) {
                 STATUS.signal(Status {
-                    output: result.output,
-                    samples,
+                    monitor: path.status(),
                     max_update_cycles: max_cycles,
                 });
             }
@@ -225,86 +301,40 @@ async fn sample_task(hw: SampleHw, mut path: SamplePath) {
     }
 }
 
-/// Drive the six lamp pins.
+/// The six lamp outputs, in [`Lamp::ALL`] order.
 struct PanelPins {
-    pins: [Output<'static>; 6],
+    pins: [Output<'static>; LAMP_COUNT],
 }
 
 impl PanelPins {
-    fn new(l: board::pins::LampPins) -> Self {
+    fn new(pins: [Peri<'static, embassy_stm32::gpio::AnyPin>; LAMP_COUNT]) -> Self {
         Self {
-            pins: [
-                Output::new(l.run, Level::Low, Speed::Low),
-                Output::new(l.r1, Level::Low, Speed::Low),
-                Output::new(l.r2, Level::Low, Speed::Low),
-                Output::new(l.r3, Level::Low, Speed::Low),
-                Output::new(l.r4, Level::Low, Speed::Low),
-                Output::new(l.fault, Level::Low, Speed::Low),
-            ],
+            pins: pins.map(|p| Output::new(p, Level::Low, Speed::Low)),
         }
     }
 
     fn show(&mut self, lamps: &PanelLamps) {
         for (pin, lamp) in self.pins.iter_mut().zip(Lamp::ALL) {
-            pin.set_level(if lamps.is_on(lamp) {
-                Level::High
-            } else {
-                Level::Low
-            });
+            pin.set_level(Level::from(lamps.is_on(lamp)));
         }
     }
 }
 
-fn mode_name(m: Mode) -> &'static str {
-    match m {
-        Mode::NotCommissioned => "not-commissioned",
-        Mode::Commissioning => "commissioning",
-        Mode::Commissioned => "commissioned",
-        Mode::CommissioningFailed => "commissioning-failed",
-        Mode::Failed => "failed",
-    }
-}
+/// The record page in the board's flash.
+struct BoardFlash(Flash<'static, Blocking>);
 
-/// Read and validate the commissioning record.
-fn load_record(
-    flash: &mut Flash<'static, embassy_stm32::flash::Blocking>,
-) -> Option<CalibrationRecord> {
-    let mut buf = [0u8; RECORD_LEN];
-    if flash
-        .blocking_read(board::RECORD_FLASH_OFFSET, &mut buf)
-        .is_err()
-    {
-        warn!("flash read failed");
-        return None;
+impl RecordStore for BoardFlash {
+    type Error = embassy_stm32::flash::Error;
+    fn read(&mut self, buf: &mut [u8; RECORD_LEN]) -> Result<(), Self::Error> {
+        self.0.blocking_read(board::RECORD_FLASH_OFFSET, buf)
     }
-    match CalibrationRecord::decode(&buf) {
-        Ok(rec) => Some(rec),
-        Err(e) => {
-            warn!("no valid commissioning record: {}", e);
-            None
-        }
+    fn erase(&mut self) -> Result<(), Self::Error> {
+        let from = board::RECORD_FLASH_OFFSET;
+        self.0.blocking_erase(from, from + board::RECORD_PAGE_SIZE)
     }
-}
-
-/// Erase the record page, write the record, read it back.
-fn store_record(
-    flash: &mut Flash<'static, embassy_stm32::flash::Blocking>,
-    rec: &CalibrationRecord,
-) -> bool {
-    let Ok(bytes) = rec.encode() else {
-        return false;
-    };
-    let from = board::RECORD_FLASH_OFFSET;
-    if flash
-        .blocking_erase(from, from + board::RECORD_PAGE_SIZE)
-        .is_err()
-    {
-        return false;
+    fn write(&mut self, bytes: &[u8; RECORD_LEN]) -> Result<(), Self::Error> {
+        self.0.blocking_write(board::RECORD_FLASH_OFFSET, bytes)
     }
-    if flash.blocking_write(from, &bytes).is_err() {
-        return false;
-    }
-    load_record(flash) == Some(*rec)
 }
 
 fn clock_config() -> embassy_stm32::Config {
@@ -330,7 +360,7 @@ fn clock_config() -> embassy_stm32::Config {
 async fn main(_spawner: Spawner) {
     let p = embassy_stm32::init(clock_config());
     info!("drive-monitor {} starting", env!("CARGO_PKG_VERSION"));
-    let watchdog_reset = previous_run_reset_by_watchdog();
+    let previous = previous_run();
 
     // Cycle counter for the per-sample cost shown in the log.
     if let Some(mut cp) = cortex_m::Peripherals::take() {
@@ -339,21 +369,23 @@ async fn main(_spawner: Spawner) {
     }
 
     let b = Board::take(p);
-    let mut wdg = IndependentWatchdog::new(b.iwdg, WATCHDOG_TIMEOUT_US);
+    let mut wdg = IndependentWatchdog::new(b.iwdg, WATCHDOG_TIMEOUT_MS * 1000);
     wdg.unleash();
 
     let mut lamps = PanelPins::new(b.lamps);
     let mut button = ExtiInput::new(b.button, b.button_exti, Pull::Down, Irqs);
-    let mut flash = Flash::new_blocking(b.flash);
+    let mut flash = BoardFlash(Flash::new_blocking(b.flash));
 
-    let mut path = match SamplePath::for_board(SAMPLE_RATE_HZ) {
+    let mut path = match SamplePath::for_board(SETTINGS.sample_rate_hz) {
         Ok(p) => p,
+        // The settings are constants and a host test (`app::tests`) builds the same path:
+        // this cannot happen, and if it did nothing could be monitored.
+        #[allow(clippy::panic)]
         Err(_) => panic!("monitor configuration rejected"),
     };
-    let mut procedure = CommissioningProcedure::new(CommissioningProcedure::DEFAULT_DURATION_S);
-    let loaded = install_stored_calibration(&mut flash, &mut path);
-    procedure.handle(Event::RecordLoaded(loaded), 0);
-    info!("commissioned: {}", loaded);
+    install_stored_calibration(&mut flash, &mut path);
+    let boot = Instant::now();
+    let mut supervisor = Supervisor::new(&SETTINGS, previous, 0, path.status());
 
     // High-priority executor for the sample path.
     interrupt::UART4.set_priority(Priority::P1);
@@ -372,180 +404,202 @@ async fn main(_spawner: Spawner) {
     };
     high.spawn(defmt::unwrap!(sample_task(hw, path)));
 
-    let boot = Instant::now();
-    let mut ticker = Ticker::every(Duration::from_millis(PANEL_PERIOD_MS));
-    let mut last = Status {
-        output: MonitorOutput::default(),
-        samples: 0,
-        max_update_cycles: 0,
-    };
-    let mut last_press_ms: u32 = 0;
+    let period = Duration::from_millis(u64::from(PANEL_PERIOD_MS));
+    let mut next = Instant::now() + period;
+    let mut max_update_cycles = 0;
     let mut log_div: u32 = 0;
     loop {
-        wdg.pet();
-        let now_ms = boot.elapsed().as_millis() as u32;
-
-        // Button (debounced 300 ms); the wait is bounded by the panel period.
-        let pressed = with_timeout(Duration::from_millis(5), button.wait_for_rising_edge())
+        // The period's wait is the wait for the button: a press at any time is seen.
+        let pressed = with_deadline(next, button.wait_for_rising_edge())
             .await
             .is_ok();
-        if pressed && now_ms.wrapping_sub(last_press_ms) > 300 {
-            last_press_ms = now_ms;
-            start_commissioning(&mut procedure, now_ms);
+        if pressed {
+            Timer::at(next).await;
         }
-        while let Ok(ev) = LEARN.try_receive() {
-            wdg.pet();
-            finish_learning(&mut procedure, &mut flash, ev, now_ms);
-        }
-        procedure.handle(Event::Tick, now_ms);
+        next += period;
+        let now_ms = boot.elapsed().as_millis() as u32;
 
-        if let Some(s) = STATUS.try_take() {
-            last = s;
+        let status = STATUS.try_take();
+        if let Some(s) = status {
+            max_update_cycles = s.max_update_cycles;
         }
-        let mut input = PanelInput::from_output(procedure.panel_mode(), &last.output);
-        if watchdog_reset && now_ms < 5_000 {
-            input.mode = Mode::Failed;
+        let tick = supervisor.tick(now_ms, status.map(|s| s.monitor), pressed);
+        if tick.pet_watchdog {
+            wdg.pet();
         }
-        lamps.show(&panel::render(&input, now_ms));
+        if let Some(change) = tick.liveness {
+            on_liveness(change);
+        }
+        if let Some(end) = tick.run_ended {
+            log_run_end(end);
+        }
+        let (command, stored) = carry_out(tick.action, &mut flash);
+        if let Some(stored) = stored {
+            log_stored(&stored);
+        }
+        if let Some(cmd) = command {
+            let sent = with_timeout(
+                Duration::from_millis(COMMAND_SEND_TIMEOUT_MS),
+                COMMANDS.send(cmd),
+            )
+            .await;
+            if sent.is_err() {
+                error!("command queue full: {=str} dropped", cmd.name());
+            }
+        }
+        lamps.show(&tick.lamps);
 
         log_div += 1;
         if log_div >= 2 {
             log_div = 0;
-            log_status(&last, procedure.panel_mode());
+            log_status(supervisor.latest(), tick.mode.name(), max_update_cycles);
         }
-        ticker.next().await;
     }
 }
 
-/// Whether the previous run ended in a watchdog reset (a panic or a hang); clears the
-/// reset flags.
-fn previous_run_reset_by_watchdog() -> bool {
+/// Why the previous run ended: the reset record (then erased) and the watchdog flag (then
+/// cleared), logged.
+fn previous_run() -> PreviousRun {
     let csr = pac::RCC.csr().read();
-    let watchdog_reset = csr.iwdgrstf();
     pac::RCC.csr().modify(|w| w.set_rmvf(true));
-    if watchdog_reset {
-        error!("previous run ended in a watchdog reset (panic or hang): see its log");
-    }
-    watchdog_reset
-}
-
-/// Reads the commissioning record and gives it to the core; true when one was installed.
-fn install_stored_calibration(
-    flash: &mut Flash<'static, embassy_stm32::flash::Blocking>,
-    path: &mut SamplePath,
-) -> bool {
-    match load_record(flash) {
-        Some(rec) => match path.command(Command::SetCalibration(rec)) {
-            Ok(()) => true,
-            Err(_) => {
-                warn!("stored calibration out of the core's range: ignored");
-                false
-            }
+    let previous = PreviousRun::at_boot(&read_reset_record(), csr.iwdgrstf());
+    write_reset_record(&[0; RESET_RECORD_LEN]);
+    match previous {
+        PreviousRun::Clean => {}
+        PreviousRun::WatchdogReset => {
+            error!("previous run ended in a watchdog reset with no reason recorded: the firmware hung")
+        }
+        PreviousRun::Recorded(rec) => match rec.cause() {
+            ResetCause::Panic => error!(
+                "previous run ended in a panic: {=str} at {=str}:{=u32}",
+                rec.message(),
+                rec.file(),
+                rec.line_or_ms()
+            ),
+            ResetCause::SampleStall => error!(
+                "previous run ended in a watchdog reset: the sample path had stalled (no samples for {=u32} ms when recorded; restarts did not help)",
+                rec.line_or_ms()
+            ),
         },
-        None => false,
+    }
+    previous
+}
+
+/// Reads the commissioning record and gives it to the core.
+fn install_stored_calibration(flash: &mut BoardFlash, path: &mut SamplePath) {
+    match flash_record::load(flash) {
+        Ok(rec) => match path.command(Command::SetCalibration(rec)) {
+            Ok(()) => info!("commissioned: record loaded"),
+            Err(_) => warn!("stored calibration out of the core's range: not commissioned"),
+        },
+        Err(LoadError::Read(e)) => warn!("flash read failed: {}: not commissioned", e),
+        Err(LoadError::Record(e)) => warn!("no valid commissioning record: {}", e),
     }
 }
 
-/// The button was pressed: starts learning unless the procedure is busy.
-fn start_commissioning(procedure: &mut CommissioningProcedure, now_ms: u32) {
-    info!("button: start commissioning");
-    if let Action::StartLearning { duration_s } = procedure.handle(Event::ButtonPressed, now_ms) {
-        if COMMANDS
-            .try_send(Command::StartCommissioning { duration_s })
-            .is_err()
-        {
-            warn!("command queue full");
+fn on_liveness(change: LivenessChange) {
+    match change {
+        LivenessChange::Stalled { for_ms } => error!(
+            "SAMPLE PATH STALLED: no samples for {=u32} ms (restarts so far {=u32}); watchdog not petted",
+            for_ms,
+            RESTARTS.load(Ordering::Relaxed)
+        ),
+        LivenessChange::RecordStall { for_ms } => {
+            write_reset_record(&ResetRecord::sample_stall(for_ms).encode());
+        }
+        LivenessChange::Recovered { after_ms } => {
+            write_reset_record(&[0; RESET_RECORD_LEN]);
+            warn!("sample path recovered after {=u32} ms", after_ms);
         }
     }
 }
 
-/// The sample task finished learning: stores the record when the procedure asks for it.
-fn finish_learning(
-    procedure: &mut CommissioningProcedure,
-    flash: &mut Flash<'static, embassy_stm32::flash::Blocking>,
-    ev: LearnEvent,
-    now_ms: u32,
-) {
-    let action = match ev {
-        LearnEvent::Done(rec) => procedure.handle(Event::LearningDone(rec), now_ms),
-        LearnEvent::Failed => procedure.handle(Event::LearningFailed, now_ms),
-    };
-    if let Action::Save(rec) = action {
-        let ok = store_record(flash, &rec);
-        info!("commissioning record stored: {}", ok);
-        procedure.handle(Event::SaveDone(ok), now_ms);
+fn log_run_end(end: RunEnd) {
+    match end {
+        RunEnd::Commissioned { run } => info!("commissioning run {=u16}: stored and in force", run),
+        RunEnd::CancelledByUser { run } => info!("commissioning run {=u16}: cancelled", run),
+        RunEnd::Failed { run, why } => error!(
+            "commissioning run {}: FAILED ({=str}); the thresholds in force are unchanged or the flash's",
+            run,
+            why.name()
+        ),
+    }
+}
+
+fn log_stored<E: defmt::Format>(stored: &flash_record::Stored<E>) {
+    match &stored.written {
+        Ok(()) => info!(
+            "commissioning record written, read back: {}",
+            stored.read_back.is_some()
+        ),
+        Err(StoreError::Encode(e)) => error!("commissioning record not written: {}", e),
+        Err(StoreError::Erase(e)) => error!("flash erase failed: {}", e),
+        Err(StoreError::Write(e)) => error!("flash write failed: {}", e),
     }
 }
 
 /// The defmt status line: residuals, lamps, the two top candidates, speed, mode, counters.
-fn log_status(last: &Status, mode: Mode) {
-    let o = &last.output;
-    let top = o.top();
-    let (top_name, top_p) = match top {
-        Some((f, p)) => (f.name(), p),
-        None => ("none", 0.0),
-    };
-    let second = o
-        .diagnosis
-        .probabilities
-        .iter()
-        .zip(Fault::ALL)
-        .filter(|(_, f)| Some(*f) != top.map(|t| t.0))
-        .fold(None::<(Fault, f32)>, |best, (p, f)| match best {
-            Some((_, bp)) if bp >= *p => best,
-            _ if *p > 0.0 => Some((f, *p)),
-            _ => best,
-        });
-    let (second_name, second_p) = second.map_or(("none", 0.0), |(f, p)| (f.name(), p));
+fn log_status(s: &MonitorStatus, mode: &str, max_update_cycles: u32) {
+    let (top_name, top_p) = s.top.map_or(("none", 0.0), |(f, p)| (f.name(), p));
+    let (second_name, second_p) = s.second.map_or(("none", 0.0), |(f, p)| (f.name(), p));
     info!(
-        "r={} lamps={} fault={=bool} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s mode={=str} overruns={=u32} samples={=u32} max_cyc={=u32}",
-        o.residuals,
-        o.lamps,
-        o.fault_detected,
+        "r={} lamps={} fault={=bool} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32}",
+        s.residuals,
+        s.residual_lamps,
+        s.fault_detected,
         top_name,
         top_p,
         second_name,
         second_p,
-        o.speed_rad_s,
-        mode_name(mode),
+        s.speed_rad_s,
+        s.zero_crossing_locked,
+        mode,
+        s.run.id,
+        s.run.blocks_learned,
+        s.run.blocks_needed,
         OVERRUNS.load(Ordering::Relaxed),
-        last.samples,
-        last.max_update_cycles,
+        RESTARTS.load(Ordering::Relaxed),
+        s.samples,
+        max_update_cycles,
     );
 }
 
-/// Panic: put the panel into the "monitor failed" pattern (RUN off, all others on), log
-/// the reason, and stop. The watchdog is no longer petted, so the MCU resets after
-/// `WATCHDOG_TIMEOUT_US`; the next boot sees the watchdog-reset flag, logs it and shows
-/// the failed pattern for 5 s before monitoring again.
+/// Panic: the panel's "monitor failed" pattern on the lamp pins of the lamp table, the
+/// reason into the reset record and the log, and stop. The watchdog is no longer petted,
+/// so the MCU resets after `WATCHDOG_TIMEOUT_MS`; the next boot reads the record, logs it
+/// and shows the failed pattern for 5 s before monitoring again.
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
     cortex_m::interrupt::disable();
     // Direct register writes: the HAL objects may be in any state. GPIO clocks are
     // enabled by `embassy_stm32::init` for every port.
     use pac::gpio::vals::Moder;
-    pac::GPIOA.moder().modify(|w| w.set_moder(5, Moder::OUTPUT));
-    pac::GPIOA.bsrr().write(|w| w.set_br(5, true));
-    for n in [8usize, 9, 10, 12, 13] {
-        pac::GPIOB.moder().modify(|w| w.set_moder(n, Moder::OUTPUT));
-        pac::GPIOB.bsrr().write(|w| w.set_bs(n, true));
+    for lamp in Lamp::ALL {
+        let pin = lamp.pin();
+        let port = match pin.port {
+            Port::A => pac::GPIOA,
+            Port::B => pac::GPIOB,
+            Port::C => pac::GPIOC,
+            Port::D => pac::GPIOD,
+            Port::E => pac::GPIOE,
+            Port::F => pac::GPIOF,
+            Port::G => pac::GPIOG,
+        };
+        let n = usize::from(pin.number);
+        port.moder().modify(|w| w.set_moder(n, Moder::OUTPUT));
+        if PanelLamps::FAILED.is_on(lamp) {
+            port.bsrr().write(|w| w.set_bs(n, true));
+        } else {
+            port.bsrr().write(|w| w.set_br(n, true));
+        }
     }
-    // Only the static part of the message and the location are logged: formatting the
+    // Only the static part of the message and the location are kept: formatting the
     // full message would pull core::fmt (float formatting alone is ~10 KiB of flash).
     let msg = info.message().as_str().unwrap_or("(formatted message)");
-    match info.location() {
-        Some(l) => error!(
-            "MONITOR FAILED: {=str} at {=str}:{=u32}",
-            msg,
-            l.file(),
-            l.line()
-        ),
-        None => error!("MONITOR FAILED: {=str}", msg),
-    }
+    let (file, line) = info.location().map_or(("?", 0), |l| (l.file(), l.line()));
+    write_reset_record(&ResetRecord::panic(msg, file, line).encode());
+    error!("MONITOR FAILED: {=str} at {=str}:{=u32}", msg, file, line);
     loop {
         cortex_m::asm::nop();
     }
 }
-
-// Keep the panel's failed pattern and the handler above in step.
-const _: () = assert!(!PanelLamps::FAILED.on[0] && PanelLamps::FAILED.on[5]);

@@ -212,6 +212,85 @@ impl CalibrationRecord {
     }
 }
 
+/// Where the record is kept: the flash page on the board, a byte array in the host tests
+/// (the software-in-the-loop rig). Erase, write and read of the one record.
+pub trait RecordStore {
+    /// What a failed flash operation reports.
+    type Error;
+    /// Reads the first [`RECORD_LEN`] bytes of the record page.
+    ///
+    /// # Errors
+    /// When the page cannot be read.
+    fn read(&mut self, buf: &mut [u8; RECORD_LEN]) -> Result<(), Self::Error>;
+    /// Erases the record page (every byte `0xFF`).
+    ///
+    /// # Errors
+    /// When the erase fails.
+    fn erase(&mut self) -> Result<(), Self::Error>;
+    /// Writes `bytes` at the start of the (erased) record page.
+    ///
+    /// # Errors
+    /// When the write fails.
+    fn write(&mut self, bytes: &[u8; RECORD_LEN]) -> Result<(), Self::Error>;
+}
+
+/// Why no record could be loaded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LoadError<E> {
+    /// The store could not be read.
+    Read(E),
+    /// The bytes are not a valid record.
+    Record(RecordError),
+}
+
+/// Reads and validates the stored record.
+///
+/// # Errors
+/// [`LoadError`]: the read failed, or the bytes are not a valid record.
+pub fn load<S: RecordStore>(store: &mut S) -> Result<CalibrationRecord, LoadError<S::Error>> {
+    let mut buf = [0u8; RECORD_LEN];
+    store.read(&mut buf).map_err(LoadError::Read)?;
+    CalibrationRecord::decode(&buf).map_err(LoadError::Record)
+}
+
+/// The result of [`store`]: what went wrong, if anything, and what the store holds now.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stored<E> {
+    /// The first failure of encode, erase or write (`Ok` when all three worked).
+    pub written: Result<(), StoreError<E>>,
+    /// The record read back after the attempt (`None`: no valid record); this, not what
+    /// was meant to be written, is what the monitor must use.
+    pub read_back: Option<CalibrationRecord>,
+}
+
+/// Why a record could not be written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StoreError<E> {
+    /// The record holds an unusable value and was not written.
+    Encode(RecordError),
+    /// The page erase failed.
+    Erase(E),
+    /// The write failed.
+    Write(E),
+}
+
+/// Erases the page, writes `rec` and reads the page back. Whatever fails, the result says
+/// what the store holds afterwards ([`Stored::read_back`]), so the caller can make the
+/// monitor use exactly that.
+pub fn store<S: RecordStore>(store: &mut S, rec: &CalibrationRecord) -> Stored<S::Error> {
+    let written = match rec.encode() {
+        Err(e) => Err(StoreError::Encode(e)),
+        Ok(bytes) => match store.erase() {
+            Err(e) => Err(StoreError::Erase(e)),
+            Ok(()) => store.write(&bytes).map_err(StoreError::Write),
+        },
+    };
+    Stored {
+        written,
+        read_back: load(store).ok(),
+    }
+}
+
 /// Sequential writer into a fixed buffer; silently stops at the end (the layout is
 /// fixed and fits, so that never happens; no panic path either way).
 struct Writer<'a> {

@@ -3,20 +3,47 @@
 //! This library holds everything of the firmware that does not touch a register, so it
 //! builds and is tested on the host (`cargo test`):
 //! - [`board`]: analog front-end scaling (ADC code -> volts/amperes), encoder and sample
-//!   rate constants, and (target only) the pin map;
+//!   rate constants, the lamp table (each lamp's pin and meaning, once) and (target only)
+//!   the pin map;
 //! - [`sampling`]: one trigger's six ADC codes + encoder count -> the core's `Sample`;
-//! - [`commissioning`]: button -> learn -> store state machine;
-//! - [`flash_record`]: the commissioning record's encoding, version and CRC;
-//! - [`panel`]: lamp mapping and blink codes;
-//! - [`app`]: the glue that runs the core per sample and turns its output into lamps.
+//! - [`commissioning`]: the button -> learn -> store procedure around the core's
+//!   commissioning runs;
+//! - [`flash_record`]: the commissioning record's encoding, version and CRC, and storing it;
+//! - [`liveness`]: timeouts on the ADC waits, the watch on the sample counter that pets
+//!   the watchdog;
+//! - [`reset_record`]: why the previous run ended (panic, stalled sample path), kept in
+//!   RAM across the reset;
+//! - [`panel`]: lamp patterns and blink codes;
+//! - [`app`]: the glue: settings, the per-sample path, the status it hands thread mode,
+//!   and thread mode's supervisor.
 //!
 //! The hardware tasks (ADC/DMA, encoder, flash, watchdog, panic handler) are in
 //! `src/firmware.rs` (included by `src/main.rs`) and only exist for `target_os = "none"`.
 #![cfg_attr(target_os = "none", no_std)]
+// No panics on the board: the sample path and everything it calls must not unwrap, expect,
+// panic or index out of bounds (the core's rule, here too).
+#![deny(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing
+)]
+// Tests may index, unwrap and panic: that is how they fail.
+#![cfg_attr(
+    test,
+    allow(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic,
+        clippy::indexing_slicing
+    )
+)]
 
 pub mod app;
 pub mod board;
 pub mod commissioning;
 pub mod flash_record;
+pub mod liveness;
 pub mod panel;
+pub mod reset_record;
 pub mod sampling;

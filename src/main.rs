@@ -4,6 +4,13 @@
 //! handler). On the host this binary is a stub so that `cargo test` at the workspace root
 //! builds; the testable logic is the `drive_monitor` library.
 #![cfg_attr(target_os = "none", no_std, no_main)]
+// No panics on the board (the sample task above all): as in the library and the core.
+#![deny(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing
+)]
 
 #[cfg(target_os = "none")]
 mod firmware;

@@ -1,37 +1,32 @@
-//! LED panel: which lamp shows what, and the blink codes.
+//! LED panel: what the lamps show, and the blink codes.
 //!
-//! A pure function of the monitor's state and the time ([`render`]), so the exact
-//! patterns are tested on the host. The firmware calls it every 50 ms and copies the
-//! result to the pins (see `board.rs` for the pin of each [`Lamp`]).
-//!
-//! # Panel
-//!
-//! | lamp | pin | meaning |
-//! |---|---|---|
-//! | RUN | PA5 (LD2) | monitor alive, see patterns below |
-//! | R1..R4 | PB8, PB9, PB10, PB12 | residual r_k beyond its threshold (steady on) |
-//! | FAULT | PB13 | fault detected; blinks the top candidate (blink code) |
+//! A pure function of the panel's inputs and the time ([`render`]), so the exact patterns
+//! are tested on the host. The firmware calls it every 50 ms and copies the result to the
+//! pins. Which pin drives which lamp, and what a lit lamp means, is defined once in
+//! `board.rs` ([`Lamp`]: [`Lamp::pin`], [`Lamp::meaning`]).
 //!
 //! # RUN lamp patterns (period 2 s)
 //!
 //! | pattern | meaning |
 //! |---|---|
-//! | 1 Hz blink (500 ms on / 500 ms off) | monitoring, commissioned |
+//! | 1 Hz blink (500 ms on / 500 ms off) | monitoring, commissioned (learned thresholds in force) |
 //! | double flash (100 on, 100 off, 100 on, 1700 off) | monitoring, NOT commissioned (no valid record: default thresholds) |
-//! | 5 Hz blink (100 on / 100 off) | commissioning (learning healthy thresholds) |
-//! | off, all five other lamps steady on | MONITOR FAILED (panic or watchdog reset; see the defmt log) |
+//! | 5 Hz blink (100 on / 100 off) | commissioning (learning healthy thresholds, then storing them) |
+//! | all six lamps flash together at 2 Hz (250 ms on / 250 ms off) | SAMPLING STALLED: no samples arrive; the lamps show no monitoring result; the firmware restarts sampling, the watchdog resets the MCU if that fails |
+//! | off, all five other lamps steady on | MONITOR FAILED (a panic or a watchdog reset; for 5 s after the reset, see the defmt log) |
 //!
 //! The RUN lamp is never off for more than 1.7 s while the monitor runs, so "RUN off and
-//! everything else on" cannot be mistaken for a normal state.
+//! everything else on" cannot be mistaken for a normal state; and only a stalled sample
+//! path flashes the residual lamps (they are steady otherwise).
 //!
 //! # FAULT lamp and blink code
 //!
 //! | pattern | meaning |
 //! |---|---|
 //! | off | no fault detected |
-//! | N blinks (250 ms on / 250 ms off), then 1.5 s dark, repeating | fault detected, top candidate N (table below) |
 //! | steady on | input invalid: ADC saturated or a sensor fault flagged by the core, no isolation |
-//! | 10 Hz flicker | commissioning failed (record could not be written / learning failed); press the button to retry |
+//! | N blinks (250 ms on / 250 ms off), then 1.5 s dark, repeating | fault detected, top candidate N (table below) |
+//! | 10 Hz flicker | the last commissioning failed (no progress, unusable statistics or not stored) and no fault is shown; the RUN lamp says which thresholds are in force; press the button to retry |
 //!
 //! Blink code N = position in the core's `Fault::ALL` plus one:
 //!
@@ -43,70 +38,81 @@
 //! apart by the method; the lamp shows the first of the tied pair and the defmt log
 //! lists the probabilities of all candidates.
 
-/// One lamp of the panel; the discriminant is its index in [`PanelLamps::on`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Lamp {
-    /// Run / healthy (PA5).
-    Run = 0,
-    /// Residual r1 beyond threshold (PB8).
-    R1 = 1,
-    /// Residual r2 beyond threshold (PB9).
-    R2 = 2,
-    /// Residual r3 beyond threshold (PB10).
-    R3 = 3,
-    /// Residual r4 beyond threshold (PB12).
-    R4 = 4,
-    /// Fault / blink code (PB13).
-    Fault = 5,
-}
+use crate::app::MonitorStatus;
+pub use crate::board::Lamp;
 
-impl Lamp {
-    /// All lamps in index order.
-    pub const ALL: [Lamp; 6] = [
-        Lamp::Run,
-        Lamp::R1,
-        Lamp::R2,
-        Lamp::R3,
-        Lamp::R4,
-        Lamp::Fault,
-    ];
-}
-
-/// State of the six lamps, indexed by [`Lamp`] (`true` = lit).
+/// State of the six lamps (`true` = lit), one field per lamp.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct PanelLamps {
-    /// Lit state per lamp, `on[Lamp::X as usize]`.
-    pub on: [bool; 6],
+    /// The RUN lamp.
+    pub run: bool,
+    /// The residual lamps r1..r4, in residual order ([`Lamp::RESIDUALS`]).
+    pub residuals: [bool; 4],
+    /// The FAULT lamp.
+    pub fault: bool,
 }
 
 impl PanelLamps {
-    /// Whether `lamp` is lit.
-    pub fn is_on(&self, lamp: Lamp) -> bool {
-        self.on.get(lamp as usize).copied().unwrap_or(false)
+    /// The "monitor failed" pattern: RUN off, every other lamp on (also the panic
+    /// handler's, which drives the pins of [`Lamp::ALL`] from it).
+    pub const FAILED: Self = Self {
+        run: false,
+        residuals: [true; 4],
+        fault: true,
+    };
+
+    /// Every lamp lit (`true`) or dark.
+    pub const fn all(on: bool) -> Self {
+        Self {
+            run: on,
+            residuals: [on; 4],
+            fault: on,
+        }
     }
 
-    /// The "monitor failed" pattern: RUN off, every other lamp on.
-    pub const FAILED: Self = Self {
-        on: [false, true, true, true, true, true],
-    };
+    /// Whether `lamp` is lit.
+    pub const fn is_on(&self, lamp: Lamp) -> bool {
+        let [r1, r2, r3, r4] = self.residuals;
+        match lamp {
+            Lamp::Run => self.run,
+            Lamp::R1 => r1,
+            Lamp::R2 => r2,
+            Lamp::R3 => r3,
+            Lamp::R4 => r4,
+            Lamp::Fault => self.fault,
+        }
+    }
 }
 
-/// What the monitor is doing, as far as the panel is concerned.
+/// What the monitor is doing, as far as the RUN lamp is concerned.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mode {
     /// Monitoring with default thresholds: no valid commissioning record.
     NotCommissioned,
-    /// Learning the healthy thresholds.
+    /// A commissioning run is active (learning, or its result being stored).
     Commissioning,
     /// Monitoring with learned thresholds.
     Commissioned,
-    /// The last commissioning attempt failed (monitoring continues).
-    CommissioningFailed,
+    /// No samples arrive: the monitor's results are stale and are not shown.
+    SamplingStalled,
     /// The monitor failed (panic or watchdog reset).
     Failed,
 }
 
-/// Inputs of [`render`], taken from the latest monitor output.
+impl Mode {
+    /// A short name for logs.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Mode::NotCommissioned => "not-commissioned",
+            Mode::Commissioning => "commissioning",
+            Mode::Commissioned => "commissioned",
+            Mode::SamplingStalled => "sampling-stalled",
+            Mode::Failed => "failed",
+        }
+    }
+}
+
+/// Inputs of [`render`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PanelInput {
     /// Panel mode.
@@ -119,19 +125,22 @@ pub struct PanelInput {
     pub input_invalid: bool,
     /// Index of the top fault candidate in `Fault::ALL` (0..=8), if any.
     pub top_candidate: Option<u8>,
+    /// The last commissioning attempt failed (shown while no fault is).
+    pub commissioning_failed: bool,
 }
 
 impl PanelInput {
-    /// The panel's inputs for the latest core output in `mode`: the residual lamps, the
-    /// fault lamp, "input invalid" when a sensor fault is flagged with no residual lamp
-    /// lit, and the top candidate's blink code.
-    pub fn from_output(mode: Mode, out: &monitor_core::MonitorOutput) -> Self {
+    /// The panel's inputs for the latest status in `mode`: the residual lamps, the fault
+    /// lamp, "input invalid" when a sensor fault is flagged with no residual lamp lit, and
+    /// the top candidate's blink code.
+    pub fn from_status(mode: Mode, status: &MonitorStatus, commissioning_failed: bool) -> Self {
         PanelInput {
             mode,
-            residual_lamps: out.lamps,
-            fault_detected: out.fault_detected,
-            input_invalid: out.sensor_fault.any() && !out.lamps.iter().any(|l| *l),
-            top_candidate: out.top().map(|(f, _)| f.index() as u8),
+            residual_lamps: status.residual_lamps,
+            fault_detected: status.fault_detected,
+            input_invalid: status.sensor_fault.any() && !status.residual_lamps.iter().any(|l| *l),
+            top_candidate: status.top.map(|(f, _)| f.index() as u8),
+            commissioning_failed,
         }
     }
 }
@@ -144,6 +153,8 @@ pub const fn blink_code(candidate_index: u8) -> u8 {
 const BLINK_ON_MS: u32 = 250;
 const BLINK_SLOT_MS: u32 = 500;
 const BLINK_GAP_MS: u32 = 1500;
+/// Half period of the "sampling stalled" flash, ms (2 Hz).
+const STALLED_HALF_PERIOD_MS: u32 = 250;
 
 /// Fault lamp state at `t_ms` for blink code `n` (>= 1): `n` pulses of 250 ms in 500 ms
 /// slots, then 1.5 s dark; period `n * 500 + 1500` ms.
@@ -160,39 +171,43 @@ fn run_lamp(mode: Mode, t_ms: u32) -> bool {
     match mode {
         Mode::Commissioned => t_ms % 1000 < 500,
         Mode::Commissioning => t_ms % 200 < 100,
-        Mode::NotCommissioned | Mode::CommissioningFailed => {
+        Mode::NotCommissioned => {
             let p = t_ms % 2000;
             p < 100 || (200..300).contains(&p)
         }
+        Mode::SamplingStalled => t_ms % (2 * STALLED_HALF_PERIOD_MS) < STALLED_HALF_PERIOD_MS,
         Mode::Failed => false,
     }
 }
 
 /// Lamp states for `input` at time `t_ms` (any monotonic millisecond clock; wraps).
 pub fn render(input: &PanelInput, t_ms: u32) -> PanelLamps {
-    if input.mode == Mode::Failed {
-        return PanelLamps::FAILED;
+    match input.mode {
+        Mode::Failed => return PanelLamps::FAILED,
+        Mode::SamplingStalled => return PanelLamps::all(run_lamp(Mode::SamplingStalled, t_ms)),
+        _ => {}
     }
-    let mut out = PanelLamps::default();
-    out.on[Lamp::Run as usize] = run_lamp(input.mode, t_ms);
-    if input.mode != Mode::Commissioning {
-        out.on[1..5].copy_from_slice(&input.residual_lamps);
+    let learning = input.mode == Mode::Commissioning;
+    PanelLamps {
+        run: run_lamp(input.mode, t_ms),
+        residuals: if learning {
+            [false; 4]
+        } else {
+            input.residual_lamps
+        },
+        fault: if learning {
+            false
+        } else if input.input_invalid {
+            true
+        } else if input.fault_detected {
+            match input.top_candidate {
+                Some(i) => blink_code_lamp(blink_code(i), t_ms),
+                None => true,
+            }
+        } else {
+            input.commissioning_failed && t_ms % 100 < 50
+        },
     }
-    out.on[Lamp::Fault as usize] = if input.mode == Mode::CommissioningFailed {
-        t_ms % 100 < 50
-    } else if input.mode == Mode::Commissioning {
-        false
-    } else if input.input_invalid {
-        true
-    } else if input.fault_detected {
-        match input.top_candidate {
-            Some(i) => blink_code_lamp(blink_code(i), t_ms),
-            None => true,
-        }
-    } else {
-        false
-    };
-    out
 }
 
 /// Decode a blink code from a recorded fault-lamp trace sampled every `step_ms`
@@ -242,8 +257,15 @@ mod tests {
             fault_detected: true,
             input_invalid: false,
             top_candidate: Some(3),
+            commissioning_failed: false,
         }
     }
+
+    const NORMAL: [Mode; 3] = [
+        Mode::NotCommissioned,
+        Mode::Commissioning,
+        Mode::Commissioned,
+    ];
 
     #[test]
     fn blink_code_round_trips_for_every_candidate() {
@@ -258,18 +280,34 @@ mod tests {
     }
 
     #[test]
-    fn failed_pattern_is_distinct() {
+    fn failed_and_stalled_patterns_are_distinct() {
         let f = render(&input(Mode::Failed), 123);
         assert_eq!(f, PanelLamps::FAILED);
-        // In every other mode the RUN lamp is lit within any 2 s window.
-        for mode in [
-            Mode::NotCommissioned,
-            Mode::Commissioning,
-            Mode::Commissioned,
-            Mode::CommissioningFailed,
-        ] {
+        // In every normal mode the RUN lamp is lit within any 2 s window...
+        for mode in NORMAL {
             let lit = (0..40u32).any(|k| render(&input(mode), 5000 + k * 50).is_on(Lamp::Run));
             assert!(lit, "{mode:?}");
+        }
+        // ...and the stalled pattern (all six together) appears in no other mode.
+        let stalled: Vec<PanelLamps> = (0..40u32)
+            .map(|k| render(&input(Mode::SamplingStalled), k * 50))
+            .collect();
+        assert!(stalled.contains(&PanelLamps::all(true)));
+        assert!(stalled.contains(&PanelLamps::all(false)));
+        assert!(stalled
+            .iter()
+            .all(|p| *p == PanelLamps::all(true) || *p == PanelLamps::all(false)));
+        // The residual lamps flash only there: in any other mode they hold still for
+        // still inputs.
+        for mode in NORMAL.into_iter().chain([Mode::Failed]) {
+            for failed in [false, true] {
+                let mut inp = input(mode);
+                inp.residual_lamps = [true; 4];
+                inp.commissioning_failed = failed;
+                let first = render(&inp, 0).residuals;
+                let still = (0..400u32).all(|k| render(&inp, k * 5).residuals == first);
+                assert!(still, "{mode:?} flashes its residual lamps");
+            }
         }
     }
 
@@ -279,5 +317,23 @@ mod tests {
         assert!(p.is_on(Lamp::R1) && !p.is_on(Lamp::R2) && p.is_on(Lamp::R3));
         let p = render(&input(Mode::Commissioning), 0);
         assert!(!p.is_on(Lamp::R1) && !p.is_on(Lamp::Fault));
+    }
+
+    #[test]
+    fn a_failed_commissioning_flickers_unless_a_fault_is_shown() {
+        let mut inp = input(Mode::Commissioned);
+        inp.commissioning_failed = true;
+        inp.fault_detected = false;
+        let trace: Vec<bool> = (0..20u32)
+            .map(|k| render(&inp, k * 25).is_on(Lamp::Fault))
+            .collect();
+        assert!(trace.contains(&true) && trace.contains(&false));
+        // The RUN lamp still says which thresholds are in force.
+        assert!(render(&inp, 0).run && !render(&inp, 600).run);
+        inp.fault_detected = true;
+        let trace: Vec<bool> = (0..400u32)
+            .map(|k| render(&inp, k * 50).is_on(Lamp::Fault))
+            .collect();
+        assert_eq!(read_blink_code(&trace, 50), Some(4));
     }
 }

@@ -1,100 +1,352 @@
 //! Software in the loop: the firmware's own logic (ADC quantization, sample path, core,
-//! commissioning state machine, flash record, panel) driven sample by sample by the
-//! simulator in `sim-host`, with the LED outputs asserted.
+//! status hand-over, supervisor with its commissioning procedure and liveness watch, flash
+//! record, reset record, panel) driven sample by sample by the simulator in `sim-host`, with
+//! the lamps, the watchdog and the flash asserted.
 //!
-//! Timeline (2.2 kW reference motor, started direct-on-line, viscous load, 10 kHz):
-//! 0-1.5 s run-up; button at 1.5 s -> 1 s of learning -> record "written" to a fake flash
-//! page; 4.0 s: Rs +50 %; 6.5 s end.
+//! The rig is the firmware without hardware: a sample period is 100 us of board time; the
+//! sample task's work per period is `SamplePath::on_frame` (or, when the source delivers
+//! nothing, the wait for ADC data with its timeout and restarts); every 100 samples it hands
+//! over a status; every 50 ms thread mode runs `Supervisor::tick` and carries out its
+//! action on a fake flash page; a watchdog model resets the "MCU" 500 ms after the last pet.
+//! A reset (watchdog, power loss) keeps what survives on a board: the flash page, the
+//! no-init RAM of the reset record and the watchdog-reset flag.
+//!
+//! At every thread tick the rig checks that RAM (the core's thresholds), flash (the record
+//! the next boot would load) and the panel (the RUN lamp's mode) agree.
 
-use drive_monitor::app::{Command, SamplePath};
+use drive_monitor::app::{
+    carry_out, MonitorStatus, SamplePath, Settings, Supervisor, Tick, PANEL_PERIOD_MS,
+    WATCHDOG_TIMEOUT_MS,
+};
 use drive_monitor::board::{self, RECORD_PAGE_SIZE};
-use drive_monitor::commissioning::{Action, CommissioningProcedure, Event, State};
-use drive_monitor::flash_record::{CalibrationRecord, RECORD_LEN};
+use drive_monitor::commissioning::{Failure, RunEnd};
+use drive_monitor::flash_record::{self, CalibrationRecord, RecordStore, RECORD_LEN};
+use drive_monitor::liveness::AdcWait;
 use drive_monitor::panel::{self, Lamp, Mode, PanelInput, PanelLamps};
+use drive_monitor::reset_record::{PreviousRun, ResetCause, ResetRecord, RESET_RECORD_LEN};
 use drive_monitor::sampling::RawFrame;
-use monitor_core::Fault;
-use monitor_core::{Abc, MonitorOutput};
+use monitor_core::{Abc, Calibration, CommissioningFailure, Fault, RunStage};
 use sim_host::params::ParamFile;
-use sim_host::sim::simulate_to_vec;
-use sim_host::sim::{FaultSpec, Scenario};
+use sim_host::sim::{simulate_to_vec, FaultSpec, LoadStep, Scenario};
 
 const FS: u32 = board::DEFAULT_SAMPLE_RATE_HZ;
-const PANEL_EVERY: usize = 500; // 50 ms at 10 kHz, as in the firmware
+const PERIODS_PER_MS: u64 = FS as u64 / 1000;
+/// The rig's settings: the firmware's, with 1 s of learning to keep the tests short.
+const SETTINGS: Settings = Settings {
+    commissioning_duration_s: 1.0,
+    ..Settings::DEFAULT
+};
 
-/// The firmware's thread loop without hardware: panel every 50 ms, button events,
-/// commissioning, a fake flash page.
+/// A flash fault to inject into the next record write.
+#[derive(Clone, Copy, Debug)]
+enum FlashFault {
+    /// Power is lost after this many bytes of the record were written.
+    PowerLossAfter(usize),
+    /// The write reports an error and writes nothing.
+    WriteFails,
+}
+
+/// The record page, with fault injection.
+#[derive(Clone, Debug)]
+struct FakeFlash {
+    page: Vec<u8>,
+    fault: Option<FlashFault>,
+    power_lost: bool,
+    writes: u32,
+}
+
+#[derive(Debug)]
+struct FlashError;
+
+impl FakeFlash {
+    fn erased() -> Self {
+        Self {
+            page: vec![0xFF; RECORD_PAGE_SIZE as usize],
+            fault: None,
+            power_lost: false,
+            writes: 0,
+        }
+    }
+
+    fn holding(rec: &CalibrationRecord) -> Self {
+        let mut f = Self::erased();
+        f.page[..RECORD_LEN].copy_from_slice(&rec.encode().unwrap());
+        f
+    }
+
+    /// The calibration the next boot would put into force (a valid record the core
+    /// accepts), the flash side of "RAM, flash and panel agree".
+    fn usable(&self) -> Option<Calibration> {
+        CalibrationRecord::decode(&self.page)
+            .ok()
+            .map(Calibration::from)
+            .filter(Calibration::is_valid)
+    }
+}
+
+impl RecordStore for FakeFlash {
+    type Error = FlashError;
+    fn read(&mut self, buf: &mut [u8; RECORD_LEN]) -> Result<(), FlashError> {
+        if self.power_lost {
+            return Err(FlashError);
+        }
+        buf.copy_from_slice(&self.page[..RECORD_LEN]);
+        Ok(())
+    }
+    fn erase(&mut self) -> Result<(), FlashError> {
+        if self.power_lost {
+            return Err(FlashError);
+        }
+        self.page.fill(0xFF);
+        Ok(())
+    }
+    fn write(&mut self, bytes: &[u8; RECORD_LEN]) -> Result<(), FlashError> {
+        if self.power_lost {
+            return Err(FlashError);
+        }
+        self.writes += 1;
+        match self.fault.take() {
+            None => {
+                self.page[..RECORD_LEN].copy_from_slice(bytes);
+                Ok(())
+            }
+            Some(FlashFault::PowerLossAfter(n)) => {
+                self.page[..n].copy_from_slice(&bytes[..n]);
+                self.power_lost = true;
+                Err(FlashError)
+            }
+            Some(FlashFault::WriteFails) => Err(FlashError),
+        }
+    }
+}
+
+/// What survives a reset on the board.
+#[derive(Clone, Debug)]
+struct Survivors {
+    flash: FakeFlash,
+    reset_ram: [u8; RESET_RECORD_LEN],
+    watchdog_reset: bool,
+}
+
+impl Survivors {
+    fn power_on(flash: FakeFlash) -> Self {
+        Self {
+            flash,
+            // Power-on RAM content: anything.
+            reset_ram: [0x5A; RESET_RECORD_LEN],
+            watchdog_reset: false,
+        }
+    }
+}
+
+/// Why a run of the rig stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Reset {
+    Watchdog,
+    PowerLoss,
+}
+
+/// One thread-mode period as the rig saw it.
+#[derive(Clone, Copy, Debug)]
+struct Seen {
+    t_ms: u32,
+    tick: Tick,
+    status: MonitorStatus,
+    /// The core's quasi-steady gate at the tick (a peek the firmware does not need).
+    quasi_steady: bool,
+}
+
+/// The firmware without hardware.
 struct Rig {
+    settings: Settings,
+    survivors: Survivors,
+    previous: PreviousRun,
     path: SamplePath,
-    procedure: CommissioningProcedure,
-    flash: [u8; RECORD_PAGE_SIZE as usize],
-    last: MonitorOutput,
-    panel: PanelLamps,
-    fault_trace: Vec<bool>,
+    supervisor: Supervisor,
+    periods: u64,
+    pending_status: Option<MonitorStatus>,
+    button: bool,
+    last_pet_ms: u32,
+    adc: AdcWait,
+    waited_us: u32,
+    restarts_at_ms: Vec<u32>,
+    seen: Vec<Seen>,
+    ended: Vec<RunEnd>,
 }
 
 impl Rig {
-    fn boot(flash: [u8; RECORD_PAGE_SIZE as usize]) -> Self {
-        let mut path = SamplePath::for_board(FS).unwrap();
-        let mut procedure = CommissioningProcedure::new(1.0);
-        let loaded = match CalibrationRecord::decode(&flash) {
-            Ok(rec) => path.command(Command::SetCalibration(rec)).is_ok(),
-            Err(_) => false,
-        };
-        procedure.handle(Event::RecordLoaded(loaded), 0);
+    fn boot(survivors: Survivors) -> Self {
+        Self::boot_with(SETTINGS, survivors)
+    }
+
+    fn boot_with(settings: Settings, mut survivors: Survivors) -> Self {
+        let previous = PreviousRun::at_boot(&survivors.reset_ram, survivors.watchdog_reset);
+        survivors.reset_ram = [0; RESET_RECORD_LEN];
+        survivors.watchdog_reset = false;
+        survivors.flash.power_lost = false;
+        let mut path = SamplePath::for_board(settings.sample_rate_hz).unwrap();
+        if let Ok(rec) = flash_record::load(&mut survivors.flash) {
+            // A record the core rejects leaves the default thresholds (logged on the board).
+            let _ = path.command(drive_monitor::app::Command::SetCalibration(rec));
+        }
+        let supervisor = Supervisor::new(&settings, previous, 0, path.status());
         Rig {
+            settings,
+            survivors,
+            previous,
             path,
-            procedure,
-            flash,
-            last: MonitorOutput::default(),
-            panel: PanelLamps::default(),
-            fault_trace: Vec::new(),
+            supervisor,
+            periods: 0,
+            pending_status: None,
+            button: false,
+            last_pet_ms: 0,
+            adc: AdcWait::new(settings.sample_rate_hz),
+            waited_us: 0,
+            restarts_at_ms: Vec::new(),
+            seen: Vec::new(),
+            ended: Vec::new(),
         }
     }
 
-    fn press(&mut self, now_ms: u32) {
-        if let Action::StartLearning { duration_s } =
-            self.procedure.handle(Event::ButtonPressed, now_ms)
-        {
-            self.path
-                .command(Command::StartCommissioning { duration_s })
-                .unwrap();
-        }
+    fn now_ms(&self) -> u32 {
+        (self.periods / PERIODS_PER_MS) as u32
     }
 
-    fn step(&mut self, raw: &RawFrame, k: usize) {
-        let now_ms = (k as u64 * 1000 / u64::from(FS)) as u32;
-        let r = self.path.on_frame(raw);
-        self.last = r.output;
-        let ev = match (r.learned, r.learning_failed) {
-            (Some(rec), _) => Some(Event::LearningDone(rec)),
-            (None, true) => Some(Event::LearningFailed),
-            _ => None,
-        };
-        if let Some(ev) = ev {
-            if let Action::Save(rec) = self.procedure.handle(ev, now_ms) {
-                let bytes = rec.encode().unwrap();
-                self.flash = [0xFF; RECORD_PAGE_SIZE as usize];
-                self.flash[..RECORD_LEN].copy_from_slice(&bytes);
-                let ok = CalibrationRecord::decode(&self.flash) == Ok(rec);
-                self.procedure.handle(Event::SaveDone(ok), now_ms);
+    fn press(&mut self) {
+        self.button = true;
+    }
+
+    /// One sample period: the sample task gets `raw` (or nothing: the source is stopped),
+    /// then thread mode runs if its period is due. `Err` when the MCU reset.
+    fn period(&mut self, raw: Option<&RawFrame>) -> Result<(), Reset> {
+        match raw {
+            Some(raw) => {
+                self.waited_us = 0;
+                self.adc.data();
+                self.path.on_frame(raw);
+                if self
+                    .path
+                    .samples()
+                    .is_multiple_of(self.settings.status_every())
+                {
+                    self.pending_status = Some(self.path.status());
+                }
+            }
+            None => {
+                self.waited_us += 1_000_000 / FS;
+                if self.waited_us >= self.adc.timeout_us() {
+                    // The wait timed out: the sample task restarts the acquisition.
+                    self.adc.timed_out();
+                    self.waited_us = 0;
+                    self.restarts_at_ms.push(self.now_ms());
+                    let now_us = (self.periods * 1_000_000 / u64::from(FS)) as u32;
+                    self.path.sampler_mut().resync(now_us);
+                }
             }
         }
-        if k.is_multiple_of(PANEL_EVERY) {
-            self.procedure.handle(Event::Tick, now_ms);
-            self.panel = panel::render(
-                &PanelInput::from_output(self.procedure.panel_mode(), &self.last),
-                now_ms,
-            );
-            self.fault_trace.push(self.panel.is_on(Lamp::Fault));
+        self.periods += 1;
+        let now_ms = self.now_ms();
+        if self
+            .periods
+            .is_multiple_of(PERIODS_PER_MS * u64::from(PANEL_PERIOD_MS))
+        {
+            self.thread_tick(now_ms)?;
         }
+        if now_ms.wrapping_sub(self.last_pet_ms) > WATCHDOG_TIMEOUT_MS {
+            self.survivors.watchdog_reset = true;
+            return Err(Reset::Watchdog);
+        }
+        Ok(())
+    }
+
+    fn thread_tick(&mut self, now_ms: u32) -> Result<(), Reset> {
+        let status = self.pending_status.take();
+        let button = std::mem::take(&mut self.button);
+        let tick = self.supervisor.tick(now_ms, status, button);
+        let used = *self.supervisor.latest();
+        self.check_agreement(now_ms, &tick, &used);
+        self.seen.push(Seen {
+            t_ms: now_ms,
+            tick,
+            status: used,
+            quasi_steady: self.path.monitor().output().quasi_steady,
+        });
+        if tick.pet_watchdog {
+            self.last_pet_ms = now_ms;
+        }
+        self.ended.extend(tick.run_ended);
+        match tick.liveness {
+            Some(drive_monitor::liveness::LivenessChange::RecordStall { for_ms }) => {
+                self.survivors.reset_ram = ResetRecord::sample_stall(for_ms).encode();
+            }
+            Some(drive_monitor::liveness::LivenessChange::Recovered { .. }) => {
+                self.survivors.reset_ram = [0; RESET_RECORD_LEN];
+            }
+            _ => {}
+        }
+        let (command, _stored) = carry_out(tick.action, &mut self.survivors.flash);
+        if self.survivors.flash.power_lost {
+            return Err(Reset::PowerLoss);
+        }
+        if let Some(cmd) = command {
+            // The sample task applies commands between two samples; a refused one is
+            // logged on the board.
+            let _ = self.path.command(cmd);
+        }
+        Ok(())
+    }
+
+    /// RAM, flash and panel agree (checked at every thread tick, before its action).
+    fn check_agreement(&self, now_ms: u32, tick: &Tick, status: &MonitorStatus) {
+        let ram = self.path.monitor().calibration();
+        let run = self.path.monitor().commissioning();
+        let flash = self.survivors.flash.usable();
+        if !matches!(run.stage, RunStage::AwaitingStorage(_)) {
+            assert_eq!(ram, flash, "{now_ms} ms: RAM and flash disagree ({run:?})");
+        }
+        assert_eq!(
+            status.commissioned,
+            ram.is_some(),
+            "{now_ms} ms: the status is not the core's"
+        );
+        let expected = if status.run.stage.is_active() {
+            Mode::Commissioning
+        } else if status.commissioned {
+            Mode::Commissioned
+        } else {
+            Mode::NotCommissioned
+        };
+        if !matches!(tick.mode, Mode::Failed | Mode::SamplingStalled) {
+            assert_eq!(tick.mode, expected, "{now_ms} ms: the panel disagrees");
+        }
+    }
+
+    /// Runs the frames from index `from` on; `at(rig, k)` may act before frame `k`.
+    fn run(
+        &mut self,
+        frames: &[RawFrame],
+        mut at: impl FnMut(&mut Rig, usize),
+    ) -> Result<(), Reset> {
+        for (k, raw) in frames.iter().enumerate() {
+            at(self, k);
+            self.period(Some(raw))?;
+        }
+        Ok(())
+    }
+
+    fn last(&self) -> &Seen {
+        self.seen.last().expect("a thread tick")
+    }
+
+    fn mode(&self) -> Mode {
+        self.last().tick.mode
     }
 }
 
 fn frames(scenario: &Scenario) -> Vec<RawFrame> {
     let params = ParamFile::reference_2p2kw();
     let rows = simulate_to_vec(&params, scenario).expect("simulation");
-    let q = SamplePath::for_board(FS).unwrap();
-    let q = q.sampler();
+    let q = *SamplePath::for_board(FS).unwrap().sampler();
     let mut theta_counts = 0.0f64;
     let dt = 1.0 / f64::from(FS);
     rows.iter()
@@ -126,6 +378,21 @@ fn frames(scenario: &Scenario) -> Vec<RawFrame> {
         .collect()
 }
 
+/// Healthy running at the rated viscous load: run-up, then steady.
+fn steady_frames(duration_s: f64) -> Vec<RawFrame> {
+    frames(&Scenario::steady(duration_s, f64::from(FS)))
+}
+
+/// A record from an earlier commissioning (a plausible healthy calibration).
+fn old_record() -> CalibrationRecord {
+    CalibrationRecord {
+        mean: [0.0, 0.001, -0.001, 0.0],
+        spread: [0.004; 4],
+    }
+}
+
+const PRESS_AT: usize = 15_000; // 1.5 s: after the run-up and the core's settling
+
 #[test]
 fn commission_then_detect_rs_fault_on_the_panel() {
     let mut scenario = Scenario::steady(6.5, f64::from(FS));
@@ -135,45 +402,54 @@ fn commission_then_detect_rs_fault_on_the_panel() {
     let frames = frames(&scenario);
     assert!(frames.len() >= 64_000, "{} samples", frames.len());
 
-    let mut rig = Rig::boot([0xFF; RECORD_PAGE_SIZE as usize]);
-    assert_eq!(rig.procedure.panel_mode(), Mode::NotCommissioned);
+    let mut rig = Rig::boot(Survivors::power_on(FakeFlash::erased()));
+    assert_eq!(rig.previous, PreviousRun::Clean);
     let mut before_fault = None;
-    for (k, raw) in frames.iter().enumerate() {
-        if k == 15_000 {
-            rig.press(1500);
+    rig.run(&frames, |rig, k| {
+        if k == PRESS_AT {
+            rig.press();
         }
-        rig.step(raw, k);
         if k == 39_500 {
-            before_fault = Some((rig.last, rig.panel, rig.procedure.state()));
+            before_fault = Some(*rig.last());
         }
-    }
+    })
+    .unwrap();
+    assert_eq!(rig.seen[0].tick.mode, Mode::NotCommissioned);
+    // Learning shows on the panel, then the stored record is in force.
+    assert!(rig.seen.iter().any(|s| s.tick.mode == Mode::Commissioning));
+    assert_eq!(rig.ended, [RunEnd::Commissioned { run: 1 }]);
+    assert_eq!(rig.survivors.flash.writes, 1);
 
     // Commissioned before the fault, no residual lamp, no fault lamp.
-    let (out, lamps, state) = before_fault.unwrap();
-    assert_eq!(state, State::Commissioned, "commissioning did not finish");
+    let seen = before_fault.unwrap();
     assert_eq!(
-        out.lamps, [false; 4],
-        "false alarm before the fault: {out:?}"
+        seen.tick.mode,
+        Mode::Commissioned,
+        "commissioning did not finish"
     );
-    assert!(!out.fault_detected);
+    assert_eq!(
+        seen.status.residual_lamps, [false; 4],
+        "false alarm: {seen:?}"
+    );
     for l in [Lamp::R1, Lamp::R2, Lamp::R3, Lamp::R4, Lamp::Fault] {
-        assert!(!lamps.is_on(l), "{l:?} lit before the fault");
+        assert!(!seen.tick.lamps.is_on(l), "{l:?} lit before the fault");
     }
+    assert!(
+        rig.seen.iter().all(|s| s.tick.pet_watchdog),
+        "samples flowed"
+    );
 
     // After the fault: detected, the residual LEDs are the core's lamps, and the fault
     // LED blinks the top candidate's code.
-    let out = rig.last;
-    assert!(out.fault_detected, "Rs +50 % not detected: {out:?}");
-    assert!(out.lamps.iter().any(|l| *l));
-    let input = PanelInput::from_output(rig.procedure.panel_mode(), &out);
+    let status = rig.last().status;
+    assert!(status.fault_detected, "Rs +50 % not detected: {status:?}");
+    assert!(status.residual_lamps.iter().any(|l| *l));
+    let input = PanelInput::from_status(rig.mode(), &status, false);
     let now = panel::render(&input, 0);
-    for (k, l) in [Lamp::R1, Lamp::R2, Lamp::R3, Lamp::R4]
-        .into_iter()
-        .enumerate()
-    {
-        assert_eq!(now.is_on(l), out.lamps[k]);
+    for (lamp, lit) in Lamp::RESIDUALS.into_iter().zip(status.residual_lamps) {
+        assert_eq!(now.is_on(lamp), lit);
     }
-    let (top, _) = out.top().expect("a candidate");
+    let (top, _) = status.top.expect("a candidate");
     let trace: Vec<bool> = (0..400u32)
         .map(|t| panel::render(&input, t * 50).is_on(Lamp::Fault))
         .collect();
@@ -183,39 +459,377 @@ fn commission_then_detect_rs_fault_on_the_panel() {
     );
 
     // The stored record brings the next boot up commissioned.
-    let rig2 = Rig::boot(rig.flash);
-    assert_eq!(rig2.procedure.state(), State::Commissioned);
+    let rig2 = Rig::boot(Survivors::power_on(rig.survivors.flash.clone()));
+    assert_eq!(
+        rig2.path.monitor().calibration(),
+        rig.path.monitor().calibration()
+    );
+    assert!(rig2.supervisor.latest().commissioned);
+}
+
+#[test]
+fn timeout_while_the_gate_is_closed_cancels_and_keeps_the_old_record() {
+    // Healthy, but the load steps by +-30 % every 0.4 s from 1.4 s to 6 s: the operating
+    // point never settles, the quasi-steady gate stays closed, no block is learned.
+    let mut scenario = Scenario::steady(7.0, f64::from(FS));
+    scenario.load.steps = (0..12)
+        .map(|k| LoadStep {
+            t_s: 1.4 + 0.4 * f64::from(k),
+            torque_nm: None,
+            bl_scale: Some(if k % 2 == 0 { 0.7 } else { 1.3 }),
+        })
+        .chain([LoadStep {
+            t_s: 6.2,
+            torque_nm: None,
+            bl_scale: Some(1.0),
+        }])
+        .collect();
+    let frames = frames(&scenario);
+    let old = old_record();
+    let mut rig = Rig::boot(Survivors::power_on(FakeFlash::holding(&old)));
+    assert!(rig.supervisor.latest().commissioned);
+    rig.run(&frames, |rig, k| {
+        if k == PRESS_AT {
+            rig.press();
+        }
+    })
+    .unwrap();
+    // The run started and learned nothing while the load stepped.
+    let learning: Vec<&Seen> = rig
+        .seen
+        .iter()
+        .filter(|s| s.status.run.stage == RunStage::Learning)
+        .collect();
+    assert!(!learning.is_empty());
+    assert!(learning.iter().all(|s| s.status.run.blocks_learned == 0));
+    // Because the gate was closed, not for want of a running motor (no sensor fault; the
+    // same motor without the steps learns in the other tests).
+    assert!(learning.iter().all(|s| !s.quasi_steady));
+    assert!(learning.iter().all(|s| !s.status.sensor_fault.any()));
+    // Cancelled for want of progress, 3 s after the start, while the gate was closed.
+    assert_eq!(
+        rig.ended,
+        [RunEnd::Failed {
+            run: Some(1),
+            why: Failure::Stalled
+        }]
+    );
+    let cancelled_at = rig
+        .seen
+        .iter()
+        .find(|s| s.tick.run_ended.is_some())
+        .unwrap()
+        .t_ms;
+    assert!((4_450..=4_700).contains(&cancelled_at), "{cancelled_at} ms");
+    assert_eq!(
+        rig.path.monitor().commissioning().stage,
+        RunStage::Failed(CommissioningFailure::Cancelled)
+    );
+    // RAM, flash and panel: the old record, commissioned, plus the failure flicker.
+    assert_eq!(rig.path.monitor().calibration(), Some(old.into()));
+    assert_eq!(rig.survivors.flash.usable(), Some(old.into()));
+    assert_eq!(rig.survivors.flash.writes, 0, "nothing was written");
+    assert_eq!(rig.mode(), Mode::Commissioned);
+    assert_eq!(
+        rig.supervisor.procedure().last_failure(),
+        Some(Failure::Stalled)
+    );
+    let input = PanelInput::from_status(Mode::Commissioned, &rig.last().status, true);
+    let flicker: Vec<bool> = (0..10u32)
+        .map(|t| panel::render(&input, t * 25).fault)
+        .collect();
+    assert!(flicker.contains(&true) && flicker.contains(&false));
+    // The core did not learn on after the cancel (the old wall-clock timeout let it).
+    assert!(rig
+        .seen
+        .iter()
+        .all(|s| s.status.run.stage != RunStage::Done));
+}
+
+#[test]
+fn the_button_cancels_a_learning_run() {
+    let frames = steady_frames(4.0);
+    let old = old_record();
+    // 3 s of learning this time.
+    let settings = Settings {
+        commissioning_duration_s: 3.0,
+        ..SETTINGS
+    };
+    let mut rig = Rig::boot_with(settings, Survivors::power_on(FakeFlash::holding(&old)));
+    rig.run(&frames, |rig, k| {
+        // Pressed at 1.5 s; again at 2.0 s, within the guard time: ignored; at 2.6 s: cancel.
+        if k == PRESS_AT || k == 20_000 || k == 26_000 {
+            rig.press();
+        }
+    })
+    .unwrap();
+    assert_eq!(rig.ended, [RunEnd::CancelledByUser { run: 1 }]);
+    let at = |ms: u32| rig.seen.iter().find(|s| s.t_ms == ms).unwrap();
+    assert_eq!(
+        at(2_400).tick.mode,
+        Mode::Commissioning,
+        "the 2 s press did not cancel"
+    );
+    assert_eq!(at(2_750).tick.mode, Mode::Commissioned);
+    assert_eq!(rig.path.monitor().calibration(), Some(old.into()));
+    assert_eq!(rig.survivors.flash.usable(), Some(old.into()));
+    assert_eq!(rig.supervisor.procedure().last_failure(), None);
+    // (The direct-on-line start's inrush saturates the +-10 A front end: the FAULT lamp
+    // is steady on for the first second, the current sensor named.)
+    assert!(
+        rig.seen
+            .iter()
+            .filter(|s| s.t_ms >= 1_500)
+            .all(|s| !s.tick.lamps.fault),
+        "a cancel is not shown as a failure"
+    );
+}
+
+#[test]
+fn power_loss_during_the_flash_write_leaves_no_record_anywhere() {
+    let frames = steady_frames(3.0);
+    let mut flash = FakeFlash::holding(&old_record());
+    // The record page was erased and 16 of the 48 bytes written when the power went.
+    flash.fault = Some(FlashFault::PowerLossAfter(16));
+    let mut rig = Rig::boot(Survivors::power_on(flash));
+    let reset = rig.run(&frames, |rig, k| {
+        if k == PRESS_AT {
+            rig.press();
+        }
+    });
+    assert_eq!(reset, Err(Reset::PowerLoss));
+    // Power back: the torn record is rejected; RAM, flash and panel say "not commissioned".
+    let survivors = Survivors::power_on(rig.survivors.flash.clone());
+    assert_eq!(
+        CalibrationRecord::decode(&survivors.flash.page),
+        Err(flash_record::RecordError::BadChecksum)
+    );
+    let mut rig = Rig::boot(survivors);
+    assert_eq!(rig.previous, PreviousRun::Clean);
+    rig.run(&frames[..5_000], |_, _| {}).unwrap();
+    assert_eq!(rig.path.monitor().calibration(), None);
+    assert_eq!(rig.survivors.flash.usable(), None);
+    assert_eq!(rig.mode(), Mode::NotCommissioned);
+}
+
+#[test]
+fn a_failed_flash_write_puts_what_the_flash_holds_into_force() {
+    let frames = steady_frames(3.5);
+    let mut flash = FakeFlash::holding(&old_record());
+    flash.fault = Some(FlashFault::WriteFails);
+    let mut rig = Rig::boot(Survivors::power_on(flash));
+    rig.run(&frames, |rig, k| {
+        if k == PRESS_AT {
+            rig.press();
+        }
+    })
+    .unwrap();
+    // The page was erased, the write failed: nothing in flash, nothing in RAM.
+    assert_eq!(
+        rig.ended,
+        [RunEnd::Failed {
+            run: Some(1),
+            why: Failure::Core(CommissioningFailure::NotStored)
+        }]
+    );
+    assert_eq!(rig.path.monitor().calibration(), None);
+    assert_eq!(rig.survivors.flash.usable(), None);
+    assert_eq!(rig.mode(), Mode::NotCommissioned);
+    // The FAULT lamp flickers at 10 Hz (on in the first half of every 100 ms; the rig's
+    // ticks fall on both halves).
+    let last_second: Vec<&Seen> = rig.seen.iter().rev().take(20).collect();
+    assert!(last_second.iter().all(|s| !s.status.fault_detected));
+    for s in last_second {
+        assert_eq!(s.tick.lamps.fault, s.t_ms % 100 < 50, "{} ms", s.t_ms);
+    }
+}
+
+#[test]
+fn a_corrupt_or_unusable_record_at_boot_means_not_commissioned_everywhere() {
+    let frames = steady_frames(2.0);
+    let good = old_record().encode().unwrap();
+    let mut flipped = FakeFlash::erased();
+    flipped.page[..RECORD_LEN].copy_from_slice(&good);
+    flipped.page[20] ^= 0x04;
+    // CRC-valid, but outside the core's range (|mean| > 1).
+    let unusable = FakeFlash::holding(&CalibrationRecord {
+        mean: [5.0, 0.0, 0.0, 0.0],
+        spread: [0.1; 4],
+    });
+    for flash in [flipped, unusable, FakeFlash::erased()] {
+        let mut rig = Rig::boot(Survivors::power_on(flash));
+        rig.run(&frames, |_, _| {}).unwrap();
+        assert_eq!(rig.path.monitor().calibration(), None);
+        assert_eq!(rig.survivors.flash.usable(), None);
+        assert!(rig
+            .seen
+            .iter()
+            .all(|s| s.tick.mode == Mode::NotCommissioned));
+    }
+    // The intact record: commissioned everywhere, from the first period on.
+    let mut rig = Rig::boot(Survivors::power_on(FakeFlash::holding(&old_record())));
+    rig.run(&frames, |_, _| {}).unwrap();
+    assert!(rig.seen.iter().all(|s| s.tick.mode == Mode::Commissioned));
+}
+
+/// Runs `frames[..stop]`, then no samples until the acquisition has been restarted
+/// `resume_after` times (then the frames go on), or for good (`None`).
+fn run_with_stall(
+    rig: &mut Rig,
+    frames: &[RawFrame],
+    stop: usize,
+    resume_after: Option<usize>,
+) -> Result<(), Reset> {
+    rig.run(&frames[..stop], |_, _| {})?;
+    while resume_after.is_none_or(|n| rig.restarts_at_ms.len() < n) {
+        rig.period(None)?;
+    }
+    rig.run(&frames[stop..], |_, _| {})
+}
+
+#[test]
+fn a_stalled_sample_path_is_shown_restarted_and_recovers() {
+    let frames = steady_frames(3.0);
+    let mut rig = Rig::boot(Survivors::power_on(FakeFlash::holding(&old_record())));
+    // The DMA stops at 2.0 s; the 150th restart (after 300 ms) brings it back.
+    run_with_stall(&mut rig, &frames, 20_000, Some(150)).unwrap();
+    let stall = |s: &&Seen| (2_000..2_300).contains(&s.t_ms);
+    let during: Vec<&Seen> = rig.seen.iter().filter(stall).collect();
+    // The first restart 2 ms after the last sample, then every 2 ms.
+    assert_eq!(rig.restarts_at_ms[0], 2_001);
+    assert_eq!(rig.restarts_at_ms[149], 2_299);
+    assert_eq!(rig.restarts_at_ms.len(), 150);
+    // No pet from the first period without samples on; the stalled pattern from 100 ms.
+    assert!(during.iter().skip(1).all(|s| !s.tick.pet_watchdog));
+    for s in &during {
+        let expected = if s.t_ms >= 2_100 {
+            Mode::SamplingStalled
+        } else {
+            Mode::Commissioned
+        };
+        assert_eq!(s.tick.mode, expected, "{} ms", s.t_ms);
+    }
+    let flashing: Vec<PanelLamps> = during
+        .iter()
+        .filter(|s| s.tick.mode == Mode::SamplingStalled)
+        .map(|s| s.tick.lamps)
+        .collect();
+    assert!(
+        flashing.contains(&PanelLamps::all(true)) && flashing.contains(&PanelLamps::all(false))
+    );
+    // Logged once when stalled, the reset record written at 300 ms and cleared after.
+    let changes: Vec<_> = rig.seen.iter().filter_map(|s| s.tick.liveness).collect();
+    use drive_monitor::liveness::LivenessChange::*;
+    assert_eq!(
+        changes,
+        [
+            Stalled { for_ms: 100 },
+            RecordStall { for_ms: 300 },
+            Recovered { after_ms: 350 }
+        ]
+    );
+    assert_eq!(ResetRecord::decode(&rig.survivors.reset_ram), None);
+    // Back to normal: petted, commissioned, the core's lamps.
+    let after: Vec<&Seen> = rig.seen.iter().filter(|s| s.t_ms >= 2_400).collect();
+    assert!(after
+        .iter()
+        .all(|s| s.tick.pet_watchdog && s.tick.mode == Mode::Commissioned));
+    assert!(after.last().unwrap().status.samples > 25_000);
+}
+
+#[test]
+fn a_stall_the_restarts_do_not_fix_ends_in_a_reported_watchdog_reset() {
+    let frames = steady_frames(2.5);
+    let mut rig = Rig::boot(Survivors::power_on(FakeFlash::holding(&old_record())));
+    let reset = run_with_stall(&mut rig, &frames, 20_000, None);
+    assert_eq!(reset, Err(Reset::Watchdog));
+    // The last pet was the last period with samples; the reset came 500 ms later, after
+    // about 250 restarts.
+    assert_eq!(rig.now_ms(), 2_501);
+    assert!(rig.restarts_at_ms.len() >= 240);
+    // The next boot knows why, shows "monitor failed" for 5 s, then monitors again.
+    let mut rig = Rig::boot(rig.survivors.clone());
+    let PreviousRun::Recorded(rec) = rig.previous else {
+        panic!("{:?}", rig.previous);
+    };
+    assert_eq!(rec.cause(), ResetCause::SampleStall);
+    assert_eq!(rec.line_or_ms(), 300);
+    let frames = steady_frames(6.0);
+    rig.run(&frames, |_, _| {}).unwrap();
+    for s in &rig.seen {
+        let expected = if s.t_ms < 5_000 {
+            Mode::Failed
+        } else {
+            Mode::Commissioned
+        };
+        assert_eq!(s.tick.mode, expected, "{} ms", s.t_ms);
+    }
+    assert_eq!(rig.seen[0].tick.lamps, PanelLamps::FAILED);
+}
+
+#[test]
+fn a_panic_reason_survives_the_reset() {
+    let frames = steady_frames(1.0);
+    let mut rig = Rig::boot(Survivors::power_on(FakeFlash::erased()));
+    rig.run(&frames, |_, _| {}).unwrap();
+    // The panic handler records the reason, stops petting; the watchdog resets.
+    let mut survivors = rig.survivors.clone();
+    survivors.reset_ram =
+        ResetRecord::panic("attempt to divide by zero", "src/app.rs", 321).encode();
+    survivors.watchdog_reset = true;
+    let rig = Rig::boot(survivors.clone());
+    let PreviousRun::Recorded(rec) = rig.previous else {
+        panic!("{:?}", rig.previous);
+    };
+    assert_eq!(
+        (rec.cause(), rec.message(), rec.file(), rec.line_or_ms()),
+        (
+            ResetCause::Panic,
+            "attempt to divide by zero",
+            "src/app.rs",
+            321
+        )
+    );
+    // The record is read once: the boot after that is clean again...
+    assert_eq!(
+        Rig::boot(rig.survivors.clone()).previous,
+        PreviousRun::Clean
+    );
+    // ...and a watchdog reset with no record is a hang.
+    survivors.reset_ram = [0; RESET_RECORD_LEN];
+    assert_eq!(Rig::boot(survivors).previous, PreviousRun::WatchdogReset);
 }
 
 #[test]
 fn saturated_adc_lights_the_fault_lamp_steadily() {
-    let mut rig = Rig::boot([0xFF; RECORD_PAGE_SIZE as usize]);
+    let mut rig = Rig::boot(Survivors::power_on(FakeFlash::erased()));
     let q = *rig.path.sampler();
-    for k in 0..2_000 {
-        let t = k as f32 / FS as f32;
-        let w = std::f32::consts::TAU * 50.0 * t;
-        let v = Abc {
-            a: 326.0 * w.cos(),
-            b: 326.0 * (w - 2.094).cos(),
-            c: 326.0 * (w + 2.094).cos(),
-        };
-        // 20 A peak on a +-10 A front end: the current codes hit the rails.
-        let i = Abc {
-            a: 20.0 * w.cos(),
-            b: 20.0 * (w - 2.094).cos(),
-            c: 20.0 * (w + 2.094).cos(),
-        };
-        rig.step(&q.quantize(v, i, 0), k);
-    }
-    assert!(rig.last.sensor_fault.current);
-    let p = panel::render(
-        &PanelInput::from_output(rig.procedure.panel_mode(), &rig.last),
-        0,
+    let frames: Vec<RawFrame> = (0..20_000)
+        .map(|k| {
+            let t = k as f32 / FS as f32;
+            let w = std::f32::consts::TAU * 50.0 * t;
+            let v = Abc {
+                a: 326.0 * w.cos(),
+                b: 326.0 * (w - 2.094).cos(),
+                c: 326.0 * (w + 2.094).cos(),
+            };
+            // 20 A peak on a +-10 A front end: the current codes hit the rails.
+            let i = Abc {
+                a: 20.0 * w.cos(),
+                b: 20.0 * (w - 2.094).cos(),
+                c: 20.0 * (w + 2.094).cos(),
+            };
+            q.quantize(v, i, 0)
+        })
+        .collect();
+    rig.run(&frames, |_, _| {}).unwrap();
+    let status = rig.last().status;
+    assert!(status.sensor_fault.current);
+    let input = PanelInput::from_status(rig.mode(), &status, false);
+    assert!(panel::render(&input, 0).is_on(Lamp::Fault));
+    assert!(
+        panel::render(&input, 777).is_on(Lamp::Fault),
+        "steady, not blinking"
     );
-    assert!(p.is_on(Lamp::Fault));
-    let p2 = panel::render(
-        &PanelInput::from_output(rig.procedure.panel_mode(), &rig.last),
-        777,
-    );
-    assert!(p2.is_on(Lamp::Fault), "steady, not blinking");
+    assert!(rig.seen.iter().rev().take(10).all(|s| s.tick.lamps.fault));
 }

@@ -1,0 +1,50 @@
+//! The lamp table in `board.rs` (`Lamp::pin`, `Lamp::label`) is the one definition of the
+//! panel's pins: the pin maps in the docs (`board.rs`'s module docs, the README's
+//! "Pin map and wiring") must list each lamp on its pin, and the code and docs that used
+//! to repeat the pins (the panel module, the firmware's panic handler) must not name them.
+
+use drive_monitor::board::Lamp;
+use std::path::PathBuf;
+
+fn read(path: &str) -> String {
+    let full = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(path);
+    std::fs::read_to_string(&full).unwrap_or_else(|e| panic!("{}: {e}", full.display()))
+}
+
+/// The table row of `lamp` in a pin map: `| <label> lamp | <pin> |` (in `board.rs` after
+/// `//! `).
+fn row(lamp: Lamp) -> String {
+    format!("| {} lamp | {} |", lamp.label(), lamp.pin())
+}
+
+#[test]
+fn the_pin_maps_in_the_docs_are_the_lamp_tables() {
+    let board = read("src/board.rs");
+    let readme = read("README.md");
+    for lamp in Lamp::ALL {
+        assert!(
+            board.contains(&format!("//! {}", row(lamp))),
+            "board.rs docs lack `{}`",
+            row(lamp)
+        );
+        assert!(readme.contains(&row(lamp)), "README lacks `{}`", row(lamp));
+        // And nothing else in the README names that pin (it was written in five places).
+        let pin = lamp.pin().to_string();
+        let mentions = readme
+            .split(|c: char| !c.is_ascii_alphanumeric())
+            .filter(|w| *w == pin)
+            .count();
+        assert_eq!(mentions, 1, "the README names {pin} {mentions} times");
+    }
+}
+
+#[test]
+fn the_panel_and_the_panic_handler_do_not_repeat_the_pins() {
+    let panel = read("src/panel.rs");
+    let firmware = read("src/firmware.rs");
+    for lamp in Lamp::ALL {
+        let pin = lamp.pin().to_string();
+        assert!(!panel.contains(&pin), "src/panel.rs names {pin}");
+        assert!(!firmware.contains(&pin), "src/firmware.rs names {pin}");
+    }
+}
