@@ -60,6 +60,12 @@ fn refused(args: &[&str]) -> String {
     err
 }
 
+/// `simulate --params P --scenario S --out O`.
+fn simulate<'a>(params: &'a Path, scenario: &'a Path, out: &'a Path) -> [&'a str; 7] {
+    let (p, sc, o) = (s(params), s(scenario), s(out));
+    ["simulate", "--params", p, "--scenario", sc, "--out", o]
+}
+
 /// A healthy 3 hp log of `secs` seconds at 2 kHz written by `simulate` into `dir`.
 fn small_log(dir: &Path, name: &str, secs: f64) -> (PathBuf, PathBuf) {
     let params = write(dir, "motor.toml", PARAMS_3HP);
@@ -69,15 +75,7 @@ fn small_log(dir: &Path, name: &str, secs: f64) -> (PathBuf, PathBuf) {
         &format!("duration_s = {secs}\nsample_rate_hz = 2000.0\n"),
     );
     let log = dir.join(name);
-    let o = run(&[
-        "simulate",
-        "--params",
-        s(&params),
-        "--scenario",
-        s(&sc),
-        "--out",
-        s(&log),
-    ]);
+    let o = run(&simulate(&params, &sc, &log));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     (params, log)
 }
@@ -105,6 +103,8 @@ fn a_reader_that_goes_away_ends_the_run_quietly() {
         vec!["diagnose", "--params", p, l, "--json"],
         vec!["compare", "--params", p, l],
         vec!["compare", "--params", p, l, "--json"],
+        vec!["explain", "--params", p, l],
+        vec!["explain", "--params", p, l, "--json"],
     ] {
         let mut child = Command::new(BIN)
             .args(&args)
@@ -222,18 +222,7 @@ fn outputs_get_the_mode_of_any_new_file() {
     let sc = dir.path().join("short.toml");
     for (umask, want) in [("022", 0o644), ("077", 0o600), ("002", 0o664)] {
         let out = dir.path().join(format!("u{umask}.csv"));
-        run_with_umask(
-            umask,
-            &[
-                "simulate",
-                "--params",
-                s(&params),
-                "--scenario",
-                s(&sc),
-                "--out",
-                s(&out),
-            ],
-        );
+        run_with_umask(umask, &simulate(&params, &sc, &out));
         assert_eq!(mode(&out), want, "umask {umask}");
     }
     // The report page and the charts (SVG via the atomic writer, PNG via the plotter).
@@ -296,15 +285,7 @@ fn an_input_under_a_name_the_command_writes_is_refused_and_unchanged() {
     let sc = dir.path().join("short.toml");
     let link = dir.path().join("out.csv");
     std::fs::hard_link(&params, &link).expect("hard link");
-    let e = refused(&[
-        "simulate",
-        "--params",
-        s(&params),
-        "--scenario",
-        s(&sc),
-        "--out",
-        s(&link),
-    ]);
+    let e = refused(&simulate(&params, &sc, &link));
     assert!(e.contains("refusing to overwrite"), "{e}");
     assert_eq!(std::fs::read_to_string(&params).expect("read"), PARAMS_3HP);
     assert_eq!(std::fs::read(&log).expect("read"), before);
@@ -341,15 +322,7 @@ fn scenarios_that_would_run_for_days_are_refused_before_writing() {
         ),
     ] {
         let sc = write(dir.path(), name, text);
-        let e = refused(&[
-            "simulate",
-            "--params",
-            s(&params),
-            "--scenario",
-            s(&sc),
-            "--out",
-            s(&out),
-        ]);
+        let e = refused(&simulate(&params, &sc, &out));
         for n in needles {
             assert!(e.contains(n), "{name}: no '{n}' in {e}");
         }

@@ -290,7 +290,10 @@ pub fn simulate_while(
 /// # Errors
 /// As [`simulate`].
 pub fn simulate_to_vec(params: &ParamFile, scenario: &Scenario) -> Result<Vec<Row>, SimError> {
-    let mut rows = Vec::with_capacity((scenario.duration_s * scenario.sample_rate_hz) as usize + 1);
+    // Reserved up to 1 M rows (about 100 MB): a scenario that validate refuses must not
+    // abort on an allocation of its estimated size first.
+    let expected = (scenario.duration_s * scenario.sample_rate_hz).clamp(0.0, 1.0e6);
+    let mut rows = Vec::with_capacity(expected as usize + 1);
     simulate(params, scenario, |r| rows.push(*r))?;
     Ok(rows)
 }
