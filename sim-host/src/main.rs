@@ -3,7 +3,17 @@
 //! The binary owns the command line and the rendering (`cli`): clap parses the arguments,
 //! each command turns them into the library's domain types at once, calls the library
 //! (`sim_host`), and renders the result as text, JSON or HTML/plots (`cli::render`).
-//! Errors reach `main` as one `anyhow` chain and leave as one line on stderr, exit code 2.
+//! Errors reach `main` as one `anyhow` chain and leave as one line on stderr.
+//!
+//! Exit status:
+//! - 0: success, and also when the reader of stdout went away (`sim-host table1 --json |
+//!   head`): a closed pipe is the reader's choice, not a failure, so the tool stops
+//!   quietly, as `cat` or `grep` would with SIGPIPE, but with status 0 rather than 141 so
+//!   that `set -o pipefail` scripts do not fail on `| head`;
+//! - 1: stdout could not be written (a full disk, an I/O error): one line on stderr;
+//! - 2: bad arguments or input, or any other error: one line on stderr;
+//! - 130 / 143: interrupted by SIGINT / SIGTERM (128 + the signal, the shell's
+//!   convention) during a command that cleans up on a signal (`simulate`).
 
 mod cli;
 
@@ -29,17 +39,39 @@ fn main() -> ExitCode {
                 .lines()
                 .find(|l| !l.trim().is_empty())
                 .unwrap_or("bad arguments");
-            eprintln!("{} (see --help)", first.trim());
+            report(&format!("{} (see --help)", first.trim()));
             return ExitCode::from(2);
         }
     };
     match cli::run(args.cmd) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", one_line_error(&e));
-            ExitCode::from(2)
+            let status = exit_status(&e);
+            if status != 0 {
+                report(&format!("error: {}", one_line_error(&e)));
+            }
+            ExitCode::from(status)
         }
     }
+}
+
+/// The exit status of a failed command (see the module documentation).
+fn exit_status(e: &anyhow::Error) -> u8 {
+    if let Some(i) = e.downcast_ref::<cli::Interrupted>() {
+        return i.exit_status();
+    }
+    match cli::stdout_error_kind(e) {
+        Some(std::io::ErrorKind::BrokenPipe) => 0,
+        Some(_) => 1,
+        None => 2,
+    }
+}
+
+/// Writes one line to stderr; a stderr that cannot be written is ignored (there is nowhere
+/// left to report to, and `eprintln!` would panic).
+fn report(line: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr().lock(), "{line}");
 }
 
 /// The error and its causes on one line; a cause whose text the message already holds

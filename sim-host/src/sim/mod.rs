@@ -95,7 +95,7 @@ mod steady;
 
 pub use scenario::{
     EffectSpec, FaultSpec, LoadKind, LoadSpec, LoadStep, Scenario, SensorFaultMode, SensorSpec,
-    SupplySpec, SupplyStep, DEFAULT_MAX_STEP_S,
+    SupplySpec, SupplyStep, Workload, DEFAULT_MAX_STEP_S, MIN_STEP_S, SAMPLE_RATE_RANGE_HZ,
 };
 pub use steady::{
     solve_slip, solve_slip_at, steady_state, steady_state_at, SteadyLoad, SteadyState,
@@ -108,6 +108,7 @@ use monitor_core::frames::{inverse_clarke, AlphaBeta};
 use monitor_core::{Fault, MotorParameters};
 use sensors::Sensors;
 use std::f64::consts::PI;
+use std::ops::ControlFlow;
 
 /// Errors of the simulator. Messages are one line and name the offending key.
 #[derive(Debug, thiserror::Error)]
@@ -268,12 +269,31 @@ pub fn simulate(
     simulate_with_truth(params, scenario, |r, _| on_row(r))
 }
 
+/// [`simulate`] whose callback may stop the run: after a row for which `on_row` returns
+/// `ControlFlow::Break(())` no further row is made (a writer that failed, a user who
+/// pressed Ctrl-C). `Ok(None)` when stopped, else the summary.
+///
+/// # Errors
+/// As [`simulate`].
+pub fn simulate_while(
+    params: &ParamFile,
+    scenario: &Scenario,
+    mut on_row: impl FnMut(&Row) -> ControlFlow<()>,
+) -> Result<Option<SimSummary>, SimError> {
+    checked_run(params, scenario)?
+        .run(|r, _| on_row(r))
+        .map(|(summary, done)| done.then_some(summary))
+}
+
 /// [`simulate`] collecting the rows in memory.
 ///
 /// # Errors
 /// As [`simulate`].
 pub fn simulate_to_vec(params: &ParamFile, scenario: &Scenario) -> Result<Vec<Row>, SimError> {
-    let mut rows = Vec::with_capacity((scenario.duration_s * scenario.sample_rate_hz) as usize + 1);
+    // Reserved up to 1 M rows (about 100 MB): a scenario that validate refuses must not
+    // abort on an allocation of its estimated size first.
+    let expected = (scenario.duration_s * scenario.sample_rate_hz).clamp(0.0, 1.0e6);
+    let mut rows = Vec::with_capacity(expected as usize + 1);
     simulate(params, scenario, |r| rows.push(*r))?;
     Ok(rows)
 }
@@ -651,14 +671,24 @@ fn scenario_events(scenario: &Scenario) -> Vec<(u64, ScenarioEvent)> {
 pub fn simulate_with_truth(
     params: &ParamFile,
     scenario: &Scenario,
-    on_row: impl FnMut(&Row, &Truth),
+    mut on_row: impl FnMut(&Row, &Truth),
 ) -> Result<SimSummary, SimError> {
+    checked_run(params, scenario)?
+        .run(|r, t| {
+            on_row(r, t);
+            ControlFlow::Continue(())
+        })
+        .map(|(summary, _)| summary)
+}
+
+/// Checks the scenario and the parameters and resolves the run.
+fn checked_run<'a>(params: &'a ParamFile, scenario: &'a Scenario) -> Result<Run<'a>, SimError> {
     scenario.validate()?;
     params.check().map_err(|e| SimError::Invalid {
         key: "params".into(),
         message: e.to_string(),
     })?;
-    Run::new(params, scenario)?.run(on_row)
+    Run::new(params, scenario)
 }
 
 /// One simulation run: the resolved scenario and the state of the loop.
@@ -704,8 +734,9 @@ impl<'a> Run<'a> {
         };
         let rate = scenario.sample_rate_hz;
         let dt = 1.0 / rate;
-        let hmax = scenario.max_step_s.unwrap_or(DEFAULT_MAX_STEP_S);
-        let nsub = ((dt / hmax) * (1.0 - 1e-12)).ceil().max(1.0) as u32;
+        let work = scenario.workload();
+        // At most 1e7 (1 s period over the 0.1 us floor of `validate`).
+        let nsub = u32::try_from(work.steps_per_row).unwrap_or(u32::MAX);
         let h = dt / f64::from(nsub);
         let events = scenario_events(scenario);
         let invalid = |message: String| SimError::Invalid {
@@ -737,7 +768,7 @@ impl<'a> Run<'a> {
             machine,
             sensors,
             supply,
-            n: (scenario.duration_s * rate).round() as u64,
+            n: work.rows,
             nsub,
             dt,
             np,
@@ -789,7 +820,11 @@ impl<'a> Run<'a> {
         (new != dtemp || k == 0).then_some(new)
     }
 
-    fn run(mut self, mut on_row: impl FnMut(&Row, &Truth)) -> Result<SimSummary, SimError> {
+    /// Runs to the end, or until `on_row` breaks; the summary and whether it ran to the end.
+    fn run(
+        mut self,
+        mut on_row: impl FnMut(&Row, &Truth) -> ControlFlow<()>,
+    ) -> Result<(SimSummary, bool), SimError> {
         let mut x = [0.0f64; 6];
         let mut next_event = 0usize;
         let mut dtemp = 0.0f64;
@@ -823,14 +858,16 @@ impl<'a> Run<'a> {
             last_p_loss = tr.p_cu_w + tr.p_fe_w;
             max_i2 = max_i2.max(tr.i_ab[0] * tr.i_ab[0] + tr.i_ab[1] * tr.i_ab[1]);
             let row = self.sensors.measure(&tr, self.dt);
-            on_row(&row, &tr);
+            if on_row(&row, &tr).is_break() {
+                return Ok((self.summary(x[4], max_i2.sqrt()), false));
+            }
             // Integrate to t + dt.
             self.supply.integrate(&self.machine, &mut x, self.nsub);
             if !(x[0].is_finite() && x[2].is_finite() && x[4].is_finite()) {
                 return Err(SimError::Diverged { t_s: t + self.dt });
             }
         }
-        Ok(self.summary(x[4], max_i2.sqrt()))
+        Ok((self.summary(x[4], max_i2.sqrt()), true))
     }
 
     fn summary(&self, wm: f64, max_abs_current_a: f64) -> SimSummary {

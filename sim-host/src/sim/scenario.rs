@@ -48,6 +48,29 @@ pub struct Scenario {
 /// Default largest integrator step [s].
 pub const DEFAULT_MAX_STEP_S: f64 = 1.0e-4;
 
+/// Output sample rates a scenario may ask for [Hz]: 1 Hz ..= 1 MHz. The monitor reads logs
+/// of 1 kHz to 50 kHz; the simulator writes outside that band too (slow rates for long
+/// thermal runs, fast ones for other tools); above 1 MHz there is nothing left to resolve
+/// (the model has no PWM switching) and a second of output would be about 100 MB.
+pub const SAMPLE_RATE_RANGE_HZ: (f64, f64) = (1.0, 1.0e6);
+
+/// Smallest `max_step_s` [s]: 0.1 us. Fixed-step RK4 at the default 100 us is already
+/// accurate to about 1e-5 A on the reference start (a 100x finer run is the accuracy
+/// reference, 1 us); a step a thousand times finer than that adds only rounding error
+/// and makes a 10 s run take 1e8 steps.
+pub const MIN_STEP_S: f64 = 1.0e-7;
+
+/// What a scenario costs before it runs ([`Scenario::workload`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Workload {
+    /// Output rows: round(duration_s * sample_rate_hz).
+    pub rows: u64,
+    /// RK4 steps per output row: ceil(sample period / max_step_s), >= 1.
+    pub steps_per_row: u64,
+    /// Integrator steps of the whole run: rows * steps_per_row (as f64: it may be huge).
+    pub steps: f64,
+}
+
 fn default_seed() -> u64 {
     1
 }
@@ -649,18 +672,12 @@ impl Scenario {
     /// Parses scenario TOML; `origin` names the source in messages.
     ///
     /// # Errors
-    /// [`SimError::Toml`] (syntax, unknown or missing key, with the line) or
+    /// [`SimError::Toml`] (syntax, unknown or missing key, with the line and column) or
     /// [`SimError::Invalid`] (a value out of range, naming the key).
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Self, SimError> {
-        let s: Scenario = toml::from_str(text).map_err(|e| {
-            let line = e
-                .span()
-                .map(|sp| text[..sp.start.min(text.len())].matches('\n').count() + 1);
-            let at = line.map(|l| format!("line {l}: ")).unwrap_or_default();
-            SimError::Toml {
-                path: origin.to_string(),
-                message: format!("{at}{}", crate::one_line(e.message())),
-            }
+        let s: Scenario = toml::from_str(text).map_err(|e| SimError::Toml {
+            path: origin.to_string(),
+            message: crate::params::toml_error_message(text, &e),
         })?;
         s.validate()?;
         Ok(s)
@@ -678,6 +695,22 @@ impl Scenario {
         Self::from_toml_str(&text, &path.display().to_string())
     }
 
+    /// The run's size: output rows and integrator steps (the integer number of RK4 steps
+    /// per output sample is the smallest that keeps the step at or below `max_step_s`).
+    /// Meaningful for a scenario that passed [`Scenario::validate`].
+    pub fn workload(&self) -> Workload {
+        let rows = (self.duration_s * self.sample_rate_hz).round();
+        let period = 1.0 / self.sample_rate_hz;
+        let hmax = self.max_step_s.unwrap_or(DEFAULT_MAX_STEP_S);
+        // The 1e-12 keeps a step that divides the period exactly from rounding up.
+        let steps_per_row = ((period / hmax) * (1.0 - 1e-12)).ceil().max(1.0);
+        Workload {
+            rows: rows as u64,
+            steps_per_row: steps_per_row as u64,
+            steps: rows * steps_per_row,
+        }
+    }
+
     /// Serialises to TOML.
     pub fn to_toml_string(&self) -> String {
         toml::to_string_pretty(self).unwrap_or_default()
@@ -690,12 +723,27 @@ impl Scenario {
     /// [`SimError::Invalid`] naming the key.
     pub fn validate(&self) -> Result<(), SimError> {
         positive("duration_s", self.duration_s)?;
-        positive("sample_rate_hz", self.sample_rate_hz)?;
+        let (lo, hi) = SAMPLE_RATE_RANGE_HZ;
+        if !(self.sample_rate_hz.is_finite() && (lo..=hi).contains(&self.sample_rate_hz)) {
+            return invalid(
+                "sample_rate_hz",
+                format!("must be in {lo}..={hi} Hz, got {}", self.sample_rate_hz),
+            );
+        }
         if self.duration_s * self.sample_rate_hz > 1.0e10 {
             return invalid("duration_s", "more than 1e10 samples".into());
         }
         if let Some(h) = self.max_step_s {
-            positive("max_step_s", h)?;
+            // The sample period with a little slack, so that 1/rate written out is accepted.
+            let period = 1.0 / self.sample_rate_hz;
+            if !(h.is_finite() && h >= MIN_STEP_S && h <= period * (1.0 + 1e-9)) {
+                return invalid(
+                    "max_step_s",
+                    format!(
+                        "must be in {MIN_STEP_S:e}..={period:e} s (the sample period), got {h:e}"
+                    ),
+                );
+            }
         }
         self.supply.validate()?;
         self.load.validate()?;
@@ -903,6 +951,63 @@ fn not_negative(key: &str, v: f64) -> Result<(), SimError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn parse(text: &str) -> Result<Scenario, String> {
+        Scenario::from_toml_str(text, "s.toml").map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn sample_rate_and_step_outside_their_ranges_are_refused_with_the_range() {
+        for ok in ["1.0", "1e6", "10000.0"] {
+            parse(&format!("duration_s = 1.0\nsample_rate_hz = {ok}\n")).unwrap();
+        }
+        for bad in ["0.5", "2e6", "1e9", "inf", "nan"] {
+            let e = parse(&format!("duration_s = 1.0\nsample_rate_hz = {bad}\n")).unwrap_err();
+            assert!(
+                e.contains("sample_rate_hz") && e.contains("1..=1000000 Hz"),
+                "{e}"
+            );
+        }
+        let with_step = |h: &str| {
+            parse(&format!(
+                "duration_s = 1.0\nsample_rate_hz = 1e4\nmax_step_s = {h}\n"
+            ))
+        };
+        // The floor and the sample period itself are in range.
+        for ok in ["1e-7", "1e-4", "0.0001", "3e-5"] {
+            with_step(ok).unwrap();
+        }
+        for bad in ["1e-12", "5e-8", "2e-4", "0.0", "-1e-5"] {
+            let e = with_step(bad).unwrap_err();
+            assert!(
+                e.contains("max_step_s") && e.contains("1e-7..=1e-4 s"),
+                "{bad}: {e}"
+            );
+        }
+    }
+
+    #[test]
+    fn workload_counts_rows_and_integrator_steps() {
+        let w = |text: &str| parse(text).unwrap().workload();
+        // 2 s at 10 kHz, the default 100 us step: one step a row.
+        let a = w("duration_s = 2.0\nsample_rate_hz = 1e4\n");
+        assert_eq!((a.rows, a.steps_per_row, a.steps), (20_000, 1, 20_000.0));
+        // A 10 us step: ten a row. A 30 us step: ceil(100/30) = 4 a row (25 us).
+        let b = w("duration_s = 2.0\nsample_rate_hz = 1e4\nmax_step_s = 1e-5\n");
+        assert_eq!((b.rows, b.steps_per_row, b.steps), (20_000, 10, 200_000.0));
+        let c = w("duration_s = 2.0\nsample_rate_hz = 1e4\nmax_step_s = 3e-5\n");
+        assert_eq!(c.steps_per_row, 4);
+        // 1 kHz with the default step: ten a row.
+        let d = w("duration_s = 1.0\nsample_rate_hz = 1000.0\n");
+        assert_eq!((d.rows, d.steps_per_row), (1000, 10));
+    }
+
+    #[test]
+    fn toml_errors_give_line_and_column() {
+        let e = parse("duration_s = 1.0\nsample_rate_hz = 1e4\nseed = = 2\n").unwrap_err();
+        // "seed = = 2": the second '=' is the 8th character of line 3.
+        assert!(e.contains("s.toml: line 3, column 8: "), "{e}");
+    }
 
     #[test]
     fn every_effect_kind_parses_with_defaults() {

@@ -47,7 +47,11 @@ fn write_outputs(
         let path = dir.join(REPORT_FILE);
         sim_host::log::write_atomic(&path, page(&svgs).as_bytes())
             .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
-        eprintln!("report: {}", path.display());
+        // Not eprintln!: a closed stderr must not panic after the report is written.
+        let _ = std::io::Write::write_all(
+            &mut std::io::stderr(),
+            format!("report: {}\n", path.display()).as_bytes(),
+        );
     }
     Ok(())
 }

@@ -11,15 +11,16 @@ use sim_host::sim::SimSummary;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// Prints `v` as one pretty JSON document on stdout.
+/// Prints `v` as one pretty JSON document on stdout ([`crate::cli::stdout`]). The document is
+/// serialised first, so a failed write is the stdout error `main` recognises.
 ///
 /// # Errors
 /// Serialisation or stdout errors.
 pub fn print<T: Serialize + ?Sized>(v: &T) -> anyhow::Result<()> {
     use std::io::Write;
-    let mut out = std::io::stdout().lock();
-    serde_json::to_writer_pretty(&mut out, v)?;
-    writeln!(out)?;
+    let mut doc = serde_json::to_vec_pretty(v)?;
+    doc.push(b'\n');
+    crate::cli::stdout().write_all(&doc)?;
     Ok(())
 }
 

@@ -205,11 +205,27 @@ pub fn write(dir: &Path, c: &Chart) -> Result<(String, Vec<PathBuf>), String> {
     sim_host::log::write_atomic(&svg_path, svg.as_bytes())
         .map_err(|e| format!("{}: {e}", svg_path.display()))?;
     let png_path = dir.join(format!("{}.png", c.stem));
-    let tmp = dir.join(format!(".{}.tmp.png", c.stem));
+    let tmp = png_staging_file(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     {
-        let root = BitMapBackend::new(&tmp, (900, 420)).into_drawing_area();
+        let root = BitMapBackend::new(tmp.path(), (900, 420)).into_drawing_area();
         draw(root, c, false)?;
     }
-    std::fs::rename(&tmp, &png_path).map_err(|e| format!("{}: {e}", png_path.display()))?;
+    tmp.persist(&png_path)
+        .map_err(|e| format!("{}: {}", png_path.display(), e.error))?;
     Ok((svg, vec![svg_path, png_path]))
+}
+
+/// The PNG's temporary file in `dir`: a random name created exclusively (it can never be an
+/// existing file, so never an input), the mode of any new file (0o666 less the umask, as
+/// `sim_host::log::write_atomic` gives the SVG), deleted when drawing fails.
+fn png_staging_file(dir: &Path) -> std::io::Result<tempfile::NamedTempFile> {
+    let mut b = tempfile::Builder::new();
+    // The image encoder picks the format from the extension.
+    b.prefix(".sim-host-").suffix(".png");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        b.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    b.tempfile_in(dir)
 }

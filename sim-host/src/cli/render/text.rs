@@ -1,5 +1,6 @@
-//! The text renderer: the human tables of every command, written to stdout (a closed pipe
-//! is an error, not a panic).
+//! The text renderer: the human tables of every command, written to stdout through
+//! [`crate::cli::stdout`] (a closed pipe or a full disk is an error that `main` recognises, not
+//! a panic).
 
 use super::json::Table1Report;
 use sim_host::analysis::compare::CompareReport;
@@ -32,7 +33,7 @@ fn number(x: f64) -> String {
 
 /// The demo's timeline and conclusion.
 pub fn demo(run: &DemoRun) -> anyhow::Result<()> {
-    let mut out = std::io::stdout().lock();
+    let mut out = crate::cli::stdout();
     writeln!(
         out,
         "3 hp induction motor, 220 V 60 Hz, direct-on-line start, viscous load; 12-bit sensors with noise.\n\
@@ -110,7 +111,7 @@ pub fn demo(run: &DemoRun) -> anyhow::Result<()> {
 /// `simulate`'s one-line summary.
 pub fn simulate(path: &Path, wall_s: f64, s: &SimSummary) -> anyhow::Result<()> {
     writeln!(
-        std::io::stdout().lock(),
+        crate::cli::stdout(),
         "wrote {} rows ({} s at {} Hz) to {} in {:.2} s; final speed {:.2} rad/s, slip {:.4}",
         s.rows,
         s.duration_s,
@@ -142,7 +143,7 @@ fn diagnose_state(p: &TimelinePoint) -> String {
 /// `diagnose`'s timeline, lamps, candidates and unbalance.
 pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
     let rep = &d.report;
-    let mut out = std::io::stdout().lock();
+    let mut out = crate::cli::stdout();
     writeln!(
         out,
         "diagnose {} ({} rows, {:.0} Hz, angle: {})",
@@ -295,7 +296,7 @@ pub fn quality_warnings(q: &DataQuality) {
 
 /// `table1`'s measured signatures beside the paper's and the physical ones.
 pub fn table1(t: &Table1Report) -> anyhow::Result<()> {
-    let mut out = std::io::stdout().lock();
+    let mut out = crate::cli::stdout();
     writeln!(
         out,
         "Table 1 end to end — {}, angle: {}",
@@ -355,7 +356,7 @@ fn model_name(effects: &[monitor_core::EffectKind], bare: &str, prefix: &str, se
 
 /// `compare`'s errors, worst windows and fitted values.
 pub fn compare(log: &Path, r: &CompareReport) -> anyhow::Result<()> {
-    let mut out = std::io::stdout().lock();
+    let mut out = crate::cli::stdout();
     writeln!(out, "compare {}", log.display())?;
     data_quality(&mut out, &r.data_quality)?;
     writeln!(
@@ -424,7 +425,7 @@ pub fn compare(log: &Path, r: &CompareReport) -> anyhow::Result<()> {
 
 /// `explain`'s ranking and verdict.
 pub fn explain(log: &Path, r: &ExplainReport) -> anyhow::Result<()> {
-    let mut out = std::io::stdout().lock();
+    let mut out = crate::cli::stdout();
     writeln!(out, "explain {}", log.display())?;
     data_quality(&mut out, &r.data_quality)?;
     writeln!(
@@ -473,7 +474,7 @@ fn spread(s: &Spread, decimals: usize) -> String {
 
 /// `bench`'s figures and, with `--detection`, the detection limits.
 pub fn bench(f: &BenchFigures, limits: Option<&[DetectionLimit]>) -> anyhow::Result<()> {
-    let mut out = std::io::stdout().lock();
+    let mut out = crate::cli::stdout();
     writeln!(
         out,
         "reference scenario: 2.2 kW, direct-on-line, 14.6 N m from 2.5 s, 10 s at 10 kHz ({} rows); median (range) of {} runs",
