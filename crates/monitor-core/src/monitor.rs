@@ -722,6 +722,12 @@ impl Monitor {
         // Plausibility is checked once per block (slow path): the ADC flags are collected
         // here, the values' range and finiteness are checked on the block's extremes there.
         // A NaN or absurd reading poisons only its own block, which is then discarded.
+        // Samples missing before this one: bridged before it is transformed (cold).
+        let since = s.timestamp_ticks.wrapping_sub(self.last_sample_ticks);
+        self.last_sample_ticks = s.timestamp_ticks;
+        if since > self.sample_gap_ticks {
+            self.bridge_samples(since);
+        }
         self.block_sat |= u8::from(s.i_saturated) | (u8::from(s.v_saturated) << 1);
         let m = 0x7fff_ffffu32;
         let vb = (s.v_abc.a.to_bits() & m)
@@ -732,11 +738,7 @@ impl Monitor {
             .max(s.i_abc.c.to_bits() & m);
         self.block_vmax = self.block_vmax.max(vb);
         self.block_imax = self.block_imax.max(ib);
-        let since = s.timestamp_ticks.wrapping_sub(self.last_sample_ticks);
-        self.last_sample_ticks = s.timestamp_ticks;
-        if since > self.sample_gap_ticks {
-            self.bridge_samples(since);
-        }
+
         let speed = self.mt.update_checked(
             s.encoder_count,
             s.timestamp_ticks,

@@ -150,10 +150,12 @@ pub fn decimate_log(
 /// working rate near [`TARGET_RATE_HZ`], coarser if the series would exceed
 /// [`MAX_WORK_SAMPLES`], never below 1 kHz.
 fn decimation_factor(log_rate_hz: f64, est_rows: f64) -> usize {
-    // (A rate estimated as 9999.999999999998 Hz is 10 kHz: the floor must not see 4.999.)
-    let mut factor = ((log_rate_hz / TARGET_RATE_HZ + 1e-6).floor() as usize).max(1);
+    // (A rate estimated as 9999.999999999998 Hz is 10 kHz: neither the floor nor the 1 kHz
+    // limit may see the last digit.)
+    let rate = log_rate_hz * (1.0 + 1e-9);
+    let mut factor = ((rate / TARGET_RATE_HZ).floor() as usize).max(1);
     while est_rows / factor as f64 > MAX_WORK_SAMPLES as f64
-        && log_rate_hz / (factor as f64 + 1.0) >= 1000.0
+        && rate / (factor as f64 + 1.0) >= 1000.0
     {
         factor += 1;
     }

@@ -142,6 +142,9 @@ pub fn parse_window(s: &str) -> Result<(f64, f64), String> {
     if !(a >= 0.0 && b > a) {
         return Err(format!("'{s}': need 0 <= START < END"));
     }
+    if !b.is_finite() {
+        return Err(format!("'{s}': END must be a finite number of seconds"));
+    }
     Ok((a, b))
 }
 
