@@ -319,14 +319,14 @@ mod tests {
                 "{bad}"
             );
         }
-        let id = l.start(1.0, 400.0, Install::AfterStorage).unwrap();
+        let id = l.start(1.0, 400.0, Install::AfterStorage).unwrap(); // ok: test
         assert!(!l.cancel(id.wrapping_add(1)), "a cancel for another run");
         assert!(l.cancel(id));
         assert_eq!(
             l.run().stage,
             RunStage::Failed(CommissioningFailure::Cancelled)
         );
-        let id = l.start(0.01, 400.0, Install::AfterStorage).unwrap();
+        let id = l.start(0.01, 400.0, Install::AfterStorage).unwrap(); // ok: test
         learned(&mut l, 4);
         assert!(matches!(l.run().stage, RunStage::AwaitingStorage(_)));
         assert_eq!(l.stored(id, None), Ok(()));
@@ -335,7 +335,7 @@ mod tests {
             RunStage::Failed(CommissioningFailure::NotStored)
         );
         // Statistics no healthy machine gives (|mean| > 1) are refused.
-        l.start(0.01, 400.0, Install::OnCompletion).unwrap();
+        l.start(0.01, 400.0, Install::OnCompletion).unwrap(); // ok: test
         let mut installed = None;
         for _ in 0..4 {
             installed = installed.or(l.learn([3.0, 0.0, 0.0, 0.0]));
@@ -345,7 +345,7 @@ mod tests {
             l.run().stage,
             RunStage::Failed(CommissioningFailure::InvalidStatistics)
         );
-        l.start(1.0, 400.0, Install::OnCompletion).unwrap();
+        l.start(1.0, 400.0, Install::OnCompletion).unwrap(); // ok: test
         l.supersede();
         assert_eq!(
             l.run().stage,
@@ -394,7 +394,7 @@ mod tests {
         fn monitor() -> Monitor {
             let mut cfg = MonitorConfig::new(crate::testing::motor_3hp(), 60.0, 220.0, 10_000.0);
             cfg.limits.i_max = 200.0;
-            Monitor::new(cfg).unwrap()
+            Monitor::new(cfg).unwrap() // ok: test
         }
 
         #[test]
@@ -402,7 +402,7 @@ mod tests {
             let mut m = monitor();
             let id = m
                 .start_commissioning_with(0.5, Install::AfterStorage)
-                .unwrap();
+                .unwrap(); // ok: test
             assert_eq!(m.commissioning().blocks_needed, 200);
             let mut k = 0;
             while m.commissioning().stage == RunStage::Learning && k < 40_000 {
@@ -436,7 +436,7 @@ mod tests {
             // Again, stored this time.
             let id = m
                 .start_commissioning_with(0.5, Install::AfterStorage)
-                .unwrap();
+                .unwrap(); // ok: test
             for _ in 0..6_000 {
                 m.update(&sample(k, false));
                 k += 1;
@@ -464,10 +464,11 @@ mod tests {
                 mean: [0.0; 4],
                 spread: [0.01; 4],
             };
-            m.set_calibration(old).unwrap();
+            m.set_calibration(old).unwrap(); // ok: test
             let id = m
                 .start_commissioning_with(0.5, Install::AfterStorage)
-                .unwrap();
+                .unwrap(); // ok: test
+
             // 1 s of settling, then 3 s of a swinging supply (the gate's timeout is 5 s).
             let mut closed = 0;
             for k in 0..40_000 {
@@ -500,7 +501,7 @@ mod tests {
                 m.start_commissioning(0.0),
                 Err(CommissioningError::Duration)
             );
-            let id = m.start_commissioning(0.2).unwrap();
+            let id = m.start_commissioning(0.2).unwrap(); // ok: test
             assert_eq!(m.start_commissioning(0.2), Err(CommissioningError::Busy));
             for k in 0..13_000 {
                 m.update(&sample(k, false));
@@ -508,13 +509,13 @@ mod tests {
             assert_eq!(m.commissioning().stage, RunStage::Done);
             assert_eq!(m.commissioning().id, id);
             assert!(m.calibration().is_some());
-            let id2 = m.start_commissioning(1.0).unwrap();
+            let id2 = m.start_commissioning(1.0).unwrap(); // ok: test
             assert_ne!(id2, id);
             let cal = Calibration {
                 mean: [0.0; 4],
                 spread: [0.02; 4],
             };
-            m.set_calibration(cal).unwrap();
+            m.set_calibration(cal).unwrap(); // ok: test
             assert_eq!(
                 m.commissioning().stage,
                 RunStage::Failed(CommissioningFailure::Superseded)
