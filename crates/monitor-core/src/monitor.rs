@@ -465,14 +465,11 @@ pub struct Monitor {
     /// Expected ticks per block and the longest gap bridged, in ticks.
     block_ticks: u32,
     max_gap_ticks: u32,
-    /// Timestamp of the previous sample; a later one more than `sample_gap_ticks` after it
-    /// starts a gap, bridged at once ([`Monitor::bridge_samples`]) up to
-    /// `max_sample_gap_ticks`.
-    last_sample_ticks: u32,
-    sample_gap_ticks: u32,
-    max_sample_gap_ticks: u32,
-    /// Ticks of the current block already bridged sample by sample.
-    bridged_ticks: u32,
+    /// The frame's estimator as it stood at the end of the last block: a block with a gap
+    /// inside is rolled back to it and bridged from there ([`Monitor::timing_event`]).
+    snap_zc: ZeroCrossing,
+    snap_pll: SrfPll,
+    snap_rfo: RotorFluxCurrentModel,
     np: f32,
     matched_lamps: Option<[bool; 4]>,
     out: MonitorOutput,
@@ -505,16 +502,19 @@ impl Monitor {
             wr: TAU * cfg.supply_hz,
         };
         let sum_lp = 5.0f32.min(0.2 * slow_hz);
+        let zc = ZeroCrossing::new(
+            dt,
+            cfg.supply_hz,
+            0.2 * cfg.supply_hz,
+            4.0 * cfg.supply_hz,
+            0.02 * cfg.v_phase_peak,
+        );
+        let pll = SrfPll::new(dt, cfg.supply_hz, cfg.pll_bw_hz, cfg.v_phase_peak);
+        let rfo = RotorFluxCurrentModel::new(dt, m.rr_ohm, m.lr_h, imr_min);
         Ok(Monitor {
-            zc: ZeroCrossing::new(
-                dt,
-                cfg.supply_hz,
-                0.2 * cfg.supply_hz,
-                4.0 * cfg.supply_hz,
-                0.02 * cfg.v_phase_peak,
-            ),
-            pll: SrfPll::new(dt, cfg.supply_hz, cfg.pll_bw_hz, cfg.v_phase_peak),
-            rfo: RotorFluxCurrentModel::new(dt, m.rr_ohm, m.lr_h, imr_min),
+            zc,
+            pll,
+            rfo,
             mt: MtSpeed::new(&cfg.encoder, cfg.tick_hz, cfg.limits.max_speed_rad_s),
             sc: SinCos::default(),
             dt,
@@ -565,10 +565,9 @@ impl Monitor {
             block_ticks_span: (cfg.tick_hz * dt) as u32,
             block_ticks: (cfg.tick_hz * slow_dt + 0.5) as u32,
             max_gap_ticks: (cfg.tick_hz * (slow_dt + cfg.max_bridged_gap_s)) as u32,
-            last_sample_ticks: 0,
-            sample_gap_ticks: (cfg.tick_hz * dt * 1.5) as u32,
-            max_sample_gap_ticks: (cfg.tick_hz * (dt + cfg.max_bridged_gap_s)) as u32,
-            bridged_ticks: 0,
+            snap_zc: zc,
+            snap_pll: pll,
+            snap_rfo: rfo,
             np: m.np(),
             matched_lamps: None,
             out: MonitorOutput {
@@ -722,12 +721,6 @@ impl Monitor {
         // Plausibility is checked once per block (slow path): the ADC flags are collected
         // here, the values' range and finiteness are checked on the block's extremes there.
         // A NaN or absurd reading poisons only its own block, which is then discarded.
-        // Samples missing before this one: bridged before it is transformed (cold).
-        let since = s.timestamp_ticks.wrapping_sub(self.last_sample_ticks);
-        self.last_sample_ticks = s.timestamp_ticks;
-        if since > self.sample_gap_ticks {
-            self.bridge_samples(since);
-        }
         self.block_sat |= u8::from(s.i_saturated) | (u8::from(s.v_saturated) << 1);
         let m = 0x7fff_ffffu32;
         let vb = (s.v_abc.a.to_bits() & m)
@@ -874,6 +867,13 @@ impl Monitor {
     // steps are separate functions for reading; each is inlined here.
     #[inline(never)]
     fn slow_path(&mut self, s: &Sample, wr: f32) {
+        self.block_end(s, wr);
+        self.snapshot_frame();
+    }
+
+    /// Everything at the end of a block (see [`Monitor::slow_path`]).
+    #[inline(always)]
+    fn block_end(&mut self, s: &Sample, wr: f32) {
         let off_time = self.block_timing(s.timestamp_ticks);
         // Plausibility of the block: saturation flags, range (NaN and inf fail, see update).
         let i_bad = (self.block_sat & 1 != 0) | (self.block_imax > self.i_max_bits);
@@ -939,31 +939,20 @@ impl Monitor {
     /// periods), else the elapsed ticks (a gap, a stalled or a backward clock).
     #[inline(always)]
     fn block_timing(&mut self, ticks: u32) -> Option<u32> {
-        let bridged = core::mem::take(&mut self.bridged_ticks);
         let prev = self.block_end_ticks.replace(ticks)?;
-        let elapsed = ticks.wrapping_sub(prev).wrapping_sub(bridged);
+        let elapsed = ticks.wrapping_sub(prev);
         (elapsed.wrapping_sub(self.block_ticks_lo) > self.block_ticks_span).then_some(elapsed)
     }
 
-    /// Samples missing before this one (`since` ticks after the previous sample, more than
-    /// 1.5 sample periods): a gap up to `max_bridged_gap_s` is bridged at once, before this
-    /// sample is transformed, by advancing the frame's estimators over the missing time, so
-    /// the samples after the gap are already in the right frame (bridged at the block's
-    /// end, the rotor-flux model would take the rest of the block's currents in a frame
-    /// behind by the gap's angle, and its flux would need a rotor time constant to
-    /// recover). The block's length check then leaves the bridged ticks out. A longer gap
-    /// or a wrapped (backward) clock is left to the block's check, which restarts.
-    #[cold]
-    #[inline(never)]
-    fn bridge_samples(&mut self, since: u32) {
-        if since > self.max_sample_gap_ticks {
-            return;
+    /// Keeps the frame's estimator as it stands at the end of a block (only the one in
+    /// use changes from sample to sample).
+    #[inline(always)]
+    fn snapshot_frame(&mut self) {
+        match self.cfg.angle_source {
+            AngleSource::ZeroCrossing => self.snap_zc = self.zc,
+            AngleSource::Pll => self.snap_pll = self.pll,
+            AngleSource::RotorFluxCurrentModel => self.snap_rfo = self.rfo,
         }
-        let missing = since - self.ticks_per_sample.min(since);
-        self.bridged_ticks = self.bridged_ticks.saturating_add(missing);
-        let t = &mut self.out.timing;
-        t.gaps_bridged = t.gaps_bridged.saturating_add(1);
-        self.skip_estimators(missing as f32 / self.cfg.tick_hz);
     }
 
     /// Advances the frame's estimators over `missing_s` seconds without samples and puts
@@ -990,9 +979,19 @@ impl Monitor {
         self.acc_n = 0;
         let t = &mut self.out.timing;
         if elapsed_ticks > self.block_ticks && elapsed_ticks <= self.max_gap_ticks {
+            // Roll the frame back to the end of the last block and advance it over the whole
+            // block's real time: the samples after the gap were transformed in a frame behind
+            // by the gap's angle, and the rotor-flux model took their currents in it (left
+            // in, its flux would need a rotor time constant to recover, and the residuals
+            // moved by 0.08 after a 10 ms gap). The block's samples are lost; at most one
+            // block (2.5 ms at 10 kHz) besides the gap.
             t.gaps_bridged = t.gaps_bridged.saturating_add(1);
-            let missing_s = (elapsed_ticks - self.block_ticks) as f32 / self.cfg.tick_hz;
-            self.skip_estimators(missing_s);
+            match self.cfg.angle_source {
+                AngleSource::ZeroCrossing => self.zc = self.snap_zc,
+                AngleSource::Pll => self.pll = self.snap_pll,
+                AngleSource::RotorFluxCurrentModel => self.rfo = self.snap_rfo,
+            }
+            self.skip_estimators(elapsed_ticks as f32 / self.cfg.tick_hz);
         } else {
             t.timing_faults = t.timing_faults.saturating_add(1);
             self.settle_left = self.settle_blocks;
