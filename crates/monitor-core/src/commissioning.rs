@@ -271,6 +271,15 @@ impl Learner {
 
 #[cfg(test)]
 mod tests {
+    /// The calibration a run awaiting storage holds; asserts the run is awaiting storage.
+    fn awaiting_storage(stage: RunStage) -> Calibration {
+        assert!(matches!(stage, RunStage::AwaitingStorage(_)), "{stage:?}");
+        match stage {
+            RunStage::AwaitingStorage(cal) => cal,
+            _ => Calibration::default(),
+        }
+    }
+
     use super::*;
 
     fn learned(l: &mut Learner, blocks: u32) -> Option<Calibration> {
@@ -296,9 +305,7 @@ mod tests {
 
         assert_eq!(l.start(0.1, 400.0, Install::AfterStorage), Ok(2));
         assert!(learned(&mut l, 40).is_none());
-        let RunStage::AwaitingStorage(cal) = l.run().stage else {
-            panic!("not awaiting storage: {:?}", l.run()); // ok: test
-        };
+        let cal = awaiting_storage(l.run().stage);
         assert_eq!(
             l.start(1.0, 400.0, Install::AfterStorage),
             Err(CommissioningError::Busy)
@@ -357,38 +364,19 @@ mod tests {
     /// voltage amplitude swinging +-20 % at 0.5 Hz while `swinging` (the quasi-steady
     /// gate stays closed).
     mod monitor {
+        use super::awaiting_storage;
         use crate::commissioning::*;
-        use crate::{Abc, CommissioningState, Monitor, MonitorConfig, Sample};
+        use crate::{CommissioningState, Monitor, MonitorConfig, Sample};
         use core::f32::consts::TAU;
 
         fn sample(k: u32, swinging: bool) -> Sample {
             let t = k as f32 * 1e-4;
-            let w = TAU * 60.0 * t;
             let scale = if swinging {
                 1.0 + 0.2 * (TAU * 0.5 * t).sin()
             } else {
                 1.0
             };
-            let ph = |x: f32| [x.cos(), (x - TAU / 3.0).cos(), (x + TAU / 3.0).cos()];
-            let (pv, pi) = (ph(w), ph(w - 0.5));
-            let (v, i) = (179.6 * scale, 10.0);
-            let wm = 1750.0 / 60.0 * TAU;
-            Sample {
-                v_abc: Abc {
-                    a: v * pv[0],
-                    b: v * pv[1],
-                    c: v * pv[2],
-                },
-                i_abc: Abc {
-                    a: i * pi[0],
-                    b: i * pi[1],
-                    c: i * pi[2],
-                },
-                encoder_count: (wm * t / TAU * 4096.0) as u32,
-                timestamp_ticks: (t * 1e6) as u32,
-                v_saturated: false,
-                i_saturated: false,
-            }
+            crate::testing::steady_sample(k, 179.6 * scale)
         }
 
         fn monitor() -> Monitor {
@@ -413,9 +401,7 @@ mod tests {
             }
             // 1 s of settling, then 0.5 s of learning.
             assert!((14_900..15_200).contains(&k), "learned after {k} samples");
-            let RunStage::AwaitingStorage(cal) = m.commissioning().stage else {
-                panic!("{:?}", m.commissioning());
-            };
+            let cal = awaiting_storage(m.commissioning().stage);
             assert_eq!(m.calibration(), None, "in force before it is stored");
             assert_eq!(m.output().commissioning, CommissioningState::Learning(1.0));
             assert!(
@@ -441,9 +427,7 @@ mod tests {
                 m.update(&sample(k, false));
                 k += 1;
             }
-            let RunStage::AwaitingStorage(cal2) = m.commissioning().stage else {
-                panic!("{:?}", m.commissioning());
-            };
+            let cal2 = awaiting_storage(m.commissioning().stage);
             assert!(cal2.is_valid() && cal != Calibration::default());
             assert!(m.calibration_stored(id, Some(cal2)).is_ok());
             assert_eq!(m.commissioning().stage, RunStage::Done);

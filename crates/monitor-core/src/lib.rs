@@ -138,4 +138,32 @@ pub(crate) mod testing {
     pub(crate) fn motor_3hp() -> MotorModel {
         crate::reference::MOTOR_3HP.motor.model()
     }
+
+    /// Sample `k` at 10 kHz of the 3 hp machine's steady state: a balanced 60 Hz supply of
+    /// `v_peak` [V] and a balanced 10 A current lagging by 0.5 rad, the shaft at 1750 rpm
+    /// on a 4096-count encoder, microsecond timestamps.
+    pub(crate) fn steady_sample(k: u32, v_peak: f32) -> crate::Sample {
+        use core::f32::consts::TAU;
+        let t = k as f32 * 1e-4;
+        let w = TAU * 60.0 * t;
+        let ph = |x: f32| crate::Abc {
+            a: x.cos(),
+            b: (x - TAU / 3.0).cos(),
+            c: (x + TAU / 3.0).cos(),
+        };
+        let scale = |p: crate::Abc<f32>, m: f32| crate::Abc {
+            a: m * p.a,
+            b: m * p.b,
+            c: m * p.c,
+        };
+        let wm = 1750.0 / 60.0 * TAU;
+        crate::Sample {
+            v_abc: scale(ph(w), v_peak),
+            i_abc: scale(ph(w - 0.5), 10.0),
+            encoder_count: (wm * t / TAU * 4096.0) as u32,
+            timestamp_ticks: (t * 1e6) as u32,
+            v_saturated: false,
+            i_saturated: false,
+        }
+    }
 }

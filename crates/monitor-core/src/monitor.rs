@@ -1175,31 +1175,9 @@ mod tests {
         }
     }
 
-    /// A balanced supply and a balanced current lagging by 30 degrees, shaft at 1750 rpm.
+    /// A balanced supply and a balanced current lagging by 0.5 rad, shaft at 1750 rpm.
     fn healthy(k: u32) -> Sample {
-        let t = k as f32 * 1e-4;
-        let w = TAU * 60.0 * t;
-        let v = 179.6;
-        let i = 10.0;
-        let ph = |x: f32| [x.cos(), (x - TAU / 3.0).cos(), (x + TAU / 3.0).cos()];
-        let (pv, pi) = (ph(w), ph(w - 0.5));
-        let wm = 1750.0 / 60.0 * TAU;
-        Sample {
-            v_abc: Abc {
-                a: v * pv[0],
-                b: v * pv[1],
-                c: v * pv[2],
-            },
-            i_abc: Abc {
-                a: i * pi[0],
-                b: i * pi[1],
-                c: i * pi[2],
-            },
-            encoder_count: (wm * t / TAU * 4096.0) as u32,
-            timestamp_ticks: (t * 1e6) as u32,
-            v_saturated: false,
-            i_saturated: false,
-        }
+        crate::testing::steady_sample(k, 179.6)
     }
 
     #[test]
