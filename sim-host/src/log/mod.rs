@@ -250,18 +250,6 @@ impl Log {
         })
     }
 
-    /// The sample rate ([`sample_rate_hz`] of the first rows), `None` without an
-    /// increasing pair of rows.
-    pub fn sample_rate_hz(&self) -> Option<f64> {
-        let head: Vec<f64> = self
-            .rows
-            .iter()
-            .take(quality::HEAD_ROWS)
-            .map(|r| r.t_s)
-            .collect();
-        sample_rate_hz(&head)
-    }
-
     /// Writes the log atomically to `path` (see [`LogWriter`]).
     ///
     /// # Errors
@@ -310,7 +298,8 @@ mod tests {
         let back = Log::read(&p).unwrap();
         assert_eq!(back.rows.len(), 10);
         assert!((back.rows[9].i_abc[0] - 0.9).abs() < 1e-9);
-        assert!((back.sample_rate_hz().unwrap() - 1e4).abs() < 1e-6);
+        let times: Vec<f64> = back.rows.iter().map(|r| r.t_s).collect();
+        assert!((sample_rate_hz(&times).unwrap() - 1e4).abs() < 1e-6);
 
         let missing = write("t_s,ia_A,ib_A\n0,1,2\n");
         let e = Log::read(missing.path()).unwrap_err().to_string();
