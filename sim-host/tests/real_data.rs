@@ -551,3 +551,88 @@ fn a_load_outside_the_commissioned_range_is_named_beside_the_lamps() {
         .any(|p| p["range_note"].is_string() && p["lamps"].to_string().contains("true"));
     assert!(lit_with_note, "no timeline point carries the note");
 }
+
+#[test]
+fn a_nameplate_20_percent_off_gets_no_confident_verdict() {
+    // The healthy log diagnosed with parameters 20 % off the machine that made it, as a
+    // nameplate gives them.
+    let c = clean();
+    let log = write("nameplate.csv", c.healthy.0, c.healthy.1.clone());
+    let text = std::fs::read_to_string(repo().join(PARAMS)).expect("params");
+    let off: String = text
+        .lines()
+        .map(|l| {
+            let scaled = ["rs_ohm", "ls_h", "lr_h", "lm_h", "j_kgm2"]
+                .iter()
+                .map(|k| (k, 1.2))
+                .chain([(&"rr_ohm", 0.8)])
+                .find(|(k, _)| l.starts_with(&format!("{} =", k)));
+            match (
+                scaled,
+                l.split('=')
+                    .nth(1)
+                    .and_then(|v| v.trim().parse::<f64>().ok()),
+            ) {
+                (Some((k, f)), Some(v)) => format!("{k} = {}\n", v * f),
+                _ => format!("{l}\n"),
+            }
+        })
+        .collect();
+    let params = clean().dir.path().join("nameplate.toml");
+    std::fs::write(&params, off).expect("write params");
+    let p = params.display().to_string();
+    let shown = log.display().to_string();
+    let d = |extra: &[&str]| -> Value {
+        let mut args = vec!["diagnose", "--json", "--params", &p, &shown];
+        args.extend_from_slice(extra);
+        let o = run(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice(&o.stdout).expect("json")
+    };
+    // Fixed thresholds against the wrong nominal values: the lamps light, but the verdict
+    // says the parameters do not fit (it used to be a fault named rr).
+    let fixed = d(&[]);
+    assert_eq!(fixed["verdict"], "could_not_judge", "{}", fixed["verdict"]);
+    assert!(
+        fixed["verdict_withheld_because"]
+            .to_string()
+            .contains("does not fit this motor"),
+        "{}",
+        fixed["verdict_withheld_because"]
+    );
+    // Commissioned on healthy running: healthy, and no lamp before the window counts.
+    let learned = d(&["--commission", COMMISSION]);
+    assert_eq!(learned["verdict"], "healthy", "{}", learned["detections"]);
+}
+
+#[test]
+fn lamps_lit_only_outside_the_commissioned_range_are_no_verdict() {
+    // Another simulator's log (motulator, 2.2 kW direct-on-line start, a load step at
+    // 3.5 s), commissioned at no load: the lamps light at the load step, and the verdict
+    // says why it cannot tell a fault from it.
+    let data = repo().join("../shared/data");
+    let (p, log) = (
+        data.join("motulator_2p2kw_dol.toml"),
+        data.join("motulator_2p2kw_dol.csv"),
+    );
+    if !log.exists() {
+        return;
+    }
+    let (p, log) = (p.display().to_string(), log.display().to_string());
+    let o = run(&[
+        "diagnose",
+        "--json",
+        "--params",
+        &p,
+        &log,
+        "--commission",
+        "1.5:2.4",
+    ]);
+    assert!(o.status.success());
+    let d: Value = serde_json::from_slice(&o.stdout).expect("json");
+    assert!(d["first_detection_s"].as_f64().is_some_and(|t| t > 3.4));
+    assert_eq!(d["verdict"], "could_not_judge");
+    assert!(d["verdict_withheld_because"]
+        .to_string()
+        .contains("outside the range commissioned"));
+}

@@ -277,6 +277,8 @@ pub struct Replay {
     i_max: f64,
     rows: u64,
     evaluated: bool,
+    /// A detection happened inside the commissioned operating range (or without one).
+    detected_in_range: bool,
     first_detection: Option<f64>,
     detections: Vec<(String, f64)>,
     timeline: Vec<TimelinePoint>,
@@ -334,6 +336,7 @@ impl Replay {
             i_max: f64::from(cfg.limits.i_max),
             rows: 0,
             evaluated: false,
+            detected_in_range: false,
             first_detection: None,
             detections: Vec::new(),
             timeline: Vec::new(),
@@ -388,7 +391,13 @@ impl Replay {
                 *m = m.max(r.abs());
             }
         }
-        if out.fault_detected {
+        // With a commissioning window asked for, lamps lit on the fixed thresholds before
+        // the learned ones are in force are not detections: the window says the nominal
+        // parameters are not to be trusted (a sensor fault counts at any time).
+        let counts = out.sensor_fault.any() || self.commission.thresholds_trusted(&out);
+        if out.fault_detected && counts {
+            self.detected_in_range |=
+                out.sensor_fault.any() || !self.commission.outside_learned_range(&out);
             if self.first_detection.is_none() {
                 self.first_detection = Some(t);
             }
@@ -474,6 +483,14 @@ impl Replay {
         }
         if let Some(why) = self.commission.why_incomplete() {
             withheld.push(why);
+        }
+        if let Some(why) = self.commission.nominal_misfit() {
+            withheld.push(why);
+        }
+        if let (Some(t), false) = (self.first_detection, self.detected_in_range) {
+            withheld.push(format!(
+                "the lamps lit (first at {t:.2} s) only while the load or the voltage was outside the range commissioned: to the paper's model a load change is a Bl change and the learned means hold only where they were learned, so a fault cannot be told from the new operating point; commission over the whole load and voltage range"
+            ));
         }
         let verdict = if !withheld.is_empty() {
             Verdict::CouldNotJudge
