@@ -82,10 +82,11 @@ pub struct DemoRun {
 impl DemoRun {
     /// True when the injected fault is among the final candidates.
     pub fn correct_fault_named(&self) -> bool {
-        self.report
-            .candidates
-            .iter()
-            .any(|c| c.fault == self.fault.name())
+        let want = match self.fault {
+            Fault::B | Fault::Bl => "b/bl",
+            f => f.name(),
+        };
+        self.report.isolation.named.as_deref() == Some(want)
     }
 }
 

@@ -60,10 +60,22 @@ pub struct Table1Row {
     pub expected: [u8; 4],
     /// Normalised residuals r1..r4 at the end of the run.
     pub residuals: [f32; 4],
-    /// Most probable candidates at the end (name, probability).
+    /// The lamps' candidates at the end (name, probability): the signature matching.
     pub candidates: Vec<(String, f32)>,
     /// Time from the fault to the first lamp [s], if any.
     pub detection_delay_s: Option<f64>,
+    /// The fault the isolation names at the end (`b/bl` for the friction class), if any
+    /// ([`crate::replay::IsolationReport`]).
+    pub named: Option<String>,
+    /// The estimated relative change of the top isolation candidate at the end.
+    pub named_change: Option<f32>,
+    /// The isolation's candidates at the end (name, probability, estimated change).
+    pub isolation_candidates: Vec<(String, f32, Option<f32>)>,
+    /// The isolation's state at the end (`isolated`, `unknown`, `no_deviation`, ...).
+    pub isolation_state: String,
+    /// Time from the fault to the first time the isolation named a fault [s] (negative:
+    /// something was named before the fault).
+    pub name_delay_s: Option<f64>,
 }
 
 /// The scenario of one case.
@@ -127,11 +139,24 @@ pub fn run_case(
         expected,
         residuals,
         candidates: rep
-            .candidates
+            .signature_candidates
             .iter()
             .map(|c| (c.fault.clone(), c.probability))
             .collect(),
         detection_delay_s: first_lamp,
+        named: rep.isolation.named.clone(),
+        named_change: rep.isolation.named_change,
+        isolation_candidates: rep
+            .candidates
+            .iter()
+            .map(|c| (c.fault.clone(), c.probability, c.change))
+            .collect(),
+        isolation_state: rep.isolation.state.clone(),
+        name_delay_s: rep
+            .isolation
+            .first_named
+            .as_ref()
+            .map(|(_, t)| t - proto.fault_at_s),
     })
 }
 

@@ -142,13 +142,19 @@ fn diagnose_runs_on_the_independent_motulator_log() {
     // friction (Bl) change: r2, r3, r4 light and B/Bl are named, r1 stays dark.
     assert_eq!(d["lamps"]["r1"], false);
     assert_eq!(d["lamps"]["r2"], true);
-    let names: Vec<&str> = d["candidates"]
+    let names: Vec<&str> = d["signature_candidates"]
         .as_array()
         .expect("list")
         .iter()
         .filter_map(|c| c["fault"].as_str())
         .collect();
     assert_eq!(names, vec!["b", "bl"]);
+    // The isolation: the constant torque is no viscous-friction change (the file's Bl is
+    // 0, so no Bl factor fits), so it names nothing rather than a wrong fault.
+    for c in d["candidates"].as_array().expect("list") {
+        assert!(c["probability"].as_f64().expect("p") < 0.5, "{c}");
+    }
+    assert_ne!(d["isolation"]["state"], "isolated");
     let t = d["first_detection_s"].as_f64().expect("detected");
     assert!(t > 2.5, "{t}");
     assert_eq!(d["unbalance"]["suspect_phase"], serde_json::Value::Null);

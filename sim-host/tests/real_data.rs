@@ -304,7 +304,7 @@ fn mutated_logs_give_the_clean_logs_verdict_and_say_what_was_wrong() {
         let t = f(&fl["first_detection_s"]);
         if fl["verdict"] != "fault"
             || (t - t_clean).abs() > 0.3
-            || fl["candidates"] != clean_faulty["candidates"]
+            || !same_candidates(&fl["candidates"], &clean_faulty["candidates"])
         {
             failures.push(format!(
                 "{name} faulty: verdict {} at {t} (clean {t_clean}), candidates {}",
@@ -430,7 +430,14 @@ fn common_daq_rates_give_the_verdicts_of_10_khz() {
         assert_eq!(h["verdict"], "healthy", "{rate} Hz: {}", h["detections"]);
     }
     for v in &verdicts[1..] {
-        assert_eq!((&v.1, &v.2), (&verdicts[0].1, &verdicts[0].2), "{} Hz", v.0);
+        assert_eq!(&v.1, &verdicts[0].1, "{} Hz", v.0);
+        assert!(
+            same_candidates(&v.2, &verdicts[0].2),
+            "{} Hz: {} against {}",
+            v.0,
+            v.2,
+            verdicts[0].2
+        );
     }
     // Current-only logs of shorted turns in phase b: at 1 kHz the faulty-phase analysis
     // runs and names the phase it names at 10 kHz.
@@ -635,4 +642,22 @@ fn lamps_lit_only_outside_the_commissioned_range_are_no_verdict() {
     assert!(d["verdict_withheld_because"]
         .to_string()
         .contains("outside the range commissioned"));
+}
+
+/// The same candidates: the same faults in the same order, probabilities within 0.05 and
+/// estimated sizes within 0.05 (the isolation fits a size from noisy data).
+fn same_candidates(a: &Value, b: &Value) -> bool {
+    let (Some(a), Some(b)) = (a.as_array(), b.as_array()) else {
+        return false;
+    };
+    let close = |x: &Value, y: &Value| match (x.as_f64(), y.as_f64()) {
+        (Some(x), Some(y)) => (x - y).abs() <= 0.05,
+        _ => x == y,
+    };
+    a.len() == b.len()
+        && a.iter().zip(b).all(|(x, y)| {
+            x["fault"] == y["fault"]
+                && close(&x["probability"], &y["probability"])
+                && close(&x["change"], &y["change"])
+        })
 }

@@ -59,6 +59,7 @@ pub mod encoder;
 pub mod error;
 pub mod filter;
 pub mod frames;
+pub mod isolation;
 pub mod machine;
 pub mod monitor;
 pub mod residuals;
@@ -74,6 +75,7 @@ pub use effect::EffectKind;
 pub use encoder::EncoderConfig;
 pub use error::{ConfigCheck, ConfigError, ConfigErrorKind};
 pub use frames::{Abc, AlphaBeta, Dq, Phase, Real, SinCos};
+pub use isolation::{Isolation, IsolationState, Isolator, Named, SteadyPoint};
 pub use machine::{reference, MotorModel, MotorParameters, ReferenceMachine, SupplyParameters};
 pub use monitor::{
     CommissioningState, Monitor, MonitorConfig, MonitorOutput, ResidualForm, Sample, SensorFlags,

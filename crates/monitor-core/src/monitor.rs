@@ -374,6 +374,11 @@ pub struct MonitorOutput {
     pub fault_detected: bool,
     /// Filtered model quantities in the chosen frame.
     pub operating: Operating,
+    /// Filtered d-axis voltage V_ds in the chosen frame [V] (with `operating`'s I_qs, i_ds
+    /// and V_qs: the full stator voltage and current vectors, for the fault isolation of
+    /// [`crate::isolation`]). Taken from each block's last sample, low-pass filtered at
+    /// `filter_hz`.
+    pub vds: f32,
     /// Mechanical speed from the encoder [rad/s].
     pub speed_rad_s: f32,
     /// Frame angular frequency [rad/s] (supply frequency in steady state).
@@ -436,7 +441,12 @@ pub struct Monitor {
     f_wr: Svf,
     f_nd: Svf,
     f_nq: Svf,
-    vmag: LowPass,
+    /// Filtered squared voltage magnitude |V|^2 [V^2] (compared with `v_run_min2`: no
+    /// square root per block).
+    vmag2: LowPass,
+    /// (`min_voltage_frac` x `v_phase_peak`)^2 [V^2].
+    v_run_min2: f32,
+    f_vds: LowPass,
     isum: LowPass,
     imax: LowPass,
     vsum: LowPass,
@@ -531,7 +541,10 @@ impl Monitor {
             f_wr: Svf::new(cfg.filter_hz, slow_dt),
             f_nd: Svf::new(cfg.sequence_hz, slow_dt),
             f_nq: Svf::new(cfg.sequence_hz, slow_dt),
-            vmag: LowPass::new(sum_lp, slow_dt),
+            vmag2: LowPass::new(sum_lp, slow_dt),
+            v_run_min2: (cfg.min_voltage_frac * cfg.v_phase_peak)
+                * (cfg.min_voltage_frac * cfg.v_phase_peak),
+            f_vds: LowPass::new(cfg.filter_hz, slow_dt),
             isum: LowPass::new(sum_lp, slow_dt),
             imax: LowPass::new(sum_lp, slow_dt),
             vsum: LowPass::new(sum_lp, slow_dt),
@@ -777,7 +790,7 @@ impl Monitor {
         self.acc[ACC_NQ] += n.q;
         self.acc_n += 1;
         if self.acc_n >= self.cfg.decimation {
-            self.slow_path(s, wr);
+            self.slow_path(s, wr, sc);
         }
         &self.out
     }
@@ -866,14 +879,14 @@ impl Monitor {
     // Kept out of line so the per-sample path does not carry its register pressure. The
     // steps are separate functions for reading; each is inlined here.
     #[inline(never)]
-    fn slow_path(&mut self, s: &Sample, wr: f32) {
-        self.block_end(s, wr);
+    fn slow_path(&mut self, s: &Sample, wr: f32, sc: SinCos) {
+        self.block_end(s, wr, sc);
         self.snapshot_frame();
     }
 
     /// Everything at the end of a block (see [`Monitor::slow_path`]).
     #[inline(always)]
-    fn block_end(&mut self, s: &Sample, wr: f32) {
+    fn block_end(&mut self, s: &Sample, wr: f32, sc: SinCos) {
         let off_time = self.block_timing(s.timestamp_ticks);
         // Plausibility of the block: saturation flags, range (NaN and inf fail, see update).
         let i_bad = (self.block_sat & 1 != 0) | (self.block_imax > self.i_max_bits);
@@ -891,7 +904,7 @@ impl Monitor {
             return;
         }
         let iqs = self.filter_block(wr);
-        self.check_sums(s);
+        self.check_sums(s, sc);
         let op = Operating {
             iqs: self.f_iqs.y,
             i_f: self.f_ids.y,
@@ -1016,6 +1029,7 @@ impl Monitor {
         ] {
             f.reset();
         }
+        self.f_vds.y = 0.0;
         self.acc = [0.0; 5];
         self.acc_n = 0;
         self.settle_left = self.settle_blocks;
@@ -1050,12 +1064,15 @@ impl Monitor {
         iqs
     }
 
-    /// Voltage magnitude (frame independent) and the sum checks on this block's last sample
-    /// (3-wire machine: ia + ib + ic = 0); ages the sensor-fault hold and the settling time.
+    /// Squared voltage magnitude (frame independent), V_ds (in the frame `sc` of this block's last
+    /// sample) and the sum checks on that sample (3-wire machine: ia + ib + ic = 0); ages
+    /// the sensor-fault hold and the settling time.
     #[inline(always)]
-    fn check_sums(&mut self, s: &Sample) {
+    fn check_sums(&mut self, s: &Sample, sc: SinCos) {
         let vab = clarke(s.v_abc);
-        self.vmag.update(crate::fast_hypot(vab.alpha, vab.beta));
+        self.vmag2
+            .update(vab.alpha * vab.alpha + vab.beta * vab.beta);
+        self.out.vds = self.f_vds.update(vab.alpha * sc.cos + vab.beta * sc.sin);
         let l = self.cfg.limits;
         let i = s.i_abc;
         self.isum.update((i.a + i.b + i.c).abs());
@@ -1123,9 +1140,8 @@ impl Monitor {
     /// residuals `rn`, while the motor runs settled and quasi-steady.
     #[inline(always)]
     fn update_lamps(&mut self, rn: [f32; 4]) {
-        let running = self.settle_left == 0
-            && self.vmag.y > self.cfg.min_voltage_frac * self.cfg.v_phase_peak
-            && !self.out.sensor_fault.any();
+        let running =
+            self.settle_left == 0 && self.vmag2.y > self.v_run_min2 && !self.out.sensor_fault.any();
         if self.learner.is_active() {
             // Learning on evaluated blocks, or the learned calibration awaiting storage.
             if running && self.out.quasi_steady && self.learner.is_learning() {

@@ -74,6 +74,17 @@ impl SequenceAnalyzer {
         self.nq.update(n.q);
     }
 
+    /// The filtered Park components `P = I1 e^{-j theta0}` (frame at +theta) as `(re, im)`.
+    pub fn positive(&self) -> (f32, f32) {
+        (self.pd.y, self.pq.y)
+    }
+
+    /// `conj(N) = I2 e^{-j theta0}` as `(re, im)` (same rotation as [`Self::positive`], so
+    /// `I2/I1 = conj(N)/P`).
+    pub fn negative(&self) -> (f32, f32) {
+        (self.nd.y, -self.nq.y)
+    }
+
     /// |I1|, the positive-sequence current magnitude (phase peak) [A].
     pub fn positive_magnitude(&self) -> f32 {
         crate::fast_hypot(self.pd.y, self.pq.y)
@@ -123,6 +134,74 @@ pub fn suspect_phase(i2_over_i1_angle_rad: f32, correction_rad: f32) -> Phase {
     let k = F32Ext::round(crate::frames::wrap_angle(i2_over_i1_angle_rad - correction_rad) / third)
         as i32;
     Phase::from_turns(k)
+}
+
+/// The winding's part of the negative sequence, with the supply's own unbalance taken out.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct WindingAsymmetry {
+    /// `|I2w/I1|`: the winding's negative-sequence current over the positive sequence.
+    pub ratio: f32,
+    /// `|V2/Z2|/|I1|`: the part the supply's voltage unbalance drives (0 without voltages).
+    pub supply_ratio: f32,
+    /// `arg(I2w/I1)` [rad].
+    pub angle_rad: f32,
+    /// The shorted-turns phase; `None` when the winding's part is below what the supply's
+    /// unbalance and the noise explain ([`winding_asymmetry`]).
+    pub suspect_phase: Option<Phase>,
+}
+
+/// Share of the supply-driven negative sequence that the model's negative-sequence
+/// impedance may be wrong by (magnitude and angle): a winding part below this fraction of
+/// `|V2/Z2|` is not evidence (nameplate parameters 10-30 % off, DESIGN.md).
+pub const SUPPLY_PART_UNCERTAINTY: f32 = 0.3;
+
+/// The workspace's one faulty-phase method on a supply that is itself unbalanced: the
+/// negative-sequence current `I2` minus the part the supply's negative-sequence voltage
+/// drives through the machine, `V2 / Z2` with `Z2 = Z(2 - s)` ([`equivalent_impedance`]);
+/// what is left is the winding's (module docs: `I2w/I1 ~ (eps/3)(Z1/Z2) a^k`), and
+/// [`suspect_phase`] names its phase.
+///
+/// Inputs as complex numbers `(re, im)` in the core's phasor convention, relative to the
+/// positive-sequence current: `i2_over_i1 = I2/I1` and, where voltages are measured,
+/// `v2_over_i1 = V2/I1` [ohm] (both from Park with one angle: [`SequenceAnalyzer`] gives
+/// `I2/I1 = conj(N)/P`). `we` [rad/s], slip `s`.
+///
+/// "None" when `|I2w/I1|` is below `min_ratio` (noise) or below
+/// [`SUPPLY_PART_UNCERTAINTY`] times `|V2/Z2|/|I1|` (what an imperfect `Z2` leaves of the
+/// supply's part). Without voltages the supply is assumed balanced.
+pub fn winding_asymmetry(
+    i2_over_i1: (f32, f32),
+    v2_over_i1: Option<(f32, f32)>,
+    m: &MotorModel,
+    we: f32,
+    s: f32,
+    min_ratio: f32,
+) -> WindingAsymmetry {
+    let (mut wr, mut wi) = i2_over_i1;
+    let mut supply_ratio = 0.0;
+    if let Some((vr, vi)) = v2_over_i1 {
+        let (zr, zi) = equivalent_impedance(m, we, 2.0 - s);
+        let d = zr * zr + zi * zi;
+        if d > 0.0 {
+            let (sr, si) = ((vr * zr + vi * zi) / d, (vi * zr - vr * zi) / d);
+            wr -= sr;
+            wi -= si;
+            supply_ratio = crate::fast_hypot(sr, si);
+        }
+    }
+    let ratio = crate::fast_hypot(wr, wi);
+    if !(ratio.is_finite() && supply_ratio.is_finite()) {
+        return WindingAsymmetry::default();
+    }
+    let angle = F32Ext::atan2(wi, wr);
+    let floor = crate::maxf(min_ratio, SUPPLY_PART_UNCERTAINTY * supply_ratio);
+    let corr = asymmetry_correction_rad(m, we, s);
+    WindingAsymmetry {
+        ratio,
+        supply_ratio,
+        angle_rad: angle,
+        suspect_phase: (ratio >= floor).then(|| suspect_phase(angle, corr)),
+    }
 }
 
 /// Fraction `eps` of a winding's impedance that an asymmetry with `|I2/I1| = ratio` has

@@ -2,13 +2,13 @@
 //! It needs only the currents, so it runs on current-only logs too.
 //!
 //! The current and voltage unbalance are the RMS negative- over positive-sequence parts of
-//! the working series (the first 10 % left out as start-up). A supply unbalance `v2/v1`
-//! drives `i2/i1 = (v2/v1) |Z1| / |Z2|` (Z1 = V1/I1 the positive-sequence impedance, Z2 the
-//! machine's negative-sequence impedance); where that accounts for at least half the current
-//! unbalance, no winding is suspect. Otherwise the phase is named by the workspace's one
-//! faulty-phase method (`monitor_core::sequence::suspect_phase`, as the monitor and
-//! `diagnose` name it): the fitted `i_neg = c conj(i_pos)` gives `I2/I1 = conj(c)`, whose
-//! angle minus `arg(Z1/Z2)` at the log's operating slip points at the winding. The slip is
+//! the working series (the first 10 % left out as start-up). The phase is named by the
+//! workspace's one faulty-phase method (`monitor_core::sequence::winding_asymmetry`, as
+//! `diagnose` names it): the fitted `i_neg = c conj(i_pos)` and `v_neg = cv conj(i_pos)`
+//! give `I2/I1 = conj(c)` and `V2/I1 = conj(cv)`; the part `V2/Z2` that the supply's own
+//! unbalance drives is taken out, and the angle of what is left, minus `arg(Z1/Z2)` at the
+//! log's operating slip, points at the winding. Below what the supply's part and the noise
+//! explain, no winding is suspect. The slip is
 //! the measured one (`1 - omega_r/omega_s`), or, without a speed column, the one at which
 //! the equivalent circuit draws the measured current (`monitor_core::sequence::slip_for_current`).
 
@@ -39,6 +39,8 @@ struct SequenceSums {
     i_neg2: f64,
     i_pos2: f64,
     cross: C64,
+    /// Sum of v_neg i_pos (the voltages' negative sequence against the currents' positive).
+    cross_v: C64,
     v_neg2: f64,
     v_pos2: f64,
     /// Sums of the squared phase currents.
@@ -68,6 +70,7 @@ impl SequenceSums {
             }
             if d.channels.voltages {
                 s.v_neg2 += d.v_neg[k].norm_sqr();
+                s.cross_v += d.v_neg[k] * ipos;
                 s.v_pos2 += d.vq[k] * d.vq[k] + d.vd[k] * d.vd[k];
             }
             s.omega_s += d.omega_s[k];
@@ -87,16 +90,28 @@ pub fn analyse(d: &Prepared, n: &MachineConstants) -> UnbalanceAnalysis {
         .voltages
         .then(|| (s.v_neg2 / s.v_pos2.max(1e-12)).sqrt());
     let c = s.cross / s.i_pos2.max(1e-12);
+    let cv = s.cross_v / s.i_pos2.max(1e-12);
     let w = s.omega_s / s.count;
-    let z1 = (s.v_pos2 / s.i_pos2.max(1e-12)).sqrt();
-    let z2 = super::effects::z2_neg(n, w).norm().max(1e-9);
-    let supply_explains = vratio
-        .map(|v| v > 0.002 && v * z1 / z2 > 0.5 * ratio)
-        .unwrap_or(false);
     let phase_rms_a = s.phase2.map(|p| (p / s.count).sqrt());
     let slip = operating_slip(d, n, &s);
-    let (phase, eps) = super::effects::asymmetry_phase(c, n, w, slip);
-    let suspect = (ratio > 0.01 && !supply_explains).then_some(phase);
+    // The core's one faulty-phase method, in its convention I2/I1 = conj(c), V2/I1 = conj(cv).
+    let (we, sl) = (w.abs().max(1.0) as f32, slip as f32);
+    let asym = monitor_core::sequence::winding_asymmetry(
+        (c.re as f32, -c.im as f32),
+        d.channels.voltages.then_some((cv.re as f32, -cv.im as f32)),
+        &n.core_model,
+        we,
+        sl,
+        0.01,
+    );
+    let suspect = asym.suspect_phase;
+    let supply_explains = suspect.is_none() && f64::from(asym.supply_ratio) > 0.5 * ratio;
+    let eps = f64::from(monitor_core::sequence::winding_change_fraction(
+        &n.core_model,
+        we,
+        sl,
+        asym.ratio,
+    ));
     let summary = match (suspect, supply_explains) {
         (Some(p), _) => {
             let mean_rms = phase_rms_a.iter().sum::<f64>() / 3.0;

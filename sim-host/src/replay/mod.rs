@@ -21,8 +21,10 @@
 //! `data_quality`; what commissioning did is its `commissioning` ([`commission`]).
 
 mod commission;
+mod isolation;
 
 pub use commission::{grace_s, CommissioningReport, RangeNote, SteadyPoint};
+pub use isolation::{FaultCandidate, IsolationGroup, IsolationReport};
 
 use crate::log::quality::{
     BadCells, CellLimits, CleanSink, DataQuality, QualityStage, SegmentBreak, TimeBase,
@@ -31,11 +33,15 @@ use crate::log::quality::{
 use crate::log::{Channels, LogError, LogFile, Row, RowSink};
 use crate::params::ParamFile;
 use commission::CommissionTracker;
+use isolation::IsolationTracker;
 use monitor_core::angle::SrfPll;
 use monitor_core::frames::{clarke, SinCos};
-use monitor_core::sequence::{asymmetry_correction_rad, slip_for_current, SequenceAnalyzer};
+use monitor_core::sequence::{
+    asymmetry_correction_rad, slip_for_current, winding_asymmetry, SequenceAnalyzer,
+};
+use monitor_core::SteadyPoint as IsolationPoint;
 use monitor_core::{
-    Abc, AngleSource, CommissioningState, ConfigError, Fault, Monitor, MonitorConfig,
+    Abc, AngleSource, CommissioningState, ConfigError, Fault, Isolator, Monitor, MonitorConfig,
     MonitorOutput, ResidualForm, Sample,
 };
 use serde::Serialize;
@@ -195,15 +201,6 @@ pub struct TimelinePoint {
     pub range_note: Option<String>,
 }
 
-/// A fault candidate of the signature matching.
-#[derive(Debug, Clone, Serialize, PartialEq)]
-pub struct FaultCandidate {
-    /// DESIGN.md fault name.
-    pub fault: String,
-    /// Probability.
-    pub probability: f32,
-}
-
 /// Result of the negative-sequence analysis (JSON key `unbalance`).
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct UnbalanceReport {
@@ -211,8 +208,14 @@ pub struct UnbalanceReport {
     pub negative_sequence_ratio: f32,
     /// "a", "b", "c" or null.
     pub suspect_phase: Option<String>,
-    /// arg(I2/I1) [deg].
+    /// arg(I2w/I1) [deg]: the winding's part (the supply's part taken out).
     pub angle_deg: f32,
+    /// |I2w|/|I1|: the winding's part of the negative sequence.
+    pub winding_ratio: f32,
+    /// |V2/Z2|/|I1|: the part the supply's voltage unbalance drives (0 without voltages).
+    pub supply_ratio: f32,
+    /// |V2|/|V1| (null without voltage columns).
+    pub voltage_negative_sequence_ratio: Option<f32>,
     /// The model correction arg(Z1/Z2) used [deg].
     pub correction_deg: f32,
 }
@@ -227,8 +230,16 @@ pub struct DiagnoseReport {
     pub verdict_withheld_because: Vec<String>,
     /// Final lamps `{"r1":bool,..}`.
     pub lamps: std::collections::BTreeMap<String, bool>,
-    /// Final fault candidates, most probable first.
+    /// Final fault candidates, most probable first, with their estimated size: from the
+    /// isolation ([`IsolationReport`]) when a fault was detected; an impossible sensor
+    /// reading names its sensor outright (size null).
     pub candidates: Vec<FaultCandidate>,
+    /// What the isolation concluded: the fault named, its size, the groups that cannot
+    /// be separated, and one sentence.
+    pub isolation: IsolationReport,
+    /// The paper's matching of the final lamps against the fault signature matrix (Table
+    /// 1 in voltage orientation), most probable first: the lamps' own candidates.
+    pub signature_candidates: Vec<FaultCandidate>,
     /// First time a lamp lit or a sensor fault was seen [s], or null.
     pub first_detection_s: Option<f64>,
     /// Negative-sequence analysis of the currents.
@@ -257,7 +268,8 @@ pub struct DiagnoseReport {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Verdict {
-    /// A lamp lit or a sensor fault was seen.
+    /// A lamp lit, a sensor fault was seen, or the isolation named a fault (other than
+    /// the friction class, which a load change also moves).
     Fault,
     /// Evaluated, and no lamp lit.
     Healthy,
@@ -287,9 +299,14 @@ pub struct Replay {
     max_abs: [f32; 4],
     last: MonitorOutput,
     t0: Option<f64>,
+    isolation: IsolationTracker,
     // Current-only unbalance analysis.
     pll: SrfPll,
     seq: SequenceAnalyzer,
+    seq_v: SequenceAnalyzer,
+    v_max: f64,
+    /// The sequence analysis' PLL follows the voltages (else the currents).
+    pll_on_voltage: bool,
 }
 
 impl Replay {
@@ -345,15 +362,29 @@ impl Replay {
             max_abs: [0.0; 4],
             last: MonitorOutput::default(),
             t0: None,
-            // Locks to the current vector; normalised by the no-load (magnetising) current peak.
+            isolation: IsolationTracker::new(Isolator::new(
+                params.motor.model(),
+                params.supply.v_phase_peak() as f32,
+                params.supply.f_hz as f32,
+            )),
+            // Locks to the voltage vector where logged (normalised by its nominal peak), else
+            // to the current vector (normalised by the no-load, magnetising, current peak).
             pll: SrfPll::new(
                 dt,
                 params.supply.f_hz as f32,
                 10.0,
-                (params.supply.v_phase_peak() / (params.supply.omega_rad_s() * params.motor.ls_h))
-                    as f32,
+                if channels.voltages {
+                    params.supply.v_phase_peak() as f32
+                } else {
+                    (params.supply.v_phase_peak()
+                        / (params.supply.omega_rad_s() * params.motor.ls_h))
+                        as f32
+                },
             ),
             seq: SequenceAnalyzer::new(2.0, dt),
+            seq_v: SequenceAnalyzer::new(2.0, dt),
+            v_max: f64::from(cfg.limits.v_max),
+            pll_on_voltage: channels.voltages,
         })
     }
 
@@ -362,23 +393,8 @@ impl Replay {
         self.rows += 1;
         let t0 = *self.t0.get_or_insert(row.t_s);
         let t = row.t_s - t0;
+        self.track_sequences(row);
         let Some(mon) = self.monitor.as_mut() else {
-            // Current-only: PLL on the current vector, sequence analysis; a row with a bad
-            // current is skipped (the monitor holds such samples out itself).
-            if row
-                .i_abc
-                .iter()
-                .all(|x| x.is_finite() && x.abs() <= self.i_max)
-            {
-                let i = clarke(Abc {
-                    a: row.i_abc[0] as f32,
-                    b: row.i_abc[1] as f32,
-                    c: row.i_abc[2] as f32,
-                });
-                let sc = SinCos::from_angle(self.pll.theta_pll());
-                self.pll.update(i, sc);
-                self.seq.update(i, sc);
-            }
             return self.last;
         };
         self.commission.before(mon, t);
@@ -395,6 +411,8 @@ impl Replay {
         // the learned ones are in force are not detections: the window says the nominal
         // parameters are not to be trusted (a sensor fault counts at any time).
         let counts = out.sensor_fault.any() || self.commission.thresholds_trusted(&out);
+        let point = self.steady_point(&out);
+        self.isolation.after(t, self.dt_s, &out, &point, counts);
         if out.fault_detected && counts {
             self.detected_in_range |=
                 out.sensor_fault.any() || !self.commission.outside_learned_range(&out);
@@ -415,6 +433,106 @@ impl Replay {
         }
         self.last = out;
         out
+    }
+
+    /// The sequence analysis of every log (the monitor's own runs on its frame without the
+    /// voltages' negative sequence): a PLL locked to the current vector, the currents' and,
+    /// where logged, the voltages' positive and negative sequences on its angle. A row with
+    /// a bad current is skipped (the monitor holds such samples out itself); a bad voltage
+    /// leaves the voltages' analysis alone.
+    fn track_sequences(&mut self, row: &Row) {
+        let ok = |x: &[f64; 3], max: f64| x.iter().all(|v| v.is_finite() && v.abs() <= max);
+        if !ok(&row.i_abc, self.i_max) {
+            return;
+        }
+        let abc = |x: &[f64; 3]| Abc {
+            a: x[0] as f32,
+            b: x[1] as f32,
+            c: x[2] as f32,
+        };
+        let i = clarke(abc(&row.i_abc));
+        let v = row
+            .v_abc
+            .as_ref()
+            .filter(|v| self.channels.voltages && ok(v, self.v_max))
+            .map(|v| clarke(abc(v)));
+        let sc = SinCos::from_angle(self.pll.theta_pll());
+        // Locked to the voltages where logged: a winding asymmetry puts tens of per cent of
+        // negative sequence into the currents, whose 2f ripple would wobble the angle; the
+        // supply's own unbalance is a few per cent.
+        match v {
+            Some(v) if self.pll_on_voltage => self.pll.update(v, sc),
+            _ => self.pll.update(i, sc),
+        };
+        self.seq.update(i, sc);
+        if let Some(v) = v {
+            self.seq_v.update(v, sc);
+        }
+    }
+
+    /// The steady-state vectors for the isolation: the positive sequences of voltage and
+    /// current on the sequence analysis' angle, its PLL's frequency, and the monitor's
+    /// electrical speed (encoder, filtered).
+    fn steady_point(&self, out: &MonitorOutput) -> IsolationPoint {
+        let (v, i) = (self.seq_v.positive(), self.seq.positive());
+        IsolationPoint {
+            i: monitor_core::Dq { d: i.0, q: i.1 },
+            v: monitor_core::Dq { d: v.0, q: v.1 },
+            we_rad_s: self.pll.omega_rad_s(),
+            wr_rad_s: out.operating.wr,
+        }
+    }
+
+    /// The negative-sequence report: the core's one faulty-phase method
+    /// ([`monitor_core::sequence::winding_asymmetry`]) with the supply's own unbalance taken
+    /// out where voltages are logged. The slip is the monitor's (encoder) where it runs,
+    /// else the equivalent circuit's for the measured current magnitude
+    /// ([`slip_for_current`]).
+    fn unbalance_report(&self, out: &MonitorOutput) -> UnbalanceReport {
+        let m = self.params.motor.model();
+        let omega = self.pll.omega_rad_s();
+        let we = if omega > 1.0 {
+            omega
+        } else {
+            self.params.supply.omega_rad_s() as f32
+        };
+        let p = self.seq.positive();
+        let p2 = p.0 * p.0 + p.1 * p.1;
+        let over_i1 = |x: (f32, f32)| {
+            if p2 > 0.0 {
+                ((x.0 * p.0 + x.1 * p.1) / p2, (x.1 * p.0 - x.0 * p.1) / p2)
+            } else {
+                (0.0, 0.0)
+            }
+        };
+        let i2 = over_i1(self.seq.negative());
+        let v2 = self
+            .channels
+            .voltages
+            .then(|| over_i1(self.seq_v.negative()));
+        let slip = if self.monitor.is_some() {
+            1.0 - out.operating.wr / we
+        } else {
+            let v_pk = if self.channels.voltages {
+                self.seq_v.positive_magnitude()
+            } else {
+                self.params.supply.v_phase_peak() as f32
+            };
+            slip_for_current(&m, v_pk, we, self.seq.positive_magnitude())
+        };
+        let w = winding_asymmetry(i2, v2, &m, we, slip, 0.005);
+        UnbalanceReport {
+            negative_sequence_ratio: monitor_core::fast_hypot(i2.0, i2.1),
+            suspect_phase: w.suspect_phase.map(|p| p.name().to_string()),
+            angle_deg: w.angle_rad.to_degrees(),
+            correction_deg: asymmetry_correction_rad(&m, we, slip).to_degrees(),
+            winding_ratio: w.ratio,
+            supply_ratio: w.supply_ratio,
+            voltage_negative_sequence_ratio: v2.map(|_| {
+                let (n, p) = (self.seq_v.negative(), self.seq_v.positive());
+                monitor_core::fast_hypot(n.0, n.1) / monitor_core::fast_hypot(p.0, p.1).max(1e-9)
+            }),
+        }
     }
 
     /// The learned calibration (mean and spread of r1..r4), once commissioning is done.
@@ -443,29 +561,26 @@ impl Replay {
                     .to_string(),
             );
         }
-        let unbalance = if self.monitor.is_some() {
-            let m = self.params.motor.model();
-            let we = out.frame_omega_rad_s.abs().max(1.0);
-            let slip = 1.0 - out.operating.wr / we;
-            UnbalanceReport {
-                negative_sequence_ratio: out.unbalance.negative_sequence_ratio,
-                suspect_phase: out.unbalance.suspect_phase.map(|p| p.name().to_string()),
-                angle_deg: out.unbalance.angle_rad.to_degrees(),
-                correction_deg: asymmetry_correction_rad(&m, we, slip).to_degrees(),
-            }
-        } else {
-            current_only_unbalance(&self.params, &self.seq, self.pll.omega_rad_s())
-        };
-        let mut candidates: Vec<FaultCandidate> = Fault::ALL
+        let unbalance = self.unbalance_report(&out);
+        let mut signature_candidates: Vec<FaultCandidate> = Fault::ALL
             .iter()
             .zip(out.diagnosis.probabilities)
             .filter(|(_, p)| *p > 0.0)
             .map(|(f, p)| FaultCandidate {
                 fault: f.name().to_string(),
                 probability: p,
+                change: None,
+                phase: None,
             })
             .collect();
-        candidates.sort_by(|a, b| b.probability.total_cmp(&a.probability));
+        signature_candidates.sort_by(|a, b| b.probability.total_cmp(&a.probability));
+        let detected = self.first_detection.is_some() || self.isolation.named_a_fault();
+        let (isolation, isolated) = self.isolation.report(detected);
+        let candidates = if out.sensor_fault.any() {
+            signature_candidates.clone()
+        } else {
+            isolated
+        };
         let lamps = (0..4)
             .map(|k| {
                 (
@@ -494,7 +609,7 @@ impl Replay {
         }
         let verdict = if !withheld.is_empty() {
             Verdict::CouldNotJudge
-        } else if self.first_detection.is_some() {
+        } else if detected {
             Verdict::Fault
         } else {
             Verdict::Healthy
@@ -508,6 +623,8 @@ impl Replay {
             },
             lamps,
             candidates,
+            isolation,
+            signature_candidates,
             first_detection_s: self.first_detection,
             unbalance,
             detections: self.detections,
@@ -538,33 +655,6 @@ fn timeline_point(t: f64, out: &MonitorOutput, range_note: Option<String>) -> Ti
         quasi_steady: out.quasi_steady,
         negative_sequence_ratio: out.unbalance.negative_sequence_ratio,
         range_note,
-    }
-}
-
-/// Current-only unbalance: the slip is not measured, so it is estimated from the current
-/// magnitude ([`slip_for_current`] on the parameter file's supply); the phase is then named
-/// as the monitor names it.
-fn current_only_unbalance(p: &ParamFile, seq: &SequenceAnalyzer, omega: f32) -> UnbalanceReport {
-    let m = p.motor.model();
-    let we = if omega > 1.0 {
-        omega
-    } else {
-        p.supply.omega_rad_s() as f32
-    };
-    let u0 = seq.result(0.0, 0.0);
-    let slip = slip_for_current(
-        &m,
-        p.supply.v_phase_peak() as f32,
-        we,
-        seq.positive_magnitude(),
-    );
-    let corr = asymmetry_correction_rad(&m, we, slip);
-    let u = seq.result(corr, 0.005);
-    UnbalanceReport {
-        negative_sequence_ratio: u.negative_sequence_ratio,
-        suspect_phase: u.suspect_phase.map(|p| p.name().to_string()),
-        angle_deg: u0.angle_rad.to_degrees(),
-        correction_deg: corr.to_degrees(),
     }
 }
 

@@ -78,34 +78,42 @@ pub fn demo(run: &DemoRun) -> anyhow::Result<()> {
         )?,
         None => writeln!(out, "no fault detected")?,
     }
-    let named: Vec<String> = run
-        .report
-        .candidates
-        .iter()
-        .map(|c| format!("{} ({:.0} %)", c.fault, 100.0 * c.probability))
-        .collect();
     writeln!(
         out,
-        "fault candidates: {}{}",
-        if named.is_empty() {
-            "none".into()
-        } else {
-            named.join(", ")
-        },
+        "lamps' candidates (the paper's signature matching): {}",
+        candidate_list(&run.report.signature_candidates)
+    )?;
+    writeln!(
+        out,
+        "fault candidates (isolation, with size): {}{}",
+        candidate_list(&run.report.candidates),
         if run.correct_fault_named() {
             "  — the injected fault is named"
         } else {
             ""
         }
     )?;
-    if run.report.candidates.len() == 2 {
-        writeln!(
-            out,
-            "(two faults share one signature in the paper's Table 1, so each gets 50 %: the parity \
-             equations cannot tell them apart)"
-        )?;
-    }
+    writeln!(out, "isolation: {}", run.report.isolation.verdict)?;
     Ok(())
+}
+
+/// Candidates as `rr 76 % (+50 %), speed_sensor 24 % (-2 %)`, or `none`.
+fn candidate_list(c: &[sim_host::replay::FaultCandidate]) -> String {
+    if c.is_empty() {
+        return "none".into();
+    }
+    c.iter()
+        .map(|c| match c.change {
+            Some(x) => format!(
+                "{} {:.0} % ({:+.0} %)",
+                c.fault,
+                100.0 * c.probability,
+                100.0 * x
+            ),
+            None => format!("{} {:.0} %", c.fault, 100.0 * c.probability),
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// `simulate`'s one-line summary.
@@ -200,20 +208,21 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
             Some(t) => writeln!(out, "first detection: {t:.2} s")?,
             None => writeln!(out, "first detection: none")?,
         }
-        let c: Vec<String> = rep
-            .candidates
-            .iter()
-            .map(|c| format!("{} {:.0} %", c.fault, 100.0 * c.probability))
-            .collect();
+        writeln!(out, "candidates: {}", candidate_list(&rep.candidates))?;
         writeln!(
             out,
-            "candidates: {}",
-            if c.is_empty() {
-                "none".to_string()
-            } else {
-                c.join(", ")
-            }
+            "lamps' candidates (signature matching): {}",
+            candidate_list(&rep.signature_candidates)
         )?;
+        writeln!(out, "isolation: {}", rep.isolation.verdict)?;
+        for g in &rep.isolation.groups {
+            writeln!(
+                out,
+                "  cannot be separated: {} ({})",
+                g.faults.join(" / "),
+                g.reason
+            )?;
+        }
     }
     let u = &rep.unbalance;
     writeln!(
@@ -302,7 +311,7 @@ pub fn table1(t: &Table1Report) -> anyhow::Result<()> {
         "Table 1 end to end — {}, angle: {}",
         t.motor, t.angle_source
     )?;
-    writeln!(out, "fault           change   measured r1 r2 r3 r4   paper r1 r2 r3 r4   physics r1 r2 r3 r4   candidates")?;
+    writeln!(out, "fault           change   measured r1 r2 r3 r4   paper r1 r2 r3 r4   physics r1 r2 r3 r4   isolation (size)       lamps' candidates")?;
     let bits = |s: &[u8; 4]| s.map(|b| if b == 1 { "I" } else { "0" });
     for r in &t.rows {
         let (m, p, e) = (bits(&r.signature), bits(&r.paper), bits(&r.expected));
@@ -314,7 +323,7 @@ pub fn table1(t: &Table1Report) -> anyhow::Result<()> {
             .collect();
         writeln!(
             out,
-            "{:<15} {:+5.0} %        {}  {}  {}  {}          {}  {}  {}  {} {diff}          {}  {}  {}  {}   {}",
+            "{:<15} {:+5.0} %        {}  {}  {}  {}          {}  {}  {}  {} {diff}          {}  {}  {}  {}   {:<22} {}",
             r.fault,
             100.0 * r.change,
             m[0],
@@ -329,6 +338,11 @@ pub fn table1(t: &Table1Report) -> anyhow::Result<()> {
             e[1],
             e[2],
             e[3],
+            match (&r.named, r.named_change) {
+                (Some(n), Some(c)) if n != "b/bl" => format!("{n} ({:+.0} %)", 100.0 * c),
+                (Some(n), _) => n.clone(),
+                (None, _) => format!("none ({})", r.isolation_state),
+            },
             if cands.is_empty() { "none".to_string() } else { cands.join(", ") }
         )?;
     }

@@ -1,0 +1,420 @@
+//! The fault isolation of a replay: the core's [`Isolator`] fed from the monitor's
+//! outputs, its baseline learned over the commissioning window, and what `diagnose`
+//! reports about it (JSON `isolation`, the candidates' `change`).
+//!
+//! The isolator works on a steady operating point: the positive-sequence voltage and current
+//! vectors of the replay's sequence analysis (one angle from a PLL on the voltages, so the
+//! point does not depend on the monitor's frame, which a speed-sensor or rotor-parameter
+//! fault detunes), the PLL's frequency and the monitor's electrical speed (encoder),
+//! averaged exponentially over [`AVERAGE_S`] once the monitor has settled, with no sensor
+//! fault, while every quantity stays within [`STEADY_FRACTION`] of its average. Every
+//! [`STEP_S`] the point is isolated (or, while commissioning learns, added to the
+//! baseline). The firmware feeds the same isolator from the monitor's own outputs
+//! ([`SteadyPoint::from_output`]).
+
+use monitor_core::isolation::{Candidate, Named};
+use monitor_core::{
+    CommissioningState, Fault, Isolation, IsolationState, Isolator, MonitorOutput, SteadyPoint,
+};
+use serde::Serialize;
+
+/// Time constant of the operating point's exponential average [s]: 25-30 supply periods,
+/// enough to average the frame frequency's ripple and to bring the residuals' scatter to
+/// about 0.05 % (module [`monitor_core::isolation`]'s default spreads).
+pub const AVERAGE_S: f64 = 0.5;
+/// How often the point is isolated or learned [s].
+pub const STEP_S: f64 = 0.05;
+/// A reported isolation older than this at the log's end says so [s].
+pub const STALE_S: f64 = 1.0;
+/// Relative change from the running average above which the vectors are not steady.
+pub const STEADY_FRACTION: f32 = 0.02;
+
+/// Every quantity of `p` within [`STEADY_FRACTION`] of `avg` (the currents and voltages of
+/// their vectors' magnitudes, the speeds of the frame's frequency).
+fn steady_against(p: &SteadyPoint, avg: &SteadyPoint) -> bool {
+    let i = monitor_core::fast_hypot(avg.i.d, avg.i.q).max(1e-6);
+    let v = monitor_core::fast_hypot(avg.v.d, avg.v.q).max(1e-6);
+    let w = avg.we_rad_s.abs().max(1.0);
+    monitor_core::fast_hypot(p.i.d - avg.i.d, p.i.q - avg.i.q) <= STEADY_FRACTION * i
+        && monitor_core::fast_hypot(p.v.d - avg.v.d, p.v.q - avg.v.q) <= STEADY_FRACTION * v
+        && (p.we_rad_s - avg.we_rad_s).abs() <= STEADY_FRACTION * w
+        && (p.wr_rad_s - avg.wr_rad_s).abs() <= STEADY_FRACTION * w
+}
+
+/// A candidate is listed from this probability on.
+pub const LIST_FROM: f32 = 0.01;
+
+/// Follows the monitor's outputs and isolates.
+pub(super) struct IsolationTracker {
+    isolator: Option<Isolator>,
+    avg: Option<SteadyPoint>,
+    averaged_s: f64,
+    next_step: f64,
+    learning: bool,
+    learned: bool,
+    last: Option<Isolation>,
+    first_named: Option<(String, f64)>,
+    /// The monitor has evaluated once (settled, voltage present).
+    running: bool,
+    /// Time of the last isolation and of the last sample [s].
+    last_t: f64,
+    end_t: f64,
+}
+
+impl IsolationTracker {
+    /// A tracker for the nominal machine (`None`: a machine the isolator rejects, then
+    /// nothing is isolated and the report says so).
+    pub(super) fn new(isolator: Option<Isolator>) -> Self {
+        IsolationTracker {
+            isolator,
+            avg: None,
+            averaged_s: 0.0,
+            next_step: 0.0,
+            learning: false,
+            learned: false,
+            last: None,
+            first_named: None,
+            running: false,
+            last_t: 0.0,
+            end_t: 0.0,
+        }
+    }
+
+    /// After the monitor's output for the sample at `t` (`dt_s` after the previous one);
+    /// `point`: the steady-state vectors at this sample (module docs); `counts`: lamps and
+    /// detections count now (the learned thresholds are in force, or none were asked for).
+    pub(super) fn after(
+        &mut self,
+        t: f64,
+        dt_s: f64,
+        out: &MonitorOutput,
+        point: &SteadyPoint,
+        counts: bool,
+    ) {
+        self.end_t = t;
+        let Some(iso) = self.isolator.as_mut() else {
+            return;
+        };
+        let learning = matches!(out.commissioning, CommissioningState::Learning(_));
+        if self.learning && !learning {
+            self.learned |= iso.finish_learning();
+        }
+        self.learning = learning;
+        self.running |= out.evaluating;
+        let usable = self.running && !out.sensor_fault.any() && (learning || counts);
+        if !usable {
+            self.avg = None;
+            self.averaged_s = 0.0;
+            return;
+        }
+        let p = *point;
+        let a = (dt_s / AVERAGE_S).min(1.0) as f32;
+        let avg = self.avg.get_or_insert(p);
+        // Quasi-steady by the vectors themselves (the monitor's gate follows its own frame,
+        // which a sensor fault can detune): every quantity within 2 % of its average.
+        if !steady_against(&p, avg) {
+            self.averaged_s = 0.0;
+        }
+        avg.approach(&p, a);
+        self.averaged_s += dt_s;
+        if self.averaged_s < AVERAGE_S || t < self.next_step {
+            return;
+        }
+        self.next_step = t + STEP_S;
+        let avg = *avg;
+        if learning {
+            iso.learn(&avg);
+        } else {
+            let result = iso.isolate(&avg);
+            if self.first_named.is_none() {
+                if let Some(n) = result.named() {
+                    self.first_named = Some((named_label(&n), t));
+                }
+            }
+            self.last = Some(result);
+            self.last_t = t;
+        }
+    }
+
+    /// The isolation named a fault other than the friction class at some point (a load
+    /// change is, to the paper's model, a Bl change: that is left to the lamps and the
+    /// commissioned range).
+    pub(super) fn named_a_fault(&self) -> bool {
+        self.first_named.as_ref().is_some_and(|(n, _)| n != "b/bl")
+    }
+
+    /// The report, and the candidates for `diagnose` (most probable first, those from
+    /// [`LIST_FROM`] on) when `detected` (a lamp lit or a sensor fault was seen).
+    pub(super) fn report(&self, detected: bool) -> (IsolationReport, Vec<FaultCandidate>) {
+        let Some(iso) = self.last else {
+            let why = if self.isolator.is_none() {
+                "the parameter file's machine cannot be used by the isolation"
+            } else {
+                "no settled, quasi-steady operating point with voltage was evaluated"
+            };
+            return (IsolationReport::not_judged(why, self.learned), Vec::new());
+        };
+        // An unknown fault lists its three nearest candidates only.
+        let listed = if iso.state == IsolationState::Unknown {
+            3
+        } else {
+            iso.candidates.len()
+        };
+        let candidates = if detected && iso.state != IsolationState::NoDeviation {
+            iso.candidates
+                .iter()
+                .take(listed)
+                .filter(|c| c.probability >= LIST_FROM)
+                .map(FaultCandidate::from)
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let report = IsolationReport {
+            state: state_name(iso.state).to_string(),
+            named: iso.named().map(|n| named_label(&n)),
+            named_change: iso.named().map(|n| match n {
+                Named::Fault(c) => c.change,
+                Named::Friction { bl, .. } => bl.change,
+            }),
+            verdict: if self.end_t - self.last_t > STALE_S {
+                format!(
+                    "{} (judged at {:.2} s; the operating point was not steady in the last {:.1} s of the log)",
+                    verdict_sentence(&iso, detected).trim_end_matches('.'),
+                    self.last_t,
+                    self.end_t - self.last_t
+                )
+            } else {
+                verdict_sentence(&iso, detected)
+            },
+            judged_at_s: self.last_t,
+            groups: groups(&iso),
+            deviation_sigma: iso.deviation,
+            unknown_probability: iso.unknown_probability,
+            separation_deg: iso.separation_deg,
+            residuals: iso.residuals,
+            baseline: if self.learned {
+                "learned in commissioning"
+            } else {
+                "nominal parameters"
+            }
+            .to_string(),
+            first_named: self.first_named.clone(),
+        };
+        (report, candidates)
+    }
+}
+
+/// A fault candidate (`diagnose --json` key `candidates`).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct FaultCandidate {
+    /// DESIGN.md fault name.
+    pub fault: String,
+    /// Probability, [0, 1].
+    pub probability: f32,
+    /// Estimated relative change (0.48 = +48 %); for a sensor its gain error; null where
+    /// only the lamps named it (a sensor reading that is impossible).
+    pub change: Option<f32>,
+    /// `a|b|c` for a single-phase sensor fault, else null.
+    pub phase: Option<String>,
+}
+
+impl From<&Candidate> for FaultCandidate {
+    fn from(c: &Candidate) -> Self {
+        FaultCandidate {
+            fault: c.fault.name().to_string(),
+            probability: c.probability,
+            change: Some(c.change),
+            phase: None,
+        }
+    }
+}
+
+/// Faults that cannot be separated here, and why (JSON `isolation.groups`).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct IsolationGroup {
+    /// The faults.
+    pub faults: Vec<String>,
+    /// Why they cannot be separated.
+    pub reason: String,
+}
+
+/// What the isolation concluded (`diagnose --json` key `isolation`).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct IsolationReport {
+    /// `isolated`, `unknown`, `no_deviation` or `not_judged`.
+    pub state: String,
+    /// The fault named (probability >= 0.5), `b/bl` for the friction class, or null.
+    pub named: Option<String>,
+    /// The named fault's estimated relative change (for `b/bl`: Bl's), or null.
+    pub named_change: Option<f32>,
+    /// One sentence.
+    pub verdict: String,
+    /// Candidates that cannot be separated at the last operating point, with the reason.
+    pub groups: Vec<IsolationGroup>,
+    /// The change from the baseline in standard deviations.
+    pub deviation_sigma: f32,
+    /// Probability that no fault of the list explains the change.
+    pub unknown_probability: f32,
+    /// Angle between the top two candidates' directions [deg].
+    pub separation_deg: f32,
+    /// The parity residuals `[e_d, e_q, e_T]` minus the baseline.
+    pub residuals: [f32; 3],
+    /// `learned in commissioning` or `nominal parameters`.
+    pub baseline: String,
+    /// The first fault named and when [s].
+    pub first_named: Option<(String, f64)>,
+    /// When the reported isolation was made [s] (the last steady operating point).
+    pub judged_at_s: f64,
+}
+
+impl IsolationReport {
+    fn not_judged(why: &str, learned: bool) -> Self {
+        IsolationReport {
+            state: state_name(IsolationState::NotJudged).to_string(),
+            named: None,
+            named_change: None,
+            verdict: format!("The fault could not be isolated: {why}."),
+            groups: Vec::new(),
+            deviation_sigma: 0.0,
+            unknown_probability: 0.0,
+            separation_deg: 0.0,
+            residuals: [0.0; 3],
+            judged_at_s: 0.0,
+            baseline: if learned {
+                "learned in commissioning"
+            } else {
+                "nominal parameters"
+            }
+            .to_string(),
+            first_named: None,
+        }
+    }
+}
+
+fn state_name(s: IsolationState) -> &'static str {
+    match s {
+        IsolationState::NotJudged => "not_judged",
+        IsolationState::NoDeviation => "no_deviation",
+        IsolationState::Isolated => "isolated",
+        IsolationState::Unknown => "unknown",
+    }
+}
+
+fn named_label(n: &Named) -> String {
+    match n {
+        Named::Fault(c) => c.fault.name().to_string(),
+        Named::Friction { .. } => "b/bl".to_string(),
+    }
+}
+
+/// A size as a signed percentage.
+fn pct(x: f32) -> String {
+    format!("{:+.0} %", 100.0 * x)
+}
+
+/// The one-sentence verdict of the isolation.
+fn verdict_sentence(iso: &Isolation, detected: bool) -> String {
+    let top = |n: usize| -> Vec<String> {
+        iso.candidates
+            .iter()
+            .take(n)
+            .map(|c| {
+                format!(
+                    "{} {} ({:.0} %)",
+                    c.fault,
+                    pct(c.change),
+                    100.0 * c.probability
+                )
+            })
+            .collect()
+    };
+    match (iso.state, iso.named()) {
+        (IsolationState::NoDeviation, _) if detected => format!(
+            "The lamps lit, but the machine's steady-state equations deviate by only {:.1} standard deviations: no fault can be isolated.",
+            iso.deviation
+        ),
+        (IsolationState::NoDeviation, _) => {
+            "The steady-state equations fit the nominal machine: nothing to isolate.".into()
+        }
+        (IsolationState::NotJudged, _) => "No usable operating point was isolated.".into(),
+        (IsolationState::Unknown, _) => format!(
+            "A change of {:.0} standard deviations that no single fault explains (an unknown fault, several faults, or a parameter file that does not fit); nearest: {}.",
+            iso.deviation,
+            top(3).join(", ")
+        ),
+        (_, Some(Named::Fault(c))) => format!(
+            "{} changed by {} (probability {:.0} %).",
+            fault_phrase(c.fault),
+            pct(c.change),
+            100.0 * c.probability
+        ),
+        (_, Some(Named::Friction { probability, b, bl })) => format!(
+            "The friction class changed (probability {:.0} %): load friction Bl {} or machine friction B {}; they cannot be separated.",
+            100.0 * probability,
+            pct(bl.change),
+            pct(b.change)
+        ),
+        (_, None) => format!(
+            "The change fits more than one fault and none alone: {}.",
+            top(3).join(", ")
+        ),
+    }
+}
+
+fn fault_phrase(f: Fault) -> &'static str {
+    match f {
+        Fault::Rs => "The stator resistance Rs",
+        Fault::Rr => "The rotor resistance Rr",
+        Fault::Ls => "The stator leakage inductance (Ls)",
+        Fault::Lr => "The rotor leakage inductance (Lr)",
+        Fault::B => "The machine friction B",
+        Fault::Bl => "The load friction Bl",
+        Fault::CurrentSensor => "The current sensors' gain",
+        Fault::VoltageSensor => "The voltage sensors' gain",
+        Fault::SpeedSensor => "The speed sensor's gain",
+    }
+}
+
+/// The groups of candidates that cannot be separated: the friction class whenever it is
+/// among the candidates, and the top two when their probabilities are within a factor 3
+/// of each other.
+fn groups(iso: &Isolation) -> Vec<IsolationGroup> {
+    let mut out = Vec::new();
+    if iso.state != IsolationState::Isolated && iso.state != IsolationState::Unknown {
+        return out;
+    }
+    let listed = |f: Fault| {
+        iso.candidates
+            .iter()
+            .any(|c| c.fault == f && c.probability >= LIST_FROM)
+    };
+    if listed(Fault::B) || listed(Fault::Bl) {
+        out.push(IsolationGroup {
+            faults: vec!["b".into(), "bl".into()],
+            reason: "both scale the load term (B + Bl) wr of the torque balance: one friction class at every operating point".into(),
+        });
+    }
+    if let [a, b, ..] = &iso.candidates[..] {
+        let friction_pair =
+            matches!(a.fault, Fault::B | Fault::Bl) && matches!(b.fault, Fault::B | Fault::Bl);
+        if !friction_pair && b.probability >= LIST_FROM && b.probability * 3.0 >= a.probability {
+            out.push(IsolationGroup {
+                faults: vec![a.fault.name().into(), b.fault.name().into()],
+                reason: pair_reason(a.fault, b.fault, iso.separation_deg),
+            });
+        }
+    }
+    out
+}
+
+fn pair_reason(a: Fault, b: Fault, sep_deg: f32) -> String {
+    let pair = |x: Fault, y: Fault| (a == x && b == y) || (a == y && b == x);
+    if pair(Fault::Rr, Fault::SpeedSensor) {
+        format!("in steady state the rotor circuit depends on Rr/slip only, so an Rr change and a small speed-sensor gain error change the currents alike (directions {sep_deg:.1} deg apart); only the torque balance with the assumed viscous load, or a speed transient, tells them apart")
+    } else if pair(Fault::CurrentSensor, Fault::VoltageSensor) {
+        format!("both scale the measured impedance V/I; only the torque balance separates them, and it is weak at light load (directions {sep_deg:.1} deg apart)")
+    } else {
+        format!("their directions in the residual space are {sep_deg:.1} deg apart at this operating point; at another load they may separate")
+    }
+}
