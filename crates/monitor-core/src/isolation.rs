@@ -366,7 +366,7 @@ impl Isolator {
     }
 
     /// Ends learning: the learned mean and twice the learned standard deviation (at least
-    /// the defaults' fifth) go into force. Returns false, and keeps the baseline in force,
+    /// [`DEFAULT_SPREAD`]: a short window's scatter understates what a longer run meets) go into force. Returns false, and keeps the baseline in force,
     /// with fewer than 10 points learned.
     pub fn finish_learning(&mut self) -> bool {
         let l = self.learning;
@@ -377,7 +377,7 @@ impl Isolator {
         let n = l.n as f32;
         let mut spread = [0.0; 3];
         for ((s, m2), d) in spread.iter_mut().zip(l.m2).zip(DEFAULT_SPREAD) {
-            *s = crate::maxf(2.0 * crate::sqrt(m2 / (n - 1.0)), 0.2 * d);
+            *s = crate::maxf(2.0 * crate::sqrt(m2 / (n - 1.0)), d);
         }
         self.set_baseline(Baseline {
             mean: l.mean,

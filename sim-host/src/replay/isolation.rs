@@ -112,10 +112,13 @@ impl IsolationTracker {
         let avg = self.avg.get_or_insert(p);
         // Quasi-steady by the vectors themselves (the monitor's gate follows its own frame,
         // which a sensor fault can detune): every quantity within 2 % of its average.
-        if !steady_against(&p, avg) {
+        if steady_against(&p, avg) {
+            avg.approach(&p, a);
+        } else {
+            // A new operating point: the average starts again from it.
+            *avg = p;
             self.averaged_s = 0.0;
         }
-        avg.approach(&p, a);
         self.averaged_s += dt_s;
         if self.averaged_s < AVERAGE_S || t < self.next_step {
             return;
