@@ -8,6 +8,7 @@ mod bench;
 mod compare;
 mod demo;
 mod diagnose;
+mod hmi;
 mod output_guard;
 mod progress;
 mod render;
@@ -55,6 +56,8 @@ pub enum Cmd {
     Explain(compare::ExplainArgs),
     /// Benchmarks.
     Bench(bench::BenchArgs),
+    /// The live terminal HMI.
+    Hmi(hmi::HmiArgs),
 }
 
 /// Runs a command.
@@ -70,6 +73,7 @@ pub fn run(cmd: Cmd) -> anyhow::Result<()> {
         Cmd::Compare(a) => compare::run_compare(a),
         Cmd::Explain(a) => compare::run_explain(a),
         Cmd::Bench(a) => bench::run(a),
+        Cmd::Hmi(a) => hmi::run(a),
     }
 }
 

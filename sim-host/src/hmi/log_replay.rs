@@ -9,9 +9,11 @@ use super::{
     quit_key, Controls, HmiState, Key, PlaybackControls, Snapshot, Source, Speed, HISTORY_S,
     SNAPSHOT_EVERY_S,
 };
-use crate::log::Row;
+use crate::log::{LogFile, Row};
 use crate::params::ParamFile;
-use crate::replay::{diagnose_file_observed, Replay, ReplayObserver, ReplayOptions};
+use crate::replay::{
+    diagnose_file_observed, Replay, ReplayError, ReplayObserver, ReplayOptions,
+};
 use monitor_core::MonitorOutput;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, PoisonError};
@@ -47,14 +49,24 @@ pub struct LogReplay {
 impl LogReplay {
     /// Starts analysing `path` with the motor `params` and `opts` (as `diagnose`), to be
     /// played back at `speed`.
-    pub fn start(params: ParamFile, path: &Path, opts: ReplayOptions, speed: Speed) -> Self {
+    ///
+    /// # Errors
+    /// The log cannot be opened or its header is not a log's ([`LogFile::open`]); errors
+    /// further in show on the screen.
+    pub fn start(
+        params: ParamFile,
+        path: &Path,
+        opts: ReplayOptions,
+        speed: Speed,
+    ) -> Result<Self, ReplayError> {
+        LogFile::open(path)?;
         let shared = Arc::new(Mutex::new(Analysis::default()));
         let worker = {
             let shared = Arc::clone(&shared);
             let path = path.to_path_buf();
             std::thread::spawn(move || analyse(&params, &path, opts, &shared))
         };
-        LogReplay {
+        Ok(LogReplay {
             path: path.to_path_buf(),
             shared,
             worker: Some(worker),
@@ -67,7 +79,7 @@ impl LogReplay {
                 verdict: None,
             },
             warned: false,
-        }
+        })
     }
 
     /// Waits until the whole log is analysed (tests, and the plain-text mode at `max`).

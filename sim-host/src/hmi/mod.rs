@@ -241,6 +241,8 @@ pub struct HmiState {
     pub warnings: Vec<String>,
     /// The last few events (fault switched on, commissioning started ...), newest last.
     pub events: VecDeque<String>,
+    /// Events since the start (the list keeps the last few).
+    pub events_total: u64,
     /// The source's controls.
     pub controls: Controls,
     /// The user asked to quit.
@@ -256,6 +258,7 @@ impl HmiState {
             history: VecDeque::new(),
             warnings: Vec::new(),
             events: VecDeque::new(),
+            events_total: 0,
             controls,
             quit: false,
         }
@@ -281,6 +284,7 @@ impl HmiState {
     /// Adds an event to the list.
     pub fn event(&mut self, text: impl Into<String>) {
         self.events.push_back(text.into());
+        self.events_total += 1;
         while self.events.len() > EVENTS_KEPT {
             self.events.pop_front();
         }
@@ -366,6 +370,8 @@ pub struct KeyBinding {
     pub scope: KeyScope,
     /// What it does.
     pub what: &'static str,
+    /// Its few words in the screen's footer.
+    pub footer: &'static str,
 }
 
 /// The HMI's keys: the one list (the screen's footer, `sim-host hmi --help` and the
@@ -375,66 +381,79 @@ pub const KEYS: &[KeyBinding] = &[
         keys: "1..9",
         scope: KeyScope::Live,
         what: "switch Table 1 fault on/off: 1 rs 2 rr 3 ls 4 lr 5 b 6 bl 7 current_sensor 8 voltage_sensor 9 speed_sensor",
+        footer: "1-9 fault",
     },
     KeyBinding {
         keys: "0",
         scope: KeyScope::Live,
         what: "clear every fault",
+        footer: "0 clear",
     },
     KeyBinding {
         keys: "s",
         scope: KeyScope::Live,
         what: "size of the next fault: +50 % / -50 % / +20 % / -20 %",
+        footer: "s size",
     },
     KeyBinding {
         keys: "+ -",
         scope: KeyScope::Live,
         what: "load step: Bl +10 % / -10 %",
+        footer: "+- load",
     },
     KeyBinding {
         keys: "v V",
         scope: KeyScope::Live,
         what: "supply voltage step -5 % / +5 %",
+        footer: "vV volt",
     },
     KeyBinding {
         keys: "f F",
         scope: KeyScope::Live,
         what: "supply frequency step -1 Hz / +1 Hz",
+        footer: "fF freq",
     },
     KeyBinding {
         keys: "c",
         scope: KeyScope::Live,
         what: "start commissioning (learn the healthy thresholds over 3 s of steady running)",
+        footer: "c commission",
     },
     KeyBinding {
         keys: "space",
         scope: KeyScope::All,
         what: "pause / resume (live simulation and replay)",
+        footer: "␣ pause",
     },
     KeyBinding {
         keys: "> <",
         scope: KeyScope::Replay,
         what: "replay speed: next (1x, 10x, max) / previous",
+        footer: "<> speed",
     },
     KeyBinding {
         keys: "left right",
         scope: KeyScope::Replay,
         what: "seek -5 s / +5 s",
+        footer: "←→ 5 s",
     },
     KeyBinding {
         keys: "pgup pgdn",
         scope: KeyScope::Replay,
         what: "seek -60 s / +60 s",
+        footer: "PgUp/Dn 60 s",
     },
     KeyBinding {
         keys: "home end",
         scope: KeyScope::Replay,
         what: "seek to the start / to the end analysed so far",
+        footer: "Home/End",
     },
     KeyBinding {
         keys: "q esc ctrl-c",
         scope: KeyScope::All,
         what: "quit",
+        footer: "q quit",
     },
 ];
 
