@@ -37,12 +37,24 @@ fn live_simulation_commissions_and_a_key_injects_a_fault() {
     let mut state = live.initial_state();
     run(&mut live, &mut state, 2.0);
     let s = state.latest.clone().expect("readings");
-    assert!((s.t_s - 1.95).abs() < 1e-6, "one reading every 50 ms: {}", s.t_s);
-    assert!(s.speed_rpm > 1700.0 && s.speed_rpm < 1800.0, "{}", s.speed_rpm);
+    assert!(
+        (s.t_s - 1.95).abs() < 1e-6,
+        "one reading every 50 ms: {}",
+        s.t_s
+    );
+    assert!(
+        s.speed_rpm > 1700.0 && s.speed_rpm < 1800.0,
+        "{}",
+        s.speed_rpm
+    );
     assert_eq!(s.state, MonitorState::Healthy, "{:?}", s.state);
     assert!(!s.learned);
     assert!(s.iqs_a.is_some_and(|x| x > 0.0) && s.vqs_v.is_some_and(|x| x > 100.0));
-    assert!(s.supply_hz.is_some_and(|f| (f - 60.0).abs() < 0.5), "{:?}", s.supply_hz);
+    assert!(
+        s.supply_hz.is_some_and(|f| (f - 60.0).abs() < 0.5),
+        "{:?}",
+        s.supply_hz
+    );
     // The strip chart holds the readings so far.
     assert_eq!(state.history.len(), 40);
 
@@ -54,10 +66,17 @@ fn live_simulation_commissions_and_a_key_injects_a_fault() {
         other => panic!("not commissioning: {other:?}"),
     };
     assert!(progress > 0.0 && progress < 1.0, "{progress}");
-    assert!(state.events.iter().any(|e| e.contains("commissioning run 1 started")));
+    assert!(state
+        .events
+        .iter()
+        .any(|e| e.contains("commissioning run 1 started")));
     run(&mut live, &mut state, 3.5);
     let s = state.latest.clone().expect("readings");
-    assert!(s.learned && s.state == MonitorState::Healthy, "{:?}", s.state);
+    assert!(
+        s.learned && s.state == MonitorState::Healthy,
+        "{:?}",
+        s.state
+    );
     assert!(!s.fault_lamp && names(&state).is_empty());
 
     // 6: the paper's Enable_F_Bl switch, Bl +50 %: r2..r4 light, b and bl named.
@@ -75,7 +94,12 @@ fn live_simulation_commissions_and_a_key_injects_a_fault() {
     let bands = s.bands.expect("bands");
     for k in 1..4 {
         let (c, h) = bands[k];
-        assert!((s.residuals[k] - c).abs() > h, "r{}: {} in {c}±{h}", k + 1, s.residuals[k]);
+        assert!(
+            (s.residuals[k] - c).abs() > h,
+            "r{}: {} in {c}±{h}",
+            k + 1,
+            s.residuals[k]
+        );
     }
 
     // 6 again clears it: the lamps go out once the load is back.
@@ -154,7 +178,10 @@ fn a_simulated_log_replays_with_speed_pause_and_seek() {
     replay.key(Key::Char('>'), &mut state);
     replay.advance(0.2, &mut state);
     assert!((replay.controls().position_s - 3.0).abs() < 1e-9);
-    assert!(matches!(state.latest.as_ref().map(|s| &s.state), Some(MonitorState::Commissioning(_))));
+    assert!(matches!(
+        state.latest.as_ref().map(|s| &s.state),
+        Some(MonitorState::Commissioning(_))
+    ));
     // Pause: time stands still.
     replay.key(Key::Char(' '), &mut state);
     replay.advance(1.0, &mut state);
@@ -167,12 +194,25 @@ fn a_simulated_log_replays_with_speed_pause_and_seek() {
     let s = state.latest.clone().expect("reading");
     assert!(s.learned && s.fault_lamp, "{:?}", s.state);
     assert!(names(&state).contains(&Fault::Lr), "{:?}", names(&state));
-    assert!(state.history.len() > 150, "the strip chart's 10 s: {}", state.history.len());
+    assert!(
+        state.history.len() > 150,
+        "the strip chart's 10 s: {}",
+        state.history.len()
+    );
     // Seek back 5 s: inside the commissioning window again.
     replay.key(Key::Left, &mut state);
     let s = state.latest.clone().expect("reading");
-    assert!((s.t_s - (c.position_s - 5.0)).abs() < 0.06, "{} {}", s.t_s, c.position_s);
-    assert!(matches!(s.state, MonitorState::Commissioning(_)), "{:?}", s.state);
+    assert!(
+        (s.t_s - (c.position_s - 5.0)).abs() < 0.06,
+        "{} {}",
+        s.t_s,
+        c.position_s
+    );
+    assert!(
+        matches!(s.state, MonitorState::Commissioning(_)),
+        "{:?}",
+        s.state
+    );
     replay.key(Key::Home, &mut state);
     assert_eq!(replay.controls().position_s, 0.0);
     // A missing log is a one-line error before the screen starts.
@@ -185,7 +225,8 @@ fn a_simulated_log_replays_with_speed_pause_and_seek() {
 
 #[test]
 fn firmware_status_lines_from_a_recorded_sample() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fw_status_sample.txt");
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fw_status_sample.txt");
     let file = std::fs::File::open(&path).expect("sample");
     let mut src = StdinStatus::from_reader(file);
     let mut state = src.initial_state();
@@ -216,8 +257,19 @@ fn firmware_status_lines_from_a_recorded_sample() {
     assert!(matches!(s.state, MonitorState::Fault(_)));
     assert_eq!(state.history.len(), 5);
     // The other log lines are events: the overrun warning among them.
-    assert!(state.events.iter().any(|e| e == "WARN ADC DMA overrun #1 (adc1 true adc2 false)"), "{:?}", state.events);
-    assert!(state.events.iter().any(|e| e.contains("mode commissioned")), "{:?}", state.events);
+    assert!(
+        state
+            .events
+            .iter()
+            .any(|e| e == "WARN ADC DMA overrun #1 (adc1 true adc2 false)"),
+        "{:?}",
+        state.events
+    );
+    assert!(
+        state.events.iter().any(|e| e.contains("mode commissioned")),
+        "{:?}",
+        state.events
+    );
 }
 
 #[test]

@@ -126,11 +126,16 @@ pub fn run(args: &HmiArgs) -> anyhow::Result<()> {
         };
         Box::new(LogReplay::start(params, log, opts, args.speed.into())?)
     } else if let Some(p) = params {
-        Box::new(LiveSim::new(p, sim_host::fault_signatures::Protocol::default().sample_rate_hz)?)
+        Box::new(LiveSim::new(
+            p,
+            sim_host::fault_signatures::Protocol::default().sample_rate_hz,
+        )?)
     } else {
         Box::new(LiveSim::demo_motor()?)
     };
-    let deadline = args.duration.map(|d| Instant::now() + Duration::from_secs_f64(d.max(0.0)));
+    let deadline = args
+        .duration
+        .map(|d| Instant::now() + Duration::from_secs_f64(d.max(0.0)));
     if args.plain || !std::io::stdout().is_terminal() {
         plain(source.as_mut(), args.every, deadline)
     } else {
@@ -224,7 +229,11 @@ fn plain(source: &mut dyn Source, every: f64, deadline: Option<Instant>) -> anyh
         }
         warnings = state.warnings.len();
         let new = usize::try_from(state.events_total - printed).unwrap_or(usize::MAX);
-        for e in state.events.iter().skip(state.events.len().saturating_sub(new)) {
+        for e in state
+            .events
+            .iter()
+            .skip(state.events.len().saturating_sub(new))
+        {
             writeln!(out, "> {e}")?;
         }
         printed = state.events_total;

@@ -9,14 +9,12 @@
 //! with the readings ([`Snapshot`], every [`SNAPSHOT_EVERY_S`] of simulated time): the
 //! simulation is deterministic whatever the screen's pace, and tests drive it directly.
 
-use super::{
-    quit_key, Controls, HmiState, Key, LiveControls, Snapshot, Source, SNAPSHOT_EVERY_S,
-};
+use super::{quit_key, Controls, HmiState, Key, LiveControls, Snapshot, Source, SNAPSHOT_EVERY_S};
 use crate::fault_signatures::{scenario, Protocol};
 use crate::params::ParamFile;
 use crate::replay::{monitor_config_for_log, LogSampler, ReplayOptions};
 use crate::sim::{simulate_interactive, FaultSpec, LoadStep, ScenarioEvent, SupplyStep};
-use monitor_core::{Fault, Monitor};
+use monitor_core::{CommissioningState, Fault, Monitor, RunStage};
 use std::ops::ControlFlow;
 use std::sync::mpsc::{channel, Receiver, Sender};
 use std::thread::JoinHandle;
@@ -71,7 +69,10 @@ impl LiveSim {
     /// # Errors
     /// The core refuses the configuration (not expected for the reference motor).
     pub fn demo_motor() -> Result<Self, crate::ExperimentError> {
-        let mut live = Self::new(ParamFile::reference_3hp(), Protocol::default().sample_rate_hz)?;
+        let mut live = Self::new(
+            ParamFile::reference_3hp(),
+            Protocol::default().sample_rate_hz,
+        )?;
         live.name = "DESIGN.md 3 hp motor".to_string();
         Ok(live)
     }
@@ -108,6 +109,7 @@ impl LiveSim {
                 snapshots: Vec::new(),
                 messages: Vec::new(),
                 reply: reply_tx,
+                learning: false,
             }
             .run(&sc, &cmd_rx)
         });
@@ -290,6 +292,8 @@ struct Worker {
     snapshots: Vec<Snapshot>,
     messages: Vec<String>,
     reply: Sender<Reply>,
+    /// A commissioning run was learning at the previous row.
+    learning: bool,
 }
 
 impl Worker {
@@ -301,6 +305,7 @@ impl Worker {
             }
             let t = self.rows as f64 * self.dt_s;
             let out = *self.monitor.update(&self.sampler.sample(row));
+            self.note_commissioning(&out, t);
             if t + 0.5 * self.dt_s >= self.next_snapshot_s {
                 self.next_snapshot_s += SNAPSHOT_EVERY_S;
                 let bands = Some(self.monitor.threshold_bands());
@@ -347,14 +352,36 @@ impl Worker {
         ControlFlow::Continue(())
     }
 
+    /// An event when a commissioning run ends.
+    fn note_commissioning(&mut self, out: &monitor_core::MonitorOutput, t: f64) {
+        let learning = matches!(out.commissioning, CommissioningState::Learning(_));
+        if self.learning && !learning {
+            let run = self.monitor.commissioning();
+            self.messages.push(match run.stage {
+                RunStage::Done => format!(
+                    "{t:.2} s: commissioning run {} done: learned thresholds in force",
+                    run.id
+                ),
+                RunStage::Failed(why) => format!(
+                    "{t:.2} s: commissioning run {} failed ({})",
+                    run.id,
+                    why.name()
+                ),
+                _ => format!("{t:.2} s: commissioning run {} ended", run.id),
+            });
+        }
+        self.learning = learning;
+    }
+
     fn commission(&mut self) {
         let t = self.rows as f64 * self.dt_s;
-        self.messages.push(match self.monitor.start_commissioning(COMMISSIONING_S) {
-            Ok(id) => format!(
+        self.messages
+            .push(match self.monitor.start_commissioning(COMMISSIONING_S) {
+                Ok(id) => format!(
                 "{t:.2} s: commissioning run {id} started ({COMMISSIONING_S} s of steady running)"
             ),
-            Err(e) => format!("{t:.2} s: commissioning not started: {e}"),
-        });
+                Err(e) => format!("{t:.2} s: commissioning not started: {e}"),
+            });
     }
 }
 
@@ -400,7 +427,14 @@ impl Source for LiveSim {
             }
             ' ' => {
                 self.controls.paused = !self.controls.paused;
-                Some(if self.controls.paused { "paused" } else { "running" }.to_string())
+                Some(
+                    if self.controls.paused {
+                        "paused"
+                    } else {
+                        "running"
+                    }
+                    .to_string(),
+                )
             }
             _ => return quit_key(key, state),
         };

@@ -11,9 +11,7 @@ use super::{
 };
 use crate::log::{LogFile, Row};
 use crate::params::ParamFile;
-use crate::replay::{
-    diagnose_file_observed, Replay, ReplayError, ReplayObserver, ReplayOptions,
-};
+use crate::replay::{diagnose_file_observed, Replay, ReplayError, ReplayObserver, ReplayOptions};
 use monitor_core::MonitorOutput;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, PoisonError};
@@ -136,7 +134,8 @@ fn analyse(params: &ParamFile, path: &Path, opts: ReplayOptions, shared: &Arc<Mu
         Ok(d) => {
             let r = d.report;
             a.warnings.extend(r.data_quality.warnings.iter().cloned());
-            a.warnings.extend(r.verdict_withheld_because.iter().cloned());
+            a.warnings
+                .extend(r.verdict_withheld_because.iter().cloned());
             let v = serde_json::to_value(r.verdict)
                 .ok()
                 .and_then(|v| v.as_str().map(str::to_string));

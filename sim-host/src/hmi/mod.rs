@@ -296,11 +296,7 @@ impl HmiState {
         let Some(s) = &self.latest else {
             return format!("{}: waiting for the first reading", self.title);
         };
-        let lamps: String = s
-            .lamps
-            .iter()
-            .map(|l| if *l { '●' } else { '○' })
-            .collect();
+        let lamps: String = s.lamps.iter().map(|l| if *l { '●' } else { '○' }).collect();
         format!(
             "{:8.2} s  {:6.0} rpm  {}{}  {}",
             s.t_s,

@@ -202,20 +202,22 @@ impl FirmwareStatus {
             _ => MonitorState::Healthy,
         };
         let sensor_faults = self.sensors.map_or(Vec::new(), |s| {
-            [Fault::CurrentSensor, Fault::VoltageSensor, Fault::SpeedSensor]
-                .into_iter()
-                .zip(s)
-                .filter_map(|(f, on)| on.then_some(f))
-                .collect()
+            [
+                Fault::CurrentSensor,
+                Fault::VoltageSensor,
+                Fault::SpeedSensor,
+            ]
+            .into_iter()
+            .zip(s)
+            .filter_map(|(f, on)| on.then_some(f))
+            .collect()
         });
         Snapshot {
             t_s,
             residuals: self.residuals,
             lamps: self.lamps,
             fault_lamp: self.fault,
-            bands: self
-                .band
-                .map(|(m, h)| [0, 1, 2, 3].map(|k| (m[k], h[k]))),
+            bands: self.band.map(|(m, h)| [0, 1, 2, 3].map(|k| (m[k], h[k]))),
             learned: self.mode.as_deref() == Some("commissioned"),
             candidates: self.candidates.clone(),
             sensor_faults,
@@ -245,7 +247,10 @@ pub fn event_text(line: &str) -> Option<String> {
                 _ => msg,
             };
             let tag = if level == "INFO" { "" } else { level };
-            return Some(format!("{tag}{}{msg}", if tag.is_empty() { "" } else { " " }));
+            return Some(format!(
+                "{tag}{}{msg}",
+                if tag.is_empty() { "" } else { " " }
+            ));
         }
     }
     None

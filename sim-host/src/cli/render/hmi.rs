@@ -16,9 +16,7 @@ use ratatui::symbols::Marker;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Axis, Block, Borders, Chart, Dataset, GraphType, Paragraph};
 use ratatui::Frame;
-use sim_host::hmi::{
-    state_text, Controls, HmiState, KeyScope, Snapshot, HISTORY_S, KEYS,
-};
+use sim_host::hmi::{state_text, Controls, HmiState, KeyScope, Snapshot, HISTORY_S, KEYS};
 
 /// Colours of r1..r4 (lamps' labels, bars and chart).
 const COLOURS: [Color; 4] = [Color::Cyan, Color::Magenta, Color::Yellow, Color::Green];
@@ -37,15 +35,18 @@ pub fn render(frame: &mut Frame, state: &HmiState) {
     ])
     .split(frame.area());
     let title = Line::from(vec![
-        Span::styled(" DRIVE MONITOR ", Style::new().add_modifier(Modifier::REVERSED)),
+        Span::styled(
+            " DRIVE MONITOR ",
+            Style::new().add_modifier(Modifier::REVERSED),
+        ),
         Span::raw(" "),
         Span::raw(state.title.as_str()),
     ]);
     frame.render_widget(Paragraph::new(title), rows[0]);
     frame.render_widget(Paragraph::new(lamps_line(state)), rows[1]);
     render_residuals(frame, rows[2], state.latest.as_ref());
-    let mid = Layout::horizontal([Constraint::Percentage(50), Constraint::Percentage(50)])
-        .split(rows[3]);
+    let mid =
+        Layout::horizontal([Constraint::Percentage(50), Constraint::Percentage(50)]).split(rows[3]);
     render_candidates(frame, mid[0], state.latest.as_ref());
     render_operating(frame, mid[1], state.latest.as_ref());
     render_chart(frame, rows[4], state);
@@ -148,7 +149,9 @@ fn render_residuals(frame: &mut Frame, area: Rect, s: Option<&Snapshot>) {
 /// The fault candidates with their probability, the winding asymmetry and the sensors
 /// flagged.
 fn render_candidates(frame: &mut Frame, area: Rect, s: Option<&Snapshot>) {
-    let block = Block::new().borders(Borders::TOP).title(" fault candidates ");
+    let block = Block::new()
+        .borders(Borders::TOP)
+        .title(" fault candidates ");
     let inner = block.inner(area);
     frame.render_widget(block, area);
     let Some(s) = s else { return };
@@ -201,7 +204,9 @@ fn quantity(name: &str, v: Option<f32>, unit: &str, decimals: usize) -> Line<'st
 
 /// Speed, I_qs, i_ds, V_qs and the supply frequency.
 fn render_operating(frame: &mut Frame, area: Rect, s: Option<&Snapshot>) {
-    let block = Block::new().borders(Borders::TOP).title(" operating point ");
+    let block = Block::new()
+        .borders(Borders::TOP)
+        .title(" operating point ");
     let inner = block.inner(area);
     frame.render_widget(block, area);
     let Some(s) = s else { return };
@@ -227,12 +232,15 @@ fn render_chart(frame: &mut Frame, area: Rect, state: &HmiState) {
                 .collect()
         })
         .collect();
-    let peak = series
-        .iter()
-        .flatten()
-        .map(|(_, y)| y.abs())
-        .fold(0.02f64, f64::max)
-        * 1.1;
+    // The scale of the bulk of the readings (95th percentile): the start's transient
+    // does not flatten the steady residuals (a point beyond the scale is clipped).
+    let mut mags: Vec<f64> = series.iter().flatten().map(|(_, y)| y.abs()).collect();
+    mags.sort_by(f64::total_cmp);
+    let p95 = mags
+        .get((mags.len() as f64 * 0.95) as usize)
+        .copied()
+        .unwrap_or(0.0);
+    let peak = (1.5 * p95).max(0.02);
     let datasets: Vec<Dataset> = series
         .iter()
         .enumerate()
@@ -342,5 +350,119 @@ fn keys_line(c: &Controls) -> Line<'static> {
         .filter(|k| !(matches!(c, Controls::Stdin(_)) && k.footer.contains("pause")))
         .map(|k| k.footer)
         .collect();
-    Line::styled(format!(" {}", items.join(" ")), Style::new().fg(Color::DarkGray))
+    Line::styled(
+        format!(" {}", items.join(" ")),
+        Style::new().fg(Color::DarkGray),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ratatui::backend::TestBackend;
+    use ratatui::Terminal;
+    use sim_host::hmi::live::LiveSim;
+    use sim_host::hmi::{Key, Source};
+
+    /// The screen of `state` on a `w` x `h` test terminal, one string per row.
+    fn screen(state: &HmiState, w: u16, h: u16) -> Vec<String> {
+        let mut t = Terminal::new(TestBackend::new(w, h)).expect("test terminal");
+        t.draw(|f| render(f, state)).expect("draw");
+        let buf = t.backend().buffer();
+        (0..h)
+            .map(|y| {
+                (0..w)
+                    .map(|x| buf[(x, y)].symbol().to_string())
+                    .collect::<String>()
+                    .trim_end()
+                    .to_string()
+            })
+            .collect()
+    }
+
+    fn run(live: &mut LiveSim, state: &mut HmiState, seconds: f64) {
+        for _ in 0..(seconds / 0.25).round() as usize {
+            live.advance(0.25, state);
+        }
+    }
+
+    fn find<'a>(rows: &'a [String], text: &str) -> &'a str {
+        rows.iter()
+            .find(|r| r.contains(text))
+            .unwrap_or_else(|| panic!("no `{text}` on the screen:\n{}", rows.join("\n")))
+    }
+
+    #[test]
+    fn the_screen_after_commissioning_and_after_a_fault_at_80x24() {
+        let mut live = LiveSim::demo_motor().expect("reference motor");
+        let mut state = live.initial_state();
+        run(&mut live, &mut state, 2.0);
+        live.key(Key::Char('c'), &mut state);
+        run(&mut live, &mut state, 5.0);
+        let rows = screen(&state, 80, 24);
+        // Commissioned: the learned bands, all lamps dark, healthy, no candidate.
+        assert!(find(&rows, "residuals against").contains("(learned)"));
+        let lamps = find(&rows, "FAULT");
+        assert!(lamps.contains("healthy") && !lamps.contains('●'), "{lamps}");
+        assert!(
+            rows.iter().any(|r| r.starts_with(" none ")),
+            "no candidates:\n{}",
+            rows.join("\n")
+        );
+        assert!(find(&rows, " > ").contains("learned thresholds in force"));
+        assert!(find(&rows, " speed ").contains("rpm"));
+        assert!(find(&rows, "I_qs").contains(" A"));
+        assert!(find(&rows, "supply frequency").contains("Hz"));
+        assert!(find(&rows, "faults on:").contains("none"));
+
+        // 6: Bl +50 %; after 3 s r2..r4 and the fault lamp are lit, b and bl named.
+        live.key(Key::Char('6'), &mut state);
+        run(&mut live, &mut state, 3.0);
+        let rows = screen(&state, 80, 24);
+        let lamps = find(&rows, "FAULT");
+        assert!(
+            lamps.contains("r1 ○ r2 ● r3 ● r4 ●") && lamps.contains("FAULT ●"),
+            "{lamps}"
+        );
+        assert!(lamps.contains("FAULT: b 50 % / bl 50 %"), "{lamps}");
+        assert!(find(&rows, " bl ").contains("50 %"));
+        assert!(find(&rows, "faults on:").contains("bl +50%"));
+        assert!(find(&rows, " > ").contains("bl +50 % switched on"));
+        // A lit residual's value marker lies off its band.
+        let r2 = rows
+            .iter()
+            .find(|r| r.starts_with(" r2 ") && r.contains('±'))
+            .expect("r2's bar");
+        let bar: Vec<char> = r2.chars().collect();
+        let at = |c: char| bar.iter().position(|x| *x == c);
+        let value = at('█').or(at('◀')).or(at('▶')).expect("value marker");
+        let band_lo = at('═').expect("band");
+        let band_hi = bar.iter().rposition(|x| *x == '═').expect("band");
+        assert!(value < band_lo || value > band_hi, "{r2}");
+        // Every row fits, the footer too.
+        assert!(rows.iter().all(|r| r.chars().count() <= 80));
+        assert!(rows[23].contains("q quit"), "{}", rows[23]);
+        if let Ok(path) = std::env::var("HMI_SCREEN_CAPTURE") {
+            std::fs::write(&path, rows.join("\n") + "\n").expect("capture written");
+        }
+    }
+
+    #[test]
+    fn the_band_bar() {
+        // Scale 0.1 over 21 cells: a cell is 0.01; zero in the middle.
+        let b = band_bar(0.05, Some((0.0, 0.03)), 0.1, 21);
+        assert_eq!(b, "·······═══┊═══·█·····");
+        let inside = band_bar(0.01, Some((0.0, 0.03)), 0.1, 21);
+        assert_eq!(inside, "·······═══┊█══·······");
+        assert!(band_bar(0.5, None, 0.1, 21).ends_with('▶'));
+        assert!(band_bar(-0.5, None, 0.1, 21).starts_with('◀'));
+    }
+
+    #[test]
+    fn a_tiny_terminal_does_not_panic() {
+        let state = HmiState::new("x", Controls::Stdin(Default::default()));
+        for (w, h) in [(1, 1), (20, 5), (80, 24), (200, 60)] {
+            assert_eq!(screen(&state, w, h).len(), usize::from(h));
+        }
+    }
 }
