@@ -92,14 +92,8 @@ fn live_simulation_commissions_and_a_key_injects_a_fault() {
     assert!(matches!(s.state, MonitorState::Fault(_)));
     // A lit residual lies outside its learned band.
     let bands = s.bands.expect("bands");
-    for k in 1..4 {
-        let (c, h) = bands[k];
-        assert!(
-            (s.residuals[k] - c).abs() > h,
-            "r{}: {} in {c}±{h}",
-            k + 1,
-            s.residuals[k]
-        );
+    for (k, (r, (c, h))) in s.residuals.iter().zip(bands).enumerate().skip(1) {
+        assert!((r - c).abs() > h, "r{}: {r} in {c}±{h}", k + 1);
     }
 
     // 6 again clears it: the lamps go out once the load is back.
@@ -298,5 +292,72 @@ fn status_line_fields() {
         "",
     ] {
         assert!(status_line::parse(other).is_none(), "{other}");
+    }
+}
+
+/// Stdout not a terminal: one status line per reading interval, the events, then exit 0
+/// when standard input ends.
+#[test]
+fn plain_text_when_stdout_is_not_a_terminal() {
+    let sample =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fw_status_sample.txt");
+    let o = assert_cmd::Command::cargo_bin("sim-host")
+        .expect("binary")
+        .args(["hmi", "--stdin", "--every", "0.1"])
+        .pipe_stdin(&sample)
+        .expect("stdin")
+        .timeout(std::time::Duration::from_secs(60))
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let status: Vec<&str> = out.lines().filter(|l| l.contains(" rpm ")).collect();
+    assert_eq!(status.len(), 5, "{out}");
+    assert!(status[2].contains("commissioning 5 %"), "{out}");
+    assert!(
+        status[4].contains("○●●● FAULT") && status[4].contains("b 50 % / bl 50 %"),
+        "{out}"
+    );
+    assert!(out.contains("> WARN ADC DMA overrun #1"), "{out}");
+    // No escape sequences: plain text.
+    assert!(!out.contains('\u{1b}'), "{out:?}");
+
+    // The live simulation for two seconds of wall time.
+    let o = assert_cmd::Command::cargo_bin("sim-host")
+        .expect("binary")
+        .args(["hmi", "--duration", "2", "--every", "0.5"])
+        .timeout(std::time::Duration::from_secs(60))
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.starts_with("live simulation: DESIGN.md 3 hp motor"),
+        "{out}"
+    );
+    assert!(
+        out.lines().filter(|l| l.contains(" rpm ")).count() >= 2,
+        "{out}"
+    );
+}
+
+/// `hmi --help` teaches: examples and the key list; the README's key list is the same.
+#[test]
+fn the_help_and_the_readme_list_the_keys() {
+    let o = assert_cmd::Command::cargo_bin("sim-host")
+        .expect("binary")
+        .args(["hmi", "--help"])
+        .output()
+        .expect("runs");
+    assert!(o.status.success());
+    let help = String::from_utf8_lossy(&o.stdout);
+    assert!(help.contains("sim-host hmi LOG --params P.toml") && help.contains("--stdin"));
+    let readme = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md"),
+    )
+    .expect("README");
+    for line in sim_host::hmi::key_help().lines().skip(1) {
+        assert!(help.contains(line), "--help lacks `{line}`");
+        assert!(readme.contains(line), "README lacks `{line}`");
     }
 }

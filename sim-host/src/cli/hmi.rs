@@ -39,7 +39,7 @@ diagnose does, at --speed 1x, 10x or max, with pause and seek\n  cargo fw-run | 
 c (commissioning, 3 s), then 6 (load friction Bl +50 %): r2..r4 light and the candidates b/bl \
 appear; 6 again clears it.\n\nWhen stdout is not a terminal (or with --plain) one status line is \
 printed every --every seconds of the source's time instead. Needs an 80x24 terminal at least.",
-    after_long_help = key_help()
+    after_help = key_help()
 )]
 pub struct HmiArgs {
     /// Log to replay (any format the log reader takes); without it, the live simulation.
@@ -113,7 +113,10 @@ impl From<SpeedArg> for Speed {
 /// stdout that cannot be written.
 pub fn run(args: &HmiArgs) -> anyhow::Result<()> {
     let params = args.params.as_deref().map(ParamFile::load).transpose()?;
-    let mut source: Box<dyn Source> = if args.stdin {
+    let plain_text = args.plain || !std::io::stdout().is_terminal();
+    let mut source: Box<dyn Source> = if args.stdin && plain_text {
+        Box::new(StdinStatus::stdin().one_at_a_time())
+    } else if args.stdin {
         Box::new(StdinStatus::stdin())
     } else if let Some(log) = &args.log {
         let params = params.context("a log replay needs --params P.toml (the log's motor)")?;
@@ -124,7 +127,14 @@ pub fn run(args: &HmiArgs) -> anyhow::Result<()> {
             allow_incomplete: true,
             ..ReplayOptions::default()
         };
-        Box::new(LogReplay::start(params, log, opts, args.speed.into())?)
+        // Plain text at `max` walks the log at 1x on a clock of its own that does not wait
+        // (a status line every --every seconds of the log, none skipped).
+        let speed = if plain_text && args.speed == SpeedArg::Max {
+            Speed::X1
+        } else {
+            args.speed.into()
+        };
+        Box::new(LogReplay::start(params, log, opts, speed)?)
     } else if let Some(p) = params {
         Box::new(LiveSim::new(
             p,
@@ -136,8 +146,9 @@ pub fn run(args: &HmiArgs) -> anyhow::Result<()> {
     let deadline = args
         .duration
         .map(|d| Instant::now() + Duration::from_secs_f64(d.max(0.0)));
-    if args.plain || !std::io::stdout().is_terminal() {
-        plain(source.as_mut(), args.every, deadline)
+    if plain_text {
+        let fast = args.stdin || (args.log.is_some() && args.speed == SpeedArg::Max);
+        plain(source.as_mut(), args.every, fast, deadline)
     } else {
         screen(source.as_mut(), deadline)
     }
@@ -206,8 +217,14 @@ fn map_key(code: KeyCode) -> Option<Key> {
 
 /// Plain text: a status line every `every` seconds of the source's time, the events and
 /// warnings as they come; ends with the source (standard input closed, the log played to
-/// its end) or at the deadline.
-fn plain(source: &mut dyn Source, every: f64, deadline: Option<Instant>) -> anyhow::Result<()> {
+/// its end) or at the deadline. `fast`: the source's clock advances `every` a turn without
+/// waiting for the wall clock (a replay at `max`), waiting only for the analysis.
+fn plain(
+    source: &mut dyn Source,
+    every: f64,
+    fast: bool,
+    deadline: Option<Instant>,
+) -> anyhow::Result<()> {
     let mut out = super::stdout();
     let mut state = source.initial_state();
     writeln!(out, "{}", state.title)?;
@@ -216,8 +233,15 @@ fn plain(source: &mut dyn Source, every: f64, deadline: Option<Instant>) -> anyh
     let mut last = Instant::now();
     loop {
         let now = Instant::now();
-        source.advance((now - last).as_secs_f64(), &mut state);
+        let shown = state.latest.as_ref().map(|s| s.t_s);
+        let step = if fast {
+            every
+        } else {
+            (now - last).as_secs_f64()
+        };
+        source.advance(step, &mut state);
         last = now;
+        let moved = state.latest.as_ref().map(|s| s.t_s) != shown;
         if let Some(s) = &state.latest {
             if s.t_s + 1e-9 >= next_t {
                 next_t = (s.t_s / every).floor() * every + every;
@@ -241,7 +265,9 @@ fn plain(source: &mut dyn Source, every: f64, deadline: Option<Instant>) -> anyh
         if finished(&state) || deadline.is_some_and(|d| Instant::now() >= d) {
             return Ok(());
         }
-        std::thread::sleep(FRAME);
+        if !(fast && moved) {
+            std::thread::sleep(FRAME);
+        }
     }
 }
 

@@ -31,7 +31,8 @@ D-Q model, fault signature matching), and compares the model with measurements t
 and which physical effect is missing.\n\nStart with:\n  sim-host demo\n  sim-host table1\n  \
 sim-host simulate --params P.toml --scenario S.toml --out D.csv\n  sim-host diagnose --params P.toml \
 D.csv --commission 2:4\n  sim-host compare --params P.toml D.csv\n  sim-host explain --params P.toml \
-D.csv\n\nEvery command takes --json (one JSON document on stdout; progress and logs on stderr)."
+D.csv\n  sim-host hmi\n\nEvery command but the interactive hmi takes --json (one JSON document on stdout; progress \
+and logs on stderr)."
 )]
 pub struct Cli {
     /// The command.

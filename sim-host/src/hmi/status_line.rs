@@ -260,6 +260,7 @@ pub fn event_text(line: &str) -> Option<String> {
 pub struct StdinStatus {
     lines: Receiver<String>,
     controls: StdinControls,
+    one_at_a_time: bool,
 }
 
 impl StdinStatus {
@@ -282,11 +283,19 @@ impl StdinStatus {
         StdinStatus {
             lines,
             controls: StdinControls::default(),
+            one_at_a_time: false,
         }
     }
 
-    /// Takes one line into the state.
-    pub fn take_line(&mut self, line: &str, state: &mut HmiState) {
+    /// Takes at most one status line per [`Source::advance`] (plain text prints every
+    /// reading of a recorded file), instead of every line waiting.
+    pub fn one_at_a_time(mut self) -> Self {
+        self.one_at_a_time = true;
+        self
+    }
+
+    /// Takes one line into the state; true for a status line.
+    pub fn take_line(&mut self, line: &str, state: &mut HmiState) -> bool {
         let c = &mut self.controls;
         c.lines += 1;
         if let Some(s) = parse(line) {
@@ -301,9 +310,12 @@ impl StdinStatus {
                 c.mode.clone_from(&s.mode);
             }
             state.push(s.snapshot(t));
-        } else if let Some(e) = event_text(line) {
+            return true;
+        }
+        if let Some(e) = event_text(line) {
             state.event(e);
         }
+        false
     }
 }
 
@@ -311,7 +323,11 @@ impl Source for StdinStatus {
     fn advance(&mut self, _wall_s: f64, state: &mut HmiState) {
         loop {
             match self.lines.try_recv() {
-                Ok(line) => self.take_line(&line, state),
+                Ok(line) => {
+                    if self.take_line(&line, state) && self.one_at_a_time {
+                        break;
+                    }
+                }
                 Err(TryRecvError::Empty) => break,
                 Err(TryRecvError::Disconnected) => {
                     if !self.controls.ended {
