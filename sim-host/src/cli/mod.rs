@@ -40,24 +40,26 @@ pub struct Cli {
     pub cmd: Cmd,
 }
 
-/// The commands.
+/// The commands. (The variants carry plain comments, not doc comments: clap would take a
+/// variant's doc comment as the command's help and hide the teaching `about`/`long_about`
+/// of its arguments' struct.)
 #[derive(Subcommand)]
 pub enum Cmd {
-    /// The main job.
+    // The main job.
     Demo(demo::DemoArgs),
-    /// Generate a log.
+    // Generate a log.
     Simulate(simulate::SimulateArgs),
-    /// Replay a log through the core.
+    // Replay a log through the core.
     Diagnose(diagnose::DiagnoseArgs),
-    /// The paper's Table 1 end to end.
+    // The paper's Table 1 end to end.
     Table1(table1::Table1Args),
-    /// Model vs measurement.
+    // Model vs measurement.
     Compare(compare::CompareArgs),
-    /// Which effect is missing.
+    // Which effect is missing.
     Explain(compare::ExplainArgs),
-    /// Benchmarks.
+    // Benchmarks.
     Bench(bench::BenchArgs),
-    /// The live terminal HMI.
+    // The live terminal HMI.
     Hmi(hmi::HmiArgs),
 }
 
