@@ -25,7 +25,7 @@ use crate::reset_record::PreviousRun;
 use crate::sampling::{AdcSampler, RawFrame, SamplingError, TICK_HZ};
 use monitor_core::{
     CommissioningError, CommissioningRun, ConfigError, Fault, Install, Monitor, MonitorConfig,
-    MotorModel, ReferenceMachine, SensorFlags,
+    MotorModel, Operating, ReferenceMachine, SensorFlags,
 };
 
 /// The machine the firmware monitors by default: DESIGN.md's "2.2 kW" reference machine
@@ -248,6 +248,18 @@ pub struct MonitorStatus {
     pub commissioned: bool,
     /// The latest commissioning run.
     pub run: CommissioningRun,
+    /// The model's inputs in the monitor's frame: I_qs, i_ds, V_qs [A, A, V] and the
+    /// electrical rotor speed (for the status line and the HMI).
+    pub operating: Operating,
+    /// The frame's frequency [Hz] (the supply frequency in steady state).
+    pub frame_hz: f32,
+    /// The quasi-steady gate is open (else a transient: the lamps hold).
+    pub quasi_steady: bool,
+    /// The lamps are being evaluated.
+    pub evaluating: bool,
+    /// The threshold band of r1..r4 in force, (centre, half-width)
+    /// (`Monitor::threshold_bands`).
+    pub bands: [(f32, f32); 4],
 }
 
 /// The per-sample path: scaling, the core, commands.
@@ -367,6 +379,11 @@ impl SamplePath {
             zero_crossing_locked: o.zero_crossing_locked,
             commissioned: self.monitor.calibration().is_some(),
             run: self.monitor.commissioning(),
+            operating: o.operating,
+            frame_hz: o.frame_omega_rad_s / core::f32::consts::TAU,
+            quasi_steady: o.quasi_steady,
+            evaluating: o.evaluating,
+            bands: self.monitor.threshold_bands(),
         }
     }
 }

@@ -538,12 +538,18 @@ fn log_stored<E: defmt::Format>(stored: &flash_record::Stored<E>) {
     }
 }
 
-/// The defmt status line: residuals, lamps, the two top candidates, speed, mode, counters.
+/// The defmt status line: residuals, lamps, the two top candidates, speed, mode,
+/// counters, the operating point, the gate and the threshold bands. Its format is
+/// documented once, in the README ("The status line"); `sim-host hmi --stdin` parses it
+/// (`sim_host::hmi::status_line`), and `tests/status_line.rs` renders this format string
+/// and parses it back, so the two cannot drift apart.
 fn log_status(s: &MonitorStatus, mode: &str, max_update_cycles: u32) {
     let (top_name, top_p) = s.top.map_or(("none", 0.0), |(f, p)| (f.name(), p));
     let (second_name, second_p) = s.second.map_or(("none", 0.0), |(f, p)| (f.name(), p));
+    let mid = s.bands.map(|b| b.0);
+    let half = s.bands.map(|b| b.1);
     info!(
-        "r={} lamps={} fault={=bool} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32}",
+        "r={} lamps={} fault={=bool} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32} iqs={=f32}A ids={=f32}A vqs={=f32}V f={=f32}Hz steady={=bool} eval={=bool} sens={=bool},{=bool},{=bool} mid={} half={}",
         s.residuals,
         s.residual_lamps,
         s.fault_detected,
@@ -561,6 +567,17 @@ fn log_status(s: &MonitorStatus, mode: &str, max_update_cycles: u32) {
         RESTARTS.load(Ordering::Relaxed),
         s.samples,
         max_update_cycles,
+        s.operating.iqs,
+        s.operating.i_f,
+        s.operating.vqs,
+        s.frame_hz,
+        s.quasi_steady,
+        s.evaluating,
+        s.sensor_fault.current,
+        s.sensor_fault.voltage,
+        s.sensor_fault.speed,
+        mid,
+        half,
     );
 }
 

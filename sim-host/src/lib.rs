@@ -9,6 +9,7 @@
 //! - [`service_profile`]: the healthy service profile of the false-alarm and
 //!   detection-limit studies;
 //! - [`demo`]: the main job (`demo`);
+//! - [`hmi`]: the live terminal HMI's model and its three sources (`hmi`);
 //! - [`analysis`]: the model-vs-measurement workflow (`compare`, `explain`);
 //! - [`bench`](mod@bench): the simulator and core figures of `bench`.
 //!
@@ -20,6 +21,7 @@ pub mod analysis;
 pub mod bench;
 pub mod demo;
 pub mod fault_signatures;
+pub mod hmi;
 pub mod log;
 pub mod params;
 pub mod replay;

@@ -687,6 +687,13 @@ impl Monitor {
         self.lamps.calibration()
     }
 
+    /// The threshold band of each normalised residual r1..r4 in force: (centre, half-width)
+    /// (learned mean and `k_sigma` spread once commissioned, else 0 and the fixed
+    /// threshold); a residual outside its band lights its lamp after the debounce.
+    pub fn threshold_bands(&self) -> [(f32, f32); 4] {
+        [0, 1, 2, 3].map(|k| self.lamps.band(k))
+    }
+
     /// Installs a stored calibration (at boot: the record read from flash). A run that is
     /// still active ends [`Failed(Superseded)`](crate::CommissioningFailure::Superseded).
     ///

@@ -8,6 +8,7 @@ mod bench;
 mod compare;
 mod demo;
 mod diagnose;
+mod hmi;
 mod output_guard;
 mod progress;
 mod render;
@@ -30,7 +31,8 @@ D-Q model, fault signature matching), and compares the model with measurements t
 and which physical effect is missing.\n\nStart with:\n  sim-host demo\n  sim-host table1\n  \
 sim-host simulate --params P.toml --scenario S.toml --out D.csv\n  sim-host diagnose --params P.toml \
 D.csv --commission 2:4\n  sim-host compare --params P.toml D.csv\n  sim-host explain --params P.toml \
-D.csv\n\nEvery command takes --json (one JSON document on stdout; progress and logs on stderr)."
+D.csv\n  sim-host hmi\n\nEvery command but the interactive hmi takes --json (one JSON document on stdout; progress \
+and logs on stderr)."
 )]
 pub struct Cli {
     /// The command.
@@ -38,23 +40,27 @@ pub struct Cli {
     pub cmd: Cmd,
 }
 
-/// The commands.
+/// The commands. (The variants carry plain comments, not doc comments: clap would take a
+/// variant's doc comment as the command's help and hide the teaching `about`/`long_about`
+/// of its arguments' struct.)
 #[derive(Subcommand)]
 pub enum Cmd {
-    /// The main job.
+    // The main job.
     Demo(demo::DemoArgs),
-    /// Generate a log.
+    // Generate a log.
     Simulate(simulate::SimulateArgs),
-    /// Replay a log through the core.
+    // Replay a log through the core.
     Diagnose(diagnose::DiagnoseArgs),
-    /// The paper's Table 1 end to end.
+    // The paper's Table 1 end to end.
     Table1(table1::Table1Args),
-    /// Model vs measurement.
+    // Model vs measurement.
     Compare(compare::CompareArgs),
-    /// Which effect is missing.
+    // Which effect is missing.
     Explain(compare::ExplainArgs),
-    /// Benchmarks.
+    // Benchmarks.
     Bench(bench::BenchArgs),
+    // The live terminal HMI.
+    Hmi(hmi::HmiArgs),
 }
 
 /// Runs a command.
@@ -70,6 +76,7 @@ pub fn run(cmd: Cmd) -> anyhow::Result<()> {
         Cmd::Compare(a) => compare::run_compare(a),
         Cmd::Explain(a) => compare::run_explain(a),
         Cmd::Bench(a) => bench::run(a),
+        Cmd::Hmi(a) => hmi::run(a),
     }
 }
 

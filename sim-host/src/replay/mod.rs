@@ -540,6 +540,17 @@ impl Replay {
         self.monitor.as_ref().and_then(|m| m.calibration())
     }
 
+    /// The threshold bands of r1..r4 in force, (centre, half-width)
+    /// ([`Monitor::threshold_bands`]); `None` for a current-only log.
+    pub fn threshold_bands(&self) -> Option<[(f32, f32); 4]> {
+        self.monitor.as_ref().map(Monitor::threshold_bands)
+    }
+
+    /// Time of `row` since the replay's first row [s] (the timeline's time).
+    pub fn time_of(&self, row: &Row) -> f64 {
+        row.t_s - self.t0.unwrap_or(row.t_s)
+    }
+
     /// True when a commissioning window was asked for and not learned.
     pub fn commissioning_incomplete(&self) -> bool {
         self.monitor.is_some() && self.commission.incomplete()
@@ -719,6 +730,39 @@ pub fn diagnose_file(
     })
 }
 
+/// Watches a replay row by row ([`diagnose_file_observed`]): the live HMI's log source.
+pub trait ReplayObserver {
+    /// The monitor's output after `row` (as the data-quality stage passed it on, glitches
+    /// filled in); `replay` for its time base and thresholds ([`Replay::time_of`],
+    /// [`Replay::threshold_bands`]).
+    fn output(&mut self, row: &Row, out: &MonitorOutput, replay: &Replay);
+    /// The replay starts again from the log's first row (the reader's fast path handed
+    /// over to the exact reader): forget every output so far.
+    fn restart(&mut self);
+}
+
+/// [`diagnose_file`] that hands every replayed row's output to `observer` as it goes.
+///
+/// # Errors
+/// As [`diagnose_file`].
+pub fn diagnose_file_observed(
+    params: &ParamFile,
+    path: &Path,
+    opts: ReplayOptions,
+    progress: &mut dyn FnMut(f64),
+    observer: &mut dyn ReplayObserver,
+) -> Result<Diagnosed, ReplayError> {
+    let file = LogFile::open(path)?;
+    replay_observed(
+        params,
+        file.channels(),
+        file.shown(),
+        opts,
+        Some(observer),
+        |stage| file.for_each_row(progress, stage).map(|_| ()),
+    )
+}
+
 /// Runs `feed` into the data-quality stage in front of a replay; builds the report.
 fn replay_through_quality(
     params: &ParamFile,
@@ -727,7 +771,20 @@ fn replay_through_quality(
     opts: ReplayOptions,
     feed: impl FnOnce(&mut dyn RowSink) -> Result<(), LogError>,
 ) -> Result<Diagnosed, ReplayError> {
+    replay_observed(params, channels, shown, opts, None, feed)
+}
+
+/// [`replay_through_quality`] with an optional observer of every output.
+fn replay_observed<'a>(
+    params: &'a ParamFile,
+    channels: Channels,
+    shown: &str,
+    opts: ReplayOptions,
+    observer: Option<&'a mut dyn ReplayObserver>,
+    feed: impl FnOnce(&mut dyn RowSink) -> Result<(), LogError>,
+) -> Result<Diagnosed, ReplayError> {
     let mut sink = ReplaySink {
+        observer,
         params,
         channels,
         opts,
@@ -827,6 +884,7 @@ fn describe_actions(q: &mut DataQuality, monitor: bool, sink: &ReplaySink<'_>) {
 /// base; rows of segments at another sample rate are counted, not replayed (the monitor's
 /// configuration follows from one rate).
 struct ReplaySink<'a> {
+    observer: Option<&'a mut dyn ReplayObserver>,
     params: &'a ParamFile,
     channels: Channels,
     opts: ReplayOptions,
@@ -926,7 +984,10 @@ impl CleanSink for ReplaySink<'_> {
             self.burst_forwarded = true;
             self.long_bursts += 1;
             for b in self.burst.drain(..) {
-                r.push(&b);
+                let out = r.push(&b);
+                if let Some(o) = self.observer.as_deref_mut() {
+                    o.output(&b, &out, r);
+                }
             }
             return true;
         }
@@ -939,7 +1000,11 @@ impl CleanSink for ReplaySink<'_> {
                 let short = |a: &Row| (row.t_s - a.t_s) * self.params.supply.f_hz <= FILL_PERIODS;
                 if let Some(a) = self.last_good.filter(short) {
                     for b in &self.burst {
-                        r.push(&between(&a, row, b.t_s));
+                        let filled = between(&a, row, b.t_s);
+                        let out = r.push(&filled);
+                        if let Some(o) = self.observer.as_deref_mut() {
+                            o.output(&filled, &out, r);
+                        }
                     }
                     self.filled_rows += self.burst.len() as u64;
                 }
@@ -948,7 +1013,10 @@ impl CleanSink for ReplaySink<'_> {
             self.burst_forwarded = false;
             self.last_good = Some(*row);
         }
-        r.push(row);
+        let out = r.push(row);
+        if let Some(o) = self.observer.as_deref_mut() {
+            o.output(row, &out, r);
+        }
         true
     }
 
@@ -963,6 +1031,9 @@ impl CleanSink for ReplaySink<'_> {
     }
 
     fn restart(&mut self) {
+        if let Some(o) = self.observer.as_deref_mut() {
+            o.restart();
+        }
         self.replay = None;
         self.other_rate = false;
         self.rows_other_rate = 0;

@@ -285,6 +285,25 @@ pub fn simulate_while(
         .map(|(summary, done)| done.then_some(summary))
 }
 
+/// [`simulate`] driven from outside as it runs (the live HMI, `sim-host hmi`): after each
+/// row `on_row` may push events into the vector it is given; they act from the next row
+/// on (their own times are ignored). An event that would make the machine unphysical
+/// (checked as the scenario's own faults are, before it acts) is left out and the run
+/// goes on. Return `ControlFlow::Break(())` to stop; `Ok(None)` when stopped, else the
+/// summary at the scenario's end.
+///
+/// # Errors
+/// As [`simulate`].
+pub fn simulate_interactive(
+    params: &ParamFile,
+    scenario: &Scenario,
+    mut on_row: impl FnMut(&Row, &mut Vec<ScenarioEvent>) -> ControlFlow<()>,
+) -> Result<Option<SimSummary>, SimError> {
+    checked_run(params, scenario)?
+        .run_with_events(|r, _, ev| on_row(r, ev))
+        .map(|(summary, done)| done.then_some(summary))
+}
+
 /// [`simulate`] collecting the rows in memory.
 ///
 /// # Errors
@@ -525,11 +544,18 @@ impl MachineBuilder<'_> {
     }
 }
 
-/// Something the scenario switches at an output sample.
-#[derive(Debug, Clone, Copy)]
-enum ScenarioEvent {
+/// Something the scenario switches at an output sample: a supply step, a load step or a
+/// fault (the scenario's `supply.steps`, `load.steps` and `faults`; an interactive run,
+/// [`simulate_interactive`], adds them as it goes).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ScenarioEvent {
+    /// A supply step (voltage scale, frequency).
     Supply(SupplyStep),
+    /// A load step (Bl scale or load torque).
     Load(LoadStep),
+    /// A fault switched on (parametric faults compose multiplicatively: the inverse change
+    /// clears one; a sensor fault replaces the channel's previous fault: a gain change of
+    /// 0 clears it).
     Fault(FaultSpec),
 }
 
@@ -822,9 +848,34 @@ impl<'a> Run<'a> {
 
     /// Runs to the end, or until `on_row` breaks; the summary and whether it ran to the end.
     fn run(
-        mut self,
+        self,
         mut on_row: impl FnMut(&Row, &Truth) -> ControlFlow<()>,
     ) -> Result<(SimSummary, bool), SimError> {
+        self.run_with_events(|r, t, _| on_row(r, t))
+    }
+
+    /// Queues `added` to act at output sample `k`, leaving out an event that would make
+    /// the machine unphysical.
+    fn insert_events(&mut self, k: u64, next_event: usize, added: &mut Vec<ScenarioEvent>) {
+        for (n, ev) in added.drain(..).enumerate() {
+            if let ScenarioEvent::Fault(f) = ev {
+                let mut scratch = self.scales;
+                scratch.apply_fault(&f);
+                if f.validate().is_err() || self.builder.build(&scratch).is_err() {
+                    continue;
+                }
+            }
+            let at = (next_event + n).min(self.events.len());
+            self.events.insert(at, (k, ev));
+        }
+    }
+
+    /// [`Run::run`] whose callback may add events ([`simulate_interactive`]).
+    fn run_with_events(
+        mut self,
+        mut on_row: impl FnMut(&Row, &Truth, &mut Vec<ScenarioEvent>) -> ControlFlow<()>,
+    ) -> Result<(SimSummary, bool), SimError> {
+        let mut added = Vec::new();
         let mut x = [0.0f64; 6];
         let mut next_event = 0usize;
         let mut dtemp = 0.0f64;
@@ -858,8 +909,11 @@ impl<'a> Run<'a> {
             last_p_loss = tr.p_cu_w + tr.p_fe_w;
             max_i2 = max_i2.max(tr.i_ab[0] * tr.i_ab[0] + tr.i_ab[1] * tr.i_ab[1]);
             let row = self.sensors.measure(&tr, self.dt);
-            if on_row(&row, &tr).is_break() {
+            if on_row(&row, &tr, &mut added).is_break() {
                 return Ok((self.summary(x[4], max_i2.sqrt()), false));
+            }
+            if !added.is_empty() {
+                self.insert_events(k + 1, next_event, &mut added);
             }
             // Integrate to t + dt.
             self.supply.integrate(&self.machine, &mut x, self.nsub);

@@ -1,0 +1,468 @@
+//! The HMI's screen (`sim-host hmi`): a pure function of [`HmiState`] ([`render`]), laid
+//! out for 80x24 and growing the strip chart on larger terminals.
+//!
+//! ```text
+//! title (source)
+//! lamps r1..r4, FAULT, state
+//! residuals: value and a bar against the threshold band (learned or fixed)
+//! fault candidates | operating point (speed, I_qs, i_ds, V_qs, f)
+//! strip chart of r1..r4 over the last seconds
+//! the source's controls; warnings and events; keys
+//! ```
+
+use ratatui::layout::{Constraint, Layout, Rect};
+use ratatui::style::{Color, Modifier, Style};
+use ratatui::symbols::Marker;
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Axis, Block, Borders, Chart, Dataset, GraphType, Paragraph};
+use ratatui::Frame;
+use sim_host::hmi::{state_text, Controls, HmiState, KeyScope, Snapshot, HISTORY_S, KEYS};
+
+/// Colours of r1..r4 (lamps' labels, bars and chart).
+const COLOURS: [Color; 4] = [Color::Cyan, Color::Magenta, Color::Yellow, Color::Green];
+
+/// Draws the whole screen.
+pub fn render(frame: &mut Frame, state: &HmiState) {
+    let rows = Layout::vertical([
+        Constraint::Length(1), // title
+        Constraint::Length(1), // lamps and state
+        Constraint::Length(5), // residual bars
+        Constraint::Length(6), // candidates | operating point
+        Constraint::Min(5),    // strip chart
+        Constraint::Length(1), // controls
+        Constraint::Length(2), // warnings, events
+        Constraint::Length(1), // keys
+    ])
+    .split(frame.area());
+    let title = Line::from(vec![
+        Span::styled(
+            " DRIVE MONITOR ",
+            Style::new().add_modifier(Modifier::REVERSED),
+        ),
+        Span::raw(" "),
+        Span::raw(state.title.as_str()),
+    ]);
+    frame.render_widget(Paragraph::new(title), rows[0]);
+    frame.render_widget(Paragraph::new(lamps_line(state)), rows[1]);
+    render_residuals(frame, rows[2], state.latest.as_ref());
+    let mid =
+        Layout::horizontal([Constraint::Percentage(50), Constraint::Percentage(50)]).split(rows[3]);
+    render_candidates(frame, mid[0], state.latest.as_ref());
+    render_operating(frame, mid[1], state.latest.as_ref());
+    render_chart(frame, rows[4], state);
+    frame.render_widget(Paragraph::new(controls_line(&state.controls)), rows[5]);
+    frame.render_widget(Paragraph::new(notes(state)), rows[6]);
+    frame.render_widget(Paragraph::new(keys_line(&state.controls)), rows[7]);
+}
+
+fn lamp(on: bool, colour: Color) -> Span<'static> {
+    if on {
+        Span::styled("●", Style::new().fg(colour).add_modifier(Modifier::BOLD))
+    } else {
+        Span::styled("○", Style::new().fg(Color::DarkGray))
+    }
+}
+
+/// Lamps r1..r4, the fault lamp and the monitor's state.
+fn lamps_line(state: &HmiState) -> Line<'static> {
+    let Some(s) = &state.latest else {
+        return Line::from(" waiting for the first reading ...");
+    };
+    let mut spans = Vec::new();
+    for (k, on) in s.lamps.iter().enumerate() {
+        spans.push(Span::raw(format!(" r{} ", k + 1)));
+        spans.push(lamp(*on, Color::Red));
+    }
+    spans.push(Span::raw("   FAULT "));
+    spans.push(lamp(s.fault_lamp, Color::Red));
+    let text = state_text(&s.state, &s.candidates);
+    let style = if s.fault_lamp {
+        Style::new().fg(Color::Red).add_modifier(Modifier::BOLD)
+    } else {
+        Style::new()
+    };
+    spans.push(Span::raw(format!("  {:7.2} s  ", s.t_s)));
+    spans.push(Span::styled(text, style));
+    Line::from(spans)
+}
+
+/// A bar of `width` cells from `-scale` to `+scale`: the band as `═`, outside it `·`, the
+/// zero line `┊` and the value `█` (clamped to the ends, `◀`/`▶` beyond them).
+pub fn band_bar(value: f32, band: Option<(f32, f32)>, scale: f32, width: usize) -> String {
+    let cell = |x: f32| -> usize {
+        let u = ((x + scale) / (2.0 * scale)).clamp(0.0, 1.0);
+        ((u * (width as f32 - 1.0)).round() as usize).min(width.saturating_sub(1))
+    };
+    let mut bar: Vec<char> = vec!['·'; width];
+    if let Some((c, h)) = band {
+        for ch in &mut bar[cell(c - h)..=cell(c + h)] {
+            *ch = '═';
+        }
+    }
+    bar[cell(0.0)] = '┊';
+    bar[cell(value)] = if value > scale {
+        '▶'
+    } else if value < -scale {
+        '◀'
+    } else {
+        '█'
+    };
+    bar.into_iter().collect()
+}
+
+/// The residuals against their bands, one line each.
+fn render_residuals(frame: &mut Frame, area: Rect, s: Option<&Snapshot>) {
+    let learned = s.is_some_and(|s| s.learned);
+    let block = Block::new().borders(Borders::TOP).title(format!(
+        " residuals against their threshold bands ({}) ",
+        if learned { "learned" } else { "fixed" }
+    ));
+    let inner = block.inner(area);
+    frame.render_widget(block, area);
+    let Some(s) = s else { return };
+    let width = usize::from(inner.width).saturating_sub(28).max(10);
+    let lines: Vec<Line> = (0..4)
+        .map(|k| {
+            let r = s.residuals[k];
+            let band = s.bands.map(|b| b[k]);
+            let reach = band.map_or(0.03, |(c, h)| c.abs() + h);
+            let scale = (2.0 * reach).max(0.01);
+            let lit = s.lamps[k];
+            let style = if lit {
+                Style::new().fg(Color::Red).add_modifier(Modifier::BOLD)
+            } else {
+                Style::new().fg(COLOURS[k])
+            };
+            let band_text = band.map_or("band n/a".to_string(), |(c, h)| {
+                format!("{:+.3}±{:.3}", c, h)
+            });
+            Line::from(vec![
+                Span::styled(format!(" r{} {:+8.4} ", k + 1, r), style),
+                Span::styled(band_bar(r, band, scale, width), style),
+                Span::raw(format!(" {band_text}")),
+            ])
+        })
+        .collect();
+    frame.render_widget(Paragraph::new(lines), inner);
+}
+
+/// The fault candidates with their probability, the winding asymmetry and the sensors
+/// flagged.
+fn render_candidates(frame: &mut Frame, area: Rect, s: Option<&Snapshot>) {
+    let block = Block::new()
+        .borders(Borders::TOP)
+        .title(" fault candidates ");
+    let inner = block.inner(area);
+    frame.render_widget(block, area);
+    let Some(s) = s else { return };
+    let mut lines: Vec<Line> = s
+        .candidates
+        .iter()
+        .take(3)
+        .map(|(f, p)| {
+            let n = (p * 10.0).round() as usize;
+            Line::from(format!(
+                " {:<15}{:>4.0} % {}",
+                f.name(),
+                p * 100.0,
+                "█".repeat(n.min(10))
+            ))
+        })
+        .collect();
+    if s.candidates.len() > 3 {
+        lines.push(Line::from(format!(
+            " ... and {} more",
+            s.candidates.len() - 3
+        )));
+    }
+    if lines.is_empty() {
+        lines.push(Line::from(" none"));
+    }
+    for f in &s.sensor_faults {
+        lines.push(Line::styled(
+            format!(" {} flagged (impossible reading)", f.name()),
+            Style::new().fg(Color::Red),
+        ));
+    }
+    if let Some(a) = &s.asymmetry {
+        let size = a
+            .winding_change
+            .map_or(String::new(), |w| format!(", winding {:+.1} %", -w * 100.0));
+        lines.push(Line::from(format!(
+            " asymmetry: phase {} (|I2/I1| {:.1} %{size})",
+            a.phase.name(),
+            a.ratio * 100.0
+        )));
+    }
+    frame.render_widget(Paragraph::new(lines), inner);
+}
+
+fn quantity(name: &str, v: Option<f32>, unit: &str, decimals: usize) -> Line<'static> {
+    let text = v.map_or("   n/a".to_string(), |x| format!("{x:>8.decimals$}"));
+    Line::from(format!(" {name:<17}{text} {unit}"))
+}
+
+/// Speed, I_qs, i_ds, V_qs and the supply frequency.
+fn render_operating(frame: &mut Frame, area: Rect, s: Option<&Snapshot>) {
+    let block = Block::new()
+        .borders(Borders::TOP)
+        .title(" operating point ");
+    let inner = block.inner(area);
+    frame.render_widget(block, area);
+    let Some(s) = s else { return };
+    let lines = vec![
+        quantity("speed", Some(s.speed_rpm), "rpm", 0),
+        quantity("I_qs (torque)", s.iqs_a, "A", 2),
+        quantity("i_ds (flux)", s.ids_a, "A", 2),
+        quantity("V_qs", s.vqs_v, "V", 1),
+        quantity("supply frequency", s.supply_hz, "Hz", 2),
+    ];
+    frame.render_widget(Paragraph::new(lines), inner);
+}
+
+/// r1..r4 over the last [`HISTORY_S`] seconds.
+fn render_chart(frame: &mut Frame, area: Rect, state: &HmiState) {
+    let now = state.history.back().map_or(0.0, |(t, _)| *t);
+    let series: Vec<Vec<(f64, f64)>> = (0..4)
+        .map(|k| {
+            state
+                .history
+                .iter()
+                .map(|(t, r)| (t - now, f64::from(r[k])))
+                .collect()
+        })
+        .collect();
+    // The scale of the bulk of the readings (95th percentile): the start's transient
+    // does not flatten the steady residuals (a point beyond the scale is clipped).
+    let mut mags: Vec<f64> = series.iter().flatten().map(|(_, y)| y.abs()).collect();
+    mags.sort_by(f64::total_cmp);
+    let p95 = mags
+        .get((mags.len() as f64 * 0.95) as usize)
+        .copied()
+        .unwrap_or(0.0);
+    let peak = (1.5 * p95).max(0.02);
+    let datasets: Vec<Dataset> = series
+        .iter()
+        .enumerate()
+        .map(|(k, data)| {
+            Dataset::default()
+                .name(format!("r{}", k + 1))
+                .marker(Marker::Braille)
+                .graph_type(GraphType::Line)
+                .style(Style::new().fg(COLOURS[k]))
+                .data(data)
+        })
+        .collect();
+    let chart = Chart::new(datasets)
+        .block(
+            Block::new()
+                .borders(Borders::TOP)
+                .title(format!(" residuals, last {HISTORY_S:.0} s ")),
+        )
+        .x_axis(
+            Axis::default()
+                .bounds([-HISTORY_S, 0.0])
+                .labels([format!("-{HISTORY_S:.0} s"), "now".to_string()]),
+        )
+        .y_axis(
+            Axis::default()
+                .bounds([-peak, peak])
+                .labels([format!("{:+.2}", -peak), format!("{:+.2}", peak)]),
+        )
+        .hidden_legend_constraints((Constraint::Ratio(1, 1), Constraint::Ratio(1, 1)));
+    frame.render_widget(chart, area);
+}
+
+/// The source's switches or playback.
+fn controls_line(c: &Controls) -> Line<'static> {
+    let text = match c {
+        Controls::Live(l) => {
+            let faults = if l.faults.is_empty() {
+                "none".to_string()
+            } else {
+                l.faults
+                    .iter()
+                    .map(|(f, x)| format!("{} {:+.0}%", f.name(), x * 100.0))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            format!(
+                " faults on: {faults} | next {:+.0}% | load x{:.2} | supply {:.0}% {:.1} Hz{}",
+                l.change * 100.0,
+                l.load_scale,
+                l.voltage_scale * 100.0,
+                l.supply_hz,
+                if l.paused { " | PAUSED" } else { "" }
+            )
+        }
+        Controls::Replay(p) => format!(
+            " replay {} {} | at {:.2} s of {:.2} s analysed{}{}",
+            p.speed.name(),
+            if p.paused { "PAUSED" } else { "playing" },
+            p.position_s,
+            p.analysed_s,
+            if p.done { " (whole log)" } else { " ..." },
+            p.verdict
+                .as_ref()
+                .map_or(String::new(), |v| format!(" | verdict: {v}"))
+        ),
+        Controls::Stdin(s) => format!(
+            " firmware: {} status lines of {} read | mode {}{}",
+            s.status_lines,
+            s.lines,
+            s.mode.as_deref().unwrap_or("?"),
+            if s.ended { " | input ended" } else { "" }
+        ),
+    };
+    Line::styled(text, Style::new().add_modifier(Modifier::REVERSED))
+}
+
+/// The latest data-quality warning and the latest event.
+fn notes(state: &HmiState) -> Vec<Line<'static>> {
+    let warning = match state.warnings.len() {
+        0 => Line::from(" data quality: no warnings"),
+        1 => Line::styled(
+            format!(" ! {}", state.warnings[0]),
+            Style::new().fg(Color::Yellow),
+        ),
+        n => Line::styled(
+            format!(" ! {} (+{} more)", state.warnings[0], n - 1),
+            Style::new().fg(Color::Yellow),
+        ),
+    };
+    let event = state
+        .events
+        .back()
+        .map_or(Line::from(""), |e| Line::from(format!(" > {e}")));
+    vec![warning, event]
+}
+
+/// The keys of the source, from the one list [`KEYS`].
+fn keys_line(c: &Controls) -> Line<'static> {
+    let scope = match c {
+        Controls::Live(_) => KeyScope::Live,
+        Controls::Replay(_) => KeyScope::Replay,
+        Controls::Stdin(_) => KeyScope::All,
+    };
+    let items: Vec<&str> = KEYS
+        .iter()
+        .filter(|k| k.scope == scope || k.scope == KeyScope::All)
+        .filter(|k| !(matches!(c, Controls::Stdin(_)) && k.footer.contains("pause")))
+        .map(|k| k.footer)
+        .collect();
+    Line::styled(
+        format!(" {}", items.join(" ")),
+        Style::new().fg(Color::DarkGray),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ratatui::backend::TestBackend;
+    use ratatui::Terminal;
+    use sim_host::hmi::live::LiveSim;
+    use sim_host::hmi::{Key, Source};
+
+    /// The screen of `state` on a `w` x `h` test terminal, one string per row.
+    fn screen(state: &HmiState, w: u16, h: u16) -> Vec<String> {
+        let mut t = Terminal::new(TestBackend::new(w, h)).expect("test terminal");
+        t.draw(|f| render(f, state)).expect("draw");
+        let buf = t.backend().buffer();
+        (0..h)
+            .map(|y| {
+                (0..w)
+                    .map(|x| buf[(x, y)].symbol().to_string())
+                    .collect::<String>()
+                    .trim_end()
+                    .to_string()
+            })
+            .collect()
+    }
+
+    fn run(live: &mut LiveSim, state: &mut HmiState, seconds: f64) {
+        for _ in 0..(seconds / 0.25).round() as usize {
+            live.advance(0.25, state);
+        }
+    }
+
+    fn find<'a>(rows: &'a [String], text: &str) -> &'a str {
+        rows.iter()
+            .find(|r| r.contains(text))
+            .unwrap_or_else(|| panic!("no `{text}` on the screen:\n{}", rows.join("\n")))
+    }
+
+    #[test]
+    fn the_screen_after_commissioning_and_after_a_fault_at_80x24() {
+        let mut live = LiveSim::demo_motor().expect("reference motor");
+        let mut state = live.initial_state();
+        run(&mut live, &mut state, 2.0);
+        live.key(Key::Char('c'), &mut state);
+        run(&mut live, &mut state, 5.0);
+        let rows = screen(&state, 80, 24);
+        // Commissioned: the learned bands, all lamps dark, healthy, no candidate.
+        assert!(find(&rows, "residuals against").contains("(learned)"));
+        let lamps = find(&rows, "FAULT");
+        assert!(lamps.contains("healthy") && !lamps.contains('●'), "{lamps}");
+        assert!(
+            rows.iter().any(|r| r.starts_with(" none ")),
+            "no candidates:\n{}",
+            rows.join("\n")
+        );
+        assert!(find(&rows, " > ").contains("learned thresholds in force"));
+        assert!(find(&rows, " speed ").contains("rpm"));
+        assert!(find(&rows, "I_qs").contains(" A"));
+        assert!(find(&rows, "supply frequency").contains("Hz"));
+        assert!(find(&rows, "faults on:").contains("none"));
+
+        // 6: Bl +50 %; after 3 s r2..r4 and the fault lamp are lit, b and bl named.
+        live.key(Key::Char('6'), &mut state);
+        run(&mut live, &mut state, 3.0);
+        let rows = screen(&state, 80, 24);
+        let lamps = find(&rows, "FAULT");
+        assert!(
+            lamps.contains("r1 ○ r2 ● r3 ● r4 ●") && lamps.contains("FAULT ●"),
+            "{lamps}"
+        );
+        assert!(lamps.contains("FAULT: b 50 % / bl 50 %"), "{lamps}");
+        assert!(find(&rows, " bl ").contains("50 %"));
+        assert!(find(&rows, "faults on:").contains("bl +50%"));
+        assert!(find(&rows, " > ").contains("bl +50 % switched on"));
+        // A lit residual's value marker lies off its band.
+        let r2 = rows
+            .iter()
+            .find(|r| r.starts_with(" r2 ") && r.contains('±'))
+            .expect("r2's bar");
+        let bar: Vec<char> = r2.chars().collect();
+        let at = |c: char| bar.iter().position(|x| *x == c);
+        let value = at('█').or(at('◀')).or(at('▶')).expect("value marker");
+        let band_lo = at('═').expect("band");
+        let band_hi = bar.iter().rposition(|x| *x == '═').expect("band");
+        assert!(value < band_lo || value > band_hi, "{r2}");
+        // Every row fits, the footer too.
+        assert!(rows.iter().all(|r| r.chars().count() <= 80));
+        assert!(rows[23].contains("q quit"), "{}", rows[23]);
+        if let Ok(path) = std::env::var("HMI_SCREEN_CAPTURE") {
+            std::fs::write(&path, rows.join("\n") + "\n").expect("capture written");
+        }
+    }
+
+    #[test]
+    fn the_band_bar() {
+        // Scale 0.1 over 21 cells: a cell is 0.01; zero in the middle.
+        let b = band_bar(0.05, Some((0.0, 0.03)), 0.1, 21);
+        assert_eq!(b, "·······═══┊═══·█·····");
+        let inside = band_bar(0.01, Some((0.0, 0.03)), 0.1, 21);
+        assert_eq!(inside, "·······═══┊█══·······");
+        assert!(band_bar(0.5, None, 0.1, 21).ends_with('▶'));
+        assert!(band_bar(-0.5, None, 0.1, 21).starts_with('◀'));
+    }
+
+    #[test]
+    fn a_tiny_terminal_does_not_panic() {
+        let state = HmiState::new("x", Controls::Stdin(Default::default()));
+        for (w, h) in [(1, 1), (20, 5), (80, 24), (200, 60)] {
+            assert_eq!(screen(&state, w, h).len(), usize::from(h));
+        }
+    }
+}

@@ -1,0 +1,487 @@
+//! The live HMI's model (`sim-host hmi`, the paper's Figures 11 and 12): what the screen
+//! shows ([`HmiState`], a sequence of monitor readings [`Snapshot`] and the source's
+//! controls), and the three sources that update it ([`Source`]):
+//!
+//! - [`live::LiveSim`]: the demo's motor simulated as it is watched; keys switch each
+//!   Table 1 fault on and off (the paper's `Enable_F_*` switches), step the load and the
+//!   supply, and start commissioning;
+//! - [`log_replay::LogReplay`]: a log replayed through the data-quality stage and the core
+//!   ([`crate::replay::diagnose_file_observed`], the one reader: every format the reader
+//!   takes), played back at 1x, 10x or as fast as it is analysed, with pause and seek;
+//! - [`status_line::StdinStatus`]: the firmware's defmt status lines
+//!   (`cargo fw-run | sim-host hmi --stdin`), parsed by [`status_line::parse`].
+//!
+//! The keys are one table, [`KEYS`] (the screen's footer, `--help` and the README use it).
+//! Drawing is the binary's (`src/cli/render/hmi.rs`): a pure function of [`HmiState`].
+
+pub mod live;
+pub mod log_replay;
+pub mod status_line;
+
+use crate::demo::MonitorState;
+use crate::params::ParamFile;
+use monitor_core::sequence::winding_change_fraction;
+use monitor_core::{Fault, MonitorOutput, Phase};
+use std::collections::VecDeque;
+
+/// Seconds of residuals the strip chart shows.
+pub const HISTORY_S: f64 = 10.0;
+/// Interval between two readings of the simulated and replayed monitor [s] (the firmware
+/// prints one every [`status_line::STATUS_PERIOD_S`]).
+pub const SNAPSHOT_EVERY_S: f64 = 0.05;
+/// Messages kept for the screen's event list.
+const EVENTS_KEPT: usize = 4;
+
+/// A winding asymmetry as the monitor's negative-sequence analysis names it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Asymmetry {
+    /// The phase ([`monitor_core::sequence::suspect_phase`], as `diagnose` names it).
+    pub phase: Phase,
+    /// |I2|/|I1|.
+    pub ratio: f32,
+    /// Fraction of that winding's impedance lost
+    /// ([`monitor_core::sequence::winding_change_fraction`]), when the motor is known.
+    pub winding_change: Option<f32>,
+}
+
+/// One reading of the monitor, from any source. Quantities a source does not give are
+/// `None`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Snapshot {
+    /// Time [s] (simulated, log or firmware time).
+    pub t_s: f64,
+    /// Normalised residuals r1..r4.
+    pub residuals: [f32; 4],
+    /// Residual lamps r1..r4.
+    pub lamps: [bool; 4],
+    /// The fault lamp: a residual lamp or a sensor fault.
+    pub fault_lamp: bool,
+    /// Threshold band of each residual in force, (centre, half-width).
+    pub bands: Option<[(f32, f32); 4]>,
+    /// Learned thresholds are in force (else the fixed ones).
+    pub learned: bool,
+    /// Fault candidates with their probabilities, most probable first.
+    pub candidates: Vec<(Fault, f32)>,
+    /// Sensors flagged from impossible readings (`current_sensor` ...).
+    pub sensor_faults: Vec<Fault>,
+    /// A winding asymmetry, when the analysis names a phase.
+    pub asymmetry: Option<Asymmetry>,
+    /// Shaft speed [rpm].
+    pub speed_rpm: f32,
+    /// Torque-producing current I_qs [A].
+    pub iqs_a: Option<f32>,
+    /// Flux-producing current i_ds [A].
+    pub ids_a: Option<f32>,
+    /// Voltage V_qs [V].
+    pub vqs_v: Option<f32>,
+    /// Supply (frame) frequency [Hz].
+    pub supply_hz: Option<f32>,
+    /// What the monitor is doing (the demo's states).
+    pub state: MonitorState,
+}
+
+impl Snapshot {
+    /// The reading of a core output at `t_s`, with the thresholds in force; `params`
+    /// sizes a winding asymmetry.
+    pub fn from_output(
+        t_s: f64,
+        out: &MonitorOutput,
+        bands: Option<[(f32, f32); 4]>,
+        learned: bool,
+        params: &ParamFile,
+    ) -> Self {
+        let mut candidates: Vec<(Fault, f32)> = Fault::ALL
+            .iter()
+            .zip(out.diagnosis.probabilities)
+            .filter(|(_, p)| *p > 0.0)
+            .map(|(f, p)| (*f, p))
+            .collect();
+        candidates.sort_by(|a, b| b.1.total_cmp(&a.1));
+        let s = out.sensor_fault;
+        let sensor_faults = [
+            (s.current, Fault::CurrentSensor),
+            (s.voltage, Fault::VoltageSensor),
+            (s.speed, Fault::SpeedSensor),
+        ]
+        .into_iter()
+        .filter_map(|(on, f)| on.then_some(f))
+        .collect();
+        let we = out.frame_omega_rad_s.abs();
+        let asymmetry = out.unbalance.suspect_phase.map(|phase| {
+            let ratio = out.unbalance.negative_sequence_ratio;
+            let winding_change = (we > 1.0).then(|| {
+                let slip = 1.0 - out.operating.wr / we;
+                winding_change_fraction(&params.motor.model(), we, slip, ratio)
+            });
+            Asymmetry {
+                phase,
+                ratio,
+                winding_change,
+            }
+        });
+        Snapshot {
+            t_s,
+            residuals: out.residuals,
+            lamps: out.lamps,
+            fault_lamp: out.fault_detected,
+            bands,
+            learned,
+            candidates,
+            sensor_faults,
+            asymmetry,
+            speed_rpm: out.speed_rad_s * 60.0 / std::f32::consts::TAU,
+            iqs_a: Some(out.operating.iqs),
+            ids_a: Some(out.operating.i_f),
+            vqs_v: Some(out.operating.vqs),
+            supply_hz: Some(we / std::f32::consts::TAU),
+            state: MonitorState::of(out),
+        }
+    }
+}
+
+/// A playback speed of a log replay.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Speed {
+    /// Real time.
+    X1,
+    /// Ten times real time.
+    X10,
+    /// As fast as the log is analysed.
+    Max,
+}
+
+impl Speed {
+    /// "1x", "10x", "max".
+    pub fn name(self) -> &'static str {
+        match self {
+            Speed::X1 => "1x",
+            Speed::X10 => "10x",
+            Speed::Max => "max",
+        }
+    }
+
+    /// The next speed (1x, 10x, max, 1x ...).
+    pub fn next(self) -> Speed {
+        match self {
+            Speed::X1 => Speed::X10,
+            Speed::X10 => Speed::Max,
+            Speed::Max => Speed::X1,
+        }
+    }
+}
+
+/// What the live simulation's switches stand at.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LiveControls {
+    /// Faults switched on, with their relative change.
+    pub faults: Vec<(Fault, f64)>,
+    /// Relative change the next fault is switched on with (0.5 = +50 %).
+    pub change: f64,
+    /// Load Bl as a multiple of the parameter file's.
+    pub load_scale: f64,
+    /// Supply voltage as a multiple of the nominal.
+    pub voltage_scale: f64,
+    /// Supply frequency [Hz].
+    pub supply_hz: f64,
+    /// The simulation is paused.
+    pub paused: bool,
+}
+
+/// Where a log replay's playback stands.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlaybackControls {
+    /// Playback speed.
+    pub speed: Speed,
+    /// Paused.
+    pub paused: bool,
+    /// Log time shown [s].
+    pub position_s: f64,
+    /// Log time analysed so far [s].
+    pub analysed_s: f64,
+    /// The whole log is analysed.
+    pub done: bool,
+    /// The analysis' verdict, once done (`fault`, `healthy`, `could_not_judge`).
+    pub verdict: Option<String>,
+}
+
+/// The firmware link's counters.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct StdinControls {
+    /// Lines read.
+    pub lines: u64,
+    /// Status lines among them.
+    pub status_lines: u64,
+    /// Standard input has ended.
+    pub ended: bool,
+    /// The firmware's mode (`commissioned`, `not-commissioned`, `commissioning` ...).
+    pub mode: Option<String>,
+}
+
+/// What the source's status panel shows.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Controls {
+    /// The live simulation.
+    Live(LiveControls),
+    /// A log replay.
+    Replay(PlaybackControls),
+    /// The firmware on standard input.
+    Stdin(StdinControls),
+}
+
+/// Everything the screen shows: a pure function of this draws it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HmiState {
+    /// What is watched (the motor, the log's path, "firmware on stdin").
+    pub title: String,
+    /// The latest reading.
+    pub latest: Option<Snapshot>,
+    /// Residuals over the last [`HISTORY_S`], oldest first: (time [s], r1..r4).
+    pub history: VecDeque<(f64, [f32; 4])>,
+    /// Data-quality warnings (and anything else that limits what the screen means).
+    pub warnings: Vec<String>,
+    /// The last few events (fault switched on, commissioning started ...), newest last.
+    pub events: VecDeque<String>,
+    /// Events since the start (the list keeps the last few).
+    pub events_total: u64,
+    /// The source's controls.
+    pub controls: Controls,
+    /// The user asked to quit.
+    pub quit: bool,
+}
+
+impl HmiState {
+    /// An empty screen for a source.
+    pub fn new(title: impl Into<String>, controls: Controls) -> Self {
+        HmiState {
+            title: title.into(),
+            latest: None,
+            history: VecDeque::new(),
+            warnings: Vec::new(),
+            events: VecDeque::new(),
+            events_total: 0,
+            controls,
+            quit: false,
+        }
+    }
+
+    /// A new reading: the latest, and into the strip chart (a reading earlier than the
+    /// last one starts the chart again).
+    pub fn push(&mut self, s: Snapshot) {
+        if self.history.back().is_some_and(|(t, _)| *t > s.t_s) {
+            self.history.clear();
+        }
+        self.history.push_back((s.t_s, s.residuals));
+        while self
+            .history
+            .front()
+            .is_some_and(|(t, _)| *t < s.t_s - HISTORY_S)
+        {
+            self.history.pop_front();
+        }
+        self.latest = Some(s);
+    }
+
+    /// Adds an event to the list.
+    pub fn event(&mut self, text: impl Into<String>) {
+        self.events.push_back(text.into());
+        self.events_total += 1;
+        while self.events.len() > EVENTS_KEPT {
+            self.events.pop_front();
+        }
+    }
+
+    /// One line for a terminal that is not a screen (stdout piped): time, speed, lamps,
+    /// state and the top candidate.
+    pub fn status_line(&self) -> String {
+        let Some(s) = &self.latest else {
+            return format!("{}: waiting for the first reading", self.title);
+        };
+        let lamps: String = s.lamps.iter().map(|l| if *l { '●' } else { '○' }).collect();
+        format!(
+            "{:8.2} s  {:6.0} rpm  {}{}  {}",
+            s.t_s,
+            s.speed_rpm,
+            lamps,
+            if s.fault_lamp { " FAULT" } else { "" },
+            state_text(&s.state, &s.candidates)
+        )
+    }
+}
+
+/// The monitor's state in words (the screen and the plain-text line).
+pub fn state_text(state: &MonitorState, candidates: &[(Fault, f32)]) -> String {
+    match state {
+        MonitorState::Commissioning(x) => format!("commissioning {:.0} %", x * 100.0),
+        MonitorState::Transient => "transient (lamps hold)".to_string(),
+        MonitorState::Starting => "starting (settling)".to_string(),
+        MonitorState::Healthy => "healthy".to_string(),
+        MonitorState::Fault(_) => {
+            let names: Vec<String> = candidates
+                .iter()
+                .map(|(f, p)| format!("{} {:.0} %", f.name(), p * 100.0))
+                .collect();
+            format!("FAULT: {}", names.join(" / "))
+        }
+    }
+}
+
+/// A key the HMI reacts to (the binary maps the terminal's key events onto these).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Key {
+    /// A printable character.
+    Char(char),
+    /// Left arrow.
+    Left,
+    /// Right arrow.
+    Right,
+    /// Page up.
+    PageUp,
+    /// Page down.
+    PageDown,
+    /// Home.
+    Home,
+    /// End.
+    End,
+    /// Escape.
+    Esc,
+}
+
+/// Which source a key belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum KeyScope {
+    /// Every source.
+    All,
+    /// The live simulation.
+    Live,
+    /// A log replay.
+    Replay,
+}
+
+/// One key binding: the key as printed, the sources it acts in, and what it does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct KeyBinding {
+    /// The key(s) as the user types them.
+    pub keys: &'static str,
+    /// Where it acts.
+    pub scope: KeyScope,
+    /// What it does.
+    pub what: &'static str,
+    /// Its few words in the screen's footer.
+    pub footer: &'static str,
+}
+
+/// The HMI's keys: the one list (the screen's footer, `sim-host hmi --help` and the
+/// README print it; the sources act on exactly these).
+pub const KEYS: &[KeyBinding] = &[
+    KeyBinding {
+        keys: "1..9",
+        scope: KeyScope::Live,
+        what: "switch Table 1 fault on/off: 1 rs 2 rr 3 ls 4 lr 5 b 6 bl 7 current_sensor 8 voltage_sensor 9 speed_sensor",
+        footer: "1-9 fault",
+    },
+    KeyBinding {
+        keys: "0",
+        scope: KeyScope::Live,
+        what: "clear every fault",
+        footer: "0 clear",
+    },
+    KeyBinding {
+        keys: "s",
+        scope: KeyScope::Live,
+        what: "size of the next fault: +50 % / -50 % / +20 % / -20 %",
+        footer: "s size",
+    },
+    KeyBinding {
+        keys: "+ -",
+        scope: KeyScope::Live,
+        what: "load step: Bl +10 % / -10 %",
+        footer: "+- load",
+    },
+    KeyBinding {
+        keys: "v V",
+        scope: KeyScope::Live,
+        what: "supply voltage step -5 % / +5 %",
+        footer: "vV volt",
+    },
+    KeyBinding {
+        keys: "f F",
+        scope: KeyScope::Live,
+        what: "supply frequency step -1 Hz / +1 Hz",
+        footer: "fF freq",
+    },
+    KeyBinding {
+        keys: "c",
+        scope: KeyScope::Live,
+        what: "start commissioning (learn the healthy thresholds over 3 s of steady running)",
+        footer: "c commission",
+    },
+    KeyBinding {
+        keys: "space",
+        scope: KeyScope::All,
+        what: "pause / resume (live simulation and replay)",
+        footer: "␣ pause",
+    },
+    KeyBinding {
+        keys: "> <",
+        scope: KeyScope::Replay,
+        what: "replay speed: next (1x, 10x, max) / previous",
+        footer: "<> speed",
+    },
+    KeyBinding {
+        keys: "left right",
+        scope: KeyScope::Replay,
+        what: "seek -5 s / +5 s",
+        footer: "←→ 5 s",
+    },
+    KeyBinding {
+        keys: "pgup pgdn",
+        scope: KeyScope::Replay,
+        what: "seek -60 s / +60 s",
+        footer: "PgUp/Dn 60 s",
+    },
+    KeyBinding {
+        keys: "home end",
+        scope: KeyScope::Replay,
+        what: "seek to the start / to the end analysed so far",
+        footer: "Home/End",
+    },
+    KeyBinding {
+        keys: "q esc ctrl-c",
+        scope: KeyScope::All,
+        what: "quit",
+        footer: "q quit",
+    },
+];
+
+/// The key list as text (`--help`, the README), one key a line.
+pub fn key_help() -> String {
+    let mut s = String::from("Keys:\n");
+    for k in KEYS {
+        let scope = match k.scope {
+            KeyScope::All => "",
+            KeyScope::Live => " (live)",
+            KeyScope::Replay => " (replay)",
+        };
+        s.push_str(&format!("  {:<13} {}{}\n", k.keys, k.what, scope));
+    }
+    s
+}
+
+/// A source of readings for the HMI.
+pub trait Source {
+    /// Advances the source by `wall_s` seconds of wall-clock time and updates `state`.
+    fn advance(&mut self, wall_s: f64, state: &mut HmiState);
+    /// Acts on a key; false when the key means nothing to this source.
+    fn key(&mut self, key: Key, state: &mut HmiState) -> bool;
+    /// The state the screen starts from.
+    fn initial_state(&self) -> HmiState;
+}
+
+/// Quits on `q`, Esc (every source): true when the key was one of them.
+pub fn quit_key(key: Key, state: &mut HmiState) -> bool {
+    if matches!(key, Key::Char('q') | Key::Esc) {
+        state.quit = true;
+        return true;
+    }
+    false
+}

@@ -1,0 +1,354 @@
+//! The firmware's defmt status line, read back (`cargo fw-run | sim-host hmi --stdin`).
+//!
+//! The line's format is documented once, in the README ("The status line", section
+//! "Build, flash, logs"); the firmware prints it (`log_status` in `src/firmware.rs`) and
+//! the root test `tests/status_line.rs` renders the firmware's own format string with
+//! known values and parses it here. One line:
+//!
+//! ```text
+//! r=[r1, r2, r3, r4] lamps=[b1, b2, b3, b4] fault=B top=NAME(P) 2nd=NAME(P) wm=Xrad/s
+//! zc_locked=.. mode=MODE run=ID:LEARNED/NEEDED overruns=N restarts=N samples=N
+//! max_cyc=N iqs=XA ids=XA vqs=XV f=XHz steady=B eval=B sens=B,B,B mid=[..] half=[..]
+//! ```
+//!
+//! The parser finds the `key=` fields anywhere in a line, so the decoder's decorations
+//! (a timestamp, the level, colours, the location, on the same or the next line) do not
+//! matter; a line is a status line when it has `r=[..]`, `lamps=[..]` and `fault=`.
+//! Fields an older firmware does not print are `None` on the screen. Other log lines with
+//! a level (`INFO`, `WARN`, `ERROR`) become events on the screen.
+
+use super::{quit_key, Controls, HmiState, Key, Snapshot, Source, StdinControls};
+use crate::demo::MonitorState;
+use monitor_core::Fault;
+use std::io::BufRead;
+use std::sync::mpsc::{channel, Receiver, TryRecvError};
+
+/// Interval between two status lines of the firmware [s] (the time axis when the lines
+/// carry no timestamp).
+pub const STATUS_PERIOD_S: f64 = 0.1;
+
+/// One status line's fields.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FirmwareStatus {
+    /// The decoder's timestamp [s], when it printed one.
+    pub timestamp_s: Option<f64>,
+    /// Normalised residuals r1..r4.
+    pub residuals: [f32; 4],
+    /// Residual lamps.
+    pub lamps: [bool; 4],
+    /// The fault lamp's cause: any lamp or a sensor fault.
+    pub fault: bool,
+    /// The two most probable candidates.
+    pub candidates: Vec<(Fault, f32)>,
+    /// Shaft speed [rad/s].
+    pub wm_rad_s: Option<f32>,
+    /// Panel mode (`commissioned`, `not-commissioned`, `commissioning`,
+    /// `sampling-stalled`, `failed`).
+    pub mode: Option<String>,
+    /// The latest commissioning run: id, evaluated blocks learned, needed.
+    pub run: Option<(u16, u32, u32)>,
+    /// I_qs [A].
+    pub iqs_a: Option<f32>,
+    /// i_ds [A].
+    pub ids_a: Option<f32>,
+    /// V_qs [V].
+    pub vqs_v: Option<f32>,
+    /// Frame (supply) frequency [Hz].
+    pub supply_hz: Option<f32>,
+    /// The quasi-steady gate is open.
+    pub steady: Option<bool>,
+    /// The lamps are being evaluated.
+    pub evaluating: Option<bool>,
+    /// Sensor flags: current, voltage, speed.
+    pub sensors: Option<[bool; 3]>,
+    /// Threshold band centres and half-widths.
+    pub band: Option<([f32; 4], [f32; 4])>,
+}
+
+/// The value of field `key` in `line` (`key=` at the start or after a space), up to the
+/// next field; `None` when absent.
+fn field<'a>(line: &'a str, key: &str) -> Option<&'a str> {
+    let pat = format!("{key}=");
+    let mut from = 0;
+    while let Some(k) = line[from..].find(&pat) {
+        let at = from + k;
+        if at == 0 || line[..at].ends_with(' ') {
+            let rest = &line[at + pat.len()..];
+            let end = if rest.starts_with('[') {
+                rest.find(']').map_or(rest.len(), |e| e + 1)
+            } else {
+                rest.find(char::is_whitespace).unwrap_or(rest.len())
+            };
+            return Some(&rest[..end]);
+        }
+        from = at + pat.len();
+    }
+    None
+}
+
+/// A number with a unit suffix (`151.2rad/s`, `4.1A`).
+fn number(v: &str) -> Option<f32> {
+    let end = v
+        .find(|c: char| !(c.is_ascii_digit() || matches!(c, '.' | '-' | '+' | 'e' | 'E')))
+        .unwrap_or(v.len());
+    v[..end].parse().ok()
+}
+
+fn list(v: &str) -> Option<Vec<&str>> {
+    let inner = v.strip_prefix('[')?.strip_suffix(']')?;
+    Some(inner.split(',').map(str::trim).collect())
+}
+
+fn floats4(v: &str) -> Option<[f32; 4]> {
+    let l = list(v)?;
+    let x: Vec<f32> = l.iter().filter_map(|s| s.parse().ok()).collect();
+    x.try_into().ok()
+}
+
+fn bools4(v: &str) -> Option<[bool; 4]> {
+    let l = list(v)?;
+    let x: Vec<bool> = l.iter().filter_map(|s| s.parse().ok()).collect();
+    x.try_into().ok()
+}
+
+/// `name(p)`: a candidate, `None` for `none`.
+fn candidate(v: &str) -> Option<(Fault, f32)> {
+    let (name, p) = v.split_once('(')?;
+    let f = Fault::from_name(name)?;
+    let p = number(p)?;
+    (p > 0.0).then_some((f, p))
+}
+
+/// The line without terminal colour sequences (`ESC [ ... letter`).
+pub fn strip_ansi(line: &str) -> String {
+    let mut out = String::with_capacity(line.len());
+    let mut chars = line.chars();
+    while let Some(c) = chars.next() {
+        if c == '\u{1b}' {
+            for d in chars.by_ref() {
+                if d.is_ascii_alphabetic() {
+                    break;
+                }
+            }
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// Parses one line of the decoder's output; `None` when it is not a status line.
+pub fn parse(line: &str) -> Option<FirmwareStatus> {
+    let line = strip_ansi(line);
+    let line = line.trim();
+    let residuals = floats4(field(line, "r")?)?;
+    let lamps = bools4(field(line, "lamps")?)?;
+    let fault = field(line, "fault")?.parse().ok()?;
+    let f = |k| field(line, k).and_then(number);
+    let b = |k| field(line, k).and_then(|v| v.parse::<bool>().ok());
+    let run = field(line, "run").and_then(|v| {
+        let (id, rest) = v.split_once(':')?;
+        let (l, n) = rest.split_once('/')?;
+        Some((id.parse().ok()?, l.parse().ok()?, n.parse().ok()?))
+    });
+    let sensors = field(line, "sens").and_then(|v| {
+        let x: Vec<bool> = v.split(',').filter_map(|s| s.parse().ok()).collect();
+        x.try_into().ok()
+    });
+    let band = field(line, "mid")
+        .and_then(floats4)
+        .zip(field(line, "half").and_then(floats4));
+    let timestamp_s = line
+        .split_whitespace()
+        .next()
+        .and_then(|t| t.parse::<f64>().ok());
+    Some(FirmwareStatus {
+        timestamp_s,
+        residuals,
+        lamps,
+        fault,
+        candidates: ["top", "2nd"]
+            .iter()
+            .filter_map(|k| field(line, k).and_then(candidate))
+            .collect(),
+        wm_rad_s: f("wm"),
+        mode: field(line, "mode").map(str::to_string),
+        run,
+        iqs_a: f("iqs"),
+        ids_a: f("ids"),
+        vqs_v: f("vqs"),
+        supply_hz: f("f"),
+        steady: b("steady"),
+        evaluating: b("eval"),
+        sensors,
+        band,
+    })
+}
+
+impl FirmwareStatus {
+    /// The reading on the screen at `t_s`.
+    pub fn snapshot(&self, t_s: f64) -> Snapshot {
+        let commissioning = self.mode.as_deref() == Some("commissioning");
+        let state = match self.run {
+            Some((_, l, n)) if commissioning && n > 0 => {
+                MonitorState::Commissioning((l as f32 / n as f32).min(1.0))
+            }
+            _ if commissioning => MonitorState::Commissioning(0.0),
+            _ if self.steady == Some(false) => MonitorState::Transient,
+            _ if self.evaluating == Some(false) => MonitorState::Starting,
+            _ if self.fault && !self.candidates.is_empty() => {
+                MonitorState::Fault(self.candidates.clone())
+            }
+            _ => MonitorState::Healthy,
+        };
+        let sensor_faults = self.sensors.map_or(Vec::new(), |s| {
+            [
+                Fault::CurrentSensor,
+                Fault::VoltageSensor,
+                Fault::SpeedSensor,
+            ]
+            .into_iter()
+            .zip(s)
+            .filter_map(|(f, on)| on.then_some(f))
+            .collect()
+        });
+        Snapshot {
+            t_s,
+            residuals: self.residuals,
+            lamps: self.lamps,
+            fault_lamp: self.fault,
+            bands: self.band.map(|(m, h)| [0, 1, 2, 3].map(|k| (m[k], h[k]))),
+            learned: self.mode.as_deref() == Some("commissioned"),
+            candidates: self.candidates.clone(),
+            sensor_faults,
+            asymmetry: None,
+            speed_rpm: self.wm_rad_s.unwrap_or(0.0) * 60.0 / std::f32::consts::TAU,
+            iqs_a: self.iqs_a,
+            ids_a: self.ids_a,
+            vqs_v: self.vqs_v,
+            supply_hz: self.supply_hz,
+            state,
+        }
+    }
+}
+
+/// A log line that is not a status line but says something (`INFO`, `WARN`, `ERROR`):
+/// its message, without the decoder's decorations.
+pub fn event_text(line: &str) -> Option<String> {
+    let line = strip_ansi(line);
+    for level in ["ERROR", "WARN", "INFO"] {
+        if let Some(k) = line.find(level) {
+            let msg = line[k + level.len()..]
+                .trim_start_matches([' ', ']'])
+                .trim();
+            // The decoder's one-line location suffix, "(crate src/file.rs:12)".
+            let msg = match msg.rfind(" (") {
+                Some(p) if msg.ends_with(')') && msg[p..].contains(".rs:") => &msg[..p],
+                _ => msg,
+            };
+            let tag = if level == "INFO" { "" } else { level };
+            return Some(format!(
+                "{tag}{}{msg}",
+                if tag.is_empty() { "" } else { " " }
+            ));
+        }
+    }
+    None
+}
+
+/// The firmware's status lines from standard input (or any reader), read on a thread.
+pub struct StdinStatus {
+    lines: Receiver<String>,
+    controls: StdinControls,
+    one_at_a_time: bool,
+}
+
+impl StdinStatus {
+    /// Reads standard input.
+    pub fn stdin() -> Self {
+        Self::from_reader(std::io::stdin())
+    }
+
+    /// Reads `r` line by line on a thread.
+    pub fn from_reader(r: impl std::io::Read + Send + 'static) -> Self {
+        let (tx, lines) = channel();
+        std::thread::spawn(move || {
+            for line in std::io::BufReader::new(r).lines() {
+                let Ok(line) = line else { break };
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        StdinStatus {
+            lines,
+            controls: StdinControls::default(),
+            one_at_a_time: false,
+        }
+    }
+
+    /// Takes at most one status line per [`Source::advance`] (plain text prints every
+    /// reading of a recorded file), instead of every line waiting.
+    pub fn one_at_a_time(mut self) -> Self {
+        self.one_at_a_time = true;
+        self
+    }
+
+    /// Takes one line into the state; true for a status line.
+    pub fn take_line(&mut self, line: &str, state: &mut HmiState) -> bool {
+        let c = &mut self.controls;
+        c.lines += 1;
+        if let Some(s) = parse(line) {
+            let t = s
+                .timestamp_s
+                .unwrap_or(c.status_lines as f64 * STATUS_PERIOD_S);
+            c.status_lines += 1;
+            if s.mode.is_some() && s.mode != c.mode {
+                if let Some(m) = &s.mode {
+                    state.event(format!("{t:.1} s: mode {m}"));
+                }
+                c.mode.clone_from(&s.mode);
+            }
+            state.push(s.snapshot(t));
+            return true;
+        }
+        if let Some(e) = event_text(line) {
+            state.event(e);
+        }
+        false
+    }
+}
+
+impl Source for StdinStatus {
+    fn advance(&mut self, _wall_s: f64, state: &mut HmiState) {
+        loop {
+            match self.lines.try_recv() {
+                Ok(line) => {
+                    if self.take_line(&line, state) && self.one_at_a_time {
+                        break;
+                    }
+                }
+                Err(TryRecvError::Empty) => break,
+                Err(TryRecvError::Disconnected) => {
+                    if !self.controls.ended {
+                        self.controls.ended = true;
+                        state.event("standard input ended");
+                    }
+                    break;
+                }
+            }
+        }
+        state.controls = Controls::Stdin(self.controls.clone());
+    }
+
+    fn key(&mut self, key: Key, state: &mut HmiState) -> bool {
+        quit_key(key, state)
+    }
+
+    fn initial_state(&self) -> HmiState {
+        HmiState::new(
+            "firmware status lines on standard input",
+            Controls::Stdin(self.controls.clone()),
+        )
+    }
+}

@@ -1,0 +1,363 @@
+//! The live HMI's three sources (`sim-host hmi`): the live simulation with its keys, a
+//! replay of a small simulated log through the data-quality stage and the core, and the
+//! firmware's status lines on standard input. (The screen itself: the binary's tests in
+//! `src/cli/render/hmi.rs`; a real terminal: `hmi_tmux.rs`.)
+
+use monitor_core::Fault;
+use sim_host::demo::MonitorState;
+use sim_host::fault_signatures::{scenario, Protocol};
+use sim_host::hmi::live::LiveSim;
+use sim_host::hmi::log_replay::LogReplay;
+use sim_host::hmi::status_line::{self, StdinStatus};
+use sim_host::hmi::{Controls, HmiState, Key, Source, Speed};
+use sim_host::log::Log;
+use sim_host::params::ParamFile;
+use sim_host::replay::ReplayOptions;
+use sim_host::sim::simulate_to_vec;
+
+/// Runs the live source for `seconds` of simulated time, in 0.25 s steps as the screen
+/// would.
+fn run(live: &mut LiveSim, state: &mut HmiState, seconds: f64) {
+    for _ in 0..(seconds / 0.25).round() as usize {
+        live.advance(0.25, state);
+    }
+}
+
+fn names(state: &HmiState) -> Vec<Fault> {
+    state
+        .latest
+        .as_ref()
+        .map(|s| s.candidates.iter().map(|(f, _)| *f).collect())
+        .unwrap_or_default()
+}
+
+#[test]
+fn live_simulation_commissions_and_a_key_injects_a_fault() {
+    let mut live = LiveSim::demo_motor().expect("reference motor");
+    let mut state = live.initial_state();
+    run(&mut live, &mut state, 2.0);
+    let s = state.latest.clone().expect("readings");
+    assert!(
+        (s.t_s - 1.95).abs() < 1e-6,
+        "one reading every 50 ms: {}",
+        s.t_s
+    );
+    assert!(
+        s.speed_rpm > 1700.0 && s.speed_rpm < 1800.0,
+        "{}",
+        s.speed_rpm
+    );
+    assert_eq!(s.state, MonitorState::Healthy, "{:?}", s.state);
+    assert!(!s.learned);
+    assert!(s.iqs_a.is_some_and(|x| x > 0.0) && s.vqs_v.is_some_and(|x| x > 100.0));
+    assert!(
+        s.supply_hz.is_some_and(|f| (f - 60.0).abs() < 0.5),
+        "{:?}",
+        s.supply_hz
+    );
+    // The strip chart holds the readings so far.
+    assert_eq!(state.history.len(), 40);
+
+    // c: commissioning with progress, then the learned thresholds in force.
+    assert!(live.key(Key::Char('c'), &mut state));
+    run(&mut live, &mut state, 1.0);
+    let progress = match state.latest.as_ref().map(|s| &s.state) {
+        Some(MonitorState::Commissioning(x)) => *x,
+        other => panic!("not commissioning: {other:?}"),
+    };
+    assert!(progress > 0.0 && progress < 1.0, "{progress}");
+    assert!(state
+        .events
+        .iter()
+        .any(|e| e.contains("commissioning run 1 started")));
+    run(&mut live, &mut state, 3.5);
+    let s = state.latest.clone().expect("readings");
+    assert!(
+        s.learned && s.state == MonitorState::Healthy,
+        "{:?}",
+        s.state
+    );
+    assert!(!s.fault_lamp && names(&state).is_empty());
+
+    // 6: the paper's Enable_F_Bl switch, Bl +50 %: r2..r4 light, b and bl named.
+    assert!(live.key(Key::Char('6'), &mut state));
+    assert_eq!(live.controls().faults, vec![(Fault::Bl, 0.5)]);
+    assert!(matches!(&state.controls, Controls::Live(c) if c.faults.len() == 1));
+    run(&mut live, &mut state, 3.0);
+    let s = state.latest.clone().expect("readings");
+    assert_eq!(s.lamps, [false, true, true, true], "{:?}", s.residuals);
+    assert!(s.fault_lamp);
+    let n = names(&state);
+    assert!(n.contains(&Fault::Bl) && n.contains(&Fault::B), "{n:?}");
+    assert!(matches!(s.state, MonitorState::Fault(_)));
+    // A lit residual lies outside its learned band.
+    let bands = s.bands.expect("bands");
+    for (k, (r, (c, h))) in s.residuals.iter().zip(bands).enumerate().skip(1) {
+        assert!((r - c).abs() > h, "r{}: {r} in {c}±{h}", k + 1);
+    }
+
+    // 6 again clears it: the lamps go out once the load is back.
+    assert!(live.key(Key::Char('6'), &mut state));
+    assert!(live.controls().faults.is_empty());
+    run(&mut live, &mut state, 4.0);
+    let s = state.latest.clone().expect("readings");
+    assert_eq!(s.lamps, [false; 4], "{:?} {:?}", s.residuals, s.state);
+}
+
+#[test]
+fn live_simulation_steps_the_load_and_the_supply() {
+    let mut live = LiveSim::demo_motor().expect("reference motor");
+    let mut state = live.initial_state();
+    run(&mut live, &mut state, 1.5);
+    let before = state.latest.clone().expect("readings");
+    for _ in 0..3 {
+        live.key(Key::Char('+'), &mut state);
+    }
+    live.key(Key::Char('F'), &mut state);
+    run(&mut live, &mut state, 1.5);
+    let after = state.latest.clone().expect("readings");
+    // More load: more torque current; 1 Hz more supply: the frame follows.
+    assert!(
+        after.iqs_a.unwrap_or(0.0) > before.iqs_a.unwrap_or(0.0) * 1.1,
+        "{:?} -> {:?}",
+        before.iqs_a,
+        after.iqs_a
+    );
+    let f = after.supply_hz.unwrap_or(0.0);
+    assert!((f - 61.0).abs() < 0.2, "{f}");
+    match &state.controls {
+        Controls::Live(c) => {
+            assert!((c.load_scale - 1.3).abs() < 1e-9 && (c.supply_hz - 61.0).abs() < 1e-9);
+        }
+        other => panic!("{other:?}"),
+    }
+    // Space pauses: no new reading.
+    live.key(Key::Char(' '), &mut state);
+    let t = state.latest.as_ref().map(|s| s.t_s);
+    live.advance(0.25, &mut state);
+    assert_eq!(state.latest.as_ref().map(|s| s.t_s), t);
+}
+
+#[test]
+fn a_simulated_log_replays_with_speed_pause_and_seek() {
+    let params = ParamFile::reference_3hp();
+    let proto = Protocol {
+        duration_s: 7.5,
+        fault_at_s: 5.0,
+        sample_rate_hz: 5_000.0,
+        ..Protocol::default()
+    };
+    let sc = scenario(Some((Fault::Lr, -0.5)), &proto);
+    let log = Log {
+        channels: sc.sensors.channels(),
+        rows: simulate_to_vec(&params, &sc).expect("simulation"),
+    };
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("lr.csv");
+    log.write(&path).expect("write");
+    let opts = ReplayOptions {
+        commission: Some((2.0, 4.0)),
+        ..ReplayOptions::default()
+    };
+    let mut replay = LogReplay::start(params, &path, opts, Speed::X1).expect("log opens");
+    let mut state = replay.initial_state();
+    replay.wait();
+
+    // 1x: one second of wall time is one second of log.
+    replay.advance(1.0, &mut state);
+    assert!((replay.controls().position_s - 1.0).abs() < 1e-9);
+    let s = state.latest.clone().expect("reading");
+    assert!((s.t_s - 1.0).abs() < 1e-6, "{}", s.t_s);
+    // 10x.
+    replay.key(Key::Char('>'), &mut state);
+    replay.advance(0.2, &mut state);
+    assert!((replay.controls().position_s - 3.0).abs() < 1e-9);
+    assert!(matches!(
+        state.latest.as_ref().map(|s| &s.state),
+        Some(MonitorState::Commissioning(_))
+    ));
+    // Pause: time stands still.
+    replay.key(Key::Char(' '), &mut state);
+    replay.advance(1.0, &mut state);
+    assert!((replay.controls().position_s - 3.0).abs() < 1e-9);
+    // Seek to the end: the lr fault is named and the verdict is in.
+    replay.key(Key::End, &mut state);
+    let c = replay.controls().clone();
+    assert!(c.done && (c.position_s - 7.5).abs() < 0.06, "{c:?}");
+    assert_eq!(c.verdict.as_deref(), Some("fault"));
+    let s = state.latest.clone().expect("reading");
+    assert!(s.learned && s.fault_lamp, "{:?}", s.state);
+    assert!(names(&state).contains(&Fault::Lr), "{:?}", names(&state));
+    assert!(
+        state.history.len() > 150,
+        "the strip chart's 10 s: {}",
+        state.history.len()
+    );
+    // Seek back 5 s: inside the commissioning window again.
+    replay.key(Key::Left, &mut state);
+    let s = state.latest.clone().expect("reading");
+    assert!(
+        (s.t_s - (c.position_s - 5.0)).abs() < 0.06,
+        "{} {}",
+        s.t_s,
+        c.position_s
+    );
+    assert!(
+        matches!(s.state, MonitorState::Commissioning(_)),
+        "{:?}",
+        s.state
+    );
+    replay.key(Key::Home, &mut state);
+    assert_eq!(replay.controls().position_s, 0.0);
+    // A missing log is a one-line error before the screen starts.
+    let e = LogReplay::start(params, &dir.path().join("nope.csv"), opts, Speed::Max)
+        .err()
+        .expect("missing log")
+        .to_string();
+    assert!(e.contains("nope.csv"), "{e}");
+}
+
+#[test]
+fn firmware_status_lines_from_a_recorded_sample() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fw_status_sample.txt");
+    let file = std::fs::File::open(&path).expect("sample");
+    let mut src = StdinStatus::from_reader(file);
+    let mut state = src.initial_state();
+    for _ in 0..200 {
+        src.advance(0.05, &mut state);
+        if matches!(&state.controls, Controls::Stdin(c) if c.ended) {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let Controls::Stdin(c) = &state.controls else {
+        panic!("{:?}", state.controls)
+    };
+    assert!(c.ended);
+    assert_eq!(c.status_lines, 5);
+    assert_eq!(c.mode.as_deref(), Some("commissioned"));
+    // The last status line (colours, one-line location) as the screen shows it.
+    let s = state.latest.clone().expect("reading");
+    assert!((s.t_s - 0.4).abs() < 1e-9, "{}", s.t_s);
+    assert_eq!(s.lamps, [false, true, true, true]);
+    assert!(s.fault_lamp && s.learned);
+    assert_eq!(names(&state), vec![Fault::B, Fault::Bl]);
+    assert!((s.speed_rpm - 148.2 * 60.0 / std::f32::consts::TAU).abs() < 0.01);
+    assert_eq!(s.iqs_a, Some(4.12));
+    assert_eq!(s.supply_hz, Some(50.01));
+    let bands = s.bands.expect("bands");
+    assert_eq!(bands[1], (-0.0101, 0.011));
+    assert!(matches!(s.state, MonitorState::Fault(_)));
+    assert_eq!(state.history.len(), 5);
+    // The other log lines are events: the overrun warning among them.
+    assert!(
+        state
+            .events
+            .iter()
+            .any(|e| e == "WARN ADC DMA overrun #1 (adc1 true adc2 false)"),
+        "{:?}",
+        state.events
+    );
+    assert!(
+        state.events.iter().any(|e| e.contains("mode commissioned")),
+        "{:?}",
+        state.events
+    );
+}
+
+#[test]
+fn status_line_fields() {
+    // Commissioning with progress from run=ID:LEARNED/NEEDED.
+    let l = "INFO  r=[0.1, 0.2, 0.3, 0.4] lamps=[false, false, false, false] fault=false top=none(0.0) 2nd=none(0.0) wm=150.0rad/s mode=commissioning run=3:1000/4000";
+    let s = status_line::parse(l).expect("status line").snapshot(1.0);
+    assert_eq!(s.state, MonitorState::Commissioning(0.25));
+    assert_eq!(s.residuals, [0.1, 0.2, 0.3, 0.4]);
+    // An older firmware's line, without the operating point: those are absent, not zero.
+    assert_eq!(s.iqs_a, None);
+    assert_eq!(s.bands, None);
+    // A decoder timestamp is the time axis.
+    let t = status_line::parse(&format!("12.500000 {l}")).expect("status line");
+    assert_eq!(t.timestamp_s, Some(12.5));
+    // Sensor flags and a transient.
+    let l2 = "r=[0.0, 0.0, 0.0, 0.0] lamps=[false, false, false, false] fault=true top=none(0.0) 2nd=none(0.0) steady=false sens=true,false,false";
+    let s2 = status_line::parse(l2).expect("status line").snapshot(0.0);
+    assert_eq!(s2.sensor_faults, vec![Fault::CurrentSensor]);
+    assert_eq!(s2.state, MonitorState::Transient);
+    // Not status lines.
+    for other in [
+        "INFO  sampling at 10000 Hz",
+        "└─ drive_monitor::firmware::log_status @ src/firmware.rs:545",
+        "r=[0.1, 0.2] lamps=[false] fault=false",
+        "",
+    ] {
+        assert!(status_line::parse(other).is_none(), "{other}");
+    }
+}
+
+/// Stdout not a terminal: one status line per reading interval, the events, then exit 0
+/// when standard input ends.
+#[test]
+fn plain_text_when_stdout_is_not_a_terminal() {
+    let sample =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fw_status_sample.txt");
+    let o = assert_cmd::Command::cargo_bin("sim-host")
+        .expect("binary")
+        .args(["hmi", "--stdin", "--every", "0.1"])
+        .pipe_stdin(&sample)
+        .expect("stdin")
+        .timeout(std::time::Duration::from_secs(60))
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let status: Vec<&str> = out.lines().filter(|l| l.contains(" rpm ")).collect();
+    assert_eq!(status.len(), 5, "{out}");
+    assert!(status[2].contains("commissioning 5 %"), "{out}");
+    assert!(
+        status[4].contains("○●●● FAULT") && status[4].contains("b 50 % / bl 50 %"),
+        "{out}"
+    );
+    assert!(out.contains("> WARN ADC DMA overrun #1"), "{out}");
+    // No escape sequences: plain text.
+    assert!(!out.contains('\u{1b}'), "{out:?}");
+
+    // The live simulation for two seconds of wall time.
+    let o = assert_cmd::Command::cargo_bin("sim-host")
+        .expect("binary")
+        .args(["hmi", "--duration", "2", "--every", "0.5"])
+        .timeout(std::time::Duration::from_secs(60))
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.starts_with("live simulation: DESIGN.md 3 hp motor"),
+        "{out}"
+    );
+    assert!(
+        out.lines().filter(|l| l.contains(" rpm ")).count() >= 2,
+        "{out}"
+    );
+}
+
+/// `hmi --help` teaches: examples and the key list; the README's key list is the same.
+#[test]
+fn the_help_and_the_readme_list_the_keys() {
+    let o = assert_cmd::Command::cargo_bin("sim-host")
+        .expect("binary")
+        .args(["hmi", "--help"])
+        .output()
+        .expect("runs");
+    assert!(o.status.success());
+    let help = String::from_utf8_lossy(&o.stdout);
+    assert!(help.contains("sim-host hmi LOG --params P.toml") && help.contains("--stdin"));
+    let readme = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md"),
+    )
+    .expect("README");
+    for line in sim_host::hmi::key_help().lines().skip(1) {
+        assert!(help.contains(line), "--help lacks `{line}`");
+        assert!(readme.contains(line), "README lacks `{line}`");
+    }
+}

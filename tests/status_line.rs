@@ -1,0 +1,141 @@
+//! The firmware's defmt status line and its reader (`sim-host hmi --stdin`) agree: the
+//! format string of `log_status` in `src/firmware.rs` is rendered here with known values
+//! the way defmt's decoder prints them, and `sim_host::hmi::status_line::parse` must read
+//! every value back; the README's "The status line" documents every field.
+
+use monitor_core::Fault;
+use sim_host::demo::MonitorState;
+use sim_host::hmi::status_line;
+use std::path::PathBuf;
+
+fn read(path: &str) -> String {
+    let full = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(path);
+    std::fs::read_to_string(&full).unwrap_or_else(|e| panic!("{}: {e}", full.display()))
+}
+
+/// The format string and the argument expressions of the `info!` in `fn log_status`.
+fn log_status_format() -> (String, Vec<String>) {
+    let src = read("src/firmware.rs");
+    let body = &src[src
+        .find("fn log_status")
+        .expect("fn log_status in src/firmware.rs")..];
+    let call = &body[body.find("info!(").expect("info! in log_status") + "info!(".len()..];
+    let open = call.find('"').expect("format string");
+    let close = open
+        + 1
+        + call[open + 1..]
+            .find('"')
+            .expect("end of the format string");
+    let format = call[open + 1..close].to_string();
+    let args_end = call[close..].find(");").expect("end of info!") + close;
+    let args = call[close + 1..args_end]
+        .split(',')
+        .map(|a| a.trim().to_string())
+        .filter(|a| !a.is_empty())
+        .collect();
+    (format, args)
+}
+
+/// What defmt's decoder prints for each argument, by its expression in `log_status`.
+fn value(arg: &str) -> &'static str {
+    match arg {
+        "s.residuals" => "[0.0123, -0.1, 0.25, -0.004]",
+        "s.residual_lamps" => "[false, true, true, true]",
+        "s.fault_detected" => "true",
+        "top_name" => "b",
+        "top_p" => "0.5",
+        "second_name" => "bl",
+        "second_p" => "0.5",
+        "s.speed_rad_s" => "150.5",
+        "s.zero_crossing_locked" => "None",
+        "mode" => "commissioned",
+        "s.run.id" => "2",
+        "s.run.blocks_learned" => "4000",
+        "s.run.blocks_needed" => "4000",
+        "OVERRUNS.load(Ordering::Relaxed)" | "RESTARTS.load(Ordering::Relaxed)" => "0",
+        "s.samples" => "123456",
+        "max_update_cycles" => "2310",
+        "s.operating.iqs" => "4.25",
+        "s.operating.i_f" => "2.5",
+        "s.operating.vqs" => "320.5",
+        "s.frame_hz" => "50.02",
+        "s.quasi_steady" => "true",
+        "s.evaluating" => "true",
+        "s.sensor_fault.current" => "false",
+        "s.sensor_fault.voltage" => "true",
+        "s.sensor_fault.speed" => "false",
+        "mid" => "[0.001, -0.01, 0.009, 0.0]",
+        "half" => "[0.006, 0.011, 0.012, 0.007]",
+        other => panic!(
+            "log_status prints `{other}`: give it a test value here and teach \
+             sim_host::hmi::status_line to read it"
+        ),
+    }
+}
+
+/// The format string with each `{...}` placeholder replaced by its argument's value.
+fn render(format: &str, args: &[String]) -> String {
+    let mut out = String::new();
+    let mut rest = format;
+    let mut k = 0;
+    while let Some(open) = rest.find('{') {
+        out.push_str(&rest[..open]);
+        let close = open + rest[open..].find('}').expect("closing brace");
+        out.push_str(value(args.get(k).expect("an argument per placeholder")));
+        k += 1;
+        rest = &rest[close + 1..];
+    }
+    out.push_str(rest);
+    assert_eq!(k, args.len(), "placeholders and arguments differ in number");
+    out
+}
+
+#[test]
+fn the_hmi_reads_every_field_the_firmware_prints() {
+    let (format, args) = log_status_format();
+    let body = render(&format, &args);
+    // As probe-rs prints it: the level before, the location on the next line.
+    let line = format!("INFO  {body}");
+    let s = status_line::parse(&line).unwrap_or_else(|| panic!("not read: {line}"));
+    assert_eq!(s.residuals, [0.0123, -0.1, 0.25, -0.004]);
+    assert_eq!(s.lamps, [false, true, true, true]);
+    assert!(s.fault);
+    assert_eq!(s.candidates, vec![(Fault::B, 0.5), (Fault::Bl, 0.5)]);
+    assert_eq!(s.wm_rad_s, Some(150.5));
+    assert_eq!(s.mode.as_deref(), Some("commissioned"));
+    assert_eq!(s.run, Some((2, 4000, 4000)));
+    assert_eq!(
+        (s.iqs_a, s.ids_a, s.vqs_v, s.supply_hz),
+        (Some(4.25), Some(2.5), Some(320.5), Some(50.02))
+    );
+    assert_eq!((s.steady, s.evaluating), (Some(true), Some(true)));
+    assert_eq!(s.sensors, Some([false, true, false]));
+    assert_eq!(
+        s.band,
+        Some(([0.001, -0.01, 0.009, 0.0], [0.006, 0.011, 0.012, 0.007]))
+    );
+    let snap = s.snapshot(0.0);
+    assert!(snap.learned && snap.fault_lamp);
+    assert_eq!(snap.sensor_faults, vec![Fault::VoltageSensor]);
+    assert!(matches!(snap.state, MonitorState::Fault(_)));
+}
+
+#[test]
+fn the_readme_documents_every_field_of_the_status_line() {
+    let (format, _) = log_status_format();
+    let readme = read("README.md");
+    let start = readme
+        .find("#### The status line")
+        .expect("README section \"The status line\"");
+    let section = &readme[start..];
+    let section = &section[..section[4..].find("\n#").map_or(section.len(), |e| e + 4)];
+    for token in format.split_whitespace() {
+        let Some((key, _)) = token.split_once('=') else {
+            continue;
+        };
+        assert!(
+            section.contains(&format!("{key}=")),
+            "README \"The status line\" does not document `{key}=`"
+        );
+    }
+}
