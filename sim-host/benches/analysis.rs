@@ -139,7 +139,7 @@ fn convert(from: &std::path::Path, to: &std::path::Path) {
 
 /// Times read, compare and explain on one log.
 fn run(path: &std::path::Path, p: ParamFile, format: &str) {
-    let size = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+    let size = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
     let c0 = cpu_s();
     let t0 = Instant::now();
     let a = Analysis::load(

@@ -241,7 +241,10 @@ fn parquet_with(path: &Path, names: &[&str]) {
 
 /// A TDMS file (written by the tdms-rs crate, as another program would) with the given
 /// groups of f64 channels `(name, values)` and, on each channel, `props`.
-fn tdms_with(path: &Path, groups: &[(&str, Vec<(&str, Vec<f64>)>)], props: &[(&str, f64)]) {
+/// A group: its name and its channels `(name, values)`.
+type Group<'a> = (&'a str, Vec<(&'a str, Vec<f64>)>);
+
+fn tdms_with(path: &Path, groups: &[Group<'_>], props: &[(&str, f64)]) {
     use tdms_rs::{PropertyValue, TdmsWriter};
     let mut w = TdmsWriter::create(path).expect("create");
     for (g, chans) in groups {
