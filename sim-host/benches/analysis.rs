@@ -8,9 +8,14 @@
 //! Prints wall times of the read (parse + decimate + frame), `compare`, `explain`, the
 //! peak resident memory (VmHWM, also after the read and after `compare`) and the CPU time of
 //! each stage.
+//!
+//! The same log is also converted once to Parquet beside it (`.parquet`, through the one
+//! log writer, about 1.3 GB for 1 h) and analysed from there: one line per format.
+//! `ANALYSIS_BENCH_FORMATS` picks them (default `csv,parquet`; `tdms` too if asked). The peak
+//! memory is the process's (VmHWM): the second format's figure includes the first's.
 
 use sim_host::analysis::{prep::ReadOptions, Analysis, Options};
-use sim_host::log::{Channels, LogWriter};
+use sim_host::log::{Channels, LogFile, LogWriter, Row};
 use sim_host::params::ParamFile;
 use sim_host::sim::{self, EffectSpec, Scenario, SensorSpec};
 use std::path::PathBuf;
@@ -92,11 +97,53 @@ fn main() {
             t.elapsed().as_secs_f64()
         );
     }
-    let size = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+    let formats = std::env::var("ANALYSIS_BENCH_FORMATS").unwrap_or_else(|_| "csv,parquet".into());
+    for ext in formats.split(',').map(str::trim) {
+        let log = if ext == "csv" {
+            path.clone()
+        } else {
+            let out = path.with_extension(ext);
+            if !out.exists() {
+                convert(&path, &out);
+            }
+            out
+        };
+        run(&log, p, ext);
+    }
+}
+
+/// Converts `from` to `to` (the format of its extension) once, through the one reader and
+/// writer.
+fn convert(from: &std::path::Path, to: &std::path::Path) {
+    let t = Instant::now();
+    let file = LogFile::open(from).expect("open log");
+    let mut w = LogWriter::create(to, file.channels()).expect("create");
+    struct Sink<'a>(&'a mut LogWriter);
+    impl sim_host::log::RowSink for Sink<'_> {
+        fn row(&mut self, r: &Row) -> bool {
+            self.0.write_row(r).is_ok()
+        }
+        fn restart(&mut self) {
+            panic!("the generated log is read by the fast path, which does not restart");
+        }
+    }
+    file.for_each_row(&mut |_| {}, &mut Sink(&mut w))
+        .expect("read");
+    w.finish().expect("finish");
+    eprintln!(
+        "converted to {} in {:.1} s",
+        to.display(),
+        t.elapsed().as_secs_f64()
+    );
+}
+
+/// Times read, compare and explain on one log.
+fn run(path: &std::path::Path, p: ParamFile, format: &str) {
+    let size = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
     let c0 = cpu_s();
     let t0 = Instant::now();
     let a = Analysis::load(
-        &path,
+        path,
         p,
         ReadOptions {
             from_s: 1.0,
@@ -125,7 +172,7 @@ fn main() {
     let t_exp = t2.elapsed().as_secs_f64();
     let c_exp = cpu_s() - c0 - c_read - c_cmp;
     println!(
-        "analysis bench: {} rows ({:.2} GB), {} threads: read+frame {:.2} s, compare {:.2} s, explain {:.2} s, total {:.2} s; peak RSS {:.0} MB (after read {:.0} MB, after compare {:.0} MB); working samples {}; error {:.4}, top {:?}",
+        "analysis bench [{format}]: {} rows ({:.2} GB), {} threads: read+frame {:.2} s, compare {:.2} s, explain {:.2} s, total {:.2} s; peak RSS {:.0} MB (after read {:.0} MB, after compare {:.0} MB); working samples {}; error {:.4}, top {:?}",
         a.data.rows,
         size as f64 / 1e9,
         rayon::current_num_threads(),

@@ -251,7 +251,21 @@ impl Analysis {
         opts: ReadOptions,
         progress: &mut dyn FnMut(f64),
     ) -> Result<Self, AnalysisError> {
-        let (dec, quality) = prep::decimate_log(log, &params, opts, progress)?;
+        Self::load_file(&crate::log::LogFile::open(log)?, params, opts, progress)
+    }
+
+    /// [`Analysis::load`] on a log already opened (any format, a TDMS group chosen:
+    /// [`crate::log::LogFile::open_with`]).
+    ///
+    /// # Errors
+    /// As [`Analysis::load`].
+    pub fn load_file(
+        log: &crate::log::LogFile,
+        params: crate::params::ParamFile,
+        opts: ReadOptions,
+        progress: &mut dyn FnMut(f64),
+    ) -> Result<Self, AnalysisError> {
+        let (dec, quality) = prep::decimate_file(log, &params, opts, progress)?;
         let data = prep::voltage_model_flux_frame(&dec, &params);
         Ok(Analysis {
             data,

@@ -124,7 +124,21 @@ pub fn decimate_log(
     opts: ReadOptions,
     progress: &mut dyn FnMut(f64),
 ) -> Result<(Decimated, DataQuality), LogError> {
-    let file = LogFile::open(path)?;
+    decimate_file(&LogFile::open(path)?, params, opts, progress)
+}
+
+/// [`decimate_log`] on a log already opened (any format, a TDMS group chosen:
+/// [`LogFile::open_with`]).
+///
+/// # Errors
+/// As [`decimate_log`].
+pub fn decimate_file(
+    file: &LogFile,
+    params: &ParamFile,
+    opts: ReadOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<(Decimated, DataQuality), LogError> {
+    let path = file.path();
     let mut sink = Decimator::new(opts, file.estimated_rows(), file.channels());
     let mut stage = QualityStage::new(&mut sink, CellLimits::for_params(params), file.shown());
     let read = file.for_each_row(progress, &mut stage);

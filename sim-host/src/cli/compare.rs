@@ -14,16 +14,20 @@ pub struct Common {
     /// Parameter file (TOML, DESIGN.md §3) with the user's nominal motor and supply values.
     #[arg(long)]
     pub params: PathBuf,
-    /// Measurement log (CSV: t_s, va_V, vb_V, vc_V, ia_A, ib_A, ic_A, wm_rad_s; t_s and the
-    /// currents are the minimum).
+    /// Measurement log (t_s, va_V, vb_V, vc_V, ia_A, ib_A, ic_A, wm_rad_s; t_s and the
+    /// currents are the minimum) as CSV, TDMS (`.tdms`) or Parquet (`.parquet`).
     pub log: PathBuf,
+    /// The TDMS group holding the channels (when the file has several).
+    #[arg(long, value_name = "NAME")]
+    pub group: Option<String>,
     /// Effects already in the model, comma separated (e.g. `thermal_drift,load_torque`).
     #[arg(long, value_delimiter = ',', value_parser = super::parse_effect)]
     pub effects: Vec<EffectKind>,
     /// Print one JSON document on stdout instead of the table.
     #[arg(long)]
     pub json: bool,
-    /// Write the plots (SVG with labels, PNG without text) into this folder.
+    /// Write the plots (each as SVG and PNG, with title, axis labels and legend) into this
+    /// folder.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
     /// Write a one-page HTML report (report.html plus the plots) into this folder.
@@ -75,15 +79,20 @@ impl Common {
         let big = std::fs::metadata(&self.log)
             .map(|m| m.len() > 20_000_000)
             .unwrap_or(false);
+        let file = sim_host::log::LogFile::open_with(
+            &self.log,
+            &sim_host::log::OpenOptions {
+                group: self.group.clone(),
+            },
+        )
+        .context("cannot analyse the log")?;
         let pb = progress::bar(progress::FRACTION_STEPS, "reading log", big);
         let opts = ReadOptions {
             from_s: self.from.unwrap_or(f64::NEG_INFINITY),
             to_s: self.to.unwrap_or(f64::INFINITY),
         };
-        let a = Analysis::load(&self.log, params, opts, &mut |f| {
-            progress::set_fraction(&pb, f)
-        })
-        .context("cannot analyse the log")?;
+        let a = Analysis::load_file(&file, params, opts, &mut |f| progress::set_fraction(&pb, f))
+            .context("cannot analyse the log")?;
         pb.finish_and_clear();
         render::text::quality_warnings(&a.quality);
         Ok(a)

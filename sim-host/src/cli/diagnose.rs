@@ -3,15 +3,17 @@
 
 use super::{progress, render, AngleArg, ResidualArg};
 use clap::Args;
+use sim_host::log::{LogFile, OpenOptions};
 use sim_host::params::ParamFile;
-use sim_host::replay::{diagnose_file, ReplayError, ReplayOptions};
+use sim_host::replay::{diagnose_log, ReplayError, ReplayOptions};
 use std::path::PathBuf;
 
 /// Arguments of `diagnose`.
 #[derive(Debug, Args)]
 #[command(
     about = "Replay a measurement log through the core: lamps r1..r4, fault candidates, unbalance",
-    long_about = "Replay a measurement log (DESIGN.md CSV schema) through exactly the core code the \
+    long_about = "Replay a measurement log (DESIGN.md CSV schema; or TDMS / Parquet with the \
+same channel names, by the file's extension) through exactly the core code the \
 firmware runs, and report the residual lamps r1..r4, the fault candidates of the paper's Table 1 with \
 their probabilities, when a fault was first detected, and the negative-sequence (unbalance / faulty \
 phase) analysis.\n\nWithout --commission the fixed thresholds are used (3 % of each normalised \
@@ -35,8 +37,11 @@ pub struct DiagnoseArgs {
     /// Motor parameter file (TOML, DESIGN.md §3).
     #[arg(long)]
     pub params: PathBuf,
-    /// Measurement log (CSV).
+    /// Measurement log: CSV, TDMS (`.tdms`) or Parquet (`.parquet`), by its extension.
     pub log: PathBuf,
+    /// The TDMS group holding the channels (when the file has several).
+    #[arg(long, value_name = "NAME")]
+    pub group: Option<String>,
     /// Learn healthy thresholds over START:END seconds of the log (healthy running that
     /// covers the load and voltage range to be monitored).
     #[arg(long, value_name = "START:END", value_parser = super::parse_window)]
@@ -77,8 +82,14 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
     let big = std::fs::metadata(&args.log)
         .map(|m| m.len() > 20_000_000)
         .unwrap_or(false);
+    let file = LogFile::open_with(
+        &args.log,
+        &OpenOptions {
+            group: args.group.clone(),
+        },
+    )?;
     let bar = progress::bar(progress::FRACTION_STEPS, "reading log", big);
-    let d = diagnose_file(&params, &args.log, opts, &mut |f| {
+    let d = diagnose_log(&params, &file, opts, &mut |f| {
         progress::set_fraction(&bar, f)
     })
     .map_err(|e| match e {

@@ -6,6 +6,7 @@
 
 mod bench;
 mod compare;
+pub mod convert;
 mod demo;
 mod diagnose;
 mod hmi;
@@ -31,7 +32,8 @@ D-Q model, fault signature matching), and compares the model with measurements t
 and which physical effect is missing.\n\nStart with:\n  sim-host demo\n  sim-host table1\n  \
 sim-host simulate --params P.toml --scenario S.toml --out D.csv\n  sim-host diagnose --params P.toml \
 D.csv --commission 2:4\n  sim-host compare --params P.toml D.csv\n  sim-host explain --params P.toml \
-D.csv\n  sim-host hmi\n\nEvery command but the interactive hmi takes --json (one JSON document on stdout; progress \
+D.csv\n  sim-host hmi\n  sim-host convert D.csv D.parquet\n\nLogs are CSV, TDMS (.tdms) or Parquet (.parquet), by \
+their extension.\n\nEvery command but the interactive hmi takes --json (one JSON document on stdout; progress \
 and logs on stderr)."
 )]
 pub struct Cli {
@@ -61,6 +63,8 @@ pub enum Cmd {
     Bench(bench::BenchArgs),
     // The live terminal HMI.
     Hmi(hmi::HmiArgs),
+    // Convert a log between CSV, TDMS and Parquet.
+    Convert(convert::ConvertArgs),
 }
 
 /// Runs a command.
@@ -77,6 +81,7 @@ pub fn run(cmd: Cmd) -> anyhow::Result<()> {
         Cmd::Explain(a) => compare::run_explain(a),
         Cmd::Bench(a) => bench::run(a),
         Cmd::Hmi(a) => hmi::run(a),
+        Cmd::Convert(a) => convert::run(a),
     }
 }
 

@@ -44,11 +44,11 @@ const CSV_BYTES_PER_S: f64 = 2.0e8;
 /// Arguments of `simulate`.
 #[derive(Debug, Args)]
 #[command(
-    about = "Simulate an induction motor (faults, effects, sensors) and write a CSV log",
+    about = "Simulate an induction motor (faults, effects, sensors) and write a log (CSV, TDMS, Parquet)",
     long_about = "Simulate a 3-phase induction motor (full-order T-equivalent model, started \
 direct-on-line) with the supply, load, faults, physical effects and sensor chain of a scenario \
-file, and write the sensor readings as a CSV log (t_s, va_V..vc_V, ia_A..ic_A, wm_rad_s, \
-enc_count). See examples/scenarios/*.toml for the scenario format. Values are written at f32 \
+file, and write the sensor readings as a log (t_s, va_V..vc_V, ia_A..ic_A, wm_rad_s, \
+enc_count): CSV, or TDMS / Parquet when --out ends in .tdms / .parquet. See examples/scenarios/*.toml for the scenario format. Values are written at f32 \
 precision (7 significant digits; time at f64).\n\nA run estimated to write more than 20 GB or \
 to take more than 2e9 integrator steps is refused unless --force. Ctrl-C removes the partial \
 output.\n\nExample:\n  sim-host \
@@ -62,7 +62,8 @@ pub struct SimulateArgs {
     /// Scenario file (TOML; see examples/scenarios).
     #[arg(long)]
     pub scenario: PathBuf,
-    /// Output CSV (written atomically; never one of the inputs).
+    /// Output log (written atomically; never one of the inputs), in the format of its
+    /// extension: `.csv` (or any other), `.tdms`, `.parquet`.
     #[arg(long)]
     pub out: PathBuf,
     /// Override the scenario's noise seed.
@@ -91,7 +92,8 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         sc.seed = s;
     }
     let work = sc.workload();
-    let bytes = work.rows as f64 * LogWriter::estimated_row_bytes(sc.sensors.channels()) as f64;
+    let bytes = work.rows as f64
+        * LogWriter::estimated_row_bytes_for(&args.out, sc.sensors.channels()) as f64;
     if !args.force {
         check_size(&args.scenario, &work, bytes)?;
     }

@@ -1,5 +1,8 @@
 //! Measurement logs in the DESIGN.md §3 CSV schema: the one reader and the one writer of
-//! the workspace.
+//! the workspace, for three file formats chosen by the extension ([`Format`]): CSV, TDMS
+//! (LabVIEW; channels named like the CSV columns, [`tdms`]) and Parquet (columns named like
+//! the CSV columns, [`parquet`]). Every format hands over the same [`Row`]s, and every
+//! command passes them through the same data-quality stage.
 //!
 //! Columns (header row, comma separated, SI units in the names, [`Column`]):
 //! `t_s, va_V, vb_V, vc_V, ia_A, ib_A, ic_A, wm_rad_s` and optionally `enc_count`
@@ -9,7 +12,8 @@
 //! times that do not increase included: judging them is the data-quality stage's
 //! ([`quality`]), which every command runs before its analysis.
 //!
-//! - Reading: [`LogFile::open`] parses the header once (columns by name); then
+//! - Reading: [`LogFile::open`] parses the header (schema, channel list) once (columns by
+//!   name); then
 //!   [`LogFile::for_each_row`] streams the rows in file order with bounded memory, through
 //!   a parallel fast path (`fast`) and, where that meets anything it does not accept, the
 //!   exact reader (`exact`), whose message names the line and column. [`Log::read`] holds
@@ -22,12 +26,63 @@
 
 mod exact;
 mod fast;
+pub mod parquet;
 pub mod quality;
 mod reader;
+pub mod tdms;
 mod writer;
 
-pub use reader::{LogFile, RowSink};
+pub use reader::{LogFile, OpenOptions, RowSink};
 pub use writer::{write_atomic, LogWriter};
+
+/// A log's file format, chosen by the file's extension (case-insensitive): `.tdms` is TDMS,
+/// `.parquet` or `.pq` Parquet, anything else CSV (`.csv`, `.txt`, none).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// Comma-separated text with a header row (DESIGN.md §3).
+    Csv,
+    /// NI TDMS, one group of channels.
+    Tdms,
+    /// Apache Parquet, one number column per channel.
+    Parquet,
+}
+
+impl Format {
+    /// Every format.
+    pub const ALL: [Format; 3] = [Format::Csv, Format::Tdms, Format::Parquet];
+
+    /// The format of a path, by its extension.
+    pub fn of_path(path: &std::path::Path) -> Format {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .unwrap_or_default();
+        match ext.as_str() {
+            "tdms" => Format::Tdms,
+            "parquet" | "pq" => Format::Parquet,
+            _ => Format::Csv,
+        }
+    }
+
+    /// The format's name ("CSV", "TDMS", "Parquet").
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Csv => "CSV",
+            Format::Tdms => "TDMS",
+            Format::Parquet => "Parquet",
+        }
+    }
+
+    /// The usual extension, without the dot.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Format::Csv => "csv",
+            Format::Tdms => "tdms",
+            Format::Parquet => "parquet",
+        }
+    }
+}
 
 /// Errors reading or writing a log. Every message is one line and names the problem.
 #[derive(Debug, thiserror::Error)]

@@ -1,7 +1,8 @@
-//! [`LogFile`]: a log opened once, its header parsed once, its rows streamed by the fast
-//! path with the exact reader behind it.
+//! [`LogFile`]: a log opened once, its header (or schema, or channel list) read once, its
+//! rows streamed: a CSV by the fast path with the exact reader behind it, a TDMS or Parquet
+//! log by its format's module ([`super::Format`]).
 
-use super::{exact, fast, Channels, Column, LogError, Row};
+use super::{exact, fast, Channels, Column, Format, LogError, Row};
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 
@@ -25,8 +26,9 @@ impl RowSink for Vec<Row> {
     }
 }
 
-/// Where each schema column sits in a line: `field[c]` is the field index of
-/// [`Column::ALL`]`[c]`, `None` when the log lacks it.
+/// Where each schema column sits in a line (a CSV), a leaf column (Parquet) or the
+/// schema's own order (TDMS): `field[c]` is the field index of [`Column::ALL`]`[c]`, `None`
+/// when the log lacks it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) struct ColumnMap {
     pub field: [Option<usize>; 9],
@@ -51,8 +53,27 @@ impl ColumnMap {
     }
 }
 
-/// A log opened for reading: its path, columns and size. Cheap to keep; every read pass
-/// opens the file anew.
+/// How to open a log ([`LogFile::open_with`]).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct OpenOptions {
+    /// The TDMS group holding the channels (`--group`); needed only when a TDMS file has
+    /// several groups. An error for the other formats, which have no groups.
+    pub group: Option<String>,
+}
+
+/// Where the rows come from.
+#[derive(Debug, Clone)]
+enum Source {
+    /// A CSV: the header's length (the data start after it).
+    Csv { header_bytes: u64 },
+    /// A TDMS file.
+    Tdms(super::tdms::TdmsSource),
+    /// A Parquet file.
+    Parquet(super::parquet::ParquetSource),
+}
+
+/// A log opened for reading: its path, format, columns and size. Cheap to keep; every read
+/// pass opens the file anew.
 #[derive(Debug, Clone)]
 pub struct LogFile {
     path: PathBuf,
@@ -60,23 +81,78 @@ pub struct LogFile {
     columns: ColumnMap,
     channels: Channels,
     len_bytes: u64,
-    header_bytes: u64,
     est_rows: f64,
+    source: Source,
 }
 
 /// Bytes of the file's head read to estimate the bytes per row.
 const HEAD_BYTES: usize = 1 << 16;
 
 impl LogFile {
-    /// Opens a log, parses and checks its header, and estimates its number of rows from the
-    /// size of the first rows.
+    /// Opens a log in the format its extension names ([`Format::of_path`]), reads and
+    /// checks its header (CSV), schema (Parquet) or channels (TDMS, the file's only group),
+    /// and estimates its number of rows.
     ///
     /// # Errors
-    /// [`LogError::Io`] if unreadable, [`LogError::Csv`] for a malformed header,
-    /// [`LogError::MissingColumn`] if `t_s` or a current is missing, or if only some of the
-    /// three voltages are present.
+    /// As [`LogFile::open_with`].
     pub fn open(path: &Path) -> Result<Self, LogError> {
+        Self::open_with(path, &OpenOptions::default())
+    }
+
+    /// Opens a log with options (the TDMS group).
+    ///
+    /// # Errors
+    /// [`LogError::Io`] if unreadable; [`LogError::MissingColumn`] if `t_s` (for TDMS: and
+    /// the waveform time) or a current is missing, or if only some of the three voltages
+    /// are present, the same in every format; [`LogError::Csv`] for a malformed CSV header;
+    /// [`LogError::NotALog`] for a file that is not a log of its format (an empty CSV,
+    /// another separator, a TDMS file with several groups and no `group`, the message
+    /// listing them; a Parquet column that is not numeric), or a `group` given for a CSV
+    /// or Parquet log.
+    pub fn open_with(path: &Path, opts: &OpenOptions) -> Result<Self, LogError> {
         let shown = path.display().to_string();
+        let format = Format::of_path(path);
+        if let (Some(g), Format::Csv | Format::Parquet) = (&opts.group, format) {
+            return Err(LogError::NotALog {
+                path: shown,
+                why: format!(
+                    "--group '{g}' names a TDMS group, and a {} log has no groups",
+                    format.name()
+                ),
+            });
+        }
+        let len_bytes = std::fs::metadata(path)
+            .map_err(|source| LogError::Io {
+                path: shown.clone(),
+                source,
+            })?
+            .len();
+        let (columns, source, est_rows) = match format {
+            Format::Csv => return Self::open_csv(path, shown),
+            Format::Tdms => {
+                let (t, c) = super::tdms::TdmsSource::open(path, &shown, opts.group.as_deref())?;
+                let n = t.rows() as f64;
+                (c, Source::Tdms(t), n)
+            }
+            Format::Parquet => {
+                let (p, c) = super::parquet::ParquetSource::open(path, &shown)?;
+                let n = p.rows() as f64;
+                (c, Source::Parquet(p), n)
+            }
+        };
+        Ok(LogFile {
+            path: path.to_path_buf(),
+            shown,
+            channels: channels_of(&columns),
+            columns,
+            len_bytes,
+            est_rows,
+            source,
+        })
+    }
+
+    /// Opens a CSV log: parses its header, estimates its rows from the first rows' size.
+    fn open_csv(path: &Path, shown: String) -> Result<Self, LogError> {
         let io = |source| LogError::Io {
             path: shown.clone(),
             source,
@@ -91,23 +167,28 @@ impl LogFile {
             .read_to_end(&mut head)
             .map_err(io)?;
         let columns = parse_header(&header, &shown)?;
-        let has = |c: Column| columns.of(c).is_some();
-        let channels = Channels {
-            voltages: has(Column::Va),
-            speed: has(Column::Speed),
-            encoder: has(Column::Encoder),
-        };
         let lines = head.iter().filter(|&&b| b == b'\n').count().max(1);
         let bytes_per_row = (head.len() as f64 / lines as f64).max(1.0);
         Ok(LogFile {
             path: path.to_path_buf(),
             shown,
+            channels: channels_of(&columns),
             columns,
-            channels,
             len_bytes,
-            header_bytes: header.len() as u64,
             est_rows: len_bytes.saturating_sub(header.len() as u64) as f64 / bytes_per_row,
+            source: Source::Csv {
+                header_bytes: header.len() as u64,
+            },
         })
+    }
+
+    /// The log's format.
+    pub fn format(&self) -> Format {
+        match self.source {
+            Source::Csv { .. } => Format::Csv,
+            Source::Tdms(_) => Format::Tdms,
+            Source::Parquet(_) => Format::Parquet,
+        }
     }
 
     /// Which optional channels the log has.
@@ -125,7 +206,8 @@ impl LogFile {
         &self.shown
     }
 
-    /// Estimated number of data rows (from the file size and the first rows' length).
+    /// Estimated number of data rows (CSV: from the file size and the first rows' length;
+    /// TDMS and Parquet: exact).
     pub fn estimated_rows(&self) -> f64 {
         self.est_rows
     }
@@ -134,7 +216,8 @@ impl LogFile {
     /// until the sink returns false. `progress` gets the fraction of the file read, at most
     /// a few hundred times. Returns the number of rows handed over.
     ///
-    /// The rows are parsed in parallel by the fast path; if it meets anything it does not
+    /// TDMS and Parquet logs are read by their modules (`tdms`, `parquet`), which hand over
+    /// what the file holds in the same way. A CSV's rows are parsed in parallel by the fast path; if it meets anything it does not
     /// accept (quotes, text, a wrong field count), the sink is told to
     /// [`RowSink::restart`] and the exact reader reads the log again from the start: the
     /// same rows, or the error naming the line and column. Non-finite numbers and times
@@ -143,12 +226,26 @@ impl LogFile {
     ///
     /// # Errors
     /// [`LogError::Io`], [`LogError::NotNumeric`] or [`LogError::Csv`], each naming the
-    /// file and, for a bad row, the line and column.
+    /// file and, for a bad row, the line and column; [`LogError::NotALog`] for a TDMS or
+    /// Parquet file that cannot be decoded.
     pub fn for_each_row(
         &self,
         progress: &mut dyn FnMut(f64),
         sink: &mut dyn RowSink,
     ) -> Result<u64, LogError> {
+        match &self.source {
+            Source::Csv { .. } => {}
+            Source::Tdms(t) => {
+                return t.for_each_row(&self.path, &self.shown, &self.columns, progress, &mut |r| {
+                    sink.row(r)
+                })
+            }
+            Source::Parquet(p) => {
+                return p.for_each_row(&self.path, &self.shown, &self.columns, progress, &mut |r| {
+                    sink.row(r)
+                })
+            }
+        }
         let mut handed = 0u64;
         let accepted = fast::for_each_row(self, fast::BLOCK_BYTES, progress, &mut |row| {
             handed += 1;
@@ -181,7 +278,20 @@ impl LogFile {
     }
 
     pub(super) fn header_bytes(&self) -> u64 {
-        self.header_bytes
+        match self.source {
+            Source::Csv { header_bytes } => header_bytes,
+            _ => 0,
+        }
+    }
+}
+
+/// The optional channels a column map has.
+fn channels_of(columns: &ColumnMap) -> Channels {
+    let has = |c: Column| columns.of(c).is_some();
+    Channels {
+        voltages: has(Column::Va),
+        speed: has(Column::Speed),
+        encoder: has(Column::Encoder),
     }
 }
 
@@ -237,12 +347,23 @@ fn parse_header(line: &[u8], shown: &str) -> Result<ColumnMap, LogError> {
         field,
         n_fields: rec.len(),
     };
+    check_columns(&map, shown, true)?;
+    Ok(map)
+}
+
+/// The columns every log needs, in every format: `t_s` (unless `need_time` is false: a
+/// TDMS log timed by its waveform properties), the three currents, and the voltages as all
+/// three phases or none.
+///
+/// # Errors
+/// [`LogError::MissingColumn`] naming the column and why it is needed.
+pub(super) fn check_columns(map: &ColumnMap, shown: &str, need_time: bool) -> Result<(), LogError> {
     let missing = |c: Column, why: &str| LogError::MissingColumn {
         path: shown.to_string(),
         column: c.name().to_string(),
         why: why.to_string(),
     };
-    if map.of(Column::Time).is_none() {
+    if need_time && map.of(Column::Time).is_none() {
         return Err(missing(Column::Time, "every analysis needs the time"));
     }
     for c in [Column::Ia, Column::Ib, Column::Ic] {
@@ -262,5 +383,5 @@ fn parse_header(line: &[u8], shown: &str) -> Result<ColumnMap, LogError> {
             ));
         }
     }
-    Ok(map)
+    Ok(())
 }

@@ -1,18 +1,19 @@
-//! The atomic CSV writer.
+//! The atomic log writer: CSV here, TDMS and Parquet through their modules.
 
-use super::{Channels, Column, LogError, Row};
+use super::{Channels, Column, Format, LogError, Row};
 use std::fmt::Write as _;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-/// Atomic CSV writer: rows go to a temporary file in the target's folder, renamed over the
-/// target only by [`LogWriter::finish`]. Dropping it unfinished (an error, an interrupted
+/// Atomic log writer in the format of the target's extension ([`Format::of_path`]): rows go
+/// to a temporary file in the target's folder, renamed over the target only by
+/// [`LogWriter::finish`]. Dropping it unfinished (an error, an interrupted
 /// run) deletes the temporary file and leaves the target untouched. The output gets the
 /// mode of any new file (0o666 less the umask).
 ///
-/// Precision: `t_s` is written with f64's shortest round-trip digits; voltages, currents
-/// and speed at f32 precision (shortest round-trip of the f32 value: 7 significant digits,
+/// Precision, the same in every format: `t_s` at f64 precision (CSV: shortest round-trip
+/// digits; TDMS DBL; Parquet DOUBLE); voltages, currents and speed at f32 precision (CSV: (shortest round-trip of the f32 value: 7 significant digits,
 /// a relative error up to 6e-8). That is far finer than any ADC (a 12-bit converter
 /// resolves 2.4e-4 of its range) but coarser than the simulator's integration error on
 /// ideal sensors: on the 2.2 kW reference start the written currents differ from the
@@ -22,13 +23,29 @@ use std::path::{Path, PathBuf};
 pub struct LogWriter {
     path: PathBuf,
     tmp: Option<tempfile::NamedTempFile>,
-    out: BufWriter<File>,
+    sink: Sink,
     channels: Channels,
     line: String,
 }
 
+/// The format-specific part of a [`LogWriter`].
+enum Sink {
+    Csv(BufWriter<File>),
+    Tdms(BufWriter<File>, Box<super::tdms::TdmsLogWriter>),
+    Parquet(Box<super::parquet::ParquetLogWriter>),
+}
+
+/// A Parquet error as the writer's I/O error.
+fn pq_io(e: ::parquet::errors::ParquetError) -> std::io::Error {
+    std::io::Error::other(crate::one_line(&e.to_string()))
+}
+
 impl LogWriter {
-    /// Starts writing a log with the given optional channels.
+    /// Starts writing a log with the given optional channels, in the format of `path`'s
+    /// extension.
+    ///
+    /// # Errors
+    /// [`LogError::Io`] when the temporary file cannot be created.
     pub fn create(path: &Path, channels: Channels) -> Result<Self, LogError> {
         let io = |source| LogError::Io {
             path: path.display().to_string(),
@@ -36,6 +53,29 @@ impl LogWriter {
         };
         let tmp = temp_file_beside(path).map_err(io)?;
         let file = tmp.reopen().map_err(io)?;
+        let sink = match Format::of_path(path) {
+            Format::Csv => Sink::Csv(Self::csv_header(file, channels).map_err(io)?),
+            Format::Tdms => Sink::Tdms(
+                BufWriter::with_capacity(1 << 20, file),
+                Box::new(super::tdms::TdmsLogWriter::new(channels)),
+            ),
+            Format::Parquet => Sink::Parquet(Box::new(
+                super::parquet::ParquetLogWriter::new(file, channels)
+                    .map_err(pq_io)
+                    .map_err(io)?,
+            )),
+        };
+        Ok(LogWriter {
+            path: path.to_path_buf(),
+            tmp: Some(tmp),
+            sink,
+            channels,
+            line: String::with_capacity(160),
+        })
+    }
+
+    /// A CSV output with its header written.
+    fn csv_header(file: File, channels: Channels) -> std::io::Result<BufWriter<File>> {
         let mut out = BufWriter::with_capacity(1 << 20, file);
         // The schema's columns this log has, in `Column` order.
         let names: Vec<&str> = Column::ALL
@@ -45,14 +85,19 @@ impl LogWriter {
             .collect();
         let mut header = names.join(",");
         header.push('\n');
-        out.write_all(header.as_bytes()).map_err(io)?;
-        Ok(LogWriter {
-            path: path.to_path_buf(),
-            tmp: Some(tmp),
-            out,
-            channels,
-            line: String::with_capacity(160),
-        })
+        out.write_all(header.as_bytes())?;
+        Ok(out)
+    }
+
+    /// The typical size of one row of a log with `channels` written to `path` [bytes]:
+    /// [`LogWriter::estimated_row_bytes`] for a CSV, the exact bytes of the binary formats
+    /// (8 for `t_s`, 4 a channel, 8 for `enc_count`).
+    pub fn estimated_row_bytes_for(path: &Path, channels: Channels) -> u64 {
+        match Format::of_path(path) {
+            Format::Csv => Self::estimated_row_bytes(channels),
+            Format::Tdms => super::tdms::TdmsLogWriter::row_bytes(channels),
+            Format::Parquet => super::parquet::ParquetLogWriter::row_bytes(channels),
+        }
     }
 
     /// The typical size of one row with `channels` [bytes], for estimating an output's
@@ -68,7 +113,19 @@ impl LogWriter {
 
     /// Appends one row. Channels the writer was not created with are skipped; a channel it
     /// was created with but the row lacks is written as 0.
+    ///
+    /// # Errors
+    /// [`LogError::Io`] when the file cannot be written.
     pub fn write_row(&mut self, r: &Row) -> Result<(), LogError> {
+        let io = |source| LogError::Io {
+            path: self.path.display().to_string(),
+            source,
+        };
+        let out = match &mut self.sink {
+            Sink::Csv(out) => out,
+            Sink::Tdms(out, w) => return w.write_row(out, r).map_err(io),
+            Sink::Parquet(w) => return w.write_row(r).map_err(pq_io).map_err(io),
+        };
         // ryu: shortest round-trip formatting, an order of magnitude faster than `{:e}`.
         // Time keeps f64 precision (1e-4 s steps over hours); the channels are written at
         // f32 precision (see the type's docs).
@@ -96,24 +153,30 @@ impl LogWriter {
             let _ = write!(l, "{}", r.enc_count.unwrap_or_default());
         }
         l.push('\n');
-        self.out
-            .write_all(l.as_bytes())
-            .map_err(|source| LogError::Io {
-                path: self.path.display().to_string(),
-                source,
-            })
+        out.write_all(l.as_bytes()).map_err(io)
     }
 
-    /// Flushes and renames the temporary file over the target.
-    pub fn finish(mut self) -> Result<(), LogError> {
+    /// Flushes (TDMS: the last segment; Parquet: the last row group and the footer) and
+    /// renames the temporary file over the target.
+    ///
+    /// # Errors
+    /// [`LogError::Io`] when the file cannot be written or renamed.
+    pub fn finish(self) -> Result<(), LogError> {
+        let LogWriter {
+            path, tmp, sink, ..
+        } = self;
         let io = |source| LogError::Io {
-            path: self.path.display().to_string(),
+            path: path.display().to_string(),
             source,
         };
-        self.out.flush().map_err(io)?;
-        if let Some(tmp) = self.tmp.take() {
-            tmp.persist(&self.path).map_err(|e| LogError::Io {
-                path: self.path.display().to_string(),
+        match sink {
+            Sink::Csv(mut out) => out.flush().map_err(io)?,
+            Sink::Tdms(mut out, mut w) => super::tdms::finish(&mut w, &mut out).map_err(io)?,
+            Sink::Parquet(w) => w.finish().map_err(pq_io).map_err(io)?,
+        }
+        if let Some(tmp) = tmp {
+            tmp.persist(&path).map_err(|e| LogError::Io {
+                path: path.display().to_string(),
                 source: e.error,
             })?;
         }

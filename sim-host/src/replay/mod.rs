@@ -724,7 +724,20 @@ pub fn diagnose_file(
     opts: ReplayOptions,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Diagnosed, ReplayError> {
-    let file = LogFile::open(path)?;
+    diagnose_log(params, &LogFile::open(path)?, opts, progress)
+}
+
+/// [`diagnose_file`] on a log already opened (any format, a TDMS group chosen:
+/// [`LogFile::open_with`]).
+///
+/// # Errors
+/// As [`diagnose_file`].
+pub fn diagnose_log(
+    params: &ParamFile,
+    file: &LogFile,
+    opts: ReplayOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Diagnosed, ReplayError> {
     replay_through_quality(params, file.channels(), file.shown(), opts, |stage| {
         file.for_each_row(progress, stage).map(|_| ())
     })

@@ -1,9 +1,11 @@
-//! Plots: every chart is written as SVG (with title, axis labels and legend) and as PNG.
+//! Plots: every chart is written as SVG and as PNG, both with title, axis labels, tick
+//! labels and legend.
 //!
-//! PNG text needs a font, and this crate builds plotters without a font backend (so no
-//! system font or font crate is needed at build time). PNGs therefore carry the curves,
-//! the grid and the legend colours but no text; the same chart's SVG and the HTML report
-//! carry the labels. Outputs are written atomically (temporary file, then rename).
+//! PNG text needs a font: DejaVu Sans (`assets/fonts/DejaVuSans.ttf`, its licence beside
+//! it) is embedded in the binary and registered with plotters' `ab_glyph` backend as
+//! "sans-serif" before the first chart is drawn ([`FONT`]), so no system font package is
+//! needed, in CI or on a user's machine. Outputs are written atomically (temporary file,
+//! then rename).
 
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -34,6 +36,23 @@ pub struct Chart<'a> {
     pub series: Vec<Series>,
     /// Logarithmic y axis.
     pub log_y: bool,
+}
+
+/// DejaVu Sans 2.37 (Bitstream Vera licence: `assets/fonts/LICENSE-DejaVu.txt`), the PNG
+/// charts' font.
+pub const FONT: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");
+
+/// Registers [`FONT`] as plotters' "sans-serif" (once per process).
+///
+/// # Errors
+/// The embedded font does not parse (not expected: a test draws with it).
+fn register_font() -> Result<(), String> {
+    static DONE: std::sync::OnceLock<Result<(), String>> = std::sync::OnceLock::new();
+    DONE.get_or_init(|| {
+        plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
+            .map_err(|_| "the embedded chart font (DejaVu Sans) does not parse".to_string())
+    })
+    .clone()
 }
 
 const PALETTE: [RGBColor; 6] = [
@@ -117,6 +136,9 @@ fn draw<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
+    if text {
+        register_font()?;
+    }
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     root.fill(&WHITE).map_err(e)?;
     let ((x0, x1), (y0, y1)) = ranges(c);
@@ -197,6 +219,12 @@ pub fn svg_string(c: &Chart) -> Result<String, String> {
     Ok(s)
 }
 
+/// Draws the chart as a PNG into `path` (`text`: with title, labels and legend).
+fn png(path: &Path, c: &Chart, text: bool) -> Result<(), String> {
+    let root = BitMapBackend::new(path, (900, 420)).into_drawing_area();
+    draw(root, c, text)
+}
+
 /// Writes `<stem>.svg` and `<stem>.png` into `dir`; returns the SVG text (for the HTML
 /// report) and the paths written.
 pub fn write(dir: &Path, c: &Chart) -> Result<(String, Vec<PathBuf>), String> {
@@ -206,10 +234,7 @@ pub fn write(dir: &Path, c: &Chart) -> Result<(String, Vec<PathBuf>), String> {
         .map_err(|e| format!("{}: {e}", svg_path.display()))?;
     let png_path = dir.join(format!("{}.png", c.stem));
     let tmp = png_staging_file(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    {
-        let root = BitMapBackend::new(tmp.path(), (900, 420)).into_drawing_area();
-        draw(root, c, false)?;
-    }
+    png(tmp.path(), c, true)?;
     tmp.persist(&png_path)
         .map_err(|e| format!("{}: {}", png_path.display(), e.error))?;
     Ok((svg, vec![svg_path, png_path]))
@@ -228,4 +253,70 @@ fn png_staging_file(dir: &Path) -> std::io::Result<tempfile::NamedTempFile> {
         b.permissions(std::fs::Permissions::from_mode(0o666));
     }
     b.tempfile_in(dir)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn chart(title: &'static str) -> Chart<'static> {
+        Chart {
+            stem: "t",
+            title,
+            x_label: "time [s]",
+            y_label: "current [A]",
+            series: vec![Series {
+                label: "measured".into(),
+                points: (0..200)
+                    .map(|k| (k as f64 * 0.01, (k as f64 * 0.1).sin()))
+                    .collect(),
+                color: 0,
+                scatter: false,
+            }],
+            log_y: false,
+        }
+    }
+
+    /// The chart's pixels as the PNG encoder gets them (RGB, 900 x 420).
+    fn pixels(c: &Chart, text: bool) -> Vec<u8> {
+        let mut buf = vec![0u8; 900 * 420 * 3];
+        {
+            let root = BitMapBackend::with_buffer(&mut buf, (900, 420)).into_drawing_area();
+            draw(root, c, text).expect("draw");
+        }
+        buf
+    }
+
+    /// Pixels that are not white in rows `y0..y1`.
+    fn ink(rgb: &[u8], y0: usize, y1: usize) -> usize {
+        rgb[y0 * 900 * 3..y1 * 900 * 3]
+            .chunks_exact(3)
+            .filter(|p| *p != [255, 255, 255])
+            .count()
+    }
+
+    #[test]
+    fn png_charts_carry_their_text() {
+        let with = pixels(&chart("Phase current, measured and predicted"), true);
+        let without = pixels(&chart("Phase current, measured and predicted"), false);
+        // The title band (the caption above the plotting area): the title's glyphs, where
+        // the chart without text has only the top of its frame.
+        let title_with = ink(&with, 0, 34);
+        let title_without = ink(&without, 0, 34);
+        assert!(
+            title_with > title_without + 300,
+            "title pixels {title_with} against {title_without}"
+        );
+        // A longer title writes more ink: the pixels are glyphs, not a box.
+        let longer = pixels(
+            &chart("Phase current, measured and predicted, over the whole log"),
+            true,
+        );
+        assert!(ink(&longer, 0, 34) > title_with + 100);
+        // And the file written is a PNG of that chart.
+        let dir = tempfile::tempdir().expect("tmp");
+        let (_, paths) = write(dir.path(), &chart("Title")).expect("write");
+        let bytes = std::fs::read(&paths[1]).expect("png");
+        assert_eq!(&bytes[1..4], b"PNG");
+    }
 }

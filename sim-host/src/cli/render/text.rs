@@ -132,6 +132,22 @@ pub fn simulate(path: &Path, wall_s: f64, s: &SimSummary) -> anyhow::Result<()> 
     Ok(())
 }
 
+/// `convert`'s one line.
+pub fn convert(c: &crate::cli::convert::Converted) -> anyhow::Result<()> {
+    writeln!(
+        crate::cli::stdout(),
+        "converted {} ({}) to {} ({}): {} rows, {:.1} MB, in {:.2} s",
+        c.input,
+        c.input_format,
+        c.output,
+        c.output_format,
+        c.rows,
+        c.output_bytes as f64 / 1e6,
+        c.wall_s
+    )?;
+    Ok(())
+}
+
 /// The state column of a `diagnose` timeline point.
 fn diagnose_state(p: &TimelinePoint) -> String {
     if p.commissioning {

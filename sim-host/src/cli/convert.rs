@@ -1,0 +1,155 @@
+//! `sim-host convert IN OUT`: rewrite a log in another format (CSV, TDMS, Parquet, by the
+//! extensions), through the one reader and the one writer (`sim_host::log`).
+//!
+//! The rows are copied as the reader hands them over (non-finite cells and times that do
+//! not increase included): judging them stays the data-quality stage's, in the command
+//! that analyses the output. The output is written atomically and may not be the input;
+//! SIGINT/SIGTERM remove the temporary file (exit status 130 / 143). A progress bar goes to
+//! stderr for inputs above 20 MB when it is a terminal.
+
+use super::output_guard::OutputGuard;
+use super::{progress, render, Interruption};
+use clap::Args;
+use sim_host::log::{Format, LogFile, LogWriter, OpenOptions, Row, RowSink};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Arguments of `convert`.
+#[derive(Debug, Args)]
+#[command(
+    about = "Convert a log between CSV, TDMS and Parquet (formats by extension)",
+    long_about = "Convert a measurement log between CSV, TDMS (.tdms) and Parquet (.parquet, .pq); \
+the formats are chosen by the file extensions (anything else is CSV). Channels keep the CSV \
+column names (t_s, va_V, vb_V, vc_V, ia_A, ib_A, ic_A, wm_rad_s, enc_count). Every writer \
+stores t_s at f64 and the other channels at f32 precision (7 significant digits). A TDMS \
+input whose time is in the waveform properties (wf_start_offset, wf_increment) gets a t_s \
+column.\n\nThe output is written atomically and is never the input.\n\nExamples:\n  \
+sim-host convert run.csv run.parquet\n  sim-host convert daq.tdms --group Motor daq.csv"
+)]
+pub struct ConvertArgs {
+    /// The log to read.
+    pub input: PathBuf,
+    /// The log to write (atomically; never the input).
+    pub output: PathBuf,
+    /// The TDMS group holding the channels (when the input has several).
+    #[arg(long, value_name = "NAME")]
+    pub group: Option<String>,
+    /// Print one JSON summary document on stdout instead of the text summary.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// What `convert` did.
+#[derive(Debug, serde::Serialize)]
+pub struct Converted {
+    /// The input path.
+    pub input: String,
+    /// Its format.
+    pub input_format: &'static str,
+    /// The output path.
+    pub output: String,
+    /// Its format.
+    pub output_format: &'static str,
+    /// Rows copied.
+    pub rows: u64,
+    /// Size of the output [bytes].
+    pub output_bytes: u64,
+    /// Wall time [s].
+    pub wall_s: f64,
+}
+
+/// Forwards rows to the writer until an error or a signal.
+struct Copy<'a> {
+    w: Option<LogWriter>,
+    args: &'a ConvertArgs,
+    channels: sim_host::log::Channels,
+    error: Option<sim_host::log::LogError>,
+    interruption: &'a Interruption,
+    rows: u64,
+}
+
+impl RowSink for Copy<'_> {
+    fn row(&mut self, row: &Row) -> bool {
+        let Some(w) = self.w.as_mut() else {
+            return false;
+        };
+        if let Err(e) = w.write_row(row) {
+            self.error = Some(e);
+            return false;
+        }
+        self.rows += 1;
+        !self.interruption.caught()
+    }
+
+    fn restart(&mut self) {
+        // The CSV fast path met a cell it does not take and the exact reader starts over
+        // (handing over the same rows, or naming the bad line): a new output, the old one's
+        // temporary file removed.
+        self.w = None;
+        self.rows = 0;
+        match LogWriter::create(&self.args.output, self.channels) {
+            Ok(w) => self.w = Some(w),
+            Err(e) => self.error = Some(e),
+        }
+    }
+}
+
+/// Runs `convert`.
+///
+/// # Errors
+/// An output that is the input, an unreadable or malformed input (one line naming the
+/// file, line and column), an I/O error writing the output, or [`super::Interrupted`].
+pub fn run(args: &ConvertArgs) -> anyhow::Result<()> {
+    OutputGuard::new(&[&args.input]).check_files(&[&args.output])?;
+    let opts = OpenOptions {
+        group: args.group.clone(),
+    };
+    let file = LogFile::open_with(&args.input, &opts)?;
+    let start = Instant::now();
+    let interruption = Interruption::catch()?;
+    let big = std::fs::metadata(&args.input)
+        .map(|m| m.len() > 20_000_000)
+        .unwrap_or(false);
+    let bar = progress::bar(progress::FRACTION_STEPS, "convert", big);
+    let mut sink = Copy {
+        w: Some(LogWriter::create(&args.output, file.channels())?),
+        args,
+        channels: file.channels(),
+        error: None,
+        interruption: &interruption,
+        rows: 0,
+    };
+    let read = file.for_each_row(&mut |f| progress::set_fraction(&bar, f), &mut sink);
+    bar.finish_and_clear();
+    let Copy { w, error, rows, .. } = sink;
+    if let Some(sig) = interruption.signal(&format!(
+        "temporary file removed, {} not written",
+        args.output.display()
+    )) {
+        drop(w);
+        return Err(sig.into());
+    }
+    read?;
+    if let Some(e) = error {
+        return Err(e.into());
+    }
+    if let Some(w) = w {
+        w.finish()?;
+    }
+    let done = Converted {
+        input: args.input.display().to_string(),
+        input_format: file.format().name(),
+        output: args.output.display().to_string(),
+        output_format: Format::of_path(&args.output).name(),
+        rows,
+        output_bytes: std::fs::metadata(&args.output)
+            .map(|m| m.len())
+            .unwrap_or(0),
+        wall_s: start.elapsed().as_secs_f64(),
+    };
+    if args.json {
+        render::json::print(&done)
+    } else {
+        render::text::convert(&done)
+    }
+}

@@ -1,0 +1,546 @@
+//! TDMS logs (NI LabVIEW's Technical Data Management Streaming format): read through the
+//! `tdms-rs` crate, written by a small streaming writer of our own ([`TdmsLogWriter`]).
+//!
+//! Reading: the channels of one group, named like the CSV columns ([`Column::name`]); the
+//! group is the file's only group or the one `--group` names (several groups and none named:
+//! an error listing them). The time is the `t_s` channel, or else the waveform properties
+//! LabVIEW writes on each channel, `wf_start_offset + k * wf_increment` [s] (taken from
+//! `ia_A`). Numeric channels of any width are read as f64. Layouts `tdms-rs` does not read
+//! (big-endian, interleaved or DAQmx raw data, incremental metadata, several chunks in one
+//! segment) are refused with one line naming the layout, rather than read wrongly: NI's
+//! "TDMS Defragment" rewrites such a file into the plain layout.
+//!
+//! Writing: one segment per [`SEGMENT_ROWS`] rows (lead-in, metadata, raw data, channel
+//! after channel), little-endian, format version 4713; `t_s` as DBL, the voltages, currents
+//! and speed as SGL (the precision of every writer, see [`super::LogWriter`]), `enc_count`
+//! as I64. Every channel carries `wf_increment` and `wf_start_offset` (from the first
+//! segment's times), so LabVIEW and DIAdem show a time axis.
+
+use super::reader::ColumnMap;
+use super::{Channels, Column, LogError, Row};
+use std::fs::File;
+use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
+use std::path::Path;
+use tdms_rs::{DataType, PropertyValue, TdmsFile};
+
+/// Rows per written segment.
+pub const SEGMENT_ROWS: usize = 1 << 16;
+/// Rows per read pass over the channels.
+const READ_ROWS: usize = 1 << 16;
+/// The group the writer puts the channels in.
+pub const GROUP: &str = "log";
+
+/// Where the time of a TDMS log comes from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum TimeSource {
+    /// The `t_s` channel.
+    Channel,
+    /// `start + k * increment` [s].
+    Waveform { start: f64, increment: f64 },
+}
+
+/// A TDMS log opened for reading: its group, channel names and time source.
+#[derive(Debug, Clone)]
+pub(super) struct TdmsSource {
+    group: String,
+    time: TimeSource,
+    rows: u64,
+}
+
+fn not_a_log(shown: &str, why: String) -> LogError {
+    LogError::NotALog {
+        path: shown.to_string(),
+        why,
+    }
+}
+
+fn tdms_error(shown: &str, e: &tdms_rs::TdmsError) -> LogError {
+    not_a_log(
+        shown,
+        format!(
+            "not a readable TDMS file: {}",
+            crate::one_line(&e.to_string())
+        ),
+    )
+}
+
+/// A property as a number (seconds for the waveform properties).
+fn number(p: &PropertyValue) -> Option<f64> {
+    Some(match p {
+        PropertyValue::Double(x) => *x,
+        PropertyValue::Float(x) => f64::from(*x),
+        PropertyValue::I32(x) => f64::from(*x),
+        PropertyValue::I64(x) => *x as f64,
+        PropertyValue::U32(x) => f64::from(*x),
+        PropertyValue::U64(x) => *x as f64,
+        _ => return None,
+    })
+}
+
+/// Refuses the layouts `tdms-rs` would misread: walks the segments' lead-ins (28 bytes
+/// each) and checks that their raw data is exactly what the channels' lengths account
+/// for.
+fn check_layout(path: &Path, shown: &str, file: &TdmsFile) -> Result<(), LogError> {
+    let io = |source| LogError::Io {
+        path: shown.to_string(),
+        source,
+    };
+    let mut f = File::open(path).map_err(io)?;
+    let len = f.metadata().map_err(io)?.len();
+    let mut pos = 0u64;
+    let mut raw = 0u64;
+    let refuse = |what: &str| {
+        not_a_log(
+            shown,
+            format!("TDMS with {what} is not read here: rewrite it with LabVIEW's TDMS Defragment (one plain segment layout) or convert it to CSV or Parquet"),
+        )
+    };
+    while pos + 28 <= len {
+        f.seek(SeekFrom::Start(pos)).map_err(io)?;
+        let mut lead = [0u8; 28];
+        f.read_exact(&mut lead).map_err(io)?;
+        if &lead[0..4] != b"TDSm" {
+            return Err(not_a_log(
+                shown,
+                format!("not a TDMS file: no segment tag at byte {pos}"),
+            ));
+        }
+        let word = |i: usize| u32::from_le_bytes([lead[i], lead[i + 1], lead[i + 2], lead[i + 3]]);
+        let long = |i: usize| {
+            let mut b = [0u8; 8];
+            b.copy_from_slice(&lead[i..i + 8]);
+            u64::from_le_bytes(b)
+        };
+        let mask = word(4);
+        if mask & (1 << 6) != 0 {
+            return Err(refuse("big-endian data"));
+        }
+        if mask & (1 << 5) != 0 {
+            return Err(refuse("interleaved data"));
+        }
+        if mask & (1 << 7) != 0 {
+            return Err(refuse("DAQmx raw data"));
+        }
+        if mask & (1 << 1) != 0 && mask & (1 << 2) == 0 {
+            return Err(refuse("incremental metadata"));
+        }
+        let (next, raw_off) = (long(12), long(20));
+        let end = if next == u64::MAX {
+            len
+        } else {
+            (pos + 28).saturating_add(next).min(len)
+        };
+        if mask & (1 << 3) != 0 {
+            raw += end.saturating_sub(pos + 28 + raw_off);
+        }
+        pos = end;
+    }
+    let mut expected = 0u64;
+    for g in file.groups() {
+        for c in g.channels() {
+            let size = c.dtype().itemsize() as u64;
+            if size == 0 {
+                // A string channel: its size is not known from the length; skip the check.
+                return Ok(());
+            }
+            expected += size * c.len() as u64;
+        }
+    }
+    if raw != expected {
+        return Err(refuse("several data chunks in a segment"));
+    }
+    Ok(())
+}
+
+impl TdmsSource {
+    /// Opens `path`: picks the group, maps the schema's channels and the time source.
+    ///
+    /// # Errors
+    /// [`LogError::NotALog`] for a file `tdms-rs` cannot read, a layout it would misread,
+    /// several groups and none named (the message lists them), a group that is not there,
+    /// channels of different lengths or of a non-numeric type;
+    /// [`LogError::MissingColumn`] as for a CSV log (the time may instead come from
+    /// `wf_increment`).
+    pub fn open(
+        path: &Path,
+        shown: &str,
+        group: Option<&str>,
+    ) -> Result<(Self, ColumnMap), LogError> {
+        let file = TdmsFile::open(path).map_err(|e| tdms_error(shown, &e))?;
+        check_layout(path, shown, &file)?;
+        let names: Vec<String> = file.groups().map(|g| g.name().to_string()).collect();
+        let listed = || {
+            names
+                .iter()
+                .map(|n| format!("'{n}'"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let name = match group {
+            Some(g) if names.iter().any(|n| n == g) => g.to_string(),
+            Some(g) => {
+                return Err(not_a_log(
+                    shown,
+                    format!("no group '{g}' in the file (its groups: {})", listed()),
+                ))
+            }
+            None => match names.as_slice() {
+                [one] => one.clone(),
+                [] => return Err(not_a_log(shown, "the TDMS file has no group".into())),
+                _ => {
+                    return Err(not_a_log(
+                        shown,
+                        format!(
+                            "the TDMS file has several groups ({}): name one with --group",
+                            listed()
+                        ),
+                    ))
+                }
+            },
+        };
+        let g = file
+            .group(&name)
+            .ok_or_else(|| not_a_log(shown, format!("no group '{name}'")))?;
+        let mut field = [None; 9];
+        let mut lens = Vec::new();
+        for (k, c) in Column::ALL.iter().enumerate() {
+            if let Some(ch) = g.channel(c.name()) {
+                if ch.dtype().itemsize() == 0
+                    || matches!(ch.dtype(), DataType::TimeStamp | DataType::Boolean)
+                {
+                    return Err(not_a_log(
+                        shown,
+                        format!(
+                            "channel '{}' holds {:?} values, not numbers",
+                            c.name(),
+                            ch.dtype()
+                        ),
+                    ));
+                }
+                field[k] = Some(k);
+                lens.push((c.name(), ch.len()));
+            }
+        }
+        let columns = ColumnMap {
+            field,
+            n_fields: Column::ALL.len(),
+        };
+        let wave = g.channel(Column::Ia.name()).and_then(|ch| {
+            let inc = ch.property("wf_increment").and_then(number)?;
+            let start = ch
+                .property("wf_start_offset")
+                .and_then(number)
+                .unwrap_or(0.0);
+            (inc.is_finite() && inc > 0.0).then_some(TimeSource::Waveform {
+                start,
+                increment: inc,
+            })
+        });
+        let time = if columns.of(Column::Time).is_some() {
+            TimeSource::Channel
+        } else if let Some(w) = wave {
+            w
+        } else {
+            return Err(LogError::MissingColumn {
+                path: shown.to_string(),
+                column: Column::Time.name().to_string(),
+                why: "every analysis needs the time: a t_s channel, or wf_increment on ia_A".into(),
+            });
+        };
+        super::reader::check_columns(&columns, shown, time == TimeSource::Channel)?;
+        let rows = lens.first().map(|l| l.1).unwrap_or(0);
+        if let Some((n, l)) = lens.iter().find(|l| l.1 != rows) {
+            return Err(not_a_log(
+                shown,
+                format!(
+                    "channels of different lengths in group '{name}': {} has {rows} values, {n} {l}",
+                    lens[0].0
+                ),
+            ));
+        }
+        Ok((
+            TdmsSource {
+                group: name,
+                time,
+                rows: rows as u64,
+            },
+            columns,
+        ))
+    }
+
+    /// Rows in the log.
+    pub fn rows(&self) -> u64 {
+        self.rows
+    }
+
+    /// Streams the rows in order (see [`super::LogFile::for_each_row`]).
+    pub fn for_each_row(
+        &self,
+        path: &Path,
+        shown: &str,
+        columns: &ColumnMap,
+        progress: &mut dyn FnMut(f64),
+        on_row: &mut dyn FnMut(&Row) -> bool,
+    ) -> Result<u64, LogError> {
+        let file = TdmsFile::open(path).map_err(|e| tdms_error(shown, &e))?;
+        let g = file
+            .group(&self.group)
+            .ok_or_else(|| not_a_log(shown, format!("no group '{}'", self.group)))?;
+        let chans: Vec<Option<tdms_rs::TdmsChannel<'_>>> = Column::ALL
+            .iter()
+            .enumerate()
+            .map(|(k, c)| columns.field[k].and_then(|_| g.channel(c.name())))
+            .collect();
+        let n = self.rows as usize;
+        let mut cols: Vec<Vec<f64>> = vec![Vec::new(); Column::ALL.len()];
+        let mut handed = 0u64;
+        let mut start = 0usize;
+        while start < n {
+            let end = (start + READ_ROWS).min(n);
+            for (k, ch) in chans.iter().enumerate() {
+                if let Some(ch) = ch {
+                    read_f64(ch, start..end, &mut cols[k]).map_err(|e| tdms_error(shown, &e))?;
+                }
+            }
+            let mut v = [0.0f64; 9];
+            for i in 0..end - start {
+                for (k, c) in cols.iter().enumerate() {
+                    if let Some(x) = c.get(i) {
+                        v[k] = *x;
+                    }
+                }
+                if let TimeSource::Waveform {
+                    start: t0,
+                    increment,
+                } = self.time
+                {
+                    v[0] = t0 + (start + i) as f64 * increment;
+                }
+                handed += 1;
+                if !on_row(&super::exact::row_from_values(&v, columns)) {
+                    return Ok(handed);
+                }
+            }
+            progress(end as f64 / n.max(1) as f64);
+            start = end;
+        }
+        Ok(handed)
+    }
+}
+
+/// Reads `range` of a numeric channel into `out` as f64.
+fn read_f64(
+    ch: &tdms_rs::TdmsChannel<'_>,
+    range: std::ops::Range<usize>,
+    out: &mut Vec<f64>,
+) -> Result<(), tdms_rs::TdmsError> {
+    fn typed<T: tdms_rs::api::reader::Pod + Default + Into<f64>>(
+        ch: &tdms_rs::TdmsChannel<'_>,
+        range: std::ops::Range<usize>,
+        out: &mut Vec<f64>,
+    ) -> Result<(), tdms_rs::TdmsError> {
+        let mut buf = vec![T::default(); range.len()];
+        ch.read(range, &mut buf)?;
+        out.clear();
+        out.extend(buf.into_iter().map(Into::into));
+        Ok(())
+    }
+    match ch.dtype() {
+        DataType::Double => typed::<f64>(ch, range, out),
+        DataType::Float => typed::<f32>(ch, range, out),
+        DataType::I8 => typed::<i8>(ch, range, out),
+        DataType::I16 => typed::<i16>(ch, range, out),
+        DataType::I32 => typed::<i32>(ch, range, out),
+        DataType::U8 => typed::<u8>(ch, range, out),
+        DataType::U16 => typed::<u16>(ch, range, out),
+        DataType::U32 => typed::<u32>(ch, range, out),
+        DataType::I64 => {
+            let mut buf = vec![0i64; range.len()];
+            ch.read(range, &mut buf)?;
+            out.clear();
+            out.extend(buf.into_iter().map(|x| x as f64));
+            Ok(())
+        }
+        DataType::U64 => {
+            let mut buf = vec![0u64; range.len()];
+            ch.read(range, &mut buf)?;
+            out.clear();
+            out.extend(buf.into_iter().map(|x| x as f64));
+            Ok(())
+        }
+        _ => Err(tdms_rs::TdmsError::TypeMismatch),
+    }
+}
+
+/// The streaming TDMS writer behind [`super::LogWriter`] for `.tdms` outputs: rows are
+/// buffered per channel and written as one segment per [`SEGMENT_ROWS`] rows.
+pub(super) struct TdmsLogWriter {
+    channels: Channels,
+    t: Vec<f64>,
+    /// Voltages a, b, c, currents a, b, c, speed (the SGL channels, in `Column` order).
+    f: [Vec<f32>; 7],
+    enc: Vec<i64>,
+    /// Segments written so far.
+    segments: u64,
+    /// The present SGL channels: (column, index into `f`).
+    sgl: Vec<(Column, usize)>,
+}
+
+/// Appends a TDMS string (u32 length, UTF-8 bytes).
+fn put_str(b: &mut Vec<u8>, s: &str) {
+    b.extend_from_slice(&(s.len() as u32).to_le_bytes());
+    b.extend_from_slice(s.as_bytes());
+}
+
+/// Appends a DBL property.
+fn put_f64_property(b: &mut Vec<u8>, name: &str, x: f64) {
+    put_str(b, name);
+    b.extend_from_slice(&10u32.to_le_bytes());
+    b.extend_from_slice(&x.to_le_bytes());
+}
+
+impl TdmsLogWriter {
+    /// A writer for a log with `channels`.
+    pub fn new(channels: Channels) -> Self {
+        let sgl = [
+            Column::Va,
+            Column::Vb,
+            Column::Vc,
+            Column::Ia,
+            Column::Ib,
+            Column::Ic,
+            Column::Speed,
+        ]
+        .into_iter()
+        .enumerate()
+        .filter(|(_, c)| channels.has(*c))
+        .map(|(k, c)| (c, k))
+        .collect();
+        TdmsLogWriter {
+            channels,
+            t: Vec::with_capacity(SEGMENT_ROWS),
+            f: Default::default(),
+            enc: Vec::new(),
+            segments: 0,
+            sgl,
+        }
+    }
+
+    /// The bytes of one row (for size estimates).
+    pub fn row_bytes(channels: Channels) -> u64 {
+        let sgl = 3 + if channels.voltages { 3 } else { 0 } + u64::from(channels.speed);
+        8 + 4 * sgl + if channels.encoder { 8 } else { 0 }
+    }
+
+    /// Buffers a row; writes a segment when [`SEGMENT_ROWS`] are buffered.
+    pub fn write_row<W: Write>(&mut self, out: &mut W, r: &Row) -> std::io::Result<()> {
+        self.t.push(r.t_s);
+        let v = r.v_abc.unwrap_or_default();
+        let vals = [
+            v[0],
+            v[1],
+            v[2],
+            r.i_abc[0],
+            r.i_abc[1],
+            r.i_abc[2],
+            r.wm_rad_s.unwrap_or_default(),
+        ];
+        for &(_, k) in &self.sgl {
+            self.f[k].push(vals[k] as f32);
+        }
+        if self.channels.encoder {
+            self.enc.push(r.enc_count.unwrap_or_default());
+        }
+        if self.t.len() >= SEGMENT_ROWS {
+            self.flush_segment(out)?;
+        }
+        Ok(())
+    }
+
+    /// Writes the buffered rows as one segment (nothing when none are buffered, except an
+    /// empty log's one metadata segment, so that the file names its channels).
+    pub fn flush_segment<W: Write>(&mut self, out: &mut W) -> std::io::Result<()> {
+        let n = self.t.len();
+        if n == 0 && self.segments > 0 {
+            return Ok(());
+        }
+        let first = self.segments == 0;
+        let mut chans: Vec<(Column, u32)> = vec![(Column::Time, 10)];
+        chans.extend(self.sgl.iter().map(|&(c, _)| (c, 9)));
+        if self.channels.encoder {
+            chans.push((Column::Encoder, 4));
+        }
+        let (start, increment) = if first {
+            let rate = super::sample_rate_hz(&self.t);
+            (
+                self.t.first().copied().unwrap_or(0.0),
+                rate.map_or(0.0, |r| 1.0 / r),
+            )
+        } else {
+            (0.0, 0.0)
+        };
+        let mut meta = Vec::new();
+        let objects = chans.len() as u32 + if first { 2 } else { 0 };
+        meta.extend_from_slice(&objects.to_le_bytes());
+        if first {
+            for path in ["/".to_string(), format!("/'{GROUP}'")] {
+                put_str(&mut meta, &path);
+                meta.extend_from_slice(&u32::MAX.to_le_bytes());
+                meta.extend_from_slice(&0u32.to_le_bytes());
+            }
+        }
+        for (c, ty) in &chans {
+            put_str(&mut meta, &format!("/'{GROUP}'/'{}'", c.name()));
+            meta.extend_from_slice(&20u32.to_le_bytes());
+            meta.extend_from_slice(&ty.to_le_bytes());
+            meta.extend_from_slice(&1u32.to_le_bytes());
+            meta.extend_from_slice(&(n as u64).to_le_bytes());
+            if first && increment > 0.0 {
+                meta.extend_from_slice(&2u32.to_le_bytes());
+                put_f64_property(&mut meta, "wf_increment", increment);
+                put_f64_property(&mut meta, "wf_start_offset", start);
+            } else {
+                meta.extend_from_slice(&0u32.to_le_bytes());
+            }
+        }
+        let raw_len = n as u64 * Self::row_bytes(self.channels);
+        let mut lead = Vec::with_capacity(28);
+        lead.extend_from_slice(b"TDSm");
+        // kTocMetaData | kTocNewObjList | kTocRawData
+        lead.extend_from_slice(&((1u32 << 1) | (1 << 2) | (1 << 3)).to_le_bytes());
+        lead.extend_from_slice(&4713u32.to_le_bytes());
+        lead.extend_from_slice(&(meta.len() as u64 + raw_len).to_le_bytes());
+        lead.extend_from_slice(&(meta.len() as u64).to_le_bytes());
+        out.write_all(&lead)?;
+        out.write_all(&meta)?;
+        let mut raw = Vec::with_capacity(8 * n);
+        for x in &self.t {
+            raw.extend_from_slice(&x.to_le_bytes());
+        }
+        out.write_all(&raw)?;
+        for &(_, k) in &self.sgl {
+            raw.clear();
+            for x in &self.f[k] {
+                raw.extend_from_slice(&x.to_le_bytes());
+            }
+            out.write_all(&raw)?;
+        }
+        raw.clear();
+        for x in &self.enc {
+            raw.extend_from_slice(&x.to_le_bytes());
+        }
+        out.write_all(&raw)?;
+        self.t.clear();
+        self.f.iter_mut().for_each(Vec::clear);
+        self.enc.clear();
+        self.segments += 1;
+        Ok(())
+    }
+}
+
+/// Convenience for tests and [`super::LogWriter`]: flush the last segment into a buffered
+/// file.
+pub(super) fn finish(w: &mut TdmsLogWriter, out: &mut BufWriter<File>) -> std::io::Result<()> {
+    w.flush_segment(out)?;
+    out.flush()
+}
