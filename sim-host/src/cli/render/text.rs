@@ -357,6 +357,7 @@ pub fn table1(t: &Table1Report) -> anyhow::Result<()> {
             match (&r.named, r.named_change) {
                 (Some(n), Some(c)) if n != "b/bl" => format!("{n} ({:+.0} %)", 100.0 * c),
                 (Some(n), _) => n.clone(),
+                (None, _) if r.isolation_state == "isolated" => "not alone".to_string(),
                 (None, _) => format!("none ({})", r.isolation_state),
             },
             if cands.is_empty() { "none".to_string() } else { cands.join(", ") }
