@@ -61,7 +61,7 @@ const INTENDED: [(&str, &str, &str); 8] = [
 
 /// Keys added since the golden outputs were taken (issue 8: the data-quality stage's
 /// report, what commissioning did, the verdict, the range note beside a lamp).
-const ADDED: [&str; 18] = [
+const ADDED: [&str; 24] = [
     "data_quality",
     "commissioning",
     "verdict",
@@ -83,6 +83,13 @@ const ADDED: [&str; 18] = [
     "isolation_state",
     "name_delay_s",
     "judged_at_s",
+    // Issue 10: plausibility, identifiability, transient advice.
+    "plausible",
+    "implausible_because",
+    "identifiability",
+    "not_identified",
+    "advice",
+    "transient",
 ];
 
 /// With `GOLDEN_REGENERATE=name1,name2` set, writes today's output as the golden file of
@@ -162,7 +169,17 @@ fn compare(a: &serde_json::Value, b: &serde_json::Value, path: &str, out: &mut V
 /// commissioning report (the thresholds line included), the range notes beside the
 /// lamps and the verdict.
 fn without_added_lines(text: &str) -> String {
-    const ADDED_LINES: [&str; 9] = [
+    const ADDED_LINES: [&str; 18] = [
+        // Issue 10: plausibility, identifiability, transient advice.
+        "  advice:",
+        "      transient (",
+        "  not plausible:",
+        "       not plausible:",
+        "  identifiability:",
+        "  ra_ohm is not identified",
+        "  ls_h is not identified",
+        "  b_plus_bl_nms is not identified",
+        "  j_kgm2 is not identified",
         "data quality:",
         "  done:",
         "  NOT TRUSTED",

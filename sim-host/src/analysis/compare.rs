@@ -20,10 +20,24 @@ pub struct CompareReport {
     pub channels: Vec<metrics::ChannelError>,
     /// Where the model fails most.
     pub worst_windows: Vec<WorstWindow>,
+    /// What to do when the worst windows are transients (a start, a step): the dynamics
+    /// effects that cover them and the `--from` past a start. Empty otherwise.
+    pub advice: Vec<String>,
     /// Fitted base parameters.
     pub base_parameters: std::collections::BTreeMap<String, ParamValue>,
     /// Fitted effects.
     pub fitted_effects: Vec<FittedEffect>,
+    /// False when a fitted value (base parameter or effect) is outside its physical range.
+    pub plausible: bool,
+    /// Why not (one line per value out of range; empty when plausible).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub implausible_because: Vec<String>,
+    /// What the log identifies: rank and conditioning of the fit's Jacobian and each base
+    /// parameter's sensitivity (null when the base parameters were not refitted).
+    pub identifiability: Option<super::fit::Jacobian>,
+    /// The base parameters the log does not identify, in words ("j_kgm2 is not identified:
+    /// the speed never changes in this log"); their values stay near the nominal ones.
+    pub not_identified: Vec<String>,
     /// Analyses that could not run and why.
     pub skipped: Vec<String>,
     /// Unbalance analysis.
@@ -63,8 +77,13 @@ impl Analysis {
                     noise_floor: f64::NAN,
                     channels: vec![],
                     worst_windows: vec![],
+                    advice: vec![],
                     base_parameters: Default::default(),
                     fitted_effects: vec![],
+                    plausible: true,
+                    implausible_because: vec![],
+                    identifiability: None,
+                    not_identified: vec![],
                     skipped,
                     unbalance,
                     data: info,
@@ -88,6 +107,11 @@ impl Analysis {
             &BaseParams::nominal(&self.constants),
             opts.fit_base,
         );
+        let jac = super::fit::jacobian(&fd, &self.constants, &active_fit, &wf, &f, opts.fit_base);
+        let not_identified = jac
+            .as_ref()
+            .map(|j| not_identified_in_words(j, d, &self.constants))
+            .unwrap_or_default();
         let active = self.setup_all(d, &list)?;
         // Data-dependent set-ups (load steps) are recomputed on the full series; keep the
         // fitted values where the parameter count agrees.
@@ -95,7 +119,7 @@ impl Analysis {
         let pred = super::fit::predict(d, &self.constants, &active, &f);
         let w = Weights::new(d, 0, usize::MAX);
         let err: ErrorSummary = metrics::errors(d, &pred, None);
-        let (worst, all) = metrics::windows(
+        let (mut worst, all) = metrics::windows(
             d,
             &pred,
             &w,
@@ -104,6 +128,21 @@ impl Analysis {
             40,
             3,
         );
+        let in_model: Vec<EffectKind> = list.iter().map(|e| e.kind()).collect();
+        let (tags, advice) = super::transients::advice(d, &self.constants, &worst, &in_model);
+        for (w, t) in worst.iter_mut().zip(tags) {
+            w.transient = t;
+        }
+        let base_parameters = self.base_table(&f.base);
+        let fitted_effects = self.fitted_effects(&active, &f);
+        let mut implausible_because = super::base_implausible(&self.constants, &f.base, d);
+        for fe in &fitted_effects {
+            implausible_because.extend(
+                fe.implausible_because
+                    .iter()
+                    .map(|w| format!("{}: {w}", fe.effect)),
+            );
+        }
         Ok(CompareOutput {
             report: CompareReport {
                 effects: list.iter().map(|e| e.kind()).collect(),
@@ -111,8 +150,13 @@ impl Analysis {
                 noise_floor: self.model_noise_floor(d, &active, &f, &pred, &w),
                 channels: err.channels,
                 worst_windows: worst,
-                base_parameters: self.base_table(&f.base),
-                fitted_effects: self.fitted_effects(&active, &f),
+                advice,
+                base_parameters,
+                fitted_effects,
+                plausible: implausible_because.is_empty(),
+                implausible_because,
+                identifiability: jac,
+                not_identified,
                 skipped,
                 unbalance,
                 data: info,
@@ -122,4 +166,69 @@ impl Analysis {
             all_windows: all,
         })
     }
+}
+
+/// The base parameters a Jacobian finds unidentified, each with the reason the log gives:
+/// how much the measured speed, flux current and load current change over it.
+fn not_identified_in_words(
+    j: &super::fit::Jacobian,
+    d: &super::prep::Prepared,
+    n: &super::simplified_model::MachineConstants,
+) -> Vec<String> {
+    let span = |x: &[f64]| {
+        let (lo, hi) = x
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        let scale = x.iter().fold(0.0f64, |a, &v| a.max(v.abs())).max(1e-9);
+        if hi >= lo {
+            (hi - lo) / scale
+        } else {
+            0.0
+        }
+    };
+    let speed_span = if d.channels.speed {
+        Some(span(&d.omega_r))
+    } else {
+        None
+    };
+    let flux_span = span(&d.i_f);
+    let load_span = span(&d.iq);
+    let sync_rpm = super::effects::sync_speed_mech(d, n) * 60.0 / (2.0 * std::f64::consts::PI);
+    j.base
+        .iter()
+        .filter(|p| !p.identified)
+        .map(|p| {
+            let why = match (p.parameter, speed_span) {
+                ("j_kgm2", Some(s)) if s < 0.02 => format!(
+                    "the speed never changes in this log (it spans {:.1} % of its largest value)",
+                    100.0 * s
+                ),
+                ("j_kgm2", Some(_)) => "the speed changes too little or too slowly for the inertia torque to matter next to the other torques".into(),
+                ("j_kgm2" | "b_plus_bl_nms", None) => "the log has no speed column, and the currents alone hardly depend on it".into(),
+                ("b_plus_bl_nms", Some(s)) if s < 0.02 => format!(
+                    "the speed never changes in this log (spans {:.1} %, synchronous {:.0} rpm): a viscous torque cannot be told from a constant one",
+                    100.0 * s,
+                    sync_rpm
+                ),
+                ("b_plus_bl_nms", Some(_)) => "the speed-dependent load torque is too small next to the other torques".into(),
+                ("ls_h", _) if flux_span < 0.05 => format!(
+                    "the flux current hardly changes (spans {:.1} %), so Ls trades off against Ra at one operating point",
+                    100.0 * flux_span
+                ),
+                ("ra_ohm", _) if load_span < 0.05 => format!(
+                    "the load current hardly changes (spans {:.1} %), so Ra trades off against Ls at one operating point",
+                    100.0 * load_span
+                ),
+                _ => "the other fitted parameters compensate its change".into(),
+            };
+            format!(
+                "{} is not identified: {why} (a 10 % change moves the error by {:.4}, below {})",
+                p.parameter,
+                p.error_change_per_10_percent,
+                super::fit::IDENTIFIED_MIN
+            )
+        })
+        .collect()
 }

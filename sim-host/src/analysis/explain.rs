@@ -60,6 +60,13 @@ pub struct EffectCandidate {
     pub summary: String,
     /// What the effect is.
     pub description: String,
+    /// False when a fitted value (the effect's, or a base parameter refitted with it) is
+    /// outside its physical range ([`effects::plausible`]): such a candidate is ranked after
+    /// every plausible one and never named by the verdict.
+    pub plausible: bool,
+    /// Why not (one entry per value out of range; empty when plausible).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub implausible_because: Vec<String>,
 }
 
 /// Result of `explain` (its JSON document).
@@ -196,11 +203,21 @@ impl Analysis {
         rank(&mut ranked, &unbalance, self.constants.torque_scale_nm);
         let best = ranked
             .first()
+            .filter(|c| c.candidate.plausible)
             .map(|c| c.candidate.explained_fraction)
             .unwrap_or(0.0);
         let near_noise = base.heldback_error <= (NOISE_MARGIN * base.noise).max(MIN_MODEL_ERROR);
         let unexplained = best < EXPLAINED_MIN || near_noise;
-        let verdict = verdict(&names, &base, ranked.first(), near_noise, unexplained);
+        let first_plausible = ranked.iter().find(|c| c.candidate.plausible);
+        let mut verdict = verdict(&names, &base, first_plausible, near_noise, unexplained);
+        verdict.push_str(&implausible_note(&ranked));
+        let base_why = super::base_implausible(&self.constants, &base.fit.base, d);
+        if !base_why.is_empty() {
+            verdict.push_str(&format!(
+                ". The configured model's own fit is not plausible ({}): the base parameters absorb an error the model cannot follow; if the log has a start or steps, see compare's advice (dynamics effects or --from)",
+                base_why.join("; ")
+            ));
+        }
         let after = if unexplained {
             None
         } else {
@@ -388,6 +405,20 @@ impl Analysis {
         let f = align(&full, f);
         let setups: Vec<FitSetup> = full.iter().map(|a| a.setup.clone()).collect();
         let me = self.fitted_effects(&full, &f).pop()?;
+        // A base parameter the candidate's refit takes out of range counts against it; one
+        // the configured model's own fit already has out of range does not (the verdict
+        // reports that apart).
+        let key = |w: &String| w.split(" =").next().unwrap_or_default().to_string();
+        let already: Vec<String> = super::base_implausible(&self.constants, &base.fit.base, d)
+            .iter()
+            .map(key)
+            .collect();
+        let mut why = me.implausible_because.clone();
+        why.extend(
+            super::base_implausible(&self.constants, &f.base, d)
+                .into_iter()
+                .filter(|w| !already.contains(&key(w))),
+        );
         Some(RankedCandidate {
             candidate: EffectCandidate {
                 effect: c.kind(),
@@ -402,6 +433,8 @@ impl Analysis {
                 parameters: me.parameters,
                 summary: me.summary,
                 description: c.description().to_string(),
+                plausible: why.is_empty(),
+                implausible_because: why,
             },
             fit: f,
             setups,
@@ -469,11 +502,14 @@ fn explain_current_only(
 /// applies the two rules where one operating point cannot tell two effects apart.
 fn rank(ranked: &mut [RankedCandidate], unbalance: &UnbalanceAnalysis, torque_scale_nm: f64) {
     ranked.sort_by(|a, b| {
-        a.score()
-            .total_cmp(&b.score())
+        b.candidate
+            .plausible
+            .cmp(&a.candidate.plausible)
+            .then(a.score().total_cmp(&b.score()))
             .then(a.candidate.n_parameters.cmp(&b.candidate.n_parameters))
     });
-    if ranked.len() < 2 {
+    // The tie-break rules below only ever reorder two plausible candidates.
+    if ranked.len() < 2 || !ranked[1].candidate.plausible {
         return;
     }
     // supply_unbalance and phase_asymmetry both add a negative-sequence current; on a log
@@ -519,6 +555,41 @@ fn rank(ranked: &mut [RankedCandidate], unbalance: &UnbalanceAnalysis, torque_sc
     }
 }
 
+/// The verdict's note on candidates whose fits are not physically plausible: those that
+/// would have explained more than the one named (or the threshold) are listed with the
+/// first reason, so that a user sees why they are not the answer.
+fn implausible_note(ranked: &[RankedCandidate]) -> String {
+    let top_plausible = ranked
+        .iter()
+        .find(|c| c.candidate.plausible)
+        .map(|c| c.score())
+        .unwrap_or(f64::INFINITY);
+    let listed: Vec<String> = ranked
+        .iter()
+        .filter(|c| !c.candidate.plausible && c.score() < top_plausible)
+        .map(|c| {
+            format!(
+                "{} would explain {:.0} % but {}",
+                c.candidate.effect,
+                100.0 * c.candidate.explained_fraction,
+                c.candidate
+                    .implausible_because
+                    .first()
+                    .map(String::as_str)
+                    .unwrap_or("a value is out of range")
+            )
+        })
+        .collect();
+    if listed.is_empty() {
+        String::new()
+    } else {
+        format!(
+            ". Not plausible, so ranked last and not named: {}",
+            listed.join("; ")
+        )
+    }
+}
+
 /// The conclusion in words.
 fn verdict(
     names: &[EffectKind],
@@ -555,7 +626,7 @@ fn verdict(
             100.0 * r.candidate.explained_fraction,
             100.0 * EXPLAINED_MIN
         ),
-        None => "unexplained: no candidate could be fitted".into(),
+        None => "unexplained: no candidate could be fitted with physically plausible values".into(),
     }
 }
 

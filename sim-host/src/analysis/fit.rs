@@ -325,3 +325,160 @@ pub fn predict(
 ) -> Prediction {
     simulate(d, n, &f.base, &terms(d, n, effects, f))
 }
+
+/// How well a log identifies one base parameter (`compare`'s `identifiability`).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ParameterSensitivity {
+    /// Base parameter key (as in `base_parameters`).
+    pub parameter: &'static str,
+    /// Change of the model error (normalized, root-sum over the channels) that a 10 %
+    /// change of this parameter causes when every other fitted parameter is refitted to
+    /// compensate: `0.1 |x_i| / sqrt((J^T J)^-1_ii)`, J the Jacobian of the data residuals
+    /// (no priors) at the fit. Small: the log cannot tell the parameter's value.
+    pub error_change_per_10_percent: f64,
+    /// True when that change is at least [`IDENTIFIED_MIN`].
+    pub identified: bool,
+}
+
+/// A 10 % change that moves the model error by less than this (0.4 % normalized error, the
+/// frame estimate's own accuracy, `explain::MIN_MODEL_ERROR`) is not identified.
+pub const IDENTIFIED_MIN: f64 = 0.004;
+
+/// Rank and conditioning of the fit's data Jacobian, and per-parameter sensitivities.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Jacobian {
+    /// Free parameters of the fit (base and effect parameters).
+    pub n_parameters: usize,
+    /// Numerical rank of the relative Jacobian (singular values above 1e-6 of the largest).
+    pub rank: usize,
+    /// Condition number of the relative Jacobian (largest over smallest singular value;
+    /// each column scaled by its parameter's magnitude).
+    pub condition_number: f64,
+    /// The four base parameters.
+    pub base: Vec<ParameterSensitivity>,
+}
+
+/// The data Jacobian at the fitted point `f` (forward differences, in parallel), relative
+/// to each parameter's magnitude, and what it says about the base parameters. `None` when
+/// the base parameters were not fitted.
+pub fn jacobian(
+    d: &Prepared,
+    n: &MachineConstants,
+    effects: &[ActiveEffect<'_>],
+    w: &Weights,
+    f: &FitResult,
+    fit_base: bool,
+) -> Option<Jacobian> {
+    if !fit_base {
+        return None;
+    }
+    let targets: Vec<(usize, [f64; 5])> = (0..d.len())
+        .step_by(w.stride)
+        .filter(|&k| w.train[k])
+        .map(|k| (k, measured(d, k)))
+        .collect();
+    let bs = btot_scale(n, d);
+    let prob = Problem {
+        d,
+        n,
+        effects,
+        w,
+        btot_scale: bs,
+        // Data residuals only: the priors are not information from the log.
+        fit_base: false,
+        rot: rotations(d),
+        norm: 1.0 / (targets.len().max(1) as f64).sqrt(),
+        targets,
+    };
+    let mut x = vec![
+        f.base.ra_scale,
+        f.base.ls_scale,
+        f.base.btot_nms,
+        f.base.j_scale,
+    ];
+    let mut mag = vec![1.0, 1.0, f.base.btot_nms.abs().max(0.1 * bs), 1.0];
+    for (e, p) in effects.iter().zip(&f.effect_params) {
+        x.extend_from_slice(p);
+        for (v, s) in p.iter().zip(&e.setup.scale) {
+            mag.push(v.abs().max(*s));
+        }
+    }
+    let r = prob.residuals(&x);
+    let cols: Vec<Vec<f64>> = (0..x.len())
+        .into_par_iter()
+        .map(|i| {
+            let h = 1e-3 * mag[i];
+            let mut xp = x.clone();
+            xp[i] += h;
+            let rp = prob.residuals(&xp);
+            // Relative column: d r / d ln|x| (a change of 100 % of the magnitude).
+            rp.iter()
+                .zip(&r)
+                .map(|(a, b)| (a - b) / h * mag[i])
+                .collect()
+        })
+        .collect();
+    let m = cols.len();
+    let mut jtj = DMatrix::<f64>::zeros(m, m);
+    for a in 0..m {
+        for c in a..m {
+            let s: f64 = cols[a].iter().zip(&cols[c]).map(|(u, v)| u * v).sum();
+            jtj[(a, c)] = s;
+            jtj[(c, a)] = s;
+        }
+    }
+    let eig = jtj.clone().symmetric_eigen();
+    let smax = eig
+        .eigenvalues
+        .iter()
+        .fold(0.0f64, |a, &v| a.max(v))
+        .max(0.0);
+    let rank = eig
+        .eigenvalues
+        .iter()
+        .filter(|&&v| v > 1e-12 * smax)
+        .count();
+    let smin = eig.eigenvalues.iter().fold(f64::INFINITY, |a, &v| a.min(v));
+    let condition_number = if smin > 0.0 {
+        (smax / smin).sqrt()
+    } else {
+        f64::INFINITY
+    };
+    // Pseudo-inverse diagonal: sum over eigenpairs above the rank threshold.
+    let inv_diag = |i: usize| -> f64 {
+        let mut s = 0.0;
+        for (k, &lam) in eig.eigenvalues.iter().enumerate() {
+            let v = eig.eigenvectors[(i, k)];
+            if lam > 1e-12 * smax {
+                s += v * v / lam;
+            } else if v.abs() > 1e-6 {
+                return f64::INFINITY;
+            }
+        }
+        s
+    };
+    let names = ["ra_ohm", "ls_h", "b_plus_bl_nms", "j_kgm2"];
+    let base = names
+        .iter()
+        .enumerate()
+        .map(|(i, &name)| {
+            let inv = inv_diag(i);
+            let ch = if inv.is_finite() && inv > 0.0 {
+                0.1 / inv.sqrt()
+            } else {
+                0.0
+            };
+            ParameterSensitivity {
+                parameter: name,
+                error_change_per_10_percent: ch,
+                identified: ch >= IDENTIFIED_MIN,
+            }
+        })
+        .collect();
+    Some(Jacobian {
+        n_parameters: m,
+        rank,
+        condition_number,
+        base,
+    })
+}

@@ -359,6 +359,9 @@ pub struct WorstWindow {
     pub dominant_error_hz: f64,
     /// That frequency in words ("2f ripple (100 Hz = 2 x supply)", "offset", ...).
     pub error_kind: String,
+    /// The transient the window lies in (start, supply step, speed change), when `compare`
+    /// found one ([`super::transients`]); null in steady operation.
+    pub transient: Option<super::transients::Transient>,
 }
 
 /// Operating condition of a window (means over the window).
@@ -457,6 +460,7 @@ pub fn windows(
                 },
                 dominant_error_hz: f,
                 error_kind: error_kind(f, fsup.abs()),
+                transient: None,
             }
         })
         .collect();

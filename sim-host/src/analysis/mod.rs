@@ -43,6 +43,7 @@ pub mod fit;
 pub mod metrics;
 pub mod prep;
 pub mod simplified_model;
+pub mod transients;
 pub mod unbalance;
 
 use effects::{EffectModel, Needs};
@@ -122,6 +123,12 @@ pub struct ParamValue {
     /// Nominal value from the parameter file (base parameters only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub nominal: Option<f64>,
+    /// False when the value is outside the physical range of motors of this size
+    /// ([`effects::plausible`]).
+    pub plausible: bool,
+    /// Why the value is not plausible (absent when it is).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub implausible_because: Option<String>,
 }
 
 /// An effect in the model with its fitted values.
@@ -133,6 +140,50 @@ pub struct FittedEffect {
     pub parameters: std::collections::BTreeMap<String, ParamValue>,
     /// In words.
     pub summary: String,
+    /// False when a fitted value is outside its physical range.
+    pub plausible: bool,
+    /// Why not (one entry per value out of range; empty when plausible).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub implausible_because: Vec<String>,
+}
+
+/// The base parameters' physical ranges ([`effects::plausible`]), one entry per parameter:
+/// key, value, range, unit.
+fn base_ranges(
+    n: &MachineConstants,
+    b: &BaseParams,
+    d: &Prepared,
+) -> [(&'static str, f64, f64, f64, &'static str, &'static str); 4] {
+    use effects::plausible as pl;
+    let bmax = (pl::BTOT_RATED_TORQUE * n.torque_scale_nm / effects::sync_speed_mech(d, n))
+        .max(3.0 * n.btot_nms);
+    [
+        ("ra_ohm", n.ra_ohm * b.ra_scale, pl::RA_RATIO.0 * n.ra_ohm, pl::RA_RATIO.1 * n.ra_ohm, "ohm",
+         "Ra follows the winding temperature: -20 C to 155 C is 0.84-1.53 x the 20 C value, plus 10 % data-sheet tolerance"),
+        ("ls_h", n.ls_h * b.ls_scale, pl::LS_RATIO.0 * n.ls_h, pl::LS_RATIO.1 * n.ls_h, "H",
+         "Ls moves at most about 30 % with saturation and tolerance"),
+        ("b_plus_bl_nms", b.btot_nms, 0.0, bmax, "N m s/rad",
+         "a viscous load carries at most 1.5 x the rated torque at synchronous speed"),
+        ("j_kgm2", n.j_kgm2 * b.j_scale, pl::J_RATIO.0 * n.j_kgm2, pl::J_RATIO.1 * n.j_kgm2, "kg m^2",
+         "the coupled load's inertia is the usual unknown, but a factor 3 either way is another machine"),
+    ]
+}
+
+/// The reasons fitted base parameters are not physically plausible (empty: plausible).
+pub fn base_implausible(n: &MachineConstants, b: &BaseParams, d: &Prepared) -> Vec<String> {
+    use effects::sig;
+    base_ranges(n, b, d)
+        .iter()
+        .filter(|(_, v, lo, hi, _, _)| !(v.is_finite() && v >= lo && v <= hi))
+        .map(|(k, v, lo, hi, u, basis)| {
+            format!(
+                "{k} = {} {u} is outside the physical range {}..{} {u} ({basis})",
+                sig(*v),
+                sig(*lo),
+                sig(*hi)
+            )
+        })
+        .collect()
 }
 
 /// Facts about the analysed data.
@@ -295,22 +346,28 @@ impl Analysis {
 
     fn base_table(&self, b: &BaseParams) -> std::collections::BTreeMap<String, ParamValue> {
         let n = &self.constants;
-        let mut m = std::collections::BTreeMap::new();
-        let mut put = |k: &str, v: f64, u: &str, nom: f64| {
-            m.insert(
-                k.to_string(),
-                ParamValue {
-                    value: v,
-                    unit: u.into(),
-                    nominal: Some(nom),
-                },
-            );
-        };
-        put("ra_ohm", n.ra_ohm * b.ra_scale, "ohm", n.ra_ohm);
-        put("ls_h", n.ls_h * b.ls_scale, "H", n.ls_h);
-        put("b_plus_bl_nms", b.btot_nms, "N m s/rad", n.btot_nms);
-        put("j_kgm2", n.j_kgm2 * b.j_scale, "kg m^2", n.j_kgm2);
-        m
+        let noms = [n.ra_ohm, n.ls_h, n.btot_nms, n.j_kgm2];
+        let why = base_implausible(n, b, &self.data);
+        base_ranges(n, b, &self.data)
+            .iter()
+            .zip(noms)
+            .map(|((k, v, _, _, u, _), nom)| {
+                let reason = why
+                    .iter()
+                    .find(|w| w.starts_with(&format!("{k} =")))
+                    .cloned();
+                (
+                    k.to_string(),
+                    ParamValue {
+                        value: *v,
+                        unit: u.to_string(),
+                        nominal: Some(nom),
+                        plausible: reason.is_none(),
+                        implausible_because: reason,
+                    },
+                )
+            })
+            .collect()
     }
 
     fn setup_all<'a>(
@@ -357,26 +414,37 @@ impl Analysis {
         active
             .iter()
             .zip(&f.effect_params)
-            .map(|(a, p)| FittedEffect {
-                effect: a.effect.kind(),
-                parameters: a
-                    .setup
-                    .names
-                    .iter()
-                    .zip(&a.setup.units)
-                    .zip(p)
-                    .map(|((n, u), v)| {
-                        (
-                            n.clone(),
-                            ParamValue {
-                                value: *v,
-                                unit: u.to_string(),
-                                nominal: None,
-                            },
-                        )
-                    })
-                    .collect(),
-                summary: a.effect.describe(&a.setup, p, &self.data, &self.constants),
+            .map(|(a, p)| {
+                let why = a.setup.implausible(p);
+                FittedEffect {
+                    effect: a.effect.kind(),
+                    parameters: a
+                        .setup
+                        .names
+                        .iter()
+                        .zip(&a.setup.units)
+                        .zip(p)
+                        .map(|((n, u), v)| {
+                            let reason = why
+                                .iter()
+                                .find(|w| w.starts_with(&format!("{n} =")))
+                                .cloned();
+                            (
+                                n.clone(),
+                                ParamValue {
+                                    value: *v,
+                                    unit: u.to_string(),
+                                    nominal: None,
+                                    plausible: reason.is_none(),
+                                    implausible_because: reason,
+                                },
+                            )
+                        })
+                        .collect(),
+                    summary: a.effect.describe(&a.setup, p, &self.data, &self.constants),
+                    plausible: why.is_empty(),
+                    implausible_because: why,
+                }
             })
             .collect()
     }

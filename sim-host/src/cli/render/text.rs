@@ -432,7 +432,13 @@ pub fn compare(log: &Path, r: &CompareReport) -> anyhow::Result<()> {
                 w.condition.time_since_start_s,
                 w.error_kind
             )?;
+            if let Some(t) = &w.transient {
+                writeln!(out, "      transient ({}): {}", t.kind, t.description)?;
+            }
         }
+    }
+    for a in &r.advice {
+        writeln!(out, "  advice: {a}")?;
     }
     for e in &r.fitted_effects {
         writeln!(out, "  {}: {}", e.effect, e.summary)?;
@@ -440,12 +446,26 @@ pub fn compare(log: &Path, r: &CompareReport) -> anyhow::Result<()> {
     for (k, v) in &r.base_parameters {
         writeln!(
             out,
-            "  fitted {:<14} {:>12.5} {} (nominal {:.5})",
+            "  fitted {:<14} {:>12.5} {} (nominal {:.5}){}",
             k,
             v.value,
             v.unit,
-            v.nominal.unwrap_or(f64::NAN)
+            v.nominal.unwrap_or(f64::NAN),
+            if v.plausible { "" } else { "  [not plausible]" }
         )?;
+    }
+    for w in &r.implausible_because {
+        writeln!(out, "  not plausible: {w}")?;
+    }
+    if let Some(j) = &r.identifiability {
+        writeln!(
+            out,
+            "  identifiability: Jacobian rank {} of {}, condition number {:.3e}",
+            j.rank, j.n_parameters, j.condition_number
+        )?;
+    }
+    for w in &r.not_identified {
+        writeln!(out, "  {w}")?;
     }
     for s in &r.skipped {
         writeln!(out, "  skipped: {s}")?;
@@ -483,6 +503,9 @@ pub fn explain(log: &Path, r: &ExplainReport) -> anyhow::Result<()> {
             100.0 * k.explained_fraction,
             k.summary
         )?;
+        for w in &k.implausible_because {
+            writeln!(out, "       not plausible: {w}")?;
+        }
     }
     for s in &r.skipped {
         writeln!(out, "  skipped: {s}")?;

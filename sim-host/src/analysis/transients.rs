@@ -1,0 +1,204 @@
+//! Transients in a log: the direct-on-line start and the steps of the supply voltage,
+//! the supply frequency or the speed, found from the measured signals. `compare` uses them
+//! to say when its worst windows are a transient, which dynamics effects cover it, and
+//! from where (`--from`) the log is past the start.
+
+use super::metrics::WorstWindow;
+use super::prep::Prepared;
+use super::simplified_model::MachineConstants;
+use monitor_core::EffectKind;
+use serde::Serialize;
+
+/// A relative change of the supply voltage amplitude or frequency larger than this within a
+/// window (or the settling time before it) makes the window a step.
+pub const STEP_MIN: f64 = 0.03;
+/// A speed change larger than this fraction of the synchronous speed within a window makes
+/// it a speed transient.
+pub const SPEED_CHANGE_MIN: f64 = 0.03;
+
+/// The transient a window lies in.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Transient {
+    /// `start` (direct-on-line start from standstill), `supply_step` (voltage or frequency
+    /// step) or `speed_change` (the speed moves, e.g. after a load step).
+    pub kind: &'static str,
+    /// What was seen, in words.
+    pub description: String,
+}
+
+/// The end of a start from standstill [s, log time]: the first time the speed reaches
+/// 90 % of its median over the rest of the log (the current envelope falls to 1.5x its
+/// median without a speed column); `None` when the log does not begin at standstill.
+pub fn start_end_s(d: &Prepared) -> Option<f64> {
+    let n = d.len();
+    if n < 10 {
+        return None;
+    }
+    let head = ((0.01 / d.dt_s).ceil() as usize).clamp(1, n);
+    let median = |x: &mut Vec<f64>| {
+        x.sort_by(f64::total_cmp);
+        x.get(x.len() / 2).copied().unwrap_or(0.0)
+    };
+    if d.channels.speed && d.omega_r.len() == n {
+        let w0 = d.omega_r[..head].iter().sum::<f64>() / head as f64;
+        let mut rest: Vec<f64> = d.omega_r[n / 2..].iter().map(|w| w.abs()).collect();
+        let wm = median(&mut rest);
+        if wm <= 0.0 || w0.abs() > 0.1 * wm {
+            return None;
+        }
+        let k = d.omega_r.iter().position(|w| w.abs() >= 0.9 * wm)?;
+        return Some(d.t_s[k]);
+    }
+    let mag: Vec<f64> = d.i_ab.iter().map(|i| i.norm()).collect();
+    let mut all = mag.clone();
+    let im = median(&mut all);
+    let first = mag.iter().take(head).sum::<f64>() / head as f64;
+    let peak = mag.iter().take(n / 4).fold(0.0f64, |a, &v| a.max(v));
+    if first > 0.1 * im || peak < 3.0 * im {
+        return None;
+    }
+    let kp = mag.iter().position(|&v| v >= peak)?;
+    let k = mag[kp..].iter().position(|&v| v < 1.5 * im)? + kp;
+    Some(d.t_s[k])
+}
+
+fn span(x: impl Iterator<Item = f64>) -> (f64, f64, f64) {
+    let (mut lo, mut hi, mut s, mut c) = (f64::INFINITY, f64::NEG_INFINITY, 0.0, 0.0);
+    for v in x {
+        lo = lo.min(v);
+        hi = hi.max(v);
+        s += v;
+        c += 1.0;
+    }
+    (lo, hi, s / f64::max(c, 1.0))
+}
+
+/// The transient window `w` lies in (or that ended within `lookback_s` before it), if any.
+pub fn classify(
+    d: &Prepared,
+    n: &MachineConstants,
+    w: &WorstWindow,
+    start_end: Option<f64>,
+    lookback_s: f64,
+) -> Option<Transient> {
+    if let Some(te) = start_end {
+        if w.t_start_s <= te + lookback_s {
+            return Some(Transient {
+                kind: "start",
+                description: format!(
+                    "the direct-on-line start (the motor reaches 90 % of its running speed at {te:.2} s)"
+                ),
+            });
+        }
+    }
+    let idx: Vec<usize> = (0..d.len())
+        .filter(|&k| d.t_s[k] >= w.t_start_s - lookback_s && d.t_s[k] <= w.t_end_s)
+        .collect();
+    if idx.len() < 2 {
+        return None;
+    }
+    let mut steps = Vec::new();
+    if d.vq.len() == d.len() {
+        let (lo, hi, m) = span(idx.iter().map(|&k| d.vq[k].hypot(d.vd[k])));
+        if m > 0.0 && (hi - lo) / m > STEP_MIN {
+            steps.push(format!(
+                "the supply voltage moves by {:.0} %",
+                100.0 * (hi - lo) / m
+            ));
+        }
+    }
+    let (lo, hi, m) = span(idx.iter().map(|&k| d.omega_s[k].abs()));
+    if m > 0.0 && (hi - lo) / m > STEP_MIN {
+        steps.push(format!(
+            "the supply frequency moves from {:.1} to {:.1} Hz",
+            lo / std::f64::consts::TAU,
+            hi / std::f64::consts::TAU
+        ));
+    }
+    if !steps.is_empty() {
+        return Some(Transient {
+            kind: "supply_step",
+            description: steps.join(" and "),
+        });
+    }
+    if d.omega_r.len() == d.len() {
+        let (lo, hi, _) = span(idx.iter().map(|&k| d.omega_r[k]));
+        let ws = super::effects::sync_speed_mech(d, n) * n.np;
+        if (hi - lo) / ws > SPEED_CHANGE_MIN {
+            return Some(Transient {
+                kind: "speed_change",
+                description: format!(
+                    "the speed changes by {:.0} % of synchronous speed",
+                    100.0 * (hi - lo) / ws
+                ),
+            });
+        }
+    }
+    None
+}
+
+/// Settling time after a transient: five rotor time constants (the slowest electrical
+/// dynamics; the flux has settled to 0.7 %).
+pub fn settling_s(n: &MachineConstants) -> f64 {
+    5.0 * n.lr_h / n.rr_ohm
+}
+
+/// The advice `compare` prints when its worst windows are transients: which dynamics
+/// effects not in the model cover them, and (for a start) the `--from` past it.
+pub fn advice(
+    d: &Prepared,
+    n: &MachineConstants,
+    worst: &[WorstWindow],
+    in_model: &[EffectKind],
+) -> (Vec<Option<Transient>>, Vec<String>) {
+    let start = start_end_s(d);
+    let look = settling_s(n);
+    let tags: Vec<Option<Transient>> = worst
+        .iter()
+        .map(|w| classify(d, n, w, start, look))
+        .collect();
+    let missing: Vec<&str> = EffectKind::ALL
+        .iter()
+        .filter(|k| k.is_dynamics() && !in_model.contains(k))
+        .map(|k| k.name())
+        .collect();
+    let mut out = Vec::new();
+    let mut kinds: Vec<&str> = tags.iter().flatten().map(|t| t.kind).collect();
+    kinds.dedup();
+    if kinds.is_empty() {
+        return (tags, out);
+    }
+    let spans: Vec<String> = worst
+        .iter()
+        .zip(&tags)
+        .filter_map(|(w, t)| {
+            t.as_ref()
+                .map(|t| format!("{:.2}-{:.2} s: {}", w.t_start_s, w.t_end_s, t.description))
+        })
+        .collect();
+    let cover = if missing.is_empty() {
+        "every dynamics effect is already in the model; what remains there is another effect or a parameter error".to_string()
+    } else {
+        let all: Vec<&str> = in_model
+            .iter()
+            .map(|k| k.name())
+            .chain(missing.iter().copied())
+            .collect();
+        format!(
+            "the model's dynamics effects cover transients: add {} (--effects {})",
+            missing.join(", "),
+            all.join(",")
+        )
+    };
+    out.push(format!(
+        "the worst windows are transients ({}); {cover}",
+        spans.join("; ")
+    ));
+    if let Some(te) = start {
+        let from = ((te + look) * 10.0).ceil() / 10.0;
+        out.push(format!(
+            "or leave the start out: --from {from:.1} (the start ends at about {te:.2} s, plus five rotor time constants)"
+        ));
+    }
+    (tags, out)
+}
