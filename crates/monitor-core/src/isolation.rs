@@ -930,29 +930,6 @@ mod tests {
     }
 
     #[test]
-    #[ignore]
-    fn print_table() {
-        for (name, m, v, we) in machines() {
-            let iso =
-                Isolator::new(m.model(), v as f32, (we / core::f64::consts::TAU) as f32).unwrap();
-            for f in Fault::ALL {
-                for change in [-0.5f64, 0.5, -0.1, 0.1] {
-                    let k = 1.0 + change;
-                    let p = measure(&faulty(&m, Some(f), k), v, we, Some(f), k);
-                    let out = iso.isolate(&p);
-                    let c = &out.candidates;
-                    println!(
-                        "{name:7} {f:15} {change:+.1} dev {:8.1} unk {:.2} | {} {:.2} {:+.3} m{:.1} | {} {:.2} {:+.3} m{:.1} | sep {:.1} e {:?}",
-                        out.deviation, out.unknown_probability,
-                        c[0].fault, c[0].probability, c[0].change, c[0].misfit,
-                        c[1].fault, c[1].probability, c[1].change, c[1].misfit, out.separation_deg, out.residuals
-                    );
-                }
-            }
-        }
-    }
-
-    #[test]
     fn unusable_points_are_not_judged() {
         let (_, m, v, _) = machines()[1];
         let iso = Isolator::new(m.model(), v as f32, 60.0).unwrap();

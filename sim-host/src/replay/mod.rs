@@ -307,6 +307,8 @@ pub struct Replay {
     v_max: f64,
     /// The sequence analysis' PLL follows the voltages (else the currents).
     pll_on_voltage: bool,
+    /// Time of the last row the sequence analysis saw [s].
+    seq_t: Option<f64>,
 }
 
 impl Replay {
@@ -385,6 +387,7 @@ impl Replay {
             seq_v: SequenceAnalyzer::new(2.0, dt),
             v_max: f64::from(cfg.limits.v_max),
             pll_on_voltage: channels.voltages,
+            seq_t: None,
         })
     }
 
@@ -393,7 +396,7 @@ impl Replay {
         self.rows += 1;
         let t0 = *self.t0.get_or_insert(row.t_s);
         let t = row.t_s - t0;
-        self.track_sequences(row);
+        self.track_sequences(row, t);
         let Some(mon) = self.monitor.as_mut() else {
             return self.last;
         };
@@ -440,7 +443,15 @@ impl Replay {
     /// where logged, the voltages' positive and negative sequences on its angle. A row with
     /// a bad current is skipped (the monitor holds such samples out itself); a bad voltage
     /// leaves the voltages' analysis alone.
-    fn track_sequences(&mut self, row: &Row) {
+    fn track_sequences(&mut self, row: &Row, t: f64) {
+        // Samples missing from the stream: the PLL's angle advances over the missing time
+        // at its frequency (as the monitor's frame does), so that the sequences stay put.
+        if let Some(prev) = self.seq_t.replace(t) {
+            let missing = t - prev - self.dt_s;
+            if missing > 0.5 * self.dt_s && missing <= MAX_BRIDGED_GAP_S {
+                self.pll.skip(missing as f32);
+            }
+        }
         let ok = |x: &[f64; 3], max: f64| x.iter().all(|v| v.is_finite() && v.abs() <= max);
         if !ok(&row.i_abc, self.i_max) {
             return;
