@@ -773,9 +773,9 @@ mod tests {
     fn the_healthy_machine_has_zero_residuals_at_its_steady_state() {
         for (name, m, v, we) in machines() {
             let iso =
-                Isolator::new(m.model(), v as f32, (we / core::f64::consts::TAU) as f32).unwrap();
+                Isolator::new(m.model(), v as f32, (we / core::f64::consts::TAU) as f32).unwrap(); // ok: test
             let p = measure(&m, v, we, None, 1.0);
-            let e = iso.residuals(&p, None).unwrap();
+            let e = iso.residuals(&p, None).unwrap(); // ok: test
             assert!(e.iter().all(|x| x.abs() < 1e-4), "{name}: {e:?}");
             assert_eq!(iso.isolate(&p).state, IsolationState::NoDeviation, "{name}");
         }
@@ -798,7 +798,7 @@ mod tests {
         let mut named = 0;
         for (name, m, v, we) in machines() {
             let iso =
-                Isolator::new(m.model(), v as f32, (we / core::f64::consts::TAU) as f32).unwrap();
+                Isolator::new(m.model(), v as f32, (we / core::f64::consts::TAU) as f32).unwrap(); // ok: test
             for f in Fault::ALL {
                 for change in [-0.5f64, 0.5, -0.1, 0.1] {
                     let k = 1.0 + change;
@@ -833,7 +833,7 @@ mod tests {
                     }
                     let top = out
                         .named_fault()
-                        .unwrap_or_else(|| panic!("{name} {f} {change}: not named: {out:?}"));
+                        .unwrap_or_else(|| panic!("{name} {f} {change}: not named: {out:?}")); // ok: test
                     assert_eq!(top.fault, f, "{name} {f} {change}: {out:?}");
                     assert!(
                         (f64::from(top.change) - change).abs() < 0.2 * change.abs(),
@@ -851,7 +851,7 @@ mod tests {
     #[test]
     fn b_and_bl_are_one_friction_class() {
         let (_, m, v, we) = machines()[1];
-        let iso = Isolator::new(m.model(), v as f32, 60.0).unwrap();
+        let iso = Isolator::new(m.model(), v as f32, 60.0).unwrap(); // ok: test
         let p = measure(&faulty(&m, Some(Fault::Bl), 1.5), v, we, None, 1.0);
         let out = iso.isolate(&p);
         let top2: Vec<Fault> = out.candidates[..2].iter().map(|c| c.fault).collect();
@@ -864,7 +864,7 @@ mod tests {
             .candidates
             .iter()
             .find(|c| c.fault == Fault::Bl)
-            .unwrap();
+            .unwrap(); // ok: test
         assert!((bl.change - 0.5).abs() < 0.1, "{}", bl.change);
         assert!(
             out.named_fault().is_none(),
@@ -880,7 +880,7 @@ mod tests {
     fn a_change_no_fault_explains_is_unknown_not_a_wrong_name() {
         // Rs and Lr both changed: no single fault's direction fits.
         let (_, m, v, we) = machines()[1];
-        let iso = Isolator::new(m.model(), v as f32, 60.0).unwrap();
+        let iso = Isolator::new(m.model(), v as f32, 60.0).unwrap(); // ok: test
         let mut t = faulty(&m, Some(Fault::Rs), 1.6);
         t.lr_h = (m.lr_h - m.lm_h) * 0.4 + m.lm_h;
         t.bl_nms *= 0.6;
@@ -902,7 +902,7 @@ mod tests {
         off.lm_h *= 0.8;
         off.ls_h = off.lm_h;
         off.lr_h = m.lr_h - m.lm_h + off.lm_h;
-        let mut iso = Isolator::new(off.model(), v as f32, 50.0).unwrap();
+        let mut iso = Isolator::new(off.model(), v as f32, 50.0).unwrap(); // ok: test
         assert_ne!(
             iso.isolate(&measure(&m, v, we, None, 1.0)).state,
             IsolationState::NoDeviation
@@ -932,7 +932,7 @@ mod tests {
     #[test]
     fn unusable_points_are_not_judged() {
         let (_, m, v, _) = machines()[1];
-        let iso = Isolator::new(m.model(), v as f32, 60.0).unwrap();
+        let iso = Isolator::new(m.model(), v as f32, 60.0).unwrap(); // ok: test
         for p in [
             SteadyPoint::default(),
             SteadyPoint {

@@ -185,6 +185,18 @@ pub enum Column {
 }
 
 impl Column {
+    /// The measured channels stored at f32 precision by every writer (voltages, currents,
+    /// speed), in [`Row`] order.
+    pub const MEASURED: [Column; 7] = [
+        Column::Va,
+        Column::Vb,
+        Column::Vc,
+        Column::Ia,
+        Column::Ib,
+        Column::Ic,
+        Column::Speed,
+    ];
+
     /// Every column of the schema, in [`Row`] order.
     pub const ALL: [Column; 9] = [
         Column::Time,

@@ -270,19 +270,11 @@ pub(super) struct ParquetLogWriter {
 impl ParquetLogWriter {
     /// Starts a file with `channels` into `file`.
     pub fn new(file: File, channels: Channels) -> Result<Self, ParquetError> {
-        let f: Vec<(Column, Vec<f32>)> = [
-            Column::Va,
-            Column::Vb,
-            Column::Vc,
-            Column::Ia,
-            Column::Ib,
-            Column::Ic,
-            Column::Speed,
-        ]
-        .into_iter()
-        .filter(|c| channels.has(*c))
-        .map(|c| (c, Vec::with_capacity(ROW_GROUP_ROWS)))
-        .collect();
+        let f: Vec<(Column, Vec<f32>)> = Column::MEASURED
+            .into_iter()
+            .filter(|c| channels.has(*c))
+            .map(|c| (c, Vec::with_capacity(ROW_GROUP_ROWS)))
+            .collect();
         let mut schema = String::from("message log {\n  REQUIRED DOUBLE t_s;\n");
         for (c, _) in &f {
             schema.push_str(&format!("  REQUIRED FLOAT {};\n", c.name()));

@@ -402,20 +402,12 @@ fn put_f64_property(b: &mut Vec<u8>, name: &str, x: f64) {
 impl TdmsLogWriter {
     /// A writer for a log with `channels`.
     pub fn new(channels: Channels) -> Self {
-        let sgl = [
-            Column::Va,
-            Column::Vb,
-            Column::Vc,
-            Column::Ia,
-            Column::Ib,
-            Column::Ic,
-            Column::Speed,
-        ]
-        .into_iter()
-        .enumerate()
-        .filter(|(_, c)| channels.has(*c))
-        .map(|(k, c)| (c, k))
-        .collect();
+        let sgl = Column::MEASURED
+            .into_iter()
+            .enumerate()
+            .filter(|(_, c)| channels.has(*c))
+            .map(|(k, c)| (c, k))
+            .collect();
         TdmsLogWriter {
             channels,
             t: Vec::with_capacity(SEGMENT_ROWS),
