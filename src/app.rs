@@ -8,7 +8,9 @@
 //!   [`MonitorStatus`] ([`SamplePath::status`]).
 //! - [`Supervisor`] runs in thread mode every [`PANEL_PERIOD_MS`]: the button, the
 //!   commissioning procedure ([`CommissioningProcedure`]), the liveness watch
-//!   ([`SampleWatch`]: the watchdog is petted only while samples flow), and the panel.
+//!   ([`SampleWatch`]: the watchdog is petted only while samples flow), the fault
+//!   isolation (`monitor_core::isolation::Follower` on the statuses: which fault, how
+//!   large; about 280 small circuit evaluations every 50 ms at most) and the panel.
 //!   [`carry_out`] turns its actions into commands, storing the learned calibration first.
 //!
 //! The host tests (`tests/sil.rs`) drive exactly these types with simulated data; the
@@ -23,9 +25,11 @@ use crate::liveness::{LivenessChange, SampleWatch};
 use crate::panel::{self, Mode, PanelInput, PanelLamps};
 use crate::reset_record::PreviousRun;
 use crate::sampling::{AdcSampler, RawFrame, SamplingError, TICK_HZ};
+use monitor_core::isolation::{Follower, Named};
 use monitor_core::{
-    CommissioningError, CommissioningRun, ConfigError, Fault, Install, Monitor, MonitorConfig,
-    MotorModel, Operating, ReferenceMachine, SensorFlags,
+    CommissioningError, CommissioningRun, ConfigError, Fault, Install, Isolation, IsolationState,
+    Isolator, Monitor, MonitorConfig, MotorModel, Operating, ReferenceMachine, SensorFlags,
+    SteadyPoint,
 };
 
 /// The machine the firmware monitors by default: DESIGN.md's "2.2 kW" reference machine
@@ -46,6 +50,17 @@ pub const BUTTON_DEBOUNCE_MS: u32 = 300;
 /// The default machine in the core's precision.
 pub fn default_motor() -> MotorModel {
     DEFAULT_MACHINE.motor.model()
+}
+
+/// The fault isolator for [`DEFAULT_MACHINE`] on its rated supply (`None` if the core
+/// rejects the machine: then nothing is isolated and the blink code says "not named").
+pub fn board_isolator() -> Option<Isolator> {
+    let supply = DEFAULT_MACHINE.supply;
+    Isolator::new(
+        default_motor(),
+        supply.v_phase_peak() as f32,
+        supply.f_hz as f32,
+    )
 }
 
 /// Core configuration for the board: [`DEFAULT_MACHINE`] on its rated supply, sampled at
@@ -260,6 +275,33 @@ pub struct MonitorStatus {
     /// The threshold band of r1..r4 in force, (centre, half-width)
     /// (`Monitor::threshold_bands`).
     pub bands: [(f32, f32); 4],
+    /// The steady-state operating point of the monitor's filtered outputs, for the fault
+    /// isolation in thread mode ([`SteadyPoint::from_output`]).
+    pub point: SteadyPoint,
+}
+
+/// The isolation in the status line's words (README, "The status line"): the label
+/// (the fault's name `rs`..`speed_sensor`, `b/bl` for the friction class, `unknown`,
+/// `none` for no deviation from the healthy baseline, `not-judged`), the named fault's
+/// size (relative change, 0.48 for +48 %; for sensors the gain error; Bl's for the
+/// friction class; 0 when nothing is named) and its probability (the unknown fault's for
+/// `unknown`, 0 otherwise).
+pub fn isolation_summary(iso: Option<&Isolation>) -> (&'static str, f32, f32) {
+    let Some(iso) = iso else {
+        return ("not-judged", 0.0, 0.0);
+    };
+    match (iso.named(), iso.state) {
+        (Some(Named::Fault(c)), _) => (c.fault.name(), c.change, c.probability),
+        (
+            Some(Named::Friction {
+                probability, bl, ..
+            }),
+            _,
+        ) => ("b/bl", bl.change, probability),
+        (None, IsolationState::NoDeviation) => ("none", 0.0, 0.0),
+        (None, IsolationState::NotJudged) => ("not-judged", 0.0, 0.0),
+        (None, _) => ("unknown", 0.0, iso.unknown_probability),
+    }
 }
 
 /// The per-sample path: scaling, the core, commands.
@@ -384,6 +426,7 @@ impl SamplePath {
             quasi_steady: o.quasi_steady,
             evaluating: o.evaluating,
             bands: self.monitor.threshold_bands(),
+            point: SteadyPoint::from_output(o),
         }
     }
 }
@@ -413,6 +456,10 @@ pub struct Supervisor {
     latest: MonitorStatus,
     failed_until_ms: Option<u32>,
     last_press_ms: Option<u32>,
+    isolation: Option<Follower>,
+    sample_rate_hz: u32,
+    /// The monitor has evaluated once since boot (settled, voltage present).
+    running: bool,
 }
 
 impl Supervisor {
@@ -437,7 +484,29 @@ impl Supervisor {
                 .failed()
                 .then(|| now_ms.wrapping_add(FAILED_BOOT_SHOW_MS)),
             last_press_ms: None,
+            isolation: board_isolator().map(Follower::new),
+            sample_rate_hz: settings.sample_rate_hz,
+            running: false,
         }
+    }
+
+    /// The latest fault isolation (`None` before the first steady half second, or when the
+    /// machine cannot be used by the isolation).
+    pub fn isolation(&self) -> Option<&Isolation> {
+        self.isolation.as_ref().and_then(Follower::last)
+    }
+
+    /// Feeds a new status to the fault isolation: its operating point, `dt` from the sample
+    /// counter, usable once the monitor has evaluated with no sensor fault, learning while
+    /// a commissioning run is active (the core's schedule: `monitor_core::isolation::Follower`).
+    fn follow(&mut self, s: &MonitorStatus, previous_samples: u32) {
+        let Some(f) = self.isolation.as_mut() else {
+            return;
+        };
+        let dt_s = s.samples.wrapping_sub(previous_samples) as f32 / self.sample_rate_hz as f32;
+        self.running |= s.evaluating;
+        let usable = self.running && !s.sensor_fault.any();
+        f.observe(&s.point, dt_s, usable, s.run.stage.is_active());
     }
 
     /// The latest status from the sample task.
@@ -454,7 +523,9 @@ impl Supervisor {
     /// came, `button` whether the button was pressed since the last tick.
     pub fn tick(&mut self, now_ms: u32, status: Option<MonitorStatus>, button: bool) -> Tick {
         if let Some(s) = status {
+            let previous = self.latest.samples;
             self.latest = s;
+            self.follow(&s, previous);
         }
         let watch = self.watch.poll(self.latest.samples, now_ms);
         let pressed = button
@@ -496,7 +567,7 @@ impl Supervisor {
             Mode::NotCommissioned
         };
         let failed = self.procedure.last_failure().is_some();
-        let input = PanelInput::from_status(mode, &self.latest, failed);
+        let input = PanelInput::from_status(mode, &self.latest, self.isolation(), failed);
         Tick {
             pet_watchdog: watch.pet_watchdog,
             mode,

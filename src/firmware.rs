@@ -43,8 +43,8 @@ use embassy_sync::signal::Signal;
 use embassy_time::{with_deadline, with_timeout, Duration, Instant, Timer};
 
 use drive_monitor::app::{
-    carry_out, Command, MonitorStatus, SamplePath, Settings, Supervisor, PANEL_PERIOD_MS,
-    WATCHDOG_TIMEOUT_MS,
+    carry_out, isolation_summary, Command, MonitorStatus, SamplePath, Settings, Supervisor,
+    PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
 };
 use drive_monitor::board::{self, pins::Board, CurrentCode, Lamp, Port, VoltageCode, LAMP_COUNT};
 use drive_monitor::commissioning::RunEnd;
@@ -53,6 +53,7 @@ use drive_monitor::liveness::{AdcWait, LivenessChange};
 use drive_monitor::panel::PanelLamps;
 use drive_monitor::reset_record::{PreviousRun, ResetCause, ResetRecord, RESET_RECORD_LEN};
 use drive_monitor::sampling::RawFrame;
+use monitor_core::Isolation;
 
 bind_interrupts!(struct Irqs {
     DMA1_CHANNEL1 => dma::InterruptHandler<peripherals::DMA1_CH1>;
@@ -452,7 +453,12 @@ async fn main(_spawner: Spawner) {
         log_div += 1;
         if log_div >= 2 {
             log_div = 0;
-            log_status(supervisor.latest(), tick.mode.name(), max_update_cycles);
+            log_status(
+                supervisor.latest(),
+                supervisor.isolation(),
+                tick.mode.name(),
+                max_update_cycles,
+            );
         }
     }
 }
@@ -539,17 +545,19 @@ fn log_stored<E: defmt::Format>(stored: &flash_record::Stored<E>) {
 }
 
 /// The defmt status line: residuals, lamps, the two top candidates, speed, mode,
-/// counters, the operating point, the gate and the threshold bands. Its format is
+/// counters, the operating point, the gate, the threshold bands and the isolation (the
+/// fault named, its size and probability: `app::isolation_summary`). Its format is
 /// documented once, in the README ("The status line"); `sim-host hmi --stdin` parses it
 /// (`sim_host::hmi::status_line`), and `tests/status_line.rs` renders this format string
 /// and parses it back, so the two cannot drift apart.
-fn log_status(s: &MonitorStatus, mode: &str, max_update_cycles: u32) {
+fn log_status(s: &MonitorStatus, iso: Option<&Isolation>, mode: &str, max_update_cycles: u32) {
     let (top_name, top_p) = s.top.map_or(("none", 0.0), |(f, p)| (f.name(), p));
+    let (iso_name, iso_change, iso_p) = isolation_summary(iso);
     let (second_name, second_p) = s.second.map_or(("none", 0.0), |(f, p)| (f.name(), p));
     let mid = s.bands.map(|b| b.0);
     let half = s.bands.map(|b| b.1);
     info!(
-        "r={} lamps={} fault={=bool} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32} iqs={=f32}A ids={=f32}A vqs={=f32}V f={=f32}Hz steady={=bool} eval={=bool} sens={=bool},{=bool},{=bool} mid={} half={}",
+        "r={} lamps={} fault={=bool} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32} iqs={=f32}A ids={=f32}A vqs={=f32}V f={=f32}Hz steady={=bool} eval={=bool} sens={=bool},{=bool},{=bool} mid={} half={} iso={=str} iso_change={=f32} iso_p={=f32}",
         s.residuals,
         s.residual_lamps,
         s.fault_detected,
@@ -578,6 +586,9 @@ fn log_status(s: &MonitorStatus, mode: &str, max_update_cycles: u32) {
         s.sensor_fault.speed,
         mid,
         half,
+        iso_name,
+        iso_change,
+        iso_p,
     );
 }
 

@@ -25,21 +25,32 @@
 //! |---|---|
 //! | off | no fault detected |
 //! | steady on | input invalid: ADC saturated or a sensor fault flagged by the core, no isolation |
-//! | N blinks (250 ms on / 250 ms off), then 1.5 s dark, repeating | fault detected, top candidate N (table below) |
+//! | N blinks (250 ms on / 250 ms off), then 1.5 s dark, repeating | fault detected, blink code N (table below) |
 //! | 10 Hz flicker | the last commissioning failed (no progress, unusable statistics or not stored) and no fault is shown; the RUN lamp says which thresholds are in force; press the button to retry |
 //!
-//! Blink code N = position in the core's `Fault::ALL` plus one:
+//! The blink code names the fault the **isolation** found (`monitor_core::isolation`: the
+//! full steady-state equations, which separate what the paper's four lamps cannot), in
+//! the core's `Fault::ALL` order plus one:
 //!
-//! | N | 1 | 2 | 3 | 4 | 5 | 6 | 7 | 8 | 9 |
-//! |---|---|---|---|---|---|---|---|---|---|
-//! | candidate | Rs | Rr | Ls | Lr | B | Bl | current sensor | voltage sensor | speed sensor |
+//! | N | 1 | 2 | 3 | 4 | 5 | 6 | 7 | 8 | 9 | 10 |
+//! |---|---|---|---|---|---|---|---|---|---|---|
+//! | fault | Rs | Rr | Ls | Lr | friction B/Bl | (Bl: not used, shown as 5) | current sensor | voltage sensor | speed sensor | detected, **not named** |
 //!
-//! Candidates with equal signatures (Rs/Rr, B/Bl, Ls/voltage sensor) cannot be told
-//! apart by the method; the lamp shows the first of the tied pair and the defmt log
-//! lists the probabilities of all candidates.
+//! B and Bl cannot be separated at any operating point (they scale the same load term), so
+//! the friction class blinks 5. Code 10 means the lamps or the isolation saw a fault that
+//! the isolation could not name: an unknown fault (no fault's direction fits), or no
+//! steady half second yet since the change. The defmt status line gives the size
+//! (`iso=rr(+0.48)`) and the paper's lamp-pattern candidates.
+//!
+//! The FAULT lamp blinks when the core's lamps detect a fault, and also when the isolation
+//! names a fault (not the friction class, which a load change is to the paper's model)
+//! while the learned baseline of a commissioning run is in force: below the lamps'
+//! thresholds the isolation's three equations can still be outside their healthy spread.
 
 use crate::app::MonitorStatus;
 pub use crate::board::Lamp;
+use monitor_core::isolation::{Isolation, Named};
+use monitor_core::Fault;
 
 /// State of the six lamps (`true` = lit), one field per lamp.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -123,27 +134,44 @@ pub struct PanelInput {
     pub fault_detected: bool,
     /// Input invalid (ADC saturated / sensor fault flag).
     pub input_invalid: bool,
-    /// Index of the top fault candidate in `Fault::ALL` (0..=8), if any.
-    pub top_candidate: Option<u8>,
+    /// Blink code of the fault shown: 1..=9 ([`blink_code`] of the isolated fault; 5 for
+    /// the friction class) or [`NOT_NAMED_CODE`].
+    pub fault_code: u8,
     /// The last commissioning attempt failed (shown while no fault is).
     pub commissioning_failed: bool,
 }
 
 impl PanelInput {
-    /// The panel's inputs for the latest status in `mode`: the residual lamps, the fault
-    /// lamp, "input invalid" when a sensor fault is flagged with no residual lamp lit, and
-    /// the top candidate's blink code.
-    pub fn from_status(mode: Mode, status: &MonitorStatus, commissioning_failed: bool) -> Self {
+    /// The panel's inputs for the latest status in `mode` and the latest `isolation`: the
+    /// residual lamps, the fault lamp (the core's detection, or a fault the isolation names
+    /// while commissioned: module docs), "input invalid" when a sensor fault is flagged
+    /// with no residual lamp lit, and the isolated fault's blink code.
+    pub fn from_status(
+        mode: Mode,
+        status: &MonitorStatus,
+        isolation: Option<&Isolation>,
+        commissioning_failed: bool,
+    ) -> Self {
+        let named = isolation.and_then(Isolation::named);
+        let fault_code = match named {
+            Some(Named::Fault(c)) => blink_code(c.fault.index() as u8),
+            Some(Named::Friction { .. }) => blink_code(Fault::B.index() as u8),
+            None => NOT_NAMED_CODE,
+        };
+        let named_fault = matches!(named, Some(Named::Fault(_)));
         PanelInput {
             mode,
             residual_lamps: status.residual_lamps,
-            fault_detected: status.fault_detected,
+            fault_detected: status.fault_detected || (named_fault && status.commissioned),
             input_invalid: status.sensor_fault.any() && !status.residual_lamps.iter().any(|l| *l),
-            top_candidate: status.top.map(|(f, _)| f.index() as u8),
+            fault_code,
             commissioning_failed,
         }
     }
 }
+
+/// Blink code of a fault detected that the isolation did not name (module docs).
+pub const NOT_NAMED_CODE: u8 = 10;
 
 /// Blink code of a candidate index: `index + 1` (1..=9).
 pub const fn blink_code(candidate_index: u8) -> u8 {
@@ -200,10 +228,7 @@ pub fn render(input: &PanelInput, t_ms: u32) -> PanelLamps {
         } else if input.input_invalid {
             true
         } else if input.fault_detected {
-            match input.top_candidate {
-                Some(i) => blink_code_lamp(blink_code(i), t_ms),
-                None => true,
-            }
+            blink_code_lamp(input.fault_code, t_ms)
         } else {
             input.commissioning_failed && t_ms % 100 < 50
         },
@@ -256,7 +281,7 @@ mod tests {
             residual_lamps: [true, false, true, false],
             fault_detected: true,
             input_invalid: false,
-            top_candidate: Some(3),
+            fault_code: 4,
             commissioning_failed: false,
         }
     }
@@ -269,14 +294,69 @@ mod tests {
 
     #[test]
     fn blink_code_round_trips_for_every_candidate() {
-        for i in 0..9u8 {
+        for code in 1..=NOT_NAMED_CODE {
             let mut inp = input(Mode::Commissioned);
-            inp.top_candidate = Some(i);
+            inp.fault_code = code;
             let trace: Vec<bool> = (0..400u32)
                 .map(|k| render(&inp, k * 50).is_on(Lamp::Fault))
                 .collect();
-            assert_eq!(read_blink_code(&trace, 50), Some(i + 1), "candidate {i}");
+            assert_eq!(read_blink_code(&trace, 50), Some(code), "code {code}");
         }
+    }
+
+    /// An isolation that names `fault` with probability `p` (the rest unknown).
+    fn isolation(fault: Fault, p: f32) -> Isolation {
+        let mut iso = Isolation {
+            state: monitor_core::IsolationState::Isolated,
+            ..Isolation::default()
+        };
+        let k = iso
+            .candidates
+            .iter()
+            .position(|c| c.fault == fault)
+            .unwrap_or(0); // ok: test
+        iso.candidates.swap(0, k);
+        iso.candidates[0].probability = p;
+        iso.unknown_probability = 1.0 - p;
+        iso
+    }
+
+    #[test]
+    fn the_code_is_the_isolated_fault_and_a_named_fault_shows_when_commissioned() {
+        let mut status = MonitorStatus {
+            commissioned: true,
+            ..MonitorStatus::default()
+        };
+        let at = |inp: &PanelInput| {
+            let trace: Vec<bool> = (0..400u32)
+                .map(|k| render(inp, k * 50).is_on(Lamp::Fault))
+                .collect();
+            read_blink_code(&trace, 50)
+        };
+        // Named, commissioned, lamps quiet: shown with the fault's code.
+        let rr = isolation(Fault::Rr, 0.9);
+        let inp = PanelInput::from_status(Mode::Commissioned, &status, Some(&rr), false);
+        assert_eq!(at(&inp), Some(2));
+        // Not commissioned: the isolation alone does not light the lamp.
+        status.commissioned = false;
+        let inp = PanelInput::from_status(Mode::NotCommissioned, &status, Some(&rr), false);
+        assert!((0..400u32).all(|k| !render(&inp, k * 50).is_on(Lamp::Fault)));
+        // The lamps detect, the isolation is not sure (p < 0.5): "not named".
+        status.fault_detected = true;
+        let unsure = isolation(Fault::Rs, 0.4);
+        let inp = PanelInput::from_status(Mode::NotCommissioned, &status, Some(&unsure), false);
+        assert_eq!(at(&inp), Some(NOT_NAMED_CODE));
+        let inp = PanelInput::from_status(Mode::NotCommissioned, &status, None, false);
+        assert_eq!(at(&inp), Some(NOT_NAMED_CODE));
+        // Bl (or B) named: the friction class, code 5, and a load change alone does not
+        // light the lamp.
+        let bl = isolation(Fault::Bl, 0.7);
+        let inp = PanelInput::from_status(Mode::Commissioned, &status, Some(&bl), false);
+        assert_eq!(at(&inp), Some(5));
+        status.fault_detected = false;
+        status.commissioned = true;
+        let inp = PanelInput::from_status(Mode::Commissioned, &status, Some(&bl), false);
+        assert!((0..400u32).all(|k| !render(&inp, k * 50).is_on(Lamp::Fault)));
     }
 
     #[test]

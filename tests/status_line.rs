@@ -66,6 +66,9 @@ fn value(arg: &str) -> &'static str {
         "s.sensor_fault.speed" => "false",
         "mid" => "[0.001, -0.01, 0.009, 0.0]",
         "half" => "[0.006, 0.011, 0.012, 0.007]",
+        "iso_name" => "rr",
+        "iso_change" => "0.48",
+        "iso_p" => "0.93",
         other => panic!(
             "log_status prints `{other}`: give it a test value here and teach \
              sim_host::hmi::status_line to read it"
@@ -113,6 +116,14 @@ fn the_hmi_reads_every_field_the_firmware_prints() {
     assert_eq!(
         s.band,
         Some(([0.001, -0.01, 0.009, 0.0], [0.006, 0.011, 0.012, 0.007]))
+    );
+    assert_eq!(
+        s.isolation,
+        Some(status_line::FirmwareIsolation {
+            named: "rr".to_string(),
+            change: 0.48,
+            probability: 0.93
+        })
     );
     let snap = s.snapshot(0.0);
     assert!(snap.learned && snap.fault_lamp);

@@ -59,8 +59,13 @@
 //!   [`Isolation::separation_deg`]).
 //!
 //! Cost: about 280 circuit evaluations of some 60 flops each per call; run it from a
-//! low-priority task (the firmware: from the status hand-over, every few hundred
-//! milliseconds), never from the per-sample path.
+//! low-priority task (the firmware: thread mode, from the status hand-over, every
+//! [`STEP_S`] at most), never from the per-sample path. [`Follower`] runs the schedule
+//! (averaging the operating point, learning the baseline, isolating) for the firmware and
+//! the host alike.
+
+mod follower;
+pub use follower::{steady_against, Follower, Step, AVERAGE_S, STEADY_FRACTION, STEP_S};
 
 use crate::frames::Dq;
 use crate::machine::MotorModel;
@@ -523,7 +528,9 @@ impl Isolator {
     }
 
     /// Best factor `k` for fault `f`: geometric grid, then golden section around the best
-    /// grid point. Returns `(chi2, k)`.
+    /// grid point. Returns `(chi2, k)`. Not inlined: one copy for the nine faults keeps
+    /// the firmware's flash small (it runs in thread mode, where a call costs nothing).
+    #[inline(never)]
     fn fit(&self, p: &SteadyPoint, f: Fault) -> (f32, f32) {
         let step = F32Ext::powf(K_MAX / K_MIN, 1.0 / (GRID - 1) as f32);
         let (mut best_k, mut best_c) = (1.0f32, self.chi2_at(p, f, 1.0));
@@ -948,5 +955,65 @@ mod tests {
             assert_eq!(iso.isolate(&p).state, IsolationState::NotJudged);
         }
         assert!(Isolator::new(m.model(), f32::NAN, 60.0).is_none());
+    }
+
+    /// The follower's schedule: nothing before half a second of steady running; a load or
+    /// supply step restarts the average; the baseline learned while commissioning learns
+    /// goes into force when it ends; an Rr +40 % change is then named with its size.
+    #[test]
+    fn the_follower_averages_learns_and_isolates_on_schedule() {
+        let (_, m, v, we) = machines()[0];
+        let iso = Isolator::new(m.model(), v as f32, (we / core::f64::consts::TAU) as f32);
+        let mut f = Follower::new(iso.unwrap()); // ok: test
+        let healthy = measure(&m, v, we, None, 1.0);
+        let dt = 0.01;
+        // 0.49 s of steady running: waiting.
+        for _ in 0..49 {
+            assert_eq!(f.observe(&healthy, dt, true, false), Step::Waiting);
+        }
+        assert!(f.last().is_none());
+        // Learning for 2 s: points go into the baseline, none is isolated.
+        let mut learned = 0;
+        for _ in 0..200 {
+            match f.observe(&healthy, dt, true, true) {
+                Step::Learned => learned += 1,
+                Step::Waiting => {}
+                other => panic!("while learning: {other:?}"), // ok: test
+            }
+        }
+        assert!((30..=45).contains(&learned), "{learned} points learned");
+        assert_eq!(
+            f.observe(&healthy, dt, true, false),
+            Step::LearningEnded(true)
+        );
+        assert!(f.learned());
+        // A 5 % voltage step: not steady, the average restarts (0.5 s before a result).
+        let mut stepped = measure(&m, 1.05 * v, we, None, 1.0);
+        let mut steps = 0;
+        for k in 0..100 {
+            if let Step::Isolated(r) = f.observe(&stepped, dt, true, false) {
+                assert!(k >= 49, "isolated {k} steps after the step");
+                assert_eq!(r.state, IsolationState::NoDeviation, "{r:?}");
+                steps += 1;
+            }
+        }
+        assert!(steps >= 5, "{steps} isolations in 1 s");
+        // An unusable point (a sensor fault) drops the average.
+        assert_eq!(f.observe(&stepped, dt, false, false), Step::Waiting);
+        let rr = faulty(&m, Some(Fault::Rr), 1.4);
+        stepped = measure(&rr, 1.05 * v, we, Some(Fault::Rr), 1.4);
+        let mut named = None;
+        for _ in 0..100 {
+            if let Step::Isolated(r) = f.observe(&stepped, dt, true, false) {
+                named = r.named_fault();
+            }
+        }
+        let c = named.unwrap_or_else(|| panic!("Rr +40 % not named: {:?}", f.last())); // ok: test
+        assert_eq!(c.fault, Fault::Rr);
+        assert!((c.change - 0.4).abs() < 0.04, "size {}", c.change);
+        // Bad time steps count as no time.
+        for dt in [f32::NAN, -1.0, f32::INFINITY] {
+            assert_eq!(f.observe(&stepped, dt, true, false), Step::Waiting);
+        }
     }
 }

@@ -9,6 +9,7 @@
 //! r=[r1, r2, r3, r4] lamps=[b1, b2, b3, b4] fault=B top=NAME(P) 2nd=NAME(P) wm=Xrad/s
 //! zc_locked=.. mode=MODE run=ID:LEARNED/NEEDED overruns=N restarts=N samples=N
 //! max_cyc=N iqs=XA ids=XA vqs=XV f=XHz steady=B eval=B sens=B,B,B mid=[..] half=[..]
+//! iso=NAME iso_change=X iso_p=P
 //! ```
 //!
 //! The parser finds the `key=` fields anywhere in a line, so the decoder's decorations
@@ -63,6 +64,20 @@ pub struct FirmwareStatus {
     pub sensors: Option<[bool; 3]>,
     /// Threshold band centres and half-widths.
     pub band: Option<([f32; 4], [f32; 4])>,
+    /// The fault isolation's result (firmware with isolation).
+    pub isolation: Option<FirmwareIsolation>,
+}
+
+/// The isolation fields of a status line (`iso=`, `iso_change=`, `iso_p=`; the firmware's
+/// `drive_monitor::app::isolation_summary`).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FirmwareIsolation {
+    /// The fault named (`rs` .. `speed_sensor`), `b/bl`, `unknown`, `none` or `not-judged`.
+    pub named: String,
+    /// The named fault's relative change (0.48 for +48 %; the gain error of a sensor).
+    pub change: f32,
+    /// Its probability (for `unknown`: the unknown fault's).
+    pub probability: f32,
 }
 
 /// The value of field `key` in `line` (`key=` at the start or after a space), up to the
@@ -158,6 +173,11 @@ pub fn parse(line: &str) -> Option<FirmwareStatus> {
     let band = field(line, "mid")
         .and_then(floats4)
         .zip(field(line, "half").and_then(floats4));
+    let isolation = field(line, "iso").map(|named| FirmwareIsolation {
+        named: named.to_string(),
+        change: f("iso_change").unwrap_or(0.0),
+        probability: f("iso_p").unwrap_or(0.0),
+    });
     let timestamp_s = line
         .split_whitespace()
         .next()
@@ -182,6 +202,7 @@ pub fn parse(line: &str) -> Option<FirmwareStatus> {
         evaluating: b("eval"),
         sensors,
         band,
+        isolation,
     })
 }
 

@@ -6,53 +6,26 @@
 //! vectors of the replay's sequence analysis (one angle from a PLL on the voltages, so the
 //! point does not depend on the monitor's frame, which a speed-sensor or rotor-parameter
 //! fault detunes), the PLL's frequency and the monitor's electrical speed (encoder),
-//! averaged exponentially over [`AVERAGE_S`] once the monitor has settled, with no sensor
-//! fault, while every quantity stays within [`STEADY_FRACTION`] of its average. Every
-//! [`STEP_S`] the point is isolated (or, while commissioning learns, added to the
-//! baseline). The firmware feeds the same isolator from the monitor's own outputs
-//! ([`SteadyPoint::from_output`]).
+//! averaged once the monitor has settled, with no sensor fault, and isolated (or, while
+//! commissioning learns, added to the baseline) on the core's schedule
+//! ([`monitor_core::isolation::Follower`]: the same code the firmware runs; the firmware
+//! feeds it the monitor's own outputs, [`SteadyPoint::from_output`]).
 
-use monitor_core::isolation::{Candidate, Named};
+use monitor_core::isolation::{Candidate, Follower, Named, Step};
 use monitor_core::{
     CommissioningState, Fault, Isolation, IsolationState, Isolator, MonitorOutput, SteadyPoint,
 };
 use serde::Serialize;
 
-/// Time constant of the operating point's exponential average [s]: 25-30 supply periods,
-/// enough to average the frame frequency's ripple and to bring the residuals' scatter to
-/// about 0.05 % (module [`monitor_core::isolation`]'s default spreads).
-pub const AVERAGE_S: f64 = 0.5;
-/// How often the point is isolated or learned [s].
-pub const STEP_S: f64 = 0.05;
 /// A reported isolation older than this at the log's end says so [s].
 pub const STALE_S: f64 = 1.0;
-/// Relative change from the running average above which the vectors are not steady.
-pub const STEADY_FRACTION: f32 = 0.02;
-
-/// Every quantity of `p` within [`STEADY_FRACTION`] of `avg` (the currents and voltages of
-/// their vectors' magnitudes, the speeds of the frame's frequency).
-fn steady_against(p: &SteadyPoint, avg: &SteadyPoint) -> bool {
-    let i = monitor_core::fast_hypot(avg.i.d, avg.i.q).max(1e-6);
-    let v = monitor_core::fast_hypot(avg.v.d, avg.v.q).max(1e-6);
-    let w = avg.we_rad_s.abs().max(1.0);
-    monitor_core::fast_hypot(p.i.d - avg.i.d, p.i.q - avg.i.q) <= STEADY_FRACTION * i
-        && monitor_core::fast_hypot(p.v.d - avg.v.d, p.v.q - avg.v.q) <= STEADY_FRACTION * v
-        && (p.we_rad_s - avg.we_rad_s).abs() <= STEADY_FRACTION * w
-        && (p.wr_rad_s - avg.wr_rad_s).abs() <= STEADY_FRACTION * w
-}
 
 /// A candidate is listed from this probability on.
 pub const LIST_FROM: f32 = 0.01;
 
-/// Follows the monitor's outputs and isolates.
+/// Follows the monitor's outputs and isolates (the core's [`Follower`] schedule).
 pub(super) struct IsolationTracker {
-    isolator: Option<Isolator>,
-    avg: Option<SteadyPoint>,
-    averaged_s: f64,
-    next_step: f64,
-    learning: bool,
-    learned: bool,
-    last: Option<Isolation>,
+    follower: Option<Follower>,
     first_named: Option<(String, f64)>,
     /// The monitor has evaluated once (settled, voltage present).
     running: bool,
@@ -66,13 +39,7 @@ impl IsolationTracker {
     /// nothing is isolated and the report says so).
     pub(super) fn new(isolator: Option<Isolator>) -> Self {
         IsolationTracker {
-            isolator,
-            avg: None,
-            averaged_s: 0.0,
-            next_step: 0.0,
-            learning: false,
-            learned: false,
-            last: None,
+            follower: isolator.map(Follower::new),
             first_named: None,
             running: false,
             last_t: 0.0,
@@ -92,49 +59,20 @@ impl IsolationTracker {
         counts: bool,
     ) {
         self.end_t = t;
-        let Some(iso) = self.isolator.as_mut() else {
+        let Some(follower) = self.follower.as_mut() else {
             return;
         };
         let learning = matches!(out.commissioning, CommissioningState::Learning(_));
-        if self.learning && !learning {
-            self.learned |= iso.finish_learning();
-        }
-        self.learning = learning;
         self.running |= out.evaluating;
         let usable = self.running && !out.sensor_fault.any() && (learning || counts);
-        if !usable {
-            self.avg = None;
-            self.averaged_s = 0.0;
-            return;
-        }
-        let p = *point;
-        let a = (dt_s / AVERAGE_S).min(1.0) as f32;
-        let avg = self.avg.get_or_insert(p);
         // Quasi-steady by the vectors themselves (the monitor's gate follows its own frame,
-        // which a sensor fault can detune): every quantity within 2 % of its average.
-        if steady_against(&p, avg) {
-            avg.approach(&p, a);
-        } else {
-            // A new operating point: the average starts again from it.
-            *avg = p;
-            self.averaged_s = 0.0;
-        }
-        self.averaged_s += dt_s;
-        if self.averaged_s < AVERAGE_S || t < self.next_step {
-            return;
-        }
-        self.next_step = t + STEP_S;
-        let avg = *avg;
-        if learning {
-            iso.learn(&avg);
-        } else {
-            let result = iso.isolate(&avg);
+        // which a sensor fault can detune).
+        if let Step::Isolated(result) = follower.observe(point, dt_s as f32, usable, learning) {
             if self.first_named.is_none() {
                 if let Some(n) = result.named() {
                     self.first_named = Some((named_label(&n), t));
                 }
             }
-            self.last = Some(result);
             self.last_t = t;
         }
     }
@@ -149,13 +87,14 @@ impl IsolationTracker {
     /// The report, and the candidates for `diagnose` (most probable first, those from
     /// [`LIST_FROM`] on) when `detected` (a lamp lit or a sensor fault was seen).
     pub(super) fn report(&self, detected: bool) -> (IsolationReport, Vec<FaultCandidate>) {
-        let Some(iso) = self.last else {
-            let why = if self.isolator.is_none() {
+        let learned = self.follower.as_ref().is_some_and(Follower::learned);
+        let Some(iso) = self.follower.as_ref().and_then(|f| f.last().copied()) else {
+            let why = if self.follower.is_none() {
                 "the parameter file's machine cannot be used by the isolation"
             } else {
                 "no settled, quasi-steady operating point with voltage was evaluated"
             };
-            return (IsolationReport::not_judged(why, self.learned), Vec::new());
+            return (IsolationReport::not_judged(why, learned), Vec::new());
         };
         // An unknown fault lists its three nearest candidates only.
         let listed = if iso.state == IsolationState::Unknown {
@@ -196,7 +135,7 @@ impl IsolationTracker {
             unknown_probability: iso.unknown_probability,
             separation_deg: iso.separation_deg,
             residuals: iso.residuals,
-            baseline: if self.learned {
+            baseline: if learned {
                 "learned in commissioning"
             } else {
                 "nominal parameters"

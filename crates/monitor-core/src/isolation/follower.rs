@@ -1,0 +1,160 @@
+//! Following a running machine with the isolator: the steady operating point averaged,
+//! the healthy baseline learned while commissioning, and an isolation every
+//! [`STEP_S`]. One home for this schedule: the firmware's thread mode and the host's
+//! replay (`sim_host::replay`) both run it.
+//!
+//! # The operating point
+//! The isolation's equations hold in steady state, so the point it is given is an
+//! exponential average, time constant [`AVERAGE_S`], of the points observed (the monitor's
+//! filtered outputs on the board, [`SteadyPoint::from_output`]; the replay's
+//! positive-sequence vectors on the host). A point is steady while every quantity stays
+//! within [`STEADY_FRACTION`] of the average: the current and voltage vectors by their
+//! distance relative to their magnitudes, the two speeds relative to the supply's
+//! frequency. A point outside starts the average again from itself (a new operating point:
+//! a load step, a supply change), and nothing is isolated until it has been averaged for
+//! [`AVERAGE_S`]: 25-30 supply periods, which also averages the frame frequency's ripple
+//! and brings the residuals' scatter to about 0.05 % (the module's [`DEFAULT_SPREAD`]).
+//!
+//! [`DEFAULT_SPREAD`]: super::DEFAULT_SPREAD
+
+use super::{Isolation, Isolator, SteadyPoint};
+use crate::fast_hypot;
+
+/// Time constant of the operating point's exponential average [s] (module docs).
+pub const AVERAGE_S: f32 = 0.5;
+/// How often the averaged point is isolated (or, while commissioning, learned) [s].
+pub const STEP_S: f32 = 0.05;
+/// Relative change from the running average above which a point is not steady.
+pub const STEADY_FRACTION: f32 = 0.02;
+
+/// Every quantity of `p` within [`STEADY_FRACTION`] of `avg`: the current and voltage
+/// vectors by their distance relative to the average's magnitude, the supply and rotor
+/// speeds relative to the supply's (at least 1 rad/s).
+pub fn steady_against(p: &SteadyPoint, avg: &SteadyPoint) -> bool {
+    let i = crate::maxf(fast_hypot(avg.i.d, avg.i.q), 1e-6);
+    let v = crate::maxf(fast_hypot(avg.v.d, avg.v.q), 1e-6);
+    let w = crate::maxf(avg.we_rad_s.abs(), 1.0);
+    fast_hypot(p.i.d - avg.i.d, p.i.q - avg.i.q) <= STEADY_FRACTION * i
+        && fast_hypot(p.v.d - avg.v.d, p.v.q - avg.v.q) <= STEADY_FRACTION * v
+        && (p.we_rad_s - avg.we_rad_s).abs() <= STEADY_FRACTION * w
+        && (p.wr_rad_s - avg.wr_rad_s).abs() <= STEADY_FRACTION * w
+}
+
+/// What one [`Follower::observe`] did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Step {
+    /// Nothing new: the point was unusable, not yet averaged long enough, or the step
+    /// ([`STEP_S`]) is not due.
+    Waiting,
+    /// The averaged point went into the baseline being learned.
+    Learned,
+    /// Learning ended: `true` when the learned baseline went into force (enough points).
+    LearningEnded(bool),
+    /// The averaged point was isolated (the result is also [`Follower::last`]).
+    Isolated(Isolation),
+}
+
+/// The isolator with its schedule: averaging, learning, isolating (module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Follower {
+    isolator: Isolator,
+    avg: Option<SteadyPoint>,
+    averaged_s: f32,
+    since_step_s: f32,
+    learning: bool,
+    learned: bool,
+    last: Option<Isolation>,
+}
+
+impl Follower {
+    /// Follows with `isolator` (its baseline in force: the default, or one set with
+    /// [`Isolator::set_baseline`]).
+    pub fn new(isolator: Isolator) -> Self {
+        Follower {
+            isolator,
+            avg: None,
+            averaged_s: 0.0,
+            since_step_s: STEP_S,
+            learning: false,
+            learned: false,
+            last: None,
+        }
+    }
+
+    /// One observed point `p`, `dt_s` [s] after the previous observation (> 0; a
+    /// non-finite or negative value counts as 0).
+    ///
+    /// `usable`: the point may be used (the monitor has settled and evaluates, no sensor
+    /// fault); an unusable point drops the average. `learning`: commissioning is learning
+    /// the healthy machine now; averaged points then go into the baseline, and its end puts
+    /// the learned baseline into force ([`Isolator::finish_learning`]: at least 10 points,
+    /// half a second of steady running). A point that is not steady against the average
+    /// restarts it.
+    pub fn observe(&mut self, p: &SteadyPoint, dt_s: f32, usable: bool, learning: bool) -> Step {
+        let dt = if dt_s.is_finite() && dt_s > 0.0 {
+            dt_s
+        } else {
+            0.0
+        };
+        // Saturates: only "due or not" matters.
+        self.since_step_s = crate::minf(self.since_step_s + dt, 2.0 * STEP_S);
+        let mut ended = None;
+        if self.learning && !learning {
+            let ok = self.isolator.finish_learning();
+            self.learned |= ok;
+            ended = Some(ok);
+        }
+        self.learning = learning;
+        if !usable {
+            self.avg = None;
+            self.averaged_s = 0.0;
+            return ended.map_or(Step::Waiting, Step::LearningEnded);
+        }
+        let a = crate::minf(dt / AVERAGE_S, 1.0);
+        let avg = self.avg.get_or_insert(*p);
+        if steady_against(p, avg) {
+            avg.approach(p, a);
+        } else {
+            *avg = *p;
+            self.averaged_s = 0.0;
+        }
+        self.averaged_s = crate::minf(self.averaged_s + dt, 2.0 * AVERAGE_S);
+        if let Some(ok) = ended {
+            return Step::LearningEnded(ok);
+        }
+        if self.averaged_s < AVERAGE_S || self.since_step_s < STEP_S {
+            return Step::Waiting;
+        }
+        self.since_step_s = 0.0;
+        let avg = *avg;
+        if learning {
+            self.isolator.learn(&avg);
+            Step::Learned
+        } else {
+            let result = self.isolator.isolate(&avg);
+            self.last = Some(result);
+            Step::Isolated(result)
+        }
+    }
+
+    /// The latest isolation, if any was made.
+    pub fn last(&self) -> Option<&Isolation> {
+        self.last.as_ref()
+    }
+
+    /// Forgets the latest isolation (for example when the machine stops: the next one
+    /// comes after [`AVERAGE_S`] of steady running).
+    pub fn clear(&mut self) {
+        self.last = None;
+    }
+
+    /// A baseline learned in commissioning is in force.
+    pub fn learned(&self) -> bool {
+        self.learned
+    }
+
+    /// The isolator (its baseline, its torque scale).
+    pub fn isolator(&self) -> &Isolator {
+        &self.isolator
+    }
+}
