@@ -23,6 +23,11 @@
 //! name the phase with it. Where the slip is not measured (a log with currents only),
 //! [`slip_for_current`] estimates it from the current magnitude.
 
+mod zero;
+pub use zero::{
+    phase_phasors, single_phase_gain, SinglePhaseGain, ZeroSequence, MAX_MISALIGNMENT_DEG,
+};
+
 use crate::filter::Svf;
 use crate::frames::{park, AlphaBeta, Phase, SinCos};
 use crate::machine::MotorModel;

@@ -12,6 +12,7 @@
 //! feeds it the monitor's own outputs, [`SteadyPoint::from_output`]).
 
 use monitor_core::isolation::{Candidate, Follower, Named, Step};
+use monitor_core::sequence::SinglePhaseGain;
 use monitor_core::{
     CommissioningState, Fault, Isolation, IsolationState, Isolator, MonitorOutput, SteadyPoint,
 };
@@ -170,6 +171,70 @@ impl From<&Candidate> for FaultCandidate {
             phase: None,
         }
     }
+}
+
+/// One phase's sensor gain error found from the zero sequence
+/// ([`monitor_core::sequence::single_phase_gain`]; JSON `unbalance.current_sensor_phase`,
+/// `unbalance.voltage_sensor_phase`).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct SensorPhaseReport {
+    /// `a`, `b` or `c`.
+    pub phase: String,
+    /// The sensor's gain error (0.2: it reads 20 % high).
+    pub gain_error: f32,
+    /// |3 I0| / |I1|: the zero sequence the error leaves in the measured set.
+    pub zero_sequence_ratio: f32,
+}
+
+impl From<&SinglePhaseGain> for SensorPhaseReport {
+    fn from(g: &SinglePhaseGain) -> Self {
+        SensorPhaseReport {
+            phase: g.phase.name().to_string(),
+            gain_error: g.gain_error,
+            zero_sequence_ratio: g.zero_sequence_ratio,
+        }
+    }
+}
+
+/// One phase's sensor: the isolation sees a gain error `g` on one of three phases as the
+/// positive sequence's `g/3`; where the zero sequence names the phase (`current`,
+/// `voltage`: [`SensorPhaseReport`]), the sensor candidates and the named fault get that
+/// phase and the sensor's own gain error, and the verdict says so.
+pub(super) fn refine_single_phase(
+    report: &mut IsolationReport,
+    candidates: &mut [FaultCandidate],
+    current: Option<&SensorPhaseReport>,
+    voltage: Option<&SensorPhaseReport>,
+) {
+    let of = |fault: &str| match fault {
+        "current_sensor" => current,
+        "voltage_sensor" => voltage,
+        _ => None,
+    };
+    for c in candidates.iter_mut() {
+        if let Some(g) = of(&c.fault) {
+            c.change = Some(g.gain_error);
+            c.phase = Some(g.phase.clone());
+        }
+    }
+    let Some(g) = report.named.as_deref().and_then(of) else {
+        return;
+    };
+    let what = if report.named.as_deref() == Some("current_sensor") {
+        "current"
+    } else {
+        "voltage"
+    };
+    report.named_change = Some(g.gain_error);
+    report.verdict = format!(
+        "The phase {} {what} sensor's gain changed by {} (the zero sequence of the three readings names it; one phase's error is a third of that on the three-phase vector){}",
+        g.phase,
+        pct(g.gain_error),
+        report
+            .verdict
+            .find(" (judged at")
+            .map_or(".".to_string(), |k| report.verdict[k..].to_string())
+    );
 }
 
 /// Faults that cannot be separated here, and why (JSON `isolation.groups`).
