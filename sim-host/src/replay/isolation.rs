@@ -54,6 +54,8 @@ pub(super) struct IsolationTracker {
     learned: bool,
     last: Option<Isolation>,
     first_named: Option<(String, f64)>,
+    /// Every label named, with the first time it was named [s].
+    names: Vec<(String, f64)>,
     /// The monitor has evaluated once (settled, voltage present).
     running: bool,
     /// Time of the last isolation and of the last sample [s].
@@ -74,6 +76,7 @@ impl IsolationTracker {
             learned: false,
             last: None,
             first_named: None,
+            names: Vec::new(),
             running: false,
             last_t: 0.0,
             end_t: 0.0,
@@ -129,14 +132,24 @@ impl IsolationTracker {
             iso.learn(&avg);
         } else {
             let result = iso.isolate(&avg);
-            if self.first_named.is_none() {
-                if let Some(n) = result.named() {
-                    self.first_named = Some((named_label(&n), t));
+            if let Some(n) = result.named() {
+                let label = named_label(&n);
+                if self.first_named.is_none() {
+                    self.first_named = Some((label.clone(), t));
+                }
+                if !self.names.iter().any(|(l, _)| *l == label) {
+                    self.names.push((label, t));
                 }
             }
             self.last = Some(result);
             self.last_t = t;
         }
+    }
+
+    /// Every label the isolation named so far (a fault's name or `b/bl`), each with the
+    /// first time it was named [s], in that order.
+    pub(super) fn names(&self) -> &[(String, f64)] {
+        &self.names
     }
 
     /// The isolation named a fault other than the friction class at some point (a load
