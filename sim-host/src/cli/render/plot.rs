@@ -255,72 +255,6 @@ fn png_staging_file(dir: &Path) -> std::io::Result<tempfile::NamedTempFile> {
     b.tempfile_in(dir)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn chart(title: &'static str) -> Chart<'static> {
-        Chart {
-            stem: "t",
-            title,
-            x_label: "time [s]",
-            y_label: "current [A]",
-            series: vec![Series {
-                label: "measured".into(),
-                points: (0..200)
-                    .map(|k| (k as f64 * 0.01, (k as f64 * 0.1).sin()))
-                    .collect(),
-                color: 0,
-                scatter: false,
-            }],
-            log_y: false,
-        }
-    }
-
-    /// The chart's pixels as the PNG encoder gets them (RGB, 900 x 420).
-    fn pixels(c: &Chart, text: bool) -> Vec<u8> {
-        let mut buf = vec![0u8; 900 * 420 * 3];
-        {
-            let root = BitMapBackend::with_buffer(&mut buf, (900, 420)).into_drawing_area();
-            draw(root, c, text).expect("draw");
-        }
-        buf
-    }
-
-    /// Pixels that are not white in rows `y0..y1`.
-    fn ink(rgb: &[u8], y0: usize, y1: usize) -> usize {
-        rgb[y0 * 900 * 3..y1 * 900 * 3]
-            .chunks_exact(3)
-            .filter(|p| *p != [255, 255, 255])
-            .count()
-    }
-
-    #[test]
-    fn png_charts_carry_their_text() {
-        let with = pixels(&chart("Phase current, measured and predicted"), true);
-        let without = pixels(&chart("Phase current, measured and predicted"), false);
-        // The title band (the caption above the plotting area): the title's glyphs, where
-        // the chart without text has only the top of its frame.
-        let title_with = ink(&with, 0, 34);
-        let title_without = ink(&without, 0, 34);
-        assert!(
-            title_with > title_without + 300,
-            "title pixels {title_with} against {title_without}"
-        );
-        // A longer title writes more ink: the pixels are glyphs, not a box.
-        let longer = pixels(
-            &chart("Phase current, measured and predicted, over the whole log"),
-            true,
-        );
-        assert!(ink(&longer, 0, 34) > title_with + 100);
-        // And the file written is a PNG of that chart.
-        let dir = tempfile::tempdir().expect("tmp");
-        let (_, paths) = write(dir.path(), &chart("Title")).expect("write");
-        let bytes = std::fs::read(&paths[1]).expect("png");
-        assert_eq!(&bytes[1..4], b"PNG");
-    }
-}
-
 /// The confusion matrices of `bench --isolation` as one SVG heatmap, one panel per angle
 /// mode side by side: rows the true fault, columns what the isolation named, the count in
 /// each cell, darker for more (the scale is each panel's largest count).
@@ -414,4 +348,70 @@ pub fn confusion_svg(matrices: &[sim_host::bench::isolation::Confusion]) -> Resu
         root.present().map_err(e)?;
     }
     Ok(s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn chart(title: &'static str) -> Chart<'static> {
+        Chart {
+            stem: "t",
+            title,
+            x_label: "time [s]",
+            y_label: "current [A]",
+            series: vec![Series {
+                label: "measured".into(),
+                points: (0..200)
+                    .map(|k| (k as f64 * 0.01, (k as f64 * 0.1).sin()))
+                    .collect(),
+                color: 0,
+                scatter: false,
+            }],
+            log_y: false,
+        }
+    }
+
+    /// The chart's pixels as the PNG encoder gets them (RGB, 900 x 420).
+    fn pixels(c: &Chart, text: bool) -> Vec<u8> {
+        let mut buf = vec![0u8; 900 * 420 * 3];
+        {
+            let root = BitMapBackend::with_buffer(&mut buf, (900, 420)).into_drawing_area();
+            draw(root, c, text).expect("draw");
+        }
+        buf
+    }
+
+    /// Pixels that are not white in rows `y0..y1`.
+    fn ink(rgb: &[u8], y0: usize, y1: usize) -> usize {
+        rgb[y0 * 900 * 3..y1 * 900 * 3]
+            .chunks_exact(3)
+            .filter(|p| *p != [255, 255, 255])
+            .count()
+    }
+
+    #[test]
+    fn png_charts_carry_their_text() {
+        let with = pixels(&chart("Phase current, measured and predicted"), true);
+        let without = pixels(&chart("Phase current, measured and predicted"), false);
+        // The title band (the caption above the plotting area): the title's glyphs, where
+        // the chart without text has only the top of its frame.
+        let title_with = ink(&with, 0, 34);
+        let title_without = ink(&without, 0, 34);
+        assert!(
+            title_with > title_without + 300,
+            "title pixels {title_with} against {title_without}"
+        );
+        // A longer title writes more ink: the pixels are glyphs, not a box.
+        let longer = pixels(
+            &chart("Phase current, measured and predicted, over the whole log"),
+            true,
+        );
+        assert!(ink(&longer, 0, 34) > title_with + 100);
+        // And the file written is a PNG of that chart.
+        let dir = tempfile::tempdir().expect("tmp");
+        let (_, paths) = write(dir.path(), &chart("Title")).expect("write");
+        let bytes = std::fs::read(&paths[1]).expect("png");
+        assert_eq!(&bytes[1..4], b"PNG");
+    }
 }
