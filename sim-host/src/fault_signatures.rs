@@ -13,7 +13,7 @@
 use crate::log::Row;
 use crate::params::ParamFile;
 use crate::replay::{Replay, ReplayOptions};
-use crate::sim::{simulate, FaultSpec, Scenario, SensorSpec};
+use crate::sim::{simulate, FaultSpec, LoadStep, Scenario, SensorSpec};
 use crate::ExperimentError;
 use monitor_core::{AngleSource, Fault};
 use serde::Serialize;
@@ -31,6 +31,11 @@ pub struct Protocol {
     pub sample_rate_hz: f64,
     /// Frame angle source.
     pub angle_source: AngleSource,
+    /// The viscous load's Bl as a multiple of the parameter file's, from the start (1: the
+    /// file's; the replay is still told the file's, as a user's file would not know).
+    pub load_scale: f64,
+    /// Seed of the sensor noise.
+    pub seed: u64,
 }
 
 impl Default for Protocol {
@@ -41,6 +46,8 @@ impl Default for Protocol {
             duration_s: 7.5,
             sample_rate_hz: 10_000.0,
             angle_source: AngleSource::RotorFluxCurrentModel,
+            load_scale: 1.0,
+            seed: 1,
         }
     }
 }
@@ -76,12 +83,24 @@ pub struct Table1Row {
     /// Time from the fault to the first time the isolation named a fault [s] (negative:
     /// something was named before the fault).
     pub name_delay_s: Option<f64>,
+    /// Every fault the isolation named during the run (`b/bl` for the friction class),
+    /// each with the first time it was named, from the fault on [s] (negative: before the
+    /// fault); a name given and later withdrawn stays here.
+    pub names_given: Vec<(String, f64)>,
 }
 
 /// The scenario of one case.
 pub fn scenario(fault: Option<(Fault, f64)>, proto: &Protocol) -> Scenario {
     let mut s = Scenario::steady(proto.duration_s, proto.sample_rate_hz);
     s.sensors = SensorSpec::default();
+    s.seed = proto.seed;
+    if proto.load_scale != 1.0 {
+        s.load.steps.push(LoadStep {
+            t_s: 0.0,
+            torque_nm: None,
+            bl_scale: Some(proto.load_scale),
+        });
+    }
     if let Some((f, change)) = fault {
         s.faults
             .push(FaultSpec::at_change(f, proto.fault_at_s, change));
@@ -113,6 +132,11 @@ pub fn run_case(
             first_lamp = Some(row.t_s - proto.fault_at_s);
         }
     })?;
+    let names_given = replay
+        .isolation_names()
+        .iter()
+        .map(|(n, t)| (n.clone(), t - proto.fault_at_s))
+        .collect();
     let rep = replay.finish();
     let lamps: Vec<bool> = (1..=4)
         .map(|k| rep.lamps.get(&format!("r{k}")).copied().unwrap_or(false))
@@ -157,6 +181,7 @@ pub fn run_case(
             .first_named
             .as_ref()
             .map(|(_, t)| t - proto.fault_at_s),
+        names_given,
     })
 }
 

@@ -9,12 +9,15 @@
 //! with the readings ([`Snapshot`], every [`SNAPSHOT_EVERY_S`] of simulated time): the
 //! simulation is deterministic whatever the screen's pace, and tests drive it directly.
 
-use super::{quit_key, Controls, HmiState, Key, LiveControls, Snapshot, Source, SNAPSHOT_EVERY_S};
+use super::{
+    quit_key, Controls, HmiState, IsolationView, Key, LiveControls, Snapshot, Source,
+    SNAPSHOT_EVERY_S,
+};
 use crate::fault_signatures::{scenario, Protocol};
 use crate::params::ParamFile;
-use crate::replay::{monitor_config_for_log, LogSampler, ReplayOptions};
+use crate::replay::{Replay, ReplayOptions};
 use crate::sim::{simulate_interactive, FaultSpec, LoadStep, ScenarioEvent, SupplyStep};
-use monitor_core::{CommissioningState, Fault, Monitor, RunStage};
+use monitor_core::{CommissioningState, Fault, RunStage};
 use std::ops::ControlFlow;
 use std::sync::mpsc::{channel, Receiver, Sender};
 use std::thread::JoinHandle;
@@ -83,11 +86,14 @@ impl LiveSim {
     /// # Errors
     /// The core refuses the configuration.
     pub fn new(params: ParamFile, sample_rate_hz: f64) -> Result<Self, crate::ExperimentError> {
-        let cfg = monitor_config_for_log(&params, sample_rate_hz, &ReplayOptions::default());
-        let monitor = Monitor::new(cfg).map_err(|source| crate::replay::ReplayError::Config {
-            source,
-            sample_rate_hz,
-        })?;
+        // The replay's monitor and isolation, fed row by row; its timeline is not kept (a
+        // live run has no end), commissioning starts on the `c` key.
+        let opts = ReplayOptions {
+            timeline_step_s: f64::INFINITY,
+            ..ReplayOptions::default()
+        };
+        let channels = crate::sim::SensorSpec::default().channels();
+        let replay = Replay::new(&params, channels, sample_rate_hz, opts)?;
         let (tx, cmd_rx) = channel();
         let (reply_tx, rx) = channel();
         let proto = Protocol {
@@ -99,8 +105,7 @@ impl LiveSim {
             let sc = scenario(None, &proto);
             Worker {
                 params,
-                monitor,
-                sampler: LogSampler::default(),
+                replay,
                 dt_s: 1.0 / sample_rate_hz,
                 rows: 0,
                 next_snapshot_s: 0.0,
@@ -282,8 +287,8 @@ fn clearing(fault: Fault, change: f64, t: f64) -> FaultSpec {
 /// The simulator's side of the live run.
 struct Worker {
     params: ParamFile,
-    monitor: Monitor,
-    sampler: LogSampler,
+    /// The core monitor and the isolation, as `diagnose` replays a log.
+    replay: Replay,
     dt_s: f64,
     rows: u64,
     next_snapshot_s: f64,
@@ -304,14 +309,15 @@ impl Worker {
                 return ControlFlow::Break(());
             }
             let t = self.rows as f64 * self.dt_s;
-            let out = *self.monitor.update(&self.sampler.sample(row));
+            let out = self.replay.push(row);
             self.note_commissioning(&out, t);
             if t + 0.5 * self.dt_s >= self.next_snapshot_s {
                 self.next_snapshot_s += SNAPSHOT_EVERY_S;
-                let bands = Some(self.monitor.threshold_bands());
-                let learned = self.monitor.calibration().is_some();
-                self.snapshots
-                    .push(Snapshot::from_output(t, &out, bands, learned, &params));
+                let bands = self.replay.threshold_bands();
+                let learned = self.replay.calibration().is_some();
+                let mut snap = Snapshot::from_output(t, &out, bands, learned, &params);
+                snap.isolation = Some(IsolationView::of_replay(&self.replay));
+                self.snapshots.push(snap);
             }
             self.rows += 1;
             self.budget = self.budget.saturating_sub(1);
@@ -356,7 +362,9 @@ impl Worker {
     fn note_commissioning(&mut self, out: &monitor_core::MonitorOutput, t: f64) {
         let learning = matches!(out.commissioning, CommissioningState::Learning(_));
         if self.learning && !learning {
-            let run = self.monitor.commissioning();
+            let Some(run) = self.replay.monitor().map(|m| m.commissioning()) else {
+                return;
+            };
             self.messages.push(match run.stage {
                 RunStage::Done => format!(
                     "{t:.2} s: commissioning run {} done: learned thresholds in force",
@@ -375,13 +383,19 @@ impl Worker {
 
     fn commission(&mut self) {
         let t = self.rows as f64 * self.dt_s;
-        self.messages
-            .push(match self.monitor.start_commissioning(COMMISSIONING_S) {
-                Ok(id) => format!(
+        self.messages.push(
+            match self
+                .replay
+                .monitor_mut()
+                .map(|m| m.start_commissioning(COMMISSIONING_S))
+            {
+                Some(Ok(id)) => format!(
                 "{t:.2} s: commissioning run {id} started ({COMMISSIONING_S} s of steady running)"
             ),
-                Err(e) => format!("{t:.2} s: commissioning not started: {e}"),
-            });
+                Some(Err(e)) => format!("{t:.2} s: commissioning not started: {e}"),
+                None => format!("{t:.2} s: commissioning not started: no monitor"),
+            },
+        );
     }
 }
 

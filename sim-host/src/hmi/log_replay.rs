@@ -174,13 +174,10 @@ impl ReplayObserver for Keeper {
         }
         self.next_s = (t / SNAPSHOT_EVERY_S).floor() * SNAPSHOT_EVERY_S + SNAPSHOT_EVERY_S;
         let learned = replay.calibration().is_some();
-        self.pending.push(Snapshot::from_output(
-            t,
-            out,
-            replay.threshold_bands(),
-            learned,
-            &self.params,
-        ));
+        let mut snap =
+            Snapshot::from_output(t, out, replay.threshold_bands(), learned, &self.params);
+        snap.isolation = Some(super::IsolationView::of_replay(replay));
+        self.pending.push(snap);
         if self.pending.len() >= BATCH {
             self.flush();
         }

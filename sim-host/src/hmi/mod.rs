@@ -78,6 +78,71 @@ pub struct Snapshot {
     pub supply_hz: Option<f32>,
     /// What the monitor is doing (the demo's states).
     pub state: MonitorState,
+    /// What the isolation concludes (the fault named with its size), where the source
+    /// runs it (the live simulation and a log replay; not the firmware's status line).
+    pub isolation: Option<IsolationView>,
+}
+
+/// The isolation's conclusion as the screen shows it ([`crate::replay::IsolationReport`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct IsolationView {
+    /// `isolated`, `unknown`, `no_deviation` or `not_judged`.
+    pub state: String,
+    /// The fault named (probability >= 0.5), `b/bl` for the friction class.
+    pub named: Option<String>,
+    /// Its estimated relative change (0.48 = +48 %; for `b/bl` Bl's).
+    pub change: Option<f32>,
+    /// The candidates listed (name, probability, estimated change), most probable first:
+    /// for an unknown fault its nearest three.
+    pub candidates: Vec<(String, f32, Option<f32>)>,
+}
+
+impl IsolationView {
+    /// From a replay's isolation report and candidates.
+    pub fn new(
+        report: &crate::replay::IsolationReport,
+        candidates: &[crate::replay::FaultCandidate],
+    ) -> Self {
+        IsolationView {
+            state: report.state.clone(),
+            named: report.named.clone(),
+            change: report.named_change,
+            candidates: candidates
+                .iter()
+                .map(|c| (c.fault.clone(), c.probability, c.change))
+                .collect(),
+        }
+    }
+
+    /// What `replay`'s isolation concludes now.
+    pub fn of_replay(replay: &crate::replay::Replay) -> Self {
+        let (report, candidates) = replay.isolation_now();
+        Self::new(&report, &candidates)
+    }
+
+    /// One line: `rr +48 %`, `unknown, nearest rr, ls, lr`, `rr / speed_sensor, not
+    /// alone`, `no deviation` or `not judged`.
+    pub fn text(&self) -> String {
+        let pct = |x: Option<f32>| x.map_or(String::new(), |c| format!(" {:+.0} %", 100.0 * c));
+        let names = |n: usize, sep: &str| {
+            self.candidates
+                .iter()
+                .take(n)
+                .map(|(f, _, _)| f.as_str())
+                .collect::<Vec<_>>()
+                .join(sep)
+        };
+        match (self.named.as_deref(), self.state.as_str()) {
+            (Some(n), _) => format!("{n}{}", pct(self.change)),
+            (None, "unknown") if self.candidates.is_empty() => "unknown fault".into(),
+            (None, "unknown") => format!("unknown, nearest {}", names(3, ", ")),
+            (None, "isolated") if !self.candidates.is_empty() => {
+                format!("{}, not alone", names(2, " / "))
+            }
+            (None, "not_judged") => "not judged".into(),
+            _ => "no deviation".into(),
+        }
+    }
 }
 
 impl Snapshot {
@@ -135,6 +200,7 @@ impl Snapshot {
             vqs_v: Some(out.operating.vqs),
             supply_hz: Some(we / std::f32::consts::TAU),
             state: MonitorState::of(out),
+            isolation: None,
         }
     }
 }

@@ -249,6 +249,7 @@ impl FirmwareStatus {
             vqs_v: self.vqs_v,
             supply_hz: self.supply_hz,
             state,
+            isolation: None,
         }
     }
 }

@@ -28,6 +28,8 @@ pub const LIST_FROM: f32 = 0.01;
 pub(super) struct IsolationTracker {
     follower: Option<Follower>,
     first_named: Option<(String, f64)>,
+    /// Every label named, with the first time it was named [s].
+    names: Vec<(String, f64)>,
     /// The monitor has evaluated once (settled, voltage present).
     running: bool,
     /// Time of the last isolation and of the last sample [s].
@@ -42,6 +44,7 @@ impl IsolationTracker {
         IsolationTracker {
             follower: isolator.map(Follower::new),
             first_named: None,
+            names: Vec::new(),
             running: false,
             last_t: 0.0,
             end_t: 0.0,
@@ -69,13 +72,23 @@ impl IsolationTracker {
         // Quasi-steady by the vectors themselves (the monitor's gate follows its own frame,
         // which a sensor fault can detune).
         if let Step::Isolated(result) = follower.observe(point, dt_s as f32, usable, learning) {
-            if self.first_named.is_none() {
-                if let Some(n) = result.named() {
-                    self.first_named = Some((named_label(&n), t));
+            if let Some(n) = result.named() {
+                let label = named_label(&n);
+                if self.first_named.is_none() {
+                    self.first_named = Some((label.clone(), t));
+                }
+                if !self.names.iter().any(|(l, _)| *l == label) {
+                    self.names.push((label, t));
                 }
             }
             self.last_t = t;
         }
+    }
+
+    /// Every label the isolation named so far (a fault's name or `b/bl`), each with the
+    /// first time it was named [s], in that order.
+    pub(super) fn names(&self) -> &[(String, f64)] {
+        &self.names
     }
 
     /// The isolation named a fault other than the friction class at some point (a load

@@ -620,6 +620,31 @@ impl Replay {
         row.t_s - self.t0.unwrap_or(row.t_s)
     }
 
+    /// What the isolation concludes now, as [`Replay::finish`] would report it (the report
+    /// and the candidates listed), for a screen that follows the replay.
+    pub fn isolation_now(&self) -> (IsolationReport, Vec<FaultCandidate>) {
+        let detected = self.first_detection.is_some() || self.isolation.named_a_fault();
+        self.isolation.report(detected)
+    }
+
+    /// Every label the isolation named so far (a fault's name or `b/bl`), each with the
+    /// first time it was named [s] (the replay's time), in that order: a name given and
+    /// later withdrawn stays here.
+    pub fn isolation_names(&self) -> &[(String, f64)] {
+        self.isolation.names()
+    }
+
+    /// The core monitor (`None` for a current-only log).
+    pub fn monitor(&self) -> Option<&Monitor> {
+        self.monitor.as_ref()
+    }
+
+    /// The core monitor, to start a commissioning run by hand (the live HMI's key); `None`
+    /// for a current-only log.
+    pub fn monitor_mut(&mut self) -> Option<&mut Monitor> {
+        self.monitor.as_mut()
+    }
+
     /// True when a commissioning window was asked for and not learned.
     pub fn commissioning_incomplete(&self) -> bool {
         self.monitor.is_some() && self.commission.incomplete()

@@ -146,8 +146,9 @@ fn render_residuals(frame: &mut Frame, area: Rect, s: Option<&Snapshot>) {
     frame.render_widget(Paragraph::new(lines), inner);
 }
 
-/// The fault candidates with their probability, the winding asymmetry and the sensors
-/// flagged.
+/// The isolation's conclusion (the fault named with its size, an unknown fault with its
+/// nearest candidates, or why nothing is named), the lamps' fault candidates with their
+/// probability, the winding asymmetry and the sensors flagged.
 fn render_candidates(frame: &mut Frame, area: Rect, s: Option<&Snapshot>) {
     let block = Block::new()
         .borders(Borders::TOP)
@@ -155,27 +156,38 @@ fn render_candidates(frame: &mut Frame, area: Rect, s: Option<&Snapshot>) {
     let inner = block.inner(area);
     frame.render_widget(block, area);
     let Some(s) = s else { return };
-    let mut lines: Vec<Line> = s
-        .candidates
-        .iter()
-        .take(3)
-        .map(|(f, p)| {
-            let n = (p * 10.0).round() as usize;
-            Line::from(format!(
-                " {:<15}{:>4.0} % {}",
-                f.name(),
-                p * 100.0,
-                "█".repeat(n.min(10))
-            ))
-        })
-        .collect();
-    if s.candidates.len() > 3 {
+    let mut lines: Vec<Line> = Vec::new();
+    // The isolation first: its name and size are the answer; the lamps' matching follows.
+    let shown = if let Some(iso) = &s.isolation {
+        let style = if iso.named.is_some() {
+            Style::new().fg(Color::Red).add_modifier(Modifier::BOLD)
+        } else {
+            Style::new()
+        };
+        lines.push(Line::from(vec![
+            Span::raw(" named: "),
+            Span::styled(iso.text(), style),
+        ]));
+        2
+    } else {
+        3
+    };
+    lines.extend(s.candidates.iter().take(shown).map(|(f, p)| {
+        let n = (p * 10.0).round() as usize;
+        Line::from(format!(
+            " {:<15}{:>4.0} % {}",
+            f.name(),
+            p * 100.0,
+            "█".repeat(n.min(10))
+        ))
+    }));
+    if s.candidates.len() > shown {
         lines.push(Line::from(format!(
             " ... and {} more",
-            s.candidates.len() - 3
+            s.candidates.len() - shown
         )));
     }
-    if lines.is_empty() {
+    if s.candidates.is_empty() {
         lines.push(Line::from(" none"));
     }
     for f in &s.sensor_faults {
@@ -445,6 +457,35 @@ mod tests {
         if let Ok(path) = std::env::var("HMI_SCREEN_CAPTURE") {
             std::fs::write(&path, rows.join("\n") + "\n").expect("capture written");
         }
+    }
+
+    #[test]
+    fn the_isolation_names_rr_with_its_size() {
+        let mut live = LiveSim::demo_motor().expect("reference motor");
+        let mut state = live.initial_state();
+        run(&mut live, &mut state, 2.0);
+        live.key(Key::Char('c'), &mut state);
+        run(&mut live, &mut state, 5.0);
+        let rows = screen(&state, 80, 24);
+        let before = find(&rows, " named: ");
+        assert!(before.contains("no deviation"), "{before}");
+        // 2: Rr +50 % (the default size); 3.5 s later the isolation names it with its size.
+        live.key(Key::Char('2'), &mut state);
+        run(&mut live, &mut state, 3.5);
+        let rows = screen(&state, 80, 24);
+        let named = find(&rows, " named: ");
+        let rest = named
+            .split(" named: rr +")
+            .nth(1)
+            .unwrap_or_else(|| panic!("rr not named with a + size: {}", rows.join("\n")));
+        let pct: f64 = rest
+            .split(" %")
+            .next()
+            .and_then(|x| x.trim().parse().ok())
+            .unwrap_or_else(|| panic!("no percentage: {named}"));
+        assert!((40.0..=60.0).contains(&pct), "{named}");
+        assert!(rows.iter().all(|r| r.chars().count() <= 80));
+        assert!(rows[23].contains("q quit"), "{}", rows[23]);
     }
 
     #[test]

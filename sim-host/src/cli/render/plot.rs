@@ -255,6 +255,101 @@ fn png_staging_file(dir: &Path) -> std::io::Result<tempfile::NamedTempFile> {
     b.tempfile_in(dir)
 }
 
+/// The confusion matrices of `bench --isolation` as one SVG heatmap, one panel per angle
+/// mode side by side: rows the true fault, columns what the isolation named, the count in
+/// each cell, darker for more (the scale is each panel's largest count).
+///
+/// # Errors
+/// Drawing errors (not expected), or no matrix.
+pub fn confusion_svg(matrices: &[sim_host::bench::isolation::Confusion]) -> Result<String, String> {
+    use plotters::coord::ranged1d::SegmentValue;
+    if matrices.is_empty() {
+        return Err("no confusion matrix to draw".into());
+    }
+    register_font()?;
+    let mut s = String::new();
+    {
+        let width = 620 * matrices.len() as u32;
+        let root = SVGBackend::with_string(&mut s, (width, 600)).into_drawing_area();
+        let e = |x: DrawingAreaErrorKind<std::io::Error>| x.to_string();
+        root.fill(&WHITE).map_err(e)?;
+        let panels = root.split_evenly((1, matrices.len()));
+        for (area, m) in panels.iter().zip(matrices) {
+            let (nr, nc) = (m.rows.len() as i32, m.columns.len() as i32);
+            let max = m.counts.iter().flatten().copied().max().unwrap_or(0).max(1);
+            let mut chart = ChartBuilder::on(area)
+                .caption(
+                    format!("isolation bench, angle mode {}", m.mode),
+                    ("sans-serif", 18),
+                )
+                .margin(10)
+                .x_label_area_size(110)
+                .y_label_area_size(110)
+                .build_cartesian_2d((0..nc).into_segmented(), (0..nr).into_segmented())
+                .map_err(e)?;
+            let label = |names: &[String], v: &SegmentValue<i32>, flip: bool| match v {
+                SegmentValue::CenterOf(i) => {
+                    let k = if flip { names.len() as i32 - 1 - i } else { *i };
+                    names.get(k as usize).cloned().unwrap_or_default()
+                }
+                _ => String::new(),
+            };
+            chart
+                .configure_mesh()
+                .disable_mesh()
+                .x_labels(nc as usize)
+                .y_labels(nr as usize)
+                .x_label_formatter(&|v| label(&m.columns, v, false))
+                .y_label_formatter(&|v| label(&m.rows, v, true))
+                .x_label_style(
+                    ("sans-serif", 13)
+                        .into_font()
+                        .transform(FontTransform::Rotate90),
+                )
+                .y_label_style(("sans-serif", 13))
+                .x_desc("named by the isolation")
+                .y_desc("true fault")
+                .draw()
+                .map_err(e)?;
+            for (r, row) in m.counts.iter().enumerate() {
+                let y = nr - 1 - r as i32;
+                for (c, n) in row.iter().enumerate() {
+                    let x = c as i32;
+                    let f = f64::from(*n) / f64::from(max);
+                    let shade = |full: f64| (255.0 - (255.0 - full) * f) as u8;
+                    let fill = RGBColor(shade(31.0), shade(90.0), shade(180.0));
+                    chart
+                        .draw_series(std::iter::once(Rectangle::new(
+                            [
+                                (SegmentValue::Exact(x), SegmentValue::Exact(y)),
+                                (SegmentValue::Exact(x + 1), SegmentValue::Exact(y + 1)),
+                            ],
+                            fill.filled(),
+                        )))
+                        .map_err(e)?;
+                    if *n > 0 {
+                        let colour = if f > 0.5 { WHITE } else { BLACK };
+                        chart
+                            .draw_series(std::iter::once(Text::new(
+                                n.to_string(),
+                                (SegmentValue::CenterOf(x), SegmentValue::CenterOf(y)),
+                                ("sans-serif", 14).into_font().color(&colour).pos(
+                                    plotters::style::text_anchor::Pos::new(
+                                        plotters::style::text_anchor::HPos::Center,
+                                        plotters::style::text_anchor::VPos::Center,
+                                    ),
+                                ),
+                            )))
+                            .map_err(e)?;
+                    }
+                }
+            }
+        }
+        root.present().map_err(e)?;
+    }
+    Ok(s)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

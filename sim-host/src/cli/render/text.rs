@@ -5,6 +5,7 @@
 use super::json::Table1Report;
 use sim_host::analysis::compare::CompareReport;
 use sim_host::analysis::explain::ExplainReport;
+use sim_host::bench::isolation::IsolationBench;
 use sim_host::bench::{BenchFigures, DetectionLimit, Spread};
 use sim_host::demo::{DemoRun, MonitorState};
 use sim_host::log::quality::DataQuality;
@@ -574,6 +575,127 @@ pub fn bench(f: &BenchFigures, limits: Option<&[DetectionLimit]>) -> anyhow::Res
                 l.fault,
                 pct(l.smallest_increase),
                 pct(l.smallest_decrease)
+            )?;
+        }
+    }
+    Ok(())
+}
+
+/// `bench --isolation`: the summary per motor and angle mode, the confusion matrices, and
+/// every case not named right.
+///
+/// # Errors
+/// Stdout errors.
+pub fn isolation_bench(b: &IsolationBench) -> anyhow::Result<()> {
+    let mut out = crate::cli::stdout();
+    writeln!(
+        out,
+        "isolation bench: {} cases at {:.0} Hz, 12-bit noisy sensors, loads 1.0 and 0.6 x the file's Bl, sizes -50/-10/+10/+50 % ({:.0} s wall)",
+        b.cases.len(),
+        b.sample_rate_hz,
+        b.wall_s
+    )?;
+    writeln!(
+        out,
+        "motor   mode        detected   named right  wrong >=0.5  size error median / max  time to name (median)"
+    )?;
+    let opt = |x: Option<f64>, scale: f64, unit: &str| {
+        x.map(|v| format!("{:.1}{unit}", scale * v))
+            .unwrap_or_else(|| "-".into())
+    };
+    for s in &b.summaries {
+        writeln!(
+            out,
+            "{:<7} {:<10} {:>4}/{:<4}  {:>4}/{:<4}   {:>6}       {:>8} / {:<8}      {}",
+            s.motor,
+            s.mode,
+            s.detected,
+            s.cases,
+            s.named_right,
+            s.cases,
+            s.wrong_named,
+            opt(s.size_error_median, 100.0, " %"),
+            opt(s.size_error_max, 100.0, " %"),
+            opt(s.time_to_name_median_s, 1.0, " s"),
+        )?;
+    }
+    for c in &b.confusion {
+        writeln!(
+            out,
+            "\nconfusion matrix, {} (rows: true fault; columns: named at the end; all motors, sizes, loads):",
+            c.mode
+        )?;
+        let short = |s: &str| match s {
+            "current_sensor" => "i_sens".to_string(),
+            "voltage_sensor" => "v_sens".to_string(),
+            "speed_sensor" => "w_sens".to_string(),
+            "unknown" => "unkn".to_string(),
+            x => x.to_string(),
+        };
+        write!(out, "{:<15}", "true \\ named")?;
+        for col in &c.columns {
+            write!(out, "{:>7}", short(col))?;
+        }
+        writeln!(out)?;
+        for (r, counts) in c.rows.iter().zip(&c.counts) {
+            write!(out, "{r:<15}")?;
+            for n in counts {
+                write!(out, "{n:>7}")?;
+            }
+            writeln!(out)?;
+        }
+    }
+    writeln!(out, "\nnot named right (named at the end; candidates):")?;
+    for c in b.cases.iter().filter(|c| !c.right) {
+        let cands: Vec<String> = c
+            .candidates
+            .iter()
+            .take(3)
+            .map(|(n, p, ch)| match ch {
+                Some(ch) => format!("{n} {:+.0} % p={p:.2}", 100.0 * ch),
+                None => format!("{n} p={p:.2}"),
+            })
+            .collect();
+        writeln!(
+            out,
+            "  {:<6} {:<10} {:<15} {:+4.0} % load {:.1}: {} ({}){}",
+            c.motor,
+            c.mode,
+            c.fault,
+            100.0 * c.change,
+            c.load_scale,
+            c.named,
+            if cands.is_empty() {
+                c.state.clone()
+            } else {
+                cands.join(", ")
+            },
+            if c.detected { "" } else { ", not detected" }
+        )?;
+    }
+    let wrong: Vec<&sim_host::bench::isolation::CaseResult> = b
+        .cases
+        .iter()
+        .filter(|c| !c.wrong_names.is_empty())
+        .collect();
+    if wrong.is_empty() {
+        writeln!(out, "\nwrong names at probability >= 0.5: none")?;
+    } else {
+        writeln!(
+            out,
+            "\nWRONG NAMES at probability >= 0.5 ({} cases):",
+            wrong.len()
+        )?;
+        for c in wrong {
+            writeln!(
+                out,
+                "  {} {} {} {:+.0} % load {:.1}: {}",
+                c.motor,
+                c.mode,
+                c.fault,
+                100.0 * c.change,
+                c.load_scale,
+                c.wrong_names.join(", ")
             )?;
         }
     }

@@ -6,8 +6,13 @@
 //!   100x smaller integrator step.
 //! - `Monitor` (the core) time per sample on the host.
 //!
+//! - `bench --isolation`: the isolation's naming, sizing and timing on every Table 1 fault
+//!   ([`isolation`]).
+//!
 //! Timings are repeated and reported as the median with the range (a shared machine's
 //! other jobs show in the range, not in a best case).
+
+pub mod isolation;
 
 use crate::log::{LogWriter, Row};
 use crate::params::ParamFile;

@@ -1,0 +1,89 @@
+//! `sim-host bench --isolation`'s library part ([`sim_host::bench::isolation`]) on a small
+//! plan: the 2.2 kW machine, Rr and the current sensor at -50/-10/+10/+50 %, both loads, the
+//! rotor-flux mode (16 runs). The isolation tests (`tests/isolation.rs`) name these faults
+//! alone on this machine, so the bench must find and name them; the confusion matrix must
+//! count every case once, on the diagonal here.
+
+use monitor_core::{AngleSource, Fault};
+use sim_host::bench::isolation::{motors, run, BenchPlan, CHANGES, LOADS};
+
+#[test]
+fn the_bench_finds_names_and_counts() {
+    let m = motors().expect("the 11 kW file parses"); // ok: test
+    assert_eq!(m.len(), 3);
+    let plan = BenchPlan {
+        motors: m.into_iter().filter(|m| m.name == "2.2 kW").collect(),
+        faults: vec![Fault::Rr, Fault::CurrentSensor],
+        changes: CHANGES.to_vec(),
+        loads: LOADS.to_vec(),
+        modes: vec![AngleSource::RotorFluxCurrentModel],
+    };
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let b = run(&plan, || {
+        done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    })
+    .expect("the bench runs"); // ok: test
+    assert_eq!(done.into_inner(), 16);
+    assert_eq!(b.cases.len(), 16);
+    for c in &b.cases {
+        assert!(c.detected, "{c:?}");
+        assert!(c.right, "{c:?}");
+        assert!(c.wrong_names.is_empty(), "{c:?}");
+        let err = c.size_error.expect("a size"); // ok: test
+        assert!(err <= 0.2, "{c:?}");
+        let t = c.time_to_name_s.expect("a time to name"); // ok: test
+        assert!(t > 0.0 && t < 3.5, "{c:?}");
+    }
+    let s = &b.summaries[0];
+    assert_eq!(
+        (s.cases, s.detected, s.named_right, s.wrong_named),
+        (16, 16, 16, 0)
+    );
+    let conf = &b.confusion[0];
+    assert_eq!(conf.rows, ["rr", "current_sensor"]);
+    assert_eq!(conf.columns.len(), 12);
+    let total: u32 = conf.counts.iter().flatten().sum();
+    assert_eq!(total, 16);
+    let rr = conf
+        .columns
+        .iter()
+        .position(|c| c == "rr")
+        .expect("rr column"); // ok: test
+    let cs = conf
+        .columns
+        .iter()
+        .position(|c| c == "current_sensor")
+        .expect("current_sensor column"); // ok: test
+    assert_eq!(conf.counts[0][rr], 8);
+    assert_eq!(conf.counts[1][cs], 8);
+}
+
+#[test]
+fn a_wrong_name_is_counted() {
+    // A row in which the isolation named rr for an Ls fault at the end, after naming ls.
+    use sim_host::bench::isolation::judge;
+    use sim_host::fault_signatures::Table1Row;
+    let row = Table1Row {
+        fault: "ls".into(),
+        change: 0.5,
+        signature: [0; 4],
+        paper: [0; 4],
+        expected: [0; 4],
+        residuals: [0.0; 4],
+        candidates: Vec::new(),
+        detection_delay_s: Some(0.2),
+        named: Some("rr".into()),
+        named_change: Some(0.03),
+        isolation_candidates: vec![("rr".into(), 0.7, Some(0.03))],
+        isolation_state: "isolated".into(),
+        name_delay_s: Some(0.8),
+        names_given: vec![("ls".into(), 0.8), ("rr".into(), 1.5)],
+    };
+    let c = judge("3 hp", AngleSource::Pll, 1.0, Fault::Ls, 0.5, &row);
+    assert!(!c.right);
+    assert_eq!(c.named, "rr");
+    assert_eq!(c.wrong_names, ["rr at +1.50 s"]);
+    assert_eq!(c.time_to_name_s, Some(0.8));
+    assert_eq!(c.size_error, None);
+    assert_eq!(c.mode, "pll");
+}
