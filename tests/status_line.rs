@@ -126,6 +126,11 @@ fn the_hmi_reads_every_field_the_firmware_prints() {
         })
     );
     let snap = s.snapshot(0.0);
+    let iso = snap
+        .isolation
+        .as_ref()
+        .expect("the isolation on the screen");
+    assert_eq!((iso.named.as_deref(), iso.change), (Some("rr"), Some(0.48)));
     assert!(snap.learned && snap.fault_lamp);
     assert_eq!(snap.sensor_faults, vec![Fault::VoltageSensor]);
     assert!(matches!(snap.state, MonitorState::Fault(_)));

@@ -65,7 +65,7 @@
 //! the host alike.
 
 mod follower;
-pub use follower::{steady_against, Follower, Step, AVERAGE_S, STEADY_FRACTION, STEP_S};
+pub use follower::{steady_against, Follower, Step, AVERAGE_S, CONFIRM_S, STEADY_FRACTION, STEP_S};
 
 use crate::frames::Dq;
 use crate::machine::MotorModel;
@@ -959,7 +959,8 @@ mod tests {
 
     /// The follower's schedule: nothing before half a second of steady running; a load or
     /// supply step restarts the average; the baseline learned while commissioning learns
-    /// goes into force when it ends; an Rr +40 % change is then named with its size.
+    /// goes into force when it ends; an Rr +40 % change is then named with its size, and
+    /// reported once it has been named for `CONFIRM_S`.
     #[test]
     fn the_follower_averages_learns_and_isolates_on_schedule() {
         let (_, m, v, we) = machines()[0];
@@ -1002,12 +1003,22 @@ mod tests {
         assert_eq!(f.observe(&stepped, dt, false, false), Step::Waiting);
         let rr = faulty(&m, Some(Fault::Rr), 1.4);
         stepped = measure(&rr, 1.05 * v, we, Some(Fault::Rr), 1.4);
-        let mut named = None;
-        for _ in 0..100 {
-            if let Step::Isolated(r) = f.observe(&stepped, dt, true, false) {
-                named = r.named_fault();
+        // Named after 0.5 s of averaging, reported after CONFIRM_S more.
+        let (mut named, mut unconfirmed) = (None, 0);
+        for k in 0..150 {
+            match f.observe(&stepped, dt, true, false) {
+                Step::Isolated(r) => {
+                    assert!(k >= 99, "in force {k} steps after the change");
+                    named = r.named_fault();
+                }
+                Step::Unconfirmed(r) => {
+                    assert_eq!(r.named_fault().map(|c| c.fault), Some(Fault::Rr));
+                    unconfirmed += 1;
+                }
+                _ => {}
             }
         }
+        assert!(unconfirmed >= 9, "{unconfirmed} unconfirmed isolations");
         let c = named.unwrap_or_else(|| panic!("Rr +40 % not named: {:?}", f.last())); // ok: test
         assert_eq!(c.fault, Fault::Rr);
         assert!((c.change - 0.4).abs() < 0.04, "size {}", c.change);

@@ -78,8 +78,8 @@ pub struct Snapshot {
     pub supply_hz: Option<f32>,
     /// What the monitor is doing (the demo's states).
     pub state: MonitorState,
-    /// What the isolation concludes (the fault named with its size), where the source
-    /// runs it (the live simulation and a log replay; not the firmware's status line).
+    /// What the isolation concludes (the fault named with its size): the live simulation
+    /// and a log replay run it, the firmware's status line carries it (`iso=`).
     pub isolation: Option<IsolationView>,
 }
 

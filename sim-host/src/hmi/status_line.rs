@@ -249,7 +249,30 @@ impl FirmwareStatus {
             vqs_v: self.vqs_v,
             supply_hz: self.supply_hz,
             state,
-            isolation: None,
+            isolation: self.isolation.as_ref().map(FirmwareIsolation::view),
+        }
+    }
+}
+
+impl FirmwareIsolation {
+    /// The screen's view of it: the state and the named fault with its size.
+    pub fn view(&self) -> super::IsolationView {
+        let named = !matches!(self.named.as_str(), "unknown" | "none" | "not-judged");
+        super::IsolationView {
+            state: match self.named.as_str() {
+                "unknown" => "unknown",
+                "none" => "no_deviation",
+                "not-judged" => "not_judged",
+                _ => "isolated",
+            }
+            .to_string(),
+            named: named.then(|| self.named.clone()),
+            change: named.then_some(self.change),
+            candidates: if named {
+                vec![(self.named.clone(), self.probability, Some(self.change))]
+            } else {
+                Vec::new()
+            },
         }
     }
 }

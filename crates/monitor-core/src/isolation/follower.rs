@@ -14,6 +14,7 @@
 //! a load step, a supply change), and nothing is isolated until it has been averaged for
 //! [`AVERAGE_S`]: 25-30 supply periods, which also averages the frame frequency's ripple
 //! and brings the residuals' scatter to about 0.05 % (the module's [`DEFAULT_SPREAD`]).
+//! A fault newly named is reported once it has stayed the one named for [`CONFIRM_S`].
 //!
 //! [`DEFAULT_SPREAD`]: super::DEFAULT_SPREAD
 
@@ -26,6 +27,12 @@ pub const AVERAGE_S: f32 = 0.5;
 pub const STEP_S: f32 = 0.05;
 /// Relative change from the running average above which a point is not steady.
 pub const STEADY_FRACTION: f32 = 0.02;
+/// How long a newly named fault must stay the one named before it is reported [s]. A change
+/// smaller than [`STEADY_FRACTION`] does not restart the average, which then mixes points
+/// from before and after it for about [`AVERAGE_S`]; on the way the residuals can pass
+/// near another fault's direction (measured: `rr` or `speed_sensor` named for 0.15-0.4 s
+/// after an Ls step on a 2-pole 11 kW machine). Withdrawing a name is immediate.
+pub const CONFIRM_S: f32 = 0.5;
 
 /// Every quantity of `p` within [`STEADY_FRACTION`] of `avg`: the current and voltage
 /// vectors by their distance relative to the average's magnitude, the supply and rotor
@@ -50,8 +57,21 @@ pub enum Step {
     Learned,
     /// Learning ended: `true` when the learned baseline went into force (enough points).
     LearningEnded(bool),
-    /// The averaged point was isolated (the result is also [`Follower::last`]).
+    /// The averaged point was isolated and the result is in force (also
+    /// [`Follower::last`]).
     Isolated(Isolation),
+    /// The averaged point was isolated but names a fault that has not been named for
+    /// [`CONFIRM_S`] yet: [`Follower::last`] keeps the previous result.
+    Unconfirmed(Isolation),
+}
+
+/// What a result names, for the confirmation: a fault's index, the friction class, or
+/// nothing.
+fn name_key(iso: &Isolation) -> Option<usize> {
+    match iso.named()? {
+        super::Named::Fault(c) => Some(c.fault.index()),
+        super::Named::Friction { .. } => Some(usize::MAX),
+    }
 }
 
 /// The isolator with its schedule: averaging, learning, isolating (module docs).
@@ -64,6 +84,10 @@ pub struct Follower {
     learning: bool,
     learned: bool,
     last: Option<Isolation>,
+    /// The name of the latest isolation, and how long it has been named [s].
+    pending: Option<usize>,
+    held_s: f32,
+    since_isolation_s: f32,
 }
 
 impl Follower {
@@ -78,6 +102,9 @@ impl Follower {
             learning: false,
             learned: false,
             last: None,
+            pending: None,
+            held_s: 0.0,
+            since_isolation_s: 0.0,
         }
     }
 
@@ -96,8 +123,9 @@ impl Follower {
         } else {
             0.0
         };
-        // Saturates: only "due or not" matters.
+        // Saturate: only "due or not" matters.
         self.since_step_s = crate::minf(self.since_step_s + dt, 2.0 * STEP_S);
+        self.since_isolation_s = crate::minf(self.since_isolation_s + dt, 2.0 * CONFIRM_S);
         let mut ended = None;
         if self.learning && !learning {
             let ok = self.isolator.finish_learning();
@@ -132,12 +160,29 @@ impl Follower {
             Step::Learned
         } else {
             let result = self.isolator.isolate(&avg);
-            self.last = Some(result);
-            Step::Isolated(result)
+            self.confirm(result)
         }
     }
 
-    /// The latest isolation, if any was made.
+    /// Puts `result` into force unless it names a fault not yet named for [`CONFIRM_S`].
+    fn confirm(&mut self, result: Isolation) -> Step {
+        let key = name_key(&result);
+        if key == self.pending {
+            self.held_s = crate::minf(self.held_s + self.since_isolation_s, 2.0 * CONFIRM_S);
+        } else {
+            self.pending = key;
+            self.held_s = 0.0;
+        }
+        self.since_isolation_s = 0.0;
+        if key.is_none() || self.held_s >= CONFIRM_S {
+            self.last = Some(result);
+            Step::Isolated(result)
+        } else {
+            Step::Unconfirmed(result)
+        }
+    }
+
+    /// The latest isolation in force, if any was made.
     pub fn last(&self) -> Option<&Isolation> {
         self.last.as_ref()
     }
@@ -146,6 +191,8 @@ impl Follower {
     /// comes after [`AVERAGE_S`] of steady running).
     pub fn clear(&mut self) {
         self.last = None;
+        self.pending = None;
+        self.held_s = 0.0;
     }
 
     /// A baseline learned in commissioning is in force.
