@@ -47,13 +47,14 @@ use rustfft::num_complex::Complex;
 use serde::Serialize;
 use std::f64::consts::PI;
 
-/// Physical range of the fitted asymmetry delta: 0..0.5. One broken bar of a 28-bar cage
-/// is delta = 0.12, three adjacent ones 0.47; a cage beyond that has lost a third of a
-/// pole pitch of bars and trips on overload long before (Bellini et al. 2001 report 1 to 4
-/// broken bars as the range of interest).
-pub const DELTA_RANGE: (f64, f64) = (0.0, 0.5);
+/// Physical range of the fitted asymmetry delta: 0..1. One broken bar of a 28-bar cage is
+/// delta = 0.12, three adjacent ones 0.47, delta = 1 is n = N/6 (4.7 of 28); a cage
+/// beyond that has lost a third of a pole pitch of bars (Bellini et al. 2001 report 1 to
+/// 4 broken bars as the range of interest). The fit overestimates delta up to about 2x
+/// (module doc), which is why the range reaches 1 rather than 0.5.
+pub const DELTA_RANGE: (f64, f64) = (0.0, 1.0);
 /// Basis of [`DELTA_RANGE`].
-pub const DELTA_BASIS: &str = "delta = 3n/(N - 3n): up to 3 adjacent broken bars of a 28-bar cage (Kliman et al. 1988, Bellini et al. 2001)";
+pub const DELTA_BASIS: &str = "delta = 3n/(N - 3n): up to N/6 adjacent broken bars (4.7 of 28; Kliman et al. 1988, Bellini et al. 2001)";
 /// Fewest frequency bins between the fundamental and a sideband (see the module doc).
 pub const MIN_BINS: f64 = 10.0;
 /// Smallest slip the sidebands are judged at: below it they sit within 2 s f = 0.6 Hz
