@@ -160,31 +160,24 @@ impl EffectModel for RotorAsymmetry {
             return Err("needs the speed column wm_rad_s (the rotor angle)".into());
         }
         let (delta0, phi0) = initial_estimate(d, n, &ang);
-        let mut s = FitSetup::default();
-        s.names = vec!["delta".into(), "phi_rad".into()];
-        s.units = vec!["1", "rad"];
-        s.init = vec![delta0, phi0];
-        s.lo = vec![0.0, phi0 - 4.0 * PI];
-        s.hi = vec![2.0, phi0 + 4.0 * PI];
-        s.scale = vec![0.05, 0.3];
-        s.plausible = vec![
-            (
-                crate::params::PlausibleRange {
-                    lo: DELTA_RANGE.0,
-                    hi: DELTA_RANGE.1,
-                },
-                DELTA_BASIS,
-            ),
-            (
-                crate::params::PlausibleRange {
-                    lo: f64::NEG_INFINITY,
-                    hi: f64::INFINITY,
-                },
-                "any angle",
-            ),
-        ];
-        s.data = ang;
-        Ok(s)
+        let any_angle = crate::params::PlausibleRange {
+            lo: f64::NEG_INFINITY,
+            hi: f64::INFINITY,
+        };
+        let delta_range = crate::params::PlausibleRange {
+            lo: DELTA_RANGE.0,
+            hi: DELTA_RANGE.1,
+        };
+        Ok(FitSetup {
+            names: vec!["delta".into(), "phi_rad".into()],
+            units: vec!["1", "rad"],
+            init: vec![delta0, phi0],
+            lo: vec![0.0, phi0 - 4.0 * PI],
+            hi: vec![2.0, phi0 + 4.0 * PI],
+            scale: vec![0.05, 0.3],
+            plausible: vec![(delta_range, DELTA_BASIS), (any_angle, "any angle")],
+            data: ang,
+        })
     }
     fn apply(
         &self,
