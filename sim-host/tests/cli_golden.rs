@@ -61,7 +61,7 @@ const INTENDED: [(&str, &str, &str); 8] = [
 
 /// Keys added since the golden outputs were taken (issue 8: the data-quality stage's
 /// report, what commissioning did, the verdict, the range note beside a lamp).
-const ADDED: [&str; 27] = [
+const ADDED: [&str; 28] = [
     "data_quality",
     "commissioning",
     "verdict",
@@ -95,7 +95,31 @@ const ADDED: [&str; 27] = [
     "not_identified",
     "advice",
     "transient",
+    // Issue 10: explain's motor current signature analysis (rotor_asymmetry).
+    "rotor_asymmetry",
 ];
+
+/// The library effect added since (issue 10, `rotor_asymmetry`): its ranking entries and
+/// its `skipped` notes are taken out of today's document before comparing (each candidate
+/// is fitted on its own, so the others' entries are unchanged).
+fn without_added_effect(v: &mut serde_json::Value) {
+    use serde_json::Value as V;
+    match v {
+        V::Object(m) => {
+            for (k, x) in m.iter_mut() {
+                if let (true, V::Array(a)) = (k == "ranking", &mut *x) {
+                    a.retain(|e| e.get("effect") != Some(&V::from("rotor_asymmetry")));
+                }
+                if let (true, V::Array(a)) = (k == "skipped", &mut *x) {
+                    a.retain(|e| !e.as_str().is_some_and(|t| t.starts_with("rotor_asymmetry")));
+                }
+                without_added_effect(x);
+            }
+        }
+        V::Array(a) => a.iter_mut().for_each(without_added_effect),
+        _ => {}
+    }
+}
 
 /// With `GOLDEN_REGENERATE=name1,name2` set, writes today's output as the golden file of
 /// each name listed (`.json` when it parses as JSON, else `.txt`) instead of comparing;
@@ -234,7 +258,8 @@ fn outputs_match_the_binary_before_the_rework() {
         if regenerate(name, &out) {
             return;
         }
-        let now: serde_json::Value = serde_json::from_slice(&out).expect("one JSON document");
+        let mut now: serde_json::Value = serde_json::from_slice(&out).expect("one JSON document");
+        without_added_effect(&mut now);
         let text = std::fs::read_to_string(golden().join(format!("{name}.json"))).unwrap();
         let before: serde_json::Value = serde_json::from_str(&text).unwrap();
         let mut diffs = Vec::new();

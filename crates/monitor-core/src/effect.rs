@@ -31,11 +31,14 @@ pub enum EffectKind {
     FluxDynamics,
     /// `current_dynamics`: the La dI_qs/dt term of eq. (28).
     CurrentDynamics,
+    /// `rotor_asymmetry`: an unequal rotor cage (broken rotor bars): (1 +/- 2s) f sidebands
+    /// in the stator current, 2 s f ripple in torque and speed.
+    RotorAsymmetry,
 }
 
 impl EffectKind {
     /// Every effect, in DESIGN.md's order.
-    pub const ALL: [EffectKind; 10] = [
+    pub const ALL: [EffectKind; 11] = [
         EffectKind::ThermalDrift,
         EffectKind::Saturation,
         EffectKind::IronLoss,
@@ -46,6 +49,7 @@ impl EffectKind {
         EffectKind::PhaseAsymmetry,
         EffectKind::FluxDynamics,
         EffectKind::CurrentDynamics,
+        EffectKind::RotorAsymmetry,
     ];
 
     /// The DESIGN.md name (`thermal_drift`, ..., `current_dynamics`).
@@ -61,6 +65,7 @@ impl EffectKind {
             EffectKind::PhaseAsymmetry => "phase_asymmetry",
             EffectKind::FluxDynamics => "flux_dynamics",
             EffectKind::CurrentDynamics => "current_dynamics",
+            EffectKind::RotorAsymmetry => "rotor_asymmetry",
         }
     }
 
@@ -88,7 +93,7 @@ mod tests {
 
     #[test]
     fn names_are_design_names_and_round_trip() {
-        let names: [&str; 10] = [
+        let names: [&str; 11] = [
             "thermal_drift",
             "saturation",
             "iron_loss",
@@ -99,6 +104,7 @@ mod tests {
             "phase_asymmetry",
             "flux_dynamics",
             "current_dynamics",
+            "rotor_asymmetry",
         ];
         for (e, n) in EffectKind::ALL.iter().zip(names) {
             assert_eq!(e.name(), n);

@@ -19,6 +19,7 @@
 //! | `phase_asymmetry` | c_re, c_im [-] | i_neg = (c_re + j c_im) conj(i_pos) |
 //! | `flux_dynamics` | tau_r_s [s] | psi_r/Lm = phi, dphi/dt = (i_f - phi)/tau_r; slip and torque from phi |
 //! | `current_dynamics` | la_h [H] | La dI_qs/dt = V_qs - Ra I_qs - Psi omega_r (eq. 28's derivative term) |
+//! | `rotor_asymmetry` | delta [-], phi_rad [rad] | Rr in Ra x (1 + (delta/3)(1 - cos(2 (Np theta_m - theta) + phi))) (see `super::rotor_asymmetry`) |
 
 use super::prep::{Prepared, C64};
 use super::simplified_model::{EffectTerms, MachineConstants};
@@ -1201,6 +1202,7 @@ pub fn model_of(kind: EffectKind) -> Box<dyn EffectModel> {
         EffectKind::PhaseAsymmetry => Box::new(PhaseAsymmetry),
         EffectKind::FluxDynamics => Box::new(FluxDynamics),
         EffectKind::CurrentDynamics => Box::new(CurrentDynamics),
+        EffectKind::RotorAsymmetry => Box::new(super::rotor_asymmetry::RotorAsymmetry),
     }
 }
 

@@ -42,6 +42,7 @@ pub mod explain;
 pub mod fit;
 pub mod metrics;
 pub mod prep;
+pub mod rotor_asymmetry;
 pub mod simplified_model;
 pub mod transients;
 pub mod unbalance;

@@ -126,6 +126,13 @@ impl BaseParams {
 pub struct EffectTerms {
     /// Multiplies Rs and Rr (winding temperature); empty = 1.
     pub r_factor: Vec<f64>,
+    /// Multiplies the rotor resistance term of Ra only (`rotor_asymmetry`); empty = 1.
+    pub rr_factor: Vec<f64>,
+    /// Extra drive of the normalised rotor flux phi = psi_r/Lm [A] (`rotor_asymmetry`: the
+    /// d-q element of an unequal rotor resistance): phi follows i_f + drive through the
+    /// rotor time constant (the fitted one with `flux_dynamics`, else the nominal Lr/Rr,
+    /// as a deviation added to the quasi-static flux); empty = 0.
+    pub phi_drive: Vec<f64>,
     /// Multiplies Lm (saturation); empty = 1.
     pub lm_factor: Vec<f64>,
     /// Extra load torque on the shaft [N m] (speed independent); empty = 0.
@@ -367,13 +374,16 @@ fn simulate_with(
     let mut phi = d.i_f[0];
     let i_f_ref = d.id.iter().fold(0.0f64, |a, &x| a.max(x.abs())).max(1e-6);
     let flux_decay = t.tau_r_s.map(|tau| (-dt / tau.max(1e-5)).exp());
+    // The rotor flux's deviation driven by `phi_drive` when the flux is quasi-static.
+    let drive_decay = (-dt * n.rr_ohm / n.lr_h).exp();
+    let mut phi_dev = 0.0f64;
     let mut inputs = InputSource::new(d, t);
     for k in 0..len {
         let x = inputs.at(k);
         let rf = t.r_factor.get(k).copied().unwrap_or(1.0);
         let mf = t.lm_factor.get(k).copied().unwrap_or(1.0);
         let rs = rs0 * rf;
-        let rr = rr0 * rf;
+        let rr = rr0 * rf * t.rr_factor.get(k).copied().unwrap_or(1.0);
         let lm = n.lm_h * mf;
         let ls = b.ls_scale * (n.lls_h + lm);
         let lmr = lm * lm / (n.llr_h + lm);
@@ -397,10 +407,12 @@ fn simulate_with(
             }
         };
         // Flux: phi = psi_r / Lm [A].
+        let drive = t.phi_drive.get(k).copied().unwrap_or(0.0);
         let (psi_p, rden, phi_t) = match flux_decay {
             Some(a) => {
                 // The rotor flux follows the raw I_ds (its own lag filters the noise).
-                phi = cl.id_raw + (phi - cl.id_raw) * a;
+                let target = cl.id_raw + drive;
+                phi = target + (phi - target) * a;
                 // sigma Ls part with the raw I_ds (fast), the rotor part through phi.
                 let psi_p = (ls - b.ls_scale * lmr) * cl.id_raw + b.ls_scale * lmr * phi;
                 let phi_c = if phi.abs() < 0.05 * i_f_ref {
@@ -411,7 +423,14 @@ fn simulate_with(
                 let rden = rs + rr * psi_p / (ls * phi_c);
                 (psi_p, rden.clamp(0.2 * (rs + rr), 50.0 * (rs + rr)), phi)
             }
-            None => (ls * cl.i_f, rs + rr, cl.i_f),
+            None if t.phi_drive.is_empty() => (ls * cl.i_f, rs + rr, cl.i_f),
+            None => {
+                phi_dev = drive + (phi_dev - drive) * drive_decay;
+                let phi = cl.i_f + phi_dev;
+                let psi_p = ls * cl.i_f + b.ls_scale * lmr * phi_dev;
+                let phi_c = if phi.abs() < 1e-6 { 1e-6 } else { phi };
+                (psi_p, rs + rr * psi_p / (ls * phi_c), phi)
+            }
         };
         let kt = 1.5 * n.np * lmr * phi_t; // Te = kt * iq  [N m/A]
         let extra = |w: f64| {

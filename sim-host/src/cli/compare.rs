@@ -137,7 +137,7 @@ pub struct CompareArgs {
     long_about = "Rank the physical effects missing from the paper's simplified model.\n\n\
 Every library effect not yet in the model (thermal_drift, saturation, iron_loss, \
 coulomb_friction, windage, load_torque, supply_unbalance, phase_asymmetry, flux_dynamics, \
-current_dynamics) is added in turn and fitted together with the base parameters (Ra, Ls, \
+current_dynamics, rotor_asymmetry) is added in turn and fitted together with the base parameters (Ra, Ls, \
 B+Bl, J). Candidates are ranked by the error on held-back time windows the fit never saw, \
 so an effect that only fits noise does not win. When no candidate explains at least 50 % of \
 the held-back error, or the error is already near the noise floor, the answer is \
@@ -149,7 +149,10 @@ sim-host compare --params motor.toml run.csv --effects load_torque   # the error
 sim-host explain --params motor.toml run.csv --effects load_torque   # anything else?\n\n\
 JSON (--json): baseline_normalized_rms_error, ranking [{effect, normalized_rms_error, \
 explained_fraction, validation_normalized_rms_error, n_parameters, parameters, summary}], \
-unexplained, verdict, skipped, unbalance, noise_floor, data_quality. When the data-quality \
+unexplained, verdict, skipped, unbalance, noise_floor, data_quality, rotor_asymmetry (the \
+motor current signature analysis: lower_sideband_db, upper_sideband_db, slip, sideband_hz, \
+speed_ripple_hz, speed_ripple_rad_s, delta, equivalent_broken_bars (with --rotor-bars N), \
+resolution_hz, resolution_needed_hz, or cannot_judge_because). When the data-quality \
 stage does not trust the log the verdict says \"could not judge\" and why."
 )]
 pub struct ExplainArgs {
@@ -161,6 +164,18 @@ pub struct ExplainArgs {
     /// ...}; --plot and --report get explain's charts and report.
     #[arg(long)]
     pub compare: bool,
+    /// Rotor bar count N: the `rotor_asymmetry` report gives the fitted asymmetry as an
+    /// equivalent number of adjacent broken bars, n = delta N / (3 (1 + delta)).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(6..))]
+    pub rotor_bars: Option<u32>,
+}
+
+/// `explain`'s JSON document: the report plus the motor current signature analysis.
+#[derive(serde::Serialize)]
+struct ExplainJson<'a> {
+    #[serde(flatten)]
+    report: &'a sim_host::analysis::explain::ExplainReport,
+    rotor_asymmetry: &'a sim_host::analysis::rotor_asymmetry::McsaReport,
 }
 
 /// Runs `compare`.
@@ -187,7 +202,9 @@ pub fn run_compare(args: &CompareArgs) -> anyhow::Result<()> {
 /// As [`run_compare`].
 pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
     let c = &args.common;
-    c.check(&render::charts::EXPLAIN)?;
+    let mut charts = render::charts::EXPLAIN.to_vec();
+    charts.push(render::mcsa::CHART);
+    c.check(&charts)?;
     let a = c.load()?;
     let opts = c.options();
     // compare's result is printed (or kept for the JSON document) before explain runs, and
@@ -210,12 +227,37 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
     let out = a.explain(&opts, &move |f| progress::set_fraction(&pbc, f))?;
     pb.finish_and_clear();
     render::html::write_explain(c.plot.as_deref(), c.report.as_deref(), &c.log, &a, &out)?;
+    // The motor current signature analysis, with the fitted rotor_asymmetry's delta.
+    let delta = out
+        .report
+        .ranking
+        .iter()
+        .find(|r| r.effect == EffectKind::RotorAsymmetry)
+        .and_then(|r| r.parameters.get("delta"))
+        .map(|p| p.value);
+    let mcsa = sim_host::analysis::rotor_asymmetry::mcsa(
+        &a.data,
+        a.constants.np,
+        args.rotor_bars.map(f64::from),
+        delta,
+    );
+    if let Some(dir) = &c.plot {
+        render::mcsa::write(dir, &mcsa)?;
+    }
+    let doc = ExplainJson {
+        report: &out.report,
+        rotor_asymmetry: &mcsa,
+    };
     match (c.json, compared) {
         (true, Some(cmp)) => render::json::print(&render::json::ExplainWithCompare {
             compare: &cmp,
-            explain: &out.report,
+            explain: &doc,
         }),
-        (true, None) => render::json::print(&out.report),
-        (false, _) => render::text::explain(&c.log, &out.report),
+        (true, None) => render::json::print(&doc),
+        (false, _) => {
+            render::text::explain(&c.log, &out.report)?;
+            print!("{}", render::mcsa::text(&mcsa));
+            Ok(())
+        }
     }
 }

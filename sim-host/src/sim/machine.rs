@@ -19,6 +19,15 @@
 //! symmetric T-equivalent; the faulty phase's resistance falls as (1 - mu) and its self
 //! inductance as (1 - mu)^2. Currents from fluxes: i_s' = (psi_s' - (Lm/Lr) psi_r) / M,
 //! M = Lls + Lm Llr / Lr, i_r = (psi_r - Lm i_s')/Lr, Lr = Llr + Lm.
+//!
+//! Rotor cage asymmetry (`rotor_asymmetry`, broken bars): rotor phase a's resistance is
+//! Rr (1 + delta). With the rotor's isolated neutral its resistance in the rotor's own
+//! alpha-beta frame is R' = Rr I + (2/3) Rr delta e_a e_a^T (the same projection as T above:
+//! C diag(R_k) C^+ = R I + (2/3) sum_k dR_k u_k u_k^T). Turned into the stator frame by the
+//! rotor's electrical angle theta_r = Np theta_m, R_r(theta_r) = Rot R' Rot^T =
+//! Rr I + (2/3) Rr delta u u^T, u = (cos theta_r, sin theta_r), and the rotor equation is
+//! dpsi_r/dt = -R_r(theta_r) i_r + J omega_r psi_r (R_r is symmetric, so the rotational EMF
+//! term is unchanged). Rotor copper loss (3/2) i_r^T R_r i_r.
 
 use std::cell::Cell;
 
@@ -121,6 +130,8 @@ pub(crate) struct Machine {
     pub lls: f64,
     pub llr: f64,
     pub rr: f64,
+    /// Rotor cage asymmetry (2/3) Rr delta [ohm] (0: symmetric cage).
+    pub rr_asym: f64,
     /// Unsaturated (or constant) magnetising inductance [H].
     pub lm0: f64,
     pub sat: Option<SatLaw>,
@@ -188,6 +199,7 @@ impl Machine {
             lls,
             llr,
             rr,
+            rr_asym: 0.0,
             lm0,
             sat,
             inv_rfe,
@@ -310,6 +322,17 @@ impl Machine {
         }
     }
 
+    /// Rotor resistance matrix R_r(theta_r) at mechanical angle `theta_m` [rad] (scalar Rr
+    /// for a symmetric cage).
+    #[inline(always)]
+    pub fn rotor_r(&self, theta_m: f64) -> Sym2 {
+        if self.rr_asym == 0.0 {
+            Sym2::scalar(self.rr)
+        } else {
+            Sym2::scalar_minus_rank1(self.rr, -self.rr_asym, self.np * theta_m)
+        }
+    }
+
     /// Electromagnetic torque [N m].
     #[inline(always)]
     pub fn torque(&self, pr: [f64; 2], ir: [f64; 2]) -> f64 {
@@ -330,11 +353,16 @@ impl Machine {
         let wr = self.np * wm;
         let te = self.torque(pr, c.i_r);
         let tl = self.load.torque(wm);
+        let rdrop = if self.rr_asym == 0.0 {
+            [self.rr * c.i_r[0], self.rr * c.i_r[1]]
+        } else {
+            self.rotor_r(x[5]).mul(c.i_r)
+        };
         [
             u[0],
             u[1],
-            -self.rr * c.i_r[0] - wr * pr[1],
-            -self.rr * c.i_r[1] + wr * pr[0],
+            -rdrop[0] - wr * pr[1],
+            -rdrop[1] + wr * pr[0],
             (te - self.b * wm - tl) * self.inv_j,
             wm,
         ]

@@ -80,7 +80,8 @@
 //!
 //! # Effects
 //! See [`EffectSpec`]: `thermal_drift`, `saturation`, `iron_loss`, `coulomb_friction`, `windage`,
-//! `load_torque`, `supply_unbalance`, `phase_asymmetry`; `flux_dynamics` and
+//! `load_torque`, `supply_unbalance`, `phase_asymmetry`, `rotor_asymmetry` (the rotor
+//! resistance matrix turning with the rotor, see `machine`); `flux_dynamics` and
 //! `current_dynamics` are properties of the full-order model (always present), so enabling
 //! them is a no-op for generation.
 //!
@@ -186,7 +187,7 @@ pub struct Truth {
     pub lm_h: f64,
     /// Input power (3/2) v . i [W].
     pub p_in_w: f64,
-    /// Copper losses (3/2)(i^T R_s i + Rr |i_r|^2) [W].
+    /// Copper losses (3/2)(i^T R_s i + i_r^T R_r i_r) [W] (R_r = Rr I for a symmetric cage).
     pub p_cu_w: f64,
     /// Iron losses (3/2)|u|^2/Rfe [W].
     pub p_fe_w: f64,
@@ -328,6 +329,8 @@ struct ResolvedEffects {
     load_torque: Option<f64>,
     unbalance: Option<(f64, f64)>,
     asym: Option<(usize, f64)>,
+    /// Rotor resistance asymmetry delta (`rotor_asymmetry`), 0 when off.
+    rotor_delta: f64,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -411,6 +414,7 @@ impl ResolvedEffects {
                 EffectSpec::PhaseAsymmetry { phase, fraction } => {
                     eff.asym = Some((phase.index(), fraction))
                 }
+                EffectSpec::RotorAsymmetry { .. } => eff.rotor_delta = e.rotor_delta()?,
                 EffectSpec::FluxDynamics {} | EffectSpec::CurrentDynamics {} => {}
             }
         }
@@ -518,7 +522,7 @@ impl MachineBuilder<'_> {
                 windage: self.eff.windage,
             }
         };
-        Machine::new(
+        let mut machine = Machine::new(
             rs,
             t_mat,
             lls,
@@ -531,7 +535,9 @@ impl MachineBuilder<'_> {
             m.j_kgm2,
             m.b_nms * md.b,
             load,
-        )
+        )?;
+        machine.rr_asym = 2.0 / 3.0 * rr * self.eff.rotor_delta;
+        Ok(machine)
     }
 
     /// The scenario key a machine that cannot be built is blamed on.
@@ -988,7 +994,7 @@ fn truth(model: &Machine, x: &[f64; 6], v: [f64; 2], t: f64, we: f64, dtemp: f64
         rr_ohm: model.rr,
         lm_h: c.lm,
         p_in_w: 1.5 * (v[0] * it[0] + v[1] * it[1]),
-        p_cu_w: 1.5 * (model.r_s.quad(it) + model.rr * (c.i_r[0].powi(2) + c.i_r[1].powi(2))),
+        p_cu_w: 1.5 * (model.r_s.quad(it) + model.rotor_r(x[5]).quad(c.i_r)),
         p_fe_w: 1.5 * (u[0] * u[0] + u[1] * u[1]) * model.inv_rfe,
         p_mech_w: te * wm,
         stored_energy_j: 0.75

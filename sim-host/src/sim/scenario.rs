@@ -378,6 +378,30 @@ pub enum EffectSpec {
         #[serde(default = "d_asym")]
         fraction: f64,
     },
+    /// Rotor cage asymmetry (broken rotor bars): rotor phase a's resistance is
+    /// Rr (1 + delta), the others Rr. In the rotor's own alpha-beta frame (amplitude-invariant
+    /// Clarke, isolated neutral) the rotor resistance is the matrix
+    /// R_r = Rr I + (2/3) Rr delta e_a e_a^T; in the stator frame it turns with the rotor,
+    /// R_r(theta) = Rr I + (2/3) Rr delta u u^T, u = (cos Np theta_m, sin Np theta_m), and the
+    /// rotor voltage equation becomes dpsi_r/dt = -R_r(theta) i_r + J omega_r psi_r. The
+    /// extra rotor loss is (3/2) i_r^T R_r i_r - (3/2) Rr |i_r|^2.
+    ///
+    /// Give `delta` (relative resistance asymmetry, 0..10), or `broken_bars` n with `bars`
+    /// N: delta = 3n / (N - 3n) (the usual approximation for n adjacent broken bars of an
+    /// N-bar cage, Kliman et al., IEEE Trans. Energy Convers. 3(4), 1988; Bellini et al.,
+    /// IEEE Trans. Ind. Appl. 37(5), 2001; it ignores the inter-bar currents and the
+    /// end-ring redistribution). Default delta = 0.1 (about one broken bar of 28).
+    RotorAsymmetry {
+        /// Relative rotor phase resistance asymmetry delta [-] (0..10).
+        #[serde(default)]
+        delta: Option<f64>,
+        /// Number of adjacent broken bars n (with `bars`; instead of `delta`).
+        #[serde(default)]
+        broken_bars: Option<f64>,
+        /// Rotor bar count N (with `broken_bars`).
+        #[serde(default)]
+        bars: Option<f64>,
+    },
     /// Rotor flux dynamics (Lr/Rr): always present in the full-order model; a no-op here.
     FluxDynamics {},
     /// Stator current dynamics (La dI/dt): always present in the full-order model; a no-op.
@@ -398,6 +422,7 @@ impl EffectSpec {
             EffectSpec::PhaseAsymmetry { .. } => EffectKind::PhaseAsymmetry,
             EffectSpec::FluxDynamics {} => EffectKind::FluxDynamics,
             EffectSpec::CurrentDynamics {} => EffectKind::CurrentDynamics,
+            EffectSpec::RotorAsymmetry { .. } => EffectKind::RotorAsymmetry,
         }
     }
 
@@ -438,6 +463,11 @@ impl EffectSpec {
             },
             EffectKind::FluxDynamics => EffectSpec::FluxDynamics {},
             EffectKind::CurrentDynamics => EffectSpec::CurrentDynamics {},
+            EffectKind::RotorAsymmetry => EffectSpec::RotorAsymmetry {
+                delta: None,
+                broken_bars: None,
+                bars: None,
+            },
         }
     }
 
@@ -530,8 +560,61 @@ impl EffectSpec {
             }
             EffectSpec::PhaseAsymmetry { fraction: f, .. } => fraction(&k("fraction"), *f),
             EffectSpec::FluxDynamics {} | EffectSpec::CurrentDynamics {} => Ok(()),
+            EffectSpec::RotorAsymmetry { .. } => self.rotor_delta().map(|_| ()),
         }
     }
+
+    /// The rotor resistance asymmetry delta of a `rotor_asymmetry` effect (0 for any
+    /// other effect): `delta`, or 3n/(N - 3n) from `broken_bars` n and `bars` N.
+    ///
+    /// # Errors
+    /// [`SimError::Invalid`] naming the key when a value is out of range or the keys do not
+    /// go together.
+    pub fn rotor_delta(&self) -> Result<f64, SimError> {
+        let EffectSpec::RotorAsymmetry {
+            delta,
+            broken_bars,
+            bars,
+        } = *self
+        else {
+            return Ok(0.0);
+        };
+        let k = |p: &str| format!("effects.rotor_asymmetry.{p}");
+        let bad = |key: &str, message: String| -> Result<f64, SimError> {
+            Err(SimError::Invalid {
+                key: key.to_string(),
+                message,
+            })
+        };
+        match (delta, broken_bars, bars) {
+            (Some(_), Some(_), _) => bad(&k("delta"), "give delta or broken_bars, not both".into()),
+            (Some(d), None, _) if d.is_finite() && (0.0..=10.0).contains(&d) => Ok(d),
+            (Some(d), None, _) => bad(&k("delta"), format!("must be in 0..10, got {d}")),
+            (None, Some(n), Some(nb)) => {
+                if !(nb.is_finite() && nb >= 6.0) {
+                    return bad(&k("bars"), format!("must be at least 6, got {nb}"));
+                }
+                if !(n.is_finite() && n >= 0.0 && 3.0 * n < nb) {
+                    return bad(
+                        &k("broken_bars"),
+                        format!("must be in 0..{} (N/3) for {nb} bars, got {n}", nb / 3.0),
+                    );
+                }
+                let d = crate::analysis::rotor_asymmetry::delta_of_broken_bars(n, nb);
+                if d <= 10.0 {
+                    Ok(d)
+                } else {
+                    bad(&k("broken_bars"), format!("gives delta = {d} > 10"))
+                }
+            }
+            (None, Some(_), None) => bad(&k("bars"), "broken_bars needs the bar count bars".into()),
+            (None, None, _) => Ok(d_rotor_delta()),
+        }
+    }
+}
+
+fn d_rotor_delta() -> f64 {
+    0.1
 }
 
 /// Sensor chain: transducer (gain and offset error), white Gaussian noise, ADC quantisation

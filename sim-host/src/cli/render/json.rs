@@ -97,11 +97,11 @@ impl Table1Report {
 
 /// `explain --compare --json`: both documents.
 #[derive(Serialize)]
-pub struct ExplainWithCompare<'a> {
+pub struct ExplainWithCompare<'a, E: Serialize = ExplainReport> {
     /// `compare`'s document.
     pub compare: &'a CompareReport,
     /// `explain`'s document.
-    pub explain: &'a ExplainReport,
+    pub explain: &'a E,
 }
 
 /// `bench --json`.

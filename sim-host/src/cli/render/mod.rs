@@ -7,5 +7,6 @@ pub mod charts;
 pub mod hmi;
 pub mod html;
 pub mod json;
+pub mod mcsa;
 pub mod plot;
 pub mod text;

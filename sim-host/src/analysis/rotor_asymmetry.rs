@@ -1,0 +1,439 @@
+//! `rotor_asymmetry`: an unequal rotor cage (broken rotor bars, cracked end ring), the
+//! library effect for `compare` / `explain`, and the motor current signature analysis
+//! (MCSA) report users of that fault expect: the (1 - 2s) f and (1 + 2s) f sidebands of the
+//! stator current in dB below the fundamental and the 2 s f speed ripple.
+//!
+//! # Model (the simplified model's view of the simulator's full-order asymmetry)
+//! The simulator gives rotor phase a the resistance Rr (1 + delta) (`crate::sim`); in
+//! alpha-beta that is R_r = Rr I + (2/3) Rr delta u u^T, u along rotor phase a. In the
+//! rotor-flux frame of the analysis the rotor current is along q (i_rq = -(Lm/Lr) I_qs), so
+//! the slip equation sees the q-q element of R_r:
+//! ```text
+//!   R_qq / Rr = 1 + (2/3) delta sin^2(g) = 1 + (delta/3) (1 - cos(2 g)),
+//!   g = Np theta_m - theta + phi/2   (rotor phase a against the flux's d axis)
+//! ```
+//! Np theta_m is the integral of the measured electrical speed, theta the analysis frame's
+//! angle, phi the unknown angle of the faulty phase (fitted). The rotor resistance term of
+//! Ra = Rs + (Ls/Lr) Rr is multiplied by R_qq / Rr: the q current and the torque are then
+//! modulated at 2 s f in the rotor-flux frame, which in the stator frame is the (1 - 2s) f
+//! sideband, and the 2 s f torque ripple moves the speed, which makes the (1 + 2s) f one.
+//! Approximations: the d-q element (Rr delta/3) sin 2g, which disturbs the rotor flux at
+//! 2 s f, is left out (the measured I_ds carries part of it into Psi = Ls i_f); and the
+//! quasi-static I_qs (no La dI/dt) is exact only while 2 s f is well below Ra / (2 pi La).
+//!
+//! # Broken bars
+//! For an N-bar cage with n adjacent broken bars the equivalent rotor phase resistance
+//! asymmetry is delta = 3n / (N - 3n), n = delta N / (3 (1 + delta)) (Kliman, Koegl,
+//! Stein, Endicott, Madden, IEEE Trans. Energy Convers. 3(4), 1988; Bellini, Filippetti,
+//! Franceschini, Tassoni, Kliman, IEEE Trans. Ind. Appl. 37(5), 2001). It is an
+//! approximation: it takes the broken bars' current as redistributed over the healthy
+//! bars of one rotor pole pitch, and ignores inter-bar currents (which make real
+//! sidebands smaller) and the end-ring resistance.
+//!
+//! # MCSA resolution
+//! The sidebands lie 2 s f from the fundamental (3.6 Hz for the 3 hp motor at 3 % slip).
+//! With a Hann window the fundamental's leakage falls 18 dB per octave from -31 dB at 2.5
+//! bins; [`MIN_BINS`] = 10 bins (-68 dB) between the fundamental and a sideband keep its
+//! leakage below the sidebands of a healthy cage (-50 to -60 dB). The resolution needed is
+//! therefore 1/T <= 2 s f / 10: T >= 5 / (s f), 2.8 s at 3 % slip and 60 Hz, 10 s at 1 %
+//! and 50 Hz. A shorter steady stretch, a slip below [`MIN_SLIP`] or a slip that varies by
+//! more than [`SLIP_STEADY`] of itself is "cannot judge".
+
+use super::effects::{EffectModel, FitSetup, ParamSpec};
+use super::prep::{zero_phase_lpf, Prepared};
+use super::simplified_model::{EffectTerms, MachineConstants};
+use monitor_core::EffectKind;
+use rustfft::num_complex::Complex;
+use serde::Serialize;
+use std::f64::consts::PI;
+
+/// Physical range of the fitted asymmetry delta: 0..1. One broken bar of a 28-bar cage is
+/// delta = 0.12, three adjacent ones 0.47, delta = 1 is n = N/6 (4.7 of 28); a cage
+/// beyond that has lost a third of a pole pitch of bars (Bellini et al. 2001 report 1 to
+/// 4 broken bars as the range of interest). The fit overestimates delta up to about 2x
+/// (module doc), which is why the range reaches 1 rather than 0.5.
+pub const DELTA_RANGE: (f64, f64) = (0.0, 1.0);
+/// Basis of [`DELTA_RANGE`].
+pub const DELTA_BASIS: &str = "delta = 3n/(N - 3n): up to N/6 adjacent broken bars (4.7 of 28; Kliman et al. 1988, Bellini et al. 2001)";
+/// Fewest frequency bins between the fundamental and a sideband (see the module doc).
+pub const MIN_BINS: f64 = 10.0;
+/// Smallest slip the sidebands are judged at: below it they sit within 2 s f = 0.6 Hz
+/// (at 50 Hz) of the fundamental, a run of 17 s at least, and no-load slip is noise.
+pub const MIN_SLIP: f64 = 0.003;
+/// Largest variation of the slip over the analysed stretch, relative to its mean.
+pub const SLIP_STEADY: f64 = 0.2;
+
+/// delta = 3n/(N - 3n) for `n` adjacent broken bars of a cage of `bars` bars (see the module
+/// doc; an approximation).
+pub fn delta_of_broken_bars(n: f64, bars: f64) -> f64 {
+    3.0 * n / (bars - 3.0 * n)
+}
+
+/// The number of adjacent broken bars n = delta N / (3 (1 + delta)) of an N-bar cage
+/// equivalent to the asymmetry `delta` (the inverse of [`delta_of_broken_bars`]).
+pub fn broken_bars_of_delta(delta: f64, bars: f64) -> f64 {
+    delta * bars / (3.0 * (1.0 + delta))
+}
+
+/// The library entry (see the module doc).
+pub struct RotorAsymmetry;
+
+/// 2 (Np theta_m - theta) per working sample: twice the measured rotor electrical angle
+/// against the analysis frame (empty without a speed column).
+fn double_slip_angle(d: &Prepared) -> Vec<f64> {
+    if d.omega_r.len() != d.len() || d.theta.len() != d.len() || d.is_empty() {
+        return Vec::new();
+    }
+    let mut th_r = d.theta[0];
+    let mut out = Vec::with_capacity(d.len());
+    for k in 0..d.len() {
+        if k > 0 {
+            let dt = d.t_s[k] - d.t_s[k - 1];
+            th_r += 0.5 * dt * (d.omega_r[k] + d.omega_r[k - 1]);
+        }
+        out.push(2.0 * (th_r - d.theta[k]));
+    }
+    out
+}
+
+/// A first estimate of (delta, phi) from the measured I_qs: its component along
+/// cos(2 g), sin(2 g) (least squares after removing the slow part), scaled by
+/// I_qs (Ls/Lr) Rr / Ra (the quasi-static gain, without the speed's feedback).
+fn initial_estimate(d: &Prepared, n: &MachineConstants, ang: &[f64]) -> (f64, f64) {
+    let slow = zero_phase_lpf(&d.iq_pos, d.dt_s, 0.2);
+    let (mut cc, mut ss, mut cs, mut yc, mut ys, mut iq) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for k in 0..ang.len() {
+        let (s, c) = ang[k].sin_cos();
+        let y = d.iq_pos[k] - slow[k];
+        cc += c * c;
+        ss += s * s;
+        cs += c * s;
+        yc += y * c;
+        ys += y * s;
+        iq += d.iq_pos[k].abs();
+    }
+    let det = cc * ss - cs * cs;
+    if det.abs() < 1e-12 || ang.is_empty() {
+        return (0.05, 0.0);
+    }
+    let a = (yc * ss - ys * cs) / det;
+    let b = (ys * cc - yc * cs) / det;
+    let iq = (iq / ang.len() as f64).max(1e-6);
+    // I_qs ripple = +I_qs (rr_a/Ra) (delta/3) cos(2g + phi) = A cos 2g + B sin 2g.
+    let delta = 3.0 * a.hypot(b) / (iq * n.rr_a_ohm / n.ra_ohm);
+    (delta.clamp(0.02, 1.0), (-b).atan2(a))
+}
+
+impl EffectModel for RotorAsymmetry {
+    fn kind(&self) -> EffectKind {
+        EffectKind::RotorAsymmetry
+    }
+    fn description(&self) -> &'static str {
+        "The rotor cage is not symmetric (broken rotor bars, a cracked end ring): the rotor resistance seen by the stator field changes at twice the slip frequency, which modulates the torque and the current: (1 - 2s) f and (1 + 2s) f sidebands in the stator current, 2 s f ripple in speed."
+    }
+    fn equations(&self) -> &'static str {
+        "Rr in Ra = Rs + (Ls/Lr) Rr is multiplied by 1 + (delta/3)(1 - cos(2 (Np theta_m - theta) + phi)): the q-q element of the rotor resistance matrix Rr I + (2/3) Rr delta u u^T, u along the faulty rotor phase; Np theta_m integrates the measured speed."
+    }
+    fn parameters(&self) -> &'static [ParamSpec] {
+        &[
+            ParamSpec {
+                name: "delta",
+                unit: "1",
+                description: "relative rotor phase resistance asymmetry (one rotor phase Rr (1 + delta)); n broken bars of N: delta = 3n/(N - 3n)",
+            },
+            ParamSpec {
+                name: "phi_rad",
+                unit: "rad",
+                description: "twice the angle of the faulty rotor phase at the log's start (a nuisance parameter)",
+            },
+        ]
+    }
+    fn needs(&self) -> super::effects::Needs {
+        super::effects::Needs {
+            voltages: true,
+            speed: true,
+        }
+    }
+    fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String> {
+        let ang = double_slip_angle(d);
+        if ang.is_empty() {
+            return Err("needs the speed column wm_rad_s (the rotor angle)".into());
+        }
+        let (delta0, phi0) = initial_estimate(d, n, &ang);
+        let any_angle = crate::params::PlausibleRange {
+            lo: f64::NEG_INFINITY,
+            hi: f64::INFINITY,
+        };
+        let delta_range = crate::params::PlausibleRange {
+            lo: DELTA_RANGE.0,
+            hi: DELTA_RANGE.1,
+        };
+        Ok(FitSetup {
+            names: vec!["delta".into(), "phi_rad".into()],
+            units: vec!["1", "rad"],
+            init: vec![delta0, phi0],
+            lo: vec![0.0, phi0 - 4.0 * PI],
+            hi: vec![2.0, phi0 + 4.0 * PI],
+            scale: vec![0.05, 0.3],
+            plausible: vec![(delta_range, DELTA_BASIS), (any_angle, "any angle")],
+            data: ang,
+        })
+    }
+    fn apply(
+        &self,
+        s: &FitSetup,
+        p: &[f64],
+        d: &Prepared,
+        _n: &MachineConstants,
+        terms: &mut EffectTerms,
+    ) {
+        if s.data.len() != d.len() {
+            return;
+        }
+        let (delta, phi) = (p[0], p[1]);
+        let f = s
+            .data
+            .iter()
+            .map(|a| 1.0 + delta / 3.0 * (1.0 - (a + phi).cos()));
+        if terms.rr_factor.len() == d.len() {
+            for (x, y) in terms.rr_factor.iter_mut().zip(f) {
+                *x *= y;
+            }
+        } else {
+            terms.rr_factor = f.collect();
+        }
+        // The d-q element (Rr delta/3) sin(2g) drives the rotor flux:
+        // tau_r dphi/dt = i_f - phi + (delta/3) sin(2g) I_qs (measured I_qs).
+        terms.phi_drive = s
+            .data
+            .iter()
+            .zip(&d.iq_pos)
+            .map(|(a, iq)| delta / 3.0 * (a + phi).sin() * iq)
+            .collect();
+    }
+    fn describe(&self, _s: &FitSetup, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
+        let m = mcsa(d, n.np, None, Some(p[0]));
+        let sb = match (m.lower_sideband_db, m.upper_sideband_db) {
+            (Some(l), Some(u)) => format!(
+                "; current sidebands {l:.1} dB ((1-2s)f) and {u:.1} dB ((1+2s)f) below the fundamental"
+            ),
+            _ => String::new(),
+        };
+        format!(
+            "rotor cage asymmetry: one rotor phase's resistance {:.1} % above the others (about {:.1} broken bars of a 28-bar cage, {:.1} of 40){sb}",
+            100.0 * p[0],
+            broken_bars_of_delta(p[0], 28.0),
+            broken_bars_of_delta(p[0], 40.0),
+        )
+    }
+}
+
+/// The motor current signature analysis of a log (`explain`'s `rotor_asymmetry` key).
+#[derive(Debug, Clone, Serialize, Default)]
+pub struct McsaReport {
+    /// True when the sidebands could be judged; else see `cannot_judge_because`.
+    pub judged: bool,
+    /// Why the log cannot be judged ("cannot judge: ...").
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cannot_judge_because: Option<String>,
+    /// Lower sideband (1 - 2s) f, dB relative to the fundamental (negative).
+    pub lower_sideband_db: Option<f64>,
+    /// Upper sideband (1 + 2s) f, dB relative to the fundamental.
+    pub upper_sideband_db: Option<f64>,
+    /// Mean slip over the analysed stretch [-].
+    pub slip: Option<f64>,
+    /// Supply frequency f [Hz].
+    pub fundamental_hz: Option<f64>,
+    /// The sidebands' frequencies [(1 - 2s) f, (1 + 2s) f] [Hz].
+    pub sideband_hz: Vec<f64>,
+    /// The 2 s f speed ripple: frequency [Hz] and amplitude (peak) [rad/s, mechanical].
+    pub speed_ripple_hz: Option<f64>,
+    /// Amplitude of the 2 s f speed ripple (peak, mechanical) [rad/s].
+    pub speed_ripple_rad_s: Option<f64>,
+    /// Fitted (or given) delta the broken-bar figure is computed from.
+    pub delta: Option<f64>,
+    /// Rotor bar count N given by `--rotor-bars`.
+    pub rotor_bars: Option<f64>,
+    /// Equivalent adjacent broken bars n = delta N / (3 (1 + delta)) (null without a bar
+    /// count or without a fitted delta).
+    pub equivalent_broken_bars: Option<f64>,
+    /// Frequency resolution 1/T of the analysed stretch [Hz].
+    pub resolution_hz: Option<f64>,
+    /// Resolution needed: 2 s f / [`MIN_BINS`] [Hz].
+    pub resolution_needed_hz: Option<f64>,
+    /// Analysed stretch [t_start, t_end] [s] (steady slip).
+    pub window_s: Vec<f64>,
+    /// Phase-a current spectrum around the fundamental (f/2 .. 3f/2), for the plot:
+    /// (frequency [Hz], dB relative to the fundamental).
+    #[serde(skip)]
+    pub spectrum: Vec<(f64, f64)>,
+}
+
+/// The stretch at the end of the log over which the slip is steady: from the last 0.2 s
+/// block whose mean slip differs from the final quarter's median by more than
+/// [`SLIP_STEADY`] of it, to the end. Returns (first sample, slip series per sample).
+fn steady_stretch(d: &Prepared) -> (usize, Vec<f64>) {
+    let len = d.len();
+    let slip: Vec<f64> = (0..len)
+        .map(|k| 1.0 - d.omega_r[k] / d.omega_s[k].abs().max(1e-6))
+        .collect();
+    let mut tail: Vec<f64> = slip[3 * len / 4..].to_vec();
+    tail.sort_by(f64::total_cmp);
+    let med = tail.get(tail.len() / 2).copied().unwrap_or(0.0);
+    let blk = ((0.2 / d.dt_s).round() as usize).max(1);
+    let mut start = 0;
+    let mut k = len;
+    while k >= blk {
+        let m = slip[k - blk..k].iter().sum::<f64>() / blk as f64;
+        if (m - med).abs() > SLIP_STEADY * med.abs().max(MIN_SLIP) {
+            start = k;
+            break;
+        }
+        k -= blk;
+    }
+    (start, slip)
+}
+
+/// Hann-windowed amplitude spectrum of `x` sampled every `dt`, zero-padded 4x: (bin
+/// spacing [Hz], peak amplitudes per bin).
+fn spectrum(x: &[f64], dt: f64) -> (f64, Vec<f64>) {
+    let n = x.len();
+    let nfft = (4 * n).next_power_of_two();
+    let mean = x.iter().sum::<f64>() / n.max(1) as f64;
+    let mut buf: Vec<Complex<f64>> = vec![Complex::new(0.0, 0.0); nfft];
+    let mut wsum = 0.0;
+    for (k, v) in x.iter().enumerate() {
+        let w = 0.5 - 0.5 * (2.0 * PI * k as f64 / n as f64).cos();
+        wsum += w;
+        buf[k] = Complex::new((v - mean) * w, 0.0);
+    }
+    rustfft::FftPlanner::new()
+        .plan_fft_forward(nfft)
+        .process(&mut buf);
+    let amp = buf[..nfft / 2]
+        .iter()
+        .map(|c| 2.0 * c.norm() / wsum.max(1e-12))
+        .collect();
+    (1.0 / (nfft as f64 * dt), amp)
+}
+
+/// Largest amplitude within `f0 +/- half` [Hz]: (frequency, amplitude).
+fn peak(df: f64, amp: &[f64], f0: f64, half: f64) -> (f64, f64) {
+    let a = ((f0 - half) / df).floor().max(0.0) as usize;
+    let b = (((f0 + half) / df).ceil() as usize).min(amp.len().saturating_sub(1));
+    (a..=b)
+        .map(|k| (k as f64 * df, amp[k]))
+        .fold((f0, 0.0), |m, x| if x.1 > m.1 { x } else { m })
+}
+
+/// The MCSA of the log: stator current sidebands at (1 -/+ 2s) f in dB below the
+/// fundamental (phase-a current, Hann window over the steady stretch at the end of the
+/// log), the 2 s f speed ripple, and the equivalent broken bars for `bars` N when `delta`
+/// is known. `np` is the number of pole pairs. "Cannot judge" (with the reason) without a
+/// speed column, on a slip below [`MIN_SLIP`] or not steady, or a stretch too short for
+/// the resolution (see the module doc).
+pub fn mcsa(d: &Prepared, np: f64, bars: Option<f64>, delta: Option<f64>) -> McsaReport {
+    let mut r = McsaReport {
+        delta,
+        rotor_bars: bars,
+        equivalent_broken_bars: bars.zip(delta).map(|(nb, dl)| broken_bars_of_delta(dl, nb)),
+        ..Default::default()
+    };
+    let no = |mut r: McsaReport, why: String| {
+        r.cannot_judge_because = Some(format!("cannot judge: {why}"));
+        r
+    };
+    if d.omega_r.len() != d.len() || d.len() < 16 {
+        return no(r, "needs the speed column wm_rad_s for the slip".into());
+    }
+    let (a, slip) = steady_stretch(d);
+    let seg = a..d.len();
+    let t_len = (d.len() - a) as f64 * d.dt_s;
+    r.window_s = vec![d.t_s[a], d.t_s[d.len() - 1]];
+    let s = slip[seg.clone()].iter().sum::<f64>() / seg.len().max(1) as f64;
+    let f1 = d.omega_s[seg.clone()].iter().map(|w| w.abs()).sum::<f64>()
+        / seg.len().max(1) as f64
+        / (2.0 * PI);
+    r.slip = Some(s);
+    r.fundamental_hz = Some(f1);
+    r.resolution_hz = Some(1.0 / t_len.max(d.dt_s));
+    if s < MIN_SLIP {
+        return no(
+            r,
+            format!(
+                "the slip {:.4} is below {MIN_SLIP} (no load): the sidebands sit on the fundamental",
+                s
+            ),
+        );
+    }
+    let fs = 2.0 * s * f1;
+    r.sideband_hz = vec![(1.0 - 2.0 * s) * f1, (1.0 + 2.0 * s) * f1];
+    r.resolution_needed_hz = Some(fs / MIN_BINS);
+    let (lo, hi) = slip[seg.clone()]
+        .chunks(((0.2 / d.dt_s) as usize).max(1))
+        .map(|c| c.iter().sum::<f64>() / c.len() as f64)
+        .fold((f64::MAX, f64::MIN), |(l, h), x| (l.min(x), h.max(x)));
+    if hi - lo > 2.0 * SLIP_STEADY * s {
+        return no(r, format!("the slip is not steady ({lo:.4}..{hi:.4})"));
+    }
+    if t_len < MIN_BINS / fs {
+        return no(
+            r,
+            format!(
+                "the steady stretch is {t_len:.2} s; {:.2} s are needed to resolve sidebands 2sf = {fs:.2} Hz from the fundamental ({MIN_BINS} bins)",
+                MIN_BINS / fs
+            ),
+        );
+    }
+    let ia: Vec<f64> = d.i_ab[seg.clone()].iter().map(|c| c.re).collect();
+    let (df, amp) = spectrum(&ia, d.dt_s);
+    let (ff, af) = peak(df, &amp, f1, 0.3 * fs);
+    let db = |x: f64| 20.0 * (x.max(1e-300) / af.max(1e-300)).log10();
+    let (_, al) = peak(df, &amp, ff - fs, 0.2 * fs);
+    let (_, au) = peak(df, &amp, ff + fs, 0.2 * fs);
+    r.lower_sideband_db = Some(db(al));
+    r.upper_sideband_db = Some(db(au));
+    r.spectrum = (((0.5 * f1) / df) as usize..((1.5 * f1) / df).min(amp.len() as f64) as usize)
+        .map(|k| (k as f64 * df, db(amp[k])))
+        .collect();
+    let wm: Vec<f64> = d.omega_r[seg].iter().map(|w| w / np).collect();
+    let (dfw, aw) = spectrum(&wm, d.dt_s);
+    let (fw, a_w) = peak(dfw, &aw, fs, 0.2 * fs);
+    r.speed_ripple_hz = Some(fw);
+    r.speed_ripple_rad_s = Some(a_w);
+    r.judged = true;
+    r
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn broken_bars_and_delta_are_inverse() {
+        // One broken bar of 28: 3/25 = 0.12.
+        assert!((delta_of_broken_bars(1.0, 28.0) - 0.12).abs() < 1e-12);
+        for (n, nb) in [(1.0, 28.0), (2.0, 40.0), (3.0, 36.0)] {
+            let d = delta_of_broken_bars(n, nb);
+            assert!((broken_bars_of_delta(d, nb) - n).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn spectrum_reads_a_sideband_level() {
+        // 60 Hz of amplitude 10 and 56 Hz of amplitude 0.1: -40 dB.
+        let dt = 1.0 / 2000.0;
+        let x: Vec<f64> = (0..20000)
+            .map(|k| {
+                let t = k as f64 * dt;
+                10.0 * (2.0 * PI * 60.0 * t).cos() + 0.1 * (2.0 * PI * 56.0 * t + 1.0).cos()
+            })
+            .collect();
+        let (df, amp) = spectrum(&x, dt);
+        let (f, a) = peak(df, &amp, 60.0, 1.0);
+        let (fl, al) = peak(df, &amp, 56.0, 0.8);
+        assert!((f - 60.0).abs() < df && (fl - 56.0).abs() < df, "{f} {fl}");
+        assert!((a - 10.0).abs() < 0.1, "{a}");
+        assert!((20.0 * (al / a).log10() + 40.0).abs() < 0.3, "{al}");
+    }
+}
