@@ -106,6 +106,7 @@ pub fn watch(
         commission: Some(COMMISSION),
         allow_incomplete: false,
         timeline_step_s: 1.0,
+        unbalance_baseline: None,
     };
     let mut replay = Replay::new(params, sc.sensors.channels(), sc.sample_rate_hz, opts)?;
     let mut w = Watch::default();

@@ -30,8 +30,14 @@ range) are held out, time in ms or us is recognised; the report's data_quality s
 was found and done, and the verdict is withheld when the log cannot be trusted.\n\n\
 Commissioning: a window the log does not complete is an error unless --allow-incomplete. \
 The learned thresholds hold only over the load and voltage range seen while learning: \
-commission over healthy running that covers the whole range.\n\nExample:\n  sim-host diagnose --params motor.toml \
-log.csv --commission 2:4"
+commission over healthy running that covers the whole range.\n\nThe faulty winding is judged \
+from the change of the negative-sequence current against the healthy machine's: --baseline \
+HEALTHY.csv replays a log of the same motor when it was healthy (same supply and load if \
+possible) and takes its negative sequence; without it, the one at the end of the --commission \
+window; without either, only the supply's own unbalance is taken out (a motor's inherent \
+asymmetry and the sensors' mismatch then count as the winding's).\n\nExample:\n  sim-host \
+diagnose --params motor.toml log.csv --commission 2:4\n  sim-host diagnose --params motor.toml \
+today.csv --baseline last_year_healthy.csv"
 )]
 pub struct DiagnoseArgs {
     /// Motor parameter file (TOML, DESIGN.md §3).
@@ -51,6 +57,10 @@ pub struct DiagnoseArgs {
     /// verdict is withheld.
     #[arg(long)]
     pub allow_incomplete: bool,
+    /// A log of the same motor when healthy: the winding is judged against its negative
+    /// sequence (read only; the same formats as LOG).
+    #[arg(long, value_name = "HEALTHY")]
+    pub baseline: Option<PathBuf>,
     /// Frame angle source.
     #[arg(long, value_enum, default_value_t = AngleArg::RotorFlux)]
     pub angle: AngleArg,
@@ -65,6 +75,35 @@ pub struct DiagnoseArgs {
     pub json: bool,
 }
 
+/// The negative sequence of the healthy log `path` (replayed without commissioning).
+fn baseline_of(
+    params: &ParamFile,
+    path: &std::path::Path,
+    args: &DiagnoseArgs,
+    opts: ReplayOptions,
+) -> anyhow::Result<sim_host::replay::UnbalanceBaseline> {
+    let file = LogFile::open_with(
+        path,
+        &OpenOptions {
+            group: args.group.clone(),
+        },
+    )
+    .map_err(|e| anyhow::anyhow!("--baseline: {e}"))?;
+    let opts = ReplayOptions {
+        commission: None,
+        ..opts
+    };
+    let d = diagnose_log(params, &file, opts, &mut |_| {})
+        .map_err(|e| anyhow::anyhow!("--baseline {}: {e}", path.display()))?;
+    if d.report.unbalance.measured.i2_over_i1 == [0.0, 0.0] {
+        anyhow::bail!(
+            "--baseline {}: no positive-sequence current in that log (the motor never ran)",
+            path.display()
+        );
+    }
+    Ok(d.report.unbalance.measured)
+}
+
 /// Runs `diagnose`.
 ///
 /// # Errors
@@ -72,13 +111,17 @@ pub struct DiagnoseArgs {
 /// core cannot be configured for.
 pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
     let params = ParamFile::load(&args.params)?;
-    let opts = ReplayOptions {
+    let mut opts = ReplayOptions {
         angle_source: args.angle.into(),
         residual_form: args.residuals.into(),
         commission: args.commission,
         allow_incomplete: args.allow_incomplete,
         timeline_step_s: args.timeline_step.max(1e-4),
+        unbalance_baseline: None,
     };
+    if let Some(healthy) = &args.baseline {
+        opts.unbalance_baseline = Some(baseline_of(&params, healthy, args, opts)?);
+    }
     let big = std::fs::metadata(&args.log)
         .map(|m| m.len() > 20_000_000)
         .unwrap_or(false);

@@ -95,6 +95,21 @@ pub struct ReplayOptions {
     pub allow_incomplete: bool,
     /// Timeline resolution [s] (one point per interval).
     pub timeline_step_s: f64,
+    /// The healthy machine's negative sequence to judge the winding against (`diagnose
+    /// --baseline HEALTHY.csv`); without it, the one learned in the commissioning window,
+    /// else none ([`UnbalanceBaseline`]).
+    pub unbalance_baseline: Option<UnbalanceBaseline>,
+}
+
+/// The healthy machine's negative sequence, relative to its positive sequence: what a
+/// motor's own asymmetry and the sensors' mismatch put there before any fault. The
+/// winding analysis judges the change from it (`unbalance.baseline`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct UnbalanceBaseline {
+    /// `I2/I1` (re, im), the sensor-corrected currents'.
+    pub i2_over_i1: [f32; 2],
+    /// `V2/I1` [ohm] (re, im), where voltages are logged.
+    pub v2_over_i1: Option<[f32; 2]>,
 }
 
 impl Default for ReplayOptions {
@@ -105,6 +120,7 @@ impl Default for ReplayOptions {
             commission: None,
             allow_incomplete: false,
             timeline_step_s: 0.1,
+            unbalance_baseline: None,
         }
     }
 }
@@ -229,6 +245,13 @@ pub struct UnbalanceReport {
     pub current_sensor_phase: Option<SensorPhaseReport>,
     /// The same for the voltage sensors (phase voltages against the star point), or null.
     pub voltage_sensor_phase: Option<SensorPhaseReport>,
+    /// What was measured, before the baseline is taken out (sensor-corrected): `I2/I1` and
+    /// `V2/I1` (re, im); a healthy log's are the `--baseline` of a later one.
+    pub measured: UnbalanceBaseline,
+    /// The healthy negative sequence the winding is judged against: `"commissioning"`
+    /// (learned in the window), `"file"` (`--baseline`), or null (none: the supply's part
+    /// alone is taken out).
+    pub baseline: Option<String>,
 }
 
 /// What `diagnose` reports (DESIGN.md §3 JSON keys, plus `verdict`, `data_quality` and
@@ -318,6 +341,9 @@ pub struct Replay {
     /// Zero sequences of the measured currents and voltages (per-phase sensor redundancy).
     zero_i: ZeroSequence,
     zero_v: ZeroSequence,
+    /// The negative sequence at the end of the commissioning window (the latest while
+    /// learning).
+    learned_unbalance: Option<UnbalanceBaseline>,
     v_max: f64,
     /// The sequence analysis' PLL follows the voltages (else the currents).
     pll_on_voltage: bool,
@@ -401,6 +427,7 @@ impl Replay {
             seq_v: SequenceAnalyzer::new(2.0, dt),
             zero_i: ZeroSequence::new(2.0, dt),
             zero_v: ZeroSequence::new(2.0, dt),
+            learned_unbalance: None,
             v_max: f64::from(cfg.limits.v_max),
             pll_on_voltage: channels.voltages,
             seq_t: None,
@@ -432,6 +459,9 @@ impl Replay {
         let counts = out.sensor_fault.any() || self.commission.thresholds_trusted(&out);
         let point = self.steady_point(&out);
         self.isolation.after(t, self.dt_s, &out, &point, counts);
+        if matches!(out.commissioning, CommissioningState::Learning(_)) {
+            self.learned_unbalance = Some(self.unbalance_ratios().0);
+        }
         if out.fault_detected && counts {
             self.detected_in_range |=
                 out.sensor_fault.any() || !self.commission.outside_learned_range(&out);
@@ -543,21 +573,22 @@ impl Replay {
     /// out where voltages are logged. The slip is the monitor's (encoder) where it runs,
     /// else the equivalent circuit's for the measured current magnitude
     /// ([`slip_for_current`]).
-    fn unbalance_report(&self, out: &MonitorOutput) -> UnbalanceReport {
-        let m = self.params.motor.model();
-        let omega = self.pll.omega_rad_s();
-        let we = if omega > 1.0 {
-            omega
-        } else {
-            self.params.supply.omega_rad_s() as f32
-        };
+    /// The sensor-corrected `I2/I1` and `V2/I1` (module docs of
+    /// [`monitor_core::sequence`]), with the sensors found wrong on one phase.
+    fn unbalance_ratios(
+        &self,
+    ) -> (
+        UnbalanceBaseline,
+        Option<SinglePhaseGain>,
+        Option<SinglePhaseGain>,
+    ) {
         let p = self.seq.positive();
         let p2 = p.0 * p.0 + p.1 * p.1;
         let over_i1 = |x: (f32, f32)| {
             if p2 > 0.0 {
-                ((x.0 * p.0 + x.1 * p.1) / p2, (x.1 * p.0 - x.0 * p.1) / p2)
+                [(x.0 * p.0 + x.1 * p.1) / p2, (x.1 * p.0 - x.0 * p.1) / p2]
             } else {
-                (0.0, 0.0)
+                [0.0, 0.0]
             }
         };
         // A sensor's own negative sequence is not the winding's (nor the supply's).
@@ -572,11 +603,38 @@ impl Replay {
                 self.zero_v.phasor(),
             )
         });
-        let i2 = over_i1(neg_i);
         // With one voltage sensor wrong, the voltages' negative sequence (corrected or not:
         // the analysis' PLL locked to the wrong readings leaves a few tenths of a per cent)
         // cannot say how much of I2 the supply drives: the currents alone judge the winding.
-        let v2 = (self.channels.voltages && gv.is_none()).then(|| over_i1(neg_v));
+        let ratios = UnbalanceBaseline {
+            i2_over_i1: over_i1(neg_i),
+            v2_over_i1: (self.channels.voltages && gv.is_none()).then(|| over_i1(neg_v)),
+        };
+        (ratios, gi, gv)
+    }
+
+    fn unbalance_report(&self, out: &MonitorOutput) -> UnbalanceReport {
+        let m = self.params.motor.model();
+        let omega = self.pll.omega_rad_s();
+        let we = if omega > 1.0 {
+            omega
+        } else {
+            self.params.supply.omega_rad_s() as f32
+        };
+        let (measured, gi, gv) = self.unbalance_ratios();
+        let (base, base_name) = match (self.opts.unbalance_baseline, self.learned_unbalance) {
+            (Some(b), _) => (Some(b), Some("file")),
+            (None, Some(b)) => (Some(b), Some("commissioning")),
+            (None, None) => (None, None),
+        };
+        let minus = |x: [f32; 2], b: Option<[f32; 2]>| {
+            let b = b.unwrap_or([0.0; 2]);
+            (x[0] - b[0], x[1] - b[1])
+        };
+        let i2 = minus(measured.i2_over_i1, base.map(|b| b.i2_over_i1));
+        let v2 = measured
+            .v2_over_i1
+            .map(|v| minus(v, base.and_then(|b| b.v2_over_i1)));
         let slip = if self.monitor.is_some() {
             1.0 - out.operating.wr / we
         } else {
@@ -589,18 +647,25 @@ impl Replay {
         };
         let w = winding_asymmetry(i2, v2, &m, we, slip, 0.005);
         UnbalanceReport {
-            negative_sequence_ratio: monitor_core::fast_hypot(i2.0, i2.1),
+            negative_sequence_ratio: monitor_core::fast_hypot(
+                measured.i2_over_i1[0],
+                measured.i2_over_i1[1],
+            ),
             suspect_phase: w.suspect_phase.map(|p| p.name().to_string()),
             angle_deg: w.angle_rad.to_degrees(),
             correction_deg: asymmetry_correction_rad(&m, we, slip).to_degrees(),
             winding_ratio: w.ratio,
             supply_ratio: w.supply_ratio,
-            voltage_negative_sequence_ratio: v2.map(|_| {
-                let (n, p) = (neg_v, self.seq_v.positive());
-                monitor_core::fast_hypot(n.0, n.1) / monitor_core::fast_hypot(p.0, p.1).max(1e-9)
+            voltage_negative_sequence_ratio: measured.v2_over_i1.map(|v| {
+                // |V2|/|V1| = |V2/I1| |I1|/|V1|
+                let i1 = self.seq.positive_magnitude();
+                monitor_core::fast_hypot(v[0], v[1]) * i1
+                    / self.seq_v.positive_magnitude().max(1e-9)
             }),
             current_sensor_phase: gi.as_ref().map(SensorPhaseReport::from),
             voltage_sensor_phase: gv.as_ref().map(SensorPhaseReport::from),
+            measured,
+            baseline: base_name.map(str::to_string),
         }
     }
 
