@@ -17,7 +17,13 @@
 use std::path::{Path, PathBuf};
 
 /// JSON paths (file, path) that changed on purpose.
-const INTENDED: [(&str, &str, &str); 8] = [
+const INTENDED: [(&str, &str, &str); 9] = [
+    // Issue 10: two more dynamics effects, each skipped on a current-only log.
+    (
+        "exp_asym_current_only",
+        ".skipped",
+        "d_axis_dynamics and cross_coupling_dynamics added",
+    ),
     // The faulty phase is named by the one method of the workspace (the core's negative
     // sequence method) instead of a phase-RMS rule; the summaries' sizes follow it.
     (

@@ -19,6 +19,14 @@
 //! | `phase_asymmetry` | c_re, c_im [-] | i_neg = (c_re + j c_im) conj(i_pos) |
 //! | `flux_dynamics` | tau_r_s [s] | psi_r/Lm = phi, dphi/dt = (i_f - phi)/tau_r; slip and torque from phi |
 //! | `current_dynamics` | la_h [H] | La dI_qs/dt = V_qs - Ra I_qs - Psi omega_r (eq. 28's derivative term) |
+//! | `d_axis_dynamics` | (none) | I_ds predicted from V_ds by the d-axis stator equation instead of measured |
+//! | `cross_coupling_dynamics` | (none) | q-axis rotor flux and the slip coupling between the axes (psi_qr != 0 in transients) |
+//!
+//! With `d_axis_dynamics` or `cross_coupling_dynamics` in the model, the model is the
+//! full-order machine of `simplified_model::simulate` (inverse-Gamma form, states I_ds,
+//! I_qs, psi_R d and q, w_m); each dynamics effect left out replaces its part by the
+//! paper's simplification; with all four in it is the full-order T-equivalent machine
+//! driven by the measured voltages.
 
 use super::prep::{Prepared, C64};
 use super::simplified_model::{EffectTerms, MachineConstants};
@@ -317,6 +325,10 @@ pub struct PhaseAsymmetry;
 pub struct FluxDynamics;
 /// Stator current transient (La dI/dt).
 pub struct CurrentDynamics;
+/// The d-axis stator equation (I_ds predicted).
+pub struct DAxisDynamics;
+/// q-axis rotor flux and cross-coupling.
+pub struct CrossCouplingDynamics;
 
 impl EffectModel for ThermalDrift {
     fn kind(&self) -> EffectKind {
@@ -1188,6 +1200,74 @@ impl EffectModel for CurrentDynamics {
     }
 }
 
+impl EffectModel for DAxisDynamics {
+    fn kind(&self) -> EffectKind {
+        EffectKind::DAxisDynamics
+    }
+    fn description(&self) -> &'static str {
+        "The flux-producing current is not a constant input: after a start or a supply step, I_ds follows the d-axis voltage through the transient inductance and the rotor flux, which the paper's model (i_f taken from the measurement) does not predict."
+    }
+    fn equations(&self) -> &'static str {
+        "L_sigma dI_ds/dt = V_ds - (Rs + Rr') I_ds + omega_k L_sigma I_qs + (Rr'/L_M) psi_Rd + omega_r psi_Rq (inverse-Gamma form, frame speed omega_k); the predicted I_ds replaces the measured one in the phase currents and drives the flux."
+    }
+    fn parameters(&self) -> &'static [ParamSpec] {
+        &[]
+    }
+    fn setup(&self, _d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, String> {
+        Ok(FitSetup::default())
+    }
+    fn apply(
+        &self,
+        _s: &FitSetup,
+        _p: &[f64],
+        _d: &Prepared,
+        _n: &MachineConstants,
+        terms: &mut EffectTerms,
+    ) {
+        terms.d_axis = true;
+    }
+    fn describe(&self, _s: &FitSetup, _p: &[f64], _d: &Prepared, n: &MachineConstants) -> String {
+        format!(
+            "the flux-producing current I_ds follows the d-axis voltage with the stator transient time constant (about {:.1} ms) instead of being a measured constant",
+            1000.0 * n.la_h / n.ra_ohm
+        )
+    }
+}
+
+impl EffectModel for CrossCouplingDynamics {
+    fn kind(&self) -> EffectKind {
+        EffectKind::CrossCouplingDynamics
+    }
+    fn description(&self) -> &'static str {
+        "In a transient the rotor flux is not on the frame's d axis: a q-axis rotor flux appears and the slip couples the axes (the paper's orientation assumes psi_qr = 0 at every instant)."
+    }
+    fn equations(&self) -> &'static str {
+        "dpsi_Rq/dt = Rr' I_qs - (Rr'/L_M) psi_Rq - (omega_k - omega_r) psi_Rd, dpsi_Rd/dt gains + (omega_k - omega_r) psi_Rq; both current equations gain the omega_k L_sigma cross terms; torque (3/2) Np (psi_Rd I_qs - psi_Rq I_ds)."
+    }
+    fn parameters(&self) -> &'static [ParamSpec] {
+        &[]
+    }
+    fn setup(&self, _d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, String> {
+        Ok(FitSetup::default())
+    }
+    fn apply(
+        &self,
+        _s: &FitSetup,
+        _p: &[f64],
+        _d: &Prepared,
+        _n: &MachineConstants,
+        terms: &mut EffectTerms,
+    ) {
+        terms.cross_coupling = true;
+    }
+    fn describe(&self, _s: &FitSetup, _p: &[f64], _d: &Prepared, n: &MachineConstants) -> String {
+        format!(
+            "the rotor flux leaves the frame's d axis in transients and the axes are coupled through the slip (rotor time constant {:.0} ms)",
+            1000.0 * n.lr_h / n.rr_ohm
+        )
+    }
+}
+
 /// The model of an effect of the library.
 pub fn model_of(kind: EffectKind) -> Box<dyn EffectModel> {
     match kind {
@@ -1201,6 +1281,8 @@ pub fn model_of(kind: EffectKind) -> Box<dyn EffectModel> {
         EffectKind::PhaseAsymmetry => Box::new(PhaseAsymmetry),
         EffectKind::FluxDynamics => Box::new(FluxDynamics),
         EffectKind::CurrentDynamics => Box::new(CurrentDynamics),
+        EffectKind::DAxisDynamics => Box::new(DAxisDynamics),
+        EffectKind::CrossCouplingDynamics => Box::new(CrossCouplingDynamics),
     }
 }
 

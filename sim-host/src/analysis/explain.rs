@@ -331,7 +331,9 @@ impl Analysis {
     fn unresolvable(&self, kind: EffectKind, dt_s: f64) -> Option<String> {
         let n = &self.constants;
         let tau = match kind {
-            EffectKind::CurrentDynamics => n.la_h / n.ra_ohm,
+            EffectKind::CurrentDynamics
+            | EffectKind::DAxisDynamics
+            | EffectKind::CrossCouplingDynamics => n.la_h / n.ra_ohm,
             EffectKind::FluxDynamics => n.lr_h / n.rr_ohm,
             _ => return None,
         };

@@ -411,7 +411,10 @@ impl ResolvedEffects {
                 EffectSpec::PhaseAsymmetry { phase, fraction } => {
                     eff.asym = Some((phase.index(), fraction))
                 }
-                EffectSpec::FluxDynamics {} | EffectSpec::CurrentDynamics {} => {}
+                EffectSpec::FluxDynamics {}
+                | EffectSpec::CurrentDynamics {}
+                | EffectSpec::DAxisDynamics {}
+                | EffectSpec::CrossCouplingDynamics {} => {}
             }
         }
         Ok(eff)

@@ -382,6 +382,10 @@ pub enum EffectSpec {
     FluxDynamics {},
     /// Stator current dynamics (La dI/dt): always present in the full-order model; a no-op.
     CurrentDynamics {},
+    /// d-axis stator dynamics: always present in the full-order model; a no-op.
+    DAxisDynamics {},
+    /// Cross-coupling and q-axis rotor flux: always present in the full-order model; a no-op.
+    CrossCouplingDynamics {},
 }
 
 impl EffectSpec {
@@ -398,6 +402,8 @@ impl EffectSpec {
             EffectSpec::PhaseAsymmetry { .. } => EffectKind::PhaseAsymmetry,
             EffectSpec::FluxDynamics {} => EffectKind::FluxDynamics,
             EffectSpec::CurrentDynamics {} => EffectKind::CurrentDynamics,
+            EffectSpec::DAxisDynamics {} => EffectKind::DAxisDynamics,
+            EffectSpec::CrossCouplingDynamics {} => EffectKind::CrossCouplingDynamics,
         }
     }
 
@@ -438,6 +444,8 @@ impl EffectSpec {
             },
             EffectKind::FluxDynamics => EffectSpec::FluxDynamics {},
             EffectKind::CurrentDynamics => EffectSpec::CurrentDynamics {},
+            EffectKind::DAxisDynamics => EffectSpec::DAxisDynamics {},
+            EffectKind::CrossCouplingDynamics => EffectSpec::CrossCouplingDynamics {},
         }
     }
 
@@ -529,7 +537,10 @@ impl EffectSpec {
                 }
             }
             EffectSpec::PhaseAsymmetry { fraction: f, .. } => fraction(&k("fraction"), *f),
-            EffectSpec::FluxDynamics {} | EffectSpec::CurrentDynamics {} => Ok(()),
+            EffectSpec::FluxDynamics {}
+            | EffectSpec::CurrentDynamics {}
+            | EffectSpec::DAxisDynamics {}
+            | EffectSpec::CrossCouplingDynamics {} => Ok(()),
         }
     }
 }
