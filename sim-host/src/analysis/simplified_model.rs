@@ -578,6 +578,67 @@ impl FullMachine {
     }
 }
 
+impl FullMachine {
+    /// The machine at sample `k` with the base parameters `b` and the effects' terms `t`.
+    fn at(n: &MachineConstants, b: &BaseParams, t: &EffectTerms, k: usize) -> FullMachine {
+        let rf = t.r_factor.get(k).copied().unwrap_or(1.0);
+        let mf = t.lm_factor.get(k).copied().unwrap_or(1.0);
+        let lm = n.lm_h * mf;
+        let lr = n.llr_h + lm;
+        let ls = b.ls_scale * (n.lls_h + lm);
+        let l_sigma = t
+            .la_h
+            .unwrap_or(b.ls_scale * (n.lls_h + lm - lm * lm / lr))
+            .clamp(1e-3 * ls, 0.9 * ls);
+        let l_m = ls - l_sigma;
+        let a = match t.tau_r_s {
+            Some(tau) => 1.0 / tau.max(1e-5),
+            None => n.rr_ohm * b.ra_scale * rf / lr,
+        };
+        FullMachine {
+            rs: n.rs_ohm * b.ra_scale * rf,
+            rr: a * l_m,
+            l_sigma,
+            a,
+            l_m,
+        }
+    }
+}
+
+/// The full-order state at the first sample: a log that starts de-energised (a start
+/// from standstill: the first current still small against the start's peak, the speed
+/// near zero) starts from the first sample's current and no flux; otherwise from the
+/// means over the first 10 ms, the flux in its steady state.
+fn full_initial_state(d: &Prepared, n: &MachineConstants, m0: &FullMachine) -> FullState {
+    let len = d.len();
+    let (wm0, iq0) = initial_state(d, n);
+    let head = ((0.01 / d.dt_s).ceil() as usize).clamp(1, len);
+    let id0 = d.id[..head].iter().sum::<f64>() / head as f64;
+    let i_peak = d
+        .i_ab
+        .iter()
+        .take(len.min(head * 20))
+        .fold(0.0f64, |a, x| a.max(x.norm()));
+    let w_sync = d.omega_s.iter().fold(0.0f64, |a, w| a.max(w.abs())) / n.np;
+    let dead = d.i_ab[0].norm() < 0.3 * i_peak && wm0.abs() < 0.05 * w_sync;
+    if dead {
+        FullState {
+            id: d.id[0],
+            iq: d.iq_pos[0],
+            wm: wm0,
+            ..Default::default()
+        }
+    } else {
+        FullState {
+            id: id0,
+            iq: iq0,
+            pd: m0.l_m * id0,
+            pq: 0.0,
+            wm: wm0,
+        }
+    }
+}
+
 /// The full-order form of the model (`d_axis_dynamics` or `cross_coupling_dynamics` in
 /// it), in the analysis frame turning at omega_k = d theta/dt, inverse-Gamma form:
 /// ```text
@@ -619,29 +680,7 @@ fn simulate_full(
     let dt = d.dt_s;
     let j = (n.j_kgm2 * b.j_scale).max(1e-9);
     let btot = b.btot_nms.max(0.0);
-    let machine_at = |k: usize| -> FullMachine {
-        let rf = t.r_factor.get(k).copied().unwrap_or(1.0);
-        let mf = t.lm_factor.get(k).copied().unwrap_or(1.0);
-        let lm = n.lm_h * mf;
-        let lr = n.llr_h + lm;
-        let ls = b.ls_scale * (n.lls_h + lm);
-        let l_sigma = t
-            .la_h
-            .unwrap_or(b.ls_scale * (n.lls_h + lm - lm * lm / lr))
-            .clamp(1e-3 * ls, 0.9 * ls);
-        let l_m = ls - l_sigma;
-        let a = match t.tau_r_s {
-            Some(tau) => 1.0 / tau.max(1e-5),
-            None => n.rr_ohm * b.ra_scale * rf / lr,
-        };
-        FullMachine {
-            rs: n.rs_ohm * b.ra_scale * rf,
-            rr: a * l_m,
-            l_sigma,
-            a,
-            l_m,
-        }
-    };
+    let machine_at = |k: usize| FullMachine::at(n, b, t, k);
     // Frame speed in the equations: the angle's increment over the step, kept within 5 %
     // (+ 20 rad/s) of the smoothed omega_s (the increments jump where the flux estimate
     // starts at a start); after each step the state is turned by what the frame turned
@@ -655,37 +694,7 @@ fn simulate_full(
             ws
         }
     };
-    let (wm0, iq0) = initial_state(d, n);
-    let head = ((0.01 / dt).ceil() as usize).clamp(1, len);
-    let id0 = d.id[..head].iter().sum::<f64>() / head as f64;
-    let m0 = machine_at(0);
-    // A log that starts de-energised (a start from standstill) starts at zero current and
-    // flux; otherwise from the head means, the flux in its steady state.
-    // (De-energised: the first sample's current is still small against the start's peak
-    // and the speed is near zero; the flux has not built up.)
-    let i_peak = d
-        .i_ab
-        .iter()
-        .take(len.min(head * 20))
-        .fold(0.0f64, |a, x| a.max(x.norm()));
-    let w_sync = d.omega_s.iter().fold(0.0f64, |a, w| a.max(w.abs())) / n.np;
-    let dead = d.i_ab[0].norm() < 0.3 * i_peak && wm0.abs() < 0.05 * w_sync;
-    let mut x = if dead {
-        FullState {
-            id: d.id[0],
-            iq: d.iq_pos[0],
-            wm: wm0,
-            ..Default::default()
-        }
-    } else {
-        FullState {
-            id: id0,
-            iq: iq0,
-            pd: m0.l_m * id0,
-            pq: 0.0,
-            wm: wm0,
-        }
-    };
+    let mut x = full_initial_state(d, n, &machine_at(0));
     let extra = |k: usize, w: f64| {
         let coulomb = if t.coulomb_nm != 0.0 {
             t.coulomb_nm * w.tanh()
