@@ -243,6 +243,11 @@ pub trait EffectModel: Send + Sync {
             speed: false,
         }
     }
+    /// Effects that must already be in the model before `explain` proposes this one (a
+    /// rung of the dynamics ladder that is only a consistent machine on top of another).
+    fn requires(&self) -> &'static [EffectKind] {
+        &[]
+    }
     /// Prepares the fit on this data: initial values, bounds, precomputed data.
     ///
     /// # Errors
@@ -1237,6 +1242,11 @@ impl EffectModel for DAxisDynamics {
 impl EffectModel for CrossCouplingDynamics {
     fn kind(&self) -> EffectKind {
         EffectKind::CrossCouplingDynamics
+    }
+    fn requires(&self) -> &'static [EffectKind] {
+        // A dynamic q-axis flux against a measured (not predicted) I_ds is not a consistent
+        // machine; without the d-axis equation the model keeps psi_Rq quasi-static.
+        &[EffectKind::DAxisDynamics]
     }
     fn description(&self) -> &'static str {
         "In a transient the rotor flux is not on the frame's d axis: a q-axis rotor flux appears and the slip couples the axes (the paper's orientation assumes psi_qr = 0 at every instant)."

@@ -318,6 +318,9 @@ impl Analysis {
     /// samples per time constant), a missing channel, or a set-up the data refuse (e.g.
     /// `load_torque` on a log without a load change: said, not dropped).
     fn cannot_rank(&self, c: &dyn EffectModel, base: &Baseline<'_>) -> Option<String> {
+        if let Some(m) = missing_requirement(c, base) {
+            return Some(m);
+        }
         if let Some(m) = self.unresolvable(c.kind(), base.fit_series.dt_s) {
             return Some(m);
         }
@@ -357,7 +360,8 @@ impl Analysis {
         let d = &self.data;
         let fd = &base.fit_series;
         needs_ok(c.needs(), d).ok()?;
-        if self.unresolvable(c.kind(), fd.dt_s).is_some() {
+        if missing_requirement(c, base).is_some() || self.unresolvable(c.kind(), fd.dt_s).is_some()
+        {
             return None;
         }
         // The configured effects start from their baseline fit.
@@ -442,6 +446,18 @@ impl Analysis {
             setups,
         })
     }
+}
+
+/// The effects `c` needs in the model first ([`EffectModel::requires`]) that the
+/// configured model lacks, as the reason it is not proposed yet.
+fn missing_requirement(c: &dyn EffectModel, base: &Baseline<'_>) -> Option<String> {
+    let missing: Vec<&str> = c
+        .requires()
+        .iter()
+        .filter(|k| !base.active.iter().any(|a| a.effect.kind() == **k))
+        .map(|k| k.name())
+        .collect();
+    (!missing.is_empty()).then(|| format!("needs {} in the model first", missing.join(", ")))
 }
 
 /// `explain` on a log without voltages: the model cannot run; only the unbalance analysis.
