@@ -248,6 +248,18 @@ pub trait EffectModel: Send + Sync {
     fn requires(&self) -> &'static [EffectKind] {
         &[]
     }
+    /// The electrical time constant of the dynamics this effect adds to the model on
+    /// machine `n` [s], `None` for an effect that changes the steady state (the default).
+    /// An effect that declares one is a structural refinement of the model's transients:
+    /// `explain` proposes it only on a series that resolves it (at least 3 samples per time
+    /// constant) and only on a log with a transient of the model's inputs (a start or a
+    /// supply step, [`super::transients::input_transients`]); in steady state the paper's
+    /// model is the steady state of the full-order machine, so a dynamics effect that
+    /// lowers the error of a log without one is absorbing another effect (README, "Honest
+    /// ranking").
+    fn time_constant_s(&self, _n: &MachineConstants) -> Option<f64> {
+        None
+    }
     /// Prepares the fit on this data: initial values, bounds, precomputed data.
     ///
     /// # Errors
@@ -1106,6 +1118,9 @@ impl EffectModel for FluxDynamics {
     fn kind(&self) -> EffectKind {
         EffectKind::FluxDynamics
     }
+    fn time_constant_s(&self, n: &MachineConstants) -> Option<f64> {
+        Some(n.lr_h / n.rr_ohm)
+    }
     fn description(&self) -> &'static str {
         "The rotor flux cannot change instantly: it follows the magnetising current with the rotor time constant Lr/Rr, so after a start or a supply step the model's Psi = Ls i_f is wrong for a few hundred ms."
     }
@@ -1153,6 +1168,9 @@ impl EffectModel for FluxDynamics {
 impl EffectModel for CurrentDynamics {
     fn kind(&self) -> EffectKind {
         EffectKind::CurrentDynamics
+    }
+    fn time_constant_s(&self, n: &MachineConstants) -> Option<f64> {
+        Some(n.la_h / n.ra_ohm)
     }
     fn description(&self) -> &'static str {
         "The stator current cannot jump: the transient inductance La = sigma Ls delays I_qs by Ta = La/Ra (a few ms) after every voltage change."
@@ -1209,6 +1227,9 @@ impl EffectModel for DAxisDynamics {
     fn kind(&self) -> EffectKind {
         EffectKind::DAxisDynamics
     }
+    fn time_constant_s(&self, n: &MachineConstants) -> Option<f64> {
+        Some(n.la_h / n.ra_ohm)
+    }
     fn description(&self) -> &'static str {
         "The flux-producing current is not a constant input: after a start or a supply step, I_ds follows the d-axis voltage through the transient inductance and the rotor flux, which the paper's model (i_f taken from the measurement) does not predict."
     }
@@ -1242,6 +1263,9 @@ impl EffectModel for DAxisDynamics {
 impl EffectModel for CrossCouplingDynamics {
     fn kind(&self) -> EffectKind {
         EffectKind::CrossCouplingDynamics
+    }
+    fn time_constant_s(&self, n: &MachineConstants) -> Option<f64> {
+        Some(n.la_h / n.ra_ohm)
     }
     fn requires(&self) -> &'static [EffectKind] {
         // A dynamic q-axis flux against a measured (not predicted) I_ds is not a consistent

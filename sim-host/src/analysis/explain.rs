@@ -6,6 +6,7 @@ use super::fit::{self, ActiveEffect, FitResult};
 use super::metrics::{self, Weights};
 use super::prep::Prepared;
 use super::simplified_model::{BaseParams, Prediction};
+use super::transients;
 use super::unbalance::UnbalanceAnalysis;
 use super::{align, needs_ok, resolve, Analysis, AnalysisError, DataInfo, Options, ParamValue};
 use monitor_core::EffectKind;
@@ -130,6 +131,9 @@ struct Baseline<'a> {
     /// the same as the working series' unless the log was coarsened).
     heldback_error_fit_series: f64,
     noise_fit_series: f64,
+    /// Whether the fit series holds a transient of the model's inputs (a start or a
+    /// supply step, [`transients::input_transients`]).
+    has_input_transient: bool,
 }
 
 /// A ranked candidate with its fit, kept to rebuild the best one's prediction.
@@ -296,6 +300,9 @@ impl Analysis {
                 self.model_noise_floor(&fd, &active, &f0, &b, &wf),
             )
         };
+        let has_input_transient = transients::input_transients(&fd, &self.constants)
+            .iter()
+            .any(|&t| t);
         Ok(Baseline {
             fit_series: fd,
             coarsening: m,
@@ -310,6 +317,7 @@ impl Analysis {
             noise,
             heldback_error_fit_series,
             noise_fit_series,
+            has_input_transient,
         })
     }
 
@@ -321,7 +329,7 @@ impl Analysis {
         if let Some(m) = missing_requirement(c, base) {
             return Some(m);
         }
-        if let Some(m) = self.unresolvable(c.kind(), base.fit_series.dt_s) {
+        if let Some(m) = self.not_dynamic(c, base) {
             return Some(m);
         }
         if let Err(m) = needs_ok(c.needs(), &self.data) {
@@ -330,20 +338,28 @@ impl Analysis {
         c.setup(&base.fit_series, &self.constants).err()
     }
 
-    /// The reason a dynamics effect cannot be fitted on a series sampled every `dt_s`.
-    fn unresolvable(&self, kind: EffectKind, dt_s: f64) -> Option<String> {
-        let n = &self.constants;
-        let tau = match kind {
-            EffectKind::CurrentDynamics
-            | EffectKind::DAxisDynamics
-            | EffectKind::CrossCouplingDynamics => n.la_h / n.ra_ohm,
-            EffectKind::FluxDynamics => n.lr_h / n.rr_ohm,
-            _ => return None,
-        };
-        (dt_s > tau / 3.0).then(|| {
-            format!(
+    /// Why a dynamics effect (one that declares a time constant,
+    /// [`EffectModel::time_constant_s`]) is not proposed on this log: its time constant is
+    /// shorter than 3 samples of the (coarse) fit series of a long log, or the log has no
+    /// transient of the model's inputs for its dynamics to act on. Without a start or a
+    /// supply step the electrical states follow the inputs quasi-statically (a load step
+    /// moves the speed at the mechanical rate), the full-order machine's steady state is
+    /// the paper's model, and what a dynamics effect's extra states gain there they gain by
+    /// absorbing another effect (README, "Honest ranking").
+    fn not_dynamic(&self, c: &dyn EffectModel, base: &Baseline<'_>) -> Option<String> {
+        let tau = c.time_constant_s(&self.constants)?;
+        let dt_s = base.fit_series.dt_s;
+        if dt_s > tau / 3.0 {
+            return Some(format!(
                 "the fit series of this long log ({:.0} Hz) cannot resolve a {:.1} ms time constant; analyse a shorter window with --from/--to",
                 1.0 / dt_s,
+                1000.0 * tau
+            ));
+        }
+        (!base.has_input_transient).then(|| {
+            format!(
+                "no start or supply step in the analysed span (voltage and frequency within {:.0} %): its {:.1} ms dynamics have nothing to act on",
+                100.0 * transients::STEP_MIN,
                 1000.0 * tau
             )
         })
@@ -360,8 +376,7 @@ impl Analysis {
         let d = &self.data;
         let fd = &base.fit_series;
         needs_ok(c.needs(), d).ok()?;
-        if missing_requirement(c, base).is_some() || self.unresolvable(c.kind(), fd.dt_s).is_some()
-        {
+        if missing_requirement(c, base).is_some() || self.not_dynamic(c, base).is_some() {
             return None;
         }
         // The configured effects start from their baseline fit.
