@@ -67,7 +67,7 @@ const INTENDED: [(&str, &str, &str); 9] = [
 
 /// Keys added since the golden outputs were taken (issue 8: the data-quality stage's
 /// report, what commissioning did, the verdict, the range note beside a lamp).
-const ADDED: [&str; 24] = [
+const ADDED: [&str; 25] = [
     "data_quality",
     "commissioning",
     "verdict",
@@ -96,6 +96,8 @@ const ADDED: [&str; 24] = [
     "not_identified",
     "advice",
     "transient",
+    // Issue 10, explain as values: how each candidate's fit ended (`lm::Report`).
+    "fit",
 ];
 
 /// With `GOLDEN_REGENERATE=name1,name2` set, writes today's output as the golden file of

@@ -68,6 +68,9 @@ pub struct EffectCandidate {
     /// Why not (one entry per value out of range; empty when plausible).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub implausible_because: Vec<String>,
+    /// How the candidate's fit ended: `{iterations, cost, termination}` (`converged`,
+    /// `iteration_limit`, `stalled`, `nothing_to_fit`), from [`super::lm`].
+    pub fit: super::lm::Report,
 }
 
 /// Result of `explain` (its JSON document).
@@ -456,6 +459,7 @@ impl Analysis {
                 description: c.description().to_string(),
                 plausible: why.is_empty(),
                 implausible_because: why,
+                fit: f.report,
             },
             fit: f,
             setups,
