@@ -212,6 +212,42 @@ impl FitSetup {
     }
 }
 
+/// An effect another one is easily confused with on some logs, and how close their
+/// penalised held-back errors must be for `explain` to let the log's evidence
+/// ([`EffectModel::evidence`]) decide between them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Confusion {
+    /// The other effect.
+    pub with: EffectKind,
+    /// The other effect's score may be up to this factor above this one's (>= 1).
+    pub within: f64,
+}
+
+/// Facts measured on the log, beside the fit, that can tell confusable effects apart.
+#[derive(Debug, Clone, Copy)]
+pub struct Evidence<'a> {
+    /// Negative-sequence over positive-sequence supply voltage (`None`: no voltages).
+    pub voltage_unbalance: Option<f64>,
+    /// True when the unbalance analysis names a faulty phase (the current unbalance is more
+    /// than the supply's voltage unbalance accounts for).
+    pub winding_suspected: bool,
+    /// Rated torque estimate of the machine [N m].
+    pub torque_scale_nm: f64,
+    /// The effect's own fitted values, in its set-up's order.
+    pub fitted: &'a [f64],
+}
+
+/// A supply negative-sequence voltage above this (0.2 %) is a measured supply unbalance.
+pub const VOLTAGE_UNBALANCE_MIN: f64 = 0.002;
+/// Load torque levels that all agree within this fraction (3 %) of the rated torque are a
+/// constant torque: the step the observer proposed is not there.
+pub const LOAD_STEP_MIN: f64 = 0.03;
+
+/// True when the supply's measured voltage unbalance accounts for the current unbalance.
+fn supply_unbalanced(e: &Evidence<'_>) -> bool {
+    !e.winding_suspected && e.voltage_unbalance.unwrap_or(0.0) > VOLTAGE_UNBALANCE_MIN
+}
+
 /// A number with 3 significant digits, for messages.
 pub fn sig(x: f64) -> String {
     if x == 0.0 || !x.is_finite() {
@@ -258,6 +294,18 @@ pub trait EffectModel: Send + Sync {
     /// lowers the error of a log without one is absorbing another effect (README, "Honest
     /// ranking").
     fn time_constant_s(&self, _n: &MachineConstants) -> Option<f64> {
+        None
+    }
+    /// Effects this one is easily confused with (the same equation on some logs).
+    fn confused_with(&self) -> &'static [Confusion] {
+        &[]
+    }
+    /// What the log's evidence says about this effect against those it is confused with:
+    /// `Some(true)` supports it, `Some(false)` contradicts it, `None` says nothing. When
+    /// two confusable candidates are ranked first and second within their
+    /// [`Confusion::within`], a first one the evidence contradicts goes second unless the
+    /// evidence contradicts the other too.
+    fn evidence(&self, _e: &Evidence<'_>) -> Option<bool> {
         None
     }
     /// Prepares the fit on this data: initial values, bounds, precomputed data.
@@ -634,6 +682,12 @@ impl EffectModel for CoulombFriction {
     fn kind(&self) -> EffectKind {
         EffectKind::CoulombFriction
     }
+    fn confused_with(&self) -> &'static [Confusion] {
+        &[Confusion {
+            with: EffectKind::LoadTorque,
+            within: 1.10,
+        }]
+    }
     fn description(&self) -> &'static str {
         "Dry friction (bearings, seals, brushes): a constant torque opposing rotation whatever the speed."
     }
@@ -850,6 +904,18 @@ impl EffectModel for LoadTorque {
     fn kind(&self) -> EffectKind {
         EffectKind::LoadTorque
     }
+    fn confused_with(&self) -> &'static [Confusion] {
+        // A constant load torque is dry friction's equation at positive speed.
+        &[Confusion {
+            with: EffectKind::CoulombFriction,
+            within: 1.10,
+        }]
+    }
+    fn evidence(&self, e: &Evidence<'_>) -> Option<bool> {
+        let hi = e.fitted.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b));
+        let lo = e.fitted.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+        Some(hi - lo >= LOAD_STEP_MIN * e.torque_scale_nm)
+    }
     fn description(&self) -> &'static str {
         "The load is a torque imposed by the driven machine (possibly switched in steps), not the paper's viscous Bl*omega."
     }
@@ -948,6 +1014,16 @@ impl EffectModel for SupplyUnbalance {
     fn kind(&self) -> EffectKind {
         EffectKind::SupplyUnbalance
     }
+    fn confused_with(&self) -> &'static [Confusion] {
+        // Both add a negative-sequence current; at one operating point they fit alike.
+        &[Confusion {
+            with: EffectKind::PhaseAsymmetry,
+            within: 1.25,
+        }]
+    }
+    fn evidence(&self, e: &Evidence<'_>) -> Option<bool> {
+        Some(supply_unbalanced(e))
+    }
     fn description(&self) -> &'static str {
         "The supply voltages are not balanced: a negative-sequence voltage drives a negative-sequence current through the machine's small negative-sequence impedance (2f ripple in the d-q frame)."
     }
@@ -1044,6 +1120,15 @@ pub fn asymmetry_phase(
 impl EffectModel for PhaseAsymmetry {
     fn kind(&self) -> EffectKind {
         EffectKind::PhaseAsymmetry
+    }
+    fn confused_with(&self) -> &'static [Confusion] {
+        &[Confusion {
+            with: EffectKind::SupplyUnbalance,
+            within: 1.25,
+        }]
+    }
+    fn evidence(&self, e: &Evidence<'_>) -> Option<bool> {
+        Some(!supply_unbalanced(e))
     }
     fn description(&self) -> &'static str {
         "One stator winding differs from the other two (inter-turn short, bad joint): the machine draws a negative-sequence current proportional to its load current even from a balanced supply."
@@ -1376,6 +1461,50 @@ mod tests {
         // Cooling of a log that starts warm is plausible, cooling below ambient is not.
         assert!(s.implausible(&[-30.0, 600.0]).is_empty());
         assert_eq!(s.implausible(&[-80.0, 600.0]).len(), 1);
+    }
+
+    /// The declarations that replace `explain`'s effect-named rules: confusions are
+    /// mutual, and the evidence tells each pair apart.
+    #[test]
+    fn confusable_effects_declare_each_other_and_their_evidence() {
+        for kind in EffectKind::ALL {
+            for c in model_of(kind).confused_with() {
+                assert!(c.within >= 1.0, "{kind}");
+                assert!(
+                    model_of(c.with)
+                        .confused_with()
+                        .iter()
+                        .any(|b| b.with == kind && b.within == c.within),
+                    "{kind} -> {} not mutual",
+                    c.with
+                );
+            }
+        }
+        let ev = |v: Option<f64>, winding: bool, fitted: &'static [f64]| Evidence {
+            voltage_unbalance: v,
+            winding_suspected: winding,
+            torque_scale_nm: 10.0,
+            fitted,
+        };
+        // A 3 % supply unbalance with no winding suspected: the supply.
+        let supply = ev(Some(0.03), false, &[]);
+        assert_eq!(SupplyUnbalance.evidence(&supply), Some(true));
+        assert_eq!(PhaseAsymmetry.evidence(&supply), Some(false));
+        // A balanced supply, or a winding named: the winding.
+        for e in [ev(Some(0.001), false, &[]), ev(Some(0.03), true, &[])] {
+            assert_eq!(SupplyUnbalance.evidence(&e), Some(false));
+            assert_eq!(PhaseAsymmetry.evidence(&e), Some(true));
+        }
+        // Load levels 2 % of rated apart are one constant torque; 30 % apart a step.
+        assert_eq!(
+            LoadTorque.evidence(&ev(None, false, &[4.0, 4.2])),
+            Some(false)
+        );
+        assert_eq!(
+            LoadTorque.evidence(&ev(None, false, &[4.0, 7.0])),
+            Some(true)
+        );
+        assert_eq!(CoulombFriction.evidence(&ev(None, false, &[4.0])), None);
     }
 
     #[test]

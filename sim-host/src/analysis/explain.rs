@@ -1,7 +1,7 @@
 //! `explain`: which physical effect of the library is missing from the model, ranked by the
 //! error it removes on held-back windows.
 
-use super::effects::{self, EffectModel, FitSetup};
+use super::effects::{self, EffectModel, Evidence, FitSetup};
 use super::fit::{self, ActiveEffect, FitResult};
 use super::metrics::{self, Weights};
 use super::prep::Prepared;
@@ -535,8 +535,11 @@ fn explain_current_only(
     }
 }
 
-/// Ranks by held-back error, each extra parameter costing [`PARAM_PENALTY`] of it, then
-/// applies the two rules where one operating point cannot tell two effects apart.
+/// Ranks by held-back error, each extra parameter costing [`PARAM_PENALTY`] of it,
+/// plausible candidates first; then, when the first two are effects that declare each other
+/// confusable ([`EffectModel::confused_with`]) and are within the declared factor, the
+/// log's evidence ([`EffectModel::evidence`]) decides: a first one it contradicts goes
+/// second unless it contradicts the other too. No rule names a particular effect.
 fn rank(ranked: &mut [RankedCandidate], unbalance: &UnbalanceAnalysis, torque_scale_nm: f64) {
     ranked.sort_by(|a, b| {
         b.candidate
@@ -545,50 +548,33 @@ fn rank(ranked: &mut [RankedCandidate], unbalance: &UnbalanceAnalysis, torque_sc
             .then(a.score().total_cmp(&b.score()))
             .then(a.candidate.n_parameters.cmp(&b.candidate.n_parameters))
     });
-    // The tie-break rules below only ever reorder two plausible candidates.
+    // Only ever reorders two plausible candidates.
     if ranked.len() < 2 || !ranked[1].candidate.plausible {
         return;
     }
-    // supply_unbalance and phase_asymmetry both add a negative-sequence current; on a log
-    // at one operating point they fit equally well. When their held-back errors are within
-    // 25 %, the measured voltage unbalance decides (the unbalance analysis: does the
-    // supply's negative-sequence voltage account for the current unbalance?).
-    let pair = [ranked[0].candidate.effect, ranked[1].candidate.effect];
-    let is_pair =
-        pair.contains(&EffectKind::SupplyUnbalance) && pair.contains(&EffectKind::PhaseAsymmetry);
-    let close = ranked[1].score() <= 1.25 * ranked[0].score();
-    let supply = unbalance.suspect_phase.is_none()
-        && unbalance.voltage_negative_sequence_ratio.unwrap_or(0.0) > 0.002;
-    let want_first = if supply {
-        EffectKind::SupplyUnbalance
-    } else {
-        EffectKind::PhaseAsymmetry
+    let (first, second) = (&ranked[0], &ranked[1]);
+    let model = effects::model_of(first.candidate.effect);
+    let Some(conf) = model
+        .confused_with()
+        .iter()
+        .find(|c| c.with == second.candidate.effect)
+    else {
+        return;
     };
-    if is_pair && close && ranked[0].candidate.effect != want_first {
-        ranked.swap(0, 1);
+    if second.score() > conf.within * first.score() {
+        return;
     }
-    // load_torque whose fitted levels are all alike (within 3 % of the rated torque: the
-    // step the observer proposed is not there) is a constant torque, the same equation as
-    // coulomb_friction at positive speed; when the two are within 10 %, the simpler name,
-    // coulomb_friction, goes first (DESIGN-level note in the README).
-    let pos = |kind: EffectKind| ranked.iter().position(|c| c.candidate.effect == kind);
-    if let (Some(lt), Some(cf)) = (
-        pos(EffectKind::LoadTorque),
-        pos(EffectKind::CoulombFriction),
-    ) {
-        let levels: Vec<f64> = ranked[lt]
-            .candidate
-            .parameters
-            .values()
-            .map(|p| p.value)
-            .collect();
-        let spread = levels.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b))
-            - levels.iter().fold(f64::INFINITY, |a, &b| a.min(b));
-        let constant = spread < 0.03 * torque_scale_nm;
-        let close = ranked[cf].score() <= 1.10 * ranked[lt].score();
-        if lt == 0 && cf == 1 && constant && close {
-            ranked.swap(0, 1);
-        }
+    let says = |r: &RankedCandidate| {
+        let fitted = r.fit.effect_params.last().map(Vec::as_slice).unwrap_or(&[]);
+        effects::model_of(r.candidate.effect).evidence(&Evidence {
+            voltage_unbalance: unbalance.voltage_negative_sequence_ratio,
+            winding_suspected: unbalance.suspect_phase.is_some(),
+            torque_scale_nm,
+            fitted,
+        })
+    };
+    if says(first) == Some(false) && says(second) != Some(false) {
+        ranked.swap(0, 1);
     }
 }
 
