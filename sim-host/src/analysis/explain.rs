@@ -2,7 +2,7 @@
 //! error it removes on held-back windows.
 
 use super::effects::{self, EffectModel, Evidence, FitSetup};
-use super::fit::{self, ActiveEffect, FitResult};
+use super::fit::{self, ActiveEffect, FitResult, FittedModel};
 use super::metrics::{self, Weights};
 use super::prep::Prepared;
 use super::simplified_model::{BaseParams, Prediction};
@@ -232,18 +232,18 @@ impl Analysis {
                 let kinds: Vec<EffectKind> =
                     names.iter().copied().chain([r.candidate.effect]).collect();
                 let boxes = resolve(&kinds);
-                let active: Vec<ActiveEffect<'_>> = boxes
-                    .iter()
-                    .zip(&r.setups)
-                    .map(|(e, s)| ActiveEffect {
-                        effect: e.as_ref(),
-                        setup: s.clone(),
-                    })
-                    .collect();
-                (
-                    r.candidate.effect,
-                    fit::predict(d, &self.constants, &active, &r.fit),
-                )
+                let model = FittedModel {
+                    effects: boxes
+                        .iter()
+                        .zip(&r.setups)
+                        .map(|(e, s)| ActiveEffect {
+                            effect: e.as_ref(),
+                            setup: s.clone(),
+                        })
+                        .collect(),
+                    fit: r.fit.clone(),
+                };
+                (r.candidate.effect, model.predict(d, &self.constants))
             })
         };
         Ok(withhold_if_untrusted(ExplainOutput {

@@ -227,6 +227,55 @@ pub fn predict(
     simulate(d, n, &f.base, &terms(d, n, effects, f))
 }
 
+/// A fitted model as a value: the effects set up on a series, the fitted base and effect
+/// values, and how the solve ended. [`FittedModel::predict`] runs it on a series (the one
+/// its set-ups were made on); `Display` says what it is in one line.
+pub struct FittedModel<'a> {
+    /// The effects in the model with their set-ups.
+    pub effects: Vec<ActiveEffect<'a>>,
+    /// The fitted values and the solver's report.
+    pub fit: FitResult,
+}
+
+impl FittedModel<'_> {
+    /// The model's prediction on `d` (the series its effects were set up on).
+    pub fn predict(&self, d: &Prepared, n: &MachineConstants) -> Prediction {
+        predict(d, n, &self.effects, &self.fit)
+    }
+}
+
+impl std::fmt::Display for FittedModel<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        use super::effects::sig;
+        let b = &self.fit.base;
+        f.write_str("paper's model")?;
+        for e in &self.effects {
+            write!(f, " + {}", e.effect.kind())?;
+        }
+        write!(
+            f,
+            "; Ra x{}, Ls x{}, B+Bl {} N m s/rad, J x{}",
+            sig(b.ra_scale),
+            sig(b.ls_scale),
+            sig(b.btot_nms),
+            sig(b.j_scale)
+        )?;
+        for (e, p) in self.effects.iter().zip(&self.fit.effect_params) {
+            for ((name, unit), v) in e.setup.names.iter().zip(&e.setup.units).zip(p) {
+                write!(f, "; {name} = {} {unit}", sig(*v))?;
+            }
+        }
+        let r = &self.fit.report;
+        write!(
+            f,
+            "; fit {} after {} iterations, cost {}",
+            r.termination,
+            r.iterations,
+            sig(r.cost)
+        )
+    }
+}
+
 /// How well a log identifies one base parameter (`compare`'s `identifiability`).
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct ParameterSensitivity {
@@ -382,4 +431,51 @@ pub fn jacobian(
         condition_number,
         base,
     })
+}
+
+#[cfg(test)]
+mod fitted_model_tests {
+    use super::*;
+    use crate::analysis::effects::model_of;
+    use monitor_core::EffectKind;
+
+    #[test]
+    fn a_fitted_model_says_what_it_is() {
+        let n = MachineConstants::from_params(&crate::params::ParamFile::reference_2p2kw());
+        let d = Prepared::default();
+        let cd = model_of(EffectKind::CurrentDynamics);
+        let setup = cd.setup(&d, &n).unwrap();
+        let m = FittedModel {
+            effects: vec![ActiveEffect {
+                effect: cd.as_ref(),
+                setup,
+            }],
+            fit: FitResult {
+                base: BaseParams {
+                    ra_scale: 1.05,
+                    ls_scale: 0.98,
+                    btot_nms: 0.01,
+                    j_scale: 1.2,
+                },
+                effect_params: vec![vec![0.0321]],
+                report: lm::Report {
+                    iterations: 7,
+                    cost: 1.5e-5,
+                    termination: lm::Termination::Converged,
+                },
+            },
+        };
+        let s = m.to_string();
+        assert!(
+            s.starts_with("paper's model + current_dynamics; Ra x1.05"),
+            "{s}"
+        );
+        assert!(s.contains("la_h = 0.0321 H"), "{s}");
+        assert!(
+            s.ends_with("fit converged after 7 iterations, cost 1.50e-5"),
+            "{s}"
+        );
+        // An empty series predicts nothing (and does not panic).
+        assert!(m.predict(&d, &n).iq.is_empty());
+    }
 }
