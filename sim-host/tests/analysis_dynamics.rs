@@ -113,3 +113,87 @@ fn full_order_machine_follows_starts_and_steps() {
     }
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+/// One case of issue 10's "hidden effects under transients": the start + V/f step + dip
+/// log of [`transients`] at 5 kHz with `kind` injected (the simulator's defaults),
+/// analysed over the whole log with the four dynamics effects in the model. Returns what
+/// `explain` ranks first, its explained fraction, `unexplained`, and `compare`'s error
+/// without and with the effect and the noise floor.
+fn hidden_case(
+    dir: &std::path::Path,
+    which: &str,
+    kind: monitor_core::EffectKind,
+) -> (String, f64, bool, f64, f64, f64) {
+    let truth = params(which);
+    let nominal = perturbed(&truth, 0.05);
+    let mut s = transients(which, 5000.0);
+    s.effects = vec![sim_host::sim::EffectSpec::with_defaults(kind)];
+    let log = write_log(dir, &format!("{which}_{}", kind.name()), &truth, &s, false);
+    let a = analyse(&log, &nominal, 0.0);
+    let ex = a.explain(&opts(&FULL), &|_| {}).unwrap().report;
+    let mut with: Vec<&str> = FULL.to_vec();
+    with.push(kind.name());
+    let before = a.compare(&opts(&FULL)).unwrap().report;
+    let after = a.compare(&opts(&with)).unwrap().report;
+    let top = ex.ranking.first();
+    let r = (
+        top.map(|c| c.effect.name()).unwrap_or("-").to_string(),
+        top.map(|c| c.explained_fraction).unwrap_or(0.0),
+        ex.unexplained,
+        before.normalized_rms_error,
+        after.normalized_rms_error,
+        after.noise_floor,
+    );
+    eprintln!(
+        "{which} {:<17} top {:<17} ({:.0} %, unexplained {}) error {:.4} -> {:.4} ({:.1}x, noise floor {:.4})",
+        kind.name(),
+        r.0,
+        100.0 * r.1,
+        r.2,
+        r.3,
+        r.4,
+        r.3 / r.4,
+        r.5
+    );
+    r
+}
+
+/// The hidden effects that are found through a start and steps (README, "Hidden effects
+/// under transients"): ranked first, claimed, and the error cut at least 5x or to within
+/// 2x the noise floor. The others (thermal drift, saturation, iron loss, friction,
+/// windage, phase asymmetry) are not yet: see the probe below.
+#[test]
+fn hidden_effects_under_transients_found() {
+    use monitor_core::EffectKind;
+    let dir = tempfile::tempdir().unwrap();
+    let mut failures = Vec::new();
+    for (which, kind) in [
+        ("2p2", EffectKind::LoadTorque),
+        ("2p2", EffectKind::SupplyUnbalance),
+        ("3hp", EffectKind::LoadTorque),
+        ("3hp", EffectKind::SupplyUnbalance),
+    ] {
+        let (top, _, unexplained, before, after, floor) = hidden_case(dir.path(), which, kind);
+        if top != kind.name() || unexplained || !(before >= 5.0 * after || after <= 2.0 * floor) {
+            failures.push(format!(
+                "{which} {kind}: top {top}, unexplained {unexplained}, {before:.4} -> {after:.4} (floor {floor:.4})"
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// Every non-dynamics effect of the library through a start and steps (a probe, ignored:
+/// `--ignored --nocapture`; `MOTOR` picks the motor, default 2p2; figures in the README).
+#[test]
+#[ignore]
+fn hidden_effects_under_transients_probe() {
+    let which = std::env::var("MOTOR").unwrap_or("2p2".into());
+    let dir = tempfile::tempdir().unwrap();
+    for kind in monitor_core::EffectKind::ALL
+        .into_iter()
+        .filter(|k| !k.is_dynamics())
+    {
+        hidden_case(dir.path(), &which, kind);
+    }
+}
