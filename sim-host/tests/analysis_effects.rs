@@ -23,8 +23,16 @@ const DYNAMICS: [&str; 2] = ["flux_dynamics", "current_dynamics"];
 const NOT_YET: [&str; 1] = ["rotor_asymmetry"];
 
 fn check_all(which: &str, noise: u32) {
+    // d_axis_dynamics and cross_coupling_dynamics are the model's own simplifications with
+    // nothing to inject (the simulator is always full order): `analysis_dynamics.rs`.
     let names: Vec<&str> = EffectKind::ALL
         .iter()
+        .filter(|k| {
+            !matches!(
+                k,
+                EffectKind::DAxisDynamics | EffectKind::CrossCouplingDynamics
+            )
+        })
         .map(|k| k.name())
         .filter(|n| !NOT_YET.contains(n))
         .collect();
@@ -203,4 +211,34 @@ fn motulator_log_points_at_load_torque() {
         .report
         .normalized_rms_error;
     assert!(after < before / 5.0, "{before} -> {after}");
+}
+
+/// The ranking rule for dynamics effects (those that declare a time constant): proposed
+/// only on a log with a transient of the model's inputs. The 3 hp load-step log has none
+/// (a load step is mechanical), so `d_axis_dynamics` is skipped with the reason; the
+/// voltage-step log has two, so it is ranked.
+#[test]
+fn dynamics_effects_need_an_input_transient() {
+    let dir = tempfile::tempdir().unwrap();
+    let truth = motor("3hp");
+    let nominal = perturbed(&truth, 0.05);
+    for (name, base, expect_skipped) in [
+        ("load_torque", &DYNAMICS[..], true),
+        ("flux_dynamics", &["current_dynamics"][..], false),
+    ] {
+        let s = scenario("3hp", Some(name), 1);
+        let log = write_log(dir.path(), name, &truth, &s, false);
+        let a = analyse(&log, &nominal, from_for("3hp", name));
+        let ex = a.explain(&opts(base), &|_| {}).unwrap().report;
+        let skipped = ex
+            .skipped
+            .iter()
+            .any(|m| m.starts_with("d_axis_dynamics: no start or supply step"));
+        let ranked = ex
+            .ranking
+            .iter()
+            .any(|c| c.effect == EffectKind::DAxisDynamics);
+        assert_eq!(skipped, expect_skipped, "{name}: {:?}", ex.skipped);
+        assert_eq!(ranked, !expect_skipped, "{name}: {:?}", ex.ranking);
+    }
 }

@@ -17,7 +17,13 @@
 use std::path::{Path, PathBuf};
 
 /// JSON paths (file, path) that changed on purpose.
-const INTENDED: [(&str, &str, &str); 8] = [
+const INTENDED: [(&str, &str, &str); 9] = [
+    // Issue 10: two more dynamics effects, each skipped on a current-only log.
+    (
+        "exp_asym_current_only",
+        ".skipped",
+        "d_axis_dynamics and cross_coupling_dynamics added",
+    ),
     // The faulty phase is named by the one method of the workspace (the core's negative
     // sequence method) instead of a phase-RMS rule; the summaries' sizes follow it.
     (
@@ -61,7 +67,7 @@ const INTENDED: [(&str, &str, &str); 8] = [
 
 /// Keys added since the golden outputs were taken (issue 8: the data-quality stage's
 /// report, what commissioning did, the verdict, the range note beside a lamp).
-const ADDED: [&str; 30] = [
+const ADDED: [&str; 31] = [
     "data_quality",
     "commissioning",
     "verdict",
@@ -99,6 +105,8 @@ const ADDED: [&str; 30] = [
     "transient",
     // Issue 10: explain's motor current signature analysis (rotor_asymmetry).
     "rotor_asymmetry",
+    // Issue 10, explain as values: how each candidate's fit ended (`lm::Report`).
+    "fit",
 ];
 
 /// The library effect added since (issue 10, `rotor_asymmetry`): its ranking entries and

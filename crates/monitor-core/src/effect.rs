@@ -34,11 +34,20 @@ pub enum EffectKind {
     /// `rotor_asymmetry`: an unequal rotor cage (broken rotor bars): (1 +/- 2s) f sidebands
     /// in the stator current, 2 s f ripple in torque and speed.
     RotorAsymmetry,
+    /// `d_axis_dynamics`: the d-axis stator voltage equation (eqs. 13-17 before the
+    /// paper takes i_ds as a constant i_f): I_ds is predicted from V_ds, with its
+    /// derivative and its coupling to I_qs and the rotor flux, instead of being measured.
+    DAxisDynamics,
+    /// `cross_coupling_dynamics`: the q-axis rotor flux and the slip coupling between the
+    /// axes (the paper sets psi_qr = 0 by orientation, eq. 18): in a transient the flux
+    /// leaves the frame's d axis. With every dynamics effect in, the model is the
+    /// full-order T-equivalent machine driven by the measured voltages.
+    CrossCouplingDynamics,
 }
 
 impl EffectKind {
     /// Every effect, in DESIGN.md's order.
-    pub const ALL: [EffectKind; 11] = [
+    pub const ALL: [EffectKind; 13] = [
         EffectKind::ThermalDrift,
         EffectKind::Saturation,
         EffectKind::IronLoss,
@@ -50,6 +59,8 @@ impl EffectKind {
         EffectKind::FluxDynamics,
         EffectKind::CurrentDynamics,
         EffectKind::RotorAsymmetry,
+        EffectKind::DAxisDynamics,
+        EffectKind::CrossCouplingDynamics,
     ];
 
     /// The DESIGN.md name (`thermal_drift`, ..., `current_dynamics`).
@@ -66,6 +77,8 @@ impl EffectKind {
             EffectKind::FluxDynamics => "flux_dynamics",
             EffectKind::CurrentDynamics => "current_dynamics",
             EffectKind::RotorAsymmetry => "rotor_asymmetry",
+            EffectKind::DAxisDynamics => "d_axis_dynamics",
+            EffectKind::CrossCouplingDynamics => "cross_coupling_dynamics",
         }
     }
 
@@ -77,7 +90,13 @@ impl EffectKind {
     /// True for the model's own simplifications (the dynamics the paper's steady-state
     /// model drops), as opposed to physical effects of a particular machine or supply.
     pub fn is_dynamics(self) -> bool {
-        matches!(self, EffectKind::FluxDynamics | EffectKind::CurrentDynamics)
+        matches!(
+            self,
+            EffectKind::FluxDynamics
+                | EffectKind::CurrentDynamics
+                | EffectKind::DAxisDynamics
+                | EffectKind::CrossCouplingDynamics
+        )
     }
 }
 
@@ -93,7 +112,7 @@ mod tests {
 
     #[test]
     fn names_are_design_names_and_round_trip() {
-        let names: [&str; 11] = [
+        let names: [&str; 13] = [
             "thermal_drift",
             "saturation",
             "iron_loss",
@@ -105,6 +124,8 @@ mod tests {
             "flux_dynamics",
             "current_dynamics",
             "rotor_asymmetry",
+            "d_axis_dynamics",
+            "cross_coupling_dynamics",
         ];
         for (e, n) in EffectKind::ALL.iter().zip(names) {
             assert_eq!(e.name(), n);

@@ -20,6 +20,14 @@
 //! | `flux_dynamics` | tau_r_s [s] | psi_r/Lm = phi, dphi/dt = (i_f - phi)/tau_r; slip and torque from phi |
 //! | `current_dynamics` | la_h [H] | La dI_qs/dt = V_qs - Ra I_qs - Psi omega_r (eq. 28's derivative term) |
 //! | `rotor_asymmetry` | delta [-], phi_rad [rad] | Rr in Ra x (1 + (delta/3)(1 - cos(2 (Np theta_m - theta) + phi))) (see `super::rotor_asymmetry`) |
+//! | `d_axis_dynamics` | (none) | I_ds predicted from V_ds by the d-axis stator equation instead of measured |
+//! | `cross_coupling_dynamics` | (none) | q-axis rotor flux and the slip coupling between the axes (psi_qr != 0 in transients) |
+//!
+//! With `d_axis_dynamics` or `cross_coupling_dynamics` in the model, the model is the
+//! full-order machine of `simplified_model::simulate` (inverse-Gamma form, states I_ds,
+//! I_qs, psi_R d and q, w_m); each dynamics effect left out replaces its part by the
+//! paper's simplification; with all four in it is the full-order T-equivalent machine
+//! driven by the measured voltages.
 
 use super::prep::{Prepared, C64};
 use super::simplified_model::{EffectTerms, MachineConstants};
@@ -205,6 +213,42 @@ impl FitSetup {
     }
 }
 
+/// An effect another one is easily confused with on some logs, and how close their
+/// penalised held-back errors must be for `explain` to let the log's evidence
+/// ([`EffectModel::evidence`]) decide between them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Confusion {
+    /// The other effect.
+    pub with: EffectKind,
+    /// The other effect's score may be up to this factor above this one's (>= 1).
+    pub within: f64,
+}
+
+/// Facts measured on the log, beside the fit, that can tell confusable effects apart.
+#[derive(Debug, Clone, Copy)]
+pub struct Evidence<'a> {
+    /// Negative-sequence over positive-sequence supply voltage (`None`: no voltages).
+    pub voltage_unbalance: Option<f64>,
+    /// True when the unbalance analysis names a faulty phase (the current unbalance is more
+    /// than the supply's voltage unbalance accounts for).
+    pub winding_suspected: bool,
+    /// Rated torque estimate of the machine [N m].
+    pub torque_scale_nm: f64,
+    /// The effect's own fitted values, in its set-up's order.
+    pub fitted: &'a [f64],
+}
+
+/// A supply negative-sequence voltage above this (0.2 %) is a measured supply unbalance.
+pub const VOLTAGE_UNBALANCE_MIN: f64 = 0.002;
+/// Load torque levels that all agree within this fraction (3 %) of the rated torque are a
+/// constant torque: the step the observer proposed is not there.
+pub const LOAD_STEP_MIN: f64 = 0.03;
+
+/// True when the supply's measured voltage unbalance accounts for the current unbalance.
+fn supply_unbalanced(e: &Evidence<'_>) -> bool {
+    !e.winding_suspected && e.voltage_unbalance.unwrap_or(0.0) > VOLTAGE_UNBALANCE_MIN
+}
+
 /// A number with 3 significant digits, for messages.
 pub fn sig(x: f64) -> String {
     if x == 0.0 || !x.is_finite() {
@@ -235,6 +279,35 @@ pub trait EffectModel: Send + Sync {
             voltages: true,
             speed: false,
         }
+    }
+    /// Effects that must already be in the model before `explain` proposes this one (a
+    /// rung of the dynamics ladder that is only a consistent machine on top of another).
+    fn requires(&self) -> &'static [EffectKind] {
+        &[]
+    }
+    /// The electrical time constant of the dynamics this effect adds to the model on
+    /// machine `n` [s], `None` for an effect that changes the steady state (the default).
+    /// An effect that declares one is a structural refinement of the model's transients:
+    /// `explain` proposes it only on a series that resolves it (at least 3 samples per time
+    /// constant) and only on a log with a transient of the model's inputs (a start or a
+    /// supply step, [`super::transients::input_transients`]); in steady state the paper's
+    /// model is the steady state of the full-order machine, so a dynamics effect that
+    /// lowers the error of a log without one is absorbing another effect (README, "Honest
+    /// ranking").
+    fn time_constant_s(&self, _n: &MachineConstants) -> Option<f64> {
+        None
+    }
+    /// Effects this one is easily confused with (the same equation on some logs).
+    fn confused_with(&self) -> &'static [Confusion] {
+        &[]
+    }
+    /// What the log's evidence says about this effect against those it is confused with:
+    /// `Some(true)` supports it, `Some(false)` contradicts it, `None` says nothing. When
+    /// two confusable candidates are ranked first and second within their
+    /// [`Confusion::within`], a first one the evidence contradicts goes second unless the
+    /// evidence contradicts the other too.
+    fn evidence(&self, _e: &Evidence<'_>) -> Option<bool> {
+        None
     }
     /// Prepares the fit on this data: initial values, bounds, precomputed data.
     ///
@@ -318,6 +391,10 @@ pub struct PhaseAsymmetry;
 pub struct FluxDynamics;
 /// Stator current transient (La dI/dt).
 pub struct CurrentDynamics;
+/// The d-axis stator equation (I_ds predicted).
+pub struct DAxisDynamics;
+/// q-axis rotor flux and cross-coupling.
+pub struct CrossCouplingDynamics;
 
 impl EffectModel for ThermalDrift {
     fn kind(&self) -> EffectKind {
@@ -606,6 +683,12 @@ impl EffectModel for CoulombFriction {
     fn kind(&self) -> EffectKind {
         EffectKind::CoulombFriction
     }
+    fn confused_with(&self) -> &'static [Confusion] {
+        &[Confusion {
+            with: EffectKind::LoadTorque,
+            within: 1.10,
+        }]
+    }
     fn description(&self) -> &'static str {
         "Dry friction (bearings, seals, brushes): a constant torque opposing rotation whatever the speed."
     }
@@ -822,6 +905,18 @@ impl EffectModel for LoadTorque {
     fn kind(&self) -> EffectKind {
         EffectKind::LoadTorque
     }
+    fn confused_with(&self) -> &'static [Confusion] {
+        // A constant load torque is dry friction's equation at positive speed.
+        &[Confusion {
+            with: EffectKind::CoulombFriction,
+            within: 1.10,
+        }]
+    }
+    fn evidence(&self, e: &Evidence<'_>) -> Option<bool> {
+        let hi = e.fitted.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b));
+        let lo = e.fitted.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+        Some(hi - lo >= LOAD_STEP_MIN * e.torque_scale_nm)
+    }
     fn description(&self) -> &'static str {
         "The load is a torque imposed by the driven machine (possibly switched in steps), not the paper's viscous Bl*omega."
     }
@@ -920,6 +1015,16 @@ impl EffectModel for SupplyUnbalance {
     fn kind(&self) -> EffectKind {
         EffectKind::SupplyUnbalance
     }
+    fn confused_with(&self) -> &'static [Confusion] {
+        // Both add a negative-sequence current; at one operating point they fit alike.
+        &[Confusion {
+            with: EffectKind::PhaseAsymmetry,
+            within: 1.25,
+        }]
+    }
+    fn evidence(&self, e: &Evidence<'_>) -> Option<bool> {
+        Some(supply_unbalanced(e))
+    }
     fn description(&self) -> &'static str {
         "The supply voltages are not balanced: a negative-sequence voltage drives a negative-sequence current through the machine's small negative-sequence impedance (2f ripple in the d-q frame)."
     }
@@ -1017,6 +1122,15 @@ impl EffectModel for PhaseAsymmetry {
     fn kind(&self) -> EffectKind {
         EffectKind::PhaseAsymmetry
     }
+    fn confused_with(&self) -> &'static [Confusion] {
+        &[Confusion {
+            with: EffectKind::SupplyUnbalance,
+            within: 1.25,
+        }]
+    }
+    fn evidence(&self, e: &Evidence<'_>) -> Option<bool> {
+        Some(!supply_unbalanced(e))
+    }
     fn description(&self) -> &'static str {
         "One stator winding differs from the other two (inter-turn short, bad joint): the machine draws a negative-sequence current proportional to its load current even from a balanced supply."
     }
@@ -1090,6 +1204,9 @@ impl EffectModel for FluxDynamics {
     fn kind(&self) -> EffectKind {
         EffectKind::FluxDynamics
     }
+    fn time_constant_s(&self, n: &MachineConstants) -> Option<f64> {
+        Some(n.lr_h / n.rr_ohm)
+    }
     fn description(&self) -> &'static str {
         "The rotor flux cannot change instantly: it follows the magnetising current with the rotor time constant Lr/Rr, so after a start or a supply step the model's Psi = Ls i_f is wrong for a few hundred ms."
     }
@@ -1137,6 +1254,9 @@ impl EffectModel for FluxDynamics {
 impl EffectModel for CurrentDynamics {
     fn kind(&self) -> EffectKind {
         EffectKind::CurrentDynamics
+    }
+    fn time_constant_s(&self, n: &MachineConstants) -> Option<f64> {
+        Some(n.la_h / n.ra_ohm)
     }
     fn description(&self) -> &'static str {
         "The stator current cannot jump: the transient inductance La = sigma Ls delays I_qs by Ta = La/Ra (a few ms) after every voltage change."
@@ -1189,6 +1309,85 @@ impl EffectModel for CurrentDynamics {
     }
 }
 
+impl EffectModel for DAxisDynamics {
+    fn kind(&self) -> EffectKind {
+        EffectKind::DAxisDynamics
+    }
+    fn time_constant_s(&self, n: &MachineConstants) -> Option<f64> {
+        Some(n.la_h / n.ra_ohm)
+    }
+    fn description(&self) -> &'static str {
+        "The flux-producing current is not a constant input: after a start or a supply step, I_ds follows the d-axis voltage through the transient inductance and the rotor flux, which the paper's model (i_f taken from the measurement) does not predict."
+    }
+    fn equations(&self) -> &'static str {
+        "L_sigma dI_ds/dt = V_ds - (Rs + Rr') I_ds + omega_k L_sigma I_qs + (Rr'/L_M) psi_Rd + omega_r psi_Rq (inverse-Gamma form, frame speed omega_k); the predicted I_ds replaces the measured one in the phase currents and drives the flux."
+    }
+    fn parameters(&self) -> &'static [ParamSpec] {
+        &[]
+    }
+    fn setup(&self, _d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, String> {
+        Ok(FitSetup::default())
+    }
+    fn apply(
+        &self,
+        _s: &FitSetup,
+        _p: &[f64],
+        _d: &Prepared,
+        _n: &MachineConstants,
+        terms: &mut EffectTerms,
+    ) {
+        terms.d_axis = true;
+    }
+    fn describe(&self, _s: &FitSetup, _p: &[f64], _d: &Prepared, n: &MachineConstants) -> String {
+        format!(
+            "the flux-producing current I_ds follows the d-axis voltage with the stator transient time constant (about {:.1} ms) instead of being a measured constant",
+            1000.0 * n.la_h / n.ra_ohm
+        )
+    }
+}
+
+impl EffectModel for CrossCouplingDynamics {
+    fn kind(&self) -> EffectKind {
+        EffectKind::CrossCouplingDynamics
+    }
+    fn time_constant_s(&self, n: &MachineConstants) -> Option<f64> {
+        Some(n.la_h / n.ra_ohm)
+    }
+    fn requires(&self) -> &'static [EffectKind] {
+        // A dynamic q-axis flux against a measured (not predicted) I_ds is not a consistent
+        // machine; without the d-axis equation the model keeps psi_Rq quasi-static.
+        &[EffectKind::DAxisDynamics]
+    }
+    fn description(&self) -> &'static str {
+        "In a transient the rotor flux is not on the frame's d axis: a q-axis rotor flux appears and the slip couples the axes (the paper's orientation assumes psi_qr = 0 at every instant)."
+    }
+    fn equations(&self) -> &'static str {
+        "dpsi_Rq/dt = Rr' I_qs - (Rr'/L_M) psi_Rq - (omega_k - omega_r) psi_Rd, dpsi_Rd/dt gains + (omega_k - omega_r) psi_Rq; both current equations gain the omega_k L_sigma cross terms; torque (3/2) Np (psi_Rd I_qs - psi_Rq I_ds)."
+    }
+    fn parameters(&self) -> &'static [ParamSpec] {
+        &[]
+    }
+    fn setup(&self, _d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, String> {
+        Ok(FitSetup::default())
+    }
+    fn apply(
+        &self,
+        _s: &FitSetup,
+        _p: &[f64],
+        _d: &Prepared,
+        _n: &MachineConstants,
+        terms: &mut EffectTerms,
+    ) {
+        terms.cross_coupling = true;
+    }
+    fn describe(&self, _s: &FitSetup, _p: &[f64], _d: &Prepared, n: &MachineConstants) -> String {
+        format!(
+            "the rotor flux leaves the frame's d axis in transients and the axes are coupled through the slip (rotor time constant {:.0} ms)",
+            1000.0 * n.lr_h / n.rr_ohm
+        )
+    }
+}
+
 /// The model of an effect of the library.
 pub fn model_of(kind: EffectKind) -> Box<dyn EffectModel> {
     match kind {
@@ -1203,6 +1402,8 @@ pub fn model_of(kind: EffectKind) -> Box<dyn EffectModel> {
         EffectKind::FluxDynamics => Box::new(FluxDynamics),
         EffectKind::CurrentDynamics => Box::new(CurrentDynamics),
         EffectKind::RotorAsymmetry => Box::new(super::rotor_asymmetry::RotorAsymmetry),
+        EffectKind::DAxisDynamics => Box::new(DAxisDynamics),
+        EffectKind::CrossCouplingDynamics => Box::new(CrossCouplingDynamics),
     }
 }
 
@@ -1262,6 +1463,50 @@ mod tests {
         // Cooling of a log that starts warm is plausible, cooling below ambient is not.
         assert!(s.implausible(&[-30.0, 600.0]).is_empty());
         assert_eq!(s.implausible(&[-80.0, 600.0]).len(), 1);
+    }
+
+    /// The declarations that replace `explain`'s effect-named rules: confusions are
+    /// mutual, and the evidence tells each pair apart.
+    #[test]
+    fn confusable_effects_declare_each_other_and_their_evidence() {
+        for kind in EffectKind::ALL {
+            for c in model_of(kind).confused_with() {
+                assert!(c.within >= 1.0, "{kind}");
+                assert!(
+                    model_of(c.with)
+                        .confused_with()
+                        .iter()
+                        .any(|b| b.with == kind && b.within == c.within),
+                    "{kind} -> {} not mutual",
+                    c.with
+                );
+            }
+        }
+        let ev = |v: Option<f64>, winding: bool, fitted: &'static [f64]| Evidence {
+            voltage_unbalance: v,
+            winding_suspected: winding,
+            torque_scale_nm: 10.0,
+            fitted,
+        };
+        // A 3 % supply unbalance with no winding suspected: the supply.
+        let supply = ev(Some(0.03), false, &[]);
+        assert_eq!(SupplyUnbalance.evidence(&supply), Some(true));
+        assert_eq!(PhaseAsymmetry.evidence(&supply), Some(false));
+        // A balanced supply, or a winding named: the winding.
+        for e in [ev(Some(0.001), false, &[]), ev(Some(0.03), true, &[])] {
+            assert_eq!(SupplyUnbalance.evidence(&e), Some(false));
+            assert_eq!(PhaseAsymmetry.evidence(&e), Some(true));
+        }
+        // Load levels 2 % of rated apart are one constant torque; 30 % apart a step.
+        assert_eq!(
+            LoadTorque.evidence(&ev(None, false, &[4.0, 4.2])),
+            Some(false)
+        );
+        assert_eq!(
+            LoadTorque.evidence(&ev(None, false, &[4.0, 7.0])),
+            Some(true)
+        );
+        assert_eq!(CoulombFriction.evidence(&ev(None, false, &[4.0])), None);
     }
 
     #[test]

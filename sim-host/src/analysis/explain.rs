@@ -1,11 +1,12 @@
 //! `explain`: which physical effect of the library is missing from the model, ranked by the
 //! error it removes on held-back windows.
 
-use super::effects::{self, EffectModel, FitSetup};
-use super::fit::{self, ActiveEffect, FitResult};
+use super::effects::{self, EffectModel, Evidence, FitSetup};
+use super::fit::{self, ActiveEffect, FitResult, FittedModel};
 use super::metrics::{self, Weights};
 use super::prep::Prepared;
 use super::simplified_model::{BaseParams, Prediction};
+use super::transients;
 use super::unbalance::UnbalanceAnalysis;
 use super::{align, needs_ok, resolve, Analysis, AnalysisError, DataInfo, Options, ParamValue};
 use monitor_core::EffectKind;
@@ -67,6 +68,9 @@ pub struct EffectCandidate {
     /// Why not (one entry per value out of range; empty when plausible).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub implausible_because: Vec<String>,
+    /// How the candidate's fit ended: `{iterations, cost, termination}` (`converged`,
+    /// `iteration_limit`, `stalled`, `nothing_to_fit`), from [`super::lm`].
+    pub fit: super::lm::Report,
 }
 
 /// Result of `explain` (its JSON document).
@@ -130,6 +134,9 @@ struct Baseline<'a> {
     /// the same as the working series' unless the log was coarsened).
     heldback_error_fit_series: f64,
     noise_fit_series: f64,
+    /// Whether the fit series holds a transient of the model's inputs (a start or a
+    /// supply step, [`transients::input_transients`]).
+    has_input_transient: bool,
 }
 
 /// A ranked candidate with its fit, kept to rebuild the best one's prediction.
@@ -225,18 +232,18 @@ impl Analysis {
                 let kinds: Vec<EffectKind> =
                     names.iter().copied().chain([r.candidate.effect]).collect();
                 let boxes = resolve(&kinds);
-                let active: Vec<ActiveEffect<'_>> = boxes
-                    .iter()
-                    .zip(&r.setups)
-                    .map(|(e, s)| ActiveEffect {
-                        effect: e.as_ref(),
-                        setup: s.clone(),
-                    })
-                    .collect();
-                (
-                    r.candidate.effect,
-                    fit::predict(d, &self.constants, &active, &r.fit),
-                )
+                let model = FittedModel {
+                    effects: boxes
+                        .iter()
+                        .zip(&r.setups)
+                        .map(|(e, s)| ActiveEffect {
+                            effect: e.as_ref(),
+                            setup: s.clone(),
+                        })
+                        .collect(),
+                    fit: r.fit.clone(),
+                };
+                (r.candidate.effect, model.predict(d, &self.constants))
             })
         };
         Ok(withhold_if_untrusted(ExplainOutput {
@@ -296,6 +303,9 @@ impl Analysis {
                 self.model_noise_floor(&fd, &active, &f0, &b, &wf),
             )
         };
+        let has_input_transient = transients::input_transients(&fd, &self.constants)
+            .iter()
+            .any(|&t| t);
         Ok(Baseline {
             fit_series: fd,
             coarsening: m,
@@ -310,6 +320,7 @@ impl Analysis {
             noise,
             heldback_error_fit_series,
             noise_fit_series,
+            has_input_transient,
         })
     }
 
@@ -318,7 +329,10 @@ impl Analysis {
     /// samples per time constant), a missing channel, or a set-up the data refuse (e.g.
     /// `load_torque` on a log without a load change: said, not dropped).
     fn cannot_rank(&self, c: &dyn EffectModel, base: &Baseline<'_>) -> Option<String> {
-        if let Some(m) = self.unresolvable(c.kind(), base.fit_series.dt_s) {
+        if let Some(m) = missing_requirement(c, base) {
+            return Some(m);
+        }
+        if let Some(m) = self.not_dynamic(c, base) {
             return Some(m);
         }
         if let Err(m) = needs_ok(c.needs(), &self.data) {
@@ -327,18 +341,28 @@ impl Analysis {
         c.setup(&base.fit_series, &self.constants).err()
     }
 
-    /// The reason a dynamics effect cannot be fitted on a series sampled every `dt_s`.
-    fn unresolvable(&self, kind: EffectKind, dt_s: f64) -> Option<String> {
-        let n = &self.constants;
-        let tau = match kind {
-            EffectKind::CurrentDynamics => n.la_h / n.ra_ohm,
-            EffectKind::FluxDynamics => n.lr_h / n.rr_ohm,
-            _ => return None,
-        };
-        (dt_s > tau / 3.0).then(|| {
-            format!(
+    /// Why a dynamics effect (one that declares a time constant,
+    /// [`EffectModel::time_constant_s`]) is not proposed on this log: its time constant is
+    /// shorter than 3 samples of the (coarse) fit series of a long log, or the log has no
+    /// transient of the model's inputs for its dynamics to act on. Without a start or a
+    /// supply step the electrical states follow the inputs quasi-statically (a load step
+    /// moves the speed at the mechanical rate), the full-order machine's steady state is
+    /// the paper's model, and what a dynamics effect's extra states gain there they gain by
+    /// absorbing another effect (README, "Honest ranking").
+    fn not_dynamic(&self, c: &dyn EffectModel, base: &Baseline<'_>) -> Option<String> {
+        let tau = c.time_constant_s(&self.constants)?;
+        let dt_s = base.fit_series.dt_s;
+        if dt_s > tau / 3.0 {
+            return Some(format!(
                 "the fit series of this long log ({:.0} Hz) cannot resolve a {:.1} ms time constant; analyse a shorter window with --from/--to",
                 1.0 / dt_s,
+                1000.0 * tau
+            ));
+        }
+        (!base.has_input_transient).then(|| {
+            format!(
+                "no start or supply step in the analysed span (voltage and frequency within {:.0} %): its {:.1} ms dynamics have nothing to act on",
+                100.0 * transients::STEP_MIN,
                 1000.0 * tau
             )
         })
@@ -355,7 +379,7 @@ impl Analysis {
         let d = &self.data;
         let fd = &base.fit_series;
         needs_ok(c.needs(), d).ok()?;
-        if self.unresolvable(c.kind(), fd.dt_s).is_some() {
+        if missing_requirement(c, base).is_some() || self.not_dynamic(c, base).is_some() {
             return None;
         }
         // The configured effects start from their baseline fit.
@@ -435,11 +459,24 @@ impl Analysis {
                 description: c.description().to_string(),
                 plausible: why.is_empty(),
                 implausible_because: why,
+                fit: f.report,
             },
             fit: f,
             setups,
         })
     }
+}
+
+/// The effects `c` needs in the model first ([`EffectModel::requires`]) that the
+/// configured model lacks, as the reason it is not proposed yet.
+fn missing_requirement(c: &dyn EffectModel, base: &Baseline<'_>) -> Option<String> {
+    let missing: Vec<&str> = c
+        .requires()
+        .iter()
+        .filter(|k| !base.active.iter().any(|a| a.effect.kind() == **k))
+        .map(|k| k.name())
+        .collect();
+    (!missing.is_empty()).then(|| format!("needs {} in the model first", missing.join(", ")))
 }
 
 /// `explain` on a log without voltages: the model cannot run; only the unbalance analysis.
@@ -498,8 +535,11 @@ fn explain_current_only(
     }
 }
 
-/// Ranks by held-back error, each extra parameter costing [`PARAM_PENALTY`] of it, then
-/// applies the two rules where one operating point cannot tell two effects apart.
+/// Ranks by held-back error, each extra parameter costing [`PARAM_PENALTY`] of it,
+/// plausible candidates first; then, when the first two are effects that declare each other
+/// confusable ([`EffectModel::confused_with`]) and are within the declared factor, the
+/// log's evidence ([`EffectModel::evidence`]) decides: a first one it contradicts goes
+/// second unless it contradicts the other too. No rule names a particular effect.
 fn rank(ranked: &mut [RankedCandidate], unbalance: &UnbalanceAnalysis, torque_scale_nm: f64) {
     ranked.sort_by(|a, b| {
         b.candidate
@@ -508,50 +548,33 @@ fn rank(ranked: &mut [RankedCandidate], unbalance: &UnbalanceAnalysis, torque_sc
             .then(a.score().total_cmp(&b.score()))
             .then(a.candidate.n_parameters.cmp(&b.candidate.n_parameters))
     });
-    // The tie-break rules below only ever reorder two plausible candidates.
+    // Only ever reorders two plausible candidates.
     if ranked.len() < 2 || !ranked[1].candidate.plausible {
         return;
     }
-    // supply_unbalance and phase_asymmetry both add a negative-sequence current; on a log
-    // at one operating point they fit equally well. When their held-back errors are within
-    // 25 %, the measured voltage unbalance decides (the unbalance analysis: does the
-    // supply's negative-sequence voltage account for the current unbalance?).
-    let pair = [ranked[0].candidate.effect, ranked[1].candidate.effect];
-    let is_pair =
-        pair.contains(&EffectKind::SupplyUnbalance) && pair.contains(&EffectKind::PhaseAsymmetry);
-    let close = ranked[1].score() <= 1.25 * ranked[0].score();
-    let supply = unbalance.suspect_phase.is_none()
-        && unbalance.voltage_negative_sequence_ratio.unwrap_or(0.0) > 0.002;
-    let want_first = if supply {
-        EffectKind::SupplyUnbalance
-    } else {
-        EffectKind::PhaseAsymmetry
+    let (first, second) = (&ranked[0], &ranked[1]);
+    let model = effects::model_of(first.candidate.effect);
+    let Some(conf) = model
+        .confused_with()
+        .iter()
+        .find(|c| c.with == second.candidate.effect)
+    else {
+        return;
     };
-    if is_pair && close && ranked[0].candidate.effect != want_first {
-        ranked.swap(0, 1);
+    if second.score() > conf.within * first.score() {
+        return;
     }
-    // load_torque whose fitted levels are all alike (within 3 % of the rated torque: the
-    // step the observer proposed is not there) is a constant torque, the same equation as
-    // coulomb_friction at positive speed; when the two are within 10 %, the simpler name,
-    // coulomb_friction, goes first (DESIGN-level note in the README).
-    let pos = |kind: EffectKind| ranked.iter().position(|c| c.candidate.effect == kind);
-    if let (Some(lt), Some(cf)) = (
-        pos(EffectKind::LoadTorque),
-        pos(EffectKind::CoulombFriction),
-    ) {
-        let levels: Vec<f64> = ranked[lt]
-            .candidate
-            .parameters
-            .values()
-            .map(|p| p.value)
-            .collect();
-        let spread = levels.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b))
-            - levels.iter().fold(f64::INFINITY, |a, &b| a.min(b));
-        let constant = spread < 0.03 * torque_scale_nm;
-        let close = ranked[cf].score() <= 1.10 * ranked[lt].score();
-        if lt == 0 && cf == 1 && constant && close {
-            ranked.swap(0, 1);
-        }
+    let says = |r: &RankedCandidate| {
+        let fitted = r.fit.effect_params.last().map(Vec::as_slice).unwrap_or(&[]);
+        effects::model_of(r.candidate.effect).evidence(&Evidence {
+            voltage_unbalance: unbalance.voltage_negative_sequence_ratio,
+            winding_suspected: unbalance.suspect_phase.is_some(),
+            torque_scale_nm,
+            fitted,
+        })
+    };
+    if says(first) == Some(false) && says(second) != Some(false) {
+        ranked.swap(0, 1);
     }
 }
 

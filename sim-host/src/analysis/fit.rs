@@ -7,16 +7,18 @@
 //! around their nominal values (sd 15 % for Ra and Ls, 30 % for J, 50 % for B+Bl, each scaled by
 //! [`PRIOR_WEIGHT`] so that one sd costs as much as a 0.01 normalized error), so a
 //! parameter the data cannot identify stays near nominal instead of wandering. The Jacobian
-//! is by forward differences (one simulation per parameter, in parallel with rayon);
+//! is by forward differences (one simulation per parameter, in parallel with rayon); the
+//! solver is [`super::lm`] (apart from the model; it reports how it ended, [`FitResult::report`]);
 //! bounds are enforced by clamping.
 
 use super::effects::{EffectModel, FitSetup};
+use super::lm::{self, LeastSquares};
 use super::metrics::{measured, predicted, Weights};
 use super::prep::{Prepared, C64};
 use super::simplified_model::{
     rotations, simulate, simulate_rot, BaseParams, EffectTerms, MachineConstants, Prediction,
 };
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 use rayon::prelude::*;
 
 /// An effect set up on the data, with its parameter values.
@@ -34,6 +36,8 @@ pub struct FitResult {
     pub base: BaseParams,
     /// Fitted parameters of each effect, in the order given.
     pub effect_params: Vec<Vec<f64>>,
+    /// How the solver ended (iterations, final cost, reason).
+    pub report: lm::Report,
 }
 
 /// Weight of the base parameters' priors relative to the data (whose residuals are scaled
@@ -82,7 +86,7 @@ impl Problem<'_> {
         terms
     }
 
-    fn residuals(&self, x: &[f64]) -> Vec<f64> {
+    fn residuals_of(&self, x: &[f64]) -> Vec<f64> {
         self.residuals_with(x, &self.terms(x))
     }
 
@@ -114,6 +118,20 @@ impl Problem<'_> {
             r.push(PRIOR_WEIGHT * (x[3] - 1.0) / 0.3);
         }
         r
+    }
+}
+
+impl LeastSquares for Problem<'_> {
+    /// The effects' terms: only the effects' parameters enter them.
+    type Cache = EffectTerms;
+    fn cache(&self, x: &[f64]) -> EffectTerms {
+        self.terms(x)
+    }
+    fn residuals(&self, x: &[f64], terms: &EffectTerms) -> Vec<f64> {
+        self.residuals_with(x, terms)
+    }
+    fn keeps_cache(&self, i: usize) -> bool {
+        i < N_BASE
     }
 }
 
@@ -168,8 +186,8 @@ pub fn fit(
         scale.extend_from_slice(&e.setup.scale);
     }
     let free: Vec<usize> = (0..x.len()).filter(|&i| fit_base || i >= N_BASE).collect();
-    let bounds = Bounds { lo, hi, scale };
-    let x = levenberg_marquardt(&prob, x, &bounds, &free, max_iter);
+    let bounds = lm::Bounds { lo, hi, scale };
+    let (x, report) = lm::solve(&prob, x, &bounds, &free, max_iter);
     let base = Problem::base(&x);
     let mut effect_params = Vec::new();
     let mut o = N_BASE;
@@ -181,125 +199,8 @@ pub fn fit(
     FitResult {
         base,
         effect_params,
+        report,
     }
-}
-
-/// Bounds and typical magnitudes of the parameter vector.
-struct Bounds {
-    lo: Vec<f64>,
-    hi: Vec<f64>,
-    scale: Vec<f64>,
-}
-
-/// Half the sum of squares.
-fn cost_of(r: &[f64]) -> f64 {
-    0.5 * r.iter().map(|v| v * v).sum::<f64>()
-}
-
-/// Levenberg-Marquardt from `x` over the `free` parameters, at most `max_iter` iterations
-/// (ends earlier when a step no longer lowers the cost, or lowers it by less than 1e-7
-/// twice in a row). Returns the parameter vector.
-fn levenberg_marquardt(
-    prob: &Problem<'_>,
-    mut x: Vec<f64>,
-    b: &Bounds,
-    free: &[usize],
-    max_iter: usize,
-) -> Vec<f64> {
-    // The effects' terms at the current point: the Jacobian columns of the base parameters
-    // reuse them (only the effects' own columns and trial steps recompute them).
-    let mut terms_x = prob.terms(&x);
-    let mut r = prob.residuals_with(&x, &terms_x);
-    let mut cost = cost_of(&r);
-    let mut lambda = 1e-3;
-    let mut small_steps = 0;
-    for _ in 0..max_iter {
-        if free.is_empty() {
-            break;
-        }
-        let (jtj, jtr) = normal_equations(prob, &x, &r, &terms_x, b, free);
-        let m = free.len();
-        let mut improved = false;
-        for _ in 0..8 {
-            let mut aug = jtj.clone();
-            for a in 0..m {
-                aug[(a, a)] += lambda * jtj[(a, a)].max(1e-12) + 1e-12;
-            }
-            let step = match aug.cholesky() {
-                Some(ch) => ch.solve(&(-&jtr)),
-                None => {
-                    lambda *= 10.0;
-                    continue;
-                }
-            };
-            let mut xn = x.clone();
-            for (a, &i) in free.iter().enumerate() {
-                xn[i] = (x[i] + step[a]).clamp(b.lo[i], b.hi[i]);
-            }
-            let tn = prob.terms(&xn);
-            let rn = prob.residuals_with(&xn, &tn);
-            let cn = cost_of(&rn);
-            if cn.is_finite() && cn < cost {
-                let rel = (cost - cn) / cost.max(1e-300);
-                x = xn;
-                r = rn;
-                terms_x = tn;
-                cost = cn;
-                lambda = (lambda / 3.0).max(1e-9);
-                improved = true;
-                if rel < 1e-7 {
-                    small_steps += 1;
-                } else {
-                    small_steps = 0;
-                }
-                break;
-            }
-            lambda *= 8.0;
-        }
-        if !improved || small_steps >= 2 {
-            break;
-        }
-    }
-    x
-}
-
-/// `J^T J` and `J^T r` at `x`, the Jacobian by forward differences, one column per free
-/// parameter, in parallel.
-fn normal_equations(
-    prob: &Problem<'_>,
-    x: &[f64],
-    r: &[f64],
-    terms_x: &EffectTerms,
-    b: &Bounds,
-    free: &[usize],
-) -> (DMatrix<f64>, DVector<f64>) {
-    let cols: Vec<Vec<f64>> = free
-        .par_iter()
-        .map(|&i| {
-            let h = 1e-4 * b.scale[i].max(1e-3 * x[i].abs());
-            let mut xp = x.to_vec();
-            let dir = if xp[i] + h > b.hi[i] { -1.0 } else { 1.0 };
-            xp[i] += dir * h;
-            let rp = if i < N_BASE {
-                prob.residuals_with(&xp, terms_x)
-            } else {
-                prob.residuals(&xp)
-            };
-            rp.iter().zip(r).map(|(a, b)| (a - b) / (dir * h)).collect()
-        })
-        .collect();
-    let m = free.len();
-    let mut jtj = DMatrix::<f64>::zeros(m, m);
-    let mut jtr = DVector::<f64>::zeros(m);
-    for a in 0..m {
-        for c in a..m {
-            let s: f64 = cols[a].iter().zip(&cols[c]).map(|(u, v)| u * v).sum();
-            jtj[(a, c)] = s;
-            jtj[(c, a)] = s;
-        }
-        jtr[a] = cols[a].iter().zip(r).map(|(u, v)| u * v).sum();
-    }
-    (jtj, jtr)
 }
 
 /// The effects' terms for fitted values.
@@ -324,6 +225,55 @@ pub fn predict(
     f: &FitResult,
 ) -> Prediction {
     simulate(d, n, &f.base, &terms(d, n, effects, f))
+}
+
+/// A fitted model as a value: the effects set up on a series, the fitted base and effect
+/// values, and how the solve ended. [`FittedModel::predict`] runs it on a series (the one
+/// its set-ups were made on); `Display` says what it is in one line.
+pub struct FittedModel<'a> {
+    /// The effects in the model with their set-ups.
+    pub effects: Vec<ActiveEffect<'a>>,
+    /// The fitted values and the solver's report.
+    pub fit: FitResult,
+}
+
+impl FittedModel<'_> {
+    /// The model's prediction on `d` (the series its effects were set up on).
+    pub fn predict(&self, d: &Prepared, n: &MachineConstants) -> Prediction {
+        predict(d, n, &self.effects, &self.fit)
+    }
+}
+
+impl std::fmt::Display for FittedModel<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        use super::effects::sig;
+        let b = &self.fit.base;
+        f.write_str("paper's model")?;
+        for e in &self.effects {
+            write!(f, " + {}", e.effect.kind())?;
+        }
+        write!(
+            f,
+            "; Ra x{}, Ls x{}, B+Bl {} N m s/rad, J x{}",
+            sig(b.ra_scale),
+            sig(b.ls_scale),
+            sig(b.btot_nms),
+            sig(b.j_scale)
+        )?;
+        for (e, p) in self.effects.iter().zip(&self.fit.effect_params) {
+            for ((name, unit), v) in e.setup.names.iter().zip(&e.setup.units).zip(p) {
+                write!(f, "; {name} = {} {unit}", sig(*v))?;
+            }
+        }
+        let r = &self.fit.report;
+        write!(
+            f,
+            "; fit {} after {} iterations, cost {}",
+            r.termination,
+            r.iterations,
+            sig(r.cost)
+        )
+    }
 }
 
 /// How well a log identifies one base parameter (`compare`'s `identifiability`).
@@ -403,14 +353,14 @@ pub fn jacobian(
             mag.push(v.abs().max(*s));
         }
     }
-    let r = prob.residuals(&x);
+    let r = prob.residuals_of(&x);
     let cols: Vec<Vec<f64>> = (0..x.len())
         .into_par_iter()
         .map(|i| {
             let h = 1e-3 * mag[i];
             let mut xp = x.clone();
             xp[i] += h;
-            let rp = prob.residuals(&xp);
+            let rp = prob.residuals_of(&xp);
             // Relative column: d r / d ln|x| (a change of 100 % of the magnitude).
             rp.iter()
                 .zip(&r)
@@ -481,4 +431,51 @@ pub fn jacobian(
         condition_number,
         base,
     })
+}
+
+#[cfg(test)]
+mod fitted_model_tests {
+    use super::*;
+    use crate::analysis::effects::model_of;
+    use monitor_core::EffectKind;
+
+    #[test]
+    fn a_fitted_model_says_what_it_is() {
+        let n = MachineConstants::from_params(&crate::params::ParamFile::reference_2p2kw());
+        let d = Prepared::default();
+        let cd = model_of(EffectKind::CurrentDynamics);
+        let setup = cd.setup(&d, &n).unwrap();
+        let m = FittedModel {
+            effects: vec![ActiveEffect {
+                effect: cd.as_ref(),
+                setup,
+            }],
+            fit: FitResult {
+                base: BaseParams {
+                    ra_scale: 1.05,
+                    ls_scale: 0.98,
+                    btot_nms: 0.01,
+                    j_scale: 1.2,
+                },
+                effect_params: vec![vec![0.0321]],
+                report: lm::Report {
+                    iterations: 7,
+                    cost: 1.5e-5,
+                    termination: lm::Termination::Converged,
+                },
+            },
+        };
+        let s = m.to_string();
+        assert!(
+            s.starts_with("paper's model + current_dynamics; Ra x1.05"),
+            "{s}"
+        );
+        assert!(s.contains("la_h = 0.0321 H"), "{s}");
+        assert!(
+            s.ends_with("fit converged after 7 iterations, cost 1.50e-5"),
+            "{s}"
+        );
+        // An empty series predicts nothing (and does not panic).
+        assert!(m.predict(&d, &n).iq.is_empty());
+    }
 }

@@ -40,6 +40,7 @@ pub mod compare;
 pub mod effects;
 pub mod explain;
 pub mod fit;
+pub mod lm;
 pub mod metrics;
 pub mod prep;
 pub mod rotor_asymmetry;

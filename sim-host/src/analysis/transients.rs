@@ -202,3 +202,93 @@ pub fn advice(
     }
     (tags, out)
 }
+
+/// The samples of `d` that lie in a transient of the model's inputs: within the
+/// [`settling_s`] after the direct-on-line start ends ([`start_end_s`]), or where the
+/// supply voltage amplitude or the supply frequency spans more than [`STEP_MIN`] of its
+/// mean over the [`settling_s`] before the sample (the same test as a `supply_step` window
+/// of [`classify`]). A load step is not an input transient: the speed moves at the
+/// mechanical rate and the electrical states follow it quasi-statically.
+pub fn input_transients(d: &Prepared, n: &MachineConstants) -> Vec<bool> {
+    let len = d.len();
+    let look = ((settling_s(n) / d.dt_s.max(1e-9)).ceil() as usize).max(1);
+    let mut out = vec![false; len];
+    if let Some(te) = start_end_s(d) {
+        let until = te + settling_s(n);
+        for (o, t) in out.iter_mut().zip(&d.t_s) {
+            *o |= *t <= until;
+        }
+    }
+    let amp: Vec<f64> = if d.vq.len() == len {
+        (0..len).map(|k| d.vq[k].hypot(d.vd[k])).collect()
+    } else {
+        Vec::new()
+    };
+    let freq: Vec<f64> = d.omega_s.iter().map(|w| w.abs()).collect();
+    for x in [&amp, &freq] {
+        if x.len() != len {
+            continue;
+        }
+        for (k, (lo, hi, mean)) in sliding_span(x, look).into_iter().enumerate() {
+            out[k] |= mean > 0.0 && (hi - lo) / mean > STEP_MIN;
+        }
+    }
+    out
+}
+
+/// Minimum, maximum and mean of `x` over the trailing window `[k + 1 - w, k]` for every
+/// `k` (monotonic queues: O(n)).
+fn sliding_span(x: &[f64], w: usize) -> Vec<(f64, f64, f64)> {
+    use std::collections::VecDeque;
+    let mut lo: VecDeque<usize> = VecDeque::new();
+    let mut hi: VecDeque<usize> = VecDeque::new();
+    let mut sum = 0.0;
+    let mut out = Vec::with_capacity(x.len());
+    for k in 0..x.len() {
+        while lo.back().is_some_and(|&j| x[j] >= x[k]) {
+            lo.pop_back();
+        }
+        lo.push_back(k);
+        while hi.back().is_some_and(|&j| x[j] <= x[k]) {
+            hi.pop_back();
+        }
+        hi.push_back(k);
+        sum += x[k];
+        if k >= w {
+            sum -= x[k - w];
+        }
+        let first = (k + 1).saturating_sub(w);
+        while lo.front().is_some_and(|&j| j < first) {
+            lo.pop_front();
+        }
+        while hi.front().is_some_and(|&j| j < first) {
+            hi.pop_front();
+        }
+        let count = (k + 1 - first) as f64;
+        out.push((x[lo[0]], x[hi[0]], sum / count));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::sliding_span;
+
+    #[test]
+    fn sliding_span_matches_a_direct_computation() {
+        let x: Vec<f64> = (0..200)
+            .map(|k| ((k * 37 % 101) as f64).sin() + 0.01 * k as f64)
+            .collect();
+        for w in [1, 3, 17, 250] {
+            let s = sliding_span(&x, w);
+            for k in 0..x.len() {
+                let win = &x[(k + 1).saturating_sub(w)..=k];
+                let lo = win.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = win.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                let mean = win.iter().sum::<f64>() / win.len() as f64;
+                assert_eq!((s[k].0, s[k].1), (lo, hi), "w {w} k {k}");
+                assert!((s[k].2 - mean).abs() < 1e-9, "w {w} k {k}");
+            }
+        }
+    }
+}

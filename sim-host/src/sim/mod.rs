@@ -415,7 +415,10 @@ impl ResolvedEffects {
                     eff.asym = Some((phase.index(), fraction))
                 }
                 EffectSpec::RotorAsymmetry { .. } => eff.rotor_delta = e.rotor_delta()?,
-                EffectSpec::FluxDynamics {} | EffectSpec::CurrentDynamics {} => {}
+                EffectSpec::FluxDynamics {}
+                | EffectSpec::CurrentDynamics {}
+                | EffectSpec::DAxisDynamics {}
+                | EffectSpec::CrossCouplingDynamics {} => {}
             }
         }
         Ok(eff)

@@ -406,6 +406,10 @@ pub enum EffectSpec {
     FluxDynamics {},
     /// Stator current dynamics (La dI/dt): always present in the full-order model; a no-op.
     CurrentDynamics {},
+    /// d-axis stator dynamics: always present in the full-order model; a no-op.
+    DAxisDynamics {},
+    /// Cross-coupling and q-axis rotor flux: always present in the full-order model; a no-op.
+    CrossCouplingDynamics {},
 }
 
 impl EffectSpec {
@@ -423,6 +427,8 @@ impl EffectSpec {
             EffectSpec::FluxDynamics {} => EffectKind::FluxDynamics,
             EffectSpec::CurrentDynamics {} => EffectKind::CurrentDynamics,
             EffectSpec::RotorAsymmetry { .. } => EffectKind::RotorAsymmetry,
+            EffectSpec::DAxisDynamics {} => EffectKind::DAxisDynamics,
+            EffectSpec::CrossCouplingDynamics {} => EffectKind::CrossCouplingDynamics,
         }
     }
 
@@ -468,6 +474,8 @@ impl EffectSpec {
                 broken_bars: None,
                 bars: None,
             },
+            EffectKind::DAxisDynamics => EffectSpec::DAxisDynamics {},
+            EffectKind::CrossCouplingDynamics => EffectSpec::CrossCouplingDynamics {},
         }
     }
 
@@ -559,7 +567,10 @@ impl EffectSpec {
                 }
             }
             EffectSpec::PhaseAsymmetry { fraction: f, .. } => fraction(&k("fraction"), *f),
-            EffectSpec::FluxDynamics {} | EffectSpec::CurrentDynamics {} => Ok(()),
+            EffectSpec::FluxDynamics {}
+            | EffectSpec::CurrentDynamics {}
+            | EffectSpec::DAxisDynamics {}
+            | EffectSpec::CrossCouplingDynamics {} => Ok(()),
             EffectSpec::RotorAsymmetry { .. } => self.rotor_delta().map(|_| ()),
         }
     }

@@ -1,0 +1,264 @@
+//! Levenberg-Marquardt for bounded nonlinear least squares, apart from any model.
+//!
+//! The problem ([`LeastSquares`]) gives residuals; the solver minimises half their sum of
+//! squares over the free parameters, with box bounds enforced by clamping each trial step,
+//! a forward-difference Jacobian computed in parallel (rayon), Marquardt's diagonal
+//! scaling, and reports how it ended ([`Report`]). Priors are the problem's business: they
+//! are residuals like any other. (The `levenberg-marquardt` crate has no bounds and
+//! argmin's LM neither; clamping to the physical bounds is what the fits here need, so the
+//! solver stays this small one, separated from the analysis model.)
+
+use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
+use serde::Serialize;
+
+/// A least-squares problem: residuals of a parameter vector.
+pub trait LeastSquares: Sync {
+    /// What the residuals need that is costly and depends only on some parameters
+    /// (computed once per point and reused by the Jacobian columns that leave it valid).
+    type Cache: Sync;
+    /// The cache at `x`.
+    fn cache(&self, x: &[f64]) -> Self::Cache;
+    /// The residuals at `x`; `cache` is [`LeastSquares::cache`] of `x` or of a point that
+    /// differs from `x` only in parameters for which [`LeastSquares::keeps_cache`] holds.
+    fn residuals(&self, x: &[f64], cache: &Self::Cache) -> Vec<f64>;
+    /// True when changing parameter `i` leaves the cache valid.
+    fn keeps_cache(&self, _i: usize) -> bool {
+        false
+    }
+}
+
+/// Box bounds and typical magnitudes of the parameter vector.
+#[derive(Debug, Clone)]
+pub struct Bounds {
+    /// Lower bounds.
+    pub lo: Vec<f64>,
+    /// Upper bounds.
+    pub hi: Vec<f64>,
+    /// Typical magnitudes (finite-difference steps: 1e-4 of them).
+    pub scale: Vec<f64>,
+}
+
+/// Why the solver stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Termination {
+    /// Two accepted steps in a row lowered the cost by less than [`REL_TOL`] of it.
+    Converged,
+    /// The iteration limit was reached while steps still lowered the cost.
+    IterationLimit,
+    /// No step lowered the cost, even with the damping raised [`DAMPING_TRIES`] times (a
+    /// minimum within the finite-difference accuracy, or a bound in the way).
+    Stalled,
+    /// No free parameter.
+    NothingToFit,
+}
+
+impl std::fmt::Display for Termination {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Termination::Converged => "converged",
+            Termination::IterationLimit => "iteration limit",
+            Termination::Stalled => "stalled",
+            Termination::NothingToFit => "nothing to fit",
+        })
+    }
+}
+
+/// How a solve ended.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Report {
+    /// Iterations run (Jacobians computed).
+    pub iterations: usize,
+    /// Final cost: half the sum of squared residuals (priors included).
+    pub cost: f64,
+    /// Why it stopped.
+    pub termination: Termination,
+}
+
+/// Relative cost decrease below which a step counts as small.
+pub const REL_TOL: f64 = 1e-7;
+/// Damping increases tried per iteration before the solve counts as stalled.
+pub const DAMPING_TRIES: usize = 8;
+
+/// Half the sum of squares.
+pub fn cost_of(r: &[f64]) -> f64 {
+    0.5 * r.iter().map(|v| v * v).sum::<f64>()
+}
+
+/// Minimises from `x` over the `free` parameters, at most `max_iter` iterations. Returns
+/// the parameter vector and how the solve ended.
+pub fn solve<P: LeastSquares>(
+    prob: &P,
+    mut x: Vec<f64>,
+    b: &Bounds,
+    free: &[usize],
+    max_iter: usize,
+) -> (Vec<f64>, Report) {
+    let mut cache = prob.cache(&x);
+    let mut r = prob.residuals(&x, &cache);
+    let mut cost = cost_of(&r);
+    let mut lambda = 1e-3;
+    let mut small_steps = 0;
+    let mut report = Report {
+        iterations: 0,
+        cost,
+        termination: Termination::IterationLimit,
+    };
+    if free.is_empty() {
+        report.termination = Termination::NothingToFit;
+        return (x, report);
+    }
+    for it in 0..max_iter {
+        report.iterations = it + 1;
+        let (jtj, jtr) = normal_equations(prob, &x, &r, &cache, b, free);
+        let m = free.len();
+        let mut improved = false;
+        for _ in 0..DAMPING_TRIES {
+            let mut aug = jtj.clone();
+            for a in 0..m {
+                aug[(a, a)] += lambda * jtj[(a, a)].max(1e-12) + 1e-12;
+            }
+            let step = match aug.cholesky() {
+                Some(ch) => ch.solve(&(-&jtr)),
+                None => {
+                    lambda *= 10.0;
+                    continue;
+                }
+            };
+            let mut xn = x.clone();
+            for (a, &i) in free.iter().enumerate() {
+                xn[i] = (x[i] + step[a]).clamp(b.lo[i], b.hi[i]);
+            }
+            let cn_cache = prob.cache(&xn);
+            let rn = prob.residuals(&xn, &cn_cache);
+            let cn = cost_of(&rn);
+            if cn.is_finite() && cn < cost {
+                let rel = (cost - cn) / cost.max(1e-300);
+                x = xn;
+                r = rn;
+                cache = cn_cache;
+                cost = cn;
+                lambda = (lambda / 3.0).max(1e-9);
+                improved = true;
+                small_steps = if rel < REL_TOL { small_steps + 1 } else { 0 };
+                break;
+            }
+            lambda *= 8.0;
+        }
+        report.cost = cost;
+        if !improved {
+            report.termination = Termination::Stalled;
+            break;
+        }
+        if small_steps >= 2 {
+            report.termination = Termination::Converged;
+            break;
+        }
+    }
+    (x, report)
+}
+
+/// `J^T J` and `J^T r` at `x`, the Jacobian by forward differences, one column per free
+/// parameter, in parallel.
+fn normal_equations<P: LeastSquares>(
+    prob: &P,
+    x: &[f64],
+    r: &[f64],
+    cache: &P::Cache,
+    b: &Bounds,
+    free: &[usize],
+) -> (DMatrix<f64>, DVector<f64>) {
+    let cols: Vec<Vec<f64>> = free
+        .par_iter()
+        .map(|&i| {
+            let h = 1e-4 * b.scale[i].max(1e-3 * x[i].abs());
+            let mut xp = x.to_vec();
+            let dir = if xp[i] + h > b.hi[i] { -1.0 } else { 1.0 };
+            xp[i] += dir * h;
+            let rp = if prob.keeps_cache(i) {
+                prob.residuals(&xp, cache)
+            } else {
+                prob.residuals(&xp, &prob.cache(&xp))
+            };
+            rp.iter().zip(r).map(|(a, b)| (a - b) / (dir * h)).collect()
+        })
+        .collect();
+    let m = free.len();
+    let mut jtj = DMatrix::<f64>::zeros(m, m);
+    let mut jtr = DVector::<f64>::zeros(m);
+    for a in 0..m {
+        for c in a..m {
+            let s: f64 = cols[a].iter().zip(&cols[c]).map(|(u, v)| u * v).sum();
+            jtj[(a, c)] = s;
+            jtj[(c, a)] = s;
+        }
+        jtr[a] = cols[a].iter().zip(r).map(|(u, v)| u * v).sum();
+    }
+    (jtj, jtr)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Rosenbrock as residuals (10 (y - x^2), 1 - x): minimum 0 at (1, 1).
+    struct Rosenbrock;
+    impl LeastSquares for Rosenbrock {
+        type Cache = ();
+        fn cache(&self, _x: &[f64]) {}
+        fn residuals(&self, x: &[f64], _c: &()) -> Vec<f64> {
+            vec![10.0 * (x[1] - x[0] * x[0]), 1.0 - x[0]]
+        }
+    }
+
+    fn bounds(lo: f64, hi: f64) -> Bounds {
+        Bounds {
+            lo: vec![lo; 2],
+            hi: vec![hi; 2],
+            scale: vec![1.0; 2],
+        }
+    }
+
+    #[test]
+    fn converges_on_rosenbrock_and_says_so() {
+        let (x, rep) = solve(
+            &Rosenbrock,
+            vec![-1.2, 1.0],
+            &bounds(-5.0, 5.0),
+            &[0, 1],
+            200,
+        );
+        assert!(
+            (x[0] - 1.0).abs() < 1e-4 && (x[1] - 1.0).abs() < 1e-4,
+            "{x:?}"
+        );
+        assert!(rep.cost < 1e-8, "{rep:?}");
+        assert_ne!(rep.termination, Termination::IterationLimit, "{rep:?}");
+        assert!(rep.iterations > 1 && rep.iterations < 200, "{rep:?}");
+    }
+
+    #[test]
+    fn reports_the_iteration_limit_and_nothing_to_fit() {
+        let (_, rep) = solve(&Rosenbrock, vec![-1.2, 1.0], &bounds(-5.0, 5.0), &[0, 1], 2);
+        assert_eq!(rep.termination, Termination::IterationLimit);
+        assert_eq!(rep.iterations, 2);
+        let (x, rep) = solve(&Rosenbrock, vec![-1.2, 1.0], &bounds(-5.0, 5.0), &[], 50);
+        assert_eq!(rep.termination, Termination::NothingToFit);
+        assert_eq!(x, vec![-1.2, 1.0]);
+    }
+
+    #[test]
+    fn respects_the_bounds() {
+        // The minimum (1, 1) lies outside x <= 0.5: the solve ends on the bound.
+        let (x, _) = solve(
+            &Rosenbrock,
+            vec![-1.2, 1.0],
+            &bounds(-5.0, 0.5),
+            &[0, 1],
+            200,
+        );
+        assert!(x[0] <= 0.5 && x[1] <= 0.5, "{x:?}");
+        assert!((x[0] - 0.5).abs() < 1e-3, "{x:?}");
+    }
+}

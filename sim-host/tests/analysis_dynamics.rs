@@ -1,0 +1,199 @@
+//! The dynamics effects up to the full-order machine (issue 10): effect-free logs with a
+//! direct-on-line start, a V/f step and a supply voltage step, both reference motors and
+//! an 11 kW machine the code was not developed on, at 2, 5 and 10 kHz, analysed over the
+//! whole log (start included). The figures are printed (`--nocapture`) and in the README.
+mod analysis_common;
+use analysis_common::*;
+use sim_host::params::ParamFile;
+use sim_host::sim::{Scenario, SupplyStep};
+
+/// All four dynamics effects: the full-order T-equivalent machine.
+const FULL: [&str; 4] = [
+    "flux_dynamics",
+    "current_dynamics",
+    "d_axis_dynamics",
+    "cross_coupling_dynamics",
+];
+
+/// A made-up 11 kW, 400 V, 50 Hz, 4-pole machine with textbook per-unit values
+/// (Z_base = 14.5 ohm: Rs 0.026 pu, Rr 0.024 pu, leakages 0.076 pu each, Xm 1.95 pu,
+/// sigma 0.07, Lr/Rr 0.27 s, inertia constant about 0.2 s with a coupled load).
+fn motor_11kw() -> ParamFile {
+    ParamFile::from_toml_str(
+        "[motor]\nrs_ohm = 0.38\nrr_ohm = 0.35\nls_h = 0.0935\nlr_h = 0.0935\nlm_h = 0.09\npoles = 4\nj_kgm2 = 0.09\nb_nms = 0.01\nbl_nms = 0.45\n[supply]\nv_ll_rms = 400.0\nf_hz = 50.0\n",
+        "11 kW test machine",
+    )
+    .expect("11 kW parameters")
+}
+
+fn params(which: &str) -> ParamFile {
+    match which {
+        "11kw" => motor_11kw(),
+        w => motor(w),
+    }
+}
+
+/// Start from standstill, a V/f step to 60 % at 1.5 s, back to rated at 2.2 s, a 10 %
+/// supply voltage dip at 2.8 s: 3.4 s at `rate_hz`, default sensors (12-bit, 0.1 % noise).
+fn transients(which: &str, rate_hz: f64) -> Scenario {
+    let f0 = params(which).supply.f_hz;
+    let mut s = Scenario::steady(3.4, rate_hz);
+    s.sensors = sensors(1);
+    s.supply.steps = vec![
+        SupplyStep {
+            t_s: 1.5,
+            v_scale: Some(0.6),
+            f_hz: Some(0.6 * f0),
+        },
+        SupplyStep {
+            t_s: 2.2,
+            v_scale: Some(1.0),
+            f_hz: Some(f0),
+        },
+        SupplyStep {
+            t_s: 2.8,
+            v_scale: Some(0.9),
+            f_hz: None,
+        },
+    ];
+    s
+}
+
+/// The ratio error / noise floor of `compare` with the paper's model and with the
+/// full-order machine over the whole log, and the latter's error, for one motor and rate.
+fn ratios(dir: &std::path::Path, which: &str, rate_hz: f64) -> (f64, f64, f64) {
+    let p = params(which);
+    let log = write_log(
+        dir,
+        &format!("{which}_{rate_hz}"),
+        &p,
+        &transients(which, rate_hz),
+        false,
+    );
+    let a = analyse(&log, &p, 0.0);
+    let paper = a.compare(&opts(&[])).unwrap().report;
+    let full = a.compare(&opts(&FULL)).unwrap().report;
+    let r_paper = paper.normalized_rms_error / paper.noise_floor;
+    // Against the same floor, so that r_paper / r_full is the error's gain.
+    let r_full = full.normalized_rms_error / paper.noise_floor;
+    eprintln!(
+        "{which} {rate_hz} Hz: paper's model {:.4} ({r_paper:.0}x noise), full order {:.4} ({r_full:.1}x that noise floor, {:.4}), plausible {}",
+        paper.normalized_rms_error, full.normalized_rms_error, paper.noise_floor, full.plausible
+    );
+    assert!(
+        full.plausible,
+        "{which} {rate_hz}: {:?}",
+        full.implausible_because
+    );
+    (r_paper, r_full, full.normalized_rms_error)
+}
+
+/// Measured (README, "Starts and steps"): the full-order model's error is 0.0065-0.0099 on
+/// the reference motors (3-6x the noise floor) and 0.021 on the 11 kW machine (10-21x),
+/// where the paper's model is at 0.33-0.58 (84-430x). The issue's target (2x the noise
+/// floor) is NOT met: a rate-independent remainder of about 0.006 (the working series'
+/// reconstruction of the start and the steps) is left. The bounds here are what is
+/// reached: at least a 20-fold gain (measured 26-56x), and an error below 0.012 (reference motors) or 0.025.
+#[test]
+fn full_order_machine_follows_starts_and_steps() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut failures = Vec::new();
+    for which in ["2p2", "3hp", "11kw"] {
+        for rate in [2000.0, 5000.0, 10_000.0] {
+            let (paper, full, full_error) = ratios(dir.path(), which, rate);
+            let bound = if which == "11kw" { 0.025 } else { 0.012 };
+            // paper / full compares ratios to the same log's noise floors: the error gain.
+            let gain = paper / full;
+            if !(full_error <= bound && gain >= 20.0) {
+                failures.push(format!(
+                    "{which} {rate}: paper {paper:.1}x, full {full:.1}x"
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// One case of issue 10's "hidden effects under transients": the start + V/f step + dip
+/// log of [`transients`] at 5 kHz with `kind` injected (the simulator's defaults),
+/// analysed over the whole log with the four dynamics effects in the model. Returns what
+/// `explain` ranks first, its explained fraction, `unexplained`, and `compare`'s error
+/// without and with the effect and the noise floor.
+fn hidden_case(
+    dir: &std::path::Path,
+    which: &str,
+    kind: monitor_core::EffectKind,
+) -> (String, f64, bool, f64, f64, f64) {
+    let truth = params(which);
+    let nominal = perturbed(&truth, 0.05);
+    let mut s = transients(which, 5000.0);
+    s.effects = vec![sim_host::sim::EffectSpec::with_defaults(kind)];
+    let log = write_log(dir, &format!("{which}_{}", kind.name()), &truth, &s, false);
+    let a = analyse(&log, &nominal, 0.0);
+    let ex = a.explain(&opts(&FULL), &|_| {}).unwrap().report;
+    let mut with: Vec<&str> = FULL.to_vec();
+    with.push(kind.name());
+    let before = a.compare(&opts(&FULL)).unwrap().report;
+    let after = a.compare(&opts(&with)).unwrap().report;
+    let top = ex.ranking.first();
+    let r = (
+        top.map(|c| c.effect.name()).unwrap_or("-").to_string(),
+        top.map(|c| c.explained_fraction).unwrap_or(0.0),
+        ex.unexplained,
+        before.normalized_rms_error,
+        after.normalized_rms_error,
+        after.noise_floor,
+    );
+    eprintln!(
+        "{which} {:<17} top {:<17} ({:.0} %, unexplained {}) error {:.4} -> {:.4} ({:.1}x, noise floor {:.4})",
+        kind.name(),
+        r.0,
+        100.0 * r.1,
+        r.2,
+        r.3,
+        r.4,
+        r.3 / r.4,
+        r.5
+    );
+    r
+}
+
+/// The hidden effects that are found through a start and steps (README, "Hidden effects
+/// under transients"): ranked first, claimed, and the error cut at least 5x or to within
+/// 2x the noise floor. The others (thermal drift, saturation, iron loss, friction,
+/// windage, phase asymmetry) are not yet: see the probe below.
+#[test]
+fn hidden_effects_under_transients_found() {
+    use monitor_core::EffectKind;
+    let dir = tempfile::tempdir().unwrap();
+    let mut failures = Vec::new();
+    for (which, kind) in [
+        ("2p2", EffectKind::LoadTorque),
+        ("2p2", EffectKind::SupplyUnbalance),
+        ("3hp", EffectKind::LoadTorque),
+        ("3hp", EffectKind::SupplyUnbalance),
+    ] {
+        let (top, _, unexplained, before, after, floor) = hidden_case(dir.path(), which, kind);
+        if top != kind.name() || unexplained || !(before >= 5.0 * after || after <= 2.0 * floor) {
+            failures.push(format!(
+                "{which} {kind}: top {top}, unexplained {unexplained}, {before:.4} -> {after:.4} (floor {floor:.4})"
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// Every non-dynamics effect of the library through a start and steps (a probe, ignored:
+/// `--ignored --nocapture`; `MOTOR` picks the motor, default 2p2; figures in the README).
+#[test]
+#[ignore]
+fn hidden_effects_under_transients_probe() {
+    let which = std::env::var("MOTOR").unwrap_or("2p2".into());
+    let dir = tempfile::tempdir().unwrap();
+    for kind in monitor_core::EffectKind::ALL
+        .into_iter()
+        .filter(|k| !k.is_dynamics())
+    {
+        hidden_case(dir.path(), &which, kind);
+    }
+}
