@@ -56,6 +56,10 @@ pub const COUNTS_PER_REV: u32 = 4096;
 /// about ten times what 12-bit sensors with 0.1 % noise and 0.2 % gain mismatch leave after
 /// the sequence analysis' 2 Hz filters (a one-phase gain error `g` gives about `g`).
 pub const SENSOR_PHASE_MIN_RATIO: f32 = 0.005;
+/// The commissioning window's negative sequence is the winding's baseline only while |I1|
+/// stays within this fraction of its value there (a motor's own asymmetry moves with the
+/// slip; `diagnose --baseline` is the user's choice and is always used).
+pub const BASELINE_I1_TOLERANCE: f32 = 0.1;
 
 /// Errors from setting up or running a replay.
 #[derive(Debug, thiserror::Error)]
@@ -110,6 +114,8 @@ pub struct UnbalanceBaseline {
     pub i2_over_i1: [f32; 2],
     /// `V2/I1` [ohm] (re, im), where voltages are logged.
     pub v2_over_i1: Option<[f32; 2]>,
+    /// |I1| [A, peak] where it was taken (the operating point).
+    pub i1_peak_a: f32,
 }
 
 impl Default for ReplayOptions {
@@ -249,8 +255,9 @@ pub struct UnbalanceReport {
     /// `V2/I1` (re, im); a healthy log's are the `--baseline` of a later one.
     pub measured: UnbalanceBaseline,
     /// The healthy negative sequence the winding is judged against: `"commissioning"`
-    /// (learned in the window), `"file"` (`--baseline`), or null (none: the supply's part
-    /// alone is taken out).
+    /// (learned in the window, used while |I1| is within [`BASELINE_I1_TOLERANCE`] of its
+    /// value there), `"file"` (`--baseline`), or null (none: the supply's part alone is
+    /// taken out).
     pub baseline: Option<String>,
 }
 
@@ -609,6 +616,7 @@ impl Replay {
         let ratios = UnbalanceBaseline {
             i2_over_i1: over_i1(neg_i),
             v2_over_i1: (self.channels.voltages && gv.is_none()).then(|| over_i1(neg_v)),
+            i1_peak_a: self.seq.positive_magnitude(),
         };
         (ratios, gi, gv)
     }
@@ -622,7 +630,14 @@ impl Replay {
             self.params.supply.omega_rad_s() as f32
         };
         let (measured, gi, gv) = self.unbalance_ratios();
-        let (base, base_name) = match (self.opts.unbalance_baseline, self.learned_unbalance) {
+        // The commissioning window's only once it was learned, and only at about its
+        // operating point: a motor's own asymmetry gives an I2/I1 that moves with the slip.
+        let i1 = self.seq.positive_magnitude();
+        let learned = self.learned_unbalance.filter(|b| {
+            matches!(out.commissioning, CommissioningState::Commissioned)
+                && (i1 - b.i1_peak_a).abs() <= BASELINE_I1_TOLERANCE * b.i1_peak_a
+        });
+        let (base, base_name) = match (self.opts.unbalance_baseline, learned) {
             (Some(b), _) => (Some(b), Some("file")),
             (None, Some(b)) => (Some(b), Some("commissioning")),
             (None, None) => (None, None),
