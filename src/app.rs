@@ -567,7 +567,12 @@ impl Supervisor {
             Mode::NotCommissioned
         };
         let failed = self.procedure.last_failure().is_some();
-        let input = PanelInput::from_status(mode, &self.latest, self.isolation(), failed);
+        let learned = self
+            .isolation
+            .as_ref()
+            .filter(|f| f.learned())
+            .and_then(Follower::last);
+        let input = PanelInput::from_status(mode, &self.latest, learned, failed);
         Tick {
             pet_watchdog: watch.pet_watchdog,
             mode,

@@ -46,6 +46,10 @@
 //! names a fault (not the friction class, which a load change is to the paper's model)
 //! while the learned baseline of a commissioning run is in force: below the lamps'
 //! thresholds the isolation's three equations can still be outside their healthy spread.
+//! The isolation's baseline is learned in RAM by a commissioning run since boot (the flash
+//! record keeps only the lamps' thresholds): until then the blink code is the lamps' top
+//! candidate in `Fault::ALL` order, as before the isolation, and the isolation is only
+//! printed on the status line.
 
 use crate::app::MonitorStatus;
 pub use crate::board::Lamp;
@@ -142,10 +146,14 @@ pub struct PanelInput {
 }
 
 impl PanelInput {
-    /// The panel's inputs for the latest status in `mode` and the latest `isolation`: the
-    /// residual lamps, the fault lamp (the core's detection, or a fault the isolation names
-    /// while commissioned: module docs), "input invalid" when a sensor fault is flagged
-    /// with no residual lamp lit, and the isolated fault's blink code.
+    /// The panel's inputs for the latest status in `mode` and the latest `isolation`
+    /// judged against a baseline learned since boot (`None` without one): the residual
+    /// lamps, the fault lamp (the core's detection, or a fault the isolation names while
+    /// commissioned: module docs), "input invalid" when a sensor fault is flagged with no
+    /// residual lamp lit, and the blink code: the isolated fault's (or "not named"); without
+    /// a learned isolation baseline the lamps' top candidate's, as the paper's method
+    /// gives it (a nameplate's parameters can be 10-30 % off: the isolation against them is
+    /// not trusted on the panel, only printed on the status line).
     pub fn from_status(
         mode: Mode,
         status: &MonitorStatus,
@@ -153,10 +161,13 @@ impl PanelInput {
         commissioning_failed: bool,
     ) -> Self {
         let named = isolation.and_then(Isolation::named);
-        let fault_code = match named {
-            Some(Named::Fault(c)) => blink_code(c.fault.index() as u8),
-            Some(Named::Friction { .. }) => blink_code(Fault::B.index() as u8),
-            None => NOT_NAMED_CODE,
+        let fault_code = match (isolation, named) {
+            (_, Some(Named::Fault(c))) => blink_code(c.fault.index() as u8),
+            (_, Some(Named::Friction { .. })) => blink_code(Fault::B.index() as u8),
+            (Some(_), None) => NOT_NAMED_CODE,
+            (None, None) => status
+                .top
+                .map_or(NOT_NAMED_CODE, |(f, _)| blink_code(f.index() as u8)),
         };
         let named_fault = matches!(named, Some(Named::Fault(_)));
         PanelInput {
@@ -346,8 +357,13 @@ mod tests {
         let unsure = isolation(Fault::Rs, 0.4);
         let inp = PanelInput::from_status(Mode::NotCommissioned, &status, Some(&unsure), false);
         assert_eq!(at(&inp), Some(NOT_NAMED_CODE));
+        // No learned isolation baseline: the lamps' top candidate, or "not named".
         let inp = PanelInput::from_status(Mode::NotCommissioned, &status, None, false);
         assert_eq!(at(&inp), Some(NOT_NAMED_CODE));
+        status.top = Some((Fault::Lr, 0.5));
+        let inp = PanelInput::from_status(Mode::NotCommissioned, &status, None, false);
+        assert_eq!(at(&inp), Some(4));
+        status.top = None;
         // Bl (or B) named: the friction class, code 5, and a load change alone does not
         // light the lamp.
         let bl = isolation(Fault::Bl, 0.7);
