@@ -137,9 +137,12 @@ pub struct CompareArgs {
     long_about = "Rank the physical effects missing from the paper's simplified model.\n\n\
 Every library effect not yet in the model (thermal_drift, saturation, iron_loss, \
 coulomb_friction, windage, load_torque, supply_unbalance, phase_asymmetry, flux_dynamics, \
-current_dynamics, rotor_asymmetry) is added in turn and fitted together with the base parameters (Ra, Ls, \
-B+Bl, J). Candidates are ranked by the error on held-back time windows the fit never saw, \
-so an effect that only fits noise does not win. When no candidate explains at least 50 % of \
+current_dynamics, d_axis_dynamics, cross_coupling_dynamics, rotor_asymmetry) is added in turn \
+and fitted together with the base parameters (Ra, Ls, B+Bl, J). The dynamics effects (those \
+with a time constant) are proposed only when the analysed span holds a start or a supply \
+step; with all four the model is the full-order machine. Candidates are ranked by the error \
+on held-back time windows the fit never saw, so an effect that only fits noise does not \
+win; a fit outside its physical range is marked plausible: false and never named. When no candidate explains at least 50 % of \
 the held-back error, or the error is already near the noise floor, the answer is \
 `unexplained: true` rather than a wrong name.\n\n\
 Workflow:\n  sim-host compare --params motor.toml run.csv          # where does the model fail?\n  \
@@ -148,7 +151,9 @@ sim-host explain --compare --params motor.toml run.csv  # both, reading a long l
 sim-host compare --params motor.toml run.csv --effects load_torque   # the error falls\n  \
 sim-host explain --params motor.toml run.csv --effects load_torque   # anything else?\n\n\
 JSON (--json): baseline_normalized_rms_error, ranking [{effect, normalized_rms_error, \
-explained_fraction, validation_normalized_rms_error, n_parameters, parameters, summary}], \
+explained_fraction, validation_normalized_rms_error, n_parameters, parameters, summary, \
+plausible, implausible_because, fit {iterations, cost, termination: converged | \
+iteration_limit | stalled | nothing_to_fit}}], \
 unexplained, verdict, skipped, unbalance, noise_floor, data_quality, rotor_asymmetry (the \
 motor current signature analysis: lower_sideband_db, upper_sideband_db, slip, sideband_hz, \
 speed_ripple_hz, speed_ripple_rad_s, delta, equivalent_broken_bars (with --rotor-bars N), \
