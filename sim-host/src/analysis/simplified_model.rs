@@ -183,6 +183,17 @@ pub struct Prediction {
     pub i_ab: Vec<C64>,
 }
 
+impl Prediction {
+    /// Empty series with room for `len` samples.
+    fn with_capacity(len: usize) -> Self {
+        Prediction {
+            iq: Vec::with_capacity(len),
+            omega_r: Vec::with_capacity(len),
+            i_ab: Vec::with_capacity(len),
+        }
+    }
+}
+
 /// Runs the model over the prepared data.
 ///
 /// Initial state from the measurement at the first sample: w_m = measured speed (0 without
@@ -366,11 +377,7 @@ fn simulate_with(
         return simulate_full(d, n, b, t, rot_at);
     }
     let len = d.len();
-    let mut out = Prediction {
-        iq: Vec::with_capacity(len),
-        omega_r: Vec::with_capacity(len),
-        i_ab: Vec::with_capacity(len),
-    };
+    let mut out = Prediction::with_capacity(len);
     if len == 0 || d.vq.len() != len {
         return out;
     }
@@ -682,11 +689,7 @@ fn simulate_full(
     rot_at: impl Fn(usize) -> C64,
 ) -> Prediction {
     let len = d.len();
-    let mut out = Prediction {
-        iq: Vec::with_capacity(len),
-        omega_r: Vec::with_capacity(len),
-        i_ab: Vec::with_capacity(len),
-    };
+    let mut out = Prediction::with_capacity(len);
     if len == 0 || d.vq.len() != len {
         return out;
     }

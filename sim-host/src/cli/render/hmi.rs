@@ -398,6 +398,16 @@ mod tests {
         }
     }
 
+    /// The demo motor run up 2 s, then commissioned ('c') and run 5 s more.
+    fn commissioned() -> (LiveSim, HmiState) {
+        let mut live = LiveSim::demo_motor().expect("reference motor");
+        let mut state = live.initial_state();
+        run(&mut live, &mut state, 2.0);
+        live.key(Key::Char('c'), &mut state);
+        run(&mut live, &mut state, 5.0);
+        (live, state)
+    }
+
     fn find<'a>(rows: &'a [String], text: &str) -> &'a str {
         rows.iter()
             .find(|r| r.contains(text))
@@ -406,11 +416,7 @@ mod tests {
 
     #[test]
     fn the_screen_after_commissioning_and_after_a_fault_at_80x24() {
-        let mut live = LiveSim::demo_motor().expect("reference motor");
-        let mut state = live.initial_state();
-        run(&mut live, &mut state, 2.0);
-        live.key(Key::Char('c'), &mut state);
-        run(&mut live, &mut state, 5.0);
+        let (mut live, mut state) = commissioned();
         let rows = screen(&state, 80, 24);
         // Commissioned: the learned bands, all lamps dark, healthy, no candidate.
         assert!(find(&rows, "residuals against").contains("(learned)"));
@@ -461,11 +467,7 @@ mod tests {
 
     #[test]
     fn the_isolation_names_rr_with_its_size() {
-        let mut live = LiveSim::demo_motor().expect("reference motor");
-        let mut state = live.initial_state();
-        run(&mut live, &mut state, 2.0);
-        live.key(Key::Char('c'), &mut state);
-        run(&mut live, &mut state, 5.0);
+        let (mut live, mut state) = commissioned();
         let rows = screen(&state, 80, 24);
         let before = find(&rows, " named: ");
         assert!(before.contains("no deviation"), "{before}");
