@@ -122,3 +122,30 @@ fn healthy_machines_shorted_windings_and_unbalanced_supplies_blame_no_sensor() {
         .collect();
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+/// A current-only log at 1 kHz (the analysis' PLL then locks to the currents, which the
+/// wrong sensor unbalances): the sensor's phase and size are still found, and no winding is
+/// blamed for what is left of its negative sequence.
+#[test]
+fn current_only_1khz_names_the_sensor_not_a_winding() {
+    for p in [ParamFile::reference_2p2kw(), ParamFile::reference_3hp()] {
+        let mut sc = Scenario::steady(8.0, 1_000.0);
+        sc.sensors = SensorSpec::default();
+        let mut f = FaultSpec::sensor_gain(Fault::CurrentSensor, 4.0, -0.15);
+        f.phase = Some(Phase::C);
+        sc.faults.push(f);
+        let rows = simulate_to_vec(&p, &sc).expect("simulate"); // ok: test
+        let currents_only = sim_host::log::Channels {
+            voltages: false,
+            speed: false,
+            encoder: false,
+        };
+        let rep =
+            diagnose_rows(&p, currents_only, &rows, ReplayOptions::default()).expect("replay"); // ok: test
+        let u = &rep.unbalance;
+        let s = u.current_sensor_phase.as_ref().expect("the sensor found"); // ok: test
+        assert_eq!(s.phase, "c", "{u:?}");
+        assert!((s.gain_error + 0.15).abs() <= 0.03, "{u:?}");
+        assert_eq!(u.suspect_phase, None, "{u:?}");
+    }
+}
