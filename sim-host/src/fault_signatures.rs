@@ -36,6 +36,10 @@ pub struct Protocol {
     pub load_scale: f64,
     /// Seed of the sensor noise.
     pub seed: u64,
+    /// The voltage ADC's full scale [V] (`None`: the simulator's default, 1.2 x the peak
+    /// phase voltage rounded up to 50 V, which a +50 % voltage-sensor gain error drives
+    /// into clipping: the readings' fundamental is then about +36 %, not +50 %).
+    pub v_range_v: Option<f64>,
 }
 
 impl Default for Protocol {
@@ -48,6 +52,7 @@ impl Default for Protocol {
             angle_source: AngleSource::RotorFluxCurrentModel,
             load_scale: 1.0,
             seed: 1,
+            v_range_v: None,
         }
     }
 }
@@ -93,6 +98,7 @@ pub struct Table1Row {
 pub fn scenario(fault: Option<(Fault, f64)>, proto: &Protocol) -> Scenario {
     let mut s = Scenario::steady(proto.duration_s, proto.sample_rate_hz);
     s.sensors = SensorSpec::default();
+    s.sensors.v_range_v = proto.v_range_v;
     s.seed = proto.seed;
     if proto.load_scale != 1.0 {
         s.load.steps.push(LoadStep {

@@ -87,3 +87,29 @@ fn a_wrong_name_is_counted() {
     assert_eq!(c.size_error, None);
     assert_eq!(c.mode, "pll");
 }
+
+/// Issue 9's small faults: Rs at -10 and +10 % on the 3 hp and the 11 kW machines (0.2 % of
+/// |V| on the 3 hp machine), both loads, both angle modes (16 runs). With a 0.5 s
+/// exponential average and the learned spreads floored at 0.15 % of |V| none of them was
+/// detected; the follower's 2 s mean brings the scatter to 0.02 % and the floor to 0.04 %
+/// (`monitor_core::isolation::LEARNED_SPREAD_FLOOR`): every case is named `rs` alone, its
+/// size within 20 %, and nothing else is named.
+#[test]
+fn rs_ten_percent_is_named_on_the_small_and_the_large_machine() {
+    let m = motors().expect("the 11 kW file parses"); // ok: test
+    let plan = BenchPlan {
+        motors: m.into_iter().filter(|m| m.name != "2.2 kW").collect(),
+        faults: vec![Fault::Rs],
+        changes: vec![-0.1, 0.1],
+        loads: LOADS.to_vec(),
+        modes: vec![AngleSource::RotorFluxCurrentModel, AngleSource::Pll],
+    };
+    let b = run(&plan, || {}).expect("the bench runs"); // ok: test
+    assert_eq!(b.cases.len(), 16);
+    for c in &b.cases {
+        assert!(c.right, "{c:?}");
+        assert!(c.wrong_names.is_empty(), "{c:?}");
+        let err = c.size_error.expect("a size"); // ok: test
+        assert!(err <= 0.2, "{c:?}");
+    }
+}

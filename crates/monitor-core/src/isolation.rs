@@ -55,6 +55,14 @@
 //!   changed);
 //! - **current and voltage sensor at no load**: both scale `Z` (the measured `V/I`); only
 //!   the torque balance separates them, and at no load the torque is small;
+//! - **Rr, the speed sensor and (near rated load) Ls**: `Z` and `Te` depend on the slip
+//!   frequency and Rr only through `ws / Rr`, so a speed reading a few tenths of a percent
+//!   off moves the voltage equations like a 10 % Rr change; the torque balance tells them
+//!   apart only through the load term `(B + Bl) wr` and, at a given current, through the
+//!   torque's slope in `ws / Rr`, which is zero at `ws Lr / Rr = 1` (`I_qs = i_ds`, about
+//!   rated load on small machines). There a stator-leakage change of 10 % also looks like
+//!   Rr +-1 % (measured on the 3 hp machine at rated load: rr, ls and speed_sensor at about
+//!   a third each; the isolation bench lists these cases);
 //! - others depend on the operating point (the angle between directions,
 //!   [`Isolation::separation_deg`]).
 //!
@@ -65,7 +73,10 @@
 //! the host alike.
 
 mod follower;
-pub use follower::{steady_against, Follower, Step, AVERAGE_S, CONFIRM_S, STEADY_FRACTION, STEP_S};
+pub use follower::{
+    steady_against, Follower, Step, AVERAGE_MAX_S, AVERAGE_S, BLOCKS, CONFIRM_S, STEADY_FRACTION,
+    STEP_S,
+};
 
 use crate::frames::Dq;
 use crate::machine::MotorModel;
@@ -123,6 +134,23 @@ impl SteadyPoint {
         }
     }
 
+    /// Adds `w` times `p` to this point (a weighted sum's step).
+    pub fn add_scaled(&mut self, p: &SteadyPoint, w: f32) {
+        self.i.d += w * p.i.d;
+        self.i.q += w * p.i.q;
+        self.v.d += w * p.v.d;
+        self.v.q += w * p.v.q;
+        self.we_rad_s += w * p.we_rad_s;
+        self.wr_rad_s += w * p.wr_rad_s;
+    }
+
+    /// Multiplies every quantity by `k` (a weighted sum into a mean).
+    pub fn scale(&mut self, k: f32) {
+        let p = *self;
+        *self = SteadyPoint::default();
+        self.add_scaled(&p, k);
+    }
+
     /// Moves this point towards `p` by the fraction `a` (an exponential average's step).
     pub fn approach(&mut self, p: &SteadyPoint, a: f32) {
         self.i.d += a * (p.i.d - self.i.d);
@@ -160,8 +188,17 @@ impl Default for Baseline {
     }
 }
 
-/// The spreads used without a learned baseline, and the floor of learned ones.
+/// The spreads used without a learned baseline (the nominal parameters' own error at other
+/// operating points is in them).
 pub const DEFAULT_SPREAD: Residual3 = [0.0015, 0.0015, 0.004];
+
+/// The floor of learned spreads, for points averaged [`AVERAGE_MAX_S`]: the largest scatter
+/// of such points measured on simulated healthy runs of the 3 hp, 2.2 kW and 11 kW machines
+/// (5 kHz, 12-bit sensors, 0.1 % noise; 24 runs, 4 seeds per machine and load) was 0.022 %
+/// of |V| on the voltage equations and 0.055 % of `T_base` on the torque balance, against
+/// 0.08 % and 0.44 % with the former 0.5 s exponential average; the floor is about twice
+/// that (a commissioning window's scatter understates what a longer run meets).
+pub const LEARNED_SPREAD_FLOOR: Residual3 = [0.0004, 0.0004, 0.001];
 
 /// One fault's fit.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -371,7 +408,7 @@ impl Isolator {
     }
 
     /// Ends learning: the learned mean and twice the learned standard deviation (at least
-    /// [`DEFAULT_SPREAD`]: a short window's scatter understates what a longer run meets) go into force. Returns false, and keeps the baseline in force,
+    /// [`LEARNED_SPREAD_FLOOR`]: a short window's scatter understates what a longer run meets) go into force. Returns false, and keeps the baseline in force,
     /// with fewer than 10 points learned.
     pub fn finish_learning(&mut self) -> bool {
         let l = self.learning;
@@ -381,7 +418,7 @@ impl Isolator {
         }
         let n = l.n as f32;
         let mut spread = [0.0; 3];
-        for ((s, m2), d) in spread.iter_mut().zip(l.m2).zip(DEFAULT_SPREAD) {
+        for ((s, m2), d) in spread.iter_mut().zip(l.m2).zip(LEARNED_SPREAD_FLOOR) {
             *s = crate::maxf(2.0 * crate::sqrt(m2 / (n - 1.0)), d);
         }
         self.set_baseline(Baseline {
@@ -442,6 +479,22 @@ impl Isolator {
             (te - tl) / self.torque_base_nm,
         ];
         e.iter().all(|x| x.is_finite()).then_some(e)
+    }
+
+    /// [`Isolator::isolate`] with the baseline's spreads multiplied by `spread_scale`
+    /// (>= 1; values below 1 or not finite count as 1): a point averaged for a shorter time
+    /// scatters more ([`Follower`]: `sqrt(AVERAGE_MAX_S / averaged)`).
+    pub fn isolate_scaled(&self, p: &SteadyPoint, spread_scale: f32) -> Isolation {
+        let k = if spread_scale.is_finite() {
+            crate::maxf(spread_scale, 1.0)
+        } else {
+            1.0
+        };
+        let mut scaled = *self;
+        for s in scaled.baseline.spread.iter_mut() {
+            *s *= k;
+        }
+        scaled.isolate(p)
     }
 
     /// Isolates the fault at the steady operating point `p` (module docs). Never panics;
@@ -982,7 +1035,8 @@ mod tests {
                 other => panic!("while learning: {other:?}"), // ok: test
             }
         }
-        assert!((30..=45).contains(&learned), "{learned} points learned");
+        // One point per STEP_S block once AVERAGE_S is averaged: 0.5..2.49 s.
+        assert!((19..=21).contains(&learned), "{learned} points learned");
         assert_eq!(
             f.observe(&healthy, dt, true, false),
             Step::LearningEnded(true)
@@ -1018,7 +1072,8 @@ mod tests {
                 _ => {}
             }
         }
-        assert!(unconfirmed >= 9, "{unconfirmed} unconfirmed isolations");
+        // One per STEP_S block for CONFIRM_S.
+        assert!(unconfirmed >= 4, "{unconfirmed} unconfirmed isolations");
         let c = named.unwrap_or_else(|| panic!("Rr +40 % not named: {:?}", f.last())); // ok: test
         assert_eq!(c.fault, Fault::Rr);
         assert!((c.change - 0.4).abs() < 0.04, "size {}", c.change);

@@ -11,7 +11,7 @@
 //! ([`monitor_core::isolation::Follower`]: the same code the firmware runs; the firmware
 //! feeds it the monitor's own outputs, [`SteadyPoint::from_output`]).
 
-use monitor_core::isolation::{Candidate, Follower, Named, Step};
+use monitor_core::isolation::{Candidate, Follower, Named, Step, DEFAULT_SPREAD};
 use monitor_core::sequence::SinglePhaseGain;
 use monitor_core::{
     CommissioningState, Fault, Isolation, IsolationState, Isolator, MonitorOutput, SteadyPoint,
@@ -149,6 +149,10 @@ impl IsolationTracker {
             unknown_probability: iso.unknown_probability,
             separation_deg: iso.separation_deg,
             residuals: iso.residuals,
+            spread: self
+                .follower
+                .as_ref()
+                .map_or(DEFAULT_SPREAD, |f| f.isolator().baseline().spread),
             baseline: if learned {
                 "learned in commissioning"
             } else {
@@ -280,6 +284,9 @@ pub struct IsolationReport {
     pub separation_deg: f32,
     /// The parity residuals `[e_d, e_q, e_T]` minus the baseline.
     pub residuals: [f32; 3],
+    /// The healthy spread of each residual (one standard deviation of the baseline in
+    /// force): the unit of `deviation_sigma`.
+    pub spread: [f32; 3],
     /// `learned in commissioning` or `nominal parameters`.
     pub baseline: String,
     /// The first fault named and when [s].
@@ -300,6 +307,7 @@ impl IsolationReport {
             unknown_probability: 0.0,
             separation_deg: 0.0,
             residuals: [0.0; 3],
+            spread: DEFAULT_SPREAD,
             judged_at_s: 0.0,
             baseline: if learned {
                 "learned in commissioning"
