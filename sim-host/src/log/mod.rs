@@ -24,6 +24,7 @@
 //!   target, renamed on [`LogWriter::finish`], so an interrupted run never leaves a
 //!   half-written output and never touches an input.
 
+pub mod clipping;
 mod exact;
 mod fast;
 pub mod parquet;

@@ -297,10 +297,23 @@ pub struct DataQuality {
     pub actions: Vec<String>,
     /// What the user should know (also printed on stderr).
     pub warnings: Vec<String>,
+    /// Voltage and current channels that clip ([`super::clipping`]): not trusted.
+    pub clipped: Vec<ClippedChannel>,
     /// False when the command's verdict would rest on data the stage rejected.
     pub trusted: bool,
     /// Why not trusted.
     pub not_trusted_because: Vec<String>,
+}
+
+/// A channel whose readings clip ([`super::clipping`]).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct ClippedChannel {
+    /// Column name (`va_V` ... `ic_A`).
+    pub column: String,
+    /// Share of its samples at the flat top, (0, 1].
+    pub share: f64,
+    /// The flat top's value [V or A].
+    pub value: f64,
 }
 
 impl DataQuality {
@@ -405,6 +418,14 @@ impl DataQuality {
                     "the currents alternate at {f:.1} Hz but the parameter file's supply is {supply_hz} Hz: check f_hz (a V/f drive below base speed also shows this)"
                 ));
             }
+        }
+        for c in &self.clipped {
+            distrust.push(format!(
+                "{} clips: {:.1} % of its samples sit at {} (a sensor or ADC past its full scale: the readings' amplitude, and every size and residual from it, is not the signal's)",
+                c.column,
+                100.0 * c.share,
+                c.value
+            ));
         }
         self.trusted = distrust.is_empty();
         self.warnings = warn;
@@ -553,6 +574,7 @@ pub struct QualityStage<'a, S: CleanSink> {
     back_run: (usize, f64),
     burst: Option<(f64, f64)>,
     crossings: CrossingCounter,
+    clips: super::clipping::ClipTracker,
     jitter: (f64, u64),
     dropping: bool,
     q: DataQuality,
@@ -577,6 +599,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             back_run: (0, f64::NAN),
             burst: None,
             crossings: CrossingCounter::default(),
+            clips: super::clipping::ClipTracker::default(),
             jitter: (0.0, 0),
             dropping: false,
             q: DataQuality::default(),
@@ -614,6 +637,16 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         }
         self.q.current_frequency_hz = self.crossings.median_period().map(|p| 1.0 / p);
         self.q.timestamp_jitter_rms_s = (self.jitter.0 / self.jitter.1.max(1) as f64).sqrt();
+        self.q.clipped = self
+            .clips
+            .clipped()
+            .into_iter()
+            .map(|(column, share, value)| ClippedChannel {
+                column,
+                share,
+                value,
+            })
+            .collect();
         self.q.assess(self.limits.supply_hz);
         Ok(self.q)
     }
@@ -808,6 +841,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         self.dropping = false;
         self.q.rows_passed += 1;
         let bad = BadCells::of(&r, &self.limits);
+        self.clips.push(&r, |c| !bad.has(c));
         if bad.any() {
             self.q.bad_rows += 1;
             for c in Column::ALL {

@@ -1,0 +1,192 @@
+//! Clipped sensors: a voltage or current channel whose readings sit at one extreme value
+//! for a large share of the samples (the flat tops of a sensor or ADC driven past its full
+//! scale).
+//!
+//! A clipped sine's fundamental is not the signal's: a +50 % voltage-sensor gain error on
+//! a front end with 1.2 x headroom reads as +36 % (measured with the simulator's default
+//! ranges), so every figure that rests on the amplitude (the residuals, the isolation's
+//! sizes, the sequence analysis) would be wrong with no sign of it. The data-quality stage
+//! ([`super::quality`]) counts, per channel, the samples equal to the channel's largest and
+//! its smallest value (streaming: the count restarts when a new extreme appears). An
+//! unclipped sine sampled by an `n`-bit ADC spends about `2 sqrt(2 / 2^(n-1)) / (2 pi)` of
+//! its samples within one code of each peak (1 % at 12 bits, 4 % at 8 bits) and, with any
+//! noise, far fewer at exactly one value; a sine clipped to `c` of its amplitude spends
+//! `acos(c) / pi` at each flat top (19.5 % for the +50 % case above, 5 % when the peak is
+//! 1.2 % over full scale). The share is over the whole log: a fault that clips for the
+//! last 3 s of a 7.5 s log shows 7.8 %, and one that clips for less than a quarter of a
+//! log can go unnoticed (a windowed count would find it; not done yet).
+
+use super::Column;
+
+/// A channel is clipped when more than this share of its samples equal its largest or its
+/// smallest value (module docs: 4 % for an unclipped full-scale sine at 8 bits).
+pub const CLIP_FRACTION: f64 = 0.05;
+
+/// Fewer samples than this in a channel are not judged.
+pub const MIN_SAMPLES: u64 = 1000;
+
+/// One channel's extremes and how often each was seen.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Extremes {
+    n: u64,
+    max: f64,
+    n_max: u64,
+    min: f64,
+    n_min: u64,
+}
+
+impl Extremes {
+    fn push(&mut self, x: f64) {
+        if self.n == 0 {
+            *self = Extremes {
+                n: 1,
+                max: x,
+                n_max: 1,
+                min: x,
+                n_min: 1,
+            };
+            return;
+        }
+        self.n += 1;
+        if x > self.max {
+            (self.max, self.n_max) = (x, 1);
+        } else if x == self.max {
+            self.n_max += 1;
+        }
+        if x < self.min {
+            (self.min, self.n_min) = (x, 1);
+        } else if x == self.min {
+            self.n_min += 1;
+        }
+    }
+
+    /// The share of samples at the more frequent extreme and that value, when the channel
+    /// is clipped: a channel that varies, with an extreme at least half its largest
+    /// magnitude (a flat top, not a stuck zero).
+    fn clipped(&self) -> Option<(f64, f64)> {
+        if self.n < MIN_SAMPLES || self.max <= self.min {
+            return None;
+        }
+        let peak = self.max.abs().max(self.min.abs());
+        let (count, value) = if self.n_max >= self.n_min {
+            (self.n_max, self.max)
+        } else {
+            (self.n_min, self.min)
+        };
+        let share = count as f64 / self.n as f64;
+        (share > CLIP_FRACTION && value.abs() >= 0.5 * peak).then_some((share, value))
+    }
+}
+
+/// The six analog channels' extremes (voltages a, b, c, currents a, b, c).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ClipTracker {
+    channels: [Extremes; 6],
+}
+
+/// The channels tracked, in [`ClipTracker`] order.
+const CHANNELS: [Column; 6] = [
+    Column::Va,
+    Column::Vb,
+    Column::Vc,
+    Column::Ia,
+    Column::Ib,
+    Column::Ic,
+];
+
+impl ClipTracker {
+    /// Counts one row's good cells (`good(c)`: the cell of `c` is finite and in range).
+    pub fn push(&mut self, row: &super::Row, good: impl Fn(Column) -> bool) {
+        let values = row.v_abc.map_or([None; 3], |v| v.map(Some));
+        let currents = row.i_abc.map(Some);
+        for ((e, c), x) in self
+            .channels
+            .iter_mut()
+            .zip(CHANNELS)
+            .zip(values.into_iter().chain(currents))
+        {
+            if let Some(x) = x.filter(|_| good(c)) {
+                e.push(x);
+            }
+        }
+    }
+
+    /// The clipped channels: name, share of samples at the flat top, and its value.
+    pub fn clipped(&self) -> Vec<(String, f64, f64)> {
+        self.channels
+            .iter()
+            .zip(CHANNELS)
+            .filter_map(|(e, c)| e.clipped().map(|(s, v)| (c.name().to_string(), s, v)))
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::log::Row;
+
+    /// A 50 Hz sine of amplitude `a` at 5 kHz on every channel, clipped to `full_scale`,
+    /// quantised to `bits`, with a little deterministic dither.
+    fn rows(a: f64, full_scale: f64, bits: u32, n: usize) -> ClipTracker {
+        let lsb = full_scale / f64::from(1u32 << (bits - 1));
+        let mut t = ClipTracker::default();
+        for k in 0..n {
+            let th = std::f64::consts::TAU * 50.0 * k as f64 / 5000.0;
+            let dither = 0.3 * lsb * ((k * 7919) % 13) as f64 / 13.0;
+            let x = |ph: f64| {
+                let y = (a * (th - ph).sin() + dither).clamp(-full_scale, full_scale);
+                (y / lsb).round() * lsb
+            };
+            let p = std::f64::consts::TAU / 3.0;
+            let r = Row {
+                t_s: k as f64 / 5000.0,
+                v_abc: Some([x(0.0), x(p), x(-p)]),
+                i_abc: [x(0.0), x(p), x(-p)],
+                wm_rad_s: None,
+                enc_count: None,
+            };
+            t.push(&r, |_| true);
+        }
+        t
+    }
+
+    #[test]
+    fn a_sine_within_full_scale_is_not_clipped_even_at_8_bits() {
+        for bits in [8, 12, 16] {
+            let c = rows(0.98, 1.0, bits, 20_000).clipped();
+            assert!(c.is_empty(), "{bits} bits: {c:?}");
+        }
+    }
+
+    #[test]
+    fn a_sine_past_full_scale_is_clipped_with_the_share_of_its_flat_tops() {
+        // 1.5 x clipped at 1.225: acos(1.225 / 1.5) / pi = 19.5 % at each flat top.
+        let c = rows(1.5, 1.225, 12, 20_000).clipped();
+        assert_eq!(c.len(), 6, "{c:?}");
+        for (name, share, value) in &c {
+            assert!((share - 0.195).abs() < 0.01, "{name}: {share}");
+            assert!((value.abs() - 1.225).abs() < 1e-3, "{name}: {value}");
+        }
+        // 10 % over full scale: acos(1 / 1.1) / pi = 13.7 % at each top.
+        let mild = rows(1.1, 1.0, 12, 20_000).clipped();
+        assert_eq!(mild.len(), 6, "{mild:?}");
+    }
+
+    #[test]
+    fn a_constant_or_short_channel_is_not_judged() {
+        let mut t = ClipTracker::default();
+        for k in 0..5000 {
+            let r = Row {
+                t_s: k as f64,
+                v_abc: Some([0.0; 3]),
+                i_abc: [1.0, 0.0, -1.0],
+                wm_rad_s: None,
+                enc_count: None,
+            };
+            t.push(&r, |_| true);
+        }
+        assert!(t.clipped().is_empty(), "{:?}", t.clipped());
+        assert!(rows(1.5, 1.0, 12, 500).clipped().is_empty());
+    }
+}
