@@ -25,7 +25,7 @@ use crate::liveness::{LivenessChange, SampleWatch};
 use crate::panel::{self, Mode, PanelInput, PanelLamps};
 use crate::reset_record::PreviousRun;
 use crate::sampling::{AdcSampler, RawFrame, SamplingError, TICK_HZ};
-use monitor_core::isolation::{Follower, Named};
+use monitor_core::isolation::{Baseline, Follower, Named, Step};
 use monitor_core::{
     CommissioningError, CommissioningRun, ConfigError, Fault, Install, Isolation, IsolationState,
     Isolator, Monitor, MonitorConfig, MotorModel, Operating, ReferenceMachine, SensorFlags,
@@ -457,6 +457,9 @@ pub struct Supervisor {
     failed_until_ms: Option<u32>,
     last_press_ms: Option<u32>,
     isolation: Option<Follower>,
+    /// The isolation baseline learned in the latest commissioning run (stored with its
+    /// calibration), `None` while learning or when that run learned too little.
+    run_baseline: Option<Baseline>,
     sample_rate_hz: u32,
     /// The monitor has evaluated once since boot (settled, voltage present).
     running: bool,
@@ -485,8 +488,19 @@ impl Supervisor {
                 .then(|| now_ms.wrapping_add(FAILED_BOOT_SHOW_MS)),
             last_press_ms: None,
             isolation: board_isolator().map(Follower::new),
+            run_baseline: None,
             sample_rate_hz: settings.sample_rate_hz,
             running: false,
+        }
+    }
+
+    /// Puts the isolation baseline of the record loaded at boot into force (the record the
+    /// core accepted), so that after a reset the isolation judges against the machine's own
+    /// baseline again. Returns whether one was put into force.
+    pub fn restore_isolation(&mut self, record: &CalibrationRecord) -> bool {
+        match (self.isolation.as_mut(), record.isolation) {
+            (Some(f), Some(b)) => f.restore_learned(b),
+            _ => false,
         }
     }
 
@@ -496,9 +510,20 @@ impl Supervisor {
         self.isolation.as_ref().and_then(Follower::last)
     }
 
+    /// The isolation baseline in force when it was learned in commissioning (this run or a
+    /// stored one); `None` with the nominal parameters' defaults.
+    pub fn isolation_baseline(&self) -> Option<Baseline> {
+        self.isolation
+            .as_ref()
+            .filter(|f| f.learned())
+            .map(|f| f.isolator().baseline())
+    }
+
     /// Feeds a new status to the fault isolation: its operating point, `dt` from the sample
     /// counter, usable once the monitor has evaluated with no sensor fault, learning while
-    /// a commissioning run is active (the core's schedule: `monitor_core::isolation::Follower`).
+    /// a commissioning run learns (the core's schedule: `monitor_core::isolation::Follower`).
+    /// Learning ends when the run stops learning, before its calibration is stored, so
+    /// that the baseline goes into the same record.
     fn follow(&mut self, s: &MonitorStatus, previous_samples: u32) {
         let Some(f) = self.isolation.as_mut() else {
             return;
@@ -506,7 +531,13 @@ impl Supervisor {
         let dt_s = s.samples.wrapping_sub(previous_samples) as f32 / self.sample_rate_hz as f32;
         self.running |= s.evaluating;
         let usable = self.running && !s.sensor_fault.any();
-        f.observe(&s.point, dt_s, usable, s.run.stage.is_active());
+        let learning = s.run.stage == monitor_core::RunStage::Learning;
+        if learning {
+            self.run_baseline = None;
+        }
+        if let Step::LearningEnded(ok) = f.observe(&s.point, dt_s, usable, learning) {
+            self.run_baseline = ok.then(|| f.isolator().baseline());
+        }
     }
 
     /// The latest status from the sample task.
@@ -546,6 +577,9 @@ impl Supervisor {
                 action = step.action;
                 run_ended = step.ended;
             }
+        }
+        if let Action::Store { record, .. } = &mut action {
+            record.isolation = self.run_baseline;
         }
         // The wrapping clock has reached `t` when `now - t` is "small" (less than half the
         // clock's range).

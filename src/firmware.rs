@@ -384,9 +384,14 @@ async fn main(_spawner: Spawner) {
         #[allow(clippy::panic)]
         Err(_) => panic!("monitor configuration rejected"),
     };
-    install_stored_calibration(&mut flash, &mut path);
+    let installed = install_stored_calibration(&mut flash, &mut path);
     let boot = Instant::now();
     let mut supervisor = Supervisor::new(&SETTINGS, previous, 0, path.status());
+    if let Some(rec) = installed {
+        if supervisor.restore_isolation(&rec) {
+            info!("isolation baseline restored from the record");
+        }
+    }
 
     // High-priority executor for the sample path.
     interrupt::UART4.set_priority(Priority::P1);
@@ -491,15 +496,31 @@ fn previous_run() -> PreviousRun {
     previous
 }
 
-/// Reads the commissioning record and gives it to the core.
-fn install_stored_calibration(flash: &mut BoardFlash, path: &mut SamplePath) {
+/// Reads the commissioning record and gives it to the core; returns it when the core
+/// accepted it.
+fn install_stored_calibration(
+    flash: &mut BoardFlash,
+    path: &mut SamplePath,
+) -> Option<flash_record::CalibrationRecord> {
     match flash_record::load(flash) {
         Ok(rec) => match path.command(Command::SetCalibration(rec)) {
-            Ok(()) => info!("commissioned: record loaded"),
-            Err(_) => warn!("stored calibration out of the core's range: not commissioned"),
+            Ok(()) => {
+                info!("commissioned: record loaded");
+                Some(rec)
+            }
+            Err(_) => {
+                warn!("stored calibration out of the core's range: not commissioned");
+                None
+            }
         },
-        Err(LoadError::Read(e)) => warn!("flash read failed: {}: not commissioned", e),
-        Err(LoadError::Record(e)) => warn!("no valid commissioning record: {}", e),
+        Err(LoadError::Read(e)) => {
+            warn!("flash read failed: {}: not commissioned", e);
+            None
+        }
+        Err(LoadError::Record(e)) => {
+            warn!("no valid commissioning record: {}", e);
+            None
+        }
     }
 }
 

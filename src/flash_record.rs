@@ -6,31 +6,49 @@
 //! that is not a complete, current-version record with a matching CRC and sane values
 //! is rejected with a [`RecordError`], and the firmware then runs "not commissioned".
 //!
-//! # Layout (little endian, [`RECORD_LEN`] = 48 bytes, a multiple of the G4's 8-byte
+//! Since version 2 it also stores the fault isolation's healthy baseline
+//! ([`monitor_core::isolation::Baseline`]: the mean and spread of its three parity
+//! residuals), learned in the same commissioning run, so that after a reset the isolation
+//! is judged against the machine's own baseline, not the nameplate parameters.
+//!
+//! # Layout (little endian, [`RECORD_LEN`] = 72 bytes, a multiple of the G4's 8-byte
 //! flash write unit)
 //!
 //! | bytes | field |
 //! |---|---|
 //! | 0..4 | magic `b"DMCR"` |
 //! | 4..6 | format version, `u16` ([`RECORD_VERSION`]) |
-//! | 6..8 | payload length in bytes, `u16` (= 32) |
+//! | 6..8 | payload length in bytes, `u16` (= 60) |
 //! | 8..24 | `mean[0..4]`, `f32` each |
 //! | 24..40 | `spread[0..4]`, `f32` each |
-//! | 40..44 | reserved, zero |
-//! | 44..48 | CRC-32 (IEEE 802.3, reflected, as zlib) of bytes 0..44 |
+//! | 40..52 | isolation baseline `mean[0..3]`, `f32` each (zero when absent) |
+//! | 52..64 | isolation baseline `spread[0..3]`, `f32` each (zero when absent) |
+//! | 64..68 | flags, `u32`: bit 0 set when the isolation baseline is present |
+//! | 68..72 | CRC-32 (IEEE 802.3, reflected, as zlib) of bytes 0..68 |
+//!
+//! Version 1 records (48 bytes: the lamps' statistics at 8..40, 4 reserved bytes, the CRC
+//! at 44..48) are still read, without an isolation baseline.
 //!
 //! Erased flash reads as all `0xFF`; that is reported as [`RecordError::Erased`].
+
+use monitor_core::isolation::Baseline;
 
 /// Magic bytes at the start of a record.
 pub const RECORD_MAGIC: [u8; 4] = *b"DMCR";
 /// Current record format version. Bump it whenever the layout or the meaning of the
 /// stored numbers changes (for example a new normalization in the core): old records
 /// are then rejected instead of misread.
-pub const RECORD_VERSION: u16 = 1;
+pub const RECORD_VERSION: u16 = 2;
 /// Encoded record length in bytes.
-pub const RECORD_LEN: usize = 48;
-const PAYLOAD_LEN: u16 = 32;
-const CRC_OFFSET: usize = 44;
+pub const RECORD_LEN: usize = 72;
+const PAYLOAD_LEN: u16 = 60;
+const CRC_OFFSET: usize = 68;
+/// Version 1: length, payload length and CRC offset.
+const V1_LEN: usize = 48;
+const V1_PAYLOAD_LEN: u16 = 32;
+const V1_CRC_OFFSET: usize = 44;
+/// Flag bit: the isolation baseline is present.
+const FLAG_ISOLATION: u32 = 1;
 
 /// Learned healthy statistics of the four residuals, as stored in flash.
 ///
@@ -43,6 +61,9 @@ pub struct CalibrationRecord {
     pub mean: [f32; 4],
     /// Spread (standard deviation) of each residual r1..r4 over the commissioning run, >= 0.
     pub spread: [f32; 4],
+    /// The fault isolation's baseline learned in the same run (`None`: not learned, or a
+    /// version 1 record); its spreads > 0.
+    pub isolation: Option<Baseline>,
 }
 
 /// Why a stored record was rejected.
@@ -112,7 +133,12 @@ pub fn crc32(data: &[u8]) -> u32 {
 }
 
 fn values_ok(rec: &CalibrationRecord) -> bool {
-    rec.mean.iter().all(|m| m.is_finite()) && rec.spread.iter().all(|s| s.is_finite() && *s >= 0.0)
+    rec.mean.iter().all(|m| m.is_finite())
+        && rec.spread.iter().all(|s| s.is_finite() && *s >= 0.0)
+        && rec.isolation.is_none_or(|b| {
+            b.mean.iter().all(|m| m.is_finite())
+                && b.spread.iter().all(|s| s.is_finite() && *s > 0.0)
+        })
 }
 
 impl From<monitor_core::Calibration> for CalibrationRecord {
@@ -120,6 +146,7 @@ impl From<monitor_core::Calibration> for CalibrationRecord {
         Self {
             mean: c.mean,
             spread: c.spread,
+            isolation: None,
         }
     }
 }
@@ -154,6 +181,19 @@ impl CalibrationRecord {
         for v in self.mean.iter().chain(self.spread.iter()) {
             w.put(&v.to_le_bytes());
         }
+        let iso = self.isolation.unwrap_or(Baseline {
+            mean: [0.0; 3],
+            spread: [0.0; 3],
+        });
+        for v in iso.mean.iter().chain(iso.spread.iter()) {
+            w.put(&v.to_le_bytes());
+        }
+        let flags = if self.isolation.is_some() {
+            FLAG_ISOLATION
+        } else {
+            0
+        };
+        w.put(&flags.to_le_bytes());
         let (body, crc_field) = out.split_at_mut(CRC_OFFSET);
         let crc = crc32(body);
         for (dst, src) in crc_field.iter_mut().zip(crc.to_le_bytes()) {
@@ -169,41 +209,54 @@ impl CalibrationRecord {
     /// See [`RecordError`]; checks run in the order truncated, erased, magic, version,
     /// length, checksum, values.
     pub fn decode(bytes: &[u8]) -> Result<Self, RecordError> {
-        let rec = bytes.get(..RECORD_LEN).ok_or(RecordError::Truncated)?;
-        if rec.iter().all(|&b| b == 0xFF) {
+        let head = bytes.get(..8).ok_or(RecordError::Truncated)?;
+        if head.iter().all(|&b| b == 0xFF) {
             return Err(RecordError::Erased);
         }
-        let mut r = Reader { buf: rec, pos: 0 };
+        let mut r = Reader { buf: head, pos: 0 };
         if r.take::<4>() != RECORD_MAGIC {
             return Err(RecordError::BadMagic);
         }
         let version = u16::from_le_bytes(r.take::<2>());
-        if version != RECORD_VERSION {
-            return Err(RecordError::UnsupportedVersion(version));
-        }
-        if u16::from_le_bytes(r.take::<2>()) != PAYLOAD_LEN {
+        let (len, payload, crc_at) = match version {
+            RECORD_VERSION => (RECORD_LEN, PAYLOAD_LEN, CRC_OFFSET),
+            1 => (V1_LEN, V1_PAYLOAD_LEN, V1_CRC_OFFSET),
+            v => return Err(RecordError::UnsupportedVersion(v)),
+        };
+        let rec = bytes.get(..len).ok_or(RecordError::Truncated)?;
+        if u16::from_le_bytes(r.take::<2>()) != payload {
             return Err(RecordError::BadLength);
         }
         let stored_crc = u32::from_le_bytes(
             Reader {
                 buf: rec,
-                pos: CRC_OFFSET,
+                pos: crc_at,
             }
             .take::<4>(),
         );
-        let body = rec.get(..CRC_OFFSET).ok_or(RecordError::Truncated)?;
+        let body = rec.get(..crc_at).ok_or(RecordError::Truncated)?;
         if crc32(body) != stored_crc {
             return Err(RecordError::BadChecksum);
         }
+        let mut r = Reader { buf: rec, pos: 8 };
         let mut out = Self {
             mean: [0.0; 4],
             spread: [0.0; 4],
+            isolation: None,
         };
-        for m in out.mean.iter_mut() {
-            *m = f32::from_le_bytes(r.take::<4>());
+        for v in out.mean.iter_mut().chain(out.spread.iter_mut()) {
+            *v = f32::from_le_bytes(r.take::<4>());
         }
-        for s in out.spread.iter_mut() {
-            *s = f32::from_le_bytes(r.take::<4>());
+        if version == RECORD_VERSION {
+            let mut b = Baseline {
+                mean: [0.0; 3],
+                spread: [0.0; 3],
+            };
+            for v in b.mean.iter_mut().chain(b.spread.iter_mut()) {
+                *v = f32::from_le_bytes(r.take::<4>());
+            }
+            let flags = u32::from_le_bytes(r.take::<4>());
+            out.isolation = (flags & FLAG_ISOLATION != 0).then_some(b);
         }
         if !values_ok(&out) {
             return Err(RecordError::InvalidValue);
@@ -332,7 +385,58 @@ mod tests {
         CalibrationRecord {
             mean: [0.01, -0.02, 0.003, 0.0],
             spread: [0.05, 0.04, 0.06, 0.07],
+            isolation: Some(Baseline {
+                mean: [1e-4, -2e-4, 3e-3],
+                spread: [4e-4, 4e-4, 1e-3],
+            }),
         }
+    }
+
+    #[test]
+    fn a_record_without_the_isolation_baseline_round_trips() {
+        let r = CalibrationRecord {
+            isolation: None,
+            ..sample()
+        };
+        assert_eq!(CalibrationRecord::decode(&r.encode().unwrap()), Ok(r));
+    }
+
+    #[test]
+    fn a_version_1_record_is_read_without_the_isolation_baseline() {
+        // Built by hand to the version 1 layout (module docs).
+        let mut v1 = [0u8; 48];
+        v1[..4].copy_from_slice(b"DMCR");
+        v1[4..6].copy_from_slice(&1u16.to_le_bytes());
+        v1[6..8].copy_from_slice(&32u16.to_le_bytes());
+        let s = sample();
+        for (k, v) in s.mean.iter().chain(s.spread.iter()).enumerate() {
+            v1[8 + 4 * k..12 + 4 * k].copy_from_slice(&v.to_le_bytes());
+        }
+        let crc = crc32(&v1[..44]);
+        v1[44..].copy_from_slice(&crc.to_le_bytes());
+        let mut page = [0xFFu8; RECORD_LEN];
+        page[..48].copy_from_slice(&v1);
+        let want = CalibrationRecord {
+            isolation: None,
+            ..s
+        };
+        assert_eq!(CalibrationRecord::decode(&page), Ok(want));
+        // A flipped bit in its payload is caught by its own CRC.
+        page[20] ^= 4;
+        assert_eq!(
+            CalibrationRecord::decode(&page),
+            Err(RecordError::BadChecksum)
+        );
+    }
+
+    #[test]
+    fn a_zero_isolation_spread_is_rejected() {
+        let mut r = sample();
+        r.isolation = Some(Baseline {
+            mean: [0.0; 3],
+            spread: [0.0, 1e-3, 1e-3],
+        });
+        assert_eq!(r.encode(), Err(RecordError::InvalidValue));
     }
 
     #[test]

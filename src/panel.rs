@@ -46,10 +46,11 @@
 //! names a fault (not the friction class, which a load change is to the paper's model)
 //! while the learned baseline of a commissioning run is in force: below the lamps'
 //! thresholds the isolation's three equations can still be outside their healthy spread.
-//! The isolation's baseline is learned in RAM by a commissioning run since boot (the flash
-//! record keeps only the lamps' thresholds): until then the blink code is the lamps' top
-//! candidate in `Fault::ALL` order, as before the isolation, and the isolation is only
-//! printed on the status line.
+//! The isolation's baseline is learned by a commissioning run and stored in the flash
+//! record beside the lamps' thresholds (record version 2; restored at boot): without one
+//! (never commissioned, or a version 1 record) the blink code is the lamps' top candidate
+//! in `Fault::ALL` order, as before the isolation, and the isolation is only printed on the
+//! status line.
 
 use crate::app::MonitorStatus;
 pub use crate::board::Lamp;
@@ -147,7 +148,7 @@ pub struct PanelInput {
 
 impl PanelInput {
     /// The panel's inputs for the latest status in `mode` and the latest `isolation`
-    /// judged against a baseline learned since boot (`None` without one): the residual
+    /// judged against a baseline learned in commissioning (`None` without one): the residual
     /// lamps, the fault lamp (the core's detection, or a fault the isolation names while
     /// commissioned: module docs), "input invalid" when a sensor fault is flagged with no
     /// residual lamp lit, and the blink code: the isolated fault's (or "not named"); without

@@ -6,11 +6,17 @@ use drive_monitor::app::{Command, SamplePath};
 use drive_monitor::flash_record::{
     crc32, CalibrationRecord, RecordError, RECORD_LEN, RECORD_VERSION,
 };
+use monitor_core::isolation::Baseline;
 
+/// A record with the isolation baseline (every byte of the layout in use).
 fn record() -> CalibrationRecord {
     CalibrationRecord {
         mean: [0.01, -0.02, 0.003, 0.0],
         spread: [0.05, 0.04, 0.06, 0.07],
+        isolation: Some(Baseline {
+            mean: [1e-4, -2e-4, 3e-3],
+            spread: [4e-4, 4e-4, 1e-3],
+        }),
     }
 }
 
@@ -29,8 +35,8 @@ fn every_single_bit_flip_is_rejected() {
 fn wrong_version_is_rejected_even_with_a_valid_crc() {
     let mut bad = record().encode().unwrap();
     bad[4..6].copy_from_slice(&(RECORD_VERSION + 1).to_le_bytes());
-    let crc = crc32(&bad[..44]);
-    bad[44..48].copy_from_slice(&crc.to_le_bytes());
+    let crc = crc32(&bad[..RECORD_LEN - 4]);
+    bad[RECORD_LEN - 4..].copy_from_slice(&crc.to_le_bytes());
     assert_eq!(
         CalibrationRecord::decode(&bad),
         Err(RecordError::UnsupportedVersion(RECORD_VERSION + 1))
@@ -69,6 +75,7 @@ fn values_out_of_the_cores_range_are_not_applied() {
     let rec = CalibrationRecord {
         mean: [5.0, 0.0, 0.0, 0.0],
         spread: [0.1; 4],
+        isolation: None,
     };
     let bytes = rec.encode().unwrap();
     let decoded = CalibrationRecord::decode(&bytes).unwrap();

@@ -185,11 +185,20 @@ impl Rig {
         survivors.watchdog_reset = false;
         survivors.flash.power_lost = false;
         let mut path = SamplePath::for_board(settings.sample_rate_hz).unwrap();
+        let mut installed = None;
         if let Ok(rec) = flash_record::load(&mut survivors.flash) {
             // A record the core rejects leaves the default thresholds (logged on the board).
-            let _ = path.command(drive_monitor::app::Command::SetCalibration(rec));
+            if path
+                .command(drive_monitor::app::Command::SetCalibration(rec))
+                .is_ok()
+            {
+                installed = Some(rec);
+            }
         }
-        let supervisor = Supervisor::new(&settings, previous, 0, path.status());
+        let mut supervisor = Supervisor::new(&settings, previous, 0, path.status());
+        if let Some(rec) = installed {
+            supervisor.restore_isolation(&rec);
+        }
         Rig {
             settings,
             survivors,
@@ -388,6 +397,7 @@ fn old_record() -> CalibrationRecord {
     CalibrationRecord {
         mean: [0.0, 0.001, -0.001, 0.0],
         spread: [0.004; 4],
+        isolation: None,
     }
 }
 
@@ -534,6 +544,59 @@ fn the_fault_lamp_blinks_the_isolated_fault_and_the_size_is_right() {
         }
     }
     assert!(wrong.is_empty(), "{wrong:#?}");
+}
+
+/// The isolation baseline learned in a commissioning run is stored with its calibration
+/// (record version 2) and put back into force at the next boot: a fault after a reset is
+/// isolated against the machine's own baseline, so the panel blinks the isolated fault
+/// and its size is right. Before, the baseline was lost at a reset and the panel fell back
+/// to the lamps' top candidate until the next commissioning.
+#[test]
+fn the_isolation_baseline_survives_a_reset() {
+    let frames_healthy = frames(&Scenario::steady(5.0, f64::from(FS)));
+    let mut rig = Rig::boot(Survivors::power_on(FakeFlash::erased()));
+    rig.run(&frames_healthy, |rig, k| {
+        if k == PRESS_AT {
+            rig.press();
+        }
+    })
+    .unwrap();
+    assert_eq!(rig.ended, [RunEnd::Commissioned { run: 1 }]);
+    let stored = CalibrationRecord::decode(&rig.survivors.flash.page).unwrap();
+    let learned = rig.supervisor.isolation_baseline();
+    let b = stored
+        .isolation
+        .expect("the run's isolation baseline is in the record");
+    assert_eq!(Some(b), learned, "the record holds the baseline in force");
+    for (s, floor) in b
+        .spread
+        .iter()
+        .zip(monitor_core::isolation::LEARNED_SPREAD_FLOOR)
+    {
+        assert!(*s >= floor && *s < 10.0 * floor, "{b:?}");
+    }
+
+    // Reset; Rr +50 % from 2 s on, no new commissioning.
+    let mut scenario = Scenario::steady(14.0, f64::from(FS));
+    scenario
+        .faults
+        .push(FaultSpec::parametric(Fault::Rr, 2.0, 0.5));
+    let frames_faulty = frames(&scenario);
+    let mut rig = Rig::boot(Survivors::power_on(rig.survivors.flash.clone()));
+    assert_eq!(rig.supervisor.isolation_baseline(), Some(b));
+    rig.run(&frames_faulty, |_, _| {}).unwrap();
+    let trace: Vec<bool> = rig
+        .seen
+        .iter()
+        .filter(|s| s.t_ms >= 4_000)
+        .map(|s| s.tick.lamps.fault)
+        .collect();
+    let code = panel::read_blink_code(&trace, PANEL_PERIOD_MS);
+    assert_eq!(code, Some(Fault::Rr.index() as u8 + 1));
+    let named = rig.supervisor.isolation().and_then(|i| i.named_fault());
+    let c = named.expect("Rr named"); // ok: test
+    assert_eq!(c.fault, Fault::Rr);
+    assert!((c.change - 0.5).abs() <= 0.1, "{c:?}");
 }
 
 #[test]
@@ -724,6 +787,7 @@ fn a_corrupt_or_unusable_record_at_boot_means_not_commissioned_everywhere() {
     let unusable = FakeFlash::holding(&CalibrationRecord {
         mean: [5.0, 0.0, 0.0, 0.0],
         spread: [0.1; 4],
+        isolation: None,
     });
     for flash in [flipped, unusable, FakeFlash::erased()] {
         let mut rig = Rig::boot(Survivors::power_on(flash));

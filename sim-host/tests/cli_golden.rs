@@ -67,7 +67,7 @@ const INTENDED: [(&str, &str, &str); 9] = [
 
 /// Keys added since the golden outputs were taken (issue 8: the data-quality stage's
 /// report, what commissioning did, the verdict, the range note beside a lamp).
-const ADDED: [&str; 31] = [
+const ADDED: [&str; 32] = [
     "data_quality",
     "commissioning",
     "verdict",
@@ -96,6 +96,8 @@ const ADDED: [&str; 31] = [
     // wrong ones).
     "names_given",
     "judged_at_s",
+    // The data-quality stage's clipped channels.
+    "clipped",
     // Issue 10: plausibility, identifiability, transient advice.
     "plausible",
     "implausible_because",

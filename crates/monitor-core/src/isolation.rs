@@ -96,6 +96,9 @@ const GOLDEN_STEPS: usize = 16;
 /// Misfit given to the unknown-fault hypothesis: 5 spreads on the 2 residual dimensions
 /// left after fitting a size.
 pub const UNKNOWN_CHI2: f32 = 25.0;
+/// Fewest averaged points a learned baseline needs: half a second of steady running after
+/// the first [`AVERAGE_S`] average, one point per [`STEP_S`] block.
+pub const MIN_LEARNED_POINTS: u32 = 5;
 /// A deviation below this misfit is no evidence of a fault: the 99.9 % point of chi-square
 /// with 3 degrees of freedom (16.3), for spreads of one standard deviation.
 pub const DETECT_CHI2: f32 = 16.0;
@@ -409,11 +412,11 @@ impl Isolator {
 
     /// Ends learning: the learned mean and twice the learned standard deviation (at least
     /// [`LEARNED_SPREAD_FLOOR`]: a short window's scatter understates what a longer run meets) go into force. Returns false, and keeps the baseline in force,
-    /// with fewer than 10 points learned.
+    /// with fewer than [`MIN_LEARNED_POINTS`] points learned.
     pub fn finish_learning(&mut self) -> bool {
         let l = self.learning;
         self.learning = Learning::default();
-        if l.n < 10 {
+        if l.n < MIN_LEARNED_POINTS {
             return false;
         }
         let n = l.n as f32;

@@ -137,7 +137,7 @@ impl Follower {
     /// `usable`: the point may be used (the monitor has settled and evaluates, no sensor
     /// fault); an unusable point drops the average. `learning`: commissioning is learning
     /// the healthy machine now; averaged points then go into the baseline, and its end puts
-    /// the learned baseline into force ([`Isolator::finish_learning`]: at least 10 points,
+    /// the learned baseline into force ([`Isolator::finish_learning`]: at least [`super::MIN_LEARNED_POINTS`] points,
     /// half a second of steady running). A point that is not steady against the average
     /// restarts it.
     pub fn observe(&mut self, p: &SteadyPoint, dt_s: f32, usable: bool, learning: bool) -> Step {
@@ -268,6 +268,15 @@ impl Follower {
         self.last = None;
         self.pending = None;
         self.held_s = 0.0;
+    }
+
+    /// Puts a baseline learned in an earlier commissioning into force (the firmware's
+    /// flash record) and counts it as learned ([`Follower::learned`]). Returns false, and
+    /// changes nothing, for a baseline [`Isolator::set_baseline`] refuses.
+    pub fn restore_learned(&mut self, b: super::Baseline) -> bool {
+        let ok = self.isolator.set_baseline(b);
+        self.learned |= ok;
+        ok
     }
 
     /// A baseline learned in commissioning is in force.
