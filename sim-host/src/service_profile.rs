@@ -85,6 +85,9 @@ pub struct Watch {
     pub first_alarm_s: Option<f64>,
     /// The learned calibration.
     pub calibration: Option<monitor_core::Calibration>,
+    /// Every name the fault isolation gave, with the first time [s] (`b/bl`, the friction
+    /// class, is what a load change is to the paper's model; any other is a false name).
+    pub isolation_names: Vec<(String, f64)>,
 }
 
 /// Runs the service profile (optionally with a fault) and watches the monitor after the
@@ -98,7 +101,23 @@ pub fn watch(
     duration_s: f64,
     fault: Option<FaultSpec>,
 ) -> Result<Watch, ExperimentError> {
-    let mut sc = healthy_service(params, seed, duration_s);
+    watch_mismatched(params, params, seed, duration_s, fault)
+}
+
+/// [`watch`] with the machine simulated from `truth` and the monitor told `nominal` (a
+/// nameplate's parameters, some tens of per cent off).
+///
+/// # Errors
+/// Simulator errors.
+pub fn watch_mismatched(
+    truth: &ParamFile,
+    nominal: &ParamFile,
+    seed: u64,
+    duration_s: f64,
+    fault: Option<FaultSpec>,
+) -> Result<Watch, ExperimentError> {
+    let params = nominal;
+    let mut sc = healthy_service(truth, seed, duration_s);
     sc.faults.extend(fault);
     let opts = ReplayOptions {
         angle_source: AngleSource::RotorFluxCurrentModel,
@@ -111,7 +130,7 @@ pub fn watch(
     let mut replay = Replay::new(params, sc.sensors.channels(), sc.sample_rate_hz, opts)?;
     let mut w = Watch::default();
     let dt = 1.0 / sc.sample_rate_hz;
-    simulate(params, &sc, |row| {
+    simulate(truth, &sc, |row| {
         let o = replay.push(row);
         if row.t_s > COMMISSION.1 {
             if o.evaluating {
@@ -124,5 +143,6 @@ pub fn watch(
         }
     })?;
     w.calibration = replay.calibration();
+    w.isolation_names = replay.isolation_names().to_vec();
     Ok(w)
 }

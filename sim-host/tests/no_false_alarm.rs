@@ -5,7 +5,7 @@
 
 use monitor_core::Fault;
 use sim_host::params::ParamFile;
-use sim_host::service_profile::watch;
+use sim_host::service_profile::{watch, watch_mismatched};
 use sim_host::sim::FaultSpec;
 
 #[test]
@@ -24,6 +24,17 @@ fn sixty_seconds_of_healthy_service_light_no_lamp() {
             w.alarm_samples, 0,
             "false alarm on the {} Hz motor at {:?} s, calibration {:?}",
             params.supply.f_hz, w.first_alarm_s, w.calibration
+        );
+        // Nor does the isolation name a fault (the friction class is a load change).
+        let false_names: Vec<_> = w
+            .isolation_names
+            .iter()
+            .filter(|(n, _)| n != "b/bl")
+            .collect();
+        assert!(
+            false_names.is_empty(),
+            "{} Hz motor: {false_names:?}",
+            params.supply.f_hz
         );
     }
 }
@@ -46,5 +57,59 @@ fn the_same_service_with_a_fault_does_light_a_lamp() {
                 params.supply.f_hz
             );
         }
+    }
+}
+
+/// The same healthy service with the monitor told parameters 15-25 % off (as from a
+/// nameplate): commissioning learns the baselines where the machine runs, and the
+/// isolation names no fault while the load and the supply step (the friction class aside,
+/// which a load change is to the paper's model).
+#[test]
+fn healthy_service_with_parameters_off_names_no_fault() {
+    for (truth, seed) in [
+        (ParamFile::reference_3hp(), 7),
+        (ParamFile::reference_2p2kw(), 11),
+    ] {
+        let mut nominal = truth.clone();
+        nominal.motor.rs_ohm *= 1.2;
+        nominal.motor.rr_ohm *= 0.8;
+        nominal.motor.lm_h *= 0.85;
+        nominal.motor.ls_h = nominal.motor.lm_h + 1.25 * (truth.motor.ls_h - truth.motor.lm_h);
+        nominal.motor.lr_h = nominal.motor.lm_h + 0.8 * (truth.motor.lr_h - truth.motor.lm_h);
+        let w = watch_mismatched(&truth, &nominal, seed, 115.0, None).expect("run");
+        let false_names: Vec<_> = w
+            .isolation_names
+            .iter()
+            .filter(|(n, _)| n != "b/bl")
+            .collect();
+        eprintln!(
+            "{} Hz motor: names {:?}, lamp samples {}, evaluated {:.1} s, commissioned {}",
+            truth.supply.f_hz,
+            w.isolation_names,
+            w.alarm_samples,
+            w.evaluated_s,
+            w.calibration.is_some()
+        );
+        assert!(w.evaluated_s >= 60.0 && w.calibration.is_some(), "{w:?}");
+        assert!(
+            false_names.is_empty(),
+            "{} Hz motor: {false_names:?}",
+            truth.supply.f_hz
+        );
+        // The same run with Rr +50 % from 50 s: the isolation does name it (it runs, and
+        // the parameters' error does not hide a real fault). Measured: `speed_sensor` is
+        // named first, 1.3 s after the fault, for about 5 s before `rr` (Rr and a speed
+        // reading move the circuit alike through ws / Rr; with the parameters off, the
+        // torque balance that separates them is off too). The same with the code before
+        // the 2 s mean (commit dbfd2f3): a known wrong transient name, left open.
+        let fault = FaultSpec::parametric(Fault::Rr, 50.0, 0.5);
+        let w = watch_mismatched(&truth, &nominal, seed, 115.0, Some(fault)).expect("run");
+        eprintln!("  with Rr +50 %: names {:?}", w.isolation_names);
+        assert!(
+            w.isolation_names
+                .iter()
+                .any(|(n, t)| n == "rr" && *t > 50.0),
+            "{w:?}"
+        );
     }
 }
