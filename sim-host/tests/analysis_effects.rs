@@ -14,14 +14,6 @@ use sim_host::sim::EffectSpec;
 
 const DYNAMICS: [&str; 2] = ["flux_dynamics", "current_dynamics"];
 
-/// Library effects this protocol does not hold yet, and why (README, "Broken rotor bars"):
-/// `rotor_asymmetry` is ranked first on both motors here, but its model (the rotor flux
-/// following i_ds at once, so delta comes out about twice the truth) cuts the error only
-/// 1.5-2x with noisy sensors (0.0278 -> 0.0172 on the 3 hp machine, noise floor 0.0062);
-/// `tests/rotor_asymmetry.rs` tests it on its own protocol (noise-free, rated and half
-/// load, 3.1-7.9x).
-const NOT_YET: [&str; 1] = ["rotor_asymmetry"];
-
 fn check_all(which: &str, noise: u32) {
     // d_axis_dynamics and cross_coupling_dynamics are the model's own simplifications with
     // nothing to inject (the simulator is always full order): `analysis_dynamics.rs`.
@@ -34,7 +26,6 @@ fn check_all(which: &str, noise: u32) {
             )
         })
         .map(|k| k.name())
-        .filter(|n| !NOT_YET.contains(n))
         .collect();
     check(which, noise, &names);
 }

@@ -17,9 +17,18 @@
 //! Ra = Rs + (Ls/Lr) Rr is multiplied by R_qq / Rr: the q current and the torque are then
 //! modulated at 2 s f in the rotor-flux frame, which in the stator frame is the (1 - 2s) f
 //! sideband, and the 2 s f torque ripple moves the speed, which makes the (1 + 2s) f one.
-//! Approximations: the d-q element (Rr delta/3) sin 2g, which disturbs the rotor flux at
-//! 2 s f, is left out (the measured I_ds carries part of it into Psi = Ls i_f); and the
-//! quasi-static I_qs (no La dI/dt) is exact only while 2 s f is well below Ra / (2 pi La).
+//! The d row drives the rotor flux phi = psi_r/Lm (exact rotor equation, first order in
+//! delta): `tau_r dphi/dt = I_ds - phi + (delta/3) [sin(2g) I_qs + (1 + cos(2g)) (I_ds - phi)]`.
+//! The second part matters although it looks second order: in a voltage-fed machine the
+//! rotor flux barely ripples (0.3 % of I_ds on the 3 hp motor at delta 0.2, against an
+//! I_ds ripple of 6 %), the drive and the I_ds ripple nearly cancel, and the flux's error
+//! reaches I_qs with a gain omega (Lm^2/Lr)/Ra of about 18. I_ds - phi is taken as the
+//! measured I_ds ripple (phi's own is a tenth of it), and the flux starts in its periodic
+//! response to the drive ([`EffectTerms::phi_drive_start`]; started from I_ds it rings for
+//! a rotor time constant, which a fit "explains" with a 4x shorter one). Approximations:
+//! the q row's sin(2g)(I_ds - phi) term (DC and 4 s f only) is left out, and without
+//! `flux_dynamics` the model's flux follows the smoothed I_ds at once, which makes the
+//! fitted delta about 2x the truth (README, "Broken rotor bars").
 //!
 //! # Broken bars
 //! For an N-bar cage with n adjacent broken bars the equivalent rotor phase resistance
@@ -50,8 +59,9 @@ use std::f64::consts::PI;
 /// Physical range of the fitted asymmetry delta: 0..1. One broken bar of a 28-bar cage is
 /// delta = 0.12, three adjacent ones 0.47, delta = 1 is n = N/6 (4.7 of 28); a cage
 /// beyond that has lost a third of a pole pitch of bars (Bellini et al. 2001 report 1 to
-/// 4 broken bars as the range of interest). The fit overestimates delta up to about 2x
-/// (module doc), which is why the range reaches 1 rather than 0.5.
+/// 4 broken bars as the range of interest). Without `flux_dynamics` in the model the fit
+/// overestimates delta up to about 2x (module doc), which is why the range reaches 1
+/// rather than 0.5.
 pub const DELTA_RANGE: (f64, f64) = (0.0, 1.0);
 /// Basis of [`DELTA_RANGE`].
 pub const DELTA_BASIS: &str = "delta = 3n/(N - 3n): up to N/6 adjacent broken bars (4.7 of 28; Kliman et al. 1988, Bellini et al. 2001)";
@@ -96,15 +106,35 @@ fn double_slip_angle(d: &Prepared) -> Vec<f64> {
     out
 }
 
-/// A first estimate of (delta, phi) from the measured I_qs: its component along
-/// cos(2 g), sin(2 g) (least squares after removing the slow part), scaled by
-/// I_qs (Ls/Lr) Rr / Ra (the quasi-static gain, without the speed's feedback).
-fn initial_estimate(d: &Prepared, n: &MachineConstants, ang: &[f64]) -> (f64, f64) {
-    let slow = zero_phase_lpf(&d.iq_pos, d.dt_s, 0.2);
+/// The measured I_ds less its part slower than the asymmetry's 2 s f (zero-phase low-pass
+/// at a fifth of the median |2 s f|, at least 0.1 Hz): what I_ds - phi is in the rotor flux
+/// equation, phi's own ripple being a tenth of I_ds's (module doc).
+fn id_ripple(d: &Prepared, ang: &[f64]) -> Vec<f64> {
+    let mut rate: Vec<f64> = ang
+        .windows(2)
+        .map(|w| ((w[1] - w[0]) / d.dt_s).abs())
+        .collect();
+    let fc = if rate.is_empty() {
+        0.1
+    } else {
+        let mid = rate.len() / 2;
+        let (_, m, _) = rate.select_nth_unstable_by(mid, f64::total_cmp);
+        (*m / (2.0 * PI) / 5.0).max(0.1)
+    };
+    let slow = zero_phase_lpf(&d.id, d.dt_s, fc);
+    d.id.iter().zip(slow).map(|(a, b)| a - b).collect()
+}
+
+/// A first estimate of (delta, phi) from the measured I_ds ripple `id_ripple`: the rotor
+/// flux barely ripples in a voltage-fed machine (the stator voltage holds the flux), so the
+/// asymmetry's drive of the flux equation (module doc) and the I_ds ripple nearly cancel:
+/// I_ds ripple = -(delta/3) I_qs sin(2g + phi) = A cos 2g + B sin 2g (least squares),
+/// A = -(delta/3) I_qs sin phi, B = -(delta/3) I_qs cos phi.
+fn initial_estimate(d: &Prepared, ang: &[f64], id_ripple: &[f64]) -> (f64, f64) {
     let (mut cc, mut ss, mut cs, mut yc, mut ys, mut iq) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-    for k in 0..ang.len() {
+    for k in 0..ang.len().min(id_ripple.len()) {
         let (s, c) = ang[k].sin_cos();
-        let y = d.iq_pos[k] - slow[k];
+        let y = id_ripple[k];
         cc += c * c;
         ss += s * s;
         cs += c * s;
@@ -119,9 +149,8 @@ fn initial_estimate(d: &Prepared, n: &MachineConstants, ang: &[f64]) -> (f64, f6
     let a = (yc * ss - ys * cs) / det;
     let b = (ys * cc - yc * cs) / det;
     let iq = (iq / ang.len() as f64).max(1e-6);
-    // I_qs ripple = +I_qs (rr_a/Ra) (delta/3) cos(2g + phi) = A cos 2g + B sin 2g.
-    let delta = 3.0 * a.hypot(b) / (iq * n.rr_a_ohm / n.ra_ohm);
-    (delta.clamp(0.02, 1.0), (-b).atan2(a))
+    let delta = 3.0 * a.hypot(b) / iq;
+    (delta.clamp(0.02, 1.0), (-a).atan2(-b))
 }
 
 impl EffectModel for RotorAsymmetry {
@@ -154,12 +183,16 @@ impl EffectModel for RotorAsymmetry {
             speed: true,
         }
     }
-    fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String> {
+    fn setup(&self, d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, String> {
         let ang = double_slip_angle(d);
         if ang.is_empty() {
             return Err("needs the speed column wm_rad_s (the rotor angle)".into());
         }
-        let (delta0, phi0) = initial_estimate(d, n, &ang);
+        // data = [2 (Np theta_m - theta) per sample, then the I_ds ripple per sample].
+        let ripple = id_ripple(d, &ang);
+        let (delta0, phi0) = initial_estimate(d, &ang, &ripple);
+        let mut data = ang;
+        data.extend(ripple);
         let any_angle = crate::params::PlausibleRange {
             lo: f64::NEG_INFINITY,
             hi: f64::INFINITY,
@@ -176,7 +209,7 @@ impl EffectModel for RotorAsymmetry {
             hi: vec![2.0, phi0 + 4.0 * PI],
             scale: vec![0.05, 0.3],
             plausible: vec![(delta_range, DELTA_BASIS), (any_angle, "any angle")],
-            data: ang,
+            data,
         })
     }
     fn apply(
@@ -187,29 +220,40 @@ impl EffectModel for RotorAsymmetry {
         _n: &MachineConstants,
         terms: &mut EffectTerms,
     ) {
-        if s.data.len() != d.len() {
+        let len = d.len();
+        if s.data.len() != 2 * len {
             return;
         }
+        let (ang, id_ripple) = s.data.split_at(len);
         let (delta, phi) = (p[0], p[1]);
-        let f = s
-            .data
+        let f = ang
             .iter()
             .map(|a| 1.0 + delta / 3.0 * (1.0 - (a + phi).cos()));
-        if terms.rr_factor.len() == d.len() {
+        if terms.rr_factor.len() == len {
             for (x, y) in terms.rr_factor.iter_mut().zip(f) {
                 *x *= y;
             }
         } else {
             terms.rr_factor = f.collect();
         }
-        // The d-q element (Rr delta/3) sin(2g) drives the rotor flux:
-        // tau_r dphi/dt = i_f - phi + (delta/3) sin(2g) I_qs (measured I_qs).
-        terms.phi_drive = s
-            .data
+        // The d row of the resistance matrix on the rotor current (module doc):
+        // tau_r dphi/dt = i_d - phi + (delta/3) [sin(2g) I_qs + (1 + cos(2g)) (I_ds - phi)],
+        // with I_ds - phi taken as the measured I_ds ripple (phi's own ripple is a tenth of
+        // it: the two first-order drives nearly cancel in a voltage-fed machine).
+        terms.phi_drive = ang
             .iter()
             .zip(&d.iq_pos)
-            .map(|(a, iq)| delta / 3.0 * (a + phi).sin() * iq)
+            .zip(id_ripple)
+            .map(|((a, iq), idr)| {
+                let (sn, cs) = (a + phi).sin_cos();
+                delta / 3.0 * (sn * iq + (1.0 + cs) * idr)
+            })
             .collect();
+        // The flux's periodic response to the drive at the first sample: the drive
+        // smoothed as i_f smooths I_ds (which makes the flux's start), over the first second.
+        let head = ((1.0 / d.dt_s) as usize).clamp(1, len);
+        terms.phi_drive_start +=
+            zero_phase_lpf(&terms.phi_drive[..head], d.dt_s, super::prep::I_F_SMOOTH_HZ)[0];
     }
     fn describe(&self, _s: &FitSetup, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
         let m = mcsa(d, n.np, None, Some(p[0]));

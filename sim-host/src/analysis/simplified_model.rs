@@ -133,6 +133,9 @@ pub struct EffectTerms {
     /// rotor time constant (the fitted one with `flux_dynamics`, else the nominal Lr/Rr,
     /// as a deviation added to the quasi-static flux); empty = 0.
     pub phi_drive: Vec<f64>,
+    /// The flux's periodic response to `phi_drive` at the first sample [A] (added to the
+    /// initial phi: a flux started without it rings for a rotor time constant).
+    pub phi_drive_start: f64,
     /// Multiplies Lm (saturation); empty = 1.
     pub lm_factor: Vec<f64>,
     /// Extra load torque on the shaft [N m] (speed independent); empty = 0.
@@ -392,7 +395,8 @@ fn simulate_with(
     let flux_decay = t.tau_r_s.map(|tau| (-dt / tau.max(1e-5)).exp());
     // The rotor flux's deviation driven by `phi_drive` when the flux is quasi-static.
     let drive_decay = (-dt * n.rr_ohm / n.lr_h).exp();
-    let mut phi_dev = 0.0f64;
+    phi += t.phi_drive_start;
+    let mut phi_dev = t.phi_drive_start;
     let mut inputs = InputSource::new(d, t);
     for k in 0..len {
         let x = inputs.at(k);
@@ -408,7 +412,7 @@ fn simulate_with(
             if k == 0 {
                 // The states start from the machine's own currents, not the terminal ones.
                 iq_state += cl.iq_shift;
-                phi = cl.i_f;
+                phi = cl.i_f + t.phi_drive_start;
             }
             cl
         } else {

@@ -196,8 +196,7 @@ pub fn scenario(which: &str, effect: Option<&str>, noise: u32) -> Scenario {
             // Two broken bars of 28 (delta 0.27, Kliman's relation) are what a user looks
             // for; the simulator's default (0.1, about one bar) leaves the 2sf ripple near
             // the noise on a 6 s log. 0.2 here, and 8 s so that the sidebands at (1 +/- 2s)f
-            // are resolved well beyond the 0.125 Hz bins (the protocol leaves it out for
-            // now: `analysis_effects::NOT_YET`).
+            // are resolved well beyond the 0.125 Hz bins.
             s.duration_s = 8.0;
             if let EffectSpec::RotorAsymmetry { delta, .. } = &mut e {
                 *delta = Some(0.2);
