@@ -78,21 +78,12 @@ impl Extremes {
     }
 }
 
-/// The six analog channels' extremes (voltages a, b, c, currents a, b, c).
+/// The six analog channels' extremes (voltages a, b, c, currents a, b, c: the first six
+/// of [`Column::MEASURED`]; zips stop at the six).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ClipTracker {
     channels: [Extremes; 6],
 }
-
-/// The channels tracked, in [`ClipTracker`] order.
-const CHANNELS: [Column; 6] = [
-    Column::Va,
-    Column::Vb,
-    Column::Vc,
-    Column::Ia,
-    Column::Ib,
-    Column::Ic,
-];
 
 impl ClipTracker {
     /// Counts one row's good cells (`good(c)`: the cell of `c` is finite and in range).
@@ -102,7 +93,7 @@ impl ClipTracker {
         for ((e, c), x) in self
             .channels
             .iter_mut()
-            .zip(CHANNELS)
+            .zip(Column::MEASURED)
             .zip(values.into_iter().chain(currents))
         {
             if let Some(x) = x.filter(|_| good(c)) {
@@ -115,7 +106,7 @@ impl ClipTracker {
     pub fn clipped(&self) -> Vec<(String, f64, f64)> {
         self.channels
             .iter()
-            .zip(CHANNELS)
+            .zip(Column::MEASURED)
             .filter_map(|(e, c)| e.clipped().map(|(s, v)| (c.name().to_string(), s, v)))
             .collect()
     }
