@@ -70,7 +70,7 @@ fn healthy_service_with_parameters_off_names_no_fault() {
         (ParamFile::reference_3hp(), 7),
         (ParamFile::reference_2p2kw(), 11),
     ] {
-        let mut nominal = truth.clone();
+        let mut nominal = truth;
         nominal.motor.rs_ohm *= 1.2;
         nominal.motor.rr_ohm *= 0.8;
         nominal.motor.lm_h *= 0.85;
