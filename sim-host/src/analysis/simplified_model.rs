@@ -373,6 +373,9 @@ fn simulate_with(
     t: &EffectTerms,
     rot_at: impl Fn(usize) -> C64,
 ) -> Prediction {
+    if t.d_axis && t.cross_coupling && t.la_h.is_some() && t.tau_r_s.is_some() {
+        return simulate_stationary(d, n, b, t, rot_at);
+    }
     if t.d_axis || t.cross_coupling {
         return simulate_full(d, n, b, t, rot_at);
     }
@@ -651,7 +654,7 @@ fn full_initial_state(d: &Prepared, n: &MachineConstants, m0: &FullMachine) -> F
         FullState {
             id: d.id[0],
             iq: d.iq_pos[0],
-            wm: wm0,
+            wm: d.omega_r.first().map_or(0.0, |w| w / n.np),
             ..Default::default()
         }
     } else {
@@ -788,6 +791,107 @@ fn simulate_full(
         if !(x.id.is_finite() && x.iq.is_finite() && x.pd.is_finite() && x.wm.is_finite()) {
             // A diverging trial of the fit: stop; the residuals of the missing samples are
             // large (the fit treats a short prediction as a bad one).
+            break;
+        }
+    }
+    out
+}
+
+/// The full-order machine (all four dynamics effects in the model) in the stationary
+/// frame, complex form (`i`, `psi_R` = alpha + j beta):
+/// ```text
+///   L_sigma di/dt = v - R i + (a - j omega_r) psi_R
+///   dpsi_R/dt     = Rr' i - (a - j omega_r) psi_R
+///   J dw_m/dt     = (3/2) Np Im(conj(psi_R) i) - (B + Bl) w_m - T_extra(w_m)
+/// ```
+/// with the symbols of [`simulate_full`]. Nothing of the machine's dynamics depends on
+/// the analysis frame: the frame only projects the outputs (I_qs) as it projects the
+/// measurement. (Run in the frame, the model must interpolate the inputs in a frame
+/// whose angle comes from the voltage-model flux estimate; through a start and at steps
+/// that frame turns by up to 0.3 rad per working sample against the rotor flux, and
+/// the inputs, read in one frame and integrated in another, leave an error of 2-10 % of
+/// the start current.) The input voltage between two working samples follows the
+/// rotation: `v(s) = (1-s) v_k e^{j w s dt} + s v_k+1 e^{-j w (1-s) dt}`, `w` the
+/// voltage's own phase step, exact for a steady rotating vector (a straight line between
+/// the samples would cut the circle's chord: 0.3 % at 50 Hz and 2 kHz). Classic RK4 per
+/// working sample. Iron loss adds `g j omega_s psi_s` to the output current.
+fn simulate_stationary(
+    d: &Prepared,
+    n: &MachineConstants,
+    b: &BaseParams,
+    t: &EffectTerms,
+    rot_at: impl Fn(usize) -> C64,
+) -> Prediction {
+    let len = d.len();
+    let mut out = Prediction::with_capacity(len);
+    if len == 0 || d.vq.len() != len {
+        return out;
+    }
+    let dt = d.dt_s;
+    let j = (n.j_kgm2 * b.j_scale).max(1e-9);
+    let btot = b.btot_nms.max(0.0);
+    let np = n.np;
+    let extra = |k: usize, w: f64| {
+        let coulomb = if t.coulomb_nm != 0.0 {
+            t.coulomb_nm * w.tanh()
+        } else {
+            0.0
+        };
+        coulomb + t.windage_nms2 * w * w.abs() + t.load_nm.get(k).copied().unwrap_or(0.0)
+    };
+    // Positive-sequence voltage, stationary frame.
+    let v_at = |k: usize| C64::new(d.vd[k], d.vq[k]) * rot_at(k);
+    let x0 = full_initial_state(d, n, &FullMachine::at(n, b, t, 0));
+    let r0 = rot_at(0);
+    let mut i = C64::new(x0.id, x0.iq) * r0;
+    let mut psi = C64::new(x0.pd, x0.pq) * r0;
+    let mut wm = x0.wm;
+    let mut v_next = v_at(0);
+    for k in 0..len {
+        let m = FullMachine::at(n, b, t, k);
+        let rot = rot_at(k);
+        let ineg = t.i_neg.get(k).copied().unwrap_or_default();
+        let mut i_out = i;
+        if t.g_fe_s != 0.0 {
+            let psi_s = i * m.l_sigma + psi;
+            i_out += C64::new(0.0, t.g_fe_s * d.omega_s[k]) * psi_s;
+        }
+        let i_ab = i_out + ineg;
+        out.iq.push((i_ab * rot.conj()).im);
+        out.omega_r.push(np * wm);
+        out.i_ab.push(i_ab);
+        if k + 1 == len {
+            break;
+        }
+        let v0 = v_next;
+        v_next = v_at(k + 1);
+        let v1 = v_next;
+        // The voltage's own rotation over the step (its phase step, wrapped).
+        let turn = if v0.norm() * v1.norm() > 0.0 {
+            (v1 * v0.conj()).arg()
+        } else {
+            0.0
+        };
+        let half = C64::from_polar(1.0, 0.5 * turn);
+        let vm = (v0 * half + v1 * half.conj()) * 0.5;
+        let r = m.rs + m.rr;
+        let inv_ls = 1.0 / m.l_sigma.max(1e-9);
+        let f = |i: C64, psi: C64, wm: f64, v: C64| -> (C64, C64, f64) {
+            let back = C64::new(m.a, -np * wm) * psi;
+            let di = (v - i * r + back) * inv_ls;
+            let dpsi = i * m.rr - back;
+            let te = 1.5 * np * (psi.conj() * i).im;
+            (di, dpsi, (te - btot * wm - extra(k, wm)) / j)
+        };
+        let h = dt;
+        let (a1, b1, c1) = f(i, psi, wm, v0);
+        let (a2, b2, c2) = f(i + a1 * (0.5 * h), psi + b1 * (0.5 * h), wm + c1 * 0.5 * h, vm);
+        let (a3, b3, c3) = f(i + a2 * (0.5 * h), psi + b2 * (0.5 * h), wm + c2 * 0.5 * h, vm);
+        let (a4, b4, c4) = f(i + a3 * h, psi + b3 * h, wm + c3 * h, v1);
+        i += (a1 + (a2 + a3) * 2.0 + a4) * (h / 6.0);
+        psi += (b1 + (b2 + b3) * 2.0 + b4) * (h / 6.0);
+        wm += (c1 + 2.0 * (c2 + c3) + c4) * (h / 6.0);
+        if !(i.re.is_finite() && i.im.is_finite() && psi.re.is_finite() && wm.is_finite()) {
             break;
         }
     }
