@@ -911,9 +911,20 @@ fn simulate_stationary(
         return out;
     }
     let dt = d.dt_s;
-    let point_samples = d.log_rate_hz * dt < 1.5;
-    // Positive-sequence voltage, stationary frame.
-    let v_at = |k: usize| C64::new(d.vd[k], d.vq[k]) * rot_at(k);
+    // A working sample is the mean of `factor` log rows: a vector turning at w comes out
+    // of the block mean scaled by `gain(w)`, the input voltage and the measured current
+    // alike. The machine is not linear in the voltage (the torque goes with its square:
+    // 0.2 % less torque through a start at 10 kHz, 1 % of the start current), so the
+    // model is driven by the voltage before the mean (v / gain) and its current is
+    // compared after it (gain i).
+    let factor = (d.log_rate_hz * dt).round().max(1.0);
+    let gain = |k: usize| {
+        let (a, c) = if k + 1 < len { (k, k + 1) } else { (k.saturating_sub(1), k) };
+        let w = phase_step(C64::new(d.vd[a], d.vq[a]) * rot_at(a), C64::new(d.vd[c], d.vq[c]) * rot_at(c)) / dt;
+        block_gain(w, dt / factor, factor)
+    };
+    // Positive-sequence voltage, stationary frame, before the block mean.
+    let v_at = |k: usize| C64::new(d.vd[k], d.vq[k]) * rot_at(k) / gain(k);
     let i_meas = |k: usize| d.i_ab[k] - d.i_neg[k];
     let x0 = full_initial_state(d, n, &FullMachine::at(n, b, t, 0));
     let r0 = rot_at(0);
@@ -947,7 +958,7 @@ fn simulate_stationary(
             let psi_s = x.i * sm.m.l_sigma + x.psi;
             i_out += C64::new(0.0, t.g_fe_s * d.omega_s[k]) * psi_s;
         }
-        let i_ab = i_out + ineg;
+        let i_ab = i_out * gain(k) + ineg;
         out.iq.push((i_ab * rot.conj()).im);
         out.omega_r.push(n.np * x.wm);
         out.i_ab.push(i_ab);
@@ -957,8 +968,7 @@ fn simulate_stationary(
         let v_after = v_at((k + 2).min(len - 1));
         let (v0, v1) = (v_cur, v_next);
         let w_old = phase_step(v_prev, v0) / dt;
-        let stepped = point_samples
-            && k > 0
+        let stepped = k > 0
             && (v1 - v0 * C64::from_polar(1.0, w_old * dt)).norm()
                 > prep::SUPPLY_STEP_REL * v0.norm().max(v1.norm());
         x = if stepped {
@@ -984,4 +994,15 @@ fn simulate_stationary(
         }
     }
     out
+}
+
+/// The discrete block mean's gain on a vector turning at `w` [rad/s]: the mean of
+/// `factor` samples `h` apart, `sin(F w h / 2) / (F sin(w h / 2))`.
+fn block_gain(w: f64, h: f64, factor: f64) -> f64 {
+    let x = 0.5 * w * h;
+    if x.abs() < 1e-9 {
+        1.0
+    } else {
+        (factor * x).sin() / (factor * x.sin())
+    }
 }
