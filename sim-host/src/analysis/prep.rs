@@ -16,8 +16,11 @@
 //!    frame it is not. Current-only logs use the nominal supply angle `2 pi f t` instead.
 //! 3. **Sequence separation**: the negative-sequence part of `x_alphabeta` is
 //!    `e^{-j theta} LPF(e^{+j theta} x)` (three first-order low-passes at
-//!    [`SEQ_LPF_HZ`]), the positive-sequence part is the rest. The balanced-machine model
-//!    is driven by the positive-sequence voltage and `i_f` = positive-sequence `i_ds`.
+//!    [`SEQ_LPF_HZ`]), the positive-sequence part is the rest; `theta` is the supply
+//!    voltage's own smoothed angle (the rotor-flux frame's for current-only logs), and
+//!    around supply steps the low-pass also runs backwards in time
+//!    (`SequenceSeparator`). The balanced-machine model is driven by the
+//!    positive-sequence voltage and `i_f` = positive-sequence `i_ds`.
 
 use crate::log::quality::{
     BadCells, CellLimits, CleanSink, DataQuality, QualityStage, SegmentBreak, TimeBase,
@@ -903,9 +906,7 @@ fn supply_steps(v_ab: &[C64], rot: &[C64]) -> Vec<usize> {
         return Vec::new();
     }
     let mid = mags.len() / 2;
-    let median = *mags
-        .select_nth_unstable_by(mid, |a, b| a.total_cmp(b))
-        .1;
+    let median = *mags.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1;
     let thr = SUPPLY_STEP_REL * median;
     (1..u.len())
         .filter(|&k| (u[k] - u[k - 1]).norm() > thr)
@@ -974,7 +975,13 @@ impl SequenceSeparator {
         let mut f = lpf3(&shifted, self.dt, SEQ_LPF_HZ, self.init_len, self.omega_2);
         if !self.steps.is_empty() {
             let rev: Vec<C64> = shifted.iter().rev().copied().collect();
-            let mut b = lpf3(&rev, self.dt, SEQ_LPF_HZ, self.init_len_end, -self.omega_2_end);
+            let mut b = lpf3(
+                &rev,
+                self.dt,
+                SEQ_LPF_HZ,
+                self.init_len_end,
+                -self.omega_2_end,
+            );
             b.reverse();
             let mut next = 0usize;
             for (k, fk) in f.iter_mut().enumerate() {

@@ -13,6 +13,10 @@
 //! both, but the steady-state parity equations (37) drop both, and on steady data neither
 //! matters; treating them as effects lets `explain` name them when transients dominate.
 //!
+//! With all four dynamics effects in, the model is the full-order machine driven by the
+//! measured voltages and runs in the stationary frame (`simulate_stationary`): the
+//! analysis frame then only projects its outputs.
+//!
 //! The mechanical equation is integrated semi-implicitly (the speed dependence of the
 //! quasi-static torque is taken at the new speed), so the step is stable at any working rate.
 //! Effects enter through [`EffectTerms`]: per-sample series computed from the measured inputs
@@ -849,7 +853,15 @@ impl<F: Fn(f64) -> f64> StatMachine<'_, F> {
 
     /// One working sample `dt` across a supply step at the fraction `phi` of it: the old
     /// voltage `v0` turning at `w_old` before, the new `v1` turning at `w_new` after.
-    fn across_step(&self, x: &StatState, dt: f64, phi: f64, v0: C64, v1: C64, w: [f64; 2]) -> StatState {
+    fn across_step(
+        &self,
+        x: &StatState,
+        dt: f64,
+        phi: f64,
+        v0: C64,
+        v1: C64,
+        w: [f64; 2],
+    ) -> StatState {
         let (ha, hb) = (phi * dt, (1.0 - phi) * dt);
         let mut y = *x;
         if ha > 0.0 {
@@ -891,13 +903,17 @@ fn phase_step(a: C64, b: C64) -> f64 {
 /// and 2 kHz). Classic RK4 per working sample. Iron loss adds `g j omega_s psi_s` to the
 /// output current.
 ///
-/// A supply step between two point samples (a log at the working rate: no block mean
-/// that records where in the interval it fell) is placed where the current says it is:
-/// its instant changes the volt-seconds of the interval by up to `dV dt / 2` (2 % of
-/// the current for 0.2 s on the reference motors at 2 kHz), so the interval is
-/// integrated with the step at its start and at its end, and the fraction that brings
-/// the current at the next sample nearest the measured one (less the model's error at
-/// this sample) is used.
+/// A supply step (the voltage leaves its rotation by more than
+/// [`prep::SUPPLY_STEP_REL`]) is placed where the current says it is: where in the
+/// sampling interval it fell changes the interval's volt-seconds by up to `dV dt / 2`
+/// (2 % of the current for 0.2 s on the reference motors at 2 kHz), so the interval is
+/// integrated with the step at its start and at its end (the old vector turning on
+/// before it, the new one after), and the fraction that brings the current at the next
+/// sample nearest the measured one (less the model's error at this sample) is used.
+///
+/// Measured on effect-free simulated logs with a start, a V/f step and a dip, ideal
+/// sensors, true parameters (2.2 kW, 11 kW; 2, 5, 10 kHz): `normalized_rms_error`
+/// 0.0003-0.0007 (on the simulator's own rows at the log rate, point samples: below 1e-5).
 fn simulate_stationary(
     d: &Prepared,
     n: &MachineConstants,
@@ -919,8 +935,15 @@ fn simulate_stationary(
     // compared after it (gain i).
     let factor = (d.log_rate_hz * dt).round().max(1.0);
     let gain = |k: usize| {
-        let (a, c) = if k + 1 < len { (k, k + 1) } else { (k.saturating_sub(1), k) };
-        let w = phase_step(C64::new(d.vd[a], d.vq[a]) * rot_at(a), C64::new(d.vd[c], d.vq[c]) * rot_at(c)) / dt;
+        let (a, c) = if k + 1 < len {
+            (k, k + 1)
+        } else {
+            (k.saturating_sub(1), k)
+        };
+        let w = phase_step(
+            C64::new(d.vd[a], d.vq[a]) * rot_at(a),
+            C64::new(d.vd[c], d.vq[c]) * rot_at(c),
+        ) / dt;
         block_gain(w, dt / factor, factor)
     };
     // Positive-sequence voltage, stationary frame, before the block mean.
