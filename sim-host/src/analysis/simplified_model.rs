@@ -934,20 +934,23 @@ fn simulate_stationary(
     // model is driven by the voltage before the mean (v / gain) and its current is
     // compared after it (gain i).
     let factor = (d.log_rate_hz * dt).round().max(1.0);
-    let gain = |k: usize| {
-        let (a, c) = if k + 1 < len {
-            (k, k + 1)
-        } else {
-            (k.saturating_sub(1), k)
-        };
-        let w = phase_step(
-            C64::new(d.vd[a], d.vq[a]) * rot_at(a),
-            C64::new(d.vd[c], d.vq[c]) * rot_at(c),
-        ) / dt;
-        block_gain(w, dt / factor, factor)
-    };
-    // Positive-sequence voltage, stationary frame, before the block mean.
-    let v_at = |k: usize| C64::new(d.vd[k], d.vq[k]) * rot_at(k) / gain(k);
+    // Positive-sequence voltage (stationary frame, after the block mean) and the gain.
+    let v_mean: Vec<C64> = (0..len)
+        .map(|k| C64::new(d.vd[k], d.vq[k]) * rot_at(k))
+        .collect();
+    let gains: Vec<f64> = (0..len)
+        .map(|k| {
+            let (a, c) = if k + 1 < len {
+                (k, k + 1)
+            } else {
+                (k.saturating_sub(1), k)
+            };
+            block_gain(phase_step(v_mean[a], v_mean[c]) / dt, dt / factor, factor)
+        })
+        .collect();
+    let gain = |k: usize| gains[k];
+    // The voltage before the block mean.
+    let v_at = |k: usize| v_mean[k] / gains[k];
     let i_meas = |k: usize| d.i_ab[k] - d.i_neg[k];
     let x0 = full_initial_state(d, n, &FullMachine::at(n, b, t, 0));
     let r0 = rot_at(0);
