@@ -1015,6 +1015,42 @@ impl SequenceSeparator {
 mod tests {
     use super::*;
 
+    /// A balanced supply that steps from 100 % at 50 Hz to 60 % at 30 Hz (a V/f step)
+    /// has no negative sequence; the separation must not make one. Before it ran in the
+    /// supply's frame and both ways around steps: 0.3 % of the voltage for 0.2 s.
+    #[test]
+    fn a_supply_step_makes_no_negative_sequence() {
+        let p = ParamFile::reference_2p2kw();
+        let dt = 0.5e-3;
+        let vpk = p.supply.v_phase_peak();
+        let mut d = Decimated {
+            channels: crate::log::Channels {
+                voltages: true,
+                speed: false,
+                encoder: false,
+            },
+            factor: 1,
+            log_rate_hz: 1.0 / dt,
+            ..Default::default()
+        };
+        let mut phase = 0.0f64;
+        for k in 0..6000 {
+            let t = k as f64 * dt;
+            let (scale, f) = if t < 1.5 { (1.0, 50.0) } else { (0.6, 30.0) };
+            let v = C64::from_polar(vpk * scale, phase);
+            // A current lagging the voltage by 30 degrees.
+            let i = C64::from_polar(5.0 * scale, phase - 0.5);
+            d.t_s.push(t);
+            d.v_ab.push([v.re as f32, v.im as f32]);
+            d.i_ab.push([i.re as f32, i.im as f32]);
+            d.i0.push(0.0);
+            phase += 2.0 * std::f64::consts::PI * f * dt;
+        }
+        let prep = voltage_model_flux_frame(&d, &p);
+        let worst = prep.v_neg.iter().map(|x| x.norm()).fold(0.0, f64::max);
+        assert!(worst < 1e-3 * vpk, "|v_neg| up to {worst:.3} V of {vpk:.0} V");
+    }
+
     #[test]
     fn clarke_round_trip_in_f64() {
         use monitor_core::frames::inverse_clarke;
