@@ -1048,7 +1048,10 @@ mod tests {
         }
         let prep = voltage_model_flux_frame(&d, &p);
         let worst = prep.v_neg.iter().map(|x| x.norm()).fold(0.0, f64::max);
-        assert!(worst < 1e-3 * vpk, "|v_neg| up to {worst:.3} V of {vpk:.0} V");
+        assert!(
+            worst < 1e-3 * vpk,
+            "|v_neg| up to {worst:.3} V of {vpk:.0} V"
+        );
     }
 
     #[test]
