@@ -898,7 +898,8 @@ fn smooth_angle(theta: Vec<f64>, dt: f64) -> Vec<f64> {
 pub const SUPPLY_STEP_REL: f64 = 0.03;
 
 /// Working samples where the supply voltage steps: the voltage in its own frame
-/// (`rot` = e^{j theta_v}) jumps by more than [`SUPPLY_STEP_REL`] of the median voltage.
+/// (`rot` = e^{j theta_v}) jumps by more than [`SUPPLY_STEP_REL`] of the median voltage
+/// and ten times the median jump.
 fn supply_steps(v_ab: &[C64], rot: &[C64]) -> Vec<usize> {
     let u: Vec<C64> = v_ab.iter().zip(rot).map(|(v, r)| v * r.conj()).collect();
     let mut mags: Vec<f64> = u.iter().map(|x| x.norm()).collect();
@@ -907,10 +908,17 @@ fn supply_steps(v_ab: &[C64], rot: &[C64]) -> Vec<usize> {
     }
     let mid = mags.len() / 2;
     let median = *mags.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1;
-    let thr = SUPPLY_STEP_REL * median;
-    (1..u.len())
-        .filter(|&k| (u[k] - u[k - 1]).norm() > thr)
-        .collect()
+    let jumps: Vec<f64> = (1..u.len()).map(|k| (u[k] - u[k - 1]).norm()).collect();
+    let mut sorted = jumps.clone();
+    let typical = if sorted.is_empty() {
+        0.0
+    } else {
+        let m = sorted.len() / 2;
+        *sorted.select_nth_unstable_by(m, |a, b| a.total_cmp(b)).1
+    };
+    // An outlier, too: harmonics in a real supply move the vector every sample.
+    let thr = (SUPPLY_STEP_REL * median).max(10.0 * typical);
+    (1..u.len()).filter(|&k| jumps[k - 1] > thr).collect()
 }
 
 /// Positive/negative sequence separation by demodulation in the `-theta` frame

@@ -876,6 +876,16 @@ impl<F: Fn(f64) -> f64> StatMachine<'_, F> {
     }
 }
 
+/// The median of a series (0 when empty).
+fn median(x: &[f64]) -> f64 {
+    let mut v: Vec<f64> = x.iter().copied().filter(|a| a.is_finite()).collect();
+    if v.is_empty() {
+        return 0.0;
+    }
+    let mid = v.len() / 2;
+    *v.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1
+}
+
 /// The voltage's phase step over a working sample [rad] (0 when either is zero).
 fn phase_step(a: C64, b: C64) -> f64 {
     if a.norm() * b.norm() > 0.0 {
@@ -938,19 +948,33 @@ fn simulate_stationary(
     let v_mean: Vec<C64> = (0..len)
         .map(|k| C64::new(d.vd[k], d.vq[k]) * rot_at(k))
         .collect();
-    let gains: Vec<f64> = (0..len)
+    // The voltage's phase step over each working sample [rad].
+    let ph: Vec<f64> = (0..len)
         .map(|k| {
-            let (a, c) = if k + 1 < len {
-                (k, k + 1)
-            } else {
-                (k.saturating_sub(1), k)
-            };
-            block_gain(phase_step(v_mean[a], v_mean[c]) / dt, dt / factor, factor)
+            let a = k.min(len.saturating_sub(2));
+            phase_step(v_mean[a], v_mean[(a + 1).min(len - 1)])
         })
+        .collect();
+    let gains: Vec<f64> = ph
+        .iter()
+        .map(|&p| block_gain(p / dt, dt / factor, factor))
         .collect();
     let gain = |k: usize| gains[k];
     // The voltage before the block mean.
     let v_at = |k: usize| v_mean[k] / gains[k];
+    // How far the voltage leaves its rotation over each working sample (relative); a
+    // supply step is an outlier of it: above SUPPLY_STEP_REL and ten times the median
+    // (harmonics in a real supply move the vector off its circle every sample).
+    let dev: Vec<f64> = (0..len)
+        .map(|k| {
+            if k == 0 || k + 1 >= len {
+                return 0.0;
+            }
+            let (v0, v1) = (v_at(k), v_at(k + 1));
+            (v1 - v0 * C64::from_polar(1.0, ph[k - 1])).norm() / v0.norm().max(v1.norm()).max(1e-12)
+        })
+        .collect();
+    let step_thr = prep::SUPPLY_STEP_REL.max(10.0 * median(&dev));
     let i_meas = |k: usize| d.i_ab[k] - d.i_neg[k];
     let x0 = full_initial_state(d, n, &FullMachine::at(n, b, t, 0));
     let r0 = rot_at(0);
@@ -959,7 +983,7 @@ fn simulate_stationary(
         psi: C64::new(x0.pd, x0.pq) * r0,
         wm: x0.wm,
     };
-    let (mut v_prev, mut v_cur) = (v_at(0), v_at(0));
+    let mut v_cur = v_at(0);
     let mut v_next = v_at(1.min(len - 1));
     for k in 0..len {
         let extra = |w: f64| {
@@ -993,15 +1017,12 @@ fn simulate_stationary(
         }
         let v_after = v_at((k + 2).min(len - 1));
         let (v0, v1) = (v_cur, v_next);
-        let w_old = phase_step(v_prev, v0) / dt;
-        let stepped = k > 0
-            && (v1 - v0 * C64::from_polar(1.0, w_old * dt)).norm()
-                > prep::SUPPLY_STEP_REL * v0.norm().max(v1.norm());
-        x = if stepped {
-            let w = [w_old, phase_step(v1, v_after) / dt];
+        x = if dev[k] > step_thr {
+            let w = [ph[k - 1] / dt, ph[k + 1] / dt];
             let early = sm.across_step(&x, dt, 0.0, v0, v1, w);
             let late = sm.across_step(&x, dt, 1.0, v0, v1, w);
-            let target = i_meas(k + 1) - (i_meas(k) - x.i);
+            // The measured currents before the block mean, as the model's.
+            let target = i_meas(k + 1) / gain(k + 1) - (i_meas(k) / gain(k) - x.i);
             let span = late.i - early.i;
             let phi = if span.norm_sqr() > 0.0 {
                 ((target - early.i) * span.conj()).re / span.norm_sqr()
@@ -1010,11 +1031,11 @@ fn simulate_stationary(
             };
             sm.across_step(&x, dt, phi.clamp(0.0, 1.0), v0, v1, w)
         } else {
-            let half = C64::from_polar(1.0, 0.5 * phase_step(v0, v1));
+            let half = C64::from_polar(1.0, 0.5 * ph[k]);
             let vm = (v0 * half + v1 * half.conj()) * 0.5;
             sm.rk4(&x, dt, [v0, vm, v1])
         };
-        (v_prev, v_cur, v_next) = (v0, v1, v_after);
+        (v_cur, v_next) = (v1, v_after);
         if !(x.i.re.is_finite() && x.i.im.is_finite() && x.psi.re.is_finite() && x.wm.is_finite()) {
             break;
         }
