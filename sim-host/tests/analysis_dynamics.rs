@@ -60,8 +60,8 @@ fn transients(which: &str, rate_hz: f64) -> Scenario {
 }
 
 /// The ratio error / noise floor of `compare` with the paper's model and with the
-/// full-order machine over the whole log, and the latter's error, for one motor and rate.
-fn ratios(dir: &std::path::Path, which: &str, rate_hz: f64) -> (f64, f64, f64) {
+/// full-order machine over the whole log, for one motor and rate.
+fn ratios(dir: &std::path::Path, which: &str, rate_hz: f64) -> (f64, f64) {
     let p = params(which);
     let log = write_log(
         dir,
@@ -85,28 +85,30 @@ fn ratios(dir: &std::path::Path, which: &str, rate_hz: f64) -> (f64, f64, f64) {
         "{which} {rate_hz}: {:?}",
         full.implausible_because
     );
-    (r_paper, r_full, full.normalized_rms_error)
+    (r_paper, r_full)
 }
 
-/// Measured (README, "Starts and steps"): the full-order model's error is 0.0065-0.0099 on
-/// the reference motors (3-6x the noise floor) and 0.021 on the 11 kW machine (10-21x),
-/// where the paper's model is at 0.33-0.58 (84-430x). The issue's target (2x the noise
-/// floor) is NOT met: a rate-independent remainder of about 0.006 (the working series'
-/// reconstruction of the start and the steps) is left. The bounds here are what is
-/// reached: at least a 20-fold gain (measured 26-56x), and an error below 0.012 (reference motors) or 0.025.
+/// Measured (README, "Starts and steps"): the full-order model's error is 0.0015-0.0041,
+/// 0.9-1.1x the noise floor, on both reference motors and the 11 kW machine at 2, 5 and
+/// 10 kHz, where the paper's model is at 0.33-0.58 (84-425x): the issue's target (2x the
+/// noise floor) is met. (Before: 0.0065-0.022, 3-15x. The remainder came from the model
+/// starting a start at the 10 ms mean speed, the spurious negative-sequence voltage the
+/// sequence separation made through the start and after each step, the instant of a step
+/// inside a sampling interval, and the block mean's gain, which the torque sees squared;
+/// see `simplified_model::simulate_stationary`.) Bounds: within 1.3x the noise floor and
+/// at least a 75-fold gain (measured 88-380x).
 #[test]
 fn full_order_machine_follows_starts_and_steps() {
     let dir = tempfile::tempdir().unwrap();
     let mut failures = Vec::new();
     for which in ["2p2", "3hp", "11kw"] {
         for rate in [2000.0, 5000.0, 10_000.0] {
-            let (paper, full, full_error) = ratios(dir.path(), which, rate);
-            let bound = if which == "11kw" { 0.025 } else { 0.012 };
+            let (paper, full) = ratios(dir.path(), which, rate);
             // paper / full compares ratios to the same log's noise floors: the error gain.
             let gain = paper / full;
-            if !(full_error <= bound && gain >= 20.0) {
+            if !(full <= 1.3 && gain >= 75.0) {
                 failures.push(format!(
-                    "{which} {rate}: paper {paper:.1}x, full {full:.1}x"
+                    "{which} {rate}: paper {paper:.1}x, full {full:.1}x the noise floor"
                 ));
             }
         }
@@ -160,8 +162,11 @@ fn hidden_case(
 
 /// The hidden effects that are found through a start and steps (README, "Hidden effects
 /// under transients"): ranked first, claimed, and the error cut at least 5x or to within
-/// 2x the noise floor. The others (thermal drift, saturation, iron loss, friction,
-/// windage, phase asymmetry) are not yet: see the probe below.
+/// 2x the noise floor. The others are not (probe below, table in the README): iron loss,
+/// friction and windage are ranked first but at the simulator's defaults sit at the noise
+/// in this log (the error without them is already within 2x the floor, and `explain`
+/// rightly claims nothing); thermal drift, saturation, phase and rotor asymmetry leave
+/// 0.013-0.041 with the right effect in (their models do not follow a start).
 #[test]
 fn hidden_effects_under_transients_found() {
     use monitor_core::EffectKind;
@@ -196,4 +201,45 @@ fn hidden_effects_under_transients_probe() {
     {
         hidden_case(dir.path(), &which, kind);
     }
+}
+
+/// The full-order model with the true parameters (no fit) against effect-free logs of
+/// [`transients`] with ideal sensors: what is left is the analysis's own reconstruction
+/// of the working series (frame, sequence separation, block means, where a step fell),
+/// not noise and not a fit. Measured 0.0003-0.0007 (2.2 kW and 11 kW, 2 and 10 kHz);
+/// before the model ran in the stationary frame with the causes in the README fixed,
+/// 0.007-0.023.
+#[test]
+fn full_order_model_reproduces_the_simulator() {
+    use sim_host::analysis::{metrics, simplified_model as sm};
+    let dir = tempfile::tempdir().unwrap();
+    let mut failures = Vec::new();
+    for (which, rate) in [
+        ("2p2", 2000.0),
+        ("2p2", 10_000.0),
+        ("11kw", 2000.0),
+        ("11kw", 10_000.0),
+    ] {
+        let p = params(which);
+        let m = p.motor.model::<f64>();
+        let mut s = transients(which, rate);
+        s.sensors = sim_host::sim::SensorSpec::ideal();
+        let log = write_log(dir.path(), &format!("ideal_{which}_{rate}"), &p, &s, false);
+        let a = analyse(&log, &p, 0.0);
+        let terms = sm::EffectTerms {
+            tau_r_s: Some(m.lr_h / m.rr_ohm),
+            la_h: Some(m.la_h()),
+            d_axis: true,
+            cross_coupling: true,
+            ..Default::default()
+        };
+        let n = &a.constants;
+        let pred = sm::simulate(&a.data, n, &sm::BaseParams::nominal(n), &terms);
+        let e = metrics::errors(&a.data, &pred, None).normalized_rms_error;
+        eprintln!("{which} {rate} Hz, true parameters, ideal sensors: {e:.5}");
+        if e.is_nan() || e > 0.001 {
+            failures.push(format!("{which} {rate}: {e:.5}"));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
 }

@@ -13,13 +13,17 @@
 //! both, but the steady-state parity equations (37) drop both, and on steady data neither
 //! matters; treating them as effects lets `explain` name them when transients dominate.
 //!
+//! With all four dynamics effects in, the model is the full-order machine driven by the
+//! measured voltages and runs in the stationary frame (`simulate_stationary`): the
+//! analysis frame then only projects its outputs.
+//!
 //! The mechanical equation is integrated semi-implicitly (the speed dependence of the
 //! quasi-static torque is taken at the new speed), so the step is stable at any working rate.
 //! Effects enter through [`EffectTerms`]: per-sample series computed from the measured inputs
 //! (resistance factor, magnetising-inductance factor, extra load torque, negative-sequence
 //! current) and a speed-dependent extra torque evaluated inside the loop.
 
-use super::prep::{Prepared, C64};
+use super::prep::{self, Prepared, C64};
 use crate::params::ParamFile;
 
 /// The machine constants the simplified model and the effects need: the parameter file's
@@ -376,6 +380,9 @@ fn simulate_with(
     t: &EffectTerms,
     rot_at: impl Fn(usize) -> C64,
 ) -> Prediction {
+    if t.d_axis && t.cross_coupling && t.la_h.is_some() && t.tau_r_s.is_some() {
+        return simulate_stationary(d, n, b, t, rot_at);
+    }
     if t.d_axis || t.cross_coupling {
         return simulate_full(d, n, b, t, rot_at);
     }
@@ -655,7 +662,7 @@ fn full_initial_state(d: &Prepared, n: &MachineConstants, m0: &FullMachine) -> F
         FullState {
             id: d.id[0],
             iq: d.iq_pos[0],
-            wm: wm0,
+            wm: d.omega_r.first().map_or(0.0, |w| w / n.np),
             ..Default::default()
         }
     } else {
@@ -796,4 +803,257 @@ fn simulate_full(
         }
     }
     out
+}
+
+/// The state of the stationary-frame full-order model: stator current, rotor flux
+/// psi_R (both alpha + j beta), mechanical speed.
+#[derive(Debug, Clone, Copy)]
+struct StatState {
+    i: C64,
+    psi: C64,
+    wm: f64,
+}
+
+/// One working sample's machine and shaft for [`simulate_stationary`].
+struct StatMachine<'a, F: Fn(f64) -> f64> {
+    m: FullMachine,
+    np: f64,
+    j: f64,
+    btot: f64,
+    /// Extra shaft torque at a speed [N m].
+    extra: &'a F,
+}
+
+impl<F: Fn(f64) -> f64> StatMachine<'_, F> {
+    #[inline(always)]
+    fn deriv(&self, x: &StatState, v: C64) -> StatState {
+        let m = &self.m;
+        let back = C64::new(m.a, -self.np * x.wm) * x.psi;
+        let te = 1.5 * self.np * (x.psi.conj() * x.i).im;
+        StatState {
+            i: (v - x.i * (m.rs + m.rr) + back) / m.l_sigma.max(1e-9),
+            psi: x.i * m.rr - back,
+            wm: (te - self.btot * x.wm - (self.extra)(x.wm)) / self.j,
+        }
+    }
+
+    /// Classic RK4 over `h` with the input at the start, middle and end.
+    fn rk4(&self, x: &StatState, h: f64, v: [C64; 3]) -> StatState {
+        let add = |a: &StatState, b: &StatState, s: f64| StatState {
+            i: a.i + b.i * s,
+            psi: a.psi + b.psi * s,
+            wm: a.wm + b.wm * s,
+        };
+        let k1 = self.deriv(x, v[0]);
+        let k2 = self.deriv(&add(x, &k1, 0.5 * h), v[1]);
+        let k3 = self.deriv(&add(x, &k2, 0.5 * h), v[1]);
+        let k4 = self.deriv(&add(x, &k3, h), v[2]);
+        StatState {
+            i: x.i + (k1.i + (k2.i + k3.i) * 2.0 + k4.i) * (h / 6.0),
+            psi: x.psi + (k1.psi + (k2.psi + k3.psi) * 2.0 + k4.psi) * (h / 6.0),
+            wm: x.wm + (k1.wm + 2.0 * (k2.wm + k3.wm) + k4.wm) * (h / 6.0),
+        }
+    }
+
+    /// One working sample `dt` across a supply step at the fraction `phi` of it: the old
+    /// voltage `v0` turning at `w_old` before, the new `v1` turning at `w_new` after.
+    fn across_step(
+        &self,
+        x: &StatState,
+        dt: f64,
+        phi: f64,
+        v0: C64,
+        v1: C64,
+        w: [f64; 2],
+    ) -> StatState {
+        let (ha, hb) = (phi * dt, (1.0 - phi) * dt);
+        let mut y = *x;
+        if ha > 0.0 {
+            let r = |t: f64| C64::from_polar(1.0, w[0] * t);
+            y = self.rk4(&y, ha, [v0, v0 * r(0.5 * ha), v0 * r(ha)]);
+        }
+        if hb > 0.0 {
+            let r = |t: f64| C64::from_polar(1.0, -w[1] * t);
+            y = self.rk4(&y, hb, [v1 * r(hb), v1 * r(0.5 * hb), v1]);
+        }
+        y
+    }
+}
+
+/// The median of a series (0 when empty).
+fn median(x: &[f64]) -> f64 {
+    let mut v: Vec<f64> = x.iter().copied().filter(|a| a.is_finite()).collect();
+    if v.is_empty() {
+        return 0.0;
+    }
+    let mid = v.len() / 2;
+    *v.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1
+}
+
+/// The voltage's phase step over a working sample [rad] (0 when either is zero).
+fn phase_step(a: C64, b: C64) -> f64 {
+    if a.norm() * b.norm() > 0.0 {
+        (b * a.conj()).arg()
+    } else {
+        0.0
+    }
+}
+
+/// The full-order machine (all four dynamics effects in the model) in the stationary
+/// frame, complex form (`i`, `psi_R` = alpha + j beta):
+/// ```text
+///   L_sigma di/dt = v - R i + (a - j omega_r) psi_R
+///   dpsi_R/dt     = Rr' i - (a - j omega_r) psi_R
+///   J dw_m/dt     = (3/2) Np Im(conj(psi_R) i) - (B + Bl) w_m - T_extra(w_m)
+/// ```
+/// with the symbols of [`simulate_full`]. Nothing of the machine's dynamics depends on
+/// the analysis frame: the frame only projects the outputs (I_qs) as it projects the
+/// measurement. (Run in the frame, the model reads the inputs in a frame whose angle
+/// comes from the voltage-model flux estimate, which through a start turns by up to
+/// 0.3 rad per working sample against the rotor flux.) The input voltage between two
+/// working samples follows the rotation, `v(s) = (1-s) v_k e^{j w s dt} + s v_k+1
+/// e^{-j w (1-s) dt}`, `w` the voltage's own phase step: exact for a steady rotating
+/// vector (a straight line between the samples cuts the circle's chord: 0.3 % at 50 Hz
+/// and 2 kHz). Classic RK4 per working sample. Iron loss adds `g j omega_s psi_s` to the
+/// output current.
+///
+/// A supply step (the voltage leaves its rotation by more than
+/// [`prep::SUPPLY_STEP_REL`]) is placed where the current says it is: where in the
+/// sampling interval it fell changes the interval's volt-seconds by up to `dV dt / 2`
+/// (2 % of the current for 0.2 s on the reference motors at 2 kHz), so the interval is
+/// integrated with the step at its start and at its end (the old vector turning on
+/// before it, the new one after), and the fraction that brings the current at the next
+/// sample nearest the measured one (less the model's error at this sample) is used.
+///
+/// Measured on effect-free simulated logs with a start, a V/f step and a dip, ideal
+/// sensors, true parameters (2.2 kW, 11 kW; 2, 5, 10 kHz): `normalized_rms_error`
+/// 0.0003-0.0007 (on the simulator's own rows at the log rate, point samples: below 1e-5).
+fn simulate_stationary(
+    d: &Prepared,
+    n: &MachineConstants,
+    b: &BaseParams,
+    t: &EffectTerms,
+    rot_at: impl Fn(usize) -> C64,
+) -> Prediction {
+    let len = d.len();
+    let mut out = Prediction::with_capacity(len);
+    if len == 0 || d.vq.len() != len {
+        return out;
+    }
+    let dt = d.dt_s;
+    // A working sample is the mean of `factor` log rows: a vector turning at w comes out
+    // of the block mean scaled by `gain(w)`, the input voltage and the measured current
+    // alike. The machine is not linear in the voltage (the torque goes with its square:
+    // 0.2 % less torque through a start at 10 kHz, 1 % of the start current), so the
+    // model is driven by the voltage before the mean (v / gain) and its current is
+    // compared after it (gain i).
+    let factor = (d.log_rate_hz * dt).round().max(1.0);
+    // Positive-sequence voltage (stationary frame, after the block mean) and the gain.
+    let v_mean: Vec<C64> = (0..len)
+        .map(|k| C64::new(d.vd[k], d.vq[k]) * rot_at(k))
+        .collect();
+    // The voltage's phase step over each working sample [rad].
+    let ph: Vec<f64> = (0..len)
+        .map(|k| {
+            let a = k.min(len.saturating_sub(2));
+            phase_step(v_mean[a], v_mean[(a + 1).min(len - 1)])
+        })
+        .collect();
+    let gains: Vec<f64> = ph
+        .iter()
+        .map(|&p| block_gain(p / dt, dt / factor, factor))
+        .collect();
+    let gain = |k: usize| gains[k];
+    // The voltage before the block mean.
+    let v_at = |k: usize| v_mean[k] / gains[k];
+    // How far the voltage leaves its rotation over each working sample (relative); a
+    // supply step is an outlier of it: above SUPPLY_STEP_REL and ten times the median
+    // (harmonics in a real supply move the vector off its circle every sample).
+    let dev: Vec<f64> = (0..len)
+        .map(|k| {
+            if k == 0 || k + 1 >= len {
+                return 0.0;
+            }
+            let (v0, v1) = (v_at(k), v_at(k + 1));
+            (v1 - v0 * C64::from_polar(1.0, ph[k - 1])).norm() / v0.norm().max(v1.norm()).max(1e-12)
+        })
+        .collect();
+    let step_thr = prep::SUPPLY_STEP_REL.max(10.0 * median(&dev));
+    let i_meas = |k: usize| d.i_ab[k] - d.i_neg[k];
+    let x0 = full_initial_state(d, n, &FullMachine::at(n, b, t, 0));
+    let r0 = rot_at(0);
+    let mut x = StatState {
+        i: C64::new(x0.id, x0.iq) * r0,
+        psi: C64::new(x0.pd, x0.pq) * r0,
+        wm: x0.wm,
+    };
+    let mut v_cur = v_at(0);
+    let mut v_next = v_at(1.min(len - 1));
+    for k in 0..len {
+        let extra = |w: f64| {
+            let coulomb = if t.coulomb_nm != 0.0 {
+                t.coulomb_nm * w.tanh()
+            } else {
+                0.0
+            };
+            coulomb + t.windage_nms2 * w * w.abs() + t.load_nm.get(k).copied().unwrap_or(0.0)
+        };
+        let sm = StatMachine {
+            m: FullMachine::at(n, b, t, k),
+            np: n.np,
+            j: (n.j_kgm2 * b.j_scale).max(1e-9),
+            btot: b.btot_nms.max(0.0),
+            extra: &extra,
+        };
+        let rot = rot_at(k);
+        let ineg = t.i_neg.get(k).copied().unwrap_or_default();
+        let mut i_out = x.i;
+        if t.g_fe_s != 0.0 {
+            let psi_s = x.i * sm.m.l_sigma + x.psi;
+            i_out += C64::new(0.0, t.g_fe_s * d.omega_s[k]) * psi_s;
+        }
+        let i_ab = i_out * gain(k) + ineg;
+        out.iq.push((i_ab * rot.conj()).im);
+        out.omega_r.push(n.np * x.wm);
+        out.i_ab.push(i_ab);
+        if k + 1 == len {
+            break;
+        }
+        let v_after = v_at((k + 2).min(len - 1));
+        let (v0, v1) = (v_cur, v_next);
+        x = if dev[k] > step_thr {
+            let w = [ph[k - 1] / dt, ph[k + 1] / dt];
+            let early = sm.across_step(&x, dt, 0.0, v0, v1, w);
+            let late = sm.across_step(&x, dt, 1.0, v0, v1, w);
+            // The measured currents before the block mean, as the model's.
+            let target = i_meas(k + 1) / gain(k + 1) - (i_meas(k) / gain(k) - x.i);
+            let span = late.i - early.i;
+            let phi = if span.norm_sqr() > 0.0 {
+                ((target - early.i) * span.conj()).re / span.norm_sqr()
+            } else {
+                0.5
+            };
+            sm.across_step(&x, dt, phi.clamp(0.0, 1.0), v0, v1, w)
+        } else {
+            let half = C64::from_polar(1.0, 0.5 * ph[k]);
+            let vm = (v0 * half + v1 * half.conj()) * 0.5;
+            sm.rk4(&x, dt, [v0, vm, v1])
+        };
+        (v_cur, v_next) = (v1, v_after);
+        if !(x.i.re.is_finite() && x.i.im.is_finite() && x.psi.re.is_finite() && x.wm.is_finite()) {
+            break;
+        }
+    }
+    out
+}
+
+/// The discrete block mean's gain on a vector turning at `w` [rad/s]: the mean of
+/// `factor` samples `h` apart, `sin(F w h / 2) / (F sin(w h / 2))`.
+fn block_gain(w: f64, h: f64, factor: f64) -> f64 {
+    let x = 0.5 * w * h;
+    if x.abs() < 1e-9 {
+        1.0
+    } else {
+        (factor * x).sin() / (factor * x.sin())
+    }
 }
