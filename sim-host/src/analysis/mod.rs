@@ -318,8 +318,11 @@ impl Analysis {
         opts: ReadOptions,
         progress: &mut dyn FnMut(f64),
     ) -> Result<Self, AnalysisError> {
+        let mut tm = std::time::Instant::now();
         let (dec, quality) = prep::decimate_file(log, &params, opts, progress)?;
+        tmark("decimate_file", &mut tm);
         let data = prep::voltage_model_flux_frame(&dec, &params);
+        tmark("flux frame", &mut tm);
         Ok(Analysis {
             data,
             constants: MachineConstants::from_params(&params),
@@ -461,6 +464,31 @@ impl Analysis {
         pred: &Prediction,
         w: &Weights,
     ) -> f64 {
+        let renoised = self.renoised(d, active, f);
+        metrics::noise_floor(d, w, Some((pred, &renoised)))
+    }
+
+    /// The fitted model's prediction and its noise floor on `d`, the two model runs on
+    /// both cores (they are independent: the noise floor's run has noise added to the
+    /// inputs).
+    fn predict_with_noise_floor(
+        &self,
+        d: &Prepared,
+        active: &[ActiveEffect<'_>],
+        f: &FitResult,
+        w: &Weights,
+    ) -> (Prediction, f64) {
+        let (pred, renoised) = rayon::join(
+            || fit::predict(d, &self.constants, active, f),
+            || self.renoised(d, active, f),
+        );
+        let noise = metrics::noise_floor(d, w, Some((&pred, &renoised)));
+        (pred, noise)
+    }
+
+    /// The fitted model run with the inputs' sensor noise added again (white, the level
+    /// measured on the inputs), for [`metrics::noise_floor`].
+    fn renoised(&self, d: &Prepared, active: &[ActiveEffect<'_>], f: &FitResult) -> Prediction {
         let mut terms = fit::terms(d, &self.constants, active, f);
         let sigma_v = 0.5 * (metrics::white_noise_sigma(&d.vd) + metrics::white_noise_sigma(&d.vq));
         terms.input_noise = Some(simplified_model::InputNoise {
@@ -468,8 +496,7 @@ impl Analysis {
             sigma_v,
             sigma_i: metrics::white_noise_sigma(&d.id),
         });
-        let renoised = simplified_model::simulate(d, &self.constants, &f.base, &terms);
-        metrics::noise_floor(d, w, Some((pred, &renoised)))
+        simplified_model::simulate(d, &self.constants, &f.base, &terms)
     }
 
     fn fit_data(&self) -> (Prepared, usize) {
@@ -495,4 +522,12 @@ impl Analysis {
     pub fn unbalance(&self) -> unbalance::UnbalanceAnalysis {
         unbalance::analyse(&self.data, &self.constants)
     }
+}
+
+/// TEMP timing.
+pub(crate) fn tmark(label: &str, t: &mut std::time::Instant) {
+    if std::env::var_os("TMARK").is_some() {
+        eprintln!("  [{:>6.3} s] {label}", t.elapsed().as_secs_f64());
+    }
+    *t = std::time::Instant::now();
 }
