@@ -97,9 +97,7 @@ impl Analysis {
             skipped.push("omega_r not compared: the log has no wm_rad_s column (the model still predicts it)".into());
         }
         let list = resolve(&opts.effects);
-        let mut tm = std::time::Instant::now();
         let (fd, _) = self.fit_data();
-        super::tmark("cmp coarsen", &mut tm);
         let active_fit = self.setup_all(&fd, &list)?;
         let wf = Weights::new(&fd, 0, super::MAX_FIT_SAMPLES);
         let f = self.fit_set(
@@ -109,20 +107,17 @@ impl Analysis {
             &BaseParams::nominal(&self.constants),
             opts.fit_base,
         );
-        super::tmark("cmp fit", &mut tm);
         let jac = super::fit::jacobian(&fd, &self.constants, &active_fit, &wf, &f, opts.fit_base);
         let not_identified = jac
             .as_ref()
             .map(|j| not_identified_in_words(j, d, &self.constants))
             .unwrap_or_default();
-        super::tmark("cmp jac", &mut tm);
         let active = self.setup_all(d, &list)?;
         // Data-dependent set-ups (load steps) are recomputed on the full series; keep the
         // fitted values where the parameter count agrees.
         let f = align(&active, f);
         let w = Weights::new(d, 0, usize::MAX);
         let (pred, noise_floor) = self.predict_with_noise_floor(d, &active, &f, &w);
-        super::tmark("cmp predict", &mut tm);
         let err: ErrorSummary = metrics::errors(d, &pred, None);
         let (mut worst, all) = metrics::windows(
             d,
@@ -138,7 +133,6 @@ impl Analysis {
         for (w, t) in worst.iter_mut().zip(tags) {
             w.transient = t;
         }
-        super::tmark("cmp windows+advice", &mut tm);
         let base_parameters = self.base_table(&f.base);
         let fitted_effects = self.fitted_effects(&active, &f);
         let mut implausible_because = super::base_implausible(&self.constants, &f.base, d);

@@ -187,11 +187,7 @@ impl Analysis {
                 self.quality.clone(),
             )));
         }
-        let mut tm = std::time::Instant::now();
-        let unb = &unbalance; let _ = unb;
-        super::tmark("unbalance+info", &mut tm);
         let mut base = self.baseline(&configured, opts)?;
-        super::tmark("baseline", &mut tm);
         let full = base.full.take();
         let base = base;
         let lib = effects::library();
@@ -231,7 +227,6 @@ impl Analysis {
                 (f?, r)
             }
         };
-        super::tmark("candidates", &mut tm);
         let mut ranked: Vec<RankedCandidate> = results.into_iter().flatten().collect();
         rank(&mut ranked, &unbalance, self.constants.torque_scale_nm);
         let best = ranked
@@ -242,7 +237,14 @@ impl Analysis {
         let near_noise = full.heldback_error <= (NOISE_MARGIN * full.noise).max(MIN_MODEL_ERROR);
         let unexplained = best < EXPLAINED_MIN || near_noise;
         let first_plausible = ranked.iter().find(|c| c.candidate.plausible);
-        let mut verdict = verdict(&names, &base, &full, first_plausible, near_noise, unexplained);
+        let mut verdict = verdict(
+            &names,
+            &base,
+            &full,
+            first_plausible,
+            near_noise,
+            unexplained,
+        );
         verdict.push_str(&implausible_note(&ranked));
         let base_why = super::base_implausible(&self.constants, &base.fit.base, d);
         if !base_why.is_empty() {
@@ -272,7 +274,6 @@ impl Analysis {
                 (r.candidate.effect, model.predict(d, &self.constants))
             })
         };
-        super::tmark("after", &mut tm);
         Ok(withhold_if_untrusted(ExplainOutput {
             report: ExplainReport {
                 effects: names,
@@ -301,9 +302,7 @@ impl Analysis {
         opts: &Options,
     ) -> Result<Baseline<'a>, AnalysisError> {
         let d = &self.data;
-        let mut tm = std::time::Instant::now();
         let (fd, m) = self.fit_data();
-        super::tmark("coarsen", &mut tm);
         let wf = Weights::new(&fd, HOLDOUT_WINDOWS, super::MAX_FIT_SAMPLES);
         let w_full = Weights::new(d, HOLDOUT_WINDOWS, usize::MAX);
         let heldback: Vec<bool> = w_full.train.iter().map(|t| !t).collect();
@@ -315,7 +314,6 @@ impl Analysis {
             &BaseParams::nominal(&self.constants),
             opts.fit_base,
         );
-        super::tmark("base fit", &mut tm);
         let heldback_fit_series: Vec<bool> = wf.train.iter().map(|t| !t).collect();
         let has_input_transient = transients::input_transients(&fd, &self.constants)
             .iter()
@@ -348,7 +346,6 @@ impl Analysis {
                 metrics::errors(fd, &b, Some(&base.heldback_fit_series)).normalized_rms_error;
             base.noise_fit_series = self.model_noise_floor(fd, &base.active, &base.fit, &b, wf);
         }
-        super::tmark("fit-series baseline", &mut tm);
         Ok(base)
     }
 
@@ -365,8 +362,7 @@ impl Analysis {
         let (before, noise) =
             self.predict_with_noise_floor(d, &active_full, &f0_full, &base.weights);
         let error = metrics::errors(d, &before, None).normalized_rms_error;
-        let heldback_error =
-            metrics::errors(d, &before, Some(&base.heldback)).normalized_rms_error;
+        let heldback_error = metrics::errors(d, &before, Some(&base.heldback)).normalized_rms_error;
         Ok(FullSeries {
             before,
             error,
@@ -455,9 +451,7 @@ impl Analysis {
             effect: c,
             setup: s,
         });
-        let mut tm = std::time::Instant::now();
         let f = self.fit_set(fd, &set, &base.fit_weights, &base.fit.base, opts.fit_base);
-        super::tmark(&format!("cand {} fit {:?}", c.kind(), f.report), &mut tm);
         // Ranked on the series it was fitted on (the working series, or its coarse copy).
         let (series, mask) = if base.coarsening == 1 {
             (d, &base.heldback)
@@ -479,7 +473,6 @@ impl Analysis {
                 },
             });
         }
-        super::tmark(&format!("cand {} pred+fullsetup", c.kind()), &mut tm);
         let f = align(&full, f);
         let setups: Vec<FitSetup> = full.iter().map(|a| a.setup.clone()).collect();
         let me = self.fitted_effects(&full, &f).pop()?;

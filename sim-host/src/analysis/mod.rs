@@ -318,11 +318,8 @@ impl Analysis {
         opts: ReadOptions,
         progress: &mut dyn FnMut(f64),
     ) -> Result<Self, AnalysisError> {
-        let mut tm = std::time::Instant::now();
         let (dec, quality) = prep::decimate_file(log, &params, opts, progress)?;
-        tmark("decimate_file", &mut tm);
         let data = prep::voltage_model_flux_frame(&dec, &params);
-        tmark("flux frame", &mut tm);
         Ok(Analysis {
             data,
             constants: MachineConstants::from_params(&params),
@@ -522,12 +519,4 @@ impl Analysis {
     pub fn unbalance(&self) -> unbalance::UnbalanceAnalysis {
         unbalance::analyse(&self.data, &self.constants)
     }
-}
-
-/// TEMP timing.
-pub(crate) fn tmark(label: &str, t: &mut std::time::Instant) {
-    if std::env::var_os("TMARK").is_some() {
-        eprintln!("  [{:>6.3} s] {label}", t.elapsed().as_secs_f64());
-    }
-    *t = std::time::Instant::now();
 }

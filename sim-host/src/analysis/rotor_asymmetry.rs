@@ -511,7 +511,11 @@ mod tests {
         assert!((df - 1.0 / (nfft as f64 * dt)).abs() < 1e-15);
         for k in 0..nfft / 2 {
             let want = 2.0 * buf[k].norm() / wsum;
-            assert!((amp[k] - want).abs() < 1e-12, "bin {k}: {} vs {want}", amp[k]);
+            assert!(
+                (amp[k] - want).abs() < 1e-12,
+                "bin {k}: {} vs {want}",
+                amp[k]
+            );
         }
         // Asked for 60 Hz, it stops just above.
         let (_, short) = spectrum(&x, dt, 60.0);

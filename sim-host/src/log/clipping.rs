@@ -53,10 +53,18 @@ impl Extremes {
         }
         self.n += 1;
         let (gt, eq_max) = (x > self.max, x == self.max);
-        self.n_max = if gt { 1 } else { self.n_max + u64::from(eq_max) };
+        self.n_max = if gt {
+            1
+        } else {
+            self.n_max + u64::from(eq_max)
+        };
         self.max = if gt { x } else { self.max };
         let (lt, eq_min) = (x < self.min, x == self.min);
-        self.n_min = if lt { 1 } else { self.n_min + u64::from(eq_min) };
+        self.n_min = if lt {
+            1
+        } else {
+            self.n_min + u64::from(eq_min)
+        };
         self.min = if lt { x } else { self.min };
     }
 
