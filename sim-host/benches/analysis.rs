@@ -6,8 +6,8 @@
 //! default sensors) into `$ANALYSIS_BENCH_LOG` (default `/tmp/sim-host-bench-<seconds>s.csv`,
 //! about 3.3 GB for 1 h) and reused. `ANALYSIS_BENCH_SECONDS` shortens the log (default 3600).
 //! Prints wall times of the read (parse + decimate + frame), `compare`, `explain`, the
-//! peak resident memory (VmHWM, also after the read and after `compare`) and the CPU time of
-//! each stage.
+//! peak resident memory (VmHWM, also after the read and after `compare`), the CPU time of
+//! each stage and the machine's load average before and after.
 //!
 //! The same log is also converted once to Parquet beside it (`.parquet`, through the one
 //! log writer, about 1.3 GB for 1 h) and analysed from there: one line per format.
@@ -137,8 +137,17 @@ fn convert(from: &std::path::Path, to: &std::path::Path) {
     );
 }
 
+/// The 1, 5 and 15 min load averages (from /proc/loadavg): on a shared machine the wall
+/// times mean little without them.
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|_| "unknown".into())
+}
+
 /// Times read, compare and explain on one log.
 fn run(path: &std::path::Path, p: ParamFile, format: &str) {
+    eprintln!("[{format}] load average before the run: {}", load_average());
     let size = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
     let c0 = cpu_s();
     let t0 = Instant::now();
@@ -188,7 +197,8 @@ fn run(path: &std::path::Path, p: ParamFile, format: &str) {
         e.report.ranking.first().map(|r| (&r.effect, r.explained_fraction))
     );
     println!(
-        "CPU time (user + system): read+frame {c_read:.2} s, compare {c_cmp:.2} s, explain {c_exp:.2} s, total {:.2} s",
-        c_read + c_cmp + c_exp
+        "CPU time (user + system): read+frame {c_read:.2} s, compare {c_cmp:.2} s, explain {c_exp:.2} s, total {:.2} s; load average after: {}",
+        c_read + c_cmp + c_exp,
+        load_average()
     );
 }

@@ -116,8 +116,8 @@ impl Analysis {
         // Data-dependent set-ups (load steps) are recomputed on the full series; keep the
         // fitted values where the parameter count agrees.
         let f = align(&active, f);
-        let pred = super::fit::predict(d, &self.constants, &active, &f);
         let w = Weights::new(d, 0, usize::MAX);
+        let (pred, noise_floor) = self.predict_with_noise_floor(d, &active, &f, &w);
         let err: ErrorSummary = metrics::errors(d, &pred, None);
         let (mut worst, all) = metrics::windows(
             d,
@@ -147,7 +147,7 @@ impl Analysis {
             report: CompareReport {
                 effects: list.iter().map(|e| e.kind()).collect(),
                 normalized_rms_error: err.normalized_rms_error,
-                noise_floor: self.model_noise_floor(d, &active, &f, &pred, &w),
+                noise_floor,
                 channels: err.channels,
                 worst_windows: worst,
                 advice,

@@ -116,20 +116,15 @@ struct Baseline<'a> {
     /// and its coarsening factor.
     fit_series: Prepared,
     coarsening: usize,
-    /// Training/held-back split on the fit series and the held-back mask of the working
-    /// series.
+    /// Training/held-back split on the fit series and on the working series, and the
+    /// held-back masks of both.
     fit_weights: Weights,
+    weights: Weights,
     heldback: Vec<bool>,
     heldback_fit_series: Vec<bool>,
     /// The configured effects set up on the fit series, and the fit.
     active: Vec<ActiveEffect<'a>>,
     fit: FitResult,
-    /// The configured model's prediction on the working series.
-    before: Prediction,
-    /// Its error over the whole log, on the held-back windows, and the noise floor.
-    error: f64,
-    heldback_error: f64,
-    noise: f64,
     /// The held-back error and noise floor on the fit series (candidates are ranked there;
     /// the same as the working series' unless the log was coarsened).
     heldback_error_fit_series: f64,
@@ -137,6 +132,19 @@ struct Baseline<'a> {
     /// Whether the fit series holds a transient of the model's inputs (a start or a
     /// supply step, [`transients::input_transients`]).
     has_input_transient: bool,
+    /// The measures on the working series, when the fit series is the working series
+    /// (else computed while the candidates are fitted: [`Analysis::full_series`]).
+    full: Option<FullSeries>,
+}
+
+/// The configured model on the working series.
+struct FullSeries {
+    /// Its prediction.
+    before: Prediction,
+    /// Its error over the whole log, on the held-back windows, and the noise floor.
+    error: f64,
+    heldback_error: f64,
+    noise: f64,
 }
 
 /// A ranked candidate with its fit, kept to rebuild the best one's prediction.
@@ -179,7 +187,9 @@ impl Analysis {
                 self.quality.clone(),
             )));
         }
-        let base = self.baseline(&configured, opts)?;
+        let mut base = self.baseline(&configured, opts)?;
+        let full = base.full.take();
+        let base = base;
         let lib = effects::library();
         let cands: Vec<&dyn EffectModel> = lib
             .iter()
@@ -197,15 +207,26 @@ impl Analysis {
         let total = cands.len().max(1);
         // Predictions are not kept per candidate (memory on long logs); the top one is
         // recomputed from its fitted values.
-        let results: Vec<Option<RankedCandidate>> = cands
-            .par_iter()
-            .map(|c| {
-                let r = self.evaluate_candidate(*c, &base, opts);
-                let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                progress(k as f64 / total as f64);
-                r
-            })
-            .collect();
+        let candidates = || -> Vec<Option<RankedCandidate>> {
+            cands
+                .par_iter()
+                .map(|c| {
+                    let r = self.evaluate_candidate(*c, &base, opts);
+                    let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                    progress(k as f64 / total as f64);
+                    r
+                })
+                .collect()
+        };
+        // A long log's candidates are ranked on the coarse series: the configured model's
+        // run over the working series is only reported, so it runs beside them.
+        let (full, results) = match full {
+            Some(f) => (f, candidates()),
+            None => {
+                let (f, r) = rayon::join(|| self.full_series(&configured, &base), candidates);
+                (f?, r)
+            }
+        };
         let mut ranked: Vec<RankedCandidate> = results.into_iter().flatten().collect();
         rank(&mut ranked, &unbalance, self.constants.torque_scale_nm);
         let best = ranked
@@ -213,10 +234,17 @@ impl Analysis {
             .filter(|c| c.candidate.plausible)
             .map(|c| c.candidate.explained_fraction)
             .unwrap_or(0.0);
-        let near_noise = base.heldback_error <= (NOISE_MARGIN * base.noise).max(MIN_MODEL_ERROR);
+        let near_noise = full.heldback_error <= (NOISE_MARGIN * full.noise).max(MIN_MODEL_ERROR);
         let unexplained = best < EXPLAINED_MIN || near_noise;
         let first_plausible = ranked.iter().find(|c| c.candidate.plausible);
-        let mut verdict = verdict(&names, &base, first_plausible, near_noise, unexplained);
+        let mut verdict = verdict(
+            &names,
+            &base,
+            &full,
+            first_plausible,
+            near_noise,
+            unexplained,
+        );
         verdict.push_str(&implausible_note(&ranked));
         let base_why = super::base_implausible(&self.constants, &base.fit.base, d);
         if !base_why.is_empty() {
@@ -249,9 +277,9 @@ impl Analysis {
         Ok(withhold_if_untrusted(ExplainOutput {
             report: ExplainReport {
                 effects: names,
-                baseline_normalized_rms_error: base.error,
-                baseline_validation_normalized_rms_error: base.heldback_error,
-                noise_floor: base.noise,
+                baseline_normalized_rms_error: full.error,
+                baseline_validation_normalized_rms_error: full.heldback_error,
+                noise_floor: full.noise,
                 ranking: ranked.into_iter().map(|c| c.candidate).collect(),
                 unexplained,
                 verdict,
@@ -260,13 +288,14 @@ impl Analysis {
                 data: info,
                 data_quality: self.quality.clone(),
             },
-            before: base.before,
+            before: full.before,
             after,
         }))
     }
 
-    /// Fits the configured model and measures it on the whole log, on the held-back
-    /// windows, and (for a long log) on the coarser series the candidates are ranked on.
+    /// Fits the configured model and measures it on the fit series (for a long log, the
+    /// coarser series the candidates are ranked on); when that is the working series, on
+    /// the whole log and the held-back windows too ([`Baseline::full`]).
     fn baseline<'a>(
         &self,
         configured: &'a [Box<dyn EffectModel>],
@@ -285,42 +314,60 @@ impl Analysis {
             &BaseParams::nominal(&self.constants),
             opts.fit_base,
         );
-        let active_full = self.setup_all(d, configured)?;
-        let f0_full = align(&active_full, f0.clone());
-        let before = fit::predict(d, &self.constants, &active_full, &f0_full);
-        let error = metrics::errors(d, &before, None).normalized_rms_error;
-        let heldback_error = metrics::errors(d, &before, Some(&heldback)).normalized_rms_error;
-        let noise = self.model_noise_floor(d, &active_full, &f0_full, &before, &w_full);
         let heldback_fit_series: Vec<bool> = wf.train.iter().map(|t| !t).collect();
-        // Long logs (fitted on a coarser series): candidates are ranked on that series, so
-        // the baseline they are compared with is measured there too.
-        let (heldback_error_fit_series, noise_fit_series) = if m == 1 {
-            (heldback_error, noise)
-        } else {
-            let b = fit::predict(&fd, &self.constants, &active, &f0);
-            (
-                metrics::errors(&fd, &b, Some(&heldback_fit_series)).normalized_rms_error,
-                self.model_noise_floor(&fd, &active, &f0, &b, &wf),
-            )
-        };
         let has_input_transient = transients::input_transients(&fd, &self.constants)
             .iter()
             .any(|&t| t);
-        Ok(Baseline {
+        let mut base = Baseline {
             fit_series: fd,
             coarsening: m,
             fit_weights: wf,
+            weights: w_full,
             heldback,
             heldback_fit_series,
             active,
             fit: f0,
+            heldback_error_fit_series: f64::NAN,
+            noise_fit_series: f64::NAN,
+            has_input_transient,
+            full: None,
+        };
+        if m == 1 {
+            let full = self.full_series(configured, &base)?;
+            base.heldback_error_fit_series = full.heldback_error;
+            base.noise_fit_series = full.noise;
+            base.full = Some(full);
+        } else {
+            // Long logs (fitted on a coarser series): candidates are ranked on that series,
+            // so the baseline they are compared with is measured there too.
+            let (fd, wf) = (&base.fit_series, &base.fit_weights);
+            let b = fit::predict(fd, &self.constants, &base.active, &base.fit);
+            base.heldback_error_fit_series =
+                metrics::errors(fd, &b, Some(&base.heldback_fit_series)).normalized_rms_error;
+            base.noise_fit_series = self.model_noise_floor(fd, &base.active, &base.fit, &b, wf);
+        }
+        Ok(base)
+    }
+
+    /// The configured model fitted in `base`, run over the working series and measured
+    /// there: over the whole log, on the held-back windows, and its noise floor.
+    fn full_series(
+        &self,
+        configured: &[Box<dyn EffectModel>],
+        base: &Baseline<'_>,
+    ) -> Result<FullSeries, AnalysisError> {
+        let d = &self.data;
+        let active_full = self.setup_all(d, configured)?;
+        let f0_full = align(&active_full, base.fit.clone());
+        let (before, noise) =
+            self.predict_with_noise_floor(d, &active_full, &f0_full, &base.weights);
+        let error = metrics::errors(d, &before, None).normalized_rms_error;
+        let heldback_error = metrics::errors(d, &before, Some(&base.heldback)).normalized_rms_error;
+        Ok(FullSeries {
             before,
             error,
             heldback_error,
             noise,
-            heldback_error_fit_series,
-            noise_fit_series,
-            has_input_transient,
         })
     }
 
@@ -617,6 +664,7 @@ fn implausible_note(ranked: &[RankedCandidate]) -> String {
 fn verdict(
     names: &[EffectKind],
     base: &Baseline<'_>,
+    full: &FullSeries,
     best: Option<&RankedCandidate>,
     near_noise: bool,
     unexplained: bool,
@@ -624,7 +672,7 @@ fn verdict(
     match best {
         _ if near_noise => format!(
             "nothing to explain: the model's error {:.4} (held-back {:.4}) is within {:.2}x the noise floor {:.4} or below {:.3}",
-            base.error, base.heldback_error, NOISE_MARGIN, base.noise, MIN_MODEL_ERROR
+            full.error, full.heldback_error, NOISE_MARGIN, full.noise, MIN_MODEL_ERROR
         ),
         Some(r) if !unexplained => {
             let c = &r.candidate;

@@ -330,14 +330,19 @@ pub fn dominant_frequency(x: &[f64], dt: f64) -> f64 {
         buf[k] = C64::new((x[k] - mean) * w, 0.0);
     }
     fft(&mut buf);
-    let mut best = (0.0, 0.0);
+    // The largest bin by its squared magnitude (no square root per bin), then its amplitude.
+    let mut best = (0usize, 0.0);
     for k in 1..m / 2 {
-        let a = buf[k].norm() * 2.0 / wsum.max(1e-12);
-        if a > best.1 {
-            best = (k as f64 / (m as f64 * dt), a);
+        let a2 = buf[k].norm_sqr();
+        if a2 > best.1 {
+            best = (k, a2);
         }
     }
-    if mean.abs() > best.1 {
+    let best = (
+        best.0 as f64 / (m as f64 * dt),
+        buf[best.0].norm() * 2.0 / wsum.max(1e-12),
+    );
+    if best.0 == 0.0 || mean.abs() > best.1 {
         0.0
     } else {
         best.0

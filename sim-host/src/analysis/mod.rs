@@ -461,6 +461,31 @@ impl Analysis {
         pred: &Prediction,
         w: &Weights,
     ) -> f64 {
+        let renoised = self.renoised(d, active, f);
+        metrics::noise_floor(d, w, Some((pred, &renoised)))
+    }
+
+    /// The fitted model's prediction and its noise floor on `d`, the two model runs on
+    /// both cores (they are independent: the noise floor's run has noise added to the
+    /// inputs).
+    fn predict_with_noise_floor(
+        &self,
+        d: &Prepared,
+        active: &[ActiveEffect<'_>],
+        f: &FitResult,
+        w: &Weights,
+    ) -> (Prediction, f64) {
+        let (pred, renoised) = rayon::join(
+            || fit::predict(d, &self.constants, active, f),
+            || self.renoised(d, active, f),
+        );
+        let noise = metrics::noise_floor(d, w, Some((&pred, &renoised)));
+        (pred, noise)
+    }
+
+    /// The fitted model run with the inputs' sensor noise added again (white, the level
+    /// measured on the inputs), for [`metrics::noise_floor`].
+    fn renoised(&self, d: &Prepared, active: &[ActiveEffect<'_>], f: &FitResult) -> Prediction {
         let mut terms = fit::terms(d, &self.constants, active, f);
         let sigma_v = 0.5 * (metrics::white_noise_sigma(&d.vd) + metrics::white_noise_sigma(&d.vq));
         terms.input_noise = Some(simplified_model::InputNoise {
@@ -468,8 +493,7 @@ impl Analysis {
             sigma_v,
             sigma_i: metrics::white_noise_sigma(&d.id),
         });
-        let renoised = simplified_model::simulate(d, &self.constants, &f.base, &terms);
-        metrics::noise_floor(d, w, Some((pred, &renoised)))
+        simplified_model::simulate(d, &self.constants, &f.base, &terms)
     }
 
     fn fit_data(&self) -> (Prepared, usize) {

@@ -652,67 +652,96 @@ pub fn voltage_model_flux_frame(d: &Decimated, p: &ParamFile) -> Prepared {
     let to_c64 = |x: &[f32; 2]| C64::new(x[0] as f64, x[1] as f64);
     let i_ab: Vec<C64> = d.i_ab.iter().map(to_c64).collect();
     let v_ab: Vec<C64> = d.v_ab.iter().map(to_c64).collect();
-    let theta = if d.channels.voltages {
-        let raw = flux_angle(&v_ab, &i_ab, dt, p);
-        smooth_angle(raw, dt)
-    } else {
-        let w0 = p.supply.omega_rad_s();
-        d.t_s.iter().map(|t| w0 * t).collect()
+    // The frame's angle and the sequence separation's own (the supply voltage's) are
+    // independent: built on both cores.
+    let frame = || {
+        let theta = if d.channels.voltages {
+            let raw = flux_angle(&v_ab, &i_ab, dt, p);
+            smooth_angle(raw, dt)
+        } else {
+            let w0 = p.supply.omega_rad_s();
+            d.t_s.iter().map(|t| w0 * t).collect()
+        };
+        let omega_s = frame_speed(&theta, &d.t_s, dt);
+        let rot: Vec<C64> = theta
+            .iter()
+            .map(|&th| C64::new(th.cos(), th.sin()))
+            .collect();
+        (theta, omega_s, rot)
     };
-    let omega_s = frame_speed(&theta, &d.t_s, dt);
-    let rot: Vec<C64> = theta
-        .iter()
-        .map(|&th| C64::new(th.cos(), th.sin()))
-        .collect();
     // The sequences are separated in the supply voltage's own (smoothed) frame when the log
     // has voltages: any frame turning with the positive sequence separates them alike in
     // steady state, but through a start the rotor-flux frame is still forming (it may
     // turn a whole revolution against the supply in the first 0.1 s), and the
     // demodulated signal then leaks volts into the negative sequence for the low-pass's
     // memory (0.2 s): 4 V on an 11 kW start, which the model takes as its input.
-    let (sep_theta, sep_omega) = if d.channels.voltages {
-        let th = smooth_angle(unwrapped_angle(&v_ab), dt);
-        let w = frame_speed(&th, &d.t_s, dt);
-        (th, w)
-    } else {
-        (theta.clone(), omega_s.clone())
-    };
-    let sep_rot: Vec<C64> = sep_theta
-        .iter()
-        .map(|&th| C64::new(th.cos(), th.sin()))
-        .collect();
-    let mut sep = SequenceSeparator::new(&sep_theta, &sep_omega, dt);
-    if d.channels.voltages {
-        sep.steps = supply_steps(&v_ab, &sep_rot);
-    }
-    let i_neg = sep.negative(&i_ab, &sep_rot);
-    let v_neg = if d.channels.voltages {
-        sep.negative(&v_ab, &sep_rot)
-    } else {
-        vec![C64::new(0.0, 0.0); n]
-    };
-    // Park transforms in complex form: x_dq = x_alphabeta e^{-j theta}.
-    let mut vd = Vec::new();
-    let mut vq = Vec::new();
-    if d.channels.voltages {
-        for k in 0..n {
-            let v = (v_ab[k] - v_neg[k]) * rot[k].conj();
-            vd.push(v.re);
-            vq.push(v.im);
+    // (A current-only log separates in the frame above: built first, then used.)
+    let separate = |theta: &[f64], omega_s: &[f64]| {
+        let (sep_theta, sep_omega) = if d.channels.voltages {
+            let th = smooth_angle(unwrapped_angle(&v_ab), dt);
+            let w = frame_speed(&th, &d.t_s, dt);
+            (th, w)
+        } else {
+            (theta.to_vec(), omega_s.to_vec())
+        };
+        let sep_rot: Vec<C64> = sep_theta
+            .iter()
+            .map(|&th| C64::new(th.cos(), th.sin()))
+            .collect();
+        let mut sep = SequenceSeparator::new(&sep_theta, &sep_omega, dt);
+        if d.channels.voltages {
+            sep.steps = supply_steps(&v_ab, &sep_rot);
         }
-    }
-    let mut id = Vec::with_capacity(n);
-    let mut iq = Vec::with_capacity(n);
-    let mut iq_pos = Vec::with_capacity(n);
-    for k in 0..n {
-        let ip = (i_ab[k] - i_neg[k]) * rot[k].conj();
-        let it = i_ab[k] * rot[k].conj();
-        id.push(ip.re);
-        iq_pos.push(ip.im);
-        iq.push(it.im);
-    }
+        rayon::join(
+            || sep.negative(&i_ab, &sep_rot),
+            || {
+                if d.channels.voltages {
+                    sep.negative(&v_ab, &sep_rot)
+                } else {
+                    vec![C64::new(0.0, 0.0); n]
+                }
+            },
+        )
+    };
+    let ((theta, omega_s, rot), (i_neg, v_neg)) = if d.channels.voltages {
+        rayon::join(frame, || separate(&[], &[]))
+    } else {
+        let f = frame();
+        let s = separate(&f.0, &f.1);
+        (f, s)
+    };
+    // Park transforms in complex form: x_dq = x_alphabeta e^{-j theta}; voltages and
+    // currents (with the flux current's smoothing) on both cores.
+    let voltages = || {
+        let mut vd = Vec::new();
+        let mut vq = Vec::new();
+        if d.channels.voltages {
+            vd.reserve(n);
+            vq.reserve(n);
+            for k in 0..n {
+                let v = (v_ab[k] - v_neg[k]) * rot[k].conj();
+                vd.push(v.re);
+                vq.push(v.im);
+            }
+        }
+        (vd, vq)
+    };
+    let currents = || {
+        let mut id = Vec::with_capacity(n);
+        let mut iq = Vec::with_capacity(n);
+        let mut iq_pos = Vec::with_capacity(n);
+        for k in 0..n {
+            let ip = (i_ab[k] - i_neg[k]) * rot[k].conj();
+            let it = i_ab[k] * rot[k].conj();
+            id.push(ip.re);
+            iq_pos.push(ip.im);
+            iq.push(it.im);
+        }
+        let i_f = zero_phase_lpf(&id, dt, I_F_SMOOTH_HZ);
+        (id, iq, iq_pos, i_f)
+    };
+    let ((vd, vq), (id, iq, iq_pos, i_f)) = rayon::join(voltages, currents);
     let np = p.motor.model::<f64>().np();
-    let i_f = zero_phase_lpf(&id, dt, I_F_SMOOTH_HZ);
     Prepared {
         i_f,
         t_s: d.t_s.clone(),
@@ -753,16 +782,18 @@ fn frame_speed(theta: &[f64], t_s: &[f64], dt: f64) -> Vec<f64> {
 /// The unwrapped angle of a vector series (a zero vector keeps the previous angle).
 fn unwrapped_angle(x: &[C64]) -> Vec<f64> {
     let mut out = Vec::with_capacity(x.len());
-    let mut prev: Option<C64> = None;
     let mut acc = 0.0f64;
+    // (Each vector's magnitude computed once: `prev` keeps it.)
+    let mut prev: Option<(C64, f64)> = None;
     for &v in x {
+        let nv = v.norm();
         match prev {
-            None => acc = if v.norm() > 0.0 { v.arg() } else { 0.0 },
-            Some(p) if v.norm() * p.norm() > 0.0 => acc += (v * p.conj()).arg(),
+            None => acc = if nv > 0.0 { v.arg() } else { 0.0 },
+            Some((p, np)) if nv * np > 0.0 => acc += (v * p.conj()).arg(),
             Some(_) => {}
         }
-        if v.norm() > 0.0 {
-            prev = Some(v);
+        if nv > 0.0 {
+            prev = Some((v, nv));
         }
         out.push(acc);
     }
