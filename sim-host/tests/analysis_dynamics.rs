@@ -189,15 +189,17 @@ fn hidden_effects_under_transients_found() {
 }
 
 /// Every non-dynamics effect of the library through a start and steps (a probe, ignored:
-/// `--ignored --nocapture`; `MOTOR` picks the motor, default 2p2; figures in the README).
+/// `--ignored --nocapture`; `MOTOR` picks the motor, default 2p2, `EFFECT` a comma-separated
+/// list of effects, default all; figures in the README).
 #[test]
 #[ignore]
 fn hidden_effects_under_transients_probe() {
     let which = std::env::var("MOTOR").unwrap_or("2p2".into());
+    let only = std::env::var("EFFECT").ok();
     let dir = tempfile::tempdir().unwrap();
     for kind in monitor_core::EffectKind::ALL
         .into_iter()
-        .filter(|k| !k.is_dynamics())
+        .filter(|k| !k.is_dynamics() && only.as_deref().is_none_or(|o| o.split(',').any(|x| x == k.name())))
     {
         hidden_case(dir.path(), &which, kind);
     }

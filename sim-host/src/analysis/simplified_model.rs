@@ -628,8 +628,10 @@ impl FullMachine {
             .unwrap_or(b.ls_scale * (n.lls_h + lm - lm * lm / lr))
             .clamp(1e-3 * ls, 0.9 * ls);
         let l_m = ls - l_sigma;
+        // The winding temperature (`thermal_drift`) heats the cage too: the fitted rotor time
+        // constant is the cold one, and a = Rr/Lr follows the resistance factor.
         let a = match t.tau_r_s {
-            Some(tau) => 1.0 / tau.max(1e-5),
+            Some(tau) => rf / tau.max(1e-5),
             None => n.rr_ohm * b.ra_scale * rf / lr,
         };
         FullMachine {
