@@ -226,6 +226,9 @@ impl EffectModel for RotorAsymmetry {
         }
         let (ang, id_ripple) = s.data.split_at(len);
         let (delta, phi) = (p[0], p[1]);
+        // The full-order model carries the cage itself (`simplified_model`'s
+        // `CageAsymmetry`); the reduced model the terms below.
+        terms.rotor_asym = Some((delta, phi));
         let f = ang
             .iter()
             .map(|a| 1.0 + delta / 3.0 * (1.0 - (a + phi).cos()));

@@ -146,6 +146,12 @@ pub struct EffectTerms {
     pub load_nm: Vec<f64>,
     /// Predicted negative-sequence current, stationary frame [A]; empty = 0.
     pub i_neg: Vec<C64>,
+    /// `phase_asymmetry`: an unequal stator winding (`None`: symmetric).
+    pub winding: Option<WindingAsymmetry>,
+    /// `rotor_asymmetry` in the full-order model: (delta, phi) of an unequal rotor cage,
+    /// rotor phase a's resistance Rr (1 + delta), `phi` twice its angle at the log's start
+    /// against the analysis frame (the reduced model uses `rr_factor` and `phi_drive`).
+    pub rotor_asym: Option<(f64, f64)>,
     /// Core-loss conductance 1/Rfe [S].
     pub g_fe_s: f64,
     /// Coulomb friction torque [N m] (tanh(w_m / 1 rad/s) shape).
@@ -164,6 +170,54 @@ pub struct EffectTerms {
     pub cross_coupling: bool,
     /// Extra white noise on the inputs (for the noise floor; `None` in every fit).
     pub input_noise: Option<InputNoise>,
+}
+
+/// An unequal stator winding (`phase_asymmetry`) in the two forms of the model.
+///
+/// Reduced model: the steady-state description `i_neg = c conj(i_pos)` (`c` from the
+/// measured positive-sequence current). Full-order model: the simulator's winding (see
+/// `crate::sim`'s machine: a fraction mu of phase k's turns shorted, stator turns matrix
+/// T = I - (2/3) mu u_k u_k^T). In the winding's MMF variables i' = T i the machine is the
+/// symmetric one driven by T^-1 v with the stator resistance Rs T^-1, and the terminal
+/// current is T^-1 i'. T^-1 = I + k u_k u_k^T, k = (2/3) mu / (1 - (2/3) mu), acts on a
+/// complex vector z as `A z = (1 + |e|) z + e conj(z)`, e = (k/2) e^{j 2 th_k}:
+/// ```text
+///   L_sigma di'/dt = A v - Rs A i' - dpsi_R/dt,   i_terminal = A i'
+/// ```
+/// To first order in e, in steady state at slip s the terminal current's negative sequence
+/// is `c conj(i_pos)` with `c = e conj((Z1 + Z2 - Rs) / Z2)` (Z1, Z2 the positive- and
+/// negative-sequence impedances): the effect fits `c` in both forms and converts it with
+/// that factor at the log's mean operating point, so that the fitted value means the same.
+#[derive(Debug, Clone, Copy)]
+pub struct WindingAsymmetry {
+    /// The steady-state ratio i_neg / conj(i_pos) [-].
+    pub c: C64,
+    /// The full-order operator's coefficient `e` [-].
+    pub e: C64,
+}
+
+impl WindingAsymmetry {
+    /// The operator `A z = (1 + |e|) z + e conj(z)` (T^-1 of the stator turns matrix).
+    #[inline(always)]
+    fn apply(&self, z: C64) -> C64 {
+        z * (1.0 + self.e.norm()) + self.e * z.conj()
+    }
+
+    /// The reduced model's negative-sequence current at sample `k` of `d`.
+    #[inline(always)]
+    fn i_neg(&self, d: &Prepared, k: usize) -> C64 {
+        self.c * (d.i_ab[k] - d.i_neg[k]).conj()
+    }
+}
+
+/// The reduced model's negative-sequence current of the effects at sample `k`.
+#[inline(always)]
+fn reduced_i_neg(d: &Prepared, t: &EffectTerms, k: usize) -> C64 {
+    let ineg = t.i_neg.get(k).copied().unwrap_or_default();
+    match &t.winding {
+        Some(w) => ineg + w.i_neg(d, k),
+        None => ineg,
+    }
 }
 
 /// White Gaussian noise added to the model's inputs, to measure how much of the inputs'
@@ -489,7 +543,7 @@ fn simulate_with(
             }
         }
         let rot = rot_at(k);
-        let ineg = t.i_neg.get(k).copied().unwrap_or_default();
+        let ineg = reduced_i_neg(d, t, k);
         // Back to the analysis frame (measured d current, predicted q current).
         let i_dq = if cl.eps != 0.0 {
             let i_true = C64::new(cl.id_term, iq + cl.i_fe_q);
@@ -751,7 +805,7 @@ fn simulate_full(
         let (v0, id0, if0) = input(0.0);
         let (xa, _) = m.deriv(sw, &x, v0, id0, if0, wk, np);
         let rot = rot_at(k);
-        let ineg = t.i_neg.get(k).copied().unwrap_or_default();
+        let ineg = reduced_i_neg(d, t, k);
         let mut i_dq = C64::new(if sw.id { xa.id } else { d.id[k] }, xa.iq);
         if t.g_fe_s != 0.0 {
             let psd = m.l_sigma * xa.id + xa.pd;
@@ -816,6 +870,24 @@ struct StatState {
     wm: f64,
 }
 
+/// An unequal rotor cage in the stationary-frame model over one working sample: rotor
+/// phase a's resistance Rr (1 + delta). As in the simulator (`crate::sim`'s machine), the
+/// rotor resistance matrix in the stator frame is Rr (I + D), D = (2/3) delta u u^T, u along
+/// rotor phase a at the electrical angle theta_a = Np theta_m + phi/2; on a complex vector
+/// `D z = (delta/3) (z + e^{j 2 theta_a} conj(z))`. In the inverse-Gamma form (psi_R =
+/// (Lm/Lr) psi_r, Rr' = (Lm/Lr)^2 Rr, a = Rr/Lr) the rotor equation
+/// `dpsi_r/dt = -R_r i_r + j omega_r psi_r` becomes
+/// `dpsi_R/dt = (I + D) (Rr' i - a psi_R) + j omega_r psi_R`.
+#[derive(Debug, Clone, Copy)]
+struct CageAsymmetry {
+    /// delta / 3.
+    d3: f64,
+    /// e^{j 2 theta_a} at the sample's start.
+    u0: C64,
+    /// d(2 theta_a)/dt over the sample [rad/s] (twice the measured electrical speed).
+    w2: f64,
+}
+
 /// One working sample's machine and shaft for [`simulate_stationary`].
 struct StatMachine<'a, F: Fn(f64) -> f64> {
     m: FullMachine,
@@ -824,32 +896,59 @@ struct StatMachine<'a, F: Fn(f64) -> f64> {
     btot: f64,
     /// Extra shaft torque at a speed [N m].
     extra: &'a F,
+    /// `phase_asymmetry` (the terminal current is `A i'`, see [`WindingAsymmetry`]).
+    wind: Option<WindingAsymmetry>,
+    /// `rotor_asymmetry`.
+    cage: Option<CageAsymmetry>,
 }
 
 impl<F: Fn(f64) -> f64> StatMachine<'_, F> {
+    /// The derivative at time `tau` into the working sample [s] (the rotor's angle).
     #[inline(always)]
-    fn deriv(&self, x: &StatState, v: C64) -> StatState {
+    fn deriv(&self, x: &StatState, v: C64, tau: f64) -> StatState {
         let m = &self.m;
-        let back = C64::new(m.a, -self.np * x.wm) * x.psi;
+        let wr = self.np * x.wm;
+        // Rotor: q = Rr' i - a psi_R, dpsi_R/dt = (I + D) q + j omega_r psi_R.
+        let mut q = x.i * m.rr - x.psi * m.a;
+        if let Some(c) = &self.cage {
+            let u = c.u0 * C64::from_polar(1.0, c.w2 * tau);
+            q += (q + u * q.conj()) * c.d3;
+        }
+        let dpsi = q + C64::new(0.0, wr) * x.psi;
         let te = 1.5 * self.np * (x.psi.conj() * x.i).im;
+        // Stator: L_sigma di/dt = v - Rs i - dpsi_R/dt (with the winding: A v - Rs A i).
+        let (v, ri) = match &self.wind {
+            Some(w) => (w.apply(v), w.apply(x.i) * m.rs),
+            None => (v, x.i * m.rs),
+        };
         StatState {
-            i: (v - x.i * (m.rs + m.rr) + back) / m.l_sigma.max(1e-9),
-            psi: x.i * m.rr - back,
+            i: (v - ri - dpsi) / m.l_sigma.max(1e-9),
+            psi: dpsi,
             wm: (te - self.btot * x.wm - (self.extra)(x.wm)) / self.j,
         }
     }
 
-    /// Classic RK4 over `h` with the input at the start, middle and end.
-    fn rk4(&self, x: &StatState, h: f64, v: [C64; 3]) -> StatState {
+    /// The terminal current of the state (the winding's `A i'`).
+    #[inline(always)]
+    fn terminal(&self, i: C64) -> C64 {
+        match &self.wind {
+            Some(w) => w.apply(i),
+            None => i,
+        }
+    }
+
+    /// Classic RK4 over `h` from `t0` into the sample, with the input at the start,
+    /// middle and end.
+    fn rk4(&self, x: &StatState, h: f64, v: [C64; 3], t0: f64) -> StatState {
         let add = |a: &StatState, b: &StatState, s: f64| StatState {
             i: a.i + b.i * s,
             psi: a.psi + b.psi * s,
             wm: a.wm + b.wm * s,
         };
-        let k1 = self.deriv(x, v[0]);
-        let k2 = self.deriv(&add(x, &k1, 0.5 * h), v[1]);
-        let k3 = self.deriv(&add(x, &k2, 0.5 * h), v[1]);
-        let k4 = self.deriv(&add(x, &k3, h), v[2]);
+        let k1 = self.deriv(x, v[0], t0);
+        let k2 = self.deriv(&add(x, &k1, 0.5 * h), v[1], t0 + 0.5 * h);
+        let k3 = self.deriv(&add(x, &k2, 0.5 * h), v[1], t0 + 0.5 * h);
+        let k4 = self.deriv(&add(x, &k3, h), v[2], t0 + h);
         StatState {
             i: x.i + (k1.i + (k2.i + k3.i) * 2.0 + k4.i) * (h / 6.0),
             psi: x.psi + (k1.psi + (k2.psi + k3.psi) * 2.0 + k4.psi) * (h / 6.0),
@@ -872,11 +971,11 @@ impl<F: Fn(f64) -> f64> StatMachine<'_, F> {
         let mut y = *x;
         if ha > 0.0 {
             let r = |t: f64| C64::from_polar(1.0, w[0] * t);
-            y = self.rk4(&y, ha, [v0, v0 * r(0.5 * ha), v0 * r(ha)]);
+            y = self.rk4(&y, ha, [v0, v0 * r(0.5 * ha), v0 * r(ha)], 0.0);
         }
         if hb > 0.0 {
             let r = |t: f64| C64::from_polar(1.0, -w[1] * t);
-            y = self.rk4(&y, hb, [v1 * r(hb), v1 * r(0.5 * hb), v1]);
+            y = self.rk4(&y, hb, [v1 * r(hb), v1 * r(0.5 * hb), v1], ha);
         }
         y
     }
@@ -991,6 +1090,7 @@ fn simulate_stationary(
     };
     let mut v_cur = v_at(0);
     let mut v_next = v_at(1.min(len - 1));
+    let mut cage = CageAngle::new(d, t);
     for k in 0..len {
         let extra = |w: f64| {
             let coulomb = if t.coulomb_nm != 0.0 {
@@ -1006,10 +1106,12 @@ fn simulate_stationary(
             j: (n.j_kgm2 * b.j_scale).max(1e-9),
             btot: b.btot_nms.max(0.0),
             extra: &extra,
+            wind: t.winding,
+            cage: cage.at(d, k),
         };
         let rot = rot_at(k);
         let ineg = t.i_neg.get(k).copied().unwrap_or_default();
-        let mut i_out = x.i;
+        let mut i_out = sm.terminal(x.i);
         if t.g_fe_s != 0.0 {
             let psi_s = x.i * sm.m.l_sigma + x.psi;
             i_out += C64::new(0.0, t.g_fe_s * d.omega_s[k]) * psi_s;
@@ -1028,10 +1130,11 @@ fn simulate_stationary(
             let early = sm.across_step(&x, dt, 0.0, v0, v1, w);
             let late = sm.across_step(&x, dt, 1.0, v0, v1, w);
             // The measured currents before the block mean, as the model's.
-            let target = i_meas(k + 1) / gain(k + 1) - (i_meas(k) / gain(k) - x.i);
-            let span = late.i - early.i;
+            let target = i_meas(k + 1) / gain(k + 1) - (i_meas(k) / gain(k) - sm.terminal(x.i));
+            let (early_i, late_i) = (sm.terminal(early.i), sm.terminal(late.i));
+            let span = late_i - early_i;
             let phi = if span.norm_sqr() > 0.0 {
-                ((target - early.i) * span.conj()).re / span.norm_sqr()
+                ((target - early_i) * span.conj()).re / span.norm_sqr()
             } else {
                 0.5
             };
@@ -1039,7 +1142,7 @@ fn simulate_stationary(
         } else {
             let half = C64::from_polar(1.0, 0.5 * ph[k]);
             let vm = (v0 * half + v1 * half.conj()) * 0.5;
-            sm.rk4(&x, dt, [v0, vm, v1])
+            sm.rk4(&x, dt, [v0, vm, v1], 0.0)
         };
         (v_cur, v_next) = (v1, v_after);
         if !(x.i.re.is_finite() && x.i.im.is_finite() && x.psi.re.is_finite() && x.wm.is_finite()) {
@@ -1047,6 +1150,41 @@ fn simulate_stationary(
         }
     }
     out
+}
+
+/// The angle 2 theta_a + phi of the faulty rotor phase for [`CageAsymmetry`] (`None`
+/// without `rotor_asymmetry` or without a speed column): Np theta_m integrates the
+/// measured electrical speed (trapezoid) from the analysis frame's angle at the first
+/// sample, as the reduced model's `rotor_asymmetry` does, so that `phi` means the same.
+struct CageAngle {
+    /// (delta, phi) of the effect.
+    p: Option<(f64, f64)>,
+    /// 2 Np theta_m at the current sample [rad].
+    th2: f64,
+}
+
+impl CageAngle {
+    fn new(d: &Prepared, t: &EffectTerms) -> Self {
+        let ok = d.omega_r.len() == d.len() && !d.is_empty();
+        CageAngle {
+            p: t.rotor_asym.filter(|_| ok),
+            th2: d.theta.first().map_or(0.0, |t| 2.0 * t),
+        }
+    }
+
+    /// The cage over working sample `k` (call for k = 0, 1, ... in turn).
+    fn at(&mut self, d: &Prepared, k: usize) -> Option<CageAsymmetry> {
+        let (delta, phi) = self.p?;
+        if k > 0 {
+            self.th2 += d.dt_s * (d.omega_r[k] + d.omega_r[k - 1]);
+        }
+        let k1 = (k + 1).min(d.len() - 1);
+        Some(CageAsymmetry {
+            d3: delta / 3.0,
+            u0: C64::from_polar(1.0, self.th2 + phi),
+            w2: d.omega_r[k] + d.omega_r[k1],
+        })
+    }
 }
 
 /// The discrete block mean's gain on a vector turning at `w` [rad/s]: the mean of
