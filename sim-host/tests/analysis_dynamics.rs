@@ -245,3 +245,38 @@ fn full_order_model_reproduces_the_simulator() {
     }
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+/// Diagnostic (ignored): the full-order model with the true parameters and the true
+/// saturation law against an ideal-sensor log with `saturation` at the simulator's
+/// defaults: the model's own error, without a fit.
+#[test]
+#[ignore]
+fn saturated_full_order_model_with_true_law() {
+    use sim_host::analysis::{metrics, simplified_model as sm};
+    let dir = tempfile::tempdir().unwrap();
+    let which = std::env::var("MOTOR").unwrap_or("2p2".into());
+    let p = params(&which);
+    let m = p.motor.model::<f64>();
+    let mut s = transients(&which, 5000.0);
+    s.sensors = sim_host::sim::SensorSpec::ideal();
+    s.effects = vec![sim_host::sim::EffectSpec::with_defaults(
+        monitor_core::EffectKind::Saturation,
+    )];
+    let log = write_log(dir.path(), &format!("sat_{which}"), &p, &s, false);
+    let a = analyse(&log, &p, 0.0);
+    let psi_sat = 1.3 * p.supply.v_phase_peak() / p.supply.omega_rad_s();
+    for sat in [None, Some((psi_sat, 6.0))] {
+        let terms = sm::EffectTerms {
+            tau_r_s: Some(m.lr_h / m.rr_ohm),
+            la_h: Some(m.la_h()),
+            d_axis: true,
+            cross_coupling: true,
+            sat,
+            ..Default::default()
+        };
+        let n = &a.constants;
+        let pred = sm::simulate(&a.data, n, &sm::BaseParams::nominal(n), &terms);
+        let e = metrics::errors(&a.data, &pred, None).normalized_rms_error;
+        eprintln!("{which} saturation law {sat:?}: {e:.5}");
+    }
+}

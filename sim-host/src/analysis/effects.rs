@@ -598,6 +598,8 @@ impl EffectModel for Saturation {
         terms: &mut EffectTerms,
     ) {
         terms.lm_factor = sat_factors(n.lm_h, &d.i_f, p[0], p[1]);
+        // The full-order model saturates with its own magnetising flux.
+        terms.sat = Some((p[0], p[1]));
     }
     fn describe(&self, s: &FitSetup, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
         // The factor falls monotonically with |i_f|: its extremes are at the extremes of |i_f|.

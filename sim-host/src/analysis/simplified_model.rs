@@ -152,6 +152,10 @@ pub struct EffectTerms {
     /// rotor phase a's resistance Rr (1 + delta), `phi` twice its angle at the log's start
     /// against the analysis frame (the reduced model uses `rr_factor` and `phi_drive`).
     pub rotor_asym: Option<(f64, f64)>,
+    /// `saturation` in the full-order model: (psi_sat [Wb], exponent n) of
+    /// Lm = Lm0 / (1 + (|psi_m| / psi_sat)^n), psi_m the model's own magnetising flux (the
+    /// reduced model uses `lm_factor`, computed from the measured i_f).
+    pub sat: Option<(f64, f64)>,
     /// Core-loss conductance 1/Rfe [S].
     pub g_fe_s: f64,
     /// Coulomb friction torque [N m] (tanh(w_m / 1 rad/s) shape).
@@ -672,8 +676,13 @@ impl FullMachine {
 impl FullMachine {
     /// The machine at sample `k` with the base parameters `b` and the effects' terms `t`.
     fn at(n: &MachineConstants, b: &BaseParams, t: &EffectTerms, k: usize) -> FullMachine {
+        Self::at_lm(n, b, t, k, t.lm_factor.get(k).copied().unwrap_or(1.0))
+    }
+
+    /// [`FullMachine::at`] with the magnetising inductance `mf` x Lm (1: unsaturated, what
+    /// the stationary-frame model's own saturation starts from).
+    fn at_lm(n: &MachineConstants, b: &BaseParams, t: &EffectTerms, k: usize, mf: f64) -> Self {
         let rf = t.r_factor.get(k).copied().unwrap_or(1.0);
-        let mf = t.lm_factor.get(k).copied().unwrap_or(1.0);
         let lm = n.lm_h * mf;
         let lr = n.llr_h + lm;
         let ls = b.ls_scale * (n.lls_h + lm);
@@ -900,12 +909,103 @@ struct StatMachine<'a, F: Fn(f64) -> f64> {
     wind: Option<WindingAsymmetry>,
     /// `rotor_asymmetry`.
     cage: Option<CageAsymmetry>,
+    /// `saturation`: the states are the fluxes of the T-equivalent circuit.
+    sat: Option<SatMachine<'a>>,
+}
+
+/// The saturated machine (`saturation` in the full-order model) as the simulator
+/// integrates it (`crate::sim`'s machine): T-equivalent circuit, states psi_s and psi_r
+/// (stationary frame; in [`StatState`] `i` holds psi_s and `psi` holds psi_r), currents
+/// from the fluxes with Lm = Lm0 / (1 + (|psi_m| / psi_sat)^n):
+/// ```text
+///   dpsi_s/dt = v - Rs i_s,   dpsi_r/dt = -Rr i_r + j omega_r psi_r
+///   psi_m = (psi_s/Lls + psi_r/Llr) / (1/Lm + 1/Lls + 1/Llr)
+///   i_s = (psi_s - psi_m)/Lls,   i_r = (psi_r - psi_m)/Llr
+///   T_e = (3/2) Np Im(psi_r conj(i_r))
+/// ```
+/// The circuit comes from the fitted unsaturated inverse-Gamma machine ([`FullMachine`]:
+/// Rs, L_sigma, L_M, a): the leakages are the nominal ones scaled by L_sigma / nominal
+/// L_sigma, Lm0 = Ls - Lls, Rr = a Lr (the inverse-Gamma L_sigma of that circuit is within
+/// (Llr/Lr)^2, 0.2 %, of the fitted one). Given psi_s and psi_r, y = 1/Lm solves
+/// `y = (1/Lm0) (1 + (W / (psi_sat (y + G)))^n)`, W = |psi_s/Lls + psi_r/Llr|,
+/// G = 1/Lls + 1/Llr, by Newton's method from the last solve (f is increasing in y).
+/// The winding (`phase_asymmetry`) and the cage (`rotor_asymmetry`) act as in
+/// [`WindingAsymmetry`] and [`CageAsymmetry`], on the fluxes' equations.
+#[derive(Clone, Copy)]
+struct SatMachine<'a> {
+    inv_lls: f64,
+    inv_llr: f64,
+    inv_lm0: f64,
+    rr: f64,
+    psi_sat: f64,
+    nexp: f64,
+    /// The last solve's 1/Lm (0: none yet).
+    guess: &'a std::cell::Cell<f64>,
+}
+
+impl<'a> SatMachine<'a> {
+    fn new(
+        n: &MachineConstants,
+        m: &FullMachine,
+        (psi_sat, nexp): (f64, f64),
+        guess: &'a std::cell::Cell<f64>,
+    ) -> Self {
+        let sigma_n = n.lls_h + n.lm_h * n.llr_h / (n.llr_h + n.lm_h);
+        let scale = m.l_sigma / sigma_n.max(1e-12);
+        let (lls, llr) = (n.lls_h * scale, n.llr_h * scale);
+        let lm0 = (m.l_sigma + m.l_m - lls).max(1e-6);
+        SatMachine {
+            inv_lls: 1.0 / lls.max(1e-9),
+            inv_llr: 1.0 / llr.max(1e-9),
+            inv_lm0: 1.0 / lm0,
+            rr: m.a * (llr + lm0),
+            psi_sat: psi_sat.max(1e-9),
+            nexp,
+            guess,
+        }
+    }
+
+    /// The linear model's state (i_s, psi_R) as fluxes (psi_s, psi_r) at Lm0.
+    fn from_linear(&self, m: &FullMachine, x: &StatState) -> StatState {
+        let lr_over_lm = 1.0 + self.inv_lm0 / self.inv_llr;
+        StatState {
+            i: x.i * m.l_sigma + x.psi,
+            psi: x.psi * lr_over_lm,
+            wm: x.wm,
+        }
+    }
+
+    /// Stator and rotor currents at the fluxes `ps`, `pr`.
+    #[inline(always)]
+    fn currents(&self, ps: C64, pr: C64) -> (C64, C64) {
+        let w = ps * self.inv_lls + pr * self.inv_llr;
+        let g = self.inv_lls + self.inv_llr;
+        let big_w = w.norm() / self.psi_sat;
+        let mut y = self.guess.get().max(self.inv_lm0);
+        for _ in 0..30 {
+            let r = (big_w / (y + g)).powf(self.nexp);
+            let f = y - self.inv_lm0 * (1.0 + r);
+            let fp = 1.0 + self.inv_lm0 * self.nexp * r / (y + g);
+            let ny = (y - f / fp).max(self.inv_lm0);
+            let done = (ny - y).abs() <= 1e-12 * ny;
+            y = ny;
+            if done {
+                break;
+            }
+        }
+        self.guess.set(y);
+        let psi_m = w / (y + g);
+        ((ps - psi_m) * self.inv_lls, (pr - psi_m) * self.inv_llr)
+    }
 }
 
 impl<F: Fn(f64) -> f64> StatMachine<'_, F> {
     /// The derivative at time `tau` into the working sample [s] (the rotor's angle).
     #[inline(always)]
     fn deriv(&self, x: &StatState, v: C64, tau: f64) -> StatState {
+        if let Some(sat) = &self.sat {
+            return self.deriv_sat(sat, x, v, tau);
+        }
         let m = &self.m;
         let wr = self.np * x.wm;
         // Rotor: q = Rr' i - a psi_R, dpsi_R/dt = (I + D) q + j omega_r psi_R.
@@ -928,9 +1028,51 @@ impl<F: Fn(f64) -> f64> StatMachine<'_, F> {
         }
     }
 
+    /// [`StatMachine::deriv`] of the saturated machine ([`SatMachine`]).
+    #[inline(always)]
+    fn deriv_sat(&self, sat: &SatMachine, x: &StatState, v: C64, tau: f64) -> StatState {
+        let (i_s, i_r) = sat.currents(x.i, x.psi);
+        let wr = self.np * x.wm;
+        let mut ri = i_r * sat.rr;
+        if let Some(c) = &self.cage {
+            let u = c.u0 * C64::from_polar(1.0, c.w2 * tau);
+            ri += (ri + u * ri.conj()) * c.d3;
+        }
+        let te = 1.5 * self.np * (x.psi * i_r.conj()).im;
+        let u_s = match &self.wind {
+            Some(w) => w.apply(v - i_s * self.m.rs),
+            None => v - i_s * self.m.rs,
+        };
+        StatState {
+            i: u_s,
+            psi: C64::new(0.0, wr) * x.psi - ri,
+            wm: (te - self.btot * x.wm - (self.extra)(x.wm)) / self.j,
+        }
+    }
+
+    /// The winding's current of the state (i' with an unequal winding): `x.i`, or from the
+    /// fluxes of the saturated machine.
+    #[inline(always)]
+    fn current(&self, x: &StatState) -> C64 {
+        match &self.sat {
+            Some(sat) => sat.currents(x.i, x.psi).0,
+            None => x.i,
+        }
+    }
+
+    /// The stator flux psi_s of the state.
+    #[inline(always)]
+    fn stator_flux(&self, x: &StatState) -> C64 {
+        match &self.sat {
+            Some(_) => x.i,
+            None => x.i * self.m.l_sigma + x.psi,
+        }
+    }
+
     /// The terminal current of the state (the winding's `A i'`).
     #[inline(always)]
-    fn terminal(&self, i: C64) -> C64 {
+    fn terminal(&self, x: &StatState) -> C64 {
+        let i = self.current(x);
         match &self.wind {
             Some(w) => w.apply(i),
             None => i,
@@ -1081,7 +1223,13 @@ fn simulate_stationary(
         .collect();
     let step_thr = prep::SUPPLY_STEP_REL.max(10.0 * median(&dev));
     let i_meas = |k: usize| d.i_ab[k] - d.i_neg[k];
-    let x0 = full_initial_state(d, n, &FullMachine::at(n, b, t, 0));
+    // With `saturation` the machine saturates with its own flux ([`SatMachine`]), not with
+    // the reduced model's factor from the measured i_f.
+    let machine_at = |k: usize| match t.sat {
+        Some(_) => FullMachine::at_lm(n, b, t, k, 1.0),
+        None => FullMachine::at(n, b, t, k),
+    };
+    let x0 = full_initial_state(d, n, &machine_at(0));
     let r0 = rot_at(0);
     let mut x = StatState {
         i: C64::new(x0.id, x0.iq) * r0,
@@ -1091,6 +1239,7 @@ fn simulate_stationary(
     let mut v_cur = v_at(0);
     let mut v_next = v_at(1.min(len - 1));
     let mut cage = CageAngle::new(d, t);
+    let lm_guess = std::cell::Cell::new(0.0);
     for k in 0..len {
         let extra = |w: f64| {
             let coulomb = if t.coulomb_nm != 0.0 {
@@ -1101,19 +1250,33 @@ fn simulate_stationary(
             coulomb + t.windage_nms2 * w * w.abs() + t.load_nm.get(k).copied().unwrap_or(0.0)
         };
         let sm = StatMachine {
-            m: FullMachine::at(n, b, t, k),
+            m: machine_at(k),
             np: n.np,
             j: (n.j_kgm2 * b.j_scale).max(1e-9),
             btot: b.btot_nms.max(0.0),
             extra: &extra,
             wind: t.winding,
             cage: cage.at(d, k),
+            sat: None,
+        };
+        let sm = match t.sat {
+            Some(law) => {
+                let sat = SatMachine::new(n, &sm.m, law, &lm_guess);
+                if k == 0 {
+                    x = sat.from_linear(&sm.m, &x);
+                }
+                StatMachine {
+                    sat: Some(sat),
+                    ..sm
+                }
+            }
+            None => sm,
         };
         let rot = rot_at(k);
         let ineg = t.i_neg.get(k).copied().unwrap_or_default();
-        let mut i_out = sm.terminal(x.i);
+        let mut i_out = sm.terminal(&x);
         if t.g_fe_s != 0.0 {
-            let psi_s = x.i * sm.m.l_sigma + x.psi;
+            let psi_s = sm.stator_flux(&x);
             i_out += C64::new(0.0, t.g_fe_s * d.omega_s[k]) * psi_s;
         }
         let i_ab = i_out * gain(k) + ineg;
@@ -1130,8 +1293,8 @@ fn simulate_stationary(
             let early = sm.across_step(&x, dt, 0.0, v0, v1, w);
             let late = sm.across_step(&x, dt, 1.0, v0, v1, w);
             // The measured currents before the block mean, as the model's.
-            let target = i_meas(k + 1) / gain(k + 1) - (i_meas(k) / gain(k) - sm.terminal(x.i));
-            let (early_i, late_i) = (sm.terminal(early.i), sm.terminal(late.i));
+            let target = i_meas(k + 1) / gain(k + 1) - (i_meas(k) / gain(k) - sm.terminal(&x));
+            let (early_i, late_i) = (sm.terminal(&early), sm.terminal(&late));
             let span = late_i - early_i;
             let phi = if span.norm_sqr() > 0.0 {
                 ((target - early_i) * span.conj()).re / span.norm_sqr()
