@@ -138,6 +138,9 @@ fn hidden_case(
     let before = a.compare(&opts(&FULL)).unwrap().report;
     let after = a.compare(&opts(&with)).unwrap().report;
     let top = ex.ranking.first();
+    if let Some(c) = top {
+        eprintln!("  {}: {}", c.effect.name(), c.summary);
+    }
     let r = (
         top.map(|c| c.effect.name()).unwrap_or("-").to_string(),
         top.map(|c| c.explained_fraction).unwrap_or(0.0),
