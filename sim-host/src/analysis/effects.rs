@@ -414,7 +414,7 @@ impl EffectModel for ThermalDrift {
         "The windings heat up with load, so the stator and rotor resistances rise (copper: +0.393 %/K; 20 -> 90 C is +27 %)."
     }
     fn equations(&self) -> &'static str {
-        "Rs(t), Rr(t) = R (1 + 0.00393 dT(t)), dT(t) = rise_k (1 - exp(-(t - t0)/tau_s)); Ra = Rs + (Ls/Lr) Rr in eq. (28) follows."
+        "Rs(t), Rr(t) = R (1 + 0.00393 dT(t)), dT(t) = rise_k (1 - exp(-(t - t0)/tau_s)); Ra = Rs + (Ls/Lr) Rr in eq. (28) follows; in the full-order model the rotor time constant Lr/Rr follows too."
     }
     fn parameters(&self) -> &'static [ParamSpec] {
         &[
@@ -553,7 +553,7 @@ impl EffectModel for Saturation {
         "The iron of the main flux path saturates: the magnetising inductance Lm falls as the magnetising current (the flux level) rises."
     }
     fn equations(&self) -> &'static str {
-        "Lm(i_f) = Lm0 / (1 + (Lm(i_f) i_f / psi_sat)^n), solved per sample; Ls = Lls + Lm and Kf (Lm^2/Lr) in eqs. (28)-(29) follow."
+        "Lm(i_f) = Lm0 / (1 + (Lm(i_f) i_f / psi_sat)^n), solved per sample; Ls = Lls + Lm and Kf (Lm^2/Lr) in eqs. (28)-(29) follow. In the full-order model (all dynamics effects in) the same law acts on the model's own magnetising flux |psi_m| = Lm |i_s + i_r|, the fluxes of the T-equivalent circuit being its states."
     }
     fn parameters(&self) -> &'static [ParamSpec] {
         &[

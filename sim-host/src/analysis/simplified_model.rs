@@ -15,7 +15,12 @@
 //!
 //! With all four dynamics effects in, the model is the full-order machine driven by the
 //! measured voltages and runs in the stationary frame (`simulate_stationary`): the
-//! analysis frame then only projects its outputs.
+//! analysis frame then only projects its outputs. There the effects that change the
+//! machine act as the simulator injects them (`crate::sim`'s machine), not through their
+//! steady-state descriptions: the heated cage's rotor time constant (`thermal_drift`),
+//! Lm on the model's own magnetising flux (`SatMachine`, `saturation`), the unequal
+//! stator winding ([`WindingAsymmetry`], `phase_asymmetry`) and rotor cage
+//! (`CageAsymmetry`, `rotor_asymmetry`).
 //!
 //! The mechanical equation is integrated semi-implicitly (the speed dependence of the
 //! quasi-static torque is taken at the new speed), so the step is stable at any working rate.
@@ -966,7 +971,7 @@ impl<'a> SatMachine<'a> {
     }
 
     /// The linear model's state (i_s, psi_R) as fluxes (psi_s, psi_r) at Lm0.
-    fn from_linear(&self, m: &FullMachine, x: &StatState) -> StatState {
+    fn linear_to_fluxes(&self, m: &FullMachine, x: &StatState) -> StatState {
         let lr_over_lm = 1.0 + self.inv_lm0 / self.inv_llr;
         StatState {
             i: x.i * m.l_sigma + x.psi,
@@ -1263,7 +1268,7 @@ fn simulate_stationary(
             Some(law) => {
                 let sat = SatMachine::new(n, &sm.m, law, &lm_guess);
                 if k == 0 {
-                    x = sat.from_linear(&sm.m, &x);
+                    x = sat.linear_to_fluxes(&sm.m, &x);
                 }
                 StatMachine {
                     sat: Some(sat),
