@@ -1189,44 +1189,16 @@ fn simulate_stationary(
         return out;
     }
     let dt = d.dt_s;
-    // A working sample is the mean of `factor` log rows: a vector turning at w comes out
-    // of the block mean scaled by `gain(w)`, the input voltage and the measured current
-    // alike. The machine is not linear in the voltage (the torque goes with its square:
-    // 0.2 % less torque through a start at 10 kHz, 1 % of the start current), so the
-    // model is driven by the voltage before the mean (v / gain) and its current is
-    // compared after it (gain i).
-    let factor = (d.log_rate_hz * dt).round().max(1.0);
-    // Positive-sequence voltage (stationary frame, after the block mean) and the gain.
-    let v_mean: Vec<C64> = (0..len)
-        .map(|k| C64::new(d.vd[k], d.vq[k]) * rot_at(k))
-        .collect();
-    // The voltage's phase step over each working sample [rad].
-    let ph: Vec<f64> = (0..len)
-        .map(|k| {
-            let a = k.min(len.saturating_sub(2));
-            phase_step(v_mean[a], v_mean[(a + 1).min(len - 1)])
-        })
-        .collect();
-    let gains: Vec<f64> = ph
-        .iter()
-        .map(|&p| block_gain(p / dt, dt / factor, factor))
-        .collect();
+    let StatVoltage {
+        v_mean,
+        ph,
+        gains,
+        dev,
+        step_thr,
+    } = StatVoltage::new(d, &rot_at);
     let gain = |k: usize| gains[k];
     // The voltage before the block mean.
     let v_at = |k: usize| v_mean[k] / gains[k];
-    // How far the voltage leaves its rotation over each working sample (relative); a
-    // supply step is an outlier of it: above SUPPLY_STEP_REL and ten times the median
-    // (harmonics in a real supply move the vector off its circle every sample).
-    let dev: Vec<f64> = (0..len)
-        .map(|k| {
-            if k == 0 || k + 1 >= len {
-                return 0.0;
-            }
-            let (v0, v1) = (v_at(k), v_at(k + 1));
-            (v1 - v0 * C64::from_polar(1.0, ph[k - 1])).norm() / v0.norm().max(v1.norm()).max(1e-12)
-        })
-        .collect();
-    let step_thr = prep::SUPPLY_STEP_REL.max(10.0 * median(&dev));
     let i_meas = |k: usize| d.i_ab[k] - d.i_neg[k];
     // With `saturation` the machine saturates with its own flux ([`SatMachine`]), not with
     // the reduced model's factor from the measured i_f.
@@ -1318,6 +1290,73 @@ fn simulate_stationary(
         }
     }
     out
+}
+
+/// The stationary-frame model's voltage input, per working sample (see
+/// [`simulate_stationary`]).
+struct StatVoltage {
+    /// Positive-sequence voltage, stationary frame, after the block mean [V].
+    v_mean: Vec<C64>,
+    /// The voltage's phase step over each working sample [rad].
+    ph: Vec<f64>,
+    /// The block mean's gain on the voltage's rotation.
+    gains: Vec<f64>,
+    /// How far the voltage leaves its rotation over each sample (relative).
+    dev: Vec<f64>,
+    /// `dev` above this is a supply step.
+    step_thr: f64,
+}
+
+impl StatVoltage {
+    fn new(d: &Prepared, rot_at: &impl Fn(usize) -> C64) -> Self {
+        let len = d.len();
+        let dt = d.dt_s;
+        // A working sample is the mean of `factor` log rows: a vector turning at w comes out
+        // of the block mean scaled by `gain(w)`, the input voltage and the measured current
+        // alike. The machine is not linear in the voltage (the torque goes with its square:
+        // 0.2 % less torque through a start at 10 kHz, 1 % of the start current), so the
+        // model is driven by the voltage before the mean (v / gain) and its current is
+        // compared after it (gain i).
+        let factor = (d.log_rate_hz * dt).round().max(1.0);
+        // Positive-sequence voltage (stationary frame, after the block mean) and the gain.
+        let v_mean: Vec<C64> = (0..len)
+            .map(|k| C64::new(d.vd[k], d.vq[k]) * rot_at(k))
+            .collect();
+        // The voltage's phase step over each working sample [rad].
+        let ph: Vec<f64> = (0..len)
+            .map(|k| {
+                let a = k.min(len.saturating_sub(2));
+                phase_step(v_mean[a], v_mean[(a + 1).min(len - 1)])
+            })
+            .collect();
+        let gains: Vec<f64> = ph
+            .iter()
+            .map(|&p| block_gain(p / dt, dt / factor, factor))
+            .collect();
+        // The voltage before the block mean.
+        let v_at = |k: usize| v_mean[k] / gains[k];
+        // How far the voltage leaves its rotation over each working sample (relative); a
+        // supply step is an outlier of it: above SUPPLY_STEP_REL and ten times the median
+        // (harmonics in a real supply move the vector off its circle every sample).
+        let dev: Vec<f64> = (0..len)
+            .map(|k| {
+                if k == 0 || k + 1 >= len {
+                    return 0.0;
+                }
+                let (v0, v1) = (v_at(k), v_at(k + 1));
+                (v1 - v0 * C64::from_polar(1.0, ph[k - 1])).norm()
+                    / v0.norm().max(v1.norm()).max(1e-12)
+            })
+            .collect();
+        let step_thr = prep::SUPPLY_STEP_REL.max(10.0 * median(&dev));
+        StatVoltage {
+            v_mean,
+            ph,
+            gains,
+            dev,
+            step_thr,
+        }
+    }
 }
 
 /// The angle 2 theta_a + phi of the faulty rotor phase for [`CageAsymmetry`] (`None`
