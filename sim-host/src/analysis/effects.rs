@@ -16,10 +16,10 @@
 //! | `windage` | k_nms2 [N m s^2/rad^2] | load += k w_m abs(w_m) |
 //! | `load_torque` | level_1..level_k [N m] | load += piecewise-constant T_L(t) (steps found in the data) |
 //! | `supply_unbalance` | y_re, y_im [-] | i_neg = (y_re + j y_im) v_neg / conj(Z2), Z2 from the nominal parameters |
-//! | `phase_asymmetry` | c_re, c_im [-] | i_neg = (c_re + j c_im) conj(i_pos) |
+//! | `phase_asymmetry` | c_re, c_im [-] | i_neg = (c_re + j c_im) conj(i_pos); full-order: the unequal winding (`simplified_model::WindingAsymmetry`) |
 //! | `flux_dynamics` | tau_r_s [s] | psi_r/Lm = phi, dphi/dt = (i_f - phi)/tau_r; slip and torque from phi |
 //! | `current_dynamics` | la_h [H] | La dI_qs/dt = V_qs - Ra I_qs - Psi omega_r (eq. 28's derivative term) |
-//! | `rotor_asymmetry` | delta [-], phi_rad [rad] | Rr in Ra x (1 + (delta/3)(1 - cos(2 (Np theta_m - theta) + phi))) (see `super::rotor_asymmetry`) |
+//! | `rotor_asymmetry` | delta [-], phi_rad [rad] | Rr in Ra x (1 + (delta/3)(1 - cos(2 (Np theta_m - theta) + phi))) (see `super::rotor_asymmetry`); full-order: rotor resistance Rr (I + (2/3) delta u u^T) |
 //! | `d_axis_dynamics` | (none) | I_ds predicted from V_ds by the d-axis stator equation instead of measured |
 //! | `cross_coupling_dynamics` | (none) | q-axis rotor flux and the slip coupling between the axes (psi_qr != 0 in transients) |
 //!
@@ -371,6 +371,16 @@ pub fn z2_neg(n: &MachineConstants, w: f64) -> C64 {
     C64::new(n.rs_ohm, w * n.lls_h) + zm * zr / (zm + zr)
 }
 
+/// Positive-sequence impedance of the machine at supply angular frequency `w` and slip `s`
+/// (T-equivalent circuit, `Rs + j w Lls + (j w Lm) || (Rr/s + j w Llr)`; the rotor branch
+/// as an admittance, so that s = 0 is the open rotor).
+pub fn z1_pos(n: &MachineConstants, w: f64, s: f64) -> C64 {
+    let w = w.abs().max(1.0);
+    let y_r = C64::new(s, 0.0) / C64::new(n.rr_ohm, s * w * n.llr_h);
+    let y_m = C64::new(0.0, -1.0 / (w * n.lm_h));
+    C64::new(n.rs_ohm, w * n.lls_h) + (y_m + y_r).inv()
+}
+
 /// Winding temperature rise: Rs and Rr follow copper's coefficient.
 pub struct ThermalDrift;
 /// Main-flux saturation.
@@ -404,7 +414,7 @@ impl EffectModel for ThermalDrift {
         "The windings heat up with load, so the stator and rotor resistances rise (copper: +0.393 %/K; 20 -> 90 C is +27 %)."
     }
     fn equations(&self) -> &'static str {
-        "Rs(t), Rr(t) = R (1 + 0.00393 dT(t)), dT(t) = rise_k (1 - exp(-(t - t0)/tau_s)); Ra = Rs + (Ls/Lr) Rr in eq. (28) follows."
+        "Rs(t), Rr(t) = R (1 + 0.00393 dT(t)), dT(t) = rise_k (1 - exp(-(t - t0)/tau_s)); Ra = Rs + (Ls/Lr) Rr in eq. (28) follows; in the full-order model the rotor time constant Lr/Rr follows too."
     }
     fn parameters(&self) -> &'static [ParamSpec] {
         &[
@@ -543,7 +553,7 @@ impl EffectModel for Saturation {
         "The iron of the main flux path saturates: the magnetising inductance Lm falls as the magnetising current (the flux level) rises."
     }
     fn equations(&self) -> &'static str {
-        "Lm(i_f) = Lm0 / (1 + (Lm(i_f) i_f / psi_sat)^n), solved per sample; Ls = Lls + Lm and Kf (Lm^2/Lr) in eqs. (28)-(29) follow."
+        "Lm(i_f) = Lm0 / (1 + (Lm(i_f) i_f / psi_sat)^n), solved per sample; Ls = Lls + Lm and Kf (Lm^2/Lr) in eqs. (28)-(29) follow. In the full-order model (all dynamics effects in) the same law acts on the model's own magnetising flux |psi_m| = Lm |i_s + i_r|, the fluxes of the T-equivalent circuit being its states."
     }
     fn parameters(&self) -> &'static [ParamSpec] {
         &[
@@ -588,6 +598,8 @@ impl EffectModel for Saturation {
         terms: &mut EffectTerms,
     ) {
         terms.lm_factor = sat_factors(n.lm_h, &d.i_f, p[0], p[1]);
+        // The full-order model saturates with its own magnetising flux.
+        terms.sat = Some((p[0], p[1]));
     }
     fn describe(&self, s: &FitSetup, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
         // The factor falls monotonically with |i_f|: its extremes are at the extremes of |i_f|.
@@ -1135,7 +1147,7 @@ impl EffectModel for PhaseAsymmetry {
         "One stator winding differs from the other two (inter-turn short, bad joint): the machine draws a negative-sequence current proportional to its load current even from a balanced supply."
     }
     fn equations(&self) -> &'static str {
-        "i_abc = balanced model current + i_neg, i_neg = (c_re + j c_im) conj(i_pos): a winding change dZ in phase k gives c = (dZ/3Zs...) e^{j 2 th_k} conj(Zs/Z2) mu/3."
+        "Reduced model: i_abc = balanced model current + i_neg, i_neg = (c_re + j c_im) conj(i_pos): a winding change dZ in phase k gives c = (dZ/3Zs...) e^{j 2 th_k} conj(Zs/Z2) mu/3. Full-order model (all dynamics effects in): the winding itself, T^-1 = I + k u_k u_k^T acting on the voltage, the stator resistance drop and the terminal current (A z = (1 + |e|) z + e conj(z), e = c conj(Z2/(Z1 + Z2 - Rs)) at the log's mean operating point, so c means the same in both)."
     }
     fn parameters(&self) -> &'static [ParamSpec] {
         &[
@@ -1157,8 +1169,19 @@ impl EffectModel for PhaseAsymmetry {
             speed: false,
         }
     }
-    fn setup(&self, _d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, String> {
+    fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String> {
         let mut s = FitSetup::default();
+        // data = the full-order form's e / c = conj(Z2 / (Z1 + Z2 - Rs)) at the log's mean
+        // operating point (`simplified_model::WindingAsymmetry`).
+        let (w, slip) = super::unbalance::operating_point(d, n);
+        let z2 = z2_neg(n, w);
+        let k = (z2 / (z1_pos(n, w, slip) + z2 - n.rs_ohm)).conj();
+        let k = if k.re.is_finite() && k.im.is_finite() {
+            k
+        } else {
+            C64::new(1.0, 0.0)
+        };
+        s.data = vec![k.re, k.im];
         s.push("c_re", "1", 0.01, -1.0, 1.0, 0.02);
         s.range(
             plausible::ASYM_C.0,
@@ -1175,17 +1198,18 @@ impl EffectModel for PhaseAsymmetry {
     }
     fn apply(
         &self,
-        _s: &FitSetup,
+        s: &FitSetup,
         p: &[f64],
-        d: &Prepared,
+        _d: &Prepared,
         _n: &MachineConstants,
         terms: &mut EffectTerms,
     ) {
         let c = C64::new(p[0], p[1]);
-        let add: Vec<C64> = (0..d.len())
-            .map(|k| c * (d.i_ab[k] - d.i_neg[k]).conj())
-            .collect();
-        add_neg(terms, add);
+        let k = match s.data[..] {
+            [re, im] => C64::new(re, im),
+            _ => C64::new(1.0, 0.0),
+        };
+        terms.winding = Some(super::simplified_model::WindingAsymmetry { c, e: c * k });
     }
     fn describe(&self, _s: &FitSetup, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
         let (w, slip) = super::unbalance::operating_point(d, n);

@@ -30,6 +30,10 @@
 //! `flux_dynamics` the model's flux follows the smoothed I_ds at once, which makes the
 //! fitted delta about 2x the truth (README, "Broken rotor bars").
 //!
+//! With all four dynamics effects in the model, the full-order model carries the whole
+//! resistance matrix in its rotor flux equation (`simplified_model`'s `CageAsymmetry`,
+//! [`EffectTerms::rotor_asym`]), with the same (delta, phi); the terms above are then unused.
+//!
 //! # Broken bars
 //! For an N-bar cage with n adjacent broken bars the equivalent rotor phase resistance
 //! asymmetry is delta = 3n / (N - 3n), n = delta N / (3 (1 + delta)) (Kliman, Koegl,
@@ -161,7 +165,7 @@ impl EffectModel for RotorAsymmetry {
         "The rotor cage is not symmetric (broken rotor bars, a cracked end ring): the rotor resistance seen by the stator field changes at twice the slip frequency, which modulates the torque and the current: (1 - 2s) f and (1 + 2s) f sidebands in the stator current, 2 s f ripple in speed."
     }
     fn equations(&self) -> &'static str {
-        "Rr in Ra = Rs + (Ls/Lr) Rr is multiplied by 1 + (delta/3)(1 - cos(2 (Np theta_m - theta) + phi)): the q-q element of the rotor resistance matrix Rr I + (2/3) Rr delta u u^T, u along the faulty rotor phase; Np theta_m integrates the measured speed."
+        "Rr in Ra = Rs + (Ls/Lr) Rr is multiplied by 1 + (delta/3)(1 - cos(2 (Np theta_m - theta) + phi)): the q-q element of the rotor resistance matrix Rr I + (2/3) Rr delta u u^T, u along the faulty rotor phase; Np theta_m integrates the measured speed. In the full-order model (all dynamics effects in) the whole matrix acts in the rotor flux equation."
     }
     fn parameters(&self) -> &'static [ParamSpec] {
         &[
@@ -226,6 +230,9 @@ impl EffectModel for RotorAsymmetry {
         }
         let (ang, id_ripple) = s.data.split_at(len);
         let (delta, phi) = (p[0], p[1]);
+        // The full-order model carries the cage itself (`simplified_model`'s
+        // `CageAsymmetry`); the reduced model the terms below.
+        terms.rotor_asym = Some((delta, phi));
         let f = ang
             .iter()
             .map(|a| 1.0 + delta / 3.0 * (1.0 - (a + phi).cos()));
