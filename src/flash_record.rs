@@ -11,38 +11,48 @@
 //! residuals), learned in the same commissioning run, so that after a reset the isolation
 //! is judged against the machine's own baseline, not the nameplate parameters.
 //!
-//! # Layout (little endian, [`RECORD_LEN`] = 72 bytes, a multiple of the G4's 8-byte
+//! Since version 3 it also stores the operating point that baseline was learned at
+//! ([`Baseline::at`]), so that away from it the isolation allows for the nameplate's error.
+//!
+//! # Layout (little endian, [`RECORD_LEN`] = 96 bytes, a multiple of the G4's 8-byte
 //! flash write unit)
 //!
 //! | bytes | field |
 //! |---|---|
 //! | 0..4 | magic `b"DMCR"` |
 //! | 4..6 | format version, `u16` ([`RECORD_VERSION`]) |
-//! | 6..8 | payload length in bytes, `u16` (= 60) |
+//! | 6..8 | payload length in bytes, `u16` (= 84) |
 //! | 8..24 | `mean[0..4]`, `f32` each |
 //! | 24..40 | `spread[0..4]`, `f32` each |
 //! | 40..52 | isolation baseline `mean[0..3]`, `f32` each (zero when absent) |
 //! | 52..64 | isolation baseline `spread[0..3]`, `f32` each (zero when absent) |
-//! | 64..68 | flags, `u32`: bit 0 set when the isolation baseline is present |
-//! | 68..72 | CRC-32 (IEEE 802.3, reflected, as zlib) of bytes 0..68 |
+//! | 64..88 | the learned point: `i_d, i_q` [A], `v_d, v_q` [V], `we, wr` [rad/s], `f32` each (zero when absent) |
+//! | 88..92 | flags, `u32`: bit 0 set when the isolation baseline is present |
+//! | 92..96 | CRC-32 (IEEE 802.3, reflected, as zlib) of bytes 0..92 |
 //!
-//! Version 1 records (48 bytes: the lamps' statistics at 8..40, 4 reserved bytes, the CRC
-//! at 44..48) are still read, without an isolation baseline.
+//! Version 2 records (72 bytes: as above without the learned point, flags at 64..68, the
+//! CRC at 68..72) are still read, with a baseline that has no learned point; version 1
+//! records (48 bytes: the lamps' statistics at 8..40, 4 reserved bytes, the CRC at
+//! 44..48) without an isolation baseline.
 //!
 //! Erased flash reads as all `0xFF`; that is reported as [`RecordError::Erased`].
 
-use monitor_core::isolation::Baseline;
+use monitor_core::isolation::{Baseline, SteadyPoint};
 
 /// Magic bytes at the start of a record.
 pub const RECORD_MAGIC: [u8; 4] = *b"DMCR";
 /// Current record format version. Bump it whenever the layout or the meaning of the
 /// stored numbers changes (for example a new normalization in the core): old records
 /// are then rejected instead of misread.
-pub const RECORD_VERSION: u16 = 2;
+pub const RECORD_VERSION: u16 = 3;
 /// Encoded record length in bytes.
-pub const RECORD_LEN: usize = 72;
-const PAYLOAD_LEN: u16 = 60;
-const CRC_OFFSET: usize = 68;
+pub const RECORD_LEN: usize = 96;
+const PAYLOAD_LEN: u16 = 84;
+const CRC_OFFSET: usize = 92;
+/// Version 2: length, payload length and CRC offset.
+const V2_LEN: usize = 72;
+const V2_PAYLOAD_LEN: u16 = 60;
+const V2_CRC_OFFSET: usize = 68;
 /// Version 1: length, payload length and CRC offset.
 const V1_LEN: usize = 48;
 const V1_PAYLOAD_LEN: u16 = 32;
@@ -138,6 +148,7 @@ fn values_ok(rec: &CalibrationRecord) -> bool {
         && rec.isolation.is_none_or(|b| {
             b.mean.iter().all(|m| m.is_finite())
                 && b.spread.iter().all(|s| s.is_finite() && *s > 0.0)
+                && point_fields(&b.at).iter().all(|x| x.is_finite())
         })
 }
 
@@ -184,8 +195,12 @@ impl CalibrationRecord {
         let iso = self.isolation.unwrap_or(Baseline {
             mean: [0.0; 3],
             spread: [0.0; 3],
+            at: SteadyPoint::default(),
         });
         for v in iso.mean.iter().chain(iso.spread.iter()) {
+            w.put(&v.to_le_bytes());
+        }
+        for v in point_fields(&iso.at) {
             w.put(&v.to_le_bytes());
         }
         let flags = if self.isolation.is_some() {
@@ -220,6 +235,7 @@ impl CalibrationRecord {
         let version = u16::from_le_bytes(r.take::<2>());
         let (len, payload, crc_at) = match version {
             RECORD_VERSION => (RECORD_LEN, PAYLOAD_LEN, CRC_OFFSET),
+            2 => (V2_LEN, V2_PAYLOAD_LEN, V2_CRC_OFFSET),
             1 => (V1_LEN, V1_PAYLOAD_LEN, V1_CRC_OFFSET),
             v => return Err(RecordError::UnsupportedVersion(v)),
         };
@@ -247,13 +263,27 @@ impl CalibrationRecord {
         for v in out.mean.iter_mut().chain(out.spread.iter_mut()) {
             *v = f32::from_le_bytes(r.take::<4>());
         }
-        if version == RECORD_VERSION {
+        if version >= 2 {
             let mut b = Baseline {
                 mean: [0.0; 3],
                 spread: [0.0; 3],
+                at: SteadyPoint::default(),
             };
             for v in b.mean.iter_mut().chain(b.spread.iter_mut()) {
                 *v = f32::from_le_bytes(r.take::<4>());
+            }
+            if version >= 3 {
+                let mut f = [0.0f32; 6];
+                for v in f.iter_mut() {
+                    *v = f32::from_le_bytes(r.take::<4>());
+                }
+                let [id, iq, vd, vq, we, wr] = f;
+                b.at = SteadyPoint {
+                    i: monitor_core::Dq { d: id, q: iq },
+                    v: monitor_core::Dq { d: vd, q: vq },
+                    we_rad_s: we,
+                    wr_rad_s: wr,
+                };
             }
             let flags = u32::from_le_bytes(r.take::<4>());
             out.isolation = (flags & FLAG_ISOLATION != 0).then_some(b);
@@ -263,6 +293,11 @@ impl CalibrationRecord {
         }
         Ok(out)
     }
+}
+
+/// The learned point's six numbers in the record's order.
+fn point_fields(p: &SteadyPoint) -> [f32; 6] {
+    [p.i.d, p.i.q, p.v.d, p.v.q, p.we_rad_s, p.wr_rad_s]
 }
 
 /// Where the record is kept: the flash page on the board, a byte array in the host tests
@@ -388,8 +423,36 @@ mod tests {
             isolation: Some(Baseline {
                 mean: [1e-4, -2e-4, 3e-3],
                 spread: [4e-4, 4e-4, 1e-3],
+                at: SteadyPoint {
+                    i: monitor_core::Dq { d: 3.5, q: 4.25 },
+                    v: monitor_core::Dq { d: -2.0, q: 325.0 },
+                    we_rad_s: 314.0,
+                    wr_rad_s: 303.5,
+                },
             }),
         }
+    }
+
+    #[test]
+    fn a_version_2_record_is_read_without_the_learned_point() {
+        // The version 2 layout: the current one without bytes 64..88.
+        let s = sample();
+        let v3 = s.encode().unwrap();
+        let mut v2 = [0u8; 72];
+        v2[..64].copy_from_slice(&v3[..64]);
+        v2[4..6].copy_from_slice(&2u16.to_le_bytes());
+        v2[6..8].copy_from_slice(&60u16.to_le_bytes());
+        v2[64..68].copy_from_slice(&v3[88..92]);
+        let crc = crc32(&v2[..68]);
+        v2[68..].copy_from_slice(&crc.to_le_bytes());
+        let mut page = [0xFFu8; RECORD_LEN];
+        page[..72].copy_from_slice(&v2);
+        let mut want = s;
+        if let Some(b) = want.isolation.as_mut() {
+            b.at = SteadyPoint::default();
+        }
+        assert_eq!(CalibrationRecord::decode(&page), Ok(want));
+        assert_ne!(want, s, "the learned point is what version 3 adds");
     }
 
     #[test]
@@ -435,6 +498,7 @@ mod tests {
         r.isolation = Some(Baseline {
             mean: [0.0; 3],
             spread: [0.0, 1e-3, 1e-3],
+            at: SteadyPoint::default(),
         });
         assert_eq!(r.encode(), Err(RecordError::InvalidValue));
     }

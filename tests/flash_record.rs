@@ -16,6 +16,12 @@ fn record() -> CalibrationRecord {
         isolation: Some(Baseline {
             mean: [1e-4, -2e-4, 3e-3],
             spread: [4e-4, 4e-4, 1e-3],
+            at: monitor_core::isolation::SteadyPoint {
+                i: monitor_core::Dq { d: 3.5, q: 4.25 },
+                v: monitor_core::Dq { d: -2.0, q: 325.0 },
+                we_rad_s: 314.0,
+                wr_rad_s: 303.5,
+            },
         }),
     }
 }

@@ -49,6 +49,23 @@
 //! that fits no fault's direction goes to it, so the monitor does not name a wrong fault
 //! with probability 0.5 or more.
 //!
+//! # Away from the learned point
+//! A learned baseline cancels the nameplate's error at the operating point where it was
+//! learned ([`Baseline::at`]), not elsewhere: after a load change the residuals move by
+//! `J(p) delta - J(p0) delta` (`delta`: the parameters' error), which no single fault's
+//! direction is meant to absorb (found on a simulated 11 kW log with parameters 15-20 % off:
+//! a load step to 0.7, then Rr +50 %, was named `current_sensor -27 %` at p = 0.95). The
+//! misfit therefore uses the covariance `S = diag(spread^2) + sum_j d_j d_j^T`, with `d_j`
+//! the difference, between the present point and the learned one, of what an error of
+//! `u` [`NAMEPLATE_UNCERTAINTY`] in parameter `j` (Rs, Rr, both leakages, Lm) does to the
+//! residuals. `u` follows the evidence: the learned mean of the voltage residuals against
+//! what a full [`NAMEPLATE_UNCERTAINTY`] error of each parameter leaves at the learned
+//! point, between [`NAMEPLATE_FLOOR`] and 1. One `S`, at the measured point with the
+//! nominal circuit, serves every hypothesis so that their misfits compare. At the learned
+//! point `d_j = 0` and nothing changes; a fault that itself moves the point (a sensor gain,
+//! a large Rr change) is judged with the widening its move brings, which is what a
+//! nameplate that is off deserves.
+//!
 //! Faults that cannot be separated:
 //! - **B and Bl**: both scale the same load term `(B + Bl) wr`; the directions coincide at
 //!   every operating point (one friction class; the size is given for each as if it alone
@@ -66,7 +83,8 @@
 //! - others depend on the operating point (the angle between directions,
 //!   [`Isolation::separation_deg`]).
 //!
-//! Cost: about 280 circuit evaluations of some 60 flops each per call; run it from a
+//! Cost: about 300 circuit evaluations of some 60 flops each per call (280 for the fits,
+//! 12 for the weight); run it from a
 //! low-priority task (the firmware: thread mode, from the status hand-over, every
 //! [`STEP_S`] at most), never from the per-sample path. [`Follower`] runs the schedule
 //! (averaging the operating point, learning the baseline, isolating) for the firmware and
@@ -102,6 +120,27 @@ pub const MIN_LEARNED_POINTS: u32 = 5;
 /// A deviation below this misfit is no evidence of a fault: the 99.9 % point of chi-square
 /// with 3 degrees of freedom (16.3), for spreads of one standard deviation.
 pub const DETECT_CHI2: f32 = 16.0;
+/// How much more probable than the runner-up a fault must be to be named alone: two
+/// faults whose directions coincide share the probability about evenly (0.50 / 0.50 up to
+/// rounding), and neither is named.
+pub const NAME_MARGIN: f32 = 0.1;
+/// Relative uncertainty of the nameplate's circuit parameters (Rs, Rr, both leakages and
+/// Lm): parameters from a nameplate or a datasheet are commonly 10-30 % off the machine
+/// (equivalent-circuit parameters from IEEE 112 / IEC 60034-28 tests of the same motor
+/// differ by 10-20 %). A learned baseline cancels their effect at the point where it was
+/// learned, not elsewhere (module docs, "Away from the learned point"). It is the most
+/// that is allowed for; how much is allowed for follows the evidence, see
+/// [`NAMEPLATE_FLOOR`].
+pub const NAMEPLATE_UNCERTAINTY: f32 = 0.2;
+/// The least nameplate error allowed for away from the learned point, as a fraction of
+/// [`NAMEPLATE_UNCERTAINTY`] (0.25: 5 %). Between it and 1 the fraction is the learned
+/// mean of the voltage residuals against what a [`NAMEPLATE_UNCERTAINTY`] error of each
+/// parameter would leave at the learned point (root sum of squares): a nameplate that fits
+/// the machine where it was learned is probably close elsewhere too. Errors that cancel
+/// at the learned point are what the floor is for. With the floor at 1 (20 % always) the
+/// isolation bench named 391 of 432 cases right and 8 wrongly (rotor resistance +-50 % at
+/// 0.6 load taken for a speed-sensor error); at 0.25, 409 and 1 (as without widening).
+pub const NAMEPLATE_FLOOR: f32 = 0.25;
 
 /// The steady-state operating point the isolation works on: the stator voltage and current
 /// vectors in one frame turning at the supply frequency, and the two speeds.
@@ -180,6 +219,11 @@ pub struct Baseline {
     pub mean: Residual3,
     /// Spread of each residual, > 0.
     pub spread: Residual3,
+    /// The mean operating point the baseline was learned at; [`SteadyPoint::default`]
+    /// (not a usable point) for the defaults and for baselines stored without it. Away
+    /// from it the nameplate's error no longer cancels and the misfit is widened
+    /// accordingly (module docs, "Away from the learned point").
+    pub at: SteadyPoint,
 }
 
 impl Default for Baseline {
@@ -187,6 +231,7 @@ impl Default for Baseline {
         Baseline {
             mean: [0.0; 3],
             spread: DEFAULT_SPREAD,
+            at: SteadyPoint::default(),
         }
     }
 }
@@ -299,7 +344,9 @@ impl Isolation {
         }
         let top = *self.candidates.first()?;
         if !matches!(top.fault, Fault::B | Fault::Bl) {
-            return (top.probability >= 0.5).then_some(Named::Fault(top));
+            let second = self.candidates.get(1).map_or(0.0, |c| c.probability);
+            let alone = top.probability >= 0.5 && top.probability - second >= NAME_MARGIN;
+            return alone.then_some(Named::Fault(top));
         }
         let find = |f: Fault| self.candidates.iter().find(|c| c.fault == f).copied();
         let (b, bl) = (find(Fault::B)?, find(Fault::Bl)?);
@@ -322,6 +369,7 @@ struct Learning {
     n: u32,
     mean: Residual3,
     m2: Residual3,
+    at: SteadyPoint,
 }
 
 /// The fault isolator: the nominal machine, the healthy baseline, and the fits.
@@ -387,6 +435,9 @@ impl Isolator {
             return false;
         }
         let mut b = b;
+        if self.residuals(&b.at, None).is_none() {
+            b.at = SteadyPoint::default();
+        }
         for (s, d) in b.spread.iter_mut().zip(DEFAULT_SPREAD) {
             *s = crate::maxf(*s, 0.2 * d);
         }
@@ -403,6 +454,7 @@ impl Isolator {
         let l = &mut self.learning;
         l.n = l.n.saturating_add(1);
         let n = l.n as f32;
+        l.at.approach(p, 1.0 / n);
         for ((m, m2), x) in l.mean.iter_mut().zip(l.m2.iter_mut()).zip(e) {
             let d = x - *m;
             *m += d / n;
@@ -427,6 +479,7 @@ impl Isolator {
         self.set_baseline(Baseline {
             mean: l.mean,
             spread,
+            at: l.at,
         })
     }
 
@@ -434,6 +487,13 @@ impl Isolator {
     /// sensors); `None` when the point is not usable (no voltage or current, frequency
     /// not positive, non-finite values).
     pub fn residuals(&self, p: &SteadyPoint, h: Option<(Fault, f32)>) -> Option<Residual3> {
+        let (c, q) = self.hypothesis(p, h);
+        self.eval(&c, &q)
+    }
+
+    /// The circuit and the readings corrected for hypothesis `h`.
+    #[inline(never)]
+    fn hypothesis(&self, p: &SteadyPoint, h: Option<(Fault, f32)>) -> (Circuit, SteadyPoint) {
         let (mut i, mut v, mut wr) = (p.i, p.v, p.wr_rad_s);
         let mut c = self.circuit();
         if let Some((f, k)) = h {
@@ -454,7 +514,70 @@ impl Isolator {
                 _ => c = c.with(f, k, &self.motor),
             }
         }
-        let we = p.we_rad_s;
+        let q = SteadyPoint {
+            i,
+            v,
+            we_rad_s: p.we_rad_s,
+            wr_rad_s: wr,
+        };
+        (c, q)
+    }
+
+    /// The weight (inverse covariance) of the residuals at the readings `q` of circuit
+    /// `c`: the inverse of `S = D + sum_j d_j d_j^T`, `D = diag(spread^2)`, with `d_j` how
+    /// much more the residuals move at `q` than at the learned point when circuit
+    /// parameter `j` (Rs, Rr, the leakages, Lm) is [`NAMEPLATE_UNCERTAINTY`] off (module
+    /// docs, "Away from the learned point"). Without a learned point, or where a point is
+    /// not usable: `D^-1`.
+    #[inline(never)]
+    fn weight(&self, c: &Circuit, q: &SteadyPoint) -> Sym3 {
+        let s = self.baseline.spread;
+        let diag = Sym3::diagonal_weight(&s);
+        let (at, c0) = (self.baseline.at, self.circuit());
+        let (Some(e_here), Some(e_at)) = (self.eval(c, q), self.eval(&c0, &at)) else {
+            return diag;
+        };
+        let [a, b, z] = s;
+        let mut cov = Sym3 {
+            xx: a * a,
+            yy: b * b,
+            zz: z * z,
+            ..Sym3::default()
+        };
+        // d_j for a NAMEPLATE_UNCERTAINTY error, and what that error leaves at the learned
+        // point in the voltage residuals (the evidence for how far off the nameplate is).
+        let mut d = [[0.0f32; 3]; 5];
+        let mut expected = 0.0f32;
+        for (j, dj) in d.iter_mut().enumerate() {
+            let (Some(h), Some(t)) = (
+                self.eval(&c.nameplate_off(j), q),
+                self.eval(&c0.nameplate_off(j), &at),
+            ) else {
+                return diag;
+            };
+            let g = sub3(&t, &e_at);
+            let [gd, gq, _] = g;
+            expected += gd * gd + gq * gq;
+            *dj = sub3(&sub3(&h, &e_here), &g);
+        }
+        let [md, mq, _] = self.baseline.mean;
+        let seen = crate::sqrt((md * md + mq * mq) / expected);
+        let u = if seen.is_finite() {
+            crate::minf(crate::maxf(seen, NAMEPLATE_FLOOR), 1.0)
+        } else {
+            1.0
+        };
+        for dj in d {
+            cov.add_outer(&dj.map(|x| u * x));
+        }
+        cov.inverse().unwrap_or(diag)
+    }
+
+    /// The parity residuals of circuit `c` at the (corrected) readings `q` (see
+    /// [`Isolator::residuals`]).
+    #[inline(never)]
+    fn eval(&self, c: &Circuit, q: &SteadyPoint) -> Option<Residual3> {
+        let (i, v, we, wr) = (q.i, q.v, q.we_rad_s, q.wr_rad_s);
         let vmag = crate::fast_hypot(v.d, v.q);
         let imag = crate::fast_hypot(i.d, i.q);
         if !(we > 0.0 && vmag > 0.0 && imag > 0.0 && wr.is_finite()) {
@@ -511,7 +634,8 @@ impl Isolator {
         for ((r, e), m) in out.residuals.iter_mut().zip(e0).zip(b.mean) {
             *r = e - m;
         }
-        let chi0 = self.chi2(&e0);
+        let w = self.weight(&self.circuit(), p);
+        let chi0 = self.chi2_at(p, None, &w);
         out.deviation = crate::sqrt(chi0);
         if chi0 < DETECT_CHI2 {
             out.state = IsolationState::NoDeviation;
@@ -519,7 +643,7 @@ impl Isolator {
         }
         let mut fits = [(0.0f32, 1.0f32); FAULT_COUNT];
         for (fit, f) in fits.iter_mut().zip(Fault::ALL) {
-            *fit = self.fit(p, f);
+            *fit = self.fit(p, f, &w);
         }
         // B and Bl scale the same load term: one friction class with one misfit (each
         // keeps the size it needs on its own).
@@ -564,21 +688,15 @@ impl Isolator {
         out
     }
 
-    /// The weighted misfit of residuals `e` against the baseline.
-    fn chi2(&self, e: &Residual3) -> f32 {
-        let b = &self.baseline;
-        let mut c = 0.0;
-        for ((x, m), s) in e.iter().zip(b.mean).zip(b.spread) {
-            let z = (x - m) / s;
-            c += z * z;
-        }
-        c
-    }
-
-    /// The misfit of hypothesis `(f, k)`; unusable points count as infinitely bad.
-    fn chi2_at(&self, p: &SteadyPoint, f: Fault, k: f32) -> f32 {
-        match self.residuals(p, Some((f, k))) {
-            Some(e) => self.chi2(&e),
+    /// The misfit of hypothesis `h` (fault `f` of factor `k`; `None`: the healthy machine)
+    /// against the baseline under the weight `w` ([`Isolator::weight`] at the measured
+    /// point, one for every hypothesis so that their misfits compare); unusable points
+    /// count as infinitely bad.
+    #[inline(never)]
+    fn chi2_at(&self, p: &SteadyPoint, h: Option<(Fault, f32)>, w: &Sym3) -> f32 {
+        let (c, q) = self.hypothesis(p, h);
+        match self.eval(&c, &q) {
+            Some(e) => w.quadratic(&sub3(&e, &self.baseline.mean)),
             None => f32::INFINITY,
         }
     }
@@ -587,12 +705,12 @@ impl Isolator {
     /// grid point. Returns `(chi2, k)`. Not inlined: one copy for the nine faults keeps
     /// the firmware's flash small (it runs in thread mode, where a call costs nothing).
     #[inline(never)]
-    fn fit(&self, p: &SteadyPoint, f: Fault) -> (f32, f32) {
+    fn fit(&self, p: &SteadyPoint, f: Fault, w: &Sym3) -> (f32, f32) {
         let step = F32Ext::powf(K_MAX / K_MIN, 1.0 / (GRID - 1) as f32);
-        let (mut best_k, mut best_c) = (1.0f32, self.chi2_at(p, f, 1.0));
+        let (mut best_k, mut best_c) = (1.0f32, self.chi2_at(p, Some((f, 1.0)), w));
         let mut k = K_MIN;
         for _ in 0..GRID {
-            let c = self.chi2_at(p, f, k);
+            let c = self.chi2_at(p, Some((f, k)), w);
             if c < best_c {
                 (best_k, best_c) = (k, c);
             }
@@ -605,18 +723,21 @@ impl Isolator {
         const G: f32 = 0.618_034;
         let mut x1 = hi - G * (hi - lo);
         let mut x2 = lo + G * (hi - lo);
-        let (mut c1, mut c2) = (self.chi2_at(p, f, x1), self.chi2_at(p, f, x2));
+        let (mut c1, mut c2) = (
+            self.chi2_at(p, Some((f, x1)), w),
+            self.chi2_at(p, Some((f, x2)), w),
+        );
         for _ in 0..GOLDEN_STEPS {
             if c1 < c2 {
                 hi = x2;
                 (x2, c2) = (x1, c1);
                 x1 = hi - G * (hi - lo);
-                c1 = self.chi2_at(p, f, x1);
+                c1 = self.chi2_at(p, Some((f, x1)), w);
             } else {
                 lo = x1;
                 (x1, c1) = (x2, c2);
                 x2 = lo + G * (hi - lo);
-                c2 = self.chi2_at(p, f, x2);
+                c2 = self.chi2_at(p, Some((f, x2)), w);
             }
         }
         for (c, x) in [(c1, x1), (c2, x2)] {
@@ -667,7 +788,97 @@ impl Isolator {
     }
 }
 
+/// A symmetric 3 x 3 matrix (covariance or weight of [`Residual3`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct Sym3 {
+    xx: f32,
+    xy: f32,
+    xz: f32,
+    yy: f32,
+    yz: f32,
+    zz: f32,
+}
+
+impl Sym3 {
+    /// `diag(1/s^2)`: the weight of independent spreads `s`.
+    fn diagonal_weight(s: &Residual3) -> Self {
+        let [a, b, c] = *s;
+        Sym3 {
+            xx: 1.0 / (a * a),
+            yy: 1.0 / (b * b),
+            zz: 1.0 / (c * c),
+            ..Sym3::default()
+        }
+    }
+
+    /// Adds the outer product `d d^T`.
+    fn add_outer(&mut self, d: &Residual3) {
+        let [x, y, z] = *d;
+        self.xx += x * x;
+        self.xy += x * y;
+        self.xz += x * z;
+        self.yy += y * y;
+        self.yz += y * z;
+        self.zz += z * z;
+    }
+
+    /// The inverse (adjugate over determinant); `None` when the determinant is not
+    /// positive or anything is not finite.
+    fn inverse(&self) -> Option<Self> {
+        let m = self;
+        let c_xx = m.yy * m.zz - m.yz * m.yz;
+        let c_xy = m.xz * m.yz - m.xy * m.zz;
+        let c_xz = m.xy * m.yz - m.xz * m.yy;
+        let det = m.xx * c_xx + m.xy * c_xy + m.xz * c_xz;
+        if !(det > 0.0 && det.is_finite()) {
+            return None;
+        }
+        let inv = Sym3 {
+            xx: c_xx / det,
+            xy: c_xy / det,
+            xz: c_xz / det,
+            yy: (m.xx * m.zz - m.xz * m.xz) / det,
+            yz: (m.xy * m.xz - m.xx * m.yz) / det,
+            zz: (m.xx * m.yy - m.xy * m.xy) / det,
+        };
+        let all = [inv.xx, inv.xy, inv.xz, inv.yy, inv.yz, inv.zz];
+        all.iter().all(|v| v.is_finite()).then_some(inv)
+    }
+
+    /// `d^T M d`.
+    fn quadratic(&self, d: &Residual3) -> f32 {
+        let [x, y, z] = *d;
+        self.xx * x * x
+            + self.yy * y * y
+            + self.zz * z * z
+            + 2.0 * (self.xy * x * y + self.xz * x * z + self.yz * y * z)
+    }
+}
+
+/// `a - b`, element by element.
+fn sub3(a: &Residual3, b: &Residual3) -> Residual3 {
+    let ([a0, a1, a2], [b0, b1, b2]) = (*a, *b);
+    [a0 - b0, a1 - b1, a2 - b2]
+}
+
 impl Circuit {
+    /// This circuit with parameter `j` (0 Rs, 1 Rr, 2 the stator leakage, 3 the rotor
+    /// leakage, 4 Lm with the leakages kept) [`NAMEPLATE_UNCERTAINTY`] larger.
+    fn nameplate_off(mut self, j: usize) -> Self {
+        let mut f = [1.0f32; 5];
+        if let Some(x) = f.get_mut(j) {
+            *x += NAMEPLATE_UNCERTAINTY;
+        }
+        let [rs, rr, lls, llr, lm] = f;
+        let (l_s, l_r) = (self.ls - self.lm, self.lr - self.lm);
+        self.rs *= rs;
+        self.rr *= rr;
+        self.lm *= lm;
+        self.ls = l_s * lls + self.lm;
+        self.lr = l_r * llr + self.lm;
+        self
+    }
+
     /// The circuit with parameter fault `f` of factor `k`. The `ls` and `lr` faults scale
     /// the leakage inductances (DESIGN.md §2: PSIM's Ls and Lr are the leakages); on a side
     /// without leakage (a Gamma-model machine) they scale Lm, as the simulator does.
@@ -985,9 +1196,16 @@ mod tests {
             None,
             1.0,
         ));
-        assert_eq!(
-            out.named_fault().map(|c| c.fault),
-            Some(Fault::Rr),
+        // Learned over a 10 % load range and widened for the nameplate's error away from
+        // the learned point, the torque balance no longer tells Rr from a speed-sensor
+        // error (directions 0.2 deg apart): they share the probability, neither is named
+        // alone, and Rr's size is right.
+        let rr = out.candidates.iter().find(|c| c.fault == Fault::Rr);
+        let rr = rr.unwrap(); // ok: test
+        assert!(rr.probability >= 0.4, "{out:?}");
+        assert!((rr.change - 0.5).abs() < 0.05, "{out:?}");
+        assert!(
+            matches!(out.named_fault().map(|c| c.fault), None | Some(Fault::Rr)),
             "{out:?}"
         );
     }
@@ -1084,5 +1302,64 @@ mod tests {
         for dt in [f32::NAN, -1.0, f32::INFINITY] {
             assert_eq!(f.observe(&stepped, dt, true, false), Step::Waiting);
         }
+    }
+    /// The nominal parameters 15-20 % off (Rs +20 %, Rr -19 %, leakages -13 %, Lm -15 %),
+    /// learned at the machine's own load; then the load moves to 0.5-1.1 of it, with or
+    /// without a fault. Before the weight was widened away from the learned point this
+    /// named wrong faults with confidence (a 10 % load rise with Rr +50 % on the 2.2 kW
+    /// machine: speed sensor at 0.74; found by hand on a simulated 11 kW log: current
+    /// sensor at 0.95 for Rr +50 % after a load step to 0.7).
+    #[test]
+    fn a_load_change_with_a_fault_and_a_nameplate_that_is_off() {
+        let (mut right, mut cases) = (0, 0);
+        let mut wrong = Vec::new();
+        for (name, m, v, we) in machines() {
+            let mut off = m;
+            let (lls, llr) = (m.ls_h - m.lm_h, m.lr_h - m.lm_h);
+            off.rs_ohm *= 1.2;
+            off.rr_ohm *= 0.81;
+            off.lm_h *= 0.85;
+            off.ls_h = lls * 0.87 + off.lm_h;
+            off.lr_h = llr * 0.87 + off.lm_h;
+            let hz = (we / core::f64::consts::TAU) as f32;
+            let mut iso = Isolator::new(off.model(), v as f32, hz).unwrap(); // ok: test
+            for _ in 0..20 {
+                iso.learn(&measure(&m, v, we, None, 1.0));
+            }
+            assert!(iso.finish_learning());
+            for load in [0.5, 0.7, 0.9, 1.1] {
+                let mut t = m;
+                t.bl_nms *= load;
+                let healthy = iso.isolate(&measure(&t, v, we, None, 1.0));
+                if let Some(Named::Fault(c)) = healthy.named() {
+                    wrong.push(format!("{name} load {load} healthy: {c:?}"));
+                }
+                for (f, k) in [
+                    (Fault::Rr, 1.5),
+                    (Fault::Rs, 1.5),
+                    (Fault::CurrentSensor, 0.7),
+                    (Fault::SpeedSensor, 1.01),
+                    (Fault::Lr, 0.5),
+                ] {
+                    let out = iso.isolate(&measure(&faulty(&t, Some(f), k), v, we, Some(f), k));
+                    cases += 1;
+                    let top = out.candidates[0];
+                    eprintln!(
+                        "{name} load {load} {f} {k}: top {} {:.2} ({:+.2}), second {} {:.2}, unknown {:.2}",
+                        top.fault, top.probability, top.change, out.candidates[1].fault,
+                        out.candidates[1].probability, out.unknown_probability
+                    );
+                    match out.named() {
+                        Some(Named::Fault(c)) if c.fault == f => right += 1,
+                        Some(Named::Fault(c)) => {
+                            wrong.push(format!("{name} load {load} {f} {k}: {c:?}"))
+                        }
+                        _ => {}
+                    }
+                }
+            }
+        }
+        eprintln!("named right {right} of {cases}");
+        assert!(wrong.is_empty(), "{wrong:#?}");
     }
 }
