@@ -67,7 +67,7 @@ const INTENDED: [(&str, &str, &str); 9] = [
 
 /// Keys added since the golden outputs were taken (issue 8: the data-quality stage's
 /// report, what commissioning did, the verdict, the range note beside a lamp).
-const ADDED: [&str; 32] = [
+const ADDED: [&str; 33] = [
     "data_quality",
     "commissioning",
     "verdict",
@@ -96,6 +96,8 @@ const ADDED: [&str; 32] = [
     // wrong ones).
     "names_given",
     "judged_at_s",
+    // Issue 9: the isolation's distance from the learned operating point.
+    "moved_from_learned",
     // The data-quality stage's clipped channels.
     "clipped",
     // Issue 10: plausibility, identifiability, transient advice.

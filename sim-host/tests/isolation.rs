@@ -158,3 +158,84 @@ fn healthy_runs_name_nothing() {
         assert!(row.isolation_candidates.is_empty(), "{row:?}");
     }
 }
+
+/// The wrong confident name found by hand (README, "Away from the learned point"): the
+/// 11 kW machine at 1 kHz, a load step to 0.7 x Bl at 6 s, then Rr +50 % at 8 s, diagnosed
+/// through the command line with a parameter file 15-20 % off (Rs +20 %, Rr -19 %, Lm
+/// -15 %, leakages -13 %) and commissioned at the first load. Before the isolation
+/// allowed for the parameter file's error away from the learned point it named
+/// `current_sensor -27 %` at p = 0.95. Now: no fault at >= 0.5 (other than the friction
+/// class, which a load change is), and the verdict says the current moved from where the
+/// baseline was learned.
+#[test]
+fn a_load_step_then_a_fault_with_a_parameter_file_that_is_off_names_no_wrong_fault() {
+    let dir = tempfile::tempdir().unwrap(); // ok: test
+    let third = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/params/11kw_2pole.toml");
+    let truth = std::fs::read_to_string(&third).unwrap(); // ok: test
+    let off = truth
+        .replace("rs_ohm = 0.42", "rs_ohm = 0.504")
+        .replace("rr_ohm = 0.36", "rr_ohm = 0.29")
+        .replace("ls_h = 0.108", "ls_h = 0.0935")
+        .replace("lr_h = 0.109", "lr_h = 0.0935")
+        .replace("lm_h = 0.104", "lm_h = 0.0885");
+    assert_ne!(
+        off, truth,
+        "the 11 kW file's values changed: update the test"
+    );
+    let off_path = dir.path().join("off.toml");
+    std::fs::write(&off_path, off).unwrap(); // ok: test
+    let scenario = dir.path().join("rr.toml");
+    std::fs::write(
+        &scenario,
+        "duration_s = 12.0\nsample_rate_hz = 1000.0\nseed = 5\n\n[[load.steps]]\nt_s = 6.0\nbl_scale = 0.7\n\n[[faults]]\nkind = \"rr\"\nat_s = 8.0\nchange = 0.5\n",
+    )
+    .unwrap(); // ok: test
+    let log = dir.path().join("rr.csv");
+    let bin = env!("CARGO_BIN_EXE_sim-host");
+    let sim = std::process::Command::new(bin)
+        .args(["simulate", "--params"])
+        .arg(&third)
+        .arg("--scenario")
+        .arg(&scenario)
+        .arg("--out")
+        .arg(&log)
+        .output()
+        .unwrap(); // ok: test
+    assert!(
+        sim.status.success(),
+        "{}",
+        String::from_utf8_lossy(&sim.stderr)
+    );
+    let out = std::process::Command::new(bin)
+        .args(["diagnose", "--json", "--commission", "3:5.5", "--params"])
+        .arg(&off_path)
+        .arg(&log)
+        .output()
+        .unwrap(); // ok: test
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap(); // ok: test
+    let iso = &v["isolation"];
+    eprintln!("{}", iso["verdict"]);
+    let named = iso["named"].as_str();
+    assert!(named.is_none() || named == Some("b/bl"), "{iso}");
+    for c in v["candidates"].as_array().unwrap() {
+        // ok: test
+        let (f, p) = (
+            c["fault"].as_str().unwrap(),
+            c["probability"].as_f64().unwrap(),
+        ); // ok: test
+        assert!(p < 0.5 || f == "b" || f == "bl", "{c}");
+    }
+    let moved = iso["moved_from_learned"].as_f64().unwrap(); // ok: test
+    assert!(moved < -0.15, "the current fell with the load: {moved}");
+    assert!(
+        iso["verdict"]
+            .as_str()
+            .is_some_and(|s| s.contains("from where the baseline was learned")),
+        "{iso}"
+    );
+}

@@ -35,6 +35,8 @@ pub(super) struct IsolationTracker {
     /// Time of the last isolation and of the last sample [s].
     last_t: f64,
     end_t: f64,
+    /// The operating point of the last isolation.
+    last_point: SteadyPoint,
 }
 
 impl IsolationTracker {
@@ -48,6 +50,7 @@ impl IsolationTracker {
             running: false,
             last_t: 0.0,
             end_t: 0.0,
+            last_point: SteadyPoint::default(),
         }
     }
 
@@ -82,6 +85,7 @@ impl IsolationTracker {
                 }
             }
             self.last_t = t;
+            self.last_point = *point;
         }
     }
 
@@ -96,6 +100,20 @@ impl IsolationTracker {
     /// commissioned range).
     pub(super) fn named_a_fault(&self) -> bool {
         self.first_named.as_ref().is_some_and(|(n, _)| n != "b/bl")
+    }
+
+    /// How far the current of the last isolation is from the one the learned baseline was
+    /// learned at: `|I| / |I_learned| - 1` (0.3: 30 % more current); `None` without a
+    /// learned baseline or its point.
+    fn moved_from_learned(&self) -> Option<f32> {
+        let f = self.follower.as_ref().filter(|f| f.learned())?;
+        let at = f.isolator().baseline().at;
+        let (i0, i1) = (
+            at.i.d.hypot(at.i.q),
+            self.last_point.i.d.hypot(self.last_point.i.q),
+        );
+        let r = i1 / i0 - 1.0;
+        (i0 > 0.0 && r.is_finite()).then_some(r)
     }
 
     /// The report, and the candidates for `diagnose` (most probable first, those from
@@ -126,6 +144,7 @@ impl IsolationTracker {
         } else {
             Vec::new()
         };
+        let moved = self.moved_from_learned();
         let report = IsolationReport {
             state: state_name(iso.state).to_string(),
             named: iso.named().map(|n| named_label(&n)),
@@ -136,13 +155,14 @@ impl IsolationTracker {
             verdict: if self.end_t - self.last_t > STALE_S {
                 format!(
                     "{} (judged at {:.2} s; the operating point was not steady in the last {:.1} s of the log)",
-                    verdict_sentence(&iso, detected).trim_end_matches('.'),
+                    verdict_sentence(&iso, detected, moved).trim_end_matches('.'),
                     self.last_t,
                     self.end_t - self.last_t
                 )
             } else {
-                verdict_sentence(&iso, detected)
+                verdict_sentence(&iso, detected, moved)
             },
+            moved_from_learned: moved,
             judged_at_s: self.last_t,
             groups: groups(&iso),
             deviation_sigma: iso.deviation,
@@ -293,6 +313,11 @@ pub struct IsolationReport {
     pub first_named: Option<(String, f64)>,
     /// When the reported isolation was made [s] (the last steady operating point).
     pub judged_at_s: f64,
+    /// How far the stator current of the reported isolation is from the one the learned
+    /// baseline was learned at, `|I| / |I_learned| - 1` (0.3: 30 % more); null without a
+    /// learned baseline. Away from the learned point the isolation allows for the
+    /// parameter file's error ([`monitor_core::isolation`], "Away from the learned point").
+    pub moved_from_learned: Option<f32>,
 }
 
 impl IsolationReport {
@@ -309,6 +334,7 @@ impl IsolationReport {
             residuals: [0.0; 3],
             spread: DEFAULT_SPREAD,
             judged_at_s: 0.0,
+            moved_from_learned: None,
             baseline: if learned {
                 "learned in commissioning"
             } else {
@@ -341,8 +367,20 @@ fn pct(x: f32) -> String {
     format!("{:+.0} %", 100.0 * x)
 }
 
-/// The one-sentence verdict of the isolation.
-fn verdict_sentence(iso: &Isolation, detected: bool) -> String {
+/// A current this far from the learned point (relative) is said in the verdict when no
+/// fault is named: the widening for the parameter file's error is then why.
+const MOVED_SAID_FROM: f32 = 0.05;
+
+/// The one-sentence verdict of the isolation; `moved`: the current's relative distance
+/// from the learned point ([`IsolationReport::moved_from_learned`]).
+fn verdict_sentence(iso: &Isolation, detected: bool, moved: Option<f32>) -> String {
+    let away = match moved {
+        Some(m) if m.abs() >= MOVED_SAID_FROM => format!(
+            " The current is {} from where the baseline was learned: there the parameter file's error is allowed for, and a fault is named only if it stands out from it (commission at this load to judge here).",
+            pct(m)
+        ),
+        _ => String::new(),
+    };
     let top = |n: usize| -> Vec<String> {
         iso.candidates
             .iter()
@@ -367,7 +405,7 @@ fn verdict_sentence(iso: &Isolation, detected: bool) -> String {
         }
         (IsolationState::NotJudged, _) => "No usable operating point was isolated.".into(),
         (IsolationState::Unknown, _) => format!(
-            "A change of {:.0} standard deviations that no single fault explains (an unknown fault, several faults, or a parameter file that does not fit); nearest: {}.",
+            "A change of {:.0} standard deviations that no single fault explains (an unknown fault, several faults, or a parameter file that does not fit); nearest: {}.{away}",
             iso.deviation,
             top(3).join(", ")
         ),
@@ -384,7 +422,7 @@ fn verdict_sentence(iso: &Isolation, detected: bool) -> String {
             pct(b.change)
         ),
         (_, None) => format!(
-            "The change fits more than one fault and none alone: {}.",
+            "The change fits more than one fault and none alone: {}.{away}",
             top(3).join(", ")
         ),
     }
