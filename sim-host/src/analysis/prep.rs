@@ -232,6 +232,22 @@ impl Decimator {
             log_start_s: self.t0,
             ..Default::default()
         };
+        // The series' expected length reserved at once: grown by doubling, each step
+        // copies the series and touches fresh pages on the reading thread. (Capacity that
+        // a shorter segment leaves unused is never touched, so costs no memory.)
+        let cap = ((self.est_rows / factor as f64) as usize)
+            .saturating_add(16)
+            .min(2 * MAX_WORK_SAMPLES);
+        let c = &mut self.cur;
+        c.t_s.reserve(cap);
+        c.i_ab.reserve(cap);
+        c.i0.reserve(cap);
+        if self.channels.voltages {
+            c.v_ab.reserve(cap);
+        }
+        if self.channels.speed {
+            c.wm.reserve(cap);
+        }
         self.seg_t0 = None;
         self.holes = false;
         self.averager = BlockAverager::default();
@@ -331,8 +347,10 @@ impl CleanSink for Decimator {
         self.last_good_t = Some(row.t_s);
         let t_first = *self.seg_t0.get_or_insert(row.t_s);
         // The row's place on the segment's sample grid, and so its block.
-        let n = ((row.t_s - t_first) / self.period + 0.5).floor().max(0.0) as u64;
-        let block = n / self.cur.factor as u64;
+        // (`max(0)` then the cast's truncation is the floor of a value >= 0, without a
+        // call to `floor`; a negative or NaN place is 0 either way.)
+        let n = ((row.t_s - t_first) / self.period + 0.5).max(0.0) as u64;
+        let block = self.averager.block_of(n, self.cur.factor as u64);
         if self.averager.push(&mut self.cur, row, block) {
             self.holes = true;
         }
@@ -452,6 +470,16 @@ struct BlockAverager {
 }
 
 impl BlockAverager {
+    /// `n / factor`: the current block when `n` falls in it (most rows), without the
+    /// division.
+    #[inline]
+    fn block_of(&self, n: u64, factor: u64) -> u64 {
+        match self.block {
+            Some(b) if n >= b * factor && n - b * factor < factor => b,
+            _ => n / factor,
+        }
+    }
+
     /// Adds a row of grid block `block`; a row of a later block first closes the current
     /// one. Returns true when a block closed short or blocks were skipped (a hole).
     fn push(&mut self, d: &mut Decimated, row: &Row, block: u64) -> bool {
