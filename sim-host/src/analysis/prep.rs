@@ -899,7 +899,8 @@ fn flux_angle(v_ab: &[C64], i_ab: &[C64], dt: f64, p: &ParamFile) -> Vec<f64> {
         if k > 0 {
             psi_s = psi_s * decay + (e + prev_e) * (0.5 * dt);
             let turn = psi_s * prev_psi.conj();
-            if turn.norm() > 1e-12 {
+            // (Squared magnitudes against squared thresholds: no square root per sample.)
+            if turn.norm_sqr() > 1e-24 {
                 w_flux += a_w * (turn.im.atan2(turn.re) / dt - w_flux);
             }
         }
@@ -914,7 +915,7 @@ fn flux_angle(v_ab: &[C64], i_ab: &[C64], dt: f64, p: &ParamFile) -> Vec<f64> {
             psi_s
         };
         let psi_r = (psi_c - i_ab[k] * sls) * kr;
-        let ang = if psi_r.norm() > 1e-6 {
+        let ang = if psi_r.norm_sqr() > 1e-12 {
             psi_r.im.atan2(psi_r.re)
         } else {
             // No flux yet: follow the nominal supply.
