@@ -292,6 +292,9 @@ fn parse_block_w<const W: usize>(block: &[u8], cols: &Cols, out: &mut Vec<f64>) 
     true
 }
 
+/// A parsed block: its values (slots, reused for the next block) and its rows.
+type Parsed = (Vec<f64>, Vec<Row>);
+
 /// Sequential reader of line-aligned blocks, reusing its buffers.
 struct BlockReader {
     f: File,
@@ -394,23 +397,23 @@ pub(super) fn for_each_row(
     // (this thread, so `on_row` need not be Send).
     let (mut to_parse, b) = reader.batch(per_batch).map_err(io)?;
     read_bytes += b;
-    let mut to_hand: Option<Vec<Option<(Vec<f64>, Vec<Row>)>>> = None;
-    let mut outs: Vec<(Vec<f64>, Vec<Row>)> = Vec::new();
+    let mut to_hand: Option<Vec<Option<Parsed>>> = None;
+    let mut outs: Vec<Parsed> = Vec::new();
     loop {
         if to_parse.is_empty() && to_hand.is_none() {
             return Ok(true);
         }
         let mut next: Option<std::io::Result<(Vec<Vec<u8>>, u64)>> = None;
-        let mut parsed: Option<Vec<Option<(Vec<f64>, Vec<Row>)>>> = None;
+        let mut parsed: Option<Vec<Option<Parsed>>> = None;
         let mut verdict: Option<bool> = None;
-        let mut free_outs: Vec<(Vec<f64>, Vec<Row>)> = Vec::new();
+        let mut free_outs: Vec<Parsed> = Vec::new();
         rayon::in_place_scope(|s| {
             if !reader.eof {
                 let (rd, nx) = (&mut reader, &mut next);
                 s.spawn(move |_| *nx = Some(rd.batch(per_batch)));
             }
             if !to_parse.is_empty() {
-                let bufs: Vec<(Vec<f64>, Vec<Row>)> = (0..to_parse.len())
+                let bufs: Vec<Parsed> = (0..to_parse.len())
                     .map(|_| outs.pop().unwrap_or_default())
                     .collect();
                 let (blocks, cols, pr, to_row) = (&to_parse, &cols, &mut parsed, &to_row);
@@ -671,7 +674,7 @@ mod tests {
             let v = if k % 2 == 0 {
                 f64::from_bits(x)
             } else {
-                ((x >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 10f64.powi((k % 13) as i32 - 6)
+                ((x >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 10f64.powi(k % 13 - 6)
             };
             if !v.is_finite() {
                 continue;
