@@ -126,16 +126,16 @@ fn digits_value(x: u64, k: usize) -> u64 {
     v.wrapping_mul(10_000 * (1 << 32) + 1) >> 32
 }
 
-/// Parses a plain decimal at the start of `b` (optional sign, digits with an optional
-/// point, optional exponent) when its value is `w 10^e` with `w <= 2^53`, `|e| <= 22` and
+/// Splits a plain decimal at the start of `b` (optional sign, digits with an optional
+/// point, optional exponent) into `(+-w, e, bytes used)` when its value is `w 10^e` with `w <= 2^53`, `|e| <= 22` and
 /// at most 19 digits: then `w` and `10^|e|` are exact and one multiplication or division
-/// rounds correctly (Clinger's fast path), the same value `fast_float2` gives. Returns the
-/// value and the bytes used; `None` for anything else (more digits, `inf`, `NaN`, a bare
+/// rounds correctly (Clinger's fast path, [`scaled`]), the same value `fast_float2` gives;
+/// `None` for anything else (more digits, `inf`, `NaN`, a bare
 /// sign, an exponent without digits), which `fast_float2` then takes, so the accepted text
 /// and the values are exactly `fast_float2::parse_partial`'s. Most cells of a log written
 /// at f32 precision (8-9 digits) take this path, several times faster.
 #[inline]
-fn parse_plain(b: &[u8]) -> Option<(f64, usize)> {
+fn parse_plain_parts(b: &[u8]) -> Option<(f64, i32, usize)> {
     let n = b.len();
     let mut i = 0;
     let neg = match b.first() {
@@ -186,22 +186,46 @@ fn parse_plain(b: &[u8]) -> Option<(f64, usize)> {
         e += if eneg { -x } else { x };
         i = j;
     }
+    if !(-22..=22).contains(&e) {
+        return None;
+    }
     let v = w as f64;
-    let v = match e {
-        0..=22 => v * POW10[e as usize],
-        -22..=-1 => v / POW10[(-e) as usize],
-        _ => return None,
-    };
-    Some((if neg { -v } else { v }, i))
+    Some((if neg { -v } else { v }, e as i32, i))
 }
 
-/// One number at the start of `b`: [`parse_plain`], else `fast_float2`.
+/// `v 10^e` for `|e| <= 22`, one correctly rounded operation (with the sign in `v`: the
+/// rounding is symmetric, so the same value as negating after).
 #[inline]
-fn parse_number(b: &[u8]) -> Option<(f64, usize)> {
-    match parse_plain(b) {
-        Some(r) => Some(r),
-        None => fast_float2::parse_partial::<f64, _>(b).ok(),
+fn scaled(v: f64, e: i32) -> f64 {
+    if e >= 0 {
+        v * POW10[e as usize]
+    } else {
+        v / POW10[(-e) as usize]
     }
+}
+
+/// [`parse_plain_parts`] as a value.
+#[cfg(test)]
+fn parse_plain(b: &[u8]) -> Option<(f64, usize)> {
+    parse_plain_parts(b).map(|(v, e, k)| (scaled(v, e), k))
+}
+
+/// One number at the start of `b`, as `(v, e, bytes used)` with the value `v 10^e`
+/// ([`scaled`]): [`parse_plain_parts`], else `fast_float2` (`e` = 0).
+#[inline]
+fn parse_number_parts(b: &[u8]) -> Option<(f64, i32, usize)> {
+    match parse_plain_parts(b) {
+        Some(r) => Some(r),
+        None => fast_float2::parse_partial::<f64, _>(b)
+            .ok()
+            .map(|(v, k)| (v, 0, k)),
+    }
+}
+
+/// One number at the start of `b` and the bytes used.
+#[cfg(test)]
+fn parse_number(b: &[u8]) -> Option<(f64, usize)> {
+    parse_number_parts(b).map(|(v, e, k)| (scaled(v, e), k))
 }
 
 /// Parses the line starting at `i` into `row`; returns the index after its line end, or
@@ -211,6 +235,9 @@ fn parse_number(b: &[u8]) -> Option<(f64, usize)> {
 #[inline]
 fn parse_line(b: &[u8], mut i: usize, cols: &Cols, row: &mut [f64; MAX_COLS]) -> Option<usize> {
     let n = b.len();
+    // Each slot's power of ten, applied once the line is read: the divisions of a line
+    // then run side by side instead of each holding up the parsing after it.
+    let mut exp = [0i32; MAX_COLS];
     for (field, &slot) in cols.slot_of.iter().enumerate() {
         if field > 0 {
             if i >= n || b[i] != b',' {
@@ -228,8 +255,9 @@ fn parse_line(b: &[u8], mut i: usize, cols: &Cols, row: &mut [f64; MAX_COLS]) ->
         while i < n && b[i] == b' ' {
             i += 1;
         }
-        let (v, k) = parse_number(&b[i..])?;
+        let (v, e, k) = parse_number_parts(&b[i..])?;
         row[slot] = v;
+        exp[slot] = e;
         i += k;
         while i < n && b[i] == b' ' {
             i += 1;
@@ -238,13 +266,17 @@ fn parse_line(b: &[u8], mut i: usize, cols: &Cols, row: &mut [f64; MAX_COLS]) ->
     if i < n && b[i] == b'\r' {
         i += 1;
     }
-    if i == n {
-        Some(n)
+    let end = if i == n {
+        n
     } else if b[i] == b'\n' {
-        Some(i + 1)
+        i + 1
     } else {
-        None
+        return None;
+    };
+    for (v, &e) in row.iter_mut().zip(&exp).take(cols.width) {
+        *v = scaled(*v, e);
     }
+    Some(end)
 }
 
 /// Parses a block of whole lines; the rows' first `cols.width` values are appended to
