@@ -3,8 +3,10 @@
 //!
 //! The header was parsed by [`super::LogFile::open`] (one column map for both paths).
 //! Data are read in 4 MiB blocks cut at line ends (`memchr`); the numbers are
-//! parsed by `fast-float2` (correctly rounded, the same values as `str::parse::<f64>`), the
-//! blocks of a batch in parallel (rayon), and the rows are handed over in file order. Reading
+//! parsed correctly rounded, the same values as `str::parse::<f64>`: plain decimals of up
+//! to 19 digits eight digits at a time with Clinger's exact path ([`parse_plain_parts`]),
+//! everything else by `fast-float2`; the blocks of a batch are parsed into rows in
+//! parallel (rayon), and the rows are handed over in file order. Reading
 //! the next batch, parsing the current one and handing over the previous one overlap, and
 //! the buffers are reused, so memory stays at a few tens of MB whatever the log's length.
 //!
