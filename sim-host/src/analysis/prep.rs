@@ -232,6 +232,22 @@ impl Decimator {
             log_start_s: self.t0,
             ..Default::default()
         };
+        // The series' expected length reserved at once: grown by doubling, each step
+        // copies the series and touches fresh pages on the reading thread. (Capacity that
+        // a shorter segment leaves unused is never touched, so costs no memory.)
+        let cap = ((self.est_rows / factor as f64) as usize)
+            .saturating_add(16)
+            .min(2 * MAX_WORK_SAMPLES);
+        let c = &mut self.cur;
+        c.t_s.reserve(cap);
+        c.i_ab.reserve(cap);
+        c.i0.reserve(cap);
+        if self.channels.voltages {
+            c.v_ab.reserve(cap);
+        }
+        if self.channels.speed {
+            c.wm.reserve(cap);
+        }
         self.seg_t0 = None;
         self.holes = false;
         self.averager = BlockAverager::default();
@@ -331,8 +347,10 @@ impl CleanSink for Decimator {
         self.last_good_t = Some(row.t_s);
         let t_first = *self.seg_t0.get_or_insert(row.t_s);
         // The row's place on the segment's sample grid, and so its block.
-        let n = ((row.t_s - t_first) / self.period + 0.5).floor().max(0.0) as u64;
-        let block = n / self.cur.factor as u64;
+        // (`max(0)` then the cast's truncation is the floor of a value >= 0, without a
+        // call to `floor`; a negative or NaN place is 0 either way.)
+        let n = ((row.t_s - t_first) / self.period + 0.5).max(0.0) as u64;
+        let block = self.averager.block_of(n, self.cur.factor as u64);
         if self.averager.push(&mut self.cur, row, block) {
             self.holes = true;
         }
@@ -452,6 +470,16 @@ struct BlockAverager {
 }
 
 impl BlockAverager {
+    /// `n / factor`: the current block when `n` falls in it (most rows), without the
+    /// division.
+    #[inline]
+    fn block_of(&self, n: u64, factor: u64) -> u64 {
+        match self.block {
+            Some(b) if n >= b * factor && n - b * factor < factor => b,
+            _ => n / factor,
+        }
+    }
+
     /// Adds a row of grid block `block`; a row of a later block first closes the current
     /// one. Returns true when a block closed short or blocks were skipped (a hole).
     fn push(&mut self, d: &mut Decimated, row: &Row, block: u64) -> bool {
@@ -570,28 +598,34 @@ impl Prepared {
 /// Zero-phase low-pass: a first-order filter run forward then backward, twice
 /// (fourth-order magnitude, no delay), each pass started at the end value.
 pub fn zero_phase_lpf(x: &[f64], dt: f64, fc: f64) -> Vec<f64> {
+    let mut y = x.to_vec();
+    zero_phase_lpf_in_place(&mut y, dt, fc);
+    y
+}
+
+/// [`zero_phase_lpf`] in place (the same values, without a copy of a long series: a
+/// fresh buffer costs its page faults).
+pub fn zero_phase_lpf_in_place(y: &mut [f64], dt: f64, fc: f64) {
     let a = 1.0 - (-2.0 * std::f64::consts::PI * fc * dt).exp();
     // Each pass starts from the mean over one time constant at its end of the series, not
     // from a single (noisy) sample: a start from one sample carries that sample's noise into
     // the first time constants of the output.
     let m =
-        ((1.0 / (2.0 * std::f64::consts::PI * fc * dt)).ceil() as usize).clamp(1, x.len().max(1));
+        ((1.0 / (2.0 * std::f64::consts::PI * fc * dt)).ceil() as usize).clamp(1, y.len().max(1));
     let head = |y: &[f64]| y.iter().take(m).sum::<f64>() / m.min(y.len()).max(1) as f64;
     let tail = |y: &[f64]| y.iter().rev().take(m).sum::<f64>() / m.min(y.len()).max(1) as f64;
-    let mut y = x.to_vec();
     for _ in 0..2 {
-        let mut s = head(&y);
+        let mut s = head(y);
         for v in y.iter_mut() {
             s += a * (*v - s);
             *v = s;
         }
-        let mut s = tail(&y);
+        let mut s = tail(y);
         for v in y.iter_mut().rev() {
             s += a * (*v - s);
             *v = s;
         }
     }
-    y
 }
 
 /// Hann weight of sample `k` of `n` (unnormalised, 0..2): the weighted mean of a rotating
@@ -602,24 +636,28 @@ fn hann(k: usize, n: usize) -> f64 {
 
 /// Third-order low-pass (three first-order stages at `fc`) of the demodulated signal
 /// `x = c + P e^{j omega k}`: a slowly varying part `c` (what the filter is for) plus a
-/// rotating remainder at `omega` [rad/sample] (the other sequence).
+/// rotating remainder at `omega` [rad/sample] (the other sequence). In place; with
+/// `backward` the series is filtered from its last sample to its first (as the reversed
+/// series would be, each output left at its own sample).
 ///
 /// The states start in their periodic steady state, `s_i = c + H^i P e^{-j omega}` with
 /// `H = a / (1 - (1 - a) e^{-j omega})`, `c` the Hann-weighted mean of the first `init_len`
 /// samples (whole turns) and `P = x_0 - c`: started from the plain mean, each stage would
 /// begin with a transient the size of its ripple, which the next stages pass as a slow
 /// bump (0.15 A on a 9 A current over the first 0.3 s).
-fn lpf3(x: &[C64], dt: f64, fc: f64, init_len: usize, omega: f64) -> Vec<C64> {
+fn lpf3(x: &mut [C64], dt: f64, fc: f64, init_len: usize, omega: f64, backward: bool) {
     let a = 1.0 - (-2.0 * std::f64::consts::PI * fc * dt).exp();
-    let m = init_len.clamp(1, x.len().max(1));
+    let n = x.len();
+    let at = |k: usize| if backward { n - 1 - k } else { k };
+    let m = init_len.clamp(1, n.max(1));
     let (mut sum, mut wsum) = (C64::new(0.0, 0.0), 0.0);
-    for (k, v) in x.iter().take(m).enumerate() {
+    for k in 0..m.min(n) {
         let w = hann(k, m);
-        sum += v * w;
+        sum += x[at(k)] * w;
         wsum += w;
     }
     let c = sum / wsum.max(1e-12);
-    let p0 = x.first().copied().unwrap_or_default() - c;
+    let p0 = if n > 0 { x[at(0)] } else { C64::default() } - c;
     let back = C64::from_polar(1.0, -omega);
     let h = C64::new(a, 0.0) / (C64::new(1.0, 0.0) - back * (1.0 - a));
     let mut s = [
@@ -627,14 +665,17 @@ fn lpf3(x: &[C64], dt: f64, fc: f64, init_len: usize, omega: f64) -> Vec<C64> {
         c + h * h * p0 * back,
         c + h * h * h * p0 * back,
     ];
-    x.iter()
-        .map(|&v| {
-            s[0] += a * (v - s[0]);
-            s[1] += a * (s[0] - s[1]);
-            s[2] += a * (s[1] - s[2]);
-            s[2]
-        })
-        .collect()
+    let mut stage = |v: &mut C64| {
+        s[0] += a * (*v - s[0]);
+        s[1] += a * (s[0] - s[1]);
+        s[2] += a * (s[1] - s[2]);
+        *v = s[2];
+    };
+    if backward {
+        x.iter_mut().rev().for_each(&mut stage);
+    } else {
+        x.iter_mut().for_each(&mut stage);
+    }
 }
 
 /// Builds the voltage-model rotor-flux frame and the d-q signals from the working series.
@@ -776,7 +817,8 @@ fn frame_speed(theta: &[f64], t_s: &[f64], dt: f64) -> Vec<f64> {
             omega[k] = (theta[b] - theta[a]) / (t_s[b] - t_s[a]);
         }
     }
-    zero_phase_lpf(&omega, dt, 20.0)
+    zero_phase_lpf_in_place(&mut omega, dt, 20.0);
+    omega
 }
 
 /// The unwrapped angle of a vector series (a zero vector keeps the previous angle).
@@ -857,7 +899,8 @@ fn flux_angle(v_ab: &[C64], i_ab: &[C64], dt: f64, p: &ParamFile) -> Vec<f64> {
         if k > 0 {
             psi_s = psi_s * decay + (e + prev_e) * (0.5 * dt);
             let turn = psi_s * prev_psi.conj();
-            if turn.norm() > 1e-12 {
+            // (Squared magnitudes against squared thresholds: no square root per sample.)
+            if turn.norm_sqr() > 1e-24 {
                 w_flux += a_w * (turn.im.atan2(turn.re) / dt - w_flux);
             }
         }
@@ -872,7 +915,7 @@ fn flux_angle(v_ab: &[C64], i_ab: &[C64], dt: f64, p: &ParamFile) -> Vec<f64> {
             psi_s
         };
         let psi_r = (psi_c - i_ab[k] * sls) * kr;
-        let ang = if psi_r.norm() > 1e-6 {
+        let ang = if psi_r.norm_sqr() > 1e-12 {
             psi_r.im.atan2(psi_r.re)
         } else {
             // No flux yet: follow the nominal supply.
@@ -898,13 +941,13 @@ fn flux_angle(v_ab: &[C64], i_ab: &[C64], dt: f64, p: &ParamFile) -> Vec<f64> {
 /// keeps start-up and step transients and makes the sequence separation clean.
 /// (Smoothing the angle's increments and summing them back avoids the end effects a
 /// filter has on a ramp.)
-fn smooth_angle(theta: Vec<f64>, dt: f64) -> Vec<f64> {
+fn smooth_angle(mut theta: Vec<f64>, dt: f64) -> Vec<f64> {
     let n = theta.len();
     if n <= 2 {
         return theta;
     }
-    let inc: Vec<f64> = theta.windows(2).map(|w| w[1] - w[0]).collect();
-    let inc = zero_phase_lpf(&inc, dt, THETA_SMOOTH_HZ);
+    let mut inc: Vec<f64> = theta.windows(2).map(|w| w[1] - w[0]).collect();
+    zero_phase_lpf_in_place(&mut inc, dt, THETA_SMOOTH_HZ);
     let mut th = theta[0];
     let mut smooth = Vec::with_capacity(n);
     smooth.push(th);
@@ -917,9 +960,15 @@ fn smooth_angle(theta: Vec<f64>, dt: f64) -> Vec<f64> {
     // of 150 rad/s^2 at 20 Hz, enough to tilt I_qs by 13 % of I_ds x 0.02 in a sweep). The
     // summed angle is therefore only the reference: the raw angle's deviation from it,
     // itself smoothed, is added back, so the frame follows the flux at every kink.
-    let dev: Vec<f64> = theta.iter().zip(&smooth).map(|(a, b)| a - b).collect();
-    let dev = zero_phase_lpf(&dev, dt, THETA_SMOOTH_HZ);
-    smooth.into_iter().zip(dev).map(|(v, e)| v + e).collect()
+    // (The deviation takes the raw angle's buffer.)
+    for (a, b) in theta.iter_mut().zip(&smooth) {
+        *a -= b;
+    }
+    zero_phase_lpf_in_place(&mut theta, dt, THETA_SMOOTH_HZ);
+    for (v, e) in smooth.iter_mut().zip(&theta) {
+        *v += e;
+    }
+    smooth
 }
 
 /// Relative jump of the supply voltage between two working samples that marks a supply
@@ -932,15 +981,28 @@ pub const SUPPLY_STEP_REL: f64 = 0.03;
 /// (`rot` = e^{j theta_v}) jumps by more than [`SUPPLY_STEP_REL`] of the median voltage
 /// and ten times the median jump.
 fn supply_steps(v_ab: &[C64], rot: &[C64]) -> Vec<usize> {
-    let u: Vec<C64> = v_ab.iter().zip(rot).map(|(v, r)| v * r.conj()).collect();
-    let mut mags: Vec<f64> = u.iter().map(|x| x.norm()).collect();
+    // The voltage in its own frame, its magnitude and its jumps, in one pass.
+    let n = v_ab.len().min(rot.len());
+    let mut mags: Vec<f64> = Vec::with_capacity(n);
+    let mut jumps: Vec<f64> = Vec::with_capacity(n.saturating_sub(1));
+    let mut prev: Option<C64> = None;
+    for (v, r) in v_ab.iter().zip(rot) {
+        let u = v * r.conj();
+        mags.push(u.norm());
+        if let Some(p) = prev {
+            jumps.push((u - p).norm());
+        }
+        prev = Some(u);
+    }
     if mags.is_empty() {
         return Vec::new();
     }
     let mid = mags.len() / 2;
     let median = *mags.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1;
-    let jumps: Vec<f64> = (1..u.len()).map(|k| (u[k] - u[k - 1]).norm()).collect();
-    let mut sorted = jumps.clone();
+    // The magnitudes' buffer takes the jumps to be ordered.
+    let mut sorted = mags;
+    sorted.clear();
+    sorted.extend_from_slice(&jumps);
     let typical = if sorted.is_empty() {
         0.0
     } else {
@@ -949,7 +1011,7 @@ fn supply_steps(v_ab: &[C64], rot: &[C64]) -> Vec<usize> {
     };
     // An outlier, too: harmonics in a real supply move the vector every sample.
     let thr = (SUPPLY_STEP_REL * median).max(10.0 * typical);
-    (1..u.len()).filter(|&k| jumps[k - 1] > thr).collect()
+    (1..n).filter(|&k| jumps[k - 1] > thr).collect()
 }
 
 /// Positive/negative sequence separation by demodulation in the `-theta` frame
@@ -1010,18 +1072,29 @@ impl SequenceSeparator {
 
     /// The negative-sequence part of `x` (stationary frame), `rot` = e^{j theta}.
     fn negative(&self, x: &[C64], rot: &[C64]) -> Vec<C64> {
-        let shifted: Vec<C64> = x.iter().zip(rot).map(|(v, r)| v * r).collect();
-        let mut f = lpf3(&shifted, self.dt, SEQ_LPF_HZ, self.init_len, self.omega_2);
-        if !self.steps.is_empty() {
-            let rev: Vec<C64> = shifted.iter().rev().copied().collect();
-            let mut b = lpf3(
-                &rev,
+        let mut f: Vec<C64> = x.iter().zip(rot).map(|(v, r)| v * r).collect();
+        // The backward pass runs on its own copy of the demodulated signal.
+        let b = (!self.steps.is_empty()).then(|| {
+            let mut b = f.clone();
+            lpf3(
+                &mut b,
                 self.dt,
                 SEQ_LPF_HZ,
                 self.init_len_end,
                 -self.omega_2_end,
+                true,
             );
-            b.reverse();
+            b
+        });
+        lpf3(
+            &mut f,
+            self.dt,
+            SEQ_LPF_HZ,
+            self.init_len,
+            self.omega_2,
+            false,
+        );
+        if let Some(b) = b {
             let mut next = 0usize;
             for (k, fk) in f.iter_mut().enumerate() {
                 while next < self.steps.len() && self.steps[next] <= k {
@@ -1046,7 +1119,10 @@ impl SequenceSeparator {
                 *fk = *fk * w_f + b[k] * (1.0 - w_f);
             }
         }
-        f.iter().zip(rot).map(|(v, r)| v * r.conj()).collect()
+        for (v, r) in f.iter_mut().zip(rot) {
+            *v *= r.conj();
+        }
+        f
     }
 }
 

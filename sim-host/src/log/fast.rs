@@ -3,8 +3,10 @@
 //!
 //! The header was parsed by [`super::LogFile::open`] (one column map for both paths).
 //! Data are read in 4 MiB blocks cut at line ends (`memchr`); the numbers are
-//! parsed by `fast-float2` (correctly rounded, the same values as `str::parse::<f64>`), the
-//! blocks of a batch in parallel (rayon), and the rows are handed over in file order. Reading
+//! parsed correctly rounded, the same values as `str::parse::<f64>`: plain decimals of up
+//! to 19 digits eight digits at a time with Clinger's exact path ([`parse_plain_parts`]),
+//! everything else by `fast-float2`; the blocks of a batch are parsed into rows in
+//! parallel (rayon), and the rows are handed over in file order. Reading
 //! the next batch, parsing the current one and handing over the previous one overlap, and
 //! the buffers are reused, so memory stays at a few tens of MB whatever the log's length.
 //!
@@ -52,6 +54,182 @@ impl Cols {
     }
 }
 
+/// Powers of ten that are exact in an `f64` (10^0 ..= 10^22).
+const POW10: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+
+/// Appends the decimal digits starting at `b[i]` to `w` (`w = 10 w + digit`, wrapping:
+/// the caller discards more than 19 digits) and counts them in `digits`; returns the index
+/// after the last digit. Eight bytes at a time where the block has them (the digits of
+/// one 8-byte word converted with three multiplications instead of a chain of one per
+/// digit).
+#[inline]
+fn digit_run(b: &[u8], mut i: usize, w: &mut u64, digits: &mut usize) -> usize {
+    while let Some(word) = b.get(i..i + 8) {
+        let mut a = [0u8; 8];
+        a.copy_from_slice(word);
+        let x = u64::from_le_bytes(a);
+        let k = leading_digits(x);
+        if k == 0 {
+            return i;
+        }
+        *w = w
+            .wrapping_mul(POW10_INT[k])
+            .wrapping_add(digits_value(x, k));
+        *digits += k;
+        i += k;
+        if k < 8 {
+            return i;
+        }
+    }
+    while i < b.len() && b[i].is_ascii_digit() {
+        *w = w.wrapping_mul(10).wrapping_add(u64::from(b[i] - b'0'));
+        *digits += 1;
+        i += 1;
+    }
+    i
+}
+
+/// Powers of ten as integers, 10^0 ..= 10^8.
+const POW10_INT: [u64; 9] = [
+    1,
+    10,
+    100,
+    1_000,
+    10_000,
+    100_000,
+    1_000_000,
+    10_000_000,
+    100_000_000,
+];
+
+/// How many of the eight bytes of `x` (the first in the lowest byte) are ASCII digits
+/// before the first that is not. (A byte below `0` borrows from the bytes after it, and
+/// one above `9` carries into them: only bytes after the first non-digit are disturbed.)
+#[inline]
+fn leading_digits(x: u64) -> usize {
+    const ONES: u64 = 0x0101_0101_0101_0101;
+    let t = x.wrapping_sub(0x30 * ONES);
+    let not_digit = (t | t.wrapping_add(0x76 * ONES)) & (0x80 * ONES);
+    (not_digit.trailing_zeros() / 8) as usize
+}
+
+/// The value of the first `k` (1..=8) bytes of `x`, all ASCII digits, the first the most
+/// significant.
+#[inline]
+fn digits_value(x: u64, k: usize) -> u64 {
+    const ONES: u64 = 0x0101_0101_0101_0101;
+    // The k digits moved to the top bytes: the bytes below read as leading zeros.
+    let v = (x.wrapping_sub(0x30 * ONES) & (0x0f * ONES)) << (8 * (8 - k));
+    let v = (v.wrapping_mul(10 * 256 + 1) >> 8) & 0x00ff_00ff_00ff_00ff;
+    let v = (v.wrapping_mul(100 * 65_536 + 1) >> 16) & 0x0000_ffff_0000_ffff;
+    v.wrapping_mul(10_000 * (1 << 32) + 1) >> 32
+}
+
+/// Splits a plain decimal at the start of `b` (optional sign, digits with an optional
+/// point, optional exponent) into `(+-w, e, bytes used)` when its value is `w 10^e` with `w <= 2^53`, `|e| <= 22` and
+/// at most 19 digits: then `w` and `10^|e|` are exact and one multiplication or division
+/// rounds correctly (Clinger's fast path, [`scaled`]), the same value `fast_float2` gives;
+/// `None` for anything else (more digits, `inf`, `NaN`, a bare
+/// sign, an exponent without digits), which `fast_float2` then takes, so the accepted text
+/// and the values are exactly `fast_float2::parse_partial`'s. Most cells of a log written
+/// at f32 precision (8-9 digits) take this path, several times faster.
+#[inline]
+fn parse_plain_parts(b: &[u8]) -> Option<(f64, i32, usize)> {
+    let n = b.len();
+    let mut i = 0;
+    let neg = match b.first() {
+        Some(b'-') => {
+            i = 1;
+            true
+        }
+        Some(b'+') => {
+            i = 1;
+            false
+        }
+        _ => false,
+    };
+    let mut w: u64 = 0;
+    let (mut digits, mut frac) = (0usize, 0usize);
+    i = digit_run(b, i, &mut w, &mut digits);
+    if i < n && b[i] == b'.' {
+        let before = digits;
+        i = digit_run(b, i + 1, &mut w, &mut digits);
+        frac = digits - before;
+    }
+    // (19 digits cannot overflow a u64.)
+    if digits == 0 || digits > 19 || w > 1 << 53 {
+        return None;
+    }
+    let mut e = -(frac as i64);
+    if i < n && (b[i] | 0x20) == b'e' {
+        let mut j = i + 1;
+        let eneg = match b.get(j) {
+            Some(b'-') => {
+                j += 1;
+                true
+            }
+            Some(b'+') => {
+                j += 1;
+                false
+            }
+            _ => false,
+        };
+        let (mut x, start) = (0i64, j);
+        while j < n && b[j].is_ascii_digit() && j - start < 4 {
+            x = 10 * x + i64::from(b[j] - b'0');
+            j += 1;
+        }
+        if j == start || (j < n && b[j].is_ascii_digit()) {
+            return None;
+        }
+        e += if eneg { -x } else { x };
+        i = j;
+    }
+    if !(-22..=22).contains(&e) {
+        return None;
+    }
+    let v = w as f64;
+    Some((if neg { -v } else { v }, e as i32, i))
+}
+
+/// `v 10^e` for `|e| <= 22`, one correctly rounded operation (with the sign in `v`: the
+/// rounding is symmetric, so the same value as negating after).
+#[inline]
+fn scaled(v: f64, e: i32) -> f64 {
+    if e >= 0 {
+        v * POW10[e as usize]
+    } else {
+        v / POW10[(-e) as usize]
+    }
+}
+
+/// [`parse_plain_parts`] as a value.
+#[cfg(test)]
+fn parse_plain(b: &[u8]) -> Option<(f64, usize)> {
+    parse_plain_parts(b).map(|(v, e, k)| (scaled(v, e), k))
+}
+
+/// One number at the start of `b`, as `(v, e, bytes used)` with the value `v 10^e`
+/// ([`scaled`]): [`parse_plain_parts`], else `fast_float2` (`e` = 0).
+#[inline]
+fn parse_number_parts(b: &[u8]) -> Option<(f64, i32, usize)> {
+    match parse_plain_parts(b) {
+        Some(r) => Some(r),
+        None => fast_float2::parse_partial::<f64, _>(b)
+            .ok()
+            .map(|(v, k)| (v, 0, k)),
+    }
+}
+
+/// One number at the start of `b` and the bytes used.
+#[cfg(test)]
+fn parse_number(b: &[u8]) -> Option<(f64, usize)> {
+    parse_number_parts(b).map(|(v, e, k)| (scaled(v, e), k))
+}
+
 /// Parses the line starting at `i` into `row`; returns the index after its line end, or
 /// `None` when a field is not a number or the field count is wrong. One pass: fields are
 /// parsed where they stand, the parser's end must be a `,` or the line end (`\n`, `\r\n`,
@@ -59,6 +237,9 @@ impl Cols {
 #[inline]
 fn parse_line(b: &[u8], mut i: usize, cols: &Cols, row: &mut [f64; MAX_COLS]) -> Option<usize> {
     let n = b.len();
+    // Each slot's power of ten, applied once the line is read: the divisions of a line
+    // then run side by side instead of each holding up the parsing after it.
+    let mut exp = [0i32; MAX_COLS];
     for (field, &slot) in cols.slot_of.iter().enumerate() {
         if field > 0 {
             if i >= n || b[i] != b',' {
@@ -76,8 +257,9 @@ fn parse_line(b: &[u8], mut i: usize, cols: &Cols, row: &mut [f64; MAX_COLS]) ->
         while i < n && b[i] == b' ' {
             i += 1;
         }
-        let (v, k) = fast_float2::parse_partial::<f64, _>(&b[i..]).ok()?;
+        let (v, e, k) = parse_number_parts(&b[i..])?;
         row[slot] = v;
+        exp[slot] = e;
         i += k;
         while i < n && b[i] == b' ' {
             i += 1;
@@ -86,13 +268,17 @@ fn parse_line(b: &[u8], mut i: usize, cols: &Cols, row: &mut [f64; MAX_COLS]) ->
     if i < n && b[i] == b'\r' {
         i += 1;
     }
-    if i == n {
-        Some(n)
+    let end = if i == n {
+        n
     } else if b[i] == b'\n' {
-        Some(i + 1)
+        i + 1
     } else {
-        None
+        return None;
+    };
+    for (v, &e) in row.iter_mut().zip(&exp).take(cols.width) {
+        *v = scaled(*v, e);
     }
+    Some(end)
 }
 
 /// Parses a block of whole lines; the rows' first `cols.width` values are appended to
@@ -139,6 +325,9 @@ fn parse_block_w<const W: usize>(block: &[u8], cols: &Cols, out: &mut Vec<f64>) 
     }
     true
 }
+
+/// A parsed block: its values (slots, reused for the next block) and its rows.
+type Parsed = (Vec<f64>, Vec<Row>);
 
 /// Sequential reader of line-aligned blocks, reusing its buffers.
 struct BlockReader {
@@ -221,6 +410,7 @@ pub(super) fn for_each_row(
     let idx: Vec<usize> = present.iter().filter_map(|&c| columns.field[c]).collect();
     let cols = Cols::new(&idx, columns.n_fields);
     let width = cols.width;
+    // (Run by the parsing workers: the reading thread only hands the rows over.)
     let to_row = |slots: &[f64]| {
         let mut v = [0.0f64; 9];
         for (&c, &x) in present.iter().zip(slots) {
@@ -241,35 +431,40 @@ pub(super) fn for_each_row(
     // (this thread, so `on_row` need not be Send).
     let (mut to_parse, b) = reader.batch(per_batch).map_err(io)?;
     read_bytes += b;
-    let mut to_hand: Option<Vec<Option<Vec<f64>>>> = None;
-    let mut outs: Vec<Vec<f64>> = Vec::new();
+    let mut to_hand: Option<Vec<Option<Parsed>>> = None;
+    let mut outs: Vec<Parsed> = Vec::new();
     loop {
         if to_parse.is_empty() && to_hand.is_none() {
             return Ok(true);
         }
         let mut next: Option<std::io::Result<(Vec<Vec<u8>>, u64)>> = None;
-        let mut parsed: Option<Vec<Option<Vec<f64>>>> = None;
+        let mut parsed: Option<Vec<Option<Parsed>>> = None;
         let mut verdict: Option<bool> = None;
-        let mut free_outs: Vec<Vec<f64>> = Vec::new();
+        let mut free_outs: Vec<Parsed> = Vec::new();
         rayon::in_place_scope(|s| {
             if !reader.eof {
                 let (rd, nx) = (&mut reader, &mut next);
                 s.spawn(move |_| *nx = Some(rd.batch(per_batch)));
             }
             if !to_parse.is_empty() {
-                let bufs: Vec<Vec<f64>> = (0..to_parse.len())
+                let bufs: Vec<Parsed> = (0..to_parse.len())
                     .map(|_| outs.pop().unwrap_or_default())
                     .collect();
-                let (blocks, cols, pr) = (&to_parse, &cols, &mut parsed);
+                let (blocks, cols, pr, to_row) = (&to_parse, &cols, &mut parsed, &to_row);
                 s.spawn(move |_| {
                     *pr = Some(
                         blocks
                             .par_iter()
                             .zip(bufs.into_par_iter())
-                            .map(|(b, mut out)| {
+                            .map(|(b, (mut out, mut rows))| {
                                 out.clear();
                                 out.reserve(b.len() / 8);
-                                parse_block(b, cols, &mut out).then_some(out)
+                                if !parse_block(b, cols, &mut out) {
+                                    return None;
+                                }
+                                rows.clear();
+                                rows.extend(out.chunks_exact(width).map(to_row));
+                                Some((out, rows))
                             })
                             .collect(),
                     );
@@ -281,8 +476,8 @@ pub(super) fn for_each_row(
                         verdict = Some(false);
                         return;
                     };
-                    for slots in v.chunks_exact(width) {
-                        if !on_row(&to_row(slots)) {
+                    for row in &v.1 {
+                        if !on_row(row) {
                             verdict = Some(true);
                             return;
                         }
@@ -458,6 +653,134 @@ mod tests {
         assert!(rows[3].t_s.is_nan());
         // (NaN is not equal to itself: compare the printed rows.)
         assert_eq!(format!("{rows:?}"), format!("{:?}", exact(&path)));
+    }
+
+    #[test]
+    fn eight_digits_at_a_time() {
+        let word = |s: &[u8]| {
+            let mut a = [b'x'; 8];
+            a[..s.len()].copy_from_slice(s);
+            u64::from_le_bytes(a)
+        };
+        assert_eq!(leading_digits(word(b"12345678")), 8);
+        assert_eq!(leading_digits(word(b"1234,678")), 4);
+        assert_eq!(leading_digits(word(b",2345678")), 0);
+        assert_eq!(leading_digits(word(b"9/:0")), 1);
+        assert_eq!(leading_digits(word(b"09.1")), 2);
+        assert_eq!(digits_value(word(b"12345678"), 8), 12_345_678);
+        assert_eq!(digits_value(word(b"90210,5"), 5), 90_210);
+        assert_eq!(digits_value(word(b"7"), 1), 7);
+        assert_eq!(digits_value(word(b"00000009"), 8), 9);
+        let (mut w, mut n) = (0, 0);
+        let s = b"1234567890123,5";
+        assert_eq!(digit_run(s, 0, &mut w, &mut n), 13);
+        assert_eq!((w, n), (1_234_567_890_123, 13));
+    }
+
+    /// The plain-decimal path gives `fast_float2`'s value and length, or leaves the text
+    /// to it: every printed f32 and f64 (shortest round trip, as the log writer prints),
+    /// fixed and scientific forms, and text around the path's limits.
+    #[test]
+    fn plain_decimals_parse_like_fast_float() {
+        let same = |s: &str| {
+            let want = fast_float2::parse_partial::<f64, _>(s.as_bytes()).ok();
+            let got = parse_number(s.as_bytes());
+            assert_eq!(
+                got.map(|(v, k)| (v.to_bits(), k)),
+                want.map(|(v, k)| (v.to_bits(), k)),
+                "{s}"
+            );
+            if let Some((v, k)) = parse_plain(s.as_bytes()) {
+                assert_eq!(
+                    (v.to_bits(), k),
+                    want.map(|(v, k)| (v.to_bits(), k)).unwrap(),
+                    "{s}"
+                );
+            }
+        };
+        let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+        let mut plain = 0;
+        for k in 0..200_000 {
+            // xorshift: bit patterns of every magnitude, then ordinary values.
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let v = if k % 2 == 0 {
+                f64::from_bits(x)
+            } else {
+                ((x >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 10f64.powi(k % 13 - 6)
+            };
+            if !v.is_finite() {
+                continue;
+            }
+            let f = v as f32;
+            for s in [
+                format!("{v}"),
+                format!("{v:e}"),
+                format!("{f}"),
+                format!("{f:e}"),
+                format!("{f:E}"),
+                format!("{:.3}", f),
+                format!("{}", (v * 1e4).round() / 1e4),
+            ] {
+                same(&s);
+                plain += usize::from(parse_plain(s.as_bytes()).is_some());
+            }
+        }
+        assert!(plain > 500_000, "the plain path took only {plain} numbers");
+        for s in [
+            "0",
+            "-0",
+            "+0",
+            "-0.0",
+            "1.",
+            ".5",
+            "-.5",
+            "+.5e1",
+            "1e22",
+            "1e23",
+            "1e-22",
+            "1e-23",
+            "9007199254740992",
+            "9007199254740993",
+            "9007199254740992e-3",
+            "1234567890123456789",
+            "12345678901234567890",
+            "0.00030000000000000003",
+            "1e",
+            "1e+",
+            "1e-",
+            "1E5",
+            "1e0005",
+            "1e00005",
+            "1e99999",
+            "2.5e-308",
+            "-",
+            "+",
+            ".",
+            "-.",
+            "e5",
+            ".e5",
+            "inf",
+            "-infinity",
+            "NaN",
+            "1.5x",
+            "1..5",
+            "1.5e3,2",
+            "326.5986,1",
+            "0.0001\r\n",
+            "1,2",
+            "1 2",
+            "000000000000000000001",
+            "0000000000000000001.5",
+            "4.9406564584124654e-324",
+            "1.7976931348623157e308",
+            "6.408294e-9",
+            "0.0000012402029",
+            "-163.67188",
+        ] {
+            same(s);
+        }
     }
 
     #[test]
