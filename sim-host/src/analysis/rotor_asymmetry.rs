@@ -351,7 +351,12 @@ fn steady_stretch(d: &Prepared) -> (usize, Vec<f64>) {
 /// (even samples real, odd imaginary) and the bins are unpacked from it: the same values
 /// to rounding as a full-length complex FFT, in half the time and memory (a 1 h log's
 /// stretch is 4 M samples, padded to 16 M).
-fn spectrum(x: &[f64], dt: f64, f_max: f64) -> (f64, Vec<f64>) {
+fn spectrum(
+    planner: &mut rustfft::FftPlanner<f64>,
+    x: &[f64],
+    dt: f64,
+    f_max: f64,
+) -> (f64, Vec<f64>) {
     let n = x.len();
     let nfft = (4 * n).next_power_of_two().max(2);
     let half = nfft / 2;
@@ -368,9 +373,7 @@ fn spectrum(x: &[f64], dt: f64, f_max: f64) -> (f64, Vec<f64>) {
             buf[k / 2].im = y;
         }
     }
-    rustfft::FftPlanner::new()
-        .plan_fft_forward(half)
-        .process(&mut buf);
+    planner.plan_fft_forward(half).process(&mut buf);
     let df = 1.0 / (nfft as f64 * dt);
     let bins = ((f_max / df).ceil() as usize).saturating_add(2).min(half);
     let amp = (0..bins)
@@ -458,7 +461,9 @@ pub fn mcsa(d: &Prepared, np: f64, bars: Option<f64>, delta: Option<f64>) -> Mcs
         );
     }
     let ia: Vec<f64> = d.i_ab[seg.clone()].iter().map(|c| c.re).collect();
-    let (df, amp) = spectrum(&ia, d.dt_s, (1.5 * f1).max(f1 + 1.6 * fs));
+    // One planner for both spectra (same length: the plan and its twiddles are reused).
+    let mut planner = rustfft::FftPlanner::new();
+    let (df, amp) = spectrum(&mut planner, &ia, d.dt_s, (1.5 * f1).max(f1 + 1.6 * fs));
     let (ff, af) = peak(df, &amp, f1, 0.3 * fs);
     let db = |x: f64| 20.0 * (x.max(1e-300) / af.max(1e-300)).log10();
     let (_, al) = peak(df, &amp, ff - fs, 0.2 * fs);
@@ -469,7 +474,7 @@ pub fn mcsa(d: &Prepared, np: f64, bars: Option<f64>, delta: Option<f64>) -> Mcs
         .map(|k| (k as f64 * df, db(amp[k])))
         .collect();
     let wm: Vec<f64> = d.omega_r[seg].iter().map(|w| w / np).collect();
-    let (dfw, aw) = spectrum(&wm, d.dt_s, 1.3 * fs);
+    let (dfw, aw) = spectrum(&mut planner, &wm, d.dt_s, 1.3 * fs);
     let (fw, a_w) = peak(dfw, &aw, fs, 0.2 * fs);
     r.speed_ripple_hz = Some(fw);
     r.speed_ripple_rad_s = Some(a_w);
@@ -501,7 +506,7 @@ mod tests {
                 3.0 + (2.0 * PI * 50.0 * t).sin() + 0.01 * (2.0 * PI * 47.3 * t).cos()
             })
             .collect();
-        let (df, amp) = spectrum(&x, dt, f64::INFINITY);
+        let (df, amp) = spectrum(&mut rustfft::FftPlanner::new(), &x, dt, f64::INFINITY);
         let n = x.len();
         let nfft = (4 * n).next_power_of_two();
         let mean = x.iter().sum::<f64>() / n as f64;
@@ -525,7 +530,7 @@ mod tests {
             );
         }
         // Asked for 60 Hz, it stops just above.
-        let (_, short) = spectrum(&x, dt, 60.0);
+        let (_, short) = spectrum(&mut rustfft::FftPlanner::new(), &x, dt, 60.0);
         assert!(short.len() as f64 * df >= 60.0 && short.len() < nfft / 2);
         assert_eq!(short[..], amp[..short.len()]);
     }
@@ -540,7 +545,7 @@ mod tests {
                 10.0 * (2.0 * PI * 60.0 * t).cos() + 0.1 * (2.0 * PI * 56.0 * t + 1.0).cos()
             })
             .collect();
-        let (df, amp) = spectrum(&x, dt, f64::INFINITY);
+        let (df, amp) = spectrum(&mut rustfft::FftPlanner::new(), &x, dt, f64::INFINITY);
         let (f, a) = peak(df, &amp, 60.0, 1.0);
         let (fl, al) = peak(df, &amp, 56.0, 0.8);
         assert!((f - 60.0).abs() < df && (fl - 56.0).abs() < df, "{f} {fl}");
