@@ -422,9 +422,17 @@ pub fn mcsa(d: &Prepared, np: f64, bars: Option<f64>, delta: Option<f64>) -> Mcs
         return no(r, "needs the speed column wm_rad_s for the slip".into());
     }
     let (a, slip) = steady_stretch(d);
+    // The last 0.2 s block itself off the final quarter's slip: no steady stretch at all
+    // (the log ends in a step or a start).
+    let (Some(&t_a), Some(&t_end)) = (d.t_s.get(a), d.t_s.last()) else {
+        return no(r, "the slip is not steady at the end of the log".into());
+    };
+    if d.len() - a < 16 {
+        return no(r, "the slip is not steady at the end of the log".into());
+    }
     let seg = a..d.len();
     let t_len = (d.len() - a) as f64 * d.dt_s;
-    r.window_s = vec![d.t_s[a], d.t_s[d.len() - 1]];
+    r.window_s = vec![t_a, t_end];
     let s = slip[seg.clone()].iter().sum::<f64>() / seg.len().max(1) as f64;
     let f1 = d.omega_s[seg.clone()].iter().map(|w| w.abs()).sum::<f64>()
         / seg.len().max(1) as f64
@@ -485,6 +493,26 @@ pub fn mcsa(d: &Prepared, np: f64, bars: Option<f64>, delta: Option<f64>) -> Mcs
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A log that ends in a step (the last 0.2 s block's slip is off the final quarter's
+    /// median): no steady stretch, "cannot judge", not an index past the end (found on a
+    /// 1 kHz, 11 kW log with a start, V/f steps and a dip, where `explain` panicked).
+    #[test]
+    fn a_log_that_ends_in_a_step_cannot_be_judged() {
+        let n = 1000;
+        let slip = |k: usize| if k < n - 100 { 0.03 } else { 0.06 };
+        let d = Prepared {
+            t_s: (0..n).map(|k| k as f64 * 1e-3).collect(),
+            dt_s: 1e-3,
+            omega_s: vec![314.0; n],
+            omega_r: (0..n).map(|k| 314.0 * (1.0 - slip(k))).collect(),
+            ..Default::default()
+        };
+        let r = mcsa(&d, 2.0, None, None);
+        assert!(!r.judged);
+        let why = r.cannot_judge_because.unwrap_or_default();
+        assert!(why.contains("not steady at the end"), "{why}");
+    }
 
     #[test]
     fn broken_bars_and_delta_are_inverse() {
