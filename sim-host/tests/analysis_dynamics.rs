@@ -125,12 +125,19 @@ fn hidden_case(
     dir: &std::path::Path,
     which: &str,
     kind: monitor_core::EffectKind,
+    rate_hz: f64,
 ) -> (String, f64, bool, f64, f64, f64) {
     let truth = params(which);
     let nominal = perturbed(&truth, 0.05);
-    let mut s = transients(which, 5000.0);
+    let mut s = transients(which, rate_hz);
     s.effects = vec![sim_host::sim::EffectSpec::with_defaults(kind)];
-    let log = write_log(dir, &format!("{which}_{}", kind.name()), &truth, &s, false);
+    let log = write_log(
+        dir,
+        &format!("{which}_{}_{rate_hz}", kind.name()),
+        &truth,
+        &s,
+        false,
+    );
     let a = analyse(&log, &nominal, 0.0);
     let ex = a.explain(&opts(&FULL), &|_| {}).unwrap().report;
     let mut with: Vec<&str> = FULL.to_vec();
@@ -150,7 +157,7 @@ fn hidden_case(
         after.noise_floor,
     );
     eprintln!(
-        "{which} {:<17} top {:<17} ({:.0} %, unexplained {}) error {:.4} -> {:.4} ({:.1}x, noise floor {:.4})",
+        "{which} {rate_hz} Hz {:<17} top {:<17} ({:.0} %, unexplained {}) error {:.4} -> {:.4} ({:.1}x, noise floor {:.4})",
         kind.name(),
         r.0,
         100.0 * r.1,
@@ -189,7 +196,8 @@ fn hidden_effects_under_transients_found() {
         .into_iter()
         .flat_map(|w| found.map(|k| (w, k)))
     {
-        let (top, _, unexplained, before, after, floor) = hidden_case(dir.path(), which, kind);
+        let (top, _, unexplained, before, after, floor) =
+            hidden_case(dir.path(), which, kind, 5000.0);
         if top != kind.name() || unexplained || !(before >= 5.0 * after || after <= 2.0 * floor) {
             failures.push(format!(
                 "{which} {kind}: top {top}, unexplained {unexplained}, {before:.4} -> {after:.4} (floor {floor:.4})"
@@ -207,6 +215,7 @@ fn hidden_effects_under_transients_found() {
 fn hidden_effects_under_transients_probe() {
     let which = std::env::var("MOTOR").unwrap_or("2p2".into());
     let only = std::env::var("EFFECT").ok();
+    let rate: f64 = std::env::var("RATE").map_or(5000.0, |r| r.parse().expect("RATE in Hz"));
     let dir = tempfile::tempdir().unwrap();
     for kind in monitor_core::EffectKind::ALL.into_iter().filter(|k| {
         !k.is_dynamics()
@@ -214,7 +223,7 @@ fn hidden_effects_under_transients_probe() {
                 .as_deref()
                 .is_none_or(|o| o.split(',').any(|x| x == k.name()))
     }) {
-        hidden_case(dir.path(), &which, kind);
+        hidden_case(dir.path(), &which, kind, rate);
     }
 }
 
