@@ -523,18 +523,18 @@ impl Isolator {
         (c, q)
     }
 
-    /// The weight (inverse covariance) of the residuals at the readings `q` of circuit
-    /// `c`: the inverse of `S = D + sum_j d_j d_j^T`, `D = diag(spread^2)`, with `d_j` how
+    /// The weight (inverse covariance) of the residuals at the measured point `q`: the
+    /// inverse of `S = D + sum_j d_j d_j^T`, `D = diag(spread^2)`, with `d_j` how
     /// much more the residuals move at `q` than at the learned point when circuit
     /// parameter `j` (Rs, Rr, the leakages, Lm) is [`NAMEPLATE_UNCERTAINTY`] off (module
     /// docs, "Away from the learned point"). Without a learned point, or where a point is
     /// not usable: `D^-1`.
     #[inline(never)]
-    fn weight(&self, c: &Circuit, q: &SteadyPoint) -> Sym3 {
+    fn weight(&self, q: &SteadyPoint) -> Sym3 {
         let s = self.baseline.spread;
         let diag = Sym3::diagonal_weight(&s);
         let (at, c0) = (self.baseline.at, self.circuit());
-        let (Some(e_here), Some(e_at)) = (self.eval(c, q), self.eval(&c0, &at)) else {
+        let (Some(e_here), Some(e_at)) = (self.eval(&c0, q), self.eval(&c0, &at)) else {
             return diag;
         };
         let [a, b, z] = s;
@@ -550,7 +550,7 @@ impl Isolator {
         let mut expected = 0.0f32;
         for (j, dj) in d.iter_mut().enumerate() {
             let (Some(h), Some(t)) = (
-                self.eval(&c.nameplate_off(j), q),
+                self.eval(&c0.nameplate_off(j), q),
                 self.eval(&c0.nameplate_off(j), &at),
             ) else {
                 return diag;
@@ -634,7 +634,7 @@ impl Isolator {
         for ((r, e), m) in out.residuals.iter_mut().zip(e0).zip(b.mean) {
             *r = e - m;
         }
-        let w = self.weight(&self.circuit(), p);
+        let w = self.weight(p);
         let chi0 = self.chi2_at(p, None, &w);
         out.deviation = crate::sqrt(chi0);
         if chi0 < DETECT_CHI2 {
