@@ -45,8 +45,12 @@ fn simulate(sc: &Scenario) -> (Channels, Vec<Row>) {
 }
 
 /// The shared folder with the two clean 10 kHz logs (9 s each).
+///
+/// It is a fixed folder under cargo's target directory, emptied when the first test of a
+/// run needs it: a `TempDir` held in a `static` is never dropped, and left about 270 MB
+/// in the system's temporary folder after every run.
 struct Clean {
-    dir: tempfile::TempDir,
+    dir: PathBuf,
     healthy: (Channels, Vec<Row>),
     faulty: (Channels, Vec<Row>),
 }
@@ -54,7 +58,13 @@ struct Clean {
 fn clean() -> &'static Clean {
     static CLEAN: OnceLock<Clean> = OnceLock::new();
     CLEAN.get_or_init(|| Clean {
-        dir: tempfile::tempdir().expect("tmp"),
+        dir: {
+            let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join("real_data");
+            // ok: test (the folder may not exist yet)
+            let _ = std::fs::remove_dir_all(&d);
+            std::fs::create_dir_all(&d).expect("test folder");
+            d
+        },
         healthy: simulate(&scenario(10_000.0, 9.0, false, "")),
         faulty: simulate(&scenario(10_000.0, 9.0, true, "")),
     })
@@ -62,7 +72,7 @@ fn clean() -> &'static Clean {
 
 /// Writes `rows` as a log named `name` in the shared folder.
 fn write(name: &str, channels: Channels, rows: Vec<Row>) -> PathBuf {
-    let p = clean().dir.path().join(name);
+    let p = clean().dir.join(name);
     Log { channels, rows }.write(&p).expect("write log");
     p
 }
@@ -585,7 +595,7 @@ fn a_nameplate_20_percent_off_gets_no_confident_verdict() {
             }
         })
         .collect();
-    let params = clean().dir.path().join("nameplate.toml");
+    let params = clean().dir.join("nameplate.toml");
     std::fs::write(&params, off).expect("write params");
     let p = params.display().to_string();
     let shown = log.display().to_string();
