@@ -116,6 +116,26 @@ fn full_order_machine_follows_starts_and_steps() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
+/// Synchronous mechanical speed of `p` [rad/s].
+fn sync_speed_mech(p: &ParamFile) -> f64 {
+    2.0 * std::f64::consts::PI * p.supply.f_hz / (0.5 * f64::from(p.motor.poles))
+}
+
+/// The T-equivalent circuit's torque at standstill on the rated supply [N m]:
+/// `3 |I_r|^2 Rr / omega_sync,mech`.
+fn locked_rotor_torque(p: &ParamFile) -> f64 {
+    use sim_host::analysis::prep::C64;
+    let m = &p.motor;
+    let w = 2.0 * std::f64::consts::PI * p.supply.f_hz;
+    let (zm, zr) = (
+        C64::new(0.0, w * m.lm_h),
+        C64::new(m.rr_ohm, w * (m.lr_h - m.lm_h)),
+    );
+    let z = C64::new(m.rs_ohm, w * (m.ls_h - m.lm_h)) + zm * zr / (zm + zr);
+    let i_r = p.supply.v_ll_rms / 3f64.sqrt() / z * zm / (zm + zr);
+    3.0 * i_r.norm_sqr() * m.rr_ohm / sync_speed_mech(p)
+}
+
 /// One case of issue 10's "hidden effects under transients": the start + V/f step + dip
 /// log of [`transients`] at 5 kHz with `kind` injected (the simulator's defaults),
 /// analysed over the whole log with the four dynamics effects in the model. Returns what
@@ -130,7 +150,19 @@ fn hidden_case(
     let truth = params(which);
     let nominal = perturbed(&truth, 0.05);
     let mut s = transients(which, rate_hz);
-    s.effects = vec![sim_host::sim::EffectSpec::with_defaults(kind)];
+    s.effects = vec![match kind {
+        // The simulator's default constant load (the viscous load's torque at synchronous
+        // speed, about rated) is more than the 11 kW machine's locked-rotor torque (a
+        // single-cage model has no deep-bar rise of Rr at standstill), and that active load
+        // drives it backwards from the start; there half of it.
+        monitor_core::EffectKind::LoadTorque => {
+            let default = truth.motor.bl_nms * sync_speed_mech(&truth);
+            sim_host::sim::EffectSpec::LoadTorque {
+                torque_nm: (default > locked_rotor_torque(&truth)).then_some(0.5 * default),
+            }
+        }
+        k => sim_host::sim::EffectSpec::with_defaults(k),
+    }];
     let log = write_log(
         dir,
         &format!("{which}_{}_{rate_hz}", kind.name()),
@@ -171,16 +203,16 @@ fn hidden_case(
 }
 
 /// The hidden effects that are found through a start and steps (README, "Hidden effects
-/// under transients"): ranked first, claimed, and the error cut at least 5x or to within
-/// 2x the noise floor. Thermal drift, saturation, phase and rotor asymmetry are found
-/// since they act inside the full-order model as the simulator injects them (the heated
-/// cage's rotor time constant, Lm on the model's own magnetising flux, the unequal stator
-/// winding, the unequal cage; `simplified_model`). The others are not (probe below, table
-/// in the README): iron loss, friction and windage are ranked first but at the
-/// simulator's defaults sit at the noise in this log (the error without them is already
-/// within 2x the floor, and `explain` rightly claims nothing).
-#[test]
-fn hidden_effects_under_transients_found() {
+/// under transients"), on both reference motors and the 11 kW machine, at `rate_hz`:
+/// ranked first, claimed, and the error cut at least 5x or to within 2x the noise floor.
+/// They are found since they act inside the full-order model as the simulator injects
+/// them (the heated cage's rotor time constant, Lm on the model's own magnetising flux,
+/// the unequal stator winding, the unequal cage, the negative-sequence voltage driving the
+/// machine; `simplified_model`). Iron loss, friction and windage are ranked first too
+/// (probe below, table in the README), but at the simulator's defaults they sit at the
+/// noise in this log (the error without them is already within 2x the floor), so
+/// `explain` may rightly claim nothing.
+fn hidden_effects_found_at(rate_hz: f64) {
     use monitor_core::EffectKind;
     let dir = tempfile::tempdir().unwrap();
     let mut failures = Vec::new();
@@ -192,19 +224,40 @@ fn hidden_effects_under_transients_found() {
         EffectKind::PhaseAsymmetry,
         EffectKind::RotorAsymmetry,
     ];
-    for (which, kind) in ["2p2", "3hp"]
+    for (which, kind) in ["2p2", "3hp", "11kw"]
         .into_iter()
         .flat_map(|w| found.map(|k| (w, k)))
     {
         let (top, _, unexplained, before, after, floor) =
-            hidden_case(dir.path(), which, kind, 5000.0);
-        if top != kind.name() || unexplained || !(before >= 5.0 * after || after <= 2.0 * floor) {
+            hidden_case(dir.path(), which, kind, rate_hz);
+        // At the noise already without it (within 2x the floor), it may rightly be left
+        // unclaimed, as in `analysis_effects.rs`.
+        let claim_due = before > 2.0 * floor;
+        if top != kind.name()
+            || (unexplained && claim_due)
+            || !(before >= 5.0 * after || after <= 2.0 * floor)
+        {
             failures.push(format!(
-                "{which} {kind}: top {top}, unexplained {unexplained}, {before:.4} -> {after:.4} (floor {floor:.4})"
+                "{which} {kind} {rate_hz} Hz: top {top}, unexplained {unexplained}, {before:.4} -> {after:.4} (floor {floor:.4})"
             ));
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn hidden_effects_under_transients_found_at_2_khz() {
+    hidden_effects_found_at(2000.0);
+}
+
+#[test]
+fn hidden_effects_under_transients_found_at_5_khz() {
+    hidden_effects_found_at(5000.0);
+}
+
+#[test]
+fn hidden_effects_under_transients_found_at_10_khz() {
+    hidden_effects_found_at(10_000.0);
 }
 
 /// Every non-dynamics effect of the library through a start and steps (a probe, ignored:

@@ -57,7 +57,10 @@ fn check(which: &str, noise: u32, names: &[&str]) {
             "{which} noise {noise} {name:<17} top {top:<17} unexplained {} error {:.4} -> {:.4} ({ratio:.1}x, noise floor {:.4})",
             ex.unexplained, before.normalized_rms_error, after.normalized_rms_error, after.noise_floor
         );
-        if top != name || ex.unexplained {
+        // An effect whose absence leaves the error within 2x the noise floor is at the
+        // noise: `explain` may rightly leave it unclaimed (it must still rank it first).
+        let at_noise = before.normalized_rms_error <= 2.0 * before.noise_floor;
+        if top != name || (ex.unexplained && !at_noise) {
             failures.push(format!(
                 "{name}: explain ranked {top} first (unexplained {})",
                 ex.unexplained

@@ -117,7 +117,8 @@ impl Analysis {
         // fitted values where the parameter count agrees.
         let f = align(&active, f);
         let w = Weights::new(d, 0, usize::MAX);
-        let (pred, noise_floor) = self.predict_with_noise_floor(d, &active, &f, &w);
+        let (pred, renoised) = self.predict_and_renoised(d, &active, &f);
+        let noise_floor = metrics::noise_floor(d, &w, Some((&pred, &renoised)));
         let err: ErrorSummary = metrics::errors(d, &pred, None);
         let (mut worst, all) = metrics::windows(
             d,

@@ -15,7 +15,7 @@
 //! | `coulomb_friction` | torque_nm [N m] | load += Tc tanh(w_m / 1 rad/s) |
 //! | `windage` | k_nms2 [N m s^2/rad^2] | load += k w_m abs(w_m) |
 //! | `load_torque` | level_1..level_k [N m] | load += piecewise-constant T_L(t) (steps found in the data) |
-//! | `supply_unbalance` | y_re, y_im [-] | i_neg = (y_re + j y_im) v_neg / conj(Z2), Z2 from the nominal parameters |
+//! | `supply_unbalance` | y_re, y_im [-] | i_neg = (y_re + j y_im) v_neg / conj(Z2), Z2 from the nominal parameters at the negative-sequence slip 2 - s; full-order: the machine driven by V_pos + y V_neg |
 //! | `phase_asymmetry` | c_re, c_im [-] | i_neg = (c_re + j c_im) conj(i_pos); full-order: the unequal winding (`simplified_model::WindingAsymmetry`) |
 //! | `flux_dynamics` | tau_r_s [s] | psi_r/Lm = phi, dphi/dt = (i_f - phi)/tau_r; slip and torque from phi |
 //! | `current_dynamics` | la_h [H] | La dI_qs/dt = V_qs - Ra I_qs - Psi omega_r (eq. 28's derivative term) |
@@ -370,9 +370,19 @@ pub fn sync_speed_mech(d: &Prepared, n: &MachineConstants) -> f64 {
 /// `Rs + j w Lls + (j w Lm) || (Rr/2 + j w Llr)`; the negative-sequence current is
 /// `v_neg / conj(Z2)`.
 pub fn z2_neg(n: &MachineConstants, w: f64) -> C64 {
+    z2_neg_at(n, w, 2.0)
+}
+
+/// [`z2_neg`] at the negative-sequence slip `s2 = 2 - s = 1 + omega_r/omega_s` of the
+/// present speed: the rotor branch is `Rr/s2 + j w Llr`, so at standstill (a start, `s2`
+/// = 1) the rotor resistance counts twice what it does near synchronous speed (the
+/// reduced model's `supply_unbalance`; the full-order model gets this from the machine
+/// itself). `s2` is held at 0.05 or more (a rotor driven backwards near the supply speed).
+pub fn z2_neg_at(n: &MachineConstants, w: f64, s2: f64) -> C64 {
     let w = w.abs().max(1.0);
+    let s2 = if s2.is_finite() { s2.max(0.05) } else { 2.0 };
     let zm = C64::new(0.0, w * n.lm_h);
-    let zr = C64::new(n.rr_ohm / 2.0, w * n.llr_h);
+    let zr = C64::new(n.rr_ohm / s2, w * n.llr_h);
     C64::new(n.rs_ohm, w * n.lls_h) + zm * zr / (zm + zr)
 }
 
@@ -1046,7 +1056,7 @@ impl EffectModel for SupplyUnbalance {
         "The supply voltages are not balanced: a negative-sequence voltage drives a negative-sequence current through the machine's small negative-sequence impedance (2f ripple in the d-q frame)."
     }
     fn equations(&self) -> &'static str {
-        "i_abc = balanced model current + i_neg, i_neg = (y_re + j y_im) v_neg / conj(Z2(omega_s)), Z2 = Rs + j w Lls + (j w Lm)||(Rr/2 + j w Llr); the balanced model is driven by the positive-sequence V_qs."
+        "i_abc = balanced model current + i_neg, i_neg = (y_re + j y_im) v_neg / conj(Z2(omega_s)), Z2 = Rs + j w Lls + (j w Lm)||(Rr/s2 + j w Llr) at the negative-sequence slip s2 = 1 + omega_r/omega_s (2 without a speed column); the balanced model is driven by the positive-sequence V_qs. Full-order model (all dynamics effects in): the machine is driven by V_pos + (y_re + j y_im) V_neg, and its own equations give the negative-sequence current (through a start, and with the 2f torque and speed ripple)."
     }
     fn parameters(&self) -> &'static [ParamSpec] {
         &[
@@ -1082,9 +1092,20 @@ impl EffectModel for SupplyUnbalance {
     ) {
         let y = C64::new(p[0], p[1]);
         let add: Vec<C64> = (0..d.len())
-            .map(|k| y * d.v_neg[k] / z2_neg(n, d.omega_s[k]).conj())
+            .map(|k| {
+                // The measured speed gives the negative-sequence slip; without it the rotor
+                // is taken as near synchronous speed (slip 2).
+                let w = d.omega_s[k];
+                let s2 = match d.omega_r.get(k) {
+                    Some(wr) if w.abs() > 1.0 => 1.0 + wr / w,
+                    _ => 2.0,
+                };
+                y * d.v_neg[k] / z2_neg_at(n, w, s2).conj()
+            })
             .collect();
         add_neg(terms, add);
+        // The full-order model drives the machine with y v_neg instead.
+        terms.v_neg_gain = Some(y);
     }
     fn describe(&self, _s: &FitSetup, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
         let (mut vn, mut vp) = (0.0, 0.0);

@@ -451,36 +451,19 @@ impl Analysis {
             .collect()
     }
 
-    /// The noise floor of the fitted model on `d` (output noise plus the inputs' noise
-    /// carried through the model, see [`metrics::noise_floor`]).
-    fn model_noise_floor(
+    /// The fitted model's prediction on `d` and the same model run with the inputs' noise
+    /// added again ([`Analysis::renoised`]): the pair [`metrics::noise_floor`] and
+    /// [`metrics::noise_floor_on`] take. The two runs are independent and share the cores.
+    fn predict_and_renoised(
         &self,
         d: &Prepared,
         active: &[ActiveEffect<'_>],
         f: &FitResult,
-        pred: &Prediction,
-        w: &Weights,
-    ) -> f64 {
-        let renoised = self.renoised(d, active, f);
-        metrics::noise_floor(d, w, Some((pred, &renoised)))
-    }
-
-    /// The fitted model's prediction and its noise floor on `d`, the two model runs on
-    /// both cores (they are independent: the noise floor's run has noise added to the
-    /// inputs).
-    fn predict_with_noise_floor(
-        &self,
-        d: &Prepared,
-        active: &[ActiveEffect<'_>],
-        f: &FitResult,
-        w: &Weights,
-    ) -> (Prediction, f64) {
-        let (pred, renoised) = rayon::join(
+    ) -> (Prediction, Prediction) {
+        rayon::join(
             || fit::predict(d, &self.constants, active, f),
             || self.renoised(d, active, f),
-        );
-        let noise = metrics::noise_floor(d, w, Some((&pred, &renoised)));
-        (pred, noise)
+        )
     }
 
     /// The fitted model run with the inputs' sensor noise added again (white, the level

@@ -149,8 +149,15 @@ pub struct EffectTerms {
     pub lm_factor: Vec<f64>,
     /// Extra load torque on the shaft [N m] (speed independent); empty = 0.
     pub load_nm: Vec<f64>,
-    /// Predicted negative-sequence current, stationary frame [A]; empty = 0.
+    /// Predicted negative-sequence current, stationary frame [A]; empty = 0 (the reduced
+    /// model's `supply_unbalance`; the full-order model uses `v_neg_gain` instead).
     pub i_neg: Vec<C64>,
+    /// `supply_unbalance` in the full-order model: the measured negative-sequence voltage
+    /// times this gain drives the machine beside the positive sequence, so that the
+    /// negative-sequence current follows from the machine itself (its slip through a start,
+    /// the 2f torque and speed ripple it makes); the gain is the reduced model's relative
+    /// admittance `y` (`None`: the positive sequence alone).
+    pub v_neg_gain: Option<C64>,
     /// `phase_asymmetry`: an unequal stator winding (`None`: symmetric).
     pub winding: Option<WindingAsymmetry>,
     /// `rotor_asymmetry` in the full-order model: (delta, phi) of an unequal rotor cage,
@@ -1250,7 +1257,11 @@ fn simulate_stationary(
             None => sm,
         };
         let rot = rot_at(k);
-        let ineg = t.i_neg.get(k).copied().unwrap_or_default();
+        // With `v_neg_gain` the negative sequence is in the machine's own current.
+        let ineg = match t.v_neg_gain {
+            Some(_) => C64::default(),
+            None => t.i_neg.get(k).copied().unwrap_or_default(),
+        };
         let mut i_out = sm.terminal(&x);
         if t.g_fe_s != 0.0 {
             let psi_s = sm.stator_flux(&x);
@@ -1264,7 +1275,15 @@ fn simulate_stationary(
             break;
         }
         let v_after = v_at((k + 2).min(len - 1));
-        let (v0, v1) = (v_cur, v_next);
+        // The negative sequence (`supply_unbalance`), rotating the other way.
+        let (vn0, vn1) = match t.v_neg_gain {
+            Some(g) => {
+                let at = |j: usize| d.v_neg.get(j).copied().unwrap_or_default();
+                (g * at(k), g * at(k + 1))
+            }
+            None => (C64::default(), C64::default()),
+        };
+        let (v0, v1) = (v_cur + vn0, v_next + vn1);
         x = if dev[k] > step_thr {
             let w = [ph[k - 1] / dt, ph[k + 1] / dt];
             let early = sm.across_step(&x, dt, 0.0, v0, v1, w);
@@ -1281,7 +1300,8 @@ fn simulate_stationary(
             sm.across_step(&x, dt, phi.clamp(0.0, 1.0), v0, v1, w)
         } else {
             let half = C64::from_polar(1.0, 0.5 * ph[k]);
-            let vm = (v0 * half + v1 * half.conj()) * 0.5;
+            let vm = (v_cur * half + v_next * half.conj()) * 0.5
+                + (vn0 * half.conj() + vn1 * half) * 0.5;
             sm.rk4(&x, dt, [v0, vm, v1], 0.0)
         };
         (v_cur, v_next) = (v1, v_after);
