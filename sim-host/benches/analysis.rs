@@ -54,6 +54,7 @@ fn cpu_s() -> f64 {
 }
 
 fn main() {
+    sim_host::keep_freed_memory();
     let secs: f64 = std::env::var("ANALYSIS_BENCH_SECONDS")
         .ok()
         .and_then(|s| s.parse().ok())

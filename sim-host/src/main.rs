@@ -21,6 +21,7 @@ use clap::Parser;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    sim_host::keep_freed_memory();
     let args = match cli::Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {

@@ -76,7 +76,7 @@ pub struct EffectCandidate {
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub implausible_because: Vec<String>,
     /// How the candidate's fit ended: `{iterations, cost, termination}` (`converged`,
-    /// `iteration_limit`, `stalled`, `nothing_to_fit`), from [`super::lm`].
+    /// `slow_progress`, `iteration_limit`, `stalled`, `nothing_to_fit`), from [`super::lm`].
     pub fit: super::lm::Report,
 }
 

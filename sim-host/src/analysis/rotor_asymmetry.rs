@@ -76,6 +76,13 @@ pub const MIN_BINS: f64 = 10.0;
 pub const MIN_SLIP: f64 = 0.003;
 /// Largest variation of the slip over the analysed stretch, relative to its mean.
 pub const SLIP_STEADY: f64 = 0.2;
+/// Longest stretch the sidebands are read from [s]: a longer steady stretch is cut to its
+/// last `max(MAX_STRETCH_S, 4 MIN_BINS / (2 s f))` seconds, 4x the resolution the
+/// sidebands need (module doc). 300 s resolve 3.3 mHz; a 1 h log's whole stretch would be
+/// a 16 M-point transform (about 3 s of CPU and 256 MB) and sharpen nothing the report
+/// reads: the leakage criterion is met, and the noise floor per bin is already far below
+/// a healthy cage's sidebands.
+pub const MAX_STRETCH_S: f64 = 300.0;
 
 /// delta = 3n/(N - 3n) for `n` adjacent broken bars of a cage of `bars` bars (see the module
 /// doc; an approximation).
@@ -403,8 +410,8 @@ fn peak(df: f64, amp: &[f64], f0: f64, half: f64) -> (f64, f64) {
 
 /// The MCSA of the log: stator current sidebands at (1 -/+ 2s) f in dB below the
 /// fundamental (phase-a current, Hann window over the steady stretch at the end of the
-/// log), the 2 s f speed ripple, and the equivalent broken bars for `bars` N when `delta`
-/// is known. `np` is the number of pole pairs. "Cannot judge" (with the reason) without a
+/// log, at most [`MAX_STRETCH_S`] of it), the 2 s f speed ripple, and the equivalent
+/// broken bars for `bars` N when `delta` is known. `np` is the number of pole pairs. "Cannot judge" (with the reason) without a
 /// speed column, on a slip below [`MIN_SLIP`] or not steady, or a stretch too short for
 /// the resolution (see the module doc).
 pub fn mcsa(d: &Prepared, np: f64, bars: Option<f64>, delta: Option<f64>) -> McsaReport {
@@ -430,13 +437,28 @@ pub fn mcsa(d: &Prepared, np: f64, bars: Option<f64>, delta: Option<f64>) -> Mcs
     if d.len() - a < 16 {
         return no(r, "the slip is not steady at the end of the log".into());
     }
+    let mean_of = |a: usize| {
+        let seg = a..d.len();
+        let s = slip[seg.clone()].iter().sum::<f64>() / seg.len().max(1) as f64;
+        let f1 = d.omega_s[seg.clone()].iter().map(|w| w.abs()).sum::<f64>()
+            / seg.len().max(1) as f64
+            / (2.0 * PI);
+        (s, f1)
+    };
+    let (s, f1) = mean_of(a);
+    // A long steady stretch is cut to MAX_STRETCH_S (or 4x the length the sidebands need).
+    let keep_s = MAX_STRETCH_S.max(4.0 * MIN_BINS / (2.0 * s * f1).max(1e-9));
+    let keep = ((keep_s / d.dt_s) as usize).max(16);
+    let (a, t_a, s, f1) = if d.len() - a > keep {
+        let a = d.len() - keep;
+        let (s, f1) = mean_of(a);
+        (a, d.t_s.get(a).copied().unwrap_or(t_a), s, f1)
+    } else {
+        (a, t_a, s, f1)
+    };
     let seg = a..d.len();
     let t_len = (d.len() - a) as f64 * d.dt_s;
     r.window_s = vec![t_a, t_end];
-    let s = slip[seg.clone()].iter().sum::<f64>() / seg.len().max(1) as f64;
-    let f1 = d.omega_s[seg.clone()].iter().map(|w| w.abs()).sum::<f64>()
-        / seg.len().max(1) as f64
-        / (2.0 * PI);
     r.slip = Some(s);
     r.fundamental_hz = Some(f1);
     r.resolution_hz = Some(1.0 / t_len.max(d.dt_s));
@@ -512,6 +534,41 @@ mod tests {
         assert!(!r.judged);
         let why = r.cannot_judge_because.unwrap_or_default();
         assert!(why.contains("not steady at the end"), "{why}");
+    }
+
+    #[test]
+    fn a_long_steady_log_is_read_over_its_last_stretch_only() {
+        // 700 s at 200 Hz, 2 % slip at 50 Hz: sidebands 2 s f = 2 Hz off, the (1 - 2s) f one
+        // at -40 dB. The whole log is steady; only its last MAX_STRETCH_S are read, and the
+        // level is still right.
+        let (dt, n) = (1.0 / 200.0, 140_000);
+        let (f1, s) = (50.0, 0.02);
+        let w = 2.0 * PI * f1;
+        let d = Prepared {
+            t_s: (0..n).map(|k| k as f64 * dt).collect(),
+            dt_s: dt,
+            omega_s: vec![w; n],
+            omega_r: vec![w * (1.0 - s); n],
+            i_ab: (0..n)
+                .map(|k| {
+                    let t = k as f64 * dt;
+                    let a = 10.0 * (w * t).cos()
+                        + 0.1 * (2.0 * PI * (1.0 - 2.0 * s) * f1 * t + 0.5).cos();
+                    super::super::prep::C64::new(a, 0.0)
+                })
+                .collect(),
+            ..Default::default()
+        };
+        let r = mcsa(&d, 2.0, None, None);
+        assert!(r.judged, "{:?}", r.cannot_judge_because);
+        let (t_a, t_end) = (r.window_s[0], r.window_s[1]);
+        assert!(
+            ((t_end - t_a) - MAX_STRETCH_S).abs() < 2.0 * dt,
+            "{t_a}..{t_end}"
+        );
+        let lo = r.lower_sideband_db.unwrap_or(0.0);
+        assert!((lo + 40.0).abs() < 0.5, "{lo}");
+        assert!((r.resolution_hz.unwrap_or(1.0) - 1.0 / MAX_STRETCH_S).abs() < 1e-4);
     }
 
     #[test]

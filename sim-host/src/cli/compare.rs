@@ -152,7 +152,7 @@ sim-host compare --params motor.toml run.csv --effects load_torque   # the error
 sim-host explain --params motor.toml run.csv --effects load_torque   # anything else?\n\n\
 JSON (--json): baseline_normalized_rms_error, ranking [{effect, normalized_rms_error, \
 explained_fraction, validation_normalized_rms_error, n_parameters, parameters, summary, \
-plausible, implausible_because, fit {iterations, cost, termination: converged | \
+plausible, implausible_because, fit {iterations, cost, termination: converged | slow_progress | \
 iteration_limit | stalled | nothing_to_fit}}], \
 unexplained, verdict, skipped, unbalance, noise_floor, data_quality, rotor_asymmetry (the \
 motor current signature analysis: lower_sideband_db, upper_sideband_db, slip, sideband_hz, \
