@@ -283,21 +283,33 @@ fn parse_line(b: &[u8], mut i: usize, cols: &Cols, row: &mut [f64; MAX_COLS]) ->
 
 /// Parses a block of whole lines; the rows' first `cols.width` values are appended to
 /// `out`. Empty lines are skipped. False at the first line the fast path does not accept.
+#[cfg(test)]
 fn parse_block(block: &[u8], cols: &Cols, out: &mut Vec<f64>) -> bool {
+    parse_block_with(block, cols, |slots| out.extend_from_slice(slots))
+}
+
+/// Parses a block of whole lines and hands each row's first `cols.width` values to
+/// `on_row`. Empty lines are skipped. False at the first line the fast path does not
+/// accept.
+fn parse_block_with(block: &[u8], cols: &Cols, on_row: impl FnMut(&[f64])) -> bool {
     // The row width as a constant, so that handing a row over is a few moves.
     match cols.width {
-        4 => parse_block_w::<4>(block, cols, out),
-        5 => parse_block_w::<5>(block, cols, out),
-        6 => parse_block_w::<6>(block, cols, out),
-        7 => parse_block_w::<7>(block, cols, out),
-        8 => parse_block_w::<8>(block, cols, out),
-        9 => parse_block_w::<9>(block, cols, out),
-        _ => parse_block_w::<0>(block, cols, out),
+        4 => parse_block_w::<4>(block, cols, on_row),
+        5 => parse_block_w::<5>(block, cols, on_row),
+        6 => parse_block_w::<6>(block, cols, on_row),
+        7 => parse_block_w::<7>(block, cols, on_row),
+        8 => parse_block_w::<8>(block, cols, on_row),
+        9 => parse_block_w::<9>(block, cols, on_row),
+        _ => parse_block_w::<0>(block, cols, on_row),
     }
 }
 
-/// [`parse_block`] for rows of `W` values (`W` = 0: any width).
-fn parse_block_w<const W: usize>(block: &[u8], cols: &Cols, out: &mut Vec<f64>) -> bool {
+/// [`parse_block_with`] for rows of `W` values (`W` = 0: any width).
+fn parse_block_w<const W: usize>(
+    block: &[u8],
+    cols: &Cols,
+    mut on_row: impl FnMut(&[f64]),
+) -> bool {
     let mut row = [0f64; MAX_COLS];
     let n = block.len();
     let mut i = 0;
@@ -318,16 +330,16 @@ fn parse_block_w<const W: usize>(block: &[u8], cols: &Cols, out: &mut Vec<f64>) 
             None => return false,
         }
         if W > 0 {
-            out.extend_from_slice(&row[..W]);
+            on_row(&row[..W]);
         } else {
-            out.extend_from_slice(&row[..cols.width]);
+            on_row(&row[..cols.width]);
         }
     }
     true
 }
 
-/// A parsed block: its values (slots, reused for the next block) and its rows.
-type Parsed = (Vec<f64>, Vec<Row>);
+/// A parsed block's rows (the buffer is reused for the next block).
+type Parsed = Vec<Row>;
 
 /// Sequential reader of line-aligned blocks, reusing its buffers.
 struct BlockReader {
@@ -409,7 +421,6 @@ pub(super) fn for_each_row(
         .collect();
     let idx: Vec<usize> = present.iter().filter_map(|&c| columns.field[c]).collect();
     let cols = Cols::new(&idx, columns.n_fields);
-    let width = cols.width;
     // (Run by the parsing workers: the reading thread only hands the rows over.)
     let to_row = |slots: &[f64]| {
         let mut v = [0.0f64; 9];
@@ -456,15 +467,14 @@ pub(super) fn for_each_row(
                         blocks
                             .par_iter()
                             .zip(bufs.into_par_iter())
-                            .map(|(b, (mut out, mut rows))| {
-                                out.clear();
-                                out.reserve(b.len() / 8);
-                                if !parse_block(b, cols, &mut out) {
+                            .map(|(b, mut rows)| {
+                                rows.clear();
+                                // (About 60 bytes a line in a typical log.)
+                                rows.reserve(b.len() / 60);
+                                if !parse_block_with(b, cols, |slots| rows.push(to_row(slots))) {
                                     return None;
                                 }
-                                rows.clear();
-                                rows.extend(out.chunks_exact(width).map(to_row));
-                                Some((out, rows))
+                                Some(rows)
                             })
                             .collect(),
                     );
@@ -476,7 +486,7 @@ pub(super) fn for_each_row(
                         verdict = Some(false);
                         return;
                     };
-                    for row in &v.1 {
+                    for row in &v {
                         if !on_row(row) {
                             verdict = Some(true);
                             return;
