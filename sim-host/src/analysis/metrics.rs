@@ -52,23 +52,7 @@ impl Weights {
     /// (0 = train on everything; n > 0: the log is cut into 2n windows and every second
     /// one is held back).
     pub fn new(d: &Prepared, holdout: usize, max_fit_samples: usize) -> Self {
-        let mut s = [0.0f64; 5];
-        for k in 0..d.len() {
-            let m = measured(d, k);
-            for c in 0..5 {
-                s[c] += m[c] * m[c];
-            }
-        }
-        let n = d.len().max(1) as f64;
-        let mut inv = [0.0; 5];
-        for c in 0..5 {
-            let rms = (s[c] / n).sqrt();
-            inv[c] = if rms > 1e-9 && (c != 1 || d.channels.speed) {
-                1.0 / rms
-            } else {
-                0.0
-            };
-        }
+        let inv = inv_rms_over(d, None);
         let len = d.len();
         let train = if holdout == 0 {
             vec![true; len]
@@ -243,24 +227,34 @@ pub fn noise_floor_on(
     mask: &[bool],
     propagated: Option<(&Prediction, &Prediction)>,
 ) -> f64 {
+    let inv = inv_rms_over(d, Some(mask));
+    normalized_noise(&channel_noise(d, propagated, Some(mask)), &inv)
+}
+
+/// 1 / RMS of each of the five measured channels ([`measured`]) over the samples `mask`
+/// keeps (all when `None`); 0 for a channel that is absent (no speed column) or whose RMS
+/// is below 1e-9 (it is then not weighted at all).
+fn inv_rms_over(d: &Prepared, mask: Option<&[bool]>) -> [f64; 5] {
     let mut sm = [0.0f64; 5];
-    let mut n = 0.0;
-    for k in (0..d.len()).filter(|&k| mask.get(k).copied().unwrap_or(false)) {
+    let mut n = 0usize;
+    for k in 0..d.len() {
+        if mask.is_some_and(|m| !m.get(k).copied().unwrap_or(false)) {
+            continue;
+        }
         let m = measured(d, k);
         for c in 0..5 {
             sm[c] += m[c] * m[c];
         }
-        n += 1.0;
+        n += 1;
     }
-    let inv = std::array::from_fn(|c| {
-        let rms = (sm[c] / f64::max(n, 1.0)).sqrt();
+    std::array::from_fn(|c| {
+        let rms = (sm[c] / n.max(1) as f64).sqrt();
         if rms > 1e-9 && (c != 1 || d.channels.speed) {
             1.0 / rms
         } else {
             0.0
         }
-    });
-    normalized_noise(&channel_noise(d, propagated, Some(mask)), &inv)
+    })
 }
 
 /// The noise of each of the five channels of [`errors`] in their units (see
