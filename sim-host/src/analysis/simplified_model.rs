@@ -1111,25 +1111,31 @@ impl<F: Fn(f64) -> f64> StatMachine<'_, F> {
     }
 
     /// One working sample `dt` across a supply step at the fraction `phi` of it: the old
-    /// voltage `v0` turning at `w_old` before, the new `v1` turning at `w_new` after.
+    /// voltage `v0` turning at `w[0]` before, the new `v1` turning at `w[1]` after. Each
+    /// voltage is `[positive sequence, negative sequence]`; the negative sequence turns the
+    /// other way.
     fn across_step(
         &self,
         x: &StatState,
         dt: f64,
         phi: f64,
-        v0: C64,
-        v1: C64,
+        v0: [C64; 2],
+        v1: [C64; 2],
         w: [f64; 2],
     ) -> StatState {
         let (ha, hb) = (phi * dt, (1.0 - phi) * dt);
+        // `v` turned by `r` (the negative sequence by its conjugate).
+        let turned = |v: [C64; 2], r: C64| v[0] * r + v[1] * r.conj();
         let mut y = *x;
         if ha > 0.0 {
             let r = |t: f64| C64::from_polar(1.0, w[0] * t);
-            y = self.rk4(&y, ha, [v0, v0 * r(0.5 * ha), v0 * r(ha)], 0.0);
+            let at = |t: f64| turned(v0, r(t));
+            y = self.rk4(&y, ha, [at(0.0), at(0.5 * ha), at(ha)], 0.0);
         }
         if hb > 0.0 {
             let r = |t: f64| C64::from_polar(1.0, -w[1] * t);
-            y = self.rk4(&y, hb, [v1 * r(hb), v1 * r(0.5 * hb), v1], ha);
+            let at = |t: f64| turned(v1, r(t));
+            y = self.rk4(&y, hb, [at(hb), at(0.5 * hb), at(0.0)], ha);
         }
         y
     }
@@ -1286,8 +1292,9 @@ fn simulate_stationary(
         let (v0, v1) = (v_cur + vn0, v_next + vn1);
         x = if dev[k] > step_thr {
             let w = [ph[k - 1] / dt, ph[k + 1] / dt];
-            let early = sm.across_step(&x, dt, 0.0, v0, v1, w);
-            let late = sm.across_step(&x, dt, 1.0, v0, v1, w);
+            let (s0, s1) = ([v_cur, vn0], [v_next, vn1]);
+            let early = sm.across_step(&x, dt, 0.0, s0, s1, w);
+            let late = sm.across_step(&x, dt, 1.0, s0, s1, w);
             // The measured currents before the block mean, as the model's.
             let target = i_meas(k + 1) / gain(k + 1) - (i_meas(k) / gain(k) - sm.terminal(&x));
             let (early_i, late_i) = (sm.terminal(&early), sm.terminal(&late));
@@ -1297,14 +1304,16 @@ fn simulate_stationary(
             } else {
                 0.5
             };
-            sm.across_step(&x, dt, phi.clamp(0.0, 1.0), v0, v1, w)
+            sm.across_step(&x, dt, phi.clamp(0.0, 1.0), s0, s1, w)
         } else {
             let half = C64::from_polar(1.0, 0.5 * ph[k]);
             let vm = (v_cur * half + v_next * half.conj()) * 0.5
                 + (vn0 * half.conj() + vn1 * half) * 0.5;
             sm.rk4(&x, dt, [v0, vm, v1], 0.0)
         };
-        (v_cur, v_next) = (v1, v_after);
+        // The measured (positive-sequence) voltages move on; `y V_neg` is added per sample
+        // above (carrying `v1` over counted it twice at each sample's start).
+        (v_cur, v_next) = (v_next, v_after);
         if !(x.i.re.is_finite() && x.i.im.is_finite() && x.psi.re.is_finite() && x.wm.is_finite()) {
             break;
         }
