@@ -171,6 +171,11 @@ pub struct FitSetup {
     /// Physical range of each parameter (parallel to `names`; a fitted value outside it is
     /// not plausible) and where the range comes from. Defaults to the fit bounds.
     pub plausible: Vec<(PlausibleRange, &'static str)>,
+    /// Other starting values the fit also tries, each a whole `init` (empty: `init` only).
+    /// For a cost with separate valleys: an amplitude and a phase, started half a turn
+    /// off, descend to the amplitude's zero bound, where the phase's gradient vanishes and
+    /// the fit stays. The start that ends at the lowest cost wins ([`super::fit::fit`]).
+    pub alt_init: Vec<Vec<f64>>,
 }
 
 impl FitSetup {

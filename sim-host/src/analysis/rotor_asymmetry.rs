@@ -220,6 +220,10 @@ impl EffectModel for RotorAsymmetry {
             hi: vec![2.0, phi0 + 4.0 * PI],
             scale: vec![0.05, 0.3],
             plausible: vec![(delta_range, DELTA_BASIS), (any_angle, "any angle")],
+            // The I_ds ripple's phase can be half a turn off through starts and steps
+            // (found on the 11 kW machine with its true parameters: the fit ended at
+            // delta = 0 and explained nothing).
+            alt_init: vec![vec![delta0, phi0 + PI]],
             data,
         })
     }
