@@ -187,24 +187,23 @@ pub fn fit(
     }
     let free: Vec<usize> = (0..x.len()).filter(|&i| fit_base || i >= N_BASE).collect();
     let bounds = lm::Bounds { lo, hi, scale };
-    // The effects' other starts (`FitSetup::alt_init`), one effect's at a time: the lowest
-    // final cost wins.
-    let mut starts = vec![x.clone()];
+    // From `x`, then from each effect's other starts (`FitSetup::alt_init`, one effect's
+    // at a time): the lowest final cost wins.
+    let mut best = lm::solve(&prob, x.clone(), &bounds, &free, max_iter);
     let mut o = N_BASE;
     for e in effects {
         let k = e.setup.init.len();
         for alt in e.setup.alt_init.iter().filter(|a| a.len() == k) {
             let mut y = x.clone();
             y[o..o + k].copy_from_slice(alt);
-            starts.push(y);
+            let r = lm::solve(&prob, y, &bounds, &free, max_iter);
+            if r.1.cost < best.1.cost {
+                best = r;
+            }
         }
         o += k;
     }
-    let (x, report) = starts
-        .into_iter()
-        .map(|x0| lm::solve(&prob, x0, &bounds, &free, max_iter))
-        .reduce(|a, b| if b.1.cost < a.1.cost { b } else { a })
-        .unwrap_or_else(|| lm::solve(&prob, x, &bounds, &free, max_iter));
+    let (x, report) = best;
     let base = Problem::base(&x);
     let mut effect_params = Vec::new();
     let mut o = N_BASE;
