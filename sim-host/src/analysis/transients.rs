@@ -74,6 +74,14 @@ fn span(x: impl Iterator<Item = f64>) -> (f64, f64, f64) {
 }
 
 /// The transient window `w` lies in (or that ended within `lookback_s` before it), if any.
+///
+/// A window up to the start's end `start_end` (90 % of the running speed) is the start;
+/// one within `lookback_s` after it (the start's settling tail) too, unless the supply
+/// voltage stepped after the start's end: then that step names it (on a machine with a
+/// long rotor time constant the tail covers the first steps of a V/f run, and a window
+/// just after such a step was called "the start"). Only the voltage's magnitude decides
+/// there: the frame's frequency and the speed still settle from the start. Later windows:
+/// a supply step or a speed change within `lookback_s` before them.
 pub fn classify(
     d: &Prepared,
     n: &MachineConstants,
@@ -81,31 +89,46 @@ pub fn classify(
     start_end: Option<f64>,
     lookback_s: f64,
 ) -> Option<Transient> {
-    if let Some(te) = start_end {
-        if w.t_start_s <= te + lookback_s {
-            return Some(Transient {
+    let within = |from: f64| -> Vec<usize> {
+        (0..d.len())
+            .filter(|&k| d.t_s[k] >= from && d.t_s[k] <= w.t_end_s)
+            .collect()
+    };
+    match start_end {
+        Some(te) if w.t_start_s <= te + lookback_s => {
+            let idx = within((w.t_start_s - lookback_s).max(te));
+            if w.t_start_s > te && voltage_step(d, &idx).is_some() {
+                return classify_events(d, n, &idx);
+            }
+            Some(Transient {
                 kind: "start",
                 description: format!(
                     "the direct-on-line start (the motor reaches 90 % of its running speed at {te:.2} s)"
                 ),
-            });
+            })
         }
+        _ => classify_events(d, n, &within(w.t_start_s - lookback_s)),
     }
-    let idx: Vec<usize> = (0..d.len())
-        .filter(|&k| d.t_s[k] >= w.t_start_s - lookback_s && d.t_s[k] <= w.t_end_s)
-        .collect();
+}
+
+/// The relative change of the supply voltage's magnitude over the samples `idx`, when it
+/// is more than [`STEP_MIN`] (a voltage-less log: none).
+fn voltage_step(d: &Prepared, idx: &[usize]) -> Option<f64> {
+    if d.vq.len() != d.len() || idx.len() < 2 {
+        return None;
+    }
+    let (lo, hi, m) = span(idx.iter().map(|&k| d.vq[k].hypot(d.vd[k])));
+    (m > 0.0 && (hi - lo) / m > STEP_MIN).then_some((hi - lo) / m)
+}
+
+/// A supply step or a speed change among the samples `idx`, if any.
+fn classify_events(d: &Prepared, n: &MachineConstants, idx: &[usize]) -> Option<Transient> {
     if idx.len() < 2 {
         return None;
     }
     let mut steps = Vec::new();
-    if d.vq.len() == d.len() {
-        let (lo, hi, m) = span(idx.iter().map(|&k| d.vq[k].hypot(d.vd[k])));
-        if m > 0.0 && (hi - lo) / m > STEP_MIN {
-            steps.push(format!(
-                "the supply voltage moves by {:.0} %",
-                100.0 * (hi - lo) / m
-            ));
-        }
+    if let Some(r) = voltage_step(d, idx) {
+        steps.push(format!("the supply voltage moves by {:.0} %", 100.0 * r));
     }
     let (lo, hi, m) = span(idx.iter().map(|&k| d.omega_s[k].abs()));
     if m > 0.0 && (hi - lo) / m > STEP_MIN {
