@@ -181,12 +181,9 @@ fn current_only_log_gets_the_unbalance_analysis() {
 
 #[test]
 fn motulator_log_points_at_load_torque() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/logs");
     let log = root.join("motulator_2p2kw_dol.csv");
-    if !log.exists() {
-        eprintln!("skipped: {} not found", log.display());
-        return;
-    }
+    assert!(log.exists(), "{} is part of the repository", log.display());
     let p = sim_host::params::ParamFile::load(&root.join("motulator_2p2kw_dol.toml")).unwrap();
     let a = analyse(&log, &p, 0.8);
     let ex = a.explain(&opts(&[]), &|_| {}).unwrap().report;

@@ -12,7 +12,7 @@
 //! Fields that changed on purpose are listed in [`INTENDED`] with the reason; they are not
 //! compared. Keys added since ([`ADDED`]) and the text lines that report them are skipped;
 //! two documents were regenerated for issue 8 (the golden README says which and why). The
-//! motulator log's cases run when `../shared/data` is there.
+//! motulator log (`examples/logs`) is part of the repository.
 
 use std::path::{Path, PathBuf};
 
@@ -250,12 +250,13 @@ fn fnv1a(bytes: &[u8]) -> u64 {
 fn outputs_match_the_binary_before_the_rework() {
     let dir = tempfile::tempdir().unwrap();
     let t = |name: &str| dir.path().join(name).display().to_string();
-    let data = repo().join("../shared/data");
+    let data = repo().join("examples/logs");
     let (mp, ml) = (
         data.join("motulator_2p2kw_dol.toml").display().to_string(),
         data.join("motulator_2p2kw_dol.csv").display().to_string(),
     );
     let have_motulator = Path::new(&ml).exists();
+    assert!(have_motulator, "{ml} is part of the repository");
     let s = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<String>>();
     let p3 = "examples/params/3hp.toml";
     let p22 = "examples/params/2p2kw.toml";
