@@ -1,0 +1,418 @@
+//! The fault isolator's fits: the parity residuals under a hypothesis, the weight, the
+//! size fit of each fault and the ranking (module docs of [`crate::isolation`]).
+
+use super::*;
+
+impl Isolator {
+    /// An isolator for the nominal `motor` on a supply of peak phase voltage
+    /// `v_phase_peak` [V] and `supply_hz` [Hz]; `None` when the motor fails
+    /// [`MotorModel::validate`] or the supply is not positive and finite.
+    pub fn new(motor: MotorModel, v_phase_peak: f32, supply_hz: f32) -> Option<Self> {
+        motor.validate().ok()?;
+        if !(v_phase_peak > 0.0 && supply_hz > 0.0 && v_phase_peak.is_finite()) {
+            return None;
+        }
+        let i_mag = v_phase_peak / (core::f32::consts::TAU * supply_hz * motor.ls_h);
+        let torque_base_nm = motor.kf_per_if() * i_mag * i_mag;
+        if !(torque_base_nm.is_finite() && torque_base_nm > 0.0) {
+            return None;
+        }
+        Some(Isolator {
+            motor,
+            torque_base_nm,
+            baseline: Baseline::default(),
+            learning: Learning::default(),
+        })
+    }
+
+    /// The torque scale of `e_T`: `3/2 Np Lm^2/Lr i_mag^2` with the magnetising current
+    /// `i_mag = V_peak / (we Ls)` [N m] (the torque at `I_qs = i_ds`, near rated torque for
+    /// common motors).
+    pub fn torque_base_nm(&self) -> f32 {
+        self.torque_base_nm
+    }
+
+    /// The baseline in use.
+    pub fn baseline(&self) -> Baseline {
+        self.baseline
+    }
+
+    /// Puts a baseline into force (for example one stored after commissioning). Spreads
+    /// below [`DEFAULT_SPREAD`]'s fifth are raised to it; non-finite values are ignored
+    /// (returns false and keeps the baseline in force).
+    pub fn set_baseline(&mut self, b: Baseline) -> bool {
+        if !b.mean.iter().chain(b.spread.iter()).all(|x| x.is_finite()) {
+            return false;
+        }
+        let mut b = b;
+        if self.residuals(&b.at, None).is_none() {
+            b.at = SteadyPoint::default();
+        }
+        for (s, d) in b.spread.iter_mut().zip(DEFAULT_SPREAD) {
+            *s = crate::maxf(*s, 0.2 * d);
+        }
+        self.baseline = b;
+        true
+    }
+
+    /// Adds a healthy operating point to the baseline being learned (commissioning).
+    /// Points that give no residuals are skipped.
+    pub fn learn(&mut self, p: &SteadyPoint) {
+        let Some(e) = self.residuals(p, None) else {
+            return;
+        };
+        let l = &mut self.learning;
+        l.n = l.n.saturating_add(1);
+        let n = l.n as f32;
+        l.at.approach(p, 1.0 / n);
+        for ((m, m2), x) in l.mean.iter_mut().zip(l.m2.iter_mut()).zip(e) {
+            let d = x - *m;
+            *m += d / n;
+            *m2 += d * (x - *m);
+        }
+    }
+
+    /// Ends learning: the learned mean and twice the learned standard deviation (at least
+    /// [`LEARNED_SPREAD_FLOOR`]: a short window's scatter understates what a longer run meets) go into force. Returns false, and keeps the baseline in force,
+    /// with fewer than [`MIN_LEARNED_POINTS`] points learned.
+    pub fn finish_learning(&mut self) -> bool {
+        let l = self.learning;
+        self.learning = Learning::default();
+        if l.n < MIN_LEARNED_POINTS {
+            return false;
+        }
+        let n = l.n as f32;
+        let mut spread = [0.0; 3];
+        for ((s, m2), d) in spread.iter_mut().zip(l.m2).zip(LEARNED_SPREAD_FLOOR) {
+            *s = crate::maxf(2.0 * crate::sqrt(m2 / (n - 1.0)), d);
+        }
+        self.set_baseline(Baseline {
+            mean: l.mean,
+            spread,
+            at: l.at,
+        })
+    }
+
+    /// The parity residuals at `p` under hypothesis `h` (`None`: the nominal machine and
+    /// sensors); `None` when the point is not usable (no voltage or current, frequency
+    /// not positive, non-finite values).
+    pub fn residuals(&self, p: &SteadyPoint, h: Option<(Fault, f32)>) -> Option<Residual3> {
+        let (c, q) = self.hypothesis(p, h);
+        self.eval(&c, &q)
+    }
+
+    /// The circuit and the readings corrected for hypothesis `h`.
+    #[inline(never)]
+    fn hypothesis(&self, p: &SteadyPoint, h: Option<(Fault, f32)>) -> (Circuit, SteadyPoint) {
+        let (mut i, mut v, mut wr) = (p.i, p.v, p.wr_rad_s);
+        let mut c = self.circuit();
+        if let Some((f, k)) = h {
+            match f {
+                Fault::CurrentSensor => {
+                    i = Dq {
+                        d: i.d / k,
+                        q: i.q / k,
+                    }
+                }
+                Fault::VoltageSensor => {
+                    v = Dq {
+                        d: v.d / k,
+                        q: v.q / k,
+                    }
+                }
+                Fault::SpeedSensor => wr /= k,
+                _ => c = c.with(f, k, &self.motor),
+            }
+        }
+        let q = SteadyPoint {
+            i,
+            v,
+            we_rad_s: p.we_rad_s,
+            wr_rad_s: wr,
+        };
+        (c, q)
+    }
+
+    /// The weight (inverse covariance) of the residuals at the measured point `q`: the
+    /// inverse of `S = D + sum_j d_j d_j^T`, `D = diag(spread^2)`, with `d_j` how
+    /// much more the residuals move at `q` than at the learned point when circuit
+    /// parameter `j` (Rs, Rr, the leakages, Lm) is [`NAMEPLATE_UNCERTAINTY`] off (module
+    /// docs, "Away from the learned point"). Without a learned point, or where a point is
+    /// not usable: `D^-1`.
+    #[inline(never)]
+    fn weight(&self, q: &SteadyPoint) -> Sym3 {
+        let s = self.baseline.spread;
+        let diag = Sym3::diagonal_weight(&s);
+        let (at, c0) = (self.baseline.at, self.circuit());
+        let (Some(e_here), Some(e_at)) = (self.eval(&c0, q), self.eval(&c0, &at)) else {
+            return diag;
+        };
+        let [a, b, z] = s;
+        let mut cov = Sym3 {
+            xx: a * a,
+            yy: b * b,
+            zz: z * z,
+            ..Sym3::default()
+        };
+        // d_j for a NAMEPLATE_UNCERTAINTY error, and what that error leaves at the learned
+        // point in the voltage residuals (the evidence for how far off the nameplate is).
+        let mut d = [[0.0f32; 3]; 5];
+        let mut expected = 0.0f32;
+        for (j, dj) in d.iter_mut().enumerate() {
+            let (Some(h), Some(t)) = (
+                self.eval(&c0.nameplate_off(j), q),
+                self.eval(&c0.nameplate_off(j), &at),
+            ) else {
+                return diag;
+            };
+            let g = sub3(&t, &e_at);
+            let [gd, gq, _] = g;
+            expected += gd * gd + gq * gq;
+            *dj = sub3(&sub3(&h, &e_here), &g);
+        }
+        let [md, mq, _] = self.baseline.mean;
+        let seen = crate::sqrt((md * md + mq * mq) / expected);
+        let u = if seen.is_finite() {
+            crate::minf(crate::maxf(seen, NAMEPLATE_FLOOR), 1.0)
+        } else {
+            1.0
+        };
+        for dj in d {
+            cov.add_outer(&dj.map(|x| u * x));
+        }
+        cov.inverse().unwrap_or(diag)
+    }
+
+    /// The parity residuals of circuit `c` at the (corrected) readings `q` (see
+    /// [`Isolator::residuals`]).
+    #[inline(never)]
+    fn eval(&self, c: &Circuit, q: &SteadyPoint) -> Option<Residual3> {
+        let (i, v, we, wr) = (q.i, q.v, q.we_rad_s, q.wr_rad_s);
+        let vmag = crate::fast_hypot(v.d, v.q);
+        let imag = crate::fast_hypot(i.d, i.q);
+        if !(we > 0.0 && vmag > 0.0 && imag > 0.0 && wr.is_finite()) {
+            return None;
+        }
+        let ws = we - wr;
+        // 1 / (Rr + j ws Lr) = (Rr - j ws Lr) / den
+        let den = c.rr * c.rr + ws * ws * c.lr * c.lr;
+        let (yr, yi) = (c.rr / den, -ws * c.lr / den);
+        let g = we * ws * c.lm * c.lm;
+        let z_re = c.rs + g * yr;
+        let z_im = we * c.ls + g * yi;
+        let vp_d = z_re * i.d - z_im * i.q;
+        let vp_q = z_re * i.q + z_im * i.d;
+        // Ir = -j ws Lm I / (Rr + j ws Lr): (-j ws Lm) * (yr + j yi) * I
+        let (a_re, a_im) = (ws * c.lm * yi, -ws * c.lm * yr);
+        let ir_d = a_re * i.d - a_im * i.q;
+        let ir_q = a_re * i.q + a_im * i.d;
+        // Te = 3/2 Np Im(conj(Lm Ir) I) = 3/2 Np Lm (ir_d i_q - ir_q i_d)
+        let te = 1.5 * c.np * c.lm * (ir_d * i.q - ir_q * i.d);
+        let tl = c.b_total * wr / c.np;
+        let e = [
+            (v.d - vp_d) / vmag,
+            (v.q - vp_q) / vmag,
+            (te - tl) / self.torque_base_nm,
+        ];
+        e.iter().all(|x| x.is_finite()).then_some(e)
+    }
+
+    /// [`Isolator::isolate`] with the baseline's spreads multiplied by `spread_scale`
+    /// (>= 1; values below 1 or not finite count as 1): a point averaged for a shorter time
+    /// scatters more ([`Follower`]: `sqrt(AVERAGE_MAX_S / averaged)`).
+    pub fn isolate_scaled(&self, p: &SteadyPoint, spread_scale: f32) -> Isolation {
+        let k = if spread_scale.is_finite() {
+            crate::maxf(spread_scale, 1.0)
+        } else {
+            1.0
+        };
+        let mut scaled = *self;
+        for s in scaled.baseline.spread.iter_mut() {
+            *s *= k;
+        }
+        scaled.isolate(p)
+    }
+
+    /// Isolates the fault at the steady operating point `p` (module docs). Never panics;
+    /// an unusable point gives [`IsolationState::NotJudged`].
+    pub fn isolate(&self, p: &SteadyPoint) -> Isolation {
+        let mut out = Isolation::default();
+        let Some(e0) = self.residuals(p, None) else {
+            return out;
+        };
+        let b = self.baseline;
+        for ((r, e), m) in out.residuals.iter_mut().zip(e0).zip(b.mean) {
+            *r = e - m;
+        }
+        let w = self.weight(p);
+        let chi0 = self.chi2_at(p, None, &w);
+        out.deviation = crate::sqrt(chi0);
+        if chi0 < DETECT_CHI2 {
+            out.state = IsolationState::NoDeviation;
+            return out;
+        }
+        let mut fits = [(0.0f32, 1.0f32); FAULT_COUNT];
+        for (fit, f) in fits.iter_mut().zip(Fault::ALL) {
+            *fit = self.fit(p, f, &w);
+        }
+        // B and Bl scale the same load term: one friction class with one misfit (each
+        // keeps the size it needs on its own).
+        let friction = [Fault::B.index(), Fault::Bl.index()];
+        let chi_friction = friction
+            .iter()
+            .filter_map(|k| fits.get(*k))
+            .fold(f32::INFINITY, |a, (c, _)| crate::minf(a, *c));
+        for k in friction {
+            if let Some((c, _)) = fits.get_mut(k) {
+                *c = chi_friction;
+            }
+        }
+        let chi_min = fits
+            .iter()
+            .fold(f32::INFINITY, |a, (c, _)| crate::minf(a, *c));
+        let chi_unknown = crate::maxf(UNKNOWN_CHI2, 0.1 * chi0);
+        let t = crate::maxf(1.0, 0.5 * chi_min);
+        let w = |c: f32| F32Ext::exp(-(c - chi_min) / (2.0 * t));
+        let mut total = w(chi_unknown);
+        for (c, _) in fits {
+            total += w(c);
+        }
+        for ((cand, (c, k)), f) in out.candidates.iter_mut().zip(fits).zip(Fault::ALL) {
+            *cand = Candidate {
+                fault: f,
+                probability: w(c) / total,
+                change: k - 1.0,
+                misfit: crate::sqrt(c),
+                at_limit: k <= K_MIN * 1.001 || k >= K_MAX * 0.999,
+            };
+        }
+        out.unknown_probability = w(chi_unknown) / total;
+        sort_by_probability(&mut out.candidates);
+        out.state =
+            if out.unknown_probability >= out.candidates.first().map_or(0.0, |c| c.probability) {
+                IsolationState::Unknown
+            } else {
+                IsolationState::Isolated
+            };
+        out.separation_deg = self.separation(p, &e0, &out.candidates);
+        out
+    }
+
+    /// The misfit of hypothesis `h` (fault `f` of factor `k`; `None`: the healthy machine)
+    /// against the baseline under the weight `w` ([`Isolator::weight`] at the measured
+    /// point, one for every hypothesis so that their misfits compare); unusable points
+    /// count as infinitely bad.
+    #[inline(never)]
+    fn chi2_at(&self, p: &SteadyPoint, h: Option<(Fault, f32)>, w: &Sym3) -> f32 {
+        let (c, q) = self.hypothesis(p, h);
+        match self.eval(&c, &q) {
+            Some(e) => w.quadratic(&sub3(&e, &self.baseline.mean)),
+            None => f32::INFINITY,
+        }
+    }
+
+    /// Best factor `k` for fault `f`: geometric grid, then golden section around the best
+    /// grid point. Returns `(chi2, k)`. Not inlined: one copy for the nine faults keeps
+    /// the firmware's flash small (it runs in thread mode, where a call costs nothing).
+    #[inline(never)]
+    fn fit(&self, p: &SteadyPoint, f: Fault, w: &Sym3) -> (f32, f32) {
+        let step = F32Ext::powf(K_MAX / K_MIN, 1.0 / (GRID - 1) as f32);
+        let (mut best_k, mut best_c) = (1.0f32, self.chi2_at(p, Some((f, 1.0)), w));
+        let mut k = K_MIN;
+        for _ in 0..GRID {
+            let c = self.chi2_at(p, Some((f, k)), w);
+            if c < best_c {
+                (best_k, best_c) = (k, c);
+            }
+            k *= step;
+        }
+        let (mut lo, mut hi) = (
+            crate::maxf(best_k / step, K_MIN),
+            crate::minf(best_k * step, K_MAX),
+        );
+        const G: f32 = 0.618_034;
+        let mut x1 = hi - G * (hi - lo);
+        let mut x2 = lo + G * (hi - lo);
+        let (mut c1, mut c2) = (
+            self.chi2_at(p, Some((f, x1)), w),
+            self.chi2_at(p, Some((f, x2)), w),
+        );
+        for _ in 0..GOLDEN_STEPS {
+            if c1 < c2 {
+                hi = x2;
+                (x2, c2) = (x1, c1);
+                x1 = hi - G * (hi - lo);
+                c1 = self.chi2_at(p, Some((f, x1)), w);
+            } else {
+                lo = x1;
+                (x1, c1) = (x2, c2);
+                x2 = lo + G * (hi - lo);
+                c2 = self.chi2_at(p, Some((f, x2)), w);
+            }
+        }
+        for (c, x) in [(c1, x1), (c2, x2)] {
+            if c < best_c {
+                (best_k, best_c) = (x, c);
+            }
+        }
+        (best_c, best_k)
+    }
+
+    /// Angle between the top two candidates' weighted directions `e(f, k*) - e(nominal)`
+    /// [deg]; 180 when either direction is empty.
+    fn separation(&self, p: &SteadyPoint, e0: &Residual3, c: &[Candidate; FAULT_COUNT]) -> f32 {
+        let dir = |cand: Option<&Candidate>| -> Option<Residual3> {
+            let cand = cand?;
+            let e = self.residuals(p, Some((cand.fault, 1.0 + cand.change)))?;
+            let mut d = [0.0; 3];
+            for (((o, x), x0), s) in d.iter_mut().zip(e).zip(e0).zip(self.baseline.spread) {
+                *o = (x - x0) / s;
+            }
+            Some(d)
+        };
+        let (Some(a), Some(b)) = (dir(c.first()), dir(c.get(1))) else {
+            return 180.0;
+        };
+        let dot: f32 = a.iter().zip(b).map(|(x, y)| x * y).sum();
+        let na = crate::sqrt(a.iter().map(|x| x * x).sum());
+        let nb = crate::sqrt(b.iter().map(|x| x * x).sum());
+        if !(na > 0.0 && nb > 0.0) {
+            return 180.0;
+        }
+        let cos = crate::minf(crate::maxf(dot / (na * nb), -1.0), 1.0);
+        F32Ext::acos(cos).to_degrees()
+    }
+
+    /// The nominal circuit.
+    fn circuit(&self) -> Circuit {
+        let m = &self.motor;
+        Circuit {
+            rs: m.rs_ohm,
+            rr: m.rr_ohm,
+            ls: m.ls_h,
+            lr: m.lr_h,
+            lm: m.lm_h,
+            np: m.np(),
+            b_total: m.b_nms + m.bl_nms,
+        }
+    }
+}
+
+/// Sorts candidates by probability, most probable first (insertion sort: nine entries,
+/// no allocation, stable so Table 1's order breaks ties).
+fn sort_by_probability(c: &mut [Candidate; FAULT_COUNT]) {
+    for n in 1..c.len() {
+        let mut j = n;
+        while j > 0 {
+            let swap = match (c.get(j - 1), c.get(j)) {
+                (Some(a), Some(b)) => b.probability > a.probability,
+                _ => false,
+            };
+            if !swap {
+                break;
+            }
+            c.swap(j - 1, j);
+            j -= 1;
+        }
+    }
+}
