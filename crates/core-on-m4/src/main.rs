@@ -247,7 +247,7 @@ fn count_instructions(cfg: &MonitorConfig, n: usize, ticks_per_instr: f32) {
         }
     });
 
-    let mut mt = MtSpeed::new(&cfg.encoder, cfg.tick_hz, cfg.limits.max_speed_rad_s);
+    let mut mt = MtSpeed::new(&cfg.encoder, cfg.tick_hz, cfg.limits.max_speed_rad_s, dt);
     let t_speed = measure(|| {
         for k in 0..n {
             let s = scenario::sample(REPLAY, k);

@@ -160,7 +160,8 @@ impl SrfPll {
     }
 
     /// Feeds the voltage vector with the sin/cos of the current PLL angle (from
-    /// [`SrfPll::theta_pll`]); advances the angle.
+    /// [`SrfPll::theta_pll`]); advances the angle and returns the new frequency estimate
+    /// [rad/s].
     pub fn update(&mut self, v: AlphaBeta, sc_pll: SinCos) -> f32 {
         // q component only: V_q = -alpha sin + beta cos.
         let e = (-v.alpha * sc_pll.sin + v.beta * sc_pll.cos) * self.inv_v;
@@ -204,9 +205,9 @@ impl SrfPll {
 /// Rotor-flux angle from the current model (indirect field orientation):
 ///
 /// `T_r d(i_mr)/dt = i_ds - i_mr`,   `omega_slip = i_qs / (T_r i_mr)`,
-/// `d(theta)/dt = omega_r + omega_slip`
+/// `d(theta)/dt = wr + omega_slip`
 ///
-/// with `T_r = L_r/R_r`, `i_mr = psi_r / L_m` the magnetising current, `omega_r` the
+/// with `T_r = L_r/R_r`, `i_mr = psi_r / L_m` the magnetising current, `wr` the
 /// electrical rotor speed (pole pairs x encoder speed) and `i_ds, i_qs` the stator currents
 /// in the estimated frame. In steady state `i_mr = i_ds` and the slip is
 /// `R_r i_qs /(L_r i_ds)`, the paper's eq. (22). The division is guarded: below
@@ -236,15 +237,15 @@ impl RotorFluxCurrentModel {
     }
 
     /// Advances the model with the stator currents in the present estimated frame and the
-    /// electrical rotor speed [rad/s]. Returns the new angle [rad].
-    pub fn update(&mut self, i_dq: Dq, omega_r: f32) -> f32 {
+    /// electrical rotor speed `wr_rad_s` (Np x mechanical) [rad/s]. Returns the new angle [rad].
+    pub fn update(&mut self, i_dq: Dq, wr_rad_s: f32) -> f32 {
         self.imr += self.dt * self.inv_tr * (i_dq.d - self.imr);
         let slip = if self.imr > self.imr_min {
             i_dq.q * self.inv_tr / self.imr
         } else {
             0.0
         };
-        self.omega = omega_r + slip;
+        self.omega = wr_rad_s + slip;
         self.theta = wrap_angle(self.theta + self.omega * self.dt);
         self.theta
     }
@@ -264,7 +265,7 @@ impl RotorFluxCurrentModel {
         self.theta
     }
 
-    /// Frame angular frequency omega_r + omega_slip [rad/s].
+    /// Frame angular frequency wr + omega_slip [rad/s].
     pub fn omega_rad_s(&self) -> f32 {
         self.omega
     }

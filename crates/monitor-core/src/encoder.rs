@@ -76,17 +76,25 @@ pub struct MtSpeed {
     last_edge_ticks: u32,
     speed_rad_s: f32,
     max_speed_rad_s: f32,
+    /// Largest believable counter step per sample period (at `max_speed_rad_s`, plus 2).
+    max_step: u32,
+    /// Timestamp ticks per sample period.
+    ticks_per_sample: u32,
 }
 
 impl MtSpeed {
     /// Builds the estimator; `tick_hz` is the timestamp rate, `max_speed_rad_s` the largest
     /// believable |speed| (a window whose estimate exceeds it is discarded and the previous
-    /// estimate kept: timestamps that stalled while the encoder counted, not motion).
-    /// Invalid settings are caught by [`crate::MonitorConfig::validate`].
-    pub fn new(cfg: &EncoderConfig, tick_hz: f32, max_speed_rad_s: f32) -> Self {
+    /// estimate kept: timestamps that stalled while the encoder counted, not motion), `dt_s`
+    /// the sample period (for [`MtSpeed::update_checked`]'s largest step per sample).
+    /// Invalid settings are caught by [`crate::MonitorConfig::validate`] (which also checks
+    /// that the largest step fits in half the counter's range).
+    pub fn new(cfg: &EncoderConfig, tick_hz: f32, max_speed_rad_s: f32, dt_s: f32) -> Self {
         let cpr = cfg.counts_per_rev.max(1) as f32;
         MtSpeed {
             max_speed_rad_s,
+            max_step: (max_speed_rad_s / TAU * cfg.counts_per_rev as f32 * dt_s) as u32 + 2,
+            ticks_per_sample: (tick_hz * dt_s + 0.5) as u32,
             rad_per_count: TAU / cpr,
             s_per_tick: 1.0 / tick_hz,
             bits: cfg.counter_bits,
@@ -145,21 +153,15 @@ impl MtSpeed {
         self.speed_rad_s
     }
 
-    /// Like [`MtSpeed::update`], but a step of more than `max_step` counts per sample
-    /// period `ticks_per_sample` is not taken as motion: the estimator restarts from this
-    /// reading and `None` is returned (the caller flags the speed sensor). Samples missing
-    /// from the stream (a gap since the last counter change) allow a proportionally larger
-    /// step. One counter difference per call.
-    pub fn update_checked(
-        &mut self,
-        count: u32,
-        ticks: u32,
-        max_step: u32,
-        ticks_per_sample: u32,
-    ) -> Option<f32> {
+    /// Like [`MtSpeed::update`], but a step of more counts per sample period than the
+    /// largest believable speed allows (see [`MtSpeed::new`]) is not taken as motion: the
+    /// estimator restarts from this reading and `None` is returned (the caller flags the
+    /// speed sensor). Samples missing from the stream (a gap since the last counter change)
+    /// allow a proportionally larger step. One counter difference per call.
+    pub fn update_checked(&mut self, count: u32, ticks: u32) -> Option<f32> {
         if self.started {
             let step = counter_delta(count, self.last_count, self.bits).unsigned_abs();
-            if step > max_step && !self.step_fits_gap(step, ticks, max_step, ticks_per_sample) {
+            if step > self.max_step && !self.step_fits_gap(step, ticks) {
                 self.started = false;
                 self.acc = 0;
                 self.update(count, ticks);
@@ -172,12 +174,12 @@ impl MtSpeed {
     /// Whether a large counter step is motion over a gap in the samples: the time since the
     /// last counter change holds enough sample periods for it.
     #[cold]
-    fn step_fits_gap(&self, step: u32, ticks: u32, max_step: u32, ticks_per_sample: u32) -> bool {
-        let periods = ticks.wrapping_sub(self.last_edge_ticks) / ticks_per_sample.max(1);
+    fn step_fits_gap(&self, step: u32, ticks: u32) -> bool {
+        let periods = ticks.wrapping_sub(self.last_edge_ticks) / self.ticks_per_sample.max(1);
         // A stalled or backward clock gives 0 or a wrapped, absurd count of periods.
         periods > 1
             && periods < (1 << 24)
-            && u64::from(step) <= u64::from(max_step) * u64::from(periods)
+            && u64::from(step) <= u64::from(self.max_step) * u64::from(periods)
     }
 
     /// Last speed estimate, mechanical [rad/s].
@@ -198,7 +200,7 @@ mod tests {
         };
         let fs = 10_000.0f32;
         let tick_hz = 1_000_000.0;
-        let mut mt = MtSpeed::new(&cfg, tick_hz, 1.0e4);
+        let mut mt = MtSpeed::new(&cfg, tick_hz, 1.0e4, 1.0 / fs);
         let n = (seconds * fs) as u32;
         let mut out = 0.0;
         for k in 0..n {
@@ -241,7 +243,7 @@ mod tests {
     #[test]
     fn direction_change_and_stop() {
         let cfg = EncoderConfig::default();
-        let mut mt = MtSpeed::new(&cfg, 10_000.0, 1.0e4);
+        let mut mt = MtSpeed::new(&cfg, 10_000.0, 1.0e4, 1e-4);
         // 10 counts per sample (153 rad/s) for 0.2 s, then backwards for 0.2 s, then stop.
         let mut c: i64 = 0;
         let mut t: u32 = 0;

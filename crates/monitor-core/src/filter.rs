@@ -39,6 +39,11 @@ impl LowPass {
         self.y += self.a * (x - self.y);
         self.y
     }
+
+    /// Forgets the state (output back to zero), keeping the cutoff.
+    pub fn reset(&mut self) {
+        self.y = 0.0;
+    }
 }
 
 /// Critically damped second-order state-variable filter with derivative outputs.
@@ -76,11 +81,13 @@ impl Svf {
         self.dy = 0.0;
     }
 
-    /// Feeds one sample.
+    /// Feeds one sample and returns the new filtered value y (the derivative is in
+    /// [`Svf::dy`], the second derivative from [`Svf::ddy`]).
     #[inline]
-    pub fn update(&mut self, x: f32) {
+    pub fn update(&mut self, x: f32) -> f32 {
         self.dy += self.wc2_dt * (x - self.y) - self.two_wc_dt * self.dy;
         self.y += self.dt * self.dy;
+        self.y
     }
 
     /// Filtered second derivative y'' for the last input `x` [unit/s^2].

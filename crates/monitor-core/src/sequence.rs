@@ -68,15 +68,17 @@ impl SequenceAnalyzer {
         }
     }
 
-    /// Feeds the current vector and the sin/cos of an angle turning at the supply frequency.
+    /// Feeds the current vector and the sin/cos of an angle turning at the supply frequency;
+    /// returns the new filtered sequences ([`Self::positive`], [`Self::negative`]).
     #[inline]
-    pub fn update(&mut self, i: AlphaBeta, sc: SinCos) {
+    pub fn update(&mut self, i: AlphaBeta, sc: SinCos) -> ((f32, f32), (f32, f32)) {
         let p = park(i, sc);
         let n = park(i, sc.negated());
         self.pd.update(p.d);
         self.pq.update(p.q);
         self.nd.update(n.d);
         self.nq.update(n.q);
+        (self.positive(), self.negative())
     }
 
     /// The filtered Park components `P = I1 e^{-j theta0}` (frame at +theta) as `(re, im)`.

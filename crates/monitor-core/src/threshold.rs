@@ -129,6 +129,7 @@ impl Welford {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Lamps {
     cfg: ThresholdConfig,
+    dt_s: f32,
     cal: Option<Calibration>,
     out_s: [f32; 4],
     in_s: [f32; 4],
@@ -136,10 +137,12 @@ pub struct Lamps {
 }
 
 impl Lamps {
-    /// New, all lamps off, fixed thresholds until [`Lamps::set_calibration`].
-    pub fn new(cfg: ThresholdConfig) -> Self {
+    /// New, all lamps off, fixed thresholds until [`Lamps::set_calibration`]; fed every
+    /// `dt_s` seconds (> 0: the monitor's block period, `decimation / sample_rate_hz`).
+    pub fn new(cfg: ThresholdConfig, dt_s: f32) -> Self {
         Lamps {
             cfg,
+            dt_s,
             cal: None,
             out_s: [0.0; 4],
             in_s: [0.0; 4],
@@ -178,8 +181,10 @@ impl Lamps {
         }
     }
 
-    /// Feeds the normalised residuals, `dt_s` after the previous call; returns lamp states.
-    pub fn update(&mut self, r: [f32; 4], dt_s: f32) -> [bool; 4] {
+    /// Feeds the normalised residuals, `dt_s` (given at construction) after the previous
+    /// call; returns lamp states.
+    pub fn update(&mut self, r: [f32; 4]) -> [bool; 4] {
+        let dt_s = self.dt_s;
         for k in 0..4 {
             let (c, w) = self.band(k);
             let dev = (r.get(k).copied().unwrap_or(0.0) - c).abs();
@@ -222,28 +227,27 @@ mod tests {
     #[test]
     fn debounce_and_hysteresis() {
         let cfg = ThresholdConfig::default();
-        let mut l = Lamps::new(cfg);
+        let mut l = Lamps::new(cfg, 0.01); // fed every 10 ms
         l.set_calibration(Some(Calibration {
             mean: [0.0; 4],
             spread: [0.001; 4],
         }));
         // Band is max(6*0.001, 0.002) = 0.006.
-        let dt = 0.01;
         for _ in 0..20 {
-            l.update([0.012, 0.0, 0.0, 0.0], dt);
+            l.update([0.012, 0.0, 0.0, 0.0]);
         }
         assert!(!l.lit()[0], "lit before the 0.3 s debounce");
         for _ in 0..15 {
-            l.update([0.012, 0.0, 0.0, 0.0], dt);
+            l.update([0.012, 0.0, 0.0, 0.0]);
         }
         assert!(l.lit()[0]);
         // Inside the band but above the inner band: stays lit indefinitely.
         for _ in 0..500 {
-            l.update([0.005, 0.0, 0.0, 0.0], dt);
+            l.update([0.005, 0.0, 0.0, 0.0]);
         }
         assert!(l.lit()[0]);
         for _ in 0..101 {
-            l.update([0.0, 0.0, 0.0, 0.0], dt);
+            l.update([0.0, 0.0, 0.0, 0.0]);
         }
         assert!(!l.lit()[0]);
     }

@@ -110,8 +110,6 @@ pub struct Monitor {
     gate_closed_for: u32,
     gate_timeout_blocks: u32,
     gate_floor: [f32; 3],
-    max_step: u32,
-    ticks_per_sample: u32,
     /// Timestamp of the last sample of the previous block, once there was one.
     block_end_ticks: Option<u32>,
     /// Block lengths in ticks accepted as on time: `lo..=lo + span`.
@@ -170,7 +168,7 @@ impl Monitor {
             zc,
             pll,
             rfo,
-            mt: MtSpeed::new(&cfg.encoder, cfg.tick_hz, cfg.limits.max_speed_rad_s),
+            mt: MtSpeed::new(&cfg.encoder, cfg.tick_hz, cfg.limits.max_speed_rad_s, dt),
             sc: SinCos::default(),
             dt,
             v_max_bits: cfg.limits.v_max.to_bits(),
@@ -195,7 +193,10 @@ impl Monitor {
             vsum: LowPass::new(sum_lp, slow_dt),
             vmax: LowPass::new(sum_lp, slow_dt),
             norm: Normaliser::new(m, reference, cfg.floor_fraction),
-            lamps: Lamps::new(cfg.thresholds),
+            lamps: Lamps::new(
+                cfg.thresholds,
+                f32::from(cfg.decimation) / cfg.sample_rate_hz,
+            ),
             learner: Learner::default(),
             settle_left: (cfg.settle_s * slow_hz) as u32,
             settle_blocks: (cfg.settle_s * slow_hz) as u32,
@@ -213,11 +214,6 @@ impl Monitor {
                 0.1 * cfg.v_phase_peak,
                 0.1 * TAU * cfg.supply_hz,
             ],
-            // Largest believable counter step per sample (validated to fit the counter).
-            max_step: (cfg.limits.max_speed_rad_s / TAU * cfg.encoder.counts_per_rev as f32 * dt)
-                as u32
-                + 2,
-            ticks_per_sample: (cfg.tick_hz * dt + 0.5) as u32,
             block_end_ticks: None,
             block_ticks_lo: (cfg.tick_hz * dt * (dec - 0.5)) as u32,
             block_ticks_span: (cfg.tick_hz * dt) as u32,
@@ -271,12 +267,7 @@ impl Monitor {
         self.block_vmax = self.block_vmax.max(vb);
         self.block_imax = self.block_imax.max(ib);
 
-        let speed = self.mt.update_checked(
-            s.encoder_count,
-            s.timestamp_ticks,
-            self.max_step,
-            self.ticks_per_sample,
-        );
+        let speed = self.mt.update_checked(s.encoder_count, s.timestamp_ticks);
         let wm = match speed {
             Some(w) => w,
             None => {
@@ -678,8 +669,7 @@ impl Monitor {
             self.refresh_commissioning_state();
             self.out.lamps = [false; 4];
         } else if running && self.out.quasi_steady {
-            let slow_dt = f32::from(self.cfg.decimation) / self.cfg.sample_rate_hz;
-            self.out.lamps = self.lamps.update(rn, slow_dt);
+            self.out.lamps = self.lamps.update(rn);
         }
         self.out.evaluating = running && self.out.quasi_steady && !self.learner.is_active();
     }

@@ -48,13 +48,13 @@ impl ZeroSequence {
         ZeroSequence { d: f, q: f }
     }
 
-    /// Feeds the three phase values and the sin/cos of the analysis angle.
+    /// Feeds the three phase values and the sin/cos of the analysis angle; returns the new
+    /// phasor ([`Self::phasor`]).
     #[inline]
-    pub fn update(&mut self, x: Abc, sc: SinCos) {
+    pub fn update(&mut self, x: Abc, sc: SinCos) -> (f32, f32) {
         // x0 e^{-j theta}, times 2: a phase signal Re(X e^{j theta}) demodulates to X/2.
         let x0 = (x.a + x.b + x.c) * (2.0 / 3.0);
-        self.d.update(x0 * sc.cos);
-        self.q.update(-x0 * sc.sin);
+        (self.d.update(x0 * sc.cos), self.q.update(-x0 * sc.sin))
     }
 
     /// `I0 e^{-j theta0}` as `(re, im)` (module docs).
