@@ -262,7 +262,7 @@ fn count_instructions(cfg: &MonitorConfig, n: usize, ticks_per_instr: f32) {
                 iqs: s.i_abc.a,
                 i_f: 3.0 + s.i_abc.b,
                 vqs: s.v_abc.a,
-                wr: 300.0 + s.i_abc.c,
+                wr_rad_s: 300.0 + s.i_abc.c,
             };
             black_box(residuals(m, op, None));
         }

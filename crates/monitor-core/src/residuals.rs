@@ -41,7 +41,7 @@ pub struct Operating {
     /// Voltage Vqs [V].
     pub vqs: f32,
     /// Electrical rotor speed wr = Np x mechanical speed [rad/s].
-    pub wr: f32,
+    pub wr_rad_s: f32,
 }
 
 /// First and second time derivatives for the full residuals (eq. 36).
@@ -76,10 +76,10 @@ pub fn residuals(m: &MotorModel, op: Operating, d: Option<Derivatives>) -> Resid
     let psi = m.ls_h * op.i_f;
     let kfnp = m.kf_per_if() * op.i_f * np;
     let k1 = psi * kfnp + ra * bb;
-    let a1 = [ra * op.iqs, psi * op.wr, op.vqs];
-    let a2 = [kfnp * op.iqs, bb * op.wr];
+    let a1 = [ra * op.iqs, psi * op.wr_rad_s, op.vqs];
+    let a2 = [kfnp * op.iqs, bb * op.wr_rad_s];
     let a3 = [k1 * op.iqs, bb * op.vqs];
-    let a4 = [k1 * op.wr, kfnp * op.vqs];
+    let a4 = [k1 * op.wr_rad_s, kfnp * op.vqs];
     let mut r = [
         a1[0] + a1[1] - a1[2],
         -a2[0] + a2[1],
@@ -190,7 +190,7 @@ mod tests {
             iqs: i_dq.1 as f32,
             i_f: i_dq.0 as f32,
             vqs: v_dq.1 as f32,
-            wr: (we * (1.0 - s)) as f32,
+            wr_rad_s: (we * (1.0 - s)) as f32,
         }
     }
 
@@ -219,7 +219,7 @@ mod tests {
         let op = steady_point(&base, 179.6, 377.0, 0.03);
         let te_np = base.kf_per_if() * op.i_f * base.np() * op.iqs;
         let m = MotorModel {
-            bl_nms: te_np / op.wr - base.b_nms,
+            bl_nms: te_np / op.wr_rad_s - base.b_nms,
             ..base
         };
         let r = residuals(&m, op, None);
@@ -269,7 +269,7 @@ mod tests {
                 iqs: iq,
                 i_f,
                 vqs: vq,
-                wr,
+                wr_rad_s: wr,
             };
             let d = Derivatives {
                 diqs: diq,

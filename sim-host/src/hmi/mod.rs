@@ -175,7 +175,7 @@ impl Snapshot {
         let asymmetry = out.unbalance.suspect_phase.map(|phase| {
             let ratio = out.unbalance.negative_sequence_ratio;
             let winding_change = (we > 1.0).then(|| {
-                let slip = 1.0 - out.operating.wr / we;
+                let slip = 1.0 - out.operating.wr_rad_s / we;
                 winding_change_fraction(&params.motor.model(), we, slip, ratio)
             });
             Asymmetry {

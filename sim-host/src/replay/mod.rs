@@ -599,7 +599,7 @@ impl Replay {
             i: monitor_core::Dq { d: i.0, q: i.1 },
             v: monitor_core::Dq { d: v.0, q: v.1 },
             we_rad_s: self.pll.omega_rad_s(),
-            wr_rad_s: out.operating.wr,
+            wr_rad_s: out.operating.wr_rad_s,
         }
     }
 
@@ -679,7 +679,7 @@ impl Replay {
             .v2_over_i1
             .map(|v| minus(v, base.and_then(|b| b.v2_over_i1)));
         let slip = if self.monitor.is_some() {
-            1.0 - out.operating.wr / we
+            1.0 - out.operating.wr_rad_s / we
         } else {
             let v_pk = if self.channels.voltages {
                 self.seq_v.positive_magnitude()

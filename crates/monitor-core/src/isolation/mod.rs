@@ -176,7 +176,7 @@ impl SteadyPoint {
                 q: o.operating.vqs,
             },
             we_rad_s: o.frame_omega_rad_s,
-            wr_rad_s: o.operating.wr,
+            wr_rad_s: o.operating.wr_rad_s,
         }
     }
 

@@ -152,7 +152,7 @@ impl Monitor {
             iqs: 0.0,
             i_f: cfg.v_phase_peak / (TAU * cfg.supply_hz * m.ls_h),
             vqs: cfg.v_phase_peak,
-            wr: TAU * cfg.supply_hz,
+            wr_rad_s: TAU * cfg.supply_hz,
         };
         let sum_lp = 5.0f32.min(0.2 * slow_hz);
         let zc = ZeroCrossing::new(
@@ -426,7 +426,7 @@ impl Monitor {
             iqs: self.f_iqs.y,
             i_f: self.f_ids.y,
             vqs: self.f_vqs.y,
-            wr: self.f_wr.y,
+            wr_rad_s: self.f_wr.y,
         };
         self.out.operating = op;
         let d = match self.cfg.residual_form {
@@ -458,7 +458,7 @@ impl Monitor {
         // Negative sequence: ten times a second is plenty for a 2 Hz filter.
         if self.report_countdown == 0 {
             self.report_countdown = self.report_every;
-            self.update_negative_sequence(op.wr);
+            self.update_negative_sequence(op.wr_rad_s);
         }
         self.report_countdown -= 1;
         self.out.fault_detected = self.out.sensor_fault.any() || self.out.lamps.iter().any(|x| *x);
