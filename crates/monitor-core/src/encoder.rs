@@ -112,13 +112,26 @@ impl MtSpeed {
     /// Feeds one sample: raw counter and timestamp. Returns the mechanical speed [rad/s].
     pub fn update(&mut self, count: u32, ticks: u32) -> f32 {
         if !self.started {
-            self.started = true;
-            self.last_count = count;
-            self.win_start_ticks = ticks;
-            self.last_edge_ticks = ticks;
+            self.start(count, ticks);
             return 0.0;
         }
-        let d = counter_delta(count, self.last_count, self.bits);
+        self.advance(
+            counter_delta(count, self.last_count, self.bits),
+            count,
+            ticks,
+        )
+    }
+
+    /// The first reading (or the first after a restart): the window starts here.
+    fn start(&mut self, count: u32, ticks: u32) {
+        self.started = true;
+        self.last_count = count;
+        self.win_start_ticks = ticks;
+        self.last_edge_ticks = ticks;
+    }
+
+    /// A reading `d` counts after the last one: the window's count and time, the speed.
+    fn advance(&mut self, d: i32, count: u32, ticks: u32) -> f32 {
         self.last_count = count;
         if d != 0 {
             self.acc = self.acc.saturating_add(d);
@@ -159,16 +172,18 @@ impl MtSpeed {
     /// speed sensor). Samples missing from the stream (a gap since the last counter change)
     /// allow a proportionally larger step. One counter difference per call.
     pub fn update_checked(&mut self, count: u32, ticks: u32) -> Option<f32> {
-        if self.started {
-            let step = counter_delta(count, self.last_count, self.bits).unsigned_abs();
-            if step > self.max_step && !self.step_fits_gap(step, ticks) {
-                self.started = false;
-                self.acc = 0;
-                self.update(count, ticks);
-                return None;
-            }
+        if !self.started {
+            self.start(count, ticks);
+            return Some(0.0);
         }
-        Some(self.update(count, ticks))
+        let d = counter_delta(count, self.last_count, self.bits);
+        let step = d.unsigned_abs();
+        if step > self.max_step && !self.step_fits_gap(step, ticks) {
+            self.acc = 0;
+            self.start(count, ticks);
+            return None;
+        }
+        Some(self.advance(d, count, ticks))
     }
 
     /// Whether a large counter step is motion over a gap in the samples: the time since the

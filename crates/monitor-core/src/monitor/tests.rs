@@ -1,6 +1,7 @@
 //! Tests of the per-sample monitor.
 
 use super::*;
+use crate::Fault;
 use proptest::prelude::*;
 
 use crate::testing::motor_3hp as motor;
