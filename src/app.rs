@@ -52,9 +52,12 @@ pub fn default_motor() -> MotorModel {
     DEFAULT_MACHINE.motor.model()
 }
 
-/// The fault isolator for [`DEFAULT_MACHINE`] on its rated supply (`None` if the core
-/// rejects the machine: then nothing is isolated and the blink code says "not named").
-pub fn board_isolator() -> Option<Isolator> {
+/// The fault isolator for [`DEFAULT_MACHINE`] on its rated supply.
+///
+/// # Errors
+/// The core's [`ConfigError`] if it rejects the machine or the supply (then nothing is
+/// isolated and the blink code says "not named").
+pub fn board_isolator() -> Result<Isolator, ConfigError> {
     let supply = DEFAULT_MACHINE.supply;
     Isolator::new(
         default_motor(),
@@ -487,7 +490,7 @@ impl Supervisor {
                 .failed()
                 .then(|| now_ms.wrapping_add(FAILED_BOOT_SHOW_MS)),
             last_press_ms: None,
-            isolation: board_isolator().map(Follower::new),
+            isolation: board_isolator().ok().map(Follower::new),
             run_baseline: None,
             sample_rate_hz: settings.sample_rate_hz,
             running: false,

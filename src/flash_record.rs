@@ -37,7 +37,7 @@
 //!
 //! Erased flash reads as all `0xFF`; that is reported as [`RecordError::Erased`].
 
-use monitor_core::isolation::{Baseline, SteadyPoint};
+use monitor_core::isolation::{Baseline, ParityResiduals, SteadyPoint};
 
 /// Magic bytes at the start of a record.
 pub const RECORD_MAGIC: [u8; 4] = *b"DMCR";
@@ -146,8 +146,11 @@ fn values_ok(rec: &CalibrationRecord) -> bool {
     rec.mean.iter().all(|m| m.is_finite())
         && rec.spread.iter().all(|s| s.is_finite() && *s >= 0.0)
         && rec.isolation.is_none_or(|b| {
-            b.mean.iter().all(|m| m.is_finite())
-                && b.spread.iter().all(|s| s.is_finite() && *s > 0.0)
+            b.mean.is_finite()
+                && b.spread
+                    .to_array()
+                    .iter()
+                    .all(|s| s.is_finite() && *s > 0.0)
                 && point_fields(&b.at).iter().all(|x| x.is_finite())
         })
 }
@@ -193,11 +196,11 @@ impl CalibrationRecord {
             w.put(&v.to_le_bytes());
         }
         let iso = self.isolation.unwrap_or(Baseline {
-            mean: [0.0; 3],
-            spread: [0.0; 3],
+            mean: ParityResiduals::default(),
+            spread: ParityResiduals::default(),
             at: SteadyPoint::default(),
         });
-        for v in iso.mean.iter().chain(iso.spread.iter()) {
+        for v in iso.mean.to_array().iter().chain(&iso.spread.to_array()) {
             w.put(&v.to_le_bytes());
         }
         for v in point_fields(&iso.at) {
@@ -265,13 +268,10 @@ impl CalibrationRecord {
         }
         if version >= 2 {
             let mut b = Baseline {
-                mean: [0.0; 3],
-                spread: [0.0; 3],
+                mean: r.residuals(),
+                spread: r.residuals(),
                 at: SteadyPoint::default(),
             };
-            for v in b.mean.iter_mut().chain(b.spread.iter_mut()) {
-                *v = f32::from_le_bytes(r.take::<4>());
-            }
             if version >= 3 {
                 let mut f = [0.0f32; 6];
                 for v in f.iter_mut() {
@@ -410,6 +410,12 @@ impl Reader<'_> {
         self.pos += N;
         out
     }
+
+    /// The next three values `[e_d, e_q, e_T]`.
+    fn residuals(&mut self) -> ParityResiduals {
+        let mut f = || f32::from_le_bytes(self.take::<4>());
+        ParityResiduals::from_array([f(), f(), f()])
+    }
 }
 
 #[cfg(test)]
@@ -421,8 +427,8 @@ mod tests {
             mean: [0.01, -0.02, 0.003, 0.0],
             spread: [0.05, 0.04, 0.06, 0.07],
             isolation: Some(Baseline {
-                mean: [1e-4, -2e-4, 3e-3],
-                spread: [4e-4, 4e-4, 1e-3],
+                mean: ParityResiduals::from_array([1e-4, -2e-4, 3e-3]),
+                spread: ParityResiduals::from_array([4e-4, 4e-4, 1e-3]),
                 at: SteadyPoint {
                     i: monitor_core::Dq { d: 3.5, q: 4.25 },
                     v: monitor_core::Dq { d: -2.0, q: 325.0 },
@@ -496,8 +502,8 @@ mod tests {
     fn a_zero_isolation_spread_is_rejected() {
         let mut r = sample();
         r.isolation = Some(Baseline {
-            mean: [0.0; 3],
-            spread: [0.0, 1e-3, 1e-3],
+            mean: ParityResiduals::default(),
+            spread: ParityResiduals::from_array([0.0, 1e-3, 1e-3]),
             at: SteadyPoint::default(),
         });
         assert_eq!(r.encode(), Err(RecordError::InvalidValue));

@@ -6,7 +6,7 @@ use drive_monitor::app::{Command, SamplePath};
 use drive_monitor::flash_record::{
     crc32, CalibrationRecord, RecordError, RECORD_LEN, RECORD_VERSION,
 };
-use monitor_core::isolation::Baseline;
+use monitor_core::isolation::{Baseline, ParityResiduals};
 
 /// A record with the isolation baseline (every byte of the layout in use).
 fn record() -> CalibrationRecord {
@@ -14,8 +14,8 @@ fn record() -> CalibrationRecord {
         mean: [0.01, -0.02, 0.003, 0.0],
         spread: [0.05, 0.04, 0.06, 0.07],
         isolation: Some(Baseline {
-            mean: [1e-4, -2e-4, 3e-3],
-            spread: [4e-4, 4e-4, 1e-3],
+            mean: ParityResiduals::from_array([1e-4, -2e-4, 3e-3]),
+            spread: ParityResiduals::from_array([4e-4, 4e-4, 1e-3]),
             at: monitor_core::isolation::SteadyPoint {
                 i: monitor_core::Dq { d: 3.5, q: 4.25 },
                 v: monitor_core::Dq { d: -2.0, q: 325.0 },

@@ -570,8 +570,9 @@ fn the_isolation_baseline_survives_a_reset() {
     assert_eq!(Some(b), learned, "the record holds the baseline in force");
     for (s, floor) in b
         .spread
+        .to_array()
         .iter()
-        .zip(monitor_core::isolation::LEARNED_SPREAD_FLOOR)
+        .zip(monitor_core::isolation::LEARNED_SPREAD_FLOOR.to_array())
     {
         assert!(*s >= floor && *s < 10.0 * floor, "{b:?}");
     }

@@ -26,6 +26,8 @@ pub enum ConfigErrorKind {
     Threshold,
     /// A stored calibration holds non-finite or out-of-range values.
     Calibration,
+    /// An isolation baseline ([`crate::isolation::Baseline`]) holds non-finite values.
+    Baseline,
 }
 
 /// Every check of the configuration: a field and what it must satisfy.
@@ -82,6 +84,10 @@ pub enum ConfigCheck {
     ThresholdRelease,
     ThresholdHysteresis,
     Calibration,
+    IsolationSupplyHz,
+    IsolationTorqueBase,
+    BaselineMean,
+    BaselineSpread,
 }
 
 impl ConfigCheck {
@@ -132,6 +138,10 @@ impl ConfigCheck {
             ThresholdRelease => "thresholds.release_s",
             ThresholdHysteresis => "thresholds.hysteresis",
             Calibration => "calibration",
+            IsolationSupplyHz => "supply_hz",
+            IsolationTorqueBase => "v_phase_peak",
+            BaselineMean => "baseline.mean",
+            BaselineSpread => "baseline.spread",
         }
     }
 
@@ -141,7 +151,9 @@ impl ConfigCheck {
         match self {
             MotorRs | MotorRr | MotorLs | MotorLr | MotorLm | MotorJ | PhasePeakVoltage
             | PllBandwidth | EncoderMinWindow | VoltageLimit | CurrentLimit | SpeedLimit
-            | CurrentSumFraction | FloorFraction | ThresholdKSigma => "be positive and finite",
+            | CurrentSumFraction | FloorFraction | ThresholdKSigma | IsolationSupplyHz => {
+                "be positive and finite"
+            }
             MotorB | MotorBl | VoltageSumFraction | SettleTime | UnbalanceMinRatio
             | SteadyGate | GateHold | MaxBridgedGap | ThresholdDebounce | ThresholdRelease => {
                 "be >= 0"
@@ -173,6 +185,10 @@ impl ConfigCheck {
             GateTimeout => "be finite and longer than gate_hold_s",
             ThresholdFixed | ThresholdMinBand | ThresholdHysteresis => "be in (0, 1]",
             Calibration => "hold finite means in [-1, 1] and spreads in [0, 2]",
+            IsolationTorqueBase => {
+                "give a positive, finite torque base 3/2 Np Lm^2/Lr i_mag^2, i_mag = v_phase_peak / (2 pi supply_hz Ls)"
+            }
+            BaselineMean | BaselineSpread => "be finite",
         }
     }
 
@@ -183,7 +199,8 @@ impl ConfigCheck {
         match self {
             MotorRs | MotorRr | MotorLs | MotorLr | MotorLm | MotorJ | MotorB | MotorBl
             | MotorPoles | MotorLsBelowLm | MotorLrBelowLm | MotorNoLeakage => K::MotorParameter,
-            SupplyVoltage | SupplyFrequency | SupplyHz | PhasePeakVoltage => K::Supply,
+            SupplyVoltage | SupplyFrequency | SupplyHz | PhasePeakVoltage | IsolationSupplyHz
+            | IsolationTorqueBase => K::Supply,
             SampleRate | TickRate | SampleRateVsSupply => K::SampleRate,
             Decimation | BlocksPerPeriod => K::Decimation,
             FilterCorner | SequenceCorner | PllBandwidth => K::Filter,
@@ -195,6 +212,7 @@ impl ConfigCheck {
             ThresholdFixed | ThresholdMinBand | ThresholdKSigma | ThresholdDebounce
             | ThresholdRelease | ThresholdHysteresis => K::Threshold,
             Calibration => K::Calibration,
+            BaselineMean | BaselineSpread => K::Baseline,
         }
     }
 }

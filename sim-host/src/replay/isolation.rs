@@ -168,11 +168,12 @@ impl IsolationTracker {
             deviation_sigma: iso.deviation,
             unknown_probability: iso.unknown_probability,
             separation_deg: iso.separation_deg,
-            residuals: iso.residuals,
+            residuals: iso.residuals.to_array(),
             spread: self
                 .follower
                 .as_ref()
-                .map_or(DEFAULT_SPREAD, |f| f.isolator().baseline().spread),
+                .map_or(DEFAULT_SPREAD, |f| f.isolator().baseline().spread)
+                .to_array(),
             baseline: if learned {
                 "learned in commissioning"
             } else {
@@ -332,7 +333,7 @@ impl IsolationReport {
             unknown_probability: 0.0,
             separation_deg: 0.0,
             residuals: [0.0; 3],
-            spread: DEFAULT_SPREAD,
+            spread: DEFAULT_SPREAD.to_array(),
             judged_at_s: 0.0,
             moved_from_learned: None,
             baseline: if learned {

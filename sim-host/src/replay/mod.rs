@@ -414,11 +414,14 @@ impl Replay {
             max_abs: [0.0; 4],
             last: MonitorOutput::default(),
             t0: None,
-            isolation: IsolationTracker::new(Isolator::new(
-                params.motor.model(),
-                params.supply.v_phase_peak() as f32,
-                params.supply.f_hz as f32,
-            )),
+            isolation: IsolationTracker::new(
+                Isolator::new(
+                    params.motor.model(),
+                    params.supply.v_phase_peak() as f32,
+                    params.supply.f_hz as f32,
+                )
+                .ok(),
+            ),
             // Locks to the voltage vector where logged (normalised by its nominal peak), else
             // to the current vector (normalised by the no-load, magnetising, current peak).
             pll: SrfPll::new(

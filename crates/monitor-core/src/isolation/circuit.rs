@@ -14,7 +14,7 @@ pub(super) struct Circuit {
     pub(super) b_total: f32,
 }
 
-/// A symmetric 3 x 3 matrix (covariance or weight of [`Residual3`]).
+/// A symmetric 3 x 3 matrix (covariance or weight of [`ParityResiduals`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub(super) struct Sym3 {
     pub(super) xx: f32,
@@ -27,8 +27,8 @@ pub(super) struct Sym3 {
 
 impl Sym3 {
     /// `diag(1/s^2)`: the weight of independent spreads `s`.
-    pub(super) fn diagonal_weight(s: &Residual3) -> Self {
-        let [a, b, c] = *s;
+    pub(super) fn diagonal_weight(s: &ParityResiduals) -> Self {
+        let [a, b, c] = s.to_array();
         Sym3 {
             xx: 1.0 / (a * a),
             yy: 1.0 / (b * b),
@@ -38,8 +38,8 @@ impl Sym3 {
     }
 
     /// Adds the outer product `d d^T`.
-    pub(super) fn add_outer(&mut self, d: &Residual3) {
-        let [x, y, z] = *d;
+    pub(super) fn add_outer(&mut self, d: &ParityResiduals) {
+        let [x, y, z] = d.to_array();
         self.xx += x * x;
         self.xy += x * y;
         self.xz += x * z;
@@ -72,19 +72,13 @@ impl Sym3 {
     }
 
     /// `d^T M d`.
-    pub(super) fn quadratic(&self, d: &Residual3) -> f32 {
-        let [x, y, z] = *d;
+    pub(super) fn quadratic(&self, d: &ParityResiduals) -> f32 {
+        let [x, y, z] = d.to_array();
         self.xx * x * x
             + self.yy * y * y
             + self.zz * z * z
             + 2.0 * (self.xy * x * y + self.xz * x * z + self.yz * y * z)
     }
-}
-
-/// `a - b`, element by element.
-pub(super) fn sub3(a: &Residual3, b: &Residual3) -> Residual3 {
-    let ([a0, a1, a2], [b0, b1, b2]) = (*a, *b);
-    [a0 - b0, a1 - b1, a2 - b2]
 }
 
 impl Circuit {

@@ -274,7 +274,7 @@ impl Follower {
     /// flash record) and counts it as learned ([`Follower::learned`]). Returns false, and
     /// changes nothing, for a baseline [`Isolator::set_baseline`] refuses.
     pub fn restore_learned(&mut self, b: super::Baseline) -> bool {
-        let ok = self.isolator.set_baseline(b);
+        let ok = self.isolator.set_baseline(b).is_ok();
         self.learned |= ok;
         ok
     }

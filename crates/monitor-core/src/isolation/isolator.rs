@@ -2,22 +2,34 @@
 //! size fit of each fault and the ranking (module docs of [`crate::isolation`]).
 
 use super::*;
+use crate::error::{ensure, ConfigCheck, ConfigError};
 
 impl Isolator {
     /// An isolator for the nominal `motor` on a supply of peak phase voltage
-    /// `v_phase_peak` [V] and `supply_hz` [Hz]; `None` when the motor fails
-    /// [`MotorModel::validate`] or the supply is not positive and finite.
-    pub fn new(motor: MotorModel, v_phase_peak: f32, supply_hz: f32) -> Option<Self> {
-        motor.validate().ok()?;
-        if !(v_phase_peak > 0.0 && supply_hz > 0.0 && v_phase_peak.is_finite()) {
-            return None;
-        }
+    /// `v_phase_peak` [V] and `supply_hz` [Hz].
+    ///
+    /// # Errors
+    /// The motor's [`MotorModel::validate`] error; [`ConfigCheck::PhasePeakVoltage`] or
+    /// [`ConfigCheck::IsolationSupplyHz`] for a supply that is not positive and finite;
+    /// [`ConfigCheck::IsolationTorqueBase`] when the torque scale
+    /// ([`Isolator::torque_base_nm`]) is not positive and finite.
+    pub fn new(motor: MotorModel, v_phase_peak: f32, supply_hz: f32) -> Result<Self, ConfigError> {
+        motor.validate()?;
+        ensure(
+            v_phase_peak > 0.0 && v_phase_peak.is_finite(),
+            ConfigCheck::PhasePeakVoltage,
+        )?;
+        ensure(
+            supply_hz > 0.0 && supply_hz.is_finite(),
+            ConfigCheck::IsolationSupplyHz,
+        )?;
         let i_mag = v_phase_peak / (core::f32::consts::TAU * supply_hz * motor.ls_h);
         let torque_base_nm = motor.kf_per_if() * i_mag * i_mag;
-        if !(torque_base_nm.is_finite() && torque_base_nm > 0.0) {
-            return None;
-        }
-        Some(Isolator {
+        ensure(
+            torque_base_nm.is_finite() && torque_base_nm > 0.0,
+            ConfigCheck::IsolationTorqueBase,
+        )?;
+        Ok(Isolator {
             motor,
             torque_base_nm,
             baseline: Baseline::default(),
@@ -38,21 +50,24 @@ impl Isolator {
     }
 
     /// Puts a baseline into force (for example one stored after commissioning). Spreads
-    /// below [`DEFAULT_SPREAD`]'s fifth are raised to it; non-finite values are ignored
-    /// (returns false and keeps the baseline in force).
-    pub fn set_baseline(&mut self, b: Baseline) -> bool {
-        if !b.mean.iter().chain(b.spread.iter()).all(|x| x.is_finite()) {
-            return false;
-        }
+    /// below [`DEFAULT_SPREAD`]'s fifth are raised to it; a learned point `at` that gives
+    /// no residuals is forgotten (the baseline then holds everywhere).
+    ///
+    /// # Errors
+    /// [`ConfigCheck::BaselineMean`] or [`ConfigCheck::BaselineSpread`] for a non-finite
+    /// value; the baseline in force is kept.
+    pub fn set_baseline(&mut self, b: Baseline) -> Result<(), ConfigError> {
+        ensure(b.mean.is_finite(), ConfigCheck::BaselineMean)?;
+        ensure(b.spread.is_finite(), ConfigCheck::BaselineSpread)?;
         let mut b = b;
         if self.residuals(&b.at, None).is_none() {
             b.at = SteadyPoint::default();
         }
-        for (s, d) in b.spread.iter_mut().zip(DEFAULT_SPREAD) {
-            *s = crate::maxf(*s, 0.2 * d);
-        }
+        b.spread = b
+            .spread
+            .zip_map(DEFAULT_SPREAD, |s, d| crate::maxf(s, 0.2 * d));
         self.baseline = b;
-        true
+        Ok(())
     }
 
     /// Adds a healthy operating point to the baseline being learned (commissioning).
@@ -65,7 +80,7 @@ impl Isolator {
         l.n = l.n.saturating_add(1);
         let n = l.n as f32;
         l.at.approach(p, 1.0 / n);
-        for ((m, m2), x) in l.mean.iter_mut().zip(l.m2.iter_mut()).zip(e) {
+        for ((m, m2), x) in l.mean.iter_mut().zip(l.m2.iter_mut()).zip(e.to_array()) {
             let d = x - *m;
             *m += d / n;
             *m2 += d * (x - *m);
@@ -73,8 +88,9 @@ impl Isolator {
     }
 
     /// Ends learning: the learned mean and twice the learned standard deviation (at least
-    /// [`LEARNED_SPREAD_FLOOR`]: a short window's scatter understates what a longer run meets) go into force. Returns false, and keeps the baseline in force,
-    /// with fewer than [`MIN_LEARNED_POINTS`] points learned.
+    /// [`LEARNED_SPREAD_FLOOR`]: a short window's scatter understates what a longer run
+    /// meets) go into force. Returns false, and keeps the baseline in force, with fewer than
+    /// [`MIN_LEARNED_POINTS`] points learned (or non-finite statistics).
     pub fn finish_learning(&mut self) -> bool {
         let l = self.learning;
         self.learning = Learning::default();
@@ -83,20 +99,25 @@ impl Isolator {
         }
         let n = l.n as f32;
         let mut spread = [0.0; 3];
-        for ((s, m2), d) in spread.iter_mut().zip(l.m2).zip(LEARNED_SPREAD_FLOOR) {
+        for ((s, m2), d) in spread
+            .iter_mut()
+            .zip(l.m2)
+            .zip(LEARNED_SPREAD_FLOOR.to_array())
+        {
             *s = crate::maxf(2.0 * crate::sqrt(m2 / (n - 1.0)), d);
         }
         self.set_baseline(Baseline {
-            mean: l.mean,
-            spread,
+            mean: ParityResiduals::from_array(l.mean),
+            spread: ParityResiduals::from_array(spread),
             at: l.at,
         })
+        .is_ok()
     }
 
     /// The parity residuals at `p` under hypothesis `h` (`None`: the nominal machine and
     /// sensors); `None` when the point is not usable (no voltage or current, frequency
     /// not positive, non-finite values).
-    pub fn residuals(&self, p: &SteadyPoint, h: Option<(Fault, f32)>) -> Option<Residual3> {
+    pub fn residuals(&self, p: &SteadyPoint, h: Option<(Fault, f32)>) -> Option<ParityResiduals> {
         let (c, q) = self.hypothesis(p, h);
         self.eval(&c, &q)
     }
@@ -147,7 +168,7 @@ impl Isolator {
         let (Some(e_here), Some(e_at)) = (self.eval(&c0, q), self.eval(&c0, &at)) else {
             return diag;
         };
-        let [a, b, z] = s;
+        let [a, b, z] = s.to_array();
         let mut cov = Sym3 {
             xx: a * a,
             yy: b * b,
@@ -156,7 +177,7 @@ impl Isolator {
         };
         // d_j for a NAMEPLATE_UNCERTAINTY error, and what that error leaves at the learned
         // point in the voltage residuals (the evidence for how far off the nameplate is).
-        let mut d = [[0.0f32; 3]; 5];
+        let mut d = [ParityResiduals::default(); 5];
         let mut expected = 0.0f32;
         for (j, dj) in d.iter_mut().enumerate() {
             let (Some(h), Some(t)) = (
@@ -165,12 +186,11 @@ impl Isolator {
             ) else {
                 return diag;
             };
-            let g = sub3(&t, &e_at);
-            let [gd, gq, _] = g;
-            expected += gd * gd + gq * gq;
-            *dj = sub3(&sub3(&h, &e_here), &g);
+            let g = t - e_at;
+            expected += g.voltage_d * g.voltage_d + g.voltage_q * g.voltage_q;
+            *dj = (h - e_here) - g;
         }
-        let [md, mq, _] = self.baseline.mean;
+        let (md, mq) = (self.baseline.mean.voltage_d, self.baseline.mean.voltage_q);
         let seen = crate::sqrt((md * md + mq * mq) / expected);
         let u = if seen.is_finite() {
             crate::minf(crate::maxf(seen, NAMEPLATE_FLOOR), 1.0)
@@ -186,7 +206,7 @@ impl Isolator {
     /// The parity residuals of circuit `c` at the (corrected) readings `q` (see
     /// [`Isolator::residuals`]).
     #[inline(never)]
-    fn eval(&self, c: &Circuit, q: &SteadyPoint) -> Option<Residual3> {
+    fn eval(&self, c: &Circuit, q: &SteadyPoint) -> Option<ParityResiduals> {
         let (i, v, we, wr) = (q.i, q.v, q.we_rad_s, q.wr_rad_s);
         let vmag = crate::fast_hypot(v.d, v.q);
         let imag = crate::fast_hypot(i.d, i.q);
@@ -209,12 +229,12 @@ impl Isolator {
         // Te = 3/2 Np Im(conj(Lm Ir) I) = 3/2 Np Lm (ir_d i_q - ir_q i_d)
         let te = 1.5 * c.np * c.lm * (ir_d * i.q - ir_q * i.d);
         let tl = c.b_total * wr / c.np;
-        let e = [
-            (v.d - vp_d) / vmag,
-            (v.q - vp_q) / vmag,
-            (te - tl) / self.torque_base_nm,
-        ];
-        e.iter().all(|x| x.is_finite()).then_some(e)
+        let e = ParityResiduals {
+            voltage_d: (v.d - vp_d) / vmag,
+            voltage_q: (v.q - vp_q) / vmag,
+            torque: (te - tl) / self.torque_base_nm,
+        };
+        e.is_finite().then_some(e)
     }
 
     /// [`Isolator::isolate`] with the baseline's spreads multiplied by `spread_scale`
@@ -227,9 +247,7 @@ impl Isolator {
             1.0
         };
         let mut scaled = *self;
-        for s in scaled.baseline.spread.iter_mut() {
-            *s *= k;
-        }
+        scaled.baseline.spread = scaled.baseline.spread.map(|s| s * k);
         scaled.isolate(p)
     }
 
@@ -241,9 +259,7 @@ impl Isolator {
             return out;
         };
         let b = self.baseline;
-        for ((r, e), m) in out.residuals.iter_mut().zip(e0).zip(b.mean) {
-            *r = e - m;
-        }
+        out.residuals = e0 - b.mean;
         let w = self.weight(p);
         let chi0 = self.chi2_at(p, None, &w);
         out.deviation = crate::sqrt(chi0);
@@ -306,7 +322,7 @@ impl Isolator {
     fn chi2_at(&self, p: &SteadyPoint, h: Option<(Fault, f32)>, w: &Sym3) -> f32 {
         let (c, q) = self.hypothesis(p, h);
         match self.eval(&c, &q) {
-            Some(e) => w.quadratic(&sub3(&e, &self.baseline.mean)),
+            Some(e) => w.quadratic(&(e - self.baseline.mean)),
             None => f32::INFINITY,
         }
     }
@@ -360,15 +376,20 @@ impl Isolator {
 
     /// Angle between the top two candidates' weighted directions `e(f, k*) - e(nominal)`
     /// [deg]; 180 when either direction is empty.
-    fn separation(&self, p: &SteadyPoint, e0: &Residual3, c: &[Candidate; FAULT_COUNT]) -> f32 {
-        let dir = |cand: Option<&Candidate>| -> Option<Residual3> {
+    fn separation(
+        &self,
+        p: &SteadyPoint,
+        e0: &ParityResiduals,
+        c: &[Candidate; FAULT_COUNT],
+    ) -> f32 {
+        let dir = |cand: Option<&Candidate>| -> Option<[f32; 3]> {
             let cand = cand?;
             let e = self.residuals(p, Some((cand.fault, 1.0 + cand.change)))?;
-            let mut d = [0.0; 3];
-            for (((o, x), x0), s) in d.iter_mut().zip(e).zip(e0).zip(self.baseline.spread) {
-                *o = (x - x0) / s;
-            }
-            Some(d)
+            Some(
+                (e - *e0)
+                    .zip_map(self.baseline.spread, |d, s| d / s)
+                    .to_array(),
+            )
         };
         let (Some(a), Some(b)) = (dir(c.first()), dir(c.get(1))) else {
             return 180.0;

@@ -22,7 +22,7 @@
 //!   this is r2 (eq. 37) with the rotor flux taken from the circuit rather than from
 //!   `Lm i_ds`.
 //!
-//! The three parity residuals ([`Residual3`]) are `e_d + j e_q = (V - Z I)/|V|` and
+//! The three parity residuals ([`ParityResiduals`]) are `e_d + j e_q = (V - Z I)/|V|` and
 //! `e_T = (Te - (B+Bl) wr/Np) / T_base` (dimensionless; `T_base` is the torque at
 //! `I_qs = i_mag`, about rated torque: [`Isolator::torque_base_nm`]). The speed implied by
 //! the electrical equations against the encoder's, and a voltage-model flux angle against
@@ -98,7 +98,7 @@ pub use follower::{
 mod circuit;
 mod isolator;
 
-use circuit::{sub3, Circuit, Sym3};
+use circuit::{Circuit, Sym3};
 
 use crate::frames::Dq;
 use crate::machine::MotorModel;
@@ -208,8 +208,64 @@ impl SteadyPoint {
     }
 }
 
-/// The three parity residuals `[e_d, e_q, e_T]` (module docs), dimensionless.
-pub type Residual3 = [f32; 3];
+/// The three parity residuals of the isolation (module docs), dimensionless: the d and q
+/// components `e_d + j e_q = (V - Z I)/|V|` of the stator-voltage equation's misfit
+/// (`Z`: the machine's steady-state impedance at the slip frequency), and the torque
+/// balance's misfit `e_T = (Te - (B + Bl) wr / Np) / T_base`
+/// ([`Isolator::torque_base_nm`]). Also used for their means and spreads ([`Baseline`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ParityResiduals {
+    /// `e_d`: the d component of the stator-voltage misfit `(V - Z I)/|V|`.
+    pub voltage_d: f32,
+    /// `e_q`: the q component of the stator-voltage misfit `(V - Z I)/|V|`.
+    pub voltage_q: f32,
+    /// `e_T`: the torque-balance misfit `(Te - (B + Bl) wr / Np) / T_base`.
+    pub torque: f32,
+}
+
+impl ParityResiduals {
+    /// The residuals from `[e_d, e_q, e_T]` (the order of the flash record and the host's
+    /// reports).
+    pub const fn from_array([voltage_d, voltage_q, torque]: [f32; 3]) -> Self {
+        ParityResiduals {
+            voltage_d,
+            voltage_q,
+            torque,
+        }
+    }
+
+    /// `[e_d, e_q, e_T]`.
+    pub const fn to_array(self) -> [f32; 3] {
+        [self.voltage_d, self.voltage_q, self.torque]
+    }
+
+    /// `f` applied to each residual.
+    pub fn map(self, f: impl Fn(f32) -> f32) -> Self {
+        Self::from_array(self.to_array().map(f))
+    }
+
+    /// `f` applied to each residual and its counterpart in `other`.
+    pub fn zip_map(self, other: Self, f: impl Fn(f32, f32) -> f32) -> Self {
+        ParityResiduals {
+            voltage_d: f(self.voltage_d, other.voltage_d),
+            voltage_q: f(self.voltage_q, other.voltage_q),
+            torque: f(self.torque, other.torque),
+        }
+    }
+
+    /// Every residual finite.
+    pub fn is_finite(&self) -> bool {
+        self.to_array().iter().all(|x| x.is_finite())
+    }
+}
+
+impl core::ops::Sub for ParityResiduals {
+    type Output = Self;
+    /// Element by element.
+    fn sub(self, rhs: Self) -> Self {
+        self.zip_map(rhs, |a, b| a - b)
+    }
+}
 
 /// The healthy reference of the residuals: mean and spread (one standard deviation), from
 /// [`Isolator::learn`] or the defaults (zero mean; spreads 0.5 % of |V| on the voltage
@@ -220,9 +276,9 @@ pub type Residual3 = [f32; 3];
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Baseline {
     /// Mean residual of the healthy machine.
-    pub mean: Residual3,
+    pub mean: ParityResiduals,
     /// Spread of each residual, > 0.
-    pub spread: Residual3,
+    pub spread: ParityResiduals,
     /// The mean operating point the baseline was learned at; [`SteadyPoint::default`]
     /// (not a usable point) for the defaults and for baselines stored without it. Away
     /// from it the nameplate's error no longer cancels and the misfit is widened
@@ -233,7 +289,7 @@ pub struct Baseline {
 impl Default for Baseline {
     fn default() -> Self {
         Baseline {
-            mean: [0.0; 3],
+            mean: ParityResiduals::default(),
             spread: DEFAULT_SPREAD,
             at: SteadyPoint::default(),
         }
@@ -242,7 +298,7 @@ impl Default for Baseline {
 
 /// The spreads used without a learned baseline (the nominal parameters' own error at other
 /// operating points is in them).
-pub const DEFAULT_SPREAD: Residual3 = [0.0015, 0.0015, 0.004];
+pub const DEFAULT_SPREAD: ParityResiduals = ParityResiduals::from_array([0.0015, 0.0015, 0.004]);
 
 /// The floor of learned spreads, for points averaged [`AVERAGE_MAX_S`]: the largest scatter
 /// of such points measured on simulated healthy runs of the 3 hp, 2.2 kW and 11 kW machines
@@ -250,7 +306,8 @@ pub const DEFAULT_SPREAD: Residual3 = [0.0015, 0.0015, 0.004];
 /// of |V| on the voltage equations and 0.055 % of `T_base` on the torque balance, against
 /// 0.08 % and 0.44 % with the former 0.5 s exponential average; the floor is about twice
 /// that (a commissioning window's scatter understates what a longer run meets).
-pub const LEARNED_SPREAD_FLOOR: Residual3 = [0.0004, 0.0004, 0.001];
+pub const LEARNED_SPREAD_FLOOR: ParityResiduals =
+    ParityResiduals::from_array([0.0004, 0.0004, 0.001]);
 
 /// One fault's fit.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -295,8 +352,8 @@ pub struct Isolation {
     /// The measured change from the baseline, in standard deviations (`sqrt(chi2)` of the
     /// healthy hypothesis).
     pub deviation: f32,
-    /// The residuals minus the baseline mean, `[e_d, e_q, e_T]`.
-    pub residuals: Residual3,
+    /// The residuals minus the baseline mean.
+    pub residuals: ParityResiduals,
     /// Angle between the top two candidates' directions (the change each fitted size makes
     /// to the residuals, weighted by the spreads) [deg], 0..180; small: they cannot be
     /// separated at this operating point.
@@ -316,7 +373,7 @@ impl Default for Isolation {
             }),
             unknown_probability: 0.0,
             deviation: 0.0,
-            residuals: [0.0; 3],
+            residuals: ParityResiduals::default(),
             separation_deg: 0.0,
         }
     }
@@ -371,8 +428,9 @@ impl Isolation {
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 struct Learning {
     n: u32,
-    mean: Residual3,
-    m2: Residual3,
+    /// Running mean and sum of squared deviations, `[e_d, e_q, e_T]`.
+    mean: [f32; 3],
+    m2: [f32; 3],
     at: SteadyPoint,
 }
 

@@ -116,7 +116,7 @@ fn the_healthy_machine_has_zero_residuals_at_its_steady_state() {
         let iso = Isolator::new(m.model(), v as f32, (we / core::f64::consts::TAU) as f32).unwrap(); // ok: test
         let p = measure(&m, v, we, None, 1.0);
         let e = iso.residuals(&p, None).unwrap(); // ok: test
-        assert!(e.iter().all(|x| x.abs() < 1e-4), "{name}: {e:?}");
+        assert!(e.to_array().iter().all(|x| x.abs() < 1e-4), "{name}: {e:?}");
         assert_eq!(iso.isolate(&p).state, IsolationState::NoDeviation, "{name}");
     }
 }
@@ -293,7 +293,50 @@ fn unusable_points_are_not_judged() {
     ] {
         assert_eq!(iso.isolate(&p).state, IsolationState::NotJudged);
     }
-    assert!(Isolator::new(m.model(), f32::NAN, 60.0).is_none());
+    assert!(Isolator::new(m.model(), f32::NAN, 60.0).is_err());
+}
+
+/// A supply or a baseline the isolation cannot use is refused with the field it names.
+#[test]
+fn a_bad_supply_or_baseline_names_its_field() {
+    let (_, m, v, we) = machines()[0];
+    let f = (we / core::f64::consts::TAU) as f32;
+    let check = |r: Result<Isolator, crate::ConfigError>| r.err().map(|e| e.field());
+    assert_eq!(
+        check(Isolator::new(m.model(), f32::NAN, f)),
+        Some("v_phase_peak")
+    );
+    assert_eq!(
+        check(Isolator::new(m.model(), v as f32, 0.0)),
+        Some("supply_hz")
+    );
+    assert_eq!(
+        check(Isolator::new(m.model(), v as f32, f32::INFINITY)),
+        Some("supply_hz")
+    );
+    let mut bad_motor = m.model();
+    bad_motor.rs_ohm = -1.0;
+    assert_eq!(
+        check(Isolator::new(bad_motor, v as f32, f)),
+        Some("motor.rs_ohm")
+    );
+    let mut iso = Isolator::new(m.model(), v as f32, f).unwrap(); // ok: test
+    let before = iso.baseline();
+    let mut b = Baseline::default();
+    b.mean.torque = f32::NAN;
+    let e = iso.set_baseline(b).unwrap_err(); // ok: test
+    assert_eq!(
+        (e.kind(), e.field()),
+        (crate::ConfigErrorKind::Baseline, "baseline.mean")
+    );
+    b = Baseline::default();
+    b.spread.voltage_q = f32::INFINITY;
+    assert_eq!(
+        iso.set_baseline(b).map_err(|e| e.field()),
+        Err("baseline.spread")
+    );
+    assert_eq!(iso.baseline(), before, "a refused baseline changes nothing");
+    assert_eq!(iso.set_baseline(Baseline::default()), Ok(()));
 }
 
 /// The follower's schedule: nothing before half a second of steady running; a load or
