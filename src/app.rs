@@ -32,7 +32,7 @@ use monitor_core::{
     SteadyPoint,
 };
 
-/// The machine the firmware monitors by default: DESIGN.md's "2.2 kW" reference machine
+/// The machine the firmware monitors by default: the "2.2 kW" reference machine
 /// (`monitor_core::reference::MOTOR_2P2KW`: 400 V, 50 Hz, 4 poles, Gamma model, Bl for the
 /// rated 14.6 N m near rated speed). Edit here for another machine.
 pub const DEFAULT_MACHINE: ReferenceMachine = monitor_core::reference::MOTOR_2P2KW;

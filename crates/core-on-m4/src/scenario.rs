@@ -33,7 +33,7 @@ pub const AMP_PER_LSB: f32 = 20.0 / 4095.0;
 /// Zero code.
 pub const MID: f32 = 4095.0 / 2.0;
 
-/// The 2.2 kW reference machine of DESIGN.md (Bl for 14.6 N m near rated speed), in the
+/// The 2.2 kW reference machine (Bl for 14.6 N m near rated speed), in the
 /// core's precision.
 pub fn motor() -> MotorModel {
     monitor_core::reference::MOTOR_2P2KW.motor.model()

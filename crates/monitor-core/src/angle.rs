@@ -1,7 +1,7 @@
 //! The synchronous angle: where the d-q frame points.
 //!
-//! Three sources, chosen in [`crate::MonitorConfig::angle_source`] (DESIGN.md §2, "Frame
-//! orientation matters"):
+//! Three sources, chosen in [`crate::MonitorConfig::angle_source`] (why the frame's
+//! orientation matters: `docs/design.md`):
 //! - [`ZeroCrossing`]: the paper's method (section 4.2, item 3): the phase-a voltage's rising
 //!   zero crossing with a frequency estimate from the crossing period. Voltage orientation.
 //! - [`SrfPll`]: a synchronous-reference-frame PLL on the voltage vector. Voltage
@@ -9,7 +9,7 @@
 //! - [`RotorFluxCurrentModel`]: the rotor-flux angle from the current model (measured
 //!   currents, encoder speed, nominal Rr, Lr, Lm). Rotor-flux orientation, in which the
 //!   paper's steady-state model (eqs. 21-23) is exact, so healthy residuals are zero at
-//!   every load. With voltage orientation the healthy r1 grows with slip (DESIGN.md: about
+//!   every load. With voltage orientation the healthy r1 grows with slip (about
 //!   0.1 % of Vqs at 1 % slip, 10 % at 5 % slip), which the paper absorbed in heuristic
 //!   thresholds.
 //!

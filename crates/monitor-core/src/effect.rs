@@ -1,10 +1,10 @@
-//! The names of the physical effects of DESIGN.md §3's effect library: one enum for the
+//! The names of the physical effects of the effect library (`docs/design.md`): one enum for the
 //! simulator (which injects them), the model-vs-measurement analysis (which fits and ranks
 //! them) and the command line (which names them). The core computes none of them; it holds
 //! the names so that all parts of the workspace share one vocabulary, as they share
 //! [`crate::Fault`].
 
-/// A physical effect the paper's simplified model leaves out (DESIGN.md §3). The name
+/// A physical effect the paper's simplified model leaves out (`docs/design.md`). The name
 /// (`snake_case`, [`EffectKind::name`]) is part of the interface: scenario files, the
 /// command line and the JSON reports use it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -46,7 +46,7 @@ pub enum EffectKind {
 }
 
 impl EffectKind {
-    /// Every effect, in DESIGN.md's order.
+    /// Every effect, in the effect library's order.
     pub const ALL: [EffectKind; 13] = [
         EffectKind::ThermalDrift,
         EffectKind::Saturation,
@@ -63,7 +63,8 @@ impl EffectKind {
         EffectKind::CrossCouplingDynamics,
     ];
 
-    /// The DESIGN.md name (`thermal_drift`, ..., `current_dynamics`).
+    /// The name in scenario files, on the command line and in JSON reports
+    /// (`thermal_drift`, ..., `cross_coupling_dynamics`).
     pub fn name(self) -> &'static str {
         match self {
             EffectKind::ThermalDrift => "thermal_drift",
@@ -82,7 +83,7 @@ impl EffectKind {
         }
     }
 
-    /// Parses a DESIGN.md name (exact, lower case).
+    /// Parses a name of [`EffectKind::name`] (exact, lower case).
     pub fn from_name(s: &str) -> Option<EffectKind> {
         EffectKind::ALL.into_iter().find(|e| e.name() == s)
     }

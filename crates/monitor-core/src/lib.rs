@@ -13,18 +13,21 @@
 //! ([`encoder`]) and the negative-sequence analysis that names a faulty phase
 //! ([`sequence`]).
 //!
-//! Source: the paper in `shared/seed` ("the paper"); corrections in DESIGN.md §2 and in the
-//! module docs ([`residuals`] lists the typos).
+//! Source: "Fault Diagnosis of Induction Motor Using D-Q Simplified Model and Parity
+//! Equations", Energies 2022, 15(22), 8372 (MDPI), doi:10.3390/en15228372 ("the paper");
+//! its typos are corrected in the module docs ([`residuals`] lists them) and in
+//! `docs/paper-errata.md`; the models and equations with their sources: `docs/design.md`.
 //!
 //! The crate also holds the vocabulary every part of the workspace shares: [`Fault`] (Table
 //! 1's faults), [`EffectKind`] (the effect library's names), [`Phase`], the parameter
-//! file's [`MotorParameters`] with its one conversion to [`MotorModel`], and DESIGN.md's
-//! [`reference`](mod@reference) machines. With the `serde` feature (the host enables it) they serialise
-//! under their DESIGN.md names.
+//! file's [`MotorParameters`] with its one conversion to [`MotorModel`], and the
+//! [`reference`](mod@reference) machines (2.2 kW and 3 hp). With the `serde` feature (the
+//! host enables it) they serialise under the names of the parameter file and the JSON
+//! reports (`docs/design.md`).
 //!
 //! ```
 //! use monitor_core::{reference, Abc, Fault, Monitor, MonitorConfig, Sample};
-//! // The DESIGN.md 3 hp motor on 220 V, 60 Hz, sampled at 10 kHz.
+//! // The 3 hp reference motor on 220 V, 60 Hz, sampled at 10 kHz.
 //! let motor = reference::MOTOR_3HP.motor.model();
 //! let mut monitor = Monitor::new(MonitorConfig::new(motor, 60.0, 220.0, 10_000.0))
 //!     .expect("a valid configuration"); // ok: doc example
@@ -136,7 +139,7 @@ pub(crate) mod testing {
     //! Shared test fixtures.
     use crate::MotorModel;
 
-    /// The DESIGN.md 3 hp textbook machine in the core's precision.
+    /// The 3 hp reference machine in the core's precision.
     pub(crate) fn motor_3hp() -> MotorModel {
         crate::reference::MOTOR_3HP.motor.model()
     }

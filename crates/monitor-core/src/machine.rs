@@ -1,18 +1,22 @@
 //! The machine's parameters: one type as the user writes them, one model the equations use,
 //! and the reference machines every part of the workspace tests with.
 //!
-//! - [`MotorParameters`] and [`SupplyParameters`]: the DESIGN.md §3 parameter file's
-//!   `[motor]` and `[supply]` sections (`f64`, SI, per phase, referred to the stator). The
+//! - [`MotorParameters`] and [`SupplyParameters`]: the parameter file's `[motor]` and
+//!   `[supply]` sections (`docs/design.md`) (`f64`, SI, per phase, referred to the stator). The
 //!   host reads them from TOML (serde behind the `serde` feature); the firmware builds
 //!   them in code. They are validated once ([`MotorParameters::validate`]).
 //! - [`MotorModel`]: what the equations need (pole pairs instead of poles), in `f32` on the
 //!   board and `f64` in the host's analysis and simulator. [`MotorParameters::model`] is the
 //!   one conversion; the derived quantities (sigma, Ra, La, Kf/i_f, leakages) are computed
 //!   only by [`MotorModel`]'s methods.
-//! - [`reference`](mod@reference): DESIGN.md's reference machines.
+//! - [`reference`](mod@reference): the reference machines (2.2 kW and 3 hp).
 //!
-//! Symbols (DESIGN.md §2): self inductances include leakage, `Ls = Lls + Lm`,
-//! `Lr = Llr + Lm`; `sigma = 1 - Lm^2/(Ls Lr)`; `Ra = Rs + (Ls/Lr) Rr` (eq. 24);
+//! Symbols (the paper's, "Fault Diagnosis of Induction Motor Using D-Q Simplified Model
+//! and Parity Equations", Energies 2022, 15(22), 8372, doi:10.3390/en15228372; the models
+//! and equations with their sources: `docs/design.md`): `Ls` and `Lr` are the stator and
+//! rotor *self* inductances, leakage plus magnetising, `Ls = Lls + Lm`, `Lr = Llr + Lm`
+//! (the faults [`crate::Fault::Ls`] and [`crate::Fault::Lr`] scale the *leakages* `Lls`
+//! and `Llr`, which the paper's simulator, PSIM, calls Ls and Lr); `sigma = 1 - Lm^2/(Ls Lr)`; `Ra = Rs + (Ls/Lr) Rr` (eq. 24);
 //! `La = sigma Ls`; `Kf = (3/2) Np (Lm^2/Lr) i_f` (eq. 25 with `P/2 = Np`).
 
 use crate::error::{ensure, ConfigCheck, ConfigError};
@@ -26,9 +30,11 @@ pub struct MotorModel<T = f32> {
     pub rs_ohm: T,
     /// Rotor resistance Rr referred to the stator [ohm], > 0.
     pub rr_ohm: T,
-    /// Stator self inductance Ls = Lls + Lm [H], >= Lm.
+    /// Stator self inductance Ls = Lls + Lm [H] (leakage plus magnetising), >= Lm. The
+    /// fault [`crate::Fault::Ls`] scales the leakage Lls ([`MotorModel::lls_h`]), not this.
     pub ls_h: T,
-    /// Rotor self inductance Lr = Llr + Lm [H], >= Lm.
+    /// Rotor self inductance Lr = Llr + Lm [H] (leakage plus magnetising), >= Lm. The
+    /// fault [`crate::Fault::Lr`] scales the leakage Llr ([`MotorModel::llr_h`]), not this.
     pub lr_h: T,
     /// Magnetising inductance Lm [H], Lm^2 < Ls Lr.
     pub lm_h: T,
@@ -113,7 +119,7 @@ impl<T: Real> MotorModel<T> {
     }
 }
 
-/// The parameter file's `[motor]` section (DESIGN.md §3): nominal T-equivalent parameters
+/// The parameter file's `[motor]` section (`docs/design.md`): nominal T-equivalent parameters
 /// per phase, referred to the stator, SI units. Unknown keys are an error when read from
 /// TOML (`serde` feature).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -124,9 +130,11 @@ pub struct MotorParameters {
     pub rs_ohm: f64,
     /// Rotor resistance Rr referred to the stator [ohm], > 0.
     pub rr_ohm: f64,
-    /// Stator self inductance Ls = Lls + Lm [H], >= Lm.
+    /// Stator self inductance Ls = Lls + Lm [H] (leakage plus magnetising), >= Lm. The
+    /// fault [`crate::Fault::Ls`] scales the leakage Lls ([`MotorModel::lls_h`]), not this.
     pub ls_h: f64,
-    /// Rotor self inductance Lr = Llr + Lm [H], >= Lm.
+    /// Rotor self inductance Lr = Llr + Lm [H] (leakage plus magnetising), >= Lm. The
+    /// fault [`crate::Fault::Lr`] scales the leakage Llr ([`MotorModel::llr_h`]), not this.
     pub lr_h: f64,
     /// Magnetising inductance Lm [H], > 0, with Lm^2 < Ls Lr.
     pub lm_h: f64,
@@ -206,7 +214,7 @@ impl SupplyParameters {
 /// sqrt(2/3): peak phase-to-neutral voltage per line-to-line RMS volt.
 pub const V_PHASE_PEAK_PER_V_LL_RMS: f64 = 0.816_496_580_927_726;
 
-/// A machine with its supply, as DESIGN.md §3 lists the reference motors.
+/// A machine with its supply: one of the reference machines ([`reference`](mod@reference)).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ReferenceMachine {
     /// A short name for reports ("2.2 kW", "3 hp").
@@ -217,12 +225,12 @@ pub struct ReferenceMachine {
     pub supply: SupplyParameters,
 }
 
-/// DESIGN.md's reference machines, defined here once for the firmware, the simulator, the
-/// analysis and every test.
+/// The reference machines (2.2 kW and 3 hp), defined here once for the firmware, the
+/// simulator, the analysis and every test.
 pub mod reference {
     use super::{MotorParameters, ReferenceMachine, SupplyParameters};
 
-    /// DESIGN.md "2.2 kW": 400 V, 50 Hz, 4 poles, T-equivalent with no stator leakage (the
+    /// "2.2 kW": 400 V, 50 Hz, 4 poles, T-equivalent with no stator leakage (the
     /// Gamma model of a common 2.2 kW machine). `bl_nms` is chosen so that Bl omega gives
     /// the rated 14.6 N m at about 1430 rpm (149.7 rad/s): 14.6 / 149.7 = 0.0975 N m s/rad.
     pub const MOTOR_2P2KW: ReferenceMachine = ReferenceMachine {
@@ -247,10 +255,11 @@ pub mod reference {
     /// Angular frequency of the 3 hp machine's 60 Hz reactances [rad/s].
     const W_60HZ: f64 = 2.0 * core::f64::consts::PI * 60.0;
 
-    /// DESIGN.md "3 hp" textbook machine: 220 V, 60 Hz, 4 poles, Xls = Xlr = 0.754 ohm and
-    /// Xm = 26.13 ohm at 60 Hz, so Lls = Llr = 0.754/(2 pi 60) = 2.0 mH and
-    /// Lm = 26.13/(2 pi 60) = 69.3 mH; J 0.089 kg m^2; B and Bl as in DESIGN.md's example
-    /// parameter file.
+    /// "3 hp": the textbook 3 hp machine (Krause, Wasynczuk and Sudhoff, *Analysis of
+    /// Electric Machinery and Drive Systems*): 220 V, 60 Hz, 4 poles, Xls = Xlr = 0.754 ohm
+    /// and Xm = 26.13 ohm at 60 Hz, so Lls = Llr = 0.754/(2 pi 60) = 2.0 mH and
+    /// Lm = 26.13/(2 pi 60) = 69.3 mH; J 0.089 kg m^2; B 0.002 and Bl 0.045 N m s/rad (the
+    /// example parameter file's).
     pub const MOTOR_3HP: ReferenceMachine = ReferenceMachine {
         name: "3 hp",
         motor: MotorParameters {

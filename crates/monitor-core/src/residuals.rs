@@ -1,6 +1,8 @@
 //! The simplified D-Q model and its parity-equation residuals (paper section 3).
 //!
-//! Symbols (DESIGN.md §2, computed by [`MotorModel`]'s methods): `Ra = Rs + (Ls/Lr) Rr`
+//! Symbols (the paper's, "Fault Diagnosis of Induction Motor Using D-Q Simplified Model and
+//! Parity Equations", Energies 2022, 15(22), 8372; computed by [`MotorModel`]'s methods;
+//! the paper's typos: `docs/paper-errata.md`): `Ra = Rs + (Ls/Lr) Rr`
 //! (eq. 24), `La = sigma Ls`,
 //! `Psi = Ls i_f` (the paper prints `Psi = Ls` and `i_f = Ls i_ds` under eq. 34: both are
 //! typos; the coefficient of omega_r in eq. 28 is `Ls i_f`), `Kf = 3/2 Np Lm^2/Lr i_f`

@@ -159,7 +159,8 @@ pub struct WindingAsymmetry {
 
 /// Share of the supply-driven negative sequence that the model's negative-sequence
 /// impedance may be wrong by (magnitude and angle): a winding part below this fraction of
-/// `|V2/Z2|` is not evidence (nameplate parameters 10-30 % off, DESIGN.md).
+/// `|V2/Z2|` is not evidence (nameplate parameters are commonly 10-30 % off the machine:
+/// [`crate::isolation::NAMEPLATE_UNCERTAINTY`]).
 pub const SUPPLY_PART_UNCERTAINTY: f32 = 0.3;
 
 /// The workspace's one faulty-phase method on a supply that is itself unbalanced: the

@@ -37,9 +37,14 @@ pub enum Fault {
     Rs,
     /// Rotor resistance Rr.
     Rr,
-    /// Stator inductance Ls.
+    /// Stator *leakage* inductance Lls = Ls - Lm (the paper's simulator, PSIM, names the
+    /// leakages Ls and Lr; the model's self inductance is [`crate::MotorModel::ls_h`] =
+    /// Lls + Lm). A fault of size k scales Lls by k; on a machine without stator leakage
+    /// (a Gamma model) it scales Lm instead.
     Ls,
-    /// Rotor inductance Lr.
+    /// Rotor *leakage* inductance Llr = Lr - Lm (PSIM's Lr; the model's self inductance is
+    /// [`crate::MotorModel::lr_h`] = Llr + Lm). A fault of size k scales Llr by k; without
+    /// rotor leakage it scales Lm instead.
     Lr,
     /// Machine friction B.
     B,
@@ -76,8 +81,8 @@ impl Fault {
         Fault::SpeedSensor,
     ];
 
-    /// The DESIGN.md name (`rs, rr, ls, lr, b, bl, current_sensor, voltage_sensor,
-    /// speed_sensor`).
+    /// The name in scenario files, on the command line and in JSON reports (`rs, rr, ls, lr,
+    /// b, bl, current_sensor, voltage_sensor, speed_sensor`; `docs/design.md`).
     pub fn name(self) -> &'static str {
         match self {
             Fault::Rs => "rs",
@@ -92,7 +97,7 @@ impl Fault {
         }
     }
 
-    /// Parses a DESIGN.md name.
+    /// Parses a name of [`Fault::name`] (exact, lower case).
     pub fn from_name(s: &str) -> Option<Fault> {
         Fault::ALL.into_iter().find(|f| f.name() == s)
     }

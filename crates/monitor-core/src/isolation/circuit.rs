@@ -100,7 +100,8 @@ impl Circuit {
     }
 
     /// The circuit with parameter fault `f` of factor `k`. The `ls` and `lr` faults scale
-    /// the leakage inductances (DESIGN.md §2: PSIM's Ls and Lr are the leakages); on a side
+    /// the leakage inductances ([`Fault::Ls`]: the paper's simulator PSIM's Ls and Lr are the
+    /// leakages); on a side
     /// without leakage (a Gamma-model machine) they scale Lm, as the simulator does.
     pub(super) fn with(mut self, f: Fault, k: f32, m: &MotorModel) -> Self {
         let (lls, llr) = (m.lls_h(), m.llr_h());

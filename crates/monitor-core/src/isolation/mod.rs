@@ -72,7 +72,7 @@
 //!   changed);
 //! - **current and voltage sensor at no load**: both scale `Z` (the measured `V/I`); only
 //!   the torque balance separates them, and at no load the torque is small;
-//! - **Rr, the speed sensor and (near rated load) Ls**: `Z` and `Te` depend on the slip
+//! - **Rr, the speed sensor and (near rated load) the stator leakage `ls`**: `Z` and `Te` depend on the slip
 //!   frequency and Rr only through `ws / Rr`, so a speed reading a few tenths of a percent
 //!   off moves the voltage equations like a 10 % Rr change; the torque balance tells them
 //!   apart only through the load term `(B + Bl) wr` and, at a given current, through the
