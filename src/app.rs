@@ -22,7 +22,7 @@ use crate::board::{self, FrontEnd};
 use crate::commissioning::{Action, CommissioningProcedure, RunEnd};
 use crate::flash_record::{self, CalibrationRecord, RecordStore, Stored};
 use crate::liveness::{LivenessChange, SampleWatch};
-use crate::panel::{self, Mode, PanelInput, PanelLamps};
+use crate::panel::{self, blink_code, Mode, PanelInput, PanelLamps, NOT_NAMED_CODE};
 use crate::reset_record::PreviousRun;
 use crate::sampling::{AdcSampler, RawFrame, SamplingError, TICK_HZ};
 use monitor_core::isolation::{Baseline, Follower, Named, Step};
@@ -304,6 +304,41 @@ pub fn isolation_summary(iso: Option<&Isolation>) -> (&'static str, f32, f32) {
         (None, IsolationState::NoDeviation) => ("none", 0.0, 0.0),
         (None, IsolationState::NotJudged) => ("not-judged", 0.0, 0.0),
         (None, _) => ("unknown", 0.0, iso.unknown_probability),
+    }
+}
+
+/// The panel's inputs ([`PanelInput`], the panel's whole interface) for the latest status
+/// in `mode` and the latest `isolation`
+/// judged against a baseline learned in commissioning (`None` without one): the residual
+/// lamps, the fault lamp (the core's detection, or a fault the isolation names while
+/// commissioned: the panel's module docs), "input invalid" when a sensor fault is flagged with no
+/// residual lamp lit, and the blink code: the isolated fault's (or "not named"); without
+/// a learned isolation baseline the lamps' top candidate's, as the paper's method
+/// gives it (a nameplate's parameters can be 10-30 % off: the isolation against them is
+/// not trusted on the panel, only printed on the status line).
+pub fn panel_input(
+    mode: Mode,
+    status: &MonitorStatus,
+    isolation: Option<&Isolation>,
+    commissioning_failed: bool,
+) -> PanelInput {
+    let named = isolation.and_then(Isolation::named);
+    let fault_code = match (isolation, named) {
+        (_, Some(Named::Fault(c))) => blink_code(c.fault.index() as u8),
+        (_, Some(Named::Friction { .. })) => blink_code(Fault::B.index() as u8),
+        (Some(_), None) => NOT_NAMED_CODE,
+        (None, None) => status
+            .top
+            .map_or(NOT_NAMED_CODE, |(f, _)| blink_code(f.index() as u8)),
+    };
+    let named_fault = matches!(named, Some(Named::Fault(_)));
+    PanelInput {
+        mode,
+        residual_lamps: status.residual_lamps,
+        fault_detected: status.fault_detected || (named_fault && status.commissioned),
+        input_invalid: status.sensor_fault.any() && !status.residual_lamps.iter().any(|l| *l),
+        fault_code,
+        commissioning_failed,
     }
 }
 
@@ -609,7 +644,7 @@ impl Supervisor {
             .as_ref()
             .filter(|f| f.learned())
             .and_then(Follower::last);
-        let input = PanelInput::from_status(mode, &self.latest, learned, failed);
+        let input = panel_input(mode, &self.latest, learned, failed);
         Tick {
             pet_watchdog: watch.pet_watchdog,
             mode,
@@ -648,6 +683,67 @@ pub fn carry_out<S: RecordStore>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::panel::{read_blink_code, render, Lamp};
+
+    /// An isolation that names `fault` with probability `p` (the rest unknown).
+    fn isolation(fault: Fault, p: f32) -> Isolation {
+        let mut iso = Isolation {
+            state: monitor_core::IsolationState::Isolated,
+            ..Isolation::default()
+        };
+        let k = iso
+            .candidates
+            .iter()
+            .position(|c| c.fault == fault)
+            .unwrap_or(0); // ok: test
+        iso.candidates.swap(0, k);
+        iso.candidates[0].probability = p;
+        iso.unknown_probability = 1.0 - p;
+        iso
+    }
+
+    #[test]
+    fn the_code_is_the_isolated_fault_and_a_named_fault_shows_when_commissioned() {
+        let mut status = MonitorStatus {
+            commissioned: true,
+            ..MonitorStatus::default()
+        };
+        let at = |inp: &PanelInput| {
+            let trace: Vec<bool> = (0..400u32)
+                .map(|k| render(inp, k * 50).is_on(Lamp::Fault))
+                .collect();
+            read_blink_code(&trace, 50)
+        };
+        // Named, commissioned, lamps quiet: shown with the fault's code.
+        let rr = isolation(Fault::Rr, 0.9);
+        let inp = panel_input(Mode::Commissioned, &status, Some(&rr), false);
+        assert_eq!(at(&inp), Some(2));
+        // Not commissioned: the isolation alone does not light the lamp.
+        status.commissioned = false;
+        let inp = panel_input(Mode::NotCommissioned, &status, Some(&rr), false);
+        assert!((0..400u32).all(|k| !render(&inp, k * 50).is_on(Lamp::Fault)));
+        // The lamps detect, the isolation is not sure (p < 0.5): "not named".
+        status.fault_detected = true;
+        let unsure = isolation(Fault::Rs, 0.4);
+        let inp = panel_input(Mode::NotCommissioned, &status, Some(&unsure), false);
+        assert_eq!(at(&inp), Some(NOT_NAMED_CODE));
+        // No learned isolation baseline: the lamps' top candidate, or "not named".
+        let inp = panel_input(Mode::NotCommissioned, &status, None, false);
+        assert_eq!(at(&inp), Some(NOT_NAMED_CODE));
+        status.top = Some((Fault::Lr, 0.5));
+        let inp = panel_input(Mode::NotCommissioned, &status, None, false);
+        assert_eq!(at(&inp), Some(4));
+        status.top = None;
+        // Bl (or B) named: the friction class, code 5, and a load change alone does not
+        // light the lamp.
+        let bl = isolation(Fault::Bl, 0.7);
+        let inp = panel_input(Mode::Commissioned, &status, Some(&bl), false);
+        assert_eq!(at(&inp), Some(5));
+        status.fault_detected = false;
+        status.commissioned = true;
+        let inp = panel_input(Mode::Commissioned, &status, Some(&bl), false);
+        assert!((0..400u32).all(|k| !render(&inp, k * 50).is_on(Lamp::Fault)));
+    }
 
     #[test]
     fn settings_out_of_range_are_named() {

@@ -52,10 +52,7 @@
 //! in `Fault::ALL` order, as before the isolation, and the isolation is only printed on the
 //! status line.
 
-use crate::app::MonitorStatus;
 pub use crate::board::Lamp;
-use monitor_core::isolation::{Isolation, Named};
-use monitor_core::Fault;
 
 /// State of the six lamps (`true` = lit), one field per lamp.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -128,7 +125,9 @@ impl Mode {
     }
 }
 
-/// Inputs of [`render`].
+/// Inputs of [`render`]: the panel's whole interface. The application builds it from the
+/// monitor's status and the isolation (`app::panel_input`); this module depends on nothing
+/// but the lamp table ([`Lamp`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PanelInput {
     /// Panel mode.
@@ -144,42 +143,6 @@ pub struct PanelInput {
     pub fault_code: u8,
     /// The last commissioning attempt failed (shown while no fault is).
     pub commissioning_failed: bool,
-}
-
-impl PanelInput {
-    /// The panel's inputs for the latest status in `mode` and the latest `isolation`
-    /// judged against a baseline learned in commissioning (`None` without one): the residual
-    /// lamps, the fault lamp (the core's detection, or a fault the isolation names while
-    /// commissioned: module docs), "input invalid" when a sensor fault is flagged with no
-    /// residual lamp lit, and the blink code: the isolated fault's (or "not named"); without
-    /// a learned isolation baseline the lamps' top candidate's, as the paper's method
-    /// gives it (a nameplate's parameters can be 10-30 % off: the isolation against them is
-    /// not trusted on the panel, only printed on the status line).
-    pub fn from_status(
-        mode: Mode,
-        status: &MonitorStatus,
-        isolation: Option<&Isolation>,
-        commissioning_failed: bool,
-    ) -> Self {
-        let named = isolation.and_then(Isolation::named);
-        let fault_code = match (isolation, named) {
-            (_, Some(Named::Fault(c))) => blink_code(c.fault.index() as u8),
-            (_, Some(Named::Friction { .. })) => blink_code(Fault::B.index() as u8),
-            (Some(_), None) => NOT_NAMED_CODE,
-            (None, None) => status
-                .top
-                .map_or(NOT_NAMED_CODE, |(f, _)| blink_code(f.index() as u8)),
-        };
-        let named_fault = matches!(named, Some(Named::Fault(_)));
-        PanelInput {
-            mode,
-            residual_lamps: status.residual_lamps,
-            fault_detected: status.fault_detected || (named_fault && status.commissioned),
-            input_invalid: status.sensor_fault.any() && !status.residual_lamps.iter().any(|l| *l),
-            fault_code,
-            commissioning_failed,
-        }
-    }
 }
 
 /// Blink code of a fault detected that the isolation did not name (module docs).
@@ -314,66 +277,6 @@ mod tests {
                 .collect();
             assert_eq!(read_blink_code(&trace, 50), Some(code), "code {code}");
         }
-    }
-
-    /// An isolation that names `fault` with probability `p` (the rest unknown).
-    fn isolation(fault: Fault, p: f32) -> Isolation {
-        let mut iso = Isolation {
-            state: monitor_core::IsolationState::Isolated,
-            ..Isolation::default()
-        };
-        let k = iso
-            .candidates
-            .iter()
-            .position(|c| c.fault == fault)
-            .unwrap_or(0); // ok: test
-        iso.candidates.swap(0, k);
-        iso.candidates[0].probability = p;
-        iso.unknown_probability = 1.0 - p;
-        iso
-    }
-
-    #[test]
-    fn the_code_is_the_isolated_fault_and_a_named_fault_shows_when_commissioned() {
-        let mut status = MonitorStatus {
-            commissioned: true,
-            ..MonitorStatus::default()
-        };
-        let at = |inp: &PanelInput| {
-            let trace: Vec<bool> = (0..400u32)
-                .map(|k| render(inp, k * 50).is_on(Lamp::Fault))
-                .collect();
-            read_blink_code(&trace, 50)
-        };
-        // Named, commissioned, lamps quiet: shown with the fault's code.
-        let rr = isolation(Fault::Rr, 0.9);
-        let inp = PanelInput::from_status(Mode::Commissioned, &status, Some(&rr), false);
-        assert_eq!(at(&inp), Some(2));
-        // Not commissioned: the isolation alone does not light the lamp.
-        status.commissioned = false;
-        let inp = PanelInput::from_status(Mode::NotCommissioned, &status, Some(&rr), false);
-        assert!((0..400u32).all(|k| !render(&inp, k * 50).is_on(Lamp::Fault)));
-        // The lamps detect, the isolation is not sure (p < 0.5): "not named".
-        status.fault_detected = true;
-        let unsure = isolation(Fault::Rs, 0.4);
-        let inp = PanelInput::from_status(Mode::NotCommissioned, &status, Some(&unsure), false);
-        assert_eq!(at(&inp), Some(NOT_NAMED_CODE));
-        // No learned isolation baseline: the lamps' top candidate, or "not named".
-        let inp = PanelInput::from_status(Mode::NotCommissioned, &status, None, false);
-        assert_eq!(at(&inp), Some(NOT_NAMED_CODE));
-        status.top = Some((Fault::Lr, 0.5));
-        let inp = PanelInput::from_status(Mode::NotCommissioned, &status, None, false);
-        assert_eq!(at(&inp), Some(4));
-        status.top = None;
-        // Bl (or B) named: the friction class, code 5, and a load change alone does not
-        // light the lamp.
-        let bl = isolation(Fault::Bl, 0.7);
-        let inp = PanelInput::from_status(Mode::Commissioned, &status, Some(&bl), false);
-        assert_eq!(at(&inp), Some(5));
-        status.fault_detected = false;
-        status.commissioned = true;
-        let inp = PanelInput::from_status(Mode::Commissioned, &status, Some(&bl), false);
-        assert!((0..400u32).all(|k| !render(&inp, k * 50).is_on(Lamp::Fault)));
     }
 
     #[test]

@@ -48,3 +48,23 @@ fn the_panel_and_the_panic_handler_do_not_repeat_the_pins() {
         assert!(!firmware.contains(&pin), "src/firmware.rs names {pin}");
     }
 }
+
+#[test]
+fn the_panel_is_a_leaf_that_imports_nothing_from_the_application() {
+    // `app` builds the panel's input (`app::panel_input`); the panel must not need `app`
+    // (they imported each other once). Code lines only: the docs may name `app`.
+    let panel = read("src/panel.rs");
+    let uses: Vec<&str> = panel
+        .lines()
+        .map(str::trim_start)
+        .filter(|l| !l.starts_with("//"))
+        .filter(|l| l.contains("crate::") || l.contains("super::") || l.contains("drive_monitor::"))
+        .filter(|l| !l.starts_with("use super::*;"))
+        .collect();
+    for l in &uses {
+        assert!(
+            l.contains("crate::board::"),
+            "src/panel.rs uses more than the lamp table: `{l}`"
+        );
+    }
+}

@@ -15,14 +15,14 @@
 //! the next boot would load) and the panel (the RUN lamp's mode) agree.
 
 use drive_monitor::app::{
-    carry_out, MonitorStatus, SamplePath, Settings, Supervisor, Tick, PANEL_PERIOD_MS,
+    carry_out, panel_input, MonitorStatus, SamplePath, Settings, Supervisor, Tick, PANEL_PERIOD_MS,
     WATCHDOG_TIMEOUT_MS,
 };
 use drive_monitor::board::{self, RECORD_PAGE_SIZE};
 use drive_monitor::commissioning::{Failure, RunEnd};
 use drive_monitor::flash_record::{self, CalibrationRecord, RecordStore, RECORD_LEN};
 use drive_monitor::liveness::AdcWait;
-use drive_monitor::panel::{self, Lamp, Mode, PanelInput, PanelLamps};
+use drive_monitor::panel::{self, Lamp, Mode, PanelLamps};
 use drive_monitor::reset_record::{PreviousRun, ResetCause, ResetRecord, RESET_RECORD_LEN};
 use drive_monitor::sampling::RawFrame;
 use monitor_core::{Abc, Calibration, CommissioningFailure, Fault, RunStage};
@@ -456,7 +456,7 @@ fn commission_then_detect_rs_fault_on_the_panel() {
     assert!(status.residual_lamps.iter().any(|l| *l));
     let iso = rig.supervisor.isolation().copied();
     eprintln!("isolation: {iso:?}");
-    let input = PanelInput::from_status(rig.mode(), &status, iso.as_ref(), false);
+    let input = panel_input(rig.mode(), &status, iso.as_ref(), false);
     let now = panel::render(&input, 0);
     for (lamp, lit) in Lamp::RESIDUALS.into_iter().zip(status.residual_lamps) {
         assert_eq!(now.is_on(lamp), lit);
@@ -667,7 +667,7 @@ fn timeout_while_the_gate_is_closed_cancels_and_keeps_the_old_record() {
         rig.supervisor.procedure().last_failure(),
         Some(Failure::Stalled)
     );
-    let input = PanelInput::from_status(Mode::Commissioned, &rig.last().status, None, true);
+    let input = panel_input(Mode::Commissioned, &rig.last().status, None, true);
     let flicker: Vec<bool> = (0..10u32)
         .map(|t| panel::render(&input, t * 25).fault)
         .collect();
@@ -959,7 +959,7 @@ fn saturated_adc_lights_the_fault_lamp_steadily() {
     rig.run(&frames, |_, _| {}).unwrap();
     let status = rig.last().status;
     assert!(status.sensor_fault.current);
-    let input = PanelInput::from_status(rig.mode(), &status, rig.supervisor.isolation(), false);
+    let input = panel_input(rig.mode(), &status, rig.supervisor.isolation(), false);
     assert!(panel::render(&input, 0).is_on(Lamp::Fault));
     assert!(
         panel::render(&input, 777).is_on(Lamp::Fault),
