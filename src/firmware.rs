@@ -176,8 +176,13 @@ impl Acquisition {
     }
 }
 
-#[embassy_executor::task]
-async fn sample_task(hw: SampleHw, mut path: SamplePath) {
+/// Starts the acquisition: the encoder (TIM4 in quadrature mode), the trigger (TIM1 update
+/// -> TRGO at the sample rate) and the two ring-buffered ADCs (ADC1 the voltages, ADC2 the
+/// currents), then the trigger, the timestamps continuing from now.
+fn start_acquisition(
+    hw: SampleHw,
+    path: &mut SamplePath,
+) -> (Qei<'static, peripherals::TIM4>, Acquisition) {
     static RING1: static_cell::StaticCell<[u16; RING_LEN]> = static_cell::StaticCell::new();
     static RING2: static_cell::StaticCell<[u16; RING_LEN]> = static_cell::StaticCell::new();
     let ring1 = RING1.init([0; RING_LEN]);
@@ -229,11 +234,48 @@ async fn sample_task(hw: SampleHw, mut path: SamplePath) {
     acq.adc2.start();
     path.sampler_mut().resync(now_us());
     acq.trigger.start();
+    (qei, acq)
+}
+
+/// Runs the sample path on the readings of one DMA half (`v` from ADC1, `i` from ADC2)
+/// with the encoder count read after them; hands thread mode a status every
+/// `status_every` samples. `max_cycles`: the longest `on_frame` so far, in CPU cycles.
+fn process_half(
+    path: &mut SamplePath,
+    v: &[u16],
+    i: &[u16],
+    encoder_count: u16,
+    max_cycles: &mut u32,
+) {
+    for (v, i) in v.chunks_exact(CHANNELS).zip(i.chunks_exact(CHANNELS)) {
+        let (&[va, vb, vc], &[ia, ib, ic]) = (v, i) else {
+            continue;
+        };
+        let raw = RawFrame {
+            v: [VoltageCode(va), VoltageCode(vb), VoltageCode(vc)],
+            i: [CurrentCode(ia), CurrentCode(ib), CurrentCode(ic)],
+            encoder_count,
+        };
+        let t0 = cortex_m::peripheral::DWT::cycle_count();
+        path.on_frame(&raw);
+        let dt = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t0);
+        *max_cycles = (*max_cycles).max(dt);
+        if path.samples().is_multiple_of(SETTINGS.status_every()) {
+            STATUS.signal(Status {
+                monitor: path.status(),
+                max_update_cycles: *max_cycles,
+            });
+        }
+    }
+}
+
+#[embassy_executor::task]
+async fn sample_task(hw: SampleHw, mut path: SamplePath) {
+    let (qei, mut acq) = start_acquisition(hw, &mut path);
     info!("sampling at {=u32} Hz", SETTINGS.sample_rate_hz);
 
     let mut wait = AdcWait::new(SETTINGS.sample_rate_hz);
     let timeout = Duration::from_micros(u64::from(wait.timeout_us()));
-    let status_every = SETTINGS.status_every();
     let mut half1 = [0u16; SAMPLES_PER_HALF * CHANNELS];
     let mut half2 = [0u16; SAMPLES_PER_HALF * CHANNELS];
     let mut max_cycles: u32 = 0;
@@ -275,30 +317,7 @@ async fn sample_task(hw: SampleHw, mut path: SamplePath) {
                 warn!("core refused a command: {=str}", e.describe());
             }
         }
-        let encoder_count = qei.count();
-        for (v, i) in half1
-            .chunks_exact(CHANNELS)
-            .zip(half2.chunks_exact(CHANNELS))
-        {
-            let (&[va, vb, vc], &[ia, ib, ic]) = (v, i) else {
-                continue;
-            };
-            let raw = RawFrame {
-                v: [VoltageCode(va), VoltageCode(vb), VoltageCode(vc)],
-                i: [CurrentCode(ia), CurrentCode(ib), CurrentCode(ic)],
-                encoder_count,
-            };
-            let t0 = cortex_m::peripheral::DWT::cycle_count();
-            path.on_frame(&raw);
-            let dt = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t0);
-            max_cycles = max_cycles.max(dt);
-            if path.samples().is_multiple_of(status_every) {
-                STATUS.signal(Status {
-                    monitor: path.status(),
-                    max_update_cycles: max_cycles,
-                });
-            }
-        }
+        process_half(&mut path, &half1, &half2, qei.count(), &mut max_cycles);
     }
 }
 
@@ -373,9 +392,14 @@ async fn main(_spawner: Spawner) {
     let mut wdg = IndependentWatchdog::new(b.iwdg, WATCHDOG_TIMEOUT_MS * 1000);
     wdg.unleash();
 
-    let mut lamps = PanelPins::new(b.lamps);
+    let mut thread = Thread {
+        lamps: PanelPins::new(b.lamps),
+        flash: BoardFlash(Flash::new_blocking(b.flash)),
+        wdg,
+        max_update_cycles: 0,
+        log_div: 0,
+    };
     let mut button = ExtiInput::new(b.button, b.button_exti, Pull::Down, Irqs);
-    let mut flash = BoardFlash(Flash::new_blocking(b.flash));
 
     let mut path = match SamplePath::for_board(SETTINGS.sample_rate_hz) {
         Ok(p) => p,
@@ -384,7 +408,7 @@ async fn main(_spawner: Spawner) {
         #[allow(clippy::panic)]
         Err(_) => panic!("monitor configuration rejected"),
     };
-    let installed = install_stored_calibration(&mut flash, &mut path);
+    let installed = install_stored_calibration(&mut thread.flash, &mut path);
     let boot = Instant::now();
     let mut supervisor = Supervisor::new(&SETTINGS, previous, 0, path.status());
     if let Some(rec) = installed {
@@ -412,8 +436,6 @@ async fn main(_spawner: Spawner) {
 
     let period = Duration::from_millis(u64::from(PANEL_PERIOD_MS));
     let mut next = Instant::now() + period;
-    let mut max_update_cycles = 0;
-    let mut log_div: u32 = 0;
     loop {
         // The period's wait is the wait for the button: a press at any time is seen.
         let pressed = with_deadline(next, button.wait_for_rising_edge())
@@ -424,14 +446,34 @@ async fn main(_spawner: Spawner) {
         }
         next += period;
         let now_ms = boot.elapsed().as_millis() as u32;
+        thread.period(&mut supervisor, now_ms, pressed).await;
+    }
+}
 
+/// What thread mode owns besides the supervisor: the lamps, the flash, the watchdog and
+/// the log's state.
+struct Thread {
+    lamps: PanelPins,
+    flash: BoardFlash,
+    wdg: IndependentWatchdog<'static, peripherals::IWDG>,
+    /// The sample task's longest `Monitor::update` so far, in CPU cycles (from its status).
+    max_update_cycles: u32,
+    /// Periods since the last status line (one every second period: 100 ms).
+    log_div: u32,
+}
+
+impl Thread {
+    /// One period at `now_ms`: the supervisor's tick on the latest status and the button,
+    /// then its consequences (watchdog, logs, the commissioning action with its command
+    /// to the sample task, the lamps) and every second period the status line.
+    async fn period(&mut self, supervisor: &mut Supervisor, now_ms: u32, pressed: bool) {
         let status = STATUS.try_take();
         if let Some(s) = status {
-            max_update_cycles = s.max_update_cycles;
+            self.max_update_cycles = s.max_update_cycles;
         }
         let tick = supervisor.tick(now_ms, status.map(|s| s.monitor), pressed);
         if tick.pet_watchdog {
-            wdg.pet();
+            self.wdg.pet();
         }
         if let Some(change) = tick.liveness {
             on_liveness(change);
@@ -439,7 +481,7 @@ async fn main(_spawner: Spawner) {
         if let Some(end) = tick.run_ended {
             log_run_end(end);
         }
-        let (command, stored) = carry_out(tick.action, &mut flash);
+        let (command, stored) = carry_out(tick.action, &mut self.flash);
         if let Some(stored) = stored {
             log_stored(&stored);
         }
@@ -453,16 +495,16 @@ async fn main(_spawner: Spawner) {
                 error!("command queue full: {=str} dropped", cmd.name());
             }
         }
-        lamps.show(&tick.lamps);
+        self.lamps.show(&tick.lamps);
 
-        log_div += 1;
-        if log_div >= 2 {
-            log_div = 0;
+        self.log_div += 1;
+        if self.log_div >= 2 {
+            self.log_div = 0;
             log_status(
                 supervisor.latest(),
                 supervisor.isolation(),
                 tick.mode.name(),
-                max_update_cycles,
+                self.max_update_cycles,
             );
         }
     }
