@@ -207,29 +207,19 @@ fn replay_matches_host(cfg: &MonitorConfig, n: usize, checks: usize, spacing: us
     ok
 }
 
-/// Counts the instructions per sample of the pipeline's parts and of the whole
-/// `Monitor::update`, and prints them.
-fn count_instructions(cfg: &MonitorConfig, n: usize, ticks_per_instr: f32) {
-    let cfg = *cfg;
-    let per_sample = |ticks: u32, base: u32, count: usize| -> f32 {
-        (ticks as f32 - base as f32) / ticks_per_instr / count as f32
-    };
-    let base = measure(|| {
-        for k in 0..n {
-            black_box(scenario::sample(REPLAY, k));
-        }
-    });
-
+/// Ticks of `n` samples through angle + Park as `Monitor::update` does it with the
+/// rotor-flux model: the frame's sin/cos advanced by a small rotation per sample
+/// (`SinCos::rotated`), resynchronised by one sin/cos per block.
+#[inline(always)]
+fn measure_angle_park(cfg: &MonitorConfig, n: usize) -> u32 {
     let m = &cfg.motor;
     let dt = 1.0 / cfg.sample_rate_hz;
     let imr_min = 0.05 * cfg.v_phase_peak / (core::f32::consts::TAU * cfg.supply_hz * m.ls_h);
     let mut rfo = RotorFluxCurrentModel::new(dt, m.rr_ohm, m.lr_h, imr_min);
     let wr = black_box(150.0f32);
-    // Angle + Park as Monitor::update does it: the frame's sin/cos advanced by a small
-    // rotation per sample (SinCos::rotated), resynchronised by one sin/cos per block.
     let dec = cfg.decimation as usize;
     let mut sc = SinCos::from_angle(rfo.theta());
-    let t_park = measure(|| {
+    measure(|| {
         for k in 0..n {
             let s = scenario::sample(REPLAY, k);
             let v = clarke(s.v_abc);
@@ -245,17 +235,27 @@ fn count_instructions(cfg: &MonitorConfig, n: usize, ticks_per_instr: f32) {
             sc = sc.rotated(rfo.omega_rad_s() * dt);
             black_box((v_dq, i_dq, n_dq));
         }
-    });
+    })
+}
 
+/// Ticks of `n` samples through the M/T speed estimate.
+#[inline(always)]
+fn measure_speed(cfg: &MonitorConfig, n: usize) -> u32 {
+    let dt = 1.0 / cfg.sample_rate_hz;
     let mut mt = MtSpeed::new(&cfg.encoder, cfg.tick_hz, cfg.limits.max_speed_rad_s, dt);
-    let t_speed = measure(|| {
+    measure(|| {
         for k in 0..n {
             let s = scenario::sample(REPLAY, k);
             black_box(mt.update(s.encoder_count, s.timestamp_ticks));
         }
-    });
+    })
+}
 
-    let t_res = measure(|| {
+/// Ticks of `n` evaluations of the steady-state residuals (eq. 37).
+#[inline(always)]
+fn measure_residuals(cfg: &MonitorConfig, n: usize) -> u32 {
+    let m = &cfg.motor;
+    measure(|| {
         for k in 0..n {
             let s = scenario::sample(REPLAY, k);
             let op = Operating {
@@ -266,28 +266,42 @@ fn count_instructions(cfg: &MonitorConfig, n: usize, ticks_per_instr: f32) {
             };
             black_box(residuals(m, op, None));
         }
-    });
+    })
+}
 
+/// Ticks of `n` samples through a fresh `Monitor` of `cfg`.
+#[inline(always)]
+fn measure_monitor(cfg: MonitorConfig, n: usize) -> u32 {
     let Ok(mut monitor) = Monitor::new(cfg) else {
         semihosting::exit(false);
     };
-    let t_all = measure(|| {
+    measure(|| {
         for k in 0..n {
             black_box(monitor.update(&scenario::sample(REPLAY, k)));
         }
-    });
+    })
+}
 
+/// Counts the instructions per sample of the pipeline's parts and of the whole
+/// `Monitor::update`, and prints them.
+fn count_instructions(cfg: &MonitorConfig, n: usize, ticks_per_instr: f32) {
+    let cfg = *cfg;
+    let per_sample = |ticks: u32, base: u32, count: usize| -> f32 {
+        (ticks as f32 - base as f32) / ticks_per_instr / count as f32
+    };
+    let base = measure(|| {
+        for k in 0..n {
+            black_box(scenario::sample(REPLAY, k));
+        }
+    });
+    let t_park = measure_angle_park(&cfg, n);
+    let t_speed = measure_speed(&cfg, n);
+    let t_res = measure_residuals(&cfg, n);
+    let t_all = measure_monitor(cfg, n);
     // Split fast and slow path: total(d) = fast + slow / d, measured at d and d/2.
     let mut cfg_half = cfg;
     cfg_half.decimation = (cfg.decimation / 2).max(1);
-    let Ok(mut monitor) = Monitor::new(cfg_half) else {
-        semihosting::exit(false);
-    };
-    let t_half = measure(|| {
-        for k in 0..n {
-            black_box(monitor.update(&scenario::sample(REPLAY, k)));
-        }
-    });
+    let t_half = measure_monitor(cfg_half, n);
     let d = f32::from(cfg.decimation);
     let dh = f32::from(cfg_half.decimation);
     let (all, half) = (per_sample(t_all, base, n), per_sample(t_half, base, n));
