@@ -3,7 +3,8 @@
 //! - `fw [--check]`: build the firmware ELF (the workspace's `firmware` profile: fat LTO,
 //!   one codegen unit, debug info) for `thumbv7em-none-eabihf`, then
 //!   read its section table and print flash and static RAM use against the goals
-//!   (64 KiB flash, 16 KiB RAM). `--check` exits 1 when a goal is missed.
+//!   (128 KiB flash, 32 KiB RAM: the smallest STM32G4 part with the same peripherals).
+//!   `--check` exits 1 when a goal is missed.
 //! - `qemu-core`: build `crates/core-on-m4` for `thumbv7em-none-eabihf`, check that its
 //!   vector table is at 0x0 (the mps2-an386 layout, not the G474's), and run it on
 //!   `qemu-system-arm -M mps2-an386 -cpu cortex-m4 -icount shift=0` with semihosting.
@@ -22,8 +23,11 @@ use std::process::{Command, ExitCode, Stdio};
 use std::time::{Duration, Instant};
 
 const TARGET: &str = "thumbv7em-none-eabihf";
-const FLASH_GOAL: u64 = 64 * 1024;
-const RAM_GOAL: u64 = 16 * 1024;
+/// Flash goal: the smallest STM32G4 part with the G474's peripherals used here (ADC1/2,
+/// TIM1, TIM4, DMA, IWDG) has 128 KiB of flash and 32 KiB of RAM.
+const FLASH_GOAL: u64 = 128 * 1024;
+/// Static RAM goal (the stack not included), see [`FLASH_GOAL`].
+const RAM_GOAL: u64 = 32 * 1024;
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -120,13 +124,15 @@ fn fw(check: bool) -> Result<(), String> {
     println!("ELF: {}", elf_path.display());
     let verdict = |used: u64, goal: u64| if used <= goal { "ok" } else { "OVER GOAL" };
     println!(
-        "flash={flash} bytes ({:.1} KiB, goal 64 KiB: {})",
+        "flash={flash} bytes ({:.1} KiB, goal {} KiB: {})",
         flash as f64 / 1024.0,
+        FLASH_GOAL / 1024,
         verdict(flash, FLASH_GOAL)
     );
     println!(
-        "ram={ram} bytes static ({:.1} KiB, goal 16 KiB: {}; stack not included)",
+        "ram={ram} bytes static ({:.1} KiB, goal {} KiB: {}; stack not included)",
         ram as f64 / 1024.0,
+        RAM_GOAL / 1024,
         verdict(ram, RAM_GOAL)
     );
     if check && (flash > FLASH_GOAL || ram > RAM_GOAL) {
