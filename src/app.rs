@@ -13,7 +13,7 @@
 //!   large; about 280 small circuit evaluations every 50 ms at most) and the panel.
 //!   [`carry_out`] turns its actions into commands, storing the learned calibration first.
 //!
-//! The host tests (`tests/sil.rs`) drive exactly these types with simulated data; the
+//! The host tests (`tests/sil/`) drive exactly these types with simulated data; the
 //! firmware (`src/firmware.rs`) only adds the hardware around them.
 //!
 //! [`Sample`]: monitor_core::Sample

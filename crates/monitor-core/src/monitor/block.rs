@@ -14,6 +14,8 @@ use core::f32::consts::TAU;
 pub(super) struct Derived {
     /// Sample period `1 / sample_rate_hz` [s].
     pub(super) dt_s: f32,
+    /// Block period `decimation / sample_rate_hz` (as `dt_s x decimation`) [s].
+    pub(super) block_dt_s: f32,
     /// Blocks per second, `sample_rate_hz / decimation` [Hz].
     pub(super) block_rate_hz: f32,
     /// Pole pairs: electrical speed per mechanical speed.
@@ -76,6 +78,7 @@ impl Derived {
         let v_run_min = cfg.min_voltage_frac * cfg.v_phase_peak;
         Derived {
             dt_s: dt,
+            block_dt_s: slow_dt,
             block_rate_hz: slow_hz,
             np: cfg.motor.np(),
             v_max_bits: cfg.limits.v_max.to_bits(),
@@ -94,11 +97,6 @@ impl Derived {
             block_ticks: (cfg.tick_hz * slow_dt + 0.5) as u32,
             max_gap_ticks: (cfg.tick_hz * (slow_dt + cfg.max_bridged_gap_s)) as u32,
         }
-    }
-
-    /// The block period `decimation / sample_rate_hz` [s].
-    pub(super) fn block_dt_s(&self, cfg: &MonitorConfig) -> f32 {
-        self.dt_s * f32::from(cfg.decimation)
     }
 }
 

@@ -32,8 +32,7 @@ impl Monitor {
         duration_s: f32,
         install: Install,
     ) -> Result<u16, CommissioningError> {
-        let slow_hz = self.cfg.sample_rate_hz / f32::from(self.cfg.decimation);
-        let id = self.learner.start(duration_s, slow_hz, install)?;
+        let id = self.learner.start(duration_s, self.k.block_rate_hz, install)?;
         self.lamps.reset();
         Ok(id)
     }

@@ -108,7 +108,7 @@ impl Monitor {
     pub fn new(cfg: MonitorConfig) -> Result<Self, ConfigError> {
         cfg.validate()?;
         let k = Derived::new(&cfg);
-        let block_dt = k.block_dt_s(&cfg);
+        let block_dt = k.block_dt_s;
         Ok(Monitor {
             k,
             frame: Frame::new(&cfg),

@@ -1,0 +1,166 @@
+//! Liveness: a stalled sample path (shown, restarted, recovered or reset by the watchdog),
+//! a panic's reason across the reset, a saturated ADC.
+
+use super::*;
+
+/// Runs `frames[..stop]`, then no samples until the acquisition has been restarted
+/// `resume_after` times (then the frames go on), or for good (`None`).
+fn run_with_stall(
+    rig: &mut Rig,
+    frames: &[RawFrame],
+    stop: usize,
+    resume_after: Option<usize>,
+) -> Result<(), Reset> {
+    rig.run(&frames[..stop], |_, _| {})?;
+    while resume_after.is_none_or(|n| rig.restarts_at_ms.len() < n) {
+        rig.period(None)?;
+    }
+    rig.run(&frames[stop..], |_, _| {})
+}
+
+#[test]
+fn a_stalled_sample_path_is_shown_restarted_and_recovers() {
+    let frames = steady_frames(3.0);
+    let mut rig = Rig::boot(Survivors::power_on(FakeFlash::holding(&old_record())));
+    // The DMA stops at 2.0 s; the 150th restart (after 300 ms) brings it back.
+    run_with_stall(&mut rig, &frames, 20_000, Some(150)).unwrap();
+    let stall = |s: &&Seen| (2_000..2_300).contains(&s.t_ms);
+    let during: Vec<&Seen> = rig.seen.iter().filter(stall).collect();
+    // The first restart 2 ms after the last sample, then every 2 ms.
+    assert_eq!(rig.restarts_at_ms[0], 2_001);
+    assert_eq!(rig.restarts_at_ms[149], 2_299);
+    assert_eq!(rig.restarts_at_ms.len(), 150);
+    // No pet from the first period without samples on; the stalled pattern from 100 ms.
+    assert!(during.iter().skip(1).all(|s| !s.tick.pet_watchdog));
+    for s in &during {
+        let expected = if s.t_ms >= 2_100 {
+            Mode::SamplingStalled
+        } else {
+            Mode::Commissioned
+        };
+        assert_eq!(s.tick.mode, expected, "{} ms", s.t_ms);
+    }
+    let flashing: Vec<PanelLamps> = during
+        .iter()
+        .filter(|s| s.tick.mode == Mode::SamplingStalled)
+        .map(|s| s.tick.lamps)
+        .collect();
+    assert!(
+        flashing.contains(&PanelLamps::all(true)) && flashing.contains(&PanelLamps::all(false))
+    );
+    // Logged once when stalled, the reset record written at 300 ms and cleared after.
+    let changes: Vec<_> = rig.seen.iter().filter_map(|s| s.tick.liveness).collect();
+    use drive_monitor::liveness::LivenessChange::*;
+    assert_eq!(
+        changes,
+        [
+            Stalled { for_ms: 100 },
+            RecordStall { for_ms: 300 },
+            Recovered { after_ms: 350 }
+        ]
+    );
+    assert_eq!(ResetRecord::decode(&rig.survivors.reset_ram), None);
+    // Back to normal: petted, commissioned, the core's lamps.
+    let after: Vec<&Seen> = rig.seen.iter().filter(|s| s.t_ms >= 2_400).collect();
+    assert!(after
+        .iter()
+        .all(|s| s.tick.pet_watchdog && s.tick.mode == Mode::Commissioned));
+    assert!(after.last().unwrap().status.samples > 25_000);
+}
+
+#[test]
+fn a_stall_the_restarts_do_not_fix_ends_in_a_reported_watchdog_reset() {
+    let frames = steady_frames(2.5);
+    let mut rig = Rig::boot(Survivors::power_on(FakeFlash::holding(&old_record())));
+    let reset = run_with_stall(&mut rig, &frames, 20_000, None);
+    assert_eq!(reset, Err(Reset::Watchdog));
+    // The last pet was the last period with samples; the reset came 500 ms later, after
+    // about 250 restarts.
+    assert_eq!(rig.now_ms(), 2_501);
+    assert!(rig.restarts_at_ms.len() >= 240);
+    // The next boot knows why, shows "monitor failed" for 5 s, then monitors again.
+    let mut rig = Rig::boot(rig.survivors.clone());
+    let PreviousRun::Recorded(rec) = rig.previous else {
+        panic!("{:?}", rig.previous);
+    };
+    assert_eq!(rec.cause(), ResetCause::SampleStall);
+    assert_eq!(rec.line_or_ms(), 300);
+    let frames = steady_frames(6.0);
+    rig.run(&frames, |_, _| {}).unwrap();
+    for s in &rig.seen {
+        let expected = if s.t_ms < 5_000 {
+            Mode::Failed
+        } else {
+            Mode::Commissioned
+        };
+        assert_eq!(s.tick.mode, expected, "{} ms", s.t_ms);
+    }
+    assert_eq!(rig.seen[0].tick.lamps, PanelLamps::FAILED);
+}
+
+#[test]
+fn a_panic_reason_survives_the_reset() {
+    let frames = steady_frames(1.0);
+    let mut rig = Rig::boot(Survivors::power_on(FakeFlash::erased()));
+    rig.run(&frames, |_, _| {}).unwrap();
+    // The panic handler records the reason, stops petting; the watchdog resets.
+    let mut survivors = rig.survivors.clone();
+    survivors.reset_ram =
+        ResetRecord::panic("attempt to divide by zero", "src/app.rs", 321).encode();
+    survivors.watchdog_reset = true;
+    let rig = Rig::boot(survivors.clone());
+    let PreviousRun::Recorded(rec) = rig.previous else {
+        panic!("{:?}", rig.previous);
+    };
+    assert_eq!(
+        (rec.cause(), rec.message(), rec.file(), rec.line_or_ms()),
+        (
+            ResetCause::Panic,
+            "attempt to divide by zero",
+            "src/app.rs",
+            321
+        )
+    );
+    // The record is read once: the boot after that is clean again...
+    assert_eq!(
+        Rig::boot(rig.survivors.clone()).previous,
+        PreviousRun::Clean
+    );
+    // ...and a watchdog reset with no record is a hang.
+    survivors.reset_ram = [0; RESET_RECORD_LEN];
+    assert_eq!(Rig::boot(survivors).previous, PreviousRun::WatchdogReset);
+}
+
+#[test]
+fn saturated_adc_lights_the_fault_lamp_steadily() {
+    let mut rig = Rig::boot(Survivors::power_on(FakeFlash::erased()));
+    let q = *rig.path.sampler();
+    let frames: Vec<RawFrame> = (0..20_000)
+        .map(|k| {
+            let t = k as f32 / FS as f32;
+            let w = std::f32::consts::TAU * 50.0 * t;
+            let v = Abc {
+                a: 326.0 * w.cos(),
+                b: 326.0 * (w - 2.094).cos(),
+                c: 326.0 * (w + 2.094).cos(),
+            };
+            // 20 A peak on a +-10 A front end: the current codes hit the rails.
+            let i = Abc {
+                a: 20.0 * w.cos(),
+                b: 20.0 * (w - 2.094).cos(),
+                c: 20.0 * (w + 2.094).cos(),
+            };
+            q.quantize(v, i, 0)
+        })
+        .collect();
+    rig.run(&frames, |_, _| {}).unwrap();
+    let status = rig.last().status;
+    assert!(status.sensor_fault.current);
+    let input = panel_input(rig.mode(), &status, rig.supervisor.isolation(), false);
+    assert!(panel::render(&input, 0).is_on(Lamp::Fault));
+    assert!(
+        panel::render(&input, 777).is_on(Lamp::Fault),
+        "steady, not blinking"
+    );
+    assert!(rig.seen.iter().rev().take(10).all(|s| s.tick.lamps.fault));
+}

@@ -1,0 +1,408 @@
+//! Software in the loop: the firmware's own logic (ADC quantization, sample path, core,
+//! status hand-over, supervisor with its commissioning procedure and liveness watch, flash
+//! record, reset record, panel) driven sample by sample by the simulator in `sim-host`, with
+//! the lamps, the watchdog and the flash asserted.
+//!
+//! The rig is the firmware without hardware: a sample period is 100 us of board time; the
+//! sample task's work per period is `SamplePath::on_frame` (or, when the source delivers
+//! nothing, the wait for ADC data with its timeout and restarts); every 100 samples it hands
+//! over a status; every 50 ms thread mode runs `Supervisor::tick` and carries out its
+//! action on a fake flash page; a watchdog model resets the "MCU" 500 ms after the last pet.
+//! A reset (watchdog, power loss) keeps what survives on a board: the flash page, the
+//! no-init RAM of the reset record and the watchdog-reset flag.
+//!
+//! At every thread tick the rig checks that RAM (the core's thresholds), flash (the record
+//! the next boot would load) and the panel (the RUN lamp's mode) agree.
+
+mod commissioning;
+mod isolation;
+mod liveness;
+
+use drive_monitor::app::{
+    carry_out, panel_input, MonitorStatus, SamplePath, Settings, Supervisor, Tick, PANEL_PERIOD_MS,
+    WATCHDOG_TIMEOUT_MS,
+};
+use drive_monitor::board::{self, RECORD_PAGE_SIZE};
+use drive_monitor::commissioning::{Failure, RunEnd};
+use drive_monitor::flash_record::{self, CalibrationRecord, RecordStore, RECORD_LEN};
+use drive_monitor::liveness::AdcWait;
+use drive_monitor::panel::{self, Lamp, Mode, PanelLamps};
+use drive_monitor::reset_record::{PreviousRun, ResetCause, ResetRecord, RESET_RECORD_LEN};
+use drive_monitor::sampling::RawFrame;
+use monitor_core::{Abc, Calibration, CommissioningFailure, Fault, RunStage};
+use sim_host::params::ParamFile;
+use sim_host::sim::{simulate_to_vec, FaultSpec, LoadStep, Scenario};
+
+const FS: u32 = board::DEFAULT_SAMPLE_RATE_HZ;
+const PERIODS_PER_MS: u64 = FS as u64 / 1000;
+/// The rig's settings: the firmware's, with 1 s of learning to keep the tests short.
+const SETTINGS: Settings = Settings {
+    commissioning_duration_s: 1.0,
+    ..Settings::DEFAULT
+};
+
+/// A flash fault to inject into the next record write.
+#[derive(Clone, Copy, Debug)]
+enum FlashFault {
+    /// Power is lost after this many bytes of the record were written.
+    PowerLossAfter(usize),
+    /// The write reports an error and writes nothing.
+    WriteFails,
+}
+
+/// The record page, with fault injection.
+#[derive(Clone, Debug)]
+struct FakeFlash {
+    page: Vec<u8>,
+    fault: Option<FlashFault>,
+    power_lost: bool,
+    writes: u32,
+}
+
+#[derive(Debug)]
+struct FlashError;
+
+impl FakeFlash {
+    fn erased() -> Self {
+        Self {
+            page: vec![0xFF; RECORD_PAGE_SIZE as usize],
+            fault: None,
+            power_lost: false,
+            writes: 0,
+        }
+    }
+
+    fn holding(rec: &CalibrationRecord) -> Self {
+        let mut f = Self::erased();
+        f.page[..RECORD_LEN].copy_from_slice(&rec.encode().unwrap());
+        f
+    }
+
+    /// The calibration the next boot would put into force (a valid record the core
+    /// accepts), the flash side of "RAM, flash and panel agree".
+    fn usable(&self) -> Option<Calibration> {
+        CalibrationRecord::decode(&self.page)
+            .ok()
+            .map(Calibration::from)
+            .filter(Calibration::is_valid)
+    }
+}
+
+impl RecordStore for FakeFlash {
+    type Error = FlashError;
+    fn read(&mut self, buf: &mut [u8; RECORD_LEN]) -> Result<(), FlashError> {
+        if self.power_lost {
+            return Err(FlashError);
+        }
+        buf.copy_from_slice(&self.page[..RECORD_LEN]);
+        Ok(())
+    }
+    fn erase(&mut self) -> Result<(), FlashError> {
+        if self.power_lost {
+            return Err(FlashError);
+        }
+        self.page.fill(0xFF);
+        Ok(())
+    }
+    fn write(&mut self, bytes: &[u8; RECORD_LEN]) -> Result<(), FlashError> {
+        if self.power_lost {
+            return Err(FlashError);
+        }
+        self.writes += 1;
+        match self.fault.take() {
+            None => {
+                self.page[..RECORD_LEN].copy_from_slice(bytes);
+                Ok(())
+            }
+            Some(FlashFault::PowerLossAfter(n)) => {
+                self.page[..n].copy_from_slice(&bytes[..n]);
+                self.power_lost = true;
+                Err(FlashError)
+            }
+            Some(FlashFault::WriteFails) => Err(FlashError),
+        }
+    }
+}
+
+/// What survives a reset on the board.
+#[derive(Clone, Debug)]
+struct Survivors {
+    flash: FakeFlash,
+    reset_ram: [u8; RESET_RECORD_LEN],
+    watchdog_reset: bool,
+}
+
+impl Survivors {
+    fn power_on(flash: FakeFlash) -> Self {
+        Self {
+            flash,
+            // Power-on RAM content: anything.
+            reset_ram: [0x5A; RESET_RECORD_LEN],
+            watchdog_reset: false,
+        }
+    }
+}
+
+/// Why a run of the rig stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Reset {
+    Watchdog,
+    PowerLoss,
+}
+
+/// One thread-mode period as the rig saw it.
+#[derive(Clone, Copy, Debug)]
+struct Seen {
+    t_ms: u32,
+    tick: Tick,
+    status: MonitorStatus,
+    /// The core's quasi-steady gate at the tick (a peek the firmware does not need).
+    quasi_steady: bool,
+}
+
+/// The firmware without hardware.
+struct Rig {
+    settings: Settings,
+    survivors: Survivors,
+    previous: PreviousRun,
+    path: SamplePath,
+    supervisor: Supervisor,
+    periods: u64,
+    pending_status: Option<MonitorStatus>,
+    button: bool,
+    last_pet_ms: u32,
+    adc: AdcWait,
+    waited_us: u32,
+    restarts_at_ms: Vec<u32>,
+    seen: Vec<Seen>,
+    ended: Vec<RunEnd>,
+}
+
+impl Rig {
+    fn boot(survivors: Survivors) -> Self {
+        Self::boot_with(SETTINGS, survivors)
+    }
+
+    fn boot_with(settings: Settings, mut survivors: Survivors) -> Self {
+        let previous = PreviousRun::at_boot(&survivors.reset_ram, survivors.watchdog_reset);
+        survivors.reset_ram = [0; RESET_RECORD_LEN];
+        survivors.watchdog_reset = false;
+        survivors.flash.power_lost = false;
+        let mut path = SamplePath::for_board(settings.sample_rate_hz).unwrap();
+        let mut installed = None;
+        if let Ok(rec) = flash_record::load(&mut survivors.flash) {
+            // A record the core rejects leaves the default thresholds (logged on the board).
+            if path
+                .command(drive_monitor::app::Command::SetCalibration(rec))
+                .is_ok()
+            {
+                installed = Some(rec);
+            }
+        }
+        let mut supervisor = Supervisor::new(&settings, previous, 0, path.status());
+        if let Some(rec) = installed {
+            supervisor.restore_isolation(&rec);
+        }
+        Rig {
+            settings,
+            survivors,
+            previous,
+            path,
+            supervisor,
+            periods: 0,
+            pending_status: None,
+            button: false,
+            last_pet_ms: 0,
+            adc: AdcWait::new(settings.sample_rate_hz),
+            waited_us: 0,
+            restarts_at_ms: Vec::new(),
+            seen: Vec::new(),
+            ended: Vec::new(),
+        }
+    }
+
+    fn now_ms(&self) -> u32 {
+        (self.periods / PERIODS_PER_MS) as u32
+    }
+
+    fn press(&mut self) {
+        self.button = true;
+    }
+
+    /// One sample period: the sample task gets `raw` (or nothing: the source is stopped),
+    /// then thread mode runs if its period is due. `Err` when the MCU reset.
+    fn period(&mut self, raw: Option<&RawFrame>) -> Result<(), Reset> {
+        match raw {
+            Some(raw) => {
+                self.waited_us = 0;
+                self.adc.data();
+                self.path.on_frame(raw);
+                if self
+                    .path
+                    .samples()
+                    .is_multiple_of(self.settings.status_every())
+                {
+                    self.pending_status = Some(self.path.status());
+                }
+            }
+            None => {
+                self.waited_us += 1_000_000 / FS;
+                if self.waited_us >= self.adc.timeout_us() {
+                    // The wait timed out: the sample task restarts the acquisition.
+                    self.adc.timed_out();
+                    self.waited_us = 0;
+                    self.restarts_at_ms.push(self.now_ms());
+                    let now_us = (self.periods * 1_000_000 / u64::from(FS)) as u32;
+                    self.path.sampler_mut().resync(now_us);
+                }
+            }
+        }
+        self.periods += 1;
+        let now_ms = self.now_ms();
+        if self
+            .periods
+            .is_multiple_of(PERIODS_PER_MS * u64::from(PANEL_PERIOD_MS))
+        {
+            self.thread_tick(now_ms)?;
+        }
+        if now_ms.wrapping_sub(self.last_pet_ms) > WATCHDOG_TIMEOUT_MS {
+            self.survivors.watchdog_reset = true;
+            return Err(Reset::Watchdog);
+        }
+        Ok(())
+    }
+
+    fn thread_tick(&mut self, now_ms: u32) -> Result<(), Reset> {
+        let status = self.pending_status.take();
+        let button = std::mem::take(&mut self.button);
+        let tick = self.supervisor.tick(now_ms, status, button);
+        let used = *self.supervisor.latest();
+        self.check_agreement(now_ms, &tick, &used);
+        self.seen.push(Seen {
+            t_ms: now_ms,
+            tick,
+            status: used,
+            quasi_steady: self.path.monitor().output().quasi_steady,
+        });
+        if tick.pet_watchdog {
+            self.last_pet_ms = now_ms;
+        }
+        self.ended.extend(tick.run_ended);
+        match tick.liveness {
+            Some(drive_monitor::liveness::LivenessChange::RecordStall { for_ms }) => {
+                self.survivors.reset_ram = ResetRecord::sample_stall(for_ms).encode();
+            }
+            Some(drive_monitor::liveness::LivenessChange::Recovered { .. }) => {
+                self.survivors.reset_ram = [0; RESET_RECORD_LEN];
+            }
+            _ => {}
+        }
+        let (command, _stored) = carry_out(tick.action, &mut self.survivors.flash);
+        if self.survivors.flash.power_lost {
+            return Err(Reset::PowerLoss);
+        }
+        if let Some(cmd) = command {
+            // The sample task applies commands between two samples; a refused one is
+            // logged on the board.
+            let _ = self.path.command(cmd);
+        }
+        Ok(())
+    }
+
+    /// RAM, flash and panel agree (checked at every thread tick, before its action).
+    fn check_agreement(&self, now_ms: u32, tick: &Tick, status: &MonitorStatus) {
+        let ram = self.path.monitor().calibration();
+        let run = self.path.monitor().commissioning();
+        let flash = self.survivors.flash.usable();
+        if !matches!(run.stage, RunStage::AwaitingStorage(_)) {
+            assert_eq!(ram, flash, "{now_ms} ms: RAM and flash disagree ({run:?})");
+        }
+        assert_eq!(
+            status.commissioned,
+            ram.is_some(),
+            "{now_ms} ms: the status is not the core's"
+        );
+        let expected = if status.run.stage.is_active() {
+            Mode::Commissioning
+        } else if status.commissioned {
+            Mode::Commissioned
+        } else {
+            Mode::NotCommissioned
+        };
+        if !matches!(tick.mode, Mode::Failed | Mode::SamplingStalled) {
+            assert_eq!(tick.mode, expected, "{now_ms} ms: the panel disagrees");
+        }
+    }
+
+    /// Runs the frames from index `from` on; `at(rig, k)` may act before frame `k`.
+    fn run(
+        &mut self,
+        frames: &[RawFrame],
+        mut at: impl FnMut(&mut Rig, usize),
+    ) -> Result<(), Reset> {
+        for (k, raw) in frames.iter().enumerate() {
+            at(self, k);
+            self.period(Some(raw))?;
+        }
+        Ok(())
+    }
+
+    fn last(&self) -> &Seen {
+        self.seen.last().expect("a thread tick")
+    }
+
+    fn mode(&self) -> Mode {
+        self.last().tick.mode
+    }
+}
+
+fn frames(scenario: &Scenario) -> Vec<RawFrame> {
+    let params = ParamFile::reference_2p2kw();
+    let rows = simulate_to_vec(&params, scenario).expect("simulation");
+    let q = *SamplePath::for_board(FS).unwrap().sampler();
+    let mut theta_counts = 0.0f64;
+    let dt = 1.0 / f64::from(FS);
+    rows.iter()
+        .map(|row| {
+            let v = row.v_abc.unwrap_or([0.0; 3]);
+            let i = row.i_abc;
+            let count = match row.enc_count {
+                Some(c) => c as u32,
+                None => {
+                    theta_counts += row.wm_rad_s.unwrap_or(0.0) * dt / std::f64::consts::TAU
+                        * f64::from(board::ENCODER_COUNTS_PER_REV);
+                    theta_counts.floor() as i64 as u32
+                }
+            };
+            q.quantize(
+                Abc {
+                    a: v[0] as f32,
+                    b: v[1] as f32,
+                    c: v[2] as f32,
+                },
+                Abc {
+                    a: i[0] as f32,
+                    b: i[1] as f32,
+                    c: i[2] as f32,
+                },
+                count,
+            )
+        })
+        .collect()
+}
+
+/// Healthy running at the rated viscous load: run-up, then steady.
+fn steady_frames(duration_s: f64) -> Vec<RawFrame> {
+    frames(&Scenario::steady(duration_s, f64::from(FS)))
+}
+
+/// A record from an earlier commissioning (a plausible healthy calibration).
+fn old_record() -> CalibrationRecord {
+    CalibrationRecord {
+        mean: [0.0, 0.001, -0.001, 0.0],
+        spread: [0.004; 4],
+        isolation: None,
+    }
+}
+
+const PRESS_AT: usize = 15_000; // 1.5 s: after the run-up and the core's settling
