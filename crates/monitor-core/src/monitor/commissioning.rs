@@ -32,7 +32,9 @@ impl Monitor {
         duration_s: f32,
         install: Install,
     ) -> Result<u16, CommissioningError> {
-        let id = self.learner.start(duration_s, self.k.block_rate_hz, install)?;
+        let id = self
+            .learner
+            .start(duration_s, self.k.block_rate_hz, install)?;
         self.lamps.reset();
         Ok(id)
     }
