@@ -34,7 +34,7 @@ impl Monitor {
     ) -> Result<u16, CommissioningError> {
         let id = self
             .learner
-            .start(duration_s, self.k.block_rate_hz, install)?;
+            .start(duration_s, self.derived.block_rate_hz, install)?;
         self.lamps.reset();
         Ok(id)
     }

@@ -70,7 +70,7 @@ pub struct Sample {
 pub struct Monitor {
     cfg: MonitorConfig,
     /// Values derived once from `cfg`.
-    k: Derived,
+    derived: Derived,
     /// The frame angle estimator and the frame's sin/cos.
     frame: Frame,
     mt: MtSpeed,
@@ -107,21 +107,21 @@ impl Monitor {
     /// The first [`ConfigError`] found by [`MonitorConfig::validate`].
     pub fn new(cfg: MonitorConfig) -> Result<Self, ConfigError> {
         cfg.validate()?;
-        let k = Derived::new(&cfg);
-        let block_dt = k.block_dt_s;
+        let derived = Derived::new(&cfg);
+        let block_dt = derived.block_dt_s;
         Ok(Monitor {
-            k,
+            derived,
             frame: Frame::new(&cfg),
             mt: MtSpeed::new(
                 &cfg.encoder,
                 cfg.tick_hz,
                 cfg.limits.max_speed_rad_s,
-                k.dt_s,
+                derived.dt_s,
             ),
             extremes: BlockExtremes::default(),
             sums: BlockSums::default(),
             filters: DqFilters::new(&cfg, block_dt),
-            checks: Checks::new(k.block_rate_hz, block_dt),
+            checks: Checks::new(derived.block_rate_hz, block_dt),
             norm: Normaliser::new(
                 &cfg.motor,
                 block::no_load_reference(&cfg),
@@ -134,7 +134,7 @@ impl Monitor {
                 f32::from(cfg.decimation) / cfg.sample_rate_hz,
             ),
             learner: Learner::default(),
-            settle_left: k.settle_blocks,
+            settle_left: derived.settle_blocks,
             sensor_hold: SensorHold::default(),
             report_countdown: 0,
             gate_left: 0,
@@ -187,11 +187,11 @@ impl Monitor {
             }
         };
         self.out.speed_rad_s = wm;
-        let wr = wm * self.k.np;
+        let wr = wm * self.derived.np;
 
         let v = clarke(s.v_abc);
         let i = clarke(s.i_abc);
-        let (sc, i_dq) = self.frame.update(s.v_abc.a, v, i, wr, self.k.dt_s);
+        let (sc, i_dq) = self.frame.update(s.v_abc.a, v, i, wr, self.derived.dt_s);
         let v_q = -v.alpha * sc.sin + v.beta * sc.cos;
         let n = park(i, sc.negated());
         self.sums.add(i_dq, v_q, n);

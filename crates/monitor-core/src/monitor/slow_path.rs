@@ -14,7 +14,7 @@ impl Monitor {
     #[cold]
     #[inline(never)]
     pub(super) fn flag(&mut self, bad: SensorFlags) {
-        self.sensor_hold.hold(bad, self.k.hold_blocks);
+        self.sensor_hold.hold(bad, self.derived.hold_blocks);
         self.out.sensor_fault = self.sensor_hold.flags();
         let sf = self.out.sensor_fault;
         // An impossible reading names its sensor outright.
@@ -48,7 +48,7 @@ impl Monitor {
     #[inline(never)]
     fn discard_block(&mut self) {
         self.sums.clear();
-        self.settle_left = self.k.settle_blocks;
+        self.settle_left = self.derived.settle_blocks;
         self.frame.restart(&self.cfg, false);
     }
 
@@ -65,7 +65,7 @@ impl Monitor {
     fn block_end(&mut self, s: &Sample, wr_rad_s: f32, sc: SinCos) {
         let off_time = self.block_timing(s.timestamp_ticks);
         // Plausibility of the block: saturation flags, range (NaN and inf fail, see update).
-        let bad = self.extremes.take_verdict(&self.k);
+        let bad = self.extremes.take_verdict(&self.derived);
         if bad.current | bad.voltage {
             self.flag(bad);
             self.discard_block();
@@ -101,7 +101,7 @@ impl Monitor {
         }
         // Negative sequence: ten times a second is plenty for a 2 Hz filter.
         if self.report_countdown == 0 {
-            self.report_countdown = self.k.report_every;
+            self.report_countdown = self.derived.report_every;
             self.update_negative_sequence(op.wr_rad_s);
         }
         self.report_countdown -= 1;
@@ -115,7 +115,8 @@ impl Monitor {
     fn block_timing(&mut self, ticks: u32) -> Option<u32> {
         let prev = self.block_end_ticks.replace(ticks)?;
         let elapsed = ticks.wrapping_sub(prev);
-        (elapsed.wrapping_sub(self.k.block_ticks_lo) > self.k.block_ticks_span).then_some(elapsed)
+        (elapsed.wrapping_sub(self.derived.block_ticks_lo) > self.derived.block_ticks_span)
+            .then_some(elapsed)
     }
 
     /// A block whose timestamps are off: the block is left out of the filters; a gap up to
@@ -127,7 +128,7 @@ impl Monitor {
     fn timing_event(&mut self, elapsed_ticks: u32) {
         self.sums.clear();
         let t = &mut self.out.timing;
-        if elapsed_ticks > self.k.block_ticks && elapsed_ticks <= self.k.max_gap_ticks {
+        if elapsed_ticks > self.derived.block_ticks && elapsed_ticks <= self.derived.max_gap_ticks {
             // Roll the frame back to the end of the last block and advance it over the whole
             // block's real time: the samples after the gap were transformed in a frame behind
             // by the gap's angle, and the rotor-flux model took their currents in it (left
@@ -138,7 +139,7 @@ impl Monitor {
             self.frame.bridge(elapsed_ticks as f32 / self.cfg.tick_hz);
         } else {
             t.timing_faults = t.timing_faults.saturating_add(1);
-            self.settle_left = self.k.settle_blocks;
+            self.settle_left = self.derived.settle_blocks;
             self.frame.restart(&self.cfg, true);
         }
     }
@@ -153,7 +154,7 @@ impl Monitor {
         t.recoveries = t.recoveries.saturating_add(1);
         self.filters.reset();
         self.sums.clear();
-        self.settle_left = self.k.settle_blocks;
+        self.settle_left = self.derived.settle_blocks;
         self.frame.restart(&self.cfg, true);
     }
 
@@ -201,8 +202,8 @@ impl Monitor {
     fn update_gate(&mut self) {
         let g = self.cfg.steady_gate_per_s;
         if g > 0.0 {
-            if self.filters.changing(g, &self.k) {
-                self.gate_left = self.k.gate_blocks.max(1);
+            if self.filters.changing(g, &self.derived) {
+                self.gate_left = self.derived.gate_blocks.max(1);
             } else {
                 self.gate_left = self.gate_left.saturating_sub(1);
             }
@@ -213,7 +214,7 @@ impl Monitor {
             self.gate_closed_for = self.gate_closed_for.saturating_add(1);
         }
         self.out.quasi_steady =
-            self.gate_left == 0 || self.gate_closed_for > self.k.gate_timeout_blocks;
+            self.gate_left == 0 || self.gate_closed_for > self.derived.gate_timeout_blocks;
     }
 
     /// Commissioning (learning the healthy statistics) or the lamp logic, on the normalised
@@ -221,7 +222,7 @@ impl Monitor {
     #[inline(always)]
     fn update_lamps(&mut self, rn: [f32; 4]) {
         let running = self.settle_left == 0
-            && self.checks.vmag2.y > self.k.v_run_min2
+            && self.checks.vmag2.y > self.derived.v_run_min2
             && !self.out.sensor_fault.any();
         if self.learner.is_active() {
             // Learning on evaluated blocks, or the learned calibration awaiting storage.
