@@ -153,6 +153,8 @@ impl Frame {
 
     /// Bridges `missing_s` seconds without samples: back to the snapshot, then the angle
     /// advanced over the missing time at the present frequency, the sin/cos on it.
+    #[cold]
+    #[inline(never)]
     pub(super) fn bridge(&mut self, missing_s: f32) {
         self.estimator = self.snapshot;
         match &mut self.estimator {
@@ -170,6 +172,8 @@ impl Frame {
 
     /// Restarts the estimator as at power-up, when `all` or when its state is not sound
     /// (see `Estimator::is_sound`), and the sin/cos always.
+    #[cold]
+    #[inline(never)]
     pub(super) fn restart(&mut self, cfg: &MonitorConfig, all: bool) {
         if all || !self.estimator.is_sound(cfg.limits.i_max) {
             self.estimator = Estimator::new(cfg);
