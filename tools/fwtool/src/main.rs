@@ -54,8 +54,19 @@ fn run(cmd: &mut Command) -> Result<(), String> {
     }
 }
 
-/// Allocated sections of an ELF32 little-endian file: (name, type, flags, addr, size).
-fn sections(elf: &[u8]) -> Result<Vec<(String, u32, u32, u32, u32)>, String> {
+/// One section header of an ELF32 file.
+struct Section {
+    name: String,
+    /// `sh_type` (`SHT_NOBITS`: no bytes in the file, as `.bss`).
+    ty: u32,
+    /// `sh_flags` (`SHF_ALLOC`: occupies memory at run time).
+    flags: u32,
+    addr: u32,
+    size: u32,
+}
+
+/// The section headers of an ELF32 little-endian file.
+fn sections(elf: &[u8]) -> Result<Vec<Section>, String> {
     let u16_at = |o: usize| elf.get(o..o + 2).map(|b| u16::from_le_bytes([b[0], b[1]]));
     let u32_at = |o: usize| {
         elf.get(o..o + 4)
@@ -81,7 +92,13 @@ fn sections(elf: &[u8]) -> Result<Vec<(String, u32, u32, u32, u32)>, String> {
             .take_while(|b| **b != 0)
             .map(|b| *b as char)
             .collect();
-        out.push((name, sh(i, 4)?, sh(i, 8)?, sh(i, 0x0C)?, sh(i, 0x14)?));
+        out.push(Section {
+            name,
+            ty: sh(i, 4)?,
+            flags: sh(i, 8)?,
+            addr: sh(i, 0x0C)?,
+            size: sh(i, 0x14)?,
+        });
     }
     Ok(out)
 }
@@ -106,7 +123,14 @@ fn fw(check: bool) -> Result<(), String> {
     let elf = std::fs::read(&elf_path).map_err(|e| format!("{}: {e}", elf_path.display()))?;
     let (mut flash, mut ram) = (0u64, 0u64);
     println!("{:<16} {:>8} {:>10}", "section", "bytes", "address");
-    for (name, ty, flags, addr, size) in sections(&elf)? {
+    for Section {
+        name,
+        ty,
+        flags,
+        addr,
+        size,
+    } in sections(&elf)?
+    {
         if flags & SHF_ALLOC == 0 || size == 0 {
             continue;
         }
@@ -155,12 +179,12 @@ fn qemu_core() -> Result<ExitCode, String> {
     let elf = std::fs::read(&elf_path).map_err(|e| format!("{}: {e}", elf_path.display()))?;
     let vt = sections(&elf)?
         .into_iter()
-        .find(|s| s.0 == ".vector_table")
+        .find(|s| s.name == ".vector_table")
         .ok_or("no .vector_table")?;
-    if vt.3 != 0 {
+    if vt.addr != 0 {
         return Err(format!(
             "vector table at {:#x}, not 0x0: the G474 memory.x was linked instead of the mps2-an386 one",
-            vt.3
+            vt.addr
         ));
     }
     let mut child = Command::new("qemu-system-arm")
