@@ -1,5 +1,5 @@
 //! The lamp table in `board.rs` (`Lamp::pin`, `Lamp::label`) is the one definition of the
-//! panel's pins: the pin maps in the docs (`board.rs`'s module docs, the README's
+//! panel's pins: the pin maps in the docs (`board.rs`'s module docs, docs/firmware.md's
 //! "Pin map and wiring") must list each lamp on its pin, and the code and docs that used
 //! to repeat the pins (the panel module, the firmware's panic handler) must not name them.
 
@@ -20,21 +20,25 @@ fn row(lamp: Lamp) -> String {
 #[test]
 fn the_pin_maps_in_the_docs_are_the_lamp_tables() {
     let board = read("src/board.rs");
-    let readme = read("README.md");
+    let readme = read("docs/firmware.md");
     for lamp in Lamp::ALL {
         assert!(
             board.contains(&format!("//! {}", row(lamp))),
             "board.rs docs lack `{}`",
             row(lamp)
         );
-        assert!(readme.contains(&row(lamp)), "README lacks `{}`", row(lamp));
-        // And nothing else in the README names that pin (it was written in five places).
+        assert!(
+            readme.contains(&row(lamp)),
+            "docs/firmware.md lacks `{}`",
+            row(lamp)
+        );
+        // And nothing else in docs/firmware.md names that pin (it was written in five places).
         let pin = lamp.pin().to_string();
         let mentions = readme
             .split(|c: char| !c.is_ascii_alphanumeric())
             .filter(|w| *w == pin)
             .count();
-        assert_eq!(mentions, 1, "the README names {pin} {mentions} times");
+        assert_eq!(mentions, 1, "docs/firmware.md names {pin} {mentions} times");
     }
 }
 

@@ -1,7 +1,7 @@
 //! The firmware's defmt status line and its reader (`sim-host hmi --stdin`) agree: the
 //! format string of `log_status` in `src/firmware.rs` is rendered here with known values
 //! the way defmt's decoder prints them, and `sim_host::hmi::status_line::parse` must read
-//! every value back; the README's "The status line" documents every field.
+//! every value back; the firmware docs' "The status line" (docs/firmware.md) documents every field.
 
 use monitor_core::Fault;
 use sim_host::demo::MonitorState;
@@ -137,12 +137,12 @@ fn the_hmi_reads_every_field_the_firmware_prints() {
 }
 
 #[test]
-fn the_readme_documents_every_field_of_the_status_line() {
+fn the_firmware_docs_document_every_field_of_the_status_line() {
     let (format, _) = log_status_format();
-    let readme = read("README.md");
+    let readme = read("docs/firmware.md");
     let start = readme
-        .find("#### The status line")
-        .expect("README section \"The status line\"");
+        .find("## The status line")
+        .expect("docs/firmware.md section \"The status line\"");
     let section = &readme[start..];
     let section = &section[..section[4..].find("\n#").map_or(section.len(), |e| e + 4)];
     for token in format.split_whitespace() {
@@ -151,7 +151,7 @@ fn the_readme_documents_every_field_of_the_status_line() {
         };
         assert!(
             section.contains(&format!("{key}=")),
-            "README \"The status line\" does not document `{key}=`"
+            "docs/firmware.md \"The status line\" does not document `{key}=`"
         );
     }
 }

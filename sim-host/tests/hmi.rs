@@ -341,7 +341,7 @@ fn plain_text_when_stdout_is_not_a_terminal() {
     );
 }
 
-/// `hmi --help` teaches: examples and the key list; the README's key list is the same.
+/// `hmi --help` teaches: examples and the key list; the HMI page's key list (docs/hmi.md) is the same.
 #[test]
 fn the_help_and_the_readme_list_the_keys() {
     let o = assert_cmd::Command::cargo_bin("sim-host")
@@ -353,11 +353,11 @@ fn the_help_and_the_readme_list_the_keys() {
     let help = String::from_utf8_lossy(&o.stdout);
     assert!(help.contains("sim-host hmi LOG --params P.toml") && help.contains("--stdin"));
     let readme = std::fs::read_to_string(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md"),
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/hmi.md"),
     )
-    .expect("README");
+    .expect("docs/hmi.md");
     for line in sim_host::hmi::key_help().lines().skip(1) {
         assert!(help.contains(line), "--help lacks `{line}`");
-        assert!(readme.contains(line), "README lacks `{line}`");
+        assert!(readme.contains(line), "docs/hmi.md lacks `{line}`");
     }
 }
