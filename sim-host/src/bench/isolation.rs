@@ -61,10 +61,9 @@ pub struct BenchMotor {
 
 impl BenchMotor {
     /// The voltage ADC's full scale of the bench [V]: [`V_RANGE_SCALE`] times the
-    /// simulator's default, so that a +50 % voltage-sensor gain error stays on scale.
+    /// sensor range ([`crate::params::SensorRanges`]), so that a +50 % voltage-sensor gain error stays on scale.
     pub fn v_range_v(&self) -> f64 {
-        let (m, s) = (&self.params.motor, &self.params.supply);
-        V_RANGE_SCALE * crate::sim::default_ranges(m, s.v_ll_rms, s.f_hz).0
+        V_RANGE_SCALE * self.params.sensor_ranges().v_range_v
     }
 
     /// The Table 1 protocol for this motor at [`SAMPLE_RATE_HZ`] in `mode`, at `load_scale`

@@ -134,9 +134,9 @@ impl Default for ReplayOptions {
 }
 
 /// The monitor configuration for replaying a log: the parameter file's machine and supply
-/// at the log's sample rate, 1 MHz timestamps. The sensor limits are generous (twice the
-/// simulator's default ADC ranges, [`crate::sim::default_ranges`]) because a log does not
-/// say its ADC ranges. (The firmware's configuration is `drive_monitor::app`'s
+/// at the log's sample rate, 1 MHz timestamps. The sensor limits are the log's
+/// ([`ParamFile::log_limits`]: twice the sensor ranges, because a log does not say its ADC
+/// ranges), the same the data-quality stage judges cells by. (The firmware's configuration is `drive_monitor::app`'s
 /// `board_monitor_config`.)
 pub fn monitor_config_for_log(
     p: &ParamFile,
@@ -152,9 +152,10 @@ pub fn monitor_config_for_log(
     cfg.angle_source = opts.angle_source;
     cfg.residual_form = opts.residual_form;
     cfg.tick_hz = TICK_HZ as f32;
-    let (v_range, i_range) = crate::sim::default_ranges(&p.motor, p.supply.v_ll_rms, p.supply.f_hz);
-    cfg.limits.v_max = 2.0 * v_range as f32;
-    cfg.limits.i_max = 2.0 * i_range as f32;
+    let limits = p.log_limits();
+    cfg.limits.v_max = limits.v_max_v;
+    cfg.limits.i_max = limits.i_max_a;
+    cfg.limits.max_speed_rad_s = limits.wm_max_rad_s;
     cfg
 }
 
@@ -428,5 +429,34 @@ pub fn angle_source_name(a: AngleSource) -> &'static str {
         AngleSource::ZeroCrossing => "zero-crossing",
         AngleSource::Pll => "pll",
         AngleSource::RotorFluxCurrentModel => "rotor-flux",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::log::quality::CellLimits;
+
+    #[test]
+    fn the_monitor_and_the_quality_stage_judge_a_log_by_the_same_limits() {
+        for p in [ParamFile::reference_2p2kw(), ParamFile::reference_3hp()] {
+            let cfg = monitor_config_for_log(&p, 10_000.0, &ReplayOptions::default());
+            let cells = CellLimits::for_params(&p);
+            assert_eq!(f64::from(cfg.limits.v_max), cells.v_max);
+            assert_eq!(f64::from(cfg.limits.i_max), cells.i_max);
+            assert_eq!(f64::from(cfg.limits.max_speed_rad_s), cells.wm_max);
+            // The speed limit is the core's own default for the supply.
+            let core = MonitorConfig::new(
+                p.motor.model(),
+                p.supply.f_hz as f32,
+                p.supply.v_ll_rms as f32,
+                10_000.0,
+            );
+            assert_eq!(cfg.limits.max_speed_rad_s, core.limits.max_speed_rad_s);
+            // Twice the sensor ranges.
+            let r = p.sensor_ranges();
+            assert_eq!(cells.v_max, 2.0 * r.v_range_v);
+            assert_eq!(cells.i_max, 2.0 * r.i_range_a);
+        }
     }
 }

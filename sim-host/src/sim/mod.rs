@@ -109,7 +109,6 @@ pub use steady::{
 
 use crate::log::Row;
 use crate::params::ParamFile;
-use monitor_core::MotorParameters;
 use run::checked_run;
 use std::ops::ControlFlow;
 
@@ -232,19 +231,6 @@ pub struct SimSummary {
     pub effects: Vec<String>,
     /// Number of faults.
     pub faults: usize,
-}
-
-/// Default ADC ranges for a motor and supply: (v_range_v, i_range_a).
-///
-/// v: 1.2 x phase peak rounded up to 50 V (400 V for the 2.2 kW motor, 250 V for 3 hp);
-/// i: 2 x the analytic locked-rotor peak current rounded up to 5 A (a direct-on-line start,
-/// whose first peaks exceed the steady locked-rotor peak, does not clip).
-pub fn default_ranges(m: &MotorParameters, v_ll_rms: f64, f_hz: f64) -> (f64, f64) {
-    let vpk = v_ll_rms * (2.0f64 / 3.0).sqrt();
-    let v = (1.2 * vpk / 50.0).ceil() * 50.0;
-    let lr = steady_state_at(m, v_ll_rms, f_hz, 1.0);
-    let i = (2.0 * 2f64.sqrt() * lr.i_phase_rms_a / 5.0).ceil() * 5.0;
-    (v, i)
 }
 
 /// Runs `scenario` on the machine `params`, calling `on_row` for every output row (constant

@@ -4,11 +4,9 @@
 use super::machine::Machine;
 use super::resolve::{rated_torque, MachineBuilder, ParameterScales, ResolvedEffects};
 use super::sensors::Sensors;
-use super::{
-    default_ranges, LoadKind, Scenario, ScenarioEvent, SimError, SimSummary, SupplyStep, Truth,
-};
+use super::{LoadKind, Scenario, ScenarioEvent, SimError, SimSummary, SupplyStep, Truth};
 use crate::log::Row;
-use crate::params::ParamFile;
+use crate::params::{ParamFile, SensorRanges};
 use monitor_core::frames::{inverse_clarke, AlphaBeta};
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
@@ -197,12 +195,12 @@ impl<'a> Run<'a> {
                 builder.build(&scratch).map_err(invalid)?;
             }
         }
-        let (dv, di) = default_ranges(m, v_ll, f0);
+        let ranges = SensorRanges::new(m, v_ll, f0);
         let sp = &scenario.sensors;
         let sensors = Sensors::new(
             sp,
-            sp.v_range_v.unwrap_or(dv),
-            sp.i_range_a.unwrap_or(di),
+            sp.v_range_v.unwrap_or(ranges.v_range_v),
+            sp.i_range_a.unwrap_or(ranges.i_range_a),
             scenario.seed,
         );
         let supply = Supply::new(vpk0, we0, h, builder.eff.unbalance);

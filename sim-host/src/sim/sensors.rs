@@ -247,18 +247,20 @@ pub struct SensorSpec {
     /// ADC resolution [bits], 2..=24, default 12.
     #[serde(default = "d_bits")]
     pub adc_bits: u32,
-    /// Voltage full scale +/- [V]. Default: 1.25 x the supply's phase peak, rounded up to
-    /// a multiple of 50 V (400 V for the 2.2 kW motor, 250 V for the 3 hp motor).
+    /// Voltage full scale +/- [V]. Default: the machine's voltage range on the scenario's
+    /// supply ([`crate::params::SensorRanges`]: 1.2 x the phase peak, rounded up to a
+    /// multiple of 50 V; 400 V for the 2.2 kW motor, 250 V for the 3 hp motor).
     #[serde(default)]
     pub v_range_v: Option<f64>,
-    /// Current full scale +/- [A]. Default: 1.25 x the analytic locked-rotor peak current,
-    /// rounded up to a multiple of 5 A (no clipping on a direct-on-line start).
+    /// Current full scale +/- [A]. Default: the machine's current range
+    /// ([`crate::params::SensorRanges`]: 2 x the analytic locked-rotor peak current, rounded
+    /// up to a multiple of 5 A; no clipping on a direct-on-line start).
     #[serde(default)]
     pub i_range_a: Option<f64>,
-    /// Voltage noise [V rms]; default 0.1 % of the range.
+    /// Voltage noise [V rms]; default 0.05 % of the range.
     #[serde(default)]
     pub noise_v: Option<f64>,
-    /// Current noise [A rms]; default 0.1 % of the range.
+    /// Current noise [A rms]; default 0.05 % of the range.
     #[serde(default)]
     pub noise_i: Option<f64>,
     /// Speed noise [rad/s rms], default 0.

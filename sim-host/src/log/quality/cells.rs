@@ -1,6 +1,7 @@
 //! Bad cells: values no sensor of the machine should report ([`CellLimits`], [`BadCells`]).
 
 use crate::log::{Column, Row};
+use crate::params::ParamFile;
 
 /// Limits beyond which a cell is bad: magnitudes no sensor of this machine should report.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -16,18 +17,15 @@ pub struct CellLimits {
 }
 
 impl CellLimits {
-    /// The limits the replay's monitor uses ([`crate::replay::monitor_config_for_log`]:
-    /// twice the simulator's ADC ranges, twice the synchronous speed) for a parameter file.
-    pub fn for_params(p: &crate::params::ParamFile) -> Self {
-        let cfg = crate::replay::monitor_config_for_log(
-            p,
-            (p.supply.f_hz * 100.0).max(1000.0),
-            &crate::replay::ReplayOptions::default(),
-        );
+    /// The limits of a log of the parameter file's machine ([`ParamFile::log_limits`]:
+    /// twice the sensor ranges, twice the supply's angular frequency), the replay's
+    /// monitor's too.
+    pub fn for_params(p: &ParamFile) -> Self {
+        let limits = p.log_limits();
         CellLimits {
-            v_max: f64::from(cfg.limits.v_max),
-            i_max: f64::from(cfg.limits.i_max),
-            wm_max: f64::from(cfg.limits.max_speed_rad_s),
+            v_max: f64::from(limits.v_max_v),
+            i_max: f64::from(limits.i_max_a),
+            wm_max: f64::from(limits.wm_max_rad_s),
             supply_hz: p.supply.f_hz,
         }
     }
