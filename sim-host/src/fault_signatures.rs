@@ -10,11 +10,10 @@
 //! at the end of the run (steady state under fault). Sensor faults are gain errors on all
 //! three phases (current, voltage) or on the speed reading and the encoder.
 
-use crate::log::Row;
+use crate::experiment::{simulate_and_replay, ExperimentError};
 use crate::params::ParamFile;
-use crate::replay::{Replay, ReplayOptions};
-use crate::sim::{simulate, FaultSpec, LoadStep, Scenario, SensorSpec};
-use crate::ExperimentError;
+use crate::replay::ReplayOptions;
+use crate::sim::{FaultSpec, LoadStep, Scenario, SensorSpec};
 use monitor_core::{AngleSource, Fault};
 use serde::Serialize;
 
@@ -130,10 +129,8 @@ pub fn run_case(
         commission: Some(proto.commission),
         ..ReplayOptions::default()
     };
-    let mut replay = Replay::new(params, sc.sensors.channels(), proto.sample_rate_hz, opts)?;
     let mut first_lamp: Option<f64> = None;
-    simulate(params, &sc, |row: &Row| {
-        let out = replay.push(row);
+    let replay = simulate_and_replay(params, params, &sc, opts, |row, out| {
         if first_lamp.is_none() && row.t_s >= proto.fault_at_s && out.lamps.iter().any(|x| *x) {
             first_lamp = Some(row.t_s - proto.fault_at_s);
         }

@@ -5,6 +5,8 @@
 //! - [`log`]: measurement logs (the one reader and writer, the sample-rate estimate);
 //! - [`params`]: the parameter file;
 //! - [`replay`]: logs through the no_std core (`diagnose`);
+//! - [`experiment`]: a simulated motor replayed through the core as it runs (the runs
+//!   below);
 //! - [`fault_signatures`]: the paper's Table 1 end to end (`table1`);
 //! - [`service_profile`]: the healthy service profile of the false-alarm and
 //!   detection-limit studies;
@@ -20,6 +22,7 @@
 pub mod analysis;
 pub mod bench;
 pub mod demo;
+pub mod experiment;
 pub mod fault_signatures;
 pub mod hmi;
 pub mod log;
@@ -27,24 +30,6 @@ pub mod params;
 pub mod replay;
 pub mod service_profile;
 pub mod sim;
-
-/// Errors of the runs that simulate a motor and replay it through the core (Table 1, the
-/// service profile, the demo, the benchmarks).
-#[derive(Debug, thiserror::Error)]
-pub enum ExperimentError {
-    /// The simulator refused the scenario or diverged.
-    #[error(transparent)]
-    Sim(#[from] sim::SimError),
-    /// The core refused the replay's configuration.
-    #[error(transparent)]
-    Replay(#[from] replay::ReplayError),
-    /// Writing a file failed.
-    #[error(transparent)]
-    Log(#[from] log::LogError),
-    /// Creating a temporary folder failed.
-    #[error("cannot create a temporary folder: {0}")]
-    Io(#[from] std::io::Error),
-}
 
 /// Folds a multi-line message onto one line (CLI errors are one line).
 pub fn one_line(s: &str) -> String {

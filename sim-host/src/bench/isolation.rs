@@ -20,10 +20,10 @@
 //!   whose size is Bl's);
 //! - **time to name**: from the fault to the first time the right name was given.
 
+use crate::experiment::ExperimentError;
 use crate::fault_signatures::{run_case, Protocol, Table1Row};
 use crate::params::{ParamError, ParamFile};
 use crate::replay::angle_source_name;
-use crate::ExperimentError;
 use monitor_core::{AngleSource, Fault};
 use serde::Serialize;
 

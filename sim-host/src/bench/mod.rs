@@ -14,11 +14,11 @@
 
 pub mod isolation;
 
+use crate::experiment::ExperimentError;
 use crate::log::{LogWriter, Row};
 use crate::params::ParamFile;
 use crate::replay::{monitor_config_for_log, LogSampler, ReplayOptions};
 use crate::sim::{simulate, Scenario};
-use crate::ExperimentError;
 use monitor_core::Monitor;
 use serde::Serialize;
 use std::time::Instant;

@@ -71,7 +71,7 @@ impl LiveSim {
     ///
     /// # Errors
     /// The core refuses the configuration (not expected for the reference motor).
-    pub fn demo_motor() -> Result<Self, crate::ExperimentError> {
+    pub fn demo_motor() -> Result<Self, crate::experiment::ExperimentError> {
         let mut live = Self::new(
             ParamFile::reference_3hp(),
             Protocol::default().sample_rate_hz,
@@ -85,7 +85,10 @@ impl LiveSim {
     ///
     /// # Errors
     /// The core refuses the configuration.
-    pub fn new(params: ParamFile, sample_rate_hz: f64) -> Result<Self, crate::ExperimentError> {
+    pub fn new(
+        params: ParamFile,
+        sample_rate_hz: f64,
+    ) -> Result<Self, crate::experiment::ExperimentError> {
         // The replay's monitor and isolation, fed row by row; its timeline is not kept (a
         // live run has no end), commissioning starts on the `c` key.
         let opts = ReplayOptions {
