@@ -7,7 +7,7 @@
 use crate::experiment::{simulate_and_replay, ExperimentError};
 use crate::fault_signatures::{scenario, Protocol};
 use crate::params::ParamFile;
-use crate::replay::{DiagnoseReport, ReplayOptions};
+use crate::replay::{DiagnoseReport, IsolationName, ReplayOptions};
 use monitor_core::{CommissioningState, Fault, MonitorOutput};
 
 /// Time between two timeline points [s].
@@ -81,11 +81,7 @@ pub struct DemoRun {
 impl DemoRun {
     /// True when the injected fault is among the final candidates.
     pub fn correct_fault_named(&self) -> bool {
-        let want = match self.fault {
-            Fault::B | Fault::Bl => "b/bl",
-            f => f.name(),
-        };
-        self.report.isolation.named.as_deref() == Some(want)
+        self.report.isolation.named == Some(IsolationName::expected(self.fault))
     }
 }
 

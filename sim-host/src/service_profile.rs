@@ -9,7 +9,7 @@
 
 use crate::experiment::{simulate_and_replay, ExperimentError};
 use crate::params::ParamFile;
-use crate::replay::ReplayOptions;
+use crate::replay::{NameGiven, ReplayOptions};
 use crate::sim::{FaultSpec, LoadSpec, LoadStep, Scenario, SensorSpec, SupplyStep};
 use monitor_core::{AngleSource, ResidualForm};
 
@@ -87,7 +87,7 @@ pub struct Watch {
     pub calibration: Option<monitor_core::Calibration>,
     /// Every name the fault isolation gave, with the first time [s] (`b/bl`, the friction
     /// class, is what a load change is to the paper's model; any other is a false name).
-    pub isolation_names: Vec<(String, f64)>,
+    pub isolation_names: Vec<NameGiven>,
 }
 
 /// Runs the service profile (optionally with a fault) and watches the monitor after the

@@ -19,7 +19,7 @@ use crate::log::{LogWriter, Row};
 use crate::params::ParamFile;
 use crate::replay::{monitor_config_for_log, LogSampler, ReplayOptions};
 use crate::sim::{simulate, Scenario};
-use monitor_core::Monitor;
+use monitor_core::{Fault, Monitor};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -186,8 +186,8 @@ pub fn measure(repeat: u32) -> Result<BenchFigures, ExperimentError> {
 pub struct DetectionLimit {
     /// Motor.
     pub motor: String,
-    /// DESIGN.md fault name.
-    pub fault: String,
+    /// The fault (JSON: its name).
+    pub fault: Fault,
     /// Smallest relative increase detected (None: not even +90 %).
     pub smallest_increase: Option<f64>,
     /// Smallest relative decrease detected, as a positive fraction (None: not even -90 %).
@@ -205,7 +205,6 @@ pub fn detection_limits(
 ) -> Result<Vec<DetectionLimit>, DetectionError> {
     use crate::service_profile::watch;
     use crate::sim::FaultSpec;
-    use monitor_core::Fault;
     use rayon::prelude::*;
     let motors = [
         ("3 hp", ParamFile::reference_3hp(), 7u64),
@@ -260,7 +259,7 @@ pub fn detection_limits(
             };
             out.push(DetectionLimit {
                 motor: n.to_string(),
-                fault: f.name().to_string(),
+                fault: f,
                 smallest_increase: get(1.0),
                 smallest_decrease: get(-1.0),
             });

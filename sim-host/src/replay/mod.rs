@@ -32,8 +32,14 @@ pub use commission::{grace_s, CommissioningReport, RangeNote, SteadyPoint};
 pub use diagnose::{
     diagnose_file, diagnose_file_observed, diagnose_log, diagnose_rows, Diagnosed, ReplayObserver,
 };
-pub use isolation::{FaultCandidate, IsolationGroup, IsolationReport, SensorPhaseReport};
-pub use report::{DiagnoseReport, TimelinePoint, UnbalanceReport, Verdict};
+pub(crate) use isolation::serialize_state;
+pub use isolation::{
+    state_name, FaultCandidate, IsolationGroup, IsolationName, IsolationReport, NameGiven,
+    SensorPhaseReport,
+};
+pub use report::{
+    BaselineSource, Detection, DiagnoseReport, TimelinePoint, UnbalanceReport, Verdict,
+};
 
 use crate::log::{Channels, LogError, Row};
 use crate::params::ParamFile;
@@ -218,7 +224,7 @@ pub struct Replay {
     /// A detection happened inside the commissioned operating range (or without one).
     detected_in_range: bool,
     first_detection: Option<f64>,
-    detections: Vec<(String, f64)>,
+    detections: Vec<Detection>,
     timeline: Vec<TimelinePoint>,
     next_point: f64,
     dt_s: f64,
@@ -360,9 +366,9 @@ impl Replay {
             if self.first_detection.is_none() {
                 self.first_detection = Some(t);
             }
-            if let Some((f, _)) = out.top() {
-                if !self.detections.iter().any(|(n, _)| n == f.name()) {
-                    self.detections.push((f.name().to_string(), t));
+            if let Some((fault, _)) = out.top() {
+                if !self.detections.iter().any(|d| d.fault == fault) {
+                    self.detections.push(Detection { fault, t_s: t });
                 }
             }
         }
@@ -399,10 +405,10 @@ impl Replay {
         self.isolation.report(detected)
     }
 
-    /// Every label the isolation named so far (a fault's name or `b/bl`), each with the
-    /// first time it was named [s] (the replay's time), in that order: a name given and
-    /// later withdrawn stays here.
-    pub fn isolation_names(&self) -> &[(String, f64)] {
+    /// Every name the isolation gave so far (a fault or the friction class `b/bl`), each
+    /// with the first time it was given [s] (the replay's time), in that order: a name
+    /// given and later withdrawn stays here.
+    pub fn isolation_names(&self) -> &[NameGiven] {
         self.isolation.names()
     }
 
@@ -421,6 +427,14 @@ impl Replay {
     pub fn commissioning_incomplete(&self) -> bool {
         self.monitor.is_some() && self.commission.incomplete()
     }
+}
+
+/// Serialises an angle source by its command-line name ([`angle_source_name`]).
+pub(crate) fn serialize_angle_source<S: serde::Serializer>(
+    a: &AngleSource,
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    s.serialize_str(angle_source_name(*a))
 }
 
 /// Name of an angle source as used on the command line.

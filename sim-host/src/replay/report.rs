@@ -2,10 +2,10 @@
 //! analysis, the verdict, built by [`Replay::finish`].
 
 use super::isolation::{self, FaultCandidate, IsolationReport, SensorPhaseReport};
-use super::{angle_source_name, CommissioningReport, Replay, UnbalanceBaseline};
+use super::{serialize_angle_source, CommissioningReport, Replay, UnbalanceBaseline};
 use crate::log::quality::DataQuality;
-use monitor_core::{CommissioningState, Fault, MonitorOutput};
-use serde::Serialize;
+use monitor_core::{AngleSource, CommissioningState, Fault, MonitorOutput, Phase};
+use serde::{Serialize, Serializer};
 
 /// One point of the diagnosis timeline.
 #[derive(Debug, Clone, Serialize)]
@@ -16,8 +16,8 @@ pub struct TimelinePoint {
     pub residuals: [f32; 4],
     /// Lamps r1..r4.
     pub lamps: [bool; 4],
-    /// Most probable fault, if any.
-    pub top: Option<String>,
+    /// Most probable fault, if any (JSON: its name).
+    pub top: Option<Fault>,
     /// Its probability.
     pub top_probability: f32,
     /// Mechanical speed [rad/s].
@@ -40,8 +40,8 @@ pub struct TimelinePoint {
 pub struct UnbalanceReport {
     /// |I2|/|I1|.
     pub negative_sequence_ratio: f32,
-    /// "a", "b", "c" or null.
-    pub suspect_phase: Option<String>,
+    /// The winding's faulty phase (JSON "a", "b", "c"), or null.
+    pub suspect_phase: Option<Phase>,
     /// arg(I2w/I1) [deg]: the winding's part (the supply's part taken out).
     pub angle_deg: f32,
     /// |I2w|/|I1|: the winding's part of the negative sequence.
@@ -61,11 +61,36 @@ pub struct UnbalanceReport {
     /// What was measured, before the baseline is taken out (sensor-corrected): `I2/I1` and
     /// `V2/I1` (re, im); a healthy log's are the `--baseline` of a later one.
     pub measured: UnbalanceBaseline,
-    /// The healthy negative sequence the winding is judged against: `"commissioning"`
-    /// (learned in the window, used while |I1| is within [`BASELINE_I1_TOLERANCE`] of its
-    /// value there), `"file"` (`--baseline`), or null (none: the supply's part alone is
-    /// taken out).
-    pub baseline: Option<String>,
+    /// The healthy negative sequence the winding is judged against ([`BaselineSource`]),
+    /// or null (none: the supply's part alone is taken out).
+    pub baseline: Option<BaselineSource>,
+}
+
+/// Where the healthy negative sequence the winding is judged against comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BaselineSource {
+    /// Learned in the commissioning window, used while |I1| is within
+    /// [`super::BASELINE_I1_TOLERANCE`] of its value there.
+    Commissioning,
+    /// The healthy log given with `--baseline`.
+    File,
+}
+
+/// A fault the lamps named (the top of the signature matching while a lamp was lit), with
+/// the first time it was named [s]. JSON: the pair `[fault, t_s]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Detection {
+    /// The fault.
+    pub fault: Fault,
+    /// When it was first named [s since the log's first row].
+    pub t_s: f64,
+}
+
+impl Serialize for Detection {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        (self.fault, self.t_s).serialize(s)
+    }
 }
 
 /// What `diagnose` reports (DESIGN.md §3 JSON keys, plus `verdict`, `data_quality` and
@@ -93,11 +118,12 @@ pub struct DiagnoseReport {
     /// Negative-sequence analysis of the currents.
     pub unbalance: UnbalanceReport,
     /// Faults ever named while the lamps were lit, with the time first named.
-    pub detections: Vec<(String, f64)>,
+    pub detections: Vec<Detection>,
     /// Analyses skipped for lack of a column, with the reason.
     pub skipped: Vec<String>,
-    /// Angle source used.
-    pub angle_source: String,
+    /// Angle source used (JSON: its command-line name, [`super::angle_source_name`]).
+    #[serde(serialize_with = "serialize_angle_source")]
+    pub angle_source: AngleSource,
     /// Commissioning window asked for, if any [s].
     pub commission: Option<(f64, f64)>,
     /// What commissioning did (state, window used, range covered).
@@ -148,7 +174,7 @@ impl Replay {
             .zip(out.diagnosis.probabilities)
             .filter(|(_, p)| *p > 0.0)
             .map(|(f, p)| FaultCandidate {
-                fault: f.name().to_string(),
+                fault: *f,
                 probability: p,
                 change: None,
                 phase: None,
@@ -216,7 +242,7 @@ impl Replay {
             unbalance,
             detections: self.detections,
             skipped,
-            angle_source: angle_source_name(self.opts.angle_source).to_string(),
+            angle_source: self.opts.angle_source,
             commission: self.opts.commission,
             commissioning: self.commission.report(self.k_sigma),
             data_quality: DataQuality::default(),
@@ -238,7 +264,7 @@ pub(super) fn timeline_point(
         t_s: t,
         residuals: out.residuals,
         lamps: out.lamps,
-        top: top.map(|(f, _)| f.name().to_string()),
+        top: top.map(|(f, _)| f),
         top_probability: top.map(|(_, p)| p).unwrap_or(0.0),
         speed_rad_s: out.speed_rad_s,
         evaluating: out.evaluating,

@@ -2,6 +2,7 @@
 //! negative and zero sequences of the currents and voltages, one phase's sensor gain error,
 //! and the negative-sequence report ([`UnbalanceReport`]).
 
+use super::report::BaselineSource;
 use super::{
     Replay, SensorPhaseReport, UnbalanceBaseline, UnbalanceReport, BASELINE_I1_TOLERANCE,
     FILLED_SAMPLES, SENSOR_PHASE_MIN_RATIO,
@@ -189,8 +190,8 @@ impl Replay {
                 && (i1 - b.i1_peak_a).abs() <= BASELINE_I1_TOLERANCE * b.i1_peak_a
         });
         let (base, base_name) = match (self.opts.unbalance_baseline, learned) {
-            (Some(b), _) => (Some(b), Some("file")),
-            (None, Some(b)) => (Some(b), Some("commissioning")),
+            (Some(b), _) => (Some(b), Some(BaselineSource::File)),
+            (None, Some(b)) => (Some(b), Some(BaselineSource::Commissioning)),
             (None, None) => (None, None),
         };
         let minus = |x: [f32; 2], b: Option<[f32; 2]>| {
@@ -225,7 +226,7 @@ impl Replay {
                 measured.i2_over_i1[0],
                 measured.i2_over_i1[1],
             ),
-            suspect_phase: w.suspect_phase.map(|p| p.name().to_string()),
+            suspect_phase: w.suspect_phase,
             angle_deg: w.angle_rad.to_degrees(),
             correction_deg: asymmetry_correction_rad(&m, we, slip).to_degrees(),
             winding_ratio: w.ratio,
@@ -239,7 +240,7 @@ impl Replay {
             current_sensor_phase: gi.as_ref().map(SensorPhaseReport::from),
             voltage_sensor_phase: gv.as_ref().map(SensorPhaseReport::from),
             measured,
-            baseline: base_name.map(str::to_string),
+            baseline: base_name,
         }
     }
 }
