@@ -85,6 +85,13 @@ pub struct DataQuality {
     pub not_trusted_because: Vec<String>,
 }
 
+/// What the assessment found: warnings, and reasons not to trust the log.
+#[derive(Debug, Default)]
+struct Findings {
+    warn: Vec<String>,
+    distrust: Vec<String>,
+}
+
 /// A channel whose readings clip ([`crate::log::clipping`]).
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct ClippedChannel {
@@ -99,8 +106,17 @@ pub struct ClippedChannel {
 impl DataQuality {
     /// Fills `warnings`, `trusted` and `not_trusted_because` from the counts.
     pub(super) fn assess(&mut self, supply_hz: f64) {
-        let mut warn = Vec::new();
-        let mut distrust = Vec::new();
+        let mut found = Findings::default();
+        self.assess_time(&mut found);
+        self.assess_cells(supply_hz, &mut found);
+        self.trusted = found.distrust.is_empty();
+        self.warnings = found.warn;
+        self.not_trusted_because = found.distrust;
+    }
+
+    /// What the timestamps say: their unit, rows dropped, gaps, segments, jitter.
+    fn assess_time(&self, found: &mut Findings) {
+        let Findings { warn, distrust } = found;
         let rows = self.rows_read.max(1) as f64;
         if self.time_unit != TimeUnit::S {
             warn.push(format!(
@@ -172,6 +188,12 @@ impl DataQuality {
                 100.0 * self.irregular_intervals as f64 / rows
             ));
         }
+    }
+
+    /// What the cells say: bad cells and their bursts, the currents' frequency, clipping.
+    fn assess_cells(&self, supply_hz: f64, found: &mut Findings) {
+        let Findings { warn, distrust } = found;
+        let rows = self.rows_read.max(1) as f64;
         if self.bad_rows > 0 {
             let cells: Vec<String> = self
                 .bad_cells
@@ -207,9 +229,6 @@ impl DataQuality {
                 c.value
             ));
         }
-        self.trusted = distrust.is_empty();
-        self.warnings = warn;
-        self.not_trusted_because = distrust;
     }
 
     /// One line for the text output: "clean" or what was found.
