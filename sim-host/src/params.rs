@@ -76,6 +76,11 @@ pub struct PlausibleRange {
 }
 
 impl PlausibleRange {
+    /// The range `lo..=hi`.
+    pub const fn new(lo: f64, hi: f64) -> Self {
+        PlausibleRange { lo, hi }
+    }
+
     /// True for a finite `x` in `lo..=hi`.
     pub fn contains(&self, x: f64) -> bool {
         x.is_finite() && x >= self.lo && x <= self.hi
@@ -105,30 +110,24 @@ pub mod plausible {
     pub const POLES: core::ops::RangeInclusive<u32> = 2..=24;
     /// Supply frequency `f_hz` [Hz]: 1..400 (400 Hz: aircraft supplies and high-speed
     /// motors; high-speed spindles above that are outside this product's scope).
-    pub const F_HZ: R = R { lo: 1.0, hi: 400.0 };
+    pub const F_HZ: R = R::new(1.0, 400.0);
     /// Line-to-line voltage `v_ll_rms` [V]: 10..15000 (low-voltage battery drives up to
     /// 13.8 kV medium-voltage machines).
-    pub const V_LL_RMS: R = R {
-        lo: 10.0,
-        hi: 15_000.0,
-    };
+    pub const V_LL_RMS: R = R::new(10.0, 15_000.0);
     /// Lm/Ls: 0.8..=1 (1 = a Gamma-model machine with no stator leakage; below 0.8 the
     /// stator leakage would exceed a quarter of Lm).
-    pub const LM_OVER_LS: R = R { lo: 0.8, hi: 1.0 };
+    pub const LM_OVER_LS: R = R::new(0.8, 1.0);
     /// Lm/Lr: 0.8..=1 (1 = an inverse-Gamma-model machine with no rotor leakage).
-    pub const LM_OVER_LR: R = R { lo: 0.8, hi: 1.0 };
+    pub const LM_OVER_LR: R = R::new(0.8, 1.0);
     /// Leakage coefficient sigma = 1 - Lm^2/(Ls Lr): 0.01..0.25.
-    pub const SIGMA: R = R { lo: 0.01, hi: 0.25 };
+    pub const SIGMA: R = R::new(0.01, 0.25);
     /// Magnetising reactance over stator resistance, 2 pi f Ls / Rs, at the file's
     /// frequency: 2..1000.
-    pub const X_OVER_RS: R = R {
-        lo: 2.0,
-        hi: 1000.0,
-    };
+    pub const X_OVER_RS: R = R::new(2.0, 1000.0);
     /// Rotor time constant Lr/Rr [s]: 0.005..5.
-    pub const ROTOR_TIME_CONSTANT_S: R = R { lo: 0.005, hi: 5.0 };
+    pub const ROTOR_TIME_CONSTANT_S: R = R::new(0.005, 5.0);
     /// Rr/Rs: 0.1..10.
-    pub const RR_OVER_RS: R = R { lo: 0.1, hi: 10.0 };
+    pub const RR_OVER_RS: R = R::new(0.1, 10.0);
     /// Inertia constant estimate H = (J omega_m^2 / 2) / S0 [s], omega_m = 2 pi f / Np the
     /// synchronous mechanical speed and S0 = V_ll^2 / (2 pi f Ls) the no-load (magnetising)
     /// reactive power standing in for the rated power: 0.002..100. Real machines have H
@@ -136,10 +135,7 @@ pub mod plausible {
     /// flywheel or a large fan on the shaft (J is rotor plus load). S0 is 0.3 to 1.1 times
     /// the rated power (no-load current 25 % to 60 % of rated at power factor 0.7 to 0.9),
     /// hence the extra margin of about 4x at both ends.
-    pub const INERTIA_CONSTANT_S: R = R {
-        lo: 0.002,
-        hi: 100.0,
-    };
+    pub const INERTIA_CONSTANT_S: R = R::new(0.002, 100.0);
 }
 
 /// A parameter file value outside the range of real machines: the key, its value, the

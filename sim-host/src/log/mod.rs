@@ -187,16 +187,11 @@ pub enum Column {
 
 impl Column {
     /// The measured channels stored at f32 precision by every writer (voltages, currents,
-    /// speed), in [`Row`] order.
-    pub const MEASURED: [Column; 7] = [
-        Column::Va,
-        Column::Vb,
-        Column::Vc,
-        Column::Ia,
-        Column::Ib,
-        Column::Ic,
-        Column::Speed,
-    ];
+    /// speed), in [`Row`] order: [`Column::ALL`] without the time and the encoder count.
+    pub const MEASURED: [Column; 7] = {
+        let all = Column::ALL;
+        [all[1], all[2], all[3], all[4], all[5], all[6], all[7]]
+    };
 
     /// Every column of the schema, in [`Row`] order.
     pub const ALL: [Column; 9] = [

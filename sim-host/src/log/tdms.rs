@@ -16,7 +16,7 @@
 //! as I64. Every channel carries `wf_increment` and `wf_start_offset` (from the first
 //! segment's times), so LabVIEW and DIAdem show a time axis.
 
-use super::reader::ColumnMap;
+use super::reader::{BinarySource, ColumnMap, LogFile};
 use super::{Channels, Column, LogError, Row};
 use std::fs::File;
 use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
@@ -272,21 +272,21 @@ impl TdmsSource {
             columns,
         ))
     }
+}
 
-    /// Rows in the log.
-    pub fn rows(&self) -> u64 {
+/// The group's channels read a segment at a time.
+impl BinarySource for TdmsSource {
+    fn rows(&self) -> u64 {
         self.rows
     }
 
-    /// Streams the rows in order (see [`super::LogFile::for_each_row`]).
-    pub fn for_each_row(
+    fn for_each_row(
         &self,
-        path: &Path,
-        shown: &str,
-        columns: &ColumnMap,
+        log: &LogFile,
         progress: &mut dyn FnMut(f64),
         on_row: &mut dyn FnMut(&Row) -> bool,
     ) -> Result<u64, LogError> {
+        let (path, shown, columns) = (log.path(), log.shown(), log.columns());
         let file = TdmsFile::open(path).map_err(|e| tdms_error(shown, &e))?;
         let g = file
             .group(&self.group)
