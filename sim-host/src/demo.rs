@@ -1,8 +1,8 @@
-//! The main job (`sim-host demo`): the DESIGN.md 3 hp motor started direct-on-line with the
-//! paper's viscous load and realistic sensors (12-bit ADC, noise, 1024-line encoder), its
-//! sensor streams replayed through the same core the firmware runs, the healthy residuals
-//! learned (commissioning, 2-4 s), a Table 1 fault injected at 5 s, and the lamps r1..r4
-//! and the fault candidates followed every 0.25 s.
+//! The main job (`sim-host demo`): the 3 hp reference motor (Krause's textbook machine)
+//! started direct-on-line with the paper's viscous load and realistic sensors (12-bit ADC,
+//! noise, 1024-line encoder), its sensor streams replayed through the same core the
+//! firmware runs, the healthy residuals learned (commissioning, 2-4 s), a Table 1 fault
+//! injected at 5 s, and the lamps r1..r4 and the fault candidates followed every 0.25 s.
 
 use crate::experiment::{simulate_and_replay, ExperimentError};
 use crate::fault_signatures::{scenario, Protocol};

@@ -1,4 +1,4 @@
-//! The motor parameter file (DESIGN.md §3): nominal T-equivalent parameters and the supply.
+//! The motor parameter file (`docs/design.md`): nominal T-equivalent parameters and the supply.
 //!
 //! ```toml
 //! [motor]
@@ -95,10 +95,11 @@ impl PlausibleRange {
 /// machine is never refused and a unit or typing error of 10x to 1000x is):
 /// - the four machines of Krause, Wasynczuk and Sudhoff, *Analysis of Electric Machinery
 ///   and Drive Systems* (3 hp / 220 V, 50 hp / 460 V, 500 hp / 2300 V, 2250 hp / 2300 V,
-///   all 60 Hz, 4 poles; the 3 hp one is DESIGN.md's): Lm/Ls 0.972..0.983, sigma
-///   0.034..0.055, X/Rs 62..457, Lr/Rr 0.087..1.6 s, Rr/Rs 0.71..2.6, H estimate 0.88..2.8 s;
-/// - DESIGN.md's 2.2 kW Gamma-model machine (Ls = Lm): Lm/Lr 0.914, sigma 0.086, X/Rs 21,
-///   Lr/Rr 0.11 s, Rr/Rs 0.68, H estimate 0.089 s;
+///   all 60 Hz, 4 poles; the 3 hp one is the repository's reference motor): Lm/Ls
+///   0.972..0.983, sigma 0.034..0.055, X/Rs 62..457, Lr/Rr 0.087..1.6 s, Rr/Rs 0.71..2.6,
+///   H estimate 0.88..2.8 s;
+/// - the repository's 2.2 kW Gamma-model reference machine (Ls = Lm): Lm/Lr 0.914, sigma
+///   0.086, X/Rs 21, Lr/Rr 0.11 s, Rr/Rs 0.68, H estimate 0.089 s;
 /// - textbook per-unit values for the small end (0.1 kW, 2 to 8 poles: Rs up to about
 ///   0.1 pu and X/Rs down to about 5, Lr/Rr down to about 20 ms, rotor inertia 1e-4 to
 ///   1e-3 kg m^2).
@@ -426,12 +427,13 @@ impl ParamFile {
         }
     }
 
-    /// DESIGN.md's "2.2 kW" machine ([`monitor_core::reference::MOTOR_2P2KW`]).
+    /// The "2.2 kW" reference machine ([`monitor_core::reference::MOTOR_2P2KW`]).
     pub fn reference_2p2kw() -> Self {
         Self::from_reference(&monitor_core::reference::MOTOR_2P2KW)
     }
 
-    /// DESIGN.md's "3 hp" textbook machine ([`monitor_core::reference::MOTOR_3HP`]).
+    /// The "3 hp" reference machine, Krause's textbook machine
+    /// ([`monitor_core::reference::MOTOR_3HP`]).
     pub fn reference_3hp() -> Self {
         Self::from_reference(&monitor_core::reference::MOTOR_3HP)
     }
@@ -594,7 +596,7 @@ mod tests {
         ParamFile::from_toml_str(&motulator.to_toml_string(), "x").unwrap();
     }
 
-    /// The message of loading `p` with `edit` applied to the DESIGN.md example.
+    /// The message of loading `p` with `edit` applied to the documented example.
     fn refused(from: &str, to: &str) -> String {
         let text = DESIGN_EXAMPLE.replace(from, to);
         assert_ne!(text, DESIGN_EXAMPLE, "{from} not in the example");

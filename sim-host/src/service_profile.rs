@@ -4,7 +4,7 @@
 //! cycle of steps (2-30 s), then watched.
 //!
 //! The paper's model lumps the load into `Bl omega`, so a load change is, to the model, a
-//! change of Bl (DESIGN.md §2): a monitor on a machine whose load varies learns the healthy
+//! change of Bl (`docs/design.md`): a monitor on a machine whose load varies learns the healthy
 //! spread of its residuals over the load and supply range it sees in service.
 
 use crate::experiment::{simulate_and_replay, ExperimentError};

@@ -35,7 +35,7 @@ fn run(params: &ParamFile, load_nm: f64, phase: Phase, fraction: f64) -> (Option
 #[test]
 fn suspect_phase_is_the_shorted_phase_for_two_motors_and_two_loads() {
     // Rated torques: 3 hp 220 V 60 Hz 4-pole at ~1710 rpm: 2238 W / 179 rad/s = 12.5 N m;
-    // 2.2 kW at ~1430 rpm: 14.6 N m (DESIGN.md reference scenario).
+    // 2.2 kW at ~1430 rpm: 14.6 N m (the reference scenario).
     let motors = [
         (ParamFile::reference_3hp(), 12.5),
         (ParamFile::reference_2p2kw(), 14.6),

@@ -123,7 +123,7 @@ impl BenchMotor {
     }
 }
 
-/// The three motors: DESIGN.md's 3 hp and 2.2 kW machines (commissioning 2..4 s, fault at
+/// The three motors: the 3 hp and 2.2 kW reference machines (commissioning 2..4 s, fault at
 /// 4.5 s, 8 s) and the 2-pole 11 kW machine, whose direct-on-line start settles later
 /// (commissioning 3..5 s, fault at 5.5 s, 9 s).
 ///

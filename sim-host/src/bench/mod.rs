@@ -1,4 +1,4 @@
-//! The figures of `sim-host bench` (DESIGN.md §4), measured on this machine.
+//! The figures of `sim-host bench` (`docs/performance.md`), measured on this machine.
 //!
 //! - Simulator throughput on the reference scenario (2.2 kW, direct-on-line, 14.6 N m from
 //!   2.5 s, 10 s at 10 kHz), in simulated seconds per wall second, in memory and with CSV
@@ -181,7 +181,7 @@ pub fn measure(repeat: u32) -> Result<BenchFigures, ExperimentError> {
     })
 }
 
-/// Smallest detected change of one fault (DESIGN.md §4 "fault detection" bar).
+/// Smallest detected change of one fault (the fault detection bar of `docs/performance.md`).
 #[derive(Debug, Serialize)]
 pub struct DetectionLimit {
     /// Motor.

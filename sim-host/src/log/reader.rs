@@ -346,7 +346,7 @@ fn parse_header(line: &[u8], shown: &str) -> Result<ColumnMap, LogError> {
             return Err(LogError::NotALog {
                 path: shown.to_string(),
                 why: format!(
-                    "the fields are separated by {sep:?}: the log must be comma-separated (DESIGN.md \u{a7}3)"
+                    "the fields are separated by {sep:?}: the log must be comma-separated (docs/design.md)"
                 ),
             });
         }

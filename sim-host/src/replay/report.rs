@@ -93,7 +93,7 @@ impl Serialize for Detection {
     }
 }
 
-/// What `diagnose` reports (DESIGN.md §3 JSON keys, plus `verdict`, `data_quality` and
+/// What `diagnose` reports (the JSON keys of `docs/design.md`, plus `verdict`, `data_quality` and
 /// `commissioning`).
 #[derive(Debug, Clone, Serialize)]
 pub struct DiagnoseReport {

@@ -24,7 +24,7 @@ pub enum SensorFaultMode {
 ///
 /// Parametric faults (`rs, rr, ls, lr, b, bl`) need `change` (relative, > -1; +0.5 = +50 %):
 /// `rs`, `rr`, `b`: the value x (1 + change). `ls`, `lr`: the LEAKAGE inductance x (1 +
-/// change), the self inductance follows (PSIM's convention, DESIGN.md §2); for a machine
+/// change), the self inductance follows (PSIM's convention, `docs/design.md`); for a machine
 /// without that leakage (the Gamma-model 2.2 kW reference has Lls = 0) Lm itself is scaled
 /// (the other leakage kept, so both self inductances follow). `bl`: Bl x (1 + change), or
 /// the load torque for a torque load. The speed sensor fault acts on `wm_rad_s` and on the
@@ -35,7 +35,7 @@ pub enum SensorFaultMode {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FaultSpec {
-    /// Which fault (DESIGN.md name).
+    /// Which fault (JSON and TOML: its name, [`Fault::name`]).
     pub kind: Fault,
     /// Switch-on time [s], >= 0.
     pub at_s: f64,

@@ -1,5 +1,5 @@
 //! Induction-motor simulator (f64): full-order T-equivalent machine, stiff supply, load,
-//! faults, physical effects and sensors, producing rows in the DESIGN.md §3 CSV schema.
+//! faults, physical effects and sensors, producing rows in the log schema (`docs/design.md`).
 //!
 //! # Model
 //! Full-order machine in the stationary alpha-beta frame (amplitude-invariant Clarke, so
@@ -72,7 +72,7 @@
 //!
 //! # Faults
 //! `rs, rr`: resistance x (1 + change). `ls, lr`: LEAKAGE inductance x (1 + change), the self
-//! inductances follow (PSIM convention, DESIGN.md §2); for a Gamma-model machine with no
+//! inductances follow (PSIM's convention, `docs/design.md`); for a Gamma-model machine with no
 //! stator leakage (the 2.2 kW reference) `ls` scales the stator inductance Ls = Lm itself
 //! (Lm x (1 + change), Lr = Llr + Lm follows); likewise `lr` when Llr = 0. `b`: B x (1 +
 //! change). `bl`: Bl x (1 + change), or the load torque for a torque load. Sensor faults:

@@ -180,7 +180,7 @@ fn d_phase_a() -> Phase {
 }
 
 /// A physical effect to inject, with its parameters: `[[effects]] name = "..."`, the name
-/// an [`EffectKind`] (DESIGN.md §3 effect library).
+/// an [`EffectKind`] (the effect library of `docs/design.md`).
 ///
 /// Each variant lists its parameters (TOML keys) with units and defaults. The defaults make a
 /// visible but realistic difference on the reference motors.
@@ -567,7 +567,7 @@ impl Scenario {
         }
     }
 
-    /// DESIGN.md §4 reference scenario for the 2.2 kW machine: direct-on-line from
+    /// The reference scenario for the 2.2 kW machine: direct-on-line from
     /// standstill, 14.6 N m constant load torque from 2.5 s, 10 s at 10 kHz, ideal sensors.
     pub fn reference_2p2kw() -> Self {
         Scenario {

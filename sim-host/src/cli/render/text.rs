@@ -568,7 +568,7 @@ pub fn bench(f: &BenchFigures, limits: Option<&[DetectionLimit]>) -> anyhow::Res
     )?;
     writeln!(
         out,
-        "(motulator 0.5.0 reference, DESIGN.md: 5.14 simulated s per wall s with DOP853 at the same accuracy)"
+        "(motulator 0.5.0 reference: 5.14 simulated s per wall s with DOP853 at the same accuracy)"
     )?;
     if let Some(limits) = limits {
         writeln!(out, "\nsmallest change detected within 10 s, service profile with load and supply steps, zero false alarms:")?;
