@@ -95,13 +95,25 @@ pub struct BenchMotor {
     pub name: &'static str,
     /// Its parameters.
     pub params: ParamFile,
-    /// Commissioning window [s], fault switch-on [s] and end of the run [s].
-    pub timing: ((f64, f64), f64, f64),
+    /// When its runs commission, fault and end.
+    pub timing: Timing,
+}
+
+/// The timing of a bench run [s from the start].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Timing {
+    /// Commissioning window [start, end).
+    pub commission: (f64, f64),
+    /// Fault switch-on.
+    pub fault_at_s: f64,
+    /// End of the run.
+    pub duration_s: f64,
 }
 
 impl BenchMotor {
-    /// The voltage ADC's full scale of the bench [V]: [`V_RANGE_SCALE`] times the
-    /// sensor range ([`crate::params::SensorRanges`]), so that a +50 % voltage-sensor gain error stays on scale.
+    /// The voltage ADC's full scale of the bench [V]: [`V_RANGE_SCALE`] times the sensor
+    /// range ([`crate::params::SensorRanges`]), so that a +50 % voltage-sensor gain error
+    /// stays on scale.
     pub fn v_range_v(&self) -> f64 {
         V_RANGE_SCALE * self.params.sensor_ranges().v_range_v
     }
@@ -109,11 +121,11 @@ impl BenchMotor {
     /// The Table 1 protocol for this motor at [`SAMPLE_RATE_HZ`] in `mode`, at `load_scale`
     /// times the file's load, with the noise `seed`.
     pub fn protocol(&self, mode: AngleSource, load_scale: f64, seed: u64) -> Protocol {
-        let (commission, fault_at_s, duration_s) = self.timing;
+        let t = self.timing;
         Protocol {
-            commission,
-            fault_at_s,
-            duration_s,
+            commission: t.commission,
+            fault_at_s: t.fault_at_s,
+            duration_s: t.duration_s,
             sample_rate_hz: SAMPLE_RATE_HZ,
             angle_source: mode,
             load_scale,
@@ -130,7 +142,11 @@ impl BenchMotor {
 /// # Errors
 /// The embedded 11 kW parameter file does not parse (a test reads it).
 pub fn motors() -> Result<Vec<BenchMotor>, ParamError> {
-    let early = ((2.0, 4.0), 4.5, 8.0);
+    let early = Timing {
+        commission: (2.0, 4.0),
+        fault_at_s: 4.5,
+        duration_s: 8.0,
+    };
     Ok(vec![
         BenchMotor {
             name: "3 hp",
@@ -145,7 +161,11 @@ pub fn motors() -> Result<Vec<BenchMotor>, ParamError> {
         BenchMotor {
             name: "11 kW",
             params: ParamFile::from_toml_str(MOTOR_11KW, "examples/params/11kw_2pole.toml")?,
-            timing: ((3.0, 5.0), 5.5, 9.0),
+            timing: Timing {
+                commission: (3.0, 5.0),
+                fault_at_s: 5.5,
+                duration_s: 9.0,
+            },
         },
     ])
 }

@@ -33,15 +33,37 @@ pub(super) struct Thermal {
     pub(super) rotor: bool,
 }
 
+/// The machine's rated point on the scenario's supply, which the effects' defaults scale
+/// with.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct RatedPoint {
+    /// Phase voltage peak [V].
+    pub(super) vpk0: f64,
+    /// Supply angular frequency [rad/s].
+    pub(super) we0: f64,
+    /// Rated torque [N m] ([`rated_torque`]).
+    pub(super) t_rated: f64,
+    /// Synchronous mechanical speed [rad/s].
+    pub(super) w_sync: f64,
+    /// The viscous load's Bl [N m s/rad].
+    pub(super) bl_base: f64,
+}
+
 impl ResolvedEffects {
     /// Resolves the scenario's effects: defaults that depend on the machine and supply
     /// (rated flux `vpk0 / we0`, rated torque `t_rated`, synchronous speed `w_sync`).
     pub(super) fn new(
         scenario: &Scenario,
         m: &MotorParameters,
-        (vpk0, we0): (f64, f64),
-        (t_rated, w_sync, bl_base): (f64, f64, f64),
+        rated: RatedPoint,
     ) -> Result<Self, SimError> {
+        let RatedPoint {
+            vpk0,
+            we0,
+            t_rated,
+            w_sync,
+            bl_base,
+        } = rated;
         let mut eff = ResolvedEffects::default();
         for e in &scenario.effects {
             match *e {

@@ -2,7 +2,7 @@
 //! the integration loop and the true state of each output sample.
 
 use super::machine::Machine;
-use super::resolve::{rated_torque, MachineBuilder, ParameterScales, ResolvedEffects};
+use super::resolve::{rated_torque, MachineBuilder, ParameterScales, RatedPoint, ResolvedEffects};
 use super::sensors::Sensors;
 use super::{LoadKind, Scenario, ScenarioEvent, SimError, SimSummary, SupplyStep, Truth};
 use crate::log::Row;
@@ -164,7 +164,14 @@ impl<'a> Run<'a> {
         let bl_base = scenario.load.bl_nms.unwrap_or(m.bl_nms);
         let w_sync = we0 / np;
         let t_rated = rated_torque(params, scenario, w_sync, bl_base);
-        let eff = ResolvedEffects::new(scenario, m, (vpk0, we0), (t_rated, w_sync, bl_base))?;
+        let rated = RatedPoint {
+            vpk0,
+            we0,
+            t_rated,
+            w_sync,
+            bl_base,
+        };
+        let eff = ResolvedEffects::new(scenario, m, rated)?;
         let torque_load = scenario.load.kind == LoadKind::Torque || eff.load_torque.is_some();
         let scales = ParameterScales {
             torque_nm: eff.load_torque.or(scenario.load.torque_nm).unwrap_or(0.0),
