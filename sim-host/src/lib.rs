@@ -1,19 +1,21 @@
 //! Host harness for the drive monitor (the library; the command line is `src/main.rs` and
-//! `src/cli/`).
+//! `src/cli/`). The modules in their layers, lowest first: a module uses only modules of
+//! lower layers (`tests/architecture.rs` checks every import), and the crate root, below
+//! them all, holds only [`one_line`].
 //!
-//! - [`sim`]: the induction-motor simulator with fault and effect injection;
-//! - [`log`]: measurement logs (the one reader and writer, the sample-rate estimate);
-//! - [`params`]: the parameter file;
-//! - [`replay`]: logs through the no_std core (`diagnose`);
-//! - [`experiment`]: a simulated motor replayed through the core as it runs (the runs
-//!   below);
-//! - [`fault_signatures`]: the paper's Table 1 end to end (`table1`);
-//! - [`service_profile`]: the healthy service profile of the false-alarm and
-//!   detection-limit studies;
-//! - [`demo`]: the main job (`demo`);
-//! - [`hmi`]: the live terminal HMI's model and its three sources (`hmi`);
-//! - [`analysis`]: the model-vs-measurement workflow (`compare`, `explain`);
-//! - [`bench`](mod@bench): the simulator and core figures of `bench`.
+//! 1. [`params`]: the parameter file, and the sensor ranges derived from it;
+//! 2. [`log`]: measurement logs (the one reader and writer, the data-quality stage, the
+//!    sample-rate estimate);
+//! 3. [`sim`]: the induction-motor simulator with fault and effect injection; [`replay`]:
+//!    logs through the no_std core (`diagnose`);
+//! 4. [`analysis`]: the model-vs-measurement workflow (`compare`, `explain`);
+//! 5. [`experiment`]: a simulated motor replayed through the core as it runs (the runs
+//!    below);
+//! 6. [`fault_signatures`]: the paper's Table 1 end to end (`table1`); [`service_profile`]:
+//!    the healthy service profile of the false-alarm and detection-limit studies;
+//! 7. [`demo`]: the main job (`demo`);
+//! 8. [`bench`](mod@bench): the simulator, core and isolation figures of `bench`; [`hmi`]:
+//!    the live terminal HMI's model and its three sources (`hmi`).
 //!
 //! The vocabulary (faults, effect names, phases, motor parameters, reference machines)
 //! is the core's (`monitor_core`), shared with the firmware. Functions return values and
