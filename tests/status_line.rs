@@ -130,7 +130,10 @@ fn the_hmi_reads_every_field_the_firmware_prints() {
         .isolation
         .as_ref()
         .expect("the isolation on the screen");
-    assert_eq!((iso.named.as_deref(), iso.change), (Some("rr"), Some(0.48)));
+    assert_eq!(
+        (iso.named.map(|n| n.name()), iso.change),
+        (Some("rr"), Some(0.48))
+    );
     assert!(snap.learned && snap.fault_lamp);
     assert_eq!(snap.sensor_faults, vec![Fault::VoltageSensor]);
     assert!(matches!(snap.state, MonitorState::Fault(_)));

@@ -14,6 +14,9 @@
 //! `ANALYSIS_BENCH_FORMATS` picks them (default `csv,parquet`; `tdms` too if asked). The peak
 //! memory is the process's (VmHWM): the second format's figure includes the first's.
 
+#[path = "../src/alloc_tuning.rs"]
+mod alloc_tuning;
+
 use sim_host::analysis::{prep::ReadOptions, Analysis, Options};
 use sim_host::log::{Channels, LogFile, LogWriter, Row};
 use sim_host::params::ParamFile;
@@ -54,7 +57,7 @@ fn cpu_s() -> f64 {
 }
 
 fn main() {
-    sim_host::keep_freed_memory();
+    alloc_tuning::keep_freed_memory();
     let secs: f64 = std::env::var("ANALYSIS_BENCH_SECONDS")
         .ok()
         .and_then(|s| s.parse().ok())

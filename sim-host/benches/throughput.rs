@@ -1,4 +1,4 @@
-//! Simulator throughput on DESIGN.md §4's reference scenario (2.2 kW machine started
+//! Simulator throughput on the reference scenario (2.2 kW machine started
 //! direct-on-line, 14.6 N m load torque from 2.5 s, 10 s at 10 kHz, ideal sensors):
 //! one iteration = 10 simulated seconds, so simulated s per wall s = 10 / time.
 //! Also the same run with the default (noisy, quantised) sensor chain.

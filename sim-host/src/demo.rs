@@ -1,14 +1,13 @@
-//! The main job (`sim-host demo`): the DESIGN.md 3 hp motor started direct-on-line with the
-//! paper's viscous load and realistic sensors (12-bit ADC, noise, 1024-line encoder), its
-//! sensor streams replayed through the same core the firmware runs, the healthy residuals
-//! learned (commissioning, 2-4 s), a Table 1 fault injected at 5 s, and the lamps r1..r4
-//! and the fault candidates followed every 0.25 s.
+//! The main job (`sim-host demo`): the 3 hp reference motor (Krause's textbook machine)
+//! started direct-on-line with the paper's viscous load and realistic sensors (12-bit ADC,
+//! noise, 1024-line encoder), its sensor streams replayed through the same core the
+//! firmware runs, the healthy residuals learned (commissioning, 2-4 s), a Table 1 fault
+//! injected at 5 s, and the lamps r1..r4 and the fault candidates followed every 0.25 s.
 
+use crate::experiment::{simulate_and_replay, ExperimentError};
 use crate::fault_signatures::{scenario, Protocol};
 use crate::params::ParamFile;
-use crate::replay::{DiagnoseReport, Replay, ReplayOptions};
-use crate::sim::simulate;
-use crate::ExperimentError;
+use crate::replay::{DiagnoseReport, IsolationName, ReplayOptions};
 use monitor_core::{CommissioningState, Fault, MonitorOutput};
 
 /// Time between two timeline points [s].
@@ -82,11 +81,7 @@ pub struct DemoRun {
 impl DemoRun {
     /// True when the injected fault is among the final candidates.
     pub fn correct_fault_named(&self) -> bool {
-        let want = match self.fault {
-            Fault::B | Fault::Bl => "b/bl",
-            f => f.name(),
-        };
-        self.report.isolation.named.as_deref() == Some(want)
+        self.report.isolation.named == Some(IsolationName::expected(self.fault))
     }
 }
 
@@ -107,12 +102,10 @@ pub fn run(fault: Fault, change: f64) -> Result<DemoRun, ExperimentError> {
         timeline_step_s: TIMELINE_STEP_S,
         ..ReplayOptions::default()
     };
-    let mut replay = Replay::new(&params, sc.sensors.channels(), proto.sample_rate_hz, opts)?;
     let mut next = 0.0;
     let mut announced = false;
     let mut points = Vec::new();
-    simulate(&params, &sc, |row| {
-        let o = replay.push(row);
+    let replay = simulate_and_replay(&params, &params, &sc, opts, |row, o| {
         if row.t_s + 1e-9 >= next {
             next += TIMELINE_STEP_S;
             let fault_injected = !announced && row.t_s >= proto.fault_at_s;
@@ -121,7 +114,7 @@ pub fn run(fault: Fault, change: f64) -> Result<DemoRun, ExperimentError> {
                 t_s: row.t_s,
                 speed_rpm: f64::from(o.speed_rad_s * 60.0 / std::f32::consts::TAU),
                 lamps: o.lamps,
-                state: MonitorState::of(&o),
+                state: MonitorState::of(o),
                 fault_injected,
             });
         }

@@ -10,13 +10,12 @@
 //! at the end of the run (steady state under fault). Sensor faults are gain errors on all
 //! three phases (current, voltage) or on the speed reading and the encoder.
 
-use crate::log::Row;
+use crate::experiment::{simulate_and_replay, ExperimentError};
 use crate::params::ParamFile;
-use crate::replay::{Replay, ReplayOptions};
-use crate::sim::{simulate, FaultSpec, LoadStep, Scenario, SensorSpec};
-use crate::ExperimentError;
-use monitor_core::{AngleSource, Fault};
-use serde::Serialize;
+use crate::replay::{serialize_state, FaultCandidate, IsolationName, NameGiven, ReplayOptions};
+use crate::sim::{FaultSpec, LoadStep, Scenario, SensorSpec};
+use monitor_core::{AngleSource, Fault, IsolationState};
+use serde::{Serialize, Serializer};
 
 /// Timing of a Table 1 run.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -60,8 +59,8 @@ impl Default for Protocol {
 /// One row of the reproduced table.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct Table1Row {
-    /// DESIGN.md fault name.
-    pub fault: String,
+    /// The fault injected (JSON: its name).
+    pub fault: Fault,
     /// Relative change (+0.5 / -0.5).
     pub change: f64,
     /// Lamps r1..r4 at the end of the run, 0/1.
@@ -72,26 +71,45 @@ pub struct Table1Row {
     pub expected: [u8; 4],
     /// Normalised residuals r1..r4 at the end of the run.
     pub residuals: [f32; 4],
-    /// The lamps' candidates at the end (name, probability): the signature matching.
-    pub candidates: Vec<(String, f32)>,
+    /// The lamps' candidates at the end: the signature matching (JSON: pairs `[fault,
+    /// probability]`).
+    #[serde(serialize_with = "fault_and_probability")]
+    pub candidates: Vec<FaultCandidate>,
     /// Time from the fault to the first lamp [s], if any.
     pub detection_delay_s: Option<f64>,
     /// The fault the isolation names at the end (`b/bl` for the friction class), if any
     /// ([`crate::replay::IsolationReport`]).
-    pub named: Option<String>,
+    pub named: Option<IsolationName>,
     /// The estimated relative change of the top isolation candidate at the end.
     pub named_change: Option<f32>,
-    /// The isolation's candidates at the end (name, probability, estimated change).
-    pub isolation_candidates: Vec<(String, f32, Option<f32>)>,
-    /// The isolation's state at the end (`isolated`, `unknown`, `no_deviation`, ...).
-    pub isolation_state: String,
+    /// The isolation's candidates at the end (JSON: triples `[fault, probability,
+    /// estimated change]`).
+    #[serde(serialize_with = "fault_probability_and_change")]
+    pub isolation_candidates: Vec<FaultCandidate>,
+    /// The isolation's state at the end (JSON `isolated`, `unknown`, `no_deviation`, ...).
+    #[serde(serialize_with = "serialize_state")]
+    pub isolation_state: IsolationState,
     /// Time from the fault to the first time the isolation named a fault [s] (negative:
     /// something was named before the fault).
     pub name_delay_s: Option<f64>,
     /// Every fault the isolation named during the run (`b/bl` for the friction class),
     /// each with the first time it was named, from the fault on [s] (negative: before the
     /// fault); a name given and later withdrawn stays here.
-    pub names_given: Vec<(String, f64)>,
+    pub names_given: Vec<NameGiven>,
+}
+
+/// Candidates as `[fault, probability]` pairs (the table's JSON).
+fn fault_and_probability<S: Serializer>(c: &[FaultCandidate], s: S) -> Result<S::Ok, S::Error> {
+    s.collect_seq(c.iter().map(|c| (c.fault, c.probability)))
+}
+
+/// Candidates as `[fault, probability, change]` triples (the table's JSON, the
+/// isolation bench's).
+pub(crate) fn fault_probability_and_change<S: Serializer>(
+    c: &[FaultCandidate],
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    s.collect_seq(c.iter().map(|c| (c.fault, c.probability, c.change)))
 }
 
 /// The scenario of one case.
@@ -130,10 +148,8 @@ pub fn run_case(
         commission: Some(proto.commission),
         ..ReplayOptions::default()
     };
-    let mut replay = Replay::new(params, sc.sensors.channels(), proto.sample_rate_hz, opts)?;
     let mut first_lamp: Option<f64> = None;
-    simulate(params, &sc, |row: &Row| {
-        let out = replay.push(row);
+    let replay = simulate_and_replay(params, params, &sc, opts, |row, out| {
         if first_lamp.is_none() && row.t_s >= proto.fault_at_s && out.lamps.iter().any(|x| *x) {
             first_lamp = Some(row.t_s - proto.fault_at_s);
         }
@@ -141,7 +157,10 @@ pub fn run_case(
     let names_given = replay
         .isolation_names()
         .iter()
-        .map(|(n, t)| (n.clone(), t - proto.fault_at_s))
+        .map(|g| NameGiven {
+            name: g.name,
+            t_s: g.t_s - proto.fault_at_s,
+        })
         .collect();
     let rep = replay.finish();
     let lamps: Vec<bool> = (1..=4)
@@ -162,31 +181,19 @@ pub fn run_case(
     }
     let residuals = rep.timeline.last().map(|p| p.residuals).unwrap_or_default();
     Ok(Table1Row {
-        fault: fault.name().to_string(),
+        fault,
         change,
         signature,
         paper,
         expected,
         residuals,
-        candidates: rep
-            .signature_candidates
-            .iter()
-            .map(|c| (c.fault.clone(), c.probability))
-            .collect(),
+        candidates: rep.signature_candidates,
         detection_delay_s: first_lamp,
-        named: rep.isolation.named.clone(),
+        named: rep.isolation.named,
         named_change: rep.isolation.named_change,
-        isolation_candidates: rep
-            .candidates
-            .iter()
-            .map(|c| (c.fault.clone(), c.probability, c.change))
-            .collect(),
-        isolation_state: rep.isolation.state.clone(),
-        name_delay_s: rep
-            .isolation
-            .first_named
-            .as_ref()
-            .map(|(_, t)| t - proto.fault_at_s),
+        isolation_candidates: rep.candidates,
+        isolation_state: rep.isolation.state,
+        name_delay_s: rep.isolation.first_named.map(|g| g.t_s - proto.fault_at_s),
         names_given,
     })
 }

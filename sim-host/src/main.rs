@@ -15,13 +15,14 @@
 //! - 130 / 143: interrupted by SIGINT / SIGTERM (128 + the signal, the shell's
 //!   convention) during a command that cleans up on a signal (`simulate`).
 
+mod alloc_tuning;
 mod cli;
 
 use clap::Parser;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    sim_host::keep_freed_memory();
+    alloc_tuning::keep_freed_memory();
     let args = match cli::Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {

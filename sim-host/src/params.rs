@@ -1,4 +1,4 @@
-//! The motor parameter file (DESIGN.md §3): nominal T-equivalent parameters and the supply.
+//! The motor parameter file (`docs/design.md`): nominal T-equivalent parameters and the supply.
 //!
 //! ```toml
 //! [motor]
@@ -24,6 +24,7 @@
 //! (`crate::sim`) and the analysis's constants (`crate::analysis::simplified_model::MachineConstants`).
 
 use monitor_core::{MotorParameters, ReferenceMachine, SupplyParameters};
+use nalgebra::Complex;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
 use std::path::Path;
@@ -75,6 +76,11 @@ pub struct PlausibleRange {
 }
 
 impl PlausibleRange {
+    /// The range `lo..=hi`.
+    pub const fn new(lo: f64, hi: f64) -> Self {
+        PlausibleRange { lo, hi }
+    }
+
     /// True for a finite `x` in `lo..=hi`.
     pub fn contains(&self, x: f64) -> bool {
         x.is_finite() && x >= self.lo && x <= self.hi
@@ -89,10 +95,11 @@ impl PlausibleRange {
 /// machine is never refused and a unit or typing error of 10x to 1000x is):
 /// - the four machines of Krause, Wasynczuk and Sudhoff, *Analysis of Electric Machinery
 ///   and Drive Systems* (3 hp / 220 V, 50 hp / 460 V, 500 hp / 2300 V, 2250 hp / 2300 V,
-///   all 60 Hz, 4 poles; the 3 hp one is DESIGN.md's): Lm/Ls 0.972..0.983, sigma
-///   0.034..0.055, X/Rs 62..457, Lr/Rr 0.087..1.6 s, Rr/Rs 0.71..2.6, H estimate 0.88..2.8 s;
-/// - DESIGN.md's 2.2 kW Gamma-model machine (Ls = Lm): Lm/Lr 0.914, sigma 0.086, X/Rs 21,
-///   Lr/Rr 0.11 s, Rr/Rs 0.68, H estimate 0.089 s;
+///   all 60 Hz, 4 poles; the 3 hp one is the repository's reference motor): Lm/Ls
+///   0.972..0.983, sigma 0.034..0.055, X/Rs 62..457, Lr/Rr 0.087..1.6 s, Rr/Rs 0.71..2.6,
+///   H estimate 0.88..2.8 s;
+/// - the repository's 2.2 kW Gamma-model reference machine (Ls = Lm): Lm/Lr 0.914, sigma
+///   0.086, X/Rs 21, Lr/Rr 0.11 s, Rr/Rs 0.68, H estimate 0.089 s;
 /// - textbook per-unit values for the small end (0.1 kW, 2 to 8 poles: Rs up to about
 ///   0.1 pu and X/Rs down to about 5, Lr/Rr down to about 20 ms, rotor inertia 1e-4 to
 ///   1e-3 kg m^2).
@@ -104,30 +111,24 @@ pub mod plausible {
     pub const POLES: core::ops::RangeInclusive<u32> = 2..=24;
     /// Supply frequency `f_hz` [Hz]: 1..400 (400 Hz: aircraft supplies and high-speed
     /// motors; high-speed spindles above that are outside this product's scope).
-    pub const F_HZ: R = R { lo: 1.0, hi: 400.0 };
+    pub const F_HZ: R = R::new(1.0, 400.0);
     /// Line-to-line voltage `v_ll_rms` [V]: 10..15000 (low-voltage battery drives up to
     /// 13.8 kV medium-voltage machines).
-    pub const V_LL_RMS: R = R {
-        lo: 10.0,
-        hi: 15_000.0,
-    };
+    pub const V_LL_RMS: R = R::new(10.0, 15_000.0);
     /// Lm/Ls: 0.8..=1 (1 = a Gamma-model machine with no stator leakage; below 0.8 the
     /// stator leakage would exceed a quarter of Lm).
-    pub const LM_OVER_LS: R = R { lo: 0.8, hi: 1.0 };
+    pub const LM_OVER_LS: R = R::new(0.8, 1.0);
     /// Lm/Lr: 0.8..=1 (1 = an inverse-Gamma-model machine with no rotor leakage).
-    pub const LM_OVER_LR: R = R { lo: 0.8, hi: 1.0 };
+    pub const LM_OVER_LR: R = R::new(0.8, 1.0);
     /// Leakage coefficient sigma = 1 - Lm^2/(Ls Lr): 0.01..0.25.
-    pub const SIGMA: R = R { lo: 0.01, hi: 0.25 };
+    pub const SIGMA: R = R::new(0.01, 0.25);
     /// Magnetising reactance over stator resistance, 2 pi f Ls / Rs, at the file's
     /// frequency: 2..1000.
-    pub const X_OVER_RS: R = R {
-        lo: 2.0,
-        hi: 1000.0,
-    };
+    pub const X_OVER_RS: R = R::new(2.0, 1000.0);
     /// Rotor time constant Lr/Rr [s]: 0.005..5.
-    pub const ROTOR_TIME_CONSTANT_S: R = R { lo: 0.005, hi: 5.0 };
+    pub const ROTOR_TIME_CONSTANT_S: R = R::new(0.005, 5.0);
     /// Rr/Rs: 0.1..10.
-    pub const RR_OVER_RS: R = R { lo: 0.1, hi: 10.0 };
+    pub const RR_OVER_RS: R = R::new(0.1, 10.0);
     /// Inertia constant estimate H = (J omega_m^2 / 2) / S0 [s], omega_m = 2 pi f / Np the
     /// synchronous mechanical speed and S0 = V_ll^2 / (2 pi f Ls) the no-load (magnetising)
     /// reactive power standing in for the rated power: 0.002..100. Real machines have H
@@ -135,10 +136,7 @@ pub mod plausible {
     /// flywheel or a large fan on the shaft (J is rotor plus load). S0 is 0.3 to 1.1 times
     /// the rated power (no-load current 25 % to 60 % of rated at power factor 0.7 to 0.9),
     /// hence the extra margin of about 4x at both ends.
-    pub const INERTIA_CONSTANT_S: R = R {
-        lo: 0.002,
-        hi: 100.0,
-    };
+    pub const INERTIA_CONSTANT_S: R = R::new(0.002, 100.0);
 }
 
 /// A parameter file value outside the range of real machines: the key, its value, the
@@ -429,14 +427,92 @@ impl ParamFile {
         }
     }
 
-    /// DESIGN.md's "2.2 kW" machine ([`monitor_core::reference::MOTOR_2P2KW`]).
+    /// The "2.2 kW" reference machine ([`monitor_core::reference::MOTOR_2P2KW`]).
     pub fn reference_2p2kw() -> Self {
         Self::from_reference(&monitor_core::reference::MOTOR_2P2KW)
     }
 
-    /// DESIGN.md's "3 hp" textbook machine ([`monitor_core::reference::MOTOR_3HP`]).
+    /// The "3 hp" reference machine, Krause's textbook machine
+    /// ([`monitor_core::reference::MOTOR_3HP`]).
     pub fn reference_3hp() -> Self {
         Self::from_reference(&monitor_core::reference::MOTOR_3HP)
+    }
+}
+
+/// The sensors' measurement ranges for a machine on a supply: the simulator's default ADC
+/// ranges ([`crate::sim::SensorSpec`]), and what the plausibility limits of a log are built
+/// from ([`ParamFile::log_limits`]). The one place these ranges are derived.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SensorRanges {
+    /// Voltage range +/- [V]: 1.2 x the phase peak sqrt(2/3) V_ll rounded up to 50 V
+    /// (400 V for the 2.2 kW reference motor, 250 V for the 3 hp one).
+    pub v_range_v: f64,
+    /// Current range +/- [A]: 2 x the locked-rotor peak current rounded up to 5 A (a
+    /// direct-on-line start, whose first peaks exceed the steady locked-rotor peak, does
+    /// not clip).
+    pub i_range_a: f64,
+}
+
+impl SensorRanges {
+    /// The ranges for motor `m` on a supply of `v_ll_rms` [V, line-to-line RMS] at `f_hz`
+    /// [Hz] (a scenario may run the motor on another supply than the parameter file's).
+    pub fn new(m: &MotorParameters, v_ll_rms: f64, f_hz: f64) -> Self {
+        let vpk = v_ll_rms * (2.0f64 / 3.0).sqrt();
+        let v = (1.2 * vpk / 50.0).ceil() * 50.0;
+        let i_locked = locked_rotor_current_rms_a(m, v_ll_rms, f_hz);
+        let i = (2.0 * 2f64.sqrt() * i_locked / 5.0).ceil() * 5.0;
+        SensorRanges {
+            v_range_v: v,
+            i_range_a: i,
+        }
+    }
+}
+
+/// Stator phase current RMS [A] of the T-equivalent circuit with the rotor locked (slip
+/// 1): `I = V / (Zs + Zm || Zr)` with `V = V_ll / sqrt 3`, `Zs = Rs + j we Lls`,
+/// `Zm = j we Lm`, `Zr = Rr + j we Llr`, `we = 2 pi f` (the simulator's analytic steady
+/// state at slip 1, `crate::sim::steady_state_at`, to the last bit; a test checks it).
+pub fn locked_rotor_current_rms_a(m: &MotorParameters, v_ll_rms: f64, f_hz: f64) -> f64 {
+    let we = 2.0 * std::f64::consts::PI * f_hz;
+    let model = m.model::<f64>();
+    let v = Complex::new(v_ll_rms / 3f64.sqrt(), 0.0);
+    let zs = Complex::new(m.rs_ohm, we * model.lls_h());
+    let zm = Complex::new(0.0, we * m.lm_h);
+    let zr = Complex::new(m.rr_ohm, we * model.llr_h());
+    let zp = zm * zr / (zm + zr);
+    (v / (zs + zp)).norm()
+}
+
+/// The largest believable readings in a log of a machine: beyond them a cell is bad (the
+/// data-quality stage, `crate::log::quality::CellLimits`) and the replay's monitor flags
+/// the sensor (`crate::replay::monitor_config_for_log`). In the core's `f32`, as the
+/// monitor's `SensorLimits`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LogLimits {
+    /// Largest |phase voltage| [V]: twice the voltage range ([`SensorRanges`]), since a
+    /// log does not say its ADC ranges.
+    pub v_max_v: f32,
+    /// Largest |phase current| [A]: twice the current range.
+    pub i_max_a: f32,
+    /// Largest |mechanical speed| [rad/s]: 2 x 2 pi f (at least twice the synchronous
+    /// speed for any number of poles; the core's default `max_speed_rad_s`).
+    pub wm_max_rad_s: f32,
+}
+
+impl ParamFile {
+    /// The sensor ranges of this machine on its own supply ([`SensorRanges::new`]).
+    pub fn sensor_ranges(&self) -> SensorRanges {
+        SensorRanges::new(&self.motor, self.supply.v_ll_rms, self.supply.f_hz)
+    }
+
+    /// The plausibility limits of a log of this machine ([`LogLimits`]).
+    pub fn log_limits(&self) -> LogLimits {
+        let r = self.sensor_ranges();
+        LogLimits {
+            v_max_v: 2.0 * r.v_range_v as f32,
+            i_max_a: 2.0 * r.i_range_a as f32,
+            wm_max_rad_s: 2.0 * std::f32::consts::TAU * self.supply.f_hz as f32,
+        }
     }
 }
 
@@ -520,7 +596,7 @@ mod tests {
         ParamFile::from_toml_str(&motulator.to_toml_string(), "x").unwrap();
     }
 
-    /// The message of loading `p` with `edit` applied to the DESIGN.md example.
+    /// The message of loading `p` with `edit` applied to the documented example.
     fn refused(from: &str, to: &str) -> String {
         let text = DESIGN_EXAMPLE.replace(from, to);
         assert_ne!(text, DESIGN_EXAMPLE, "{from} not in the example");
@@ -603,6 +679,32 @@ mod tests {
             p.check().unwrap();
             let back = ParamFile::from_toml_str(&p.to_toml_string(), "x").unwrap();
             assert_eq!(back, p);
+        }
+    }
+
+    #[test]
+    fn sensor_ranges_of_the_reference_motors() {
+        // The values the simulator's documentation states: 400 V for the 2.2 kW motor,
+        // 250 V for the 3 hp one (1.2 x the phase peak, rounded up to 50 V).
+        let r = ParamFile::reference_2p2kw().sensor_ranges();
+        assert_eq!(r.v_range_v, 400.0);
+        assert_eq!(ParamFile::reference_3hp().sensor_ranges().v_range_v, 250.0);
+        // The current range: a multiple of 5 A between 2 and 2.5 times the locked-rotor
+        // peak current (2 x peak, rounded up to 5 A).
+        for p in [ParamFile::reference_2p2kw(), ParamFile::reference_3hp()] {
+            let r = p.sensor_ranges();
+            let i_pk = 2f64.sqrt()
+                * locked_rotor_current_rms_a(&p.motor, p.supply.v_ll_rms, p.supply.f_hz);
+            assert_eq!(r.i_range_a % 5.0, 0.0);
+            assert!(
+                r.i_range_a >= 2.0 * i_pk && r.i_range_a < 2.0 * i_pk + 5.0,
+                "{r:?} {i_pk}"
+            );
+            // The log's limits: twice the ranges, twice the supply's angular frequency.
+            let l = p.log_limits();
+            assert_eq!(f64::from(l.v_max_v), 2.0 * r.v_range_v);
+            assert_eq!(f64::from(l.i_max_a), 2.0 * r.i_range_a);
+            assert!((f64::from(l.wm_max_rad_s) - 2.0 * TAU * p.supply.f_hz).abs() < 1e-3);
         }
     }
 }

@@ -4,13 +4,13 @@
 //! cycle of steps (2-30 s), then watched.
 //!
 //! The paper's model lumps the load into `Bl omega`, so a load change is, to the model, a
-//! change of Bl (DESIGN.md §2): a monitor on a machine whose load varies learns the healthy
+//! change of Bl (`docs/design.md`): a monitor on a machine whose load varies learns the healthy
 //! spread of its residuals over the load and supply range it sees in service.
 
+use crate::experiment::{simulate_and_replay, ExperimentError};
 use crate::params::ParamFile;
-use crate::replay::{Replay, ReplayOptions};
-use crate::sim::{simulate, FaultSpec, LoadSpec, LoadStep, Scenario, SensorSpec, SupplyStep};
-use crate::ExperimentError;
+use crate::replay::{NameGiven, ReplayOptions};
+use crate::sim::{FaultSpec, LoadSpec, LoadStep, Scenario, SensorSpec, SupplyStep};
 use monitor_core::{AngleSource, ResidualForm};
 
 /// Commissioning window of the profile [s].
@@ -87,7 +87,7 @@ pub struct Watch {
     pub calibration: Option<monitor_core::Calibration>,
     /// Every name the fault isolation gave, with the first time [s] (`b/bl`, the friction
     /// class, is what a load change is to the paper's model; any other is a false name).
-    pub isolation_names: Vec<(String, f64)>,
+    pub isolation_names: Vec<NameGiven>,
 }
 
 /// Runs the service profile (optionally with a fault) and watches the monitor after the
@@ -127,11 +127,9 @@ pub fn watch_mismatched(
         timeline_step_s: 1.0,
         unbalance_baseline: None,
     };
-    let mut replay = Replay::new(params, sc.sensors.channels(), sc.sample_rate_hz, opts)?;
     let mut w = Watch::default();
     let dt = 1.0 / sc.sample_rate_hz;
-    simulate(truth, &sc, |row| {
-        let o = replay.push(row);
+    let replay = simulate_and_replay(truth, params, &sc, opts, |row, o| {
         if row.t_s > COMMISSION.1 {
             if o.evaluating {
                 w.evaluated_s += dt;

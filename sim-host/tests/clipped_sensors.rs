@@ -8,7 +8,7 @@ use monitor_core::Fault;
 use sim_host::fault_signatures::{scenario, Protocol};
 use sim_host::log::Channels;
 use sim_host::params::ParamFile;
-use sim_host::replay::{diagnose_rows, ReplayOptions, Verdict};
+use sim_host::replay::{diagnose_rows, IsolationName, ReplayOptions, Verdict};
 
 fn diagnose(
     p: &ParamFile,
@@ -71,7 +71,10 @@ fn a_clipped_voltage_sensor_withholds_the_verdict_and_headroom_gives_the_size() 
         "{:?}",
         room.data_quality.not_trusted_because
     );
-    assert_eq!(room.isolation.named.as_deref(), Some("voltage_sensor"));
+    assert_eq!(
+        room.isolation.named.map(IsolationName::name),
+        Some("voltage_sensor")
+    );
     let size = room.isolation.named_change.expect("a size"); // ok: test
     assert!((size - 0.5).abs() < 0.1, "{size}");
 

@@ -6,7 +6,7 @@ use monitor_core::AngleSource;
 use monitor_core::Phase;
 use rayon::prelude::*;
 use sim_host::params::ParamFile;
-use sim_host::replay::{diagnose_rows, ReplayOptions};
+use sim_host::replay::{diagnose_rows, BaselineSource, ReplayOptions};
 use sim_host::sim::{simulate_to_vec, EffectSpec, LoadKind, LoadSpec, Scenario, SensorSpec};
 
 fn run(params: &ParamFile, load_nm: f64, phase: Phase, fraction: f64) -> (Option<String>, f32) {
@@ -27,7 +27,7 @@ fn run(params: &ParamFile, load_nm: f64, phase: Phase, fraction: f64) -> (Option
     };
     let rep = diagnose_rows(params, sc.sensors.channels(), &rows, opts).expect("replay");
     (
-        rep.unbalance.suspect_phase,
+        rep.unbalance.suspect_phase.map(|p| p.name().to_string()),
         rep.unbalance.negative_sequence_ratio,
     )
 }
@@ -35,7 +35,7 @@ fn run(params: &ParamFile, load_nm: f64, phase: Phase, fraction: f64) -> (Option
 #[test]
 fn suspect_phase_is_the_shorted_phase_for_two_motors_and_two_loads() {
     // Rated torques: 3 hp 220 V 60 Hz 4-pole at ~1710 rpm: 2238 W / 179 rad/s = 12.5 N m;
-    // 2.2 kW at ~1430 rpm: 14.6 N m (DESIGN.md reference scenario).
+    // 2.2 kW at ~1430 rpm: 14.6 N m (the reference scenario).
     let motors = [
         (ParamFile::reference_3hp(), 12.5),
         (ParamFile::reference_2p2kw(), 14.6),
@@ -119,7 +119,7 @@ fn diagnose_and_the_analysis_name_the_same_phase() {
         };
         let a = Analysis::load(&path, p, opts, &mut |_| {}).expect("analysis");
         let u = a.unbalance();
-        assert_eq!(rep.unbalance.suspect_phase.as_deref(), Some(name));
+        assert_eq!(rep.unbalance.suspect_phase.map(Phase::name), Some(name));
         assert_eq!(u.suspect_phase.as_deref(), Some(name), "{}", u.summary);
     }
 }
@@ -204,7 +204,7 @@ fn on_an_unbalanced_supply_the_shorted_phase_is_named_and_a_healthy_motor_gets_n
         match want {
             Some(name) => {
                 shorted += 1;
-                if u.suspect_phase.as_deref() == Some(*name) {
+                if u.suspect_phase.map(Phase::name) == Some(*name) {
                     right += 1;
                 } else if u.suspect_phase.is_some() {
                     failures.push(format!("{tag}: wrong phase {:?}", u.suspect_phase));
@@ -272,7 +272,7 @@ fn a_healthy_baseline_takes_the_motors_own_asymmetry_out() {
             },
         );
         if commissioned.unbalance.suspect_phase.is_some()
-            || commissioned.unbalance.baseline.as_deref() != Some("commissioning")
+            || commissioned.unbalance.baseline != Some(BaselineSource::Commissioning)
         {
             failures.push(format!(
                 "{} Hz healthy, commissioned: {:?}",
@@ -293,8 +293,8 @@ fn a_healthy_baseline_takes_the_motors_own_asymmetry_out() {
         }
         for phase in Phase::ALL {
             let rep = replay(&mismatched(&params, Some((phase, 0.03)), 13), with_file);
-            if rep.unbalance.suspect_phase.as_deref() != Some(phase.name())
-                || rep.unbalance.baseline.as_deref() != Some("file")
+            if rep.unbalance.suspect_phase.map(Phase::name) != Some(phase.name())
+                || rep.unbalance.baseline != Some(BaselineSource::File)
             {
                 failures.push(format!(
                     "{} Hz, 3 % shorted in {}: {:?}",

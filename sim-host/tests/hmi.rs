@@ -332,7 +332,7 @@ fn plain_text_when_stdout_is_not_a_terminal() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(
-        out.starts_with("live simulation: DESIGN.md 3 hp motor"),
+        out.starts_with("live simulation: 3 hp reference motor"),
         "{out}"
     );
     assert!(

@@ -20,6 +20,7 @@ use monitor_core::Fault;
 use rayon::prelude::*;
 use sim_host::fault_signatures::{run_case, Protocol, Table1Row};
 use sim_host::params::ParamFile;
+use sim_host::replay::{state_name, FaultCandidate, IsolationName};
 use std::path::Path;
 
 fn machines() -> Vec<(&'static str, ParamFile)> {
@@ -101,7 +102,8 @@ fn every_fault_is_named_with_its_size_or_honestly_not_named() {
         let name = machines[*m].0;
         let tag = format!("{name} {f} {change:+}");
         // Never a wrong fault at >= 0.5.
-        for (c, p, _) in &row.isolation_candidates {
+        for cand in &row.isolation_candidates {
+            let (c, p) = (cand.fault.name(), &cand.probability);
             let friction = matches!(f, Fault::B | Fault::Bl) && (c == "b" || c == "bl");
             if *p >= 0.5 && c != f.name() && !friction {
                 failures.push(format!("{tag}: wrong fault {c} at {p:.2}"));
@@ -119,7 +121,7 @@ fn every_fault_is_named_with_its_size_or_honestly_not_named() {
             Fault::B | Fault::Bl => "b/bl",
             _ => f.name(),
         };
-        if row.named.as_deref() == Some(want) {
+        if row.named.map(IsolationName::name) == Some(want) {
             if !matches!(f, Fault::B | Fault::Bl) {
                 let size = row.named_change.map(f64::from).unwrap_or(f64::NAN);
                 let exempt = not_separable(name, *f, *change).is_some();
@@ -138,16 +140,20 @@ fn every_fault_is_named_with_its_size_or_honestly_not_named() {
             // lead to the fault it is confused with.
             if change.abs() > 0.4 {
                 match row.isolation_candidates.first() {
-                    Some((c, _, Some(k)))
-                        if c == f.name()
-                            && (f64::from(*k) - change).abs() <= 0.2 * change.abs() => {}
+                    Some(FaultCandidate {
+                        fault: c,
+                        change: Some(k),
+                        ..
+                    }) if c == f && (f64::from(*k) - change).abs() <= 0.2 * change.abs() => {}
                     top => failures.push(format!("{tag} ({why}): top candidate {top:?}")),
                 }
             }
         } else {
             failures.push(format!(
                 "{tag}: named {:?} ({}), candidates {:?}",
-                row.named, row.isolation_state, row.isolation_candidates
+                row.named,
+                state_name(row.isolation_state),
+                row.isolation_candidates
             ));
         }
     }

@@ -4,8 +4,9 @@
 //! alone on this machine, so the bench must find and name them; the confusion matrix must
 //! count every case once, on the diagonal here.
 
-use monitor_core::{AngleSource, Fault};
+use monitor_core::{AngleSource, Fault, IsolationState};
 use sim_host::bench::isolation::{motors, run, BenchPlan, CHANGES, LOADS};
+use sim_host::replay::{angle_source_name, FaultCandidate, IsolationName, NameGiven};
 
 #[test]
 fn the_bench_finds_names_and_counts() {
@@ -40,19 +41,22 @@ fn the_bench_finds_names_and_counts() {
         (16, 16, 16, 0)
     );
     let conf = &b.confusion[0];
-    assert_eq!(conf.rows, ["rr", "current_sensor"]);
+    assert_eq!(
+        conf.rows.iter().map(|f| f.name()).collect::<Vec<_>>(),
+        ["rr", "current_sensor"]
+    );
     assert_eq!(conf.columns.len(), 12);
     let total: u32 = conf.counts.iter().flatten().sum();
     assert_eq!(total, 16);
     let rr = conf
         .columns
         .iter()
-        .position(|c| c == "rr")
+        .position(|c| c.name() == "rr")
         .expect("rr column"); // ok: test
     let cs = conf
         .columns
         .iter()
-        .position(|c| c == "current_sensor")
+        .position(|c| c.name() == "current_sensor")
         .expect("current_sensor column"); // ok: test
     assert_eq!(conf.counts[0][rr], 8);
     assert_eq!(conf.counts[1][cs], 8);
@@ -63,8 +67,9 @@ fn a_wrong_name_is_counted() {
     // A row in which the isolation named rr for an Ls fault at the end, after naming ls.
     use sim_host::bench::isolation::judge;
     use sim_host::fault_signatures::Table1Row;
+    let name = |n: &str| IsolationName::from_name(n).expect("a name"); // ok: test
     let row = Table1Row {
-        fault: "ls".into(),
+        fault: Fault::Ls,
         change: 0.5,
         signature: [0; 4],
         paper: [0; 4],
@@ -72,20 +77,34 @@ fn a_wrong_name_is_counted() {
         residuals: [0.0; 4],
         candidates: Vec::new(),
         detection_delay_s: Some(0.2),
-        named: Some("rr".into()),
+        named: Some(name("rr")),
         named_change: Some(0.03),
-        isolation_candidates: vec![("rr".into(), 0.7, Some(0.03))],
-        isolation_state: "isolated".into(),
+        isolation_candidates: vec![FaultCandidate {
+            fault: Fault::Rr,
+            probability: 0.7,
+            change: Some(0.03),
+            phase: None,
+        }],
+        isolation_state: IsolationState::Isolated,
         name_delay_s: Some(0.8),
-        names_given: vec![("ls".into(), 0.8), ("rr".into(), 1.5)],
+        names_given: vec![
+            NameGiven {
+                name: name("ls"),
+                t_s: 0.8,
+            },
+            NameGiven {
+                name: name("rr"),
+                t_s: 1.5,
+            },
+        ],
     };
     let c = judge("3 hp", AngleSource::Pll, 1.0, Fault::Ls, 0.5, &row);
     assert!(!c.right);
-    assert_eq!(c.named, "rr");
+    assert_eq!(c.named.name(), "rr");
     assert_eq!(c.wrong_names, ["rr at +1.50 s"]);
     assert_eq!(c.time_to_name_s, Some(0.8));
     assert_eq!(c.size_error, None);
-    assert_eq!(c.mode, "pll");
+    assert_eq!(angle_source_name(c.mode), "pll");
 }
 
 /// Issue 9's small faults: Rs at -10 and +10 % on the 3 hp and the 11 kW machines (0.2 % of

@@ -29,7 +29,7 @@ fn sixty_seconds_of_healthy_service_light_no_lamp() {
         let false_names: Vec<_> = w
             .isolation_names
             .iter()
-            .filter(|(n, _)| n != "b/bl")
+            .filter(|g| g.name.name() != "b/bl")
             .collect();
         assert!(
             false_names.is_empty(),
@@ -80,7 +80,7 @@ fn healthy_service_with_parameters_off_names_no_fault() {
         let false_names: Vec<_> = w
             .isolation_names
             .iter()
-            .filter(|(n, _)| n != "b/bl")
+            .filter(|g| g.name.name() != "b/bl")
             .collect();
         eprintln!(
             "{} Hz motor: names {:?}, lamp samples {}, evaluated {:.1} s, commissioned {}",
@@ -117,7 +117,7 @@ fn healthy_service_with_parameters_off_names_no_fault() {
         assert!(
             w.isolation_names
                 .iter()
-                .all(|(n, _)| n == "rr" || n == "b/bl"),
+                .all(|g| g.name.name() == "rr" || g.name.name() == "b/bl"),
             "{w:?}"
         );
     }

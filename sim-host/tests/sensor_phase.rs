@@ -61,9 +61,9 @@ fn one_phase_sensor_gain_is_named_with_its_phase_and_size() {
             let rep = diagnose(p, &sc, Some(*window));
             let top = rep.candidates.first();
             let ok = top.is_some_and(|c| {
-                c.fault == fault.name()
+                c.fault.name() == fault.name()
                     && c.probability >= 0.5
-                    && c.phase.as_deref() == Some(phase.name())
+                    && c.phase.map(Phase::name) == Some(phase.name())
                     && c.change.is_some_and(|x| (f64::from(x) - change).abs() <= 0.2 * change.abs())
             });
             // The sensor's negative sequence is not blamed on a winding.
@@ -111,7 +111,7 @@ fn healthy_machines_shorted_windings_and_unbalanced_supplies_blame_no_sensor() {
             let sensor_blamed = u.current_sensor_phase.is_some()
                 || u.voltage_sensor_phase.is_some()
                 || rep.candidates.iter().any(|c| c.phase.is_some());
-            let winding_right = u.suspect_phase.as_deref() == shorted.map(Phase::name);
+            let winding_right = u.suspect_phase.map(Phase::name) == shorted.map(Phase::name);
             (sensor_blamed || !winding_right).then(|| {
                 format!(
                     "{name}, shorted {shorted:?}: winding {:?}, sensors {:?} / {:?}, candidates {:?}",
@@ -144,7 +144,7 @@ fn current_only_1khz_names_the_sensor_not_a_winding() {
             diagnose_rows(&p, currents_only, &rows, ReplayOptions::default()).expect("replay"); // ok: test
         let u = &rep.unbalance;
         let s = u.current_sensor_phase.as_ref().expect("the sensor found"); // ok: test
-        assert_eq!(s.phase, "c", "{u:?}");
+        assert_eq!(s.phase.name(), "c", "{u:?}");
         assert!((s.gain_error + 0.15).abs() <= 0.03, "{u:?}");
         assert_eq!(u.suspect_phase, None, "{u:?}");
     }

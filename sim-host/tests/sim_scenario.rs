@@ -1,5 +1,5 @@
 //! Scenario files: the examples parse and run; bad keys are named; the CLI writes a CSV in
-//! the DESIGN.md schema and refuses to overwrite an input.
+//! the log schema (`docs/design.md`) and refuses to overwrite an input.
 
 use sim_host::log::Log;
 use sim_host::params::ParamFile;

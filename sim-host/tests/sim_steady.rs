@@ -93,7 +93,7 @@ fn sim_steady_viscous_load_matches_paper_load() {
     assert!((tr.te_nm - st.torque_nm).abs() < 1e-2 * st.torque_nm);
 }
 
-/// Integration accuracy on the DESIGN.md §4 reference scenario: the default step (100 us)
+/// Integration accuracy on the reference scenario: the default step (100 us)
 /// against a 100x finer run. The bar is motulator's 1.2e-5 A.
 #[test]
 fn sim_reference_accuracy_against_fine_step() {

@@ -20,12 +20,13 @@
 //!   whose size is Bl's);
 //! - **time to name**: from the fault to the first time the right name was given.
 
+use crate::experiment::ExperimentError;
 use crate::fault_signatures::{run_case, Protocol, Table1Row};
 use crate::params::{ParamError, ParamFile};
-use crate::replay::angle_source_name;
-use crate::ExperimentError;
-use monitor_core::{AngleSource, Fault};
-use serde::Serialize;
+use crate::replay::{serialize_angle_source, serialize_state, FaultCandidate, IsolationName};
+use monitor_core::{AngleSource, Fault, IsolationState};
+use serde::{Serialize, Serializer};
+use std::fmt;
 
 /// Sample rate of every case [Hz] (the bar is stated at 5 kHz).
 pub const SAMPLE_RATE_HZ: f64 = 5000.0;
@@ -36,7 +37,46 @@ pub const LOADS: [f64; 2] = [1.0, 0.6];
 /// The two angle modes: the monitor's rotor-flux frame and the paper's voltage PLL.
 pub const MODES: [AngleSource; 2] = [AngleSource::RotorFluxCurrentModel, AngleSource::Pll];
 /// Columns of the confusion matrix after the nine faults.
-pub const EXTRA_COLUMNS: [&str; 3] = ["b/bl", "unknown", "none"];
+pub const EXTRA_COLUMNS: [Outcome; 3] = [
+    Outcome::Named(IsolationName::Friction),
+    Outcome::Unknown,
+    Outcome::Nothing,
+];
+
+/// What the isolation concluded at the end of a case: the confusion matrix's column.
+/// Serialised as its name ([`Outcome::name`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outcome {
+    /// A fault, or the friction class, named alone.
+    Named(IsolationName),
+    /// An unknown fault: no fault of the list explains the change.
+    Unknown,
+    /// Nothing named alone.
+    Nothing,
+}
+
+impl Outcome {
+    /// The name (`rr`, `b/bl`), `unknown` or `none`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Outcome::Named(n) => n.name(),
+            Outcome::Unknown => "unknown",
+            Outcome::Nothing => "none",
+        }
+    }
+}
+
+impl fmt::Display for Outcome {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl Serialize for Outcome {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
 
 /// The bench's voltage full scale as a multiple of the simulator's default (1.2 x the peak
 /// phase voltage, rounded up to 50 V): with the default, a +50 % voltage-sensor gain error
@@ -55,26 +95,37 @@ pub struct BenchMotor {
     pub name: &'static str,
     /// Its parameters.
     pub params: ParamFile,
-    /// Commissioning window [s], fault switch-on [s] and end of the run [s].
-    pub timing: ((f64, f64), f64, f64),
+    /// When its runs commission, fault and end.
+    pub timing: Timing,
+}
+
+/// The timing of a bench run [s from the start].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Timing {
+    /// Commissioning window [start, end).
+    pub commission: (f64, f64),
+    /// Fault switch-on.
+    pub fault_at_s: f64,
+    /// End of the run.
+    pub duration_s: f64,
 }
 
 impl BenchMotor {
-    /// The voltage ADC's full scale of the bench [V]: [`V_RANGE_SCALE`] times the
-    /// simulator's default, so that a +50 % voltage-sensor gain error stays on scale.
+    /// The voltage ADC's full scale of the bench [V]: [`V_RANGE_SCALE`] times the sensor
+    /// range ([`crate::params::SensorRanges`]), so that a +50 % voltage-sensor gain error
+    /// stays on scale.
     pub fn v_range_v(&self) -> f64 {
-        let (m, s) = (&self.params.motor, &self.params.supply);
-        V_RANGE_SCALE * crate::sim::default_ranges(m, s.v_ll_rms, s.f_hz).0
+        V_RANGE_SCALE * self.params.sensor_ranges().v_range_v
     }
 
     /// The Table 1 protocol for this motor at [`SAMPLE_RATE_HZ`] in `mode`, at `load_scale`
     /// times the file's load, with the noise `seed`.
     pub fn protocol(&self, mode: AngleSource, load_scale: f64, seed: u64) -> Protocol {
-        let (commission, fault_at_s, duration_s) = self.timing;
+        let t = self.timing;
         Protocol {
-            commission,
-            fault_at_s,
-            duration_s,
+            commission: t.commission,
+            fault_at_s: t.fault_at_s,
+            duration_s: t.duration_s,
             sample_rate_hz: SAMPLE_RATE_HZ,
             angle_source: mode,
             load_scale,
@@ -84,14 +135,18 @@ impl BenchMotor {
     }
 }
 
-/// The three motors: DESIGN.md's 3 hp and 2.2 kW machines (commissioning 2..4 s, fault at
+/// The three motors: the 3 hp and 2.2 kW reference machines (commissioning 2..4 s, fault at
 /// 4.5 s, 8 s) and the 2-pole 11 kW machine, whose direct-on-line start settles later
 /// (commissioning 3..5 s, fault at 5.5 s, 9 s).
 ///
 /// # Errors
 /// The embedded 11 kW parameter file does not parse (a test reads it).
 pub fn motors() -> Result<Vec<BenchMotor>, ParamError> {
-    let early = ((2.0, 4.0), 4.5, 8.0);
+    let early = Timing {
+        commission: (2.0, 4.0),
+        fault_at_s: 4.5,
+        duration_s: 8.0,
+    };
     Ok(vec![
         BenchMotor {
             name: "3 hp",
@@ -106,7 +161,11 @@ pub fn motors() -> Result<Vec<BenchMotor>, ParamError> {
         BenchMotor {
             name: "11 kW",
             params: ParamFile::from_toml_str(MOTOR_11KW, "examples/params/11kw_2pole.toml")?,
-            timing: ((3.0, 5.0), 5.5, 9.0),
+            timing: Timing {
+                commission: (3.0, 5.0),
+                fault_at_s: 5.5,
+                duration_s: 9.0,
+            },
         },
     ])
 }
@@ -162,10 +221,11 @@ impl BenchPlan {
 pub struct CaseResult {
     /// Motor.
     pub motor: String,
-    /// Angle mode (`rotor-flux`, `pll`).
-    pub mode: String,
-    /// DESIGN.md fault name.
-    pub fault: String,
+    /// Angle mode (JSON `rotor-flux`, `pll`).
+    #[serde(serialize_with = "serialize_angle_source")]
+    pub mode: AngleSource,
+    /// The true fault (JSON: its name).
+    pub fault: Fault,
     /// True relative change.
     pub change: f64,
     /// Load as a multiple of the file's Bl.
@@ -174,7 +234,7 @@ pub struct CaseResult {
     pub detected: bool,
     /// The confusion matrix's column: the name at the end (`b/bl` for the friction
     /// class), `unknown`, or `none` (nothing named alone).
-    pub named: String,
+    pub named: Outcome,
     /// `named` is the true fault (`b/bl` for B and Bl).
     pub right: bool,
     /// The isolation's estimated change of the named fault at the end.
@@ -187,17 +247,11 @@ pub struct CaseResult {
     /// true one (`name at +t s` from the fault), and wrong candidates >= 0.5 at the end.
     pub wrong_names: Vec<String>,
     /// The isolation's state at the end.
-    pub state: String,
-    /// The candidates at the end (name, probability, estimated change).
-    pub candidates: Vec<(String, f32, Option<f32>)>,
-}
-
-/// The name the isolation should give for `f`: its own, `b/bl` for B and Bl.
-pub fn expected_name(f: Fault) -> &'static str {
-    match f {
-        Fault::B | Fault::Bl => "b/bl",
-        _ => f.name(),
-    }
+    #[serde(serialize_with = "serialize_state")]
+    pub state: IsolationState,
+    /// The candidates at the end (JSON: triples `[fault, probability, estimated change]`).
+    #[serde(serialize_with = "crate::fault_signatures::fault_probability_and_change")]
+    pub candidates: Vec<FaultCandidate>,
 }
 
 /// Judges one case's row (module docs).
@@ -209,24 +263,30 @@ pub fn judge(
     change: f64,
     row: &Table1Row,
 ) -> CaseResult {
-    let want = expected_name(f);
+    let want = IsolationName::expected(f);
     let friction = matches!(f, Fault::B | Fault::Bl);
-    let named = match (&row.named, row.isolation_state.as_str()) {
-        (Some(n), _) => n.clone(),
-        (None, "unknown") => "unknown".to_string(),
-        (None, _) => "none".to_string(),
+    let named = match (row.named, row.isolation_state) {
+        (Some(n), _) => Outcome::Named(n),
+        (None, IsolationState::Unknown) => Outcome::Unknown,
+        (None, _) => Outcome::Nothing,
     };
-    let right = named == want;
+    let right = named == Outcome::Named(want);
     let mut wrong_names: Vec<String> = row
         .names_given
         .iter()
-        .filter(|(n, _)| n != want)
-        .map(|(n, t)| format!("{n} at {t:+.2} s"))
+        .filter(|g| g.name != want)
+        .map(|g| format!("{} at {:+.2} s", g.name, g.t_s))
         .collect();
-    for (c, p, _) in &row.isolation_candidates {
-        let ok = c == f.name() || (friction && (c == "b" || c == "bl"));
-        if *p >= 0.5 && !ok && !wrong_names.iter().any(|w| w.starts_with(&format!("{c} "))) {
-            wrong_names.push(format!("{c} p={p:.2} at the end"));
+    for c in &row.isolation_candidates {
+        let ok = c.fault == f || (friction && matches!(c.fault, Fault::B | Fault::Bl));
+        let (name, p) = (c.fault, c.probability);
+        if p >= 0.5
+            && !ok
+            && !wrong_names
+                .iter()
+                .any(|w| w.starts_with(&format!("{name} ")))
+        {
+            wrong_names.push(format!("{name} p={p:.2} at the end"));
         }
     }
     let size_error = (right && !friction)
@@ -238,17 +298,20 @@ pub fn judge(
     let time_to_name_s = row
         .names_given
         .iter()
-        .find(|(n, t)| n == want && *t >= 0.0)
-        .map(|(_, t)| *t);
+        .find(|g| g.name == want && g.t_s >= 0.0)
+        .map(|g| g.t_s);
     let after_fault = |t: &Option<f64>| t.is_some_and(|t| t >= 0.0);
     let detected = row.detection_delay_s.is_some()
-        || row.names_given.iter().any(|(_, t)| *t >= 0.0)
+        || row.names_given.iter().any(|g| g.t_s >= 0.0)
         || after_fault(&row.name_delay_s)
-        || matches!(row.isolation_state.as_str(), "isolated" | "unknown");
+        || matches!(
+            row.isolation_state,
+            IsolationState::Isolated | IsolationState::Unknown
+        );
     CaseResult {
         motor: motor.to_string(),
-        mode: angle_source_name(mode).to_string(),
-        fault: f.name().to_string(),
+        mode,
+        fault: f,
         change,
         load_scale: load,
         detected,
@@ -258,7 +321,7 @@ pub fn judge(
         size_error,
         time_to_name_s,
         wrong_names,
-        state: row.isolation_state.clone(),
+        state: row.isolation_state,
         candidates: row.isolation_candidates.clone(),
     }
 }
@@ -268,8 +331,9 @@ pub fn judge(
 pub struct Summary {
     /// Motor.
     pub motor: String,
-    /// Angle mode.
-    pub mode: String,
+    /// Angle mode (JSON: its command-line name).
+    #[serde(serialize_with = "serialize_angle_source")]
+    pub mode: AngleSource,
     /// Cases.
     pub cases: usize,
     /// Cases detected.
@@ -289,12 +353,13 @@ pub struct Summary {
 /// A confusion matrix: rows the true faults, columns what was named.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct Confusion {
-    /// Angle mode.
-    pub mode: String,
+    /// Angle mode (JSON: its command-line name).
+    #[serde(serialize_with = "serialize_angle_source")]
+    pub mode: AngleSource,
     /// Row labels (true faults).
-    pub rows: Vec<String>,
+    pub rows: Vec<Fault>,
     /// Column labels: the nine faults, `b/bl`, `unknown`, `none`.
-    pub columns: Vec<String>,
+    pub columns: Vec<Outcome>,
     /// Counts, `counts[row][column]`.
     pub counts: Vec<Vec<u32>>,
 }
@@ -328,7 +393,7 @@ fn median(mut v: Vec<f64>) -> Option<f64> {
 }
 
 /// The summary of the cases of one motor in one mode.
-pub fn summarise(motor: &str, mode: &str, cases: &[CaseResult]) -> Summary {
+pub fn summarise(motor: &str, mode: AngleSource, cases: &[CaseResult]) -> Summary {
     let mine: Vec<&CaseResult> = cases
         .iter()
         .filter(|c| c.motor == motor && c.mode == mode)
@@ -336,7 +401,7 @@ pub fn summarise(motor: &str, mode: &str, cases: &[CaseResult]) -> Summary {
     let sizes: Vec<f64> = mine.iter().filter_map(|c| c.size_error).collect();
     Summary {
         motor: motor.to_string(),
-        mode: mode.to_string(),
+        mode,
         cases: mine.len(),
         detected: mine.iter().filter(|c| c.detected).count(),
         named_right: mine.iter().filter(|c| c.right).count(),
@@ -348,11 +413,11 @@ pub fn summarise(motor: &str, mode: &str, cases: &[CaseResult]) -> Summary {
 }
 
 /// The confusion matrix of the cases in `mode` (rows: `faults`).
-pub fn confusion(mode: &str, faults: &[Fault], cases: &[CaseResult]) -> Confusion {
-    let columns: Vec<String> = Fault::ALL
+pub fn confusion(mode: AngleSource, faults: &[Fault], cases: &[CaseResult]) -> Confusion {
+    let columns: Vec<Outcome> = Fault::ALL
         .iter()
-        .map(|f| f.name().to_string())
-        .chain(EXTRA_COLUMNS.iter().map(|s| s.to_string()))
+        .map(|f| Outcome::Named(IsolationName::Fault(*f)))
+        .chain(EXTRA_COLUMNS)
         .collect();
     let counts = faults
         .iter()
@@ -362,15 +427,15 @@ pub fn confusion(mode: &str, faults: &[Fault], cases: &[CaseResult]) -> Confusio
                 .map(|col| {
                     cases
                         .iter()
-                        .filter(|c| c.mode == mode && c.fault == f.name() && c.named == *col)
+                        .filter(|c| c.mode == mode && c.fault == *f && c.named == *col)
                         .count() as u32
                 })
                 .collect()
         })
         .collect();
     Confusion {
-        mode: mode.to_string(),
-        rows: faults.iter().map(|f| f.name().to_string()).collect(),
+        mode,
+        rows: faults.to_vec(),
         columns,
         counts,
     }
@@ -408,13 +473,13 @@ pub fn run(plan: &BenchPlan, on_done: impl Fn() + Sync) -> Result<IsolationBench
     let mut summaries = Vec::new();
     for m in &plan.motors {
         for &mode in &plan.modes {
-            summaries.push(summarise(m.name, angle_source_name(mode), &cases));
+            summaries.push(summarise(m.name, mode, &cases));
         }
     }
     let confusion = plan
         .modes
         .iter()
-        .map(|&mode| confusion(angle_source_name(mode), &plan.faults, &cases))
+        .map(|&mode| confusion(mode, &plan.faults, &cases))
         .collect();
     Ok(IsolationBench {
         sample_rate_hz: SAMPLE_RATE_HZ,

@@ -1,4 +1,4 @@
-//! The figures of `sim-host bench` (DESIGN.md §4), measured on this machine.
+//! The figures of `sim-host bench` (`docs/performance.md`), measured on this machine.
 //!
 //! - Simulator throughput on the reference scenario (2.2 kW, direct-on-line, 14.6 N m from
 //!   2.5 s, 10 s at 10 kHz), in simulated seconds per wall second, in memory and with CSV
@@ -14,12 +14,12 @@
 
 pub mod isolation;
 
+use crate::experiment::ExperimentError;
 use crate::log::{LogWriter, Row};
 use crate::params::ParamFile;
 use crate::replay::{monitor_config_for_log, LogSampler, ReplayOptions};
 use crate::sim::{simulate, Scenario};
-use crate::ExperimentError;
-use monitor_core::Monitor;
+use monitor_core::{Fault, Monitor};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -181,13 +181,13 @@ pub fn measure(repeat: u32) -> Result<BenchFigures, ExperimentError> {
     })
 }
 
-/// Smallest detected change of one fault (DESIGN.md §4 "fault detection" bar).
+/// Smallest detected change of one fault (the fault detection bar of `docs/performance.md`).
 #[derive(Debug, Serialize)]
 pub struct DetectionLimit {
     /// Motor.
     pub motor: String,
-    /// DESIGN.md fault name.
-    pub fault: String,
+    /// The fault (JSON: its name).
+    pub fault: Fault,
     /// Smallest relative increase detected (None: not even +90 %).
     pub smallest_increase: Option<f64>,
     /// Smallest relative decrease detected, as a positive fraction (None: not even -90 %).
@@ -205,7 +205,6 @@ pub fn detection_limits(
 ) -> Result<Vec<DetectionLimit>, DetectionError> {
     use crate::service_profile::watch;
     use crate::sim::FaultSpec;
-    use monitor_core::Fault;
     use rayon::prelude::*;
     let motors = [
         ("3 hp", ParamFile::reference_3hp(), 7u64),
@@ -260,7 +259,7 @@ pub fn detection_limits(
             };
             out.push(DetectionLimit {
                 motor: n.to_string(),
-                fault: f.name().to_string(),
+                fault: f,
                 smallest_increase: get(1.0),
                 smallest_decrease: get(-1.0),
             });

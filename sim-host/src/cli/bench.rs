@@ -1,4 +1,4 @@
-//! `sim-host bench`: the figures DESIGN.md §4 asks for, measured on this machine
+//! `sim-host bench`: the performance figures (`docs/performance.md`), measured on this machine
 //! ([`sim_host::bench`]); with `--isolation`, the isolation's bench
 //! ([`sim_host::bench::isolation`]).
 
@@ -13,7 +13,7 @@ pub const CONFUSION_SVG: &str = "isolation_confusion.svg";
 #[derive(Debug, Args)]
 #[command(
     about = "Measure simulator throughput and accuracy, the core's time per sample, or (--isolation) how well faults are named",
-    long_about = "Measure on this machine: the simulator's throughput on DESIGN.md's reference \
+    long_about = "Measure on this machine: the simulator's throughput on the reference \
 scenario (2.2 kW machine started direct-on-line, 14.6 N m load from 2.5 s, 10 s at 10 kHz) in \
 simulated seconds per wall second, in memory and with CSV writing; its accuracy against a run with a \
 100x smaller step; and the core Monitor's time per sample. Each timing runs --repeat times after a \

@@ -11,7 +11,7 @@ use std::path::PathBuf;
 /// Options shared by `compare` and `explain`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct Common {
-    /// Parameter file (TOML, DESIGN.md §3) with the user's nominal motor and supply values.
+    /// Parameter file (TOML, docs/design.md) with the user's nominal motor and supply values.
     #[arg(long)]
     pub params: PathBuf,
     /// Measurement log (t_s, va_V, vb_V, vc_V, ia_A, ib_A, ic_A, wm_rad_s; t_s and the

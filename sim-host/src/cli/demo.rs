@@ -8,7 +8,7 @@ use monitor_core::Fault;
 #[derive(Debug, Args)]
 #[command(
     about = "The main job: simulate a motor, inject a fault mid-run, watch the lamps and the named fault",
-    long_about = "Simulate the DESIGN.md 3 hp textbook motor started direct-on-line with the paper's \
+    long_about = "Simulate the 3 hp reference motor started direct-on-line with the paper's \
 viscous load and realistic sensors (12-bit ADC, noise, 1024-line encoder), replay the sensor streams \
 through the same core the firmware runs, learn the healthy residuals (commissioning, 2-4 s), inject a \
 fault at 5 s and print a timeline of the residual lamps r1..r4 and the fault candidates of the paper's \

@@ -12,7 +12,7 @@ use std::path::PathBuf;
 #[derive(Debug, Args)]
 #[command(
     about = "Replay a measurement log through the core: lamps r1..r4, fault candidates, unbalance",
-    long_about = "Replay a measurement log (DESIGN.md CSV schema; or TDMS / Parquet with the \
+    long_about = "Replay a measurement log (CSV, schema in docs/design.md; or TDMS / Parquet with the \
 same channel names, by the file's extension) through exactly the core code the \
 firmware runs, and report the residual lamps r1..r4, the fault candidates of the paper's Table 1 with \
 their probabilities, when a fault was first detected, and the negative-sequence (unbalance / faulty \
@@ -40,7 +40,7 @@ diagnose --params motor.toml log.csv --commission 2:4\n  sim-host diagnose --par
 today.csv --baseline last_year_healthy.csv"
 )]
 pub struct DiagnoseArgs {
-    /// Motor parameter file (TOML, DESIGN.md §3).
+    /// Motor parameter file (TOML, docs/design.md).
     #[arg(long)]
     pub params: PathBuf,
     /// Measurement log: CSV, TDMS (`.tdms`) or Parquet (`.parquet`), by its extension.

@@ -31,7 +31,7 @@ its value, the fault candidates with their probabilities (and the phase of a win
 speed, I_qs, i_ds, V_qs and the supply frequency, the monitor's state (transient, commissioning \
 with progress, healthy, fault), the data-quality warnings, and a strip chart of the residuals over \
 the last 10 s.\n\nThree sources:\n  sim-host hmi                        live simulation of the demo's \
-motor (DESIGN.md 3 hp, 12-bit noisy sensors); keys switch each Table 1 fault on and off (the \
+motor (3 hp reference motor, 12-bit noisy sensors); keys switch each Table 1 fault on and off (the \
 paper's Enable_F_* switches), step the load and the supply, and start commissioning\n  \
 sim-host hmi LOG --params P.toml    replay a log through the data-quality stage and the core, as \
 diagnose does, at --speed 1x, 10x or max, with pause and seek\n  cargo fw-run | sim-host hmi \
@@ -45,8 +45,8 @@ pub struct HmiArgs {
     /// Log to replay (any format the log reader takes); without it, the live simulation.
     #[arg(conflicts_with = "stdin")]
     pub log: Option<PathBuf>,
-    /// Motor parameter file (TOML, DESIGN.md §3): the log's motor, or the motor to simulate
-    /// live (default: the demo's DESIGN.md 3 hp motor).
+    /// Motor parameter file (TOML, docs/design.md): the log's motor, or the motor to simulate
+    /// live (default: the demo's 3 hp reference motor).
     #[arg(long)]
     pub params: Option<PathBuf>,
     /// Read the firmware's defmt status lines from standard input (`cargo fw-run |

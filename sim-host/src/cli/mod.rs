@@ -125,7 +125,7 @@ impl From<ResidualArg> for ResidualForm {
     }
 }
 
-/// Parses a DESIGN.md fault name.
+/// Parses a fault name ([`monitor_core::Fault::name`]).
 pub fn parse_fault(s: &str) -> Result<Fault, String> {
     Fault::from_name(s).ok_or_else(|| {
         let names: Vec<&str> = Fault::ALL.iter().map(|f| f.name()).collect();

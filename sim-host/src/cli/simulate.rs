@@ -1,5 +1,5 @@
 //! `sim-host simulate --params P.toml --scenario S.toml --out D.csv [--json]`: generate a
-//! measurement log (DESIGN.md §3 CSV schema) from a motor parameter file and a scenario
+//! measurement log (the CSV schema of `docs/design.md`) from a motor parameter file and a scenario
 //! (format: `sim_host::sim`).
 //!
 //! The CSV is written atomically (`sim_host::log::LogWriter`): a failed run, or one stopped by
@@ -20,24 +20,24 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Largest output a run writes without `--force` [bytes]: 20 GB, about 6 h of the
-/// DESIGN.md schema at 10 kHz (a 1 h log at 10 kHz is about 3 GB) and more than any analysis
+/// log schema at 10 kHz (a 1 h log at 10 kHz is about 3 GB) and more than any analysis
 /// here reads in reasonable time; a typo in `duration_s` or `sample_rate_hz` (8e5 s, 1e9 Hz)
 /// asks for hundreds of GB.
 pub const MAX_OUTPUT_BYTES: f64 = 20.0e9;
 
 /// Most integrator steps a run takes without `--force`: 2e9, about 3 minutes of RK4 on one
-/// core of this machine (DESIGN.md: about 1.1e7 steps per second in memory) and 55 h of
+/// core of this machine (measured: about 1.1e7 steps per second in memory) and 55 h of
 /// simulated time at the default 100 us step.
 pub const MAX_STEPS: f64 = 2.0e9;
 
 /// Runs expected to take longer than this [s] show a progress bar (on a terminal).
 pub const PROGRESS_AFTER_S: f64 = 2.0;
 
-/// RK4 steps per second of the release build (DESIGN.md §4: about 1100 simulated seconds
-/// per wall second at 100 us steps).
+/// RK4 steps per second of the release build (measured, `docs/performance.md`: about
+/// 1100 simulated seconds per wall second at 100 us steps).
 const STEPS_PER_S: f64 = 1.1e7;
 
-/// CSV bytes written per second of the release build (DESIGN.md §4: about 228 simulated
+/// CSV bytes written per second of the release build (measured: about 228 simulated
 /// seconds per wall second at 10 kHz and about 90 bytes a row).
 const CSV_BYTES_PER_S: f64 = 2.0e8;
 
@@ -56,7 +56,7 @@ simulate --params examples/params/2p2kw.toml --scenario examples/scenarios/refer
 --out ref.csv"
 )]
 pub struct SimulateArgs {
-    /// Motor parameter file (TOML, DESIGN.md §3).
+    /// Motor parameter file (TOML, docs/design.md).
     #[arg(long)]
     pub params: PathBuf,
     /// Scenario file (TOML; see examples/scenarios).

@@ -18,7 +18,7 @@ the run. Prints the measured signature next to the paper's; '*' marks a differen
 notes on where the physics disagrees with the paper).\n\nExample:\n  sim-host table1 --json"
 )]
 pub struct Table1Args {
-    /// Motor parameter file (default: the DESIGN.md 3 hp textbook motor).
+    /// Motor parameter file (default: the 3 hp reference motor).
     #[arg(long)]
     pub params: Option<PathBuf>,
     /// Frame angle source.
@@ -38,7 +38,7 @@ pub fn run(args: &Table1Args) -> anyhow::Result<()> {
         Some(p) => (ParamFile::load(p)?, p.display().to_string()),
         None => (
             ParamFile::reference_3hp(),
-            "3 hp textbook motor (DESIGN.md)".to_string(),
+            "3 hp reference motor".to_string(),
         ),
     };
     let proto = Protocol {

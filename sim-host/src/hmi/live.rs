@@ -1,5 +1,5 @@
 //! The live simulation behind `sim-host hmi` (no arguments): the demo's motor (the
-//! DESIGN.md 3 hp machine started direct-on-line with the paper's viscous load and 12-bit
+//! 3 hp reference motor started direct-on-line with the paper's viscous load and 12-bit
 //! noisy sensors, [`crate::demo`]) simulated as it is watched, its sensor rows fed to the
 //! core row by row, with the paper's switches: each Table 1 fault on and off, load and
 //! supply steps, commissioning.
@@ -67,16 +67,16 @@ pub struct LiveSim {
 }
 
 impl LiveSim {
-    /// Starts the demo's motor (the DESIGN.md 3 hp machine at 10 kHz).
+    /// Starts the demo's motor (the 3 hp reference motor at 10 kHz).
     ///
     /// # Errors
     /// The core refuses the configuration (not expected for the reference motor).
-    pub fn demo_motor() -> Result<Self, crate::ExperimentError> {
+    pub fn demo_motor() -> Result<Self, crate::experiment::ExperimentError> {
         let mut live = Self::new(
             ParamFile::reference_3hp(),
             Protocol::default().sample_rate_hz,
         )?;
-        live.name = "DESIGN.md 3 hp motor".to_string();
+        live.name = "3 hp reference motor".to_string();
         Ok(live)
     }
 
@@ -85,7 +85,10 @@ impl LiveSim {
     ///
     /// # Errors
     /// The core refuses the configuration.
-    pub fn new(params: ParamFile, sample_rate_hz: f64) -> Result<Self, crate::ExperimentError> {
+    pub fn new(
+        params: ParamFile,
+        sample_rate_hz: f64,
+    ) -> Result<Self, crate::experiment::ExperimentError> {
         // The replay's monitor and isolation, fed row by row; its timeline is not kept (a
         // live run has no end), commissioning starts on the `c` key.
         let opts = ReplayOptions {

@@ -20,8 +20,9 @@ pub mod status_line;
 
 use crate::demo::MonitorState;
 use crate::params::ParamFile;
+use crate::replay::{FaultCandidate, IsolationName, IsolationReport, Replay};
 use monitor_core::sequence::winding_change_fraction;
-use monitor_core::{Fault, MonitorOutput, Phase};
+use monitor_core::{Fault, IsolationState, MonitorOutput, Phase};
 use std::collections::VecDeque;
 
 /// Seconds of residuals the strip chart shows.
@@ -86,36 +87,29 @@ pub struct Snapshot {
 /// The isolation's conclusion as the screen shows it ([`crate::replay::IsolationReport`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct IsolationView {
-    /// `isolated`, `unknown`, `no_deviation` or `not_judged`.
-    pub state: String,
-    /// The fault named (probability >= 0.5), `b/bl` for the friction class.
-    pub named: Option<String>,
+    /// The conclusion.
+    pub state: IsolationState,
+    /// The fault named (probability >= 0.5) or the friction class `b/bl`.
+    pub named: Option<IsolationName>,
     /// Its estimated relative change (0.48 = +48 %; for `b/bl` Bl's).
     pub change: Option<f32>,
-    /// The candidates listed (name, probability, estimated change), most probable first:
-    /// for an unknown fault its nearest three.
-    pub candidates: Vec<(String, f32, Option<f32>)>,
+    /// The candidates listed, most probable first: for an unknown fault its nearest three.
+    pub candidates: Vec<FaultCandidate>,
 }
 
 impl IsolationView {
     /// From a replay's isolation report and candidates.
-    pub fn new(
-        report: &crate::replay::IsolationReport,
-        candidates: &[crate::replay::FaultCandidate],
-    ) -> Self {
+    pub fn new(report: &IsolationReport, candidates: &[FaultCandidate]) -> Self {
         IsolationView {
-            state: report.state.clone(),
-            named: report.named.clone(),
+            state: report.state,
+            named: report.named,
             change: report.named_change,
-            candidates: candidates
-                .iter()
-                .map(|c| (c.fault.clone(), c.probability, c.change))
-                .collect(),
+            candidates: candidates.to_vec(),
         }
     }
 
     /// What `replay`'s isolation concludes now.
-    pub fn of_replay(replay: &crate::replay::Replay) -> Self {
+    pub fn of_replay(replay: &Replay) -> Self {
         let (report, candidates) = replay.isolation_now();
         Self::new(&report, &candidates)
     }
@@ -128,18 +122,18 @@ impl IsolationView {
             self.candidates
                 .iter()
                 .take(n)
-                .map(|(f, _, _)| f.as_str())
+                .map(|c| c.fault.name())
                 .collect::<Vec<_>>()
                 .join(sep)
         };
-        match (self.named.as_deref(), self.state.as_str()) {
+        match (self.named, self.state) {
             (Some(n), _) => format!("{n}{}", pct(self.change)),
-            (None, "unknown") if self.candidates.is_empty() => "unknown fault".into(),
-            (None, "unknown") => format!("unknown, nearest {}", names(3, ", ")),
-            (None, "isolated") if !self.candidates.is_empty() => {
+            (None, IsolationState::Unknown) if self.candidates.is_empty() => "unknown fault".into(),
+            (None, IsolationState::Unknown) => format!("unknown, nearest {}", names(3, ", ")),
+            (None, IsolationState::Isolated) if !self.candidates.is_empty() => {
                 format!("{}, not alone", names(2, " / "))
             }
-            (None, "not_judged") => "not judged".into(),
+            (None, IsolationState::NotJudged) => "not judged".into(),
             _ => "no deviation".into(),
         }
     }

@@ -20,7 +20,8 @@
 
 use super::{quit_key, Controls, HmiState, Key, Snapshot, Source, StdinControls};
 use crate::demo::MonitorState;
-use monitor_core::Fault;
+use crate::replay::{FaultCandidate, IsolationName};
+use monitor_core::{Fault, IsolationState};
 use std::io::BufRead;
 use std::sync::mpsc::{channel, Receiver, TryRecvError};
 
@@ -257,21 +258,24 @@ impl FirmwareStatus {
 impl FirmwareIsolation {
     /// The screen's view of it: the state and the named fault with its size.
     pub fn view(&self) -> super::IsolationView {
-        let named = !matches!(self.named.as_str(), "unknown" | "none" | "not-judged");
+        let (state, named) = match self.named.as_str() {
+            "unknown" => (IsolationState::Unknown, None),
+            "none" => (IsolationState::NoDeviation, None),
+            "not-judged" => (IsolationState::NotJudged, None),
+            name => (IsolationState::Isolated, IsolationName::from_name(name)),
+        };
         super::IsolationView {
-            state: match self.named.as_str() {
-                "unknown" => "unknown",
-                "none" => "no_deviation",
-                "not-judged" => "not_judged",
-                _ => "isolated",
-            }
-            .to_string(),
-            named: named.then(|| self.named.clone()),
-            change: named.then_some(self.change),
-            candidates: if named {
-                vec![(self.named.clone(), self.probability, Some(self.change))]
-            } else {
-                Vec::new()
+            state,
+            named,
+            change: named.map(|_| self.change),
+            candidates: match named {
+                Some(IsolationName::Fault(fault)) => vec![FaultCandidate {
+                    fault,
+                    probability: self.probability,
+                    change: Some(self.change),
+                    phase: None,
+                }],
+                _ => Vec::new(),
             },
         }
     }

@@ -462,38 +462,10 @@ pub(super) fn for_each_row(
                     .map(|_| outs.pop().unwrap_or_default())
                     .collect();
                 let (blocks, cols, pr, to_row) = (&to_parse, &cols, &mut parsed, &to_row);
-                s.spawn(move |_| {
-                    *pr = Some(
-                        blocks
-                            .par_iter()
-                            .zip(bufs.into_par_iter())
-                            .map(|(b, mut rows)| {
-                                rows.clear();
-                                // (About 60 bytes a line in a typical log.)
-                                rows.reserve(b.len() / 60);
-                                if !parse_block_with(b, cols, |slots| rows.push(to_row(slots))) {
-                                    return None;
-                                }
-                                Some(rows)
-                            })
-                            .collect(),
-                    );
-                });
+                s.spawn(move |_| *pr = Some(parse_blocks(blocks, bufs, cols, to_row)));
             }
             if let Some(batch) = to_hand.take() {
-                for p in batch {
-                    let Some(v) = p else {
-                        verdict = Some(false);
-                        return;
-                    };
-                    for row in &v {
-                        if !on_row(row) {
-                            verdict = Some(true);
-                            return;
-                        }
-                    }
-                    free_outs.push(v);
-                }
+                verdict = hand_over(batch, on_row, &mut free_outs);
             }
         });
         if let Some(v) = verdict {
@@ -512,6 +484,51 @@ pub(super) fn for_each_row(
             None => to_parse = Vec::new(),
         }
     }
+}
+
+/// Parses a batch of blocks in parallel into the row buffers `bufs` (reused), one result
+/// per block: `None` where the block is not for the fast path.
+fn parse_blocks(
+    blocks: &[Vec<u8>],
+    bufs: Vec<Parsed>,
+    cols: &Cols,
+    to_row: &(impl Fn(&[f64]) -> Row + Sync),
+) -> Vec<Option<Parsed>> {
+    blocks
+        .par_iter()
+        .zip(bufs.into_par_iter())
+        .map(|(b, mut rows)| {
+            rows.clear();
+            // (About 60 bytes a line in a typical log.)
+            rows.reserve(b.len() / 60);
+            if !parse_block_with(b, cols, |slots| rows.push(to_row(slots))) {
+                return None;
+            }
+            Some(rows)
+        })
+        .collect()
+}
+
+/// Hands a parsed batch's rows to `on_row` in order, returning each emptied buffer to
+/// `free`. `Some(false)`: a block was not for the fast path (give up); `Some(true)`:
+/// `on_row` asked to stop; `None`: go on.
+fn hand_over(
+    batch: Vec<Option<Parsed>>,
+    on_row: &mut dyn FnMut(&Row) -> bool,
+    free: &mut Vec<Parsed>,
+) -> Option<bool> {
+    for p in batch {
+        let Some(v) = p else {
+            return Some(false);
+        };
+        for row in &v {
+            if !on_row(row) {
+                return Some(true);
+            }
+        }
+        free.push(v);
+    }
+    None
 }
 
 #[cfg(test)]

@@ -1,5 +1,5 @@
-//! Measurement logs in the DESIGN.md §3 CSV schema: the one reader and the one writer of
-//! the workspace, for three file formats chosen by the extension ([`Format`]): CSV, TDMS
+//! Measurement logs in the CSV schema of `docs/design.md`: the one reader and the one
+//! writer of the workspace, for three file formats chosen by the extension ([`Format`]): CSV, TDMS
 //! (LabVIEW; channels named like the CSV columns, [`tdms`]) and Parquet (columns named like
 //! the CSV columns, [`parquet`]). Every format hands over the same [`Row`]s, and every
 //! command passes them through the same data-quality stage.
@@ -40,7 +40,7 @@ pub use writer::{write_atomic, LogWriter};
 /// `.parquet` or `.pq` Parquet, anything else CSV (`.csv`, `.txt`, none).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Format {
-    /// Comma-separated text with a header row (DESIGN.md §3).
+    /// Comma-separated text with a header row (the schema of `docs/design.md`).
     Csv,
     /// NI TDMS, one group of channels.
     Tdms,
@@ -187,16 +187,11 @@ pub enum Column {
 
 impl Column {
     /// The measured channels stored at f32 precision by every writer (voltages, currents,
-    /// speed), in [`Row`] order.
-    pub const MEASURED: [Column; 7] = [
-        Column::Va,
-        Column::Vb,
-        Column::Vc,
-        Column::Ia,
-        Column::Ib,
-        Column::Ic,
-        Column::Speed,
-    ];
+    /// speed), in [`Row`] order: [`Column::ALL`] without the time and the encoder count.
+    pub const MEASURED: [Column; 7] = {
+        let all = Column::ALL;
+        [all[1], all[2], all[3], all[4], all[5], all[6], all[7]]
+    };
 
     /// Every column of the schema, in [`Row`] order.
     pub const ALL: [Column; 9] = [
@@ -211,7 +206,7 @@ impl Column {
         Column::Encoder,
     ];
 
-    /// The header name (DESIGN.md §3).
+    /// The header name (the schema of `docs/design.md`).
     pub fn name(self) -> &'static str {
         match self {
             Column::Time => "t_s",

@@ -13,7 +13,7 @@
 //! encoding, uncompressed (sensor noise does not compress), [`ROW_GROUP_ROWS`] rows per row
 //! group.
 
-use super::reader::ColumnMap;
+use super::reader::{BinarySource, ColumnMap, LogFile};
 use super::{Channels, Column, LogError, Row};
 use parquet::basic::{Compression, Encoding, Type as PhysicalType};
 use parquet::column::reader::{ColumnReader, ColumnReaderImpl};
@@ -122,22 +122,21 @@ impl ParquetSource {
             .collect();
         Ok((ParquetSource { groups }, columns))
     }
+}
 
-    /// Rows in the log.
-    pub fn rows(&self) -> u64 {
+/// Row groups decoded in parallel, a batch ahead of the rows handed over on this thread.
+impl BinarySource for ParquetSource {
+    fn rows(&self) -> u64 {
         self.groups.iter().sum()
     }
 
-    /// Streams the rows in order (see [`super::LogFile::for_each_row`]): row groups decoded
-    /// in parallel, a batch ahead of the rows handed over on this thread.
-    pub fn for_each_row(
+    fn for_each_row(
         &self,
-        path: &Path,
-        shown: &str,
-        columns: &ColumnMap,
+        log: &LogFile,
         progress: &mut dyn FnMut(f64),
         on_row: &mut dyn FnMut(&Row) -> bool,
     ) -> Result<u64, LogError> {
+        let (path, shown, columns) = (log.path(), log.shown(), log.columns());
         let ng = self.groups.len();
         let per_batch = rayon::current_num_threads().max(1) * 2;
         let total = self.rows().max(1) as f64;

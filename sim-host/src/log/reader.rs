@@ -61,6 +61,26 @@ pub struct OpenOptions {
     pub group: Option<String>,
 }
 
+/// A log format read by its own decoder (TDMS, Parquet), whose rows are counted when it
+/// is opened.
+pub(super) trait BinarySource {
+    /// Rows in the log.
+    fn rows(&self) -> u64;
+
+    /// Streams the rows of `log` (opened as this source) in order, as
+    /// [`LogFile::for_each_row`] does; `on_row` returns false to stop. Returns the rows
+    /// handed over.
+    ///
+    /// # Errors
+    /// [`LogError::NotALog`] for a file that cannot be decoded.
+    fn for_each_row(
+        &self,
+        log: &LogFile,
+        progress: &mut dyn FnMut(f64),
+        on_row: &mut dyn FnMut(&Row) -> bool,
+    ) -> Result<u64, LogError>;
+}
+
 /// Where the rows come from.
 #[derive(Debug, Clone)]
 enum Source {
@@ -128,7 +148,7 @@ impl LogFile {
             })?
             .len();
         let (columns, source, est_rows) = match format {
-            Format::Csv => return Self::open_csv(path, shown),
+            Format::Csv => Self::open_csv(path, &shown, len_bytes)?,
             Format::Tdms => {
                 let (t, c) = super::tdms::TdmsSource::open(path, &shown, opts.group.as_deref())?;
                 let n = t.rows() as f64;
@@ -151,14 +171,18 @@ impl LogFile {
         })
     }
 
-    /// Opens a CSV log: parses its header, estimates its rows from the first rows' size.
-    fn open_csv(path: &Path, shown: String) -> Result<Self, LogError> {
+    /// Opens a CSV log of `len_bytes` bytes: parses its header, estimates its rows from the
+    /// first rows' size.
+    fn open_csv(
+        path: &Path,
+        shown: &str,
+        len_bytes: u64,
+    ) -> Result<(ColumnMap, Source, f64), LogError> {
         let io = |source| LogError::Io {
-            path: shown.clone(),
+            path: shown.to_string(),
             source,
         };
         let f = std::fs::File::open(path).map_err(io)?;
-        let len_bytes = f.metadata().map_err(io)?.len();
         let mut r = BufReader::new(f);
         let mut header = Vec::new();
         r.read_until(b'\n', &mut header).map_err(io)?;
@@ -166,20 +190,14 @@ impl LogFile {
         r.take(HEAD_BYTES as u64)
             .read_to_end(&mut head)
             .map_err(io)?;
-        let columns = parse_header(&header, &shown)?;
+        let columns = parse_header(&header, shown)?;
         let lines = head.iter().filter(|&&b| b == b'\n').count().max(1);
         let bytes_per_row = (head.len() as f64 / lines as f64).max(1.0);
-        Ok(LogFile {
-            path: path.to_path_buf(),
-            shown,
-            channels: channels_of(&columns),
-            columns,
-            len_bytes,
-            est_rows: len_bytes.saturating_sub(header.len() as u64) as f64 / bytes_per_row,
-            source: Source::Csv {
-                header_bytes: header.len() as u64,
-            },
-        })
+        let est_rows = len_bytes.saturating_sub(header.len() as u64) as f64 / bytes_per_row;
+        let source = Source::Csv {
+            header_bytes: header.len() as u64,
+        };
+        Ok((columns, source, est_rows))
     }
 
     /// The log's format.
@@ -233,19 +251,20 @@ impl LogFile {
         progress: &mut dyn FnMut(f64),
         sink: &mut dyn RowSink,
     ) -> Result<u64, LogError> {
-        match &self.source {
-            Source::Csv { .. } => {}
-            Source::Tdms(t) => {
-                return t.for_each_row(&self.path, &self.shown, &self.columns, progress, &mut |r| {
-                    sink.row(r)
-                })
-            }
-            Source::Parquet(p) => {
-                return p.for_each_row(&self.path, &self.shown, &self.columns, progress, &mut |r| {
-                    sink.row(r)
-                })
-            }
-        }
+        let binary: &dyn BinarySource = match &self.source {
+            Source::Csv { .. } => return self.csv_rows(progress, sink),
+            Source::Tdms(t) => t,
+            Source::Parquet(p) => p,
+        };
+        binary.for_each_row(self, progress, &mut |r| sink.row(r))
+    }
+
+    /// [`LogFile::for_each_row`] of a CSV log: the fast path, else the exact reader.
+    fn csv_rows(
+        &self,
+        progress: &mut dyn FnMut(f64),
+        sink: &mut dyn RowSink,
+    ) -> Result<u64, LogError> {
         let mut handed = 0u64;
         let accepted = fast::for_each_row(self, fast::BLOCK_BYTES, progress, &mut |row| {
             handed += 1;
@@ -327,7 +346,7 @@ fn parse_header(line: &[u8], shown: &str) -> Result<ColumnMap, LogError> {
             return Err(LogError::NotALog {
                 path: shown.to_string(),
                 why: format!(
-                    "the fields are separated by {sep:?}: the log must be comma-separated (DESIGN.md \u{a7}3)"
+                    "the fields are separated by {sep:?}: the log must be comma-separated (docs/design.md)"
                 ),
             });
         }

@@ -16,7 +16,7 @@
 //! as I64. Every channel carries `wf_increment` and `wf_start_offset` (from the first
 //! segment's times), so LabVIEW and DIAdem show a time axis.
 
-use super::reader::ColumnMap;
+use super::reader::{BinarySource, ColumnMap, LogFile};
 use super::{Channels, Column, LogError, Row};
 use std::fs::File;
 use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
@@ -152,6 +152,39 @@ fn check_layout(path: &Path, shown: &str, file: &TdmsFile) -> Result<(), LogErro
     Ok(())
 }
 
+/// The group to read: `group` when the file has it, else the file's only group.
+///
+/// # Errors
+/// [`LogError::NotALog`] for a group that is not there, a file without groups, or several
+/// groups and none named (the message lists them).
+fn pick_group(names: &[String], group: Option<&str>, shown: &str) -> Result<String, LogError> {
+    let listed = || {
+        names
+            .iter()
+            .map(|n| format!("'{n}'"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    match group {
+        Some(g) if names.iter().any(|n| n == g) => Ok(g.to_string()),
+        Some(g) => Err(not_a_log(
+            shown,
+            format!("no group '{g}' in the file (its groups: {})", listed()),
+        )),
+        None => match names {
+            [one] => Ok(one.clone()),
+            [] => Err(not_a_log(shown, "the TDMS file has no group".into())),
+            _ => Err(not_a_log(
+                shown,
+                format!(
+                    "the TDMS file has several groups ({}): name one with --group",
+                    listed()
+                ),
+            )),
+        },
+    }
+}
+
 impl TdmsSource {
     /// Opens `path`: picks the group, maps the schema's channels and the time source.
     ///
@@ -169,35 +202,7 @@ impl TdmsSource {
         let file = TdmsFile::open(path).map_err(|e| tdms_error(shown, &e))?;
         check_layout(path, shown, &file)?;
         let names: Vec<String> = file.groups().map(|g| g.name().to_string()).collect();
-        let listed = || {
-            names
-                .iter()
-                .map(|n| format!("'{n}'"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        let name = match group {
-            Some(g) if names.iter().any(|n| n == g) => g.to_string(),
-            Some(g) => {
-                return Err(not_a_log(
-                    shown,
-                    format!("no group '{g}' in the file (its groups: {})", listed()),
-                ))
-            }
-            None => match names.as_slice() {
-                [one] => one.clone(),
-                [] => return Err(not_a_log(shown, "the TDMS file has no group".into())),
-                _ => {
-                    return Err(not_a_log(
-                        shown,
-                        format!(
-                            "the TDMS file has several groups ({}): name one with --group",
-                            listed()
-                        ),
-                    ))
-                }
-            },
-        };
+        let name = pick_group(&names, group, shown)?;
         let g = file
             .group(&name)
             .ok_or_else(|| not_a_log(shown, format!("no group '{name}'")))?;
@@ -267,21 +272,21 @@ impl TdmsSource {
             columns,
         ))
     }
+}
 
-    /// Rows in the log.
-    pub fn rows(&self) -> u64 {
+/// The group's channels read a segment at a time.
+impl BinarySource for TdmsSource {
+    fn rows(&self) -> u64 {
         self.rows
     }
 
-    /// Streams the rows in order (see [`super::LogFile::for_each_row`]).
-    pub fn for_each_row(
+    fn for_each_row(
         &self,
-        path: &Path,
-        shown: &str,
-        columns: &ColumnMap,
+        log: &LogFile,
         progress: &mut dyn FnMut(f64),
         on_row: &mut dyn FnMut(&Row) -> bool,
     ) -> Result<u64, LogError> {
+        let (path, shown, columns) = (log.path(), log.shown(), log.columns());
         let file = TdmsFile::open(path).map_err(|e| tdms_error(shown, &e))?;
         let g = file
             .group(&self.group)

@@ -11,7 +11,7 @@
 //! `diagnose` refuses to give a verdict unless `--allow-incomplete`.
 //!
 //! The learned healthy means hold only near the operating point they were learned at
-//! (DESIGN.md: to the paper's model a load change is a Bl change, a voltage change moves
+//! (to the paper's model a load change is a Bl change, a voltage change moves
 //! the residuals' means). While an r2/r3/r4 lamp is lit the tracker compares the load
 //! current `Iqs` and the voltage `Vqs` with their span during learning and says when they
 //! have left it ([`RangeNote`]).

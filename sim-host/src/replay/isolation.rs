@@ -14,9 +14,11 @@
 use monitor_core::isolation::{Candidate, Follower, Named, Step, DEFAULT_SPREAD};
 use monitor_core::sequence::SinglePhaseGain;
 use monitor_core::{
-    CommissioningState, Fault, Isolation, IsolationState, Isolator, MonitorOutput, SteadyPoint,
+    CommissioningState, Fault, Isolation, IsolationState, Isolator, MonitorOutput, Phase,
+    SteadyPoint,
 };
-use serde::Serialize;
+use serde::{Serialize, Serializer};
+use std::fmt;
 
 /// A reported isolation older than this at the log's end says so [s].
 pub const STALE_S: f64 = 1.0;
@@ -24,12 +26,95 @@ pub const STALE_S: f64 = 1.0;
 /// A candidate is listed from this probability on.
 pub const LIST_FROM: f32 = 0.01;
 
+/// What the isolation names, as the reports say it: one fault, or the friction class
+/// (`b/bl`: B and Bl scale the same term of the torque balance and cannot be separated,
+/// and to the paper's model a load change is a Bl change). Serialised as its name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum IsolationName {
+    /// One fault (never B or Bl alone: they are the friction class).
+    Fault(Fault),
+    /// The friction class B/Bl.
+    Friction,
+}
+
+impl IsolationName {
+    /// The name the isolation should give for `fault`: its own, the friction class for B
+    /// and Bl.
+    pub fn expected(fault: Fault) -> Self {
+        match fault {
+            Fault::B | Fault::Bl => IsolationName::Friction,
+            f => IsolationName::Fault(f),
+        }
+    }
+
+    /// The name of the core's conclusion.
+    pub fn of(named: &Named) -> Self {
+        match named {
+            Named::Fault(c) => IsolationName::Fault(c.fault),
+            Named::Friction { .. } => IsolationName::Friction,
+        }
+    }
+
+    /// The fault's name ([`Fault::name`]) or `b/bl`.
+    pub fn name(self) -> &'static str {
+        match self {
+            IsolationName::Fault(f) => f.name(),
+            IsolationName::Friction => "b/bl",
+        }
+    }
+
+    /// The name back from its text ([`IsolationName::name`]); `None` for any other text.
+    pub fn from_name(s: &str) -> Option<Self> {
+        if s == "b/bl" {
+            Some(IsolationName::Friction)
+        } else {
+            Fault::from_name(s).map(IsolationName::Fault)
+        }
+    }
+}
+
+impl fmt::Display for IsolationName {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl Serialize for IsolationName {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+/// A name the isolation gave, with the first time it gave it [s]. Serialised as the pair
+/// `[name, t_s]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NameGiven {
+    /// What was named.
+    pub name: IsolationName,
+    /// When it was first named [s] (the replay's time, or as the caller shifts it).
+    pub t_s: f64,
+}
+
+impl Serialize for NameGiven {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        (self.name, self.t_s).serialize(s)
+    }
+}
+
+/// Serialises an [`IsolationState`] by its report name ([`state_name`]).
+pub(crate) fn serialize_state<S: Serializer>(
+    state: &IsolationState,
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    s.serialize_str(state_name(*state))
+}
+
 /// Follows the monitor's outputs and isolates (the core's [`Follower`] schedule).
 pub(super) struct IsolationTracker {
     follower: Option<Follower>,
-    first_named: Option<(String, f64)>,
-    /// Every label named, with the first time it was named [s].
-    names: Vec<(String, f64)>,
+    first_named: Option<NameGiven>,
+    /// Every name given, with the first time it was given [s].
+    names: Vec<NameGiven>,
     /// The monitor has evaluated once (settled, voltage present).
     running: bool,
     /// Time of the last isolation and of the last sample [s].
@@ -76,12 +161,13 @@ impl IsolationTracker {
         // which a sensor fault can detune).
         if let Step::Isolated(result) = follower.observe(point, dt_s as f32, usable, learning) {
             if let Some(n) = result.named() {
-                let label = named_label(&n);
-                if self.first_named.is_none() {
-                    self.first_named = Some((label.clone(), t));
-                }
-                if !self.names.iter().any(|(l, _)| *l == label) {
-                    self.names.push((label, t));
+                let given = NameGiven {
+                    name: IsolationName::of(&n),
+                    t_s: t,
+                };
+                self.first_named.get_or_insert(given);
+                if !self.names.iter().any(|g| g.name == given.name) {
+                    self.names.push(given);
                 }
             }
             self.last_t = t;
@@ -89,9 +175,9 @@ impl IsolationTracker {
         }
     }
 
-    /// Every label the isolation named so far (a fault's name or `b/bl`), each with the
-    /// first time it was named [s], in that order.
-    pub(super) fn names(&self) -> &[(String, f64)] {
+    /// Every name the isolation gave so far (a fault or the friction class), each with the
+    /// first time it was given [s], in that order.
+    pub(super) fn names(&self) -> &[NameGiven] {
         &self.names
     }
 
@@ -99,7 +185,8 @@ impl IsolationTracker {
     /// change is, to the paper's model, a Bl change: that is left to the lamps and the
     /// commissioned range).
     pub(super) fn named_a_fault(&self) -> bool {
-        self.first_named.as_ref().is_some_and(|(n, _)| n != "b/bl")
+        self.first_named
+            .is_some_and(|g| g.name != IsolationName::Friction)
     }
 
     /// How far the current of the last isolation is from the one the learned baseline was
@@ -146,8 +233,8 @@ impl IsolationTracker {
         };
         let moved = self.moved_from_learned();
         let report = IsolationReport {
-            state: state_name(iso.state).to_string(),
-            named: iso.named().map(|n| named_label(&n)),
+            state: iso.state,
+            named: iso.named().map(|n| IsolationName::of(&n)),
             named_change: iso.named().map(|n| match n {
                 Named::Fault(c) => c.change,
                 Named::Friction { bl, .. } => bl.change,
@@ -180,7 +267,7 @@ impl IsolationTracker {
                 "nominal parameters"
             }
             .to_string(),
-            first_named: self.first_named.clone(),
+            first_named: self.first_named,
         };
         (report, candidates)
     }
@@ -189,21 +276,21 @@ impl IsolationTracker {
 /// A fault candidate (`diagnose --json` key `candidates`).
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct FaultCandidate {
-    /// DESIGN.md fault name.
-    pub fault: String,
+    /// The fault (JSON: its name, [`Fault::name`]).
+    pub fault: Fault,
     /// Probability, [0, 1].
     pub probability: f32,
     /// Estimated relative change (0.48 = +48 %); for a sensor its gain error; null where
     /// only the lamps named it (a sensor reading that is impossible).
     pub change: Option<f32>,
-    /// `a|b|c` for a single-phase sensor fault, else null.
-    pub phase: Option<String>,
+    /// The phase of a single-phase sensor fault (JSON `a|b|c`), else null.
+    pub phase: Option<Phase>,
 }
 
 impl From<&Candidate> for FaultCandidate {
     fn from(c: &Candidate) -> Self {
         FaultCandidate {
-            fault: c.fault.name().to_string(),
+            fault: c.fault,
             probability: c.probability,
             change: Some(c.change),
             phase: None,
@@ -216,8 +303,8 @@ impl From<&Candidate> for FaultCandidate {
 /// `unbalance.voltage_sensor_phase`).
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct SensorPhaseReport {
-    /// `a`, `b` or `c`.
-    pub phase: String,
+    /// The phase (JSON `a`, `b` or `c`).
+    pub phase: Phase,
     /// The sensor's gain error (0.2: it reads 20 % high).
     pub gain_error: f32,
     /// |3 I0| / |I1|: the zero sequence the error leaves in the measured set.
@@ -227,7 +314,7 @@ pub struct SensorPhaseReport {
 impl From<&SinglePhaseGain> for SensorPhaseReport {
     fn from(g: &SinglePhaseGain) -> Self {
         SensorPhaseReport {
-            phase: g.phase.name().to_string(),
+            phase: g.phase,
             gain_error: g.gain_error,
             zero_sequence_ratio: g.zero_sequence_ratio,
         }
@@ -244,29 +331,27 @@ pub(super) fn refine_single_phase(
     current: Option<&SensorPhaseReport>,
     voltage: Option<&SensorPhaseReport>,
 ) {
-    let of = |fault: &str| match fault {
-        "current_sensor" => current,
-        "voltage_sensor" => voltage,
+    let of = |fault: Fault| match fault {
+        Fault::CurrentSensor => current.map(|g| (g, "current")),
+        Fault::VoltageSensor => voltage.map(|g| (g, "voltage")),
         _ => None,
     };
     for c in candidates.iter_mut() {
-        if let Some(g) = of(&c.fault) {
+        if let Some((g, _)) = of(c.fault) {
             c.change = Some(g.gain_error);
-            c.phase = Some(g.phase.clone());
+            c.phase = Some(g.phase);
         }
     }
-    let Some(g) = report.named.as_deref().and_then(of) else {
+    let Some((g, what)) = (match report.named {
+        Some(IsolationName::Fault(f)) => of(f),
+        _ => None,
+    }) else {
         return;
-    };
-    let what = if report.named.as_deref() == Some("current_sensor") {
-        "current"
-    } else {
-        "voltage"
     };
     report.named_change = Some(g.gain_error);
     report.verdict = format!(
         "The phase {} {what} sensor's gain changed by {} (the zero sequence of the three readings names it; one phase's error is a third of that on the three-phase vector){}",
-        g.phase,
+        g.phase.name(),
         pct(g.gain_error),
         report
             .verdict
@@ -278,8 +363,8 @@ pub(super) fn refine_single_phase(
 /// Faults that cannot be separated here, and why (JSON `isolation.groups`).
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct IsolationGroup {
-    /// The faults.
-    pub faults: Vec<String>,
+    /// The faults (JSON: their names).
+    pub faults: Vec<Fault>,
     /// Why they cannot be separated.
     pub reason: String,
 }
@@ -287,10 +372,11 @@ pub struct IsolationGroup {
 /// What the isolation concluded (`diagnose --json` key `isolation`).
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct IsolationReport {
-    /// `isolated`, `unknown`, `no_deviation` or `not_judged`.
-    pub state: String,
-    /// The fault named (probability >= 0.5), `b/bl` for the friction class, or null.
-    pub named: Option<String>,
+    /// The conclusion (JSON `isolated`, `unknown`, `no_deviation` or `not_judged`).
+    #[serde(serialize_with = "serialize_state")]
+    pub state: IsolationState,
+    /// The fault named (probability >= 0.5) or the friction class (`b/bl`), or null.
+    pub named: Option<IsolationName>,
     /// The named fault's estimated relative change (for `b/bl`: Bl's), or null.
     pub named_change: Option<f32>,
     /// One sentence.
@@ -310,8 +396,8 @@ pub struct IsolationReport {
     pub spread: [f32; 3],
     /// `learned in commissioning` or `nominal parameters`.
     pub baseline: String,
-    /// The first fault named and when [s].
-    pub first_named: Option<(String, f64)>,
+    /// The first name given and when [s] (JSON `[name, t_s]`).
+    pub first_named: Option<NameGiven>,
     /// When the reported isolation was made [s] (the last steady operating point).
     pub judged_at_s: f64,
     /// How far the stator current of the reported isolation is from the one the learned
@@ -324,7 +410,7 @@ pub struct IsolationReport {
 impl IsolationReport {
     fn not_judged(why: &str, learned: bool) -> Self {
         IsolationReport {
-            state: state_name(IsolationState::NotJudged).to_string(),
+            state: IsolationState::NotJudged,
             named: None,
             named_change: None,
             verdict: format!("The fault could not be isolated: {why}."),
@@ -347,19 +433,13 @@ impl IsolationReport {
     }
 }
 
-fn state_name(s: IsolationState) -> &'static str {
+/// The report's name of an isolation state.
+pub fn state_name(s: IsolationState) -> &'static str {
     match s {
         IsolationState::NotJudged => "not_judged",
         IsolationState::NoDeviation => "no_deviation",
         IsolationState::Isolated => "isolated",
         IsolationState::Unknown => "unknown",
-    }
-}
-
-fn named_label(n: &Named) -> String {
-    match n {
-        Named::Fault(c) => c.fault.name().to_string(),
-        Named::Friction { .. } => "b/bl".to_string(),
     }
 }
 
@@ -458,7 +538,7 @@ fn groups(iso: &Isolation) -> Vec<IsolationGroup> {
     };
     if listed(Fault::B) || listed(Fault::Bl) {
         out.push(IsolationGroup {
-            faults: vec!["b".into(), "bl".into()],
+            faults: vec![Fault::B, Fault::Bl],
             reason: "both scale the load term (B + Bl) wr of the torque balance: one friction class at every operating point".into(),
         });
     }
@@ -467,7 +547,7 @@ fn groups(iso: &Isolation) -> Vec<IsolationGroup> {
             matches!(a.fault, Fault::B | Fault::Bl) && matches!(b.fault, Fault::B | Fault::Bl);
         if !friction_pair && b.probability >= LIST_FROM && b.probability * 3.0 >= a.probability {
             out.push(IsolationGroup {
-                faults: vec![a.fault.name().into(), b.fault.name().into()],
+                faults: vec![a.fault, b.fault],
                 reason: pair_reason(a.fault, b.fault, iso.separation_deg),
             });
         }

@@ -2,8 +2,8 @@
 //!
 //! See the module documentation of [`crate::sim`] for the TOML format.
 
-use super::SimError;
-use monitor_core::{EffectKind, Fault, Phase};
+use super::{FaultSpec, SensorSpec, SimError};
+use monitor_core::{EffectKind, Phase};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -147,85 +147,6 @@ pub struct LoadStep {
     pub bl_scale: Option<f64>,
 }
 
-/// What a sensor fault does to the reading x.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum SensorFaultMode {
-    /// Reads (1 + change) * x.
-    Gain,
-    /// Reads x + offset (offset in the channel's unit: V, A or rad/s).
-    Offset,
-    /// Reads 0 (the encoder stops counting).
-    Disconnected,
-    /// Holds the last reading before the fault (the encoder stops counting).
-    Stuck,
-}
-
-/// One fault, switched on at the first output sample at or after `at_s` and kept on.
-///
-/// Parametric faults (`rs, rr, ls, lr, b, bl`) need `change` (relative, > -1; +0.5 = +50 %):
-/// `rs`, `rr`, `b`: the value x (1 + change). `ls`, `lr`: the LEAKAGE inductance x (1 +
-/// change), the self inductance follows (PSIM's convention, DESIGN.md §2); for a machine
-/// without that leakage (the Gamma-model 2.2 kW reference has Lls = 0) Lm itself is scaled
-/// (the other leakage kept, so both self inductances follow). `bl`: Bl x (1 + change), or
-/// the load torque for a torque load. The speed sensor fault acts on `wm_rad_s` and on the
-/// encoder count.
-/// Sensor faults need `mode`; `gain` needs `change`, `offset` needs `offset`; `phase`
-/// (voltage and current sensors only) restricts the fault to one phase (default: all three).
-/// Several faults of the same kind compose multiplicatively.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct FaultSpec {
-    /// Which fault (DESIGN.md name).
-    pub kind: Fault,
-    /// Switch-on time [s], >= 0.
-    pub at_s: f64,
-    /// Relative change (parametric faults, sensor gain).
-    #[serde(default)]
-    pub change: Option<f64>,
-    /// Sensor fault mode.
-    #[serde(default)]
-    pub mode: Option<SensorFaultMode>,
-    /// Sensor offset in the channel's unit [V, A or rad/s].
-    #[serde(default)]
-    pub offset: Option<f64>,
-    /// Restrict a voltage/current sensor fault to one phase.
-    #[serde(default)]
-    pub phase: Option<Phase>,
-}
-
-impl FaultSpec {
-    /// A parametric fault (`rs, rr, ls, lr, b, bl`) with relative `change` at `at_s`.
-    pub fn parametric(kind: Fault, at_s: f64, change: f64) -> Self {
-        FaultSpec {
-            kind,
-            at_s,
-            change: Some(change),
-            mode: None,
-            offset: None,
-            phase: None,
-        }
-    }
-    /// Table 1's kind of fault of relative size `change` at `at_s`: a parametric change,
-    /// or for a sensor a gain error on all its channels (the reading is (1 + change)
-    /// times the true value).
-    pub fn at_change(kind: Fault, at_s: f64, change: f64) -> Self {
-        if kind.is_sensor() {
-            Self::sensor_gain(kind, at_s, change)
-        } else {
-            Self::parametric(kind, at_s, change)
-        }
-    }
-
-    /// A sensor gain fault: the reading is (1 + change) times the true value.
-    pub fn sensor_gain(kind: Fault, at_s: f64, change: f64) -> Self {
-        FaultSpec {
-            mode: Some(SensorFaultMode::Gain),
-            ..Self::parametric(kind, at_s, change)
-        }
-    }
-}
-
 /// Main-flux saturation law parameters; see [`EffectSpec::Saturation`].
 fn d_sat_exp() -> f64 {
     6.0
@@ -239,7 +160,7 @@ fn d_tau_s() -> f64 {
 fn d_alpha() -> f64 {
     0.00393
 }
-fn d_true() -> bool {
+pub(super) fn d_true() -> bool {
     true
 }
 fn d_iron_ratio() -> f64 {
@@ -259,7 +180,7 @@ fn d_phase_a() -> Phase {
 }
 
 /// A physical effect to inject, with its parameters: `[[effects]] name = "..."`, the name
-/// an [`EffectKind`] (DESIGN.md §3 effect library).
+/// an [`EffectKind`] (the effect library of `docs/design.md`).
 ///
 /// Each variant lists its parameters (TOML keys) with units and defaults. The defaults make a
 /// visible but realistic difference on the reference motors.
@@ -628,105 +549,6 @@ fn d_rotor_delta() -> f64 {
     0.1
 }
 
-/// Sensor chain: transducer (gain and offset error), white Gaussian noise, ADC quantisation
-/// with clamping to the range; the encoder gives cumulative counts, 4 x lines per rev.
-///
-/// reading = clamp(round(((1 + gain_error) x + offset + noise) / lsb) lsb), lsb = range /
-/// 2^(bits-1). Speed `wm_rad_s` is not quantised (it stands for a computed speed); add
-/// `noise_w_rad_s` for a noisy one.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SensorSpec {
-    /// Ideal sensors: no ADC, no noise, no gain/offset errors (the true values). Sensor
-    /// faults still apply.
-    #[serde(default)]
-    pub ideal: bool,
-    /// ADC resolution [bits], 2..=24, default 12.
-    #[serde(default = "d_bits")]
-    pub adc_bits: u32,
-    /// Voltage full scale +/- [V]. Default: 1.25 x the supply's phase peak, rounded up to
-    /// a multiple of 50 V (400 V for the 2.2 kW motor, 250 V for the 3 hp motor).
-    #[serde(default)]
-    pub v_range_v: Option<f64>,
-    /// Current full scale +/- [A]. Default: 1.25 x the analytic locked-rotor peak current,
-    /// rounded up to a multiple of 5 A (no clipping on a direct-on-line start).
-    #[serde(default)]
-    pub i_range_a: Option<f64>,
-    /// Voltage noise [V rms]; default 0.1 % of the range.
-    #[serde(default)]
-    pub noise_v: Option<f64>,
-    /// Current noise [A rms]; default 0.1 % of the range.
-    #[serde(default)]
-    pub noise_i: Option<f64>,
-    /// Speed noise [rad/s rms], default 0.
-    #[serde(default)]
-    pub noise_w_rad_s: f64,
-    /// Relative gain error of the voltage channels (all three), default 0.
-    #[serde(default)]
-    pub v_gain_error: f64,
-    /// Offset of the voltage channels [V], default 0.
-    #[serde(default)]
-    pub v_offset_v: f64,
-    /// Relative gain error of the current channels, default 0.
-    #[serde(default)]
-    pub i_gain_error: f64,
-    /// Offset of the current channels [A], default 0.
-    #[serde(default)]
-    pub i_offset_a: f64,
-    /// Encoder lines per revolution (counts per rev = 4 x lines), default 1024.
-    #[serde(default = "d_lines")]
-    pub encoder_lines: u32,
-    /// Write the voltage columns (default true).
-    #[serde(default = "d_true")]
-    pub voltages: bool,
-    /// Write the `wm_rad_s` column (default true).
-    #[serde(default = "d_true")]
-    pub speed: bool,
-    /// Write the `enc_count` column (default true).
-    #[serde(default = "d_true")]
-    pub encoder: bool,
-}
-
-fn d_bits() -> u32 {
-    12
-}
-fn d_lines() -> u32 {
-    1024
-}
-
-impl Default for SensorSpec {
-    fn default() -> Self {
-        SensorSpec {
-            ideal: false,
-            adc_bits: 12,
-            v_range_v: None,
-            i_range_a: None,
-            noise_v: None,
-            noise_i: None,
-            noise_w_rad_s: 0.0,
-            v_gain_error: 0.0,
-            v_offset_v: 0.0,
-            i_gain_error: 0.0,
-            i_offset_a: 0.0,
-            encoder_lines: 1024,
-            voltages: true,
-            speed: true,
-            encoder: true,
-        }
-    }
-}
-
-impl SensorSpec {
-    /// Ideal sensors: readings are the true phase voltages, currents and speed (the
-    /// encoder still counts whole counts). All channels on.
-    pub fn ideal() -> Self {
-        SensorSpec {
-            ideal: true,
-            ..SensorSpec::default()
-        }
-    }
-}
-
 impl Scenario {
     /// A healthy run of `duration_s` at `sample_rate_hz`: the parameter file's supply, the
     /// paper's viscous load, no faults or effects, ideal sensors, seed 1. Starts from
@@ -745,7 +567,7 @@ impl Scenario {
         }
     }
 
-    /// DESIGN.md §4 reference scenario for the 2.2 kW machine: direct-on-line from
+    /// The reference scenario for the 2.2 kW machine: direct-on-line from
     /// standstill, 14.6 N m constant load torque from 2.5 s, 10 s at 10 kHz, ideal sensors.
     pub fn reference_2p2kw() -> Self {
         Scenario {
@@ -928,96 +750,8 @@ impl LoadSpec {
     }
 }
 
-impl FaultSpec {
-    /// Checks that the fault has what its kind needs.
-    ///
-    /// # Errors
-    /// [`SimError::Invalid`] naming the key.
-    pub fn validate(&self) -> Result<(), SimError> {
-        not_negative("faults.at_s", self.at_s)?;
-        if !self.kind.is_sensor() {
-            if self.mode.is_some() || self.offset.is_some() || self.phase.is_some() {
-                return invalid(
-                    "faults.mode",
-                    "mode/offset/phase are for sensor faults only".into(),
-                );
-            }
-            return match self.change {
-                Some(c) if c.is_finite() && c > -1.0 => Ok(()),
-                Some(c) => invalid("faults.change", format!("must be > -1, got {c}")),
-                None => invalid("faults.change", "a parametric fault needs change".into()),
-            };
-        }
-        let Some(mode) = self.mode else {
-            return invalid(
-                "faults.mode",
-                "a sensor fault needs mode = gain|offset|disconnected|stuck".into(),
-            );
-        };
-        match mode {
-            SensorFaultMode::Gain if !self.change.is_some_and(f64::is_finite) => {
-                return invalid("faults.change", "mode = \"gain\" needs change".into())
-            }
-            SensorFaultMode::Offset if !self.offset.is_some_and(f64::is_finite) => {
-                return invalid("faults.offset", "mode = \"offset\" needs offset".into())
-            }
-            _ => {}
-        }
-        if self.phase.is_some() && self.kind == Fault::SpeedSensor {
-            return invalid("faults.phase", "the speed sensor has no phases".into());
-        }
-        Ok(())
-    }
-}
-
-impl SensorSpec {
-    /// Checks the sensor chain's ranges.
-    ///
-    /// # Errors
-    /// [`SimError::Invalid`] naming the key.
-    pub fn validate(&self) -> Result<(), SimError> {
-        if !(2..=24).contains(&self.adc_bits) {
-            return invalid(
-                "sensors.adc_bits",
-                format!("must be 2..=24, got {}", self.adc_bits),
-            );
-        }
-        for (key, v) in [
-            ("sensors.v_range_v", self.v_range_v),
-            ("sensors.i_range_a", self.i_range_a),
-        ] {
-            if let Some(v) = v {
-                positive(key, v)?;
-            }
-        }
-        for (key, v) in [
-            ("sensors.noise_v", self.noise_v),
-            ("sensors.noise_i", self.noise_i),
-        ] {
-            if let Some(v) = v {
-                not_negative(key, v)?;
-            }
-        }
-        not_negative("sensors.noise_w_rad_s", self.noise_w_rad_s)?;
-        for (key, v) in [
-            ("sensors.v_gain_error", self.v_gain_error),
-            ("sensors.v_offset_v", self.v_offset_v),
-            ("sensors.i_gain_error", self.i_gain_error),
-            ("sensors.i_offset_a", self.i_offset_a),
-        ] {
-            if !v.is_finite() {
-                return invalid(key, format!("must be finite, got {v}"));
-            }
-        }
-        if self.encoder_lines == 0 {
-            return invalid("sensors.encoder_lines", "must be >= 1".into());
-        }
-        Ok(())
-    }
-}
-
 /// `Err(SimError::Invalid)` for `key`.
-fn invalid(key: &str, message: String) -> Result<(), SimError> {
+pub(super) fn invalid(key: &str, message: String) -> Result<(), SimError> {
     Err(SimError::Invalid {
         key: key.to_string(),
         message,
@@ -1025,7 +759,7 @@ fn invalid(key: &str, message: String) -> Result<(), SimError> {
 }
 
 /// Checks `v` is positive and finite.
-fn positive(key: &str, v: f64) -> Result<(), SimError> {
+pub(super) fn positive(key: &str, v: f64) -> Result<(), SimError> {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
@@ -1034,7 +768,7 @@ fn positive(key: &str, v: f64) -> Result<(), SimError> {
 }
 
 /// Checks `v` is finite and >= 0.
-fn not_negative(key: &str, v: f64) -> Result<(), SimError> {
+pub(super) fn not_negative(key: &str, v: f64) -> Result<(), SimError> {
     if v.is_finite() && v >= 0.0 {
         Ok(())
     } else {

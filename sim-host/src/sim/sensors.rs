@@ -1,12 +1,14 @@
 //! The sensor chain: transducer faults, gain/offset errors, white noise, ADC, encoder.
 
-use super::scenario::{FaultSpec, SensorFaultMode, SensorSpec};
-use super::Truth;
-use crate::log::Row;
+use super::faults::{FaultSpec, SensorFaultMode};
+use super::scenario::{d_true, invalid, not_negative, positive};
+use super::{SimError, Truth};
+use crate::log::{Channels, Row};
 use monitor_core::Fault;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
+use serde::{Deserialize, Serialize};
 
 /// Transducer fault state of one channel.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -215,5 +217,163 @@ impl Sensors {
         };
         *last = y;
         y
+    }
+}
+
+impl SensorSpec {
+    /// The CSV channels these sensors produce.
+    pub fn channels(&self) -> Channels {
+        Channels {
+            voltages: self.voltages,
+            speed: self.speed,
+            encoder: self.encoder,
+        }
+    }
+}
+
+/// Sensor chain: transducer (gain and offset error), white Gaussian noise, ADC quantisation
+/// with clamping to the range; the encoder gives cumulative counts, 4 x lines per rev.
+///
+/// reading = clamp(round(((1 + gain_error) x + offset + noise) / lsb) lsb), lsb = range /
+/// 2^(bits-1). Speed `wm_rad_s` is not quantised (it stands for a computed speed); add
+/// `noise_w_rad_s` for a noisy one.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorSpec {
+    /// Ideal sensors: no ADC, no noise, no gain/offset errors (the true values). Sensor
+    /// faults still apply.
+    #[serde(default)]
+    pub ideal: bool,
+    /// ADC resolution [bits], 2..=24, default 12.
+    #[serde(default = "d_bits")]
+    pub adc_bits: u32,
+    /// Voltage full scale +/- [V]. Default: the machine's voltage range on the scenario's
+    /// supply ([`crate::params::SensorRanges`]: 1.2 x the phase peak, rounded up to a
+    /// multiple of 50 V; 400 V for the 2.2 kW motor, 250 V for the 3 hp motor).
+    #[serde(default)]
+    pub v_range_v: Option<f64>,
+    /// Current full scale +/- [A]. Default: the machine's current range
+    /// ([`crate::params::SensorRanges`]: 2 x the analytic locked-rotor peak current, rounded
+    /// up to a multiple of 5 A; no clipping on a direct-on-line start).
+    #[serde(default)]
+    pub i_range_a: Option<f64>,
+    /// Voltage noise [V rms]; default 0.05 % of the range.
+    #[serde(default)]
+    pub noise_v: Option<f64>,
+    /// Current noise [A rms]; default 0.05 % of the range.
+    #[serde(default)]
+    pub noise_i: Option<f64>,
+    /// Speed noise [rad/s rms], default 0.
+    #[serde(default)]
+    pub noise_w_rad_s: f64,
+    /// Relative gain error of the voltage channels (all three), default 0.
+    #[serde(default)]
+    pub v_gain_error: f64,
+    /// Offset of the voltage channels [V], default 0.
+    #[serde(default)]
+    pub v_offset_v: f64,
+    /// Relative gain error of the current channels, default 0.
+    #[serde(default)]
+    pub i_gain_error: f64,
+    /// Offset of the current channels [A], default 0.
+    #[serde(default)]
+    pub i_offset_a: f64,
+    /// Encoder lines per revolution (counts per rev = 4 x lines), default 1024.
+    #[serde(default = "d_lines")]
+    pub encoder_lines: u32,
+    /// Write the voltage columns (default true).
+    #[serde(default = "d_true")]
+    pub voltages: bool,
+    /// Write the `wm_rad_s` column (default true).
+    #[serde(default = "d_true")]
+    pub speed: bool,
+    /// Write the `enc_count` column (default true).
+    #[serde(default = "d_true")]
+    pub encoder: bool,
+}
+
+fn d_bits() -> u32 {
+    12
+}
+fn d_lines() -> u32 {
+    1024
+}
+
+impl Default for SensorSpec {
+    fn default() -> Self {
+        SensorSpec {
+            ideal: false,
+            adc_bits: 12,
+            v_range_v: None,
+            i_range_a: None,
+            noise_v: None,
+            noise_i: None,
+            noise_w_rad_s: 0.0,
+            v_gain_error: 0.0,
+            v_offset_v: 0.0,
+            i_gain_error: 0.0,
+            i_offset_a: 0.0,
+            encoder_lines: 1024,
+            voltages: true,
+            speed: true,
+            encoder: true,
+        }
+    }
+}
+
+impl SensorSpec {
+    /// Ideal sensors: readings are the true phase voltages, currents and speed (the
+    /// encoder still counts whole counts). All channels on.
+    pub fn ideal() -> Self {
+        SensorSpec {
+            ideal: true,
+            ..SensorSpec::default()
+        }
+    }
+}
+
+impl SensorSpec {
+    /// Checks the sensor chain's ranges.
+    ///
+    /// # Errors
+    /// [`SimError::Invalid`] naming the key.
+    pub fn validate(&self) -> Result<(), SimError> {
+        if !(2..=24).contains(&self.adc_bits) {
+            return invalid(
+                "sensors.adc_bits",
+                format!("must be 2..=24, got {}", self.adc_bits),
+            );
+        }
+        for (key, v) in [
+            ("sensors.v_range_v", self.v_range_v),
+            ("sensors.i_range_a", self.i_range_a),
+        ] {
+            if let Some(v) = v {
+                positive(key, v)?;
+            }
+        }
+        for (key, v) in [
+            ("sensors.noise_v", self.noise_v),
+            ("sensors.noise_i", self.noise_i),
+        ] {
+            if let Some(v) = v {
+                not_negative(key, v)?;
+            }
+        }
+        not_negative("sensors.noise_w_rad_s", self.noise_w_rad_s)?;
+        for (key, v) in [
+            ("sensors.v_gain_error", self.v_gain_error),
+            ("sensors.v_offset_v", self.v_offset_v),
+            ("sensors.i_gain_error", self.i_gain_error),
+            ("sensors.i_offset_a", self.i_offset_a),
+        ] {
+            if !v.is_finite() {
+                return invalid(key, format!("must be finite, got {v}"));
+            }
+        }
+        if self.encoder_lines == 0 {
+            return invalid("sensors.encoder_lines", "must be >= 1".into());
+        }
+        Ok(())
     }
 }

@@ -213,4 +213,20 @@ mod tests {
         assert!(st.slip > 0.02 && st.slip < 0.08, "{}", st.slip);
         assert!(solve_slip(&p, SteadyLoad::torque(&p, 1000.0)).is_err());
     }
+
+    #[test]
+    fn the_sensor_ranges_locked_rotor_current_is_the_circuits() {
+        // params derives the sensors' current range from the same circuit at slip 1.
+        for p in [ParamFile::reference_2p2kw(), ParamFile::reference_3hp()] {
+            for (v, f) in [
+                (p.supply.v_ll_rms, p.supply.f_hz),
+                (400.0, 50.0),
+                (230.0, 60.0),
+            ] {
+                let st = steady_state_at(&p.motor, v, f, 1.0);
+                let i = crate::params::locked_rotor_current_rms_a(&p.motor, v, f);
+                assert_eq!(i, st.i_phase_rms_a, "{v} V {f} Hz");
+            }
+        }
+    }
 }

@@ -279,7 +279,10 @@ pub fn confusion_svg(matrices: &[sim_host::bench::isolation::Confusion]) -> Resu
             let max = m.counts.iter().flatten().copied().max().unwrap_or(0).max(1);
             let mut chart = ChartBuilder::on(area)
                 .caption(
-                    format!("isolation bench, angle mode {}", m.mode),
+                    format!(
+                        "isolation bench, angle mode {}",
+                        sim_host::replay::angle_source_name(m.mode)
+                    ),
                     ("sans-serif", 18),
                 )
                 .margin(10)
@@ -287,6 +290,8 @@ pub fn confusion_svg(matrices: &[sim_host::bench::isolation::Confusion]) -> Resu
                 .y_label_area_size(110)
                 .build_cartesian_2d((0..nc).into_segmented(), (0..nr).into_segmented())
                 .map_err(e)?;
+            let columns: Vec<String> = m.columns.iter().map(|c| c.to_string()).collect();
+            let rows: Vec<String> = m.rows.iter().map(|f| f.to_string()).collect();
             let label = |names: &[String], v: &SegmentValue<i32>, flip: bool| match v {
                 SegmentValue::CenterOf(i) => {
                     let k = if flip { names.len() as i32 - 1 - i } else { *i };
@@ -299,8 +304,8 @@ pub fn confusion_svg(matrices: &[sim_host::bench::isolation::Confusion]) -> Resu
                 .disable_mesh()
                 .x_labels(nc as usize)
                 .y_labels(nr as usize)
-                .x_label_formatter(&|v| label(&m.columns, v, false))
-                .y_label_formatter(&|v| label(&m.rows, v, true))
+                .x_label_formatter(&|v| label(&columns, v, false))
+                .y_label_formatter(&|v| label(&rows, v, true))
                 .x_label_style(
                     ("sans-serif", 13)
                         .into_font()

@@ -3,13 +3,17 @@
 //! a panic).
 
 use super::json::Table1Report;
+use monitor_core::{Fault, IsolationState, Phase};
 use sim_host::analysis::compare::CompareReport;
 use sim_host::analysis::explain::ExplainReport;
-use sim_host::bench::isolation::IsolationBench;
+use sim_host::bench::isolation::{CaseResult, Confusion, IsolationBench, Outcome};
 use sim_host::bench::{BenchFigures, DetectionLimit, Spread};
 use sim_host::demo::{DemoRun, MonitorState};
 use sim_host::log::quality::DataQuality;
-use sim_host::replay::{CommissioningReport, Diagnosed, TimelinePoint, Verdict};
+use sim_host::replay::{
+    angle_source_name, state_name, CommissioningReport, Diagnosed, IsolationName, TimelinePoint,
+    Verdict,
+};
 use sim_host::sim::SimSummary;
 use std::io::Write;
 use std::path::Path;
@@ -175,7 +179,7 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
         log.display(),
         rep.rows,
         d.sample_rate_hz,
-        rep.angle_source
+        angle_source_name(rep.angle_source)
     )?;
     data_quality(&mut out, &rep.data_quality)?;
     commissioning(&mut out, &rep.commissioning)?;
@@ -236,7 +240,11 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
             writeln!(
                 out,
                 "  cannot be separated: {} ({})",
-                g.faults.join(" / "),
+                g.faults
+                    .iter()
+                    .map(|f| f.name())
+                    .collect::<Vec<_>>()
+                    .join(" / "),
                 g.reason
             )?;
         }
@@ -246,7 +254,7 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
         out,
         "unbalance: |I2|/|I1| = {:.2} %, suspect phase: {}",
         100.0 * u.negative_sequence_ratio,
-        u.suspect_phase.as_deref().unwrap_or("none")
+        u.suspect_phase.map_or("none", Phase::name)
     )?;
     for n in &rep.commissioning.outside_range {
         writeln!(out, "note at {:.2} s: {}", n.t_s, n.note)?;
@@ -336,12 +344,12 @@ pub fn table1(t: &Table1Report) -> anyhow::Result<()> {
         let cands: Vec<String> = r
             .candidates
             .iter()
-            .map(|(f, p)| format!("{f} {:.0}%", 100.0 * p))
+            .map(|c| format!("{} {:.0}%", c.fault, 100.0 * c.probability))
             .collect();
         writeln!(
             out,
             "{:<15} {:+5.0} %        {}  {}  {}  {}          {}  {}  {}  {} {diff}          {}  {}  {}  {}   {:<22} {}",
-            r.fault,
+            r.fault.name(),
             100.0 * r.change,
             m[0],
             m[1],
@@ -355,11 +363,13 @@ pub fn table1(t: &Table1Report) -> anyhow::Result<()> {
             e[1],
             e[2],
             e[3],
-            match (&r.named, r.named_change) {
-                (Some(n), Some(c)) if n != "b/bl" => format!("{n} ({:+.0} %)", 100.0 * c),
-                (Some(n), _) => n.clone(),
-                (None, _) if r.isolation_state == "isolated" => "not alone".to_string(),
-                (None, _) => format!("none ({})", r.isolation_state),
+            match (r.named, r.named_change) {
+                (Some(IsolationName::Fault(n)), Some(c)) => format!("{n} ({:+.0} %)", 100.0 * c),
+                (Some(n), _) => n.to_string(),
+                (None, _) if r.isolation_state == IsolationState::Isolated => {
+                    "not alone".to_string()
+                }
+                (None, _) => format!("none ({})", state_name(r.isolation_state)),
             },
             if cands.is_empty() { "none".to_string() } else { cands.join(", ") }
         )?;
@@ -558,7 +568,7 @@ pub fn bench(f: &BenchFigures, limits: Option<&[DetectionLimit]>) -> anyhow::Res
     )?;
     writeln!(
         out,
-        "(motulator 0.5.0 reference, DESIGN.md: 5.14 simulated s per wall s with DOP853 at the same accuracy)"
+        "(motulator 0.5.0 reference: 5.14 simulated s per wall s with DOP853 at the same accuracy)"
     )?;
     if let Some(limits) = limits {
         writeln!(out, "\nsmallest change detected within 10 s, service profile with load and supply steps, zero false alarms:")?;
@@ -572,7 +582,7 @@ pub fn bench(f: &BenchFigures, limits: Option<&[DetectionLimit]>) -> anyhow::Res
                 out,
                 "{:<7} {:<15} {}  {}",
                 l.motor,
-                l.fault,
+                l.fault.name(),
                 pct(l.smallest_increase),
                 pct(l.smallest_decrease)
             )?;
@@ -588,6 +598,16 @@ pub fn bench(f: &BenchFigures, limits: Option<&[DetectionLimit]>) -> anyhow::Res
 /// Stdout errors.
 pub fn isolation_bench(b: &IsolationBench) -> anyhow::Result<()> {
     let mut out = crate::cli::stdout();
+    isolation_summaries(&mut out, b)?;
+    for c in &b.confusion {
+        confusion_matrix(&mut out, c)?;
+    }
+    cases_not_named_right(&mut out, b)?;
+    wrong_names(&mut out, b)
+}
+
+/// The bench's heading and one line per motor and angle mode.
+fn isolation_summaries(out: &mut impl Write, b: &IsolationBench) -> anyhow::Result<()> {
     writeln!(
         out,
         "isolation bench: {} cases at {:.0} Hz, 12-bit noisy sensors, loads 1.0 and 0.6 x the file's Bl, sizes -50/-10/+10/+50 % ({:.0} s wall)",
@@ -608,7 +628,7 @@ pub fn isolation_bench(b: &IsolationBench) -> anyhow::Result<()> {
             out,
             "{:<7} {:<10} {:>4}/{:<4}  {:>4}/{:<4}   {:>6}       {:>8} / {:<8}      {}",
             s.motor,
-            s.mode,
+            angle_source_name(s.mode),
             s.detected,
             s.cases,
             s.named_right,
@@ -619,85 +639,98 @@ pub fn isolation_bench(b: &IsolationBench) -> anyhow::Result<()> {
             opt(s.time_to_name_median_s, 1.0, " s"),
         )?;
     }
-    for c in &b.confusion {
-        writeln!(
-            out,
-            "\nconfusion matrix, {} (rows: true fault; columns: named at the end; all motors, sizes, loads):",
-            c.mode
-        )?;
-        let short = |s: &str| match s {
-            "current_sensor" => "i_sens".to_string(),
-            "voltage_sensor" => "v_sens".to_string(),
-            "speed_sensor" => "w_sens".to_string(),
-            "unknown" => "unkn".to_string(),
-            x => x.to_string(),
-        };
-        write!(out, "{:<15}", "true \\ named")?;
-        for col in &c.columns {
-            write!(out, "{:>7}", short(col))?;
+    Ok(())
+}
+
+/// One angle mode's confusion matrix (rows: the true faults; columns: what was named).
+fn confusion_matrix(out: &mut impl Write, c: &Confusion) -> anyhow::Result<()> {
+    writeln!(
+        out,
+        "\nconfusion matrix, {} (rows: true fault; columns: named at the end; all motors, sizes, loads):",
+        angle_source_name(c.mode)
+    )?;
+    let short = |o: &Outcome| match o {
+        Outcome::Named(IsolationName::Fault(Fault::CurrentSensor)) => "i_sens",
+        Outcome::Named(IsolationName::Fault(Fault::VoltageSensor)) => "v_sens",
+        Outcome::Named(IsolationName::Fault(Fault::SpeedSensor)) => "w_sens",
+        Outcome::Unknown => "unkn",
+        o => o.name(),
+    };
+    write!(out, "{:<15}", "true \\ named")?;
+    for col in &c.columns {
+        write!(out, "{:>7}", short(col))?;
+    }
+    writeln!(out)?;
+    for (r, counts) in c.rows.iter().zip(&c.counts) {
+        write!(out, "{:<15}", r.name())?;
+        for n in counts {
+            write!(out, "{n:>7}")?;
         }
         writeln!(out)?;
-        for (r, counts) in c.rows.iter().zip(&c.counts) {
-            write!(out, "{r:<15}")?;
-            for n in counts {
-                write!(out, "{n:>7}")?;
-            }
-            writeln!(out)?;
-        }
     }
+    Ok(())
+}
+
+/// Every case not named right: the name at the end and the candidates.
+fn cases_not_named_right(out: &mut impl Write, b: &IsolationBench) -> anyhow::Result<()> {
     writeln!(out, "\nnot named right (named at the end; candidates):")?;
     for c in b.cases.iter().filter(|c| !c.right) {
         let cands: Vec<String> = c
             .candidates
             .iter()
             .take(3)
-            .map(|(n, p, ch)| match ch {
-                Some(ch) => format!("{n} {:+.0} % p={p:.2}", 100.0 * ch),
-                None => format!("{n} p={p:.2}"),
+            .map(|c| match c.change {
+                Some(ch) => format!("{} {:+.0} % p={:.2}", c.fault, 100.0 * ch, c.probability),
+                None => format!("{} p={:.2}", c.fault, c.probability),
             })
             .collect();
         writeln!(
             out,
             "  {:<6} {:<10} {:<15} {:+4.0} % load {:.1}: {} ({}){}",
             c.motor,
-            c.mode,
-            c.fault,
+            angle_source_name(c.mode),
+            c.fault.name(),
             100.0 * c.change,
             c.load_scale,
             c.named,
             if cands.is_empty() {
-                c.state.clone()
+                state_name(c.state).to_string()
             } else {
                 cands.join(", ")
             },
             if c.detected { "" } else { ", not detected" }
         )?;
     }
-    let wrong: Vec<&sim_host::bench::isolation::CaseResult> = b
+    Ok(())
+}
+
+/// The cases with a wrong name at probability >= 0.5 (the bar: none).
+fn wrong_names(out: &mut impl Write, b: &IsolationBench) -> anyhow::Result<()> {
+    let wrong: Vec<&CaseResult> = b
         .cases
         .iter()
         .filter(|c| !c.wrong_names.is_empty())
         .collect();
     if wrong.is_empty() {
         writeln!(out, "\nwrong names at probability >= 0.5: none")?;
-    } else {
+        return Ok(());
+    }
+    writeln!(
+        out,
+        "\nWRONG NAMES at probability >= 0.5 ({} cases):",
+        wrong.len()
+    )?;
+    for c in wrong {
         writeln!(
             out,
-            "\nWRONG NAMES at probability >= 0.5 ({} cases):",
-            wrong.len()
+            "  {} {} {} {:+.0} % load {:.1}: {}",
+            c.motor,
+            angle_source_name(c.mode),
+            c.fault,
+            100.0 * c.change,
+            c.load_scale,
+            c.wrong_names.join(", ")
         )?;
-        for c in wrong {
-            writeln!(
-                out,
-                "  {} {} {} {:+.0} % load {:.1}: {}",
-                c.motor,
-                c.mode,
-                c.fault,
-                100.0 * c.change,
-                c.load_scale,
-                c.wrong_names.join(", ")
-            )?;
-        }
     }
     Ok(())
 }

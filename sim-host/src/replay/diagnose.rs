@@ -1,0 +1,435 @@
+//! A log through the data-quality stage and a [`Replay`]: what `sim-host diagnose` runs
+//! ([`diagnose_file`]), the glitch bursts filled or held out, and the observer of every
+//! output (the live HMI's log source).
+
+use super::{DiagnoseReport, Replay, ReplayError, ReplayOptions, Verdict};
+use crate::log::quality::{
+    BadCells, CellLimits, CleanSink, DataQuality, QualityStage, SegmentBreak, TimeBase,
+    MAX_BRIDGED_GAP_S,
+};
+use crate::log::{Channels, LogError, LogFile, Row, RowSink};
+use crate::params::ParamFile;
+use monitor_core::{Abc, MonitorOutput};
+use std::path::Path;
+
+/// A log replayed by [`diagnose_file`] or [`diagnose_rows`].
+#[derive(Debug, Clone)]
+pub struct Diagnosed {
+    /// The report (`diagnose --json`), `data_quality` included.
+    pub report: DiagnoseReport,
+    /// The log's nominal sample rate (the data-quality stage's) [Hz].
+    pub sample_rate_hz: f64,
+}
+
+/// Replays rows held in memory, through the data-quality stage, and returns the report.
+///
+/// # Errors
+/// As [`diagnose_file`].
+pub fn diagnose_rows(
+    params: &ParamFile,
+    channels: Channels,
+    rows: &[Row],
+    opts: ReplayOptions,
+) -> Result<DiagnoseReport, ReplayError> {
+    replay_through_quality(params, channels, "the log", opts, |stage| {
+        for r in rows {
+            if !stage.row(r) {
+                break;
+            }
+        }
+        Ok(())
+    })
+    .map(|d| d.report)
+}
+
+/// Streams a log file through the data-quality stage and the core (`sim-host
+/// diagnose`): the stage's time base configures the monitor, and every row is replayed,
+/// with bounded memory whatever the log's length.
+///
+/// # Errors
+/// [`ReplayError::Log`] naming the file, line and column, or the stage's time-base
+/// errors (a log without rows or sampled below 8 samples per supply period, with the rate
+/// needed); [`ReplayError::Config`] when the core rejects the configuration;
+/// [`ReplayError::IncompleteCommissioning`] for a window not learned without
+/// `allow_incomplete`.
+pub fn diagnose_file(
+    params: &ParamFile,
+    path: &Path,
+    opts: ReplayOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Diagnosed, ReplayError> {
+    diagnose_log(params, &LogFile::open(path)?, opts, progress)
+}
+
+/// [`diagnose_file`] on a log already opened (any format, a TDMS group chosen:
+/// [`LogFile::open_with`]).
+///
+/// # Errors
+/// As [`diagnose_file`].
+pub fn diagnose_log(
+    params: &ParamFile,
+    file: &LogFile,
+    opts: ReplayOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Diagnosed, ReplayError> {
+    replay_through_quality(params, file.channels(), file.shown(), opts, |stage| {
+        file.for_each_row(progress, stage).map(|_| ())
+    })
+}
+
+/// Watches a replay row by row ([`diagnose_file_observed`]): the live HMI's log source.
+pub trait ReplayObserver {
+    /// The monitor's output after `row` (as the data-quality stage passed it on, glitches
+    /// filled in); `replay` for its time base and thresholds ([`Replay::time_of`],
+    /// [`Replay::threshold_bands`]).
+    fn output(&mut self, row: &Row, out: &MonitorOutput, replay: &Replay);
+    /// The replay starts again from the log's first row (the reader's fast path handed
+    /// over to the exact reader): forget every output so far.
+    fn restart(&mut self);
+}
+
+/// [`diagnose_file`] that hands every replayed row's output to `observer` as it goes.
+///
+/// # Errors
+/// As [`diagnose_file`].
+pub fn diagnose_file_observed(
+    params: &ParamFile,
+    path: &Path,
+    opts: ReplayOptions,
+    progress: &mut dyn FnMut(f64),
+    observer: &mut dyn ReplayObserver,
+) -> Result<Diagnosed, ReplayError> {
+    let file = LogFile::open(path)?;
+    replay_observed(
+        params,
+        file.channels(),
+        file.shown(),
+        opts,
+        Some(observer),
+        |stage| file.for_each_row(progress, stage).map(|_| ()),
+    )
+}
+
+/// Runs `feed` into the data-quality stage in front of a replay; builds the report.
+fn replay_through_quality(
+    params: &ParamFile,
+    channels: Channels,
+    shown: &str,
+    opts: ReplayOptions,
+    feed: impl FnOnce(&mut dyn RowSink) -> Result<(), LogError>,
+) -> Result<Diagnosed, ReplayError> {
+    replay_observed(params, channels, shown, opts, None, feed)
+}
+
+/// [`replay_through_quality`] with an optional observer of every output.
+fn replay_observed<'a>(
+    params: &'a ParamFile,
+    channels: Channels,
+    shown: &str,
+    opts: ReplayOptions,
+    observer: Option<&'a mut dyn ReplayObserver>,
+    feed: impl FnOnce(&mut dyn RowSink) -> Result<(), LogError>,
+) -> Result<Diagnosed, ReplayError> {
+    let mut sink = ReplaySink {
+        observer,
+        params,
+        channels,
+        opts,
+        replay: None,
+        rate_hz: 0.0,
+        other_rate: false,
+        rows_other_rate: 0,
+        restarts: 0,
+        burst: Vec::new(),
+        burst_forwarded: false,
+        short_bursts: 0,
+        long_bursts: 0,
+        last_good: None,
+        filled_rows: 0,
+        error: None,
+    };
+    let mut stage = QualityStage::new(&mut sink, CellLimits::for_params(params), shown);
+    let read = feed(&mut stage);
+    let quality = stage.finish();
+    if let Some(e) = sink.error {
+        return Err(e);
+    }
+    read?;
+    let mut quality = quality?;
+    let Some(replay) = sink.replay.take() else {
+        return Err(ReplayError::Option(format!("{shown}: no rows to replay")));
+    };
+    if replay.commissioning_incomplete() && !opts.allow_incomplete {
+        let why = replay.commission.why_incomplete().unwrap_or_default();
+        return Err(ReplayError::IncompleteCommissioning { why });
+    }
+    let can_residuals = replay.monitor.is_some();
+    let mut report = replay.finish();
+    describe_actions(&mut quality, can_residuals, &sink);
+    if !quality.trusted {
+        report.verdict = Verdict::CouldNotJudge;
+        report.verdict_withheld_because.extend(
+            quality
+                .not_trusted_because
+                .iter()
+                .map(|w| format!("data quality: {w}")),
+        );
+    }
+    report.data_quality = quality;
+    Ok(Diagnosed {
+        report,
+        sample_rate_hz: sink.rate_hz,
+    })
+}
+
+/// What `diagnose` did about what the stage found, in the report's `actions`.
+fn describe_actions(q: &mut DataQuality, monitor: bool, sink: &ReplaySink<'_>) {
+    let who = if monitor {
+        "the monitor"
+    } else {
+        "the unbalance analysis"
+    };
+    if q.gaps_bridged > 0 {
+        q.actions.push(format!(
+            "short gaps: {who} advanced its estimators over the real elapsed time"
+        ));
+    }
+    if q.long_gaps > 0 || q.clock_resets > 0 {
+        q.actions.push(format!(
+            "long gaps and clock resets: {who} restarted its estimators and settled again"
+        ));
+    }
+    if sink.short_bursts > 0 {
+        q.actions.push(format!(
+            "{} bursts of bad cells up to {MAX_BRIDGED_GAP_S} s: {} rows of glitches within a quarter supply period filled in between their neighbours along the rotation, the longer bursts left out and bridged like gaps",
+            sink.short_bursts, sink.filled_rows
+        ));
+    }
+    if sink.long_bursts > 0 {
+        q.actions.push(format!(
+            "{} bursts of bad cells longer than {MAX_BRIDGED_GAP_S} s: given to {who}, which holds them out and flags the sensor",
+            sink.long_bursts
+        ));
+    }
+    if q.repeated_or_backward_rows + q.non_finite_times > 0 {
+        q.actions
+            .push("rows with a repeated, backward or unreadable time: dropped".to_string());
+    }
+    if sink.rows_other_rate > 0 {
+        q.actions.push(format!(
+            "{} rows at another sample rate not diagnosed (the monitor runs at {:.0} Hz)",
+            sink.rows_other_rate, sink.rate_hz
+        ));
+        q.warnings.push(format!(
+            "{} rows at another sample rate were not diagnosed",
+            sink.rows_other_rate
+        ));
+    }
+}
+
+/// The replay behind the data-quality stage: configured when the stage knows the time
+/// base; rows of segments at another sample rate are counted, not replayed (the monitor's
+/// configuration follows from one rate).
+struct ReplaySink<'a> {
+    observer: Option<&'a mut dyn ReplayObserver>,
+    params: &'a ParamFile,
+    channels: Channels,
+    opts: ReplayOptions,
+    replay: Option<Replay>,
+    rate_hz: f64,
+    other_rate: bool,
+    rows_other_rate: u64,
+    restarts: u64,
+    burst: Vec<Row>,
+    burst_forwarded: bool,
+    short_bursts: u64,
+    long_bursts: u64,
+    last_good: Option<Row>,
+    filled_rows: u64,
+    error: Option<ReplayError>,
+}
+
+/// Glitches spanning (with their good neighbours) at most this fraction of a supply
+/// period are filled in between the neighbours: a quarter period keeps the phase step
+/// between them unambiguous.
+const FILL_PERIODS: f64 = 0.25;
+
+/// The row at `t` between rows `a` and `b`. The voltage and current space vectors turn
+/// from `a`'s to `b`'s along the rotation (angle and magnitude interpolated linearly,
+/// exact for a steady balanced set, where a straight line in abc would cut the circle's
+/// chord), the zero sequence, the speed and the encoder count (rounded) along a line.
+fn between(a: &Row, b: &Row, t: f64) -> Row {
+    use monitor_core::frames::{clarke, inverse_clarke, zero_sequence, AlphaBeta};
+    use nalgebra::Complex;
+    let w = if b.t_s > a.t_s {
+        ((t - a.t_s) / (b.t_s - a.t_s)).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let mix = |x: f64, y: f64| x + w * (y - x);
+    let turn = |x: [f64; 3], y: [f64; 3]| {
+        let (p, q) = (clarke(Abc::from_array(x)), clarke(Abc::from_array(y)));
+        let (zp, zq) = (Complex::new(p.alpha, p.beta), Complex::new(q.alpha, q.beta));
+        let step = (zq * zp.conj()).arg();
+        let z = Complex::from_polar(mix(zp.norm(), zq.norm()), zp.arg() + w * step);
+        let x0 = mix(
+            zero_sequence(Abc::from_array(x)),
+            zero_sequence(Abc::from_array(y)),
+        );
+        inverse_clarke(
+            AlphaBeta {
+                alpha: z.re,
+                beta: z.im,
+            },
+            x0,
+        )
+        .to_array()
+    };
+    Row {
+        t_s: t,
+        v_abc: a.v_abc.zip(b.v_abc).map(|(x, y)| turn(x, y)),
+        i_abc: turn(a.i_abc, b.i_abc),
+        wm_rad_s: a.wm_rad_s.zip(b.wm_rad_s).map(|(x, y)| mix(x, y)),
+        enc_count: a
+            .enc_count
+            .zip(b.enc_count)
+            .map(|(x, y)| x + (w * (y - x) as f64).round() as i64),
+    }
+}
+
+impl CleanSink for ReplaySink<'_> {
+    fn begin(&mut self, base: &TimeBase) -> bool {
+        self.rate_hz = base.sample_rate_hz;
+        match Replay::new(self.params, self.channels, base.sample_rate_hz, self.opts) {
+            Ok(r) => {
+                self.replay = Some(r);
+                true
+            }
+            Err(e) => {
+                self.error = Some(e);
+                false
+            }
+        }
+    }
+
+    fn row(&mut self, row: &Row, bad: BadCells) -> bool {
+        if self.other_rate {
+            self.rows_other_rate += 1;
+            return true;
+        }
+        let Some(r) = self.replay.as_mut() else {
+            return true;
+        };
+        if bad.any() && !self.burst_forwarded {
+            // A glitch burst is held until it ends (dropped: the monitor bridges it like a
+            // gap) or outlasts the longest gap bridged (a sensor that has failed: the rows
+            // go to the monitor, which holds them out and flags the sensor).
+            self.burst.push(*row);
+            if self.burst.len() as f64 <= MAX_BRIDGED_GAP_S * self.rate_hz {
+                return true;
+            }
+            self.burst_forwarded = true;
+            self.long_bursts += 1;
+            for b in self.burst.drain(..) {
+                let out = r.push(&b);
+                if let Some(o) = self.observer.as_deref_mut() {
+                    o.output(&b, &out, r);
+                }
+            }
+            return true;
+        }
+        if !bad.any() {
+            if !self.burst.is_empty() && !self.burst_forwarded {
+                self.short_bursts += 1;
+                // A glitch of a few samples is filled in between its good neighbours (the
+                // monitor would otherwise lose the whole block it falls in); a longer one
+                // is left out, a gap the monitor bridges.
+                let short = |a: &Row| (row.t_s - a.t_s) * self.params.supply.f_hz <= FILL_PERIODS;
+                if let Some(a) = self.last_good.filter(short) {
+                    for b in &self.burst {
+                        let filled = between(&a, row, b.t_s);
+                        let out = r.push(&filled);
+                        if let Some(o) = self.observer.as_deref_mut() {
+                            o.output(&filled, &out, r);
+                        }
+                    }
+                    self.filled_rows += self.burst.len() as u64;
+                }
+            }
+            self.burst.clear();
+            self.burst_forwarded = false;
+            self.last_good = Some(*row);
+        }
+        let out = r.push(row);
+        if let Some(o) = self.observer.as_deref_mut() {
+            o.output(row, &out, r);
+        }
+        true
+    }
+
+    fn new_segment(&mut self, why: SegmentBreak) -> bool {
+        match why {
+            SegmentBreak::RateChange(r) => {
+                self.other_rate = (r / self.rate_hz - 1.0).abs() > 0.02;
+            }
+            SegmentBreak::Gap(_) | SegmentBreak::ClockReset => self.restarts += 1,
+        }
+        true
+    }
+
+    fn restart(&mut self) {
+        if let Some(o) = self.observer.as_deref_mut() {
+            o.restart();
+        }
+        self.replay = None;
+        self.other_rate = false;
+        self.rows_other_rate = 0;
+        self.restarts = 0;
+        self.burst.clear();
+        self.burst_forwarded = false;
+        self.short_bursts = 0;
+        self.long_bursts = 0;
+        self.last_good = None;
+        self.filled_rows = 0;
+        self.error = None;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A balanced 50 Hz set (300 V, 10 A lagging 0.4 rad) with a zero sequence, at `t`.
+    fn row(t: f64) -> Row {
+        let w = std::f64::consts::TAU * 50.0 * t;
+        let set = |amp: f64, lag: f64| {
+            [0.0, 1.0, 2.0].map(|k| amp * (w - lag - k * std::f64::consts::TAU / 3.0).cos() + 0.5)
+        };
+        Row {
+            t_s: t,
+            v_abc: Some(set(300.0, 0.0)),
+            i_abc: set(10.0, 0.4),
+            wm_rad_s: Some(150.0 + 10.0 * t),
+            enc_count: Some((100_000.0 * t) as i64),
+        }
+    }
+
+    #[test]
+    fn a_glitch_is_filled_along_the_rotation() {
+        // A fifth of a period between the neighbours (4 ms at 50 Hz, four samples at 1 kHz):
+        // a straight line in abc would miss by (omega h)^2 / 8 = 20 % of the amplitude.
+        let (a, b) = (row(0.010), row(0.014));
+        for t in [0.011, 0.012, 0.013] {
+            let f = between(&a, &b, t);
+            let truth = row(t);
+            for (x, y) in f.i_abc.iter().zip(truth.i_abc) {
+                assert!((x - y).abs() < 1e-9, "{t}: {x} vs {y}");
+            }
+            let (fv, tv) = (f.v_abc.unwrap_or_default(), truth.v_abc.unwrap_or_default()); // ok: test
+            for (x, y) in fv.iter().zip(tv) {
+                assert!((x - y).abs() < 1e-7, "{t}: {x} vs {y}");
+            }
+            assert!((f.wm_rad_s.unwrap_or(0.0) - (150.0 + 10.0 * t)).abs() < 1e-9);
+        }
+    }
+}

@@ -1,0 +1,276 @@
+//! What a replay reports ([`DiagnoseReport`]): the timeline, the negative-sequence
+//! analysis, the verdict, built by [`Replay::finish`].
+
+use super::isolation::{self, FaultCandidate, IsolationReport, SensorPhaseReport};
+use super::{serialize_angle_source, CommissioningReport, Replay, UnbalanceBaseline};
+use crate::log::quality::DataQuality;
+use monitor_core::{AngleSource, CommissioningState, Fault, MonitorOutput, Phase};
+use serde::{Serialize, Serializer};
+
+/// One point of the diagnosis timeline.
+#[derive(Debug, Clone, Serialize)]
+pub struct TimelinePoint {
+    /// Time [s].
+    pub t_s: f64,
+    /// Normalised residuals r1..r4.
+    pub residuals: [f32; 4],
+    /// Lamps r1..r4.
+    pub lamps: [bool; 4],
+    /// Most probable fault, if any (JSON: its name).
+    pub top: Option<Fault>,
+    /// Its probability.
+    pub top_probability: f32,
+    /// Mechanical speed [rad/s].
+    pub speed_rad_s: f32,
+    /// Lamps are being evaluated (running, settled, commissioned or fixed).
+    pub evaluating: bool,
+    /// Learning healthy statistics.
+    pub commissioning: bool,
+    /// The operating point is quasi-steady (the steady-state residuals apply).
+    pub quasi_steady: bool,
+    /// |I2|/|I1|.
+    pub negative_sequence_ratio: f32,
+    /// Beside a lit r2..r4 lamp: the operating point has left the commissioned range.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub range_note: Option<String>,
+}
+
+/// Result of the negative-sequence analysis (JSON key `unbalance`).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct UnbalanceReport {
+    /// |I2|/|I1|.
+    pub negative_sequence_ratio: f32,
+    /// The winding's faulty phase (JSON "a", "b", "c"), or null.
+    pub suspect_phase: Option<Phase>,
+    /// arg(I2w/I1) [deg]: the winding's part (the supply's part taken out).
+    pub angle_deg: f32,
+    /// |I2w|/|I1|: the winding's part of the negative sequence.
+    pub winding_ratio: f32,
+    /// |V2/Z2|/|I1|: the part the supply's voltage unbalance drives (0 without voltages).
+    pub supply_ratio: f32,
+    /// |V2|/|V1| (null without voltage columns).
+    pub voltage_negative_sequence_ratio: Option<f32>,
+    /// The model correction arg(Z1/Z2) used [deg].
+    pub correction_deg: f32,
+    /// One phase's current sensor with a gain error, from the zero sequence of the three
+    /// measured currents (zero for a star without neutral, whatever the machine does), or
+    /// null; its part of the negative sequence is taken out before a winding is blamed.
+    pub current_sensor_phase: Option<SensorPhaseReport>,
+    /// The same for the voltage sensors (phase voltages against the star point), or null.
+    pub voltage_sensor_phase: Option<SensorPhaseReport>,
+    /// What was measured, before the baseline is taken out (sensor-corrected): `I2/I1` and
+    /// `V2/I1` (re, im); a healthy log's are the `--baseline` of a later one.
+    pub measured: UnbalanceBaseline,
+    /// The healthy negative sequence the winding is judged against ([`BaselineSource`]),
+    /// or null (none: the supply's part alone is taken out).
+    pub baseline: Option<BaselineSource>,
+}
+
+/// Where the healthy negative sequence the winding is judged against comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BaselineSource {
+    /// Learned in the commissioning window, used while |I1| is within
+    /// [`super::BASELINE_I1_TOLERANCE`] of its value there.
+    Commissioning,
+    /// The healthy log given with `--baseline`.
+    File,
+}
+
+/// A fault the lamps named (the top of the signature matching while a lamp was lit), with
+/// the first time it was named [s]. JSON: the pair `[fault, t_s]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Detection {
+    /// The fault.
+    pub fault: Fault,
+    /// When it was first named [s since the log's first row].
+    pub t_s: f64,
+}
+
+impl Serialize for Detection {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        (self.fault, self.t_s).serialize(s)
+    }
+}
+
+/// What `diagnose` reports (the JSON keys of `docs/design.md`, plus `verdict`, `data_quality` and
+/// `commissioning`).
+#[derive(Debug, Clone, Serialize)]
+pub struct DiagnoseReport {
+    /// `fault`, `healthy` or `could not judge` ([`Verdict`]).
+    pub verdict: Verdict,
+    /// Why the verdict could not be given (empty otherwise).
+    pub verdict_withheld_because: Vec<String>,
+    /// Final lamps `{"r1":bool,..}`.
+    pub lamps: std::collections::BTreeMap<String, bool>,
+    /// Final fault candidates, most probable first, with their estimated size: from the
+    /// isolation ([`IsolationReport`]) when a fault was detected; an impossible sensor
+    /// reading names its sensor outright (size null).
+    pub candidates: Vec<FaultCandidate>,
+    /// What the isolation concluded: the fault named, its size, the groups that cannot
+    /// be separated, and one sentence.
+    pub isolation: IsolationReport,
+    /// The paper's matching of the final lamps against the fault signature matrix (Table
+    /// 1 in voltage orientation), most probable first: the lamps' own candidates.
+    pub signature_candidates: Vec<FaultCandidate>,
+    /// First time a lamp lit or a sensor fault was seen [s], or null.
+    pub first_detection_s: Option<f64>,
+    /// Negative-sequence analysis of the currents.
+    pub unbalance: UnbalanceReport,
+    /// Faults ever named while the lamps were lit, with the time first named.
+    pub detections: Vec<Detection>,
+    /// Analyses skipped for lack of a column, with the reason.
+    pub skipped: Vec<String>,
+    /// Angle source used (JSON: its command-line name, [`super::angle_source_name`]).
+    #[serde(serialize_with = "serialize_angle_source")]
+    pub angle_source: AngleSource,
+    /// Commissioning window asked for, if any [s].
+    pub commission: Option<(f64, f64)>,
+    /// What commissioning did (state, window used, range covered).
+    pub commissioning: CommissioningReport,
+    /// What the data-quality stage found and did.
+    pub data_quality: DataQuality,
+    /// Rows replayed.
+    pub rows: u64,
+    /// Largest |normalised residual| while evaluating, r1..r4.
+    pub max_abs_residual: [f32; 4],
+    /// Timeline (one point per `timeline_step_s`).
+    pub timeline: Vec<TimelinePoint>,
+}
+
+/// `diagnose`'s overall answer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// A lamp lit, a sensor fault was seen, or the isolation named a fault (other than
+    /// the friction class, which a load change also moves).
+    Fault,
+    /// Evaluated, and no lamp lit.
+    Healthy,
+    /// The data or the setup does not allow an answer (see `verdict_withheld_because`).
+    CouldNotJudge,
+}
+
+impl Replay {
+    /// Ends the replay and builds the report (`data_quality` left at its default for the
+    /// caller to fill).
+    pub fn finish(self) -> DiagnoseReport {
+        let out = self.last;
+        let mut skipped = Vec::new();
+        if !self.channels.voltages {
+            skipped.push(
+                "residuals r1..r4 and fault signatures: need the voltages va_V, vb_V, vc_V (Vqs)"
+                    .to_string(),
+            );
+        } else if !(self.channels.speed || self.channels.encoder) {
+            skipped.push(
+                "residuals r1..r4 and fault signatures: need the speed (wm_rad_s or enc_count)"
+                    .to_string(),
+            );
+        }
+        let unbalance = self.unbalance_report(&out);
+        let mut signature_candidates: Vec<FaultCandidate> = Fault::ALL
+            .iter()
+            .zip(out.diagnosis.probabilities)
+            .filter(|(_, p)| *p > 0.0)
+            .map(|(f, p)| FaultCandidate {
+                fault: *f,
+                probability: p,
+                change: None,
+                phase: None,
+            })
+            .collect();
+        signature_candidates.sort_by(|a, b| b.probability.total_cmp(&a.probability));
+        let detected = self.first_detection.is_some() || self.isolation.named_a_fault();
+        let (mut isolation, mut isolated) = self.isolation.report(detected);
+        isolation::refine_single_phase(
+            &mut isolation,
+            &mut isolated,
+            unbalance.current_sensor_phase.as_ref(),
+            unbalance.voltage_sensor_phase.as_ref(),
+        );
+        let candidates = if out.sensor_fault.any() {
+            signature_candidates.clone()
+        } else {
+            isolated
+        };
+        let lamps = (0..4)
+            .map(|k| {
+                (
+                    format!("r{}", k + 1),
+                    out.lamps.get(k).copied().unwrap_or(false),
+                )
+            })
+            .collect();
+        let mut withheld = skipped.clone();
+        if self.monitor.is_some() && !self.evaluated && self.first_detection.is_none() {
+            withheld.push(
+                "the lamps were never evaluated (the motor never ran settled and quasi-steady with voltage)"
+                    .to_string(),
+            );
+        }
+        if let Some(why) = self.commission.why_incomplete() {
+            withheld.push(why);
+        }
+        if let Some(why) = self.commission.nominal_misfit() {
+            withheld.push(why);
+        }
+        if let (Some(t), false) = (self.first_detection, self.detected_in_range) {
+            withheld.push(format!(
+                "the lamps lit (first at {t:.2} s) only while the load or the voltage was outside the range commissioned: to the paper's model a load change is a Bl change and the learned means hold only where they were learned, so a fault cannot be told from the new operating point; commission over the whole load and voltage range"
+            ));
+        }
+        let verdict = if !withheld.is_empty() {
+            Verdict::CouldNotJudge
+        } else if detected {
+            Verdict::Fault
+        } else {
+            Verdict::Healthy
+        };
+        DiagnoseReport {
+            verdict,
+            verdict_withheld_because: if verdict == Verdict::CouldNotJudge {
+                withheld
+            } else {
+                Vec::new()
+            },
+            lamps,
+            candidates,
+            isolation,
+            signature_candidates,
+            first_detection_s: self.first_detection,
+            unbalance,
+            detections: self.detections,
+            skipped,
+            angle_source: self.opts.angle_source,
+            commission: self.opts.commission,
+            commissioning: self.commission.report(self.k_sigma),
+            data_quality: DataQuality::default(),
+            rows: self.rows,
+            max_abs_residual: self.max_abs,
+            timeline: self.timeline,
+        }
+    }
+}
+
+/// The timeline point of an output at `t`.
+pub(super) fn timeline_point(
+    t: f64,
+    out: &MonitorOutput,
+    range_note: Option<String>,
+) -> TimelinePoint {
+    let top = out.top();
+    TimelinePoint {
+        t_s: t,
+        residuals: out.residuals,
+        lamps: out.lamps,
+        top: top.map(|(f, _)| f),
+        top_probability: top.map(|(_, p)| p).unwrap_or(0.0),
+        speed_rad_s: out.speed_rad_s,
+        evaluating: out.evaluating,
+        commissioning: matches!(out.commissioning, CommissioningState::Learning(_)),
+        quasi_steady: out.quasi_steady,
+        negative_sequence_ratio: out.unbalance.negative_sequence_ratio,
+        range_note,
+    }
+}

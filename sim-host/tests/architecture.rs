@@ -1,0 +1,532 @@
+//! The workspace's shape, checked on its sources: a test that fails on an import against
+//! the layers, on a file or a function grown too long, and on a reference to a file the
+//! repository does not hold. Every failure names the file, the line and the rule.
+//!
+//! 1. **Layers** (`sim-host`): the library's modules point one way,
+//!    `params < log < {sim, replay} < analysis < experiment < {fault_signatures,
+//!    service_profile} < demo < {bench, hmi}`, and the binary (`main.rs`, `cli/`) on top. A
+//!    module uses only modules of a lower layer ([`LAYERS`]); two modules of one layer do
+//!    not use each other. The crate root (`lib.rs`) is below them all: it declares the
+//!    modules and holds `one_line`, and its items use none of them. Checked on every
+//!    `use` and every path (`crate::`, `super::`, `self::`), tests inside `src/` included.
+//! 2. **The core stands alone**: `monitor-core` depends on no crate of the workspace (no
+//!    `path` dependency) and names none.
+//! 3. **The panel is a leaf** (firmware, `src/panel.rs`): it uses nothing from `app`.
+//! 4. **Files**: no `.rs` file in `crates/`, `src/`, `sim-host/`, `tests/` or `tools/` over
+//!    [`MAX_FILE_LINES`] lines (`wc -l`).
+//! 5. **Functions**: no function outside tests over [`MAX_FN_LINES`] lines, counted from
+//!    the line of `fn` to the line of its closing brace (`#[cfg(test)]` modules, `#[test]`
+//!    functions, `tests/` and `benches/` folders are tests).
+//! 6. **The repository stands alone**: no tracked `.rs`, `.toml` or `.md` file names the
+//!    team's design file or its shared folder ([`FOREIGN`]); a user who clones the
+//!    repository has neither. The paper is cited by its title, the design by `docs/`.
+//!
+//! The files are those git tracks (`git ls-files`), or, without git, every file below the
+//! workspace outside `target/` and hidden folders.
+
+use std::path::{Path, PathBuf};
+use syn::visit::Visit;
+
+/// sim-host's library modules and their layers, lowest first.
+const LAYERS: [(&str, u8); 11] = [
+    ("params", 1),
+    ("log", 2),
+    ("sim", 3),
+    ("replay", 3),
+    ("analysis", 4),
+    ("experiment", 5),
+    ("fault_signatures", 6),
+    ("service_profile", 6),
+    ("demo", 7),
+    ("bench", 8),
+    ("hmi", 8),
+];
+
+/// Longest `.rs` file [lines].
+const MAX_FILE_LINES: usize = 900;
+/// Longest non-test function [lines].
+const MAX_FN_LINES: usize = 100;
+/// The workspace's folders of Rust code.
+const CODE_DIRS: [&str; 5] = ["crates/", "src/", "sim-host/", "tests/", "tools/"];
+/// References to files outside the repository (spelled in two parts, so that this file
+/// does not hold them).
+const FOREIGN: [&str; 2] = [concat!("DESIGN", ".md"), concat!("..", "/shared")];
+/// The workspace's crates by the names code uses.
+const WORKSPACE_CRATES: [&str; 5] = [
+    "drive_monitor",
+    "sim_host",
+    "monitor_core",
+    "core_on_m4",
+    "fwtool",
+];
+
+fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .canonicalize()
+        .expect("the workspace folder")
+}
+
+/// The workspace's files (relative paths with `/`), tracked by git, else found by walking.
+fn files() -> Vec<String> {
+    let root = workspace();
+    let git = std::process::Command::new("git")
+        .arg("-C")
+        .arg(&root)
+        .args(["ls-files", "-z"])
+        .output();
+    if let Ok(out) = git {
+        if out.status.success() && !out.stdout.is_empty() {
+            return String::from_utf8_lossy(&out.stdout)
+                .split('\0')
+                .filter(|f| !f.is_empty() && root.join(f).is_file())
+                .map(str::to_string)
+                .collect();
+        }
+    }
+    let mut found = Vec::new();
+    walk(&root, &root, &mut found);
+    found
+}
+
+fn walk(root: &Path, dir: &Path, found: &mut Vec<String>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let path = e.path();
+        let name = e.file_name().to_string_lossy().to_string();
+        if name.starts_with('.') || name == "target" {
+            continue;
+        }
+        if path.is_dir() {
+            walk(root, &path, found);
+        } else if let Ok(rel) = path.strip_prefix(root) {
+            found.push(rel.to_string_lossy().replace('\\', "/"));
+        }
+    }
+}
+
+fn read(rel: &str) -> String {
+    std::fs::read_to_string(workspace().join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"))
+}
+
+fn parse(rel: &str) -> syn::File {
+    syn::parse_file(&read(rel)).unwrap_or_else(|e| {
+        let at = e.span().start();
+        panic!("{rel}:{}:{}: cannot parse: {e}", at.line, at.column + 1)
+    })
+}
+
+/// Fails with every violation, one per line.
+fn verdict(rule: &str, violations: Vec<String>) {
+    assert!(
+        violations.is_empty(),
+        "{} violation(s) of the rule \"{rule}\":\n{}",
+        violations.len(),
+        violations.join("\n")
+    );
+}
+
+fn is_code(rel: &str) -> bool {
+    rel.ends_with(".rs") && CODE_DIRS.iter().any(|d| rel.starts_with(d))
+}
+
+fn is_test_file(rel: &str) -> bool {
+    rel.starts_with("tests/") || rel.contains("/tests/") || rel.contains("/benches/")
+}
+
+fn is_cfg_test(attrs: &[syn::Attribute]) -> bool {
+    attrs.iter().any(|a| {
+        (a.path().is_ident("cfg")
+            && matches!(&a.meta, syn::Meta::List(l) if l.tokens.to_string().split(|c: char| !c.is_alphanumeric() && c != '_').any(|w| w == "test")))
+            || a.path().is_ident("test")
+    })
+}
+
+/// One path as written: the module it is written in (file and inline modules), its
+/// leading segments, its line.
+#[derive(Debug, Clone)]
+struct PathUse {
+    module: Vec<String>,
+    segments: Vec<String>,
+    line: usize,
+}
+
+/// Collects every path and `use` of a file.
+struct Paths {
+    module: Vec<String>,
+    found: Vec<PathUse>,
+    /// Leave out the items that are `mod` declarations (the crate root's rule).
+    skip_mod_items: bool,
+}
+
+impl Paths {
+    fn of(file: &syn::File, module: Vec<String>) -> Vec<PathUse> {
+        let mut p = Paths {
+            module,
+            found: Vec::new(),
+            skip_mod_items: false,
+        };
+        p.visit_file(file);
+        p.found
+    }
+
+    fn use_tree(&mut self, tree: &syn::UseTree, mut prefix: Vec<String>, line: usize) {
+        match tree {
+            syn::UseTree::Path(p) => {
+                prefix.push(p.ident.to_string());
+                self.use_tree(&p.tree, prefix, line);
+            }
+            syn::UseTree::Name(n) => {
+                prefix.push(n.ident.to_string());
+                self.push(prefix, line);
+            }
+            syn::UseTree::Rename(r) => {
+                prefix.push(r.ident.to_string());
+                self.push(prefix, line);
+            }
+            syn::UseTree::Glob(_) => self.push(prefix, line),
+            syn::UseTree::Group(g) => {
+                for t in &g.items {
+                    self.use_tree(t, prefix.clone(), line);
+                }
+            }
+        }
+    }
+
+    fn push(&mut self, segments: Vec<String>, line: usize) {
+        if !segments.is_empty() {
+            self.found.push(PathUse {
+                module: self.module.clone(),
+                segments,
+                line,
+            });
+        }
+    }
+}
+
+impl<'ast> Visit<'ast> for Paths {
+    fn visit_item_mod(&mut self, m: &'ast syn::ItemMod) {
+        if m.content.is_none() && self.skip_mod_items {
+            return;
+        }
+        self.module.push(m.ident.to_string());
+        syn::visit::visit_item_mod(self, m);
+        self.module.pop();
+    }
+
+    fn visit_item_use(&mut self, u: &'ast syn::ItemUse) {
+        let line = u.use_token.span.start().line;
+        self.use_tree(&u.tree, Vec::new(), line);
+    }
+
+    fn visit_path(&mut self, p: &'ast syn::Path) {
+        if p.leading_colon.is_none() {
+            if let Some(first) = p.segments.first() {
+                let line = first.ident.span().start().line;
+                let segs = p.segments.iter().map(|s| s.ident.to_string()).collect();
+                self.push(segs, line);
+            }
+        }
+        syn::visit::visit_path(self, p);
+    }
+}
+
+/// The top-level module a path of a file in module `module` reaches in its own crate, if
+/// any: `crate::X`, `super::…::X`, `self::X`, or a bare `X` in the crate root (the
+/// caller decides whether a bare name is a module).
+fn top_module(u: &PathUse) -> Option<String> {
+    let s = &u.segments;
+    match s.first()?.as_str() {
+        "crate" => s.get(1).cloned(),
+        "super" => {
+            let ups = s.iter().take_while(|x| *x == "super").count();
+            let depth = u.module.len().checked_sub(ups)?;
+            if depth == 0 {
+                s.get(ups).cloned()
+            } else {
+                u.module.first().cloned()
+            }
+        }
+        "self" => u.module.first().cloned().or_else(|| s.get(1).cloned()),
+        first if u.module.is_empty() => Some(first.to_string()),
+        _ => None,
+    }
+}
+
+/// A sim-host library file's module path (`log/quality/report.rs` -> `log::quality::report`).
+fn module_of(rel_in_src: &str) -> Vec<String> {
+    let no_ext = rel_in_src.trim_end_matches(".rs");
+    let mut parts: Vec<String> = no_ext.split('/').map(str::to_string).collect();
+    if parts.last().is_some_and(|p| p == "mod" || p == "lib") {
+        parts.pop();
+    }
+    parts
+}
+
+fn layer(module: &str) -> Option<u8> {
+    LAYERS.iter().find(|(m, _)| *m == module).map(|(_, r)| *r)
+}
+
+#[test]
+fn sim_host_layers_point_one_way() {
+    let mut bad = Vec::new();
+    // Every module of the library has a layer.
+    let lib = parse("sim-host/src/lib.rs");
+    for item in &lib.items {
+        if let syn::Item::Mod(m) = item {
+            let name = m.ident.to_string();
+            if layer(&name).is_none() {
+                bad.push(format!(
+                    "sim-host/src/lib.rs:{}: layers: module `{name}` has no layer (add it to LAYERS in sim-host/tests/architecture.rs)",
+                    m.ident.span().start().line
+                ));
+            }
+        }
+    }
+    // The crate root's items use no module.
+    let mut root = Paths {
+        module: Vec::new(),
+        found: Vec::new(),
+        skip_mod_items: true,
+    };
+    root.visit_file(&lib);
+    for u in &root.found {
+        if let Some(m) = top_module(u).filter(|m| layer(m).is_some()) {
+            bad.push(format!(
+                "sim-host/src/lib.rs:{}: layers: the crate root uses `{}` (module `{m}`); the root is below every module",
+                u.line,
+                u.segments.join("::")
+            ));
+        }
+    }
+    let binary = |f: &str| f == "main.rs" || f == "alloc_tuning.rs" || f.starts_with("cli/");
+    for rel in files() {
+        let Some(in_src) = rel.strip_prefix("sim-host/src/") else {
+            continue;
+        };
+        if !rel.ends_with(".rs") || in_src == "lib.rs" || binary(in_src) {
+            continue;
+        }
+        let module = module_of(in_src);
+        let Some(own) = module.first().cloned() else {
+            continue;
+        };
+        let Some(rank) = layer(&own) else {
+            bad.push(format!("{rel}:1: layers: module `{own}` has no layer"));
+            continue;
+        };
+        for u in Paths::of(&parse(&rel), module) {
+            let Some(target) = top_module(&u) else {
+                continue;
+            };
+            let Some(to) = layer(&target) else {
+                continue; // an item of the crate root (`crate::one_line`)
+            };
+            if target != own && to >= rank {
+                bad.push(format!(
+                    "{rel}:{}: layers: `{own}` (layer {rank}) uses `{}` of `{target}` (layer {to}); a module uses only lower layers",
+                    u.line,
+                    u.segments.join("::")
+                ));
+            }
+        }
+    }
+    verdict("sim-host's modules point one way", bad);
+}
+
+#[test]
+fn monitor_core_uses_nothing_from_the_workspace() {
+    let mut bad = Vec::new();
+    let manifest = "crates/monitor-core/Cargo.toml";
+    let toml: toml::Table = read(manifest).parse().expect("monitor-core's manifest");
+    for section in ["dependencies", "dev-dependencies", "build-dependencies"] {
+        for (name, spec) in toml
+            .get(section)
+            .and_then(|s| s.as_table())
+            .into_iter()
+            .flatten()
+        {
+            if spec.get("path").is_some() {
+                let line = read(manifest)
+                    .lines()
+                    .position(|l| l.trim_start().starts_with(name.as_str()))
+                    .map_or(1, |i| i + 1);
+                bad.push(format!(
+                    "{manifest}:{line}: core alone: [{section}] `{name}` is a crate of the workspace"
+                ));
+            }
+        }
+    }
+    for rel in files() {
+        if !(rel.starts_with("crates/monitor-core/") && rel.ends_with(".rs")) {
+            continue;
+        }
+        for u in Paths::of(&parse(&rel), Vec::new()) {
+            let first = u.segments[0].as_str();
+            if WORKSPACE_CRATES.contains(&first) && first != "monitor_core" {
+                bad.push(format!(
+                    "{rel}:{}: core alone: uses `{}` of the workspace crate `{first}`",
+                    u.line,
+                    u.segments.join("::")
+                ));
+            }
+        }
+    }
+    verdict("monitor-core uses nothing from the workspace", bad);
+}
+
+#[test]
+fn the_firmware_panel_is_a_leaf() {
+    let rel = "src/panel.rs";
+    let bad = Paths::of(&parse(rel), vec!["panel".to_string()])
+        .into_iter()
+        .filter(|u| top_module(u).as_deref() == Some("app"))
+        .map(|u| {
+            format!(
+                "{rel}:{}: panel leaf: uses `{}` of `app` (the panel's interface is its input type; app uses the panel, not the reverse)",
+                u.line,
+                u.segments.join("::")
+            )
+        })
+        .collect();
+    verdict("the panel uses nothing from app", bad);
+}
+
+#[test]
+fn no_rust_file_over_900_lines() {
+    let bad = files()
+        .into_iter()
+        .filter(|f| is_code(f))
+        .filter_map(|f| {
+            let n = read(&f).lines().count();
+            (n > MAX_FILE_LINES).then(|| {
+                format!(
+                    "{f}:{}: file size: {n} lines, more than {MAX_FILE_LINES}",
+                    MAX_FILE_LINES + 1
+                )
+            })
+        })
+        .collect();
+    verdict("no .rs file over 900 lines", bad);
+}
+
+/// Collects the functions (outside tests) longer than [`MAX_FN_LINES`].
+struct LongFunctions<'a> {
+    rel: &'a str,
+    found: Vec<String>,
+}
+
+impl LongFunctions<'_> {
+    fn check(&mut self, attrs: &[syn::Attribute], sig: &syn::Signature, body: &syn::Block) {
+        if is_cfg_test(attrs) {
+            return;
+        }
+        let start = sig.fn_token.span.start().line;
+        let end = body.brace_token.span.close().end().line;
+        let n = end + 1 - start;
+        if n > MAX_FN_LINES {
+            self.found.push(format!(
+                "{}:{start}: function size: `{}` is {n} lines (fn to closing brace), more than {MAX_FN_LINES}",
+                self.rel, sig.ident
+            ));
+        }
+    }
+}
+
+impl<'ast> Visit<'ast> for LongFunctions<'_> {
+    fn visit_item_mod(&mut self, m: &'ast syn::ItemMod) {
+        if !is_cfg_test(&m.attrs) {
+            syn::visit::visit_item_mod(self, m);
+        }
+    }
+    fn visit_item_fn(&mut self, f: &'ast syn::ItemFn) {
+        self.check(&f.attrs, &f.sig, &f.block);
+        if !is_cfg_test(&f.attrs) {
+            syn::visit::visit_item_fn(self, f);
+        }
+    }
+    fn visit_impl_item_fn(&mut self, f: &'ast syn::ImplItemFn) {
+        self.check(&f.attrs, &f.sig, &f.block);
+        syn::visit::visit_impl_item_fn(self, f);
+    }
+    fn visit_trait_item_fn(&mut self, f: &'ast syn::TraitItemFn) {
+        if let Some(body) = &f.default {
+            self.check(&f.attrs, &f.sig, body);
+        }
+        syn::visit::visit_trait_item_fn(self, f);
+    }
+    fn visit_item_impl(&mut self, i: &'ast syn::ItemImpl) {
+        if !is_cfg_test(&i.attrs) {
+            syn::visit::visit_item_impl(self, i);
+        }
+    }
+}
+
+#[test]
+fn no_function_over_100_lines_outside_tests() {
+    let mut bad = Vec::new();
+    for rel in files() {
+        if !is_code(&rel) || is_test_file(&rel) {
+            continue;
+        }
+        let mut v = LongFunctions {
+            rel: &rel,
+            found: Vec::new(),
+        };
+        v.visit_file(&parse(&rel));
+        bad.extend(v.found);
+    }
+    verdict("no function over 100 lines outside tests", bad);
+}
+
+#[test]
+fn no_reference_to_files_outside_the_repository() {
+    let mut bad = Vec::new();
+    for rel in files() {
+        if !(rel.ends_with(".rs") || rel.ends_with(".toml") || rel.ends_with(".md")) {
+            continue;
+        }
+        for (i, line) in read(&rel).lines().enumerate() {
+            for needle in FOREIGN {
+                if line.contains(needle) {
+                    bad.push(format!(
+                        "{rel}:{}: stands alone: names `{needle}`, which a clone of the repository does not have (cite the paper by its title, link docs/)",
+                        i + 1
+                    ));
+                }
+            }
+        }
+    }
+    verdict("no reference to files outside the repository", bad);
+}
+
+/// The checks themselves can fail: a path against the layers, a foreign reference.
+#[test]
+fn the_checks_catch_what_they_should() {
+    let file: syn::File = syn::parse_str(
+        "use crate::replay::Replay; use super::super::sim::x; fn f() { crate::hmi::g(); }",
+    )
+    .unwrap();
+    let tops: Vec<_> = Paths::of(&file, vec!["log".into(), "quality".into()])
+        .iter()
+        .filter_map(top_module)
+        .collect();
+    assert_eq!(tops, ["replay", "sim", "hmi"]);
+    // `super` from a nested module stays in its top module.
+    let file: syn::File = syn::parse_str("use super::Column;").unwrap();
+    let u = &Paths::of(&file, vec!["log".into(), "quality".into()])[0];
+    assert_eq!(top_module(u).as_deref(), Some("log"));
+    // A long function is found, a test function is not.
+    let body = "    let x = 1;\n".repeat(MAX_FN_LINES);
+    let text = format!("fn long() {{\n{body}}}\n#[cfg(test)]\nmod t {{ fn long() {{\n{body}}} }}");
+    let mut v = LongFunctions {
+        rel: "x.rs",
+        found: Vec::new(),
+    };
+    v.visit_file(&syn::parse_str(&text).unwrap());
+    assert_eq!(v.found.len(), 1, "{:?}", v.found);
+    assert!(v.found[0].contains("x.rs:1: function size: `long` is 102 lines"));
+    assert!(FOREIGN.iter().all(|n| !n.is_empty()));
+}
