@@ -41,7 +41,9 @@
 //! Franceschini, Tassoni, Kliman, IEEE Trans. Ind. Appl. 37(5), 2001). It is an
 //! approximation: it takes the broken bars' current as redistributed over the healthy
 //! bars of one rotor pole pitch, and ignores inter-bar currents (which make real
-//! sidebands smaller) and the end-ring resistance.
+//! sidebands smaller) and the end-ring resistance. The formula lives with the machine model
+//! the simulator integrates (`crate::sim`'s machine, `delta_of_broken_bars` and its
+//! inverse `broken_bars_of_delta`); the analysis only reads it.
 //!
 //! # MCSA resolution
 //! The sidebands lie 2 s f from the fundamental (3.6 Hz for the 3 hp motor at 3 % slip).
@@ -55,6 +57,7 @@
 use super::effects::{EffectModel, FitSetup, ParamSpec};
 use super::prep::{zero_phase_lpf, Prepared};
 use super::simplified_model::{EffectTerms, MachineConstants};
+use crate::sim::machine::broken_bars_of_delta;
 use monitor_core::EffectKind;
 use rustfft::num_complex::Complex;
 use serde::Serialize;
@@ -83,18 +86,6 @@ pub const SLIP_STEADY: f64 = 0.2;
 /// reads: the leakage criterion is met, and the noise floor per bin is already far below
 /// a healthy cage's sidebands.
 pub const MAX_STRETCH_S: f64 = 300.0;
-
-/// delta = 3n/(N - 3n) for `n` adjacent broken bars of a cage of `bars` bars (see the module
-/// doc; an approximation).
-pub fn delta_of_broken_bars(n: f64, bars: f64) -> f64 {
-    3.0 * n / (bars - 3.0 * n)
-}
-
-/// The number of adjacent broken bars n = delta N / (3 (1 + delta)) of an N-bar cage
-/// equivalent to the asymmetry `delta` (the inverse of [`delta_of_broken_bars`]).
-pub fn broken_bars_of_delta(delta: f64, bars: f64) -> f64 {
-    delta * bars / (3.0 * (1.0 + delta))
-}
 
 /// The library entry (see the module doc).
 pub struct RotorAsymmetry;
@@ -573,16 +564,6 @@ mod tests {
         let lo = r.lower_sideband_db.unwrap_or(0.0);
         assert!((lo + 40.0).abs() < 0.5, "{lo}");
         assert!((r.resolution_hz.unwrap_or(1.0) - 1.0 / MAX_STRETCH_S).abs() < 1e-4);
-    }
-
-    #[test]
-    fn broken_bars_and_delta_are_inverse() {
-        // One broken bar of 28: 3/25 = 0.12.
-        assert!((delta_of_broken_bars(1.0, 28.0) - 0.12).abs() < 1e-12);
-        for (n, nb) in [(1.0, 28.0), (2.0, 40.0), (3.0, 36.0)] {
-            let d = delta_of_broken_bars(n, nb);
-            assert!((broken_bars_of_delta(d, nb) - n).abs() < 1e-12);
-        }
     }
 
     #[test]

@@ -89,7 +89,7 @@
 //! Other code gets only [`Row`]s of sensor readings ([`simulate`]); the true state
 //! ([`Truth`]) is available to tests through [`simulate_with_truth`] and never enters a row.
 
-mod machine;
+pub(crate) mod machine;
 mod scenario;
 mod sensors;
 mod steady;
