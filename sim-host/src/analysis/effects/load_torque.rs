@@ -1,0 +1,230 @@
+//! `load_torque`: the load as a torque input.
+
+use super::{plausible, Confusion, Evidence, Needs, LOAD_STEP_MIN};
+use super::{EffectModel, FitSetup, ParamSpec};
+use crate::analysis::prep::Prepared;
+use crate::analysis::simplified_model::{EffectTerms, MachineConstants};
+use monitor_core::EffectKind;
+
+/// Load as a torque input.
+pub struct LoadTorque;
+
+/// Torque observer: Te(measured I_qs, i_f) - J dw_m/dt, low-passed at 10 Hz, then with
+/// the best viscous line c1 w_m (through the origin) removed, segmented into constant levels by binary
+/// segmentation (minimum segment 0.1 s or 5 % of the log; a split must move the level by
+/// more than 3 % of the rated torque estimate, and the supply must hold still around it).
+/// Returns (segment start time, observer level) pairs, flattened.
+fn load_steps(d: &Prepared, n: &MachineConstants) -> Vec<f64> {
+    let len = d.len();
+    if d.omega_r.len() != len || len < 20 {
+        return vec![];
+    }
+    let dt = d.dt_s;
+    let lmr = n.lm_h * n.lm_h / n.lr_h;
+    let mut obs = Vec::with_capacity(len);
+    let a = 1.0 - (-2.0 * std::f64::consts::PI * 10.0 * dt).exp();
+    let (mut s1, mut s2) = (0.0, 0.0);
+    // (Few series of the log's length: this also runs on the full working series of a long
+    // log, so w_m is recomputed where needed rather than stored.)
+    let w_at = |k: usize| d.omega_r[k] / n.np;
+    let mut wprev = w_at(0);
+    for k in 0..len {
+        let wm = w_at(k);
+        let te = 1.5 * n.np * lmr * d.i_f[k] * d.iq_pos[k];
+        let acc = (wm - wprev) / dt;
+        wprev = wm;
+        let x = te - n.j_kgm2 * acc;
+        if k == 0 {
+            s1 = x;
+            s2 = x;
+        }
+        s1 += a * (x - s1);
+        s2 += a * (s1 - s2);
+        obs.push(s2);
+    }
+    // Remove the best viscous line through the origin (the paper's Bl*omega): what is
+    // left is load torque the viscous model cannot describe.
+    let (sww, swx) = obs.iter().enumerate().fold((0.0, 0.0), |acc, (k, x)| {
+        let w = w_at(k);
+        (acc.0 + w * w, acc.1 + w * x)
+    });
+    let c1 = if sww > 0.0 { swx / sww } else { 0.0 };
+    let min_len = ((0.1 / dt) as usize).max(len / 10).max(2);
+    let thresh = 0.03 * n.torque_scale_nm;
+    // Cumulative sum of the residual torque obs - c1 w_m.
+    let mut cum = vec![0.0; len + 1];
+    for k in 0..len {
+        cum[k + 1] = cum[k] + (obs[k] - c1 * w_at(k));
+    }
+    drop(obs);
+    let mean = |a: usize, b: usize| (cum[b] - cum[a]) / (b - a) as f64;
+    // A load step is a torque change while the supply holds still: splits where the supply
+    // frequency or voltage moves by more than 1 % within +/- half a minimum segment are
+    // refused (speed sweeps change the friction torque, not the load).
+    let cum_of = |x: &dyn Fn(usize) -> f64| {
+        let mut c = vec![0.0; len + 1];
+        for k in 0..len {
+            c[k + 1] = c[k] + x(k);
+        }
+        c
+    };
+    let cw = cum_of(&|k| d.omega_s[k]);
+    let cv = cum_of(&|k| d.vq[k].hypot(d.vd[k]));
+    let half = (min_len / 2).max(1);
+    let supply_steady = |kk: usize| {
+        let a = kk.saturating_sub(half);
+        let b = (kk + half).min(len);
+        if kk <= a || b <= kk {
+            return true;
+        }
+        let m = |c: &[f64], x: usize, y: usize| (c[y] - c[x]) / (y - x) as f64;
+        let (w1, w2) = (m(&cw, a, kk), m(&cw, kk, b));
+        let (v1, v2) = (m(&cv, a, kk), m(&cv, kk, b));
+        (w1 - w2).abs() <= 0.01 * w1.abs().max(w2.abs()).max(1e-9)
+            && (v1 - v2).abs() <= 0.01 * v1.abs().max(v2.abs()).max(1e-9)
+    };
+    let mut segs = vec![(0usize, len)];
+    for _ in 0..6 {
+        let mut best: Option<(usize, usize, f64)> = None;
+        for (si, &(a0, b0)) in segs.iter().enumerate() {
+            if b0 - a0 < 2 * min_len {
+                continue;
+            }
+            let step = ((b0 - a0) / 400).max(1);
+            let mut kk = a0 + min_len;
+            while kk <= b0 - min_len {
+                let ml = mean(a0, kk);
+                let mr = mean(kk, b0);
+                let gain = (ml - mr).powi(2) * ((kk - a0) * (b0 - kk)) as f64 / (b0 - a0) as f64;
+                if (ml - mr).abs() > thresh
+                    && best.map(|b| gain > b.2).unwrap_or(true)
+                    && supply_steady(kk)
+                {
+                    best = Some((si, kk, gain));
+                }
+                kk += step;
+            }
+        }
+        match best {
+            Some((si, kk, _)) => {
+                let (a0, b0) = segs[si];
+                segs[si] = (a0, kk);
+                segs.insert(si + 1, (kk, b0));
+            }
+            None => break,
+        }
+    }
+    segs.iter()
+        .flat_map(|&(a0, b0)| [d.t_s[a0], mean(a0, b0)])
+        .collect()
+}
+
+impl EffectModel for LoadTorque {
+    fn kind(&self) -> EffectKind {
+        EffectKind::LoadTorque
+    }
+    fn confused_with(&self) -> &'static [Confusion] {
+        // A constant load torque is dry friction's equation at positive speed.
+        &[Confusion {
+            with: EffectKind::CoulombFriction,
+            within: 1.10,
+        }]
+    }
+    fn evidence(&self, e: &Evidence<'_>) -> Option<bool> {
+        let hi = e.fitted.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b));
+        let lo = e.fitted.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+        Some(hi - lo >= LOAD_STEP_MIN * e.torque_scale_nm)
+    }
+    fn description(&self) -> &'static str {
+        "The load is a torque imposed by the driven machine (possibly switched in steps), not the paper's viscous Bl*omega."
+    }
+    fn equations(&self) -> &'static str {
+        "J dw_m/dt = Kf I_qs - (B + Bl) w_m - T_L(t), T_L piecewise constant; the step times come from a torque observer on the measured speed and current, the levels are fitted."
+    }
+    fn parameters(&self) -> &'static [ParamSpec] {
+        &[ParamSpec {
+            name: "level_k",
+            unit: "N m",
+            description: "load torque in segment k (one parameter per detected segment)",
+        }]
+    }
+    fn needs(&self) -> Needs {
+        Needs {
+            voltages: true,
+            speed: true,
+        }
+    }
+    fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String> {
+        if d.omega_r.is_empty() {
+            return Err(
+                "needs the speed column wm_rad_s (the torque observer uses the measured speed)"
+                    .into(),
+            );
+        }
+        let pairs = load_steps(d, n);
+        let steps: Vec<f64> = pairs.iter().step_by(2).copied().collect();
+        let levels: Vec<f64> = pairs.iter().skip(1).step_by(2).copied().collect();
+        if steps.len() < 2 {
+            return Err("no change of load torque found in the log: a constant load torque is the same equation as coulomb_friction at positive speed, so it is left to that effect".into());
+        }
+        let t = n.torque_scale_nm;
+        let mut s = FitSetup::default();
+        // Initial levels: the observer's mean torque beyond the viscous line per segment.
+        for (k, (&ts, &lv)) in steps.iter().zip(&levels).enumerate() {
+            s.push(
+                &format!("level_{}_from_{:.2}_s", k + 1, ts),
+                "N m",
+                lv.clamp(-3.0 * t, 3.0 * t),
+                -3.0 * t,
+                3.0 * t,
+                0.2 * t,
+            );
+            s.range(
+                plausible::LOAD_RATIO.0 * t,
+                plausible::LOAD_RATIO.1 * t,
+                plausible::LOAD_BASIS,
+            );
+        }
+        s.data = steps;
+        Ok(s)
+    }
+    fn apply(
+        &self,
+        s: &FitSetup,
+        p: &[f64],
+        d: &Prepared,
+        _n: &MachineConstants,
+        terms: &mut EffectTerms,
+    ) {
+        let mut seg = 0usize;
+        let load: Vec<f64> = d
+            .t_s
+            .iter()
+            .map(|&t| {
+                while seg + 1 < s.data.len() && t >= s.data[seg + 1] {
+                    seg += 1;
+                }
+                p.get(seg).copied().unwrap_or(0.0)
+            })
+            .collect();
+        if terms.load_nm.len() == load.len() {
+            for (a, b) in terms.load_nm.iter_mut().zip(load) {
+                *a += b;
+            }
+        } else {
+            terms.load_nm = load;
+        }
+    }
+    fn describe(&self, s: &FitSetup, p: &[f64], _d: &Prepared, _n: &MachineConstants) -> String {
+        let parts: Vec<String> = s
+            .data
+            .iter()
+            .zip(p)
+            .map(|(t, v)| format!("{v:.2} N m from {t:.2} s"))
+            .collect();
+        format!(
+            "load behaves as a torque input (on top of the refitted viscous term): {}",
+            parts.join(", ")
+        )
+    }
+}
