@@ -332,6 +332,18 @@ fn hidden_effects_under_transients_probe() {
     }
 }
 
+/// All four states of the full-order machine dynamic, with the true La and Lr/Rr of `m`.
+fn full_order_dynamics(
+    m: &monitor_core::MotorModel<f64>,
+) -> sim_host::analysis::simplified_model::Dynamics {
+    sim_host::analysis::simplified_model::Dynamics {
+        stator_current_la_h: Some(m.la_h()),
+        rotor_flux_tau_s: Some(m.lr_h / m.rr_ohm),
+        stator_d_axis: true,
+        rotor_flux_q_axis: true,
+    }
+}
+
 /// The full-order model with the true parameters (no fit) against effect-free logs of
 /// [`transients`] with ideal sensors: what is left is the analysis's own reconstruction
 /// of the working series (frame, sequence separation, block means, where a step fell),
@@ -355,11 +367,8 @@ fn full_order_model_reproduces_the_simulator() {
         s.sensors = sim_host::sim::SensorSpec::ideal();
         let log = write_log(dir.path(), &format!("ideal_{which}_{rate}"), &p, &s, false);
         let a = analyse(&log, &p, 0.0);
-        let terms = sm::EffectTerms {
-            tau_r_s: Some(m.lr_h / m.rr_ohm),
-            la_h: Some(m.la_h()),
-            d_axis: true,
-            cross_coupling: true,
+        let terms = sm::ModelTerms {
+            dynamics: full_order_dynamics(&m),
             ..Default::default()
         };
         let n = &a.constants;
@@ -373,7 +382,7 @@ fn full_order_model_reproduces_the_simulator() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-/// The full-order model's own saturation (`EffectTerms::sat`, the simulator's law on
+/// The full-order model's own saturation (`ModelTerms::magnetising.law`, the simulator's law on
 /// the model's magnetising flux) with the true parameters and the simulator's default law
 /// (psi_sat = 1.3 x the rated flux, n = 6), no fit, against ideal-sensor logs of
 /// [`transients`] with `saturation` injected: at the reconstruction floor of the
@@ -397,12 +406,15 @@ fn saturated_full_order_model_reproduces_the_simulator() {
         let psi_sat = 1.3 * p.supply.v_phase_peak() / p.supply.omega_rad_s();
         let mut e = [0.0; 2];
         for (sat, e) in [None, Some((psi_sat, 6.0))].into_iter().zip(&mut e) {
-            let terms = sm::EffectTerms {
-                tau_r_s: Some(m.lr_h / m.rr_ohm),
-                la_h: Some(m.la_h()),
-                d_axis: true,
-                cross_coupling: true,
-                sat,
+            let terms = sm::ModelTerms {
+                dynamics: full_order_dynamics(&m),
+                magnetising: sm::Magnetising {
+                    law: sat.map(|(psi_sat_wb, exponent)| sm::SaturationLaw {
+                        psi_sat_wb,
+                        exponent,
+                    }),
+                    ..Default::default()
+                },
                 ..Default::default()
             };
             let n = &a.constants;

@@ -8,7 +8,7 @@ use super::prep::Prepared;
 use super::simplified_model::{BaseParams, Prediction};
 use super::transients;
 use super::unbalance::UnbalanceAnalysis;
-use super::{align, needs_ok, resolve, Analysis, AnalysisError, DataInfo, Options, ParamValue};
+use super::{align, resolve, Analysis, AnalysisError, DataInfo, Options, ParamValue};
 use monitor_core::EffectKind;
 use serde::Serialize;
 
@@ -398,10 +398,12 @@ impl Analysis {
         if let Some(m) = self.not_dynamic(c, base) {
             return Some(m);
         }
-        if let Err(m) = needs_ok(c.needs(), &self.data) {
-            return Some(m);
+        if let Err(m) = c.needs().met_by(&self.data) {
+            return Some(m.to_string());
         }
-        c.setup(&base.fit_series, &self.constants).err()
+        c.setup(&base.fit_series, &self.constants)
+            .err()
+            .map(|m| m.to_string())
     }
 
     /// Why a dynamics effect (one that declares a time constant,
@@ -441,7 +443,7 @@ impl Analysis {
     ) -> Option<RankedCandidate> {
         let d = &self.data;
         let fd = &base.fit_series;
-        needs_ok(c.needs(), d).ok()?;
+        c.needs().met_by(d).ok()?;
         if missing_requirement(c, base).is_some() || self.not_dynamic(c, base).is_some() {
             return None;
         }
@@ -452,9 +454,7 @@ impl Analysis {
             .zip(&base.fit.effect_params)
             .map(|(a, p)| {
                 let mut s = a.setup.clone();
-                if s.init.len() == p.len() {
-                    s.init = p.clone();
-                }
+                s.start_from(p);
                 ActiveEffect {
                     effect: a.effect,
                     setup: s,
@@ -462,7 +462,7 @@ impl Analysis {
             })
             .collect();
         let s = c.setup(fd, &self.constants).ok()?;
-        let np = s.init.len();
+        let np = s.len();
         set.push(ActiveEffect {
             effect: c,
             setup: s,

@@ -48,7 +48,7 @@ pub mod simplified_model;
 pub mod transients;
 pub mod unbalance;
 
-use effects::{EffectModel, Needs};
+use effects::EffectModel;
 use fit::{ActiveEffect, FitResult};
 use metrics::Weights;
 use monitor_core::EffectKind;
@@ -72,9 +72,15 @@ pub enum AnalysisError {
     /// Unknown effect name.
     #[error("unknown effect '{0}' (known: {known})", known = known_effects())]
     UnknownEffect(String),
-    /// The log lacks what an analysis needs.
-    #[error("{0}")]
-    Missing(String),
+    /// A configured effect cannot be set up on the log (a channel it needs is missing, or
+    /// the log holds nothing it could fit).
+    #[error("effect {effect}: {source}")]
+    Effect {
+        /// Which effect.
+        effect: EffectKind,
+        /// Why not.
+        source: effects::SetupError,
+    },
 }
 
 /// The library's effect names, comma separated (for messages).
@@ -212,18 +218,6 @@ fn resolve(kinds: &[EffectKind]) -> Vec<Box<dyn EffectModel>> {
         }
     }
     v
-}
-
-fn needs_ok(n: Needs, d: &Prepared) -> Result<(), String> {
-    if n.voltages && !d.channels.voltages {
-        return Err(
-            "needs the voltage columns va_V, vb_V, vc_V (the model is driven by V_qs)".into(),
-        );
-    }
-    if n.speed && !d.channels.speed {
-        return Err("needs the speed column wm_rad_s".into());
-    }
-    Ok(())
 }
 
 /// Block-averages a working series by `m` (for fitting long logs).
@@ -379,11 +373,14 @@ impl Analysis {
     ) -> Result<Vec<ActiveEffect<'a>>, AnalysisError> {
         let mut v = Vec::new();
         for e in list {
-            needs_ok(e.needs(), d)
-                .map_err(|m| AnalysisError::Missing(format!("effect {}: {m}", e.kind())))?;
             let setup = e
-                .setup(d, &self.constants)
-                .map_err(|m| AnalysisError::Missing(format!("effect {}: {m}", e.kind())))?;
+                .needs()
+                .met_by(d)
+                .and_then(|()| e.setup(d, &self.constants))
+                .map_err(|source| AnalysisError::Effect {
+                    effect: e.kind(),
+                    source,
+                })?;
             v.push(ActiveEffect {
                 effect: e.as_ref(),
                 setup,
@@ -422,20 +419,16 @@ impl Analysis {
                     effect: a.effect.kind(),
                     parameters: a
                         .setup
-                        .names
+                        .params
                         .iter()
-                        .zip(&a.setup.units)
                         .zip(p)
-                        .map(|((n, u), v)| {
-                            let reason = why
-                                .iter()
-                                .find(|w| w.starts_with(&format!("{n} =")))
-                                .cloned();
+                        .map(|(q, v)| {
+                            let reason = q.implausible_because(*v);
                             (
-                                n.clone(),
+                                q.name.clone(),
                                 ParamValue {
                                     value: *v,
-                                    unit: u.to_string(),
+                                    unit: q.unit.to_string(),
                                     nominal: None,
                                     plausible: reason.is_none(),
                                     implausible_because: reason,
@@ -443,7 +436,7 @@ impl Analysis {
                             )
                         })
                         .collect(),
-                    summary: a.effect.describe(&a.setup, p, &self.data, &self.constants),
+                    summary: a.setup.describe(p, &self.data, &self.constants),
                     plausible: why.is_empty(),
                     implausible_because: why,
                 }
@@ -490,8 +483,8 @@ impl Analysis {
 /// full series; then the set-up's initial values stand).
 fn align(active: &[ActiveEffect<'_>], mut f: FitResult) -> FitResult {
     for (a, p) in active.iter().zip(f.effect_params.iter_mut()) {
-        if p.len() != a.setup.init.len() {
-            *p = a.setup.init.clone();
+        if p.len() != a.setup.len() {
+            *p = a.setup.init();
         }
     }
     f

@@ -1,38 +1,9 @@
-//! `rotor_asymmetry`: an unequal rotor cage (broken rotor bars, cracked end ring), the
-//! library effect for `compare` / `explain`, and the motor current signature analysis
-//! (MCSA) report users of that fault expect: the (1 - 2s) f and (1 + 2s) f sidebands of the
-//! stator current in dB below the fundamental and the 2 s f speed ripple.
+//! `rotor_asymmetry` (an unequal rotor cage: broken rotor bars, a cracked end ring): the
+//! motor current signature analysis (MCSA) report users of that fault expect: the
+//! (1 - 2s) f and (1 + 2s) f sidebands of the stator current in dB below the fundamental
+//! and the 2 s f speed ripple.
 //!
-//! # Model (the simplified model's view of the simulator's full-order asymmetry)
-//! The simulator gives rotor phase a the resistance Rr (1 + delta) (`crate::sim`); in
-//! alpha-beta that is R_r = Rr I + (2/3) Rr delta u u^T, u along rotor phase a. In the
-//! rotor-flux frame of the analysis the rotor current is along q (i_rq = -(Lm/Lr) I_qs), so
-//! the slip equation sees the q-q element of R_r:
-//! ```text
-//!   R_qq / Rr = 1 + (2/3) delta sin^2(g) = 1 + (delta/3) (1 - cos(2 g)),
-//!   g = Np theta_m - theta + phi/2   (rotor phase a against the flux's d axis)
-//! ```
-//! Np theta_m is the integral of the measured electrical speed, theta the analysis frame's
-//! angle, phi the unknown angle of the faulty phase (fitted). The rotor resistance term of
-//! Ra = Rs + (Ls/Lr) Rr is multiplied by R_qq / Rr: the q current and the torque are then
-//! modulated at 2 s f in the rotor-flux frame, which in the stator frame is the (1 - 2s) f
-//! sideband, and the 2 s f torque ripple moves the speed, which makes the (1 + 2s) f one.
-//! The d row drives the rotor flux phi = psi_r/Lm (exact rotor equation, first order in
-//! delta): `tau_r dphi/dt = I_ds - phi + (delta/3) [sin(2g) I_qs + (1 + cos(2g)) (I_ds - phi)]`.
-//! The second part matters although it looks second order: in a voltage-fed machine the
-//! rotor flux barely ripples (0.3 % of I_ds on the 3 hp motor at delta 0.2, against an
-//! I_ds ripple of 6 %), the drive and the I_ds ripple nearly cancel, and the flux's error
-//! reaches I_qs with a gain omega (Lm^2/Lr)/Ra of about 18. I_ds - phi is taken as the
-//! measured I_ds ripple (phi's own is a tenth of it), and the flux starts in its periodic
-//! response to the drive ([`EffectTerms::phi_drive_start`]; started from I_ds it rings for
-//! a rotor time constant, which a fit "explains" with a 4x shorter one). Approximations:
-//! the q row's sin(2g)(I_ds - phi) term (DC and 4 s f only) is left out, and without
-//! `flux_dynamics` the model's flux follows the smoothed I_ds at once, which makes the
-//! fitted delta about 2x the truth (README, "Broken rotor bars").
-//!
-//! With all four dynamics effects in the model, the full-order model carries the whole
-//! resistance matrix in its rotor flux equation (`simplified_model`'s `CageAsymmetry`,
-//! [`EffectTerms::rotor_asym`]), with the same (delta, phi); the terms above are then unused.
+//! The effect model itself (`compare` / `explain`) is `super::effects`' `RotorAsymmetry`.
 //!
 //! # Broken bars
 //! For an N-bar cage with n adjacent broken bars the equivalent rotor phase resistance

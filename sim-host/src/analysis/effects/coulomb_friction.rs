@@ -1,13 +1,32 @@
 //! `coulomb_friction`: dry friction.
 
-use super::{plausible, Confusion};
-use super::{EffectModel, FitSetup, ParamSpec};
+use super::SetupError;
+use super::{plausible, Confusion, Contribution, EffectModel, FitParam, FitSetup, ParamSpec};
 use crate::analysis::prep::Prepared;
-use crate::analysis::simplified_model::{EffectTerms, MachineConstants};
+use crate::analysis::simplified_model::{MachineConstants, ModelTerms, SpeedTorque};
 use monitor_core::EffectKind;
 
 /// Dry friction.
+#[derive(Debug, Clone, Copy)]
 pub struct CoulombFriction;
+
+/// A dry friction torque `Tc tanh(w_m / 1 rad/s)` on the shaft.
+#[derive(Debug, Clone, Copy)]
+struct DryFriction {
+    /// Tc [N m].
+    torque_nm: f64,
+}
+
+impl SpeedTorque for DryFriction {
+    fn torque_nm(&self, wm_rad_s: f64) -> f64 {
+        // (No tanh when there is no dry friction: 0 x tanh(w) is 0.)
+        if self.torque_nm != 0.0 {
+            self.torque_nm * (wm_rad_s / 1.0).tanh()
+        } else {
+            0.0
+        }
+    }
+}
 
 impl EffectModel for CoulombFriction {
     fn kind(&self) -> EffectKind {
@@ -32,32 +51,31 @@ impl EffectModel for CoulombFriction {
             description: "dry friction torque Tc",
         }]
     }
-    fn setup(&self, _d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String> {
+    fn setup(&self, _d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let t = n.torque_scale_nm;
-        let mut s = FitSetup::default();
-        s.push("torque_nm", "N m", 0.01 * t, -0.1 * t, t, 0.05 * t);
-        s.range(
-            plausible::COULOMB_RATIO.0 * t,
-            plausible::COULOMB_RATIO.1 * t,
-            plausible::COULOMB_BASIS,
-        );
-        Ok(s)
+        let r = plausible::COULOMB_RATIO;
+        Ok(FitSetup::new(*self).param(
+            FitParam::new("torque_nm", "N m", 0.01 * t, (-0.1 * t, t), 0.05 * t)
+                .physical((r.0 * t, r.1 * t), plausible::COULOMB_BASIS),
+        ))
     }
-    fn apply(
-        &self,
-        _s: &FitSetup,
-        p: &[f64],
-        _d: &Prepared,
-        _n: &MachineConstants,
-        terms: &mut EffectTerms,
-    ) {
-        terms.coulomb_nm = p[0];
+}
+
+impl Contribution for CoulombFriction {
+    /// The friction torque on the shaft.
+    fn contribute(&self, p: &[f64], _d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
+        if let &[torque_nm] = p {
+            t.add_speed_torque(DryFriction { torque_nm });
+        }
     }
-    fn describe(&self, _s: &FitSetup, p: &[f64], _d: &Prepared, n: &MachineConstants) -> String {
+    fn describe(&self, p: &[f64], _d: &Prepared, n: &MachineConstants) -> String {
+        let &[tc] = p else {
+            return String::new();
+        };
         format!(
             "constant friction torque of about {:.2} N m ({:.1} % of the rated torque estimate {:.1} N m), independent of speed",
-            p[0],
-            100.0 * p[0] / n.torque_scale_nm,
+            tc,
+            100.0 * tc / n.torque_scale_nm,
             n.torque_scale_nm
         )
     }

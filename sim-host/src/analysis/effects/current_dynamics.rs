@@ -1,12 +1,12 @@
 //! `current_dynamics`: the stator current transient (La dI/dt).
 
-use super::plausible;
-use super::{EffectModel, FitSetup, ParamSpec};
+use super::{dynamics_param, Contribution, EffectModel, FitSetup, ParamSpec, SetupError};
 use crate::analysis::prep::Prepared;
-use crate::analysis::simplified_model::{EffectTerms, MachineConstants};
+use crate::analysis::simplified_model::{MachineConstants, ModelTerms};
 use monitor_core::EffectKind;
 
 /// Stator current transient (La dI/dt).
+#[derive(Debug, Clone, Copy)]
 pub struct CurrentDynamics;
 
 impl EffectModel for CurrentDynamics {
@@ -29,40 +29,27 @@ impl EffectModel for CurrentDynamics {
             description: "transient inductance La = sigma Ls",
         }]
     }
-    fn setup(&self, _d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String> {
-        let mut s = FitSetup::default();
-        s.push(
-            "la_h",
-            "H",
-            n.la_h,
-            0.3 * n.la_h,
-            3.0 * n.la_h,
-            0.2 * n.la_h,
-        );
-        s.range(
-            plausible::DYNAMICS_RATIO.0 * n.la_h,
-            plausible::DYNAMICS_RATIO.1 * n.la_h,
-            plausible::DYNAMICS_BASIS,
-        );
-        s.data.push(n.la_h);
-        Ok(s)
+    fn setup(&self, _d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
+        Ok(FitSetup::new(*self).param(dynamics_param("la_h", "H", n.la_h)))
     }
-    fn apply(
-        &self,
-        _s: &FitSetup,
-        p: &[f64],
-        _d: &Prepared,
-        _n: &MachineConstants,
-        terms: &mut EffectTerms,
-    ) {
-        terms.la_h = Some(p[0]);
+}
+
+impl Contribution for CurrentDynamics {
+    /// The stator current's derivative term with the fitted La.
+    fn contribute(&self, p: &[f64], _d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
+        if let &[la_h] = p {
+            t.dynamics.stator_current_la_h = Some(la_h);
+        }
     }
-    fn describe(&self, s: &FitSetup, p: &[f64], _d: &Prepared, n: &MachineConstants) -> String {
+    fn describe(&self, p: &[f64], _d: &Prepared, n: &MachineConstants) -> String {
+        let &[la_h] = p else {
+            return String::new();
+        };
         format!(
             "stator current lags voltage changes: La = {:.1} mH (nominal sigma Ls = {:.1} mH), electrical time constant about {:.1} ms",
-            1000.0 * p[0],
-            1000.0 * s.data.first().copied().unwrap_or(0.0),
-            1000.0 * p[0] / n.ra_ohm
+            1000.0 * la_h,
+            1000.0 * n.la_h,
+            1000.0 * la_h / n.ra_ohm
         )
     }
 }

@@ -1,12 +1,12 @@
 //! `flux_dynamics`: the rotor flux is not constant.
 
-use super::plausible;
-use super::{EffectModel, FitSetup, ParamSpec};
+use super::{dynamics_param, Contribution, EffectModel, FitSetup, ParamSpec, SetupError};
 use crate::analysis::prep::Prepared;
-use crate::analysis::simplified_model::{EffectTerms, MachineConstants};
+use crate::analysis::simplified_model::{MachineConstants, ModelTerms};
 use monitor_core::EffectKind;
 
 /// Rotor flux not constant.
+#[derive(Debug, Clone, Copy)]
 pub struct FluxDynamics;
 
 impl EffectModel for FluxDynamics {
@@ -29,33 +29,26 @@ impl EffectModel for FluxDynamics {
             description: "rotor time constant Lr/Rr",
         }]
     }
-    fn setup(&self, _d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String> {
-        let tau = n.lr_h / n.rr_ohm;
-        let mut s = FitSetup::default();
-        s.push("tau_r_s", "s", tau, 0.3 * tau, 3.0 * tau, 0.2 * tau);
-        s.range(
-            plausible::DYNAMICS_RATIO.0 * tau,
-            plausible::DYNAMICS_RATIO.1 * tau,
-            plausible::DYNAMICS_BASIS,
-        );
-        s.data.push(tau);
-        Ok(s)
+    fn setup(&self, _d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
+        Ok(FitSetup::new(*self).param(dynamics_param("tau_r_s", "s", n.lr_h / n.rr_ohm)))
     }
-    fn apply(
-        &self,
-        _s: &FitSetup,
-        p: &[f64],
-        _d: &Prepared,
-        _n: &MachineConstants,
-        terms: &mut EffectTerms,
-    ) {
-        terms.tau_r_s = Some(p[0]);
+}
+
+impl Contribution for FluxDynamics {
+    /// The rotor flux's dynamics with the fitted rotor time constant.
+    fn contribute(&self, p: &[f64], _d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
+        if let &[tau_r_s] = p {
+            t.dynamics.rotor_flux_tau_s = Some(tau_r_s);
+        }
     }
-    fn describe(&self, s: &FitSetup, p: &[f64], _d: &Prepared, _n: &MachineConstants) -> String {
+    fn describe(&self, p: &[f64], _d: &Prepared, n: &MachineConstants) -> String {
+        let &[tau_r_s] = p else {
+            return String::new();
+        };
         format!(
             "rotor flux lags the magnetising current with a rotor time constant of {:.0} ms (nominal Lr/Rr = {:.0} ms): the model's constant-flux assumption fails in transients",
-            1000.0 * p[0],
-            1000.0 * s.data.first().copied().unwrap_or(0.0)
+            1000.0 * tau_r_s,
+            1000.0 * (n.lr_h / n.rr_ohm)
         )
     }
 }

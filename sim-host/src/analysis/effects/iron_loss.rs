@@ -1,13 +1,21 @@
 //! `iron_loss`: core loss.
 
-use super::{plausible, rated_flux_wb, sync_speed_mech};
-use super::{EffectModel, FitSetup, ParamSpec};
+use super::{plausible, rated_flux_wb, sync_speed_mech, Contribution, EffectModel, FitParam};
+use super::{FitSetup, ParamSpec, SetupError};
 use crate::analysis::prep::Prepared;
-use crate::analysis::simplified_model::{EffectTerms, MachineConstants};
+use crate::analysis::simplified_model::{MachineConstants, ModelTerms};
 use monitor_core::EffectKind;
 
 /// Core loss.
+#[derive(Debug, Clone, Copy)]
 pub struct IronLoss;
+
+/// Iron loss set up on a log: the magnetising reactance at the log's highest supply
+/// frequency.
+struct OnLog {
+    /// Xm [ohm].
+    xm_ohm: f64,
+}
 
 impl EffectModel for IronLoss {
     fn kind(&self) -> EffectKind {
@@ -26,48 +34,47 @@ impl EffectModel for IronLoss {
             description: "core-loss conductance 1/Rfe",
         }]
     }
-    fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String> {
+    fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let w = sync_speed_mech(d, n) * n.np;
         let xm = w * n.lm_h;
-        let mut s = FitSetup::default();
-        s.push(
-            "g_fe_s",
-            "S",
-            1.0 / (100.0 * xm),
-            -0.2 / xm,
-            1.0 / xm,
-            0.02 / xm,
-        );
-        s.range(
-            -0.01 / xm,
-            1.0 / (plausible::RFE_OVER_XM_MIN * xm),
-            plausible::G_FE_BASIS,
-        );
-        s.data.push(xm);
-        Ok(s)
+        Ok(FitSetup::new(OnLog { xm_ohm: xm }).param(
+            FitParam::new(
+                "g_fe_s",
+                "S",
+                1.0 / (100.0 * xm),
+                (-0.2 / xm, 1.0 / xm),
+                0.02 / xm,
+            )
+            .physical(
+                (-0.01 / xm, 1.0 / (plausible::RFE_OVER_XM_MIN * xm)),
+                plausible::G_FE_BASIS,
+            ),
+        ))
     }
-    fn apply(
-        &self,
-        _s: &FitSetup,
-        p: &[f64],
-        _d: &Prepared,
-        _n: &MachineConstants,
-        terms: &mut EffectTerms,
-    ) {
-        terms.g_fe_s = p[0];
+}
+
+impl Contribution for OnLog {
+    /// The core-loss conductance.
+    fn contribute(&self, p: &[f64], _d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
+        if let &[g_fe_s] = p {
+            t.magnetising.core_loss_s += g_fe_s;
+        }
     }
-    fn describe(&self, s: &FitSetup, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
-        let xm = s.data.first().copied().unwrap_or(1.0);
+    fn describe(&self, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
+        let &[g] = p else {
+            return String::new();
+        };
+        let xm = self.xm_ohm;
         let psi = rated_flux_wb(d);
         let w = sync_speed_mech(d, n) * n.np;
-        let p_fe = 1.5 * (w * psi).powi(2) * p[0];
-        if p[0] <= 0.0 {
+        let p_fe = 1.5 * (w * psi).powi(2) * g;
+        if g <= 0.0 {
             return "no core loss found (fitted conductance not positive)".into();
         }
         format!(
             "core loss resistance Rfe about {:.0} ohm ({:.0} x Xm), about {:.0} W of iron loss at the highest supply frequency of the log",
-            1.0 / p[0],
-            1.0 / (p[0] * xm),
+            1.0 / g,
+            1.0 / (g * xm),
             p_fe
         )
     }

@@ -1,24 +1,28 @@
 //! `load_torque`: the load as a torque input.
 
-use super::{plausible, Confusion, Evidence, Needs, LOAD_STEP_MIN};
-use super::{EffectModel, FitSetup, ParamSpec};
+use super::{plausible, Confusion, Contribution, EffectModel, Evidence, FitParam, FitSetup};
+use super::{Needs, ParamSpec, SetupError, LOAD_STEP_MIN};
 use crate::analysis::prep::Prepared;
-use crate::analysis::simplified_model::{EffectTerms, MachineConstants};
+use crate::analysis::simplified_model::{MachineConstants, ModelTerms};
 use monitor_core::EffectKind;
 
 /// Load as a torque input.
+#[derive(Debug, Clone, Copy)]
 pub struct LoadTorque;
 
-/// Torque observer: Te(measured I_qs, i_f) - J dw_m/dt, low-passed at 10 Hz, then with
-/// the best viscous line c1 w_m (through the origin) removed, segmented into constant levels by binary
-/// segmentation (minimum segment 0.1 s or 5 % of the log; a split must move the level by
-/// more than 3 % of the rated torque estimate, and the supply must hold still around it).
-/// Returns (segment start time, observer level) pairs, flattened.
-fn load_steps(d: &Prepared, n: &MachineConstants) -> Vec<f64> {
+/// A constant level of the torque observer: from `from_s` [s] on, `level_nm` [N m].
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Segment {
+    from_s: f64,
+    level_nm: f64,
+}
+
+/// The torque observer's series: Te(measured I_qs, i_f) - J dw_m/dt, low-passed at 10 Hz
+/// (two first-order passes), less the best viscous line c1 w_m through the origin (the
+/// paper's Bl omega; what is left is load torque the viscous model cannot describe), as
+/// a cumulative sum (length len + 1) for the segments' means.
+fn observer_cumsum(d: &Prepared, n: &MachineConstants) -> Vec<f64> {
     let len = d.len();
-    if d.omega_r.len() != len || len < 20 {
-        return vec![];
-    }
     let dt = d.dt_s;
     let lmr = n.lm_h * n.lm_h / n.lr_h;
     let mut obs = Vec::with_capacity(len);
@@ -42,47 +46,77 @@ fn load_steps(d: &Prepared, n: &MachineConstants) -> Vec<f64> {
         s2 += a * (s1 - s2);
         obs.push(s2);
     }
-    // Remove the best viscous line through the origin (the paper's Bl*omega): what is
-    // left is load torque the viscous model cannot describe.
     let (sww, swx) = obs.iter().enumerate().fold((0.0, 0.0), |acc, (k, x)| {
         let w = w_at(k);
         (acc.0 + w * w, acc.1 + w * x)
     });
     let c1 = if sww > 0.0 { swx / sww } else { 0.0 };
-    let min_len = ((0.1 / dt) as usize).max(len / 10).max(2);
-    let thresh = 0.03 * n.torque_scale_nm;
-    // Cumulative sum of the residual torque obs - c1 w_m.
     let mut cum = vec![0.0; len + 1];
     for k in 0..len {
         cum[k + 1] = cum[k] + (obs[k] - c1 * w_at(k));
     }
-    drop(obs);
-    let mean = |a: usize, b: usize| (cum[b] - cum[a]) / (b - a) as f64;
-    // A load step is a torque change while the supply holds still: splits where the supply
-    // frequency or voltage moves by more than 1 % within +/- half a minimum segment are
-    // refused (speed sweeps change the friction torque, not the load).
-    let cum_of = |x: &dyn Fn(usize) -> f64| {
-        let mut c = vec![0.0; len + 1];
-        for k in 0..len {
-            c[k + 1] = c[k] + x(k);
+    cum
+}
+
+/// Whether the supply holds still around each split candidate: a load step is a torque
+/// change while the supply holds still, so splits where the supply frequency or voltage
+/// moves by more than 1 % within +/- `half` samples are refused (speed sweeps change the
+/// friction torque, not the load).
+struct SupplySteady {
+    /// Cumulative sums of omega_s and |V| (length len + 1).
+    cw: Vec<f64>,
+    cv: Vec<f64>,
+    half: usize,
+}
+
+impl SupplySteady {
+    fn new(d: &Prepared, half: usize) -> Self {
+        let len = d.len();
+        let cum_of = |x: &dyn Fn(usize) -> f64| {
+            let mut c = vec![0.0; len + 1];
+            for k in 0..len {
+                c[k + 1] = c[k] + x(k);
+            }
+            c
+        };
+        SupplySteady {
+            cw: cum_of(&|k| d.omega_s[k]),
+            cv: cum_of(&|k| d.vq[k].hypot(d.vd[k])),
+            half,
         }
-        c
-    };
-    let cw = cum_of(&|k| d.omega_s[k]);
-    let cv = cum_of(&|k| d.vq[k].hypot(d.vd[k]));
-    let half = (min_len / 2).max(1);
-    let supply_steady = |kk: usize| {
-        let a = kk.saturating_sub(half);
-        let b = (kk + half).min(len);
+    }
+
+    /// True when the supply holds still around sample `kk`.
+    fn at(&self, kk: usize) -> bool {
+        let len = self.cw.len() - 1;
+        let a = kk.saturating_sub(self.half);
+        let b = (kk + self.half).min(len);
         if kk <= a || b <= kk {
             return true;
         }
         let m = |c: &[f64], x: usize, y: usize| (c[y] - c[x]) / (y - x) as f64;
-        let (w1, w2) = (m(&cw, a, kk), m(&cw, kk, b));
-        let (v1, v2) = (m(&cv, a, kk), m(&cv, kk, b));
+        let (w1, w2) = (m(&self.cw, a, kk), m(&self.cw, kk, b));
+        let (v1, v2) = (m(&self.cv, a, kk), m(&self.cv, kk, b));
         (w1 - w2).abs() <= 0.01 * w1.abs().max(w2.abs()).max(1e-9)
             && (v1 - v2).abs() <= 0.01 * v1.abs().max(v2.abs()).max(1e-9)
-    };
+    }
+}
+
+/// Torque observer ([`observer_cumsum`]) segmented into constant levels by binary
+/// segmentation (at most 6 splits; minimum segment 0.1 s or 10 % of the log; a split must
+/// move the level by more than 3 % of the rated torque estimate, and the supply must hold
+/// still around it, [`SupplySteady`]). Returns the segments in time order (empty without
+/// a speed column or on fewer than 20 samples).
+fn load_steps(d: &Prepared, n: &MachineConstants) -> Vec<Segment> {
+    let len = d.len();
+    if d.omega_r.len() != len || len < 20 {
+        return vec![];
+    }
+    let cum = observer_cumsum(d, n);
+    let mean = |a: usize, b: usize| (cum[b] - cum[a]) / (b - a) as f64;
+    let min_len = ((0.1 / d.dt_s) as usize).max(len / 10).max(2);
+    let thresh = 0.03 * n.torque_scale_nm;
+    let steady = SupplySteady::new(d, (min_len / 2).max(1));
     let mut segs = vec![(0usize, len)];
     for _ in 0..6 {
         let mut best: Option<(usize, usize, f64)> = None;
@@ -98,25 +132,29 @@ fn load_steps(d: &Prepared, n: &MachineConstants) -> Vec<f64> {
                 let gain = (ml - mr).powi(2) * ((kk - a0) * (b0 - kk)) as f64 / (b0 - a0) as f64;
                 if (ml - mr).abs() > thresh
                     && best.map(|b| gain > b.2).unwrap_or(true)
-                    && supply_steady(kk)
+                    && steady.at(kk)
                 {
                     best = Some((si, kk, gain));
                 }
                 kk += step;
             }
         }
-        match best {
-            Some((si, kk, _)) => {
-                let (a0, b0) = segs[si];
-                segs[si] = (a0, kk);
-                segs.insert(si + 1, (kk, b0));
-            }
-            None => break,
-        }
+        let Some((si, kk, _)) = best else { break };
+        let (a0, b0) = segs[si];
+        segs[si] = (a0, kk);
+        segs.insert(si + 1, (kk, b0));
     }
     segs.iter()
-        .flat_map(|&(a0, b0)| [d.t_s[a0], mean(a0, b0)])
+        .map(|&(a0, b0)| Segment {
+            from_s: d.t_s[a0],
+            level_nm: mean(a0, b0),
+        })
         .collect()
+}
+
+/// Load torque set up on a log: the times the segments start [s].
+struct Steps {
+    from_s: Vec<f64>,
 }
 
 impl EffectModel for LoadTorque {
@@ -149,75 +187,55 @@ impl EffectModel for LoadTorque {
         }]
     }
     fn needs(&self) -> Needs {
-        Needs {
-            voltages: true,
-            speed: true,
-        }
+        Needs::VOLTAGES_AND_SPEED
     }
-    fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String> {
+    fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
         if d.omega_r.is_empty() {
-            return Err(
-                "needs the speed column wm_rad_s (the torque observer uses the measured speed)"
-                    .into(),
-            );
+            return Err(SetupError::NoSpeed {
+                because: "the torque observer uses the measured speed",
+            });
         }
-        let pairs = load_steps(d, n);
-        let steps: Vec<f64> = pairs.iter().step_by(2).copied().collect();
-        let levels: Vec<f64> = pairs.iter().skip(1).step_by(2).copied().collect();
-        if steps.len() < 2 {
-            return Err("no change of load torque found in the log: a constant load torque is the same equation as coulomb_friction at positive speed, so it is left to that effect".into());
+        let segments = load_steps(d, n);
+        if segments.len() < 2 {
+            return Err(SetupError::NothingToFit("no change of load torque found in the log: a constant load torque is the same equation as coulomb_friction at positive speed, so it is left to that effect"));
         }
         let t = n.torque_scale_nm;
-        let mut s = FitSetup::default();
+        let r = plausible::LOAD_RATIO;
+        let from_s = segments.iter().map(|s| s.from_s).collect();
         // Initial levels: the observer's mean torque beyond the viscous line per segment.
-        for (k, (&ts, &lv)) in steps.iter().zip(&levels).enumerate() {
-            s.push(
-                &format!("level_{}_from_{:.2}_s", k + 1, ts),
-                "N m",
-                lv.clamp(-3.0 * t, 3.0 * t),
-                -3.0 * t,
-                3.0 * t,
-                0.2 * t,
-            );
-            s.range(
-                plausible::LOAD_RATIO.0 * t,
-                plausible::LOAD_RATIO.1 * t,
-                plausible::LOAD_BASIS,
-            );
-        }
-        s.data = steps;
-        Ok(s)
-    }
-    fn apply(
-        &self,
-        s: &FitSetup,
-        p: &[f64],
-        d: &Prepared,
-        _n: &MachineConstants,
-        terms: &mut EffectTerms,
-    ) {
-        let mut seg = 0usize;
-        let load: Vec<f64> = d
-            .t_s
+        Ok(segments
             .iter()
-            .map(|&t| {
-                while seg + 1 < s.data.len() && t >= s.data[seg + 1] {
-                    seg += 1;
-                }
-                p.get(seg).copied().unwrap_or(0.0)
-            })
-            .collect();
-        if terms.load_nm.len() == load.len() {
-            for (a, b) in terms.load_nm.iter_mut().zip(load) {
-                *a += b;
-            }
-        } else {
-            terms.load_nm = load;
-        }
+            .enumerate()
+            .fold(FitSetup::new(Steps { from_s }), |s, (k, seg)| {
+                s.param(
+                    FitParam::new(
+                        format!("level_{}_from_{:.2}_s", k + 1, seg.from_s),
+                        "N m",
+                        seg.level_nm.clamp(-3.0 * t, 3.0 * t),
+                        (-3.0 * t, 3.0 * t),
+                        0.2 * t,
+                    )
+                    .physical((r.0 * t, r.1 * t), plausible::LOAD_BASIS),
+                )
+            }))
     }
-    fn describe(&self, s: &FitSetup, p: &[f64], _d: &Prepared, _n: &MachineConstants) -> String {
-        let parts: Vec<String> = s
-            .data
+}
+
+impl Contribution for Steps {
+    /// The piecewise-constant load torque per sample.
+    fn contribute(&self, p: &[f64], d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
+        let from = &self.from_s;
+        let mut seg = 0usize;
+        t.add_load_torque(d.t_s.iter().map(|&t| {
+            while seg + 1 < from.len() && t >= from[seg + 1] {
+                seg += 1;
+            }
+            p.get(seg).copied().unwrap_or(0.0)
+        }));
+    }
+    fn describe(&self, p: &[f64], _d: &Prepared, _n: &MachineConstants) -> String {
+        let parts: Vec<String> = self
+            .from_s
             .iter()
             .zip(p)
             .map(|(t, v)| format!("{v:.2} N m from {t:.2} s"))

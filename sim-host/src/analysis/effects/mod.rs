@@ -1,25 +1,31 @@
 //! The effect library: named physical effects the simplified model can be extended with.
 //!
-//! Every effect implements [`EffectModel`]: which [`EffectKind`] it is (its DESIGN.md
-//! name), a physical description, its parameters with units, the way it changes the model
-//! equations (in words and in code: [`EffectModel::apply`] writes its contribution into
-//! [`EffectTerms`]) and a sentence a drives engineer understands for fitted values
-//! ([`EffectModel::describe`]). [`model_of`] gives the model of a kind. (The simulator
-//! injects the same effects with `crate::sim::EffectSpec`.)
+//! Every effect implements [`EffectModel`]: which [`EffectKind`] it is (its name in the
+//! JSON documents and on the command line, `docs/design.md`), a physical description, its
+//! parameters with units, the way it changes the model equations in words
+//! ([`EffectModel::equations`]), and [`EffectModel::setup`]: the effect set up on a log
+//! ([`FitSetup`]), its parameters typed ([`FitParam`]: name, unit, start, bounds, scale,
+//! physical range and its source) and its [`Contribution`] to the model for given values:
+//! what it writes into the model's physical channels
+//! ([`crate::analysis::simplified_model::ModelTerms`]) and a sentence a drives engineer
+//! understands for fitted values. The trait's other methods have defaults (voltages
+//! needed, nothing required first, no time constant, not confusable); an effect writes
+//! what differs. [`model_of`] gives the model of a kind (the registry: one line per
+//! effect). (The simulator injects the same effects with `crate::sim::EffectSpec`.)
 //!
 //! | name | parameters | model change |
 //! |---|---|---|
-//! | `thermal_drift` | rise_k [K], tau_s [s] | Rs, Rr x (1 + 0.00393 dT(t)), dT = rise (1 - e^{-t/tau}) |
-//! | `saturation` | psi_sat_wb [Wb], exponent [-] | Lm = Lm0 / (1 + (Lm i_f / psi_sat)^n) |
-//! | `iron_loss` | g_fe_s [S] (= 1/Rfe) | I_qs += omega_s Ls i_f / Rfe (core-loss current) |
-//! | `coulomb_friction` | torque_nm [N m] | load += Tc tanh(w_m / 1 rad/s) |
-//! | `windage` | k_nms2 [N m s^2/rad^2] | load += k w_m abs(w_m) |
-//! | `load_torque` | level_1..level_k [N m] | load += piecewise-constant T_L(t) (steps found in the data) |
-//! | `supply_unbalance` | y_re, y_im [-] | i_neg = (y_re + j y_im) v_neg / conj(Z2), Z2 from the nominal parameters at the negative-sequence slip 2 - s; full-order: the machine driven by V_pos + y V_neg |
-//! | `phase_asymmetry` | c_re, c_im [-] | i_neg = (c_re + j c_im) conj(i_pos); full-order: the unequal winding (`simplified_model::WindingAsymmetry`) |
-//! | `flux_dynamics` | tau_r_s [s] | psi_r/Lm = phi, dphi/dt = (i_f - phi)/tau_r; slip and torque from phi |
-//! | `current_dynamics` | la_h [H] | La dI_qs/dt = V_qs - Ra I_qs - Psi omega_r (eq. 28's derivative term) |
-//! | `rotor_asymmetry` | delta [-], phi_rad [rad] | Rr in Ra x (1 + (delta/3)(1 - cos(2 (Np theta_m - theta) + phi))) (see `super::rotor_asymmetry`); full-order: rotor resistance Rr (I + (2/3) delta u u^T) |
+//! | `thermal_drift` | rise_k \[K\], tau_s \[s\] | Rs, Rr x (1 + 0.00393 dT(t)), dT = rise (1 - e^{-t/tau}) |
+//! | `saturation` | psi_sat_wb \[Wb\], exponent \[-\] | Lm = Lm0 / (1 + (Lm i_f / psi_sat)^n) |
+//! | `iron_loss` | g_fe_s \[S\] (= 1/Rfe) | I_qs += omega_s Ls i_f / Rfe (core-loss current) |
+//! | `coulomb_friction` | torque_nm \[N m\] | load += Tc tanh(w_m / 1 rad/s) |
+//! | `windage` | k_nms2 \[N m s^2/rad^2\] | load += k w_m abs(w_m) |
+//! | `load_torque` | level_1..level_k \[N m\] | load += piecewise-constant T_L(t) (steps found in the data) |
+//! | `supply_unbalance` | y_re, y_im \[-\] | i_neg = (y_re + j y_im) v_neg / conj(Z2), Z2 from the nominal parameters at the negative-sequence slip 2 - s; full-order: the machine driven by V_pos + y V_neg |
+//! | `phase_asymmetry` | c_re, c_im \[-\] | i_neg = (c_re + j c_im) conj(i_pos); full-order: the unequal winding (`simplified_model::WindingAsymmetry`) |
+//! | `flux_dynamics` | tau_r_s \[s\] | psi_r/Lm = phi, dphi/dt = (i_f - phi)/tau_r; slip and torque from phi |
+//! | `current_dynamics` | la_h \[H\] | La dI_qs/dt = V_qs - Ra I_qs - Psi omega_r (eq. 28's derivative term) |
+//! | `rotor_asymmetry` | delta \[-\], phi_rad \[rad\] | Rr in Ra x (1 + (delta/3)(1 - cos(2 (Np theta_m - theta) + phi))); full-order: rotor resistance Rr (I + (2/3) delta u u^T) |
 //! | `d_axis_dynamics` | (none) | I_ds predicted from V_ds by the d-axis stator equation instead of measured |
 //! | `cross_coupling_dynamics` | (none) | q-axis rotor flux and the slip coupling between the axes (psi_qr != 0 in transients) |
 //!
@@ -27,7 +33,8 @@
 //! full-order machine of `simplified_model::simulate` (inverse-Gamma form, states I_ds,
 //! I_qs, psi_R d and q, w_m); each dynamics effect left out replaces its part by the
 //! paper's simplification; with all four in it is the full-order T-equivalent machine
-//! driven by the measured voltages.
+//! driven by the measured voltages. The two that add no parameter only switch a state of
+//! the model on ([`StateSwitch`]).
 
 mod coulomb_friction;
 mod cross_coupling_dynamics;
@@ -41,14 +48,16 @@ mod phase_asymmetry;
 pub mod plausible;
 mod rotor_asymmetry;
 mod saturation;
+mod setup;
 mod supply_unbalance;
+mod switch;
 mod thermal_drift;
 mod windage;
 
 pub use coulomb_friction::CoulombFriction;
-pub use cross_coupling_dynamics::CrossCouplingDynamics;
+pub use cross_coupling_dynamics::CROSS_COUPLING_DYNAMICS;
 pub use current_dynamics::CurrentDynamics;
-pub use d_axis_dynamics::DAxisDynamics;
+pub use d_axis_dynamics::D_AXIS_DYNAMICS;
 pub use flux_dynamics::FluxDynamics;
 pub use impedance::{z1_pos, z2_neg, z2_neg_at};
 pub use iron_loss::IronLoss;
@@ -56,13 +65,14 @@ pub use load_torque::LoadTorque;
 pub use phase_asymmetry::{asymmetry_phase, PhaseAsymmetry};
 pub use rotor_asymmetry::{RotorAsymmetry, DELTA_BASIS, DELTA_RANGE};
 pub use saturation::Saturation;
+pub use setup::{Contribution, FitParam, FitSetup, SetupError};
 pub use supply_unbalance::SupplyUnbalance;
+pub use switch::StateSwitch;
 pub use thermal_drift::{ThermalDrift, ALPHA_CU_PER_K};
 pub use windage::Windage;
 
 use super::prep::Prepared;
-use super::simplified_model::{EffectTerms, MachineConstants};
-use crate::params::PlausibleRange;
+use super::simplified_model::MachineConstants;
 use monitor_core::EffectKind;
 
 /// One parameter of an effect.
@@ -85,71 +95,35 @@ pub struct Needs {
     pub speed: bool,
 }
 
-/// Data-dependent set-up of an effect: initial values, bounds and scales of its parameters
-/// (same order as the names), plus any precomputed data (for example load-step times).
-#[derive(Debug, Clone, Default)]
-pub struct FitSetup {
-    /// Parameter names (for `load_torque` one per segment).
-    pub names: Vec<String>,
-    /// Units, parallel to `names`.
-    pub units: Vec<&'static str>,
-    /// Initial values.
-    pub init: Vec<f64>,
-    /// Lower bounds.
-    pub lo: Vec<f64>,
-    /// Upper bounds.
-    pub hi: Vec<f64>,
-    /// Typical magnitudes (finite-difference steps and conditioning).
-    pub scale: Vec<f64>,
-    /// Effect-specific precomputed numbers.
-    pub data: Vec<f64>,
-    /// Physical range of each parameter (parallel to `names`; a fitted value outside it is
-    /// not plausible) and where the range comes from. Defaults to the fit bounds.
-    pub plausible: Vec<(PlausibleRange, &'static str)>,
-    /// Other starting values the fit also tries, each a whole `init` (empty: `init` only).
-    /// For a cost with separate valleys: an amplitude and a phase, started half a turn
-    /// off, descend to the amplitude's zero bound, where the phase's gradient vanishes and
-    /// the fit stays. The start that ends at the lowest cost wins ([`super::fit::fit`]).
-    pub alt_init: Vec<Vec<f64>>,
-}
+impl Needs {
+    /// The phase voltages (every effect of the model driven by V_qs: the default).
+    pub const VOLTAGES: Needs = Needs {
+        voltages: true,
+        speed: false,
+    };
+    /// The phase voltages and the measured speed.
+    pub const VOLTAGES_AND_SPEED: Needs = Needs {
+        voltages: true,
+        speed: true,
+    };
+    /// Only the currents.
+    pub const CURRENTS: Needs = Needs {
+        voltages: false,
+        speed: false,
+    };
 
-impl FitSetup {
-    /// Sets the physical range of the last parameter pushed and the range's source.
-    fn range(&mut self, lo: f64, hi: f64, basis: &'static str) {
-        if let Some(r) = self.plausible.last_mut() {
-            *r = (PlausibleRange { lo, hi }, basis);
+    /// Whether the log `d` carries what is needed.
+    ///
+    /// # Errors
+    /// The first channel missing ([`SetupError::NoVoltages`], [`SetupError::NoSpeed`]).
+    pub fn met_by(self, d: &Prepared) -> Result<(), SetupError> {
+        if self.voltages && !d.channels.voltages {
+            return Err(SetupError::NoVoltages);
         }
-    }
-
-    /// The reasons the values `p` are not physically plausible (empty: plausible): one line
-    /// per parameter outside its range, naming value, unit, range and the range's basis.
-    pub fn implausible(&self, p: &[f64]) -> Vec<String> {
-        self.names
-            .iter()
-            .zip(&self.units)
-            .zip(&self.plausible)
-            .zip(p)
-            .filter(|(((_, _), (r, _)), v)| !r.contains(**v))
-            .map(|(((name, unit), (r, basis)), v)| {
-                format!(
-                    "{name} = {} {unit} is outside the physical range {}..{} {unit} ({basis})",
-                    sig(*v),
-                    sig(r.lo),
-                    sig(r.hi)
-                )
-            })
-            .collect()
-    }
-
-    fn push(&mut self, name: &str, unit: &'static str, init: f64, lo: f64, hi: f64, scale: f64) {
-        self.names.push(name.to_string());
-        self.units.push(unit);
-        self.init.push(init);
-        self.lo.push(lo);
-        self.hi.push(hi);
-        self.scale.push(scale);
-        self.plausible
-            .push((PlausibleRange { lo, hi }, "the fit's bounds"));
+        if self.speed && !d.channels.speed {
+            return Err(SetupError::NoSpeed { because: "" });
+        }
+        Ok(())
     }
 }
 
@@ -186,7 +160,7 @@ pub const VOLTAGE_UNBALANCE_MIN: f64 = 0.002;
 pub const LOAD_STEP_MIN: f64 = 0.03;
 
 /// True when the supply's measured voltage unbalance accounts for the current unbalance.
-fn supply_unbalanced(e: &Evidence<'_>) -> bool {
+pub(crate) fn supply_unbalanced(e: &Evidence<'_>) -> bool {
     !e.winding_suspected && e.voltage_unbalance.unwrap_or(0.0) > VOLTAGE_UNBALANCE_MIN
 }
 
@@ -204,25 +178,28 @@ pub fn sig(x: f64) -> String {
     }
 }
 
-/// How a physical effect of the library changes the simplified model.
+/// How a physical effect of the library changes the simplified model. An effect writes
+/// its kind, its description and equations, and its [`EffectModel::setup`]; every other
+/// method has a default that holds for most effects.
 pub trait EffectModel: Send + Sync {
-    /// Which effect (its DESIGN.md name is `kind().name()`).
+    /// Which effect (its name in the documents is `kind().name()`).
     fn kind(&self) -> EffectKind;
     /// Physical description, one or two sentences.
     fn description(&self) -> &'static str;
     /// How the effect changes the model equations (text with the equation).
     fn equations(&self) -> &'static str;
-    /// Parameters with units (documentation; [`EffectModel::setup`] gives the data-dependent list).
-    fn parameters(&self) -> &'static [ParamSpec];
-    /// Channels the log must have.
+    /// Parameters with units (documentation; [`EffectModel::setup`] gives the
+    /// data-dependent list). Default: none.
+    fn parameters(&self) -> &'static [ParamSpec] {
+        &[]
+    }
+    /// Channels the log must have. Default: the voltages.
     fn needs(&self) -> Needs {
-        Needs {
-            voltages: true,
-            speed: false,
-        }
+        Needs::VOLTAGES
     }
     /// Effects that must already be in the model before `explain` proposes this one (a
     /// rung of the dynamics ladder that is only a consistent machine on top of another).
+    /// Default: none.
     fn requires(&self) -> &'static [EffectKind] {
         &[]
     }
@@ -233,41 +210,47 @@ pub trait EffectModel: Send + Sync {
     /// constant) and only on a log with a transient of the model's inputs (a start or a
     /// supply step, [`super::transients::input_transients`]); in steady state the paper's
     /// model is the steady state of the full-order machine, so a dynamics effect that
-    /// lowers the error of a log without one is absorbing another effect (README, "Honest
-    /// ranking").
+    /// lowers the error of a log without one is absorbing another effect
+    /// (README, "Honest ranking").
     fn time_constant_s(&self, _n: &MachineConstants) -> Option<f64> {
         None
     }
-    /// Effects this one is easily confused with (the same equation on some logs).
+    /// Effects this one is easily confused with (the same equation on some logs). Default:
+    /// none.
     fn confused_with(&self) -> &'static [Confusion] {
         &[]
     }
     /// What the log's evidence says about this effect against those it is confused with:
-    /// `Some(true)` supports it, `Some(false)` contradicts it, `None` says nothing. When
-    /// two confusable candidates are ranked first and second within their
+    /// `Some(true)` supports it, `Some(false)` contradicts it, `None` says nothing (the
+    /// default). When two confusable candidates are ranked first and second within their
     /// [`Confusion::within`], a first one the evidence contradicts goes second unless the
     /// evidence contradicts the other too.
     fn evidence(&self, _e: &Evidence<'_>) -> Option<bool> {
         None
     }
-    /// Prepares the fit on this data: initial values, bounds, precomputed data.
+    /// The effect set up on this data: its parameters (start, bounds, physical range) and
+    /// its contribution to the model, with what it precomputes from the data.
     ///
     /// # Errors
-    /// A one-line reason when the effect cannot be fitted on this log.
-    fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String>;
-    /// Writes the effect's contribution for parameter values `p` into `terms`.
-    fn apply(
-        &self,
-        s: &FitSetup,
-        p: &[f64],
-        d: &Prepared,
-        n: &MachineConstants,
-        terms: &mut EffectTerms,
-    );
-    /// The fitted values in words a drives engineer understands.
-    fn describe(&self, s: &FitSetup, p: &[f64], d: &Prepared, n: &MachineConstants) -> String;
+    /// [`SetupError`] when the effect cannot be fitted on this log.
+    fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError>;
 }
 
+/// A dynamics effect's parameter about its nominal value `nominal`: fitted within 0.3 to
+/// 3 times it from the nominal value, plausible within [`plausible::DYNAMICS_RATIO`] of it.
+fn dynamics_param(name: &'static str, unit: &'static str, nominal: f64) -> FitParam {
+    let r = plausible::DYNAMICS_RATIO;
+    FitParam::new(
+        name,
+        unit,
+        nominal,
+        (0.3 * nominal, 3.0 * nominal),
+        0.2 * nominal,
+    )
+    .physical((r.0 * nominal, r.1 * nominal), plausible::DYNAMICS_BASIS)
+}
+
+/// The log's duration [s] (at least one sample period; 1 s for an empty series).
 fn duration(d: &Prepared) -> f64 {
     match (d.t_s.first(), d.t_s.last()) {
         (Some(a), Some(b)) => (b - a).max(d.dt_s),
@@ -320,12 +303,12 @@ pub fn model_of(kind: EffectKind) -> Box<dyn EffectModel> {
         EffectKind::FluxDynamics => Box::new(FluxDynamics),
         EffectKind::CurrentDynamics => Box::new(CurrentDynamics),
         EffectKind::RotorAsymmetry => Box::new(RotorAsymmetry),
-        EffectKind::DAxisDynamics => Box::new(DAxisDynamics),
-        EffectKind::CrossCouplingDynamics => Box::new(CrossCouplingDynamics),
+        EffectKind::DAxisDynamics => Box::new(D_AXIS_DYNAMICS),
+        EffectKind::CrossCouplingDynamics => Box::new(CROSS_COUPLING_DYNAMICS),
     }
 }
 
-/// The whole library, in DESIGN.md order.
+/// The whole library, in the order of [`EffectKind::ALL`].
 pub fn library() -> Vec<Box<dyn EffectModel>> {
     EffectKind::ALL.into_iter().map(model_of).collect()
 }

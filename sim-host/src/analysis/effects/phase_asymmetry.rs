@@ -1,15 +1,22 @@
 //! `phase_asymmetry`: one stator winding differs.
 
 use super::impedance::{z1_pos, z2_neg};
-use super::{plausible, supply_unbalanced, Confusion, Evidence, Needs};
-use super::{EffectModel, FitSetup, ParamSpec};
-use crate::analysis::prep::Prepared;
-use crate::analysis::prep::C64;
-use crate::analysis::simplified_model::{EffectTerms, MachineConstants};
+use super::{plausible, supply_unbalanced, Confusion, Contribution, EffectModel, Evidence};
+use super::{FitParam, FitSetup, Needs, ParamSpec, SetupError};
+use crate::analysis::prep::{Prepared, C64};
+use crate::analysis::simplified_model::{MachineConstants, ModelTerms, WindingAsymmetry};
+use crate::analysis::unbalance::operating_point;
 use monitor_core::EffectKind;
 
 /// One stator winding differs.
+#[derive(Debug, Clone, Copy)]
 pub struct PhaseAsymmetry;
+
+/// The winding asymmetry set up on a log: the full-order form's `e / c =
+/// conj(Z2 / (Z1 + Z2 - Rs))` at the log's mean operating point ([`WindingAsymmetry`]).
+struct OnLog {
+    e_over_c: C64,
+}
 
 /// The winding asymmetry a fitted `c` (i_neg = c conj(i_pos)) points at, named by the
 /// workspace's one faulty-phase method (`monitor_core::sequence`): in the core's phasor
@@ -66,16 +73,10 @@ impl EffectModel for PhaseAsymmetry {
         ]
     }
     fn needs(&self) -> Needs {
-        Needs {
-            voltages: false,
-            speed: false,
-        }
+        Needs::CURRENTS
     }
-    fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String> {
-        let mut s = FitSetup::default();
-        // data = the full-order form's e / c = conj(Z2 / (Z1 + Z2 - Rs)) at the log's mean
-        // operating point (`simplified_model::WindingAsymmetry`).
-        let (w, slip) = crate::analysis::unbalance::operating_point(d, n);
+    fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
+        let (w, slip) = operating_point(d, n);
         let z2 = z2_neg(n, w);
         let k = (z2 / (z1_pos(n, w, slip) + z2 - n.rs_ohm)).conj();
         let k = if k.re.is_finite() && k.im.is_finite() {
@@ -83,39 +84,35 @@ impl EffectModel for PhaseAsymmetry {
         } else {
             C64::new(1.0, 0.0)
         };
-        s.data = vec![k.re, k.im];
-        s.push("c_re", "1", 0.01, -1.0, 1.0, 0.02);
-        s.range(
-            plausible::ASYM_C.0,
-            plausible::ASYM_C.1,
-            plausible::ASYM_BASIS,
-        );
-        s.push("c_im", "1", 0.0, -1.0, 1.0, 0.02);
-        s.range(
-            plausible::ASYM_C.0,
-            plausible::ASYM_C.1,
-            plausible::ASYM_BASIS,
-        );
-        Ok(s)
-    }
-    fn apply(
-        &self,
-        s: &FitSetup,
-        p: &[f64],
-        _d: &Prepared,
-        _n: &MachineConstants,
-        terms: &mut EffectTerms,
-    ) {
-        let c = C64::new(p[0], p[1]);
-        let k = match s.data[..] {
-            [re, im] => C64::new(re, im),
-            _ => C64::new(1.0, 0.0),
+        let c = |name| {
+            FitParam::new(name, "1", 0.0, (-1.0, 1.0), 0.02)
+                .physical(plausible::ASYM_C, plausible::ASYM_BASIS)
         };
-        terms.winding = Some(crate::analysis::simplified_model::WindingAsymmetry { c, e: c * k });
+        Ok(FitSetup::new(OnLog { e_over_c: k })
+            .param(FitParam {
+                init: 0.01,
+                ..c("c_re")
+            })
+            .param(c("c_im")))
     }
-    fn describe(&self, _s: &FitSetup, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
-        let (w, slip) = crate::analysis::unbalance::operating_point(d, n);
-        let c = C64::new(p[0], p[1]);
+}
+
+impl Contribution for OnLog {
+    /// The unequal stator winding in its two forms (`c` and `e`).
+    fn contribute(&self, p: &[f64], _d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
+        let &[c_re, c_im] = p else { return };
+        let c = C64::new(c_re, c_im);
+        t.stator_winding = Some(WindingAsymmetry {
+            c,
+            e: c * self.e_over_c,
+        });
+    }
+    fn describe(&self, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
+        let &[c_re, c_im] = p else {
+            return String::new();
+        };
+        let (w, slip) = operating_point(d, n);
+        let c = C64::new(c_re, c_im);
         let (ph, eps) = asymmetry_phase(c, n, w, slip);
         format!(
             "phase {} winding differs: negative-sequence current {:.1} % of the positive-sequence current; fits about {:.1} % of that winding's impedance lost (an inter-turn short removes turns)",

@@ -1,13 +1,20 @@
 //! `saturation`: main-flux saturation.
 
-use super::{plausible, rated_flux_wb};
-use super::{EffectModel, FitSetup, ParamSpec};
+use super::SetupError;
+use super::{plausible, rated_flux_wb, Contribution, EffectModel, FitParam, FitSetup, ParamSpec};
 use crate::analysis::prep::Prepared;
-use crate::analysis::simplified_model::{EffectTerms, MachineConstants};
+use crate::analysis::simplified_model::{MachineConstants, ModelTerms, SaturationLaw};
 use monitor_core::EffectKind;
 
 /// Main-flux saturation.
+#[derive(Debug, Clone, Copy)]
 pub struct Saturation;
+
+/// Saturation set up on a log: the log's flux level.
+struct OnLog {
+    /// The log's flux level `|V| / omega_s` [Wb] (`rated_flux_wb`).
+    rated_flux_wb: f64,
+}
 
 /// Lm / Lm0 for magnetising current `im` [A]: solves x (1 + (x a)^n) = 1, a = Lm0 im / psi_sat.
 fn sat_factor(lm0: f64, im: f64, psi_sat: f64, nexp: f64) -> f64 {
@@ -100,39 +107,41 @@ impl EffectModel for Saturation {
             },
         ]
     }
-    fn setup(&self, d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, String> {
+    fn setup(&self, d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let psi = rated_flux_wb(d);
-        let mut s = FitSetup::default();
-        s.push(
-            "psi_sat_wb",
-            "Wb",
-            1.2 * psi,
-            0.5 * psi,
-            5.0 * psi,
-            0.2 * psi,
-        );
-        s.range(
-            plausible::PSI_SAT_RATIO.0 * psi,
-            plausible::PSI_SAT_RATIO.1 * psi,
-            plausible::PSI_SAT_BASIS,
-        );
-        s.push("exponent", "1", 7.0, 2.0, 14.0, 2.0);
-        s.data.push(psi);
-        Ok(s)
+        let r = plausible::PSI_SAT_RATIO;
+        Ok(FitSetup::new(OnLog { rated_flux_wb: psi })
+            .param(
+                FitParam::new(
+                    "psi_sat_wb",
+                    "Wb",
+                    1.2 * psi,
+                    (0.5 * psi, 5.0 * psi),
+                    0.2 * psi,
+                )
+                .physical((r.0 * psi, r.1 * psi), plausible::PSI_SAT_BASIS),
+            )
+            .param(FitParam::new("exponent", "1", 7.0, (2.0, 14.0), 2.0)))
     }
-    fn apply(
-        &self,
-        _s: &FitSetup,
-        p: &[f64],
-        d: &Prepared,
-        n: &MachineConstants,
-        terms: &mut EffectTerms,
-    ) {
-        terms.lm_factor = sat_factors(n.lm_h, &d.i_f, p[0], p[1]);
-        // The full-order model saturates with its own magnetising flux.
-        terms.sat = Some((p[0], p[1]));
+}
+
+impl Contribution for OnLog {
+    /// Lm's scale from the measured i_f per sample (the reduced model) and the law itself
+    /// (the full-order model saturates with its own magnetising flux).
+    fn contribute(&self, p: &[f64], d: &Prepared, n: &MachineConstants, t: &mut ModelTerms) {
+        let &[psi_sat_wb, exponent] = p else { return };
+        t.scale_magnetising_inductance(
+            sat_factors(n.lm_h, &d.i_f, psi_sat_wb, exponent).into_iter(),
+        );
+        t.magnetising.law = Some(SaturationLaw {
+            psi_sat_wb,
+            exponent,
+        });
     }
-    fn describe(&self, s: &FitSetup, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
+    fn describe(&self, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
+        let &[psi_sat, nexp] = p else {
+            return String::new();
+        };
         // The factor falls monotonically with |i_f|: its extremes are at the extremes of |i_f|.
         let (mut imin, mut imax) = (f64::INFINITY, f64::NEG_INFINITY);
         for &i in &d.i_f {
@@ -141,8 +150,8 @@ impl EffectModel for Saturation {
         }
         let (lo, hi) = if imax >= imin {
             (
-                sat_factor(n.lm_h, imax, p[0], p[1]),
-                sat_factor(n.lm_h, imin, p[0], p[1]),
+                sat_factor(n.lm_h, imax, psi_sat, nexp),
+                sat_factor(n.lm_h, imin, psi_sat, nexp),
             )
         } else {
             (f64::INFINITY, 0.0)
@@ -151,9 +160,9 @@ impl EffectModel for Saturation {
             "magnetising inductance falls with flux: Lm is {:.0} % to {:.0} % of its unsaturated value over this log (saturation flux {:.2} Wb = {:.2} x the rated flux, knee exponent {:.1})",
             lo * 100.0,
             hi * 100.0,
-            p[0],
-            p[0] / s.data.first().copied().unwrap_or(1.0),
-            p[1]
+            psi_sat,
+            psi_sat / self.rated_flux_wb,
+            nexp
         )
     }
 }

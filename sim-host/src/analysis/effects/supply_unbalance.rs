@@ -1,14 +1,14 @@
 //! `supply_unbalance`: negative-sequence supply voltage.
 
 use super::impedance::{z2_neg, z2_neg_at};
-use super::{plausible, supply_unbalanced, sync_speed_mech, Confusion, Evidence};
-use super::{EffectModel, FitSetup, ParamSpec};
-use crate::analysis::prep::Prepared;
-use crate::analysis::prep::C64;
-use crate::analysis::simplified_model::{EffectTerms, MachineConstants};
+use super::{plausible, supply_unbalanced, sync_speed_mech, Confusion, Contribution, Evidence};
+use super::{EffectModel, FitParam, FitSetup, ParamSpec, SetupError};
+use crate::analysis::prep::{Prepared, C64};
+use crate::analysis::simplified_model::{MachineConstants, ModelTerms};
 use monitor_core::EffectKind;
 
 /// Negative-sequence supply voltage.
+#[derive(Debug, Clone, Copy)]
 pub struct SupplyUnbalance;
 
 impl EffectModel for SupplyUnbalance {
@@ -47,40 +47,41 @@ impl EffectModel for SupplyUnbalance {
             },
         ]
     }
-    fn setup(&self, _d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, String> {
-        let mut s = FitSetup::default();
-        s.push("y_re", "1", 0.5, -5.0, 5.0, 0.2);
-        s.range(plausible::Y2_RE.0, plausible::Y2_RE.1, plausible::Y2_BASIS);
-        s.push("y_im", "1", 0.0, -5.0, 5.0, 0.2);
-        s.range(plausible::Y2_IM.0, plausible::Y2_IM.1, plausible::Y2_BASIS);
-        Ok(s)
+    fn setup(&self, _d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, SetupError> {
+        Ok(FitSetup::new(*self)
+            .param(
+                FitParam::new("y_re", "1", 0.5, (-5.0, 5.0), 0.2)
+                    .physical(plausible::Y2_RE, plausible::Y2_BASIS),
+            )
+            .param(
+                FitParam::new("y_im", "1", 0.0, (-5.0, 5.0), 0.2)
+                    .physical(plausible::Y2_IM, plausible::Y2_BASIS),
+            ))
     }
-    fn apply(
-        &self,
-        _s: &FitSetup,
-        p: &[f64],
-        d: &Prepared,
-        n: &MachineConstants,
-        terms: &mut EffectTerms,
-    ) {
-        let y = C64::new(p[0], p[1]);
-        let add: Vec<C64> = (0..d.len())
-            .map(|k| {
-                // The measured speed gives the negative-sequence slip; without it the rotor
-                // is taken as near synchronous speed (slip 2).
-                let w = d.omega_s[k];
-                let s2 = match d.omega_r.get(k) {
-                    Some(wr) if w.abs() > 1.0 => 1.0 + wr / w,
-                    _ => 2.0,
-                };
-                y * d.v_neg[k] / z2_neg_at(n, w, s2).conj()
-            })
-            .collect();
-        add_neg(terms, add);
-        // The full-order model drives the machine with y v_neg instead.
-        terms.v_neg_gain = Some(y);
+}
+
+impl Contribution for SupplyUnbalance {
+    /// The reduced model's negative-sequence current `y v_neg / conj(Z2)` per sample, and
+    /// the full-order model's drive `y v_neg` of the machine.
+    fn contribute(&self, p: &[f64], d: &Prepared, n: &MachineConstants, t: &mut ModelTerms) {
+        let &[y_re, y_im] = p else { return };
+        let y = C64::new(y_re, y_im);
+        t.add_negative_sequence_current((0..d.len()).map(|k| {
+            // The measured speed gives the negative-sequence slip; without it the rotor
+            // is taken as near synchronous speed (slip 2).
+            let w = d.omega_s[k];
+            let s2 = match d.omega_r.get(k) {
+                Some(wr) if w.abs() > 1.0 => 1.0 + wr / w,
+                _ => 2.0,
+            };
+            y * d.v_neg[k] / z2_neg_at(n, w, s2).conj()
+        }));
+        t.negative_sequence.voltage_gain = Some(y);
     }
-    fn describe(&self, _s: &FitSetup, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
+    fn describe(&self, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
+        let &[y_re, y_im] = p else {
+            return String::new();
+        };
         let (mut vn, mut vp) = (0.0, 0.0);
         for k in 0..d.len() {
             vn += d.v_neg[k].norm_sqr();
@@ -88,22 +89,12 @@ impl EffectModel for SupplyUnbalance {
         }
         let ratio = (vn / vp.max(1e-12)).sqrt();
         let w = sync_speed_mech(d, n) * n.np;
-        let z = z2_neg(n, w).norm() / C64::new(p[0], p[1]).norm().max(1e-9);
+        let z = z2_neg(n, w).norm() / C64::new(y_re, y_im).norm().max(1e-9);
         format!(
             "supply voltage unbalance of {:.1} % (negative sequence / positive sequence); the machine's negative-sequence impedance is about {:.1} ohm (nominal {:.1} ohm)",
             100.0 * ratio,
             z,
             z2_neg(n, w).norm()
         )
-    }
-}
-
-fn add_neg(terms: &mut EffectTerms, add: Vec<C64>) {
-    if terms.i_neg.len() == add.len() {
-        for (a, b) in terms.i_neg.iter_mut().zip(add) {
-            *a += b;
-        }
-    } else {
-        terms.i_neg = add;
     }
 }

@@ -1,15 +1,16 @@
 //! `thermal_drift`: winding temperature rise.
 
-use super::{duration, plausible};
-use super::{EffectModel, FitSetup, ParamSpec};
+use super::SetupError;
+use super::{duration, plausible, Contribution, EffectModel, FitParam, FitSetup, ParamSpec};
 use crate::analysis::prep::Prepared;
-use crate::analysis::simplified_model::{EffectTerms, MachineConstants};
+use crate::analysis::simplified_model::{MachineConstants, ModelTerms};
 use monitor_core::EffectKind;
 
 /// Copper temperature coefficient of resistance [1/K] (0.393 %/K at 20 C).
 pub const ALPHA_CU_PER_K: f64 = 0.00393;
 
 /// Winding temperature rise: Rs and Rr follow copper's coefficient.
+#[derive(Debug, Clone, Copy)]
 pub struct ThermalDrift;
 
 impl EffectModel for ThermalDrift {
@@ -36,42 +37,38 @@ impl EffectModel for ThermalDrift {
             },
         ]
     }
-    fn setup(&self, d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, String> {
+    fn setup(&self, d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let t = duration(d);
-        let mut s = FitSetup::default();
-        s.push("rise_k", "K", 10.0, -100.0, 400.0, 20.0);
-        s.range(
-            plausible::RISE_K.0,
-            plausible::RISE_K.1,
-            plausible::RISE_K_BASIS,
-        );
-        s.push("tau_s", "s", t / 3.0, t / 200.0, 20.0 * t, t / 3.0);
-        s.range(
-            plausible::TAU_S.0,
-            plausible::TAU_S.1,
-            plausible::TAU_S_BASIS,
-        );
-        Ok(s)
+        Ok(FitSetup::new(*self)
+            .param(
+                FitParam::new("rise_k", "K", 10.0, (-100.0, 400.0), 20.0)
+                    .physical(plausible::RISE_K, plausible::RISE_K_BASIS),
+            )
+            .param(
+                FitParam::new("tau_s", "s", t / 3.0, (t / 200.0, 20.0 * t), t / 3.0)
+                    .physical(plausible::TAU_S, plausible::TAU_S_BASIS),
+            ))
     }
-    fn apply(
-        &self,
-        _s: &FitSetup,
-        p: &[f64],
-        d: &Prepared,
-        _n: &MachineConstants,
-        terms: &mut EffectTerms,
-    ) {
+}
+
+impl Contribution for ThermalDrift {
+    /// The resistance scale 1 + alpha dT(t) per sample (Rs and Rr alike).
+    fn contribute(&self, p: &[f64], d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
+        let &[rise_k, tau_s] = p else { return };
         let t0 = d.t_s.first().copied().unwrap_or(0.0);
-        let tau = p[1].max(1e-6);
-        terms.r_factor = d
-            .t_s
-            .iter()
-            .map(|t| 1.0 + ALPHA_CU_PER_K * p[0] * (1.0 - (-(t - t0) / tau).exp()))
-            .collect();
+        let tau = tau_s.max(1e-6);
+        t.scale_resistances(
+            d.t_s
+                .iter()
+                .map(|t| 1.0 + ALPHA_CU_PER_K * rise_k * (1.0 - (-(t - t0) / tau).exp())),
+        );
     }
-    fn describe(&self, _s: &FitSetup, p: &[f64], d: &Prepared, _n: &MachineConstants) -> String {
+    fn describe(&self, p: &[f64], d: &Prepared, _n: &MachineConstants) -> String {
+        let &[rise_k, tau_s] = p else {
+            return String::new();
+        };
         let t = duration(d);
-        let dt_end = p[0] * (1.0 - (-t / p[1].max(1e-6)).exp());
+        let dt_end = rise_k * (1.0 - (-t / tau_s.max(1e-6)).exp());
         format!(
             "winding resistance {} {:.0} % over the run ({:.0} s), consistent with about {:.0} K of {} (copper 0.393 %/K); thermal time constant about {:.3} s",
             if dt_end >= 0.0 { "rises" } else { "falls" },
@@ -79,7 +76,7 @@ impl EffectModel for ThermalDrift {
             t,
             dt_end.abs(),
             if dt_end >= 0.0 { "heating" } else { "cooling" },
-            p[1]
+            tau_s
         )
     }
 }
@@ -87,7 +84,6 @@ impl EffectModel for ThermalDrift {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::prep::Prepared;
 
     /// The case: `thermal_drift` "explaining" a gap in the data as 400 K of heating
     /// with a 0.01 s time constant is not plausible, and both values are named; a heat

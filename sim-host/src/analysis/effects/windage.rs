@@ -1,13 +1,33 @@
 //! `windage`: fan and air drag.
 
-use super::{plausible, sync_speed_mech};
-use super::{EffectModel, FitSetup, ParamSpec};
+use super::{plausible, sync_speed_mech, Contribution, EffectModel, FitParam, FitSetup};
+use super::{ParamSpec, SetupError};
 use crate::analysis::prep::Prepared;
-use crate::analysis::simplified_model::{EffectTerms, MachineConstants};
+use crate::analysis::simplified_model::{MachineConstants, ModelTerms, SpeedTorque};
 use monitor_core::EffectKind;
 
 /// Fan / windage torque.
+#[derive(Debug, Clone, Copy)]
 pub struct Windage;
+
+/// Windage set up on a log: the log's highest synchronous speed.
+struct OnLog {
+    /// [rad/s], mechanical.
+    sync_speed_rad_s: f64,
+}
+
+/// A drag torque `k w_m |w_m|` on the shaft.
+#[derive(Debug, Clone, Copy)]
+struct Drag {
+    /// k [N m s^2/rad^2].
+    k_nms2: f64,
+}
+
+impl SpeedTorque for Drag {
+    fn torque_nm(&self, wm_rad_s: f64) -> f64 {
+        self.k_nms2 * wm_rad_s * wm_rad_s.abs()
+    }
+}
 
 impl EffectModel for Windage {
     fn kind(&self) -> EffectKind {
@@ -26,43 +46,43 @@ impl EffectModel for Windage {
             description: "windage coefficient k",
         }]
     }
-    fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, String> {
+    fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let w = sync_speed_mech(d, n);
         let k = n.torque_scale_nm / (w * w);
-        let mut s = FitSetup::default();
-        s.push(
-            "k_nms2",
-            "N m s^2/rad^2",
-            0.01 * k,
-            -0.1 * k,
-            2.0 * k,
-            0.05 * k,
-        );
-        s.range(
-            plausible::WINDAGE_RATIO.0 * k,
-            plausible::WINDAGE_RATIO.1 * k,
-            plausible::WINDAGE_BASIS,
-        );
-        s.data.push(w);
-        Ok(s)
+        let r = plausible::WINDAGE_RATIO;
+        Ok(FitSetup::new(OnLog {
+            sync_speed_rad_s: w,
+        })
+        .param(
+            FitParam::new(
+                "k_nms2",
+                "N m s^2/rad^2",
+                0.01 * k,
+                (-0.1 * k, 2.0 * k),
+                0.05 * k,
+            )
+            .physical((r.0 * k, r.1 * k), plausible::WINDAGE_BASIS),
+        ))
     }
-    fn apply(
-        &self,
-        _s: &FitSetup,
-        p: &[f64],
-        _d: &Prepared,
-        _n: &MachineConstants,
-        terms: &mut EffectTerms,
-    ) {
-        terms.windage_nms2 = p[0];
+}
+
+impl Contribution for OnLog {
+    /// The drag torque on the shaft.
+    fn contribute(&self, p: &[f64], _d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
+        if let &[k_nms2] = p {
+            t.add_speed_torque(Drag { k_nms2 });
+        }
     }
-    fn describe(&self, s: &FitSetup, p: &[f64], _d: &Prepared, n: &MachineConstants) -> String {
-        let w = s.data.first().copied().unwrap_or(1.0);
+    fn describe(&self, p: &[f64], _d: &Prepared, n: &MachineConstants) -> String {
+        let &[k] = p else {
+            return String::new();
+        };
+        let w = self.sync_speed_rad_s;
         format!(
             "speed-squared drag k = {:.3e} N m s^2/rad^2: {:.2} N m at synchronous speed ({:.1} % of the rated torque estimate)",
-            p[0],
-            p[0] * w * w,
-            100.0 * p[0] * w * w / n.torque_scale_nm
+            k,
+            k * w * w,
+            100.0 * k * w * w / n.torque_scale_nm
         )
     }
 }

@@ -1,9 +1,9 @@
-//! The full-order form in the analysis frame (`d_axis_dynamics` or
-//! `cross_coupling_dynamics` in the model).
+//! The full-order form in the analysis frame (the stator d axis or the q-axis rotor flux
+//! dynamic, [`super::Dynamics`]), and what it shares with the stationary-frame form: the
+//! machine at a sample, the initial state, the run's set-up ([`FullRun`]).
 
 use super::reduced::initial_state;
-use super::terms::reduced_i_neg;
-use super::{BaseParams, EffectTerms, MachineConstants, Prediction};
+use super::{BaseParams, MachineConstants, Mechanics, ModelTerms, Prediction};
 use crate::analysis::prep::{Prepared, C64};
 
 /// The machine of the full-order form at one sample (inverse-Gamma equivalent of the
@@ -119,10 +119,16 @@ impl FullMachine {
     pub(super) fn at(
         n: &MachineConstants,
         b: &BaseParams,
-        t: &EffectTerms,
+        t: &ModelTerms,
         k: usize,
     ) -> FullMachine {
-        Self::at_lm(n, b, t, k, t.lm_factor.get(k).copied().unwrap_or(1.0))
+        Self::at_lm(
+            n,
+            b,
+            t,
+            k,
+            t.magnetising.lm_scale.get(k).copied().unwrap_or(1.0),
+        )
     }
 
     /// [`FullMachine::at`] with the magnetising inductance `mf` x Lm (1: unsaturated, what
@@ -130,22 +136,23 @@ impl FullMachine {
     pub(super) fn at_lm(
         n: &MachineConstants,
         b: &BaseParams,
-        t: &EffectTerms,
+        t: &ModelTerms,
         k: usize,
         mf: f64,
     ) -> Self {
-        let rf = t.r_factor.get(k).copied().unwrap_or(1.0);
+        let rf = t.resistance.scale.get(k).copied().unwrap_or(1.0);
         let lm = n.lm_h * mf;
         let lr = n.llr_h + lm;
         let ls = b.ls_scale * (n.lls_h + lm);
         let l_sigma = t
-            .la_h
+            .dynamics
+            .stator_current_la_h
             .unwrap_or(b.ls_scale * (n.lls_h + lm - lm * lm / lr))
             .clamp(1e-3 * ls, 0.9 * ls);
         let l_m = ls - l_sigma;
-        // The winding temperature (`thermal_drift`) heats the cage too: the fitted rotor time
-        // constant is the cold one, and a = Rr/Lr follows the resistance factor.
-        let a = match t.tau_r_s {
+        // A winding temperature heats the cage too: the fitted rotor time constant is the
+        // cold one, and a = Rr/Lr follows the resistance scale.
+        let a = match t.dynamics.rotor_flux_tau_s {
             Some(tau) => rf / tau.max(1e-5),
             None => n.rr_ohm * b.ra_scale * rf / lr,
         };
@@ -197,8 +204,59 @@ pub(super) fn full_initial_state(
     }
 }
 
-/// The full-order form of the model (`d_axis_dynamics` or `cross_coupling_dynamics` in
-/// it), in the analysis frame turning at omega_k = d theta/dt, inverse-Gamma form:
+/// What both full-order forms set up before their loop: the data, the shaft's constants,
+/// the machine at each sample and the initial state. `None` when there is nothing to
+/// simulate (no samples, or no voltages to drive the model).
+pub(super) struct FullRun<'a> {
+    pub(super) d: &'a Prepared,
+    pub(super) n: &'a MachineConstants,
+    pub(super) b: &'a BaseParams,
+    pub(super) t: &'a ModelTerms,
+    pub(super) mech: Mechanics,
+    /// The initial state ([`full_initial_state`]).
+    pub(super) x0: FullState,
+    /// The machine's Lm starts unsaturated at every sample (the stationary model's own
+    /// magnetising law acts on it) instead of following the channel's scale.
+    unsaturated: bool,
+}
+
+impl<'a> FullRun<'a> {
+    pub(super) fn new(
+        d: &'a Prepared,
+        n: &'a MachineConstants,
+        b: &'a BaseParams,
+        t: &'a ModelTerms,
+        unsaturated: bool,
+    ) -> Option<Self> {
+        let len = d.len();
+        if len == 0 || d.vq.len() != len {
+            return None;
+        }
+        let mut run = FullRun {
+            d,
+            n,
+            b,
+            t,
+            mech: Mechanics::new(n, b),
+            x0: FullState::default(),
+            unsaturated,
+        };
+        run.x0 = full_initial_state(d, n, &run.machine(0));
+        Some(run)
+    }
+
+    /// The machine at sample `k`.
+    pub(super) fn machine(&self, k: usize) -> FullMachine {
+        if self.unsaturated {
+            FullMachine::at_lm(self.n, self.b, self.t, k, 1.0)
+        } else {
+            FullMachine::at(self.n, self.b, self.t, k)
+        }
+    }
+}
+
+/// The full-order form of the model (the stator d axis or the q-axis rotor flux dynamic),
+/// in the analysis frame turning at omega_k = d theta/dt, inverse-Gamma form:
 /// ```text
 ///   L_sigma dI_ds/dt = V_ds - R I_ds + omega_k L_sigma I_qs + a psi_Rd + omega_r psi_Rq
 ///   L_sigma dI_qs/dt = V_qs - R I_qs - omega_k L_sigma I_ds + a psi_Rq - omega_r psi_Rd
@@ -206,89 +264,129 @@ pub(super) fn full_initial_state(
 ///   dpsi_Rq/dt = Rr' I_qs - a psi_Rq - (omega_k - omega_r) psi_Rd
 ///   J dw_m/dt = (3/2) Np (psi_Rd I_qs - psi_Rq I_ds) - (B + Bl) w_m - T_extra(w_m)
 /// ```
-/// R = Rs + Rr', Rr' = (Lm/Lr)^2 Rr, L_M = Lm^2/Lr, a = Rr'/L_M = Rr/Lr. Each dynamics
-/// effect not in the model replaces its part by the paper's simplification ([`Switches`]).
-/// The refitted Ra scales Rs and Rr, Ls scales L_M and L_sigma; `current_dynamics`'
-/// La sets L_sigma (L_M = Ls - La), `flux_dynamics`' tau_r sets a. Integration: classic
-/// RK4 per working sample, inputs linear between samples (L_sigma/R is about 7 samples at
-/// 2 kHz, RK4's error is below 1e-6 of a step). Iron loss adds g j omega_k psi_s to the
-/// output current (no feedback: 1 % of the current at Rfe = 8 Xm).
+/// R = Rs + Rr', Rr' = (Lm/Lr)^2 Rr, L_M = Lm^2/Lr, a = Rr'/L_M = Rr/Lr. Each state not
+/// dynamic replaces its part by the paper's simplification ([`Switches`]). The refitted Ra
+/// scales Rs and Rr, Ls scales L_M and L_sigma; the stator current's La sets L_sigma
+/// (L_M = Ls - La), the rotor flux's tau_r sets a. Integration: classic RK4 per working
+/// sample, inputs linear between samples (L_sigma/R is about 7 samples at 2 kHz, RK4's
+/// error is below 1e-6 of a step). Core loss adds g j omega_k psi_s to the output current
+/// (no feedback: 1 % of the current at Rfe = 8 Xm).
 pub(super) fn simulate_full(
     d: &Prepared,
     n: &MachineConstants,
     b: &BaseParams,
-    t: &EffectTerms,
+    t: &ModelTerms,
     rot_at: impl Fn(usize) -> C64,
 ) -> Prediction {
+    let Some(run) = FullRun::new(d, n, b, t, false) else {
+        return Prediction::default();
+    };
     let len = d.len();
     let mut out = Prediction::with_capacity(len);
-    if len == 0 || d.vq.len() != len {
-        return out;
-    }
-    let sw = Switches {
-        iq: t.la_h.is_some(),
-        id: t.d_axis,
-        flux: t.tau_r_s.is_some(),
-        cross: t.cross_coupling,
+    let form = FrameForm {
+        run: &run,
+        sw: Switches::of(&t.dynamics),
     };
-    let dt = d.dt_s;
-    let j = (n.j_kgm2 * b.j_scale).max(1e-9);
-    let btot = b.btot_nms.max(0.0);
-    let machine_at = |k: usize| FullMachine::at(n, b, t, k);
-    // Frame speed in the equations: the angle's increment over the step, kept within 5 %
-    // (+ 20 rad/s) of the smoothed omega_s (the increments jump where the flux estimate
-    // starts at a start); after each step the state is turned by what the frame turned
-    // beyond that, so the frame the model runs in is exactly the measurements' frame.
-    let wk_at = |k: usize| -> f64 {
-        let ws = d.omega_s[k];
-        if k + 1 < len {
-            let lim = 0.05 * ws.abs() + 20.0;
-            ((d.theta[k + 1] - d.theta[k]) / dt).clamp(ws - lim, ws + lim)
-        } else {
-            ws
-        }
-    };
-    let mut x = full_initial_state(d, n, &machine_at(0));
-    let extra = |k: usize, w: f64| {
-        let coulomb = if t.coulomb_nm != 0.0 {
-            t.coulomb_nm * w.tanh()
-        } else {
-            0.0
-        };
-        coulomb + t.windage_nms2 * w * w.abs() + t.load_nm.get(k).copied().unwrap_or(0.0)
-    };
-    let np = n.np;
+    let mut x = run.x0;
     for k in 0..len {
-        let m = machine_at(k);
-        let wk = wk_at(k);
-        let input = |s: f64| -> ((f64, f64), f64, f64) {
-            let k1 = (k + 1).min(len - 1);
-            let lerp = |a: &[f64]| a[k] + s * (a[k1] - a[k]);
-            ((lerp(&d.vd), lerp(&d.vq)), lerp(&d.id), lerp(&d.i_f))
-        };
-        // Output at sample k (the algebraic parts resolved).
-        let (v0, id0, if0) = input(0.0);
-        let (xa, _) = m.deriv(sw, &x, v0, id0, if0, wk, np);
-        let rot = rot_at(k);
-        let ineg = reduced_i_neg(d, t, k);
-        let mut i_dq = C64::new(if sw.id { xa.id } else { d.id[k] }, xa.iq);
-        if t.g_fe_s != 0.0 {
-            let psd = m.l_sigma * xa.id + xa.pd;
-            let psq = m.l_sigma * xa.iq + xa.pq;
-            i_dq += C64::new(-psq, psd) * (t.g_fe_s * wk);
-        }
-        out.iq.push(i_dq.im + (ineg * rot.conj()).im);
-        out.omega_r.push(np * xa.wm);
-        out.i_ab.push(i_dq * rot + ineg);
+        let m = run.machine(k);
+        let wk = form.frame_speed(k);
+        form.output(k, &m, wk, &x, rot_at(k), &mut out);
         if k + 1 == len {
             break;
         }
-        // RK4 over [k, k+1] for the electrical states; the speed with the torque.
+        x = form.step(k, &m, wk, &x);
+        if !(x.id.is_finite() && x.iq.is_finite() && x.pd.is_finite() && x.wm.is_finite()) {
+            // A diverging trial of the fit: stop; the residuals of the missing samples are
+            // large (the fit treats a short prediction as a bad one).
+            break;
+        }
+    }
+    out
+}
+
+impl Switches {
+    /// The switches of the dynamics channel.
+    fn of(dy: &super::Dynamics) -> Self {
+        Switches {
+            iq: dy.stator_current_la_h.is_some(),
+            id: dy.stator_d_axis,
+            flux: dy.rotor_flux_tau_s.is_some(),
+            cross: dy.rotor_flux_q_axis,
+        }
+    }
+}
+
+/// The full-order form in the analysis frame over one run ([`simulate_full`]).
+struct FrameForm<'a> {
+    run: &'a FullRun<'a>,
+    sw: Switches,
+}
+
+impl FrameForm<'_> {
+    /// Frame speed in the equations at sample `k` [rad/s]: the angle's increment over the
+    /// step, kept within 5 % (+ 20 rad/s) of the smoothed omega_s (the increments jump
+    /// where the flux estimate starts at a start); after each step the state is turned by
+    /// what the frame turned beyond that ([`FrameForm::step`]), so the frame the model runs
+    /// in is exactly the measurements' frame.
+    fn frame_speed(&self, k: usize) -> f64 {
+        let d = self.run.d;
+        let ws = d.omega_s[k];
+        if k + 1 < d.len() {
+            let lim = 0.05 * ws.abs() + 20.0;
+            ((d.theta[k + 1] - d.theta[k]) / d.dt_s).clamp(ws - lim, ws + lim)
+        } else {
+            ws
+        }
+    }
+
+    /// The inputs at the fraction `s` of the interval from sample `k`: (V_ds, V_qs), I_ds,
+    /// i_f, linear between the samples.
+    fn input(&self, k: usize, s: f64) -> ((f64, f64), f64, f64) {
+        let d = self.run.d;
+        let k1 = (k + 1).min(d.len() - 1);
+        let lerp = |a: &[f64]| a[k] + s * (a[k1] - a[k]);
+        ((lerp(&d.vd), lerp(&d.vq)), lerp(&d.id), lerp(&d.i_f))
+    }
+
+    /// The outputs at sample `k` (the algebraic parts of the state resolved), the frame
+    /// turned by `rot`.
+    fn output(
+        &self,
+        k: usize,
+        m: &FullMachine,
+        wk: f64,
+        x: &FullState,
+        rot: C64,
+        out: &mut Prediction,
+    ) {
+        let (d, n, t) = (self.run.d, self.run.n, self.run.t);
+        let (v0, id0, if0) = self.input(k, 0.0);
+        let (xa, _) = m.deriv(self.sw, x, v0, id0, if0, wk, n.np);
+        let ineg = t.reduced_i_neg(d, k);
+        let mut i_dq = C64::new(if self.sw.id { xa.id } else { d.id[k] }, xa.iq);
+        let g = t.magnetising.core_loss_s;
+        if g != 0.0 {
+            let psd = m.l_sigma * xa.id + xa.pd;
+            let psq = m.l_sigma * xa.iq + xa.pq;
+            i_dq += C64::new(-psq, psd) * (g * wk);
+        }
+        out.iq.push(i_dq.im + (ineg * rot.conj()).im);
+        out.omega_r.push(n.np * xa.wm);
+        out.i_ab.push(i_dq * rot + ineg);
+    }
+
+    /// RK4 over [k, k+1] for the electrical states, the speed with the torque; then the
+    /// state turned by what the frame turned beyond `wk`.
+    fn step(&self, k: usize, m: &FullMachine, wk: f64, x: &FullState) -> FullState {
+        let (d, np) = (self.run.d, self.run.n.np);
+        let Mechanics { j, btot } = self.run.mech;
+        let dt = d.dt_s;
         let f = |st: &FullState, s: f64| -> FullState {
-            let (v, idm, ifm) = input(s);
-            let (xa, mut dx) = m.deriv(sw, st, v, idm, ifm, wk, np);
+            let (v, idm, ifm) = self.input(k, s);
+            let (xa, mut dx) = m.deriv(self.sw, st, v, idm, ifm, wk, np);
             let te = 1.5 * np * (xa.pd * xa.iq - xa.pq * xa.id);
-            dx.wm = (te - btot * xa.wm - extra(k, xa.wm)) / j;
+            dx.wm = (te - btot * xa.wm - self.run.t.shaft.extra_nm(k, xa.wm)) / j;
             dx
         };
         let add = |a: &FullState, b: &FullState, h: f64| FullState {
@@ -298,10 +396,10 @@ pub(super) fn simulate_full(
             pq: a.pq + h * b.pq,
             wm: a.wm + h * b.wm,
         };
-        let k1 = f(&x, 0.0);
-        let k2 = f(&add(&x, &k1, 0.5 * dt), 0.5);
-        let k3 = f(&add(&x, &k2, 0.5 * dt), 0.5);
-        let k4 = f(&add(&x, &k3, dt), 1.0);
+        let k1 = f(x, 0.0);
+        let k2 = f(&add(x, &k1, 0.5 * dt), 0.5);
+        let k3 = f(&add(x, &k2, 0.5 * dt), 0.5);
+        let k4 = f(&add(x, &k3, dt), 1.0);
         let sum = FullState {
             id: k1.id + 2.0 * (k2.id + k3.id) + k4.id,
             iq: k1.iq + 2.0 * (k2.iq + k3.iq) + k4.iq,
@@ -309,7 +407,7 @@ pub(super) fn simulate_full(
             pq: k1.pq + 2.0 * (k2.pq + k3.pq) + k4.pq,
             wm: k1.wm + 2.0 * (k2.wm + k3.wm) + k4.wm,
         };
-        x = add(&x, &sum, dt / 6.0);
+        let mut x = add(x, &sum, dt / 6.0);
         let corr = (d.theta[k + 1] - d.theta[k]) - wk * dt;
         if corr != 0.0 {
             let r = C64::from_polar(1.0, -corr);
@@ -317,11 +415,6 @@ pub(super) fn simulate_full(
             let p = C64::new(x.pd, x.pq) * r;
             (x.id, x.iq, x.pd, x.pq) = (i.re, i.im, p.re, p.im);
         }
-        if !(x.id.is_finite() && x.iq.is_finite() && x.pd.is_finite() && x.wm.is_finite()) {
-            // A diverging trial of the fit: stop; the residuals of the missing samples are
-            // large (the fit treats a short prediction as a bad one).
-            break;
-        }
+        x
     }
-    out
 }

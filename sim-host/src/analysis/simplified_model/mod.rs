@@ -1,8 +1,11 @@
-//! The paper's simplified model (eqs. 23-29), driven by measured inputs, with effects: the
-//! model `compare` and `explain` test against a log. (The simulator's full-order machine
-//! is `crate::sim`'s; the core evaluates the same simplified model's residuals.)
+//! The simplified model of "Fault Diagnosis of Induction Motor Using D-Q Simplified Model
+//! and Parity Equations" (Energies 2022, 15(22), 8372; eqs. 23-29), driven by measured
+//! inputs, with effects: the model `compare` and `explain` test against a log. (The
+//! simulator's full-order machine is `crate::sim`'s; the core evaluates the same simplified
+//! model's residuals.)
 //!
-//! Base model (rotor-flux frame, DESIGN.md §2), per working sample:
+//! Base model (rotor-flux frame; the models and their sources: `docs/design.md`), per
+//! working sample:
 //! ```text
 //!   Psi   = Ls i_f                        (i_f = measured positive-sequence I_ds, smoothed)
 //!   I_qs  = (V_qs - Psi omega_r) / Ra     (eq. 23/28 with La dI_qs/dt dropped: see below)
@@ -14,7 +17,7 @@
 //! matters; treating them as effects lets `explain` name them when transients dominate.
 //!
 //! With all four dynamics effects in, the model is the full-order machine driven by the
-//! measured voltages and runs in the stationary frame (`simulate_stationary`): the
+//! measured voltages and runs in the stationary frame (`stationary`): the
 //! analysis frame then only projects its outputs. There the effects that change the
 //! machine act as the simulator injects them (`crate::sim`'s machine), not through their
 //! steady-state descriptions: the heated cage's rotor time constant (`thermal_drift`),
@@ -22,22 +25,28 @@
 //! stator winding ([`WindingAsymmetry`], `phase_asymmetry`) and rotor cage
 //! (`CageAsymmetry`, `rotor_asymmetry`).
 //!
-//! The mechanical equation is integrated semi-implicitly (the speed dependence of the
-//! quasi-static torque is taken at the new speed), so the step is stable at any working rate.
-//! Effects enter through [`EffectTerms`]: per-sample series computed from the measured inputs
-//! (resistance factor, magnetising-inductance factor, extra load torque, negative-sequence
-//! current) and a speed-dependent extra torque evaluated inside the loop.
+//! The forms: `reduced` (the paper's model with the effects' steady-state terms; the
+//! mechanical equation semi-implicit, so the step is stable at any working rate),
+//! `full_order` (the full-order form in the analysis frame, with the dynamics effects
+//! that are in) and `stationary` (all four in).
+//!
+//! Effects enter through one interface, [`ModelTerms`]: physical channels (resistance and
+//! magnetising-inductance scales per sample, the magnetising law and the core loss, extra
+//! shaft torques, the negative sequence, unequal windings, which states are dynamic) that
+//! each effect writes and the model reads; the model does not name effects.
 
 mod full_order;
 mod reduced;
 mod stationary;
 mod terms;
 
-pub use terms::{EffectTerms, WindingAsymmetry};
+pub use terms::{
+    CageAsymmetry, Dynamics, Magnetising, ModelTerms, NegativeSequence, Resistance, RotorCage,
+    SaturationLaw, Shaft, SpeedTorque, WindingAsymmetry,
+};
 
 use super::prep::{Prepared, C64};
 use crate::params::ParamFile;
-use reduced::simulate_with;
 
 /// The machine constants the simplified model and the effects need: the parameter file's
 /// nominal values and what [`monitor_core::MotorModel`] derives from them (Ra, La, the
@@ -137,6 +146,23 @@ impl BaseParams {
     }
 }
 
+/// The shaft's constants of a run: J [kg m^2] and B + Bl [N m s/rad] of the base
+/// parameters, held physical (J at least 1e-9, B + Bl at least 0).
+#[derive(Debug, Clone, Copy)]
+struct Mechanics {
+    j: f64,
+    btot: f64,
+}
+
+impl Mechanics {
+    fn new(n: &MachineConstants, b: &BaseParams) -> Self {
+        Mechanics {
+            j: (n.j_kgm2 * b.j_scale).max(1e-9),
+            btot: b.btot_nms.max(0.0),
+        }
+    }
+}
+
 /// White Gaussian noise added to the model's inputs, to measure how much of the inputs'
 /// sensor noise reaches the outputs (see `metrics::noise_floor`).
 #[derive(Debug, Clone, Copy)]
@@ -172,11 +198,12 @@ impl Prediction {
     }
 }
 
-/// Runs the model over the prepared data.
+/// Runs the model over the prepared data: the form the dynamics channel asks for
+/// ([`Dynamics`]).
 ///
 /// Initial state from the measurement at the first sample: w_m = measured speed (0 without
 /// a speed column), I_qs = measured, the normalised rotor flux phi = i_f.
-pub fn simulate(d: &Prepared, n: &MachineConstants, b: &BaseParams, t: &EffectTerms) -> Prediction {
+pub fn simulate(d: &Prepared, n: &MachineConstants, b: &BaseParams, t: &ModelTerms) -> Prediction {
     simulate_with(d, n, b, t, |k| C64::new(d.theta[k].cos(), d.theta[k].sin()))
 }
 
@@ -198,10 +225,28 @@ pub fn simulate_rot(
     rot: &[C64],
     n: &MachineConstants,
     b: &BaseParams,
-    t: &EffectTerms,
+    t: &ModelTerms,
 ) -> Prediction {
     if rot.len() != d.len() {
         return simulate(d, n, b, t);
     }
     simulate_with(d, n, b, t, |k| rot[k])
+}
+
+/// The form of the model the dynamics channel asks for, `rot_at(k)` the frame rotation.
+#[inline(always)]
+fn simulate_with(
+    d: &Prepared,
+    n: &MachineConstants,
+    b: &BaseParams,
+    t: &ModelTerms,
+    rot_at: impl Fn(usize) -> C64,
+) -> Prediction {
+    if t.dynamics.is_full_order() {
+        stationary::simulate_stationary(d, n, b, t, rot_at)
+    } else if t.dynamics.needs_full_form() {
+        full_order::simulate_full(d, n, b, t, rot_at)
+    } else {
+        reduced::simulate_reduced(d, n, b, t, rot_at)
+    }
 }

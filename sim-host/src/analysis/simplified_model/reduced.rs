@@ -1,9 +1,6 @@
 //! The reduced model: the paper's simplified model with the effects' steady-state terms.
 
-use super::full_order::simulate_full;
-use super::stationary::simulate_stationary;
-use super::terms::reduced_i_neg;
-use super::{BaseParams, EffectTerms, InputNoise, MachineConstants, Prediction};
+use super::{BaseParams, InputNoise, MachineConstants, Mechanics, ModelTerms, Prediction};
 use crate::analysis::prep::{Prepared, C64};
 
 /// The model's inputs at one working sample: V_ds, V_qs, I_ds, i_f, positive-sequence I_qs.
@@ -25,7 +22,7 @@ struct InputSource<'a> {
 }
 
 impl<'a> InputSource<'a> {
-    fn new(d: &'a Prepared, t: &EffectTerms) -> Self {
+    fn new(d: &'a Prepared, t: &ModelTerms) -> Self {
         let noise = t.input_noise.map(|nz| {
             use rand::SeedableRng;
             (
@@ -72,7 +69,8 @@ impl<'a> InputSource<'a> {
     }
 }
 
-/// The machine behind the core-loss conductance (`iron_loss`) at one sample.
+/// The machine behind the core-loss conductance ([`super::Magnetising::core_loss_s`]) at
+/// one sample.
 #[derive(Debug, Clone, Copy)]
 struct CoreLoss {
     /// Flux-making current of the machine [A].
@@ -91,7 +89,7 @@ struct CoreLoss {
     iq_shift: f64,
 }
 
-/// Core loss (`iron_loss`, g = 1/Rfe across the magnetising branch, behind Rs): the
+/// Core loss (g = 1/Rfe across the magnetising branch, behind Rs): the
 /// terminal current is the machine's i_s plus i_fe = g j w_s psi_s, psi_s =
 /// Ls i_ds + j sigma Ls i_qs. Three consequences, all evaluated here:
 /// (1) Rs carries i_fe too: the machine behind Rs sees V_qs - Rs i_fe,q;
@@ -144,137 +142,247 @@ pub(super) fn initial_state(d: &Prepared, n: &MachineConstants) -> (f64, f64) {
     (wm, iq)
 }
 
-#[inline(always)]
-pub(super) fn simulate_with(
-    d: &Prepared,
-    n: &MachineConstants,
-    b: &BaseParams,
-    t: &EffectTerms,
-    rot_at: impl Fn(usize) -> C64,
-) -> Prediction {
-    if t.d_axis && t.cross_coupling && t.la_h.is_some() && t.tau_r_s.is_some() {
-        return simulate_stationary(d, n, b, t, rot_at);
+impl CoreLoss {
+    /// No core loss: the measured inputs as they are.
+    fn none(x: Inputs) -> Self {
+        CoreLoss {
+            i_f: x.i_f,
+            id_raw: x.id,
+            vq: x.vq,
+            eps: 0.0,
+            id_term: x.id,
+            i_fe_q: 0.0,
+            iq_shift: 0.0,
+        }
     }
-    if t.d_axis || t.cross_coupling {
-        return simulate_full(d, n, b, t, rot_at);
+}
+
+/// The reduced model's constants over a run.
+struct Reduced<'a> {
+    d: &'a Prepared,
+    n: &'a MachineConstants,
+    b: &'a BaseParams,
+    t: &'a ModelTerms,
+    mech: Mechanics,
+    /// Rs and the rotor term of Ra with the refitted Ra scale [ohm].
+    rs0: f64,
+    rr0: f64,
+    /// Largest |I_ds| [A] (the floor of the flux in the slip term).
+    i_f_ref: f64,
+    /// Decay of the rotor flux over a sample with rotor-flux dynamics.
+    flux_decay: Option<f64>,
+    /// Decay over a sample of the flux's deviation driven by the rotor flux drive.
+    drive_decay: f64,
+}
+
+/// The reduced model's state: speed [rad/s, mechanical], I_qs [A], the normalised rotor
+/// flux phi = psi_r/Lm [A] and its driven deviation [A].
+struct State {
+    wm: f64,
+    iq: f64,
+    phi: f64,
+    phi_dev: f64,
+}
+
+/// The machine at one sample: resistances, inductances [ohm, H].
+struct AtSample {
+    rs: f64,
+    rr: f64,
+    lm: f64,
+    ls: f64,
+    /// Lm^2 / Lr [H].
+    lmr: f64,
+}
+
+/// The flux's part of eqs. (28)-(29) at one sample: Psi' [Wb] of eq. (28), the resistance
+/// of its quasi-static solution [ohm], and the flux current the torque uses [A].
+struct FluxTerms {
+    psi_p: f64,
+    rden: f64,
+    phi_t: f64,
+}
+
+impl<'a> Reduced<'a> {
+    fn new(d: &'a Prepared, n: &'a MachineConstants, b: &'a BaseParams, t: &'a ModelTerms) -> Self {
+        let dt = d.dt_s;
+        Reduced {
+            d,
+            n,
+            b,
+            t,
+            mech: Mechanics::new(n, b),
+            rs0: n.rs_ohm * b.ra_scale,
+            rr0: n.rr_a_ohm * b.ra_scale,
+            i_f_ref: d.id.iter().fold(0.0f64, |a, &x| a.max(x.abs())).max(1e-6),
+            flux_decay: t
+                .dynamics
+                .rotor_flux_tau_s
+                .map(|tau| (-dt / tau.max(1e-5)).exp()),
+            drive_decay: (-dt * n.rr_ohm / n.lr_h).exp(),
+        }
     }
-    let len = d.len();
-    let mut out = Prediction::with_capacity(len);
-    if len == 0 || d.vq.len() != len {
-        return out;
+
+    /// The initial state (the measurement's first 10 ms, the flux at i_f).
+    fn initial(&self) -> State {
+        let (wm, iq) = initial_state(self.d, self.n);
+        let start = self.t.rotor_cage.flux_drive_start;
+        State {
+            wm,
+            iq,
+            phi: self.d.i_f[0] + start,
+            phi_dev: start,
+        }
     }
-    let dt = d.dt_s;
-    let j = (n.j_kgm2 * b.j_scale).max(1e-9);
-    let btot = b.btot_nms.max(0.0);
-    let rs0 = n.rs_ohm * b.ra_scale;
-    let rr0 = n.rr_a_ohm * b.ra_scale;
-    let (mut wm, mut iq_state) = initial_state(d, n);
-    let mut phi = d.i_f[0];
-    let i_f_ref = d.id.iter().fold(0.0f64, |a, &x| a.max(x.abs())).max(1e-6);
-    let flux_decay = t.tau_r_s.map(|tau| (-dt / tau.max(1e-5)).exp());
-    // The rotor flux's deviation driven by `phi_drive` when the flux is quasi-static.
-    let drive_decay = (-dt * n.rr_ohm / n.lr_h).exp();
-    phi += t.phi_drive_start;
-    let mut phi_dev = t.phi_drive_start;
-    let mut inputs = InputSource::new(d, t);
-    for k in 0..len {
-        let x = inputs.at(k);
-        let rf = t.r_factor.get(k).copied().unwrap_or(1.0);
-        let mf = t.lm_factor.get(k).copied().unwrap_or(1.0);
-        let rs = rs0 * rf;
-        let rr = rr0 * rf * t.rr_factor.get(k).copied().unwrap_or(1.0);
+
+    /// The machine at sample `k`: the resistance and magnetising channels applied.
+    fn at(&self, k: usize) -> AtSample {
+        let (n, t) = (self.n, self.t);
+        let rf = t.resistance.scale.get(k).copied().unwrap_or(1.0);
+        let mf = t.magnetising.lm_scale.get(k).copied().unwrap_or(1.0);
         let lm = n.lm_h * mf;
-        let ls = b.ls_scale * (n.lls_h + lm);
-        let lmr = lm * lm / (n.llr_h + lm);
-        let cl = if t.g_fe_s != 0.0 {
-            let cl = core_loss(t.g_fe_s, d.omega_s[k], n, ls, lm, rs, x);
-            if k == 0 {
-                // The states start from the machine's own currents, not the terminal ones.
-                iq_state += cl.iq_shift;
-                phi = cl.i_f + t.phi_drive_start;
-            }
-            cl
-        } else {
-            CoreLoss {
-                i_f: x.i_f,
-                id_raw: x.id,
-                vq: x.vq,
-                eps: 0.0,
-                id_term: x.id,
-                i_fe_q: 0.0,
-                iq_shift: 0.0,
-            }
-        };
-        // Flux: phi = psi_r / Lm [A].
-        let drive = t.phi_drive.get(k).copied().unwrap_or(0.0);
-        let (psi_p, rden, phi_t) = match flux_decay {
+        AtSample {
+            rs: self.rs0 * rf,
+            rr: self.rr0 * rf * t.resistance.rotor_scale.get(k).copied().unwrap_or(1.0),
+            lm,
+            ls: self.b.ls_scale * (n.lls_h + lm),
+            lmr: lm * lm / (n.llr_h + lm),
+        }
+    }
+
+    /// The core loss at sample `k`; at the first sample the states start from the
+    /// machine's own currents, not the terminal ones.
+    fn core_loss(&self, k: usize, m: &AtSample, x: Inputs, s: &mut State) -> CoreLoss {
+        let g = self.t.magnetising.core_loss_s;
+        if g == 0.0 {
+            return CoreLoss::none(x);
+        }
+        let cl = core_loss(g, self.d.omega_s[k], self.n, m.ls, m.lm, m.rs, x);
+        if k == 0 {
+            s.iq += cl.iq_shift;
+            s.phi = cl.i_f + self.t.rotor_cage.flux_drive_start;
+        }
+        cl
+    }
+
+    /// The rotor flux at sample `k` (phi = psi_r / Lm [A]): with rotor-flux dynamics it
+    /// follows the raw I_ds through the rotor time constant; without, it is i_f (plus the
+    /// deviation the flux drive makes through the nominal rotor time constant).
+    fn flux(&self, k: usize, m: &AtSample, cl: &CoreLoss, s: &mut State) -> FluxTerms {
+        let (ls, lmr, rs, rr) = (m.ls, m.lmr, m.rs, m.rr);
+        let ls_scale = self.b.ls_scale;
+        let cage = &self.t.rotor_cage;
+        let drive = cage.flux_drive.get(k).copied().unwrap_or(0.0);
+        match self.flux_decay {
             Some(a) => {
                 // The rotor flux follows the raw I_ds (its own lag filters the noise).
                 let target = cl.id_raw + drive;
-                phi = target + (phi - target) * a;
+                s.phi = target + (s.phi - target) * a;
+                let phi = s.phi;
                 // sigma Ls part with the raw I_ds (fast), the rotor part through phi.
-                let psi_p = (ls - b.ls_scale * lmr) * cl.id_raw + b.ls_scale * lmr * phi;
-                let phi_c = if phi.abs() < 0.05 * i_f_ref {
-                    0.05 * i_f_ref * if phi < 0.0 { -1.0 } else { 1.0 }
+                let psi_p = (ls - ls_scale * lmr) * cl.id_raw + ls_scale * lmr * phi;
+                let phi_c = if phi.abs() < 0.05 * self.i_f_ref {
+                    0.05 * self.i_f_ref * if phi < 0.0 { -1.0 } else { 1.0 }
                 } else {
                     phi
                 };
                 let rden = rs + rr * psi_p / (ls * phi_c);
-                (psi_p, rden.clamp(0.2 * (rs + rr), 50.0 * (rs + rr)), phi)
+                FluxTerms {
+                    psi_p,
+                    rden: rden.clamp(0.2 * (rs + rr), 50.0 * (rs + rr)),
+                    phi_t: phi,
+                }
             }
-            None if t.phi_drive.is_empty() => (ls * cl.i_f, rs + rr, cl.i_f),
+            None if cage.flux_drive.is_empty() => FluxTerms {
+                psi_p: ls * cl.i_f,
+                rden: rs + rr,
+                phi_t: cl.i_f,
+            },
             None => {
-                phi_dev = drive + (phi_dev - drive) * drive_decay;
-                let phi = cl.i_f + phi_dev;
-                let psi_p = ls * cl.i_f + b.ls_scale * lmr * phi_dev;
+                s.phi_dev = drive + (s.phi_dev - drive) * self.drive_decay;
+                let phi = cl.i_f + s.phi_dev;
+                let psi_p = ls * cl.i_f + ls_scale * lmr * s.phi_dev;
                 let phi_c = if phi.abs() < 1e-6 { 1e-6 } else { phi };
-                (psi_p, rs + rr * psi_p / (ls * phi_c), phi)
+                FluxTerms {
+                    psi_p,
+                    rden: rs + rr * psi_p / (ls * phi_c),
+                    phi_t: phi,
+                }
             }
-        };
-        let kt = 1.5 * n.np * lmr * phi_t; // Te = kt * iq  [N m/A]
-        let extra = |w: f64| {
-            // (No tanh when there is no dry friction: 0 x tanh(w) is 0.)
-            let coulomb = if t.coulomb_nm != 0.0 {
-                t.coulomb_nm * (w / 1.0).tanh()
-            } else {
-                0.0
-            };
-            coulomb + t.windage_nms2 * w * w.abs() + t.load_nm.get(k).copied().unwrap_or(0.0)
-        };
-        let vq = cl.vq;
-        let iq;
-        match t.la_h {
+        }
+    }
+
+    /// Eqs. (28)-(29) over one sample: the new I_qs and speed from V_qs `vq` [V] (the
+    /// speed semi-implicit, so the step is stable at any working rate).
+    fn mechanics(&self, k: usize, m: &AtSample, f: &FluxTerms, vq: f64, s: &mut State) {
+        let (n, dt) = (self.n, self.d.dt_s);
+        let Mechanics { j, btot } = self.mech;
+        let kt = 1.5 * n.np * m.lmr * f.phi_t; // Te = kt * iq  [N m/A]
+        let extra = |w: f64| self.t.shaft.extra_nm(k, w);
+        let (psi_p, rden) = (f.psi_p, f.rden);
+        match self.t.dynamics.stator_current_la_h {
             Some(la) => {
-                let iq_ss = (vq - psi_p * n.np * wm) / rden;
+                let iq_ss = (vq - psi_p * n.np * s.wm) / rden;
                 let a = (-dt * rden / la.max(1e-6)).exp();
-                iq_state = iq_ss + (iq_state - iq_ss) * a;
-                iq = iq_state;
-                let te = kt * iq;
-                wm = (j * wm + dt * (te - extra(wm))) / (j + dt * btot);
+                s.iq = iq_ss + (s.iq - iq_ss) * a;
+                let te = kt * s.iq;
+                s.wm = (j * s.wm + dt * (te - extra(s.wm))) / (j + dt * btot);
             }
             None => {
                 // Te = kt (vq - psi_p Np wm)/rden, linear in wm: implicit.
                 let a = kt * vq / rden;
                 let bb = kt * psi_p * n.np / rden;
-                wm = (j * wm + dt * (a - extra(wm))) / (j + dt * (bb + btot));
-                iq = (vq - psi_p * n.np * wm) / rden;
+                s.wm = (j * s.wm + dt * (a - extra(s.wm))) / (j + dt * (bb + btot));
+                s.iq = (vq - psi_p * n.np * s.wm) / rden;
             }
         }
-        let rot = rot_at(k);
-        let ineg = reduced_i_neg(d, t, k);
-        // Back to the analysis frame (measured d current, predicted q current).
+    }
+
+    /// The outputs at sample `k` in the analysis frame turned by `rot`: the measured d
+    /// current, the predicted q current (with the core loss' frame tilt undone), the
+    /// negative sequence added.
+    fn output(&self, k: usize, rot: C64, cl: &CoreLoss, s: &State, out: &mut Prediction) {
+        let d = self.d;
+        let ineg = self.t.reduced_i_neg(d, k);
         let i_dq = if cl.eps != 0.0 {
-            let i_true = C64::new(cl.id_term, iq + cl.i_fe_q);
+            let i_true = C64::new(cl.id_term, s.iq + cl.i_fe_q);
             let fwd = C64::new(cl.eps.cos(), cl.eps.sin());
             C64::new(d.id[k], (i_true * fwd).im)
         } else {
             // The measured I_ds (not a re-noised one: the error never sees its noise).
-            C64::new(d.id[k], iq)
+            C64::new(d.id[k], s.iq)
         };
         let i_ab = i_dq * rot + ineg;
         out.iq.push(i_dq.im + (ineg * rot.conj()).im);
-        out.omega_r.push(n.np * wm);
+        out.omega_r.push(self.n.np * s.wm);
         out.i_ab.push(i_ab);
+    }
+}
+
+/// The reduced model (no full-order dynamics: see the module doc of [`super`]) over the
+/// working series, `rot_at(k)` the frame rotation `e^{j theta_k}`.
+#[inline(always)]
+pub(super) fn simulate_reduced(
+    d: &Prepared,
+    n: &MachineConstants,
+    b: &BaseParams,
+    t: &ModelTerms,
+    rot_at: impl Fn(usize) -> C64,
+) -> Prediction {
+    let len = d.len();
+    let mut out = Prediction::with_capacity(len);
+    if len == 0 || d.vq.len() != len {
+        return out;
+    }
+    let model = Reduced::new(d, n, b, t);
+    let mut s = model.initial();
+    let mut inputs = InputSource::new(d, t);
+    for k in 0..len {
+        let x = inputs.at(k);
+        let m = model.at(k);
+        let cl = model.core_loss(k, &m, x, &mut s);
+        let f = model.flux(k, &m, &cl, &mut s);
+        model.mechanics(k, &m, &f, cl.vq, &mut s);
+        model.output(k, rot_at(k), &cl, &s, &mut out);
     }
     out
 }

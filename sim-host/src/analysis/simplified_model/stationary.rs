@@ -1,8 +1,9 @@
-//! The full-order machine in the stationary frame (all four dynamics effects in the model).
+//! The full-order machine in the stationary frame (all four states of [`super::Dynamics`]
+//! dynamic).
 
-use super::full_order::{full_initial_state, FullMachine};
-use super::terms::WindingAsymmetry;
-use super::{BaseParams, EffectTerms, MachineConstants, Prediction};
+use super::full_order::{FullMachine, FullRun};
+use super::terms::{SaturationLaw, Shaft, WindingAsymmetry};
+use super::{BaseParams, MachineConstants, Mechanics, ModelTerms, Prediction};
 use crate::analysis::prep::{self, Prepared, C64};
 
 /// The state of the stationary-frame full-order model: stator current, rotor flux
@@ -23,7 +24,7 @@ struct StatState {
 /// `dpsi_r/dt = -R_r i_r + j omega_r psi_r` becomes
 /// `dpsi_R/dt = (I + D) (Rr' i - a psi_R) + j omega_r psi_R`.
 #[derive(Debug, Clone, Copy)]
-struct CageAsymmetry {
+struct CageOverSample {
     /// delta / 3.
     d3: f64,
     /// e^{j 2 theta_a} at the sample's start.
@@ -33,22 +34,23 @@ struct CageAsymmetry {
 }
 
 /// One working sample's machine and shaft for [`simulate_stationary`].
-struct StatMachine<'a, F: Fn(f64) -> f64> {
+struct StatMachine<'a> {
     m: FullMachine,
     np: f64,
-    j: f64,
-    btot: f64,
-    /// Extra shaft torque at a speed [N m].
-    extra: &'a F,
-    /// `phase_asymmetry` (the terminal current is `A i'`, see [`WindingAsymmetry`]).
+    mech: Mechanics,
+    /// The shaft's extra torques and the sample they are taken at.
+    shaft: &'a Shaft,
+    k: usize,
+    /// An unequal stator winding (the terminal current is `A i'`, see
+    /// [`WindingAsymmetry`]).
     wind: Option<WindingAsymmetry>,
-    /// `rotor_asymmetry`.
-    cage: Option<CageAsymmetry>,
-    /// `saturation`: the states are the fluxes of the T-equivalent circuit.
+    /// An unequal rotor cage.
+    cage: Option<CageOverSample>,
+    /// A magnetising law: the states are the fluxes of the T-equivalent circuit.
     sat: Option<SatMachine<'a>>,
 }
 
-/// The saturated machine (`saturation` in the full-order model) as the simulator
+/// The saturated machine (a magnetising law in the full-order model) as the simulator
 /// integrates it (`crate::sim`'s machine): T-equivalent circuit, states psi_s and psi_r
 /// (stationary frame; in [`StatState`] `i` holds psi_s and `psi` holds psi_r), currents
 /// from the fluxes with Lm = Lm0 / (1 + (|psi_m| / psi_sat)^n):
@@ -64,8 +66,8 @@ struct StatMachine<'a, F: Fn(f64) -> f64> {
 /// (Llr/Lr)^2, 0.2 %, of the fitted one). Given psi_s and psi_r, y = 1/Lm solves
 /// `y = (1/Lm0) (1 + (W / (psi_sat (y + G)))^n)`, W = |psi_s/Lls + psi_r/Llr|,
 /// G = 1/Lls + 1/Llr, by Newton's method from the last solve (f is increasing in y).
-/// The winding (`phase_asymmetry`) and the cage (`rotor_asymmetry`) act as in
-/// [`WindingAsymmetry`] and [`CageAsymmetry`], on the fluxes' equations.
+/// The winding and the cage act as in [`WindingAsymmetry`] and [`CageOverSample`], on the
+/// fluxes' equations.
 #[derive(Clone, Copy)]
 struct SatMachine<'a> {
     inv_lls: f64,
@@ -82,7 +84,7 @@ impl<'a> SatMachine<'a> {
     fn new(
         n: &MachineConstants,
         m: &FullMachine,
-        (psi_sat, nexp): (f64, f64),
+        law: SaturationLaw,
         guess: &'a std::cell::Cell<f64>,
     ) -> Self {
         let sigma_n = n.lls_h + n.lm_h * n.llr_h / (n.llr_h + n.lm_h);
@@ -94,8 +96,8 @@ impl<'a> SatMachine<'a> {
             inv_llr: 1.0 / llr.max(1e-9),
             inv_lm0: 1.0 / lm0,
             rr: m.a * (llr + lm0),
-            psi_sat: psi_sat.max(1e-9),
-            nexp,
+            psi_sat: law.psi_sat_wb.max(1e-9),
+            nexp: law.exponent,
             guess,
         }
     }
@@ -134,7 +136,7 @@ impl<'a> SatMachine<'a> {
     }
 }
 
-impl<F: Fn(f64) -> f64> StatMachine<'_, F> {
+impl StatMachine<'_> {
     /// The derivative at time `tau` into the working sample [s] (the rotor's angle).
     #[inline(always)]
     fn deriv(&self, x: &StatState, v: C64, tau: f64) -> StatState {
@@ -159,7 +161,7 @@ impl<F: Fn(f64) -> f64> StatMachine<'_, F> {
         StatState {
             i: (v - ri - dpsi) / m.l_sigma.max(1e-9),
             psi: dpsi,
-            wm: (te - self.btot * x.wm - (self.extra)(x.wm)) / self.j,
+            wm: (te - self.mech.btot * x.wm - self.shaft.extra_nm(self.k, x.wm)) / self.mech.j,
         }
     }
 
@@ -181,7 +183,7 @@ impl<F: Fn(f64) -> f64> StatMachine<'_, F> {
         StatState {
             i: u_s,
             psi: C64::new(0.0, wr) * x.psi - ri,
-            wm: (te - self.btot * x.wm - (self.extra)(x.wm)) / self.j,
+            wm: (te - self.mech.btot * x.wm - self.shaft.extra_nm(self.k, x.wm)) / self.mech.j,
         }
     }
 
@@ -290,7 +292,7 @@ fn phase_step(a: C64, b: C64) -> f64 {
 ///   dpsi_R/dt     = Rr' i - (a - j omega_r) psi_R
 ///   J dw_m/dt     = (3/2) Np Im(conj(psi_R) i) - (B + Bl) w_m - T_extra(w_m)
 /// ```
-/// with the symbols of [`simulate_full`]. Nothing of the machine's dynamics depends on
+/// with the symbols of `full_order::simulate_full`. Nothing of the machine's dynamics depends on
 /// the analysis frame: the frame only projects the outputs (I_qs) as it projects the
 /// measurement. (Run in the frame, the model reads the inputs in a frame whose angle
 /// comes from the voltage-model flux estimate, which through a start turns by up to
@@ -316,63 +318,38 @@ pub(super) fn simulate_stationary(
     d: &Prepared,
     n: &MachineConstants,
     b: &BaseParams,
-    t: &EffectTerms,
+    t: &ModelTerms,
     rot_at: impl Fn(usize) -> C64,
 ) -> Prediction {
+    // With a magnetising law the machine saturates with its own flux ([`SatMachine`]), not
+    // with the reduced model's scale from the measured i_f.
+    let Some(run) = FullRun::new(d, n, b, t, t.magnetising.law.is_some()) else {
+        return Prediction::default();
+    };
     let len = d.len();
     let mut out = Prediction::with_capacity(len);
-    if len == 0 || d.vq.len() != len {
-        return out;
-    }
-    let dt = d.dt_s;
-    let StatVoltage {
-        v_mean,
-        ph,
-        gains,
-        dev,
-        step_thr,
-    } = StatVoltage::new(d, &rot_at);
-    let gain = |k: usize| gains[k];
-    // The voltage before the block mean.
-    let v_at = |k: usize| v_mean[k] / gains[k];
-    let i_meas = |k: usize| d.i_ab[k] - d.i_neg[k];
-    // With `saturation` the machine saturates with its own flux ([`SatMachine`]), not with
-    // the reduced model's factor from the measured i_f.
-    let machine_at = |k: usize| match t.sat {
-        Some(_) => FullMachine::at_lm(n, b, t, k, 1.0),
-        None => FullMachine::at(n, b, t, k),
-    };
-    let x0 = full_initial_state(d, n, &machine_at(0));
-    let r0 = rot_at(0);
+    let volt = StatVoltage::new(d, &rot_at);
+    let (x0, r0) = (run.x0, rot_at(0));
     let mut x = StatState {
         i: C64::new(x0.id, x0.iq) * r0,
         psi: C64::new(x0.pd, x0.pq) * r0,
         wm: x0.wm,
     };
-    let mut v_cur = v_at(0);
-    let mut v_next = v_at(1.min(len - 1));
+    let mut v = [volt.v_at(0), volt.v_at(1.min(len - 1))];
     let mut cage = CageAngle::new(d, t);
     let lm_guess = std::cell::Cell::new(0.0);
     for k in 0..len {
-        let extra = |w: f64| {
-            let coulomb = if t.coulomb_nm != 0.0 {
-                t.coulomb_nm * w.tanh()
-            } else {
-                0.0
-            };
-            coulomb + t.windage_nms2 * w * w.abs() + t.load_nm.get(k).copied().unwrap_or(0.0)
-        };
         let sm = StatMachine {
-            m: machine_at(k),
+            m: run.machine(k),
             np: n.np,
-            j: (n.j_kgm2 * b.j_scale).max(1e-9),
-            btot: b.btot_nms.max(0.0),
-            extra: &extra,
-            wind: t.winding,
+            mech: run.mech,
+            shaft: &t.shaft,
+            k,
+            wind: t.stator_winding,
             cage: cage.at(d, k),
             sat: None,
         };
-        let sm = match t.sat {
+        let sm = match t.magnetising.law {
             Some(law) => {
                 let sat = SatMachine::new(n, &sm.m, law, &lm_guess);
                 if k == 0 {
@@ -385,63 +362,104 @@ pub(super) fn simulate_stationary(
             }
             None => sm,
         };
-        let rot = rot_at(k);
-        // With `v_neg_gain` the negative sequence is in the machine's own current.
-        let ineg = match t.v_neg_gain {
-            Some(_) => C64::default(),
-            None => t.i_neg.get(k).copied().unwrap_or_default(),
-        };
-        let mut i_out = sm.terminal(&x);
-        if t.g_fe_s != 0.0 {
-            let psi_s = sm.stator_flux(&x);
-            i_out += C64::new(0.0, t.g_fe_s * d.omega_s[k]) * psi_s;
-        }
-        let i_ab = i_out * gain(k) + ineg;
-        out.iq.push((i_ab * rot.conj()).im);
-        out.omega_r.push(n.np * x.wm);
-        out.i_ab.push(i_ab);
+        stationary_output(&run, &volt, &sm, &x, k, rot_at(k), &mut out);
         if k + 1 == len {
             break;
         }
-        let v_after = v_at((k + 2).min(len - 1));
-        // The negative sequence (`supply_unbalance`), rotating the other way.
-        let (vn0, vn1) = match t.v_neg_gain {
-            Some(g) => {
-                let at = |j: usize| d.v_neg.get(j).copied().unwrap_or_default();
-                (g * at(k), g * at(k + 1))
-            }
-            None => (C64::default(), C64::default()),
-        };
-        let (v0, v1) = (v_cur + vn0, v_next + vn1);
-        x = if dev[k] > step_thr {
-            let w = [ph[k - 1] / dt, ph[k + 1] / dt];
-            let (s0, s1) = ([v_cur, vn0], [v_next, vn1]);
-            let early = sm.across_step(&x, dt, 0.0, s0, s1, w);
-            let late = sm.across_step(&x, dt, 1.0, s0, s1, w);
-            // The measured currents before the block mean, as the model's.
-            let target = i_meas(k + 1) / gain(k + 1) - (i_meas(k) / gain(k) - sm.terminal(&x));
-            let (early_i, late_i) = (sm.terminal(&early), sm.terminal(&late));
-            let span = late_i - early_i;
-            let phi = if span.norm_sqr() > 0.0 {
-                ((target - early_i) * span.conj()).re / span.norm_sqr()
-            } else {
-                0.5
-            };
-            sm.across_step(&x, dt, phi.clamp(0.0, 1.0), s0, s1, w)
-        } else {
-            let half = C64::from_polar(1.0, 0.5 * ph[k]);
-            let vm = (v_cur * half + v_next * half.conj()) * 0.5
-                + (vn0 * half.conj() + vn1 * half) * 0.5;
-            sm.rk4(&x, dt, [v0, vm, v1], 0.0)
-        };
+        let v_after = volt.v_at((k + 2).min(len - 1));
+        x = stationary_step(&run, &volt, &sm, &x, k, v);
         // The measured (positive-sequence) voltages move on; `y V_neg` is added per sample
-        // above (carrying `v1` over counted it twice at each sample's start).
-        (v_cur, v_next) = (v_next, v_after);
+        // (carrying `v1` over counted it twice at each sample's start).
+        v = [v[1], v_after];
         if !(x.i.re.is_finite() && x.i.im.is_finite() && x.psi.re.is_finite() && x.wm.is_finite()) {
             break;
         }
     }
     out
+}
+
+/// The outputs of the stationary-frame model at sample `k`: the terminal current (with
+/// the core-loss current, after the block mean), projected on the analysis frame `rot`.
+fn stationary_output(
+    run: &FullRun<'_>,
+    volt: &StatVoltage,
+    sm: &StatMachine<'_>,
+    x: &StatState,
+    k: usize,
+    rot: C64,
+    out: &mut Prediction,
+) {
+    let (d, t) = (run.d, run.t);
+    // With a negative-sequence voltage drive the negative sequence is in the machine's
+    // own current.
+    let ineg = match t.negative_sequence.voltage_gain {
+        Some(_) => C64::default(),
+        None => t
+            .negative_sequence
+            .current
+            .get(k)
+            .copied()
+            .unwrap_or_default(),
+    };
+    let mut i_out = sm.terminal(x);
+    let g = t.magnetising.core_loss_s;
+    if g != 0.0 {
+        let psi_s = sm.stator_flux(x);
+        i_out += C64::new(0.0, g * d.omega_s[k]) * psi_s;
+    }
+    let i_ab = i_out * volt.gains[k] + ineg;
+    out.iq.push((i_ab * rot.conj()).im);
+    out.omega_r.push(run.n.np * x.wm);
+    out.i_ab.push(i_ab);
+}
+
+/// The stationary-frame state at sample `k + 1` from `x` at `k`, `v` the positive-sequence
+/// voltages before the block mean at `k` and `k + 1`: RK4 along the rotation, or across a
+/// supply step placed where the measured current says it fell.
+fn stationary_step(
+    run: &FullRun<'_>,
+    volt: &StatVoltage,
+    sm: &StatMachine<'_>,
+    x: &StatState,
+    k: usize,
+    v: [C64; 2],
+) -> StatState {
+    let (d, t) = (run.d, run.t);
+    let dt = d.dt_s;
+    let [v_cur, v_next] = v;
+    // The negative sequence (a negative-sequence voltage drive), rotating the other way.
+    let (vn0, vn1) = match t.negative_sequence.voltage_gain {
+        Some(g) => {
+            let at = |j: usize| d.v_neg.get(j).copied().unwrap_or_default();
+            (g * at(k), g * at(k + 1))
+        }
+        None => (C64::default(), C64::default()),
+    };
+    let (v0, v1) = (v_cur + vn0, v_next + vn1);
+    let ph = &volt.ph;
+    if volt.dev[k] > volt.step_thr {
+        let w = [ph[k - 1] / dt, ph[k + 1] / dt];
+        let (s0, s1) = ([v_cur, vn0], [v_next, vn1]);
+        let early = sm.across_step(x, dt, 0.0, s0, s1, w);
+        let late = sm.across_step(x, dt, 1.0, s0, s1, w);
+        // The measured currents before the block mean, as the model's.
+        let gain = |k: usize| volt.gains[k];
+        let i_meas = |k: usize| d.i_ab[k] - d.i_neg[k];
+        let target = i_meas(k + 1) / gain(k + 1) - (i_meas(k) / gain(k) - sm.terminal(x));
+        let (early_i, late_i) = (sm.terminal(&early), sm.terminal(&late));
+        let span = late_i - early_i;
+        let phi = if span.norm_sqr() > 0.0 {
+            ((target - early_i) * span.conj()).re / span.norm_sqr()
+        } else {
+            0.5
+        };
+        sm.across_step(x, dt, phi.clamp(0.0, 1.0), s0, s1, w)
+    } else {
+        let half = C64::from_polar(1.0, 0.5 * ph[k]);
+        let vm =
+            (v_cur * half + v_next * half.conj()) * 0.5 + (vn0 * half.conj() + vn1 * half) * 0.5;
+        sm.rk4(x, dt, [v0, vm, v1], 0.0)
+    }
 }
 
 /// The stationary-frame model's voltage input, per working sample (see
@@ -460,6 +478,11 @@ struct StatVoltage {
 }
 
 impl StatVoltage {
+    /// The positive-sequence voltage at sample `k` before the block mean [V].
+    fn v_at(&self, k: usize) -> C64 {
+        self.v_mean[k] / self.gains[k]
+    }
+
     fn new(d: &Prepared, rot_at: &impl Fn(usize) -> C64) -> Self {
         let len = d.len();
         let dt = d.dt_s;
@@ -511,34 +534,37 @@ impl StatVoltage {
     }
 }
 
-/// The angle 2 theta_a + phi of the faulty rotor phase for [`CageAsymmetry`] (`None`
-/// without `rotor_asymmetry` or without a speed column): Np theta_m integrates the
+/// The angle 2 theta_a + phi of the faulty rotor phase for [`CageOverSample`] (`None`
+/// without an unequal cage or without a speed column): Np theta_m integrates the
 /// measured electrical speed (trapezoid) from the analysis frame's angle at the first
-/// sample, as the reduced model's `rotor_asymmetry` does, so that `phi` means the same.
+/// sample, as the reduced model's cage terms do, so that `phi` means the same.
 struct CageAngle {
-    /// (delta, phi) of the effect.
-    p: Option<(f64, f64)>,
+    /// The unequal cage of the terms.
+    p: Option<super::CageAsymmetry>,
     /// 2 Np theta_m at the current sample [rad].
     th2: f64,
 }
 
 impl CageAngle {
-    fn new(d: &Prepared, t: &EffectTerms) -> Self {
+    fn new(d: &Prepared, t: &ModelTerms) -> Self {
         let ok = d.omega_r.len() == d.len() && !d.is_empty();
         CageAngle {
-            p: t.rotor_asym.filter(|_| ok),
+            p: t.rotor_cage.asymmetry.filter(|_| ok),
             th2: d.theta.first().map_or(0.0, |t| 2.0 * t),
         }
     }
 
     /// The cage over working sample `k` (call for k = 0, 1, ... in turn).
-    fn at(&mut self, d: &Prepared, k: usize) -> Option<CageAsymmetry> {
-        let (delta, phi) = self.p?;
+    fn at(&mut self, d: &Prepared, k: usize) -> Option<CageOverSample> {
+        let super::CageAsymmetry {
+            delta,
+            phi_rad: phi,
+        } = self.p?;
         if k > 0 {
             self.th2 += d.dt_s * (d.omega_r[k] + d.omega_r[k - 1]);
         }
         let k1 = (k + 1).min(d.len() - 1);
-        Some(CageAsymmetry {
+        Some(CageOverSample {
             d3: delta / 3.0,
             u0: C64::from_polar(1.0, self.th2 + phi),
             w2: d.omega_r[k] + d.omega_r[k1],
