@@ -184,13 +184,11 @@ impl Analysis {
         opts: &Options,
         progress: &(dyn Fn(f64) + Sync),
     ) -> Result<ExplainOutput, AnalysisError> {
-        use rayon::prelude::*;
-        let d = &self.data;
         let unbalance = self.unbalance();
         let info = self.info();
         let configured = resolve(&opts.effects);
         let names: Vec<EffectKind> = configured.iter().map(|e| e.kind()).collect();
-        if !d.channels.voltages {
+        if !self.data.channels.voltages {
             return Ok(withhold_if_untrusted(explain_current_only(
                 names,
                 unbalance,
@@ -214,31 +212,8 @@ impl Analysis {
                     .map(|m| format!("{}: {m}", c.kind()))
             })
             .collect();
-        let done = std::sync::atomic::AtomicUsize::new(0);
-        let total = cands.len().max(1);
-        // Predictions are not kept per candidate (memory on long logs); the top one is
-        // recomputed from its fitted values.
-        let candidates = || -> Vec<Option<RankedCandidate>> {
-            cands
-                .par_iter()
-                .map(|c| {
-                    let r = self.evaluate_candidate(*c, &base, opts);
-                    let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                    progress(k as f64 / total as f64);
-                    r
-                })
-                .collect()
-        };
-        // A long log's candidates are ranked on the coarse series: the configured model's
-        // run over the working series is only reported, so it runs beside them.
-        let (full, results) = match full {
-            Some(f) => (f, candidates()),
-            None => {
-                let (f, r) = rayon::join(|| self.full_series(&configured, &base), candidates);
-                (f?, r)
-            }
-        };
-        let mut ranked: Vec<RankedCandidate> = results.into_iter().flatten().collect();
+        let (full, mut ranked) =
+            self.fit_candidates(&configured, &base, full, &cands, opts, progress)?;
         rank(&mut ranked, &unbalance, self.constants.torque_scale_nm);
         let best = ranked
             .first()
@@ -248,43 +223,10 @@ impl Analysis {
         let near_noise =
             full.heldback_error <= (NOISE_MARGIN * full.heldback_noise).max(MIN_MODEL_ERROR);
         let unexplained = best < EXPLAINED_MIN || near_noise;
-        let first_plausible = ranked.iter().find(|c| c.candidate.plausible);
-        let mut verdict = verdict(
-            &names,
-            &base,
-            &full,
-            first_plausible,
-            near_noise,
-            unexplained,
-        );
-        verdict.push_str(&implausible_note(&ranked));
-        let base_why = super::base_implausible(&self.constants, &base.fit.base, d);
-        if !base_why.is_empty() {
-            verdict.push_str(&format!(
-                ". The configured model's own fit is not plausible ({}): the base parameters absorb an error the model cannot follow; if the log has a start or steps, see compare's advice (dynamics effects or --from)",
-                base_why.join("; ")
-            ));
-        }
-        let after = if unexplained {
-            None
-        } else {
-            ranked.first().map(|r| {
-                let kinds: Vec<EffectKind> =
-                    names.iter().copied().chain([r.candidate.effect]).collect();
-                let boxes = resolve(&kinds);
-                let model = FittedModel {
-                    effects: boxes
-                        .iter()
-                        .zip(&r.setups)
-                        .map(|(e, s)| ActiveEffect {
-                            effect: e.as_ref(),
-                            setup: s.clone(),
-                        })
-                        .collect(),
-                    fit: r.fit.clone(),
-                };
-                (r.candidate.effect, model.predict(d, &self.constants))
-            })
+        let verdict = self.verdict(&names, &base, &full, &ranked, near_noise, unexplained);
+        let after = match ranked.first() {
+            Some(r) if !unexplained => Some((r.candidate.effect, self.predict_with(&names, r))),
+            _ => None,
         };
         Ok(withhold_if_untrusted(ExplainOutput {
             report: ExplainReport {
@@ -303,6 +245,89 @@ impl Analysis {
             before: full.before,
             after,
         }))
+    }
+
+    /// Fits every candidate of `cands` that can be ranked (in parallel, `progress` told the
+    /// fraction done) and, unless `full` already holds them, the configured model's
+    /// measures on the working series ([`Analysis::full_series`]). Predictions are not kept
+    /// per candidate (memory on long logs); the top one is recomputed from its fitted
+    /// values ([`Analysis::predict_with`]).
+    fn fit_candidates(
+        &self,
+        configured: &[Box<dyn EffectModel>],
+        base: &Baseline<'_>,
+        full: Option<FullSeries>,
+        cands: &[&dyn EffectModel],
+        opts: &Options,
+        progress: &(dyn Fn(f64) + Sync),
+    ) -> Result<(FullSeries, Vec<RankedCandidate>), AnalysisError> {
+        use rayon::prelude::*;
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        let total = cands.len().max(1);
+        let candidates = || -> Vec<Option<RankedCandidate>> {
+            cands
+                .par_iter()
+                .map(|c| {
+                    let r = self.evaluate_candidate(*c, base, opts);
+                    let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                    progress(k as f64 / total as f64);
+                    r
+                })
+                .collect()
+        };
+        // A long log's candidates are ranked on the coarse series: the configured model's
+        // run over the working series is only reported, so it runs beside them.
+        let (full, results) = match full {
+            Some(f) => (f, candidates()),
+            None => {
+                let (f, r) = rayon::join(|| self.full_series(configured, base), candidates);
+                (f?, r)
+            }
+        };
+        Ok((full, results.into_iter().flatten().collect()))
+    }
+
+    /// The verdict ([`verdict`]) with the notes on implausible candidates and on an
+    /// implausible fit of the configured model itself.
+    fn verdict(
+        &self,
+        names: &[EffectKind],
+        base: &Baseline<'_>,
+        full: &FullSeries,
+        ranked: &[RankedCandidate],
+        near_noise: bool,
+        unexplained: bool,
+    ) -> String {
+        let first_plausible = ranked.iter().find(|c| c.candidate.plausible);
+        let mut v = verdict(names, base, full, first_plausible, near_noise, unexplained);
+        v.push_str(&implausible_note(ranked));
+        let base_why = super::base_implausible(&self.constants, &base.fit.base, &self.data);
+        if !base_why.is_empty() {
+            v.push_str(&format!(
+                ". The configured model's own fit is not plausible ({}): the base parameters absorb an error the model cannot follow; if the log has a start or steps, see compare's advice (dynamics effects or --from)",
+                base_why.join("; ")
+            ));
+        }
+        v
+    }
+
+    /// The prediction of the configured model (`names`) with candidate `r` added, from
+    /// their fitted values, on the working series.
+    fn predict_with(&self, names: &[EffectKind], r: &RankedCandidate) -> Prediction {
+        let kinds: Vec<EffectKind> = names.iter().copied().chain([r.candidate.effect]).collect();
+        let boxes = resolve(&kinds);
+        let model = FittedModel {
+            effects: boxes
+                .iter()
+                .zip(&r.setups)
+                .map(|(e, s)| ActiveEffect {
+                    effect: e.as_ref(),
+                    setup: s.clone(),
+                })
+                .collect(),
+            fit: r.fit.clone(),
+        };
+        model.predict(&self.data, &self.constants)
     }
 
     /// Fits the configured model and measures it on the fit series (for a long log, the

@@ -1,7 +1,9 @@
 //! `coulomb_friction`: dry friction.
 
-use super::SetupError;
-use super::{plausible, Confusion, Contribution, EffectModel, FitParam, FitSetup, ParamSpec};
+use super::{
+    plausible, About, Confusion, Contribution, EffectModel, FitParam, FitSetup, ParamSpec,
+    SetupError,
+};
 use crate::analysis::prep::Prepared;
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms, SpeedTorque};
 use monitor_core::EffectKind;
@@ -28,9 +30,21 @@ impl SpeedTorque for DryFriction {
     }
 }
 
+/// What `CoulombFriction` is ([`About`]).
+const ABOUT: About = About {
+    kind: EffectKind::CoulombFriction,
+    description: "Dry friction (bearings, seals, brushes): a constant torque opposing rotation whatever the speed.",
+    equations: "J dw_m/dt = Kf I_qs - (B + Bl) w_m - Tc tanh(w_m / 1 rad/s)  (eq. 29 plus a constant friction torque).",
+    parameters: &[ParamSpec {
+        name: "torque_nm",
+        unit: "N m",
+        description: "dry friction torque Tc",
+    }],
+};
+
 impl EffectModel for CoulombFriction {
-    fn kind(&self) -> EffectKind {
-        EffectKind::CoulombFriction
+    fn about(&self) -> &About {
+        &ABOUT
     }
     fn confused_with(&self) -> &'static [Confusion] {
         &[Confusion {
@@ -38,25 +52,15 @@ impl EffectModel for CoulombFriction {
             within: 1.10,
         }]
     }
-    fn description(&self) -> &'static str {
-        "Dry friction (bearings, seals, brushes): a constant torque opposing rotation whatever the speed."
-    }
-    fn equations(&self) -> &'static str {
-        "J dw_m/dt = Kf I_qs - (B + Bl) w_m - Tc tanh(w_m / 1 rad/s)  (eq. 29 plus a constant friction torque)."
-    }
-    fn parameters(&self) -> &'static [ParamSpec] {
-        &[ParamSpec {
-            name: "torque_nm",
-            unit: "N m",
-            description: "dry friction torque Tc",
-        }]
-    }
     fn setup(&self, _d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let t = n.torque_scale_nm;
         let r = plausible::COULOMB_RATIO;
         Ok(FitSetup::new(*self).param(
-            FitParam::new("torque_nm", "N m", 0.01 * t, (-0.1 * t, t), 0.05 * t)
-                .physical((r.0 * t, r.1 * t), plausible::COULOMB_BASIS),
+            FitParam::new("torque_nm", "N m", 0.01 * t, (-0.1 * t, t), 0.05 * t).physical_scaled(
+                r,
+                t,
+                plausible::COULOMB_BASIS,
+            ),
         ))
     }
 }

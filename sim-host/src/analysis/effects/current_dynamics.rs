@@ -1,6 +1,6 @@
 //! `current_dynamics`: the stator current transient (La dI/dt).
 
-use super::{dynamics_param, Contribution, EffectModel, FitSetup, ParamSpec, SetupError};
+use super::{dynamics_param, About, Contribution, EffectModel, FitSetup, ParamSpec, SetupError};
 use crate::analysis::prep::Prepared;
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms};
 use monitor_core::EffectKind;
@@ -9,25 +9,24 @@ use monitor_core::EffectKind;
 #[derive(Debug, Clone, Copy)]
 pub struct CurrentDynamics;
 
+/// What `CurrentDynamics` is ([`About`]).
+const ABOUT: About = About {
+    kind: EffectKind::CurrentDynamics,
+    description: "The stator current cannot jump: the transient inductance La = sigma Ls delays I_qs by Ta = La/Ra (a few ms) after every voltage change.",
+    equations: "La dI_qs/dt = V_qs - Ra I_qs - Psi omega_r (eq. 28 with its derivative term) instead of the quasi-static I_qs = (V_qs - Psi omega_r)/Ra.",
+    parameters: &[ParamSpec {
+        name: "la_h",
+        unit: "H",
+        description: "transient inductance La = sigma Ls",
+    }],
+};
+
 impl EffectModel for CurrentDynamics {
-    fn kind(&self) -> EffectKind {
-        EffectKind::CurrentDynamics
+    fn about(&self) -> &About {
+        &ABOUT
     }
     fn time_constant_s(&self, n: &MachineConstants) -> Option<f64> {
         Some(n.la_h / n.ra_ohm)
-    }
-    fn description(&self) -> &'static str {
-        "The stator current cannot jump: the transient inductance La = sigma Ls delays I_qs by Ta = La/Ra (a few ms) after every voltage change."
-    }
-    fn equations(&self) -> &'static str {
-        "La dI_qs/dt = V_qs - Ra I_qs - Psi omega_r (eq. 28 with its derivative term) instead of the quasi-static I_qs = (V_qs - Psi omega_r)/Ra."
-    }
-    fn parameters(&self) -> &'static [ParamSpec] {
-        &[ParamSpec {
-            name: "la_h",
-            unit: "H",
-            description: "transient inductance La = sigma Ls",
-        }]
     }
     fn setup(&self, _d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
         Ok(FitSetup::new(*self).param(dynamics_param("la_h", "H", n.la_h)))

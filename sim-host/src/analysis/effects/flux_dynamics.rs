@@ -1,6 +1,6 @@
 //! `flux_dynamics`: the rotor flux is not constant.
 
-use super::{dynamics_param, Contribution, EffectModel, FitSetup, ParamSpec, SetupError};
+use super::{dynamics_param, About, Contribution, EffectModel, FitSetup, ParamSpec, SetupError};
 use crate::analysis::prep::Prepared;
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms};
 use monitor_core::EffectKind;
@@ -9,25 +9,24 @@ use monitor_core::EffectKind;
 #[derive(Debug, Clone, Copy)]
 pub struct FluxDynamics;
 
+/// What `FluxDynamics` is ([`About`]).
+const ABOUT: About = About {
+    kind: EffectKind::FluxDynamics,
+    description: "The rotor flux cannot change instantly: it follows the magnetising current with the rotor time constant Lr/Rr, so after a start or a supply step the model's Psi = Ls i_f is wrong for a few hundred ms.",
+    equations: "phi = psi_r/Lm, dphi/dt = (i_f - phi)/tau_r; Psi' = sigma Ls i_f + (Lm^2/Lr) phi replaces Ls i_f in eq. (28), the slip term Rr (Ls/Lr) becomes Rr Psi'/(Lr phi), Kf uses phi instead of i_f.",
+    parameters: &[ParamSpec {
+        name: "tau_r_s",
+        unit: "s",
+        description: "rotor time constant Lr/Rr",
+    }],
+};
+
 impl EffectModel for FluxDynamics {
-    fn kind(&self) -> EffectKind {
-        EffectKind::FluxDynamics
+    fn about(&self) -> &About {
+        &ABOUT
     }
     fn time_constant_s(&self, n: &MachineConstants) -> Option<f64> {
         Some(n.lr_h / n.rr_ohm)
-    }
-    fn description(&self) -> &'static str {
-        "The rotor flux cannot change instantly: it follows the magnetising current with the rotor time constant Lr/Rr, so after a start or a supply step the model's Psi = Ls i_f is wrong for a few hundred ms."
-    }
-    fn equations(&self) -> &'static str {
-        "phi = psi_r/Lm, dphi/dt = (i_f - phi)/tau_r; Psi' = sigma Ls i_f + (Lm^2/Lr) phi replaces Ls i_f in eq. (28), the slip term Rr (Ls/Lr) becomes Rr Psi'/(Lr phi), Kf uses phi instead of i_f."
-    }
-    fn parameters(&self) -> &'static [ParamSpec] {
-        &[ParamSpec {
-            name: "tau_r_s",
-            unit: "s",
-            description: "rotor time constant Lr/Rr",
-        }]
     }
     fn setup(&self, _d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
         Ok(FitSetup::new(*self).param(dynamics_param("tau_r_s", "s", n.lr_h / n.rr_ohm)))

@@ -1,7 +1,9 @@
 //! `iron_loss`: core loss.
 
-use super::{plausible, rated_flux_wb, sync_speed_mech, Contribution, EffectModel, FitParam};
-use super::{FitSetup, ParamSpec, SetupError};
+use super::{
+    plausible, rated_flux_wb, sync_speed_mech, About, Contribution, EffectModel, FitParam,
+    FitSetup, ParamSpec, SetupError,
+};
 use crate::analysis::prep::Prepared;
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms};
 use monitor_core::EffectKind;
@@ -17,22 +19,21 @@ struct OnLog {
     xm_ohm: f64,
 }
 
+/// What `IronLoss` is ([`About`]).
+const ABOUT: About = About {
+    kind: EffectKind::IronLoss,
+    description: "Eddy-current and hysteresis losses in the core draw a current in phase with the air-gap voltage, modelled as a resistance Rfe across the magnetising branch.",
+    equations: "I_qs(measured) = I_qs(torque, eq. 28) + omega_s Ls i_f / Rfe; only the torque part drives eq. (29); Rs carries the core-loss current too (V_qs - Rs i_fe in eq. 28); the flux current is I_ds + omega_s sigma Ls I_qs / Rfe; and the voltage-model frame, built from the terminal current, is turned by (Lr/Lm) sigma Ls omega_s Ls / (Lm Rfe) against the rotor flux, which the model undoes.",
+    parameters: &[ParamSpec {
+        name: "g_fe_s",
+        unit: "S",
+        description: "core-loss conductance 1/Rfe",
+    }],
+};
+
 impl EffectModel for IronLoss {
-    fn kind(&self) -> EffectKind {
-        EffectKind::IronLoss
-    }
-    fn description(&self) -> &'static str {
-        "Eddy-current and hysteresis losses in the core draw a current in phase with the air-gap voltage, modelled as a resistance Rfe across the magnetising branch."
-    }
-    fn equations(&self) -> &'static str {
-        "I_qs(measured) = I_qs(torque, eq. 28) + omega_s Ls i_f / Rfe; only the torque part drives eq. (29); Rs carries the core-loss current too (V_qs - Rs i_fe in eq. 28); the flux current is I_ds + omega_s sigma Ls I_qs / Rfe; and the voltage-model frame, built from the terminal current, is turned by (Lr/Lm) sigma Ls omega_s Ls / (Lm Rfe) against the rotor flux, which the model undoes."
-    }
-    fn parameters(&self) -> &'static [ParamSpec] {
-        &[ParamSpec {
-            name: "g_fe_s",
-            unit: "S",
-            description: "core-loss conductance 1/Rfe",
-        }]
+    fn about(&self) -> &About {
+        &ABOUT
     }
     fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let w = sync_speed_mech(d, n) * n.np;

@@ -1,7 +1,9 @@
 //! `load_torque`: the load as a torque input.
 
-use super::{plausible, Confusion, Contribution, EffectModel, Evidence, FitParam, FitSetup};
-use super::{Needs, ParamSpec, SetupError, LOAD_STEP_MIN};
+use super::{
+    plausible, About, Confusion, Contribution, EffectModel, Evidence, FitParam, FitSetup, Needs,
+    ParamSpec, SetupError, LOAD_STEP_MIN,
+};
 use crate::analysis::prep::Prepared;
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms};
 use monitor_core::EffectKind;
@@ -157,9 +159,21 @@ struct Steps {
     from_s: Vec<f64>,
 }
 
+/// What `LoadTorque` is ([`About`]).
+const ABOUT: About = About {
+    kind: EffectKind::LoadTorque,
+    description: "The load is a torque imposed by the driven machine (possibly switched in steps), not the paper's viscous Bl*omega.",
+    equations: "J dw_m/dt = Kf I_qs - (B + Bl) w_m - T_L(t), T_L piecewise constant; the step times come from a torque observer on the measured speed and current, the levels are fitted.",
+    parameters: &[ParamSpec {
+        name: "level_k",
+        unit: "N m",
+        description: "load torque in segment k (one parameter per detected segment)",
+    }],
+};
+
 impl EffectModel for LoadTorque {
-    fn kind(&self) -> EffectKind {
-        EffectKind::LoadTorque
+    fn about(&self) -> &About {
+        &ABOUT
     }
     fn confused_with(&self) -> &'static [Confusion] {
         // A constant load torque is dry friction's equation at positive speed.
@@ -172,19 +186,6 @@ impl EffectModel for LoadTorque {
         let hi = e.fitted.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b));
         let lo = e.fitted.iter().fold(f64::INFINITY, |a, &b| a.min(b));
         Some(hi - lo >= LOAD_STEP_MIN * e.torque_scale_nm)
-    }
-    fn description(&self) -> &'static str {
-        "The load is a torque imposed by the driven machine (possibly switched in steps), not the paper's viscous Bl*omega."
-    }
-    fn equations(&self) -> &'static str {
-        "J dw_m/dt = Kf I_qs - (B + Bl) w_m - T_L(t), T_L piecewise constant; the step times come from a torque observer on the measured speed and current, the levels are fitted."
-    }
-    fn parameters(&self) -> &'static [ParamSpec] {
-        &[ParamSpec {
-            name: "level_k",
-            unit: "N m",
-            description: "load torque in segment k (one parameter per detected segment)",
-        }]
     }
     fn needs(&self) -> Needs {
         Needs::VOLTAGES_AND_SPEED
@@ -215,7 +216,7 @@ impl EffectModel for LoadTorque {
                         (-3.0 * t, 3.0 * t),
                         0.2 * t,
                     )
-                    .physical((r.0 * t, r.1 * t), plausible::LOAD_BASIS),
+                    .physical_scaled(r, t, plausible::LOAD_BASIS),
                 )
             }))
     }

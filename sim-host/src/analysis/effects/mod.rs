@@ -2,8 +2,8 @@
 //!
 //! Every effect implements [`EffectModel`]: which [`EffectKind`] it is (its name in the
 //! JSON documents and on the command line, `docs/design.md`), a physical description, its
-//! parameters with units, the way it changes the model equations in words
-//! ([`EffectModel::equations`]), and [`EffectModel::setup`]: the effect set up on a log
+//! parameters with units, the way it changes the model equations in words (all declared
+//! as one [`About`]), and [`EffectModel::setup`]: the effect set up on a log
 //! ([`FitSetup`]), its parameters typed ([`FitParam`]: name, unit, start, bounds, scale,
 //! physical range and its source) and its [`Contribution`] to the model for given values:
 //! what it writes into the model's physical channels
@@ -178,20 +178,41 @@ pub fn sig(x: f64) -> String {
     }
 }
 
-/// How a physical effect of the library changes the simplified model. An effect writes
-/// its kind, its description and equations, and its [`EffectModel::setup`]; every other
+/// What an effect is, in words: the documentation [`EffectModel::about`] gives.
+#[derive(Debug, Clone, Copy)]
+pub struct About {
+    /// Which effect.
+    pub kind: EffectKind,
+    /// Physical description, one or two sentences.
+    pub description: &'static str,
+    /// How the effect changes the model equations (text with the equation).
+    pub equations: &'static str,
+    /// Parameters with units (the set-up gives the data-dependent list; empty: none).
+    pub parameters: &'static [ParamSpec],
+}
+
+/// How a physical effect of the library changes the simplified model. An effect declares
+/// what it is ([`EffectModel::about`]) and writes its [`EffectModel::setup`]; every other
 /// method has a default that holds for most effects.
 pub trait EffectModel: Send + Sync {
+    /// What the effect is, in words.
+    fn about(&self) -> &About;
     /// Which effect (its name in the documents is `kind().name()`).
-    fn kind(&self) -> EffectKind;
+    fn kind(&self) -> EffectKind {
+        self.about().kind
+    }
     /// Physical description, one or two sentences.
-    fn description(&self) -> &'static str;
+    fn description(&self) -> &'static str {
+        self.about().description
+    }
     /// How the effect changes the model equations (text with the equation).
-    fn equations(&self) -> &'static str;
+    fn equations(&self) -> &'static str {
+        self.about().equations
+    }
     /// Parameters with units (documentation; [`EffectModel::setup`] gives the
-    /// data-dependent list). Default: none.
+    /// data-dependent list).
     fn parameters(&self) -> &'static [ParamSpec] {
-        &[]
+        self.about().parameters
     }
     /// Channels the log must have. Default: the voltages.
     fn needs(&self) -> Needs {
@@ -247,7 +268,7 @@ fn dynamics_param(name: &'static str, unit: &'static str, nominal: f64) -> FitPa
         (0.3 * nominal, 3.0 * nominal),
         0.2 * nominal,
     )
-    .physical((r.0 * nominal, r.1 * nominal), plausible::DYNAMICS_BASIS)
+    .physical_scaled(r, nominal, plausible::DYNAMICS_BASIS)
 }
 
 /// The log's duration [s] (at least one sample period; 1 s for an empty series).

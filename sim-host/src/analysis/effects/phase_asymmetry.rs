@@ -1,8 +1,10 @@
 //! `phase_asymmetry`: one stator winding differs.
 
 use super::impedance::{z1_pos, z2_neg};
-use super::{plausible, supply_unbalanced, Confusion, Contribution, EffectModel, Evidence};
-use super::{FitParam, FitSetup, Needs, ParamSpec, SetupError};
+use super::{
+    plausible, supply_unbalanced, About, Confusion, Contribution, EffectModel, Evidence, FitParam,
+    FitSetup, Needs, ParamSpec, SetupError,
+};
 use crate::analysis::prep::{Prepared, C64};
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms, WindingAsymmetry};
 use crate::analysis::unbalance::operating_point;
@@ -39,9 +41,28 @@ pub fn asymmetry_phase(
     (phase, f64::from(eps))
 }
 
+/// What `PhaseAsymmetry` is ([`About`]).
+const ABOUT: About = About {
+    kind: EffectKind::PhaseAsymmetry,
+    description: "One stator winding differs from the other two (inter-turn short, bad joint): the machine draws a negative-sequence current proportional to its load current even from a balanced supply.",
+    equations: "Reduced model: i_abc = balanced model current + i_neg, i_neg = (c_re + j c_im) conj(i_pos): a winding change dZ in phase k gives c = (dZ/3Zs...) e^{j 2 th_k} conj(Zs/Z2) mu/3. Full-order model (all dynamics effects in): the winding itself, T^-1 = I + k u_k u_k^T acting on the voltage, the stator resistance drop and the terminal current (A z = (1 + |e|) z + e conj(z), e = c conj(Z2/(Z1 + Z2 - Rs)) at the log's mean operating point, so c means the same in both).",
+    parameters: &[
+        ParamSpec {
+            name: "c_re",
+            unit: "1",
+            description: "real part of i_neg / conj(i_pos)",
+        },
+        ParamSpec {
+            name: "c_im",
+            unit: "1",
+            description: "imaginary part of i_neg / conj(i_pos)",
+        },
+    ],
+};
+
 impl EffectModel for PhaseAsymmetry {
-    fn kind(&self) -> EffectKind {
-        EffectKind::PhaseAsymmetry
+    fn about(&self) -> &About {
+        &ABOUT
     }
     fn confused_with(&self) -> &'static [Confusion] {
         &[Confusion {
@@ -51,26 +72,6 @@ impl EffectModel for PhaseAsymmetry {
     }
     fn evidence(&self, e: &Evidence<'_>) -> Option<bool> {
         Some(!supply_unbalanced(e))
-    }
-    fn description(&self) -> &'static str {
-        "One stator winding differs from the other two (inter-turn short, bad joint): the machine draws a negative-sequence current proportional to its load current even from a balanced supply."
-    }
-    fn equations(&self) -> &'static str {
-        "Reduced model: i_abc = balanced model current + i_neg, i_neg = (c_re + j c_im) conj(i_pos): a winding change dZ in phase k gives c = (dZ/3Zs...) e^{j 2 th_k} conj(Zs/Z2) mu/3. Full-order model (all dynamics effects in): the winding itself, T^-1 = I + k u_k u_k^T acting on the voltage, the stator resistance drop and the terminal current (A z = (1 + |e|) z + e conj(z), e = c conj(Z2/(Z1 + Z2 - Rs)) at the log's mean operating point, so c means the same in both)."
-    }
-    fn parameters(&self) -> &'static [ParamSpec] {
-        &[
-            ParamSpec {
-                name: "c_re",
-                unit: "1",
-                description: "real part of i_neg / conj(i_pos)",
-            },
-            ParamSpec {
-                name: "c_im",
-                unit: "1",
-                description: "imaginary part of i_neg / conj(i_pos)",
-            },
-        ]
     }
     fn needs(&self) -> Needs {
         Needs::CURRENTS

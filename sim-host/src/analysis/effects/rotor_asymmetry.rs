@@ -33,7 +33,7 @@
 //! resistance matrix in its rotor flux equation (`simplified_model::RotorCage::asymmetry`), with the same
 //! (delta, phi); the terms above are then unused.
 
-use super::{Contribution, EffectModel, FitParam, FitSetup, Needs, ParamSpec, SetupError};
+use super::{About, Contribution, EffectModel, FitParam, FitSetup, Needs, ParamSpec, SetupError};
 use crate::analysis::prep::{zero_phase_lpf, Prepared, I_F_SMOOTH_HZ};
 use crate::analysis::rotor_asymmetry::mcsa;
 use crate::analysis::simplified_model::{CageAsymmetry, MachineConstants, ModelTerms};
@@ -130,29 +130,28 @@ fn initial_estimate(d: &Prepared, ang: &[f64], id_ripple: &[f64]) -> (f64, f64) 
     (delta.clamp(0.02, 1.0), (-a).atan2(-b))
 }
 
+/// What `RotorAsymmetry` is ([`About`]).
+const ABOUT: About = About {
+    kind: EffectKind::RotorAsymmetry,
+    description: "The rotor cage is not symmetric (broken rotor bars, a cracked end ring): the rotor resistance seen by the stator field changes at twice the slip frequency, which modulates the torque and the current: (1 - 2s) f and (1 + 2s) f sidebands in the stator current, 2 s f ripple in speed.",
+    equations: "Rr in Ra = Rs + (Ls/Lr) Rr is multiplied by 1 + (delta/3)(1 - cos(2 (Np theta_m - theta) + phi)): the q-q element of the rotor resistance matrix Rr I + (2/3) Rr delta u u^T, u along the faulty rotor phase; Np theta_m integrates the measured speed. In the full-order model (all dynamics effects in) the whole matrix acts in the rotor flux equation.",
+    parameters: &[
+        ParamSpec {
+            name: "delta",
+            unit: "1",
+            description: "relative rotor phase resistance asymmetry (one rotor phase Rr (1 + delta)); n broken bars of N: delta = 3n/(N - 3n)",
+        },
+        ParamSpec {
+            name: "phi_rad",
+            unit: "rad",
+            description: "twice the angle of the faulty rotor phase at the log's start (a nuisance parameter)",
+        },
+    ],
+};
+
 impl EffectModel for RotorAsymmetry {
-    fn kind(&self) -> EffectKind {
-        EffectKind::RotorAsymmetry
-    }
-    fn description(&self) -> &'static str {
-        "The rotor cage is not symmetric (broken rotor bars, a cracked end ring): the rotor resistance seen by the stator field changes at twice the slip frequency, which modulates the torque and the current: (1 - 2s) f and (1 + 2s) f sidebands in the stator current, 2 s f ripple in speed."
-    }
-    fn equations(&self) -> &'static str {
-        "Rr in Ra = Rs + (Ls/Lr) Rr is multiplied by 1 + (delta/3)(1 - cos(2 (Np theta_m - theta) + phi)): the q-q element of the rotor resistance matrix Rr I + (2/3) Rr delta u u^T, u along the faulty rotor phase; Np theta_m integrates the measured speed. In the full-order model (all dynamics effects in) the whole matrix acts in the rotor flux equation."
-    }
-    fn parameters(&self) -> &'static [ParamSpec] {
-        &[
-            ParamSpec {
-                name: "delta",
-                unit: "1",
-                description: "relative rotor phase resistance asymmetry (one rotor phase Rr (1 + delta)); n broken bars of N: delta = 3n/(N - 3n)",
-            },
-            ParamSpec {
-                name: "phi_rad",
-                unit: "rad",
-                description: "twice the angle of the faulty rotor phase at the log's start (a nuisance parameter)",
-            },
-        ]
+    fn about(&self) -> &About {
+        &ABOUT
     }
     fn needs(&self) -> Needs {
         Needs::VOLTAGES_AND_SPEED

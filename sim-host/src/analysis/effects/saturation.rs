@@ -1,7 +1,9 @@
 //! `saturation`: main-flux saturation.
 
-use super::SetupError;
-use super::{plausible, rated_flux_wb, Contribution, EffectModel, FitParam, FitSetup, ParamSpec};
+use super::{
+    plausible, rated_flux_wb, About, Contribution, EffectModel, FitParam, FitSetup, ParamSpec,
+    SetupError,
+};
 use crate::analysis::prep::Prepared;
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms, SaturationLaw};
 use monitor_core::EffectKind;
@@ -83,29 +85,28 @@ fn sat_factors(lm0: f64, i_f: &[f64], psi_sat: f64, nexp: f64) -> Vec<f64> {
         .collect()
 }
 
+/// What `Saturation` is ([`About`]).
+const ABOUT: About = About {
+    kind: EffectKind::Saturation,
+    description: "The iron of the main flux path saturates: the magnetising inductance Lm falls as the magnetising current (the flux level) rises.",
+    equations: "Lm(i_f) = Lm0 / (1 + (Lm(i_f) i_f / psi_sat)^n), solved per sample; Ls = Lls + Lm and Kf (Lm^2/Lr) in eqs. (28)-(29) follow. In the full-order model (all dynamics effects in) the same law acts on the model's own magnetising flux |psi_m| = Lm |i_s + i_r|, the fluxes of the T-equivalent circuit being its states.",
+    parameters: &[
+        ParamSpec {
+            name: "psi_sat_wb",
+            unit: "Wb",
+            description: "flux linkage at which Lm has halved",
+        },
+        ParamSpec {
+            name: "exponent",
+            unit: "1",
+            description: "sharpness of the saturation knee",
+        },
+    ],
+};
+
 impl EffectModel for Saturation {
-    fn kind(&self) -> EffectKind {
-        EffectKind::Saturation
-    }
-    fn description(&self) -> &'static str {
-        "The iron of the main flux path saturates: the magnetising inductance Lm falls as the magnetising current (the flux level) rises."
-    }
-    fn equations(&self) -> &'static str {
-        "Lm(i_f) = Lm0 / (1 + (Lm(i_f) i_f / psi_sat)^n), solved per sample; Ls = Lls + Lm and Kf (Lm^2/Lr) in eqs. (28)-(29) follow. In the full-order model (all dynamics effects in) the same law acts on the model's own magnetising flux |psi_m| = Lm |i_s + i_r|, the fluxes of the T-equivalent circuit being its states."
-    }
-    fn parameters(&self) -> &'static [ParamSpec] {
-        &[
-            ParamSpec {
-                name: "psi_sat_wb",
-                unit: "Wb",
-                description: "flux linkage at which Lm has halved",
-            },
-            ParamSpec {
-                name: "exponent",
-                unit: "1",
-                description: "sharpness of the saturation knee",
-            },
-        ]
+    fn about(&self) -> &About {
+        &ABOUT
     }
     fn setup(&self, d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let psi = rated_flux_wb(d);
@@ -119,7 +120,7 @@ impl EffectModel for Saturation {
                     (0.5 * psi, 5.0 * psi),
                     0.2 * psi,
                 )
-                .physical((r.0 * psi, r.1 * psi), plausible::PSI_SAT_BASIS),
+                .physical_scaled(r, psi, plausible::PSI_SAT_BASIS),
             )
             .param(FitParam::new("exponent", "1", 7.0, (2.0, 14.0), 2.0)))
     }

@@ -87,6 +87,12 @@ impl FitParam {
         self
     }
 
+    /// The parameter with the physical range `lo * scale ..= hi * scale` from `basis` (a
+    /// range relative to a scale of the machine or the log).
+    pub fn physical_scaled(self, (lo, hi): (f64, f64), scale: f64, basis: &'static str) -> Self {
+        self.physical((lo * scale, hi * scale), basis)
+    }
+
     /// Why the value `v` is not physically plausible (`None`: it is), naming value, unit,
     /// range and the range's basis.
     pub fn implausible_because(&self, v: f64) -> Option<String> {

@@ -1,8 +1,10 @@
 //! `supply_unbalance`: negative-sequence supply voltage.
 
 use super::impedance::{z2_neg, z2_neg_at};
-use super::{plausible, supply_unbalanced, sync_speed_mech, Confusion, Contribution, Evidence};
-use super::{EffectModel, FitParam, FitSetup, ParamSpec, SetupError};
+use super::{
+    plausible, supply_unbalanced, sync_speed_mech, About, Confusion, Contribution, EffectModel,
+    Evidence, FitParam, FitSetup, ParamSpec, SetupError,
+};
 use crate::analysis::prep::{Prepared, C64};
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms};
 use monitor_core::EffectKind;
@@ -11,9 +13,30 @@ use monitor_core::EffectKind;
 #[derive(Debug, Clone, Copy)]
 pub struct SupplyUnbalance;
 
+/// What `SupplyUnbalance` is ([`About`]).
+const ABOUT: About = About {
+    kind: EffectKind::SupplyUnbalance,
+    description: "The supply voltages are not balanced: a negative-sequence voltage drives a negative-sequence current through the machine's small negative-sequence impedance (2f ripple in the d-q frame).",
+    equations: "i_abc = balanced model current + i_neg, i_neg = (y_re + j y_im) v_neg / conj(Z2(omega_s)), Z2 = Rs + j w Lls + (j w Lm)||(Rr/s2 + j w Llr) at the negative-sequence slip s2 = 1 + omega_r/omega_s (2 without a speed column); the balanced model is driven by the positive-sequence V_qs. Full-order model (all dynamics effects in): the machine is driven by V_pos + (y_re + j y_im) V_neg, and its own equations give the negative-sequence current (through a start, and with the 2f torque and speed ripple).",
+    parameters: &[
+        ParamSpec {
+            name: "y_re",
+            unit: "1",
+            description:
+                "real part of the negative-sequence admittance relative to nominal 1/Z2",
+        },
+        ParamSpec {
+            name: "y_im",
+            unit: "1",
+            description:
+                "imaginary part of the negative-sequence admittance relative to nominal 1/Z2",
+        },
+    ],
+};
+
 impl EffectModel for SupplyUnbalance {
-    fn kind(&self) -> EffectKind {
-        EffectKind::SupplyUnbalance
+    fn about(&self) -> &About {
+        &ABOUT
     }
     fn confused_with(&self) -> &'static [Confusion] {
         // Both add a negative-sequence current; at one operating point they fit alike.
@@ -24,28 +47,6 @@ impl EffectModel for SupplyUnbalance {
     }
     fn evidence(&self, e: &Evidence<'_>) -> Option<bool> {
         Some(supply_unbalanced(e))
-    }
-    fn description(&self) -> &'static str {
-        "The supply voltages are not balanced: a negative-sequence voltage drives a negative-sequence current through the machine's small negative-sequence impedance (2f ripple in the d-q frame)."
-    }
-    fn equations(&self) -> &'static str {
-        "i_abc = balanced model current + i_neg, i_neg = (y_re + j y_im) v_neg / conj(Z2(omega_s)), Z2 = Rs + j w Lls + (j w Lm)||(Rr/s2 + j w Llr) at the negative-sequence slip s2 = 1 + omega_r/omega_s (2 without a speed column); the balanced model is driven by the positive-sequence V_qs. Full-order model (all dynamics effects in): the machine is driven by V_pos + (y_re + j y_im) V_neg, and its own equations give the negative-sequence current (through a start, and with the 2f torque and speed ripple)."
-    }
-    fn parameters(&self) -> &'static [ParamSpec] {
-        &[
-            ParamSpec {
-                name: "y_re",
-                unit: "1",
-                description:
-                    "real part of the negative-sequence admittance relative to nominal 1/Z2",
-            },
-            ParamSpec {
-                name: "y_im",
-                unit: "1",
-                description:
-                    "imaginary part of the negative-sequence admittance relative to nominal 1/Z2",
-            },
-        ]
     }
     fn setup(&self, _d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, SetupError> {
         Ok(FitSetup::new(*self)

@@ -1,7 +1,7 @@
 //! A small generic effect for the rungs of the dynamics ladder that add no parameter: each
 //! only switches one state of the full-order machine on ([`StateSwitch`]).
 
-use super::{Contribution, EffectModel, FitSetup, SetupError};
+use super::{About, Contribution, EffectModel, FitSetup, SetupError};
 use crate::analysis::prep::Prepared;
 use crate::analysis::simplified_model::{Dynamics, MachineConstants, ModelTerms};
 use monitor_core::EffectKind;
@@ -12,12 +12,8 @@ use monitor_core::EffectKind;
 /// start or a supply step that the series resolves).
 #[derive(Debug, Clone, Copy)]
 pub struct StateSwitch {
-    /// Which effect.
-    pub kind: EffectKind,
-    /// Physical description ([`EffectModel::description`]).
-    pub description: &'static str,
-    /// The equation it adds ([`EffectModel::equations`]).
-    pub equations: &'static str,
+    /// What it is (no parameters).
+    pub about: About,
     /// Effects that must be in the model first ([`EffectModel::requires`]).
     pub requires: &'static [EffectKind],
     /// Turns the state on.
@@ -27,14 +23,8 @@ pub struct StateSwitch {
 }
 
 impl EffectModel for StateSwitch {
-    fn kind(&self) -> EffectKind {
-        self.kind
-    }
-    fn description(&self) -> &'static str {
-        self.description
-    }
-    fn equations(&self) -> &'static str {
-        self.equations
+    fn about(&self) -> &About {
+        &self.about
     }
     fn requires(&self) -> &'static [EffectKind] {
         self.requires

@@ -1,7 +1,9 @@
 //! `thermal_drift`: winding temperature rise.
 
-use super::SetupError;
-use super::{duration, plausible, Contribution, EffectModel, FitParam, FitSetup, ParamSpec};
+use super::{
+    duration, plausible, About, Contribution, EffectModel, FitParam, FitSetup, ParamSpec,
+    SetupError,
+};
 use crate::analysis::prep::Prepared;
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms};
 use monitor_core::EffectKind;
@@ -13,29 +15,28 @@ pub const ALPHA_CU_PER_K: f64 = 0.00393;
 #[derive(Debug, Clone, Copy)]
 pub struct ThermalDrift;
 
+/// What `ThermalDrift` is ([`About`]).
+const ABOUT: About = About {
+    kind: EffectKind::ThermalDrift,
+    description: "The windings heat up with load, so the stator and rotor resistances rise (copper: +0.393 %/K; 20 -> 90 C is +27 %).",
+    equations: "Rs(t), Rr(t) = R (1 + 0.00393 dT(t)), dT(t) = rise_k (1 - exp(-(t - t0)/tau_s)); Ra = Rs + (Ls/Lr) Rr in eq. (28) follows; in the full-order model the rotor time constant Lr/Rr follows too.",
+    parameters: &[
+        ParamSpec {
+            name: "rise_k",
+            unit: "K",
+            description: "final winding temperature rise",
+        },
+        ParamSpec {
+            name: "tau_s",
+            unit: "s",
+            description: "thermal time constant",
+        },
+    ],
+};
+
 impl EffectModel for ThermalDrift {
-    fn kind(&self) -> EffectKind {
-        EffectKind::ThermalDrift
-    }
-    fn description(&self) -> &'static str {
-        "The windings heat up with load, so the stator and rotor resistances rise (copper: +0.393 %/K; 20 -> 90 C is +27 %)."
-    }
-    fn equations(&self) -> &'static str {
-        "Rs(t), Rr(t) = R (1 + 0.00393 dT(t)), dT(t) = rise_k (1 - exp(-(t - t0)/tau_s)); Ra = Rs + (Ls/Lr) Rr in eq. (28) follows; in the full-order model the rotor time constant Lr/Rr follows too."
-    }
-    fn parameters(&self) -> &'static [ParamSpec] {
-        &[
-            ParamSpec {
-                name: "rise_k",
-                unit: "K",
-                description: "final winding temperature rise",
-            },
-            ParamSpec {
-                name: "tau_s",
-                unit: "s",
-                description: "thermal time constant",
-            },
-        ]
+    fn about(&self) -> &About {
+        &ABOUT
     }
     fn setup(&self, d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let t = duration(d);

@@ -1,7 +1,9 @@
 //! `windage`: fan and air drag.
 
-use super::{plausible, sync_speed_mech, Contribution, EffectModel, FitParam, FitSetup};
-use super::{ParamSpec, SetupError};
+use super::{
+    plausible, sync_speed_mech, About, Contribution, EffectModel, FitParam, FitSetup, ParamSpec,
+    SetupError,
+};
 use crate::analysis::prep::Prepared;
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms, SpeedTorque};
 use monitor_core::EffectKind;
@@ -29,22 +31,21 @@ impl SpeedTorque for Drag {
     }
 }
 
+/// What `Windage` is ([`About`]).
+const ABOUT: About = About {
+    kind: EffectKind::Windage,
+    description: "Fan and air drag: a load torque growing with the square of speed.",
+    equations: "J dw_m/dt = Kf I_qs - (B + Bl) w_m - k w_m |w_m|  (eq. 29 plus a quadratic drag).",
+    parameters: &[ParamSpec {
+        name: "k_nms2",
+        unit: "N m s^2/rad^2",
+        description: "windage coefficient k",
+    }],
+};
+
 impl EffectModel for Windage {
-    fn kind(&self) -> EffectKind {
-        EffectKind::Windage
-    }
-    fn description(&self) -> &'static str {
-        "Fan and air drag: a load torque growing with the square of speed."
-    }
-    fn equations(&self) -> &'static str {
-        "J dw_m/dt = Kf I_qs - (B + Bl) w_m - k w_m |w_m|  (eq. 29 plus a quadratic drag)."
-    }
-    fn parameters(&self) -> &'static [ParamSpec] {
-        &[ParamSpec {
-            name: "k_nms2",
-            unit: "N m s^2/rad^2",
-            description: "windage coefficient k",
-        }]
+    fn about(&self) -> &About {
+        &ABOUT
     }
     fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let w = sync_speed_mech(d, n);
@@ -61,7 +62,7 @@ impl EffectModel for Windage {
                 (-0.1 * k, 2.0 * k),
                 0.05 * k,
             )
-            .physical((r.0 * k, r.1 * k), plausible::WINDAGE_BASIS),
+            .physical_scaled(r, k, plausible::WINDAGE_BASIS),
         ))
     }
 }

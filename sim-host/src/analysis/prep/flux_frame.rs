@@ -22,102 +22,36 @@ pub fn voltage_model_flux_frame(d: &Decimated, p: &ParamFile) -> Prepared {
     let to_c64 = |x: &[f32; 2]| C64::new(x[0] as f64, x[1] as f64);
     let i_ab: Vec<C64> = d.i_ab.iter().map(to_c64).collect();
     let v_ab: Vec<C64> = d.v_ab.iter().map(to_c64).collect();
+    let w = Working {
+        d,
+        v_ab: &v_ab,
+        i_ab: &i_ab,
+        dt,
+    };
     // The frame's angle and the sequence separation's own (the supply voltage's) are
-    // independent: built on both cores.
-    let frame = || {
-        let theta = if d.channels.voltages {
-            let raw = flux_angle(&v_ab, &i_ab, dt, p);
-            smooth_angle(raw, dt)
-        } else {
-            let w0 = p.supply.omega_rad_s();
-            d.t_s.iter().map(|t| w0 * t).collect()
-        };
-        let omega_s = frame_speed(&theta, &d.t_s, dt);
-        let rot: Vec<C64> = theta
-            .iter()
-            .map(|&th| C64::new(th.cos(), th.sin()))
-            .collect();
-        (theta, omega_s, rot)
-    };
-    // The sequences are separated in the supply voltage's own (smoothed) frame when the log
-    // has voltages: any frame turning with the positive sequence separates them alike in
-    // steady state, but through a start the rotor-flux frame is still forming (it may
-    // turn a whole revolution against the supply in the first 0.1 s), and the
-    // demodulated signal then leaks volts into the negative sequence for the low-pass's
-    // memory (0.2 s): 4 V on an 11 kW start, which the model takes as its input.
-    // (A current-only log separates in the frame above: built first, then used.)
-    let separate = |theta: &[f64], omega_s: &[f64]| {
-        let (sep_theta, sep_omega) = if d.channels.voltages {
-            let th = smooth_angle(unwrapped_angle(&v_ab), dt);
-            let w = frame_speed(&th, &d.t_s, dt);
-            (th, w)
-        } else {
-            (theta.to_vec(), omega_s.to_vec())
-        };
-        let sep_rot: Vec<C64> = sep_theta
-            .iter()
-            .map(|&th| C64::new(th.cos(), th.sin()))
-            .collect();
-        let mut sep = SequenceSeparator::new(&sep_theta, &sep_omega, dt);
-        if d.channels.voltages {
-            sep.steps = supply_steps(&v_ab, &sep_rot);
-        }
-        rayon::join(
-            || sep.negative(&i_ab, &sep_rot),
-            || {
-                if d.channels.voltages {
-                    sep.negative(&v_ab, &sep_rot)
-                } else {
-                    vec![C64::new(0.0, 0.0); n]
-                }
-            },
-        )
-    };
-    let ((theta, omega_s, rot), (i_neg, v_neg)) = if d.channels.voltages {
-        rayon::join(frame, || separate(&[], &[]))
+    // independent: built on both cores. (A current-only log separates in the frame: built
+    // first, then used.)
+    let (f, (i_neg, v_neg)) = if d.channels.voltages {
+        rayon::join(|| w.frame(p), || w.sequences(None))
     } else {
-        let f = frame();
-        let s = separate(&f.0, &f.1);
+        let f = w.frame(p);
+        let s = w.sequences(Some(&f));
         (f, s)
     };
+    let rot = &f.rot;
     // Park transforms in complex form: x_dq = x_alphabeta e^{-j theta}; voltages and
     // currents (with the flux current's smoothing) on both cores.
-    let voltages = || {
-        let mut vd = Vec::new();
-        let mut vq = Vec::new();
-        if d.channels.voltages {
-            vd.reserve(n);
-            vq.reserve(n);
-            for k in 0..n {
-                let v = (v_ab[k] - v_neg[k]) * rot[k].conj();
-                vd.push(v.re);
-                vq.push(v.im);
-            }
-        }
-        (vd, vq)
-    };
-    let currents = || {
-        let mut id = Vec::with_capacity(n);
-        let mut iq = Vec::with_capacity(n);
-        let mut iq_pos = Vec::with_capacity(n);
-        for k in 0..n {
-            let ip = (i_ab[k] - i_neg[k]) * rot[k].conj();
-            let it = i_ab[k] * rot[k].conj();
-            id.push(ip.re);
-            iq_pos.push(ip.im);
-            iq.push(it.im);
-        }
-        let i_f = zero_phase_lpf(&id, dt, I_F_SMOOTH_HZ);
-        (id, iq, iq_pos, i_f)
-    };
-    let ((vd, vq), (id, iq, iq_pos, i_f)) = rayon::join(voltages, currents);
+    let ((vd, vq), (id, iq, iq_pos, i_f)) = rayon::join(
+        || w.park_voltages(&v_neg, rot),
+        || w.park_currents(&i_neg, rot),
+    );
     let np = p.motor.model::<f64>().np();
     Prepared {
         i_f,
         t_s: d.t_s.clone(),
         dt_s: dt,
-        theta,
-        omega_s,
+        theta: f.theta,
+        omega_s: f.omega_s,
         vd,
         vq,
         id,
@@ -132,6 +66,126 @@ pub fn voltage_model_flux_frame(d: &Decimated, p: &ParamFile) -> Prepared {
         rows: d.rows,
         log_rate_hz: d.log_rate_hz,
         log_start_s: d.log_start_s,
+    }
+}
+
+/// The working series as complex vectors, with its sample period [s].
+struct Working<'a> {
+    d: &'a Decimated,
+    v_ab: &'a [C64],
+    i_ab: &'a [C64],
+    dt: f64,
+}
+
+/// The analysis frame: its Park angle [rad] (unwrapped), speed [rad/s] and rotation
+/// e^{j theta}.
+struct Frame {
+    theta: Vec<f64>,
+    omega_s: Vec<f64>,
+    rot: Vec<C64>,
+}
+
+impl Working<'_> {
+    /// The frame: the voltage-model rotor-flux angle, smoothed (the nominal supply angle
+    /// for a current-only log).
+    fn frame(&self, p: &ParamFile) -> Frame {
+        let (d, dt) = (self.d, self.dt);
+        let theta = if d.channels.voltages {
+            let raw = flux_angle(self.v_ab, self.i_ab, dt, p);
+            smooth_angle(raw, dt)
+        } else {
+            let w0 = p.supply.omega_rad_s();
+            d.t_s.iter().map(|t| w0 * t).collect()
+        };
+        let omega_s = frame_speed(&theta, &d.t_s, dt);
+        let rot: Vec<C64> = theta
+            .iter()
+            .map(|&th| C64::new(th.cos(), th.sin()))
+            .collect();
+        Frame {
+            theta,
+            omega_s,
+            rot,
+        }
+    }
+
+    /// The negative sequences of the current and the voltage (zeros without voltages).
+    /// They are separated in the supply voltage's own (smoothed) frame when the log has
+    /// voltages: any frame turning with the positive sequence separates them alike in
+    /// steady state, but through a start the rotor-flux frame is still forming (it may turn
+    /// a whole revolution against the supply in the first 0.1 s), and the demodulated
+    /// signal then leaks volts into the negative sequence for the low-pass's memory
+    /// (0.2 s): 4 V on an 11 kW start, which the model takes as its input. A current-only
+    /// log separates in the analysis frame `frame`.
+    fn sequences(&self, frame: Option<&Frame>) -> (Vec<C64>, Vec<C64>) {
+        let (d, dt) = (self.d, self.dt);
+        let voltages = d.channels.voltages;
+        let (sep_theta, sep_omega) = match frame {
+            Some(f) if !voltages => (f.theta.clone(), f.omega_s.clone()),
+            _ => {
+                let th = smooth_angle(unwrapped_angle(self.v_ab), dt);
+                let w = frame_speed(&th, &d.t_s, dt);
+                (th, w)
+            }
+        };
+        let sep_rot: Vec<C64> = sep_theta
+            .iter()
+            .map(|&th| C64::new(th.cos(), th.sin()))
+            .collect();
+        let mut sep = SequenceSeparator::new(&sep_theta, &sep_omega, dt);
+        if voltages {
+            sep.steps = supply_steps(self.v_ab, &sep_rot);
+        }
+        rayon::join(
+            || sep.negative(self.i_ab, &sep_rot),
+            || {
+                if voltages {
+                    sep.negative(self.v_ab, &sep_rot)
+                } else {
+                    vec![C64::new(0.0, 0.0); d.t_s.len()]
+                }
+            },
+        )
+    }
+
+    /// The positive-sequence V_ds and V_qs (empty without voltages).
+    fn park_voltages(&self, v_neg: &[C64], rot: &[C64]) -> (Vec<f64>, Vec<f64>) {
+        let n = self.d.t_s.len();
+        let mut vd = Vec::new();
+        let mut vq = Vec::new();
+        if self.d.channels.voltages {
+            vd.reserve(n);
+            vq.reserve(n);
+            for k in 0..n {
+                let v = (self.v_ab[k] - v_neg[k]) * rot[k].conj();
+                vd.push(v.re);
+                vq.push(v.im);
+            }
+        }
+        (vd, vq)
+    }
+
+    /// The positive-sequence I_ds, the whole I_qs, the positive-sequence I_qs and i_f.
+    #[allow(clippy::type_complexity)]
+    fn park_currents(
+        &self,
+        i_neg: &[C64],
+        rot: &[C64],
+    ) -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
+        let n = self.d.t_s.len();
+        let i_ab = self.i_ab;
+        let mut id = Vec::with_capacity(n);
+        let mut iq = Vec::with_capacity(n);
+        let mut iq_pos = Vec::with_capacity(n);
+        for k in 0..n {
+            let ip = (i_ab[k] - i_neg[k]) * rot[k].conj();
+            let it = i_ab[k] * rot[k].conj();
+            id.push(ip.re);
+            iq_pos.push(ip.im);
+            iq.push(it.im);
+        }
+        let i_f = zero_phase_lpf(&id, self.dt, I_F_SMOOTH_HZ);
+        (id, iq, iq_pos, i_f)
     }
 }
 

@@ -3,7 +3,7 @@
 //! machine at a sample, the initial state, the run's set-up ([`FullRun`]).
 
 use super::reduced::initial_state;
-use super::{BaseParams, MachineConstants, Mechanics, ModelTerms, Prediction};
+use super::{BaseParams, MachineConstants, Mechanics, ModelTerms, Prediction, Run};
 use crate::analysis::prep::{Prepared, C64};
 
 /// The machine of the full-order form at one sample (inverse-Gamma equivalent of the
@@ -208,10 +208,7 @@ pub(super) fn full_initial_state(
 /// the machine at each sample and the initial state. `None` when there is nothing to
 /// simulate (no samples, or no voltages to drive the model).
 pub(super) struct FullRun<'a> {
-    pub(super) d: &'a Prepared,
-    pub(super) n: &'a MachineConstants,
-    pub(super) b: &'a BaseParams,
-    pub(super) t: &'a ModelTerms,
+    pub(super) run: Run<'a>,
     pub(super) mech: Mechanics,
     /// The initial state ([`full_initial_state`]).
     pub(super) x0: FullState,
@@ -221,36 +218,29 @@ pub(super) struct FullRun<'a> {
 }
 
 impl<'a> FullRun<'a> {
-    pub(super) fn new(
-        d: &'a Prepared,
-        n: &'a MachineConstants,
-        b: &'a BaseParams,
-        t: &'a ModelTerms,
-        unsaturated: bool,
-    ) -> Option<Self> {
+    pub(super) fn new(run: Run<'a>, unsaturated: bool) -> Option<Self> {
+        let Run { d, n, b, .. } = run;
         let len = d.len();
         if len == 0 || d.vq.len() != len {
             return None;
         }
-        let mut run = FullRun {
-            d,
-            n,
-            b,
-            t,
+        let mut full = FullRun {
+            run,
             mech: Mechanics::new(n, b),
             x0: FullState::default(),
             unsaturated,
         };
-        run.x0 = full_initial_state(d, n, &run.machine(0));
-        Some(run)
+        full.x0 = full_initial_state(d, n, &full.machine(0));
+        Some(full)
     }
 
     /// The machine at sample `k`.
     pub(super) fn machine(&self, k: usize) -> FullMachine {
+        let Run { n, b, t, .. } = self.run;
         if self.unsaturated {
-            FullMachine::at_lm(self.n, self.b, self.t, k, 1.0)
+            FullMachine::at_lm(n, b, t, k, 1.0)
         } else {
-            FullMachine::at(self.n, self.b, self.t, k)
+            FullMachine::at(n, b, t, k)
         }
     }
 }
@@ -271,25 +261,19 @@ impl<'a> FullRun<'a> {
 /// sample, inputs linear between samples (L_sigma/R is about 7 samples at 2 kHz, RK4's
 /// error is below 1e-6 of a step). Core loss adds g j omega_k psi_s to the output current
 /// (no feedback: 1 % of the current at Rfe = 8 Xm).
-pub(super) fn simulate_full(
-    d: &Prepared,
-    n: &MachineConstants,
-    b: &BaseParams,
-    t: &ModelTerms,
-    rot_at: impl Fn(usize) -> C64,
-) -> Prediction {
-    let Some(run) = FullRun::new(d, n, b, t, false) else {
+pub(super) fn simulate_full(run: Run<'_>, rot_at: impl Fn(usize) -> C64) -> Prediction {
+    let Some(full) = FullRun::new(run, false) else {
         return Prediction::default();
     };
-    let len = d.len();
+    let len = run.d.len();
     let mut out = Prediction::with_capacity(len);
     let form = FrameForm {
-        run: &run,
-        sw: Switches::of(&t.dynamics),
+        full: &full,
+        sw: Switches::of(&run.t.dynamics),
     };
-    let mut x = run.x0;
+    let mut x = full.x0;
     for k in 0..len {
-        let m = run.machine(k);
+        let m = full.machine(k);
         let wk = form.frame_speed(k);
         form.output(k, &m, wk, &x, rot_at(k), &mut out);
         if k + 1 == len {
@@ -319,7 +303,7 @@ impl Switches {
 
 /// The full-order form in the analysis frame over one run ([`simulate_full`]).
 struct FrameForm<'a> {
-    run: &'a FullRun<'a>,
+    full: &'a FullRun<'a>,
     sw: Switches,
 }
 
@@ -330,7 +314,7 @@ impl FrameForm<'_> {
     /// what the frame turned beyond that ([`FrameForm::step`]), so the frame the model runs
     /// in is exactly the measurements' frame.
     fn frame_speed(&self, k: usize) -> f64 {
-        let d = self.run.d;
+        let d = self.full.run.d;
         let ws = d.omega_s[k];
         if k + 1 < d.len() {
             let lim = 0.05 * ws.abs() + 20.0;
@@ -343,7 +327,7 @@ impl FrameForm<'_> {
     /// The inputs at the fraction `s` of the interval from sample `k`: (V_ds, V_qs), I_ds,
     /// i_f, linear between the samples.
     fn input(&self, k: usize, s: f64) -> ((f64, f64), f64, f64) {
-        let d = self.run.d;
+        let d = self.full.run.d;
         let k1 = (k + 1).min(d.len() - 1);
         let lerp = |a: &[f64]| a[k] + s * (a[k1] - a[k]);
         ((lerp(&d.vd), lerp(&d.vq)), lerp(&d.id), lerp(&d.i_f))
@@ -360,7 +344,7 @@ impl FrameForm<'_> {
         rot: C64,
         out: &mut Prediction,
     ) {
-        let (d, n, t) = (self.run.d, self.run.n, self.run.t);
+        let Run { d, n, t, .. } = self.full.run;
         let (v0, id0, if0) = self.input(k, 0.0);
         let (xa, _) = m.deriv(self.sw, x, v0, id0, if0, wk, n.np);
         let ineg = t.reduced_i_neg(d, k);
@@ -379,14 +363,14 @@ impl FrameForm<'_> {
     /// RK4 over [k, k+1] for the electrical states, the speed with the torque; then the
     /// state turned by what the frame turned beyond `wk`.
     fn step(&self, k: usize, m: &FullMachine, wk: f64, x: &FullState) -> FullState {
-        let (d, np) = (self.run.d, self.run.n.np);
-        let Mechanics { j, btot } = self.run.mech;
+        let (d, np) = (self.full.run.d, self.full.run.n.np);
+        let Mechanics { j, btot } = self.full.mech;
         let dt = d.dt_s;
         let f = |st: &FullState, s: f64| -> FullState {
             let (v, idm, ifm) = self.input(k, s);
             let (xa, mut dx) = m.deriv(self.sw, st, v, idm, ifm, wk, np);
             let te = 1.5 * np * (xa.pd * xa.iq - xa.pq * xa.id);
-            dx.wm = (te - btot * xa.wm - self.run.t.shaft.extra_nm(k, xa.wm)) / j;
+            dx.wm = (te - btot * xa.wm - self.full.run.t.shaft.extra_nm(k, xa.wm)) / j;
             dx
         };
         let add = |a: &FullState, b: &FullState, h: f64| FullState {

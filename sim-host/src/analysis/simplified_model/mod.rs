@@ -242,11 +242,22 @@ fn simulate_with(
     t: &ModelTerms,
     rot_at: impl Fn(usize) -> C64,
 ) -> Prediction {
+    let run = Run { d, n, b, t };
     if t.dynamics.is_full_order() {
-        stationary::simulate_stationary(d, n, b, t, rot_at)
+        stationary::simulate_stationary(run, rot_at)
     } else if t.dynamics.needs_full_form() {
-        full_order::simulate_full(d, n, b, t, rot_at)
+        full_order::simulate_full(run, rot_at)
     } else {
-        reduced::simulate_reduced(d, n, b, t, rot_at)
+        reduced::simulate_reduced(run, rot_at)
     }
+}
+
+/// One run of the model: the working series, the machine's constants, the base
+/// parameters and the effects' terms.
+#[derive(Clone, Copy)]
+struct Run<'a> {
+    d: &'a Prepared,
+    n: &'a MachineConstants,
+    b: &'a BaseParams,
+    t: &'a ModelTerms,
 }

@@ -1,6 +1,6 @@
 //! The reduced model: the paper's simplified model with the effects' steady-state terms.
 
-use super::{BaseParams, InputNoise, MachineConstants, Mechanics, ModelTerms, Prediction};
+use super::{InputNoise, MachineConstants, Mechanics, ModelTerms, Prediction, Run};
 use crate::analysis::prep::{Prepared, C64};
 
 /// The model's inputs at one working sample: V_ds, V_qs, I_ds, i_f, positive-sequence I_qs.
@@ -159,10 +159,7 @@ impl CoreLoss {
 
 /// The reduced model's constants over a run.
 struct Reduced<'a> {
-    d: &'a Prepared,
-    n: &'a MachineConstants,
-    b: &'a BaseParams,
-    t: &'a ModelTerms,
+    run: Run<'a>,
     mech: Mechanics,
     /// Rs and the rotor term of Ra with the refitted Ra scale [ohm].
     rs0: f64,
@@ -203,13 +200,11 @@ struct FluxTerms {
 }
 
 impl<'a> Reduced<'a> {
-    fn new(d: &'a Prepared, n: &'a MachineConstants, b: &'a BaseParams, t: &'a ModelTerms) -> Self {
+    fn new(run: Run<'a>) -> Self {
+        let Run { d, n, b, t } = run;
         let dt = d.dt_s;
         Reduced {
-            d,
-            n,
-            b,
-            t,
+            run,
             mech: Mechanics::new(n, b),
             rs0: n.rs_ohm * b.ra_scale,
             rr0: n.rr_a_ohm * b.ra_scale,
@@ -224,19 +219,19 @@ impl<'a> Reduced<'a> {
 
     /// The initial state (the measurement's first 10 ms, the flux at i_f).
     fn initial(&self) -> State {
-        let (wm, iq) = initial_state(self.d, self.n);
-        let start = self.t.rotor_cage.flux_drive_start;
+        let (wm, iq) = initial_state(self.run.d, self.run.n);
+        let start = self.run.t.rotor_cage.flux_drive_start;
         State {
             wm,
             iq,
-            phi: self.d.i_f[0] + start,
+            phi: self.run.d.i_f[0] + start,
             phi_dev: start,
         }
     }
 
     /// The machine at sample `k`: the resistance and magnetising channels applied.
     fn at(&self, k: usize) -> AtSample {
-        let (n, t) = (self.n, self.t);
+        let (n, t) = (self.run.n, self.run.t);
         let rf = t.resistance.scale.get(k).copied().unwrap_or(1.0);
         let mf = t.magnetising.lm_scale.get(k).copied().unwrap_or(1.0);
         let lm = n.lm_h * mf;
@@ -244,7 +239,7 @@ impl<'a> Reduced<'a> {
             rs: self.rs0 * rf,
             rr: self.rr0 * rf * t.resistance.rotor_scale.get(k).copied().unwrap_or(1.0),
             lm,
-            ls: self.b.ls_scale * (n.lls_h + lm),
+            ls: self.run.b.ls_scale * (n.lls_h + lm),
             lmr: lm * lm / (n.llr_h + lm),
         }
     }
@@ -252,14 +247,14 @@ impl<'a> Reduced<'a> {
     /// The core loss at sample `k`; at the first sample the states start from the
     /// machine's own currents, not the terminal ones.
     fn core_loss(&self, k: usize, m: &AtSample, x: Inputs, s: &mut State) -> CoreLoss {
-        let g = self.t.magnetising.core_loss_s;
+        let g = self.run.t.magnetising.core_loss_s;
         if g == 0.0 {
             return CoreLoss::none(x);
         }
-        let cl = core_loss(g, self.d.omega_s[k], self.n, m.ls, m.lm, m.rs, x);
+        let cl = core_loss(g, self.run.d.omega_s[k], self.run.n, m.ls, m.lm, m.rs, x);
         if k == 0 {
             s.iq += cl.iq_shift;
-            s.phi = cl.i_f + self.t.rotor_cage.flux_drive_start;
+            s.phi = cl.i_f + self.run.t.rotor_cage.flux_drive_start;
         }
         cl
     }
@@ -269,8 +264,8 @@ impl<'a> Reduced<'a> {
     /// deviation the flux drive makes through the nominal rotor time constant).
     fn flux(&self, k: usize, m: &AtSample, cl: &CoreLoss, s: &mut State) -> FluxTerms {
         let (ls, lmr, rs, rr) = (m.ls, m.lmr, m.rs, m.rr);
-        let ls_scale = self.b.ls_scale;
-        let cage = &self.t.rotor_cage;
+        let ls_scale = self.run.b.ls_scale;
+        let cage = &self.run.t.rotor_cage;
         let drive = cage.flux_drive.get(k).copied().unwrap_or(0.0);
         match self.flux_decay {
             Some(a) => {
@@ -314,12 +309,12 @@ impl<'a> Reduced<'a> {
     /// Eqs. (28)-(29) over one sample: the new I_qs and speed from V_qs `vq` [V] (the
     /// speed semi-implicit, so the step is stable at any working rate).
     fn mechanics(&self, k: usize, m: &AtSample, f: &FluxTerms, vq: f64, s: &mut State) {
-        let (n, dt) = (self.n, self.d.dt_s);
+        let (n, dt) = (self.run.n, self.run.d.dt_s);
         let Mechanics { j, btot } = self.mech;
         let kt = 1.5 * n.np * m.lmr * f.phi_t; // Te = kt * iq  [N m/A]
-        let extra = |w: f64| self.t.shaft.extra_nm(k, w);
+        let extra = |w: f64| self.run.t.shaft.extra_nm(k, w);
         let (psi_p, rden) = (f.psi_p, f.rden);
-        match self.t.dynamics.stator_current_la_h {
+        match self.run.t.dynamics.stator_current_la_h {
             Some(la) => {
                 let iq_ss = (vq - psi_p * n.np * s.wm) / rden;
                 let a = (-dt * rden / la.max(1e-6)).exp();
@@ -341,8 +336,8 @@ impl<'a> Reduced<'a> {
     /// current, the predicted q current (with the core loss' frame tilt undone), the
     /// negative sequence added.
     fn output(&self, k: usize, rot: C64, cl: &CoreLoss, s: &State, out: &mut Prediction) {
-        let d = self.d;
-        let ineg = self.t.reduced_i_neg(d, k);
+        let d = self.run.d;
+        let ineg = self.run.t.reduced_i_neg(d, k);
         let i_dq = if cl.eps != 0.0 {
             let i_true = C64::new(cl.id_term, s.iq + cl.i_fe_q);
             let fwd = C64::new(cl.eps.cos(), cl.eps.sin());
@@ -353,7 +348,7 @@ impl<'a> Reduced<'a> {
         };
         let i_ab = i_dq * rot + ineg;
         out.iq.push(i_dq.im + (ineg * rot.conj()).im);
-        out.omega_r.push(self.n.np * s.wm);
+        out.omega_r.push(self.run.n.np * s.wm);
         out.i_ab.push(i_ab);
     }
 }
@@ -361,21 +356,16 @@ impl<'a> Reduced<'a> {
 /// The reduced model (no full-order dynamics: see the module doc of [`super`]) over the
 /// working series, `rot_at(k)` the frame rotation `e^{j theta_k}`.
 #[inline(always)]
-pub(super) fn simulate_reduced(
-    d: &Prepared,
-    n: &MachineConstants,
-    b: &BaseParams,
-    t: &ModelTerms,
-    rot_at: impl Fn(usize) -> C64,
-) -> Prediction {
+pub(super) fn simulate_reduced(run: Run<'_>, rot_at: impl Fn(usize) -> C64) -> Prediction {
+    let d = run.d;
     let len = d.len();
     let mut out = Prediction::with_capacity(len);
     if len == 0 || d.vq.len() != len {
         return out;
     }
-    let model = Reduced::new(d, n, b, t);
+    let model = Reduced::new(run);
     let mut s = model.initial();
-    let mut inputs = InputSource::new(d, t);
+    let mut inputs = InputSource::new(d, run.t);
     for k in 0..len {
         let x = inputs.at(k);
         let m = model.at(k);

@@ -3,7 +3,7 @@
 
 use super::full_order::{FullMachine, FullRun};
 use super::terms::{SaturationLaw, Shaft, WindingAsymmetry};
-use super::{BaseParams, MachineConstants, Mechanics, ModelTerms, Prediction};
+use super::{MachineConstants, Mechanics, ModelTerms, Prediction, Run};
 use crate::analysis::prep::{self, Prepared, C64};
 
 /// The state of the stationary-frame full-order model: stator current, rotor flux
@@ -314,35 +314,33 @@ fn phase_step(a: C64, b: C64) -> f64 {
 /// Measured on effect-free simulated logs with a start, a V/f step and a dip, ideal
 /// sensors, true parameters (2.2 kW, 11 kW; 2, 5, 10 kHz): `normalized_rms_error`
 /// 0.0003-0.0007 (on the simulator's own rows at the log rate, point samples: below 1e-5).
-pub(super) fn simulate_stationary(
-    d: &Prepared,
-    n: &MachineConstants,
-    b: &BaseParams,
-    t: &ModelTerms,
-    rot_at: impl Fn(usize) -> C64,
-) -> Prediction {
+pub(super) fn simulate_stationary(run: Run<'_>, rot_at: impl Fn(usize) -> C64) -> Prediction {
+    let Run { d, n, t, .. } = run;
     // With a magnetising law the machine saturates with its own flux ([`SatMachine`]), not
     // with the reduced model's scale from the measured i_f.
-    let Some(run) = FullRun::new(d, n, b, t, t.magnetising.law.is_some()) else {
+    let Some(full) = FullRun::new(run, t.magnetising.law.is_some()) else {
         return Prediction::default();
     };
     let len = d.len();
     let mut out = Prediction::with_capacity(len);
-    let volt = StatVoltage::new(d, &rot_at);
-    let (x0, r0) = (run.x0, rot_at(0));
+    let form = StatForm {
+        full: &full,
+        volt: StatVoltage::new(d, &rot_at),
+    };
+    let (x0, r0) = (full.x0, rot_at(0));
     let mut x = StatState {
         i: C64::new(x0.id, x0.iq) * r0,
         psi: C64::new(x0.pd, x0.pq) * r0,
         wm: x0.wm,
     };
-    let mut v = [volt.v_at(0), volt.v_at(1.min(len - 1))];
+    let mut v = [form.volt.v_at(0), form.volt.v_at(1.min(len - 1))];
     let mut cage = CageAngle::new(d, t);
     let lm_guess = std::cell::Cell::new(0.0);
     for k in 0..len {
         let sm = StatMachine {
-            m: run.machine(k),
+            m: full.machine(k),
             np: n.np,
-            mech: run.mech,
+            mech: full.mech,
             shaft: &t.shaft,
             k,
             wind: t.stator_winding,
@@ -362,12 +360,12 @@ pub(super) fn simulate_stationary(
             }
             None => sm,
         };
-        stationary_output(&run, &volt, &sm, &x, k, rot_at(k), &mut out);
+        form.output(&sm, &x, k, rot_at(k), &mut out);
         if k + 1 == len {
             break;
         }
-        let v_after = volt.v_at((k + 2).min(len - 1));
-        x = stationary_step(&run, &volt, &sm, &x, k, v);
+        let v_after = form.volt.v_at((k + 2).min(len - 1));
+        x = form.step(&sm, &x, k, v);
         // The measured (positive-sequence) voltages move on; `y V_neg` is added per sample
         // (carrying `v1` over counted it twice at each sample's start).
         v = [v[1], v_after];
@@ -378,87 +376,87 @@ pub(super) fn simulate_stationary(
     out
 }
 
-/// The outputs of the stationary-frame model at sample `k`: the terminal current (with
-/// the core-loss current, after the block mean), projected on the analysis frame `rot`.
-fn stationary_output(
-    run: &FullRun<'_>,
-    volt: &StatVoltage,
-    sm: &StatMachine<'_>,
-    x: &StatState,
-    k: usize,
-    rot: C64,
-    out: &mut Prediction,
-) {
-    let (d, t) = (run.d, run.t);
-    // With a negative-sequence voltage drive the negative sequence is in the machine's
-    // own current.
-    let ineg = match t.negative_sequence.voltage_gain {
-        Some(_) => C64::default(),
-        None => t
-            .negative_sequence
-            .current
-            .get(k)
-            .copied()
-            .unwrap_or_default(),
-    };
-    let mut i_out = sm.terminal(x);
-    let g = t.magnetising.core_loss_s;
-    if g != 0.0 {
-        let psi_s = sm.stator_flux(x);
-        i_out += C64::new(0.0, g * d.omega_s[k]) * psi_s;
-    }
-    let i_ab = i_out * volt.gains[k] + ineg;
-    out.iq.push((i_ab * rot.conj()).im);
-    out.omega_r.push(run.n.np * x.wm);
-    out.i_ab.push(i_ab);
+/// The stationary-frame model over one run: its set-up and its voltage input.
+struct StatForm<'a> {
+    full: &'a FullRun<'a>,
+    volt: StatVoltage,
 }
 
-/// The stationary-frame state at sample `k + 1` from `x` at `k`, `v` the positive-sequence
-/// voltages before the block mean at `k` and `k + 1`: RK4 along the rotation, or across a
-/// supply step placed where the measured current says it fell.
-fn stationary_step(
-    run: &FullRun<'_>,
-    volt: &StatVoltage,
-    sm: &StatMachine<'_>,
-    x: &StatState,
-    k: usize,
-    v: [C64; 2],
-) -> StatState {
-    let (d, t) = (run.d, run.t);
-    let dt = d.dt_s;
-    let [v_cur, v_next] = v;
-    // The negative sequence (a negative-sequence voltage drive), rotating the other way.
-    let (vn0, vn1) = match t.negative_sequence.voltage_gain {
-        Some(g) => {
-            let at = |j: usize| d.v_neg.get(j).copied().unwrap_or_default();
-            (g * at(k), g * at(k + 1))
-        }
-        None => (C64::default(), C64::default()),
-    };
-    let (v0, v1) = (v_cur + vn0, v_next + vn1);
-    let ph = &volt.ph;
-    if volt.dev[k] > volt.step_thr {
-        let w = [ph[k - 1] / dt, ph[k + 1] / dt];
-        let (s0, s1) = ([v_cur, vn0], [v_next, vn1]);
-        let early = sm.across_step(x, dt, 0.0, s0, s1, w);
-        let late = sm.across_step(x, dt, 1.0, s0, s1, w);
-        // The measured currents before the block mean, as the model's.
-        let gain = |k: usize| volt.gains[k];
-        let i_meas = |k: usize| d.i_ab[k] - d.i_neg[k];
-        let target = i_meas(k + 1) / gain(k + 1) - (i_meas(k) / gain(k) - sm.terminal(x));
-        let (early_i, late_i) = (sm.terminal(&early), sm.terminal(&late));
-        let span = late_i - early_i;
-        let phi = if span.norm_sqr() > 0.0 {
-            ((target - early_i) * span.conj()).re / span.norm_sqr()
-        } else {
-            0.5
+impl StatForm<'_> {
+    /// The outputs at sample `k`: the terminal current (with the core-loss current, after
+    /// the block mean), projected on the analysis frame `rot`.
+    fn output(
+        &self,
+        sm: &StatMachine<'_>,
+        x: &StatState,
+        k: usize,
+        rot: C64,
+        out: &mut Prediction,
+    ) {
+        let Run { d, n, t, .. } = self.full.run;
+        // With a negative-sequence voltage drive the negative sequence is in the machine's
+        // own current.
+        let ineg = match t.negative_sequence.voltage_gain {
+            Some(_) => C64::default(),
+            None => t
+                .negative_sequence
+                .current
+                .get(k)
+                .copied()
+                .unwrap_or_default(),
         };
-        sm.across_step(x, dt, phi.clamp(0.0, 1.0), s0, s1, w)
-    } else {
-        let half = C64::from_polar(1.0, 0.5 * ph[k]);
-        let vm =
-            (v_cur * half + v_next * half.conj()) * 0.5 + (vn0 * half.conj() + vn1 * half) * 0.5;
-        sm.rk4(x, dt, [v0, vm, v1], 0.0)
+        let mut i_out = sm.terminal(x);
+        let g = t.magnetising.core_loss_s;
+        if g != 0.0 {
+            let psi_s = sm.stator_flux(x);
+            i_out += C64::new(0.0, g * d.omega_s[k]) * psi_s;
+        }
+        let i_ab = i_out * self.volt.gains[k] + ineg;
+        out.iq.push((i_ab * rot.conj()).im);
+        out.omega_r.push(n.np * x.wm);
+        out.i_ab.push(i_ab);
+    }
+
+    /// The state at sample `k + 1` from `x` at `k`, `v` the positive-sequence voltages
+    /// before the block mean at `k` and `k + 1`: RK4 along the rotation, or across a supply
+    /// step placed where the measured current says it fell.
+    fn step(&self, sm: &StatMachine<'_>, x: &StatState, k: usize, v: [C64; 2]) -> StatState {
+        let Run { d, t, .. } = self.full.run;
+        let (volt, dt) = (&self.volt, d.dt_s);
+        let [v_cur, v_next] = v;
+        // The negative sequence (a negative-sequence voltage drive), rotating the other way.
+        let (vn0, vn1) = match t.negative_sequence.voltage_gain {
+            Some(g) => {
+                let at = |j: usize| d.v_neg.get(j).copied().unwrap_or_default();
+                (g * at(k), g * at(k + 1))
+            }
+            None => (C64::default(), C64::default()),
+        };
+        let (v0, v1) = (v_cur + vn0, v_next + vn1);
+        let ph = &volt.ph;
+        if volt.dev[k] > volt.step_thr {
+            let w = [ph[k - 1] / dt, ph[k + 1] / dt];
+            let (s0, s1) = ([v_cur, vn0], [v_next, vn1]);
+            let early = sm.across_step(x, dt, 0.0, s0, s1, w);
+            let late = sm.across_step(x, dt, 1.0, s0, s1, w);
+            // The measured currents before the block mean, as the model's.
+            let gain = |k: usize| volt.gains[k];
+            let i_meas = |k: usize| d.i_ab[k] - d.i_neg[k];
+            let target = i_meas(k + 1) / gain(k + 1) - (i_meas(k) / gain(k) - sm.terminal(x));
+            let (early_i, late_i) = (sm.terminal(&early), sm.terminal(&late));
+            let span = late_i - early_i;
+            let phi = if span.norm_sqr() > 0.0 {
+                ((target - early_i) * span.conj()).re / span.norm_sqr()
+            } else {
+                0.5
+            };
+            sm.across_step(x, dt, phi.clamp(0.0, 1.0), s0, s1, w)
+        } else {
+            let half = C64::from_polar(1.0, 0.5 * ph[k]);
+            let vm = (v_cur * half + v_next * half.conj()) * 0.5
+                + (vn0 * half.conj() + vn1 * half) * 0.5;
+            sm.rk4(x, dt, [v0, vm, v1], 0.0)
+        }
     }
 }
 
