@@ -11,9 +11,9 @@
 //!    leaky integral of
 //!    `v - Rs i` (voltage model; the leak, [`FLUX_LEAK_RAD_S`], removes drift at a phase
 //!    error of `leak/omega`, 0.2 degrees at 50 Hz), the rotor flux is
-//!    `psi_r = (Lr/Lm) (psi_s - sigma Ls i)`, and its angle is the Park angle. DESIGN.md §2:
-//!    in this frame the paper's model (23) is exact in steady state, in a voltage-oriented
-//!    frame it is not. Current-only logs use the nominal supply angle `2 pi f t` instead.
+//!    `psi_r = (Lr/Lm) (psi_s - sigma Ls i)`, and its angle is the Park angle. In this
+//!    frame the paper's model (23) is exact in steady state, in a voltage-oriented frame
+//!    it is not (`docs/design.md`, the frame orientation). Current-only logs use the nominal supply angle `2 pi f t` instead.
 //! 3. **Sequence separation**: the negative-sequence part of `x_alphabeta` is
 //!    `e^{-j theta} LPF(e^{+j theta} x)` (three first-order low-passes at
 //!    [`SEQ_LPF_HZ`]), the positive-sequence part is the rest; `theta` is the supply
