@@ -1,7 +1,7 @@
 //! `explain`: which physical effect of the library is missing from the model, ranked by the
 //! error it removes on held-back windows.
 
-use super::effects::{self, EffectModel, Evidence, FitSetup};
+use super::effects::{self, EffectModel, Evidence, FitSetup, SetupError};
 use super::fit::{self, ActiveEffect, FitResult, FittedModel};
 use super::metrics::{self, Weights};
 use super::prep::Prepared;
@@ -412,23 +412,23 @@ impl Analysis {
         })
     }
 
-    /// Why a candidate cannot be ranked on this log, if it cannot: a dynamics effect whose
-    /// time constant the (coarse) fit series of a long log cannot resolve (fewer than 3
-    /// samples per time constant), a missing channel, or a set-up the data refuse (e.g.
-    /// `load_torque` on a log without a load change: said, not dropped).
-    fn cannot_rank(&self, c: &dyn EffectModel, base: &Baseline<'_>) -> Option<String> {
+    /// Why a candidate cannot be ranked on this log, if it cannot: an effect it needs in
+    /// the model first, a dynamics effect whose time constant the (coarse) fit series of a
+    /// long log cannot resolve or that has no transient to act on, a missing channel, or a
+    /// set-up the data refuse (e.g. `load_torque` on a log without a load change: said,
+    /// not dropped).
+    fn cannot_rank(&self, c: &dyn EffectModel, base: &Baseline<'_>) -> Option<NotRanked> {
         if let Some(m) = missing_requirement(c, base) {
             return Some(m);
         }
         if let Some(m) = self.not_dynamic(c, base) {
             return Some(m);
         }
-        if let Err(m) = c.needs().met_by(&self.data) {
-            return Some(m.to_string());
-        }
-        c.setup(&base.fit_series, &self.constants)
-            .err()
-            .map(|m| m.to_string())
+        let setup = c
+            .needs()
+            .met_by(&self.data)
+            .and_then(|()| c.setup(&base.fit_series, &self.constants).map(|_| ()));
+        setup.err().map(NotRanked::Setup)
     }
 
     /// Why a dynamics effect (one that declares a time constant,
@@ -439,23 +439,13 @@ impl Analysis {
     /// moves the speed at the mechanical rate), the full-order machine's steady state is
     /// the paper's model, and what a dynamics effect's extra states gain there they gain by
     /// absorbing another effect (README, "Honest ranking").
-    fn not_dynamic(&self, c: &dyn EffectModel, base: &Baseline<'_>) -> Option<String> {
-        let tau = c.time_constant_s(&self.constants)?;
+    fn not_dynamic(&self, c: &dyn EffectModel, base: &Baseline<'_>) -> Option<NotRanked> {
+        let tau_s = c.time_constant_s(&self.constants)?;
         let dt_s = base.fit_series.dt_s;
-        if dt_s > tau / 3.0 {
-            return Some(format!(
-                "the fit series of this long log ({:.0} Hz) cannot resolve a {:.1} ms time constant; analyse a shorter window with --from/--to",
-                1.0 / dt_s,
-                1000.0 * tau
-            ));
+        if dt_s > tau_s / 3.0 {
+            return Some(NotRanked::Unresolved { dt_s, tau_s });
         }
-        (!base.has_input_transient).then(|| {
-            format!(
-                "no start or supply step in the analysed span (voltage and frequency within {:.0} %): its {:.1} ms dynamics have nothing to act on",
-                100.0 * transients::STEP_MIN,
-                1000.0 * tau
-            )
-        })
+        (!base.has_input_transient).then_some(NotRanked::NoTransient { tau_s })
     }
 
     /// Adds candidate `c` to the configured model, fits both on the fit series and
@@ -520,16 +510,16 @@ impl Analysis {
         // A base parameter the candidate's refit takes out of range counts against it; one
         // the configured model's own fit already has out of range does not (the verdict
         // reports that apart).
-        let key = |w: &String| w.split(" =").next().unwrap_or_default().to_string();
-        let already: Vec<String> = super::base_implausible(&self.constants, &base.fit.base, d)
-            .iter()
-            .map(key)
+        let already: Vec<&str> = super::base_out_of_range(&self.constants, &base.fit.base, d)
+            .into_iter()
+            .map(|(k, _)| k)
             .collect();
         let mut why = me.implausible_because.clone();
         why.extend(
-            super::base_implausible(&self.constants, &f.base, d)
+            super::base_out_of_range(&self.constants, &f.base, d)
                 .into_iter()
-                .filter(|w| !already.contains(&key(w))),
+                .filter(|(k, _)| !already.contains(k))
+                .map(|(_, w)| w),
         );
         Some(RankedCandidate {
             candidate: EffectCandidate {
@@ -555,16 +545,52 @@ impl Analysis {
     }
 }
 
+/// Why `explain` does not rank a candidate on this log (the report's `skipped`).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+enum NotRanked {
+    /// Effects it needs in the model first ([`EffectModel::requires`]).
+    #[error("needs {} in the model first", names(.0))]
+    Requires(Vec<EffectKind>),
+    /// Its time constant `tau_s` [s] is shorter than 3 samples of the fit series (period
+    /// `dt_s` [s]).
+    #[error("the fit series of this long log ({:.0} Hz) cannot resolve a {:.1} ms time constant; analyse a shorter window with --from/--to", 1.0 / dt_s, 1000.0 * tau_s)]
+    Unresolved {
+        /// Sample period of the fit series [s].
+        dt_s: f64,
+        /// The effect's time constant [s].
+        tau_s: f64,
+    },
+    /// A dynamics effect (time constant `tau_s` [s]) on a log without a start or a supply
+    /// step.
+    #[error("no start or supply step in the analysed span (voltage and frequency within {:.0} %): its {:.1} ms dynamics have nothing to act on", 100.0 * transients::STEP_MIN, 1000.0 * tau_s)]
+    NoTransient {
+        /// The effect's time constant [s].
+        tau_s: f64,
+    },
+    /// The log lacks a channel, or the set-up refuses the data.
+    #[error(transparent)]
+    Setup(SetupError),
+}
+
+/// Effect names, comma separated.
+fn names(kinds: &[EffectKind]) -> String {
+    kinds
+        .iter()
+        .map(|k| k.name())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// The effects `c` needs in the model first ([`EffectModel::requires`]) that the
 /// configured model lacks, as the reason it is not proposed yet.
-fn missing_requirement(c: &dyn EffectModel, base: &Baseline<'_>) -> Option<String> {
-    let missing: Vec<&str> = c
+fn missing_requirement(c: &dyn EffectModel, base: &Baseline<'_>) -> Option<NotRanked> {
+    let missing: Vec<EffectKind> = c
         .requires()
         .iter()
-        .filter(|k| !base.active.iter().any(|a| a.effect.kind() == **k))
-        .map(|k| k.name())
+        .copied()
+        .filter(|k| !base.active.iter().any(|a| a.effect.kind() == *k))
         .collect();
-    (!missing.is_empty()).then(|| format!("needs {} in the model first", missing.join(", ")))
+    (!missing.is_empty()).then_some(NotRanked::Requires(missing))
 }
 
 /// `explain` on a log without voltages: the model cannot run; only the unbalance analysis.

@@ -155,42 +155,75 @@ pub struct FittedEffect {
     pub implausible_because: Vec<String>,
 }
 
-/// The base parameters' physical ranges ([`effects::plausible`]), one entry per parameter:
-/// key, value, range, unit.
-fn base_ranges(
-    n: &MachineConstants,
-    b: &BaseParams,
-    d: &Prepared,
-) -> [(&'static str, f64, f64, f64, &'static str, &'static str); 4] {
+/// A fitted base parameter with its unit and physical range ([`effects::plausible`]).
+struct BaseValue {
+    /// JSON key.
+    key: &'static str,
+    value: f64,
+    unit: &'static str,
+    range: crate::params::PlausibleRange,
+    /// Where the range comes from.
+    basis: &'static str,
+}
+
+impl BaseValue {
+    fn new(
+        key: &'static str,
+        value: f64,
+        (lo, hi): (f64, f64),
+        unit: &'static str,
+        basis: &'static str,
+    ) -> Self {
+        BaseValue {
+            key,
+            value,
+            unit,
+            range: crate::params::PlausibleRange { lo, hi },
+            basis,
+        }
+    }
+
+    /// Why the value is not plausible (`None`: it is).
+    fn implausible_because(&self) -> Option<String> {
+        effects::outside(self.key, self.unit, self.value, &self.range, self.basis)
+    }
+}
+
+/// The fitted base parameters `b` with their physical ranges.
+fn base_values(n: &MachineConstants, b: &BaseParams, d: &Prepared) -> [BaseValue; 4] {
     use effects::plausible as pl;
     let bmax = (pl::BTOT_RATED_TORQUE * n.torque_scale_nm / effects::sync_speed_mech(d, n))
         .max(3.0 * n.btot_nms);
+    let rel = |r: (f64, f64), x: f64| (r.0 * x, r.1 * x);
     [
-        ("ra_ohm", n.ra_ohm * b.ra_scale, pl::RA_RATIO.0 * n.ra_ohm, pl::RA_RATIO.1 * n.ra_ohm, "ohm",
-         "Ra follows the winding temperature: -20 C to 155 C is 0.84-1.53 x the 20 C value, plus 10 % data-sheet tolerance"),
-        ("ls_h", n.ls_h * b.ls_scale, pl::LS_RATIO.0 * n.ls_h, pl::LS_RATIO.1 * n.ls_h, "H",
-         "Ls moves at most about 30 % with saturation and tolerance"),
-        ("b_plus_bl_nms", b.btot_nms, 0.0, bmax, "N m s/rad",
-         "a viscous load carries at most 1.5 x the rated torque at synchronous speed"),
-        ("j_kgm2", n.j_kgm2 * b.j_scale, pl::J_RATIO.0 * n.j_kgm2, pl::J_RATIO.1 * n.j_kgm2, "kg m^2",
-         "the coupled load's inertia is the usual unknown, but a factor 3 either way is another machine"),
+        BaseValue::new("ra_ohm", n.ra_ohm * b.ra_scale, rel(pl::RA_RATIO, n.ra_ohm), "ohm",
+            "Ra follows the winding temperature: -20 C to 155 C is 0.84-1.53 x the 20 C value, plus 10 % data-sheet tolerance"),
+        BaseValue::new("ls_h", n.ls_h * b.ls_scale, rel(pl::LS_RATIO, n.ls_h), "H",
+            "Ls moves at most about 30 % with saturation and tolerance"),
+        BaseValue::new("b_plus_bl_nms", b.btot_nms, (0.0, bmax), "N m s/rad",
+            "a viscous load carries at most 1.5 x the rated torque at synchronous speed"),
+        BaseValue::new("j_kgm2", n.j_kgm2 * b.j_scale, rel(pl::J_RATIO, n.j_kgm2), "kg m^2",
+            "the coupled load's inertia is the usual unknown, but a factor 3 either way is another machine"),
     ]
+}
+
+/// The fitted base parameters that are not physically plausible: their keys and why.
+fn base_out_of_range(
+    n: &MachineConstants,
+    b: &BaseParams,
+    d: &Prepared,
+) -> Vec<(&'static str, String)> {
+    base_values(n, b, d)
+        .iter()
+        .filter_map(|v| Some((v.key, v.implausible_because()?)))
+        .collect()
 }
 
 /// The reasons fitted base parameters are not physically plausible (empty: plausible).
 pub fn base_implausible(n: &MachineConstants, b: &BaseParams, d: &Prepared) -> Vec<String> {
-    use effects::sig;
-    base_ranges(n, b, d)
-        .iter()
-        .filter(|(_, v, lo, hi, _, _)| !(v.is_finite() && v >= lo && v <= hi))
-        .map(|(k, v, lo, hi, u, basis)| {
-            format!(
-                "{k} = {} {u} is outside the physical range {}..{} {u} ({basis})",
-                sig(*v),
-                sig(*lo),
-                sig(*hi)
-            )
-        })
+    base_out_of_range(n, b, d)
+        .into_iter()
+        .map(|(_, why)| why)
         .collect()
 }
 
@@ -343,20 +376,16 @@ impl Analysis {
     fn base_table(&self, b: &BaseParams) -> std::collections::BTreeMap<String, ParamValue> {
         let n = &self.constants;
         let noms = [n.ra_ohm, n.ls_h, n.btot_nms, n.j_kgm2];
-        let why = base_implausible(n, b, &self.data);
-        base_ranges(n, b, &self.data)
+        base_values(n, b, &self.data)
             .iter()
             .zip(noms)
-            .map(|((k, v, _, _, u, _), nom)| {
-                let reason = why
-                    .iter()
-                    .find(|w| w.starts_with(&format!("{k} =")))
-                    .cloned();
+            .map(|(v, nom)| {
+                let reason = v.implausible_because();
                 (
-                    k.to_string(),
+                    v.key.to_string(),
                     ParamValue {
-                        value: *v,
-                        unit: u.to_string(),
+                        value: v.value,
+                        unit: v.unit.to_string(),
                         nominal: Some(nom),
                         plausible: reason.is_none(),
                         implausible_because: reason,

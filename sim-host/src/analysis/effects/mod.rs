@@ -65,7 +65,7 @@ pub use load_torque::LoadTorque;
 pub use phase_asymmetry::{asymmetry_phase, PhaseAsymmetry};
 pub use rotor_asymmetry::{RotorAsymmetry, DELTA_BASIS, DELTA_RANGE};
 pub use saturation::Saturation;
-pub use setup::{Contribution, FitParam, FitSetup, SetupError};
+pub use setup::{outside, Contribution, FitParam, FitSetup, SetupError};
 pub use supply_unbalance::SupplyUnbalance;
 pub use switch::StateSwitch;
 pub use thermal_drift::{ThermalDrift, ALPHA_CU_PER_K};

@@ -96,18 +96,28 @@ impl FitParam {
     /// Why the value `v` is not physically plausible (`None`: it is), naming value, unit,
     /// range and the range's basis.
     pub fn implausible_because(&self, v: f64) -> Option<String> {
-        let (r, unit) = (&self.plausible, self.unit);
-        (!r.contains(v)).then(|| {
-            format!(
-                "{} = {} {unit} is outside the physical range {}..{} {unit} ({})",
-                self.name,
-                sig(v),
-                sig(r.lo),
-                sig(r.hi),
-                self.basis
-            )
-        })
+        outside(&self.name, self.unit, v, &self.plausible, self.basis)
     }
+}
+
+/// Why the value `v` of quantity `name` [`unit`] is not physically plausible (`None`: it
+/// lies in `range`): `name = v unit is outside the physical range lo..hi unit (basis)`,
+/// numbers to 3 significant digits.
+pub fn outside(
+    name: &str,
+    unit: &str,
+    v: f64,
+    range: &PlausibleRange,
+    basis: &str,
+) -> Option<String> {
+    (!range.contains(v)).then(|| {
+        format!(
+            "{name} = {} {unit} is outside the physical range {}..{} {unit} ({basis})",
+            sig(v),
+            sig(range.lo),
+            sig(range.hi)
+        )
+    })
 }
 
 /// What an effect set up on a log contributes to the model: the effect with the numbers

@@ -28,17 +28,16 @@ pub(super) struct FullState {
     pub(super) wm: f64,
 }
 
-/// The switches of the full-order form: which dynamics effects are in the model.
+/// The switches of the full-order form: which states are dynamic ([`super::Dynamics`]).
 #[derive(Debug, Clone, Copy)]
 struct Switches {
-    /// `current_dynamics`: L_sigma dI_qs/dt (else the q equation is algebraic).
+    /// L_sigma dI_qs/dt (else the q equation is algebraic).
     iq: bool,
-    /// `d_axis_dynamics`: the d-axis equation (else I_ds is the measured one).
+    /// The d-axis equation (else I_ds is the measured one).
     id: bool,
-    /// `flux_dynamics`: the rotor-flux equations (else psi_Rd = L_M i_f).
+    /// The rotor-flux equations (else psi_Rd = L_M i_f).
     flux: bool,
-    /// `cross_coupling_dynamics`: psi_Rq (else 0); a state only with `flux` and `id`,
-    /// quasi-static otherwise.
+    /// psi_Rq (else 0); a state only with `flux` and `id`, quasi-static otherwise.
     cross: bool,
 }
 
