@@ -622,7 +622,8 @@ fn explain_current_only(
         .filter(|k| !names.contains(k))
         .map(|k| {
             format!(
-                "{k}: needs the voltage columns va_V, vb_V, vc_V (the model is driven by V_qs); see the unbalance analysis"
+                "{k}: {}; see the unbalance analysis",
+                SetupError::NoVoltages
             )
         })
         .collect();

@@ -278,3 +278,56 @@ impl WindingAsymmetry {
         self.c * (d.i_ab[k] - d.i_neg[k]).conj()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(Debug)]
+    struct Linear(f64);
+    impl SpeedTorque for Linear {
+        fn torque_nm(&self, w: f64) -> f64 {
+            self.0 * w
+        }
+    }
+
+    /// Two effects on one channel compose: scales multiply, torques and currents add, and
+    /// the first effect's series is taken as it is.
+    #[test]
+    fn channels_compose_across_effects() {
+        let mut t = ModelTerms::default();
+        t.scale_resistances([1.5, 2.0].into_iter());
+        assert_eq!(t.resistance.scale, [1.5, 2.0]);
+        t.scale_resistances([2.0, 4.0].into_iter());
+        assert_eq!(t.resistance.scale, [3.0, 8.0]);
+        t.add_load_torque([1.0, 2.0].into_iter());
+        t.add_load_torque([0.5, 0.25].into_iter());
+        assert_eq!(t.shaft.load_nm, [1.5, 2.25]);
+        t.add_speed_torque(Linear(2.0));
+        t.add_speed_torque(Linear(0.5));
+        // 2 w + 0.5 w at w = 4, plus the sample's load; past the series' end no load.
+        assert_eq!(t.shaft.extra_nm(1, 4.0), 10.0 + 2.25);
+        assert_eq!(t.shaft.extra_nm(7, 4.0), 10.0);
+        t.add_negative_sequence_current([C64::new(1.0, 0.0)].into_iter());
+        t.add_negative_sequence_current([C64::new(0.0, 2.0)].into_iter());
+        assert_eq!(t.negative_sequence.current, [C64::new(1.0, 2.0)]);
+        t.drive_rotor_flux([0.25].into_iter(), 0.5);
+        t.drive_rotor_flux([0.5].into_iter(), 0.25);
+        assert_eq!(t.rotor_cage.flux_drive, [0.75]);
+        assert_eq!(t.rotor_cage.flux_drive_start, 0.75);
+    }
+
+    /// The form of the model follows the dynamics channel.
+    #[test]
+    fn the_dynamics_channel_picks_the_form() {
+        let mut dy = Dynamics::default();
+        assert!(!dy.needs_full_form() && !dy.is_full_order());
+        dy.stator_d_axis = true;
+        assert!(dy.needs_full_form() && !dy.is_full_order());
+        dy.rotor_flux_q_axis = true;
+        dy.stator_current_la_h = Some(0.02);
+        assert!(!dy.is_full_order());
+        dy.rotor_flux_tau_s = Some(0.1);
+        assert!(dy.is_full_order());
+    }
+}
