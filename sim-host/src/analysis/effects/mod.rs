@@ -97,20 +97,15 @@ pub struct Needs {
 
 impl Needs {
     /// The phase voltages (every effect of the model driven by V_qs: the default).
-    pub const VOLTAGES: Needs = Needs {
-        voltages: true,
-        speed: false,
-    };
+    pub const VOLTAGES: Needs = Needs::of(true, false);
     /// The phase voltages and the measured speed.
-    pub const VOLTAGES_AND_SPEED: Needs = Needs {
-        voltages: true,
-        speed: true,
-    };
+    pub const VOLTAGES_AND_SPEED: Needs = Needs::of(true, true);
     /// Only the currents.
-    pub const CURRENTS: Needs = Needs {
-        voltages: false,
-        speed: false,
-    };
+    pub const CURRENTS: Needs = Needs::of(false, false);
+
+    const fn of(voltages: bool, speed: bool) -> Needs {
+        Needs { voltages, speed }
+    }
 
     /// Whether the log `d` carries what is needed.
     ///
