@@ -1,5 +1,5 @@
-//! Discrepancy-analysis benchmark (DESIGN.md §4): `compare` + `explain` on a 1 h log at
-//! 10 kHz (36 M samples), goal <= 10 s on 2 cores with bounded memory.
+//! Discrepancy-analysis benchmark (`docs/performance.md`): `compare` + `explain` on a 1 h
+//! log at 10 kHz (36 M samples), goal <= 10 s on 2 cores with bounded memory.
 //!
 //! Run: `cargo bench -p sim-host --bench analysis` (release profile). The log is generated
 //! once with the simulator (2.2 kW motor, thermal drift with a 20 min time constant,

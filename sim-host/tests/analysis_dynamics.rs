@@ -2,6 +2,11 @@
 //! direct-on-line start, a V/f step and a supply voltage step, both reference motors and
 //! an 11 kW machine the code was not developed on, at 2, 5 and 10 kHz, analysed over the
 //! whole log (start included). The figures are printed (`--nocapture`) and in the README.
+//!
+//! Full sweeps: by default each sweep over motors, rates and effects checks a
+//! representative subset (each effect on one motor at one rate, every motor and every rate
+//! on some effect); `MONITOR_FULL_SWEEPS=1` checks every case (`analysis_common`'s module
+//! doc; `.ci/run` runs it).
 mod analysis_common;
 use analysis_common::*;
 use sim_host::params::ParamFile;
@@ -101,8 +106,16 @@ fn ratios(dir: &std::path::Path, which: &str, rate_hz: f64) -> (f64, f64) {
 fn full_order_machine_follows_starts_and_steps() {
     let dir = tempfile::tempdir().unwrap();
     let mut failures = Vec::new();
-    for which in ["2p2", "3hp", "11kw"] {
-        for rate in [2000.0, 5000.0, 10_000.0] {
+    let cases = sweep(
+        "motors x rates",
+        ["2p2", "3hp", "11kw"]
+            .into_iter()
+            .flat_map(|w| [2000.0, 5000.0, 10_000.0].map(|r| (w, r))),
+        // Each motor at another rate.
+        |c| matches!(c, ("2p2", 2000.0) | ("3hp", 5000.0) | ("11kw", 10_000.0)),
+    );
+    for (which, rate) in cases {
+        {
             let (paper, full) = ratios(dir.path(), which, rate);
             // paper / full compares ratios to the same log's noise floors: the error gain.
             let gain = paper / full;
@@ -276,10 +289,14 @@ fn hidden_effects_found_at(rate_hz: f64) {
         EffectKind::PhaseAsymmetry,
         EffectKind::RotorAsymmetry,
     ];
-    for (which, kind) in ["2p2", "3hp", "11kw"]
-        .into_iter()
-        .flat_map(|w| found.map(|k| (w, k)))
-    {
+    let cases = sweep(
+        &format!("hidden effects at {rate_hz} Hz"),
+        ["2p2", "3hp", "11kw"]
+            .into_iter()
+            .flat_map(|w| found.map(|k| (w, k))),
+        |&(which, kind)| in_default_hidden(which, kind, rate_hz),
+    );
+    for (which, kind) in cases {
         let (top, _, unexplained, before, after, floor) =
             hidden_case(dir.path(), which, kind, rate_hz);
         // At the noise already without it (within 2x the floor), it may rightly be left
@@ -295,6 +312,22 @@ fn hidden_effects_found_at(rate_hz: f64) {
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// The hidden-effect cases of the default run: each effect once, each motor and each rate
+/// twice.
+fn in_default_hidden(which: &str, kind: monitor_core::EffectKind, rate_hz: f64) -> bool {
+    use monitor_core::EffectKind as K;
+    let (w, r) = match kind {
+        K::LoadTorque => ("2p2", 2000.0),
+        K::Saturation => ("3hp", 2000.0),
+        K::ThermalDrift => ("3hp", 5000.0),
+        K::RotorAsymmetry => ("11kw", 5000.0),
+        K::SupplyUnbalance => ("2p2", 10_000.0),
+        K::PhaseAsymmetry => ("11kw", 10_000.0),
+        _ => return false,
+    };
+    which == w && rate_hz == r
 }
 
 #[test]
@@ -332,6 +365,18 @@ fn hidden_effects_under_transients_probe() {
     }
 }
 
+/// All four states of the full-order machine dynamic, with the true La and Lr/Rr of `m`.
+fn full_order_dynamics(
+    m: &monitor_core::MotorModel<f64>,
+) -> sim_host::analysis::simplified_model::Dynamics {
+    sim_host::analysis::simplified_model::Dynamics {
+        stator_current_la_h: Some(m.la_h()),
+        rotor_flux_tau_s: Some(m.lr_h / m.rr_ohm),
+        stator_d_axis: true,
+        rotor_flux_q_axis: true,
+    }
+}
+
 /// The full-order model with the true parameters (no fit) against effect-free logs of
 /// [`transients`] with ideal sensors: what is left is the analysis's own reconstruction
 /// of the working series (frame, sequence separation, block means, where a step fell),
@@ -355,11 +400,8 @@ fn full_order_model_reproduces_the_simulator() {
         s.sensors = sim_host::sim::SensorSpec::ideal();
         let log = write_log(dir.path(), &format!("ideal_{which}_{rate}"), &p, &s, false);
         let a = analyse(&log, &p, 0.0);
-        let terms = sm::EffectTerms {
-            tau_r_s: Some(m.lr_h / m.rr_ohm),
-            la_h: Some(m.la_h()),
-            d_axis: true,
-            cross_coupling: true,
+        let terms = sm::ModelTerms {
+            dynamics: full_order_dynamics(&m),
             ..Default::default()
         };
         let n = &a.constants;
@@ -373,7 +415,7 @@ fn full_order_model_reproduces_the_simulator() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-/// The full-order model's own saturation (`EffectTerms::sat`, the simulator's law on
+/// The full-order model's own saturation (`ModelTerms::magnetising.law`, the simulator's law on
 /// the model's magnetising flux) with the true parameters and the simulator's default law
 /// (psi_sat = 1.3 x the rated flux, n = 6), no fit, against ideal-sensor logs of
 /// [`transients`] with `saturation` injected: at the reconstruction floor of the
@@ -397,12 +439,15 @@ fn saturated_full_order_model_reproduces_the_simulator() {
         let psi_sat = 1.3 * p.supply.v_phase_peak() / p.supply.omega_rad_s();
         let mut e = [0.0; 2];
         for (sat, e) in [None, Some((psi_sat, 6.0))].into_iter().zip(&mut e) {
-            let terms = sm::EffectTerms {
-                tau_r_s: Some(m.lr_h / m.rr_ohm),
-                la_h: Some(m.la_h()),
-                d_axis: true,
-                cross_coupling: true,
-                sat,
+            let terms = sm::ModelTerms {
+                dynamics: full_order_dynamics(&m),
+                magnetising: sm::Magnetising {
+                    law: sat.map(|(psi_sat_wb, exponent)| sm::SaturationLaw {
+                        psi_sat_wb,
+                        exponent,
+                    }),
+                    ..Default::default()
+                },
                 ..Default::default()
             };
             let n = &a.constants;
@@ -477,13 +522,37 @@ fn effect_parameters_are_recovered_through_transients() {
     use monitor_core::EffectKind as K;
     let dir = tempfile::tempdir().unwrap();
     let mut failures = Vec::new();
+    let kinds: Vec<K> = K::ALL.into_iter().filter(|k| !k.is_dynamics()).collect();
+    // By default each effect once, on the motors and rates in turn (each motor and each
+    // rate three times).
+    let in_default = |which: &str, rate: f64, kind: K| {
+        let i = kinds.iter().position(|k| *k == kind).unwrap_or(0);
+        which == ["2p2", "3hp", "11kw"][(i + 1) % 3]
+            && rate == [2000.0, 5000.0, 10_000.0][(i / 3) % 3]
+    };
+    let cases = sweep(
+        "effect parameters",
+        ["2p2", "3hp", "11kw"]
+            .into_iter()
+            .flat_map(|w| {
+                [2000.0, 5000.0, 10_000.0].into_iter().flat_map(move |r| {
+                    K::ALL
+                        .into_iter()
+                        .filter(|k| !k.is_dynamics())
+                        .map(move |k| (w, r, k))
+                })
+            })
+            // (The 11 kW machine's load torque is not run: see the doc above.)
+            .filter(|&(w, _, k)| !(w == "11kw" && k == K::LoadTorque)),
+        |&(w, r, k)| in_default(w, r, k),
+    );
     for (which, rate) in ["2p2", "3hp", "11kw"]
         .into_iter()
         .flat_map(|w| [2000.0, 5000.0, 10_000.0].map(|r| (w, r)))
     {
         let p = params(which);
         for kind in K::ALL.into_iter().filter(|k| !k.is_dynamics()) {
-            if which == "11kw" && kind == K::LoadTorque {
+            if !cases.contains(&(which, rate, kind)) {
                 continue;
             }
             let mut s = transients(which, rate);

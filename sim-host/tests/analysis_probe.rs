@@ -30,14 +30,22 @@ fn probe() {
         let base_env = std::env::var("BASE").unwrap_or_default();
         let base: Vec<&str> = base_env.split(',').filter(|s| !s.is_empty()).collect();
         if let Ok(g) = std::env::var("TRUTH_G") {
-            use sim_host::analysis::simplified_model::{simulate, BaseParams, EffectTerms};
+            use sim_host::analysis::simplified_model::{
+                simulate, BaseParams, Dynamics, Magnetising, ModelTerms,
+            };
             let n = &a.constants;
             let g: f64 = g.parse().unwrap();
             let xm = 2.0 * std::f64::consts::PI * nominal.supply.f_hz * nominal.motor.lm_h;
-            let t = EffectTerms {
-                g_fe_s: if g > 0.0 { 1.0 / (g * xm) } else { 0.0 },
-                tau_r_s: Some(n.lr_h / n.rr_ohm),
-                la_h: Some(n.la_h),
+            let t = ModelTerms {
+                magnetising: Magnetising {
+                    core_loss_s: if g > 0.0 { 1.0 / (g * xm) } else { 0.0 },
+                    ..Default::default()
+                },
+                dynamics: Dynamics {
+                    rotor_flux_tau_s: Some(n.lr_h / n.rr_ohm),
+                    stator_current_la_h: Some(n.la_h),
+                    ..Default::default()
+                },
                 ..Default::default()
             };
             let p = simulate(&a.data, n, &BaseParams::nominal(n), &t);

@@ -69,29 +69,7 @@ impl Analysis {
         let unbalance = self.unbalance();
         let info = self.info();
         if !d.channels.voltages {
-            skipped.push("model prediction (I_qs, omega_r, phase currents) skipped: the log has no voltage columns va_V, vb_V, vc_V, and the model is driven by V_qs; the unbalance analysis ran on the currents".into());
-            return Ok(CompareOutput {
-                report: CompareReport {
-                    effects: opts.effects.clone(),
-                    normalized_rms_error: f64::NAN,
-                    noise_floor: f64::NAN,
-                    channels: vec![],
-                    worst_windows: vec![],
-                    advice: vec![],
-                    base_parameters: Default::default(),
-                    fitted_effects: vec![],
-                    plausible: true,
-                    implausible_because: vec![],
-                    identifiability: None,
-                    not_identified: vec![],
-                    skipped,
-                    unbalance,
-                    data: info,
-                    data_quality: self.quality.clone(),
-                },
-                prediction: Prediction::default(),
-                all_windows: vec![],
-            });
+            return Ok(self.compare_current_only(opts, unbalance, info));
         }
         if !d.channels.speed {
             skipped.push("omega_r not compared: the log has no wm_rad_s column (the model still predicts it)".into());
@@ -166,6 +144,40 @@ impl Analysis {
             prediction: pred,
             all_windows: all,
         })
+    }
+}
+
+impl Analysis {
+    /// `compare` on a log without voltages: the model cannot run; only the unbalance
+    /// analysis.
+    fn compare_current_only(
+        &self,
+        opts: &Options,
+        unbalance: UnbalanceAnalysis,
+        info: DataInfo,
+    ) -> CompareOutput {
+        CompareOutput {
+            report: CompareReport {
+                effects: opts.effects.clone(),
+                normalized_rms_error: f64::NAN,
+                noise_floor: f64::NAN,
+                channels: vec![],
+                worst_windows: vec![],
+                advice: vec![],
+                base_parameters: Default::default(),
+                fitted_effects: vec![],
+                plausible: true,
+                implausible_because: vec![],
+                identifiability: None,
+                not_identified: vec![],
+                skipped: vec!["model prediction (I_qs, omega_r, phase currents) skipped: the log has no voltage columns va_V, vb_V, vc_V, and the model is driven by V_qs; the unbalance analysis ran on the currents".into()],
+                unbalance,
+                data: info,
+                data_quality: self.quality.clone(),
+            },
+            prediction: Prediction::default(),
+            all_windows: vec![],
+        }
     }
 }
 

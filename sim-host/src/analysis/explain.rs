@@ -1,14 +1,14 @@
 //! `explain`: which physical effect of the library is missing from the model, ranked by the
 //! error it removes on held-back windows.
 
-use super::effects::{self, EffectModel, Evidence, FitSetup};
+use super::effects::{self, EffectModel, Evidence, FitSetup, SetupError};
 use super::fit::{self, ActiveEffect, FitResult, FittedModel};
 use super::metrics::{self, Weights};
 use super::prep::Prepared;
 use super::simplified_model::{BaseParams, Prediction};
 use super::transients;
 use super::unbalance::UnbalanceAnalysis;
-use super::{align, needs_ok, resolve, Analysis, AnalysisError, DataInfo, Options, ParamValue};
+use super::{align, resolve, Analysis, AnalysisError, DataInfo, Options, ParamValue};
 use monitor_core::EffectKind;
 use serde::Serialize;
 
@@ -184,13 +184,11 @@ impl Analysis {
         opts: &Options,
         progress: &(dyn Fn(f64) + Sync),
     ) -> Result<ExplainOutput, AnalysisError> {
-        use rayon::prelude::*;
-        let d = &self.data;
         let unbalance = self.unbalance();
         let info = self.info();
         let configured = resolve(&opts.effects);
         let names: Vec<EffectKind> = configured.iter().map(|e| e.kind()).collect();
-        if !d.channels.voltages {
+        if !self.data.channels.voltages {
             return Ok(withhold_if_untrusted(explain_current_only(
                 names,
                 unbalance,
@@ -214,31 +212,8 @@ impl Analysis {
                     .map(|m| format!("{}: {m}", c.kind()))
             })
             .collect();
-        let done = std::sync::atomic::AtomicUsize::new(0);
-        let total = cands.len().max(1);
-        // Predictions are not kept per candidate (memory on long logs); the top one is
-        // recomputed from its fitted values.
-        let candidates = || -> Vec<Option<RankedCandidate>> {
-            cands
-                .par_iter()
-                .map(|c| {
-                    let r = self.evaluate_candidate(*c, &base, opts);
-                    let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                    progress(k as f64 / total as f64);
-                    r
-                })
-                .collect()
-        };
-        // A long log's candidates are ranked on the coarse series: the configured model's
-        // run over the working series is only reported, so it runs beside them.
-        let (full, results) = match full {
-            Some(f) => (f, candidates()),
-            None => {
-                let (f, r) = rayon::join(|| self.full_series(&configured, &base), candidates);
-                (f?, r)
-            }
-        };
-        let mut ranked: Vec<RankedCandidate> = results.into_iter().flatten().collect();
+        let (full, mut ranked) =
+            self.fit_candidates(&configured, &base, full, &cands, opts, progress)?;
         rank(&mut ranked, &unbalance, self.constants.torque_scale_nm);
         let best = ranked
             .first()
@@ -248,43 +223,10 @@ impl Analysis {
         let near_noise =
             full.heldback_error <= (NOISE_MARGIN * full.heldback_noise).max(MIN_MODEL_ERROR);
         let unexplained = best < EXPLAINED_MIN || near_noise;
-        let first_plausible = ranked.iter().find(|c| c.candidate.plausible);
-        let mut verdict = verdict(
-            &names,
-            &base,
-            &full,
-            first_plausible,
-            near_noise,
-            unexplained,
-        );
-        verdict.push_str(&implausible_note(&ranked));
-        let base_why = super::base_implausible(&self.constants, &base.fit.base, d);
-        if !base_why.is_empty() {
-            verdict.push_str(&format!(
-                ". The configured model's own fit is not plausible ({}): the base parameters absorb an error the model cannot follow; if the log has a start or steps, see compare's advice (dynamics effects or --from)",
-                base_why.join("; ")
-            ));
-        }
-        let after = if unexplained {
-            None
-        } else {
-            ranked.first().map(|r| {
-                let kinds: Vec<EffectKind> =
-                    names.iter().copied().chain([r.candidate.effect]).collect();
-                let boxes = resolve(&kinds);
-                let model = FittedModel {
-                    effects: boxes
-                        .iter()
-                        .zip(&r.setups)
-                        .map(|(e, s)| ActiveEffect {
-                            effect: e.as_ref(),
-                            setup: s.clone(),
-                        })
-                        .collect(),
-                    fit: r.fit.clone(),
-                };
-                (r.candidate.effect, model.predict(d, &self.constants))
-            })
+        let verdict = self.verdict(&names, &base, &full, &ranked, near_noise, unexplained);
+        let after = match ranked.first() {
+            Some(r) if !unexplained => Some((r.candidate.effect, self.predict_with(&names, r))),
+            _ => None,
         };
         Ok(withhold_if_untrusted(ExplainOutput {
             report: ExplainReport {
@@ -303,6 +245,89 @@ impl Analysis {
             before: full.before,
             after,
         }))
+    }
+
+    /// Fits every candidate of `cands` that can be ranked (in parallel, `progress` told the
+    /// fraction done) and, unless `full` already holds them, the configured model's
+    /// measures on the working series ([`Analysis::full_series`]). Predictions are not kept
+    /// per candidate (memory on long logs); the top one is recomputed from its fitted
+    /// values ([`Analysis::predict_with`]).
+    fn fit_candidates(
+        &self,
+        configured: &[Box<dyn EffectModel>],
+        base: &Baseline<'_>,
+        full: Option<FullSeries>,
+        cands: &[&dyn EffectModel],
+        opts: &Options,
+        progress: &(dyn Fn(f64) + Sync),
+    ) -> Result<(FullSeries, Vec<RankedCandidate>), AnalysisError> {
+        use rayon::prelude::*;
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        let total = cands.len().max(1);
+        let candidates = || -> Vec<Option<RankedCandidate>> {
+            cands
+                .par_iter()
+                .map(|c| {
+                    let r = self.evaluate_candidate(*c, base, opts);
+                    let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                    progress(k as f64 / total as f64);
+                    r
+                })
+                .collect()
+        };
+        // A long log's candidates are ranked on the coarse series: the configured model's
+        // run over the working series is only reported, so it runs beside them.
+        let (full, results) = match full {
+            Some(f) => (f, candidates()),
+            None => {
+                let (f, r) = rayon::join(|| self.full_series(configured, base), candidates);
+                (f?, r)
+            }
+        };
+        Ok((full, results.into_iter().flatten().collect()))
+    }
+
+    /// The verdict ([`verdict`]) with the notes on implausible candidates and on an
+    /// implausible fit of the configured model itself.
+    fn verdict(
+        &self,
+        names: &[EffectKind],
+        base: &Baseline<'_>,
+        full: &FullSeries,
+        ranked: &[RankedCandidate],
+        near_noise: bool,
+        unexplained: bool,
+    ) -> String {
+        let first_plausible = ranked.iter().find(|c| c.candidate.plausible);
+        let mut v = verdict(names, base, full, first_plausible, near_noise, unexplained);
+        v.push_str(&implausible_note(ranked));
+        let base_why = super::base_implausible(&self.constants, &base.fit.base, &self.data);
+        if !base_why.is_empty() {
+            v.push_str(&format!(
+                ". The configured model's own fit is not plausible ({}): the base parameters absorb an error the model cannot follow; if the log has a start or steps, see compare's advice (dynamics effects or --from)",
+                base_why.join("; ")
+            ));
+        }
+        v
+    }
+
+    /// The prediction of the configured model (`names`) with candidate `r` added, from
+    /// their fitted values, on the working series.
+    fn predict_with(&self, names: &[EffectKind], r: &RankedCandidate) -> Prediction {
+        let kinds: Vec<EffectKind> = names.iter().copied().chain([r.candidate.effect]).collect();
+        let boxes = resolve(&kinds);
+        let model = FittedModel {
+            effects: boxes
+                .iter()
+                .zip(&r.setups)
+                .map(|(e, s)| ActiveEffect {
+                    effect: e.as_ref(),
+                    setup: s.clone(),
+                })
+                .collect(),
+            fit: r.fit.clone(),
+        };
+        model.predict(&self.data, &self.constants)
     }
 
     /// Fits the configured model and measures it on the fit series (for a long log, the
@@ -387,21 +412,23 @@ impl Analysis {
         })
     }
 
-    /// Why a candidate cannot be ranked on this log, if it cannot: a dynamics effect whose
-    /// time constant the (coarse) fit series of a long log cannot resolve (fewer than 3
-    /// samples per time constant), a missing channel, or a set-up the data refuse (e.g.
-    /// `load_torque` on a log without a load change: said, not dropped).
-    fn cannot_rank(&self, c: &dyn EffectModel, base: &Baseline<'_>) -> Option<String> {
+    /// Why a candidate cannot be ranked on this log, if it cannot: an effect it needs in
+    /// the model first, a dynamics effect whose time constant the (coarse) fit series of a
+    /// long log cannot resolve or that has no transient to act on, a missing channel, or a
+    /// set-up the data refuse (e.g. `load_torque` on a log without a load change: said,
+    /// not dropped).
+    fn cannot_rank(&self, c: &dyn EffectModel, base: &Baseline<'_>) -> Option<NotRanked> {
         if let Some(m) = missing_requirement(c, base) {
             return Some(m);
         }
         if let Some(m) = self.not_dynamic(c, base) {
             return Some(m);
         }
-        if let Err(m) = needs_ok(c.needs(), &self.data) {
-            return Some(m);
-        }
-        c.setup(&base.fit_series, &self.constants).err()
+        let setup = c
+            .needs()
+            .met_by(&self.data)
+            .and_then(|()| c.setup(&base.fit_series, &self.constants).map(|_| ()));
+        setup.err().map(NotRanked::Setup)
     }
 
     /// Why a dynamics effect (one that declares a time constant,
@@ -412,23 +439,13 @@ impl Analysis {
     /// moves the speed at the mechanical rate), the full-order machine's steady state is
     /// the paper's model, and what a dynamics effect's extra states gain there they gain by
     /// absorbing another effect (README, "Honest ranking").
-    fn not_dynamic(&self, c: &dyn EffectModel, base: &Baseline<'_>) -> Option<String> {
-        let tau = c.time_constant_s(&self.constants)?;
+    fn not_dynamic(&self, c: &dyn EffectModel, base: &Baseline<'_>) -> Option<NotRanked> {
+        let tau_s = c.time_constant_s(&self.constants)?;
         let dt_s = base.fit_series.dt_s;
-        if dt_s > tau / 3.0 {
-            return Some(format!(
-                "the fit series of this long log ({:.0} Hz) cannot resolve a {:.1} ms time constant; analyse a shorter window with --from/--to",
-                1.0 / dt_s,
-                1000.0 * tau
-            ));
+        if dt_s > tau_s / 3.0 {
+            return Some(NotRanked::Unresolved { dt_s, tau_s });
         }
-        (!base.has_input_transient).then(|| {
-            format!(
-                "no start or supply step in the analysed span (voltage and frequency within {:.0} %): its {:.1} ms dynamics have nothing to act on",
-                100.0 * transients::STEP_MIN,
-                1000.0 * tau
-            )
-        })
+        (!base.has_input_transient).then_some(NotRanked::NoTransient { tau_s })
     }
 
     /// Adds candidate `c` to the configured model, fits both on the fit series and
@@ -441,7 +458,7 @@ impl Analysis {
     ) -> Option<RankedCandidate> {
         let d = &self.data;
         let fd = &base.fit_series;
-        needs_ok(c.needs(), d).ok()?;
+        c.needs().met_by(d).ok()?;
         if missing_requirement(c, base).is_some() || self.not_dynamic(c, base).is_some() {
             return None;
         }
@@ -452,9 +469,7 @@ impl Analysis {
             .zip(&base.fit.effect_params)
             .map(|(a, p)| {
                 let mut s = a.setup.clone();
-                if s.init.len() == p.len() {
-                    s.init = p.clone();
-                }
+                s.start_from(p);
                 ActiveEffect {
                     effect: a.effect,
                     setup: s,
@@ -462,7 +477,7 @@ impl Analysis {
             })
             .collect();
         let s = c.setup(fd, &self.constants).ok()?;
-        let np = s.init.len();
+        let np = s.len();
         set.push(ActiveEffect {
             effect: c,
             setup: s,
@@ -495,16 +510,16 @@ impl Analysis {
         // A base parameter the candidate's refit takes out of range counts against it; one
         // the configured model's own fit already has out of range does not (the verdict
         // reports that apart).
-        let key = |w: &String| w.split(" =").next().unwrap_or_default().to_string();
-        let already: Vec<String> = super::base_implausible(&self.constants, &base.fit.base, d)
-            .iter()
-            .map(key)
+        let already: Vec<&str> = super::base_out_of_range(&self.constants, &base.fit.base, d)
+            .into_iter()
+            .map(|(k, _)| k)
             .collect();
         let mut why = me.implausible_because.clone();
         why.extend(
-            super::base_implausible(&self.constants, &f.base, d)
+            super::base_out_of_range(&self.constants, &f.base, d)
                 .into_iter()
-                .filter(|w| !already.contains(&key(w))),
+                .filter(|(k, _)| !already.contains(k))
+                .map(|(_, w)| w),
         );
         Some(RankedCandidate {
             candidate: EffectCandidate {
@@ -530,16 +545,52 @@ impl Analysis {
     }
 }
 
+/// Why `explain` does not rank a candidate on this log (the report's `skipped`).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+enum NotRanked {
+    /// Effects it needs in the model first ([`EffectModel::requires`]).
+    #[error("needs {} in the model first", names(.0))]
+    Requires(Vec<EffectKind>),
+    /// Its time constant `tau_s` [s] is shorter than 3 samples of the fit series (period
+    /// `dt_s` [s]).
+    #[error("the fit series of this long log ({:.0} Hz) cannot resolve a {:.1} ms time constant; analyse a shorter window with --from/--to", 1.0 / dt_s, 1000.0 * tau_s)]
+    Unresolved {
+        /// Sample period of the fit series [s].
+        dt_s: f64,
+        /// The effect's time constant [s].
+        tau_s: f64,
+    },
+    /// A dynamics effect (time constant `tau_s` [s]) on a log without a start or a supply
+    /// step.
+    #[error("no start or supply step in the analysed span (voltage and frequency within {:.0} %): its {:.1} ms dynamics have nothing to act on", 100.0 * transients::STEP_MIN, 1000.0 * tau_s)]
+    NoTransient {
+        /// The effect's time constant [s].
+        tau_s: f64,
+    },
+    /// The log lacks a channel, or the set-up refuses the data.
+    #[error(transparent)]
+    Setup(SetupError),
+}
+
+/// Effect names, comma separated.
+fn names(kinds: &[EffectKind]) -> String {
+    kinds
+        .iter()
+        .map(|k| k.name())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// The effects `c` needs in the model first ([`EffectModel::requires`]) that the
 /// configured model lacks, as the reason it is not proposed yet.
-fn missing_requirement(c: &dyn EffectModel, base: &Baseline<'_>) -> Option<String> {
-    let missing: Vec<&str> = c
+fn missing_requirement(c: &dyn EffectModel, base: &Baseline<'_>) -> Option<NotRanked> {
+    let missing: Vec<EffectKind> = c
         .requires()
         .iter()
-        .filter(|k| !base.active.iter().any(|a| a.effect.kind() == **k))
-        .map(|k| k.name())
+        .copied()
+        .filter(|k| !base.active.iter().any(|a| a.effect.kind() == *k))
         .collect();
-    (!missing.is_empty()).then(|| format!("needs {} in the model first", missing.join(", ")))
+    (!missing.is_empty()).then_some(NotRanked::Requires(missing))
 }
 
 /// `explain` on a log without voltages: the model cannot run; only the unbalance analysis.
@@ -571,7 +622,8 @@ fn explain_current_only(
         .filter(|k| !names.contains(k))
         .map(|k| {
             format!(
-                "{k}: needs the voltage columns va_V, vb_V, vc_V (the model is driven by V_qs); see the unbalance analysis"
+                "{k}: {}; see the unbalance analysis",
+                SetupError::NoVoltages
             )
         })
         .collect();

@@ -16,7 +16,7 @@ use super::lm::{self, LeastSquares};
 use super::metrics::{measured, predicted, Weights};
 use super::prep::{Prepared, C64};
 use super::simplified_model::{
-    rotations, simulate, simulate_rot, BaseParams, EffectTerms, MachineConstants, Prediction,
+    rotations, simulate, simulate_rot, BaseParams, MachineConstants, ModelTerms, Prediction,
 };
 use nalgebra::DMatrix;
 use rayon::prelude::*;
@@ -62,7 +62,7 @@ struct Problem<'a> {
     norm: f64,
 }
 
-impl Problem<'_> {
+impl<'a> Problem<'a> {
     fn base(x: &[f64]) -> BaseParams {
         BaseParams {
             ra_scale: x[0],
@@ -72,16 +72,39 @@ impl Problem<'_> {
         }
     }
 
+    /// The problem on `d` (the training samples of `w`, their measured channels fixed);
+    /// with `priors` the base parameters' priors are residuals too.
+    fn new(
+        d: &'a Prepared,
+        n: &'a MachineConstants,
+        effects: &'a [ActiveEffect<'a>],
+        w: &'a Weights,
+        priors: bool,
+    ) -> Self {
+        let targets: Vec<(usize, [f64; 5])> = (0..d.len())
+            .step_by(w.stride)
+            .filter(|&k| w.train[k])
+            .map(|k| (k, measured(d, k)))
+            .collect();
+        Problem {
+            d,
+            n,
+            effects,
+            w,
+            btot_scale: btot_scale(n, d),
+            fit_base: priors,
+            rot: rotations(d),
+            norm: 1.0 / (targets.len().max(1) as f64).sqrt(),
+            targets,
+        }
+    }
+
     /// The effects' contributions for the effect parameters in `x` (the base parameters do
     /// not enter them).
-    fn terms(&self, x: &[f64]) -> EffectTerms {
-        let mut terms = EffectTerms::default();
-        let mut o = N_BASE;
-        for e in self.effects {
-            let k = e.setup.init.len();
-            e.effect
-                .apply(&e.setup, &x[o..o + k], self.d, self.n, &mut terms);
-            o += k;
+    fn terms(&self, x: &[f64]) -> ModelTerms {
+        let mut terms = ModelTerms::default();
+        for (e, p) in effect_values(self.effects, &x[N_BASE..]) {
+            e.setup.contribute(p, self.d, self.n, &mut terms);
         }
         terms
     }
@@ -92,7 +115,7 @@ impl Problem<'_> {
 
     /// The same residuals as [`Weights::residuals`] on the training samples (the measured
     /// side precomputed), plus the priors; `terms` must be [`Problem::terms`] of `x`.
-    fn residuals_with(&self, x: &[f64], terms: &EffectTerms) -> Vec<f64> {
+    fn residuals_with(&self, x: &[f64], terms: &ModelTerms) -> Vec<f64> {
         let p = simulate_rot(self.d, &self.rot, self.n, &Self::base(x), terms);
         let inv = &self.w.inv_rms;
         let nc = self.w.n_channels();
@@ -123,11 +146,11 @@ impl Problem<'_> {
 
 impl LeastSquares for Problem<'_> {
     /// The effects' terms: only the effects' parameters enter them.
-    type Cache = EffectTerms;
-    fn cache(&self, x: &[f64]) -> EffectTerms {
+    type Cache = ModelTerms;
+    fn cache(&self, x: &[f64]) -> ModelTerms {
         self.terms(x)
     }
-    fn residuals(&self, x: &[f64], terms: &EffectTerms) -> Vec<f64> {
+    fn residuals(&self, x: &[f64], terms: &ModelTerms) -> Vec<f64> {
         self.residuals_with(x, terms)
     }
     fn keeps_cache(&self, i: usize) -> bool {
@@ -142,8 +165,22 @@ pub fn btot_scale(n: &MachineConstants, d: &Prepared) -> f64 {
     n.btot_nms.max(0.2 * n.torque_scale_nm / wmax.max(1.0))
 }
 
+/// Each effect with its slice of the effect values `values` (laid out in the effects'
+/// order, each set-up's parameter count; a short `values` ends the list).
+fn effect_values<'e, 'v>(
+    effects: &'e [ActiveEffect<'e>],
+    values: &'v [f64],
+) -> impl Iterator<Item = (&'e ActiveEffect<'e>, &'v [f64])> {
+    let mut o = 0;
+    effects.iter().map_while(move |e| {
+        let p = values.get(o..o + e.setup.len())?;
+        o += e.setup.len();
+        Some((e, p))
+    })
+}
+
 /// Fits base parameters (unless `fit_base` is false: nominal values are kept) and the
-/// effects' parameters, starting from `start` (base) and each set-up's `init`.
+/// effects' parameters, starting from `start` (base) and each set-up's initial values.
 pub fn fit(
     d: &Prepared,
     n: &MachineConstants,
@@ -153,23 +190,8 @@ pub fn fit(
     fit_base: bool,
     max_iter: usize,
 ) -> FitResult {
-    let bs = btot_scale(n, d);
-    let targets: Vec<(usize, [f64; 5])> = (0..d.len())
-        .step_by(w.stride)
-        .filter(|&k| w.train[k])
-        .map(|k| (k, measured(d, k)))
-        .collect();
-    let prob = Problem {
-        d,
-        n,
-        effects,
-        w,
-        btot_scale: bs,
-        fit_base,
-        rot: rotations(d),
-        norm: 1.0 / (targets.len().max(1) as f64).sqrt(),
-        targets,
-    };
+    let prob = Problem::new(d, n, effects, w, fit_base);
+    let bs = prob.btot_scale;
     let mut x = vec![
         start.ra_scale,
         start.ls_scale,
@@ -179,11 +201,11 @@ pub fn fit(
     let mut lo = vec![0.3, 0.5, 0.0, 0.2];
     let mut hi = vec![3.0, 2.0, 50.0 * bs, 5.0];
     let mut scale = vec![0.05, 0.05, 0.2 * bs, 0.1];
-    for e in effects {
-        x.extend_from_slice(&e.setup.init);
-        lo.extend_from_slice(&e.setup.lo);
-        hi.extend_from_slice(&e.setup.hi);
-        scale.extend_from_slice(&e.setup.scale);
+    for q in effects.iter().flat_map(|e| &e.setup.params) {
+        x.push(q.init);
+        lo.push(q.lo);
+        hi.push(q.hi);
+        scale.push(q.scale);
     }
     let free: Vec<usize> = (0..x.len()).filter(|&i| fit_base || i >= N_BASE).collect();
     let bounds = lm::Bounds { lo, hi, scale };
@@ -192,7 +214,7 @@ pub fn fit(
     let mut best = lm::solve(&prob, x.clone(), &bounds, &free, max_iter);
     let mut o = N_BASE;
     for e in effects {
-        let k = e.setup.init.len();
+        let k = e.setup.len();
         for alt in e.setup.alt_init.iter().filter(|a| a.len() == k) {
             let mut y = x.clone();
             y[o..o + k].copy_from_slice(alt);
@@ -204,17 +226,11 @@ pub fn fit(
         o += k;
     }
     let (x, report) = best;
-    let base = Problem::base(&x);
-    let mut effect_params = Vec::new();
-    let mut o = N_BASE;
-    for e in effects {
-        let k = e.setup.init.len();
-        effect_params.push(x[o..o + k].to_vec());
-        o += k;
-    }
     FitResult {
-        base,
-        effect_params,
+        base: Problem::base(&x),
+        effect_params: effect_values(effects, &x[N_BASE..])
+            .map(|(_, p)| p.to_vec())
+            .collect(),
         report,
     }
 }
@@ -225,10 +241,10 @@ pub fn terms(
     n: &MachineConstants,
     effects: &[ActiveEffect<'_>],
     f: &FitResult,
-) -> EffectTerms {
-    let mut terms = EffectTerms::default();
+) -> ModelTerms {
+    let mut terms = ModelTerms::default();
     for (e, p) in effects.iter().zip(&f.effect_params) {
-        e.effect.apply(&e.setup, p, d, n, &mut terms);
+        e.setup.contribute(p, d, n, &mut terms);
     }
     terms
 }
@@ -277,8 +293,8 @@ impl std::fmt::Display for FittedModel<'_> {
             sig(b.j_scale)
         )?;
         for (e, p) in self.effects.iter().zip(&self.fit.effect_params) {
-            for ((name, unit), v) in e.setup.names.iter().zip(&e.setup.units).zip(p) {
-                write!(f, "; {name} = {} {unit}", sig(*v))?;
+            for (q, v) in e.setup.params.iter().zip(p) {
+                write!(f, "; {} = {} {}", q.name, sig(*v), q.unit)?;
             }
         }
         let r = &self.fit.report;
@@ -338,24 +354,9 @@ pub fn jacobian(
     if !fit_base {
         return None;
     }
-    let targets: Vec<(usize, [f64; 5])> = (0..d.len())
-        .step_by(w.stride)
-        .filter(|&k| w.train[k])
-        .map(|k| (k, measured(d, k)))
-        .collect();
-    let bs = btot_scale(n, d);
-    let prob = Problem {
-        d,
-        n,
-        effects,
-        w,
-        btot_scale: bs,
-        // Data residuals only: the priors are not information from the log.
-        fit_base: false,
-        rot: rotations(d),
-        norm: 1.0 / (targets.len().max(1) as f64).sqrt(),
-        targets,
-    };
+    // Data residuals only: the priors are not information from the log.
+    let prob = Problem::new(d, n, effects, w, false);
+    let bs = prob.btot_scale;
     let mut x = vec![
         f.base.ra_scale,
         f.base.ls_scale,
@@ -365,70 +366,17 @@ pub fn jacobian(
     let mut mag = vec![1.0, 1.0, f.base.btot_nms.abs().max(0.1 * bs), 1.0];
     for (e, p) in effects.iter().zip(&f.effect_params) {
         x.extend_from_slice(p);
-        for (v, s) in p.iter().zip(&e.setup.scale) {
-            mag.push(v.abs().max(*s));
+        for (v, q) in p.iter().zip(&e.setup.params) {
+            mag.push(v.abs().max(q.scale));
         }
     }
-    let r = prob.residuals_of(&x);
-    let cols: Vec<Vec<f64>> = (0..x.len())
-        .into_par_iter()
-        .map(|i| {
-            let h = 1e-3 * mag[i];
-            let mut xp = x.clone();
-            xp[i] += h;
-            let rp = prob.residuals_of(&xp);
-            // Relative column: d r / d ln|x| (a change of 100 % of the magnitude).
-            rp.iter()
-                .zip(&r)
-                .map(|(a, b)| (a - b) / h * mag[i])
-                .collect()
-        })
-        .collect();
-    let m = cols.len();
-    let mut jtj = DMatrix::<f64>::zeros(m, m);
-    for a in 0..m {
-        for c in a..m {
-            let s: f64 = cols[a].iter().zip(&cols[c]).map(|(u, v)| u * v).sum();
-            jtj[(a, c)] = s;
-            jtj[(c, a)] = s;
-        }
-    }
-    let eig = jtj.clone().symmetric_eigen();
-    let smax = eig
-        .eigenvalues
-        .iter()
-        .fold(0.0f64, |a, &v| a.max(v))
-        .max(0.0);
-    let rank = eig
-        .eigenvalues
-        .iter()
-        .filter(|&&v| v > 1e-12 * smax)
-        .count();
-    let smin = eig.eigenvalues.iter().fold(f64::INFINITY, |a, &v| a.min(v));
-    let condition_number = if smin > 0.0 {
-        (smax / smin).sqrt()
-    } else {
-        f64::INFINITY
-    };
-    // Pseudo-inverse diagonal: sum over eigenpairs above the rank threshold.
-    let inv_diag = |i: usize| -> f64 {
-        let mut s = 0.0;
-        for (k, &lam) in eig.eigenvalues.iter().enumerate() {
-            let v = eig.eigenvectors[(i, k)];
-            if lam > 1e-12 * smax {
-                s += v * v / lam;
-            } else if v.abs() > 1e-6 {
-                return f64::INFINITY;
-            }
-        }
-        s
-    };
+    let g = Gram::of(&relative_columns(&prob, &x, &mag));
     let names = ["ra_ohm", "ls_h", "b_plus_bl_nms", "j_kgm2"];
     let base = names
         .iter()
         .enumerate()
         .map(|(i, &name)| {
-            let inv = inv_diag(i);
+            let inv = g.inverse_diagonal(i);
             let ch = if inv.is_finite() && inv > 0.0 {
                 0.1 / inv.sqrt()
             } else {
@@ -442,11 +390,97 @@ pub fn jacobian(
         })
         .collect();
     Some(Jacobian {
-        n_parameters: m,
-        rank,
-        condition_number,
+        n_parameters: x.len(),
+        rank: g.rank(),
+        condition_number: g.condition_number(),
         base,
     })
+}
+
+/// The Jacobian's columns at `x`, each relative to its parameter's magnitude `mag`
+/// (d r / d ln|x|: a change of 100 % of the magnitude), by forward differences of 1e-3 of
+/// the magnitude, in parallel.
+fn relative_columns(prob: &Problem<'_>, x: &[f64], mag: &[f64]) -> Vec<Vec<f64>> {
+    let r = prob.residuals_of(x);
+    (0..x.len())
+        .into_par_iter()
+        .map(|i| {
+            let h = 1e-3 * mag[i];
+            let mut xp = x.to_vec();
+            xp[i] += h;
+            let rp = prob.residuals_of(&xp);
+            rp.iter()
+                .zip(&r)
+                .map(|(a, b)| (a - b) / h * mag[i])
+                .collect()
+        })
+        .collect()
+}
+
+/// The Gram matrix J^T J of a Jacobian's columns, by its eigen-decomposition.
+struct Gram {
+    eig: nalgebra::SymmetricEigen<f64, nalgebra::Dyn>,
+    /// The largest eigenvalue (at least 0).
+    smax: f64,
+}
+
+impl Gram {
+    fn of(cols: &[Vec<f64>]) -> Self {
+        let m = cols.len();
+        let mut jtj = DMatrix::<f64>::zeros(m, m);
+        for a in 0..m {
+            for c in a..m {
+                let s: f64 = cols[a].iter().zip(&cols[c]).map(|(u, v)| u * v).sum();
+                jtj[(a, c)] = s;
+                jtj[(c, a)] = s;
+            }
+        }
+        let eig = jtj.symmetric_eigen();
+        let smax = eig
+            .eigenvalues
+            .iter()
+            .fold(0.0f64, |a, &v| a.max(v))
+            .max(0.0);
+        Gram { eig, smax }
+    }
+
+    /// Numerical rank: eigenvalues above 1e-12 of the largest (singular values above 1e-6).
+    fn rank(&self) -> usize {
+        self.eig
+            .eigenvalues
+            .iter()
+            .filter(|&&v| v > 1e-12 * self.smax)
+            .count()
+    }
+
+    /// Largest over smallest singular value (infinite when singular).
+    fn condition_number(&self) -> f64 {
+        let smin = self
+            .eig
+            .eigenvalues
+            .iter()
+            .fold(f64::INFINITY, |a, &v| a.min(v));
+        if smin > 0.0 {
+            (self.smax / smin).sqrt()
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// Diagonal element `i` of the pseudo-inverse: the sum over the eigenpairs above the
+    /// rank threshold; infinite when parameter `i` lies in the null space.
+    fn inverse_diagonal(&self, i: usize) -> f64 {
+        let mut s = 0.0;
+        for (k, &lam) in self.eig.eigenvalues.iter().enumerate() {
+            let v = self.eig.eigenvectors[(i, k)];
+            if lam > 1e-12 * self.smax {
+                s += v * v / lam;
+            } else if v.abs() > 1e-6 {
+                return f64::INFINITY;
+            }
+        }
+        s
+    }
 }
 
 #[cfg(test)]

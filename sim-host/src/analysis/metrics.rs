@@ -4,7 +4,7 @@
 //! Channels: `iqs_A` (I_qs, rotor-flux frame), `omega_r_rad_s` (electrical rotor speed,
 //! when the log has `wm_rad_s`), `ia_A`, `ib_A`, `ic_A` (phase currents). Each channel's
 //! RMS error is divided by that channel's measured RMS; `normalized_rms_error` is the mean
-//! over the channels present (DESIGN.md §3).
+//! over the channels present (the JSON key's definition: `docs/design.md`).
 
 use super::prep::{phase_values, Prepared, C64};
 use super::simplified_model::Prediction;

@@ -48,7 +48,7 @@ pub mod simplified_model;
 pub mod transients;
 pub mod unbalance;
 
-use effects::{EffectModel, Needs};
+use effects::EffectModel;
 use fit::{ActiveEffect, FitResult};
 use metrics::Weights;
 use monitor_core::EffectKind;
@@ -72,9 +72,15 @@ pub enum AnalysisError {
     /// Unknown effect name.
     #[error("unknown effect '{0}' (known: {known})", known = known_effects())]
     UnknownEffect(String),
-    /// The log lacks what an analysis needs.
-    #[error("{0}")]
-    Missing(String),
+    /// A configured effect cannot be set up on the log (a channel it needs is missing, or
+    /// the log holds nothing it could fit).
+    #[error("effect {effect}: {source}")]
+    Effect {
+        /// Which effect.
+        effect: EffectKind,
+        /// Why not.
+        source: effects::SetupError,
+    },
 }
 
 /// The library's effect names, comma separated (for messages).
@@ -149,42 +155,75 @@ pub struct FittedEffect {
     pub implausible_because: Vec<String>,
 }
 
-/// The base parameters' physical ranges ([`effects::plausible`]), one entry per parameter:
-/// key, value, range, unit.
-fn base_ranges(
-    n: &MachineConstants,
-    b: &BaseParams,
-    d: &Prepared,
-) -> [(&'static str, f64, f64, f64, &'static str, &'static str); 4] {
+/// A fitted base parameter with its unit and physical range ([`effects::plausible`]).
+struct BaseValue {
+    /// JSON key.
+    key: &'static str,
+    value: f64,
+    unit: &'static str,
+    range: crate::params::PlausibleRange,
+    /// Where the range comes from.
+    basis: &'static str,
+}
+
+impl BaseValue {
+    fn new(
+        key: &'static str,
+        value: f64,
+        (lo, hi): (f64, f64),
+        unit: &'static str,
+        basis: &'static str,
+    ) -> Self {
+        BaseValue {
+            key,
+            value,
+            unit,
+            range: crate::params::PlausibleRange { lo, hi },
+            basis,
+        }
+    }
+
+    /// Why the value is not plausible (`None`: it is).
+    fn implausible_because(&self) -> Option<String> {
+        effects::outside(self.key, self.unit, self.value, &self.range, self.basis)
+    }
+}
+
+/// The fitted base parameters `b` with their physical ranges.
+fn base_values(n: &MachineConstants, b: &BaseParams, d: &Prepared) -> [BaseValue; 4] {
     use effects::plausible as pl;
     let bmax = (pl::BTOT_RATED_TORQUE * n.torque_scale_nm / effects::sync_speed_mech(d, n))
         .max(3.0 * n.btot_nms);
+    let rel = |r: (f64, f64), x: f64| (r.0 * x, r.1 * x);
     [
-        ("ra_ohm", n.ra_ohm * b.ra_scale, pl::RA_RATIO.0 * n.ra_ohm, pl::RA_RATIO.1 * n.ra_ohm, "ohm",
-         "Ra follows the winding temperature: -20 C to 155 C is 0.84-1.53 x the 20 C value, plus 10 % data-sheet tolerance"),
-        ("ls_h", n.ls_h * b.ls_scale, pl::LS_RATIO.0 * n.ls_h, pl::LS_RATIO.1 * n.ls_h, "H",
-         "Ls moves at most about 30 % with saturation and tolerance"),
-        ("b_plus_bl_nms", b.btot_nms, 0.0, bmax, "N m s/rad",
-         "a viscous load carries at most 1.5 x the rated torque at synchronous speed"),
-        ("j_kgm2", n.j_kgm2 * b.j_scale, pl::J_RATIO.0 * n.j_kgm2, pl::J_RATIO.1 * n.j_kgm2, "kg m^2",
-         "the coupled load's inertia is the usual unknown, but a factor 3 either way is another machine"),
+        BaseValue::new("ra_ohm", n.ra_ohm * b.ra_scale, rel(pl::RA_RATIO, n.ra_ohm), "ohm",
+            "Ra follows the winding temperature: -20 C to 155 C is 0.84-1.53 x the 20 C value, plus 10 % data-sheet tolerance"),
+        BaseValue::new("ls_h", n.ls_h * b.ls_scale, rel(pl::LS_RATIO, n.ls_h), "H",
+            "Ls moves at most about 30 % with saturation and tolerance"),
+        BaseValue::new("b_plus_bl_nms", b.btot_nms, (0.0, bmax), "N m s/rad",
+            "a viscous load carries at most 1.5 x the rated torque at synchronous speed"),
+        BaseValue::new("j_kgm2", n.j_kgm2 * b.j_scale, rel(pl::J_RATIO, n.j_kgm2), "kg m^2",
+            "the coupled load's inertia is the usual unknown, but a factor 3 either way is another machine"),
     ]
+}
+
+/// The fitted base parameters that are not physically plausible: their keys and why.
+fn base_out_of_range(
+    n: &MachineConstants,
+    b: &BaseParams,
+    d: &Prepared,
+) -> Vec<(&'static str, String)> {
+    base_values(n, b, d)
+        .iter()
+        .filter_map(|v| Some((v.key, v.implausible_because()?)))
+        .collect()
 }
 
 /// The reasons fitted base parameters are not physically plausible (empty: plausible).
 pub fn base_implausible(n: &MachineConstants, b: &BaseParams, d: &Prepared) -> Vec<String> {
-    use effects::sig;
-    base_ranges(n, b, d)
-        .iter()
-        .filter(|(_, v, lo, hi, _, _)| !(v.is_finite() && v >= lo && v <= hi))
-        .map(|(k, v, lo, hi, u, basis)| {
-            format!(
-                "{k} = {} {u} is outside the physical range {}..{} {u} ({basis})",
-                sig(*v),
-                sig(*lo),
-                sig(*hi)
-            )
-        })
+    base_out_of_range(n, b, d)
+        .into_iter()
+        .map(|(_, why)| why)
         .collect()
 }
 
@@ -212,18 +251,6 @@ fn resolve(kinds: &[EffectKind]) -> Vec<Box<dyn EffectModel>> {
         }
     }
     v
-}
-
-fn needs_ok(n: Needs, d: &Prepared) -> Result<(), String> {
-    if n.voltages && !d.channels.voltages {
-        return Err(
-            "needs the voltage columns va_V, vb_V, vc_V (the model is driven by V_qs)".into(),
-        );
-    }
-    if n.speed && !d.channels.speed {
-        return Err("needs the speed column wm_rad_s".into());
-    }
-    Ok(())
 }
 
 /// Block-averages a working series by `m` (for fitting long logs).
@@ -349,20 +376,16 @@ impl Analysis {
     fn base_table(&self, b: &BaseParams) -> std::collections::BTreeMap<String, ParamValue> {
         let n = &self.constants;
         let noms = [n.ra_ohm, n.ls_h, n.btot_nms, n.j_kgm2];
-        let why = base_implausible(n, b, &self.data);
-        base_ranges(n, b, &self.data)
+        base_values(n, b, &self.data)
             .iter()
             .zip(noms)
-            .map(|((k, v, _, _, u, _), nom)| {
-                let reason = why
-                    .iter()
-                    .find(|w| w.starts_with(&format!("{k} =")))
-                    .cloned();
+            .map(|(v, nom)| {
+                let reason = v.implausible_because();
                 (
-                    k.to_string(),
+                    v.key.to_string(),
                     ParamValue {
-                        value: *v,
-                        unit: u.to_string(),
+                        value: v.value,
+                        unit: v.unit.to_string(),
                         nominal: Some(nom),
                         plausible: reason.is_none(),
                         implausible_because: reason,
@@ -379,11 +402,14 @@ impl Analysis {
     ) -> Result<Vec<ActiveEffect<'a>>, AnalysisError> {
         let mut v = Vec::new();
         for e in list {
-            needs_ok(e.needs(), d)
-                .map_err(|m| AnalysisError::Missing(format!("effect {}: {m}", e.kind())))?;
             let setup = e
-                .setup(d, &self.constants)
-                .map_err(|m| AnalysisError::Missing(format!("effect {}: {m}", e.kind())))?;
+                .needs()
+                .met_by(d)
+                .and_then(|()| e.setup(d, &self.constants))
+                .map_err(|source| AnalysisError::Effect {
+                    effect: e.kind(),
+                    source,
+                })?;
             v.push(ActiveEffect {
                 effect: e.as_ref(),
                 setup,
@@ -422,20 +448,16 @@ impl Analysis {
                     effect: a.effect.kind(),
                     parameters: a
                         .setup
-                        .names
+                        .params
                         .iter()
-                        .zip(&a.setup.units)
                         .zip(p)
-                        .map(|((n, u), v)| {
-                            let reason = why
-                                .iter()
-                                .find(|w| w.starts_with(&format!("{n} =")))
-                                .cloned();
+                        .map(|(q, v)| {
+                            let reason = q.implausible_because(*v);
                             (
-                                n.clone(),
+                                q.name.clone(),
                                 ParamValue {
                                     value: *v,
-                                    unit: u.to_string(),
+                                    unit: q.unit.to_string(),
                                     nominal: None,
                                     plausible: reason.is_none(),
                                     implausible_because: reason,
@@ -443,7 +465,7 @@ impl Analysis {
                             )
                         })
                         .collect(),
-                    summary: a.effect.describe(&a.setup, p, &self.data, &self.constants),
+                    summary: a.setup.describe(p, &self.data, &self.constants),
                     plausible: why.is_empty(),
                     implausible_because: why,
                 }
@@ -490,8 +512,8 @@ impl Analysis {
 /// full series; then the set-up's initial values stand).
 fn align(active: &[ActiveEffect<'_>], mut f: FitResult) -> FitResult {
     for (a, p) in active.iter().zip(f.effect_params.iter_mut()) {
-        if p.len() != a.setup.init.len() {
-            *p = a.setup.init.clone();
+        if p.len() != a.setup.len() {
+            *p = a.setup.init();
         }
     }
     f

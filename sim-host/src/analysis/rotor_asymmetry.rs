@@ -1,38 +1,9 @@
-//! `rotor_asymmetry`: an unequal rotor cage (broken rotor bars, cracked end ring), the
-//! library effect for `compare` / `explain`, and the motor current signature analysis
-//! (MCSA) report users of that fault expect: the (1 - 2s) f and (1 + 2s) f sidebands of the
-//! stator current in dB below the fundamental and the 2 s f speed ripple.
+//! `rotor_asymmetry` (an unequal rotor cage: broken rotor bars, a cracked end ring): the
+//! motor current signature analysis (MCSA) report users of that fault expect: the
+//! (1 - 2s) f and (1 + 2s) f sidebands of the stator current in dB below the fundamental
+//! and the 2 s f speed ripple.
 //!
-//! # Model (the simplified model's view of the simulator's full-order asymmetry)
-//! The simulator gives rotor phase a the resistance Rr (1 + delta) (`crate::sim`); in
-//! alpha-beta that is R_r = Rr I + (2/3) Rr delta u u^T, u along rotor phase a. In the
-//! rotor-flux frame of the analysis the rotor current is along q (i_rq = -(Lm/Lr) I_qs), so
-//! the slip equation sees the q-q element of R_r:
-//! ```text
-//!   R_qq / Rr = 1 + (2/3) delta sin^2(g) = 1 + (delta/3) (1 - cos(2 g)),
-//!   g = Np theta_m - theta + phi/2   (rotor phase a against the flux's d axis)
-//! ```
-//! Np theta_m is the integral of the measured electrical speed, theta the analysis frame's
-//! angle, phi the unknown angle of the faulty phase (fitted). The rotor resistance term of
-//! Ra = Rs + (Ls/Lr) Rr is multiplied by R_qq / Rr: the q current and the torque are then
-//! modulated at 2 s f in the rotor-flux frame, which in the stator frame is the (1 - 2s) f
-//! sideband, and the 2 s f torque ripple moves the speed, which makes the (1 + 2s) f one.
-//! The d row drives the rotor flux phi = psi_r/Lm (exact rotor equation, first order in
-//! delta): `tau_r dphi/dt = I_ds - phi + (delta/3) [sin(2g) I_qs + (1 + cos(2g)) (I_ds - phi)]`.
-//! The second part matters although it looks second order: in a voltage-fed machine the
-//! rotor flux barely ripples (0.3 % of I_ds on the 3 hp motor at delta 0.2, against an
-//! I_ds ripple of 6 %), the drive and the I_ds ripple nearly cancel, and the flux's error
-//! reaches I_qs with a gain omega (Lm^2/Lr)/Ra of about 18. I_ds - phi is taken as the
-//! measured I_ds ripple (phi's own is a tenth of it), and the flux starts in its periodic
-//! response to the drive ([`EffectTerms::phi_drive_start`]; started from I_ds it rings for
-//! a rotor time constant, which a fit "explains" with a 4x shorter one). Approximations:
-//! the q row's sin(2g)(I_ds - phi) term (DC and 4 s f only) is left out, and without
-//! `flux_dynamics` the model's flux follows the smoothed I_ds at once, which makes the
-//! fitted delta about 2x the truth (README, "Broken rotor bars").
-//!
-//! With all four dynamics effects in the model, the full-order model carries the whole
-//! resistance matrix in its rotor flux equation (`simplified_model`'s `CageAsymmetry`,
-//! [`EffectTerms::rotor_asym`]), with the same (delta, phi); the terms above are then unused.
+//! The effect model itself (`compare` / `explain`) is `super::effects`' `RotorAsymmetry`.
 //!
 //! # Broken bars
 //! For an N-bar cage with n adjacent broken bars the equivalent rotor phase resistance
@@ -41,7 +12,9 @@
 //! Franceschini, Tassoni, Kliman, IEEE Trans. Ind. Appl. 37(5), 2001). It is an
 //! approximation: it takes the broken bars' current as redistributed over the healthy
 //! bars of one rotor pole pitch, and ignores inter-bar currents (which make real
-//! sidebands smaller) and the end-ring resistance.
+//! sidebands smaller) and the end-ring resistance. The formula lives with the machine model
+//! the simulator integrates (`crate::sim`'s machine, `delta_of_broken_bars` and its
+//! inverse `broken_bars_of_delta`); the analysis only reads it.
 //!
 //! # MCSA resolution
 //! The sidebands lie 2 s f from the fundamental (3.6 Hz for the 3 hp motor at 3 % slip).
@@ -52,23 +25,12 @@
 //! and 50 Hz. A shorter steady stretch, a slip below [`MIN_SLIP`] or a slip that varies by
 //! more than [`SLIP_STEADY`] of itself is "cannot judge".
 
-use super::effects::{EffectModel, FitSetup, ParamSpec};
-use super::prep::{zero_phase_lpf, Prepared};
-use super::simplified_model::{EffectTerms, MachineConstants};
-use monitor_core::EffectKind;
+use super::prep::Prepared;
+use crate::sim::machine::broken_bars_of_delta;
 use rustfft::num_complex::Complex;
 use serde::Serialize;
 use std::f64::consts::PI;
 
-/// Physical range of the fitted asymmetry delta: 0..1. One broken bar of a 28-bar cage is
-/// delta = 0.12, three adjacent ones 0.47, delta = 1 is n = N/6 (4.7 of 28); a cage
-/// beyond that has lost a third of a pole pitch of bars (Bellini et al. 2001 report 1 to
-/// 4 broken bars as the range of interest). Without `flux_dynamics` in the model the fit
-/// overestimates delta up to about 2x (module doc), which is why the range reaches 1
-/// rather than 0.5.
-pub const DELTA_RANGE: (f64, f64) = (0.0, 1.0);
-/// Basis of [`DELTA_RANGE`].
-pub const DELTA_BASIS: &str = "delta = 3n/(N - 3n): up to N/6 adjacent broken bars (4.7 of 28; Kliman et al. 1988, Bellini et al. 2001)";
 /// Fewest frequency bins between the fundamental and a sideband (see the module doc).
 pub const MIN_BINS: f64 = 10.0;
 /// Smallest slip the sidebands are judged at: below it they sit within 2 s f = 0.6 Hz
@@ -83,212 +45,6 @@ pub const SLIP_STEADY: f64 = 0.2;
 /// reads: the leakage criterion is met, and the noise floor per bin is already far below
 /// a healthy cage's sidebands.
 pub const MAX_STRETCH_S: f64 = 300.0;
-
-/// delta = 3n/(N - 3n) for `n` adjacent broken bars of a cage of `bars` bars (see the module
-/// doc; an approximation).
-pub fn delta_of_broken_bars(n: f64, bars: f64) -> f64 {
-    3.0 * n / (bars - 3.0 * n)
-}
-
-/// The number of adjacent broken bars n = delta N / (3 (1 + delta)) of an N-bar cage
-/// equivalent to the asymmetry `delta` (the inverse of [`delta_of_broken_bars`]).
-pub fn broken_bars_of_delta(delta: f64, bars: f64) -> f64 {
-    delta * bars / (3.0 * (1.0 + delta))
-}
-
-/// The library entry (see the module doc).
-pub struct RotorAsymmetry;
-
-/// 2 (Np theta_m - theta) per working sample: twice the measured rotor electrical angle
-/// against the analysis frame (empty without a speed column).
-fn double_slip_angle(d: &Prepared) -> Vec<f64> {
-    if d.omega_r.len() != d.len() || d.theta.len() != d.len() || d.is_empty() {
-        return Vec::new();
-    }
-    let mut th_r = d.theta[0];
-    let mut out = Vec::with_capacity(d.len());
-    for k in 0..d.len() {
-        if k > 0 {
-            let dt = d.t_s[k] - d.t_s[k - 1];
-            th_r += 0.5 * dt * (d.omega_r[k] + d.omega_r[k - 1]);
-        }
-        out.push(2.0 * (th_r - d.theta[k]));
-    }
-    out
-}
-
-/// The measured I_ds less its part slower than the asymmetry's 2 s f (zero-phase low-pass
-/// at a fifth of the median |2 s f|, at least 0.1 Hz): what I_ds - phi is in the rotor flux
-/// equation, phi's own ripple being a tenth of I_ds's (module doc).
-fn id_ripple(d: &Prepared, ang: &[f64]) -> Vec<f64> {
-    let mut rate: Vec<f64> = ang
-        .windows(2)
-        .map(|w| ((w[1] - w[0]) / d.dt_s).abs())
-        .collect();
-    let fc = if rate.is_empty() {
-        0.1
-    } else {
-        let mid = rate.len() / 2;
-        let (_, m, _) = rate.select_nth_unstable_by(mid, f64::total_cmp);
-        (*m / (2.0 * PI) / 5.0).max(0.1)
-    };
-    let slow = zero_phase_lpf(&d.id, d.dt_s, fc);
-    d.id.iter().zip(slow).map(|(a, b)| a - b).collect()
-}
-
-/// A first estimate of (delta, phi) from the measured I_ds ripple `id_ripple`: the rotor
-/// flux barely ripples in a voltage-fed machine (the stator voltage holds the flux), so the
-/// asymmetry's drive of the flux equation (module doc) and the I_ds ripple nearly cancel:
-/// I_ds ripple = -(delta/3) I_qs sin(2g + phi) = A cos 2g + B sin 2g (least squares),
-/// A = -(delta/3) I_qs sin phi, B = -(delta/3) I_qs cos phi.
-fn initial_estimate(d: &Prepared, ang: &[f64], id_ripple: &[f64]) -> (f64, f64) {
-    let (mut cc, mut ss, mut cs, mut yc, mut ys, mut iq) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-    for k in 0..ang.len().min(id_ripple.len()) {
-        let (s, c) = ang[k].sin_cos();
-        let y = id_ripple[k];
-        cc += c * c;
-        ss += s * s;
-        cs += c * s;
-        yc += y * c;
-        ys += y * s;
-        iq += d.iq_pos[k].abs();
-    }
-    let det = cc * ss - cs * cs;
-    if det.abs() < 1e-12 || ang.is_empty() {
-        return (0.05, 0.0);
-    }
-    let a = (yc * ss - ys * cs) / det;
-    let b = (ys * cc - yc * cs) / det;
-    let iq = (iq / ang.len() as f64).max(1e-6);
-    let delta = 3.0 * a.hypot(b) / iq;
-    (delta.clamp(0.02, 1.0), (-a).atan2(-b))
-}
-
-impl EffectModel for RotorAsymmetry {
-    fn kind(&self) -> EffectKind {
-        EffectKind::RotorAsymmetry
-    }
-    fn description(&self) -> &'static str {
-        "The rotor cage is not symmetric (broken rotor bars, a cracked end ring): the rotor resistance seen by the stator field changes at twice the slip frequency, which modulates the torque and the current: (1 - 2s) f and (1 + 2s) f sidebands in the stator current, 2 s f ripple in speed."
-    }
-    fn equations(&self) -> &'static str {
-        "Rr in Ra = Rs + (Ls/Lr) Rr is multiplied by 1 + (delta/3)(1 - cos(2 (Np theta_m - theta) + phi)): the q-q element of the rotor resistance matrix Rr I + (2/3) Rr delta u u^T, u along the faulty rotor phase; Np theta_m integrates the measured speed. In the full-order model (all dynamics effects in) the whole matrix acts in the rotor flux equation."
-    }
-    fn parameters(&self) -> &'static [ParamSpec] {
-        &[
-            ParamSpec {
-                name: "delta",
-                unit: "1",
-                description: "relative rotor phase resistance asymmetry (one rotor phase Rr (1 + delta)); n broken bars of N: delta = 3n/(N - 3n)",
-            },
-            ParamSpec {
-                name: "phi_rad",
-                unit: "rad",
-                description: "twice the angle of the faulty rotor phase at the log's start (a nuisance parameter)",
-            },
-        ]
-    }
-    fn needs(&self) -> super::effects::Needs {
-        super::effects::Needs {
-            voltages: true,
-            speed: true,
-        }
-    }
-    fn setup(&self, d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, String> {
-        let ang = double_slip_angle(d);
-        if ang.is_empty() {
-            return Err("needs the speed column wm_rad_s (the rotor angle)".into());
-        }
-        // data = [2 (Np theta_m - theta) per sample, then the I_ds ripple per sample].
-        let ripple = id_ripple(d, &ang);
-        let (delta0, phi0) = initial_estimate(d, &ang, &ripple);
-        let mut data = ang;
-        data.extend(ripple);
-        let any_angle = crate::params::PlausibleRange {
-            lo: f64::NEG_INFINITY,
-            hi: f64::INFINITY,
-        };
-        let delta_range = crate::params::PlausibleRange {
-            lo: DELTA_RANGE.0,
-            hi: DELTA_RANGE.1,
-        };
-        Ok(FitSetup {
-            names: vec!["delta".into(), "phi_rad".into()],
-            units: vec!["1", "rad"],
-            init: vec![delta0, phi0],
-            lo: vec![0.0, phi0 - 4.0 * PI],
-            hi: vec![2.0, phi0 + 4.0 * PI],
-            scale: vec![0.05, 0.3],
-            plausible: vec![(delta_range, DELTA_BASIS), (any_angle, "any angle")],
-            // The I_ds ripple's phase can be half a turn off through starts and steps
-            // (found on the 11 kW machine with its true parameters: the fit ended at
-            // delta = 0 and explained nothing).
-            alt_init: vec![vec![delta0, phi0 + PI]],
-            data,
-        })
-    }
-    fn apply(
-        &self,
-        s: &FitSetup,
-        p: &[f64],
-        d: &Prepared,
-        _n: &MachineConstants,
-        terms: &mut EffectTerms,
-    ) {
-        let len = d.len();
-        if s.data.len() != 2 * len {
-            return;
-        }
-        let (ang, id_ripple) = s.data.split_at(len);
-        let (delta, phi) = (p[0], p[1]);
-        // The full-order model carries the cage itself (`simplified_model`'s
-        // `CageAsymmetry`); the reduced model the terms below.
-        terms.rotor_asym = Some((delta, phi));
-        let f = ang
-            .iter()
-            .map(|a| 1.0 + delta / 3.0 * (1.0 - (a + phi).cos()));
-        if terms.rr_factor.len() == len {
-            for (x, y) in terms.rr_factor.iter_mut().zip(f) {
-                *x *= y;
-            }
-        } else {
-            terms.rr_factor = f.collect();
-        }
-        // The d row of the resistance matrix on the rotor current (module doc):
-        // tau_r dphi/dt = i_d - phi + (delta/3) [sin(2g) I_qs + (1 + cos(2g)) (I_ds - phi)],
-        // with I_ds - phi taken as the measured I_ds ripple (phi's own ripple is a tenth of
-        // it: the two first-order drives nearly cancel in a voltage-fed machine).
-        terms.phi_drive = ang
-            .iter()
-            .zip(&d.iq_pos)
-            .zip(id_ripple)
-            .map(|((a, iq), idr)| {
-                let (sn, cs) = (a + phi).sin_cos();
-                delta / 3.0 * (sn * iq + (1.0 + cs) * idr)
-            })
-            .collect();
-        // The flux's periodic response to the drive at the first sample: the drive
-        // smoothed as i_f smooths I_ds (which makes the flux's start), over the first second.
-        let head = ((1.0 / d.dt_s) as usize).clamp(1, len);
-        terms.phi_drive_start +=
-            zero_phase_lpf(&terms.phi_drive[..head], d.dt_s, super::prep::I_F_SMOOTH_HZ)[0];
-    }
-    fn describe(&self, _s: &FitSetup, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
-        let m = mcsa(d, n.np, None, Some(p[0]));
-        let sb = match (m.lower_sideband_db, m.upper_sideband_db) {
-            (Some(l), Some(u)) => format!(
-                "; current sidebands {l:.1} dB ((1-2s)f) and {u:.1} dB ((1+2s)f) below the fundamental"
-            ),
-            _ => String::new(),
-        };
-        format!(
-            "rotor cage asymmetry: one rotor phase's resistance {:.1} % above the others (about {:.1} broken bars of a 28-bar cage, {:.1} of 40){sb}",
-            100.0 * p[0],
-            broken_bars_of_delta(p[0], 28.0),
-            broken_bars_of_delta(p[0], 40.0),
-        )
-    }
-}
 
 /// The motor current signature analysis of a log (`explain`'s `rotor_asymmetry` key).
 #[derive(Debug, Clone, Serialize, Default)]
@@ -573,16 +329,6 @@ mod tests {
         let lo = r.lower_sideband_db.unwrap_or(0.0);
         assert!((lo + 40.0).abs() < 0.5, "{lo}");
         assert!((r.resolution_hz.unwrap_or(1.0) - 1.0 / MAX_STRETCH_S).abs() < 1e-4);
-    }
-
-    #[test]
-    fn broken_bars_and_delta_are_inverse() {
-        // One broken bar of 28: 3/25 = 0.12.
-        assert!((delta_of_broken_bars(1.0, 28.0) - 0.12).abs() < 1e-12);
-        for (n, nb) in [(1.0, 28.0), (2.0, 40.0), (3.0, 36.0)] {
-            let d = delta_of_broken_bars(n, nb);
-            assert!((broken_bars_of_delta(d, nb) - n).abs() < 1e-12);
-        }
     }
 
     #[test]

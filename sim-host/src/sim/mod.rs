@@ -90,7 +90,7 @@
 //! ([`Truth`]) is available to tests through [`simulate_with_truth`] and never enters a row.
 
 mod faults;
-mod machine;
+pub(crate) mod machine;
 mod resolve;
 mod run;
 mod scenario;

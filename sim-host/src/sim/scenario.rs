@@ -532,7 +532,7 @@ impl EffectSpec {
                         format!("must be in 0..{} (N/3) for {nb} bars, got {n}", nb / 3.0),
                     );
                 }
-                let d = crate::analysis::rotor_asymmetry::delta_of_broken_bars(n, nb);
+                let d = super::machine::delta_of_broken_bars(n, nb);
                 if d <= 10.0 {
                     Ok(d)
                 } else {

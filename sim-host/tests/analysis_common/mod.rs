@@ -1,5 +1,16 @@
 //! Shared helpers of the analysis tests: generate logs with the simulator (the analysis is
 //! never told what was injected) and run the analysis through the library or the binary.
+//!
+//! # Full sweeps
+//! The physics sweeps of `analysis_dynamics.rs`, `analysis_effects.rs` and
+//! `rotor_asymmetry.rs` (every motor at every sample rate, every hidden-effect case, every
+//! noise level and load) take minutes. By default each runs a representative subset that
+//! can still fail on every kind of physics the sweep checks (each effect on one motor at
+//! one rate, every motor and rate on some effect); with the environment variable
+//! `MONITOR_FULL_SWEEPS=1` they run whole (`.ci/run` does, after `cargo test`):
+//! ```text
+//! MONITOR_FULL_SWEEPS=1 cargo test -p sim-host --test analysis_dynamics --test analysis_effects --test rotor_asymmetry
+//! ```
 #![allow(dead_code, missing_docs)]
 
 use monitor_core::EffectKind;
@@ -10,6 +21,45 @@ use sim_host::sim::{
     self, EffectSpec, LoadKind, LoadSpec, LoadStep, Scenario, SensorSpec, SupplyStep,
 };
 use std::path::{Path, PathBuf};
+
+/// The environment variable that turns the full sweeps on (see the module doc).
+pub const FULL_SWEEPS: &str = "MONITOR_FULL_SWEEPS";
+
+/// True when `MONITOR_FULL_SWEEPS=1`: the tests run their full sweeps.
+pub fn full_sweeps() -> bool {
+    std::env::var(FULL_SWEEPS).is_ok_and(|v| v == "1")
+}
+
+/// The cases of a sweep this run checks: all of `all` under `MONITOR_FULL_SWEEPS=1`, else
+/// those `in_default` keeps (the representative subset); says which on stderr.
+pub fn sweep<T>(
+    what: &str,
+    all: impl IntoIterator<Item = T>,
+    in_default: impl Fn(&T) -> bool,
+) -> Vec<T> {
+    let all: Vec<T> = all.into_iter().collect();
+    let n = all.len();
+    if full_sweeps() {
+        eprintln!("{what}: all {n} cases ({FULL_SWEEPS}=1)");
+        return all;
+    }
+    let kept: Vec<T> = all.into_iter().filter(|c| in_default(c)).collect();
+    eprintln!(
+        "{what}: {} of {n} cases (the representative subset; {FULL_SWEEPS}=1 runs all)",
+        kept.len()
+    );
+    kept
+}
+
+/// False, with a note on stderr, for a test that belongs to the full sweeps only (it runs
+/// under `MONITOR_FULL_SWEEPS=1`).
+pub fn in_this_run(test: &str) -> bool {
+    let run = full_sweeps();
+    if !run {
+        eprintln!("{test}: part of the full sweep only ({FULL_SWEEPS}=1 runs it)");
+    }
+    run
+}
 
 /// Nominal parameters deliberately off: every electrical and mechanical value scaled by
 /// 1 +/- `off` (alternating signs), as a user's datasheet values would be.
