@@ -283,7 +283,7 @@ pub struct MonitorStatus {
     pub point: SteadyPoint,
 }
 
-/// The isolation in the status line's words (README, "The status line"): the label
+/// The isolation in the status line's words (docs/firmware.md, "The status line"): the label
 /// (the fault's name `rs`..`speed_sensor`, `b/bl` for the friction class, `unknown`,
 /// `none` for no deviation from the healthy baseline, `not-judged`), the named fault's
 /// size (relative change, 0.48 for +48 %; for sensors the gain error; Bl's for the

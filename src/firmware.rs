@@ -610,7 +610,7 @@ fn log_stored<E: defmt::Format>(stored: &flash_record::Stored<E>) {
 /// The defmt status line: residuals, lamps, the two top candidates, speed, mode,
 /// counters, the operating point, the gate, the threshold bands and the isolation (the
 /// fault named, its size and probability: `app::isolation_summary`). Its format is
-/// documented once, in the README ("The status line"); `sim-host hmi --stdin` parses it
+/// documented once, in docs/firmware.md ("The status line"); `sim-host hmi --stdin` parses it
 /// (`sim_host::hmi::status_line`), and `tests/status_line.rs` renders this format string
 /// and parses it back, so the two cannot drift apart.
 fn log_status(s: &MonitorStatus, iso: Option<&Isolation>, mode: &str, max_update_cycles: u32) {

@@ -1,7 +1,7 @@
 //! The dynamics effects up to the full-order machine (issue 10): effect-free logs with a
 //! direct-on-line start, a V/f step and a supply voltage step, both reference motors and
 //! an 11 kW machine the code was not developed on, at 2, 5 and 10 kHz, analysed over the
-//! whole log (start included). The figures are printed (`--nocapture`) and in the README.
+//! whole log (start included). The figures are printed (`--nocapture`) and in docs/model-vs-measurement.md ("Measured").
 //!
 //! Full sweeps: by default each sweep over motors, rates and effects checks a
 //! representative subset (each effect on one motor at one rate, every motor and every rate
@@ -93,7 +93,7 @@ fn ratios(dir: &std::path::Path, which: &str, rate_hz: f64) -> (f64, f64) {
     (r_paper, r_full)
 }
 
-/// Measured (README, "Starts and steps"): the full-order model's error is 0.0015-0.0041,
+/// Measured (docs/model-vs-measurement.md, "Through a start and steps"): the full-order model's error is 0.0015-0.0041,
 /// 0.9-1.1x the noise floor, on both reference motors and the 11 kW machine at 2, 5 and
 /// 10 kHz, where the paper's model is at 0.33-0.58 (84-425x): the issue's target (2x the
 /// noise floor) is met. (Before: 0.0065-0.022, 3-15x. The remainder came from the model
@@ -135,7 +135,7 @@ fn full_order_machine_follows_starts_and_steps() {
 /// is `y = 1 + 0j`: the machine's own equations give its negative-sequence current, so
 /// nothing is left for `y` to absorb. (Until 2026-11-23 the model added the previous
 /// sample's negative-sequence voltage to the next step's start as well, and `y` came out
-/// 0.67 on the README's second walkthrough log with the error still cut 19x: the fit hid
+/// 0.67 on the second walkthrough's log (docs/model-vs-measurement.md) with the error still cut 19x: the fit hid
 /// the double count.) Measured: y 0.9997 + 0.00002j on that log.
 #[test]
 fn supply_unbalance_fits_the_true_admittance() {
@@ -267,14 +267,14 @@ fn hidden_case(
     r
 }
 
-/// The hidden effects that are found through a start and steps (README, "Hidden effects
+/// The hidden effects that are found through a start and steps (docs/model-vs-measurement.md, "Hidden effects
 /// under transients"), on both reference motors and the 11 kW machine, at `rate_hz`:
 /// ranked first, claimed, and the error cut at least 5x or to within 2x the noise floor.
 /// They are found since they act inside the full-order model as the simulator injects
 /// them (the heated cage's rotor time constant, Lm on the model's own magnetising flux,
 /// the unequal stator winding, the unequal cage, the negative-sequence voltage driving the
 /// machine; `simplified_model`). Iron loss, friction and windage are ranked first too
-/// (probe below, table in the README), but at the simulator's defaults they sit at the
+/// (probe below, table in docs/model-vs-measurement.md), but at the simulator's defaults they sit at the
 /// noise in this log (the error without them is already within 2x the floor), so
 /// `explain` may rightly claim nothing.
 fn hidden_effects_found_at(rate_hz: f64) {
@@ -347,7 +347,7 @@ fn hidden_effects_under_transients_found_at_10_khz() {
 
 /// Every non-dynamics effect of the library through a start and steps (a probe, ignored:
 /// `--ignored --nocapture`; `MOTOR` picks the motor, default 2p2, `EFFECT` a comma-separated
-/// list of effects, default all; figures in the README).
+/// list of effects, default all; figures in docs/model-vs-measurement.md).
 #[test]
 #[ignore]
 fn hidden_effects_under_transients_probe() {
@@ -381,7 +381,7 @@ fn full_order_dynamics(
 /// [`transients`] with ideal sensors: what is left is the analysis's own reconstruction
 /// of the working series (frame, sequence separation, block means, where a step fell),
 /// not noise and not a fit. Measured 0.0003-0.0007 (2.2 kW and 11 kW, 2 and 10 kHz);
-/// before the model ran in the stationary frame with the causes in the README fixed,
+/// before the model ran in the stationary frame with the causes in docs/model-vs-measurement.md fixed,
 /// 0.007-0.023.
 #[test]
 fn full_order_model_reproduces_the_simulator() {

@@ -7,7 +7,7 @@
 //! Protocol: a full-order simulator always has rotor-flux and stator-current dynamics, and
 //! the scenarios that excite an effect (sweeps, steps) excite them too; so the model the
 //! user starts from holds `flux_dynamics` and `current_dynamics` (each of those two is
-//! tested with only the other one in the model). See the README, "Model vs measurement".
+//! tested with only the other one in the model). See docs/model-vs-measurement.md.
 //!
 //! Full sweeps: by default each effect is checked on one of the four motor and noise
 //! configurations (every configuration checks some) and the effect-free logs on two of the

@@ -173,7 +173,7 @@ fn healthy_runs_name_nothing() {
     }
 }
 
-/// The wrong confident name found by hand (README, "Away from the learned point"): the
+/// The wrong confident name found by hand (docs/isolation.md, "Away from the learned operating point"): the
 /// 11 kW machine at 1 kHz, a load step to 0.7 x Bl at 6 s, then Rr +50 % at 8 s, diagnosed
 /// through the command line with a parameter file 15-20 % off (Rs +20 %, Rr -19 %, Lm
 /// -15 %, leakages -13 %) and commissioned at the first load. Before the isolation

@@ -3,7 +3,7 @@
 //!
 //! The assertion is the physically right signature for the default rotor-flux frame,
 //! `monitor_core::ROTOR_FLUX_SIGNATURES`; where it differs from the paper's Table 1 the
-//! core's `signature` module docs and the README explain why. One documented allowance:
+//! core's `signature` module docs and docs/paper-errata.md explain why. One documented allowance:
 //! for the small machine friction B (0.002 N m s/rad on the 3 hp motor), `r4 = Ra r2` moves
 //! by a few 1e-4 of its terms, below the lamp's band; r4 may stay dark on the B rows (a dark
 //! r4 still names B/Bl at distance one).

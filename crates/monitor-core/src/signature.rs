@@ -11,7 +11,7 @@
 //! - [`ROTOR_FLUX_SIGNATURES`], what the normalised residuals of eq. (37) physically do in
 //!   rotor-flux orientation with the current-model angle and faults on the phase-level
 //!   sensors, derived from the residuals' structure and confirmed end to end in simulation
-//!   (`sim-host table1`, the README's Table 1 notes). Differences from Table 1:
+//!   (`sim-host table1`, docs/paper-errata.md's Table 1 notes). Differences from Table 1:
 //!   - **Rs, Rr, r3**: by eq. (37) `r3 = (B+Bl) r1 - Psi r2`; these faults leave r2 at zero, so
 //!     r3 is proportional to r1 and, normalised by its own terms, exactly as large. The
 //!     paper's 0 comes from comparing r3 in its own units (V N m s/rad) with a threshold.

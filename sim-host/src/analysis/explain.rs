@@ -29,7 +29,7 @@ pub const PARAM_PENALTY: f64 = 0.02;
 /// start and three supply steps all fell in training windows, and thermal drift on an
 /// 11 kW machine, seen mostly in the transients, read as unexplained; with 10, the one
 /// flux peak of a 7 s voltage sweep fell only in held-back windows, and the saturation fit
-/// had to extrapolate past its knee there. 8 serves both (README, "Honest ranking"); a
+/// had to extrapolate past its knee there. 8 serves both (docs/model-vs-measurement.md, "How it works"); a
 /// split stratified by the operating point is the real fix and is not built.
 pub const HOLDOUT_WINDOWS: usize = 8;
 
@@ -438,7 +438,7 @@ impl Analysis {
     /// supply step the electrical states follow the inputs quasi-statically (a load step
     /// moves the speed at the mechanical rate), the full-order machine's steady state is
     /// the paper's model, and what a dynamics effect's extra states gain there they gain by
-    /// absorbing another effect (README, "Honest ranking").
+    /// absorbing another effect (docs/model-vs-measurement.md, "How it works").
     fn not_dynamic(&self, c: &dyn EffectModel, base: &Baseline<'_>) -> Option<NotRanked> {
         let tau_s = c.time_constant_s(&self.constants)?;
         let dt_s = base.fit_series.dt_s;

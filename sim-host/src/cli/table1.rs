@@ -14,7 +14,7 @@ use std::path::PathBuf;
     long_about = "For each of the nine faults of the paper's Table 1, at +50 % and -50 %: simulate \
 the motor (direct-on-line start, viscous load Bl*omega, 12-bit noisy sensors), commission the monitor \
 on the healthy part (2-4 s), switch the fault on at 4.5 s, and read the residual lamps at the end of \
-the run. Prints the measured signature next to the paper's; '*' marks a difference (see the README's \
+the run. Prints the measured signature next to the paper's; '*' marks a difference (see docs/paper-errata.md's \
 notes on where the physics disagrees with the paper).\n\nExample:\n  sim-host table1 --json"
 )]
 pub struct Table1Args {

@@ -11,7 +11,7 @@
 //! - [`status_line::StdinStatus`]: the firmware's defmt status lines
 //!   (`cargo fw-run | sim-host hmi --stdin`), parsed by [`status_line::parse`].
 //!
-//! The keys are one table, [`KEYS`] (the screen's footer, `--help` and the README use it).
+//! The keys are one table, [`KEYS`] (the screen's footer, `--help` and docs/hmi.md use it).
 //! Drawing is the binary's (`src/cli/render/hmi.rs`): a pure function of [`HmiState`].
 
 pub mod live;
@@ -431,7 +431,7 @@ pub struct KeyBinding {
 }
 
 /// The HMI's keys: the one list (the screen's footer, `sim-host hmi --help` and the
-/// README print it; the sources act on exactly these).
+/// docs/hmi.md print it; the sources act on exactly these).
 pub const KEYS: &[KeyBinding] = &[
     KeyBinding {
         keys: "1..9",
@@ -513,7 +513,7 @@ pub const KEYS: &[KeyBinding] = &[
     },
 ];
 
-/// The key list as text (`--help`, the README), one key a line.
+/// The key list as text (`--help`, docs/hmi.md), one key a line.
 pub fn key_help() -> String {
     let mut s = String::from("Keys:\n");
     for k in KEYS {

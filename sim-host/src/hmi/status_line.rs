@@ -1,6 +1,6 @@
 //! The firmware's defmt status line, read back (`cargo fw-run | sim-host hmi --stdin`).
 //!
-//! The line's format is documented once, in the README ("The status line", section
+//! The line's format is documented once, in docs/firmware.md ("The status line", section
 //! "Build, flash, logs"); the firmware prints it (`log_status` in `src/firmware.rs`) and
 //! the root test `tests/status_line.rs` renders the firmware's own format string with
 //! known values and parses it here. One line:

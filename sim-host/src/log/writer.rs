@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 /// a relative error up to 6e-8). That is far finer than any ADC (a 12-bit converter
 /// resolves 2.4e-4 of its range) but coarser than the simulator's integration error on
 /// ideal sensors: on the 2.2 kW reference start the written currents differ from the
-/// simulated ones by up to 3.7e-6 A, four times the integrator's 9.7e-7 A (the README's
+/// simulated ones by up to 3.7e-6 A, four times the integrator's 9.7e-7 A (docs/performance.md's
 /// benchmark table). Work that needs the simulator's full accuracy takes the rows in
 /// memory (`crate::sim::simulate`), not through a CSV.
 pub struct LogWriter {

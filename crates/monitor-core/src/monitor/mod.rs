@@ -61,7 +61,7 @@ pub struct Sample {
 /// The drive monitor. Construction validates the configuration; [`Monitor::update`] never
 /// panics and never allocates.
 ///
-/// Cost structure (see the README's instruction counts): the per-sample fast path does the
+/// Cost structure (see docs/performance.md's instruction counts): the per-sample fast path does the
 /// plausibility check, the M/T speed, Clarke, one sin/cos, three Park rotations and five
 /// accumulations; the d-q quantities are block-averaged over `decimation` samples (a
 /// boxcar anti-alias filter with nulls at multiples of the slow rate) and everything else

@@ -227,7 +227,7 @@ pub trait EffectModel: Send + Sync {
     /// supply step, [`super::transients::input_transients`]); in steady state the paper's
     /// model is the steady state of the full-order machine, so a dynamics effect that
     /// lowers the error of a log without one is absorbing another effect
-    /// (README, "Honest ranking").
+    /// (docs/model-vs-measurement.md, "How it works").
     fn time_constant_s(&self, _n: &MachineConstants) -> Option<f64> {
         None
     }

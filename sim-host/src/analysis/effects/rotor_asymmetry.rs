@@ -27,7 +27,7 @@
 //! a rotor time constant, which a fit "explains" with a 4x shorter one). Approximations:
 //! the q row's sin(2g)(I_ds - phi) term (DC and 4 s f only) is left out, and without
 //! `flux_dynamics` the model's flux follows the smoothed I_ds at once, which makes the
-//! fitted delta about 2x the truth (README, "Broken rotor bars").
+//! fitted delta about 2x the truth (docs/model-vs-measurement.md, "Broken rotor bars").
 //!
 //! With all four dynamics effects in the model, the full-order model carries the whole
 //! resistance matrix in its rotor flux equation (`simplified_model::RotorCage::asymmetry`), with the same

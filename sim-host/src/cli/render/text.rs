@@ -378,7 +378,7 @@ pub fn table1(t: &Table1Report) -> anyhow::Result<()> {
     writeln!(
         out,
         "\n{} of {n} rows equal the paper's Table 1, {phys} of {n} the physically expected signature \
-         ('I' = residual moves; '*' = differs from the paper; see the README for why).",
+         ('I' = residual moves; '*' = differs from the paper; see docs/paper-errata.md for why).",
         t.matches_paper,
         n = t.rows.len()
     )?;
