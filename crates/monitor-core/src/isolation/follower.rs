@@ -102,6 +102,8 @@ pub struct Follower {
     blocks: [SteadyPoint; BLOCKS],
     filled: usize,
     next: usize,
+    /// The mean of the filled blocks, kept with them (every point is judged against it).
+    mean: Option<SteadyPoint>,
     learning: bool,
     learned: bool,
     last: Option<Isolation>,
@@ -122,6 +124,7 @@ impl Follower {
             blocks: [SteadyPoint::default(); BLOCKS],
             filled: 0,
             next: 0,
+            mean: None,
             learning: false,
             learned: false,
             last: None,
@@ -195,6 +198,7 @@ impl Follower {
         self.block_sum = SteadyPoint::default();
         self.block_s = 0.0;
         self.filled = 0;
+        self.mean = None;
     }
 
     /// The point the next one is judged steady against: the mean of the blocks, else the
@@ -220,10 +224,17 @@ impl Follower {
         self.filled = core::cmp::min(self.filled + 1, BLOCKS);
         self.block_sum = SteadyPoint::default();
         self.block_s = 0.0;
+        self.mean = self.blocks_mean();
     }
 
-    /// The mean of the filled blocks; `None` before the first.
+    /// The mean of the filled blocks; `None` before the first (kept by
+    /// [`Follower::close_block`] and [`Follower::restart`], the only changes of the blocks).
     fn mean(&self) -> Option<SteadyPoint> {
+        self.mean
+    }
+
+    /// [`Follower::mean`] computed from the blocks.
+    fn blocks_mean(&self) -> Option<SteadyPoint> {
         if self.filled == 0 {
             return None;
         }
