@@ -55,13 +55,42 @@ pub const CONFIRM_S: f32 = 0.5;
 /// vectors by their distance relative to the average's magnitude, the supply and rotor
 /// speeds relative to the supply's (at least 1 rad/s).
 pub fn steady_against(p: &SteadyPoint, avg: &SteadyPoint) -> bool {
-    let i = crate::maxf(fast_hypot(avg.i.d, avg.i.q), 1e-6);
-    let v = crate::maxf(fast_hypot(avg.v.d, avg.v.q), 1e-6);
-    let w = crate::maxf(avg.we_rad_s.abs(), 1.0);
-    fast_hypot(p.i.d - avg.i.d, p.i.q - avg.i.q) <= STEADY_FRACTION * i
-        && fast_hypot(p.v.d - avg.v.d, p.v.q - avg.v.q) <= STEADY_FRACTION * v
-        && (p.we_rad_s - avg.we_rad_s).abs() <= STEADY_FRACTION * w
-        && (p.wr_rad_s - avg.wr_rad_s).abs() <= STEADY_FRACTION * w
+    SteadyBand::of(*avg).admits(p)
+}
+
+/// [`steady_against`] for one average, its limits computed once (the follower judges every
+/// point against the same average until a block closes).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct SteadyBand {
+    avg: SteadyPoint,
+    /// [`STEADY_FRACTION`] of the current's magnitude (at least 1e-6 A) [A].
+    i: f32,
+    /// [`STEADY_FRACTION`] of the voltage's magnitude (at least 1e-6 V) [V].
+    v: f32,
+    /// [`STEADY_FRACTION`] of the supply's speed (at least 1 rad/s) [rad/s].
+    w: f32,
+}
+
+impl SteadyBand {
+    fn of(avg: SteadyPoint) -> Self {
+        let i = crate::maxf(fast_hypot(avg.i.d, avg.i.q), 1e-6);
+        let v = crate::maxf(fast_hypot(avg.v.d, avg.v.q), 1e-6);
+        let w = crate::maxf(avg.we_rad_s.abs(), 1.0);
+        SteadyBand {
+            avg,
+            i: STEADY_FRACTION * i,
+            v: STEADY_FRACTION * v,
+            w: STEADY_FRACTION * w,
+        }
+    }
+
+    fn admits(&self, p: &SteadyPoint) -> bool {
+        let avg = &self.avg;
+        fast_hypot(p.i.d - avg.i.d, p.i.q - avg.i.q) <= self.i
+            && fast_hypot(p.v.d - avg.v.d, p.v.q - avg.v.q) <= self.v
+            && (p.we_rad_s - avg.we_rad_s).abs() <= self.w
+            && (p.wr_rad_s - avg.wr_rad_s).abs() <= self.w
+    }
 }
 
 /// What one [`Follower::observe`] did.
@@ -102,8 +131,9 @@ pub struct Follower {
     blocks: [SteadyPoint; BLOCKS],
     filled: usize,
     next: usize,
-    /// The mean of the filled blocks, kept with them (every point is judged against it).
-    mean: Option<SteadyPoint>,
+    /// The mean of the filled blocks and its limits, kept with them (every point is judged
+    /// against it).
+    mean: Option<SteadyBand>,
     learning: bool,
     learned: bool,
     last: Option<Isolation>,
@@ -162,7 +192,7 @@ impl Follower {
             self.restart();
             return ended.map_or(Step::Waiting, Step::LearningEnded);
         }
-        if self.reference().is_some_and(|r| !steady_against(p, &r)) {
+        if self.reference().is_some_and(|r| !r.admits(p)) {
             self.restart();
         }
         self.block_sum.add_scaled(p, dt);
@@ -203,12 +233,12 @@ impl Follower {
 
     /// The point the next one is judged steady against: the mean of the blocks, else the
     /// block being summed; `None` before any point.
-    fn reference(&self) -> Option<SteadyPoint> {
-        self.mean().or_else(|| {
+    fn reference(&self) -> Option<SteadyBand> {
+        self.mean.or_else(|| {
             (self.block_s > 0.0).then(|| {
                 let mut m = self.block_sum;
                 m.scale(1.0 / self.block_s);
-                m
+                SteadyBand::of(m)
             })
         })
     }
@@ -224,13 +254,13 @@ impl Follower {
         self.filled = core::cmp::min(self.filled + 1, BLOCKS);
         self.block_sum = SteadyPoint::default();
         self.block_s = 0.0;
-        self.mean = self.blocks_mean();
+        self.mean = self.blocks_mean().map(SteadyBand::of);
     }
 
     /// The mean of the filled blocks; `None` before the first (kept by
     /// [`Follower::close_block`] and [`Follower::restart`], the only changes of the blocks).
     fn mean(&self) -> Option<SteadyPoint> {
-        self.mean
+        self.mean.map(|b| b.avg)
     }
 
     /// [`Follower::mean`] computed from the blocks.
