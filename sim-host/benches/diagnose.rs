@@ -1,6 +1,6 @@
 //! `diagnose` benchmark: `sim-host diagnose --json` on a 1 h log at 10 kHz (36 M rows).
-//! The goal: at most 5 s wall on 2 cores and 0.15 CPU-s per million rows, with
-//! bounded memory and the same report.
+//! Goal: at most 5 s wall on 2 cores and 0.15 CPU-s per million rows, with bounded memory
+//! (measured figures and where the time goes: docs/performance.md).
 //!
 //! Run: `cargo bench -p sim-host --bench diagnose` (release profile). The log is the
 //! analysis benchmark's (`common::ensure_log`: the simulator, 2.2 kW motor, thermal drift,
