@@ -16,12 +16,11 @@
 
 #[path = "../src/alloc_tuning.rs"]
 mod alloc_tuning;
+mod common;
 
 use sim_host::analysis::{prep::ReadOptions, Analysis, Options};
-use sim_host::log::{Channels, LogFile, LogWriter, Row};
+use sim_host::log::{LogFile, LogWriter, Row};
 use sim_host::params::ParamFile;
-use sim_host::sim::{self, EffectSpec, Scenario, SensorSpec};
-use std::path::PathBuf;
 use std::time::Instant;
 
 fn peak_rss_mb() -> f64 {
@@ -38,69 +37,15 @@ fn peak_rss_mb() -> f64 {
         .unwrap_or(f64::NAN)
 }
 
-/// CPU time (user + system) of this process so far [s], from /proc/self/stat (clock ticks
-/// of 10 ms); NaN where unavailable. With the wall times it tells a shared machine's
-/// interference apart from the work itself.
-fn cpu_s() -> f64 {
-    std::fs::read_to_string("/proc/self/stat")
-        .ok()
-        .and_then(|s| {
-            // Fields after the command name (which is in parentheses): utime is the 14th
-            // field of the line, stime the 15th.
-            let rest = &s[s.rfind(')')? + 2..];
-            let f: Vec<&str> = rest.split_whitespace().collect();
-            let ut: f64 = f.get(11)?.parse().ok()?;
-            let st: f64 = f.get(12)?.parse().ok()?;
-            Some((ut + st) / 100.0)
-        })
-        .unwrap_or(f64::NAN)
-}
-
 fn main() {
     alloc_tuning::keep_freed_memory();
     let secs: f64 = std::env::var("ANALYSIS_BENCH_SECONDS")
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(3600.0);
-    let path = PathBuf::from(
-        std::env::var("ANALYSIS_BENCH_LOG")
-            .unwrap_or_else(|_| format!("/tmp/sim-host-bench-{}s.csv", secs as u64)),
-    );
+    let path = common::log_path("ANALYSIS_BENCH_LOG", secs);
     let p = ParamFile::reference_2p2kw();
-    if !path.exists() {
-        let mut s = Scenario::steady(secs, 10_000.0);
-        s.sensors = SensorSpec::default();
-        s.effects = vec![EffectSpec::ThermalDrift {
-            rise_k: Some(60.0),
-            tau_s: 1200.0_f64.min(secs / 3.0),
-            at_s: 0.0,
-            r_th_k_per_w: None,
-            alpha_per_k: 0.00393,
-            rotor: true,
-        }];
-        let t = Instant::now();
-        let mut w = LogWriter::create(
-            &path,
-            Channels {
-                voltages: true,
-                speed: true,
-                encoder: false,
-            },
-        )
-        .expect("create log");
-        sim::simulate(&p, &s, |r| {
-            let mut r = *r;
-            r.enc_count = None;
-            w.write_row(&r).expect("write row");
-        })
-        .expect("simulate");
-        w.finish().expect("finish log");
-        eprintln!(
-            "generated {} in {:.1} s",
-            path.display(),
-            t.elapsed().as_secs_f64()
-        );
-    }
+    common::ensure_log(&path, &p, secs);
     let formats = std::env::var("ANALYSIS_BENCH_FORMATS").unwrap_or_else(|_| "csv,parquet".into());
     for ext in formats.split(',').map(str::trim) {
         let log = if ext == "csv" {
@@ -141,19 +86,14 @@ fn convert(from: &std::path::Path, to: &std::path::Path) {
     );
 }
 
-/// The 1, 5 and 15 min load averages (from /proc/loadavg): on a shared machine the wall
-/// times mean little without them.
-fn load_average() -> String {
-    std::fs::read_to_string("/proc/loadavg")
-        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
-        .unwrap_or_else(|_| "unknown".into())
-}
-
 /// Times read, compare and explain on one log.
 fn run(path: &std::path::Path, p: ParamFile, format: &str) {
-    eprintln!("[{format}] load average before the run: {}", load_average());
+    eprintln!(
+        "[{format}] load average before the run: {}",
+        common::load_average()
+    );
     let size = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
-    let c0 = cpu_s();
+    let c0 = common::stat_seconds(11);
     let t0 = Instant::now();
     let a = Analysis::load(
         path,
@@ -166,7 +106,7 @@ fn run(path: &std::path::Path, p: ParamFile, format: &str) {
     )
     .expect("load");
     let t_read = t0.elapsed().as_secs_f64();
-    let c_read = cpu_s() - c0;
+    let c_read = common::stat_seconds(11) - c0;
     let rss_read = peak_rss_mb();
     let opts = Options {
         effects: vec![],
@@ -175,7 +115,7 @@ fn run(path: &std::path::Path, p: ParamFile, format: &str) {
     let t1 = Instant::now();
     let c = a.compare(&opts).expect("compare");
     let t_cmp = t1.elapsed().as_secs_f64();
-    let c_cmp = cpu_s() - c0 - c_read;
+    let c_cmp = common::stat_seconds(11) - c0 - c_read;
     let rss_cmp = peak_rss_mb();
     // As `explain --compare` does: compare's result is reported, then dropped.
     let cmp_error = c.report.normalized_rms_error;
@@ -183,7 +123,7 @@ fn run(path: &std::path::Path, p: ParamFile, format: &str) {
     let t2 = Instant::now();
     let e = a.explain(&opts, &|_| {}).expect("explain");
     let t_exp = t2.elapsed().as_secs_f64();
-    let c_exp = cpu_s() - c0 - c_read - c_cmp;
+    let c_exp = common::stat_seconds(11) - c0 - c_read - c_cmp;
     println!(
         "analysis bench [{format}]: {} rows ({:.2} GB), {} threads: read+frame {:.2} s, compare {:.2} s, explain {:.2} s, total {:.2} s; peak RSS {:.0} MB (after read {:.0} MB, after compare {:.0} MB); working samples {}; error {:.4}, top {:?}",
         a.data.rows,
@@ -203,6 +143,6 @@ fn run(path: &std::path::Path, p: ParamFile, format: &str) {
     println!(
         "CPU time (user + system): read+frame {c_read:.2} s, compare {c_cmp:.2} s, explain {c_exp:.2} s, total {:.2} s; load average after: {}",
         c_read + c_cmp + c_exp,
-        load_average()
+        common::load_average()
     );
 }

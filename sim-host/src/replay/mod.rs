@@ -182,8 +182,7 @@ impl LogSampler {
                 if let Some(t0) = self.last_t {
                     self.theta_m += w * (row.t_s - t0);
                 }
-                (self.theta_m / std::f64::consts::TAU * f64::from(COUNTS_PER_REV)).floor() as i64
-                    as u32
+                floor_i64(self.theta_m / std::f64::consts::TAU * f64::from(COUNTS_PER_REV)) as u32
             }
             (None, None) => 0,
         };
@@ -202,10 +201,36 @@ impl LogSampler {
                 c: i[2] as f32,
             },
             encoder_count: count,
-            timestamp_ticks: ((row.t_s * TICK_HZ).round() as i64) as u32,
+            timestamp_ticks: round_i64(row.t_s * TICK_HZ) as u32,
             v_saturated: false,
             i_saturated: false,
         }
+    }
+}
+
+/// `x.floor() as i64` (saturating; 0 for NaN) without a call into libm: the baseline
+/// x86-64 target has no rounding instruction, and the replay converts every row.
+fn floor_i64(x: f64) -> i64 {
+    let t = x as i64;
+    // `t as f64` is exact wherever x has a fraction (|x| < 2^52).
+    if (t as f64) > x {
+        t.saturating_sub(1)
+    } else {
+        t
+    }
+}
+
+/// `x.round() as i64` (half away from zero, saturating; 0 for NaN), as [`floor_i64`].
+fn round_i64(x: f64) -> i64 {
+    let t = x as i64;
+    // Exact wherever x has a fraction (|x| < 2^52).
+    let frac = x - t as f64;
+    if frac >= 0.5 {
+        t.saturating_add(1)
+    } else if frac <= -0.5 {
+        t.saturating_sub(1)
+    } else {
+        t
     }
 }
 
@@ -453,6 +478,44 @@ pub fn angle_source_name(a: AngleSource) -> &'static str {
 mod tests {
     use super::*;
     use crate::log::quality::CellLimits;
+
+    #[test]
+    fn floor_and_round_as_std() {
+        let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+        let mut values = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            -1.5,
+            2.5,
+            0.499_999_999_999_999_94,
+            -0.499_999_999_999_999_94,
+            4_503_599_627_370_495.5,
+            -4_503_599_627_370_495.5,
+            9.223_372_036_854_775e18,
+            -9.223_372_036_854_775e18,
+            1e300,
+            -1e300,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        for k in 0..100_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let v = f64::from_bits(x);
+            values.push(v);
+            values.push(((x >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 10f64.powi(k % 20));
+            values.push((k as f64 - 50_000.0) * 0.25);
+        }
+        for v in values {
+            assert_eq!(floor_i64(v), v.floor() as i64, "{v:e}");
+            assert_eq!(round_i64(v), v.round() as i64, "{v:e}");
+        }
+    }
 
     #[test]
     fn the_monitor_and_the_quality_stage_judge_a_log_by_the_same_limits() {
