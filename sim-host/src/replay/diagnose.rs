@@ -2,7 +2,7 @@
 //! ([`diagnose_file`]), the glitch bursts filled or held out, and the observer of every
 //! output (the live HMI's log source).
 
-use super::{DiagnoseReport, Replay, ReplayError, ReplayOptions, Verdict};
+use super::{pipe, DiagnoseReport, Replay, ReplayError, ReplayOptions, Verdict};
 use crate::log::quality::{
     BadCells, CellLimits, CleanSink, DataQuality, QualityStage, SegmentBreak, TimeBase,
     MAX_BRIDGED_GAP_S,
@@ -121,7 +121,9 @@ fn replay_through_quality(
     replay_observed(params, channels, shown, opts, None, feed)
 }
 
-/// [`replay_through_quality`] with an optional observer of every output.
+/// [`replay_through_quality`] with an optional observer of every output. Without one,
+/// the replay runs on a thread of its own beside the data-quality stage ([`pipe`]: the
+/// same results, on two cores).
 fn replay_observed<'a>(
     params: &'a ParamFile,
     channels: Channels,
@@ -130,28 +132,43 @@ fn replay_observed<'a>(
     observer: Option<&'a mut dyn ReplayObserver>,
     feed: impl FnOnce(&mut dyn RowSink) -> Result<(), LogError>,
 ) -> Result<Diagnosed, ReplayError> {
-    let mut sink = ReplaySink {
-        observer,
-        params,
-        channels,
-        opts,
-        replay: None,
-        rate_hz: 0.0,
-        other_rate: false,
-        rows_other_rate: 0,
-        restarts: 0,
-        burst: Vec::new(),
-        burst_forwarded: false,
-        short_bursts: 0,
-        long_bursts: 0,
-        last_good: None,
-        filled_rows: 0,
-        error: None,
-    };
-    let mut stage = QualityStage::new(&mut sink, CellLimits::for_params(params), shown);
+    match observer {
+        None => {
+            let mut sink = ReplaySink::<NoObserver>::new(params, channels, opts, None);
+            let (read, quality) =
+                pipe::on_own_thread(&mut sink, |p| through_quality(p, params, shown, feed));
+            conclude(sink, read, quality, shown, opts)
+        }
+        Some(o) => {
+            let mut sink = ReplaySink::new(params, channels, opts, Some(o));
+            let (read, quality) = through_quality(&mut sink, params, shown, feed);
+            conclude(sink, read, quality, shown, opts)
+        }
+    }
+}
+
+/// Runs `feed` into the data-quality stage in front of `clean`: the read's result and
+/// the stage's report.
+fn through_quality<S: CleanSink>(
+    clean: &mut S,
+    params: &ParamFile,
+    shown: &str,
+    feed: impl FnOnce(&mut dyn RowSink) -> Result<(), LogError>,
+) -> (Result<(), LogError>, Result<DataQuality, LogError>) {
+    let mut stage = QualityStage::new(clean, CellLimits::for_params(params), shown);
     let read = feed(&mut stage);
-    let quality = stage.finish();
-    if let Some(e) = sink.error {
+    (read, stage.finish())
+}
+
+/// The report of a replay whose rows have all been read.
+fn conclude<O: ReplayObserver + ?Sized>(
+    mut sink: ReplaySink<'_, O>,
+    read: Result<(), LogError>,
+    quality: Result<DataQuality, LogError>,
+    shown: &str,
+    opts: ReplayOptions,
+) -> Result<Diagnosed, ReplayError> {
+    if let Some(e) = sink.error.take() {
         return Err(e);
     }
     read?;
@@ -183,7 +200,11 @@ fn replay_observed<'a>(
 }
 
 /// What `diagnose` did about what the stage found, in the report's `actions`.
-fn describe_actions(q: &mut DataQuality, monitor: bool, sink: &ReplaySink<'_>) {
+fn describe_actions<O: ReplayObserver + ?Sized>(
+    q: &mut DataQuality,
+    monitor: bool,
+    sink: &ReplaySink<'_, O>,
+) {
     let who = if monitor {
         "the monitor"
     } else {
@@ -230,8 +251,8 @@ fn describe_actions(q: &mut DataQuality, monitor: bool, sink: &ReplaySink<'_>) {
 /// The replay behind the data-quality stage: configured when the stage knows the time
 /// base; rows of segments at another sample rate are counted, not replayed (the monitor's
 /// configuration follows from one rate).
-struct ReplaySink<'a> {
-    observer: Option<&'a mut dyn ReplayObserver>,
+struct ReplaySink<'a, O: ReplayObserver + ?Sized> {
+    observer: Option<&'a mut O>,
     params: &'a ParamFile,
     channels: Channels,
     opts: ReplayOptions,
@@ -253,6 +274,47 @@ struct ReplaySink<'a> {
 /// period are filled in between the neighbours: a quarter period keeps the phase step
 /// between them unambiguous.
 const FILL_PERIODS: f64 = 0.25;
+
+impl<'a, O: ReplayObserver + ?Sized> ReplaySink<'a, O> {
+    fn new(
+        params: &'a ParamFile,
+        channels: Channels,
+        opts: ReplayOptions,
+        observer: Option<&'a mut O>,
+    ) -> Self {
+        ReplaySink {
+            observer,
+            params,
+            channels,
+            opts,
+            replay: None,
+            rate_hz: 0.0,
+            other_rate: false,
+            rows_other_rate: 0,
+            restarts: 0,
+            burst: Vec::new(),
+            burst_forwarded: false,
+            short_bursts: 0,
+            long_bursts: 0,
+            last_good: None,
+            filled_rows: 0,
+            error: None,
+        }
+    }
+}
+
+/// The observer of a replay without one (no value exists): the replay's sink can then
+/// move to a thread of its own.
+enum NoObserver {}
+
+impl ReplayObserver for NoObserver {
+    fn output(&mut self, _: &Row, _: &MonitorOutput, _: &Replay) {
+        match *self {}
+    }
+    fn restart(&mut self) {
+        match *self {}
+    }
+}
 
 /// The row at `t` between rows `a` and `b`. The voltage and current space vectors turn
 /// from `a`'s to `b`'s along the rotation (angle and magnitude interpolated linearly,
@@ -297,7 +359,7 @@ fn between(a: &Row, b: &Row, t: f64) -> Row {
     }
 }
 
-impl CleanSink for ReplaySink<'_> {
+impl<O: ReplayObserver + ?Sized> CleanSink for ReplaySink<'_, O> {
     fn begin(&mut self, base: &TimeBase) -> bool {
         self.rate_hz = base.sample_rate_hz;
         match Replay::new(self.params, self.channels, base.sample_rate_hz, self.opts) {

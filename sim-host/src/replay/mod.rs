@@ -23,6 +23,7 @@
 mod commission;
 mod diagnose;
 mod isolation;
+mod pipe;
 mod report;
 mod sequences;
 
