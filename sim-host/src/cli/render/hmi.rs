@@ -492,6 +492,26 @@ mod tests {
         assert!(rows[23].contains("q quit"), "{}", rows[23]);
     }
 
+    /// Issue 28: after Rs +50 % the header's first fault is `rs +` with its size, and no
+    /// probability is printed as a percentage (the only `%` in the header is the size).
+    #[test]
+    fn the_header_names_rs_with_its_size_first_at_100x30_and_80x24() {
+        let (mut live, mut state) = commissioned();
+        // 1: Rs +50 % (the default size).
+        live.key(Key::Char('1'), &mut state);
+        run(&mut live, &mut state, 3.5);
+        for (w, h) in [(100, 30), (80, 24)] {
+            let rows = screen(&state, w, h);
+            let header = find(&rows, "FAULT ");
+            let after_time = header
+                .split(" s  ")
+                .nth(1)
+                .unwrap_or_else(|| panic!("no time in the header: {header}"));
+            assert!(after_time.starts_with("rs +"), "{w}x{h}: {header}");
+            assert_eq!(header.matches('%').count(), 1, "{w}x{h}: {header}");
+        }
+    }
+
     #[test]
     fn the_band_bar() {
         // Scale 0.1 over 21 cells: a cell is 0.01; zero in the middle.
