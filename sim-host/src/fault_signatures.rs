@@ -221,3 +221,87 @@ pub fn run_all(
         })
         .collect()
 }
+
+/// One fault candidate in words, the same on the HMI, the demo and `diagnose`'s text
+/// (issue 28: one way to write each number): the fault's name, then its probability as
+/// `p 0.33` (never a bare percentage, which reads like a size), then, when known, its
+/// size signed with the parameter's name in brackets, e.g. `rr p 0.76 (rr +50 %)`.
+///
+/// `probability` in [0, 1]; `change` a relative parameter change (0.5 = +50 %).
+pub fn candidate_text(name: &str, probability: f32, change: Option<f32>) -> String {
+    match change {
+        Some(x) => format!("{name} p {probability:.2} ({})", size_text(name, x)),
+        None => format!("{name} p {probability:.2}"),
+    }
+}
+
+/// A fault's size signed with the parameter's name, `rs +50 %` (`change` relative, 0.5 =
+/// +50 %); the one form every output uses for a size.
+pub fn size_text(name: &str, change: f32) -> String {
+    format!("{name} {:+.0} %", 100.0 * change)
+}
+
+/// Fault candidates in words ([`candidate_text`]), with B and Bl as one friction class
+/// `b/bl` (their probabilities added, the size Bl's, the size the isolation names for the
+/// class): the two cannot be told apart by the residuals, so they are shown once.
+/// `candidates` as (fault, probability in [0, 1], relative change if estimated).
+pub fn candidates_text(
+    candidates: impl IntoIterator<Item = (Fault, f32, Option<f32>)>,
+) -> Vec<String> {
+    let mut rows: Vec<(&'static str, f32, Option<f32>)> = Vec::new();
+    let mut friction: Option<usize> = None;
+    for (f, p, change) in candidates {
+        if matches!(f, Fault::B | Fault::Bl) {
+            if let Some(row) = friction.and_then(|k| rows.get_mut(k)) {
+                row.1 += p;
+                if f == Fault::Bl {
+                    row.2 = change;
+                }
+                continue;
+            }
+            friction = Some(rows.len());
+            let change = if f == Fault::Bl { change } else { None };
+            rows.push((IsolationName::Friction.name(), p, change));
+        } else {
+            rows.push((f.name(), p, change));
+        }
+    }
+    rows.into_iter()
+        .map(|(n, p, c)| candidate_text(n, p, c))
+        .collect()
+}
+
+/// The lamps' signature candidates as `sig. rs p 0.33 / ls p 0.33` (short: the HMI's
+/// header fits 80 columns), or `sig. none` (B and Bl as one class, [`candidates_text`]).
+pub fn signature_text(candidates: impl IntoIterator<Item = (Fault, f32)>) -> String {
+    let names = candidates_text(candidates.into_iter().map(|(f, p)| (f, p, None)));
+    if names.is_empty() {
+        "sig. none".into()
+    } else {
+        format!("sig. {}", names.join(" / "))
+    }
+}
+
+#[cfg(test)]
+mod text_tests {
+    use super::*;
+
+    #[test]
+    fn sizes_are_signed_and_probabilities_are_not_percentages() {
+        assert_eq!(size_text("rs", 0.5), "rs +50 %");
+        assert_eq!(
+            candidate_text("rr", 0.76, Some(0.5)),
+            "rr p 0.76 (rr +50 %)"
+        );
+        assert_eq!(
+            signature_text([(Fault::Rs, 1.0 / 3.0), (Fault::Ls, 1.0 / 3.0)]),
+            "sig. rs p 0.33 / ls p 0.33"
+        );
+        // B and Bl: one friction class with Bl's size (a Bl +50 % fault reads as B +300 %).
+        assert_eq!(
+            candidates_text([(Fault::B, 0.5, Some(3.0)), (Fault::Bl, 0.5, Some(0.5))]),
+            ["b/bl p 1.00 (b/bl +50 %)"]
+        );
+        assert_eq!(signature_text([]), "sig. none");
+    }
+}

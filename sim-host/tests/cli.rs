@@ -52,11 +52,14 @@ fn demo_names_the_injected_fault() {
     assert_eq!(j["correct_fault_among_candidates"], true, "{}", j["named"]);
     let t = j["first_detection_s"].as_f64().expect("detected");
     assert!(t > 5.0 && t < 7.0, "detected at {t}");
-    // The human timeline shows the lamps and the candidates.
+    // The human timeline shows the lamps and the candidates: B and Bl as one friction
+    // class, the probability as `p 1.00` and the size signed with the name (issue 28).
     let o = bin().arg("demo").output().expect("run");
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(
-        o.status.success() && text.contains("FAULT: b 50 % / bl 50 %"),
+        o.status.success()
+            && text.contains("FAULT (sig. b/bl p 1.00)")
+            && text.contains("(b/bl +50 %)"),
         "{text}"
     );
 }

@@ -315,7 +315,7 @@ fn plain_text_when_stdout_is_not_a_terminal() {
     assert_eq!(status.len(), 5, "{out}");
     assert!(status[2].contains("commissioning 5 %"), "{out}");
     assert!(
-        status[4].contains("○●●● FAULT") && status[4].contains("b 50 % / bl 50 %"),
+        status[4].contains("○●●● FAULT") && status[4].contains("sig. b/bl p 1.00"),
         "{out}"
     );
     assert!(out.contains("> WARN ADC DMA overrun #1"), "{out}");

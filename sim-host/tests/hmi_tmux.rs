@@ -92,7 +92,7 @@ fn a_user_commissions_injects_a_fault_and_quits() {
     t.keys("c");
     t.wait_for(&["learned thresholds in force", "(learned)"]);
     t.keys("6");
-    let pane = t.wait_for(&["FAULT: b 50 % / bl 50 %", "bl +50%"]);
+    let pane = t.wait_for(&["b/bl +50 % | sig. b/bl p 1.00", "bl +50%"]);
     assert!(pane.contains("r2 ●") && pane.contains("FAULT ●"), "{pane}");
     t.keys("q");
     let pane = t.wait_for(&["EXITED 0"]);

@@ -117,7 +117,10 @@ impl IsolationView {
     /// One line: `rr +48 %`, `unknown, nearest rr, ls, lr`, `rr / speed_sensor, not
     /// alone`, `no deviation` or `not judged`.
     pub fn text(&self) -> String {
-        let pct = |x: Option<f32>| x.map_or(String::new(), |c| format!(" {:+.0} %", 100.0 * c));
+        let sized = |n: IsolationName, x: Option<f32>| {
+            let n = n.to_string();
+            x.map_or(n.clone(), |c| crate::fault_signatures::size_text(&n, c))
+        };
         let names = |n: usize, sep: &str| {
             self.candidates
                 .iter()
@@ -127,7 +130,7 @@ impl IsolationView {
                 .join(sep)
         };
         match (self.named, self.state) {
-            (Some(n), _) => format!("{n}{}", pct(self.change)),
+            (Some(n), _) => sized(n, self.change),
             (None, IsolationState::Unknown) if self.candidates.is_empty() => "unknown fault".into(),
             (None, IsolationState::Unknown) => format!("unknown, nearest {}", names(3, ", ")),
             (None, IsolationState::Isolated) if !self.candidates.is_empty() => {
@@ -368,6 +371,26 @@ impl HmiState {
     }
 }
 
+/// The screen's header: the isolated fault with its size first (`rs +50 % | sig. rs p
+/// 0.33 / ls p 0.33`; the FAULT lamp stands beside it), then the lamps' signature candidates; without a
+/// named fault, the monitor's state in words ([`state_text`]).
+pub fn header_text(s: &Snapshot) -> String {
+    let named = s.isolation.as_ref().filter(|i| i.named.is_some());
+    match (named, &s.state) {
+        (Some(iso), MonitorState::Fault(_)) => format!(
+            "{} | {}",
+            iso.text(),
+            crate::fault_signatures::signature_text(s.candidates.iter().map(|(f, p)| (*f, *p)))
+        ),
+        (Some(iso), _) => format!(
+            "{} | named: {}",
+            state_text(&s.state, &s.candidates),
+            iso.text()
+        ),
+        (None, _) => state_text(&s.state, &s.candidates),
+    }
+}
+
 /// The monitor's state in words (the screen and the plain-text line).
 pub fn state_text(state: &MonitorState, candidates: &[(Fault, f32)]) -> String {
     match state {
@@ -376,11 +399,9 @@ pub fn state_text(state: &MonitorState, candidates: &[(Fault, f32)]) -> String {
         MonitorState::Starting => "starting (settling)".to_string(),
         MonitorState::Healthy => "healthy".to_string(),
         MonitorState::Fault(_) => {
-            let names: Vec<String> = candidates
-                .iter()
-                .map(|(f, p)| format!("{} {:.0} %", f.name(), p * 100.0))
-                .collect();
-            format!("FAULT: {}", names.join(" / "))
+            let sig =
+                crate::fault_signatures::signature_text(candidates.iter().map(|(f, p)| (*f, *p)));
+            format!("FAULT ({sig})")
         }
     }
 }

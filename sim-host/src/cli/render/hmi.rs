@@ -16,7 +16,7 @@ use ratatui::symbols::Marker;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Axis, Block, Borders, Chart, Dataset, GraphType, Paragraph};
 use ratatui::Frame;
-use sim_host::hmi::{state_text, Controls, HmiState, KeyScope, Snapshot, HISTORY_S, KEYS};
+use sim_host::hmi::{header_text, Controls, HmiState, KeyScope, Snapshot, HISTORY_S, KEYS};
 
 /// Colours of r1..r4 (lamps' labels, bars and chart).
 const COLOURS: [Color; 4] = [Color::Cyan, Color::Magenta, Color::Yellow, Color::Green];
@@ -75,7 +75,7 @@ fn lamps_line(state: &HmiState) -> Line<'static> {
     }
     spans.push(Span::raw("   FAULT "));
     spans.push(lamp(s.fault_lamp, Color::Red));
-    let text = state_text(&s.state, &s.candidates);
+    let text = header_text(s);
     let style = if s.fault_lamp {
         Style::new().fg(Color::Red).add_modifier(Modifier::BOLD)
     } else {
@@ -175,9 +175,9 @@ fn render_candidates(frame: &mut Frame, area: Rect, s: Option<&Snapshot>) {
     lines.extend(s.candidates.iter().take(shown).map(|(f, p)| {
         let n = (p * 10.0).round() as usize;
         Line::from(format!(
-            " {:<15}{:>4.0} % {}",
+            " {:<15}p {:.2} {}",
             f.name(),
-            p * 100.0,
+            p,
             "█".repeat(n.min(10))
         ))
     }));
@@ -442,8 +442,10 @@ mod tests {
             lamps.contains("r1 ○ r2 ● r3 ● r4 ●") && lamps.contains("FAULT ●"),
             "{lamps}"
         );
-        assert!(lamps.contains("FAULT: b 50 % / bl 50 %"), "{lamps}");
-        assert!(find(&rows, " bl ").contains("50 %"));
+        // Issue 28: the named fault and its size first, the signature's probabilities
+        // second, B and Bl as one friction class.
+        assert!(lamps.contains("b/bl +50 % | sig. b/bl p 1.00"), "{lamps}");
+        assert!(find(&rows, " bl ").contains("p 0.50"));
         assert!(find(&rows, "faults on:").contains("bl +50%"));
         assert!(find(&rows, " > ").contains("bl +50 % switched on"));
         // A lit residual's value marker lies off its band.
@@ -488,6 +490,26 @@ mod tests {
         assert!((40.0..=60.0).contains(&pct), "{named}");
         assert!(rows.iter().all(|r| r.chars().count() <= 80));
         assert!(rows[23].contains("q quit"), "{}", rows[23]);
+    }
+
+    /// Issue 28: after Rs +50 % the header's first fault is `rs +` with its size, and no
+    /// probability is printed as a percentage (the only `%` in the header is the size).
+    #[test]
+    fn the_header_names_rs_with_its_size_first_at_100x30_and_80x24() {
+        let (mut live, mut state) = commissioned();
+        // 1: Rs +50 % (the default size).
+        live.key(Key::Char('1'), &mut state);
+        run(&mut live, &mut state, 3.5);
+        for (w, h) in [(100, 30), (80, 24)] {
+            let rows = screen(&state, w, h);
+            let header = find(&rows, "FAULT ");
+            let after_time = header
+                .split(" s  ")
+                .nth(1)
+                .unwrap_or_else(|| panic!("no time in the header: {header}"));
+            assert!(after_time.starts_with("rs +"), "{w}x{h}: {header}");
+            assert_eq!(header.matches('%').count(), 1, "{w}x{h}: {header}");
+        }
     }
 
     #[test]

@@ -55,11 +55,9 @@ pub fn demo(run: &DemoRun) -> anyhow::Result<()> {
             MonitorState::Starting => "starting".to_string(),
             MonitorState::Healthy => "healthy".to_string(),
             MonitorState::Fault(c) => {
-                let names: Vec<String> = c
-                    .iter()
-                    .map(|(f, p)| format!("{} {:.0} %", f.name(), 100.0 * p))
-                    .collect();
-                format!("FAULT: {}", names.join(" / "))
+                let sig =
+                    sim_host::fault_signatures::signature_text(c.iter().map(|(f, p)| (*f, *p)));
+                format!("FAULT ({sig})")
             }
         };
         let mark = if p.fault_injected {
@@ -102,23 +100,15 @@ pub fn demo(run: &DemoRun) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Candidates as `rr 76 % (+50 %), speed_sensor 24 % (-2 %)`, or `none`.
+/// Candidates as `rr p 0.76 (rr +50 %), speed_sensor p 0.24 (speed_sensor -2 %)`, or `none`.
 fn candidate_list(c: &[sim_host::replay::FaultCandidate]) -> String {
     if c.is_empty() {
         return "none".into();
     }
-    c.iter()
-        .map(|c| match c.change {
-            Some(x) => format!(
-                "{} {:.0} % ({:+.0} %)",
-                c.fault,
-                100.0 * c.probability,
-                100.0 * x
-            ),
-            None => format!("{} {:.0} %", c.fault, 100.0 * c.probability),
-        })
-        .collect::<Vec<_>>()
-        .join(", ")
+    sim_host::fault_signatures::candidates_text(
+        c.iter().map(|c| (c.fault, c.probability, c.change)),
+    )
+    .join(", ")
 }
 
 /// `simulate`'s one-line summary.
@@ -164,7 +154,13 @@ fn diagnose_state(p: &TimelinePoint) -> String {
     } else {
         p.top
             .as_ref()
-            .map(|t| format!("{t} {:.0} %", 100.0 * p.top_probability))
+            .map(|t| {
+                format!(
+                    "{} p {:.2}",
+                    sim_host::replay::IsolationName::expected(*t),
+                    p.top_probability
+                )
+            })
             .unwrap_or_else(|| "healthy".into())
     }
 }
