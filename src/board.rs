@@ -84,6 +84,10 @@ pub const ENCODER_COUNTS_PER_REV: u32 = 4 * ENCODER_LINES;
 pub const RECORD_FLASH_OFFSET: u32 = 0x0007_F800;
 /// Size of the flash page that holds the record (erase granularity, dual-bank mode).
 pub const RECORD_PAGE_SIZE: u32 = 2048;
+/// Offset of the motor record (`monitor_core::motor_record`, written by `sim-host
+/// board-record`) from the start of flash, bytes: the 2 KiB page before the commissioning
+/// record, `0x0807_F000`, also kept out of the linker's reach by `memory.x`.
+pub const MOTOR_RECORD_FLASH_OFFSET: u32 = RECORD_FLASH_OFFSET - RECORD_PAGE_SIZE;
 
 /// A GPIO port of the STM32G474 (`A` = GPIOA, ...).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

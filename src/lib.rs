@@ -44,6 +44,7 @@ pub mod board;
 pub mod commissioning;
 pub mod flash_record;
 pub mod liveness;
+pub mod motor_source;
 pub mod panel;
 pub mod reset_record;
 pub mod sampling;

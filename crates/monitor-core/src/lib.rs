@@ -65,6 +65,7 @@ pub mod frames;
 pub mod isolation;
 pub mod machine;
 pub mod monitor;
+pub mod motor_record;
 pub mod residuals;
 pub mod sequence;
 pub mod signature;

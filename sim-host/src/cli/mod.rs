@@ -5,6 +5,7 @@
 //! ([`output_guard`]) are the binary's too.
 
 mod bench;
+mod board_record;
 mod compare;
 pub mod convert;
 mod demo;
@@ -65,6 +66,8 @@ pub enum Cmd {
     Hmi(hmi::HmiArgs),
     // Convert a log between CSV, TDMS and Parquet.
     Convert(convert::ConvertArgs),
+    // Write the board's motor record.
+    BoardRecord(board_record::BoardRecordArgs),
 }
 
 /// Runs a command.
@@ -82,6 +85,7 @@ pub fn run(cmd: Cmd) -> anyhow::Result<()> {
         Cmd::Bench(a) => bench::run(a),
         Cmd::Hmi(a) => hmi::run(a),
         Cmd::Convert(a) => convert::run(a),
+        Cmd::BoardRecord(a) => board_record::run(a),
     }
 }
 

@@ -1,0 +1,108 @@
+//! The machine the firmware monitors: the motor record in flash
+//! (`monitor_core::motor_record`, written by `sim-host board-record`) or, when the page
+//! holds no valid record, the built-in default ([`crate::app::DEFAULT_MACHINE`] with the
+//! board's front end). Host-testable: the firmware reads the page at
+//! [`board::MOTOR_RECORD_FLASH_OFFSET`] and hands the bytes to [`select`].
+
+use crate::app::DEFAULT_MACHINE;
+use crate::board::{self, ChannelScale, FrontEnd};
+use crate::sampling::TICK_HZ;
+use monitor_core::motor_record::{MotorRecord, RecordError};
+use monitor_core::MonitorConfig;
+
+/// Where the machine in force came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MachineSource {
+    /// A valid motor record in flash.
+    Flash,
+    /// The built-in default, because the record was rejected for this reason
+    /// ([`RecordError::Magic`]: the page is erased, no record was ever written).
+    Default(RecordError),
+}
+
+impl MachineSource {
+    /// One line for the boot log: "motor record from flash" or
+    /// "built-in default motor (record: <reason>)".
+    pub fn describe(&self) -> &'static str {
+        match self {
+            MachineSource::Flash => "motor record from flash",
+            MachineSource::Default(RecordError::Magic) => "built-in default motor (no record)",
+            MachineSource::Default(RecordError::Version) => {
+                "built-in default motor (record of another version)"
+            }
+            MachineSource::Default(RecordError::Crc) => "built-in default motor (record CRC bad)",
+            MachineSource::Default(RecordError::Truncated | RecordError::Length) => {
+                "built-in default motor (record truncated)"
+            }
+            MachineSource::Default(RecordError::Invalid) => {
+                "built-in default motor (record values rejected)"
+            }
+        }
+    }
+
+    /// True when the built-in default is in force.
+    pub fn is_default(&self) -> bool {
+        matches!(self, MachineSource::Default(_))
+    }
+}
+
+/// The built-in default as a record: [`DEFAULT_MACHINE`], the board's full scales
+/// ([`board::CURRENT_FULL_SCALE_A`], [`board::VOLTAGE_FULL_SCALE_V`]), zero at mid-scale
+/// ([`board::MID_SCALE_CODE`]) and [`board::ENCODER_LINES`] lines counting up.
+pub fn default_record() -> MotorRecord {
+    MotorRecord {
+        motor: DEFAULT_MACHINE.motor,
+        supply: DEFAULT_MACHINE.supply,
+        current_full_scale_a: board::CURRENT_FULL_SCALE_A,
+        voltage_full_scale_v: board::VOLTAGE_FULL_SCALE_V,
+        current_offset_counts: [board::MID_SCALE_CODE; 3],
+        voltage_offset_counts: [board::MID_SCALE_CODE; 3],
+        encoder_lines: board::ENCODER_LINES as u16,
+        encoder_reversed: false,
+    }
+}
+
+/// The record stored in `page` (the bytes read from the motor-record flash page) if it is
+/// valid, otherwise [`default_record`], with where it came from.
+pub fn select(page: &[u8]) -> (MotorRecord, MachineSource) {
+    match MotorRecord::parse(page) {
+        Ok(rec) => (rec, MachineSource::Flash),
+        Err(e) => (default_record(), MachineSource::Default(e)),
+    }
+}
+
+/// The core configuration for `rec` at `sample_rate_hz`: its machine on its supply, 1 MHz
+/// timestamps, a 16-bit x4 encoder counter with `4 x encoder_lines` counts per revolution,
+/// and sensor limits equal to the full scales. For [`default_record`] this is
+/// [`crate::app::board_monitor_config`] (a test checks it).
+pub fn monitor_config(rec: &MotorRecord, sample_rate_hz: u32) -> MonitorConfig {
+    let mut cfg = MonitorConfig::new(
+        rec.motor.model(),
+        rec.supply.f_hz as f32,
+        rec.supply.v_ll_rms as f32,
+        sample_rate_hz as f32,
+    );
+    cfg.tick_hz = TICK_HZ as f32;
+    cfg.encoder.counter_bits = 16;
+    cfg.encoder.counts_per_rev = 4 * u32::from(rec.encoder_lines);
+    cfg.limits.v_max = rec.voltage_full_scale_v;
+    cfg.limits.i_max = rec.current_full_scale_a;
+    cfg
+}
+
+/// The front end for `rec`: `per_lsb = 2 x full scale / 4095` and each channel's offset.
+/// For [`default_record`] this is [`FrontEnd::DEFAULT`].
+pub fn front_end(rec: &MotorRecord) -> FrontEnd {
+    let max = f32::from(board::ADC_MAX_CODE);
+    let scale = |offset_code: f32, full_scale: f32| ChannelScale {
+        offset_code,
+        per_lsb: 2.0 * full_scale / max,
+    };
+    let [va, vb, vc] = rec.voltage_offset_counts;
+    let [ia, ib, ic] = rec.current_offset_counts;
+    let (v, i) = (rec.voltage_full_scale_v, rec.current_full_scale_a);
+    FrontEnd {
+        voltage: [scale(va, v), scale(vb, v), scale(vc, v)],
+        current: [scale(ia, i), scale(ib, i), scale(ic, i)],
+    }
+}

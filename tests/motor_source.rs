@@ -1,0 +1,74 @@
+//! The firmware's choice of machine at boot (`drive_monitor::motor_source`): a valid record
+//! from `monitor_core::motor_record` is used; a corrupt, truncated, old or missing one falls
+//! back to the built-in default, and the boot line says which.
+
+use drive_monitor::app::{board_monitor_config, DEFAULT_MACHINE};
+use drive_monitor::board::FrontEnd;
+use drive_monitor::motor_source::{self, MachineSource};
+use monitor_core::motor_record::{MotorRecord, RecordError, STORED_LEN};
+use monitor_core::reference::MOTOR_3HP;
+
+fn other_motor() -> MotorRecord {
+    MotorRecord {
+        motor: MOTOR_3HP.motor,
+        supply: MOTOR_3HP.supply,
+        current_full_scale_a: 25.0,
+        voltage_full_scale_v: 600.0,
+        current_offset_counts: [2040.0, 2050.0, 2047.5],
+        voltage_offset_counts: [2047.5; 3],
+        encoder_lines: 2500,
+        encoder_reversed: false,
+    }
+}
+
+fn page_with(bytes: &[u8]) -> [u8; 2048] {
+    let mut page = [0xFF; 2048];
+    page[..bytes.len()].copy_from_slice(bytes);
+    page
+}
+
+#[test]
+fn a_valid_record_is_used() {
+    let (rec, source) = motor_source::select(&page_with(&other_motor().to_bytes()));
+    assert_eq!(source, MachineSource::Flash);
+    assert_eq!(rec.motor, MOTOR_3HP.motor);
+    assert_eq!(source.describe(), "motor record from flash");
+    let cfg = motor_source::monitor_config(&rec, 10_000);
+    assert_eq!(cfg.encoder.counts_per_rev, 10_000);
+    assert_eq!(cfg.limits.i_max, 25.0);
+    let fe = motor_source::front_end(&rec);
+    assert_eq!(fe.current[0].offset_code, 2040.0);
+    assert_eq!(fe.current[0].per_lsb, 50.0 / 4095.0);
+}
+
+#[test]
+fn corrupt_truncated_old_or_missing_records_fall_back_to_the_default() {
+    let good = other_motor().to_bytes();
+    let mut flipped = good;
+    flipped[20] ^= 0x01;
+    let mut old = good;
+    old[4] = 0; // version 0
+    let cases: [(&[u8], RecordError); 4] = [
+        (&flipped, RecordError::Crc),
+        (&good[..STORED_LEN - 1], RecordError::Truncated),
+        (&old, RecordError::Version),
+        (&[0xFF; 2048], RecordError::Magic),
+    ];
+    for (bytes, why) in cases {
+        let (rec, source) = motor_source::select(bytes);
+        assert_eq!(source, MachineSource::Default(why));
+        assert!(source.is_default());
+        assert!(source.describe().starts_with("built-in default motor"));
+        assert_eq!(rec.motor, DEFAULT_MACHINE.motor);
+    }
+}
+
+#[test]
+fn the_default_record_is_the_built_in_configuration() {
+    let rec = motor_source::default_record();
+    assert_eq!(
+        motor_source::monitor_config(&rec, 10_000),
+        board_monitor_config(10_000)
+    );
+    assert_eq!(motor_source::front_end(&rec), FrontEnd::DEFAULT);
+}
