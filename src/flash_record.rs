@@ -125,22 +125,10 @@ impl defmt::Format for RecordError {
     }
 }
 
-/// CRC-32 (IEEE 802.3 polynomial 0x04C1_1DB7, reflected, init and final XOR
-/// 0xFFFF_FFFF; the same as zlib's `crc32`). Bitwise, no table: 48 bytes take a few
-/// microseconds, and it runs only at boot and after commissioning.
-///
-/// Check value: `crc32(b"123456789") == 0xCBF4_3926`.
-pub fn crc32(data: &[u8]) -> u32 {
-    let mut crc = 0xFFFF_FFFFu32;
-    for &byte in data {
-        crc ^= u32::from(byte);
-        for _ in 0..8 {
-            let mask = (crc & 1).wrapping_neg();
-            crc = (crc >> 1) ^ (0xEDB8_8320 & mask);
-        }
-    }
-    !crc
-}
+/// CRC-32 (IEEE 802.3 polynomial, reflected, init and final XOR 0xFFFF_FFFF; zlib's
+/// `crc32`): the core's one implementation, shared with the motor record. Check value:
+/// `crc32(b"123456789") == 0xCBF4_3926`.
+pub use monitor_core::motor_record::crc32;
 
 fn values_ok(rec: &CalibrationRecord) -> bool {
     rec.mean.iter().all(|m| m.is_finite())
