@@ -466,14 +466,7 @@ fn verdict_sentence(iso: &Isolation, detected: bool, moved: Option<f32>) -> Stri
         iso.candidates
             .iter()
             .take(n)
-            .map(|c| {
-                format!(
-                    "{} {} ({:.0} %)",
-                    c.fault,
-                    pct(c.change),
-                    100.0 * c.probability
-                )
-            })
+            .map(|c| format!("{} {} (p {:.2})", c.fault, pct(c.change), c.probability))
             .collect()
     };
     match (iso.state, iso.named()) {
@@ -491,14 +484,15 @@ fn verdict_sentence(iso: &Isolation, detected: bool, moved: Option<f32>) -> Stri
             top(3).join(", ")
         ),
         (_, Some(Named::Fault(c))) => format!(
-            "{} changed by {} (probability {:.0} %).",
+            "{} changed by {} (p {:.2}).",
             fault_phrase(c.fault),
             pct(c.change),
-            100.0 * c.probability
+            c.probability
         ),
         (_, Some(Named::Friction { probability, b, bl })) => format!(
-            "The friction class changed (probability {:.0} %): load friction Bl {} or machine friction B {}; they cannot be separated.",
-            100.0 * probability,
+            "The friction class b/bl changed by {} (p {:.2}): load friction Bl {}, or the same torque as machine friction B {}; they cannot be separated.",
+            pct(bl.change),
+            probability,
             pct(bl.change),
             pct(b.change)
         ),
