@@ -406,7 +406,7 @@ fn circuit(n: &Nameplate, r: &Rated, a: &Assumptions) -> Result<Circuit, Namepla
     let p_fw_w = a.fw_fraction * r.p_out_w;
     let p_ag = (r.p_out_w + p_fw_w) / (1.0 - r.slip);
     let rs = (p_in - p_ag) / (3.0 * r.i_a * r.i_a);
-    if !(rs > 0.0) {
+    if rs.is_nan() || rs <= 0.0 {
         return Err(field_error(
             "--efficiency",
             format!(
