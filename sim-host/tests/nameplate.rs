@@ -28,6 +28,35 @@ struct Machine {
 
 const W50: f64 = 2.0 * PI * 50.0;
 
+/// A 4-pole machine from its T-circuit `[rs, rr, xls, xlr, xm]` (ohm at `f_hz`).
+fn machine(name: &'static str, p_kw: f64, v_ll: f64, f_hz: f64, t: [f64; 5]) -> Machine {
+    let [rs, rr, xls, xlr, xm] = t;
+    Machine {
+        name,
+        p_kw,
+        v_ll,
+        f_hz,
+        poles: 4,
+        rs,
+        rr,
+        xls,
+        xlr,
+        xm,
+    }
+}
+
+/// A machine of Krause et al.'s table: 60 Hz, Xls = Xlr (ohm at 60 Hz).
+fn krause(name: &'static str, hp: f64, v_ll: f64, rs: f64, xl: f64, xm: f64, rr: f64) -> Machine {
+    machine(name, hp * 0.7457, v_ll, 60.0, [rs, rr, xl, xl, xm])
+}
+
+/// A Simscape preset as the Modelica Buildings library transcribes it: 400 V, 50 Hz,
+/// Ls = Lr, Lm [H].
+fn simscape(name: &'static str, p_kw: f64, rs: f64, rr: f64, ls: f64, lm: f64) -> Machine {
+    let (xl, xm) = (W50 * (ls - lm), W50 * lm);
+    machine(name, p_kw, 400.0, 50.0, [rs, rr, xl, xl, xm])
+}
+
 /// The five machines, 2.2 kW to 50 hp, all 4-pole.
 fn machines() -> [Machine; 5] {
     [
@@ -35,75 +64,24 @@ fn machines() -> [Machine; 5] {
         // 50 Hz induction machine (nominal 5 A, 14.6 N m), inverse-Gamma parameters
         // R_s = 3.7, R_R = 2.1 ohm, L_sgm = 0.021, L_M = 0.224 H: the leakage all on the
         // stator side, Llr = 0.
-        Machine {
-            name: "motulator 2.2 kW",
-            p_kw: 2.2,
-            v_ll: 400.0,
-            f_hz: 50.0,
-            poles: 4,
-            rs: 3.7,
-            rr: 2.1,
-            xls: W50 * 0.021,
-            xlr: 0.0,
-            xm: W50 * 0.224,
-        },
+        machine(
+            "motulator 2.2 kW",
+            2.2,
+            400.0,
+            50.0,
+            [3.7, 2.1, W50 * 0.021, 0.0, W50 * 0.224],
+        ),
         // Krause, Wasynczuk and Sudhoff, Analysis of Electric Machinery and Drive Systems:
-        // the 3 hp, 220 V, 60 Hz machine (reactances at 60 Hz).
-        Machine {
-            name: "Krause 3 hp",
-            p_kw: 3.0 * 0.7457,
-            v_ll: 220.0,
-            f_hz: 60.0,
-            poles: 4,
-            rs: 0.435,
-            rr: 0.816,
-            xls: 0.754,
-            xlr: 0.754,
-            xm: 26.13,
-        },
+        // the 3 hp, 220 V machine.
+        krause("Krause 3 hp", 3.0, 220.0, 0.435, 0.754, 26.13, 0.816),
         // MATLAB/Simscape Electrical's asynchronous machine preset "4 kW, 400 V, 50 Hz,
         // 1430 rpm", as transcribed in the Modelica Buildings library (LBNL),
-        // InductionMotors.Data.IM_5HP_400V_50Hz: Rs 1.405, Rr 1.395 ohm, Ls = Lr =
-        // 0.178039 H, Lm = 0.1722 H.
-        Machine {
-            name: "Simscape 4 kW",
-            p_kw: 4.0,
-            v_ll: 400.0,
-            f_hz: 50.0,
-            poles: 4,
-            rs: 1.405,
-            rr: 1.395,
-            xls: W50 * (0.178039 - 0.1722),
-            xlr: W50 * (0.178039 - 0.1722),
-            xm: W50 * 0.1722,
-        },
-        // The same library's IM_20HP_400V_50Hz (Simscape's 15 kW, 400 V, 50 Hz preset):
-        // Rs 0.2147, Rr 0.2205 ohm, Ls = Lr = 0.065181 H, Lm = 0.06419 H.
-        Machine {
-            name: "Simscape 15 kW",
-            p_kw: 15.0,
-            v_ll: 400.0,
-            f_hz: 50.0,
-            poles: 4,
-            rs: 0.2147,
-            rr: 0.2205,
-            xls: W50 * (0.065181 - 0.06419),
-            xlr: W50 * (0.065181 - 0.06419),
-            xm: W50 * 0.06419,
-        },
-        // Krause et al.'s 50 hp, 460 V, 60 Hz machine.
-        Machine {
-            name: "Krause 50 hp",
-            p_kw: 50.0 * 0.7457,
-            v_ll: 460.0,
-            f_hz: 60.0,
-            poles: 4,
-            rs: 0.087,
-            rr: 0.228,
-            xls: 0.302,
-            xlr: 0.302,
-            xm: 13.08,
-        },
+        // InductionMotors.Data.IM_5HP_400V_50Hz.
+        simscape("Simscape 4 kW", 4.0, 1.405, 1.395, 0.178039, 0.1722),
+        // The same library's IM_20HP_400V_50Hz (Simscape's 15 kW, 400 V, 50 Hz preset).
+        simscape("Simscape 15 kW", 15.0, 0.2147, 0.2205, 0.065181, 0.06419),
+        // Krause et al.'s 50 hp, 460 V machine.
+        krause("Krause 50 hp", 50.0, 460.0, 0.087, 0.302, 13.08, 0.228),
     ]
 }
 
@@ -454,4 +432,33 @@ fn the_written_toml_loads_and_says_where_each_value_comes_from() {
         err.contains("--efficiency") && err.trim().lines().count() == 1,
         "{err}"
     );
+}
+
+#[test]
+fn the_help_teaches_what_goes_in_what_comes_out_and_how_far_off() {
+    let o = Command::cargo_bin("sim-host")
+        .expect("binary")
+        .args(["params", "from-nameplate", "--help"])
+        .output()
+        .expect("run");
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout);
+    for needle in [
+        "nameplate gives",
+        "How far off",
+        "35 %",
+        "refine it with a log of the healthy",
+        "--json",
+        "--locked-rotor-ratio",
+        "  sim-host params from-nameplate ",
+    ] {
+        assert!(text.contains(needle), "{needle} missing:\n{text}");
+    }
+    // `sim-host --help` lists the group.
+    let o = Command::cargo_bin("sim-host")
+        .expect("binary")
+        .arg("--help")
+        .output()
+        .expect("run");
+    assert!(String::from_utf8_lossy(&o.stdout).contains("params"));
 }

@@ -71,8 +71,8 @@ catalogue, or the NEMA code letter);\n  \
 - J from a catalogue power-size fit (x3 either way; the motor alone), Bl the paper's viscous \
 load at rated torque.\n\n\
 How far off: on five published machines (2.2 kW to 50 hp, docs/own-motor.md) Rs, Rr, the \
-total leakage and Lm came within 35 % with IA/IN given; without it the leakage of an atypical \
-machine was off by 75 %. Real motors add what a nameplate hides (deep bars, saturation, \
+total leakage and Lm came within 23 % with IA/IN given (the bar: 35 %); without it, within \
+25 % but for the leakage of one atypical machine (+72 %). Real motors add what a nameplate hides (deep bars, saturation, \
 temperature): treat the file as a starting point and refine it with a log of the healthy \
 motor.\n\n\
 Each value is written with its range and source as a TOML comment; --json prints them as \
