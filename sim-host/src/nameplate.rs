@@ -25,9 +25,11 @@
 //!    0..2 %, typical of 4-pole fan-cooled motors of 1 to 50 kW); the air-gap power
 //!    `P_ag = (P + P_fw) / (1 - s)`; the rotor copper loss is `s P_ag`; everything else,
 //!    `P_in - P_ag`, is put in Rs: `Rs = (P_in - P_ag) / (3 I^2)`. The circuit has no
-//!    iron-loss branch, so iron and stray-load losses are lumped into Rs: it is the
-//!    effective resistance a fit of the same circuit to the motor's terminals gives, and
-//!    can be 20 %..50 % above the winding's DC resistance.
+//!    iron-loss branch, so iron and stray-load losses are lumped into Rs, so that the
+//!    file's machine draws the nameplate's input power at the rated point. This Rs is an
+//!    effective value: iron and stray-load losses are typically 60 %..100 % of the stator
+//!    copper loss, so a real motor's winding DC resistance is about 0.5..0.65 of it. (The
+//!    test machines have no iron loss: there the estimate is the winding's value.)
 //! 4. The rest of the impedance `Z - Rs = j Xls + (j Xm || (Rr/s + j Xlr))` gives Rr and Xm
 //!    for a given total leakage `Xl = Xls + Xlr` (`Xls = a Xl`, `a` by NEMA design from
 //!    IEEE Std 112: 0.5 for designs A and D, 0.4 for B, 0.3 for C).
@@ -535,7 +537,7 @@ fn value_meta(n: &Nameplate) -> [(&'static str, &'static str, String); 11] {
         n.design.stator_share()
     );
     [
-        ("motor.rs_ohm", "ohm", "losses P/eta - (P + P_fw)/(1 - s) over 3 I^2: an effective value with iron and stray losses lumped in (the DC resistance can be 20..50 % lower)".into()),
+        ("motor.rs_ohm", "ohm", "losses P/eta - (P + P_fw)/(1 - s) over 3 I^2: an effective value with iron and stray losses lumped in (a real winding's DC resistance is about 0.5..0.65 of it)".into()),
         ("motor.rr_ohm", "ohm", format!("rated-point impedance V_ph/I at acos(pf), less Rs, with {leak}")),
         ("motor.ls_h", "H", "lm_h + lls_h".into()),
         ("motor.lr_h", "H", "lm_h + llr_h".into()),
