@@ -346,7 +346,18 @@ fn poles_and_slip(n: &Nameplate) -> Result<(u32, bool, f64), NameplateError> {
                     ),
                 ));
             }
-            ((2.0 * pairs).min(f64::from(u32::MAX)) as u32, true)
+            let poles = (2.0 * pairs).min(f64::from(u32::MAX)) as u32;
+            if !plausible::POLES.contains(&poles) {
+                return Err(field_error(
+                    "--speed-rpm",
+                    format!(
+                        "{} rpm at {f} Hz would need {poles} poles, more than {}",
+                        n.speed_rpm,
+                        plausible::POLES.end()
+                    ),
+                ));
+            }
+            (poles, true)
         }
     };
     let n_sync = 120.0 * f / f64::from(poles);

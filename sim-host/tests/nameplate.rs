@@ -301,6 +301,14 @@ fn nameplates_no_induction_motor_can_have_are_refused_naming_the_option() {
         },
         "--poles",
     );
+    // 10 rpm at 50 Hz would be a 598-pole machine.
+    refused(
+        Nameplate {
+            speed_rpm: 10.0,
+            ..good()
+        },
+        "--speed-rpm",
+    );
     for (field, n) in [
         (
             "--power-kw",
