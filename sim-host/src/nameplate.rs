@@ -22,7 +22,7 @@
 //! 2. Slip `s = (n_sync - n) / n_sync`, `n_sync = 120 f / poles`; the poles, when not given,
 //!    are the largest even number whose synchronous speed is above `n`.
 //! 3. Power balance: `P_in = P / eta`; friction and windage `P_fw` = 0.5 % of P (range
-//!    0..2 %, typical of 4-pole fan-cooled motors of 1 to 50 kW); the air-gap power
+//!    0..2 %: an engineering assumption for 4-pole fan-cooled motors of 1 to 50 kW); the air-gap power
 //!    `P_ag = (P + P_fw) / (1 - s)`; the rotor copper loss is `s P_ag`; everything else,
 //!    `P_in - P_ag`, is put in Rs: `Rs = (P_in - P_ag) / (3 I^2)`. The circuit has no
 //!    iron-loss branch, so iron and stray-load losses are lumped into Rs, so that the
@@ -46,9 +46,9 @@
 //!    Steps 4 and 5 repeat until Xl settles (a fixed point; a few iterations).
 //! 6. Mechanics, from empirical power-size relations with a wide uncertainty: the rotor
 //!    inertia `J = 0.0016 P_eq^1.45` kg m^2 with `P_eq` [kW] the power of a 4-pole 50 Hz
-//!    motor of the same rated torque (a fit to the rotor inertias of IEC 4-pole cage
-//!    motors in manufacturers' catalogues, 1 kW to 50 kW; range /3..x3; the load's inertia
-//!    is not included); `B = P_fw / w_m^2`; the load `Bl = P / w_m^2`, the paper's viscous
+//!    motor of the same rated torque (a rough power law through typical catalogue rotor
+//!    inertias of IEC 4-pole cage motors: about 0.005 kg m^2 at 2.2 kW, 0.08 at 15 kW,
+//!    0.3 at 37 kW; range /3..x3; the load's inertia is not included); `B = P_fw / w_m^2`; the load `Bl = P / w_m^2`, the paper's viscous
 //!    load ("Fault Diagnosis of Induction Motor Using D-Q Simplified Model and Parity
 //!    Equations", Energies 2022, 15(22), 8372) that asks for rated torque at rated speed.
 //!
@@ -553,7 +553,7 @@ fn value_meta(n: &Nameplate) -> [(&'static str, &'static str, String); 11] {
         ("motor.ls_h", "H", "lm_h + lls_h".into()),
         ("motor.lr_h", "H", "lm_h + llr_h".into()),
         ("motor.lm_h", "H", format!("rated-point impedance less Rs, with {leak}")),
-        ("motor.j_kgm2", "kg m^2", format!("rotor alone, J = {J_COEFF} P_eq^{J_EXP} (catalogue fit, P_eq the 4-pole 50 Hz power of the same torque, kW; /3..x3): add the load's inertia")),
+        ("motor.j_kgm2", "kg m^2", format!("rotor alone, J = {J_COEFF} P_eq^{J_EXP} (a rough power law through typical catalogue values, P_eq the 4-pole 50 Hz power of the same torque, kW; /3..x3): add the load's inertia")),
         ("motor.b_nms", "N m s/rad", "friction and windage 0.5 % of P (0..2 %) at rated speed".into()),
         ("motor.bl_nms", "N m s/rad", "the paper's viscous load at rated torque and speed, P/w_m^2: set it to your load".into()),
         ("lls_h", "H", format!("{leak}; {split}")),
