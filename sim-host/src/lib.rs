@@ -5,7 +5,8 @@
 //!
 //! 1. [`params`]: the parameter file, and the sensor ranges derived from it;
 //! 2. [`log`]: measurement logs (the one reader and writer, the data-quality stage, the
-//!    sample-rate estimate);
+//!    sample-rate estimate); [`nameplate`]: a parameter file estimated from a motor's
+//!    nameplate (`params from-nameplate`);
 //! 3. [`sim`]: the induction-motor simulator with fault and effect injection; [`replay`]:
 //!    logs through the no_std core (`diagnose`);
 //! 4. [`analysis`]: the model-vs-measurement workflow (`compare`, `explain`);
@@ -28,6 +29,7 @@ pub mod experiment;
 pub mod fault_signatures;
 pub mod hmi;
 pub mod log;
+pub mod nameplate;
 pub mod params;
 pub mod replay;
 pub mod service_profile;

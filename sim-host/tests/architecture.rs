@@ -28,9 +28,10 @@ use std::path::{Path, PathBuf};
 use syn::visit::Visit;
 
 /// sim-host's library modules and their layers, lowest first.
-const LAYERS: [(&str, u8); 11] = [
+const LAYERS: [(&str, u8); 12] = [
     ("params", 1),
     ("log", 2),
+    ("nameplate", 2),
     ("sim", 3),
     ("replay", 3),
     ("analysis", 4),

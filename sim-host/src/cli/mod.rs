@@ -12,6 +12,7 @@ mod demo;
 mod diagnose;
 mod hmi;
 mod output_guard;
+mod params_cmd;
 mod progress;
 mod render;
 mod simulate;
@@ -68,6 +69,8 @@ pub enum Cmd {
     Convert(convert::ConvertArgs),
     // Write the board's motor record.
     BoardRecord(board_record::BoardRecordArgs),
+    // Make a parameter file (from a nameplate).
+    Params(params_cmd::ParamsArgs),
 }
 
 /// Runs a command.
@@ -86,6 +89,7 @@ pub fn run(cmd: Cmd) -> anyhow::Result<()> {
         Cmd::Hmi(a) => hmi::run(a),
         Cmd::Convert(a) => convert::run(a),
         Cmd::BoardRecord(a) => board_record::run(a),
+        Cmd::Params(a) => params_cmd::run(a),
     }
 }
 
