@@ -4,8 +4,8 @@
 
 use super::{pipe, DiagnoseReport, Replay, ReplayError, ReplayOptions, Verdict};
 use crate::log::quality::{
-    BadCells, CellLimits, CleanSink, DataQuality, NotJudged, QualityStage, SegmentBreak,
-    TimeBase, MAX_BRIDGED_GAP_S, MAX_NOT_JUDGED_FRACTION,
+    BadCells, CellLimits, CleanSink, DataQuality, NotJudged, QualityStage, SegmentBreak, TimeBase,
+    MAX_BRIDGED_GAP_S, MAX_NOT_JUDGED_FRACTION,
 };
 use crate::log::{Channels, Column, LogError, LogFile, Row, RowSink};
 use crate::params::ParamFile;
@@ -391,7 +391,9 @@ impl<O: ReplayObserver + ?Sized> ReplaySink<'_, O> {
                 self.time_offset = last.t_s + self.time_offset + CLOCK_RESET_GAP_S - row.t_s;
                 // The shaft turned on over the bridged time at the last speed (the count
                 // handed on by the data-quality stage continues with no step).
-                let w = r.monitor().map_or(0.0, |m| f64::from(m.output().speed_rad_s));
+                let w = r
+                    .monitor()
+                    .map_or(0.0, |m| f64::from(m.output().speed_rad_s));
                 let turned = w * CLOCK_RESET_GAP_S / std::f64::consts::TAU;
                 self.enc_offset = self
                     .enc_offset
@@ -439,7 +441,10 @@ impl<O: ReplayObserver + ?Sized> ReplaySink<'_, O> {
     fn resample(&mut self, row: &Row, bad: BadCells) {
         let f = self.params.supply.f_hz;
         if self.other_rate_hz < MIN_RESAMPLE_PER_PERIOD * f {
-            self.note_not_judged(row, "sampled too coarsely to resample onto the monitor's rate");
+            self.note_not_judged(
+                row,
+                "sampled too coarsely to resample onto the monitor's rate",
+            );
             return;
         }
         if bad.any() {
@@ -448,7 +453,10 @@ impl<O: ReplayObserver + ?Sized> ReplaySink<'_, O> {
         }
         self.rows_other_rate += 1;
         let dt = 1.0 / self.rate_hz;
-        match self.resample_from.filter(|a| (row.t_s - a.0.t_s) * f <= FILL_PERIODS) {
+        match self
+            .resample_from
+            .filter(|a| (row.t_s - a.0.t_s) * f <= FILL_PERIODS)
+        {
             Some((a, mut t)) => {
                 while t <= row.t_s + 1e-6 * dt {
                     self.feed(&between(&a, row, t));
@@ -466,7 +474,10 @@ impl<O: ReplayObserver + ?Sized> ReplaySink<'_, O> {
     /// Records `row` as not judged, `why`, extending the last stretch when it continues.
     fn note_not_judged(&mut self, row: &Row, why: &'static str) {
         let t = row.t_s + self.time_offset;
-        let t = self.replay.as_ref().map_or(t, |r| r.time_of(&Row { t_s: t, ..*row }));
+        let t = self
+            .replay
+            .as_ref()
+            .map_or(t, |r| r.time_of(&Row { t_s: t, ..*row }));
         match self.not_judged.last_mut() {
             Some(last) if last.2 == why && t - last.1 <= MAX_BRIDGED_GAP_S => last.1 = t,
             _ => self.not_judged.push((t, t, why)),

@@ -36,7 +36,7 @@ pub use diagnose::{
 pub(crate) use isolation::serialize_state;
 pub use isolation::{
     state_name, FaultCandidate, IsolationGroup, IsolationName, IsolationReport, NameGiven,
-    SensorPhaseReport,
+    SensorPhaseReport, NOMINAL_UNCERTAINTY,
 };
 pub use report::{
     BaselineSource, Detection, DiagnoseReport, TimelinePoint, UnbalanceReport, Verdict,
@@ -197,7 +197,9 @@ impl LogSampler {
             (None, Some(c), _) => c,
             (None, None, _) => synth,
             (Some(n), Some(c), Some(l)) => n.wrapping_add(c.wrapping_sub(l)),
-            (Some(n), _, _) if row.wm_rad_s.is_some() => n.wrapping_add(synth.wrapping_sub(self.synth)),
+            (Some(n), _, _) if row.wm_rad_s.is_some() => {
+                n.wrapping_add(synth.wrapping_sub(self.synth))
+            }
             (Some(n), _, _) => n,
         };
         self.count = Some(count);

@@ -16,8 +16,8 @@
 //! wrap and is undone (the count handed on stays continuous); any other is a bad cell,
 //! judged against the last good count, so one corrupt value costs one row. When
 //! [`RESET_RUN`] rows in a row are bad but move plausibly among themselves, the counter was
-//! re-zeroed: they become the new reference and the count handed on continues from the
-//! last good one.
+//! re-zeroed: they become the new reference, and the count handed on continues from the
+//! last good one advanced by the run's own motion.
 
 /// Counts per revolution the replay assumes for `enc_count` (4 x 1024 lines, the core's
 /// `EncoderConfig` default).
@@ -52,6 +52,8 @@ pub struct EncoderTrack {
     pending_base: Option<i64>,
     /// The current run of bad but mutually plausible counts: length, last raw, last time.
     run: (u32, i64, f64),
+    /// The first raw count of that run.
+    run_first: i64,
     /// Wraps undone.
     pub wraps: u64,
     /// Re-zeroed counters followed.
@@ -131,14 +133,23 @@ impl EncoderTrack {
         let (n, prev, prev_t) = self.run;
         let plausible =
             n > 0 && raw.wrapping_sub(prev).unsigned_abs() <= self.max_step(t_s - prev_t) as u64;
+        if !plausible {
+            self.run_first = raw;
+        }
         self.run = (if plausible { n + 1 } else { 1 }, raw, t_s);
         if self.run.0 < RESET_RUN {
             return EncoderCell::Bad;
         }
-        // Re-zeroed: the run's latest count is the new reference, and the count handed on
-        // continues from the last good one (the motion during the run is unknown; its rows
-        // were bad cells, filled or held out downstream).
-        let handed = last.wrapping_add(self.offset);
+        // Re-zeroed: the run's latest count is the new reference (its rows were bad cells,
+        // filled or held out downstream).
+        // The run moved as the shaft did: the count handed on advances by the run's motion
+        // and one step of its mean rate (the step into the run is unknown).
+        let moved = raw.wrapping_sub(self.run_first);
+        let step = moved / i64::from(RESET_RUN - 1);
+        let handed = last
+            .wrapping_add(self.offset)
+            .wrapping_add(moved)
+            .wrapping_add(step);
         self.offset = handed.wrapping_sub(raw);
         self.resets += 1;
         self.run.0 = 0;
@@ -157,7 +168,10 @@ mod tests {
         (0..n)
             .map(|k| {
                 let t = k as f64 / 5000.0;
-                ((150.0 * t * COUNTS_PER_REV / std::f64::consts::TAU).round() as i64, t)
+                (
+                    (150.0 * t * COUNTS_PER_REV / std::f64::consts::TAU).round() as i64,
+                    t,
+                )
             })
             .collect()
     }
@@ -255,5 +269,13 @@ mod tests {
             })
             .collect();
         assert!(good.windows(2).all(|w| (15..=25).contains(&(w[1] - w[0]))));
+        // ... and goes on where the shaft is: within a step of the count never re-zeroed.
+        let truth = counts(5000);
+        let k = 3000 + RESET_RUN as usize - 1;
+        assert_eq!(out[k - 1], EncoderCell::Bad);
+        match out[k] {
+            EncoderCell::Good(c) => assert!((c - truth[k].0).abs() <= 20, "{c} vs {}", truth[k].0),
+            EncoderCell::Bad => panic!("the run's end is still bad"),
+        }
     }
 }

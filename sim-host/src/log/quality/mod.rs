@@ -37,7 +37,9 @@
 //! **Cells.** A cell that is not finite or lies beyond [`CellLimits`] (far beyond what the
 //! machine could draw or the supply could give) is bad ([`BadCells`]). The encoder count
 //! is judged by its steps ([`encoder`]): counter wraps are undone, an unreadable count or
-//! a jump no shaft can make is a bad cell, a re-zeroed counter is followed. Consecutive rows
+//! a jump no shaft can make is a bad cell, a re-zeroed counter is followed. A phase channel
+//! frozen while the others alternate, or a whole set dead while the other set is live, is
+//! bad too ([`stuck`]). Consecutive rows
 //! with bad cells form a glitch burst. The stage counts them and hands the rows on,
 //! flagged: the monitor holds such samples out as the firmware does with impossible ADC
 //! readings, the analysis drops them and bridges the hole like dropped samples.
@@ -54,6 +56,7 @@
 mod cells;
 pub mod encoder;
 mod report;
+pub mod stuck;
 mod time_base;
 
 pub use cells::{BadCells, CellLimits};
@@ -79,7 +82,7 @@ pub const RATE_CHANGE_RUN: usize = 64;
 pub const MIN_SAMPLES_PER_PERIOD: f64 = 8.0;
 /// Relative difference between the current's frequency and the supply frequency that is
 /// warned about.
-pub const SUPPLY_MISMATCH: f64 = 0.2;
+pub const SUPPLY_MISMATCH: f64 = 0.05;
 /// Fraction of rows dropped or held out (or of intervals irregular) beyond which no
 /// verdict is given.
 pub const MAX_BAD_FRACTION: f64 = 0.05;
@@ -156,6 +159,7 @@ pub struct QualityStage<'a, S: CleanSink> {
     crossings: CrossingCounter,
     clips: super::clipping::ClipTracker,
     encoder: encoder::EncoderTrack,
+    stuck: stuck::StuckTracker,
     jitter: (f64, u64),
     dropping: bool,
     q: DataQuality,
@@ -182,6 +186,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             crossings: CrossingCounter::default(),
             clips: super::clipping::ClipTracker::default(),
             encoder: encoder::EncoderTrack::new(limits.wm_max),
+            stuck: stuck::StuckTracker::default(),
             jitter: (0.0, 0),
             dropping: false,
             q: DataQuality::default(),
@@ -258,6 +263,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         };
         self.base = Some(base);
         self.period = period;
+        self.stuck = stuck::StuckTracker::new(period, self.limits.supply_hz);
         self.q.time_unit = unit;
         self.q.sample_rate_hz = base.sample_rate_hz;
         self.q.segments = 1;
@@ -385,6 +391,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         self.q.gaps_bridged -= self.q.gaps_bridged.min(counts.0);
         self.q.irregular_intervals -= self.q.irregular_intervals.min(counts.1);
         self.period = med;
+        self.stuck = stuck::StuckTracker::new(med, self.limits.supply_hz);
         if self.q.rate_changes.len() < LIST_CAP {
             let t0 = self.base.map_or(0.0, |b| b.t0_s);
             self.q.rate_changes.push(RateChange {
@@ -431,6 +438,13 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             match self.encoder.check(raw, r.t_s) {
                 encoder::EncoderCell::Good(c) => r.enc_count = Some(c),
                 encoder::EncoderCell::Bad => bad.set(Column::Encoder),
+            }
+        }
+        let before = bad;
+        self.stuck.check(&r, &mut bad);
+        for c in Column::ALL {
+            if bad.has(c) && !before.has(c) {
+                *self.q.stuck_cells.entry(c.name().to_string()).or_insert(0) += 1;
             }
         }
         self.clips.push(&r, |c| !bad.has(c));
@@ -499,6 +513,7 @@ impl<S: CleanSink> RowSink for QualityStage<'_, S> {
         self.burst = None;
         self.crossings = CrossingCounter::default();
         self.encoder = encoder::EncoderTrack::new(self.limits.wm_max);
+        self.stuck = stuck::StuckTracker::default();
         self.jitter = (0.0, 0);
         self.dropping = false;
         self.q = DataQuality::default();
@@ -550,7 +565,7 @@ mod tests {
         let ph = |k: f64| 10.0 * (w - k * std::f64::consts::TAU / 3.0).cos();
         Row {
             t_s: t,
-            v_abc: Some([300.0 * w.cos(), 0.0, 0.0]),
+            v_abc: Some([30.0 * ph(0.0), 30.0 * ph(1.0), 30.0 * ph(2.0)]),
             i_abc: [ph(0.0), ph(1.0), ph(2.0)],
             wm_rad_s: Some(150.0),
             enc_count: None,

@@ -72,6 +72,9 @@ pub struct DataQuality {
     pub bad_cells: BTreeMap<String, u64>,
     /// Rows with at least one bad cell.
     pub bad_rows: u64,
+    /// Cells of stuck or dead phase channels per column ([`super::stuck`]; counted in
+    /// `bad_cells` too).
+    pub stuck_cells: BTreeMap<String, u64>,
     /// Wraps of the encoder counter (16, 24, 32 or 64 bits) undone
     /// ([`super::encoder`]).
     pub encoder_wraps: u64,
@@ -226,6 +229,19 @@ impl DataQuality {
                 self.glitch_bursts,
                 self.longest_burst_s
             ));
+        }
+        for (c, n) in &self.stuck_cells {
+            let share = *n as f64 / rows;
+            let what = format!(
+                "{c} is stuck on {:.1} % of the rows (identical readings for over {} of a supply period while the other channels alternate: a frozen sensor, a held DAQ channel, a dead input)",
+                100.0 * share,
+                super::stuck::STUCK_PERIODS
+            );
+            if share > MAX_BAD_FRACTION {
+                distrust.push(what);
+            } else {
+                warn.push(what);
+            }
         }
         if self.rows_in_short_bursts as f64 / rows > MAX_BAD_FRACTION {
             distrust.push(format!(
