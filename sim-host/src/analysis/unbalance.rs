@@ -170,14 +170,14 @@ pub fn analyse(d: &Prepared, n: &MachineConstants) -> UnbalanceAnalysis {
 /// [`UnbalanceAnalysis::cannot_judge_because`]); `None` when it can.
 fn cannot_judge(d: &Prepared, s: &SequenceSums, omega_s: f64) -> Option<String> {
     let periods = s.count * d.dt_s * omega_s.abs() / std::f64::consts::TAU;
-    if !(periods >= MIN_STEADY_PERIODS) {
+    if periods.is_nan() || periods < MIN_STEADY_PERIODS {
         return Some(format!(
             "{periods:.1} supply periods analysed, {MIN_STEADY_PERIODS} needed (give a longer log or window)"
         ));
     }
     let mean = s.i_pos / s.count;
     let var = (s.i_pos2 / s.count - mean * mean).max(0.0);
-    if !(var.sqrt() <= MAX_CURRENT_VARIATION * mean) {
+    if mean.is_nan() || var.sqrt() > MAX_CURRENT_VARIATION * mean {
         return Some(format!(
             "the current varies by {:.0} % RMS over the stretch analysed (a start or a load change; {:.0} % at most): its decaying terms look like a negative sequence",
             100.0 * var.sqrt() / mean.max(1e-12),
@@ -187,7 +187,7 @@ fn cannot_judge(d: &Prepared, s: &SequenceSums, omega_s: f64) -> Option<String> 
     let from = d.len() / 10;
     let re: Vec<f64> = d.i_ab[from..].iter().map(|z| z.re).collect();
     let noise = super::metrics::white_noise_sigma(&re);
-    if !(mean > MIN_SIGNAL_OVER_NOISE * noise) {
+    if noise.is_nan() || mean <= MIN_SIGNAL_OVER_NOISE * noise {
         return Some(format!(
             "the current ({mean:.3} A) is within {MIN_SIGNAL_OVER_NOISE}x its noise ({noise:.3} A)"
         ));
