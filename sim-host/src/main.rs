@@ -35,13 +35,21 @@ fn main() -> ExitCode {
             ) {
                 e.exit();
             }
-            // One line: clap's first line names the problem; the usage hint is dropped.
+            // One line: clap's first paragraph names the problem (a missing argument's
+            // name is on the lines after the first); the usage hint is dropped.
             let text = e.render().to_string();
-            let first = text
+            let first: Vec<&str> = text
                 .lines()
-                .find(|l| !l.trim().is_empty())
-                .unwrap_or("bad arguments");
-            report(&format!("{} (see --help)", first.trim()));
+                .skip_while(|l| l.trim().is_empty())
+                .take_while(|l| !l.trim().is_empty())
+                .map(str::trim)
+                .collect();
+            let first = if first.is_empty() {
+                "bad arguments".to_string()
+            } else {
+                first.join(" ")
+            };
+            report(&format!("{first} (see --help)"));
             return ExitCode::from(2);
         }
     };

@@ -67,7 +67,7 @@ const INTENDED: [(&str, &str, &str); 9] = [
 
 /// Keys added since the golden outputs were taken (issue 8: the data-quality stage's
 /// report, what commissioning did, the verdict, the range note beside a lamp).
-const ADDED: [&str; 33] = [
+const ADDED: [&str; 38] = [
     "data_quality",
     "commissioning",
     "verdict",
@@ -111,6 +111,13 @@ const ADDED: [&str; 33] = [
     "rotor_asymmetry",
     // Issue 10, explain as values: how each candidate's fit ended (`lm::Report`).
     "fit",
+    // Issue 29: the encoder count's wraps and re-zeroing, stuck channels and the stretches
+    // not judged in the data-quality report; why the unbalance could not be judged.
+    "encoder_wraps",
+    "encoder_resets",
+    "stuck_cells",
+    "not_judged",
+    "cannot_judge_because",
 ];
 
 /// The library effect added since (issue 10, `rotor_asymmetry`): its ranking entries and

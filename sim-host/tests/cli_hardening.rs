@@ -363,3 +363,29 @@ fn parameter_files_no_machine_has_are_refused_naming_key_value_and_range() {
         }
     }
 }
+
+#[test]
+fn nan_and_negative_arguments_are_refused_by_name() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (params, log) = small_log(dir.path(), "a.csv", 0.5);
+    let (p, l) = (s(&params), s(&log));
+    for (args, name) in [
+        (vec!["compare", "--params", p, l, "--from", "-5"], "--from"),
+        (vec!["compare", "--params", p, l, "--from", "nan"], "--from"),
+        (vec!["explain", "--params", p, l, "--to", "inf"], "--to"),
+        (
+            vec!["diagnose", "--params", p, l, "--timeline-step", "0"],
+            "--timeline-step",
+        ),
+        (
+            vec!["hmi", l, "--params", p, "--duration", "nan"],
+            "--duration",
+        ),
+        (vec!["bench", "--repeat", "0"], "--repeat"),
+        // A missing required argument is named, not only "required arguments".
+        (vec!["diagnose", l], "--params"),
+    ] {
+        let err = refused(&args);
+        assert!(err.contains(name), "{args:?}: {err}");
+    }
+}

@@ -21,7 +21,13 @@ fn sim_example_files_parse_and_run() {
     for e in std::fs::read_dir(examples().join("scenarios")).unwrap() {
         let path = e.unwrap().path();
         let mut sc = Scenario::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        // Shortened to 0.3 s: the events after it are left out (a scenario's events must
+        // lie inside its run, which simulate checks).
         sc.duration_s = sc.duration_s.min(0.3);
+        let end = sc.duration_s;
+        sc.faults.retain(|f| f.at_s < end);
+        sc.supply.steps.retain(|s| s.t_s < end);
+        sc.load.steps.retain(|s| s.t_s < end);
         let rows = sim::simulate_to_vec(&p, &sc).unwrap();
         assert_eq!(
             rows.len(),
@@ -153,4 +159,50 @@ fn sim_cli_writes_the_csv_schema_and_refuses_to_overwrite_inputs() {
         err.contains("bogus_key") && err.trim().lines().count() == 1,
         "{err}"
     );
+}
+
+#[test]
+fn values_the_run_would_not_carry_out_are_refused_by_key() {
+    let p = ParamFile::reference_2p2kw();
+    let head = "duration_s = 1.0\nsample_rate_hz = 1000.0\n";
+    let cases = [
+        (
+            "[[faults]]\nkind = \"rs\"\nat_s = 2.0\nchange = 0.5\n",
+            "faults.at_s",
+        ),
+        (
+            "[[faults]]\nkind = \"rs\"\nat_s = 1e9\nchange = 0.5\n",
+            "faults.at_s",
+        ),
+        (
+            "[supply]\nsteps = [{ t_s = 1.5, v_scale = 0.9 }]\n",
+            "supply.steps.t_s",
+        ),
+        ("[supply]\nf_hz = 1e6\n", "supply.f_hz"),
+        (
+            "[[faults]]\nkind = \"current_sensor\"\nat_s = 0.5\nmode = \"offset\"\noffset = 1e9\n",
+            "faults.offset",
+        ),
+        (
+            "[[faults]]\nkind = \"voltage_sensor\"\nat_s = 0.5\nmode = \"gain\"\nchange = -1.0\n",
+            "faults.change",
+        ),
+    ];
+    for (tail, key) in cases {
+        let sc = Scenario::from_toml_str(&format!("{head}{tail}"), "s.toml").unwrap();
+        let e = sim::simulate_to_vec(&p, &sc).unwrap_err().to_string();
+        assert!(e.contains(key), "{tail}: {e}");
+        assert!(!e.contains('\n'), "{e}");
+    }
+    let tiny =
+        Scenario::from_toml_str("duration_s = 1e-9\nsample_rate_hz = 1000.0\n", "s").unwrap();
+    let e = sim::simulate_to_vec(&p, &tiny).unwrap_err().to_string();
+    assert!(e.contains("duration_s") && e.contains("rows"), "{e}");
+    // The same run with its events inside the duration goes.
+    let ok = Scenario::from_toml_str(
+        &format!("{head}[[faults]]\nkind = \"rs\"\nat_s = 0.5\nchange = 0.5\n"),
+        "s.toml",
+    )
+    .unwrap();
+    assert_eq!(sim::simulate_to_vec(&p, &ok).unwrap().len(), 1000);
 }

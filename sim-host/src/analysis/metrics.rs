@@ -118,7 +118,8 @@ pub struct ChannelError {
     pub rms_error: f64,
     /// RMS of the measured signal.
     pub rms_measured: f64,
-    /// rms_error / rms_measured.
+    /// rms_error / rms_measured (by at least [`MIN_SCALE_OF_PREDICTED`] of the model's
+    /// RMS).
     pub normalized: f64,
 }
 
@@ -131,10 +132,17 @@ pub struct ErrorSummary {
     pub normalized_rms_error: f64,
 }
 
-/// Errors over the samples where `mask` is true (all when `None`).
+/// The smallest normalisation of a channel's error in [`errors`], as a fraction of the
+/// model's RMS of that channel: a measured RMS near zero (a dead sensor, a channel
+/// recorded in the wrong unit) does not turn a large error into a small one.
+pub const MIN_SCALE_OF_PREDICTED: f64 = 0.1;
+
+/// Errors over the samples where `mask` is true (all when `None`): per channel the RMS
+/// error over `max(RMS measured, `[`MIN_SCALE_OF_PREDICTED`]` x RMS predicted)`.
 pub fn errors(d: &Prepared, p: &Prediction, mask: Option<&[bool]>) -> ErrorSummary {
     let mut se = [0.0f64; 5];
     let mut sm = [0.0f64; 5];
+    let mut sp = [0.0f64; 5];
     let mut n = 0.0;
     for k in 0..d.len().min(p.iq.len()) {
         if let Some(m) = mask {
@@ -147,6 +155,7 @@ pub fn errors(d: &Prepared, p: &Prediction, mask: Option<&[bool]>) -> ErrorSumma
         for c in 0..5 {
             se[c] += (b[c] - a[c]).powi(2);
             sm[c] += a[c] * a[c];
+            sp[c] += b[c] * b[c];
         }
         n += 1.0;
     }
@@ -159,7 +168,11 @@ pub fn errors(d: &Prepared, p: &Prediction, mask: Option<&[bool]>) -> ErrorSumma
         }
         let rms_e = (se[c] / n).sqrt();
         let rms_m = (sm[c] / n).sqrt();
-        let norm = if rms_m > 0.0 { rms_e / rms_m } else { 0.0 };
+        // Normalised by the measured RMS, but never by less than a tenth of the model's:
+        // a dead channel (all zero) is a 100 % misfit of a model that predicts current, not
+        // a perfect fit divided by zero.
+        let scale = rms_m.max(MIN_SCALE_OF_PREDICTED * (sp[c] / n).sqrt());
+        let norm = if scale > 0.0 { rms_e / scale } else { 0.0 };
         sum += norm;
         channels.push(ChannelError {
             channel: CHANNELS[c].to_string(),

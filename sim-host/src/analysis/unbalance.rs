@@ -30,7 +30,24 @@ pub struct UnbalanceAnalysis {
     pub phase_rms_a: [f64; 3],
     /// In words.
     pub summary: String,
+    /// Why no phase or unbalance is claimed although the numbers exist: fewer than
+    /// [`MIN_STEADY_PERIODS`] supply periods analysed, or a positive-sequence current that
+    /// is not steady ([`MAX_CURRENT_VARIATION`]) or lies in the noise; null when judged.
+    pub cannot_judge_because: Option<String>,
 }
+
+/// Supply periods the analysis needs (after the first 10 % of the series) to claim an
+/// unbalance or a phase: a negative sequence of a few % needs many periods to stand
+/// clear of the noise and of a transient's decaying terms.
+pub const MIN_STEADY_PERIODS: f64 = 25.0;
+/// Largest RMS variation of the positive-sequence current magnitude, as a fraction of its
+/// mean, over the analysed part: beyond it the series is a transient (a start, a load
+/// step), whose decaying terms look like a negative sequence.
+pub const MAX_CURRENT_VARIATION: f64 = 0.3;
+/// Smallest mean positive-sequence current, as a fraction of the RMS of the currents'
+/// white noise ([`super::metrics::white_noise_sigma`]) x 10: below it the phases' ratio is
+/// noise over noise.
+pub const MIN_SIGNAL_OVER_NOISE: f64 = 10.0;
 
 /// Sums over the analysed part of the series.
 #[derive(Default)]
@@ -104,7 +121,8 @@ pub fn analyse(d: &Prepared, n: &MachineConstants) -> UnbalanceAnalysis {
         sl,
         0.01,
     );
-    let suspect = asym.suspect_phase;
+    let cannot_judge = cannot_judge(d, &s, w);
+    let suspect = asym.suspect_phase.filter(|_| cannot_judge.is_none());
     let supply_explains = suspect.is_none() && f64::from(asym.supply_ratio) > 0.5 * ratio;
     let eps = f64::from(monitor_core::sequence::winding_change_fraction(
         &n.core_model,
@@ -113,6 +131,11 @@ pub fn analyse(d: &Prepared, n: &MachineConstants) -> UnbalanceAnalysis {
         asym.ratio,
     ));
     let summary = match (suspect, supply_explains) {
+        _ if cannot_judge.is_some() => format!(
+            "cannot judge the unbalance (negative sequence {:.1} %): {}",
+            100.0 * ratio,
+            cannot_judge.as_deref().unwrap_or_default()
+        ),
         (Some(p), _) => {
             let mean_rms = phase_rms_a.iter().sum::<f64>() / 3.0;
             let dev = phase_rms_a[p.index()] - mean_rms;
@@ -139,7 +162,37 @@ pub fn analyse(d: &Prepared, n: &MachineConstants) -> UnbalanceAnalysis {
         suspect_phase: suspect.map(|p| p.name().to_string()),
         phase_rms_a,
         summary,
+        cannot_judge_because: cannot_judge,
     }
+}
+
+/// Why the series cannot carry an unbalance claim (see
+/// [`UnbalanceAnalysis::cannot_judge_because`]); `None` when it can.
+fn cannot_judge(d: &Prepared, s: &SequenceSums, omega_s: f64) -> Option<String> {
+    let periods = s.count * d.dt_s * omega_s.abs() / std::f64::consts::TAU;
+    if periods.is_nan() || periods < MIN_STEADY_PERIODS {
+        return Some(format!(
+            "{periods:.1} supply periods analysed, {MIN_STEADY_PERIODS} needed (give a longer log or window)"
+        ));
+    }
+    let mean = s.i_pos / s.count;
+    let var = (s.i_pos2 / s.count - mean * mean).max(0.0);
+    if mean.is_nan() || var.sqrt() > MAX_CURRENT_VARIATION * mean {
+        return Some(format!(
+            "the current varies by {:.0} % RMS over the stretch analysed (a start or a load change; {:.0} % at most): its decaying terms look like a negative sequence",
+            100.0 * var.sqrt() / mean.max(1e-12),
+            100.0 * MAX_CURRENT_VARIATION
+        ));
+    }
+    let from = d.len() / 10;
+    let re: Vec<f64> = d.i_ab[from..].iter().map(|z| z.re).collect();
+    let noise = super::metrics::white_noise_sigma(&re);
+    if noise.is_nan() || mean <= MIN_SIGNAL_OVER_NOISE * noise {
+        return Some(format!(
+            "the current ({mean:.3} A) is within {MIN_SIGNAL_OVER_NOISE}x its noise ({noise:.3} A)"
+        ));
+    }
+    None
 }
 
 /// The log's mean supply angular frequency [rad/s] and slip over its last 90 % (module

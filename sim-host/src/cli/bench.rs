@@ -30,7 +30,7 @@ cargo run --release -p sim-host -- bench --isolation --plot /tmp/isoplot"
 )]
 pub struct BenchArgs {
     /// Repetitions of each timing (the median and the range are reported).
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
     pub repeat: u32,
     /// Also find, per fault and sign, the smallest change detected within 10 s under the
     /// healthy service profile (load and supply steps, noisy sensors) at zero false alarms

@@ -34,10 +34,10 @@ pub struct Common {
     #[arg(long, value_name = "DIR")]
     pub report: Option<PathBuf>,
     /// Analyse from this time on [s] (e.g. to leave a start-up out).
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = super::parse_seconds)]
     pub from: Option<f64>,
     /// Analyse up to this time [s].
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = super::parse_positive_seconds)]
     pub to: Option<f64>,
     /// Keep the nominal base parameters (do not refit Ra, Ls, B+Bl, J).
     #[arg(long)]

@@ -68,7 +68,7 @@ pub struct DiagnoseArgs {
     #[arg(long, value_enum, default_value_t = ResidualArg::Steady)]
     pub residuals: ResidualArg,
     /// Timeline resolution in the output [s].
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true, value_parser = super::parse_positive_seconds)]
     pub timeline_step: f64,
     /// Print one JSON document on stdout instead of the table.
     #[arg(long)]

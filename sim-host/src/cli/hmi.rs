@@ -72,7 +72,7 @@ pub struct HmiArgs {
     #[arg(long, default_value_t = 1.0, value_parser = parse_every)]
     pub every: f64,
     /// Stop after this many seconds of wall-clock time (scripts, tests).
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = super::parse_positive_seconds)]
     pub duration: Option<f64>,
 }
 

@@ -146,6 +146,26 @@ pub fn parse_effect(s: &str) -> Result<EffectKind, String> {
     sim_host::analysis::parse_effect(s.trim()).map_err(|e| e.to_string())
 }
 
+/// A time on the command line [s]: a finite number >= 0 (negative values reach this
+/// parser, so that `--from -5` is refused by name rather than taken for a flag).
+pub fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
+        Ok(x) => Err(format!(
+            "{x} is not a time: give a finite number of seconds >= 0"
+        )),
+        Err(_) => Err(format!("'{s}' is not a number of seconds")),
+    }
+}
+
+/// A duration or step on the command line [s]: a finite number > 0.
+pub fn parse_positive_seconds(s: &str) -> Result<f64, String> {
+    match parse_seconds(s)? {
+        x if x > 0.0 => Ok(x),
+        x => Err(format!("{x} s: give a finite number of seconds > 0")),
+    }
+}
+
 /// Parses `START:END` (seconds).
 pub fn parse_window(s: &str) -> Result<(f64, f64), String> {
     let (a, b) = s

@@ -105,7 +105,7 @@ pub(super) fn row_from_values(v: &[f64; 9], columns: &ColumnMap) -> Row {
         v_abc: has(Column::Va).then_some([v[1], v[2], v[3]]),
         i_abc: [v[4], v[5], v[6]],
         wm_rad_s: has(Column::Speed).then_some(v[7]),
-        enc_count: has(Column::Encoder).then_some(v[8].round() as i64),
+        enc_count: has(Column::Encoder).then_some(super::enc_count_of(v[8])),
     }
 }
 

@@ -237,6 +237,26 @@ pub struct Row {
     pub enc_count: Option<i64>,
 }
 
+/// The [`Row::enc_count`] of a cell that holds no readable count: not finite, or beyond
+/// `±2^53` where the readers' `f64` no longer carries every integer (a 64-bit counter
+/// near its overflow). The data-quality stage marks such a cell bad
+/// ([`quality::BadCells`]), as it does a non-finite current.
+pub const ENC_COUNT_UNREADABLE: i64 = i64::MIN;
+
+/// The largest encoder count the readers carry exactly, `2^53`.
+pub const ENC_COUNT_EXACT_MAX: f64 = 9_007_199_254_740_992.0;
+
+/// The encoder count of a cell's value: the nearest integer, or
+/// [`ENC_COUNT_UNREADABLE`] for a value that is not finite or beyond
+/// `±`[`ENC_COUNT_EXACT_MAX`].
+pub fn enc_count_of(x: f64) -> i64 {
+    if x.is_finite() && x.abs() <= ENC_COUNT_EXACT_MAX {
+        x.round() as i64
+    } else {
+        ENC_COUNT_UNREADABLE
+    }
+}
+
 /// Which optional channels a log carries.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Channels {

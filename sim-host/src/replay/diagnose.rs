@@ -4,10 +4,10 @@
 
 use super::{pipe, DiagnoseReport, Replay, ReplayError, ReplayOptions, Verdict};
 use crate::log::quality::{
-    BadCells, CellLimits, CleanSink, DataQuality, QualityStage, SegmentBreak, TimeBase,
-    MAX_BRIDGED_GAP_S,
+    BadCells, CellLimits, CleanSink, DataQuality, NotJudged, QualityStage, SegmentBreak, TimeBase,
+    MAX_BRIDGED_GAP_S, MAX_NOT_JUDGED_FRACTION,
 };
-use crate::log::{Channels, LogError, LogFile, Row, RowSink};
+use crate::log::{Channels, Column, LogError, LogFile, Row, RowSink};
 use crate::params::ParamFile;
 use monitor_core::{Abc, MonitorOutput};
 use std::path::Path;
@@ -183,6 +183,7 @@ fn conclude<O: ReplayObserver + ?Sized>(
     let can_residuals = replay.monitor.is_some();
     let mut report = replay.finish();
     describe_actions(&mut quality, can_residuals, &sink);
+    withhold_healthy_over_unjudged(&mut report, &quality);
     if !quality.trusted {
         report.verdict = Verdict::CouldNotJudge;
         report.verdict_withheld_because.extend(
@@ -238,12 +239,49 @@ fn describe_actions<O: ReplayObserver + ?Sized>(
     }
     if sink.rows_other_rate > 0 {
         q.actions.push(format!(
-            "{} rows at another sample rate not diagnosed (the monitor runs at {:.0} Hz)",
+            "{} rows at another sample rate resampled onto the monitor's {:.0} Hz clock (interpolated along the rotation)",
             sink.rows_other_rate, sink.rate_hz
         ));
+    }
+    if q.clock_resets > 0 {
+        q.actions.push(format!(
+            "after each clock reset the replay's time goes on from the last row's plus {CLOCK_RESET_GAP_S} s (the times reported are the replay's)"
+        ));
+    }
+    q.not_judged = sink
+        .not_judged
+        .iter()
+        .map(|&(from_s, to_s, why)| NotJudged {
+            from_s,
+            to_s,
+            why: why.to_string(),
+        })
+        .collect();
+    for n in &q.not_judged {
         q.warnings.push(format!(
-            "{} rows at another sample rate were not diagnosed",
-            sink.rows_other_rate
+            "{:.2}..{:.2} s not judged: {}",
+            n.from_s, n.to_s, n.why
+        ));
+    }
+}
+
+/// A "healthy" verdict is withheld when more than [`MAX_NOT_JUDGED_FRACTION`] of the log
+/// was not judged: a fault may hide there (a fault found elsewhere stands).
+fn withhold_healthy_over_unjudged(report: &mut DiagnoseReport, q: &DataQuality) {
+    let unjudged: f64 = q.not_judged.iter().map(|n| n.to_s - n.from_s).sum();
+    if report.verdict == Verdict::Healthy
+        && unjudged > MAX_NOT_JUDGED_FRACTION * q.duration_s.max(f64::MIN_POSITIVE)
+    {
+        report.verdict = Verdict::CouldNotJudge;
+        report.verdict_withheld_because.push(format!(
+            "{unjudged:.2} s of the {:.2} s log could not be judged (over {:.0} %): {}",
+            q.duration_s,
+            100.0 * MAX_NOT_JUDGED_FRACTION,
+            q.not_judged
+                .iter()
+                .map(|n| format!("{:.2}..{:.2} s, {}", n.from_s, n.to_s, n.why))
+                .collect::<Vec<_>>()
+                .join("; ")
         ));
     }
 }
@@ -261,8 +299,25 @@ struct ReplaySink<'a, O: ReplayObserver + ?Sized> {
     other_rate: bool,
     rows_other_rate: u64,
     restarts: u64,
-    burst: Vec<Row>,
+    burst: Vec<(Row, BadCells)>,
     burst_forwarded: bool,
+    /// The rate of the segment at another rate [Hz].
+    other_rate_hz: f64,
+    /// The last row replayed (its own time, before any clock-reset offset), where the
+    /// resampling of a segment at another rate starts.
+    last_fed: Option<Row>,
+    /// The row the resampling interpolates from, and the next time on the monitor's clock
+    /// [s].
+    resample_from: Option<(Row, f64)>,
+    /// A clock reset was seen: the next row replayed sets [`ReplaySink::time_offset`].
+    clock_reset_pending: bool,
+    /// Added to every row's time after a clock reset, so the replay's time goes on [s].
+    time_offset: f64,
+    /// Added to every row's encoder count after a clock reset: the turn over the bridged
+    /// time.
+    enc_offset: i64,
+    /// Stretches of the log not judged, `(from, to, why)` [s of the replay's time].
+    not_judged: Vec<(f64, f64, &'static str)>,
     short_bursts: u64,
     long_bursts: u64,
     last_good: Option<Row>,
@@ -294,11 +349,138 @@ impl<'a, O: ReplayObserver + ?Sized> ReplaySink<'a, O> {
             restarts: 0,
             burst: Vec::new(),
             burst_forwarded: false,
+            other_rate_hz: 0.0,
+            last_fed: None,
+            resample_from: None,
+            clock_reset_pending: false,
+            time_offset: 0.0,
+            enc_offset: 0,
+            not_judged: Vec::new(),
             short_bursts: 0,
             long_bursts: 0,
             last_good: None,
             filled_rows: 0,
             error: None,
+        }
+    }
+}
+
+/// True when the only bad cell is the encoder count.
+fn encoder_only(bad: BadCells) -> bool {
+    Column::ALL
+        .iter()
+        .all(|&c| !bad.has(c) || c == Column::Encoder)
+}
+
+/// Samples per supply period below which a segment at another rate is not resampled onto
+/// the monitor's clock (not judged).
+const MIN_RESAMPLE_PER_PERIOD: f64 = 20.0;
+/// Time the replay puts between the segments around a clock reset [s]: a long gap, after
+/// which the monitor restarts its estimators and settles.
+const CLOCK_RESET_GAP_S: f64 = 2.0 * MAX_BRIDGED_GAP_S;
+
+impl<O: ReplayObserver + ?Sized> ReplaySink<'_, O> {
+    /// Replays one row: after a clock reset its time is moved on to follow the last row's
+    /// by [`CLOCK_RESET_GAP_S`] (the replay's time never goes back).
+    fn feed(&mut self, row: &Row) {
+        let Some(r) = self.replay.as_mut() else {
+            return;
+        };
+        if std::mem::take(&mut self.clock_reset_pending) {
+            if let Some(last) = self.last_fed {
+                self.time_offset = last.t_s + self.time_offset + CLOCK_RESET_GAP_S - row.t_s;
+                // The shaft turned on over the bridged time at the last speed (the count
+                // handed on by the data-quality stage continues with no step).
+                let w = r
+                    .monitor()
+                    .map_or(0.0, |m| f64::from(m.output().speed_rad_s));
+                let turned = w * CLOCK_RESET_GAP_S / std::f64::consts::TAU;
+                self.enc_offset = self
+                    .enc_offset
+                    .wrapping_add((turned * f64::from(super::COUNTS_PER_REV)).round() as i64);
+            }
+        }
+        self.last_fed = Some(*row);
+        let shifted = Row {
+            t_s: row.t_s + self.time_offset,
+            enc_count: row.enc_count.map(|c| c.wrapping_add(self.enc_offset)),
+            ..*row
+        };
+        let out = r.push(&shifted);
+        if let Some(o) = self.observer.as_deref_mut() {
+            o.output(&shifted, &out, r);
+        }
+    }
+
+    /// A row with bad cells given to the monitor, which holds them out and flags the
+    /// sensor; a row whose only bad cell is the encoder count (no speed channel to take
+    /// over) is not judged: a count the log cannot carry is no reading of the shaft.
+    fn forward_bad(&mut self, row: &Row, bad: BadCells) {
+        if encoder_only(bad) {
+            self.note_not_judged(row, "the encoder count is unreadable or jumps");
+        } else {
+            self.feed(row);
+        }
+    }
+
+    /// Where the encoder count is bad and the speed channel good, the speed channel takes
+    /// over (the sampler keeps the count continuous across the switch).
+    fn speed_from_tachometer(&self, row: &Row, mut bad: BadCells) -> (Row, BadCells) {
+        let mut row = *row;
+        if bad.has(Column::Encoder) && row.wm_rad_s.is_some() && !bad.has(Column::Speed) {
+            row.enc_count = None;
+            bad.clear(Column::Encoder);
+        }
+        (row, bad)
+    }
+
+    /// A row of a segment at another sample rate: resampled onto the monitor's clock
+    /// (interpolated along the rotation from the row before, [`between`]) where the
+    /// segment has at least [`MIN_RESAMPLE_PER_PERIOD`] samples per supply period and the
+    /// two rows lie within [`FILL_PERIODS`]; else not judged.
+    fn resample(&mut self, row: &Row, bad: BadCells) {
+        let f = self.params.supply.f_hz;
+        if self.other_rate_hz < MIN_RESAMPLE_PER_PERIOD * f {
+            self.note_not_judged(
+                row,
+                "sampled too coarsely to resample onto the monitor's rate",
+            );
+            return;
+        }
+        if bad.any() {
+            // Held out; the interpolation spans it when short.
+            return;
+        }
+        self.rows_other_rate += 1;
+        let dt = 1.0 / self.rate_hz;
+        match self
+            .resample_from
+            .filter(|a| (row.t_s - a.0.t_s) * f <= FILL_PERIODS)
+        {
+            Some((a, mut t)) => {
+                while t <= row.t_s + 1e-6 * dt {
+                    self.feed(&between(&a, row, t));
+                    t += dt;
+                }
+                self.resample_from = Some((*row, t));
+            }
+            None => {
+                self.feed(row);
+                self.resample_from = Some((*row, row.t_s + dt));
+            }
+        }
+    }
+
+    /// Records `row` as not judged, `why`, extending the last stretch when it continues.
+    fn note_not_judged(&mut self, row: &Row, why: &'static str) {
+        let t = row.t_s + self.time_offset;
+        let t = self
+            .replay
+            .as_ref()
+            .map_or(t, |r| r.time_of(&Row { t_s: t, ..*row }));
+        match self.not_judged.last_mut() {
+            Some(last) if last.2 == why && t - last.1 <= MAX_BRIDGED_GAP_S => last.1 = t,
+            _ => self.not_judged.push((t, t, why)),
         }
     }
 }
@@ -375,66 +557,73 @@ impl<O: ReplayObserver + ?Sized> CleanSink for ReplaySink<'_, O> {
     }
 
     fn row(&mut self, row: &Row, bad: BadCells) -> bool {
-        if self.other_rate {
-            self.rows_other_rate += 1;
+        if self.replay.is_none() {
             return true;
         }
-        let Some(r) = self.replay.as_mut() else {
+        let (row, bad) = self.speed_from_tachometer(row, bad);
+        if self.other_rate {
+            self.resample(&row, bad);
             return true;
-        };
+        }
         if bad.any() && !self.burst_forwarded {
             // A glitch burst is held until it ends (dropped: the monitor bridges it like a
             // gap) or outlasts the longest gap bridged (a sensor that has failed: the rows
             // go to the monitor, which holds them out and flags the sensor).
-            self.burst.push(*row);
+            self.burst.push((row, bad));
             if self.burst.len() as f64 <= MAX_BRIDGED_GAP_S * self.rate_hz {
                 return true;
             }
             self.burst_forwarded = true;
-            self.long_bursts += 1;
-            for b in self.burst.drain(..) {
-                let out = r.push(&b);
-                if let Some(o) = self.observer.as_deref_mut() {
-                    o.output(&b, &out, r);
-                }
+            if !encoder_only(bad) {
+                self.long_bursts += 1;
+            }
+            let burst = std::mem::take(&mut self.burst);
+            for (b, why) in &burst {
+                self.forward_bad(b, *why);
             }
             return true;
         }
-        if !bad.any() {
-            if !self.burst.is_empty() && !self.burst_forwarded {
-                self.short_bursts += 1;
-                // A glitch of a few samples is filled in between its good neighbours (the
-                // monitor would otherwise lose the whole block it falls in); a longer one
-                // is left out, a gap the monitor bridges.
-                let short = |a: &Row| (row.t_s - a.t_s) * self.params.supply.f_hz <= FILL_PERIODS;
-                if let Some(a) = self.last_good.filter(short) {
-                    for b in &self.burst {
-                        let filled = between(&a, row, b.t_s);
-                        let out = r.push(&filled);
-                        if let Some(o) = self.observer.as_deref_mut() {
-                            o.output(&filled, &out, r);
-                        }
-                    }
-                    self.filled_rows += self.burst.len() as u64;
+        if bad.any() {
+            self.forward_bad(&row, bad);
+            return true;
+        }
+        if !self.burst.is_empty() && !self.burst_forwarded {
+            self.short_bursts += 1;
+            // A glitch of a few samples is filled in between its good neighbours (the
+            // monitor would otherwise lose the whole block it falls in); a longer one is
+            // left out, a gap the monitor bridges.
+            let short = |a: &Row| (row.t_s - a.t_s) * self.params.supply.f_hz <= FILL_PERIODS;
+            if let Some(a) = self.last_good.filter(short) {
+                let burst = std::mem::take(&mut self.burst);
+                for (b, _) in &burst {
+                    self.feed(&between(&a, &row, b.t_s));
                 }
+                self.filled_rows += burst.len() as u64;
             }
-            self.burst.clear();
-            self.burst_forwarded = false;
-            self.last_good = Some(*row);
         }
-        let out = r.push(row);
-        if let Some(o) = self.observer.as_deref_mut() {
-            o.output(row, &out, r);
-        }
+        self.burst.clear();
+        self.burst_forwarded = false;
+        self.last_good = Some(row);
+        self.feed(&row);
         true
     }
 
     fn new_segment(&mut self, why: SegmentBreak) -> bool {
         match why {
             SegmentBreak::RateChange(r) => {
-                self.other_rate = (r / self.rate_hz - 1.0).abs() > 0.02;
+                let other = (r / self.rate_hz - 1.0).abs() > 0.02;
+                if other && !self.other_rate {
+                    let dt = 1.0 / self.rate_hz;
+                    self.resample_from = self.last_fed.map(|l| (l, l.t_s + dt));
+                }
+                self.other_rate = other;
+                self.other_rate_hz = r;
             }
-            SegmentBreak::Gap(_) | SegmentBreak::ClockReset => self.restarts += 1,
+            SegmentBreak::Gap(_) => self.restarts += 1,
+            SegmentBreak::ClockReset => {
+                self.restarts += 1;
+                self.clock_reset_pending = true;
+            }
         }
         true
     }
@@ -449,6 +638,13 @@ impl<O: ReplayObserver + ?Sized> CleanSink for ReplaySink<'_, O> {
         self.restarts = 0;
         self.burst.clear();
         self.burst_forwarded = false;
+        self.other_rate_hz = 0.0;
+        self.last_fed = None;
+        self.resample_from = None;
+        self.clock_reset_pending = false;
+        self.time_offset = 0.0;
+        self.enc_offset = 0;
+        self.not_judged.clear();
         self.short_bursts = 0;
         self.long_bursts = 0;
         self.last_good = None;

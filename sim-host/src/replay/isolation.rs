@@ -122,7 +122,15 @@ pub(super) struct IsolationTracker {
     end_t: f64,
     /// The operating point of the last isolation.
     last_point: SteadyPoint,
+    /// A lamp lit while lamps counted.
+    lamps_lit: bool,
 }
+
+/// How far a parameter file's values may be off the machine's (nameplate estimates are
+/// 10-30 % off): against the nominal parameters (no commissioning), a change this small or
+/// smaller, with every lamp dark, is the file's own error as much as a fault, and is not
+/// named.
+pub const NOMINAL_UNCERTAINTY: f32 = 0.3;
 
 impl IsolationTracker {
     /// A tracker for the nominal machine (`None`: a machine the isolator rejects, then
@@ -136,6 +144,7 @@ impl IsolationTracker {
             last_t: 0.0,
             end_t: 0.0,
             last_point: SteadyPoint::default(),
+            lamps_lit: false,
         }
     }
 
@@ -157,10 +166,15 @@ impl IsolationTracker {
         let learning = matches!(out.commissioning, CommissioningState::Learning(_));
         self.running |= out.evaluating;
         let usable = self.running && !out.sensor_fault.any() && (learning || counts);
+        self.lamps_lit |= counts && out.fault_detected;
+        let learned = follower.learned();
         // Quasi-steady by the vectors themselves (the monitor's gate follows its own frame,
         // which a sensor fault can detune).
         if let Step::Isolated(result) = follower.observe(point, dt_s as f32, usable, learning) {
-            if let Some(n) = result.named() {
+            let named = result
+                .named()
+                .filter(|n| learned || self.lamps_lit || !within_nominal_uncertainty(n));
+            if let Some(n) = named {
                 let given = NameGiven {
                     name: IsolationName::of(&n),
                     t_s: t,
@@ -232,14 +246,26 @@ impl IsolationTracker {
             Vec::new()
         };
         let moved = self.moved_from_learned();
+        let in_file_error = iso
+            .named()
+            .filter(|n| !learned && !self.lamps_lit && within_nominal_uncertainty(n));
+        let named = iso.named().filter(|_| in_file_error.is_none());
         let report = IsolationReport {
             state: iso.state,
-            named: iso.named().map(|n| IsolationName::of(&n)),
-            named_change: iso.named().map(|n| match n {
+            named: named.map(|n| IsolationName::of(&n)),
+            named_change: named.map(|n| match n {
                 Named::Fault(c) => c.change,
                 Named::Friction { bl, .. } => bl.change,
             }),
-            verdict: if self.end_t - self.last_t > STALE_S {
+            verdict: if let Some(Named::Fault(c)) = in_file_error {
+                format!(
+                    "The nearest fault, {} {} (p {:.2}), is within the parameter file's own uncertainty (+/-{:.0} %) while every lamp stayed dark: not named. Commission on the healthy machine to judge changes this small.",
+                    c.fault,
+                    pct(c.change),
+                    c.probability,
+                    100.0 * NOMINAL_UNCERTAINTY
+                )
+            } else if self.end_t - self.last_t > STALE_S {
                 format!(
                     "{} (judged at {:.2} s; the operating point was not steady in the last {:.1} s of the log)",
                     verdict_sentence(&iso, detected, moved).trim_end_matches('.'),
@@ -454,6 +480,12 @@ const MOVED_SAID_FROM: f32 = 0.05;
 
 /// The one-sentence verdict of the isolation; `moved`: the current's relative distance
 /// from the learned point ([`IsolationReport::moved_from_learned`]).
+/// A named fault (not the friction class, which a load change moves) whose size is within
+/// [`NOMINAL_UNCERTAINTY`].
+fn within_nominal_uncertainty(n: &Named) -> bool {
+    matches!(n, Named::Fault(c) if c.change.abs() <= NOMINAL_UNCERTAINTY)
+}
+
 fn verdict_sentence(iso: &Isolation, detected: bool, moved: Option<f32>) -> String {
     let away = match moved {
         Some(m) if m.abs() >= MOVED_SAID_FROM => format!(

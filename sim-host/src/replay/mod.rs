@@ -36,7 +36,7 @@ pub use diagnose::{
 pub(crate) use isolation::serialize_state;
 pub use isolation::{
     state_name, FaultCandidate, IsolationGroup, IsolationName, IsolationReport, NameGiven,
-    SensorPhaseReport,
+    SensorPhaseReport, NOMINAL_UNCERTAINTY,
 };
 pub use report::{
     BaselineSource, Detection, DiagnoseReport, TimelinePoint, UnbalanceReport, Verdict,
@@ -168,25 +168,44 @@ pub fn monitor_config_for_log(
 
 /// Converts log rows to core samples, synthesising encoder counts from speed if needed
 /// (the host's counterpart of the firmware's `drive_monitor::sampling::AdcSampler`).
+///
+/// The count handed to the core is one continuous count: each row advances it by the
+/// encoder's own step where this row and the one before carry `enc_count`, else by the
+/// speed channel's `floor(theta_m C / 2 pi)` step (`theta_m` the integral of `wm_rad_s`,
+/// `C` = [`COUNTS_PER_REV`]), else not at all. A log that switches between the two (the
+/// data-quality stage drops a bad count where the speed channel is good) gives no jump.
 #[derive(Debug, Clone, Default)]
 pub struct LogSampler {
     theta_m: f64,
     last_t: Option<f64>,
+    /// The last row's encoder count, if it had one.
+    last_enc: Option<i64>,
+    /// The count handed on (`None` before the first row).
+    count: Option<i64>,
+    /// The speed channel's synthesised count at the last row.
+    synth: i64,
 }
 
 impl LogSampler {
     /// The core sample for `row` (voltages 0 when the log has none).
     pub fn sample(&mut self, row: &Row) -> Sample {
-        let count = match (row.enc_count, row.wm_rad_s) {
-            (Some(c), _) => c as u32,
-            (None, Some(w)) => {
-                if let Some(t0) = self.last_t {
-                    self.theta_m += w * (row.t_s - t0);
-                }
-                floor_i64(self.theta_m / std::f64::consts::TAU * f64::from(COUNTS_PER_REV)) as u32
+        if let (Some(t0), Some(w)) = (self.last_t, row.wm_rad_s) {
+            self.theta_m += w * (row.t_s - t0);
+        }
+        let synth = floor_i64(self.theta_m / std::f64::consts::TAU * f64::from(COUNTS_PER_REV));
+        let count = match (self.count, row.enc_count, self.last_enc) {
+            (None, Some(c), _) => c,
+            (None, None, _) => synth,
+            (Some(n), Some(c), Some(l)) => n.wrapping_add(c.wrapping_sub(l)),
+            (Some(n), _, _) if row.wm_rad_s.is_some() => {
+                n.wrapping_add(synth.wrapping_sub(self.synth))
             }
-            (None, None) => 0,
+            (Some(n), _, _) => n,
         };
+        self.count = Some(count);
+        self.synth = synth;
+        self.last_enc = row.enc_count;
+        let count = count as u32;
         self.last_t = Some(row.t_s);
         let v = row.v_abc.unwrap_or([0.0; 3]);
         let i = row.i_abc;
@@ -273,6 +292,12 @@ pub struct Replay {
     pll_on_voltage: bool,
     /// Time of the last row the sequence analysis saw [s].
     seq_t: Option<f64>,
+    /// The monitor's count of timing faults (estimator restarts) at the last row.
+    timing_faults_seen: u32,
+    /// The isolation ignores points until this time [s] (the settling after a restart).
+    isolation_hold_until: f64,
+    /// The monitor's settling time after a restart [s].
+    settle_s: f64,
 }
 
 impl Replay {
@@ -358,6 +383,9 @@ impl Replay {
             v_max: f64::from(cfg.limits.v_max),
             pll_on_voltage: channels.voltages,
             seq_t: None,
+            timing_faults_seen: 0,
+            isolation_hold_until: f64::NEG_INFINITY,
+            settle_s: f64::from(cfg.settle_s),
         })
     }
 
@@ -385,7 +413,16 @@ impl Replay {
         // parameters are not to be trusted (a sensor fault counts at any time).
         let counts = out.sensor_fault.any() || self.commission.thresholds_trusted(&out);
         let point = self.steady_point(&out);
-        self.isolation.after(t, self.dt_s, &out, &point, counts);
+        // After a restart of the monitor's estimators (a long gap, a clock reset) the
+        // isolation waits out the monitor's settling time too: the restarted frame's
+        // vectors look steady before they are right.
+        if out.timing.timing_faults != self.timing_faults_seen {
+            self.timing_faults_seen = out.timing.timing_faults;
+            self.isolation_hold_until = t + self.settle_s;
+        }
+        let settled = t >= self.isolation_hold_until;
+        self.isolation
+            .after(t, self.dt_s, &out, &point, counts && settled);
         if matches!(out.commissioning, CommissioningState::Learning(_)) {
             self.learned_unbalance = Some(self.unbalance_ratios().0);
         }
@@ -405,6 +442,12 @@ impl Replay {
         // stage's sample clock may put the sample at the step a hair before it).
         if t + 0.5 * self.dt_s >= self.next_point {
             self.next_point += self.opts.timeline_step_s;
+            if self.next_point <= t {
+                // After a gap: the next step after this sample, not one point per step
+                // missed.
+                let steps = ((t - self.next_point) / self.opts.timeline_step_s).floor() + 1.0;
+                self.next_point += steps * self.opts.timeline_step_s;
+            }
             self.timeline.push(timeline_point(t, &out, range_note));
         }
         self.last = out;

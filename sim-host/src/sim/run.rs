@@ -132,7 +132,111 @@ pub(super) fn checked_run<'a>(
         key: "params".into(),
         message: e.to_string(),
     })?;
+    check_against_run(params, scenario)?;
     Run::new(params, scenario)
+}
+
+/// Supply frequencies a run accepts, as multiples of the parameter file's (a V/f drive
+/// from a tenth of base speed to twice it).
+pub const SUPPLY_F_RANGE: (f64, f64) = (0.1, 2.0);
+/// Fewest output rows of a run.
+pub const MIN_ROWS: f64 = 2.0;
+
+/// The scenario's values against the run and the machine: every time inside the duration,
+/// at least [`MIN_ROWS`] rows, supply
+/// frequencies within [`SUPPLY_F_RANGE`] of the parameter file's, sensor offsets inside
+/// the sensor's range and sensor gains that leave a reading (`change > -1`; a dead sensor
+/// is `mode = "disconnected"`).
+///
+/// # Errors
+/// [`SimError::Invalid`] naming the key.
+fn check_against_run(params: &ParamFile, sc: &Scenario) -> Result<(), SimError> {
+    let bad = |key: &str, message: String| {
+        Err(SimError::Invalid {
+            key: key.into(),
+            message,
+        })
+    };
+    let end = sc.duration_s;
+    let times = sc
+        .faults
+        .iter()
+        .map(|f| ("faults.at_s", f.at_s))
+        .chain(sc.supply.steps.iter().map(|s| ("supply.steps.t_s", s.t_s)))
+        .chain(sc.load.steps.iter().map(|s| ("load.steps.t_s", s.t_s)));
+    for (key, t) in times {
+        if t >= end {
+            return bad(
+                key,
+                format!("{t} s is not inside the run (duration_s = {end} s): it would never act"),
+            );
+        }
+    }
+    let f0 = params.supply.f_hz;
+    let (lo, hi) = (SUPPLY_F_RANGE.0 * f0, SUPPLY_F_RANGE.1 * f0);
+    let freqs = sc
+        .supply
+        .f_hz
+        .map(|f| ("supply.f_hz", f))
+        .into_iter()
+        .chain(
+            sc.supply
+                .steps
+                .iter()
+                .filter_map(|s| s.f_hz.map(|f| ("supply.steps.f_hz", f))),
+        );
+    for (key, f) in freqs {
+        if !(lo..=hi).contains(&f) {
+            return bad(
+                key,
+                format!(
+                    "{f} Hz is outside {lo}..={hi} Hz (0.1 to 2 x the parameter file's {f0} Hz)"
+                ),
+            );
+        }
+    }
+    let rows = (sc.duration_s * sc.sample_rate_hz).round();
+    if rows < MIN_ROWS {
+        return bad(
+            "duration_s",
+            format!(
+                "{end} s at {} Hz gives {rows} rows; at least {MIN_ROWS} are needed",
+                sc.sample_rate_hz
+            ),
+        );
+    }
+    check_sensor_faults(params, sc)
+}
+
+/// Sensor faults the sensors can show: offsets inside the range, gains that leave a reading.
+fn check_sensor_faults(params: &ParamFile, sc: &Scenario) -> Result<(), SimError> {
+    let ranges = params.sensor_ranges();
+    let wm_max = f64::from(params.log_limits().wm_max_rad_s);
+    for f in sc.faults.iter().filter(|f| f.kind.is_sensor()) {
+        if let Some(c) = f.change.filter(|c| *c <= -1.0) {
+            return Err(SimError::Invalid {
+                key: "faults.change".into(),
+                message: format!(
+                    "a sensor gain change of {c} leaves no reading (gain {}); a dead sensor is mode = \"disconnected\"",
+                    1.0 + c
+                ),
+            });
+        }
+        let range = match f.kind {
+            monitor_core::Fault::VoltageSensor => ranges.v_range_v,
+            monitor_core::Fault::CurrentSensor => ranges.i_range_a,
+            _ => wm_max,
+        };
+        if let Some(o) = f.offset.filter(|o| o.abs() > range) {
+            return Err(SimError::Invalid {
+                key: "faults.offset".into(),
+                message: format!(
+                    "{o} is beyond the sensor's range of +/-{range} (the reading would only clip)"
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// One simulation run: the resolved scenario and the state of the loop.

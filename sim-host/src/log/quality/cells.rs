@@ -44,7 +44,12 @@ impl BadCells {
     pub fn has(self, c: Column) -> bool {
         self.0 & (1 << c as u16) != 0
     }
-    fn set(&mut self, c: Column) {
+    /// Marks the cell of `c` good.
+    pub fn clear(&mut self, c: Column) {
+        self.0 &= !(1 << c as u16);
+    }
+    /// Marks the cell of `c` bad.
+    pub fn set(&mut self, c: Column) {
         self.0 |= 1 << c as u16;
     }
 

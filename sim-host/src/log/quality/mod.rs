@@ -35,7 +35,11 @@
 //! period of the clock, and every row off the grid, keeps its own time.
 //!
 //! **Cells.** A cell that is not finite or lies beyond [`CellLimits`] (far beyond what the
-//! machine could draw or the supply could give) is bad ([`BadCells`]); consecutive rows
+//! machine could draw or the supply could give) is bad ([`BadCells`]). The encoder count
+//! is judged by its steps ([`encoder`]): counter wraps are undone, an unreadable count or
+//! a jump no shaft can make is a bad cell, a re-zeroed counter is followed. A phase channel
+//! frozen while the others alternate, or a whole set dead while the other set is live, is
+//! bad too ([`stuck`]). Consecutive rows
 //! with bad cells form a glitch burst. The stage counts them and hands the rows on,
 //! flagged: the monitor holds such samples out as the firmware does with impossible ADC
 //! readings, the analysis drops them and bridges the hole like dropped samples.
@@ -50,11 +54,13 @@
 //! samples are missing: the commands then withhold their verdict and say why.
 
 mod cells;
+pub mod encoder;
 mod report;
+pub mod stuck;
 mod time_base;
 
 pub use cells::{BadCells, CellLimits};
-pub use report::{ClippedChannel, DataQuality, RateChange};
+pub use report::{ClippedChannel, DataQuality, NotJudged, RateChange};
 pub(in crate::log) use time_base::median_positive;
 pub use time_base::TimeUnit;
 
@@ -76,12 +82,15 @@ pub const RATE_CHANGE_RUN: usize = 64;
 pub const MIN_SAMPLES_PER_PERIOD: f64 = 8.0;
 /// Relative difference between the current's frequency and the supply frequency that is
 /// warned about.
-pub const SUPPLY_MISMATCH: f64 = 0.2;
+pub const SUPPLY_MISMATCH: f64 = 0.05;
 /// Fraction of rows dropped or held out (or of intervals irregular) beyond which no
 /// verdict is given.
 pub const MAX_BAD_FRACTION: f64 = 0.05;
 /// Stretches of rows with unusable time beyond which their share counts against trust.
 pub const MAX_DROP_RUNS: u64 = 3;
+/// Fraction of the log's duration not judged (a stretch the command could not replay)
+/// beyond which "healthy" is not said: a fault may hide there.
+pub const MAX_NOT_JUDGED_FRACTION: f64 = 0.05;
 /// Fraction of missing samples (bridged gaps) beyond which no verdict is given.
 pub const MAX_DROPPED_FRACTION: f64 = 0.10;
 /// Gain of the timestamp smoothing: each row on the grid moves the sample clock this
@@ -149,6 +158,8 @@ pub struct QualityStage<'a, S: CleanSink> {
     burst: Option<(f64, f64)>,
     crossings: CrossingCounter,
     clips: super::clipping::ClipTracker,
+    encoder: encoder::EncoderTrack,
+    stuck: stuck::StuckTracker,
     jitter: (f64, u64),
     dropping: bool,
     q: DataQuality,
@@ -174,6 +185,8 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             burst: None,
             crossings: CrossingCounter::default(),
             clips: super::clipping::ClipTracker::default(),
+            encoder: encoder::EncoderTrack::new(limits.wm_max),
+            stuck: stuck::StuckTracker::default(),
             jitter: (0.0, 0),
             dropping: false,
             q: DataQuality::default(),
@@ -211,6 +224,8 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         }
         self.q.current_frequency_hz = self.crossings.median_period().map(|p| 1.0 / p);
         self.q.timestamp_jitter_rms_s = (self.jitter.0 / self.jitter.1.max(1) as f64).sqrt();
+        self.q.encoder_wraps = self.encoder.wraps;
+        self.q.encoder_resets = self.encoder.resets;
         self.q.clipped = self
             .clips
             .clipped()
@@ -248,6 +263,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         };
         self.base = Some(base);
         self.period = period;
+        self.stuck = stuck::StuckTracker::new(period, self.limits.supply_hz);
         self.q.time_unit = unit;
         self.q.sample_rate_hz = base.sample_rate_hz;
         self.q.segments = 1;
@@ -375,6 +391,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         self.q.gaps_bridged -= self.q.gaps_bridged.min(counts.0);
         self.q.irregular_intervals -= self.q.irregular_intervals.min(counts.1);
         self.period = med;
+        self.stuck = stuck::StuckTracker::new(med, self.limits.supply_hz);
         if self.q.rate_changes.len() < LIST_CAP {
             let t0 = self.base.map_or(0.0, |b| b.t0_s);
             self.q.rate_changes.push(RateChange {
@@ -401,6 +418,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         self.back_run.0 = 0;
         self.off_run.clear();
         self.off_run_counts = (0, 0);
+        self.encoder.restart();
         self.new_segment(SegmentBreak::ClockReset) && self.emit(p)
     }
 
@@ -409,12 +427,26 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         self.sink.new_segment(why)
     }
 
-    /// Passes a row on: cells judged, bursts and crossings tracked.
-    fn emit(&mut self, r: Row) -> bool {
+    /// Passes a row on: cells judged (the encoder count made continuous, see
+    /// [`encoder`]), bursts and crossings tracked.
+    fn emit(&mut self, mut r: Row) -> bool {
         self.last_t = r.t_s;
         self.dropping = false;
         self.q.rows_passed += 1;
-        let bad = BadCells::of(&r, &self.limits);
+        let mut bad = BadCells::of(&r, &self.limits);
+        if let Some(raw) = r.enc_count {
+            match self.encoder.check(raw, r.t_s) {
+                encoder::EncoderCell::Good(c) => r.enc_count = Some(c),
+                encoder::EncoderCell::Bad => bad.set(Column::Encoder),
+            }
+        }
+        let before = bad;
+        self.stuck.check(&r, &mut bad);
+        for c in Column::ALL {
+            if bad.has(c) && !before.has(c) {
+                *self.q.stuck_cells.entry(c.name().to_string()).or_insert(0) += 1;
+            }
+        }
         self.clips.push(&r, |c| !bad.has(c));
         if bad.any() {
             self.q.bad_rows += 1;
@@ -480,6 +512,8 @@ impl<S: CleanSink> RowSink for QualityStage<'_, S> {
         self.back_run = (0, f64::NAN);
         self.burst = None;
         self.crossings = CrossingCounter::default();
+        self.encoder = encoder::EncoderTrack::new(self.limits.wm_max);
+        self.stuck = stuck::StuckTracker::default();
         self.jitter = (0.0, 0);
         self.dropping = false;
         self.q = DataQuality::default();
@@ -531,7 +565,7 @@ mod tests {
         let ph = |k: f64| 10.0 * (w - k * std::f64::consts::TAU / 3.0).cos();
         Row {
             t_s: t,
-            v_abc: Some([300.0 * w.cos(), 0.0, 0.0]),
+            v_abc: Some([30.0 * ph(0.0), 30.0 * ph(1.0), 30.0 * ph(2.0)]),
             i_abc: [ph(0.0), ph(1.0), ph(2.0)],
             wm_rad_s: Some(150.0),
             enc_count: None,

@@ -17,6 +17,17 @@ pub struct RateChange {
     pub rate_hz: f64,
 }
 
+/// A stretch of the log the command could not judge (JSON `data_quality.not_judged`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct NotJudged {
+    /// From [s of the command's time: since the first row, clock resets bridged].
+    pub from_s: f64,
+    /// To [s].
+    pub to_s: f64,
+    /// Why not.
+    pub why: String,
+}
+
 /// What the data-quality stage found and what was done (JSON key `data_quality`). Times
 /// are seconds since the log's first row.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
@@ -61,6 +72,14 @@ pub struct DataQuality {
     pub bad_cells: BTreeMap<String, u64>,
     /// Rows with at least one bad cell.
     pub bad_rows: u64,
+    /// Cells of stuck or dead phase channels per column ([`super::stuck`]; counted in
+    /// `bad_cells` too).
+    pub stuck_cells: BTreeMap<String, u64>,
+    /// Wraps of the encoder counter (16, 24, 32 or 64 bits) undone
+    /// ([`super::encoder`]).
+    pub encoder_wraps: u64,
+    /// Re-zeroed encoder counters followed ([`super::encoder`]).
+    pub encoder_resets: u64,
     /// Runs of consecutive rows with bad cells.
     pub glitch_bursts: u64,
     /// Longest such run [s].
@@ -75,6 +94,9 @@ pub struct DataQuality {
     pub current_frequency_hz: Option<f64>,
     /// What the command did about what was found.
     pub actions: Vec<String>,
+    /// Stretches the command could not judge (a verdict of "healthy" is withheld when
+    /// they exceed [`super::MAX_NOT_JUDGED_FRACTION`] of the log).
+    pub not_judged: Vec<NotJudged>,
     /// What the user should know (also printed on stderr).
     pub warnings: Vec<String>,
     /// Voltage and current channels that clip ([`crate::log::clipping`]): not trusted.
@@ -207,6 +229,19 @@ impl DataQuality {
                 self.glitch_bursts,
                 self.longest_burst_s
             ));
+        }
+        for (c, n) in &self.stuck_cells {
+            let share = *n as f64 / rows;
+            let what = format!(
+                "{c} is stuck on {:.1} % of the rows (identical readings for over {} of a supply period while the other channels alternate: a frozen sensor, a held DAQ channel, a dead input)",
+                100.0 * share,
+                super::stuck::STUCK_PERIODS
+            );
+            if share > MAX_BAD_FRACTION {
+                distrust.push(what);
+            } else {
+                warn.push(what);
+            }
         }
         if self.rows_in_short_bursts as f64 / rows > MAX_BAD_FRACTION {
             distrust.push(format!(
