@@ -339,9 +339,20 @@ fn bad_toml_inputs_give_one_line_errors_naming_the_key() {
 #[test]
 fn every_command_has_a_help_that_teaches() {
     for cmd in [
-        "demo", "simulate", "diagnose", "table1", "compare", "explain", "bench", "hmi",
+        "demo",
+        "simulate",
+        "diagnose",
+        "table1",
+        "compare",
+        "explain",
+        "bench",
+        "hmi",
+        "params from-nameplate",
     ] {
-        let o = bin().args([cmd, "--help"]).output().expect("run");
+        let o = bin()
+            .args(cmd.split(' ').chain(["--help"]))
+            .output()
+            .expect("run");
         let text = String::from_utf8_lossy(&o.stdout);
         assert!(o.status.success(), "{cmd} --help failed");
         // Every command but the interactive HMI has a JSON output.
