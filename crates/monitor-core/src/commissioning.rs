@@ -210,6 +210,25 @@ impl Learner {
         if self.run.blocks_learned < self.run.blocks_needed {
             return None;
         }
+        self.complete()
+    }
+
+    /// Ends run `id` now with the blocks learned so far, if it is learning and has learned
+    /// at least `min_blocks` (>= 1): the run completes as if those had been asked for.
+    /// Returns whether it ended, and the calibration to put into force now, as
+    /// [`Learner::learn`].
+    pub(crate) fn finish(&mut self, id: u16, min_blocks: u32) -> (bool, Option<Calibration>) {
+        let enough = self.run.blocks_learned >= min_blocks.max(1);
+        if id != self.run.id || !self.is_learning() || !enough {
+            return (false, None);
+        }
+        self.run.blocks_needed = self.run.blocks_learned;
+        (true, self.complete())
+    }
+
+    /// The run has learned its blocks: checks the statistics and ends it.
+    #[cold]
+    fn complete(&mut self) -> Option<Calibration> {
         let cal = self.welford.calibration();
         if !cal.is_valid() {
             self.run.stage = RunStage::Failed(CommissioningFailure::InvalidStatistics);
@@ -289,6 +308,28 @@ mod tests {
             out = out.or(l.learn([x, -x, 0.0, x]));
         }
         out
+    }
+
+    #[test]
+    fn a_run_finished_early_needs_its_minimum_and_then_completes() {
+        let mut l = Learner::default();
+        let id = l.start(1.0, 400.0, Install::OnCompletion).unwrap_or(0);
+        assert!(learned(&mut l, 99).is_none());
+        // 99 blocks learned: not enough for a minimum of 100; another run's id changes
+        // nothing either.
+        assert_eq!(l.finish(id, 100), (false, None));
+        assert_eq!(l.finish(id.wrapping_add(1), 10), (false, None));
+        assert_eq!(l.run().stage, RunStage::Learning);
+        assert!(learned(&mut l, 1).is_none());
+        let (ended, cal) = l.finish(id, 100);
+        assert!(ended);
+        assert_eq!(l.run().stage, RunStage::Done);
+        assert_eq!(l.run().blocks_needed, 100);
+        // The calibration of the 100 blocks learned: mean of 0, 0.001, 0.002 repeated.
+        let cal = cal.unwrap_or_default();
+        assert!((cal.mean[0] - 0.00099).abs() < 2e-5, "{cal:?}");
+        // A run no longer learning is not finished again.
+        assert_eq!(l.finish(id, 1), (false, None));
     }
 
     #[test]

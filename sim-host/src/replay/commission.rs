@@ -25,6 +25,17 @@ pub fn grace_s(start_s: f64, end_s: f64) -> f64 {
     (0.5 * (end_s - start_s)).max(1.0)
 }
 
+/// The least evaluated running a window must hold to be learned [s]: 1 s (400 blocks at
+/// the usual 2.5 ms; the isolation's baseline needs half a second of it), or the whole
+/// window when it is shorter. A window over real running, with supply or load steps
+/// inside it, is learned from its quasi-steady blocks when they add up to this much.
+pub fn min_learned_s(start_s: f64, end_s: f64) -> f64 {
+    MIN_LEARNED_S.min(end_s - start_s)
+}
+
+/// See [`min_learned_s`].
+pub const MIN_LEARNED_S: f64 = 1.0;
+
 /// Departure from the commissioned range that is reported (fraction of the range's
 /// largest magnitude): 20 %. A load step of that size is what the learned means do not
 /// cover, while the faults the lamps are for move the operating point less (Rr +50 % at
@@ -152,6 +163,16 @@ impl CommissionTracker {
             self.run_id = mon.start_commissioning((b - a) as f32).ok();
         }
         if let Some(id) = self.run_id {
+            // At the window's end the run ends with the evaluated running it learned inside
+            // the window (supply and load steps close the quasi-steady gate for a while),
+            // if that is at least the stated minimum; else it may go on for the grace time.
+            if self.ended_at.is_none()
+                && t >= b
+                && mon.commissioning().stage == RunStage::Learning
+                && mon.finish_commissioning(id, min_learned_s(a, b) as f32)
+            {
+                self.ended_at = Some(t);
+            }
             if self.ended_at.is_none()
                 && t > b + grace_s(a, b)
                 && mon.commissioning().stage == RunStage::Learning
@@ -299,10 +320,10 @@ impl CommissionTracker {
                 "--commission {a}:{b}: the log ends at {end:.2} s, before the window starts"
             ),
             Some(_) => format!(
-                "--commission {a}:{b}: learned {:.2} s of the {:.2} s of evaluated running asked for by {:.2} s ({}); the lamps were off while learning",
+                "--commission {a}:{b}: learned {:.2} s of evaluated running by {:.2} s, {:.2} s at least needed ({}); the lamps were off while learning",
                 self.seconds(self.learned.0),
-                b - a,
                 self.ended_at.unwrap_or(end),
+                min_learned_s(a, b),
                 if self.cancelled {
                     "the window held too little quasi-steady running with usable data"
                 } else {

@@ -53,6 +53,30 @@ impl Monitor {
         cancelled
     }
 
+    /// Ends run `run_id` now with what it has learned, if it is still learning and has
+    /// learned at least `min_s` seconds of evaluated running: the run completes as if that
+    /// much had been asked for (statistics checked, the calibration put into force or
+    /// awaiting storage as its [`Install`] says). A window over real running, whose supply
+    /// and load steps close the quasi-steady gate for a while, is learned so. Returns
+    /// whether the run ended; false (nothing changes) for another run, a run not
+    /// learning, or one that has learned less than `min_s`.
+    pub fn finish_commissioning(&mut self, run_id: u16, min_s: f32) -> bool {
+        let min_blocks = min_s * self.derived.block_rate_hz;
+        let min_blocks = if min_blocks.is_finite() && min_blocks >= 1.0 {
+            min_blocks.min(4.0e9) as u32
+        } else {
+            1
+        };
+        let (ended, cal) = self.learner.finish(run_id, min_blocks);
+        if let Some(cal) = cal {
+            self.lamps.set_calibration(Some(cal));
+        }
+        if ended {
+            self.refresh_commissioning_state();
+        }
+        ended
+    }
+
     /// Reports what the calibration store holds after storing run `run_id`'s calibration
     /// (read back after the write; `None`: no usable record). The thresholds in force
     /// become exactly `stored` (`None`: the fixed thresholds), so the monitor and its store
