@@ -160,6 +160,14 @@ pub enum LogError {
         /// The file.
         path: String,
     },
+    /// The log has rows, but too few usable ones in the window asked for.
+    #[error("{path}: too few usable rows in the selected time window ({why})")]
+    NoUsableRows {
+        /// The file.
+        path: String,
+        /// What held them out.
+        why: String,
+    },
 }
 
 /// A column of the schema, in the order a [`Row`] holds them.

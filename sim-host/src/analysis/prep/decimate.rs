@@ -54,7 +54,7 @@ pub struct Decimated {
 ///
 /// # Errors
 /// The log reader's and the stage's errors (one line, naming the file, line and column,
-/// or the sample rate needed), or [`LogError::Empty`] when the time window holds fewer
+/// or the sample rate needed), or [`LogError::NoUsableRows`] (with what held them out) when the time window holds fewer
 /// than 16 working samples.
 pub fn decimate_log(
     path: &Path,
@@ -87,11 +87,19 @@ pub fn decimate_file(
     sink.describe(&mut quality);
     let d = sink.best.take().unwrap_or_default();
     if d.t_s.len() < 16 {
-        return Err(LogError::Empty {
-            path: format!(
-                "{} (in the selected time window, too few rows)",
-                path.display()
-            ),
+        let why = if !quality.not_trusted_because.is_empty() {
+            quality.not_trusted_because.join("; ")
+        } else if quality.bad_rows > 0 {
+            format!(
+                "{} of {} rows held out for bad cells",
+                quality.bad_rows, quality.rows_read
+            )
+        } else {
+            format!("{} rows in the log", quality.rows_read)
+        };
+        return Err(LogError::NoUsableRows {
+            path: path.display().to_string(),
+            why,
         });
     }
     progress(1.0);
