@@ -383,13 +383,16 @@ impl HmiState {
             return format!("{}: waiting for the first reading", self.title);
         };
         let lamps: String = s.lamps.iter().map(|l| if *l { '●' } else { '○' }).collect();
-        let text = header_text(s);
-        // The lamp's word once: a state that says FAULT itself carries it.
+        let header = header_text(s);
         let lamp = match (&s.state, s.fault_lamp) {
             (MonitorState::Moved(_), _) => " MOVED",
-            _ if text.starts_with("FAULT") => "",
             (_, true) => " FAULT",
             (_, false) => "",
+        };
+        // The lamp's word once: a state that begins with it loses it.
+        let text = match header.strip_prefix("FAULT ") {
+            Some(rest) if !lamp.is_empty() => rest.to_string(),
+            _ => header,
         };
         format!(
             "{:8.2} s  {:6.0} rpm  {}{}  {}",
