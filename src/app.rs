@@ -532,6 +532,14 @@ impl Supervisor {
         }
     }
 
+    /// Isolates against `isolator`'s machine from now on (the motor record's, read at boot;
+    /// [`Supervisor::new`] starts with [`board_isolator`]'s built-in default). `None`: the
+    /// machine was rejected, nothing is isolated (the blink code says "not named").
+    pub fn set_isolator(&mut self, isolator: Option<Isolator>) {
+        self.isolation = isolator.map(Follower::new);
+        self.run_baseline = None;
+    }
+
     /// Puts the isolation baseline of the record loaded at boot into force (the record the
     /// core accepted), so that after a reset the isolation judges against the machine's own
     /// baseline again. Returns whether one was put into force.

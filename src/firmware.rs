@@ -50,9 +50,11 @@ use drive_monitor::board::{self, pins::Board, CurrentCode, Lamp, Port, VoltageCo
 use drive_monitor::commissioning::RunEnd;
 use drive_monitor::flash_record::{self, LoadError, RecordStore, StoreError, RECORD_LEN};
 use drive_monitor::liveness::{AdcWait, LivenessChange};
+use drive_monitor::motor_source;
 use drive_monitor::panel::PanelLamps;
 use drive_monitor::reset_record::{PreviousRun, ResetCause, ResetRecord, RESET_RECORD_LEN};
 use drive_monitor::sampling::RawFrame;
+use monitor_core::motor_record::STORED_LEN as MOTOR_RECORD_LEN;
 use monitor_core::Isolation;
 
 bind_interrupts!(struct Irqs {
@@ -401,16 +403,38 @@ async fn main(_spawner: Spawner) {
     };
     let mut button = ExtiInput::new(b.button, b.button_exti, Pull::Down, Irqs);
 
-    let mut path = match SamplePath::for_board(SETTINGS.sample_rate_hz) {
+    // The machine: the motor record in flash, else the built-in default (the reason is
+    // logged). A page that cannot be read counts as erased.
+    let mut page = [0xFF_u8; MOTOR_RECORD_LEN];
+    if let Err(e) = thread
+        .flash
+        .0
+        .blocking_read(board::MOTOR_RECORD_FLASH_OFFSET, &mut page)
+    {
+        warn!("motor record page unreadable: {}", e);
+    }
+    let (machine, source) = motor_source::select(&page);
+    info!("{=str}", source.describe());
+    let mut path = match motor_source::sample_path(&machine, SETTINGS.sample_rate_hz) {
         Ok(p) => p,
-        // The settings are constants and a host test (`app::tests`) builds the same path:
-        // this cannot happen, and if it did nothing could be monitored.
-        #[allow(clippy::panic)]
-        Err(_) => panic!("monitor configuration rejected"),
+        Err(_) => {
+            // A record the core accepted at boot but not at this sample rate: the default.
+            warn!("motor record rejected at this sample rate: built-in default motor");
+            match SamplePath::for_board(SETTINGS.sample_rate_hz) {
+                Ok(p) => p,
+                // The settings are constants and a host test (`app::tests`) builds the same
+                // path: this cannot happen, and if it did nothing could be monitored.
+                #[allow(clippy::panic)]
+                Err(_) => panic!("monitor configuration rejected"),
+            }
+        }
     };
     let installed = install_stored_calibration(&mut thread.flash, &mut path);
     let boot = Instant::now();
     let mut supervisor = Supervisor::new(&SETTINGS, previous, 0, path.status());
+    if !source.is_default() {
+        supervisor.set_isolator(motor_source::isolator(&machine).ok());
+    }
     if let Some(rec) = installed {
         if supervisor.restore_isolation(&rec) {
             info!("isolation baseline restored from the record");

@@ -4,11 +4,12 @@
 //! board's front end). Host-testable: the firmware reads the page at
 //! [`board::MOTOR_RECORD_FLASH_OFFSET`] and hands the bytes to [`select`].
 
-use crate::app::DEFAULT_MACHINE;
+use crate::app::{AppError, SamplePath, DEFAULT_MACHINE};
 use crate::board::{self, ChannelScale, FrontEnd};
 use crate::sampling::TICK_HZ;
+use monitor_core::isolation::Isolator;
 use monitor_core::motor_record::{MotorRecord, RecordError};
-use monitor_core::MonitorConfig;
+use monitor_core::{ConfigError, MonitorConfig};
 
 /// Where the machine in force came from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -105,4 +106,31 @@ pub fn front_end(rec: &MotorRecord) -> FrontEnd {
         voltage: [scale(va, v), scale(vb, v), scale(vc, v)],
         current: [scale(ia, i), scale(ib, i), scale(ic, i)],
     }
+}
+
+/// The sample path for `rec` at `sample_rate_hz`: [`monitor_config`] and [`front_end`].
+/// For [`default_record`] this is [`SamplePath::for_board`].
+///
+/// # Errors
+/// As [`SamplePath::new`] (a record that [`select`] accepted passed the core's checks of
+/// its machine; the sample rate is the firmware's setting).
+pub fn sample_path(rec: &MotorRecord, sample_rate_hz: u32) -> Result<SamplePath, AppError> {
+    SamplePath::new(
+        monitor_config(rec, sample_rate_hz),
+        front_end(rec),
+        sample_rate_hz,
+    )
+}
+
+/// The fault isolator for `rec`'s machine on its supply (for [`default_record`],
+/// [`crate::app::board_isolator`]).
+///
+/// # Errors
+/// The core's [`ConfigError`] if it rejects the machine or the supply.
+pub fn isolator(rec: &MotorRecord) -> Result<Isolator, ConfigError> {
+    Isolator::new(
+        rec.motor.model(),
+        rec.supply.v_phase_peak() as f32,
+        rec.supply.f_hz as f32,
+    )
 }

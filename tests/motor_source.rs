@@ -72,3 +72,28 @@ fn the_default_record_is_the_built_in_configuration() {
     );
     assert_eq!(motor_source::front_end(&rec), FrontEnd::DEFAULT);
 }
+
+#[test]
+fn the_boot_builds_the_sample_path_and_isolator_of_the_record() {
+    use drive_monitor::app::{board_isolator, SamplePath};
+    // The default record gives exactly the built-in board set-up.
+    let default = motor_source::default_record();
+    let path = motor_source::sample_path(&default, 10_000).expect("default path");
+    let board = SamplePath::for_board(10_000).expect("board path");
+    assert_eq!(path.monitor().config(), board.monitor().config());
+    let iso = motor_source::isolator(&default).expect("default isolator");
+    let built_in = board_isolator().expect("built-in isolator");
+    assert_eq!(iso.torque_base_nm(), built_in.torque_base_nm());
+    // Another motor's record gives its own configuration and its own isolator.
+    let rec = other_motor();
+    let path = motor_source::sample_path(&rec, 10_000).expect("record path");
+    let cfg = path.monitor().config();
+    assert_eq!(cfg.encoder.counts_per_rev, 10_000);
+    assert_eq!(cfg.limits.i_max, 25.0);
+    assert_ne!(cfg, board.monitor().config());
+    // The 3 hp machine's torque base is not the 2.2 kW one's: the isolator judges the
+    // record's machine.
+    let iso = motor_source::isolator(&rec).expect("record isolator");
+    let (a, b) = (iso.torque_base_nm(), built_in.torque_base_nm());
+    assert!((a / b - 1.0).abs() > 0.05, "{a} vs {b}");
+}

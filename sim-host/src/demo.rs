@@ -26,6 +26,10 @@ pub enum MonitorState {
     Healthy,
     /// Lamps lit: the candidates with their probabilities.
     Fault(Vec<(Fault, f32)>),
+    /// The load or the voltage has left the commissioned range and no fault is named (the
+    /// amber state): lamps may light, the FAULT lamp stays off; the note says where the
+    /// operating point went ([`crate::replay::Replay::operating_point_moved`]).
+    Moved(String),
 }
 
 impl MonitorState {

@@ -91,9 +91,30 @@ fn a_user_commissions_injects_a_fault_and_quits() {
     assert!(pane.lines().count() <= 24 && pane.lines().all(|l| l.chars().count() <= 80));
     t.keys("c");
     t.wait_for(&["learned thresholds in force", "(learned)"]);
-    t.keys("6");
-    let pane = t.wait_for(&["b/bl +50 % | sig. b/bl p 1.00", "bl +50%"]);
-    assert!(pane.contains("r2 ●") && pane.contains("FAULT ●"), "{pane}");
+    // A +30 % load step with no fault: residual lamps, the amber MOVED lamp, no FAULT.
+    t.keys("+");
+    t.keys("+");
+    t.keys("+");
+    let pane = t.wait_for(&["MOVED ●", "load (Iqs)", "load x1.30", "r2 ●"]);
+    assert!(!pane.contains("FAULT"), "{pane}");
+    // Back to the commissioned load, then Rs +50 %: the red FAULT lamp and `rs +` first.
+    t.keys("-");
+    t.keys("-");
+    t.keys("-");
+    t.wait_for(&["load x1.00", "FAULT ○"]);
+    t.keys("1");
+    let pane = t.wait_for(&["FAULT ●", "named: rs +", "rs +50%"]);
+    let header = pane
+        .lines()
+        .find(|l| l.contains("FAULT ●"))
+        .unwrap_or_default();
+    assert!(
+        header
+            .split(" s  ")
+            .nth(1)
+            .is_some_and(|h| h.starts_with("rs +")),
+        "{pane}"
+    );
     t.keys("q");
     let pane = t.wait_for(&["EXITED 0"]);
     // The alternate screen is left: the HMI is gone from the terminal.

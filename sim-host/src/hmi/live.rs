@@ -9,10 +9,7 @@
 //! with the readings ([`Snapshot`], every [`SNAPSHOT_EVERY_S`] of simulated time): the
 //! simulation is deterministic whatever the screen's pace, and tests drive it directly.
 
-use super::{
-    quit_key, Controls, HmiState, IsolationView, Key, LiveControls, Snapshot, Source,
-    SNAPSHOT_EVERY_S,
-};
+use super::{quit_key, Controls, HmiState, Key, LiveControls, Snapshot, Source, SNAPSHOT_EVERY_S};
 use crate::fault_signatures::{scenario, Protocol};
 use crate::params::ParamFile;
 use crate::replay::{Replay, ReplayOptions};
@@ -316,10 +313,7 @@ impl Worker {
             self.note_commissioning(&out, t);
             if t + 0.5 * self.dt_s >= self.next_snapshot_s {
                 self.next_snapshot_s += SNAPSHOT_EVERY_S;
-                let bands = self.replay.threshold_bands();
-                let learned = self.replay.calibration().is_some();
-                let mut snap = Snapshot::from_output(t, &out, bands, learned, &params);
-                snap.isolation = Some(IsolationView::of_replay(&self.replay));
+                let snap = Snapshot::from_replay(t, &out, &self.replay, &params);
                 self.snapshots.push(snap);
             }
             self.rows += 1;

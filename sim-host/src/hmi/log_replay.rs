@@ -173,10 +173,7 @@ impl ReplayObserver for Keeper {
             return;
         }
         self.next_s = (t / SNAPSHOT_EVERY_S).floor() * SNAPSHOT_EVERY_S + SNAPSHOT_EVERY_S;
-        let learned = replay.calibration().is_some();
-        let mut snap =
-            Snapshot::from_output(t, out, replay.threshold_bands(), learned, &self.params);
-        snap.isolation = Some(super::IsolationView::of_replay(replay));
+        let snap = Snapshot::from_replay(t, out, replay, &self.params);
         self.pending.push(snap);
         if self.pending.len() >= BATCH {
             self.flush();

@@ -202,6 +202,29 @@ impl Snapshot {
     }
 }
 
+impl Snapshot {
+    /// The reading of a replay's output `out` at `t_s` ([`Snapshot::from_output`]) with
+    /// the replay's isolation, and the amber state: where the load or the voltage has left
+    /// the commissioned range ([`Replay::operating_point_moved`]) and neither the isolation
+    /// nor a sensor check names a fault, the state is [`MonitorState::Moved`] and the FAULT
+    /// lamp stays off (the residual lamps show what they show).
+    pub fn from_replay(t_s: f64, out: &MonitorOutput, replay: &Replay, params: &ParamFile) -> Self {
+        let learned = replay.calibration().is_some();
+        let mut s = Snapshot::from_output(t_s, out, replay.threshold_bands(), learned, params);
+        let iso = IsolationView::of_replay(replay);
+        let fault_named = matches!(iso.named, Some(IsolationName::Fault(_)));
+        s.isolation = Some(iso);
+        let evaluated = matches!(s.state, MonitorState::Healthy | MonitorState::Fault(_));
+        if let Some(note) = replay.operating_point_moved(out) {
+            if evaluated && !fault_named && s.sensor_faults.is_empty() {
+                s.state = MonitorState::Moved(note);
+                s.fault_lamp = false;
+            }
+        }
+        s
+    }
+}
+
 /// A playback speed of a log replay.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Speed {
@@ -360,13 +383,20 @@ impl HmiState {
             return format!("{}: waiting for the first reading", self.title);
         };
         let lamps: String = s.lamps.iter().map(|l| if *l { '●' } else { '○' }).collect();
+        let header = header_text(s);
+        let lamp = match (&s.state, s.fault_lamp) {
+            (MonitorState::Moved(_), _) => " MOVED",
+            (_, true) => " FAULT",
+            (_, false) => "",
+        };
+        // The lamp's word once: a state that begins with it loses it.
+        let text = match header.strip_prefix("FAULT ") {
+            Some(rest) if !lamp.is_empty() => rest.to_string(),
+            _ => header,
+        };
         format!(
             "{:8.2} s  {:6.0} rpm  {}{}  {}",
-            s.t_s,
-            s.speed_rpm,
-            lamps,
-            if s.fault_lamp { " FAULT" } else { "" },
-            state_text(&s.state, &s.candidates)
+            s.t_s, s.speed_rpm, lamps, lamp, text
         )
     }
 }
@@ -382,6 +412,7 @@ pub fn header_text(s: &Snapshot) -> String {
             iso.text(),
             crate::fault_signatures::signature_text(s.candidates.iter().map(|(f, p)| (*f, *p)))
         ),
+        (Some(iso), MonitorState::Moved(note)) => format!("moved: {} | {note}", iso.text()),
         (Some(iso), _) => format!(
             "{} | named: {}",
             state_text(&s.state, &s.candidates),
@@ -403,6 +434,7 @@ pub fn state_text(state: &MonitorState, candidates: &[(Fault, f32)]) -> String {
                 crate::fault_signatures::signature_text(candidates.iter().map(|(f, p)| (*f, *p)));
             format!("FAULT ({sig})")
         }
+        MonitorState::Moved(note) => format!("operating point moved: {note}"),
     }
 }
 

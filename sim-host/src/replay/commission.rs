@@ -253,6 +253,33 @@ impl CommissionTracker {
         (!said.is_empty()).then(|| said.join("; "))
     }
 
+    /// Where the learned thresholds are in force and the load current or the voltage has
+    /// left the span seen while learning (beyond the reporting margin): the note, as the
+    /// timeline's `range_note` words it, whether or not a lamp is lit. `None` inside the
+    /// range or without a learned window.
+    pub(super) fn moved_note(&self, out: &MonitorOutput) -> Option<String> {
+        if out.commissioning != CommissioningState::Commissioned {
+            return None;
+        }
+        let mut said = Vec::new();
+        for (span, x, what) in [
+            (self.iqs, out.operating.iqs, "load (Iqs)"),
+            (self.vqs, out.operating.vqs, "voltage (Vqs)"),
+        ] {
+            if let Some(f) = span.and_then(|s| outside(s, x)) {
+                let s = span.unwrap_or_default();
+                said.push(format!(
+                    "{what} {x:.2} is {:.0} % {} the commissioned {:.2}..{:.2}",
+                    100.0 * f.abs(),
+                    if f > 0.0 { "above" } else { "below" },
+                    s[0],
+                    s[1]
+                ));
+            }
+        }
+        (!said.is_empty()).then(|| said.join("; "))
+    }
+
     /// True when the learned thresholds are in force and the load current or the voltage
     /// is outside the span seen while learning (beyond the reporting margin).
     pub(super) fn outside_learned_range(&self, out: &MonitorOutput) -> bool {

@@ -486,6 +486,15 @@ impl Replay {
         self.isolation.names()
     }
 
+    /// Where the load or the voltage of `out` has left the range learned in
+    /// commissioning: the note ("load (Iqs) 9.52 is 47 % above the commissioned
+    /// 6.47..6.48"); `None` inside it or without a learned window. The HMI shows this as
+    /// the amber "operating point moved" state: to the paper's model a load change is a Bl
+    /// change, so lamps lit there are not a fault unless the isolation names one.
+    pub fn operating_point_moved(&self, out: &MonitorOutput) -> Option<String> {
+        self.commission.moved_note(out)
+    }
+
     /// The core monitor (`None` for a current-only log).
     pub fn monitor(&self) -> Option<&Monitor> {
         self.monitor.as_ref()

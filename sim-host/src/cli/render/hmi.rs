@@ -16,6 +16,7 @@ use ratatui::symbols::Marker;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Axis, Block, Borders, Chart, Dataset, GraphType, Paragraph};
 use ratatui::Frame;
+use sim_host::demo::MonitorState;
 use sim_host::hmi::{header_text, Controls, HmiState, KeyScope, Snapshot, HISTORY_S, KEYS};
 
 /// Colours of r1..r4 (lamps' labels, bars and chart).
@@ -43,7 +44,7 @@ pub fn render(frame: &mut Frame, state: &HmiState) {
         Span::raw(state.title.as_str()),
     ]);
     frame.render_widget(Paragraph::new(title), rows[0]);
-    frame.render_widget(Paragraph::new(lamps_line(state)), rows[1]);
+    frame.render_widget(Paragraph::new(lamps_line(state, rows[1].width)), rows[1]);
     render_residuals(frame, rows[2], state.latest.as_ref());
     let mid =
         Layout::horizontal([Constraint::Percentage(50), Constraint::Percentage(50)]).split(rows[3]);
@@ -63,8 +64,9 @@ fn lamp(on: bool, colour: Color) -> Span<'static> {
     }
 }
 
-/// Lamps r1..r4, the fault lamp and the monitor's state.
-fn lamps_line(state: &HmiState) -> Line<'static> {
+/// Lamps r1..r4, the fault lamp (red) or the amber "operating point moved" lamp, and the
+/// monitor's state, fitted into `width` columns at a word boundary.
+fn lamps_line(state: &HmiState, width: u16) -> Line<'static> {
     let Some(s) = &state.latest else {
         return Line::from(" waiting for the first reading ...");
     };
@@ -73,17 +75,75 @@ fn lamps_line(state: &HmiState) -> Line<'static> {
         spans.push(Span::raw(format!(" r{} ", k + 1)));
         spans.push(lamp(*on, Color::Red));
     }
-    spans.push(Span::raw("   FAULT "));
-    spans.push(lamp(s.fault_lamp, Color::Red));
-    let text = header_text(s);
+    let moved = matches!(s.state, MonitorState::Moved(_));
+    if moved {
+        spans.push(Span::raw("   MOVED "));
+        spans.push(lamp(true, Color::Yellow));
+    } else {
+        spans.push(Span::raw("   FAULT "));
+        spans.push(lamp(s.fault_lamp, Color::Red));
+    }
     let style = if s.fault_lamp {
         Style::new().fg(Color::Red).add_modifier(Modifier::BOLD)
+    } else if moved {
+        Style::new().fg(Color::Yellow).add_modifier(Modifier::BOLD)
     } else {
         Style::new()
     };
     spans.push(Span::raw(format!("  {:7.2} s  ", s.t_s)));
+    let used: usize = spans.iter().map(|s| s.content.chars().count()).sum();
+    let text = fit_words(&header_text(s), usize::from(width).saturating_sub(used));
     spans.push(Span::styled(text, style));
     Line::from(spans)
+}
+
+/// A threshold band `centre±half-width` with the digits it has: the half-width to two
+/// significant digits (at least three decimals), the centre to the same decimals, and a
+/// centre that rounds to zero written `0` (not `-0.000`).
+pub fn band_digits(centre: f32, half: f32) -> String {
+    let decimals = if half > 0.0 && half.is_finite() {
+        (1 - half.log10().floor() as i32).clamp(3, 6) as usize
+    } else {
+        3
+    };
+    let unit = 10f32.powi(-(decimals as i32));
+    let c = if centre.abs() < 0.5 * unit {
+        "0".to_string()
+    } else {
+        format!("{centre:+.decimals$}")
+    };
+    format!("{c}±{half:.decimals$}")
+}
+
+/// `text` in at most `width` columns: whole words, and `…` where words were left out
+/// (never cut mid-word; a first word longer than the width is the one thing shortened).
+pub fn fit_words(text: &str, width: usize) -> String {
+    if text.chars().count() <= width {
+        return text.to_string();
+    }
+    let mut out = String::new();
+    for word in text.split(' ') {
+        let next = if out.is_empty() {
+            word.chars().count()
+        } else {
+            out.chars().count() + 1 + word.chars().count()
+        };
+        // Room for the word and the ellipsis after it.
+        if next + 1 > width {
+            break;
+        }
+        if !out.is_empty() {
+            out.push(' ');
+        }
+        out.push_str(word);
+    }
+    if out.is_empty() {
+        out = text.chars().take(width.saturating_sub(1)).collect();
+    }
+    let out = out
+        .trim_end_matches([' ', '|', '/', ',', ':', ';'])
+        .to_string();
+    format!("{out}…")
 }
 
 /// A bar of `width` cells from `-scale` to `+scale`: the band as `═`, outside it `·`, the
@@ -133,9 +193,7 @@ fn render_residuals(frame: &mut Frame, area: Rect, s: Option<&Snapshot>) {
             } else {
                 Style::new().fg(COLOURS[k])
             };
-            let band_text = band.map_or("band n/a".to_string(), |(c, h)| {
-                format!("{:+.3}±{:.3}", c, h)
-            });
+            let band_text = band.map_or("band n/a".to_string(), |(c, h)| band_digits(c, h));
             Line::from(vec![
                 Span::styled(format!(" r{} {:+8.4} ", k + 1, r), style),
                 Span::styled(band_bar(r, band, scale, width), style),
@@ -265,12 +323,18 @@ fn render_chart(frame: &mut Frame, area: Rect, state: &HmiState) {
                 .data(data)
         })
         .collect();
+    // The legend is in the title, in the lines' colours: it fits at every size (ratatui's
+    // own legend box needs more rows than an 80x24 screen gives the chart).
+    let mut title = vec![Span::raw(format!(" residuals, last {HISTORY_S:.0} s: "))];
+    for (k, colour) in COLOURS.iter().enumerate() {
+        title.push(Span::styled(
+            format!("━ r{} ", k + 1),
+            Style::new().fg(*colour).add_modifier(Modifier::BOLD),
+        ));
+    }
     let chart = Chart::new(datasets)
-        .block(
-            Block::new()
-                .borders(Borders::TOP)
-                .title(format!(" residuals, last {HISTORY_S:.0} s ")),
-        )
+        .block(Block::new().borders(Borders::TOP).title(Line::from(title)))
+        .legend_position(None)
         .x_axis(
             Axis::default()
                 .bounds([-HISTORY_S, 0.0])
@@ -280,8 +344,7 @@ fn render_chart(frame: &mut Frame, area: Rect, state: &HmiState) {
             Axis::default()
                 .bounds([-peak, peak])
                 .labels([format!("{:+.2}", -peak), format!("{:+.2}", peak)]),
-        )
-        .hidden_legend_constraints((Constraint::Ratio(1, 1), Constraint::Ratio(1, 1)));
+        );
     frame.render_widget(chart, area);
 }
 
@@ -307,17 +370,30 @@ fn controls_line(c: &Controls) -> Line<'static> {
                 if l.paused { " | PAUSED" } else { "" }
             )
         }
-        Controls::Replay(p) => format!(
-            " replay {} {} | at {:.2} s of {:.2} s analysed{}{}",
-            p.speed.name(),
-            if p.paused { "PAUSED" } else { "playing" },
-            p.position_s,
-            p.analysed_s,
-            if p.done { " (whole log)" } else { " ..." },
-            p.verdict
-                .as_ref()
-                .map_or(String::new(), |v| format!(" | verdict: {v}"))
-        ),
+        Controls::Replay(p) => {
+            // The verdict is the whole log's: it is shown once the playback has reached the
+            // end, not beside the lamps of an earlier moment.
+            let at_end = p.done && p.position_s >= p.analysed_s - 1e-9;
+            format!(
+                " replay {} {} | at {:.2} s of {:.2} s analysed{}{}",
+                p.speed.name(),
+                if at_end {
+                    "ENDED"
+                } else if p.paused {
+                    "PAUSED"
+                } else {
+                    "playing"
+                },
+                p.position_s,
+                p.analysed_s,
+                if p.done { " (whole log)" } else { " ..." },
+                match (&p.verdict, at_end) {
+                    (Some(v), true) => format!(" | verdict: {v}"),
+                    (Some(_), false) => " | verdict at the end".to_string(),
+                    (None, _) => String::new(),
+                }
+            )
+        }
         Controls::Stdin(s) => format!(
             " firmware: {} status lines of {} read | mode {}{}",
             s.status_lines,
@@ -433,18 +509,19 @@ mod tests {
         assert!(find(&rows, "supply frequency").contains("Hz"));
         assert!(find(&rows, "faults on:").contains("none"));
 
-        // 6: Bl +50 %; after 3 s r2..r4 and the fault lamp are lit, b and bl named.
+        // 6: Bl +50 %; after 3 s r2..r4 are lit and b/bl is named. To the paper's model a
+        // Bl change is a load change, and the load current has left the commissioned
+        // range: the amber "operating point moved" lamp, not the red FAULT lamp (issue 28).
         live.key(Key::Char('6'), &mut state);
         run(&mut live, &mut state, 3.0);
         let rows = screen(&state, 80, 24);
-        let lamps = find(&rows, "FAULT");
+        let lamps = find(&rows, "MOVED");
         assert!(
-            lamps.contains("r1 ○ r2 ● r3 ● r4 ●") && lamps.contains("FAULT ●"),
+            lamps.contains("r1 ○ r2 ● r3 ● r4 ●") && lamps.contains("MOVED ●"),
             "{lamps}"
         );
-        // Issue 28: the named fault and its size first, the signature's probabilities
-        // second, B and Bl as one friction class.
-        assert!(lamps.contains("b/bl +50 % | sig. b/bl p 1.00"), "{lamps}");
+        // Issue 28: the named class and its size first; B and Bl as one friction class.
+        assert!(lamps.contains("moved: b/bl +50 % | load (Iqs)"), "{lamps}");
         assert!(find(&rows, " bl ").contains("p 0.50"));
         assert!(find(&rows, "faults on:").contains("bl +50%"));
         assert!(find(&rows, " > ").contains("bl +50 % switched on"));
@@ -510,6 +587,60 @@ mod tests {
             assert!(after_time.starts_with("rs +"), "{w}x{h}: {header}");
             assert_eq!(header.matches('%').count(), 1, "{w}x{h}: {header}");
         }
+    }
+
+    /// Issue 28: a +30 % load step with no fault lights residual lamps but not the FAULT
+    /// lamp: the amber state says the operating point moved, in every size.
+    #[test]
+    fn a_load_step_without_a_fault_is_amber_not_a_red_fault() {
+        let (mut live, mut state) = commissioned();
+        for _ in 0..3 {
+            live.key(Key::Char('+'), &mut state);
+        }
+        run(&mut live, &mut state, 3.0);
+        for (w, h) in [(100, 30), (80, 24)] {
+            let rows = screen(&state, w, h);
+            let lamps = rows
+                .iter()
+                .find(|r| r.contains("MOVED") || r.contains("FAULT"))
+                .unwrap_or_else(|| panic!("no lamp line:\n{}", rows.join("\n")));
+            assert!(
+                lamps.contains("MOVED ●") && !lamps.contains("FAULT"),
+                "{w}x{h}: {lamps}"
+            );
+            assert!(lamps.contains("load (Iqs)"), "{w}x{h}: {lamps}");
+            assert!(rows.iter().all(|r| r.chars().count() <= usize::from(w)));
+        }
+        // The plain status line says MOVED once and no FAULT.
+        let line = state.status_line();
+        assert!(
+            line.contains(" MOVED ") && !line.contains("FAULT"),
+            "{line}"
+        );
+    }
+
+    #[test]
+    fn words_are_never_cut_and_bands_keep_their_digits() {
+        let t = "moved: b/bl +50 % | load (Iqs) 9.52 is 47 % above the commissioned 6.47..6.48";
+        for w in [20, 31, 45, 60, 200] {
+            let f = fit_words(t, w);
+            assert!(f.chars().count() <= w, "{w}: {f}");
+            let kept: Vec<&str> = f.trim_end_matches('…').split(' ').collect();
+            let words: Vec<&str> = t.split(' ').collect();
+            // The words kept are the text's first words, whole (the last may have lost a
+            // trailing separator).
+            let n = kept.len();
+            assert_eq!(kept[..n - 1], words[..n - 1], "{w}: {f}");
+            assert_eq!(
+                kept[n - 1],
+                words[n - 1].trim_end_matches([':', '|', '/', ',', ';']),
+                "{w}: {f}"
+            );
+        }
+        assert_eq!(fit_words(t, 200), t);
+        assert_eq!(band_digits(-0.00004, 0.0021), "0±0.0021");
+        assert_eq!(band_digits(0.0123, 0.034), "+0.012±0.034");
+        assert_eq!(band_digits(-0.5, 0.25), "-0.500±0.250");
     }
 
     #[test]

@@ -59,6 +59,7 @@ pub fn demo(run: &DemoRun) -> anyhow::Result<()> {
                     sim_host::fault_signatures::signature_text(c.iter().map(|(f, p)| (*f, *p)));
                 format!("FAULT ({sig})")
             }
+            MonitorState::Moved(note) => format!("operating point moved: {note}"),
         };
         let mark = if p.fault_injected {
             "  <- fault injected"
