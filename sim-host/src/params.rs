@@ -15,6 +15,14 @@
 //! v_ll_rms = 220.0 # line-to-line RMS voltage [V]
 //! f_hz = 60.0      # supply frequency [Hz]
 //! ```
+//! An optional `[columns]` table maps the log's channels and units to the schema's
+//! columns ([`ColumnMapping`], `docs/design.md`):
+//! ```toml
+//! [columns]
+//! t_s = { name = "Time", unit = "ms" }
+//! ia_A = { name = "Ia", unit = "mA" }
+//! wm_rad_s = { name = "Speed", unit = "rpm" }
+//! ```
 //! Unknown keys are an error (a typo must not pass silently) and a missing key is named.
 //!
 //! The sections are the core's [`MotorParameters`] and [`SupplyParameters`] (one type for
@@ -23,6 +31,8 @@
 //! [`MotorParameters::model`] (the core and the analysis), the simulator's machine
 //! (`crate::sim`) and the analysis's constants (`crate::analysis::simplified_model::MachineConstants`).
 
+use crate::log::mapping::ColumnEntry;
+use crate::log::ColumnMapping;
 use monitor_core::{MotorParameters, ReferenceMachine, SupplyParameters};
 use nalgebra::Complex;
 use serde::{Deserialize, Serialize};
@@ -55,6 +65,15 @@ pub enum ParamError {
         path: String,
         /// Which key, its value and the plausible range.
         source: Implausible,
+    },
+    /// The `[columns]` table is wrong (a key that is no schema column, a unit the column
+    /// cannot have, two columns naming one channel).
+    #[error("bad parameter file {path}: [columns] {message}")]
+    Columns {
+        /// The file.
+        path: String,
+        /// What is wrong, naming the key.
+        message: String,
     },
     /// A value is outside its physical range.
     #[error("bad parameter file {path}: {source}")]
@@ -237,19 +256,48 @@ pub struct ParamFile {
     pub supply: SupplyParameters,
 }
 
+/// The file as written: [`ParamFile`]'s sections and the optional `[columns]` table.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileSections {
+    motor: MotorParameters,
+    supply: SupplyParameters,
+    #[serde(default)]
+    columns: std::collections::BTreeMap<String, ColumnEntry>,
+}
+
 impl ParamFile {
-    /// Parses TOML text; `origin` names the source in messages.
+    /// Parses TOML text; `origin` names the source in messages. A `[columns]` table is
+    /// checked and left out ([`ParamFile::from_toml_str_with_columns`] returns it).
+    ///
+    /// # Errors
+    /// As [`ParamFile::from_toml_str_with_columns`].
+    pub fn from_toml_str(text: &str, origin: &str) -> Result<Self, ParamError> {
+        Self::from_toml_str_with_columns(text, origin).map(|(p, _)| p)
+    }
+
+    /// Parses TOML text and its `[columns]` table, the mapping of the schema's columns to a
+    /// log's channels and units ([`ColumnMapping`], `docs/design.md`); `origin` names the
+    /// source in messages.
     ///
     /// # Errors
     /// [`ParamError::Toml`] for malformed TOML (with its line and column) or an unknown or
     /// missing key, [`ParamError::Implausible`] for a value outside the range of real
     /// machines ([`ParamFile::check_plausible`]), [`ParamError::Range`] for a value the
-    /// equations cannot take ([`ParamFile::check`]); each names the key.
-    pub fn from_toml_str(text: &str, origin: &str) -> Result<Self, ParamError> {
-        let p: ParamFile = toml::from_str(text).map_err(|e| ParamError::Toml {
+    /// equations cannot take ([`ParamFile::check`]), [`ParamError::Columns`] for a wrong
+    /// `[columns]` entry; each names the key.
+    pub fn from_toml_str_with_columns(
+        text: &str,
+        origin: &str,
+    ) -> Result<(Self, ColumnMapping), ParamError> {
+        let f: FileSections = toml::from_str(text).map_err(|e| ParamError::Toml {
             path: origin.to_string(),
             message: toml_error_message(text, &e),
         })?;
+        let p = ParamFile {
+            motor: f.motor,
+            supply: f.supply,
+        };
         p.check_plausible()
             .map_err(|source| ParamError::Implausible {
                 path: origin.to_string(),
@@ -259,7 +307,13 @@ impl ParamFile {
             path: origin.to_string(),
             source,
         })?;
-        Ok(p)
+        let columns = ColumnMapping::from_table(&f.columns, p.motor.poles / 2).map_err(|message| {
+            ParamError::Columns {
+                path: origin.to_string(),
+                message,
+            }
+        })?;
+        Ok((p, columns))
     }
 
     /// Checks that every value lies in the range of real induction machines
@@ -395,11 +449,21 @@ impl ParamFile {
     /// # Errors
     /// [`ParamError::Io`] when unreadable, else as [`ParamFile::from_toml_str`].
     pub fn load(path: &Path) -> Result<Self, ParamError> {
+        Self::load_with_columns(path).map(|(p, _)| p)
+    }
+
+    /// Reads and checks a parameter file and its `[columns]` table
+    /// ([`ParamFile::from_toml_str_with_columns`]).
+    ///
+    /// # Errors
+    /// [`ParamError::Io`] when unreadable, else as
+    /// [`ParamFile::from_toml_str_with_columns`].
+    pub fn load_with_columns(path: &Path) -> Result<(Self, ColumnMapping), ParamError> {
         let text = std::fs::read_to_string(path).map_err(|source| ParamError::Io {
             path: path.display().to_string(),
             source,
         })?;
-        Self::from_toml_str(&text, &path.display().to_string())
+        Self::from_toml_str_with_columns(&text, &path.display().to_string())
     }
 
     /// Checks that the equations can take the values (finite, positive, Ls >= Lm, ...): the

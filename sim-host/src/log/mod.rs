@@ -27,12 +27,14 @@
 pub mod clipping;
 mod exact;
 mod fast;
+pub mod mapping;
 pub mod parquet;
 pub mod quality;
 mod reader;
 pub mod tdms;
 mod writer;
 
+pub use mapping::{ChannelUnit, ColumnMapping};
 pub use reader::{LogFile, OpenOptions, RowSink};
 pub use writer::{write_atomic, LogWriter};
 
@@ -96,14 +98,53 @@ pub enum LogError {
         /// The I/O error.
         source: std::io::Error,
     },
-    /// A required column is missing.
-    #[error("{path}: missing column '{column}' ({why})")]
+    /// A required column is missing: named, with the channels the log has and the
+    /// closest of them ([`mapping`]).
+    #[error("{path}: missing column '{column}'{mapped} ({why}); the log has {found}{hint}")]
     MissingColumn {
         /// The file.
         path: String,
-        /// The column's name.
+        /// The column's name in the log (the schema's, or the one `[columns]` gives).
         column: String,
+        /// " (for ia_A in [columns])" when the name comes from the mapping, else empty.
+        mapped: String,
         /// Why it is needed.
+        why: String,
+        /// The channels the log has, as a list.
+        found: String,
+        /// The closest channel and where to map it.
+        hint: String,
+    },
+    /// A column name appears twice in the log.
+    #[error("{path}: column '{column}' appears twice, at columns {first} and {second}: which one is meant cannot be told")]
+    DuplicateColumn {
+        /// The file.
+        path: String,
+        /// The name.
+        column: String,
+        /// 1-based position of its first occurrence.
+        first: usize,
+        /// 1-based position of its second occurrence.
+        second: usize,
+    },
+    /// A channel's unit disagrees with the mapping, or is not one the reader knows.
+    #[error("{path}: channel '{channel}' {why}")]
+    Unit {
+        /// The file.
+        path: String,
+        /// The channel.
+        channel: String,
+        /// What is wrong, naming both units.
+        why: String,
+    },
+    /// A channel holds no usable value at all.
+    #[error("{path}: channel {channel} {why}")]
+    NoValue {
+        /// The file.
+        path: String,
+        /// The channel (schema name, with the log's name when mapped).
+        channel: String,
+        /// "holds no finite value", or what its values are instead.
         why: String,
     },
     /// A cell is not a number.
@@ -160,6 +201,14 @@ pub enum LogError {
         /// The file.
         path: String,
     },
+}
+
+/// True for the text of a missing value in a CSV cell: empty, `NA` or `null` (any case).
+/// Such a cell is read as NaN, like the cells `NaN` and `inf`: the data-quality stage
+/// holds them all out and counts them alike (`docs/data-quality.md`).
+pub fn is_missing(cell: &str) -> bool {
+    let c = cell.trim();
+    c.is_empty() || c.eq_ignore_ascii_case("na") || c.eq_ignore_ascii_case("null")
 }
 
 /// A column of the schema, in the order a [`Row`] holds them.

@@ -34,9 +34,11 @@
 //! clock a little off the estimated period is followed. A row within [`CLOCK_EXACT`] of a
 //! period of the clock, and every row off the grid, keeps its own time.
 //!
-//! **Cells.** A cell that is not finite or lies beyond [`CellLimits`] (far beyond what the
-//! machine could draw or the supply could give) is bad ([`BadCells`]); consecutive rows
-//! with bad cells form a glitch burst. The stage counts them and hands the rows on,
+//! **Cells.** A cell that is not finite (a missing value, `NaN`, `inf`: one rule for all,
+//! see [`super::is_missing`]) or lies beyond [`CellLimits`] (far beyond what the machine
+//! could draw or the supply could give) is bad ([`BadCells`]); consecutive rows with bad
+//! cells form a glitch burst. A channel without one usable cell is an error naming it
+//! ([`LogError::NoValue`]). Blank lines of a CSV are skipped and counted. The stage counts them and hands the rows on,
 //! flagged: the monitor holds such samples out as the firmware does with impossible ADC
 //! readings, the analysis drops them and bridges the hole like dropped samples.
 //!
@@ -151,10 +153,16 @@ pub struct QualityStage<'a, S: CleanSink> {
     clips: super::clipping::ClipTracker,
     jitter: (f64, u64),
     dropping: bool,
+    /// Columns (bits of [`Column`]) with no usable cell so far, and with no finite one.
+    never_good: u16,
+    never_finite: u16,
     q: DataQuality,
     error: Option<LogError>,
     stopped: bool,
 }
+
+/// Every column's bit (as [`BadCells`] numbers them).
+const ALL_COLUMNS: u16 = (1 << Column::ALL.len()) - 1;
 
 impl<'a, S: CleanSink> QualityStage<'a, S> {
     /// A stage for the log shown as `shown` in messages, judging cells against `limits`.
@@ -176,17 +184,88 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             clips: super::clipping::ClipTracker::default(),
             jitter: (0.0, 0),
             dropping: false,
+            never_good: ALL_COLUMNS,
+            never_finite: ALL_COLUMNS,
             q: DataQuality::default(),
             error: None,
             stopped: false,
         }
     }
 
+    /// Notes which cells of `r` are finite and which usable, while some column has had
+    /// none (after the first rows, one comparison per row).
+    fn note_values(&mut self, r: &Row, bad: BadCells) {
+        if self.never_good == 0 {
+            return;
+        }
+        let cells = [
+            (Column::Va, r.v_abc.map(|v| v[0])),
+            (Column::Vb, r.v_abc.map(|v| v[1])),
+            (Column::Vc, r.v_abc.map(|v| v[2])),
+            (Column::Ia, Some(r.i_abc[0])),
+            (Column::Ib, Some(r.i_abc[1])),
+            (Column::Ic, Some(r.i_abc[2])),
+            (Column::Speed, r.wm_rad_s),
+        ];
+        // Columns the log lacks and the ones the stage does not judge have nothing to find.
+        self.never_good &= !(1 << Column::Time as u16 | 1 << Column::Encoder as u16);
+        for (c, x) in cells {
+            let bit = 1u16 << c as u16;
+            match x {
+                None => self.never_good &= !bit,
+                Some(x) => {
+                    if x.is_finite() {
+                        self.never_finite &= !bit;
+                    }
+                    if !bad.has(c) {
+                        self.never_good &= !bit;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The error for a channel without one usable cell (all NaN, or all beyond the
+    /// limits: a unit the mapping does not give), once rows were passed.
+    fn channel_without_values(&self) -> Option<LogError> {
+        if self.q.rows_passed == 0 {
+            return None;
+        }
+        let c = Column::ALL
+            .into_iter()
+            .find(|c| self.never_good & (1 << *c as u16) != 0)?;
+        let why = if self.never_finite & (1 << c as u16) != 0 {
+            "holds no finite value (every cell is empty, NA, null, NaN or inf)".to_string()
+        } else {
+            let (limit, unit) = match c {
+                Column::Va | Column::Vb | Column::Vc => (self.limits.v_max, "V"),
+                Column::Ia | Column::Ib | Column::Ic => (self.limits.i_max, "A"),
+                _ => (self.limits.wm_max, "rad/s"),
+            };
+            format!(
+                "holds no value within +/-{limit:.0} {unit}, twice this motor's sensor range: if it is recorded in another unit, give it in the parameter file's [columns] table, e.g. {} = {{ name = \"...\", unit = \"{}\" }} (docs/design.md)",
+                c.name(),
+                match c {
+                    Column::Va | Column::Vb | Column::Vc => "mV",
+                    Column::Ia | Column::Ib | Column::Ic => "mA",
+                    _ => "rpm",
+                }
+            )
+        };
+        Some(LogError::NoValue {
+            path: self.shown.clone(),
+            channel: c.name().to_string(),
+            why,
+        })
+    }
+
     /// Ends the read (settles the rows still held) and returns the report.
     ///
     /// # Errors
     /// [`LogError::Empty`] for a log without rows; the time-base errors of the first rows
-    /// ([`LogError::NoTimeBase`], [`LogError::RateTooLow`]).
+    /// ([`LogError::NoTimeBase`], [`LogError::RateTooLow`]); [`LogError::NoValue`] for a
+    /// channel without one usable cell (all missing or not finite: "channel ia_A holds no
+    /// finite value"; all beyond the limits: its unit is not the schema's).
     pub fn finish(mut self) -> Result<DataQuality, LogError> {
         if let Some(e) = self.error.take() {
             return Err(e);
@@ -206,6 +285,9 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             }
         }
         self.end_burst();
+        if let Some(e) = self.channel_without_values() {
+            return Err(e);
+        }
         if let Some(b) = self.base {
             self.q.duration_s = (self.last_t - b.t0_s).max(0.0);
         }
@@ -415,6 +497,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         self.dropping = false;
         self.q.rows_passed += 1;
         let bad = BadCells::of(&r, &self.limits);
+        self.note_values(&r, bad);
         self.clips.push(&r, |c| !bad.has(c));
         if bad.any() {
             self.q.bad_rows += 1;
@@ -482,9 +565,15 @@ impl<S: CleanSink> RowSink for QualityStage<'_, S> {
         self.crossings = CrossingCounter::default();
         self.jitter = (0.0, 0);
         self.dropping = false;
+        self.never_good = ALL_COLUMNS;
+        self.never_finite = ALL_COLUMNS;
         self.q = DataQuality::default();
         self.error = None;
         self.stopped = false;
+    }
+
+    fn blank_lines(&mut self, lines: u64) {
+        self.q.blank_lines = lines;
     }
 }
 
