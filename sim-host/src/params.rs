@@ -307,12 +307,13 @@ impl ParamFile {
             path: origin.to_string(),
             source,
         })?;
-        let columns = ColumnMapping::from_table(&f.columns, p.motor.poles / 2).map_err(|message| {
-            ParamError::Columns {
-                path: origin.to_string(),
-                message,
-            }
-        })?;
+        let columns =
+            ColumnMapping::from_table(&f.columns, p.motor.poles / 2).map_err(|message| {
+                ParamError::Columns {
+                    path: origin.to_string(),
+                    message,
+                }
+            })?;
         Ok((p, columns))
     }
 

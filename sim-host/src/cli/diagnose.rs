@@ -82,8 +82,7 @@ fn baseline_of(
     open: &OpenOptions,
     opts: ReplayOptions,
 ) -> anyhow::Result<sim_host::replay::UnbalanceBaseline> {
-    let file = LogFile::open_with(path, open)
-    .map_err(|e| anyhow::anyhow!("--baseline: {e}"))?;
+    let file = LogFile::open_with(path, open).map_err(|e| anyhow::anyhow!("--baseline: {e}"))?;
     let opts = ReplayOptions {
         commission: None,
         ..opts

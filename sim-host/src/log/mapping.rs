@@ -482,7 +482,10 @@ pub(super) fn parse_iso8601(s: &str) -> Option<(i64, f64)> {
         std::str::from_utf8(t).ok()?.parse().ok()
     };
     let (y, mo, d) = (num(0..4)?, num(5..7)?, num(8..10)?);
-    if b.get(4) != Some(&b'-') || b.get(7) != Some(&b'-') || !matches!(b.get(10), Some(b'T' | b't' | b' ')) {
+    if b.get(4) != Some(&b'-')
+        || b.get(7) != Some(&b'-')
+        || !matches!(b.get(10), Some(b'T' | b't' | b' '))
+    {
         return None;
     }
     let (h, mi, sec) = (num(11..13)?, num(14..16)?, num(17..19)?);
@@ -528,7 +531,11 @@ pub(super) fn parse_iso8601(s: &str) -> Option<(i64, f64)> {
         _ => return None,
     };
     // Days from the civil date (Howard Hinnant's algorithm, proleptic Gregorian).
-    let (yy, m) = if mo <= 2 { (y - 1, mo + 9) } else { (y, mo - 3) };
+    let (yy, m) = if mo <= 2 {
+        (y - 1, mo + 9)
+    } else {
+        (y, mo - 3)
+    };
     let era = yy.div_euclid(400);
     let yoe = yy - era * 400;
     let doy = (153 * m + 2) / 5 + d - 1;
@@ -543,14 +550,32 @@ mod tests {
 
     #[test]
     fn units_and_factors() {
-        assert_eq!(ChannelUnit::parse(Column::Time, "ms"), Ok(ChannelUnit::Milliseconds));
-        assert_eq!(ChannelUnit::parse(Column::Time, "µs"), Ok(ChannelUnit::Microseconds));
-        assert_eq!(ChannelUnit::parse(Column::Time, "us"), Ok(ChannelUnit::Microseconds));
-        assert_eq!(ChannelUnit::parse(Column::Ia, "mA"), Ok(ChannelUnit::Milliamperes));
+        assert_eq!(
+            ChannelUnit::parse(Column::Time, "ms"),
+            Ok(ChannelUnit::Milliseconds)
+        );
+        assert_eq!(
+            ChannelUnit::parse(Column::Time, "µs"),
+            Ok(ChannelUnit::Microseconds)
+        );
+        assert_eq!(
+            ChannelUnit::parse(Column::Time, "us"),
+            Ok(ChannelUnit::Microseconds)
+        );
+        assert_eq!(
+            ChannelUnit::parse(Column::Ia, "mA"),
+            Ok(ChannelUnit::Milliamperes)
+        );
         let e = ChannelUnit::parse(Column::Ia, "mV").unwrap_err();
-        assert!(e.contains("'mV'") && e.contains("ia_A") && e.contains("A, mA"), "{e}");
+        assert!(
+            e.contains("'mV'") && e.contains("ia_A") && e.contains("A, mA"),
+            "{e}"
+        );
         assert!(ChannelUnit::parse(Column::Speed, "Hz").is_err());
-        assert_eq!(ChannelUnit::Rpm.factor(2) * 1500.0, 1500.0 * std::f64::consts::TAU / 60.0);
+        assert_eq!(
+            ChannelUnit::Rpm.factor(2) * 1500.0,
+            1500.0 * std::f64::consts::TAU / 60.0
+        );
         // 50 Hz electrical on a 4-pole machine: 25 rev/s, 157.08 rad/s.
         assert!((ChannelUnit::ElectricalHz.factor(2) * 50.0 - 157.079_632_7).abs() < 1e-6);
         assert_eq!(ChannelUnit::Kilovolts.factor(2), 1000.0);
@@ -562,7 +587,9 @@ mod tests {
         m.set(Column::Ia, "I", None).unwrap();
         let e = m.set(Column::Ib, "I", None).unwrap_err();
         assert!(e.contains("ia_A and ib_A both name channel 'I'"), "{e}");
-        let e = m.set(Column::Va, "U1", Some(ChannelUnit::Amperes)).unwrap_err();
+        let e = m
+            .set(Column::Va, "U1", Some(ChannelUnit::Amperes))
+            .unwrap_err();
         assert!(e.contains("va_V") && e.contains("'A'"), "{e}");
     }
 
@@ -575,7 +602,10 @@ mod tests {
         assert_eq!(closest(Column::Ia, "ia_A", &found), Some("Ia"));
         assert_eq!(closest(Column::Ic, "ic_A", &found), Some("Ic"));
         assert_eq!(closest(Column::Time, "t_s", &found), Some("t"));
-        assert_eq!(closest(Column::Speed, "wm_rad_s", &found), Some("speed_rpm"));
+        assert_eq!(
+            closest(Column::Speed, "wm_rad_s", &found),
+            Some("speed_rpm")
+        );
         assert_eq!(closest(Column::Encoder, "enc_count", &found), None);
         let other: Vec<String> = vec!["Time".into(), "Strom 1".into()];
         assert_eq!(closest(Column::Time, "t_s", &other), Some("Time"));
@@ -584,13 +614,25 @@ mod tests {
     #[test]
     fn iso8601_text() {
         assert_eq!(parse_iso8601("1970-01-01T00:00:00Z"), Some((0, 0.0)));
-        assert_eq!(parse_iso8601("2000-03-01 00:00:01.25"), Some((951_868_801, 0.25)));
+        assert_eq!(
+            parse_iso8601("2000-03-01 00:00:01.25"),
+            Some((951_868_801, 0.25))
+        );
         assert_eq!(
             parse_iso8601("2024-05-01T12:00:00.125+02:00"),
             Some((1_714_557_600, 0.125))
         );
-        assert_eq!(parse_iso8601("2024-05-01T10:00:00Z").map(|x| x.0), Some(1_714_557_600));
-        for bad in ["2024-05-01", "2024-13-01T00:00:00", "12:00:00", "2024-05-01T10:00:00Q", "x"] {
+        assert_eq!(
+            parse_iso8601("2024-05-01T10:00:00Z").map(|x| x.0),
+            Some(1_714_557_600)
+        );
+        for bad in [
+            "2024-05-01",
+            "2024-13-01T00:00:00",
+            "12:00:00",
+            "2024-05-01T10:00:00Q",
+            "x",
+        ] {
             assert_eq!(parse_iso8601(bad), None, "{bad}");
         }
     }

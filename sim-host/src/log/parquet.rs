@@ -99,7 +99,10 @@ impl ParquetSource {
             let ty = schema.column(j).physical_type();
             if !matches!(
                 ty,
-                PhysicalType::DOUBLE | PhysicalType::FLOAT | PhysicalType::INT32 | PhysicalType::INT64
+                PhysicalType::DOUBLE
+                    | PhysicalType::FLOAT
+                    | PhysicalType::INT32
+                    | PhysicalType::INT64
             ) {
                 return Err(not_a_log(
                     shown,
@@ -107,11 +110,14 @@ impl ParquetSource {
                 ));
             }
             let recorded = timestamp_unit(schema.column(j).logical_type_ref());
-            units[k] = super::mapping::resolve_unit(shown, *c, &found[j], mapping.unit_of(*c), recorded)?;
+            units[k] =
+                super::mapping::resolve_unit(shown, *c, &found[j], mapping.unit_of(*c), recorded)?;
         }
         columns.set_units(&units, mapping);
         if columns.of(Column::Time).is_none() {
-            if let Some(j) = (0..found.len()).find(|&j| timestamp_unit(schema.column(j).logical_type_ref()).is_some()) {
+            if let Some(j) = (0..found.len())
+                .find(|&j| timestamp_unit(schema.column(j).logical_type_ref()).is_some())
+            {
                 return Err(LogError::MissingColumn {
                     path: shown.to_string(),
                     column: mapping.name_of(Column::Time).to_string(),

@@ -76,11 +76,19 @@ impl ColumnMap {
     ///
     /// # Errors
     /// [`LogError::DuplicateColumn`] when a name looked up appears twice.
-    pub fn locate(found: &[String], mapping: &ColumnMapping, shown: &str) -> Result<Self, LogError> {
+    pub fn locate(
+        found: &[String],
+        mapping: &ColumnMapping,
+        shown: &str,
+    ) -> Result<Self, LogError> {
         let mut field = [None; 9];
         for (f, c) in field.iter_mut().zip(Column::ALL) {
             let name = mapping.name_of(c);
-            let mut at = found.iter().enumerate().filter(|(_, h)| *h == name).map(|(i, _)| i);
+            let mut at = found
+                .iter()
+                .enumerate()
+                .filter(|(_, h)| *h == name)
+                .map(|(i, _)| i);
             *f = at.next();
             if let (Some(first), Some(second)) = (*f, at.next()) {
                 return Err(LogError::DuplicateColumn {

@@ -185,6 +185,35 @@ fn pick_group(names: &[String], group: Option<&str>, shown: &str) -> Result<Stri
     }
 }
 
+/// The unit channel `ch` (column `c`) is read in ([`super::mapping::resolve_unit`]: the
+/// mapping's, checked against the channel's `unit_string`).
+///
+/// # Errors
+/// [`LogError::NotALog`] for a channel that does not hold numbers; [`LogError::Unit`] as
+/// `resolve_unit`.
+fn channel_unit(
+    ch: &tdms_rs::TdmsChannel<'_>,
+    c: Column,
+    mapping: &super::ColumnMapping,
+    shown: &str,
+) -> Result<Option<super::ChannelUnit>, LogError> {
+    if ch.dtype().itemsize() == 0 || matches!(ch.dtype(), DataType::TimeStamp | DataType::Boolean) {
+        return Err(not_a_log(
+            shown,
+            format!(
+                "channel '{}' holds {:?} values, not numbers",
+                ch.name(),
+                ch.dtype()
+            ),
+        ));
+    }
+    let recorded = match ch.property("unit_string") {
+        Some(PropertyValue::String(u)) => Some(u.as_str()),
+        _ => None,
+    };
+    super::mapping::resolve_unit(shown, c, ch.name(), mapping.unit_of(c), recorded)
+}
+
 impl TdmsSource {
     /// Opens `path`: picks the group, maps the schema's channels and the time source.
     ///
@@ -218,26 +247,11 @@ impl TdmsSource {
             let Some(ch) = g.channel(&columns.names[k]) else {
                 continue;
             };
-            if ch.dtype().itemsize() == 0
-                || matches!(ch.dtype(), DataType::TimeStamp | DataType::Boolean)
-            {
-                return Err(not_a_log(
-                    shown,
-                    format!(
-                        "channel '{}' holds {:?} values, not numbers",
-                        columns.names[k],
-                        ch.dtype()
-                    ),
-                ));
-            }
-            let recorded = match ch.property("unit_string") {
-                Some(PropertyValue::String(u)) => Some(u.as_str()),
-                _ => None,
-            };
-            units[k] =
-                super::mapping::resolve_unit(shown, *c, &columns.names[k], mapping.unit_of(*c), recorded)?;
+            units[k] = channel_unit(&ch, *c, mapping, shown)?;
             lens.push((columns.names[k].clone(), ch.len()));
         }
+        // The currents first: a group of renamed channels is told which to map.
+        super::reader::check_columns(&columns, shown, false, mapping, &found)?;
         let wave = g.channel(mapping.name_of(Column::Ia)).and_then(|ch| {
             let inc = ch.property("wf_increment").and_then(number)?;
             let start = ch
@@ -266,7 +280,13 @@ impl TdmsSource {
                 ),
             ));
         };
-        super::reader::check_columns(&columns, shown, time == TimeSource::Channel, mapping, &found)?;
+        super::reader::check_columns(
+            &columns,
+            shown,
+            time == TimeSource::Channel,
+            mapping,
+            &found,
+        )?;
         // (The waveform time is in seconds: wf_increment's unit.)
         columns.set_units(&units, mapping);
         let rows = lens.first().map(|l| l.1).unwrap_or(0);

@@ -37,8 +37,9 @@
 //! **Cells.** A cell that is not finite (a missing value, `NaN`, `inf`: one rule for all,
 //! see [`super::is_missing`]) or lies beyond [`CellLimits`] (far beyond what the machine
 //! could draw or the supply could give) is bad ([`BadCells`]); consecutive rows with bad
-//! cells form a glitch burst. A channel without one usable cell is an error naming it
-//! ([`LogError::NoValue`]). Blank lines of a CSV are skipped and counted. The stage counts them and hands the rows on,
+//! cells form a glitch burst. When at least [`UNUSABLE_FRACTION`] of the rows have a bad cell,
+//! nothing is left to analyse: an error names the channel with the most bad cells and
+//! what they are ([`LogError::NoValue`]). Blank lines of a CSV are skipped and counted. The stage counts them and hands the rows on,
 //! flagged: the monitor holds such samples out as the firmware does with impossible ADC
 //! readings, the analysis drops them and bridges the hole like dropped samples.
 //!
@@ -153,16 +154,16 @@ pub struct QualityStage<'a, S: CleanSink> {
     clips: super::clipping::ClipTracker,
     jitter: (f64, u64),
     dropping: bool,
-    /// Columns (bits of [`Column`]) with no usable cell so far, and with no finite one.
-    never_good: u16,
-    never_finite: u16,
+    /// Cells not finite, per column.
+    non_finite: [u64; 9],
     q: DataQuality,
     error: Option<LogError>,
     stopped: bool,
 }
 
-/// Every column's bit (as [`BadCells`] numbers them).
-const ALL_COLUMNS: u16 = (1 << Column::ALL.len()) - 1;
+/// Fraction of the rows with a bad cell at and above which nothing is left to analyse: the
+/// channel to blame is named ([`LogError::NoValue`]).
+pub const UNUSABLE_FRACTION: f64 = 0.99;
 
 impl<'a, S: CleanSink> QualityStage<'a, S> {
     /// A stage for the log shown as `shown` in messages, judging cells against `limits`.
@@ -184,72 +185,40 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             clips: super::clipping::ClipTracker::default(),
             jitter: (0.0, 0),
             dropping: false,
-            never_good: ALL_COLUMNS,
-            never_finite: ALL_COLUMNS,
+            non_finite: [0; 9],
             q: DataQuality::default(),
             error: None,
             stopped: false,
         }
     }
 
-    /// Notes which cells of `r` are finite and which usable, while some column has had
-    /// none (after the first rows, one comparison per row).
-    fn note_values(&mut self, r: &Row, bad: BadCells) {
-        if self.never_good == 0 {
-            return;
-        }
-        let cells = [
-            (Column::Va, r.v_abc.map(|v| v[0])),
-            (Column::Vb, r.v_abc.map(|v| v[1])),
-            (Column::Vc, r.v_abc.map(|v| v[2])),
-            (Column::Ia, Some(r.i_abc[0])),
-            (Column::Ib, Some(r.i_abc[1])),
-            (Column::Ic, Some(r.i_abc[2])),
-            (Column::Speed, r.wm_rad_s),
-        ];
-        // Columns the log lacks and the ones the stage does not judge have nothing to find.
-        self.never_good &= !(1 << Column::Time as u16 | 1 << Column::Encoder as u16);
-        for (c, x) in cells {
-            let bit = 1u16 << c as u16;
-            match x {
-                None => self.never_good &= !bit,
-                Some(x) => {
-                    if x.is_finite() {
-                        self.never_finite &= !bit;
-                    }
-                    if !bad.has(c) {
-                        self.never_good &= !bit;
-                    }
-                }
-            }
-        }
-    }
-
-    /// The error for a channel without one usable cell (all NaN, or all beyond the
-    /// limits: a unit the mapping does not give), once rows were passed.
+    /// The error for a log none of whose rows can be analysed because of one channel (at
+    /// least [`UNUSABLE_FRACTION`] of the rows have a bad cell): names the channel with the
+    /// most bad cells and what they are (not finite: "channel ia_A holds no finite value";
+    /// beyond the limits: a unit the parameter file's `[columns]` does not give).
     fn channel_without_values(&self) -> Option<LogError> {
-        if self.q.rows_passed == 0 {
+        let rows = self.q.rows_passed;
+        if rows == 0 || (self.q.bad_rows as f64) < UNUSABLE_FRACTION * rows as f64 {
             return None;
         }
-        let c = Column::ALL
+        let (c, n) = Column::ALL
             .into_iter()
-            .find(|c| self.never_good & (1 << *c as u16) != 0)?;
-        let why = if self.never_finite & (1 << c as u16) != 0 {
+            .map(|c| (c, self.q.bad_cells.get(c.name()).copied().unwrap_or(0)))
+            .max_by_key(|(_, n)| *n)?;
+        let non_finite = self.non_finite[c as usize];
+        let why = if non_finite == rows {
             "holds no finite value (every cell is empty, NA, null, NaN or inf)".to_string()
+        } else if 2 * non_finite >= n {
+            format!("has {non_finite} of its {rows} cells empty, NA, null, NaN or inf: nothing is left to analyse")
         } else {
-            let (limit, unit) = match c {
-                Column::Va | Column::Vb | Column::Vc => (self.limits.v_max, "V"),
-                Column::Ia | Column::Ib | Column::Ic => (self.limits.i_max, "A"),
-                _ => (self.limits.wm_max, "rad/s"),
+            let (limit, unit, other) = match c {
+                Column::Va | Column::Vb | Column::Vc => (self.limits.v_max, "V", "mV"),
+                Column::Ia | Column::Ib | Column::Ic => (self.limits.i_max, "A", "mA"),
+                _ => (self.limits.wm_max, "rad/s", "rpm"),
             };
             format!(
-                "holds no value within +/-{limit:.0} {unit}, twice this motor's sensor range: if it is recorded in another unit, give it in the parameter file's [columns] table, e.g. {} = {{ name = \"...\", unit = \"{}\" }} (docs/design.md)",
-                c.name(),
-                match c {
-                    Column::Va | Column::Vb | Column::Vc => "mV",
-                    Column::Ia | Column::Ib | Column::Ic => "mA",
-                    _ => "rpm",
-                }
+                "has {n} of its {rows} values beyond +/-{limit:.0} {unit} (twice this motor's sensor range): if it is recorded in another unit, give it in the parameter file's [columns] table, e.g. {} = {{ name = \"...\", unit = \"{other}\" }} (docs/design.md)",
+                c.name()
             )
         };
         Some(LogError::NoValue {
@@ -263,9 +232,9 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
     ///
     /// # Errors
     /// [`LogError::Empty`] for a log without rows; the time-base errors of the first rows
-    /// ([`LogError::NoTimeBase`], [`LogError::RateTooLow`]); [`LogError::NoValue`] for a
-    /// channel without one usable cell (all missing or not finite: "channel ia_A holds no
-    /// finite value"; all beyond the limits: its unit is not the schema's).
+    /// ([`LogError::NoTimeBase`], [`LogError::RateTooLow`]); [`LogError::NoValue`] when
+    /// a channel leaves nothing to analyse (all missing or not finite: "channel ia_A holds
+    /// no finite value"; beyond the limits: its unit is not the schema's).
     pub fn finish(mut self) -> Result<DataQuality, LogError> {
         if let Some(e) = self.error.take() {
             return Err(e);
@@ -497,13 +466,13 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         self.dropping = false;
         self.q.rows_passed += 1;
         let bad = BadCells::of(&r, &self.limits);
-        self.note_values(&r, bad);
         self.clips.push(&r, |c| !bad.has(c));
         if bad.any() {
             self.q.bad_rows += 1;
             for c in Column::ALL {
                 if bad.has(c) {
                     *self.q.bad_cells.entry(c.name().to_string()).or_insert(0) += 1;
+                    self.non_finite[c as usize] += u64::from(!cell_of(&r, c).is_finite());
                 }
             }
             let start = self.burst.map_or(r.t_s, |b| b.0);
@@ -532,6 +501,22 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
                 self.q.rows_in_short_bursts += (length / self.period).round() as u64;
             }
         }
+    }
+}
+
+/// The value of measured column `c` in `r` (NaN where the log lacks it).
+fn cell_of(r: &Row, c: Column) -> f64 {
+    let v = r.v_abc.unwrap_or([f64::NAN; 3]);
+    match c {
+        Column::Va => v[0],
+        Column::Vb => v[1],
+        Column::Vc => v[2],
+        Column::Ia => r.i_abc[0],
+        Column::Ib => r.i_abc[1],
+        Column::Ic => r.i_abc[2],
+        Column::Speed => r.wm_rad_s.unwrap_or(f64::NAN),
+        Column::Time => r.t_s,
+        Column::Encoder => f64::NAN,
     }
 }
 
@@ -565,8 +550,7 @@ impl<S: CleanSink> RowSink for QualityStage<'_, S> {
         self.crossings = CrossingCounter::default();
         self.jitter = (0.0, 0);
         self.dropping = false;
-        self.never_good = ALL_COLUMNS;
-        self.never_finite = ALL_COLUMNS;
+        self.non_finite = [0; 9];
         self.q = DataQuality::default();
         self.error = None;
         self.stopped = false;
