@@ -337,9 +337,9 @@ fn a_missing_column_lists_the_channels_and_suggests_the_closest() {
     }
     let e = fails(&["diagnose", "--params", s(&plain), s(&tdms)]);
     assert!(
-        e.contains("missing column 'ia_A'")
+        e.contains("missing column 't_s'")
             && e.contains("the log has Ia, Ib, Ic")
-            && e.contains("did you mean 'Ia'?"),
+            && e.contains("channel 'Ia' has wf_increment: map it to ia_A in [columns]"),
         "{e}"
     );
     let currents = params_with(
@@ -431,11 +431,16 @@ fn healthy_csv(dir: &Path) -> String {
 /// `text` with the `ia_A` cell (5th field) of data rows `rows` (1-based) replaced by
 /// `cells`, in turn.
 fn with_cells(text: &str, rows: &[usize], cells: &[&str]) -> String {
+    with_field(text, 4, rows, cells)
+}
+
+/// `text` with field `field` (0-based) of data rows `rows` replaced by `cells`, in turn.
+fn with_field(text: &str, field: usize, rows: &[usize], cells: &[&str]) -> String {
     let mut out = String::new();
     for (k, line) in text.lines().enumerate() {
         let mut f: Vec<&str> = line.split(',').collect();
         if let Some(j) = rows.iter().position(|r| *r == k) {
-            f[4] = cells[j % cells.len()];
+            f[field] = cells[j % cells.len()];
         }
         out.push_str(&f.join(","));
         out.push('\n');
@@ -473,6 +478,13 @@ fn missing_values_duplicates_and_blank_lines_follow_one_rule() {
         &with_cells(&text, &rows, &["na", "NULL", " ", "inf"]),
     );
     assert_eq!(case["bad_cells"], nan["bad_cells"], "{case}");
+    // The encoder count too (it used to become 0, a jump of the count).
+    let enc = data_quality(
+        d,
+        "enc.csv",
+        &with_field(&text, 8, &rows, &["", "NA", "null", "NaN"]),
+    );
+    assert_eq!(enc["bad_cells"]["enc_count"], 4, "{enc}");
     // Blank lines: skipped and counted.
     let blank = text.replacen("\n", "\n\n", 3).replace("\n\n\n", "\n\n");
     let q = data_quality(d, "blank.csv", &blank);

@@ -450,7 +450,17 @@ pub(super) fn missing_column(
         Some(_) => format!(" (for {} in [columns])", c.name()),
         None => String::new(),
     };
-    let hint = match closest(c, wanted, found) {
+    // Channels another column already reads are no candidates.
+    let free: Vec<String> = found
+        .iter()
+        .filter(|f| {
+            Column::ALL
+                .iter()
+                .all(|o| mapping.name_of(*o) != f.as_str())
+        })
+        .cloned()
+        .collect();
+    let hint = match closest(c, wanted, &free) {
         Some(f) => format!(
             "; did you mean '{f}'? Map it in the parameter file's [columns] table: {} = {{ name = \"{f}\", unit = \"...\" }} (docs/design.md)",
             c.name()

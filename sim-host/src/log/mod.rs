@@ -282,9 +282,37 @@ pub struct Row {
     pub i_abc: [f64; 3],
     /// Rotor mechanical speed [rad/s].
     pub wm_rad_s: Option<f64>,
-    /// Cumulative encoder count (may be negative when running backwards).
+    /// Cumulative encoder count (may be negative when running backwards);
+    /// [`ENC_NOT_A_NUMBER`] where the log's cell is missing or not finite (the data-quality
+    /// stage holds such a cell out, [`quality::BadCells`]).
     pub enc_count: Option<i64>,
 }
+
+impl Row {
+    /// The value of column `c` in the schema's unit; `None` where the log lacks the
+    /// column, or for an encoder count that was not a number ([`ENC_NOT_A_NUMBER`]).
+    pub fn value(&self, c: Column) -> Option<f64> {
+        let v = self.v_abc;
+        match c {
+            Column::Time => Some(self.t_s),
+            Column::Va => v.map(|v| v[0]),
+            Column::Vb => v.map(|v| v[1]),
+            Column::Vc => v.map(|v| v[2]),
+            Column::Ia => Some(self.i_abc[0]),
+            Column::Ib => Some(self.i_abc[1]),
+            Column::Ic => Some(self.i_abc[2]),
+            Column::Speed => self.wm_rad_s,
+            Column::Encoder => self
+                .enc_count
+                .filter(|n| *n != ENC_NOT_A_NUMBER)
+                .map(|n| n as f64),
+        }
+    }
+}
+
+/// The [`Row::enc_count`] of a cell that is missing, NaN or infinite (no count can be
+/// this: it is the most negative `i64`).
+pub const ENC_NOT_A_NUMBER: i64 = i64::MIN;
 
 /// Which optional channels a log carries.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -440,6 +468,68 @@ mod tests {
                 e.contains(says) && !e.contains("missing column"),
                 "{text:?}: {e}"
             );
+        }
+    }
+
+    /// Rows and the blank lines the reader reports.
+    #[derive(Default)]
+    struct Counted {
+        rows: Vec<Row>,
+        blank: u64,
+    }
+
+    impl RowSink for Counted {
+        fn row(&mut self, row: &Row) -> bool {
+            self.rows.push(*row);
+            true
+        }
+        fn restart(&mut self) {
+            self.rows.clear();
+        }
+        fn blank_lines(&mut self, lines: u64) {
+            self.blank = lines;
+        }
+    }
+
+    fn counted(text: &str, columns: ColumnMapping) -> Counted {
+        let f = write(text);
+        let opts = OpenOptions {
+            columns,
+            ..OpenOptions::default()
+        };
+        let file = LogFile::open_with(f.path(), &opts).unwrap();
+        let mut c = Counted::default();
+        file.for_each_row(&mut |_| {}, &mut c).unwrap();
+        c
+    }
+
+    #[test]
+    fn missing_values_blank_lines_and_units_alike_on_both_csv_paths() {
+        let text = "t_s,ia_A,ib_A,ic_A,enc_count\n0,1,,3,5\n\n0.1,NA,null,NaN,\n0.2,1,2,3,NA\n\n";
+        // The fast path takes it; a quoted cell sends it to the exact reader.
+        let exact = text.replace("0.2,1", "0.2,\"1\"");
+        for t in [text, exact.as_str()] {
+            let c = counted(t, ColumnMapping::default());
+            assert_eq!(c.blank, 2, "{t:?}");
+            assert_eq!(c.rows.len(), 3);
+            assert!(c.rows[0].i_abc[1].is_nan() && c.rows[1].i_abc.iter().all(|x| x.is_nan()));
+            assert_eq!(c.rows[0].enc_count, Some(5));
+            assert_eq!(c.rows[1].enc_count, Some(ENC_NOT_A_NUMBER));
+            assert_eq!(c.rows[2].value(Column::Encoder), None);
+        }
+        // Units: ms and mA, one multiplication each; epoch ms counted from the first row.
+        let mut m = ColumnMapping::new(2);
+        m.set(Column::Time, "T", Some(ChannelUnit::EpochMilliseconds))
+            .unwrap();
+        m.set(Column::Ia, "I1", Some(ChannelUnit::Milliamperes))
+            .unwrap();
+        let text = "I1,T,ib_A,ic_A\n1500,1714564800000,2,3\n-250,1714564800000.5,2,3\n";
+        for t in [text.to_string(), text.replace(",2,3\n-", ",\"2\",3\n-")] {
+            let c = counted(&t, m.clone());
+            assert_eq!(c.rows[0].t_s, 0.0, "{t:?}");
+            assert!((c.rows[1].t_s - 5e-4).abs() < 1e-9);
+            assert!((c.rows[0].i_abc[0] - 1.5).abs() < 1e-12);
+            assert!((c.rows[1].i_abc[0] + 0.25).abs() < 1e-12);
         }
     }
 

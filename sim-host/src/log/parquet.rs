@@ -344,18 +344,8 @@ impl ParquetLogWriter {
     /// Buffers a row; writes a row group when [`ROW_GROUP_ROWS`] are buffered.
     pub fn write_row(&mut self, r: &Row) -> Result<(), ParquetError> {
         self.t.push(r.t_s);
-        let v = r.v_abc.unwrap_or_default();
         for (c, vals) in &mut self.f {
-            let x = match c {
-                Column::Va => v[0],
-                Column::Vb => v[1],
-                Column::Vc => v[2],
-                Column::Ia => r.i_abc[0],
-                Column::Ib => r.i_abc[1],
-                Column::Ic => r.i_abc[2],
-                _ => r.wm_rad_s.unwrap_or_default(),
-            };
-            vals.push(x as f32);
+            vals.push(r.value(*c).unwrap_or_default() as f32);
         }
         if self.channels.encoder {
             self.enc.push(r.enc_count.unwrap_or_default());

@@ -250,8 +250,6 @@ impl TdmsSource {
             units[k] = channel_unit(&ch, *c, mapping, shown)?;
             lens.push((columns.names[k].clone(), ch.len()));
         }
-        // The currents first: a group of renamed channels is told which to map.
-        super::reader::check_columns(&columns, shown, false, mapping, &found)?;
         let wave = g.channel(mapping.name_of(Column::Ia)).and_then(|ch| {
             let inc = ch.property("wf_increment").and_then(number)?;
             let start = ch
@@ -268,13 +266,24 @@ impl TdmsSource {
         } else if let Some(w) = wave {
             w
         } else {
+            // A channel timed by its waveform properties under another name: say so.
+            let elsewhere = g
+                .channels()
+                .find(|ch| ch.property("wf_increment").is_some())
+                .map(|ch| {
+                    format!(
+                        "; channel '{}' has wf_increment: map it to ia_A in [columns] and the time comes from it",
+                        ch.name()
+                    )
+                })
+                .unwrap_or_default();
             return Err(super::mapping::missing_column(
                 shown,
                 Column::Time,
                 mapping,
                 &found,
                 &format!(
-                    "every analysis needs the time: a {} channel, or wf_increment on {}",
+                    "every analysis needs the time: a {} channel, or wf_increment on {}{elsewhere}",
                     mapping.name_of(Column::Time),
                     mapping.name_of(Column::Ia)
                 ),

@@ -472,7 +472,8 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             for c in Column::ALL {
                 if bad.has(c) {
                     *self.q.bad_cells.entry(c.name().to_string()).or_insert(0) += 1;
-                    self.non_finite[c as usize] += u64::from(!cell_of(&r, c).is_finite());
+                    let x = r.value(c).unwrap_or(f64::NAN);
+                    self.non_finite[c as usize] += u64::from(!x.is_finite());
                 }
             }
             let start = self.burst.map_or(r.t_s, |b| b.0);
@@ -501,22 +502,6 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
                 self.q.rows_in_short_bursts += (length / self.period).round() as u64;
             }
         }
-    }
-}
-
-/// The value of measured column `c` in `r` (NaN where the log lacks it).
-fn cell_of(r: &Row, c: Column) -> f64 {
-    let v = r.v_abc.unwrap_or([f64::NAN; 3]);
-    match c {
-        Column::Va => v[0],
-        Column::Vb => v[1],
-        Column::Vc => v[2],
-        Column::Ia => r.i_abc[0],
-        Column::Ib => r.i_abc[1],
-        Column::Ic => r.i_abc[2],
-        Column::Speed => r.wm_rad_s.unwrap_or(f64::NAN),
-        Column::Time => r.t_s,
-        Column::Encoder => f64::NAN,
     }
 }
 
