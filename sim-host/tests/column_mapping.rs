@@ -98,11 +98,11 @@ fn daq_csv(path: &Path, rows: &[Row], iso: bool) {
     let mut t = DAQ.map(|d| d.0).join(",");
     t.push('\n');
     for r in rows {
-        for k in 0..DAQ.len() {
+        for (k, (_, column)) in DAQ.iter().enumerate() {
             if k > 0 {
                 t.push(',');
             }
-            if iso && DAQ[k].1 == Some(0) {
+            if iso && *column == Some(0) {
                 // 2024-05-01T12:00:00Z plus the row's time, to the 0.1 us.
                 let us = (r.t_s * 1e7).round() as u64;
                 let (sec, frac) = (us / 10_000_000, us % 10_000_000);
@@ -522,8 +522,8 @@ fn missing_values_duplicates_and_blank_lines_follow_one_rule() {
     for (k, line) in text.lines().enumerate() {
         let mut f: Vec<String> = line.split(',').map(str::to_string).collect();
         if k > 0 {
-            for c in 4..7 {
-                f[c] = format!("{}", f[c].parse::<f64>().expect("num") * 1e3);
+            for cell in &mut f[4..7] {
+                *cell = format!("{}", cell.parse::<f64>().expect("num") * 1e3);
             }
         }
         ma.push_str(&f.join(","));

@@ -468,13 +468,22 @@ pub(super) fn missing_column(
         None => "; map the log's channel in the parameter file's [columns] table (docs/design.md)"
             .to_string(),
     };
+    missing_column_with(shown, wanted, &format!("{mapped} ({why})"), found, &hint)
+}
+
+/// [`LogError::MissingColumn`] for the log's column `column`, with `why` (" (...)" or "")
+/// after its name, the channels `found`, and `hint` ("; ...") at the end.
+pub(super) fn missing_column_with(
+    shown: &str,
+    column: &str,
+    why: &str,
+    found: &[String],
+    hint: &str,
+) -> LogError {
     LogError::MissingColumn {
         path: shown.to_string(),
-        column: wanted.to_string(),
-        mapped,
-        why: why.to_string(),
-        found: channel_list(found),
-        hint,
+        column: column.to_string(),
+        detail: format!("{why}; the log has {}{hint}", channel_list(found)),
     }
 }
 

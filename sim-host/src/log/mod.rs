@@ -98,22 +98,18 @@ pub enum LogError {
         /// The I/O error.
         source: std::io::Error,
     },
-    /// A required column is missing: named, with the channels the log has and the
-    /// closest of them ([`mapping`]).
-    #[error("{path}: missing column '{column}'{mapped} ({why}); the log has {found}{hint}")]
+    /// A required column is missing: named, with why it is needed, the channels the log
+    /// has and the closest of them ([`mapping`]).
+    #[error("{path}: missing column '{column}'{detail}")]
     MissingColumn {
         /// The file.
         path: String,
         /// The column's name in the log (the schema's, or the one `[columns]` gives).
         column: String,
-        /// " (for ia_A in [columns])" when the name comes from the mapping, else empty.
-        mapped: String,
-        /// Why it is needed.
-        why: String,
-        /// The channels the log has, as a list.
-        found: String,
-        /// The closest channel and where to map it.
-        hint: String,
+        /// The rest of the message: " (for ia_A in [columns])" when the name comes from
+        /// the mapping, " (why it is needed)", "; the log has ...", the closest channel
+        /// and where to map it.
+        detail: String,
     },
     /// A column name appears twice in the log.
     #[error("{path}: column '{column}' appears twice, at columns {first} and {second}: which one is meant cannot be told")]

@@ -118,19 +118,18 @@ impl ParquetSource {
             if let Some(j) = (0..found.len())
                 .find(|&j| timestamp_unit(schema.column(j).logical_type_ref()).is_some())
             {
-                return Err(LogError::MissingColumn {
-                    path: shown.to_string(),
-                    column: mapping.name_of(Column::Time).to_string(),
-                    mapped: String::new(),
-                    why: "every analysis needs the time".into(),
-                    found: super::mapping::channel_list(&found),
-                    hint: format!(
+                return Err(super::mapping::missing_column_with(
+                    shown,
+                    mapping.name_of(Column::Time),
+                    " (every analysis needs the time)",
+                    &found,
+                    &format!(
                         "; column '{}' is a timestamp: make it the time in the parameter file's [columns] table: t_s = {{ name = \"{}\" }} (its unit, {}, is read from the file; docs/design.md)",
                         found[j],
                         found[j],
                         timestamp_unit(schema.column(j).logical_type_ref()).unwrap_or("epoch_ms")
                     ),
-                });
+                ));
             }
         }
         super::reader::check_columns(&columns, shown, true, mapping, &found)?;

@@ -19,17 +19,18 @@ pub trait RowSink {
 }
 
 /// A timestamp column's time counted from the first row with a finite time: passes the
-/// rows on to `sink` with that time subtracted.
+/// rows on to `sink` with that time subtracted, then scaled to seconds by `factor`.
 struct FromFirstRow<'a> {
     sink: &'a mut dyn RowSink,
     t0: Option<f64>,
+    factor: f64,
 }
 
 impl RowSink for FromFirstRow<'_> {
     fn row(&mut self, row: &Row) -> bool {
         let mut r = *row;
         if r.t_s.is_finite() {
-            r.t_s -= *self.t0.get_or_insert(row.t_s);
+            r.t_s = (r.t_s - *self.t0.get_or_insert(row.t_s)) * self.factor;
         }
         self.sink.row(&r)
     }
@@ -65,6 +66,9 @@ pub(super) struct ColumnMap {
     pub scale: [f64; 9],
     /// How the time column is read.
     pub time: TimeKind,
+    /// A timestamp's factor to seconds, applied after the first row's time is subtracted
+    /// (so that the difference is exact; `scale[0]` is then 1).
+    pub time_factor: f64,
     /// Each column's channel name in the log (the schema's name unless mapped).
     pub names: [String; 9],
 }
@@ -104,6 +108,7 @@ impl ColumnMap {
             n_fields: found.len(),
             scale: [1.0; 9],
             time: TimeKind::Plain,
+            time_factor: 1.0,
             names: Column::ALL.map(|c| mapping.name_of(c).to_string()),
         };
         map.set_units(&Column::ALL.map(|c| mapping.unit_of(c)), mapping);
@@ -114,6 +119,10 @@ impl ColumnMap {
     pub fn set_units(&mut self, units: &[Option<ChannelUnit>; 9], mapping: &ColumnMapping) {
         self.scale = mapping.factors(units);
         self.time = units[0].map_or(TimeKind::Plain, ChannelUnit::time_kind);
+        self.time_factor = 1.0;
+        if self.time != TimeKind::Plain {
+            self.time_factor = std::mem::replace(&mut self.scale[0], 1.0);
+        }
     }
 
     /// The channel name of field `i` (for messages).
@@ -334,7 +343,11 @@ impl LogFile {
         sink: &mut dyn RowSink,
     ) -> Result<u64, LogError> {
         if self.columns.time != TimeKind::Plain {
-            let mut from_first = FromFirstRow { sink, t0: None };
+            let mut from_first = FromFirstRow {
+                sink,
+                t0: None,
+                factor: self.columns.time_factor,
+            };
             return self.rows_in_order(progress, &mut from_first);
         }
         self.rows_in_order(progress, sink)
