@@ -16,7 +16,8 @@
 //! f_hz = 60.0      # supply frequency [Hz]
 //! ```
 //! An optional `[columns]` table maps the log's channels and units to the schema's
-//! columns ([`ColumnMapping`], `docs/design.md`):
+//! columns ([`ColumnsTable`], read into a mapping by the log reader,
+//! `crate::log::ColumnMapping`; `docs/design.md`):
 //! ```toml
 //! [columns]
 //! t_s = { name = "Time", unit = "ms" }
@@ -31,8 +32,6 @@
 //! [`MotorParameters::model`] (the core and the analysis), the simulator's machine
 //! (`crate::sim`) and the analysis's constants (`crate::analysis::simplified_model::MachineConstants`).
 
-use crate::log::mapping::ColumnEntry;
-use crate::log::ColumnMapping;
 use monitor_core::{MotorParameters, ReferenceMachine, SupplyParameters};
 use nalgebra::Complex;
 use serde::{Deserialize, Serialize};
@@ -67,7 +66,8 @@ pub enum ParamError {
         source: Implausible,
     },
     /// The `[columns]` table is wrong (a key that is no schema column, a unit the column
-    /// cannot have, two columns naming one channel).
+    /// cannot have, two columns naming one channel), as the log reader finds it
+    /// (`crate::log::mapping::load_params`).
     #[error("bad parameter file {path}: [columns] {message}")]
     Columns {
         /// The file.
@@ -256,6 +256,23 @@ pub struct ParamFile {
     pub supply: SupplyParameters,
 }
 
+/// One entry of the parameter file's `[columns]` table: `ia_A = { name = "Ia", unit =
+/// "mA" }` (the key a schema column, `name` the log's channel, `unit` optional). What the
+/// keys and units may be, and the mapping built from them, is the log reader's
+/// (`crate::log::ColumnMapping::from_table`, `docs/design.md`).
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ColumnEntry {
+    /// The channel's name in the log.
+    pub name: String,
+    /// Its unit; absent: the schema's SI unit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<String>,
+}
+
+/// The `[columns]` table: schema column name to [`ColumnEntry`].
+pub type ColumnsTable = std::collections::BTreeMap<String, ColumnEntry>;
+
 /// The file as written: [`ParamFile`]'s sections and the optional `[columns]` table.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -263,12 +280,12 @@ struct FileSections {
     motor: MotorParameters,
     supply: SupplyParameters,
     #[serde(default)]
-    columns: std::collections::BTreeMap<String, ColumnEntry>,
+    columns: ColumnsTable,
 }
 
 impl ParamFile {
     /// Parses TOML text; `origin` names the source in messages. A `[columns]` table is
-    /// checked and left out ([`ParamFile::from_toml_str_with_columns`] returns it).
+    /// left out ([`ParamFile::from_toml_str_with_columns`] returns it).
     ///
     /// # Errors
     /// As [`ParamFile::from_toml_str_with_columns`].
@@ -276,20 +293,21 @@ impl ParamFile {
         Self::from_toml_str_with_columns(text, origin).map(|(p, _)| p)
     }
 
-    /// Parses TOML text and its `[columns]` table, the mapping of the schema's columns to a
-    /// log's channels and units ([`ColumnMapping`], `docs/design.md`); `origin` names the
-    /// source in messages.
+    /// Parses TOML text and returns its `[columns]` table too, the mapping of the schema's
+    /// columns to a log's channels and units (checked and built by the log reader,
+    /// `crate::log::mapping::load_params`; `docs/design.md`); `origin` names the source in
+    /// messages.
     ///
     /// # Errors
     /// [`ParamError::Toml`] for malformed TOML (with its line and column) or an unknown or
-    /// missing key, [`ParamError::Implausible`] for a value outside the range of real
-    /// machines ([`ParamFile::check_plausible`]), [`ParamError::Range`] for a value the
-    /// equations cannot take ([`ParamFile::check`]), [`ParamError::Columns`] for a wrong
-    /// `[columns]` entry; each names the key.
+    /// missing key (in a `[columns]` entry too), [`ParamError::Implausible`] for a value
+    /// outside the range of real machines ([`ParamFile::check_plausible`]),
+    /// [`ParamError::Range`] for a value the equations cannot take ([`ParamFile::check`]);
+    /// each names the key.
     pub fn from_toml_str_with_columns(
         text: &str,
         origin: &str,
-    ) -> Result<(Self, ColumnMapping), ParamError> {
+    ) -> Result<(Self, ColumnsTable), ParamError> {
         let f: FileSections = toml::from_str(text).map_err(|e| ParamError::Toml {
             path: origin.to_string(),
             message: toml_error_message(text, &e),
@@ -307,14 +325,7 @@ impl ParamFile {
             path: origin.to_string(),
             source,
         })?;
-        let columns =
-            ColumnMapping::from_table(&f.columns, p.motor.poles / 2).map_err(|message| {
-                ParamError::Columns {
-                    path: origin.to_string(),
-                    message,
-                }
-            })?;
-        Ok((p, columns))
+        Ok((p, f.columns))
     }
 
     /// Checks that every value lies in the range of real induction machines
@@ -453,13 +464,13 @@ impl ParamFile {
         Self::load_with_columns(path).map(|(p, _)| p)
     }
 
-    /// Reads and checks a parameter file and its `[columns]` table
+    /// Reads and checks a parameter file and returns its `[columns]` table too
     /// ([`ParamFile::from_toml_str_with_columns`]).
     ///
     /// # Errors
     /// [`ParamError::Io`] when unreadable, else as
     /// [`ParamFile::from_toml_str_with_columns`].
-    pub fn load_with_columns(path: &Path) -> Result<(Self, ColumnMapping), ParamError> {
+    pub fn load_with_columns(path: &Path) -> Result<(Self, ColumnsTable), ParamError> {
         let text = std::fs::read_to_string(path).map_err(|source| ParamError::Io {
             path: path.display().to_string(),
             source,

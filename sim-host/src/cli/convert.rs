@@ -11,7 +11,6 @@ use super::output_guard::OutputGuard;
 use super::{progress, render, Interruption};
 use clap::Args;
 use sim_host::log::{Format, LogFile, LogWriter, OpenOptions, Row, RowSink};
-use sim_host::params::ParamFile;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -113,7 +112,7 @@ pub fn run(args: &ConvertArgs) -> anyhow::Result<()> {
     inputs.extend(args.params.as_deref());
     OutputGuard::new(&inputs).check_files(&[&args.output])?;
     let columns = match &args.params {
-        Some(p) => ParamFile::load_with_columns(p)?.1,
+        Some(p) => sim_host::log::mapping::load_params(p)?.1,
         None => Default::default(),
     };
     let opts = OpenOptions {

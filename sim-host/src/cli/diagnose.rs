@@ -104,7 +104,7 @@ fn baseline_of(
 /// Bad parameter file or log (one line naming the file, line and column), or a log the
 /// core cannot be configured for.
 pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
-    let (params, columns) = ParamFile::load_with_columns(&args.params)?;
+    let (params, columns) = sim_host::log::mapping::load_params(&args.params)?;
     let open = OpenOptions {
         group: args.group.clone(),
         columns,

@@ -24,6 +24,7 @@
 //! ([`missing_column`]).
 
 use super::{Column, LogError};
+use crate::params::{ColumnsTable, ParamError, ParamFile};
 
 /// The unit a log's channel is recorded in; see the module documentation for the list.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -321,18 +322,6 @@ pub(super) fn resolve_unit(
     }
 }
 
-/// One entry of the parameter file's `[columns]` table: `ia_A = { name = "Ia", unit =
-/// "mA" }` (the key a schema column, `name` the log's channel, `unit` optional).
-#[derive(Debug, Clone, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct ColumnEntry {
-    /// The channel's name in the log.
-    pub name: String,
-    /// Its unit (see the module documentation); absent: the schema's SI unit.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub unit: Option<String>,
-}
-
 impl ColumnMapping {
     /// The mapping of a `[columns]` table for a machine of `pole_pairs` pole pairs.
     ///
@@ -340,10 +329,7 @@ impl ColumnMapping {
     /// A one-line message naming the key: not a schema column (the message lists them), a
     /// unit the column cannot be recorded in, an empty name, two columns naming one
     /// channel.
-    pub fn from_table(
-        table: &std::collections::BTreeMap<String, ColumnEntry>,
-        pole_pairs: u32,
-    ) -> Result<Self, String> {
+    pub fn from_table(table: &ColumnsTable, pole_pairs: u32) -> Result<Self, String> {
         let mut m = ColumnMapping::new(pole_pairs);
         for (key, e) in table {
             let Some(c) = Column::ALL.iter().find(|c| c.name() == key.as_str()) else {
@@ -362,6 +348,23 @@ impl ColumnMapping {
         }
         Ok(m)
     }
+}
+
+/// Reads and checks the parameter file `path` and the mapping of its `[columns]` table
+/// (the machine's pole pairs for `Hz_el`): what a command that reads a log loads.
+///
+/// # Errors
+/// As [`ParamFile::load_with_columns`]; [`ParamError::Columns`] naming the `[columns]` key
+/// that is wrong ([`ColumnMapping::from_table`]).
+pub fn load_params(path: &std::path::Path) -> Result<(ParamFile, ColumnMapping), ParamError> {
+    let (p, table) = ParamFile::load_with_columns(path)?;
+    let columns = ColumnMapping::from_table(&table, p.motor.poles / 2).map_err(|message| {
+        ParamError::Columns {
+            path: path.display().to_string(),
+            message,
+        }
+    })?;
+    Ok((p, columns))
 }
 
 /// Levenshtein distance between two short strings (characters).
