@@ -346,6 +346,20 @@ impl ColumnMapping {
                 .transpose()?;
             m.set(*c, &e.name, unit)?;
         }
+        // A column left out keeps its schema name: no mapped column may take it.
+        for (i, a) in Column::ALL.iter().enumerate() {
+            if let Some(b) = Column::ALL[i + 1..]
+                .iter()
+                .find(|b| m.name_of(**b) == m.name_of(*a))
+            {
+                return Err(format!(
+                    "{} and {} both name channel '{}'",
+                    a.name(),
+                    b.name(),
+                    m.name_of(*a)
+                ));
+            }
+        }
         Ok(m)
     }
 }
@@ -613,6 +627,25 @@ mod tests {
             .set(Column::Va, "U1", Some(ChannelUnit::Amperes))
             .unwrap_err();
         assert!(e.contains("va_V") && e.contains("'A'"), "{e}");
+    }
+
+    #[test]
+    fn a_table_of_the_parameter_file() {
+        let entry = |name: &str, unit: Option<&str>| crate::params::ColumnEntry {
+            name: name.into(),
+            unit: unit.map(Into::into),
+        };
+        let mut t = ColumnsTable::new();
+        t.insert("wm_rad_s".into(), entry("n", Some("Hz_el")));
+        t.insert("ia_A".into(), entry("ib_A", None));
+        let e = ColumnMapping::from_table(&t, 2).unwrap_err();
+        assert!(e.contains("ia_A and ib_A both name channel 'ib_A'"), "{e}");
+        // A swap of two phases is fine.
+        t.insert("ib_A".into(), entry("ia_A", None));
+        let m = ColumnMapping::from_table(&t, 2).unwrap();
+        assert_eq!(m.name_of(Column::Ib), "ia_A");
+        assert_eq!(m.unit_of(Column::Speed), Some(ChannelUnit::ElectricalHz));
+        assert_eq!(m.name_of(Column::Time), "t_s");
     }
 
     #[test]
