@@ -158,11 +158,7 @@ pub(super) fn row_from_values(v: &[f64; 9], columns: &ColumnMap) -> Row {
         v_abc: has(Column::Va).then_some([v[1] * k[1], v[2] * k[2], v[3] * k[3]]),
         i_abc: [v[4] * k[4], v[5] * k[5], v[6] * k[6]],
         wm_rad_s: has(Column::Speed).then_some(v[7] * k[7]),
-        enc_count: has(Column::Encoder).then_some(if v[8].is_finite() {
-            v[8].round() as i64
-        } else {
-            super::ENC_NOT_A_NUMBER
-        }),
+        enc_count: has(Column::Encoder).then_some(super::enc_count_of(v[8])),
     }
 }
 

@@ -138,7 +138,7 @@ pub enum LogError {
     NoValue {
         /// The file.
         path: String,
-        /// The channel (schema name, with the log's name when mapped).
+        /// The channel's schema name.
         channel: String,
         /// "holds no finite value", or what its values are instead.
         why: String,
@@ -278,37 +278,29 @@ pub struct Row {
     pub i_abc: [f64; 3],
     /// Rotor mechanical speed [rad/s].
     pub wm_rad_s: Option<f64>,
-    /// Cumulative encoder count (may be negative when running backwards);
-    /// [`ENC_NOT_A_NUMBER`] where the log's cell is missing or not finite (the data-quality
-    /// stage holds such a cell out, [`quality::BadCells`]).
+    /// Cumulative encoder count (may be negative when running backwards).
     pub enc_count: Option<i64>,
 }
 
-impl Row {
-    /// The value of column `c` in the schema's unit; `None` where the log lacks the
-    /// column, or for an encoder count that was not a number ([`ENC_NOT_A_NUMBER`]).
-    pub fn value(&self, c: Column) -> Option<f64> {
-        let v = self.v_abc;
-        match c {
-            Column::Time => Some(self.t_s),
-            Column::Va => v.map(|v| v[0]),
-            Column::Vb => v.map(|v| v[1]),
-            Column::Vc => v.map(|v| v[2]),
-            Column::Ia => Some(self.i_abc[0]),
-            Column::Ib => Some(self.i_abc[1]),
-            Column::Ic => Some(self.i_abc[2]),
-            Column::Speed => self.wm_rad_s,
-            Column::Encoder => self
-                .enc_count
-                .filter(|n| *n != ENC_NOT_A_NUMBER)
-                .map(|n| n as f64),
-        }
+/// The [`Row::enc_count`] of a cell that holds no readable count: not finite, or beyond
+/// `±2^53` where the readers' `f64` no longer carries every integer (a 64-bit counter
+/// near its overflow). The data-quality stage marks such a cell bad
+/// ([`quality::BadCells`]), as it does a non-finite current.
+pub const ENC_COUNT_UNREADABLE: i64 = i64::MIN;
+
+/// The largest encoder count the readers carry exactly, `2^53`.
+pub const ENC_COUNT_EXACT_MAX: f64 = 9_007_199_254_740_992.0;
+
+/// The encoder count of a cell's value: the nearest integer, or
+/// [`ENC_COUNT_UNREADABLE`] for a value that is not finite or beyond
+/// `±`[`ENC_COUNT_EXACT_MAX`].
+pub fn enc_count_of(x: f64) -> i64 {
+    if x.is_finite() && x.abs() <= ENC_COUNT_EXACT_MAX {
+        x.round() as i64
+    } else {
+        ENC_COUNT_UNREADABLE
     }
 }
-
-/// The [`Row::enc_count`] of a cell that is missing, NaN or infinite (no count can be
-/// this: it is the most negative `i64`).
-pub const ENC_NOT_A_NUMBER: i64 = i64::MIN;
 
 /// Which optional channels a log carries.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -329,6 +321,28 @@ impl Channels {
             Column::Va | Column::Vb | Column::Vc => self.voltages,
             Column::Speed => self.speed,
             Column::Encoder => self.encoder,
+        }
+    }
+}
+
+impl Row {
+    /// The value of column `c` in the schema's unit; `None` where the log lacks the
+    /// column, or for an encoder count that was not a number ([`ENC_COUNT_UNREADABLE`]).
+    pub fn value(&self, c: Column) -> Option<f64> {
+        let v = self.v_abc;
+        match c {
+            Column::Time => Some(self.t_s),
+            Column::Va => v.map(|v| v[0]),
+            Column::Vb => v.map(|v| v[1]),
+            Column::Vc => v.map(|v| v[2]),
+            Column::Ia => Some(self.i_abc[0]),
+            Column::Ib => Some(self.i_abc[1]),
+            Column::Ic => Some(self.i_abc[2]),
+            Column::Speed => self.wm_rad_s,
+            Column::Encoder => self
+                .enc_count
+                .filter(|n| *n != ENC_COUNT_UNREADABLE)
+                .map(|n| n as f64),
         }
     }
 }
@@ -510,7 +524,7 @@ mod tests {
             assert_eq!(c.rows.len(), 3);
             assert!(c.rows[0].i_abc[1].is_nan() && c.rows[1].i_abc.iter().all(|x| x.is_nan()));
             assert_eq!(c.rows[0].enc_count, Some(5));
-            assert_eq!(c.rows[1].enc_count, Some(ENC_NOT_A_NUMBER));
+            assert_eq!(c.rows[1].enc_count, Some(ENC_COUNT_UNREADABLE));
             assert_eq!(c.rows[2].value(Column::Encoder), None);
         }
         // Units: ms and mA, one multiplication each; epoch ms counted from the first row.

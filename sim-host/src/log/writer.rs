@@ -152,7 +152,7 @@ impl LogWriter {
             // Writing into a String cannot fail.
             match r.enc_count.unwrap_or_default() {
                 // (A count that was not a number stays one.)
-                super::ENC_NOT_A_NUMBER => l.push_str("NaN"),
+                super::ENC_COUNT_UNREADABLE => l.push_str("NaN"),
                 n => {
                     let _ = write!(l, "{n}");
                 }

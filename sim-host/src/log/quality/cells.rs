@@ -1,6 +1,6 @@
 //! Bad cells: values no sensor of the machine should report ([`CellLimits`], [`BadCells`]),
 //! and missing ones (NaN, and an encoder count that was not a number,
-//! [`crate::log::ENC_NOT_A_NUMBER`]).
+//! [`crate::log::ENC_COUNT_UNREADABLE`]).
 
 use crate::log::{Column, Row};
 use crate::params::ParamFile;
@@ -69,7 +69,7 @@ impl BadCells {
         if row.wm_rad_s.is_some_and(|w| bad(w, lim.wm_max)) {
             b.set(Column::Speed);
         }
-        if row.enc_count == Some(crate::log::ENC_NOT_A_NUMBER) {
+        if row.enc_count == Some(crate::log::ENC_COUNT_UNREADABLE) {
             b.set(Column::Encoder);
         }
         b
