@@ -33,6 +33,20 @@ impl CellLimits {
     }
 }
 
+impl CellLimits {
+    /// True when `x`, a cell of column `c`, lies beyond its limit (voltages, currents,
+    /// speed; never for the time and the encoder count).
+    pub fn beyond(&self, c: Column, x: f64) -> bool {
+        let max = match c {
+            Column::Va | Column::Vb | Column::Vc => self.v_max,
+            Column::Ia | Column::Ib | Column::Ic => self.i_max,
+            Column::Speed => self.wm_max,
+            Column::Time | Column::Encoder => return false,
+        };
+        x.abs() > max
+    }
+}
+
 /// The bad cells of a row: one bit per [`Column`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct BadCells(u16);

@@ -34,14 +34,17 @@
 //! clock a little off the estimated period is followed. A row within [`CLOCK_EXACT`] of a
 //! period of the clock, and every row off the grid, keeps its own time.
 //!
-//! **Cells.** A cell that is not finite (a missing value, `NaN`, `inf`: one rule for all,
-//! see [`super::is_missing`]) or lies beyond [`CellLimits`] (far beyond what the machine
-//! could draw or the supply could give) is bad ([`BadCells`]); consecutive rows with bad
-//! cells form a glitch burst. When at least [`UNUSABLE_FRACTION`] of the rows have a bad cell,
-//! nothing is left to analyse: an error names the channel with the most bad cells and
-//! what they are ([`LogError::NoValue`]). Blank lines of a CSV are skipped and counted. The stage counts them and hands the rows on,
+//! **Cells.** A cell that is not finite or lies beyond [`CellLimits`] (far beyond what the
+//! machine could draw or the supply could give) is bad ([`BadCells`]); consecutive rows
+//! with bad cells form a glitch burst. The stage counts them and hands the rows on,
 //! flagged: the monitor holds such samples out as the firmware does with impossible ADC
 //! readings, the analysis drops them and bridges the hole like dropped samples.
+//!
+//! **Missing values**, one rule: an empty CSV cell, `NA`, `null`, `NaN` and `inf` are all
+//! read as NaN ([`super::is_missing`]) and are bad cells alike. When at least
+//! [`UNUSABLE_FRACTION`] of the rows have a bad cell, nothing is left to analyse: an error
+//! names the channel with the most bad cells and what they are ([`LogError::NoValue`]).
+//! Blank lines of a CSV are skipped and counted (`DataQuality::blank_lines`).
 //!
 //! **Supply frequency.** The median period of the phase-a current's zero crossings is
 //! compared with the parameter file's supply frequency; a difference over
@@ -154,8 +157,8 @@ pub struct QualityStage<'a, S: CleanSink> {
     clips: super::clipping::ClipTracker,
     jitter: (f64, u64),
     dropping: bool,
-    /// Cells not finite, per column.
-    non_finite: [u64; 9],
+    /// Bad cells per column: [not finite, finite but beyond the limits].
+    cells_out: [[u64; 2]; 9],
     q: DataQuality,
     error: Option<LogError>,
     stopped: bool,
@@ -185,7 +188,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             clips: super::clipping::ClipTracker::default(),
             jitter: (0.0, 0),
             dropping: false,
-            non_finite: [0; 9],
+            cells_out: [[0; 2]; 9],
             q: DataQuality::default(),
             error: None,
             stopped: false,
@@ -201,14 +204,17 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         if rows == 0 || (self.q.bad_rows as f64) < UNUSABLE_FRACTION * rows as f64 {
             return None;
         }
-        let (c, n) = Column::ALL
+        // The channel with the most cells missing or out of range; a log made unusable by
+        // other bad cells (stuck channels...) is left to the command's own judgement.
+        let (c, [non_finite, beyond]) = Column::ALL
             .into_iter()
-            .map(|c| (c, self.q.bad_cells.get(c.name()).copied().unwrap_or(0)))
-            .max_by_key(|(_, n)| *n)?;
-        let non_finite = self.non_finite[c as usize];
+            .map(|c| (c, self.cells_out[c as usize]))
+            .max_by_key(|(_, n)| n[0] + n[1])?;
         let why = if non_finite == rows {
             "holds no finite value (every cell is empty, NA, null, NaN or inf)".to_string()
-        } else if 2 * non_finite >= n {
+        } else if 2 * (non_finite + beyond) < rows {
+            return None;
+        } else if non_finite >= beyond {
             format!("has {non_finite} of its {rows} cells empty, NA, null, NaN or inf: nothing is left to analyse")
         } else {
             let (limit, unit, other) = match c {
@@ -217,7 +223,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
                 _ => (self.limits.wm_max, "rad/s", "rpm"),
             };
             format!(
-                "has {n} of its {rows} values beyond +/-{limit:.0} {unit} (twice this motor's sensor range): if it is recorded in another unit, give it in the parameter file's [columns] table, e.g. {} = {{ name = \"...\", unit = \"{other}\" }} (docs/design.md)",
+                "has {beyond} of its {rows} values beyond +/-{limit:.0} {unit} (twice this motor's sensor range): if it is recorded in another unit, give it in the parameter file's [columns] table, e.g. {} = {{ name = \"...\", unit = \"{other}\" }} (docs/design.md)",
                 c.name()
             )
         };
@@ -473,7 +479,9 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
                 if bad.has(c) {
                     *self.q.bad_cells.entry(c.name().to_string()).or_insert(0) += 1;
                     let x = r.value(c).unwrap_or(f64::NAN);
-                    self.non_finite[c as usize] += u64::from(!x.is_finite());
+                    let (finite, beyond) = (x.is_finite(), self.limits.beyond(c, x));
+                    self.cells_out[c as usize][0] += u64::from(!finite);
+                    self.cells_out[c as usize][1] += u64::from(finite && beyond);
                 }
             }
             let start = self.burst.map_or(r.t_s, |b| b.0);
@@ -535,7 +543,7 @@ impl<S: CleanSink> RowSink for QualityStage<'_, S> {
         self.crossings = CrossingCounter::default();
         self.jitter = (0.0, 0);
         self.dropping = false;
-        self.non_finite = [0; 9];
+        self.cells_out = [[0; 2]; 9];
         self.q = DataQuality::default();
         self.error = None;
         self.stopped = false;
