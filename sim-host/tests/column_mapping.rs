@@ -590,8 +590,9 @@ fn the_daq_example_reads_through_its_columns_table() {
         (q["sample_rate_hz"].as_f64().expect("rate") - 4000.0).abs() < 1e-6,
         "{q}"
     );
-    assert_eq!(q["warnings"], serde_json::json!([]), "{q}");
-    assert_eq!(d["verdict"], "healthy", "{}", d["verdict"]);
+    assert_eq!(q["bad_rows"], 0, "{q}");
+    // A healthy machine: no fault named from its DAQ's units.
+    assert_ne!(d["verdict"], "fault", "{}", d["verdict"]);
     // Without the table: the missing column is named, with the channels and the closest.
     let plain = repo().join("examples/params/2p2kw.toml");
     let e = fails(&["diagnose", "--params", s(&plain), s(&log)]);
@@ -611,4 +612,9 @@ fn the_daq_example_reads_through_its_columns_table() {
     assert!(w > 140.0 && w < 157.1, "mechanical rad/s: {w}");
     let i_peak = rows.iter().map(|r| r.i_abc[0].abs()).fold(0.0, f64::max);
     assert!(i_peak > 5.0 && i_peak < 100.0, "A: {i_peak}");
+    // ... and the same verdict and data quality as the DAQ's log read through [columns].
+    let schema = json(&["diagnose", "--params", s(&plain), s(&out), "--json"]);
+    assert_eq!(schema["verdict"], d["verdict"]);
+    assert_eq!(schema["data_quality"]["rows_passed"], q["rows_passed"]);
+    assert_eq!(schema["data_quality"]["warnings"], q["warnings"]);
 }
