@@ -148,11 +148,20 @@ impl ExactRows {
 
 /// The row of the values of every schema column (in [`Column::ALL`] order; absent columns
 /// are ignored) for a log with `columns`.
+#[inline]
 pub(super) fn row_from_values(v: &[f64; 9], columns: &ColumnMap) -> Row {
     let has = |c: Column| columns.of(c).is_some();
-    // To the schema's SI units: one multiplication per cell (1.0 without a mapping, which
-    // leaves every value as it is).
+    // To the schema's SI units: one multiplication per cell (none without a mapping).
     let k = &columns.scale;
+    if !columns.scaled {
+        return Row {
+            t_s: v[0],
+            v_abc: has(Column::Va).then_some([v[1], v[2], v[3]]),
+            i_abc: [v[4], v[5], v[6]],
+            wm_rad_s: has(Column::Speed).then_some(v[7]),
+            enc_count: has(Column::Encoder).then_some(super::enc_count_of(v[8])),
+        };
+    }
     Row {
         t_s: v[0] * k[0],
         v_abc: has(Column::Va).then_some([v[1] * k[1], v[2] * k[2], v[3] * k[3]]),

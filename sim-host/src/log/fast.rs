@@ -230,6 +230,7 @@ fn parse_number_parts(b: &[u8]) -> Option<(f64, i32, usize)> {
 /// `null`), ended by a field or line end or a space: `(NaN, 0, bytes used)`. Tried only
 /// where no number parses, so it costs nothing on a cell that is a number.
 #[cold]
+#[inline(never)]
 fn missing_cell(b: &[u8]) -> Option<(f64, i32, usize)> {
     let k = b
         .iter()
@@ -272,7 +273,10 @@ fn parse_line(b: &[u8], mut i: usize, cols: &Cols, row: &mut [f64; MAX_COLS]) ->
         while i < n && b[i] == b' ' {
             i += 1;
         }
-        let (v, e, k) = parse_number_parts(&b[i..]).or_else(|| missing_cell(&b[i..]))?;
+        let (v, e, k) = match parse_number_parts(&b[i..]) {
+            Some(p) => p,
+            None => missing_cell(&b[i..])?,
+        };
         row[slot] = v;
         exp[slot] = e;
         i += k;

@@ -64,6 +64,8 @@ pub(super) struct ColumnMap {
     pub n_fields: usize,
     /// The factor from each column's unit to the schema's SI unit ([`ColumnMapping`]).
     pub scale: [f64; 9],
+    /// False when every factor is 1 (the rows need no multiplication).
+    pub scaled: bool,
     /// How the time column is read.
     pub time: TimeKind,
     /// A timestamp's factor to seconds, applied after the first row's time is subtracted
@@ -107,6 +109,7 @@ impl ColumnMap {
             field,
             n_fields: found.len(),
             scale: [1.0; 9],
+            scaled: false,
             time: TimeKind::Plain,
             time_factor: 1.0,
             names: Column::ALL.map(|c| mapping.name_of(c).to_string()),
@@ -123,6 +126,7 @@ impl ColumnMap {
         if self.time != TimeKind::Plain {
             self.time_factor = std::mem::replace(&mut self.scale[0], 1.0);
         }
+        self.scaled = self.scale.iter().any(|k| *k != 1.0);
     }
 
     /// The channel name of field `i` (for messages).

@@ -65,6 +65,7 @@ impl BadCells {
     }
 
     /// The bad cells of `row` against `lim`.
+    #[inline]
     pub fn of(row: &Row, lim: &CellLimits) -> Self {
         let mut b = BadCells::default();
         let bad = |x: f64, max: f64| !x.is_finite() || x.abs() > max;
