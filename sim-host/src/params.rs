@@ -15,6 +15,15 @@
 //! v_ll_rms = 220.0 # line-to-line RMS voltage [V]
 //! f_hz = 60.0      # supply frequency [Hz]
 //! ```
+//! An optional `[columns]` table maps the log's channels and units to the schema's
+//! columns ([`ColumnsTable`], read into a mapping by the log reader,
+//! `crate::log::ColumnMapping`; `docs/design.md`):
+//! ```toml
+//! [columns]
+//! t_s = { name = "Time", unit = "ms" }
+//! ia_A = { name = "Ia", unit = "mA" }
+//! wm_rad_s = { name = "Speed", unit = "rpm" }
+//! ```
 //! Unknown keys are an error (a typo must not pass silently) and a missing key is named.
 //!
 //! The sections are the core's [`MotorParameters`] and [`SupplyParameters`] (one type for
@@ -55,6 +64,16 @@ pub enum ParamError {
         path: String,
         /// Which key, its value and the plausible range.
         source: Implausible,
+    },
+    /// The `[columns]` table is wrong (a key that is no schema column, a unit the column
+    /// cannot have, two columns naming one channel), as the log reader finds it
+    /// (`crate::log::mapping::load_params`).
+    #[error("bad parameter file {path}: [columns] {message}")]
+    Columns {
+        /// The file.
+        path: String,
+        /// What is wrong, naming the key.
+        message: String,
     },
     /// A value is outside its physical range.
     #[error("bad parameter file {path}: {source}")]
@@ -237,19 +256,66 @@ pub struct ParamFile {
     pub supply: SupplyParameters,
 }
 
+/// One entry of the parameter file's `[columns]` table: `ia_A = { name = "Ia", unit =
+/// "mA" }` (the key a schema column, `name` the log's channel, `unit` optional). What the
+/// keys and units may be, and the mapping built from them, is the log reader's
+/// (`crate::log::ColumnMapping::from_table`, `docs/design.md`).
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ColumnEntry {
+    /// The channel's name in the log.
+    pub name: String,
+    /// Its unit; absent: the schema's SI unit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<String>,
+}
+
+/// The `[columns]` table: schema column name to [`ColumnEntry`].
+pub type ColumnsTable = std::collections::BTreeMap<String, ColumnEntry>;
+
+/// The file as written: [`ParamFile`]'s sections and the optional `[columns]` table.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileSections {
+    motor: MotorParameters,
+    supply: SupplyParameters,
+    #[serde(default)]
+    columns: ColumnsTable,
+}
+
 impl ParamFile {
-    /// Parses TOML text; `origin` names the source in messages.
+    /// Parses TOML text; `origin` names the source in messages. A `[columns]` table is
+    /// left out ([`ParamFile::from_toml_str_with_columns`] returns it).
+    ///
+    /// # Errors
+    /// As [`ParamFile::from_toml_str_with_columns`].
+    pub fn from_toml_str(text: &str, origin: &str) -> Result<Self, ParamError> {
+        Self::from_toml_str_with_columns(text, origin).map(|(p, _)| p)
+    }
+
+    /// Parses TOML text and returns its `[columns]` table too, the mapping of the schema's
+    /// columns to a log's channels and units (checked and built by the log reader,
+    /// `crate::log::mapping::load_params`; `docs/design.md`); `origin` names the source in
+    /// messages.
     ///
     /// # Errors
     /// [`ParamError::Toml`] for malformed TOML (with its line and column) or an unknown or
-    /// missing key, [`ParamError::Implausible`] for a value outside the range of real
-    /// machines ([`ParamFile::check_plausible`]), [`ParamError::Range`] for a value the
-    /// equations cannot take ([`ParamFile::check`]); each names the key.
-    pub fn from_toml_str(text: &str, origin: &str) -> Result<Self, ParamError> {
-        let p: ParamFile = toml::from_str(text).map_err(|e| ParamError::Toml {
+    /// missing key (in a `[columns]` entry too), [`ParamError::Implausible`] for a value
+    /// outside the range of real machines ([`ParamFile::check_plausible`]),
+    /// [`ParamError::Range`] for a value the equations cannot take ([`ParamFile::check`]);
+    /// each names the key.
+    pub fn from_toml_str_with_columns(
+        text: &str,
+        origin: &str,
+    ) -> Result<(Self, ColumnsTable), ParamError> {
+        let f: FileSections = toml::from_str(text).map_err(|e| ParamError::Toml {
             path: origin.to_string(),
             message: toml_error_message(text, &e),
         })?;
+        let p = ParamFile {
+            motor: f.motor,
+            supply: f.supply,
+        };
         p.check_plausible()
             .map_err(|source| ParamError::Implausible {
                 path: origin.to_string(),
@@ -259,7 +325,7 @@ impl ParamFile {
             path: origin.to_string(),
             source,
         })?;
-        Ok(p)
+        Ok((p, f.columns))
     }
 
     /// Checks that every value lies in the range of real induction machines
@@ -395,11 +461,21 @@ impl ParamFile {
     /// # Errors
     /// [`ParamError::Io`] when unreadable, else as [`ParamFile::from_toml_str`].
     pub fn load(path: &Path) -> Result<Self, ParamError> {
+        Self::load_with_columns(path).map(|(p, _)| p)
+    }
+
+    /// Reads and checks a parameter file and returns its `[columns]` table too
+    /// ([`ParamFile::from_toml_str_with_columns`]).
+    ///
+    /// # Errors
+    /// [`ParamError::Io`] when unreadable, else as
+    /// [`ParamFile::from_toml_str_with_columns`].
+    pub fn load_with_columns(path: &Path) -> Result<(Self, ColumnsTable), ParamError> {
         let text = std::fs::read_to_string(path).map_err(|source| ParamError::Io {
             path: path.display().to_string(),
             source,
         })?;
-        Self::from_toml_str(&text, &path.display().to_string())
+        Self::from_toml_str_with_columns(&text, &path.display().to_string())
     }
 
     /// Checks that the equations can take the values (finite, positive, Ls >= Lm, ...): the

@@ -75,7 +75,7 @@ impl Common {
 
     /// Reads the parameter file and the log (with a progress bar for large logs).
     fn load(&self) -> anyhow::Result<Analysis> {
-        let params = sim_host::params::ParamFile::load(&self.params)?;
+        let (params, columns) = sim_host::log::mapping::load_params(&self.params)?;
         let big = std::fs::metadata(&self.log)
             .map(|m| m.len() > 20_000_000)
             .unwrap_or(false);
@@ -83,6 +83,7 @@ impl Common {
             &self.log,
             &sim_host::log::OpenOptions {
                 group: self.group.clone(),
+                columns,
             },
         )
         .context("cannot analyse the log")?;

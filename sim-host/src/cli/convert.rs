@@ -23,8 +23,12 @@ the formats are chosen by the file extensions (anything else is CSV). Channels k
 column names (t_s, va_V, vb_V, vc_V, ia_A, ib_A, ic_A, wm_rad_s, enc_count). Every writer \
 stores t_s at f64 and the other channels at f32 precision (7 significant digits). A TDMS \
 input whose time is in the waveform properties (wf_start_offset, wf_increment) gets a t_s \
-column.\n\nThe output is written atomically and is never the input.\n\nExamples:\n  \
-sim-host convert run.csv run.parquet\n  sim-host convert daq.tdms --group Motor daq.csv"
+column.\n\nA log whose channels have other names or units (Ia in mA, time in ms, speed in \
+rpm) is read through the [columns] table of the parameter file given with --params \
+(docs/design.md); the output then has the schema's names and SI units.\n\nThe output is \
+written atomically and is never the input.\n\nExamples:\n  \
+sim-host convert run.csv run.parquet\n  sim-host convert daq.tdms --group Motor daq.csv\n  \
+sim-host convert --params examples/params/daq_2p2kw.toml examples/logs/daq_2p2kw.csv run.csv"
 )]
 pub struct ConvertArgs {
     /// The log to read.
@@ -34,6 +38,10 @@ pub struct ConvertArgs {
     /// The TDMS group holding the channels (when the input has several).
     #[arg(long, value_name = "NAME")]
     pub group: Option<String>,
+    /// A parameter file whose `[columns]` table maps the input's channels and units to the
+    /// schema's (docs/design.md); the output has the schema's names and SI units.
+    #[arg(long, value_name = "P.toml")]
+    pub params: Option<PathBuf>,
     /// Print one JSON summary document on stdout instead of the text summary.
     #[arg(long)]
     pub json: bool,
@@ -100,9 +108,16 @@ impl RowSink for Copy<'_> {
 /// An output that is the input, an unreadable or malformed input (one line naming the
 /// file, line and column), an I/O error writing the output, or [`super::Interrupted`].
 pub fn run(args: &ConvertArgs) -> anyhow::Result<()> {
-    OutputGuard::new(&[&args.input]).check_files(&[&args.output])?;
+    let mut inputs = vec![args.input.as_path()];
+    inputs.extend(args.params.as_deref());
+    OutputGuard::new(&inputs).check_files(&[&args.output])?;
+    let columns = match &args.params {
+        Some(p) => sim_host::log::mapping::load_params(p)?.1,
+        None => Default::default(),
+    };
     let opts = OpenOptions {
         group: args.group.clone(),
+        columns,
     };
     let file = LogFile::open_with(&args.input, &opts)?;
     let start = Instant::now();

@@ -79,16 +79,10 @@ pub struct DiagnoseArgs {
 fn baseline_of(
     params: &ParamFile,
     path: &std::path::Path,
-    args: &DiagnoseArgs,
+    open: &OpenOptions,
     opts: ReplayOptions,
 ) -> anyhow::Result<sim_host::replay::UnbalanceBaseline> {
-    let file = LogFile::open_with(
-        path,
-        &OpenOptions {
-            group: args.group.clone(),
-        },
-    )
-    .map_err(|e| anyhow::anyhow!("--baseline: {e}"))?;
+    let file = LogFile::open_with(path, open).map_err(|e| anyhow::anyhow!("--baseline: {e}"))?;
     let opts = ReplayOptions {
         commission: None,
         ..opts
@@ -110,7 +104,11 @@ fn baseline_of(
 /// Bad parameter file or log (one line naming the file, line and column), or a log the
 /// core cannot be configured for.
 pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
-    let params = ParamFile::load(&args.params)?;
+    let (params, columns) = sim_host::log::mapping::load_params(&args.params)?;
+    let open = OpenOptions {
+        group: args.group.clone(),
+        columns,
+    };
     let mut opts = ReplayOptions {
         angle_source: args.angle.into(),
         residual_form: args.residuals.into(),
@@ -120,17 +118,12 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         unbalance_baseline: None,
     };
     if let Some(healthy) = &args.baseline {
-        opts.unbalance_baseline = Some(baseline_of(&params, healthy, args, opts)?);
+        opts.unbalance_baseline = Some(baseline_of(&params, healthy, &open, opts)?);
     }
     let big = std::fs::metadata(&args.log)
         .map(|m| m.len() > 20_000_000)
         .unwrap_or(false);
-    let file = LogFile::open_with(
-        &args.log,
-        &OpenOptions {
-            group: args.group.clone(),
-        },
-    )?;
+    let file = LogFile::open_with(&args.log, &open)?;
     let bar = progress::bar(progress::FRACTION_STEPS, "reading log", big);
     let d = diagnose_log(&params, &file, opts, &mut |f| {
         progress::set_fraction(&bar, f)

@@ -12,7 +12,6 @@ use sim_host::hmi::live::LiveSim;
 use sim_host::hmi::log_replay::LogReplay;
 use sim_host::hmi::status_line::StdinStatus;
 use sim_host::hmi::{key_help, HmiState, Key, Source, Speed};
-use sim_host::params::ParamFile;
 use sim_host::replay::ReplayOptions;
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
@@ -112,7 +111,17 @@ impl From<SpeedArg> for Speed {
 /// A bad parameter file or log (one line naming it), a terminal that cannot be set up, or
 /// stdout that cannot be written.
 pub fn run(args: &HmiArgs) -> anyhow::Result<()> {
-    let params = args.params.as_deref().map(ParamFile::load).transpose()?;
+    // The parameter file with its [columns] mapping (a log replay reads the log's own
+    // channel names and units through it).
+    let loaded = args
+        .params
+        .as_deref()
+        .map(sim_host::log::mapping::load_params)
+        .transpose()?;
+    let (params, columns) = match loaded {
+        Some((p, c)) => (Some(p), c),
+        None => (None, Default::default()),
+    };
     let plain_text = args.plain || !std::io::stdout().is_terminal();
     let mut source: Box<dyn Source> = if args.stdin && plain_text {
         Box::new(StdinStatus::stdin().one_at_a_time())
@@ -134,7 +143,11 @@ pub fn run(args: &HmiArgs) -> anyhow::Result<()> {
         } else {
             args.speed.into()
         };
-        Box::new(LogReplay::start(params, log, opts, speed)?)
+        let open = sim_host::log::OpenOptions {
+            columns,
+            ..Default::default()
+        };
+        Box::new(LogReplay::start_with(params, log, open, opts, speed)?)
     } else if let Some(p) = params {
         Box::new(LiveSim::new(
             p,

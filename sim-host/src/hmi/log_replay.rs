@@ -9,7 +9,7 @@ use super::{
     quit_key, Controls, HmiState, Key, PlaybackControls, Snapshot, Source, Speed, HISTORY_S,
     SNAPSHOT_EVERY_S,
 };
-use crate::log::{LogFile, Row};
+use crate::log::{LogFile, OpenOptions, Row};
 use crate::params::ParamFile;
 use crate::replay::{diagnose_file_observed, Replay, ReplayError, ReplayObserver, ReplayOptions};
 use monitor_core::MonitorOutput;
@@ -57,12 +57,27 @@ impl LogReplay {
         opts: ReplayOptions,
         speed: Speed,
     ) -> Result<Self, ReplayError> {
-        LogFile::open(path)?;
+        Self::start_with(params, path, OpenOptions::default(), opts, speed)
+    }
+
+    /// [`LogReplay::start`] with the log opened with `open` (the parameter file's
+    /// `[columns]` mapping, a TDMS group).
+    ///
+    /// # Errors
+    /// As [`LogReplay::start`].
+    pub fn start_with(
+        params: ParamFile,
+        path: &Path,
+        open: OpenOptions,
+        opts: ReplayOptions,
+        speed: Speed,
+    ) -> Result<Self, ReplayError> {
+        LogFile::open_with(path, &open)?;
         let shared = Arc::new(Mutex::new(Analysis::default()));
         let worker = {
             let shared = Arc::clone(&shared);
             let path = path.to_path_buf();
-            std::thread::spawn(move || analyse(&params, &path, opts, &shared))
+            std::thread::spawn(move || analyse(&params, &path, &open, opts, &shared))
         };
         Ok(LogReplay {
             path: path.to_path_buf(),
@@ -118,7 +133,13 @@ impl Drop for LogReplay {
 }
 
 /// The worker: the replay with an observer that keeps the readings.
-fn analyse(params: &ParamFile, path: &Path, opts: ReplayOptions, shared: &Arc<Mutex<Analysis>>) {
+fn analyse(
+    params: &ParamFile,
+    path: &Path,
+    open: &OpenOptions,
+    opts: ReplayOptions,
+    shared: &Arc<Mutex<Analysis>>,
+) {
     let mut keeper = Keeper {
         params: *params,
         shared: Arc::clone(shared),
@@ -126,7 +147,7 @@ fn analyse(params: &ParamFile, path: &Path, opts: ReplayOptions, shared: &Arc<Mu
         next_s: 0.0,
         stop: false,
     };
-    let result = diagnose_file_observed(params, path, opts, &mut |_| {}, &mut keeper);
+    let result = diagnose_file_observed(params, path, open, opts, &mut |_| {}, &mut keeper);
     keeper.flush();
     let mut a = shared.lock().unwrap_or_else(PoisonError::into_inner);
     a.done = true;

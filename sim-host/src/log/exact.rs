@@ -1,8 +1,11 @@
 //! The exact reader: row by row through the `csv` crate (quoting, any field count checks),
 //! slow but with messages that name the line and column. Behind the fast path. Like it, it
-//! hands over non-finite numbers and times that do not increase (the data-quality stage
-//! judges them); text that is not a number is an error.
+//! hands over non-finite numbers, missing values ([`super::is_missing`], as NaN) and times
+//! that do not increase (the data-quality stage judges them), skips blank lines and counts
+//! them; other text that is not a number is an error. It alone reads a time column of
+//! ISO 8601 text ([`super::mapping`]).
 
+use super::mapping::{parse_iso8601, TimeKind};
 use super::reader::{ColumnMap, LogFile};
 use super::{Column, LogError, Row};
 use std::fs::File;
@@ -14,6 +17,12 @@ pub(super) struct ExactRows {
     rdr: csv::Reader<BufReader<File>>,
     columns: ColumnMap,
     record: csv::ByteRecord,
+    /// The line of the last record (blank lines are the gaps between records).
+    last_line: u64,
+    /// Blank lines skipped so far.
+    blank: u64,
+    /// An ISO 8601 time column's first whole second (the times count from it).
+    iso_t0: Option<i64>,
 }
 
 impl ExactRows {
@@ -39,9 +48,17 @@ impl ExactRows {
         Ok(ExactRows {
             shown,
             rdr,
-            columns: *log.columns(),
+            columns: log.columns().clone(),
             record,
+            last_line: 1,
+            blank: 0,
+            iso_t0: None,
         })
+    }
+
+    /// Blank lines skipped so far (at the end of the file: all of them).
+    pub fn blank_lines(&self) -> u64 {
+        self.blank
     }
 
     /// Bytes read so far.
@@ -49,12 +66,19 @@ impl ExactRows {
         self.rdr.position().byte()
     }
 
-    fn cell(&self, c: Column, line: u64) -> Result<Option<f64>, LogError> {
+    fn cell(&mut self, c: Column, line: u64) -> Result<Option<f64>, LogError> {
         let Some(col) = self.columns.of(c) else {
             return Ok(None);
         };
         let raw = self.record.get(col).unwrap_or(b"");
         let s = std::str::from_utf8(raw).unwrap_or("");
+        if c == Column::Time && self.columns.time == TimeKind::Iso8601 {
+            let s = s.to_string();
+            return self.iso_time(&s, line).map(Some);
+        }
+        if super::is_missing(s) {
+            return Ok(Some(f64::NAN));
+        }
         s.parse::<f64>()
             .map(Some)
             .map_err(|_| LogError::NotNumeric {
@@ -65,17 +89,43 @@ impl ExactRows {
             })
     }
 
+    /// An ISO 8601 time [s since the first row's whole second]; a missing value is NaN.
+    fn iso_time(&mut self, s: &str, line: u64) -> Result<f64, LogError> {
+        if super::is_missing(s) {
+            return Ok(f64::NAN);
+        }
+        let (secs, frac) = parse_iso8601(s).ok_or_else(|| LogError::Csv {
+            path: self.shown.clone(),
+            line,
+            message: format!(
+                "column '{}': '{}' is not an ISO 8601 time (YYYY-MM-DDTHH:MM:SS[.fff][Z|+HH:MM]), as [columns] says",
+                self.columns.names[0],
+                s.chars().take(40).collect::<String>()
+            ),
+        })?;
+        let t0 = *self.iso_t0.get_or_insert(secs);
+        Ok((secs - t0) as f64 + frac)
+    }
+
     /// Reads the next row; `Ok(None)` at the end of the file.
     ///
     /// # Errors
     /// [`LogError::NotNumeric`] or [`LogError::Csv`], each naming the line.
     pub fn next_row(&mut self) -> Result<Option<Row>, LogError> {
         match self.rdr.read_byte_record(&mut self.record) {
-            Ok(false) => return Ok(None),
+            Ok(false) => {
+                // Blank lines at the end: the lines after the last record's.
+                let end = self.rdr.position().line();
+                self.blank += end.saturating_sub(self.last_line + 1);
+                self.last_line = end;
+                return Ok(None);
+            }
             Ok(true) => {}
             Err(e) => return Err(csv_error(&self.shown, &e)),
         }
         let line = self.record.position().map(|p| p.line()).unwrap_or(0);
+        self.blank += line.saturating_sub(self.last_line + 1);
+        self.last_line = line;
         let t = self.cell(Column::Time, line)?.unwrap_or(f64::NAN);
         let mut v = [0.0f64; 9];
         v[0] = t;
@@ -98,13 +148,25 @@ impl ExactRows {
 
 /// The row of the values of every schema column (in [`Column::ALL`] order; absent columns
 /// are ignored) for a log with `columns`.
+#[inline]
 pub(super) fn row_from_values(v: &[f64; 9], columns: &ColumnMap) -> Row {
     let has = |c: Column| columns.of(c).is_some();
+    // To the schema's SI units: one multiplication per cell (none without a mapping).
+    let k = &columns.scale;
+    if !columns.scaled {
+        return Row {
+            t_s: v[0],
+            v_abc: has(Column::Va).then_some([v[1], v[2], v[3]]),
+            i_abc: [v[4], v[5], v[6]],
+            wm_rad_s: has(Column::Speed).then_some(v[7]),
+            enc_count: has(Column::Encoder).then_some(super::enc_count_of(v[8])),
+        };
+    }
     Row {
-        t_s: v[0],
-        v_abc: has(Column::Va).then_some([v[1], v[2], v[3]]),
-        i_abc: [v[4], v[5], v[6]],
-        wm_rad_s: has(Column::Speed).then_some(v[7]),
+        t_s: v[0] * k[0],
+        v_abc: has(Column::Va).then_some([v[1] * k[1], v[2] * k[2], v[3] * k[3]]),
+        i_abc: [v[4] * k[4], v[5] * k[5], v[6] * k[6]],
+        wm_rad_s: has(Column::Speed).then_some(v[7] * k[7]),
         enc_count: has(Column::Encoder).then_some(super::enc_count_of(v[8])),
     }
 }

@@ -16,11 +16,13 @@
 //! times that do not increase are handed over: the data-quality stage judges them.
 
 use super::exact::row_from_values;
+use super::mapping::TimeKind;
 use super::reader::LogFile;
 use super::{Column, LogError, Row};
 use rayon::prelude::*;
 use std::fs::File;
 use std::io::{Read, Seek, SeekFrom};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Bytes per block (one parallel work item).
 pub(super) const BLOCK_BYTES: usize = 4 << 20;
@@ -224,6 +226,20 @@ fn parse_number_parts(b: &[u8]) -> Option<(f64, i32, usize)> {
     }
 }
 
+/// A missing value at the start of `b` ([`super::is_missing`]: an empty cell, `NA`,
+/// `null`), ended by a field or line end or a space: `(NaN, 0, bytes used)`. Tried only
+/// where no number parses, so it costs nothing on a cell that is a number.
+#[cold]
+#[inline(never)]
+fn missing_cell(b: &[u8]) -> Option<(f64, i32, usize)> {
+    let k = b
+        .iter()
+        .position(|c| matches!(c, b',' | b'\n' | b'\r' | b' '))
+        .unwrap_or(b.len());
+    let text = std::str::from_utf8(&b[..k]).ok()?;
+    super::is_missing(text).then_some((f64::NAN, 0, k))
+}
+
 /// One number at the start of `b` and the bytes used.
 #[cfg(test)]
 fn parse_number(b: &[u8]) -> Option<(f64, usize)> {
@@ -257,7 +273,10 @@ fn parse_line(b: &[u8], mut i: usize, cols: &Cols, row: &mut [f64; MAX_COLS]) ->
         while i < n && b[i] == b' ' {
             i += 1;
         }
-        let (v, e, k) = parse_number_parts(&b[i..])?;
+        let (v, e, k) = match parse_number_parts(&b[i..]) {
+            Some(p) => p,
+            None => missing_cell(&b[i..])?,
+        };
         row[slot] = v;
         exp[slot] = e;
         i += k;
@@ -285,13 +304,13 @@ fn parse_line(b: &[u8], mut i: usize, cols: &Cols, row: &mut [f64; MAX_COLS]) ->
 /// `out`. Empty lines are skipped. False at the first line the fast path does not accept.
 #[cfg(test)]
 fn parse_block(block: &[u8], cols: &Cols, out: &mut Vec<f64>) -> bool {
-    parse_block_with(block, cols, |slots| out.extend_from_slice(slots))
+    parse_block_with(block, cols, |slots| out.extend_from_slice(slots)).is_some()
 }
 
 /// Parses a block of whole lines and hands each row's first `cols.width` values to
-/// `on_row`. Empty lines are skipped. False at the first line the fast path does not
-/// accept.
-fn parse_block_with(block: &[u8], cols: &Cols, on_row: impl FnMut(&[f64])) -> bool {
+/// `on_row`. Empty lines are skipped and counted: returns their number, or `None` at the
+/// first line the fast path does not accept.
+fn parse_block_with(block: &[u8], cols: &Cols, on_row: impl FnMut(&[f64])) -> Option<u64> {
     // The row width as a constant, so that handing a row over is a few moves.
     match cols.width {
         4 => parse_block_w::<4>(block, cols, on_row),
@@ -309,33 +328,33 @@ fn parse_block_w<const W: usize>(
     block: &[u8],
     cols: &Cols,
     mut on_row: impl FnMut(&[f64]),
-) -> bool {
+) -> Option<u64> {
     let mut row = [0f64; MAX_COLS];
     let n = block.len();
     let mut i = 0;
+    let mut blank = 0u64;
     while i < n {
         match block[i] {
             b'\n' => {
                 i += 1;
+                blank += 1;
                 continue;
             }
             b'\r' if i + 1 >= n || block[i + 1] == b'\n' => {
                 i += 2;
+                blank += 1;
                 continue;
             }
             _ => {}
         }
-        match parse_line(block, i, cols, &mut row) {
-            Some(e) => i = e,
-            None => return false,
-        }
+        i = parse_line(block, i, cols, &mut row)?;
         if W > 0 {
             on_row(&row[..W]);
         } else {
             on_row(&row[..cols.width]);
         }
     }
-    true
+    Some(blank)
 }
 
 /// A parsed block's rows (the buffer is reused for the next block).
@@ -396,7 +415,8 @@ impl BlockReader {
 
 /// Streams the data rows of `log` in file order, parsing in parallel, `block` bytes per
 /// work item. `on_row` returns false to stop early. `progress` gets the fraction of the file read.
-/// Returns `Ok(false)` when the fast path gave up (see the module documentation).
+/// Returns the number of blank lines skipped, or `Ok(None)` when the fast path gave up
+/// (see the module documentation; a time column of ISO 8601 text is the exact reader's).
 ///
 /// # Errors
 /// I/O errors.
@@ -405,7 +425,10 @@ pub(super) fn for_each_row(
     block: usize,
     progress: &mut dyn FnMut(f64),
     on_row: &mut dyn FnMut(&Row) -> bool,
-) -> Result<bool, LogError> {
+) -> Result<Option<u64>, LogError> {
+    if log.columns().time == TimeKind::Iso8601 {
+        return Ok(None);
+    }
     let io = |source| LogError::Io {
         path: log.shown().to_string(),
         source,
@@ -444,9 +467,10 @@ pub(super) fn for_each_row(
     read_bytes += b;
     let mut to_hand: Option<Vec<Option<Parsed>>> = None;
     let mut outs: Vec<Parsed> = Vec::new();
+    let blank = AtomicU64::new(0);
     loop {
         if to_parse.is_empty() && to_hand.is_none() {
-            return Ok(true);
+            return Ok(Some(blank.into_inner()));
         }
         let mut next: Option<std::io::Result<(Vec<Vec<u8>>, u64)>> = None;
         let mut parsed: Option<Vec<Option<Parsed>>> = None;
@@ -461,15 +485,18 @@ pub(super) fn for_each_row(
                 let bufs: Vec<Parsed> = (0..to_parse.len())
                     .map(|_| outs.pop().unwrap_or_default())
                     .collect();
-                let (blocks, cols, pr, to_row) = (&to_parse, &cols, &mut parsed, &to_row);
-                s.spawn(move |_| *pr = Some(parse_blocks(blocks, bufs, cols, to_row)));
+                let (blocks, cols, pr, to_row, blank) =
+                    (&to_parse, &cols, &mut parsed, &to_row, &blank);
+                s.spawn(move |_| *pr = Some(parse_blocks(blocks, bufs, cols, to_row, blank)));
             }
             if let Some(batch) = to_hand.take() {
                 verdict = hand_over(batch, on_row, &mut free_outs);
             }
         });
-        if let Some(v) = verdict {
-            return Ok(v);
+        match verdict {
+            Some(true) => return Ok(Some(blank.into_inner())),
+            Some(false) => return Ok(None),
+            None => {}
         }
         outs.append(&mut free_outs);
         progress((read_bytes as f64 / total).min(1.0));
@@ -487,12 +514,14 @@ pub(super) fn for_each_row(
 }
 
 /// Parses a batch of blocks in parallel into the row buffers `bufs` (reused), one result
-/// per block: `None` where the block is not for the fast path.
+/// per block: `None` where the block is not for the fast path. Adds the blank lines
+/// skipped to `blank`.
 fn parse_blocks(
     blocks: &[Vec<u8>],
     bufs: Vec<Parsed>,
     cols: &Cols,
     to_row: &(impl Fn(&[f64]) -> Row + Sync),
+    blank: &AtomicU64,
 ) -> Vec<Option<Parsed>> {
     blocks
         .par_iter()
@@ -501,9 +530,8 @@ fn parse_blocks(
             rows.clear();
             // (About 60 bytes a line in a typical log.)
             rows.reserve(b.len() / 60);
-            if !parse_block_with(b, cols, |slots| rows.push(to_row(slots))) {
-                return None;
-            }
+            let skipped = parse_block_with(b, cols, |slots| rows.push(to_row(slots)))?;
+            blank.fetch_add(skipped, Ordering::Relaxed);
             Some(rows)
         })
         .collect()
@@ -592,7 +620,7 @@ mod tests {
             true
         })
         .unwrap();
-        (ok, v)
+        (ok.is_some(), v)
     }
 
     #[test]
@@ -633,7 +661,7 @@ mod tests {
             n < 10
         })
         .unwrap();
-        assert!(ok);
+        assert!(ok.is_some());
         assert_eq!(n, 10);
         // Anything the fast path does not take: it gives up (the caller re-reads exactly).
         for bad in [

@@ -27,12 +27,14 @@
 pub mod clipping;
 mod exact;
 mod fast;
+pub mod mapping;
 pub mod parquet;
 pub mod quality;
 mod reader;
 pub mod tdms;
 mod writer;
 
+pub use mapping::{ChannelUnit, ColumnMapping};
 pub use reader::{LogFile, OpenOptions, RowSink};
 pub use writer::{write_atomic, LogWriter};
 
@@ -96,14 +98,49 @@ pub enum LogError {
         /// The I/O error.
         source: std::io::Error,
     },
-    /// A required column is missing.
-    #[error("{path}: missing column '{column}' ({why})")]
+    /// A required column is missing: named, with why it is needed, the channels the log
+    /// has and the closest of them ([`mapping`]).
+    #[error("{path}: missing column '{column}'{detail}")]
     MissingColumn {
         /// The file.
         path: String,
-        /// The column's name.
+        /// The column's name in the log (the schema's, or the one `[columns]` gives).
         column: String,
-        /// Why it is needed.
+        /// The rest of the message: " (for ia_A in [columns])" when the name comes from
+        /// the mapping, " (why it is needed)", "; the log has ...", the closest channel
+        /// and where to map it.
+        detail: String,
+    },
+    /// A column name appears twice in the log.
+    #[error("{path}: column '{column}' appears twice, at columns {first} and {second}: which one is meant cannot be told")]
+    DuplicateColumn {
+        /// The file.
+        path: String,
+        /// The name.
+        column: String,
+        /// 1-based position of its first occurrence.
+        first: usize,
+        /// 1-based position of its second occurrence.
+        second: usize,
+    },
+    /// A channel's unit disagrees with the mapping, or is not one the reader knows.
+    #[error("{path}: channel '{channel}' {why}")]
+    Unit {
+        /// The file.
+        path: String,
+        /// The channel.
+        channel: String,
+        /// What is wrong, naming both units.
+        why: String,
+    },
+    /// A channel holds no usable value at all.
+    #[error("{path}: channel {channel} {why}")]
+    NoValue {
+        /// The file.
+        path: String,
+        /// The channel's schema name.
+        channel: String,
+        /// "holds no finite value", or what its values are instead.
         why: String,
     },
     /// A cell is not a number.
@@ -168,6 +205,14 @@ pub enum LogError {
         /// What held them out.
         why: String,
     },
+}
+
+/// True for the text of a missing value in a CSV cell: empty, `NA` or `null` (any case).
+/// Such a cell is read as NaN, like the cells `NaN` and `inf`: the data-quality stage
+/// holds them all out and counts them alike (`docs/data-quality.md`).
+pub fn is_missing(cell: &str) -> bool {
+    let c = cell.trim();
+    c.is_empty() || c.eq_ignore_ascii_case("na") || c.eq_ignore_ascii_case("null")
 }
 
 /// A column of the schema, in the order a [`Row`] holds them.
@@ -284,6 +329,28 @@ impl Channels {
             Column::Va | Column::Vb | Column::Vc => self.voltages,
             Column::Speed => self.speed,
             Column::Encoder => self.encoder,
+        }
+    }
+}
+
+impl Row {
+    /// The value of column `c` in the schema's unit; `None` where the log lacks the
+    /// column, or for an encoder count that was not a number ([`ENC_COUNT_UNREADABLE`]).
+    pub fn value(&self, c: Column) -> Option<f64> {
+        let v = self.v_abc;
+        match c {
+            Column::Time => Some(self.t_s),
+            Column::Va => v.map(|v| v[0]),
+            Column::Vb => v.map(|v| v[1]),
+            Column::Vc => v.map(|v| v[2]),
+            Column::Ia => Some(self.i_abc[0]),
+            Column::Ib => Some(self.i_abc[1]),
+            Column::Ic => Some(self.i_abc[2]),
+            Column::Speed => self.wm_rad_s,
+            Column::Encoder => self
+                .enc_count
+                .filter(|n| *n != ENC_COUNT_UNREADABLE)
+                .map(|n| n as f64),
         }
     }
 }
@@ -419,6 +486,68 @@ mod tests {
                 e.contains(says) && !e.contains("missing column"),
                 "{text:?}: {e}"
             );
+        }
+    }
+
+    /// Rows and the blank lines the reader reports.
+    #[derive(Default)]
+    struct Counted {
+        rows: Vec<Row>,
+        blank: u64,
+    }
+
+    impl RowSink for Counted {
+        fn row(&mut self, row: &Row) -> bool {
+            self.rows.push(*row);
+            true
+        }
+        fn restart(&mut self) {
+            self.rows.clear();
+        }
+        fn blank_lines(&mut self, lines: u64) {
+            self.blank = lines;
+        }
+    }
+
+    fn counted(text: &str, columns: ColumnMapping) -> Counted {
+        let f = write(text);
+        let opts = OpenOptions {
+            columns,
+            ..OpenOptions::default()
+        };
+        let file = LogFile::open_with(f.path(), &opts).unwrap();
+        let mut c = Counted::default();
+        file.for_each_row(&mut |_| {}, &mut c).unwrap();
+        c
+    }
+
+    #[test]
+    fn missing_values_blank_lines_and_units_alike_on_both_csv_paths() {
+        let text = "t_s,ia_A,ib_A,ic_A,enc_count\n0,1,,3,5\n\n0.1,NA,null,NaN,\n0.2,1,2,3,NA\n\n";
+        // The fast path takes it; a quoted cell sends it to the exact reader.
+        let exact = text.replace("0.2,1", "0.2,\"1\"");
+        for t in [text, exact.as_str()] {
+            let c = counted(t, ColumnMapping::default());
+            assert_eq!(c.blank, 2, "{t:?}");
+            assert_eq!(c.rows.len(), 3);
+            assert!(c.rows[0].i_abc[1].is_nan() && c.rows[1].i_abc.iter().all(|x| x.is_nan()));
+            assert_eq!(c.rows[0].enc_count, Some(5));
+            assert_eq!(c.rows[1].enc_count, Some(ENC_COUNT_UNREADABLE));
+            assert_eq!(c.rows[2].value(Column::Encoder), None);
+        }
+        // Units: ms and mA, one multiplication each; epoch ms counted from the first row.
+        let mut m = ColumnMapping::new(2);
+        m.set(Column::Time, "T", Some(ChannelUnit::EpochMilliseconds))
+            .unwrap();
+        m.set(Column::Ia, "I1", Some(ChannelUnit::Milliamperes))
+            .unwrap();
+        let text = "I1,T,ib_A,ic_A\n1500,1714564800000,2,3\n-250,1714564800000.5,2,3\n";
+        for t in [text.to_string(), text.replace(",2,3\n-", ",\"2\",3\n-")] {
+            let c = counted(&t, m.clone());
+            assert_eq!(c.rows[0].t_s, 0.0, "{t:?}");
+            assert!((c.rows[1].t_s - 5e-4).abs() < 1e-9);
+            assert!((c.rows[0].i_abc[0] - 1.5).abs() < 1e-12);
+            assert!((c.rows[1].i_abc[0] + 0.25).abs() < 1e-12);
         }
     }
 

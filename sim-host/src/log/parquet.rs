@@ -13,9 +13,10 @@
 //! encoding, uncompressed (sensor noise does not compress), [`ROW_GROUP_ROWS`] rows per row
 //! group.
 
+use super::mapping::ColumnMapping;
 use super::reader::{BinarySource, ColumnMap, LogFile};
 use super::{Channels, Column, LogError, Row};
-use parquet::basic::{Compression, Encoding, Type as PhysicalType};
+use parquet::basic::{Compression, Encoding, LogicalType, TimeUnit, Type as PhysicalType};
 use parquet::column::reader::{ColumnReader, ColumnReaderImpl};
 use parquet::data_type::{DataType, DoubleType, FloatType, Int64Type};
 use parquet::errors::ParquetError;
@@ -53,6 +54,19 @@ fn pq_error(shown: &str, e: &ParquetError) -> LogError {
     )
 }
 
+/// The unit of a timestamp column (`epoch_ms`, `epoch_us`, `epoch_ns`), `None` for any
+/// other logical type.
+fn timestamp_unit(t: Option<&LogicalType>) -> Option<&'static str> {
+    match t {
+        Some(LogicalType::Timestamp(ts)) => Some(match ts.unit {
+            TimeUnit::MILLIS => "epoch_ms",
+            TimeUnit::MICROS => "epoch_us",
+            TimeUnit::NANOS => "epoch_ns",
+        }),
+        _ => None,
+    }
+}
+
 /// One decoded row group: the values of each [`Column::ALL`] column (empty when absent).
 type Decoded = [Vec<f64>; 9];
 
@@ -62,7 +76,11 @@ impl ParquetSource {
     /// # Errors
     /// [`LogError::NotALog`] for a file that is not Parquet, a schema column that is not a
     /// number or a codec not built in; [`LogError::MissingColumn`] as for a CSV log.
-    pub fn open(path: &Path, shown: &str) -> Result<(Self, ColumnMap), LogError> {
+    pub fn open(
+        path: &Path,
+        shown: &str,
+        mapping: &ColumnMapping,
+    ) -> Result<(Self, ColumnMap), LogError> {
         let f = File::open(path).map_err(|source| LogError::Io {
             path: shown.to_string(),
             source,
@@ -70,34 +88,52 @@ impl ParquetSource {
         let r = SerializedFileReader::new(f).map_err(|e| pq_error(shown, &e))?;
         let meta = r.metadata();
         let schema = meta.file_metadata().schema_descr();
-        let mut field = [None; 9];
+        // Leaf columns by their dotted path: a top-level column is its name.
+        let found: Vec<String> = (0..schema.num_columns())
+            .map(|j| schema.column(j).path().string())
+            .collect();
+        let mut columns = ColumnMap::locate(&found, mapping, shown)?;
+        let mut units = [None; 9];
         for (k, c) in Column::ALL.iter().enumerate() {
-            let found = (0..schema.num_columns()).find(|&j| {
-                let p = schema.column(j);
-                p.path().parts().len() == 1 && p.name() == c.name()
-            });
-            if let Some(j) = found {
-                let ty = schema.column(j).physical_type();
-                if !matches!(
-                    ty,
-                    PhysicalType::DOUBLE
-                        | PhysicalType::FLOAT
-                        | PhysicalType::INT32
-                        | PhysicalType::INT64
-                ) {
-                    return Err(not_a_log(
-                        shown,
-                        format!("column '{}' is of type {ty}: it must hold numbers (DOUBLE, FLOAT, INT32 or INT64)", c.name()),
-                    ));
-                }
-                field[k] = Some(j);
+            let Some(j) = columns.field[k] else { continue };
+            let ty = schema.column(j).physical_type();
+            if !matches!(
+                ty,
+                PhysicalType::DOUBLE
+                    | PhysicalType::FLOAT
+                    | PhysicalType::INT32
+                    | PhysicalType::INT64
+            ) {
+                return Err(not_a_log(
+                    shown,
+                    format!("column '{}' is of type {ty}: it must hold numbers (DOUBLE, FLOAT, INT32 or INT64)", found[j]),
+                ));
+            }
+            let recorded = timestamp_unit(schema.column(j).logical_type_ref());
+            units[k] =
+                super::mapping::resolve_unit(shown, *c, &found[j], mapping.unit_of(*c), recorded)?;
+        }
+        columns.set_units(&units, mapping);
+        if columns.of(Column::Time).is_none() {
+            if let Some(j) = (0..found.len())
+                .find(|&j| timestamp_unit(schema.column(j).logical_type_ref()).is_some())
+            {
+                return Err(super::mapping::missing_column_with(
+                    shown,
+                    mapping.name_of(Column::Time),
+                    " (every analysis needs the time)",
+                    &found,
+                    &format!(
+                        "; column '{}' is a timestamp: make it the time in the parameter file's [columns] table: t_s = {{ name = \"{}\" }} (its unit, {}, is read from the file; docs/design.md)",
+                        found[j],
+                        found[j],
+                        timestamp_unit(schema.column(j).logical_type_ref()).unwrap_or("epoch_ms")
+                    ),
+                ));
             }
         }
-        let columns = ColumnMap {
-            field,
-            n_fields: schema.num_columns(),
-        };
-        super::reader::check_columns(&columns, shown, true)?;
+        super::reader::check_columns(&columns, shown, true, mapping, &found)?;
+        let field = columns.field;
         for rg in meta.row_groups() {
             for j in field.iter().flatten() {
                 let codec = rg.column(*j).compression();
@@ -307,18 +343,8 @@ impl ParquetLogWriter {
     /// Buffers a row; writes a row group when [`ROW_GROUP_ROWS`] are buffered.
     pub fn write_row(&mut self, r: &Row) -> Result<(), ParquetError> {
         self.t.push(r.t_s);
-        let v = r.v_abc.unwrap_or_default();
         for (c, vals) in &mut self.f {
-            let x = match c {
-                Column::Va => v[0],
-                Column::Vb => v[1],
-                Column::Vc => v[2],
-                Column::Ia => r.i_abc[0],
-                Column::Ib => r.i_abc[1],
-                Column::Ic => r.i_abc[2],
-                _ => r.wm_rad_s.unwrap_or_default(),
-            };
-            vals.push(x as f32);
+            vals.push(r.value(*c).unwrap_or_default() as f32);
         }
         if self.channels.encoder {
             self.enc.push(r.enc_count.unwrap_or_default());

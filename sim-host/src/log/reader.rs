@@ -2,6 +2,7 @@
 //! rows streamed: a CSV by the fast path with the exact reader behind it, a TDMS or Parquet
 //! log by its format's module ([`super::Format`]).
 
+use super::mapping::{ChannelUnit, ColumnMapping, TimeKind};
 use super::{exact, fast, Channels, Column, Format, LogError, Row};
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
@@ -13,6 +14,33 @@ pub trait RowSink {
     /// Forget every row received so far: the rows will come again from the first one (the
     /// fast path met something it does not accept and the exact reader takes over).
     fn restart(&mut self);
+    /// After the last row: the blank lines the reader skipped (a CSV's; none by default).
+    fn blank_lines(&mut self, _lines: u64) {}
+}
+
+/// A timestamp column's time counted from the first row with a finite time: passes the
+/// rows on to `sink` with that time subtracted, then scaled to seconds by `factor`.
+struct FromFirstRow<'a> {
+    sink: &'a mut dyn RowSink,
+    t0: Option<f64>,
+    factor: f64,
+}
+
+impl RowSink for FromFirstRow<'_> {
+    fn row(&mut self, row: &Row) -> bool {
+        let mut r = *row;
+        if r.t_s.is_finite() {
+            r.t_s = (r.t_s - *self.t0.get_or_insert(row.t_s)) * self.factor;
+        }
+        self.sink.row(&r)
+    }
+    fn restart(&mut self) {
+        self.t0 = None;
+        self.sink.restart();
+    }
+    fn blank_lines(&mut self, lines: u64) {
+        self.sink.blank_lines(lines);
+    }
 }
 
 /// Collects every row.
@@ -27,23 +55,86 @@ impl RowSink for Vec<Row> {
 }
 
 /// Where each schema column sits in a line (a CSV), a leaf column (Parquet) or the
-/// schema's own order (TDMS): `field[c]` is the field index of [`Column::ALL`]`[c]`, `None`
-/// when the log lacks it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// group's channels (TDMS), and how its values become the schema's: `field[c]` is the
+/// field index of [`Column::ALL`]`[c]`, `None` when the log lacks it.
+#[derive(Debug, Clone, PartialEq)]
 pub(super) struct ColumnMap {
     pub field: [Option<usize>; 9],
     /// Fields per line (the header's).
     pub n_fields: usize,
+    /// The factor from each column's unit to the schema's SI unit ([`ColumnMapping`]).
+    pub scale: [f64; 9],
+    /// False when every factor is 1 (the rows need no multiplication).
+    pub scaled: bool,
+    /// How the time column is read.
+    pub time: TimeKind,
+    /// A timestamp's factor to seconds, applied after the first row's time is subtracted
+    /// (so that the difference is exact; `scale[0]` is then 1).
+    pub time_factor: f64,
+    /// Each column's channel name in the log (the schema's name unless mapped).
+    pub names: [String; 9],
 }
 
 impl ColumnMap {
-    /// The header name of field `i` (for messages).
+    /// The columns of a log whose fields (CSV header fields, Parquet leaf columns, TDMS
+    /// channels) are named `found`, each looked up by the name `mapping` gives it, in the
+    /// unit it gives.
+    ///
+    /// # Errors
+    /// [`LogError::DuplicateColumn`] when a name looked up appears twice.
+    pub fn locate(
+        found: &[String],
+        mapping: &ColumnMapping,
+        shown: &str,
+    ) -> Result<Self, LogError> {
+        let mut field = [None; 9];
+        for (f, c) in field.iter_mut().zip(Column::ALL) {
+            let name = mapping.name_of(c);
+            let mut at = found
+                .iter()
+                .enumerate()
+                .filter(|(_, h)| *h == name)
+                .map(|(i, _)| i);
+            *f = at.next();
+            if let (Some(first), Some(second)) = (*f, at.next()) {
+                return Err(LogError::DuplicateColumn {
+                    path: shown.to_string(),
+                    column: name.to_string(),
+                    first: first + 1,
+                    second: second + 1,
+                });
+            }
+        }
+        let mut map = ColumnMap {
+            field,
+            n_fields: found.len(),
+            scale: [1.0; 9],
+            scaled: false,
+            time: TimeKind::Plain,
+            time_factor: 1.0,
+            names: Column::ALL.map(|c| mapping.name_of(c).to_string()),
+        };
+        map.set_units(&Column::ALL.map(|c| mapping.unit_of(c)), mapping);
+        Ok(map)
+    }
+
+    /// Reads each column in `units` (`None`: the schema's SI unit).
+    pub fn set_units(&mut self, units: &[Option<ChannelUnit>; 9], mapping: &ColumnMapping) {
+        self.scale = mapping.factors(units);
+        self.time = units[0].map_or(TimeKind::Plain, ChannelUnit::time_kind);
+        self.time_factor = 1.0;
+        if self.time != TimeKind::Plain {
+            self.time_factor = std::mem::replace(&mut self.scale[0], 1.0);
+        }
+        self.scaled = self.scale.iter().any(|k| *k != 1.0);
+    }
+
+    /// The channel name of field `i` (for messages).
     pub fn name_of_field(&self, i: usize) -> String {
-        Column::ALL
+        self.field
             .iter()
-            .zip(self.field)
-            .find(|(_, f)| *f == Some(i))
-            .map(|(c, _)| c.name().to_string())
+            .position(|f| *f == Some(i))
+            .map(|k| self.names[k].clone())
             .unwrap_or_else(|| format!("#{i}"))
     }
 
@@ -59,6 +150,9 @@ pub struct OpenOptions {
     /// The TDMS group holding the channels (`--group`); needed only when a TDMS file has
     /// several groups. An error for the other formats, which have no groups.
     pub group: Option<String>,
+    /// Which channel holds each schema column, and its unit (the parameter file's
+    /// `[columns]` table; empty: the schema's names and SI units).
+    pub columns: ColumnMapping,
 }
 
 /// A log format read by its own decoder (TDMS, Parquet), whose rows are counted when it
@@ -148,14 +242,14 @@ impl LogFile {
             })?
             .len();
         let (columns, source, est_rows) = match format {
-            Format::Csv => Self::open_csv(path, &shown, len_bytes)?,
+            Format::Csv => Self::open_csv(path, &shown, len_bytes, &opts.columns)?,
             Format::Tdms => {
-                let (t, c) = super::tdms::TdmsSource::open(path, &shown, opts.group.as_deref())?;
+                let (t, c) = super::tdms::TdmsSource::open(path, &shown, opts)?;
                 let n = t.rows() as f64;
                 (c, Source::Tdms(t), n)
             }
             Format::Parquet => {
-                let (p, c) = super::parquet::ParquetSource::open(path, &shown)?;
+                let (p, c) = super::parquet::ParquetSource::open(path, &shown, &opts.columns)?;
                 let n = p.rows() as f64;
                 (c, Source::Parquet(p), n)
             }
@@ -177,6 +271,7 @@ impl LogFile {
         path: &Path,
         shown: &str,
         len_bytes: u64,
+        mapping: &ColumnMapping,
     ) -> Result<(ColumnMap, Source, f64), LogError> {
         let io = |source| LogError::Io {
             path: shown.to_string(),
@@ -190,7 +285,7 @@ impl LogFile {
         r.take(HEAD_BYTES as u64)
             .read_to_end(&mut head)
             .map_err(io)?;
-        let columns = parse_header(&header, shown)?;
+        let columns = parse_header(&header, shown, mapping)?;
         let lines = head.iter().filter(|&&b| b == b'\n').count().max(1);
         let bytes_per_row = (head.len() as f64 / lines as f64).max(1.0);
         let est_rows = len_bytes.saturating_sub(header.len() as u64) as f64 / bytes_per_row;
@@ -251,6 +346,23 @@ impl LogFile {
         progress: &mut dyn FnMut(f64),
         sink: &mut dyn RowSink,
     ) -> Result<u64, LogError> {
+        if self.columns.time != TimeKind::Plain {
+            let mut from_first = FromFirstRow {
+                sink,
+                t0: None,
+                factor: self.columns.time_factor,
+            };
+            return self.rows_in_order(progress, &mut from_first);
+        }
+        self.rows_in_order(progress, sink)
+    }
+
+    /// [`LogFile::for_each_row`] with the times as read.
+    fn rows_in_order(
+        &self,
+        progress: &mut dyn FnMut(f64),
+        sink: &mut dyn RowSink,
+    ) -> Result<u64, LogError> {
         let binary: &dyn BinarySource = match &self.source {
             Source::Csv { .. } => return self.csv_rows(progress, sink),
             Source::Tdms(t) => t,
@@ -270,7 +382,8 @@ impl LogFile {
             handed += 1;
             sink.row(row)
         })?;
-        if accepted {
+        if let Some(blank) = accepted {
+            sink.blank_lines(blank);
             return Ok(handed);
         }
         sink.restart();
@@ -285,6 +398,7 @@ impl LogFile {
                 progress((rows.byte_offset() as f64 / self.len_bytes.max(1) as f64).min(1.0));
             }
         }
+        sink.blank_lines(rows.blank_lines());
         Ok(handed)
     }
 
@@ -315,7 +429,7 @@ fn channels_of(columns: &ColumnMap) -> Channels {
 }
 
 /// Parses the header line (CSV quoting allowed, names trimmed) into the column map.
-fn parse_header(line: &[u8], shown: &str) -> Result<ColumnMap, LogError> {
+fn parse_header(line: &[u8], shown: &str, mapping: &ColumnMapping) -> Result<ColumnMap, LogError> {
     let mut rdr = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .has_headers(false)
@@ -357,16 +471,9 @@ fn parse_header(line: &[u8], shown: &str) -> Result<ColumnMap, LogError> {
             why: "line 1 holds numbers: it must be the header naming the columns (t_s, ia_A, ib_A, ic_A, ...)".to_string(),
         });
     }
-    let find = |c: Column| rec.iter().position(|h| h == c.name());
-    let mut field = [None; 9];
-    for (f, c) in field.iter_mut().zip(Column::ALL) {
-        *f = find(c);
-    }
-    let map = ColumnMap {
-        field,
-        n_fields: rec.len(),
-    };
-    check_columns(&map, shown, true)?;
+    let found: Vec<String> = rec.iter().map(str::to_string).collect();
+    let map = ColumnMap::locate(&found, mapping, shown)?;
+    check_columns(&map, shown, true, mapping, &found)?;
     Ok(map)
 }
 
@@ -375,13 +482,17 @@ fn parse_header(line: &[u8], shown: &str) -> Result<ColumnMap, LogError> {
 /// three phases or none.
 ///
 /// # Errors
-/// [`LogError::MissingColumn`] naming the column and why it is needed.
-pub(super) fn check_columns(map: &ColumnMap, shown: &str, need_time: bool) -> Result<(), LogError> {
-    let missing = |c: Column, why: &str| LogError::MissingColumn {
-        path: shown.to_string(),
-        column: c.name().to_string(),
-        why: why.to_string(),
-    };
+/// [`LogError::MissingColumn`] naming the column and why it is needed, listing the
+/// channels `found` and suggesting the closest ([`super::mapping::missing_column`]).
+pub(super) fn check_columns(
+    map: &ColumnMap,
+    shown: &str,
+    need_time: bool,
+    mapping: &ColumnMapping,
+    found: &[String],
+) -> Result<(), LogError> {
+    let missing =
+        |c: Column, why: &str| super::mapping::missing_column(shown, c, mapping, found, why);
     if need_time && map.of(Column::Time).is_none() {
         return Err(missing(Column::Time, "every analysis needs the time"));
     }

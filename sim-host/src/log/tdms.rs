@@ -16,7 +16,7 @@
 //! as I64. Every channel carries `wf_increment` and `wf_start_offset` (from the first
 //! segment's times), so LabVIEW and DIAdem show a time axis.
 
-use super::reader::{BinarySource, ColumnMap, LogFile};
+use super::reader::{BinarySource, ColumnMap, LogFile, OpenOptions};
 use super::{Channels, Column, LogError, Row};
 use std::fs::File;
 use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
@@ -185,6 +185,35 @@ fn pick_group(names: &[String], group: Option<&str>, shown: &str) -> Result<Stri
     }
 }
 
+/// The unit channel `ch` (column `c`) is read in ([`super::mapping::resolve_unit`]: the
+/// mapping's, checked against the channel's `unit_string`).
+///
+/// # Errors
+/// [`LogError::NotALog`] for a channel that does not hold numbers; [`LogError::Unit`] as
+/// `resolve_unit`.
+fn channel_unit(
+    ch: &tdms_rs::TdmsChannel<'_>,
+    c: Column,
+    mapping: &super::ColumnMapping,
+    shown: &str,
+) -> Result<Option<super::ChannelUnit>, LogError> {
+    if ch.dtype().itemsize() == 0 || matches!(ch.dtype(), DataType::TimeStamp | DataType::Boolean) {
+        return Err(not_a_log(
+            shown,
+            format!(
+                "channel '{}' holds {:?} values, not numbers",
+                ch.name(),
+                ch.dtype()
+            ),
+        ));
+    }
+    let recorded = match ch.property("unit_string") {
+        Some(PropertyValue::String(u)) => Some(u.as_str()),
+        _ => None,
+    };
+    super::mapping::resolve_unit(shown, c, ch.name(), mapping.unit_of(c), recorded)
+}
+
 impl TdmsSource {
     /// Opens `path`: picks the group, maps the schema's channels and the time source.
     ///
@@ -197,40 +226,31 @@ impl TdmsSource {
     pub fn open(
         path: &Path,
         shown: &str,
-        group: Option<&str>,
+        opts: &OpenOptions,
     ) -> Result<(Self, ColumnMap), LogError> {
+        let mapping = &opts.columns;
         let file = TdmsFile::open(path).map_err(|e| tdms_error(shown, &e))?;
         check_layout(path, shown, &file)?;
         let names: Vec<String> = file.groups().map(|g| g.name().to_string()).collect();
-        let name = pick_group(&names, group, shown)?;
+        let name = pick_group(&names, opts.group.as_deref(), shown)?;
         let g = file
             .group(&name)
             .ok_or_else(|| not_a_log(shown, format!("no group '{name}'")))?;
-        let mut field = [None; 9];
+        let found: Vec<String> = g.channels().map(|c| c.name().to_string()).collect();
+        let mut columns = ColumnMap::locate(&found, mapping, shown)?;
         let mut lens = Vec::new();
+        let mut units = [None; 9];
         for (k, c) in Column::ALL.iter().enumerate() {
-            if let Some(ch) = g.channel(c.name()) {
-                if ch.dtype().itemsize() == 0
-                    || matches!(ch.dtype(), DataType::TimeStamp | DataType::Boolean)
-                {
-                    return Err(not_a_log(
-                        shown,
-                        format!(
-                            "channel '{}' holds {:?} values, not numbers",
-                            c.name(),
-                            ch.dtype()
-                        ),
-                    ));
-                }
-                field[k] = Some(k);
-                lens.push((c.name(), ch.len()));
+            if columns.field[k].is_none() {
+                continue;
             }
+            let Some(ch) = g.channel(&columns.names[k]) else {
+                continue;
+            };
+            units[k] = channel_unit(&ch, *c, mapping, shown)?;
+            lens.push((columns.names[k].clone(), ch.len()));
         }
-        let columns = ColumnMap {
-            field,
-            n_fields: Column::ALL.len(),
-        };
-        let wave = g.channel(Column::Ia.name()).and_then(|ch| {
+        let wave = g.channel(mapping.name_of(Column::Ia)).and_then(|ch| {
             let inc = ch.property("wf_increment").and_then(number)?;
             let start = ch
                 .property("wf_start_offset")
@@ -246,13 +266,38 @@ impl TdmsSource {
         } else if let Some(w) = wave {
             w
         } else {
-            return Err(LogError::MissingColumn {
-                path: shown.to_string(),
-                column: Column::Time.name().to_string(),
-                why: "every analysis needs the time: a t_s channel, or wf_increment on ia_A".into(),
-            });
+            // A channel timed by its waveform properties under another name: say so.
+            let elsewhere = g
+                .channels()
+                .find(|ch| ch.property("wf_increment").is_some())
+                .map(|ch| {
+                    format!(
+                        "; channel '{}' has wf_increment: map it to ia_A in [columns] and the time comes from it",
+                        ch.name()
+                    )
+                })
+                .unwrap_or_default();
+            return Err(super::mapping::missing_column(
+                shown,
+                Column::Time,
+                mapping,
+                &found,
+                &format!(
+                    "every analysis needs the time: a {} channel, or wf_increment on {}{elsewhere}",
+                    mapping.name_of(Column::Time),
+                    mapping.name_of(Column::Ia)
+                ),
+            ));
         };
-        super::reader::check_columns(&columns, shown, time == TimeSource::Channel)?;
+        super::reader::check_columns(
+            &columns,
+            shown,
+            time == TimeSource::Channel,
+            mapping,
+            &found,
+        )?;
+        // (The waveform time is in seconds: wf_increment's unit.)
+        columns.set_units(&units, mapping);
         let rows = lens.first().map(|l| l.1).unwrap_or(0);
         if let Some((n, l)) = lens.iter().find(|l| l.1 != rows) {
             return Err(not_a_log(
@@ -291,10 +336,8 @@ impl BinarySource for TdmsSource {
         let g = file
             .group(&self.group)
             .ok_or_else(|| not_a_log(shown, format!("no group '{}'", self.group)))?;
-        let chans: Vec<Option<tdms_rs::TdmsChannel<'_>>> = Column::ALL
-            .iter()
-            .enumerate()
-            .map(|(k, c)| columns.field[k].and_then(|_| g.channel(c.name())))
+        let chans: Vec<Option<tdms_rs::TdmsChannel<'_>>> = (0..Column::ALL.len())
+            .map(|k| columns.field[k].and_then(|_| g.channel(&columns.names[k])))
             .collect();
         let n = self.rows as usize;
         let mut cols: Vec<Vec<f64>> = vec![Vec::new(); Column::ALL.len()];

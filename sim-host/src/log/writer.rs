@@ -150,7 +150,13 @@ impl LogWriter {
         if self.channels.encoder {
             l.push(',');
             // Writing into a String cannot fail.
-            let _ = write!(l, "{}", r.enc_count.unwrap_or_default());
+            match r.enc_count.unwrap_or_default() {
+                // (A count that was not a number stays one.)
+                super::ENC_COUNT_UNREADABLE => l.push_str("NaN"),
+                n => {
+                    let _ = write!(l, "{n}");
+                }
+            }
         }
         l.push('\n');
         out.write_all(l.as_bytes()).map_err(io)

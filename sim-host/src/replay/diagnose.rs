@@ -7,7 +7,7 @@ use crate::log::quality::{
     BadCells, CellLimits, CleanSink, DataQuality, NotJudged, QualityStage, SegmentBreak, TimeBase,
     MAX_BRIDGED_GAP_S, MAX_NOT_JUDGED_FRACTION,
 };
-use crate::log::{Channels, Column, LogError, LogFile, Row, RowSink};
+use crate::log::{Channels, Column, LogError, LogFile, OpenOptions, Row, RowSink};
 use crate::params::ParamFile;
 use monitor_core::{Abc, MonitorOutput};
 use std::path::Path;
@@ -88,18 +88,20 @@ pub trait ReplayObserver {
     fn restart(&mut self);
 }
 
-/// [`diagnose_file`] that hands every replayed row's output to `observer` as it goes.
+/// [`diagnose_file`] that hands every replayed row's output to `observer` as it goes, the
+/// log opened with `open` (a TDMS group, the parameter file's `[columns]` mapping).
 ///
 /// # Errors
 /// As [`diagnose_file`].
 pub fn diagnose_file_observed(
     params: &ParamFile,
     path: &Path,
+    open: &OpenOptions,
     opts: ReplayOptions,
     progress: &mut dyn FnMut(f64),
     observer: &mut dyn ReplayObserver,
 ) -> Result<Diagnosed, ReplayError> {
-    let file = LogFile::open(path)?;
+    let file = LogFile::open_with(path, open)?;
     replay_observed(
         params,
         file.channels(),

@@ -1,4 +1,6 @@
-//! Bad cells: values no sensor of the machine should report ([`CellLimits`], [`BadCells`]).
+//! Bad cells: values no sensor of the machine should report ([`CellLimits`], [`BadCells`]),
+//! and missing ones (NaN, and an encoder count that was not a number,
+//! [`crate::log::ENC_COUNT_UNREADABLE`]).
 
 use crate::log::{Column, Row};
 use crate::params::ParamFile;
@@ -31,6 +33,20 @@ impl CellLimits {
     }
 }
 
+impl CellLimits {
+    /// True when `x`, a cell of column `c`, lies beyond its limit (voltages, currents,
+    /// speed; never for the time and the encoder count).
+    pub fn beyond(&self, c: Column, x: f64) -> bool {
+        let max = match c {
+            Column::Va | Column::Vb | Column::Vc => self.v_max,
+            Column::Ia | Column::Ib | Column::Ic => self.i_max,
+            Column::Speed => self.wm_max,
+            Column::Time | Column::Encoder => return false,
+        };
+        x.abs() > max
+    }
+}
+
 /// The bad cells of a row: one bit per [`Column`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct BadCells(u16);
@@ -54,6 +70,7 @@ impl BadCells {
     }
 
     /// The bad cells of `row` against `lim`.
+    #[inline]
     pub fn of(row: &Row, lim: &CellLimits) -> Self {
         let mut b = BadCells::default();
         let bad = |x: f64, max: f64| !x.is_finite() || x.abs() > max;
@@ -71,6 +88,9 @@ impl BadCells {
         }
         if row.wm_rad_s.is_some_and(|w| bad(w, lim.wm_max)) {
             b.set(Column::Speed);
+        }
+        if row.enc_count == Some(crate::log::ENC_COUNT_UNREADABLE) {
+            b.set(Column::Encoder);
         }
         b
     }

@@ -44,6 +44,12 @@
 //! flagged: the monitor holds such samples out as the firmware does with impossible ADC
 //! readings, the analysis drops them and bridges the hole like dropped samples.
 //!
+//! **Missing values**, one rule: an empty CSV cell, `NA`, `null`, `NaN` and `inf` are all
+//! read as NaN ([`super::is_missing`]) and are bad cells alike. When at least
+//! [`UNUSABLE_FRACTION`] of the rows have a bad cell, nothing is left to analyse: an error
+//! names the channel with the most bad cells and what they are ([`LogError::NoValue`]).
+//! Blank lines of a CSV are skipped and counted (`DataQuality::blank_lines`).
+//!
 //! **Supply frequency.** The median period of the phase-a current's zero crossings is
 //! compared with the parameter file's supply frequency; a difference over
 //! [`SUPPLY_MISMATCH`] is a warning (a V/f drive running below base speed also gives one).
@@ -162,10 +168,16 @@ pub struct QualityStage<'a, S: CleanSink> {
     stuck: stuck::StuckTracker,
     jitter: (f64, u64),
     dropping: bool,
+    /// Bad cells per column: [not finite, finite but beyond the limits].
+    cells_out: [[u64; 2]; 9],
     q: DataQuality,
     error: Option<LogError>,
     stopped: bool,
 }
+
+/// Fraction of the rows with a bad cell at and above which nothing is left to analyse: the
+/// channel to blame is named ([`LogError::NoValue`]).
+pub const UNUSABLE_FRACTION: f64 = 0.99;
 
 impl<'a, S: CleanSink> QualityStage<'a, S> {
     /// A stage for the log shown as `shown` in messages, judging cells against `limits`.
@@ -189,17 +201,59 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             stuck: stuck::StuckTracker::default(),
             jitter: (0.0, 0),
             dropping: false,
+            cells_out: [[0; 2]; 9],
             q: DataQuality::default(),
             error: None,
             stopped: false,
         }
     }
 
+    /// The error for a log none of whose rows can be analysed because of one channel (at
+    /// least [`UNUSABLE_FRACTION`] of the rows have a bad cell): names the channel with the
+    /// most bad cells and what they are (not finite: "channel ia_A holds no finite value";
+    /// beyond the limits: a unit the parameter file's `[columns]` does not give).
+    fn channel_without_values(&self) -> Option<LogError> {
+        let rows = self.q.rows_passed;
+        if rows == 0 || (self.q.bad_rows as f64) < UNUSABLE_FRACTION * rows as f64 {
+            return None;
+        }
+        // The channel with the most cells missing or out of range; a log made unusable by
+        // other bad cells (stuck channels...) is left to the command's own judgement.
+        let (c, [non_finite, beyond]) = Column::ALL
+            .into_iter()
+            .map(|c| (c, self.cells_out[c as usize]))
+            .max_by_key(|(_, n)| n[0] + n[1])?;
+        let why = if non_finite == rows {
+            "holds no finite value (every cell is empty, NA, null, NaN or inf)".to_string()
+        } else if 2 * (non_finite + beyond) < rows {
+            return None;
+        } else if non_finite >= beyond {
+            format!("has {non_finite} of its {rows} cells empty, NA, null, NaN or inf: nothing is left to analyse")
+        } else {
+            let (limit, unit, other) = match c {
+                Column::Va | Column::Vb | Column::Vc => (self.limits.v_max, "V", "mV"),
+                Column::Ia | Column::Ib | Column::Ic => (self.limits.i_max, "A", "mA"),
+                _ => (self.limits.wm_max, "rad/s", "rpm"),
+            };
+            format!(
+                "has {beyond} of its {rows} values beyond +/-{limit:.0} {unit} (twice this motor's sensor range): if it is recorded in another unit, give it in the parameter file's [columns] table, e.g. {} = {{ name = \"...\", unit = \"{other}\" }} (docs/design.md)",
+                c.name()
+            )
+        };
+        Some(LogError::NoValue {
+            path: self.shown.clone(),
+            channel: c.name().to_string(),
+            why,
+        })
+    }
+
     /// Ends the read (settles the rows still held) and returns the report.
     ///
     /// # Errors
     /// [`LogError::Empty`] for a log without rows; the time-base errors of the first rows
-    /// ([`LogError::NoTimeBase`], [`LogError::RateTooLow`]).
+    /// ([`LogError::NoTimeBase`], [`LogError::RateTooLow`]); [`LogError::NoValue`] when
+    /// a channel leaves nothing to analyse (all missing or not finite: "channel ia_A holds
+    /// no finite value"; beyond the limits: its unit is not the schema's).
     pub fn finish(mut self) -> Result<DataQuality, LogError> {
         if let Some(e) = self.error.take() {
             return Err(e);
@@ -219,6 +273,9 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             }
         }
         self.end_burst();
+        if let Some(e) = self.channel_without_values() {
+            return Err(e);
+        }
         if let Some(b) = self.base {
             self.q.duration_s = (self.last_t - b.t0_s).max(0.0);
         }
@@ -453,6 +510,10 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             for c in Column::ALL {
                 if bad.has(c) {
                     *self.q.bad_cells.entry(c.name().to_string()).or_insert(0) += 1;
+                    let x = r.value(c).unwrap_or(f64::NAN);
+                    let (finite, beyond) = (x.is_finite(), self.limits.beyond(c, x));
+                    self.cells_out[c as usize][0] += u64::from(!finite);
+                    self.cells_out[c as usize][1] += u64::from(finite && beyond);
                 }
             }
             let start = self.burst.map_or(r.t_s, |b| b.0);
@@ -516,9 +577,14 @@ impl<S: CleanSink> RowSink for QualityStage<'_, S> {
         self.stuck = stuck::StuckTracker::default();
         self.jitter = (0.0, 0);
         self.dropping = false;
+        self.cells_out = [[0; 2]; 9];
         self.q = DataQuality::default();
         self.error = None;
         self.stopped = false;
+    }
+
+    fn blank_lines(&mut self, lines: u64) {
+        self.q.blank_lines = lines;
     }
 }
 

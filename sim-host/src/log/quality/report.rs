@@ -89,6 +89,9 @@ pub struct DataQuality {
     pub rows_in_short_bursts: u64,
     /// Stretches of consecutive rows dropped for their time (a stalled clock is one).
     pub time_drop_runs: u64,
+    /// Blank lines of a CSV, skipped (JSON: present when not zero).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub blank_lines: u64,
     /// Frequency of the phase-a current (median zero-crossing period) [Hz], if it
     /// alternates.
     pub current_frequency_hz: Option<f64>,
@@ -105,6 +108,10 @@ pub struct DataQuality {
     pub trusted: bool,
     /// Why not trusted.
     pub not_trusted_because: Vec<String>,
+}
+
+fn is_zero(n: &u64) -> bool {
+    *n == 0
 }
 
 /// What the assessment found: warnings, and reasons not to trust the log.
@@ -216,6 +223,9 @@ impl DataQuality {
     fn assess_cells(&self, supply_hz: f64, found: &mut Findings) {
         let Findings { warn, distrust } = found;
         let rows = self.rows_read.max(1) as f64;
+        if self.blank_lines > 0 {
+            warn.push(format!("{} blank lines skipped", self.blank_lines));
+        }
         if self.bad_rows > 0 {
             let cells: Vec<String> = self
                 .bad_cells
