@@ -67,7 +67,7 @@ const INTENDED: [(&str, &str, &str); 9] = [
 
 /// Keys added since the golden outputs were taken (issue 8: the data-quality stage's
 /// report, what commissioning did, the verdict, the range note beside a lamp).
-const ADDED: [&str; 38] = [
+const ADDED: [&str; 39] = [
     "data_quality",
     "commissioning",
     "verdict",
@@ -118,6 +118,7 @@ const ADDED: [&str; 38] = [
     "stuck_cells",
     "not_judged",
     "cannot_judge_because",
+    "wiring",
 ];
 
 /// The library effect added since (issue 10, `rotor_asymmetry`): its ranking entries and

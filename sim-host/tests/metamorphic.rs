@@ -133,6 +133,18 @@ fn mutations() -> Vec<Mutation> {
             }
             r
         }),
+        ("currents ib and ic swapped", |mut r| {
+            for x in &mut r {
+                x.i_abc.swap(1, 2);
+            }
+            r
+        }),
+        ("ia copied over ib", |mut r| {
+            for x in &mut r {
+                x.i_abc[1] = x.i_abc[0];
+            }
+            r
+        }),
         ("all currents zero", |mut r| {
             for x in &mut r {
                 x.i_abc = [0.0; 3];

@@ -179,7 +179,15 @@ fn conclude<O: ReplayObserver + ?Sized>(
         return Err(ReplayError::Option(format!("{shown}: no rows to replay")));
     };
     if replay.commissioning_incomplete() && !opts.allow_incomplete {
-        let why = replay.commission.why_incomplete().unwrap_or_default();
+        let mut why = replay.commission.why_incomplete().unwrap_or_default();
+        // What the data-quality stage distrusts is often why nothing was learned (swapped
+        // channels, a dead sensor): say it in the same line.
+        if !quality.trusted {
+            why = format!(
+                "{why}; data quality: {}",
+                quality.not_trusted_because.join("; ")
+            );
+        }
         return Err(ReplayError::IncompleteCommissioning { why });
     }
     let can_residuals = replay.monitor.is_some();

@@ -39,7 +39,8 @@
 //! is judged by its steps ([`encoder`]): counter wraps are undone, an unreadable count or
 //! a jump no shaft can make is a bad cell, a re-zeroed counter is followed. A phase channel
 //! frozen while the others alternate, or a whole set dead while the other set is live, is
-//! bad too ([`stuck`]). Consecutive rows
+//! bad too ([`stuck`]); duplicated channels and a reversed phase order withhold the verdict
+//! ([`wiring`]). Consecutive rows
 //! with bad cells form a glitch burst. The stage counts them and hands the rows on,
 //! flagged: the monitor holds such samples out as the firmware does with impossible ADC
 //! readings, the analysis drops them and bridges the hole like dropped samples.
@@ -64,6 +65,7 @@ pub mod encoder;
 mod report;
 pub mod stuck;
 mod time_base;
+pub mod wiring;
 
 pub use cells::{BadCells, CellLimits};
 pub use report::{ClippedChannel, DataQuality, NotJudged, RateChange};
@@ -166,6 +168,7 @@ pub struct QualityStage<'a, S: CleanSink> {
     clips: super::clipping::ClipTracker,
     encoder: encoder::EncoderTrack,
     stuck: stuck::StuckTracker,
+    wiring: wiring::WiringCheck,
     jitter: (f64, u64),
     dropping: bool,
     /// Bad cells per column: [not finite, finite but beyond the limits].
@@ -199,6 +202,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             clips: super::clipping::ClipTracker::default(),
             encoder: encoder::EncoderTrack::new(limits.wm_max),
             stuck: stuck::StuckTracker::default(),
+            wiring: wiring::WiringCheck::default(),
             jitter: (0.0, 0),
             dropping: false,
             cells_out: [[0; 2]; 9],
@@ -281,6 +285,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         }
         self.q.current_frequency_hz = self.crossings.median_period().map(|p| 1.0 / p);
         self.q.timestamp_jitter_rms_s = (self.jitter.0 / self.jitter.1.max(1) as f64).sqrt();
+        self.q.wiring = self.wiring.findings();
         self.q.encoder_wraps = self.encoder.wraps;
         self.q.encoder_resets = self.encoder.resets;
         self.q.clipped = self
@@ -481,6 +486,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
 
     fn new_segment(&mut self, why: SegmentBreak) -> bool {
         self.q.segments += 1;
+        self.wiring.interrupt();
         self.sink.new_segment(why)
     }
 
@@ -521,6 +527,11 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         } else {
             self.end_burst();
             self.crossings.push(r.t_s, r.i_abc[0], 1.0);
+        }
+        if bad.any() {
+            self.wiring.interrupt();
+        } else {
+            self.wiring.push(&r);
         }
         self.sink.row(&r, bad)
     }
@@ -575,6 +586,7 @@ impl<S: CleanSink> RowSink for QualityStage<'_, S> {
         self.crossings = CrossingCounter::default();
         self.encoder = encoder::EncoderTrack::new(self.limits.wm_max);
         self.stuck = stuck::StuckTracker::default();
+        self.wiring = wiring::WiringCheck::default();
         self.jitter = (0.0, 0);
         self.dropping = false;
         self.cells_out = [[0; 2]; 9];

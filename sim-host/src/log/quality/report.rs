@@ -75,6 +75,8 @@ pub struct DataQuality {
     /// Cells of stuck or dead phase channels per column ([`super::stuck`]; counted in
     /// `bad_cells` too).
     pub stuck_cells: BTreeMap<String, u64>,
+    /// Duplicated channels and a reversed phase order ([`super::wiring`]), one line each.
+    pub wiring: Vec<String>,
     /// Wraps of the encoder counter (16, 24, 32 or 64 bits) undone
     /// ([`super::encoder`]).
     pub encoder_wraps: u64,
@@ -239,6 +241,9 @@ impl DataQuality {
                 self.glitch_bursts,
                 self.longest_burst_s
             ));
+        }
+        for w in &self.wiring {
+            distrust.push(w.clone());
         }
         for (c, n) in &self.stuck_cells {
             let share = *n as f64 / rows;
