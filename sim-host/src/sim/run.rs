@@ -142,7 +142,7 @@ pub const SUPPLY_F_RANGE: (f64, f64) = (0.1, 2.0);
 /// Fewest output rows of a run.
 pub const MIN_ROWS: f64 = 2.0;
 
-/// The scenario's values against the run and the machine: every time inside the duration,
+/// The scenario's values against the run and the machine: every time at or before the end of the run,
 /// at least [`MIN_ROWS`] rows, supply
 /// frequencies within [`SUPPLY_F_RANGE`] of the parameter file's, sensor offsets inside
 /// the sensor's range and sensor gains that leave a reading (`change > -1`; a dead sensor
@@ -165,10 +165,11 @@ fn check_against_run(params: &ParamFile, sc: &Scenario) -> Result<(), SimError> 
         .chain(sc.supply.steps.iter().map(|s| ("supply.steps.t_s", s.t_s)))
         .chain(sc.load.steps.iter().map(|s| ("load.steps.t_s", s.t_s)));
     for (key, t) in times {
-        if t >= end {
+        // (At exactly the end is allowed: a list of steps up to the duration is common.)
+        if t > end {
             return bad(
                 key,
-                format!("{t} s is not inside the run (duration_s = {end} s): it would never act"),
+                format!("{t} s is after the run's end (duration_s = {end} s): it would never act"),
             );
         }
     }

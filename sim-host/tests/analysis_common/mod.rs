@@ -255,6 +255,10 @@ pub fn scenario(which: &str, effect: Option<&str>, noise: u32) -> Scenario {
         _ => {}
     }
     s.effects = vec![e];
+    // The ramps are laid out from the motor's settling time and may run past the end on the
+    // slower motor: the steps after the end never acted, and simulate refuses them.
+    let end = s.duration_s;
+    s.supply.steps.retain(|st| st.t_s <= end);
     s
 }
 
