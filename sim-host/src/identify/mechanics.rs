@@ -71,7 +71,7 @@ fn judged_linear(v: f64, sg: f64) -> Judged {
         return Err(FLAT.into());
     }
     let (lo, hi) = (v - 1.96 * sg, v + 1.96 * sg);
-    if !(v > 0.0) {
+    if v.is_nan() || v <= 0.0 {
         return Err(format!(
             "the fit gives {v:.3e}, not a physical value (95 % interval {lo:.3e}..{hi:.3e})"
         ));

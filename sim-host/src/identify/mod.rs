@@ -105,7 +105,7 @@ impl Samples {
         let times: Vec<f64> = rows.iter().map(|r| r.t_s).collect();
         let rate = crate::log::sample_rate_hz(&times).unwrap_or(0.0);
         let span = times.last().zip(times.first()).map_or(0.0, |(b, a)| b - a);
-        if !(rate > 0.0) || span < MIN_DURATION_S {
+        if rate.is_nan() || rate <= 0.0 || span < MIN_DURATION_S {
             return bad(format!(
                 "{span:.3} s of log in the window: identify needs at least {MIN_DURATION_S} s of regular samples"
             ));
@@ -159,7 +159,7 @@ impl Samples {
         let n = self.i_ab.len();
         let sq: f64 = self.i_ab.iter().map(|i| i[0] * i[0] + i[1] * i[1]).sum();
         self.i_rms_a = (sq / n.max(1) as f64).sqrt();
-        if !(self.i_rms_a > 0.0) {
+        if self.i_rms_a.is_nan() || self.i_rms_a <= 0.0 {
             return Err(IdentifyError::Log(
                 "the currents are zero throughout: nothing to identify".into(),
             ));
@@ -167,7 +167,7 @@ impl Samples {
         let head = ((0.1 / self.dt_s) as usize).clamp(2, n);
         let norm = |i: &[f64; 2]| i[0].hypot(i[1]);
         let peak = self.i_ab[..head].iter().map(norm).fold(0.0, f64::max);
-        self.starts_dead = self.i_ab.first().map_or(true, |i| norm(i) < 0.05 * peak);
+        self.starts_dead = self.i_ab.first().is_none_or(|i| norm(i) < 0.05 * peak);
         let c = |v: &[f64; 2]| Complex::new(v[0], v[1]);
         let turn: f64 = self.v_ab[..head]
             .windows(2)
@@ -416,7 +416,7 @@ pub fn covariance_sigmas(a: &nalgebra::DMatrix<f64>, s2: f64, flat: f64) -> Vec<
     let top = eig.eigenvalues.iter().fold(0.0f64, |t, e| t.max(e.abs()));
     let mut var = vec![0.0; m];
     for (k, &lam) in eig.eigenvalues.iter().enumerate() {
-        let flat = !(lam > flat * top);
+        let flat = lam.is_nan() || lam <= flat * top;
         for (i, v) in var.iter_mut().enumerate() {
             let u = eig.eigenvectors[(i, k)];
             if flat {
