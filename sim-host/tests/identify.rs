@@ -506,3 +506,99 @@ fn the_help_teaches_what_the_log_must_hold_and_what_cannot_be_told() {
     let (_, out, _) = run(&["--help"]);
     assert!(out.contains("identify"));
 }
+
+/// The fault the isolation names for `fault` at `change` on `truth`, the replay told
+/// `told` (the Table 1 protocol: commissioning 2-4 s, the fault at 4.5 s).
+fn named(
+    truth: &ParamFile,
+    told: &ParamFile,
+    fault: monitor_core::Fault,
+    change: f64,
+) -> Option<sim_host::replay::IsolationName> {
+    use sim_host::fault_signatures::{scenario, Protocol};
+    let proto = Protocol::default();
+    let opts = sim_host::replay::ReplayOptions {
+        angle_source: proto.angle_source,
+        commission: Some(proto.commission),
+        ..Default::default()
+    };
+    let sc = scenario(Some((fault, change)), &proto);
+    sim_host::experiment::simulate_and_replay(truth, told, &sc, opts, |_, _| {})
+        .expect("runs")
+        .finish()
+        .isolation
+        .named
+}
+
+/// The reference machine's parameters identified from the Table 1 protocol's healthy
+/// run (a start with the viscous load, 10 kHz, 12-bit sensors), 4 s, from its nameplate
+/// estimate.
+fn identified(truth: &ParamFile, m: &Machine) -> ParamFile {
+    use sim_host::fault_signatures::{scenario, Protocol};
+    let proto = Protocol::default();
+    let rows = sim_host::sim::simulate_to_vec(truth, &scenario(None, &proto)).expect("simulates");
+    let s = Samples::from_rows(&rows, channels(), 0.0, 4.0).expect("samples");
+    identify(&m.start(), &s, &mut |_| {})
+        .expect("identifies")
+        .params
+}
+
+/// The stretch goal: `diagnose` with the identified parameters names the same fault as
+/// with the true ones, for every Table 1 fault at ±50 % on the 3 hp reference motor. With
+/// `MONITOR_FULL_SWEEPS=1` also the 2.2 kW reference, where the bar is lower: never a
+/// different fault. Its machine has no stator leakage and the nameplate estimate splits
+/// the leakage 0.4 : 0.6; measured: the `ls` fault (which on that machine scales Lm
+/// itself) at ±50 % is named with the true parameters and left unnamed with the
+/// identified ones, the 16 other cases agree.
+#[test]
+fn the_identified_parameters_name_the_same_faults_as_the_true_ones() {
+    use rayon::prelude::*;
+    let mut motors = vec![(
+        ParamFile::reference_3hp(),
+        Machine {
+            name: "3 hp reference",
+            p_kw: 3.0 * 0.7457,
+            v_ll: 220.0,
+            f_hz: 60.0,
+            t: [0.0; 5],
+            j: 0.0,
+        },
+    )];
+    if std::env::var("MONITOR_FULL_SWEEPS").is_ok_and(|v| v == "1") {
+        motors.push((
+            ParamFile::reference_2p2kw(),
+            Machine {
+                name: "2.2 kW reference",
+                p_kw: 2.2,
+                v_ll: 400.0,
+                f_hz: 50.0,
+                t: [0.0; 5],
+                j: 0.0,
+            },
+        ));
+    }
+    for (truth, mut m) in motors {
+        let p = truth.motor;
+        m.t = [p.rs_ohm, p.rr_ohm, p.ls_h - p.lm_h, p.lr_h - p.lm_h, p.lm_h];
+        m.j = p.j_kgm2;
+        m.v_ll = truth.supply.v_ll_rms;
+        m.f_hz = truth.supply.f_hz;
+        let told = identified(&truth, &m);
+        let cases: Vec<(monitor_core::Fault, f64)> = monitor_core::Fault::ALL
+            .iter()
+            .flat_map(|f| [(*f, 0.5), (*f, -0.5)])
+            .collect();
+        let exact = m.name == "3 hp reference";
+        let diffs: Vec<String> = cases
+            .par_iter()
+            .filter_map(|&(f, c)| {
+                let a = named(&truth, &truth, f, c);
+                let b = named(&truth, &told, f, c);
+                eprintln!("{} {f} {c:+}: true {a:?}, identified {b:?}", m.name);
+                let wrong = if exact { a != b } else { b.is_some() && a != b };
+                wrong.then(|| format!("{f} {c:+}: true params name {a:?}, identified {b:?}"))
+            })
+            .collect();
+        assert!(diffs.is_empty(), "{}: {diffs:#?}", m.name);
+    }
+}
