@@ -28,6 +28,7 @@ pub mod demo;
 pub mod experiment;
 pub mod fault_signatures;
 pub mod hmi;
+pub mod identify;
 pub mod log;
 pub mod nameplate;
 pub mod params;

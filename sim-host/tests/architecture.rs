@@ -28,7 +28,7 @@ use std::path::{Path, PathBuf};
 use syn::visit::Visit;
 
 /// sim-host's library modules and their layers, lowest first.
-const LAYERS: [(&str, u8); 12] = [
+const LAYERS: [(&str, u8); 13] = [
     ("params", 1),
     ("log", 2),
     ("nameplate", 2),
@@ -36,6 +36,7 @@ const LAYERS: [(&str, u8); 12] = [
     ("replay", 3),
     ("analysis", 4),
     ("experiment", 5),
+    ("identify", 5),
     ("fault_signatures", 6),
     ("service_profile", 6),
     ("demo", 7),

@@ -196,9 +196,11 @@ fn slow_progress(history: &[f64]) -> bool {
     }
 }
 
-/// `J^T J` and `J^T r` at `x`, the Jacobian by forward differences, one column per free
-/// parameter, in parallel.
-fn normal_equations<P: LeastSquares>(
+/// `J^T J` and `J^T r` at `x` (`r` the residuals at `x`, `cache` its cache), the Jacobian
+/// by forward differences (steps 1e-4 of the scale), one column per free parameter, in
+/// parallel; rows and columns in `free`'s order. Public for the Gauss-Newton covariance
+/// `s^2 (J^T J)^-1` at an optimum (`crate::identify`).
+pub fn normal_equations<P: LeastSquares>(
     prob: &P,
     x: &[f64],
     r: &[f64],

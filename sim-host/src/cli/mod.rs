@@ -11,6 +11,7 @@ pub mod convert;
 mod demo;
 mod diagnose;
 mod hmi;
+mod identify;
 mod output_guard;
 mod params_cmd;
 mod progress;
@@ -71,6 +72,8 @@ pub enum Cmd {
     BoardRecord(board_record::BoardRecordArgs),
     // Make a parameter file (from a nameplate).
     Params(params_cmd::ParamsArgs),
+    // Identify the circuit from a log.
+    Identify(identify::IdentifyArgs),
 }
 
 /// Runs a command.
@@ -90,6 +93,7 @@ pub fn run(cmd: Cmd) -> anyhow::Result<()> {
         Cmd::Convert(a) => convert::run(a),
         Cmd::BoardRecord(a) => board_record::run(a),
         Cmd::Params(a) => params_cmd::run(a),
+        Cmd::Identify(a) => identify::run(a),
     }
 }
 

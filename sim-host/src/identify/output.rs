@@ -1,0 +1,136 @@
+//! The parameter file `identify` writes: the start file's, with the identified values in,
+//! each line saying where its value came from; the start file's `[columns]` table kept.
+
+use super::{Estimate, Identification};
+use crate::nameplate::toml_number;
+use crate::params::ParamFile;
+
+/// The start file with the identified values (the start's where not identified). The
+/// leakage is split by the start's stator share; B + Bl by the start's B : Bl ratio.
+pub(super) fn written_params(start: &ParamFile, e: &[Estimate], share: f64) -> ParamFile {
+    let mut p = *start;
+    let v = |k: usize| e.get(k).map_or(f64::NAN, Estimate::written);
+    let (leak, lm) = (v(2), v(3));
+    p.motor.rs_ohm = v(0);
+    p.motor.rr_ohm = v(1);
+    p.motor.lm_h = lm;
+    p.motor.ls_h = lm + share * leak;
+    p.motor.lr_h = lm + (1.0 - share) * leak;
+    p.motor.j_kgm2 = v(4);
+    let (b0, bl0) = (start.motor.b_nms, start.motor.bl_nms);
+    let b_share = if b0 + bl0 > 0.0 { b0 / (b0 + bl0) } else { 1.0 };
+    if e.get(5).is_some_and(|x| x.value.is_some()) {
+        p.motor.b_nms = b_share * v(5);
+        p.motor.bl_nms = (1.0 - b_share) * v(5);
+    }
+    p
+}
+
+/// "Lls" and "Llr": never identified apart (the reason says why and what is kept).
+pub(super) fn leakage_split(e: &[Estimate], start: &ParamFile) -> Vec<Estimate> {
+    let m = &start.motor;
+    let why = "the terminals cannot split the leakage (the linear T-circuit is terminal-equivalent to the \
+               inverse-Gamma circuit for any split): Lls + Llr is identified, split as in the start file";
+    let unit = e.get(2).map_or("H".to_string(), |x| x.unit.clone());
+    [
+        ("Lls", "ls_h - lm_h", m.ls_h - m.lm_h),
+        ("Llr", "lr_h - lm_h", m.lr_h - m.lm_h),
+    ]
+    .into_iter()
+    .map(|(name, key, start)| Estimate {
+        name: name.into(),
+        key: key.into(),
+        unit: unit.clone(),
+        start,
+        value: None,
+        lo: None,
+        hi: None,
+        not_identified_because: Some(why.into()),
+    })
+    .collect()
+}
+
+/// Where estimate `e`'s value came from, for a comment.
+fn source(e: &Estimate) -> String {
+    match (e.value, e.lo, e.hi) {
+        (Some(_), Some(lo), Some(hi)) => format!(
+            "identified, 95 % interval [{}..{}] {}",
+            toml_number(lo),
+            toml_number(hi),
+            e.unit
+        ),
+        _ => format!(
+            "kept from the start file: {} not identified ({})",
+            e.name,
+            e.not_identified_because.as_deref().unwrap_or("")
+        ),
+    }
+}
+
+/// The TOML text of the identified parameter file. `start_text` is the start file's text
+/// (its `[columns]` table is copied), `start_name` and `log_name` name the inputs.
+pub fn to_toml(id: &Identification, start_text: &str, start_name: &str, log_name: &str) -> String {
+    let m = &id.params.motor;
+    let e = |k: usize| id.estimates.get(k).map(source).unwrap_or_default();
+    let mut s = format!(
+        "# Identified by `sim-host identify` (docs/own-motor.md) from {log_name}, {:.3}..{:.3} s\n\
+         # ({} samples, {}), starting from {start_name}.\n\
+         # Current error RMS {:.2} % of the current's RMS (the start file: {:.2} %). Each value:\n\
+         # identified with its 95 % interval, or kept from the start file with the reason.\n[motor]\n",
+        id.window_s.0,
+        id.window_s.1,
+        id.samples,
+        if id.speed_imposed { "the measured speed imposed" } else { "no speed channel: the shaft simulated" },
+        100.0 * id.relative_rms_error,
+        100.0 * id.relative_rms_error_start,
+    );
+    let share = id.stator_leakage_share;
+    let lines = [
+        ("rs_ohm", m.rs_ohm, e(0)),
+        ("rr_ohm", m.rr_ohm, e(1)),
+        (
+            "ls_h",
+            m.ls_h,
+            format!("Lm + Lls, Lls = {share:.3} x (Lls + Llr): Lls + Llr {} (the split kept from the start file: the terminals cannot tell it)", e(2)),
+        ),
+        ("lr_h", m.lr_h, format!("Lm + Llr, Llr = {:.3} x (Lls + Llr)", 1.0 - share)),
+        ("lm_h", m.lm_h, e(3)),
+    ];
+    for (key, v, why) in lines {
+        s.push_str(&format!("{key} = {} # {why}\n", toml_number(v)));
+    }
+    s.push_str(&format!("poles = {} # from the start file\n", m.poles));
+    s.push_str(&format!("j_kgm2 = {} # {}\n", toml_number(m.j_kgm2), e(4)));
+    let b = e(5);
+    s.push_str(&format!(
+        "b_nms = {} # B + Bl {b}; split in the start file's ratio B : Bl\n",
+        toml_number(m.b_nms)
+    ));
+    s.push_str(&format!(
+        "bl_nms = {} # the rest of B + Bl\n",
+        toml_number(m.bl_nms)
+    ));
+    s.push_str(&format!(
+        "[supply]\nv_ll_rms = {} # from the start file\nf_hz = {} # from the start file\n",
+        toml_number(id.params.supply.v_ll_rms),
+        toml_number(id.params.supply.f_hz)
+    ));
+    let columns = ParamFile::from_toml_str_with_columns(start_text, start_name)
+        .map(|(_, c)| c)
+        .unwrap_or_default();
+    if !columns.is_empty() {
+        s.push_str(
+            "# The start file's [columns] table: the log's channels and units.\n[columns]\n",
+        );
+        let quoted = |x: &str| toml::Value::String(x.to_string()).to_string();
+        for (key, c) in &columns {
+            let unit = c
+                .unit
+                .as_deref()
+                .map(|u| format!(", unit = {}", quoted(u)))
+                .unwrap_or_default();
+            s.push_str(&format!("{key} = {{ name = {}{unit} }}\n", quoted(&c.name)));
+        }
+    }
+    s
+}

@@ -1,0 +1,604 @@
+//! `identify` against known circuits: five published machines (2.2 kW to 50 hp, the same
+//! as `tests/nameplate.rs`), each simulated from standstill with ±8 % supply steps and the
+//! default 12-bit sensors (ADC quantisation and noise), identified from the nameplate
+//! estimate (`params from-nameplate`'s, its nameplate computed here from the circuit at
+//! rated power by the analytic steady state) at 5 and 10 kHz: Rs, Rr, the total leakage
+//! and Lm against the published circuit (10 %) and against the same circuit with the start
+//! file's leakage split (1 %; the split is what no terminal log can tell). Also: the
+//! motulator log (a simulator this project did not write), a log that cannot identify
+//! some parameters says so, bad input is one line, and the command never writes over its
+//! inputs.
+//!
+//! All ten runs (3 s logs) take about 2 s in the test profile.
+
+use assert_cmd::Command;
+use monitor_core::{MotorParameters, SupplyParameters};
+use sim_host::identify::{identify, Identification, Samples};
+use sim_host::log::{Channels, Row};
+use sim_host::nameplate::{estimate, Connection, Nameplate, NemaDesign};
+use sim_host::params::ParamFile;
+use sim_host::sim::{steady_state_at, Scenario, SensorSpec, SupplyStep};
+use std::f64::consts::TAU;
+
+/// A machine: name, rated kW, V_ll, Hz, [Rs, Rr, Lls, Llr, Lm] (ohm, H), J [kg m^2].
+struct Machine {
+    name: &'static str,
+    p_kw: f64,
+    v_ll: f64,
+    f_hz: f64,
+    t: [f64; 5],
+    j: f64,
+}
+
+/// The five machines (4-pole): motulator's 2.2 kW (its leakage all on the stator side);
+/// Krause, Wasynczuk and Sudhoff's 3 hp and 50 hp (Analysis of Electric Machinery and
+/// Drive Systems, 60 Hz, Xls = Xlr, with their J); MATLAB/Simscape's 4 kW and 15 kW
+/// presets as transcribed by the Modelica Buildings library (Ls = Lr, J of the presets).
+fn machines() -> Vec<Machine> {
+    let w60 = TAU * 60.0;
+    let krause = |name, hp: f64, v, rs, xl: f64, xm: f64, rr, j| Machine {
+        name,
+        p_kw: hp * 0.7457,
+        v_ll: v,
+        f_hz: 60.0,
+        t: [rs, rr, xl / w60, xl / w60, xm / w60],
+        j,
+    };
+    let simscape = |name, p_kw, rs, rr, ls: f64, lm: f64, j| Machine {
+        name,
+        p_kw,
+        v_ll: 400.0,
+        f_hz: 50.0,
+        t: [rs, rr, ls - lm, ls - lm, lm],
+        j,
+    };
+    vec![
+        Machine {
+            name: "motulator 2.2 kW",
+            p_kw: 2.2,
+            v_ll: 400.0,
+            f_hz: 50.0,
+            t: [3.7, 2.1, 0.021, 0.0, 0.224],
+            j: 0.015,
+        },
+        krause("Krause 3 hp", 3.0, 220.0, 0.435, 0.754, 26.13, 0.816, 0.089),
+        simscape("Simscape 4 kW", 4.0, 1.405, 1.395, 0.178039, 0.1722, 0.0131),
+        simscape(
+            "Simscape 15 kW",
+            15.0,
+            0.2147,
+            0.2205,
+            0.065181,
+            0.06419,
+            0.102,
+        ),
+        krause(
+            "Krause 50 hp",
+            50.0,
+            460.0,
+            0.087,
+            0.302,
+            13.08,
+            0.228,
+            1.662,
+        ),
+    ]
+}
+
+impl Machine {
+    /// The true parameter file: the circuit, J, the paper's viscous load at rated torque.
+    fn truth(&self) -> ParamFile {
+        let [rs, rr, lls, llr, lm] = self.t;
+        let w_rated = TAU * self.f_hz / 2.0 * 0.97;
+        ParamFile {
+            motor: MotorParameters {
+                rs_ohm: rs,
+                rr_ohm: rr,
+                ls_h: lm + lls,
+                lr_h: lm + llr,
+                lm_h: lm,
+                poles: 4,
+                j_kgm2: self.j,
+                b_nms: 0.005 * 1000.0 * self.p_kw / (w_rated * w_rated),
+                bl_nms: 1000.0 * self.p_kw / (w_rated * w_rated),
+            },
+            supply: SupplyParameters {
+                v_ll_rms: self.v_ll,
+                f_hz: self.f_hz,
+            },
+        }
+    }
+
+    /// The nameplate at rated shaft power (slip by bisection on the analytic steady
+    /// state), rounded as a nameplate prints it.
+    fn nameplate(&self) -> Nameplate {
+        let m = self.truth().motor;
+        let at = |s: f64| steady_state_at(&m, self.v_ll, self.f_hz, s);
+        let (mut lo, mut hi) = (1e-5, 0.3);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if at(mid).p_mech_w < 1000.0 * self.p_kw {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let st = at(0.5 * (lo + hi));
+        let sig3 = |x: f64| {
+            let k = 10f64.powi(2 - x.log10().floor() as i32);
+            (x * k).round() / k
+        };
+        Nameplate {
+            power_kw: self.p_kw,
+            voltage_v: self.v_ll,
+            current_a: sig3(st.i_phase_rms_a),
+            frequency_hz: self.f_hz,
+            speed_rpm: (st.wm_rad_s * 60.0 / TAU).round(),
+            power_factor: (100.0 * st.power_factor).round() / 100.0,
+            efficiency: (1000.0 * 1000.0 * self.p_kw / st.p_in_w).round() / 1000.0,
+            poles: None,
+            connection: Connection::Star,
+            locked_rotor_ratio: None,
+            design: NemaDesign::B,
+        }
+    }
+
+    /// The start file: `params from-nameplate`'s estimate.
+    fn start(&self) -> ParamFile {
+        estimate(&self.nameplate())
+            .unwrap_or_else(|e| panic!("{}: {e}", self.name))
+            .params
+    }
+}
+
+/// A start from standstill with ±8 % supply steps every 0.5 s from 1 s (time for the
+/// largest machine to run up), 12-bit sensors with their default noise.
+fn healthy_log(m: &Machine, rate_hz: f64, duration_s: f64) -> Vec<Row> {
+    let mut sc = Scenario::steady(duration_s, rate_hz);
+    sc.sensors = SensorSpec::default();
+    sc.supply.steps = (0..)
+        .map(|k| 1.0 + 0.5 * k as f64)
+        .take_while(|t| *t < duration_s)
+        .enumerate()
+        .map(|(k, t)| SupplyStep {
+            t_s: t,
+            v_scale: Some(if k % 2 == 0 { 0.92 } else { 1.0 }),
+            f_hz: None,
+        })
+        .collect();
+    sim_host::sim::simulate_to_vec(&m.truth(), &sc).expect("simulates")
+}
+
+fn channels() -> Channels {
+    Channels {
+        voltages: true,
+        speed: true,
+        encoder: true,
+    }
+}
+
+/// The machine's circuit re-expressed with the stator leakage share `f` = Lls / (Lls +
+/// Llr): the T-circuit with that split and the same terminal behaviour (the same
+/// inverse-Gamma parameters L_sigma = Lls + Lm Llr / Lr, L_M = Lm^2 / Lr and
+/// R_R = Rr (Lm / Lr)^2; Slemon, "Modelling of induction machines for electric drives",
+/// IEEE Trans. Ind. Appl. 25(6), 1989). Returns [Rs, Rr, Lls + Llr, Lm].
+fn with_split(t: [f64; 5], f: f64) -> [f64; 4] {
+    let [rs, rr, lls, llr, lm] = t;
+    let lr = lm + llr;
+    let (l_sigma, l_m, r_r) = (lls + lm * llr / lr, lm * lm / lr, rr * (lm / lr).powi(2));
+    // For a total leakage L: Lm from L_M = Lm^2 / (Lm + (1 - f) L), then L_sigma(L),
+    // increasing in L: bisection.
+    let lm_of = |l: f64| 0.5 * (l_m + (l_m * l_m + 4.0 * l_m * (1.0 - f) * l).sqrt());
+    let sigma_of = |l: f64| {
+        let m = lm_of(l);
+        f * l + m * (1.0 - f) * l / (m + (1.0 - f) * l)
+    };
+    let (mut lo, mut hi) = (0.0, 10.0 * l_sigma);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if sigma_of(mid) < l_sigma {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let l = 0.5 * (lo + hi);
+    let m = lm_of(l);
+    let lr_f = m + (1.0 - f) * l;
+    [rs, r_r * (lr_f / m).powi(2), l, m]
+}
+
+/// Relative errors of (Rs, Rr, Lls + Llr, Lm) against `truth`.
+fn errors(name: &str, truth: [f64; 4], id: &Identification) -> [f64; 4] {
+    let mut e = [f64::NAN; 4];
+    for (k, t) in truth.iter().enumerate() {
+        let v = id.estimates[k]
+            .value
+            .unwrap_or_else(|| panic!("{name}: {} not identified", id.estimates[k].name));
+        e[k] = v / t - 1.0;
+    }
+    e
+}
+
+fn pct(e: [f64; 4]) -> String {
+    format!(
+        "Rs {:+.2} %, Rr {:+.2} %, Lls+Llr {:+.2} %, Lm {:+.2} %",
+        100.0 * e[0],
+        100.0 * e[1],
+        100.0 * e[2],
+        100.0 * e[3]
+    )
+}
+
+/// Identifies machine `m` from a 3 s log at `rate_hz`: the errors against the published
+/// circuit, and against the same circuit with the start file's leakage split.
+fn check_machine(m: &Machine, rate_hz: f64) -> ([f64; 4], [f64; 4]) {
+    let rows = healthy_log(m, rate_hz, 3.0);
+    let s =
+        Samples::from_rows(&rows, channels(), f64::NEG_INFINITY, f64::INFINITY).expect("samples");
+    let id = identify(&m.start(), &s, &mut |_| {}).expect("identifies");
+    let raw = errors(m.name, [m.t[0], m.t[1], m.t[2] + m.t[3], m.t[4]], &id);
+    let eq = errors(m.name, with_split(m.t, id.stator_leakage_share), &id);
+    eprintln!(
+        "{} at {} kHz: {} | with the start's split {:.2}: {} (current error {:.2} %, start {:.2} %)",
+        m.name,
+        rate_hz / 1000.0,
+        pct(raw),
+        id.stator_leakage_share,
+        pct(eq),
+        100.0 * id.relative_rms_error,
+        100.0 * id.relative_rms_error_start
+    );
+    (raw, eq)
+}
+
+/// The bars: against the circuit with the start file's leakage split (what a log can
+/// determine) within 1 %; against the published circuit within 10 %, but for the
+/// motulator machine whose leakage is all on the stator side (the nameplate estimate
+/// splits it 0.4 : 0.6, NEMA design B): there the split moves Rr by about (1 + 0.6 L /
+/// Lm)^2 - 1 = +11.6 %, which no terminal log can tell.
+fn check_rate(rate_hz: f64) {
+    for m in machines() {
+        let (raw, eq) = check_machine(&m, rate_hz);
+        for (k, what) in ["Rs", "Rr", "Lls + Llr", "Lm"].iter().enumerate() {
+            assert!(
+                eq[k].abs() <= 0.01,
+                "{} at {rate_hz} Hz: {what} off by {:+.2} % from the equivalent circuit",
+                m.name,
+                100.0 * eq[k]
+            );
+            let split_case = m.t[3] == 0.0 && k == 1;
+            let bar = if split_case { 0.125 } else { 0.10 };
+            assert!(
+                raw[k].abs() <= bar,
+                "{} at {rate_hz} Hz: {what} off by {:+.1} %",
+                m.name,
+                100.0 * raw[k]
+            );
+        }
+    }
+}
+
+#[test]
+fn five_machines_at_5_khz_from_the_nameplate_estimate() {
+    check_rate(5000.0);
+}
+
+#[test]
+fn five_machines_at_10_khz_from_the_nameplate_estimate() {
+    check_rate(10_000.0);
+}
+
+/// `identify` on `args`; (status ok, stdout, stderr).
+fn run(args: &[&str]) -> (bool, String, String) {
+    let o = Command::cargo_bin("sim-host")
+        .expect("binary")
+        .args(args)
+        .output()
+        .expect("runs");
+    (
+        o.status.success(),
+        String::from_utf8_lossy(&o.stdout).into(),
+        String::from_utf8_lossy(&o.stderr).into(),
+    )
+}
+
+fn root(p: &str) -> String {
+    format!("{}/../{p}", env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn the_motulator_log_from_its_nameplate_within_10_percent_and_the_file_says_where_from() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let start = dir.path().join("start.toml");
+    let out = dir.path().join("motor.toml");
+    let log = root("examples/logs/motulator_2p2kw_dol.csv");
+    // Its nameplate at rated power from the log's true circuit (examples/logs/README.md).
+    let truth = ParamFile::load(std::path::Path::new(&root(
+        "examples/logs/motulator_2p2kw_dol.toml",
+    )))
+    .expect("truth");
+    let m = Machine {
+        name: "motulator log",
+        p_kw: 2.2,
+        v_ll: 400.0,
+        f_hz: 50.0,
+        t: [3.7, 2.5, 0.0, 0.023, 0.245],
+        j: 0.015,
+    };
+    assert_eq!(m.truth().motor.lr_h, truth.motor.lr_h);
+    std::fs::write(
+        &start,
+        estimate(&m.nameplate()).expect("estimate").to_toml(),
+    )
+    .expect("write");
+    let (ok, stdout, stderr) = run(&[
+        "identify",
+        "--params",
+        start.to_str().unwrap(),
+        &log,
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(ok, "{stderr}");
+    let j: serde_json::Value = serde_json::from_str(&stdout).expect("one JSON document");
+    let est = &j["identification"]["estimates"];
+    let truth4 = [3.7, 2.5, 0.023, 0.245];
+    for (k, t) in truth4.iter().enumerate() {
+        let v = est[k]["value"]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{}", est[k]));
+        eprintln!(
+            "motulator log: {} {:+.2} %",
+            est[k]["name"],
+            100.0 * (v / t - 1.0)
+        );
+        assert!(
+            (v / t - 1.0).abs() <= 0.10,
+            "{}: {v} vs {t}",
+            est[k]["name"]
+        );
+        let (lo, hi) = (
+            est[k]["lo"].as_f64().unwrap(),
+            est[k]["hi"].as_f64().unwrap(),
+        );
+        assert!(lo <= v && v <= hi);
+    }
+    // Lls and Llr apart: not identified, with the reason.
+    let names: Vec<&str> = est
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|e| e["name"].as_str())
+        .collect();
+    for split in ["Lls", "Llr"] {
+        let e = est
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|e| e["name"] == split)
+            .expect(split);
+        assert!(
+            e["value"].is_null()
+                && e["not_identified_because"]
+                    .as_str()
+                    .unwrap()
+                    .contains("cannot split"),
+            "{names:?}"
+        );
+    }
+    let written = ParamFile::load(&out).expect("the written file loads");
+    assert!((written.motor.rs_ohm / 3.7 - 1.0).abs() < 0.1);
+    let text = std::fs::read_to_string(&out).unwrap();
+    for key in ["rs_ohm", "rr_ohm", "lm_h", "j_kgm2"] {
+        let line = text
+            .lines()
+            .find(|l| l.starts_with(&format!("{key} = ")))
+            .expect(key);
+        assert!(
+            line.contains("# identified, 95 % interval [")
+                || line.contains("# kept from the start file"),
+            "{line}"
+        );
+    }
+    // Never over an input, nor over an existing file without --force.
+    for target in [start.to_str().unwrap(), log.as_str(), out.to_str().unwrap()] {
+        let (ok, _, err) = run(&[
+            "identify",
+            "--params",
+            start.to_str().unwrap(),
+            &log,
+            "--out",
+            target,
+        ]);
+        assert!(!ok && err.trim().lines().count() == 1, "{err}");
+        assert!(err.contains("refusing to overwrite"), "{err}");
+    }
+}
+
+#[test]
+fn steady_running_at_one_point_says_what_it_cannot_identify() {
+    let all = machines();
+    let m = &all[0];
+    // No supply steps: a start, then 1.5 s of steady running at one point, fitted alone.
+    let mut sc = Scenario::steady(3.0, 5000.0);
+    sc.sensors = SensorSpec::default();
+    let rows = sim_host::sim::simulate_to_vec(&m.truth(), &sc).expect("simulates");
+    let s = Samples::from_rows(&rows, channels(), 1.5, f64::INFINITY).expect("samples");
+    assert!(!s.starts_dead);
+    let id = identify(&m.start(), &s, &mut |_| {}).expect("runs");
+    let not: Vec<&str> = id
+        .estimates
+        .iter()
+        .filter(|e| e.value.is_none())
+        .map(|e| e.name.as_str())
+        .collect();
+    eprintln!("one steady point: not identified {not:?}");
+    for e in &id.estimates {
+        eprintln!("  {} {:?} {:?}", e.name, e.value, e.not_identified_because);
+    }
+    assert!(not.contains(&"J"), "{not:?}");
+    let electrical = ["Rs", "Rr", "Lls + Llr", "Lm"];
+    assert!(
+        electrical.iter().filter(|n| not.contains(n)).count() >= 2,
+        "one steady point gives two real equations for four parameters: {not:?}"
+    );
+    for e in id.estimates.iter().filter(|e| e.value.is_none()) {
+        assert!(e
+            .not_identified_because
+            .as_deref()
+            .is_some_and(|w| !w.is_empty()));
+    }
+}
+
+#[test]
+fn bad_input_is_one_line_naming_the_problem() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let params = root("examples/logs/motulator_2p2kw_dol.toml");
+    // A current-only log: no voltages to drive the model.
+    let log = dir.path().join("current_only.csv");
+    let mut text = String::from("t_s,ia_A,ib_A,ic_A\n");
+    for k in 0..3000 {
+        let t = k as f64 * 2e-4;
+        let a = (TAU * 50.0 * t).sin();
+        text.push_str(&format!("{t},{a},{},{}\n", -0.5 * a, -0.5 * a));
+    }
+    std::fs::write(&log, text).unwrap();
+    let (ok, _, err) = run(&["identify", "--params", &params, log.to_str().unwrap()]);
+    assert!(
+        !ok && err.trim().lines().count() == 1 && err.contains("no voltages"),
+        "{err}"
+    );
+    // A window too short.
+    let csv = root("examples/logs/motulator_2p2kw_dol.csv");
+    let (ok, _, err) = run(&[
+        "identify", "--params", &params, &csv, "--from", "1", "--to", "1.05",
+    ]);
+    assert!(
+        !ok && err.trim().lines().count() == 1 && err.contains("at least"),
+        "{err}"
+    );
+    // A start file that is no machine.
+    let bad = dir.path().join("bad.toml");
+    let p = std::fs::read_to_string(&params)
+        .unwrap()
+        .replace("rr_ohm = 2.5", "rr_ohm = 0.0");
+    std::fs::write(&bad, p).unwrap();
+    let (ok, _, err) = run(&["identify", "--params", bad.to_str().unwrap(), &csv]);
+    assert!(!ok && err.trim().lines().count() == 1, "{err}");
+}
+
+#[test]
+fn the_help_teaches_what_the_log_must_hold_and_what_cannot_be_told() {
+    let (ok, out, _) = run(&["identify", "--help"]);
+    assert!(ok);
+    for needle in [
+        "What the log must hold",
+        "Lls and Llr apart",
+        "not identified",
+        "--out",
+        "95 %",
+        "params from-nameplate",
+    ] {
+        assert!(out.contains(needle), "{needle} missing:\n{out}");
+    }
+    let (_, out, _) = run(&["--help"]);
+    assert!(out.contains("identify"));
+}
+
+/// The fault the isolation names for `fault` at `change` on `truth`, the replay told
+/// `told` (the Table 1 protocol: commissioning 2-4 s, the fault at 4.5 s).
+fn named(
+    truth: &ParamFile,
+    told: &ParamFile,
+    fault: monitor_core::Fault,
+    change: f64,
+) -> Option<sim_host::replay::IsolationName> {
+    use sim_host::fault_signatures::{scenario, Protocol};
+    let proto = Protocol::default();
+    let opts = sim_host::replay::ReplayOptions {
+        angle_source: proto.angle_source,
+        commission: Some(proto.commission),
+        ..Default::default()
+    };
+    let sc = scenario(Some((fault, change)), &proto);
+    sim_host::experiment::simulate_and_replay(truth, told, &sc, opts, |_, _| {})
+        .expect("runs")
+        .finish()
+        .isolation
+        .named
+}
+
+/// The reference machine's parameters identified from the Table 1 protocol's healthy
+/// run (a start with the viscous load, 10 kHz, 12-bit sensors), 4 s, from its nameplate
+/// estimate.
+fn identified(truth: &ParamFile, m: &Machine) -> ParamFile {
+    use sim_host::fault_signatures::{scenario, Protocol};
+    let proto = Protocol::default();
+    let rows = sim_host::sim::simulate_to_vec(truth, &scenario(None, &proto)).expect("simulates");
+    let s = Samples::from_rows(&rows, channels(), 0.0, 4.0).expect("samples");
+    identify(&m.start(), &s, &mut |_| {})
+        .expect("identifies")
+        .params
+}
+
+/// The stretch goal: `diagnose` with the identified parameters names the same fault as
+/// with the true ones, for every Table 1 fault at ±50 % on the 3 hp reference motor. With
+/// `MONITOR_FULL_SWEEPS=1` also the 2.2 kW reference, where the bar is lower: never a
+/// different fault. Its machine has no stator leakage and the nameplate estimate splits
+/// the leakage 0.4 : 0.6; measured: the `ls` fault (which on that machine scales Lm
+/// itself) at ±50 % is named with the true parameters and left unnamed with the
+/// identified ones, the 16 other cases agree.
+#[test]
+fn the_identified_parameters_name_the_same_faults_as_the_true_ones() {
+    use rayon::prelude::*;
+    let mut motors = vec![(
+        ParamFile::reference_3hp(),
+        Machine {
+            name: "3 hp reference",
+            p_kw: 3.0 * 0.7457,
+            v_ll: 220.0,
+            f_hz: 60.0,
+            t: [0.0; 5],
+            j: 0.0,
+        },
+    )];
+    if std::env::var("MONITOR_FULL_SWEEPS").is_ok_and(|v| v == "1") {
+        motors.push((
+            ParamFile::reference_2p2kw(),
+            Machine {
+                name: "2.2 kW reference",
+                p_kw: 2.2,
+                v_ll: 400.0,
+                f_hz: 50.0,
+                t: [0.0; 5],
+                j: 0.0,
+            },
+        ));
+    }
+    for (truth, mut m) in motors {
+        let p = truth.motor;
+        m.t = [p.rs_ohm, p.rr_ohm, p.ls_h - p.lm_h, p.lr_h - p.lm_h, p.lm_h];
+        m.j = p.j_kgm2;
+        m.v_ll = truth.supply.v_ll_rms;
+        m.f_hz = truth.supply.f_hz;
+        let told = identified(&truth, &m);
+        let cases: Vec<(monitor_core::Fault, f64)> = monitor_core::Fault::ALL
+            .iter()
+            .flat_map(|f| [(*f, 0.5), (*f, -0.5)])
+            .collect();
+        let exact = m.name == "3 hp reference";
+        let diffs: Vec<String> = cases
+            .par_iter()
+            .filter_map(|&(f, c)| {
+                let a = named(&truth, &truth, f, c);
+                let b = named(&truth, &told, f, c);
+                eprintln!("{} {f} {c:+}: true {a:?}, identified {b:?}", m.name);
+                let wrong = if exact { a != b } else { b.is_some() && a != b };
+                wrong.then(|| format!("{f} {c:+}: true params name {a:?}, identified {b:?}"))
+            })
+            .collect();
+        assert!(diffs.is_empty(), "{}: {diffs:#?}", m.name);
+    }
+}
