@@ -18,8 +18,11 @@ fn run(params: &ParamFile, load_nm: f64, phase: Phase, fraction: f64) -> (Option
         bl_nms: None,
         steps: vec![],
     };
-    sc.effects
-        .push(EffectSpec::PhaseAsymmetry { phase, fraction });
+    sc.effects.push(EffectSpec::PhaseAsymmetry {
+        phase,
+        fraction,
+        fault_resistance_ohm: None,
+    });
     let rows = simulate_to_vec(params, &sc).expect("simulate");
     let opts = ReplayOptions {
         angle_source: AngleSource::RotorFluxCurrentModel,
@@ -102,6 +105,7 @@ fn diagnose_and_the_analysis_name_the_same_phase() {
         sc.effects.push(EffectSpec::PhaseAsymmetry {
             phase,
             fraction: 0.05,
+            fault_resistance_ohm: None,
         });
         let rows = simulate_to_vec(&p, &sc).expect("simulate");
         let rep = diagnose_rows(&p, sc.sensors.channels(), &rows, ReplayOptions::default())
@@ -147,8 +151,11 @@ fn run_unbalanced(
         angle_deg,
     });
     if let Some((phase, fraction)) = short {
-        sc.effects
-            .push(EffectSpec::PhaseAsymmetry { phase, fraction });
+        sc.effects.push(EffectSpec::PhaseAsymmetry {
+            phase,
+            fraction,
+            fault_resistance_ohm: None,
+        });
     }
     let rows = simulate_to_vec(params, &sc).expect("simulate");
     diagnose_rows(
@@ -242,8 +249,11 @@ fn mismatched(
         angle_deg: 30.0,
     });
     if let Some((phase, fraction)) = shorted {
-        sc.effects
-            .push(EffectSpec::PhaseAsymmetry { phase, fraction });
+        sc.effects.push(EffectSpec::PhaseAsymmetry {
+            phase,
+            fraction,
+            fault_resistance_ohm: None,
+        });
     }
     simulate_to_vec(params, &sc).expect("simulate") // ok: test
 }

@@ -22,22 +22,20 @@ struct OnLog {
 
 /// The winding asymmetry a fitted `c` (i_neg = c conj(i_pos)) points at, named by the
 /// workspace's one faulty-phase method (`monitor_core::sequence`): in the core's phasor
-/// convention `I2/I1 = conj(c)`; the correction `arg(Z1/Z2)` is taken at the slip of the
-/// log's mean operating point `slip` and supply `w` [rad/s]. Returns the phase and the
-/// fraction of that winding's impedance lost (the first-order size of the asymmetry).
+/// convention `I2/I1 = conj(c)`; the correction `arg Z1` is taken at the slip of the log's
+/// mean operating point `slip` and supply `w` [rad/s]. Returns the phase and the least
+/// fraction of that phase's turns shorted (a bolted short; a fault resistance means more).
 pub fn asymmetry_phase(
     c: C64,
     n: &MachineConstants,
     w: f64,
     slip: f64,
 ) -> (monitor_core::Phase, f64) {
-    use monitor_core::sequence::{
-        asymmetry_correction_rad, suspect_phase, winding_change_fraction,
-    };
+    use monitor_core::sequence::{asymmetry_correction_rad, min_shorted_fraction, suspect_phase};
     let (we, s) = (w.abs().max(1.0) as f32, slip as f32);
     let corr = asymmetry_correction_rad(&n.core_model, we, s);
     let phase = suspect_phase(-(c.arg() as f32), corr);
-    let eps = winding_change_fraction(&n.core_model, we, s, c.norm() as f32);
+    let eps = min_shorted_fraction(&n.core_model, we, s, c.norm() as f32);
     (phase, f64::from(eps))
 }
 
@@ -116,7 +114,7 @@ impl Contribution for OnLog {
         let c = C64::new(c_re, c_im);
         let (ph, eps) = asymmetry_phase(c, n, w, slip);
         format!(
-            "phase {} winding differs: negative-sequence current {:.1} % of the positive-sequence current; fits about {:.1} % of that winding's impedance lost (an inter-turn short removes turns)",
+            "phase {} winding differs: negative-sequence current {:.1} % of the positive-sequence current; shorted turns in that phase, at least {:.1} % of its turns (a bolted short; a fault resistance means more)",
             ph.name(),
             100.0 * c.norm(),
             100.0 * eps,
