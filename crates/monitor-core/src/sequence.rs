@@ -67,7 +67,25 @@ pub struct NegativeSequence {
     /// arg(I2/I1) [rad], in (-pi, pi].
     pub angle_rad: f32,
     /// The phase whose winding the asymmetry points at; None below the ratio threshold.
+    /// The monitor names it from the winding's part ([`winding_asymmetry`]).
     pub suspect_phase: Option<Phase>,
+    /// The winding's part `|I2w/I1|` (the supply's `V2/Z2` taken out) where the voltages'
+    /// negative sequence is known (the monitor), else the whole ratio.
+    pub winding_ratio: f32,
+    /// The phase's confidence, 0..1 ([`phase_confidence`]); 0 without a phase.
+    pub phase_confidence: f32,
+}
+
+/// `conj(N)/P` as `(re, im)`: a Park pair's negative-sequence phasor over the positive
+/// sequence's (`P = (pd, pq)` at +theta, `N = (nd, nq)` at -theta; module docs), e.g.
+/// `I2/I1` or, with the voltages' `N`, `V2/I1` [ohm]. (0, 0) for `|P|` ~ 0.
+pub fn over_positive(p: (f32, f32), n: (f32, f32)) -> (f32, f32) {
+    let p2 = p.0 * p.0 + p.1 * p.1;
+    if !(p2 > 1e-12) {
+        return (0.0, 0.0);
+    }
+    let (a, b) = (n.0, -n.1);
+    ((a * p.0 + b * p.1) / p2, (b * p.0 - a * p.1) / p2)
 }
 
 /// Streaming positive/negative-sequence separation.
@@ -155,6 +173,12 @@ pub fn sequence_result(
         negative_sequence_ratio: ratio,
         angle_rad: angle,
         suspect_phase: suspect,
+        winding_ratio: ratio,
+        phase_confidence: if suspect.is_some() {
+            phase_confidence(angle, correction_rad)
+        } else {
+            0.0
+        },
     }
 }
 

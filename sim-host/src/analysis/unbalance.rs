@@ -113,13 +113,20 @@ pub fn analyse(d: &Prepared, n: &MachineConstants) -> UnbalanceAnalysis {
     let slip = operating_slip(d, n, &s);
     // The core's one faulty-phase method, in its convention I2/I1 = conj(c), V2/I1 = conj(cv).
     let (we, sl) = (w.abs().max(1.0) as f32, slip as f32);
+    // A current-only log cannot tell a winding from the supply's unbalance or the machine's
+    // own build asymmetry: below a healthy machine's inherent asymmetry no phase is named.
+    let min_ratio = if d.channels.voltages {
+        0.01
+    } else {
+        monitor_core::sequence::INHERENT_ASYMMETRY_RATIO
+    };
     let asym = monitor_core::sequence::winding_asymmetry(
         (c.re as f32, -c.im as f32),
         d.channels.voltages.then_some((cv.re as f32, -cv.im as f32)),
         &n.core_model,
         we,
         sl,
-        0.01,
+        min_ratio,
     );
     let cannot_judge = cannot_judge(d, &s, w);
     let suspect = asym.suspect_phase.filter(|_| cannot_judge.is_none());
@@ -153,6 +160,11 @@ pub fn analyse(d: &Prepared, n: &MachineConstants) -> UnbalanceAnalysis {
             "negative-sequence current {:.1} %, caused by the supply's {:.1} % voltage unbalance (no winding suspected)",
             100.0 * ratio,
             100.0 * vratio.unwrap_or(0.0)
+        ),
+        (None, false) if !d.channels.voltages && ratio >= 0.01 => format!(
+            "negative sequence {:.1} %: cannot judge the phase (a current-only log: below a healthy machine's own asymmetry of {:.0} % a winding cannot be told from the supply's unbalance or the machine's build; diagnose --baseline with a healthy log judges it)",
+            100.0 * ratio,
+            100.0 * monitor_core::sequence::INHERENT_ASYMMETRY_RATIO
         ),
         (None, false) => format!("currents balanced (negative sequence {:.2} %)", 100.0 * ratio),
     };

@@ -18,7 +18,7 @@ pub(super) struct ResolvedEffects {
     pub(super) load_torque: Option<f64>,
     pub(super) unbalance: Option<(f64, f64)>,
     /// Shorted turns (`phase_asymmetry`): phase index, fraction mu, fault resistance r_f
-    /// [ohm] (`None`: the healthy phase's Rs).
+    /// [ohm] (`None`: a tenth of the healthy phase's Rs).
     pub(super) asym: Option<(usize, f64, Option<f64>)>,
     /// Rotor resistance asymmetry delta (`rotor_asymmetry`), 0 when off.
     pub(super) rotor_delta: f64,
@@ -216,11 +216,10 @@ impl MachineBuilder<'_> {
         }
         let lls = if gamma_s { 0.0 } else { model.lls_h() * md.lls };
         let llr = if gamma_r { 0.0 } else { model.llr_h() * md.llr };
-        // The fault resistance defaults to the healthy phase's (cold) Rs.
-        let turn = self
-            .eff
-            .asym
-            .map(|(ph, mu, rf)| TurnLoop::new(ph, mu, rf.unwrap_or(m.rs_ohm), rs, model.lls_h()));
+        // The fault resistance defaults to a tenth of the healthy phase's (cold) Rs.
+        let turn = self.eff.asym.map(|(ph, mu, rf)| {
+            TurnLoop::new(ph, mu, rf.unwrap_or(0.1 * m.rs_ohm), rs, model.lls_h())
+        });
         let (c_nm, w0) = self.eff.coulomb.unwrap_or((0.0, 1.0));
         let load = if self.torque_load {
             LoadLaw {

@@ -289,7 +289,8 @@ pub enum EffectSpec {
     /// `R_f = Rs (1 - 2mu/3) + r_f/mu`, and the terminals draw (2/3) mu i_f u_k on top of the
     /// healthy machine's current (star connection, isolated neutral; `sim::machine` docs).
     /// The negative-sequence current is `I2/I1 = (mu/3) (Z1/Z_f) a^k`. Default mu = 0.05 in
-    /// phase a through r_f = the phase's resistance Rs. A bolted short (`r_f = 0`) of a few
+    /// phase a through r_f = Rs/10 (a low-resistance short, as insulation breakdown makes:
+    /// the loop draws a few times the rated current). A bolted short (`r_f = 0`) of a few
     /// per cent of the turns draws a loop current of V/Rs, tens of times the rated current.
     PhaseAsymmetry {
         /// Faulty phase, default "a".
@@ -298,7 +299,8 @@ pub enum EffectSpec {
         /// Fraction mu of the winding shorted (0..0.5), default 0.05.
         #[serde(default = "d_asym")]
         fraction: f64,
-        /// Fault resistance r_f of the short [ohm], >= 0; default the phase's resistance Rs.
+        /// Fault resistance r_f of the short [ohm], >= 0; default a tenth of the phase's
+        /// resistance Rs.
         #[serde(default)]
         fault_resistance_ohm: Option<f64>,
     },

@@ -1,6 +1,6 @@
 //! `phase_asymmetry`: one stator winding differs.
 
-use super::impedance::{z1_pos, z2_neg};
+use super::impedance::z1_pos;
 use super::{
     plausible, supply_unbalanced, About, Confusion, Contribution, EffectModel, Evidence, FitParam,
     FitSetup, Needs, ParamSpec, SetupError,
@@ -14,10 +14,10 @@ use monitor_core::EffectKind;
 #[derive(Debug, Clone, Copy)]
 pub struct PhaseAsymmetry;
 
-/// The winding asymmetry set up on a log: the full-order form's `e / c =
-/// conj(Z2 / (Z1 + Z2 - Rs))` at the log's mean operating point ([`WindingAsymmetry`]).
+/// The shorted turns set up on a log: the full-order form's loop admittance over `c`,
+/// `y / c = 1 / conj(Z1)` at the log's mean operating point ([`WindingAsymmetry`]).
 struct OnLog {
-    e_over_c: C64,
+    y_over_c: C64,
 }
 
 /// The winding asymmetry a fitted `c` (i_neg = c conj(i_pos)) points at, named by the
@@ -43,7 +43,7 @@ pub fn asymmetry_phase(
 const ABOUT: About = About {
     kind: EffectKind::PhaseAsymmetry,
     description: "One stator winding differs from the other two (inter-turn short, bad joint): the machine draws a negative-sequence current proportional to its load current even from a balanced supply.",
-    equations: "Reduced model: i_abc = balanced model current + i_neg, i_neg = (c_re + j c_im) conj(i_pos): a winding change dZ in phase k gives c = (dZ/3Zs...) e^{j 2 th_k} conj(Zs/Z2) mu/3. Full-order model (all dynamics effects in): the winding itself, T^-1 = I + k u_k u_k^T acting on the voltage, the stator resistance drop and the terminal current (A z = (1 + |e|) z + e conj(z), e = c conj(Z2/(Z1 + Z2 - Rs)) at the log's mean operating point, so c means the same in both).",
+    equations: "Reduced model: i_abc = balanced model current + i_neg, i_neg = (c_re + j c_im) conj(i_pos). Shorted turns (a fraction mu of phase k through r_f; Tallam, Habetler, Harley 2002) give c = (mu/(3 R_f)) e^{j 2 th_k} conj(Z1), R_f = Rs (1 - 2mu/3) + r_f/mu. Full-order model (all dynamics effects in): the machine stays symmetric and the terminals draw the shorted loop's current |y| v + y conj(v), y = c / conj(Z1) at the log's mean operating point, so c means the same in both.",
     parameters: &[
         ParamSpec {
             name: "c_re",
@@ -76,18 +76,17 @@ impl EffectModel for PhaseAsymmetry {
     }
     fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let (w, slip) = operating_point(d, n);
-        let z2 = z2_neg(n, w);
-        let k = (z2 / (z1_pos(n, w, slip) + z2 - n.rs_ohm)).conj();
+        let k = C64::new(1.0, 0.0) / z1_pos(n, w, slip).conj();
         let k = if k.re.is_finite() && k.im.is_finite() {
             k
         } else {
-            C64::new(1.0, 0.0)
+            C64::new(0.0, 0.0)
         };
         let c = |name| {
             FitParam::new(name, "1", 0.0, (-1.0, 1.0), 0.02)
                 .physical(plausible::ASYM_C, plausible::ASYM_BASIS)
         };
-        Ok(FitSetup::new(OnLog { e_over_c: k })
+        Ok(FitSetup::new(OnLog { y_over_c: k })
             .param(FitParam {
                 init: 0.01,
                 ..c("c_re")
@@ -97,13 +96,13 @@ impl EffectModel for PhaseAsymmetry {
 }
 
 impl Contribution for OnLog {
-    /// The unequal stator winding in its two forms (`c` and `e`).
+    /// The shorted turns in their two forms (`c` and `y`).
     fn contribute(&self, p: &[f64], _d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
         let &[c_re, c_im] = p else { return };
         let c = C64::new(c_re, c_im);
         t.stator_winding = Some(WindingAsymmetry {
             c,
-            e: c * self.e_over_c,
+            y: c * self.y_over_c,
         });
     }
     fn describe(&self, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
