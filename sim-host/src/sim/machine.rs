@@ -25,8 +25,8 @@
 //! ```
 //! so the machine's states are those of the healthy machine and the terminals draw
 //! i_s = i_s' + (2/3) mu i_f u_k on top ([`TurnLoop`]). The loop dissipates mu R_f i_f^2 and
-//! stores mu (mu Lls/3) i_f^2 / 2. Its time constant (tens of microseconds) is far below a
-//! step, so it is integrated exactly for the supply held over a step.
+//! stores mu (mu Lls/3) i_f^2 / 2. Its time constant (tens of microseconds) is as short as a
+//! step, so it is integrated exactly, for the supply's sinusoid over each step.
 //!
 //! Rotor cage asymmetry (`rotor_asymmetry`, broken bars): rotor phase a's resistance is
 //! Rr (1 + delta). With the rotor's isolated neutral its resistance in the rotor's own
@@ -133,15 +133,58 @@ impl TurnLoop {
         }
     }
 
-    /// The loop current after `h` [s] from `i_f` [A] with the supply `v` (alpha-beta) held:
-    /// the exact solution of `l di/dt = u.v - r i`.
-    #[inline(always)]
-    pub fn step(&self, i_f: f64, v: [f64; 2], h: f64) -> f64 {
-        let target = (self.u[0] * v[0] + self.u[1] * v[1]) / self.r;
-        if self.l <= 0.0 {
-            return target;
+    /// The loop's voltage `u.v` over a step, from its values `p0`, `p1` at the step's ends:
+    /// a sinusoid at the supply's `we` [rad/s] (both sequences project onto the phase at
+    /// `we`), `p(t) = Re(P e^{j we t})`, `P = p0 - j p'(0)/we`; `None` where `we h` is too
+    /// small to tell the slope (then the voltage is taken linear).
+    fn phasor(p0: f64, p1: f64, we: f64, h: f64) -> Option<(f64, f64)> {
+        let (s, c) = (we * h).sin_cos();
+        (s.abs() > 1e-9).then(|| (p0, -(p1 - p0 * c) / s))
+    }
+
+    /// The forced currents at the step's start and end: `Re(P e^{j we t} / (r + j we l))`,
+    /// or, for a linear voltage, `(p - tau p')/r`.
+    fn forced_ends(&self, p0: f64, p1: f64, we: f64, h: f64) -> (f64, f64) {
+        match Self::phasor(p0, p1, we, h) {
+            Some((pr, pi)) => {
+                let (zr, zi) = (self.r, we * self.l);
+                let d = zr * zr + zi * zi;
+                // P / Z, then turned by we h.
+                let (qr, qi) = ((pr * zr + pi * zi) / d, (pi * zr - pr * zi) / d);
+                let (s, c) = (we * h).sin_cos();
+                (qr, qr * c - qi * s)
+            }
+            None => {
+                let slope = (p1 - p0) / h;
+                let tau = self.l / self.r;
+                ((p0 - tau * slope) / self.r, (p1 - tau * slope) / self.r)
+            }
         }
-        target + (i_f - target) * (-h * self.r / self.l).exp()
+    }
+
+    /// The loop current after `h` [s] from `i_f` [A] with the supply going from `v0` to
+    /// `v1` (alpha-beta) at `we` [rad/s] over the step: the exact solution of
+    /// `l di/dt = u.v(t) - r i` for a sinusoidal `u.v`, `i(t) = forced(t) + c e^{-t/tau}`,
+    /// `tau = l/r`.
+    #[inline(always)]
+    pub fn step(&self, i_f: f64, v0: [f64; 2], v1: [f64; 2], we: f64, h: f64) -> f64 {
+        let p = |v: [f64; 2]| self.u[0] * v[0] + self.u[1] * v[1];
+        let (p0, p1) = (p(v0), p(v1));
+        if self.l <= 0.0 {
+            return p1 / self.r;
+        }
+        let (f0, f1) = self.forced_ends(p0, p1, we, h);
+        f1 + (i_f - f0) * (-h * self.r / self.l).exp()
+    }
+
+    /// The loop's forced current at the start of a step from `v0` to `v1` (its own
+    /// transient, tens of microseconds, left out): where a run starts the loop.
+    pub fn forced(&self, v0: [f64; 2], v1: [f64; 2], we: f64, h: f64) -> f64 {
+        let p = |v: [f64; 2]| self.u[0] * v[0] + self.u[1] * v[1];
+        if self.l <= 0.0 {
+            return p(v0) / self.r;
+        }
+        self.forced_ends(p(v0), p(v1), we, h).0
     }
 
     /// What the terminals draw on top of the machine, (2/3) mu i_f u_k [A].

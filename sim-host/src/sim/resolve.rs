@@ -217,7 +217,7 @@ impl MachineBuilder<'_> {
         let lls = if gamma_s { 0.0 } else { model.lls_h() * md.lls };
         let llr = if gamma_r { 0.0 } else { model.llr_h() * md.llr };
         // The fault resistance defaults to a tenth of the healthy phase's (cold) Rs.
-        let turn = self.eff.asym.map(|(ph, mu, rf)| {
+        let turn = self.eff.asym.filter(|a| a.1 > 0.0).map(|(ph, mu, rf)| {
             TurnLoop::new(ph, mu, rf.unwrap_or(0.1 * m.rs_ohm), rs, model.lls_h())
         });
         let (c_nm, w0) = self.eff.coulomb.unwrap_or((0.0, 1.0));

@@ -73,16 +73,25 @@ impl Supply {
         [p[0] * r[0] - p[1] * r[1], p[0] * r[1] + p[1] * r[0]]
     }
 
+    /// The shorted loop's current where a run starts (its forced response to the supply:
+    /// the loop settles in tens of microseconds, faster than any sample), 0 without one.
+    fn loop_start(&self, machine: &Machine) -> f64 {
+        let p1 = Self::rotate(Self::rotate(self.p, self.rot), self.rot);
+        machine.turn.map_or(0.0, |t| {
+            t.forced(self.voltage(self.p), self.voltage(p1), self.we, self.h)
+        })
+    }
+
     /// Integrates `machine` over one output sample (`nsub` steps of `h`), and the shorted
-    /// loop's current `i_f` of a turn fault (exact for the step's mid voltage).
+    /// loop's current `i_f` of a turn fault (exact for the supply's sinusoid).
     fn integrate(&mut self, machine: &Machine, x: &mut [f64; 6], i_f: &mut f64, nsub: u32) {
         for _ in 0..nsub {
             let pm = Self::rotate(self.p, self.rot);
             let pe = Self::rotate(pm, self.rot);
-            let vm = self.voltage(pm);
-            machine.rk4(x, self.h, self.voltage(self.p), vm, self.voltage(pe));
+            let (v0, v1) = (self.voltage(self.p), self.voltage(pe));
+            machine.rk4(x, self.h, v0, self.voltage(pm), v1);
             if let Some(t) = &machine.turn {
-                *i_f = t.step(*i_f, vm, self.h);
+                *i_f = t.step(*i_f, v0, v1, self.we, self.h);
             }
             self.p = pe;
         }
@@ -410,7 +419,7 @@ impl<'a> Run<'a> {
         let mut dtemp = 0.0f64;
         let mut max_i2 = 0.0f64;
         let mut last_p_loss = 0.0f64;
-        let mut i_f = 0.0f64;
+        let mut i_f = self.supply.loop_start(&self.machine);
         for k in 0..self.n {
             let t = k as f64 * self.dt;
             let mut rebuild = self.apply_events(k, &mut next_event);

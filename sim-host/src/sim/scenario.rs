@@ -499,13 +499,7 @@ impl EffectSpec {
                 ..
             } => {
                 fraction(&k("fraction"), *f)?;
-                match rf {
-                    Some(r) if !(r.is_finite() && *r >= 0.0) => invalid(
-                        &k("fault_resistance_ohm"),
-                        format!("must be a finite resistance >= 0 ohm (got {r})"),
-                    ),
-                    _ => Ok(()),
-                }
+                rf.map_or(Ok(()), |r| not_negative(&k("fault_resistance_ohm"), r))
             }
             EffectSpec::FluxDynamics {}
             | EffectSpec::CurrentDynamics {}
