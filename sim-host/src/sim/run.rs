@@ -458,10 +458,42 @@ impl<'a> Run<'a> {
             self.supply
                 .integrate(&self.machine, &mut x, &mut i_f, self.nsub);
             if !(x[0].is_finite() && x[2].is_finite() && x[4].is_finite()) {
-                return Err(SimError::Diverged { t_s: t + self.dt });
+                return Err(SimError::Diverged {
+                    t_s: t + self.dt,
+                    cause: self.divergence_cause(next_event),
+                });
             }
         }
         Ok((self.summary(x[4], max_i2.sqrt()), true))
+    }
+
+    /// What a divergence followed, in the scenario's keys: the last event applied (of the
+    /// first `applied`), or, with none, the values in force from the start.
+    fn divergence_cause(&self, applied: usize) -> String {
+        let opt = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:e}"));
+        let Some((k, ev)) = applied.checked_sub(1).and_then(|i| self.events.get(i)) else {
+            return "from the start: a value out of any motor's range in the parameter file                     (j_kgm2, b_nms, bl_nms, the inductances) or the scenario (load.torque_nm,                     load.bl_nms, supply, the effects' values); the machine's states grew                     without bound"
+                .into();
+        };
+        let at = *k as f64 * self.dt;
+        let what = match ev {
+            ScenarioEvent::Supply(s) => format!(
+                "supply.steps (v_scale {}, f_hz {})",
+                opt(s.v_scale),
+                opt(s.f_hz)
+            ),
+            ScenarioEvent::Load(s) => format!(
+                "load.steps (torque_nm {}, bl_scale {})",
+                opt(s.torque_nm),
+                opt(s.bl_scale)
+            ),
+            ScenarioEvent::Fault(f) => {
+                format!("faults (kind {}, change {})", f.kind.name(), opt(f.change))
+            }
+        };
+        format!(
+            "right after the step at {at} s in {what}; a value that size is out of any motor's range"
+        )
     }
 
     fn summary(&self, wm: f64, max_abs_current_a: f64) -> SimSummary {
