@@ -22,13 +22,13 @@ use crate::board::{self, FrontEnd};
 use crate::commissioning::{Action, CommissioningProcedure, RunEnd};
 use crate::flash_record::{self, CalibrationRecord, RecordStore, Stored};
 use crate::liveness::{LivenessChange, SampleWatch};
-use crate::panel::{self, blink_code, Mode, PanelInput, PanelLamps, NOT_NAMED_CODE};
+use crate::panel::{self, blink_code, winding_code, Mode, PanelInput, PanelLamps, NOT_NAMED_CODE};
 use crate::reset_record::PreviousRun;
 use crate::sampling::{AdcSampler, RawFrame, SamplingError, TICK_HZ};
 use monitor_core::isolation::{Baseline, Follower, Named, Step};
 use monitor_core::{
     CommissioningError, CommissioningRun, ConfigError, Fault, Install, Isolation, IsolationState,
-    Isolator, Monitor, MonitorConfig, MotorModel, Operating, ReferenceMachine, SensorFlags,
+    Isolator, Monitor, MonitorConfig, MotorModel, Operating, Phase, ReferenceMachine, SensorFlags,
     SteadyPoint,
 };
 
@@ -281,6 +281,10 @@ pub struct MonitorStatus {
     /// The steady-state operating point of the monitor's filtered outputs, for the fault
     /// isolation in thread mode ([`SteadyPoint::from_output`]).
     pub point: SteadyPoint,
+    /// Shorted turns: the phase the core's negative-sequence analysis names and the
+    /// winding's part of `|I2/I1|` (the supply's unbalance taken out; named only above a
+    /// healthy machine's own asymmetry, `monitor_core::sequence::INHERENT_ASYMMETRY_RATIO`).
+    pub winding: Option<(Phase, f32)>,
 }
 
 /// The isolation in the status line's words (docs/firmware.md, "The status line"): the label
@@ -332,10 +336,18 @@ pub fn panel_input(
             .map_or(NOT_NAMED_CODE, |(f, _)| blink_code(f.index() as u8)),
     };
     let named_fault = matches!(named, Some(Named::Fault(_)));
+    let other_fault = status.fault_detected || (named_fault && status.commissioned);
+    // Shorted turns blink their own code while nothing else is shown.
+    let (fault_detected, fault_code) = match status.winding {
+        Some((phase, _)) if !other_fault && !status.sensor_fault.any() => {
+            (true, winding_code(phase.index() as u8))
+        }
+        _ => (other_fault, fault_code),
+    };
     PanelInput {
         mode,
         residual_lamps: status.residual_lamps,
-        fault_detected: status.fault_detected || (named_fault && status.commissioned),
+        fault_detected,
         input_invalid: status.sensor_fault.any() && !status.residual_lamps.iter().any(|l| *l),
         fault_code,
         commissioning_failed,
@@ -465,6 +477,10 @@ impl SamplePath {
             evaluating: o.evaluating,
             bands: self.monitor.threshold_bands(),
             point: SteadyPoint::from_output(o),
+            winding: o
+                .unbalance
+                .suspect_phase
+                .map(|p| (p, o.unbalance.winding_ratio)),
         }
     }
 }
@@ -751,6 +767,17 @@ mod tests {
         status.commissioned = true;
         let inp = panel_input(Mode::Commissioned, &status, Some(&bl), false);
         assert!((0..400u32).all(|k| !render(&inp, k * 50).is_on(Lamp::Fault)));
+        // Shorted turns blink their phase's code (11, 12, 13) while nothing else is shown;
+        // a lamp fault keeps its own code.
+        for (k, phase) in Phase::ALL.into_iter().enumerate() {
+            status.winding = Some((phase, 0.05));
+            let inp = panel_input(Mode::Commissioned, &status, None, false);
+            assert_eq!(at(&inp), Some(11 + k as u8), "{phase:?}");
+        }
+        status.fault_detected = true;
+        status.top = Some((Fault::Rs, 0.5));
+        let inp = panel_input(Mode::Commissioned, &status, None, false);
+        assert_eq!(at(&inp), Some(1));
     }
 
     #[test]

@@ -32,9 +32,16 @@
 //! full steady-state equations, which separate what the paper's four lamps cannot), in
 //! the core's `Fault::ALL` order plus one:
 //!
-//! | N | 1 | 2 | 3 | 4 | 5 | 6 | 7 | 8 | 9 | 10 |
-//! |---|---|---|---|---|---|---|---|---|---|---|
-//! | fault | Rs | Rr | Ls | Lr | friction B/Bl | (Bl: not used, shown as 5) | current sensor | voltage sensor | speed sensor | detected, **not named** |
+//! | N | 1 | 2 | 3 | 4 | 5 | 6 | 7 | 8 | 9 | 10 | 11 | 12 | 13 |
+//! |---|---|---|---|---|---|---|---|---|---|---|---|---|---|
+//! | fault | Rs | Rr | Ls | Lr | friction B/Bl | (Bl: not used, shown as 5) | current sensor | voltage sensor | speed sensor | detected, **not named** | shorted turns, phase a | phase b | phase c |
+//!
+//! Codes 11-13 name the phase of shorted turns (the core's negative-sequence analysis,
+//! `monitor_core::sequence`: the supply's own unbalance taken out with the measured
+//! voltages, the phase from the angle of the rest against the power-factor angle). They
+//! show only while no other fault is detected, and only for a winding part above a healthy
+//! machine's own asymmetry (3 % of I2/I1; the board keeps no healthy baseline of it). The
+//! status line gives the phase and the size (`wind=b wind_i2=0.041`).
 //!
 //! B and Bl cannot be separated at any operating point (they scale the same load term), so
 //! the friction class blinks 5. Code 10 means the lamps or the isolation saw a fault that
@@ -139,7 +146,8 @@ pub struct PanelInput {
     /// Input invalid (ADC saturated / sensor fault flag).
     pub input_invalid: bool,
     /// Blink code of the fault shown: 1..=9 ([`blink_code`] of the isolated fault; 5 for
-    /// the friction class) or [`NOT_NAMED_CODE`].
+    /// the friction class), [`NOT_NAMED_CODE`], or 11..=13 for shorted turns
+    /// ([`winding_code`]).
     pub fault_code: u8,
     /// The last commissioning attempt failed (shown while no fault is).
     pub commissioning_failed: bool,
@@ -147,6 +155,15 @@ pub struct PanelInput {
 
 /// Blink code of a fault detected that the isolation did not name (module docs).
 pub const NOT_NAMED_CODE: u8 = 10;
+
+/// Blink code of shorted turns in phase a; b and c follow (12, 13; module docs).
+pub const WINDING_CODE_A: u8 = 11;
+
+/// Blink code of shorted turns in the phase of index `phase_index` (0, 1, 2 for a, b, c):
+/// 11, 12, 13.
+pub const fn winding_code(phase_index: u8) -> u8 {
+    WINDING_CODE_A.saturating_add(phase_index)
+}
 
 /// Blink code of a candidate index: `index + 1` (1..=9).
 pub const fn blink_code(candidate_index: u8) -> u8 {
@@ -269,7 +286,7 @@ mod tests {
 
     #[test]
     fn blink_code_round_trips_for_every_candidate() {
-        for code in 1..=NOT_NAMED_CODE {
+        for code in 1..=winding_code(2) {
             let mut inp = input(Mode::Commissioned);
             inp.fault_code = code;
             let trace: Vec<bool> = (0..400u32)

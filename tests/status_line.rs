@@ -69,6 +69,8 @@ fn value(arg: &str) -> &'static str {
         "iso_name" => "rr",
         "iso_change" => "0.48",
         "iso_p" => "0.93",
+        "wind_name" => "b",
+        "wind_i2" => "0.041",
         other => panic!(
             "log_status prints `{other}`: give it a test value here and teach \
              sim_host::hmi::status_line to read it"
@@ -125,7 +127,12 @@ fn the_hmi_reads_every_field_the_firmware_prints() {
             probability: 0.93
         })
     );
+    assert_eq!(s.winding, Some((monitor_core::Phase::B, 0.041)));
     let snap = s.snapshot(0.0);
+    assert_eq!(
+        snap.asymmetry.map(|a| (a.phase, a.ratio)),
+        Some((monitor_core::Phase::B, 0.041))
+    );
     let iso = snap
         .isolation
         .as_ref()

@@ -241,6 +241,7 @@ fn current_only_log_through_the_binary() {
     s.effects = vec![sim_host::sim::EffectSpec::PhaseAsymmetry {
         phase: monitor_core::Phase::C,
         fraction: 0.05,
+        fault_resistance_ohm: None,
     }];
     let log = write_log(dir.path(), "i_only", &truth, &s, true);
     let params = write_params(dir.path(), "p", &perturbed(&truth, 0.05));

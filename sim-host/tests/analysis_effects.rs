@@ -172,6 +172,7 @@ fn current_only_log_gets_the_unbalance_analysis() {
     s.effects = vec![EffectSpec::PhaseAsymmetry {
         phase: monitor_core::Phase::B,
         fraction: 0.05,
+        fault_resistance_ohm: None,
     }];
     let log = write_log(dir.path(), "asym_b", &truth, &s, true);
     let a = analyse(&log, &nominal, settle_s("2p2"));

@@ -9,7 +9,12 @@ use sim_host::params::ParamFile;
 use sim_host::replay::{diagnose_rows, BaselineSource, ReplayOptions};
 use sim_host::sim::{simulate_to_vec, EffectSpec, LoadKind, LoadSpec, Scenario, SensorSpec};
 
-fn run(params: &ParamFile, load_nm: f64, phase: Phase, fraction: f64) -> (Option<String>, f32) {
+fn run(
+    params: &ParamFile,
+    load_nm: f64,
+    phase: Phase,
+    fraction: f64,
+) -> (Option<String>, f32, Option<String>) {
     let mut sc = Scenario::steady(4.0, 10_000.0);
     sc.sensors = SensorSpec::default();
     sc.load = LoadSpec {
@@ -18,8 +23,11 @@ fn run(params: &ParamFile, load_nm: f64, phase: Phase, fraction: f64) -> (Option
         bl_nms: None,
         steps: vec![],
     };
-    sc.effects
-        .push(EffectSpec::PhaseAsymmetry { phase, fraction });
+    sc.effects.push(EffectSpec::PhaseAsymmetry {
+        phase,
+        fraction,
+        fault_resistance_ohm: None,
+    });
     let rows = simulate_to_vec(params, &sc).expect("simulate");
     let opts = ReplayOptions {
         angle_source: AngleSource::RotorFluxCurrentModel,
@@ -29,13 +37,16 @@ fn run(params: &ParamFile, load_nm: f64, phase: Phase, fraction: f64) -> (Option
     (
         rep.unbalance.suspect_phase.map(|p| p.name().to_string()),
         rep.unbalance.negative_sequence_ratio,
+        rep.unbalance.phase_not_judged,
     )
 }
 
 #[test]
 fn suspect_phase_is_the_shorted_phase_for_two_motors_and_two_loads() {
-    // Rated torques: 3 hp 220 V 60 Hz 4-pole at ~1710 rpm: 2238 W / 179 rad/s = 12.5 N m;
-    // 2.2 kW at ~1430 rpm: 14.6 N m (the reference scenario).
+    // Without a healthy baseline: the phase right whenever the winding's part stands clear
+    // of a healthy machine's own asymmetry (3 %), "cannot judge the phase" below it, never a
+    // wrong phase. Rated torques: 3 hp 220 V 60 Hz 4-pole at ~1710 rpm: 2238 W / 179 rad/s =
+    // 12.5 N m; 2.2 kW at ~1430 rpm: 14.6 N m (the reference scenario).
     let motors = [
         (ParamFile::reference_3hp(), 12.5),
         (ParamFile::reference_2p2kw(), 14.6),
@@ -44,7 +55,7 @@ fn suspect_phase_is_the_shorted_phase_for_two_motors_and_two_loads() {
     for (m, rated) in &motors {
         for load in [0.0, *rated] {
             for (phase, name) in [(Phase::A, "a"), (Phase::B, "b"), (Phase::C, "c")] {
-                // 5 % and 2 % of the phase's turns shorted.
+                // 5 % and 2 % of the phase's turns shorted (through Rs/10).
                 for fraction in [0.05, 0.02] {
                     cases.push((*m, load, phase, name, fraction));
                 }
@@ -54,20 +65,25 @@ fn suspect_phase_is_the_shorted_phase_for_two_motors_and_two_loads() {
     let results: Vec<_> = cases
         .par_iter()
         .map(|(m, load, phase, name, fraction)| {
-            let (got, ratio) = run(m, *load, *phase, *fraction);
-            (m.supply.f_hz, *load, *name, got, ratio)
+            let (got, ratio, not_judged) = run(m, *load, *phase, *fraction);
+            (m.supply.f_hz, *load, *name, got, ratio, not_judged)
         })
         .collect();
-    let mut failures = Vec::new();
-    for (f, load, name, got, ratio) in &results {
-        eprintln!("{f} Hz motor, load {load} N m, shorted phase {name}: suspect {got:?}, |I2|/|I1| = {ratio:.4}");
-        if got.as_deref() != Some(*name) {
-            failures.push(format!(
-                "{f} Hz motor, load {load}: expected {name}, got {got:?}"
-            ));
+    let (mut named, mut failures) = (0, Vec::new());
+    for (f, load, name, got, ratio, not_judged) in &results {
+        eprintln!("{f} Hz motor, load {load} N m, shorted phase {name}: suspect {got:?}, |I2|/|I1| = {ratio:.4}, {not_judged:?}");
+        match got {
+            Some(g) if g == name => named += 1,
+            Some(g) => failures.push(format!("{f} Hz, load {load}: {name} named {g}")),
+            None if *ratio >= 0.035 || not_judged.is_none() => failures.push(format!(
+                "{f} Hz, load {load}, {name}: none at {ratio} without a reason"
+            )),
+            None => {}
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");
+    // The 5 % shorts stand clear of 3 % everywhere, the 2 % ones on the 3 hp machine.
+    assert!(named >= 18, "{named} of 24 named");
 }
 
 #[test]
@@ -102,6 +118,7 @@ fn diagnose_and_the_analysis_name_the_same_phase() {
         sc.effects.push(EffectSpec::PhaseAsymmetry {
             phase,
             fraction: 0.05,
+            fault_resistance_ohm: None,
         });
         let rows = simulate_to_vec(&p, &sc).expect("simulate");
         let rep = diagnose_rows(&p, sc.sensors.channels(), &rows, ReplayOptions::default())
@@ -147,8 +164,11 @@ fn run_unbalanced(
         angle_deg,
     });
     if let Some((phase, fraction)) = short {
-        sc.effects
-            .push(EffectSpec::PhaseAsymmetry { phase, fraction });
+        sc.effects.push(EffectSpec::PhaseAsymmetry {
+            phase,
+            fraction,
+            fault_resistance_ohm: None,
+        });
     }
     let rows = simulate_to_vec(params, &sc).expect("simulate");
     diagnose_rows(
@@ -163,9 +183,9 @@ fn run_unbalanced(
 
 #[test]
 fn on_an_unbalanced_supply_the_shorted_phase_is_named_and_a_healthy_motor_gets_none() {
-    // 1-3 % supply unbalance at several angles; 2-10 % of a phase's turns shorted; no load
-    // and rated load; both reference motors; voltages logged (10 kHz). The supply's part
-    // V2/Z2 is taken out before the phase is named.
+    // 1-3 % supply unbalance at several angles; 2-10 % of a phase's turns shorted (through
+    // Rs/10); no load and rated load; both reference motors; voltages logged (10 kHz), no
+    // baseline. The supply's part V2/Z2 is taken out before the phase is named.
     let motors = [
         (ParamFile::reference_3hp(), 12.5),
         (ParamFile::reference_2p2kw(), 14.6),
@@ -216,8 +236,10 @@ fn on_an_unbalanced_supply_the_shorted_phase_is_named_and_a_healthy_motor_gets_n
             None => {}
         }
     }
-    // At least 9 in 10 shorted-turn cases right; a wrong phase is never named.
-    assert!(10 * right >= 9 * shorted, "{right} of {shorted} right");
+    // Without a baseline the small shorts are not judged (below a healthy machine's own
+    // asymmetry; `turn_fault.rs` judges them against a healthy recording): at least three
+    // in four right, and a wrong phase is never named.
+    assert!(4 * right >= 3 * shorted, "{right} of {shorted} right");
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
@@ -242,8 +264,11 @@ fn mismatched(
         angle_deg: 30.0,
     });
     if let Some((phase, fraction)) = shorted {
-        sc.effects
-            .push(EffectSpec::PhaseAsymmetry { phase, fraction });
+        sc.effects.push(EffectSpec::PhaseAsymmetry {
+            phase,
+            fraction,
+            fault_resistance_ohm: None,
+        });
     }
     simulate_to_vec(params, &sc).expect("simulate") // ok: test
 }

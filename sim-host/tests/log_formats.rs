@@ -415,6 +415,45 @@ fn tdms_groups_and_waveform_time() {
 }
 
 #[test]
+fn an_empty_or_truncated_tdms_is_refused_naming_it() {
+    // A recording cut short (an interrupted copy, a full disk) must be refused as such, not
+    // as "no group" or as a layout to defragment.
+    let dir = tempfile::tempdir().expect("tmp");
+    let f = dir.path().join("w.tdms");
+    let rows: Vec<Row> = (0..120_000)
+        .map(|k| Row {
+            t_s: k as f64 * 1e-4,
+            v_abc: None,
+            i_abc: [1.0, -1.0, 0.0],
+            wm_rad_s: None,
+            enc_count: None,
+        })
+        .collect();
+    Log {
+        channels: Channels {
+            voltages: false,
+            speed: false,
+            encoder: false,
+        },
+        rows,
+    }
+    .write(&f)
+    .expect("write");
+    let bytes = std::fs::read(&f).expect("read");
+    for (cut, want) in [
+        (0, "empty"),
+        (20, "truncated"),
+        (600, "truncated"),
+        (bytes.len() - 1000, "truncated"),
+    ] {
+        let t = dir.path().join(format!("cut{cut}.tdms"));
+        std::fs::write(&t, &bytes[..cut]).expect("write");
+        let err = open_error(&t, &OpenOptions::default());
+        assert!(err.contains(want), "{cut} bytes: {err}");
+    }
+}
+
+#[test]
 fn the_tdms_we_write_is_what_the_crate_reads() {
     let dir = tempfile::tempdir().expect("tmp");
     let f = dir.path().join("w.tdms");

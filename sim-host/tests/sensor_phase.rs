@@ -102,6 +102,7 @@ fn healthy_machines_shorted_windings_and_unbalanced_supplies_blame_no_sensor() {
                 sc.effects.push(EffectSpec::PhaseAsymmetry {
                     phase: *phase,
                     fraction: 0.05,
+                    fault_resistance_ohm: None,
                 });
             }
             // (No commissioning: the supply's 2f ripple keeps the lamps' gate closed; the

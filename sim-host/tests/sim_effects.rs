@@ -183,6 +183,7 @@ fn sim_phase_asymmetry_unbalances_the_currents_towards_the_faulty_phase() {
     sc.effects.push(EffectSpec::PhaseAsymmetry {
         phase: monitor_core::Phase::B,
         fraction: 0.1,
+        fault_resistance_ohm: None,
     });
     let tr = run(&p, &sc);
     let n = 2000;

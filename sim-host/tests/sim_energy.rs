@@ -45,6 +45,7 @@ fn sim_energy_balance_with_iron_loss_and_asymmetry() {
         EffectSpec::PhaseAsymmetry {
             phase: Phase::B,
             fraction: 0.08,
+            fault_resistance_ohm: None,
         },
     ];
     assert!(balance(&ParamFile::reference_3hp(), eff.clone()) < 1e-6);

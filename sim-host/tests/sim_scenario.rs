@@ -206,3 +206,34 @@ fn values_the_run_would_not_carry_out_are_refused_by_key() {
     .unwrap();
     assert_eq!(sim::simulate_to_vec(&p, &ok).unwrap().len(), 1000);
 }
+
+#[test]
+fn a_diverged_run_names_the_value_it_followed() {
+    // Values no motor has, that the checks before the run let through, end in a message
+    // that names the scenario key the machine diverged after (or, from the start, where to
+    // look), not a bare time.
+    let p = ParamFile::reference_2p2kw();
+    let run = |toml: &str| {
+        let sc = Scenario::from_toml_str(toml, "test").expect("scenario"); // ok: test
+        sim::simulate(&p, &sc, |_| {})
+            .expect_err("diverges") // ok: test
+            .to_string()
+    };
+    let after_fault = run(
+        "duration_s = 1.0\nsample_rate_hz = 5000.0\nfaults = [{ kind = \"rs\", at_s = 0.5, change = 1e6 }]\n",
+    );
+    assert!(
+        after_fault.contains("diverged")
+            && after_fault.contains("faults")
+            && after_fault.contains("rs")
+            && after_fault.contains("0.5 s"),
+        "{after_fault}"
+    );
+    let from_start = run(
+        "duration_s = 1.0\nsample_rate_hz = 5000.0\n[load]\nkind = \"torque\"\ntorque_nm = 1e12\n",
+    );
+    assert!(
+        from_start.contains("from the start") && from_start.contains("load.torque_nm"),
+        "{from_start}"
+    );
+}

@@ -127,6 +127,11 @@ impl Phase {
         }
     }
 
+    /// The phase named "a", "b" or "c" ([`Phase::name`]); `None` for any other text.
+    pub fn from_name(name: &str) -> Option<Phase> {
+        Phase::ALL.into_iter().find(|p| p.name() == name)
+    }
+
     /// 0, 1, 2 for a, b, c: the index `k` of the winding axis at `k 2pi/3`.
     pub fn index(self) -> usize {
         self as usize

@@ -7,16 +7,42 @@
 //! give `P = I1 e^{-j theta0}` and, with `-theta`, `N = conj(I2) e^{j theta0}`; so
 //! `I2/I1 = conj(N)/P` whatever the angle's offset `theta0`.
 //!
-//! Suspect phase: an impedance change `dZ` in phase k of a star-connected machine with an
-//! isolated neutral on a balanced supply drives, to first order, `I2 = -dZ I1 a^k / (3 Z2)`
-//! (k = 0, 1, 2 for a, b, c; Z2 = negative-sequence impedance). Shorted turns reduce the
-//! phase's whole impedance, `dZ ~ -eps Z1`, so `I2/I1 ~ (eps/3)(Z1/Z2) a^k`: the angle of
-//! `I2/I1` minus `arg(Z1/Z2)` is a multiple of 120 degrees that names the phase. `Z1 = Z(s)`
-//! and `Z2 = Z(2 - s)` come from the T-equivalent circuit at the present slip
+//! Suspect phase: shorted turns as they are (Tallam, Habetler, Harley, "Transient model for
+//! induction machines with stator winding turn faults", IEEE Trans. Ind. Appl. 38(3),
+//! 2002). A fraction `mu` of phase k's turns is shorted through a fault resistance `r_f`.
+//! The shorted turns stay in the winding and link `mu` of its flux; the loop carries the
+//! fault current `i_f`. In alpha-beta (amplitude-invariant, isolated neutral) with the
+//! MMF current `i_s' = i_s - (2/3) mu i_f u_k`, `u_k = e^{j 2pi k/3}`:
+//! ```text
+//!   v_s = Rs i_s' + dpsi_s/dt                       (the symmetric machine in i_s')
+//!   r_f i_f = mu Rs (i_k - i_f) + mu dlambda_k/dt    (the shorted loop)
+//!   =>  Z_f I_f = V_k,   Z_f = Rs (1 - 2mu/3) + r_f/mu + j we mu Lls/3
+//! ```
+//! The machine itself stays balanced; the terminals draw the loop's current on top, whose
+//! negative sequence is `I2 = (mu/3) I_f a^{-k}`; with `V_k = V1 a^{-k}` and `a^{-2k} = a^k`,
+//! `I2/I1 = (mu/3)(Z1/Z_f) a^k` (k = 0, 1, 2 for a, b, c; `Z1 = Z(s)` the positive-sequence
+//! impedance). `Z_f` is nearly resistive (its angle is below 3 degrees for up to 10 % of the
+//! turns on the workspace's reference motors), so the angle of `I2/I1` minus `arg Z1` (the
+//! power-factor angle) is a multiple of 120 degrees that names the phase
 //! ([`asymmetry_correction_rad`]). The angle depends strongly on load (Z1 is mostly
 //! inductive at no load, mostly resistive at full load), which is why the correction is
-//! computed at the operating point. A supply unbalance gives a negative sequence too; this
-//! analysis cannot tell the two apart without the voltages (see the host's `explain`).
+//! computed at the operating point. With voltages logged the correction needs no model:
+//! `arg(I2/V1) = -arg Z_f + k 120 deg`.
+//!
+//! An earlier form of this module took a shorted turn as a winding that lost part of its
+//! impedance, `dZ = -eps Z1`, which gives `I2/I1 = (eps/3)(Z1/Z2) a^k` with the
+//! negative-sequence impedance `Z2 = Z(2 - s)`: the angle then differs by `arg Z2`
+//! (60-80 degrees), enough to name the neighbouring phase. Recordings of real shorted turns
+//! follow the loop above, not that form.
+//!
+//! The size: `3 |I2| = mu |I_f|`, the shorted loop's ampere-turns as a share of the
+//! phase's ([`shorted_turns_mmf_ratio`]); the fraction of turns needs `r_f`, and a bolted
+//! short (`r_f = 0`) gives its least value ([`min_shorted_fraction`]).
+//!
+//! A supply unbalance gives a negative sequence too; this analysis cannot tell the two
+//! apart without the voltages or a healthy baseline (see the host's replay). A healthy
+//! machine has an inherent asymmetry of a few per cent of `I2/I1`
+//! ([`INHERENT_ASYMMETRY_RATIO`]).
 //!
 //! This is the workspace's one faulty-phase method ([`suspect_phase`]): the monitor, the
 //! host's replay of current-only logs and the host's model-vs-measurement analysis all
@@ -41,7 +67,25 @@ pub struct NegativeSequence {
     /// arg(I2/I1) [rad], in (-pi, pi].
     pub angle_rad: f32,
     /// The phase whose winding the asymmetry points at; None below the ratio threshold.
+    /// The monitor names it from the winding's part ([`winding_asymmetry`]).
     pub suspect_phase: Option<Phase>,
+    /// The winding's part `|I2w/I1|` (the supply's `V2/Z2` taken out) where the voltages'
+    /// negative sequence is known (the monitor), else the whole ratio.
+    pub winding_ratio: f32,
+    /// The phase's confidence, 0..1 ([`phase_confidence`]); 0 without a phase.
+    pub phase_confidence: f32,
+}
+
+/// `conj(N)/P` as `(re, im)`: a Park pair's negative-sequence phasor over the positive
+/// sequence's (`P = (pd, pq)` at +theta, `N = (nd, nq)` at -theta; module docs), e.g.
+/// `I2/I1` or, with the voltages' `N`, `V2/I1` [ohm]. (0, 0) for `|P|` ~ 0.
+pub fn over_positive(p: (f32, f32), n: (f32, f32)) -> (f32, f32) {
+    let p2 = p.0 * p.0 + p.1 * p.1;
+    if !(p2 > 1e-12) {
+        return (0.0, 0.0);
+    }
+    let (a, b) = (n.0, -n.1);
+    ((a * p.0 + b * p.1) / p2, (b * p.0 - a * p.1) / p2)
 }
 
 /// Streaming positive/negative-sequence separation.
@@ -97,7 +141,7 @@ impl SequenceAnalyzer {
         crate::fast_hypot(self.pd.y, self.pq.y)
     }
 
-    /// Ratio, angle and suspect phase, given the model correction `arg(Z1/Z2)` and the
+    /// Ratio, angle and suspect phase, given the model correction `arg Z1` and the
     /// ratio below which no phase is named.
     pub fn result(&self, correction_rad: f32, min_ratio: f32) -> NegativeSequence {
         sequence_result(
@@ -129,13 +173,19 @@ pub fn sequence_result(
         negative_sequence_ratio: ratio,
         angle_rad: angle,
         suspect_phase: suspect,
+        winding_ratio: ratio,
+        phase_confidence: if suspect.is_some() {
+            phase_confidence(angle, correction_rad)
+        } else {
+            0.0
+        },
     }
 }
 
 /// The phase a winding asymmetry sits in (module docs): the angle of `I2/I1` [rad] minus
-/// the correction `arg(Z1/Z2)` ([`asymmetry_correction_rad`]) rounded to the nearest
-/// multiple of 120 degrees, `k` thirds of a turn naming phase `k` (a, b, c). Assumes the
-/// winding lost impedance (shorted turns), the common fault; any finite angles.
+/// the correction `arg Z1` ([`asymmetry_correction_rad`]) rounded to the nearest multiple
+/// of 120 degrees, `k` thirds of a turn naming phase `k` (a, b, c). Assumes shorted turns
+/// (a loop through a fault resistance), the common winding fault; any finite angles.
 pub fn suspect_phase(i2_over_i1_angle_rad: f32, correction_rad: f32) -> Phase {
     let third = core::f32::consts::TAU / 3.0;
     let k = F32Ext::round(crate::frames::wrap_angle(i2_over_i1_angle_rad - correction_rad) / third)
@@ -155,6 +205,8 @@ pub struct WindingAsymmetry {
     /// The shorted-turns phase; `None` when the winding's part is below what the supply's
     /// unbalance and the noise explain ([`winding_asymmetry`]).
     pub suspect_phase: Option<Phase>,
+    /// The phase's confidence, 0..1 ([`phase_confidence`]); 0 without a phase.
+    pub phase_confidence: f32,
 }
 
 /// Share of the supply-driven negative sequence that the model's negative-sequence
@@ -166,7 +218,7 @@ pub const SUPPLY_PART_UNCERTAINTY: f32 = 0.3;
 /// The workspace's one faulty-phase method on a supply that is itself unbalanced: the
 /// negative-sequence current `I2` minus the part the supply's negative-sequence voltage
 /// drives through the machine, `V2 / Z2` with `Z2 = Z(2 - s)` ([`equivalent_impedance`]);
-/// what is left is the winding's (module docs: `I2w/I1 ~ (eps/3)(Z1/Z2) a^k`), and
+/// what is left is the winding's (module docs: `I2w/I1 ~ (mu/3)(Z1/Z_f) a^k`), and
 /// [`suspect_phase`] names its phase.
 ///
 /// Inputs as complex numbers `(re, im)` in the core's phasor convention, relative to the
@@ -204,25 +256,38 @@ pub fn winding_asymmetry(
     let angle = F32Ext::atan2(wi, wr);
     let floor = crate::maxf(min_ratio, SUPPLY_PART_UNCERTAINTY * supply_ratio);
     let corr = asymmetry_correction_rad(m, we, s);
+    let named = ratio >= floor;
     WindingAsymmetry {
         ratio,
         supply_ratio,
         angle_rad: angle,
-        suspect_phase: (ratio >= floor).then(|| suspect_phase(angle, corr)),
+        suspect_phase: named.then(|| suspect_phase(angle, corr)),
+        phase_confidence: if named {
+            phase_confidence(angle, corr)
+        } else {
+            0.0
+        },
     }
 }
 
-/// Fraction `eps` of a winding's impedance that an asymmetry with `|I2/I1| = ratio` has
-/// lost, from the first-order relation of the module docs, `|I2/I1| = (eps/3) |Z1/Z2|`,
-/// with `Z1 = Z(s)` and `Z2 = Z(2 - s)` at supply `we` [rad/s] and slip `s`.
-pub fn winding_change_fraction(m: &MotorModel, we: f32, s: f32, ratio: f32) -> f32 {
+/// The shorted loop's ampere-turns over the positive-sequence current, `mu |I_f| / |I1|`,
+/// for a winding part `|I2w/I1| = ratio` (module docs: `3 |I2| = mu |I_f|`). Model-free;
+/// `ratio` >= 0, result >= 0.
+pub fn shorted_turns_mmf_ratio(ratio: f32) -> f32 {
+    3.0 * ratio
+}
+
+/// The least fraction `mu` of one phase's turns shorted that draws `|I2w/I1| = ratio` at
+/// supply `we` [rad/s] and slip `s`: a bolted short (`r_f = 0`, `Z_f ~ Rs`) in the module
+/// docs' relation `|I2/I1| = (mu/3) |Z1| / |Z_f|`, so `mu >= 3 ratio Rs / |Z1|`. A fault
+/// resistance means more turns for the same `I2`. 0 when `Z1` is not positive.
+pub fn min_shorted_fraction(m: &MotorModel, we: f32, s: f32, ratio: f32) -> f32 {
     let z1 = equivalent_impedance(m, we, s);
-    let z2 = equivalent_impedance(m, we, 2.0 - s);
     let z1n = crate::fast_hypot(z1.0, z1.1);
     if !(z1n > 0.0) {
         return 0.0;
     }
-    3.0 * ratio * crate::fast_hypot(z2.0, z2.1) / z1n
+    3.0 * ratio * m.rs_ohm / z1n
 }
 
 /// The slip at which the equivalent circuit on a supply of peak phase voltage `v_peak` [V]
@@ -269,13 +334,30 @@ pub fn equivalent_impedance(m: &MotorModel, we: f32, s: f32) -> (f32, f32) {
     (m.rs_ohm + pr, we * (m.ls_h - m.lm_h) + pi)
 }
 
-/// `arg(Z1/Z2) = arg Z(s) - arg Z(2 - s)` [rad]: the angle between a winding asymmetry's
-/// negative-sequence current and the phase it sits in (module docs).
+/// `arg Z1 = arg Z(s)` [rad], the positive-sequence power-factor angle: the angle between a
+/// shorted-turns negative-sequence current `I2/I1` and the `a^k` of the phase it sits in
+/// (module docs: `I2/I1 = (mu/3)(Z1/Z_f) a^k` with a nearly resistive loop impedance
+/// `Z_f`). Supply `we` [rad/s], slip `s` (kept at least 1e-4 in magnitude).
 pub fn asymmetry_correction_rad(m: &MotorModel, we: f32, s: f32) -> f32 {
     let z1 = equivalent_impedance(m, we, s);
-    let z2 = equivalent_impedance(m, we, 2.0 - s);
-    crate::frames::wrap_angle(F32Ext::atan2(z1.1, z1.0) - F32Ext::atan2(z2.1, z2.0))
+    F32Ext::atan2(z1.1, z1.0)
 }
+
+/// How far the angle `I2/I1` minus the correction lies inside its phase's 120-degree sector:
+/// 1 on the sector's centre, 0 on its border with the next phase (`1 - |dev| / 60 deg`).
+/// A reading near 0 names a phase by a hair; the phase's confidence in the reports.
+pub fn phase_confidence(i2_over_i1_angle_rad: f32, correction_rad: f32) -> f32 {
+    let third = core::f32::consts::TAU / 3.0;
+    let x = crate::frames::wrap_angle(i2_over_i1_angle_rad - correction_rad) / third;
+    let dev = x - F32Ext::round(x);
+    crate::maxf(0.0, 1.0 - 2.0 * F32Ext::abs(dev))
+}
+
+/// A healthy machine's own negative sequence, `|I2/I1|` from its winding and core
+/// tolerances (a few per cent on real motors). Without voltages and without a healthy
+/// baseline, a winding part below this is not judged: the phase it would name is the
+/// machine's build, not a fault.
+pub const INHERENT_ASYMMETRY_RATIO: f32 = 0.03;
 
 #[cfg(test)]
 mod tests {

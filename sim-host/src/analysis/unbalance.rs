@@ -6,7 +6,7 @@
 //! workspace's one faulty-phase method (`monitor_core::sequence::winding_asymmetry`, as
 //! `diagnose` names it): the fitted `i_neg = c conj(i_pos)` and `v_neg = cv conj(i_pos)`
 //! give `I2/I1 = conj(c)` and `V2/I1 = conj(cv)`; the part `V2/Z2` that the supply's own
-//! unbalance drives is taken out, and the angle of what is left, minus `arg(Z1/Z2)` at the
+//! unbalance drives is taken out, and the angle of what is left, minus `arg Z1` at the
 //! log's operating slip, points at the winding. Below what the supply's part and the noise
 //! explain, no winding is suspect. The slip is
 //! the measured one (`1 - omega_r/omega_s`), or, without a speed column, the one at which
@@ -113,18 +113,25 @@ pub fn analyse(d: &Prepared, n: &MachineConstants) -> UnbalanceAnalysis {
     let slip = operating_slip(d, n, &s);
     // The core's one faulty-phase method, in its convention I2/I1 = conj(c), V2/I1 = conj(cv).
     let (we, sl) = (w.abs().max(1.0) as f32, slip as f32);
+    // A current-only log cannot tell a winding from the supply's unbalance or the machine's
+    // own build asymmetry: below a healthy machine's inherent asymmetry no phase is named.
+    let min_ratio = if d.channels.voltages {
+        0.01
+    } else {
+        monitor_core::sequence::INHERENT_ASYMMETRY_RATIO
+    };
     let asym = monitor_core::sequence::winding_asymmetry(
         (c.re as f32, -c.im as f32),
         d.channels.voltages.then_some((cv.re as f32, -cv.im as f32)),
         &n.core_model,
         we,
         sl,
-        0.01,
+        min_ratio,
     );
     let cannot_judge = cannot_judge(d, &s, w);
     let suspect = asym.suspect_phase.filter(|_| cannot_judge.is_none());
     let supply_explains = suspect.is_none() && f64::from(asym.supply_ratio) > 0.5 * ratio;
-    let eps = f64::from(monitor_core::sequence::winding_change_fraction(
+    let eps = f64::from(monitor_core::sequence::min_shorted_fraction(
         &n.core_model,
         we,
         sl,
@@ -140,7 +147,7 @@ pub fn analyse(d: &Prepared, n: &MachineConstants) -> UnbalanceAnalysis {
             let mean_rms = phase_rms_a.iter().sum::<f64>() / 3.0;
             let dev = phase_rms_a[p.index()] - mean_rms;
             format!(
-                "negative-sequence current {:.1} % of positive sequence{}: phase {} winding differs (the negative sequence fits about {:.1} % of its impedance lost, as by shorted turns; its current is {:.1} % {} the mean)",
+                "negative-sequence current {:.1} % of positive sequence{}: phase {} winding differs (shorted turns: at least {:.1} % of its turns, as a bolted short; its current is {:.1} % {} the mean)",
                 100.0 * ratio,
                 if d.channels.voltages { "" } else { " (current-only log: supply assumed balanced, from the parameter file)" },
                 p.name(),
@@ -153,6 +160,11 @@ pub fn analyse(d: &Prepared, n: &MachineConstants) -> UnbalanceAnalysis {
             "negative-sequence current {:.1} %, caused by the supply's {:.1} % voltage unbalance (no winding suspected)",
             100.0 * ratio,
             100.0 * vratio.unwrap_or(0.0)
+        ),
+        (None, false) if !d.channels.voltages && ratio >= 0.01 => format!(
+            "negative sequence {:.1} %: cannot judge the phase (a current-only log: below a healthy machine's own asymmetry of {:.0} % a winding cannot be told from the supply's unbalance or the machine's build; diagnose --baseline with a healthy log judges it)",
+            100.0 * ratio,
+            100.0 * monitor_core::sequence::INHERENT_ASYMMETRY_RATIO
         ),
         (None, false) => format!("currents balanced (negative sequence {:.2} %)", 100.0 * ratio),
     };

@@ -21,7 +21,7 @@ pub mod status_line;
 use crate::demo::MonitorState;
 use crate::params::ParamFile;
 use crate::replay::{FaultCandidate, IsolationName, IsolationReport, Replay};
-use monitor_core::sequence::winding_change_fraction;
+use monitor_core::sequence::min_shorted_fraction;
 use monitor_core::{Fault, IsolationState, MonitorOutput, Phase};
 use std::collections::VecDeque;
 
@@ -40,9 +40,9 @@ pub struct Asymmetry {
     pub phase: Phase,
     /// |I2|/|I1|.
     pub ratio: f32,
-    /// Fraction of that winding's impedance lost
-    /// ([`monitor_core::sequence::winding_change_fraction`]), when the motor is known.
-    pub winding_change: Option<f32>,
+    /// The least fraction of that phase's turns shorted (a bolted short,
+    /// [`monitor_core::sequence::min_shorted_fraction`]), when the motor is known.
+    pub min_shorted_fraction: Option<f32>,
 }
 
 /// One reading of the monitor, from any source. Quantities a source does not give are
@@ -171,14 +171,14 @@ impl Snapshot {
         let we = out.frame_omega_rad_s.abs();
         let asymmetry = out.unbalance.suspect_phase.map(|phase| {
             let ratio = out.unbalance.negative_sequence_ratio;
-            let winding_change = (we > 1.0).then(|| {
+            let min_shorted_fraction = (we > 1.0).then(|| {
                 let slip = 1.0 - out.operating.wr_rad_s / we;
-                winding_change_fraction(&params.motor.model(), we, slip, ratio)
+                min_shorted_fraction(&params.motor.model(), we, slip, ratio)
             });
             Asymmetry {
                 phase,
                 ratio,
-                winding_change,
+                min_shorted_fraction,
             }
         });
         Snapshot {

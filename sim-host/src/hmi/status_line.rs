@@ -9,7 +9,7 @@
 //! r=[r1, r2, r3, r4] lamps=[b1, b2, b3, b4] fault=B top=NAME(P) 2nd=NAME(P) wm=Xrad/s
 //! zc_locked=.. mode=MODE run=ID:LEARNED/NEEDED overruns=N restarts=N samples=N
 //! max_cyc=N iqs=XA ids=XA vqs=XV f=XHz steady=B eval=B sens=B,B,B mid=[..] half=[..]
-//! iso=NAME iso_change=X iso_p=P
+//! iso=NAME iso_change=X iso_p=P wind=PHASE wind_i2=X
 //! ```
 //!
 //! The parser finds the `key=` fields anywhere in a line, so the decoder's decorations
@@ -67,6 +67,9 @@ pub struct FirmwareStatus {
     pub band: Option<([f32; 4], [f32; 4])>,
     /// The fault isolation's result (firmware with isolation).
     pub isolation: Option<FirmwareIsolation>,
+    /// Shorted turns (`wind=`, `wind_i2=`): the phase named and the winding's part of
+    /// |I2/I1|; `None` for `wind=none` or an older firmware.
+    pub winding: Option<(monitor_core::Phase, f32)>,
 }
 
 /// The isolation fields of a status line (`iso=`, `iso_change=`, `iso_p=`; the firmware's
@@ -204,6 +207,9 @@ pub fn parse(line: &str) -> Option<FirmwareStatus> {
         sensors,
         band,
         isolation,
+        winding: field(line, "wind")
+            .and_then(monitor_core::Phase::from_name)
+            .map(|p| (p, f("wind_i2").unwrap_or(0.0))),
     })
 }
 
@@ -243,7 +249,11 @@ impl FirmwareStatus {
             learned: self.mode.as_deref() == Some("commissioned"),
             candidates: self.candidates.clone(),
             sensor_faults,
-            asymmetry: None,
+            asymmetry: self.winding.map(|(phase, ratio)| super::Asymmetry {
+                phase,
+                ratio,
+                min_shorted_fraction: None,
+            }),
             speed_rpm: self.wm_rad_s.unwrap_or(0.0) * 60.0 / std::f32::consts::TAU,
             iqs_a: self.iqs_a,
             ids_a: self.ids_a,

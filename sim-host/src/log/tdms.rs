@@ -77,16 +77,30 @@ fn number(p: &PropertyValue) -> Option<f64> {
     })
 }
 
-/// Refuses the layouts `tdms-rs` would misread: walks the segments' lead-ins (28 bytes
-/// each) and checks that their raw data is exactly what the channels' lengths account
-/// for.
-fn check_layout(path: &Path, shown: &str, file: &TdmsFile) -> Result<(), LogError> {
+/// Refuses the layouts `tdms-rs` would misread and files that end early: walks the
+/// segments' lead-ins (28 bytes each); returns the bytes of raw data they hold
+/// ([`check_chunks`] compares them with the channels' lengths).
+fn walk_segments(path: &Path, shown: &str) -> Result<u64, LogError> {
     let io = |source| LogError::Io {
         path: shown.to_string(),
         source,
     };
     let mut f = File::open(path).map_err(io)?;
     let len = f.metadata().map_err(io)?.len();
+    if len == 0 {
+        return Err(not_a_log(shown, "the TDMS file is empty (0 bytes)".into()));
+    }
+    let truncated = |why: String| {
+        not_a_log(
+            shown,
+            format!("the TDMS file is truncated: {why} (an interrupted recording or copy; re-export it, or rewrite it with LabVIEW's TDMS Defragment)"),
+        )
+    };
+    if len < 28 {
+        return Err(truncated(format!(
+            "{len} bytes, shorter than one segment's 28-byte lead-in"
+        )));
+    }
     let mut pos = 0u64;
     let mut raw = 0u64;
     let refuse = |what: &str| {
@@ -125,16 +139,40 @@ fn check_layout(path: &Path, shown: &str, file: &TdmsFile) -> Result<(), LogErro
             return Err(refuse("incremental metadata"));
         }
         let (next, raw_off) = (long(12), long(20));
+        if next != u64::MAX && (pos + 28).saturating_add(next) > len {
+            return Err(truncated(format!(
+                "the segment at byte {pos} declares {next} bytes after its lead-in, the file has {} more",
+                len - pos - 28
+            )));
+        }
         let end = if next == u64::MAX {
             len
         } else {
-            (pos + 28).saturating_add(next).min(len)
+            pos + 28 + next
         };
         if mask & (1 << 3) != 0 {
             raw += end.saturating_sub(pos + 28 + raw_off);
         }
         pos = end;
     }
+    if pos < len {
+        return Err(truncated(format!(
+            "{} bytes after the last segment, less than a lead-in",
+            len - pos
+        )));
+    }
+    Ok(raw)
+}
+
+/// Refuses a file whose raw data (`raw` bytes, [`walk_segments`]) is not exactly what the
+/// channels' lengths account for (several data chunks in a segment).
+fn check_chunks(shown: &str, raw: u64, file: &TdmsFile) -> Result<(), LogError> {
+    let refuse = |what: &str| {
+        not_a_log(
+            shown,
+            format!("TDMS with {what} is not read here: rewrite it with LabVIEW's TDMS Defragment (one plain segment layout) or convert it to CSV or Parquet"),
+        )
+    };
     let mut expected = 0u64;
     for g in file.groups() {
         for c in g.channels() {
@@ -229,8 +267,9 @@ impl TdmsSource {
         opts: &OpenOptions,
     ) -> Result<(Self, ColumnMap), LogError> {
         let mapping = &opts.columns;
+        let raw = walk_segments(path, shown)?;
         let file = TdmsFile::open(path).map_err(|e| tdms_error(shown, &e))?;
-        check_layout(path, shown, &file)?;
+        check_chunks(shown, raw, &file)?;
         let names: Vec<String> = file.groups().map(|g| g.name().to_string()).collect();
         let name = pick_group(&names, opts.group.as_deref(), shown)?;
         let g = file

@@ -42,6 +42,14 @@ pub struct UnbalanceReport {
     pub negative_sequence_ratio: f32,
     /// The winding's faulty phase (JSON "a", "b", "c"), or null.
     pub suspect_phase: Option<Phase>,
+    /// The phase's confidence, 0..1: 1 with the angle on its phase's sector centre, 0 on the
+    /// border with the next phase (`monitor_core::sequence::phase_confidence`); 0 without a
+    /// phase.
+    pub phase_confidence: f32,
+    /// Why no phase is judged although the currents are unbalanced, or null: no healthy
+    /// baseline, and the winding part is within a healthy machine's own asymmetry
+    /// (`monitor_core::sequence::INHERENT_ASYMMETRY_RATIO`).
+    pub phase_not_judged: Option<String>,
     /// arg(I2w/I1) [deg]: the winding's part (the supply's part taken out).
     pub angle_deg: f32,
     /// |I2w|/|I1|: the winding's part of the negative sequence.
@@ -50,7 +58,7 @@ pub struct UnbalanceReport {
     pub supply_ratio: f32,
     /// |V2|/|V1| (null without voltage columns).
     pub voltage_negative_sequence_ratio: Option<f32>,
-    /// The model correction arg(Z1/Z2) used [deg].
+    /// The model correction arg Z1 (the power-factor angle, shorted turns) used [deg].
     pub correction_deg: f32,
     /// One phase's current sensor with a gain error, from the zero sequence of the three
     /// measured currents (zero for a star without neutral, whatever the machine does), or

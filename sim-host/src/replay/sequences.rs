@@ -12,7 +12,7 @@ use crate::log::Row;
 use monitor_core::frames::{clarke, park, AlphaBeta, SinCos};
 use monitor_core::sequence::{
     asymmetry_correction_rad, single_phase_gain, slip_for_current, winding_asymmetry,
-    SinglePhaseGain,
+    SinglePhaseGain, INHERENT_ASYMMETRY_RATIO,
 };
 use monitor_core::SteadyPoint as IsolationPoint;
 use monitor_core::{Abc, CommissioningState, MonitorOutput};
@@ -220,13 +220,32 @@ impl Replay {
             Some(g) if !self.pll_on_voltage => 0.005f32.max(0.5 * g.gain_error * g.gain_error),
             _ => 0.005,
         };
+        // Without a healthy baseline nothing tells the winding's part from the machine's own
+        // build asymmetry and the sensors' mismatch (nor, without voltages, from the
+        // supply's): below a healthy machine's inherent asymmetry the phase is not judged.
+        let inherent = base.is_none();
+        let min_ratio = if inherent {
+            min_ratio.max(INHERENT_ASYMMETRY_RATIO)
+        } else {
+            min_ratio
+        };
         let w = winding_asymmetry(i2, v2, &m, we, slip, min_ratio);
+        let phase_not_judged = (inherent && w.suspect_phase.is_none() && w.ratio >= 0.005)
+            .then(|| {
+                format!(
+                    "cannot judge the phase: the winding's part of the negative sequence ({:.1} % of I1) is within a healthy machine's own asymmetry ({:.0} %) and there is no healthy baseline (give --baseline with a healthy log of this motor, or commission)",
+                    100.0 * w.ratio,
+                    100.0 * INHERENT_ASYMMETRY_RATIO
+                )
+            });
         UnbalanceReport {
             negative_sequence_ratio: monitor_core::fast_hypot(
                 measured.i2_over_i1[0],
                 measured.i2_over_i1[1],
             ),
             suspect_phase: w.suspect_phase,
+            phase_confidence: w.phase_confidence,
+            phase_not_judged,
             angle_deg: w.angle_rad.to_degrees(),
             correction_deg: asymmetry_correction_rad(&m, we, slip).to_degrees(),
             winding_ratio: w.ratio,

@@ -1,28 +1,36 @@
 //! The full-order T-equivalent machine the simulator integrates, in the stationary
 //! alpha-beta frame (amplitude-invariant Clarke).
 //!
-//! States x = [psi_s'_alpha, psi_s'_beta, psi_r_alpha, psi_r_beta, omega_m, theta_m]
+//! States x = [psi_s_alpha, psi_s_beta, psi_r_alpha, psi_r_beta, omega_m, theta_m]
 //! (flux linkages [Wb], mechanical speed [rad/s], mechanical angle [rad]):
 //! ```text
-//!   dpsi_s'/dt = T^-1 u,      (I + R_s/Rfe) u = v_s - R_s i_s   (u = v_s - R_s i_s without iron loss)
+//!   dpsi_s/dt = u,      (1 + Rs/Rfe) u = v_s - Rs i_s   (u = v_s - Rs i_s without iron loss)
 //!   dpsi_r/dt  = -Rr i_r + J omega_r psi_r,   J = [[0,-1],[1,0]],  omega_r = Np omega_m
-//!   psi_s' = Lls i_s' + psi_m,  psi_r = Llr i_r + psi_m,  psi_m = Lm (i_s' + i_r)
-//!   i_s = T^-1 i_s',  psi_s = T psi_s',  R_s = Rs T
+//!   psi_s = Lls i_s + psi_m,  psi_r = Llr i_r + psi_m,  psi_m = Lm (i_s + i_r)
 //!   T_e = (3/2) Np (psi_r_beta i_r_alpha - psi_r_alpha i_r_beta)   (= (3/2) Np psi_s x i_s)
 //!   J_m domega_m/dt = T_e - B omega_m - T_load(omega_m, t),   dtheta_m/dt = omega_m
 //! ```
-//! T is the stator turns matrix: I for a healthy machine; with a fraction mu of phase k's
-//! turns shorted out (`phase_asymmetry`), the abc turns diag(1 - mu e_k) seen in alpha-beta
-//! with an isolated neutral is T = I - (2/3) mu u_k u_k^T, u_k = (cos th_k, sin th_k),
-//! th_k = 0, 2pi/3, 4pi/3. The winding's MMF is T i_s and the flux it links is T times the
-//! field's, so in the primed variables (i_s' = T i_s, psi_s' = T^-1 psi_s) the machine is the
-//! symmetric T-equivalent; the faulty phase's resistance falls as (1 - mu) and its self
-//! inductance as (1 - mu)^2. Currents from fluxes: i_s' = (psi_s' - (Lm/Lr) psi_r) / M,
-//! M = Lls + Lm Llr / Lr, i_r = (psi_r - Lm i_s')/Lr, Lr = Llr + Lm.
+//! (i_s there is the machine's own stator current: the MMF current i_s' below.)
+//! Shorted turns (`phase_asymmetry`; Tallam, Habetler, Harley, "Transient model for induction
+//! machines with stator winding turn faults", IEEE Trans. Ind. Appl. 38(3), 2002): a fraction
+//! mu of phase k's turns shorted through a fault resistance r_f. The shorted turns stay in
+//! the winding and link mu of its flux; the loop carries i_f. With the MMF current
+//! i_s' = i_s - (2/3) mu i_f u_k (u_k = (cos th_k, sin th_k), th_k = 0, 2pi/3, 4pi/3 for a, b,
+//! c; amplitude-invariant Clarke, isolated neutral) the stator equation is the symmetric
+//! machine's, dpsi_s/dt = v_s - Rs i_s', and the loop's (the shorted part's drop
+//! mu Rs (i_k - i_f) plus its EMF mu dlambda_k/dt across r_f, with the zero-sequence leakage
+//! of the loop's own current) is
+//! ```text
+//!   (mu Lls/3) di_f/dt = u_k . v_s - R_f i_f,   R_f = Rs (1 - 2mu/3) + r_f/mu
+//! ```
+//! so the machine's states are those of the healthy machine and the terminals draw
+//! i_s = i_s' + (2/3) mu i_f u_k on top ([`TurnLoop`]). The loop dissipates mu R_f i_f^2 and
+//! stores mu (mu Lls/3) i_f^2 / 2. Its time constant (tens of microseconds) is as short as a
+//! step, so it is integrated exactly, for the supply's sinusoid over each step.
 //!
 //! Rotor cage asymmetry (`rotor_asymmetry`, broken bars): rotor phase a's resistance is
 //! Rr (1 + delta). With the rotor's isolated neutral its resistance in the rotor's own
-//! alpha-beta frame is R' = Rr I + (2/3) Rr delta e_a e_a^T (the same projection as T above:
+//! alpha-beta frame is R' = Rr I + (2/3) Rr delta e_a e_a^T (the projection of a one-phase change:
 //! C diag(R_k) C^+ = R I + (2/3) sum_k dR_k u_k u_k^T). Turned into the stator frame by the
 //! rotor's electrical angle theta_r = Np theta_m, R_r(theta_r) = Rot R' Rot^T =
 //! Rr I + (2/3) Rr delta u u^T, u = (cos theta_r, sin theta_r), and the rotor equation is
@@ -55,24 +63,6 @@ impl Sym2 {
     #[inline(always)]
     pub fn mul(&self, v: [f64; 2]) -> [f64; 2] {
         [self.a * v[0] + self.b * v[1], self.b * v[0] + self.c * v[1]]
-    }
-    pub fn scale(&self, k: f64) -> Self {
-        Sym2 {
-            a: self.a * k,
-            b: self.b * k,
-            c: self.c * k,
-        }
-    }
-    pub fn is_pos_def(&self) -> bool {
-        self.a > 0.0 && self.a * self.c - self.b * self.b > 0.0
-    }
-    pub fn inv(&self) -> Sym2 {
-        let d = self.a * self.c - self.b * self.b;
-        Sym2 {
-            a: self.c / d,
-            b: -self.b / d,
-            c: self.a / d,
-        }
     }
     /// Quadratic form v^T S v.
     pub fn quad(&self, v: [f64; 2]) -> f64 {
@@ -116,17 +106,112 @@ impl LoadLaw {
     }
 }
 
+/// The shorted loop of an inter-turn fault (module docs): a fraction `mu` of one phase's
+/// turns through a fault resistance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct TurnLoop {
+    /// Unit vector u_k of the faulty phase's axis.
+    pub u: [f64; 2],
+    /// Fraction mu of the phase's turns shorted (0..0.5].
+    pub mu: f64,
+    /// Loop resistance R_f = Rs (1 - 2mu/3) + r_f/mu [ohm] (per unit of mu^2 of the loop).
+    pub r: f64,
+    /// Loop inductance mu Lls / 3 [H] (same scaling).
+    pub l: f64,
+}
+
+impl TurnLoop {
+    /// The loop of `mu` of phase `phase` (0, 1, 2 for a, b, c) through `r_f_ohm`, with the
+    /// healthy winding's `rs` [ohm] and leakage `lls` [H].
+    pub fn new(phase: usize, mu: f64, r_f_ohm: f64, rs: f64, lls: f64) -> Self {
+        let th = phase as f64 * 2.0 * std::f64::consts::PI / 3.0;
+        TurnLoop {
+            u: [th.cos(), th.sin()],
+            mu,
+            r: rs * (1.0 - 2.0 * mu / 3.0) + r_f_ohm / mu,
+            l: mu * lls / 3.0,
+        }
+    }
+
+    /// The loop's voltage `u.v` over a step, from its values `p0`, `p1` at the step's ends:
+    /// a sinusoid at the supply's `we` [rad/s] (both sequences project onto the phase at
+    /// `we`), `p(t) = Re(P e^{j we t})`, `P = p0 - j p'(0)/we`; `None` where `we h` is too
+    /// small to tell the slope (then the voltage is taken linear).
+    fn phasor(p0: f64, p1: f64, we: f64, h: f64) -> Option<(f64, f64)> {
+        let (s, c) = (we * h).sin_cos();
+        (s.abs() > 1e-9).then(|| (p0, -(p1 - p0 * c) / s))
+    }
+
+    /// The forced currents at the step's start and end: `Re(P e^{j we t} / (r + j we l))`,
+    /// or, for a linear voltage, `(p - tau p')/r`.
+    fn forced_ends(&self, p0: f64, p1: f64, we: f64, h: f64) -> (f64, f64) {
+        match Self::phasor(p0, p1, we, h) {
+            Some((pr, pi)) => {
+                let (zr, zi) = (self.r, we * self.l);
+                let d = zr * zr + zi * zi;
+                // P / Z, then turned by we h.
+                let (qr, qi) = ((pr * zr + pi * zi) / d, (pi * zr - pr * zi) / d);
+                let (s, c) = (we * h).sin_cos();
+                (qr, qr * c - qi * s)
+            }
+            None => {
+                let slope = (p1 - p0) / h;
+                let tau = self.l / self.r;
+                ((p0 - tau * slope) / self.r, (p1 - tau * slope) / self.r)
+            }
+        }
+    }
+
+    /// The loop current after `h` [s] from `i_f` [A] with the supply going from `v0` to
+    /// `v1` (alpha-beta) at `we` [rad/s] over the step: the exact solution of
+    /// `l di/dt = u.v(t) - r i` for a sinusoidal `u.v`, `i(t) = forced(t) + c e^{-t/tau}`,
+    /// `tau = l/r`.
+    #[inline(always)]
+    pub fn step(&self, i_f: f64, v0: [f64; 2], v1: [f64; 2], we: f64, h: f64) -> f64 {
+        let p = |v: [f64; 2]| self.u[0] * v[0] + self.u[1] * v[1];
+        let (p0, p1) = (p(v0), p(v1));
+        if self.l <= 0.0 {
+            return p1 / self.r;
+        }
+        let (f0, f1) = self.forced_ends(p0, p1, we, h);
+        f1 + (i_f - f0) * (-h * self.r / self.l).exp()
+    }
+
+    /// The loop's forced current at the start of a step from `v0` to `v1` (its own
+    /// transient, tens of microseconds, left out): where a run starts the loop.
+    pub fn forced(&self, v0: [f64; 2], v1: [f64; 2], we: f64, h: f64) -> f64 {
+        let p = |v: [f64; 2]| self.u[0] * v[0] + self.u[1] * v[1];
+        if self.l <= 0.0 {
+            return p(v0) / self.r;
+        }
+        self.forced_ends(p(v0), p(v1), we, h).0
+    }
+
+    /// What the terminals draw on top of the machine, (2/3) mu i_f u_k [A].
+    #[inline(always)]
+    pub fn terminal(&self, i_f: f64) -> [f64; 2] {
+        let k = 2.0 / 3.0 * self.mu * i_f;
+        [k * self.u[0], k * self.u[1]]
+    }
+
+    /// Power the loop dissipates at `i_f`, mu R_f i_f^2 [W].
+    pub fn loss_w(&self, i_f: f64) -> f64 {
+        self.mu * self.r * i_f * i_f
+    }
+
+    /// Energy the loop's leakage stores at `i_f`, mu l i_f^2 / 2 [J].
+    pub fn stored_j(&self, i_f: f64) -> f64 {
+        0.5 * self.mu * self.l * i_f * i_f
+    }
+}
+
 /// Everything the derivative needs, precomputed (rebuilt when a parameter changes).
 #[derive(Debug, Clone)]
 pub(crate) struct Machine {
     /// Stator resistance of the healthy phases [ohm].
     pub rs: f64,
-    /// Stator resistance matrix Rs T [ohm].
-    pub r_s: Sym2,
-    /// Stator turns matrix T and its inverse; `asym` = T != I.
-    pub t_mat: Sym2,
-    pub tinv: Sym2,
-    pub asym: bool,
+    /// The shorted loop of a turn fault, if any.
+    pub turn: Option<TurnLoop>,
     pub lls: f64,
     pub llr: f64,
     pub rr: f64,
@@ -135,9 +220,9 @@ pub(crate) struct Machine {
     /// Unsaturated (or constant) magnetising inductance [H].
     pub lm0: f64,
     pub sat: Option<SatLaw>,
-    /// 1/Rfe [S], 0 without iron loss, and (I + R_s/Rfe)^-1.
+    /// 1/Rfe [S], 0 without iron loss, and 1/(1 + Rs/Rfe).
     pub inv_rfe: f64,
-    pub k_fe: Sym2,
+    pub k_fe: f64,
     pub np: f64,
     pub inv_j: f64,
     pub b: f64,
@@ -153,7 +238,7 @@ pub(crate) struct Machine {
 /// Currents and magnetising inductance at a state.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Currents {
-    /// Primed stator current i_s' = T i_s (the winding's MMF current) [A].
+    /// The machine's stator current (the winding's MMF current i_s') [A].
     pub i_s: [f64; 2],
     /// Rotor current [A].
     pub i_r: [f64; 2],
@@ -166,7 +251,7 @@ impl Machine {
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         rs: f64,
-        t_mat: Sym2,
+        turn: Option<TurnLoop>,
         lls: f64,
         llr: f64,
         rr: f64,
@@ -179,23 +264,18 @@ impl Machine {
         load: LoadLaw,
     ) -> Result<Machine, String> {
         let (minv, kr, inv_lr) = Self::linear(lls, llr, lm0)?;
-        if !t_mat.is_pos_def() {
-            return Err("the stator turns matrix is not positive definite".into());
+        if let Some(t) = &turn {
+            if !(t.r > 0.0 && t.r.is_finite() && t.l >= 0.0) {
+                return Err(format!(
+                    "the shorted loop's resistance must be positive (R_f = {} ohm)",
+                    t.r
+                ));
+            }
         }
-        let r_s = t_mat.scale(rs);
-        let asym = t_mat != Sym2::scalar(1.0);
         let inv_rfe = rfe.map(|r| 1.0 / r).unwrap_or(0.0);
-        let k = Sym2 {
-            a: 1.0 + r_s.a * inv_rfe,
-            b: r_s.b * inv_rfe,
-            c: 1.0 + r_s.c * inv_rfe,
-        };
         Ok(Machine {
             rs,
-            r_s,
-            t_mat,
-            tinv: t_mat.inv(),
-            asym,
+            turn,
             lls,
             llr,
             rr,
@@ -203,7 +283,7 @@ impl Machine {
             lm0,
             sat,
             inv_rfe,
-            k_fe: k.inv(),
+            k_fe: 1.0 / (1.0 + rs * inv_rfe),
             np,
             inv_j: 1.0 / j,
             b,
@@ -296,29 +376,14 @@ impl Machine {
         Currents { i_s, i_r, lm: x1 }
     }
 
-    /// Real stator (branch) current i_s = T^-1 i_s'.
-    #[inline(always)]
-    pub fn real_is(&self, i_s_primed: [f64; 2]) -> [f64; 2] {
-        if self.asym {
-            self.tinv.mul(i_s_primed)
-        } else {
-            i_s_primed
-        }
-    }
-
-    /// Voltage behind Rs (= dpsi_s/dt) for supply voltage `v` and real branch current `i_s`.
+    /// Voltage behind Rs (= dpsi_s/dt) for supply voltage `v` and the machine's current `i_s`.
     #[inline(always)]
     pub fn u(&self, v: [f64; 2], i_s: [f64; 2]) -> [f64; 2] {
-        let ri = if self.asym {
-            self.r_s.mul(i_s)
-        } else {
-            [self.rs * i_s[0], self.rs * i_s[1]]
-        };
-        let e = [v[0] - ri[0], v[1] - ri[1]];
+        let e = [v[0] - self.rs * i_s[0], v[1] - self.rs * i_s[1]];
         if self.inv_rfe == 0.0 {
             e
         } else {
-            self.k_fe.mul(e)
+            [self.k_fe * e[0], self.k_fe * e[1]]
         }
     }
 
@@ -346,10 +411,7 @@ impl Machine {
         let pr = [x[2], x[3]];
         let wm = x[4];
         let c = self.currents(ps, pr);
-        let mut u = self.u(v, self.real_is(c.i_s));
-        if self.asym {
-            u = self.tinv.mul(u);
-        }
+        let u = self.u(v, c.i_s);
         let wr = self.np * wm;
         let te = self.torque(pr, c.i_r);
         let tl = self.load.torque(wm);

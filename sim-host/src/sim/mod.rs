@@ -140,10 +140,13 @@ pub enum SimError {
         message: String,
     },
     /// The state stopped being finite (should not happen for physical parameters).
-    #[error("simulation diverged at t = {t_s} s")]
+    #[error("simulation diverged at t = {t_s} s: {cause}")]
     Diverged {
         /// Time of the first non-finite state [s].
         t_s: f64,
+        /// The scenario value it followed (the last step before it, in the scenario's
+        /// keys), or what to check when it diverged from the start.
+        cause: String,
     },
 }
 

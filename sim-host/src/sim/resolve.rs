@@ -2,11 +2,10 @@
 //! their machine-dependent defaults, the parameter changes in effect (faults, load steps,
 //! winding temperature) and the builder of the [`Machine`] they give.
 
-use super::machine::{LoadLaw, Machine, SatLaw, Sym2};
+use super::machine::{LoadLaw, Machine, SatLaw, TurnLoop};
 use super::{EffectSpec, FaultSpec, LoadKind, Scenario, SimError};
 use crate::params::ParamFile;
 use monitor_core::{Fault, MotorParameters};
-use std::f64::consts::PI;
 
 /// The effects of a scenario, resolved to the numbers the machine and the loop need.
 #[derive(Debug, Clone, Default)]
@@ -18,7 +17,9 @@ pub(super) struct ResolvedEffects {
     pub(super) windage: f64,
     pub(super) load_torque: Option<f64>,
     pub(super) unbalance: Option<(f64, f64)>,
-    pub(super) asym: Option<(usize, f64)>,
+    /// Shorted turns (`phase_asymmetry`): phase index, fraction mu, fault resistance r_f
+    /// [ohm] (`None`: a tenth of the healthy phase's Rs).
+    pub(super) asym: Option<(usize, f64, Option<f64>)>,
     /// Rotor resistance asymmetry delta (`rotor_asymmetry`), 0 when off.
     pub(super) rotor_delta: f64,
 }
@@ -123,9 +124,11 @@ impl ResolvedEffects {
                     fraction,
                     angle_deg,
                 } => eff.unbalance = Some((fraction, angle_deg.to_radians())),
-                EffectSpec::PhaseAsymmetry { phase, fraction } => {
-                    eff.asym = Some((phase.index(), fraction))
-                }
+                EffectSpec::PhaseAsymmetry {
+                    phase,
+                    fraction,
+                    fault_resistance_ohm,
+                } => eff.asym = Some((phase.index(), fraction, fault_resistance_ohm)),
                 EffectSpec::RotorAsymmetry { .. } => eff.rotor_delta = e.rotor_delta()?,
                 EffectSpec::FluxDynamics {}
                 | EffectSpec::CurrentDynamics {}
@@ -213,12 +216,10 @@ impl MachineBuilder<'_> {
         }
         let lls = if gamma_s { 0.0 } else { model.lls_h() * md.lls };
         let llr = if gamma_r { 0.0 } else { model.llr_h() * md.llr };
-        let t_mat = match self.eff.asym {
-            Some((ph, mu)) => {
-                Sym2::scalar_minus_rank1(1.0, 2.0 / 3.0 * mu, ph as f64 * 2.0 * PI / 3.0)
-            }
-            None => Sym2::scalar(1.0),
-        };
+        // The fault resistance defaults to a tenth of the healthy phase's (cold) Rs.
+        let turn = self.eff.asym.filter(|a| a.1 > 0.0).map(|(ph, mu, rf)| {
+            TurnLoop::new(ph, mu, rf.unwrap_or(0.1 * m.rs_ohm), rs, model.lls_h())
+        });
         let (c_nm, w0) = self.eff.coulomb.unwrap_or((0.0, 1.0));
         let load = if self.torque_load {
             LoadLaw {
@@ -239,7 +240,7 @@ impl MachineBuilder<'_> {
         };
         let mut machine = Machine::new(
             rs,
-            t_mat,
+            turn,
             lls,
             llr,
             rr,

@@ -73,18 +73,26 @@ impl Supply {
         [p[0] * r[0] - p[1] * r[1], p[0] * r[1] + p[1] * r[0]]
     }
 
-    /// Integrates `machine` over one output sample (`nsub` steps of `h`).
-    fn integrate(&mut self, machine: &Machine, x: &mut [f64; 6], nsub: u32) {
+    /// The shorted loop's current where a run starts (its forced response to the supply:
+    /// the loop settles in tens of microseconds, faster than any sample), 0 without one.
+    fn loop_start(&self, machine: &Machine) -> f64 {
+        let p1 = Self::rotate(Self::rotate(self.p, self.rot), self.rot);
+        machine.turn.map_or(0.0, |t| {
+            t.forced(self.voltage(self.p), self.voltage(p1), self.we, self.h)
+        })
+    }
+
+    /// Integrates `machine` over one output sample (`nsub` steps of `h`), and the shorted
+    /// loop's current `i_f` of a turn fault (exact for the supply's sinusoid).
+    fn integrate(&mut self, machine: &Machine, x: &mut [f64; 6], i_f: &mut f64, nsub: u32) {
         for _ in 0..nsub {
             let pm = Self::rotate(self.p, self.rot);
             let pe = Self::rotate(pm, self.rot);
-            machine.rk4(
-                x,
-                self.h,
-                self.voltage(self.p),
-                self.voltage(pm),
-                self.voltage(pe),
-            );
+            let (v0, v1) = (self.voltage(self.p), self.voltage(pe));
+            machine.rk4(x, self.h, v0, self.voltage(pm), v1);
+            if let Some(t) = &machine.turn {
+                *i_f = t.step(*i_f, v0, v1, self.we, self.h);
+            }
             self.p = pe;
         }
         // Renormalise |p| = 1 (first-order Newton step: no sqrt, |p| drifts by ~1e-16/step).
@@ -411,6 +419,7 @@ impl<'a> Run<'a> {
         let mut dtemp = 0.0f64;
         let mut max_i2 = 0.0f64;
         let mut last_p_loss = 0.0f64;
+        let mut i_f = self.supply.loop_start(&self.machine);
         for k in 0..self.n {
             let t = k as f64 * self.dt;
             let mut rebuild = self.apply_events(k, &mut next_event);
@@ -435,7 +444,7 @@ impl<'a> Run<'a> {
             }
             // Outputs at t.
             let v = self.supply.voltage(self.supply.p);
-            let tr = truth(&self.machine, &x, v, t, self.supply.we, dtemp);
+            let tr = truth(&self.machine, &x, i_f, v, t, self.supply.we, dtemp);
             last_p_loss = tr.p_cu_w + tr.p_fe_w;
             max_i2 = max_i2.max(tr.i_ab[0] * tr.i_ab[0] + tr.i_ab[1] * tr.i_ab[1]);
             let row = self.sensors.measure(&tr, self.dt);
@@ -446,12 +455,45 @@ impl<'a> Run<'a> {
                 self.insert_events(k + 1, next_event, &mut added);
             }
             // Integrate to t + dt.
-            self.supply.integrate(&self.machine, &mut x, self.nsub);
+            self.supply
+                .integrate(&self.machine, &mut x, &mut i_f, self.nsub);
             if !(x[0].is_finite() && x[2].is_finite() && x[4].is_finite()) {
-                return Err(SimError::Diverged { t_s: t + self.dt });
+                return Err(SimError::Diverged {
+                    t_s: t + self.dt,
+                    cause: self.divergence_cause(next_event),
+                });
             }
         }
         Ok((self.summary(x[4], max_i2.sqrt()), true))
+    }
+
+    /// What a divergence followed, in the scenario's keys: the last event applied (of the
+    /// first `applied`), or, with none, the values in force from the start.
+    fn divergence_cause(&self, applied: usize) -> String {
+        let opt = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:e}"));
+        let Some((k, ev)) = applied.checked_sub(1).and_then(|i| self.events.get(i)) else {
+            return "from the start: a value out of any motor's range in the parameter file                     (j_kgm2, b_nms, bl_nms, the inductances) or the scenario (load.torque_nm,                     load.bl_nms, supply, the effects' values); the machine's states grew                     without bound"
+                .into();
+        };
+        let at = *k as f64 * self.dt;
+        let what = match ev {
+            ScenarioEvent::Supply(s) => format!(
+                "supply.steps (v_scale {}, f_hz {})",
+                opt(s.v_scale),
+                opt(s.f_hz)
+            ),
+            ScenarioEvent::Load(s) => format!(
+                "load.steps (torque_nm {}, bl_scale {})",
+                opt(s.torque_nm),
+                opt(s.bl_scale)
+            ),
+            ScenarioEvent::Fault(f) => {
+                format!("faults (kind {}, change {})", f.kind.name(), opt(f.change))
+            }
+        };
+        format!(
+            "right after the step at {at} s in {what}; a value that size is out of any motor's range"
+        )
     }
 
     fn summary(&self, wm: f64, max_abs_current_a: f64) -> SimSummary {
@@ -479,14 +521,30 @@ impl<'a> Run<'a> {
     }
 }
 
-fn truth(model: &Machine, x: &[f64; 6], v: [f64; 2], t: f64, we: f64, dtemp: f64) -> Truth {
-    let psp = [x[0], x[1]];
+/// The true quantities at state `x` with the shorted loop's current `i_f` (0 without a turn
+/// fault) and the supply `v`.
+#[allow(clippy::too_many_arguments)]
+fn truth(
+    model: &Machine,
+    x: &[f64; 6],
+    i_f: f64,
+    v: [f64; 2],
+    t: f64,
+    we: f64,
+    dtemp: f64,
+) -> Truth {
+    let ps = [x[0], x[1]];
     let pr = [x[2], x[3]];
-    let c = model.currents(psp, pr);
-    let is = model.real_is(c.i_s);
-    let ps = model.t_mat.mul(psp);
+    let c = model.currents(ps, pr);
+    let is = c.i_s;
     let u = model.u(v, is);
-    let it = [is[0] + u[0] * model.inv_rfe, is[1] + u[1] * model.inv_rfe];
+    // The machine's branch current (with the iron-loss current), then the terminals'.
+    let ib = [is[0] + u[0] * model.inv_rfe, is[1] + u[1] * model.inv_rfe];
+    let loop_i = model.turn.map_or([0.0; 2], |l| l.terminal(i_f));
+    let it = [ib[0] + loop_i[0], ib[1] + loop_i[1]];
+    let (loop_loss, loop_stored) = model
+        .turn
+        .map_or((0.0, 0.0), |l| (l.loss_w(i_f), l.stored_j(i_f)));
     let abc = |a: [f64; 2]| {
         inverse_clarke(
             AlphaBeta {
@@ -518,11 +576,14 @@ fn truth(model: &Machine, x: &[f64; 6], v: [f64; 2], t: f64, we: f64, dtemp: f64
         rr_ohm: model.rr,
         lm_h: c.lm,
         p_in_w: 1.5 * (v[0] * it[0] + v[1] * it[1]),
-        p_cu_w: 1.5 * (model.r_s.quad(it) + model.rotor_r(x[5]).quad(c.i_r)),
+        p_cu_w: 1.5
+            * (model.rs * (ib[0] * ib[0] + ib[1] * ib[1]) + model.rotor_r(x[5]).quad(c.i_r))
+            + loop_loss,
         p_fe_w: 1.5 * (u[0] * u[0] + u[1] * u[1]) * model.inv_rfe,
         p_mech_w: te * wm,
         stored_energy_j: 0.75
-            * (ps[0] * is[0] + ps[1] * is[1] + pr[0] * c.i_r[0] + pr[1] * c.i_r[1]),
+            * (ps[0] * is[0] + ps[1] * is[1] + pr[0] * c.i_r[0] + pr[1] * c.i_r[1])
+            + loop_stored,
         temperature_rise_k: dtemp,
     }
 }

@@ -282,15 +282,16 @@ pub enum EffectSpec {
         #[serde(default)]
         angle_deg: f64,
     },
-    /// Shorted turns in one stator phase (inter-turn short), modelled as a fraction mu of
-    /// that phase's turns taken out of the circuit: its resistance falls as (1 - mu), its
-    /// self inductance as (1 - mu)^2 and its coupling to the rotor as (1 - mu). Star
-    /// connection, isolated neutral: in alpha-beta the turns matrix is
-    /// T = I - (2/3) mu u u^T, u = (cos th_k, sin th_k), th_k = 0, 2pi/3, 4pi/3 for a, b, c;
-    /// R_s = Rs T, psi_s = T (symmetric machine flux of the MMF current T i_s). The current
-    /// circulating in the shorted loop itself is not modelled. Default mu = 0.05 in phase a.
-    /// Measured (3 hp, no load, mu = 0.1 in phase b): the faulty phase carries the largest
-    /// current.
+    /// Shorted turns in one stator phase (inter-turn short) as they are (Tallam, Habetler,
+    /// Harley, IEEE Trans. Ind. Appl. 38(3), 2002): a fraction mu of that phase's turns
+    /// shorted through a fault resistance r_f. The shorted turns stay in the winding; the
+    /// loop carries the fault current i_f, `(mu Lls/3) di_f/dt = u_k . v_s - R_f i_f`,
+    /// `R_f = Rs (1 - 2mu/3) + r_f/mu`, and the terminals draw (2/3) mu i_f u_k on top of the
+    /// healthy machine's current (star connection, isolated neutral; `sim::machine` docs).
+    /// The negative-sequence current is `I2/I1 = (mu/3) (Z1/Z_f) a^k`. Default mu = 0.05 in
+    /// phase a through r_f = Rs/10 (a low-resistance short, as insulation breakdown makes:
+    /// the loop draws a few times the rated current). A bolted short (`r_f = 0`) of a few
+    /// per cent of the turns draws a loop current of V/Rs, tens of times the rated current.
     PhaseAsymmetry {
         /// Faulty phase, default "a".
         #[serde(default = "d_phase_a")]
@@ -298,6 +299,10 @@ pub enum EffectSpec {
         /// Fraction mu of the winding shorted (0..0.5), default 0.05.
         #[serde(default = "d_asym")]
         fraction: f64,
+        /// Fault resistance r_f of the short [ohm], >= 0; default a tenth of the phase's
+        /// resistance Rs.
+        #[serde(default)]
+        fault_resistance_ohm: Option<f64>,
     },
     /// Rotor cage asymmetry (broken rotor bars): rotor phase a's resistance is
     /// Rr (1 + delta), the others Rr. In the rotor's own alpha-beta frame (amplitude-invariant
@@ -387,6 +392,7 @@ impl EffectSpec {
             EffectKind::PhaseAsymmetry => EffectSpec::PhaseAsymmetry {
                 phase: d_phase_a(),
                 fraction: d_asym(),
+                fault_resistance_ohm: None,
             },
             EffectKind::FluxDynamics => EffectSpec::FluxDynamics {},
             EffectKind::CurrentDynamics => EffectSpec::CurrentDynamics {},
@@ -487,7 +493,14 @@ impl EffectSpec {
                     invalid(&k("angle_deg"), "must be finite".into())
                 }
             }
-            EffectSpec::PhaseAsymmetry { fraction: f, .. } => fraction(&k("fraction"), *f),
+            EffectSpec::PhaseAsymmetry {
+                fraction: f,
+                fault_resistance_ohm: rf,
+                ..
+            } => {
+                fraction(&k("fraction"), *f)?;
+                rf.map_or(Ok(()), |r| not_negative(&k("fault_resistance_ohm"), r))
+            }
             EffectSpec::FluxDynamics {}
             | EffectSpec::CurrentDynamics {}
             | EffectSpec::DAxisDynamics {}

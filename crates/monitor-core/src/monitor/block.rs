@@ -226,6 +226,10 @@ pub(super) struct DqFilters {
     pub(super) nd: Svf,
     /// The negative sequence's q component [A].
     pub(super) nq: Svf,
+    /// The voltage's negative sequence, d and q (each block's last sample) [V]: the
+    /// supply's own unbalance, taken out before a winding is named.
+    pub(super) vnd: Svf,
+    pub(super) vnq: Svf,
     /// V_ds of each block's last sample [V].
     pub(super) vds: LowPass,
 }
@@ -243,6 +247,8 @@ impl DqFilters {
             wr: dq,
             nd: seq,
             nq: seq,
+            vnd: seq,
+            vnq: seq,
             vds: LowPass::new(cfg.filter_hz, block_dt_s),
         }
     }
@@ -267,6 +273,8 @@ impl DqFilters {
             &mut self.wr,
             &mut self.nd,
             &mut self.nq,
+            &mut self.vnd,
+            &mut self.vnq,
         ] {
             f.reset();
         }

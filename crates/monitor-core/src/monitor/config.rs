@@ -71,7 +71,10 @@ pub struct MonitorConfig {
     pub pll_bw_hz: f32,
     /// Negative-sequence filter corner [Hz] (default 2).
     pub sequence_hz: f32,
-    /// Smallest |I2|/|I1| for which a suspect phase is named (default 0.005).
+    /// Smallest |I2|/|I1| for which a suspect phase is named (default
+    /// [`crate::sequence::INHERENT_ASYMMETRY_RATIO`], 0.03: the monitor has no healthy
+    /// baseline of the negative sequence and does not take the supply's part out, so below
+    /// a healthy machine's own asymmetry the phase would be the machine's build).
     pub unbalance_min_ratio: f32,
     /// Residual floor as a fraction of the no-load term sums (default 0.02).
     pub floor_fraction: f32,
@@ -157,7 +160,7 @@ impl MonitorConfig {
             min_voltage_frac: 0.3,
             pll_bw_hz: crate::minf(20.0, sample_rate_hz / 50.0),
             sequence_hz: 2.0,
-            unbalance_min_ratio: 0.005,
+            unbalance_min_ratio: crate::sequence::INHERENT_ASYMMETRY_RATIO,
             floor_fraction: 0.02,
             steady_gate_per_s: 0.1,
             gate_hold_s: 0.5,

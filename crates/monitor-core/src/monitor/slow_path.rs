@@ -6,7 +6,9 @@
 use super::{Monitor, ResidualForm, Sample, SensorFlags};
 use crate::frames::{clarke, SinCos};
 use crate::residuals::residuals;
-use crate::sequence::{asymmetry_correction_rad, sequence_result};
+use crate::sequence::{
+    asymmetry_correction_rad, over_positive, sequence_result, winding_asymmetry,
+};
 use crate::signature::{match_signature, Diagnosis, Fault, FAULT_COUNT};
 
 impl Monitor {
@@ -184,6 +186,9 @@ impl Monitor {
             .filters
             .vds
             .update(vab.alpha * sc.cos + vab.beta * sc.sin);
+        let vn = crate::frames::park(vab, sc.negated());
+        self.filters.vnd.update(vn.d);
+        self.filters.vnq.update(vn.q);
         let bad = self.checks.sums(s, &self.cfg.limits);
         if bad.current | bad.voltage {
             self.flag(bad);
@@ -249,13 +254,24 @@ impl Monitor {
         } else {
             0.0
         };
-        let corr = asymmetry_correction_rad(&self.cfg.motor, we.abs().max(1.0), slip);
+        let we = we.abs().max(1.0);
+        let corr = asymmetry_correction_rad(&self.cfg.motor, we, slip);
         let f = &self.filters;
-        self.out.unbalance = sequence_result(
-            (f.ids.y, f.iqs.y),
-            (f.nd.y, f.nq.y),
-            corr,
+        let p = (f.ids.y, f.iqs.y);
+        let mut out = sequence_result(p, (f.nd.y, f.nq.y), corr, self.cfg.unbalance_min_ratio);
+        // The phase from the winding's part: the supply's V2/Z2 taken out (module docs of
+        // `crate::sequence`).
+        let w = winding_asymmetry(
+            over_positive(p, (f.nd.y, f.nq.y)),
+            Some(over_positive(p, (f.vnd.y, f.vnq.y))),
+            &self.cfg.motor,
+            we,
+            slip,
             self.cfg.unbalance_min_ratio,
         );
+        out.suspect_phase = w.suspect_phase;
+        out.winding_ratio = w.ratio;
+        out.phase_confidence = w.phase_confidence;
+        self.out.unbalance = out;
     }
 }

@@ -1,6 +1,6 @@
 //! `phase_asymmetry`: one stator winding differs.
 
-use super::impedance::{z1_pos, z2_neg};
+use super::impedance::z1_pos;
 use super::{
     plausible, supply_unbalanced, About, Confusion, Contribution, EffectModel, Evidence, FitParam,
     FitSetup, Needs, ParamSpec, SetupError,
@@ -14,30 +14,28 @@ use monitor_core::EffectKind;
 #[derive(Debug, Clone, Copy)]
 pub struct PhaseAsymmetry;
 
-/// The winding asymmetry set up on a log: the full-order form's `e / c =
-/// conj(Z2 / (Z1 + Z2 - Rs))` at the log's mean operating point ([`WindingAsymmetry`]).
+/// The shorted turns set up on a log: the full-order form's loop admittance over `c`,
+/// `y / c = 1 / conj(Z1)` at the log's mean operating point ([`WindingAsymmetry`]).
 struct OnLog {
-    e_over_c: C64,
+    y_over_c: C64,
 }
 
 /// The winding asymmetry a fitted `c` (i_neg = c conj(i_pos)) points at, named by the
 /// workspace's one faulty-phase method (`monitor_core::sequence`): in the core's phasor
-/// convention `I2/I1 = conj(c)`; the correction `arg(Z1/Z2)` is taken at the slip of the
-/// log's mean operating point `slip` and supply `w` [rad/s]. Returns the phase and the
-/// fraction of that winding's impedance lost (the first-order size of the asymmetry).
+/// convention `I2/I1 = conj(c)`; the correction `arg Z1` is taken at the slip of the log's
+/// mean operating point `slip` and supply `w` [rad/s]. Returns the phase and the least
+/// fraction of that phase's turns shorted (a bolted short; a fault resistance means more).
 pub fn asymmetry_phase(
     c: C64,
     n: &MachineConstants,
     w: f64,
     slip: f64,
 ) -> (monitor_core::Phase, f64) {
-    use monitor_core::sequence::{
-        asymmetry_correction_rad, suspect_phase, winding_change_fraction,
-    };
+    use monitor_core::sequence::{asymmetry_correction_rad, min_shorted_fraction, suspect_phase};
     let (we, s) = (w.abs().max(1.0) as f32, slip as f32);
     let corr = asymmetry_correction_rad(&n.core_model, we, s);
     let phase = suspect_phase(-(c.arg() as f32), corr);
-    let eps = winding_change_fraction(&n.core_model, we, s, c.norm() as f32);
+    let eps = min_shorted_fraction(&n.core_model, we, s, c.norm() as f32);
     (phase, f64::from(eps))
 }
 
@@ -45,7 +43,7 @@ pub fn asymmetry_phase(
 const ABOUT: About = About {
     kind: EffectKind::PhaseAsymmetry,
     description: "One stator winding differs from the other two (inter-turn short, bad joint): the machine draws a negative-sequence current proportional to its load current even from a balanced supply.",
-    equations: "Reduced model: i_abc = balanced model current + i_neg, i_neg = (c_re + j c_im) conj(i_pos): a winding change dZ in phase k gives c = (dZ/3Zs...) e^{j 2 th_k} conj(Zs/Z2) mu/3. Full-order model (all dynamics effects in): the winding itself, T^-1 = I + k u_k u_k^T acting on the voltage, the stator resistance drop and the terminal current (A z = (1 + |e|) z + e conj(z), e = c conj(Z2/(Z1 + Z2 - Rs)) at the log's mean operating point, so c means the same in both).",
+    equations: "Reduced model: i_abc = balanced model current + i_neg, i_neg = (c_re + j c_im) conj(i_pos). Shorted turns (a fraction mu of phase k through r_f; Tallam, Habetler, Harley 2002) give c = (mu/(3 R_f)) e^{j 2 th_k} conj(Z1), R_f = Rs (1 - 2mu/3) + r_f/mu. Full-order model (all dynamics effects in): the machine stays symmetric and the terminals draw the shorted loop's current |y| v + y conj(v), y = c / conj(Z1) at the log's mean operating point, so c means the same in both.",
     parameters: &[
         ParamSpec {
             name: "c_re",
@@ -78,18 +76,17 @@ impl EffectModel for PhaseAsymmetry {
     }
     fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let (w, slip) = operating_point(d, n);
-        let z2 = z2_neg(n, w);
-        let k = (z2 / (z1_pos(n, w, slip) + z2 - n.rs_ohm)).conj();
+        let k = C64::new(1.0, 0.0) / z1_pos(n, w, slip).conj();
         let k = if k.re.is_finite() && k.im.is_finite() {
             k
         } else {
-            C64::new(1.0, 0.0)
+            C64::new(0.0, 0.0)
         };
         let c = |name| {
             FitParam::new(name, "1", 0.0, (-1.0, 1.0), 0.02)
                 .physical(plausible::ASYM_C, plausible::ASYM_BASIS)
         };
-        Ok(FitSetup::new(OnLog { e_over_c: k })
+        Ok(FitSetup::new(OnLog { y_over_c: k })
             .param(FitParam {
                 init: 0.01,
                 ..c("c_re")
@@ -99,13 +96,13 @@ impl EffectModel for PhaseAsymmetry {
 }
 
 impl Contribution for OnLog {
-    /// The unequal stator winding in its two forms (`c` and `e`).
+    /// The shorted turns in their two forms (`c` and `y`).
     fn contribute(&self, p: &[f64], _d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
         let &[c_re, c_im] = p else { return };
         let c = C64::new(c_re, c_im);
         t.stator_winding = Some(WindingAsymmetry {
             c,
-            e: c * self.e_over_c,
+            y: c * self.y_over_c,
         });
     }
     fn describe(&self, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
@@ -116,7 +113,7 @@ impl Contribution for OnLog {
         let c = C64::new(c_re, c_im);
         let (ph, eps) = asymmetry_phase(c, n, w, slip);
         format!(
-            "phase {} winding differs: negative-sequence current {:.1} % of the positive-sequence current; fits about {:.1} % of that winding's impedance lost (an inter-turn short removes turns)",
+            "phase {} winding differs: negative-sequence current {:.1} % of the positive-sequence current; shorted turns in that phase, at least {:.1} % of its turns (a bolted short; a fault resistance means more)",
             ph.name(),
             100.0 * c.norm(),
             100.0 * eps,

@@ -333,18 +333,24 @@ impl<'a> Reduced<'a> {
     }
 
     /// The outputs at sample `k` in the analysis frame turned by `rot`: the measured d
-    /// current, the predicted q current (with the core loss' frame tilt undone), the
+    /// current, the predicted q current (with the core loss' frame tilt undone, and the
+    /// shorted-turn loop's in-phase current `|y| V_qs`, which makes no torque), the
     /// negative sequence added.
     fn output(&self, k: usize, rot: C64, cl: &CoreLoss, s: &State, out: &mut Prediction) {
         let d = self.run.d;
         let ineg = self.run.t.reduced_i_neg(d, k);
+        let loop_q = self
+            .run
+            .t
+            .stator_winding
+            .map_or(0.0, |w| w.y.norm() * d.vq[k]);
         let i_dq = if cl.eps != 0.0 {
             let i_true = C64::new(cl.id_term, s.iq + cl.i_fe_q);
             let fwd = C64::new(cl.eps.cos(), cl.eps.sin());
-            C64::new(d.id[k], (i_true * fwd).im)
+            C64::new(d.id[k], (i_true * fwd).im + loop_q)
         } else {
             // The measured I_ds (not a re-noised one: the error never sees its noise).
-            C64::new(d.id[k], s.iq)
+            C64::new(d.id[k], s.iq + loop_q)
         };
         let i_ab = i_dq * rot + ineg;
         out.iq.push(i_dq.im + (ineg * rot.conj()).im);

@@ -41,7 +41,7 @@ struct StatMachine<'a> {
     /// The shaft's extra torques and the sample they are taken at.
     shaft: &'a Shaft,
     k: usize,
-    /// An unequal stator winding (the terminal current is `A i'`, see
+    /// Shorted turns (the terminal current adds the loop's, see
     /// [`WindingAsymmetry`]).
     wind: Option<WindingAsymmetry>,
     /// An unequal rotor cage.
@@ -153,13 +153,10 @@ impl StatMachine<'_> {
         }
         let dpsi = q + C64::new(0.0, wr) * x.psi;
         let te = 1.5 * self.np * (x.psi.conj() * x.i).im;
-        // Stator: L_sigma di/dt = v - Rs i - dpsi_R/dt (with the winding: A v - Rs A i).
-        let (v, ri) = match &self.wind {
-            Some(w) => (w.apply(v), w.apply(x.i) * m.rs),
-            None => (v, x.i * m.rs),
-        };
+        // Stator: L_sigma di/dt = v - Rs i - dpsi_R/dt (shorted turns leave the machine
+        // symmetric: their loop is drawn at the terminals).
         StatState {
-            i: (v - ri - dpsi) / m.l_sigma.max(1e-9),
+            i: (v - x.i * m.rs - dpsi) / m.l_sigma.max(1e-9),
             psi: dpsi,
             wm: (te - self.mech.btot * x.wm - self.shaft.extra_nm(self.k, x.wm)) / self.mech.j,
         }
@@ -176,12 +173,8 @@ impl StatMachine<'_> {
             ri += (ri + u * ri.conj()) * c.d3;
         }
         let te = 1.5 * self.np * (x.psi * i_r.conj()).im;
-        let u_s = match &self.wind {
-            Some(w) => w.apply(v - i_s * self.m.rs),
-            None => v - i_s * self.m.rs,
-        };
         StatState {
-            i: u_s,
+            i: v - i_s * self.m.rs,
             psi: C64::new(0.0, wr) * x.psi - ri,
             wm: (te - self.mech.btot * x.wm - self.shaft.extra_nm(self.k, x.wm)) / self.mech.j,
         }
@@ -206,12 +199,13 @@ impl StatMachine<'_> {
         }
     }
 
-    /// The terminal current of the state (the winding's `A i'`).
+    /// The terminal current of the state with the stator voltage `v` (the shorted loop's
+    /// current on top of the machine's, [`WindingAsymmetry::loop_current`]).
     #[inline(always)]
-    fn terminal(&self, x: &StatState) -> C64 {
+    fn terminal(&self, x: &StatState, v: C64) -> C64 {
         let i = self.current(x);
         match &self.wind {
-            Some(w) => w.apply(i),
+            Some(w) => i + w.loop_current(v),
             None => i,
         }
     }
@@ -405,7 +399,7 @@ impl StatForm<'_> {
                 .copied()
                 .unwrap_or_default(),
         };
-        let mut i_out = sm.terminal(x);
+        let mut i_out = sm.terminal(x, self.volt.v_at(k));
         let g = t.magnetising.core_loss_s;
         if g != 0.0 {
             let psi_s = sm.stator_flux(x);
@@ -442,8 +436,8 @@ impl StatForm<'_> {
             // The measured currents before the block mean, as the model's.
             let gain = |k: usize| volt.gains[k];
             let i_meas = |k: usize| d.i_ab[k] - d.i_neg[k];
-            let target = i_meas(k + 1) / gain(k + 1) - (i_meas(k) / gain(k) - sm.terminal(x));
-            let (early_i, late_i) = (sm.terminal(&early), sm.terminal(&late));
+            let target = i_meas(k + 1) / gain(k + 1) - (i_meas(k) / gain(k) - sm.current(x));
+            let (early_i, late_i) = (sm.current(&early), sm.current(&late));
             let span = late_i - early_i;
             let phi = if span.norm_sqr() > 0.0 {
                 ((target - early_i) * span.conj()).re / span.norm_sqr()

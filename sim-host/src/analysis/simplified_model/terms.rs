@@ -241,35 +241,33 @@ impl ModelTerms {
     }
 }
 
-/// An unequal stator winding in the two forms of the model.
+/// Shorted turns in one stator phase in the two forms of the model.
 ///
 /// Reduced model: the steady-state description `i_neg = c conj(i_pos)` (`c` from the
-/// measured positive-sequence current). Full-order model: the simulator's winding (see
-/// `crate::sim`'s machine: a fraction mu of phase k's turns shorted, stator turns matrix
-/// T = I - (2/3) mu u_k u_k^T). In the winding's MMF variables i' = T i the machine is the
-/// symmetric one driven by T^-1 v with the stator resistance Rs T^-1, and the terminal
-/// current is T^-1 i'. T^-1 = I + k u_k u_k^T, k = (2/3) mu / (1 - (2/3) mu), acts on a
-/// complex vector z as `A z = (1 + |e|) z + e conj(z)`, e = (k/2) e^{j 2 th_k}:
+/// measured positive-sequence current). Full-order model: the simulator's turn fault (see
+/// `crate::sim`'s machine; Tallam, Habetler, Harley, IEEE Trans. Ind. Appl. 38(3), 2002): the
+/// machine stays the symmetric one and the terminals draw the shorted loop's current on
+/// top, `(2/3) mu i_f u_k` with `i_f = (u_k . v) / R_f` (the loop's time constant is tens of
+/// microseconds, far below a working sample). As a complex vector that is
 /// ```text
-///   L_sigma di'/dt = A v - Rs A i' - dpsi_R/dt,   i_terminal = A i'
+///   i_loop = |y| v + y conj(v),   y = (mu / (3 R_f)) e^{j 2 th_k}
 /// ```
-/// To first order in e, in steady state at slip s the terminal current's negative sequence
-/// is `c conj(i_pos)` with `c = e conj((Z1 + Z2 - Rs) / Z2)` (Z1, Z2 the positive- and
-/// negative-sequence impedances): the effect fits `c` in both forms and converts it with
-/// that factor at the log's mean operating point, so that the fitted value means the same.
+/// whose negative sequence is `y conj(Z1) conj(i_pos)`: the effect fits `c` in both forms
+/// and converts it with `y = c / conj(Z1)` (Z1 the positive-sequence impedance at the log's
+/// mean operating point), so that the fitted value means the same.
 #[derive(Debug, Clone, Copy)]
 pub struct WindingAsymmetry {
     /// The steady-state ratio i_neg / conj(i_pos) [-].
     pub c: C64,
-    /// The full-order operator's coefficient `e` [-].
-    pub e: C64,
+    /// The full-order loop admittance `y` [S].
+    pub y: C64,
 }
 
 impl WindingAsymmetry {
-    /// The operator `A z = (1 + |e|) z + e conj(z)` (T^-1 of the stator turns matrix).
+    /// The shorted loop's terminal current for the stator voltage `v` [A].
     #[inline(always)]
-    pub(super) fn apply(&self, z: C64) -> C64 {
-        z * (1.0 + self.e.norm()) + self.e * z.conj()
+    pub(super) fn loop_current(&self, v: C64) -> C64 {
+        v * self.y.norm() + self.y * v.conj()
     }
 
     /// The reduced model's negative-sequence current at sample `k` of `d`.

@@ -255,9 +255,9 @@ fn render_candidates(frame: &mut Frame, area: Rect, s: Option<&Snapshot>) {
         ));
     }
     if let Some(a) = &s.asymmetry {
-        let size = a
-            .winding_change
-            .map_or(String::new(), |w| format!(", winding {:+.1} %", -w * 100.0));
+        let size = a.min_shorted_fraction.map_or(String::new(), |w| {
+            format!(", >= {:.1} % of turns", w * 100.0)
+        });
         lines.push(Line::from(format!(
             " asymmetry: phase {} (|I2/I1| {:.1} %{size})",
             a.phase.name(),

@@ -1,0 +1,338 @@
+//! Shorted turns as they are: the simulator's turn-fault loop (Tallam, Habetler, Harley,
+//! IEEE Trans. Ind. Appl. 38(3), 2002) against a phasor solution written here, and the
+//! faulty phase named from the negative-sequence change on three motors, no load and full
+//! load, 1-3 % supply unbalance: currents only at 1 kHz against a healthy recording, and
+//! 10 kHz with voltages. A healthy recording against another names no phase, nor does a
+//! 1 % gain mismatch of two current sensors.
+
+use monitor_core::Phase;
+use rayon::prelude::*;
+use sim_host::params::ParamFile;
+use sim_host::replay::{diagnose_rows, ReplayOptions, UnbalanceReport};
+use sim_host::sim::{
+    simulate_to_vec, simulate_with_truth, EffectSpec, LoadKind, LoadSpec, Scenario, SensorSpec,
+};
+use std::f64::consts::{PI, TAU};
+
+/// A made-up 11 kW, 400 V, 50 Hz, 4-pole machine with textbook per-unit values (the
+/// workspace's reference motors are 2.2 kW and 3 hp; the method was not tuned on this one).
+fn motor_11kw() -> ParamFile {
+    ParamFile::from_toml_str(
+        "[motor]\nrs_ohm = 0.38\nrr_ohm = 0.35\nls_h = 0.0935\nlr_h = 0.0935\nlm_h = 0.09\npoles = 4\nj_kgm2 = 0.09\nb_nms = 0.01\nbl_nms = 0.45\n[supply]\nv_ll_rms = 400.0\nf_hz = 50.0\n",
+        "11 kW test machine",
+    )
+    .expect("11 kW parameters") // ok: test
+}
+
+/// The three motors with their rated torque [N m].
+fn motors() -> [(ParamFile, f64, &'static str); 3] {
+    [
+        (ParamFile::reference_3hp(), 12.5, "3 hp"),
+        (ParamFile::reference_2p2kw(), 14.6, "2.2 kW"),
+        (motor_11kw(), 72.0, "11 kW"),
+    ]
+}
+
+type C = (f64, f64);
+fn mul(a: C, b: C) -> C {
+    (a.0 * b.0 - a.1 * b.1, a.0 * b.1 + a.1 * b.0)
+}
+fn div(a: C, b: C) -> C {
+    let d = b.0 * b.0 + b.1 * b.1;
+    ((a.0 * b.0 + a.1 * b.1) / d, (a.1 * b.0 - a.0 * b.1) / d)
+}
+fn add(a: C, b: C) -> C {
+    (a.0 + b.0, a.1 + b.1)
+}
+
+/// The T-equivalent circuit's impedance per phase at slip `s` (textbook).
+fn z_t(p: &ParamFile, we: f64, s: f64) -> C {
+    let m = &p.motor;
+    let (lls, llr) = (m.ls_h - m.lm_h, m.lr_h - m.lm_h);
+    let zm = (0.0, we * m.lm_h);
+    let zr = (m.rr_ohm / s, we * llr);
+    add((m.rs_ohm, we * lls), div(mul(zm, zr), add(zm, zr)))
+}
+
+/// The symmetrical components I1, I2 (phase peak, complex) of the last `periods` supply
+/// periods of three phase currents sampled at `dt`.
+fn sequences(i_abc: &[[f64; 3]], dt: f64, f: f64, periods: f64) -> (C, C) {
+    let n = (periods / f / dt).round() as usize;
+    let rows = &i_abc[i_abc.len() - n..];
+    let t0 = (i_abc.len() - n) as f64 * dt;
+    let mut ph = [(0.0, 0.0); 3];
+    for (k, r) in rows.iter().enumerate() {
+        let th = TAU * f * (t0 + k as f64 * dt);
+        for j in 0..3 {
+            ph[j].0 += 2.0 * r[j] * th.cos() / n as f64;
+            ph[j].1 -= 2.0 * r[j] * th.sin() / n as f64;
+        }
+    }
+    let a = (-0.5, 3f64.sqrt() / 2.0);
+    let a2 = (-0.5, -(3f64.sqrt()) / 2.0);
+    let third = |x: C| (x.0 / 3.0, x.1 / 3.0);
+    let i1 = third(add(add(ph[0], mul(a, ph[1])), mul(a2, ph[2])));
+    let i2 = third(add(add(ph[0], mul(a2, ph[1])), mul(a, ph[2])));
+    (i1, i2)
+}
+
+#[test]
+fn the_simulated_turn_fault_draws_the_negative_sequence_of_its_phasor_solution() {
+    // With V_k = V1 a^-k the loop draws I_f = V_k / Z_f, Z_f = Rs (1 - 2mu/3) + r_f/mu +
+    // j we mu Lls/3, whose sequences add (mu/3) I_f a^k... to the machine's V1/Z1:
+    // I2/I1 = r a^k / (1 + r), r = (mu/3) Z1/Z_f, Z1 at the run's own slip. Magnitude within
+    // 3 %, angle within 2 degrees, every phase.
+    let mut failures = Vec::new();
+    for (p, rated, name) in motors() {
+        for (k, phase) in Phase::ALL.into_iter().enumerate() {
+            let (mu, rf) = ([0.03, 0.06, 0.1][k], [0.5, 1.0, 2.0][k] * p.motor.rs_ohm);
+            let mut sc = Scenario::steady(3.0, 10_000.0);
+            sc.load = LoadSpec {
+                kind: LoadKind::Torque,
+                torque_nm: Some(0.5 * rated),
+                bl_nms: None,
+                steps: vec![],
+            };
+            sc.effects.push(EffectSpec::PhaseAsymmetry {
+                phase,
+                fraction: mu,
+                fault_resistance_ohm: Some(rf),
+            });
+            let mut i = Vec::new();
+            let mut w = Vec::new();
+            simulate_with_truth(&p, &sc, |_, t| {
+                i.push(t.i_abc);
+                w.push(t.wm_rad_s);
+            })
+            .expect("simulate"); // ok: test
+            let f = p.supply.f_hz;
+            let we = TAU * f;
+            let (i1, i2) = sequences(&i, 1e-4, f, 20.0);
+            let wm = w.iter().rev().take(2000).sum::<f64>() / 2000.0;
+            let np = f64::from(p.motor.poles) / 2.0;
+            let s = 1.0 - np * wm / we;
+            let lls = p.motor.ls_h - p.motor.lm_h;
+            let rs = p.motor.rs_ohm;
+            let zf = (rs * (1.0 - 2.0 * mu / 3.0) + rf / mu, we * mu * lls / 3.0);
+            let ak = ((k as f64 * TAU / 3.0).cos(), (k as f64 * TAU / 3.0).sin());
+            // The loop's own positive sequence adds (mu/3) V1/Z_f to I1.
+            let r0 = mul((mu / 3.0, 0.0), div(z_t(&p, we, s), zf));
+            let want = div(mul(r0, ak), add((1.0, 0.0), r0));
+            let got = div(i2, i1);
+            let (mg, mw) = (got.0.hypot(got.1), want.0.hypot(want.1));
+            let dang =
+                ((got.1.atan2(got.0) - want.1.atan2(want.0) + 3.0 * PI) % TAU - PI).to_degrees();
+            eprintln!(
+                "{name} phase {}: |I2/I1| {mg:.5} (phasor {mw:.5}), angle off {dang:.2} deg",
+                phase.name()
+            );
+            if (mg / mw - 1.0).abs() > 0.03 || dang.abs() > 2.0 {
+                failures.push(format!("{name} {}: {got:?} vs {want:?}", phase.name()));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// One recording: `load_nm`, a supply with `unbalance` of its positive sequence at
+/// `angle_deg`, shorted turns `short` (phase, mu, r_f over Rs) or none, at `rate_hz`, with
+/// or without the voltage columns (never a speed column: a field recording of currents).
+struct Case {
+    load_nm: f64,
+    unbalance: f64,
+    angle_deg: f64,
+    short: Option<(Phase, f64, f64)>,
+    rate_hz: f64,
+    voltages: bool,
+    seed: u64,
+    /// Current-sensor gain errors of phases a, b (a mismatch between channels).
+    gains: [f64; 2],
+}
+
+fn record(p: &ParamFile, c: &Case) -> (Vec<sim_host::log::Row>, SensorSpec) {
+    let mut sc = Scenario::steady(4.0, c.rate_hz);
+    sc.seed = c.seed;
+    sc.sensors = SensorSpec {
+        voltages: c.voltages,
+        speed: false,
+        encoder: false,
+        ..SensorSpec::default()
+    };
+    sc.load = LoadSpec {
+        kind: LoadKind::Torque,
+        torque_nm: Some(c.load_nm),
+        bl_nms: None,
+        steps: vec![],
+    };
+    if c.unbalance > 0.0 {
+        sc.effects.push(EffectSpec::SupplyUnbalance {
+            fraction: c.unbalance,
+            angle_deg: c.angle_deg,
+        });
+    }
+    if let Some((phase, mu, rf_over_rs)) = c.short {
+        sc.effects.push(EffectSpec::PhaseAsymmetry {
+            phase,
+            fraction: mu,
+            fault_resistance_ohm: Some(rf_over_rs * p.motor.rs_ohm),
+        });
+    }
+    for (phase, g) in [Phase::A, Phase::B].into_iter().zip(c.gains) {
+        if g != 0.0 {
+            let mut f =
+                sim_host::sim::FaultSpec::sensor_gain(monitor_core::Fault::CurrentSensor, 0.0, g);
+            f.phase = Some(phase);
+            sc.faults.push(f);
+        }
+    }
+    let rows = simulate_to_vec(p, &sc).expect("simulate"); // ok: test
+    (rows, sc.sensors)
+}
+
+fn judge(p: &ParamFile, c: &Case, baseline: Option<&UnbalanceReport>) -> UnbalanceReport {
+    let (rows, sensors) = record(p, c);
+    let opts = ReplayOptions {
+        unbalance_baseline: baseline.map(|b| b.measured),
+        ..ReplayOptions::default()
+    };
+    diagnose_rows(p, sensors.channels(), &rows, opts)
+        .expect("replay") // ok: test
+        .unbalance
+}
+
+#[test]
+fn the_shorted_phase_is_named_against_a_healthy_recording() {
+    // 2-10 % of one phase's turns through 0.05-0.2 Rs (a low-resistance short, as insulation
+    // breakdown makes: the loop draws a few times the rated current), every phase, no load
+    // and full load, on 1-3 % supply unbalance; currents only at 1 kHz and with voltages at 10 kHz; three
+    // motors. The baseline is a healthy recording on the same supply (another noise seed).
+    let mut groups = Vec::new();
+    for (mi, (_, rated, _)) in motors().iter().enumerate() {
+        for (li, load) in [0.0, *rated].into_iter().enumerate() {
+            for (ri, (rate_hz, voltages)) in
+                [(1000.0, false), (10_000.0, true)].into_iter().enumerate()
+            {
+                let g = mi * 4 + li * 2 + ri;
+                let unb = [0.01, 0.02, 0.03][g % 3];
+                let ang = [20.0, 140.0, 250.0, 320.0][g % 4];
+                groups.push((mi, load, unb, ang, rate_hz, voltages));
+            }
+        }
+    }
+    let base = |load_nm, unbalance, angle_deg, rate_hz, voltages, seed| Case {
+        load_nm,
+        unbalance,
+        angle_deg,
+        short: None,
+        rate_hz,
+        voltages,
+        seed,
+        gains: [0.0; 2],
+    };
+    let mut jobs = Vec::new();
+    for (gi, &(mi, load, unb, ang, rate, volt)) in groups.iter().enumerate() {
+        for (k, phase) in Phase::ALL.into_iter().enumerate() {
+            for (j, mu) in [0.02, 0.05, 0.1].into_iter().enumerate() {
+                let rf = [0.05, 0.1, 0.2][(gi + k + j) % 3];
+                jobs.push((gi, mi, Some((phase, mu, rf)), load, unb, ang, rate, volt));
+            }
+        }
+        // A healthy recording against the healthy baseline.
+        jobs.push((gi, mi, None, load, unb, ang, rate, volt));
+    }
+    let baselines: Vec<UnbalanceReport> = groups
+        .par_iter()
+        .map(|&(mi, load, unb, ang, rate, volt)| {
+            let p = &motors()[mi].0;
+            judge(p, &base(load, unb, ang, rate, volt, 101), None)
+        })
+        .collect();
+    let results: Vec<_> = jobs
+        .par_iter()
+        .map(|&(gi, mi, short, load, unb, ang, rate, volt)| {
+            let p = &motors()[mi].0;
+            let c = Case {
+                short,
+                ..base(load, unb, ang, rate, volt, 202 + gi as u64)
+            };
+            (
+                gi,
+                mi,
+                short,
+                load,
+                rate,
+                judge(p, &c, Some(&baselines[gi])),
+            )
+        })
+        .collect();
+    let (mut right, mut shorted, mut failures) = (0, 0, Vec::new());
+    for (gi, mi, short, load, rate, u) in &results {
+        let (_, unb, ang) = (groups[*gi].1, groups[*gi].2, groups[*gi].3);
+        let tag = format!(
+            "{} load {load} N m, supply {unb} at {ang} deg, {rate} Hz, short {short:?}",
+            motors()[*mi].2
+        );
+        eprintln!(
+            "{tag}: suspect {:?} (confidence {:.2}), winding {:.4}, angle {:.1} deg, correction {:.1} deg",
+            u.suspect_phase, u.phase_confidence, u.winding_ratio, u.angle_deg, u.correction_deg
+        );
+        match short {
+            Some((phase, _, _)) => {
+                shorted += 1;
+                if u.suspect_phase == Some(*phase) {
+                    right += 1;
+                } else {
+                    failures.push(format!("{tag}: got {:?}", u.suspect_phase));
+                }
+            }
+            None if u.suspect_phase.is_some() => {
+                failures.push(format!("{tag}: healthy got {:?}", u.suspect_phase))
+            }
+            None => {}
+        }
+    }
+    eprintln!("phase right in {right} of {shorted}");
+    assert!(
+        10 * right >= 9 * shorted,
+        "{right} of {shorted}: {failures:#?}"
+    );
+    // A healthy recording never gets a phase.
+    let healthy_named = failures.iter().filter(|f| f.contains("healthy")).count();
+    assert_eq!(healthy_named, 0, "{failures:#?}");
+}
+
+#[test]
+fn a_one_percent_current_sensor_mismatch_names_no_phase() {
+    // A healthy motor whose current channels a and b differ by 1 % (a +0.5 %, b -0.5 %, and
+    // a +1 % alone), with and without voltages, no baseline; and against a healthy
+    // baseline recorded before the mismatch.
+    let mut failures = Vec::new();
+    for (p, rated, name) in motors() {
+        for (voltages, rate_hz) in [(false, 1000.0), (true, 10_000.0)] {
+            let case = |gains, seed| Case {
+                load_nm: 0.5 * rated,
+                unbalance: 0.0,
+                angle_deg: 0.0,
+                short: None,
+                rate_hz,
+                voltages,
+                seed,
+                gains,
+            };
+            let clean = judge(&p, &case([0.0, 0.0], 5), None);
+            for gains in [[0.005, -0.005], [0.01, 0.0]] {
+                for base in [None, Some(&clean)] {
+                    let u = judge(&p, &case(gains, 6), base);
+                    if u.suspect_phase.is_some() {
+                        failures.push(format!(
+                            "{name}, voltages {voltages}, gains {gains:?}, baseline {}: {:?}",
+                            base.is_some(),
+                            u
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
