@@ -17,7 +17,7 @@
 
 use super::Samples;
 use crate::analysis::lm::LeastSquares;
-use crate::sim::machine::{LoadLaw, Machine, Sym2};
+use crate::sim::machine::{LoadLaw, Machine};
 use nalgebra::Complex;
 
 /// The parameters `identify` varies, physical units. The leakage is the total
@@ -93,7 +93,7 @@ impl Circuit {
         };
         Machine::new(
             self.rs_ohm,
-            Sym2::scalar(1.0),
+            None,
             self.lls(),
             self.llr(),
             self.rr_ohm,
