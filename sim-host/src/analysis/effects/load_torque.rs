@@ -20,15 +20,16 @@ pub struct LoadSegment {
     /// Where the segment starts [s, log time]: the first segment at the first working
     /// sample, the others where their step lies, placed within its working sample.
     pub from_s: f64,
-    /// The segment's mean of the torque balance's residual [N m] (what `load_torque`'s fit
-    /// starts its level from; the load beyond the file's B + Bl).
+    /// The segment's mean of the torque balance's residual with the file's B + Bl [N m]
+    /// (what `load_torque`'s fit starts its level from, with B + Bl at the file's value).
     pub level_nm: f64,
 }
 
-/// The torque balance's residual per working interval `k..k+1` [N m] (length len - 1):
-/// the load torque the shaft's equation asks for,
+/// The torque balance per working interval `k..k+1` (length len - 1): the torque the
+/// shaft's load takes, `T_L + (B + Bl) w_m` [N m], and the interval's mean speed `w_m`
+/// [rad/s],
 /// ```text
-///   T_L = Te - J dw_m/dt - (B + Bl) w_m,   Te = (3/2) Np (Lm/Lr) Im(conj(psi_r) i_s),
+///   T_L + (B + Bl) w_m = Te - J dw_m/dt,   Te = (3/2) Np (Lm/Lr) Im(conj(psi_r) i_s),
 /// ```
 /// with the rotor flux of the current model (stationary frame, driven by the measured
 /// current and speed, the file's Lm, Lr, Rr), `d psi_r/dt = (Lm/tau_r) i_s - (1/tau_r -
@@ -39,7 +40,7 @@ pub struct LoadSegment {
 /// start and after a step, and nothing is low-passed: a step of the load is a step of
 /// this series at its sample. (The paper: "Fault Diagnosis of Induction Motor Using D-Q
 /// Simplified Model and Parity Equations", Energies 2022, 15(22), 8372.)
-fn torque_balance(d: &Prepared, n: &MachineConstants) -> Vec<f64> {
+fn torque_balance(d: &Prepared, n: &MachineConstants) -> Vec<(f64, f64)> {
     let len = d.len().min(d.omega_r.len()).min(d.i_ab.len());
     let h = d.dt_s;
     let tau_r = n.lr_h / n.rr_ohm.max(1e-9);
@@ -60,7 +61,7 @@ fn torque_balance(d: &Prepared, n: &MachineConstants) -> Vec<f64> {
         psi = next;
         let te = kt * (psi_mid.conj() * i_mid).im;
         let (w0, w1) = (d.omega_r[k] / n.np, d.omega_r[k + 1] / n.np);
-        out.push(te - n.j_kgm2 * (w1 - w0) / h - n.btot_nms * 0.5 * (w0 + w1));
+        out.push((te - n.j_kgm2 * (w1 - w0) / h, 0.5 * (w0 + w1)));
     }
     out
 }
@@ -109,12 +110,40 @@ impl SupplySteady {
     }
 }
 
-/// The torque balance's residual ([`torque_balance`]) segmented into constant levels
+/// The viscous coefficient B + Bl [N m s/rad] the torque balance `y = T_L + B w` shows
+/// within the segments `bounds` (the slope of y on w about each segment's means, pooled;
+/// `fallback` where the speed hardly varies within the segments).
+fn viscous_within(yw: &[(f64, f64)], bounds: &[usize], fallback: f64) -> f64 {
+    let (mut sww, mut swy, mut sw2) = (0.0, 0.0, 0.0);
+    for b in bounds.windows(2) {
+        let seg = yw.get(b[0]..b[1]).unwrap_or(&[]);
+        let m = seg.len().max(1) as f64;
+        let (yb, wb) = seg
+            .iter()
+            .fold((0.0, 0.0), |a, (y, w)| (a.0 + y / m, a.1 + w / m));
+        for (y, w) in seg {
+            sww += (w - wb) * (w - wb);
+            swy += (w - wb) * (y - yb);
+            sw2 += w * w;
+        }
+    }
+    // Less than 1 % of the speed's spread varies within the segments: not identified.
+    if sww > 1e-4 * sw2 && sww > 0.0 {
+        swy / sww
+    } else {
+        fallback
+    }
+}
+
+/// The torque balance's residual `T_L` ([`torque_balance`], less a viscous line B w)
+/// segmented into constant levels
 /// ([`crate::analysis::change_point`]: least-squares binary segmentation, at most 6 splits,
 /// each re-optimised between its neighbours; minimum segment 0.1 s or 10 % of the log; a
 /// split must move the level by more than 3 % of the rated torque estimate, and the supply
-/// must hold still around it, [`SupplySteady`]), each split placed within its sample.
-/// Returns the segments in time order: one segment is a log without a load step; empty
+/// must hold still around it, [`SupplySteady`]), each split placed within its sample. B is
+/// the file's B + Bl first, then twice what the torque balance shows within the segments
+/// found ([`viscous_within`]; a torque load replaces the paper's Bl, and a viscous line
+/// left in the residual would read a start as a step). Returns the segments in time order: one segment is a log without a load step; empty
 /// without a speed column or on fewer than 20 samples. The steps are what `load_torque`
 /// fits levels for.
 pub fn load_segments(d: &Prepared, n: &MachineConstants) -> Vec<LoadSegment> {
@@ -122,29 +151,38 @@ pub fn load_segments(d: &Prepared, n: &MachineConstants) -> Vec<LoadSegment> {
     if d.omega_r.len() != len || len < 20 {
         return vec![];
     }
-    let c = Cumulative::new(torque_balance(d, n));
+    let yw = torque_balance(d, n);
+    let residual = |b: f64| Cumulative::new(yw.iter().map(|(y, w)| y - b * w));
     let search = Search {
         min_len: ((0.1 / d.dt_s) as usize).max(len / 10).max(2),
         min_shift: 0.03 * n.torque_scale_nm,
         max_splits: 6,
     };
     let steady = SupplySteady::new(d, (search.min_len / 2).max(1));
-    let cuts = c.splits(&search, &|k| steady.at(k));
-    let mut bounds = vec![0];
-    bounds.extend(&cuts);
-    bounds.push(c.len());
+    let bounds_of = |c: &Cumulative| {
+        let mut b = vec![0];
+        b.extend(c.splits(&search, &|k| steady.at(k)));
+        b.push(c.len());
+        b
+    };
+    let mut c = residual(n.btot_nms);
+    let mut bounds = bounds_of(&c);
+    for _ in 0..2 {
+        c = residual(viscous_within(&yw, &bounds, n.btot_nms));
+        bounds = bounds_of(&c);
+    }
+    let file_b = residual(n.btot_nms);
     bounds
         .windows(2)
         .enumerate()
         .map(|(i, w)| {
-            let level_nm = c.mean(w[0], w[1]);
             let within = match i {
                 0 => 0.0,
-                _ => c.within_sample(w[0], c.mean(bounds[i - 1], w[0]), level_nm),
+                _ => c.within_sample(w[0], c.mean(bounds[i - 1], w[0]), c.mean(w[0], w[1])),
             };
             LoadSegment {
                 from_s: d.t_s[w[0]] + within * d.dt_s,
-                level_nm,
+                level_nm: file_b.mean(w[0], w[1]),
             }
         })
         .collect()
