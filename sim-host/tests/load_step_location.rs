@@ -120,7 +120,7 @@ fn true_time(t: f64) -> f64 {
 
 /// Two load steps at times on no grid of the log (1.2345 s and 2.7182 s; the simulator
 /// applies a step at its first output sample at or after the time), the whole log with its
-/// start: each step found within 2 ms. A torque load without steps: no step.
+/// start: each step found within 2 ms. A torque load without steps: no step, one level.
 #[test]
 fn steps_off_any_grid_are_found_to_the_sample() {
     let truth = motor("2p2");
@@ -132,13 +132,14 @@ fn steps_off_any_grid_are_found_to_the_sample() {
     for (s, (t, _)) in seg[1..].iter().zip(STEPS) {
         assert!((s.from_s - true_time(t)).abs() <= 0.002, "{s:?} vs {t}");
     }
-    // No step in the log: none placed, and `load_torque` says there is nothing to fit.
+    // No step in the log: none placed; `load_torque` fits one constant level.
     let (_dir0, log0) = project_log(&[]);
     let a0 = analyse(&log0, &truth, f64::NEG_INFINITY);
     assert_eq!(segments(&a0).len(), 1, "{:?}", segments(&a0));
-    assert!(model_of(EffectKind::LoadTorque)
+    let setup = model_of(EffectKind::LoadTorque)
         .setup(&a0.data, &a0.constants)
-        .is_err());
+        .unwrap();
+    assert_eq!(setup.len(), 1, "{:?}", setup.params);
 }
 
 /// The sizes of the two steps above from the fit (full-order model and `load_torque`,

@@ -231,8 +231,10 @@ impl EffectModel for LoadTorque {
             });
         }
         let segments = load_segments(d, n);
-        if segments.len() < 2 {
-            return Err(SetupError::NothingToFit("no change of load torque found in the log: a constant load torque is the same equation as coulomb_friction at positive speed, so it is left to that effect"));
+        if segments.is_empty() {
+            return Err(SetupError::NothingToFit(
+                "the log is too short for a torque balance (fewer than 20 samples)",
+            ));
         }
         let t = n.torque_scale_nm;
         let r = plausible::LOAD_RATIO;
