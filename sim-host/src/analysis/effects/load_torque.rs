@@ -46,10 +46,10 @@ fn torque_balance(d: &Prepared, n: &MachineConstants) -> Vec<(f64, f64)> {
     let tau_r = n.lr_h / n.rr_ohm.max(1e-9);
     let kt = 1.5 * n.np * n.lm_h / n.lr_h;
     let mut out = Vec::with_capacity(len.saturating_sub(1));
-    let Some(&i0) = d.i_ab.first() else {
+    let (Some(&i0), Some(&wr0)) = (d.i_ab.first(), d.omega_r.first()) else {
         return out;
     };
-    let slip0 = d.omega_s.first().copied().unwrap_or(0.0) - d.omega_r[0];
+    let slip0 = d.omega_s.first().copied().unwrap_or(0.0) - wr0;
     let mut psi = i0 * n.lm_h / C64::new(1.0, slip0 * tau_r);
     for k in 0..len.saturating_sub(1) {
         let i_mid = 0.5 * (d.i_ab[k] + d.i_ab[k + 1]);
