@@ -36,6 +36,7 @@
 // Sample loops index several parallel series at once; iterators would obscure that.
 #![allow(clippy::needless_range_loop)]
 
+pub mod change_point;
 pub mod compare;
 pub mod effects;
 pub mod explain;

@@ -4,7 +4,8 @@ use super::{
     plausible, About, Confusion, Contribution, EffectModel, Evidence, FitParam, FitSetup, Needs,
     ParamSpec, SetupError, LOAD_STEP_MIN,
 };
-use crate::analysis::prep::Prepared;
+use crate::analysis::change_point::{Cumulative, Search};
+use crate::analysis::prep::{Prepared, C64};
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms};
 use monitor_core::EffectKind;
 
@@ -12,52 +13,57 @@ use monitor_core::EffectKind;
 #[derive(Debug, Clone, Copy)]
 pub struct LoadTorque;
 
-/// A constant level of the torque observer: from `from_s` [s] on, `level_nm` [N m].
+/// A constant level of the load torque the log's torque balance shows ([`load_segments`]):
+/// from `from_s` on, `level_nm`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Segment {
-    from_s: f64,
-    level_nm: f64,
+pub struct LoadSegment {
+    /// Where the segment starts [s, log time]: the first segment at the first working
+    /// sample, the others where their step lies, placed within its working sample.
+    pub from_s: f64,
+    /// The segment's mean of the torque balance's residual with the file's B + Bl [N m]
+    /// (what `load_torque`'s fit starts its level from, with B + Bl at the file's value).
+    pub level_nm: f64,
 }
 
-/// The torque observer's series: Te(measured I_qs, i_f) - J dw_m/dt, low-passed at 10 Hz
-/// (two first-order passes), less the best viscous line c1 w_m through the origin (the
-/// paper's Bl omega; what is left is load torque the viscous model cannot describe), as
-/// a cumulative sum (length len + 1) for the segments' means.
-fn observer_cumsum(d: &Prepared, n: &MachineConstants) -> Vec<f64> {
-    let len = d.len();
-    let dt = d.dt_s;
-    let lmr = n.lm_h * n.lm_h / n.lr_h;
-    let mut obs = Vec::with_capacity(len);
-    let a = 1.0 - (-2.0 * std::f64::consts::PI * 10.0 * dt).exp();
-    let (mut s1, mut s2) = (0.0, 0.0);
-    // (Few series of the log's length: this also runs on the full working series of a long
-    // log, so w_m is recomputed where needed rather than stored.)
-    let w_at = |k: usize| d.omega_r[k] / n.np;
-    let mut wprev = w_at(0);
-    for k in 0..len {
-        let wm = w_at(k);
-        let te = 1.5 * n.np * lmr * d.i_f[k] * d.iq_pos[k];
-        let acc = (wm - wprev) / dt;
-        wprev = wm;
-        let x = te - n.j_kgm2 * acc;
-        if k == 0 {
-            s1 = x;
-            s2 = x;
-        }
-        s1 += a * (x - s1);
-        s2 += a * (s1 - s2);
-        obs.push(s2);
+/// The torque balance per working interval `k..k+1` (length len - 1): the torque the
+/// shaft's load takes, `T_L + (B + Bl) w_m` [N m], and the interval's mean speed `w_m`
+/// [rad/s],
+/// ```text
+///   T_L + (B + Bl) w_m = Te - J dw_m/dt,   Te = (3/2) Np (Lm/Lr) Im(conj(psi_r) i_s),
+/// ```
+/// with the rotor flux of the current model (stationary frame, driven by the measured
+/// current and speed, the file's Lm, Lr, Rr), `d psi_r/dt = (Lm/tau_r) i_s - (1/tau_r -
+/// j omega_r) psi_r`, discretised exactly for the current held at its interval's mean;
+/// dw_m/dt is the interval's difference quotient (its sum over a segment is the speed
+/// change: the segments' means carry no differentiated noise). Unlike the torque of the
+/// paper's constant-flux model (eq. 18, Te from i_f), the current model's holds in a
+/// start and after a step, and nothing is low-passed: a step of the load is a step of
+/// this series at its sample. (The paper: "Fault Diagnosis of Induction Motor Using D-Q
+/// Simplified Model and Parity Equations", Energies 2022, 15(22), 8372.)
+fn torque_balance(d: &Prepared, n: &MachineConstants) -> Vec<(f64, f64)> {
+    let len = d.len().min(d.omega_r.len()).min(d.i_ab.len());
+    let h = d.dt_s;
+    let tau_r = n.lr_h / n.rr_ohm.max(1e-9);
+    let kt = 1.5 * n.np * n.lm_h / n.lr_h;
+    let mut out = Vec::with_capacity(len.saturating_sub(1));
+    let (Some(&i0), Some(&wr0)) = (d.i_ab.first(), d.omega_r.first()) else {
+        return out;
+    };
+    let slip0 = d.omega_s.first().copied().unwrap_or(0.0) - wr0;
+    let mut psi = i0 * n.lm_h / C64::new(1.0, slip0 * tau_r);
+    for k in 0..len.saturating_sub(1) {
+        let i_mid = 0.5 * (d.i_ab[k] + d.i_ab[k + 1]);
+        let wr = 0.5 * (d.omega_r[k] + d.omega_r[k + 1]);
+        let a = C64::new(-1.0 / tau_r, wr);
+        let e = (a * h).exp();
+        let next = e * psi + (e - 1.0) / a * (n.lm_h / tau_r) * i_mid;
+        let psi_mid = 0.5 * (psi + next);
+        psi = next;
+        let te = kt * (psi_mid.conj() * i_mid).im;
+        let (w0, w1) = (d.omega_r[k] / n.np, d.omega_r[k + 1] / n.np);
+        out.push((te - n.j_kgm2 * (w1 - w0) / h, 0.5 * (w0 + w1)));
     }
-    let (sww, swx) = obs.iter().enumerate().fold((0.0, 0.0), |acc, (k, x)| {
-        let w = w_at(k);
-        (acc.0 + w * w, acc.1 + w * x)
-    });
-    let c1 = if sww > 0.0 { swx / sww } else { 0.0 };
-    let mut cum = vec![0.0; len + 1];
-    for k in 0..len {
-        cum[k + 1] = cum[k] + (obs[k] - c1 * w_at(k));
-    }
-    cum
+    out
 }
 
 /// Whether the supply holds still around each split candidate: a load step is a torque
@@ -104,52 +110,80 @@ impl SupplySteady {
     }
 }
 
-/// Torque observer ([`observer_cumsum`]) segmented into constant levels by binary
-/// segmentation (at most 6 splits; minimum segment 0.1 s or 10 % of the log; a split must
-/// move the level by more than 3 % of the rated torque estimate, and the supply must hold
-/// still around it, [`SupplySteady`]). Returns the segments in time order (empty without
-/// a speed column or on fewer than 20 samples).
-fn load_steps(d: &Prepared, n: &MachineConstants) -> Vec<Segment> {
+/// The viscous coefficient B + Bl [N m s/rad] the torque balance `y = T_L + B w` shows
+/// within the segments `bounds` (the slope of y on w about each segment's means, pooled;
+/// `fallback` where the speed hardly varies within the segments).
+fn viscous_within(yw: &[(f64, f64)], bounds: &[usize], fallback: f64) -> f64 {
+    let (mut sww, mut swy, mut sw2) = (0.0, 0.0, 0.0);
+    for b in bounds.windows(2) {
+        let seg = yw.get(b[0]..b[1]).unwrap_or(&[]);
+        let m = seg.len().max(1) as f64;
+        let (yb, wb) = seg
+            .iter()
+            .fold((0.0, 0.0), |a, (y, w)| (a.0 + y / m, a.1 + w / m));
+        for (y, w) in seg {
+            sww += (w - wb) * (w - wb);
+            swy += (w - wb) * (y - yb);
+            sw2 += w * w;
+        }
+    }
+    // Less than 1 % of the speed's spread varies within the segments: not identified.
+    if sww > 1e-4 * sw2 && sww > 0.0 {
+        swy / sww
+    } else {
+        fallback
+    }
+}
+
+/// The torque balance's residual `T_L` ([`torque_balance`], less a viscous line B w)
+/// segmented into constant levels
+/// ([`crate::analysis::change_point`]: least-squares binary segmentation, at most 6 splits,
+/// each re-optimised between its neighbours; minimum segment 0.1 s or 10 % of the log; a
+/// split must move the level by more than 3 % of the rated torque estimate, and the supply
+/// must hold still around it, [`SupplySteady`]), each split placed within its sample. B is
+/// the file's B + Bl first, then twice what the torque balance shows within the segments
+/// found ([`viscous_within`]; a torque load replaces the paper's Bl, and a viscous line
+/// left in the residual would read a start as a step). Returns the segments in time order: one segment is a log without a load step; empty
+/// without a speed column or on fewer than 20 samples. The steps are what `load_torque`
+/// fits levels for.
+pub fn load_segments(d: &Prepared, n: &MachineConstants) -> Vec<LoadSegment> {
     let len = d.len();
     if d.omega_r.len() != len || len < 20 {
         return vec![];
     }
-    let cum = observer_cumsum(d, n);
-    let mean = |a: usize, b: usize| (cum[b] - cum[a]) / (b - a) as f64;
-    let min_len = ((0.1 / d.dt_s) as usize).max(len / 10).max(2);
-    let thresh = 0.03 * n.torque_scale_nm;
-    let steady = SupplySteady::new(d, (min_len / 2).max(1));
-    let mut segs = vec![(0usize, len)];
-    for _ in 0..6 {
-        let mut best: Option<(usize, usize, f64)> = None;
-        for (si, &(a0, b0)) in segs.iter().enumerate() {
-            if b0 - a0 < 2 * min_len {
-                continue;
-            }
-            let step = ((b0 - a0) / 400).max(1);
-            let mut kk = a0 + min_len;
-            while kk <= b0 - min_len {
-                let ml = mean(a0, kk);
-                let mr = mean(kk, b0);
-                let gain = (ml - mr).powi(2) * ((kk - a0) * (b0 - kk)) as f64 / (b0 - a0) as f64;
-                if (ml - mr).abs() > thresh
-                    && best.map(|b| gain > b.2).unwrap_or(true)
-                    && steady.at(kk)
-                {
-                    best = Some((si, kk, gain));
-                }
-                kk += step;
-            }
-        }
-        let Some((si, kk, _)) = best else { break };
-        let (a0, b0) = segs[si];
-        segs[si] = (a0, kk);
-        segs.insert(si + 1, (kk, b0));
+    let yw = torque_balance(d, n);
+    let residual = |b: f64| Cumulative::new(yw.iter().map(|(y, w)| y - b * w));
+    let search = Search {
+        min_len: ((0.1 / d.dt_s) as usize).max(len / 10).max(2),
+        min_shift: 0.03 * n.torque_scale_nm,
+        max_splits: 6,
+    };
+    let steady = SupplySteady::new(d, (search.min_len / 2).max(1));
+    let bounds_of = |c: &Cumulative| {
+        let mut b = vec![0];
+        b.extend(c.splits(&search, &|k| steady.at(k)));
+        b.push(c.len());
+        b
+    };
+    let mut c = residual(n.btot_nms);
+    let mut bounds = bounds_of(&c);
+    for _ in 0..2 {
+        c = residual(viscous_within(&yw, &bounds, n.btot_nms));
+        bounds = bounds_of(&c);
     }
-    segs.iter()
-        .map(|&(a0, b0)| Segment {
-            from_s: d.t_s[a0],
-            level_nm: mean(a0, b0),
+    let file_b = residual(n.btot_nms);
+    bounds
+        .windows(2)
+        .enumerate()
+        .map(|(i, w)| {
+            let within = match i {
+                0 => 0.0,
+                _ => c.within_sample(w[0], c.mean(bounds[i - 1], w[0]), c.mean(w[0], w[1])),
+            };
+            LoadSegment {
+                from_s: d.t_s[w[0]] + within * d.dt_s,
+                level_nm: file_b.mean(w[0], w[1]),
+            }
         })
         .collect()
 }
@@ -163,7 +197,7 @@ struct Steps {
 const ABOUT: About = About {
     kind: EffectKind::LoadTorque,
     description: "The load is a torque imposed by the driven machine (possibly switched in steps), not the paper's viscous Bl*omega.",
-    equations: "J dw_m/dt = Kf I_qs - (B + Bl) w_m - T_L(t), T_L piecewise constant; the step times come from a torque observer on the measured speed and current, the levels are fitted.",
+    equations: "J dw_m/dt = Kf I_qs - (B + Bl) w_m - T_L(t), T_L piecewise constant; the step times come from change-point detection on the torque balance's residual (measured speed and current, current-model rotor flux), placed within their sample; the levels are fitted.",
     parameters: &[ParamSpec {
         name: "level_k",
         unit: "N m",
@@ -196,9 +230,11 @@ impl EffectModel for LoadTorque {
                 because: "the torque observer uses the measured speed",
             });
         }
-        let segments = load_steps(d, n);
-        if segments.len() < 2 {
-            return Err(SetupError::NothingToFit("no change of load torque found in the log: a constant load torque is the same equation as coulomb_friction at positive speed, so it is left to that effect"));
+        let segments = load_segments(d, n);
+        if segments.is_empty() {
+            return Err(SetupError::NothingToFit(
+                "the log is too short for a torque balance (fewer than 20 samples)",
+            ));
         }
         let t = n.torque_scale_nm;
         let r = plausible::LOAD_RATIO;
@@ -223,15 +259,25 @@ impl EffectModel for LoadTorque {
 }
 
 impl Contribution for Steps {
-    /// The piecewise-constant load torque per sample.
+    /// The piecewise-constant load torque per working interval `k..k+1`: the mean over
+    /// the interval, so a step inside an interval counts with the part of it after the
+    /// step.
     fn contribute(&self, p: &[f64], d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
         let from = &self.from_s;
+        let level = |i: usize| p.get(i).copied().unwrap_or(0.0);
+        let h = d.dt_s;
         let mut seg = 0usize;
         t.add_load_torque(d.t_s.iter().map(|&t| {
             while seg + 1 < from.len() && t >= from[seg + 1] {
                 seg += 1;
             }
-            p.get(seg).copied().unwrap_or(0.0)
+            match from.get(seg + 1) {
+                Some(&next) if h > 0.0 && next < t + h => {
+                    let after = (t + h - next) / h;
+                    (1.0 - after) * level(seg) + after * level(seg + 1)
+                }
+                _ => level(seg),
+            }
         }));
     }
     fn describe(&self, p: &[f64], _d: &Prepared, _n: &MachineConstants) -> String {
@@ -239,7 +285,7 @@ impl Contribution for Steps {
             .from_s
             .iter()
             .zip(p)
-            .map(|(t, v)| format!("{v:.2} N m from {t:.2} s"))
+            .map(|(t, v)| format!("{v:.2} N m from {t:.4} s"))
             .collect();
         format!(
             "load behaves as a torque input (on top of the refitted viscous term): {}",

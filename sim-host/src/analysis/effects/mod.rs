@@ -20,7 +20,7 @@
 //! | `iron_loss` | g_fe_s \[S\] (= 1/Rfe) | I_qs += omega_s Ls i_f / Rfe (core-loss current) |
 //! | `coulomb_friction` | torque_nm \[N m\] | load += Tc tanh(w_m / 1 rad/s) |
 //! | `windage` | k_nms2 \[N m s^2/rad^2\] | load += k w_m abs(w_m) |
-//! | `load_torque` | level_1..level_k \[N m\] | load += piecewise-constant T_L(t) (steps found in the data) |
+//! | `load_torque` | level_1..level_k \[N m\] | load += piecewise-constant T_L(t) (steps found in the data to the sample: `crate::analysis::change_point`) |
 //! | `supply_unbalance` | y_re, y_im \[-\] | i_neg = (y_re + j y_im) v_neg / conj(Z2), Z2 from the nominal parameters at the negative-sequence slip 2 - s; full-order: the machine driven by V_pos + y V_neg |
 //! | `phase_asymmetry` | c_re, c_im \[-\] | i_neg = (c_re + j c_im) conj(i_pos); full-order: the unequal winding (`simplified_model::WindingAsymmetry`) |
 //! | `flux_dynamics` | tau_r_s \[s\] | psi_r/Lm = phi, dphi/dt = (i_f - phi)/tau_r; slip and torque from phi |
@@ -61,7 +61,7 @@ pub use d_axis_dynamics::D_AXIS_DYNAMICS;
 pub use flux_dynamics::FluxDynamics;
 pub use impedance::{z1_pos, z2_neg, z2_neg_at};
 pub use iron_loss::IronLoss;
-pub use load_torque::LoadTorque;
+pub use load_torque::{load_segments, LoadSegment, LoadTorque};
 pub use phase_asymmetry::{asymmetry_phase, PhaseAsymmetry};
 pub use rotor_asymmetry::{RotorAsymmetry, DELTA_BASIS, DELTA_RANGE};
 pub use saturation::Saturation;
