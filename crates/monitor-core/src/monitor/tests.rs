@@ -150,3 +150,22 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn a_balanced_machine_has_no_winding_part() {
+    // Balanced voltages and currents: the voltages' negative sequence is nil, and so is the
+    // winding's part of the currents'.
+    for src in [AngleSource::Pll, AngleSource::RotorFluxCurrentModel] {
+        let mut m = monitor(src);
+        let mut o = MonitorOutput::default();
+        for k in 0..40_000 {
+            o = *m.update(&healthy(k));
+        }
+        let u = o.unbalance;
+        assert!(
+            u.negative_sequence_ratio < 0.01 && u.winding_ratio < 0.01,
+            "{src:?}: {u:?}"
+        );
+        assert_eq!(u.suspect_phase, None);
+    }
+}
