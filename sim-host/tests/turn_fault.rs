@@ -33,25 +33,15 @@ fn motors() -> [(ParamFile, f64, &'static str); 3] {
     ]
 }
 
-type C = (f64, f64);
-fn mul(a: C, b: C) -> C {
-    (a.0 * b.0 - a.1 * b.1, a.0 * b.1 + a.1 * b.0)
-}
-fn div(a: C, b: C) -> C {
-    let d = b.0 * b.0 + b.1 * b.1;
-    ((a.0 * b.0 + a.1 * b.1) / d, (a.1 * b.0 - a.0 * b.1) / d)
-}
-fn add(a: C, b: C) -> C {
-    (a.0 + b.0, a.1 + b.1)
-}
+type C = sim_host::analysis::prep::C64;
 
 /// The T-equivalent circuit's impedance per phase at slip `s` (textbook).
 fn z_t(p: &ParamFile, we: f64, s: f64) -> C {
     let m = &p.motor;
     let (lls, llr) = (m.ls_h - m.lm_h, m.lr_h - m.lm_h);
-    let zm = (0.0, we * m.lm_h);
-    let zr = (m.rr_ohm / s, we * llr);
-    add((m.rs_ohm, we * lls), div(mul(zm, zr), add(zm, zr)))
+    let zm = C::new(0.0, we * m.lm_h);
+    let zr = C::new(m.rr_ohm / s, we * llr);
+    C::new(m.rs_ohm, we * lls) + zm * zr / (zm + zr)
 }
 
 /// The symmetrical components I1, I2 (phase peak, complex) of the last `periods` supply
@@ -60,19 +50,16 @@ fn sequences(i_abc: &[[f64; 3]], dt: f64, f: f64, periods: f64) -> (C, C) {
     let n = (periods / f / dt).round() as usize;
     let rows = &i_abc[i_abc.len() - n..];
     let t0 = (i_abc.len() - n) as f64 * dt;
-    let mut ph = [(0.0, 0.0); 3];
+    let mut ph = [C::new(0.0, 0.0); 3];
     for (k, r) in rows.iter().enumerate() {
         let th = TAU * f * (t0 + k as f64 * dt);
         for j in 0..3 {
-            ph[j].0 += 2.0 * r[j] * th.cos() / n as f64;
-            ph[j].1 -= 2.0 * r[j] * th.sin() / n as f64;
+            ph[j] += C::from_polar(2.0 * r[j] / n as f64, -th);
         }
     }
-    let a = (-0.5, 3f64.sqrt() / 2.0);
-    let a2 = (-0.5, -(3f64.sqrt()) / 2.0);
-    let third = |x: C| (x.0 / 3.0, x.1 / 3.0);
-    let i1 = third(add(add(ph[0], mul(a, ph[1])), mul(a2, ph[2])));
-    let i2 = third(add(add(ph[0], mul(a2, ph[1])), mul(a, ph[2])));
+    let a = C::from_polar(1.0, TAU / 3.0);
+    let i1 = (ph[0] + a * ph[1] + a * a * ph[2]) / 3.0;
+    let i2 = (ph[0] + a * a * ph[1] + a * ph[2]) / 3.0;
     (i1, i2)
 }
 
@@ -113,21 +100,20 @@ fn the_simulated_turn_fault_draws_the_negative_sequence_of_its_phasor_solution()
             let s = 1.0 - np * wm / we;
             let lls = p.motor.ls_h - p.motor.lm_h;
             let rs = p.motor.rs_ohm;
-            let zf = (rs * (1.0 - 2.0 * mu / 3.0) + rf / mu, we * mu * lls / 3.0);
-            let ak = ((k as f64 * TAU / 3.0).cos(), (k as f64 * TAU / 3.0).sin());
+            let zf = C::new(rs * (1.0 - 2.0 * mu / 3.0) + rf / mu, we * mu * lls / 3.0);
+            let ak = C::from_polar(1.0, k as f64 * TAU / 3.0);
             // The loop's own positive sequence adds (mu/3) V1/Z_f to I1.
-            let r0 = mul((mu / 3.0, 0.0), div(z_t(&p, we, s), zf));
-            let want = div(mul(r0, ak), add((1.0, 0.0), r0));
-            let got = div(i2, i1);
-            let (mg, mw) = (got.0.hypot(got.1), want.0.hypot(want.1));
-            let dang =
-                ((got.1.atan2(got.0) - want.1.atan2(want.0) + 3.0 * PI) % TAU - PI).to_degrees();
+            let r0 = z_t(&p, we, s) / zf * (mu / 3.0);
+            let want = r0 * ak / (1.0 + r0);
+            let got = i2 / i1;
+            let (mg, mw) = (got.norm(), want.norm());
+            let dang = ((got.arg() - want.arg() + 3.0 * PI) % TAU - PI).to_degrees();
             eprintln!(
                 "{name} phase {}: |I2/I1| {mg:.5} (phasor {mw:.5}), angle off {dang:.2} deg",
                 phase.name()
             );
             if (mg / mw - 1.0).abs() > 0.03 || dang.abs() > 2.0 {
-                failures.push(format!("{name} {}: {got:?} vs {want:?}", phase.name()));
+                failures.push(format!("{name} {}: {got} vs {want}", phase.name()));
             }
         }
     }
@@ -136,7 +122,8 @@ fn the_simulated_turn_fault_draws_the_negative_sequence_of_its_phasor_solution()
 
 /// One recording: `load_nm`, a supply with `unbalance` of its positive sequence at
 /// `angle_deg`, shorted turns `short` (phase, mu, r_f over Rs) or none, at `rate_hz`, with
-/// or without the voltage columns (never a speed column: a field recording of currents).
+/// or without the voltage columns, with the shaft measured (`shaft`) or not (a field
+/// recording of currents).
 struct Case {
     load_nm: f64,
     unbalance: f64,
