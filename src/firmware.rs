@@ -6,9 +6,11 @@
 //!   of [`SETTINGS`]; each ADC fills a DMA ring of two samples, so every sample wakes the
 //!   task (half- and full-transfer interrupts). The task reads the encoder counter (TIM4)
 //!   and runs `SamplePath::on_frame` (scaling and `Monitor::update`). Every wait for ADC
-//!   data has a timeout ([`AdcWait`]): when it expires the acquisition is restarted.
-//!   Overruns (the DMA lapped the reader) are counted, logged, and the two rings are
-//!   resynchronised with the trigger stopped. Every `status_every` samples the task hands
+//!   data has a timeout ([`AdcWait`]): when it expires (an ADC overrun, a DMA transfer
+//!   error, a stopped trigger) or the DMA lapped the reader, the acquisition is recovered
+//!   by `drive_monitor::recovery::recover` on the registers (`firmware/acquisition.rs`):
+//!   trigger, ADCs and DMA stopped, `OVR` and `TEIF` cleared, DMA re-armed, ADCs and
+//!   trigger restarted, in the reference manual's order. Every `status_every` samples the task hands
 //!   thread mode a small `MonitorStatus`.
 //! - `main` in thread mode: boot (clocks, watchdog, why the previous run ended, flash
 //!   record), then every 50 ms `Supervisor::tick`: button, commissioning procedure, the
@@ -21,8 +23,10 @@
 //! Communication: `COMMANDS` (Channel, thread -> sample task), `STATUS` (Signal, latest
 //! status, sample task -> thread, 100 Hz).
 
+mod acquisition;
+
 use core::mem::MaybeUninit;
-use core::sync::atomic::{AtomicU32, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
 
 use defmt::{error, info, warn};
 use defmt_rtt as _;
@@ -52,10 +56,15 @@ use drive_monitor::flash_record::{self, LoadError, RecordStore, StoreError, RECO
 use drive_monitor::liveness::{AdcWait, LivenessChange};
 use drive_monitor::motor_source;
 use drive_monitor::panel::PanelLamps;
-use drive_monitor::reset_record::{PreviousRun, ResetCause, ResetRecord, RESET_RECORD_LEN};
+use drive_monitor::recovery::{self, RecoveryCounts, StepTimeout};
+use drive_monitor::reset_record::{
+    Phase, PreviousRun, ResetCause, ResetRecord, ResetSource, RESET_RECORD_LEN,
+};
 use drive_monitor::sampling::RawFrame;
 use monitor_core::motor_record::STORED_LEN as MOTOR_RECORD_LEN;
 use monitor_core::Isolation;
+
+use acquisition::HwAcquisition;
 
 bind_interrupts!(struct Irqs {
     DMA1_CHANNEL1 => dma::InterruptHandler<peripherals::DMA1_CH1>;
@@ -92,6 +101,14 @@ static STATUS: Signal<CriticalSectionRawMutex, Status> = Signal::new();
 static OVERRUNS: AtomicU32 = AtomicU32::new(0);
 static RESTARTS: AtomicU32 = AtomicU32::new(0);
 static EXECUTOR_HIGH: InterruptExecutor = InterruptExecutor::new();
+/// What the firmware is doing ([`Phase::number`]), for the record of a `defmt` panic.
+static PHASE: AtomicU8 = AtomicU8::new(0);
+/// The independent watchdog runs (else the panic handler resets the MCU itself).
+static WATCHDOG_RUNNING: AtomicBool = AtomicBool::new(false);
+
+fn set_phase(phase: Phase) {
+    PHASE.store(phase.number(), Ordering::Relaxed);
+}
 
 /// The reset record: RAM in cortex-m-rt's `.uninit` section, which the start-up code
 /// neither zeroes nor initialises, so it keeps its content across a reset.
@@ -146,45 +163,13 @@ struct SampleHw {
     enc_b: Peri<'static, peripherals::PB7>,
 }
 
-fn now_us() -> u32 {
-    Instant::now().as_micros() as u32
-}
-
-/// The acquisition: trigger timer and the two ring-buffered ADCs.
-struct Acquisition {
-    trigger: HwTimer<'static, peripherals::TIM1>,
-    adc1: RingBufferedAdc<'static, peripherals::ADC1>,
-    adc2: RingBufferedAdc<'static, peripherals::ADC2>,
-}
-
-impl Acquisition {
-    /// Restarts both rings with the trigger stopped, so that ADC1 and ADC2 start again on
-    /// the same conversion, and continues the timestamps from now (the gap shows).
-    async fn restart(&mut self, path: &mut SamplePath, stop_dma: bool) {
-        self.trigger.stop();
-        if stop_dma {
-            self.adc1.stop();
-            self.adc2.stop();
-        }
-        Timer::after_micros(20).await;
-        self.adc1.clear();
-        self.adc2.clear();
-        if stop_dma {
-            self.adc1.start();
-            self.adc2.start();
-        }
-        path.sampler_mut().resync(now_us());
-        self.trigger.start();
-    }
-}
-
 /// Starts the acquisition: the encoder (TIM4 in quadrature mode), the trigger (TIM1 update
 /// -> TRGO at the sample rate) and the two ring-buffered ADCs (ADC1 the voltages, ADC2 the
 /// currents), then the trigger, the timestamps continuing from now.
 fn start_acquisition(
     hw: SampleHw,
     path: &mut SamplePath,
-) -> (Qei<'static, peripherals::TIM4>, Acquisition) {
+) -> (Qei<'static, peripherals::TIM4>, HwAcquisition) {
     static RING1: static_cell::StaticCell<[u16; RING_LEN]> = static_cell::StaticCell::new();
     static RING2: static_cell::StaticCell<[u16; RING_LEN]> = static_cell::StaticCell::new();
     let ring1 = RING1.init([0; RING_LEN]);
@@ -227,15 +212,9 @@ fn start_acquisition(
         triggers::TIM1_TRGO,
         Exten::RISING_EDGE,
     );
-    let mut acq = Acquisition {
-        trigger,
-        adc1,
-        adc2,
-    };
-    acq.adc1.start();
-    acq.adc2.start();
-    path.sampler_mut().resync(now_us());
-    acq.trigger.start();
+    let mut acq = HwAcquisition::new(trigger, adc1, adc2, RING_LEN as u16);
+    acq.start();
+    path.sampler_mut().resync(acq.started_us);
     (qei, acq)
 }
 
@@ -273,7 +252,13 @@ fn process_half(
 
 #[embassy_executor::task]
 async fn sample_task(hw: SampleHw, mut path: SamplePath) {
+    // The HAL's ADC set-up waits on registers without a bound (power-up, calibration,
+    // ADRDY, ADSTART): the record says so if the watchdog has to end it.
+    set_phase(Phase::AdcSetup);
+    write_reset_record(&ResetRecord::setup(Phase::AdcSetup).encode());
     let (qei, mut acq) = start_acquisition(hw, &mut path);
+    write_reset_record(&[0; RESET_RECORD_LEN]);
+    set_phase(Phase::Sampling);
     info!("sampling at {=u32} Hz", SETTINGS.sample_rate_hz);
 
     let mut wait = AdcWait::new(SETTINGS.sample_rate_hz);
@@ -281,6 +266,7 @@ async fn sample_task(hw: SampleHw, mut path: SamplePath) {
     let mut half1 = [0u16; SAMPLES_PER_HALF * CHANNELS];
     let mut half2 = [0u16; SAMPLES_PER_HALF * CHANNELS];
     let mut max_cycles: u32 = 0;
+    let mut counts = RecoveryCounts::default();
     loop {
         let read = with_timeout(timeout, async {
             let r1 = acq.adc1.read(&mut half1).await;
@@ -288,30 +274,60 @@ async fn sample_task(hw: SampleHw, mut path: SamplePath) {
             (r1.is_ok(), r2.is_ok())
         })
         .await;
-        let Ok((ok1, ok2)) = read else {
-            // No data within the timeout: the DMA or the trigger stalled. Restart the
-            // acquisition (thread mode shows the stall and stops petting the watchdog
-            // until samples flow again).
-            let restart = wait.timed_out();
-            RESTARTS.fetch_add(1, Ordering::Relaxed);
-            if restart.log {
-                error!(
-                    "no ADC data for {=u32} us: restarting sampling (attempt {=u32})",
-                    wait.timeout_us(),
-                    restart.attempt
-                );
+        let lapped = match read {
+            Ok((ok1, ok2)) => {
+                if let Some(n) = wait.data() {
+                    warn!("sampling resumed after {=u32} recoveries", n);
+                }
+                if !(ok1 && ok2) {
+                    // The DMA lapped the reader: samples were lost.
+                    let n = OVERRUNS.fetch_add(1, Ordering::Relaxed) + 1;
+                    warn!(
+                        "ADC DMA ring lapped #{=u32} (adc1 {} adc2 {})",
+                        n, !ok1, !ok2
+                    );
+                }
+                !(ok1 && ok2)
             }
-            acq.restart(&mut path, true).await;
-            continue;
+            Err(_) => {
+                // No data within the timeout: an ADC overrun, a DMA error, or a stopped
+                // trigger (thread mode shows a stall and stops petting the watchdog until
+                // samples flow again).
+                let restart = wait.timed_out();
+                RESTARTS.fetch_add(1, Ordering::Relaxed);
+                if restart.log {
+                    error!(
+                        "no ADC data for {=u32} us: recovering the acquisition (attempt {=u32})",
+                        wait.timeout_us(),
+                        restart.attempt
+                    );
+                }
+                true
+            }
         };
-        if let Some(n) = wait.data() {
-            warn!("sampling resumed after {=u32} restarts", n);
-        }
-        if !(ok1 && ok2) {
-            // Samples were lost: count, log, resynchronise both rings.
-            let n = OVERRUNS.fetch_add(1, Ordering::Relaxed) + 1;
-            warn!("ADC DMA overrun #{=u32} (adc1 {} adc2 {})", n, !ok1, !ok2);
-            acq.restart(&mut path, false).await;
+        if lapped {
+            // One sequence for every cause (drive_monitor::recovery): trigger, ADCs and
+            // DMA stopped, OVR and TEIF cleared, DMA re-armed, ADCs and trigger restarted;
+            // the timestamps continue from the restart (the gap shows).
+            set_phase(Phase::Recovery);
+            let result = recovery::recover(&mut acq);
+            path.sampler_mut().resync(acq.started_us);
+            set_phase(Phase::Sampling);
+            counts.count(result);
+            match result {
+                Ok(f) if f.adc_overrun || f.dma_error => warn!(
+                    "acquisition recovered: adc overrun {=bool}, dma error {=bool} (recoveries {=u32}, overruns {=u32}, dma errors {=u32})",
+                    f.adc_overrun,
+                    f.dma_error,
+                    counts.recoveries,
+                    counts.adc_overruns,
+                    counts.dma_errors
+                ),
+                Ok(_) => {}
+                Err(StepTimeout(step)) => {
+                    error!("acquisition recovery stopped at {=str}: timed out", step.name())
+                }
+            }
             continue;
         }
         while let Ok(cmd) = COMMANDS.try_receive() {
@@ -342,20 +358,45 @@ impl PanelPins {
     }
 }
 
-/// The record page in the board's flash.
-struct BoardFlash(Flash<'static, Blocking>);
+/// Why the board's flash could not be used.
+#[derive(defmt::Format)]
+enum FlashError {
+    /// The option bytes select single-bank flash (the records' pages need dual-bank).
+    SingleBank,
+    /// The flash driver's error.
+    Driver(embassy_stm32::flash::Error),
+}
+
+/// The record pages in the board's flash (`None`: the option bytes are single-bank).
+struct BoardFlash(Option<Flash<'static, Blocking>>);
+
+impl BoardFlash {
+    fn driver(&mut self) -> Result<&mut Flash<'static, Blocking>, FlashError> {
+        self.0.as_mut().ok_or(FlashError::SingleBank)
+    }
+
+    fn read_at(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), FlashError> {
+        self.driver()?
+            .blocking_read(offset, buf)
+            .map_err(FlashError::Driver)
+    }
+}
 
 impl RecordStore for BoardFlash {
-    type Error = embassy_stm32::flash::Error;
+    type Error = FlashError;
     fn read(&mut self, buf: &mut [u8; RECORD_LEN]) -> Result<(), Self::Error> {
-        self.0.blocking_read(board::RECORD_FLASH_OFFSET, buf)
+        self.read_at(board::RECORD_FLASH_OFFSET, buf)
     }
     fn erase(&mut self) -> Result<(), Self::Error> {
         let from = board::RECORD_FLASH_OFFSET;
-        self.0.blocking_erase(from, from + board::RECORD_PAGE_SIZE)
+        self.driver()?
+            .blocking_erase(from, from + board::RECORD_PAGE_SIZE)
+            .map_err(FlashError::Driver)
     }
     fn write(&mut self, bytes: &[u8; RECORD_LEN]) -> Result<(), Self::Error> {
-        self.0.blocking_write(board::RECORD_FLASH_OFFSET, bytes)
+        self.driver()?
+            .blocking_write(board::RECORD_FLASH_OFFSET, bytes)
+            .map_err(FlashError::Driver)
     }
 }
 
@@ -391,12 +432,23 @@ async fn main(_spawner: Spawner) {
     }
 
     let b = Board::take(p);
+    // The watchdog stops while a debugger halts the core (DBGMCU_APB1FZR1.DBG_IWDG_STOP):
+    // stepping through the firmware does not reset it.
+    pac::DBGMCU.apb1lfzr().modify(|w| w.set_iwdg(true));
     let mut wdg = IndependentWatchdog::new(b.iwdg, WATCHDOG_TIMEOUT_MS * 1000);
     wdg.unleash();
+    WATCHDOG_RUNNING.store(true, Ordering::Relaxed);
+    // The flash driver (built for dual-bank) panics on single-bank option bytes: check
+    // first and run without the records instead (the built-in motor, not commissioned).
+    set_phase(Phase::Flash);
+    let dual_bank = pac::FLASH.optr().read().dbank();
+    if !dual_bank {
+        error!("option bytes: single-bank flash (DBANK = 0); the records need dual-bank: set DBANK with STM32CubeProgrammer. Running with the built-in motor, not commissioned");
+    }
 
     let mut thread = Thread {
         lamps: PanelPins::new(b.lamps),
-        flash: BoardFlash(Flash::new_blocking(b.flash)),
+        flash: BoardFlash(dual_bank.then(|| Flash::new_blocking(b.flash))),
         wdg,
         max_update_cycles: 0,
         log_div: 0,
@@ -408,8 +460,7 @@ async fn main(_spawner: Spawner) {
     let mut page = [0xFF_u8; MOTOR_RECORD_LEN];
     if let Err(e) = thread
         .flash
-        .0
-        .blocking_read(board::MOTOR_RECORD_FLASH_OFFSET, &mut page)
+        .read_at(board::MOTOR_RECORD_FLASH_OFFSET, &mut page)
     {
         warn!("motor record page unreadable: {}", e);
     }
@@ -456,7 +507,13 @@ async fn main(_spawner: Spawner) {
         enc_a: b.encoder_a,
         enc_b: b.encoder_b,
     };
-    high.spawn(defmt::unwrap!(sample_task(hw, path)));
+    set_phase(Phase::Boot);
+    match sample_task(hw, path) {
+        Ok(task) => high.spawn(task),
+        // A task that is spawned once, at boot: the pool cannot be full.
+        #[allow(clippy::panic)]
+        Err(_) => panic!("sample task not spawned"),
+    }
 
     let period = Duration::from_millis(u64::from(PANEL_PERIOD_MS));
     let mut next = Instant::now() + period;
@@ -534,32 +591,52 @@ impl Thread {
     }
 }
 
-/// Why the previous run ended: the reset record (then erased) and the watchdog flag (then
+/// Why the previous run ended: the reset record (then erased) and the reset flags (then
 /// cleared), logged.
 fn previous_run() -> PreviousRun {
-    let csr = pac::RCC.csr().read();
+    let source = ResetSource::from_csr(pac::RCC.csr().read().0);
     pac::RCC.csr().modify(|w| w.set_rmvf(true));
-    let previous = PreviousRun::at_boot(&read_reset_record(), csr.iwdgrstf());
+    let previous = PreviousRun::at_boot(&read_reset_record(), source);
     write_reset_record(&[0; RESET_RECORD_LEN]);
+    info!("reset by {=str}", source.name());
     match previous {
         PreviousRun::Clean => {}
         PreviousRun::WatchdogReset => {
             error!("previous run ended in a watchdog reset with no reason recorded: the firmware hung")
         }
-        PreviousRun::Recorded(rec) => match rec.cause() {
-            ResetCause::Panic => error!(
-                "previous run ended in a panic: {=str} at {=str}:{=u32}",
-                rec.message(),
-                rec.file(),
-                rec.line_or_ms()
-            ),
-            ResetCause::SampleStall => error!(
-                "previous run ended in a watchdog reset: the sample path had stalled (no samples for {=u32} ms when recorded; restarts did not help)",
-                rec.line_or_ms()
-            ),
-        },
+        PreviousRun::ResetDuring { record, source } => warn!(
+            "previous run: {=str} recorded ({=u32}), then a {=str} reset came before the watchdog's",
+            record.message(),
+            record.line_or_ms(),
+            source.name()
+        ),
+        PreviousRun::Recorded(rec) => log_record(&rec),
     }
     previous
+}
+
+fn log_record(rec: &ResetRecord) {
+    match rec.cause() {
+        ResetCause::Panic => error!(
+            "previous run ended in a panic: {=str} at {=str}:{=u32}",
+            rec.message(),
+            rec.file(),
+            rec.line_or_ms()
+        ),
+        ResetCause::DefmtPanic => error!(
+            "previous run ended in a defmt panic during {=str}, called from {=u32:#010x} (addr2line -e the ELF; the message is in that run's log)",
+            rec.message(),
+            rec.line_or_ms()
+        ),
+        ResetCause::SetupTimeout => error!(
+            "previous run ended in a watchdog reset: the {=str} set-up did not finish",
+            rec.message()
+        ),
+        ResetCause::SampleStall => error!(
+            "previous run ended in a watchdog reset: the sample path had stalled (no samples for {=u32} ms when recorded; recoveries did not help)",
+            rec.line_or_ms()
+        ),
+    }
 }
 
 /// Reads the commissioning record and gives it to the core; returns it when the core
@@ -682,13 +759,35 @@ fn log_status(s: &MonitorStatus, iso: Option<&Isolation>, mode: &str, max_update
     );
 }
 
-/// Panic: the panel's "monitor failed" pattern on the lamp pins of the lamp table, the
-/// reason into the reset record and the log, and stop. The watchdog is no longer petted,
-/// so the MCU resets after `WATCHDOG_TIMEOUT_MS`; the next boot reads the record, logs it
-/// and shows the failed pattern for 5 s before monitoring again.
+/// Panic: the reason into the reset record (RAM that survives the reset), then [`fail`].
+/// Only the static part of the message and the location are kept: formatting the full
+/// message would pull core::fmt (float formatting alone is ~10 KiB of flash).
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
     cortex_m::interrupt::disable();
+    let location = info.location().map(|l| (l.file(), l.line()));
+    let record = ResetRecord::on_panic(info.message().as_str(), location);
+    fail(&record)
+}
+
+/// A panic through `defmt::panic!` (the HAL with its `defmt` feature, `defmt::unwrap!`):
+/// its message is already in the defmt log; the record keeps the phase and the address the
+/// handler was called from. Without this handler defmt calls `core::panic!()` and the record
+/// would name a line in defmt's source.
+#[defmt::panic_handler]
+fn defmt_panic() -> ! {
+    cortex_m::interrupt::disable();
+    let return_address = cortex_m::register::lr::read();
+    let phase = Phase::from_number(PHASE.load(Ordering::Relaxed)).unwrap_or(Phase::Boot);
+    fail(&ResetRecord::defmt_panic(phase, return_address).encode())
+}
+
+/// The end of a failed run: the panel's "monitor failed" pattern on the lamp pins of the
+/// lamp table, `record` into the reset record and the log, then the reset: the watchdog's
+/// (no longer petted) after `WATCHDOG_TIMEOUT_MS`, or, when it does not run yet, a
+/// software reset after the same time. The next boot reads the record, logs it and shows
+/// the failed pattern for 5 s before monitoring again.
+fn fail(record: &[u8; RESET_RECORD_LEN]) -> ! {
     // Direct register writes: the HAL objects may be in any state. GPIO clocks are
     // enabled by `embassy_stm32::init` for every port.
     use pac::gpio::vals::Moder;
@@ -711,13 +810,20 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
             port.bsrr().write(|w| w.set_br(n, true));
         }
     }
-    // Only the static part of the message and the location are kept: formatting the
-    // full message would pull core::fmt (float formatting alone is ~10 KiB of flash).
-    let msg = info.message().as_str().unwrap_or("(formatted message)");
-    let (file, line) = info.location().map_or(("?", 0), |l| (l.file(), l.line()));
-    write_reset_record(&ResetRecord::panic(msg, file, line).encode());
-    error!("MONITOR FAILED: {=str} at {=str}:{=u32}", msg, file, line);
-    loop {
-        cortex_m::asm::nop();
+    write_reset_record(record);
+    if let Some(rec) = ResetRecord::decode(record) {
+        error!(
+            "MONITOR FAILED: {=str} at {=str}:{=u32}",
+            rec.message(),
+            rec.file(),
+            rec.line_or_ms()
+        );
     }
+    if !WATCHDOG_RUNNING.load(Ordering::Relaxed) {
+        warn!("watchdog not running yet: software reset");
+    }
+    // The watchdog's time at the full clock (longer at the 16 MHz reset clock): the failed
+    // pattern shows, then the watchdog or the software reset ends the run.
+    cortex_m::asm::delay(WATCHDOG_TIMEOUT_MS * 170_000);
+    cortex_m::peripheral::SCB::sys_reset()
 }
