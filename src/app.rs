@@ -351,6 +351,7 @@ pub fn panel_input(
         input_invalid: status.sensor_fault.any() && !status.residual_lamps.iter().any(|l| *l),
         fault_code,
         commissioning_failed,
+        default_motor: false,
     }
 }
 
@@ -517,6 +518,8 @@ pub struct Supervisor {
     sample_rate_hz: u32,
     /// The monitor has evaluated once since boot (settled, voltage present).
     running: bool,
+    /// The built-in default motor is monitored (the panel marks it).
+    default_motor: bool,
 }
 
 impl Supervisor {
@@ -545,7 +548,14 @@ impl Supervisor {
             run_baseline: None,
             sample_rate_hz: settings.sample_rate_hz,
             running: false,
+            default_motor: false,
         }
+    }
+
+    /// Whether the built-in default motor is monitored (no valid motor record at boot): the
+    /// panel shows it ([`crate::panel`], "Built-in default motor"). Off until set.
+    pub fn set_default_motor(&mut self, default_motor: bool) {
+        self.default_motor = default_motor;
     }
 
     /// Isolates against `isolator`'s machine from now on (the motor record's, read at boot;
@@ -668,7 +678,10 @@ impl Supervisor {
             .as_ref()
             .filter(|f| f.learned())
             .and_then(Follower::last);
-        let input = panel_input(mode, &self.latest, learned, failed);
+        let input = PanelInput {
+            default_motor: self.default_motor,
+            ..panel_input(mode, &self.latest, learned, failed)
+        };
         Tick {
             pet_watchdog: watch.pet_watchdog,
             mode,

@@ -54,7 +54,7 @@ use drive_monitor::board::{self, pins::Board, CurrentCode, Lamp, Port, VoltageCo
 use drive_monitor::commissioning::RunEnd;
 use drive_monitor::flash_record::{self, LoadError, RecordStore, StoreError, RECORD_LEN};
 use drive_monitor::liveness::{AdcWait, LivenessChange};
-use drive_monitor::motor_source;
+use drive_monitor::motor_source::{self, EncoderSetup};
 use drive_monitor::panel::PanelLamps;
 use drive_monitor::recovery::{self, RecoveryCounts, StepTimeout};
 use drive_monitor::reset_record::{
@@ -161,6 +161,8 @@ struct SampleHw {
     tim4: Peri<'static, peripherals::TIM4>,
     enc_a: Peri<'static, peripherals::PB6>,
     enc_b: Peri<'static, peripherals::PB7>,
+    /// The encoder's direction, filter and pull-ups from the motor record.
+    encoder: EncoderSetup,
 }
 
 /// Starts the acquisition: the encoder (TIM4 in quadrature mode), the trigger (TIM1 update
@@ -175,7 +177,26 @@ fn start_acquisition(
     let ring1 = RING1.init([0; RING_LEN]);
     let ring2 = RING2.init([0; RING_LEN]);
 
-    let qei = Qei::new(hw.tim4, hw.enc_a, hw.enc_b, QeiConfig::default());
+    let pull = if hw.encoder.pull_up {
+        Pull::Up
+    } else {
+        Pull::None
+    };
+    let qei_config = QeiConfig {
+        ch1_pull: pull,
+        ch2_pull: pull,
+        ..QeiConfig::default()
+    };
+    let qei = Qei::new(hw.tim4, hw.enc_a, hw.enc_b, qei_config);
+    // The input filter on both inputs and the direction (input A's polarity), from the
+    // motor record (`motor_source::encoder_setup`).
+    let tim4 = pac::TIM4;
+    let filter = pac::timer::vals::FilterValue::from_bits(hw.encoder.input_filter);
+    tim4.ccmr_input(0).modify(|w| {
+        w.set_icf(0, filter);
+        w.set_icf(1, filter);
+    });
+    tim4.ccer().modify(|w| w.set_ccp(0, hw.encoder.invert_a));
 
     // Sample trigger: TIM1 update event -> TRGO -> both ADCs (rising edge).
     let trigger = HwTimer::new(hw.tim1);
@@ -464,13 +485,16 @@ async fn main(_spawner: Spawner) {
     {
         warn!("motor record page unreadable: {}", e);
     }
-    let (machine, source) = motor_source::select(&page);
+    let (mut machine, source) = motor_source::select(&page);
     info!("{=str}", source.describe());
+    let mut default_motor = source.is_default();
     let mut path = match motor_source::sample_path(&machine, SETTINGS.sample_rate_hz) {
         Ok(p) => p,
         Err(_) => {
             // A record the core accepted at boot but not at this sample rate: the default.
             warn!("motor record rejected at this sample rate: built-in default motor");
+            default_motor = true;
+            machine = motor_source::default_record();
             match SamplePath::for_board(SETTINGS.sample_rate_hz) {
                 Ok(p) => p,
                 // The settings are constants and a host test (`app::tests`) builds the same
@@ -483,7 +507,8 @@ async fn main(_spawner: Spawner) {
     let installed = install_stored_calibration(&mut thread.flash, &mut path);
     let boot = Instant::now();
     let mut supervisor = Supervisor::new(&SETTINGS, previous, 0, path.status());
-    if !source.is_default() {
+    supervisor.set_default_motor(default_motor);
+    if !default_motor {
         supervisor.set_isolator(motor_source::isolator(&machine).ok());
     }
     if let Some(rec) = installed {
@@ -506,6 +531,7 @@ async fn main(_spawner: Spawner) {
         tim4: b.encoder_timer,
         enc_a: b.encoder_a,
         enc_b: b.encoder_b,
+        encoder: motor_source::encoder_setup(&machine),
     };
     set_phase(Phase::Boot);
     match sample_task(hw, path) {
