@@ -55,6 +55,7 @@ use drive_monitor::commissioning::RunEnd;
 use drive_monitor::flash_record::{self, LoadError, RecordStore, StoreError, RECORD_LEN};
 use drive_monitor::liveness::{AdcWait, LivenessChange};
 use drive_monitor::motor_source::{self, EncoderSetup};
+use drive_monitor::offset_trim::{ChannelTrim, TrimResult, MAX_OFFSET_CODES};
 use drive_monitor::panel::PanelLamps;
 use drive_monitor::recovery::{self, RecoveryCounts, StepTimeout};
 use drive_monitor::reset_record::{
@@ -98,6 +99,8 @@ struct Status {
 
 static COMMANDS: Channel<CriticalSectionRawMutex, Command, 4> = Channel::new();
 static STATUS: Signal<CriticalSectionRawMutex, Status> = Signal::new();
+/// The start-up offset trim's result (sample task -> thread mode, once).
+static TRIM: Signal<CriticalSectionRawMutex, TrimResult> = Signal::new();
 static OVERRUNS: AtomicU32 = AtomicU32::new(0);
 static RESTARTS: AtomicU32 = AtomicU32::new(0);
 static EXECUTOR_HIGH: InterruptExecutor = InterruptExecutor::new();
@@ -258,6 +261,9 @@ fn process_half(
             i: [CurrentCode(ia), CurrentCode(ib), CurrentCode(ic)],
             encoder_count,
         };
+        if let Some(trim) = path.trim_offsets(&raw) {
+            TRIM.signal(trim);
+        }
         let t0 = cortex_m::peripheral::DWT::cycle_count();
         path.on_frame(&raw);
         let dt = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t0);
@@ -578,6 +584,10 @@ impl Thread {
         if let Some(s) = status {
             self.max_update_cycles = s.max_update_cycles;
         }
+        if let Some(trim) = TRIM.try_take() {
+            supervisor.set_offset_fault(&trim);
+            log_trim(&trim);
+        }
         let tick = supervisor.tick(now_ms, status.map(|s| s.monitor), pressed);
         if tick.pet_watchdog {
             self.wdg.pet();
@@ -706,6 +716,28 @@ fn on_liveness(change: LivenessChange) {
         LivenessChange::Recovered { after_ms } => {
             write_reset_record(&[0; RESET_RECORD_LEN]);
             warn!("sample path recovered after {=u32} ms", after_ms);
+        }
+    }
+}
+
+/// The start-up offset trim, channel by channel (`drive_monitor::offset_trim`).
+fn log_trim(trim: &TrimResult) {
+    let names = ["va", "vb", "vc", "ia", "ib", "ic"];
+    let channels = trim.voltage.iter().chain(trim.current.iter());
+    for (name, channel) in names.into_iter().zip(channels) {
+        match *channel {
+            ChannelTrim::Trimmed(code) => info!("offset trim {=str}: zero at {=f32} codes, in force", name, code),
+            ChannelTrim::OutOfBound(code) => error!(
+                "offset trim {=str}: zero at {=f32} codes, beyond +-{=f32} of mid-scale: sensor flagged, not used",
+                name,
+                code,
+                MAX_OFFSET_CODES
+            ),
+            ChannelTrim::NotQuiet(spread) => info!(
+                "offset trim {=str}: not quiet (spread {=f32} codes; motor running or supply on): not trimmed",
+                name,
+                spread
+            ),
         }
     }
 }

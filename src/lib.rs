@@ -15,6 +15,7 @@
 //!   register sequence in the reference manual's order, over a trait the host rig fakes);
 //! - [`reset_record`]: why the previous run ended (panic, stalled sample path), kept in
 //!   RAM across the reset;
+//! - [`offset_trim`]: each channel's zero measured at start-up with the motor off, bounded;
 //! - [`panel`]: lamp patterns and blink codes;
 //! - [`app`]: the glue: settings, the per-sample path, the status it hands thread mode,
 //!   and thread mode's supervisor.
@@ -47,6 +48,7 @@ pub mod commissioning;
 pub mod flash_record;
 pub mod liveness;
 pub mod motor_source;
+pub mod offset_trim;
 pub mod panel;
 pub mod recovery;
 pub mod reset_record;

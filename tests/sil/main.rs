@@ -18,6 +18,7 @@ mod commissioning;
 mod isolation;
 mod liveness;
 mod recovery;
+mod startup;
 
 use drive_monitor::app::{
     carry_out, panel_input, MonitorStatus, SamplePath, Settings, Supervisor, Tick, PANEL_PERIOD_MS,
@@ -27,6 +28,7 @@ use drive_monitor::board::{self, RECORD_PAGE_SIZE};
 use drive_monitor::commissioning::{Failure, RunEnd};
 use drive_monitor::flash_record::{self, CalibrationRecord, RecordStore, RECORD_LEN};
 use drive_monitor::liveness::AdcWait;
+use drive_monitor::offset_trim::TrimResult;
 use drive_monitor::panel::{self, Lamp, Mode, PanelLamps};
 use drive_monitor::recovery::{Faults, StepTimeout};
 use drive_monitor::reset_record::{
@@ -186,6 +188,8 @@ struct Rig {
     restart: fn(&mut recovery::FakeAcq) -> Result<Faults, StepTimeout>,
     /// The results of the restarts.
     recoveries: Vec<Result<Faults, StepTimeout>>,
+    /// The start-up offset trim's result.
+    trims: Vec<TrimResult>,
     seen: Vec<Seen>,
     ended: Vec<RunEnd>,
 }
@@ -233,6 +237,7 @@ impl Rig {
             acq: recovery::FakeAcq::running(),
             restart: drive_monitor::recovery::recover,
             recoveries: Vec::new(),
+            trims: Vec::new(),
             seen: Vec::new(),
             ended: Vec::new(),
         }
@@ -253,6 +258,11 @@ impl Rig {
             Some(raw) => {
                 self.waited_us = 0;
                 self.adc.data();
+                if let Some(trim) = self.path.trim_offsets(raw) {
+                    // Handed to thread mode on the board (logged, the sensor flags).
+                    self.supervisor.set_offset_fault(&trim);
+                    self.trims.push(trim);
+                }
                 self.path.on_frame(raw);
                 if self
                     .path
@@ -384,7 +394,7 @@ fn frames(scenario: &Scenario) -> Vec<RawFrame> {
     let rows = simulate_to_vec(&params, scenario).expect("simulation");
     let q = *SamplePath::for_board(FS).unwrap().sampler();
     let mut theta_counts = 0.0f64;
-    let dt = 1.0 / f64::from(FS);
+    let dt = 1.0 / scenario.sample_rate_hz;
     rows.iter()
         .map(|row| {
             let v = row.v_abc.unwrap_or([0.0; 3]);
