@@ -62,7 +62,7 @@ use drive_monitor::reset_record::{
     Phase, PreviousRun, ResetCause, ResetRecord, ResetSource, RESET_RECORD_LEN,
 };
 use drive_monitor::sampling::RawFrame;
-use monitor_core::motor_record::STORED_LEN as MOTOR_RECORD_LEN;
+use monitor_core::motor_record::{MotorRecord, STORED_LEN as MOTOR_RECORD_LEN};
 use monitor_core::Isolation;
 
 use acquisition::HwAcquisition;
@@ -446,6 +446,48 @@ fn clock_config() -> embassy_stm32::Config {
     config
 }
 
+/// The independent watchdog, started, and frozen while a debugger halts the core
+/// (`DBGMCU_APB1FZR1.DBG_IWDG_STOP`): stepping through the firmware does not reset it.
+fn start_watchdog(
+    iwdg: Peri<'static, peripherals::IWDG>,
+) -> IndependentWatchdog<'static, peripherals::IWDG> {
+    pac::DBGMCU.apb1lfzr().modify(|w| w.set_iwdg(true));
+    let mut wdg = IndependentWatchdog::new(iwdg, WATCHDOG_TIMEOUT_MS * 1000);
+    wdg.unleash();
+    WATCHDOG_RUNNING.store(true, Ordering::Relaxed);
+    wdg
+}
+
+/// The machine: the motor record in flash, else the built-in default (the reason is
+/// logged; a page that cannot be read counts as erased). Returns the record in force, its
+/// sample path and whether it is the built-in default.
+fn select_machine(flash: &mut BoardFlash) -> (MotorRecord, SamplePath, bool) {
+    let mut page = [0xFF_u8; MOTOR_RECORD_LEN];
+    if let Err(e) = flash.read_at(board::MOTOR_RECORD_FLASH_OFFSET, &mut page) {
+        warn!("motor record page unreadable: {}", e);
+    }
+    let (mut machine, source) = motor_source::select(&page);
+    info!("{=str}", source.describe());
+    let mut default_motor = source.is_default();
+    let path = match motor_source::sample_path(&machine, SETTINGS.sample_rate_hz) {
+        Ok(p) => p,
+        Err(_) => {
+            // A record the core accepted at boot but not at this sample rate: the default.
+            warn!("motor record rejected at this sample rate: built-in default motor");
+            default_motor = true;
+            machine = motor_source::default_record();
+            match SamplePath::for_board(SETTINGS.sample_rate_hz) {
+                Ok(p) => p,
+                // The settings are constants and a host test (`app::tests`) builds the same
+                // path: this cannot happen, and if it did nothing could be monitored.
+                #[allow(clippy::panic)]
+                Err(_) => panic!("monitor configuration rejected"),
+            }
+        }
+    };
+    (machine, path, default_motor)
+}
+
 #[embassy_executor::main]
 async fn main(_spawner: Spawner) {
     let p = embassy_stm32::init(clock_config());
@@ -459,12 +501,7 @@ async fn main(_spawner: Spawner) {
     }
 
     let b = Board::take(p);
-    // The watchdog stops while a debugger halts the core (DBGMCU_APB1FZR1.DBG_IWDG_STOP):
-    // stepping through the firmware does not reset it.
-    pac::DBGMCU.apb1lfzr().modify(|w| w.set_iwdg(true));
-    let mut wdg = IndependentWatchdog::new(b.iwdg, WATCHDOG_TIMEOUT_MS * 1000);
-    wdg.unleash();
-    WATCHDOG_RUNNING.store(true, Ordering::Relaxed);
+    let wdg = start_watchdog(b.iwdg);
     // The flash driver (built for dual-bank) panics on single-bank option bytes: check
     // first and run without the records instead (the built-in motor, not commissioned).
     set_phase(Phase::Flash);
@@ -482,34 +519,7 @@ async fn main(_spawner: Spawner) {
     };
     let mut button = ExtiInput::new(b.button, b.button_exti, Pull::Down, Irqs);
 
-    // The machine: the motor record in flash, else the built-in default (the reason is
-    // logged). A page that cannot be read counts as erased.
-    let mut page = [0xFF_u8; MOTOR_RECORD_LEN];
-    if let Err(e) = thread
-        .flash
-        .read_at(board::MOTOR_RECORD_FLASH_OFFSET, &mut page)
-    {
-        warn!("motor record page unreadable: {}", e);
-    }
-    let (mut machine, source) = motor_source::select(&page);
-    info!("{=str}", source.describe());
-    let mut default_motor = source.is_default();
-    let mut path = match motor_source::sample_path(&machine, SETTINGS.sample_rate_hz) {
-        Ok(p) => p,
-        Err(_) => {
-            // A record the core accepted at boot but not at this sample rate: the default.
-            warn!("motor record rejected at this sample rate: built-in default motor");
-            default_motor = true;
-            machine = motor_source::default_record();
-            match SamplePath::for_board(SETTINGS.sample_rate_hz) {
-                Ok(p) => p,
-                // The settings are constants and a host test (`app::tests`) builds the same
-                // path: this cannot happen, and if it did nothing could be monitored.
-                #[allow(clippy::panic)]
-                Err(_) => panic!("monitor configuration rejected"),
-            }
-        }
-    };
+    let (machine, mut path, default_motor) = select_machine(&mut thread.flash);
     let installed = install_stored_calibration(&mut thread.flash, &mut path);
     let boot = Instant::now();
     let mut supervisor = Supervisor::new(&SETTINGS, previous, 0, path.status());
