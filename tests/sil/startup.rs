@@ -125,3 +125,47 @@ fn the_internal_oscillators_tolerance_scales_the_frequency_and_speed_estimates()
         assert!(!fault, "{error}");
     }
 }
+
+#[test]
+fn a_corrupt_or_old_motor_record_shows_the_default_motor_mark_on_the_panel() {
+    use drive_monitor::motor_source;
+    let valid = motor_source::default_record().to_bytes();
+    let mut corrupt = valid;
+    corrupt[20] ^= 0x10;
+    let mut old = valid;
+    old[4] = 0; // another version
+    let erased = [0xFF; 256];
+    let off = motor_off(12.5, [0; 6]);
+    let pages: [(&[u8], bool); 4] = [
+        (&valid, false),
+        (&corrupt, true),
+        (&old, true),
+        (&erased, true),
+    ];
+    for (page, default) in pages {
+        // The boot's choice (src/firmware.rs: `motor_source::select`), handed to the panel.
+        let (_, source) = motor_source::select(page);
+        assert_eq!(source.is_default(), default, "{source:?}");
+        let mut rig = Rig::boot(Survivors::power_on(FakeFlash::erased()));
+        rig.supervisor.set_default_motor(source.is_default());
+        rig.run(&off, |_, _| {}).unwrap();
+        // The RUN lamp's longest lit stretch at the 50 ms ticks.
+        let (mut on_ms, mut longest_ms) = (0, 0);
+        for s in &rig.seen {
+            on_ms = if s.tick.lamps.run { on_ms + 50 } else { 0 };
+            longest_ms = longest_ms.max(on_ms);
+            assert_eq!(s.tick.mode, Mode::NotCommissioned, "{} ms", s.t_ms);
+        }
+        if default {
+            // Lit through 10.0..12.0 s of every 10 s (the first period starts at boot).
+            assert!(rig
+                .seen
+                .iter()
+                .filter(|s| (10_000..12_000).contains(&s.t_ms) || s.t_ms < 2_000)
+                .all(|s| s.tick.lamps.run));
+            assert!((1_950..=2_000).contains(&longest_ms), "{longest_ms}");
+        } else {
+            assert!(longest_ms <= 100, "{longest_ms}");
+        }
+    }
+}
