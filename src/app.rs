@@ -379,7 +379,7 @@ impl SamplePath {
             monitor: Monitor::new(cfg).map_err(AppError::Config)?,
             sampler: AdcSampler::new(front_end, sample_rate_hz).map_err(AppError::Sampling)?,
             samples: 0,
-            trim: OffsetTrim::new(),
+            trim: OffsetTrim::new(&front_end),
         })
     }
 

@@ -740,7 +740,7 @@ fn log_trim(trim: &TrimResult) {
         match *channel {
             ChannelTrim::Trimmed(code) => info!("offset trim {=str}: zero at {=f32} codes, in force", name, code),
             ChannelTrim::OutOfBound(code) => error!(
-                "offset trim {=str}: zero at {=f32} codes, beyond +-{=f32} of mid-scale: sensor flagged, not used",
+                "offset trim {=str}: zero at {=f32} codes, beyond +-{=f32} of the zero in force: sensor flagged, not used",
                 name,
                 code,
                 MAX_OFFSET_CODES

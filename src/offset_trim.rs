@@ -8,7 +8,8 @@
 //! runs as usual meanwhile); then each channel's mean and spread decide
 //! ([`ChannelTrim`]):
 //! - **quiet** (spread <= [`QUIET_SPREAD_CODES`]: the motor is off, no supply on the voltage
-//!   inputs) and within [`MAX_OFFSET_CODES`] of mid-scale: the mean is the channel's new
+//!   inputs) and within [`MAX_OFFSET_CODES`] of the zero in force (the motor record's
+//!   offset, mid-scale for the built-in default): the mean is the channel's new
 //!   offset, put into force in the sample path's front end for this run
 //!   ([`crate::app::SamplePath::apply_trim`]) and logged, so it can be written into the
 //!   parameter file for the motor record;
@@ -21,7 +22,7 @@
 //! Bounded work: six additions and six multiply-adds per sample for [`TRIM_SAMPLES`]
 //! samples, then nothing.
 
-use crate::board::MID_SCALE_CODE;
+use crate::board::{FrontEnd, MID_SCALE_CODE};
 use crate::sampling::RawFrame;
 
 /// Samples the trim averages: 0.1 s at 10 kHz, five periods of a 50 Hz supply (so a
@@ -30,9 +31,9 @@ pub const TRIM_SAMPLES: u32 = 1_000;
 /// Largest spread (standard deviation) of a quiet channel, ADC codes: the front end's noise
 /// is 1-3 codes; a 1 % sine of full scale has a spread of 29 codes.
 pub const QUIET_SPREAD_CODES: f32 = 8.0;
-/// Largest distance of a trimmed offset from mid-scale, ADC codes (100 codes: 2.4 % of the
-/// range, about 10 V or 0.24 A with the default front end); beyond it the sensor is
-/// flagged instead.
+/// Largest distance of a trimmed offset from the zero in force (the motor record's offset,
+/// mid-scale by default), ADC codes (100 codes: 2.4 % of the range, about 10 V or 0.24 A
+/// with the default front end); beyond it the sensor is flagged instead.
 pub const MAX_OFFSET_CODES: f32 = 100.0;
 
 /// What the trim found for one channel.
@@ -40,8 +41,8 @@ pub const MAX_OFFSET_CODES: f32 = 100.0;
 pub enum ChannelTrim {
     /// Quiet and within bounds: the measured zero, codes.
     Trimmed(f32),
-    /// Quiet but farther than [`MAX_OFFSET_CODES`] from mid-scale: the measured zero,
-    /// codes (not used; the sensor is flagged).
+    /// Quiet but farther than [`MAX_OFFSET_CODES`] from the zero in force: the measured
+    /// zero, codes (not used; the sensor is flagged).
     OutOfBound(f32),
     /// Not quiet: the measured spread, codes (nothing trimmed).
     NotQuiet(f32),
@@ -84,22 +85,27 @@ impl TrimResult {
 }
 
 /// The accumulator: sums and sums of squares of the six channels' codes (exact integers).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OffsetTrim {
     sum: [u32; 6],
     sum_sq: [u64; 6],
     n: u32,
     done: bool,
+    /// The zeros in force, codes: va, vb, vc, ia, ib, ic.
+    nominal: [f32; 6],
 }
 
 impl OffsetTrim {
-    /// An empty accumulator.
-    pub const fn new() -> Self {
+    /// An empty accumulator judging against `front_end`'s zeros.
+    pub fn new(front_end: &FrontEnd) -> Self {
+        let [va, vb, vc] = front_end.voltage;
+        let [ia, ib, ic] = front_end.current;
         Self {
             sum: [0; 6],
             sum_sq: [0; 6],
             n: 0,
             done: false,
+            nominal: [va, vb, vc, ia, ib, ic].map(|c| c.offset_code),
         }
     }
 
@@ -122,11 +128,12 @@ impl OffsetTrim {
         }
         self.done = true;
         let ch = |k: usize| {
-            let (s, q) = (
+            let (s, q, zero) = (
                 self.sum.get(k).copied().unwrap_or(0),
                 self.sum_sq.get(k).copied().unwrap_or(0),
+                self.nominal.get(k).copied().unwrap_or(MID_SCALE_CODE),
             );
-            judge(s, q, self.n)
+            judge(s, q, self.n, zero)
         };
         Some(TrimResult {
             voltage: [ch(0), ch(1), ch(2)],
@@ -136,8 +143,8 @@ impl OffsetTrim {
 }
 
 /// One channel from its sum, sum of squares and count (`n > 0`): mean and spread in codes,
-/// then the bounds.
-fn judge(sum: u32, sum_sq: u64, n: u32) -> ChannelTrim {
+/// then the bounds around `zero`, the zero in force.
+fn judge(sum: u32, sum_sq: u64, n: u32, zero: f32) -> ChannelTrim {
     let n64 = u64::from(n.max(1));
     let s = u64::from(sum);
     // n^2 var = n sum_sq - sum^2, exact in integers (>= 0 for any real data).
@@ -146,7 +153,7 @@ fn judge(sum: u32, sum_sq: u64, n: u32) -> ChannelTrim {
     let mean = sum as f32 / n64 as f32;
     if spread > QUIET_SPREAD_CODES {
         ChannelTrim::NotQuiet(spread)
-    } else if (mean - MID_SCALE_CODE).abs() > MAX_OFFSET_CODES {
+    } else if (mean - zero).abs() > MAX_OFFSET_CODES {
         ChannelTrim::OutOfBound(mean)
     } else {
         ChannelTrim::Trimmed(mean)
@@ -168,7 +175,7 @@ mod tests {
 
     #[test]
     fn quiet_channels_are_trimmed_out_of_bound_ones_flagged_running_ones_left() {
-        let mut trim = OffsetTrim::new();
+        let mut trim = OffsetTrim::new(&FrontEnd::DEFAULT);
         let mut result = None;
         for k in 0..TRIM_SAMPLES {
             // +-1 code of noise around 2050 / 2040; a dead sensor at 1800 (ib); a 50 Hz
@@ -201,8 +208,8 @@ mod tests {
     #[test]
     fn the_bounds_are_inclusive_and_a_rail_is_out_of_bound() {
         let half = MID_SCALE_CODE;
-        assert!(matches!(judge(0, 0, 10), ChannelTrim::OutOfBound(_)));
-        let at = |code: u32| judge(code * 10, u64::from(code * code) * 10, 10);
+        assert!(matches!(judge(0, 0, 10, half), ChannelTrim::OutOfBound(_)));
+        let at = |code: u32| judge(code * 10, u64::from(code * code) * 10, 10, half);
         assert!(matches!(
             at((half + MAX_OFFSET_CODES - 0.5) as u32),
             ChannelTrim::Trimmed(_)
@@ -212,5 +219,9 @@ mod tests {
             ChannelTrim::OutOfBound(_)
         ));
         assert!(matches!(at(4095), ChannelTrim::OutOfBound(_)));
+        // The bound is around the zero in force (a record's offset), not mid-scale.
+        let at_500 = |code: u32| judge(code * 10, u64::from(code * code) * 10, 10, 500.0);
+        assert_eq!(at_500(560), ChannelTrim::Trimmed(560.0));
+        assert_eq!(at_500(2048), ChannelTrim::OutOfBound(2048.0));
     }
 }
