@@ -303,7 +303,7 @@ async fn sample_task(hw: SampleHw, mut path: SamplePath) {
             (r1.is_ok(), r2.is_ok())
         })
         .await;
-        let lapped = match read {
+        let recover_now = match read {
             Ok((ok1, ok2)) => {
                 if let Some(n) = wait.data() {
                     warn!("sampling resumed after {=u32} recoveries", n);
@@ -334,7 +334,7 @@ async fn sample_task(hw: SampleHw, mut path: SamplePath) {
                 true
             }
         };
-        if lapped {
+        if recover_now {
             // One sequence for every cause (drive_monitor::recovery): trigger, ADCs and
             // DMA stopped, OVR and TEIF cleared, DMA re-armed, ADCs and trigger restarted;
             // the timestamps continue from the restart (the gap shows).

@@ -23,7 +23,7 @@
 //! | [`Step::StopAdc`] | `ADSTP`, then wait for `ADSTART = 0` (bounded) | a conversion in flight ends before the DMA stops (else it would set `OVR` itself) |
 //! | [`Step::PauseDma`] | `EN = 0`, then wait for it (bounded) | `CNDTR` may only be written with the channel off |
 //! | [`Step::ClearFlags`] | `OVR` (write 1), `TEIF`/`HTIF`/`TCIF` (`DMA_IFCR`) | a latched `OVR` blocks the DMA requests |
-//! | [`Step::RearmDma`] | `CNDTR` = ring length, ring indices reset, `EN = 1`, `DMAEN`/`DMACFG` circular | the DMA is ready before the ADC asks |
+//! | [`Step::RearmDma`] | `CNDTR` = ring length, ring indices reset, `DMAEN`/`DMACFG` circular, `EN = 1` | the DMA is ready before the ADC asks |
 //! | [`Step::StartAdc`] | `ADSTART = 1` (waits for the next trigger) | both ADCs armed before the trigger |
 //! | [`Step::StartTrigger`] | TIM1 counter on, timestamps continue from now | ADC1 and ADC2 start on the same trigger |
 //!
