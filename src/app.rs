@@ -22,6 +22,7 @@ use crate::board::{self, FrontEnd};
 use crate::commissioning::{Action, CommissioningProcedure, RunEnd};
 use crate::flash_record::{self, CalibrationRecord, RecordStore, Stored};
 use crate::liveness::{LivenessChange, SampleWatch};
+use crate::offset_trim::{OffsetTrim, TrimResult};
 use crate::panel::{self, blink_code, winding_code, Mode, PanelInput, PanelLamps, NOT_NAMED_CODE};
 use crate::reset_record::PreviousRun;
 use crate::sampling::{AdcSampler, RawFrame, SamplingError, TICK_HZ};
@@ -351,6 +352,7 @@ pub fn panel_input(
         input_invalid: status.sensor_fault.any() && !status.residual_lamps.iter().any(|l| *l),
         fault_code,
         commissioning_failed,
+        default_motor: false,
     }
 }
 
@@ -360,6 +362,7 @@ pub struct SamplePath {
     monitor: Monitor,
     sampler: AdcSampler,
     samples: u32,
+    trim: OffsetTrim,
 }
 
 impl SamplePath {
@@ -376,6 +379,7 @@ impl SamplePath {
             monitor: Monitor::new(cfg).map_err(AppError::Config)?,
             sampler: AdcSampler::new(front_end, sample_rate_hz).map_err(AppError::Sampling)?,
             samples: 0,
+            trim: OffsetTrim::new(&front_end),
         })
     }
 
@@ -415,6 +419,25 @@ impl SamplePath {
                 .set_calibration(rec.into())
                 .map_err(CommandError::Calibration),
         }
+    }
+
+    /// The start-up offset trim ([`crate::offset_trim`]): adds `raw` (the frame also given
+    /// to [`SamplePath::on_frame`]) and, at the [`crate::offset_trim::TRIM_SAMPLES`]th
+    /// frame, puts the trimmed channels' offsets into force in the front end and returns the
+    /// result (the out-of-bound channels go to [`Supervisor::set_offset_fault`]). `None`
+    /// before and after (then it returns at once).
+    pub fn trim_offsets(&mut self, raw: &RawFrame) -> Option<TrimResult> {
+        let trim = self.trim.add(raw)?;
+        let mut fe = *self.sampler.front_end();
+        let channels = (fe.voltage.iter_mut().zip(trim.voltage))
+            .chain(fe.current.iter_mut().zip(trim.current));
+        for (scale, channel) in channels {
+            if let Some(offset) = channel.offset() {
+                scale.offset_code = offset;
+            }
+        }
+        self.sampler.set_front_end(fe);
+        Some(trim)
     }
 
     /// The ADC sampler (for timestamp resynchronisation after lost samples).
@@ -517,6 +540,10 @@ pub struct Supervisor {
     sample_rate_hz: u32,
     /// The monitor has evaluated once since boot (settled, voltage present).
     running: bool,
+    /// The built-in default motor is monitored (the panel marks it).
+    default_motor: bool,
+    /// Sensors whose start-up offset was out of bound ([`Supervisor::set_offset_fault`]).
+    offset_fault: SensorFlags,
 }
 
 impl Supervisor {
@@ -545,7 +572,23 @@ impl Supervisor {
             run_baseline: None,
             sample_rate_hz: settings.sample_rate_hz,
             running: false,
+            default_motor: false,
+            offset_fault: SensorFlags::default(),
         }
+    }
+
+    /// The start-up offset trim found a channel out of bound ([`crate::offset_trim`]): from
+    /// now on that sensor counts as faulty in every status (the panel's "input invalid", the
+    /// status line's `sens=`, and the isolation does not use the statuses).
+    pub fn set_offset_fault(&mut self, trim: &TrimResult) {
+        self.offset_fault.voltage |= trim.voltage_fault();
+        self.offset_fault.current |= trim.current_fault();
+    }
+
+    /// Whether the built-in default motor is monitored (no valid motor record at boot): the
+    /// panel shows it ([`crate::panel`], "Built-in default motor"). Off until set.
+    pub fn set_default_motor(&mut self, default_motor: bool) {
+        self.default_motor = default_motor;
     }
 
     /// Isolates against `isolator`'s machine from now on (the motor record's, read at boot;
@@ -615,7 +658,9 @@ impl Supervisor {
     /// One period at `now_ms`: `status` is the sample task's latest status if a new one
     /// came, `button` whether the button was pressed since the last tick.
     pub fn tick(&mut self, now_ms: u32, status: Option<MonitorStatus>, button: bool) -> Tick {
-        if let Some(s) = status {
+        if let Some(mut s) = status {
+            s.sensor_fault.voltage |= self.offset_fault.voltage;
+            s.sensor_fault.current |= self.offset_fault.current;
             let previous = self.latest.samples;
             self.latest = s;
             self.follow(&s, previous);
@@ -668,7 +713,10 @@ impl Supervisor {
             .as_ref()
             .filter(|f| f.learned())
             .and_then(Follower::last);
-        let input = panel_input(mode, &self.latest, learned, failed);
+        let input = PanelInput {
+            default_motor: self.default_motor,
+            ..panel_input(mode, &self.latest, learned, failed)
+        };
         Tick {
             pet_watchdog: watch.pet_watchdog,
             mode,

@@ -33,7 +33,7 @@
 //! | encoder A / B | PB6 / PB7 | TIM4_CH1 / TIM4_CH2 | quadrature x4, 1024 lines |
 //! | sample trigger | (internal) | TIM1 TRGO | both ADCs, rising edge |
 //! | RUN lamp | PA5 | LD2 (green, on board) | [`Lamp::Run`] |
-//! | r1 lamp | PB8 | GPIO out | [`Lamp::R1`] |
+//! | r1 lamp | PB14 | GPIO out | [`Lamp::R1`] (not PB8: that is BOOT0) |
 //! | r2 lamp | PB9 | GPIO out | [`Lamp::R2`] |
 //! | r3 lamp | PB10 | GPIO out | [`Lamp::R3`] |
 //! | r4 lamp | PB12 | GPIO out | [`Lamp::R4`] |
@@ -76,6 +76,35 @@ pub const ENCODER_LINES: u32 = 1024;
 /// Encoder counts per mechanical revolution with x4 quadrature decoding:
 /// `4 * 1024 = 4096`.
 pub const ENCODER_COUNTS_PER_REV: u32 = 4 * ENCODER_LINES;
+
+/// Kernel clock of the encoder timer TIM4, Hz: the APB1 timer clock at the 170 MHz system
+/// clock (`firmware.rs`'s clock configuration, APB1 undivided).
+pub const ENCODER_TIMER_HZ: u32 = 170_000_000;
+
+/// Length of the timer input filter `ICxF = 0..=15` in timer clocks, with `f_DTS = f_CK_INT`
+/// (`CKD = 0`): `N` consecutive equal samples at `f_SAMPLING` (STM32G4 reference manual
+/// RM0440, `TIMx_CCMR1_Input`, `IC1F`): 0, fCK_INT x 2/4/8, fDTS/2 x 6/8, fDTS/4 x 6/8,
+/// fDTS/8 x 6/8, fDTS/16 x 5/6/8, fDTS/32 x 5/6/8.
+pub const INPUT_FILTER_CLOCKS: [u32; 16] = [
+    0, 2, 4, 8, 12, 16, 24, 32, 48, 64, 80, 96, 128, 160, 192, 256,
+];
+
+/// The encoder inputs' filter setting `ICxF` (0..=15): the longest filter whose delay is at
+/// most a quarter of the shortest time between two quadrature edges, `1 / (4 x lines x
+/// max_rev_per_s)`, on a timer clocked at `timer_hz`. A longer filter would swallow real
+/// edges at `max_rev_per_s`; this one rejects any glitch shorter than its delay. 0 (no
+/// filter) when even the shortest is too long or the inputs are not valid.
+pub fn encoder_input_filter(lines: u16, max_rev_per_s: f32, timer_hz: u32) -> u8 {
+    let edges_per_s = 4.0 * f32::from(lines) * max_rev_per_s;
+    if !(edges_per_s > 0.0 && edges_per_s.is_finite()) || timer_hz == 0 {
+        return 0;
+    }
+    let budget_clocks = timer_hz as f32 / edges_per_s / 4.0;
+    INPUT_FILTER_CLOCKS
+        .iter()
+        .rposition(|&n| n as f32 <= budget_clocks)
+        .map_or(0, |k| k as u8)
+}
 
 /// Offset of the commissioning record from the start of flash (0x0800_0000), bytes:
 /// the last 2 KiB page of bank 2 (dual-bank mode), `0x0807_F800`. `memory.x` keeps the
@@ -225,7 +254,7 @@ macro_rules! panel_lamps {
 // The lamp table: the one place where a lamp's pin, label and meaning are written.
 panel_lamps! {
     Run = 0: PA5, "RUN", "RUN: the monitor is alive; its blink pattern says what it does (LD2 on the board).";
-    R1 = 1: PB8, "r1", "r1: residual r1 beyond its threshold.";
+    R1 = 1: PB14, "r1", "r1: residual r1 beyond its threshold.";
     R2 = 2: PB9, "r2", "r2: residual r2 beyond its threshold.";
     R3 = 3: PB10, "r3", "r3: residual r3 beyond its threshold.";
     R4 = 4: PB12, "r4", "r4: residual r4 beyond its threshold.";
@@ -437,6 +466,21 @@ mod tests {
         assert_eq!(v.code_of(1e6), ADC_MAX_CODE);
         assert_eq!(v.code_of(-1e6), 0);
         assert!(is_saturated_code(0) && is_saturated_code(4095) && !is_saturated_code(1));
+    }
+
+    #[test]
+    fn the_encoder_filter_keeps_a_quarter_of_the_shortest_edge_interval() {
+        // 1024 lines at 50 rev/s: 204 800 edges/s, 4.88 us apart; a quarter is 1.22 us,
+        // 207.5 clocks at 170 MHz: the longest filter within it is fDTS/32 x 6 = 192.
+        assert_eq!(encoder_input_filter(1024, 50.0, 170_000_000), 14);
+        // Twice the speed: 103.8 clocks -> fDTS/16 x 6 = 96 (11).
+        assert_eq!(encoder_input_filter(1024, 100.0, 170_000_000), 11);
+        // A slow encoder gets the longest filter, an impossible one none.
+        assert_eq!(encoder_input_filter(100, 10.0, 170_000_000), 15);
+        assert_eq!(encoder_input_filter(60_000, 1_000.0, 170_000_000), 0);
+        assert_eq!(encoder_input_filter(0, 50.0, 170_000_000), 0);
+        assert_eq!(encoder_input_filter(1024, f32::NAN, 170_000_000), 0);
+        assert!(INPUT_FILTER_CLOCKS.windows(2).all(|w| w[0] < w[1]));
     }
 
     #[test]

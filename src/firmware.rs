@@ -6,23 +6,29 @@
 //!   of [`SETTINGS`]; each ADC fills a DMA ring of two samples, so every sample wakes the
 //!   task (half- and full-transfer interrupts). The task reads the encoder counter (TIM4)
 //!   and runs `SamplePath::on_frame` (scaling and `Monitor::update`). Every wait for ADC
-//!   data has a timeout ([`AdcWait`]): when it expires the acquisition is restarted.
-//!   Overruns (the DMA lapped the reader) are counted, logged, and the two rings are
-//!   resynchronised with the trigger stopped. Every `status_every` samples the task hands
+//!   data has a timeout ([`AdcWait`]): when it expires (an ADC overrun, a DMA transfer
+//!   error, a stopped trigger) or the DMA lapped the reader, the acquisition is recovered
+//!   by `drive_monitor::recovery::recover` on the registers (`firmware/acquisition.rs`):
+//!   trigger, ADCs and DMA stopped, `OVR` and `TEIF` cleared, DMA re-armed, ADCs and
+//!   trigger restarted, in the reference manual's order. Every `status_every` samples the task hands
 //!   thread mode a small `MonitorStatus`.
 //! - `main` in thread mode: boot (clocks, watchdog, why the previous run ended, flash
 //!   record), then every 50 ms `Supervisor::tick`: button, commissioning procedure, the
 //!   watch on the sample counter (the watchdog is petted only while samples flow), panel;
 //!   it carries out the commissioning action (storing the record in flash) and logs a
 //!   status line every 100 ms.
-//! - The panic handler: "monitor failed" on the panel, the reason into the reset record
-//!   (RAM that survives the reset), then it waits for the watchdog.
+//! - The panic handlers (`firmware/failure.rs`, `core`'s and defmt's): "monitor failed" on
+//!   the panel, the reason into the reset record (RAM that survives the reset), then the
+//!   watchdog's reset, or a software reset when the watchdog does not run yet.
 //!
 //! Communication: `COMMANDS` (Channel, thread -> sample task), `STATUS` (Signal, latest
-//! status, sample task -> thread, 100 Hz).
+//! status, sample task -> thread, 100 Hz), `TRIM` (Signal, the start-up offset trim, once).
+
+mod acquisition;
+mod failure;
 
 use core::mem::MaybeUninit;
-use core::sync::atomic::{AtomicU32, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
 
 use defmt::{error, info, warn};
 use defmt_rtt as _;
@@ -46,16 +52,22 @@ use drive_monitor::app::{
     carry_out, isolation_summary, Command, MonitorStatus, SamplePath, Settings, Supervisor,
     PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
 };
-use drive_monitor::board::{self, pins::Board, CurrentCode, Lamp, Port, VoltageCode, LAMP_COUNT};
+use drive_monitor::board::{self, pins::Board, CurrentCode, Lamp, VoltageCode, LAMP_COUNT};
 use drive_monitor::commissioning::RunEnd;
 use drive_monitor::flash_record::{self, LoadError, RecordStore, StoreError, RECORD_LEN};
 use drive_monitor::liveness::{AdcWait, LivenessChange};
-use drive_monitor::motor_source;
+use drive_monitor::motor_source::{self, EncoderSetup};
+use drive_monitor::offset_trim::{ChannelTrim, TrimResult, MAX_OFFSET_CODES};
 use drive_monitor::panel::PanelLamps;
-use drive_monitor::reset_record::{PreviousRun, ResetCause, ResetRecord, RESET_RECORD_LEN};
+use drive_monitor::recovery::{self, RecoveryCounts, StepTimeout};
+use drive_monitor::reset_record::{
+    Phase, PreviousRun, ResetCause, ResetRecord, ResetSource, RESET_RECORD_LEN,
+};
 use drive_monitor::sampling::RawFrame;
-use monitor_core::motor_record::STORED_LEN as MOTOR_RECORD_LEN;
+use monitor_core::motor_record::{MotorRecord, STORED_LEN as MOTOR_RECORD_LEN};
 use monitor_core::Isolation;
+
+use acquisition::HwAcquisition;
 
 bind_interrupts!(struct Irqs {
     DMA1_CHANNEL1 => dma::InterruptHandler<peripherals::DMA1_CH1>;
@@ -89,9 +101,19 @@ struct Status {
 
 static COMMANDS: Channel<CriticalSectionRawMutex, Command, 4> = Channel::new();
 static STATUS: Signal<CriticalSectionRawMutex, Status> = Signal::new();
+/// The start-up offset trim's result (sample task -> thread mode, once).
+static TRIM: Signal<CriticalSectionRawMutex, TrimResult> = Signal::new();
 static OVERRUNS: AtomicU32 = AtomicU32::new(0);
 static RESTARTS: AtomicU32 = AtomicU32::new(0);
 static EXECUTOR_HIGH: InterruptExecutor = InterruptExecutor::new();
+/// What the firmware is doing ([`Phase::number`]), for the record of a `defmt` panic.
+static PHASE: AtomicU8 = AtomicU8::new(0);
+/// The independent watchdog runs (else the panic handler resets the MCU itself).
+static WATCHDOG_RUNNING: AtomicBool = AtomicBool::new(false);
+
+fn set_phase(phase: Phase) {
+    PHASE.store(phase.number(), Ordering::Relaxed);
+}
 
 /// The reset record: RAM in cortex-m-rt's `.uninit` section, which the start-up code
 /// neither zeroes nor initialises, so it keeps its content across a reset.
@@ -144,38 +166,8 @@ struct SampleHw {
     tim4: Peri<'static, peripherals::TIM4>,
     enc_a: Peri<'static, peripherals::PB6>,
     enc_b: Peri<'static, peripherals::PB7>,
-}
-
-fn now_us() -> u32 {
-    Instant::now().as_micros() as u32
-}
-
-/// The acquisition: trigger timer and the two ring-buffered ADCs.
-struct Acquisition {
-    trigger: HwTimer<'static, peripherals::TIM1>,
-    adc1: RingBufferedAdc<'static, peripherals::ADC1>,
-    adc2: RingBufferedAdc<'static, peripherals::ADC2>,
-}
-
-impl Acquisition {
-    /// Restarts both rings with the trigger stopped, so that ADC1 and ADC2 start again on
-    /// the same conversion, and continues the timestamps from now (the gap shows).
-    async fn restart(&mut self, path: &mut SamplePath, stop_dma: bool) {
-        self.trigger.stop();
-        if stop_dma {
-            self.adc1.stop();
-            self.adc2.stop();
-        }
-        Timer::after_micros(20).await;
-        self.adc1.clear();
-        self.adc2.clear();
-        if stop_dma {
-            self.adc1.start();
-            self.adc2.start();
-        }
-        path.sampler_mut().resync(now_us());
-        self.trigger.start();
-    }
+    /// The encoder's direction, filter and pull-ups from the motor record.
+    encoder: EncoderSetup,
 }
 
 /// Starts the acquisition: the encoder (TIM4 in quadrature mode), the trigger (TIM1 update
@@ -184,13 +176,32 @@ impl Acquisition {
 fn start_acquisition(
     hw: SampleHw,
     path: &mut SamplePath,
-) -> (Qei<'static, peripherals::TIM4>, Acquisition) {
+) -> (Qei<'static, peripherals::TIM4>, HwAcquisition) {
     static RING1: static_cell::StaticCell<[u16; RING_LEN]> = static_cell::StaticCell::new();
     static RING2: static_cell::StaticCell<[u16; RING_LEN]> = static_cell::StaticCell::new();
     let ring1 = RING1.init([0; RING_LEN]);
     let ring2 = RING2.init([0; RING_LEN]);
 
-    let qei = Qei::new(hw.tim4, hw.enc_a, hw.enc_b, QeiConfig::default());
+    let pull = if hw.encoder.pull_up {
+        Pull::Up
+    } else {
+        Pull::None
+    };
+    let qei_config = QeiConfig {
+        ch1_pull: pull,
+        ch2_pull: pull,
+        ..QeiConfig::default()
+    };
+    let qei = Qei::new(hw.tim4, hw.enc_a, hw.enc_b, qei_config);
+    // The input filter on both inputs and the direction (input A's polarity), from the
+    // motor record (`motor_source::encoder_setup`).
+    let tim4 = pac::TIM4;
+    let filter = pac::timer::vals::FilterValue::from_bits(hw.encoder.input_filter);
+    tim4.ccmr_input(0).modify(|w| {
+        w.set_icf(0, filter);
+        w.set_icf(1, filter);
+    });
+    tim4.ccer().modify(|w| w.set_ccp(0, hw.encoder.invert_a));
 
     // Sample trigger: TIM1 update event -> TRGO -> both ADCs (rising edge).
     let trigger = HwTimer::new(hw.tim1);
@@ -227,15 +238,9 @@ fn start_acquisition(
         triggers::TIM1_TRGO,
         Exten::RISING_EDGE,
     );
-    let mut acq = Acquisition {
-        trigger,
-        adc1,
-        adc2,
-    };
-    acq.adc1.start();
-    acq.adc2.start();
-    path.sampler_mut().resync(now_us());
-    acq.trigger.start();
+    let mut acq = HwAcquisition::new(trigger, adc1, adc2, RING_LEN as u16);
+    acq.start();
+    path.sampler_mut().resync(acq.started_us);
     (qei, acq)
 }
 
@@ -258,6 +263,9 @@ fn process_half(
             i: [CurrentCode(ia), CurrentCode(ib), CurrentCode(ic)],
             encoder_count,
         };
+        if let Some(trim) = path.trim_offsets(&raw) {
+            TRIM.signal(trim);
+        }
         let t0 = cortex_m::peripheral::DWT::cycle_count();
         path.on_frame(&raw);
         let dt = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t0);
@@ -273,7 +281,13 @@ fn process_half(
 
 #[embassy_executor::task]
 async fn sample_task(hw: SampleHw, mut path: SamplePath) {
+    // The HAL's ADC set-up waits on registers without a bound (power-up, calibration,
+    // ADRDY, ADSTART): the record says so if the watchdog has to end it.
+    set_phase(Phase::AdcSetup);
+    write_reset_record(&ResetRecord::setup(Phase::AdcSetup).encode());
     let (qei, mut acq) = start_acquisition(hw, &mut path);
+    write_reset_record(&[0; RESET_RECORD_LEN]);
+    set_phase(Phase::Sampling);
     info!("sampling at {=u32} Hz", SETTINGS.sample_rate_hz);
 
     let mut wait = AdcWait::new(SETTINGS.sample_rate_hz);
@@ -281,6 +295,7 @@ async fn sample_task(hw: SampleHw, mut path: SamplePath) {
     let mut half1 = [0u16; SAMPLES_PER_HALF * CHANNELS];
     let mut half2 = [0u16; SAMPLES_PER_HALF * CHANNELS];
     let mut max_cycles: u32 = 0;
+    let mut counts = RecoveryCounts::default();
     loop {
         let read = with_timeout(timeout, async {
             let r1 = acq.adc1.read(&mut half1).await;
@@ -288,30 +303,60 @@ async fn sample_task(hw: SampleHw, mut path: SamplePath) {
             (r1.is_ok(), r2.is_ok())
         })
         .await;
-        let Ok((ok1, ok2)) = read else {
-            // No data within the timeout: the DMA or the trigger stalled. Restart the
-            // acquisition (thread mode shows the stall and stops petting the watchdog
-            // until samples flow again).
-            let restart = wait.timed_out();
-            RESTARTS.fetch_add(1, Ordering::Relaxed);
-            if restart.log {
-                error!(
-                    "no ADC data for {=u32} us: restarting sampling (attempt {=u32})",
-                    wait.timeout_us(),
-                    restart.attempt
-                );
+        let recover_now = match read {
+            Ok((ok1, ok2)) => {
+                if let Some(n) = wait.data() {
+                    warn!("sampling resumed after {=u32} recoveries", n);
+                }
+                if !(ok1 && ok2) {
+                    // The DMA lapped the reader: samples were lost.
+                    let n = OVERRUNS.fetch_add(1, Ordering::Relaxed) + 1;
+                    warn!(
+                        "ADC DMA ring lapped #{=u32} (adc1 {} adc2 {})",
+                        n, !ok1, !ok2
+                    );
+                }
+                !(ok1 && ok2)
             }
-            acq.restart(&mut path, true).await;
-            continue;
+            Err(_) => {
+                // No data within the timeout: an ADC overrun, a DMA error, or a stopped
+                // trigger (thread mode shows a stall and stops petting the watchdog until
+                // samples flow again).
+                let restart = wait.timed_out();
+                RESTARTS.fetch_add(1, Ordering::Relaxed);
+                if restart.log {
+                    error!(
+                        "no ADC data for {=u32} us: recovering the acquisition (attempt {=u32})",
+                        wait.timeout_us(),
+                        restart.attempt
+                    );
+                }
+                true
+            }
         };
-        if let Some(n) = wait.data() {
-            warn!("sampling resumed after {=u32} restarts", n);
-        }
-        if !(ok1 && ok2) {
-            // Samples were lost: count, log, resynchronise both rings.
-            let n = OVERRUNS.fetch_add(1, Ordering::Relaxed) + 1;
-            warn!("ADC DMA overrun #{=u32} (adc1 {} adc2 {})", n, !ok1, !ok2);
-            acq.restart(&mut path, false).await;
+        if recover_now {
+            // One sequence for every cause (drive_monitor::recovery): trigger, ADCs and
+            // DMA stopped, OVR and TEIF cleared, DMA re-armed, ADCs and trigger restarted;
+            // the timestamps continue from the restart (the gap shows).
+            set_phase(Phase::Recovery);
+            let result = recovery::recover(&mut acq);
+            path.sampler_mut().resync(acq.started_us);
+            set_phase(Phase::Sampling);
+            counts.count(result);
+            match result {
+                Ok(f) if f.adc_overrun || f.dma_error => warn!(
+                    "acquisition recovered: adc overrun {=bool}, dma error {=bool} (recoveries {=u32}, overruns {=u32}, dma errors {=u32})",
+                    f.adc_overrun,
+                    f.dma_error,
+                    counts.recoveries,
+                    counts.adc_overruns,
+                    counts.dma_errors
+                ),
+                Ok(_) => {}
+                Err(StepTimeout(step)) => {
+                    error!("acquisition recovery stopped at {=str}: timed out", step.name())
+                }
+            }
             continue;
         }
         while let Ok(cmd) = COMMANDS.try_receive() {
@@ -342,20 +387,45 @@ impl PanelPins {
     }
 }
 
-/// The record page in the board's flash.
-struct BoardFlash(Flash<'static, Blocking>);
+/// Why the board's flash could not be used.
+#[derive(defmt::Format)]
+enum FlashError {
+    /// The option bytes select single-bank flash (the records' pages need dual-bank).
+    SingleBank,
+    /// The flash driver's error.
+    Driver(embassy_stm32::flash::Error),
+}
+
+/// The record pages in the board's flash (`None`: the option bytes are single-bank).
+struct BoardFlash(Option<Flash<'static, Blocking>>);
+
+impl BoardFlash {
+    fn driver(&mut self) -> Result<&mut Flash<'static, Blocking>, FlashError> {
+        self.0.as_mut().ok_or(FlashError::SingleBank)
+    }
+
+    fn read_at(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), FlashError> {
+        self.driver()?
+            .blocking_read(offset, buf)
+            .map_err(FlashError::Driver)
+    }
+}
 
 impl RecordStore for BoardFlash {
-    type Error = embassy_stm32::flash::Error;
+    type Error = FlashError;
     fn read(&mut self, buf: &mut [u8; RECORD_LEN]) -> Result<(), Self::Error> {
-        self.0.blocking_read(board::RECORD_FLASH_OFFSET, buf)
+        self.read_at(board::RECORD_FLASH_OFFSET, buf)
     }
     fn erase(&mut self) -> Result<(), Self::Error> {
         let from = board::RECORD_FLASH_OFFSET;
-        self.0.blocking_erase(from, from + board::RECORD_PAGE_SIZE)
+        self.driver()?
+            .blocking_erase(from, from + board::RECORD_PAGE_SIZE)
+            .map_err(FlashError::Driver)
     }
     fn write(&mut self, bytes: &[u8; RECORD_LEN]) -> Result<(), Self::Error> {
-        self.0.blocking_write(board::RECORD_FLASH_OFFSET, bytes)
+        self.driver()?
+            .blocking_write(board::RECORD_FLASH_OFFSET, bytes)
+            .map_err(FlashError::Driver)
     }
 }
 
@@ -378,6 +448,48 @@ fn clock_config() -> embassy_stm32::Config {
     config
 }
 
+/// The independent watchdog, started, and frozen while a debugger halts the core
+/// (`DBGMCU_APB1FZR1.DBG_IWDG_STOP`): stepping through the firmware does not reset it.
+fn start_watchdog(
+    iwdg: Peri<'static, peripherals::IWDG>,
+) -> IndependentWatchdog<'static, peripherals::IWDG> {
+    pac::DBGMCU.apb1lfzr().modify(|w| w.set_iwdg(true));
+    let mut wdg = IndependentWatchdog::new(iwdg, WATCHDOG_TIMEOUT_MS * 1000);
+    wdg.unleash();
+    WATCHDOG_RUNNING.store(true, Ordering::Relaxed);
+    wdg
+}
+
+/// The machine: the motor record in flash, else the built-in default (the reason is
+/// logged; a page that cannot be read counts as erased). Returns the record in force, its
+/// sample path and whether it is the built-in default.
+fn select_machine(flash: &mut BoardFlash) -> (MotorRecord, SamplePath, bool) {
+    let mut page = [0xFF_u8; MOTOR_RECORD_LEN];
+    if let Err(e) = flash.read_at(board::MOTOR_RECORD_FLASH_OFFSET, &mut page) {
+        warn!("motor record page unreadable: {}", e);
+    }
+    let (mut machine, source) = motor_source::select(&page);
+    info!("{=str}", source.describe());
+    let mut default_motor = source.is_default();
+    let path = match motor_source::sample_path(&machine, SETTINGS.sample_rate_hz) {
+        Ok(p) => p,
+        Err(_) => {
+            // A record the core accepted at boot but not at this sample rate: the default.
+            warn!("motor record rejected at this sample rate: built-in default motor");
+            default_motor = true;
+            machine = motor_source::default_record();
+            match SamplePath::for_board(SETTINGS.sample_rate_hz) {
+                Ok(p) => p,
+                // The settings are constants and a host test (`app::tests`) builds the same
+                // path: this cannot happen, and if it did nothing could be monitored.
+                #[allow(clippy::panic)]
+                Err(_) => panic!("monitor configuration rejected"),
+            }
+        }
+    };
+    (machine, path, default_motor)
+}
+
 #[embassy_executor::main]
 async fn main(_spawner: Spawner) {
     let p = embassy_stm32::init(clock_config());
@@ -391,48 +503,30 @@ async fn main(_spawner: Spawner) {
     }
 
     let b = Board::take(p);
-    let mut wdg = IndependentWatchdog::new(b.iwdg, WATCHDOG_TIMEOUT_MS * 1000);
-    wdg.unleash();
+    let wdg = start_watchdog(b.iwdg);
+    // The flash driver (built for dual-bank) panics on single-bank option bytes: check
+    // first and run without the records instead (the built-in motor, not commissioned).
+    set_phase(Phase::Flash);
+    let dual_bank = pac::FLASH.optr().read().dbank();
+    if !dual_bank {
+        error!("option bytes: single-bank flash (DBANK = 0); the records need dual-bank: set DBANK with STM32CubeProgrammer. Running with the built-in motor, not commissioned");
+    }
 
     let mut thread = Thread {
         lamps: PanelPins::new(b.lamps),
-        flash: BoardFlash(Flash::new_blocking(b.flash)),
+        flash: BoardFlash(dual_bank.then(|| Flash::new_blocking(b.flash))),
         wdg,
         max_update_cycles: 0,
         log_div: 0,
     };
     let mut button = ExtiInput::new(b.button, b.button_exti, Pull::Down, Irqs);
 
-    // The machine: the motor record in flash, else the built-in default (the reason is
-    // logged). A page that cannot be read counts as erased.
-    let mut page = [0xFF_u8; MOTOR_RECORD_LEN];
-    if let Err(e) = thread
-        .flash
-        .0
-        .blocking_read(board::MOTOR_RECORD_FLASH_OFFSET, &mut page)
-    {
-        warn!("motor record page unreadable: {}", e);
-    }
-    let (machine, source) = motor_source::select(&page);
-    info!("{=str}", source.describe());
-    let mut path = match motor_source::sample_path(&machine, SETTINGS.sample_rate_hz) {
-        Ok(p) => p,
-        Err(_) => {
-            // A record the core accepted at boot but not at this sample rate: the default.
-            warn!("motor record rejected at this sample rate: built-in default motor");
-            match SamplePath::for_board(SETTINGS.sample_rate_hz) {
-                Ok(p) => p,
-                // The settings are constants and a host test (`app::tests`) builds the same
-                // path: this cannot happen, and if it did nothing could be monitored.
-                #[allow(clippy::panic)]
-                Err(_) => panic!("monitor configuration rejected"),
-            }
-        }
-    };
+    let (machine, mut path, default_motor) = select_machine(&mut thread.flash);
     let installed = install_stored_calibration(&mut thread.flash, &mut path);
     let boot = Instant::now();
     let mut supervisor = Supervisor::new(&SETTINGS, previous, 0, path.status());
-    if !source.is_default() {
+    supervisor.set_default_motor(default_motor);
+    if !default_motor {
         supervisor.set_isolator(motor_source::isolator(&machine).ok());
     }
     if let Some(rec) = installed {
@@ -455,8 +549,15 @@ async fn main(_spawner: Spawner) {
         tim4: b.encoder_timer,
         enc_a: b.encoder_a,
         enc_b: b.encoder_b,
+        encoder: motor_source::encoder_setup(&machine),
     };
-    high.spawn(defmt::unwrap!(sample_task(hw, path)));
+    set_phase(Phase::Boot);
+    match sample_task(hw, path) {
+        Ok(task) => high.spawn(task),
+        // A task that is spawned once, at boot: the pool cannot be full.
+        #[allow(clippy::panic)]
+        Err(_) => panic!("sample task not spawned"),
+    }
 
     let period = Duration::from_millis(u64::from(PANEL_PERIOD_MS));
     let mut next = Instant::now() + period;
@@ -494,6 +595,10 @@ impl Thread {
         let status = STATUS.try_take();
         if let Some(s) = status {
             self.max_update_cycles = s.max_update_cycles;
+        }
+        if let Some(trim) = TRIM.try_take() {
+            supervisor.set_offset_fault(&trim);
+            log_trim(&trim);
         }
         let tick = supervisor.tick(now_ms, status.map(|s| s.monitor), pressed);
         if tick.pet_watchdog {
@@ -534,32 +639,52 @@ impl Thread {
     }
 }
 
-/// Why the previous run ended: the reset record (then erased) and the watchdog flag (then
+/// Why the previous run ended: the reset record (then erased) and the reset flags (then
 /// cleared), logged.
 fn previous_run() -> PreviousRun {
-    let csr = pac::RCC.csr().read();
+    let source = ResetSource::from_csr(pac::RCC.csr().read().0);
     pac::RCC.csr().modify(|w| w.set_rmvf(true));
-    let previous = PreviousRun::at_boot(&read_reset_record(), csr.iwdgrstf());
+    let previous = PreviousRun::at_boot(&read_reset_record(), source);
     write_reset_record(&[0; RESET_RECORD_LEN]);
+    info!("reset by {=str}", source.name());
     match previous {
         PreviousRun::Clean => {}
         PreviousRun::WatchdogReset => {
             error!("previous run ended in a watchdog reset with no reason recorded: the firmware hung")
         }
-        PreviousRun::Recorded(rec) => match rec.cause() {
-            ResetCause::Panic => error!(
-                "previous run ended in a panic: {=str} at {=str}:{=u32}",
-                rec.message(),
-                rec.file(),
-                rec.line_or_ms()
-            ),
-            ResetCause::SampleStall => error!(
-                "previous run ended in a watchdog reset: the sample path had stalled (no samples for {=u32} ms when recorded; restarts did not help)",
-                rec.line_or_ms()
-            ),
-        },
+        PreviousRun::ResetDuring { record, source } => warn!(
+            "previous run: {=str} recorded ({=u32}), then a {=str} reset came before the watchdog's",
+            record.message(),
+            record.line_or_ms(),
+            source.name()
+        ),
+        PreviousRun::Recorded(rec) => log_record(&rec),
     }
     previous
+}
+
+fn log_record(rec: &ResetRecord) {
+    match rec.cause() {
+        ResetCause::Panic => error!(
+            "previous run ended in a panic: {=str} at {=str}:{=u32}",
+            rec.message(),
+            rec.file(),
+            rec.line_or_ms()
+        ),
+        ResetCause::DefmtPanic => error!(
+            "previous run ended in a defmt panic during {=str}, called from {=u32:#010x} (addr2line -e the ELF; the message is in that run's log)",
+            rec.message(),
+            rec.line_or_ms()
+        ),
+        ResetCause::SetupTimeout => error!(
+            "previous run ended in a watchdog reset: the {=str} set-up did not finish",
+            rec.message()
+        ),
+        ResetCause::SampleStall => error!(
+            "previous run ended in a watchdog reset: the sample path had stalled (no samples for {=u32} ms when recorded; recoveries did not help)",
+            rec.line_or_ms()
+        ),
+    }
 }
 
 /// Reads the commissioning record and gives it to the core; returns it when the core
@@ -603,6 +728,28 @@ fn on_liveness(change: LivenessChange) {
         LivenessChange::Recovered { after_ms } => {
             write_reset_record(&[0; RESET_RECORD_LEN]);
             warn!("sample path recovered after {=u32} ms", after_ms);
+        }
+    }
+}
+
+/// The start-up offset trim, channel by channel (`drive_monitor::offset_trim`).
+fn log_trim(trim: &TrimResult) {
+    let names = ["va", "vb", "vc", "ia", "ib", "ic"];
+    let channels = trim.voltage.iter().chain(trim.current.iter());
+    for (name, channel) in names.into_iter().zip(channels) {
+        match *channel {
+            ChannelTrim::Trimmed(code) => info!("offset trim {=str}: zero at {=f32} codes, in force", name, code),
+            ChannelTrim::OutOfBound(code) => error!(
+                "offset trim {=str}: zero at {=f32} codes, beyond +-{=f32} of the zero in force: sensor flagged, not used",
+                name,
+                code,
+                MAX_OFFSET_CODES
+            ),
+            ChannelTrim::NotQuiet(spread) => info!(
+                "offset trim {=str}: not quiet (spread {=f32} codes; motor running or supply on): not trimmed",
+                name,
+                spread
+            ),
         }
     }
 }
@@ -680,44 +827,4 @@ fn log_status(s: &MonitorStatus, iso: Option<&Isolation>, mode: &str, max_update
         wind_name,
         wind_i2,
     );
-}
-
-/// Panic: the panel's "monitor failed" pattern on the lamp pins of the lamp table, the
-/// reason into the reset record and the log, and stop. The watchdog is no longer petted,
-/// so the MCU resets after `WATCHDOG_TIMEOUT_MS`; the next boot reads the record, logs it
-/// and shows the failed pattern for 5 s before monitoring again.
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
-    cortex_m::interrupt::disable();
-    // Direct register writes: the HAL objects may be in any state. GPIO clocks are
-    // enabled by `embassy_stm32::init` for every port.
-    use pac::gpio::vals::Moder;
-    for lamp in Lamp::ALL {
-        let pin = lamp.pin();
-        let port = match pin.port {
-            Port::A => pac::GPIOA,
-            Port::B => pac::GPIOB,
-            Port::C => pac::GPIOC,
-            Port::D => pac::GPIOD,
-            Port::E => pac::GPIOE,
-            Port::F => pac::GPIOF,
-            Port::G => pac::GPIOG,
-        };
-        let n = usize::from(pin.number);
-        port.moder().modify(|w| w.set_moder(n, Moder::OUTPUT));
-        if PanelLamps::FAILED.is_on(lamp) {
-            port.bsrr().write(|w| w.set_bs(n, true));
-        } else {
-            port.bsrr().write(|w| w.set_br(n, true));
-        }
-    }
-    // Only the static part of the message and the location are kept: formatting the
-    // full message would pull core::fmt (float formatting alone is ~10 KiB of flash).
-    let msg = info.message().as_str().unwrap_or("(formatted message)");
-    let (file, line) = info.location().map_or(("?", 0), |l| (l.file(), l.line()));
-    write_reset_record(&ResetRecord::panic(msg, file, line).encode());
-    error!("MONITOR FAILED: {=str} at {=str}:{=u32}", msg, file, line);
-    loop {
-        cortex_m::asm::nop();
-    }
 }

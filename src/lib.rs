@@ -11,8 +11,11 @@
 //! - [`flash_record`]: the commissioning record's encoding, version and CRC, and storing it;
 //! - [`liveness`]: timeouts on the ADC waits, the watch on the sample counter that pets
 //!   the watchdog;
+//! - [`recovery`]: the acquisition's recovery after an ADC overrun or a DMA error (the
+//!   register sequence in the reference manual's order, over a trait the host rig fakes);
 //! - [`reset_record`]: why the previous run ended (panic, stalled sample path), kept in
 //!   RAM across the reset;
+//! - [`offset_trim`]: each channel's zero measured at start-up with the motor off, bounded;
 //! - [`panel`]: lamp patterns and blink codes;
 //! - [`app`]: the glue: settings, the per-sample path, the status it hands thread mode,
 //!   and thread mode's supervisor.
@@ -45,6 +48,8 @@ pub mod commissioning;
 pub mod flash_record;
 pub mod liveness;
 pub mod motor_source;
+pub mod offset_trim;
 pub mod panel;
+pub mod recovery;
 pub mod reset_record;
 pub mod sampling;

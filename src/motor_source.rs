@@ -122,6 +122,42 @@ pub fn sample_path(rec: &MotorRecord, sample_rate_hz: u32) -> Result<SamplePath,
     )
 }
 
+/// How the encoder timer is set up for a record: counts per revolution (4 x lines),
+/// the count direction, the input filter and the pull-ups.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EncoderSetup {
+    /// Quadrature counts per revolution, `4 x encoder_lines` (the core's
+    /// `EncoderConfig::counts_per_rev`, [`monitor_config`]).
+    pub counts_per_rev: u32,
+    /// Invert input A's polarity (`TIMx_CCER.CC1P`), so that the counter counts up when the
+    /// motor turns forward with an encoder that counts down: the record's
+    /// `encoder_reversed`, applied in the timer at no cost per sample.
+    pub invert_a: bool,
+    /// The inputs' filter `ICxF` ([`board::encoder_input_filter`] at twice the supply's
+    /// synchronous speed).
+    pub input_filter: u8,
+    /// Internal pull-ups on A and B (about 40 kohm): open-collector encoders need a pull-up,
+    /// push-pull ones are not disturbed by it, and an unplugged encoder reads a steady high
+    /// instead of noise.
+    pub pull_up: bool,
+}
+
+/// The encoder setup for `rec` ([`EncoderSetup`]).
+pub fn encoder_setup(rec: &MotorRecord) -> EncoderSetup {
+    let pole_pairs = (rec.motor.poles / 2).max(1) as f32;
+    let max_rev_per_s = 2.0 * rec.supply.f_hz as f32 / pole_pairs;
+    EncoderSetup {
+        counts_per_rev: 4 * u32::from(rec.encoder_lines),
+        invert_a: rec.encoder_reversed,
+        input_filter: board::encoder_input_filter(
+            rec.encoder_lines,
+            max_rev_per_s,
+            board::ENCODER_TIMER_HZ,
+        ),
+        pull_up: true,
+    }
+}
+
 /// The fault isolator for `rec`'s machine on its supply (for [`default_record`],
 /// [`crate::app::board_isolator`]).
 ///

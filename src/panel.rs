@@ -15,6 +15,13 @@
 //! | all six lamps flash together at 2 Hz (250 ms on / 250 ms off) | SAMPLING STALLED: no samples arrive; the lamps show no monitoring result; the firmware restarts sampling, the watchdog resets the MCU if that fails |
 //! | off, all five other lamps steady on | MONITOR FAILED (a panic or a watchdog reset; for 5 s after the reset, see the defmt log) |
 //!
+//! **Built-in default motor.** When no valid motor record was found in flash (or the
+//! option bytes are single-bank and the flash is not used), the firmware monitors the
+//! built-in default machine: then, in the three monitoring/commissioning patterns above,
+//! the RUN lamp is lit **steadily for the first 2 s of every 10 s**, dark for 0.5 s, then
+//! shows its pattern as above for 7.5 s. No other state lights the RUN lamp for more than
+//! 500 ms at a time.
+//!
 //! The RUN lamp is never off for more than 1.7 s while the monitor runs, so "RUN off and
 //! everything else on" cannot be mistaken for a normal state; and only a stalled sample
 //! path flashes the residual lamps (they are steady otherwise).
@@ -151,6 +158,9 @@ pub struct PanelInput {
     pub fault_code: u8,
     /// The last commissioning attempt failed (shown while no fault is).
     pub commissioning_failed: bool,
+    /// The built-in default motor is monitored (no valid motor record): the RUN lamp's
+    /// steady 2 s of every 10 s (module docs).
+    pub default_motor: bool,
 }
 
 /// Blink code of a fault detected that the isolation did not name (module docs).
@@ -175,6 +185,11 @@ const BLINK_SLOT_MS: u32 = 500;
 const BLINK_GAP_MS: u32 = 1500;
 /// Half period of the "sampling stalled" flash, ms (2 Hz).
 const STALLED_HALF_PERIOD_MS: u32 = 250;
+/// Period of the "built-in default motor" mark and its steady part, ms.
+const DEFAULT_MOTOR_PERIOD_MS: u32 = 10_000;
+const DEFAULT_MOTOR_ON_MS: u32 = 2_000;
+/// The dark gap after it, ms (so the mark is never longer than 2 s).
+const DEFAULT_MOTOR_GAP_MS: u32 = 500;
 
 /// Fault lamp state at `t_ms` for blink code `n` (>= 1): `n` pulses of 250 ms in 500 ms
 /// slots, then 1.5 s dark; period `n * 500 + 1500` ms.
@@ -208,8 +223,14 @@ pub fn render(input: &PanelInput, t_ms: u32) -> PanelLamps {
         _ => {}
     }
     let learning = input.mode == Mode::Commissioning;
+    let mark_phase = t_ms % DEFAULT_MOTOR_PERIOD_MS;
+    let run = match input.default_motor {
+        true if mark_phase < DEFAULT_MOTOR_ON_MS => true,
+        true if mark_phase < DEFAULT_MOTOR_ON_MS + DEFAULT_MOTOR_GAP_MS => false,
+        _ => run_lamp(input.mode, t_ms),
+    };
     PanelLamps {
-        run: run_lamp(input.mode, t_ms),
+        run,
         residuals: if learning {
             [false; 4]
         } else {
@@ -275,7 +296,50 @@ mod tests {
             input_invalid: false,
             fault_code: 4,
             commissioning_failed: false,
+            default_motor: false,
         }
+    }
+
+    /// The longest time the RUN lamp is lit without a break in 20 s, ms.
+    fn longest_run_on_ms(inp: &PanelInput) -> u32 {
+        let (mut on, mut longest) = (0, 0);
+        for k in 0..2_000u32 {
+            on = if render(inp, k * 10).run { on + 10 } else { 0 };
+            longest = longest.max(on);
+        }
+        longest
+    }
+
+    #[test]
+    fn the_default_motor_lights_the_run_lamp_for_2_s_in_10_and_nothing_else_does() {
+        for mode in NORMAL {
+            let mut inp = input(mode);
+            assert!(longest_run_on_ms(&inp) <= 500, "{mode:?}");
+            inp.default_motor = true;
+            assert_eq!(longest_run_on_ms(&inp), 2_000, "{mode:?}");
+            // The steady part starts every 10 s; the mode's own pattern shows in between.
+            assert!((0..200u32).all(|k| render(&inp, 20_000 + k * 10).run));
+            let own = |t: u32| render(&input(mode), t).run;
+            assert!((250..1000u32).all(|k| render(&inp, k * 10).run == own(k * 10)));
+            // The residual and fault lamps are unchanged.
+            let plain = render(&input(mode), 100);
+            let marked = render(&inp, 100);
+            assert_eq!(
+                (plain.residuals, plain.fault),
+                (marked.residuals, marked.fault)
+            );
+        }
+        for mode in [Mode::Failed, Mode::SamplingStalled] {
+            let mut inp = input(mode);
+            inp.default_motor = true;
+            assert!(longest_run_on_ms(&inp) <= 250, "{mode:?}");
+        }
+        let mut inp = input(Mode::Commissioned);
+        inp.default_motor = true;
+        let trace: Vec<bool> = (0..400u32)
+            .map(|k| render(&inp, k * 50).is_on(Lamp::Fault))
+            .collect();
+        assert_eq!(read_blink_code(&trace, 50), Some(4));
     }
 
     const NORMAL: [Mode; 3] = [

@@ -8,16 +8,29 @@
 //! panic, a stalled sample path and a hang without either no longer all read "watchdog
 //! reset".
 //!
+//! The record is read together with the reset flags of `RCC_CSR` ([`ResetSource`]): a
+//! stalled sample path or a set-up that did not finish ends in a watchdog reset, so such
+//! a record is reported as the cause only after a watchdog reset; after a reset by the
+//! button, a brown-out or a power-on the boot says that a stall was recorded and that
+//! this other reset came first ([`PreviousRun::ResetDuring`]). A panic ends in a watchdog
+//! reset or in the panic handler's software reset (before the watchdog runs); it is
+//! reported whatever reset followed.
+//!
+//! Panics through `defmt::panic!` (the HAL's assertions with its `defmt` feature, the
+//! firmware's `defmt::unwrap!`) do not hand their message to the handler (it is in the
+//! defmt log); their record names the firmware's [`Phase`] at the time and the address
+//! the handler was called from ([`ResetRecord::defmt_panic`]).
+//!
 //! # Layout ([`RESET_RECORD_LEN`] = 128 bytes, little endian)
 //!
 //! | bytes | field |
 //! |---|---|
 //! | 0..4 | magic `b"DMRR"` |
-//! | 4 | cause: 1 = panic, 2 = sample path stalled |
+//! | 4 | cause: 1 = panic, 2 = sample path stalled, 3 = a set-up step did not finish, 4 = a `defmt` panic |
 //! | 5 | message length (0..=[`MESSAGE_LEN`]) |
 //! | 6 | file length (0..=[`FILE_LEN`]) |
 //! | 7 | reserved, zero |
-//! | 8..12 | line (panic) or stall time in ms (stall), `u32` |
+//! | 8..12 | line (panic), stall time in ms (stall), phase (set-up), return address (`defmt` panic), `u32` |
 //! | 12..76 | message, UTF-8, zero padded |
 //! | 76..124 | file (the end of the path), UTF-8, zero padded |
 //! | 124..128 | CRC-32 of bytes 0..124 ([`crate::flash_record::crc32`]) |
@@ -42,6 +55,151 @@ pub enum ResetCause {
     Panic,
     /// No samples arrived and the restarts did not help; the watchdog reset the MCU.
     SampleStall,
+    /// A set-up step (its [`Phase`] in the message) did not finish before the watchdog
+    /// reset the MCU: the HAL's set-up waits on registers without a bound, so the record is
+    /// written before the step and cleared after it ([`ResetRecord::setup`]).
+    SetupTimeout,
+    /// A panic through `defmt::panic!` (the HAL, `defmt::unwrap!`): the [`Phase`] in the
+    /// message, the address the panic handler was called from in the number.
+    DefmtPanic,
+}
+
+impl ResetCause {
+    /// The record's byte for the cause.
+    const fn code(self) -> u8 {
+        match self {
+            ResetCause::Panic => 1,
+            ResetCause::SampleStall => 2,
+            ResetCause::SetupTimeout => 3,
+            ResetCause::DefmtPanic => 4,
+        }
+    }
+
+    /// The cause of a record's byte.
+    const fn from_code(code: u8) -> Option<Self> {
+        match code {
+            1 => Some(ResetCause::Panic),
+            2 => Some(ResetCause::SampleStall),
+            3 => Some(ResetCause::SetupTimeout),
+            4 => Some(ResetCause::DefmtPanic),
+            _ => None,
+        }
+    }
+
+    /// Whether the cause ends in a watchdog reset (and only then is reported as the cause).
+    pub const fn ends_in_watchdog_reset(self) -> bool {
+        matches!(self, ResetCause::SampleStall | ResetCause::SetupTimeout)
+    }
+}
+
+/// What the firmware is doing, for a `defmt` panic's record and a set-up step's (the
+/// firmware keeps the current phase in a static; [`Phase::name`] goes into the record).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    /// Clocks, the watchdog, the reset record, the motor record.
+    Boot,
+    /// The flash driver and the records in flash.
+    Flash,
+    /// The ADCs' set-up: power-up, calibration, enable, the rings.
+    AdcSetup,
+    /// The sample path runs.
+    Sampling,
+    /// The acquisition's recovery after an overrun or a DMA error.
+    Recovery,
+}
+
+impl Phase {
+    /// All phases.
+    pub const ALL: [Phase; 5] = [
+        Phase::Boot,
+        Phase::Flash,
+        Phase::AdcSetup,
+        Phase::Sampling,
+        Phase::Recovery,
+    ];
+
+    /// The phase's name in logs and records.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Phase::Boot => "boot",
+            Phase::Flash => "flash",
+            Phase::AdcSetup => "adc-setup",
+            Phase::Sampling => "sampling",
+            Phase::Recovery => "recovery",
+        }
+    }
+
+    /// The phase's number (its index in [`Phase::ALL`]), for a static.
+    pub const fn number(self) -> u8 {
+        self as u8
+    }
+
+    /// The phase of a number (`None` out of range).
+    pub fn from_number(n: u8) -> Option<Phase> {
+        Phase::ALL.get(usize::from(n)).copied()
+    }
+}
+
+/// What reset the MCU, from the reset flags of `RCC_CSR` (STM32G4 reference manual RM0440,
+/// "RCC control/status register"). Every reset also pulses the NRST pin, so the pin flag
+/// means the button (or an external reset) only when no other flag is set.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ResetSource {
+    /// The independent watchdog (`IWDGRSTF`, bit 29).
+    IndependentWatchdog,
+    /// The window watchdog (`WWDGRSTF`, bit 30; not used by the firmware).
+    WindowWatchdog,
+    /// A software reset (`SFTRSTF`, bit 28): the panic handler's, before the watchdog runs.
+    Software,
+    /// Loading the option bytes (`OBLRSTF`, bit 25).
+    OptionBytes,
+    /// An illegal low-power entry (`LPWRRSTF`, bit 31).
+    LowPower,
+    /// A power-on or a brown-out (`BORRSTF`, bit 27).
+    PowerOnOrBrownOut,
+    /// The reset button (NRST, `PINRSTF`, bit 26) or a debugger's reset.
+    Pin,
+    /// No flag set (the flags were cleared and nothing reset since).
+    Unknown,
+}
+
+impl ResetSource {
+    /// The source named by the reset flags of `RCC_CSR`'s value `csr`, most specific
+    /// first (watchdogs, software, option bytes, low power, power/brown-out, the pin).
+    pub fn from_csr(csr: u32) -> Self {
+        let bit = |n: u32| csr & (1 << n) != 0;
+        if bit(29) {
+            ResetSource::IndependentWatchdog
+        } else if bit(30) {
+            ResetSource::WindowWatchdog
+        } else if bit(28) {
+            ResetSource::Software
+        } else if bit(25) {
+            ResetSource::OptionBytes
+        } else if bit(31) {
+            ResetSource::LowPower
+        } else if bit(27) {
+            ResetSource::PowerOnOrBrownOut
+        } else if bit(26) {
+            ResetSource::Pin
+        } else {
+            ResetSource::Unknown
+        }
+    }
+
+    /// A short name for logs.
+    pub const fn name(self) -> &'static str {
+        match self {
+            ResetSource::IndependentWatchdog => "watchdog",
+            ResetSource::WindowWatchdog => "window watchdog",
+            ResetSource::Software => "software",
+            ResetSource::OptionBytes => "option-byte load",
+            ResetSource::LowPower => "low-power",
+            ResetSource::PowerOnOrBrownOut => "power-on or brown-out",
+            ResetSource::Pin => "reset button",
+            ResetSource::Unknown => "unknown",
+        }
+    }
 }
 
 /// The record: the cause, a message, and a location (panic) or a duration (stall).
@@ -116,6 +274,41 @@ impl ResetRecord {
         }
     }
 
+    /// The record a panic with `message` (`None`: a formatted message, which is not kept:
+    /// formatting would pull `core::fmt` into the firmware) at `location` (file, line)
+    /// leaves in the reset record's RAM: what the panic handler writes, and what the next
+    /// boot reports ([`PreviousRun::at_boot`]).
+    pub fn on_panic(
+        message: Option<&str>,
+        location: Option<(&str, u32)>,
+    ) -> [u8; RESET_RECORD_LEN] {
+        let (file, line) = location.unwrap_or(("?", 0));
+        Self::panic(message.unwrap_or("(formatted message)"), file, line).encode()
+    }
+
+    /// A panic through `defmt::panic!` in `phase`, the handler called from `return_address`
+    /// (look it up with `addr2line -e` on the ELF; the message is in the defmt log).
+    pub fn defmt_panic(phase: Phase, return_address: u32) -> Self {
+        Self {
+            cause: ResetCause::DefmtPanic,
+            number: return_address,
+            message: Text::new(phase.name(), false),
+            file: Text::new("", true),
+        }
+    }
+
+    /// The record written before a set-up step of `phase` that waits on hardware without
+    /// a bound, cleared when it finished: if the step hangs, the watchdog's reset is
+    /// reported as that step's timeout.
+    pub fn setup(phase: Phase) -> Self {
+        Self {
+            cause: ResetCause::SetupTimeout,
+            number: u32::from(phase.number()),
+            message: Text::new(phase.name(), false),
+            file: Text::new("", true),
+        }
+    }
+
     /// A stalled sample path, `stalled_ms` without samples when recorded.
     pub fn sample_stall(stalled_ms: u32) -> Self {
         Self {
@@ -141,7 +334,8 @@ impl ResetRecord {
         self.file.as_str()
     }
 
-    /// The line of a panic; the time without samples, ms, for a stall.
+    /// The line of a panic; the time without samples, ms, for a stall; the phase's number
+    /// for a set-up timeout; the return address for a `defmt` panic.
     pub fn line_or_ms(&self) -> u32 {
         self.number
     }
@@ -154,10 +348,7 @@ impl ResetRecord {
             MAGIC[1],
             MAGIC[2],
             MAGIC[3],
-            match self.cause {
-                ResetCause::Panic => 1,
-                ResetCause::SampleStall => 2,
-            },
+            self.cause.code(),
             self.message.len,
             self.file.len,
             0,
@@ -185,11 +376,7 @@ impl ResetRecord {
         if body.get(..4)? != MAGIC || crc32(body).to_le_bytes() != *crc {
             return None;
         }
-        let cause = match body.get(4)? {
-            1 => ResetCause::Panic,
-            2 => ResetCause::SampleStall,
-            _ => return None,
-        };
+        let cause = ResetCause::from_code(*body.get(4)?)?;
         let (message_len, file_len) = (*body.get(5)?, *body.get(6)?);
         if usize::from(message_len) > MESSAGE_LEN || usize::from(file_len) > FILE_LEN {
             return None;
@@ -208,25 +395,42 @@ impl ResetRecord {
 /// What the previous run ended with, as the boot sees it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PreviousRun {
-    /// A power-on or a reset with no record and no watchdog flag.
+    /// A reset with no record and no watchdog reset (power-on, the button, a debugger).
     Clean,
-    /// A record says why (a panic or a stalled sample path).
+    /// A record says why (a panic, a stalled sample path, a set-up that did not finish).
     Recorded(ResetRecord),
     /// The watchdog reset the MCU and nothing recorded why: the firmware hung.
     WatchdogReset,
+    /// A record of a stall or an unfinished set-up was written, but `source`, not the
+    /// watchdog, reset the MCU before it would have: the condition was seen, it is not
+    /// known whether it would have cleared.
+    ResetDuring {
+        /// The record written (a stall or a set-up).
+        record: ResetRecord,
+        /// What reset the MCU instead of the watchdog.
+        source: ResetSource,
+    },
 }
 
 impl PreviousRun {
-    /// From the record area's bytes and the watchdog reset flag.
-    pub fn at_boot(record: &[u8; RESET_RECORD_LEN], watchdog_reset: bool) -> Self {
+    /// From the record area's bytes and the reset flags' source.
+    pub fn at_boot(record: &[u8; RESET_RECORD_LEN], source: ResetSource) -> Self {
+        let watchdog = source == ResetSource::IndependentWatchdog;
         match ResetRecord::decode(record) {
+            Some(rec) if rec.cause().ends_in_watchdog_reset() && !watchdog => {
+                PreviousRun::ResetDuring {
+                    record: rec,
+                    source,
+                }
+            }
             Some(rec) => PreviousRun::Recorded(rec),
-            None if watchdog_reset => PreviousRun::WatchdogReset,
+            None if watchdog => PreviousRun::WatchdogReset,
             None => PreviousRun::Clean,
         }
     }
 
-    /// The previous run failed (the panel shows "monitor failed" for a while).
+    /// The previous run failed (the panel shows "monitor failed" for a while): a record or
+    /// a watchdog reset; a stall cut short by another reset counts too (it was seen).
     pub fn failed(&self) -> bool {
         !matches!(self, PreviousRun::Clean)
     }
@@ -268,17 +472,143 @@ mod tests {
         }
         assert_eq!(ResetRecord::decode(&[0; RESET_RECORD_LEN]), None);
         assert_eq!(ResetRecord::decode(&[0xA5; RESET_RECORD_LEN]), None);
+        let wd = ResetSource::IndependentWatchdog;
         assert_eq!(
-            PreviousRun::at_boot(&[0; RESET_RECORD_LEN], true),
+            PreviousRun::at_boot(&[0; RESET_RECORD_LEN], wd),
             PreviousRun::WatchdogReset
         );
         assert_eq!(
-            PreviousRun::at_boot(&[0; RESET_RECORD_LEN], false),
+            PreviousRun::at_boot(&[0; RESET_RECORD_LEN], ResetSource::Pin),
             PreviousRun::Clean
         );
         assert!(matches!(
-            PreviousRun::at_boot(&good, true),
+            PreviousRun::at_boot(&good, wd),
             PreviousRun::Recorded(r) if r.cause() == ResetCause::Panic
         ));
+    }
+
+    #[test]
+    fn the_reset_flags_name_the_source_most_specific_first() {
+        // RCC_CSR flags (RM0440): OBL 25, PIN 26, BOR 27, SFT 28, IWDG 29, WWDG 30, LPWR 31.
+        let (obl, pin, bor, sft, iwdg, wwdg, lpwr) = (
+            1 << 25,
+            1 << 26,
+            1 << 27,
+            1 << 28,
+            1 << 29,
+            1 << 30,
+            1u32 << 31,
+        );
+        let table = [
+            (0, ResetSource::Unknown),
+            (pin, ResetSource::Pin),
+            // A power-on sets the brown-out and the pin flags.
+            (pin | bor, ResetSource::PowerOnOrBrownOut),
+            // Every internal reset pulses NRST: the pin flag comes with it.
+            (pin | iwdg, ResetSource::IndependentWatchdog),
+            (pin | sft, ResetSource::Software),
+            (pin | wwdg, ResetSource::WindowWatchdog),
+            (pin | obl, ResetSource::OptionBytes),
+            (pin | lpwr, ResetSource::LowPower),
+            // The LSI bits (0, 1) and RMVF (23) are not reset flags.
+            (pin | 0b11 | 1 << 23, ResetSource::Pin),
+            (pin | bor | iwdg, ResetSource::IndependentWatchdog),
+        ];
+        for (csr, source) in table {
+            assert_eq!(ResetSource::from_csr(csr), source, "{csr:#010x}");
+        }
+    }
+
+    #[test]
+    fn a_stall_or_setup_record_is_the_cause_only_after_a_watchdog_reset() {
+        let wd = ResetSource::IndependentWatchdog;
+        for rec in [
+            ResetRecord::sample_stall(300),
+            ResetRecord::setup(Phase::AdcSetup),
+        ] {
+            let bytes = rec.encode();
+            assert_eq!(PreviousRun::at_boot(&bytes, wd), PreviousRun::Recorded(rec));
+            for source in [
+                ResetSource::Pin,
+                ResetSource::PowerOnOrBrownOut,
+                ResetSource::Software,
+                ResetSource::Unknown,
+            ] {
+                let previous = PreviousRun::at_boot(&bytes, source);
+                assert_eq!(
+                    previous,
+                    PreviousRun::ResetDuring {
+                        record: rec,
+                        source
+                    }
+                );
+                assert!(previous.failed());
+            }
+        }
+        // A panic is reported whatever reset followed it (the watchdog or the handler's
+        // software reset, or the button while the panel showed it).
+        let panic = ResetRecord::panic("boom", "src/main.rs", 1);
+        for source in [wd, ResetSource::Software, ResetSource::Pin] {
+            assert_eq!(
+                PreviousRun::at_boot(&panic.encode(), source),
+                PreviousRun::Recorded(panic)
+            );
+        }
+        let defmt = ResetRecord::defmt_panic(Phase::AdcSetup, 0x0800_1234);
+        let back = ResetRecord::decode(&defmt.encode()).unwrap();
+        assert_eq!(
+            (back.cause(), back.message(), back.line_or_ms()),
+            (ResetCause::DefmtPanic, "adc-setup", 0x0800_1234)
+        );
+        for phase in Phase::ALL {
+            assert_eq!(Phase::from_number(phase.number()), Some(phase));
+        }
+        assert_eq!(Phase::from_number(Phase::ALL.len() as u8), None);
+    }
+
+    #[test]
+    fn the_record_a_panic_leaves_is_the_record_the_next_boot_reports() {
+        use std::sync::Mutex;
+        // The no-init RAM of the reset record.
+        static RAM: Mutex<[u8; RESET_RECORD_LEN]> = Mutex::new([0x5A; RESET_RECORD_LEN]);
+        let others = std::panic::take_hook();
+        // The host's panic handler does what the firmware's does with its PanicInfo: the
+        // static message and the location through `ResetRecord::on_panic` into the RAM.
+        std::panic::set_hook(Box::new(|info| {
+            let message = info.payload().downcast_ref::<&str>().copied();
+            let location = info.location().map(|l| (l.file(), l.line()));
+            *RAM.lock().unwrap() = ResetRecord::on_panic(message, location);
+        }));
+        let line = line!() + 1;
+        let literal = std::panic::catch_unwind(|| panic!("sample ring misaligned"));
+        let ram_literal = *RAM.lock().unwrap();
+        let formatted = std::panic::catch_unwind(|| panic!("index {}", std::hint::black_box(7)));
+        let ram_formatted = *RAM.lock().unwrap();
+        std::panic::set_hook(others);
+        assert!(literal.is_err() && formatted.is_err());
+        // The next boot (after the handler's software reset or the watchdog's).
+        for source in [ResetSource::Software, ResetSource::IndependentWatchdog] {
+            let PreviousRun::Recorded(rec) = PreviousRun::at_boot(&ram_literal, source) else {
+                panic!("no record after a panic");
+            };
+            assert_eq!(
+                (rec.cause(), rec.message(), rec.file(), rec.line_or_ms()),
+                (
+                    ResetCause::Panic,
+                    "sample ring misaligned",
+                    "src/reset_record.rs",
+                    line
+                )
+            );
+        }
+        let PreviousRun::Recorded(rec) =
+            PreviousRun::at_boot(&ram_formatted, ResetSource::Software)
+        else {
+            panic!("no record after a formatted panic");
+        };
+        assert_eq!(
+            (rec.message(), rec.line_or_ms()),
+            ("(formatted message)", line + 2)
+        );
     }
 }

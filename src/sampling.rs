@@ -71,6 +71,17 @@ impl AdcSampler {
         self.ticks_per_sample
     }
 
+    /// The front end's scaling in force.
+    pub fn front_end(&self) -> &FrontEnd {
+        &self.front_end
+    }
+
+    /// Replaces the front end's scaling (a start-up offset trim,
+    /// `crate::app::SamplePath::trim_offsets`).
+    pub fn set_front_end(&mut self, front_end: FrontEnd) {
+        self.front_end = front_end;
+    }
+
     /// Continue the timestamps from `now_ticks` (after lost samples).
     pub fn resync(&mut self, now_ticks: u32) {
         self.next_ticks = now_ticks;

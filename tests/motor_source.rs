@@ -97,3 +97,41 @@ fn the_boot_builds_the_sample_path_and_isolator_of_the_record() {
     let (a, b) = (iso.torque_base_nm(), built_in.torque_base_nm());
     assert!((a / b - 1.0).abs() > 0.05, "{a} vs {b}");
 }
+
+#[test]
+fn the_encoder_timer_is_set_up_from_the_record() {
+    use drive_monitor::motor_source::EncoderSetup;
+    // The default: 1024 lines counting up, 4 poles at 50 Hz (up to 50 rev/s with the
+    // margin): a quarter edge interval of 207 clocks, filter fDTS/32 x 6 (192 clocks, 14).
+    assert_eq!(
+        motor_source::encoder_setup(&motor_source::default_record()),
+        EncoderSetup {
+            counts_per_rev: 4096,
+            invert_a: false,
+            input_filter: 14,
+            pull_up: true
+        }
+    );
+    // The 3 hp record, reversed: 2500 lines at up to 60 rev/s, 70.8 clocks: fDTS/8 x 8
+    // (64 clocks, 9); the direction inverted in the timer, the line count the core's too.
+    let rec = MotorRecord {
+        encoder_reversed: true,
+        ..other_motor()
+    };
+    let setup = motor_source::encoder_setup(&rec);
+    assert_eq!(
+        setup,
+        EncoderSetup {
+            counts_per_rev: 10_000,
+            invert_a: true,
+            input_filter: 9,
+            pull_up: true
+        }
+    );
+    assert_eq!(
+        setup.counts_per_rev,
+        motor_source::monitor_config(&rec, 10_000)
+            .encoder
+            .counts_per_rev
+    );
+}

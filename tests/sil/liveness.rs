@@ -99,6 +99,40 @@ fn a_stall_the_restarts_do_not_fix_ends_in_a_reported_watchdog_reset() {
 }
 
 #[test]
+fn a_stall_cut_short_by_the_reset_button_is_not_reported_as_a_watchdog_stall() {
+    let frames = steady_frames(2.5);
+    let mut rig = Rig::boot(Survivors::power_on(FakeFlash::holding(&old_record())));
+    // The stall is recorded at 300 ms; the user presses the reset button at 400 ms.
+    rig.run(&frames[..20_000], |_, _| {}).unwrap();
+    while rig.now_ms() < 2_400 {
+        rig.period(None).unwrap();
+    }
+    let stall = ResetRecord::sample_stall(300);
+    assert_eq!(ResetRecord::decode(&rig.survivors.reset_ram), Some(stall));
+    let mut survivors = rig.survivors.clone();
+    survivors.reset_source = ResetSource::Pin;
+    let rig = Rig::boot(survivors.clone());
+    assert_eq!(
+        rig.previous,
+        PreviousRun::ResetDuring {
+            record: stall,
+            source: ResetSource::Pin
+        }
+    );
+    // A brown-out that keeps the RAM says so too; the watchdog's reset is the stall's.
+    survivors.reset_source = ResetSource::PowerOnOrBrownOut;
+    assert!(matches!(
+        Rig::boot(survivors.clone()).previous,
+        PreviousRun::ResetDuring {
+            source: ResetSource::PowerOnOrBrownOut,
+            ..
+        }
+    ));
+    survivors.reset_source = ResetSource::IndependentWatchdog;
+    assert_eq!(Rig::boot(survivors).previous, PreviousRun::Recorded(stall));
+}
+
+#[test]
 fn a_panic_reason_survives_the_reset() {
     let frames = steady_frames(1.0);
     let mut rig = Rig::boot(Survivors::power_on(FakeFlash::erased()));
@@ -107,7 +141,7 @@ fn a_panic_reason_survives_the_reset() {
     let mut survivors = rig.survivors.clone();
     survivors.reset_ram =
         ResetRecord::panic("attempt to divide by zero", "src/app.rs", 321).encode();
-    survivors.watchdog_reset = true;
+    survivors.reset_source = ResetSource::IndependentWatchdog;
     let rig = Rig::boot(survivors.clone());
     let PreviousRun::Recorded(rec) = rig.previous else {
         panic!("{:?}", rig.previous);

@@ -17,6 +17,8 @@
 mod commissioning;
 mod isolation;
 mod liveness;
+mod recovery;
+mod startup;
 
 use drive_monitor::app::{
     carry_out, panel_input, MonitorStatus, SamplePath, Settings, Supervisor, Tick, PANEL_PERIOD_MS,
@@ -26,8 +28,12 @@ use drive_monitor::board::{self, RECORD_PAGE_SIZE};
 use drive_monitor::commissioning::{Failure, RunEnd};
 use drive_monitor::flash_record::{self, CalibrationRecord, RecordStore, RECORD_LEN};
 use drive_monitor::liveness::AdcWait;
+use drive_monitor::offset_trim::TrimResult;
 use drive_monitor::panel::{self, Lamp, Mode, PanelLamps};
-use drive_monitor::reset_record::{PreviousRun, ResetCause, ResetRecord, RESET_RECORD_LEN};
+use drive_monitor::recovery::{Faults, StepTimeout};
+use drive_monitor::reset_record::{
+    PreviousRun, ResetCause, ResetRecord, ResetSource, RESET_RECORD_LEN,
+};
 use drive_monitor::sampling::RawFrame;
 use monitor_core::{Abc, Calibration, CommissioningFailure, Fault, RunStage};
 use sim_host::params::ParamFile;
@@ -129,7 +135,8 @@ impl RecordStore for FakeFlash {
 struct Survivors {
     flash: FakeFlash,
     reset_ram: [u8; RESET_RECORD_LEN],
-    watchdog_reset: bool,
+    /// What the reset flags of `RCC_CSR` say at the next boot.
+    reset_source: ResetSource,
 }
 
 impl Survivors {
@@ -138,7 +145,7 @@ impl Survivors {
             flash,
             // Power-on RAM content: anything.
             reset_ram: [0x5A; RESET_RECORD_LEN],
-            watchdog_reset: false,
+            reset_source: ResetSource::PowerOnOrBrownOut,
         }
     }
 }
@@ -174,6 +181,15 @@ struct Rig {
     adc: AdcWait,
     waited_us: u32,
     restarts_at_ms: Vec<u32>,
+    /// The ADCs, DMA channels and trigger (a model of the hardware, `recovery::FakeAcq`).
+    acq: recovery::FakeAcq,
+    /// What the sample task runs when a wait timed out: the firmware's
+    /// `drive_monitor::recovery::recover`, or another sequence to compare with.
+    restart: fn(&mut recovery::FakeAcq) -> Result<Faults, StepTimeout>,
+    /// The results of the restarts.
+    recoveries: Vec<Result<Faults, StepTimeout>>,
+    /// The start-up offset trim's result.
+    trims: Vec<TrimResult>,
     seen: Vec<Seen>,
     ended: Vec<RunEnd>,
 }
@@ -184,9 +200,11 @@ impl Rig {
     }
 
     fn boot_with(settings: Settings, mut survivors: Survivors) -> Self {
-        let previous = PreviousRun::at_boot(&survivors.reset_ram, survivors.watchdog_reset);
+        let previous = PreviousRun::at_boot(&survivors.reset_ram, survivors.reset_source);
         survivors.reset_ram = [0; RESET_RECORD_LEN];
-        survivors.watchdog_reset = false;
+        // The flags are cleared at boot; a boot of the rig without a reset event is the
+        // reset button's.
+        survivors.reset_source = ResetSource::Pin;
         survivors.flash.power_lost = false;
         let mut path = SamplePath::for_board(settings.sample_rate_hz).unwrap();
         let mut installed = None;
@@ -216,6 +234,10 @@ impl Rig {
             adc: AdcWait::new(settings.sample_rate_hz),
             waited_us: 0,
             restarts_at_ms: Vec::new(),
+            acq: recovery::FakeAcq::running(),
+            restart: drive_monitor::recovery::recover,
+            recoveries: Vec::new(),
+            trims: Vec::new(),
             seen: Vec::new(),
             ended: Vec::new(),
         }
@@ -236,6 +258,11 @@ impl Rig {
             Some(raw) => {
                 self.waited_us = 0;
                 self.adc.data();
+                if let Some(trim) = self.path.trim_offsets(raw) {
+                    // Handed to thread mode on the board (logged, the sensor flags).
+                    self.supervisor.set_offset_fault(&trim);
+                    self.trims.push(trim);
+                }
                 self.path.on_frame(raw);
                 if self
                     .path
@@ -248,8 +275,10 @@ impl Rig {
             None => {
                 self.waited_us += 1_000_000 / FS;
                 if self.waited_us >= self.adc.timeout_us() {
-                    // The wait timed out: the sample task restarts the acquisition.
+                    // The wait timed out: the sample task recovers the acquisition.
                     self.adc.timed_out();
+                    let result = (self.restart)(&mut self.acq);
+                    self.recoveries.push(result);
                     self.waited_us = 0;
                     self.restarts_at_ms.push(self.now_ms());
                     let now_us = (self.periods * 1_000_000 / u64::from(FS)) as u32;
@@ -266,7 +295,7 @@ impl Rig {
             self.thread_tick(now_ms)?;
         }
         if now_ms.wrapping_sub(self.last_pet_ms) > WATCHDOG_TIMEOUT_MS {
-            self.survivors.watchdog_reset = true;
+            self.survivors.reset_source = ResetSource::IndependentWatchdog;
             return Err(Reset::Watchdog);
         }
         Ok(())
@@ -299,6 +328,7 @@ impl Rig {
         }
         let (command, _stored) = carry_out(tick.action, &mut self.survivors.flash);
         if self.survivors.flash.power_lost {
+            self.survivors.reset_source = ResetSource::PowerOnOrBrownOut;
             return Err(Reset::PowerLoss);
         }
         if let Some(cmd) = command {
@@ -334,7 +364,8 @@ impl Rig {
         }
     }
 
-    /// Runs the frames from index `from` on; `at(rig, k)` may act before frame `k`.
+    /// Runs the frames (one per trigger period; lost while the acquisition delivers
+    /// nothing); `at(rig, k)` may act before frame `k`.
     fn run(
         &mut self,
         frames: &[RawFrame],
@@ -342,7 +373,9 @@ impl Rig {
     ) -> Result<(), Reset> {
         for (k, raw) in frames.iter().enumerate() {
             at(self, k);
-            self.period(Some(raw))?;
+            // The frame reaches the sample path only when the hardware delivers it.
+            let delivered = self.acq.trigger();
+            self.period(delivered.then_some(raw))?;
         }
         Ok(())
     }
@@ -361,7 +394,7 @@ fn frames(scenario: &Scenario) -> Vec<RawFrame> {
     let rows = simulate_to_vec(&params, scenario).expect("simulation");
     let q = *SamplePath::for_board(FS).unwrap().sampler();
     let mut theta_counts = 0.0f64;
-    let dt = 1.0 / f64::from(FS);
+    let dt = 1.0 / scenario.sample_rate_hz;
     rows.iter()
         .map(|row| {
             let v = row.v_abc.unwrap_or([0.0; 3]);

@@ -1,0 +1,286 @@
+//! Recovery of the acquisition after an ADC overrun or a DMA transfer error.
+//!
+//! The acquisition is TIM1's trigger (TRGO), two ADCs converting three channels each per
+//! trigger, and one DMA channel per ADC moving the results into a ring. Two hardware faults
+//! stop it for good unless they are cleared:
+//! - **ADC overrun** (`OVR` in `ADC_ISR`): a conversion finished before the DMA took the
+//!   previous result. With DMA on, the ADC then stops issuing DMA requests until software
+//!   clears `OVR` (STM32G4 reference manual RM0440, "Managing conversions using the DMA"
+//!   and "Overrun management"); restarting the DMA or the trigger alone never brings the
+//!   data back.
+//! - **DMA transfer error** (`TEIF` in `DMA_ISR`): the DMA hardware clears the channel's
+//!   `EN` bit; nothing moves until the flag is cleared and the channel is re-armed (RM0440,
+//!   "DMA transfer error management"). The HAL's DMA interrupt panics on it, so the
+//!   firmware masks the channel's transfer-error interrupt (`TEIE`) and recovers here.
+//!
+//! Both show up in the sample task as a wait for ADC data that times out (or a ring the DMA
+//! lapped). [`recover`] then runs one sequence, the same for every cause, in the order the
+//! reference manual asks for:
+//!
+//! | step | what | why this order |
+//! |---|---|---|
+//! | [`Step::StopTrigger`] | TIM1 counter off | no new conversion starts |
+//! | [`Step::StopAdc`] | `ADSTP`, then wait for `ADSTART = 0` (bounded) | a conversion in flight ends before the DMA stops (else it would set `OVR` itself) |
+//! | [`Step::PauseDma`] | `EN = 0`, then wait for it (bounded) | `CNDTR` may only be written with the channel off |
+//! | [`Step::ClearFlags`] | `OVR` (write 1), `TEIF`/`HTIF`/`TCIF` (`DMA_IFCR`) | a latched `OVR` blocks the DMA requests |
+//! | [`Step::RearmDma`] | `CNDTR` = ring length, ring indices reset, `DMAEN`/`DMACFG` circular, `EN = 1` | the DMA is ready before the ADC asks |
+//! | [`Step::StartAdc`] | `ADSTART = 1` (waits for the next trigger) | both ADCs armed before the trigger |
+//! | [`Step::StartTrigger`] | TIM1 counter on, timestamps continue from now | ADC1 and ADC2 start on the same trigger |
+//!
+//! The sequence is written once, over the [`Acquisition`] trait: the firmware implements
+//! it with the registers (`src/firmware.rs`), the host tests with a model of the hardware
+//! that obeys the rules above (`tests/sil/recovery.rs`), into which they inject an overrun
+//! and a DMA error. The monitor itself (its thresholds, the commissioning state, the
+//! counters) is not touched by a recovery: only the acquisition restarts.
+
+/// One step of the recovery sequence, in its order (module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Step {
+    /// Stop the sample trigger.
+    StopTrigger,
+    /// Stop both ADCs' conversions and wait until they stopped.
+    StopAdc,
+    /// Disable both DMA channels and wait until they are off.
+    PauseDma,
+    /// Clear the ADCs' overrun flags and the DMA channels' interrupt flags.
+    ClearFlags,
+    /// Reload both DMA channels with the ring length, reset the rings, enable the channels
+    /// and the ADCs' DMA requests.
+    RearmDma,
+    /// Start both ADCs' regular conversions (they wait for the trigger).
+    StartAdc,
+    /// Start the sample trigger (and continue the timestamps from now).
+    StartTrigger,
+}
+
+impl Step {
+    /// All steps, in the order [`recover`] runs them.
+    pub const ORDER: [Step; 7] = [
+        Step::StopTrigger,
+        Step::StopAdc,
+        Step::PauseDma,
+        Step::ClearFlags,
+        Step::RearmDma,
+        Step::StartAdc,
+        Step::StartTrigger,
+    ];
+
+    /// A short name for logs.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Step::StopTrigger => "stop-trigger",
+            Step::StopAdc => "stop-adc",
+            Step::PauseDma => "pause-dma",
+            Step::ClearFlags => "clear-flags",
+            Step::RearmDma => "rearm-dma",
+            Step::StartAdc => "start-adc",
+            Step::StartTrigger => "start-trigger",
+        }
+    }
+}
+
+/// The hardware faults latched when a recovery started.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Faults {
+    /// An ADC's `OVR` flag was set.
+    pub adc_overrun: bool,
+    /// A DMA channel's `TEIF` flag was set.
+    pub dma_error: bool,
+}
+
+/// A bounded wait of the sequence ran out (a register never reached its state): the
+/// acquisition is left stopped; the sample task tries again at its next timeout, and the
+/// watchdog resets the MCU if that never helps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StepTimeout(pub Step);
+
+/// Polls of a register the sequence's waits allow (each a few cycles: about 1 ms at
+/// 170 MHz, far above the 1-2 conversion times an `ADSTP` or a DMA disable takes).
+pub const POLL_LIMIT: u32 = 50_000;
+
+/// Polls `done` up to `limit` times; `Err(StepTimeout(step))` when it never returned true.
+/// The firmware's bounded waits on a register (here and in the ADC set-up).
+///
+/// # Errors
+/// [`StepTimeout`] naming `step`.
+pub fn poll_until(
+    step: Step,
+    limit: u32,
+    mut done: impl FnMut() -> bool,
+) -> Result<(), StepTimeout> {
+    for _ in 0..limit {
+        if done() {
+            return Ok(());
+        }
+    }
+    Err(StepTimeout(step))
+}
+
+/// The acquisition as [`recover`] drives it: both ADCs and their DMA channels, and the
+/// trigger. Each method is one [`Step`] (the waits bounded, [`poll_until`]).
+pub trait Acquisition {
+    /// The faults latched now (`OVR`, `TEIF`), read before anything is cleared.
+    fn faults(&mut self) -> Faults;
+    /// [`Step::StopTrigger`].
+    fn stop_trigger(&mut self);
+    /// [`Step::StopAdc`].
+    ///
+    /// # Errors
+    /// [`StepTimeout`] when `ADSTART` never cleared.
+    fn stop_adc(&mut self) -> Result<(), StepTimeout>;
+    /// [`Step::PauseDma`].
+    ///
+    /// # Errors
+    /// [`StepTimeout`] when `EN` never cleared.
+    fn pause_dma(&mut self) -> Result<(), StepTimeout>;
+    /// [`Step::ClearFlags`].
+    fn clear_flags(&mut self);
+    /// [`Step::RearmDma`].
+    fn rearm_dma(&mut self);
+    /// [`Step::StartAdc`].
+    fn start_adc(&mut self);
+    /// [`Step::StartTrigger`].
+    fn start_trigger(&mut self);
+}
+
+/// Runs the recovery sequence on `acq` (module docs) and returns the faults that were
+/// latched when it started.
+///
+/// # Errors
+/// [`StepTimeout`] when a bounded wait ran out (the sequence stops there).
+pub fn recover<A: Acquisition>(acq: &mut A) -> Result<Faults, StepTimeout> {
+    let faults = acq.faults();
+    acq.stop_trigger();
+    acq.stop_adc()?;
+    acq.pause_dma()?;
+    acq.clear_flags();
+    acq.rearm_dma();
+    acq.start_adc();
+    acq.start_trigger();
+    Ok(faults)
+}
+
+/// Counts of the recoveries since boot, by cause (for the log; the status line's
+/// `restarts` counts them all).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RecoveryCounts {
+    /// Recoveries run.
+    pub recoveries: u32,
+    /// Of those, with an ADC overrun latched.
+    pub adc_overruns: u32,
+    /// Of those, with a DMA transfer error latched.
+    pub dma_errors: u32,
+    /// Recoveries stopped by a bounded wait ([`StepTimeout`]).
+    pub timeouts: u32,
+}
+
+impl RecoveryCounts {
+    /// Counts one recovery's result.
+    pub fn count(&mut self, result: Result<Faults, StepTimeout>) {
+        self.recoveries = self.recoveries.saturating_add(1);
+        match result {
+            Ok(f) => {
+                self.adc_overruns = self.adc_overruns.saturating_add(u32::from(f.adc_overrun));
+                self.dma_errors = self.dma_errors.saturating_add(u32::from(f.dma_error));
+            }
+            Err(_) => self.timeouts = self.timeouts.saturating_add(1),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Records the calls, fails the wait of `fail` if set.
+    #[derive(Default)]
+    struct Trace {
+        steps: Vec<Step>,
+        fail: Option<Step>,
+    }
+
+    impl Trace {
+        fn wait(&mut self, step: Step) -> Result<(), StepTimeout> {
+            self.steps.push(step);
+            poll_until(step, 10, || self.fail != Some(step))
+        }
+    }
+
+    impl Acquisition for Trace {
+        fn faults(&mut self) -> Faults {
+            Faults {
+                adc_overrun: true,
+                dma_error: false,
+            }
+        }
+        fn stop_trigger(&mut self) {
+            self.steps.push(Step::StopTrigger);
+        }
+        fn stop_adc(&mut self) -> Result<(), StepTimeout> {
+            self.wait(Step::StopAdc)
+        }
+        fn pause_dma(&mut self) -> Result<(), StepTimeout> {
+            self.wait(Step::PauseDma)
+        }
+        fn clear_flags(&mut self) {
+            self.steps.push(Step::ClearFlags);
+        }
+        fn rearm_dma(&mut self) {
+            self.steps.push(Step::RearmDma);
+        }
+        fn start_adc(&mut self) {
+            self.steps.push(Step::StartAdc);
+        }
+        fn start_trigger(&mut self) {
+            self.steps.push(Step::StartTrigger);
+        }
+    }
+
+    #[test]
+    fn the_sequence_runs_in_the_reference_manuals_order() {
+        let mut t = Trace::default();
+        assert_eq!(
+            recover(&mut t),
+            Ok(Faults {
+                adc_overrun: true,
+                dma_error: false
+            })
+        );
+        assert_eq!(t.steps, Step::ORDER);
+    }
+
+    #[test]
+    fn a_wait_that_runs_out_stops_the_sequence_and_is_counted() {
+        let mut t = Trace {
+            fail: Some(Step::StopAdc),
+            ..Trace::default()
+        };
+        let r = recover(&mut t);
+        assert_eq!(r, Err(StepTimeout(Step::StopAdc)));
+        assert_eq!(t.steps, [Step::StopTrigger, Step::StopAdc]);
+        let mut n = RecoveryCounts::default();
+        n.count(r);
+        n.count(Ok(Faults {
+            adc_overrun: false,
+            dma_error: true,
+        }));
+        assert_eq!(
+            n,
+            RecoveryCounts {
+                recoveries: 2,
+                adc_overruns: 0,
+                dma_errors: 1,
+                timeouts: 1
+            }
+        );
+        let mut polls = 0;
+        assert_eq!(
+            poll_until(Step::PauseDma, 7, || {
+                polls += 1;
+                false
+            }),
+            Err(StepTimeout(Step::PauseDma))
+        );
+        assert_eq!(polls, 7);
+    }
+}

@@ -1,0 +1,171 @@
+//! Start-up: the offset trim with the motor off, and the time base's tolerance (the
+//! internal oscillator's +-1 %) measured on the monitor's frequency and speed.
+
+use super::*;
+use drive_monitor::offset_trim::{ChannelTrim, TRIM_SAMPLES};
+
+/// `duration_s` of the motor off: every code at the front end's zero plus `offset` (codes
+/// per channel: va, vb, vc, ia, ib, ic) and 0..2 codes of noise.
+fn motor_off(duration_s: f64, offset: [i32; 6]) -> Vec<RawFrame> {
+    let n = (duration_s * f64::from(FS)) as usize;
+    let q = *SamplePath::for_board(FS).unwrap().sampler();
+    let at_zero = q.quantize(Abc::default(), Abc::default(), 0);
+    (0..n)
+        .map(|k| shifted(&at_zero, offset, (k % 3) as i32))
+        .collect()
+}
+
+/// `raw` with `offset` (+ `noise`) added to each channel's code.
+fn shifted(raw: &RawFrame, offset: [i32; 6], noise: i32) -> RawFrame {
+    let add = |code: u16, d: i32| (i32::from(code) + d + noise).clamp(0, 4095) as u16;
+    let mut out = *raw;
+    for (k, c) in out.v.iter_mut().enumerate() {
+        c.0 = add(c.0, offset[k]);
+    }
+    for (k, c) in out.i.iter_mut().enumerate() {
+        c.0 = add(c.0, offset[3 + k]);
+    }
+    out
+}
+
+#[test]
+fn the_offset_trim_measures_the_zero_with_the_motor_off_and_puts_it_into_force() {
+    let offset = [3, -2, 0, 12, -7, 0];
+    let off = motor_off(0.2, offset);
+    // The expected zero of each channel: the mean of the codes the rig sends in the
+    // trim's window.
+    let window = &off[..TRIM_SAMPLES as usize];
+    let mean = |f: &dyn Fn(&RawFrame) -> u16| {
+        window.iter().map(|r| f64::from(f(r))).sum::<f64>() / window.len() as f64
+    };
+    let expected_ia = mean(&|r| r.i[0].0);
+    let expected_vb = mean(&|r| r.v[1].0);
+    // Then the motor starts, its codes carrying the same offsets.
+    let running: Vec<RawFrame> = steady_frames(2.5)
+        .iter()
+        .map(|r| shifted(r, offset, 0))
+        .collect();
+    let mut rig = Rig::boot(Survivors::power_on(FakeFlash::holding(&old_record())));
+    rig.run(&off, |_, _| {}).unwrap();
+    rig.run(&running, |_, _| {}).unwrap();
+    assert_eq!(rig.trims.len(), 1);
+    let fe = *rig.path.sampler().front_end();
+    assert!((f64::from(fe.current[0].offset_code) - expected_ia).abs() < 1e-3);
+    assert!((f64::from(fe.voltage[1].offset_code) - expected_vb).abs() < 1e-3);
+    // The zero reads zero now: within half a code of the noise.
+    let quiet = rig.path.sampler().clone().build(&off[0]);
+    assert!(
+        quiet.i_abc.a.abs() < 1.5 * board::AMP_PER_LSB,
+        "{:?}",
+        quiet.i_abc
+    );
+    assert!(rig.trims[0]
+        .voltage
+        .iter()
+        .all(|c| matches!(c, ChannelTrim::Trimmed(_))));
+    // No sensor is flagged, and the running machine is healthy.
+    let last = rig.last().status;
+    assert!(!last.sensor_fault.any() && !last.fault_detected, "{last:?}");
+}
+
+#[test]
+fn an_offset_out_of_bound_is_not_used_and_flags_the_sensor() {
+    // ib's zero 300 codes off (a sensor without supply, a broken amplifier).
+    let off = motor_off(1.0, [0, 0, 0, 0, 300, 0]);
+    let mut rig = Rig::boot(Survivors::power_on(FakeFlash::erased()));
+    rig.run(&off, |_, _| {}).unwrap();
+    let trim = rig.trims[0];
+    assert!(matches!(trim.current[1], ChannelTrim::OutOfBound(x) if x > 2300.0));
+    assert!(trim.current_fault() && !trim.voltage_fault());
+    // Not used: ib keeps the nominal zero; the sensor is flagged from the next status on
+    // and the FAULT lamp is steady (input invalid).
+    let fe = *rig.path.sampler().front_end();
+    assert_eq!(fe.current[1].offset_code, board::MID_SCALE_CODE);
+    let after: Vec<&Seen> = rig.seen.iter().filter(|s| s.t_ms >= 200).collect();
+    assert!(after.iter().all(|s| s.status.sensor_fault.current));
+    assert!(after.iter().all(|s| s.tick.lamps.fault), "steady");
+}
+
+#[test]
+fn the_internal_oscillators_tolerance_scales_the_frequency_and_speed_estimates() {
+    // The time base (HSI, +-1 % over temperature and parts) clocks the trigger: a fast
+    // oscillator samples faster than the firmware assumes, so everything it measures in
+    // time reads slow by the same factor.
+    let mut seen = Vec::new();
+    for error in [-0.01, 0.0, 0.01] {
+        let frames = frames(&Scenario::steady(3.0, f64::from(FS) * (1.0 + error)));
+        let mut rig = Rig::boot(Survivors::power_on(FakeFlash::holding(&old_record())));
+        rig.run(&frames, |_, _| {}).unwrap();
+        let s = rig.last().status;
+        seen.push((
+            error,
+            s.frame_hz,
+            s.speed_rad_s,
+            s.fault_detected,
+            s.residuals,
+        ));
+    }
+    for (error, f_hz, w_rad_s, fault, r) in &seen {
+        eprintln!(
+            "error {error:+.2}: f {f_hz:.4} Hz, wm {w_rad_s:.3} rad/s, fault {fault}, r {r:?}"
+        );
+    }
+    let (_, f0, w0, ..) = seen[1];
+    for &(error, f_hz, w_rad_s, fault, _) in &seen {
+        let scale = 1.0 / (1.0 + error);
+        assert!(
+            (f64::from(f_hz / f0) - scale).abs() < 5e-4,
+            "{error}: {f_hz} vs {f0}"
+        );
+        assert!(
+            (f64::from(w_rad_s / w0) - scale).abs() < 5e-4,
+            "{error}: {w_rad_s} vs {w0}"
+        );
+        // A healthy machine is not flagged for the oscillator's tolerance.
+        assert!(!fault, "{error}");
+    }
+}
+
+#[test]
+fn a_corrupt_or_old_motor_record_shows_the_default_motor_mark_on_the_panel() {
+    use drive_monitor::motor_source;
+    let valid = motor_source::default_record().to_bytes();
+    let mut corrupt = valid;
+    corrupt[20] ^= 0x10;
+    let mut old = valid;
+    old[4] = 0; // another version
+    let erased = [0xFF; 256];
+    let off = motor_off(12.5, [0; 6]);
+    let pages: [(&[u8], bool); 4] = [
+        (&valid, false),
+        (&corrupt, true),
+        (&old, true),
+        (&erased, true),
+    ];
+    for (page, default) in pages {
+        // The boot's choice (src/firmware.rs: `motor_source::select`), handed to the panel.
+        let (_, source) = motor_source::select(page);
+        assert_eq!(source.is_default(), default, "{source:?}");
+        let mut rig = Rig::boot(Survivors::power_on(FakeFlash::erased()));
+        rig.supervisor.set_default_motor(source.is_default());
+        rig.run(&off, |_, _| {}).unwrap();
+        // The RUN lamp's longest lit stretch at the 50 ms ticks.
+        let (mut on_ms, mut longest_ms) = (0, 0);
+        for s in &rig.seen {
+            on_ms = if s.tick.lamps.run { on_ms + 50 } else { 0 };
+            longest_ms = longest_ms.max(on_ms);
+            assert_eq!(s.tick.mode, Mode::NotCommissioned, "{} ms", s.t_ms);
+        }
+        if default {
+            // Lit through 10.0..12.0 s of every 10 s (the first period starts at boot).
+            assert!(rig
+                .seen
+                .iter()
+                .filter(|s| (10_000..12_000).contains(&s.t_ms) || s.t_ms < 2_000)
+                .all(|s| s.tick.lamps.run));
+            assert!((1_950..=2_000).contains(&longest_ms), "{longest_ms}");
+        } else {
+            assert!(longest_ms <= 100, "{longest_ms}");
+        }
+    }
+}
