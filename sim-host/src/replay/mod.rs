@@ -26,6 +26,7 @@ mod isolation;
 mod pipe;
 mod report;
 mod sequences;
+mod unsettled;
 
 use report::timeline_point;
 
@@ -298,6 +299,8 @@ pub struct Replay {
     timing_faults_seen: u32,
     /// The isolation ignores points until this time [s] (the settling after a restart).
     isolation_hold_until: f64,
+    /// The stretch where the quasi-steady gate held the lamps, at the log's end.
+    unsettled: unsettled::Unsettled,
     /// The monitor's settling time after a restart [s].
     settle_s: f64,
 }
@@ -387,6 +390,7 @@ impl Replay {
             seq_t: None,
             timing_faults_seen: 0,
             isolation_hold_until: f64::NEG_INFINITY,
+            unsettled: unsettled::Unsettled::default(),
             settle_s: f64::from(cfg.settle_s),
         })
     }
@@ -414,6 +418,19 @@ impl Replay {
         // the learned ones are in force are not detections: the window says the nominal
         // parameters are not to be trusted (a sensor fault counts at any time).
         let counts = out.sensor_fault.any() || self.commission.thresholds_trusted(&out);
+        // The bands only matter (and are only looked up) while the gate holds the lamps.
+        let bands = if out.quasi_steady {
+            [(0.0, 0.0); 4]
+        } else {
+            mon.threshold_bands()
+        };
+        self.unsettled.after(
+            t,
+            &out,
+            bands,
+            self.evaluated,
+            self.commission.thresholds_trusted(&out),
+        );
         let point = self.steady_point(&out);
         // After a restart of the monitor's estimators (a long gap, a clock reset) the
         // isolation waits out the monitor's settling time too: the restarted frame's
@@ -487,7 +504,7 @@ impl Replay {
     }
 
     /// Where the load or the voltage of `out` has left the range learned in
-    /// commissioning: the note ("load (Iqs) 9.52 is 47 % above the commissioned
+    /// commissioning: the note ("load (active current) 9.52 is 47 % above the commissioned
     /// 6.47..6.48"); `None` inside it or without a learned window. The HMI shows this as
     /// the amber "operating point moved" state: to the paper's model a load change is a Bl
     /// change, so lamps lit there are not a fault unless the isolation names one.

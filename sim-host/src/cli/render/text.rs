@@ -290,7 +290,7 @@ fn commissioning(out: &mut impl Write, c: &CommissioningReport) -> anyhow::Resul
         };
         writeln!(
             out,
-            "  learned {:.2} s of evaluated running; load current Iqs {}, voltage Vqs {}",
+            "  learned {:.2} s of evaluated running; load (active current) {}, voltage |V| {}",
             c.seconds_evaluated,
             span(c.load_current_a, "A"),
             span(c.voltage_v, "V")
