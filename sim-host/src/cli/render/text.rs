@@ -408,12 +408,18 @@ pub fn compare(log: &Path, r: &CompareReport) -> anyhow::Result<()> {
             " + "
         )
     )?;
-    writeln!(
-        out,
-        "  normalized_rms_error {}   (noise floor {})",
-        number(r.normalized_rms_error),
-        number(r.noise_floor)
-    )?;
+    match r.diverged_at_s {
+        Some(t) => writeln!(
+            out,
+            "  normalized_rms_error: not judged: the model diverged at {t:.3} s (see 'not plausible' below)"
+        )?,
+        None => writeln!(
+            out,
+            "  normalized_rms_error {}   (noise floor {})",
+            number(r.normalized_rms_error),
+            number(r.noise_floor)
+        )?,
+    }
     for ch in &r.channels {
         writeln!(
             out,
