@@ -492,8 +492,16 @@ impl Replay {
     /// What the isolation concludes now, as [`Replay::finish`] would report it (the report
     /// and the candidates listed), for a screen that follows the replay.
     pub fn isolation_now(&self) -> (IsolationReport, Vec<FaultCandidate>) {
-        let detected = self.first_detection.is_some() || self.isolation.named_a_fault();
+        let detected = self.detected();
         self.isolation.report(detected)
+    }
+
+    /// Whether a fault was detected: a lamp lit or the isolation named a fault, unless the
+    /// isolation ends finding that the windings' heating explains it
+    /// (`monitor_core::isolation`, "Heating is not a fault").
+    fn detected(&self) -> bool {
+        !self.isolation.heating_explains_lamps()
+            && (self.first_detection.is_some() || self.isolation.named_a_fault())
     }
 
     /// Every name the isolation gave so far (a fault or the friction class `b/bl`), each

@@ -189,7 +189,7 @@ impl Replay {
             })
             .collect();
         signature_candidates.sort_by(|a, b| b.probability.total_cmp(&a.probability));
-        let detected = self.first_detection.is_some() || self.isolation.named_a_fault();
+        let detected = self.detected();
         let (mut isolation, mut isolated) = self.isolation.report(detected);
         isolation::refine_single_phase(
             &mut isolation,
