@@ -15,45 +15,17 @@
 //! Twelve 40 s and four 60 s replays at 2 kHz: about 15 s in the test profile on 2 cores.
 //! Longer time constants (to 30 min) run with `MONITOR_FULL_SWEEPS=1` as 1 h logs.
 
-use monitor_core::{Fault, MotorParameters, SupplyParameters};
+mod small_motor;
+
+use monitor_core::Fault;
 use rayon::prelude::*;
 use sim_host::experiment::simulate_and_replay;
 use sim_host::params::ParamFile;
 use sim_host::replay::{DiagnoseReport, IsolationName, ReplayOptions, Verdict};
 use sim_host::sim::{EffectSpec, FaultSpec, Scenario, SensorSpec};
-use std::f64::consts::TAU;
-
-/// The 0.37 kW machine of `tests/sensor_gain_steps.rs`.
-fn small_0p37kw() -> ParamFile {
-    let w = TAU * 50.0;
-    let (lm, ll) = (260.0 / w, 16.0 / w);
-    let w_rated = TAU * 1375.0 / 60.0;
-    let bl = 370.0 / (w_rated * w_rated);
-    ParamFile {
-        motor: MotorParameters {
-            rs_ohm: 30.0,
-            rr_ohm: 24.0,
-            ls_h: lm + ll,
-            lr_h: lm + ll,
-            lm_h: lm,
-            poles: 4,
-            j_kgm2: 0.0009,
-            b_nms: 0.005 * bl,
-            bl_nms: bl,
-        },
-        supply: SupplyParameters {
-            v_ll_rms: 400.0,
-            f_hz: 50.0,
-        },
-    }
-}
 
 fn motors() -> Vec<(&'static str, ParamFile)> {
-    vec![
-        ("3 hp", ParamFile::reference_3hp()),
-        ("2.2 kW", ParamFile::reference_2p2kw()),
-        ("0.37 kW", small_0p37kw()),
-    ]
+    small_motor::three_motors()
 }
 
 /// Heating from 4 s: `rise_k` with time constant `tau_s`; `fault` on top.

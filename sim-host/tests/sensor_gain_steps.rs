@@ -11,47 +11,17 @@
 //!
 //! 45 faulty and 3 healthy 8 s replays: about 10 s in the test profile on 2 cores.
 
-use monitor_core::{Fault, MotorParameters, SupplyParameters};
+mod small_motor;
+
+use monitor_core::Fault;
 use rayon::prelude::*;
 use sim_host::experiment::simulate_and_replay;
 use sim_host::params::ParamFile;
 use sim_host::replay::{DiagnoseReport, ReplayOptions, Verdict};
 use sim_host::sim::{FaultSpec, Scenario, SensorSpec};
-use std::f64::consts::TAU;
-
-/// The 0.37 kW, 400 V, 50 Hz, 4-pole machine of `tests/nameplate.rs` (Rs 30, Rr 24,
-/// Xls = Xlr 16, Xm 260 ohm at 50 Hz), J of a 71-frame motor, the paper's viscous load at
-/// its rated torque (2.57 N m at 1375 rpm).
-fn small_0p37kw() -> ParamFile {
-    let w = TAU * 50.0;
-    let (lm, ll) = (260.0 / w, 16.0 / w);
-    let w_rated = TAU * 1375.0 / 60.0;
-    let bl = 370.0 / (w_rated * w_rated);
-    ParamFile {
-        motor: MotorParameters {
-            rs_ohm: 30.0,
-            rr_ohm: 24.0,
-            ls_h: lm + ll,
-            lr_h: lm + ll,
-            lm_h: lm,
-            poles: 4,
-            j_kgm2: 0.0009,
-            b_nms: 0.005 * bl,
-            bl_nms: bl,
-        },
-        supply: SupplyParameters {
-            v_ll_rms: 400.0,
-            f_hz: 50.0,
-        },
-    }
-}
 
 fn motors() -> Vec<(&'static str, ParamFile)> {
-    vec![
-        ("3 hp", ParamFile::reference_3hp()),
-        ("2.2 kW", ParamFile::reference_2p2kw()),
-        ("0.37 kW", small_0p37kw()),
-    ]
+    small_motor::three_motors()
 }
 
 /// The replay's report of `p`'s machine with `fault` (a sensor gain step at 5 s) or none.

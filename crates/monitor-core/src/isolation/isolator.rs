@@ -531,17 +531,26 @@ fn rank(out: &mut Isolation, fits: &mut [(f32, f32); FAULT_COUNT], heat: (f32, f
             *c = chi_friction;
         }
     }
+    // Heating takes part in the ranking only where it can explain the deviation (misfit
+    // within HEATING_MAX_MISFIT): elsewhere the faults rank among themselves as without it.
     let (chi_heat, k_heat) = heat;
-    let chi_min = fits.iter().fold(chi_heat, |a, (c, _)| crate::minf(a, *c));
+    let heat_in = crate::sqrt(chi_heat) <= HEATING_MAX_MISFIT;
+    let chi_min = fits.iter().fold(
+        if heat_in { chi_heat } else { f32::INFINITY },
+        |a, (c, _)| crate::minf(a, *c),
+    );
     let chi_unknown = crate::maxf(UNKNOWN_CHI2, 0.1 * chi0);
     let t = crate::maxf(1.0, 0.5 * chi_min);
     let w = |c: f32| F32Ext::exp(-(c - chi_min) / (2.0 * t));
-    let mut total = w(chi_unknown) + w(chi_heat);
+    let mut total = w(chi_unknown);
     for (c, _) in fits.iter() {
         total += w(*c);
     }
+    if heat_in {
+        total += w(chi_heat);
+    }
     out.heating = Heating {
-        probability: w(chi_heat) / total,
+        probability: if heat_in { w(chi_heat) / total } else { 0.0 },
         factor: k_heat,
         misfit: crate::sqrt(chi_heat),
     };
