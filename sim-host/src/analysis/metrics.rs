@@ -204,7 +204,12 @@ pub fn diverged_at(d: &Prepared, p: &Prediction) -> Option<f64> {
     let i_max = d.i_ab.iter().take(n).map(|c| c.norm()).fold(0.0, f64::max);
     let limit = DIVERGED_CURRENT_RATIO * i_max.max(1e-9);
     let t = |k: usize| d.t_s.get(k).copied().unwrap_or(f64::NAN);
-    if let Some(k) = p.i_ab.iter().take(n).position(|c| !(c.norm() <= limit)) {
+    if let Some(k) = p
+        .i_ab
+        .iter()
+        .take(n)
+        .position(|c| c.norm().is_nan() || c.norm() > limit)
+    {
         return Some(t(k));
     }
     (p.i_ab.len() < n).then(|| t(p.i_ab.len()))
