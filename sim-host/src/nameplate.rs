@@ -55,7 +55,7 @@
 //! Each range is the envelope of the estimates over every combination of the ends of the
 //! assumptions' ranges (friction and windage, total leakage, leakage split from the Gamma
 //! to the inverse-Gamma model, and efficiency and power factor by +/- 0.005, the rounding
-//! of a nameplate). `docs/own-motor.md` has the measured errors on five published machines.
+//! of a nameplate). `docs/own-motor.md` has the measured errors on six machines (0.37 kW to 50 hp).
 
 use crate::params::{plausible, ParamError, ParamFile};
 use nalgebra::Complex;
@@ -681,6 +681,11 @@ pub fn toml_number(x: f64) -> String {
     }
 }
 
+/// One line of a parameter file: `key = value # comment` ([`toml_number`]'s value).
+pub fn toml_entry(key: &str, x: f64, comment: &str) -> String {
+    format!("{key} = {} # {comment}\n", toml_number(x))
+}
+
 impl Estimate {
     /// The value of `key` (a key of [`Estimate::values`]).
     pub fn value(&self, key: &str) -> Option<&Estimated> {
@@ -716,13 +721,16 @@ impl Estimate {
         s.push_str("[motor]\n");
         for v in self.values.iter().filter(|v| v.key.starts_with("motor.")) {
             let key = v.key.trim_start_matches("motor.");
-            s.push_str(&format!(
-                "{key} = {} # [{}..{}] {}; {}\n",
-                toml_number(v.value),
-                toml_number(v.lo),
-                toml_number(v.hi),
-                v.unit,
-                v.source
+            s.push_str(&toml_entry(
+                key,
+                v.value,
+                &format!(
+                    "[{}..{}] {}; {}",
+                    toml_number(v.lo),
+                    toml_number(v.hi),
+                    v.unit,
+                    v.source
+                ),
             ));
             if key == "lm_h" {
                 s.push_str(&format!(
@@ -747,13 +755,15 @@ impl Estimate {
             ));
         }
         s.push_str("[supply]\n");
-        s.push_str(&format!(
-            "v_ll_rms = {} # rated line-to-line voltage [V], from the nameplate\n",
-            toml_number(n.voltage_v)
+        s.push_str(&toml_entry(
+            "v_ll_rms",
+            n.voltage_v,
+            "rated line-to-line voltage [V], from the nameplate",
         ));
-        s.push_str(&format!(
-            "f_hz = {} # rated frequency [Hz], from the nameplate\n",
-            toml_number(n.frequency_hz)
+        s.push_str(&toml_entry(
+            "f_hz",
+            n.frequency_hz,
+            "rated frequency [Hz], from the nameplate",
         ));
         s
     }

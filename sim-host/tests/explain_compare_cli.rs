@@ -55,3 +55,35 @@ fn explain_with_compare_reads_once_and_agrees_with_the_two_commands() {
     assert!(ci < ei, "{text}");
     assert!(text.contains("normalized_rms_error"), "{text}");
 }
+
+/// A model that diverges (the motulator log's start with two of the four dynamics effects
+/// and no flux dynamics: its predicted current runs away within milliseconds) gets no error
+/// figure: the text says "not judged" and when, the JSON has `diverged_at_s` and the
+/// reason under `implausible_because`, and the model is not plausible. A convergent model
+/// of the same log has no `diverged_at_s`.
+#[test]
+fn a_diverged_model_reports_no_error_figure() {
+    let root = format!("{}/..", env!("CARGO_MANIFEST_DIR"));
+    let params = std::path::PathBuf::from(format!("{root}/examples/logs/motulator_2p2kw_dol.toml"));
+    let log = std::path::PathBuf::from(format!("{root}/examples/logs/motulator_2p2kw_dol.csv"));
+    let effects = ["--effects", "d_axis_dynamics,cross_coupling_dynamics"];
+    let text = String::from_utf8(run(&[&["compare"][..], &effects].concat(), &params, &log))
+        .expect("utf-8");
+    assert!(
+        text.contains("normalized_rms_error: not judged: the model diverged at"),
+        "{text}"
+    );
+    let j = json(&run(
+        &[&["compare", "--json"][..], &effects].concat(),
+        &params,
+        &log,
+    ));
+    let t = j["diverged_at_s"].as_f64().expect("diverged_at_s");
+    assert!((0.0..1.0).contains(&t), "{t}");
+    assert_eq!(j["plausible"], false);
+    assert!(j["implausible_because"][0]
+        .as_str()
+        .is_some_and(|w| w.starts_with("the model diverged")));
+    let ok = json(&run(&["compare", "--json", "--to", "2.4"], &params, &log));
+    assert!(ok.get("diverged_at_s").is_none(), "{ok}");
+}

@@ -93,7 +93,7 @@ fn live_simulation_commissions_and_a_key_injects_a_fault() {
     let n = names(&state);
     assert!(n.contains(&Fault::Bl) && n.contains(&Fault::B), "{n:?}");
     assert!(
-        matches!(&s.state, MonitorState::Moved(note) if note.contains("load (Iqs)")),
+        matches!(&s.state, MonitorState::Moved(note) if note.contains("load (active current)")),
         "{:?}",
         s.state
     );

@@ -95,7 +95,7 @@ fn a_user_commissions_injects_a_fault_and_quits() {
     t.keys("+");
     t.keys("+");
     t.keys("+");
-    let pane = t.wait_for(&["MOVED ●", "load (Iqs)", "load x1.30", "r2 ●"]);
+    let pane = t.wait_for(&["MOVED ●", "load (active", "load x1.30", "r2 ●"]);
     assert!(!pane.contains("FAULT"), "{pane}");
     // Back to the commissioned load, then Rs +50 %: the red FAULT lamp and `rs +` first.
     t.keys("-");

@@ -1,5 +1,5 @@
-//! `identify` against known circuits: five published machines (2.2 kW to 50 hp, the same
-//! as `tests/nameplate.rs`), each simulated from standstill with ±8 % supply steps and the
+//! `identify` against known circuits: six machines (0.37 kW to 50 hp, the same as
+//! `tests/nameplate.rs`; five published), each simulated from standstill with ±8 % supply steps and the
 //! default 12-bit sensors (ADC quantisation and noise), identified from the nameplate
 //! estimate (`params from-nameplate`'s, its nameplate computed here from the circuit at
 //! rated power by the analytic steady state) at 5 and 10 kHz: Rs, Rr, the total leakage
@@ -13,7 +13,7 @@
 
 use assert_cmd::Command;
 use monitor_core::{MotorParameters, SupplyParameters};
-use sim_host::identify::{identify, Identification, Samples};
+use sim_host::identify::{identify, Identification, InverseGamma, Samples};
 use sim_host::log::{Channels, Row};
 use sim_host::nameplate::{estimate, Connection, Nameplate, NemaDesign};
 use sim_host::params::ParamFile;
@@ -30,7 +30,9 @@ struct Machine {
     j: f64,
 }
 
-/// The five machines (4-pole): motulator's 2.2 kW (its leakage all on the stator side);
+/// The six machines (4-pole): a 0.37 kW machine of per-unit values typical of its size
+/// (made for these tests, see `tests/nameplate.rs`); motulator's 2.2 kW (published in
+/// inverse-Gamma form: its leakage all on the stator side);
 /// Krause, Wasynczuk and Sudhoff's 3 hp and 50 hp (Analysis of Electric Machinery and
 /// Drive Systems, 60 Hz, Xls = Xlr, with their J); MATLAB/Simscape's 4 kW and 15 kW
 /// presets as transcribed by the Modelica Buildings library (Ls = Lr, J of the presets).
@@ -52,7 +54,16 @@ fn machines() -> Vec<Machine> {
         t: [rs, rr, ls - lm, ls - lm, lm],
         j,
     };
+    let w50 = TAU * 50.0;
     vec![
+        Machine {
+            name: "small 0.37 kW",
+            p_kw: 0.37,
+            v_ll: 400.0,
+            f_hz: 50.0,
+            t: [30.0, 24.0, 16.0 / w50, 16.0 / w50, 260.0 / w50],
+            j: 0.0009,
+        },
         Machine {
             name: "motulator 2.2 kW",
             p_kw: 2.2,
@@ -231,61 +242,83 @@ fn pct(e: [f64; 4]) -> String {
 }
 
 /// Identifies machine `m` from a 3 s log at `rate_hz`: the errors against the published
-/// circuit, and against the same circuit with the start file's leakage split.
-fn check_machine(m: &Machine, rate_hz: f64) -> ([f64; 4], [f64; 4]) {
+/// circuit, against the same circuit with the start file's leakage split, and of the
+/// split-free (inverse-Gamma) form against the circuit's.
+fn check_machine(m: &Machine, rate_hz: f64) -> ([f64; 4], [f64; 4], [f64; 4]) {
     let rows = healthy_log(m, rate_hz, 3.0);
     let s =
         Samples::from_rows(&rows, channels(), f64::NEG_INFINITY, f64::INFINITY).expect("samples");
     let id = identify(&m.start(), &s, &mut |_| {}).expect("identifies");
     let raw = errors(m.name, [m.t[0], m.t[1], m.t[2] + m.t[3], m.t[4]], &id);
     let eq = errors(m.name, with_split(m.t, id.stator_leakage_share), &id);
+    let [rs, rr, lls, llr, lm] = m.t;
+    let truth_g = InverseGamma::of_t_circuit(rs, rr, lls, llr, lm);
+    let g = id.inverse_gamma.expect("all four identified");
+    let gamma = [
+        g.rs_ohm / truth_g.rs_ohm - 1.0,
+        g.r_r_ohm / truth_g.r_r_ohm - 1.0,
+        g.l_sigma_h / truth_g.l_sigma_h - 1.0,
+        g.l_m_h / truth_g.l_m_h - 1.0,
+    ];
     eprintln!(
-        "{} at {} kHz: {} | with the start's split {:.2}: {} (current error {:.2} %, start {:.2} %)",
+        "{} at {} kHz: {} | with the start's split {:.2}: {} | inverse-Gamma R_R {:+.2} %, L_sigma {:+.2} %, \
+         L_M {:+.2} % (current error {:.2} %, start {:.2} %)",
         m.name,
         rate_hz / 1000.0,
         pct(raw),
         id.stator_leakage_share,
         pct(eq),
+        100.0 * gamma[1],
+        100.0 * gamma[2],
+        100.0 * gamma[3],
         100.0 * id.relative_rms_error,
         100.0 * id.relative_rms_error_start
     );
-    (raw, eq)
+    (raw, eq, gamma)
 }
 
 /// The bars: against the circuit with the start file's leakage split (what a log can
-/// determine) within 1 %; against the published circuit within 10 %, but for the
-/// motulator machine whose leakage is all on the stator side (the nameplate estimate
-/// splits it 0.4 : 0.6, NEMA design B): there the split moves Rr by about (1 + 0.6 L /
-/// Lm)^2 - 1 = +11.6 %, which no terminal log can tell.
+/// determine) within 1 %, and its split-free (inverse-Gamma) form within 1 %; against the
+/// published circuit within 10 %. A machine is judged in the form it is published in:
+/// motulator publishes its 2.2 kW machine in inverse-Gamma form (all its leakage on the
+/// stator side), and a T-circuit with the nameplate estimate's 0.4 : 0.6 split (NEMA
+/// design B) has an Rr (1 + 0.6 L / Lm)^2 - 1 = +11.6 % above that form's R_R: the same
+/// terminals, which no log can tell apart. Its T-circuit errors are printed only.
 fn check_rate(rate_hz: f64) {
     for m in machines() {
-        let (raw, eq) = check_machine(&m, rate_hz);
+        let (raw, eq, gamma) = check_machine(&m, rate_hz);
+        let inverse_gamma_published = m.name.starts_with("motulator");
         for (k, what) in ["Rs", "Rr", "Lls + Llr", "Lm"].iter().enumerate() {
             assert!(
-                eq[k].abs() <= 0.01,
-                "{} at {rate_hz} Hz: {what} off by {:+.2} % from the equivalent circuit",
+                eq[k].abs() <= 0.01 && gamma[k].abs() <= 0.01,
+                "{} at {rate_hz} Hz: {what} off by {:+.2} % from the equivalent circuit ({:+.2} % in \
+                 inverse-Gamma form)",
                 m.name,
-                100.0 * eq[k]
+                100.0 * eq[k],
+                100.0 * gamma[k]
             );
-            let split_case = m.t[3] == 0.0 && k == 1;
-            let bar = if split_case { 0.125 } else { 0.10 };
+            let published = if inverse_gamma_published {
+                gamma[k]
+            } else {
+                raw[k]
+            };
             assert!(
-                raw[k].abs() <= bar,
-                "{} at {rate_hz} Hz: {what} off by {:+.1} %",
+                published.abs() <= 0.10,
+                "{} at {rate_hz} Hz: {what} off by {:+.1} % from the published circuit",
                 m.name,
-                100.0 * raw[k]
+                100.0 * published
             );
         }
     }
 }
 
 #[test]
-fn five_machines_at_5_khz_from_the_nameplate_estimate() {
+fn six_machines_at_5_khz_from_the_nameplate_estimate() {
     check_rate(5000.0);
 }
 
 #[test]
-fn five_machines_at_10_khz_from_the_nameplate_estimate() {
+fn six_machines_at_10_khz_from_the_nameplate_estimate() {
     check_rate(10_000.0);
 }
 
@@ -364,6 +397,23 @@ fn the_motulator_log_from_its_nameplate_within_10_percent_and_the_file_says_wher
             est[k]["hi"].as_f64().unwrap(),
         );
         assert!(lo <= v && v <= hi);
+    }
+    // The split-free form: what the log determines, whatever the split (within 1 %).
+    let g = &j["identification"]["inverse_gamma"];
+    let [rs, rr, lls, llr, lm] = m.t;
+    let t = InverseGamma::of_t_circuit(rs, rr, lls, llr, lm);
+    for (key, truth) in [
+        ("rs_ohm", t.rs_ohm),
+        ("r_r_ohm", t.r_r_ohm),
+        ("l_sigma_h", t.l_sigma_h),
+        ("l_m_h", t.l_m_h),
+    ] {
+        let v = g[key].as_f64().unwrap_or_else(|| panic!("{key}: {g}"));
+        eprintln!(
+            "motulator log: inverse-Gamma {key} {:+.3} %",
+            100.0 * (v / truth - 1.0)
+        );
+        assert!((v / truth - 1.0).abs() <= 0.01, "{key}: {v} vs {truth}");
     }
     // Lls and Llr apart: not identified, with the reason.
     let names: Vec<&str> = est
@@ -544,7 +594,8 @@ fn identified(truth: &ParamFile, m: &Machine) -> ParamFile {
 }
 
 /// The stretch goal: `diagnose` with the identified parameters names the same fault as
-/// with the true ones, for every Table 1 fault at ±50 % on the 3 hp reference motor. With
+/// with the true ones, for every Table 1 fault at ±50 % on two motors: the 3 hp reference
+/// motor and the Simscape 4 kW machine (a circuit the project was not developed on). With
 /// `MONITOR_FULL_SWEEPS=1` also the 2.2 kW reference, where the bar is lower: never a
 /// different fault. Its machine has no stator leakage and the nameplate estimate splits
 /// the leakage 0.4 : 0.6; measured: the `ls` fault (which on that machine scales Lm
@@ -564,6 +615,11 @@ fn the_identified_parameters_name_the_same_faults_as_the_true_ones() {
             j: 0.0,
         },
     )];
+    let simscape = machines()
+        .into_iter()
+        .find(|m| m.name == "Simscape 4 kW")
+        .expect("listed");
+    motors.push((simscape.truth(), simscape));
     if std::env::var("MONITOR_FULL_SWEEPS").is_ok_and(|v| v == "1") {
         motors.push((
             ParamFile::reference_2p2kw(),
@@ -588,7 +644,7 @@ fn the_identified_parameters_name_the_same_faults_as_the_true_ones() {
             .iter()
             .flat_map(|f| [(*f, 0.5), (*f, -0.5)])
             .collect();
-        let exact = m.name == "3 hp reference";
+        let exact = m.name != "2.2 kW reference";
         let diffs: Vec<String> = cases
             .par_iter()
             .filter_map(|&(f, c)| {

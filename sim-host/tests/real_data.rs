@@ -558,7 +558,7 @@ fn a_load_outside_the_commissioned_range_is_named_beside_the_lamps() {
     );
     let notes = d["commissioning"]["outside_range"].to_string();
     assert!(
-        notes.contains("load (Iqs)") && notes.contains("above the commissioned range"),
+        notes.contains("load (active current)") && notes.contains("above the commissioned range"),
         "{notes}"
     );
     let lit_with_note = d["timeline"]

@@ -14,6 +14,10 @@ pub struct CompareReport {
     pub effects: Vec<EffectKind>,
     /// Mean normalised RMS error over the channels.
     pub normalized_rms_error: f64,
+    /// Where the model's prediction diverged [s] ([`metrics::diverged_at`]): then
+    /// `normalized_rms_error` measures nothing. Absent (JSON) when it did not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub diverged_at_s: Option<f64>,
     /// The error a perfect model would show (sensor noise) on the same measure.
     pub noise_floor: f64,
     /// Per-channel errors.
@@ -115,6 +119,18 @@ impl Analysis {
         let base_parameters = self.base_table(&f.base);
         let fitted_effects = self.fitted_effects(&active, &f);
         let mut implausible_because = super::base_implausible(&self.constants, &f.base, d);
+        let diverged_at_s = metrics::diverged_at(d, &pred);
+        if let Some(t) = diverged_at_s {
+            implausible_because.insert(
+                0,
+                format!(
+                    "the model diverged at {t:.3} s (its predicted current left {}x the largest measured): the error \
+                     {:.4} measures nothing; add the effects the advice names, or leave the start out (--from)",
+                    metrics::DIVERGED_CURRENT_RATIO,
+                    err.normalized_rms_error
+                ),
+            );
+        }
         for fe in &fitted_effects {
             implausible_because.extend(
                 fe.implausible_because
@@ -126,6 +142,7 @@ impl Analysis {
             report: CompareReport {
                 effects: list.iter().map(|e| e.kind()).collect(),
                 normalized_rms_error: err.normalized_rms_error,
+                diverged_at_s,
                 noise_floor,
                 channels: err.channels,
                 worst_windows: worst,
@@ -160,6 +177,7 @@ impl Analysis {
             report: CompareReport {
                 effects: opts.effects.clone(),
                 normalized_rms_error: f64::NAN,
+                diverged_at_s: None,
                 noise_floor: f64::NAN,
                 channels: vec![],
                 worst_windows: vec![],

@@ -188,6 +188,33 @@ pub fn errors(d: &Prepared, p: &Prediction, mask: Option<&[bool]>) -> ErrorSumma
     }
 }
 
+/// How far beyond the largest measured stator current a predicted one may go before the
+/// prediction counts as diverged: 20 times (a locked-rotor current is 5-8 times rated; a
+/// model that predicts 20 times the largest current the log holds has left the physics).
+pub const DIVERGED_CURRENT_RATIO: f64 = 20.0;
+
+/// Where the prediction `p` of the log `d` diverged: the time [s] of the first sample whose
+/// predicted current vector exceeds [`DIVERGED_CURRENT_RATIO`] times the largest measured
+/// one, or that is not finite, or where the prediction stops short of the log (a fit's
+/// trial that blew up); `None` for a prediction that stays physical. An error measured
+/// against a diverged prediction says nothing about the model (its normalisation caps it at
+/// `1 / MIN_SCALE_OF_PREDICTED`), so it must not be reported as one.
+pub fn diverged_at(d: &Prepared, p: &Prediction) -> Option<f64> {
+    let n = d.len().min(d.i_ab.len());
+    let i_max = d.i_ab.iter().take(n).map(|c| c.norm()).fold(0.0, f64::max);
+    let limit = DIVERGED_CURRENT_RATIO * i_max.max(1e-9);
+    let t = |k: usize| d.t_s.get(k).copied().unwrap_or(f64::NAN);
+    if let Some(k) = p
+        .i_ab
+        .iter()
+        .take(n)
+        .position(|c| c.norm().is_nan() || c.norm() > limit)
+    {
+        return Some(t(k));
+    }
+    (p.i_ab.len() < n).then(|| t(p.i_ab.len()))
+}
+
 /// Robust white-noise estimate of a series: sigma = 1.4826 MAD(D^4 x) / sqrt(70), the
 /// median absolute deviation of the fourth difference (70 = C(8,4), the variance gain of
 /// the fourth difference on white noise). A smooth signal and sparse steps do not move it;

@@ -29,13 +29,15 @@ B + Bl come from the torque balance T_e = J dw/dt + (B + Bl) w with the identifi
 Each value gets a 95 % interval (from the fit's Jacobian and its residual variance: a lower bound \
 when the model misses an effect of the real motor, such as saturation or temperature).\n\n\
 What it cannot tell: Lls and Llr apart (no terminal measurement can: only their sum is \
-identified, split as in the start file); a parameter the log does not excite (steady running at \
+identified, split as in the start file, and Rr and Lm are those of that split; the split-free \
+inverse-Gamma form R_R, L_sigma, L_M is printed too, and is what to compare with a machine \
+published in that form); a parameter the log does not excite (steady running at \
 one point gives one complex impedance for the four electrical parameters; constant speed leaves \
 J free) is reported \"not identified\" with the reason, and the written file keeps the start value for it. \
 A constant load torque is not in the model: B + Bl then absorbs it.\n\n\
 Output: a table (parameter, start, identified, 95 % interval), or --json (one document: \
-estimates [{name, key, unit, start, value, lo, hi, not_identified_because}], relative errors, \
-solver, toml). --out writes the parameter file (atomically; never over the log or the start \
+estimates [{name, key, unit, start, value, lo, hi, not_identified_because}], inverse_gamma \
+{rs_ohm, r_r_ohm, l_sigma_h, l_m_h}, relative errors, solver, toml). --out writes the parameter file (atomically; never over the log or the start \
 file, nor over another file without --force), each line saying where its value came from; the \
 start file's [columns] table is kept, so the new file reads the same log.\n\n\
 Example (docs/own-motor.md):\n  \
@@ -79,13 +81,7 @@ fn check(args: &IdentifyArgs) -> anyhow::Result<()> {
         }
     }
     if let Some(out) = &args.out {
-        OutputGuard::new(&[&args.log, &args.params]).check_files(&[out])?;
-        if out.exists() && !args.force {
-            anyhow::bail!(
-                "{} exists: refusing to overwrite it (give --force, or another --out)",
-                out.display()
-            );
-        }
+        OutputGuard::new(&[&args.log, &args.params]).check_new_file(out, args.force)?;
     }
     Ok(())
 }
@@ -187,6 +183,9 @@ fn table(id: &Identification) -> String {
                 e.not_identified_because.as_deref().unwrap_or("")
             )),
         }
+    }
+    if let Some(g) = &id.inverse_gamma {
+        s.push_str(&format!("{}\n", identify::inverse_gamma_line("", g)));
     }
     s
 }

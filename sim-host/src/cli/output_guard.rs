@@ -52,6 +52,22 @@ impl OutputGuard {
         Ok(())
     }
 
+    /// Refuses a parameter-file output that is an input, or that exists without `force`
+    /// (a parameter file may have been tuned by hand: it is kept unless asked).
+    ///
+    /// # Errors
+    /// As [`OutputGuard::check_files`], or "... exists: refusing to overwrite it".
+    pub fn check_new_file(&self, out: &Path, force: bool) -> anyhow::Result<()> {
+        self.check_files(&[out])?;
+        if out.exists() && !force {
+            anyhow::bail!(
+                "{} exists: refusing to overwrite it (give --force, or another --out)",
+                out.display()
+            );
+        }
+        Ok(())
+    }
+
     /// Refuses an output folder that is an input file, then checks the `files` it will get
     /// (names relative to `dir`).
     ///

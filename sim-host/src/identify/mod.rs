@@ -36,7 +36,7 @@ use model::{Circuit, CurrentFit, N_PARAMS};
 use nalgebra::Complex;
 use serde::Serialize;
 
-pub use output::to_toml;
+pub use output::{inverse_gamma_line, to_toml};
 
 /// Why identification could not run (one line each).
 #[derive(Debug, thiserror::Error)]
@@ -242,6 +242,10 @@ pub struct Identification {
     pub params: ParamFile,
     /// The stator leakage share Lls / (Lls + Llr) kept from the start file.
     pub stator_leakage_share: f64,
+    /// The identified circuit in its split-free (inverse-Gamma) form, when Rs, Rr, the
+    /// leakage and Lm were all identified: the parameters a terminal log determines
+    /// whatever the split.
+    pub inverse_gamma: Option<InverseGamma>,
     /// Samples fitted, and the log's window [s].
     pub samples: usize,
     /// First and last time fitted [s].
@@ -255,6 +259,55 @@ pub struct Identification {
     pub relative_rms_error: f64,
     /// How the solver ended.
     pub solver: lm::Report,
+}
+
+/// The inverse-Gamma equivalent circuit (Slemon, "Modelling of induction machines for
+/// electric drives", IEEE Trans. Ind. Appl. 25(6), 1989): the T-circuit with all its
+/// leakage moved to the stator side, terminal-equivalent to it for any split,
+/// ```text
+///   L_sigma = Lls + Lm Llr / Lr,   L_M = Lm^2 / Lr,   R_R = Rr (Lm / Lr)^2,   Lr = Lm + Llr.
+/// ```
+/// These are what a log of the terminals determines; simulators and drive software that
+/// use this form (e.g. motulator) publish their machines in it, so compare with those.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct InverseGamma {
+    /// Stator resistance Rs [ohm] (the same in both forms).
+    pub rs_ohm: f64,
+    /// Rotor resistance R_R [ohm].
+    pub r_r_ohm: f64,
+    /// Leakage inductance L_sigma [H].
+    pub l_sigma_h: f64,
+    /// Magnetising inductance L_M [H].
+    pub l_m_h: f64,
+}
+
+impl InverseGamma {
+    /// The inverse-Gamma form of the T-circuit Rs, Rr, Lls, Llr, Lm [ohm, H]; all values
+    /// must be positive (Lls, Llr non-negative), else the result is not finite.
+    pub fn of_t_circuit(rs_ohm: f64, rr_ohm: f64, lls_h: f64, llr_h: f64, lm_h: f64) -> Self {
+        let lr = lm_h + llr_h;
+        let k = lm_h / lr;
+        InverseGamma {
+            rs_ohm,
+            r_r_ohm: rr_ohm * k * k,
+            l_sigma_h: lls_h + k * llr_h,
+            l_m_h: k * lm_h,
+        }
+    }
+
+    /// Of the identified estimates (Rs, Rr, Lls + Llr, Lm in [`PARAMS`]' order) with the
+    /// stator leakage share `share`; `None` when one of them was not identified.
+    fn of_estimates(e: &[Estimate], share: f64) -> Option<Self> {
+        let v = |k: usize| e.get(k).and_then(|x| x.value);
+        let (rs, rr, leak, lm) = (v(0)?, v(1)?, v(2)?, v(3)?);
+        Some(Self::of_t_circuit(
+            rs,
+            rr,
+            share * leak,
+            (1.0 - share) * leak,
+            lm,
+        ))
+    }
 }
 
 /// Maximum Levenberg-Marquardt iterations.
@@ -366,11 +419,13 @@ pub fn identify(
     }
     progress(1.0);
     let params = output::written_params(start, &estimates, c0.stator_leakage_share);
+    let inverse_gamma = InverseGamma::of_estimates(&estimates, c0.stator_leakage_share);
     estimates.extend(output::leakage_split(&estimates, start));
     Ok(Identification {
         estimates,
         params,
         stator_leakage_share: c0.stator_leakage_share,
+        inverse_gamma,
         samples: s.i_ab.len(),
         window_s: (s.t0_s, s.t0_s + (s.i_ab.len() - 1) as f64 * s.dt_s),
         speed_imposed: speed,

@@ -2,7 +2,7 @@
 //! each line saying where its value came from; the start file's `[columns]` table kept.
 
 use super::{Estimate, Identification};
-use crate::nameplate::toml_number;
+use crate::nameplate::{toml_entry, toml_number};
 use crate::params::ParamFile;
 
 /// The start file with the identified values (the start's where not identified). The
@@ -84,6 +84,9 @@ pub fn to_toml(id: &Identification, start_text: &str, start_name: &str, log_name
         100.0 * id.relative_rms_error,
         100.0 * id.relative_rms_error_start,
     );
+    if let Some(g) = id.inverse_gamma {
+        s.push_str(&format!("{}\n", inverse_gamma_line("# ", &g)));
+    }
     let share = id.stator_leakage_share;
     let lines = [
         ("rs_ohm", m.rs_ohm, e(0)),
@@ -97,23 +100,27 @@ pub fn to_toml(id: &Identification, start_text: &str, start_name: &str, log_name
         ("lm_h", m.lm_h, e(3)),
     ];
     for (key, v, why) in lines {
-        s.push_str(&format!("{key} = {} # {why}\n", toml_number(v)));
+        s.push_str(&toml_entry(key, v, &why));
     }
     s.push_str(&format!("poles = {} # from the start file\n", m.poles));
-    s.push_str(&format!("j_kgm2 = {} # {}\n", toml_number(m.j_kgm2), e(4)));
+    s.push_str(&toml_entry("j_kgm2", m.j_kgm2, &e(4)));
     let b = e(5);
-    s.push_str(&format!(
-        "b_nms = {} # B + Bl {b}; split in the start file's ratio B : Bl\n",
-        toml_number(m.b_nms)
+    s.push_str(&toml_entry(
+        "b_nms",
+        m.b_nms,
+        &format!("B + Bl {b}; split in the start file's ratio B : Bl"),
     ));
-    s.push_str(&format!(
-        "bl_nms = {} # the rest of B + Bl\n",
-        toml_number(m.bl_nms)
+    s.push_str(&toml_entry("bl_nms", m.bl_nms, "the rest of B + Bl"));
+    s.push_str("[supply]\n");
+    s.push_str(&toml_entry(
+        "v_ll_rms",
+        id.params.supply.v_ll_rms,
+        "from the start file",
     ));
-    s.push_str(&format!(
-        "[supply]\nv_ll_rms = {} # from the start file\nf_hz = {} # from the start file\n",
-        toml_number(id.params.supply.v_ll_rms),
-        toml_number(id.params.supply.f_hz)
+    s.push_str(&toml_entry(
+        "f_hz",
+        id.params.supply.f_hz,
+        "from the start file",
     ));
     let columns = ParamFile::from_toml_str_with_columns(start_text, start_name)
         .map(|(_, c)| c)
@@ -133,4 +140,16 @@ pub fn to_toml(id: &Identification, start_text: &str, start_name: &str, log_name
         }
     }
     s
+}
+
+/// The split-free form in one line (for the TOML's comment and the text report).
+pub fn inverse_gamma_line(prefix: &str, g: &super::InverseGamma) -> String {
+    format!(
+        "{prefix}Split-free (inverse-Gamma) form, what the log determines whatever the split: Rs {} ohm, \
+         R_R {} ohm, L_sigma {} H, L_M {} H",
+        toml_number(g.rs_ohm),
+        toml_number(g.r_r_ohm),
+        toml_number(g.l_sigma_h),
+        toml_number(g.l_m_h)
+    )
 }

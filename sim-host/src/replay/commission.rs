@@ -13,8 +13,16 @@
 //! The learned healthy means hold only near the operating point they were learned at
 //! (to the paper's model a load change is a Bl change, a voltage change moves
 //! the residuals' means). While an r2/r3/r4 lamp is lit the tracker compares the load
-//! current `Iqs` and the voltage `Vqs` with their span during learning and says when they
-//! have left it ([`RangeNote`]).
+//! and the voltage with their span during learning and says when they have left it
+//! ([`RangeNote`]). Both are measured without the model's d-q frame, whose angle comes
+//! from the speed reading and the parameter file (a speed-sensor fault turns it, and with
+//! it `Iqs` and `Vqs`, without the machine's operating point moving at all):
+//! ```text
+//!   |V| = sqrt(V_ds^2 + V_qs^2),   I_active = (V_ds i_ds + V_qs i_qs) / |V|
+//! ```
+//! (amplitude-invariant d-q: `|V|` is the phase voltage's peak, `I_active` the peak of
+//! the current's part in phase with the voltage, `P = 1.5 |V| I_active`), both unchanged
+//! by any rotation of the frame ([`operating_point`]).
 
 use monitor_core::{CommissioningState, Monitor, MonitorConfig, MonitorOutput, RunStage};
 use serde::Serialize;
@@ -39,7 +47,7 @@ pub const MIN_LEARNED_S: f64 = 1.0;
 /// Departure from the commissioned range that is reported (fraction of the range's
 /// largest magnitude): 20 %. A load step of that size is what the learned means do not
 /// cover, while the faults the lamps are for move the operating point less (Rr +50 % at
-/// constant load torque moves Iqs by about 8 %; a Bl +50 % fault moves it like a 50 %
+/// constant load torque moves the load current by about 8 %; a Bl +50 % fault moves it like a 50 %
 /// load step and is, to the paper's model, one).
 const RANGE_MARGIN: f32 = 0.2;
 
@@ -57,9 +65,10 @@ pub struct CommissioningReport {
     pub seconds_evaluated: f64,
     /// Seconds of evaluated running the window asked for.
     pub seconds_needed: f64,
-    /// Span of the load (torque) current Iqs while learning, `[min, max]` [A].
+    /// Span of the load (the active current, in phase with the voltage: module docs)
+    /// while learning, `[min, max]` [A peak].
     pub load_current_a: Option<[f32; 2]>,
-    /// Span of the voltage Vqs while learning, `[min, max]` [V].
+    /// Span of the voltage magnitude |V| while learning, `[min, max]` [V peak, phase].
     pub voltage_v: Option<[f32; 2]>,
     /// Which thresholds the lamps used, in words.
     pub thresholds: String,
@@ -106,6 +115,20 @@ pub(super) struct CommissionTracker {
     noted: u8,
     last_t: f64,
     learned: (u32, u32),
+}
+
+/// The load and the voltage of `out`, independent of the d-q frame's angle: the active
+/// current `I_active = (V_ds i_ds + V_qs i_qs) / |V|` [A] and the voltage magnitude
+/// `|V| = sqrt(V_ds^2 + V_qs^2)` [V] (module docs); `I_active` is NaN without voltage.
+pub(super) fn operating_point(out: &MonitorOutput) -> (f32, f32) {
+    let o = &out.operating;
+    let v = out.vds.hypot(o.vqs);
+    let i_active = if v > 1e-3 {
+        (out.vds * o.i_f + o.vqs * o.iqs) / v
+    } else {
+        f32::NAN
+    };
+    (i_active, v)
 }
 
 fn widen(span: &mut Option<[f32; 2]>, x: f32) {
@@ -196,8 +219,9 @@ impl CommissionTracker {
             }
         }
         if matches!(out.commissioning, CommissioningState::Learning(_)) && out.quasi_steady {
-            widen(&mut self.iqs, out.operating.iqs);
-            widen(&mut self.vqs, out.operating.vqs);
+            let (i_active, v) = operating_point(out);
+            widen(&mut self.iqs, i_active);
+            widen(&mut self.vqs, v);
         }
         if self.requested.is_none() && self.first_steady.is_none() && out.evaluating {
             self.first_steady = Some(SteadyPoint {
@@ -214,17 +238,18 @@ impl CommissionTracker {
 
     fn range_note(&mut self, t: f64, out: &MonitorOutput) -> Option<String> {
         let mut said = Vec::new();
+        let (i_active, v) = operating_point(out);
         let checks = [
             (
                 self.iqs,
-                out.operating.iqs,
-                "load (Iqs)",
+                i_active,
+                "load (active current)",
                 "to the paper's model a load change is a Bl change",
             ),
             (
                 self.vqs,
-                out.operating.vqs,
-                "voltage (Vqs)",
+                v,
+                "voltage (|V|)",
                 "the learned healthy means hold only at the voltage they were learned at",
             ),
         ];
@@ -262,9 +287,10 @@ impl CommissionTracker {
             return None;
         }
         let mut said = Vec::new();
+        let (i_active, v) = operating_point(out);
         for (span, x, what) in [
-            (self.iqs, out.operating.iqs, "load (Iqs)"),
-            (self.vqs, out.operating.vqs, "voltage (Vqs)"),
+            (self.iqs, i_active, "load (active current)"),
+            (self.vqs, v, "voltage (|V|)"),
         ] {
             if let Some(f) = span.and_then(|s| outside(s, x)) {
                 let s = span.unwrap_or_default();
@@ -283,15 +309,10 @@ impl CommissionTracker {
     /// True when the learned thresholds are in force and the load current or the voltage
     /// is outside the span seen while learning (beyond the reporting margin).
     pub(super) fn outside_learned_range(&self, out: &MonitorOutput) -> bool {
+        let (i_active, v) = operating_point(out);
         out.commissioning == CommissioningState::Commissioned
-            && (self
-                .iqs
-                .and_then(|s| outside(s, out.operating.iqs))
-                .is_some()
-                || self
-                    .vqs
-                    .and_then(|s| outside(s, out.operating.vqs))
-                    .is_some())
+            && (self.iqs.and_then(|s| outside(s, i_active)).is_some()
+                || self.vqs.and_then(|s| outside(s, v)).is_some())
     }
 
     /// Whether lamps on the thresholds now in force count as detections: always without a

@@ -164,7 +164,13 @@ impl IsolationTracker {
             return;
         };
         let learning = matches!(out.commissioning, CommissioningState::Learning(_));
-        self.running |= out.evaluating;
+        // Running: the monitor evaluates its lamps, or its commissioning has learned a
+        // block (it learns on running, quasi-steady blocks only, and does not evaluate
+        // meanwhile: a window that opens before the first evaluation would otherwise teach
+        // the isolation nothing).
+        let learned_blocks =
+            matches!(out.commissioning, CommissioningState::Learning(f) if f > 0.0);
+        self.running |= out.evaluating || learned_blocks;
         let usable = self.running && !out.sensor_fault.any() && (learning || counts);
         self.lamps_lit |= counts && out.fault_detected;
         let learned = follower.learned();
@@ -206,6 +212,24 @@ impl IsolationTracker {
     /// How far the current of the last isolation is from the one the learned baseline was
     /// learned at: `|I| / |I_learned| - 1` (0.3: 30 % more current); `None` without a
     /// learned baseline or its point.
+    /// The tracked winding temperature rise [K] when a learned baseline is in force and it
+    /// is at least [`REPORTED_RISE_K`] either way.
+    pub(super) fn winding_rise_k(&self) -> Option<f32> {
+        let f = self.follower.as_ref().filter(|f| f.learned())?;
+        let rise = f.isolator().winding_rise_k();
+        (rise.abs() >= REPORTED_RISE_K).then_some(rise)
+    }
+
+    /// The lamps' detections, and any name given on the way, are explained by the
+    /// winding's heating: the last isolation found no deviation from the machine at its
+    /// tracked (warmer) temperature, which has risen by at least [`REPORTED_RISE_K`] (a
+    /// name given while the tracking lagged a fast warming was withdrawn since).
+    pub(super) fn heating_explains_lamps(&self) -> bool {
+        let last = self.follower.as_ref().and_then(|f| f.last().copied());
+        self.winding_rise_k().is_some_and(|r| r > 0.0)
+            && last.is_some_and(|i| i.state == IsolationState::NoDeviation)
+    }
+
     fn moved_from_learned(&self) -> Option<f32> {
         let f = self.follower.as_ref().filter(|f| f.learned())?;
         let at = f.isolator().baseline().at;
@@ -272,10 +296,22 @@ impl IsolationTracker {
                     self.last_t,
                     self.end_t - self.last_t
                 )
+            } else if let (Some(rise), IsolationState::NoDeviation) =
+                (self.winding_rise_k(), iso.state)
+            {
+                format!(
+                    "The windings warmed by {rise:.0} K since commissioning (Rs and Rr {} together, copper 0.393 %/K): heating, not a fault; the warm machine's steady-state equations fit{}.",
+                    pct(rise * monitor_core::isolation::COPPER_ALPHA_PER_K),
+                    if self.lamps_lit { "; the lamps lit because their residuals were learned on the cold machine" } else { "" }
+                ) + &self.first_named.map_or(String::new(), |g| format!(
+                    " ({} was named at {:.2} s while the tracked temperature lagged, and withdrawn.)",
+                    g.name, g.t_s
+                ))
             } else {
                 verdict_sentence(&iso, detected, moved)
             },
             moved_from_learned: moved,
+            winding_rise_k: self.winding_rise_k(),
             judged_at_s: self.last_t,
             groups: groups(&iso),
             deviation_sigma: iso.deviation,
@@ -431,7 +467,16 @@ pub struct IsolationReport {
     /// learned baseline. Away from the learned point the isolation allows for the
     /// parameter file's error ([`monitor_core::isolation`], "Away from the learned point").
     pub moved_from_learned: Option<f32>,
+    /// The winding's temperature rise since commissioning the isolation tracked [K]
+    /// (Rs and Rr together, copper 0.393 %/K: [`monitor_core::isolation`], "Heating is not
+    /// a fault"); absent (JSON) below [`REPORTED_RISE_K`] or without a learned baseline.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub winding_rise_k: Option<f32>,
 }
+
+/// Smallest tracked winding temperature change that is reported [K] (5 K: 2 % on Rs and Rr,
+/// well above the fit's resolution, below what matters for the insulation).
+pub const REPORTED_RISE_K: f32 = 5.0;
 
 impl IsolationReport {
     fn not_judged(why: &str, learned: bool) -> Self {
@@ -448,6 +493,7 @@ impl IsolationReport {
             spread: DEFAULT_SPREAD.to_array(),
             judged_at_s: 0.0,
             moved_from_learned: None,
+            winding_rise_k: None,
             baseline: if learned {
                 "learned in commissioning"
             } else {

@@ -26,6 +26,7 @@ mod isolation;
 mod pipe;
 mod report;
 mod sequences;
+mod unsettled;
 
 use report::timeline_point;
 
@@ -298,6 +299,8 @@ pub struct Replay {
     timing_faults_seen: u32,
     /// The isolation ignores points until this time [s] (the settling after a restart).
     isolation_hold_until: f64,
+    /// The stretch where the quasi-steady gate held the lamps, at the log's end.
+    unsettled: unsettled::Unsettled,
     /// The monitor's settling time after a restart [s].
     settle_s: f64,
 }
@@ -387,6 +390,7 @@ impl Replay {
             seq_t: None,
             timing_faults_seen: 0,
             isolation_hold_until: f64::NEG_INFINITY,
+            unsettled: unsettled::Unsettled::default(),
             settle_s: f64::from(cfg.settle_s),
         })
     }
@@ -414,6 +418,19 @@ impl Replay {
         // the learned ones are in force are not detections: the window says the nominal
         // parameters are not to be trusted (a sensor fault counts at any time).
         let counts = out.sensor_fault.any() || self.commission.thresholds_trusted(&out);
+        // The bands only matter (and are only looked up) while the gate holds the lamps.
+        let bands = if out.quasi_steady {
+            [(0.0, 0.0); 4]
+        } else {
+            mon.threshold_bands()
+        };
+        self.unsettled.after(
+            t,
+            &out,
+            bands,
+            self.evaluated,
+            self.commission.thresholds_trusted(&out),
+        );
         let point = self.steady_point(&out);
         // After a restart of the monitor's estimators (a long gap, a clock reset) the
         // isolation waits out the monitor's settling time too: the restarted frame's
@@ -475,8 +492,16 @@ impl Replay {
     /// What the isolation concludes now, as [`Replay::finish`] would report it (the report
     /// and the candidates listed), for a screen that follows the replay.
     pub fn isolation_now(&self) -> (IsolationReport, Vec<FaultCandidate>) {
-        let detected = self.first_detection.is_some() || self.isolation.named_a_fault();
+        let detected = self.detected();
         self.isolation.report(detected)
+    }
+
+    /// Whether a fault was detected: a lamp lit or the isolation named a fault, unless the
+    /// isolation ends finding that the windings' heating explains it
+    /// (`monitor_core::isolation`, "Heating is not a fault").
+    fn detected(&self) -> bool {
+        !self.isolation.heating_explains_lamps()
+            && (self.first_detection.is_some() || self.isolation.named_a_fault())
     }
 
     /// Every name the isolation gave so far (a fault or the friction class `b/bl`), each
@@ -487,7 +512,7 @@ impl Replay {
     }
 
     /// Where the load or the voltage of `out` has left the range learned in
-    /// commissioning: the note ("load (Iqs) 9.52 is 47 % above the commissioned
+    /// commissioning: the note ("load (active current) 9.52 is 47 % above the commissioned
     /// 6.47..6.48"); `None` inside it or without a learned window. The HMI shows this as
     /// the amber "operating point moved" state: to the paper's model a load change is a Bl
     /// change, so lamps lit there are not a fault unless the isolation names one.

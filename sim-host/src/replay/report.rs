@@ -189,7 +189,7 @@ impl Replay {
             })
             .collect();
         signature_candidates.sort_by(|a, b| b.probability.total_cmp(&a.probability));
-        let detected = self.first_detection.is_some() || self.isolation.named_a_fault();
+        let detected = self.detected();
         let (mut isolation, mut isolated) = self.isolation.report(detected);
         isolation::refine_single_phase(
             &mut isolation,
@@ -210,24 +210,7 @@ impl Replay {
                 )
             })
             .collect();
-        let mut withheld = skipped.clone();
-        if self.monitor.is_some() && !self.evaluated && self.first_detection.is_none() {
-            withheld.push(
-                "the lamps were never evaluated (the motor never ran settled and quasi-steady with voltage)"
-                    .to_string(),
-            );
-        }
-        if let Some(why) = self.commission.why_incomplete() {
-            withheld.push(why);
-        }
-        if let Some(why) = self.commission.nominal_misfit() {
-            withheld.push(why);
-        }
-        if let (Some(t), false) = (self.first_detection, self.detected_in_range) {
-            withheld.push(format!(
-                "the lamps lit (first at {t:.2} s) only while the load or the voltage was outside the range commissioned: to the paper's model a load change is a Bl change and the learned means hold only where they were learned, so a fault cannot be told from the new operating point; commission over the whole load and voltage range"
-            ));
-        }
+        let withheld = self.withheld(&skipped, detected, &isolation);
         let verdict = if !withheld.is_empty() {
             Verdict::CouldNotJudge
         } else if detected {
@@ -258,6 +241,44 @@ impl Replay {
             max_abs_residual: self.max_abs,
             timeline: self.timeline,
         }
+    }
+
+    /// Why the verdict is withheld (empty: it is not): `skipped` (what the log could not
+    /// feed), then the replay's own reasons; `detected` whether a lamp or the isolation
+    /// detected a fault, `isolation` the isolation's report.
+    fn withheld(
+        &self,
+        skipped: &[String],
+        detected: bool,
+        isolation: &IsolationReport,
+    ) -> Vec<String> {
+        let mut withheld = skipped.to_vec();
+        if self.monitor.is_some() && !self.evaluated && self.first_detection.is_none() {
+            withheld.push(
+                    "the lamps were never evaluated (the motor never ran settled and quasi-steady with voltage)"
+                        .to_string(),
+                );
+        }
+        if let Some(why) = self.commission.why_incomplete() {
+            withheld.push(why);
+        }
+        if let Some(why) = self.commission.nominal_misfit() {
+            withheld.push(why);
+        }
+        if let (Some(why), false) = (self.unsettled.withheld(), detected) {
+            withheld.push(why);
+        }
+        // The isolation allows for a move away from its learned point (its covariance
+        // widens there: `monitor_core::isolation`), so a fault it names is a verdict even
+        // where the lamps' learned means do not hold; only lamps alone are withheld.
+        let named_fault = matches!(isolation.named, Some(isolation::IsolationName::Fault(_)));
+        if let (Some(t), false, false) = (self.first_detection, self.detected_in_range, named_fault)
+        {
+            withheld.push(format!(
+                    "the lamps lit (first at {t:.2} s) only while the load or the voltage was outside the range commissioned: to the paper's model a load change is a Bl change and the learned means hold only where they were learned, so a fault cannot be told from the new operating point; commission over the whole load and voltage range"
+                ));
+        }
+        withheld
     }
 }
 

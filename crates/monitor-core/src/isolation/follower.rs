@@ -239,7 +239,15 @@ impl Follower {
             Step::Learned
         } else {
             let scale = crate::sqrt(AVERAGE_MAX_S / averaged_s);
-            let result = self.isolator.isolate_scaled(&avg, scale);
+            let mut result = self.isolator.isolate_scaled(&avg, scale);
+            // Heating is not a fault: the machine judged against warms with the winding,
+            // and the point is judged again (module docs of `crate::isolation`).
+            let warming = self.isolator.winding_rise_k().abs() >= super::WARMING_K;
+            let heating = result.heating_explains() || (warming && result.heating_continues());
+            if self.learned && heating {
+                self.isolator.track_heating(result.heating.factor);
+                result = self.isolator.isolate_scaled(&avg, scale);
+            }
             self.confirm(result)
         }
     }

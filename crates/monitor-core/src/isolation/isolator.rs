@@ -34,6 +34,7 @@ impl Isolator {
             torque_base_nm,
             baseline: Baseline::default(),
             learning: Learning::default(),
+            heating_factor: 1.0,
         })
     }
 
@@ -42,6 +43,31 @@ impl Isolator {
     /// common motors).
     pub fn torque_base_nm(&self) -> f32 {
         self.torque_base_nm
+    }
+
+    /// The tracked winding's resistance factor `1 + alpha dT` (Rs and Rr of the machine
+    /// the isolation judges against, relative to the parameter file's): 1 until the
+    /// [`Follower`] tracks a heating ([`Isolation::heating_explains`]).
+    pub fn heating_factor(&self) -> f32 {
+        self.heating_factor
+    }
+
+    /// The tracked winding temperature rise since commissioning [K]:
+    /// `(heating_factor - 1) / alpha` ([`COPPER_ALPHA_PER_K`]).
+    pub fn winding_rise_k(&self) -> f32 {
+        (self.heating_factor - 1.0) / COPPER_ALPHA_PER_K
+    }
+
+    /// Takes a further heating of factor `k` into the machine judged against (the tracked
+    /// factor times `k`, kept within [`HEATING_K_MIN`]..[`HEATING_K_MAX`]); a factor that
+    /// is not finite and positive changes nothing.
+    pub fn track_heating(&mut self, k: f32) {
+        if k.is_finite() && k > 0.0 {
+            self.heating_factor = crate::minf(
+                crate::maxf(self.heating_factor * k, HEATING_K_MIN),
+                HEATING_K_MAX,
+            );
+        }
     }
 
     /// The baseline in use.
@@ -271,45 +297,16 @@ impl Isolator {
         for (fit, f) in fits.iter_mut().zip(Fault::ALL) {
             *fit = self.fit(p, f, &w);
         }
-        // B and Bl scale the same load term: one friction class with one misfit (each
-        // keeps the size it needs on its own).
-        let friction = [Fault::B.index(), Fault::Bl.index()];
-        let chi_friction = friction
-            .iter()
-            .filter_map(|k| fits.get(*k))
-            .fold(f32::INFINITY, |a, (c, _)| crate::minf(a, *c));
-        for k in friction {
-            if let Some((c, _)) = fits.get_mut(k) {
-                *c = chi_friction;
+        let heat = self.fit_heating(p, &w);
+        rank(&mut out, &mut fits, heat, chi0);
+        // On a warm machine a fault is judged with the tracked temperature's lag allowed
+        // for (heating itself is decided on the single fits above).
+        if (self.heating_factor - 1.0).abs() >= WARM_FACTOR && !out.heating_explains() {
+            for (fit, f) in fits.iter_mut().zip(Fault::ALL) {
+                *fit = self.fit_on_warm(p, f, &w, *fit);
             }
+            rank(&mut out, &mut fits, heat, chi0);
         }
-        let chi_min = fits
-            .iter()
-            .fold(f32::INFINITY, |a, (c, _)| crate::minf(a, *c));
-        let chi_unknown = crate::maxf(UNKNOWN_CHI2, 0.1 * chi0);
-        let t = crate::maxf(1.0, 0.5 * chi_min);
-        let w = |c: f32| F32Ext::exp(-(c - chi_min) / (2.0 * t));
-        let mut total = w(chi_unknown);
-        for (c, _) in fits {
-            total += w(c);
-        }
-        for ((cand, (c, k)), f) in out.candidates.iter_mut().zip(fits).zip(Fault::ALL) {
-            *cand = Candidate {
-                fault: f,
-                probability: w(c) / total,
-                change: k - 1.0,
-                misfit: crate::sqrt(c),
-                at_limit: k <= K_MIN * 1.001 || k >= K_MAX * 0.999,
-            };
-        }
-        out.unknown_probability = w(chi_unknown) / total;
-        sort_by_probability(&mut out.candidates);
-        out.state =
-            if out.unknown_probability >= out.candidates.first().map_or(0.0, |c| c.probability) {
-                IsolationState::Unknown
-            } else {
-                IsolationState::Isolated
-            };
         out.separation_deg = self.separation(p, &e0, &out.candidates);
         out
     }
@@ -325,6 +322,59 @@ impl Isolator {
             Some(e) => w.quadratic(&(e - self.baseline.mean)),
             None => f32::INFINITY,
         }
+    }
+
+    /// The heating hypothesis' best factor `k` (Rs and Rr of the tracked machine both times
+    /// `k`, the total within [`HEATING_K_MIN`]..[`HEATING_K_MAX`]): golden section (the
+    /// misfit is unimodal over so narrow a range). Returns `(chi2, k)`.
+    #[inline(never)]
+    fn fit_heating(&self, p: &SteadyPoint, w: &Sym3) -> (f32, f32) {
+        golden(
+            |k| self.warmer(k).chi2_at(p, None, w),
+            HEATING_K_MIN / self.heating_factor,
+            HEATING_K_MAX / self.heating_factor,
+            HEATING_STEPS,
+        )
+    }
+
+    /// This isolator with the tracked winding `k` times warmer (Rs and Rr times `k`).
+    fn warmer(&self, k: f32) -> Isolator {
+        let mut t = *self;
+        t.heating_factor *= k;
+        t
+    }
+
+    /// Fault `f`'s fit on a warm machine (one whose heating was tracked): the tracked
+    /// temperature lags the winding's (the tracking follows only deviations the isolation
+    /// detects), and a fault judged against a lagging temperature would carry the lag into
+    /// its direction. The lag is a second, penalised parameter: the misfit adds
+    /// `(lag / HEATING_LAG_SIGMA_K)^2` (the tracked temperature's own uncertainty as a
+    /// prior), within +-[`HEATING_LAG_K`]. Two rounds of alternating fits, the lag for the
+    /// fault's size, then the size on the machine so warmed; returns the better of
+    /// `(chi2, k)` and `single`.
+    #[inline(never)]
+    fn fit_on_warm(&self, p: &SteadyPoint, f: Fault, w: &Sym3, single: (f32, f32)) -> (f32, f32) {
+        let d = HEATING_LAG_K * COPPER_ALPHA_PER_K;
+        let prior = |k: f32| {
+            let lag = (k - 1.0) / (COPPER_ALPHA_PER_K * HEATING_LAG_SIGMA_K);
+            lag * lag
+        };
+        let mut best = single;
+        let mut kf = single.1;
+        for _ in 0..2 {
+            let (_, kh) = golden(
+                |k| self.warmer(k).chi2_at(p, Some((f, kf)), w) + prior(k),
+                1.0 - d,
+                1.0 + d,
+                LAG_STEPS,
+            );
+            let (c, k) = self.warmer(kh).fit(p, f, w);
+            kf = k;
+            if c + prior(kh) < best.0 {
+                best = (c + prior(kh), k);
+            }
+        }
+        best
     }
 
     /// Best factor `k` for fault `f`: geometric grid, then golden section around the best
@@ -404,12 +454,13 @@ impl Isolator {
         F32Ext::acos(cos).to_degrees()
     }
 
-    /// The nominal circuit.
+    /// The nominal circuit at the tracked winding temperature (Rs and Rr times
+    /// [`Isolator::heating_factor`]).
     fn circuit(&self) -> Circuit {
         let m = &self.motor;
         Circuit {
-            rs: m.rs_ohm,
-            rr: m.rr_ohm,
+            rs: m.rs_ohm * self.heating_factor,
+            rr: m.rr_ohm * self.heating_factor,
             ls: m.ls_h,
             lr: m.lr_h,
             lm: m.lm_h,
@@ -417,6 +468,109 @@ impl Isolator {
             b_total: m.b_nms + m.bl_nms,
         }
     }
+}
+
+/// Golden-section steps of the heating fit: its bracket (0.90..1.63 of the tracked factor)
+/// shrunk by 0.618^20, to 1e-4 of the factor (0.03 K).
+const HEATING_STEPS: usize = 20;
+/// How far the tracked winding temperature may lag the winding's when a fault is fitted on
+/// a warm machine [K] (the tracking follows only deviations the isolation detects, 4
+/// standard deviations: measured up to 3 K behind on the 3 hp motor warming 60 K with a
+/// 10 s time constant).
+const HEATING_LAG_K: f32 = 10.0;
+/// One standard deviation of the tracked temperature's lag [K]: the prior of a fault's fit
+/// on a warm machine ([`Isolator::fit_on_warm`]); 3 K, the lag measured on the 3 hp motor
+/// warming 60 K with a 10 s time constant.
+const HEATING_LAG_SIGMA_K: f32 = 3.0;
+/// Golden-section steps of the lag's fit: +-10 K shrunk by 0.618^12, to 0.07 K.
+const LAG_STEPS: usize = 12;
+/// A tracked heating factor this far from 1 makes the machine "warm" for the faults' fits
+/// ([`Isolator::fit_on_warm`]): 0.004, 1 K.
+const WARM_FACTOR: f32 = COPPER_ALPHA_PER_K;
+
+/// The minimum of a unimodal `chi` over `lo..hi` by `steps` golden-section steps:
+/// `(chi, x)`.
+fn golden(chi: impl Fn(f32) -> f32, lo: f32, hi: f32, steps: usize) -> (f32, f32) {
+    const G: f32 = 0.618_034;
+    let (mut lo, mut hi) = (lo, hi);
+    let mut x1 = hi - G * (hi - lo);
+    let mut x2 = lo + G * (hi - lo);
+    let (mut c1, mut c2) = (chi(x1), chi(x2));
+    for _ in 0..steps {
+        if c1 < c2 {
+            hi = x2;
+            (x2, c2) = (x1, c1);
+            x1 = hi - G * (hi - lo);
+            c1 = chi(x1);
+        } else {
+            lo = x1;
+            (x1, c1) = (x2, c2);
+            x2 = lo + G * (hi - lo);
+            c2 = chi(x2);
+        }
+    }
+    if c1 < c2 {
+        (c1, x1)
+    } else {
+        (c2, x2)
+    }
+}
+
+/// Ranks the faults' fits `(chi2, k)`, the heating fit `heat` and the unknown fault into
+/// `out` (candidates, probabilities, state), for a deviation of misfit `chi0` (module
+/// docs). B and Bl scale the same load term: one friction class with one misfit (each
+/// keeps the size it needs on its own).
+fn rank(out: &mut Isolation, fits: &mut [(f32, f32); FAULT_COUNT], heat: (f32, f32), chi0: f32) {
+    let friction = [Fault::B.index(), Fault::Bl.index()];
+    let chi_friction = friction
+        .iter()
+        .filter_map(|k| fits.get(*k))
+        .fold(f32::INFINITY, |a, (c, _)| crate::minf(a, *c));
+    for k in friction {
+        if let Some((c, _)) = fits.get_mut(k) {
+            *c = chi_friction;
+        }
+    }
+    // Heating takes part in the ranking only where it can explain the deviation (misfit
+    // within HEATING_MAX_MISFIT): elsewhere the faults rank among themselves as without it.
+    let (chi_heat, k_heat) = heat;
+    let heat_in = crate::sqrt(chi_heat) <= HEATING_MAX_MISFIT;
+    let chi_min = fits.iter().fold(
+        if heat_in { chi_heat } else { f32::INFINITY },
+        |a, (c, _)| crate::minf(a, *c),
+    );
+    let chi_unknown = crate::maxf(UNKNOWN_CHI2, 0.1 * chi0);
+    let t = crate::maxf(1.0, 0.5 * chi_min);
+    let w = |c: f32| F32Ext::exp(-(c - chi_min) / (2.0 * t));
+    let mut total = w(chi_unknown);
+    for (c, _) in fits.iter() {
+        total += w(*c);
+    }
+    if heat_in {
+        total += w(chi_heat);
+    }
+    out.heating = Heating {
+        probability: if heat_in { w(chi_heat) / total } else { 0.0 },
+        factor: k_heat,
+        misfit: crate::sqrt(chi_heat),
+    };
+    for ((cand, (c, k)), f) in out.candidates.iter_mut().zip(*fits).zip(Fault::ALL) {
+        *cand = Candidate {
+            fault: f,
+            probability: w(c) / total,
+            change: k - 1.0,
+            misfit: crate::sqrt(c),
+            at_limit: k <= K_MIN * 1.001 || k >= K_MAX * 0.999,
+        };
+    }
+    out.unknown_probability = w(chi_unknown) / total;
+    sort_by_probability(&mut out.candidates);
+    out.state = if out.unknown_probability >= out.candidates.first().map_or(0.0, |c| c.probability)
+    {
+        IsolationState::Unknown
+    } else {
+        IsolationState::Isolated
+    };
 }
 
 /// Sorts candidates by probability, most probable first (insertion sort: nine entries,

@@ -66,6 +66,20 @@
 //! a large Rr change) is judged with the widening its move brings, which is what a
 //! nameplate that is off deserves.
 //!
+//! # Heating is not a fault
+//! A winding that warms raises Rs and Rr together, by the same factor
+//! `k = 1 + alpha dT` (copper: [`COPPER_ALPHA_PER_K`] = 0.393 %/K; an aluminium cage's
+//! 0.403 %/K is within the fit's resolution). Beside the faults the isolation fits this
+//! *heating* hypothesis (Rs and Rr both times `k`, `k` from [`HEATING_K_MIN`] to
+//! [`HEATING_K_MAX`] of the winding's commissioned temperature: 25 K cooler to 160 K warmer,
+//! beyond an insulation class H winding's 125 K rise) and ranks it with them
+//! ([`Isolation::heating`]). When it is the most probable explanation the [`Follower`]
+//! tracks it: the isolator's machine takes the warmer resistances
+//! ([`Isolator::heating_factor`]) and the point is isolated again against it, so the
+//! rise is reported, not a fault, and a later fault is judged against the warm machine.
+//! A change that moves Rs or Rr alone, or both but apart from their common ratio, fits a
+//! fault better and is named as before.
+//!
 //! Faults that cannot be separated:
 //! - **B and Bl**: both scale the same load term `(B + Bl) wr`; the directions coincide at
 //!   every operating point (one friction class; the size is given for each as if it alone
@@ -118,6 +132,16 @@ const GOLDEN_STEPS: usize = 16;
 /// Misfit given to the unknown-fault hypothesis: 5 spreads on the 2 residual dimensions
 /// left after fitting a size.
 pub const UNKNOWN_CHI2: f32 = 25.0;
+/// Temperature coefficient of copper's resistance near 20 °C [1/K] (IEC 60228; IEEE Std 112
+/// corrects resistances with 234.5 + T, the same 0.393 %/K at 20 °C).
+pub const COPPER_ALPHA_PER_K: f32 = 0.00393;
+/// Smallest resistance factor of the heating hypothesis, relative to the commissioned
+/// winding: 25 K cooler (a motor commissioned warm, then cooled).
+pub const HEATING_K_MIN: f32 = 1.0 - 25.0 * COPPER_ALPHA_PER_K;
+/// Largest resistance factor of the heating hypothesis: 160 K warmer than commissioned (a
+/// cold start at 20 °C to 180 °C, the class H limit; beyond it a change is not heating).
+pub const HEATING_K_MAX: f32 = 1.0 + 160.0 * COPPER_ALPHA_PER_K;
+
 /// Fewest averaged points a learned baseline needs: half a second of steady running after
 /// the first [`AVERAGE_S`] average, one point per [`STEP_S`] block.
 pub const MIN_LEARNED_POINTS: u32 = 5;
@@ -358,6 +382,77 @@ pub struct Isolation {
     /// to the residuals, weighted by the spreads) [deg], 0..180; small: they cannot be
     /// separated at this operating point.
     pub separation_deg: f32,
+    /// The heating hypothesis' fit (module docs, "Heating is not a fault").
+    pub heating: Heating,
+}
+
+/// The heating hypothesis' fit: Rs and Rr of the isolator's machine both times `factor`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Heating {
+    /// Probability, [0, 1], ranked with the faults and the unknown fault (their
+    /// probabilities and this one sum to 1).
+    pub probability: f32,
+    /// Resistance factor relative to the isolator's machine ([`Isolator::heating_factor`]):
+    /// `1 + alpha dT` of the further rise.
+    pub factor: f32,
+    /// Misfit left after the fit, in standard deviations.
+    pub misfit: f32,
+}
+
+impl Default for Heating {
+    fn default() -> Self {
+        Heating {
+            probability: 0.0,
+            factor: 1.0,
+            misfit: 0.0,
+        }
+    }
+}
+
+/// Largest misfit of the heating hypothesis that is tracked, in standard deviations (the
+/// square root of [`DETECT_CHI2`]): heating must explain the deviation to within the healthy
+/// scatter. A fault that arrives while the winding still warms leaves a residual that
+/// neither heating nor the fault alone explains; it is not taken into the temperature.
+pub const HEATING_MAX_MISFIT: f32 = 4.0;
+/// Tracked rise from which the winding counts as warming ([`Isolation::heating_continues`])
+/// [K].
+pub const WARMING_K: f32 = 5.0;
+
+impl Isolation {
+    /// The heating hypothesis explains the deviation alone, as a fault is named alone
+    /// ([`Isolation::named`]): probability at least 0.5, [`NAME_MARGIN`] ahead of every
+    /// fault and of the unknown fault, with a misfit of at most [`HEATING_MAX_MISFIT`]. Where
+    /// heating and a fault cannot be told apart (an Rr change on a machine whose Rs is a
+    /// small part of its impedance) nothing is taken into the temperature.
+    pub fn heating_explains(&self) -> bool {
+        let h = self.heating.probability;
+        let runner_up = self
+            .candidates
+            .first()
+            .map_or(0.0, |c| c.probability)
+            .max(self.unknown_probability);
+        matches!(
+            self.state,
+            IsolationState::Isolated | IsolationState::Unknown
+        ) && h >= 0.5
+            && h - runner_up >= NAME_MARGIN
+            && self.heating.misfit <= HEATING_MAX_MISFIT
+    }
+
+    /// Once the winding is warming (a tracked rise of [`WARMING_K`] or more), heating goes
+    /// on explaining a further deviation that it fits best (more probable than every fault
+    /// and the unknown fault) within [`HEATING_MAX_MISFIT`]: a winding that has started to
+    /// warm goes on warming, and the small steps of the tracking are where heating and an
+    /// Rr change are hardest to tell apart.
+    pub fn heating_continues(&self) -> bool {
+        let h = self.heating.probability;
+        matches!(
+            self.state,
+            IsolationState::Isolated | IsolationState::Unknown
+        ) && h > self.unknown_probability
+            && self.candidates.first().is_none_or(|c| h > c.probability)
+            && self.heating.misfit <= HEATING_MAX_MISFIT
+    }
 }
 
 impl Default for Isolation {
@@ -375,6 +470,7 @@ impl Default for Isolation {
             deviation: 0.0,
             residuals: ParityResiduals::default(),
             separation_deg: 0.0,
+            heating: Heating::default(),
         }
     }
 }
@@ -441,6 +537,9 @@ pub struct Isolator {
     torque_base_nm: f32,
     baseline: Baseline,
     learning: Learning,
+    /// Rs and Rr factor of the winding's tracked temperature, relative to the
+    /// commissioned one (module docs, "Heating is not a fault").
+    heating_factor: f32,
 }
 
 #[cfg(test)]

@@ -521,7 +521,10 @@ mod tests {
             "{lamps}"
         );
         // Issue 28: the named class and its size first; B and Bl as one friction class.
-        assert!(lamps.contains("moved: b/bl +50 % | load (Iqs)"), "{lamps}");
+        assert!(
+            lamps.contains("moved: b/bl +50 % | load (active"),
+            "{lamps}"
+        );
         assert!(find(&rows, " bl ").contains("p 0.50"));
         assert!(find(&rows, "faults on:").contains("bl +50%"));
         assert!(find(&rows, " > ").contains("bl +50 % switched on"));
@@ -608,7 +611,7 @@ mod tests {
                 lamps.contains("MOVED ●") && !lamps.contains("FAULT"),
                 "{w}x{h}: {lamps}"
             );
-            assert!(lamps.contains("load (Iqs)"), "{w}x{h}: {lamps}");
+            assert!(lamps.contains("load (active"), "{w}x{h}: {lamps}");
             assert!(rows.iter().all(|r| r.chars().count() <= usize::from(w)));
         }
         // The plain status line says MOVED once and no FAULT.

@@ -290,7 +290,7 @@ fn commissioning(out: &mut impl Write, c: &CommissioningReport) -> anyhow::Resul
         };
         writeln!(
             out,
-            "  learned {:.2} s of evaluated running; load current Iqs {}, voltage Vqs {}",
+            "  learned {:.2} s of evaluated running; load (active current) {}, voltage |V| {}",
             c.seconds_evaluated,
             span(c.load_current_a, "A"),
             span(c.voltage_v, "V")
@@ -408,12 +408,18 @@ pub fn compare(log: &Path, r: &CompareReport) -> anyhow::Result<()> {
             " + "
         )
     )?;
-    writeln!(
-        out,
-        "  normalized_rms_error {}   (noise floor {})",
-        number(r.normalized_rms_error),
-        number(r.noise_floor)
-    )?;
+    match r.diverged_at_s {
+        Some(t) => writeln!(
+            out,
+            "  normalized_rms_error: not judged: the model diverged at {t:.3} s (see 'not plausible' below)"
+        )?,
+        None => writeln!(
+            out,
+            "  normalized_rms_error {}   (noise floor {})",
+            number(r.normalized_rms_error),
+            number(r.noise_floor)
+        )?,
+    }
     for ch in &r.channels {
         writeln!(
             out,

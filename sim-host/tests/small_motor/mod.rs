@@ -1,0 +1,43 @@
+//! The 0.37 kW machine the tests use beside the two reference motors (the one of
+//! `tests/nameplate.rs`: made for the tests from per-unit values typical of its size, not a
+//! published circuit), and the three motors as a list.
+
+use monitor_core::{MotorParameters, SupplyParameters};
+use sim_host::params::ParamFile;
+use std::f64::consts::TAU;
+
+/// The 0.37 kW, 400 V, 50 Hz, 4-pole machine (Rs 30, Rr 24, Xls = Xlr 16, Xm 260 ohm at
+/// 50 Hz), J of a 71-frame motor, the paper's viscous load at its rated torque (2.57 N m
+/// at 1375 rpm).
+pub fn small_0p37kw() -> ParamFile {
+    let w = TAU * 50.0;
+    let (lm, ll) = (260.0 / w, 16.0 / w);
+    let w_rated = TAU * 1375.0 / 60.0;
+    let bl = 370.0 / (w_rated * w_rated);
+    ParamFile {
+        motor: MotorParameters {
+            rs_ohm: 30.0,
+            rr_ohm: 24.0,
+            ls_h: lm + ll,
+            lr_h: lm + ll,
+            lm_h: lm,
+            poles: 4,
+            j_kgm2: 0.0009,
+            b_nms: 0.005 * bl,
+            bl_nms: bl,
+        },
+        supply: SupplyParameters {
+            v_ll_rms: 400.0,
+            f_hz: 50.0,
+        },
+    }
+}
+
+/// The 3 hp and 2.2 kW reference motors and the 0.37 kW machine, with their names.
+pub fn three_motors() -> Vec<(&'static str, ParamFile)> {
+    vec![
+        ("3 hp", ParamFile::reference_3hp()),
+        ("2.2 kW", ParamFile::reference_2p2kw()),
+        ("0.37 kW", small_0p37kw()),
+    ]
+}
