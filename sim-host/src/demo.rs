@@ -7,50 +7,12 @@
 use crate::experiment::{simulate_and_replay, ExperimentError};
 use crate::fault_signatures::{scenario, Protocol};
 use crate::params::ParamFile;
+pub use crate::replay::MonitorState;
 use crate::replay::{DiagnoseReport, IsolationName, ReplayOptions};
-use monitor_core::{CommissioningState, Fault, MonitorOutput};
+use monitor_core::Fault;
 
 /// Time between two timeline points [s].
 pub const TIMELINE_STEP_S: f64 = 0.25;
-
-/// What the monitor is doing at a timeline point, as the panel would show it.
-#[derive(Debug, Clone, PartialEq)]
-pub enum MonitorState {
-    /// Learning the healthy residuals; the fraction done.
-    Commissioning(f32),
-    /// The operating point is changing: the lamps hold.
-    Transient,
-    /// Settling after start (lamps not yet evaluated).
-    Starting,
-    /// Evaluating, no lamp lit.
-    Healthy,
-    /// Lamps lit: the candidates with their probabilities.
-    Fault(Vec<(Fault, f32)>),
-    /// The load or the voltage has left the commissioned range and no fault is named (the
-    /// amber state): lamps may light, the FAULT lamp stays off; the note says where the
-    /// operating point went ([`crate::replay::Replay::operating_point_moved`]).
-    Moved(String),
-}
-
-impl MonitorState {
-    /// The state of a monitor output.
-    pub fn of(o: &MonitorOutput) -> Self {
-        match o.commissioning {
-            CommissioningState::Learning(x) => MonitorState::Commissioning(x),
-            _ if !o.quasi_steady => MonitorState::Transient,
-            _ if !o.evaluating => MonitorState::Starting,
-            _ if o.top().is_none() => MonitorState::Healthy,
-            _ => MonitorState::Fault(
-                Fault::ALL
-                    .iter()
-                    .zip(o.diagnosis.probabilities)
-                    .filter(|(_, p)| *p > 0.0)
-                    .map(|(f, p)| (*f, p))
-                    .collect(),
-            ),
-        }
-    }
-}
 
 /// One point of the demo's timeline.
 #[derive(Debug, Clone, PartialEq)]

@@ -41,7 +41,8 @@ pub use isolation::{
     SensorPhaseReport, NOMINAL_UNCERTAINTY,
 };
 pub use report::{
-    BaselineSource, Detection, DiagnoseReport, TimelinePoint, UnbalanceReport, Verdict,
+    BaselineSource, Detection, DiagnoseReport, MonitorState, TimelinePoint, UnbalanceReport,
+    Verdict,
 };
 
 use crate::log::{Channels, LogError, Row};
