@@ -4,11 +4,12 @@
 //! firmware runs, the healthy residuals learned (commissioning, 2-4 s), a Table 1 fault
 //! injected at 5 s, and the lamps r1..r4 and the fault candidates followed every 0.25 s.
 
-use crate::experiment::{simulate_and_replay, ExperimentError};
+use crate::experiment::ExperimentError;
 use crate::fault_signatures::{scenario, Protocol};
 use crate::params::ParamFile;
 pub use crate::replay::MonitorState;
-use crate::replay::{DiagnoseReport, IsolationName, ReplayOptions};
+use crate::replay::{DiagnoseReport, IsolationName, Panel, Replay, ReplayOptions};
+use crate::sim::simulate;
 use monitor_core::Fault;
 
 /// Time between two timeline points [s].
@@ -23,8 +24,9 @@ pub struct DemoPoint {
     pub speed_rpm: f64,
     /// Lamps r1..r4.
     pub lamps: [bool; 4],
-    /// The monitor's state.
-    pub state: MonitorState,
+    /// What the panel shows: the state, the FAULT lamp, the isolation's conclusion
+    /// ([`crate::replay::Replay::panel`]).
+    pub panel: Panel,
     /// The first point at or after the fault's onset.
     pub fault_injected: bool,
 }
@@ -71,7 +73,9 @@ pub fn run(fault: Fault, change: f64) -> Result<DemoRun, ExperimentError> {
     let mut next = 0.0;
     let mut announced = false;
     let mut points = Vec::new();
-    let replay = simulate_and_replay(&params, &params, &sc, opts, |row, o| {
+    let mut replay = Replay::new(&params, sc.sensors.channels(), sc.sample_rate_hz, opts)?;
+    simulate(&params, &sc, |row| {
+        let o = replay.push(row);
         if row.t_s + 1e-9 >= next {
             next += TIMELINE_STEP_S;
             let fault_injected = !announced && row.t_s >= proto.fault_at_s;
@@ -80,7 +84,7 @@ pub fn run(fault: Fault, change: f64) -> Result<DemoRun, ExperimentError> {
                 t_s: row.t_s,
                 speed_rpm: f64::from(o.speed_rad_s * 60.0 / std::f32::consts::TAU),
                 lamps: o.lamps,
-                state: MonitorState::of(o),
+                panel: replay.panel(&o),
                 fault_injected,
             });
         }

@@ -34,14 +34,60 @@ impl MonitorState {
             _ if !o.quasi_steady => MonitorState::Transient,
             _ if !o.evaluating => MonitorState::Starting,
             _ if o.top().is_none() => MonitorState::Healthy,
-            _ => MonitorState::Fault(
-                Fault::ALL
+            _ => {
+                let mut c: Vec<(Fault, f32)> = Fault::ALL
                     .iter()
                     .zip(o.diagnosis.probabilities)
                     .filter(|(_, p)| *p > 0.0)
                     .map(|(f, p)| (*f, p))
-                    .collect(),
-            ),
+                    .collect();
+                c.sort_by(|a, b| b.1.total_cmp(&a.1));
+                MonitorState::Fault(c)
+            }
+        }
+    }
+}
+
+impl Replay {
+    /// The monitor's state at the replay's output `out` as the panel shows it, the one rule
+    /// of the HMI, the demo and `diagnose`'s timeline: [`MonitorState::of`], except that
+    /// where the load or the voltage has left the commissioned range
+    /// ([`Replay::operating_point_moved`]) and neither the isolation nor a sensor check
+    /// names a fault, an evaluated output (healthy or lamps lit) is the amber
+    /// [`MonitorState::Moved`] with the note: to the paper's model a load change is a Bl
+    /// change, so lamps lit there are not a fault (the friction class `b/bl` is not named
+    /// as one).
+    pub fn state(&self, out: &MonitorOutput) -> MonitorState {
+        let state = MonitorState::of(out);
+        let evaluated = matches!(state, MonitorState::Healthy | MonitorState::Fault(_));
+        if !evaluated || out.sensor_fault.any() {
+            return state;
+        }
+        let Some(note) = self.operating_point_moved(out) else {
+            return state;
+        };
+        let fault_named = matches!(
+            self.isolation_now().0.named,
+            Some(isolation::IsolationName::Fault(_))
+        );
+        if fault_named {
+            state
+        } else {
+            MonitorState::Moved(note)
+        }
+    }
+
+    /// What the panel shows at the replay's output `out`: the state ([`Replay::state`]),
+    /// the FAULT lamp (off in the amber state) and, where the lamps are evaluated, the
+    /// isolation's conclusion.
+    pub fn panel(&self, out: &MonitorOutput) -> Panel {
+        let state = self.state(out);
+        let moved = matches!(state, MonitorState::Moved(_));
+        let evaluated = moved || matches!(state, MonitorState::Healthy | MonitorState::Fault(_));
+        Panel {
+            fault_lamp: out.fault_detected && !moved,
+            isolation: evaluated.then(|| self.isolation_now()),
+            state,
         }
     }
 }
@@ -72,6 +118,23 @@ pub struct TimelinePoint {
     /// Beside a lit r2..r4 lamp: the operating point has left the commissioned range.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub range_note: Option<String>,
+    /// What the panel shows ([`Replay::panel`]; not in the JSON, whose keys above carry
+    /// it).
+    #[serde(skip)]
+    pub panel: Panel,
+}
+
+/// What the panel shows at an output ([`Replay::panel`]): the HMI, the demo's and
+/// `diagnose`'s timelines.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Panel {
+    /// The state ([`Replay::state`]).
+    pub state: MonitorState,
+    /// The FAULT lamp: a residual lamp or a sensor fault, off in the amber state.
+    pub fault_lamp: bool,
+    /// What the isolation concluded where the lamps are evaluated (the report and the
+    /// candidates listed, [`Replay::isolation_now`]), else `None`.
+    pub isolation: Option<(IsolationReport, Vec<FaultCandidate>)>,
 }
 
 /// Result of the negative-sequence analysis (JSON key `unbalance`).
@@ -300,8 +363,10 @@ impl Replay {
     }
 }
 
-/// The timeline point of an output at `t`.
+/// The timeline point of an output at `t` of `replay`, with what the panel shows
+/// ([`Replay::panel`]).
 pub(super) fn timeline_point(
+    replay: &Replay,
     t: f64,
     out: &MonitorOutput,
     range_note: Option<String>,
@@ -319,5 +384,6 @@ pub(super) fn timeline_point(
         quasi_steady: out.quasi_steady,
         negative_sequence_ratio: out.unbalance.negative_sequence_ratio,
         range_note,
+        panel: replay.panel(out),
     }
 }
