@@ -15,13 +15,17 @@ use std::path::Path;
 /// The report page's file name in `--report DIR`.
 pub const REPORT_FILE: &str = "report.html";
 
-/// Writes the charts into `dir` (created if needed); returns (stem, svg) pairs.
+/// Writes the charts into `dir` (created if needed); returns (title, HTML) pairs: the SVG,
+/// or for a chart not drawn the sentence why.
 fn write_charts(dir: &Path, charts: &[Chart]) -> anyhow::Result<Vec<(String, String)>> {
     std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
     let mut v = Vec::new();
     for c in charts {
-        let (svg, _) = plot::write(dir, c).map_err(anyhow::Error::msg)?;
-        v.push((c.stem.to_string(), svg));
+        let body = match &c.omitted {
+            Some(why) => format!("<p><i>{}</i></p>", esc(why)),
+            None => plot::write(dir, c).map_err(anyhow::Error::msg)?.0,
+        };
+        v.push((c.title.to_string(), body));
     }
     Ok(v)
 }
@@ -141,8 +145,8 @@ fn compare_html(log: &str, out: &CompareOutput, charts: &[(String, String)]) -> 
         let _ = write!(h, "<p><b>{}</b>: {}</p>", e.effect, esc(&e.summary));
     }
     let _ = write!(h, "<h2>Unbalance</h2><p>{}</p>", esc(&r.unbalance.summary));
-    for (stem, svg) in charts {
-        let _ = write!(h, "<h3>{stem}</h3>{svg}");
+    for (title, svg) in charts {
+        let _ = write!(h, "<h3>{}</h3>{svg}", esc(title));
     }
     h.push_str("<p>Next step: <code>sim-host explain</code> ranks the physical effects that could remove this error.</p></body></html>");
     h
@@ -168,8 +172,8 @@ fn explain_html(log: &str, out: &ExplainOutput, charts: &[(String, String)]) -> 
         let _ = write!(h, "<p><i>skipped: {}</i></p>", esc(s));
     }
     let _ = write!(h, "<h2>Unbalance</h2><p>{}</p>", esc(&r.unbalance.summary));
-    for (stem, svg) in charts {
-        let _ = write!(h, "<h3>{stem}</h3>{svg}");
+    for (title, svg) in charts {
+        let _ = write!(h, "<h3>{}</h3>{svg}", esc(title));
     }
     h.push_str("</body></html>");
     h

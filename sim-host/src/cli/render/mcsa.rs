@@ -64,6 +64,7 @@ pub fn chart(r: &McsaReport) -> Option<Chart<'static>> {
         points: vec![(f, lo), (f, 0.0)],
         color,
         scatter: false,
+        dashed: false,
     };
     let f = |i: usize| r.sideband_hz.get(i).copied().unwrap_or(f64::NAN);
     Some(Chart {
@@ -83,11 +84,13 @@ pub fn chart(r: &McsaReport) -> Option<Chart<'static>> {
                 ),
                 color: 0,
                 scatter: false,
+                dashed: false,
             },
             marker(f(0), &format!("(1-2s)f = {:.2} Hz", f(0)), 1),
             marker(f(1), &format!("(1+2s)f = {:.2} Hz", f(1)), 2),
         ],
         log_y: false,
+        omitted: None,
     })
 }
 
