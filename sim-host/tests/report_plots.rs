@@ -193,3 +193,84 @@ fn explain_report_draws_the_model_before_dashed_and_on_top() {
         "the model before lies under the other lines"
     );
 }
+
+/// The numbers (with their sign and decimals) of a text: `0.3008`, `-0.03`, `96`.
+fn numbers(text: &str) -> Vec<String> {
+    let mut v = Vec::new();
+    let mut cur = String::new();
+    for ch in text.chars().chain([' ']) {
+        if ch.is_ascii_digit() || (ch == '.' && !cur.is_empty()) || (ch == '-' && cur.is_empty()) {
+            cur.push(ch);
+        } else {
+            let n = cur.trim_end_matches('.').to_string();
+            if n.chars().any(|c| c.is_ascii_digit()) {
+                v.push(n);
+            }
+            cur.clear();
+        }
+    }
+    v
+}
+
+/// The text of every table cell of `html`.
+fn cells(html: &str) -> Vec<String> {
+    html.split("<td")
+        .skip(1)
+        .filter_map(|c| {
+            c.split_once('>')?
+                .1
+                .split("</td>")
+                .next()
+                .map(str::to_string)
+        })
+        .collect()
+}
+
+#[test]
+fn explain_report_tables_hold_the_headline_numbers_and_the_spectrum() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let dir = tmp.path().join("e");
+    run(&[
+        "explain",
+        "--from",
+        "1.5",
+        "--report",
+        dir.to_str().expect("utf8"),
+    ]);
+    let html = std::fs::read_to_string(dir.join("report.html")).expect("report");
+    let headline = html
+        .split("<p class=v>")
+        .nth(1)
+        .and_then(|h| h.split("</p>").next())
+        .expect("headline");
+    // The headline's finding: the effect, how much it explains, the errors before and
+    // after, and the fitted values (up to the advice "Add it with ...").
+    let finding = headline.split("Add it with").next().unwrap_or(headline);
+    let table_numbers: Vec<String> = cells(&html).iter().flat_map(|c| numbers(c)).collect();
+    let quoted = numbers(finding);
+    assert!(quoted.len() >= 3, "{finding}");
+    for n in &quoted {
+        assert!(
+            table_numbers.contains(n),
+            "the headline quotes {n}, no table holds it: {finding}"
+        );
+    }
+    // Held-back and whole-log errors before and after.
+    assert!(html.contains("<th>held-back windows</th><th>whole log</th>"));
+    // The plausibility flags and the motor current signature analysis.
+    assert!(html.contains("[not plausible]"));
+    assert!(html.contains("motor current signature analysis"));
+    assert!(dir.join("mcsa_spectrum.svg").exists());
+}
+
+#[test]
+fn compare_report_holds_the_advice_flags_and_identifiability() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let dir = tmp.path().join("r");
+    run(&["compare", "--report", dir.to_str().expect("utf8")]);
+    let html = std::fs::read_to_string(dir.join("report.html")).expect("report");
+    assert!(html.contains("<h2>Advice</h2>"), "no advice");
+    assert!(html.contains("--from 0.7"), "no --from advice");
+    assert!(html.contains("[not plausible]") && html.contains("not plausible: j_kgm2"));
+    assert!(html.contains("Identifiability: Jacobian rank"));
+}

@@ -3,7 +3,6 @@
 
 use super::plot::{self, Chart, Series};
 use sim_host::analysis::rotor_asymmetry::McsaReport;
-use std::path::Path;
 
 /// File stem of the spectrum chart `explain --plot DIR` writes.
 pub const CHART: &str = "mcsa_spectrum";
@@ -92,15 +91,4 @@ pub fn chart(r: &McsaReport) -> Option<Chart<'static>> {
         log_y: false,
         omitted: None,
     })
-}
-
-/// Writes the chart into `dir` (when the log could be judged).
-///
-/// # Errors
-/// The chart cannot be written.
-pub fn write(dir: &Path, r: &McsaReport) -> anyhow::Result<()> {
-    if let Some(c) = chart(r) {
-        plot::write(dir, &c).map_err(|e| anyhow::anyhow!("cannot write the plot: {e}"))?;
-    }
-    Ok(())
 }
