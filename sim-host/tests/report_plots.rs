@@ -91,6 +91,20 @@ fn points_per_column(svg: &str) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// `explain --from 1.5 --report DIR` of the motulator log: (the temporary folder, DIR).
+fn explain_report() -> (tempfile::TempDir, PathBuf) {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let dir = tmp.path().join("e");
+    run(&[
+        "explain",
+        "--from",
+        "1.5",
+        "--report",
+        dir.to_str().expect("utf8"),
+    ]);
+    (tmp, dir)
+}
+
 fn headings(html: &str) -> Vec<String> {
     html.split("<h3>")
         .skip(1)
@@ -153,15 +167,7 @@ fn compare_report_draws_envelopes_zooms_and_one_unit_per_axis() {
 
 #[test]
 fn explain_report_draws_the_model_before_dashed_and_on_top() {
-    let tmp = tempfile::tempdir().expect("tmp");
-    let dir = tmp.path().join("e");
-    run(&[
-        "explain",
-        "--from",
-        "1.5",
-        "--report",
-        dir.to_str().expect("utf8"),
-    ]);
+    let (_tmp, dir) = explain_report();
     check_dir(
         &dir,
         &[
@@ -228,15 +234,7 @@ fn cells(html: &str) -> Vec<String> {
 
 #[test]
 fn explain_report_tables_hold_the_headline_numbers_and_the_spectrum() {
-    let tmp = tempfile::tempdir().expect("tmp");
-    let dir = tmp.path().join("e");
-    run(&[
-        "explain",
-        "--from",
-        "1.5",
-        "--report",
-        dir.to_str().expect("utf8"),
-    ]);
+    let (_tmp, dir) = explain_report();
     let html = std::fs::read_to_string(dir.join("report.html")).expect("report");
     let headline = html
         .split("<p class=v>")

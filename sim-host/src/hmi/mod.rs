@@ -152,13 +152,7 @@ impl Snapshot {
         learned: bool,
         params: &ParamFile,
     ) -> Self {
-        let mut candidates: Vec<(Fault, f32)> = Fault::ALL
-            .iter()
-            .zip(out.diagnosis.probabilities)
-            .filter(|(_, p)| *p > 0.0)
-            .map(|(f, p)| (*f, p))
-            .collect();
-        candidates.sort_by(|a, b| b.1.total_cmp(&a.1));
+        let candidates = MonitorState::signature(out);
         let s = out.sensor_fault;
         let sensor_faults = [
             (s.current, Fault::CurrentSensor),

@@ -34,17 +34,21 @@ impl MonitorState {
             _ if !o.quasi_steady => MonitorState::Transient,
             _ if !o.evaluating => MonitorState::Starting,
             _ if o.top().is_none() => MonitorState::Healthy,
-            _ => {
-                let mut c: Vec<(Fault, f32)> = Fault::ALL
-                    .iter()
-                    .zip(o.diagnosis.probabilities)
-                    .filter(|(_, p)| *p > 0.0)
-                    .map(|(f, p)| (*f, p))
-                    .collect();
-                c.sort_by(|a, b| b.1.total_cmp(&a.1));
-                MonitorState::Fault(c)
-            }
+            _ => MonitorState::Fault(MonitorState::signature(o)),
         }
+    }
+
+    /// The signature matching's candidates of `o` (probability above zero), most probable
+    /// first.
+    pub fn signature(o: &MonitorOutput) -> Vec<(Fault, f32)> {
+        let mut c: Vec<(Fault, f32)> = Fault::ALL
+            .iter()
+            .zip(o.diagnosis.probabilities)
+            .filter(|(_, p)| *p > 0.0)
+            .map(|(f, p)| (*f, p))
+            .collect();
+        c.sort_by(|a, b| b.1.total_cmp(&a.1));
+        c
     }
 }
 
