@@ -271,4 +271,7 @@ fn compare_report_holds_the_advice_flags_and_identifiability() {
     assert!(html.contains("--from 0.7"), "no --from advice");
     assert!(html.contains("[not plausible]") && html.contains("not plausible: j_kgm2"));
     assert!(html.contains("Identifiability: Jacobian rank"));
+    // The data-quality stage's line and the worst windows' transients, as the text has them.
+    assert!(html.contains("Data quality: clean"));
+    assert!(html.contains("transient (start): the direct-on-line start"));
 }

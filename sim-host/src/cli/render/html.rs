@@ -10,6 +10,7 @@ use sim_host::analysis::compare::CompareOutput;
 use sim_host::analysis::explain::ExplainOutput;
 use sim_host::analysis::rotor_asymmetry::McsaReport;
 use sim_host::analysis::Analysis;
+use sim_host::log::quality::DataQuality;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -115,6 +116,7 @@ fn compare_html(log: &str, out: &CompareOutput, charts: &[(String, String)]) -> 
     let mut h = String::new();
     let _ = write!(h, "<!doctype html><html><head><meta charset=utf-8><title>compare: {}</title><style>{STYLE}</style></head><body>", esc(log));
     let _ = write!(h, "<h1>Model vs measurement</h1><p>Log <code>{}</code>: {} rows at {:.0} Hz ({:.2} s), analysed at {:.0} Hz in the {}.</p>", esc(log), r.data.rows, r.data.log_rate_hz, r.data.duration_s, r.data.working_rate_hz, esc(&r.data.frame));
+    data_quality(&mut h, &r.data_quality);
     let eff = if r.effects.is_empty() {
         "none (the paper's model, eqs. 28-29)".to_string()
     } else {
@@ -134,7 +136,12 @@ fn compare_html(log: &str, out: &CompareOutput, charts: &[(String, String)]) -> 
     }
     h.push_str("</table><h2>Where the model fails most</h2><table><tr><th>from [s]</th><th>to [s]</th><th>error</th><th>speed [rpm]</th><th>load I_qs [A]</th><th>voltage [%]</th><th>supply [Hz]</th><th>since start [s]</th><th class=l>error is mostly</th></tr>");
     for w in &r.worst_windows {
-        let _ = write!(h, "<tr><td>{:.2}</td><td>{:.2}</td><td>{:.4}</td><td>{}</td><td>{:.2}</td><td>{:.1}</td><td>{:.1}</td><td>{:.2}</td><td class=l>{}</td></tr>", w.t_start_s, w.t_end_s, w.normalized_rms_error, w.condition.speed_rpm.map(|s| format!("{s:.0}")).unwrap_or("-".into()), w.condition.load_current_a, w.condition.voltage_percent, w.condition.supply_hz, w.condition.time_since_start_s, esc(&w.error_kind));
+        let transient = w
+            .transient
+            .as_ref()
+            .map(|t| format!("; transient ({}): {}", t.kind, t.description))
+            .unwrap_or_default();
+        let _ = write!(h, "<tr><td>{:.2}</td><td>{:.2}</td><td>{:.4}</td><td>{}</td><td>{:.2}</td><td>{:.1}</td><td>{:.1}</td><td>{:.2}</td><td class=l>{}{}</td></tr>", w.t_start_s, w.t_end_s, w.normalized_rms_error, w.condition.speed_rpm.map(|s| format!("{s:.0}")).unwrap_or("-".into()), w.condition.load_current_a, w.condition.voltage_percent, w.condition.supply_hz, w.condition.time_since_start_s, esc(&w.error_kind), esc(&transient));
     }
     h.push_str("</table>");
     if !r.advice.is_empty() {
@@ -193,6 +200,7 @@ fn explain_html(
     let _ = write!(h, "<!doctype html><html><head><meta charset=utf-8><title>explain: {}</title><style>{STYLE}</style></head><body>", esc(log));
     let _ = write!(h, "<h1>Which physical effect is missing?</h1><p>Log <code>{}</code>. Effects already in the model: {}.</p>", esc(log), if r.effects.is_empty() { "none".into() } else { effect_list(&r.effects) });
     let _ = write!(h, "<p class=v>{}</p>", esc(&r.verdict));
+    data_quality(&mut h, &r.data_quality);
     let _ = write!(h, "<p>Error of the model as configured: {:.4} (whole log), {:.4} on the held-back windows the fits never saw; noise floor {:.4}. Each candidate below was added to the model and fitted together with the base parameters; ranking is by the held-back error, so an effect that only fits noise does not win.</p>", r.baseline_normalized_rms_error, r.baseline_validation_normalized_rms_error, r.noise_floor);
     h.push_str("<table><tr><th>rank</th><th class=l>effect</th><th>error</th><th>held-back error</th><th>explained</th><th>params</th><th class=l>fitted, in words</th></tr>");
     for (i, c) in r.ranking.iter().enumerate() {
@@ -221,6 +229,25 @@ fn explain_html(
     }
     h.push_str("</body></html>");
     h
+}
+
+/// The data-quality stage's finding and what was done, as the text prints it.
+fn data_quality(h: &mut String, q: &DataQuality) {
+    let _ = write!(h, "<p>Data quality: {}</p>", esc(&q.summary()));
+    if !q.actions.is_empty() {
+        h.push_str("<ul>");
+        for a in &q.actions {
+            let _ = write!(h, "<li>done: {}</li>", esc(&a.to_string()));
+        }
+        h.push_str("</ul>");
+    }
+    if !q.trusted {
+        let _ = write!(
+            h,
+            "<p><b>NOT TRUSTED</b>: {}</p>",
+            esc(&q.not_trusted_because.join("; "))
+        );
+    }
 }
 
 fn effect_list(e: &[monitor_core::EffectKind]) -> String {
