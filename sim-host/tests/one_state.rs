@@ -13,6 +13,7 @@ use sim_host::hmi::{HmiState, Key, Source};
 use sim_host::log::Log;
 use sim_host::params::ParamFile;
 use sim_host::sim::{simulate_to_vec, LoadStep, Scenario};
+use std::path::Path;
 
 /// The demo's protocol: commissioning 2-4 s, the fault at 5 s, 8 s in all.
 fn protocol() -> Protocol {
@@ -182,5 +183,44 @@ fn a_load_step_without_a_fault_is_the_amber_state_in_diagnose_and_the_hmi() {
             "{who}: not the amber state with the load's note: {s}"
         );
         assert!(!s.contains("FAULT"), "{who}: {s}");
+    }
+}
+
+/// `diagnose` never prints a bare "verdict: FAULT" beside "final lamps: none" and
+/// "candidates: none" (the README's simulated 3 hp log with load steps and its window): it
+/// says what the verdict rests on.
+#[test]
+fn a_fault_verdict_beside_dark_lamps_says_why() {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let p = repo.join("examples/params/3hp.toml");
+    let sc = repo.join("examples/scenarios/healthy_3hp.toml");
+    let dir = tempfile::tempdir().expect("tmp");
+    let csv = dir.path().join("run.csv");
+    let path = |p: &Path| p.to_str().expect("utf8").to_string();
+    stdout(&[
+        "simulate",
+        "--params",
+        &path(&p),
+        "--scenario",
+        &path(&sc),
+        "--out",
+        &path(&csv),
+    ]);
+    let text = stdout(&[
+        "diagnose",
+        "--params",
+        &path(&p),
+        &path(&csv),
+        "--commission",
+        "2:3.5",
+    ]);
+    let dark = text.contains("\nfinal lamps: none\n") && text.contains("\ncandidates: none\n");
+    let verdict = text.lines().last().unwrap_or_default();
+    assert!(
+        !(dark && verdict == "verdict: FAULT"),
+        "a bare FAULT beside dark lamps and no candidate:\n{text}"
+    );
+    if dark && verdict.starts_with("verdict: FAULT") {
+        assert!(verdict.contains("the lamps lit at "), "{verdict}");
     }
 }

@@ -154,7 +154,28 @@ fn panel_text(p: &Panel) -> String {
 /// The verdict line of `diagnose` and the demo.
 fn verdict(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
     match rep.verdict {
-        Verdict::Fault => writeln!(out, "verdict: FAULT")?,
+        Verdict::Fault if rep.lamps.values().any(|l| *l) || !rep.candidates.is_empty() => {
+            writeln!(out, "verdict: FAULT")?
+        }
+        // Dark lamps and no candidate at the end: say what the verdict rests on.
+        Verdict::Fault => writeln!(
+            out,
+            "verdict: FAULT: the lamps lit at {}{}; they are dark at the end and the isolation names no single fault",
+            rep.first_detection_s
+                .map_or("-".into(), |t| format!("{t:.2} s")),
+            if rep.detections.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    " (the lamps' matching named {})",
+                    rep.detections
+                        .iter()
+                        .map(|d| format!("{} at {:.2} s", IsolationName::expected(d.fault), d.t_s))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            }
+        )?,
         Verdict::Healthy => writeln!(out, "verdict: healthy")?,
         Verdict::CouldNotJudge => writeln!(
             out,
