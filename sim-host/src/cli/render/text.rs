@@ -206,7 +206,7 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
     if rep.skipped.is_empty() {
         writeln!(
             out,
-            "\n  time    speed   r1      r2      r3      r4      lamps     top candidate"
+            "\n  time    speed   r1      r2      r3      r4      lamps     state"
         )?;
         for p in &rep.timeline {
             let lamps: String = p.lamps.iter().map(|l| lamp(*l)).collect();
