@@ -62,7 +62,18 @@ impl Replay {
     /// change, so lamps lit there are not a fault (the friction class `b/bl` is not named
     /// as one).
     pub fn state(&self, out: &MonitorOutput) -> MonitorState {
-        let state = MonitorState::of(out);
+        self.state_given(out, MonitorState::of(out), None)
+    }
+
+    /// [`Replay::state`] from the output's own state `state` ([`MonitorState::of`]) and,
+    /// when the caller has it, the isolation's report now (else asked for only where the
+    /// operating point has moved).
+    fn state_given(
+        &self,
+        out: &MonitorOutput,
+        state: MonitorState,
+        isolation: Option<&IsolationReport>,
+    ) -> MonitorState {
         let evaluated = matches!(state, MonitorState::Healthy | MonitorState::Fault(_));
         if !evaluated || out.sensor_fault.any() {
             return state;
@@ -70,11 +81,11 @@ impl Replay {
         let Some(note) = self.operating_point_moved(out) else {
             return state;
         };
-        let fault_named = matches!(
-            self.isolation_now().0.named,
-            Some(isolation::IsolationName::Fault(_))
-        );
-        if fault_named {
+        let named = match isolation {
+            Some(r) => r.named,
+            None => self.isolation_now().0.named,
+        };
+        if matches!(named, Some(isolation::IsolationName::Fault(_))) {
             state
         } else {
             MonitorState::Moved(note)
@@ -83,14 +94,15 @@ impl Replay {
 
     /// What the panel shows at the replay's output `out`: the state ([`Replay::state`]),
     /// the FAULT lamp (off in the amber state) and, where the lamps are evaluated, the
-    /// isolation's conclusion.
+    /// isolation's conclusion (asked for once).
     pub fn panel(&self, out: &MonitorOutput) -> Panel {
-        let state = self.state(out);
-        let moved = matches!(state, MonitorState::Moved(_));
-        let evaluated = moved || matches!(state, MonitorState::Healthy | MonitorState::Fault(_));
+        let own = MonitorState::of(out);
+        let evaluated = matches!(own, MonitorState::Healthy | MonitorState::Fault(_));
+        let isolation = evaluated.then(|| self.isolation_now());
+        let state = self.state_given(out, own, isolation.as_ref().map(|(r, _)| r));
         Panel {
-            fault_lamp: out.fault_detected && !moved,
-            isolation: evaluated.then(|| self.isolation_now()),
+            fault_lamp: out.fault_detected && !matches!(state, MonitorState::Moved(_)),
+            isolation,
             state,
         }
     }
