@@ -150,6 +150,7 @@ fn compare_report_draws_envelopes_zooms_and_one_unit_per_axis() {
             "overlay_ia",
             "error_time",
             "error_time_omega_r",
+            "error_spectrum",
         ],
     );
     // One unit per error chart.

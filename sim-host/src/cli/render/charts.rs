@@ -301,7 +301,7 @@ pub fn compare_charts(d: &Prepared, out: &CompareOutput) -> Vec<Chart<'static>> 
         y_label: "amplitude [A]",
         series: vec![Series {
             label: "I_qs error".into(),
-            points: metrics::spectrum(&eiq, d.dt_s),
+            points: plot::thin(&metrics::spectrum(&eiq, d.dt_s), MAX_POINTS),
             color: 4,
             scatter: false,
             dashed: false,
