@@ -4,53 +4,16 @@
 //! firmware runs, the healthy residuals learned (commissioning, 2-4 s), a Table 1 fault
 //! injected at 5 s, and the lamps r1..r4 and the fault candidates followed every 0.25 s.
 
-use crate::experiment::{simulate_and_replay, ExperimentError};
+use crate::experiment::ExperimentError;
 use crate::fault_signatures::{scenario, Protocol};
 use crate::params::ParamFile;
-use crate::replay::{DiagnoseReport, IsolationName, ReplayOptions};
-use monitor_core::{CommissioningState, Fault, MonitorOutput};
+pub use crate::replay::MonitorState;
+use crate::replay::{DiagnoseReport, IsolationName, Panel, Replay, ReplayOptions};
+use crate::sim::simulate;
+use monitor_core::Fault;
 
 /// Time between two timeline points [s].
 pub const TIMELINE_STEP_S: f64 = 0.25;
-
-/// What the monitor is doing at a timeline point, as the panel would show it.
-#[derive(Debug, Clone, PartialEq)]
-pub enum MonitorState {
-    /// Learning the healthy residuals; the fraction done.
-    Commissioning(f32),
-    /// The operating point is changing: the lamps hold.
-    Transient,
-    /// Settling after start (lamps not yet evaluated).
-    Starting,
-    /// Evaluating, no lamp lit.
-    Healthy,
-    /// Lamps lit: the candidates with their probabilities.
-    Fault(Vec<(Fault, f32)>),
-    /// The load or the voltage has left the commissioned range and no fault is named (the
-    /// amber state): lamps may light, the FAULT lamp stays off; the note says where the
-    /// operating point went ([`crate::replay::Replay::operating_point_moved`]).
-    Moved(String),
-}
-
-impl MonitorState {
-    /// The state of a monitor output.
-    pub fn of(o: &MonitorOutput) -> Self {
-        match o.commissioning {
-            CommissioningState::Learning(x) => MonitorState::Commissioning(x),
-            _ if !o.quasi_steady => MonitorState::Transient,
-            _ if !o.evaluating => MonitorState::Starting,
-            _ if o.top().is_none() => MonitorState::Healthy,
-            _ => MonitorState::Fault(
-                Fault::ALL
-                    .iter()
-                    .zip(o.diagnosis.probabilities)
-                    .filter(|(_, p)| *p > 0.0)
-                    .map(|(f, p)| (*f, p))
-                    .collect(),
-            ),
-        }
-    }
-}
 
 /// One point of the demo's timeline.
 #[derive(Debug, Clone, PartialEq)]
@@ -61,8 +24,9 @@ pub struct DemoPoint {
     pub speed_rpm: f64,
     /// Lamps r1..r4.
     pub lamps: [bool; 4],
-    /// The monitor's state.
-    pub state: MonitorState,
+    /// What the panel shows: the state, the FAULT lamp, the isolation's conclusion
+    /// ([`crate::replay::Replay::panel`]).
+    pub panel: Panel,
     /// The first point at or after the fault's onset.
     pub fault_injected: bool,
 }
@@ -109,7 +73,9 @@ pub fn run(fault: Fault, change: f64) -> Result<DemoRun, ExperimentError> {
     let mut next = 0.0;
     let mut announced = false;
     let mut points = Vec::new();
-    let replay = simulate_and_replay(&params, &params, &sc, opts, |row, o| {
+    let mut replay = Replay::new(&params, sc.sensors.channels(), sc.sample_rate_hz, opts)?;
+    simulate(&params, &sc, |row| {
+        let o = replay.push(row);
         if row.t_s + 1e-9 >= next {
             next += TIMELINE_STEP_S;
             let fault_injected = !announced && row.t_s >= proto.fault_at_s;
@@ -118,7 +84,7 @@ pub fn run(fault: Fault, change: f64) -> Result<DemoRun, ExperimentError> {
                 t_s: row.t_s,
                 speed_rpm: f64::from(o.speed_rad_s * 60.0 / std::f32::consts::TAU),
                 lamps: o.lamps,
-                state: MonitorState::of(o),
+                panel: replay.panel(&o),
                 fault_injected,
             });
         }

@@ -67,6 +67,7 @@ fn compare_and_explain_json_plots_report_and_the_error_falls() {
     ] {
         assert!(w["condition"].get(k).is_some(), "condition lacks {k}");
     }
+    let html = std::fs::read_to_string(report.join("report.html")).unwrap();
     for f in [
         "overlay_iqs",
         "overlay_omega_r",
@@ -77,6 +78,14 @@ fn compare_and_explain_json_plots_report_and_the_error_falls() {
         "error_vs_voltage",
         "error_spectrum",
     ] {
+        // A scatter over one operating point is not drawn; the report says why (issue 28).
+        if f.starts_with("error_vs_") && !plots.join(format!("{f}.svg")).exists() {
+            assert!(
+                html.contains("Not drawn: "),
+                "{f}: neither drawn nor said why"
+            );
+            continue;
+        }
         for ext in ["svg", "png"] {
             let p = plots.join(format!("{f}.{ext}"));
             assert!(
@@ -88,7 +97,6 @@ fn compare_and_explain_json_plots_report_and_the_error_falls() {
             );
         }
     }
-    let html = std::fs::read_to_string(report.join("report.html")).unwrap();
     assert!(html.contains("<svg") && html.contains("Where the model fails most"));
 
     let out = bin()

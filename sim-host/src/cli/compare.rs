@@ -232,7 +232,6 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
     let pbc = pb.clone();
     let out = a.explain(&opts, &move |f| progress::set_fraction(&pbc, f))?;
     pb.finish_and_clear();
-    render::html::write_explain(c.plot.as_deref(), c.report.as_deref(), &c.log, &a, &out)?;
     // The motor current signature analysis, with the fitted rotor_asymmetry's delta.
     let delta = out
         .report
@@ -247,9 +246,14 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
         args.rotor_bars.map(f64::from),
         delta,
     );
-    if let Some(dir) = &c.plot {
-        render::mcsa::write(dir, &mcsa)?;
-    }
+    render::html::write_explain(
+        c.plot.as_deref(),
+        c.report.as_deref(),
+        &c.log,
+        &a,
+        &out,
+        &mcsa,
+    )?;
     let doc = ExplainJson {
         report: &out.report,
         rotor_asymmetry: &mcsa,

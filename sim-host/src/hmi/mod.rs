@@ -152,13 +152,7 @@ impl Snapshot {
         learned: bool,
         params: &ParamFile,
     ) -> Self {
-        let mut candidates: Vec<(Fault, f32)> = Fault::ALL
-            .iter()
-            .zip(out.diagnosis.probabilities)
-            .filter(|(_, p)| *p > 0.0)
-            .map(|(f, p)| (*f, p))
-            .collect();
-        candidates.sort_by(|a, b| b.1.total_cmp(&a.1));
+        let candidates = MonitorState::signature(out);
         let s = out.sensor_fault;
         let sensor_faults = [
             (s.current, Fault::CurrentSensor),
@@ -211,15 +205,10 @@ impl Snapshot {
     pub fn from_replay(t_s: f64, out: &MonitorOutput, replay: &Replay, params: &ParamFile) -> Self {
         let learned = replay.calibration().is_some();
         let mut s = Snapshot::from_output(t_s, out, replay.threshold_bands(), learned, params);
-        let iso = IsolationView::of_replay(replay);
-        let fault_named = matches!(iso.named, Some(IsolationName::Fault(_)));
-        s.isolation = Some(iso);
-        let evaluated = matches!(s.state, MonitorState::Healthy | MonitorState::Fault(_));
-        if let Some(note) = replay.operating_point_moved(out) {
-            if evaluated && !fault_named && s.sensor_faults.is_empty() {
-                s.state = MonitorState::Moved(note);
-                s.fault_lamp = false;
-            }
+        s.isolation = Some(IsolationView::of_replay(replay));
+        s.state = replay.state(out);
+        if matches!(s.state, MonitorState::Moved(_)) {
+            s.fault_lamp = false;
         }
         s
     }
@@ -383,16 +372,12 @@ impl HmiState {
             return format!("{}: waiting for the first reading", self.title);
         };
         let lamps: String = s.lamps.iter().map(|l| if *l { '●' } else { '○' }).collect();
-        let header = header_text(s);
-        let lamp = match (&s.state, s.fault_lamp) {
-            (MonitorState::Moved(_), _) => " MOVED",
-            (_, true) => " FAULT",
-            (_, false) => "",
-        };
-        // The lamp's word once: a state that begins with it loses it.
-        let text = match header.strip_prefix("FAULT ") {
-            Some(rest) if !lamp.is_empty() => rest.to_string(),
-            _ => header,
+        let (lamp, text) =
+            lamp_and_header(&s.state, s.fault_lamp, &s.candidates, s.isolation.as_ref());
+        let lamp = if lamp.is_empty() {
+            String::new()
+        } else {
+            format!(" {lamp}")
         };
         format!(
             "{:8.2} s  {:6.0} rpm  {}{}  {}",
@@ -405,21 +390,51 @@ impl HmiState {
 /// 0.33 / ls p 0.33`; the FAULT lamp stands beside it), then the lamps' signature candidates; without a
 /// named fault, the monitor's state in words ([`state_text`]).
 pub fn header_text(s: &Snapshot) -> String {
-    let named = s.isolation.as_ref().filter(|i| i.named.is_some());
-    match (named, &s.state) {
+    header_of(&s.state, &s.candidates, s.isolation.as_ref())
+}
+
+/// [`header_text`] of a state, the lamps' signature candidates (most probable first) and
+/// the isolation's conclusion: the one wording of the HMI, the demo and `diagnose`'s
+/// timeline.
+pub fn header_of(
+    state: &MonitorState,
+    candidates: &[(Fault, f32)],
+    isolation: Option<&IsolationView>,
+) -> String {
+    let named = isolation.filter(|i| i.named.is_some());
+    match (named, state) {
         (Some(iso), MonitorState::Fault(_)) => format!(
             "{} | {}",
             iso.text(),
-            crate::fault_signatures::signature_text(s.candidates.iter().map(|(f, p)| (*f, *p)))
+            crate::fault_signatures::signature_text(candidates.iter().map(|(f, p)| (*f, *p)))
         ),
         (Some(iso), MonitorState::Moved(note)) => format!("moved: {} | {note}", iso.text()),
-        (Some(iso), _) => format!(
-            "{} | named: {}",
-            state_text(&s.state, &s.candidates),
-            iso.text()
-        ),
-        (None, _) => state_text(&s.state, &s.candidates),
+        (Some(iso), _) => format!("{} | named: {}", state_text(state, candidates), iso.text()),
+        (None, _) => state_text(state, candidates),
     }
+}
+
+/// The lamp's word (`FAULT`, the amber `MOVED`, or empty with the FAULT lamp off) and the
+/// header ([`header_of`]) without the word repeated: the plain status line, the demo's and
+/// `diagnose`'s state column.
+pub fn lamp_and_header(
+    state: &MonitorState,
+    fault_lamp: bool,
+    candidates: &[(Fault, f32)],
+    isolation: Option<&IsolationView>,
+) -> (&'static str, String) {
+    let header = header_of(state, candidates, isolation);
+    let lamp = match (state, fault_lamp) {
+        (MonitorState::Moved(_), _) => "MOVED",
+        (_, true) => "FAULT",
+        (_, false) => "",
+    };
+    // The lamp's word once: a state that begins with it loses it.
+    let text = match header.strip_prefix("FAULT ") {
+        Some(rest) if !lamp.is_empty() => rest.to_string(),
+        _ => header,
+    };
+    (lamp, text)
 }
 
 /// The monitor's state in words (the screen and the plain-text line).

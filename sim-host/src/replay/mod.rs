@@ -42,7 +42,8 @@ pub use isolation::{
     SensorPhaseReport, NOMINAL_UNCERTAINTY,
 };
 pub use report::{
-    BaselineSource, Detection, DiagnoseReport, TimelinePoint, UnbalanceReport, Verdict,
+    BaselineSource, Detection, DiagnoseReport, MonitorState, Panel, TimelinePoint, UnbalanceReport,
+    Verdict,
 };
 
 use crate::log::{Channels, LogError, Row};
@@ -467,7 +468,8 @@ impl Replay {
                 let steps = ((t - self.next_point) / self.opts.timeline_step_s).floor() + 1.0;
                 self.next_point += steps * self.opts.timeline_step_s;
             }
-            self.timeline.push(timeline_point(t, &out, range_note));
+            let point = timeline_point(self, t, &out, range_note);
+            self.timeline.push(point);
         }
         self.last = out;
         out

@@ -7,6 +7,107 @@ use crate::log::quality::DataQuality;
 use monitor_core::{AngleSource, CommissioningState, Fault, MonitorOutput, Phase};
 use serde::{Serialize, Serializer};
 
+/// What the monitor is doing at a timeline point, as the panel would show it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum MonitorState {
+    /// Learning the healthy residuals; the fraction done.
+    Commissioning(f32),
+    /// The operating point is changing: the lamps hold.
+    Transient,
+    /// Settling after start (lamps not yet evaluated).
+    Starting,
+    /// Evaluating, no lamp lit.
+    Healthy,
+    /// Lamps lit: the candidates with their probabilities.
+    Fault(Vec<(Fault, f32)>),
+    /// The load or the voltage has left the commissioned range and no fault is named (the
+    /// amber state): lamps may light, the FAULT lamp stays off; the note says where the
+    /// operating point went ([`crate::replay::Replay::operating_point_moved`]).
+    Moved(String),
+}
+
+impl MonitorState {
+    /// The state of a monitor output.
+    pub fn of(o: &MonitorOutput) -> Self {
+        match o.commissioning {
+            CommissioningState::Learning(x) => MonitorState::Commissioning(x),
+            _ if !o.quasi_steady => MonitorState::Transient,
+            _ if !o.evaluating => MonitorState::Starting,
+            _ if o.top().is_none() => MonitorState::Healthy,
+            _ => MonitorState::Fault(MonitorState::signature(o)),
+        }
+    }
+
+    /// The signature matching's candidates of `o` (probability above zero), most probable
+    /// first.
+    pub fn signature(o: &MonitorOutput) -> Vec<(Fault, f32)> {
+        let mut c: Vec<(Fault, f32)> = Fault::ALL
+            .iter()
+            .zip(o.diagnosis.probabilities)
+            .filter(|(_, p)| *p > 0.0)
+            .map(|(f, p)| (*f, p))
+            .collect();
+        c.sort_by(|a, b| b.1.total_cmp(&a.1));
+        c
+    }
+}
+
+impl Replay {
+    /// The monitor's state at the replay's output `out` as the panel shows it, the one rule
+    /// of the HMI, the demo and `diagnose`'s timeline: [`MonitorState::of`], except that
+    /// where the load or the voltage has left the commissioned range
+    /// ([`Replay::operating_point_moved`]) and neither the isolation nor a sensor check
+    /// names a fault, an evaluated output (healthy or lamps lit) is the amber
+    /// [`MonitorState::Moved`] with the note: to the paper's model a load change is a Bl
+    /// change, so lamps lit there are not a fault (the friction class `b/bl` is not named
+    /// as one).
+    pub fn state(&self, out: &MonitorOutput) -> MonitorState {
+        self.state_given(out, MonitorState::of(out), None)
+    }
+
+    /// [`Replay::state`] from the output's own state `state` ([`MonitorState::of`]) and,
+    /// when the caller has it, the isolation's report now (else asked for only where the
+    /// operating point has moved).
+    fn state_given(
+        &self,
+        out: &MonitorOutput,
+        state: MonitorState,
+        isolation: Option<&IsolationReport>,
+    ) -> MonitorState {
+        let evaluated = matches!(state, MonitorState::Healthy | MonitorState::Fault(_));
+        if !evaluated || out.sensor_fault.any() {
+            return state;
+        }
+        let Some(note) = self.operating_point_moved(out) else {
+            return state;
+        };
+        let named = match isolation {
+            Some(r) => r.named,
+            None => self.isolation_now().0.named,
+        };
+        if matches!(named, Some(isolation::IsolationName::Fault(_))) {
+            state
+        } else {
+            MonitorState::Moved(note)
+        }
+    }
+
+    /// What the panel shows at the replay's output `out`: the state ([`Replay::state`]),
+    /// the FAULT lamp (off in the amber state) and, where the lamps are evaluated, the
+    /// isolation's conclusion (asked for once).
+    pub fn panel(&self, out: &MonitorOutput) -> Panel {
+        let own = MonitorState::of(out);
+        let evaluated = matches!(own, MonitorState::Healthy | MonitorState::Fault(_));
+        let isolation = evaluated.then(|| self.isolation_now());
+        let state = self.state_given(out, own, isolation.as_ref().map(|(r, _)| r));
+        Panel {
+            fault_lamp: out.fault_detected && !matches!(state, MonitorState::Moved(_)),
+            isolation,
+            state,
+        }
+    }
+}
+
 /// One point of the diagnosis timeline.
 #[derive(Debug, Clone, Serialize)]
 pub struct TimelinePoint {
@@ -33,6 +134,23 @@ pub struct TimelinePoint {
     /// Beside a lit r2..r4 lamp: the operating point has left the commissioned range.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub range_note: Option<String>,
+    /// What the panel shows ([`Replay::panel`]; not in the JSON, whose keys above carry
+    /// it).
+    #[serde(skip)]
+    pub panel: Panel,
+}
+
+/// What the panel shows at an output ([`Replay::panel`]): the HMI, the demo's and
+/// `diagnose`'s timelines.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Panel {
+    /// The state ([`Replay::state`]).
+    pub state: MonitorState,
+    /// The FAULT lamp: a residual lamp or a sensor fault, off in the amber state.
+    pub fault_lamp: bool,
+    /// What the isolation concluded where the lamps are evaluated (the report and the
+    /// candidates listed, [`Replay::isolation_now`]), else `None`.
+    pub isolation: Option<(IsolationReport, Vec<FaultCandidate>)>,
 }
 
 /// Result of the negative-sequence analysis (JSON key `unbalance`).
@@ -282,8 +400,10 @@ impl Replay {
     }
 }
 
-/// The timeline point of an output at `t`.
+/// The timeline point of an output at `t` of `replay`, with what the panel shows
+/// ([`Replay::panel`]).
 pub(super) fn timeline_point(
+    replay: &Replay,
     t: f64,
     out: &MonitorOutput,
     range_note: Option<String>,
@@ -301,5 +421,6 @@ pub(super) fn timeline_point(
         quasi_steady: out.quasi_steady,
         negative_sequence_ratio: out.unbalance.negative_sequence_ratio,
         range_note,
+        panel: replay.panel(out),
     }
 }

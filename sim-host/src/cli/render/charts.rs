@@ -6,12 +6,17 @@ use sim_host::analysis::metrics::{self, WorstWindow};
 use sim_host::analysis::prep::Prepared;
 use sim_host::analysis::simplified_model::Prediction;
 
-/// The charts `compare` writes (file stems; each as `.svg` and `.png`).
-pub const COMPARE: [&str; 9] = [
+/// The charts `compare` writes (file stems; each as `.svg` and `.png`; the zoomed panels
+/// only for a log long enough to be drawn as envelopes, a scatter only where the log spans
+/// operating points).
+pub const COMPARE: [&str; 12] = [
     "overlay_iqs",
     "overlay_omega_r",
+    "zoom_iqs_1",
+    "zoom_iqs_2",
     "overlay_ia",
     "error_time",
+    "error_time_omega_r",
     "error_vs_speed",
     "error_vs_load",
     "error_vs_voltage",
@@ -20,9 +25,11 @@ pub const COMPARE: [&str; 9] = [
 ];
 
 /// The charts `explain` writes.
-pub const EXPLAIN: [&str; 3] = [
+pub const EXPLAIN: [&str; 5] = [
     "before_after_iqs",
     "before_after_omega_r",
+    "zoom_before_after_iqs_1",
+    "zoom_before_after_iqs_2",
     "before_after_error",
 ];
 
@@ -34,7 +41,14 @@ pub fn file_names(stems: &[&str]) -> Vec<String> {
         .collect()
 }
 
-const MAX_POINTS: usize = 4000;
+/// Points a line over a short span keeps (min/max pairs): under one per pixel column of a
+/// [`plot::WIDTH_PX`] chart.
+const MAX_POINTS: usize = 800;
+/// A line over more supply periods than this is drawn as its envelope (RMS per supply
+/// period): sample by sample it would be a solid band.
+const ENVELOPE_FROM_PERIODS: usize = 40;
+/// Supply periods a zoomed panel shows.
+const ZOOM_PERIODS: usize = 4;
 
 /// (file stem, title, x label, points) of an error-vs-condition chart.
 type ScatterSpec = (&'static str, &'static str, &'static str, Vec<(f64, f64)>);
@@ -50,7 +64,118 @@ fn line(label: impl Into<String>, t: &[f64], y: impl Iterator<Item = f64>, color
         points: pts(t, y),
         color,
         scatter: false,
+        dashed: false,
     }
+}
+
+/// Samples in one supply period (from the mean frame speed; 50 Hz without one).
+fn period_samples(d: &Prepared) -> usize {
+    let n = d.omega_s.len().max(1) as f64;
+    let w = d.omega_s.iter().map(|w| w.abs()).sum::<f64>() / n;
+    let f_hz = if w > 1.0 {
+        w / std::f64::consts::TAU
+    } else {
+        50.0
+    };
+    ((1.0 / (f_hz * d.dt_s)).round() as usize).max(1)
+}
+
+/// The envelope of `y`: per supply period of `per` samples, (mid time, RMS with the sign
+/// of the period's mean).
+fn envelope(t: &[f64], y: &[f64], per: usize) -> Vec<(f64, f64)> {
+    t.chunks(per)
+        .zip(y.chunks(per))
+        .filter_map(|(tc, yc)| {
+            let (first, last) = (tc.first()?, tc.last()?);
+            let n = yc.len().max(1) as f64;
+            let rms = (yc.iter().map(|v| v * v).sum::<f64>() / n).sqrt();
+            let sign = if yc.iter().sum::<f64>() < 0.0 {
+                -1.0
+            } else {
+                1.0
+            };
+            Some((0.5 * (first + last), sign * rms))
+        })
+        .collect()
+}
+
+/// A line of `y` over `t`: sample by sample over a short span, its envelope
+/// ([`envelope`], the label says so) over more than [`ENVELOPE_FROM_PERIODS`] periods.
+fn trace(label: &str, t: &[f64], y: &[f64], per: usize, color: usize) -> Series {
+    if t.len() > ENVELOPE_FROM_PERIODS * per {
+        Series {
+            label: format!("{label} (RMS per supply period)"),
+            points: envelope(t, y, per),
+            color,
+            scatter: false,
+            dashed: false,
+        }
+    } else {
+        line(label, t, y.iter().copied(), color)
+    }
+}
+
+/// The dashed "before" line, drawn last so that it lies on top.
+fn before(mut s: Series) -> Series {
+    s.dashed = true;
+    s
+}
+
+/// The sample spans of the zoomed panels: [`ZOOM_PERIODS`] supply periods around the two
+/// periods where `error` is largest (apart by more than a panel), when the log is long
+/// enough to be drawn as envelopes; else none.
+fn worst_spans(error: &[f64], per: usize) -> Vec<(usize, usize)> {
+    let n = error.len();
+    if n <= ENVELOPE_FROM_PERIODS * per {
+        return Vec::new();
+    }
+    let mut periods: Vec<(usize, f64)> = error
+        .chunks(per)
+        .map(|c| c.iter().map(|v| v * v).sum::<f64>())
+        .enumerate()
+        .collect();
+    periods.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let mut picked: Vec<usize> = Vec::new();
+    for (k, _) in periods {
+        if picked.iter().all(|p| p.abs_diff(k) > 2 * ZOOM_PERIODS) {
+            picked.push(k);
+        }
+        if picked.len() == 2 {
+            break;
+        }
+    }
+    picked
+        .into_iter()
+        .map(|k| {
+            let a = (k * per).saturating_sub(ZOOM_PERIODS * per / 2);
+            (a, (a + ZOOM_PERIODS * per).min(n))
+        })
+        .collect()
+}
+
+/// The zoomed panels of `series` (label, values, colour, dashed) over `spans`.
+fn zooms(
+    t: &[f64],
+    spans: &[(usize, usize)],
+    stems: [&'static str; 2],
+    titles: [&'static str; 2],
+    series: &[(&str, &[f64], usize, bool)],
+) -> Vec<Chart<'static>> {
+    spans
+        .iter()
+        .zip(stems.into_iter().zip(titles))
+        .map(|(&(a, b), (stem, title))| {
+            let s = series
+                .iter()
+                .map(|&(label, y, color, dashed)| {
+                    let mut s = line(label, &t[a..b], y[a..b].iter().copied(), color);
+                    s.dashed = dashed;
+                    s
+                })
+                .collect();
+            over_time(stem, title, "I_qs [A]", s)
+        })
+        .collect()
 }
 
 /// A chart over time.
@@ -67,6 +192,7 @@ fn over_time(
         y_label,
         series,
         log_y: false,
+        omitted: None,
     }
 }
 
@@ -85,7 +211,8 @@ fn zoom(d: &Prepared, worst: &[WorstWindow]) -> (usize, usize) {
     (a, (a + per).min(n))
 }
 
-/// Builds the `compare` charts: overlays, error vs time, error vs operating variables,
+/// Builds the `compare` charts: overlays (envelopes over a long log, with zoomed panels at
+/// the worst periods), error vs time (one unit per chart), error vs operating variables,
 /// error spectrum.
 pub fn compare_charts(d: &Prepared, out: &CompareOutput) -> Vec<Chart<'static>> {
     let p = &out.prediction;
@@ -94,26 +221,38 @@ pub fn compare_charts(d: &Prepared, out: &CompareOutput) -> Vec<Chart<'static>> 
         return v;
     }
     let t = &d.t_s;
+    let per = period_samples(d);
     v.push(over_time(
         "overlay_iqs",
-        "I_qs: measured vs model",
+        "q-axis current I_qs: measured vs model",
         "I_qs [A]",
         vec![
-            line("measured", t, d.iq.iter().copied(), 0),
-            line("model", t, p.iq.iter().copied(), 1),
+            trace("measured", t, &d.iq, per, 0),
+            trace("model", t, &p.iq, per, 1),
         ],
     ));
     if d.channels.speed {
         v.push(over_time(
             "overlay_omega_r",
-            "omega_r (electrical rotor speed): measured vs model",
+            "Rotor speed omega_r (electrical): measured vs model",
             "omega_r [rad/s]",
             vec![
-                line("measured", t, d.omega_r.iter().copied(), 0),
-                line("model", t, p.omega_r.iter().copied(), 1),
+                trace("measured", t, &d.omega_r, per, 0),
+                trace("model", t, &p.omega_r, per, 1),
             ],
         ));
     }
+    let eiq: Vec<f64> = p.iq.iter().zip(&d.iq).map(|(a, b)| a - b).collect();
+    v.extend(zooms(
+        t,
+        &worst_spans(&eiq, per),
+        ["zoom_iqs_1", "zoom_iqs_2"],
+        [
+            "q-axis current, a few supply periods where the model is worst: measured vs model",
+            "q-axis current, a few supply periods where the model is second worst: measured vs model",
+        ],
+        &[("measured", &d.iq, 0, false), ("model", &p.iq, 1, false)],
+    ));
     let (a, b) = zoom(d, &out.report.worst_windows);
     v.push(over_time(
         "overlay_ia",
@@ -134,33 +273,61 @@ pub fn compare_charts(d: &Prepared, out: &CompareOutput) -> Vec<Chart<'static>> 
             ),
         ],
     ));
-    let eiq: Vec<f64> = p.iq.iter().zip(&d.iq).map(|(a, b)| a - b).collect();
-    let mut err_series = vec![line("I_qs error [A]", t, eiq.iter().copied(), 1)];
-    if d.channels.speed {
-        let e = p.omega_r.iter().zip(&d.omega_r).map(|(a, b)| a - b);
-        err_series.push(line("omega_r error [rad/s]", t, e, 2));
-    }
     v.push(over_time(
         "error_time",
-        "Model error vs time (model - measured)",
-        "error",
-        err_series,
+        "Error of the q-axis current vs time (model - measured)",
+        "I_qs error [A]",
+        vec![trace("I_qs error", t, &eiq, per, 1)],
     ));
+    if d.channels.speed {
+        let e: Vec<f64> = p
+            .omega_r
+            .iter()
+            .zip(&d.omega_r)
+            .map(|(a, b)| a - b)
+            .collect();
+        v.push(over_time(
+            "error_time_omega_r",
+            "Error of the rotor speed vs time (model - measured)",
+            "omega_r error [rad/s]",
+            vec![trace("omega_r error", t, &e, per, 2)],
+        ));
+    }
     v.extend(condition_charts(d, &out.all_windows));
     v.push(Chart {
         stem: "error_spectrum",
-        title: "Spectrum of the I_qs error",
+        title: "Spectrum of the q-axis current's error",
         x_label: "frequency [Hz]",
         y_label: "amplitude [A]",
         series: vec![Series {
             label: "I_qs error".into(),
-            points: metrics::spectrum(&eiq, d.dt_s),
+            points: plot::thin(&metrics::spectrum(&eiq, d.dt_s), MAX_POINTS),
             color: 4,
             scatter: false,
+            dashed: false,
         }],
         log_y: true,
+        omitted: None,
     });
     v
+}
+
+/// Why an error-vs-condition chart is not drawn: fewer than three windows, or every
+/// window's condition within 5 % of one value (the log holds one operating point).
+fn one_operating_point(x_label: &str, points: &[(f64, f64)]) -> Option<String> {
+    let lo = points.iter().map(|p| p.0).fold(f64::INFINITY, f64::min);
+    let hi = points.iter().map(|p| p.0).fold(f64::NEG_INFINITY, f64::max);
+    if points.len() < 3 {
+        return Some(format!(
+            "Not drawn: {} window(s), too few to set the error against {x_label}.",
+            points.len()
+        ));
+    }
+    (hi - lo <= 0.05 * lo.abs().max(hi.abs())).then(|| {
+        format!(
+            "Not drawn: every window's {x_label} lies within {lo:.2}..{hi:.2}; the log holds one operating point, so the error cannot be set against it."
+        )
+    })
 }
 
 /// Window error against the operating condition: speed, load current, voltage, time since
@@ -208,55 +375,51 @@ fn condition_charts(d: &Prepared, all: &[WorstWindow]) -> Vec<Chart<'static>> {
             title,
             x_label: xl,
             y_label: "normalized RMS error",
+            omitted: one_operating_point(xl, &points),
             series: vec![Series {
                 label: "window".into(),
                 points,
                 color: 3,
                 scatter: true,
+                dashed: false,
             }],
             log_y: false,
         })
         .collect()
 }
 
-/// Before/after charts of `explain`: I_qs and omega_r overlays of measured, the configured
-/// model, and the model with the top-ranked effect.
+/// Before/after charts of `explain`: I_qs and omega_r overlays of measured, the model with
+/// the top-ranked effect, and the configured model ("before", dashed and on top), as
+/// envelopes over a long log with zoomed panels at the periods the model before is worst.
 pub fn explain_charts(
     d: &Prepared,
-    before: &Prediction,
+    before_p: &Prediction,
     after: Option<&(monitor_core::EffectKind, Prediction)>,
 ) -> Vec<Chart<'static>> {
     let mut v = Vec::new();
-    if before.iq.is_empty() {
+    if before_p.iq.is_empty() {
         return v;
     }
     let t = &d.t_s;
-    // Measured, the model before, and (when an effect was found) the model with it.
+    let per = period_samples(d);
     let overlay = |measured: &[f64], pick: &dyn Fn(&Prediction) -> &[f64]| {
-        let mut s = vec![
-            line("measured", t, measured.iter().copied(), 0),
-            line("model before", t, pick(before).iter().copied(), 1),
-        ];
+        let mut s = vec![trace("measured", t, measured, per, 0)];
         if let Some((name, p)) = after {
-            s.push(line(
-                format!("model + {name}"),
-                t,
-                pick(p).iter().copied(),
-                2,
-            ));
+            s.push(trace(&format!("model + {name}"), t, pick(p), per, 2));
         }
+        s.push(before(trace("model before", t, pick(before_p), per, 1)));
         s
     };
     v.push(over_time(
         "before_after_iqs",
-        "I_qs: measured, model before and after adding the top effect",
+        "q-axis current I_qs: measured, model before (dashed) and with the top effect",
         "I_qs [A]",
         overlay(&d.iq, &|p| &p.iq),
     ));
     if d.channels.speed {
         v.push(over_time(
             "before_after_omega_r",
-            "omega_r: measured, model before and after adding the top effect",
+            "Rotor speed omega_r: measured, model before (dashed) and with the top effect",
             "omega_r [rad/s]",
             overlay(&d.omega_r, &|p| &p.omega_r),
         ));
@@ -267,19 +430,32 @@ pub fn explain_charts(
             .map(|(a, b)| a - b)
             .collect::<Vec<_>>()
     };
-    let mut s = vec![line("error before", t, error(before).into_iter(), 1)];
-    if let Some((name, p)) = after {
-        s.push(line(
-            format!("error with {name}"),
-            t,
-            error(p).into_iter(),
-            2,
-        ));
+    let e_before = error(before_p);
+    let named = after.map(|(name, p)| (format!("model + {name}"), p));
+    let mut zs: Vec<(&str, &[f64], usize, bool)> = vec![("measured", &d.iq, 0, false)];
+    if let Some((label, p)) = &named {
+        zs.push((label, &p.iq, 2, false));
     }
+    zs.push(("model before", &before_p.iq, 1, true));
+    v.extend(zooms(
+        t,
+        &worst_spans(&e_before, per),
+        ["zoom_before_after_iqs_1", "zoom_before_after_iqs_2"],
+        [
+            "q-axis current, a few supply periods where the model before is worst",
+            "q-axis current, a few supply periods where the model before is second worst",
+        ],
+        &zs,
+    ));
+    let mut s = Vec::new();
+    if let Some((name, p)) = after {
+        s.push(trace(&format!("error with {name}"), t, &error(p), per, 2));
+    }
+    s.push(before(trace("error before", t, &e_before, per, 1)));
     v.push(over_time(
         "before_after_error",
-        "I_qs error before and after",
-        "error [A]",
+        "Error of the q-axis current before (dashed) and after adding the top effect",
+        "I_qs error [A]",
         s,
     ));
     v

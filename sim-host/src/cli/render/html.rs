@@ -8,20 +8,26 @@ use super::{charts, plot};
 use plot::Chart;
 use sim_host::analysis::compare::CompareOutput;
 use sim_host::analysis::explain::ExplainOutput;
+use sim_host::analysis::rotor_asymmetry::McsaReport;
 use sim_host::analysis::Analysis;
+use sim_host::log::quality::DataQuality;
 use std::fmt::Write as _;
 use std::path::Path;
 
 /// The report page's file name in `--report DIR`.
 pub const REPORT_FILE: &str = "report.html";
 
-/// Writes the charts into `dir` (created if needed); returns (stem, svg) pairs.
+/// Writes the charts into `dir` (created if needed); returns (title, HTML) pairs: the SVG,
+/// or for a chart not drawn the sentence why.
 fn write_charts(dir: &Path, charts: &[Chart]) -> anyhow::Result<Vec<(String, String)>> {
     std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
     let mut v = Vec::new();
     for c in charts {
-        let (svg, _) = plot::write(dir, c).map_err(anyhow::Error::msg)?;
-        v.push((c.stem.to_string(), svg));
+        let body = match &c.omitted {
+            Some(why) => format!("<p><i>{}</i></p>", esc(why)),
+            None => plot::write(dir, c).map_err(anyhow::Error::msg)?.0,
+        };
+        v.push((c.title.to_string(), body));
     }
     Ok(v)
 }
@@ -73,20 +79,26 @@ pub fn write_compare(
     )
 }
 
-/// `explain --plot DIR --report DIR`.
+/// `explain --plot DIR --report DIR`, with the motor current signature analysis (its
+/// spectrum among the charts, its text in the report).
 pub fn write_explain(
     plot: Option<&Path>,
     report: Option<&Path>,
     log: &Path,
     a: &Analysis,
     out: &ExplainOutput,
+    mcsa: &McsaReport,
 ) -> anyhow::Result<()> {
     let log = log.display().to_string();
     write_outputs(
         plot,
         report,
-        || charts::explain_charts(&a.data, &out.before, out.after.as_ref()),
-        |svgs| explain_html(&log, out, svgs),
+        || {
+            let mut v = charts::explain_charts(&a.data, &out.before, out.after.as_ref());
+            v.extend(super::mcsa::chart(mcsa));
+            v
+        },
+        |svgs| explain_html(&log, out, mcsa, svgs),
     )
 }
 
@@ -104,6 +116,7 @@ fn compare_html(log: &str, out: &CompareOutput, charts: &[(String, String)]) -> 
     let mut h = String::new();
     let _ = write!(h, "<!doctype html><html><head><meta charset=utf-8><title>compare: {}</title><style>{STYLE}</style></head><body>", esc(log));
     let _ = write!(h, "<h1>Model vs measurement</h1><p>Log <code>{}</code>: {} rows at {:.0} Hz ({:.2} s), analysed at {:.0} Hz in the {}.</p>", esc(log), r.data.rows, r.data.log_rate_hz, r.data.duration_s, r.data.working_rate_hz, esc(&r.data.frame));
+    data_quality(&mut h, &r.data_quality);
     let eff = if r.effects.is_empty() {
         "none (the paper's model, eqs. 28-29)".to_string()
     } else {
@@ -123,56 +136,118 @@ fn compare_html(log: &str, out: &CompareOutput, charts: &[(String, String)]) -> 
     }
     h.push_str("</table><h2>Where the model fails most</h2><table><tr><th>from [s]</th><th>to [s]</th><th>error</th><th>speed [rpm]</th><th>load I_qs [A]</th><th>voltage [%]</th><th>supply [Hz]</th><th>since start [s]</th><th class=l>error is mostly</th></tr>");
     for w in &r.worst_windows {
-        let _ = write!(h, "<tr><td>{:.2}</td><td>{:.2}</td><td>{:.4}</td><td>{}</td><td>{:.2}</td><td>{:.1}</td><td>{:.1}</td><td>{:.2}</td><td class=l>{}</td></tr>", w.t_start_s, w.t_end_s, w.normalized_rms_error, w.condition.speed_rpm.map(|s| format!("{s:.0}")).unwrap_or("-".into()), w.condition.load_current_a, w.condition.voltage_percent, w.condition.supply_hz, w.condition.time_since_start_s, esc(&w.error_kind));
+        let transient = w
+            .transient
+            .as_ref()
+            .map(|t| format!("; transient ({}): {}", t.kind, t.description))
+            .unwrap_or_default();
+        let _ = write!(h, "<tr><td>{:.2}</td><td>{:.2}</td><td>{:.4}</td><td>{}</td><td>{:.2}</td><td>{:.1}</td><td>{:.1}</td><td>{:.2}</td><td class=l>{}{}</td></tr>", w.t_start_s, w.t_end_s, w.normalized_rms_error, w.condition.speed_rpm.map(|s| format!("{s:.0}")).unwrap_or("-".into()), w.condition.load_current_a, w.condition.voltage_percent, w.condition.supply_hz, w.condition.time_since_start_s, esc(&w.error_kind), esc(&transient));
     }
-    h.push_str("</table><h2>Fitted parameters</h2><p>Nominal values are never exact; the parameters the data identify are refitted.</p><table><tr><th class=l>parameter</th><th>fitted</th><th>nominal</th><th class=l>unit</th></tr>");
+    h.push_str("</table>");
+    if !r.advice.is_empty() {
+        h.push_str("<h2>Advice</h2><ul>");
+        for a in &r.advice {
+            let _ = write!(h, "<li>{}</li>", esc(a));
+        }
+        h.push_str("</ul>");
+    }
+    h.push_str("<h2>Fitted parameters</h2><p>Nominal values are never exact; the parameters the data identify are refitted.</p><table><tr><th class=l>parameter</th><th>fitted</th><th>nominal</th><th class=l>unit</th><th class=l>plausible</th></tr>");
     for (k, v) in &r.base_parameters {
         let _ = write!(
             h,
-            "<tr><td class=l>{}</td><td>{:.5}</td><td>{:.5}</td><td class=l>{}</td></tr>",
+            "<tr><td class=l>{}</td><td>{:.5}</td><td>{:.5}</td><td class=l>{}</td><td class=l>{}</td></tr>",
             k,
             v.value,
             v.nominal.unwrap_or(f64::NAN),
-            esc(&v.unit)
+            esc(&v.unit),
+            if v.plausible { "yes" } else { "[not plausible]" }
         );
     }
     h.push_str("</table>");
+    for w in &r.implausible_because {
+        let _ = write!(h, "<p>not plausible: {}</p>", esc(w));
+    }
+    if let Some(j) = &r.identifiability {
+        let _ = write!(
+            h,
+            "<p>Identifiability: Jacobian rank {} of {}, condition number {:.3e}.</p>",
+            j.rank, j.n_parameters, j.condition_number
+        );
+    }
+    for w in &r.not_identified {
+        let _ = write!(h, "<p>{}</p>", esc(w));
+    }
     for e in &r.fitted_effects {
         let _ = write!(h, "<p><b>{}</b>: {}</p>", e.effect, esc(&e.summary));
     }
     let _ = write!(h, "<h2>Unbalance</h2><p>{}</p>", esc(&r.unbalance.summary));
-    for (stem, svg) in charts {
-        let _ = write!(h, "<h3>{stem}</h3>{svg}");
+    for (title, svg) in charts {
+        let _ = write!(h, "<h3>{}</h3>{svg}", esc(title));
     }
     h.push_str("<p>Next step: <code>sim-host explain</code> ranks the physical effects that could remove this error.</p></body></html>");
     h
 }
 
 /// The `explain` report page.
-fn explain_html(log: &str, out: &ExplainOutput, charts: &[(String, String)]) -> String {
+fn explain_html(
+    log: &str,
+    out: &ExplainOutput,
+    mcsa: &McsaReport,
+    charts: &[(String, String)],
+) -> String {
     let r = &out.report;
     let mut h = String::new();
     let _ = write!(h, "<!doctype html><html><head><meta charset=utf-8><title>explain: {}</title><style>{STYLE}</style></head><body>", esc(log));
     let _ = write!(h, "<h1>Which physical effect is missing?</h1><p>Log <code>{}</code>. Effects already in the model: {}.</p>", esc(log), if r.effects.is_empty() { "none".into() } else { effect_list(&r.effects) });
     let _ = write!(h, "<p class=v>{}</p>", esc(&r.verdict));
+    data_quality(&mut h, &r.data_quality);
     let _ = write!(h, "<p>Error of the model as configured: {:.4} (whole log), {:.4} on the held-back windows the fits never saw; noise floor {:.4}. Each candidate below was added to the model and fitted together with the base parameters; ranking is by the held-back error, so an effect that only fits noise does not win.</p>", r.baseline_normalized_rms_error, r.baseline_validation_normalized_rms_error, r.noise_floor);
     h.push_str("<table><tr><th>rank</th><th class=l>effect</th><th>error</th><th>held-back error</th><th>explained</th><th>params</th><th class=l>fitted, in words</th></tr>");
     for (i, c) in r.ranking.iter().enumerate() {
-        let _ = write!(h, "<tr><td>{}</td><td class=l>{}</td><td>{:.4}</td><td>{:.4}</td><td>{:.0} %</td><td>{}</td><td class=l>{}</td></tr>", i + 1, c.effect, c.normalized_rms_error, c.validation_normalized_rms_error, 100.0 * c.explained_fraction, c.n_parameters, esc(&c.summary));
+        let flags: String = c
+            .implausible_because
+            .iter()
+            .map(|w| format!(" [not plausible] {}", esc(w)))
+            .collect();
+        let _ = write!(h, "<tr><td>{}</td><td class=l>{}</td><td>{:.4}</td><td>{:.4}</td><td>{:.0} %</td><td>{}</td><td class=l>{}{flags}</td></tr>", i + 1, c.effect, c.normalized_rms_error, c.validation_normalized_rms_error, 100.0 * c.explained_fraction, c.n_parameters, esc(&c.summary));
     }
     h.push_str("</table>");
     if let Some(c) = r.ranking.first() {
-        let _ = write!(h, "<h2>Before / after</h2><table><tr><th class=l>model</th><th>normalized RMS error</th></tr><tr><td class=l>as configured</td><td>{:.4}</td></tr><tr><td class=l>+ {}</td><td>{:.4}</td></tr></table>", r.baseline_normalized_rms_error, c.effect, c.normalized_rms_error);
+        let _ = write!(h, "<h2>Before / after</h2><table><tr><th class=l>model</th><th>held-back windows</th><th>whole log</th></tr><tr><td class=l>as configured</td><td>{:.4}</td><td>{:.4}</td></tr><tr><td class=l>+ {}</td><td>{:.4}</td><td>{:.4}</td></tr></table>", r.baseline_validation_normalized_rms_error, r.baseline_normalized_rms_error, c.effect, c.validation_normalized_rms_error, c.normalized_rms_error);
     }
     for s in &r.skipped {
         let _ = write!(h, "<p><i>skipped: {}</i></p>", esc(s));
     }
     let _ = write!(h, "<h2>Unbalance</h2><p>{}</p>", esc(&r.unbalance.summary));
-    for (stem, svg) in charts {
-        let _ = write!(h, "<h3>{stem}</h3>{svg}");
+    let _ = write!(
+        h,
+        "<h2>Rotor asymmetry (motor current signature analysis)</h2><pre>{}</pre>",
+        esc(&super::mcsa::text(mcsa))
+    );
+    for (title, svg) in charts {
+        let _ = write!(h, "<h3>{}</h3>{svg}", esc(title));
     }
     h.push_str("</body></html>");
     h
+}
+
+/// The data-quality stage's finding and what was done, as the text prints it.
+fn data_quality(h: &mut String, q: &DataQuality) {
+    let _ = write!(h, "<p>Data quality: {}</p>", esc(&q.summary()));
+    if !q.actions.is_empty() {
+        h.push_str("<ul>");
+        for a in &q.actions {
+            let _ = write!(h, "<li>done: {}</li>", esc(&a.to_string()));
+        }
+        h.push_str("</ul>");
+    }
+    if !q.trusted {
+        let _ = write!(
+            h,
+            "<p><b>NOT TRUSTED</b>: {}</p>",
+            esc(&q.not_trusted_because.join("; "))
+        );
+    }
 }
 
 fn effect_list(e: &[monitor_core::EffectKind]) -> String {

@@ -3,7 +3,6 @@
 
 use super::plot::{self, Chart, Series};
 use sim_host::analysis::rotor_asymmetry::McsaReport;
-use std::path::Path;
 
 /// File stem of the spectrum chart `explain --plot DIR` writes.
 pub const CHART: &str = "mcsa_spectrum";
@@ -64,6 +63,7 @@ pub fn chart(r: &McsaReport) -> Option<Chart<'static>> {
         points: vec![(f, lo), (f, 0.0)],
         color,
         scatter: false,
+        dashed: false,
     };
     let f = |i: usize| r.sideband_hz.get(i).copied().unwrap_or(f64::NAN);
     Some(Chart {
@@ -83,21 +83,12 @@ pub fn chart(r: &McsaReport) -> Option<Chart<'static>> {
                 ),
                 color: 0,
                 scatter: false,
+                dashed: false,
             },
             marker(f(0), &format!("(1-2s)f = {:.2} Hz", f(0)), 1),
             marker(f(1), &format!("(1+2s)f = {:.2} Hz", f(1)), 2),
         ],
         log_y: false,
+        omitted: None,
     })
-}
-
-/// Writes the chart into `dir` (when the log could be judged).
-///
-/// # Errors
-/// The chart cannot be written.
-pub fn write(dir: &Path, r: &McsaReport) -> anyhow::Result<()> {
-    if let Some(c) = chart(r) {
-        plot::write(dir, &c).map_err(|e| anyhow::anyhow!("cannot write the plot: {e}"))?;
-    }
-    Ok(())
 }

@@ -20,6 +20,8 @@ pub struct Series {
     pub color: usize,
     /// Draw as points instead of a line.
     pub scatter: bool,
+    /// Draw the line dashed (the model before a change, drawn last so that it lies on top).
+    pub dashed: bool,
 }
 
 /// A chart description.
@@ -36,7 +38,14 @@ pub struct Chart<'a> {
     pub series: Vec<Series>,
     /// Logarithmic y axis.
     pub log_y: bool,
+    /// Why the chart is not drawn (a sentence for the report in its place), or `None`.
+    pub omitted: Option<String>,
 }
+
+/// Width of every chart [px].
+pub const WIDTH_PX: u32 = 900;
+/// Height of every chart [px].
+const HEIGHT_PX: u32 = 420;
 
 /// DejaVu Sans 2.37 (Bitstream Vera licence: `assets/fonts/LICENSE-DejaVu.txt`), the PNG
 /// charts' font.
@@ -177,6 +186,15 @@ where
                         a.label(s.label.clone())
                             .legend(move |(x, y)| Circle::new((x + 10, y), 4, col.filled()));
                     }
+                } else if s.dashed {
+                    let a = chart
+                        .draw_series(DashedLineSeries::new(pts, 6, 4, col.stroke_width(2)))
+                        .map_err(e)?;
+                    if text {
+                        a.label(s.label.clone()).legend(move |(x, y)| {
+                            PathElement::new(vec![(x, y), (x + 8, y)], col.stroke_width(2))
+                        });
+                    }
                 } else {
                     let a = chart
                         .draw_series(LineSeries::new(pts, col.stroke_width(1)))
@@ -213,7 +231,7 @@ where
 pub fn svg_string(c: &Chart) -> Result<String, String> {
     let mut s = String::new();
     {
-        let root = SVGBackend::with_string(&mut s, (900, 420)).into_drawing_area();
+        let root = SVGBackend::with_string(&mut s, (WIDTH_PX, HEIGHT_PX)).into_drawing_area();
         draw(root, c, true)?;
     }
     Ok(s)
@@ -221,7 +239,7 @@ pub fn svg_string(c: &Chart) -> Result<String, String> {
 
 /// Draws the chart as a PNG into `path` (`text`: with title, labels and legend).
 fn png(path: &Path, c: &Chart, text: bool) -> Result<(), String> {
-    let root = BitMapBackend::new(path, (900, 420)).into_drawing_area();
+    let root = BitMapBackend::new(path, (WIDTH_PX, HEIGHT_PX)).into_drawing_area();
     draw(root, c, text)
 }
 
@@ -372,8 +390,10 @@ mod tests {
                     .collect(),
                 color: 0,
                 scatter: false,
+                dashed: false,
             }],
             log_y: false,
+            omitted: None,
         }
     }
 

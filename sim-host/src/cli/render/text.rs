@@ -9,10 +9,11 @@ use sim_host::analysis::explain::ExplainReport;
 use sim_host::bench::isolation::{CaseResult, Confusion, IsolationBench, Outcome};
 use sim_host::bench::{BenchFigures, DetectionLimit, Spread};
 use sim_host::demo::{DemoRun, MonitorState};
+use sim_host::hmi::IsolationView;
 use sim_host::log::quality::DataQuality;
 use sim_host::replay::{
-    angle_source_name, state_name, CommissioningReport, Diagnosed, IsolationName, TimelinePoint,
-    Verdict,
+    angle_source_name, state_name, CommissioningReport, DiagnoseReport, Diagnosed, IsolationName,
+    Panel, Verdict,
 };
 use sim_host::sim::SimSummary;
 use std::io::Write;
@@ -49,18 +50,7 @@ pub fn demo(run: &DemoRun) -> anyhow::Result<()> {
     )?;
     writeln!(out, "  time   speed rpm   r1 r2 r3 r4   state")?;
     for p in &run.points {
-        let state = match &p.state {
-            MonitorState::Commissioning(x) => format!("commissioning {:3.0} %", 100.0 * x),
-            MonitorState::Transient => "transient".to_string(),
-            MonitorState::Starting => "starting".to_string(),
-            MonitorState::Healthy => "healthy".to_string(),
-            MonitorState::Fault(c) => {
-                let sig =
-                    sim_host::fault_signatures::signature_text(c.iter().map(|(f, p)| (*f, *p)));
-                format!("FAULT ({sig})")
-            }
-            MonitorState::Moved(note) => format!("operating point moved: {note}"),
-        };
+        let state = panel_text(&p.panel);
         let mark = if p.fault_injected {
             "  <- fault injected"
         } else {
@@ -98,7 +88,7 @@ pub fn demo(run: &DemoRun) -> anyhow::Result<()> {
         }
     )?;
     writeln!(out, "isolation: {}", run.report.isolation.verdict)?;
-    Ok(())
+    verdict(&mut out, &run.report)
 }
 
 /// Candidates as `rr p 0.76 (rr +50 %), speed_sensor p 0.24 (speed_sensor -2 %)`, or `none`.
@@ -144,26 +134,56 @@ pub fn convert(c: &crate::cli::convert::Converted) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The state column of a `diagnose` timeline point.
-fn diagnose_state(p: &TimelinePoint) -> String {
-    if p.commissioning {
-        "learning".to_string()
-    } else if !p.quasi_steady {
-        "transient (lamps hold)".to_string()
-    } else if !p.evaluating {
-        "settling".to_string()
+/// The state column of a demo or `diagnose` timeline point: the HMI's lamp word and header
+/// ([`sim_host::hmi::lamp_and_header`]), so the three say the same state, fault and size.
+fn panel_text(p: &Panel) -> String {
+    let candidates = match &p.state {
+        MonitorState::Fault(c) => c.as_slice(),
+        _ => &[],
+    };
+    let iso = p.isolation.as_ref().map(|(r, c)| IsolationView::new(r, c));
+    let (lamp, text) =
+        sim_host::hmi::lamp_and_header(&p.state, p.fault_lamp, candidates, iso.as_ref());
+    if lamp.is_empty() {
+        text
     } else {
-        p.top
-            .as_ref()
-            .map(|t| {
-                format!(
-                    "{} p {:.2}",
-                    sim_host::replay::IsolationName::expected(*t),
-                    p.top_probability
-                )
-            })
-            .unwrap_or_else(|| "healthy".into())
+        format!("{lamp} {text}")
     }
+}
+
+/// The verdict line of `diagnose` and the demo.
+fn verdict(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
+    match rep.verdict {
+        Verdict::Fault if rep.lamps.values().any(|l| *l) || !rep.candidates.is_empty() => {
+            writeln!(out, "verdict: FAULT")?
+        }
+        // Dark lamps and no candidate at the end: say what the verdict rests on.
+        Verdict::Fault => writeln!(
+            out,
+            "verdict: FAULT: the lamps lit at {}{}; they are dark at the end and the isolation names no single fault",
+            rep.first_detection_s
+                .map_or("-".into(), |t| format!("{t:.2} s")),
+            if rep.detections.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    " (the lamps' matching named {})",
+                    rep.detections
+                        .iter()
+                        .map(|d| format!("{} at {:.2} s", IsolationName::expected(d.fault), d.t_s))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            }
+        )?,
+        Verdict::Healthy => writeln!(out, "verdict: healthy")?,
+        Verdict::CouldNotJudge => writeln!(
+            out,
+            "verdict: could not judge: {}",
+            rep.verdict_withheld_because.join("; ")
+        )?,
+    }
+    Ok(())
 }
 
 /// `diagnose`'s timeline, lamps, candidates and unbalance.
@@ -186,7 +206,7 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
     if rep.skipped.is_empty() {
         writeln!(
             out,
-            "\n  time    speed   r1      r2      r3      r4      lamps     top candidate"
+            "\n  time    speed   r1      r2      r3      r4      lamps     state"
         )?;
         for p in &rep.timeline {
             let lamps: String = p.lamps.iter().map(|l| lamp(*l)).collect();
@@ -200,9 +220,10 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
                 r[1],
                 r[2],
                 r[3],
-                diagnose_state(p),
+                panel_text(&p.panel),
                 p.range_note
                     .as_ref()
+                    .filter(|_| !matches!(p.panel.state, MonitorState::Moved(_)))
                     .map(|n| format!("  [{n}]"))
                     .unwrap_or_default()
             )?;
@@ -256,16 +277,7 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
     for n in &rep.commissioning.outside_range {
         writeln!(out, "note at {:.2} s: {}", n.t_s, n.note)?;
     }
-    match rep.verdict {
-        Verdict::Fault => writeln!(out, "verdict: FAULT")?,
-        Verdict::Healthy => writeln!(out, "verdict: healthy")?,
-        Verdict::CouldNotJudge => writeln!(
-            out,
-            "verdict: could not judge: {}",
-            rep.verdict_withheld_because.join("; ")
-        )?,
-    }
-    Ok(())
+    verdict(&mut out, rep)
 }
 
 /// The data-quality stage's finding in one line, and what was done about it.

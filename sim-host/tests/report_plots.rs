@@ -1,0 +1,278 @@
+//! The report's plots a person can read (issue 28): over the 5 s motulator log no line is
+//! a solid band (fewer than 2 drawn points per pixel column: envelopes over the long span,
+//! zoomed panels of a few supply periods), the model "before" is dashed and drawn after
+//! the other lines, one unit per error chart, a scatter over one operating point is
+//! replaced by a sentence, and the headings are words, not file names.
+
+use assert_cmd::Command;
+use std::path::{Path, PathBuf};
+
+/// Drawn points per pixel column a line may have at most.
+const MAX_POINTS_PER_COLUMN: f64 = 2.0;
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("workspace")
+        .to_path_buf()
+}
+
+fn run(args: &[&str]) {
+    let logs = repo().join("examples/logs");
+    let p = logs.join("motulator_2p2kw_dol.toml");
+    let csv = logs.join("motulator_2p2kw_dol.csv");
+    let out = Command::cargo_bin("sim-host")
+        .expect("binary")
+        .args(args)
+        .args([
+            "--params",
+            p.to_str().expect("utf8"),
+            csv.to_str().expect("utf8"),
+        ])
+        .output()
+        .expect("runs");
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// The point lists of every `<polyline>` of an SVG as (x, y) pixels.
+fn polylines(svg: &str) -> Vec<(String, Vec<(f64, f64)>)> {
+    svg.split("<polyline")
+        .skip(1)
+        .filter_map(|p| {
+            let tag = p.split('>').next()?;
+            let pts = tag.split("points=\"").nth(1)?.split('"').next()?;
+            let v = pts
+                .split_whitespace()
+                .filter_map(|xy| {
+                    let (x, y) = xy.split_once(',')?;
+                    Some((x.parse().ok()?, y.parse().ok()?))
+                })
+                .collect();
+            Some((tag.to_string(), v))
+        })
+        .collect()
+}
+
+/// The stroke colour of a polyline's tag.
+fn stroke(tag: &str) -> &str {
+    tag.split("stroke=\"")
+        .nth(1)
+        .and_then(|s| s.split('"').next())
+        .unwrap_or("")
+}
+
+/// The largest number of drawn points per pixel column of any line of `svg`: each data
+/// colour's points (all its polylines: a dashed line is many) over the columns it spans.
+fn points_per_column(svg: &str) -> f64 {
+    let lines = polylines(svg);
+    let mut colours: Vec<&str> = lines
+        .iter()
+        .filter(|(t, v)| v.len() > 2 && stroke(t) != "#000000")
+        .map(|(t, _)| stroke(t))
+        .collect();
+    colours.sort_unstable();
+    colours.dedup();
+    colours
+        .iter()
+        .map(|c| {
+            let v: Vec<(f64, f64)> = lines
+                .iter()
+                .filter(|(t, _)| stroke(t) == *c)
+                .flat_map(|(_, v)| v.iter().copied())
+                .collect();
+            let lo = v.iter().map(|p| p.0).fold(f64::INFINITY, f64::min);
+            let hi = v.iter().map(|p| p.0).fold(f64::NEG_INFINITY, f64::max);
+            v.len() as f64 / (hi - lo + 1.0)
+        })
+        .fold(0.0, f64::max)
+}
+
+/// `explain --from 1.5 --report DIR` of the motulator log: (the temporary folder, DIR).
+fn explain_report() -> (tempfile::TempDir, PathBuf) {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let dir = tmp.path().join("e");
+    run(&[
+        "explain",
+        "--from",
+        "1.5",
+        "--report",
+        dir.to_str().expect("utf8"),
+    ]);
+    (tmp, dir)
+}
+
+fn headings(html: &str) -> Vec<String> {
+    html.split("<h3>")
+        .skip(1)
+        .filter_map(|h| h.split("</h3>").next().map(str::to_string))
+        .collect()
+}
+
+fn check_dir(dir: &Path, stems: &[&str]) -> String {
+    for stem in stems {
+        let path = dir.join(format!("{stem}.svg"));
+        let svg =
+            std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let n = points_per_column(&svg);
+        assert!(
+            n > 0.0 && n < MAX_POINTS_PER_COLUMN,
+            "{stem}: {n:.2} drawn points per pixel column (a solid band from {MAX_POINTS_PER_COLUMN})"
+        );
+    }
+    let html = std::fs::read_to_string(dir.join("report.html")).expect("report");
+    let hs = headings(&html);
+    assert!(hs.len() >= stems.len(), "{hs:?}");
+    for h in &hs {
+        assert!(
+            h.split_whitespace().count() >= 3 && !h.split_whitespace().any(|w| stems.contains(&w)),
+            "a heading that is not words: {h}"
+        );
+    }
+    html
+}
+
+#[test]
+fn compare_report_draws_envelopes_zooms_and_one_unit_per_axis() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let dir = tmp.path().join("r");
+    run(&["compare", "--report", dir.to_str().expect("utf8")]);
+    let html = check_dir(
+        &dir,
+        &[
+            "overlay_iqs",
+            "overlay_omega_r",
+            "zoom_iqs_1",
+            "zoom_iqs_2",
+            "overlay_ia",
+            "error_time",
+            "error_time_omega_r",
+            "error_spectrum",
+        ],
+    );
+    // One unit per error chart.
+    let e = std::fs::read_to_string(dir.join("error_time.svg")).expect("svg");
+    assert!(e.contains("[A]") && !e.contains("rad/s"));
+    let w = std::fs::read_to_string(dir.join("error_time_omega_r.svg")).expect("svg");
+    assert!(w.contains("[rad/s]") && !w.contains("[A]"));
+    // The motulator log runs at one supply voltage: no scatter against it, a sentence.
+    assert!(!dir.join("error_vs_voltage.svg").exists());
+    assert!(
+        html.contains("Not drawn: every window's voltage"),
+        "no sentence for the omitted scatter"
+    );
+}
+
+#[test]
+fn explain_report_draws_the_model_before_dashed_and_on_top() {
+    let (_tmp, dir) = explain_report();
+    check_dir(
+        &dir,
+        &[
+            "before_after_iqs",
+            "before_after_omega_r",
+            "zoom_before_after_iqs_1",
+            "before_after_error",
+        ],
+    );
+    // "model before" is the palette's red (#D62728), dashed (many short segments), and the
+    // last data line drawn (after the green model with the effect).
+    let svg = std::fs::read_to_string(dir.join("before_after_iqs.svg")).expect("svg");
+    let lines = polylines(&svg);
+    let red = lines.iter().filter(|(t, _)| t.contains("#D62728")).count();
+    assert!(
+        red > 20,
+        "the model before is not dashed: {red} red segments"
+    );
+    let last_green = lines
+        .iter()
+        .rposition(|(t, v)| t.contains("#2CA02C") && v.len() > 2)
+        .expect("the model with the effect");
+    let first_red = lines
+        .iter()
+        .position(|(t, _)| t.contains("#D62728"))
+        .expect("the model before");
+    assert!(
+        first_red > last_green,
+        "the model before lies under the other lines"
+    );
+}
+
+/// The numbers (with their sign and decimals) of a text: `0.3008`, `-0.03`, `96`.
+fn numbers(text: &str) -> Vec<String> {
+    let mut v = Vec::new();
+    let mut cur = String::new();
+    for ch in text.chars().chain([' ']) {
+        if ch.is_ascii_digit() || (ch == '.' && !cur.is_empty()) || (ch == '-' && cur.is_empty()) {
+            cur.push(ch);
+        } else {
+            let n = cur.trim_end_matches('.').to_string();
+            if n.chars().any(|c| c.is_ascii_digit()) {
+                v.push(n);
+            }
+            cur.clear();
+        }
+    }
+    v
+}
+
+/// The text of every table cell of `html`.
+fn cells(html: &str) -> Vec<String> {
+    html.split("<td")
+        .skip(1)
+        .filter_map(|c| {
+            c.split_once('>')?
+                .1
+                .split("</td>")
+                .next()
+                .map(str::to_string)
+        })
+        .collect()
+}
+
+#[test]
+fn explain_report_tables_hold_the_headline_numbers_and_the_spectrum() {
+    let (_tmp, dir) = explain_report();
+    let html = std::fs::read_to_string(dir.join("report.html")).expect("report");
+    let headline = html
+        .split("<p class=v>")
+        .nth(1)
+        .and_then(|h| h.split("</p>").next())
+        .expect("headline");
+    // The headline's finding: the effect, how much it explains, the errors before and
+    // after, and the fitted values (up to the advice "Add it with ...").
+    let finding = headline.split("Add it with").next().unwrap_or(headline);
+    let table_numbers: Vec<String> = cells(&html).iter().flat_map(|c| numbers(c)).collect();
+    let quoted = numbers(finding);
+    assert!(quoted.len() >= 3, "{finding}");
+    for n in &quoted {
+        assert!(
+            table_numbers.contains(n),
+            "the headline quotes {n}, no table holds it: {finding}"
+        );
+    }
+    // Held-back and whole-log errors before and after.
+    assert!(html.contains("<th>held-back windows</th><th>whole log</th>"));
+    // The plausibility flags and the motor current signature analysis.
+    assert!(html.contains("[not plausible]"));
+    assert!(html.contains("motor current signature analysis"));
+    assert!(dir.join("mcsa_spectrum.svg").exists());
+}
+
+#[test]
+fn compare_report_holds_the_advice_flags_and_identifiability() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let dir = tmp.path().join("r");
+    run(&["compare", "--report", dir.to_str().expect("utf8")]);
+    let html = std::fs::read_to_string(dir.join("report.html")).expect("report");
+    assert!(html.contains("<h2>Advice</h2>"), "no advice");
+    assert!(html.contains("--from 0.7"), "no --from advice");
+    assert!(html.contains("[not plausible]") && html.contains("not plausible: j_kgm2"));
+    assert!(html.contains("Identifiability: Jacobian rank"));
+    // The data-quality stage's line and the worst windows' transients, as the text has them.
+    assert!(html.contains("Data quality: clean"));
+    assert!(html.contains("transient (start): the direct-on-line start"));
+}
