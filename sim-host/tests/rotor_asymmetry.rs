@@ -261,6 +261,11 @@ fn faulty_case(which: &str, load: f64, min_cut: f64) {
     assert!((n - d * 28.0 / (3.0 * (1.0 + d))).abs() < 1e-9);
     // The resolution is fine enough for 2sf.
     assert!(m.resolution_hz.unwrap() <= m.resolution_needed_hz.unwrap());
+    // The spectrum's own estimate agrees with the fit, and with the truth within half a
+    // bar (delta 0.2 is 1.56 bars of 28).
+    assert_eq!(m.fit_and_spectrum_agree, Some(true), "{m:?}");
+    let ns = m.spectral_broken_bars.unwrap();
+    assert!((ns - 0.2 * 28.0 / 3.6).abs() < 0.5, "{ns}");
 }
 
 #[test]
@@ -299,6 +304,7 @@ fn explain_does_not_claim_rotor_asymmetry_on_healthy_logs() {
         assert!(!(claimed && first == "rotor_asymmetry"), "{which}: {first}");
         // The healthy cage's sidebands are far below a faulty one's (-60 dB and lower).
         assert!(m.lower_sideband_db.unwrap() < -65.0, "{which}: {m:?}");
+        assert_ne!(m.fit_and_spectrum_agree, Some(true), "{which}: {m:?}");
     }
 }
 
@@ -306,12 +312,13 @@ fn explain_does_not_claim_rotor_asymmetry_on_healthy_logs() {
 fn mcsa_cannot_judge_a_short_log_or_no_load() {
     let dir = tempfile::tempdir().unwrap();
     let p = motor("3hp");
-    // 3.5 s: 1.5 s steady after the load step, 2sf = 5 Hz needs 2 s.
+    // 2.6 s: at most 0.6 s steady after the load step; 2sf = 5.5 Hz needs 0.9 s (5 bins of
+    // the Blackman-Harris window).
     let log = write_log(
         dir.path(),
         "short",
         &p,
-        &scenario("3hp", 1.0, 0.2, 3.5),
+        &scenario("3hp", 1.0, 0.2, 2.6),
         false,
     );
     let a = analyse(&log, &p, settle_s("3hp"));
