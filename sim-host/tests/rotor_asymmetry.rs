@@ -13,36 +13,18 @@
 
 mod analysis_common;
 
-use analysis_common::{analyse, in_this_run, motor, opts, settle_s, sweep, write_log};
+use analysis_common::{
+    analyse, in_this_run, loaded_start, motor, opts, settle_s, sweep, write_log,
+};
 use monitor_core::EffectKind;
 use sim_host::analysis::rotor_asymmetry::{mcsa, McsaReport};
 use sim_host::params::ParamFile;
-use sim_host::sim::{self, EffectSpec, LoadKind, LoadSpec, LoadStep, Scenario, Truth};
+use sim_host::sim::{self, EffectSpec, Scenario, Truth};
 use std::f64::consts::PI;
-
-/// Rated torque of the reference motors [N m] (3 hp: 2238 W at about 1750 rpm; 2.2 kW:
-/// the reference scenario's load, `examples/scenarios/reference_2p2kw.toml`).
-fn rated_nm(which: &str) -> f64 {
-    if which == "3hp" {
-        12.2
-    } else {
-        14.6
-    }
-}
 
 /// Direct-on-line start, the load switched on at the settle time, `delta` injected.
 fn scenario(which: &str, load: f64, delta: f64, duration_s: f64) -> Scenario {
-    let mut s = Scenario::steady(duration_s, 4000.0);
-    s.load = LoadSpec {
-        kind: LoadKind::Torque,
-        torque_nm: Some(0.0),
-        bl_nms: None,
-        steps: vec![LoadStep {
-            t_s: settle_s(which),
-            torque_nm: Some(load * rated_nm(which)),
-            bl_scale: None,
-        }],
-    };
+    let mut s = loaded_start(which, load, duration_s, 4000.0);
     s.effects = vec![EffectSpec::RotorAsymmetry {
         delta: Some(delta),
         broken_bars: None,
