@@ -24,6 +24,16 @@ use sim_host::sim::{EffectSpec, Scenario, SensorSpec};
 /// told it).
 const BARS: f64 = 28.0;
 
+/// Every motor with 0, 1 and 2 broken bars.
+const EVERY_CAGE: [(&str, f64); 6] = [
+    ("3hp", 0.0),
+    ("3hp", 1.0),
+    ("3hp", 2.0),
+    ("2p2kw", 0.0),
+    ("2p2kw", 1.0),
+    ("2p2kw", 2.0),
+];
+
 /// Time after the load step before the record starts [s]: the slip has settled.
 const AFTER_STEP_S: f64 = 1.5;
 
@@ -119,15 +129,9 @@ fn two_second_records_of_healthy_motors_are_not_named() {
 
 #[test]
 fn eight_second_records_at_10_khz() {
-    let cases = [
-        ("3hp", 0.0),
-        ("3hp", 1.0),
-        ("3hp", 2.0),
-        ("2p2kw", 0.0),
-        ("2p2kw", 1.0),
-        ("2p2kw", 2.0),
-    ];
-    for (which, broken) in sweep("8 s records at 10 kHz", cases, |c| *c == ("2p2kw", 2.0)) {
+    for (which, broken) in sweep("8 s records at 10 kHz", EVERY_CAGE, |c| {
+        *c == ("2p2kw", 2.0)
+    }) {
         check(which, broken, 8.0, 10_000.0, false);
     }
 }
@@ -135,16 +139,8 @@ fn eight_second_records_at_10_khz() {
 #[test]
 fn two_second_records_with_sensor_noise() {
     // The simulator's default sensor chain: 12-bit ADCs and 0.1 % noise.
-    let cases = [
-        ("3hp", 0.0),
-        ("3hp", 1.0),
-        ("3hp", 2.0),
-        ("2p2kw", 0.0),
-        ("2p2kw", 1.0),
-        ("2p2kw", 2.0),
-    ];
     let default = |c: &(&str, f64)| *c == ("3hp", 1.0) || *c == ("2p2kw", 0.0);
-    for (which, broken) in sweep("noisy 2 s records at 2 kHz", cases, default) {
+    for (which, broken) in sweep("noisy 2 s records at 2 kHz", EVERY_CAGE, default) {
         check(which, broken, 2.0, 2000.0, true);
     }
 }
