@@ -94,7 +94,7 @@ const INTENDED: [(&str, &str, &str); 14] = [
 
 /// Keys added since the golden outputs were taken (issue 8: the data-quality stage's
 /// report, what commissioning did, the verdict, the range note beside a lamp).
-const ADDED: [&str; 41] = [
+const ADDED: [&str; 45] = [
     // Issue 25: the phase's confidence and why no phase is judged.
     "phase_confidence",
     "phase_not_judged",
@@ -149,6 +149,11 @@ const ADDED: [&str; 41] = [
     "not_judged",
     "cannot_judge_because",
     "wiring",
+    // Issue 23: the MCSA's broken-bar estimate from the spectrum beside the fit's.
+    "torque_current_share",
+    "spectral_delta",
+    "spectral_broken_bars",
+    "fit_and_spectrum_agree",
 ];
 
 /// The library effect added since (issue 10, `rotor_asymmetry`): its ranking entries and

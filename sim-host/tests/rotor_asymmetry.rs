@@ -13,36 +13,18 @@
 
 mod analysis_common;
 
-use analysis_common::{analyse, in_this_run, motor, opts, settle_s, sweep, write_log};
+use analysis_common::{
+    analyse, in_this_run, loaded_start, motor, opts, settle_s, sweep, write_log,
+};
 use monitor_core::EffectKind;
 use sim_host::analysis::rotor_asymmetry::{mcsa, McsaReport};
 use sim_host::params::ParamFile;
-use sim_host::sim::{self, EffectSpec, LoadKind, LoadSpec, LoadStep, Scenario, Truth};
+use sim_host::sim::{self, EffectSpec, Scenario, Truth};
 use std::f64::consts::PI;
-
-/// Rated torque of the reference motors [N m] (3 hp: 2238 W at about 1750 rpm; 2.2 kW:
-/// the reference scenario's load, `examples/scenarios/reference_2p2kw.toml`).
-fn rated_nm(which: &str) -> f64 {
-    if which == "3hp" {
-        12.2
-    } else {
-        14.6
-    }
-}
 
 /// Direct-on-line start, the load switched on at the settle time, `delta` injected.
 fn scenario(which: &str, load: f64, delta: f64, duration_s: f64) -> Scenario {
-    let mut s = Scenario::steady(duration_s, 4000.0);
-    s.load = LoadSpec {
-        kind: LoadKind::Torque,
-        torque_nm: Some(0.0),
-        bl_nms: None,
-        steps: vec![LoadStep {
-            t_s: settle_s(which),
-            torque_nm: Some(load * rated_nm(which)),
-            bl_scale: None,
-        }],
-    };
+    let mut s = loaded_start(which, load, duration_s, 4000.0);
     s.effects = vec![EffectSpec::RotorAsymmetry {
         delta: Some(delta),
         broken_bars: None,
@@ -261,6 +243,11 @@ fn faulty_case(which: &str, load: f64, min_cut: f64) {
     assert!((n - d * 28.0 / (3.0 * (1.0 + d))).abs() < 1e-9);
     // The resolution is fine enough for 2sf.
     assert!(m.resolution_hz.unwrap() <= m.resolution_needed_hz.unwrap());
+    // The spectrum's own estimate agrees with the fit, and with the truth within half a
+    // bar (delta 0.2 is 1.56 bars of 28).
+    assert_eq!(m.fit_and_spectrum_agree, Some(true), "{m:?}");
+    let ns = m.spectral_broken_bars.unwrap();
+    assert!((ns - 0.2 * 28.0 / 3.6).abs() < 0.5, "{ns}");
 }
 
 #[test]
@@ -299,6 +286,7 @@ fn explain_does_not_claim_rotor_asymmetry_on_healthy_logs() {
         assert!(!(claimed && first == "rotor_asymmetry"), "{which}: {first}");
         // The healthy cage's sidebands are far below a faulty one's (-60 dB and lower).
         assert!(m.lower_sideband_db.unwrap() < -65.0, "{which}: {m:?}");
+        assert_ne!(m.fit_and_spectrum_agree, Some(true), "{which}: {m:?}");
     }
 }
 
@@ -306,12 +294,13 @@ fn explain_does_not_claim_rotor_asymmetry_on_healthy_logs() {
 fn mcsa_cannot_judge_a_short_log_or_no_load() {
     let dir = tempfile::tempdir().unwrap();
     let p = motor("3hp");
-    // 3.5 s: 1.5 s steady after the load step, 2sf = 5 Hz needs 2 s.
+    // 2.6 s: at most 0.6 s steady after the load step; 2sf = 5.5 Hz needs 0.9 s (5 bins of
+    // the Blackman-Harris window).
     let log = write_log(
         dir.path(),
         "short",
         &p,
-        &scenario("3hp", 1.0, 0.2, 3.5),
+        &scenario("3hp", 1.0, 0.2, 2.6),
         false,
     );
     let a = analyse(&log, &p, settle_s("3hp"));

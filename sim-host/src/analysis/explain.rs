@@ -515,6 +515,13 @@ impl Analysis {
             .map(|(k, _)| k)
             .collect();
         let mut why = me.implausible_because.clone();
+        // A cage asymmetry is named only when the current spectrum agrees with the fit.
+        if c.kind() == EffectKind::RotorAsymmetry {
+            let delta = me.parameters.get("delta").map(|p| p.value);
+            why.extend(delta.and_then(|dl| {
+                super::rotor_asymmetry::spectrum_contradicts(d, self.constants.np, dl)
+            }));
+        }
         why.extend(
             super::base_out_of_range(&self.constants, &f.base, d)
                 .into_iter()

@@ -17,13 +17,45 @@
 //! inverse `broken_bars_of_delta`); the analysis only reads it.
 //!
 //! # MCSA resolution
-//! The sidebands lie 2 s f from the fundamental (3.6 Hz for the 3 hp motor at 3 % slip).
-//! With a Hann window the fundamental's leakage falls 18 dB per octave from -31 dB at 2.5
-//! bins; [`MIN_BINS`] = 10 bins (-68 dB) between the fundamental and a sideband keep its
-//! leakage below the sidebands of a healthy cage (-50 to -60 dB). The resolution needed is
-//! therefore 1/T <= 2 s f / 10: T >= 5 / (s f), 2.8 s at 3 % slip and 60 Hz, 10 s at 1 %
-//! and 50 Hz. A shorter steady stretch, a slip below [`MIN_SLIP`] or a slip that varies by
-//! more than [`SLIP_STEADY`] of itself is "cannot judge".
+//! The sidebands lie 2 s f from the fundamental (3.6 Hz for the 3 hp motor at 3 % slip),
+//! and a record of T seconds resolves 1/T (one bin). The current is windowed with the
+//! 4-term Blackman-Harris window (coefficients 0.35875, 0.48829, 0.14128, 0.01168; F. J.
+//! Harris, "On the use of windows for harmonic analysis with the discrete Fourier
+//! transform", Proc. IEEE 66(1), 1978, table I and fig. 69): its main lobe is +/- 4 bins
+//! wide ([`MAIN_LOBE_HALF_BINS`]) and outside it the leakage of any tone stays below
+//! -92 dB, far below the sidebands of a healthy cage (-50 to -60 dB on real motors, Thomson
+//! and Fenger, IEEE Ind. Appl. Magazine 7(4), 2001). The rule: a sideband is read when its
+//! whole search interval, 2 s f +/- [`SLIP_STEADY`] of it (the slip is known to that), lies
+//! outside the fundamental's main lobe, i.e. 2 s f (1 - SLIP_STEADY) >= 4 bins:
+//! [`MIN_BINS`] = 4 / (1 - 0.2) = 5 bins, T >= 5 / (2 s f) = 2.5 / (s f): 1.4 s at 3 % slip
+//! and 60 Hz, 2 s at 2.5 % and 50 Hz, 5 s at 1 % and 50 Hz (the Hann window this replaces
+//! needed 10 bins, 4x longer records, for its slowly falling leakage). The transform is
+//! zero-padded 4x, so the peaks are read within 1/8 bin of their true frequency, where
+//! the window's scalloping loss is below 0.1 dB (Harris's 0.83 dB at 1/2 bin). A shorter
+//! steady stretch, a slip below [`MIN_SLIP`] or a slip that varies by more than
+//! [`SLIP_STEADY`] of itself is "cannot judge" (saying how long a record is needed).
+//!
+//! # Broken bars from the spectrum
+//! The asymmetry delta makes a backward-rotating rotor current at -s f (in rotor
+//! coordinates): the resistance mismatch's negative-sequence part, (delta/3) Rr, times the
+//! forward rotor current I_r, drives the backward circuit, whose impedance at small slip
+//! is the rotor resistance Rr (1 + delta/3) (the stator is short-circuited at (1 - 2s) f by
+//! the supply): I_b / I_r = (delta/3) / (1 + delta/3) = delta / (3 + delta). In the stator
+//! it is the (1 - 2s) f sideband; the 2 s f speed ripple moves part of it to (1 + 2s) f, and
+//! the sum of the two does not depend on the inertia (Bellini, Filippetti, Franceschini,
+//! Tassoni, Kliman, IEEE Trans. Ind. Appl. 37(5), 2001). The rotor current seen in the
+//! stator is the torque-producing (q, rotor-flux frame) part I_q of the current, the
+//! magnetizing part carries no sideband. Hence, from the spectrum
+//! ```text
+//!   r = (I_(1-2s)f + I_(1+2s)f) / I_q,   delta = 3 r / (1 - r),   n = r N / (1 + 2 r)
+//! ```
+//! (the last with Kliman's n = delta N / (3 (1 + delta)), i.e. r = n / (N - 2n)). Its
+//! approximations: small slip (the backward circuit's leakage reactance s omega L_sigma
+//! neglected against Rr), the stator's impedance at (1 - 2s) f neglected, the
+//! magnetizing-to-leakage coupling Lm^2/(Ls Lr) taken as 1, and the cage model's own
+//! (no inter-bar currents, which make real sidebands smaller: a real cage's estimate is a
+//! lower bound). The report gives it beside the fit's delta; `explain` names
+//! `rotor_asymmetry` only when the two agree ([`fit_and_spectrum_agree`]).
 
 use super::prep::Prepared;
 use crate::sim::machine::broken_bars_of_delta;
@@ -31,8 +63,43 @@ use rustfft::num_complex::Complex;
 use serde::Serialize;
 use std::f64::consts::PI;
 
-/// Fewest frequency bins between the fundamental and a sideband (see the module doc).
-pub const MIN_BINS: f64 = 10.0;
+/// Half-width of the 4-term Blackman-Harris window's main lobe [bins of 1/T] (Harris
+/// 1978; module doc).
+pub const MAIN_LOBE_HALF_BINS: f64 = 4.0;
+/// Fewest frequency bins between the fundamental and a sideband: the sideband's search
+/// interval, +/- [`SLIP_STEADY`] of 2 s f, clear of the fundamental's main lobe,
+/// `MAIN_LOBE_HALF_BINS / (1 - SLIP_STEADY)` = 5 (module doc).
+pub const MIN_BINS: f64 = 5.0;
+// The sideband's search interval starts (1 - SLIP_STEADY) MIN_BINS bins from the
+// fundamental: at the main lobe's edge or beyond (checked when compiled).
+const _: () = assert!(MIN_BINS * (1.0 - SLIP_STEADY) >= MAIN_LOBE_HALF_BINS - 1e-9);
+/// The 4-term Blackman-Harris window's coefficients a0..a3 (-92 dB sidelobes; Harris
+/// 1978): w(k) = a0 - a1 cos(2 pi k/n) + a2 cos(4 pi k/n) - a3 cos(6 pi k/n).
+pub const BLACKMAN_HARRIS_4: [f64; 4] = [0.35875, 0.48829, 0.14128, 0.01168];
+/// The spectrum's and the fit's delta agree when they are within this factor (2) of each
+/// other ([`fit_and_spectrum_agree`]): the spectral relation's approximations (module doc)
+/// are well within it, a healthy cage's fitted noise (a small delta, no sidebands) is not.
+pub const AGREE_FACTOR: f64 = 2.0;
+
+/// The asymmetry delta the sidebands say (module doc, "Broken bars from the spectrum"):
+/// `r = (10^(lower_db/20) + 10^(upper_db/20)) / q_share`, `delta = 3 r / (1 - r)`, where
+/// `q_share` = I_q / I_1 is the torque-producing share of the current (0..1]. `None` when
+/// `q_share` is not positive or r >= 1 (sidebands as large as the torque current: not the
+/// first-order relation's range).
+pub fn spectral_delta(lower_db: f64, upper_db: f64, q_share: f64) -> Option<f64> {
+    let lin = |db: f64| 10f64.powf(db / 20.0);
+    let r = (lin(lower_db) + lin(upper_db)) / q_share;
+    (q_share > 0.0 && r.is_finite() && r < 1.0).then(|| 3.0 * r / (1.0 - r))
+}
+
+/// True when the spectrum's delta and the fit's agree within [`AGREE_FACTOR`] of each
+/// other (both positive): what `explain` requires before it names `rotor_asymmetry`.
+pub fn fit_and_spectrum_agree(fit_delta: f64, spectral_delta: f64) -> bool {
+    fit_delta > 0.0
+        && spectral_delta > 0.0
+        && spectral_delta <= AGREE_FACTOR * fit_delta
+        && fit_delta <= AGREE_FACTOR * spectral_delta
+}
 /// Smallest slip the sidebands are judged at: below it they sit within 2 s f = 0.6 Hz
 /// (at 50 Hz) of the fundamental, a run of 17 s at least, and no-load slip is noise.
 pub const MIN_SLIP: f64 = 0.003;
@@ -75,6 +142,17 @@ pub struct McsaReport {
     /// Equivalent adjacent broken bars n = delta N / (3 (1 + delta)) (null without a bar
     /// count or without a fitted delta).
     pub equivalent_broken_bars: Option<f64>,
+    /// Torque-producing share of the current I_q / I_1 over the analysed stretch (rotor-flux
+    /// frame; the spectral estimate's reference, module doc).
+    pub torque_current_share: Option<f64>,
+    /// The asymmetry delta the sidebands say ([`spectral_delta`]).
+    pub spectral_delta: Option<f64>,
+    /// Adjacent broken bars the sidebands say, n = r N / (1 + 2r) (module doc; null
+    /// without a bar count or without judged sidebands).
+    pub spectral_broken_bars: Option<f64>,
+    /// Whether the fitted `delta` and `spectral_delta` agree ([`fit_and_spectrum_agree`];
+    /// null when either is missing).
+    pub fit_and_spectrum_agree: Option<bool>,
     /// Frequency resolution 1/T of the analysed stretch [Hz].
     pub resolution_hz: Option<f64>,
     /// Resolution needed: 2 s f / [`MIN_BINS`] [Hz].
@@ -112,7 +190,14 @@ fn steady_stretch(d: &Prepared) -> (usize, Vec<f64>) {
     (start, slip)
 }
 
-/// Hann-windowed amplitude spectrum of `x` sampled every `dt`, zero-padded 4x: (bin
+/// The 4-term Blackman-Harris window [`BLACKMAN_HARRIS_4`] at sample `k` of `n`.
+fn blackman_harris(k: usize, n: usize) -> f64 {
+    let [a0, a1, a2, a3] = BLACKMAN_HARRIS_4;
+    let x = 2.0 * PI * k as f64 / n.max(1) as f64;
+    a0 - a1 * x.cos() + a2 * (2.0 * x).cos() - a3 * (3.0 * x).cos()
+}
+
+/// Blackman-Harris-windowed amplitude spectrum of `x` sampled every `dt`, zero-padded 4x: (bin
 /// spacing [Hz], peak amplitudes per bin from 0 Hz to at least `f_max` [Hz] (or to the
 /// Nyquist frequency)). The real series is transformed as a complex one of half the length
 /// (even samples real, odd imaginary) and the bins are unpacked from it: the same values
@@ -131,7 +216,7 @@ fn spectrum(
     let mut buf: Vec<Complex<f64>> = vec![Complex::new(0.0, 0.0); half];
     let mut wsum = 0.0;
     for (k, v) in x.iter().enumerate() {
-        let w = 0.5 - 0.5 * (2.0 * PI * k as f64 / n as f64).cos();
+        let w = blackman_harris(k, n);
         wsum += w;
         let y = (v - mean) * w;
         if k % 2 == 0 {
@@ -159,6 +244,22 @@ fn spectrum(
     (df, amp)
 }
 
+/// Why the current spectrum contradicts a fitted asymmetry `fit_delta` (`explain` then
+/// does not name `rotor_asymmetry`): the sidebands were judged ([`mcsa`]) and their
+/// [`spectral_delta`] does not agree with it ([`fit_and_spectrum_agree`]). `None` when they
+/// agree or when the spectrum cannot judge (it then says nothing either way).
+pub fn spectrum_contradicts(d: &Prepared, np: f64, fit_delta: f64) -> Option<String> {
+    let m = mcsa(d, np, None, Some(fit_delta));
+    let spectral = m.spectral_delta?;
+    (m.fit_and_spectrum_agree == Some(false)).then(|| {
+        format!(
+            "the current spectrum's sidebands ({:.1} / {:.1} dB) say delta {spectral:.3}, not the fitted {fit_delta:.3} (within {AGREE_FACTOR}x)",
+            m.lower_sideband_db.unwrap_or(f64::NAN),
+            m.upper_sideband_db.unwrap_or(f64::NAN),
+        )
+    })
+}
+
 /// Largest amplitude within `f0 +/- half` [Hz]: (frequency, amplitude).
 fn peak(df: f64, amp: &[f64], f0: f64, half: f64) -> (f64, f64) {
     let a = ((f0 - half) / df).floor().max(0.0) as usize;
@@ -168,8 +269,31 @@ fn peak(df: f64, amp: &[f64], f0: f64, half: f64) -> (f64, f64) {
         .fold((f0, 0.0), |m, x| if x.1 > m.1 { x } else { m })
 }
 
+/// The spectral broken-bar estimate of a judged report `r` (its sidebands read) over the
+/// samples `seg`: the torque-current share, [`spectral_delta`], its broken bars of
+/// `r.rotor_bars` and the agreement with `r.delta` (module doc).
+fn spectral_estimate(r: &mut McsaReport, d: &Prepared, seg: std::ops::Range<usize>) {
+    let mean = |x: &[f64]| x.iter().sum::<f64>() / x.len().max(1) as f64;
+    let part = |x: &[f64]| mean(x.get(seg.clone()).unwrap_or(&[]));
+    let (id, iq) = (part(&d.id), part(&d.iq));
+    let share = iq.abs() / id.hypot(iq).max(1e-12);
+    r.torque_current_share = Some(share);
+    r.spectral_delta = r
+        .lower_sideband_db
+        .zip(r.upper_sideband_db)
+        .and_then(|(l, u)| spectral_delta(l, u, share));
+    r.spectral_broken_bars = r
+        .rotor_bars
+        .zip(r.spectral_delta)
+        .map(|(nb, dl)| broken_bars_of_delta(dl, nb));
+    r.fit_and_spectrum_agree = r
+        .delta
+        .zip(r.spectral_delta)
+        .map(|(f, s)| fit_and_spectrum_agree(f, s));
+}
+
 /// The MCSA of the log: stator current sidebands at (1 -/+ 2s) f in dB below the
-/// fundamental (phase-a current, Hann window over the steady stretch at the end of the
+/// fundamental (phase-a current, Blackman-Harris window over the steady stretch at the end of the
 /// log, at most [`MAX_STRETCH_S`] of it), the 2 s f speed ripple, and the equivalent
 /// broken bars for `bars` N when `delta` is known. `np` is the number of pole pairs. "Cannot judge" (with the reason) without a
 /// speed column, on a slip below [`MIN_SLIP`] or not steady, or a stretch too short for
@@ -245,7 +369,7 @@ pub fn mcsa(d: &Prepared, np: f64, bars: Option<f64>, delta: Option<f64>) -> Mcs
         return no(
             r,
             format!(
-                "the steady stretch is {t_len:.2} s; {:.2} s are needed to resolve sidebands 2sf = {fs:.2} Hz from the fundamental ({MIN_BINS} bins)",
+                "the steady stretch is {t_len:.2} s; {:.2} s are needed to resolve sidebands 2sf = {fs:.2} Hz from the fundamental ({MIN_BINS} bins of a Blackman-Harris window)",
                 MIN_BINS / fs
             ),
         );
@@ -256,10 +380,11 @@ pub fn mcsa(d: &Prepared, np: f64, bars: Option<f64>, delta: Option<f64>) -> Mcs
     let (df, amp) = spectrum(&mut planner, &ia, d.dt_s, (1.5 * f1).max(f1 + 1.6 * fs));
     let (ff, af) = peak(df, &amp, f1, 0.3 * fs);
     let db = |x: f64| 20.0 * (x.max(1e-300) / af.max(1e-300)).log10();
-    let (_, al) = peak(df, &amp, ff - fs, 0.2 * fs);
-    let (_, au) = peak(df, &amp, ff + fs, 0.2 * fs);
+    let (_, al) = peak(df, &amp, ff - fs, SLIP_STEADY * fs);
+    let (_, au) = peak(df, &amp, ff + fs, SLIP_STEADY * fs);
     r.lower_sideband_db = Some(db(al));
     r.upper_sideband_db = Some(db(au));
+    spectral_estimate(&mut r, d, seg.clone());
     r.spectrum = (((0.5 * f1) / df) as usize..((1.5 * f1) / df).min(amp.len() as f64) as usize)
         .map(|k| (k as f64 * df, db(amp[k])))
         .collect();
@@ -345,7 +470,11 @@ mod tests {
         let n = x.len();
         let nfft = (4 * n).next_power_of_two();
         let mean = x.iter().sum::<f64>() / n as f64;
-        let w = |k: usize| 0.5 - 0.5 * (2.0 * PI * k as f64 / n as f64).cos();
+        // 4-term Blackman-Harris (Harris 1978, table I).
+        let w = |k: usize| {
+            let x = 2.0 * PI * k as f64 / n as f64;
+            0.35875 - 0.48829 * x.cos() + 0.14128 * (2.0 * x).cos() - 0.01168 * (3.0 * x).cos()
+        };
         let wsum: f64 = (0..n).map(w).sum();
         let mut buf = vec![Complex::new(0.0, 0.0); nfft];
         for k in 0..n {
@@ -368,6 +497,40 @@ mod tests {
         let (_, short) = spectrum(&mut rustfft::FftPlanner::new(), &x, dt, 60.0);
         assert!(short.len() as f64 * df >= 60.0 && short.len() < nfft / 2);
         assert_eq!(short[..], amp[..short.len()]);
+    }
+
+    #[test]
+    fn the_resolution_rule_keeps_the_search_clear_of_the_main_lobe() {
+        // Leakage of a tone 4.2 bins off (between bins, 4x padded) below -90 dB; a tone
+        // 80 dB down 5 bins off read within 0.5 dB.
+        let (dt, n) = (1e-3, 2000);
+        let x: Vec<f64> = (0..n)
+            .map(|k| {
+                let t = k as f64 * dt;
+                (2.0 * PI * 50.3 * t).cos() + 1e-4 * (2.0 * PI * 52.8 * t).cos()
+            })
+            .collect();
+        let (df, amp) = spectrum(&mut rustfft::FftPlanner::new(), &x, dt, 100.0);
+        let (_, a1) = peak(df, &amp, 50.3, 0.3);
+        let (_, a2) = peak(df, &amp, 52.8, 0.5);
+        let far = peak(df, &amp, 48.0, 0.2).1;
+        assert!(20.0 * (far / a1).log10() < -90.0, "{far}");
+        assert!((20.0 * (a2 / a1).log10() + 80.0).abs() < 0.5, "{a2}");
+    }
+
+    #[test]
+    fn spectral_delta_inverts_the_backward_current_relation() {
+        // n broken bars of N: r = n / (N - 2n) of the torque current, split between the
+        // two sidebands; the delta it gives is Kliman's 3n / (N - 3n).
+        for (n, nb, q, split) in [(1.0, 28.0, 0.8, 0.7), (2.0, 40.0, 0.6, 0.9)] {
+            let r = n / (nb - 2.0 * n);
+            let db = |x: f64| 20.0 * (x * q).log10();
+            let d = spectral_delta(db(split * r), db((1.0 - split) * r), q).unwrap();
+            assert!((d - 3.0 * n / (nb - 3.0 * n)).abs() < 1e-9, "{d}");
+        }
+        assert!(spectral_delta(-3.0, -3.0, 0.5).is_none());
+        assert!(fit_and_spectrum_agree(0.2, 0.15) && !fit_and_spectrum_agree(0.2, 0.05));
+        assert!(!fit_and_spectrum_agree(0.01, 1e-5));
     }
 
     #[test]

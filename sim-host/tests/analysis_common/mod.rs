@@ -96,6 +96,33 @@ pub fn motor(which: &str) -> ParamFile {
     }
 }
 
+/// Rated torque of the reference motors [N m] (3 hp: 2238 W at about 1750 rpm; 2.2 kW:
+/// the reference scenario's load, `examples/scenarios/reference_2p2kw.toml`).
+pub fn rated_nm(which: &str) -> f64 {
+    if which == "3hp" {
+        12.2
+    } else {
+        14.6
+    }
+}
+
+/// A direct-on-line start at no load, `load` times the rated torque ([`rated_nm`])
+/// switched on at the settle time ([`settle_s`]), logged at `rate_hz` for `duration_s`.
+pub fn loaded_start(which: &str, load: f64, duration_s: f64, rate_hz: f64) -> Scenario {
+    let mut s = Scenario::steady(duration_s, rate_hz);
+    s.load = LoadSpec {
+        kind: LoadKind::Torque,
+        torque_nm: Some(0.0),
+        bl_nms: None,
+        steps: vec![LoadStep {
+            t_s: settle_s(which),
+            torque_nm: Some(load * rated_nm(which)),
+            bl_scale: None,
+        }],
+    };
+    s
+}
+
 /// Time for the direct-on-line start to settle [s] (analyses start here).
 pub fn settle_s(which: &str) -> f64 {
     match which {
