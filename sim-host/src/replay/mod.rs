@@ -419,8 +419,9 @@ impl Replay {
         // the learned ones are in force are not detections: the window says the nominal
         // parameters are not to be trusted (a sensor fault counts at any time).
         let counts = out.sensor_fault.any() || self.commission.thresholds_trusted(&out);
-        // The bands only matter (and are only looked up) while the gate holds the lamps.
-        let bands = if out.quasi_steady {
+        // The bands only matter (and are only looked up) while the gate holds the lamps or a
+        // lamp is lit.
+        let bands = if out.quasi_steady && !out.fault_detected {
             [(0.0, 0.0); 4]
         } else {
             mon.threshold_bands()
@@ -428,7 +429,11 @@ impl Replay {
         self.unsettled.after(
             t,
             &out,
-            bands,
+            if out.quasi_steady {
+                [(0.0, 0.0); 4]
+            } else {
+                bands
+            },
             self.evaluated,
             self.commission.thresholds_trusted(&out),
         );
@@ -447,8 +452,13 @@ impl Replay {
             self.learned_unbalance = Some(self.unbalance_ratios().0);
         }
         if out.fault_detected && counts {
+            // A detection counts as one inside the commissioned range only while the lamps
+            // are evaluated (quasi-steady) and a lit lamp's residual is outside its band: a
+            // lamp held through a transient, or after its residual came back (the load
+            // returned into the range), detects nothing new there.
+            let current = out.evaluating && lit_outside_band(&out, bands);
             self.detected_in_range |=
-                out.sensor_fault.any() || !self.commission.outside_learned_range(&out);
+                out.sensor_fault.any() || (current && !self.commission.outside_learned_range(&out));
             if self.first_detection.is_none() {
                 self.first_detection = Some(t);
             }
@@ -537,6 +547,15 @@ impl Replay {
     pub fn commissioning_incomplete(&self) -> bool {
         self.monitor.is_some() && self.commission.incomplete()
     }
+}
+
+/// Whether a lit lamp's residual lies outside its band `(centre, half-width)` now.
+fn lit_outside_band(out: &MonitorOutput, bands: [(f32, f32); 4]) -> bool {
+    out.lamps
+        .iter()
+        .zip(out.residuals)
+        .zip(bands)
+        .any(|((lit, r), (c, h))| *lit && (r - c).abs() > h)
 }
 
 /// Serialises an angle source by its command-line name ([`angle_source_name`]).
