@@ -124,6 +124,15 @@ pub(super) struct IsolationTracker {
     last_point: SteadyPoint,
     /// A lamp lit while lamps counted.
     lamps_lit: bool,
+    /// The operating points kept since a deviation, and their joint isolation.
+    evidence: super::evidence::Evidence,
+}
+
+/// Whether `iso` names a fault (the friction class does not count: to the paper's model a
+/// load change is a Bl change, and the joint fit over operating points, which treats the
+/// load as an unknown input, may name the electrical fault behind it).
+fn names_a_fault(iso: &Isolation) -> bool {
+    matches!(iso.named(), Some(Named::Fault(_)))
 }
 
 /// How far a parameter file's values may be off the machine's (nameplate estimates are
@@ -145,6 +154,7 @@ impl IsolationTracker {
             end_t: 0.0,
             last_point: SteadyPoint::default(),
             lamps_lit: false,
+            evidence: super::evidence::Evidence::default(),
         }
     }
 
@@ -177,8 +187,17 @@ impl IsolationTracker {
         // Quasi-steady by the vectors themselves (the monitor's gate follows its own frame,
         // which a sensor fault can detune).
         if let Step::Isolated(result) = follower.observe(point, dt_s as f32, usable, learning) {
+            self.evidence.after(follower, &result);
+            // A fault one point cannot name may be named from several (evidence across
+            // operating points).
+            let joint = self
+                .evidence
+                .named()
+                .filter(|_| !names_a_fault(&result))
+                .and_then(|(j, _)| j.named());
             let named = result
                 .named()
+                .or(joint)
                 .filter(|n| learned || self.lamps_lit || !within_nominal_uncertainty(n));
             if let Some(n) = named {
                 let given = NameGiven {
@@ -220,6 +239,25 @@ impl IsolationTracker {
         (rise.abs() >= REPORTED_RISE_K).then_some(rise)
     }
 
+    /// The sentence of a winding that warmed (a tracked rise of at least
+    /// [`REPORTED_RISE_K`]) when the isolation finds no deviation from the warm machine.
+    fn heating_sentence(&self, state: IsolationState) -> Option<String> {
+        let rise = self
+            .winding_rise_k()
+            .filter(|_| state == IsolationState::NoDeviation)?;
+        let withdrawn = self.first_named.map_or(String::new(), |g| {
+            format!(
+                " ({} was named at {:.2} s while the tracked temperature lagged, and withdrawn.)",
+                g.name, g.t_s
+            )
+        });
+        Some(format!(
+            "The windings warmed by {rise:.0} K since commissioning (Rs and Rr {} together, copper 0.393 %/K): heating, not a fault; the warm machine's steady-state equations fit{}.{withdrawn}",
+            pct(rise * monitor_core::isolation::COPPER_ALPHA_PER_K),
+            if self.lamps_lit { "; the lamps lit because their residuals were learned on the cold machine" } else { "" }
+        ))
+    }
+
     /// The lamps' detections, and any name given on the way, are explained by the
     /// winding's heating: the last isolation found no deviation from the machine at its
     /// tracked (warmer) temperature, which has risen by at least [`REPORTED_RISE_K`] (a
@@ -245,7 +283,7 @@ impl IsolationTracker {
     /// [`LIST_FROM`] on) when `detected` (a lamp lit or a sensor fault was seen).
     pub(super) fn report(&self, detected: bool) -> (IsolationReport, Vec<FaultCandidate>) {
         let learned = self.follower.as_ref().is_some_and(Follower::learned);
-        let Some(iso) = self.follower.as_ref().and_then(|f| f.last().copied()) else {
+        let Some(single) = self.follower.as_ref().and_then(|f| f.last().copied()) else {
             let why = if self.follower.is_none() {
                 "the parameter file's machine cannot be used by the isolation"
             } else {
@@ -253,6 +291,13 @@ impl IsolationTracker {
             };
             return (IsolationReport::not_judged(why, learned), Vec::new());
         };
+        // The joint isolation over the operating points kept, where it names a fault that
+        // the last point alone does not.
+        let joint = self
+            .evidence
+            .named()
+            .filter(|_| !names_a_fault(&single) && single.state != IsolationState::NoDeviation);
+        let iso = joint.map_or(single, |(j, _)| j);
         // An unknown fault lists its three nearest candidates only.
         let listed = if iso.state == IsolationState::Unknown {
             3
@@ -296,19 +341,17 @@ impl IsolationTracker {
                     self.last_t,
                     self.end_t - self.last_t
                 )
-            } else if let (Some(rise), IsolationState::NoDeviation) =
-                (self.winding_rise_k(), iso.state)
-            {
-                format!(
-                    "The windings warmed by {rise:.0} K since commissioning (Rs and Rr {} together, copper 0.393 %/K): heating, not a fault; the warm machine's steady-state equations fit{}.",
-                    pct(rise * monitor_core::isolation::COPPER_ALPHA_PER_K),
-                    if self.lamps_lit { "; the lamps lit because their residuals were learned on the cold machine" } else { "" }
-                ) + &self.first_named.map_or(String::new(), |g| format!(
-                    " ({} was named at {:.2} s while the tracked temperature lagged, and withdrawn.)",
-                    g.name, g.t_s
-                ))
+            } else if let Some(warm) = self.heating_sentence(iso.state) {
+                warm
             } else {
-                verdict_sentence(&iso, detected, moved)
+                let s = verdict_sentence(&iso, detected, moved);
+                match joint {
+                    Some((_, n)) => format!(
+                        "{} (from {n} operating points together, the stator-voltage equations only: the load as an unknown input)",
+                        s.trim_end_matches('.')
+                    ),
+                    None => s,
+                }
             },
             moved_from_learned: moved,
             winding_rise_k: self.winding_rise_k(),
@@ -630,10 +673,10 @@ fn groups(iso: &Isolation) -> Vec<IsolationGroup> {
 fn pair_reason(a: Fault, b: Fault, sep_deg: f32) -> String {
     let pair = |x: Fault, y: Fault| (a == x && b == y) || (a == y && b == x);
     if pair(Fault::Rr, Fault::SpeedSensor) {
-        format!("in steady state the rotor circuit depends on Rr/slip only, so an Rr change and a small speed-sensor gain error change the currents alike (directions {sep_deg:.1} deg apart); only the torque balance with the assumed viscous load, or a speed transient, tells them apart")
+        format!("in steady state the rotor circuit depends on Rr/slip only, so an Rr change and a small speed-sensor gain error change the currents alike (directions {sep_deg:.1} deg apart); only the torque balance with the assumed viscous load, a speed transient, or a load change of 20 % or more (the isolation then fits the operating points together) tells them apart")
     } else if pair(Fault::CurrentSensor, Fault::VoltageSensor) {
         format!("both scale the measured impedance V/I; only the torque balance separates them, and it is weak at light load (directions {sep_deg:.1} deg apart)")
     } else {
-        format!("their directions in the residual space are {sep_deg:.1} deg apart at this operating point; at another load they may separate")
+        format!("their directions in the residual space are {sep_deg:.1} deg apart at this operating point; a load change of 20 % or more may separate them (the isolation then fits the operating points together)")
     }
 }

@@ -22,6 +22,7 @@
 
 mod commission;
 mod diagnose;
+mod evidence;
 mod isolation;
 mod pipe;
 mod report;

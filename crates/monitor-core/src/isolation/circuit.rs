@@ -26,6 +26,21 @@ pub(super) struct Sym3 {
 }
 
 impl Sym3 {
+    /// The weight of the two voltage residuals alone, the torque balance left out (the load
+    /// as an unknown input): the inverse of the d-q block of this weight's covariance, with
+    /// zero weight on `e_T`; `None` when a matrix is singular.
+    pub(super) fn voltage_only(&self) -> Option<Self> {
+        let mut s = self.inverse()?;
+        s.xz = 0.0;
+        s.yz = 0.0;
+        s.zz = 1.0;
+        let mut w = s.inverse()?;
+        w.xz = 0.0;
+        w.yz = 0.0;
+        w.zz = 0.0;
+        Some(w)
+    }
+
     /// `diag(1/s^2)`: the weight of independent spreads `s`.
     pub(super) fn diagonal_weight(s: &ParityResiduals) -> Self {
         let [a, b, c] = s.to_array();

@@ -327,6 +327,17 @@ impl Follower {
         }
     }
 
+    /// The averaged operating point the latest isolation judged, with its spread scale
+    /// `sqrt(AVERAGE_MAX_S / averaged)` (the evidence [`Isolator::isolate_points`] combines);
+    /// `None` before [`AVERAGE_S`] of steady running.
+    pub fn averaged(&self) -> Option<(SteadyPoint, f32)> {
+        let averaged_s = self.filled as f32 * STEP_S;
+        if averaged_s < AVERAGE_S - 0.5 * STEP_S {
+            return None;
+        }
+        Some((self.mean()?, crate::sqrt(AVERAGE_MAX_S / averaged_s)))
+    }
+
     /// The latest isolation in force, if any was made.
     pub fn last(&self) -> Option<&Isolation> {
         self.last.as_ref()

@@ -378,50 +378,83 @@ impl Isolator {
     }
 
     /// Best factor `k` for fault `f`: geometric grid, then golden section around the best
-    /// grid point. Returns `(chi2, k)`. Not inlined: one copy for the nine faults keeps
-    /// the firmware's flash small (it runs in thread mode, where a call costs nothing).
+    /// grid point ([`fit_factor`]). Returns `(chi2, k)`. Not inlined: one copy for the nine
+    /// faults keeps the firmware's flash small (it runs in thread mode, where a call costs
+    /// nothing).
     #[inline(never)]
     fn fit(&self, p: &SteadyPoint, f: Fault, w: &Sym3) -> (f32, f32) {
-        let step = F32Ext::powf(K_MAX / K_MIN, 1.0 / (GRID - 1) as f32);
-        let (mut best_k, mut best_c) = (1.0f32, self.chi2_at(p, Some((f, 1.0)), w));
-        let mut k = K_MIN;
-        for _ in 0..GRID {
-            let c = self.chi2_at(p, Some((f, k)), w);
-            if c < best_c {
-                (best_k, best_c) = (k, c);
-            }
-            k *= step;
-        }
-        let (mut lo, mut hi) = (
-            crate::maxf(best_k / step, K_MIN),
-            crate::minf(best_k * step, K_MAX),
-        );
-        const G: f32 = 0.618_034;
-        let mut x1 = hi - G * (hi - lo);
-        let mut x2 = lo + G * (hi - lo);
-        let (mut c1, mut c2) = (
-            self.chi2_at(p, Some((f, x1)), w),
-            self.chi2_at(p, Some((f, x2)), w),
-        );
-        for _ in 0..GOLDEN_STEPS {
-            if c1 < c2 {
-                hi = x2;
-                (x2, c2) = (x1, c1);
-                x1 = hi - G * (hi - lo);
-                c1 = self.chi2_at(p, Some((f, x1)), w);
+        fit_factor(|k| self.chi2_at(p, Some((f, k)), w))
+    }
+
+    /// Isolates the fault from several steady operating points together (evidence across
+    /// operating points): each hypothesis' misfit is the sum of its misfits at the points,
+    /// each point weighted at itself ([`Isolator::weight`], its spreads times its
+    /// `spread_scale` >= 1) and fitted with one size for all. The load at each point is an
+    /// unknown input: only the stator-voltage equations (`e_d`, `e_q`) count, the torque
+    /// balance (which holds only for the load model assumed) is left out, so B and Bl are
+    /// not judged here. Faults whose directions
+    /// coincide at one operating point (Ls, Rr and the speed sensor near rated load) part
+    /// at another. The heating hypothesis takes part as in [`Isolator::isolate`]. At most
+    /// [`MAX_POINTS`] points are used (the first ones); none usable gives
+    /// [`IsolationState::NotJudged`].
+    pub fn isolate_points(&self, points: &[(SteadyPoint, f32)]) -> Isolation {
+        let mut out = Isolation::default();
+        let mut used = [(SteadyPoint::default(), Sym3::default()); MAX_POINTS];
+        let mut n = 0;
+        for (p, scale) in points.iter().take(MAX_POINTS) {
+            let k = if scale.is_finite() {
+                crate::maxf(*scale, 1.0)
             } else {
-                lo = x1;
-                (x1, c1) = (x2, c2);
-                x2 = lo + G * (hi - lo);
-                c2 = self.chi2_at(p, Some((f, x2)), w);
+                1.0
+            };
+            let mut scaled = *self;
+            scaled.baseline.spread = scaled.baseline.spread.map(|s| s * k);
+            if self.residuals(p, None).is_none() {
+                continue;
+            }
+            let Some(w) = scaled.weight(p).voltage_only() else {
+                continue;
+            };
+            if let Some(slot) = used.get_mut(n) {
+                *slot = (*p, w);
+                n += 1;
             }
         }
-        for (c, x) in [(c1, x1), (c2, x2)] {
-            if c < best_c {
-                (best_k, best_c) = (x, c);
-            }
+        let used = used.get(..n).unwrap_or(&[]);
+        let Some((first, _)) = used.first() else {
+            return out;
+        };
+        let chi = |h: Option<(Fault, f32)>| -> f32 {
+            used.iter().map(|(p, w)| self.chi2_at(p, h, w)).sum()
+        };
+        let chi0 = chi(None);
+        out.deviation = crate::sqrt(chi0);
+        if let Some(e0) = self.residuals(first, None) {
+            out.residuals = e0 - self.baseline.mean;
         }
-        (best_c, best_k)
+        // Each point adds two or three equations: the detection threshold grows with them.
+        if chi0 < DETECT_CHI2 * n as f32 {
+            out.state = IsolationState::NoDeviation;
+            return out;
+        }
+        let mut fits = [(0.0f32, 1.0f32); FAULT_COUNT];
+        for (fit, f) in fits.iter_mut().zip(Fault::ALL) {
+            *fit = fit_factor(|k| chi(Some((f, k))));
+        }
+        let heat = golden(
+            |k| {
+                let warm = self.warmer(k);
+                used.iter().map(|(p, w)| warm.chi2_at(p, None, w)).sum()
+            },
+            HEATING_K_MIN / self.heating_factor,
+            HEATING_K_MAX / self.heating_factor,
+            HEATING_STEPS,
+        );
+        rank(&mut out, &mut fits, heat, chi0);
+        if let Some(e0) = self.residuals(first, None) {
+            out.separation_deg = self.separation(first, &e0, &out.candidates);
+        }
+        out
     }
 
     /// Angle between the top two candidates' weighted directions `e(f, k*) - e(nominal)`
@@ -571,6 +604,36 @@ fn rank(out: &mut Isolation, fits: &mut [(f32, f32); FAULT_COUNT], heat: (f32, f
     } else {
         IsolationState::Isolated
     };
+}
+
+/// Most operating points [`Isolator::isolate_points`] combines.
+pub const MAX_POINTS: usize = 4;
+
+/// Best factor `k` of a misfit `chi(k)` over [`K_MIN`]..[`K_MAX`]: a geometric grid of
+/// [`GRID`] points (and `k = 1`), then [`GOLDEN_STEPS`] of golden section around the best
+/// grid point. Returns `(chi2, k)`.
+fn fit_factor(chi: impl Fn(f32) -> f32) -> (f32, f32) {
+    let step = F32Ext::powf(K_MAX / K_MIN, 1.0 / (GRID - 1) as f32);
+    let (mut best_k, mut best_c) = (1.0f32, chi(1.0));
+    let mut k = K_MIN;
+    for _ in 0..GRID {
+        let c = chi(k);
+        if c < best_c {
+            (best_k, best_c) = (k, c);
+        }
+        k *= step;
+    }
+    let (c, x) = golden(
+        &chi,
+        crate::maxf(best_k / step, K_MIN),
+        crate::minf(best_k * step, K_MAX),
+        GOLDEN_STEPS,
+    );
+    if c < best_c {
+        (c, x)
+    } else {
+        (best_c, best_k)
+    }
 }
 
 /// Sorts candidates by probability, most probable first (insertion sort: nine entries,

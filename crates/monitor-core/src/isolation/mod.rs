@@ -111,6 +111,7 @@ pub use follower::{
 };
 mod circuit;
 mod isolator;
+pub use isolator::MAX_POINTS;
 
 use circuit::{Circuit, Sym3};
 

@@ -539,3 +539,63 @@ fn heating_is_explained_and_no_table1_fault_is_taken_for_it() {
         }
     }
 }
+
+/// Evidence across operating points: on the 3 hp motor at rated load an Ls change moves the
+/// residuals where an Rr change and a small speed-sensor error do, so one point cannot name
+/// it; the same machine seen also at 0.7 and 0.5 of the load separates them, and
+/// `isolate_points` names ls with its size. A fault that one point already names keeps its
+/// name and size with more points.
+#[test]
+fn faults_that_coincide_at_one_point_part_over_several() {
+    let (_, m, v, we) = machines()[1];
+    let iso = Isolator::new(m.model(), v as f32, (we / core::f64::consts::TAU) as f32).unwrap(); // ok: test
+    let at_load = |f: Fault, k: f64, load: f64| {
+        let mut t = faulty(&m, Some(f), k);
+        t.bl_nms *= load;
+        (measure(&t, v, we, Some(f), k), 1.0f32)
+    };
+    for k in [1.5, 0.5] {
+        let one = iso.isolate(&at_load(Fault::Ls, k, 1.0).0);
+        std::eprintln!(
+            "3 hp ls x{k} at one point: {:?}",
+            one.candidates[..3]
+                .iter()
+                .map(|c| (c.fault, c.probability))
+                .collect::<std::vec::Vec<_>>()
+        );
+        assert!(one.named().is_none(), "one point: {one:?}");
+        let pts = [
+            at_load(Fault::Ls, k, 1.0),
+            at_load(Fault::Ls, k, 0.7),
+            at_load(Fault::Ls, k, 0.5),
+        ];
+        let joint = iso.isolate_points(&pts);
+        std::eprintln!(
+            "3 hp ls x{k} at three points: {:?}",
+            joint.candidates[..3]
+                .iter()
+                .map(|c| (c.fault, c.probability, c.change))
+                .collect::<std::vec::Vec<_>>()
+        );
+        match joint.named() {
+            Some(Named::Fault(c)) => {
+                assert_eq!(c.fault, Fault::Ls);
+                assert!(
+                    (f64::from(c.change) - (k - 1.0)).abs() <= 0.1 * (k - 1.0).abs(),
+                    "{c:?}"
+                );
+            }
+            other => panic!("three points: {other:?} {joint:?}"),
+        }
+    }
+    for f in [Fault::Rs, Fault::Rr, Fault::SpeedSensor] {
+        let pts = [at_load(f, 1.3, 1.0), at_load(f, 1.3, 0.7)];
+        let joint = iso.isolate_points(&pts);
+        match joint.named() {
+            Some(Named::Fault(c)) if c.fault == f => {
+                assert!((c.change - 0.3).abs() <= 0.03, "{f}: {c:?}")
+            }
+            other => panic!("{f}: {other:?}"),
+        }
+    }
+}

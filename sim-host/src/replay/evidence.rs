@@ -1,0 +1,90 @@
+//! Evidence across operating points: once the isolation sees a deviation, the steady
+//! operating points the motor visits are kept (one per load level) and every hypothesis is
+//! fitted over all of them together (`monitor_core::isolation::Isolator::isolate_points`,
+//! the stator-voltage equations only: the load at each point is an unknown input). Faults
+//! that coincide at one point (on the 3 hp motor at rated load Ls, Rr and the speed sensor)
+//! part over two load levels 20 % apart or more.
+
+use monitor_core::isolation::{
+    Follower, Isolation, IsolationState, Named, SteadyPoint, MAX_POINTS,
+};
+
+/// Smallest relative difference of the load (the active current) between two kept points:
+/// 15 %, so that two points are two operating points and not one seen twice.
+pub const LEVEL_APART: f32 = 0.15;
+
+/// The active current of a steady point (its current's part in phase with its voltage) [A].
+fn active_current(p: &SteadyPoint) -> f32 {
+    let v = p.v.d.hypot(p.v.q);
+    if v > 0.0 {
+        (p.v.d * p.i.d + p.v.q * p.i.q) / v
+    } else {
+        f32::NAN
+    }
+}
+
+/// The kept points and the joint isolation over them.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Evidence {
+    points: Vec<(SteadyPoint, f32)>,
+    joint: Option<Isolation>,
+}
+
+impl Evidence {
+    /// After an isolation `result` of the follower: a deviation keeps the averaged point
+    /// (replacing the one at its load level, else added, the oldest dropped beyond
+    /// [`MAX_POINTS`]) and refits jointly; no deviation forgets the evidence.
+    pub(super) fn after(&mut self, follower: &Follower, result: &Isolation) {
+        if !matches!(
+            result.state,
+            IsolationState::Isolated | IsolationState::Unknown
+        ) || result.heating_explains()
+        {
+            self.points.clear();
+            self.joint = None;
+            return;
+        }
+        let Some((p, scale)) = follower.averaged() else {
+            return;
+        };
+        let a = active_current(&p);
+        if !a.is_finite() {
+            return;
+        }
+        let same_level = self.points.iter().position(|(q, _)| {
+            let b = active_current(q);
+            (a - b).abs() < LEVEL_APART * b.abs().max(a.abs())
+        });
+        match same_level {
+            Some(k) => {
+                if let Some(slot) = self.points.get_mut(k) {
+                    *slot = (p, scale);
+                }
+            }
+            None => {
+                if self.points.len() >= MAX_POINTS {
+                    self.points.remove(0);
+                }
+                self.points.push((p, scale));
+            }
+        }
+        self.joint =
+            (self.points.len() >= 2).then(|| follower.isolator().isolate_points(&self.points));
+    }
+
+    /// The joint isolation when it names a fault (not the friction class, which the
+    /// voltage equations cannot judge) that explains every point within the healthy
+    /// scatter (its misfit within `sqrt(16 n)` for n points), and the number of points.
+    pub(super) fn named(&self) -> Option<(Isolation, usize)> {
+        let j = self.joint?;
+        let n = self.points.len();
+        match j.named()? {
+            Named::Fault(c)
+                if c.misfit * c.misfit <= monitor_core::isolation::DETECT_CHI2 * n as f32 =>
+            {
+                Some((j, n))
+            }
+            _ => None,
+        }
+    }
+}
