@@ -24,6 +24,7 @@ use crate::flash_record::{self, CalibrationRecord, RecordStore, Stored};
 use crate::liveness::{LivenessChange, SampleWatch};
 use crate::offset_trim::{OffsetTrim, TrimResult};
 use crate::panel::{self, blink_code, winding_code, Mode, PanelInput, PanelLamps, NOT_NAMED_CODE};
+use crate::range_watch::RangeWatch;
 use crate::reset_record::PreviousRun;
 use crate::sampling::{AdcSampler, RawFrame, SamplingError, TICK_HZ};
 use monitor_core::isolation::{Baseline, Follower, Named, Step};
@@ -286,6 +287,13 @@ pub struct MonitorStatus {
     /// winding's part of `|I2/I1|` (the supply's unbalance taken out; named only above a
     /// healthy machine's own asymmetry, `monitor_core::sequence::INHERENT_ASYMMETRY_RATIO`).
     pub winding: Option<(Phase, f32)>,
+    /// The filtered `V_ds` [V] (with `operating`: the operating point without the frame's
+    /// angle, [`RangeWatch::point`]).
+    pub vds: f32,
+    /// The operating point has left the commissioned range: set by [`Supervisor::tick`]
+    /// ([`RangeWatch::moved`]), false as the sample path hands it ([`panel_input`] shows
+    /// the amber state only when no fault is named).
+    pub moved: bool,
 }
 
 /// The isolation in the status line's words (docs/firmware.md, "The status line"): the label
@@ -337,7 +345,9 @@ pub fn panel_input(
             .map_or(NOT_NAMED_CODE, |(f, _)| blink_code(f.index() as u8)),
     };
     let named_fault = matches!(named, Some(Named::Fault(_)));
-    let other_fault = status.fault_detected || (named_fault && status.commissioned);
+    // The amber "operating point moved" state: no FAULT lamp for the lamps (panel docs).
+    let moved = status.moved && !named_fault && !status.sensor_fault.any();
+    let other_fault = !moved && (status.fault_detected || (named_fault && status.commissioned));
     // Shorted turns blink their own code while nothing else is shown.
     let (fault_detected, fault_code) = match status.winding {
         Some((phase, _)) if !other_fault && !status.sensor_fault.any() => {
@@ -353,6 +363,7 @@ pub fn panel_input(
         fault_code,
         commissioning_failed,
         default_motor: false,
+        moved,
     }
 }
 
@@ -504,6 +515,8 @@ impl SamplePath {
                 .unbalance
                 .suspect_phase
                 .map(|p| (p, o.unbalance.winding_ratio)),
+            vds: o.vds,
+            moved: false,
         }
     }
 }
@@ -544,6 +557,8 @@ pub struct Supervisor {
     default_motor: bool,
     /// Sensors whose start-up offset was out of bound ([`Supervisor::set_offset_fault`]).
     offset_fault: SensorFlags,
+    /// The commissioned operating range (RAM only) and the "moved" judgement.
+    range: RangeWatch,
 }
 
 impl Supervisor {
@@ -574,6 +589,7 @@ impl Supervisor {
             running: false,
             default_motor: false,
             offset_fault: SensorFlags::default(),
+            range: RangeWatch::new(),
         }
     }
 
@@ -645,6 +661,11 @@ impl Supervisor {
         }
     }
 
+    /// The commissioned operating range and the "moved" judgement.
+    pub fn range(&self) -> &RangeWatch {
+        &self.range
+    }
+
     /// The latest status from the sample task.
     pub fn latest(&self) -> &MonitorStatus {
         &self.latest
@@ -664,6 +685,7 @@ impl Supervisor {
             let previous = self.latest.samples;
             self.latest = s;
             self.follow(&s, previous);
+            self.range.observe(&s);
         }
         let watch = self.watch.poll(self.latest.samples, now_ms);
         let pressed = button
@@ -683,6 +705,9 @@ impl Supervisor {
                 let step = self.procedure.on_status(&self.latest.run, now_ms);
                 action = step.action;
                 run_ended = step.ended;
+            }
+            if let Some(RunEnd::Commissioned { run }) = run_ended {
+                self.range.commit(run);
             }
         }
         if let Action::Store { record, .. } = &mut action {
@@ -713,6 +738,7 @@ impl Supervisor {
             .as_ref()
             .filter(|f| f.learned())
             .and_then(Follower::last);
+        self.latest.moved = self.range.moved(&self.latest);
         let input = PanelInput {
             default_motor: self.default_motor,
             ..panel_input(mode, &self.latest, learned, failed)

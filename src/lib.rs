@@ -50,6 +50,7 @@ pub mod liveness;
 pub mod motor_source;
 pub mod offset_trim;
 pub mod panel;
+pub mod range_watch;
 pub mod recovery;
 pub mod reset_record;
 pub mod sampling;

@@ -11,6 +11,7 @@
 //! |---|---|
 //! | 1 Hz blink (500 ms on / 500 ms off) | monitoring, commissioned (learned thresholds in force) |
 //! | double flash (100 on, 100 off, 100 on, 1700 off) | monitoring, NOT commissioned (no valid record: default thresholds) |
+//! | triple flash (100 on, 100 off, 100 on, 100 off, 100 on, 1500 off) | OPERATING POINT MOVED (the "amber" state): commissioned, but the load or the voltage is more than 20 % outside the range the commissioning run saw, and the isolation names no fault; residual lamps may be lit, the FAULT lamp stays off for them (below) |
 //! | 5 Hz blink (100 on / 100 off) | commissioning (learning healthy thresholds, then storing them) |
 //! | all six lamps flash together at 2 Hz (250 ms on / 250 ms off) | SAMPLING STALLED: no samples arrive; the lamps show no monitoring result; the firmware restarts sampling, the watchdog resets the MCU if that fails |
 //! | off, all five other lamps steady on | MONITOR FAILED (a panic or a watchdog reset; for 5 s after the reset, see the defmt log) |
@@ -26,11 +27,23 @@
 //! everything else on" cannot be mistaken for a normal state; and only a stalled sample
 //! path flashes the residual lamps (they are steady otherwise).
 //!
+//! **Operating point moved.** While commissioning learns, the board records the span of
+//! the load (the active current, in phase with the voltage) and of the voltage magnitude,
+//! both measured without the d-q frame's angle (`crate::range_watch`, the core's
+//! `monitor_core::operating_range`: the same rule as the host's `diagnose` and HMI). When
+//! afterwards either is more than 20 % of the span's largest magnitude outside it, the
+//! learned healthy means no longer hold (to the paper's model a load change is a Bl
+//! change): lit residual lamps are then no fault by themselves. Unless the isolation names
+//! a fault (the friction class B/Bl does not count, a load change is one) or a sensor
+//! fault is flagged, the FAULT lamp stays off and the RUN lamp triple-flashes instead of
+//! its 1 Hz blink; the status line says `moved=true`. The span lives in RAM only: after
+//! a reset without a new commissioning run the board does not judge "moved".
+//!
 //! # FAULT lamp and blink code
 //!
 //! | pattern | meaning |
 //! |---|---|
-//! | off | no fault detected |
+//! | off | no fault detected (also in the "operating point moved" state, above) |
 //! | steady on | input invalid: ADC saturated or a sensor fault flagged by the core, no isolation |
 //! | N blinks (250 ms on / 250 ms off), then 1.5 s dark, repeating | fault detected, blink code N (table below) |
 //! | 10 Hz flicker | the last commissioning failed (no progress, unusable statistics or not stored) and no fault is shown; the RUN lamp says which thresholds are in force; press the button to retry |
@@ -161,6 +174,10 @@ pub struct PanelInput {
     /// The built-in default motor is monitored (no valid motor record): the RUN lamp's
     /// steady 2 s of every 10 s (module docs).
     pub default_motor: bool,
+    /// Commissioned, and the operating point (load or voltage) has left the commissioned
+    /// range with no fault named: the RUN lamp's triple flash, the "amber" state (module
+    /// docs). The application clears `fault_detected` for the lamps' detection then.
+    pub moved: bool,
 }
 
 /// Blink code of a fault detected that the isolation did not name (module docs).
@@ -215,6 +232,13 @@ fn run_lamp(mode: Mode, t_ms: u32) -> bool {
     }
 }
 
+/// The RUN lamp's "operating point moved" pattern: three 100 ms flashes 100 ms apart,
+/// then 1.5 s dark (period 2 s).
+fn moved_run_lamp(t_ms: u32) -> bool {
+    let p = t_ms % 2000;
+    p < 500 && p % 200 < 100
+}
+
 /// Lamp states for `input` at time `t_ms` (any monotonic millisecond clock; wraps).
 pub fn render(input: &PanelInput, t_ms: u32) -> PanelLamps {
     match input.mode {
@@ -227,6 +251,7 @@ pub fn render(input: &PanelInput, t_ms: u32) -> PanelLamps {
     let run = match input.default_motor {
         true if mark_phase < DEFAULT_MOTOR_ON_MS => true,
         true if mark_phase < DEFAULT_MOTOR_ON_MS + DEFAULT_MOTOR_GAP_MS => false,
+        _ if input.moved && input.mode == Mode::Commissioned => moved_run_lamp(t_ms),
         _ => run_lamp(input.mode, t_ms),
     };
     PanelLamps {
@@ -297,7 +322,14 @@ mod tests {
             fault_code: 4,
             commissioning_failed: false,
             default_motor: false,
+            moved: false,
         }
+    }
+
+    /// The RUN lamp's rising edges in one 2 s period.
+    fn run_flashes(inp: &PanelInput) -> usize {
+        let trace: Vec<bool> = (0..200u32).map(|k| render(inp, k * 10).run).collect();
+        trace.windows(2).filter(|w| !w[0] && w[1]).count() + usize::from(trace[0])
     }
 
     /// The longest time the RUN lamp is lit without a break in 20 s, ms.
@@ -416,5 +448,27 @@ mod tests {
             .map(|k| render(&inp, k * 50).is_on(Lamp::Fault))
             .collect();
         assert_eq!(read_blink_code(&trace, 50), Some(4));
+    }
+
+    #[test]
+    fn the_moved_state_triple_flashes_the_run_lamp_with_the_fault_lamp_off() {
+        let mut inp = input(Mode::Commissioned);
+        inp.fault_detected = false;
+        inp.residual_lamps = [false, true, true, true];
+        assert_eq!(run_flashes(&inp), 2, "commissioned: 1 Hz blink");
+        inp.moved = true;
+        assert_eq!(run_flashes(&inp), 3, "moved: triple flash");
+        let not = input(Mode::NotCommissioned);
+        assert_eq!(run_flashes(&not), 2, "not commissioned: double flash");
+        for k in 0..400u32 {
+            let p = render(&inp, k * 5);
+            assert!(!p.is_on(Lamp::Fault) && p.residuals == [false, true, true, true]);
+        }
+        // Only a commissioned monitor shows it: while learning the RUN lamp says so.
+        inp.mode = Mode::Commissioning;
+        assert_eq!(run_flashes(&inp), 10);
+        // The RUN lamp is never lit for more than 500 ms nor dark for more than 1.7 s.
+        inp.mode = Mode::Commissioned;
+        assert!(longest_run_on_ms(&inp) <= 500);
     }
 }

@@ -71,6 +71,7 @@ fn value(arg: &str) -> &'static str {
         "iso_p" => "0.93",
         "wind_name" => "b",
         "wind_i2" => "0.041",
+        "s.moved" => "true",
         other => panic!(
             "log_status prints `{other}`: give it a test value here and teach \
              sim_host::hmi::status_line to read it"
@@ -128,6 +129,7 @@ fn the_hmi_reads_every_field_the_firmware_prints() {
         })
     );
     assert_eq!(s.winding, Some((monitor_core::Phase::B, 0.041)));
+    assert_eq!(s.moved, Some(true));
     let snap = s.snapshot(0.0);
     assert_eq!(
         snap.asymmetry.map(|a| (a.phase, a.ratio)),
@@ -144,6 +146,18 @@ fn the_hmi_reads_every_field_the_firmware_prints() {
     assert!(snap.learned && snap.fault_lamp);
     assert_eq!(snap.sensor_faults, vec![Fault::VoltageSensor]);
     assert!(matches!(snap.state, MonitorState::Fault(_)));
+    // The same line with the friction class named (a load change, to the paper's model)
+    // and no sensor fault: the board's "operating point moved" state, no FAULT lamp; and
+    // `moved=false` keeps the fault.
+    let friction = line
+        .replace("iso=rr", "iso=b/bl")
+        .replace("sens=false,true,false", "sens=false,false,false");
+    let snap = status_line::parse(&friction).expect("read").snapshot(0.0);
+    assert!(matches!(snap.state, MonitorState::Moved(_)) && !snap.fault_lamp);
+    let snap = status_line::parse(&friction.replace("moved=true", "moved=false"))
+        .expect("read")
+        .snapshot(0.0);
+    assert!(matches!(snap.state, MonitorState::Fault(_)) && snap.fault_lamp);
 }
 
 #[test]

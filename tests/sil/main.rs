@@ -17,6 +17,7 @@
 mod commissioning;
 mod isolation;
 mod liveness;
+mod moved;
 mod recovery;
 mod startup;
 

@@ -66,6 +66,7 @@ pub mod isolation;
 pub mod machine;
 pub mod monitor;
 pub mod motor_record;
+pub mod operating_range;
 pub mod residuals;
 pub mod sequence;
 pub mod signature;
@@ -85,6 +86,7 @@ pub use monitor::{
     CommissioningState, Monitor, MonitorConfig, MonitorOutput, ResidualForm, Sample, SensorFlags,
     SensorLimits,
 };
+pub use operating_range::{OperatingPoint, OperatingRange};
 pub use residuals::Operating;
 pub use sequence::NegativeSequence;
 pub use signature::{Diagnosis, Fault, FAULT_COUNT, ROTOR_FLUX_SIGNATURES, TABLE1};

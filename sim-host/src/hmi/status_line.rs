@@ -70,6 +70,10 @@ pub struct FirmwareStatus {
     /// Shorted turns (`wind=`, `wind_i2=`): the phase named and the winding's part of
     /// |I2/I1|; `None` for `wind=none` or an older firmware.
     pub winding: Option<(monitor_core::Phase, f32)>,
+    /// The operating point has left the commissioned range (`moved=`, the firmware's
+    /// `RangeWatch::moved`); `None` from an older firmware. With no fault named (`iso=`)
+    /// the screen shows the amber "moved" state and no FAULT lamp, as the board's panel.
+    pub moved: Option<bool>,
 }
 
 /// The isolation fields of a status line (`iso=`, `iso_change=`, `iso_p=`; the firmware's
@@ -210,6 +214,7 @@ pub fn parse(line: &str) -> Option<FirmwareStatus> {
         winding: field(line, "wind")
             .and_then(monitor_core::Phase::from_name)
             .map(|p| (p, f("wind_i2").unwrap_or(0.0))),
+        moved: b("moved"),
     })
 }
 
@@ -229,6 +234,22 @@ impl FirmwareStatus {
             }
             _ => MonitorState::Healthy,
         };
+        let named_fault = self
+            .isolation
+            .as_ref()
+            .is_some_and(|i| matches!(i.view().named, Some(IsolationName::Fault(_))));
+        let sensor = self.sensors.is_some_and(|s| s.iter().any(|x| *x));
+        let state = match state {
+            MonitorState::Healthy | MonitorState::Fault(_)
+                if self.moved == Some(true) && !named_fault && !sensor =>
+            {
+                MonitorState::Moved(
+                    "the board says the load or the voltage left the commissioned range"
+                        .to_string(),
+                )
+            }
+            other => other,
+        };
         let sensor_faults = self.sensors.map_or(Vec::new(), |s| {
             [
                 Fault::CurrentSensor,
@@ -244,7 +265,7 @@ impl FirmwareStatus {
             t_s,
             residuals: self.residuals,
             lamps: self.lamps,
-            fault_lamp: self.fault,
+            fault_lamp: self.fault && !matches!(state, MonitorState::Moved(_)),
             bands: self.band.map(|(m, h)| [0, 1, 2, 3].map(|k| (m[k], h[k]))),
             learned: self.mode.as_deref() == Some("commissioned"),
             candidates: self.candidates.clone(),

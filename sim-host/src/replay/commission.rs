@@ -22,9 +22,14 @@
 //! ```
 //! (amplitude-invariant d-q: `|V|` is the phase voltage's peak, `I_active` the peak of
 //! the current's part in phase with the voltage, `P = 1.5 |V| I_active`), both unchanged
-//! by any rotation of the frame ([`operating_point`]).
+//! by any rotation of the frame ([`operating_point`]). The rule (the arithmetic, the span
+//! and the 20 % margin, `monitor_core::operating_range::RANGE_MARGIN`) is the core's
+//! `monitor_core::operating_range`, which the firmware's panel uses too.
 
-use monitor_core::{CommissioningState, Monitor, MonitorConfig, MonitorOutput, RunStage};
+use monitor_core::operating_range::{outside, widen};
+use monitor_core::{
+    CommissioningState, Monitor, MonitorConfig, MonitorOutput, OperatingPoint, RunStage,
+};
 use serde::Serialize;
 
 /// How long after the window's end a run may still finish [s]: half the window, at least
@@ -43,13 +48,6 @@ pub fn min_learned_s(start_s: f64, end_s: f64) -> f64 {
 
 /// See [`min_learned_s`].
 pub const MIN_LEARNED_S: f64 = 1.0;
-
-/// Departure from the commissioned range that is reported (fraction of the range's
-/// largest magnitude): 20 %. A load step of that size is what the learned means do not
-/// cover, while the faults the lamps are for move the operating point less (Rr +50 % at
-/// constant load torque moves the load current by about 8 %; a Bl +50 % fault moves it like a 50 %
-/// load step and is, to the paper's model, one).
-const RANGE_MARGIN: f32 = 0.2;
 
 /// The commissioning part of `diagnose`'s report.
 #[derive(Debug, Clone, Serialize, PartialEq)]
@@ -119,39 +117,13 @@ pub(super) struct CommissionTracker {
 
 /// The load and the voltage of `out`, independent of the d-q frame's angle: the active
 /// current `I_active = (V_ds i_ds + V_qs i_qs) / |V|` [A] and the voltage magnitude
-/// `|V| = sqrt(V_ds^2 + V_qs^2)` [V] (module docs); `I_active` is NaN without voltage.
+/// `|V| = sqrt(V_ds^2 + V_qs^2)` [V] (module docs; the rule is the core's
+/// [`OperatingPoint`], `|V|` by the standard library's `hypot`); `I_active` is NaN without
+/// voltage.
 pub(super) fn operating_point(out: &MonitorOutput) -> (f32, f32) {
     let o = &out.operating;
-    let v = out.vds.hypot(o.vqs);
-    let i_active = if v > 1e-3 {
-        (out.vds * o.i_f + o.vqs * o.iqs) / v
-    } else {
-        f32::NAN
-    };
-    (i_active, v)
-}
-
-fn widen(span: &mut Option<[f32; 2]>, x: f32) {
-    if !x.is_finite() {
-        return;
-    }
-    let s = span.get_or_insert([x, x]);
-    s[0] = s[0].min(x);
-    s[1] = s[1].max(x);
-}
-
-/// How far `x` lies outside `span`, as a signed fraction of the span's largest magnitude
-/// (positive above, negative below), `None` inside or within the margin.
-fn outside(span: [f32; 2], x: f32) -> Option<f32> {
-    let scale = span[0].abs().max(span[1].abs()).max(1e-6);
-    let f = if x > span[1] {
-        (x - span[1]) / scale
-    } else if x < span[0] {
-        (x - span[0]) / scale
-    } else {
-        0.0
-    };
-    (f.abs() > RANGE_MARGIN).then_some(f)
+    let p = OperatingPoint::with_magnitude(out.vds, o.vqs, o.i_f, o.iqs, out.vds.hypot(o.vqs));
+    (p.load_a, p.voltage_v)
 }
 
 impl CommissionTracker {

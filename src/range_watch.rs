@@ -1,0 +1,83 @@
+//! The commissioned operating range in thread mode, and the panel's "operating point moved"
+//! state.
+//!
+//! The learned healthy means of the residuals hold only near the operating point of the
+//! commissioning run that learned them (to the paper's model a load change is a Bl change).
+//! While a run learns, [`RangeWatch::observe`] widens the span of the load (active current)
+//! and of the voltage magnitude, measured without the d-q frame's angle, from each
+//! quasi-steady status the sample task hands over (block rate, nothing in the per-sample
+//! path); when the run ends stored and in force ([`RangeWatch::commit`]) that span is the
+//! commissioned range. Afterwards [`RangeWatch::moved`] says when the load or the voltage is
+//! more than 20 % of the span's largest magnitude outside it: the rule and the margin are
+//! the core's (`monitor_core::operating_range`), the same as the host's `diagnose`, HMI
+//! and demo.
+//!
+//! The range lives in RAM only: after a reset without a new commissioning run the board
+//! does not judge "moved" (the flash record holds the thresholds and the isolation
+//! baseline, not the range).
+
+use crate::app::MonitorStatus;
+use monitor_core::{OperatingPoint, OperatingRange, RunStage};
+
+/// The commissioned range and the one being learned (module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RangeWatch {
+    /// The range of the run in force (since boot); empty before one.
+    commissioned: OperatingRange,
+    /// The range the latest run learned (or is learning), and its run id.
+    learning: Option<(u16, OperatingRange)>,
+}
+
+impl RangeWatch {
+    /// Nothing learned.
+    pub const fn new() -> Self {
+        Self {
+            commissioned: OperatingRange::EMPTY,
+            learning: None,
+        }
+    }
+
+    /// The operating point of a status ([`OperatingPoint::from_dq`] of its `V_ds`, `V_qs`,
+    /// `i_ds`, `I_qs`).
+    pub fn point(s: &MonitorStatus) -> OperatingPoint {
+        OperatingPoint::from_dq(s.vds, s.operating.vqs, s.operating.i_f, s.operating.iqs)
+    }
+
+    /// Feeds a status: while its run learns and the quasi-steady gate is open, widens that
+    /// run's range (a new run starts from nothing).
+    pub fn observe(&mut self, s: &MonitorStatus) {
+        if s.run.stage != RunStage::Learning || !s.quasi_steady {
+            return;
+        }
+        let id = s.run.id;
+        if !matches!(self.learning, Some((run, _)) if run == id) {
+            self.learning = Some((id, OperatingRange::EMPTY));
+        }
+        if let Some((_, range)) = &mut self.learning {
+            range.learn(Self::point(s));
+        }
+    }
+
+    /// The run `run` ended stored and in force: its range is the commissioned one (a run
+    /// that learned no point leaves nothing to judge against).
+    pub fn commit(&mut self, run: u16) {
+        self.commissioned = match self.learning {
+            Some((id, range)) if id == run => range,
+            _ => OperatingRange::EMPTY,
+        };
+    }
+
+    /// The commissioned range in force (empty before a run since boot).
+    pub fn commissioned(&self) -> &OperatingRange {
+        &self.commissioned
+    }
+
+    /// The status's operating point has left the commissioned range (beyond the core's
+    /// margin) while the learned thresholds are in force and the lamps are evaluated.
+    pub fn moved(&self, s: &MonitorStatus) -> bool {
+        s.commissioned
+            && s.evaluating
+            && !s.run.stage.is_active()
+            && self.commissioned.moved(Self::point(s))
+    }
+}
