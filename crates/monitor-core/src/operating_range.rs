@@ -179,13 +179,13 @@ mod tests {
         assert_eq!(r.voltage_v, Some([309.0, 311.0]));
         // +30 % load: 6.5 A is 1.5 A = 30 % of 5 A above the span.
         assert!(r.moved(at(6.5, 310.0)));
-        let f = r.load_outside(at(6.5, 310.0)).unwrap();
+        let f = r.load_outside(at(6.5, 310.0)).unwrap(); // ok: test
         assert!((f - 0.3).abs() < 1e-6, "{f}");
         // +10 %: within the margin.
         assert!(!r.moved(at(5.5, 310.0)));
         // Below: 2.9 A is 1.1 A = 22 % of 5 A below.
-        assert!(r.load_outside(at(2.9, 310.0)).unwrap() < -RANGE_MARGIN);
-        // The voltage alone.
+        assert!(r.load_outside(at(2.9, 310.0)).unwrap() < -RANGE_MARGIN); // ok: test
+                                                                          // The voltage alone.
         assert!(r.moved(at(4.5, 240.0)));
         assert!(!r.moved(at(f32::NAN, 310.0)));
     }

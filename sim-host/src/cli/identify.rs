@@ -118,10 +118,7 @@ pub fn run(args: &IdentifyArgs) -> anyhow::Result<()> {
     })?;
     pb.finish_and_clear();
     let toml = identify::to_toml(&id, &start_text, &shown(&args.params), &shown(&args.log));
-    if let Some(out) = &args.out {
-        sim_host::log::write_atomic(out, toml.as_bytes())
-            .with_context(|| format!("writing {}", out.display()))?;
-    }
+    super::write_out(args.out.as_deref(), toml.as_bytes())?;
     let mut stdout = super::stdout();
     if args.json {
         let doc = serde_json::json!({

@@ -196,6 +196,20 @@ pub fn parse_window(s: &str) -> Result<(f64, f64), String> {
 
 /// Standard output for the renderers: locked, and every write error marked as a
 /// [`StdoutError`] (kept as the `io::Error`'s inner error, its kind unchanged), so that
+/// Writes `bytes` to `out` atomically when an output was asked for (`--out`); nothing
+/// otherwise.
+///
+/// # Errors
+/// "writing PATH" with the I/O error.
+pub fn write_out(out: Option<&std::path::Path>, bytes: &[u8]) -> anyhow::Result<()> {
+    if let Some(out) = out {
+        anyhow::Context::with_context(sim_host::log::write_atomic(out, bytes), || {
+            format!("writing {}", out.display())
+        })?;
+    }
+    Ok(())
+}
+
 /// `main` can tell a closed pipe (quiet exit) or a full disk on stdout from other errors.
 pub fn stdout() -> Stdout {
     Stdout(std::io::stdout().lock())

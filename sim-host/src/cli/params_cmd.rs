@@ -3,7 +3,6 @@
 //! atomically and never over an existing file unless `--force`.
 
 use super::output_guard::OutputGuard;
-use anyhow::Context;
 use clap::{Args, Subcommand, ValueEnum};
 use sim_host::nameplate::{self, Connection, Nameplate, NemaDesign};
 use std::io::Write;
@@ -179,10 +178,7 @@ pub fn run_from_nameplate(args: &FromNameplateArgs) -> anyhow::Result<()> {
     }
     let estimate = nameplate::estimate(&args.nameplate())?;
     let toml = estimate.to_toml();
-    if let Some(out) = &args.out {
-        sim_host::log::write_atomic(out, toml.as_bytes())
-            .with_context(|| format!("writing {}", out.display()))?;
-    }
+    super::write_out(args.out.as_deref(), toml.as_bytes())?;
     let mut stdout = super::stdout();
     if args.json {
         let doc = serde_json::json!({

@@ -585,7 +585,7 @@ fn faults_that_coincide_at_one_point_part_over_several() {
                     "{c:?}"
                 );
             }
-            other => panic!("three points: {other:?} {joint:?}"),
+            other => panic!("three points: {other:?} {joint:?}"), // ok: test
         }
     }
     for f in [Fault::Rs, Fault::Rr, Fault::SpeedSensor] {
@@ -595,7 +595,7 @@ fn faults_that_coincide_at_one_point_part_over_several() {
             Some(Named::Fault(c)) if c.fault == f => {
                 assert!((c.change - 0.3).abs() <= 0.03, "{f}: {c:?}")
             }
-            other => panic!("{f}: {other:?}"),
+            other => panic!("{f}: {other:?}"), // ok: test
         }
     }
 }
