@@ -306,7 +306,11 @@ fn channel_noise(
 ) -> [f64; 5] {
     let s_iq = white_noise_sigma(&d.iq);
     let s_w = white_noise_sigma(&d.omega_r);
-    let s_ph = s_iq / 2f64.sqrt();
+    // A model whose current vector is its own shows both axes' noise in each phase
+    // current's error (s^2 cos^2 + s^2 sin^2); one that takes the measured I_ds only the
+    // q axis's, spread over the rotating phase (s^2 sin^2, mean s^2 / 2).
+    let own_d = propagated.is_some_and(|(a, _)| a.predicts_d_axis);
+    let s_ph = if own_d { s_iq } else { s_iq / 2f64.sqrt() };
     let mut s = [s_iq, s_w, s_ph, s_ph, s_ph];
     if let Some((a, b)) = propagated {
         let mut se = [0.0f64; 5];

@@ -65,6 +65,7 @@ pub fn voltage_model_flux_frame(d: &Decimated, p: &ParamFile) -> Prepared {
         channels: d.channels,
         rows: d.rows,
         log_rate_hz: d.log_rate_hz,
+        block_rows: d.factor,
         log_start_s: d.log_start_s,
     }
 }

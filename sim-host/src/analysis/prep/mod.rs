@@ -118,6 +118,12 @@ pub struct Prepared {
     pub rows: u64,
     /// Log sample rate [Hz].
     pub log_rate_hz: f64,
+    /// Log rows averaged into each working sample by the block mean of stage 1 (its gain
+    /// on a rotating vector, which the full-order model undoes: `simplified_model`). A
+    /// coarsened series (a long log's fit series, `Analysis`) keeps its working series'
+    /// value: it is averaged in the rotating frame, where a steady vector has no gain.
+    /// 0 = not known: one block of `log_rate_hz * dt_s` rows.
+    pub block_rows: usize,
     /// Time of the log's first row [s].
     pub log_start_s: f64,
 }

@@ -270,6 +270,7 @@ pub(super) fn simulate_full(run: Run<'_>, rot_at: impl Fn(usize) -> C64) -> Pred
         full: &full,
         sw: Switches::of(&run.t.dynamics),
     };
+    out.predicts_d_axis = form.sw.id;
     let mut x = full.x0;
     for k in 0..len {
         let m = full.machine(k);

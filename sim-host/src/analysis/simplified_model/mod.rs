@@ -185,6 +185,12 @@ pub struct Prediction {
     pub omega_r: Vec<f64>,
     /// Predicted current vector, stationary frame [A].
     pub i_ab: Vec<C64>,
+    /// True when the model predicts I_ds itself (the stator current is a state: the
+    /// stationary-frame full-order machine, or `d_axis_dynamics` in the analysis frame);
+    /// false when the predicted current vector takes the measured I_ds (the reduced
+    /// model): then only the q-axis sensor noise shows in the phase currents' error
+    /// (`metrics::noise_floor`).
+    pub predicts_d_axis: bool,
 }
 
 impl Prediction {
@@ -194,6 +200,7 @@ impl Prediction {
             iq: Vec::with_capacity(len),
             omega_r: Vec::with_capacity(len),
             i_ab: Vec::with_capacity(len),
+            predicts_d_axis: false,
         }
     }
 }

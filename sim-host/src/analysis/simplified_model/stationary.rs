@@ -3,7 +3,7 @@
 
 use super::full_order::{FullMachine, FullRun};
 use super::terms::{SaturationLaw, Shaft, WindingAsymmetry};
-use super::{MachineConstants, Mechanics, ModelTerms, Prediction, Run};
+use super::{InputNoise, MachineConstants, Mechanics, ModelTerms, Prediction, Run};
 use crate::analysis::prep::{self, Prepared, C64};
 
 /// The state of the stationary-frame full-order model: stator current, rotor flux
@@ -317,9 +317,10 @@ pub(super) fn simulate_stationary(run: Run<'_>, rot_at: impl Fn(usize) -> C64) -
     };
     let len = d.len();
     let mut out = Prediction::with_capacity(len);
+    out.predicts_d_axis = true;
     let form = StatForm {
         full: &full,
-        volt: StatVoltage::new(d, &rot_at),
+        volt: StatVoltage::new(d, &rot_at, t.input_noise),
     };
     let (x0, r0) = (full.x0, rot_at(0));
     let mut x = StatState {
@@ -475,7 +476,12 @@ impl StatVoltage {
         self.v_mean[k] / self.gains[k]
     }
 
-    fn new(d: &Prepared, rot_at: &impl Fn(usize) -> C64) -> Self {
+    /// The voltage input of `d` in the stationary frame (`rot_at` the frame rotation),
+    /// with `noise`'s white noise added to each component of every working sample when
+    /// given (the renoised run of `metrics::noise_floor`: the sensors' noise, as it is in
+    /// the measured series, again, so that the steps, the phase steps and the block
+    /// mean's gains below see it as they see the measured noise).
+    fn new(d: &Prepared, rot_at: &impl Fn(usize) -> C64, noise: Option<InputNoise>) -> Self {
         let len = d.len();
         let dt = d.dt_s;
         // A working sample is the mean of `factor` log rows: a vector turning at w comes out
@@ -483,12 +489,30 @@ impl StatVoltage {
         // alike. The machine is not linear in the voltage (the torque goes with its square:
         // 0.2 % less torque through a start at 10 kHz, 1 % of the start current), so the
         // model is driven by the voltage before the mean (v / gain) and its current is
-        // compared after it (gain i).
-        let factor = (d.log_rate_hz * dt).round().max(1.0);
+        // compared after it (gain i). `h` is the log's row spacing; a coarsened series'
+        // sample spans several blocks but carries one block's gain (`Prepared::block_rows`).
+        let rows = (d.log_rate_hz * dt).round().max(1.0);
+        let h = dt / rows;
+        let factor = match d.block_rows {
+            0 => rows,
+            b => b as f64,
+        };
         // Positive-sequence voltage (stationary frame, after the block mean) and the gain.
-        let v_mean: Vec<C64> = (0..len)
+        let mut v_mean: Vec<C64> = (0..len)
             .map(|k| C64::new(d.vd[k], d.vq[k]) * rot_at(k))
             .collect();
+        if let Some(nz) = noise {
+            use rand::SeedableRng;
+            use rand_distr::{Distribution, StandardNormal};
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(nz.seed);
+            for v in &mut v_mean {
+                let (a, b): (f64, f64) = (
+                    StandardNormal.sample(&mut rng),
+                    StandardNormal.sample(&mut rng),
+                );
+                *v += C64::new(a, b) * nz.sigma_v;
+            }
+        }
         // The voltage's phase step over each working sample [rad].
         let ph: Vec<f64> = (0..len)
             .map(|k| {
@@ -496,10 +520,7 @@ impl StatVoltage {
                 phase_step(v_mean[a], v_mean[(a + 1).min(len - 1)])
             })
             .collect();
-        let gains: Vec<f64> = ph
-            .iter()
-            .map(|&p| block_gain(p / dt, dt / factor, factor))
-            .collect();
+        let gains: Vec<f64> = ph.iter().map(|&p| block_gain(p / dt, h, factor)).collect();
         // The voltage before the block mean.
         let v_at = |k: usize| v_mean[k] / gains[k];
         // How far the voltage leaves its rotation over each working sample (relative); a
