@@ -546,7 +546,8 @@ pub struct Supervisor {
     latest: MonitorStatus,
     failed_until_ms: Option<u32>,
     last_press_ms: Option<u32>,
-    isolation: Option<Follower>,
+    /// The fault isolation's schedule (its isolator holds the tracked winding rise).
+    pub isolation: Option<Follower>,
     /// The isolation baseline learned in the latest commissioning run (stored with its
     /// calibration), `None` while learning or when that run learned too little.
     run_baseline: Option<Baseline>,
@@ -625,8 +626,7 @@ impl Supervisor {
         }
     }
 
-    /// The latest fault isolation (`None` before the first steady half second, or when the
-    /// machine cannot be used by the isolation).
+    /// The latest fault isolation (`None` before the first steady half second, or unusable).
     pub fn isolation(&self) -> Option<&Isolation> {
         self.isolation.as_ref().and_then(Follower::last)
     }

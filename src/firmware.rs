@@ -632,6 +632,10 @@ impl Thread {
             log_status(
                 supervisor.latest(),
                 supervisor.isolation(),
+                supervisor
+                    .isolation
+                    .as_ref()
+                    .map_or(0.0, |f| f.isolator().winding_rise_k()),
                 tick.mode.name(),
                 self.max_update_cycles,
             );
@@ -779,12 +783,19 @@ fn log_stored<E: defmt::Format>(stored: &flash_record::Stored<E>) {
 }
 
 /// The defmt status line: residuals, lamps, the two top candidates, speed, mode,
-/// counters, the operating point, the gate, the threshold bands and the isolation (the
-/// fault named, its size and probability: `app::isolation_summary`). Its format is
+/// counters, the operating point, the gate, the threshold bands, the isolation (the
+/// fault named, its size and probability: `app::isolation_summary`) and the winding
+/// temperature rise the isolation tracks since commissioning (`rise_k` [K]). Its format is
 /// documented once, in docs/firmware.md ("The status line"); `sim-host hmi --stdin` parses it
 /// (`sim_host::hmi::status_line`), and `tests/status_line.rs` renders this format string
 /// and parses it back, so the two cannot drift apart.
-fn log_status(s: &MonitorStatus, iso: Option<&Isolation>, mode: &str, max_update_cycles: u32) {
+fn log_status(
+    s: &MonitorStatus,
+    iso: Option<&Isolation>,
+    rise_k: f32,
+    mode: &str,
+    max_update_cycles: u32,
+) {
     let (top_name, top_p) = s.top.map_or(("none", 0.0), |(f, p)| (f.name(), p));
     let (iso_name, iso_change, iso_p) = isolation_summary(iso);
     let (second_name, second_p) = s.second.map_or(("none", 0.0), |(f, p)| (f.name(), p));
@@ -792,7 +803,7 @@ fn log_status(s: &MonitorStatus, iso: Option<&Isolation>, mode: &str, max_update
     let mid = s.bands.map(|b| b.0);
     let half = s.bands.map(|b| b.1);
     info!(
-        "r={} lamps={} fault={=bool} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32} iqs={=f32}A ids={=f32}A vqs={=f32}V f={=f32}Hz steady={=bool} eval={=bool} sens={=bool},{=bool},{=bool} mid={} half={} iso={=str} iso_change={=f32} iso_p={=f32} wind={=str} wind_i2={=f32} moved={=bool}",
+        "r={} lamps={} fault={=bool} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32} iqs={=f32}A ids={=f32}A vqs={=f32}V f={=f32}Hz steady={=bool} eval={=bool} sens={=bool},{=bool},{=bool} mid={} half={} iso={=str} iso_change={=f32} iso_p={=f32} wind={=str} wind_i2={=f32} moved={=bool} rise={=f32}K",
         s.residuals,
         s.residual_lamps,
         s.fault_detected,
@@ -827,5 +838,6 @@ fn log_status(s: &MonitorStatus, iso: Option<&Isolation>, mode: &str, max_update
         wind_name,
         wind_i2,
         s.moved,
+        rise_k,
     );
 }

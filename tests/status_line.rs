@@ -72,6 +72,7 @@ fn value(arg: &str) -> &'static str {
         "wind_name" => "b",
         "wind_i2" => "0.041",
         "s.moved" => "true",
+        "rise_k" => "54.4",
         other => panic!(
             "log_status prints `{other}`: give it a test value here and teach \
              sim_host::hmi::status_line to read it"
@@ -130,6 +131,14 @@ fn the_hmi_reads_every_field_the_firmware_prints() {
     );
     assert_eq!(s.winding, Some((monitor_core::Phase::B, 0.041)));
     assert_eq!(s.moved, Some(true));
+    assert_eq!(s.winding_rise_k, Some(54.4));
+    // The screen's isolation line carries the rise.
+    let iso = s.snapshot(0.0).isolation.expect("iso= read");
+    assert!(
+        iso.text().ends_with("; windings +54 K (heating)"),
+        "{}",
+        iso.text()
+    );
     let snap = s.snapshot(0.0);
     assert_eq!(
         snap.asymmetry.map(|a| (a.phase, a.ratio)),

@@ -5,7 +5,8 @@ use super::effects::{self, EffectModel, Evidence, FitSetup, SetupError};
 use super::fit::{self, ActiveEffect, FitResult, FittedModel};
 use super::metrics::{self, Weights};
 use super::prep::Prepared;
-use super::simplified_model::{BaseParams, Prediction};
+use super::refit::BaseRefit;
+use super::simplified_model::{BaseParams, MachineConstants, Prediction};
 use super::transients;
 use super::unbalance::UnbalanceAnalysis;
 use super::{align, resolve, Analysis, AnalysisError, DataInfo, Options, ParamValue};
@@ -105,6 +106,11 @@ pub struct ExplainReport {
     pub data: DataInfo,
     /// What the data-quality stage found and what the analysis did about it.
     pub data_quality: crate::log::quality::DataQuality,
+    /// The base parameters refitted to the log before effects were judged, file value
+    /// against refitted value, and whether the model was recentred on them because the
+    /// file's values did not fit ([`super::refit`]). `None` when the model did not run
+    /// (a current-only log).
+    pub base_refit: Option<BaseRefit>,
 }
 
 /// Everything `explain` computed.
@@ -184,6 +190,18 @@ impl Analysis {
         opts: &Options,
         progress: &(dyn Fn(f64) + Sync),
     ) -> Result<ExplainOutput, AnalysisError> {
+        self.explain_once(opts, progress, true)
+    }
+
+    /// [`Analysis::explain`]; when `may_recentre` and the configured model's own fit is
+    /// not physically plausible, the model is recentred on the identified refitted base
+    /// parameters and explained again ([`super::refit`]).
+    fn explain_once(
+        &self,
+        opts: &Options,
+        progress: &(dyn Fn(f64) + Sync),
+        may_recentre: bool,
+    ) -> Result<ExplainOutput, AnalysisError> {
         let unbalance = self.unbalance();
         let info = self.info();
         let configured = resolve(&opts.effects);
@@ -197,6 +215,30 @@ impl Analysis {
             )));
         }
         let mut base = self.baseline(&configured, opts)?;
+        let mut refit = self.base_refit(&base, opts);
+        let flagged = super::base_out_of_range(&self.constants, &base.fit.base, &self.data);
+        // Through a start or a supply step, a model without the always-present dynamics
+        // flags its base parameters because they absorb what it cannot follow: the verdict
+        // says so, and recentring on them would judge effects against that error.
+        let structural = base.has_input_transient
+            && ![EffectKind::FluxDynamics, EffectKind::CurrentDynamics]
+                .iter()
+                .all(|k| names.contains(k));
+        if may_recentre && !structural && flagged.iter().any(|(k, _)| refit.identifies(k)) {
+            let because = flagged.into_iter().map(|(_, why)| why).collect();
+            let params = refit.recentred_params(&self.params);
+            let recentred = Analysis {
+                data: self.data.clone(),
+                constants: MachineConstants::from_params(&params),
+                params,
+                quality: self.quality.clone(),
+            };
+            let mut out = recentred.explain_once(opts, progress, false)?;
+            refit.recentred = true;
+            refit.because = because;
+            out.report.base_refit = Some(refit);
+            return Ok(out);
+        }
         let full = base.full.take();
         let base = base;
         let lib = effects::library();
@@ -241,6 +283,7 @@ impl Analysis {
                 unbalance,
                 data: info,
                 data_quality: self.quality.clone(),
+                base_refit: Some(refit),
             },
             before: full.before,
             after,
@@ -386,6 +429,20 @@ impl Analysis {
                 metrics::noise_floor_on(fd, &base.heldback_fit_series, Some((&b, &renoised)));
         }
         Ok(base)
+    }
+
+    /// The configured model's base parameters as refitted in `base`, with what the log
+    /// identifies of them ([`fit::jacobian`] on the fit series).
+    fn base_refit(&self, base: &Baseline<'_>, opts: &Options) -> BaseRefit {
+        let jac = fit::jacobian(
+            &base.fit_series,
+            &self.constants,
+            &base.active,
+            &base.fit_weights,
+            &base.fit,
+            opts.fit_base,
+        );
+        BaseRefit::new(&self.constants, &base.fit.base, jac.as_ref())
     }
 
     /// The configured model fitted in `base`, run over the working series and measured
@@ -651,6 +708,7 @@ fn explain_current_only(
             unbalance,
             data: info,
             data_quality: quality,
+            base_refit: None,
         },
         before: Prediction::default(),
         after: None,

@@ -44,6 +44,7 @@ pub mod fit;
 pub mod lm;
 pub mod metrics;
 pub mod prep;
+pub mod refit;
 pub mod rotor_asymmetry;
 pub mod simplified_model;
 pub mod transients;

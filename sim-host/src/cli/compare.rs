@@ -143,7 +143,11 @@ and fitted together with the base parameters (Ra, Ls, B+Bl, J). The dynamics eff
 with a time constant) are proposed only when the analysed span holds a start or a supply \
 step; with all four the model is the full-order machine. Candidates are ranked by the error \
 on held-back time windows the fit never saw, so an effect that only fits noise does not \
-win; a fit outside its physical range is marked plausible: false and never named. When no candidate explains at least 50 % of \
+win; a fit outside its physical range is marked plausible: false and never named. The base \
+parameters refitted to the log are printed with the parameter file's values, and those the \
+log does not identify are named; when the file's values do not fit the log at all (the \
+refit outside their physical range), the model is first recentred on the identified refitted \
+values and the effects are judged against that. When no candidate explains at least 50 % of \
 the held-back error, or the error is already near the noise floor, the answer is \
 `unexplained: true` rather than a wrong name.\n\n\
 Workflow:\n  sim-host compare --params motor.toml run.csv          # where does the model fail?\n  \
@@ -158,7 +162,9 @@ iteration_limit | stalled | nothing_to_fit}}], \
 unexplained, verdict, skipped, unbalance, noise_floor, data_quality, rotor_asymmetry (the \
 motor current signature analysis: lower_sideband_db, upper_sideband_db, slip, sideband_hz, \
 speed_ripple_hz, speed_ripple_rad_s, delta, equivalent_broken_bars (with --rotor-bars N), \
-resolution_hz, resolution_needed_hz, or cannot_judge_because). When the data-quality \
+spectral_delta, spectral_broken_bars, fit_and_spectrum_agree, window_s, resolution_hz, \
+resolution_needed_hz, or cannot_judge_because), base_refit {parameters [{parameter, unit, \
+configured, refitted, identified}], recentred, because}. When the data-quality \
 stage does not trust the log the verdict says \"could not judge\" and why."
 )]
 pub struct ExplainArgs {

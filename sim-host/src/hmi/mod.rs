@@ -95,6 +95,9 @@ pub struct IsolationView {
     pub change: Option<f32>,
     /// The candidates listed, most probable first: for an unknown fault its nearest three.
     pub candidates: Vec<FaultCandidate>,
+    /// The winding temperature rise since commissioning the isolation tracks [K]
+    /// (`Isolator::winding_rise_k`), when known.
+    pub winding_rise_k: Option<f32>,
 }
 
 impl IsolationView {
@@ -105,6 +108,7 @@ impl IsolationView {
             named: report.named,
             change: report.named_change,
             candidates: candidates.to_vec(),
+            winding_rise_k: report.winding_rise_k,
         }
     }
 
@@ -115,8 +119,19 @@ impl IsolationView {
     }
 
     /// One line: `rr +48 %`, `unknown, nearest rr, ls, lr`, `rr / speed_sensor, not
-    /// alone`, `no deviation` or `not judged`.
+    /// alone`, `no deviation` or `not judged`; followed by `; windings +54 K (heating)`
+    /// once the tracked rise reaches [`monitor_core::isolation::WARMING_K`].
     pub fn text(&self) -> String {
+        let rise = self
+            .winding_rise_k
+            .filter(|r| r.abs() >= monitor_core::isolation::WARMING_K)
+            .map(|r| format!("; windings {r:+.0} K (heating)"))
+            .unwrap_or_default();
+        format!("{}{rise}", self.conclusion())
+    }
+
+    /// [`IsolationView::text`] without the winding rise.
+    fn conclusion(&self) -> String {
         let sized = |n: IsolationName, x: Option<f32>| {
             let n = n.to_string();
             x.map_or(n.clone(), |c| crate::fault_signatures::size_text(&n, c))

@@ -9,7 +9,7 @@
 //! r=[r1, r2, r3, r4] lamps=[b1, b2, b3, b4] fault=B top=NAME(P) 2nd=NAME(P) wm=Xrad/s
 //! zc_locked=.. mode=MODE run=ID:LEARNED/NEEDED overruns=N restarts=N samples=N
 //! max_cyc=N iqs=XA ids=XA vqs=XV f=XHz steady=B eval=B sens=B,B,B mid=[..] half=[..]
-//! iso=NAME iso_change=X iso_p=P wind=PHASE wind_i2=X
+//! iso=NAME iso_change=X iso_p=P wind=PHASE wind_i2=X moved=B rise=XK
 //! ```
 //!
 //! The parser finds the `key=` fields anywhere in a line, so the decoder's decorations
@@ -74,6 +74,8 @@ pub struct FirmwareStatus {
     /// `RangeWatch::moved`); `None` from an older firmware. With no fault named (`iso=`)
     /// the screen shows the amber "moved" state and no FAULT lamp, as the board's panel.
     pub moved: Option<bool>,
+    /// The winding temperature rise since commissioning the isolation tracks [K] (`rise=`).
+    pub winding_rise_k: Option<f32>,
 }
 
 /// The isolation fields of a status line (`iso=`, `iso_change=`, `iso_p=`; the firmware's
@@ -215,6 +217,7 @@ pub fn parse(line: &str) -> Option<FirmwareStatus> {
             .and_then(monitor_core::Phase::from_name)
             .map(|p| (p, f("wind_i2").unwrap_or(0.0))),
         moved: b("moved"),
+        winding_rise_k: f("rise"),
     })
 }
 
@@ -281,7 +284,10 @@ impl FirmwareStatus {
             vqs_v: self.vqs_v,
             supply_hz: self.supply_hz,
             state,
-            isolation: self.isolation.as_ref().map(FirmwareIsolation::view),
+            isolation: self.isolation.as_ref().map(|i| super::IsolationView {
+                winding_rise_k: self.winding_rise_k,
+                ..i.view()
+            }),
         }
     }
 }
@@ -308,6 +314,7 @@ impl FirmwareIsolation {
                 }],
                 _ => Vec::new(),
             },
+            winding_rise_k: None,
         }
     }
 }

@@ -200,6 +200,11 @@ fn explain_html(
     let _ = write!(h, "<!doctype html><html><head><meta charset=utf-8><title>explain: {}</title><style>{STYLE}</style></head><body>", esc(log));
     let _ = write!(h, "<h1>Which physical effect is missing?</h1><p>Log <code>{}</code>. Effects already in the model: {}.</p>", esc(log), if r.effects.is_empty() { "none".into() } else { effect_list(&r.effects) });
     let _ = write!(h, "<p class=v>{}</p>", esc(&r.verdict));
+    if let Some(words) = r.base_refit.as_ref().map(|b| b.in_words()) {
+        if !words.is_empty() {
+            let _ = write!(h, "<p>{}</p>", esc(&words));
+        }
+    }
     data_quality(&mut h, &r.data_quality);
     let _ = write!(h, "<p>Error of the model as configured: {:.4} (whole log), {:.4} on the held-back windows the fits never saw; noise floor {:.4}. Each candidate below was added to the model and fitted together with the base parameters; ranking is by the held-back error, so an effect that only fits noise does not win.</p>", r.baseline_normalized_rms_error, r.baseline_validation_normalized_rms_error, r.noise_floor);
     h.push_str("<table><tr><th>rank</th><th class=l>effect</th><th>error</th><th>held-back error</th><th>explained</th><th>params</th><th class=l>fitted, in words</th></tr>");

@@ -43,6 +43,20 @@ pub fn text(r: &McsaReport) -> String {
             r.delta.unwrap_or(f64::NAN)
         ));
     }
+    if let Some(d) = r.spectral_delta {
+        let bars = r
+            .spectral_broken_bars
+            .map(|n| format!(": about {n:.1} adjacent broken bars"))
+            .unwrap_or_default();
+        let agree = match r.fit_and_spectrum_agree {
+            Some(true) => "; the fit and the spectrum agree",
+            Some(false) => "; the fit and the spectrum disagree, so rotor_asymmetry is not named",
+            None => "",
+        };
+        s.push_str(&format!(
+            "  from the sidebands: delta {d:.3}{bars}{agree}\n"
+        ));
+    }
     s
 }
 
@@ -68,7 +82,7 @@ pub fn chart(r: &McsaReport) -> Option<Chart<'static>> {
     let f = |i: usize| r.sideband_hz.get(i).copied().unwrap_or(f64::NAN);
     Some(Chart {
         stem: CHART,
-        title: "Stator current spectrum (phase a, Hann) with the (1-2s)f and (1+2s)f sidebands",
+        title: "Stator current spectrum (phase a, Blackman-Harris window) with the (1-2s)f and (1+2s)f sidebands",
         x_label: "frequency [Hz]",
         y_label: "amplitude [dB re fundamental]",
         series: vec![

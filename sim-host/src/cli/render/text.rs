@@ -538,6 +538,11 @@ pub fn explain(log: &Path, r: &ExplainReport) -> anyhow::Result<()> {
     }
     writeln!(out, "  unbalance: {}", r.unbalance.summary)?;
     writeln!(out, "{}", r.verdict)?;
+    if let Some(words) = r.base_refit.as_ref().map(|b| b.in_words()) {
+        if !words.is_empty() {
+            writeln!(out, "  {words}")?;
+        }
+    }
     Ok(())
 }
 
