@@ -154,10 +154,14 @@ impl MtSpeed {
                 self.acc = 0;
                 self.win_start_ticks = ticks;
                 self.last_edge_ticks = ticks;
-            } else if idle > 0 {
+            } else if idle > self.ticks_per_sample {
                 // Between edges the speed cannot exceed one count per elapsed time: this
-                // bounds the estimate while decelerating to a stop.
-                let bound = self.rad_per_count / (idle as f32 * self.s_per_tick);
+                // bounds the estimate while decelerating to a stop. An edge is seen only at
+                // the sample after it and the sample times jitter by a tick, so one sample
+                // period of the elapsed time is not counted (else a sample without a count
+                // near one count per sample clamps the estimate by the jitter).
+                let bound = self.rad_per_count
+                    / ((idle - self.ticks_per_sample) as f32 * self.s_per_tick);
                 if self.speed_rad_s.abs() > bound {
                     self.speed_rad_s = bound.copysign(self.speed_rad_s);
                 }
@@ -245,6 +249,20 @@ mod tests {
             // Timing quantised to 100 us over a >= 50 ms window: <= 0.2 % + one count.
             let tol = 0.003 * speed.abs() + TAU / 4096.0 / 0.05;
             prop_assert!((w - speed).abs() < tol, "speed {} estimate {}", speed, w);
+        }
+    }
+
+    /// Near one count per sample a sample without a count must not clamp the estimate by
+    /// the one-tick jitter of the sample times (-15.268 rad/s was read as -15.188: the
+    /// bound of one count per 101 ticks between two samples 100 us apart).
+    #[test]
+    fn about_one_count_per_sample_is_not_clamped_by_tick_jitter() {
+        for speed in [-15.268f32, 15.268, -15.309, -15.2, 15.0] {
+            for tick0 in [0u32, 1, 7, 123_457, u32::MAX - 5_000] {
+                let w = run(speed, 65_000, tick0, 16, 0.3);
+                let tol = 0.003 * speed.abs() + TAU / 4096.0 / 0.05;
+                assert!((w - speed).abs() < tol, "speed {speed} tick0 {tick0}: {w}");
+            }
         }
     }
 
