@@ -160,8 +160,8 @@ impl MtSpeed {
                 // the sample after it and the sample times jitter by a tick, so one sample
                 // period of the elapsed time is not counted (else a sample without a count
                 // near one count per sample clamps the estimate by the jitter).
-                let bound = self.rad_per_count
-                    / ((idle - self.ticks_per_sample) as f32 * self.s_per_tick);
+                let bound =
+                    self.rad_per_count / ((idle - self.ticks_per_sample) as f32 * self.s_per_tick);
                 if self.speed_rad_s.abs() > bound {
                     self.speed_rad_s = bound.copysign(self.speed_rad_s);
                 }
