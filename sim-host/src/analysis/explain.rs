@@ -224,21 +224,6 @@ impl Analysis {
             && ![EffectKind::FluxDynamics, EffectKind::CurrentDynamics]
                 .iter()
                 .all(|k| names.contains(k));
-        if may_recentre && !structural && flagged.iter().any(|(k, _)| refit.identifies(k)) {
-            let because = flagged.into_iter().map(|(_, why)| why).collect();
-            let params = refit.recentred_params(&self.params);
-            let recentred = Analysis {
-                data: self.data.clone(),
-                constants: MachineConstants::from_params(&params),
-                params,
-                quality: self.quality.clone(),
-            };
-            let mut out = recentred.explain_once(opts, progress, false)?;
-            refit.recentred = true;
-            refit.because = because;
-            out.report.base_refit = Some(refit);
-            return Ok(out);
-        }
         let full = base.full.take();
         let base = base;
         let lib = effects::library();
@@ -265,6 +250,28 @@ impl Analysis {
         let near_noise =
             full.heldback_error <= (NOISE_MARGIN * full.heldback_noise).max(MIN_MODEL_ERROR);
         let unexplained = best < EXPLAINED_MIN || near_noise;
+        // Recentred only when nothing could be named on the file's model: a missing effect
+        // also pushes the base parameters out of range, and then naming it is the answer.
+        if may_recentre
+            && unexplained
+            && !near_noise
+            && !structural
+            && flagged.iter().any(|(k, _)| refit.identifies(k))
+        {
+            let because = flagged.into_iter().map(|(_, why)| why).collect();
+            let params = refit.recentred_params(&self.params);
+            let recentred = Analysis {
+                data: self.data.clone(),
+                constants: MachineConstants::from_params(&params),
+                params,
+                quality: self.quality.clone(),
+            };
+            let mut out = recentred.explain_once(opts, progress, false)?;
+            refit.recentred = true;
+            refit.because = because;
+            out.report.base_refit = Some(refit);
+            return Ok(out);
+        }
         let verdict = self.verdict(&names, &base, &full, &ranked, near_noise, unexplained);
         let after = match ranked.first() {
             Some(r) if !unexplained => Some((r.candidate.effect, self.predict_with(&names, r))),

@@ -11,7 +11,8 @@
 //! When the refit of a parameter the log identifies lands outside the physical range the
 //! file's values allow (for example a coupled load whose inertia the file guesses at a
 //! quarter of the truth), every effect fitted on top of it would inherit that flag and none
-//! could be named. Then the model is *recentred*: the identified base
+//! could be named; when, on the file's model, no effect can then be named, the model is
+//! *recentred*: the identified base
 //! parameters become the machine's constants (the file's Rs and Rr scaled together by the
 //! refitted Ra, its Lm, Ls and Lr by the refitted Ls, its J by the refitted J, its Bl set so
 //! that B + Bl is the refitted value), and the effects are fitted and judged against that
