@@ -4,6 +4,14 @@
 //! the stator-voltage equations only: the load at each point is an unknown input). Faults
 //! that coincide at one point (on the 3 hp motor at rated load Ls, Rr and the speed sensor)
 //! part over two load levels 20 % apart or more.
+//!
+//! The last point judged healthy before the deviation is kept as the *anchor*: where the
+//! slip has not moved since, the load is the torque the machine gave there, and the joint
+//! fit compares each hypothesis' torque with it (`Isolator::isolate_points_anchored`). A
+//! sensor gain step, which moves neither the machine nor its speed, is judged with it from
+//! the first point after the step: a current sensor's error scales the torque computed
+//! from the currents, a voltage sensor's does not (the stator-voltage equations alone see
+//! the two alike).
 
 use monitor_core::isolation::{
     Follower, Isolation, IsolationState, Named, SteadyPoint, MAX_POINTS,
@@ -28,12 +36,15 @@ fn active_current(p: &SteadyPoint) -> f32 {
 pub(super) struct Evidence {
     points: Vec<(SteadyPoint, f32)>,
     joint: Option<Isolation>,
+    /// The last averaged point judged healthy (no deviation) before the points kept.
+    anchor: Option<SteadyPoint>,
 }
 
 impl Evidence {
     /// After an isolation `result` of the follower: a deviation keeps the averaged point
     /// (replacing the one at its load level, else added, the oldest dropped beyond
-    /// [`MAX_POINTS`]) and refits jointly; no deviation forgets the evidence.
+    /// [`MAX_POINTS`], except the first with an anchor) and refits jointly; no deviation
+    /// forgets the evidence and makes the averaged point the anchor.
     pub(super) fn after(&mut self, follower: &Follower, result: &Isolation) {
         if !matches!(
             result.state,
@@ -42,6 +53,9 @@ impl Evidence {
         {
             self.points.clear();
             self.joint = None;
+            if result.state == IsolationState::NoDeviation {
+                self.anchor = follower.averaged().map(|(p, _)| p);
+            }
             return;
         }
         let Some((p, scale)) = follower.averaged() else {
@@ -63,13 +77,27 @@ impl Evidence {
             }
             None => {
                 if self.points.len() >= MAX_POINTS {
-                    self.points.remove(0);
+                    // The first point, at the anchor's load, is the one the torque
+                    // comparison holds for: the oldest after it goes.
+                    let oldest = usize::from(self.anchor.is_some() && self.points.len() > 1);
+                    self.points.remove(oldest);
                 }
                 self.points.push((p, scale));
             }
         }
-        self.joint =
-            (self.points.len() >= 2).then(|| follower.isolator().isolate_points(&self.points));
+        if std::env::var("H24_NOANCHOR").is_ok() { self.anchor = None; }
+        let enough = self.points.len() >= 2 || self.anchor.is_some();
+        self.joint = enough.then(|| {
+            follower
+                .isolator()
+                .isolate_points_anchored(&self.points, self.anchor.as_ref())
+        });
+        if std::env::var("H24_DEBUG").is_ok() {
+            if let Some(j) = &self.joint {
+                let c: Vec<String> = j.candidates.iter().take(3).map(|c| format!("{} {:+.3} p{:.2} m{:.1}", c.fault, c.change, c.probability, c.misfit)).collect();
+                eprintln!("JOINT n {} anchor {:?} dev {:.1} {:?} {:?}", self.points.len(), self.anchor.map(|a| a.wr_rad_s), j.deviation, j.state, c);
+            }
+        }
     }
 
     /// The joint isolation when it names a fault (not the friction class, which the

@@ -44,6 +44,10 @@ pub const STEP_S: f32 = 0.1;
 pub const BLOCKS: usize = 20;
 /// Relative change from the running average above which a point is not steady.
 pub const STEADY_FRACTION: f32 = 0.02;
+/// How long after a point left the band of the average the blocks are dropped [s] (module
+/// docs): the host's 2 Hz critically damped sequence filters leave 0.4 % of a step after
+/// 0.5 s, and a step that the band caught at 2 % of the current thus leaves less than 0.01 %.
+pub const SETTLE_S: f32 = 0.5;
 /// How long a newly named fault must stay the one named before it is reported [s]. A change
 /// smaller than [`STEADY_FRACTION`] does not restart the average, which then mixes points
 /// from before and after it for up to [`AVERAGE_MAX_S`]; on the way the residuals can pass
@@ -162,6 +166,8 @@ pub struct Follower {
     pending: Option<usize>,
     held_s: f32,
     since_isolation_s: f32,
+    /// Time left of the settling after a point left the band [s] ([`SETTLE_S`]).
+    settling_s: f32,
 }
 
 impl Follower {
@@ -182,6 +188,7 @@ impl Follower {
             pending: None,
             held_s: 0.0,
             since_isolation_s: 0.0,
+            settling_s: 0.0,
         }
     }
 
@@ -215,11 +222,20 @@ impl Follower {
         }
         if self.reference().is_some_and(|r| !r.admits(p)) {
             self.restart();
+            self.settling_s = SETTLE_S;
+        } else {
+            self.settling_s = crate::maxf(self.settling_s - dt, 0.0);
         }
         self.block_sum.add_scaled(p, dt);
         self.block_s += dt;
         // (Float sums of the time steps: a thousandth of slack.)
         if self.block_s < 0.999 * STEP_S {
+            return ended.map_or(Step::Waiting, Step::LearningEnded);
+        }
+        if self.settling_s > 0.0 {
+            // Still settling: the block is dropped (module docs).
+            self.block_sum = SteadyPoint::default();
+            self.block_s = 0.0;
             return ended.map_or(Step::Waiting, Step::LearningEnded);
         }
         self.close_block();

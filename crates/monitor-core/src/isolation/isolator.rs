@@ -35,6 +35,7 @@ impl Isolator {
             baseline: Baseline::default(),
             learning: Learning::default(),
             heating_factor: 1.0,
+            learned_range: crate::OperatingRange::EMPTY,
         })
     }
 
@@ -93,6 +94,7 @@ impl Isolator {
             .spread
             .zip_map(DEFAULT_SPREAD, |s, d| crate::maxf(s, 0.2 * d));
         self.baseline = b;
+        self.learned_range = crate::OperatingRange::EMPTY;
         Ok(())
     }
 
@@ -106,6 +108,7 @@ impl Isolator {
         l.n = l.n.saturating_add(1);
         let n = l.n as f32;
         l.at.approach(p, 1.0 / n);
+        l.range.learn(crate::OperatingPoint::from_dq(p.v.d, p.v.q, p.i.d, p.i.q));
         for ((m, m2), x) in l.mean.iter_mut().zip(l.m2.iter_mut()).zip(e.to_array()) {
             let d = x - *m;
             *m += d / n;
@@ -132,12 +135,32 @@ impl Isolator {
         {
             *s = crate::maxf(2.0 * crate::sqrt(m2 / (n - 1.0)), d);
         }
-        self.set_baseline(Baseline {
-            mean: ParityResiduals::from_array(l.mean),
-            spread: ParityResiduals::from_array(spread),
-            at: l.at,
-        })
-        .is_ok()
+        let ok = self
+            .set_baseline(Baseline {
+                mean: ParityResiduals::from_array(l.mean),
+                spread: ParityResiduals::from_array(spread),
+                at: l.at,
+            })
+            .is_ok();
+        if ok {
+            self.learned_range = l.range;
+        }
+        ok
+    }
+
+    /// The measured point `q` lies within the load span the baseline was learned over, and
+    /// that span is a range ([`WIDE_SPAN`]), with the voltage within the learned range's
+    /// margin (module docs, "Over a commissioned range").
+    fn within_learned_span(&self, q: &SteadyPoint) -> bool {
+        let r = self.learned_range;
+        let p = crate::OperatingPoint::from_dq(q.v.d, q.v.q, q.i.d, q.i.q);
+        match r.load_a {
+            Some([lo, hi]) => {
+                let wide = hi - lo >= WIDE_SPAN * crate::maxf(lo.abs(), hi.abs());
+                wide && p.load_a >= lo && p.load_a <= hi && r.voltage_outside(p).is_none()
+            }
+            None => false,
+        }
     }
 
     /// The parity residuals at `p` under hypothesis `h` (`None`: the nominal machine and
@@ -190,6 +213,9 @@ impl Isolator {
     fn weight(&self, q: &SteadyPoint) -> Sym3 {
         let s = self.baseline.spread;
         let diag = Sym3::diagonal_weight(&s);
+        if self.within_learned_span(q) {
+            return diag;
+        }
         let (at, c0) = (self.baseline.at, self.circuit());
         let (Some(e_here), Some(e_at)) = (self.eval(&c0, q), self.eval(&c0, &at)) else {
             return diag;
@@ -398,8 +424,27 @@ impl Isolator {
     /// [`MAX_POINTS`] points are used (the first ones); none usable gives
     /// [`IsolationState::NotJudged`].
     pub fn isolate_points(&self, points: &[(SteadyPoint, f32)]) -> Isolation {
+        self.isolate_points_anchored(points, None)
+    }
+
+    /// [`Isolator::isolate_points`] with the load known at one point: `anchor`, the last
+    /// steady point judged healthy before the deviation began (module docs, "The load
+    /// before the deviation"). At each point the torque the circuit gives under the
+    /// hypothesis is compared with the anchor's (the nominal machine's torque there). The
+    /// load may have moved since; in the machine's linear region a load change moves the
+    /// slip by about as much, so the comparison's spread is widened by
+    /// [`LOAD_SLIP_FACTOR`] times the measured slip's relative change times the anchor's
+    /// torque. A sensor gain step, which moves neither the machine nor its speed, is thus
+    /// judged with the torque balance (a current sensor's error scales the torque computed
+    /// from the currents, a voltage sensor's does not), while a load step or a fault that
+    /// moves the slip leaves the voltage equations to decide.
+    pub fn isolate_points_anchored(
+        &self,
+        points: &[(SteadyPoint, f32)],
+        anchor: Option<&SteadyPoint>,
+    ) -> Isolation {
         let mut out = Isolation::default();
-        let mut used = [(SteadyPoint::default(), Sym3::default()); MAX_POINTS];
+        let mut used = [(SteadyPoint::default(), Sym3::default(), 1.0f32); MAX_POINTS];
         let mut n = 0;
         for (p, scale) in points.iter().take(MAX_POINTS) {
             let k = if scale.is_finite() {
@@ -416,17 +461,21 @@ impl Isolator {
                 continue;
             };
             if let Some(slot) = used.get_mut(n) {
-                *slot = (*p, w);
+                *slot = (*p, w, k);
                 n += 1;
             }
         }
         let used = used.get(..n).unwrap_or(&[]);
-        let Some((first, _)) = used.first() else {
+        let Some((first, _, _)) = used.first() else {
             return out;
         };
-        let chi = |h: Option<(Fault, f32)>| -> f32 {
-            used.iter().map(|(p, w)| self.chi2_at(p, h, w)).sum()
+        let load = anchor.and_then(|a| Some((*a, self.torque_nm(a, None)?)));
+        let chi_with = |iso: &Isolator, h: Option<(Fault, f32)>| -> f32 {
+            used.iter()
+                .map(|(p, w, k)| iso.chi2_at(p, h, w) + iso.chi2_load(p, h, load, *k))
+                .sum()
         };
+        let chi = |h: Option<(Fault, f32)>| chi_with(self, h);
         let chi0 = chi(None);
         out.deviation = crate::sqrt(chi0);
         if let Some(e0) = self.residuals(first, None) {
@@ -442,10 +491,7 @@ impl Isolator {
             *fit = fit_factor(|k| chi(Some((f, k))));
         }
         let heat = golden(
-            |k| {
-                let warm = self.warmer(k);
-                used.iter().map(|(p, w)| warm.chi2_at(p, None, w)).sum()
-            },
+            |k| chi_with(&self.warmer(k), None),
             HEATING_K_MIN / self.heating_factor,
             HEATING_K_MAX / self.heating_factor,
             HEATING_STEPS,
@@ -455,6 +501,46 @@ impl Isolator {
             out.separation_deg = self.separation(first, &e0, &out.candidates);
         }
         out
+    }
+
+    /// The air-gap torque the circuit gives at `p` under hypothesis `h` [N m]
+    /// (`Te = e_T T_base + (B + Bl) wr / Np`, the torque of [`ParityResiduals::torque`]);
+    /// `None` where the point gives no residuals.
+    fn torque_nm(&self, p: &SteadyPoint, h: Option<(Fault, f32)>) -> Option<f32> {
+        let (c, q) = self.hypothesis(p, h);
+        let e = self.eval(&c, &q)?;
+        Some(e.torque * self.torque_base_nm + c.b_total * q.wr_rad_s / c.np)
+    }
+
+    /// The misfit of the torque at `p` under `h` against the load known at the anchor
+    /// (`load`: the anchor point and its torque; `None`: no term), with the spread
+    /// [`ANCHOR_TORQUE_SPREAD`] times `scale` widened by [`LOAD_SLIP_FACTOR`] times the
+    /// measured slip's relative change from the anchor times the anchor's torque.
+    fn chi2_load(
+        &self,
+        p: &SteadyPoint,
+        h: Option<(Fault, f32)>,
+        load: Option<(SteadyPoint, f32)>,
+        scale: f32,
+    ) -> f32 {
+        let Some((a, t0)) = load else {
+            return 0.0;
+        };
+        let Some(te) = self.torque_nm(p, h) else {
+            return f32::INFINITY;
+        };
+        let slip0 = crate::maxf((a.we_rad_s - a.wr_rad_s).abs(), 1e-3);
+        let slip = p.we_rad_s - p.wr_rad_s;
+        let moved = (slip - (a.we_rad_s - a.wr_rad_s)) / slip0;
+        let s_load = LOAD_SLIP_FACTOR * moved * t0 / self.torque_base_nm;
+        let s = ANCHOR_TORQUE_SPREAD * scale;
+        let d = (te - t0) / self.torque_base_nm;
+        let var = s * s + s_load * s_load;
+        if var > 0.0 {
+            d * d / var
+        } else {
+            0.0
+        }
     }
 
     /// Angle between the top two candidates' weighted directions `e(f, k*) - e(nominal)`
@@ -605,6 +691,17 @@ fn rank(out: &mut Isolation, fits: &mut [(f32, f32); FAULT_COUNT], heat: (f32, f
         IsolationState::Isolated
     };
 }
+
+/// How much the load may have changed between the anchor and a point, per relative change
+/// of the measured slip ([`Isolator::isolate_points_anchored`]): 2. In the machine's linear
+/// region the torque is proportional to the slip, so a load change moves the slip by about
+/// as much; twice that covers the curvature up to rated load.
+pub const LOAD_SLIP_FACTOR: f32 = 2.0;
+
+/// Spread of the torque comparison with the anchor, as a fraction of `T_base`: twice the
+/// learned floor of the torque balance ([`LEARNED_SPREAD_FLOOR`]), for the two points'
+/// scatter together.
+pub const ANCHOR_TORQUE_SPREAD: f32 = 2.0 * LEARNED_SPREAD_FLOOR.torque;
 
 /// Most operating points [`Isolator::isolate_points`] combines.
 pub const MAX_POINTS: usize = 4;
