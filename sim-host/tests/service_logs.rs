@@ -69,7 +69,11 @@ fn faults() -> Vec<(Fault, f64)> {
     }
     v.push((Fault::Rs, 0.2));
     v.push((Fault::Rr, 0.2));
-    for f in [Fault::SpeedSensor, Fault::CurrentSensor, Fault::VoltageSensor] {
+    for f in [
+        Fault::SpeedSensor,
+        Fault::CurrentSensor,
+        Fault::VoltageSensor,
+    ] {
         v.push((f, 0.05));
         v.push((f, -0.05));
     }
@@ -113,9 +117,9 @@ impl Outcome {
     }
 
     fn row(&self) -> String {
-        let case = self
-            .fault
-            .map_or("healthy".to_string(), |(f, c)| format!("{f} {:+.0} %", 100.0 * c));
+        let case = self.fault.map_or("healthy".to_string(), |(f, c)| {
+            format!("{f} {:+.0} %", 100.0 * c)
+        });
         let named = self.named.map_or("-".to_string(), |n| {
             format!(
                 "{n} {}",
@@ -163,7 +167,7 @@ fn run(motor: &'static str, p: &ParamFile, fault: Option<(Fault, f64)>, seed: u6
     let replay = simulate_and_replay(p, p, &sc, opts, |_, _| {}).expect("runs");
     let given = replay.isolation_names().to_vec();
     let r = replay.finish();
-    let o = Outcome {
+    Outcome {
         motor,
         fault,
         named: r.isolation.named,
@@ -171,10 +175,6 @@ fn run(motor: &'static str, p: &ParamFile, fault: Option<(Fault, f64)>, seed: u6
         given,
         verdict: r.isolation.verdict.chars().take(110).collect(),
         spread: r.isolation.spread,
-    };
-    eprintln!("rise {:?} dev {}", r.isolation.winding_rise_k, r.isolation.deviation_sigma);
-    Outcome {
-        ..o
     }
 }
 
@@ -258,18 +258,4 @@ fn service_logs_of_three_motors_every_fault() {
     let out = table(&cases);
     let bad = bar_failures(&out);
     assert!(bad.is_empty(), "{bad:#?}");
-}
-
-#[test]
-fn debug_one() {
-    let Ok(m) = std::env::var("H24_DEBUG") else { return };
-    let m: usize = m.parse().unwrap();
-    let ms = motors();
-    let fault = std::env::var("H24_FAULT").ok().map(|f| {
-        let (n, c) = f.split_once(':').unwrap();
-        (Fault::from_name(n).unwrap(), c.parse::<f64>().unwrap())
-    });
-    let seed = std::env::var("H24_SEED").map_or(901, |s| s.parse().unwrap());
-    let o = run(ms[m].0, &ms[m].1, fault, seed);
-    eprintln!("{}", o.row());
 }

@@ -70,6 +70,8 @@ impl Evidence {
             (a - b).abs() < LEVEL_APART * b.abs().max(a.abs())
         });
         match same_level {
+            // The first point is replaced only by one whose slip is as near the anchor's.
+            Some(0) if !self.nearer_the_anchor(&p) => {}
             Some(k) => {
                 if let Some(slot) = self.points.get_mut(k) {
                     *slot = (p, scale);
@@ -85,19 +87,22 @@ impl Evidence {
                 self.points.push((p, scale));
             }
         }
-        if std::env::var("H24_NOANCHOR").is_ok() { self.anchor = None; }
         let enough = self.points.len() >= 2 || self.anchor.is_some();
         self.joint = enough.then(|| {
             follower
                 .isolator()
                 .isolate_points_anchored(&self.points, self.anchor.as_ref())
         });
-        if std::env::var("H24_DEBUG").is_ok() {
-            if let Some(j) = &self.joint {
-                let c: Vec<String> = j.candidates.iter().take(3).map(|c| format!("{} {:+.3} p{:.2} m{:.1}", c.fault, c.change, c.probability, c.misfit)).collect();
-                eprintln!("JOINT n {} anchor {:?} dev {:.1} {:?} {:?}", self.points.len(), self.anchor.map(|a| a.wr_rad_s), j.deviation, j.state, c);
-            }
-        }
+    }
+
+    /// `p`'s slip is at least as near the anchor's as the first point's (true without an
+    /// anchor or a first point).
+    fn nearer_the_anchor(&self, p: &SteadyPoint) -> bool {
+        let (Some(a), Some((first, _))) = (self.anchor, self.points.first()) else {
+            return true;
+        };
+        let slip = |q: &SteadyPoint| q.we_rad_s - q.wr_rad_s;
+        (slip(p) - slip(&a)).abs() <= (slip(first) - slip(&a)).abs()
     }
 
     /// The joint isolation when it names a fault (not the friction class, which the

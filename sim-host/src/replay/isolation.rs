@@ -187,16 +187,6 @@ impl IsolationTracker {
         // Quasi-steady by the vectors themselves (the monitor's gate follows its own frame,
         // which a sensor fault can detune).
         let step = follower.observe(point, dt_s as f32, usable, learning);
-        if std::env::var("H24_DEBUG").is_ok() {
-            if let Some((avg, _)) = follower.averaged() {
-                if matches!(step, Step::Learned | Step::Isolated(_) | Step::Unconfirmed(_)) {
-                    let e = follower.isolator().residuals(&avg, None);
-                    let v = avg.v.d.hypot(avg.v.q);
-                    let ia = (avg.v.d * avg.i.d + avg.v.q * avg.i.q) / v;
-                    eprintln!("DBG t {t:.1} learn {learning} ia {ia:.3} wr {:.2} e {:?}", avg.wr_rad_s, e.map(|e| e.to_array()));
-                }
-            }
-        }
         if let Step::Isolated(result) = step {
             self.evidence.after(follower, &result);
             // A fault one point cannot name may be named from several (evidence across

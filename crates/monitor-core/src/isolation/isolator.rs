@@ -108,7 +108,8 @@ impl Isolator {
         l.n = l.n.saturating_add(1);
         let n = l.n as f32;
         l.at.approach(p, 1.0 / n);
-        l.range.learn(crate::OperatingPoint::from_dq(p.v.d, p.v.q, p.i.d, p.i.q));
+        l.range
+            .learn(crate::OperatingPoint::from_dq(p.v.d, p.v.q, p.i.d, p.i.q));
         for ((m, m2), x) in l.mean.iter_mut().zip(l.m2.iter_mut()).zip(e.to_array()) {
             let d = x - *m;
             *m += d / n;
@@ -513,7 +514,8 @@ impl Isolator {
     }
 
     /// The misfit of the torque at `p` under `h` against the load known at the anchor
-    /// (`load`: the anchor point and its torque; `None`: no term), with the spread
+    /// (`load`: the anchor point and its torque; `None`, or a slip that moved more than
+    /// [`ANCHOR_SLIP_BAND`] from the anchor's: no term), with the spread
     /// [`ANCHOR_TORQUE_SPREAD`] times `scale` widened by [`LOAD_SLIP_FACTOR`] times the
     /// measured slip's relative change from the anchor times the anchor's torque.
     fn chi2_load(
@@ -532,6 +534,9 @@ impl Isolator {
         let slip0 = crate::maxf((a.we_rad_s - a.wr_rad_s).abs(), 1e-3);
         let slip = p.we_rad_s - p.wr_rad_s;
         let moved = (slip - (a.we_rad_s - a.wr_rad_s)) / slip0;
+        if !(moved.abs() <= ANCHOR_SLIP_BAND) {
+            return 0.0;
+        }
         let s_load = LOAD_SLIP_FACTOR * moved * t0 / self.torque_base_nm;
         let s = ANCHOR_TORQUE_SPREAD * scale;
         let d = (te - t0) / self.torque_base_nm;
@@ -697,6 +702,12 @@ fn rank(out: &mut Isolation, fits: &mut [(f32, f32); FAULT_COUNT], heat: (f32, f
 /// region the torque is proportional to the slip, so a load change moves the slip by about
 /// as much; twice that covers the curvature up to rated load.
 pub const LOAD_SLIP_FACTOR: f32 = 2.0;
+
+/// Largest relative change of the measured slip from the anchor's at which the load is
+/// taken as known ([`Isolator::isolate_points_anchored`]): 10 %. Beyond it the load may have
+/// moved by tens of per cent, and a comparison so widened only adds chance to the ranking
+/// of faults the voltage equations see alike (the current and voltage sensors).
+pub const ANCHOR_SLIP_BAND: f32 = 0.1;
 
 /// Spread of the torque comparison with the anchor, as a fraction of `T_base`: twice the
 /// learned floor of the torque balance ([`LEARNED_SPREAD_FLOOR`]), for the two points'

@@ -83,7 +83,8 @@
 //! *anchor*), the load there is known: the torque the nominal machine gave at the anchor.
 //! [`Isolator::isolate_points_anchored`] compares each hypothesis' torque with it, its
 //! spread widened by how far the load may have moved: [`LOAD_SLIP_FACTOR`] times the
-//! measured slip's relative change (in the linear region the torque follows the slip). A
+//! measured slip's relative change (in the linear region the torque follows the slip), and
+//! only within [`ANCHOR_SLIP_BAND`] of the anchor's slip. A
 //! sensor gain step, which moves neither the machine nor its speed, is then judged with the torque balance (a current sensor's error scales the torque, a
 //! voltage sensor's does not: the two scale `Z = V / I` alike and only the torque tells
 //! them apart), while a fault that moves the speed falls back to the voltage equations.
@@ -129,12 +130,11 @@
 mod follower;
 pub use follower::{
     steady_against, Follower, Step, AVERAGE_MAX_S, AVERAGE_S, BLOCKS, CONFIRM_S, SETTLE_S,
-    STEADY_FRACTION,
-    STEP_S,
+    STEADY_FRACTION, STEP_S,
 };
 mod circuit;
 mod isolator;
-pub use isolator::{ANCHOR_TORQUE_SPREAD, LOAD_SLIP_FACTOR, MAX_POINTS};
+pub use isolator::{ANCHOR_SLIP_BAND, ANCHOR_TORQUE_SPREAD, LOAD_SLIP_FACTOR, MAX_POINTS};
 
 use circuit::{Circuit, Sym3};
 
