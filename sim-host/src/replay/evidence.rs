@@ -6,12 +6,13 @@
 //! part over two load levels 20 % apart or more.
 //!
 //! The last point judged healthy before the deviation is kept as the *anchor*: where the
-//! slip has not moved since, the load is the torque the machine gave there, and the joint
-//! fit compares each hypothesis' torque with it (`Isolator::isolate_points_anchored`). A
-//! sensor gain step, which moves neither the machine nor its speed, is judged with it from
-//! the first point after the step: a current sensor's error scales the torque computed
-//! from the currents, a voltage sensor's does not (the stator-voltage equations alone see
-//! the two alike).
+//! load (the active current) has not moved since, the load is the torque the machine gave
+//! there, and the joint fit compares each hypothesis' torque at the first point of the
+//! deviation with it (`Isolator::isolate_points_anchored`; that point is kept while the
+//! deviation lasts). A sensor gain step, which moves neither the
+//! machine nor its load, is judged with it from the first point after the step: a current
+//! sensor's error scales the torque computed from the currents, a voltage sensor's does
+//! not (the stator-voltage equations alone see the two alike).
 
 use monitor_core::isolation::{
     Follower, Isolation, IsolationState, Named, SteadyPoint, MAX_POINTS,
@@ -70,8 +71,8 @@ impl Evidence {
             (a - b).abs() < LEVEL_APART * b.abs().max(a.abs())
         });
         match same_level {
-            // The first point is replaced only by one whose slip is as near the anchor's.
-            Some(0) if !self.nearer_the_anchor(&p) => {}
+            // The first point, compared with the anchor's load, stays.
+            Some(0) if self.anchor.is_some() => {}
             Some(k) => {
                 if let Some(slot) = self.points.get_mut(k) {
                     *slot = (p, scale);
@@ -93,16 +94,6 @@ impl Evidence {
                 .isolator()
                 .isolate_points_anchored(&self.points, self.anchor.as_ref())
         });
-    }
-
-    /// `p`'s slip is at least as near the anchor's as the first point's (true without an
-    /// anchor or a first point).
-    fn nearer_the_anchor(&self, p: &SteadyPoint) -> bool {
-        let (Some(a), Some((first, _))) = (self.anchor, self.points.first()) else {
-            return true;
-        };
-        let slip = |q: &SteadyPoint| q.we_rad_s - q.wr_rad_s;
-        (slip(p) - slip(&a)).abs() <= (slip(first) - slip(&a)).abs()
     }
 
     /// The joint isolation when it names a fault (not the friction class, which the

@@ -186,8 +186,7 @@ impl IsolationTracker {
         let learned = follower.learned();
         // Quasi-steady by the vectors themselves (the monitor's gate follows its own frame,
         // which a sensor fault can detune).
-        let step = follower.observe(point, dt_s as f32, usable, learning);
-        if let Step::Isolated(result) = step {
+        if let Step::Isolated(result) = follower.observe(point, dt_s as f32, usable, learning) {
             self.evidence.after(follower, &result);
             // A fault one point cannot name may be named from several (evidence across
             // operating points).

@@ -430,15 +430,17 @@ impl Isolator {
 
     /// [`Isolator::isolate_points`] with the load known at one point: `anchor`, the last
     /// steady point judged healthy before the deviation began (module docs, "The load
-    /// before the deviation"). At each point the torque the circuit gives under the
-    /// hypothesis is compared with the anchor's (the nominal machine's torque there). The
-    /// load may have moved since; in the machine's linear region a load change moves the
-    /// slip by about as much, so the comparison's spread is widened by
-    /// [`LOAD_SLIP_FACTOR`] times the measured slip's relative change times the anchor's
-    /// torque. A sensor gain step, which moves neither the machine nor its speed, is thus
-    /// judged with the torque balance (a current sensor's error scales the torque computed
-    /// from the currents, a voltage sensor's does not), while a load step or a fault that
-    /// moves the slip leaves the voltage equations to decide.
+    /// before the deviation"). At the first point (the first steady point of the deviation,
+    /// the nearest to the anchor in time), if its active current is within
+    /// [`ANCHOR_LOAD_BAND`] of the anchor's, the torque the circuit gives under the
+    /// hypothesis is compared with the anchor's load carried to the point's speed by the
+    /// paper's viscous law (the nominal machine's torque at the anchor times the speeds'
+    /// ratio, [`LOAD_LAW_SPREAD`] allowed). A sensor gain step, which moves neither the
+    /// machine nor its load, is thus judged with the torque balance (a current sensor's
+    /// error scales the torque computed from the currents, a voltage sensor's does not),
+    /// and an Rr change at one load level parts from a speed-sensor error (the one slows
+    /// the machine and its viscous load, the other only the reading); a load step leaves the
+    /// voltage equations to decide.
     pub fn isolate_points_anchored(
         &self,
         points: &[(SteadyPoint, f32)],
@@ -471,10 +473,13 @@ impl Isolator {
             return out;
         };
         let load = anchor.and_then(|a| Some((*a, self.torque_nm(a, None)?)));
+        // The load is compared at the first point only: the first steady point of the
+        // deviation, the one nearest the anchor in time.
         let chi_with = |iso: &Isolator, h: Option<(Fault, f32)>| -> f32 {
-            used.iter()
-                .map(|(p, w, k)| iso.chi2_at(p, h, w) + iso.chi2_load(p, h, load, *k))
-                .sum()
+            let first = used
+                .first()
+                .map_or(0.0, |(p, _, k)| iso.chi2_load(p, h, load, *k));
+            first + used.iter().map(|(p, w, _)| iso.chi2_at(p, h, w)).sum::<f32>()
         };
         let chi = |h: Option<(Fault, f32)>| chi_with(self, h);
         let chi0 = chi(None);
@@ -514,10 +519,12 @@ impl Isolator {
     }
 
     /// The misfit of the torque at `p` under `h` against the load known at the anchor
-    /// (`load`: the anchor point and its torque; `None`, or a slip that moved more than
-    /// [`ANCHOR_SLIP_BAND`] from the anchor's: no term), with the spread
-    /// [`ANCHOR_TORQUE_SPREAD`] times `scale` widened by [`LOAD_SLIP_FACTOR`] times the
-    /// measured slip's relative change from the anchor times the anchor's torque.
+    /// (`load`: the anchor point and its torque; `None`: no term). Under `h` (its sensor
+    /// correction applied to the point, not to the anchor, measured before) the load is taken as unchanged where the active
+    /// current moved by at most [`ANCHOR_LOAD_BAND`] from the anchor's (else no term), and
+    /// as the paper's viscous load `T0 wr / wr0` there; the spread is
+    /// [`ANCHOR_TORQUE_SPREAD`] times `scale`, widened by [`LOAD_LAW_SPREAD`] times the
+    /// speed's relative change times `T0`.
     fn chi2_load(
         &self,
         p: &SteadyPoint,
@@ -528,19 +535,25 @@ impl Isolator {
         let Some((a, t0)) = load else {
             return 0.0;
         };
+        // (The anchor was measured before the deviation: its readings stand as they are.)
+        let ((_, q), qa) = (self.hypothesis(p, h), a);
+        let active = |x: &SteadyPoint| {
+            crate::OperatingPoint::from_dq(x.v.d, x.v.q, x.i.d, x.i.q).load_a
+        };
+        let (ia, i0) = (active(&q), active(&qa));
+        let moved = (ia - i0) / crate::maxf(i0.abs(), 1e-6);
+        if !(moved.abs() <= ANCHOR_LOAD_BAND) {
+            return 0.0;
+        }
         let Some(te) = self.torque_nm(p, h) else {
             return f32::INFINITY;
         };
-        let slip0 = crate::maxf((a.we_rad_s - a.wr_rad_s).abs(), 1e-3);
-        let slip = p.we_rad_s - p.wr_rad_s;
-        let moved = (slip - (a.we_rad_s - a.wr_rad_s)) / slip0;
-        if !(moved.abs() <= ANCHOR_SLIP_BAND) {
-            return 0.0;
-        }
-        let s_load = LOAD_SLIP_FACTOR * moved * t0 / self.torque_base_nm;
+        let speed = q.wr_rad_s / crate::maxf(qa.wr_rad_s.abs(), 1.0);
+        let t_load = t0 * speed;
+        let s_law = LOAD_LAW_SPREAD * (speed - 1.0) * t0 / self.torque_base_nm;
         let s = ANCHOR_TORQUE_SPREAD * scale;
-        let d = (te - t0) / self.torque_base_nm;
-        let var = s * s + s_load * s_load;
+        let d = (te - t_load) / self.torque_base_nm;
+        let var = s * s + s_law * s_law;
         if var > 0.0 {
             d * d / var
         } else {
@@ -697,17 +710,17 @@ fn rank(out: &mut Isolation, fits: &mut [(f32, f32); FAULT_COUNT], heat: (f32, f
     };
 }
 
-/// How much the load may have changed between the anchor and a point, per relative change
-/// of the measured slip ([`Isolator::isolate_points_anchored`]): 2. In the machine's linear
-/// region the torque is proportional to the slip, so a load change moves the slip by about
-/// as much; twice that covers the curvature up to rated load.
-pub const LOAD_SLIP_FACTOR: f32 = 2.0;
+/// Largest relative change of the active current from the anchor's (the sensor
+/// correction of the hypothesis applied) at which the load is taken as unchanged
+/// ([`Isolator::isolate_points_anchored`]): 6 %. The active current follows the input
+/// power: at a constant load the faults of the list move it by their losses, a few per
+/// cent (Rr +50 % about 3 %), while a load step of 10 % or more moves it by about as much.
+pub const ANCHOR_LOAD_BAND: f32 = 0.06;
 
-/// Largest relative change of the measured slip from the anchor's at which the load is
-/// taken as known ([`Isolator::isolate_points_anchored`]): 10 %. Beyond it the load may have
-/// moved by tens of per cent, and a comparison so widened only adds chance to the ranking
-/// of faults the voltage equations see alike (the current and voltage sensors).
-pub const ANCHOR_SLIP_BAND: f32 = 0.1;
+/// Uncertainty of the load's speed law around the paper's viscous `T ~ wr`
+/// ([`Isolator::isolate_points_anchored`]): the exponent 1 +- 0.25, times the speed's
+/// relative change from the anchor.
+pub const LOAD_LAW_SPREAD: f32 = 0.25;
 
 /// Spread of the torque comparison with the anchor, as a fraction of `T_base`: twice the
 /// learned floor of the torque balance ([`LEARNED_SPREAD_FLOOR`]), for the two points'

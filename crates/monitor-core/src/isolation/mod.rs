@@ -78,16 +78,17 @@
 //! of deviation for 15 on the voltage equations.)
 //!
 //! # The load before the deviation
-//! The torque balance needs the load, which in service moves. Where the deviation began at
-//! a steady point whose slip has not moved since the last point judged healthy (the
-//! *anchor*), the load there is known: the torque the nominal machine gave at the anchor.
-//! [`Isolator::isolate_points_anchored`] compares each hypothesis' torque with it, its
-//! spread widened by how far the load may have moved: [`LOAD_SLIP_FACTOR`] times the
-//! measured slip's relative change (in the linear region the torque follows the slip), and
-//! only within [`ANCHOR_SLIP_BAND`] of the anchor's slip. A
-//! sensor gain step, which moves neither the machine nor its speed, is then judged with the torque balance (a current sensor's error scales the torque, a
-//! voltage sensor's does not: the two scale `Z = V / I` alike and only the torque tells
-//! them apart), while a fault that moves the speed falls back to the voltage equations.
+//! The torque balance needs the load, which in service moves. The last steady point judged
+//! healthy before a deviation began (the *anchor*) tells the load there: the torque the
+//! nominal machine gave. Where the active current (the input power's measure) has not
+//! moved by more than [`ANCHOR_LOAD_BAND`] since, the load is taken as the same viscous
+//! load, carried to the point's speed ([`LOAD_LAW_SPREAD`] allowed for its law), and
+//! [`Isolator::isolate_points_anchored`] compares each hypothesis' torque with it. A
+//! sensor gain step, which moves neither the machine nor its load, is then judged with the
+//! torque balance (a current sensor's error scales the torque, a voltage sensor's does not:
+//! the two scale `Z = V / I` alike and only the torque tells them apart), and an Rr change
+//! parts from a speed-sensor error at one load level. A load step leaves the voltage
+//! equations to decide.
 //!
 //! # Heating is not a fault
 //! A winding that warms raises Rs and Rr together, by the same factor
@@ -134,7 +135,7 @@ pub use follower::{
 };
 mod circuit;
 mod isolator;
-pub use isolator::{ANCHOR_SLIP_BAND, ANCHOR_TORQUE_SPREAD, LOAD_SLIP_FACTOR, MAX_POINTS};
+pub use isolator::{ANCHOR_LOAD_BAND, ANCHOR_TORQUE_SPREAD, LOAD_LAW_SPREAD, MAX_POINTS};
 
 use circuit::{Circuit, Sym3};
 
