@@ -22,6 +22,11 @@ use monitor_core::isolation::{
 /// 15 %, so that two points are two operating points and not one seen twice.
 pub const LEVEL_APART: f32 = 0.15;
 
+/// Largest relative difference of the active current at which a later point replaces the
+/// first one (the same operating point averaged again): 2 %, the follower's steadiness
+/// band (`monitor_core::isolation::STEADY_FRACTION`).
+const SAME_POINT: f32 = monitor_core::isolation::STEADY_FRACTION;
+
 /// The active current of a steady point (its current's part in phase with its voltage) [A].
 fn active_current(p: &SteadyPoint) -> f32 {
     let v = p.v.d.hypot(p.v.q);
@@ -44,8 +49,9 @@ pub(super) struct Evidence {
 impl Evidence {
     /// After an isolation `result` of the follower: a deviation keeps the averaged point
     /// (replacing the one at its load level, else added, the oldest dropped beyond
-    /// [`MAX_POINTS`], except the first with an anchor) and refits jointly; no deviation
-    /// forgets the evidence and makes the averaged point the anchor.
+    /// [`MAX_POINTS`], except the first with an anchor) and refits jointly; no deviation, or
+    /// one the stator-voltage equations do not see (the load moved), forgets the evidence
+    /// and makes the averaged point the anchor.
     pub(super) fn after(&mut self, follower: &Follower, result: &Isolation) {
         if !matches!(
             result.state,
@@ -62,6 +68,16 @@ impl Evidence {
         let Some((p, scale)) = follower.averaged() else {
             return;
         };
+        // A deviation the stator-voltage equations do not see (the torque balance's alone:
+        // the load moved) is an operating-point change, not a fault: the point is healthy
+        // evidence, and the new anchor.
+        let iso = follower.isolator();
+        if iso.isolate_points(&[(p, scale)]).state == IsolationState::NoDeviation {
+            self.points.clear();
+            self.joint = None;
+            self.anchor = Some(p);
+            return;
+        }
         let a = active_current(&p);
         if !a.is_finite() {
             return;
@@ -71,8 +87,12 @@ impl Evidence {
             (a - b).abs() < LEVEL_APART * b.abs().max(a.abs())
         });
         match same_level {
-            // The first point, compared with the anchor's load, stays.
-            Some(0) if self.anchor.is_some() => {}
+            // The first point, compared with the anchor's load, gives way only to a later
+            // average of the same operating point before the load has moved (the first may
+            // have begun inside the change).
+            Some(0)
+                if self.anchor.is_some()
+                    && (self.points.len() > 1 || !self.same_point_as_first(a)) => {}
             Some(k) => {
                 if let Some(slot) = self.points.get_mut(k) {
                     *slot = (p, scale);
@@ -94,6 +114,20 @@ impl Evidence {
                 .isolator()
                 .isolate_points_anchored(&self.points, self.anchor.as_ref())
         });
+    }
+
+    /// The active current `a` is within [`SAME_POINT`] of the first point's.
+    fn same_point_as_first(&self, a: f32) -> bool {
+        self.points.first().is_some_and(|(q, _)| {
+            let b = active_current(q);
+            (a - b).abs() <= SAME_POINT * b.abs()
+        })
+    }
+
+    /// The joint isolation compares the first point's torque with the load at an anchor
+    /// (the last point judged healthy before the deviation).
+    pub(super) fn anchored(&self) -> bool {
+        self.anchor.is_some()
     }
 
     /// The joint isolation when it names a fault (not the friction class, which the

@@ -479,7 +479,11 @@ impl Isolator {
             let first = used
                 .first()
                 .map_or(0.0, |(p, _, k)| iso.chi2_load(p, h, load, *k));
-            first + used.iter().map(|(p, w, _)| iso.chi2_at(p, h, w)).sum::<f32>()
+            first
+                + used
+                    .iter()
+                    .map(|(p, w, _)| iso.chi2_at(p, h, w))
+                    .sum::<f32>()
         };
         let chi = |h: Option<(Fault, f32)>| chi_with(self, h);
         let chi0 = chi(None);
@@ -537,9 +541,8 @@ impl Isolator {
         };
         // (The anchor was measured before the deviation: its readings stand as they are.)
         let ((_, q), qa) = (self.hypothesis(p, h), a);
-        let active = |x: &SteadyPoint| {
-            crate::OperatingPoint::from_dq(x.v.d, x.v.q, x.i.d, x.i.q).load_a
-        };
+        let active =
+            |x: &SteadyPoint| crate::OperatingPoint::from_dq(x.v.d, x.v.q, x.i.d, x.i.q).load_a;
         let (ia, i0) = (active(&q), active(&qa));
         let moved = (ia - i0) / crate::maxf(i0.abs(), 1e-6);
         if !(moved.abs() <= ANCHOR_LOAD_BAND) {
