@@ -27,6 +27,12 @@ pub const LEVEL_APART: f32 = 0.15;
 /// band (`monitor_core::isolation::STEADY_FRACTION`).
 const SAME_POINT: f32 = monitor_core::isolation::STEADY_FRACTION;
 
+/// Largest deviation of the stator-voltage equations alone [standard deviations] at which
+/// a point the single isolation reads as the friction class counts as a load that moved:
+/// 2, half the detection threshold (a fault that moves the voltage equations a little, Ls
+/// on the 3 hp machine at one load level, stays evidence).
+const LOAD_MOVED_SIGMA: f32 = 2.0;
+
 /// The active current of a steady point (its current's part in phase with its voltage) [A].
 fn active_current(p: &SteadyPoint) -> f32 {
     let v = p.v.d.hypot(p.v.q);
@@ -68,11 +74,13 @@ impl Evidence {
         let Some((p, scale)) = follower.averaged() else {
             return;
         };
-        // A deviation the stator-voltage equations do not see (the torque balance's alone:
-        // the load moved) is an operating-point change, not a fault: the point is healthy
-        // evidence, and the new anchor.
+        // A deviation the single point reads as the friction class that the stator-voltage
+        // equations do not see (within LOAD_MOVED_SIGMA: the load moved) is an
+        // operating-point change, not a fault: the point is healthy evidence, and the new
+        // anchor.
         let iso = follower.isolator();
-        if iso.isolate_points(&[(p, scale)]).state == IsolationState::NoDeviation {
+        let friction = matches!(result.named(), Some(Named::Friction { .. }));
+        if friction && iso.isolate_points(&[(p, scale)]).deviation < LOAD_MOVED_SIGMA {
             self.points.clear();
             self.joint = None;
             self.anchor = Some(p);

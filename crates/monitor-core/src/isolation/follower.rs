@@ -35,10 +35,11 @@
 //! commissioning over the load range learned spreads of 0.1-0.3 % instead of 0.04 %).
 //!
 //! A change smaller than [`STEADY_FRACTION`] (Ls or Lr +-50 % on the 3 hp machine) does
-//! not leave the band: the first isolation that sees a deviation after a healthy one
-//! averages blocks from before the change with blocks after it. That result is not used:
-//! the average is begun again, with the same settling, and the deviation is judged on
-//! blocks after it (measured on the same service logs: the blend passed the direction of
+//! not leave the band: the first isolation that sees a deviation after a healthy one, on a
+//! full average ([`AVERAGE_MAX_S`]), averages blocks from before the change with blocks
+//! after it. That result is not used: the average is begun again, with the same settling,
+//! and the deviation is judged on blocks after it (once per operating point: again only
+//! after the point has left the band) (measured on the same service logs: the blend passed the direction of
 //! Rs for half a second after an Lr +-50 % step on the 3 hp machine, and Rs was named).
 //!
 //! [`DEFAULT_SPREAD`]: super::DEFAULT_SPREAD
@@ -181,7 +182,8 @@ pub struct Follower {
     since_isolation_s: f32,
     /// Time left of the settling after a point left the band [s] ([`SETTLE_S`]).
     settling_s: f32,
-    /// The average was begun again at the onset of the deviation in force (module docs).
+    /// The average was begun again at the onset of a deviation since the point last left
+    /// the band (module docs).
     onset_restarted: bool,
 }
 
@@ -239,6 +241,7 @@ impl Follower {
         if self.reference().is_some_and(|r| !r.admits(p)) {
             self.restart();
             self.settling_s = SETTLE_S;
+            self.onset_restarted = false;
         } else {
             self.settling_s = crate::maxf(self.settling_s - dt, 0.0);
         }
@@ -287,16 +290,16 @@ impl Follower {
             let was_healthy = self
                 .last
                 .is_none_or(|l| l.state == super::IsolationState::NoDeviation);
-            if deviates && !heating && was_healthy && !self.onset_restarted {
+            // (Only a full average can hold blocks from before a change that stayed inside
+            // the band; one begun after a band restart cannot.)
+            let full = self.filled >= BLOCKS;
+            if deviates && !heating && was_healthy && full && !self.onset_restarted {
                 // The onset of a deviation: the average is begun again after it (module
                 // docs).
                 self.onset_restarted = true;
                 self.restart();
                 self.settling_s = SETTLE_S;
                 return Step::Waiting;
-            }
-            if result.state == super::IsolationState::NoDeviation {
-                self.onset_restarted = false;
             }
             self.confirm(result)
         }
