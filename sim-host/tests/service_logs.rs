@@ -14,7 +14,7 @@
 //! tuned on). The whole table (51 logs, about 10 s on two cores in the test profile) runs
 //! with `MONITOR_FULL_SWEEPS=1` (`.ci/run` runs it), with the hour-long log below; plain
 //! `cargo test` runs a subset of seven on the 2.2 kW machine. Print the table with
-//! `-- --nocapture`. Measured (docs/isolation.md, "Service logs"): 46 of 48 named alone
+//! `-- --nocapture`. Measured (docs/isolation.md, "Service logs"): 45 of 48 named alone
 //! with their size, no wrong name, the healthy logs name nothing.
 
 use monitor_core::Fault;
