@@ -76,11 +76,16 @@ impl Evidence {
         };
         // A deviation the single point reads as the friction class that the stator-voltage
         // equations do not see (within LOAD_MOVED_SIGMA: the load moved) is an
-        // operating-point change, not a fault: the point is healthy evidence, and the new
-        // anchor.
+        // operating-point change, not a fault: before any evidence of a fault it is the new
+        // anchor. After such evidence it is one more operating point of the joint fit (an
+        // Ls change on the 3 hp machine at half load moves the voltage equations by less
+        // than LOAD_MOVED_SIGMA; the points before the load move still tell it).
         let iso = follower.isolator();
         let friction = matches!(result.named(), Some(Named::Friction { .. }));
-        if friction && iso.isolate_points(&[(p, scale)]).deviation < LOAD_MOVED_SIGMA {
+        if friction
+            && self.points.is_empty()
+            && iso.isolate_points(&[(p, scale)]).deviation < LOAD_MOVED_SIGMA
+        {
             self.points.clear();
             self.joint = None;
             self.anchor = Some(p);
