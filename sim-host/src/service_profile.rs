@@ -12,6 +12,9 @@ use crate::params::ParamFile;
 use crate::replay::{NameGiven, ReplayOptions};
 use crate::sim::{FaultSpec, LoadSpec, LoadStep, Scenario, SensorSpec, SupplyStep};
 use monitor_core::{AngleSource, ResidualForm};
+use rand::seq::SliceRandom;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 
 /// Commissioning window of the profile [s].
 pub const COMMISSION: (f64, f64) = (2.0, 30.0);
@@ -144,3 +147,55 @@ pub fn watch_mismatched(
     w.isolation_names = replay.isolation_names().to_vec();
     Ok(w)
 }
+
+/// A service log whose load moves (issue 24's service logs): the paper's viscous load
+/// `Bl omega` with Bl stepped every [`MOVING_PERIOD_S`] between 0.7 and 1.3 times the
+/// parameter file's (+-30 %). Over [`MOVING_COMMISSION`] the load visits 0.7, 0.85, 1.0,
+/// 1.15 and 1.3 in an order drawn from `seed` (the commissioning sees the whole range);
+/// afterwards every level is drawn from `seed` uniformly in 0.7..1.3, at least 0.1 from
+/// the one before. The supply is the file's, the sensors the simulator's default 12-bit,
+/// 0.1 %-noise ones; `rate_hz` [Hz] the log's sample rate.
+pub fn moving_load(params: &ParamFile, seed: u64, duration_s: f64, rate_hz: f64) -> Scenario {
+    let mut sc = Scenario::steady(duration_s, rate_hz);
+    sc.seed = seed;
+    sc.sensors = SensorSpec::default();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5EED_10AD);
+    let mut first = [0.7, 0.85, 1.0, 1.15, 1.3];
+    first.shuffle(&mut rng);
+    let mut steps = Vec::new();
+    let mut t = MOVING_PERIOD_S;
+    let mut last: f64 = 1.0;
+    let mut k = 0;
+    while t < duration_s {
+        let level = match first.get(k) {
+            Some(&l) => l,
+            None => loop {
+                let l = rng.gen_range(0.7..1.3);
+                if (l - last).abs() >= 0.1 {
+                    break l;
+                }
+            },
+        };
+        steps.push(LoadStep {
+            t_s: t,
+            torque_nm: None,
+            bl_scale: Some(level),
+        });
+        last = level;
+        k += 1;
+        t += MOVING_PERIOD_S;
+    }
+    sc.load = LoadSpec {
+        bl_nms: Some(params.motor.bl_nms),
+        steps,
+        ..LoadSpec::default()
+    };
+    sc
+}
+
+/// How often the load of [`moving_load`] steps [s].
+pub const MOVING_PERIOD_S: f64 = 4.0;
+
+/// The commissioning window of [`moving_load`] [s]: from the end of the start (a 37 kW
+/// machine's run-up takes about a second and a half) over the five first load levels.
+pub const MOVING_COMMISSION: (f64, f64) = (2.0, 24.0);

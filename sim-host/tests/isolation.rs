@@ -83,7 +83,7 @@ fn run(m: usize, f: Fault, change: f64) -> Table1Row {
         sample_rate_hz: 5000.0,
         commission: if late { (3.0, 5.0) } else { (2.0, 4.0) },
         fault_at_s: if late { 5.5 } else { 4.5 },
-        duration_s: if late { 9.0 } else { 8.0 },
+        duration_s: if late { 10.5 } else { 9.5 },
         ..Protocol::default()
     };
     run_case(p, f, change, &proto).unwrap_or_else(|e| panic!("{name} {f} {change}: {e}"))
@@ -135,17 +135,28 @@ fn every_fault_is_named_with_its_size_or_honestly_not_named() {
             if row.named.is_some() {
                 failures.push(format!("{tag} ({why}): named {:?}", row.named));
             }
-            // Shared, but still the leading candidate with its size (the issue's "top
+            // Shared, but still a leading candidate with its size (the issue's "top
             // candidate"): at +/-50 % a fault that is not named alone must not lose the
-            // lead to the fault it is confused with.
+            // lead to the fault it is confused with by more than a tie (the core's
+            // NAME_MARGIN: two faults whose directions coincide share the probability
+            // about evenly, and which of them is first by a hundredth is the noise's).
             if change.abs() > 0.4 {
-                match row.isolation_candidates.first() {
+                let top = row
+                    .isolation_candidates
+                    .first()
+                    .map_or(0.0, |c| c.probability);
+                let own = row.isolation_candidates.iter().find(|c| c.fault == *f);
+                match own {
                     Some(FaultCandidate {
-                        fault: c,
+                        probability,
                         change: Some(k),
                         ..
-                    }) if c == f && (f64::from(*k) - change).abs() <= 0.2 * change.abs() => {}
-                    top => failures.push(format!("{tag} ({why}): top candidate {top:?}")),
+                    }) if *probability >= top - monitor_core::isolation::NAME_MARGIN
+                        && (f64::from(*k) - change).abs() <= 0.2 * change.abs() => {}
+                    _ => failures.push(format!(
+                        "{tag} ({why}): not a leading candidate with its size: {:?}",
+                        row.isolation_candidates
+                    )),
                 }
             }
         } else {
@@ -178,8 +189,8 @@ fn healthy_runs_name_nothing() {
 /// through the command line with a parameter file 15-20 % off (Rs +20 %, Rr -19 %, Lm
 /// -15 %, leakages -13 %) and commissioned at the first load. Before the isolation
 /// allowed for the parameter file's error away from the learned point it named
-/// `current_sensor -27 %` at p = 0.95. Now: no fault at >= 0.5 (other than the friction
-/// class, which a load change is), and the verdict says the current moved from where the
+/// `current_sensor -27 %` at p = 0.95. Now: no wrong fault at >= 0.5 (the friction class,
+/// which a load change is, or the injected Rr with its size), and the verdict says the current moved from where the
 /// baseline was learned.
 #[test]
 fn a_load_step_then_a_fault_with_a_parameter_file_that_is_off_names_no_wrong_fault() {
@@ -234,22 +245,39 @@ fn a_load_step_then_a_fault_with_a_parameter_file_that_is_off_names_no_wrong_fau
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap(); // ok: test
     let iso = &v["isolation"];
     eprintln!("{}", iso["verdict"]);
+    // Nothing wrong named: the friction class (a load change is one to the paper's model)
+    // or the injected Rr +50 % with its size (the torque against the load measured just
+    // before the change tells it since issue 24), or nothing.
     let named = iso["named"].as_str();
-    assert!(named.is_none() || named == Some("b/bl"), "{iso}");
+    match named {
+        None | Some("b/bl") => {}
+        Some("rr") => {
+            let size = iso["named_change"].as_f64().unwrap_or(f64::NAN); // ok: test
+            assert!(
+                (size - 0.5).abs() <= 0.1,
+                "rr named with size {size}: {iso}"
+            );
+        }
+        Some(other) => panic!("{other} named: {iso}"), // ok: test
+    }
     for c in v["candidates"].as_array().unwrap() {
         // ok: test
         let (f, p) = (
             c["fault"].as_str().unwrap(),
             c["probability"].as_f64().unwrap(),
         ); // ok: test
-        assert!(p < 0.5 || f == "b" || f == "bl", "{c}");
+        assert!(p < 0.5 || f == "b" || f == "bl" || f == "rr", "{c}");
     }
     let moved = iso["moved_from_learned"].as_f64().unwrap(); // ok: test
     assert!(moved < -0.15, "the current fell with the load: {moved}");
+    // Where nothing is named, the verdict says why: the point is away from the learned one.
+    let said = if named == Some("rr") {
+        "The rotor resistance Rr changed by +50 %"
+    } else {
+        "from where the baseline was learned"
+    };
     assert!(
-        iso["verdict"]
-            .as_str()
-            .is_some_and(|s| s.contains("from where the baseline was learned")),
+        iso["verdict"].as_str().is_some_and(|s| s.contains(said)),
         "{iso}"
     );
 }

@@ -22,8 +22,9 @@ fn the_fault_lamp_blinks_the_isolated_fault_and_the_size_is_right() {
     ];
     let mut wrong = Vec::new();
     for (fault, sensor, change) in cases {
-        // Long enough for two periods of blink code 9 after the fault is named.
-        let mut scenario = Scenario::steady(20.0, f64::from(FS));
+        // Long enough for two periods of blink code 9 after the fault is named (about 2 s
+        // after it: the first deviation restarts the average, monitor_core's follower).
+        let mut scenario = Scenario::steady(30.0, f64::from(FS));
         scenario.faults.push(if sensor {
             FaultSpec::sensor_gain(fault, 4.0, change)
         } else {
@@ -41,7 +42,7 @@ fn the_fault_lamp_blinks_the_isolated_fault_and_the_size_is_right() {
         let trace: Vec<bool> = rig
             .seen
             .iter()
-            .filter(|s| s.t_ms >= 5_000)
+            .filter(|s| s.t_ms >= 7_000)
             .map(|s| s.tick.lamps.fault)
             .collect();
         let code = panel::read_blink_code(&trace, PANEL_PERIOD_MS);

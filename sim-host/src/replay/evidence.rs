@@ -4,6 +4,15 @@
 //! the stator-voltage equations only: the load at each point is an unknown input). Faults
 //! that coincide at one point (on the 3 hp motor at rated load Ls, Rr and the speed sensor)
 //! part over two load levels 20 % apart or more.
+//!
+//! The last point judged healthy before the deviation is kept as the *anchor*: where the
+//! load (the active current) has not moved since, the load is the torque the machine gave
+//! there, and the joint fit compares each hypothesis' torque at the first point of the
+//! deviation with it (`Isolator::isolate_points_anchored`; that point is kept while the
+//! deviation lasts). A sensor gain step, which moves neither the
+//! machine nor its load, is judged with it from the first point after the step: a current
+//! sensor's error scales the torque computed from the currents, a voltage sensor's does
+//! not (the stator-voltage equations alone see the two alike).
 
 use monitor_core::isolation::{
     Follower, Isolation, IsolationState, Named, SteadyPoint, MAX_POINTS,
@@ -12,6 +21,17 @@ use monitor_core::isolation::{
 /// Smallest relative difference of the load (the active current) between two kept points:
 /// 15 %, so that two points are two operating points and not one seen twice.
 pub const LEVEL_APART: f32 = 0.15;
+
+/// Largest relative difference of the active current at which a later point replaces the
+/// first one (the same operating point averaged again): 2 %, the follower's steadiness
+/// band (`monitor_core::isolation::STEADY_FRACTION`).
+const SAME_POINT: f32 = monitor_core::isolation::STEADY_FRACTION;
+
+/// Largest deviation of the stator-voltage equations alone [standard deviations] at which
+/// a point the single isolation reads as the friction class counts as a load that moved:
+/// 2, half the detection threshold (a fault that moves the voltage equations a little, Ls
+/// on the 3 hp machine at one load level, stays evidence).
+const LOAD_MOVED_SIGMA: f32 = 2.0;
 
 /// The active current of a steady point (its current's part in phase with its voltage) [A].
 fn active_current(p: &SteadyPoint) -> f32 {
@@ -28,12 +48,16 @@ fn active_current(p: &SteadyPoint) -> f32 {
 pub(super) struct Evidence {
     points: Vec<(SteadyPoint, f32)>,
     joint: Option<Isolation>,
+    /// The last averaged point judged healthy (no deviation) before the points kept.
+    anchor: Option<SteadyPoint>,
 }
 
 impl Evidence {
     /// After an isolation `result` of the follower: a deviation keeps the averaged point
     /// (replacing the one at its load level, else added, the oldest dropped beyond
-    /// [`MAX_POINTS`]) and refits jointly; no deviation forgets the evidence.
+    /// [`MAX_POINTS`], except the first with an anchor) and refits jointly; no deviation, or
+    /// one the stator-voltage equations do not see (the load moved), forgets the evidence
+    /// and makes the averaged point the anchor.
     pub(super) fn after(&mut self, follower: &Follower, result: &Isolation) {
         if !matches!(
             result.state,
@@ -42,11 +66,31 @@ impl Evidence {
         {
             self.points.clear();
             self.joint = None;
+            if result.state == IsolationState::NoDeviation {
+                self.anchor = follower.averaged().map(|(p, _)| p);
+            }
             return;
         }
         let Some((p, scale)) = follower.averaged() else {
             return;
         };
+        // A deviation the single point reads as the friction class that the stator-voltage
+        // equations do not see (within LOAD_MOVED_SIGMA: the load moved) is an
+        // operating-point change, not a fault: before any evidence of a fault it is the new
+        // anchor. After such evidence it is one more operating point of the joint fit (an
+        // Ls change on the 3 hp machine at half load moves the voltage equations by less
+        // than LOAD_MOVED_SIGMA; the points before the load move still tell it).
+        let iso = follower.isolator();
+        let friction = matches!(result.named(), Some(Named::Friction { .. }));
+        if friction
+            && self.points.is_empty()
+            && iso.isolate_points(&[(p, scale)]).deviation < LOAD_MOVED_SIGMA
+        {
+            self.points.clear();
+            self.joint = None;
+            self.anchor = Some(p);
+            return;
+        }
         let a = active_current(&p);
         if !a.is_finite() {
             return;
@@ -56,6 +100,12 @@ impl Evidence {
             (a - b).abs() < LEVEL_APART * b.abs().max(a.abs())
         });
         match same_level {
+            // The first point, compared with the anchor's load, gives way only to a later
+            // average of the same operating point before the load has moved (the first may
+            // have begun inside the change).
+            Some(0)
+                if self.anchor.is_some()
+                    && (self.points.len() > 1 || !self.same_point_as_first(a)) => {}
             Some(k) => {
                 if let Some(slot) = self.points.get_mut(k) {
                     *slot = (p, scale);
@@ -63,13 +113,34 @@ impl Evidence {
             }
             None => {
                 if self.points.len() >= MAX_POINTS {
-                    self.points.remove(0);
+                    // The first point, at the anchor's load, is the one the torque
+                    // comparison holds for: the oldest after it goes.
+                    let oldest = usize::from(self.anchor.is_some() && self.points.len() > 1);
+                    self.points.remove(oldest);
                 }
                 self.points.push((p, scale));
             }
         }
-        self.joint =
-            (self.points.len() >= 2).then(|| follower.isolator().isolate_points(&self.points));
+        let enough = self.points.len() >= 2 || self.anchor.is_some();
+        self.joint = enough.then(|| {
+            follower
+                .isolator()
+                .isolate_points_anchored(&self.points, self.anchor.as_ref())
+        });
+    }
+
+    /// The active current `a` is within [`SAME_POINT`] of the first point's.
+    fn same_point_as_first(&self, a: f32) -> bool {
+        self.points.first().is_some_and(|(q, _)| {
+            let b = active_current(q);
+            (a - b).abs() <= SAME_POINT * b.abs()
+        })
+    }
+
+    /// The joint isolation compares the first point's torque with the load at an anchor
+    /// (the last point judged healthy before the deviation).
+    pub(super) fn anchored(&self) -> bool {
+        self.anchor.is_some()
     }
 
     /// The joint isolation when it names a fault (not the friction class, which the

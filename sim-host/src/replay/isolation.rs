@@ -195,9 +195,10 @@ impl IsolationTracker {
                 .named()
                 .filter(|_| !names_a_fault(&result))
                 .and_then(|(j, _)| j.named());
-            let named = result
-                .named()
-                .or(joint)
+            // (The joint fit's fault before the friction class of the last point: a load
+            // that moved is, to the paper's model, a Bl change.)
+            let named = joint
+                .or(result.named())
                 .filter(|n| learned || self.lamps_lit || !within_nominal_uncertainty(n));
             if let Some(n) = named {
                 let given = NameGiven {
@@ -346,6 +347,11 @@ impl IsolationTracker {
             } else {
                 let s = verdict_sentence(&iso, detected, moved);
                 match joint {
+                    Some((_, n)) if self.evidence.anchored() => format!(
+                        "{} (from {n} operating point{} since the change, the stator-voltage equations with the load as an unknown input, and the torque against the load measured just before the change)",
+                        s.trim_end_matches('.'),
+                        if n == 1 { "" } else { "s" }
+                    ),
                     Some((_, n)) => format!(
                         "{} (from {n} operating points together, the stator-voltage equations only: the load as an unknown input)",
                         s.trim_end_matches('.')

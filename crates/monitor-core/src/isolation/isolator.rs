@@ -35,6 +35,7 @@ impl Isolator {
             baseline: Baseline::default(),
             learning: Learning::default(),
             heating_factor: 1.0,
+            learned_range: crate::OperatingRange::EMPTY,
         })
     }
 
@@ -93,6 +94,7 @@ impl Isolator {
             .spread
             .zip_map(DEFAULT_SPREAD, |s, d| crate::maxf(s, 0.2 * d));
         self.baseline = b;
+        self.learned_range = crate::OperatingRange::EMPTY;
         Ok(())
     }
 
@@ -106,6 +108,8 @@ impl Isolator {
         l.n = l.n.saturating_add(1);
         let n = l.n as f32;
         l.at.approach(p, 1.0 / n);
+        l.range
+            .learn(crate::OperatingPoint::from_dq(p.v.d, p.v.q, p.i.d, p.i.q));
         for ((m, m2), x) in l.mean.iter_mut().zip(l.m2.iter_mut()).zip(e.to_array()) {
             let d = x - *m;
             *m += d / n;
@@ -132,12 +136,32 @@ impl Isolator {
         {
             *s = crate::maxf(2.0 * crate::sqrt(m2 / (n - 1.0)), d);
         }
-        self.set_baseline(Baseline {
-            mean: ParityResiduals::from_array(l.mean),
-            spread: ParityResiduals::from_array(spread),
-            at: l.at,
-        })
-        .is_ok()
+        let ok = self
+            .set_baseline(Baseline {
+                mean: ParityResiduals::from_array(l.mean),
+                spread: ParityResiduals::from_array(spread),
+                at: l.at,
+            })
+            .is_ok();
+        if ok {
+            self.learned_range = l.range;
+        }
+        ok
+    }
+
+    /// The measured point `q` lies within the load span the baseline was learned over, and
+    /// that span is a range ([`WIDE_SPAN`]), with the voltage within the learned range's
+    /// margin (module docs, "Over a commissioned range").
+    fn within_learned_span(&self, q: &SteadyPoint) -> bool {
+        let r = self.learned_range;
+        let p = crate::OperatingPoint::from_dq(q.v.d, q.v.q, q.i.d, q.i.q);
+        match r.load_a {
+            Some([lo, hi]) => {
+                let wide = hi - lo >= WIDE_SPAN * crate::maxf(lo.abs(), hi.abs());
+                wide && p.load_a >= lo && p.load_a <= hi && r.voltage_outside(p).is_none()
+            }
+            None => false,
+        }
     }
 
     /// The parity residuals at `p` under hypothesis `h` (`None`: the nominal machine and
@@ -190,6 +214,9 @@ impl Isolator {
     fn weight(&self, q: &SteadyPoint) -> Sym3 {
         let s = self.baseline.spread;
         let diag = Sym3::diagonal_weight(&s);
+        if self.within_learned_span(q) {
+            return diag;
+        }
         let (at, c0) = (self.baseline.at, self.circuit());
         let (Some(e_here), Some(e_at)) = (self.eval(&c0, q), self.eval(&c0, &at)) else {
             return diag;
@@ -398,8 +425,29 @@ impl Isolator {
     /// [`MAX_POINTS`] points are used (the first ones); none usable gives
     /// [`IsolationState::NotJudged`].
     pub fn isolate_points(&self, points: &[(SteadyPoint, f32)]) -> Isolation {
+        self.isolate_points_anchored(points, None)
+    }
+
+    /// [`Isolator::isolate_points`] with the load known at one point: `anchor`, the last
+    /// steady point judged healthy before the deviation began (module docs, "The load
+    /// before the deviation"). At the first point (the first steady point of the deviation,
+    /// the nearest to the anchor in time), if its active current is within
+    /// [`ANCHOR_LOAD_BAND`] of the anchor's, the torque the circuit gives under the
+    /// hypothesis is compared with the anchor's load carried to the point's speed by the
+    /// paper's viscous law (the nominal machine's torque at the anchor times the speeds'
+    /// ratio, [`LOAD_LAW_SPREAD`] allowed). A sensor gain step, which moves neither the
+    /// machine nor its load, is thus judged with the torque balance (a current sensor's
+    /// error scales the torque computed from the currents, a voltage sensor's does not),
+    /// and an Rr change at one load level parts from a speed-sensor error (the one slows
+    /// the machine and its viscous load, the other only the reading); a load step leaves the
+    /// voltage equations to decide.
+    pub fn isolate_points_anchored(
+        &self,
+        points: &[(SteadyPoint, f32)],
+        anchor: Option<&SteadyPoint>,
+    ) -> Isolation {
         let mut out = Isolation::default();
-        let mut used = [(SteadyPoint::default(), Sym3::default()); MAX_POINTS];
+        let mut used = [(SteadyPoint::default(), Sym3::default(), 1.0f32); MAX_POINTS];
         let mut n = 0;
         for (p, scale) in points.iter().take(MAX_POINTS) {
             let k = if scale.is_finite() {
@@ -416,17 +464,28 @@ impl Isolator {
                 continue;
             };
             if let Some(slot) = used.get_mut(n) {
-                *slot = (*p, w);
+                *slot = (*p, w, k);
                 n += 1;
             }
         }
         let used = used.get(..n).unwrap_or(&[]);
-        let Some((first, _)) = used.first() else {
+        let Some((first, _, _)) = used.first() else {
             return out;
         };
-        let chi = |h: Option<(Fault, f32)>| -> f32 {
-            used.iter().map(|(p, w)| self.chi2_at(p, h, w)).sum()
+        let load = anchor.and_then(|a| Some((*a, self.torque_nm(a, None)?)));
+        // The load is compared at the first point only: the first steady point of the
+        // deviation, the one nearest the anchor in time.
+        let chi_with = |iso: &Isolator, h: Option<(Fault, f32)>| -> f32 {
+            let first = used
+                .first()
+                .map_or(0.0, |(p, _, k)| iso.chi2_load(p, h, load, *k));
+            first
+                + used
+                    .iter()
+                    .map(|(p, w, _)| iso.chi2_at(p, h, w))
+                    .sum::<f32>()
         };
+        let chi = |h: Option<(Fault, f32)>| chi_with(self, h);
         let chi0 = chi(None);
         out.deviation = crate::sqrt(chi0);
         if let Some(e0) = self.residuals(first, None) {
@@ -442,10 +501,7 @@ impl Isolator {
             *fit = fit_factor(|k| chi(Some((f, k))));
         }
         let heat = golden(
-            |k| {
-                let warm = self.warmer(k);
-                used.iter().map(|(p, w)| warm.chi2_at(p, None, w)).sum()
-            },
+            |k| chi_with(&self.warmer(k), None),
             HEATING_K_MIN / self.heating_factor,
             HEATING_K_MAX / self.heating_factor,
             HEATING_STEPS,
@@ -455,6 +511,57 @@ impl Isolator {
             out.separation_deg = self.separation(first, &e0, &out.candidates);
         }
         out
+    }
+
+    /// The air-gap torque the circuit gives at `p` under hypothesis `h` [N m]
+    /// (`Te = e_T T_base + (B + Bl) wr / Np`, the torque of [`ParityResiduals::torque`]);
+    /// `None` where the point gives no residuals.
+    fn torque_nm(&self, p: &SteadyPoint, h: Option<(Fault, f32)>) -> Option<f32> {
+        let (c, q) = self.hypothesis(p, h);
+        let e = self.eval(&c, &q)?;
+        Some(e.torque * self.torque_base_nm + c.b_total * q.wr_rad_s / c.np)
+    }
+
+    /// The misfit of the torque at `p` under `h` against the load known at the anchor
+    /// (`load`: the anchor point and its torque; `None`: no term). Under `h` (its sensor
+    /// correction applied to the point, not to the anchor, measured before) the load is taken as unchanged where the active
+    /// current moved by at most [`ANCHOR_LOAD_BAND`] from the anchor's (else no term), and
+    /// as the paper's viscous load `T0 wr / wr0` there; the spread is
+    /// [`ANCHOR_TORQUE_SPREAD`] times `scale`, widened by [`LOAD_LAW_SPREAD`] times the
+    /// speed's relative change times `T0`.
+    fn chi2_load(
+        &self,
+        p: &SteadyPoint,
+        h: Option<(Fault, f32)>,
+        load: Option<(SteadyPoint, f32)>,
+        scale: f32,
+    ) -> f32 {
+        let Some((a, t0)) = load else {
+            return 0.0;
+        };
+        // (The anchor was measured before the deviation: its readings stand as they are.)
+        let ((_, q), qa) = (self.hypothesis(p, h), a);
+        let active =
+            |x: &SteadyPoint| crate::OperatingPoint::from_dq(x.v.d, x.v.q, x.i.d, x.i.q).load_a;
+        let (ia, i0) = (active(&q), active(&qa));
+        let moved = (ia - i0) / crate::maxf(i0.abs(), 1e-6);
+        if !(moved.abs() <= ANCHOR_LOAD_BAND) {
+            return 0.0;
+        }
+        let Some(te) = self.torque_nm(p, h) else {
+            return f32::INFINITY;
+        };
+        let speed = q.wr_rad_s / crate::maxf(qa.wr_rad_s.abs(), 1.0);
+        let t_load = t0 * speed;
+        let s_law = LOAD_LAW_SPREAD * (speed - 1.0) * t0 / self.torque_base_nm;
+        let s = ANCHOR_TORQUE_SPREAD * scale;
+        let d = (te - t_load) / self.torque_base_nm;
+        let var = s * s + s_law * s_law;
+        if var > 0.0 {
+            d * d / var
+        } else {
+            0.0
+        }
     }
 
     /// Angle between the top two candidates' weighted directions `e(f, k*) - e(nominal)`
@@ -605,6 +712,23 @@ fn rank(out: &mut Isolation, fits: &mut [(f32, f32); FAULT_COUNT], heat: (f32, f
         IsolationState::Isolated
     };
 }
+
+/// Largest relative change of the active current from the anchor's (the sensor
+/// correction of the hypothesis applied) at which the load is taken as unchanged
+/// ([`Isolator::isolate_points_anchored`]): 6 %. The active current follows the input
+/// power: at a constant load the faults of the list move it by their losses, a few per
+/// cent (Rr +50 % about 3 %), while a load step of 10 % or more moves it by about as much.
+pub const ANCHOR_LOAD_BAND: f32 = 0.06;
+
+/// Uncertainty of the load's speed law around the paper's viscous `T ~ wr`
+/// ([`Isolator::isolate_points_anchored`]): the exponent 1 +- 0.25, times the speed's
+/// relative change from the anchor.
+pub const LOAD_LAW_SPREAD: f32 = 0.25;
+
+/// Spread of the torque comparison with the anchor, as a fraction of `T_base`: twice the
+/// learned floor of the torque balance ([`LEARNED_SPREAD_FLOOR`]), for the two points'
+/// scatter together.
+pub const ANCHOR_TORQUE_SPREAD: f32 = 2.0 * LEARNED_SPREAD_FLOOR.torque;
 
 /// Most operating points [`Isolator::isolate_points`] combines.
 pub const MAX_POINTS: usize = 4;

@@ -371,12 +371,14 @@ fn the_follower_averages_learns_and_isolates_on_schedule() {
         Step::LearningEnded(true)
     );
     assert!(f.learned());
-    // A 5 % voltage step: not steady, the average restarts (0.5 s before a result).
+    // A 5 % voltage step: not steady, the average restarts after SETTLE_S (blocks dropped)
+    // and gives a result once AVERAGE_S is averaged: 1 s after the step.
     let mut stepped = measure(&m, 1.05 * v, we, None, 1.0);
     let mut steps = 0;
-    for k in 0..100 {
+    let first = ((SETTLE_S + AVERAGE_S) / dt) as usize - 1;
+    for k in 0..150 {
         if let Step::Isolated(r) = f.observe(&stepped, dt, true, false) {
-            assert!(k >= 49, "isolated {k} steps after the step");
+            assert!(k >= first, "isolated {k} steps after the step");
             assert_eq!(r.state, IsolationState::NoDeviation, "{r:?}");
             steps += 1;
         }
@@ -386,7 +388,7 @@ fn the_follower_averages_learns_and_isolates_on_schedule() {
     assert_eq!(f.observe(&stepped, dt, false, false), Step::Waiting);
     let rr = faulty(&m, Some(Fault::Rr), 1.4);
     stepped = measure(&rr, 1.05 * v, we, Some(Fault::Rr), 1.4);
-    // Named after 0.5 s of averaging, reported after CONFIRM_S more.
+    // Named after SETTLE_S and 0.5 s of averaging, reported after CONFIRM_S more.
     let (mut named, mut unconfirmed) = (None, 0);
     for k in 0..150 {
         match f.observe(&stepped, dt, true, false) {
