@@ -68,6 +68,8 @@ pub fn run(fault: Fault, change: f64) -> Result<DemoRun, ExperimentError> {
     let opts = ReplayOptions {
         commission: Some(proto.commission),
         timeline_step_s: TIMELINE_STEP_S,
+        // The paper's scenario: its fixed viscous load, a Bl change is a fault.
+        load: crate::replay::LoadModel::Viscous,
         ..ReplayOptions::default()
     };
     let mut next = 0.0;

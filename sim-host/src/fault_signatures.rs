@@ -146,6 +146,8 @@ pub fn run_case(
     let opts = ReplayOptions {
         angle_source: proto.angle_source,
         commission: Some(proto.commission),
+        // Table 1's protocol: the paper's fixed viscous load, a Bl change is a fault.
+        load: crate::replay::LoadModel::Viscous,
         ..ReplayOptions::default()
     };
     let mut first_lamp: Option<f64> = None;

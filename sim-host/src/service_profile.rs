@@ -129,6 +129,7 @@ pub fn watch_mismatched(
         allow_incomplete: false,
         timeline_step_s: 1.0,
         unbalance_baseline: None,
+        load: crate::replay::LoadModel::Unknown,
     };
     let mut w = Watch::default();
     let dt = 1.0 / sc.sample_rate_hz;

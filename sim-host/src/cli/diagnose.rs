@@ -1,7 +1,7 @@
 //! `sim-host diagnose`: replay a log through the core ([`sim_host::replay::diagnose_file`])
 //! and report lamps, candidates and the negative-sequence analysis.
 
-use super::{progress, render, AngleArg, ResidualArg};
+use super::{progress, render, AngleArg, LoadArg, ResidualArg};
 use clap::Args;
 use sim_host::log::{LogFile, OpenOptions};
 use sim_host::params::ParamFile;
@@ -19,7 +19,11 @@ their probabilities, when a fault was first detected, and the negative-sequence 
 phase) analysis.\n\nWithout --commission the fixed thresholds are used (3 % of each normalised \
 residual). With --commission START:END the healthy mean and spread of every residual are learned \
 over that part of the log (seconds) and the lamps use mean +/- k*spread with debounce and \
-hysteresis.\n\nThe frame (--angle rotor-flux, the default) is the core's current-model rotor-flux \
+hysteresis.\n\nThe load is an unknown input by default (--load unknown, real service): a load \
+change is reported as a load move with its time (isolation.events), never as a fault, and \
+electrical faults are named from the stator-voltage equations and the torque against the load \
+measured just before a change; --load viscous takes the paper's fixed viscous load, where a \
+B/Bl change is the fault b/bl.\n\nThe frame (--angle rotor-flux, the default) is the core's current-model rotor-flux \
 angle (encoder speed, nominal Rr and Lr); compare/explain use a voltage-model rotor-flux estimate \
 instead.\n\nLogs with only t_s and the three currents still get the unbalance analysis (the \
 supply is taken from the parameter file).\n\nAny sample rate from 1 kHz to 50 kHz works (at \
@@ -67,6 +71,11 @@ pub struct DiagnoseArgs {
     /// Residual form the lamps act on.
     #[arg(long, value_enum, default_value_t = ResidualArg::Steady)]
     pub residuals: ResidualArg,
+    /// What is known of the load: `unknown` (service: a load change is an operating-point
+    /// change, never a named fault) or `viscous` (the paper's fixed viscous load: a B/Bl
+    /// change is the fault `b/bl`).
+    #[arg(long, value_enum, default_value_t = LoadArg::Unknown)]
+    pub load: LoadArg,
     /// Timeline resolution in the output [s].
     #[arg(long, default_value_t = 0.5, allow_negative_numbers = true, value_parser = super::parse_positive_seconds)]
     pub timeline_step: f64,
@@ -116,6 +125,7 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         allow_incomplete: args.allow_incomplete,
         timeline_step_s: args.timeline_step.max(1e-4),
         unbalance_baseline: None,
+        load: args.load.into(),
     };
     if let Some(healthy) = &args.baseline {
         opts.unbalance_baseline = Some(baseline_of(&params, healthy, &open, opts)?);

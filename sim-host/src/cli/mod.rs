@@ -121,6 +121,25 @@ impl From<AngleArg> for AngleSource {
     }
 }
 
+/// What is known of the load, on the command line (`diagnose --load`, `hmi --load`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum LoadArg {
+    /// The load is an unknown input (real service): a load change is an operating-point
+    /// change, reported as a load move; the friction class b/bl is never named.
+    Unknown,
+    /// The paper's fixed viscous load (Table 1): a B/Bl change is a fault, named `b/bl`.
+    Viscous,
+}
+
+impl From<LoadArg> for sim_host::replay::LoadModel {
+    fn from(a: LoadArg) -> Self {
+        match a {
+            LoadArg::Unknown => sim_host::replay::LoadModel::Unknown,
+            LoadArg::Viscous => sim_host::replay::LoadModel::Viscous,
+        }
+    }
+}
+
 /// Residual form on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum ResidualArg {

@@ -90,6 +90,8 @@ impl LiveSim {
         // live run has no end), commissioning starts on the `c` key.
         let opts = ReplayOptions {
             timeline_step_s: f64::INFINITY,
+            // The demo's scenario, live: the paper's fixed viscous load.
+            load: crate::replay::LoadModel::Viscous,
             ..ReplayOptions::default()
         };
         let channels = crate::sim::SensorSpec::default().channels();

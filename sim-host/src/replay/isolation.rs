@@ -11,6 +11,7 @@
 //! ([`monitor_core::isolation::Follower`]: the same code the firmware runs; the firmware
 //! feeds it the monitor's own outputs, [`SteadyPoint::from_output`]).
 
+use super::events::IsolationEvent;
 use monitor_core::isolation::{Candidate, Follower, Named, Step, DEFAULT_SPREAD};
 use monitor_core::sequence::SinglePhaseGain;
 use monitor_core::{
@@ -126,6 +127,35 @@ pub(super) struct IsolationTracker {
     lamps_lit: bool,
     /// The operating points kept since a deviation, and their joint isolation.
     evidence: super::evidence::Evidence,
+    /// What is known of the load ([`super::LoadModel`]).
+    load: super::LoadModel,
+    /// Names and load moves, with times.
+    events: super::events::EventLog,
+}
+
+/// The candidates `diagnose` lists for `iso` when `detected` (most probable first, those
+/// from [`LIST_FROM`] on; an unknown fault's three nearest only; none without a deviation).
+fn listed_candidates(iso: &Isolation, detected: bool) -> Vec<FaultCandidate> {
+    if !detected || iso.state == IsolationState::NoDeviation {
+        return Vec::new();
+    }
+    let listed = if iso.state == IsolationState::Unknown {
+        3
+    } else {
+        iso.candidates.len()
+    };
+    iso.candidates
+        .iter()
+        .take(listed)
+        .filter(|c| c.probability >= LIST_FROM)
+        .map(FaultCandidate::from)
+        .collect()
+}
+
+/// `n` is the friction class while the load is an unknown input: a load move, not a name
+/// ([`super::LoadModel::Unknown`]).
+fn load_reading(load: super::LoadModel, n: &Named) -> bool {
+    load == super::LoadModel::Unknown && matches!(n, Named::Friction { .. })
 }
 
 /// Whether `iso` names a fault (the friction class does not count: to the paper's model a
@@ -144,7 +174,7 @@ pub const NOMINAL_UNCERTAINTY: f32 = 0.3;
 impl IsolationTracker {
     /// A tracker for the nominal machine (`None`: a machine the isolator rejects, then
     /// nothing is isolated and the report says so).
-    pub(super) fn new(isolator: Option<Isolator>) -> Self {
+    pub(super) fn new(isolator: Option<Isolator>, load: super::LoadModel) -> Self {
         IsolationTracker {
             follower: isolator.map(Follower::new),
             first_named: None,
@@ -155,6 +185,8 @@ impl IsolationTracker {
             last_point: SteadyPoint::default(),
             lamps_lit: false,
             evidence: super::evidence::Evidence::default(),
+            load,
+            events: super::events::EventLog::default(),
         }
     }
 
@@ -170,6 +202,7 @@ impl IsolationTracker {
         counts: bool,
     ) {
         self.end_t = t;
+        let load = self.load;
         let Some(follower) = self.follower.as_mut() else {
             return;
         };
@@ -199,7 +232,11 @@ impl IsolationTracker {
             // that moved is, to the paper's model, a Bl change.)
             let named = joint
                 .or(result.named())
-                .filter(|n| learned || self.lamps_lit || !within_nominal_uncertainty(n));
+                .filter(|n| learned || self.lamps_lit || !within_nominal_uncertainty(n))
+                .filter(|n| !load_reading(load, n));
+            if let Some((p, _)) = follower.averaged() {
+                self.events.point(t, &p);
+            }
             if let Some(n) = named {
                 let given = NameGiven {
                     name: IsolationName::of(&n),
@@ -208,6 +245,13 @@ impl IsolationTracker {
                 self.first_named.get_or_insert(given);
                 if !self.names.iter().any(|g| g.name == given.name) {
                     self.names.push(given);
+                    let (change, p) = match n {
+                        Named::Fault(c) => (c.change, c.probability),
+                        Named::Friction {
+                            probability, bl, ..
+                        } => (bl.change, probability),
+                    };
+                    self.events.named(t, given.name, change, p);
                 }
             }
             self.last_t = t;
@@ -269,6 +313,52 @@ impl IsolationTracker {
             && last.is_some_and(|i| i.state == IsolationState::NoDeviation)
     }
 
+    /// The verdict sentence `s` with the evidence it was drawn from, where the joint fit over
+    /// the operating points kept (`joint`: its isolation and the number of points) named it.
+    fn with_evidence(&self, s: String, joint: Option<(Isolation, usize)>) -> String {
+        match joint {
+            Some((_, n)) if self.evidence.anchored() => format!(
+                "{} (from {n} operating point{} since the change, the stator-voltage equations with the load as an unknown input, and the torque against the load measured just before the change)",
+                s.trim_end_matches('.'),
+                if n == 1 { "" } else { "s" }
+            ),
+            Some((_, n)) => format!(
+                "{} (from {n} operating points together, the stator-voltage equations only: the load as an unknown input)",
+                s.trim_end_matches('.')
+            ),
+            None => s,
+        }
+    }
+
+    /// The verdict where the last point reads as the friction class with the load an unknown
+    /// input ([`super::LoadModel::Unknown`]): the load moved.
+    fn load_moved_sentence(&self) -> String {
+        let last = self.events.events().iter().rev().find_map(|e| match e {
+            IsolationEvent::LoadMoved { t_s, from_a, to_a } => Some((*t_s, *from_a, *to_a)),
+            IsolationEvent::Named { .. } => None,
+        });
+        let what = last.map_or(String::new(), |(t, a0, a1)| {
+            format!(
+                " (at {t:.2} s the active current went from {a0:.2} to {a1:.2} A, {})",
+                pct(a1 / a0 - 1.0)
+            )
+        });
+        format!(
+            "The load moved{what}: an operating-point change, not a fault; the stator-voltage equations, with the load as an unknown input, fit the machine. (A change of the machine's friction B cannot be told from a load change without a load model: for the paper's fixed viscous load, where a Bl change is a fault, give --load viscous.)"
+        )
+    }
+
+    /// With the load an unknown input ([`super::LoadModel::Unknown`]), the lamps' detections
+    /// are the load's move: the last isolation reads the friction class (the load), the
+    /// operating points since name no fault, and no fault was ever named.
+    pub(super) fn load_explains_lamps(&self) -> bool {
+        let last = self.follower.as_ref().and_then(|f| f.last().copied());
+        let friction = last
+            .and_then(|i| i.named())
+            .is_some_and(|n| load_reading(self.load, &n));
+        friction && self.evidence.named().is_none() && !self.named_a_fault()
+    }
+
     fn moved_from_learned(&self) -> Option<f32> {
         let f = self.follower.as_ref().filter(|f| f.learned())?;
         let at = f.isolator().baseline().at;
@@ -298,23 +388,14 @@ impl IsolationTracker {
             .evidence
             .named()
             .filter(|_| !names_a_fault(&single) && single.state != IsolationState::NoDeviation);
-        let iso = joint.map_or(single, |(j, _)| j);
-        // An unknown fault lists its three nearest candidates only.
-        let listed = if iso.state == IsolationState::Unknown {
-            3
-        } else {
-            iso.candidates.len()
-        };
-        let candidates = if detected && iso.state != IsolationState::NoDeviation {
-            iso.candidates
-                .iter()
-                .take(listed)
-                .filter(|c| c.probability >= LIST_FROM)
-                .map(FaultCandidate::from)
-                .collect()
-        } else {
-            Vec::new()
-        };
+        let mut iso = joint.map_or(single, |(j, _)| j);
+        // With the load an unknown input, the friction class is the load's move: nothing
+        // deviates from the machine (the load move is an event).
+        let load_moved = iso.named().is_some_and(|n| load_reading(self.load, &n));
+        if load_moved {
+            iso.state = IsolationState::NoDeviation;
+        }
+        let candidates = listed_candidates(&iso, detected);
         let moved = self.moved_from_learned();
         let in_file_error = iso
             .named()
@@ -344,20 +425,10 @@ impl IsolationTracker {
                 )
             } else if let Some(warm) = self.heating_sentence(iso.state) {
                 warm
+            } else if load_moved {
+                self.load_moved_sentence()
             } else {
-                let s = verdict_sentence(&iso, detected, moved);
-                match joint {
-                    Some((_, n)) if self.evidence.anchored() => format!(
-                        "{} (from {n} operating point{} since the change, the stator-voltage equations with the load as an unknown input, and the torque against the load measured just before the change)",
-                        s.trim_end_matches('.'),
-                        if n == 1 { "" } else { "s" }
-                    ),
-                    Some((_, n)) => format!(
-                        "{} (from {n} operating points together, the stator-voltage equations only: the load as an unknown input)",
-                        s.trim_end_matches('.')
-                    ),
-                    None => s,
-                }
+                self.with_evidence(verdict_sentence(&iso, detected, moved), joint)
             },
             moved_from_learned: moved,
             winding_rise_k: self.winding_rise_k(),
@@ -379,6 +450,8 @@ impl IsolationTracker {
             }
             .to_string(),
             first_named: self.first_named,
+            events: self.events.events().to_vec(),
+            events_dropped: self.events.dropped(),
         };
         (report, candidates)
     }
@@ -521,6 +594,11 @@ pub struct IsolationReport {
     /// a fault"); absent (JSON) below [`REPORTED_RISE_K`] or without a learned baseline.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub winding_rise_k: Option<f32>,
+    /// What happened, with times: each name the first time it was given (with its size and
+    /// probability) and each load move ([`IsolationEvent`]), at most [`super::MAX_EVENTS`].
+    pub events: Vec<IsolationEvent>,
+    /// How many events came after [`super::MAX_EVENTS`] and are not listed.
+    pub events_dropped: usize,
 }
 
 /// Smallest tracked winding temperature change that is reported [K] (5 K: 2 % on Rs and Rr,
@@ -550,6 +628,8 @@ impl IsolationReport {
             }
             .to_string(),
             first_named: None,
+            events: Vec::new(),
+            events_dropped: 0,
         }
     }
 }

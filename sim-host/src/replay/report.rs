@@ -78,8 +78,16 @@ impl Replay {
         if !evaluated || out.sensor_fault.any() {
             return state;
         }
-        let Some(note) = self.operating_point_moved(out) else {
-            return state;
+        let note = match self.operating_point_moved(out) {
+            Some(note) => note,
+            // With the load an unknown input, lamps lit for a load that moved inside the
+            // commissioned range are the amber state too (`LoadModel::Unknown`).
+            None if matches!(state, MonitorState::Fault(_))
+                && self.isolation.load_explains_lamps() =>
+            {
+                LOAD_MOVED_NOTE.to_string()
+            }
+            None => return state,
         };
         let named = match isolation {
             Some(r) => r.named,
@@ -107,6 +115,11 @@ impl Replay {
         }
     }
 }
+
+/// The amber state's note where the lamps lit for a load that moved inside the commissioned
+/// range, with the load an unknown input (`LoadModel::Unknown`).
+pub const LOAD_MOVED_NOTE: &str =
+    "load moved inside the commissioned range; the stator-voltage equations fit (the torque residuals read it as Bl)";
 
 /// One point of the diagnosis timeline.
 #[derive(Debug, Clone, Serialize)]

@@ -266,6 +266,7 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
                 g.reason
             )?;
         }
+        events(&mut out, &rep.isolation)?;
     }
     let u = &rep.unbalance;
     writeln!(
@@ -278,6 +279,43 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
         writeln!(out, "note at {:.2} s: {}", n.t_s, n.note)?;
     }
     verdict(&mut out, rep)
+}
+
+/// Most load moves the text report lists (every name is listed; `--json` has up to
+/// [`sim_host::replay::MAX_EVENTS`] events).
+const LOAD_MOVES_LISTED: usize = 10;
+
+/// The isolation's events with their times: every name, and the first
+/// [`LOAD_MOVES_LISTED`] load moves.
+fn events(out: &mut impl Write, iso: &sim_host::replay::IsolationReport) -> anyhow::Result<()> {
+    use sim_host::replay::IsolationEvent;
+    if iso.events.is_empty() {
+        return Ok(());
+    }
+    let moves = iso
+        .events
+        .iter()
+        .filter(|e| matches!(e, IsolationEvent::LoadMoved { .. }))
+        .count();
+    writeln!(out, "events:")?;
+    let mut listed = 0;
+    for e in &iso.events {
+        if matches!(e, IsolationEvent::LoadMoved { .. }) {
+            listed += 1;
+            if listed > LOAD_MOVES_LISTED {
+                continue;
+            }
+        }
+        writeln!(out, "  {}", e.line())?;
+    }
+    let more = moves.saturating_sub(LOAD_MOVES_LISTED) + iso.events_dropped;
+    if more > 0 {
+        writeln!(
+            out,
+            "  ... and {more} more load moves (diagnose --json lists the first 200 events)"
+        )?;
+    }
+    Ok(())
 }
 
 /// The data-quality stage's finding in one line, and what was done about it.
