@@ -7,7 +7,11 @@
 //! ranges), so every figure that rests on the amplitude (the residuals, the isolation's
 //! sizes, the sequence analysis) would be wrong with no sign of it. The data-quality stage
 //! ([`super::quality`]) counts, per channel, the samples equal to the channel's largest and
-//! its smallest value (streaming: the count restarts when a new extreme appears). An
+//! its smallest value that lie in a run of two or more such samples (a flat top; streaming:
+//! the count restarts when a new extreme appears). A lone sample at the extreme is a peak,
+//! not a flat top: a noise-free sine sampled at a whole number of samples per period (a
+//! simulator's log at 1 kHz, 20 samples per 50 Hz period) repeats its peak value once per
+//! period, 5 % of its samples, and was taken for a clip before runs were required. An
 //! unclipped sine sampled by an `n`-bit ADC spends about `2 sqrt(2 / 2^(n-1)) / (2 pi)` of
 //! its samples within one code of each peak (1 % at 12 bits, 4 % at 8 bits) and, with any
 //! noise, far fewer at exactly one value; a sine clipped to `c` of its amplitude spends
@@ -30,41 +34,60 @@ pub const MIN_SAMPLES: u64 = 1000;
 struct Extremes {
     n: u64,
     max: f64,
+    /// Samples at `max` in runs of two or more.
     n_max: u64,
+    /// Length of the run at `max` that the last sample ended (0: the last was not at it).
+    run_max: u64,
     min: f64,
     n_min: u64,
+    run_min: u64,
+}
+
+/// One extreme's count after a sample: `run` is the length of the run at the extreme the
+/// sample continues (0 when it is not at it), `count` the samples in runs of two or more;
+/// a sample that sets a new extreme starts a run of one and the count again.
+#[inline(always)]
+fn count_run(count: u64, run: u64, new: bool, at: bool) -> (u64, u64) {
+    let run = if new {
+        1
+    } else if at {
+        run + 1
+    } else {
+        0
+    };
+    // The second sample of a run brings the first with it.
+    let add = match run {
+        2 => 2,
+        r if r > 2 => 1,
+        _ => 0,
+    };
+    (if new { 0 } else { count + add }, run)
 }
 
 impl Extremes {
-    /// Counts one value. Branch-free after the first (selects, not jumps: the reading
-    /// thread calls it six times a row, with comparisons no predictor gets right at the
-    /// extremes of a noisy sine).
+    /// Counts one value (selects rather than jumps where it can: the reading thread calls
+    /// it six times a row, with comparisons no predictor gets right at the extremes of a
+    /// noisy sine).
     #[inline(always)]
     fn push(&mut self, x: f64) {
         if self.n == 0 {
             *self = Extremes {
                 n: 1,
                 max: x,
-                n_max: 1,
+                n_max: 0,
+                run_max: 1,
                 min: x,
-                n_min: 1,
+                n_min: 0,
+                run_min: 1,
             };
             return;
         }
         self.n += 1;
         let (gt, eq_max) = (x > self.max, x == self.max);
-        self.n_max = if gt {
-            1
-        } else {
-            self.n_max + u64::from(eq_max)
-        };
+        (self.n_max, self.run_max) = count_run(self.n_max, self.run_max, gt, eq_max);
         self.max = if gt { x } else { self.max };
         let (lt, eq_min) = (x < self.min, x == self.min);
-        self.n_min = if lt {
-            1
-        } else {
-            self.n_min + u64::from(eq_min)
-        };
+        (self.n_min, self.run_min) = count_run(self.n_min, self.run_min, lt, eq_min);
         self.min = if lt { x } else { self.min };
     }
 
@@ -171,6 +194,43 @@ mod tests {
         // 10 % over full scale: acos(1 / 1.1) / pi = 13.7 % at each top.
         let mild = rows(1.1, 1.0, 12, 20_000).clipped();
         assert_eq!(mild.len(), 6, "{mild:?}");
+    }
+
+    /// A noise-free sine sampled at 20 samples per period repeats its peak value once per
+    /// period (5 % of the samples, each alone): a peak, not a flat top.
+    #[test]
+    fn a_noise_free_sine_at_whole_samples_per_period_is_not_clipped() {
+        let mut t = ClipTracker::default();
+        for k in 0..20_000 {
+            let th = std::f64::consts::TAU * (k % 20) as f64 / 20.0;
+            let x = |ph: f64| 325.0 * (th - ph).sin();
+            let p = std::f64::consts::TAU / 3.0;
+            let r = Row {
+                t_s: k as f64 / 1000.0,
+                v_abc: Some([x(0.0), x(p), x(-p)]),
+                i_abc: [x(0.0), x(p), x(-p)],
+                wm_rad_s: None,
+                enc_count: None,
+            };
+            t.push(&r, |_| true);
+        }
+        assert!(t.clipped().is_empty(), "{:?}", t.clipped());
+        // The same sine clipped at 90 % of its peak: flat tops of three samples.
+        let mut c = ClipTracker::default();
+        for k in 0..20_000 {
+            let th = std::f64::consts::TAU * (k % 20) as f64 / 20.0;
+            let x = |ph: f64| (325.0 * (th - ph).sin()).clamp(-292.5, 292.5);
+            let p = std::f64::consts::TAU / 3.0;
+            let r = Row {
+                t_s: k as f64 / 1000.0,
+                v_abc: Some([x(0.0), x(p), x(-p)]),
+                i_abc: [x(0.0), x(p), x(-p)],
+                wm_rad_s: None,
+                enc_count: None,
+            };
+            c.push(&r, |_| true);
+        }
+        assert_eq!(c.clipped().len(), 6, "{:?}", c.clipped());
     }
 
     #[test]

@@ -133,6 +133,20 @@ pub(super) struct IsolationTracker {
     events: super::events::EventLog,
 }
 
+/// With the load an unknown input, B and Bl are not candidates (their change is the load's
+/// move): their probabilities are set to zero and they go last, so that no list, group or
+/// sentence offers them (the others keep their probabilities). Applied after the name is
+/// decided ([`IsolationTracker::report`]).
+fn without_friction(iso: &mut Isolation) {
+    for c in iso.candidates.iter_mut() {
+        if matches!(c.fault, Fault::B | Fault::Bl) {
+            c.probability = 0.0;
+        }
+    }
+    iso.candidates
+        .sort_by(|a, b| b.probability.total_cmp(&a.probability));
+}
+
 /// The candidates `diagnose` lists for `iso` when `detected` (most probable first, those
 /// from [`LIST_FROM`] on; an unknown fault's three nearest only; none without a deviation).
 fn listed_candidates(iso: &Isolation, detected: bool) -> Vec<FaultCandidate> {
@@ -394,6 +408,9 @@ impl IsolationTracker {
         let load_moved = iso.named().is_some_and(|n| load_reading(self.load, &n));
         if load_moved {
             iso.state = IsolationState::NoDeviation;
+        }
+        if self.load == super::LoadModel::Unknown {
+            without_friction(&mut iso);
         }
         let candidates = listed_candidates(&iso, detected);
         let moved = self.moved_from_learned();
