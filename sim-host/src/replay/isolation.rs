@@ -125,7 +125,7 @@ pub(super) struct IsolationTracker {
     /// A lamp lit while lamps counted.
     lamps_lit: bool,
     /// The operating points kept since a deviation, and their joint isolation.
-    evidence: super::evidence::Evidence,
+    evidence: monitor_core::isolation::Evidence,
 }
 
 /// Whether `iso` names a fault (the friction class does not count: to the paper's model a
@@ -154,7 +154,7 @@ impl IsolationTracker {
             end_t: 0.0,
             last_point: SteadyPoint::default(),
             lamps_lit: false,
-            evidence: super::evidence::Evidence::default(),
+            evidence: monitor_core::isolation::Evidence::default(),
         }
     }
 

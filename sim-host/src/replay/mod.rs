@@ -22,7 +22,6 @@
 
 mod commission;
 mod diagnose;
-mod evidence;
 mod isolation;
 mod pipe;
 mod report;
