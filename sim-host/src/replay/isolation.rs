@@ -128,13 +128,6 @@ pub(super) struct IsolationTracker {
     evidence: monitor_core::isolation::Evidence,
 }
 
-/// Whether `iso` names a fault (the friction class does not count: to the paper's model a
-/// load change is a Bl change, and the joint fit over operating points, which treats the
-/// load as an unknown input, may name the electrical fault behind it).
-fn names_a_fault(iso: &Isolation) -> bool {
-    matches!(iso.named(), Some(Named::Fault(_)))
-}
-
 /// How far a parameter file's values may be off the machine's (nameplate estimates are
 /// 10-30 % off): against the nominal parameters (no commissioning), a change this small or
 /// smaller, with every lamp dark, is the file's own error as much as a fault, and is not
@@ -192,8 +185,7 @@ impl IsolationTracker {
             // operating points).
             let joint = self
                 .evidence
-                .named()
-                .filter(|_| !names_a_fault(&result))
+                .joint_beside(&result)
                 .and_then(|(j, _)| j.named());
             // (The joint fit's fault before the friction class of the last point: a load
             // that moved is, to the paper's model, a Bl change.)
@@ -294,10 +286,7 @@ impl IsolationTracker {
         };
         // The joint isolation over the operating points kept, where it names a fault that
         // the last point alone does not.
-        let joint = self
-            .evidence
-            .named()
-            .filter(|_| !names_a_fault(&single) && single.state != IsolationState::NoDeviation);
+        let joint = self.evidence.joint_beside(&single).map(|(j, n)| (*j, n));
         let iso = joint.map_or(single, |(j, _)| j);
         // An unknown fault lists its three nearest candidates only.
         let listed = if iso.state == IsolationState::Unknown {

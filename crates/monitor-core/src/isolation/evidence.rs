@@ -162,6 +162,24 @@ impl Evidence {
         self.anchor.is_some()
     }
 
+    /// The joint isolation in force beside the single point's latest result `single`, with
+    /// the number of points (the one rule the host's replay and the firmware share): the
+    /// joint fit's when it names a fault ([`Evidence::named`]) while `single` deviates and
+    /// names none. The friction class of `single` does not count as a name: to the paper's
+    /// model a load that moved is a Bl change, and the joint fit, which treats the load as
+    /// an unknown input, may name the electrical fault behind it.
+    pub fn joint_beside(&self, single: &Isolation) -> Option<(&Isolation, usize)> {
+        let (_, n) = self.named()?;
+        let joint = self.joint.as_ref()?;
+        let names_a_fault = matches!(single.named(), Some(Named::Fault(_)));
+        (!names_a_fault && single.state != IsolationState::NoDeviation).then_some((joint, n))
+    }
+
+    /// The isolation in force: [`Evidence::joint_beside`]'s, else `single`.
+    pub fn in_force<'a>(&'a self, single: &'a Isolation) -> &'a Isolation {
+        self.joint_beside(single).map_or(single, |(j, _)| j)
+    }
+
     /// The joint isolation when it names a fault (not the friction class, which the
     /// voltage equations cannot judge) that explains every point within the healthy
     /// scatter (its misfit within `sqrt(16 n)` for n points), and the number of points.
