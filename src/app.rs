@@ -34,6 +34,9 @@ use monitor_core::{
     SteadyPoint,
 };
 
+mod isolation;
+pub use isolation::{board_isolator, isolation_summary};
+
 /// The machine the firmware monitors by default: the "2.2 kW" reference machine
 /// (`monitor_core::reference::MOTOR_2P2KW`: 400 V, 50 Hz, 4 poles, Gamma model, Bl for the
 /// rated 14.6 N m near rated speed). Edit here for another machine.
@@ -52,20 +55,6 @@ pub const BUTTON_DEBOUNCE_MS: u32 = 300;
 /// The default machine in the core's precision.
 pub fn default_motor() -> MotorModel {
     DEFAULT_MACHINE.motor.model()
-}
-
-/// The fault isolator for [`DEFAULT_MACHINE`] on its rated supply.
-///
-/// # Errors
-/// The core's [`ConfigError`] if it rejects the machine or the supply (then nothing is
-/// isolated and the blink code says "not named").
-pub fn board_isolator() -> Result<Isolator, ConfigError> {
-    let supply = DEFAULT_MACHINE.supply;
-    Isolator::new(
-        default_motor(),
-        supply.v_phase_peak() as f32,
-        supply.f_hz as f32,
-    )
 }
 
 /// Core configuration for the board: [`DEFAULT_MACHINE`] on its rated supply, sampled at
@@ -294,30 +283,6 @@ pub struct MonitorStatus {
     /// ([`RangeWatch::moved`]), false as the sample path hands it ([`panel_input`] shows
     /// the amber state only when no fault is named).
     pub moved: bool,
-}
-
-/// The isolation in the status line's words (docs/firmware.md, "The status line"): the label
-/// (the fault's name `rs`..`speed_sensor`, `b/bl` for the friction class, `unknown`,
-/// `none` for no deviation from the healthy baseline, `not-judged`), the named fault's
-/// size (relative change, 0.48 for +48 %; for sensors the gain error; Bl's for the
-/// friction class; 0 when nothing is named) and its probability (the unknown fault's for
-/// `unknown`, 0 otherwise).
-pub fn isolation_summary(iso: Option<&Isolation>) -> (&'static str, f32, f32) {
-    let Some(iso) = iso else {
-        return ("not-judged", 0.0, 0.0);
-    };
-    match (iso.named(), iso.state) {
-        (Some(Named::Fault(c)), _) => (c.fault.name(), c.change, c.probability),
-        (
-            Some(Named::Friction {
-                probability, bl, ..
-            }),
-            _,
-        ) => ("b/bl", bl.change, probability),
-        (None, IsolationState::NoDeviation) => ("none", 0.0, 0.0),
-        (None, IsolationState::NotJudged) => ("not-judged", 0.0, 0.0),
-        (None, _) => ("unknown", 0.0, iso.unknown_probability),
-    }
 }
 
 /// The panel's inputs ([`PanelInput`], the panel's whole interface) for the latest status
@@ -606,59 +571,6 @@ impl Supervisor {
     /// panel shows it ([`crate::panel`], "Built-in default motor"). Off until set.
     pub fn set_default_motor(&mut self, default_motor: bool) {
         self.default_motor = default_motor;
-    }
-
-    /// Isolates against `isolator`'s machine from now on (the motor record's, read at boot;
-    /// [`Supervisor::new`] starts with [`board_isolator`]'s built-in default). `None`: the
-    /// machine was rejected, nothing is isolated (the blink code says "not named").
-    pub fn set_isolator(&mut self, isolator: Option<Isolator>) {
-        self.isolation = isolator.map(Follower::new);
-        self.run_baseline = None;
-    }
-
-    /// Puts the isolation baseline of the record loaded at boot into force (the record the
-    /// core accepted), so that after a reset the isolation judges against the machine's own
-    /// baseline again. Returns whether one was put into force.
-    pub fn restore_isolation(&mut self, record: &CalibrationRecord) -> bool {
-        match (self.isolation.as_mut(), record.isolation) {
-            (Some(f), Some(b)) => f.restore_learned(b),
-            _ => false,
-        }
-    }
-
-    /// The latest fault isolation (`None` before the first steady half second, or unusable).
-    pub fn isolation(&self) -> Option<&Isolation> {
-        self.isolation.as_ref().and_then(Follower::last)
-    }
-
-    /// The isolation baseline in force when it was learned in commissioning (this run or a
-    /// stored one); `None` with the nominal parameters' defaults.
-    pub fn isolation_baseline(&self) -> Option<Baseline> {
-        self.isolation
-            .as_ref()
-            .filter(|f| f.learned())
-            .map(|f| f.isolator().baseline())
-    }
-
-    /// Feeds a new status to the fault isolation: its operating point, `dt` from the sample
-    /// counter, usable once the monitor has evaluated with no sensor fault, learning while
-    /// a commissioning run learns (the core's schedule: `monitor_core::isolation::Follower`).
-    /// Learning ends when the run stops learning, before its calibration is stored, so
-    /// that the baseline goes into the same record.
-    fn follow(&mut self, s: &MonitorStatus, previous_samples: u32) {
-        let Some(f) = self.isolation.as_mut() else {
-            return;
-        };
-        let dt_s = s.samples.wrapping_sub(previous_samples) as f32 / self.sample_rate_hz as f32;
-        self.running |= s.evaluating;
-        let usable = self.running && !s.sensor_fault.any();
-        let learning = s.run.stage == monitor_core::RunStage::Learning;
-        if learning {
-            self.run_baseline = None;
-        }
-        if let Step::LearningEnded(ok) = f.observe(&s.point, dt_s, usable, learning) {
-            self.run_baseline = ok.then(|| f.isolator().baseline());
-        }
     }
 
     /// The commissioned operating range and the "moved" judgement.
