@@ -27,7 +27,7 @@ use crate::panel::{self, blink_code, winding_code, Mode, PanelInput, PanelLamps,
 use crate::range_watch::RangeWatch;
 use crate::reset_record::PreviousRun;
 use crate::sampling::{AdcSampler, RawFrame, SamplingError, TICK_HZ};
-use monitor_core::isolation::{Baseline, Follower, Named, Step};
+use monitor_core::isolation::{Baseline, Evidence, Follower, Named, Step};
 use monitor_core::{
     CommissioningError, CommissioningRun, ConfigError, Fault, Install, Isolation, IsolationState,
     Isolator, Monitor, MonitorConfig, MotorModel, Operating, Phase, ReferenceMachine, SensorFlags,
@@ -513,6 +513,9 @@ pub struct Supervisor {
     last_press_ms: Option<u32>,
     /// The fault isolation's schedule (its isolator holds the tracked winding rise).
     pub isolation: Option<Follower>,
+    /// The operating points kept since a deviation began and their joint isolation (the
+    /// host's replay keeps the same: `monitor_core::isolation::Evidence`).
+    evidence: Evidence,
     /// The isolation baseline learned in the latest commissioning run (stored with its
     /// calibration), `None` while learning or when that run learned too little.
     run_baseline: Option<Baseline>,
@@ -550,6 +553,7 @@ impl Supervisor {
                 .then(|| now_ms.wrapping_add(FAILED_BOOT_SHOW_MS)),
             last_press_ms: None,
             isolation: board_isolator().ok().map(Follower::new),
+            evidence: Evidence::default(),
             run_baseline: None,
             sample_rate_hz: settings.sample_rate_hz,
             running: false,
@@ -645,12 +649,12 @@ impl Supervisor {
             Mode::NotCommissioned
         };
         let failed = self.procedure.last_failure().is_some();
+        self.latest.moved = self.range.moved(&self.latest);
         let learned = self
             .isolation
             .as_ref()
             .filter(|f| f.learned())
-            .and_then(Follower::last);
-        self.latest.moved = self.range.moved(&self.latest);
+            .and_then(|_| self.isolation());
         let input = PanelInput {
             default_motor: self.default_motor,
             ..panel_input(mode, &self.latest, learned, failed)

@@ -49,6 +49,7 @@ impl Supervisor {
     pub fn set_isolator(&mut self, isolator: Option<Isolator>) {
         self.isolation = isolator.map(Follower::new);
         self.run_baseline = None;
+        self.evidence = Evidence::default();
     }
 
     /// Puts the isolation baseline of the record loaded at boot into force (the record the
@@ -61,9 +62,13 @@ impl Supervisor {
         }
     }
 
-    /// The latest fault isolation (`None` before the first steady half second, or unusable).
+    /// The latest fault isolation in force (`None` before the first steady half second, or
+    /// unusable): the averaged point's, or the joint fit's over the operating points kept
+    /// since the deviation began where it names a fault that the point alone does not
+    /// (`monitor_core::isolation::Evidence::joint_beside`: the host's rule).
     pub fn isolation(&self) -> Option<&Isolation> {
-        self.isolation.as_ref().and_then(Follower::last)
+        let single = self.isolation.as_ref().and_then(Follower::last)?;
+        Some(self.evidence.in_force(single))
     }
 
     /// The isolation baseline in force when it was learned in commissioning (this run or a
@@ -79,7 +84,9 @@ impl Supervisor {
     /// counter, usable once the monitor has evaluated with no sensor fault, learning while
     /// a commissioning run learns (the core's schedule: `monitor_core::isolation::Follower`).
     /// Learning ends when the run stops learning, before its calibration is stored, so
-    /// that the baseline goes into the same record.
+    /// that the baseline goes into the same record. Each isolation goes to the evidence
+    /// across operating points ([`Evidence::after`]: a joint fit once per 0.1 s block at
+    /// most); a run that learns forgets it (a new baseline).
     pub(super) fn follow(&mut self, s: &MonitorStatus, previous_samples: u32) {
         let Some(f) = self.isolation.as_mut() else {
             return;
@@ -90,9 +97,12 @@ impl Supervisor {
         let learning = s.run.stage == monitor_core::RunStage::Learning;
         if learning {
             self.run_baseline = None;
+            self.evidence = Evidence::default();
         }
-        if let Step::LearningEnded(ok) = f.observe(&s.point, dt_s, usable, learning) {
-            self.run_baseline = ok.then(|| f.isolator().baseline());
+        match f.observe(&s.point, dt_s, usable, learning) {
+            Step::LearningEnded(ok) => self.run_baseline = ok.then(|| f.isolator().baseline()),
+            Step::Isolated(result) => self.evidence.after(f, &result),
+            _ => {}
         }
     }
 }
