@@ -106,9 +106,7 @@ impl Evidence {
             // The first point, compared with the anchor's load, gives way only to a later
             // average of the same operating point before the load has moved (the first may
             // have begun inside the change).
-            Some(0)
-                if self.anchor.is_some()
-                    && (self.len > 1 || !self.same_point_as_first(a)) => {}
+            Some(0) if self.anchor.is_some() && (self.len > 1 || !self.same_point_as_first(a)) => {}
             Some(k) => {
                 if let Some(slot) = self.kept_mut().get_mut(k) {
                     *slot = (p, scale);
@@ -187,10 +185,7 @@ impl Evidence {
         let j = self.joint?;
         let n = self.len;
         match j.named()? {
-            Named::Fault(c) if c.misfit * c.misfit <= super::DETECT_CHI2 * n as f32 =>
-            {
-                Some((j, n))
-            }
+            Named::Fault(c) if c.misfit * c.misfit <= super::DETECT_CHI2 * n as f32 => Some((j, n)),
             _ => None,
         }
     }
