@@ -10,7 +10,8 @@
 //!   commissioning procedure ([`CommissioningProcedure`]), the liveness watch
 //!   ([`SampleWatch`]: the watchdog is petted only while samples flow), the fault
 //!   isolation (`monitor_core::isolation::Follower` on the statuses: which fault, how
-//!   large; about 280 small circuit evaluations every 50 ms at most) and the panel.
+//!   large; with the evidence across operating points, `monitor_core::isolation::Evidence`,
+//!   at most about 1 M instructions per 0.1 s block, docs/firmware.md "Size") and the panel.
 //!   [`carry_out`] turns its actions into commands, storing the learned calibration first.
 //!
 //! The host tests (`tests/sil/`) drive exactly these types with simulated data; the

@@ -62,13 +62,7 @@ fn board_run(sc: &Scenario) -> Rig {
     rig.supervisor
         .set_isolator(motor_source::isolator(&rec).ok());
     let frames = frames_with(&ParamFile::reference_3hp(), &rig.path, sc);
-    rig.run(&frames, |rig, k| {
-        if k == PRESS_AT {
-            rig.press();
-        }
-    })
-    .unwrap();
-    assert_eq!(rig.ended, [RunEnd::Commissioned { run: 1 }]);
+    rig.run_commissioning(&frames);
     rig
 }
 

@@ -382,6 +382,18 @@ impl Rig {
         Ok(())
     }
 
+    /// Runs `frames` with the button pressed at [`PRESS_AT`] and checks that the run
+    /// commissioned.
+    fn run_commissioning(&mut self, frames: &[RawFrame]) {
+        self.run(frames, |rig, k| {
+            if k == PRESS_AT {
+                rig.press();
+            }
+        })
+        .unwrap();
+        assert_eq!(self.ended, [RunEnd::Commissioned { run: 1 }]);
+    }
+
     fn last(&self) -> &Seen {
         self.seen.last().expect("a thread tick")
     }
