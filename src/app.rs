@@ -10,7 +10,8 @@
 //!   commissioning procedure ([`CommissioningProcedure`]), the liveness watch
 //!   ([`SampleWatch`]: the watchdog is petted only while samples flow), the fault
 //!   isolation (`monitor_core::isolation::Follower` on the statuses: which fault, how
-//!   large; about 280 small circuit evaluations every 50 ms at most) and the panel.
+//!   large; with the evidence across operating points, `monitor_core::isolation::Evidence`,
+//!   at most about 1 M instructions per 0.1 s block, docs/firmware.md "Size") and the panel.
 //!   [`carry_out`] turns its actions into commands, storing the learned calibration first.
 //!
 //! The host tests (`tests/sil/`) drive exactly these types with simulated data; the
@@ -27,12 +28,15 @@ use crate::panel::{self, blink_code, winding_code, Mode, PanelInput, PanelLamps,
 use crate::range_watch::RangeWatch;
 use crate::reset_record::PreviousRun;
 use crate::sampling::{AdcSampler, RawFrame, SamplingError, TICK_HZ};
-use monitor_core::isolation::{Baseline, Follower, Named, Step};
+use monitor_core::isolation::{Baseline, Evidence, Follower, Named, Step};
 use monitor_core::{
     CommissioningError, CommissioningRun, ConfigError, Fault, Install, Isolation, IsolationState,
     Isolator, Monitor, MonitorConfig, MotorModel, Operating, Phase, ReferenceMachine, SensorFlags,
     SteadyPoint,
 };
+
+mod isolation;
+pub use isolation::{board_isolator, isolation_summary};
 
 /// The machine the firmware monitors by default: the "2.2 kW" reference machine
 /// (`monitor_core::reference::MOTOR_2P2KW`: 400 V, 50 Hz, 4 poles, Gamma model, Bl for the
@@ -52,20 +56,6 @@ pub const BUTTON_DEBOUNCE_MS: u32 = 300;
 /// The default machine in the core's precision.
 pub fn default_motor() -> MotorModel {
     DEFAULT_MACHINE.motor.model()
-}
-
-/// The fault isolator for [`DEFAULT_MACHINE`] on its rated supply.
-///
-/// # Errors
-/// The core's [`ConfigError`] if it rejects the machine or the supply (then nothing is
-/// isolated and the blink code says "not named").
-pub fn board_isolator() -> Result<Isolator, ConfigError> {
-    let supply = DEFAULT_MACHINE.supply;
-    Isolator::new(
-        default_motor(),
-        supply.v_phase_peak() as f32,
-        supply.f_hz as f32,
-    )
 }
 
 /// Core configuration for the board: [`DEFAULT_MACHINE`] on its rated supply, sampled at
@@ -296,30 +286,6 @@ pub struct MonitorStatus {
     pub moved: bool,
 }
 
-/// The isolation in the status line's words (docs/firmware.md, "The status line"): the label
-/// (the fault's name `rs`..`speed_sensor`, `b/bl` for the friction class, `unknown`,
-/// `none` for no deviation from the healthy baseline, `not-judged`), the named fault's
-/// size (relative change, 0.48 for +48 %; for sensors the gain error; Bl's for the
-/// friction class; 0 when nothing is named) and its probability (the unknown fault's for
-/// `unknown`, 0 otherwise).
-pub fn isolation_summary(iso: Option<&Isolation>) -> (&'static str, f32, f32) {
-    let Some(iso) = iso else {
-        return ("not-judged", 0.0, 0.0);
-    };
-    match (iso.named(), iso.state) {
-        (Some(Named::Fault(c)), _) => (c.fault.name(), c.change, c.probability),
-        (
-            Some(Named::Friction {
-                probability, bl, ..
-            }),
-            _,
-        ) => ("b/bl", bl.change, probability),
-        (None, IsolationState::NoDeviation) => ("none", 0.0, 0.0),
-        (None, IsolationState::NotJudged) => ("not-judged", 0.0, 0.0),
-        (None, _) => ("unknown", 0.0, iso.unknown_probability),
-    }
-}
-
 /// The panel's inputs ([`PanelInput`], the panel's whole interface) for the latest status
 /// in `mode` and the latest `isolation`
 /// judged against a baseline learned in commissioning (`None` without one): the residual
@@ -548,6 +514,9 @@ pub struct Supervisor {
     last_press_ms: Option<u32>,
     /// The fault isolation's schedule (its isolator holds the tracked winding rise).
     pub isolation: Option<Follower>,
+    /// The operating points kept since a deviation began and their joint isolation (the
+    /// host's replay keeps the same: `monitor_core::isolation::Evidence`).
+    evidence: Evidence,
     /// The isolation baseline learned in the latest commissioning run (stored with its
     /// calibration), `None` while learning or when that run learned too little.
     run_baseline: Option<Baseline>,
@@ -585,6 +554,7 @@ impl Supervisor {
                 .then(|| now_ms.wrapping_add(FAILED_BOOT_SHOW_MS)),
             last_press_ms: None,
             isolation: board_isolator().ok().map(Follower::new),
+            evidence: Evidence::default(),
             run_baseline: None,
             sample_rate_hz: settings.sample_rate_hz,
             running: false,
@@ -606,59 +576,6 @@ impl Supervisor {
     /// panel shows it ([`crate::panel`], "Built-in default motor"). Off until set.
     pub fn set_default_motor(&mut self, default_motor: bool) {
         self.default_motor = default_motor;
-    }
-
-    /// Isolates against `isolator`'s machine from now on (the motor record's, read at boot;
-    /// [`Supervisor::new`] starts with [`board_isolator`]'s built-in default). `None`: the
-    /// machine was rejected, nothing is isolated (the blink code says "not named").
-    pub fn set_isolator(&mut self, isolator: Option<Isolator>) {
-        self.isolation = isolator.map(Follower::new);
-        self.run_baseline = None;
-    }
-
-    /// Puts the isolation baseline of the record loaded at boot into force (the record the
-    /// core accepted), so that after a reset the isolation judges against the machine's own
-    /// baseline again. Returns whether one was put into force.
-    pub fn restore_isolation(&mut self, record: &CalibrationRecord) -> bool {
-        match (self.isolation.as_mut(), record.isolation) {
-            (Some(f), Some(b)) => f.restore_learned(b),
-            _ => false,
-        }
-    }
-
-    /// The latest fault isolation (`None` before the first steady half second, or unusable).
-    pub fn isolation(&self) -> Option<&Isolation> {
-        self.isolation.as_ref().and_then(Follower::last)
-    }
-
-    /// The isolation baseline in force when it was learned in commissioning (this run or a
-    /// stored one); `None` with the nominal parameters' defaults.
-    pub fn isolation_baseline(&self) -> Option<Baseline> {
-        self.isolation
-            .as_ref()
-            .filter(|f| f.learned())
-            .map(|f| f.isolator().baseline())
-    }
-
-    /// Feeds a new status to the fault isolation: its operating point, `dt` from the sample
-    /// counter, usable once the monitor has evaluated with no sensor fault, learning while
-    /// a commissioning run learns (the core's schedule: `monitor_core::isolation::Follower`).
-    /// Learning ends when the run stops learning, before its calibration is stored, so
-    /// that the baseline goes into the same record.
-    fn follow(&mut self, s: &MonitorStatus, previous_samples: u32) {
-        let Some(f) = self.isolation.as_mut() else {
-            return;
-        };
-        let dt_s = s.samples.wrapping_sub(previous_samples) as f32 / self.sample_rate_hz as f32;
-        self.running |= s.evaluating;
-        let usable = self.running && !s.sensor_fault.any();
-        let learning = s.run.stage == monitor_core::RunStage::Learning;
-        if learning {
-            self.run_baseline = None;
-        }
-        if let Step::LearningEnded(ok) = f.observe(&s.point, dt_s, usable, learning) {
-            self.run_baseline = ok.then(|| f.isolator().baseline());
-        }
     }
 
     /// The commissioned operating range and the "moved" judgement.
@@ -733,12 +650,12 @@ impl Supervisor {
             Mode::NotCommissioned
         };
         let failed = self.procedure.last_failure().is_some();
+        self.latest.moved = self.range.moved(&self.latest);
         let learned = self
             .isolation
             .as_ref()
             .filter(|f| f.learned())
-            .and_then(Follower::last);
-        self.latest.moved = self.range.moved(&self.latest);
+            .and_then(|_| self.isolation());
         let input = PanelInput {
             default_motor: self.default_motor,
             ..panel_input(mode, &self.latest, learned, failed)

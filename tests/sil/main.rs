@@ -15,6 +15,7 @@
 //! the next boot would load) and the panel (the RUN lamp's mode) agree.
 
 mod commissioning;
+mod evidence;
 mod isolation;
 mod liveness;
 mod moved;
@@ -381,6 +382,18 @@ impl Rig {
         Ok(())
     }
 
+    /// Runs `frames` with the button pressed at [`PRESS_AT`] and checks that the run
+    /// commissioned.
+    fn run_commissioning(&mut self, frames: &[RawFrame]) {
+        self.run(frames, |rig, k| {
+            if k == PRESS_AT {
+                rig.press();
+            }
+        })
+        .unwrap();
+        assert_eq!(self.ended, [RunEnd::Commissioned { run: 1 }]);
+    }
+
     fn last(&self) -> &Seen {
         self.seen.last().expect("a thread tick")
     }
@@ -391,9 +404,18 @@ impl Rig {
 }
 
 fn frames(scenario: &Scenario) -> Vec<RawFrame> {
-    let params = ParamFile::reference_2p2kw();
-    let rows = simulate_to_vec(&params, scenario).expect("simulation");
-    let q = *SamplePath::for_board(FS).unwrap().sampler();
+    frames_with(
+        &ParamFile::reference_2p2kw(),
+        &SamplePath::for_board(FS).unwrap(),
+        scenario,
+    )
+}
+
+/// The frames of `params`' machine in `scenario`, quantized by `path`'s front end (the
+/// encoder with the board's counts per revolution).
+fn frames_with(params: &ParamFile, path: &SamplePath, scenario: &Scenario) -> Vec<RawFrame> {
+    let rows = simulate_to_vec(params, scenario).expect("simulation");
+    let q = *path.sampler();
     let mut theta_counts = 0.0f64;
     let dt = 1.0 / scenario.sample_rate_hz;
     rows.iter()

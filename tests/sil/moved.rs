@@ -22,13 +22,7 @@ fn run_flashes_per_2s(rig: &Rig, window: std::ops::Range<u32>) -> f64 {
 fn commissioned_then(scenario: &Scenario) -> Rig {
     let frames = frames(scenario);
     let mut rig = Rig::boot(Survivors::power_on(FakeFlash::erased()));
-    rig.run(&frames, |rig, k| {
-        if k == PRESS_AT {
-            rig.press();
-        }
-    })
-    .unwrap();
-    assert_eq!(rig.ended, [RunEnd::Commissioned { run: 1 }]);
+    rig.run_commissioning(&frames);
     rig
 }
 

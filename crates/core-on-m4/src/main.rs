@@ -13,7 +13,11 @@
 //!    step per executed instruction); SysTick is read around each loop and calibrated
 //!    against a loop of a known instruction count, and the cost of the loop itself
 //!    (decoding the sample) is subtracted.
-//! 3. Prints `name=value` lines and exits 0, or non-zero on any mismatch.
+//! 3. Counts the instructions of the fault isolation's work per 0.1 s block in thread
+//!    mode (not per sample): one isolation of the averaged point and one joint fit over
+//!    [`MAX_POINTS`] operating points with an anchor (the evidence across operating
+//!    points, `monitor_core::isolation::Evidence`).
+//! 4. Prints `name=value` lines and exits 0, or non-zero on any mismatch.
 #![no_std]
 #![no_main]
 
@@ -27,6 +31,7 @@ use cortex_m_rt::entry;
 use monitor_core::angle::RotorFluxCurrentModel;
 use monitor_core::encoder::MtSpeed;
 use monitor_core::frames::{clarke, park, SinCos};
+use monitor_core::isolation::{Isolator, SteadyPoint, MAX_POINTS};
 use monitor_core::residuals::{residuals, Operating};
 use monitor_core::{Monitor, MonitorConfig};
 use scenario::Check;
@@ -152,6 +157,7 @@ fn main() -> ! {
     let cfg = scenario::config();
     let ok = replay_matches_host(&cfg, n, checks, spacing);
     count_instructions(&cfg, n, ticks_per_instr);
+    count_isolation(&cfg, n, ticks_per_instr);
     println!("result={}", if ok { "pass" } else { "FAIL" });
     semihosting::exit(ok)
 }
@@ -327,6 +333,55 @@ fn count_instructions(cfg: &MonitorConfig, n: usize, ticks_per_instr: f32) {
     println!("fast_path={:.0}", fast);
     println!("slow_path_per_call={:.0}", slow);
     println!("whole_pipeline={:.0}", per_sample(t_all, base, n));
+}
+
+/// Counts the instructions of the isolation's thread-mode work per 0.1 s block (module
+/// docs, 3) and prints them: `isolate_single` (`Isolator::isolate_scaled`, the averaged
+/// point) and `isolate_joint` (`Isolator::isolate_points_anchored` over [`MAX_POINTS`]
+/// points and an anchor). The points are the monitor's steady points
+/// (`SteadyPoint::from_output`) over the last quarter of the replay with the voltage read
+/// 5 % high, a deviation, so that every hypothesis is fitted (a point without deviation
+/// returns early); the anchor is the last point as read. The isolator is the replay's
+/// machine on its supply (400 V, 50 Hz).
+fn count_isolation(cfg: &MonitorConfig, n: usize, ticks_per_instr: f32) {
+    let Ok(mut monitor) = Monitor::new(*cfg) else {
+        semihosting::exit(false);
+    };
+    let Ok(isolator) = Isolator::new(scenario::motor(), 400.0 * 0.816_496_6, 50.0) else {
+        semihosting::exit(false);
+    };
+    let mut points = [(SteadyPoint::default(), 1.0f32); MAX_POINTS];
+    let mut anchor = SteadyPoint::default();
+    let spacing = n / (4 * MAX_POINTS);
+    for k in 0..n {
+        let out = monitor.update(&scenario::sample(REPLAY, k));
+        let from_end = n - 1 - k;
+        if spacing > 0 && from_end.is_multiple_of(spacing) && from_end / spacing < MAX_POINTS {
+            let mut p = SteadyPoint::from_output(out);
+            if from_end == 0 {
+                anchor = p;
+            }
+            p.v.d *= 1.05;
+            p.v.q *= 1.05;
+            points[from_end / spacing] = (p, 1.0);
+        }
+    }
+    let mut single = None;
+    let t_single = measure(|| {
+        single = Some(black_box(isolator.isolate_scaled(&points[0].0, 1.0)));
+    });
+    let mut joint = None;
+    let t_joint = measure(|| {
+        joint = Some(black_box(
+            isolator.isolate_points_anchored(&points, Some(&anchor)),
+        ));
+    });
+    let instr = |t: u32| t as f32 / ticks_per_instr;
+    let state = |i: Option<monitor_core::Isolation>| i.map(|i| (i.state, i.deviation));
+    println!("isolate_single_state={:?}", state(single));
+    println!("isolate_joint_state={:?}", state(joint));
+    println!("isolate_single={:.0}", instr(t_single));
+    println!("isolate_joint_{}_points={:.0}", MAX_POINTS, instr(t_joint));
 }
 
 #[panic_handler]

@@ -126,7 +126,7 @@ pub(super) struct IsolationTracker {
     /// A lamp lit while lamps counted.
     lamps_lit: bool,
     /// The operating points kept since a deviation, and their joint isolation.
-    evidence: super::evidence::Evidence,
+    evidence: monitor_core::isolation::Evidence,
     /// What is known of the load ([`super::LoadModel`]).
     load: super::LoadModel,
     /// Names and load moves, with times.
@@ -172,13 +172,6 @@ fn load_reading(load: super::LoadModel, n: &Named) -> bool {
     load == super::LoadModel::Unknown && matches!(n, Named::Friction { .. })
 }
 
-/// Whether `iso` names a fault (the friction class does not count: to the paper's model a
-/// load change is a Bl change, and the joint fit over operating points, which treats the
-/// load as an unknown input, may name the electrical fault behind it).
-fn names_a_fault(iso: &Isolation) -> bool {
-    matches!(iso.named(), Some(Named::Fault(_)))
-}
-
 /// How far a parameter file's values may be off the machine's (nameplate estimates are
 /// 10-30 % off): against the nominal parameters (no commissioning), a change this small or
 /// smaller, with every lamp dark, is the file's own error as much as a fault, and is not
@@ -198,7 +191,7 @@ impl IsolationTracker {
             end_t: 0.0,
             last_point: SteadyPoint::default(),
             lamps_lit: false,
-            evidence: super::evidence::Evidence::default(),
+            evidence: monitor_core::isolation::Evidence::default(),
             load,
             events: super::events::EventLog::default(),
         }
@@ -239,8 +232,7 @@ impl IsolationTracker {
             // operating points).
             let joint = self
                 .evidence
-                .named()
-                .filter(|_| !names_a_fault(&result))
+                .joint_beside(&result)
                 .and_then(|(j, _)| j.named());
             // (The joint fit's fault before the friction class of the last point: a load
             // that moved is, to the paper's model, a Bl change.)
@@ -398,10 +390,7 @@ impl IsolationTracker {
         };
         // The joint isolation over the operating points kept, where it names a fault that
         // the last point alone does not.
-        let joint = self
-            .evidence
-            .named()
-            .filter(|_| !names_a_fault(&single) && single.state != IsolationState::NoDeviation);
+        let joint = self.evidence.joint_beside(&single).map(|(j, n)| (*j, n));
         let mut iso = joint.map_or(single, |(j, _)| j);
         // With the load an unknown input, the friction class is the load's move: nothing
         // deviates from the machine (the load move is an event).

@@ -23,7 +23,6 @@
 mod commission;
 mod diagnose;
 mod events;
-mod evidence;
 mod isolation;
 mod pipe;
 mod report;

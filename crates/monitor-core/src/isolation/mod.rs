@@ -134,6 +134,8 @@ pub use follower::{
     STEADY_FRACTION, STEP_S,
 };
 mod circuit;
+mod evidence;
+pub use evidence::{Evidence, LEVEL_APART};
 mod isolator;
 pub use isolator::{ANCHOR_LOAD_BAND, ANCHOR_TORQUE_SPREAD, LOAD_LAW_SPREAD, MAX_POINTS};
 

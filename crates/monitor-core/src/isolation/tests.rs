@@ -601,3 +601,49 @@ fn faults_that_coincide_at_one_point_part_over_several() {
         }
     }
 }
+
+/// The evidence across operating points through the follower, on the 3 hp machine's
+/// analytic steady states: healthy at rated load (the anchor), then Ls x1.5 at rated load,
+/// where the single point does not name it, and at four lighter load levels 20 % or more
+/// apart. The evidence names Ls with its size at every level after the first, and beyond
+/// [`MAX_POINTS`] levels it keeps that many.
+#[test]
+fn the_evidence_names_ls_over_load_levels_and_keeps_max_points() {
+    let (_, m, v, we) = machines()[1];
+    let iso = Isolator::new(m.model(), v as f32, (we / core::f64::consts::TAU) as f32).unwrap(); // ok: test
+    let mut f = Follower::new(iso);
+    let mut ev = Evidence::default();
+    let at_load = |fault: Option<Fault>, load: f64| {
+        let mut t = faulty(&m, fault, 1.5);
+        t.bl_nms *= load;
+        measure(&t, v, we, fault, 1.5)
+    };
+    // Three seconds at each point, 10 ms apart.
+    let run = |p: SteadyPoint, f: &mut Follower, ev: &mut Evidence| {
+        for _ in 0..300 {
+            if let Step::Isolated(r) = f.observe(&p, 0.01, true, false) {
+                ev.after(f, &r);
+            }
+        }
+    };
+    run(at_load(None, 1.0), &mut f, &mut ev);
+    run(at_load(Some(Fault::Ls), 1.0), &mut f, &mut ev);
+    let single = *f.last().unwrap(); // ok: test
+    assert!(single.named_fault().is_none(), "one point: {single:?}");
+    assert!(ev.anchored(), "the healthy point is the anchor");
+    let mut kept = std::vec::Vec::new();
+    for load in [0.75, 0.55, 0.4, 0.3] {
+        run(at_load(Some(Fault::Ls), load), &mut f, &mut ev);
+        let (joint, n) = ev.named().unwrap(); // ok: test
+        let c = joint.named_fault().unwrap(); // ok: test
+        assert_eq!(c.fault, Fault::Ls, "{load}: {joint:?}");
+        assert!((c.change - 0.5).abs() <= 0.05, "{load}: {c:?}");
+        let single = *f.last().unwrap(); // ok: test
+        assert_eq!(
+            ev.in_force(&single).named_fault().map(|c| c.fault),
+            Some(Fault::Ls)
+        );
+        kept.push(n);
+    }
+    assert_eq!(kept, [2, 3, MAX_POINTS, MAX_POINTS]);
+}

@@ -1,6 +1,6 @@
 //! Evidence across operating points: once the isolation sees a deviation, the steady
 //! operating points the motor visits are kept (one per load level) and every hypothesis is
-//! fitted over all of them together (`monitor_core::isolation::Isolator::isolate_points`,
+//! fitted over all of them together ([`Isolator::isolate_points`](super::Isolator::isolate_points),
 //! the stator-voltage equations only: the load at each point is an unknown input). Faults
 //! that coincide at one point (on the 3 hp motor at rated load Ls, Rr and the speed sensor)
 //! part over two load levels 20 % apart or more.
@@ -13,10 +13,11 @@
 //! machine nor its load, is judged with it from the first point after the step: a current
 //! sensor's error scales the torque computed from the currents, a voltage sensor's does
 //! not (the stator-voltage equations alone see the two alike).
+//!
+//! No allocation: the points are kept in an array of [`MAX_POINTS`]; the host's replay and
+//! the firmware's thread mode run this same code.
 
-use monitor_core::isolation::{
-    Follower, Isolation, IsolationState, Named, SteadyPoint, MAX_POINTS,
-};
+use super::{Follower, Isolation, IsolationState, Named, SteadyPoint, MAX_POINTS};
 
 /// Smallest relative difference of the load (the active current) between two kept points:
 /// 15 %, so that two points are two operating points and not one seen twice.
@@ -25,7 +26,7 @@ pub const LEVEL_APART: f32 = 0.15;
 /// Largest relative difference of the active current at which a later point replaces the
 /// first one (the same operating point averaged again): 2 %, the follower's steadiness
 /// band (`monitor_core::isolation::STEADY_FRACTION`).
-const SAME_POINT: f32 = monitor_core::isolation::STEADY_FRACTION;
+const SAME_POINT: f32 = super::STEADY_FRACTION;
 
 /// Largest deviation of the stator-voltage equations alone [standard deviations] at which
 /// a point the single isolation reads as the friction class counts as a load that moved:
@@ -35,7 +36,7 @@ const LOAD_MOVED_SIGMA: f32 = 2.0;
 
 /// The active current of a steady point (its current's part in phase with its voltage) [A].
 fn active_current(p: &SteadyPoint) -> f32 {
-    let v = p.v.d.hypot(p.v.q);
+    let v = crate::fast_hypot(p.v.d, p.v.q);
     if v > 0.0 {
         (p.v.d * p.i.d + p.v.q * p.i.q) / v
     } else {
@@ -44,9 +45,11 @@ fn active_current(p: &SteadyPoint) -> f32 {
 }
 
 /// The kept points and the joint isolation over them.
-#[derive(Debug, Clone, Default)]
-pub(super) struct Evidence {
-    points: Vec<(SteadyPoint, f32)>,
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Evidence {
+    /// The points kept (the first `len`), each with its spread scale.
+    points: [(SteadyPoint, f32); MAX_POINTS],
+    len: usize,
     joint: Option<Isolation>,
     /// The last averaged point judged healthy (no deviation) before the points kept.
     anchor: Option<SteadyPoint>,
@@ -58,13 +61,13 @@ impl Evidence {
     /// [`MAX_POINTS`], except the first with an anchor) and refits jointly; no deviation, or
     /// one the stator-voltage equations do not see (the load moved), forgets the evidence
     /// and makes the averaged point the anchor.
-    pub(super) fn after(&mut self, follower: &Follower, result: &Isolation) {
+    pub fn after(&mut self, follower: &Follower, result: &Isolation) {
         if !matches!(
             result.state,
             IsolationState::Isolated | IsolationState::Unknown
         ) || result.heating_explains()
         {
-            self.points.clear();
+            self.len = 0;
             self.joint = None;
             if result.state == IsolationState::NoDeviation {
                 self.anchor = follower.averaged().map(|(p, _)| p);
@@ -83,10 +86,10 @@ impl Evidence {
         let iso = follower.isolator();
         let friction = matches!(result.named(), Some(Named::Friction { .. }));
         if friction
-            && self.points.is_empty()
+            && self.len == 0
             && iso.isolate_points(&[(p, scale)]).deviation < LOAD_MOVED_SIGMA
         {
-            self.points.clear();
+            self.len = 0;
             self.joint = None;
             self.anchor = Some(p);
             return;
@@ -95,7 +98,7 @@ impl Evidence {
         if !a.is_finite() {
             return;
         }
-        let same_level = self.points.iter().position(|(q, _)| {
+        let same_level = self.kept().iter().position(|(q, _)| {
             let b = active_current(q);
             (a - b).abs() < LEVEL_APART * b.abs().max(a.abs())
         });
@@ -103,35 +106,49 @@ impl Evidence {
             // The first point, compared with the anchor's load, gives way only to a later
             // average of the same operating point before the load has moved (the first may
             // have begun inside the change).
-            Some(0)
-                if self.anchor.is_some()
-                    && (self.points.len() > 1 || !self.same_point_as_first(a)) => {}
+            Some(0) if self.anchor.is_some() && (self.len > 1 || !self.same_point_as_first(a)) => {}
             Some(k) => {
-                if let Some(slot) = self.points.get_mut(k) {
+                if let Some(slot) = self.kept_mut().get_mut(k) {
                     *slot = (p, scale);
                 }
             }
             None => {
-                if self.points.len() >= MAX_POINTS {
+                if self.len >= MAX_POINTS {
                     // The first point, at the anchor's load, is the one the torque
                     // comparison holds for: the oldest after it goes.
-                    let oldest = usize::from(self.anchor.is_some() && self.points.len() > 1);
-                    self.points.remove(oldest);
+                    let oldest = usize::from(self.anchor.is_some() && self.len > 1);
+                    if let Some(tail) = self.kept_mut().get_mut(oldest..) {
+                        tail.rotate_left(1);
+                    }
+                    self.len -= 1;
                 }
-                self.points.push((p, scale));
+                if let Some(slot) = self.points.get_mut(self.len) {
+                    *slot = (p, scale);
+                    self.len += 1;
+                }
             }
         }
-        let enough = self.points.len() >= 2 || self.anchor.is_some();
+        let enough = self.len >= 2 || self.anchor.is_some();
         self.joint = enough.then(|| {
             follower
                 .isolator()
-                .isolate_points_anchored(&self.points, self.anchor.as_ref())
+                .isolate_points_anchored(self.kept(), self.anchor.as_ref())
         });
+    }
+
+    /// The points kept, oldest first.
+    fn kept(&self) -> &[(SteadyPoint, f32)] {
+        self.points.get(..self.len).unwrap_or(&[])
+    }
+
+    /// The points kept, oldest first, to change in place.
+    fn kept_mut(&mut self) -> &mut [(SteadyPoint, f32)] {
+        self.points.get_mut(..self.len).unwrap_or(&mut [])
     }
 
     /// The active current `a` is within [`SAME_POINT`] of the first point's.
     fn same_point_as_first(&self, a: f32) -> bool {
-        self.points.first().is_some_and(|(q, _)| {
+        self.kept().first().is_some_and(|(q, _)| {
             let b = active_current(q);
             (a - b).abs() <= SAME_POINT * b.abs()
         })
@@ -139,22 +156,36 @@ impl Evidence {
 
     /// The joint isolation compares the first point's torque with the load at an anchor
     /// (the last point judged healthy before the deviation).
-    pub(super) fn anchored(&self) -> bool {
+    pub fn anchored(&self) -> bool {
         self.anchor.is_some()
+    }
+
+    /// The joint isolation in force beside the single point's latest result `single`, with
+    /// the number of points (the one rule the host's replay and the firmware share): the
+    /// joint fit's when it names a fault ([`Evidence::named`]) while `single` deviates and
+    /// names none. The friction class of `single` does not count as a name: to the paper's
+    /// model a load that moved is a Bl change, and the joint fit, which treats the load as
+    /// an unknown input, may name the electrical fault behind it.
+    pub fn joint_beside(&self, single: &Isolation) -> Option<(&Isolation, usize)> {
+        let (_, n) = self.named()?;
+        let joint = self.joint.as_ref()?;
+        let names_a_fault = matches!(single.named(), Some(Named::Fault(_)));
+        (!names_a_fault && single.state != IsolationState::NoDeviation).then_some((joint, n))
+    }
+
+    /// The isolation in force: [`Evidence::joint_beside`]'s, else `single`.
+    pub fn in_force<'a>(&'a self, single: &'a Isolation) -> &'a Isolation {
+        self.joint_beside(single).map_or(single, |(j, _)| j)
     }
 
     /// The joint isolation when it names a fault (not the friction class, which the
     /// voltage equations cannot judge) that explains every point within the healthy
     /// scatter (its misfit within `sqrt(16 n)` for n points), and the number of points.
-    pub(super) fn named(&self) -> Option<(Isolation, usize)> {
+    pub fn named(&self) -> Option<(Isolation, usize)> {
         let j = self.joint?;
-        let n = self.points.len();
+        let n = self.len;
         match j.named()? {
-            Named::Fault(c)
-                if c.misfit * c.misfit <= monitor_core::isolation::DETECT_CHI2 * n as f32 =>
-            {
-                Some((j, n))
-            }
+            Named::Fault(c) if c.misfit * c.misfit <= super::DETECT_CHI2 * n as f32 => Some((j, n)),
             _ => None,
         }
     }
