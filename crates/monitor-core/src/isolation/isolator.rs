@@ -555,8 +555,13 @@ impl Isolator {
         let t_load = t0 * speed;
         let s_law = LOAD_LAW_SPREAD * (speed - 1.0) * t0 / self.torque_base_nm;
         let s = ANCHOR_TORQUE_SPREAD * scale;
+        // The parameter file's own torque error: what commissioning learned as the torque
+        // balance's healthy mean (zero for a file that fits the machine; a nameplate 20 %
+        // off leaves several per cent, and the change of that error between the anchor and
+        // a faulty point is of its order).
+        let s_file = self.baseline.mean.torque;
         let d = (te - t_load) / self.torque_base_nm;
-        let var = s * s + s_law * s_law;
+        let var = s * s + s_law * s_law + s_file * s_file;
         if var > 0.0 {
             d * d / var
         } else {
