@@ -446,7 +446,7 @@ pub(super) fn for_each_row(
     let cols = Cols::new(&idx, columns.n_fields);
     // (Run by the parsing workers: the reading thread only hands the rows over.)
     let to_row = |slots: &[f64]| {
-        let mut v = [0.0f64; 9];
+        let mut v = [0.0f64; Column::COUNT];
         for (&c, &x) in present.iter().zip(slots) {
             v[c] = x;
         }

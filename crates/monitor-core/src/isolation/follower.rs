@@ -185,6 +185,9 @@ pub struct Follower {
     /// The average was begun again at the onset of a deviation since the point last left
     /// the band (module docs).
     onset_restarted: bool,
+    /// The winding's measured rise since commissioning [K], when a temperature channel
+    /// gives it ([`Follower::set_measured_rise_k`]).
+    measured_rise_k: Option<f32>,
 }
 
 impl Follower {
@@ -207,7 +210,26 @@ impl Follower {
             since_isolation_s: 0.0,
             settling_s: 0.0,
             onset_restarted: false,
+            measured_rise_k: None,
         }
+    }
+
+    /// The winding's rise since commissioning measured by a temperature channel [K]
+    /// (`Some`), or none (`None`: the rise is tracked from the resistances again, from
+    /// the factor last in force). A measured rise replaces the tracking: the isolator's
+    /// Rs and Rr are `1 + alpha rise_k` times the commissioned ones
+    /// ([`Isolator::set_winding_rise_k`]) and no heating is inferred from the residuals.
+    /// Returns false for a rise the isolator refuses (not finite, or beyond 25 K cooler
+    /// .. 160 K warmer): then no measured rise is in force, as with `None`.
+    pub fn set_measured_rise_k(&mut self, rise_k: Option<f32>) -> bool {
+        let ok = rise_k.is_some_and(|r| self.isolator.set_winding_rise_k(r));
+        self.measured_rise_k = if ok { rise_k } else { None };
+        ok || rise_k.is_none()
+    }
+
+    /// The measured rise in force ([`Follower::set_measured_rise_k`]) [K].
+    pub fn measured_rise_k(&self) -> Option<f32> {
+        self.measured_rise_k
     }
 
     /// One observed point `p`, `dt_s` [s] after the previous observation (> 0; a
@@ -279,7 +301,8 @@ impl Follower {
             // and the point is judged again (module docs of `crate::isolation`).
             let warming = self.isolator.winding_rise_k().abs() >= super::WARMING_K;
             let heating = result.heating_explains() || (warming && result.heating_continues());
-            if self.learned && heating {
+            // (A measured rise is in force instead: nothing is inferred.)
+            if self.learned && heating && self.measured_rise_k.is_none() {
                 self.isolator.track_heating(result.heating.factor);
                 result = self.isolator.isolate_scaled(&avg, scale);
             }
