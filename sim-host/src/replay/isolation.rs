@@ -126,6 +126,8 @@ pub(super) struct IsolationTracker {
     lamps_lit: bool,
     /// The operating points kept since a deviation, and their joint isolation.
     evidence: super::evidence::Evidence,
+    /// The log's temperature channel (`t_winding_c`), when it has one.
+    temperature: super::temperature::TemperatureChannel,
 }
 
 /// Whether `iso` names a fault (the friction class does not count: to the paper's model a
@@ -143,8 +145,9 @@ pub const NOMINAL_UNCERTAINTY: f32 = 0.3;
 
 impl IsolationTracker {
     /// A tracker for the nominal machine (`None`: a machine the isolator rejects, then
-    /// nothing is isolated and the report says so).
-    pub(super) fn new(isolator: Option<Isolator>) -> Self {
+    /// nothing is isolated and the report says so), of a log with a temperature column
+    /// (`temperature_column`) or without.
+    pub(super) fn new(isolator: Option<Isolator>, temperature_column: bool) -> Self {
         IsolationTracker {
             follower: isolator.map(Follower::new),
             first_named: None,
@@ -155,12 +158,14 @@ impl IsolationTracker {
             last_point: SteadyPoint::default(),
             lamps_lit: false,
             evidence: super::evidence::Evidence::default(),
+            temperature: super::temperature::TemperatureChannel::new(temperature_column),
         }
     }
 
     /// After the monitor's output for the sample at `t` (`dt_s` after the previous one);
     /// `point`: the steady-state vectors at this sample (module docs); `counts`: lamps and
-    /// detections count now (the learned thresholds are in force, or none were asked for).
+    /// detections count now (the learned thresholds are in force, or none were asked for);
+    /// `temperature_c`: the log's temperature reading, if it has the column.
     pub(super) fn after(
         &mut self,
         t: f64,
@@ -168,6 +173,7 @@ impl IsolationTracker {
         out: &MonitorOutput,
         point: &SteadyPoint,
         counts: bool,
+        temperature_c: Option<f64>,
     ) {
         self.end_t = t;
         let Some(follower) = self.follower.as_mut() else {
@@ -184,9 +190,13 @@ impl IsolationTracker {
         let usable = self.running && !out.sensor_fault.any() && (learning || counts);
         self.lamps_lit |= counts && out.fault_detected;
         let learned = follower.learned();
+        self.temperature
+            .put_in_force(follower, t, temperature_c, learning);
         // Quasi-steady by the vectors themselves (the monitor's gate follows its own frame,
         // which a sensor fault can detune).
         if let Step::Isolated(result) = follower.observe(point, dt_s as f32, usable, learning) {
+            let measured = follower.measured_rise_k().is_some();
+            self.temperature.after_isolation(t, &result, measured);
             self.evidence.after(follower, &result);
             // A fault one point cannot name may be named from several (evidence across
             // operating points).
@@ -361,6 +371,7 @@ impl IsolationTracker {
             },
             moved_from_learned: moved,
             winding_rise_k: self.winding_rise_k(),
+            temperature: self.temperature.report(),
             judged_at_s: self.last_t,
             groups: groups(&iso),
             deviation_sigma: iso.deviation,
@@ -521,6 +532,10 @@ pub struct IsolationReport {
     /// a fault"); absent (JSON) below [`REPORTED_RISE_K`] or without a learned baseline.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub winding_rise_k: Option<f32>,
+    /// The log's temperature channel (JSON keys `winding_temperature_c`, `measured_rise_k`,
+    /// `temperature_channel`, present only for a log with the column).
+    #[serde(flatten)]
+    pub temperature: super::temperature::TemperatureReport,
 }
 
 /// Smallest tracked winding temperature change that is reported [K] (5 K: 2 % on Rs and Rr,
@@ -543,6 +558,7 @@ impl IsolationReport {
             judged_at_s: 0.0,
             moved_from_learned: None,
             winding_rise_k: None,
+            temperature: Default::default(),
             baseline: if learned {
                 "learned in commissioning"
             } else {

@@ -474,6 +474,19 @@ fn a_load_change_with_a_fault_and_a_nameplate_that_is_off() {
 }
 
 /// The machine warmed by `rise_k`: Rs and Rr times 1 + alpha rise.
+/// An isolator for `m` on a supply of peak `v` and `we` rad/s, with a baseline learned at
+/// its healthy point (spreads at their floor, [`LEARNED_SPREAD_FLOOR`]).
+fn floor_isolator(m: &MotorParameters, v: f64, we: f64) -> Isolator {
+    let mut iso = Isolator::new(m.model(), v as f32, (we / core::f64::consts::TAU) as f32).unwrap(); // ok: test
+    iso.set_baseline(Baseline {
+        mean: ParityResiduals::default(),
+        spread: LEARNED_SPREAD_FLOOR,
+        at: measure(m, v, we, None, 1.0),
+    })
+    .unwrap(); // ok: test
+    iso
+}
+
 fn warmed(m: &MotorParameters, rise_k: f64) -> MotorParameters {
     let k = 1.0 + f64::from(COPPER_ALPHA_PER_K) * rise_k;
     MotorParameters {
@@ -490,14 +503,7 @@ fn warmed(m: &MotorParameters, rise_k: f64) -> MotorParameters {
 #[test]
 fn heating_is_explained_and_no_table1_fault_is_taken_for_it() {
     for (name, m, v, we) in machines() {
-        let mut iso =
-            Isolator::new(m.model(), v as f32, (we / core::f64::consts::TAU) as f32).unwrap(); // ok: test
-        iso.set_baseline(Baseline {
-            mean: ParityResiduals::default(),
-            spread: LEARNED_SPREAD_FLOOR,
-            at: measure(&m, v, we, None, 1.0),
-        })
-        .unwrap(); // ok: test
+        let iso = floor_isolator(&m, v, we);
         for rise in [20.0, 60.0, 100.0] {
             let p = measure(&warmed(&m, rise), v, we, None, 1.0);
             let r = iso.isolate(&p);
@@ -609,14 +615,7 @@ fn faults_that_coincide_at_one_point_part_over_several() {
 #[test]
 fn a_measured_rise_compensates_rs_and_rr() {
     for (name, m, v, we) in machines() {
-        let mut iso =
-            Isolator::new(m.model(), v as f32, (we / core::f64::consts::TAU) as f32).unwrap(); // ok: test
-        iso.set_baseline(Baseline {
-            mean: ParityResiduals::default(),
-            spread: LEARNED_SPREAD_FLOOR,
-            at: measure(&m, v, we, None, 1.0),
-        })
-        .unwrap(); // ok: test
+        let mut iso = floor_isolator(&m, v, we);
         for bad in [f32::NAN, f32::INFINITY, -30.0, 170.0] {
             assert!(!iso.set_winding_rise_k(bad), "{name} {bad}");
             assert_eq!(iso.heating_factor(), 1.0, "{name} {bad}");
