@@ -62,10 +62,11 @@ fn probe() -> TemperatureSpec {
 fn summary(r: &DiagnoseReport) -> String {
     let i = &r.isolation;
     format!(
-        "{:?}, named {:?} {:?}, rise {:?} (tracked {:?}), {:?} at {:?} degC",
+        "{:?}, named {:?} {:?} (first {:?}), rise {:?} (tracked {:?}), {:?} at {:?} degC",
         r.verdict,
         i.named,
         i.named_change,
+        i.first_named.map(|g| (g.name.to_string(), g.t_s)),
         i.temperature.measured_rise_k,
         i.winding_rise_k,
         i.temperature.temperature_channel,
@@ -295,6 +296,14 @@ fn the_column_is_read_in_the_daqs_units() {
     assert_eq!(rows[0].t_winding_c, Some(41.5));
     let rows = read("t_s,ia_A,ib_A,ic_A\n0,1,2,3\n", ColumnMapping::default());
     assert_eq!(rows[0].t_winding_c, None);
+    // Every column of the schema at once, on the fast path and (a quoted cell) the exact one.
+    let all = "t_s,va_V,vb_V,vc_V,ia_A,ib_A,ic_A,wm_rad_s,enc_count,t_winding_c\n";
+    for line in ["0,1,2,3,4,5,6,7,8,41.5\n", "0,1,2,3,4,5,6,7,\"8\",41.5\n"] {
+        let rows = read(&format!("{all}{line}{line}"), ColumnMapping::default());
+        assert_eq!(rows.len(), 2, "{line}");
+        assert_eq!(rows[1].enc_count, Some(8), "{line}");
+        assert_eq!(rows[1].t_winding_c, Some(41.5), "{line}");
+    }
     // A temperature cannot be given in a current's unit, nor a current in degC.
     let mut m = ColumnMapping::new(2);
     assert!(m

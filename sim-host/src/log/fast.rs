@@ -27,7 +27,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// Bytes per block (one parallel work item).
 pub(super) const BLOCK_BYTES: usize = 4 << 20;
 /// Largest number of parsed columns (every column of the schema).
-const MAX_COLS: usize = 9;
+const MAX_COLS: usize = Column::COUNT;
 /// Marker of a column that is not parsed.
 const SKIP: usize = usize::MAX;
 
@@ -319,6 +319,7 @@ fn parse_block_with(block: &[u8], cols: &Cols, on_row: impl FnMut(&[f64])) -> Op
         7 => parse_block_w::<7>(block, cols, on_row),
         8 => parse_block_w::<8>(block, cols, on_row),
         9 => parse_block_w::<9>(block, cols, on_row),
+        10 => parse_block_w::<10>(block, cols, on_row),
         _ => parse_block_w::<0>(block, cols, on_row),
     }
 }

@@ -195,8 +195,8 @@ impl IsolationTracker {
         // Quasi-steady by the vectors themselves (the monitor's gate follows its own frame,
         // which a sensor fault can detune).
         if let Step::Isolated(result) = follower.observe(point, dt_s as f32, usable, learning) {
-            let measured = follower.measured_rise_k().is_some();
-            self.temperature.after_isolation(t, &result, measured);
+            let lag = follower.measured_rise_k().map(|_| follower.probe_lag_k());
+            self.temperature.after_isolation(t, &result, lag);
             self.evidence.after(follower, &result);
             // A fault one point cannot name may be named from several (evidence across
             // operating points).

@@ -1,6 +1,7 @@
 //! The log's temperature channel (`t_winding_c`) in the isolation: the winding's rise
 //! since commissioning measured instead of inferred from the resistances
-//! ([`monitor_core::isolation::Follower::set_measured_rise_k`]), while the channel is
+//! ([`monitor_core::isolation::Follower::set_measured_rise_k`]; the residuals correct only
+//! the probe's lag, within [`monitor_core::isolation::PROBE_LAG_K`]), while the channel is
 //! plausible.
 //!
 //! The commissioned temperature is the mean of the channel's readings over the
@@ -169,15 +170,17 @@ impl TemperatureChannel {
         }
     }
 
-    /// After an isolation at `t` made with the channel's rise in force (`in_force`): the
+    /// After an isolation at `t` made with the channel's rise in force, corrected by the
+    /// residuals for the probe's lag `lag_k` [K] (`None`: no measured rise in force): the
     /// resistances' own heating fit against the channel ([`DISAGREE_K`], [`DISAGREE_S`]).
-    pub fn after_isolation(&mut self, t: f64, iso: &Isolation, in_force: bool) {
-        if !in_force || self.not_used.is_some() {
+    pub fn after_isolation(&mut self, t: f64, iso: &Isolation, lag_k: Option<f32>) {
+        let Some(lag_k) = lag_k.filter(|_| self.not_used.is_none()) else {
             self.disagree_since_s = None;
             return;
-        }
-        // (The heating fit is relative to the machine judged against: the measured one.)
-        let off_k = (iso.heating.factor - 1.0) / COPPER_ALPHA_PER_K;
+        };
+        // (The heating fit is relative to the machine judged against: the measured one
+        // with its lag correction.)
+        let off_k = lag_k + (iso.heating.factor - 1.0) / COPPER_ALPHA_PER_K;
         if iso.heating_explains() && off_k.abs() > DISAGREE_K {
             let since = *self.disagree_since_s.get_or_insert(t);
             if t - since >= DISAGREE_S {
