@@ -15,7 +15,9 @@
 //!   worse than without the channel;
 //! - a probe on the frame, reading a constant 15 K below the winding, gives the same
 //!   verdict and rise (only the rise counts);
-//! - the column read under a DAQ's own name in degF and K.
+//! - the column read under a DAQ's own name in degF and K;
+//! - the simulated probe is slow (one reading a hold period, lagging the winding) and
+//!   leaves every other column as it was.
 //!
 //! Twelve 40-70 s replays at 2 kHz: a few seconds in the test profile on 2 cores.
 
@@ -312,4 +314,58 @@ fn the_column_is_read_in_the_daqs_units() {
     assert!(m.set(Column::Ia, "Ia", Some(ChannelUnit::DegC)).is_err());
     assert!(ChannelUnit::parse(Column::Temperature, "degF").is_ok());
     assert!(ChannelUnit::parse(Column::Temperature, "rpm").is_err());
+}
+
+/// The simulated channel is a slow probe: a new reading at most once a hold period, lagging
+/// the winding (start temperature plus the `thermal_drift` rise) by no more than its time
+/// constant and hold times the warming rate; asking for it leaves every other column as it
+/// was (its noise has a stream of its own).
+#[test]
+fn the_simulated_channel_is_a_slow_probe_and_leaves_the_other_columns_alone() {
+    use sim_host::sim::{simulate, EffectSpec};
+    let p = ParamFile::reference_2p2kw();
+    let rows = |probe: Option<TemperatureSpec>| {
+        let mut sc = Scenario::steady(10.0, 2000.0);
+        sc.sensors = SensorSpec {
+            temperature: probe,
+            ..SensorSpec::default()
+        };
+        sc.effects.push(
+            toml::from_str::<EffectSpec>(
+                "name = \"thermal_drift\"\nrise_k = 60.0\ntau_s = 20.0\nat_s = 4.0\n",
+            )
+            .expect("effect"),
+        );
+        let mut out: Vec<Row> = Vec::new();
+        simulate(&p, &sc, |r: &Row| out.push(*r)).expect("simulate");
+        out
+    };
+    let plain = rows(None);
+    let with = rows(Some(probe()));
+    assert_eq!(plain.len(), with.len());
+    for (a, b) in plain.iter().zip(&with) {
+        assert_eq!(a.t_winding_c, None);
+        assert_eq!(
+            *a,
+            Row {
+                t_winding_c: None,
+                ..*b
+            }
+        );
+    }
+    let readings: Vec<f64> = with.iter().map(|r| r.t_winding_c.expect("t")).collect();
+    let changes = readings.windows(2).filter(|w| w[0] != w[1]).count();
+    assert!(
+        changes <= 10,
+        "a new reading once a second: {changes} changes in 10 s"
+    );
+    let last = *readings.last().expect("rows");
+    let t_end = with.last().expect("rows").t_s;
+    let winding = 20.0 + rise_at(60.0, 20.0, t_end);
+    let rate = 60.0 / 20.0 * (-(t_end - 4.0) / 20.0f64).exp();
+    let max_lag = rate * (2.0 + 1.0);
+    assert!(
+        last <= winding + 0.5 && last >= winding - max_lag - 0.5,
+        "reading {last:.2} degC, winding {winding:.2} degC, lag at most {max_lag:.1} K"
+    );
 }
