@@ -243,7 +243,8 @@ pub enum Column {
 
 impl Column {
     /// The measured channels stored at f32 precision by every writer (voltages, currents,
-    /// speed), in [`Row`] order: [`Column::ALL`] without the time and the encoder count.
+    /// speed), in [`Row`] order: [`Column::ALL`] without the time, the encoder count and the
+    /// temperature (written at f32 too, but not judged by the data-quality stage).
     pub const MEASURED: [Column; 7] = {
         let all = Column::ALL;
         [all[1], all[2], all[3], all[4], all[5], all[6], all[7]]

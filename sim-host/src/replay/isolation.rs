@@ -383,12 +383,7 @@ impl IsolationTracker {
                 .as_ref()
                 .map_or(DEFAULT_SPREAD, |f| f.isolator().baseline().spread)
                 .to_array(),
-            baseline: if learned {
-                "learned in commissioning"
-            } else {
-                "nominal parameters"
-            }
-            .to_string(),
+            baseline: baseline_name(learned),
             first_named: self.first_named,
         };
         (report, candidates)
@@ -559,15 +554,20 @@ impl IsolationReport {
             moved_from_learned: None,
             winding_rise_k: None,
             temperature: Default::default(),
-            baseline: if learned {
-                "learned in commissioning"
-            } else {
-                "nominal parameters"
-            }
-            .to_string(),
+            baseline: baseline_name(learned),
             first_named: None,
         }
     }
+}
+
+/// The report's name of the baseline in force (`baseline`).
+fn baseline_name(learned: bool) -> String {
+    if learned {
+        "learned in commissioning"
+    } else {
+        "nominal parameters"
+    }
+    .to_string()
 }
 
 /// The report's name of an isolation state.
