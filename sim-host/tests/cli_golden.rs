@@ -94,7 +94,7 @@ const INTENDED: [(&str, &str, &str); 14] = [
 
 /// Keys added since the golden outputs were taken (issue 8: the data-quality stage's
 /// report, what commissioning did, the verdict, the range note beside a lamp).
-const ADDED: [&str; 48] = [
+const ADDED: [&str; 51] = [
     // Issue 25: the phase's confidence and why no phase is judged.
     "phase_confidence",
     "phase_not_judged",
@@ -159,6 +159,10 @@ const ADDED: [&str; 48] = [
     // Issue 24: the isolation's events (names and load moves with times).
     "events",
     "events_dropped",
+    // Issue 24: the log's temperature channel (only for a log with a t_winding_c column).
+    "winding_temperature_c",
+    "measured_rise_k",
+    "temperature_channel",
 ];
 
 /// The library effect added since (issue 10, `rotor_asymmetry`): its ranking entries and

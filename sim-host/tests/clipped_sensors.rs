@@ -26,6 +26,7 @@ fn diagnose(
         voltages: true,
         speed: true,
         encoder: false,
+        temperature: false,
     };
     let opts = ReplayOptions {
         commission: Some(proto.commission),

@@ -28,6 +28,7 @@ fn channels() -> Channels {
         voltages: true,
         speed: true,
         encoder: false,
+        temperature: false,
     }
 }
 

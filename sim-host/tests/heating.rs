@@ -20,10 +20,9 @@ mod small_motor;
 
 use monitor_core::Fault;
 use rayon::prelude::*;
-use sim_host::experiment::simulate_and_replay;
 use sim_host::params::ParamFile;
-use sim_host::replay::{DiagnoseReport, IsolationName, ReplayOptions, Verdict};
-use sim_host::sim::{EffectSpec, FaultSpec, Scenario, SensorSpec};
+use sim_host::replay::{DiagnoseReport, IsolationName, Verdict};
+use sim_host::sim::{Scenario, SensorSpec};
 
 fn motors() -> Vec<(&'static str, ParamFile)> {
     small_motor::three_motors()
@@ -52,22 +51,7 @@ fn run_at(
     let mut sc = Scenario::steady(duration_s, rate_hz);
     sc.sensors = SensorSpec::default();
     sc.seed = 5;
-    if rise_k > 0.0 {
-        let toml =
-            format!("name = \"thermal_drift\"\nrise_k = {rise_k}\ntau_s = {tau_s}\nat_s = 4.0\n");
-        sc.effects
-            .push(toml::from_str::<EffectSpec>(&toml).expect("effect"));
-    }
-    if let Some((f, at_s, change)) = fault {
-        sc.faults.push(FaultSpec::parametric(f, at_s, change));
-    }
-    let opts = ReplayOptions {
-        commission: Some((1.5, 3.5)),
-        ..Default::default()
-    };
-    simulate_and_replay(p, p, &sc, opts, |_, _| {})
-        .expect("runs")
-        .finish()
+    small_motor::replay_warming(p, sc, (rise_k, tau_s), fault)
 }
 
 /// The rise reached at the end of a log of `duration_s` (heating from 4 s).

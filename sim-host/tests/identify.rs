@@ -185,6 +185,7 @@ fn channels() -> Channels {
         voltages: true,
         speed: true,
         encoder: true,
+        temperature: false,
     }
 }
 

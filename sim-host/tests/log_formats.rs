@@ -427,6 +427,7 @@ fn an_empty_or_truncated_tdms_is_refused_naming_it() {
             i_abc: [1.0, -1.0, 0.0],
             wm_rad_s: None,
             enc_count: None,
+            t_winding_c: None,
         })
         .collect();
     Log {
@@ -434,6 +435,7 @@ fn an_empty_or_truncated_tdms_is_refused_naming_it() {
             voltages: false,
             speed: false,
             encoder: false,
+            temperature: false,
         },
         rows,
     }
@@ -465,6 +467,7 @@ fn the_tdms_we_write_is_what_the_crate_reads() {
             i_abc: [k as f64, -(k as f64), 0.5],
             wm_rad_s: Some(150.0),
             enc_count: Some(k as i64 * 3),
+            t_winding_c: None,
         })
         .collect();
     Log {
@@ -472,6 +475,7 @@ fn the_tdms_we_write_is_what_the_crate_reads() {
             voltages: false,
             speed: true,
             encoder: true,
+            temperature: false,
         },
         rows: rows.clone(),
     }

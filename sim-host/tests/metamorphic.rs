@@ -34,6 +34,7 @@ fn diagnose(rows: &[Row], speed: bool) -> Result<DiagnoseReport, String> {
         voltages: true,
         speed,
         encoder: true,
+        temperature: false,
     };
     let rows: Vec<Row> = rows
         .iter()

@@ -141,6 +141,7 @@ fn textbook_rows(p: &ParamFile, rate_hz: f64) -> Vec<Row> {
             i_abc: [is.re, (is * a).re, (is * a.conj()).re],
             wm_rad_s: Some(x.2),
             enc_count: None,
+            t_winding_c: None,
         });
         for j in 0..sub {
             let t0 = t + j as f64 * h;
@@ -188,6 +189,7 @@ fn motulator_rows(rate_hz: f64) -> Vec<Row> {
             i_abc: [c[4], c[5], c[6]],
             wm_rad_s: Some(c[7]),
             enc_count: None,
+            t_winding_c: None,
         })
         .collect()
 }
@@ -250,6 +252,7 @@ fn effect_free_log(
             voltages: true,
             speed: true,
             encoder: false,
+            temperature: false,
         },
         rows,
     };

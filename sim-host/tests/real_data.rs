@@ -490,6 +490,7 @@ fn a_rate_the_physics_cannot_serve_names_the_rate_needed() {
                 i_abc: [ph(0.0), ph(2.094), ph(-2.094)],
                 wm_rad_s: None,
                 enc_count: None,
+                t_winding_c: None,
             }
         })
         .collect();

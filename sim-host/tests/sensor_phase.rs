@@ -140,6 +140,7 @@ fn current_only_1khz_names_the_sensor_not_a_winding() {
             voltages: false,
             speed: false,
             encoder: false,
+            temperature: false,
         };
         let rep =
             diagnose_rows(&p, currents_only, &rows, ReplayOptions::default()).expect("replay"); // ok: test

@@ -37,6 +37,7 @@ pub fn ensure_log(path: &Path, p: &ParamFile, secs: f64) {
         voltages: true,
         speed: true,
         encoder: false,
+        temperature: false,
     };
     let mut w = LogWriter::create(path, channels).expect("create log");
     sim::simulate(p, &s, |r| {

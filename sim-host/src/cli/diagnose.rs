@@ -39,7 +39,14 @@ from the change of the negative-sequence current against the healthy machine's: 
 HEALTHY.csv replays a log of the same motor when it was healthy (same supply and load if \
 possible) and takes its negative sequence; without it, the one at the end of the --commission \
 window; without either, only the supply's own unbalance is taken out (a motor's inherent \
-asymmetry and the sensors' mismatch then count as the winding's).\n\nExample:\n  sim-host \
+asymmetry and the sensors' mismatch then count as the winding's).\n\nA winding (or frame) \
+temperature column, t_winding_c in degC (or a DAQ's channel in degC, K or degF through the \
+parameter file's [columns] table), compensates Rs and Rr with the rise measured since \
+commissioning (copper 0.393 %/K) instead of tracking it from the residuals; JSON \
+isolation.winding_temperature_c, measured_rise_k and temperature_channel (used, or not used: \
+why: NaN or out of -40..250 degC for 10 s, a jump faster than a winding heats, stuck for 30 s, \
+or the resistances disagree by more than 20 K; then the rise is tracked from the \
+resistances).\n\nExample:\n  sim-host \
 diagnose --params motor.toml log.csv --commission 2:4\n  sim-host diagnose --params motor.toml \
 today.csv --baseline last_year_healthy.csv"
 )]

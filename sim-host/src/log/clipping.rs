@@ -168,6 +168,7 @@ mod tests {
                 i_abc: [x(0.0), x(p), x(-p)],
                 wm_rad_s: None,
                 enc_count: None,
+                t_winding_c: None,
             };
             t.push(&r, |_| true);
         }
@@ -243,6 +244,7 @@ mod tests {
                 i_abc: [1.0, 0.0, -1.0],
                 wm_rad_s: None,
                 enc_count: None,
+                t_winding_c: None,
             };
             t.push(&r, |_| true);
         }

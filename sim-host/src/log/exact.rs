@@ -127,7 +127,7 @@ impl ExactRows {
         self.blank += line.saturating_sub(self.last_line + 1);
         self.last_line = line;
         let t = self.cell(Column::Time, line)?.unwrap_or(f64::NAN);
-        let mut v = [0.0f64; 9];
+        let mut v = [0.0f64; Column::COUNT];
         v[0] = t;
         // Currents first: a row with several bad cells names the required column.
         for c in [
@@ -139,6 +139,7 @@ impl ExactRows {
             Column::Vc,
             Column::Speed,
             Column::Encoder,
+            Column::Temperature,
         ] {
             v[c as usize] = self.cell(c, line)?.unwrap_or(0.0);
         }
@@ -149,10 +150,11 @@ impl ExactRows {
 /// The row of the values of every schema column (in [`Column::ALL`] order; absent columns
 /// are ignored) for a log with `columns`.
 #[inline]
-pub(super) fn row_from_values(v: &[f64; 9], columns: &ColumnMap) -> Row {
+pub(super) fn row_from_values(v: &[f64; Column::COUNT], columns: &ColumnMap) -> Row {
     let has = |c: Column| columns.of(c).is_some();
     // To the schema's SI units: one multiplication per cell (none without a mapping).
     let k = &columns.scale;
+    let t_winding_c = has(Column::Temperature).then(|| (v[9] + columns.temp_offset) * k[9]);
     if !columns.scaled {
         return Row {
             t_s: v[0],
@@ -160,6 +162,7 @@ pub(super) fn row_from_values(v: &[f64; 9], columns: &ColumnMap) -> Row {
             i_abc: [v[4], v[5], v[6]],
             wm_rad_s: has(Column::Speed).then_some(v[7]),
             enc_count: has(Column::Encoder).then_some(super::enc_count_of(v[8])),
+            t_winding_c,
         };
     }
     Row {
@@ -168,6 +171,7 @@ pub(super) fn row_from_values(v: &[f64; 9], columns: &ColumnMap) -> Row {
         i_abc: [v[4] * k[4], v[5] * k[5], v[6] * k[6]],
         wm_rad_s: has(Column::Speed).then_some(v[7] * k[7]),
         enc_count: has(Column::Encoder).then_some(super::enc_count_of(v[8])),
+        t_winding_c,
     }
 }
 

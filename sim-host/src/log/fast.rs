@@ -27,7 +27,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// Bytes per block (one parallel work item).
 pub(super) const BLOCK_BYTES: usize = 4 << 20;
 /// Largest number of parsed columns (every column of the schema).
-const MAX_COLS: usize = 9;
+const MAX_COLS: usize = Column::COUNT;
 /// Marker of a column that is not parsed.
 const SKIP: usize = usize::MAX;
 
@@ -319,6 +319,7 @@ fn parse_block_with(block: &[u8], cols: &Cols, on_row: impl FnMut(&[f64])) -> Op
         7 => parse_block_w::<7>(block, cols, on_row),
         8 => parse_block_w::<8>(block, cols, on_row),
         9 => parse_block_w::<9>(block, cols, on_row),
+        10 => parse_block_w::<10>(block, cols, on_row),
         _ => parse_block_w::<0>(block, cols, on_row),
     }
 }
@@ -446,7 +447,7 @@ pub(super) fn for_each_row(
     let cols = Cols::new(&idx, columns.n_fields);
     // (Run by the parsing workers: the reading thread only hands the rows over.)
     let to_row = |slots: &[f64]| {
-        let mut v = [0.0f64; 9];
+        let mut v = [0.0f64; Column::COUNT];
         for (&c, &x) in present.iter().zip(slots) {
             v[c] = x;
         }

@@ -18,7 +18,9 @@
 //! - speed (`wm_rad_s`, mechanical): `rad/s`, `rpm` (mechanical revolutions per minute,
 //!   times `2 pi / 60`) or `Hz_el` (the electrical frequency of the rotor speed, times
 //!   `2 pi / Np` with `Np` the parameter file's pole pairs);
-//! - `enc_count`: `count`.
+//! - `enc_count`: `count`;
+//! - temperature (`t_winding_c`): `degC` (or `°C`, `C`), `K`, `degF` (or `°F`, `F`): the
+//!   one column converted with an offset too ([`ChannelUnit::offset`]).
 //!
 //! Missing columns are reported with the channels the log has and the closest of them
 //! ([`missing_column`]).
@@ -64,6 +66,12 @@ pub enum ChannelUnit {
     ElectricalHz,
     /// Encoder counts.
     Count,
+    /// Degrees Celsius.
+    DegC,
+    /// Kelvin (degC + 273.15).
+    Kelvin,
+    /// Degrees Fahrenheit (degC 9/5 + 32).
+    DegF,
 }
 
 /// How a log's time column is to be read.
@@ -80,7 +88,7 @@ pub(super) enum TimeKind {
 
 impl ChannelUnit {
     /// Every unit with its spellings (the first is the one written in messages).
-    const SPELLINGS: [(ChannelUnit, &'static [&'static str]); 17] = [
+    const SPELLINGS: [(ChannelUnit, &'static [&'static str]); 20] = [
         (ChannelUnit::Seconds, &["s", "sec", "Seconds"]),
         (ChannelUnit::Milliseconds, &["ms"]),
         (ChannelUnit::Microseconds, &["us", "µs"]),
@@ -98,6 +106,9 @@ impl ChannelUnit {
         (ChannelUnit::Rpm, &["rpm", "RPM", "1/min"]),
         (ChannelUnit::ElectricalHz, &["Hz_el"]),
         (ChannelUnit::Count, &["count"]),
+        (ChannelUnit::DegC, &["degC", "°C", "C", "Celsius"]),
+        (ChannelUnit::Kelvin, &["K", "Kelvin"]),
+        (ChannelUnit::DegF, &["degF", "°F", "F", "Fahrenheit"]),
     ];
 
     /// The units a schema column may be recorded in.
@@ -118,6 +129,7 @@ impl ChannelUnit {
             Column::Ia | Column::Ib | Column::Ic => &[U::Amperes, U::Milliamperes],
             Column::Speed => &[U::RadPerSecond, U::Rpm, U::ElectricalHz],
             Column::Encoder => &[U::Count],
+            Column::Temperature => &[U::DegC, U::Kelvin, U::DegF],
         }
     }
 
@@ -163,7 +175,10 @@ impl ChannelUnit {
             | ChannelUnit::Volts
             | ChannelUnit::Amperes
             | ChannelUnit::RadPerSecond
-            | ChannelUnit::Count => 1.0,
+            | ChannelUnit::Count
+            | ChannelUnit::DegC
+            | ChannelUnit::Kelvin => 1.0,
+            ChannelUnit::DegF => 5.0 / 9.0,
             ChannelUnit::Milliseconds
             | ChannelUnit::EpochMilliseconds
             | ChannelUnit::Millivolts
@@ -173,6 +188,17 @@ impl ChannelUnit {
             ChannelUnit::Kilovolts => 1e3,
             ChannelUnit::Rpm => TAU / 60.0,
             ChannelUnit::ElectricalHz => TAU / f64::from(pole_pairs.max(1)),
+        }
+    }
+
+    /// What is added to a value in this unit before [`ChannelUnit::factor`] multiplies it
+    /// (the temperatures' zero: `-273.15` for kelvin, `-32` for degF; 0 for every other
+    /// unit).
+    pub fn offset(self) -> f64 {
+        match self {
+            ChannelUnit::Kelvin => -273.15,
+            ChannelUnit::DegF => -32.0,
+            _ => 0.0,
         }
     }
 
@@ -204,7 +230,7 @@ pub struct MappedChannel {
 /// column by its schema name, in SI units.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct ColumnMapping {
-    channels: [Option<MappedChannel>; 9],
+    channels: [Option<MappedChannel>; Column::COUNT],
     pole_pairs: u32,
 }
 
@@ -280,7 +306,10 @@ impl ColumnMapping {
 
     /// The factors to SI of every column (in [`Column::ALL`] order) for the `units` the
     /// channels are recorded in (`None`: SI).
-    pub(super) fn factors(&self, units: &[Option<ChannelUnit>; 9]) -> [f64; 9] {
+    pub(super) fn factors(
+        &self,
+        units: &[Option<ChannelUnit>; Column::COUNT],
+    ) -> [f64; Column::COUNT] {
         units.map(|u| u.map_or(1.0, |u| u.factor(self.pole_pairs)))
     }
 }
@@ -416,6 +445,7 @@ fn usual_names(c: Column) -> &'static [&'static str] {
         Column::Ic => &["ic", "ics", "i3", "ilc", "currentc"],
         Column::Speed => &["wm", "w", "speed", "n", "rpm", "omega", "wr", "speedrpm"],
         Column::Encoder => &["enc", "encoder", "count", "counts", "position"],
+        Column::Temperature => &["temp", "temperature", "twinding", "tstator", "theta"],
     }
 }
 

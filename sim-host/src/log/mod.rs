@@ -6,7 +6,7 @@
 //!
 //! Columns (header row, comma separated, SI units in the names, [`Column`]):
 //! `t_s, va_V, vb_V, vc_V, ia_A, ib_A, ic_A, wm_rad_s` and optionally `enc_count`
-//! (cumulative encoder count). `t_s` and the three currents are required; the voltages
+//! (cumulative encoder count) and `t_winding_c` (winding temperature, degC). `t_s` and the three currents are required; the voltages
 //! (all three or none) and the speed (`wm_rad_s`, mechanical rad/s) are optional; extra
 //! columns are ignored. The reader hands over what the file holds, non-finite cells and
 //! times that do not increase included: judging them is the data-quality stage's
@@ -236,18 +236,25 @@ pub enum Column {
     Speed,
     /// `enc_count`: cumulative encoder count.
     Encoder,
+    /// `t_winding_c`: winding (or stator frame) temperature [degC], optional; not judged
+    /// by the data-quality stage (the isolation judges its plausibility).
+    Temperature,
 }
 
 impl Column {
     /// The measured channels stored at f32 precision by every writer (voltages, currents,
-    /// speed), in [`Row`] order: [`Column::ALL`] without the time and the encoder count.
+    /// speed), in [`Row`] order: [`Column::ALL`] without the time, the encoder count and the
+    /// temperature (written at f32 too, but not judged by the data-quality stage).
     pub const MEASURED: [Column; 7] = {
         let all = Column::ALL;
         [all[1], all[2], all[3], all[4], all[5], all[6], all[7]]
     };
 
+    /// How many columns the schema has.
+    pub const COUNT: usize = 10;
+
     /// Every column of the schema, in [`Row`] order.
-    pub const ALL: [Column; 9] = [
+    pub const ALL: [Column; Column::COUNT] = [
         Column::Time,
         Column::Va,
         Column::Vb,
@@ -257,6 +264,7 @@ impl Column {
         Column::Ic,
         Column::Speed,
         Column::Encoder,
+        Column::Temperature,
     ];
 
     /// The header name (the schema of `docs/design.md`).
@@ -271,6 +279,7 @@ impl Column {
             Column::Ic => "ic_A",
             Column::Speed => "wm_rad_s",
             Column::Encoder => "enc_count",
+            Column::Temperature => "t_winding_c",
         }
     }
 }
@@ -288,6 +297,8 @@ pub struct Row {
     pub wm_rad_s: Option<f64>,
     /// Cumulative encoder count (may be negative when running backwards).
     pub enc_count: Option<i64>,
+    /// Winding (or stator frame) temperature [degC] (`t_winding_c`).
+    pub t_winding_c: Option<f64>,
 }
 
 /// The [`Row::enc_count`] of a cell that holds no readable count: not finite, or beyond
@@ -319,6 +330,8 @@ pub struct Channels {
     pub speed: bool,
     /// `enc_count` present.
     pub encoder: bool,
+    /// `t_winding_c` present.
+    pub temperature: bool,
 }
 
 impl Channels {
@@ -329,6 +342,7 @@ impl Channels {
             Column::Va | Column::Vb | Column::Vc => self.voltages,
             Column::Speed => self.speed,
             Column::Encoder => self.encoder,
+            Column::Temperature => self.temperature,
         }
     }
 }
@@ -351,6 +365,7 @@ impl Row {
                 .enc_count
                 .filter(|n| *n != ENC_COUNT_UNREADABLE)
                 .map(|n| n as f64),
+            Column::Temperature => self.t_winding_c,
         }
     }
 }
@@ -441,6 +456,7 @@ mod tests {
                 voltages: true,
                 speed: true,
                 encoder: false,
+                temperature: false,
             },
             rows: (0..10)
                 .map(|k| Row {
@@ -449,6 +465,7 @@ mod tests {
                     i_abc: [0.1 * k as f64, 2.0, -3.0],
                     wm_rad_s: Some(150.0),
                     enc_count: None,
+                    t_winding_c: None,
                 })
                 .collect(),
         };

@@ -68,7 +68,7 @@ fn timestamp_unit(t: Option<&LogicalType>) -> Option<&'static str> {
 }
 
 /// One decoded row group: the values of each [`Column::ALL`] column (empty when absent).
-type Decoded = [Vec<f64>; 9];
+type Decoded = [Vec<f64>; Column::COUNT];
 
 impl ParquetSource {
     /// Opens `path` and maps the schema's columns.
@@ -93,7 +93,7 @@ impl ParquetSource {
             .map(|j| schema.column(j).path().string())
             .collect();
         let mut columns = ColumnMap::locate(&found, mapping, shown)?;
-        let mut units = [None; 9];
+        let mut units = [None; Column::COUNT];
         for (k, c) in Column::ALL.iter().enumerate() {
             let Some(j) = columns.field[k] else { continue };
             let ty = schema.column(j).physical_type();
@@ -204,7 +204,7 @@ impl BinarySource for ParquetSource {
                         }
                     };
                     let n = cols.iter().find(|c| !c.is_empty()).map_or(0, Vec::len);
-                    let mut v = [0.0f64; 9];
+                    let mut v = [0.0f64; Column::COUNT];
                     for i in 0..n {
                         for (k, c) in cols.iter().enumerate() {
                             if let Some(x) = c.get(i) {

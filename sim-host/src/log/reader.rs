@@ -59,11 +59,11 @@ impl RowSink for Vec<Row> {
 /// field index of [`Column::ALL`]`[c]`, `None` when the log lacks it.
 #[derive(Debug, Clone, PartialEq)]
 pub(super) struct ColumnMap {
-    pub field: [Option<usize>; 9],
+    pub field: [Option<usize>; Column::COUNT],
     /// Fields per line (the header's).
     pub n_fields: usize,
     /// The factor from each column's unit to the schema's SI unit ([`ColumnMapping`]).
-    pub scale: [f64; 9],
+    pub scale: [f64; Column::COUNT],
     /// False when every factor is 1 (the rows need no multiplication).
     pub scaled: bool,
     /// How the time column is read.
@@ -71,8 +71,10 @@ pub(super) struct ColumnMap {
     /// A timestamp's factor to seconds, applied after the first row's time is subtracted
     /// (so that the difference is exact; `scale[0]` is then 1).
     pub time_factor: f64,
+    /// What is added to the temperature's values before `scale` ([`ChannelUnit::offset`]).
+    pub temp_offset: f64,
     /// Each column's channel name in the log (the schema's name unless mapped).
-    pub names: [String; 9],
+    pub names: [String; Column::COUNT],
 }
 
 impl ColumnMap {
@@ -87,7 +89,7 @@ impl ColumnMap {
         mapping: &ColumnMapping,
         shown: &str,
     ) -> Result<Self, LogError> {
-        let mut field = [None; 9];
+        let mut field = [None; Column::COUNT];
         for (f, c) in field.iter_mut().zip(Column::ALL) {
             let name = mapping.name_of(c);
             let mut at = found
@@ -108,10 +110,11 @@ impl ColumnMap {
         let mut map = ColumnMap {
             field,
             n_fields: found.len(),
-            scale: [1.0; 9],
+            scale: [1.0; Column::COUNT],
             scaled: false,
             time: TimeKind::Plain,
             time_factor: 1.0,
+            temp_offset: 0.0,
             names: Column::ALL.map(|c| mapping.name_of(c).to_string()),
         };
         map.set_units(&Column::ALL.map(|c| mapping.unit_of(c)), mapping);
@@ -119,8 +122,13 @@ impl ColumnMap {
     }
 
     /// Reads each column in `units` (`None`: the schema's SI unit).
-    pub fn set_units(&mut self, units: &[Option<ChannelUnit>; 9], mapping: &ColumnMapping) {
+    pub fn set_units(
+        &mut self,
+        units: &[Option<ChannelUnit>; Column::COUNT],
+        mapping: &ColumnMapping,
+    ) {
         self.scale = mapping.factors(units);
+        self.temp_offset = units[Column::Temperature as usize].map_or(0.0, ChannelUnit::offset);
         self.time = units[0].map_or(TimeKind::Plain, ChannelUnit::time_kind);
         self.time_factor = 1.0;
         if self.time != TimeKind::Plain {
@@ -425,6 +433,7 @@ fn channels_of(columns: &ColumnMap) -> Channels {
         voltages: has(Column::Va),
         speed: has(Column::Speed),
         encoder: has(Column::Encoder),
+        temperature: has(Column::Temperature),
     }
 }
 

@@ -278,7 +278,7 @@ impl TdmsSource {
         let found: Vec<String> = g.channels().map(|c| c.name().to_string()).collect();
         let mut columns = ColumnMap::locate(&found, mapping, shown)?;
         let mut lens = Vec::new();
-        let mut units = [None; 9];
+        let mut units = [None; Column::COUNT];
         for (k, c) in Column::ALL.iter().enumerate() {
             if columns.field[k].is_none() {
                 continue;
@@ -389,7 +389,7 @@ impl BinarySource for TdmsSource {
                     read_f64(ch, start..end, &mut cols[k]).map_err(|e| tdms_error(shown, &e))?;
                 }
             }
-            let mut v = [0.0f64; 9];
+            let mut v = [0.0f64; Column::COUNT];
             for i in 0..end - start {
                 for (k, c) in cols.iter().enumerate() {
                     if let Some(x) = c.get(i) {

@@ -42,7 +42,8 @@ fn pq_io(e: ::parquet::errors::ParquetError) -> std::io::Error {
 
 impl LogWriter {
     /// Starts writing a log with the given optional channels, in the format of `path`'s
-    /// extension.
+    /// extension. The temperature column (`t_winding_c`) is written to a CSV only: TDMS and
+    /// Parquet outputs leave it out.
     ///
     /// # Errors
     /// [`LogError::Io`] when the temporary file cannot be created.
@@ -53,7 +54,12 @@ impl LogWriter {
         };
         let tmp = temp_file_beside(path).map_err(io)?;
         let file = tmp.reopen().map_err(io)?;
-        let sink = match Format::of_path(path) {
+        let format = Format::of_path(path);
+        let channels = Channels {
+            temperature: channels.temperature && format == Format::Csv,
+            ..channels
+        };
+        let sink = match format {
             Format::Csv => Sink::Csv(Self::csv_header(file, channels).map_err(io)?),
             Format::Tdms => Sink::Tdms(
                 BufWriter::with_capacity(1 << 20, file),
@@ -157,6 +163,10 @@ impl LogWriter {
                     let _ = write!(l, "{n}");
                 }
             }
+        }
+        if self.channels.temperature {
+            l.push(',');
+            push_f32(l, r.t_winding_c.unwrap_or(f64::NAN) as f32);
         }
         l.push('\n');
         out.write_all(l.as_bytes()).map_err(io)

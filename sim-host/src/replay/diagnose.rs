@@ -548,6 +548,7 @@ fn between(a: &Row, b: &Row, t: f64) -> Row {
             .enc_count
             .zip(b.enc_count)
             .map(|(x, y)| x + (w * (y - x) as f64).round() as i64),
+        t_winding_c: a.t_winding_c.zip(b.t_winding_c).map(|(x, y)| mix(x, y)),
     }
 }
 
@@ -679,6 +680,7 @@ mod tests {
             i_abc: set(10.0, 0.4),
             wm_rad_s: Some(150.0 + 10.0 * t),
             enc_count: Some((100_000.0 * t) as i64),
+            t_winding_c: None,
         }
     }
 

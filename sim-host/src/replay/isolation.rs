@@ -131,6 +131,8 @@ pub(super) struct IsolationTracker {
     load: super::LoadModel,
     /// Names and load moves, with times.
     events: super::events::EventLog,
+    /// The log's temperature channel (`t_winding_c`), when it has one.
+    temperature: super::temperature::TemperatureChannel,
 }
 
 /// With the load an unknown input, B and Bl are not candidates (their change is the load's
@@ -180,8 +182,13 @@ pub const NOMINAL_UNCERTAINTY: f32 = 0.3;
 
 impl IsolationTracker {
     /// A tracker for the nominal machine (`None`: a machine the isolator rejects, then
-    /// nothing is isolated and the report says so).
-    pub(super) fn new(isolator: Option<Isolator>, load: super::LoadModel) -> Self {
+    /// nothing is isolated and the report says so), of a log with a temperature column
+    /// (`temperature_column`) or without; `load`: what is known of the load.
+    pub(super) fn new(
+        isolator: Option<Isolator>,
+        temperature_column: bool,
+        load: super::LoadModel,
+    ) -> Self {
         IsolationTracker {
             follower: isolator.map(Follower::new),
             first_named: None,
@@ -194,12 +201,14 @@ impl IsolationTracker {
             evidence: monitor_core::isolation::Evidence::default(),
             load,
             events: super::events::EventLog::default(),
+            temperature: super::temperature::TemperatureChannel::new(temperature_column),
         }
     }
 
     /// After the monitor's output for the sample at `t` (`dt_s` after the previous one);
     /// `point`: the steady-state vectors at this sample (module docs); `counts`: lamps and
-    /// detections count now (the learned thresholds are in force, or none were asked for).
+    /// detections count now (the learned thresholds are in force, or none were asked for);
+    /// `temperature_c`: the log's temperature reading, if it has the column.
     pub(super) fn after(
         &mut self,
         t: f64,
@@ -207,6 +216,7 @@ impl IsolationTracker {
         out: &MonitorOutput,
         point: &SteadyPoint,
         counts: bool,
+        temperature_c: Option<f64>,
     ) {
         self.end_t = t;
         let load = self.load;
@@ -224,9 +234,13 @@ impl IsolationTracker {
         let usable = self.running && !out.sensor_fault.any() && (learning || counts);
         self.lamps_lit |= counts && out.fault_detected;
         let learned = follower.learned();
+        self.temperature
+            .put_in_force(follower, t, temperature_c, learning);
         // Quasi-steady by the vectors themselves (the monitor's gate follows its own frame,
         // which a sensor fault can detune).
         if let Step::Isolated(result) = follower.observe(point, dt_s as f32, usable, learning) {
+            let lag = follower.measured_rise_k().map(|_| follower.probe_lag_k());
+            self.temperature.after_isolation(t, &result, lag);
             self.evidence.after(follower, &result);
             // A fault one point cannot name may be named from several (evidence across
             // operating points).
@@ -438,6 +452,7 @@ impl IsolationTracker {
             },
             moved_from_learned: moved,
             winding_rise_k: self.winding_rise_k(),
+            temperature: self.temperature.report(),
             judged_at_s: self.last_t,
             groups: groups(&iso),
             deviation_sigma: iso.deviation,
@@ -449,12 +464,7 @@ impl IsolationTracker {
                 .as_ref()
                 .map_or(DEFAULT_SPREAD, |f| f.isolator().baseline().spread)
                 .to_array(),
-            baseline: if learned {
-                "learned in commissioning"
-            } else {
-                "nominal parameters"
-            }
-            .to_string(),
+            baseline: baseline_name(learned),
             first_named: self.first_named,
             events: self.events.events().to_vec(),
             events_dropped: self.events.dropped(),
@@ -605,6 +615,10 @@ pub struct IsolationReport {
     pub events: Vec<IsolationEvent>,
     /// How many events came after [`super::MAX_EVENTS`] and are not listed.
     pub events_dropped: usize,
+    /// The log's temperature channel (JSON keys `winding_temperature_c`, `measured_rise_k`,
+    /// `temperature_channel`, present only for a log with the column).
+    #[serde(flatten)]
+    pub temperature: super::temperature::TemperatureReport,
 }
 
 /// Smallest tracked winding temperature change that is reported [K] (5 K: 2 % on Rs and Rr,
@@ -627,17 +641,23 @@ impl IsolationReport {
             judged_at_s: 0.0,
             moved_from_learned: None,
             winding_rise_k: None,
-            baseline: if learned {
-                "learned in commissioning"
-            } else {
-                "nominal parameters"
-            }
-            .to_string(),
+            temperature: Default::default(),
+            baseline: baseline_name(learned),
             first_named: None,
             events: Vec::new(),
             events_dropped: 0,
         }
     }
+}
+
+/// The report's name of the baseline in force (`baseline`).
+fn baseline_name(learned: bool) -> String {
+    if learned {
+        "learned in commissioning"
+    } else {
+        "nominal parameters"
+    }
+    .to_string()
 }
 
 /// The report's name of an isolation state.

@@ -27,6 +27,7 @@ mod isolation;
 mod pipe;
 mod report;
 mod sequences;
+mod temperature;
 mod unsettled;
 
 use report::timeline_point;
@@ -47,6 +48,7 @@ pub use report::{
     BaselineSource, Detection, DiagnoseReport, MonitorState, Panel, TimelinePoint, UnbalanceReport,
     Verdict,
 };
+pub use temperature::TemperatureReport;
 
 use crate::log::{Channels, LogError, Row};
 use crate::params::ParamFile;
@@ -391,6 +393,7 @@ impl Replay {
                     params.supply.f_hz as f32,
                 )
                 .ok(),
+                channels.temperature,
                 opts.load,
             ),
             // Locks to the voltage vector where logged (normalised by its nominal peak), else
@@ -472,8 +475,14 @@ impl Replay {
             self.isolation_hold_until = t + self.settle_s;
         }
         let settled = t >= self.isolation_hold_until;
-        self.isolation
-            .after(t, self.dt_s, &out, &point, counts && settled);
+        self.isolation.after(
+            t,
+            self.dt_s,
+            &out,
+            &point,
+            counts && settled,
+            row.t_winding_c,
+        );
         if matches!(out.commissioning, CommissioningState::Learning(_)) {
             self.learned_unbalance = Some(self.unbalance_ratios().0);
         }

@@ -188,6 +188,7 @@ mod tests {
             i_abc: [t, -t, 0.0],
             wm_rad_s: None,
             enc_count: None,
+            t_winding_c: None,
         }
     }
 

@@ -96,6 +96,7 @@ mod run;
 mod scenario;
 mod sensors;
 mod steady;
+mod thermometer;
 
 pub use faults::{FaultSpec, SensorFaultMode};
 pub use scenario::{
@@ -106,6 +107,7 @@ pub use sensors::SensorSpec;
 pub use steady::{
     solve_slip, solve_slip_at, steady_state, steady_state_at, SteadyLoad, SteadyState,
 };
+pub use thermometer::TemperatureSpec;
 
 use crate::log::Row;
 use crate::params::ParamFile;

@@ -2,6 +2,7 @@
 
 use super::faults::{FaultSpec, SensorFaultMode};
 use super::scenario::{d_true, invalid, not_negative, positive};
+use super::thermometer::{TemperatureSpec, Thermometer};
 use super::{SimError, Truth};
 use crate::log::{Channels, Row};
 use monitor_core::Fault;
@@ -78,6 +79,7 @@ pub(crate) struct Sensors {
     voltages: bool,
     speed: bool,
     encoder: bool,
+    thermometer: Option<Thermometer>,
     /// Ranges in effect [V], [A] (for the summary).
     pub v_range_v: f64,
     pub i_range_a: f64,
@@ -116,6 +118,7 @@ impl Sensors {
             voltages: spec.voltages,
             speed: spec.speed,
             encoder: spec.encoder,
+            thermometer: spec.temperature.as_ref().map(|t| Thermometer::new(t, seed)),
             v_range_v,
             i_range_a,
             noise_v: if spec.ideal { 0.0 } else { noise_v },
@@ -203,6 +206,10 @@ impl Sensors {
             i_abc: i,
             wm_rad_s: wm,
             enc_count: enc,
+            t_winding_c: self
+                .thermometer
+                .as_mut()
+                .map(|th| th.read(tr.t_s, tr.temperature_rise_k, dt_s)),
         }
     }
 
@@ -227,6 +234,7 @@ impl SensorSpec {
             voltages: self.voltages,
             speed: self.speed,
             encoder: self.encoder,
+            temperature: self.temperature.is_some(),
         }
     }
 }
@@ -290,6 +298,10 @@ pub struct SensorSpec {
     /// Write the `enc_count` column (default true).
     #[serde(default = "d_true")]
     pub encoder: bool,
+    /// The winding-temperature channel `t_winding_c` (`[sensors.temperature]`), written
+    /// only when given (default none: the log has no temperature column).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub temperature: Option<TemperatureSpec>,
 }
 
 fn d_bits() -> u32 {
@@ -317,6 +329,7 @@ impl Default for SensorSpec {
             voltages: true,
             speed: true,
             encoder: true,
+            temperature: None,
         }
     }
 }
@@ -373,6 +386,9 @@ impl SensorSpec {
         }
         if self.encoder_lines == 0 {
             return invalid("sensors.encoder_lines", "must be >= 1".into());
+        }
+        if let Some(t) = &self.temperature {
+            t.validate()?;
         }
         Ok(())
     }

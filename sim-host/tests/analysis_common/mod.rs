@@ -302,6 +302,7 @@ pub fn write_log(
             voltages: true,
             speed: true,
             encoder: false,
+            temperature: false,
         },
         rows,
     };
@@ -310,6 +311,7 @@ pub fn write_log(
             voltages: false,
             speed: false,
             encoder: false,
+            temperature: false,
         };
         for r in &mut log.rows {
             r.v_abc = None;

@@ -41,3 +41,32 @@ pub fn three_motors() -> Vec<(&'static str, ParamFile)> {
         ("0.37 kW", small_0p37kw()),
     ]
 }
+
+/// Replays `sc` on `p` commissioned cold over 1.5-3.5 s, its windings warming from 4 s by
+/// `rise_k` with the thermal time constant `tau_s` (the simulator's `thermal_drift`; no
+/// warming for a rise of 0), with `fault` (kind, time [s], relative change) on top.
+#[allow(dead_code)] // (not every test of the three motors warms them)
+pub fn replay_warming(
+    p: &ParamFile,
+    mut sc: sim_host::sim::Scenario,
+    (rise_k, tau_s): (f64, f64),
+    fault: Option<(monitor_core::Fault, f64, f64)>,
+) -> sim_host::replay::DiagnoseReport {
+    use sim_host::sim::{EffectSpec, FaultSpec};
+    if rise_k > 0.0 {
+        let toml =
+            format!("name = \"thermal_drift\"\nrise_k = {rise_k}\ntau_s = {tau_s}\nat_s = 4.0\n");
+        sc.effects
+            .push(toml::from_str::<EffectSpec>(&toml).expect("effect"));
+    }
+    if let Some((f, at_s, change)) = fault {
+        sc.faults.push(FaultSpec::parametric(f, at_s, change));
+    }
+    let opts = sim_host::replay::ReplayOptions {
+        commission: Some((1.5, 3.5)),
+        ..Default::default()
+    };
+    sim_host::experiment::simulate_and_replay(p, p, &sc, opts, |_, _| {})
+        .expect("runs")
+        .finish()
+}

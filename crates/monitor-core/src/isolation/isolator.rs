@@ -71,6 +71,22 @@ impl Isolator {
         }
     }
 
+    /// Sets the winding's rise since commissioning to a measured `rise_k` [K] (a
+    /// temperature channel: the measured temperature minus the one commissioning saw):
+    /// [`Isolator::heating_factor`] becomes `k = 1 + alpha rise_k` ([`COPPER_ALPHA_PER_K`]),
+    /// replacing the tracked one. Returns false, and changes nothing, for a rise that is
+    /// not finite or whose `k` lies outside [`HEATING_K_MIN`]..[`HEATING_K_MAX`] (25 K
+    /// cooler to 160 K warmer than commissioned: no winding heats or cools that far in
+    /// service, so the channel is wrong).
+    pub fn set_winding_rise_k(&mut self, rise_k: f32) -> bool {
+        let k = 1.0 + COPPER_ALPHA_PER_K * rise_k;
+        let ok = rise_k.is_finite() && (HEATING_K_MIN..=HEATING_K_MAX).contains(&k);
+        if ok {
+            self.heating_factor = k;
+        }
+        ok
+    }
+
     /// The baseline in use.
     pub fn baseline(&self) -> Baseline {
         self.baseline

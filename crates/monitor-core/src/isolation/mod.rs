@@ -130,8 +130,8 @@
 
 mod follower;
 pub use follower::{
-    steady_against, Follower, Step, AVERAGE_MAX_S, AVERAGE_S, BLOCKS, CONFIRM_S, SETTLE_S,
-    STEADY_FRACTION, STEP_S,
+    steady_against, Follower, Step, AVERAGE_MAX_S, AVERAGE_S, BLOCKS, CONFIRM_S, PROBE_LAG_K,
+    SETTLE_S, STEADY_FRACTION, STEP_S,
 };
 mod circuit;
 mod evidence;

@@ -372,6 +372,7 @@ mod tests {
                 voltages: true,
                 speed: false,
                 encoder: false,
+                temperature: false,
             },
             factor: 1,
             log_rate_hz: 1.0 / dt,

@@ -91,6 +91,24 @@ pub fn demo(run: &DemoRun) -> anyhow::Result<()> {
     verdict(&mut out, &run.report)
 }
 
+/// The temperature channel's line (`None` for a log without the column): the reading and
+/// the rise the isolation compensates Rs and Rr with, or why the channel is not used.
+fn temperature_line(t: &sim_host::replay::TemperatureReport) -> Option<String> {
+    let status = t.temperature_channel.as_deref()?;
+    let reading = t
+        .winding_temperature_c
+        .map_or("no reading".to_string(), |c| format!("{c:.1} degC"));
+    Some(match (status.strip_prefix("not used: "), t.measured_rise_k) {
+        (Some(why), _) => format!(
+            "temperature channel not used: {why}; heating tracked from the resistances (last reading {reading})"
+        ),
+        (None, Some(rise)) => format!(
+            "winding temperature: {reading}, {rise:+.1} K since commissioning (temperature channel; Rs and Rr compensated, copper 0.393 %/K)"
+        ),
+        (None, None) => format!("winding temperature: {reading} (temperature channel)"),
+    })
+}
+
 /// Candidates as `rr p 0.76 (rr +50 %), speed_sensor p 0.24 (speed_sensor -2 %)`, or `none`.
 fn candidate_list(c: &[sim_host::replay::FaultCandidate]) -> String {
     if c.is_empty() {
@@ -254,6 +272,9 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
             candidate_list(&rep.signature_candidates)
         )?;
         writeln!(out, "isolation: {}", rep.isolation.verdict)?;
+        if let Some(line) = temperature_line(&rep.isolation.temperature) {
+            writeln!(out, "{line}")?;
+        }
         for g in &rep.isolation.groups {
             writeln!(
                 out,

@@ -41,7 +41,7 @@ impl CellLimits {
             Column::Va | Column::Vb | Column::Vc => self.v_max,
             Column::Ia | Column::Ib | Column::Ic => self.i_max,
             Column::Speed => self.wm_max,
-            Column::Time | Column::Encoder => return false,
+            Column::Time | Column::Encoder | Column::Temperature => return false,
         };
         x.abs() > max
     }

@@ -172,7 +172,7 @@ pub struct QualityStage<'a, S: CleanSink> {
     jitter: (f64, u64),
     dropping: bool,
     /// Bad cells per column: [not finite, finite but beyond the limits].
-    cells_out: [[u64; 2]; 9],
+    cells_out: [[u64; 2]; Column::COUNT],
     q: DataQuality,
     error: Option<LogError>,
     stopped: bool,
@@ -205,7 +205,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             wiring: wiring::WiringCheck::default(),
             jitter: (0.0, 0),
             dropping: false,
-            cells_out: [[0; 2]; 9],
+            cells_out: [[0; 2]; Column::COUNT],
             q: DataQuality::default(),
             error: None,
             stopped: false,
@@ -589,7 +589,7 @@ impl<S: CleanSink> RowSink for QualityStage<'_, S> {
         self.wiring = wiring::WiringCheck::default();
         self.jitter = (0.0, 0);
         self.dropping = false;
-        self.cells_out = [[0; 2]; 9];
+        self.cells_out = [[0; 2]; Column::COUNT];
         self.q = DataQuality::default();
         self.error = None;
         self.stopped = false;
@@ -647,6 +647,7 @@ mod tests {
             i_abc: [ph(0.0), ph(1.0), ph(2.0)],
             wm_rad_s: Some(150.0),
             enc_count: None,
+            t_winding_c: None,
         }
     }
 

@@ -97,6 +97,7 @@ mod tests {
             i_abc: [ph(10.0, 0.0), ph(10.0, 1.0), ph(10.0, 2.0)],
             wm_rad_s: Some(150.0),
             enc_count: None,
+            t_winding_c: None,
         }
     }
 

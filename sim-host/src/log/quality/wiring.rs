@@ -129,6 +129,7 @@ mod tests {
             i_abc: i,
             wm_rad_s: None,
             enc_count: None,
+            t_winding_c: None,
         }
     }
 
