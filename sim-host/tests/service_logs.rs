@@ -82,6 +82,18 @@ fn faults() -> Vec<(Fault, f64)> {
     v
 }
 
+/// Every motor's healthy log and every fault of the bar: (motor index, fault).
+fn every_case() -> Vec<(usize, Option<(Fault, f64)>)> {
+    let mut cases = Vec::new();
+    for m in 0..motors().len() {
+        cases.push((m, None));
+        for f in faults() {
+            cases.push((m, Some(f)));
+        }
+    }
+    cases
+}
+
 /// One service log's outcome.
 struct Outcome {
     motor: &'static str,
@@ -160,7 +172,7 @@ impl Outcome {
 /// The parameter file a user would write from a nameplate, off the machine: Rs +20 %, Rr
 /// -20 %, Lm -5 % (the leakages kept).
 fn nameplate_off(p: &ParamFile) -> ParamFile {
-    let mut n = p.clone();
+    let mut n = *p;
     n.motor.rs_ohm *= 1.2;
     n.motor.rr_ohm *= 0.8;
     let lm = 0.05 * n.motor.lm_h;
@@ -170,11 +182,8 @@ fn nameplate_off(p: &ParamFile) -> ParamFile {
     n
 }
 
-fn run(motor: &'static str, p: &ParamFile, fault: Option<(Fault, f64)>, seed: u64) -> Outcome {
-    run_with(motor, p, p, fault, seed)
-}
-
-/// [`run`] with the monitor told `nominal` while the machine is `p`.
+/// One service log of machine `p` (seed `seed`, `fault` at [`FAULT_AT_S`]), the monitor
+/// told `nominal`.
 fn run_with(
     motor: &'static str,
     p: &ParamFile,
@@ -213,7 +222,7 @@ fn table(cases: &[(usize, Option<(Fault, f64)>)], off: bool) -> Vec<Outcome> {
         .enumerate()
         .map(|(k, &(m, fault))| {
             let (name, p) = &ms[m];
-            let nominal = if off { nameplate_off(p) } else { p.clone() };
+            let nominal = if off { nameplate_off(p) } else { *p };
             run_with(name, p, &nominal, fault, 900 + k as u64)
         })
         .collect();
@@ -285,13 +294,7 @@ fn service_logs_of_three_motors_every_fault() {
         eprintln!("skipped: set MONITOR_FULL_SWEEPS=1");
         return;
     }
-    let mut cases = Vec::new();
-    for m in 0..motors().len() {
-        cases.push((m, None));
-        for f in faults() {
-            cases.push((m, Some(f)));
-        }
-    }
+    let cases = every_case();
     let out = table(&cases, false);
     let bad = bar_failures(&out);
     assert!(bad.is_empty(), "{bad:#?}");
@@ -308,13 +311,7 @@ fn service_logs_with_a_nameplate_that_is_off_name_nothing_wrong() {
         eprintln!("skipped: set MONITOR_FULL_SWEEPS=1");
         return;
     }
-    let mut cases = Vec::new();
-    for m in 0..motors().len() {
-        cases.push((m, None));
-        for f in faults() {
-            cases.push((m, Some(f)));
-        }
-    }
+    let cases = every_case();
     let out = table(&cases, true);
     let wrong: Vec<String> = out
         .iter()

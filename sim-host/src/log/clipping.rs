@@ -201,37 +201,30 @@ mod tests {
     /// period (5 % of the samples, each alone): a peak, not a flat top.
     #[test]
     fn a_noise_free_sine_at_whole_samples_per_period_is_not_clipped() {
-        let mut t = ClipTracker::default();
-        for k in 0..20_000 {
-            let th = std::f64::consts::TAU * (k % 20) as f64 / 20.0;
-            let x = |ph: f64| 325.0 * (th - ph).sin();
-            let p = std::f64::consts::TAU / 3.0;
-            let r = Row {
-                t_s: k as f64 / 1000.0,
-                v_abc: Some([x(0.0), x(p), x(-p)]),
-                i_abc: [x(0.0), x(p), x(-p)],
-                wm_rad_s: None,
-                enc_count: None,
-            };
-            t.push(&r, |_| true);
-        }
-        assert!(t.clipped().is_empty(), "{:?}", t.clipped());
+        // 325 V peak at 20 samples per period (1 kHz, 50 Hz), clipped at `clip` volts.
+        let sync = |clip: f64| {
+            let mut t = ClipTracker::default();
+            for k in 0..20_000 {
+                let th = std::f64::consts::TAU * (k % 20) as f64 / 20.0;
+                let x = |ph: f64| (325.0 * (th - ph).sin()).clamp(-clip, clip);
+                let p = std::f64::consts::TAU / 3.0;
+                let r = Row {
+                    t_s: k as f64 / 1000.0,
+                    v_abc: Some([x(0.0), x(p), x(-p)]),
+                    i_abc: [x(0.0), x(p), x(-p)],
+                    wm_rad_s: None,
+                    enc_count: None,
+                    t_winding_c: None,
+                };
+                t.push(&r, |_| true);
+            }
+            t.clipped()
+        };
+        let clean = sync(400.0);
+        assert!(clean.is_empty(), "{clean:?}");
         // The same sine clipped at 90 % of its peak: flat tops of three samples.
-        let mut c = ClipTracker::default();
-        for k in 0..20_000 {
-            let th = std::f64::consts::TAU * (k % 20) as f64 / 20.0;
-            let x = |ph: f64| (325.0 * (th - ph).sin()).clamp(-292.5, 292.5);
-            let p = std::f64::consts::TAU / 3.0;
-            let r = Row {
-                t_s: k as f64 / 1000.0,
-                v_abc: Some([x(0.0), x(p), x(-p)]),
-                i_abc: [x(0.0), x(p), x(-p)],
-                wm_rad_s: None,
-                enc_count: None,
-            };
-            c.push(&r, |_| true);
-        }
-        assert_eq!(c.clipped().len(), 6, "{:?}", c.clipped());
+        let clipped = sync(292.5);
+        assert_eq!(clipped.len(), 6, "{clipped:?}");
     }
 
     #[test]
