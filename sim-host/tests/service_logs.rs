@@ -82,6 +82,16 @@ fn faults() -> Vec<(Fault, f64)> {
     v
 }
 
+/// The long runs are asked for (`MONITOR_FULL_SWEEPS=1`, as `.ci/run` does); says so when
+/// they are skipped.
+fn full_sweeps() -> bool {
+    let on = std::env::var("MONITOR_FULL_SWEEPS").is_ok_and(|v| v == "1");
+    if !on {
+        eprintln!("skipped: set MONITOR_FULL_SWEEPS=1");
+    }
+    on
+}
+
 /// Every motor's healthy log and every fault of the bar: (motor index, fault).
 fn every_case() -> Vec<(usize, Option<(Fault, f64)>)> {
     let mut cases = Vec::new();
@@ -290,8 +300,7 @@ fn service_logs_of_the_2p2kw_motor_a_subset() {
 
 #[test]
 fn service_logs_of_three_motors_every_fault() {
-    if !std::env::var("MONITOR_FULL_SWEEPS").is_ok_and(|v| v == "1") {
-        eprintln!("skipped: set MONITOR_FULL_SWEEPS=1");
+    if !full_sweeps() {
         return;
     }
     let cases = every_case();
@@ -307,8 +316,7 @@ fn service_logs_of_three_motors_every_fault() {
 /// logs").
 #[test]
 fn service_logs_with_a_nameplate_that_is_off_name_nothing_wrong() {
-    if !std::env::var("MONITOR_FULL_SWEEPS").is_ok_and(|v| v == "1") {
-        eprintln!("skipped: set MONITOR_FULL_SWEEPS=1");
+    if !full_sweeps() {
         return;
     }
     let cases = every_case();
@@ -325,13 +333,11 @@ fn service_logs_with_a_nameplate_that_is_off_name_nothing_wrong() {
 /// isolation's 0.1 s blocks and the 2 Hz sequence filters as they are, at a fifth of the
 /// cost): commissioned over 60-500 s at the file's load, the viscous load stepped to 0.7,
 /// 1.2 and 0.9 x Bl at 10, 25 and 40 min, and Rr +20 % at 50 min. The fault is named with
-/// its size after 50 min; no fault is named before it (the load steps are operating-point
-/// changes: to the paper's model, whose torque balance has the viscous load, a change of
-/// the friction class b/bl, the amber MOVED state). About 10 s in the test profile; with `MONITOR_FULL_SWEEPS=1`.
+/// its size after 50 min; nothing is named before it: with the load an unknown input (the
+/// replay's default) each load step is a load move, listed as an event with its time. About 10 s in the test profile; with `MONITOR_FULL_SWEEPS=1`.
 #[test]
 fn an_hour_with_load_steps_and_a_rotor_fault_at_50_min() {
-    if !std::env::var("MONITOR_FULL_SWEEPS").is_ok_and(|v| v == "1") {
-        eprintln!("skipped: set MONITOR_FULL_SWEEPS=1");
+    if !full_sweeps() {
         return;
     }
     let p = ParamFile::reference_2p2kw();

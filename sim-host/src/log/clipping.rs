@@ -161,18 +161,24 @@ mod tests {
                 let y = (a * (th - ph).sin() + dither).clamp(-full_scale, full_scale);
                 (y / lsb).round() * lsb
             };
-            let p = std::f64::consts::TAU / 3.0;
-            let r = Row {
-                t_s: k as f64 / 5000.0,
-                v_abc: Some([x(0.0), x(p), x(-p)]),
-                i_abc: [x(0.0), x(p), x(-p)],
-                wm_rad_s: None,
-                enc_count: None,
-                t_winding_c: None,
-            };
-            t.push(&r, |_| true);
+            push_three_phase(&mut t, k as f64 / 5000.0, x);
         }
         t
+    }
+
+    /// One row of three phases `x(0)`, `x(2 pi/3)`, `x(-2 pi/3)` on the voltages and the
+    /// currents at `t_s`.
+    fn push_three_phase(t: &mut ClipTracker, t_s: f64, x: impl Fn(f64) -> f64) {
+        let p = std::f64::consts::TAU / 3.0;
+        let r = Row {
+            t_s,
+            v_abc: Some([x(0.0), x(p), x(-p)]),
+            i_abc: [x(0.0), x(p), x(-p)],
+            wm_rad_s: None,
+            enc_count: None,
+            t_winding_c: None,
+        };
+        t.push(&r, |_| true);
     }
 
     #[test]
@@ -207,16 +213,7 @@ mod tests {
             for k in 0..20_000 {
                 let th = std::f64::consts::TAU * (k % 20) as f64 / 20.0;
                 let x = |ph: f64| (325.0 * (th - ph).sin()).clamp(-clip, clip);
-                let p = std::f64::consts::TAU / 3.0;
-                let r = Row {
-                    t_s: k as f64 / 1000.0,
-                    v_abc: Some([x(0.0), x(p), x(-p)]),
-                    i_abc: [x(0.0), x(p), x(-p)],
-                    wm_rad_s: None,
-                    enc_count: None,
-                    t_winding_c: None,
-                };
-                t.push(&r, |_| true);
+                push_three_phase(&mut t, k as f64 / 1000.0, x);
             }
             t.clipped()
         };

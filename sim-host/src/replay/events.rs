@@ -140,11 +140,9 @@ impl EventLog {
     }
 }
 
-/// The active current of a steady point (its current's part in phase with its voltage)
-/// [A, peak]: `(vd id + vq iq) / |v|` ([`monitor_core::OperatingPoint`]'s `load_a`; NaN
-/// without voltage).
+/// The active current of a steady point [A, peak] ([`SteadyPoint::operating_point`]).
 fn active_current(p: &SteadyPoint) -> f32 {
-    monitor_core::OperatingPoint::from_dq(p.v.d, p.v.q, p.i.d, p.i.q).load_a
+    p.operating_point().load_a
 }
 
 #[cfg(test)]

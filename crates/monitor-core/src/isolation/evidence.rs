@@ -34,14 +34,9 @@ const SAME_POINT: f32 = super::STEADY_FRACTION;
 /// on the 3 hp machine at one load level, stays evidence).
 const LOAD_MOVED_SIGMA: f32 = 2.0;
 
-/// The active current of a steady point (its current's part in phase with its voltage) [A].
+/// The active current of a steady point [A] ([`SteadyPoint::operating_point`]).
 fn active_current(p: &SteadyPoint) -> f32 {
-    let v = crate::fast_hypot(p.v.d, p.v.q);
-    if v > 0.0 {
-        (p.v.d * p.i.d + p.v.q * p.i.q) / v
-    } else {
-        f32::NAN
-    }
+    p.operating_point().load_a
 }
 
 /// The kept points and the joint isolation over them.

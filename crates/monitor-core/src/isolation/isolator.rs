@@ -124,8 +124,7 @@ impl Isolator {
         l.n = l.n.saturating_add(1);
         let n = l.n as f32;
         l.at.approach(p, 1.0 / n);
-        l.range
-            .learn(crate::OperatingPoint::from_dq(p.v.d, p.v.q, p.i.d, p.i.q));
+        l.range.learn(p.operating_point());
         for ((m, m2), x) in l.mean.iter_mut().zip(l.m2.iter_mut()).zip(e.to_array()) {
             let d = x - *m;
             *m += d / n;
@@ -170,7 +169,7 @@ impl Isolator {
     /// margin (module docs, "Over a commissioned range").
     fn within_learned_span(&self, q: &SteadyPoint) -> bool {
         let r = self.learned_range;
-        let p = crate::OperatingPoint::from_dq(q.v.d, q.v.q, q.i.d, q.i.q);
+        let p = q.operating_point();
         match r.load_a {
             Some([lo, hi]) => {
                 let wide = hi - lo >= WIDE_SPAN * crate::maxf(lo.abs(), hi.abs());
@@ -557,8 +556,7 @@ impl Isolator {
         };
         // (The anchor was measured before the deviation: its readings stand as they are.)
         let ((_, q), qa) = (self.hypothesis(p, h), a);
-        let active =
-            |x: &SteadyPoint| crate::OperatingPoint::from_dq(x.v.d, x.v.q, x.i.d, x.i.q).load_a;
+        let active = |x: &SteadyPoint| x.operating_point().load_a;
         let (ia, i0) = (active(&q), active(&qa));
         let moved = (ia - i0) / crate::maxf(i0.abs(), 1e-6);
         if !(moved.abs() <= ANCHOR_LOAD_BAND) {

@@ -217,6 +217,13 @@ pub struct SteadyPoint {
 }
 
 impl SteadyPoint {
+    /// The point's load and voltage ([`crate::OperatingPoint`]): its active current (the
+    /// current's part in phase with the voltage, `(vd id + vq iq) / |v|` [A]; NaN without
+    /// voltage) and `|v|` [V].
+    pub fn operating_point(&self) -> crate::OperatingPoint {
+        crate::OperatingPoint::from_dq(self.v.d, self.v.q, self.i.d, self.i.q)
+    }
+
     /// The point the monitor's filtered outputs describe: `(i_ds, I_qs)`, `(V_ds, V_qs)`,
     /// the frame's angular frequency and the electrical rotor speed (all filtered at the
     /// monitor's `filter_hz`, except the frame frequency: average it over a few supply
