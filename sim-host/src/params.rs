@@ -257,17 +257,27 @@ pub struct ParamFile {
 }
 
 /// One entry of the parameter file's `[columns]` table: `ia_A = { name = "Ia", unit =
-/// "mA" }` (the key a schema column, `name` the log's channel, `unit` optional). What the
-/// keys and units may be, and the mapping built from them, is the log reader's
-/// (`crate::log::ColumnMapping::from_table`, `docs/design.md`).
-#[derive(Debug, Clone, PartialEq, Eq, Deserialize, Serialize)]
+/// "mA" }` (the key a schema column, `name` the log's channel, `unit` optional), or
+/// `ia_A = { column = 1 }` (the log's first field, for a file without a header row), or,
+/// for the time only, `t_s = { sample_rate_hz = 1000.0 }` (no time column: the rows are
+/// samples at that rate). What the keys and units may be, and the mapping built from
+/// them, is the log reader's (`crate::log::ColumnMapping::from_table`, `docs/design.md`).
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct ColumnEntry {
-    /// The channel's name in the log.
-    pub name: String,
+    /// The channel's name in the log (its header field, Parquet column or TDMS channel).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// The channel's place in each line, counted from 1 (instead of `name`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub column: Option<u32>,
     /// Its unit; absent: the schema's SI unit.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub unit: Option<String>,
+    /// `t_s` only: the log has no time column and its rows are samples at this rate [Hz]
+    /// (instead of `name` or `column`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sample_rate_hz: Option<f64>,
 }
 
 /// The `[columns]` table: schema column name to [`ColumnEntry`].

@@ -305,7 +305,7 @@ fn a_healthy_baseline_takes_the_motors_own_asymmetry_out() {
             ));
         }
         let with_file = ReplayOptions {
-            unbalance_baseline: Some(bare.unbalance.measured),
+            unbalance_baseline: Some(bare.unbalance.measured.into()),
             ..ReplayOptions::default()
         };
         // The healthy motor on another day (another noise seed) against its baseline.

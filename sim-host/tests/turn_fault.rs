@@ -181,7 +181,7 @@ fn record(p: &ParamFile, c: &Case) -> (Vec<sim_host::log::Row>, SensorSpec) {
 fn judge(p: &ParamFile, c: &Case, baseline: Option<&UnbalanceReport>) -> UnbalanceReport {
     let (rows, sensors) = record(p, c);
     let opts = ReplayOptions {
-        unbalance_baseline: baseline.map(|b| b.measured),
+        unbalance_baseline: baseline.map(|b| b.measured.into()),
         ..ReplayOptions::default()
     };
     diagnose_rows(p, sensors.channels(), &rows, opts)

@@ -186,6 +186,15 @@ impl SrfPll {
         }
     }
 
+    /// Sets the PLL's own angle to `theta_pll_rad` (the vector's angle, on +d), e.g. the
+    /// first sample's `atan2(beta, alpha)`, so that the loop starts locked instead of
+    /// pulling in from zero. A non-finite angle is ignored.
+    pub fn align(&mut self, theta_pll_rad: f32) {
+        if theta_pll_rad.is_finite() {
+            self.theta_pll = wrap_angle(theta_pll_rad);
+        }
+    }
+
     /// The PLL's own angle (voltage on +d) [rad].
     pub fn theta_pll(&self) -> f32 {
         self.theta_pll

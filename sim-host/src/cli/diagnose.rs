@@ -34,12 +34,19 @@ range) are held out, time in ms or us is recognised; the report's data_quality s
 was found and done, and the verdict is withheld when the log cannot be trusted.\n\n\
 Commissioning: a window the log does not complete is an error unless --allow-incomplete. \
 The learned thresholds hold only over the load and voltage range seen while learning: \
-commission over healthy running that covers the whole range.\n\nThe faulty winding is judged \
-from the change of the negative-sequence current against the healthy machine's: --baseline \
-HEALTHY.csv replays a log of the same motor when it was healthy (same supply and load if \
-possible) and takes its negative sequence; without it, the one at the end of the --commission \
-window; without either, only the supply's own unbalance is taken out (a motor's inherent \
-asymmetry and the sensors' mismatch then count as the winding's).\n\nA winding (or frame) \
+commission over healthy running that covers the whole range.\n\nThe faulty winding (shorted \
+turns) is judged from the change of the negative-sequence current, measured by least-squares \
+phasors over windows of ten supply periods and grouped into steady stretches (a short \
+switched on and off within the log is a stretch of its own), against the healthy machine's: \
+--baseline HEALTHY... replays logs of the same motor when it was healthy (same supply and \
+load if possible; several files, or a folder of them): their mean is the reference and their \
+spread, with a default spread counted as one run, sets the least change that names a phase \
+(JSON unbalance.least_change, baseline_runs, baseline_spread). Without --baseline, the \
+--commission window's; without either, no phase below twice a healthy machine's own \
+asymmetry (6 %). The reference angle is measured from the voltages where logged, else the \
+model's at the measured speed, else at the current's magnitude when the parameter file can \
+draw it, else unknown between no load and full load; its uncertainty lowers the phase's \
+confidence (unbalance.operating_point, correction_uncertainty_deg).\n\nA winding (or frame) \
 temperature column, t_winding_c in degC (or a DAQ's channel in degC, K or degF through the \
 parameter file's [columns] table), compensates Rs and Rr with the rise measured since \
 commissioning (copper 0.393 %/K) instead of tracking it from the residuals; JSON \
@@ -48,7 +55,8 @@ why: NaN or out of -40..250 degC for 10 s, a jump faster than a winding heats, s
 or the resistances disagree by more than 20 K; then the rise is tracked from the \
 resistances).\n\nExample:\n  sim-host \
 diagnose --params motor.toml log.csv --commission 2:4\n  sim-host diagnose --params motor.toml \
-today.csv --baseline last_year_healthy.csv"
+today.csv --baseline healthy_1.csv healthy_2.csv\n  sim-host diagnose --params motor.toml \
+today.csv --baseline healthy_runs/"
 )]
 pub struct DiagnoseArgs {
     /// Motor parameter file (TOML, docs/design.md).
@@ -68,10 +76,12 @@ pub struct DiagnoseArgs {
     /// verdict is withheld.
     #[arg(long)]
     pub allow_incomplete: bool,
-    /// A log of the same motor when healthy: the winding is judged against its negative
-    /// sequence (read only; the same formats as LOG).
-    #[arg(long, value_name = "HEALTHY")]
-    pub baseline: Option<PathBuf>,
+    /// Logs of the same motor when healthy (several files, or a folder of them; read
+    /// only; the same formats as LOG): the winding is judged against their mean negative
+    /// sequence, and their spread sets the least change that names a phase. Give LOG
+    /// before --baseline, or repeat --baseline for each file.
+    #[arg(long, value_name = "HEALTHY", num_args = 1.., action = clap::ArgAction::Append)]
+    pub baseline: Vec<PathBuf>,
     /// Frame angle source.
     #[arg(long, value_enum, default_value_t = AngleArg::RotorFlux)]
     pub angle: AngleArg,
@@ -89,6 +99,40 @@ pub struct DiagnoseArgs {
     /// Print one JSON document on stdout instead of the table.
     #[arg(long)]
     pub json: bool,
+}
+
+/// The healthy logs of `--baseline`: each file as given, each folder's log files (CSV,
+/// TDMS, Parquet, by extension) in name order.
+///
+/// # Errors
+/// A folder without logs, or one that cannot be read.
+fn baseline_files(given: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
+    let mut files = Vec::new();
+    for p in given {
+        if !p.is_dir() {
+            files.push(p.clone());
+            continue;
+        }
+        let mut in_dir: Vec<PathBuf> = std::fs::read_dir(p)
+            .map_err(|e| anyhow::anyhow!("--baseline {}: {e}", p.display()))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|f| {
+                f.is_file()
+                    && f.extension().and_then(|x| x.to_str()).is_some_and(|x| {
+                        ["csv", "tdms", "parquet"].contains(&x.to_ascii_lowercase().as_str())
+                    })
+            })
+            .collect();
+        if in_dir.is_empty() {
+            anyhow::bail!(
+                "--baseline {}: the folder holds no log (.csv, .tdms or .parquet)",
+                p.display()
+            );
+        }
+        in_dir.sort();
+        files.extend(in_dir);
+    }
+    Ok(files)
 }
 
 /// The negative sequence of the healthy log `path` (replayed without commissioning).
@@ -114,6 +158,14 @@ fn baseline_of(
     Ok(d.report.unbalance.measured)
 }
 
+/// True when `a` and `b` name the same file.
+fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    }
+}
+
 /// Runs `diagnose`.
 ///
 /// # Errors
@@ -134,8 +186,19 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         unbalance_baseline: None,
         load: args.load.into(),
     };
-    if let Some(healthy) = &args.baseline {
-        opts.unbalance_baseline = Some(baseline_of(&params, healthy, &open, opts)?);
+    if !args.baseline.is_empty() {
+        let files = baseline_files(&args.baseline)?;
+        if let Some(same) = files.iter().find(|f| same_file(f, &args.log)) {
+            anyhow::bail!(
+                "--baseline {}: that is the log being judged; give healthy logs of the same motor",
+                same.display()
+            );
+        }
+        let runs = files
+            .iter()
+            .map(|f| baseline_of(&params, f, &open, opts))
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        opts.unbalance_baseline = sim_host::replay::HealthyReference::from_runs(&runs);
     }
     let big = std::fs::metadata(&args.log)
         .map(|m| m.len() > 20_000_000)

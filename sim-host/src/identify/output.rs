@@ -131,12 +131,17 @@ pub fn to_toml(id: &Identification, start_text: &str, start_name: &str, log_name
         );
         let quoted = |x: &str| toml::Value::String(x.to_string()).to_string();
         for (key, c) in &columns {
-            let unit = c
-                .unit
-                .as_deref()
-                .map(|u| format!(", unit = {}", quoted(u)))
-                .unwrap_or_default();
-            s.push_str(&format!("{key} = {{ name = {}{unit} }}\n", quoted(&c.name)));
+            let parts: Vec<String> = [
+                c.name.as_deref().map(|n| format!("name = {}", quoted(n))),
+                c.column.map(|n| format!("column = {n}")),
+                c.unit.as_deref().map(|u| format!("unit = {}", quoted(u))),
+                c.sample_rate_hz
+                    .map(|r| format!("sample_rate_hz = {}", toml::Value::Float(r))),
+            ]
+            .into_iter()
+            .flatten()
+            .collect();
+            s.push_str(&format!("{key} = {{ {} }}\n", parts.join(", ")));
         }
     }
     s

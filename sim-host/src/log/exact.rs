@@ -26,7 +26,7 @@ pub(super) struct ExactRows {
 }
 
 impl ExactRows {
-    /// Opens the file and skips its header line.
+    /// Opens the file and skips its header line (a file without one starts with data).
     pub fn new(log: &LogFile) -> Result<Self, LogError> {
         let shown = log.shown().to_string();
         let f = File::open(log.path()).map_err(|source| LogError::Io {
@@ -42,15 +42,18 @@ impl ExactRows {
             .terminator(csv::Terminator::Any(b'\n'))
             .from_reader(BufReader::with_capacity(1 << 20, f));
         let mut record = csv::ByteRecord::new();
-        // The header (already parsed by `LogFile::open`).
-        rdr.read_byte_record(&mut record)
-            .map_err(|e| csv_error(&shown, &e))?;
+        // The header (already parsed by `LogFile::open`), unless the file has none.
+        let header = log.header_bytes() > 0;
+        if header {
+            rdr.read_byte_record(&mut record)
+                .map_err(|e| csv_error(&shown, &e))?;
+        }
         Ok(ExactRows {
             shown,
             rdr,
             columns: log.columns().clone(),
             record,
-            last_line: 1,
+            last_line: u64::from(header),
             blank: 0,
             iso_t0: None,
         })

@@ -215,23 +215,34 @@ impl ChannelUnit {
     }
 }
 
-/// One schema column's channel in the log: its name there and, when given, its unit.
+/// One schema column's channel in the log: its name there (or its place in a line) and,
+/// when given, its unit.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct MappedChannel {
-    /// The channel's name in the log (CSV header field, TDMS channel, Parquet column).
+    /// The channel's name in the log (CSV header field, TDMS channel, Parquet column); for
+    /// a channel given by its place, `column N` (as messages show it).
     pub name: String,
     /// Its unit; `None`: the schema's SI unit (a TDMS channel's `unit_string` when it has
     /// one).
     pub unit: Option<ChannelUnit>,
+    /// The channel's place among a line's fields (or the file's columns), from 0, when it
+    /// is given by place (`column = N` in `[columns]`, N from 1) rather than by name.
+    pub position: Option<usize>,
 }
+
+/// Slowest and fastest sample rate `t_s = { sample_rate_hz = ... }` may give [Hz].
+pub const SAMPLE_RATE_RANGE_HZ: (f64, f64) = (1.0, 10e6);
 
 /// The mapping from the schema's columns to a log's channels (the parameter file's
 /// `[columns]` table; see the module documentation). The default maps nothing: every
 /// column by its schema name, in SI units.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct ColumnMapping {
     channels: [Option<MappedChannel>; Column::COUNT],
     pole_pairs: u32,
+    /// The rows are samples at this rate [Hz]: the log has no time column
+    /// (`t_s = { sample_rate_hz = ... }`).
+    sample_rate_hz: Option<f64>,
 }
 
 impl ColumnMapping {
@@ -241,7 +252,61 @@ impl ColumnMapping {
         ColumnMapping {
             channels: Default::default(),
             pole_pairs,
+            sample_rate_hz: None,
         }
+    }
+
+    /// Maps schema column `c` to the log's field at `position` (from 0) of every line, for
+    /// a file without a header row (or whose header names are not to be used), recorded in
+    /// `unit`. Messages name the channel `column N` (N = `position + 1`).
+    ///
+    /// # Errors
+    /// As [`ColumnMapping::set`] (two columns at one place among them).
+    pub fn set_position(
+        &mut self,
+        c: Column,
+        position: usize,
+        unit: Option<ChannelUnit>,
+    ) -> Result<(), String> {
+        self.set(c, &format!("column {}", position + 1), unit)?;
+        if let Some(m) = self.channels[c as usize].as_mut() {
+            m.position = Some(position);
+        }
+        Ok(())
+    }
+
+    /// The log has no time column: its rows are samples at `rate_hz` [Hz] (the first row
+    /// at `t_s = 0`). Replaces a mapping of the time column.
+    ///
+    /// # Errors
+    /// A one-line message for a rate that is not finite or lies outside
+    /// [`SAMPLE_RATE_RANGE_HZ`].
+    pub fn set_sample_rate(&mut self, rate_hz: f64) -> Result<(), String> {
+        let (lo, hi) = SAMPLE_RATE_RANGE_HZ;
+        if !(rate_hz.is_finite() && (lo..=hi).contains(&rate_hz)) {
+            return Err(format!(
+                "t_s: sample_rate_hz = {rate_hz} is not a sample rate ({lo}..{hi:e} Hz)"
+            ));
+        }
+        self.channels[Column::Time as usize] = None;
+        self.sample_rate_hz = Some(rate_hz);
+        Ok(())
+    }
+
+    /// The sample rate of a log without a time column ([`ColumnMapping::set_sample_rate`]).
+    pub fn sample_rate_hz(&self) -> Option<f64> {
+        self.sample_rate_hz
+    }
+
+    /// The place of column `c` among a line's fields (from 0), when it is mapped by place.
+    pub fn position_of(&self, c: Column) -> Option<usize> {
+        self.get(c).and_then(|m| m.position)
+    }
+
+    /// True when some column is mapped by its place ([`ColumnMapping::set_position`]): a
+    /// CSV whose first line holds numbers is then read as a file without a header row.
+    pub fn by_position(&self) -> bool {
+        self.channels.iter().flatten().any(|m| m.position.is_some())
     }
 
     /// Maps schema column `c` to the log's channel `name`, recorded in `unit`.
@@ -275,6 +340,7 @@ impl ColumnMapping {
         self.channels[c as usize] = Some(MappedChannel {
             name: name.to_string(),
             unit,
+            position: None,
         });
         Ok(())
     }
@@ -286,7 +352,7 @@ impl ColumnMapping {
 
     /// True when nothing is mapped.
     pub fn is_empty(&self) -> bool {
-        self.channels.iter().all(Option::is_none)
+        self.channels.iter().all(Option::is_none) && self.sample_rate_hz.is_none()
     }
 
     /// The name column `c` has in the log: the mapped name, else the schema's.
@@ -368,12 +434,49 @@ impl ColumnMapping {
                     names.join(", ")
                 ));
             };
+            if let Some(rate) = e.sample_rate_hz {
+                if *c != Column::Time {
+                    return Err(format!(
+                        "{key}: sample_rate_hz belongs to t_s (a log without a time column: t_s = {{ sample_rate_hz = 1000.0 }})"
+                    ));
+                }
+                if e.name.is_some() || e.column.is_some() || e.unit.is_some() {
+                    return Err(format!(
+                        "{key}: sample_rate_hz says the log has no time column; give either it or the time column (name or column, with its unit), not both"
+                    ));
+                }
+                m.set_sample_rate(rate)?;
+                continue;
+            }
             let unit = e
                 .unit
                 .as_deref()
                 .map(|u| ChannelUnit::parse(*c, u).map_err(|why| format!("{key}: {why}")))
                 .transpose()?;
-            m.set(*c, &e.name, unit)?;
+            match (&e.name, e.column) {
+                (Some(name), None) => m.set(*c, name, unit)?,
+                (None, Some(n)) if n >= 1 => m.set_position(*c, n as usize - 1, unit)?,
+                (None, Some(_)) => {
+                    return Err(format!(
+                        "{key}: column = 0; the fields of a line are counted from 1"
+                    ))
+                }
+                (Some(_), Some(_)) => {
+                    return Err(format!(
+                        "{key}: give the channel by name or by column, not both"
+                    ))
+                }
+                (None, None) => {
+                    return Err(format!(
+                        "{key}: give the channel's name (name = \"Ia\") or its place in a line (column = 1){}",
+                        if *c == Column::Time {
+                            ", or sample_rate_hz = ... for a log without a time column"
+                        } else {
+                            ""
+                        }
+                    ))
+                }
+            }
         }
         // A column left out keeps its schema name: no mapped column may take it.
         for (i, a) in Column::ALL.iter().enumerate() {
@@ -662,8 +765,9 @@ mod tests {
     #[test]
     fn a_table_of_the_parameter_file() {
         let entry = |name: &str, unit: Option<&str>| crate::params::ColumnEntry {
-            name: name.into(),
+            name: Some(name.into()),
             unit: unit.map(Into::into),
+            ..Default::default()
         };
         let mut t = ColumnsTable::new();
         t.insert("wm_rad_s".into(), entry("n", Some("Hz_el")));

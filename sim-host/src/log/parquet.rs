@@ -114,7 +114,7 @@ impl ParquetSource {
                 super::mapping::resolve_unit(shown, *c, &found[j], mapping.unit_of(*c), recorded)?;
         }
         columns.set_units(&units, mapping);
-        if columns.of(Column::Time).is_none() {
+        if columns.of(Column::Time).is_none() && columns.sample_rate_hz.is_none() {
             if let Some(j) = (0..found.len())
                 .find(|&j| timestamp_unit(schema.column(j).logical_type_ref()).is_some())
             {

@@ -43,6 +43,30 @@ impl RowSink for FromFirstRow<'_> {
     }
 }
 
+/// A log without a time column ([`ColumnMapping::sample_rate_hz`]): row `k` (from 0) is
+/// handed on to `sink` at `t_s = k / rate`.
+struct Clocked<'a> {
+    sink: &'a mut dyn RowSink,
+    next: u64,
+    rate_hz: f64,
+}
+
+impl RowSink for Clocked<'_> {
+    fn row(&mut self, row: &Row) -> bool {
+        let mut r = *row;
+        r.t_s = self.next as f64 / self.rate_hz;
+        self.next += 1;
+        self.sink.row(&r)
+    }
+    fn restart(&mut self) {
+        self.next = 0;
+        self.sink.restart();
+    }
+    fn blank_lines(&mut self, lines: u64) {
+        self.sink.blank_lines(lines);
+    }
+}
+
 /// Collects every row.
 impl RowSink for Vec<Row> {
     fn row(&mut self, row: &Row) -> bool {
@@ -75,6 +99,9 @@ pub(super) struct ColumnMap {
     pub temp_offset: f64,
     /// Each column's channel name in the log (the schema's name unless mapped).
     pub names: [String; Column::COUNT],
+    /// The log has no time column: its rows are samples at this rate [Hz]
+    /// ([`ColumnMapping::sample_rate_hz`]).
+    pub sample_rate_hz: Option<f64>,
 }
 
 impl ColumnMap {
@@ -91,6 +118,11 @@ impl ColumnMap {
     ) -> Result<Self, LogError> {
         let mut field = [None; Column::COUNT];
         for (f, c) in field.iter_mut().zip(Column::ALL) {
+            if let Some(p) = mapping.position_of(c) {
+                // Past the last field: missing (`check_columns` says so).
+                *f = (p < found.len()).then_some(p);
+                continue;
+            }
             let name = mapping.name_of(c);
             let mut at = found
                 .iter()
@@ -116,6 +148,7 @@ impl ColumnMap {
             time_factor: 1.0,
             temp_offset: 0.0,
             names: Column::ALL.map(|c| mapping.name_of(c).to_string()),
+            sample_rate_hz: mapping.sample_rate_hz(),
         };
         map.set_units(&Column::ALL.map(|c| mapping.unit_of(c)), mapping);
         Ok(map)
@@ -153,7 +186,7 @@ impl ColumnMap {
 }
 
 /// How to open a log ([`LogFile::open_with`]).
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct OpenOptions {
     /// The TDMS group holding the channels (`--group`); needed only when a TDMS file has
     /// several groups. An error for the other formats, which have no groups.
@@ -293,13 +326,12 @@ impl LogFile {
         r.take(HEAD_BYTES as u64)
             .read_to_end(&mut head)
             .map_err(io)?;
-        let columns = parse_header(&header, shown, mapping)?;
+        let (columns, has_header) = parse_header(&header, shown, mapping)?;
+        let header_bytes = if has_header { header.len() as u64 } else { 0 };
         let lines = head.iter().filter(|&&b| b == b'\n').count().max(1);
         let bytes_per_row = (head.len() as f64 / lines as f64).max(1.0);
-        let est_rows = len_bytes.saturating_sub(header.len() as u64) as f64 / bytes_per_row;
-        let source = Source::Csv {
-            header_bytes: header.len() as u64,
-        };
+        let est_rows = len_bytes.saturating_sub(header_bytes) as f64 / bytes_per_row;
+        let source = Source::Csv { header_bytes };
         Ok((columns, source, est_rows))
     }
 
@@ -354,6 +386,14 @@ impl LogFile {
         progress: &mut dyn FnMut(f64),
         sink: &mut dyn RowSink,
     ) -> Result<u64, LogError> {
+        if let (None, Some(rate_hz)) = (self.columns.of(Column::Time), self.columns.sample_rate_hz) {
+            let mut clocked = Clocked {
+                sink,
+                next: 0,
+                rate_hz,
+            };
+            return self.rows_in_order(progress, &mut clocked);
+        }
         if self.columns.time != TimeKind::Plain {
             let mut from_first = FromFirstRow {
                 sink,
@@ -437,8 +477,15 @@ fn channels_of(columns: &ColumnMap) -> Channels {
     }
 }
 
-/// Parses the header line (CSV quoting allowed, names trimmed) into the column map.
-fn parse_header(line: &[u8], shown: &str, mapping: &ColumnMapping) -> Result<ColumnMap, LogError> {
+/// Parses the header line (CSV quoting allowed, names trimmed) into the column map; true
+/// with it when line 1 is a header. A first line of numbers is data when `[columns]` maps
+/// the channels by their place (a file without a header row); without such a mapping it
+/// is refused with the table to write.
+fn parse_header(
+    line: &[u8],
+    shown: &str,
+    mapping: &ColumnMapping,
+) -> Result<(ColumnMap, bool), LogError> {
     let mut rdr = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .has_headers(false)
@@ -474,16 +521,24 @@ fn parse_header(line: &[u8], shown: &str, mapping: &ColumnMapping) -> Result<Col
             });
         }
     }
-    if rec.get(0).is_some_and(|h| h.parse::<f64>().is_ok()) {
+    let numbers = rec.get(0).is_some_and(|h| h.parse::<f64>().is_ok());
+    if numbers && !mapping.by_position() {
         return Err(LogError::NotALog {
             path: shown.to_string(),
-            why: "line 1 holds numbers: it must be the header naming the columns (t_s, ia_A, ib_A, ic_A, ...)".to_string(),
+            why: format!(
+                "line 1 holds numbers: the file has no header row naming the columns; say which of its {} fields is which, by place, in the parameter file's [columns] table, and the sample rate if no field is the time, e.g. t_s = {{ sample_rate_hz = 1000.0 }}, ia_A = {{ column = 1 }}, ib_A = {{ column = 2 }}, ic_A = {{ column = 3 }} (docs/design.md)",
+                rec.len()
+            ),
         });
     }
-    let found: Vec<String> = rec.iter().map(str::to_string).collect();
+    let found: Vec<String> = if numbers {
+        (1..=rec.len()).map(|k| format!("column {k}")).collect()
+    } else {
+        rec.iter().map(str::to_string).collect()
+    };
     let map = ColumnMap::locate(&found, mapping, shown)?;
     check_columns(&map, shown, true, mapping, &found)?;
-    Ok(map)
+    Ok((map, !numbers))
 }
 
 /// The columns every log needs, in every format: `t_s` (unless `need_time` is false: a
@@ -502,8 +557,11 @@ pub(super) fn check_columns(
 ) -> Result<(), LogError> {
     let missing =
         |c: Column, why: &str| super::mapping::missing_column(shown, c, mapping, found, why);
-    if need_time && map.of(Column::Time).is_none() {
-        return Err(missing(Column::Time, "every analysis needs the time"));
+    if need_time && map.of(Column::Time).is_none() && map.sample_rate_hz.is_none() {
+        return Err(missing(
+            Column::Time,
+            "every analysis needs the time: a time column, or the sample rate of a log without one, t_s = { sample_rate_hz = ... }",
+        ));
     }
     for c in [Column::Ia, Column::Ib, Column::Ic] {
         if map.of(c).is_none() {

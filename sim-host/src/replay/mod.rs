@@ -29,6 +29,7 @@ mod report;
 mod sequences;
 mod temperature;
 mod unsettled;
+mod winding;
 
 use report::timeline_point;
 
@@ -48,14 +49,17 @@ pub use report::{
     BaselineSource, Detection, DiagnoseReport, MonitorState, Panel, TimelinePoint, UnbalanceReport,
     Verdict,
 };
+pub use sequences::{SequenceWindow, WINDOW_PERIODS};
 pub use temperature::TemperatureReport;
+pub use winding::{
+    segments, HealthyReference, OperatingPointSource, SequenceSegment, DEFAULT_SPREAD_CURRENTS,
+    DEFAULT_SPREAD_VOLTAGES, LEAST_CHANGE_SPREADS, NO_BASELINE_SPREAD,
+};
 
 use crate::log::{Channels, LogError, Row};
 use crate::params::ParamFile;
 use commission::CommissionTracker;
 use isolation::IsolationTracker;
-use monitor_core::angle::SrfPll;
-use monitor_core::sequence::{SequenceAnalyzer, ZeroSequence};
 use monitor_core::{
     Abc, AngleSource, CommissioningState, ConfigError, Isolator, Monitor, MonitorConfig,
     MonitorOutput, ResidualForm, Sample,
@@ -119,7 +123,7 @@ pub struct ReplayOptions {
     /// The healthy machine's negative sequence to judge the winding against (`diagnose
     /// --baseline HEALTHY.csv`); without it, the one learned in the commissioning window,
     /// else none ([`UnbalanceBaseline`]).
-    pub unbalance_baseline: Option<UnbalanceBaseline>,
+    pub unbalance_baseline: Option<HealthyReference>,
     /// What is known of the load ([`LoadModel`]; `diagnose --load`).
     pub load: LoadModel,
 }
@@ -294,7 +298,6 @@ pub struct Replay {
     channels: Channels,
     commission: CommissionTracker,
     k_sigma: f32,
-    i_max: f64,
     rows: u64,
     evaluated: bool,
     /// A detection happened inside the commissioned operating range (or without one).
@@ -308,21 +311,8 @@ pub struct Replay {
     last: MonitorOutput,
     t0: Option<f64>,
     isolation: IsolationTracker,
-    // Current-only unbalance analysis.
-    pll: SrfPll,
-    seq: SequenceAnalyzer,
-    seq_v: SequenceAnalyzer,
-    /// Zero sequences of the measured currents and voltages (per-phase sensor redundancy).
-    zero_i: ZeroSequence,
-    zero_v: ZeroSequence,
-    /// The negative sequence at the end of the commissioning window (the latest while
-    /// learning).
-    learned_unbalance: Option<UnbalanceBaseline>,
-    v_max: f64,
-    /// The sequence analysis' PLL follows the voltages (else the currents).
-    pll_on_voltage: bool,
-    /// Time of the last row the sequence analysis saw [s].
-    seq_t: Option<f64>,
+    /// The symmetrical components, sample by sample ([`sequences::SequenceTracker`]).
+    sequences: sequences::SequenceTracker,
     /// The monitor's count of timing faults (estimator restarts) at the last row.
     timing_faults_seen: u32,
     /// The isolation ignores points until this time [s] (the settling after a restart).
@@ -365,7 +355,6 @@ impl Replay {
             cfg.validate().map_err(config_error)?;
             None
         };
-        let dt = (1.0 / sample_rate_hz) as f32;
         Ok(Replay {
             monitor,
             sampler: LogSampler::default(),
@@ -374,7 +363,6 @@ impl Replay {
             channels,
             commission: CommissionTracker::new(opts.commission, &cfg),
             k_sigma: cfg.thresholds.k_sigma,
-            i_max: f64::from(cfg.limits.i_max),
             rows: 0,
             evaluated: false,
             detected_in_range: false,
@@ -396,28 +384,13 @@ impl Replay {
                 channels.temperature,
                 opts.load,
             ),
-            // Locks to the voltage vector where logged (normalised by its nominal peak), else
-            // to the current vector (normalised by the no-load, magnetising, current peak).
-            pll: SrfPll::new(
-                dt,
-                params.supply.f_hz as f32,
-                10.0,
-                if channels.voltages {
-                    params.supply.v_phase_peak() as f32
-                } else {
-                    (params.supply.v_phase_peak()
-                        / (params.supply.omega_rad_s() * params.motor.ls_h))
-                        as f32
-                },
+            sequences: sequences::SequenceTracker::new(
+                params,
+                channels.voltages,
+                sample_rate_hz,
+                f64::from(cfg.limits.i_max),
+                f64::from(cfg.limits.v_max),
             ),
-            seq: SequenceAnalyzer::new(2.0, dt),
-            seq_v: SequenceAnalyzer::new(2.0, dt),
-            zero_i: ZeroSequence::new(2.0, dt),
-            zero_v: ZeroSequence::new(2.0, dt),
-            learned_unbalance: None,
-            v_max: f64::from(cfg.limits.v_max),
-            pll_on_voltage: channels.voltages,
-            seq_t: None,
             timing_faults_seen: 0,
             isolation_hold_until: f64::NEG_INFINITY,
             unsettled: unsettled::Unsettled::default(),
@@ -430,7 +403,9 @@ impl Replay {
         self.rows += 1;
         let t0 = *self.t0.get_or_insert(row.t_s);
         let t = row.t_s - t0;
-        self.track_sequences(row, t);
+        let learning = matches!(self.last.commissioning, CommissioningState::Learning(_));
+        let wr = self.monitor.as_ref().map(|_| self.last.operating.wr_rad_s);
+        self.sequences.track(row, t, learning, wr);
         let Some(mon) = self.monitor.as_mut() else {
             return self.last;
         };
@@ -466,7 +441,7 @@ impl Replay {
             self.evaluated,
             self.commission.thresholds_trusted(&out),
         );
-        let point = self.steady_point(&out);
+        let point = self.sequences.steady_point(out.operating.wr_rad_s);
         // After a restart of the monitor's estimators (a long gap, a clock reset) the
         // isolation waits out the monitor's settling time too: the restarted frame's
         // vectors look steady before they are right.
@@ -483,9 +458,6 @@ impl Replay {
             counts && settled,
             row.t_winding_c,
         );
-        if matches!(out.commissioning, CommissioningState::Learning(_)) {
-            self.learned_unbalance = Some(self.unbalance_ratios().0);
-        }
         if out.fault_detected && counts {
             // A detection counts as one inside the commissioned range only while the lamps
             // are evaluated (quasi-steady) and a lit lamp's residual is outside its band: a

@@ -189,8 +189,28 @@ pub struct UnbalanceReport {
     pub supply_ratio: f32,
     /// |V2|/|V1| (null without voltage columns).
     pub voltage_negative_sequence_ratio: Option<f32>,
-    /// The model correction arg Z1 (the power-factor angle, shorted turns) used [deg].
+    /// The reference angle arg Z1 (the power-factor angle, shorted turns) used [deg].
     pub correction_deg: f32,
+    /// Its uncertainty [deg] (it widens the phase's confidence).
+    pub correction_uncertainty_deg: f32,
+    /// Where the reference angle comes from (null when nothing was judged).
+    pub operating_point: Option<super::OperatingPointSource>,
+    /// The slip the reference angle was taken at, where one was used.
+    pub slip: Option<f32>,
+    /// The least change of the winding's negative sequence (fraction of |I1|) that may
+    /// name a phase: twice the healthy reference's spread.
+    pub least_change: f32,
+    /// The spread the change is judged with (each component, fraction of |I1|): the
+    /// healthy reference's and the judged segment's own.
+    pub spread: f32,
+    /// How many healthy runs `--baseline` gave (0: none).
+    pub baseline_runs: u32,
+    /// Their RMS distance from their mean (`|I2/I1|` units), null for fewer than two.
+    pub baseline_spread: Option<f32>,
+    /// Index into `segments` of the one judged (the largest change), null without one.
+    pub judged_segment: Option<usize>,
+    /// The log's steady stretches of negative sequence, in time order.
+    pub segments: Vec<super::SequenceSegment>,
     /// One phase's current sensor with a gain error, from the zero sequence of the three
     /// measured currents (zero for a star without neutral, whatever the machine does), or
     /// null; its part of the negative sequence is taken out before a winding is blamed.
@@ -293,8 +313,10 @@ pub enum Verdict {
 impl Replay {
     /// Ends the replay and builds the report (`data_quality` left at its default for the
     /// caller to fill).
-    pub fn finish(self) -> DiagnoseReport {
+    pub fn finish(mut self) -> DiagnoseReport {
         let out = self.last;
+        self.sequences
+            .finish(self.monitor.as_ref().map(|_| out.operating.wr_rad_s));
         let mut skipped = Vec::new();
         if !self.channels.voltages {
             skipped.push(
@@ -307,7 +329,7 @@ impl Replay {
                     .to_string(),
             );
         }
-        let unbalance = self.unbalance_report(&out);
+        let unbalance = self.unbalance_report();
         let mut signature_candidates: Vec<FaultCandidate> = Fault::ALL
             .iter()
             .zip(out.diagnosis.probabilities)

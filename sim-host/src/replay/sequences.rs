@@ -1,71 +1,297 @@
-//! The replay's sequence analysis: a PLL on the voltages (else the currents), the positive,
-//! negative and zero sequences of the currents and voltages, one phase's sensor gain error,
-//! and the negative-sequence report ([`UnbalanceReport`]).
+//! The replay's sequence tracker ([`SequenceTracker`]): the symmetrical components of the
+//! currents and voltages, sample by sample.
+//!
+//! Two analyses run on one PLL (locked to the voltages where logged, else to the
+//! amplitude-normalised current vector):
+//! - filtered Park sequences ([`SequenceAnalyzer`], 2 Hz) on the PLL's own angle: the
+//!   steady point the isolation evaluates ([`SequenceTracker::steady_point`]);
+//! - least-squares phasors ([`PhasorFit`]) over windows of [`WINDOW_PERIODS`] supply
+//!   periods on a reference angle that turns at the PLL's frequency low-passed at
+//!   [`REFERENCE_FC_HZ`]: the negative-sequence analysis ([`super::winding`]). The
+//!   reference does not follow the `2f` wobble that a large negative sequence puts into the
+//!   current vector's angle (a PLL that follows it moves part of the negative sequence into
+//!   the angle: on real recordings of shorted turns a 15 % negative sequence read as
+//!   2.4 %), and the fit is exact for any offset of it.
 
-use super::report::BaselineSource;
-use super::{
-    Replay, SensorPhaseReport, UnbalanceBaseline, UnbalanceReport, BASELINE_I1_TOLERANCE,
-    FILLED_SAMPLES, SENSOR_PHASE_MIN_RATIO,
-};
+use super::{FILLED_SAMPLES, SENSOR_PHASE_MIN_RATIO};
 use crate::log::quality::MAX_BRIDGED_GAP_S;
 use crate::log::Row;
+use crate::params::ParamFile;
+use monitor_core::angle::SrfPll;
+use monitor_core::filter::Svf;
 use monitor_core::frames::{clarke, park, AlphaBeta, SinCos};
 use monitor_core::sequence::{
-    asymmetry_correction_rad, single_phase_gain, slip_for_current, winding_asymmetry,
-    SinglePhaseGain, INHERENT_ASYMMETRY_RATIO,
+    single_phase_gain, PhasorFit, SequenceAnalyzer, SinglePhaseGain, ThreePhasors, ZeroSequence,
 };
+use monitor_core::Abc;
 use monitor_core::SteadyPoint as IsolationPoint;
-use monitor_core::{Abc, CommissioningState, MonitorOutput};
 
-impl Replay {
-    /// The sequence analysis of every log (the monitor's own runs on its frame without the
-    /// voltages' negative sequence): a PLL locked to the current vector, the currents' and,
-    /// where logged, the voltages' positive and negative sequences on its angle. A row with
-    /// a bad current is skipped (the monitor holds such samples out itself); a bad voltage
-    /// leaves the voltages' analysis alone.
-    pub(super) fn track_sequences(&mut self, row: &Row, t: f64) {
-        // Samples missing from the stream: the PLL's angle advances over the missing time
-        // at its frequency (as the monitor's frame does), so that the sequences stay put.
+/// Supply periods per least-squares window (at the nominal frequency): 0.17 s at 60 Hz,
+/// 0.2 s at 50 Hz. Short enough to see a fault switched on and off within a few seconds,
+/// long enough that harmonics and noise average out.
+pub const WINDOW_PERIODS: f64 = 10.0;
+
+/// Corner of the low-pass on the PLL's frequency that the least-squares reference turns at
+/// [Hz]: a second-order filter that passes `2f` wobble at `(1/(2f))^2` (7e-5 at 60 Hz).
+pub const REFERENCE_FC_HZ: f32 = 1.0;
+
+/// Largest change of the reference frequency within a window for the window to count as
+/// steady (a fraction of its mean): above it the supply frequency moved (a run-up, a
+/// drive's ramp) or the PLL was still locking.
+pub const STEADY_FREQUENCY_RANGE: f32 = 0.005;
+
+/// Least share of a window's samples the fit must have used (bad samples are held out).
+pub const MIN_WINDOW_FILL: f64 = 0.8;
+
+/// One window of the least-squares analysis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SequenceWindow {
+    /// Time of the window's first and last sample [s since the log's first row].
+    pub from_s: f64,
+    /// See `from_s`.
+    pub to_s: f64,
+    /// The currents' phase phasors.
+    pub i: ThreePhasors,
+    /// The voltages' phase phasors, where logged and good in the whole window.
+    pub v: Option<ThreePhasors>,
+    /// Mean supply angular frequency over the window [rad/s].
+    pub we_rad_s: f32,
+    /// Mean over the window of the reference angle less `w0 t` (the nominal frequency's
+    /// angle), unwrapped [rad]: how far the reference turned from a fixed-frequency frame,
+    /// so that windows can be put into one frame ([`SequenceWindow::offset_rad`]).
+    pub offset_rad: f64,
+    /// The monitor's electrical rotor speed at the window's end [rad/s], where the log
+    /// has a speed (encoder or speed column).
+    pub wr_rad_s: Option<f32>,
+    /// The fit used at least [`MIN_WINDOW_FILL`] of the window's samples.
+    pub complete: bool,
+    /// Complete, and the supply frequency held still.
+    pub steady: bool,
+    /// The window lies in the commissioning window's learning.
+    pub learning: bool,
+}
+
+/// The window being filled.
+#[derive(Debug, Clone, Copy)]
+struct OpenWindow {
+    fit_i: PhasorFit,
+    fit_v: PhasorFit,
+    /// Samples offered (good or not).
+    offered: u32,
+    /// Voltage samples that were bad (the voltages' fit is then not used).
+    bad_v: u32,
+    from_s: f64,
+    to_s: f64,
+    w_sum: f64,
+    offset_sum: f64,
+    w_min: f32,
+    w_max: f32,
+    learning: bool,
+}
+
+impl OpenWindow {
+    fn new() -> Self {
+        OpenWindow {
+            fit_i: PhasorFit::new(),
+            fit_v: PhasorFit::new(),
+            offered: 0,
+            bad_v: 0,
+            from_s: 0.0,
+            to_s: 0.0,
+            w_sum: 0.0,
+            offset_sum: 0.0,
+            w_min: f32::INFINITY,
+            w_max: 0.0,
+            learning: true,
+        }
+    }
+}
+
+/// The sequences of every log, sample by sample (module docs).
+#[derive(Debug, Clone)]
+pub(super) struct SequenceTracker {
+    dt_s: f64,
+    i_max: f64,
+    v_max: f64,
+    voltages: bool,
+    /// The PLL follows the voltages (else the normalised currents).
+    pll_on_voltage: bool,
+    pll: SrfPll,
+    /// Mean square of the current vector, low-passed: the currents' normaliser for the PLL.
+    i_ms: Svf,
+    seq: SequenceAnalyzer,
+    seq_v: SequenceAnalyzer,
+    zero_i: ZeroSequence,
+    zero_v: ZeroSequence,
+    /// Time of the last row seen [s].
+    last_t: Option<f64>,
+    /// The PLL's frequency low-passed (`y`) and the reference angle it turns [rad].
+    w_ref: Svf,
+    theta_ref: f32,
+    /// The reference angle less `w0 t`, unwrapped [rad], and `w0` [rad/s].
+    offset: f64,
+    w0: f64,
+    /// Samples per least-squares window.
+    window_len: u32,
+    open: OpenWindow,
+    windows: Vec<SequenceWindow>,
+}
+
+impl SequenceTracker {
+    /// A tracker for a log at `sample_rate_hz` with (or without) voltage columns; the
+    /// sample limits `i_max`, `v_max` are the monitor's.
+    pub fn new(
+        params: &ParamFile,
+        voltages: bool,
+        sample_rate_hz: f64,
+        i_max: f64,
+        v_max: f64,
+    ) -> Self {
+        let dt = (1.0 / sample_rate_hz) as f32;
+        let f0 = params.supply.f_hz as f32;
+        let mut w_ref = Svf::new(REFERENCE_FC_HZ, dt);
+        w_ref.y = core::f32::consts::TAU * f0;
+        SequenceTracker {
+            dt_s: 1.0 / sample_rate_hz,
+            i_max,
+            v_max,
+            voltages,
+            pll_on_voltage: voltages,
+            // Locks to the voltage vector where logged (normalised by its nominal peak),
+            // else to the current vector normalised by its own RMS magnitude (so that the
+            // loop's gain holds whatever the currents' scale).
+            pll: SrfPll::new(
+                dt,
+                f0,
+                10.0,
+                if voltages {
+                    params.supply.v_phase_peak() as f32
+                } else {
+                    1.0
+                },
+            ),
+            i_ms: Svf::new(2.0, dt),
+            seq: SequenceAnalyzer::new(2.0, dt),
+            seq_v: SequenceAnalyzer::new(2.0, dt),
+            zero_i: ZeroSequence::new(2.0, dt),
+            zero_v: ZeroSequence::new(2.0, dt),
+            last_t: None,
+            w_ref,
+            theta_ref: 0.0,
+            offset: 0.0,
+            w0: std::f64::consts::TAU * params.supply.f_hz,
+            window_len: ((WINDOW_PERIODS * sample_rate_hz / params.supply.f_hz).round() as u32)
+                .max(monitor_core::sequence::PHASOR_FIT_MIN_SAMPLES),
+            open: OpenWindow::new(),
+            windows: Vec::new(),
+        }
+    }
+
+    /// Feeds one row at `t` [s since the first row]; `learning`: the monitor is learning
+    /// its commissioning window; `wr_rad_s`: the monitor's electrical rotor speed where the
+    /// log has one. A row with a bad current is held out (the monitor holds such samples
+    /// out itself); a bad voltage leaves the voltages' analysis alone.
+    pub fn track(&mut self, row: &Row, t: f64, learning: bool, wr_rad_s: Option<f32>) {
+        // Samples missing from the stream: the angles advance over the missing time at
+        // their frequency (as the monitor's frame does), so that the sequences stay put.
         let mut filled = 0usize;
-        if let Some(prev) = self.seq_t.replace(t) {
+        if let Some(prev) = self.last_t.replace(t) {
             let missing = t - prev - self.dt_s;
             if missing > 0.5 * self.dt_s && missing <= MAX_BRIDGED_GAP_S {
                 self.pll.skip(missing as f32);
+                self.theta_ref = monitor_core::frames::wrap_angle(
+                    self.theta_ref + self.w_ref.y * missing as f32,
+                );
+                self.offset += (f64::from(self.w_ref.y) - self.w0) * missing;
                 let m = (missing / self.dt_s).round();
                 if m <= FILLED_SAMPLES as f64 {
                     filled = m as usize;
                 }
+            } else if missing > MAX_BRIDGED_GAP_S {
+                // A gap the data-quality stage does not bridge: the window ends there.
+                self.close_window(wr_rad_s);
             }
         }
+        self.theta_ref =
+            monitor_core::frames::wrap_angle(self.theta_ref + self.w_ref.y * self.dt_s as f32);
+        self.offset += (f64::from(self.w_ref.y) - self.w0) * self.dt_s;
+        self.offer_window_sample(t, learning);
         let ok = |x: &[f64; 3], max: f64| x.iter().all(|v| v.is_finite() && v.abs() <= max);
-        if !ok(&row.i_abc, self.i_max) {
-            return;
-        }
         let abc = |x: &[f64; 3]| Abc {
             a: x[0] as f32,
             b: x[1] as f32,
             c: x[2] as f32,
         };
-        let i_abc = abc(&row.i_abc);
+        if ok(&row.i_abc, self.i_max) {
+            let i_abc = abc(&row.i_abc);
+            let v_abc = row
+                .v_abc
+                .as_ref()
+                .filter(|v| self.voltages && ok(v, self.v_max))
+                .map(abc);
+            if self.voltages && v_abc.is_none() {
+                self.open.bad_v += 1;
+            }
+            self.filtered(i_abc, v_abc, filled);
+            let sc = SinCos::from_angle(self.theta_ref);
+            self.open.fit_i.update(sc, i_abc);
+            if let Some(v) = v_abc {
+                self.open.fit_v.update(sc, v);
+            }
+        }
+        if self.open.offered >= self.window_len {
+            self.close_window(wr_rad_s);
+        }
+    }
+
+    /// Counts a sample into the open window (its time span, the reference's frequency).
+    fn offer_window_sample(&mut self, t: f64, learning: bool) {
+        let w = self.w_ref.y;
+        let o = &mut self.open;
+        if o.offered == 0 {
+            o.from_s = t;
+        }
+        o.offered += 1;
+        o.to_s = t;
+        o.w_sum += f64::from(w);
+        o.offset_sum += self.offset;
+        o.w_min = o.w_min.min(w);
+        o.w_max = o.w_max.max(w);
+        o.learning &= learning;
+    }
+
+    /// The PLL and the filtered sequences (the isolation's steady point); the reference
+    /// frequency follows the PLL's.
+    fn filtered(&mut self, i_abc: Abc, v_abc: Option<Abc>, filled: usize) {
         let i = clarke(i_abc);
-        let v_abc = row
-            .v_abc
-            .as_ref()
-            .filter(|v| self.channels.voltages && ok(v, self.v_max))
-            .map(abc);
         let v = v_abc.map(clarke);
         let sc = SinCos::from_angle(self.pll.theta_pll());
-        // Locked to the voltages where logged: a winding asymmetry puts tens of per cent of
-        // negative sequence into the currents, whose 2f ripple would wobble the angle; the
-        // supply's own unbalance is a few per cent.
         match v {
-            Some(v) if self.pll_on_voltage => self.pll.update(v, sc),
-            _ => self.pll.update(i, sc),
-        };
+            Some(v) if self.pll_on_voltage => {
+                self.pll.update(v, sc);
+            }
+            _ => {
+                let m2 = i.alpha * i.alpha + i.beta * i.beta;
+                if self.i_ms.y <= 0.0 {
+                    // The first good sample: the loop starts on the current vector.
+                    self.i_ms.y = m2;
+                    self.pll.align(i.beta.atan2(i.alpha));
+                }
+                self.i_ms.update(m2);
+                let k = 1.0 / monitor_core::sqrt(self.i_ms.y.max(1e-12));
+                self.pll.update(
+                    AlphaBeta {
+                        alpha: i.alpha * k,
+                        beta: i.beta * k,
+                    },
+                    sc,
+                );
+            }
+        }
+        self.w_ref.update(self.pll.omega_rad_s());
         // A few missing samples: the sequence filters get the vectors turned back to the
         // missing instants (a filter that skips a sample of the other sequence's 2f image
-        // keeps an error of about that sample's share: 0.1 % of samples dropped at random
-        // read as a 0.15 % voltage unbalance, enough to name a winding).
+        // keeps an error of about that sample's share).
         let w_dt = self.pll.omega_rad_s() * self.dt_s as f32;
         for j in (1..=filled).rev() {
             let back = SinCos::from_angle(j as f32 * w_dt);
@@ -90,176 +316,68 @@ impl Replay {
         }
     }
 
-    /// One phase's sensor gain error in the currents and in the voltages (the zero
-    /// sequence, [`single_phase_gain`]), evidence from [`SENSOR_PHASE_MIN_RATIO`] on.
-    fn sensor_phases(&self) -> (Option<SinglePhaseGain>, Option<SinglePhaseGain>) {
-        let current = single_phase_gain(
-            self.seq.positive(),
-            self.seq.negative(),
-            self.zero_i.phasor(),
-            SENSOR_PHASE_MIN_RATIO,
-        );
-        let voltage = self
-            .channels
-            .voltages
-            .then(|| {
-                single_phase_gain(
-                    self.seq_v.positive(),
-                    self.seq_v.negative(),
-                    self.zero_v.phasor(),
-                    SENSOR_PHASE_MIN_RATIO,
-                )
-            })
-            .flatten();
-        (current, voltage)
+    /// Ends the open window: solves its fits and keeps it (when it has a solution).
+    fn close_window(&mut self, wr_rad_s: Option<f32>) {
+        let o = std::mem::replace(&mut self.open, OpenWindow::new());
+        if o.offered == 0 {
+            return;
+        }
+        let Some(i) = o.fit_i.solve() else {
+            return;
+        };
+        let w_mean = (o.w_sum / f64::from(o.offered)) as f32;
+        let complete = f64::from(i.samples) >= MIN_WINDOW_FILL * f64::from(self.window_len);
+        let steady =
+            complete && w_mean > 0.0 && (o.w_max - o.w_min) <= STEADY_FREQUENCY_RANGE * w_mean;
+        self.windows.push(SequenceWindow {
+            from_s: o.from_s,
+            to_s: o.to_s,
+            i,
+            v: (self.voltages && o.bad_v == 0)
+                .then(|| o.fit_v.solve())
+                .flatten(),
+            we_rad_s: w_mean,
+            offset_rad: o.offset_sum / f64::from(o.offered),
+            wr_rad_s,
+            complete,
+            steady,
+            learning: o.learning,
+        });
+    }
+
+    /// Ends the analysis: the last window, if it holds at least half a window's samples.
+    pub fn finish(&mut self, wr_rad_s: Option<f32>) {
+        if f64::from(self.open.offered) >= 0.5 * f64::from(self.window_len) {
+            self.close_window(wr_rad_s);
+        }
+    }
+
+    /// The least-squares windows so far (the open one left out).
+    pub fn windows(&self) -> &[SequenceWindow] {
+        &self.windows
     }
 
     /// The steady-state vectors for the isolation: the positive sequences of voltage and
-    /// current on the sequence analysis' angle, its PLL's frequency, and the monitor's
-    /// electrical speed (encoder, filtered).
-    pub(super) fn steady_point(&self, out: &MonitorOutput) -> IsolationPoint {
+    /// current on the PLL's angle, its frequency, and the monitor's electrical speed
+    /// `wr_rad_s` (encoder, filtered).
+    pub fn steady_point(&self, wr_rad_s: f32) -> IsolationPoint {
         let (v, i) = (self.seq_v.positive(), self.seq.positive());
         IsolationPoint {
             i: monitor_core::Dq { d: i.0, q: i.1 },
             v: monitor_core::Dq { d: v.0, q: v.1 },
             we_rad_s: self.pll.omega_rad_s(),
-            wr_rad_s: out.operating.wr_rad_s,
+            wr_rad_s,
         }
     }
+}
 
-    /// The negative-sequence report: the core's one faulty-phase method
-    /// ([`monitor_core::sequence::winding_asymmetry`]) with the supply's own unbalance taken
-    /// out where voltages are logged. The slip is the monitor's (encoder) where it runs,
-    /// else the equivalent circuit's for the measured current magnitude
-    /// ([`slip_for_current`]).
-    /// The sensor-corrected `I2/I1` and `V2/I1` (module docs of
-    /// [`monitor_core::sequence`]), with the sensors found wrong on one phase.
-    pub(super) fn unbalance_ratios(
-        &self,
-    ) -> (
-        UnbalanceBaseline,
-        Option<SinglePhaseGain>,
-        Option<SinglePhaseGain>,
-    ) {
-        let p = self.seq.positive();
-        let p2 = p.0 * p.0 + p.1 * p.1;
-        let over_i1 = |x: (f32, f32)| {
-            if p2 > 0.0 {
-                [(x.0 * p.0 + x.1 * p.1) / p2, (x.1 * p.0 - x.0 * p.1) / p2]
-            } else {
-                [0.0, 0.0]
-            }
-        };
-        // A sensor's own negative sequence is not the winding's (nor the supply's).
-        let (gi, gv) = self.sensor_phases();
-        let neg_i = gi.map_or(self.seq.negative(), |g| {
-            g.corrected_negative(p, self.seq.negative(), self.zero_i.phasor())
-        });
-        let neg_v = gv.map_or(self.seq_v.negative(), |g| {
-            g.corrected_negative(
-                self.seq_v.positive(),
-                self.seq_v.negative(),
-                self.zero_v.phasor(),
-            )
-        });
-        // With one voltage sensor wrong, the voltages' negative sequence (corrected or not:
-        // the analysis' PLL locked to the wrong readings leaves a few tenths of a per cent)
-        // cannot say how much of I2 the supply drives: the currents alone judge the winding.
-        let ratios = UnbalanceBaseline {
-            i2_over_i1: over_i1(neg_i),
-            v2_over_i1: (self.channels.voltages && gv.is_none()).then(|| over_i1(neg_v)),
-            i1_peak_a: self.seq.positive_magnitude(),
-        };
-        (ratios, gi, gv)
-    }
-
-    pub(super) fn unbalance_report(&self, out: &MonitorOutput) -> UnbalanceReport {
-        let m = self.params.motor.model();
-        let omega = self.pll.omega_rad_s();
-        let we = if omega > 1.0 {
-            omega
-        } else {
-            self.params.supply.omega_rad_s() as f32
-        };
-        let (measured, gi, gv) = self.unbalance_ratios();
-        // The commissioning window's only once it was learned, and only at about its
-        // operating point: a motor's own asymmetry gives an I2/I1 that moves with the slip.
-        let i1 = self.seq.positive_magnitude();
-        let learned = self.learned_unbalance.filter(|b| {
-            matches!(out.commissioning, CommissioningState::Commissioned)
-                && (i1 - b.i1_peak_a).abs() <= BASELINE_I1_TOLERANCE * b.i1_peak_a
-        });
-        let (base, base_name) = match (self.opts.unbalance_baseline, learned) {
-            (Some(b), _) => (Some(b), Some(BaselineSource::File)),
-            (None, Some(b)) => (Some(b), Some(BaselineSource::Commissioning)),
-            (None, None) => (None, None),
-        };
-        let minus = |x: [f32; 2], b: Option<[f32; 2]>| {
-            let b = b.unwrap_or([0.0; 2]);
-            (x[0] - b[0], x[1] - b[1])
-        };
-        let i2 = minus(measured.i2_over_i1, base.map(|b| b.i2_over_i1));
-        let v2 = measured
-            .v2_over_i1
-            .map(|v| minus(v, base.and_then(|b| b.v2_over_i1)));
-        let slip = if self.monitor.is_some() {
-            1.0 - out.operating.wr_rad_s / we
-        } else {
-            let v_pk = if self.channels.voltages {
-                self.seq_v.positive_magnitude()
-            } else {
-                self.params.supply.v_phase_peak() as f32
-            };
-            slip_for_current(&m, v_pk, we, self.seq.positive_magnitude())
-        };
-        // A current-only log locks the analysis' PLL to the currents: one wrong current
-        // sensor's negative sequence (g/3 of I1) wobbles the angle at 2f and leaves about
-        // g^2/3 in I2 after the correction (measured: 0.7 % for g = -15 % at 1 kHz), so a
-        // winding is named only above that.
-        let min_ratio = match gi {
-            Some(g) if !self.pll_on_voltage => 0.005f32.max(0.5 * g.gain_error * g.gain_error),
-            _ => 0.005,
-        };
-        // Without a healthy baseline nothing tells the winding's part from the machine's own
-        // build asymmetry and the sensors' mismatch (nor, without voltages, from the
-        // supply's): below a healthy machine's inherent asymmetry the phase is not judged.
-        let inherent = base.is_none();
-        let min_ratio = if inherent {
-            min_ratio.max(INHERENT_ASYMMETRY_RATIO)
-        } else {
-            min_ratio
-        };
-        let w = winding_asymmetry(i2, v2, &m, we, slip, min_ratio);
-        let phase_not_judged = (inherent && w.suspect_phase.is_none() && w.ratio >= 0.005)
-            .then(|| {
-                format!(
-                    "cannot judge the phase: the winding's part of the negative sequence ({:.1} % of I1) is within a healthy machine's own asymmetry ({:.0} %) and there is no healthy baseline (give --baseline with a healthy log of this motor, or commission)",
-                    100.0 * w.ratio,
-                    100.0 * INHERENT_ASYMMETRY_RATIO
-                )
-            });
-        UnbalanceReport {
-            negative_sequence_ratio: monitor_core::fast_hypot(
-                measured.i2_over_i1[0],
-                measured.i2_over_i1[1],
-            ),
-            suspect_phase: w.suspect_phase,
-            phase_confidence: w.phase_confidence,
-            phase_not_judged,
-            angle_deg: w.angle_rad.to_degrees(),
-            correction_deg: asymmetry_correction_rad(&m, we, slip).to_degrees(),
-            winding_ratio: w.ratio,
-            supply_ratio: w.supply_ratio,
-            voltage_negative_sequence_ratio: measured.v2_over_i1.map(|v| {
-                // |V2|/|V1| = |V2/I1| |I1|/|V1|
-                let i1 = self.seq.positive_magnitude();
-                monitor_core::fast_hypot(v[0], v[1]) * i1
-                    / self.seq_v.positive_magnitude().max(1e-9)
-            }),
-            current_sensor_phase: gi.as_ref().map(SensorPhaseReport::from),
-            voltage_sensor_phase: gv.as_ref().map(SensorPhaseReport::from),
-            measured,
-            baseline: base_name,
-        }
-    }
+/// One phase's sensor gain error in a set of phasors (the zero sequence,
+/// [`single_phase_gain`]), evidence from [`SENSOR_PHASE_MIN_RATIO`] on: `p`, `n`, `z` the
+/// positive, negative and zero sequences with one rotation.
+pub(super) fn sensor_phase(
+    p: (f32, f32),
+    n: (f32, f32),
+    z: (f32, f32),
+) -> Option<SinglePhaseGain> {
+    single_phase_gain(p, n, z, SENSOR_PHASE_MIN_RATIO)
 }

@@ -289,17 +289,77 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
         }
         events(&mut out, &rep.isolation)?;
     }
-    let u = &rep.unbalance;
+    unbalance(&mut out, &rep.unbalance)?;
+    for n in &rep.commissioning.outside_range {
+        writeln!(out, "note at {:.2} s: {}", n.t_s, n.note)?;
+    }
+    verdict(&mut out, rep)
+}
+
+/// Segments of the negative sequence the text report lists (the JSON has up to
+/// `sim_host::replay::winding::MAX_SEGMENTS`).
+const SEGMENTS_LISTED: usize = 8;
+
+/// The negative-sequence analysis: the whole log's ratio and phase, its steady stretches,
+/// and the winding's judgement in a sentence.
+fn unbalance(out: &mut impl Write, u: &sim_host::replay::UnbalanceReport) -> anyhow::Result<()> {
     writeln!(
         out,
         "unbalance: |I2|/|I1| = {:.2} %, suspect phase: {}",
         100.0 * u.negative_sequence_ratio,
         u.suspect_phase.map_or("none", Phase::name)
     )?;
-    for n in &rep.commissioning.outside_range {
-        writeln!(out, "note at {:.2} s: {}", n.t_s, n.note)?;
+    if u.segments.len() > 1 {
+        writeln!(out, "  steady stretches (least-squares phasors):")?;
+        for (k, s) in u.segments.iter().enumerate().take(SEGMENTS_LISTED) {
+            writeln!(
+                out,
+                "    {:>6.2}..{:<6.2} s  |I1| {:>7.3} A  I2/I1 {:>5.1} % at {:>4.0} deg{}",
+                s.from_s,
+                s.to_s,
+                s.i1_peak_a,
+                100.0 * s.negative_sequence_ratio,
+                s.angle_deg,
+                if u.judged_segment == Some(k) { "  <- judged" } else { "" }
+            )?;
+        }
+        if u.segments.len() > SEGMENTS_LISTED {
+            writeln!(out, "    ... {} more (--json lists them)", u.segments.len() - SEGMENTS_LISTED)?;
+        }
     }
-    verdict(&mut out, rep)
+    let against = match (u.baseline, u.baseline_runs) {
+        (Some(sim_host::replay::BaselineSource::File), 1) => "against 1 healthy run".to_string(),
+        (Some(sim_host::replay::BaselineSource::File), n) => format!(
+            "against the mean of {n} healthy runs (their spread {:.1} %)",
+            100.0 * u.baseline_spread.unwrap_or(0.0)
+        ),
+        (Some(sim_host::replay::BaselineSource::Commissioning), _) => {
+            "against the commissioning window".to_string()
+        }
+        (None, _) => "with no healthy baseline".to_string(),
+    };
+    let reference = u.operating_point.map(|o| {
+        format!(
+            "reference angle {:.0} +/- {:.0} deg, {}",
+            u.correction_deg,
+            u.correction_uncertainty_deg,
+            o.describe()
+        )
+    });
+    match (u.suspect_phase, &u.phase_not_judged) {
+        (Some(p), _) => writeln!(
+            out,
+            "winding: shorted turns in phase {} (confidence {:.2}): the negative sequence changed by {:.1} % of I1 {against}, least change {:.1} %; {}",
+            p.name(),
+            u.phase_confidence,
+            100.0 * u.winding_ratio,
+            100.0 * u.least_change,
+            reference.unwrap_or_default()
+        )?,
+        (None, Some(why)) => writeln!(out, "winding: {why}")?,
+        (None, None) => {}
+    }
+    Ok(())
 }
 
 /// Most load moves the text report lists (every name is listed; `--json` has up to

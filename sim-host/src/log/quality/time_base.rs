@@ -48,7 +48,9 @@ pub(in crate::log) fn median_positive(x: &mut Vec<f64>) -> Option<f64> {
     Some(x[x.len() / 2])
 }
 
-/// Zero crossings of one signal with hysteresis (a tenth of its recent peak): the
+/// Zero crossings of one signal with hysteresis (three tenths of its recent peak: a
+/// no-load current on a grid carries a 5th harmonic of a quarter of its fundamental, whose
+/// ripple crosses a tenth of the peak twice more per period): the
 /// periods between positive-going crossings.
 #[derive(Debug, Clone, Default)]
 pub(super) struct CrossingCounter {
@@ -70,7 +72,7 @@ impl CrossingCounter {
         let dt = self.last_t.map_or(0.0, |l| (t - l).max(0.0));
         self.last_t = Some(t);
         self.peak = (self.peak * (1.0 - dt / decay_s).max(0.0)).max(x.abs());
-        let h = 0.1 * self.peak;
+        let h = 0.3 * self.peak;
         let now = if x > h {
             Some(true)
         } else if x < -h {
