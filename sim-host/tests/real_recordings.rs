@@ -169,7 +169,11 @@ fn the_recordings_are_read_as_published_and_the_negative_sequence_is_exact() {
         let ls = least_squares_ratio(&currents, 1000.0, 59.0, 61.0);
         let ours = f64::from(judge(name, None).negative_sequence_ratio);
         let rel = (ours / ls - 1.0).abs();
-        eprintln!("{name}: least squares {:.2} %, diagnose {:.2} %", 100.0 * ls, 100.0 * ours);
+        eprintln!(
+            "{name}: least squares {:.2} %, diagnose {:.2} %",
+            100.0 * ls,
+            100.0 * ours
+        );
         worst = worst.max(rel);
         assert!(rel < 0.05, "{name}: {ours} against {ls}");
     }
@@ -188,7 +192,9 @@ fn without_its_columns_table_a_published_file_is_refused_with_the_table_to_write
     .expect_err("a headerless file without a mapping"); // ok: test
     let msg = e.to_string();
     assert!(
-        msg.contains("no header row") && msg.contains("sample_rate_hz") && msg.contains("column = 1"),
+        msg.contains("no header row")
+            && msg.contains("sample_rate_hz")
+            && msg.contains("column = 1"),
         "{msg}"
     );
 }
@@ -203,7 +209,9 @@ fn the_shorted_phase_is_named_against_the_healthy_runs() {
         };
         total += 1;
         let u = judge(&name, Some(base));
-        let got = u.suspect_phase.map(|p| p.name().chars().next().unwrap_or('?'));
+        let got = u
+            .suspect_phase
+            .map(|p| p.name().chars().next().unwrap_or('?'));
         eprintln!(
             "{name}: {got:?} confidence {:.2}, change {:.1} % at {:.0} deg, reference {:.0} +/- {:.0} deg{}",
             u.phase_confidence,
@@ -216,7 +224,10 @@ fn the_shorted_phase_is_named_against_the_healthy_runs() {
         if got == Some(phase) {
             right += 1;
         } else if got.is_some() && u.phase_confidence >= 0.5 {
-            failures.push(format!("{name}: wrong phase {got:?} at {:.2}", u.phase_confidence));
+            failures.push(format!(
+                "{name}: wrong phase {got:?} at {:.2}",
+                u.phase_confidence
+            ));
         }
     }
     eprintln!("shorted phase right in {right} of {total}");
@@ -236,7 +247,9 @@ fn without_a_baseline_no_recording_gets_a_wrong_phase() {
     let (mut right, mut cannot) = (0, 0);
     for name in recordings() {
         let u = judge(&name, None);
-        let got = u.suspect_phase.map(|p| p.name().chars().next().unwrap_or('?'));
+        let got = u
+            .suspect_phase
+            .map(|p| p.name().chars().next().unwrap_or('?'));
         match (shorted(&name), got) {
             (_, None) => {
                 assert!(u.phase_not_judged.is_some(), "{name}: say why");

@@ -386,7 +386,8 @@ impl LogFile {
         progress: &mut dyn FnMut(f64),
         sink: &mut dyn RowSink,
     ) -> Result<u64, LogError> {
-        if let (None, Some(rate_hz)) = (self.columns.of(Column::Time), self.columns.sample_rate_hz) {
+        if let (None, Some(rate_hz)) = (self.columns.of(Column::Time), self.columns.sample_rate_hz)
+        {
             let mut clocked = Clocked {
                 sink,
                 next: 0,

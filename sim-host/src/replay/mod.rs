@@ -53,7 +53,7 @@ pub use sequences::{SequenceWindow, WINDOW_PERIODS};
 pub use temperature::TemperatureReport;
 pub use winding::{
     segments, HealthyReference, OperatingPointSource, SequenceSegment, DEFAULT_SPREAD_CURRENTS,
-    DEFAULT_SPREAD_VOLTAGES, LEAST_CHANGE_SPREADS, NO_BASELINE_SPREAD,
+    DEFAULT_SPREAD_VOLTAGES, LEAST_CHANGE_SPREADS, NO_BASELINE_SPREAD, NO_BASELINE_SPREAD_VOLTAGES,
 };
 
 use crate::log::{Channels, LogError, Row};

@@ -374,10 +374,6 @@ impl SequenceTracker {
 /// One phase's sensor gain error in a set of phasors (the zero sequence,
 /// [`single_phase_gain`]), evidence from [`SENSOR_PHASE_MIN_RATIO`] on: `p`, `n`, `z` the
 /// positive, negative and zero sequences with one rotation.
-pub(super) fn sensor_phase(
-    p: (f32, f32),
-    n: (f32, f32),
-    z: (f32, f32),
-) -> Option<SinglePhaseGain> {
+pub(super) fn sensor_phase(p: (f32, f32), n: (f32, f32), z: (f32, f32)) -> Option<SinglePhaseGain> {
     single_phase_gain(p, n, z, SENSOR_PHASE_MIN_RATIO)
 }

@@ -13,16 +13,18 @@
 //!    spread `s0` counts as one run's worth of evidence, the runs add their own); else the
 //!    commissioning window's, within [`super::BASELINE_I1_TOLERANCE`] of its `|I1|`, with
 //!    `s0`; else none: `R = 0` and `sigma` = [`NO_BASELINE_SPREAD`], a healthy machine's
-//!    own asymmetry. `s0` is [`DEFAULT_SPREAD_CURRENTS`] for a log without voltages (the
+//!    own asymmetry ([`NO_BASELINE_SPREAD_VOLTAGES`] with voltages). `s0` is [`DEFAULT_SPREAD_CURRENTS`] for a log without voltages (the
 //!    supply's unbalance changes between runs, and without voltages it cannot be taken
 //!    out) and [`DEFAULT_SPREAD_VOLTAGES`] with them.
 //! 3. **The change** of each segment, `c = (I2/I1 - V2/(Z2 I1)) - R'` (the supply's part
 //!    `V2/Z2` taken out where voltages are logged, `R'` the reference's winding part),
 //!    judged by `monitor_core::sequence::judge_phase`: it names a phase when
-//!    `|c| >= 2 sigma` ([`LEAST_CHANGE_SPREADS`]), the negative-sequence current itself grew
-//!    by at least half that (a load change moves `I2/I1` by moving `I1`, not `I2`), and the
-//!    angle `arg c - arg Z1` lies inside its phase's sector by more than its uncertainty.
-//!    The segment with the largest change is reported.
+//!    `|c| >= 2 sigma'` ([`LEAST_CHANGE_SPREADS`]) and the angle `arg c - arg Z1` lies
+//!    inside its phase's sector by more than its uncertainty. Without voltages a segment at
+//!    another `|I1|` than the reference's widens the spread, `sigma'^2 = sigma^2 +
+//!    (|R| |1 - I1_R/I1|)^2`: the supply's part of `I2` stays as the load moves while `I1`
+//!    does not, so `I2/I1` moves with the load. The segment with the largest change that
+//!    names a phase is reported, else the one with the largest change.
 //! 4. **The reference angle** `arg Z1` (Tallam's loop: `I2/I1 = (mu/3)(Z1/Z_f) a^k`,
 //!    `monitor_core::sequence`): measured as `arg(V1/I1)` where voltages are logged;
 //!    else the model's at the slip from the speed; else at the slip where the model draws
@@ -34,8 +36,8 @@ use super::report::BaselineSource;
 use super::sequences::{sensor_phase, SequenceWindow};
 use super::{Replay, SensorPhaseReport, UnbalanceBaseline, UnbalanceReport, BASELINE_I1_TOLERANCE};
 use monitor_core::sequence::{
-    asymmetry_correction_rad, equivalent_impedance, judge_phase, slip_for_current,
-    PhaseJudgement, PhaseNotNamed, SinglePhaseGain, INHERENT_ASYMMETRY_RATIO,
+    asymmetry_correction_rad, equivalent_impedance, judge_phase, slip_for_current, PhaseJudgement,
+    PhaseNotNamed, SinglePhaseGain, INHERENT_ASYMMETRY_RATIO,
 };
 use monitor_core::{MotorModel, Phase};
 use serde::Serialize;
@@ -46,6 +48,9 @@ pub const MIN_SEGMENT_WINDOWS: usize = 3;
 /// mean, and farther than [`SEGMENT_STEP_REL`] of the mean's size, starts a new segment:
 /// three times the window-to-window scatter of a healthy motor's reading at 1 kHz.
 pub const SEGMENT_STEP_MIN: f32 = 0.015;
+/// The same for the voltages' `V2/V1` and `V0/V1` (a voltage sensor's 5 % gain step
+/// moves them by 1.7 %).
+pub const SEGMENT_VOLTAGE_STEP_MIN: f32 = 0.005;
 /// See [`SEGMENT_STEP_MIN`]: a large negative sequence scatters in proportion.
 pub const SEGMENT_STEP_REL: f32 = 0.15;
 /// A window whose `|I1|` differs from its segment's mean by more than this fraction starts
@@ -59,8 +64,13 @@ pub const DEFAULT_SPREAD_CURRENTS: f32 = 0.015;
 /// The default spread with voltages logged: the supply's part is taken out of every
 /// reading; what is left is the model's negative-sequence impedance error and the sensors.
 pub const DEFAULT_SPREAD_VOLTAGES: f32 = 0.0025;
-/// Without any healthy reference, the spread is a healthy machine's own asymmetry.
+/// Without any healthy reference and without voltages, the spread is a healthy machine's
+/// own asymmetry ([`INHERENT_ASYMMETRY_RATIO`], 3 %): with the supply's unbalance, which
+/// the currents alone cannot tell from it, a healthy motor's `I2/I1` reaches twice that.
 pub const NO_BASELINE_SPREAD: f32 = INHERENT_ASYMMETRY_RATIO;
+/// Without a healthy reference but with voltages (the supply's part taken out): half of
+/// it, so that a winding part above the machine's own asymmetry (3 %) may name a phase.
+pub const NO_BASELINE_SPREAD_VOLTAGES: f32 = 0.5 * INHERENT_ASYMMETRY_RATIO;
 /// The least change that may name a phase, in spreads.
 pub const LEAST_CHANGE_SPREADS: f32 = 2.0;
 /// The largest slip taken for "full load" where the operating point is not known (rated
@@ -178,11 +188,22 @@ fn mean(xs: impl Iterator<Item = C>) -> C {
     ((s.0 / f64::from(n)) as f32, (s.1 / f64::from(n)) as f32)
 }
 
+/// A window's features that a segment holds still: `I2/I1`, `I0/I1` and, with voltages,
+/// `V2/V1`, `V0/V1` (a sensor's gain step moves the zero sequences, a winding or the
+/// supply the negative ones).
+fn features(w: &SequenceWindow) -> [C; 4] {
+    let p = w.i.positive();
+    let v = w.v.map_or([(0.0, 0.0); 2], |v| {
+        let p = v.positive();
+        [cdiv(v.negative(), p), cdiv(v.zero(), p)]
+    });
+    [cdiv(w.i.negative(), p), cdiv(w.i.zero(), p), v[0], v[1]]
+}
+
 /// The steady segments of `windows` (module docs, step 1).
 pub fn segments(windows: &[SequenceWindow]) -> Vec<SequenceSegment> {
     let mut out = Vec::new();
     let mut cur: Vec<&SequenceWindow> = Vec::new();
-    let ratio = |w: &SequenceWindow| cdiv(w.i.negative(), w.i.positive());
     let close = |cur: &mut Vec<&SequenceWindow>, out: &mut Vec<SequenceSegment>| {
         if cur.len() >= MIN_SEGMENT_WINDOWS {
             out.push(segment_of(cur));
@@ -195,12 +216,18 @@ pub fn segments(windows: &[SequenceWindow]) -> Vec<SequenceSegment> {
             continue;
         }
         if !cur.is_empty() {
-            let r_mean = mean(cur.iter().map(|w| ratio(w)));
+            let f = features(w);
+            let moved = (0..4).any(|k| {
+                let m = mean(cur.iter().map(|w| features(w)[k]));
+                let floor = if k < 2 {
+                    SEGMENT_STEP_MIN
+                } else {
+                    SEGMENT_VOLTAGE_STEP_MIN
+                };
+                abs(sub(f[k], m)) > floor.max(SEGMENT_STEP_REL * abs(m))
+            });
             let i1_mean = cur.iter().map(|w| abs(w.i.positive())).sum::<f32>() / cur.len() as f32;
-            let step = SEGMENT_STEP_MIN.max(SEGMENT_STEP_REL * abs(r_mean));
-            if abs(sub(ratio(w), r_mean)) > step
-                || (abs(w.i.positive()) - i1_mean).abs() > SEGMENT_I1_STEP * i1_mean
-            {
+            if moved || (abs(w.i.positive()) - i1_mean).abs() > SEGMENT_I1_STEP * i1_mean {
                 close(&mut cur, &mut out);
             }
         }
@@ -218,9 +245,12 @@ fn segment_of(ws: &[&SequenceWindow]) -> SequenceSegment {
         .map(|w| cdiv(w.i.negative(), w.i.positive()))
         .collect();
     let r = mean(rs.iter().copied());
-    let var = rs.iter().map(|x| abs(sub(*x, r)).powi(2)).sum::<f32>()
-        / (2.0 * (n.max(2) - 1) as f32);
-    let volts: Option<Vec<_>> = ws.iter().map(|w| w.v.map(|v| (v, w.i.positive()))).collect();
+    let var =
+        rs.iter().map(|x| abs(sub(*x, r)).powi(2)).sum::<f32>() / (2.0 * (n.max(2) - 1) as f32);
+    let volts: Option<Vec<_>> = ws
+        .iter()
+        .map(|w| w.v.map(|v| (v, w.i.positive())))
+        .collect();
     let (v1, v2) = match volts {
         Some(v) => (
             Some(mean(v.iter().map(|(v, i1)| cdiv(v.positive(), *i1)))),
@@ -244,17 +274,13 @@ fn segment_of(ws: &[&SequenceWindow]) -> SequenceSegment {
             mean(ws.iter().map(|w| w.i.negative())),
             mean(ws.iter().map(|w| w.i.zero())),
         ],
-        v_pnz: ws
-            .iter()
-            .map(|w| w.v)
-            .collect::<Option<Vec<_>>>()
-            .map(|v| {
-                [
-                    mean(v.iter().map(|v| v.positive())),
-                    mean(v.iter().map(|v| v.negative())),
-                    mean(v.iter().map(|v| v.zero())),
-                ]
-            }),
+        v_pnz: ws.iter().map(|w| w.v).collect::<Option<Vec<_>>>().map(|v| {
+            [
+                mean(v.iter().map(|v| v.positive())),
+                mean(v.iter().map(|v| v.negative())),
+                mean(v.iter().map(|v| v.zero())),
+            ]
+        }),
         we: ws.iter().map(|w| w.we_rad_s).sum::<f32>() / n as f32,
         wr: ws.last().and_then(|w| w.wr_rad_s),
         learning: ws.iter().all(|w| w.learning),
@@ -395,27 +421,31 @@ fn winding_part(i2: C, v2: Option<C>, m: &MotorModel, we: f32, s: f32) -> (C, f3
     }
 }
 
-/// What was measured in the whole log (the mean of its steady windows, the sensor-checked
-/// currents'): a healthy log's is the `--baseline` of a later one.
-fn measured_of(windows: &[SequenceWindow]) -> (UnbalanceBaseline, f32) {
-    let steady: Vec<&SequenceWindow> = windows.iter().filter(|w| w.steady).collect();
-    let ratios = || steady.iter().map(|w| cdiv(w.i.negative(), w.i.positive()));
-    let r = mean(ratios());
-    let v2 = steady
-        .iter()
-        .map(|w| w.v.map(|v| cdiv(v.negative(), w.i.positive())))
-        .collect::<Option<Vec<_>>>()
-        .filter(|v| !v.is_empty())
-        .map(|v| mean(v.into_iter()));
-    let i1 = if steady.is_empty() {
-        0.0
-    } else {
-        steady.iter().map(|w| abs(w.i.positive())).sum::<f32>() / steady.len() as f32
-    };
+/// What was measured: the longest steady segment's `I2/I1`, `V2/I1` and `|I1|` (a
+/// healthy log's are the `--baseline` of a later one: its settled running, a start or a
+/// load step left out), and the whole log's least-squares `|I2|/|I1|`.
+fn measured_of(windows: &[SequenceWindow], segs: &[SequenceSegment]) -> (UnbalanceBaseline, f32) {
+    let longest = segs.iter().max_by_key(|s| s.windows);
+    let measured = longest.map_or(
+        UnbalanceBaseline {
+            i2_over_i1: [0.0, 0.0],
+            v2_over_i1: None,
+            i1_peak_a: 0.0,
+        },
+        |s| UnbalanceBaseline {
+            i2_over_i1: [s.r.0, s.r.1],
+            v2_over_i1: s.v2.map(|v| [v.0, v.1]),
+            i1_peak_a: s.i1_peak_a,
+        },
+    );
     // The whole log's least-squares ratio: the phasors of every complete window averaged
     // (one rotation), the supply frequency within 5 % of nominal-or-median: a run-up is
     // left out, a settling PLL is not (the fit does not need a settled reference).
-    let mut ws: Vec<f32> = windows.iter().filter(|w| w.complete).map(|w| w.we_rad_s).collect();
+    let mut ws: Vec<f32> = windows
+        .iter()
+        .filter(|w| w.complete)
+        .map(|w| w.we_rad_s)
+        .collect();
     ws.sort_by(f32::total_cmp);
     let w_med = ws.get(ws.len() / 2).copied().unwrap_or(0.0);
     let whole: Vec<&SequenceWindow> = windows
@@ -425,7 +455,11 @@ fn measured_of(windows: &[SequenceWindow]) -> (UnbalanceBaseline, f32) {
     // Into one frame turning at the log's mean frequency: the reference's offset from it
     // (a line through the windows' offsets) turned back, as a fit over the whole log at
     // one frequency sees the phasors.
-    let line = fit_line(whole.iter().map(|w| (0.5 * (w.from_s + w.to_s), w.offset_rad)));
+    let line = fit_line(
+        whole
+            .iter()
+            .map(|w| (0.5 * (w.from_s + w.to_s), w.offset_rad)),
+    );
     let turned = |w: &SequenceWindow, x: C| {
         let d = (w.offset_rad - line.0 - line.1 * 0.5 * (w.from_s + w.to_s)) as f32;
         let (sn, cs) = d.sin_cos();
@@ -434,14 +468,7 @@ fn measured_of(windows: &[SequenceWindow]) -> (UnbalanceBaseline, f32) {
     let p = mean(whole.iter().map(|w| turned(w, w.i.positive())));
     let n = mean(whole.iter().map(|w| turned(w, w.i.negative())));
     let whole = if abs(p) > 0.0 { abs(n) / abs(p) } else { 0.0 };
-    (
-        UnbalanceBaseline {
-            i2_over_i1: [r.0, r.1],
-            v2_over_i1: v2.map(|v| [v.0, v.1]),
-            i1_peak_a: i1,
-        },
-        whole,
-    )
+    (measured, whole)
 }
 
 /// The least-squares line `y = a + b x` through `(x, y)` points, as `(a, b)`; `(mean, 0)`
@@ -481,7 +508,6 @@ struct Judged {
     change: C,
     supply_ratio: f32,
     judgement: PhaseJudgement,
-    grew: bool,
     reference: (f32, f32, Option<f32>, OperatingPointSource),
     sigma: f32,
     least_change: f32,
@@ -494,7 +520,7 @@ impl Replay {
         let m = self.params.motor.model();
         let windows = self.sequences.windows();
         let segs = segments(windows);
-        let (measured, whole_ratio) = measured_of(windows);
+        let (measured, whole_ratio) = measured_of(windows, &segs);
         let s0 = if self.channels.voltages {
             DEFAULT_SPREAD_VOLTAGES
         } else {
@@ -502,17 +528,17 @@ impl Replay {
         };
         let file = self.opts.unbalance_baseline;
         // The commissioning window's reference: its steady windows.
-        let learned: Vec<&SequenceSegment> = segs.iter().filter(|s| s.learning).collect();
-        let learned = (!learned.is_empty()).then(|| Reference {
-            r: mean(learned.iter().map(|s| s.r)),
-            v2: learned
-                .iter()
-                .map(|s| s.v2)
-                .collect::<Option<Vec<_>>>()
-                .map(|v| mean(v.into_iter())),
-            i1: learned.iter().map(|s| s.i1_peak_a).sum::<f32>() / learned.len() as f32,
-            sigma: s0,
-            source: Some(BaselineSource::Commissioning),
+        let learned: Vec<&SequenceWindow> =
+            windows.iter().filter(|w| w.steady && w.learning).collect();
+        let learned = (learned.len() >= MIN_SEGMENT_WINDOWS).then(|| {
+            let s = segment_of(&learned);
+            Reference {
+                r: s.r,
+                v2: s.v2,
+                i1: s.i1_peak_a,
+                sigma: s0,
+                source: Some(BaselineSource::Commissioning),
+            }
         });
         let reference_for = |seg: &SequenceSegment| -> Reference {
             if let Some(f) = file {
@@ -526,10 +552,7 @@ impl Replay {
                 };
             }
             match &learned {
-                Some(l)
-                    if !seg.learning
-                        && (seg.i1_peak_a - l.i1).abs() <= BASELINE_I1_TOLERANCE * l.i1 =>
-                {
+                Some(l) if (seg.i1_peak_a - l.i1).abs() <= BASELINE_I1_TOLERANCE * l.i1 => {
                     Reference {
                         r: l.r,
                         v2: l.v2,
@@ -542,7 +565,11 @@ impl Replay {
                     r: (0.0, 0.0),
                     v2: None,
                     i1: seg.i1_peak_a,
-                    sigma: NO_BASELINE_SPREAD,
+                    sigma: if seg.v2.is_some() {
+                        NO_BASELINE_SPREAD_VOLTAGES
+                    } else {
+                        NO_BASELINE_SPREAD
+                    },
                     source: None,
                 },
             }
@@ -578,23 +605,22 @@ impl Replay {
                     s,
                 );
                 let change = sub(w, w_ref);
-                let sigma = reference.sigma.hypot(seg.sem);
-                let least_change = LEAST_CHANGE_SPREADS * reference.sigma;
-                // The negative-sequence current itself, against the reference's current.
-                let grew = abs(w) * seg.i1_peak_a - abs(w_ref) * reference.i1
-                    >= 0.5 * least_change * reference.i1;
-                let mut judgement = judge_phase(change, op.0, op.1, sigma, least_change);
-                if !grew && judgement.phase.is_some() {
-                    judgement.phase = None;
-                    judgement.confidence = 0.0;
-                    judgement.not_named = Some(PhaseNotNamed::BelowLeastChange);
-                }
+                // Another operating point than the reference's, without the voltages to
+                // take the supply's part out: I2/I1 moves with I1.
+                let moved = if v2.is_none() && seg.i1_peak_a > 0.0 {
+                    abs(w_ref) * (1.0 - reference.i1 / seg.i1_peak_a).abs()
+                } else {
+                    0.0
+                };
+                let healthy = reference.sigma.hypot(moved);
+                let sigma = healthy.hypot(seg.sem);
+                let least_change = LEAST_CHANGE_SPREADS * healthy;
+                let judgement = judge_phase(change, op.0, op.1, sigma, least_change);
                 Judged {
                     index,
                     change,
                     supply_ratio,
                     judgement,
-                    grew,
                     reference: op,
                     sigma,
                     least_change,
@@ -613,10 +639,8 @@ impl Replay {
                     .iter()
                     .max_by(|a, b| abs(a.change).total_cmp(&abs(b.change)))
             });
-        let (gi, gv) = pick
-            .map(|j| &segs[j.index])
-            .or(segs.last())
-            .map_or((None, None), sensor_phases);
+        // The sensors at the log's end (as the isolation's candidates are).
+        let (gi, gv) = segs.last().map_or((None, None), sensor_phases);
         let runs = file.map_or(0, |f| f.runs);
         let mut report = UnbalanceReport {
             negative_sequence_ratio: whole_ratio,
@@ -688,7 +712,9 @@ fn sensor_phases(seg: &SequenceSegment) -> (Option<SinglePhaseGain>, Option<Sing
 /// them when it lies beyond (then at index `MAX_SEGMENTS - 1`).
 fn listed_segments(mut segs: Vec<SequenceSegment>, judged: Option<usize>) -> Vec<SequenceSegment> {
     if segs.len() > MAX_SEGMENTS {
-        let keep = judged.filter(|&k| k >= MAX_SEGMENTS - 1).map(|k| segs[k].clone());
+        let keep = judged
+            .filter(|&k| k >= MAX_SEGMENTS - 1)
+            .map(|k| segs[k].clone());
         segs.truncate(MAX_SEGMENTS);
         if let Some(k) = keep {
             segs[MAX_SEGMENTS - 1] = k;
@@ -719,11 +745,8 @@ fn not_judged_reason(j: &Judged, seg: &SequenceSegment) -> Option<String> {
     let change = 100.0 * abs(j.change);
     Some(match (why, j.source) {
         (PhaseNotNamed::BelowLeastChange, None) => format!(
-            "cannot judge the phase: the negative sequence ({change:.1} % of I1 at {at}) is within twice a healthy machine's own asymmetry ({:.0} %) and there is no healthy baseline (give --baseline with healthy logs of this motor, or commission)",
-            100.0 * NO_BASELINE_SPREAD
-        ),
-        (PhaseNotNamed::BelowLeastChange, Some(_)) if !j.grew && change >= 100.0 * j.least_change => format!(
-            "no phase: the negative sequence moved by {change:.1} % of I1 at {at}, but the negative-sequence current itself did not grow (an operating-point change moves I2/I1 through I1)"
+            "cannot judge the phase: the negative sequence ({change:.1} % of I1 at {at}) is within what a healthy machine's own asymmetry may reach ({:.0} %) and there is no healthy baseline (give --baseline with healthy logs of this motor, or commission)",
+            100.0 * j.least_change
         ),
         (PhaseNotNamed::BelowLeastChange, Some(_)) => format!(
             "no phase: the change of the negative sequence ({change:.1} % of I1 at {at}) is within what healthy runs differ by (least change {:.1} %)",

@@ -219,10 +219,7 @@ mod tests {
     fn ratio(ph: &ThreePhasors) -> (f64, f64) {
         let (p, n) = (c64(ph.positive()), c64(ph.negative()));
         let d = p.0 * p.0 + p.1 * p.1;
-        (
-            ((n.0 * p.0 + n.1 * p.1) / d),
-            ((n.1 * p.0 - n.0 * p.1) / d),
-        )
+        (((n.0 * p.0 + n.1 * p.1) / d), ((n.1 * p.0 - n.0 * p.1) / d))
     }
 
     #[test]
@@ -230,7 +227,11 @@ mod tests {
         // Whole periods and a fraction of one, at 1 and 10 kHz: |I2/I1| = 0.3 at 50 deg.
         // Over whole periods the 7 % fifth harmonic is orthogonal to the regressors; over
         // 7.4 periods it leaks 0.1 % of the ratio.
-        for (fs, n, tol) in [(1000.0, 1000, 1e-5), (1000.0, 167, 5e-4), (10_000.0, 1234, 5e-4)] {
+        for (fs, n, tol) in [
+            (1000.0, 1000, 1e-5),
+            (1000.0, 167, 5e-4),
+            (10_000.0, 1234, 5e-4),
+        ] {
             let ph = fit(60.0, 60.0, fs, n, (3.0, 50f64.to_radians()));
             let r = ratio(&ph);
             let (m, a) = (r.0.hypot(r.1), r.1.atan2(r.0).to_degrees());
@@ -253,7 +254,14 @@ mod tests {
     fn too_few_samples_or_a_still_reference_give_nothing() {
         let mut p = PhasorFit::new();
         for _ in 0..100 {
-            p.update(SinCos::default(), Abc { a: 1.0, b: 2.0, c: 3.0 });
+            p.update(
+                SinCos::default(),
+                Abc {
+                    a: 1.0,
+                    b: 2.0,
+                    c: 3.0,
+                },
+            );
         }
         assert_eq!(p.solve(), None);
         p.reset();

@@ -320,11 +320,19 @@ fn unbalance(out: &mut impl Write, u: &sim_host::replay::UnbalanceReport) -> any
                 s.i1_peak_a,
                 100.0 * s.negative_sequence_ratio,
                 s.angle_deg,
-                if u.judged_segment == Some(k) { "  <- judged" } else { "" }
+                if u.judged_segment == Some(k) {
+                    "  <- judged"
+                } else {
+                    ""
+                }
             )?;
         }
         if u.segments.len() > SEGMENTS_LISTED {
-            writeln!(out, "    ... {} more (--json lists them)", u.segments.len() - SEGMENTS_LISTED)?;
+            writeln!(
+                out,
+                "    ... {} more (--json lists them)",
+                u.segments.len() - SEGMENTS_LISTED
+            )?;
         }
     }
     let against = match (u.baseline, u.baseline_runs) {
