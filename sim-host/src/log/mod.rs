@@ -495,7 +495,7 @@ mod tests {
             ("\n", "the file is empty"),
             ("t_s;ia_A;ib_A;ic_A\n0;1;2;3\n", "separated by ';'"),
             ("t_s\tia_A\tib_A\tic_A\n0\t1\t2\t3\n", "separated by '\\t'"),
-            ("0,1,2,3\n1,1,2,3\n", "must be the header"),
+            ("0,1,2,3\n1,1,2,3\n", "no header row"),
         ] {
             let f = write(text);
             let e = Log::read(f.path()).unwrap_err().to_string();

@@ -514,10 +514,101 @@ struct Judged {
     source: Option<BaselineSource>,
 }
 
+/// What every segment is judged with: the model, the nominal supply, whether the speed is
+/// measured, and the healthy references.
+struct Judge {
+    m: MotorModel,
+    v_nominal: f32,
+    speed: bool,
+    file: Option<HealthyReference>,
+    learned: Option<Reference>,
+    s0: f32,
+}
+
+impl Judge {
+    /// The healthy reference a segment is judged against (module docs, step 2).
+    fn reference_for(&self, seg: &SequenceSegment) -> Reference {
+        if let Some(f) = self.file {
+            let c = |x: [f32; 2]| (x[0], x[1]);
+            return Reference {
+                r: c(f.mean.i2_over_i1),
+                v2: f.mean.v2_over_i1.map(c),
+                i1: f.mean.i1_peak_a,
+                sigma: f.sigma(self.s0),
+                source: Some(BaselineSource::File),
+            };
+        }
+        match &self.learned {
+            Some(l) if (seg.i1_peak_a - l.i1).abs() <= BASELINE_I1_TOLERANCE * l.i1 => Reference {
+                r: l.r,
+                v2: l.v2,
+                i1: l.i1,
+                sigma: l.sigma,
+                source: l.source,
+            },
+            _ => Reference {
+                r: (0.0, 0.0),
+                v2: None,
+                i1: seg.i1_peak_a,
+                sigma: if seg.v2.is_some() {
+                    NO_BASELINE_SPREAD_VOLTAGES
+                } else {
+                    NO_BASELINE_SPREAD
+                },
+                source: None,
+            },
+        }
+    }
+
+    /// One segment's change from its reference, judged (module docs, steps 3 and 4).
+    fn judge(&self, index: usize, seg: &SequenceSegment) -> Judged {
+        let m = &self.m;
+        let reference = self.reference_for(seg);
+        let op = reference_angle(seg, m, self.v_nominal, self.speed);
+        let s = op.2.unwrap_or(0.0).max(1e-4);
+        // A sensor's own negative sequence is not the winding's (nor the supply's); with one
+        // voltage sensor wrong the voltages cannot say how much of I2 the supply drives, and
+        // the currents alone judge.
+        let (gi, gv) = sensor_phases(seg);
+        let [p, n, z] = seg.pnz;
+        let r = match gi {
+            Some(g) => {
+                let d = sub(cdiv(g.corrected_negative(p, n, z), p), cdiv(n, p));
+                (seg.r.0 + d.0, seg.r.1 + d.1)
+            }
+            None => seg.r,
+        };
+        let v2 = seg.v2.filter(|_| gv.is_none());
+        let (w, supply_ratio) = winding_part(r, v2, m, seg.we, s);
+        let ref_v2 = reference.v2.filter(|_| v2.is_some());
+        let (w_ref, _) = winding_part(reference.r, ref_v2, m, seg.we, s);
+        let change = sub(w, w_ref);
+        // Another operating point than the reference's, without the voltages to take the
+        // supply's part out: I2/I1 moves with I1.
+        let moved = if v2.is_none() && seg.i1_peak_a > 0.0 {
+            abs(w_ref) * (1.0 - reference.i1 / seg.i1_peak_a).abs()
+        } else {
+            0.0
+        };
+        let healthy = reference.sigma.hypot(moved);
+        let sigma = healthy.hypot(seg.sem);
+        let least_change = LEAST_CHANGE_SPREADS * healthy;
+        Judged {
+            index,
+            change,
+            supply_ratio,
+            judgement: judge_phase(change, op.0, op.1, sigma, least_change),
+            reference: op,
+            sigma,
+            least_change,
+            source: reference.source,
+        }
+    }
+}
+
 impl Replay {
     /// The negative-sequence report (module docs).
     pub(super) fn unbalance_report(&self) -> UnbalanceReport {
-        let m = self.params.motor.model();
         let windows = self.sequences.windows();
         let segs = segments(windows);
         let (measured, whole_ratio) = measured_of(windows, &segs);
@@ -526,7 +617,6 @@ impl Replay {
         } else {
             DEFAULT_SPREAD_CURRENTS
         };
-        let file = self.opts.unbalance_baseline;
         // The commissioning window's reference: its steady windows.
         let learned: Vec<&SequenceWindow> =
             windows.iter().filter(|w| w.steady && w.learning).collect();
@@ -540,108 +630,31 @@ impl Replay {
                 source: Some(BaselineSource::Commissioning),
             }
         });
-        let reference_for = |seg: &SequenceSegment| -> Reference {
-            if let Some(f) = file {
-                let c = |x: [f32; 2]| (x[0], x[1]);
-                return Reference {
-                    r: c(f.mean.i2_over_i1),
-                    v2: f.mean.v2_over_i1.map(c),
-                    i1: f.mean.i1_peak_a,
-                    sigma: f.sigma(s0),
-                    source: Some(BaselineSource::File),
-                };
-            }
-            match &learned {
-                Some(l) if (seg.i1_peak_a - l.i1).abs() <= BASELINE_I1_TOLERANCE * l.i1 => {
-                    Reference {
-                        r: l.r,
-                        v2: l.v2,
-                        i1: l.i1,
-                        sigma: l.sigma,
-                        source: l.source,
-                    }
-                }
-                _ => Reference {
-                    r: (0.0, 0.0),
-                    v2: None,
-                    i1: seg.i1_peak_a,
-                    sigma: if seg.v2.is_some() {
-                        NO_BASELINE_SPREAD_VOLTAGES
-                    } else {
-                        NO_BASELINE_SPREAD
-                    },
-                    source: None,
-                },
-            }
+        let judge = Judge {
+            m: self.params.motor.model(),
+            v_nominal: self.params.supply.v_phase_peak() as f32,
+            speed: self.monitor.is_some(),
+            file: self.opts.unbalance_baseline,
+            learned,
+            s0,
         };
-        let v_nom = self.params.supply.v_phase_peak() as f32;
-        let speed = self.monitor.is_some();
         let judged: Vec<Judged> = segs
             .iter()
             .enumerate()
-            .map(|(index, seg)| {
-                let reference = reference_for(seg);
-                let op = reference_angle(seg, &m, v_nom, speed);
-                let s = op.2.unwrap_or(0.0).max(1e-4);
-                // A sensor's own negative sequence is not the winding's (nor the supply's);
-                // with one voltage sensor wrong the voltages cannot say how much of I2 the
-                // supply drives, and the currents alone judge.
-                let (gi, gv) = sensor_phases(seg);
-                let [p, n, z] = seg.pnz;
-                let r = match gi {
-                    Some(g) => {
-                        let d = sub(cdiv(g.corrected_negative(p, n, z), p), cdiv(n, p));
-                        (seg.r.0 + d.0, seg.r.1 + d.1)
-                    }
-                    None => seg.r,
-                };
-                let v2 = seg.v2.filter(|_| gv.is_none());
-                let (w, supply_ratio) = winding_part(r, v2, &m, seg.we, s);
-                let (w_ref, _) = winding_part(
-                    reference.r,
-                    reference.v2.filter(|_| v2.is_some()),
-                    &m,
-                    seg.we,
-                    s,
-                );
-                let change = sub(w, w_ref);
-                // Another operating point than the reference's, without the voltages to
-                // take the supply's part out: I2/I1 moves with I1.
-                let moved = if v2.is_none() && seg.i1_peak_a > 0.0 {
-                    abs(w_ref) * (1.0 - reference.i1 / seg.i1_peak_a).abs()
-                } else {
-                    0.0
-                };
-                let healthy = reference.sigma.hypot(moved);
-                let sigma = healthy.hypot(seg.sem);
-                let least_change = LEAST_CHANGE_SPREADS * healthy;
-                let judgement = judge_phase(change, op.0, op.1, sigma, least_change);
-                Judged {
-                    index,
-                    change,
-                    supply_ratio,
-                    judgement,
-                    reference: op,
-                    sigma,
-                    least_change,
-                    source: reference.source,
-                }
-            })
+            .map(|(k, seg)| judge.judge(k, seg))
             .collect();
         // The segment with the largest change among those that name a phase, else the
         // largest change.
-        let pick = judged
-            .iter()
-            .filter(|j| j.judgement.phase.is_some())
-            .max_by(|a, b| abs(a.change).total_cmp(&abs(b.change)))
-            .or_else(|| {
-                judged
-                    .iter()
-                    .max_by(|a, b| abs(a.change).total_cmp(&abs(b.change)))
-            });
+        let largest = |it: &mut dyn Iterator<Item = &Judged>| {
+            it.max_by(|a, b| abs(a.change).total_cmp(&abs(b.change)))
+                .map(|j| j.index)
+        };
+        let pick = largest(&mut judged.iter().filter(|j| j.judgement.phase.is_some()))
+            .or_else(|| largest(&mut judged.iter()))
+            .and_then(|k| judged.get(k));
         // The sensors at the log's end (as the isolation's candidates are).
         let (gi, gv) = segs.last().map_or((None, None), sensor_phases);
-        let runs = file.map_or(0, |f| f.runs);
+        let file = self.opts.unbalance_baseline;
         let mut report = UnbalanceReport {
             negative_sequence_ratio: whole_ratio,
             suspect_phase: None,
@@ -657,14 +670,14 @@ impl Replay {
             slip: None,
             least_change: 0.0,
             spread: 0.0,
-            baseline_runs: runs,
+            baseline_runs: file.map_or(0, |f| f.runs),
             baseline_spread: file.and_then(|f| f.measured_spread()),
             judged_segment: None,
             segments: Vec::new(),
             current_sensor_phase: gi.as_ref().map(SensorPhaseReport::from),
             voltage_sensor_phase: gv.as_ref().map(SensorPhaseReport::from),
             measured,
-            baseline: None,
+            baseline: file.map(|_| BaselineSource::File),
         };
         match pick {
             None => {
@@ -673,29 +686,30 @@ impl Replay {
                     MIN_SEGMENT_WINDOWS,
                     MIN_SEGMENT_WINDOWS as f64 * super::sequences::WINDOW_PERIODS / self.params.supply.f_hz
                 ));
-                report.baseline = file.map(|_| BaselineSource::File);
             }
-            Some(j) => {
-                let j_ = &j.judgement;
-                report.suspect_phase = j_.phase;
-                report.phase_confidence = j_.confidence;
-                report.angle_deg = j.change.1.atan2(j.change.0).to_degrees();
-                report.winding_ratio = abs(j.change);
-                report.supply_ratio = j.supply_ratio;
-                report.correction_deg = j.reference.0.to_degrees();
-                report.correction_uncertainty_deg = j.reference.1.to_degrees();
-                report.operating_point = Some(j.reference.3);
-                report.slip = j.reference.2;
-                report.least_change = j.least_change;
-                report.spread = j.sigma;
-                report.baseline = j.source;
-                report.phase_not_judged = not_judged_reason(j, &segs[j.index]);
-                report.judged_segment = Some(j.index.min(MAX_SEGMENTS - 1));
-            }
+            Some(j) => fill_judgement(&mut report, j, &segs),
         }
         report.segments = listed_segments(segs, pick.map(|j| j.index));
         report
     }
+}
+
+/// The judged segment's keys of the report.
+fn fill_judgement(report: &mut UnbalanceReport, j: &Judged, segs: &[SequenceSegment]) {
+    report.suspect_phase = j.judgement.phase;
+    report.phase_confidence = j.judgement.confidence;
+    report.angle_deg = j.change.1.atan2(j.change.0).to_degrees();
+    report.winding_ratio = abs(j.change);
+    report.supply_ratio = j.supply_ratio;
+    report.correction_deg = j.reference.0.to_degrees();
+    report.correction_uncertainty_deg = j.reference.1.to_degrees();
+    report.operating_point = Some(j.reference.3);
+    report.slip = j.reference.2;
+    report.least_change = j.least_change;
+    report.spread = j.sigma;
+    report.baseline = j.source;
+    report.phase_not_judged = segs.get(j.index).and_then(|s| not_judged_reason(j, s));
+    report.judged_segment = Some(j.index.min(MAX_SEGMENTS - 1));
 }
 
 /// One phase's current sensor and voltage sensor with a gain error in a segment (the zero
@@ -738,9 +752,17 @@ fn measured_voltage_ratio(windows: &[SequenceWindow]) -> Option<f32> {
     (abs(p) > 0.0).then(|| abs(n) / abs(p))
 }
 
-/// Why the judged segment names no phase, in a sentence; `None` when it names one.
+/// A change of `I2/I1` below this is no asymmetry to speak of (the noise of 12-bit sensors):
+/// no reason is given for naming no phase.
+pub const BALANCED_RATIO: f32 = 0.005;
+
+/// Why the judged segment names no phase, in a sentence; `None` when it names one, or when
+/// the change is below [`BALANCED_RATIO`] (nothing to judge).
 fn not_judged_reason(j: &Judged, seg: &SequenceSegment) -> Option<String> {
     let why = j.judgement.not_named?;
+    if why == PhaseNotNamed::BelowLeastChange && abs(j.change) < BALANCED_RATIO {
+        return None;
+    }
     let at = format!("{:.1}..{:.1} s", seg.from_s, seg.to_s);
     let change = 100.0 * abs(j.change);
     Some(match (why, j.source) {

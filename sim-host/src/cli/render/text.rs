@@ -314,7 +314,7 @@ fn unbalance(out: &mut impl Write, u: &sim_host::replay::UnbalanceReport) -> any
         for (k, s) in u.segments.iter().enumerate().take(SEGMENTS_LISTED) {
             writeln!(
                 out,
-                "    {:>6.2}..{:<6.2} s  |I1| {:>7.3} A  I2/I1 {:>5.1} % at {:>4.0} deg{}",
+                "    at {:.2}..{:.2} s: |I1| {:.3} A, I2/I1 {:.1} % at {:.0} deg{}",
                 s.from_s,
                 s.to_s,
                 s.i1_peak_a,
