@@ -618,3 +618,75 @@ fn the_daq_example_reads_through_its_columns_table() {
     assert_eq!(schema["data_quality"]["rows_passed"], q["rows_passed"]);
     assert_eq!(schema["data_quality"]["warnings"], q["warnings"]);
 }
+
+/// A headerless CSV without a time column (as a published data set writes it), the same
+/// rows with a header row, and the parameter file's `[columns]` by place: the same rows; the
+/// mistakes are refused with the key named.
+#[test]
+fn a_file_without_header_or_time_reads_through_columns_by_place() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let f = 1000.0;
+    let mut body = String::new();
+    for k in 0..2000 {
+        let t = k as f64 / f;
+        let i = |sh: f64| 5.0 * (TAU * 50.0 * t - sh).cos();
+        writeln!(body, "{:.6},{:.6},{:.6}", i(0.0), i(TAU / 3.0), i(-TAU / 3.0)).unwrap();
+    }
+    let bare = dir.path().join("bare.csv");
+    std::fs::write(&bare, &body).expect("write");
+    let headed = dir.path().join("headed.csv");
+    std::fs::write(&headed, format!("Strom 1,Strom 2,Strom 3\n{body}")).expect("write");
+    let by_place = "[columns]\nt_s = { sample_rate_hz = 1000.0 }\nia_A = { column = 1 }\nib_A = { column = 2 }\nic_A = { column = 3 }\n";
+    let p = params_with(dir.path(), "p.toml", by_place);
+    let read = |log: &Path| {
+        let (_, columns) = sim_host::log::mapping::load_params(&p).expect("params");
+        let file = sim_host::log::LogFile::open_with(
+            log,
+            &sim_host::log::OpenOptions {
+                group: None,
+                columns,
+            },
+        )
+        .expect("open");
+        let mut rows: Vec<Row> = Vec::new();
+        file.for_each_row(&mut |_| {}, &mut rows).expect("rows");
+        rows
+    };
+    let (a, b) = (read(&bare), read(&headed));
+    assert_eq!(a.len(), 2000);
+    assert_eq!(a.len(), b.len());
+    for (k, (x, y)) in a.iter().zip(&b).enumerate() {
+        assert_eq!(x.i_abc, y.i_abc, "row {k}");
+        assert!((x.t_s - k as f64 / f).abs() < 1e-12, "row {k}: {}", x.t_s);
+        assert_eq!(x.t_s, y.t_s);
+    }
+    // diagnose reads it and says the rate.
+    let v = json(&["diagnose", "--params", s(&p), s(&bare), "--json"]);
+    assert_eq!(v["rows"], 2000, "{v}");
+    assert!((v["data_quality"]["sample_rate_hz"].as_f64().unwrap() - 1000.0).abs() < 1e-6);
+    // Without the table: refused, with the table to write.
+    let plain = params_with(dir.path(), "plain.toml", "");
+    let e = fails(&["diagnose", "--params", s(&plain), s(&bare)]);
+    assert!(e.contains("no header row") && e.contains("column = 1"), "{e}");
+    // The mistakes, each naming its key.
+    for (table, says) in [
+        ("ia_A = { column = 0 }", "column = 0"),
+        ("ia_A = { column = 1, name = \"Ia\" }", "not both"),
+        ("ia_A = { sample_rate_hz = 1000.0 }", "belongs to t_s"),
+        ("t_s = { sample_rate_hz = 1000.0, unit = \"ms\" }", "not both"),
+        ("t_s = { sample_rate_hz = -5.0 }", "not a sample rate"),
+        ("ia_A = { unit = \"A\" }", "ia_A: give the channel"),
+    ] {
+        let p = params_with(dir.path(), "bad.toml", &format!("[columns]\n{table}\n"));
+        let e = fails(&["diagnose", "--params", s(&p), s(&bare)]);
+        assert!(e.contains(says), "{table}: {e}");
+    }
+    // A place past the line's last field is a missing column.
+    let p = params_with(
+        dir.path(),
+        "past.toml",
+        "[columns]\nt_s = { sample_rate_hz = 1000.0 }\nia_A = { column = 1 }\nib_A = { column = 2 }\nic_A = { column = 4 }\n",
+    );
+    let e = fails(&["diagnose", "--params", s(&p), s(&bare)]);
+    assert!(e.contains("column 4") && e.contains("ic_A"), "{e}");
+}
