@@ -106,8 +106,9 @@ fn least_squares_ratio(rows: &[[f64; 3]], fs: f64, f_lo: f64, f_hi: f64) -> f64 
             for c in 0..3 {
                 for r in c + 1..3 {
                     let f = a[r][c] / a[c][c];
-                    for k in 0..3 {
-                        a[r][k] -= f * a[c][k];
+                    let pivot_row = a[c];
+                    for (x, p) in a[r].iter_mut().zip(pivot_row) {
+                        *x -= f * p;
                     }
                     b[r] -= f * b[c];
                 }

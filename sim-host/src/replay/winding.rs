@@ -160,7 +160,7 @@ type C = (f32, f32);
 
 fn cdiv(a: C, b: C) -> C {
     let d = b.0 * b.0 + b.1 * b.1;
-    if !(d > 0.0) {
+    if d.is_nan() || d <= 0.0 {
         return (0.0, 0.0);
     }
     ((a.0 * b.0 + a.1 * b.1) / d, (a.1 * b.0 - a.0 * b.1) / d)
@@ -486,7 +486,7 @@ fn fit_line(points: impl Iterator<Item = (f64, f64)>) -> (f64, f64) {
         return (0.0, 0.0);
     }
     let d = n * sxx - sx * sx;
-    if !(d.abs() > 1e-12 * n * sxx.max(1e-300)) {
+    if d.is_nan() || d.abs() <= 1e-12 * n * sxx.max(1e-300) {
         return (sy / n, 0.0);
     }
     let b = (n * sxy - sx * sy) / d;
