@@ -630,7 +630,14 @@ fn a_file_without_header_or_time_reads_through_columns_by_place() {
     for k in 0..2000 {
         let t = k as f64 / f;
         let i = |sh: f64| 5.0 * (TAU * 50.0 * t - sh).cos();
-        writeln!(body, "{:.6},{:.6},{:.6}", i(0.0), i(TAU / 3.0), i(-TAU / 3.0)).unwrap();
+        writeln!(
+            body,
+            "{:.6},{:.6},{:.6}",
+            i(0.0),
+            i(TAU / 3.0),
+            i(-TAU / 3.0)
+        )
+        .unwrap();
     }
     let bare = dir.path().join("bare.csv");
     std::fs::write(&bare, &body).expect("write");
@@ -667,13 +674,19 @@ fn a_file_without_header_or_time_reads_through_columns_by_place() {
     // Without the table: refused, with the table to write.
     let plain = params_with(dir.path(), "plain.toml", "");
     let e = fails(&["diagnose", "--params", s(&plain), s(&bare)]);
-    assert!(e.contains("no header row") && e.contains("column = 1"), "{e}");
+    assert!(
+        e.contains("no header row") && e.contains("column = 1"),
+        "{e}"
+    );
     // The mistakes, each naming its key.
     for (table, says) in [
         ("ia_A = { column = 0 }", "column = 0"),
         ("ia_A = { column = 1, name = \"Ia\" }", "not both"),
         ("ia_A = { sample_rate_hz = 1000.0 }", "belongs to t_s"),
-        ("t_s = { sample_rate_hz = 1000.0, unit = \"ms\" }", "not both"),
+        (
+            "t_s = { sample_rate_hz = 1000.0, unit = \"ms\" }",
+            "not both",
+        ),
         ("t_s = { sample_rate_hz = -5.0 }", "not a sample rate"),
         ("ia_A = { unit = \"A\" }", "ia_A: give the channel"),
     ] {

@@ -340,7 +340,11 @@ fn the_command_takes_several_healthy_runs_or_a_folder() {
     let h1 = d.join("SC_HLT_001.csv").display().to_string();
     let h2 = d.join("SC_HLT_002.csv").display().to_string();
     let files = run(&["--baseline", &h1, &h2]);
-    assert!(files.status.success(), "{}", String::from_utf8_lossy(&files.stderr));
+    assert!(
+        files.status.success(),
+        "{}",
+        String::from_utf8_lossy(&files.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&files.stdout).expect("json"); // ok: test
     assert_eq!(v["unbalance"]["suspect_phase"], "c", "{}", v["unbalance"]);
     assert_eq!(v["unbalance"]["baseline_runs"], 2);
