@@ -1,8 +1,15 @@
 //! The main job (`sim-host demo`): the 3 hp reference motor (Krause's textbook machine)
-//! started direct-on-line with the paper's viscous load and realistic sensors (12-bit ADC,
-//! noise, 1024-line encoder), its sensor streams replayed through the same core the
-//! firmware runs, the healthy residuals learned (commissioning, 2-4 s), a Table 1 fault
-//! injected at 5 s, and the lamps r1..r4 and the fault candidates followed every 0.25 s.
+//! started direct-on-line with realistic sensors (12-bit ADC, noise, 1024-line encoder), its
+//! sensor streams replayed through the same core the firmware runs, and the lamps r1..r4
+//! and the fault candidates followed every 0.25 s.
+//!
+//! The default run is a day in service ([`Story::Service`]): the healthy residuals are
+//! learned (commissioning, 2-4 s); the load rises 40 % at 5 s and falls back at 6.5 s, which
+//! the monitor shows as what it is (the amber "operating point moved", a load move in the
+//! events, no fault); then the stator resistance rises 50 % at 8.5 s (a loose connection, a
+//! burnt contact), which lights the lamps and is named with its size. The load is an unknown
+//! input, as in service. [`Story::Paper`] is the paper's own protocol: one Table 1 fault at
+//! 5 s with the paper's fixed viscous load, under which a Bl change is a fault.
 
 use crate::experiment::ExperimentError;
 use crate::fault_signatures::{scenario, Protocol};
@@ -29,11 +36,64 @@ pub struct DemoPoint {
     pub panel: Panel,
     /// The first point at or after the fault's onset.
     pub fault_injected: bool,
+    /// The first point at or after a load step: the load's new Bl as a multiple of the
+    /// commissioned one.
+    pub load_step: Option<f64>,
+}
+
+/// Which run the demo tells.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Story {
+    /// A day in service (the default): commissioning, a load step and back, then `fault`
+    /// of relative size `change` at [`SERVICE_FAULT_AT_S`]; the load an unknown input.
+    Service {
+        /// The fault (Table 1's names).
+        fault: Fault,
+        /// Its relative change (0.5 = +50 %; sensors: gain error).
+        change: f64,
+    },
+    /// The paper's protocol (`demo --paper`): `fault` at 5 s on the paper's fixed viscous
+    /// load, commissioning 2-4 s.
+    Paper {
+        /// The fault.
+        fault: Fault,
+        /// Its relative change.
+        change: f64,
+    },
+}
+
+/// The service story's load step: the viscous load's Bl times this from
+/// [`LOAD_STEP_AT_S`] to [`LOAD_BACK_AT_S`].
+pub const LOAD_STEP_SCALE: f64 = 1.4;
+/// When the load rises [s].
+pub const LOAD_STEP_AT_S: f64 = 5.0;
+/// When it falls back [s].
+pub const LOAD_BACK_AT_S: f64 = 6.5;
+/// When the service story's fault comes [s].
+pub const SERVICE_FAULT_AT_S: f64 = 8.5;
+
+impl Story {
+    /// The default: the service story with the stator resistance +50 %.
+    pub fn service() -> Self {
+        Story::Service {
+            fault: Fault::Rs,
+            change: 0.5,
+        }
+    }
+
+    /// The injected fault and its change.
+    pub fn fault(self) -> (Fault, f64) {
+        match self {
+            Story::Service { fault, change } | Story::Paper { fault, change } => (fault, change),
+        }
+    }
 }
 
 /// A finished demo run.
 #[derive(Debug, Clone)]
 pub struct DemoRun {
+    /// What was run.
+    pub story: Story,
     /// The injected fault and its relative size (sensors: gain error).
     pub fault: Fault,
     /// Relative change (0.5 = +50 %).
@@ -47,33 +107,72 @@ pub struct DemoRun {
 }
 
 impl DemoRun {
+    /// Seconds from the fault's onset to the first point in the red FAULT state (the panel's
+    /// FAULT lamp on), `None` when none came.
+    pub fn detected_after_s(&self) -> Option<f64> {
+        self.points
+            .iter()
+            .find(|p| p.t_s + 1e-9 >= self.fault_at_s && p.panel.fault_lamp)
+            .map(|p| p.t_s - self.fault_at_s)
+    }
+
     /// True when the injected fault is among the final candidates.
     pub fn correct_fault_named(&self) -> bool {
         self.report.isolation.named == Some(IsolationName::expected(self.fault))
     }
 }
 
-/// Runs the demo with `fault` of relative size `change` (-0.95..5) at 5 s.
+/// Runs the demo's `story` (the fault's change -0.95..5).
 ///
 /// # Errors
 /// Simulator or replay configuration errors (not expected for the reference motor).
-pub fn run(fault: Fault, change: f64) -> Result<DemoRun, ExperimentError> {
+pub fn run(story: Story) -> Result<DemoRun, ExperimentError> {
     let params = ParamFile::reference_3hp();
-    let proto = Protocol {
-        duration_s: 8.0,
-        fault_at_s: 5.0,
-        ..Protocol::default()
+    let (fault, change) = story.fault();
+    let (proto, load) = match story {
+        Story::Service { .. } => (
+            Protocol {
+                duration_s: 11.0,
+                fault_at_s: SERVICE_FAULT_AT_S,
+                ..Protocol::default()
+            },
+            // Service: the load is an unknown input.
+            crate::replay::LoadModel::Unknown,
+        ),
+        Story::Paper { .. } => (
+            Protocol {
+                duration_s: 8.0,
+                fault_at_s: 5.0,
+                ..Protocol::default()
+            },
+            // The paper's scenario: its fixed viscous load, a Bl change is a fault.
+            crate::replay::LoadModel::Viscous,
+        ),
     };
-    let sc = scenario(Some((fault, change)), &proto);
+    let mut sc = scenario(Some((fault, change)), &proto);
+    let steps = match story {
+        Story::Service { .. } => vec![
+            (LOAD_STEP_AT_S, LOAD_STEP_SCALE),
+            (LOAD_BACK_AT_S, 1.0),
+        ],
+        Story::Paper { .. } => Vec::new(),
+    };
+    for &(t_s, scale) in &steps {
+        sc.load.steps.push(crate::sim::LoadStep {
+            t_s,
+            torque_nm: None,
+            bl_scale: Some(scale),
+        });
+    }
     let opts = ReplayOptions {
         commission: Some(proto.commission),
         timeline_step_s: TIMELINE_STEP_S,
-        // The paper's scenario: its fixed viscous load, a Bl change is a fault.
-        load: crate::replay::LoadModel::Viscous,
+        load,
         ..ReplayOptions::default()
     };
     let mut next = 0.0;
     let mut announced = false;
+    let mut steps_left = steps.as_slice();
     let mut points = Vec::new();
     let mut replay = Replay::new(&params, sc.sensors.channels(), sc.sample_rate_hz, opts)?;
     simulate(&params, &sc, |row| {
@@ -82,16 +181,25 @@ pub fn run(fault: Fault, change: f64) -> Result<DemoRun, ExperimentError> {
             next += TIMELINE_STEP_S;
             let fault_injected = !announced && row.t_s >= proto.fault_at_s;
             announced |= fault_injected;
+            let load_step = match steps_left.split_first() {
+                Some((&(t, scale), rest)) if row.t_s + 1e-9 >= t => {
+                    steps_left = rest;
+                    Some(scale)
+                }
+                _ => None,
+            };
             points.push(DemoPoint {
                 t_s: row.t_s,
                 speed_rpm: f64::from(o.speed_rad_s * 60.0 / std::f32::consts::TAU),
                 lamps: o.lamps,
                 panel: replay.panel(&o),
                 fault_injected,
+                load_step,
             });
         }
     })?;
     Ok(DemoRun {
+        story,
         fault,
         change,
         fault_at_s: proto.fault_at_s,

@@ -7,20 +7,30 @@ use monitor_core::Fault;
 /// Arguments of `demo`.
 #[derive(Debug, Args)]
 #[command(
-    about = "The main job: simulate a motor, inject a fault mid-run, watch the lamps and the named fault",
-    long_about = "Simulate the 3 hp reference motor started direct-on-line with the paper's \
-viscous load and realistic sensors (12-bit ADC, noise, 1024-line encoder), replay the sensor streams \
-through the same core the firmware runs, learn the healthy residuals (commissioning, 2-4 s), inject a \
-fault at 5 s and print a timeline of the residual lamps r1..r4 and the fault candidates of the paper's \
-Table 1.\n\nExample:\n  sim-host demo --fault lr --change -0.5"
+    about = "The main job: a motor in service, a load step, a fault, the lamps and the fault named",
+    long_about = "Simulate the 3 hp reference motor started direct-on-line with realistic sensors \
+(12-bit ADC, noise, 1024-line encoder) and replay the sensor streams through the same core the \
+firmware runs, printing a timeline of the residual lamps r1..r4, the panel's state and the fault \
+candidates.\n\nThe default run is a day in service: the monitor learns the healthy motor \
+(commissioning, 2-4 s); the load rises 40 % at 5 s and falls back at 6.5 s, shown as what it is (the \
+amber MOVED state and a load move, no fault: the load is an unknown input); the stator resistance \
+rises 50 % at 8.5 s, and the lamps light red and the fault is named with its size. --fault and \
+--change choose another fault for 8.5 s.\n\n--paper runs the paper's protocol instead: one Table 1 \
+fault at 5 s (default: the load friction Bl +50 %) on the paper's fixed viscous load, under which a \
+Bl change is a fault.\n\nExamples:\n  sim-host demo\n  sim-host demo --fault lr --change -0.5\n  \
+sim-host demo --paper"
 )]
 pub struct DemoArgs {
-    /// Fault to inject: rs, rr, ls, lr, b, bl, current_sensor, voltage_sensor, speed_sensor.
-    #[arg(long, default_value = "bl", value_parser = super::parse_fault)]
-    pub fault: Fault,
+    /// Fault to inject: rs, rr, ls, lr, b, bl, current_sensor, voltage_sensor, speed_sensor
+    /// (default: rs; with --paper: bl).
+    #[arg(long, value_parser = super::parse_fault)]
+    pub fault: Option<Fault>,
     /// Relative change, -0.95..5 (0.5 = +50 %; sensor faults: gain error).
     #[arg(long, default_value_t = 0.5, allow_negative_numbers = true, value_parser = parse_change)]
     pub change: f64,
+    /// The paper's protocol: one fault at 5 s on its fixed viscous load (no load step).
+    #[arg(long)]
+    pub paper: bool,
     /// Print one JSON document on stdout instead of the timeline.
     #[arg(long)]
     pub json: bool,
@@ -43,7 +53,19 @@ fn parse_change(s: &str) -> Result<f64, String> {
 /// # Errors
 /// Simulator errors (not expected for the reference motor) or an I/O error on stdout.
 pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
-    let run = sim_host::demo::run(args.fault, args.change)?;
+    use sim_host::demo::Story;
+    let story = if args.paper {
+        Story::Paper {
+            fault: args.fault.unwrap_or(Fault::Bl),
+            change: args.change,
+        }
+    } else {
+        Story::Service {
+            fault: args.fault.unwrap_or(Fault::Rs),
+            change: args.change,
+        }
+    };
+    let run = sim_host::demo::run(story)?;
     if args.json {
         render::json::print(&render::json::demo(&run))
     } else {

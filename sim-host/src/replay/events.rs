@@ -111,6 +111,15 @@ impl EventLog {
         }
     }
 
+    /// The commissioned operating point, where no steady point was recorded yet: the load
+    /// the first move is measured from.
+    pub(super) fn seed(&mut self, p: &SteadyPoint) {
+        let a = active_current(p);
+        if self.load_a.is_none() && a.is_finite() {
+            self.load_a = Some(a);
+        }
+    }
+
     /// A name given for the first time.
     pub(super) fn named(&mut self, t: f64, name: IsolationName, change: f32, probability: f32) {
         self.push(IsolationEvent::Named {

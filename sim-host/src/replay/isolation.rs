@@ -234,6 +234,14 @@ impl IsolationTracker {
         let usable = self.running && !out.sensor_fault.any() && (learning || counts);
         self.lamps_lit |= counts && out.fault_detected;
         let learned = follower.learned();
+        if learned {
+            // Load moves are measured from the commissioned point, and recorded at every
+            // quasi-steady output (the isolation does not run outside the learned range).
+            self.events.seed(&follower.isolator().baseline().at);
+            if usable && out.quasi_steady {
+                self.events.point(t, point);
+            }
+        }
         self.temperature
             .put_in_force(follower, t, temperature_c, learning);
         // Quasi-steady by the vectors themselves (the monitor's gate follows its own frame,

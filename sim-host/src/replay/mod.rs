@@ -313,6 +313,10 @@ pub struct Replay {
     isolation: IsolationTracker,
     /// The symmetrical components, sample by sample ([`sequences::SequenceTracker`]).
     sequences: sequences::SequenceTracker,
+    /// The lamps lit now first lit while the operating point had moved (or the load
+    /// explained them), and have not all been dark since: their release after the load came
+    /// back is still the amber state.
+    lamps_since_moved: bool,
     /// The monitor's count of timing faults (estimator restarts) at the last row.
     timing_faults_seen: u32,
     /// The isolation ignores points until this time [s] (the settling after a restart).
@@ -384,6 +388,7 @@ impl Replay {
                 channels.temperature,
                 opts.load,
             ),
+            lamps_since_moved: false,
             sequences: sequences::SequenceTracker::new(
                 params,
                 channels.voltages,
@@ -487,6 +492,13 @@ impl Replay {
             }
             let point = timeline_point(self, t, &out, range_note);
             self.timeline.push(point);
+        }
+        if !out.lamps.iter().any(|l| *l) {
+            self.lamps_since_moved = false;
+        } else if self.commission.moved_note(&out).is_some()
+            || self.isolation.load_explains_lamps()
+        {
+            self.lamps_since_moved = true;
         }
         self.last = out;
         out

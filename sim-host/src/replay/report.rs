@@ -87,6 +87,12 @@ impl Replay {
             {
                 LOAD_MOVED_NOTE.to_string()
             }
+            // Lamps that lit while the load had moved are still releasing (they go out
+            // after a second inside their bands): amber until they do, unless the isolation
+            // names a fault meanwhile.
+            None if matches!(state, MonitorState::Fault(_)) && self.lamps_since_moved => {
+                LOAD_BACK_NOTE.to_string()
+            }
             None => return state,
         };
         let named = match isolation {
@@ -108,8 +114,19 @@ impl Replay {
         let evaluated = matches!(own, MonitorState::Healthy | MonitorState::Fault(_));
         let isolation = evaluated.then(|| self.isolation_now());
         let state = self.state_given(out, own, isolation.as_ref().map(|(r, _)| r));
+        // Lamps held through the transient after a load move are the load's, not a fault,
+        // unless the isolation names one.
+        let held_for_load = self.lamps_since_moved
+            && !matches!(
+                isolation
+                    .as_ref()
+                    .map_or_else(|| self.isolation_now().0.named, |(r, _)| r.named),
+                Some(isolation::IsolationName::Fault(_))
+            );
         Panel {
-            fault_lamp: out.fault_detected && !matches!(state, MonitorState::Moved(_)),
+            fault_lamp: out.fault_detected
+                && !matches!(state, MonitorState::Moved(_))
+                && !held_for_load,
             isolation,
             state,
         }
@@ -120,6 +137,11 @@ impl Replay {
 /// range, with the load an unknown input (`LoadModel::Unknown`).
 pub const LOAD_MOVED_NOTE: &str =
     "load moved inside the commissioned range; the stator-voltage equations fit (the torque residuals read it as Bl)";
+
+/// The amber state's note while lamps that lit for a load move go out after the load came
+/// back into the commissioned range.
+pub const LOAD_BACK_NOTE: &str =
+    "the load came back; the lamps that lit while it had moved are going out";
 
 /// One point of the diagnosis timeline.
 #[derive(Debug, Clone, Serialize)]

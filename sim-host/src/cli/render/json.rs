@@ -27,10 +27,17 @@ pub fn print<T: Serialize + ?Sized>(v: &T) -> anyhow::Result<()> {
 /// `demo --json`.
 #[derive(Serialize)]
 pub struct DemoReport<'a> {
+    /// `service` (the default run) or `paper` (`--paper`).
+    story: &'static str,
     fault_injected: &'static str,
     change: f64,
     fault_at_s: f64,
     first_detection_s: Option<f64>,
+    /// Seconds from the fault to the first red FAULT state, null when none came.
+    detected_after_s: Option<f64>,
+    /// The isolation's events (load moves and names, with times).
+    events: &'a [sim_host::replay::IsolationEvent],
+    verdict: sim_host::replay::Verdict,
     named: &'a [FaultCandidate],
     correct_fault_among_candidates: bool,
     lamps: &'a BTreeMap<String, bool>,
@@ -40,10 +47,17 @@ pub struct DemoReport<'a> {
 /// The `demo --json` document of a run.
 pub fn demo(run: &DemoRun) -> DemoReport<'_> {
     DemoReport {
+        story: match run.story {
+            sim_host::demo::Story::Service { .. } => "service",
+            sim_host::demo::Story::Paper { .. } => "paper",
+        },
         fault_injected: run.fault.name(),
         change: run.change,
         fault_at_s: run.fault_at_s,
         first_detection_s: run.report.first_detection_s,
+        detected_after_s: run.detected_after_s(),
+        events: &run.report.isolation.events,
+        verdict: run.report.verdict,
         named: &run.report.candidates,
         correct_fault_among_candidates: run.correct_fault_named(),
         lamps: &run.report.lamps,

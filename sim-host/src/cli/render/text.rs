@@ -39,22 +39,33 @@ fn number(x: f64) -> String {
 
 /// The demo's timeline and conclusion.
 pub fn demo(run: &DemoRun) -> anyhow::Result<()> {
+    use sim_host::demo::{Story, LOAD_BACK_AT_S, LOAD_STEP_AT_S, LOAD_STEP_SCALE};
     let mut out = crate::cli::stdout();
-    writeln!(
-        out,
-        "3 hp induction motor, 220 V 60 Hz, direct-on-line start, viscous load; 12-bit sensors with noise.\n\
-         Commissioning 2.0-4.0 s learns the healthy residuals; at {:.1} s: {} {:+.0} %.\n",
-        run.fault_at_s,
-        run.fault.name(),
-        100.0 * run.change
-    )?;
+    let fault = format!("{} {:+.0} %", run.fault.name(), 100.0 * run.change);
+    match run.story {
+        Story::Service { .. } => writeln!(
+            out,
+            "3 hp induction motor, 220 V 60 Hz, started direct-on-line; 12-bit sensors with noise; the load is\n\
+             an unknown input, as in service. Commissioning 2.0-4.0 s learns the healthy motor; the load rises\n\
+             {:.0} % at {LOAD_STEP_AT_S:.1} s and falls back at {LOAD_BACK_AT_S:.1} s; at {:.1} s: {fault}.\n",
+            100.0 * (LOAD_STEP_SCALE - 1.0),
+            run.fault_at_s,
+        )?,
+        Story::Paper { .. } => writeln!(
+            out,
+            "3 hp induction motor, 220 V 60 Hz, direct-on-line start, the paper's fixed viscous load; 12-bit\n\
+             sensors with noise. Commissioning 2.0-4.0 s learns the healthy residuals; at {:.1} s: {fault}.\n",
+            run.fault_at_s,
+        )?,
+    }
     writeln!(out, "  time   speed rpm   r1 r2 r3 r4   state")?;
     for p in &run.points {
         let state = panel_text(&p.panel);
-        let mark = if p.fault_injected {
-            "  <- fault injected"
-        } else {
-            ""
+        let mark = match (p.fault_injected, p.load_step) {
+            (true, _) => "  <- fault injected".to_string(),
+            (false, Some(k)) if k > 1.0 => format!("  <- load +{:.0} %", 100.0 * (k - 1.0)),
+            (false, Some(_)) => "  <- load back".to_string(),
+            (false, None) => String::new(),
         };
         let l = p.lamps.map(lamp);
         writeln!(
@@ -64,13 +75,17 @@ pub fn demo(run: &DemoRun) -> anyhow::Result<()> {
         )?;
     }
     writeln!(out)?;
-    match run.report.first_detection_s {
+    for e in &run.report.isolation.events {
+        if matches!(e, sim_host::replay::IsolationEvent::LoadMoved { .. }) {
+            writeln!(out, "event: {} (not a fault)", e.line().trim())?;
+        }
+    }
+    match run.detected_after_s() {
         Some(t) => writeln!(
             out,
-            "detected {:.2} s after the fault was injected",
-            t - run.fault_at_s
+            "detected {t:.2} s after the fault was injected (the first red FAULT state)"
         )?,
-        None => writeln!(out, "no fault detected")?,
+        None => writeln!(out, "the injected fault never lit the red FAULT state")?,
     }
     writeln!(
         out,
@@ -88,6 +103,14 @@ pub fn demo(run: &DemoRun) -> anyhow::Result<()> {
         }
     )?;
     writeln!(out, "isolation: {}", run.report.isolation.verdict)?;
+    if matches!(run.fault, monitor_core::Fault::B | monitor_core::Fault::Bl) {
+        writeln!(
+            out,
+            "note: B and Bl scale one load term (B + Bl) w: to the paper's model a friction change is a load \
+             change. With the load an unknown input (service, the default) it is a load move, never a fault; \
+             under the paper's fixed viscous load (--paper) it is the fault b/bl, and B and Bl cannot be told apart."
+        )?;
+    }
     verdict(&mut out, &run.report)
 }
 
@@ -173,7 +196,7 @@ fn panel_text(p: &Panel) -> String {
 fn verdict(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
     match rep.verdict {
         Verdict::Fault if rep.lamps.values().any(|l| *l) || !rep.candidates.is_empty() => {
-            writeln!(out, "verdict: FAULT")?
+            writeln!(out, "verdict: FAULT{}", named_fault(rep))?
         }
         // Dark lamps and no candidate at the end: say what the verdict rests on.
         Verdict::Fault => writeln!(
@@ -202,6 +225,23 @@ fn verdict(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
         )?,
     }
     Ok(())
+}
+
+/// The fault the isolation named, with its size and phase, as ` rs +50 %` (empty when it
+/// named none).
+fn named_fault(rep: &DiagnoseReport) -> String {
+    let Some(IsolationName::Fault(f)) = rep.isolation.named else {
+        return String::new();
+    };
+    let c = rep.candidates.iter().find(|c| c.fault == f);
+    let size = c
+        .and_then(|c| c.change)
+        .or(rep.isolation.named_change)
+        .map_or(String::new(), |x| format!(" {:+.0} %", 100.0 * x));
+    let phase = c
+        .and_then(|c| c.phase)
+        .map_or(String::new(), |p| format!(" (phase {})", p.name()));
+    format!(" {}{size}{phase}", f.name())
 }
 
 /// `diagnose`'s timeline, lamps, candidates and unbalance.
