@@ -151,10 +151,7 @@ pub fn run(story: Story) -> Result<DemoRun, ExperimentError> {
     };
     let mut sc = scenario(Some((fault, change)), &proto);
     let steps = match story {
-        Story::Service { .. } => vec![
-            (LOAD_STEP_AT_S, LOAD_STEP_SCALE),
-            (LOAD_BACK_AT_S, 1.0),
-        ],
+        Story::Service { .. } => vec![(LOAD_STEP_AT_S, LOAD_STEP_SCALE), (LOAD_BACK_AT_S, 1.0)],
         Story::Paper { .. } => Vec::new(),
     };
     for &(t_s, scale) in &steps {

@@ -53,7 +53,9 @@ fn last_state(text: &str) -> String {
 
 /// The demo's last state.
 fn demo(fault: &str) -> String {
-    last_state(&stdout(&["demo", "--fault", fault, "--change", "0.5"]))
+    last_state(&stdout(&[
+        "demo", "--paper", "--fault", fault, "--change", "0.5",
+    ]))
 }
 
 /// `diagnose`'s last state on the demo's motor simulated with `sc`, commissioned 2-4 s.

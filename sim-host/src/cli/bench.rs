@@ -74,7 +74,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             detection_limits: limits.as_deref(),
         })
     } else {
-        render::text::bench(&figures, limits.as_deref())
+        render::bench_text::bench(&figures, limits.as_deref())
     }
 }
 
@@ -100,6 +100,6 @@ fn run_isolation(args: &BenchArgs) -> anyhow::Result<()> {
     if args.json {
         render::json::print(&result)
     } else {
-        render::text::isolation_bench(&result)
+        render::bench_text::isolation_bench(&result)
     }
 }

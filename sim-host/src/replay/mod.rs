@@ -495,8 +495,7 @@ impl Replay {
         }
         if !out.lamps.iter().any(|l| *l) {
             self.lamps_since_moved = false;
-        } else if self.commission.moved_note(&out).is_some()
-            || self.isolation.load_explains_lamps()
+        } else if self.commission.moved_note(&out).is_some() || self.isolation.load_explains_lamps()
         {
             self.lamps_since_moved = true;
         }
