@@ -695,6 +695,10 @@ fn within_nominal_uncertainty(n: &Named) -> bool {
     matches!(n, Named::Fault(c) if c.change.abs() <= NOMINAL_UNCERTAINTY)
 }
 
+/// A current this far (relative) from the commissioned point's is another operating point:
+/// an unexplained deviation there is not reported as a possible fault.
+pub const MOVED_FAR: f32 = 0.5;
+
 fn verdict_sentence(iso: &Isolation, detected: bool, moved: Option<f32>) -> String {
     let away = match moved {
         Some(m) if m.abs() >= MOVED_SAID_FROM => format!(
@@ -719,6 +723,14 @@ fn verdict_sentence(iso: &Isolation, detected: bool, moved: Option<f32>) -> Stri
             "The steady-state equations fit the nominal machine: nothing to isolate.".into()
         }
         (IsolationState::NotJudged, _) => "No usable operating point was isolated.".into(),
+        // Far from the commissioned point the learned baseline does not hold: the deviation
+        // is the operating point's, not evidence of a fault (the verdict says the same).
+        (IsolationState::Unknown, _) if moved.is_some_and(|m| m.abs() >= MOVED_FAR) => format!(
+            "The operating point moved far from the commissioned one (current {}): the healthy baseline learned there does not hold here, so the deviation ({:.0} standard deviations) is not judged as a fault; the nearest single faults would be {}. Commission at this load to judge it.",
+            pct(moved.unwrap_or(0.0)),
+            iso.deviation,
+            top(3).join(", ")
+        ),
         (IsolationState::Unknown, _) => format!(
             "A change of {:.0} standard deviations that no single fault explains (an unknown fault, several faults, or a parameter file that does not fit); nearest: {}.{away}",
             iso.deviation,

@@ -366,6 +366,16 @@ impl Replay {
         signature_candidates.sort_by(|a, b| b.probability.total_cmp(&a.probability));
         let detected = self.detected();
         let (mut isolation, mut isolated) = self.isolation.report(detected);
+        // Outside the commissioned range at the end, a deviation no single fault explains
+        // is the new operating point's, said calmly (the verdict withholds a judgement).
+        if isolation.state == monitor_core::IsolationState::Unknown {
+            if let Some(note) = self.commission.moved_note(&out) {
+                isolation.verdict = format!(
+                    "Not judged as a fault: the operating point moved outside the commissioned range ({note}), where the healthy baseline does not hold; the deviation there ({:.0} standard deviations) fits no single fault, as a new load would not. Commission over this load to judge it.",
+                    isolation.deviation_sigma
+                );
+            }
+        }
         isolation::refine_single_phase(
             &mut isolation,
             &mut isolated,
@@ -386,19 +396,23 @@ impl Replay {
             })
             .collect();
         let withheld = self.withheld(&skipped, detected, &isolation);
-        let verdict = if !withheld.is_empty() {
-            Verdict::CouldNotJudge
-        } else if detected {
+        // Shorted turns named against a healthy reference (the change stands clear of what
+        // healthy runs differ by, and its angle of the reference's uncertainty) are a fault
+        // whatever else could not be judged.
+        let winding = unbalance.suspect_phase.is_some() && unbalance.baseline.is_some();
+        let verdict = if winding || (withheld.is_empty() && detected) {
             Verdict::Fault
+        } else if !withheld.is_empty() {
+            Verdict::CouldNotJudge
         } else {
             Verdict::Healthy
         };
         DiagnoseReport {
             verdict,
-            verdict_withheld_because: if verdict == Verdict::CouldNotJudge {
-                withheld
-            } else {
+            verdict_withheld_because: if verdict == Verdict::Fault && detected {
                 Vec::new()
+            } else {
+                withheld
             },
             lamps,
             candidates,

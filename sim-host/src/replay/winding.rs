@@ -23,8 +23,9 @@
 //!    inside its phase's sector by more than its uncertainty. Without voltages a segment at
 //!    another `|I1|` than the reference's widens the spread, `sigma'^2 = sigma^2 +
 //!    (|R| |1 - I1_R/I1|)^2`: the supply's part of `I2` stays as the load moves while `I1`
-//!    does not, so `I2/I1` moves with the load. The segment with the largest change that
-//!    names a phase is reported, else the one with the largest change.
+//!    does not, so `I2/I1` moves with the load. The segment whose change stands out most
+//!    from its spread (`|c|/sigma'`) among those that name a phase is reported, else the one
+//!    that stands out most.
 //! 4. **The reference angle** `arg Z1` (Tallam's loop: `I2/I1 = (mu/3)(Z1/Z_f) a^k`,
 //!    `monitor_core::sequence`): measured as `arg(V1/I1)` where voltages are logged;
 //!    else the model's at the slip from the speed; else at the slip where the model draws
@@ -53,6 +54,8 @@ pub const SEGMENT_STEP_MIN: f32 = 0.015;
 pub const SEGMENT_VOLTAGE_STEP_MIN: f32 = 0.005;
 /// See [`SEGMENT_STEP_MIN`]: a large negative sequence scatters in proportion.
 pub const SEGMENT_STEP_REL: f32 = 0.15;
+/// Unsteady windows in a row that a segment may hold (left out of its means).
+pub const MAX_UNSTEADY_INSIDE: usize = 2;
 /// A window whose `|I1|` differs from its segment's mean by more than this fraction starts
 /// a new segment (the operating point moved).
 pub const SEGMENT_I1_STEP: f32 = 0.05;
@@ -200,38 +203,65 @@ fn features(w: &SequenceWindow) -> [C; 4] {
     [cdiv(w.i.negative(), p), cdiv(w.i.zero(), p), v[0], v[1]]
 }
 
-/// The steady segments of `windows` (module docs, step 1).
+/// Whether window `w` lies outside the segment `cur` (its features or its `|I1|`).
+fn departs(cur: &[&SequenceWindow], w: &SequenceWindow) -> bool {
+    let f = features(w);
+    let moved = (0..4).any(|k| {
+        let m = mean(cur.iter().map(|w| features(w)[k]));
+        let floor = if k < 2 {
+            SEGMENT_STEP_MIN
+        } else {
+            SEGMENT_VOLTAGE_STEP_MIN
+        };
+        abs(sub(f[k], m)) > floor.max(SEGMENT_STEP_REL * abs(m))
+    });
+    let i1_mean = cur.iter().map(|w| abs(w.i.positive())).sum::<f32>() / cur.len().max(1) as f32;
+    moved || (abs(w.i.positive()) - i1_mean).abs() > SEGMENT_I1_STEP * i1_mean
+}
+
+/// The steady segments of `windows` (module docs, step 1). A step must hold for two
+/// windows: one window out of line (a burst of noise) is left out of its segment, two in a
+/// row start the next one.
 pub fn segments(windows: &[SequenceWindow]) -> Vec<SequenceSegment> {
     let mut out = Vec::new();
     let mut cur: Vec<&SequenceWindow> = Vec::new();
+    let mut pending: Option<&SequenceWindow> = None;
     let close = |cur: &mut Vec<&SequenceWindow>, out: &mut Vec<SequenceSegment>| {
         if cur.len() >= MIN_SEGMENT_WINDOWS {
             out.push(segment_of(cur));
         }
         cur.clear();
     };
+    let mut unsteady = 0usize;
     for w in windows {
         if !w.steady {
-            close(&mut cur, &mut out);
+            // One or two unsteady windows (a PLL disturbance, a burst of bad samples) are
+            // left out of the segment; more end it (a run-up, a ramp).
+            unsteady += 1;
+            if unsteady > MAX_UNSTEADY_INSIDE {
+                close(&mut cur, &mut out);
+                pending = None;
+            }
             continue;
         }
-        if !cur.is_empty() {
-            let f = features(w);
-            let moved = (0..4).any(|k| {
-                let m = mean(cur.iter().map(|w| features(w)[k]));
-                let floor = if k < 2 {
-                    SEGMENT_STEP_MIN
-                } else {
-                    SEGMENT_VOLTAGE_STEP_MIN
-                };
-                abs(sub(f[k], m)) > floor.max(SEGMENT_STEP_REL * abs(m))
-            });
-            let i1_mean = cur.iter().map(|w| abs(w.i.positive())).sum::<f32>() / cur.len() as f32;
-            if moved || (abs(w.i.positive()) - i1_mean).abs() > SEGMENT_I1_STEP * i1_mean {
+        unsteady = 0;
+        if cur.is_empty() || !departs(&cur, w) {
+            pending = None;
+            cur.push(w);
+            continue;
+        }
+        match pending.take() {
+            None => pending = Some(w),
+            Some(p) => {
                 close(&mut cur, &mut out);
+                // The first window after a step may straddle it: it starts the new segment
+                // only when the second agrees with it.
+                if !departs(&[p], w) {
+                    cur.push(p);
+                }
+                cur.push(w);
             }
         }
-        cur.push(w);
     }
     close(&mut cur, &mut out);
     out
@@ -643,11 +673,11 @@ impl Replay {
             .enumerate()
             .map(|(k, seg)| judge.judge(k, seg))
             .collect();
-        // The segment with the largest change among those that name a phase, else the
-        // largest change.
+        // The segment whose change stands out most from its spread among those that name a
+        // phase, else the one that stands out most (a short segment's own scatter counts).
+        let z = |j: &Judged| abs(j.change) / j.sigma.max(1e-6);
         let largest = |it: &mut dyn Iterator<Item = &Judged>| {
-            it.max_by(|a, b| abs(a.change).total_cmp(&abs(b.change)))
-                .map(|j| j.index)
+            it.max_by(|a, b| z(a).total_cmp(&z(b))).map(|j| j.index)
         };
         let pick = largest(&mut judged.iter().filter(|j| j.judgement.phase.is_some()))
             .or_else(|| largest(&mut judged.iter()))

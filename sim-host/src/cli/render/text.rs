@@ -192,6 +192,25 @@ fn panel_text(p: &Panel) -> String {
 
 /// The verdict line of `diagnose` and the demo.
 fn verdict(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
+    let u = &rep.unbalance;
+    if let (Verdict::Fault, Some(p), Some(_)) = (rep.verdict, u.suspect_phase, u.baseline) {
+        let also = if rep.verdict_withheld_because.is_empty() {
+            String::new()
+        } else {
+            format!("; not judged: {}", rep.verdict_withheld_because.join("; "))
+        };
+        let named = named_fault(rep);
+        writeln!(
+            out,
+            "verdict: FAULT{}{} shorted turns in phase {} (the negative sequence changed by {:.1} % of I1, confidence {:.2}){also}",
+            named,
+            if named.is_empty() { "" } else { " and" },
+            p.name(),
+            100.0 * u.winding_ratio,
+            u.phase_confidence
+        )?;
+        return Ok(());
+    }
     match rep.verdict {
         Verdict::Fault if rep.lamps.values().any(|l| *l) || !rep.candidates.is_empty() => {
             writeln!(out, "verdict: FAULT{}", named_fault(rep))?
