@@ -81,6 +81,11 @@ pub const FILLED_SAMPLES: usize = 50;
 /// stays within this fraction of its value there (a motor's own asymmetry moves with the
 /// slip; `diagnose --baseline` is the user's choice and is always used).
 pub const BASELINE_I1_TOLERANCE: f32 = 0.1;
+/// The least running, in seconds, on which the lamps must have been judged (evaluated,
+/// quasi-steady, on thresholds in force) for the verdict `healthy`: less is "could not
+/// judge" with how much was judged. One rule for `diagnose`, the HMI's log replay and the
+/// demo (all report through [`Replay::finish`]).
+pub const MIN_JUDGED_S: f64 = 1.0;
 
 /// Errors from setting up or running a replay.
 #[derive(Debug, thiserror::Error)]
@@ -300,6 +305,9 @@ pub struct Replay {
     k_sigma: f32,
     rows: u64,
     evaluated: bool,
+    /// Seconds of running on which the lamps were judged: evaluated, quasi-steady, on
+    /// thresholds in force ([`MIN_JUDGED_S`] for a healthy verdict).
+    judged_s: f64,
     /// A detection happened inside the commissioned operating range (or without one).
     detected_in_range: bool,
     first_detection: Option<f64>,
@@ -369,6 +377,7 @@ impl Replay {
             k_sigma: cfg.thresholds.k_sigma,
             rows: 0,
             evaluated: false,
+            judged_s: 0.0,
             detected_in_range: false,
             first_detection: None,
             detections: Vec::new(),
@@ -428,6 +437,9 @@ impl Replay {
         // the learned ones are in force are not detections: the window says the nominal
         // parameters are not to be trusted (a sensor fault counts at any time).
         let counts = out.sensor_fault.any() || self.commission.thresholds_trusted(&out);
+        if out.evaluating && out.quasi_steady && self.commission.thresholds_trusted(&out) {
+            self.judged_s += self.dt_s;
+        }
         // The bands only matter (and are only looked up) while the gate holds the lamps or a
         // lamp is lit.
         let bands = if out.quasi_steady && !out.fault_detected {

@@ -447,6 +447,12 @@ impl Replay {
                     "the lamps were never evaluated (the motor never ran settled and quasi-steady with voltage)"
                         .to_string(),
                 );
+        } else if self.monitor.is_some() && !detected && self.judged_s < super::MIN_JUDGED_S {
+            withheld.push(format!(
+                "the lamps were judged on only {:.2} s of settled, quasi-steady running (a healthy verdict needs at least {:.1} s): the log is all start or transient, or ends too soon after commissioning",
+                self.judged_s,
+                super::MIN_JUDGED_S
+            ));
         }
         if let Some(why) = self.commission.why_incomplete() {
             withheld.push(why);
