@@ -72,7 +72,11 @@ fn matches(want: &str, actual: &str) -> bool {
     }
     let mut rest = actual;
     for (j, p) in parts.iter().enumerate() {
-        let p = if j + 1 == parts.len() { p.trim_end() } else { p };
+        let p = if j + 1 == parts.len() {
+            p.trim_end()
+        } else {
+            p
+        };
         if p.is_empty() {
             continue;
         }
@@ -88,7 +92,9 @@ fn matches(want: &str, actual: &str) -> bool {
             rest = &rest[at + p.len()..];
         }
     }
-    parts.last().is_none_or(|l| l.trim_end().is_empty() || rest.trim_end().is_empty())
+    parts
+        .last()
+        .is_none_or(|l| l.trim_end().is_empty() || rest.trim_end().is_empty())
 }
 
 fn check(file: &str) -> usize {
@@ -156,7 +162,10 @@ fn the_readme_walkthroughs_print_what_the_readme_shows() {
 fn shown_lines_match_with_elisions() {
     assert!(matches("a ... c", "a b c"));
     assert!(matches("verdict: FAULT rs +...", "verdict: FAULT rs +50 %"));
-    assert!(!matches("verdict: FAULT rs +5...", "verdict: FAULT lr -50 %"));
+    assert!(!matches(
+        "verdict: FAULT rs +5...",
+        "verdict: FAULT lr -50 %"
+    ));
     assert!(matches("x", "x  "));
     assert!(!matches("x", "y"));
     let w = walkthroughs("```\n$ sim-host demo \\\n   --paper\nline\n...\n```\n");

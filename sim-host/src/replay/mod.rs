@@ -437,9 +437,6 @@ impl Replay {
         // the learned ones are in force are not detections: the window says the nominal
         // parameters are not to be trusted (a sensor fault counts at any time).
         let counts = out.sensor_fault.any() || self.commission.thresholds_trusted(&out);
-        if out.evaluating && out.quasi_steady && self.commission.thresholds_trusted(&out) {
-            self.judged_s += self.dt_s;
-        }
         // The bands only matter (and are only looked up) while the gate holds the lamps or a
         // lamp is lit.
         let bands = if out.quasi_steady && !out.fault_detected {
@@ -505,14 +502,23 @@ impl Replay {
             let point = timeline_point(self, t, &out, range_note);
             self.timeline.push(point);
         }
+        self.track_judged(&out);
+        self.last = out;
+        out
+    }
+
+    /// The running the lamps were judged on ([`MIN_JUDGED_S`]), and whether the lamps lit
+    /// now lit while the load had moved.
+    fn track_judged(&mut self, out: &MonitorOutput) {
+        if out.evaluating && out.quasi_steady && self.commission.thresholds_trusted(out) {
+            self.judged_s += self.dt_s;
+        }
         if !out.lamps.iter().any(|l| *l) {
             self.lamps_since_moved = false;
-        } else if self.commission.moved_note(&out).is_some() || self.isolation.load_explains_lamps()
+        } else if self.commission.moved_note(out).is_some() || self.isolation.load_explains_lamps()
         {
             self.lamps_since_moved = true;
         }
-        self.last = out;
-        out
     }
 
     /// The learned calibration (mean and spread of r1..r4), once commissioning is done.
