@@ -283,6 +283,54 @@ pub struct ColumnEntry {
 /// The `[columns]` table: schema column name to [`ColumnEntry`].
 pub type ColumnsTable = std::collections::BTreeMap<String, ColumnEntry>;
 
+/// The entries of a `[columns]` table as TOML lines (`ia_A = { name = "Ia", unit = "mA" }`,
+/// one per key, without the `[columns]` header), for a file that carries a table over.
+pub fn columns_entries_toml(table: &ColumnsTable) -> String {
+    let quoted = |x: &str| toml::Value::String(x.to_string()).to_string();
+    let mut s = String::new();
+    for (key, c) in table {
+        let parts: Vec<String> = [
+            c.name.as_deref().map(|n| format!("name = {}", quoted(n))),
+            c.column.map(|n| format!("column = {n}")),
+            c.unit.as_deref().map(|u| format!("unit = {}", quoted(u))),
+            c.sample_rate_hz
+                .map(|r| format!("sample_rate_hz = {}", toml::Value::Float(r))),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        s.push_str(&format!("{key} = {{ {} }}\n", parts.join(", ")));
+    }
+    s
+}
+
+/// The `[columns]` table of the TOML file `path` (only that table is read: a parameter file,
+/// or a file holding the table alone).
+///
+/// # Errors
+/// [`ParamError::Io`] or [`ParamError::Toml`] naming the file; a file without a `[columns]`
+/// table is [`ParamError::Columns`].
+pub fn load_columns_table(path: &std::path::Path) -> Result<ColumnsTable, ParamError> {
+    #[derive(Deserialize)]
+    struct OnlyColumns {
+        #[serde(default)]
+        columns: Option<ColumnsTable>,
+    }
+    let shown = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| ParamError::Io {
+        path: shown.clone(),
+        source,
+    })?;
+    let f: OnlyColumns = toml::from_str(&text).map_err(|e| ParamError::Toml {
+        path: shown.clone(),
+        message: toml_error_message(&text, &e),
+    })?;
+    f.columns.ok_or(ParamError::Columns {
+        path: shown,
+        message: "the file has no [columns] table".to_string(),
+    })
+}
+
 /// The file as written: [`ParamFile`]'s sections and the optional `[columns]` table.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -2,7 +2,8 @@
 //! `$ sim-host ...` is run (from the repository's root, with the binary for `sim-host`), and
 //! every output line the block shows must appear in the command's output, in order. A line
 //! `...` skips any number of lines; `...` inside a line stands for any text there. Commands
-//! that write files write them into a temporary folder (`--out` is rewritten there).
+//! that write files write them into a temporary folder (`--out NAME` is rewritten there, and
+//! so is `NAME` where a later walkthrough reads it).
 
 use std::path::{Path, PathBuf};
 
@@ -102,15 +103,22 @@ fn check(file: &str) -> usize {
     let tmp = tempfile::tempdir().expect("tempdir");
     let mut failures = Vec::new();
     let runs = walkthroughs(&md);
+    // Files a walkthrough wrote (`--out NAME`), read by the later ones by that name.
+    let mut written: Vec<String> = Vec::new();
     for w in &runs {
         let mut args = w.args.clone();
         for k in 0..args.len() {
             if args[k] == "--out" && k + 1 < args.len() {
-                let name = Path::new(&args[k + 1])
+                written.push(args[k + 1].clone());
+            }
+        }
+        for a in args.iter_mut() {
+            if written.contains(a) {
+                let name = Path::new(a.as_str())
                     .file_name()
                     .map(|n| n.to_os_string())
                     .unwrap_or_default();
-                args[k + 1] = tmp.path().join(name).display().to_string();
+                *a = tmp.path().join(name).display().to_string();
             }
         }
         let o = assert_cmd::Command::cargo_bin("sim-host")

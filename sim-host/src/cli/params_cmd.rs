@@ -117,6 +117,10 @@ pub struct FromNameplateArgs {
     /// NEMA design letter (the stator/rotor leakage split; IEC design N is B).
     #[arg(long, value_enum, default_value_t = DesignArg::B)]
     pub nema_design: DesignArg,
+    /// Carry the [columns] table of this file over (a parameter file of another motor on
+    /// the same DAQ, or a file holding the table alone): the log's channel names and units.
+    #[arg(long, value_name = "FILE")]
+    pub columns_from: Option<PathBuf>,
     /// Write the parameter file here (atomically) instead of printing it.
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
@@ -177,7 +181,19 @@ pub fn run_from_nameplate(args: &FromNameplateArgs) -> anyhow::Result<()> {
         OutputGuard::new(&[]).check_new_file(out, args.force)?;
     }
     let estimate = nameplate::estimate(&args.nameplate())?;
-    let toml = estimate.to_toml();
+    let mut toml = estimate.to_toml();
+    if let Some(from) = &args.columns_from {
+        let table = sim_host::params::load_columns_table(from)?;
+        // Checked as every command that reads a log checks it.
+        sim_host::log::ColumnMapping::from_table(&table, estimate.poles / 2).map_err(|m| {
+            anyhow::anyhow!("--columns-from {}: [columns] {m}", from.display())
+        })?;
+        toml.push_str(&format!(
+            "\n# The log's channels and units, from {}.\n[columns]\n{}",
+            from.display(),
+            sim_host::params::columns_entries_toml(&table)
+        ));
+    }
     super::write_out(args.out.as_deref(), toml.as_bytes())?;
     let mut stdout = super::stdout();
     if args.json {

@@ -129,20 +129,7 @@ pub fn to_toml(id: &Identification, start_text: &str, start_name: &str, log_name
         s.push_str(
             "# The start file's [columns] table: the log's channels and units.\n[columns]\n",
         );
-        let quoted = |x: &str| toml::Value::String(x.to_string()).to_string();
-        for (key, c) in &columns {
-            let parts: Vec<String> = [
-                c.name.as_deref().map(|n| format!("name = {}", quoted(n))),
-                c.column.map(|n| format!("column = {n}")),
-                c.unit.as_deref().map(|u| format!("unit = {}", quoted(u))),
-                c.sample_rate_hz
-                    .map(|r| format!("sample_rate_hz = {}", toml::Value::Float(r))),
-            ]
-            .into_iter()
-            .flatten()
-            .collect();
-            s.push_str(&format!("{key} = {{ {} }}\n", parts.join(", ")));
-        }
+        s.push_str(&crate::params::columns_entries_toml(&columns));
     }
     s
 }

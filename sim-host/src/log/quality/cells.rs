@@ -16,6 +16,10 @@ pub struct CellLimits {
     pub wm_max: f64,
     /// Supply frequency of the parameter file [Hz].
     pub supply_hz: f64,
+    /// The machine's mechanical synchronous speed [rad/s] (0: not known).
+    pub sync_rad_s: f64,
+    /// Its pole pairs.
+    pub pole_pairs: f64,
 }
 
 impl CellLimits {
@@ -29,6 +33,8 @@ impl CellLimits {
             i_max: f64::from(limits.i_max_a),
             wm_max: f64::from(limits.wm_max_rad_s),
             supply_hz: p.supply.f_hz,
+            sync_rad_s: p.supply.omega_rad_s() / f64::from((p.motor.poles / 2).max(1)),
+            pole_pairs: f64::from((p.motor.poles / 2).max(1)),
         }
     }
 }

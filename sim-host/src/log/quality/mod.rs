@@ -63,6 +63,7 @@
 mod cells;
 pub mod encoder;
 mod report;
+mod speed_unit;
 pub mod stuck;
 mod time_base;
 pub mod wiring;
@@ -165,6 +166,8 @@ pub struct QualityStage<'a, S: CleanSink> {
     back_run: (usize, f64),
     burst: Option<(f64, f64)>,
     crossings: CrossingCounter,
+    /// The speed channel's median over synchronous ([`speed_unit`]).
+    speed: speed_unit::SpeedScale,
     clips: super::clipping::ClipTracker,
     encoder: encoder::EncoderTrack,
     stuck: stuck::StuckTracker,
@@ -199,6 +202,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             back_run: (0, f64::NAN),
             burst: None,
             crossings: CrossingCounter::default(),
+            speed: speed_unit::SpeedScale::new(limits.sync_rad_s),
             clips: super::clipping::ClipTracker::default(),
             encoder: encoder::EncoderTrack::new(limits.wm_max),
             stuck: stuck::StuckTracker::default(),
@@ -284,6 +288,11 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             self.q.duration_s = (self.last_t - b.t0_s).max(0.0);
         }
         self.q.current_frequency_hz = self.crossings.median_period().map(|p| 1.0 / p);
+        let running = self
+            .q
+            .current_frequency_hz
+            .is_some_and(|f| (f / self.limits.supply_hz - 1.0).abs() < 0.2);
+        self.q.speed_unit = self.speed.finding(running, self.limits.pole_pairs);
         self.q.timestamp_jitter_rms_s = (self.jitter.0 / self.jitter.1.max(1) as f64).sqrt();
         self.q.wiring = self.wiring.findings();
         self.q.encoder_wraps = self.encoder.wraps;
@@ -527,6 +536,9 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         } else {
             self.end_burst();
             self.crossings.push(r.t_s, r.i_abc[0], 1.0);
+            if let Some(w) = r.wm_rad_s {
+                self.speed.push(w);
+            }
         }
         if bad.any() {
             self.wiring.interrupt();
@@ -635,6 +647,8 @@ mod tests {
         i_max: 100.0,
         wm_max: 1000.0,
         supply_hz: 50.0,
+        sync_rad_s: 157.08,
+        pole_pairs: 2.0,
     };
 
     /// A 50 Hz three-phase row at time `t` (10 A peak).

@@ -97,6 +97,9 @@ pub struct DataQuality {
     /// Frequency of the phase-a current (median zero-crossing period) [Hz], if it
     /// alternates.
     pub current_frequency_hz: Option<f64>,
+    /// The speed channel is no running motor's: the likely unit (`super::speed_unit`);
+    /// null when it is plausible or absent. Not trusted.
+    pub speed_unit: Option<String>,
     /// What the command did about what was found.
     pub actions: Vec<String>,
     /// Stretches the command could not judge (a verdict of "healthy" is withheld when
@@ -271,6 +274,9 @@ impl DataQuality {
                 ));
             }
         }
+        if let Some(s) = &self.speed_unit {
+            distrust.push(s.clone());
+        }
         for c in &self.clipped {
             distrust.push(format!(
                 "{} clips: {:.1} % of its samples sit at {} (a sensor or ADC past its full scale: the readings' amplitude, and every size and residual from it, is not the signal's)",
@@ -283,6 +289,14 @@ impl DataQuality {
 
     /// One line for the text output: "clean" or what was found.
     pub fn summary(&self) -> String {
+        if self.warnings.is_empty() && !self.not_trusted_because.is_empty() {
+            return format!(
+                "{} rows at {:.0} Hz, time in {}: not trusted (below)",
+                self.rows_read,
+                self.sample_rate_hz,
+                self.time_unit.name()
+            );
+        }
         if self.warnings.is_empty() {
             return format!(
                 "clean ({} rows at {:.0} Hz, time in {})",
