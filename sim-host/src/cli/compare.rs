@@ -75,7 +75,7 @@ impl Common {
 
     /// Reads the parameter file and the log (with a progress bar for large logs).
     fn load(&self) -> anyhow::Result<Analysis> {
-        let (params, columns) = sim_host::log::mapping::load_params(&self.params)?;
+        let (params, columns) = super::load_params_for(&self.params, &self.log)?;
         let big = std::fs::metadata(&self.log)
             .map(|m| m.len() > 20_000_000)
             .unwrap_or(false);

@@ -172,7 +172,7 @@ fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
 /// Bad parameter file or log (one line naming the file, line and column), or a log the
 /// core cannot be configured for.
 pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
-    let (params, columns) = sim_host::log::mapping::load_params(&args.params)?;
+    let (params, columns) = super::load_params_for(&args.params, &args.log)?;
     let open = OpenOptions {
         group: args.group.clone(),
         columns,

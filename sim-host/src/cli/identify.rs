@@ -92,7 +92,7 @@ fn check(args: &IdentifyArgs) -> anyhow::Result<()> {
 /// Bad input (one line naming the file, the column or the problem), or a write error.
 pub fn run(args: &IdentifyArgs) -> anyhow::Result<()> {
     check(args)?;
-    let (params, columns) = sim_host::log::mapping::load_params(&args.params)?;
+    let (params, columns) = super::load_params_for(&args.params, &args.log)?;
     let start_text = std::fs::read_to_string(&args.params)
         .with_context(|| format!("reading {}", args.params.display()))?;
     let file = LogFile::open_with(

@@ -213,8 +213,41 @@ pub fn parse_window(s: &str) -> Result<(f64, f64), String> {
     Ok((a, b))
 }
 
-/// Standard output for the renderers: locked, and every write error marked as a
-/// [`StdoutError`] (kept as the `io::Error`'s inner error, its kind unchanged), so that
+/// Reads the parameter file `params` and its `[columns]` mapping for the log `log`
+/// (`sim_host::log::mapping::load_params`). When it cannot be read as a parameter file and
+/// the two look swapped (the parameter file named like a log, the log like a TOML file), the
+/// one-line error says so.
+///
+/// # Errors
+/// The parameter file's error, with the swap named where it looks like one.
+pub fn load_params_for(
+    params: &std::path::Path,
+    log: &std::path::Path,
+) -> anyhow::Result<(sim_host::params::ParamFile, sim_host::log::ColumnMapping)> {
+    let ext = |p: &std::path::Path| {
+        p.extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .unwrap_or_default()
+    };
+    sim_host::log::mapping::load_params(params).map_err(|e| {
+        let looks_log = ["csv", "tdms", "parquet"].contains(&ext(params).as_str());
+        if looks_log || ext(log) == "toml" {
+            anyhow::anyhow!(
+                "--params {} is a log, not a parameter file{}: the arguments look swapped (give --params P.toml LOG)",
+                params.display(),
+                if ext(log) == "toml" {
+                    format!(", and {} a parameter file", log.display())
+                } else {
+                    String::new()
+                }
+            )
+        } else {
+            e.into()
+        }
+    })
+}
+
 /// Writes `bytes` to `out` atomically when an output was asked for (`--out`); nothing
 /// otherwise.
 ///
@@ -229,6 +262,8 @@ pub fn write_out(out: Option<&std::path::Path>, bytes: &[u8]) -> anyhow::Result<
     Ok(())
 }
 
+/// Standard output for the renderers: locked, and every write error marked as a
+/// [`StdoutError`] (kept as the `io::Error`'s inner error, its kind unchanged), so that
 /// `main` can tell a closed pipe (quiet exit) or a full disk on stdout from other errors.
 pub fn stdout() -> Stdout {
     Stdout(std::io::stdout().lock())

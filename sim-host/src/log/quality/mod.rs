@@ -288,11 +288,13 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             self.q.duration_s = (self.last_t - b.t0_s).max(0.0);
         }
         self.q.current_frequency_hz = self.crossings.median_period().map(|p| 1.0 / p);
-        let running = self
-            .q
-            .current_frequency_hz
-            .is_some_and(|f| (f / self.limits.supply_hz - 1.0).abs() < 0.2);
-        self.q.speed_unit = self.speed.finding(running, self.limits.pole_pairs);
+        // Running: the currents alternate (at whatever frequency a drive gives them); the
+        // synchronous speed scales with that frequency.
+        let f_cur = self.q.current_frequency_hz.filter(|f| *f > 1.0);
+        let scale = f_cur.map_or(1.0, |f| f / self.limits.supply_hz);
+        self.q.speed_unit = self
+            .speed
+            .finding(f_cur.is_some(), scale, self.limits.pole_pairs);
         self.q.timestamp_jitter_rms_s = (self.jitter.0 / self.jitter.1.max(1) as f64).sqrt();
         self.q.wiring = self.wiring.findings();
         self.q.encoder_wraps = self.encoder.wraps;

@@ -63,9 +63,16 @@ impl SpeedScale {
     }
 
     /// The finding, when the speed is no running motor's; `running`: the currents alternate
-    /// at about the supply frequency. `pole_pairs` names the electrical-speed mistake.
-    pub(super) fn finding(&self, running: bool, pole_pairs: f64) -> Option<String> {
-        let r = self.median_ratio()?;
+    /// at about the supply frequency; `supply_scale`: the currents' frequency over the
+    /// parameter file's (a drive's output: the synchronous speed scales with it).
+    /// `pole_pairs` names the electrical-speed mistake.
+    pub(super) fn finding(
+        &self,
+        running: bool,
+        supply_scale: f64,
+        pole_pairs: f64,
+    ) -> Option<String> {
+        let r = self.median_ratio()? / supply_scale.max(1e-3);
         if r <= MAX_RATIO && (r >= MIN_RATIO || !running) {
             return None;
         }
@@ -104,20 +111,26 @@ mod tests {
         for _ in 0..1000 {
             s.push(1440.0); // rpm of a 4-pole motor at 4 % slip, read as rad/s
         }
-        let f = s.finding(true, 2.0).expect("a finding");
+        let f = s.finding(true, 1.0, 2.0).expect("a finding");
         assert!(f.contains("rpm but read as rad/s"), "{f}");
         let mut ok = SpeedScale::new(sync);
         for _ in 0..1000 {
             ok.push(150.8);
         }
-        assert_eq!(ok.finding(true, 2.0), None);
+        assert_eq!(ok.finding(true, 1.0, 2.0), None);
+        // A drive at 1.5 times the base frequency turns the motor 1.5 times as fast.
+        let mut fast = SpeedScale::new(sync);
+        for _ in 0..1000 {
+            fast.push(1.5 * 150.8);
+        }
+        assert_eq!(fast.finding(true, 1.5, 2.0), None);
         let mut slow = SpeedScale::new(sync);
         for _ in 0..1000 {
             slow.push(150.8 * std::f64::consts::TAU / 60.0);
         }
-        let f = slow.finding(true, 2.0).expect("a finding");
+        let f = slow.finding(true, 1.0, 2.0).expect("a finding");
         assert!(f.contains("given the unit rpm"), "{f}");
         // At standstill (the currents do not alternate) a low speed is no finding.
-        assert_eq!(slow.finding(false, 2.0), None);
+        assert_eq!(slow.finding(false, 1.0, 2.0), None);
     }
 }
