@@ -697,6 +697,12 @@ pub fn explain(log: &Path, r: &ExplainReport) -> anyhow::Result<()> {
         number(r.baseline_validation_normalized_rms_error),
         number(r.noise_floor)
     )?;
+    // The answer first, then how it was reached.
+    writeln!(out, "{}", r.verdict)?;
+    writeln!(
+        out,
+        "  ranking: the plausible fits by the error they leave on the held-back part of the log, then the fits whose parameters are not physical (a fit that explains much with an impossible value is no explanation)"
+    )?;
     writeln!(
         out,
         "  {:<4} {:<18} {:>10} {:>10} {:>10}  fitted",
@@ -721,7 +727,6 @@ pub fn explain(log: &Path, r: &ExplainReport) -> anyhow::Result<()> {
         writeln!(out, "  skipped: {s}")?;
     }
     writeln!(out, "  unbalance: {}", r.unbalance.summary)?;
-    writeln!(out, "{}", r.verdict)?;
     if let Some(words) = r.base_refit.as_ref().map(|b| b.in_words()) {
         if !words.is_empty() {
             writeln!(out, "  {words}")?;
