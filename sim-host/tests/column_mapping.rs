@@ -580,14 +580,14 @@ fn the_daq_example_reads_through_its_columns_table() {
     let params = repo().join("examples/params/daq_2p2kw.toml");
     let log = repo().join("examples/logs/daq_2p2kw.csv");
     assert!(
-        std::fs::metadata(&log).expect("example").len() <= 300_000,
+        std::fs::metadata(&log).expect("example").len() <= 600_000,
         "the example stays small"
     );
     let d = json(&["diagnose", "--params", s(&params), s(&log), "--json"]);
     let q = &d["data_quality"];
     assert_eq!(q["time_unit"], "s", "{q}");
     assert!(
-        (q["sample_rate_hz"].as_f64().expect("rate") - 4000.0).abs() < 1e-6,
+        (q["sample_rate_hz"].as_f64().expect("rate") - 1000.0).abs() < 1e-6,
         "{q}"
     );
     assert_eq!(q["bad_rows"], 0, "{q}");
@@ -607,7 +607,7 @@ fn the_daq_example_reads_through_its_columns_table() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let rows = Log::read(&out).expect("read").rows;
     let last = rows.last().expect("rows");
-    assert!((last.t_s - 1.49975).abs() < 1e-9, "{last:?}");
+    assert!((last.t_s - 9.999).abs() < 1e-9, "{last:?}");
     let w = last.wm_rad_s.expect("speed");
     assert!(w > 140.0 && w < 157.1, "mechanical rad/s: {w}");
     let i_peak = rows.iter().map(|r| r.i_abc[0].abs()).fold(0.0, f64::max);

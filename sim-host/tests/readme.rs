@@ -1,7 +1,8 @@
 //! The README's walkthroughs print what the README shows: every code block that starts with
 //! `$ sim-host ...` is run (from the repository's root, with the binary for `sim-host`), and
 //! every output line the block shows must appear in the command's output, in order. A line
-//! `...` skips any number of lines; `...` inside a line stands for any text there. Commands
+//! `...` skips any number of lines; `...` inside a line stands for any text there; `# ...`
+//! lines are comments. Commands
 //! that write files write them into a temporary folder (`--out NAME` is rewritten there, and
 //! so is `NAME` where a later walkthrough reads it).
 
@@ -51,7 +52,10 @@ fn walkthroughs(md: &str) -> Vec<Walkthrough> {
             i += 1;
             let mut shown = Vec::new();
             while i < block.len() && !block[i].starts_with("$ ") {
-                shown.push(block[i].to_string());
+                // `# ...` lines are the reader's comments, not output.
+                if !block[i].starts_with('#') {
+                    shown.push(block[i].to_string());
+                }
                 i += 1;
             }
             out.push(Walkthrough {

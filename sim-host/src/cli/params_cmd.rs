@@ -185,9 +185,8 @@ pub fn run_from_nameplate(args: &FromNameplateArgs) -> anyhow::Result<()> {
     if let Some(from) = &args.columns_from {
         let table = sim_host::params::load_columns_table(from)?;
         // Checked as every command that reads a log checks it.
-        sim_host::log::ColumnMapping::from_table(&table, estimate.poles / 2).map_err(|m| {
-            anyhow::anyhow!("--columns-from {}: [columns] {m}", from.display())
-        })?;
+        sim_host::log::ColumnMapping::from_table(&table, estimate.poles / 2)
+            .map_err(|m| anyhow::anyhow!("--columns-from {}: [columns] {m}", from.display()))?;
         toml.push_str(&format!(
             "\n# The log's channels and units, from {}.\n[columns]\n{}",
             from.display(),

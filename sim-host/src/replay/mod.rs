@@ -550,8 +550,23 @@ impl Replay {
     /// input, that the load moved ([`LoadModel::Unknown`]: the lamps' torque residuals see a
     /// load change as the paper's Bl fault).
     fn detected(&self) -> bool {
-        let lamps = self.first_detection.is_some() && !self.isolation.load_explains_lamps();
+        // With the load unknown, lamps whose matching only ever named the friction class
+        // (B, Bl: the load term) read a load move, not a fault.
+        let only_load = self.opts.load == LoadModel::Unknown
+            && !self.detections.is_empty()
+            && self
+                .detections
+                .iter()
+                .all(|d| matches!(d.fault, monitor_core::Fault::B | monitor_core::Fault::Bl))
+            && !self.out_sensor_fault_seen();
+        let lamps =
+            self.first_detection.is_some() && !self.isolation.load_explains_lamps() && !only_load;
         !self.isolation.heating_explains_lamps() && (lamps || self.isolation.named_a_fault())
+    }
+
+    /// A sensor fault was flagged at the end (the lamps' detections then stand).
+    fn out_sensor_fault_seen(&self) -> bool {
+        self.last.sensor_fault.any()
     }
 
     /// Every name the isolation gave so far (a fault or the friction class `b/bl`), each
