@@ -26,7 +26,7 @@ const COLOURS: [Color; 4] = [Color::Cyan, Color::Magenta, Color::Yellow, Color::
 pub fn render(frame: &mut Frame, state: &HmiState) {
     let rows = Layout::vertical([
         Constraint::Length(1), // title
-        Constraint::Length(1), // lamps and state
+        Constraint::Length(2), // lamps and state (the state may take a second line)
         Constraint::Length(5), // residual bars
         Constraint::Length(6), // candidates | operating point
         Constraint::Min(5),    // strip chart
@@ -44,7 +44,7 @@ pub fn render(frame: &mut Frame, state: &HmiState) {
         Span::raw(state.title.as_str()),
     ]);
     frame.render_widget(Paragraph::new(title), rows[0]);
-    frame.render_widget(Paragraph::new(lamps_line(state, rows[1].width)), rows[1]);
+    frame.render_widget(Paragraph::new(lamps_lines(state, rows[1].width)), rows[1]);
     render_residuals(frame, rows[2], state.latest.as_ref());
     let mid =
         Layout::horizontal([Constraint::Percentage(50), Constraint::Percentage(50)]).split(rows[3]);
@@ -65,10 +65,11 @@ fn lamp(on: bool, colour: Color) -> Span<'static> {
 }
 
 /// Lamps r1..r4, the fault lamp (red) or the amber "operating point moved" lamp, and the
-/// monitor's state, fitted into `width` columns at a word boundary.
-fn lamps_line(state: &HmiState, width: u16) -> Line<'static> {
+/// monitor's state: on the lamps' line as far as it fits, the rest on a second line (both
+/// fitted into `width` columns at word boundaries).
+fn lamps_lines(state: &HmiState, width: u16) -> Vec<Line<'static>> {
     let Some(s) = &state.latest else {
-        return Line::from(" waiting for the first reading ...");
+        return vec![Line::from(" waiting for the first reading ...")];
     };
     let mut spans = Vec::new();
     for (k, on) in s.lamps.iter().enumerate() {
@@ -92,9 +93,35 @@ fn lamps_line(state: &HmiState, width: u16) -> Line<'static> {
     };
     spans.push(Span::raw(format!("  {:7.2} s  ", s.t_s)));
     let used: usize = spans.iter().map(|s| s.content.chars().count()).sum();
-    let text = fit_words(&header_text(s), usize::from(width).saturating_sub(used));
-    spans.push(Span::styled(text, style));
-    Line::from(spans)
+    let room = usize::from(width).saturating_sub(used);
+    let text = header_text(s);
+    // The first line takes whole words while they fit; the second takes the rest.
+    let mut first = String::new();
+    let mut rest = text.as_str();
+    for w in text.split(' ') {
+        let next = if first.is_empty() {
+            w.chars().count()
+        } else {
+            first.chars().count() + 1 + w.chars().count()
+        };
+        if next > room {
+            break;
+        }
+        if !first.is_empty() {
+            first.push(' ');
+        }
+        first.push_str(w);
+        rest = rest[w.len()..]
+            .strip_prefix(' ')
+            .unwrap_or(&rest[w.len()..]);
+    }
+    spans.push(Span::styled(first, style));
+    let mut lines = vec![Line::from(spans)];
+    if !rest.is_empty() {
+        let second = fit_words(rest, usize::from(width).saturating_sub(3));
+        lines.push(Line::from(Span::styled(format!("   {second}"), style)));
+    }
+    lines
 }
 
 /// A threshold band `centre±half-width` with the digits it has: the half-width to two
@@ -613,6 +640,16 @@ mod tests {
             );
             assert!(lamps.contains("load (active"), "{w}x{h}: {lamps}");
             assert!(rows.iter().all(|r| r.chars().count() <= usize::from(w)));
+            // Issue 44: the state is not cut at 100 columns: it goes on on a second line,
+            // to its last word (the commissioned range).
+            let k = rows.iter().position(|r| r == lamps).unwrap_or(0);
+            let both = format!("{} {}", rows[k], rows.get(k + 1).map_or("", |r| r.as_str()));
+            if w == 100 {
+                assert!(
+                    !both.contains('…') && both.contains("commissioned"),
+                    "{both}"
+                );
+            }
         }
         // The plain status line says MOVED once and no FAULT.
         let line = state.status_line();
