@@ -95,10 +95,30 @@ impl Common {
         let a = Analysis::load_file(&file, params, opts, &mut |f| progress::set_fraction(&pb, f))
             .context("cannot analyse the log")?;
         pb.finish_and_clear();
+        // A window too short to judge is refused: a model's error over less than
+        // MIN_ANALYSED_PERIODS supply periods says nothing about the machine.
+        let span = match (a.data.t_s.first(), a.data.t_s.last()) {
+            (Some(t0), Some(t1)) => t1 - t0,
+            _ => 0.0,
+        };
+        let least = MIN_ANALYSED_PERIODS / a.params.supply.f_hz;
+        if !(span >= least) {
+            anyhow::bail!(
+                "{}: the analysed window is {:.3} s ({:.1} supply periods): at least {:.2} s ({MIN_ANALYSED_PERIODS:.0} periods) are needed to judge the model (widen --from/--to)",
+                self.log.display(),
+                span,
+                span * a.params.supply.f_hz,
+                least
+            );
+        }
         render::text::quality_warnings(&a.quality);
         Ok(a)
     }
 }
+
+/// Supply periods the analysed window of `compare` and `explain` must hold (0.5 s at
+/// 50 Hz): fewer leave a transient's tail and the noise to judge the model by.
+pub const MIN_ANALYSED_PERIODS: f64 = 25.0;
 
 /// Arguments of `compare`.
 #[derive(clap::Args, Debug, Clone)]

@@ -346,12 +346,12 @@ impl IsolationTracker {
     fn with_evidence(&self, s: String, joint: Option<(Isolation, usize)>) -> String {
         match joint {
             Some((_, n)) if self.evidence.anchored() => format!(
-                "{} (from {n} operating point{} since the change, the stator-voltage equations with the load as an unknown input, and the torque against the load measured just before the change)",
+                "{} (from {n} operating point{} since the change: the stator-voltage equations, which need no load model, and the torque against the load measured just before the change)",
                 s.trim_end_matches('.'),
                 if n == 1 { "" } else { "s" }
             ),
             Some((_, n)) => format!(
-                "{} (from {n} operating points together, the stator-voltage equations only: the load as an unknown input)",
+                "{} (from {n} operating points together: the stator-voltage equations only, which need no load model)",
                 s.trim_end_matches('.')
             ),
             None => s,

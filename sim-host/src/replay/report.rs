@@ -330,6 +330,11 @@ pub enum Verdict {
     Healthy,
     /// The data or the setup does not allow an answer (see `verdict_withheld_because`).
     CouldNotJudge,
+    /// A fault was named, but its size is below [`super::MIN_FAULT_CHANGE`]: what a
+    /// parameter file's error away from the commissioned point and a few kelvin of heating
+    /// move; the motor is watched, no crew is sent (the reason in
+    /// `verdict_withheld_because`).
+    Watching,
 }
 
 impl Replay {
@@ -400,7 +405,23 @@ impl Replay {
         // healthy runs differ by, and its angle of the reference's uncertainty) are a fault
         // whatever else could not be judged.
         let winding = unbalance.suspect_phase.is_some() && unbalance.baseline.is_some();
-        let verdict = if winding || (withheld.is_empty() && detected) {
+        // A named fault too small to send a crew for: watched (the one rule for a FAULT
+        // verdict: a name whose size stands clear of what the file's error and heating move).
+        let small = (!out.sensor_fault.any())
+            .then_some(())
+            .and(isolation.named.zip(isolation.named_change))
+            .filter(|(_, c)| c.abs() < super::MIN_FAULT_CHANGE);
+        let mut withheld = withheld;
+        let verdict = if winding {
+            Verdict::Fault
+        } else if let (Some((name, c)), true, true) = (small, withheld.is_empty(), detected) {
+            withheld.push(format!(
+                "watching: the isolation names {name} {:+.1} %, below the {:.0} % a fault needs (what a parameter file's error away from the commissioned point and a few kelvin of heating move)",
+                100.0 * c,
+                100.0 * super::MIN_FAULT_CHANGE
+            ));
+            Verdict::Watching
+        } else if withheld.is_empty() && detected {
             Verdict::Fault
         } else if !withheld.is_empty() {
             Verdict::CouldNotJudge

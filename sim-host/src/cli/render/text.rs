@@ -235,6 +235,11 @@ fn verdict(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
             }
         )?,
         Verdict::Healthy => writeln!(out, "verdict: healthy")?,
+        Verdict::Watching => writeln!(
+            out,
+            "verdict: {}",
+            rep.verdict_withheld_because.join("; ")
+        )?,
         Verdict::CouldNotJudge => writeln!(
             out,
             "verdict: could not judge: {}",
