@@ -23,6 +23,7 @@
 //! `thiserror` errors; rendering (text, JSON, HTML, plots) is the binary's.
 
 pub mod analysis;
+pub mod api;
 pub mod bench;
 pub mod demo;
 pub mod experiment;

@@ -28,7 +28,7 @@ use std::path::{Path, PathBuf};
 use syn::visit::Visit;
 
 /// sim-host's library modules and their layers, lowest first.
-const LAYERS: [(&str, u8); 13] = [
+const LAYERS: [(&str, u8); 15] = [
     ("params", 1),
     ("log", 2),
     ("nameplate", 2),
@@ -39,7 +39,9 @@ const LAYERS: [(&str, u8); 13] = [
     ("identify", 5),
     ("fault_signatures", 6),
     ("service_profile", 6),
+    ("api", 6),
     ("demo", 7),
+    ("fleet", 7),
     ("bench", 8),
     ("hmi", 8),
 ];

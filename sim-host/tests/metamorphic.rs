@@ -193,6 +193,11 @@ fn judge(
             Err(format!("{name}: could not judge, but gives no reason"))
         }
         (Verdict::CouldNotJudge, _) => Ok(()),
+        // A name below the size a fault needs, said with its reason: no crew sent.
+        (Verdict::Watching, _) if r.verdict_withheld_because.is_empty() => {
+            Err(format!("{name}: watching, but gives no reason"))
+        }
+        (Verdict::Watching, _) => Ok(()),
         (Verdict::Healthy, None) => Ok(()),
         (Verdict::Healthy, Some(f)) => Err(format!("{name}: the {f:?} fault was missed")),
         (Verdict::Fault, want) => {

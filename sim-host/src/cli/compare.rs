@@ -3,9 +3,8 @@
 
 use super::output_guard::OutputGuard;
 use super::{progress, render};
-use anyhow::Context as _;
 use monitor_core::EffectKind;
-use sim_host::analysis::{prep::ReadOptions, Analysis, Options};
+use sim_host::analysis::{Analysis, Options};
 use std::path::PathBuf;
 
 /// Options shared by `compare` and `explain`.
@@ -47,10 +46,7 @@ pub struct Common {
 impl Common {
     /// The analysis options.
     fn options(&self) -> Options {
-        Options {
-            effects: self.effects.clone(),
-            fit_base: !self.no_fit,
-        }
+        self.request(None).options()
     }
 
     /// Refuses outputs that would overwrite an input, and a window that ends before it
@@ -75,50 +71,42 @@ impl Common {
 
     /// Reads the parameter file and the log (with a progress bar for large logs).
     fn load(&self) -> anyhow::Result<Analysis> {
-        let (params, columns) = super::load_params_for(&self.params, &self.log)?;
+        // (Read once here for the swapped-arguments message.)
+        super::load_params_for(&self.params, &self.log)?;
         let big = std::fs::metadata(&self.log)
             .map(|m| m.len() > 20_000_000)
             .unwrap_or(false);
-        let file = sim_host::log::LogFile::open_with(
-            &self.log,
-            &sim_host::log::OpenOptions {
-                group: self.group.clone(),
-                columns,
-            },
-        )
-        .context("cannot analyse the log")?;
         let pb = progress::bar(progress::FRACTION_STEPS, "reading log", big);
-        let opts = ReadOptions {
-            from_s: self.from.unwrap_or(f64::NEG_INFINITY),
-            to_s: self.to.unwrap_or(f64::INFINITY),
-        };
-        let a = Analysis::load_file(&file, params, opts, &mut |f| progress::set_fraction(&pb, f))
-            .context("cannot analyse the log")?;
+        let req = self.request(None);
+        let a = sim_host::api::load_analysis(
+            sim_host::api::ParamsSource::Path(&self.params),
+            &self.log,
+            &req,
+            &mut |f| progress::set_fraction(&pb, f),
+        )
+        .map_err(|e| match e.kind() {
+            sim_host::api::ErrorKind::Params | sim_host::api::ErrorKind::Option => {
+                anyhow::Error::new(e)
+            }
+            _ => anyhow::Error::new(e).context("cannot analyse the log"),
+        })?;
         pb.finish_and_clear();
-        // A window too short to judge is refused: a model's error over less than
-        // MIN_ANALYSED_PERIODS supply periods says nothing about the machine.
-        let span = match (a.data.t_s.first(), a.data.t_s.last()) {
-            (Some(t0), Some(t1)) => t1 - t0,
-            _ => 0.0,
-        };
-        let least = MIN_ANALYSED_PERIODS / a.params.supply.f_hz;
-        if !(span >= least) {
-            anyhow::bail!(
-                "{}: the analysed window is {:.3} s ({:.1} supply periods): at least {:.2} s ({MIN_ANALYSED_PERIODS:.0} periods) are needed to judge the model (widen --from/--to)",
-                self.log.display(),
-                span,
-                span * a.params.supply.f_hz,
-                least
-            );
-        }
         render::text::quality_warnings(&a.quality);
         Ok(a)
     }
-}
 
-/// Supply periods the analysed window of `compare` and `explain` must hold (0.5 s at
-/// 50 Hz): fewer leave a transient's tail and the noise to judge the model by.
-pub const MIN_ANALYSED_PERIODS: f64 = 25.0;
+    /// The library's request for these options.
+    fn request(&self, rotor_bars: Option<u32>) -> sim_host::api::AnalysisRequest {
+        sim_host::api::AnalysisRequest {
+            effects: self.effects.clone(),
+            from_s: self.from,
+            to_s: self.to,
+            no_fit: self.no_fit,
+            group: self.group.clone(),
+            rotor_bars,
+        }
+    }
+}
 
 /// Arguments of `compare`.
 #[derive(clap::Args, Debug, Clone)]
@@ -202,14 +190,6 @@ pub struct ExplainArgs {
     pub rotor_bars: Option<u32>,
 }
 
-/// `explain`'s JSON document: the report plus the motor current signature analysis.
-#[derive(serde::Serialize)]
-struct ExplainJson<'a> {
-    #[serde(flatten)]
-    report: &'a sim_host::analysis::explain::ExplainReport,
-    rotor_asymmetry: &'a sim_host::analysis::rotor_asymmetry::McsaReport,
-}
-
 /// Runs `compare`.
 ///
 /// # Errors
@@ -259,19 +239,7 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
     let out = a.explain(&opts, &move |f| progress::set_fraction(&pbc, f))?;
     pb.finish_and_clear();
     // The motor current signature analysis, with the fitted rotor_asymmetry's delta.
-    let delta = out
-        .report
-        .ranking
-        .iter()
-        .find(|r| r.effect == EffectKind::RotorAsymmetry)
-        .and_then(|r| r.parameters.get("delta"))
-        .map(|p| p.value);
-    let mcsa = sim_host::analysis::rotor_asymmetry::mcsa(
-        &a.data,
-        a.constants.np,
-        args.rotor_bars.map(f64::from),
-        delta,
-    );
+    let mcsa = sim_host::api::mcsa_beside(&a, &out.report, args.rotor_bars);
     render::html::write_explain(
         c.plot.as_deref(),
         c.report.as_deref(),
@@ -280,9 +248,9 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
         &out,
         &mcsa,
     )?;
-    let doc = ExplainJson {
-        report: &out.report,
-        rotor_asymmetry: &mcsa,
+    let doc = sim_host::api::ExplainDocument {
+        report: out.report,
+        rotor_asymmetry: mcsa,
     };
     match (c.json, compared) {
         (true, Some(cmp)) => render::json::print(&render::json::ExplainWithCompare {
@@ -291,8 +259,8 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
         }),
         (true, None) => render::json::print(&doc),
         (false, _) => {
-            render::text::explain(&c.log, &out.report)?;
-            print!("{}", render::mcsa::text(&mcsa));
+            render::text::explain(&c.log, &doc.report)?;
+            print!("{}", render::mcsa::text(&doc.rotor_asymmetry));
             Ok(())
         }
     }

@@ -3,9 +3,6 @@
 
 use super::{progress, render, AngleArg, LoadArg, ResidualArg};
 use clap::Args;
-use sim_host::log::{LogFile, OpenOptions};
-use sim_host::params::ParamFile;
-use sim_host::replay::{diagnose_log, ReplayError, ReplayOptions};
 use std::path::PathBuf;
 
 /// Arguments of `diagnose`.
@@ -101,118 +98,34 @@ pub struct DiagnoseArgs {
     pub json: bool,
 }
 
-/// The healthy logs of `--baseline`: each file as given, each folder's log files (CSV,
-/// TDMS, Parquet, by extension) in name order.
-///
-/// # Errors
-/// A folder without logs, or one that cannot be read.
-fn baseline_files(given: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
-    let mut files = Vec::new();
-    for p in given {
-        if !p.is_dir() {
-            files.push(p.clone());
-            continue;
-        }
-        let mut in_dir: Vec<PathBuf> = std::fs::read_dir(p)
-            .map_err(|e| anyhow::anyhow!("--baseline {}: {e}", p.display()))?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|f| {
-                f.is_file()
-                    && f.extension().and_then(|x| x.to_str()).is_some_and(|x| {
-                        ["csv", "tdms", "parquet"].contains(&x.to_ascii_lowercase().as_str())
-                    })
-            })
-            .collect();
-        if in_dir.is_empty() {
-            anyhow::bail!(
-                "--baseline {}: the folder holds no log (.csv, .tdms or .parquet)",
-                p.display()
-            );
-        }
-        in_dir.sort();
-        files.extend(in_dir);
-    }
-    Ok(files)
-}
-
-/// The negative sequence of the healthy log `path` (replayed without commissioning).
-fn baseline_of(
-    params: &ParamFile,
-    path: &std::path::Path,
-    open: &OpenOptions,
-    opts: ReplayOptions,
-) -> anyhow::Result<sim_host::replay::UnbalanceBaseline> {
-    let file = LogFile::open_with(path, open).map_err(|e| anyhow::anyhow!("--baseline: {e}"))?;
-    let opts = ReplayOptions {
-        commission: None,
-        ..opts
-    };
-    let d = diagnose_log(params, &file, opts, &mut |_| {})
-        .map_err(|e| anyhow::anyhow!("--baseline {}: {e}", path.display()))?;
-    if d.report.unbalance.measured.i2_over_i1 == [0.0, 0.0] {
-        anyhow::bail!(
-            "--baseline {}: no positive-sequence current in that log (the motor never ran)",
-            path.display()
-        );
-    }
-    Ok(d.report.unbalance.measured)
-}
-
-/// True when `a` and `b` name the same file.
-fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => false,
-    }
-}
-
 /// Runs `diagnose`.
 ///
 /// # Errors
 /// Bad parameter file or log (one line naming the file, line and column), or a log the
 /// core cannot be configured for.
 pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
-    let (params, columns) = super::load_params_for(&args.params, &args.log)?;
-    let open = OpenOptions {
-        group: args.group.clone(),
-        columns,
-    };
-    let mut opts = ReplayOptions {
-        angle_source: args.angle.into(),
-        residual_form: args.residuals.into(),
+    // (Read once here for the swapped-arguments message.)
+    super::load_params_for(&args.params, &args.log)?;
+    let req = sim_host::api::DiagnoseRequest {
         commission: args.commission,
         allow_incomplete: args.allow_incomplete,
-        timeline_step_s: args.timeline_step.max(1e-4),
-        unbalance_baseline: None,
+        baseline: args.baseline.clone(),
         load: args.load.into(),
+        angle_source: args.angle.into(),
+        residual_form: args.residuals.into(),
+        timeline_step_s: args.timeline_step,
+        group: args.group.clone(),
     };
-    if !args.baseline.is_empty() {
-        let files = baseline_files(&args.baseline)?;
-        if let Some(same) = files.iter().find(|f| same_file(f, &args.log)) {
-            anyhow::bail!(
-                "--baseline {}: that is the log being judged; give healthy logs of the same motor",
-                same.display()
-            );
-        }
-        let runs = files
-            .iter()
-            .map(|f| baseline_of(&params, f, &open, opts))
-            .collect::<anyhow::Result<Vec<_>>>()?;
-        opts.unbalance_baseline = sim_host::replay::HealthyReference::from_runs(&runs);
-    }
     let big = std::fs::metadata(&args.log)
         .map(|m| m.len() > 20_000_000)
         .unwrap_or(false);
-    let file = LogFile::open_with(&args.log, &open)?;
     let bar = progress::bar(progress::FRACTION_STEPS, "reading log", big);
-    let d = diagnose_log(&params, &file, opts, &mut |f| {
-        progress::set_fraction(&bar, f)
-    })
-    .map_err(|e| match e {
-        // Log errors name the file already; the monitor's configuration does not.
-        ReplayError::Config { .. } => anyhow::Error::new(e).context(args.log.display().to_string()),
-        e => e.into(),
-    })?;
+    let d = sim_host::api::diagnose(
+        sim_host::api::ParamsSource::Path(&args.params),
+        &args.log,
+        &req,
+        &mut |f| progress::set_fraction(&bar, f),
+    )?;
     bar.finish_and_clear();
     render::text::quality_warnings(&d.report.data_quality);
     if args.json {

@@ -4,7 +4,7 @@
 
 use super::output_guard::OutputGuard;
 use clap::{Args, Subcommand, ValueEnum};
-use sim_host::nameplate::{self, Connection, Nameplate, NemaDesign};
+use sim_host::nameplate::{Connection, Nameplate, NemaDesign};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -180,31 +180,12 @@ pub fn run_from_nameplate(args: &FromNameplateArgs) -> anyhow::Result<()> {
         // parameter file (perhaps tuned by hand) is kept unless --force.
         OutputGuard::new(&[]).check_new_file(out, args.force)?;
     }
-    let estimate = nameplate::estimate(&args.nameplate())?;
-    let mut toml = estimate.to_toml();
-    if let Some(from) = &args.columns_from {
-        let table = sim_host::params::load_columns_table(from)?;
-        // Checked as every command that reads a log checks it.
-        sim_host::log::ColumnMapping::from_table(&table, estimate.poles / 2)
-            .map_err(|m| anyhow::anyhow!("--columns-from {}: [columns] {m}", from.display()))?;
-        toml.push_str(&format!(
-            "\n# The log's channels and units, from {}.\n[columns]\n{}",
-            from.display(),
-            sim_host::params::columns_entries_toml(&table)
-        ));
-    }
+    let (estimate, toml) =
+        sim_host::api::params_from_nameplate(&args.nameplate(), args.columns_from.as_deref())?;
     super::write_out(args.out.as_deref(), toml.as_bytes())?;
     let mut stdout = super::stdout();
     if args.json {
-        let doc = serde_json::json!({
-            "nameplate": estimate.nameplate,
-            "poles": estimate.poles,
-            "poles_inferred": estimate.poles_inferred,
-            "slip": estimate.slip,
-            "values": estimate.values,
-            "out": args.out.as_ref().map(|p| p.display().to_string()),
-            "toml": toml,
-        });
+        let doc = sim_host::api::nameplate_document(&estimate, &toml, args.out.as_deref());
         writeln!(stdout, "{}", serde_json::to_string_pretty(&doc)?)?;
     } else if let Some(out) = &args.out {
         writeln!(stdout, "wrote {}", out.display())?;

@@ -28,6 +28,7 @@
 pub mod mechanics;
 pub mod model;
 mod output;
+mod refuse;
 
 use crate::analysis::lm::{self, Bounds};
 use crate::log::{Channels, Row};
@@ -37,6 +38,7 @@ use nalgebra::Complex;
 use serde::Serialize;
 
 pub use output::{inverse_gamma_line, to_toml};
+pub use refuse::{refusal, MAX_FIT_ERROR};
 
 /// Why identification could not run (one line each).
 #[derive(Debug, thiserror::Error)]
