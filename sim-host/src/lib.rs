@@ -28,6 +28,7 @@ pub mod bench;
 pub mod demo;
 pub mod experiment;
 pub mod fault_signatures;
+pub mod fleet;
 pub mod hmi;
 pub mod identify;
 pub mod log;

@@ -10,6 +10,7 @@ mod compare;
 pub mod convert;
 mod demo;
 mod diagnose;
+mod fleet;
 mod hmi;
 mod identify;
 mod output_guard;
@@ -76,6 +77,8 @@ pub enum Cmd {
     Params(params_cmd::ParamsArgs),
     // Identify the circuit from a log.
     Identify(identify::IdentifyArgs),
+    // Many motors' logs, one row each.
+    Fleet(fleet::FleetArgs),
 }
 
 /// Runs a command.
@@ -96,6 +99,7 @@ pub fn run(cmd: Cmd) -> anyhow::Result<()> {
         Cmd::BoardRecord(a) => board_record::run(a),
         Cmd::Params(a) => params_cmd::run(a),
         Cmd::Identify(a) => identify::run(a),
+        Cmd::Fleet(a) => fleet::run(a),
     }
 }
 

@@ -1,0 +1,58 @@
+//! `sim-host fleet`: many motors' logs judged on one machine ([`sim_host::fleet`]), one row
+//! per log, as CSV or JSON: the same table the Python package's Dask run returns.
+
+use super::render;
+use clap::Args;
+use rayon::prelude::*;
+use std::path::PathBuf;
+
+/// Arguments of `fleet`.
+#[derive(Debug, Args)]
+#[command(
+    about = "Judge many motors' logs: one row per log (motor, verdict, fault, size, phase, ...)",
+    long_about = "Diagnose many logs of many motors on this machine, in parallel, and print one row \
+per log: motor, file, rows, rate_hz, verdict, fault, size, phase, confidence, \
+first_detection_s, load_moves, data_quality, error. A bad file is a row with its error, never a \
+failed run.\n\nThe motor table (TOML) says which parameter file, commissioning window, healthy \
+baseline and load belong to which motor, and which logs are its (a pattern on the file name; \
+paths relative to the table's folder):\n\n  [[motor]]\n  name = \"pump_7\"\n  params = \
+\"params/pump_7.toml\"\n  logs = \"pump_7_*\"\n  commission = [2.0, 4.0]   # optional\n  \
+baseline = [\"healthy/pump_7\"]   # optional: healthy logs or folders\n  load = \"unknown\"   # \
+optional: or \"viscous\"\n\nFor hundreds of motors and many machines, the Python package runs the \
+same rows on a Dask cluster (docs/python.md).\n\nExample:\n  sim-host fleet motors.toml logs/*.csv \
+--json"
+)]
+pub struct FleetArgs {
+    /// The motor table (TOML).
+    pub motors: PathBuf,
+    /// The logs (CSV, TDMS or Parquet).
+    #[arg(required = true)]
+    pub logs: Vec<PathBuf>,
+    /// Print one JSON document (a list of rows) instead of CSV.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `fleet`.
+///
+/// # Errors
+/// A motor table that cannot be read, or an error writing to standard output (a log's own
+/// error is its row's).
+pub fn run(args: &FleetArgs) -> anyhow::Result<()> {
+    let table = sim_host::fleet::MotorTable::load(&args.motors)?;
+    let rows: Vec<sim_host::fleet::FleetRow> = args
+        .logs
+        .par_iter()
+        .map(|log| sim_host::fleet::row(&table, log))
+        .collect();
+    if args.json {
+        return render::json::print(&rows);
+    }
+    // (The header comes from the rows' field names: sim_host::fleet::COLUMNS.)
+    let mut w = csv::Writer::from_writer(super::stdout());
+    for r in &rows {
+        w.serialize(r)?;
+    }
+    w.flush()?;
+    Ok(())
+}
