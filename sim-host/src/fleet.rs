@@ -120,15 +120,8 @@ impl MotorTable {
                     )));
                 }
             }
-            let fix = |p: &PathBuf| {
-                if p.is_relative() {
-                    base.join(p)
-                } else {
-                    p.clone()
-                }
-            };
-            m.params = fix(&m.params);
-            m.baseline = m.baseline.iter().map(fix).collect();
+            m.params = from_base(base, &m.params);
+            m.baseline = m.baseline.iter().map(|p| from_base(base, p)).collect();
         }
         Ok(t)
     }
@@ -137,6 +130,15 @@ impl MotorTable {
     pub fn motor_of(&self, log: &Path) -> Option<&MotorEntry> {
         let name = log.file_name()?.to_string_lossy();
         self.motor.iter().find(|m| wildcard(&m.logs, &name))
+    }
+}
+
+/// `p` taken from `base` when relative.
+fn from_base(base: &Path, p: &Path) -> PathBuf {
+    if p.is_relative() {
+        base.join(p)
+    } else {
+        p.to_path_buf()
     }
 }
 
