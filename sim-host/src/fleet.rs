@@ -288,6 +288,24 @@ pub fn row(table: &MotorTable, log: &Path) -> FleetRow {
     }
 }
 
+/// The row of `log` (shown as `shown`: a URL it was fetched from, say), its motor found by
+/// `shown`'s file name.
+pub fn row_shown(table: &MotorTable, log: &Path, shown: &str) -> FleetRow {
+    let mut r = match table.motor_of(Path::new(shown)) {
+        Some(m) => row_for(m, log),
+        None => FleetRow::failed(
+            "",
+            log,
+            "no motor of the table matches this file's name".to_string(),
+        ),
+    };
+    r.file = shown.to_string();
+    if let Some(e) = &mut r.error {
+        *e = e.replace(&log.display().to_string(), shown);
+    }
+    r
+}
+
 /// The row of `log` as motor `m`'s.
 pub fn row_for(m: &MotorEntry, log: &Path) -> FleetRow {
     let req = DiagnoseRequest {

@@ -1,0 +1,163 @@
+"""Typed results: the command's JSON document with its keys as attributes.
+
+``Result.to_dict()`` returns the document exactly as the command line's ``--json`` prints
+it; attribute access returns nested :class:`Result` objects for tables, lists of them for
+lists of tables, and plain values otherwise. The time series come as pandas DataFrames.
+"""
+
+from __future__ import annotations
+
+import copy
+from typing import Any, Dict, List
+
+
+class Result:
+    """A JSON document whose keys are attributes (``r.isolation.events``)."""
+
+    def __init__(self, doc: Dict[str, Any]):
+        object.__setattr__(self, "_doc", doc)
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The document, as the command line's ``--json`` prints it (a deep copy)."""
+        return copy.deepcopy(self._doc)
+
+    def keys(self) -> List[str]:
+        """The document's keys."""
+        return list(self._doc.keys())
+
+    def __getattr__(self, name: str) -> Any:
+        try:
+            return _wrap(self._doc[name])
+        except KeyError:
+            raise AttributeError(
+                f"{type(self).__name__} has no key {name!r} (keys: {', '.join(self._doc)})"
+            ) from None
+
+    def __getitem__(self, name: str) -> Any:
+        return _wrap(self._doc[name])
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._doc
+
+    def __dir__(self) -> List[str]:
+        return sorted(set(super().__dir__()) | set(self._doc))
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise AttributeError("results are read-only: use to_dict() for a copy to change")
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Result) and self._doc == other._doc
+
+    def __repr__(self) -> str:
+        keys = ", ".join(list(self._doc)[:6])
+        more = ", ..." if len(self._doc) > 6 else ""
+        return f"{type(self).__name__}({keys}{more})"
+
+
+def _wrap(v: Any) -> Any:
+    if isinstance(v, dict):
+        return Result(v)
+    if isinstance(v, list) and v and all(isinstance(x, dict) for x in v):
+        return [Result(x) for x in v]
+    return v
+
+
+def _frame(rows: List[Dict[str, Any]]):
+    import pandas as pd
+
+    return pd.DataFrame(rows)
+
+
+class DiagnoseResult(Result):
+    """``diagnose``'s report. Keys: ``verdict``, ``verdict_withheld_because``, ``lamps``,
+    ``candidates``, ``isolation``, ``unbalance``, ``commissioning``, ``data_quality``,
+    ``first_detection_s``, ``timeline``, ... (docs/design.md)."""
+
+    @property
+    def timeline(self):
+        """The timeline as a DataFrame: one row per point (``t_s``; ``r1``..``r4`` the
+        normalised residuals; ``lamp_r1``..``lamp_r4``; ``speed_rad_s``; the states).
+        ``to_dict()["timeline"]`` keeps the JSON's list."""
+        rows = []
+        for p in self._doc.get("timeline", []):
+            row = {k: v for k, v in p.items() if k not in ("residuals", "lamps")}
+            for k, (r, lit) in enumerate(zip(p.get("residuals", []), p.get("lamps", []))):
+                row[f"r{k + 1}"] = r
+                row[f"lamp_r{k + 1}"] = lit
+            rows.append(row)
+        return _frame(rows)
+
+    @property
+    def events(self):
+        """The isolation's events (names and load moves, with times) as a DataFrame."""
+        return _frame(self._doc.get("isolation", {}).get("events", []))
+
+    @property
+    def segments(self):
+        """The negative sequence's steady stretches (``unbalance.segments``) as a
+        DataFrame."""
+        return _frame(self._doc.get("unbalance", {}).get("segments", []))
+
+
+class CompareResult(Result):
+    """``compare``'s report. Keys: ``effects``, ``normalized_rms_error``, ``noise_floor``,
+    ``channels``, ``worst_windows``, ``base_parameters``, ``unbalance``, ``data_quality``."""
+
+    @property
+    def channels_frame(self):
+        """Per-channel RMS errors as a DataFrame."""
+        return _frame(self._doc.get("channels", []))
+
+    @property
+    def worst_windows_frame(self):
+        """The windows where the model fails most, as a DataFrame (the condition flattened)."""
+        rows = []
+        for w in self._doc.get("worst_windows", []):
+            row = {k: v for k, v in w.items() if k != "condition"}
+            row.update({f"condition_{k}": v for k, v in (w.get("condition") or {}).items()})
+            rows.append(row)
+        return _frame(rows)
+
+
+class ExplainResult(Result):
+    """``explain``'s report. Keys: ``baseline_normalized_rms_error``, ``ranking``,
+    ``unexplained``, ``verdict``, ``rotor_asymmetry``, ``data_quality``, ..."""
+
+    @property
+    def ranking_frame(self):
+        """The ranking as a DataFrame (effect, errors, explained fraction, plausibility)."""
+        keep = (
+            "effect",
+            "normalized_rms_error",
+            "validation_normalized_rms_error",
+            "explained_fraction",
+            "plausible",
+            "summary",
+        )
+        return _frame([{k: r.get(k) for k in keep} for r in self._doc.get("ranking", [])])
+
+
+class IdentifyResult(Result):
+    """``identify``'s result. Keys: ``identification`` (``estimates``, ``inverse_gamma``,
+    ``relative_rms_error``, ``solver``, ...), ``out``, ``toml``."""
+
+    @property
+    def estimates_frame(self):
+        """The estimates as a DataFrame: name, unit, start, value, 95 % interval, or why not
+        identified."""
+        return _frame(self._doc.get("identification", {}).get("estimates", []))
+
+
+class NameplateResult(Result):
+    """``params from-nameplate``'s result. Keys: ``nameplate``, ``poles``, ``slip``,
+    ``values`` (each with its range and source), ``toml``."""
+
+    @property
+    def params(self) -> Dict[str, Any]:
+        """The parameter file as a dict (``{"motor": {...}, "supply": {...}}``), usable as
+        ``params`` by the other functions."""
+        try:
+            import tomllib  # Python 3.11+
+        except ImportError:  # pragma: no cover
+            import tomli as tomllib  # type: ignore
+        return tomllib.loads(self._doc["toml"])

@@ -1,0 +1,177 @@
+"""Many motors' logs judged on Dask (``diagnose_many``): one row per log.
+
+The motor table says which parameter file, commissioning window, healthy baseline and load
+belong to which motor, and which logs are its (a pattern on the file name); it is the
+``sim-host fleet`` command's table (docs/python.md), given as a TOML file or as rows (a
+pandas DataFrame or a list of dicts with the keys ``name``, ``params``, ``logs`` and,
+optionally, ``commission``, ``baseline``, ``load``).
+
+Each log is one Dask task: the worker fetches it (any fsspec URL: ``s3://``, ``gs://``,
+``abfs://``, ``http(s)://``; local paths as they are), runs the library's diagnosis (the GIL
+released) and returns the row. A bad file is a row with its ``error``; the run never fails for
+one log. The scheduling, retries and placement are Dask's.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+from typing import Any, Dict, Iterable, List, Optional, Sequence, Union
+
+from . import _native
+
+__all__ = ["diagnose_many", "motor_table_toml", "COLUMNS"]
+
+#: The fleet table's columns, in order (the same as ``sim-host fleet``'s CSV header).
+COLUMNS: List[str] = list(_native.fleet_columns())
+
+
+def _toml_value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, float)):
+        return repr(float(v))
+    if isinstance(v, (str, os.PathLike)):
+        return json.dumps(os.fspath(v))
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    raise ValueError(f"motor table value {v!r} is not a number, text or list")
+
+
+def motor_table_toml(motors: Any) -> str:
+    """The TOML text of a motor table given as rows (a DataFrame or a list of dicts), or read
+    from a TOML file (a path)."""
+    if isinstance(motors, (str, os.PathLike)) and Path(os.fspath(motors)).exists():
+        return Path(os.fspath(motors)).read_text()
+    try:
+        import pandas as pd
+
+        if isinstance(motors, pd.DataFrame):
+            motors = motors.to_dict(orient="records")
+    except ImportError:  # pragma: no cover
+        pass
+    out = []
+    for m in motors:
+        out.append("[[motor]]")
+        for k, v in m.items():
+            if v is None or (isinstance(v, float) and v != v):
+                continue
+            out.append(f"{k} = {_toml_value(v)}")
+    return "\n".join(out) + "\n"
+
+
+def _expand(logs: Union[str, Sequence[str]], storage_options: Optional[Dict[str, Any]]) -> List[str]:
+    """The logs: a list as given, or a glob (local or fsspec URL) expanded."""
+    if isinstance(logs, (str, os.PathLike)):
+        pattern = os.fspath(logs)
+        if any(c in pattern for c in "*?["):
+            import fsspec
+
+            fs, _, paths = fsspec.get_fs_token_paths(pattern, storage_options=storage_options or {})
+            protocol = fs.protocol if isinstance(fs.protocol, str) else fs.protocol[0]
+            if protocol in ("file", "local"):
+                return sorted(paths)
+            return sorted(f"{protocol}://{p}" for p in paths)
+        return [pattern]
+    return [os.fspath(x) for x in logs]
+
+
+def _is_remote(log: str) -> bool:
+    return "://" in log and not log.startswith("file://")
+
+
+def _row(log: str, table_toml: str, base: str, storage_options: Optional[Dict[str, Any]]) -> Dict[str, Any]:
+    """One log's row, on a worker: fetched if remote, diagnosed, its row (never raises)."""
+    shown = log
+    local = log[len("file://"):] if log.startswith("file://") else log
+    tmp = None
+    try:
+        if _is_remote(log):
+            import fsspec
+
+            suffix = Path(log.split("?", 1)[0]).suffix
+            fd, tmp = tempfile.mkstemp(suffix=suffix, prefix="drive_monitor_fleet_")
+            os.close(fd)
+            with fsspec.open(log, "rb", **(storage_options or {})) as src, open(tmp, "wb") as dst:
+                while True:
+                    chunk = src.read(1 << 22)
+                    if not chunk:
+                        break
+                    dst.write(chunk)
+            local = tmp
+        return json.loads(_native.fleet_row(table_toml, base, local, shown))
+    except Exception as e:  # a worker's own failure (a fetch) is the row's error too
+        row = {c: None for c in COLUMNS}
+        row.update(motor="", file=shown, error=f"{type(e).__name__}: {e}")
+        return row
+    finally:
+        if tmp is not None and os.path.exists(tmp):
+            os.remove(tmp)
+
+
+def diagnose_many(
+    logs: Union[str, Sequence[str]],
+    motors: Any,
+    client: Any = None,
+    storage_options: Optional[Dict[str, Any]] = None,
+    base: Optional[Union[str, "os.PathLike[str]"]] = None,
+):
+    """Diagnose many motors' logs on a Dask cluster; one row per log.
+
+    Parameters
+    ----------
+    logs : list of paths/URLs, or a glob (local or any fsspec URL: ``s3://bucket/logs/*.csv``)
+        The logs (CSV, TDMS or Parquet).
+    motors : path to a motor table (TOML), a DataFrame, or a list of dicts
+        Which parameter file, commissioning window, baseline and load belong to which motor,
+        and which logs are its (``logs``: a pattern on the file name).
+    client : dask.distributed.Client, optional
+        Where to run. Default: a ``LocalCluster`` with one single-threaded worker process per
+        core, closed at the end.
+    storage_options : dict, optional
+        fsspec's options for remote logs (credentials, endpoints).
+    base : path, optional
+        The folder the motor table's relative paths start from (default: the table file's
+        folder, or the working directory for rows).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per log, columns :data:`COLUMNS`: motor, file, rows, rate_hz, verdict, fault,
+        size, phase, confidence, first_detection_s, load_moves, data_quality, error.
+    """
+    import pandas as pd
+
+    table = motor_table_toml(motors)
+    if base is None:
+        base = (
+            str(Path(os.fspath(motors)).resolve().parent)
+            if isinstance(motors, (str, os.PathLike))
+            else os.getcwd()
+        )
+    paths = _expand(logs, storage_options)
+    own = client is None
+    cluster = None
+    if own:
+        from dask.distributed import Client, LocalCluster
+
+        cluster = LocalCluster(n_workers=os.cpu_count() or 1, threads_per_worker=1, processes=True)
+        client = Client(cluster)
+    try:
+        futures = client.map(
+            _row,
+            paths,
+            table_toml=table,
+            base=os.fspath(base),
+            storage_options=storage_options,
+            pure=False,
+        )
+        rows = client.gather(futures)
+    finally:
+        if own:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    return pd.DataFrame(rows, columns=COLUMNS)

@@ -1,0 +1,389 @@
+//! `drive_monitor._native`: the Python package's bindings to the library the `sim-host`
+//! command line runs (`sim_host::api`, `sim_host::fleet`). Every function takes paths (the
+//! Python layer writes in-memory data to a temporary Parquet file first) and returns the
+//! command's `--json` document as a string, so a result is the command line's, key for key.
+//!
+//! The GIL is released while the Rust code runs; a panic never crosses into Python (it is
+//! an `InternalError`); errors are the exception classes below, carrying the command line's
+//! one-line message.
+
+use pyo3::create_exception;
+use pyo3::exceptions::PyException;
+use pyo3::prelude::*;
+use sim_host::api::{self, ApiError, ErrorKind, ParamsSource};
+use std::path::PathBuf;
+
+create_exception!(
+    _native,
+    DriveMonitorError,
+    PyException,
+    "Base of every drive_monitor error."
+);
+create_exception!(
+    _native,
+    ParamsError,
+    DriveMonitorError,
+    "The parameter file cannot be read, or is not one."
+);
+create_exception!(
+    _native,
+    LogError,
+    DriveMonitorError,
+    "The log cannot be read, or is not one."
+);
+create_exception!(
+    _native,
+    OptionError,
+    DriveMonitorError,
+    "An option is wrong (a window, a baseline, a name), or the analysis refused the data."
+);
+create_exception!(
+    _native,
+    AnalysisError,
+    DriveMonitorError,
+    "The analysis could not run on this log."
+);
+create_exception!(
+    _native,
+    InternalError,
+    DriveMonitorError,
+    "A bug: the library panicked (please report it with the call)."
+);
+
+/// The exception of an [`ApiError`].
+fn to_py(e: ApiError) -> PyErr {
+    let msg = e.to_string();
+    match e.kind() {
+        ErrorKind::Params => ParamsError::new_err(msg),
+        ErrorKind::Log => LogError::new_err(msg),
+        ErrorKind::Option => OptionError::new_err(msg),
+        ErrorKind::Analysis => AnalysisError::new_err(msg),
+    }
+}
+
+/// Runs `f` without the GIL, a panic turned into [`InternalError`].
+fn run<T: Send>(py: Python<'_>, f: impl FnOnce() -> Result<T, PyErr> + Send) -> PyResult<T> {
+    py.allow_threads(|| {
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|p| {
+            let what = p
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| p.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            Err(InternalError::new_err(format!("internal error: {what}")))
+        })
+    })
+}
+
+/// A parameter file: a path, or (with `is_text`) its TOML text.
+fn params_source<'a>(params: &'a str, is_text: bool) -> ParamsSource<'a> {
+    if is_text {
+        ParamsSource::Toml {
+            text: params,
+            origin: "the parameter dict",
+        }
+    } else {
+        ParamsSource::Path(std::path::Path::new(params))
+    }
+}
+
+fn json<T: serde::Serialize>(v: &T) -> PyResult<String> {
+    serde_json::to_string(v).map_err(|e| InternalError::new_err(e.to_string()))
+}
+
+fn load_of(name: &str) -> PyResult<sim_host::replay::LoadModel> {
+    match name {
+        "unknown" => Ok(sim_host::replay::LoadModel::Unknown),
+        "viscous" => Ok(sim_host::replay::LoadModel::Viscous),
+        other => Err(OptionError::new_err(format!(
+            "load = '{other}': give 'unknown' or 'viscous'"
+        ))),
+    }
+}
+
+fn angle_of(name: &str) -> PyResult<monitor_core::AngleSource> {
+    match name {
+        "rotor-flux" => Ok(monitor_core::AngleSource::RotorFluxCurrentModel),
+        "pll" => Ok(monitor_core::AngleSource::Pll),
+        "zero-crossing" => Ok(monitor_core::AngleSource::ZeroCrossing),
+        other => Err(OptionError::new_err(format!(
+            "angle = '{other}': give 'rotor-flux', 'pll' or 'zero-crossing'"
+        ))),
+    }
+}
+
+fn residuals_of(name: &str) -> PyResult<monitor_core::ResidualForm> {
+    match name {
+        "steady" => Ok(monitor_core::ResidualForm::Steady),
+        "full" => Ok(monitor_core::ResidualForm::Full),
+        other => Err(OptionError::new_err(format!(
+            "residuals = '{other}': give 'steady' or 'full'"
+        ))),
+    }
+}
+
+fn effects_of(names: &[String]) -> PyResult<Vec<monitor_core::EffectKind>> {
+    names
+        .iter()
+        .map(|n| {
+            monitor_core::EffectKind::ALL
+                .iter()
+                .find(|e| e.name() == n.as_str())
+                .copied()
+                .ok_or_else(|| OptionError::new_err(format!("effect '{n}' is not in the library")))
+        })
+        .collect()
+}
+
+/// `diagnose --json` of the log at `log` with the parameter file `params`.
+#[pyfunction]
+#[pyo3(signature = (log, params, params_is_text=false, commission=None, baseline=Vec::new(), load="unknown", angle="rotor-flux", residuals="steady", allow_incomplete=false, timeline_step=0.5, group=None))]
+#[allow(clippy::too_many_arguments)]
+fn diagnose(
+    py: Python<'_>,
+    log: PathBuf,
+    params: String,
+    params_is_text: bool,
+    commission: Option<(f64, f64)>,
+    baseline: Vec<PathBuf>,
+    load: &str,
+    angle: &str,
+    residuals: &str,
+    allow_incomplete: bool,
+    timeline_step: f64,
+    group: Option<String>,
+) -> PyResult<String> {
+    let req = api::DiagnoseRequest {
+        commission,
+        allow_incomplete,
+        baseline,
+        load: load_of(load)?,
+        angle_source: angle_of(angle)?,
+        residual_form: residuals_of(residuals)?,
+        timeline_step_s: timeline_step,
+        group,
+    };
+    run(py, || {
+        let d = api::diagnose(
+            params_source(&params, params_is_text),
+            &log,
+            &req,
+            &mut |_| {},
+        )
+        .map_err(to_py)?;
+        json(&d.report)
+    })
+}
+
+fn analysis_request(
+    effects: &[String],
+    from_s: Option<f64>,
+    to_s: Option<f64>,
+    no_fit: bool,
+    group: Option<String>,
+    rotor_bars: Option<u32>,
+) -> PyResult<api::AnalysisRequest> {
+    Ok(api::AnalysisRequest {
+        effects: effects_of(effects)?,
+        from_s,
+        to_s,
+        no_fit,
+        group,
+        rotor_bars,
+    })
+}
+
+/// `compare --json`.
+#[pyfunction]
+#[pyo3(signature = (log, params, params_is_text=false, effects=Vec::new(), from_s=None, to_s=None, no_fit=false, group=None))]
+#[allow(clippy::too_many_arguments)]
+fn compare(
+    py: Python<'_>,
+    log: PathBuf,
+    params: String,
+    params_is_text: bool,
+    effects: Vec<String>,
+    from_s: Option<f64>,
+    to_s: Option<f64>,
+    no_fit: bool,
+    group: Option<String>,
+) -> PyResult<String> {
+    let req = analysis_request(&effects, from_s, to_s, no_fit, group, None)?;
+    run(py, || {
+        json(&api::compare(params_source(&params, params_is_text), &log, &req).map_err(to_py)?)
+    })
+}
+
+/// `explain --json`.
+#[pyfunction]
+#[pyo3(signature = (log, params, params_is_text=false, effects=Vec::new(), from_s=None, to_s=None, no_fit=false, group=None, rotor_bars=None))]
+#[allow(clippy::too_many_arguments)]
+fn explain(
+    py: Python<'_>,
+    log: PathBuf,
+    params: String,
+    params_is_text: bool,
+    effects: Vec<String>,
+    from_s: Option<f64>,
+    to_s: Option<f64>,
+    no_fit: bool,
+    group: Option<String>,
+    rotor_bars: Option<u32>,
+) -> PyResult<String> {
+    let req = analysis_request(&effects, from_s, to_s, no_fit, group, rotor_bars)?;
+    run(py, || {
+        json(&api::explain(params_source(&params, params_is_text), &log, &req).map_err(to_py)?)
+    })
+}
+
+/// `identify --json`: `{"identification": ..., "out": null, "toml": ...}`.
+#[pyfunction]
+#[pyo3(signature = (log, params, params_is_text=false, from_s=None, to_s=None, group=None))]
+fn identify(
+    py: Python<'_>,
+    log: PathBuf,
+    params: String,
+    params_is_text: bool,
+    from_s: Option<f64>,
+    to_s: Option<f64>,
+    group: Option<String>,
+) -> PyResult<String> {
+    run(py, || {
+        let id = api::identify(
+            params_source(&params, params_is_text),
+            &log,
+            from_s,
+            to_s,
+            group,
+            &mut |_| {},
+        )
+        .map_err(to_py)?;
+        json(&serde_json::json!({
+            "identification": id.identification,
+            "out": null,
+            "toml": id.toml,
+        }))
+    })
+}
+
+/// `params from-nameplate --json`.
+#[pyfunction]
+#[pyo3(signature = (power_kw, voltage_v, current_a, frequency_hz, speed_rpm, power_factor, efficiency, poles=None, connection="star", locked_rotor_ratio=None, nema_design="B", columns_from=None))]
+#[allow(clippy::too_many_arguments)]
+fn params_from_nameplate(
+    py: Python<'_>,
+    power_kw: f64,
+    voltage_v: f64,
+    current_a: f64,
+    frequency_hz: f64,
+    speed_rpm: f64,
+    power_factor: f64,
+    efficiency: f64,
+    poles: Option<u32>,
+    connection: &str,
+    locked_rotor_ratio: Option<f64>,
+    nema_design: &str,
+    columns_from: Option<PathBuf>,
+) -> PyResult<String> {
+    use sim_host::nameplate::{Connection, Nameplate, NemaDesign};
+    let connection = match connection {
+        "star" => Connection::Star,
+        "delta" => Connection::Delta,
+        other => {
+            return Err(OptionError::new_err(format!(
+                "connection = '{other}': give 'star' or 'delta'"
+            )))
+        }
+    };
+    let design = match nema_design {
+        "A" => NemaDesign::A,
+        "B" => NemaDesign::B,
+        "C" => NemaDesign::C,
+        "D" => NemaDesign::D,
+        other => {
+            return Err(OptionError::new_err(format!(
+                "nema_design = '{other}': give 'A', 'B', 'C' or 'D'"
+            )))
+        }
+    };
+    let n = Nameplate {
+        power_kw,
+        voltage_v,
+        current_a,
+        frequency_hz,
+        speed_rpm,
+        power_factor,
+        efficiency,
+        poles,
+        connection,
+        locked_rotor_ratio,
+        design,
+    };
+    run(py, || {
+        let (estimate, toml) =
+            api::params_from_nameplate(&n, columns_from.as_deref()).map_err(to_py)?;
+        json(&api::nameplate_document(&estimate, &toml, None))
+    })
+}
+
+/// `simulate` into `out` (CSV, TDMS or Parquet by extension); the summary.
+#[pyfunction]
+#[pyo3(signature = (params, scenario_toml, out, params_is_text=false))]
+fn simulate(
+    py: Python<'_>,
+    params: String,
+    scenario_toml: String,
+    out: PathBuf,
+    params_is_text: bool,
+) -> PyResult<String> {
+    run(py, || {
+        let s = api::simulate_to_file(params_source(&params, params_is_text), &scenario_toml, &out)
+            .map_err(to_py)?;
+        json(&s)
+    })
+}
+
+/// One log's row of the fleet table (`sim-host fleet`), as JSON: the motor table's text
+/// (`base` its folder, for its relative paths), the log at `log`, shown as `shown`.
+#[pyfunction]
+fn fleet_row(
+    py: Python<'_>,
+    table_toml: String,
+    base: PathBuf,
+    log: PathBuf,
+    shown: String,
+) -> PyResult<String> {
+    run(py, || {
+        let table =
+            sim_host::fleet::MotorTable::from_toml_str(&table_toml, "the motor table", &base)
+                .map_err(|e| OptionError::new_err(e.to_string()))?;
+        json(&sim_host::fleet::row_shown(&table, &log, &shown))
+    })
+}
+
+/// The fleet table's columns, in order.
+#[pyfunction]
+fn fleet_columns() -> Vec<&'static str> {
+    sim_host::fleet::COLUMNS.to_vec()
+}
+
+/// The Rust extension of `drive_monitor`.
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("DriveMonitorError", py.get_type::<DriveMonitorError>())?;
+    m.add("ParamsError", py.get_type::<ParamsError>())?;
+    m.add("LogError", py.get_type::<LogError>())?;
+    m.add("OptionError", py.get_type::<OptionError>())?;
+    m.add("AnalysisError", py.get_type::<AnalysisError>())?;
+    m.add("InternalError", py.get_type::<InternalError>())?;
+    m.add_function(wrap_pyfunction!(diagnose, m)?)?;
+    m.add_function(wrap_pyfunction!(compare, m)?)?;
+    m.add_function(wrap_pyfunction!(explain, m)?)?;
+    m.add_function(wrap_pyfunction!(identify, m)?)?;
+    m.add_function(wrap_pyfunction!(params_from_nameplate, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet_row, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet_columns, m)?)?;
+    Ok(())
+}

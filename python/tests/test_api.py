@@ -1,0 +1,125 @@
+"""The package against the command line: the same documents, from files and from data in
+memory; every error class with the command's message."""
+
+import json
+import subprocess
+
+import numpy as np
+import pandas as pd
+import pyarrow as pa
+import pytest
+
+import drive_monitor as dm
+from conftest import cli_json
+
+MOTULATOR = "examples/logs/motulator_2p2kw_dol.csv"
+MOTULATOR_P = "examples/logs/motulator_2p2kw_dol.toml"
+ITSC = "examples/recordings/itsc"
+
+
+def test_diagnose_is_the_commands_document(repo, sim_host):
+    r = dm.diagnose(repo / MOTULATOR, repo / MOTULATOR_P, commission=(1.5, 2.4))
+    cli = cli_json(sim_host, "diagnose", "--params", MOTULATOR_P, MOTULATOR, "--commission", "1.5:2.4")
+    assert r.to_dict() == cli
+    assert r.verdict == cli["verdict"]
+    assert r.isolation.events[0].event == cli["isolation"]["events"][0]["event"]
+    # The time series as DataFrames.
+    tl = r.timeline
+    assert isinstance(tl, pd.DataFrame) and len(tl) == len(cli["timeline"])
+    assert {"t_s", "r1", "r4", "lamp_r2"} <= set(tl.columns)
+
+
+def test_a_dataframe_a_table_and_arrays_give_the_files_document(repo):
+    path = repo / MOTULATOR
+    from_file = dm.diagnose(path, repo / MOTULATOR_P, commission=(1.5, 2.4)).to_dict()
+    frame = pd.read_csv(path)
+    for data in (frame, pa.Table.from_pandas(frame), {c: frame[c].to_numpy() for c in frame.columns}):
+        got = dm.diagnose(data, repo / MOTULATOR_P, commission=(1.5, 2.4)).to_dict()
+        assert got == from_file
+
+
+def test_params_as_a_dict_and_a_daq_log_through_its_columns(repo, sim_host):
+    import tomllib
+
+    p = tomllib.loads((repo / "examples/params/daq_2p2kw.toml").read_text())
+    r = dm.diagnose(repo / "examples/logs/daq_2p2kw.csv", p, commission=(1.0, 6.5))
+    cli = cli_json(sim_host, "diagnose", "--params", "examples/params/daq_2p2kw.toml",
+                   "examples/logs/daq_2p2kw.csv", "--commission", "1:6.5")
+    assert r.to_dict() == cli
+    assert r.verdict == "healthy"
+
+
+def test_real_recordings_with_a_baseline(repo):
+    r = dm.diagnose(repo / ITSC / "SC_A0_B0_C1_001.csv", repo / ITSC / "baldor_0p75hp.toml",
+                    baseline=[repo / ITSC / "SC_HLT_001.csv", repo / ITSC / "SC_HLT_002.csv"])
+    assert r.unbalance.suspect_phase == "c"
+    assert r.verdict == "fault"
+    assert len(r.segments) == 2
+
+
+def test_compare_explain_identify_nameplate(repo, sim_host):
+    c = dm.compare(repo / MOTULATOR, repo / MOTULATOR_P, from_s=0.8, effects=["load_torque"])
+    cli = cli_json(sim_host, "compare", "--params", MOTULATOR_P, MOTULATOR, "--from", "0.8",
+                   "--effects", "load_torque")
+    assert c.to_dict() == cli
+    assert c.normalized_rms_error < 0.05
+    e = dm.explain(repo / MOTULATOR, repo / MOTULATOR_P, from_s=0.8)
+    assert e.ranking[0].effect == "load_torque"
+    assert e.to_dict() == cli_json(sim_host, "explain", "--params", MOTULATOR_P, MOTULATOR, "--from", "0.8")
+    n = dm.params_from_nameplate(2.2, 400, 4.8, 50, 1438, 0.77, 0.863,
+                                 columns_from=repo / "examples/params/daq_2p2kw.toml")
+    assert n.poles == 4 and "[columns]" in n.toml
+    i = dm.identify(repo / "examples/logs/daq_2p2kw.csv", n.params)
+    assert i.identification.relative_rms_error < 0.01
+    rs = [x for x in i.identification.estimates if x.key == "rs_ohm"][0]
+    assert abs(rs.value / 3.7 - 1) < 0.03
+
+
+def test_simulate_returns_the_schema(repo):
+    frame = dm.simulate(repo / "examples/params/3hp.toml",
+                        "duration_s = 0.5\nsample_rate_hz = 2000.0\nseed = 1\n")
+    assert list(frame.columns[:7]) == ["t_s", "va_V", "vb_V", "vc_V", "ia_A", "ib_A", "ic_A"]
+    assert len(frame) == 1000
+
+
+@pytest.mark.parametrize(
+    "call, error, says",
+    [
+        (lambda r: dm.diagnose(r / MOTULATOR, r / "nosuch.toml"), dm.ParamsError, "nosuch.toml"),
+        (lambda r: dm.diagnose(r / MOTULATOR, {"motor": {"rs_ohm": 1.0}}), dm.ParamsError, "missing"),
+        (lambda r: dm.diagnose(r / "nosuch.csv", r / MOTULATOR_P), dm.LogError, "nosuch.csv"),
+        (lambda r: dm.diagnose({"t_s": np.zeros(3)}, r / MOTULATOR_P), dm.LogError, "ia_A"),
+        (lambda r: dm.diagnose(r / MOTULATOR, r / MOTULATOR_P, commission=(3.0, 2.0)), dm.OptionError, "--commission"),
+        (lambda r: dm.diagnose(r / MOTULATOR, r / MOTULATOR_P, load="heavy"), dm.OptionError, "load"),
+        (lambda r: dm.compare(r / MOTULATOR, r / MOTULATOR_P, from_s=4.99), dm.OptionError, "at least"),
+        (lambda r: dm.identify(r / ITSC / "SC_HLT_001.csv", r / ITSC / "baldor_0p75hp.toml"), dm.OptionError, "identify"),
+    ],
+)
+def test_every_error_class_carries_the_commands_message(repo, call, error, says):
+    with pytest.raises(error) as e:
+        call(repo)
+    assert isinstance(e.value, dm.DriveMonitorError)
+    msg = str(e.value)
+    assert says in msg and "\n" not in msg, msg
+
+
+def test_the_gil_is_released(repo):
+    """Two threads run two diagnoses in about the time of one (the GIL released)."""
+    import threading
+    import time
+
+    def one():
+        dm.diagnose(repo / MOTULATOR, repo / MOTULATOR_P)
+
+    t0 = time.perf_counter()
+    one()
+    single = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    ts = [threading.Thread(target=one) for _ in range(2)]
+    for t in ts:
+        t.start()
+    for t in ts:
+        t.join()
+    both = time.perf_counter() - t0
+    # With the GIL held, two would take twice as long; allow the machine's noise.
+    assert both < 1.8 * single + 0.05, (single, both)
