@@ -401,33 +401,14 @@ impl Replay {
             })
             .collect();
         let withheld = self.withheld(&skipped, detected, &isolation);
-        // Shorted turns named against a healthy reference (the change stands clear of what
-        // healthy runs differ by, and its angle of the reference's uncertainty) are a fault
-        // whatever else could not be judged.
         let winding = unbalance.suspect_phase.is_some() && unbalance.baseline.is_some();
-        // A named fault too small to send a crew for: watched (the one rule for a FAULT
-        // verdict: a name whose size stands clear of what the file's error and heating move).
-        let small = (!out.sensor_fault.any())
-            .then_some(())
-            .and(isolation.named.zip(isolation.named_change))
-            .filter(|(_, c)| c.abs() < super::MIN_FAULT_CHANGE);
-        let mut withheld = withheld;
-        let verdict = if winding {
-            Verdict::Fault
-        } else if let (Some((name, c)), true, true) = (small, withheld.is_empty(), detected) {
-            withheld.push(format!(
-                "watching: the isolation names {name} {:+.1} %, below the {:.0} % a fault needs (what a parameter file's error away from the commissioned point and a few kelvin of heating move)",
-                100.0 * c,
-                100.0 * super::MIN_FAULT_CHANGE
-            ));
-            Verdict::Watching
-        } else if withheld.is_empty() && detected {
-            Verdict::Fault
-        } else if !withheld.is_empty() {
-            Verdict::CouldNotJudge
-        } else {
-            Verdict::Healthy
-        };
+        let (verdict, withheld) = verdict_of(
+            withheld,
+            detected,
+            winding,
+            out.sensor_fault.any(),
+            &isolation,
+        );
         DiagnoseReport {
             verdict,
             verdict_withheld_because: if verdict == Verdict::Fault && detected {
@@ -521,4 +502,44 @@ pub(super) fn timeline_point(
         range_note,
         panel: replay.panel(out),
     }
+}
+
+/// The verdict from the replay's findings: `withheld` the reasons a judgement is withheld
+/// (returned with a watching reason added where it applies), `detected` whether a lamp or
+/// the isolation detected a fault, `winding` whether shorted turns were named against a
+/// healthy reference, `sensor_fault` whether a sensor lamp is lit.
+fn verdict_of(
+    mut withheld: Vec<String>,
+    detected: bool,
+    winding: bool,
+    sensor_fault: bool,
+    isolation: &IsolationReport,
+) -> (Verdict, Vec<String>) {
+    // Shorted turns named against a healthy reference (the change stands clear of what
+    // healthy runs differ by, and its angle of the reference's uncertainty) are a fault
+    // whatever else could not be judged.
+    if winding {
+        return (Verdict::Fault, withheld);
+    }
+    // A named fault too small to send a crew for: watched (the one rule for a FAULT
+    // verdict: a name whose size stands clear of what the file's error and heating move).
+    let small = (!sensor_fault)
+        .then_some(())
+        .and(isolation.named.zip(isolation.named_change))
+        .filter(|(_, c)| c.abs() < super::MIN_FAULT_CHANGE);
+    let verdict = if let (Some((name, c)), true, true) = (small, withheld.is_empty(), detected) {
+        withheld.push(format!(
+            "watching: the isolation names {name} {:+.1} %, below the {:.0} % a fault needs (what a parameter file's error away from the commissioned point and a few kelvin of heating move)",
+            100.0 * c,
+            100.0 * super::MIN_FAULT_CHANGE
+        ));
+        Verdict::Watching
+    } else if withheld.is_empty() && detected {
+        Verdict::Fault
+    } else if !withheld.is_empty() {
+        Verdict::CouldNotJudge
+    } else {
+        Verdict::Healthy
+    };
+    (verdict, withheld)
 }
