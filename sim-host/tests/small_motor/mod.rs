@@ -48,14 +48,27 @@ pub fn three_motors() -> Vec<(&'static str, ParamFile)> {
 #[allow(dead_code)] // (not every test of the three motors warms them)
 pub fn replay_warming(
     p: &ParamFile,
-    mut sc: sim_host::sim::Scenario,
+    sc: sim_host::sim::Scenario,
     (rise_k, tau_s): (f64, f64),
     fault: Option<(monitor_core::Fault, f64, f64)>,
 ) -> sim_host::replay::DiagnoseReport {
+    replay_warming_from(p, sc, (rise_k, tau_s, 4.0), fault, (1.5, 3.5))
+}
+
+/// [`replay_warming`] with the warming from `at_s` and commissioned over `commission`.
+#[allow(dead_code)] // (not every test of the three motors warms them)
+pub fn replay_warming_from(
+    p: &ParamFile,
+    mut sc: sim_host::sim::Scenario,
+    (rise_k, tau_s, at_s): (f64, f64, f64),
+    fault: Option<(monitor_core::Fault, f64, f64)>,
+    commission: (f64, f64),
+) -> sim_host::replay::DiagnoseReport {
     use sim_host::sim::{EffectSpec, FaultSpec};
     if rise_k > 0.0 {
-        let toml =
-            format!("name = \"thermal_drift\"\nrise_k = {rise_k}\ntau_s = {tau_s}\nat_s = 4.0\n");
+        let toml = format!(
+            "name = \"thermal_drift\"\nrise_k = {rise_k}\ntau_s = {tau_s}\nat_s = {at_s}\n"
+        );
         sc.effects
             .push(toml::from_str::<EffectSpec>(&toml).expect("effect"));
     }
@@ -63,7 +76,7 @@ pub fn replay_warming(
         sc.faults.push(FaultSpec::parametric(f, at_s, change));
     }
     let opts = sim_host::replay::ReplayOptions {
-        commission: Some((1.5, 3.5)),
+        commission: Some(commission),
         ..Default::default()
     };
     sim_host::experiment::simulate_and_replay(p, p, &sc, opts, |_, _| {})

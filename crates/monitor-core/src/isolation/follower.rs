@@ -181,6 +181,8 @@ pub struct Follower {
     /// against it).
     mean: Option<SteadyBand>,
     learning: bool,
+    /// Time since learning began [s] (the learned points' times).
+    learning_s: f32,
     learned: bool,
     last: Option<Isolation>,
     /// The name of the latest isolation, and how long it has been named [s].
@@ -213,6 +215,7 @@ impl Follower {
             next: 0,
             mean: None,
             learning: false,
+            learning_s: 0.0,
             learned: false,
             last: None,
             pending: None,
@@ -282,6 +285,12 @@ impl Follower {
             self.learned |= ok;
             ended = Some(ok);
         }
+        if learning && !self.learning {
+            self.learning_s = 0.0;
+        }
+        if learning {
+            self.learning_s += dt;
+        }
         self.learning = learning;
         if !usable {
             self.restart();
@@ -319,15 +328,28 @@ impl Follower {
             return Step::Waiting;
         }
         if learning {
-            self.isolator.learn(&avg);
+            // (The averaged point's time: the middle of its blocks.)
+            let t = crate::maxf(self.learning_s - 0.5 * averaged_s, 0.0);
+            self.isolator.learn_at(&avg, t);
             Step::Learned
         } else {
             let scale = crate::sqrt(AVERAGE_MAX_S / averaged_s);
             let mut result = self.isolator.isolate_scaled(&avg, scale);
             // Heating is not a fault: the machine judged against warms with the winding,
             // and the point is judged again (module docs of `crate::isolation`).
+            let was_healthy = self
+                .last
+                .is_none_or(|l| l.state == super::IsolationState::NoDeviation);
+            // (Only a full average can hold blocks from before a change that stayed inside
+            // the band; one begun after a band restart cannot.)
+            let full = self.filled >= BLOCKS;
+            let onset = was_healthy && full && !self.onset_restarted;
             let warming = self.isolator.winding_rise_k().abs() >= super::WARMING_K;
-            let heating = result.heating_explains() || (warming && result.heating_continues());
+            // (A warming that begins is judged on blocks after the onset, as a fault is:
+            // the blend of a step fault's onset can fit a small heating best.)
+            let heating = result.heating_explains()
+                || (warming && result.heating_continues())
+                || (!onset && result.heating_begins());
             if self.learned && heating {
                 self.track(result.heating.factor);
                 result = self.isolator.isolate_scaled(&avg, scale);
@@ -336,13 +358,7 @@ impl Follower {
                 result.state,
                 super::IsolationState::Isolated | super::IsolationState::Unknown
             );
-            let was_healthy = self
-                .last
-                .is_none_or(|l| l.state == super::IsolationState::NoDeviation);
-            // (Only a full average can hold blocks from before a change that stayed inside
-            // the band; one begun after a band restart cannot.)
-            let full = self.filled >= BLOCKS;
-            if deviates && !heating && was_healthy && full && !self.onset_restarted {
+            if deviates && !heating && onset {
                 // The onset of a deviation: the average is begun again after it (module
                 // docs).
                 self.onset_restarted = true;

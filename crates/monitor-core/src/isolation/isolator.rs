@@ -114,28 +114,55 @@ impl Isolator {
         Ok(())
     }
 
-    /// Adds a healthy operating point to the baseline being learned (commissioning).
-    /// Points that give no residuals are skipped.
+    /// Adds a healthy operating point to the baseline being learned (commissioning), as
+    /// [`Isolator::learn_at`] with the point's time counted as [`super::STEP_S`] per point
+    /// (points learned at a steady pace).
     pub fn learn(&mut self, p: &SteadyPoint) {
+        let t = self.learning.n as f32 * super::STEP_S;
+        self.learn_at(p, t);
+    }
+
+    /// Adds a healthy operating point to the baseline being learned (commissioning), `t_s`
+    /// [s] after learning began (non-decreasing from point to point). Points that give no
+    /// residuals, and non-finite times, are skipped.
+    pub fn learn_at(&mut self, p: &SteadyPoint, t_s: f32) {
         let Some(e) = self.residuals(p, None) else {
             return;
         };
+        // The heating direction: de/dk for Rs and Rr times k (finite difference).
+        let Some(warm) = self.warmer(1.0 + LEARN_DK).residuals(p, None) else {
+            return;
+        };
+        if !t_s.is_finite() {
+            return;
+        }
         let l = &mut self.learning;
+        if l.n == 0 {
+            l.shift = e.to_array();
+        }
         l.n = l.n.saturating_add(1);
-        let n = l.n as f32;
-        l.at.approach(p, 1.0 / n);
+        l.t_last = t_s;
+        l.at.approach(p, 1.0 / l.n as f32);
         l.range.learn(p.operating_point());
-        for ((m, m2), x) in l.mean.iter_mut().zip(l.m2.iter_mut()).zip(e.to_array()) {
-            let d = x - *m;
-            *m += d / n;
-            *m2 += d * (x - *m);
+        for (((sums, shift), x), w) in l
+            .sums
+            .iter_mut()
+            .zip(l.shift)
+            .zip(e.to_array())
+            .zip(warm.to_array())
+        {
+            sums.add(x - shift, (w - x) / LEARN_DK * t_s);
         }
     }
 
     /// Ends learning: the learned mean and twice the learned standard deviation (at least
     /// [`LEARNED_SPREAD_FLOOR`]: a short window's scatter understates what a longer run
-    /// meets) go into force. Returns false, and keeps the baseline in force, with fewer than
-    /// [`MIN_LEARNED_POINTS`] points learned (or non-finite statistics).
+    /// meets) go into force. A winding that warmed (or cooled) steadily over the window at
+    /// one load is taken out of both (module docs, "Heating during commissioning"): the
+    /// mean is the machine's at the window's start, the spread that about the warming
+    /// trend, and the tracked heating factor that at the window's end. Returns false, and
+    /// keeps the baseline in force, with fewer than [`MIN_LEARNED_POINTS`] points learned
+    /// (or non-finite statistics).
     pub fn finish_learning(&mut self) -> bool {
         let l = self.learning;
         self.learning = Learning::default();
@@ -143,23 +170,55 @@ impl Isolator {
             return false;
         }
         let n = l.n as f32;
+        // The warming rate r (x = m + r u) fitted on the three residuals weighted by the
+        // default spreads.
+        let centred = l.sums.map(|s| s.centred(n));
+        let (mut num, mut den, mut ss0) = (0.0, 0.0, 0.0);
+        for ((xx, xu, uu), d) in centred.iter().zip(DEFAULT_SPREAD.to_array()) {
+            let w = 1.0 / (d * d);
+            num += w * xu;
+            den += w * uu;
+            ss0 += w * xx;
+        }
+        let r = if den > 0.0 { num / den } else { 0.0 };
+        // The trend is a warming only at one load (a load that moved moves the residuals
+        // by the file's error), of at least WARMING_K over the window (a healthy window's
+        // noise makes trends of a kelvin or two), and where it explains most of the scatter.
+        let one_load = l
+            .range
+            .load_a
+            .is_some_and(|[lo, hi]| hi - lo < WIDE_SPAN * crate::maxf(lo.abs(), hi.abs()));
+        let remaining = ss0 - r * num;
+        let rise = -r * l.t_last;
+        let warming = one_load
+            && r.is_finite()
+            && rise.abs() >= COPPER_ALPHA_PER_K * WARMING_K
+            && remaining <= (1.0 - WARMING_EXPLAINS) * ss0
+            && (HEATING_K_MIN..=HEATING_K_MAX).contains(&(1.0 + rise));
+        let r = if warming { r } else { 0.0 };
         let mut spread = [0.0; 3];
-        for ((s, m2), d) in spread
+        let mut mean = [0.0; 3];
+        for ((((s, m), (xx, xu, uu)), (sums, shift)), floor) in spread
             .iter_mut()
-            .zip(l.m2)
+            .zip(mean.iter_mut())
+            .zip(centred)
+            .zip(l.sums.iter().zip(l.shift))
             .zip(LEARNED_SPREAD_FLOOR.to_array())
         {
-            *s = crate::maxf(2.0 * crate::sqrt(m2 / (n - 1.0)), d);
+            let var = crate::maxf(xx - 2.0 * r * xu + r * r * uu, 0.0) / (n - 1.0);
+            *s = crate::maxf(2.0 * crate::sqrt(var), floor);
+            *m = shift + (sums.x - r * sums.u) / n;
         }
         let ok = self
             .set_baseline(Baseline {
-                mean: ParityResiduals::from_array(l.mean),
+                mean: ParityResiduals::from_array(mean),
                 spread: ParityResiduals::from_array(spread),
                 at: l.at,
             })
             .is_ok();
         if ok {
             self.learned_range = l.range;
+            self.heating_factor = if warming { 1.0 + rise } else { 1.0 };
         }
         ok
     }
