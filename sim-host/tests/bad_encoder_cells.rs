@@ -30,10 +30,10 @@ fn spoil(csv: &str) -> (String, usize) {
     for b in 0..40usize {
         let first = 1 + 22_500 + 350 * b; // row of 4.5 s + 70 ms per burst (5 kHz)
         let rows = if b % 8 == 0 { 2 } else { 1 };
-        for row in first..first + rows {
-            let mut cells: Vec<String> = lines[row].split(',').map(str::to_string).collect();
+        for line in lines.iter_mut().skip(first).take(rows) {
+            let mut cells: Vec<String> = line.split(',').map(str::to_string).collect();
             cells[col] = kinds[b % kinds.len()].to_string();
-            lines[row] = cells.join(",");
+            *line = cells.join(",");
             spoilt += 1;
         }
     }
