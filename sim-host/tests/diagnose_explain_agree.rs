@@ -129,3 +129,55 @@ fn diagnose_and_explain_agree_on_twenty_logs() {
         );
     }
 }
+
+/// An effect-free control (issue 40): a healthy 0.37 kW machine (per-unit values typical of
+/// its size, `tests/small_motor`) on V/f steps (50 -> 40 -> 30 -> 50 Hz with the voltage),
+/// 10 s at 5 kHz, explained with the four dynamics effects `compare`'s advice leads to, on
+/// the whole log and after the start: no effect is claimed. (A run of an earlier version
+/// named `supply_unbalance` here.)
+#[test]
+fn a_healthy_motor_on_vf_steps_claims_no_effect() {
+    let w = std::f64::consts::TAU * 50.0;
+    let (lm, ll) = (260.0 / w, 16.0 / w);
+    let w_rated = std::f64::consts::TAU * 1375.0 / 60.0;
+    let bl = 370.0 / (w_rated * w_rated);
+    let params = format!(
+        "[motor]\nrs_ohm = 30.0\nrr_ohm = 24.0\nls_h = {ls}\nlr_h = {ls}\nlm_h = {lm}\npoles = 4\nj_kgm2 = 0.0009\nb_nms = {b}\nbl_nms = {bl}\n[supply]\nv_ll_rms = 400.0\nf_hz = 50.0\n",
+        ls = lm + ll,
+        b = 0.005 * bl
+    );
+    let source = || ParamsSource::Toml {
+        text: &params,
+        origin: "the 0.37 kW machine",
+    };
+    let scenario = "duration_s = 10.0\nsample_rate_hz = 5000.0\nseed = 4\n[supply]\nsteps = [{ t_s = 3.0, v_scale = 0.8, f_hz = 40.0 }, { t_s = 5.0, v_scale = 0.6, f_hz = 30.0 }, { t_s = 7.0, v_scale = 1.0, f_hz = 50.0 }]\n";
+    let dir = tempfile::tempdir().expect("temp dir");
+    let log = dir.path().join("vf.csv");
+    api::simulate_to_file(source(), scenario, &log).expect("simulates");
+    let dynamics: Vec<monitor_core::EffectKind> = [
+        "flux_dynamics",
+        "current_dynamics",
+        "d_axis_dynamics",
+        "cross_coupling_dynamics",
+    ]
+    .iter()
+    .map(|n| monitor_core::EffectKind::from_name(n).expect("an effect"))
+    .collect();
+    for from_s in [None, Some(0.3)] {
+        let req = AnalysisRequest {
+            effects: dynamics.clone(),
+            from_s,
+            ..Default::default()
+        };
+        let e = api::explain(source(), &log, &req).expect("explains");
+        let verdict = e["verdict"].as_str().unwrap_or_default();
+        eprintln!(
+            "from {from_s:?}: {}",
+            verdict.chars().take(160).collect::<String>()
+        );
+        assert!(
+            !verdict.starts_with("missing effect"),
+            "from {from_s:?}: {verdict}"
+        );
+    }
+}
