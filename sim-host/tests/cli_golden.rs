@@ -94,7 +94,9 @@ const INTENDED: [(&str, &str, &str); 14] = [
 
 /// Keys added since the golden outputs were taken (issue 8: the data-quality stage's
 /// report, what commissioning did, the verdict, the range note beside a lamp).
-const ADDED: [&str; 63] = [
+const ADDED: [&str; 64] = [
+    // Issue 40: a healthy verdict's detection limits at the commissioned point.
+    "detection_limits",
     // Issue 44: the speed channel's unit judged (data quality).
     "speed_unit",
     // Issue 42: the demo's story, detection after the fault and verdict (its `events` are

@@ -476,6 +476,11 @@ impl IsolationTracker {
             first_named: self.first_named,
             events: self.events.events().to_vec(),
             events_dropped: self.events.dropped(),
+            detection_limits: if learned && iso.state == IsolationState::NoDeviation {
+                self.detection_limits()
+            } else {
+                Vec::new()
+            },
         };
         (report, candidates)
     }
@@ -627,6 +632,44 @@ pub struct IsolationReport {
     /// `temperature_channel`, present only for a log with the column).
     #[serde(flatten)]
     pub temperature: super::temperature::TemperatureReport,
+    /// Where nothing deviated from a learned baseline: the smallest change of each fault
+    /// the isolation would have seen at the commissioned point
+    /// ([`monitor_core::Isolator::detection_limit`]), so that "healthy" says how small a
+    /// fault it can rule out; absent (JSON) otherwise.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub detection_limits: Vec<DetectionLimit>,
+}
+
+/// The smallest change of one fault the isolation detects at the commissioned point
+/// (`diagnose --json` `isolation.detection_limits`).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct DetectionLimit {
+    /// The fault (JSON: its name).
+    pub fault: Fault,
+    /// The smallest relative change seen (0.25: a change of +-25 %; for a sensor, of its
+    /// gain).
+    pub change: f32,
+}
+
+impl IsolationTracker {
+    /// Each fault's detection limit at the commissioned point (the friction pair as one
+    /// class, `b/bl` by Bl's limit, with the load an unknown input not at all).
+    fn detection_limits(&self) -> Vec<DetectionLimit> {
+        let Some(f) = self.follower.as_ref() else {
+            return Vec::new();
+        };
+        let iso = f.isolator();
+        let at = iso.baseline().at;
+        Fault::ALL
+            .into_iter()
+            .filter(|fault| *fault != Fault::B)
+            .filter(|fault| *fault != Fault::Bl || self.load != super::LoadModel::Unknown)
+            .filter_map(|fault| {
+                iso.detection_limit(&at, fault)
+                    .map(|change| DetectionLimit { fault, change })
+            })
+            .collect()
+    }
 }
 
 /// Smallest tracked winding temperature change that is reported [K] (5 K: 2 % on Rs and Rr,
@@ -654,6 +697,7 @@ impl IsolationReport {
             first_named: None,
             events: Vec::new(),
             events_dropped: 0,
+            detection_limits: Vec::new(),
         }
     }
 }

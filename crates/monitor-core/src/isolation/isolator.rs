@@ -412,6 +412,23 @@ impl Isolator {
         out
     }
 
+    /// The smallest relative change of fault `f` the isolation detects at the operating
+    /// point `p` on a full average ([`super::AVERAGE_MAX_S`]): the change `dk` at which the
+    /// deviation from the baseline reaches [`DETECT_CHI2`], linearised,
+    /// `dk = sqrt(DETECT_CHI2 / (d^T W d))` with `d = de/dk` (a finite difference of
+    /// [`LIMIT_DK`]) and `W` the weight the isolation judges `p` with (the baseline's spreads,
+    /// widened away from the commissioned point). A fault smaller than this is not seen:
+    /// with a learned baseline it is the commissioning's own detection limit for that fault
+    /// (for the 50 hp motor's Rs, a few tenths: Rs is under 1 % of its impedance). `None`
+    /// where the point gives no residuals or the fault does not move them.
+    pub fn detection_limit(&self, p: &SteadyPoint, f: Fault) -> Option<f32> {
+        let w = self.weight(p);
+        let e0 = self.residuals(p, None)?;
+        let e1 = self.residuals(p, Some((f, 1.0 + LIMIT_DK)))?;
+        let q = w.quadratic(&(e1 - e0)) / (LIMIT_DK * LIMIT_DK);
+        (q.is_finite() && q > 0.0).then(|| crate::sqrt(DETECT_CHI2 / q))
+    }
+
     /// The misfit of hypothesis `h` (fault `f` of factor `k`; `None`: the healthy machine)
     /// against the baseline under the weight `w` ([`Isolator::weight`] at the measured
     /// point, one for every hypothesis so that their misfits compare); unusable points

@@ -487,6 +487,8 @@ pub const HEATING_ONSET_K: f32 = 20.0;
 pub const WARMING_EXPLAINS: f32 = 0.75;
 /// Step of the heating factor for the heating direction `de/dk` while learning.
 const LEARN_DK: f32 = 0.01;
+/// Step of a fault's factor for its direction `de/dk` in [`Isolator::detection_limit`].
+pub const LIMIT_DK: f32 = 0.01;
 
 impl Isolation {
     /// The heating hypothesis explains the deviation alone, as a fault is named alone

@@ -334,6 +334,19 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
             candidate_list(&rep.signature_candidates)
         )?;
         writeln!(out, "isolation: {}", rep.isolation.verdict)?;
+        if !rep.isolation.detection_limits.is_empty() {
+            writeln!(
+                out,
+                "  smallest changes the isolation detects at the commissioned point (smaller ones pass as healthy; a FAULT also needs {:.0} %): {}",
+                100.0 * sim_host::replay::MIN_FAULT_CHANGE,
+                rep.isolation
+                    .detection_limits
+                    .iter()
+                    .map(|l| format!("{} {}", l.fault.name(), limit_pct(l.change)))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )?;
+        }
         if let Some(line) = temperature_line(&rep.isolation.temperature) {
             writeln!(out, "{line}")?;
         }
@@ -356,6 +369,19 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
         writeln!(out, "note at {:.2} s: {}", n.t_s, n.note)?;
     }
     verdict(&mut out, rep)
+}
+
+/// A detection limit in per cent with two significant digits (0.106 -> "11 %",
+/// 0.0016 -> "0.16 %").
+fn limit_pct(change: f32) -> String {
+    let p = 100.0 * change;
+    if p >= 10.0 {
+        format!("{p:.0} %")
+    } else if p >= 1.0 {
+        format!("{p:.1} %")
+    } else {
+        format!("{p:.2} %")
+    }
 }
 
 /// Segments of the negative sequence the text report lists (the JSON has up to
