@@ -225,6 +225,59 @@ fn six_machines_within_35_percent_with_the_locked_rotor_ratio() {
     }
 }
 
+/// A nameplate is a guaranteed value, and the motor on the bench differs from it within IEC
+/// 60034-1's tolerances (efficiency: 15 % of the losses; power factor: a sixth of
+/// `1 - cos phi`). With the plate's efficiency and power factor moved to the ends of those
+/// tolerances (each way, with IA/IN), every true value stays inside the stated range, and
+/// the table says how far Rs moves (it takes the losses' remainder).
+#[test]
+fn plates_off_by_the_iec_tolerances_keep_every_true_value_in_its_range() {
+    let mut worst_rs: f64 = 0.0;
+    let mut outside = Vec::new();
+    for m in machines() {
+        let base = nameplate(&m, true);
+        let d_eta = 0.15 * (1.0 - base.efficiency);
+        let d_pf = ((1.0 - base.power_factor) / 6.0).clamp(0.02, 0.07);
+        for (de, dp) in [(-d_eta, 0.0), (d_eta, 0.0), (0.0, -d_pf), (0.0, d_pf)] {
+            let mut n = base;
+            n.efficiency = base.efficiency + de;
+            n.power_factor = (base.power_factor + dp).min(0.99);
+            let Ok(e) = estimate(&n) else {
+                // (A plate the tolerances make impossible, such as an efficiency above
+                // 1 - slip, is refused, which is right.)
+                continue;
+            };
+            let w = TAU * m.f_hz;
+            let truth = [m.rs, m.rr, (m.xls + m.xlr) / w, m.xm / w];
+            for (key, t) in [
+                "motor.rs_ohm",
+                "motor.rr_ohm",
+                "lls_h + llr_h",
+                "motor.lm_h",
+            ]
+            .iter()
+            .zip(truth)
+            {
+                let v = e.value(key).expect(key);
+                if key == &"motor.rs_ohm" {
+                    worst_rs = worst_rs.max((v.value / t - 1.0).abs());
+                }
+                if !(v.lo <= t && t <= v.hi) {
+                    outside.push(format!(
+                        "{} eta {:+.3} pf {:+.3}: {key} true {t:.4} outside {:.4}..{:.4} (estimate {:.4})",
+                        m.name, de, dp, v.lo, v.hi, v.value
+                    ));
+                }
+            }
+        }
+    }
+    eprintln!(
+        "plates off by the IEC tolerances: Rs off by up to {:.0} %",
+        100.0 * worst_rs
+    );
+    assert!(outside.is_empty(), "{outside:#?}");
+}
+
 #[test]
 fn without_the_locked_rotor_ratio_only_the_leakage_of_an_atypical_machine_misses() {
     // The total leakage is then the typical 0.12 Z_b. The 15 kW preset's is 0.069 Z_b
