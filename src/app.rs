@@ -310,7 +310,10 @@ pub fn panel_input(
             .top
             .map_or(NOT_NAMED_CODE, |(f, _)| blink_code(f.index() as u8)),
     };
-    let named_fault = matches!(named, Some(Named::Fault(_)));
+    // (A name whose size is below the one rule's 5 % is watched, not a FAULT: the core's
+    // `Named::stands_clear`, as `diagnose`'s verdict `watching`.)
+    let named_fault =
+        matches!(named, Some(Named::Fault(_))) && named.is_some_and(|n| n.stands_clear());
     // The amber "operating point moved" state: no FAULT lamp for the lamps (panel docs).
     let moved = status.moved && !named_fault && !status.sensor_fault.any();
     let other_fault = !moved && (status.fault_detected || (named_fault && status.commissioned));
@@ -700,7 +703,8 @@ mod tests {
     use super::*;
     use crate::panel::{read_blink_code, render, Lamp};
 
-    /// An isolation that names `fault` with probability `p` (the rest unknown).
+    /// An isolation that names `fault` with probability `p` and a change of +30 % (the rest
+    /// unknown).
     fn isolation(fault: Fault, p: f32) -> Isolation {
         let mut iso = Isolation {
             state: monitor_core::IsolationState::Isolated,
@@ -713,6 +717,7 @@ mod tests {
             .unwrap_or(0); // ok: test
         iso.candidates.swap(0, k);
         iso.candidates[0].probability = p;
+        iso.candidates[0].change = 0.3;
         iso.unknown_probability = 1.0 - p;
         iso
     }
@@ -733,6 +738,11 @@ mod tests {
         let rr = isolation(Fault::Rr, 0.9);
         let inp = panel_input(Mode::Commissioned, &status, Some(&rr), false);
         assert_eq!(at(&inp), Some(2));
+        // The same name 3 % in size is watched, not a FAULT (the one rule's 5 %).
+        let mut small = rr;
+        small.candidates[0].change = 0.03;
+        let inp = panel_input(Mode::Commissioned, &status, Some(&small), false);
+        assert!((0..400u32).all(|k| !render(&inp, k * 50).is_on(Lamp::Fault)));
         // Not commissioned: the isolation alone does not light the lamp.
         status.commissioned = false;
         let inp = panel_input(Mode::NotCommissioned, &status, Some(&rr), false);

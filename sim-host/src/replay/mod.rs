@@ -86,12 +86,11 @@ pub const BASELINE_I1_TOLERANCE: f32 = 0.1;
 /// judge" with how much was judged. One rule for `diagnose`, the HMI's log replay and the
 /// demo (all report through [`Replay::finish`]).
 pub const MIN_JUDGED_S: f64 = 1.0;
-/// The least relative change of a named fault for the verdict `fault` (a sensor's gain
-/// error, a parameter's change, the friction class in Bl's terms): 5 %, what 13 K of heating
-/// does to a winding's resistance and about what a commissioned parameter file's error leaves
-/// at other operating points. Below it the verdict is `watching`, with the name and its size.
-/// One rule for `diagnose`, the HMI's log replay and the demo ([`Replay::finish`]).
-pub const MIN_FAULT_CHANGE: f32 = 0.05;
+/// The least relative change of a named fault for the verdict `fault`: the core's one rule
+/// ([`monitor_core::isolation::MIN_FAULT_CHANGE`], 5 %), shared by `diagnose`, the HMI's log
+/// replay, the demo ([`Replay::finish`]) and the board's FAULT lamp. Below it the verdict is
+/// `watching`, with the name and its size.
+pub const MIN_FAULT_CHANGE: f32 = monitor_core::isolation::MIN_FAULT_CHANGE;
 
 /// Errors from setting up or running a replay.
 #[derive(Debug, thiserror::Error)]

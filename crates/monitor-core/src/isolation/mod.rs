@@ -580,6 +580,30 @@ pub enum Named {
     },
 }
 
+/// The least relative change of a named fault for a FAULT (a sensor's gain error, a
+/// parameter's change, the friction class in Bl's terms): 5 %, what 13 K of heating does to
+/// a winding's resistance and about what a commissioned parameter file's error leaves at
+/// other operating points. Below it the fault is watched, not reported: the one rule for a
+/// FAULT shared by `diagnose` (the verdict `watching`), the HMI and the board's FAULT lamp
+/// ([`Named::stands_clear`]).
+pub const MIN_FAULT_CHANGE: f32 = 0.05;
+
+impl Named {
+    /// The name's size: the fault's change, or Bl's for the friction class.
+    pub fn change(&self) -> f32 {
+        match self {
+            Named::Fault(c) => c.change,
+            Named::Friction { bl, .. } => bl.change,
+        }
+    }
+
+    /// The name's size stands clear of what heating and the parameter file's error move:
+    /// `|change| >= MIN_FAULT_CHANGE` ([`MIN_FAULT_CHANGE`]).
+    pub fn stands_clear(&self) -> bool {
+        self.change().abs() >= MIN_FAULT_CHANGE
+    }
+}
+
 impl Isolation {
     /// The fault (or the friction class) named: state [`IsolationState::Isolated`] and
     /// probability at least 0.5; `None` otherwise.
