@@ -3,20 +3,23 @@
 //! lower layers (`tests/architecture.rs` checks every import), and the crate root, below
 //! them all, holds only [`one_line`].
 //!
-//! 1. [`params`]: the parameter file, and the sensor ranges derived from it;
-//! 2. [`log`]: measurement logs (the one reader and writer, the data-quality stage, the
-//!    sample-rate estimate); [`nameplate`]: a parameter file estimated from a motor's
-//!    nameplate (`params from-nameplate`);
-//! 3. [`sim`]: the induction-motor simulator with fault and effect injection; [`replay`]:
-//!    logs through the no_std core (`diagnose`);
-//! 4. [`analysis`]: the model-vs-measurement workflow (`compare`, `explain`);
-//! 5. [`experiment`]: a simulated motor replayed through the core as it runs (the runs
-//!    below);
-//! 6. [`fault_signatures`]: the paper's Table 1 end to end (`table1`); [`service_profile`]:
-//!    the healthy service profile of the false-alarm and detection-limit studies;
-//! 7. [`demo`]: the main job (`demo`);
-//! 8. [`bench`](mod@bench): the simulator, core and isolation figures of `bench`; [`hmi`]:
-//!    the live terminal HMI's model and its three sources (`hmi`).
+//! - layer 1: [`params`]: the parameter file, and the sensor ranges derived from it;
+//! - layer 2: [`log`]: measurement logs (the one reader and writer, the data-quality stage,
+//!   the sample-rate estimate); [`nameplate`]: a parameter file estimated from a motor's
+//!   nameplate (`params from-nameplate`);
+//! - layer 3: [`sim`]: the induction-motor simulator with fault and effect injection;
+//!   [`replay`]: logs through the no_std core (`diagnose`);
+//! - layer 4: [`analysis`]: the model-vs-measurement workflow (`compare`, `explain`);
+//! - layer 5: [`experiment`]: a simulated motor replayed through the core as it runs;
+//!   [`identify`]: the motor's parameters from a log of the healthy motor (`identify`);
+//! - layer 6: [`fault_signatures`]: the paper's Table 1 end to end (`table1`);
+//!   [`service_profile`]: the healthy service profile of the false-alarm and
+//!   detection-limit studies; [`api`]: one call per command, for the command line and
+//!   the Python package;
+//! - layer 7: [`demo`]: the main job (`demo`); [`fleet`]: many motors' logs, one row each
+//!   (`fleet`);
+//! - layer 8: [`bench`](mod@bench): the simulator, core and isolation figures of `bench`;
+//!   [`hmi`]: the live terminal HMI's model and its three sources (`hmi`).
 //!
 //! The vocabulary (faults, effect names, phases, motor parameters, reference machines)
 //! is the core's (`monitor_core`), shared with the firmware. Functions return values and

@@ -2,10 +2,10 @@
 //! the layers, on a file or a function grown too long, and on a reference to a file the
 //! repository does not hold. Every failure names the file, the line and the rule.
 //!
-//! 1. **Layers** (`sim-host`): the library's modules point one way,
-//!    `params < log < {sim, replay} < analysis < experiment < {fault_signatures,
-//!    service_profile} < demo < {bench, hmi}`, and the binary (`main.rs`, `cli/`) on top. A
-//!    module uses only modules of a lower layer ([`LAYERS`]); two modules of one layer do
+//! 1. **Layers** (`sim-host`): the library's modules point one way, as [`LAYERS`] orders
+//!    them, and the binary (`main.rs`, `cli/`) on top. [`LAYERS`] is the one table: the
+//!    layer diagram of `docs/architecture.md` and the list in `sim-host/src/lib.rs` are
+//!    checked against it. A module uses only modules of a lower layer; two modules of one layer do
 //!    not use each other. The crate root (`lib.rs`) is below them all: it declares the
 //!    modules and holds `one_line`, and its items use none of them. Checked on every
 //!    `use` and every path (`crate::`, `super::`, `self::`), tests inside `src/` included.
@@ -533,4 +533,80 @@ fn the_checks_catch_what_they_should() {
     assert_eq!(v.found.len(), 1, "{:?}", v.found);
     assert!(v.found[0].contains("x.rs:1: function size: `long` is 102 lines"));
     assert!(FOREIGN.iter().all(|n| !n.is_empty()));
+}
+
+/// The modules each `layer N:` line of `text` names (the docs' spelling: `layer 3: sim,
+/// replay` in docs/architecture.md, `//! - layer 3: [`sim`]: ...; [`replay`]: ...` in
+/// lib.rs), as `(module, layer)` pairs; `cli` is the binary's and left out.
+fn layers_in(text: &str, lib_style: bool) -> Vec<(String, u8)> {
+    let mut out = Vec::new();
+    let mut current: Option<u8> = None;
+    for line in text.lines() {
+        let l = line.trim_start_matches("//!").trim();
+        let l = l.trim_start_matches("- ").trim();
+        if let Some(rest) = l.strip_prefix("layer ") {
+            let (n, body) = rest.split_once(':').unwrap_or(("", ""));
+            current = n.trim().parse().ok();
+            if !lib_style && !body.trim_start().starts_with("cli") {
+                for m in body.split(',') {
+                    let m = m.split_whitespace().next().unwrap_or("");
+                    if let (Some(k), false) = (current, m.is_empty() || m == "cli") {
+                        out.push((m.to_string(), k));
+                    }
+                }
+            }
+            if !lib_style {
+                current = None;
+                continue;
+            }
+        } else if lib_style && !l.starts_with(char::is_lowercase) && !l.starts_with('[') {
+            current = None;
+        }
+        if lib_style {
+            if let Some(k) = current {
+                // Module links: "[`name`]" or "[`name`](mod@name)" at the start of a
+                // clause (after "layer N:" or "; ").
+                let body = l
+                    .split_once(':')
+                    .map_or(l, |(a, b)| if a.starts_with("layer") { b } else { l });
+                for clause in std::iter::once(body).chain(body.split("; ").skip(1)) {
+                    let c = clause.trim_start();
+                    if let Some(rest) = c.strip_prefix("[`") {
+                        if let Some((name, _)) = rest.split_once('`') {
+                            if !out.iter().any(|(m, _): &(String, u8)| m == name) {
+                                out.push((name.to_string(), k));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn the_docs_layer_diagram_and_lib_rs_are_the_layers_table() {
+    let root = workspace();
+    let mut want: Vec<(String, u8)> = LAYERS.iter().map(|(m, k)| (m.to_string(), *k)).collect();
+    want.sort();
+    let doc =
+        std::fs::read_to_string(root.join("docs/architecture.md")).expect("docs/architecture.md");
+    let lib = std::fs::read_to_string(root.join("sim-host/src/lib.rs")).expect("lib.rs");
+    let lib_doc: String = lib
+        .lines()
+        .take_while(|l| l.starts_with("//!"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let in_doc = layers_in(&doc, false);
+    let in_lib = layers_in(&lib_doc, true);
+    assert_eq!(
+        in_doc, want,
+        "docs/architecture.md's layer diagram differs from LAYERS"
+    );
+    assert_eq!(
+        in_lib, want,
+        "sim-host/src/lib.rs's layer list differs from LAYERS"
+    );
 }

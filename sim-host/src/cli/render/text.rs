@@ -334,18 +334,8 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
             candidate_list(&rep.signature_candidates)
         )?;
         writeln!(out, "isolation: {}", rep.isolation.verdict)?;
-        if !rep.isolation.detection_limits.is_empty() {
-            writeln!(
-                out,
-                "  smallest changes the isolation detects at the commissioned point (smaller ones pass as healthy; a FAULT also needs {:.0} %): {}",
-                100.0 * sim_host::replay::MIN_FAULT_CHANGE,
-                rep.isolation
-                    .detection_limits
-                    .iter()
-                    .map(|l| format!("{} {}", l.fault.name(), limit_pct(l.change)))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )?;
+        if let Some(line) = detection_limits_line(&rep.isolation.detection_limits) {
+            writeln!(out, "{line}")?;
         }
         if let Some(line) = temperature_line(&rep.isolation.temperature) {
             writeln!(out, "{line}")?;
@@ -369,6 +359,21 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
         writeln!(out, "note at {:.2} s: {}", n.t_s, n.note)?;
     }
     verdict(&mut out, rep)
+}
+
+/// The healthy verdict's detection limits in a line (none without them).
+fn detection_limits_line(limits: &[sim_host::replay::DetectionLimit]) -> Option<String> {
+    (!limits.is_empty()).then(|| {
+        format!(
+            "  smallest changes the isolation detects at the commissioned point (smaller ones pass as healthy; a FAULT also needs {:.0} %): {}",
+            100.0 * sim_host::replay::MIN_FAULT_CHANGE,
+            limits
+                .iter()
+                .map(|l| format!("{} {}", l.fault.name(), limit_pct(l.change)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    })
 }
 
 /// A detection limit in per cent with two significant digits (0.106 -> "11 %",
