@@ -88,13 +88,12 @@ pub fn load_params(source: ParamsSource<'_>) -> Result<(ParamFile, ColumnMapping
         ParamsSource::Path(p) => Ok(crate::log::mapping::load_params(p)?),
         ParamsSource::Toml { text, origin } => {
             let (p, table) = ParamFile::from_toml_str_with_columns(text, origin)?;
-            let columns =
-                ColumnMapping::from_table(&table, p.motor.poles / 2).map_err(|message| {
-                    ParamError::Columns {
-                        path: origin.to_string(),
-                        message,
-                    }
-                })?;
+            let columns = ColumnMapping::from_table(&table, p.motor.poles / 2).map_err(|e| {
+                ParamError::Columns {
+                    path: origin.to_string(),
+                    message: e.to_string(),
+                }
+            })?;
             Ok((p, columns))
         }
     }

@@ -138,20 +138,16 @@ impl ChannelUnit {
     ///
     /// # Errors
     /// A one-line message naming the column, the text and the units it may take.
-    pub fn parse(c: Column, text: &str) -> Result<Self, String> {
+    pub fn parse(c: Column, text: &str) -> Result<Self, ColumnsError> {
         let t = text.trim();
         let allowed = Self::allowed(c);
         Self::SPELLINGS
             .iter()
             .find(|(u, names)| allowed.contains(u) && names.contains(&t))
             .map(|(u, _)| *u)
-            .ok_or_else(|| {
-                let list: Vec<&str> = allowed.iter().map(|u| u.name()).collect();
-                format!(
-                    "unit '{t}' is not one {} may be recorded in ({})",
-                    c.name(),
-                    list.join(", ")
-                )
+            .ok_or_else(|| ColumnsError::Unit {
+                column: c,
+                text: t.to_string(),
             })
     }
 
@@ -233,6 +229,88 @@ pub struct MappedChannel {
 /// Slowest and fastest sample rate `t_s = { sample_rate_hz = ... }` may give [Hz].
 pub const SAMPLE_RATE_RANGE_HZ: (f64, f64) = (1.0, 10e6);
 
+/// What is wrong with a `[columns]` table or a mapping call, naming the key or column (the
+/// messages are one line each; [`ParamError::Columns`] carries them with the file's name).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ColumnsError {
+    /// A unit the column cannot be recorded in.
+    #[error("unit '{text}' is not one {} may be recorded in ({})", .column.name(), allowed_units(*.column))]
+    Unit {
+        /// The schema column.
+        column: Column,
+        /// The unit as written.
+        text: String,
+    },
+    /// An error of one key of the table (`key: why`).
+    #[error("{key}: {source}")]
+    Key {
+        /// The key (a schema column's name).
+        key: String,
+        /// What is wrong with it.
+        source: Box<ColumnsError>,
+    },
+    /// A channel name that is empty.
+    #[error("{}: the channel name is empty", .0.name())]
+    EmptyName(Column),
+    /// Two schema columns name one channel of the log.
+    #[error("{} and {} both name channel '{name}'", .first.name(), .second.name())]
+    SameChannel {
+        /// The column mapped first.
+        first: Column,
+        /// The other.
+        second: Column,
+        /// The channel both name.
+        name: String,
+    },
+    /// A sample rate that is not finite or outside [`SAMPLE_RATE_RANGE_HZ`].
+    #[error("t_s: sample_rate_hz = {rate_hz} is not a sample rate ({lo}..{hi:e} Hz)", lo = SAMPLE_RATE_RANGE_HZ.0, hi = SAMPLE_RATE_RANGE_HZ.1)]
+    SampleRate {
+        /// The rate given [Hz].
+        rate_hz: f64,
+    },
+    /// A key that is no schema column.
+    #[error("'{0}' is not a column of the schema (the keys are {keys})", keys = schema_keys())]
+    NotAColumn(String),
+    /// `sample_rate_hz` given to a column other than `t_s`.
+    #[error("{0}: sample_rate_hz belongs to t_s (a log without a time column: t_s = {{ sample_rate_hz = 1000.0 }})")]
+    RateNotForTime(String),
+    /// `sample_rate_hz` and a time column both given.
+    #[error("{0}: sample_rate_hz says the log has no time column; give either it or the time column (name or column, with its unit), not both")]
+    RateAndTimeColumn(String),
+    /// `column = 0`.
+    #[error("{0}: column = 0; the fields of a line are counted from 1")]
+    ColumnZero(String),
+    /// Both a name and a place.
+    #[error("{0}: give the channel by name or by column, not both")]
+    NameAndColumn(String),
+    /// Neither a name nor a place (nor, for the time, a sample rate).
+    #[error("{key}: give the channel's name (name = \"Ia\") or its place in a line (column = 1){}", if *.time { ", or sample_rate_hz = ... for a log without a time column" } else { "" })]
+    NoChannel {
+        /// The key.
+        key: String,
+        /// It is the time column's.
+        time: bool,
+    },
+}
+
+/// The units column `c` may be recorded in, by name, comma-separated.
+fn allowed_units(c: Column) -> String {
+    ChannelUnit::allowed(c)
+        .iter()
+        .map(|u| u.name())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The schema's column names, comma-separated.
+fn schema_keys() -> String {
+    Column::ALL
+        .iter()
+        .map(|c| c.name())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// The mapping from the schema's columns to a log's channels (the parameter file's
 /// `[columns]` table; see the module documentation). The default maps nothing: every
 /// column by its schema name, in SI units.
@@ -267,7 +345,7 @@ impl ColumnMapping {
         c: Column,
         position: usize,
         unit: Option<ChannelUnit>,
-    ) -> Result<(), String> {
+    ) -> Result<(), ColumnsError> {
         self.set(c, &format!("column {}", position + 1), unit)?;
         if let Some(m) = self.channels[c as usize].as_mut() {
             m.position = Some(position);
@@ -281,12 +359,10 @@ impl ColumnMapping {
     /// # Errors
     /// A one-line message for a rate that is not finite or lies outside
     /// [`SAMPLE_RATE_RANGE_HZ`].
-    pub fn set_sample_rate(&mut self, rate_hz: f64) -> Result<(), String> {
+    pub fn set_sample_rate(&mut self, rate_hz: f64) -> Result<(), ColumnsError> {
         let (lo, hi) = SAMPLE_RATE_RANGE_HZ;
         if !(rate_hz.is_finite() && (lo..=hi).contains(&rate_hz)) {
-            return Err(format!(
-                "t_s: sample_rate_hz = {rate_hz} is not a sample rate ({lo}..{hi:e} Hz)"
-            ));
+            return Err(ColumnsError::SampleRate { rate_hz });
         }
         self.channels[Column::Time as usize] = None;
         self.sample_rate_hz = Some(rate_hz);
@@ -314,28 +390,35 @@ impl ColumnMapping {
     /// # Errors
     /// A one-line message for an empty name, a unit column `c` cannot be recorded in, or a
     /// channel already mapped to another column.
-    pub fn set(&mut self, c: Column, name: &str, unit: Option<ChannelUnit>) -> Result<(), String> {
+    pub fn set(
+        &mut self,
+        c: Column,
+        name: &str,
+        unit: Option<ChannelUnit>,
+    ) -> Result<(), ColumnsError> {
         if name.trim().is_empty() {
-            return Err(format!("{}: the channel name is empty", c.name()));
+            return Err(ColumnsError::EmptyName(c));
         }
         if let Some(u) = unit {
             if !ChannelUnit::allowed(c).contains(&u) {
-                return Err(format!(
-                    "{}: {}",
-                    c.name(),
-                    ChannelUnit::parse(c, u.name()).err().unwrap_or_default()
-                ));
+                return Err(ColumnsError::Key {
+                    key: c.name().to_string(),
+                    source: Box::new(ColumnsError::Unit {
+                        column: c,
+                        text: u.name().to_string(),
+                    }),
+                });
             }
         }
         if let Some(other) = Column::ALL
             .iter()
             .find(|o| **o != c && self.name_of(**o) == name && self.get(**o).is_some())
         {
-            return Err(format!(
-                "{} and {} both name channel '{name}'",
-                other.name(),
-                c.name()
-            ));
+            return Err(ColumnsError::SameChannel {
+                first: *other,
+                second: c,
+                name: name.to_string(),
+            });
         }
         self.channels[c as usize] = Some(MappedChannel {
             name: name.to_string(),
@@ -424,26 +507,18 @@ impl ColumnMapping {
     /// A one-line message naming the key: not a schema column (the message lists them), a
     /// unit the column cannot be recorded in, an empty name, two columns naming one
     /// channel.
-    pub fn from_table(table: &ColumnsTable, pole_pairs: u32) -> Result<Self, String> {
+    pub fn from_table(table: &ColumnsTable, pole_pairs: u32) -> Result<Self, ColumnsError> {
         let mut m = ColumnMapping::new(pole_pairs);
         for (key, e) in table {
             let Some(c) = Column::ALL.iter().find(|c| c.name() == key.as_str()) else {
-                let names: Vec<&str> = Column::ALL.iter().map(|c| c.name()).collect();
-                return Err(format!(
-                    "'{key}' is not a column of the schema (the keys are {})",
-                    names.join(", ")
-                ));
+                return Err(ColumnsError::NotAColumn(key.clone()));
             };
             if let Some(rate) = e.sample_rate_hz {
                 if *c != Column::Time {
-                    return Err(format!(
-                        "{key}: sample_rate_hz belongs to t_s (a log without a time column: t_s = {{ sample_rate_hz = 1000.0 }})"
-                    ));
+                    return Err(ColumnsError::RateNotForTime(key.clone()));
                 }
                 if e.name.is_some() || e.column.is_some() || e.unit.is_some() {
-                    return Err(format!(
-                        "{key}: sample_rate_hz says the log has no time column; give either it or the time column (name or column, with its unit), not both"
-                    ));
+                    return Err(ColumnsError::RateAndTimeColumn(key.clone()));
                 }
                 m.set_sample_rate(rate)?;
                 continue;
@@ -451,30 +526,23 @@ impl ColumnMapping {
             let unit = e
                 .unit
                 .as_deref()
-                .map(|u| ChannelUnit::parse(*c, u).map_err(|why| format!("{key}: {why}")))
+                .map(|u| {
+                    ChannelUnit::parse(*c, u).map_err(|why| ColumnsError::Key {
+                        key: key.clone(),
+                        source: Box::new(why),
+                    })
+                })
                 .transpose()?;
             match (&e.name, e.column) {
                 (Some(name), None) => m.set(*c, name, unit)?,
                 (None, Some(n)) if n >= 1 => m.set_position(*c, n as usize - 1, unit)?,
-                (None, Some(_)) => {
-                    return Err(format!(
-                        "{key}: column = 0; the fields of a line are counted from 1"
-                    ))
-                }
-                (Some(_), Some(_)) => {
-                    return Err(format!(
-                        "{key}: give the channel by name or by column, not both"
-                    ))
-                }
+                (None, Some(_)) => return Err(ColumnsError::ColumnZero(key.clone())),
+                (Some(_), Some(_)) => return Err(ColumnsError::NameAndColumn(key.clone())),
                 (None, None) => {
-                    return Err(format!(
-                        "{key}: give the channel's name (name = \"Ia\") or its place in a line (column = 1){}",
-                        if *c == Column::Time {
-                            ", or sample_rate_hz = ... for a log without a time column"
-                        } else {
-                            ""
-                        }
-                    ))
+                    return Err(ColumnsError::NoChannel {
+                        key: key.clone(),
+                        time: *c == Column::Time,
+                    })
                 }
             }
         }
@@ -484,12 +552,11 @@ impl ColumnMapping {
                 .iter()
                 .find(|b| m.name_of(**b) == m.name_of(*a))
             {
-                return Err(format!(
-                    "{} and {} both name channel '{}'",
-                    a.name(),
-                    b.name(),
-                    m.name_of(*a)
-                ));
+                return Err(ColumnsError::SameChannel {
+                    first: *a,
+                    second: *b,
+                    name: m.name_of(*a).to_string(),
+                });
             }
         }
         Ok(m)
@@ -504,12 +571,11 @@ impl ColumnMapping {
 /// that is wrong ([`ColumnMapping::from_table`]).
 pub fn load_params(path: &std::path::Path) -> Result<(ParamFile, ColumnMapping), ParamError> {
     let (p, table) = ParamFile::load_with_columns(path)?;
-    let columns = ColumnMapping::from_table(&table, p.motor.poles / 2).map_err(|message| {
-        ParamError::Columns {
+    let columns =
+        ColumnMapping::from_table(&table, p.motor.poles / 2).map_err(|e| ParamError::Columns {
             path: path.display().to_string(),
-            message,
-        }
-    })?;
+            message: e.to_string(),
+        })?;
     Ok((p, columns))
 }
 
@@ -735,7 +801,9 @@ mod tests {
             ChannelUnit::parse(Column::Ia, "mA"),
             Ok(ChannelUnit::Milliamperes)
         );
-        let e = ChannelUnit::parse(Column::Ia, "mV").unwrap_err();
+        let e = ChannelUnit::parse(Column::Ia, "mV")
+            .unwrap_err()
+            .to_string();
         assert!(
             e.contains("'mV'") && e.contains("ia_A") && e.contains("A, mA"),
             "{e}"
@@ -755,10 +823,23 @@ mod tests {
         let mut m = ColumnMapping::new(2);
         m.set(Column::Ia, "I", None).unwrap();
         let e = m.set(Column::Ib, "I", None).unwrap_err();
-        assert!(e.contains("ia_A and ib_A both name channel 'I'"), "{e}");
+        assert_eq!(
+            e,
+            ColumnsError::SameChannel {
+                first: Column::Ia,
+                second: Column::Ib,
+                name: "I".into()
+            }
+        );
+        assert!(
+            e.to_string()
+                .contains("ia_A and ib_A both name channel 'I'"),
+            "{e}"
+        );
         let e = m
             .set(Column::Va, "U1", Some(ChannelUnit::Amperes))
-            .unwrap_err();
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("va_V") && e.contains("'A'"), "{e}");
     }
 
@@ -772,7 +853,7 @@ mod tests {
         let mut t = ColumnsTable::new();
         t.insert("wm_rad_s".into(), entry("n", Some("Hz_el")));
         t.insert("ia_A".into(), entry("ib_A", None));
-        let e = ColumnMapping::from_table(&t, 2).unwrap_err();
+        let e = ColumnMapping::from_table(&t, 2).unwrap_err().to_string();
         assert!(e.contains("ia_A and ib_A both name channel 'ib_A'"), "{e}");
         // A swap of two phases is fine.
         t.insert("ib_A".into(), entry("ia_A", None));
