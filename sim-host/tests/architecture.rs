@@ -610,3 +610,31 @@ fn the_docs_layer_diagram_and_lib_rs_are_the_layers_table() {
         "sim-host/src/lib.rs's layer list differs from LAYERS"
     );
 }
+
+/// 7. **Typed errors**: no library function of the core, the firmware or `sim-host` returns
+///    `Result<_, String>` (the binary's `cli/` and test modules excepted): a library error
+///    is a `thiserror` type with fields, and its text is made where it is shown.
+#[test]
+fn no_string_errors_in_the_library() {
+    let root = workspace();
+    let mut bad = Vec::new();
+    for f in files() {
+        let lib = (f.starts_with("sim-host/src/") && !f.starts_with("sim-host/src/cli/"))
+            || f.starts_with("crates/monitor-core/src/")
+            || f.starts_with("src/")
+            || f.starts_with("python/src/");
+        if !lib || !f.ends_with(".rs") {
+            continue;
+        }
+        let text = std::fs::read_to_string(root.join(&f)).unwrap_or_default();
+        // (A file's test module, at its end, is a test.)
+        let code = text.split("#[cfg(test)]\nmod tests").next().unwrap_or("");
+        for (k, line) in code.lines().enumerate() {
+            let compact: String = line.split_whitespace().collect();
+            if compact.contains("Result<") && compact.contains(",String>") {
+                bad.push(format!("{f}:{}: {}", k + 1, line.trim()));
+            }
+        }
+    }
+    assert!(bad.is_empty(), "Result<_, String> in the library: {bad:#?}");
+}

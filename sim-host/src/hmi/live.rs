@@ -55,7 +55,7 @@ pub struct LiveSim {
     sample_rate_hz: f64,
     tx: Option<Sender<Command>>,
     rx: Receiver<Reply>,
-    worker: Option<JoinHandle<Result<(), String>>>,
+    worker: Option<JoinHandle<Result<(), crate::sim::SimError>>>,
     /// Simulated time [s] so far.
     t_s: f64,
     controls: LiveControls,
@@ -304,7 +304,11 @@ struct Worker {
 }
 
 impl Worker {
-    fn run(mut self, sc: &crate::sim::Scenario, rx: &Receiver<Command>) -> Result<(), String> {
+    fn run(
+        mut self,
+        sc: &crate::sim::Scenario,
+        rx: &Receiver<Command>,
+    ) -> Result<(), crate::sim::SimError> {
         let params = self.params;
         simulate_interactive(&params, sc, |row, events| {
             if self.wait_for_work(rx, events).is_break() {
@@ -323,7 +327,6 @@ impl Worker {
             ControlFlow::Continue(())
         })
         .map(|_| ())
-        .map_err(|e| e.to_string())
     }
 
     /// Answers when the rows asked for are done, then waits for the next request; events

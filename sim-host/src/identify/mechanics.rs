@@ -16,8 +16,48 @@ use nalgebra::DMatrix;
 /// Window of the integrated torque balance [s].
 pub const WINDOW_S: f64 = 0.02;
 
-/// The judged result of a mechanical parameter: `(value, lo, hi)` or why not identified.
-pub type Judged = Result<(f64, f64, f64), String>;
+/// The judged result of a parameter: `(value, lo, hi)` or why it was not identified.
+pub type Judged = Result<(f64, f64, f64), NotIdentified>;
+
+/// Why a parameter was not identified (its `Display` is the report's sentence,
+/// `not_identified_because`).
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum NotIdentified {
+    /// A flat direction of the fit.
+    #[error(
+        "the log leaves it undetermined (a flat direction of the fit: the log does not excite it)"
+    )]
+    Flat,
+    /// A 95 % interval wider than the value.
+    #[error("the log does not determine it: its 95 % interval {lo:.3e}..{hi:.3e} is wider than the value {value:.3e}")]
+    TooWide {
+        /// The value.
+        value: f64,
+        /// The interval's ends.
+        lo: f64,
+        /// The interval's ends.
+        hi: f64,
+    },
+    /// A value that is not positive.
+    #[error("the fit gives {value:.3e}, not a physical value (95 % interval {lo:.3e}..{hi:.3e})")]
+    NotPhysical {
+        /// The value.
+        value: f64,
+        /// The interval's ends.
+        lo: f64,
+        /// The interval's ends.
+        hi: f64,
+    },
+    /// The identified circuit cannot be simulated.
+    #[error("the identified circuit cannot be simulated")]
+    CircuitFails,
+    /// Too few samples for the torque balance's windows.
+    #[error("the log is too short for the torque balance")]
+    TooShort,
+    /// The parameter was not among those fitted.
+    #[error("not fitted")]
+    NotFitted,
+}
 
 /// J and B + Bl.
 #[derive(Debug, Clone)]
@@ -37,28 +77,17 @@ pub struct LogEstimate {
     pub sigma: f64,
 }
 
-/// The reason text of an interval wider than the value.
-fn too_wide(lo: f64, hi: f64, v: f64) -> String {
-    format!(
-        "the log does not determine it: its 95 % interval {lo:.3e}..{hi:.3e} is wider than the value {v:.3e}"
-    )
-}
-
-/// The reason text of a flat direction.
-pub const FLAT: &str =
-    "the log leaves it undetermined (a flat direction of the fit: the log does not excite it)";
-
 impl LogEstimate {
     /// The 95 % interval `value exp(+-1.96 sigma)`; not identified when it is wider than
     /// the value or sigma is not finite.
     pub fn judged(&self) -> Judged {
         let (v, sg) = (self.value, self.sigma);
         if !sg.is_finite() {
-            return Err(FLAT.into());
+            return Err(NotIdentified::Flat);
         }
         let (lo, hi) = (v * (-1.96 * sg).exp(), v * (1.96 * sg).exp());
         if hi - lo > v {
-            return Err(too_wide(lo, hi, v));
+            return Err(NotIdentified::TooWide { value: v, lo, hi });
         }
         Ok((v, lo, hi))
     }
@@ -68,28 +97,26 @@ impl LogEstimate {
 /// than the value or the value is not positive.
 fn judged_linear(v: f64, sg: f64) -> Judged {
     if !sg.is_finite() {
-        return Err(FLAT.into());
+        return Err(NotIdentified::Flat);
     }
     let (lo, hi) = (v - 1.96 * sg, v + 1.96 * sg);
     if v.is_nan() || v <= 0.0 {
-        return Err(format!(
-            "the fit gives {v:.3e}, not a physical value (95 % interval {lo:.3e}..{hi:.3e})"
-        ));
+        return Err(NotIdentified::NotPhysical { value: v, lo, hi });
     }
     if hi - lo > v {
-        return Err(too_wide(lo, hi, v));
+        return Err(NotIdentified::TooWide { value: v, lo, hi });
     }
     Ok((v, lo, hi))
 }
 
 /// J and B + Bl of the log `s` with the identified circuit `c` (the speed imposed).
 pub fn fit(c: &Circuit, s: &Samples) -> Mechanics {
-    let fail = |why: &str| Mechanics {
-        j: Err(why.into()),
-        b_total: Err(why.into()),
+    let fail = |why: NotIdentified| Mechanics {
+        j: Err(why),
+        b_total: Err(why),
     };
     let (Some(t), Some(w)) = (simulate(c, s), s.wm_rad_s.as_ref()) else {
-        return fail("the identified circuit cannot be simulated");
+        return fail(NotIdentified::CircuitFails);
     };
     let step = ((WINDOW_S / s.dt_s).round() as usize).max(1);
     let (mut rows, mut y) = (Vec::new(), Vec::new());
@@ -109,7 +136,7 @@ pub fn fit(c: &Circuit, s: &Samples) -> Mechanics {
         a = b;
     }
     if rows.len() < 3 {
-        return fail("the log is too short for the torque balance");
+        return fail(NotIdentified::TooShort);
     }
     linear_fit(&rows, &y)
 }

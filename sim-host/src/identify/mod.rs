@@ -496,17 +496,17 @@ fn estimate(k: usize, start: f64, p: f64, sigma: Option<f64>) -> Estimate {
             sigma: sg,
         }
         .judged(),
-        None => Err("not fitted".to_string()),
+        None => Err(mechanics::NotIdentified::NotFitted),
     };
     estimate_or(k, start, e)
 }
 
 /// The estimate of parameter `k` from a judged value.
-fn estimate_or(k: usize, start: f64, e: Result<(f64, f64, f64), String>) -> Estimate {
+fn estimate_or(k: usize, start: f64, e: mechanics::Judged) -> Estimate {
     let (name, key, unit) = PARAMS[k];
     let (value, lo, hi, why) = match e {
         Ok((v, lo, hi)) => (Some(v), Some(lo), Some(hi), None),
-        Err(why) => (None, None, None, Some(why)),
+        Err(why) => (None, None, None, Some(why.to_string())),
     };
     Estimate {
         name: name.into(),

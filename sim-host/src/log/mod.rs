@@ -25,6 +25,7 @@
 //!   half-written output and never touches an input.
 
 pub mod clipping;
+mod columns_error;
 mod exact;
 mod fast;
 pub mod mapping;

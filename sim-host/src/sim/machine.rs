@@ -246,6 +246,28 @@ pub(crate) struct Currents {
     pub lm: f64,
 }
 
+/// A machine the simulator cannot integrate (the scenario's key is named by the caller,
+/// [`super::SimError::Invalid`]).
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum MachineError {
+    /// The stator/rotor inductance matrix is not positive definite.
+    #[error("the inductance matrix is not positive definite (Lls = {lls_h} H, Lm = {lm_h} H, Llr = {llr_h} H)")]
+    Inductances {
+        /// Stator leakage [H].
+        lls_h: f64,
+        /// Magnetising inductance [H].
+        lm_h: f64,
+        /// Rotor leakage [H].
+        llr_h: f64,
+    },
+    /// A shorted-turn loop whose fault resistance is not positive.
+    #[error("the shorted loop's resistance must be positive (R_f = {r_f_ohm} ohm)")]
+    ShortedLoop {
+        /// The fault resistance [ohm].
+        r_f_ohm: f64,
+    },
+}
+
 impl Machine {
     /// Builds the model; `Err` names what is not physical.
     #[allow(clippy::too_many_arguments)]
@@ -262,14 +284,11 @@ impl Machine {
         j: f64,
         b: f64,
         load: LoadLaw,
-    ) -> Result<Machine, String> {
+    ) -> Result<Machine, MachineError> {
         let (minv, kr, inv_lr) = Self::linear(lls, llr, lm0)?;
         if let Some(t) = &turn {
             if !(t.r > 0.0 && t.r.is_finite() && t.l >= 0.0) {
-                return Err(format!(
-                    "the shorted loop's resistance must be positive (R_f = {} ohm)",
-                    t.r
-                ));
+                return Err(MachineError::ShortedLoop { r_f_ohm: t.r });
             }
         }
         let inv_rfe = rfe.map(|r| 1.0 / r).unwrap_or(0.0);
@@ -295,14 +314,15 @@ impl Machine {
         })
     }
 
-    fn linear(lls: f64, llr: f64, lm: f64) -> Result<(f64, f64, f64), String> {
+    fn linear(lls: f64, llr: f64, lm: f64) -> Result<(f64, f64, f64), MachineError> {
         let lr = llr + lm;
         let m = lls + lm * llr / lr;
         if !(m > 0.0 && lr > 0.0 && lm > 0.0 && lls >= 0.0) {
-            return Err(format!(
-                "the inductance matrix is not positive definite (Lls = {lls} H, Lm = {lm} H, \
-                 Llr = {llr} H)"
-            ));
+            return Err(MachineError::Inductances {
+                lls_h: lls,
+                lm_h: lm,
+                llr_h: llr,
+            });
         }
         Ok((1.0 / m, lm / lr, 1.0 / lr))
     }

@@ -2,7 +2,7 @@
 //! their machine-dependent defaults, the parameter changes in effect (faults, load steps,
 //! winding temperature) and the builder of the [`Machine`] they give.
 
-use super::machine::{LoadLaw, Machine, SatLaw, TurnLoop};
+use super::machine::{LoadLaw, Machine, MachineError, SatLaw, TurnLoop};
 use super::{EffectSpec, FaultSpec, LoadKind, Scenario, SimError};
 use crate::params::ParamFile;
 use monitor_core::{Fault, MotorParameters};
@@ -200,7 +200,7 @@ pub(super) struct MachineBuilder<'a> {
 }
 
 impl MachineBuilder<'_> {
-    pub(super) fn build(&self, md: &ParameterScales) -> Result<Machine, String> {
+    pub(super) fn build(&self, md: &ParameterScales) -> Result<Machine, MachineError> {
         let m = self.m;
         let model = m.model::<f64>();
         let rs = m.rs_ohm * md.rs * md.th_s;

@@ -1,7 +1,7 @@
 //! One simulation run: the stiff supply, the scenario's events at their output samples,
 //! the integration loop and the true state of each output sample.
 
-use super::machine::Machine;
+use super::machine::{Machine, MachineError};
 use super::resolve::{rated_torque, MachineBuilder, ParameterScales, RatedPoint, ResolvedEffects};
 use super::sensors::Sensors;
 use super::{LoadKind, Scenario, ScenarioEvent, SimError, SimSummary, SupplyStep, Truth};
@@ -303,9 +303,9 @@ impl<'a> Run<'a> {
         let nsub = u32::try_from(work.steps_per_row).unwrap_or(u32::MAX);
         let h = dt / f64::from(nsub);
         let events = scenario_events(scenario);
-        let invalid = |message: String| SimError::Invalid {
+        let invalid = |e: MachineError| SimError::Invalid {
             key: builder.blamed_key().to_string(),
-            message,
+            message: e.to_string(),
         };
         let machine = builder.build(&scales).map_err(invalid)?;
         let mut scratch = scales;
@@ -435,9 +435,9 @@ impl<'a> Run<'a> {
                 let nm = self
                     .builder
                     .build(&self.scales)
-                    .map_err(|message| SimError::Invalid {
+                    .map_err(|e| SimError::Invalid {
                         key: self.builder.blamed_key().to_string(),
-                        message,
+                        message: e.to_string(),
                     })?;
                 nm.take_guess(&self.machine);
                 self.machine = nm;
