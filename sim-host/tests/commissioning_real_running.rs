@@ -41,7 +41,10 @@ fn a_window_with_supply_steps_inside_is_learned_and_the_log_stays_healthy() {
             ..ReplayOptions::default()
         };
         let r = diagnose_rows(&p, channels(), &rows, opts).expect("learned"); // ok: test
-        assert_eq!(r.commissioning.state, "learned");
+        assert_eq!(
+            r.commissioning.state,
+            sim_host::replay::CommissioningOutcome::Learned
+        );
         let learned = r.commissioning.seconds_evaluated;
         // Less than the window (the steps closed the gate), at least the minimum.
         assert!(

@@ -113,12 +113,12 @@ fn every_rate_keeps_a_healthy_run_quiet() {
             let rep = diagnose_rows(p, sc.sensors.channels(), &rows, opts).expect("replay");
             let quiet = rep.verdict == Verdict::Healthy
                 && rep.first_detection_s.is_none()
-                && rep.commissioning.state == "learned"
+                && rep.commissioning.state == sim_host::replay::CommissioningOutcome::Learned
                 && rep.data_quality.trusted
                 && (rep.data_quality.sample_rate_hz / rate - 1.0).abs() < 1e-4;
             (!quiet).then(|| {
                 format!(
-                    "{name} at {rate} Hz: verdict {:?}, first detection {:?}, commissioning {}, max |r| {:?}, rate {}",
+                    "{name} at {rate} Hz: verdict {:?}, first detection {:?}, commissioning {:?}, max |r| {:?}, rate {}",
                     rep.verdict,
                     rep.first_detection_s,
                     rep.commissioning.state,

@@ -49,11 +49,24 @@ pub fn min_learned_s(start_s: f64, end_s: f64) -> f64 {
 /// See [`min_learned_s`].
 pub const MIN_LEARNED_S: f64 = 1.0;
 
+/// What became of the commissioning asked for (JSON `learned`, `incomplete`, `none`).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum CommissioningOutcome {
+    /// The window was learned: the thresholds and the isolation's baseline are the
+    /// learned ones.
+    Learned,
+    /// A window was asked for and not learned (the report says why).
+    Incomplete,
+    /// No window was asked for: the thresholds are fixed.
+    None,
+}
+
 /// The commissioning part of `diagnose`'s report.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct CommissioningReport {
     /// `learned`, `incomplete` or `none`.
-    pub state: &'static str,
+    pub state: CommissioningOutcome,
     /// The window asked for, `[START, END]` [s], if any.
     pub requested: Option<[f64; 2]>,
     /// The part of the log the run actually spanned, from its start to its end (or to
@@ -365,7 +378,7 @@ impl CommissionTracker {
         );
         let (state, thresholds, advice) = match self.requested {
             None => (
-                "none",
+                CommissioningOutcome::None,
                 fixed,
                 Some(
                     "the thresholds are fixed against the parameter file's nominal values; a real motor's parameters differ by 10-30 %, so commission (--commission START:END) over healthy running that covers the whole load and voltage range"
@@ -373,7 +386,7 @@ impl CommissionTracker {
                 ),
             ),
             Some((a, _)) if self.learned_ok() => (
-                "learned",
+                CommissioningOutcome::Learned,
                 format!(
                     "learned over {a}..{:.2} s: mean +/- {k_sigma} spreads",
                     self.ended_at.unwrap_or(self.last_t)
@@ -381,7 +394,7 @@ impl CommissionTracker {
                 None,
             ),
             Some(_) => (
-                "incomplete",
+                CommissioningOutcome::Incomplete,
                 format!("{fixed} (commissioning incomplete)"),
                 self.why_incomplete(),
             ),

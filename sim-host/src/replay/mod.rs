@@ -34,7 +34,8 @@ mod winding;
 use report::timeline_point;
 
 pub use commission::{
-    grace_s, min_learned_s, CommissioningReport, RangeNote, SteadyPoint, MIN_LEARNED_S,
+    grace_s, min_learned_s, CommissioningOutcome, CommissioningReport, RangeNote, SteadyPoint,
+    MIN_LEARNED_S,
 };
 pub use diagnose::{
     diagnose_file, diagnose_file_observed, diagnose_log, diagnose_rows, Diagnosed, ReplayObserver,

@@ -515,7 +515,7 @@ fn data_quality(out: &mut impl Write, q: &DataQuality) -> anyhow::Result<()> {
 /// What `diagnose` did about its thresholds.
 fn commissioning(out: &mut impl Write, c: &CommissioningReport) -> anyhow::Result<()> {
     writeln!(out, "thresholds: {}", c.thresholds)?;
-    if c.state == "learned" {
+    if c.state == sim_host::replay::CommissioningOutcome::Learned {
         let span = |s: Option<[f32; 2]>, u: &str| {
             s.map(|[a, b]| format!("{a:.1}..{b:.1} {u}"))
                 .unwrap_or_else(|| "-".into())
