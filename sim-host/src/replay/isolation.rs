@@ -608,7 +608,7 @@ pub struct IsolationReport {
     /// force): the unit of `deviation_sigma`.
     pub spread: [f32; 3],
     /// `learned in commissioning` or `nominal parameters`.
-    pub baseline: String,
+    pub baseline: IsolationBaseline,
     /// The first name given and when [s] (JSON `[name, t_s]`).
     pub first_named: Option<NameGiven>,
     /// When the reported isolation was made [s] (the last steady operating point).
@@ -702,14 +702,25 @@ impl IsolationReport {
     }
 }
 
-/// The report's name of the baseline in force (`baseline`).
-fn baseline_name(learned: bool) -> String {
+/// The baseline the isolation judges against (`isolation.baseline`, JSON `learned in
+/// commissioning` or `nominal parameters`).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq, Eq)]
+pub enum IsolationBaseline {
+    /// Learned on the healthy machine while commissioning.
+    #[serde(rename = "learned in commissioning")]
+    Learned,
+    /// The parameter file's nominal machine with the default spreads.
+    #[serde(rename = "nominal parameters")]
+    Nominal,
+}
+
+/// The baseline in force: learned or nominal.
+fn baseline_name(learned: bool) -> IsolationBaseline {
     if learned {
-        "learned in commissioning"
+        IsolationBaseline::Learned
     } else {
-        "nominal parameters"
+        IsolationBaseline::Nominal
     }
-    .to_string()
 }
 
 /// The report's name of an isolation state.

@@ -43,8 +43,8 @@ pub use diagnose::{
 pub use events::{IsolationEvent, LOAD_MOVE_FRACTION, MAX_EVENTS};
 pub(crate) use isolation::serialize_state;
 pub use isolation::{
-    state_name, DetectionLimit, FaultCandidate, IsolationGroup, IsolationName, IsolationReport,
-    NameGiven, SensorPhaseReport, NOMINAL_UNCERTAINTY,
+    state_name, DetectionLimit, FaultCandidate, IsolationBaseline, IsolationGroup, IsolationName,
+    IsolationReport, NameGiven, SensorPhaseReport, NOMINAL_UNCERTAINTY,
 };
 pub use report::{
     BaselineSource, Detection, DiagnoseReport, MonitorState, Panel, TimelinePoint, UnbalanceReport,
