@@ -238,9 +238,9 @@ fn start_acquisition(
         triggers::TIM1_TRGO,
         Exten::RISING_EDGE,
     );
-    let mut acq = HwAcquisition::new(trigger, adc1, adc2, RING_LEN as u16);
-    acq.start();
-    path.sampler_mut().resync(acq.started_us);
+    let mut acq = acquisition::new_acquisition(trigger, adc1, adc2, RING_LEN as u16);
+    acquisition::start(&mut acq);
+    path.sampler_mut().resync(acq.regs.started_us);
     (qei, acq)
 }
 
@@ -298,8 +298,8 @@ async fn sample_task(hw: SampleHw, mut path: SamplePath) {
     let mut counts = RecoveryCounts::default();
     loop {
         let read = with_timeout(timeout, async {
-            let r1 = acq.adc1.read(&mut half1).await;
-            let r2 = acq.adc2.read(&mut half2).await;
+            let r1 = acq.regs.adc1.read(&mut half1).await;
+            let r2 = acq.regs.adc2.read(&mut half2).await;
             (r1.is_ok(), r2.is_ok())
         })
         .await;
@@ -340,7 +340,7 @@ async fn sample_task(hw: SampleHw, mut path: SamplePath) {
             // the timestamps continue from the restart (the gap shows).
             set_phase(Phase::Recovery);
             let result = recovery::recover(&mut acq);
-            path.sampler_mut().resync(acq.started_us);
+            path.sampler_mut().resync(acq.regs.started_us);
             set_phase(Phase::Sampling);
             counts.count(result);
             match result {

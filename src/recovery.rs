@@ -22,15 +22,17 @@
 //! | [`Step::StopTrigger`] | TIM1 counter off | no new conversion starts |
 //! | [`Step::StopAdc`] | `ADSTP`, then wait for `ADSTART = 0` (bounded) | a conversion in flight ends before the DMA stops (else it would set `OVR` itself) |
 //! | [`Step::PauseDma`] | `EN = 0`, then wait for it (bounded) | `CNDTR` may only be written with the channel off |
-//! | [`Step::ClearFlags`] | `OVR` (write 1), `TEIF`/`HTIF`/`TCIF` (`DMA_IFCR`) | a latched `OVR` blocks the DMA requests |
+//! | [`Step::ClearFlags`] | `OVR`, `EOC`, `EOS` (write 1), `TEIF`/`HTIF`/`TCIF` (`DMA_IFCR`) | a latched `OVR` blocks the DMA requests; an `EOC` left set (the data register unread since the overrun) sets `OVR` again at the next conversion |
 //! | [`Step::RearmDma`] | `CNDTR` = ring length, ring indices reset, `DMAEN`/`DMACFG` circular, `EN = 1` | the DMA is ready before the ADC asks |
 //! | [`Step::StartAdc`] | `ADSTART = 1` (waits for the next trigger) | both ADCs armed before the trigger |
 //! | [`Step::StartTrigger`] | TIM1 counter on, timestamps continue from now | ADC1 and ADC2 start on the same trigger |
 //!
-//! The sequence is written once, over the [`Acquisition`] trait: the firmware implements
-//! it with the registers (`src/firmware.rs`), the host tests with a model of the hardware
-//! that obeys the rules above (`tests/sil/recovery.rs`), into which they inject an overrun
-//! and a DMA error. The monitor itself (its thresholds, the commissioning state, the
+//! The sequence is written once, over the [`Acquisition`] trait, and its register accesses
+//! once, in [`RegisterAcquisition`] over the [`AcqRegisters`] trait: the firmware implements
+//! that with the STM32G474's registers (`src/firmware/acquisition.rs`), the host tests with
+//! a register-level model of ADC + DMA that keeps `ADC_DR` and `EOC` as the hardware does
+//! and checks every access's precondition (`tests/sil/recovery.rs`), into which they inject
+//! an overrun, a DMA error and a lapped ring. The monitor itself (its thresholds, the commissioning state, the
 //! counters) is not touched by a recovery: only the acquisition restarts.
 
 /// One step of the recovery sequence, in its order (module docs).
@@ -158,6 +160,151 @@ pub fn recover<A: Acquisition>(acq: &mut A) -> Result<Faults, StepTimeout> {
     acq.start_adc();
     acq.start_trigger();
     Ok(faults)
+}
+
+/// An ADC's status flags of `ADC_ISR` that the recovery reads and clears (RM0440): `OVR`,
+/// `EOC` (a result waits in `ADC_DR`) and `EOS` (a sequence ended).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct AdcFlags {
+    /// `OVR`: a conversion ended while `EOC` was still set.
+    pub ovr: bool,
+    /// `EOC`: the data register holds a result nobody read.
+    pub eoc: bool,
+    /// `EOS`: the regular sequence ended.
+    pub eos: bool,
+}
+
+impl AdcFlags {
+    /// What [`Step::ClearFlags`] writes to `ADC_ISR` (write 1 to clear): `OVR`, `EOC` and
+    /// `EOS` together, as ST's HAL does. After an overrun with `OVRMOD = 0` the data
+    /// register was never read and `EOC` stays 1; RM0440 sets `OVR` again as soon as a
+    /// conversion ends while `EOC` is 1, so clearing `OVR` alone re-overruns at the first
+    /// conversion after the restart.
+    pub const RECOVERY_CLEAR: AdcFlags = AdcFlags {
+        ovr: true,
+        eoc: true,
+        eos: true,
+    };
+}
+
+/// The register accesses of the acquisition's recovery, one per hardware action: ADC `i`
+/// (0: ADC1, the voltages; 1: ADC2, the currents), its DMA channel `i`, the trigger. The
+/// firmware implements it on the STM32G474's registers (`src/firmware/acquisition.rs`);
+/// the host tests on a register-level model of ADC + DMA that keeps `ADC_DR` and `EOC` as
+/// the hardware does and checks each access's precondition (`tests/sil/recovery.rs`).
+/// [`RegisterAcquisition`] is the sequence over them, the same code on both.
+pub trait AcqRegisters {
+    /// `ADC_ISR`'s `OVR`, `EOC`, `EOS` of ADC `i`.
+    fn adc_flags(&mut self, i: usize) -> AdcFlags;
+    /// Writes 1 to the flags set in `f` of ADC `i`'s `ADC_ISR` (clears them).
+    fn adc_clear(&mut self, i: usize, f: AdcFlags);
+    /// `ADSTART` of ADC `i`: its regular conversions are on.
+    fn adc_started(&mut self, i: usize) -> bool;
+    /// `ADDIS` of ADC `i`: it is being disabled.
+    fn adc_disabling(&mut self, i: usize) -> bool;
+    /// Sets `ADSTP` of ADC `i` (allowed only with `ADSTART = 1` and `ADDIS = 0`).
+    fn adc_stop(&mut self, i: usize);
+    /// Sets `ADSTART` of ADC `i`.
+    fn adc_start(&mut self, i: usize);
+    /// `DMAEN = 1`, `DMACFG` circular in ADC `i`'s `ADC_CFGR` (allowed only with
+    /// `ADSTART = 0`).
+    fn adc_dma_circular(&mut self, i: usize);
+    /// `TEIF` of DMA channel `i`.
+    fn dma_error(&mut self, i: usize) -> bool;
+    /// Clears `TEIF`, `HTIF`, `TCIF` and `GIF` of DMA channel `i` (`DMA_IFCR`).
+    fn dma_clear(&mut self, i: usize);
+    /// `EN` of DMA channel `i`.
+    fn dma_enabled(&mut self, i: usize) -> bool;
+    /// Disables DMA channel `i` (`EN = 0`; on the board through the HAL's ring).
+    fn dma_disable(&mut self, i: usize);
+    /// Writes `CNDTR` of DMA channel `i` (allowed only with `EN = 0`) and resets the
+    /// ring's read position to match.
+    fn dma_reload(&mut self, i: usize, transfers: u16);
+    /// Enables DMA channel `i` (`EN = 1`).
+    fn dma_enable(&mut self, i: usize);
+    /// Stops the sample trigger (TIM1's counter).
+    fn trigger_stop(&mut self);
+    /// Starts the sample trigger.
+    fn trigger_start(&mut self);
+}
+
+/// The two ADCs and their DMA channels.
+const CHANNELS: [usize; 2] = [0, 1];
+
+/// The acquisition over its registers: [`Acquisition`] (the recovery's steps) written once
+/// over [`AcqRegisters`], for the board's registers and the host's model alike.
+#[derive(Debug)]
+pub struct RegisterAcquisition<R> {
+    /// The registers.
+    pub regs: R,
+    /// DMA transfers per ring turn (the ring's length in 16-bit words).
+    pub ring_len: u16,
+}
+
+impl<R: AcqRegisters> Acquisition for RegisterAcquisition<R> {
+    fn faults(&mut self) -> Faults {
+        Faults {
+            adc_overrun: CHANNELS.iter().any(|&i| self.regs.adc_flags(i).ovr),
+            dma_error: CHANNELS.iter().any(|&i| self.regs.dma_error(i)),
+        }
+    }
+
+    fn stop_trigger(&mut self) {
+        self.regs.trigger_stop();
+    }
+
+    fn stop_adc(&mut self) -> Result<(), StepTimeout> {
+        for i in CHANNELS {
+            if self.regs.adc_started(i) && !self.regs.adc_disabling(i) {
+                self.regs.adc_stop(i);
+            }
+        }
+        let regs = &mut self.regs;
+        poll_until(Step::StopAdc, POLL_LIMIT, || {
+            CHANNELS.iter().all(|&i| !regs.adc_started(i))
+        })
+    }
+
+    fn pause_dma(&mut self) -> Result<(), StepTimeout> {
+        for i in CHANNELS {
+            self.regs.dma_disable(i);
+        }
+        let regs = &mut self.regs;
+        poll_until(Step::PauseDma, POLL_LIMIT, || {
+            CHANNELS.iter().all(|&i| !regs.dma_enabled(i))
+        })
+    }
+
+    fn clear_flags(&mut self) {
+        for i in CHANNELS {
+            self.regs.adc_clear(i, AdcFlags::RECOVERY_CLEAR);
+            self.regs.dma_clear(i);
+        }
+    }
+
+    fn rearm_dma(&mut self) {
+        for i in CHANNELS {
+            // The channel is off: CNDTR is writable.
+            self.regs.dma_reload(i, self.ring_len);
+        }
+        for i in CHANNELS {
+            // ADSTART = 0 here, so DMAEN/DMACFG are writable.
+            self.regs.adc_dma_circular(i);
+        }
+        for i in CHANNELS {
+            self.regs.dma_enable(i);
+        }
+    }
+
+    fn start_adc(&mut self) {
+        for i in CHANNELS {
+            self.regs.adc_start(i);
+        }
+    }
+
+    fn start_trigger(&mut self) {
+        self.regs.trigger_start();
+    }
 }
 
 /// Counts of the recoveries since boot, by cause (for the log; the status line's

@@ -1,13 +1,13 @@
-//! The acquisition's registers: the recovery sequence of `drive_monitor::recovery` (ADC
-//! overrun, DMA transfer error) on the STM32G474's ADC1/ADC2 and DMA1 channels 1/2, in the
-//! order of the reference manual RM0440 (the table in `drive_monitor::recovery`).
+//! The acquisition's registers: [`AcqRegisters`] on the STM32G474's ADC1/ADC2 and DMA1
+//! channels 1/2. The recovery's sequence over them is `drive_monitor::recovery`'s
+//! [`RegisterAcquisition`] (the same code the host tests run on a register-level model);
+//! here are only the single register accesses, in RM0440's terms.
 //!
 //! The ring-buffered ADCs of embassy-stm32 own the DMA channels; what they do not offer
-//! (stopping a conversion without clearing `DMAEN`, clearing `OVR` and `TEIF`, reloading
-//! `CNDTR`) is done here on the registers, with every wait bounded
-//! ([`recovery::poll_until`]).
+//! (stopping a conversion without clearing `DMAEN`, clearing `OVR`/`EOC`/`EOS` and `TEIF`,
+//! reloading `CNDTR`) is done on the registers.
 
-use drive_monitor::recovery::{self, Acquisition, Faults, Step, StepTimeout, POLL_LIMIT};
+use drive_monitor::recovery::{AcqRegisters, AdcFlags, RegisterAcquisition};
 use embassy_stm32::adc::RingBufferedAdc;
 use embassy_stm32::pac;
 use embassy_stm32::pac::adc::vals::{Adstp, Dmacfg, Dmaen};
@@ -20,13 +20,15 @@ const ADCS: [pac::adc::Adc; 2] = [pac::ADC1, pac::ADC2];
 /// The DMA1 channels of the two rings (register index: channel 1 is index 0).
 const DMA_CHANNELS: [usize; 2] = [0, 1];
 
-/// The acquisition: trigger timer and the two ring-buffered ADCs.
-pub(super) struct HwAcquisition {
+/// The acquisition: trigger timer and the two ring-buffered ADCs, as the recovery drives
+/// them ([`RegisterAcquisition`] over [`HwRegisters`]).
+pub(super) type HwAcquisition = RegisterAcquisition<HwRegisters>;
+
+/// The acquisition's hardware: trigger timer and the two ring-buffered ADCs.
+pub(super) struct HwRegisters {
     pub(super) trigger: HwTimer<'static, peripherals::TIM1>,
     pub(super) adc1: RingBufferedAdc<'static, peripherals::ADC1>,
     pub(super) adc2: RingBufferedAdc<'static, peripherals::ADC2>,
-    /// DMA transfers per ring turn (the ring's length in 16-bit words).
-    ring_len: u16,
     /// When the trigger was last started, us (the timestamps continue from there).
     pub(super) started_us: u32,
 }
@@ -35,115 +37,144 @@ fn now_us() -> u32 {
     Instant::now().as_micros() as u32
 }
 
-impl HwAcquisition {
-    /// Wraps the rings (not started yet) and masks the DMA channels' transfer-error
-    /// interrupt: the HAL's DMA interrupt panics on a transfer error; with the interrupt
-    /// masked the error stops the channel, the sample task's wait times out and
-    /// [`recovery::recover`] clears and re-arms it. `TEIE` may only be written with the
-    /// channel disabled, as it is before the first start.
-    pub(super) fn new(
-        trigger: HwTimer<'static, peripherals::TIM1>,
-        adc1: RingBufferedAdc<'static, peripherals::ADC1>,
-        adc2: RingBufferedAdc<'static, peripherals::ADC2>,
-        ring_len: u16,
-    ) -> Self {
-        for n in DMA_CHANNELS {
-            pac::DMA1.ch(n).cr().modify(|w| w.set_teie(false));
-        }
-        Self {
+/// Wraps the rings (not started yet) and masks the DMA channels' transfer-error interrupt:
+/// the HAL's DMA interrupt panics on a transfer error; with the interrupt masked the error
+/// stops the channel, the sample task's wait times out and the recovery clears and re-arms
+/// it. `TEIE` may only be written with the channel disabled, as it is before the first
+/// start.
+pub(super) fn new_acquisition(
+    trigger: HwTimer<'static, peripherals::TIM1>,
+    adc1: RingBufferedAdc<'static, peripherals::ADC1>,
+    adc2: RingBufferedAdc<'static, peripherals::ADC2>,
+    ring_len: u16,
+) -> HwAcquisition {
+    for n in DMA_CHANNELS {
+        pac::DMA1.ch(n).cr().modify(|w| w.set_teie(false));
+    }
+    RegisterAcquisition {
+        regs: HwRegisters {
             trigger,
             adc1,
             adc2,
-            ring_len,
             started_us: 0,
-        }
-    }
-
-    /// The first start: both rings and ADCs, then the trigger.
-    pub(super) fn start(&mut self) {
-        self.adc1.start();
-        self.adc2.start();
-        self.start_trigger();
+        },
+        ring_len,
     }
 }
 
-impl Acquisition for HwAcquisition {
-    fn faults(&mut self) -> Faults {
-        let isr = pac::DMA1.isr().read();
-        Faults {
-            adc_overrun: ADCS.iter().any(|a| a.isr().read().ovr()),
-            dma_error: DMA_CHANNELS.iter().any(|&n| isr.teif(n)),
+/// The first start: both rings and ADCs, then the trigger.
+pub(super) fn start(acq: &mut HwAcquisition) {
+    acq.regs.adc1.start();
+    acq.regs.adc2.start();
+    acq.regs.trigger_start();
+}
+
+/// ADC `i`'s registers (0: ADC1, else ADC2).
+fn adc(i: usize) -> pac::adc::Adc {
+    if i == 0 {
+        ADCS[0]
+    } else {
+        ADCS[1]
+    }
+}
+
+/// DMA channel `i`'s register index.
+fn dma(i: usize) -> usize {
+    if i == 0 {
+        DMA_CHANNELS[0]
+    } else {
+        DMA_CHANNELS[1]
+    }
+}
+
+impl AcqRegisters for HwRegisters {
+    fn adc_flags(&mut self, i: usize) -> AdcFlags {
+        let isr = adc(i).isr().read();
+        AdcFlags {
+            ovr: isr.ovr(),
+            eoc: isr.eoc(),
+            eos: isr.eos(),
         }
     }
 
-    fn stop_trigger(&mut self) {
-        self.trigger.stop();
-    }
-
-    fn stop_adc(&mut self) -> Result<(), StepTimeout> {
-        for a in ADCS {
-            let cr = a.cr().read();
-            if cr.adstart() && !cr.addis() {
-                a.cr().modify(|w| w.set_adstp(Adstp::STOP));
-            }
-        }
-        recovery::poll_until(Step::StopAdc, POLL_LIMIT, || {
-            ADCS.iter().all(|a| !a.cr().read().adstart())
-        })
-    }
-
-    fn pause_dma(&mut self) -> Result<(), StepTimeout> {
-        self.adc1.stop();
-        self.adc2.stop();
-        recovery::poll_until(Step::PauseDma, POLL_LIMIT, || {
-            DMA_CHANNELS
-                .iter()
-                .all(|&n| !pac::DMA1.ch(n).cr().read().en())
-        })
-    }
-
-    fn clear_flags(&mut self) {
-        for a in ADCS {
-            // Write 1 to clear; the other flags are left as they are.
-            a.isr().write(|w| w.set_ovr(true));
-        }
-        pac::DMA1.ifcr().write(|w| {
-            for n in DMA_CHANNELS {
-                w.set_teif(n, true);
-                w.set_htif(n, true);
-                w.set_tcif(n, true);
-                w.set_gif(n, true);
-            }
+    fn adc_clear(&mut self, i: usize, f: AdcFlags) {
+        // Write 1 to clear; the other flags are left as they are.
+        adc(i).isr().write(|w| {
+            w.set_ovr(f.ovr);
+            w.set_eoc(f.eoc);
+            w.set_eos(f.eos);
         });
     }
 
-    fn rearm_dma(&mut self) {
-        for n in DMA_CHANNELS {
-            // The whole ring again, from its start (the channel is off: CNDTR is writable).
-            pac::DMA1.ch(n).ndtr().write(|w| w.set_ndt(self.ring_len));
-        }
-        // The rings' read and write positions from the reloaded counters.
-        self.adc1.clear();
-        self.adc2.clear();
-        for a in ADCS {
-            // ADSTART = 0 here, so DMAEN/DMACFG are writable.
-            a.cfgr().modify(|w| {
-                w.set_dmaen(Dmaen::ENABLE);
-                w.set_dmacfg(Dmacfg::CIRCULAR);
-            });
-        }
-        for n in DMA_CHANNELS {
-            pac::DMA1.ch(n).cr().modify(|w| w.set_en(true));
+    fn adc_started(&mut self, i: usize) -> bool {
+        adc(i).cr().read().adstart()
+    }
+
+    fn adc_disabling(&mut self, i: usize) -> bool {
+        adc(i).cr().read().addis()
+    }
+
+    fn adc_stop(&mut self, i: usize) {
+        adc(i).cr().modify(|w| w.set_adstp(Adstp::STOP));
+    }
+
+    fn adc_start(&mut self, i: usize) {
+        adc(i).cr().modify(|w| w.set_adstart(true));
+    }
+
+    fn adc_dma_circular(&mut self, i: usize) {
+        adc(i).cfgr().modify(|w| {
+            w.set_dmaen(Dmaen::ENABLE);
+            w.set_dmacfg(Dmacfg::CIRCULAR);
+        });
+    }
+
+    fn dma_error(&mut self, i: usize) -> bool {
+        pac::DMA1.isr().read().teif(dma(i))
+    }
+
+    fn dma_clear(&mut self, i: usize) {
+        let n = dma(i);
+        pac::DMA1.ifcr().write(|w| {
+            w.set_teif(n, true);
+            w.set_htif(n, true);
+            w.set_tcif(n, true);
+            w.set_gif(n, true);
+        });
+    }
+
+    fn dma_enabled(&mut self, i: usize) -> bool {
+        pac::DMA1.ch(dma(i)).cr().read().en()
+    }
+
+    fn dma_disable(&mut self, i: usize) {
+        if i == 0 {
+            self.adc1.stop();
+        } else {
+            self.adc2.stop();
         }
     }
 
-    fn start_adc(&mut self) {
-        for a in ADCS {
-            a.cr().modify(|w| w.set_adstart(true));
+    fn dma_reload(&mut self, i: usize, transfers: u16) {
+        // The whole ring again, from its start (the channel is off: CNDTR is writable);
+        // the ring's read and write positions from the reloaded counter.
+        pac::DMA1.ch(dma(i)).ndtr().write(|w| w.set_ndt(transfers));
+        if i == 0 {
+            self.adc1.clear();
+        } else {
+            self.adc2.clear();
         }
     }
 
-    fn start_trigger(&mut self) {
+    fn dma_enable(&mut self, i: usize) {
+        pac::DMA1.ch(dma(i)).cr().modify(|w| w.set_en(true));
+    }
+
+    fn trigger_stop(&mut self) {
+        self.trigger.stop();
+    }
+
+    fn trigger_start(&mut self) {
         self.started_us = now_us();
         self.trigger.start();
     }

@@ -183,11 +183,12 @@ struct Rig {
     adc: AdcWait,
     waited_us: u32,
     restarts_at_ms: Vec<u32>,
-    /// The ADCs, DMA channels and trigger (a model of the hardware, `recovery::FakeAcq`).
-    acq: recovery::FakeAcq,
+    /// The ADCs, DMA channels and trigger: the firmware's register sequence over a
+    /// register-level model of the hardware (`recovery::AdcDmaModel`).
+    acq: recovery::ModelAcq,
     /// What the sample task runs when a wait timed out: the firmware's
     /// `drive_monitor::recovery::recover`, or another sequence to compare with.
-    restart: fn(&mut recovery::FakeAcq) -> Result<Faults, StepTimeout>,
+    restart: fn(&mut recovery::ModelAcq) -> Result<Faults, StepTimeout>,
     /// The results of the restarts.
     recoveries: Vec<Result<Faults, StepTimeout>>,
     /// The start-up offset trim's result.
@@ -236,7 +237,7 @@ impl Rig {
             adc: AdcWait::new(settings.sample_rate_hz),
             waited_us: 0,
             restarts_at_ms: Vec::new(),
-            acq: recovery::FakeAcq::running(),
+            acq: recovery::AdcDmaModel::running(),
             restart: drive_monitor::recovery::recover,
             recoveries: Vec::new(),
             trims: Vec::new(),
@@ -376,7 +377,7 @@ impl Rig {
         for (k, raw) in frames.iter().enumerate() {
             at(self, k);
             // The frame reaches the sample path only when the hardware delivers it.
-            let delivered = self.acq.trigger();
+            let delivered = self.acq.regs.trigger();
             self.period(delivered.then_some(raw))?;
         }
         Ok(())

@@ -1,115 +1,289 @@
-//! The acquisition's recovery: a model of the ADC/DMA hardware (the rules of the reference
-//! manual RM0440 that `drive_monitor::recovery` relies on) into which an ADC overrun and a
-//! DMA transfer error are injected; the monitor resumes with its state intact. The
-//! firmware's former restart (no `OVR` cleared) is run on the same model and never
-//! resumes.
+//! The acquisition's recovery on a register-level model of the STM32G474's ADC + DMA
+//! (RM0440): each ADC keeps its data register and `EOC` as the hardware does (a result sits
+//! in `ADC_DR` with `EOC = 1` until the DMA reads it; a conversion that ends while `EOC` is
+//! 1 sets `OVR` and, with `OVRMOD = 0`, keeps the old data; while `OVR` is set the ADC
+//! issues no DMA requests), each DMA channel its `EN`, `CNDTR` and `TEIF`, and every
+//! register access checks its precondition (`ADSTP` only while converting, `DMAEN`/`DMACFG`
+//! only with `ADSTART = 0`, `CNDTR` only with the channel off). The firmware's own sequence,
+//! `drive_monitor::recovery::RegisterAcquisition` (the code `src/firmware/acquisition.rs`
+//! runs over the real registers), drives it; an overrun, a DMA error and a lapped ring are
+//! injected and the monitor resumes with its state intact. The same sequence with only
+//! `OVR` cleared (the firmware's sequence before the `EOC` clear) re-overruns at the first
+//! conversion and never resumes, as does the firmware's former restart.
 
 use super::*;
-use drive_monitor::recovery::{self, Acquisition, Faults, Step, StepTimeout};
+use drive_monitor::recovery::{
+    self, AcqRegisters, Acquisition, AdcFlags, Faults, RegisterAcquisition, Step, StepTimeout,
+};
 
-/// The ADCs, their DMA channels and the trigger, as far as the recovery is concerned.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct FakeAcq {
-    trigger_on: bool,
-    /// `ADSTART`: the ADCs convert on each trigger.
+/// The ring's length in DMA transfers (the firmware's `RING_LEN`, two halves of samples).
+pub(super) const RING_LEN: u16 = 12;
+
+/// One ADC as the recovery sees it.
+#[derive(Clone, Copy, Debug, Default)]
+struct AdcModel {
     adstart: bool,
-    /// `OVR`: latched by a conversion whose previous result nobody took; while set, the
-    /// ADC issues no DMA requests (RM0440, with `DMAEN = 1`).
     ovr: bool,
-    /// The data register holds a result the DMA has not taken.
-    dr_full: bool,
-    /// The ADCs' `DMAEN`.
-    dmaen: bool,
-    /// The DMA channels' `EN` (cleared by the hardware on a transfer error).
-    dma_en: bool,
-    /// `TEIF`.
-    teif: bool,
+    eoc: bool,
+    eos: bool,
+    /// `ADC_DR`: the number of the conversion whose result it holds.
+    dr: u32,
+    /// `DMAEN` with `DMACFG` circular.
+    dma_circular: bool,
 }
 
-impl FakeAcq {
-    pub(super) fn running() -> Self {
-        Self {
-            trigger_on: true,
+/// One DMA channel.
+#[derive(Clone, Copy, Debug, Default)]
+struct DmaModel {
+    en: bool,
+    teif: bool,
+    cndtr: u16,
+    /// The results the channel moved, in order (the last few).
+    moved: u32,
+}
+
+/// The two ADCs, their DMA channels and the trigger, at register level (module docs).
+#[derive(Clone, Debug)]
+pub(super) struct AdcDmaModel {
+    trigger_on: bool,
+    adc: [AdcModel; 2],
+    dma: [DmaModel; 2],
+    conversions: u32,
+    /// Overruns the hardware latched (each conversion that ended with `EOC` still set).
+    pub(super) overruns: u32,
+    /// Register accesses made against their precondition (RM0440), in words.
+    pub(super) violations: Vec<String>,
+}
+
+/// The acquisition the rig runs: the firmware's sequence over the model.
+pub(super) type ModelAcq = RegisterAcquisition<AdcDmaModel>;
+
+impl AdcDmaModel {
+    pub(super) fn running() -> ModelAcq {
+        let adc = AdcModel {
             adstart: true,
-            ovr: false,
-            dr_full: false,
-            dmaen: true,
-            dma_en: true,
-            teif: false,
+            dma_circular: true,
+            ..AdcModel::default()
+        };
+        let dma = DmaModel {
+            en: true,
+            cndtr: RING_LEN,
+            ..DmaModel::default()
+        };
+        RegisterAcquisition {
+            regs: AdcDmaModel {
+                trigger_on: true,
+                adc: [adc; 2],
+                dma: [dma; 2],
+                conversions: 0,
+                overruns: 0,
+                violations: Vec::new(),
+            },
+            ring_len: RING_LEN,
         }
     }
 
-    /// One trigger period: whether a conversion's results reach the ring.
+    /// One trigger period: each converting ADC ends a conversion (an overrun if `EOC` is
+    /// still set), then its DMA channel takes the result if it can. Whether both results
+    /// reached the rings.
     pub(super) fn trigger(&mut self) -> bool {
-        if !(self.trigger_on && self.adstart) {
+        if !self.trigger_on {
             return false;
         }
-        if self.ovr {
-            return false;
+        self.conversions += 1;
+        let mut delivered = [false; 2];
+        for ((a, d), got) in self.adc.iter_mut().zip(&mut self.dma).zip(&mut delivered) {
+            if !a.adstart {
+                continue;
+            }
+            if a.eoc {
+                // OVRMOD = 0: the old result stays in ADC_DR.
+                if !a.ovr {
+                    self.overruns += 1;
+                }
+                a.ovr = true;
+            } else {
+                a.dr = self.conversions;
+                a.eoc = true;
+                a.eos = true;
+            }
+            // The DMA request: none while OVR is set.
+            if a.eoc && !a.ovr && a.dma_circular && d.en {
+                a.eoc = false;
+                d.moved = a.dr;
+                d.cndtr = if d.cndtr <= 1 { RING_LEN } else { d.cndtr - 1 };
+                *got = true;
+            }
         }
-        if self.dmaen && self.dma_en {
-            self.dr_full = false;
-            return true;
-        }
-        // Nobody takes the result: the next conversion overruns.
-        if self.dr_full {
-            self.ovr = true;
-        }
-        self.dr_full = true;
-        false
+        delivered == [true; 2]
     }
 
-    /// A conversion finished before the DMA took the previous one.
-    fn inject_overrun(&mut self) {
-        self.ovr = true;
+    /// A conversion ended before the DMA took the previous result: `OVR` set, the data
+    /// register holding the unread result (`EOC = 1`).
+    pub(super) fn inject_overrun(&mut self) {
+        for a in &mut self.adc {
+            a.ovr = true;
+            a.eoc = true;
+        }
+        self.overruns += 1;
     }
 
     /// A DMA transfer error: the hardware sets `TEIF` and clears `EN`.
-    fn inject_dma_error(&mut self) {
-        self.teif = true;
-        self.dma_en = false;
+    pub(super) fn inject_dma_error(&mut self) {
+        for d in &mut self.dma {
+            d.teif = true;
+            d.en = false;
+        }
+    }
+
+    fn violation(&mut self, what: String) {
+        self.violations.push(what);
     }
 }
 
-impl Acquisition for FakeAcq {
-    fn faults(&mut self) -> Faults {
-        Faults {
-            adc_overrun: self.ovr,
-            dma_error: self.teif,
+impl AcqRegisters for AdcDmaModel {
+    fn adc_flags(&mut self, i: usize) -> AdcFlags {
+        let a = self.adc[i];
+        AdcFlags {
+            ovr: a.ovr,
+            eoc: a.eoc,
+            eos: a.eos,
         }
     }
-    fn stop_trigger(&mut self) {
+    fn adc_clear(&mut self, i: usize, f: AdcFlags) {
+        let a = &mut self.adc[i];
+        a.ovr &= !f.ovr;
+        a.eoc &= !f.eoc;
+        a.eos &= !f.eos;
+    }
+    fn adc_started(&mut self, i: usize) -> bool {
+        self.adc[i].adstart
+    }
+    fn adc_disabling(&mut self, _i: usize) -> bool {
+        false
+    }
+    fn adc_stop(&mut self, i: usize) {
+        if !self.adc[i].adstart {
+            self.violation(format!("ADSTP on ADC{} while ADSTART = 0", i + 1));
+        }
+        // The conversion in flight ends (no result: the model's conversions are instant).
+        self.adc[i].adstart = false;
+    }
+    fn adc_start(&mut self, i: usize) {
+        self.adc[i].adstart = true;
+    }
+    fn adc_dma_circular(&mut self, i: usize) {
+        if self.adc[i].adstart {
+            self.violation(format!(
+                "DMAEN/DMACFG of ADC{} written while ADSTART = 1",
+                i + 1
+            ));
+        }
+        self.adc[i].dma_circular = true;
+    }
+    fn dma_error(&mut self, i: usize) -> bool {
+        self.dma[i].teif
+    }
+    fn dma_clear(&mut self, i: usize) {
+        self.dma[i].teif = false;
+    }
+    fn dma_enabled(&mut self, i: usize) -> bool {
+        self.dma[i].en
+    }
+    fn dma_disable(&mut self, i: usize) {
+        self.dma[i].en = false;
+    }
+    fn dma_reload(&mut self, i: usize, transfers: u16) {
+        if self.dma[i].en {
+            self.violation(format!(
+                "CNDTR of DMA channel {} written while EN = 1",
+                i + 1
+            ));
+        }
+        self.dma[i].cndtr = transfers;
+    }
+    fn dma_enable(&mut self, i: usize) {
+        self.dma[i].en = true;
+    }
+    fn trigger_stop(&mut self) {
         self.trigger_on = false;
     }
-    fn stop_adc(&mut self) -> Result<(), StepTimeout> {
-        self.adstart = false;
-        Ok(())
-    }
-    fn pause_dma(&mut self) -> Result<(), StepTimeout> {
-        self.dma_en = false;
-        Ok(())
-    }
-    fn clear_flags(&mut self) {
-        self.ovr = false;
-        self.teif = false;
-    }
-    fn rearm_dma(&mut self) {
-        self.dr_full = false;
-        self.dmaen = true;
-        self.dma_en = true;
-    }
-    fn start_adc(&mut self) {
-        self.adstart = true;
-    }
-    fn start_trigger(&mut self) {
+    fn trigger_start(&mut self) {
         self.trigger_on = true;
     }
+}
+
+/// The firmware's sequence with only `OVR` cleared in `ADC_ISR` (before the `EOC` clear):
+/// every register access as the model's, `EOC` and `EOS` left set.
+struct OnlyOvr<'a>(&'a mut AdcDmaModel);
+
+impl AcqRegisters for OnlyOvr<'_> {
+    fn adc_flags(&mut self, i: usize) -> AdcFlags {
+        self.0.adc_flags(i)
+    }
+    fn adc_clear(&mut self, i: usize, f: AdcFlags) {
+        self.0.adc_clear(
+            i,
+            AdcFlags {
+                ovr: f.ovr,
+                ..AdcFlags::default()
+            },
+        );
+    }
+    fn adc_started(&mut self, i: usize) -> bool {
+        self.0.adc_started(i)
+    }
+    fn adc_disabling(&mut self, i: usize) -> bool {
+        self.0.adc_disabling(i)
+    }
+    fn adc_stop(&mut self, i: usize) {
+        self.0.adc_stop(i);
+    }
+    fn adc_start(&mut self, i: usize) {
+        self.0.adc_start(i);
+    }
+    fn adc_dma_circular(&mut self, i: usize) {
+        self.0.adc_dma_circular(i);
+    }
+    fn dma_error(&mut self, i: usize) -> bool {
+        self.0.dma_error(i)
+    }
+    fn dma_clear(&mut self, i: usize) {
+        self.0.dma_clear(i);
+    }
+    fn dma_enabled(&mut self, i: usize) -> bool {
+        self.0.dma_enabled(i)
+    }
+    fn dma_disable(&mut self, i: usize) {
+        self.0.dma_disable(i);
+    }
+    fn dma_reload(&mut self, i: usize, transfers: u16) {
+        self.0.dma_reload(i, transfers);
+    }
+    fn dma_enable(&mut self, i: usize) {
+        self.0.dma_enable(i);
+    }
+    fn trigger_stop(&mut self) {
+        self.0.trigger_stop();
+    }
+    fn trigger_start(&mut self) {
+        self.0.trigger_start();
+    }
+}
+
+/// The recovery with only `OVR` cleared ([`OnlyOvr`]).
+fn recover_only_ovr(acq: &mut ModelAcq) -> Result<Faults, StepTimeout> {
+    let mut weak = RegisterAcquisition {
+        regs: OnlyOvr(&mut acq.regs),
+        ring_len: acq.ring_len,
+    };
+    recovery::recover(&mut weak)
 }
 
 /// The firmware's restart before the recovery: the trigger stopped, the DMA paused and
 /// resumed with the rings cleared, `ADSTART` set, the trigger started, and `OVR` never
 /// cleared.
-fn former_restart(acq: &mut FakeAcq) -> Result<Faults, StepTimeout> {
+fn former_restart(acq: &mut ModelAcq) -> Result<Faults, StepTimeout> {
     let faults = acq.faults();
     acq.stop_trigger();
     acq.pause_dma()?;
@@ -124,10 +298,10 @@ const DMA_ERROR_AT: usize = 25_000;
 
 fn inject(rig: &mut Rig, k: usize) {
     if k == OVERRUN_AT {
-        rig.acq.inject_overrun();
+        rig.acq.regs.inject_overrun();
     }
     if k == DMA_ERROR_AT {
-        rig.acq.inject_dma_error();
+        rig.acq.regs.inject_dma_error();
     }
 }
 
@@ -206,11 +380,11 @@ fn the_former_restart_never_clears_the_overrun_and_ends_in_a_watchdog_reset() {
 
 #[test]
 fn the_sequence_on_the_model_clears_what_blocks_the_dma() {
-    let mut acq = FakeAcq::running();
-    acq.inject_dma_error();
+    let mut acq = AdcDmaModel::running();
+    acq.regs.inject_dma_error();
     // The ADC goes on converting into a full data register: overrun.
-    assert!(!acq.trigger() && !acq.trigger());
-    assert!(acq.ovr);
+    assert!(!acq.regs.trigger() && !acq.regs.trigger());
+    assert!(acq.regs.adc_flags(0).ovr && acq.regs.adc_flags(0).eoc);
     assert_eq!(
         recovery::recover(&mut acq),
         Ok(Faults {
@@ -218,8 +392,82 @@ fn the_sequence_on_the_model_clears_what_blocks_the_dma() {
             dma_error: true
         })
     );
-    assert!(acq.trigger());
+    assert!(acq.regs.trigger());
     assert_eq!(recovery::recover(&mut acq), Ok(Faults::default()));
-    assert!(acq.trigger());
+    assert!(acq.regs.trigger());
     assert_eq!(Step::ORDER.first(), Some(&Step::StopTrigger));
+    assert!(acq.regs.violations.is_empty(), "{:?}", acq.regs.violations);
+}
+
+/// The done-when of the overrun recovery: with the model's `EOC` behaviour, a forced
+/// overrun resumes within 2 ms (the sample task's timeout: 20 periods at 10 kHz) with no
+/// second overrun, every register access within its precondition; the same sequence
+/// without the `EOC` clear re-overruns at the first conversion after every restart and
+/// never resumes.
+#[test]
+fn a_forced_overrun_resumes_within_2_ms_and_without_the_eoc_clear_it_never_does() {
+    let frames = steady_frames(3.5);
+    let mut rig = Rig::boot(Survivors::power_on(FakeFlash::holding(&old_record())));
+    let overruns_before = rig.acq.regs.overruns;
+    rig.run(&frames, |rig, k| {
+        if k == OVERRUN_AT {
+            rig.acq.regs.inject_overrun();
+        }
+    })
+    .unwrap();
+    assert_eq!(
+        rig.acq.regs.overruns - overruns_before,
+        1,
+        "a second overrun"
+    );
+    assert_eq!(
+        rig.recoveries,
+        [Ok(Faults {
+            adc_overrun: true,
+            dma_error: false
+        })]
+    );
+    let resumed_ms = rig.restarts_at_ms[0] as f64 - OVERRUN_AT as f64 / 10.0;
+    assert!(
+        resumed_ms <= 2.0,
+        "resumed {resumed_ms} ms after the overrun"
+    );
+    assert!(
+        rig.acq.regs.violations.is_empty(),
+        "{:?}",
+        rig.acq.regs.violations
+    );
+
+    // Without the EOC clear: OVR again at the first conversion after each restart.
+    let mut rig = Rig::boot(Survivors::power_on(FakeFlash::holding(&old_record())));
+    rig.restart = recover_only_ovr;
+    let reset = rig.run(&frames, |rig, k| {
+        if k == OVERRUN_AT {
+            rig.acq.regs.inject_overrun();
+        }
+    });
+    assert_eq!(reset, Err(Reset::Watchdog));
+    assert!(rig.acq.regs.overruns > 100, "{}", rig.acq.regs.overruns);
+    assert!(rig.recoveries.iter().skip(1).all(|r| *r
+        == Ok(Faults {
+            adc_overrun: true,
+            dma_error: false
+        })));
+}
+
+/// A lapped ring (the reader fell a turn behind the DMA, the sample task's read fails):
+/// the same sequence reloads `CNDTR` with the whole ring from its start, within its
+/// preconditions, and the next trigger delivers.
+#[test]
+fn a_lapped_ring_is_reloaded_from_its_start() {
+    let mut acq = AdcDmaModel::running();
+    for _ in 0..(3 * RING_LEN as usize + 5) {
+        assert!(acq.regs.trigger());
+    }
+    assert_ne!(acq.regs.dma[0].cndtr, RING_LEN);
+    assert_eq!(recovery::recover(&mut acq), Ok(Faults::default()));
+    assert_eq!(acq.regs.dma.map(|d| d.cndtr), [RING_LEN; 2]);
+    assert!(acq.regs.trigger());
+    assert!(acq.regs.violations.is_empty(), "{:?}", acq.regs.violations);
+    assert_eq!(acq.regs.dma[0].moved, acq.regs.conversions);
 }
