@@ -684,6 +684,12 @@ fn log_record(rec: &ResetRecord) {
             "previous run ended in a watchdog reset: the {=str} set-up did not finish",
             rec.message()
         ),
+        ResetCause::HardFault => error!(
+            "previous run ended in a {=str} at pc {=u32:#010x}: {=str} (addr2line -e the ELF)",
+            rec.file(),
+            rec.line_or_ms(),
+            rec.message()
+        ),
         ResetCause::SampleStall => error!(
             "previous run ended in a watchdog reset: the sample path had stalled (no samples for {=u32} ms when recorded; recoveries did not help)",
             rec.line_or_ms()

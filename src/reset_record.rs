@@ -26,11 +26,11 @@
 //! | bytes | field |
 //! |---|---|
 //! | 0..4 | magic `b"DMRR"` |
-//! | 4 | cause: 1 = panic, 2 = sample path stalled, 3 = a set-up step did not finish, 4 = a `defmt` panic |
+//! | 4 | cause: 1 = panic, 2 = sample path stalled, 3 = a set-up step did not finish, 4 = a `defmt` panic, 5 = a HardFault or an unhandled exception |
 //! | 5 | message length (0..=[`MESSAGE_LEN`]) |
 //! | 6 | file length (0..=[`FILE_LEN`]) |
 //! | 7 | reserved, zero |
-//! | 8..12 | line (panic), stall time in ms (stall), phase (set-up), return address (`defmt` panic), `u32` |
+//! | 8..12 | line (panic), stall time in ms (stall), phase (set-up), return address (`defmt` panic), stacked PC (HardFault), `u32` |
 //! | 12..76 | message, UTF-8, zero padded |
 //! | 76..124 | file (the end of the path), UTF-8, zero padded |
 //! | 124..128 | CRC-32 of bytes 0..124 ([`crate::flash_record::crc32`]) |
@@ -62,6 +62,11 @@ pub enum ResetCause {
     /// A panic through `defmt::panic!` (the HAL, `defmt::unwrap!`): the [`Phase`] in the
     /// message, the address the panic handler was called from in the number.
     DefmtPanic,
+    /// A HardFault (or an exception or interrupt without a handler): the faulting
+    /// instruction's address (the stacked PC) in the number, the stacked LR and the fault
+    /// status registers (`CFSR`, `HFSR`, `BFAR`) in the message, as hexadecimal text
+    /// ([`ResetRecord::hard_fault`]).
+    HardFault,
 }
 
 impl ResetCause {
@@ -72,6 +77,7 @@ impl ResetCause {
             ResetCause::SampleStall => 2,
             ResetCause::SetupTimeout => 3,
             ResetCause::DefmtPanic => 4,
+            ResetCause::HardFault => 5,
         }
     }
 
@@ -82,6 +88,7 @@ impl ResetCause {
             2 => Some(ResetCause::SampleStall),
             3 => Some(ResetCause::SetupTimeout),
             4 => Some(ResetCause::DefmtPanic),
+            5 => Some(ResetCause::HardFault),
             _ => None,
         }
     }
@@ -297,6 +304,69 @@ impl ResetRecord {
         }
     }
 
+    /// A HardFault (`exception` "hard fault"; or "exception N" for an exception or
+    /// interrupt without a handler, `irqn` its number) at the stacked `pc`, with the
+    /// stacked `lr` and the fault status registers `cfsr`, `hfsr`, `bfar` (ARMv7-M ARM
+    /// B3.2.15-B3.2.18) written into the message as `lr=0x........ cfsr=0x........
+    /// hfsr=0x........ bfar=0x........` (hexadecimal digits, no formatting machinery: the
+    /// handler runs in any state). Look the PC up with `addr2line -e` on the ELF.
+    pub fn hard_fault(
+        irqn: Option<i16>,
+        pc: u32,
+        lr: u32,
+        cfsr: u32,
+        hfsr: u32,
+        bfar: u32,
+    ) -> Self {
+        let mut message = [0u8; 61];
+        for (k, (name, v)) in [
+            ("lr=0x", lr),
+            (" cfsr=0x", cfsr),
+            (" hfsr=0x", hfsr),
+            (" bfar=0x", bfar),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            // Each field: its name (5 or 8 bytes) and 8 digits; fixed places.
+            let at = if k == 0 { 0 } else { 13 + 16 * (k - 1) };
+            let digits = hex8(v);
+            for (dst, src) in message
+                .iter_mut()
+                .skip(at)
+                .zip(name.as_bytes().iter().chain(digits.iter()))
+            {
+                *dst = *src;
+            }
+        }
+        let message = core::str::from_utf8(&message).unwrap_or("");
+        // The exception's number in decimal (-15..=255), or "hard fault".
+        let mut file = *b"exception -000";
+        let file = match irqn {
+            None => "hard fault",
+            Some(k) => {
+                let v = k.unsigned_abs();
+                let sign = if k < 0 { b'-' } else { b' ' };
+                let digits = [
+                    sign,
+                    b'0' + (v / 100 % 10) as u8,
+                    b'0' + (v / 10 % 10) as u8,
+                    b'0' + (v % 10) as u8,
+                ];
+                for (dst, src) in file.iter_mut().skip(10).zip(digits) {
+                    *dst = src;
+                }
+                core::str::from_utf8(&file).unwrap_or("exception")
+            }
+        };
+        Self {
+            cause: ResetCause::HardFault,
+            number: pc,
+            message: Text::new(message, false),
+            file: Text::new(file, true),
+        }
+    }
+
     /// The record written before a set-up step of `phase` that waits on hardware without
     /// a bound, cleared when it finished: if the step hangs, the watchdog's reset is
     /// reported as that step's timeout.
@@ -390,6 +460,20 @@ impl ResetRecord {
             file: Text::from_bytes(body.get(FILE_AT..CRC_AT)?, file_len)?,
         })
     }
+}
+
+/// `v` as 8 upper-case hexadecimal digits.
+fn hex8(v: u32) -> [u8; 8] {
+    let mut out = [b'0'; 8];
+    for (k, d) in out.iter_mut().enumerate() {
+        let nibble = (v >> (28 - 4 * k)) & 0xF;
+        *d = if nibble < 10 {
+            b'0' + nibble as u8
+        } else {
+            b'A' + (nibble as u8 - 10)
+        };
+    }
+    out
 }
 
 /// What the previous run ended with, as the boot sees it.

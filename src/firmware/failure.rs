@@ -1,5 +1,7 @@
-//! The end of a failed run: the panic handlers (`core`'s and defmt's) and what both do
-//! (the panel's "monitor failed" pattern, the reset record, the reset).
+//! The end of a failed run: the panic handlers (`core`'s and defmt's), the HardFault and
+//! default exception handlers, and what all do (the panel's "monitor failed" pattern, the
+//! reset record, the reset). Without the exception handlers a fault would end in
+//! cortex-m-rt's endless loop: no record, and before the watchdog runs no reset at all.
 
 use core::sync::atomic::Ordering;
 
@@ -11,6 +13,35 @@ use drive_monitor::reset_record::{Phase, ResetRecord, RESET_RECORD_LEN};
 use embassy_stm32::pac;
 
 use super::{write_reset_record, PHASE, WATCHDOG_RUNNING};
+
+/// A HardFault (a bus or memory fault, a usage fault escalated, an undefined instruction):
+/// the stacked PC and LR and the fault status registers into the reset record, then
+/// [`fail`]: the next boot reports where it happened.
+#[cortex_m_rt::exception]
+#[allow(unsafe_code)]
+unsafe fn HardFault(frame: &cortex_m_rt::ExceptionFrame) -> ! {
+    cortex_m::interrupt::disable();
+    // SAFETY: the System Control Block's fault status registers are read-only here; the
+    // handler runs with interrupts off and never returns.
+    let scb = unsafe { &*cortex_m::peripheral::SCB::PTR };
+    let (cfsr, hfsr, bfar) = (scb.cfsr.read(), scb.hfsr.read(), scb.bfar.read());
+    let record = ResetRecord::hard_fault(None, frame.pc(), frame.lr(), cfsr, hfsr, bfar);
+    fail(&record.encode())
+}
+
+/// An exception or interrupt without a handler: its number into the reset record, then
+/// [`fail`] (cortex-m-rt's default would spin for ever).
+#[cortex_m_rt::exception]
+#[allow(unsafe_code)]
+unsafe fn DefaultHandler(irqn: i16) {
+    cortex_m::interrupt::disable();
+    // SAFETY: as in `HardFault`.
+    let scb = unsafe { &*cortex_m::peripheral::SCB::PTR };
+    let (cfsr, hfsr, bfar) = (scb.cfsr.read(), scb.hfsr.read(), scb.bfar.read());
+    let lr = cortex_m::register::lr::read();
+    let record = ResetRecord::hard_fault(Some(irqn), 0, lr, cfsr, hfsr, bfar);
+    fail(&record.encode())
+}
 
 /// Panic: the reason into the reset record (RAM that survives the reset), then [`fail`].
 /// Only the static part of the message and the location are kept: formatting the full

@@ -198,3 +198,43 @@ fn saturated_adc_lights_the_fault_lamp_steadily() {
     );
     assert!(rig.seen.iter().rev().take(10).all(|s| s.tick.lamps.fault));
 }
+
+/// A HardFault mid-run (issue 43): the handler writes what `ResetRecord::hard_fault` makes
+/// of the stacked PC and LR and the fault status registers, then resets (the watchdog's,
+/// or a software reset before it runs); the next boot reports it with the PC and the
+/// registers, whatever the reset was, and shows "monitor failed".
+#[test]
+fn a_hard_fault_leaves_a_record_the_next_boot_reports() {
+    let frames = steady_frames(1.0);
+    let mut rig = Rig::boot(Survivors::power_on(FakeFlash::erased()));
+    rig.run(&frames, |_, _| {}).unwrap();
+    // A precise bus fault escalated to HardFault: CFSR.PRECISERR | BFARVALID, HFSR.FORCED.
+    let (pc, lr, cfsr, hfsr, bfar) = (
+        0x0800_1A2C,
+        0x0800_1F01,
+        0x0000_8200,
+        0x4000_0000,
+        0x6000_0000,
+    );
+    for source in [ResetSource::IndependentWatchdog, ResetSource::Software] {
+        let mut survivors = rig.survivors.clone();
+        survivors.reset_ram = ResetRecord::hard_fault(None, pc, lr, cfsr, hfsr, bfar).encode();
+        survivors.reset_source = source;
+        let next = Rig::boot(survivors);
+        let PreviousRun::Recorded(rec) = next.previous else {
+            panic!("{source:?}: {:?}", next.previous);
+        };
+        assert_eq!(rec.cause(), ResetCause::HardFault);
+        assert_eq!(rec.line_or_ms(), pc);
+        assert_eq!(rec.file(), "hard fault");
+        assert_eq!(
+            rec.message(),
+            "lr=0x08001F01 cfsr=0x00008200 hfsr=0x40000000 bfar=0x60000000"
+        );
+        assert!(next.previous.failed());
+    }
+    // An interrupt without a handler names its number.
+    let rec = ResetRecord::hard_fault(Some(-1), 0, 0, 0, 0, 0);
+    let back = ResetRecord::decode(&rec.encode()).expect("decodes");
+    assert_eq!(back.file(), "exception -001");
+}
