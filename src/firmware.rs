@@ -208,8 +208,13 @@ fn start_acquisition(
     trigger.set_frequency(Hertz(SETTINGS.sample_rate_hz), RoundTo::Slower);
     trigger.set_master_mode(MasterMode::UPDATE);
 
-    // 24.5 ADC cycles sampling time: enough for a low-impedance isolated amplifier output.
-    let st = SampleTime::CYCLES24_5;
+    // 247.5 ADC cycles sampling time (5.8 us at the 42.5 MHz ADC clock): the documented
+    // front end (docs/firmware.md, "Voltage and current sensing") drives each pin through a
+    // 1 kohm / 10 nF anti-alias filter; the datasheet's bound on the source resistance,
+    // R_AIN < t_S / (f_ADC C_ADC ln(2^(N+2))) - R_ADC, with C_ADC 5 pF and R_ADC 1 kohm,
+    // is about 11 kohm at 24.5 cycles and 120 kohm at 247.5; three conversions of
+    // 247.5 + 12.5 cycles take 18.4 us of the 100 us period.
+    let st = SampleTime::CYCLES247_5;
     let adc1 = Adc::new(hw.adc1, AdcConfig::default());
     let adc1: RingBufferedAdc<'static, peripherals::ADC1> = adc1.into_ring_buffered(
         hw.dma1,
