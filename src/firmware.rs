@@ -70,10 +70,32 @@ use monitor_core::Isolation;
 use acquisition::HwAcquisition;
 
 bind_interrupts!(struct Irqs {
-    DMA1_CHANNEL1 => dma::InterruptHandler<peripherals::DMA1_CH1>;
-    DMA1_CHANNEL2 => dma::InterruptHandler<peripherals::DMA1_CH2>;
+    DMA1_CHANNEL1 => acquisition::AdcDmaInterrupt<peripherals::DMA1_CH1, 0>;
+    DMA1_CHANNEL2 => acquisition::AdcDmaInterrupt<peripherals::DMA1_CH2, 1>;
     EXTI15_10 => exti::InterruptHandler<interrupt::typelevel::EXTI15_10>;
 });
+
+// SAFETY: the DMA channels' vectors run `acquisition::AdcDmaInterrupt`, which calls
+// embassy's `dma::InterruptHandler` for the channel every time except with `TEIF` set,
+// when the channel is off (the hardware cleared `EN`) and the recovery owns it: the ring
+// drivers get every interrupt of a running channel, which is what the binding promises.
+#[allow(unsafe_code)]
+unsafe impl
+    interrupt::typelevel::Binding<
+        interrupt::typelevel::DMA1_CHANNEL1,
+        dma::InterruptHandler<peripherals::DMA1_CH1>,
+    > for Irqs
+{
+}
+// SAFETY: as above, for channel 2.
+#[allow(unsafe_code)]
+unsafe impl
+    interrupt::typelevel::Binding<
+        interrupt::typelevel::DMA1_CHANNEL2,
+        dma::InterruptHandler<peripherals::DMA1_CH2>,
+    > for Irqs
+{
+}
 
 /// The firmware's settings: the sample rate (10 kHz; it must divide 1 MHz, and TIM1 at
 /// 170 MHz divides it exactly for 10 kHz), the commissioning time and stall time. The

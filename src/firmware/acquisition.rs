@@ -7,8 +7,12 @@
 //! (stopping a conversion without clearing `DMAEN`, clearing `OVR`/`EOC`/`EOS` and `TEIF`,
 //! reloading `CNDTR`) is done on the registers.
 
+use core::marker::PhantomData;
+
 use drive_monitor::recovery::{AcqRegisters, AdcFlags, RegisterAcquisition};
 use embassy_stm32::adc::RingBufferedAdc;
+use embassy_stm32::dma;
+use embassy_stm32::interrupt::typelevel::Handler;
 use embassy_stm32::pac;
 use embassy_stm32::pac::adc::vals::{Adstp, Dmacfg, Dmaen};
 use embassy_stm32::peripherals;
@@ -177,5 +181,32 @@ impl AcqRegisters for HwRegisters {
     fn trigger_start(&mut self) {
         self.started_us = now_us();
         self.trigger.start();
+    }
+}
+
+/// The ADC rings' DMA interrupt: embassy-stm32 0.6's handler panics whenever it runs with
+/// `TEIF` set (it checks the flag before `HTIF`/`TCIF`, whatever `TEIE` says), so a transfer
+/// error that coincides with a half- or full-transfer interrupt would end the run. This
+/// handler looks first: with `TEIF` set (the hardware has cleared the channel's `EN`) it
+/// acknowledges `HTIF`/`TCIF` and returns, leaving `TEIF` for the recovery
+/// ([`RegisterAcquisition`]: the sample task's wait times out, the sequence clears and
+/// re-arms the channel); otherwise it is embassy's handler. `N` is the channel's register
+/// index (0: DMA1 channel 1).
+pub(super) struct AdcDmaInterrupt<T: dma::ChannelInstance, const N: usize> {
+    _channel: PhantomData<T>,
+}
+
+impl<T: dma::ChannelInstance, const N: usize> Handler<T::Interrupt> for AdcDmaInterrupt<T, N> {
+    #[allow(unsafe_code)]
+    unsafe fn on_interrupt() {
+        if pac::DMA1.isr().read().teif(N) {
+            pac::DMA1.ifcr().write(|w| {
+                w.set_htif(N, true);
+                w.set_tcif(N, true);
+            });
+            return;
+        }
+        // SAFETY: called from this channel's interrupt, as embassy's handler expects.
+        unsafe { <dma::InterruptHandler<T> as Handler<T::Interrupt>>::on_interrupt() }
     }
 }
