@@ -575,6 +575,16 @@ impl Supervisor {
         self.offset_fault.current |= trim.current_fault();
     }
 
+    /// The start-up check of the ADC's reference (VDDA from VREFINT,
+    /// [`crate::board::ReferenceCheck`]): a reference outside its band, or unreadable,
+    /// scales every reading, so from now on both sensors count as faulty, as an offset out
+    /// of bound does (the panel's "input invalid", the status line's `sens=`).
+    pub fn set_reference(&mut self, check: crate::board::ReferenceCheck) {
+        let bad = check.distrusts_readings();
+        self.offset_fault.voltage |= bad;
+        self.offset_fault.current |= bad;
+    }
+
     /// Whether the built-in default motor is monitored (no valid motor record at boot): the
     /// panel shows it ([`crate::panel`], "Built-in default motor"). Off until set.
     pub fn set_default_motor(&mut self, default_motor: bool) {

@@ -438,6 +438,52 @@ pub mod pins {
     }
 }
 
+/// VDDA at which the factory measured `VREFINT_CAL` (STM32G474 datasheet: 3.0 V, 30 degC; the
+/// calibration word is at 0x1FFF_75AA).
+pub const VREFINT_CAL_VDDA_V: f32 = 3.0;
+
+/// The band VDDA must lie in [V]: the NUCLEO's 3.3 V regulator within 3 %. VDDA is the ADC's
+/// reference, so every voltage and current reading scales with it: 3.2 V read as 3.3 V is
+/// every reading 3 % high.
+pub const VDDA_BAND_V: (f32, f32) = (3.2, 3.4);
+
+/// VDDA from a VREFINT reading `code` (12 bits) and the factory's `cal` word:
+/// `VDDA = 3.0 V x cal / code` (RM0440, "Calculating the actual VDDA voltage using the
+/// internal reference voltage"); `None` for a reading of 0 or at full scale, or a `cal`
+/// of 0 or at full scale (no usable figure).
+pub fn vdda_from_vrefint(code: u16, cal: u16) -> Option<f32> {
+    let ok = |c: u16| c > 0 && c < ADC_MAX_CODE;
+    (ok(code) && ok(cal)).then(|| VREFINT_CAL_VDDA_V * f32::from(cal) / f32::from(code))
+}
+
+/// What the reference check found at start-up.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ReferenceCheck {
+    /// VDDA in [`VDDA_BAND_V`] [V].
+    InBand(f32),
+    /// VDDA outside [`VDDA_BAND_V`] [V]: every reading is scaled by `3.3 / VDDA`.
+    OutOfBand(f32),
+    /// No usable VREFINT reading (0 or full scale, or no calibration word).
+    Unreadable,
+}
+
+impl ReferenceCheck {
+    /// The check of a VREFINT reading `code` against the factory's `cal` word.
+    pub fn of(code: u16, cal: u16) -> Self {
+        match vdda_from_vrefint(code, cal) {
+            Some(v) if (VDDA_BAND_V.0..=VDDA_BAND_V.1).contains(&v) => Self::InBand(v),
+            Some(v) => Self::OutOfBand(v),
+            None => Self::Unreadable,
+        }
+    }
+
+    /// The readings cannot be trusted: the sensors count as faulty (the panel's "input
+    /// invalid").
+    pub fn distrusts_readings(self) -> bool {
+        !matches!(self, Self::InBand(_))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -514,5 +560,25 @@ mod tests {
         assert_eq!(Lamp::ALL.first(), Some(&Lamp::Run));
         assert_eq!(Lamp::ALL.last(), Some(&Lamp::Fault));
         assert_eq!(Lamp::ALL.get(1..5), Some(&Lamp::RESIDUALS[..]));
+    }
+
+    #[test]
+    fn vdda_from_vrefint_follows_the_reference_manuals_formula() {
+        // A typical calibration word (1.212 V at 3.0 V: 1655 codes) read at 3.3 V.
+        let cal = 1655;
+        let code = (f32::from(cal) * 3.0 / 3.3).round() as u16;
+        let v = vdda_from_vrefint(code, cal).unwrap_or(0.0);
+        assert!((v - 3.3).abs() < 0.005, "{v}");
+        assert_eq!(ReferenceCheck::of(code, cal), ReferenceCheck::InBand(v));
+        // A sagging 3.0 V supply: out of band, readings distrusted.
+        let low = ReferenceCheck::of(cal, cal);
+        assert_eq!(low, ReferenceCheck::OutOfBand(3.0));
+        assert!(low.distrusts_readings());
+        assert_eq!(ReferenceCheck::of(0, cal), ReferenceCheck::Unreadable);
+        assert_eq!(
+            ReferenceCheck::of(ADC_MAX_CODE, cal),
+            ReferenceCheck::Unreadable
+        );
+        assert_eq!(ReferenceCheck::of(1500, 0), ReferenceCheck::Unreadable);
     }
 }

@@ -125,6 +125,8 @@ static COMMANDS: Channel<CriticalSectionRawMutex, Command, 4> = Channel::new();
 static STATUS: Signal<CriticalSectionRawMutex, Status> = Signal::new();
 /// The start-up offset trim's result (sample task -> thread mode, once).
 static TRIM: Signal<CriticalSectionRawMutex, TrimResult> = Signal::new();
+/// The start-up check of the ADC's reference, from the sample task to thread mode.
+static REFERENCE: Signal<CriticalSectionRawMutex, board::ReferenceCheck> = Signal::new();
 static OVERRUNS: AtomicU32 = AtomicU32::new(0);
 static RESTARTS: AtomicU32 = AtomicU32::new(0);
 static EXECUTOR_HIGH: InterruptExecutor = InterruptExecutor::new();
@@ -237,7 +239,13 @@ fn start_acquisition(
     // is about 11 kohm at 24.5 cycles and 120 kohm at 247.5; three conversions of
     // 247.5 + 12.5 cycles take 18.4 us of the 100 us period.
     let st = SampleTime::CYCLES247_5;
-    let adc1 = Adc::new(hw.adc1, AdcConfig::default());
+    let mut adc1 = Adc::new(hw.adc1, AdcConfig::default());
+    // The ADC's reference: VDDA from VREFINT against the factory's calibration word, once
+    // before the rings start (the supervisor flags the sensors when it is out of band).
+    let mut vrefint = adc1.enable_vrefint();
+    let code = adc1.blocking_read(&mut vrefint, SampleTime::CYCLES247_5);
+    let cal = pac::VREFINTCAL.data().read();
+    REFERENCE.signal(board::ReferenceCheck::of(code, cal));
     let adc1: RingBufferedAdc<'static, peripherals::ADC1> = adc1.into_ring_buffered(
         hw.dma1,
         ring1,
@@ -626,6 +634,21 @@ impl Thread {
         if let Some(trim) = TRIM.try_take() {
             supervisor.set_offset_fault(&trim);
             log_trim(&trim);
+        }
+        if let Some(check) = REFERENCE.try_take() {
+            supervisor.set_reference(check);
+            match check {
+                board::ReferenceCheck::InBand(v) => info!("reference: VDDA {=f32} V", v),
+                board::ReferenceCheck::OutOfBand(v) => error!(
+                    "reference: VDDA {=f32} V outside {=f32}..{=f32} V: every reading is off by that ratio; the sensors are flagged",
+                    v,
+                    board::VDDA_BAND_V.0,
+                    board::VDDA_BAND_V.1
+                ),
+                board::ReferenceCheck::Unreadable => {
+                    error!("reference: VREFINT unreadable; the sensors are flagged")
+                }
+            }
         }
         let tick = supervisor.tick(now_ms, status.map(|s| s.monitor), pressed);
         if tick.pet_watchdog {
