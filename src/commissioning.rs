@@ -104,21 +104,21 @@ pub enum Action {
 
 /// The result of feeding the procedure.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Step {
+pub struct CommissioningStep {
     /// What to do now.
     pub action: Action,
     /// A followed run (or a start request) ended at this step.
     pub ended: Option<RunEnd>,
 }
 
-impl Step {
-    const NOTHING: Step = Step {
+impl CommissioningStep {
+    const NOTHING: CommissioningStep = CommissioningStep {
         action: Action::None,
         ended: None,
     };
 
-    fn act(action: Action) -> Step {
-        Step {
+    fn act(action: Action) -> CommissioningStep {
+        CommissioningStep {
             action,
             ended: None,
         }
@@ -238,14 +238,14 @@ impl CommissioningProcedure {
     }
 
     /// The latest status reported `run` at `now_ms` (call it every panel period).
-    pub fn on_status(&mut self, run: &CommissioningRun, now_ms: u32) -> Step {
+    pub fn on_status(&mut self, run: &CommissioningRun, now_ms: u32) -> CommissioningStep {
         match self.tracking {
             Tracking::Idle if run.stage.is_active() => {
                 // A run the procedure did not ask for (none should exist): follow it.
                 self.follow(run, now_ms);
                 self.following(run, now_ms)
             }
-            Tracking::Idle => Step::NOTHING,
+            Tracking::Idle => CommissioningStep::NOTHING,
             Tracking::Requested {
                 previous_run,
                 since_ms,
@@ -259,7 +259,7 @@ impl CommissioningProcedure {
                         why: Failure::NotStarted,
                     })
                 } else {
-                    Step::NOTHING
+                    CommissioningStep::NOTHING
                 }
             }
             Tracking::Following { run: id, .. } if id != run.id => {
@@ -282,7 +282,7 @@ impl CommissioningProcedure {
         };
     }
 
-    fn following(&mut self, run: &CommissioningRun, now_ms: u32) -> Step {
+    fn following(&mut self, run: &CommissioningRun, now_ms: u32) -> CommissioningStep {
         let Tracking::Following {
             run: id,
             started_ms,
@@ -292,14 +292,14 @@ impl CommissioningProcedure {
             mut stored_ms,
         } = self.tracking
         else {
-            return Step::NOTHING;
+            return CommissioningStep::NOTHING;
         };
         let since = |t: u32| now_ms.wrapping_sub(t);
         let step = match run.stage {
             RunStage::Learning if run.blocks_learned != blocks => {
                 blocks = run.blocks_learned;
                 progress_ms = now_ms;
-                Step::NOTHING
+                CommissioningStep::NOTHING
             }
             RunStage::Learning => {
                 let due = match cancel {
@@ -309,17 +309,17 @@ impl CommissioningProcedure {
                 if due {
                     let reason = cancel.map_or(CancelReason::Stalled, |(r, _)| r);
                     cancel = Some((reason, now_ms));
-                    Step::act(Action::Cancel { run: id })
+                    CommissioningStep::act(Action::Cancel { run: id })
                 } else {
-                    Step::NOTHING
+                    CommissioningStep::NOTHING
                 }
             }
             RunStage::AwaitingStorage(cal) => {
                 if stored_ms.is_some_and(|t| since(t) < Self::RETRY_MS) {
-                    Step::NOTHING
+                    CommissioningStep::NOTHING
                 } else {
                     stored_ms = Some(now_ms);
-                    Step::act(Action::Store {
+                    CommissioningStep::act(Action::Store {
                         run: id,
                         record: cal.into(),
                     })
@@ -347,7 +347,7 @@ impl CommissioningProcedure {
             }
             RunStage::Idle => {
                 self.tracking = Tracking::Idle;
-                return Step::NOTHING;
+                return CommissioningStep::NOTHING;
             }
         };
         self.tracking = Tracking::Following {
@@ -361,13 +361,13 @@ impl CommissioningProcedure {
         step
     }
 
-    fn end(&mut self, end: RunEnd) -> Step {
+    fn end(&mut self, end: RunEnd) -> CommissioningStep {
         self.tracking = Tracking::Idle;
         self.last_failure = match end {
             RunEnd::Failed { why, .. } => Some(why),
             RunEnd::Commissioned { .. } | RunEnd::CancelledByUser { .. } => None,
         };
-        Step {
+        CommissioningStep {
             action: Action::None,
             ended: Some(end),
         }
@@ -402,11 +402,11 @@ mod tests {
         assert_eq!(p.button(&idle, 0), Action::Start { duration_s: 2.0 });
         assert!(p.busy());
         assert_eq!(p.button(&idle, 10), Action::None, "no double start");
-        assert_eq!(p.on_status(&idle, 50), Step::NOTHING);
+        assert_eq!(p.on_status(&idle, 50), CommissioningStep::NOTHING);
         // Progress keeps it going however long it takes.
         for k in 0..100u32 {
             let s = p.on_status(&run(1, RunStage::Learning, k), 100 + 1000 * k);
-            assert_eq!(s, Step::NOTHING);
+            assert_eq!(s, CommissioningStep::NOTHING);
         }
         let awaiting = run(1, RunStage::AwaitingStorage(cal()), 100);
         let store = Action::Store {

@@ -61,7 +61,7 @@ use drive_monitor::offset_trim::{ChannelTrim, TrimResult, MAX_OFFSET_CODES};
 use drive_monitor::panel::PanelLamps;
 use drive_monitor::recovery::{self, RecoveryCounts, StepTimeout};
 use drive_monitor::reset_record::{
-    Phase, PreviousRun, ResetCause, ResetRecord, ResetSource, RESET_RECORD_LEN,
+    BootPhase, PreviousRun, ResetCause, ResetRecord, ResetSource, RESET_RECORD_LEN,
 };
 use drive_monitor::sampling::RawFrame;
 use monitor_core::motor_record::{MotorRecord, STORED_LEN as MOTOR_RECORD_LEN};
@@ -130,12 +130,12 @@ static REFERENCE: Signal<CriticalSectionRawMutex, board::ReferenceCheck> = Signa
 static OVERRUNS: AtomicU32 = AtomicU32::new(0);
 static RESTARTS: AtomicU32 = AtomicU32::new(0);
 static EXECUTOR_HIGH: InterruptExecutor = InterruptExecutor::new();
-/// What the firmware is doing ([`Phase::number`]), for the record of a `defmt` panic.
+/// What the firmware is doing ([`BootPhase::number`]), for the record of a `defmt` panic.
 static PHASE: AtomicU8 = AtomicU8::new(0);
 /// The independent watchdog runs (else the panic handler resets the MCU itself).
 static WATCHDOG_RUNNING: AtomicBool = AtomicBool::new(false);
 
-fn set_phase(phase: Phase) {
+fn set_phase(phase: BootPhase) {
     PHASE.store(phase.number(), Ordering::Relaxed);
 }
 
@@ -318,11 +318,11 @@ fn process_half(
 async fn sample_task(hw: SampleHw, mut path: SamplePath) {
     // The HAL's ADC set-up waits on registers without a bound (power-up, calibration,
     // ADRDY, ADSTART): the record says so if the watchdog has to end it.
-    set_phase(Phase::AdcSetup);
-    write_reset_record(&ResetRecord::setup(Phase::AdcSetup).encode());
+    set_phase(BootPhase::AdcSetup);
+    write_reset_record(&ResetRecord::setup(BootPhase::AdcSetup).encode());
     let (qei, mut acq) = start_acquisition(hw, &mut path);
     write_reset_record(&[0; RESET_RECORD_LEN]);
-    set_phase(Phase::Sampling);
+    set_phase(BootPhase::Sampling);
     info!("sampling at {=u32} Hz", SETTINGS.sample_rate_hz);
 
     let mut wait = AdcWait::new(SETTINGS.sample_rate_hz);
@@ -373,10 +373,10 @@ async fn sample_task(hw: SampleHw, mut path: SamplePath) {
             // One sequence for every cause (drive_monitor::recovery): trigger, ADCs and
             // DMA stopped, OVR and TEIF cleared, DMA re-armed, ADCs and trigger restarted;
             // the timestamps continue from the restart (the gap shows).
-            set_phase(Phase::Recovery);
+            set_phase(BootPhase::Recovery);
             let result = recovery::recover(&mut acq);
             path.sampler_mut().resync(acq.regs.started_us);
-            set_phase(Phase::Sampling);
+            set_phase(BootPhase::Sampling);
             counts.count(result);
             match result {
                 Ok(f) if f.adc_overrun || f.dma_error => warn!(
@@ -541,7 +541,7 @@ async fn main(_spawner: Spawner) {
     let wdg = start_watchdog(b.iwdg);
     // The flash driver (built for dual-bank) panics on single-bank option bytes: check
     // first and run without the records instead (the built-in motor, not commissioned).
-    set_phase(Phase::Flash);
+    set_phase(BootPhase::Flash);
     let dual_bank = pac::FLASH.optr().read().dbank();
     if !dual_bank {
         error!("option bytes: single-bank flash (DBANK = 0); the records need dual-bank: set DBANK with STM32CubeProgrammer. Running with the built-in motor, not commissioned");
@@ -586,7 +586,7 @@ async fn main(_spawner: Spawner) {
         enc_b: b.encoder_b,
         encoder: motor_source::encoder_setup(&machine),
     };
-    set_phase(Phase::Boot);
+    set_phase(BootPhase::Boot);
     match sample_task(hw, path) {
         Ok(task) => high.spawn(task),
         // A task that is spawned once, at boot: the pool cannot be full.

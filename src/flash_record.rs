@@ -4,7 +4,7 @@
 //! (per residual r1..r4: mean and spread, in the core's normalized units). It is written
 //! to the page at [`crate::board::RECORD_FLASH_OFFSET`] and read back at boot. Anything
 //! that is not a complete, current-version record with a matching CRC and sane values
-//! is rejected with a [`RecordError`], and the firmware then runs "not commissioned".
+//! is rejected with a [`FlashRecordError`], and the firmware then runs "not commissioned".
 //!
 //! Since version 2 it also stores the fault isolation's healthy baseline
 //! ([`monitor_core::isolation::Baseline`]: the mean and spread of its three parity
@@ -35,7 +35,7 @@
 //! records (48 bytes: the lamps' statistics at 8..40, 4 reserved bytes, the CRC at
 //! 44..48) without an isolation baseline.
 //!
-//! Erased flash reads as all `0xFF`; that is reported as [`RecordError::Erased`].
+//! Erased flash reads as all `0xFF`; that is reported as [`FlashRecordError::Erased`].
 
 use monitor_core::isolation::{Baseline, ParityResiduals, SteadyPoint};
 
@@ -79,7 +79,7 @@ pub struct CalibrationRecord {
 /// Why a stored record was rejected.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[non_exhaustive]
-pub enum RecordError {
+pub enum FlashRecordError {
     /// Fewer than [`RECORD_LEN`] bytes were given.
     Truncated,
     /// The page is erased (all `0xFF`): never commissioned.
@@ -96,7 +96,7 @@ pub enum RecordError {
     InvalidValue,
 }
 
-impl core::fmt::Display for RecordError {
+impl core::fmt::Display for FlashRecordError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
             Self::Truncated => f.write_str("record truncated"),
@@ -111,7 +111,7 @@ impl core::fmt::Display for RecordError {
 }
 
 #[cfg(target_os = "none")]
-impl defmt::Format for RecordError {
+impl defmt::Format for FlashRecordError {
     fn format(&self, f: defmt::Formatter<'_>) {
         match self {
             Self::Truncated => defmt::write!(f, "Truncated"),
@@ -166,11 +166,11 @@ impl CalibrationRecord {
     /// Encode into the flash layout described in the module docs.
     ///
     /// # Errors
-    /// [`RecordError::InvalidValue`] if a value is non-finite or a spread is negative
+    /// [`FlashRecordError::InvalidValue`] if a value is non-finite or a spread is negative
     /// (such a record would be rejected at the next boot anyway).
-    pub fn encode(&self) -> Result<[u8; RECORD_LEN], RecordError> {
+    pub fn encode(&self) -> Result<[u8; RECORD_LEN], FlashRecordError> {
         if !values_ok(self) {
-            return Err(RecordError::InvalidValue);
+            return Err(FlashRecordError::InvalidValue);
         }
         let mut out = [0u8; RECORD_LEN];
         let mut w = Writer {
@@ -212,27 +212,27 @@ impl CalibrationRecord {
     /// bytes are looked at; extra bytes (the rest of the page) are ignored.
     ///
     /// # Errors
-    /// See [`RecordError`]; checks run in the order truncated, erased, magic, version,
+    /// See [`FlashRecordError`]; checks run in the order truncated, erased, magic, version,
     /// length, checksum, values.
-    pub fn decode(bytes: &[u8]) -> Result<Self, RecordError> {
-        let head = bytes.get(..8).ok_or(RecordError::Truncated)?;
+    pub fn decode(bytes: &[u8]) -> Result<Self, FlashRecordError> {
+        let head = bytes.get(..8).ok_or(FlashRecordError::Truncated)?;
         if head.iter().all(|&b| b == 0xFF) {
-            return Err(RecordError::Erased);
+            return Err(FlashRecordError::Erased);
         }
         let mut r = Reader { buf: head, pos: 0 };
         if r.take::<4>() != RECORD_MAGIC {
-            return Err(RecordError::BadMagic);
+            return Err(FlashRecordError::BadMagic);
         }
         let version = u16::from_le_bytes(r.take::<2>());
         let (len, payload, crc_at) = match version {
             RECORD_VERSION => (RECORD_LEN, PAYLOAD_LEN, CRC_OFFSET),
             2 => (V2_LEN, V2_PAYLOAD_LEN, V2_CRC_OFFSET),
             1 => (V1_LEN, V1_PAYLOAD_LEN, V1_CRC_OFFSET),
-            v => return Err(RecordError::UnsupportedVersion(v)),
+            v => return Err(FlashRecordError::UnsupportedVersion(v)),
         };
-        let rec = bytes.get(..len).ok_or(RecordError::Truncated)?;
+        let rec = bytes.get(..len).ok_or(FlashRecordError::Truncated)?;
         if u16::from_le_bytes(r.take::<2>()) != payload {
-            return Err(RecordError::BadLength);
+            return Err(FlashRecordError::BadLength);
         }
         let stored_crc = u32::from_le_bytes(
             Reader {
@@ -241,9 +241,9 @@ impl CalibrationRecord {
             }
             .take::<4>(),
         );
-        let body = rec.get(..crc_at).ok_or(RecordError::Truncated)?;
+        let body = rec.get(..crc_at).ok_or(FlashRecordError::Truncated)?;
         if crc32(body) != stored_crc {
-            return Err(RecordError::BadChecksum);
+            return Err(FlashRecordError::BadChecksum);
         }
         let mut r = Reader { buf: rec, pos: 8 };
         let mut out = Self {
@@ -277,7 +277,7 @@ impl CalibrationRecord {
             out.isolation = (flags & FLAG_ISOLATION != 0).then_some(b);
         }
         if !values_ok(&out) {
-            return Err(RecordError::InvalidValue);
+            return Err(FlashRecordError::InvalidValue);
         }
         Ok(out)
     }
@@ -316,7 +316,7 @@ pub enum LoadError<E> {
     /// The store could not be read.
     Read(E),
     /// The bytes are not a valid record.
-    Record(RecordError),
+    Record(FlashRecordError),
 }
 
 /// Reads and validates the stored record.
@@ -343,7 +343,7 @@ pub struct Stored<E> {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StoreError<E> {
     /// The record holds an unusable value and was not written.
-    Encode(RecordError),
+    Encode(FlashRecordError),
     /// The page erase failed.
     Erase(E),
     /// The write failed.
@@ -482,7 +482,7 @@ mod tests {
         page[20] ^= 4;
         assert_eq!(
             CalibrationRecord::decode(&page),
-            Err(RecordError::BadChecksum)
+            Err(FlashRecordError::BadChecksum)
         );
     }
 
@@ -494,7 +494,7 @@ mod tests {
             spread: ParityResiduals::from_array([0.0, 1e-3, 1e-3]),
             at: SteadyPoint::default(),
         });
-        assert_eq!(r.encode(), Err(RecordError::InvalidValue));
+        assert_eq!(r.encode(), Err(FlashRecordError::InvalidValue));
     }
 
     #[test]
@@ -516,8 +516,8 @@ mod tests {
     fn rejects_invalid_values_on_encode() {
         let mut r = sample();
         r.spread[2] = -1.0;
-        assert_eq!(r.encode(), Err(RecordError::InvalidValue));
+        assert_eq!(r.encode(), Err(FlashRecordError::InvalidValue));
         r.spread[2] = f32::NAN;
-        assert_eq!(r.encode(), Err(RecordError::InvalidValue));
+        assert_eq!(r.encode(), Err(FlashRecordError::InvalidValue));
     }
 }

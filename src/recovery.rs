@@ -19,13 +19,13 @@
 //!
 //! | step | what | why this order |
 //! |---|---|---|
-//! | [`Step::StopTrigger`] | TIM1 counter off | no new conversion starts |
-//! | [`Step::StopAdc`] | `ADSTP`, then wait for `ADSTART = 0` (bounded) | a conversion in flight ends before the DMA stops (else it would set `OVR` itself) |
-//! | [`Step::PauseDma`] | `EN = 0`, then wait for it (bounded) | `CNDTR` may only be written with the channel off |
-//! | [`Step::ClearFlags`] | `OVR`, `EOC`, `EOS` (write 1), `TEIF`/`HTIF`/`TCIF` (`DMA_IFCR`) | a latched `OVR` blocks the DMA requests; an `EOC` left set (the data register unread since the overrun) sets `OVR` again at the next conversion |
-//! | [`Step::RearmDma`] | `CNDTR` = ring length, ring indices reset, `DMAEN`/`DMACFG` circular, `EN = 1` | the DMA is ready before the ADC asks |
-//! | [`Step::StartAdc`] | `ADSTART = 1` (waits for the next trigger) | both ADCs armed before the trigger |
-//! | [`Step::StartTrigger`] | TIM1 counter on, timestamps continue from now | ADC1 and ADC2 start on the same trigger |
+//! | [`RecoveryStep::StopTrigger`] | TIM1 counter off | no new conversion starts |
+//! | [`RecoveryStep::StopAdc`] | `ADSTP`, then wait for `ADSTART = 0` (bounded) | a conversion in flight ends before the DMA stops (else it would set `OVR` itself) |
+//! | [`RecoveryStep::PauseDma`] | `EN = 0`, then wait for it (bounded) | `CNDTR` may only be written with the channel off |
+//! | [`RecoveryStep::ClearFlags`] | `OVR`, `EOC`, `EOS` (write 1), `TEIF`/`HTIF`/`TCIF` (`DMA_IFCR`) | a latched `OVR` blocks the DMA requests; an `EOC` left set (the data register unread since the overrun) sets `OVR` again at the next conversion |
+//! | [`RecoveryStep::RearmDma`] | `CNDTR` = ring length, ring indices reset, `DMAEN`/`DMACFG` circular, `EN = 1` | the DMA is ready before the ADC asks |
+//! | [`RecoveryStep::StartAdc`] | `ADSTART = 1` (waits for the next trigger) | both ADCs armed before the trigger |
+//! | [`RecoveryStep::StartTrigger`] | TIM1 counter on, timestamps continue from now | ADC1 and ADC2 start on the same trigger |
 //!
 //! The sequence is written once, over the [`Acquisition`] trait, and its register accesses
 //! once, in [`RegisterAcquisition`] over the [`AcqRegisters`] trait: the firmware implements
@@ -37,7 +37,7 @@
 
 /// One step of the recovery sequence, in its order (module docs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Step {
+pub enum RecoveryStep {
     /// Stop the sample trigger.
     StopTrigger,
     /// Stop both ADCs' conversions and wait until they stopped.
@@ -55,28 +55,28 @@ pub enum Step {
     StartTrigger,
 }
 
-impl Step {
+impl RecoveryStep {
     /// All steps, in the order [`recover`] runs them.
-    pub const ORDER: [Step; 7] = [
-        Step::StopTrigger,
-        Step::StopAdc,
-        Step::PauseDma,
-        Step::ClearFlags,
-        Step::RearmDma,
-        Step::StartAdc,
-        Step::StartTrigger,
+    pub const ORDER: [RecoveryStep; 7] = [
+        RecoveryStep::StopTrigger,
+        RecoveryStep::StopAdc,
+        RecoveryStep::PauseDma,
+        RecoveryStep::ClearFlags,
+        RecoveryStep::RearmDma,
+        RecoveryStep::StartAdc,
+        RecoveryStep::StartTrigger,
     ];
 
     /// A short name for logs.
     pub const fn name(self) -> &'static str {
         match self {
-            Step::StopTrigger => "stop-trigger",
-            Step::StopAdc => "stop-adc",
-            Step::PauseDma => "pause-dma",
-            Step::ClearFlags => "clear-flags",
-            Step::RearmDma => "rearm-dma",
-            Step::StartAdc => "start-adc",
-            Step::StartTrigger => "start-trigger",
+            RecoveryStep::StopTrigger => "stop-trigger",
+            RecoveryStep::StopAdc => "stop-adc",
+            RecoveryStep::PauseDma => "pause-dma",
+            RecoveryStep::ClearFlags => "clear-flags",
+            RecoveryStep::RearmDma => "rearm-dma",
+            RecoveryStep::StartAdc => "start-adc",
+            RecoveryStep::StartTrigger => "start-trigger",
         }
     }
 }
@@ -94,7 +94,7 @@ pub struct Faults {
 /// acquisition is left stopped; the sample task tries again at its next timeout, and the
 /// watchdog resets the MCU if that never helps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct StepTimeout(pub Step);
+pub struct StepTimeout(pub RecoveryStep);
 
 /// Polls of a register the sequence's waits allow (each a few cycles: about 1 ms at
 /// 170 MHz, far above the 1-2 conversion times an `ADSTP` or a DMA disable takes).
@@ -106,7 +106,7 @@ pub const POLL_LIMIT: u32 = 50_000;
 /// # Errors
 /// [`StepTimeout`] naming `step`.
 pub fn poll_until(
-    step: Step,
+    step: RecoveryStep,
     limit: u32,
     mut done: impl FnMut() -> bool,
 ) -> Result<(), StepTimeout> {
@@ -119,29 +119,29 @@ pub fn poll_until(
 }
 
 /// The acquisition as [`recover`] drives it: both ADCs and their DMA channels, and the
-/// trigger. Each method is one [`Step`] (the waits bounded, [`poll_until`]).
+/// trigger. Each method is one [`RecoveryStep`] (the waits bounded, [`poll_until`]).
 pub trait Acquisition {
     /// The faults latched now (`OVR`, `TEIF`), read before anything is cleared.
     fn faults(&mut self) -> Faults;
-    /// [`Step::StopTrigger`].
+    /// [`RecoveryStep::StopTrigger`].
     fn stop_trigger(&mut self);
-    /// [`Step::StopAdc`].
+    /// [`RecoveryStep::StopAdc`].
     ///
     /// # Errors
     /// [`StepTimeout`] when `ADSTART` never cleared.
     fn stop_adc(&mut self) -> Result<(), StepTimeout>;
-    /// [`Step::PauseDma`].
+    /// [`RecoveryStep::PauseDma`].
     ///
     /// # Errors
     /// [`StepTimeout`] when `EN` never cleared.
     fn pause_dma(&mut self) -> Result<(), StepTimeout>;
-    /// [`Step::ClearFlags`].
+    /// [`RecoveryStep::ClearFlags`].
     fn clear_flags(&mut self);
-    /// [`Step::RearmDma`].
+    /// [`RecoveryStep::RearmDma`].
     fn rearm_dma(&mut self);
-    /// [`Step::StartAdc`].
+    /// [`RecoveryStep::StartAdc`].
     fn start_adc(&mut self);
-    /// [`Step::StartTrigger`].
+    /// [`RecoveryStep::StartTrigger`].
     fn start_trigger(&mut self);
 }
 
@@ -175,7 +175,7 @@ pub struct AdcFlags {
 }
 
 impl AdcFlags {
-    /// What [`Step::ClearFlags`] writes to `ADC_ISR` (write 1 to clear): `OVR`, `EOC` and
+    /// What [`RecoveryStep::ClearFlags`] writes to `ADC_ISR` (write 1 to clear): `OVR`, `EOC` and
     /// `EOS` together, as ST's HAL does. After an overrun with `OVRMOD = 0` the data
     /// register was never read and `EOC` stays 1; RM0440 sets `OVR` again as soon as a
     /// conversion ends while `EOC` is 1, so clearing `OVR` alone re-overruns at the first
@@ -260,7 +260,7 @@ impl<R: AcqRegisters> Acquisition for RegisterAcquisition<R> {
             }
         }
         let regs = &mut self.regs;
-        poll_until(Step::StopAdc, POLL_LIMIT, || {
+        poll_until(RecoveryStep::StopAdc, POLL_LIMIT, || {
             CHANNELS.iter().all(|&i| !regs.adc_started(i))
         })
     }
@@ -270,7 +270,7 @@ impl<R: AcqRegisters> Acquisition for RegisterAcquisition<R> {
             self.regs.dma_disable(i);
         }
         let regs = &mut self.regs;
-        poll_until(Step::PauseDma, POLL_LIMIT, || {
+        poll_until(RecoveryStep::PauseDma, POLL_LIMIT, || {
             CHANNELS.iter().all(|&i| !regs.dma_enabled(i))
         })
     }
@@ -342,12 +342,12 @@ mod tests {
     /// Records the calls, fails the wait of `fail` if set.
     #[derive(Default)]
     struct Trace {
-        steps: Vec<Step>,
-        fail: Option<Step>,
+        steps: Vec<RecoveryStep>,
+        fail: Option<RecoveryStep>,
     }
 
     impl Trace {
-        fn wait(&mut self, step: Step) -> Result<(), StepTimeout> {
+        fn wait(&mut self, step: RecoveryStep) -> Result<(), StepTimeout> {
             self.steps.push(step);
             poll_until(step, 10, || self.fail != Some(step))
         }
@@ -361,25 +361,25 @@ mod tests {
             }
         }
         fn stop_trigger(&mut self) {
-            self.steps.push(Step::StopTrigger);
+            self.steps.push(RecoveryStep::StopTrigger);
         }
         fn stop_adc(&mut self) -> Result<(), StepTimeout> {
-            self.wait(Step::StopAdc)
+            self.wait(RecoveryStep::StopAdc)
         }
         fn pause_dma(&mut self) -> Result<(), StepTimeout> {
-            self.wait(Step::PauseDma)
+            self.wait(RecoveryStep::PauseDma)
         }
         fn clear_flags(&mut self) {
-            self.steps.push(Step::ClearFlags);
+            self.steps.push(RecoveryStep::ClearFlags);
         }
         fn rearm_dma(&mut self) {
-            self.steps.push(Step::RearmDma);
+            self.steps.push(RecoveryStep::RearmDma);
         }
         fn start_adc(&mut self) {
-            self.steps.push(Step::StartAdc);
+            self.steps.push(RecoveryStep::StartAdc);
         }
         fn start_trigger(&mut self) {
-            self.steps.push(Step::StartTrigger);
+            self.steps.push(RecoveryStep::StartTrigger);
         }
     }
 
@@ -393,18 +393,18 @@ mod tests {
                 dma_error: false
             })
         );
-        assert_eq!(t.steps, Step::ORDER);
+        assert_eq!(t.steps, RecoveryStep::ORDER);
     }
 
     #[test]
     fn a_wait_that_runs_out_stops_the_sequence_and_is_counted() {
         let mut t = Trace {
-            fail: Some(Step::StopAdc),
+            fail: Some(RecoveryStep::StopAdc),
             ..Trace::default()
         };
         let r = recover(&mut t);
-        assert_eq!(r, Err(StepTimeout(Step::StopAdc)));
-        assert_eq!(t.steps, [Step::StopTrigger, Step::StopAdc]);
+        assert_eq!(r, Err(StepTimeout(RecoveryStep::StopAdc)));
+        assert_eq!(t.steps, [RecoveryStep::StopTrigger, RecoveryStep::StopAdc]);
         let mut n = RecoveryCounts::default();
         n.count(r);
         n.count(Ok(Faults {
@@ -422,11 +422,11 @@ mod tests {
         );
         let mut polls = 0;
         assert_eq!(
-            poll_until(Step::PauseDma, 7, || {
+            poll_until(RecoveryStep::PauseDma, 7, || {
                 polls += 1;
                 false
             }),
-            Err(StepTimeout(Step::PauseDma))
+            Err(StepTimeout(RecoveryStep::PauseDma))
         );
         assert_eq!(polls, 7);
     }

@@ -18,7 +18,7 @@
 //!
 //! Panics through `defmt::panic!` (the HAL's assertions with its `defmt` feature, the
 //! firmware's `defmt::unwrap!`) do not hand their message to the handler (it is in the
-//! defmt log); their record names the firmware's [`Phase`] at the time and the address
+//! defmt log); their record names the firmware's [`BootPhase`] at the time and the address
 //! the handler was called from ([`ResetRecord::defmt_panic`]).
 //!
 //! # Layout ([`RESET_RECORD_LEN`] = 128 bytes, little endian)
@@ -55,11 +55,11 @@ pub enum ResetCause {
     Panic,
     /// No samples arrived and the restarts did not help; the watchdog reset the MCU.
     SampleStall,
-    /// A set-up step (its [`Phase`] in the message) did not finish before the watchdog
+    /// A set-up step (its [`BootPhase`] in the message) did not finish before the watchdog
     /// reset the MCU: the HAL's set-up waits on registers without a bound, so the record is
     /// written before the step and cleared after it ([`ResetRecord::setup`]).
     SetupTimeout,
-    /// A panic through `defmt::panic!` (the HAL, `defmt::unwrap!`): the [`Phase`] in the
+    /// A panic through `defmt::panic!` (the HAL, `defmt::unwrap!`): the [`BootPhase`] in the
     /// message, the address the panic handler was called from in the number.
     DefmtPanic,
     /// A HardFault (or an exception or interrupt without a handler): the faulting
@@ -100,9 +100,9 @@ impl ResetCause {
 }
 
 /// What the firmware is doing, for a `defmt` panic's record and a set-up step's (the
-/// firmware keeps the current phase in a static; [`Phase::name`] goes into the record).
+/// firmware keeps the current phase in a static; [`BootPhase::name`] goes into the record).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Phase {
+pub enum BootPhase {
     /// Clocks, the watchdog, the reset record, the motor record.
     Boot,
     /// The flash driver and the records in flash.
@@ -115,35 +115,35 @@ pub enum Phase {
     Recovery,
 }
 
-impl Phase {
+impl BootPhase {
     /// All phases.
-    pub const ALL: [Phase; 5] = [
-        Phase::Boot,
-        Phase::Flash,
-        Phase::AdcSetup,
-        Phase::Sampling,
-        Phase::Recovery,
+    pub const ALL: [BootPhase; 5] = [
+        BootPhase::Boot,
+        BootPhase::Flash,
+        BootPhase::AdcSetup,
+        BootPhase::Sampling,
+        BootPhase::Recovery,
     ];
 
     /// The phase's name in logs and records.
     pub const fn name(self) -> &'static str {
         match self {
-            Phase::Boot => "boot",
-            Phase::Flash => "flash",
-            Phase::AdcSetup => "adc-setup",
-            Phase::Sampling => "sampling",
-            Phase::Recovery => "recovery",
+            BootPhase::Boot => "boot",
+            BootPhase::Flash => "flash",
+            BootPhase::AdcSetup => "adc-setup",
+            BootPhase::Sampling => "sampling",
+            BootPhase::Recovery => "recovery",
         }
     }
 
-    /// The phase's number (its index in [`Phase::ALL`]), for a static.
+    /// The phase's number (its index in [`BootPhase::ALL`]), for a static.
     pub const fn number(self) -> u8 {
         self as u8
     }
 
     /// The phase of a number (`None` out of range).
-    pub fn from_number(n: u8) -> Option<Phase> {
-        Phase::ALL.get(usize::from(n)).copied()
+    pub fn from_number(n: u8) -> Option<BootPhase> {
+        BootPhase::ALL.get(usize::from(n)).copied()
     }
 }
 
@@ -295,7 +295,7 @@ impl ResetRecord {
 
     /// A panic through `defmt::panic!` in `phase`, the handler called from `return_address`
     /// (look it up with `addr2line -e` on the ELF; the message is in the defmt log).
-    pub fn defmt_panic(phase: Phase, return_address: u32) -> Self {
+    pub fn defmt_panic(phase: BootPhase, return_address: u32) -> Self {
         Self {
             cause: ResetCause::DefmtPanic,
             number: return_address,
@@ -370,7 +370,7 @@ impl ResetRecord {
     /// The record written before a set-up step of `phase` that waits on hardware without
     /// a bound, cleared when it finished: if the step hangs, the watchdog's reset is
     /// reported as that step's timeout.
-    pub fn setup(phase: Phase) -> Self {
+    pub fn setup(phase: BootPhase) -> Self {
         Self {
             cause: ResetCause::SetupTimeout,
             number: u32::from(phase.number()),
@@ -608,7 +608,7 @@ mod tests {
         let wd = ResetSource::IndependentWatchdog;
         for rec in [
             ResetRecord::sample_stall(300),
-            ResetRecord::setup(Phase::AdcSetup),
+            ResetRecord::setup(BootPhase::AdcSetup),
         ] {
             let bytes = rec.encode();
             assert_eq!(PreviousRun::at_boot(&bytes, wd), PreviousRun::Recorded(rec));
@@ -638,16 +638,16 @@ mod tests {
                 PreviousRun::Recorded(panic)
             );
         }
-        let defmt = ResetRecord::defmt_panic(Phase::AdcSetup, 0x0800_1234);
+        let defmt = ResetRecord::defmt_panic(BootPhase::AdcSetup, 0x0800_1234);
         let back = ResetRecord::decode(&defmt.encode()).unwrap();
         assert_eq!(
             (back.cause(), back.message(), back.line_or_ms()),
             (ResetCause::DefmtPanic, "adc-setup", 0x0800_1234)
         );
-        for phase in Phase::ALL {
-            assert_eq!(Phase::from_number(phase.number()), Some(phase));
+        for phase in BootPhase::ALL {
+            assert_eq!(BootPhase::from_number(phase.number()), Some(phase));
         }
-        assert_eq!(Phase::from_number(Phase::ALL.len() as u8), None);
+        assert_eq!(BootPhase::from_number(BootPhase::ALL.len() as u8), None);
     }
 
     #[test]

@@ -460,7 +460,7 @@ pub fn identify(
 pub fn params_from_nameplate(
     n: &crate::nameplate::Nameplate,
     columns_from: Option<&Path>,
-) -> Result<(crate::nameplate::Estimate, String), ApiError> {
+) -> Result<(crate::nameplate::NameplateEstimate, String), ApiError> {
     let estimate = crate::nameplate::estimate(n).map_err(|e| ApiError::Option(e.to_string()))?;
     let mut toml = estimate.to_toml();
     if let Some(from) = columns_from {
@@ -480,7 +480,7 @@ pub fn params_from_nameplate(
 
 /// `params from-nameplate --json`'s document (`out`: where the file was written, if it was).
 pub fn nameplate_document(
-    estimate: &crate::nameplate::Estimate,
+    estimate: &crate::nameplate::NameplateEstimate,
     toml: &str,
     out: Option<&Path>,
 ) -> serde_json::Value {

@@ -171,7 +171,7 @@ pub struct Estimated {
 /// The result of [`estimate`]: the parameter file, each value with its range and source,
 /// and the rated point as read.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct Estimate {
+pub struct NameplateEstimate {
     /// The nameplate, as given.
     pub nameplate: Nameplate,
     /// The parameter file (checked: plausible and within the equations' limits).
@@ -265,7 +265,7 @@ struct Rated {
 
 /// One circuit: per-phase star-equivalent values [ohm at the rated frequency] and losses.
 #[derive(Debug, Clone, Copy)]
-struct Circuit {
+struct RatedCircuit {
     rs: f64,
     rr: f64,
     xls: f64,
@@ -442,7 +442,7 @@ fn locked_rotor_impedance(rs: f64, rr: f64, xls: f64, xlr: f64, xm: f64) -> f64 
 }
 
 /// The circuit under one set of assumptions (steps 3 to 5).
-fn circuit(n: &Nameplate, r: &Rated, a: &Assumptions) -> Result<Circuit, NameplateError> {
+fn circuit(n: &Nameplate, r: &Rated, a: &Assumptions) -> Result<RatedCircuit, NameplateError> {
     let eta = n.efficiency + a.d_efficiency;
     let pf = (n.power_factor + a.d_power_factor).min(0.999);
     let p_in = r.p_out_w / eta;
@@ -513,7 +513,7 @@ fn circuit(n: &Nameplate, r: &Rated, a: &Assumptions) -> Result<Circuit, Namepla
         }
     }
     let (xls, xlr) = split(xl);
-    Ok(Circuit {
+    Ok(RatedCircuit {
         rs,
         rr,
         xls,
@@ -544,8 +544,8 @@ fn inertia_kgm2(r: &Rated) -> f64 {
     J_COEFF * p_eq_kw.powf(J_EXP)
 }
 
-/// The values of one circuit, in the order of [`Estimate::values`].
-fn circuit_values(c: &Circuit, r: &Rated) -> [f64; 11] {
+/// The values of one circuit, in the order of [`NameplateEstimate::values`].
+fn circuit_values(c: &RatedCircuit, r: &Rated) -> [f64; 11] {
     let w = TAU * r.f_hz;
     let (lm, lls, llr) = (c.xm / w, c.xls / w, c.xlr / w);
     let w2 = r.speed_rad_s * r.speed_rad_s;
@@ -637,7 +637,7 @@ fn assumption_sets(n: &Nameplate) -> Vec<Assumptions> {
 /// not finite or not positive, P off sqrt 3 V I cos phi eta by more than 20 %, an
 /// efficiency above 1 - slip), naming the option; [`NameplateError::Params`] when the
 /// estimate fails the parameter file's checks.
-pub fn estimate(n: &Nameplate) -> Result<Estimate, NameplateError> {
+pub fn estimate(n: &Nameplate) -> Result<NameplateEstimate, NameplateError> {
     check_fields(n)?;
     let (poles, poles_inferred, slip) = poles_and_slip(n)?;
     let rated = Rated {
@@ -677,7 +677,7 @@ pub fn estimate(n: &Nameplate) -> Result<Estimate, NameplateError> {
             source,
         })
         .collect();
-    let mut e = Estimate {
+    let mut e = NameplateEstimate {
         nameplate: *n,
         params: ParamFile::reference_3hp(),
         poles,
@@ -716,8 +716,8 @@ pub fn toml_entry(key: &str, x: f64, comment: &str) -> String {
     format!("{key} = {} # {comment}\n", toml_number(x))
 }
 
-impl Estimate {
-    /// The value of `key` (a key of [`Estimate::values`]).
+impl NameplateEstimate {
+    /// The value of `key` (a key of [`NameplateEstimate::values`]).
     pub fn value(&self, key: &str) -> Option<&Estimated> {
         self.values.iter().find(|v| v.key == key)
     }
@@ -878,8 +878,8 @@ mod tests {
             ..plate(1438.0, 50.0)
         })
         .unwrap();
-        let total = |e: &Estimate| e.value("lls_h + llr_h").unwrap().value;
-        let lls = |e: &Estimate| e.value("lls_h").unwrap().value;
+        let total = |e: &NameplateEstimate| e.value("lls_h + llr_h").unwrap().value;
+        let lls = |e: &NameplateEstimate| e.value("lls_h").unwrap().value;
         assert!((total(&c) / total(&star) - 1.0).abs() < 1e-12);
         assert!((lls(&c) / total(&c) - 0.3).abs() < 1e-9);
         assert!((lls(&star) / total(&star) - 0.4).abs() < 1e-9);

@@ -79,7 +79,7 @@ pub fn healthy_service(params: &ParamFile, seed: u64, duration_s: f64) -> Scenar
 
 /// What a watched run saw after commissioning.
 #[derive(Debug, Clone, Default)]
-pub struct Watch {
+pub struct ServiceWatch {
     /// Samples after commissioning with a fault indication (lamp or sensor fault).
     pub alarm_samples: usize,
     /// Seconds after commissioning during which lamps were evaluated.
@@ -103,7 +103,7 @@ pub fn watch(
     seed: u64,
     duration_s: f64,
     fault: Option<FaultSpec>,
-) -> Result<Watch, ExperimentError> {
+) -> Result<ServiceWatch, ExperimentError> {
     watch_mismatched(params, params, seed, duration_s, fault)
 }
 
@@ -118,7 +118,7 @@ pub fn watch_mismatched(
     seed: u64,
     duration_s: f64,
     fault: Option<FaultSpec>,
-) -> Result<Watch, ExperimentError> {
+) -> Result<ServiceWatch, ExperimentError> {
     let params = nominal;
     let mut sc = healthy_service(truth, seed, duration_s);
     sc.faults.extend(fault);
@@ -131,7 +131,7 @@ pub fn watch_mismatched(
         unbalance_baseline: None,
         load: crate::replay::LoadModel::Unknown,
     };
-    let mut w = Watch::default();
+    let mut w = ServiceWatch::default();
     let dt = 1.0 / sc.sample_rate_hz;
     let replay = simulate_and_replay(truth, params, &sc, opts, |row, o| {
         if row.t_s > COMMISSION.1 {

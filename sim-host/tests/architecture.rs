@@ -638,3 +638,54 @@ fn no_string_errors_in_the_library() {
     }
     assert!(bad.is_empty(), "Result<_, String> in the library: {bad:#?}");
 }
+
+/// 8. **Unique names**: no public type (`pub struct|enum|trait|type`) of the core, the
+///    firmware, `sim-host` or the Python bindings has the name of another (test modules
+///    excepted): a name a user or a drives engineer searches for finds one thing.
+#[test]
+fn no_public_type_name_is_defined_twice() {
+    let root = workspace();
+    let mut seen: std::collections::BTreeMap<String, Vec<String>> = Default::default();
+    for f in files() {
+        let lib = [
+            "crates/monitor-core/src/",
+            "src/",
+            "sim-host/src/",
+            "python/src/",
+        ]
+        .iter()
+        .any(|d| f.starts_with(d));
+        if !lib || !f.ends_with(".rs") {
+            continue;
+        }
+        let text = std::fs::read_to_string(root.join(&f)).unwrap_or_default();
+        let code = text.split("#[cfg(test)]\nmod tests").next().unwrap_or("");
+        for (k, line) in code.lines().enumerate() {
+            let mut words = line.split_whitespace();
+            if words.next() != Some("pub") {
+                continue;
+            }
+            let (Some(kind), Some(name)) = (words.next(), words.next()) else {
+                continue;
+            };
+            if !["struct", "enum", "trait", "type"].contains(&kind) {
+                continue;
+            }
+            let name: String = name
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect();
+            seen.entry(name).or_default().push(format!("{f}:{}", k + 1));
+        }
+    }
+    let twice: Vec<String> = seen
+        .iter()
+        .filter(|(_, at)| at.len() > 1)
+        .map(|(n, at)| format!("{n}: {}", at.join(", ")))
+        .collect();
+    assert!(seen.len() > 100, "only {} public types found", seen.len());
+    assert!(
+        twice.is_empty(),
+        "public type names defined twice: {twice:#?}"
+    );
+}

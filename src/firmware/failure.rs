@@ -9,7 +9,7 @@ use defmt::{error, warn};
 use drive_monitor::app::WATCHDOG_TIMEOUT_MS;
 use drive_monitor::board::{Lamp, Port};
 use drive_monitor::panel::PanelLamps;
-use drive_monitor::reset_record::{Phase, ResetRecord, RESET_RECORD_LEN};
+use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
 use embassy_stm32::pac;
 
 use super::{write_reset_record, PHASE, WATCHDOG_RUNNING};
@@ -62,7 +62,7 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
 fn defmt_panic() -> ! {
     cortex_m::interrupt::disable();
     let return_address = cortex_m::register::lr::read();
-    let phase = Phase::from_number(PHASE.load(Ordering::Relaxed)).unwrap_or(Phase::Boot);
+    let phase = BootPhase::from_number(PHASE.load(Ordering::Relaxed)).unwrap_or(BootPhase::Boot);
     fail(&ResetRecord::defmt_panic(phase, return_address).encode())
 }
 

@@ -13,7 +13,8 @@
 
 use super::*;
 use drive_monitor::recovery::{
-    self, AcqRegisters, Acquisition, AdcFlags, Faults, RegisterAcquisition, Step, StepTimeout,
+    self, AcqRegisters, Acquisition, AdcFlags, Faults, RecoveryStep, RegisterAcquisition,
+    StepTimeout,
 };
 
 /// The ring's length in DMA transfers (the firmware's `RING_LEN`, two halves of samples).
@@ -395,7 +396,10 @@ fn the_sequence_on_the_model_clears_what_blocks_the_dma() {
     assert!(acq.regs.trigger());
     assert_eq!(recovery::recover(&mut acq), Ok(Faults::default()));
     assert!(acq.regs.trigger());
-    assert_eq!(Step::ORDER.first(), Some(&Step::StopTrigger));
+    assert_eq!(
+        RecoveryStep::ORDER.first(),
+        Some(&RecoveryStep::StopTrigger)
+    );
     assert!(acq.regs.violations.is_empty(), "{:?}", acq.regs.violations);
 }
 

@@ -1,7 +1,7 @@
 //! `explain`: which physical effect of the library is missing from the model, ranked by the
 //! error it removes on held-back windows.
 
-use super::effects::{self, EffectModel, Evidence, FitSetup, SetupError};
+use super::effects::{self, EffectEvidence, EffectModel, FitSetup, SetupError};
 use super::fit::{self, ActiveEffect, FitResult, FittedModel};
 use super::metrics::{self, Weights};
 use super::prep::Prepared;
@@ -753,7 +753,7 @@ fn rank(ranked: &mut [RankedCandidate], unbalance: &UnbalanceAnalysis, torque_sc
     }
     let says = |r: &RankedCandidate| {
         let fitted = r.fit.effect_params.last().map(Vec::as_slice).unwrap_or(&[]);
-        effects::model_of(r.candidate.effect).evidence(&Evidence {
+        effects::model_of(r.candidate.effect).evidence(&EffectEvidence {
             voltage_unbalance: unbalance.voltage_negative_sequence_ratio,
             winding_suspected: unbalance.suspect_phase.is_some(),
             torque_scale_nm,

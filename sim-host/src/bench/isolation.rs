@@ -355,7 +355,7 @@ pub struct Summary {
 
 /// A confusion matrix: rows the true faults, columns what was named.
 #[derive(Debug, Clone, Serialize, PartialEq)]
-pub struct Confusion {
+pub struct IsolationConfusion {
     /// Angle mode (JSON: its command-line name).
     #[serde(serialize_with = "serialize_angle_source")]
     pub mode: AngleSource,
@@ -377,7 +377,7 @@ pub struct IsolationBench {
     /// Per motor and angle mode.
     pub summaries: Vec<Summary>,
     /// One per angle mode, over all motors, sizes and loads.
-    pub confusion: Vec<Confusion>,
+    pub confusion: Vec<IsolationConfusion>,
     /// Wall time of the run [s].
     pub wall_s: f64,
 }
@@ -416,7 +416,7 @@ pub fn summarise(motor: &str, mode: AngleSource, cases: &[CaseResult]) -> Summar
 }
 
 /// The confusion matrix of the cases in `mode` (rows: `faults`).
-pub fn confusion(mode: AngleSource, faults: &[Fault], cases: &[CaseResult]) -> Confusion {
+pub fn confusion(mode: AngleSource, faults: &[Fault], cases: &[CaseResult]) -> IsolationConfusion {
     let columns: Vec<Outcome> = Fault::ALL
         .iter()
         .map(|f| Outcome::Named(IsolationName::Fault(*f)))
@@ -436,7 +436,7 @@ pub fn confusion(mode: AngleSource, faults: &[Fault], cases: &[CaseResult]) -> C
                 .collect()
         })
         .collect();
-    Confusion {
+    IsolationConfusion {
         mode,
         rows: faults.to_vec(),
         columns,

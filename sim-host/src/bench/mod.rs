@@ -183,7 +183,7 @@ pub fn measure(repeat: u32) -> Result<BenchFigures, ExperimentError> {
 
 /// Smallest detected change of one fault (the fault detection bar of `docs/performance.md`).
 #[derive(Debug, Serialize)]
-pub struct DetectionLimit {
+pub struct DetectionLimitCase {
     /// Motor.
     pub motor: String,
     /// The fault (JSON: its name).
@@ -202,7 +202,7 @@ pub struct DetectionLimit {
 /// [`DetectionError`]: the healthy profile alarmed, or a simulator error.
 pub fn detection_limits(
     on_case: &(dyn Fn() + Sync),
-) -> Result<Vec<DetectionLimit>, DetectionError> {
+) -> Result<Vec<DetectionLimitCase>, DetectionError> {
     use crate::service_profile::watch;
     use crate::sim::FaultSpec;
     use rayon::prelude::*;
@@ -257,7 +257,7 @@ pub fn detection_limits(
                     .find(|(m, ff, s, _)| m == n && *ff == f && *s == sg)
                     .and_then(|x| x.3)
             };
-            out.push(DetectionLimit {
+            out.push(DetectionLimitCase {
                 motor: n.to_string(),
                 fault: f,
                 smallest_increase: get(1.0),

@@ -9,7 +9,7 @@
 //! load torque (not in the model) is taken as friction: B + Bl is then the mean torque
 //! over the mean speed of the windows, not a viscous coefficient.
 
-use super::model::{simulate, Circuit};
+use super::model::{simulate, IdentifiedCircuit};
 use super::Samples;
 use nalgebra::DMatrix;
 
@@ -110,7 +110,7 @@ fn judged_linear(v: f64, sg: f64) -> Judged {
 }
 
 /// J and B + Bl of the log `s` with the identified circuit `c` (the speed imposed).
-pub fn fit(c: &Circuit, s: &Samples) -> Mechanics {
+pub fn fit(c: &IdentifiedCircuit, s: &Samples) -> Mechanics {
     let fail = |why: NotIdentified| Mechanics {
         j: Err(why),
         b_total: Err(why),

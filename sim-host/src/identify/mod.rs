@@ -33,7 +33,7 @@ mod refuse;
 use crate::analysis::lm::{self, Bounds};
 use crate::log::{Channels, Row};
 use crate::params::ParamFile;
-use model::{Circuit, CurrentFit, N_PARAMS};
+use model::{CurrentFit, IdentifiedCircuit, N_PARAMS};
 use nalgebra::Complex;
 use serde::Serialize;
 
@@ -196,7 +196,7 @@ impl Samples {
     }
 }
 
-/// The identified parameters' names, keys and units, in [`Circuit::to_vec`]'s order.
+/// The identified parameters' names, keys and units, in [`IdentifiedCircuit::to_vec`]'s order.
 pub const PARAMS: [(&str, &str, &str); N_PARAMS] = [
     ("Rs", "rs_ohm", "ohm"),
     ("Rr", "rr_ohm", "ohm"),
@@ -319,7 +319,7 @@ pub const MAX_ITER: usize = 60;
 ///
 /// # Errors
 /// [`IdentifyError::Start`] when it is not a machine (non-positive values).
-pub fn start_circuit(p: &ParamFile) -> Result<Circuit, IdentifyError> {
+pub fn start_circuit(p: &ParamFile) -> Result<IdentifiedCircuit, IdentifyError> {
     let m = &p.motor;
     let (lls, llr) = (m.ls_h - m.lm_h, m.lr_h - m.lm_h);
     let leak = lls + llr;
@@ -336,7 +336,7 @@ pub fn start_circuit(p: &ParamFile) -> Result<Circuit, IdentifyError> {
             m.rs_ohm, m.rr_ohm, m.lm_h, m.j_kgm2, m.poles
         )));
     }
-    Ok(Circuit {
+    Ok(IdentifiedCircuit {
         rs_ohm: m.rs_ohm,
         rr_ohm: m.rr_ohm,
         leakage_h: leak,

@@ -21,9 +21,9 @@ use crate::sim::machine::{LoadLaw, Machine};
 use nalgebra::Complex;
 
 /// The parameters `identify` varies, physical units. The leakage is the total
-/// `Lls + Llr`, split by the fixed stator fraction [`Circuit::stator_leakage_share`].
+/// `Lls + Llr`, split by the fixed stator fraction [`IdentifiedCircuit::stator_leakage_share`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Circuit {
+pub struct IdentifiedCircuit {
     /// Stator resistance Rs [ohm].
     pub rs_ohm: f64,
     /// Rotor resistance Rr (referred to the stator) [ohm].
@@ -42,10 +42,10 @@ pub struct Circuit {
     pub np: f64,
 }
 
-/// Number of parameters in [`Circuit::to_vec`].
+/// Number of parameters in [`IdentifiedCircuit::to_vec`].
 pub const N_PARAMS: usize = 6;
 
-impl Circuit {
+impl IdentifiedCircuit {
     /// The varied parameters as a vector, in [`super::PARAMS`]' order.
     pub fn to_vec(&self) -> [f64; N_PARAMS] {
         [
@@ -59,9 +59,9 @@ impl Circuit {
     }
 
     /// This circuit with the varied parameters `p` (same order).
-    pub fn with(&self, p: &[f64]) -> Circuit {
+    pub fn with(&self, p: &[f64]) -> IdentifiedCircuit {
         let g = |k: usize| p.get(k).copied().unwrap_or(f64::NAN);
-        Circuit {
+        IdentifiedCircuit {
             rs_ohm: g(0),
             rr_ohm: g(1),
             leakage_h: g(2),
@@ -141,7 +141,7 @@ pub struct Trace {
 
 /// Simulates the log `s` with circuit `c` (speed imposed when the log has it). `None` when
 /// the circuit is not physical or the simulation diverges.
-pub fn simulate(c: &Circuit, s: &Samples) -> Option<Trace> {
+pub fn simulate(c: &IdentifiedCircuit, s: &Samples) -> Option<Trace> {
     let wm_meas = s.wm_rad_s.as_deref();
     let m = c.machine(wm_meas.is_some())?;
     let n = s.i_ab.len();
@@ -182,18 +182,18 @@ pub fn simulate(c: &Circuit, s: &Samples) -> Option<Trace> {
 }
 
 /// The least-squares problem: the parameters are `ln(p / p_start)` (all of
-/// [`Circuit::to_vec`]); the residuals the current errors over the measured current's RMS,
+/// [`IdentifiedCircuit::to_vec`]); the residuals the current errors over the measured current's RMS,
 /// alpha and beta of every sample.
 pub struct CurrentFit<'a> {
     /// The log.
     pub samples: &'a Samples,
     /// The start circuit (the scale of the parameters).
-    pub start: Circuit,
+    pub start: IdentifiedCircuit,
 }
 
 impl CurrentFit<'_> {
     /// The circuit at the solver's vector `x`.
-    pub fn circuit(&self, x: &[f64]) -> Circuit {
+    pub fn circuit(&self, x: &[f64]) -> IdentifiedCircuit {
         let p0 = self.start.to_vec();
         let p: Vec<f64> = p0.iter().zip(x).map(|(p, x)| p * x.exp()).collect();
         self.start.with(&p)

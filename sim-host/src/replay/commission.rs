@@ -84,7 +84,7 @@ pub struct CommissioningReport {
     /// Which thresholds the lamps used, in words.
     pub thresholds: String,
     /// Without commissioning: the first quasi-steady point and the residuals there.
-    pub first_quasi_steady: Option<SteadyPoint>,
+    pub first_quasi_steady: Option<QuasiSteadyPoint>,
     /// Times a lit r2/r3/r4 lamp met an operating point outside the learned range.
     pub outside_range: Vec<RangeNote>,
     /// What the user should do or know, if anything.
@@ -93,7 +93,7 @@ pub struct CommissioningReport {
 
 /// The residuals at one time.
 #[derive(Debug, Clone, Copy, Serialize, PartialEq)]
-pub struct SteadyPoint {
+pub struct QuasiSteadyPoint {
     /// Time since the log's start [s].
     pub t_s: f64,
     /// Normalised residuals r1..r4 (the fixed thresholds act on |r|).
@@ -121,7 +121,7 @@ pub(super) struct CommissionTracker {
     fixed: [f32; 4],
     iqs: Option<[f32; 2]>,
     vqs: Option<[f32; 2]>,
-    first_steady: Option<SteadyPoint>,
+    first_steady: Option<QuasiSteadyPoint>,
     notes: Vec<RangeNote>,
     noted: u8,
     last_t: f64,
@@ -209,7 +209,7 @@ impl CommissionTracker {
             widen(&mut self.vqs, v);
         }
         if self.requested.is_none() && self.first_steady.is_none() && out.evaluating {
-            self.first_steady = Some(SteadyPoint {
+            self.first_steady = Some(QuasiSteadyPoint {
                 t_s: t,
                 residuals: out.residuals,
             });

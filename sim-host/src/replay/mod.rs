@@ -34,7 +34,7 @@ mod winding;
 use report::timeline_point;
 
 pub use commission::{
-    grace_s, min_learned_s, CommissioningOutcome, CommissioningReport, RangeNote, SteadyPoint,
+    grace_s, min_learned_s, CommissioningOutcome, CommissioningReport, QuasiSteadyPoint, RangeNote,
     MIN_LEARNED_S,
 };
 pub use diagnose::{

@@ -1,8 +1,8 @@
 //! `load_torque`: the load as a torque input.
 
 use super::{
-    plausible, About, Confusion, Contribution, EffectModel, Evidence, FitParam, FitSetup, Needs,
-    ParamSpec, SetupError, LOAD_STEP_MIN,
+    plausible, About, Confusion, Contribution, EffectEvidence, EffectModel, FitParam, FitSetup,
+    Needs, ParamSpec, SetupError, LOAD_STEP_MIN,
 };
 use crate::analysis::change_point::{Cumulative, Search};
 use crate::analysis::prep::{Prepared, C64};
@@ -216,7 +216,7 @@ impl EffectModel for LoadTorque {
             within: 1.10,
         }]
     }
-    fn evidence(&self, e: &Evidence<'_>) -> Option<bool> {
+    fn evidence(&self, e: &EffectEvidence<'_>) -> Option<bool> {
         let hi = e.fitted.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b));
         let lo = e.fitted.iter().fold(f64::INFINITY, |a, &b| a.min(b));
         Some(hi - lo >= LOAD_STEP_MIN * e.torque_scale_nm)

@@ -22,7 +22,7 @@
 //! | `windage` | k_nms2 \[N m s^2/rad^2\] | load += k w_m abs(w_m) |
 //! | `load_torque` | level_1..level_k \[N m\] | load += piecewise-constant T_L(t) (steps found in the data to the sample: `crate::analysis::change_point`) |
 //! | `supply_unbalance` | y_re, y_im \[-\] | i_neg = (y_re + j y_im) v_neg / conj(Z2), Z2 from the nominal parameters at the negative-sequence slip 2 - s; full-order: the machine driven by V_pos + y V_neg |
-//! | `phase_asymmetry` | c_re, c_im \[-\] | i_neg = (c_re + j c_im) conj(i_pos); full-order: the unequal winding (`simplified_model::WindingAsymmetry`) |
+//! | `phase_asymmetry` | c_re, c_im \[-\] | i_neg = (c_re + j c_im) conj(i_pos); full-order: the unequal winding (`simplified_model::WindingAsymmetryTerm`) |
 //! | `flux_dynamics` | tau_r_s \[s\] | psi_r/Lm = phi, dphi/dt = (i_f - phi)/tau_r; slip and torque from phi |
 //! | `current_dynamics` | la_h \[H\] | La dI_qs/dt = V_qs - Ra I_qs - Psi omega_r (eq. 28's derivative term) |
 //! | `rotor_asymmetry` | delta \[-\], phi_rad \[rad\] | Rr in Ra x (1 + (delta/3)(1 - cos(2 (Np theta_m - theta) + phi))); full-order: rotor resistance Rr (I + (2/3) delta u u^T) |
@@ -135,7 +135,7 @@ pub struct Confusion {
 
 /// Facts measured on the log, beside the fit, that can tell confusable effects apart.
 #[derive(Debug, Clone, Copy)]
-pub struct Evidence<'a> {
+pub struct EffectEvidence<'a> {
     /// Negative-sequence over positive-sequence supply voltage (`None`: no voltages).
     pub voltage_unbalance: Option<f64>,
     /// True when the unbalance analysis names a faulty phase (the current unbalance is more
@@ -155,7 +155,7 @@ pub const VOLTAGE_UNBALANCE_MIN: f64 = 0.002;
 pub const LOAD_STEP_MIN: f64 = 0.03;
 
 /// True when the supply's measured voltage unbalance accounts for the current unbalance.
-pub(crate) fn supply_unbalanced(e: &Evidence<'_>) -> bool {
+pub(crate) fn supply_unbalanced(e: &EffectEvidence<'_>) -> bool {
     !e.winding_suspected && e.voltage_unbalance.unwrap_or(0.0) > VOLTAGE_UNBALANCE_MIN
 }
 
@@ -241,7 +241,7 @@ pub trait EffectModel: Send + Sync {
     /// default). When two confusable candidates are ranked first and second within their
     /// [`Confusion::within`], a first one the evidence contradicts goes second unless the
     /// evidence contradicts the other too.
-    fn evidence(&self, _e: &Evidence<'_>) -> Option<bool> {
+    fn evidence(&self, _e: &EffectEvidence<'_>) -> Option<bool> {
         None
     }
     /// The effect set up on this data: its parameters (start, bounds, physical range) and
@@ -379,7 +379,7 @@ mod tests {
                 );
             }
         }
-        let ev = |v: Option<f64>, winding: bool, fitted: &'static [f64]| Evidence {
+        let ev = |v: Option<f64>, winding: bool, fitted: &'static [f64]| EffectEvidence {
             voltage_unbalance: v,
             winding_suspected: winding,
             torque_scale_nm: 10.0,

@@ -2,11 +2,11 @@
 
 use super::impedance::z1_pos;
 use super::{
-    plausible, supply_unbalanced, About, Confusion, Contribution, EffectModel, Evidence, FitParam,
-    FitSetup, Needs, ParamSpec, SetupError,
+    plausible, supply_unbalanced, About, Confusion, Contribution, EffectEvidence, EffectModel,
+    FitParam, FitSetup, Needs, ParamSpec, SetupError,
 };
 use crate::analysis::prep::{Prepared, C64};
-use crate::analysis::simplified_model::{MachineConstants, ModelTerms, WindingAsymmetry};
+use crate::analysis::simplified_model::{MachineConstants, ModelTerms, WindingAsymmetryTerm};
 use crate::analysis::unbalance::operating_point;
 use monitor_core::EffectKind;
 
@@ -15,7 +15,7 @@ use monitor_core::EffectKind;
 pub struct PhaseAsymmetry;
 
 /// The shorted turns set up on a log: the full-order form's loop admittance over `c`,
-/// `y / c = 1 / conj(Z1)` at the log's mean operating point ([`WindingAsymmetry`]).
+/// `y / c = 1 / conj(Z1)` at the log's mean operating point ([`WindingAsymmetryTerm`]).
 struct OnLog {
     y_over_c: C64,
 }
@@ -68,7 +68,7 @@ impl EffectModel for PhaseAsymmetry {
             within: 1.25,
         }]
     }
-    fn evidence(&self, e: &Evidence<'_>) -> Option<bool> {
+    fn evidence(&self, e: &EffectEvidence<'_>) -> Option<bool> {
         Some(!supply_unbalanced(e))
     }
     fn needs(&self) -> Needs {
@@ -100,7 +100,7 @@ impl Contribution for OnLog {
     fn contribute(&self, p: &[f64], _d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
         let &[c_re, c_im] = p else { return };
         let c = C64::new(c_re, c_im);
-        t.stator_winding = Some(WindingAsymmetry {
+        t.stator_winding = Some(WindingAsymmetryTerm {
             c,
             y: c * self.y_over_c,
         });

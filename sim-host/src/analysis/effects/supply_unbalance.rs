@@ -2,8 +2,8 @@
 
 use super::impedance::{z2_neg, z2_neg_at};
 use super::{
-    plausible, supply_unbalanced, sync_speed_mech, About, Confusion, Contribution, EffectModel,
-    Evidence, FitParam, FitSetup, ParamSpec, SetupError,
+    plausible, supply_unbalanced, sync_speed_mech, About, Confusion, Contribution, EffectEvidence,
+    EffectModel, FitParam, FitSetup, ParamSpec, SetupError,
 };
 use crate::analysis::prep::{Prepared, C64};
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms};
@@ -45,7 +45,7 @@ impl EffectModel for SupplyUnbalance {
             within: 1.25,
         }]
     }
-    fn evidence(&self, e: &Evidence<'_>) -> Option<bool> {
+    fn evidence(&self, e: &EffectEvidence<'_>) -> Option<bool> {
         Some(supply_unbalanced(e))
     }
     fn setup(&self, _d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, SetupError> {

@@ -22,7 +22,7 @@
 //! machine act as the simulator injects them (`crate::sim`'s machine), not through their
 //! steady-state descriptions: the heated cage's rotor time constant (`thermal_drift`),
 //! Lm on the model's own magnetising flux (`SatMachine`, `saturation`), the unequal
-//! stator winding ([`WindingAsymmetry`], `phase_asymmetry`) and rotor cage
+//! stator winding ([`WindingAsymmetryTerm`], `phase_asymmetry`) and rotor cage
 //! (`CageAsymmetry`, `rotor_asymmetry`).
 //!
 //! The forms: `reduced` (the paper's model with the effects' steady-state terms; the
@@ -41,8 +41,8 @@ mod stationary;
 mod terms;
 
 pub use terms::{
-    CageAsymmetry, Dynamics, Magnetising, ModelTerms, NegativeSequence, Resistance, RotorCage,
-    SaturationLaw, Shaft, SpeedTorque, WindingAsymmetry,
+    CageAsymmetry, Dynamics, Magnetising, ModelTerms, NegativeSequenceTerm, Resistance, RotorCage,
+    SaturationLaw, Shaft, SpeedTorque, WindingAsymmetryTerm,
 };
 
 use super::prep::{Prepared, C64};

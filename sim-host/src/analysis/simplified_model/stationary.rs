@@ -2,7 +2,7 @@
 //! dynamic).
 
 use super::full_order::{FullMachine, FullRun};
-use super::terms::{SaturationLaw, Shaft, WindingAsymmetry};
+use super::terms::{SaturationLaw, Shaft, WindingAsymmetryTerm};
 use super::{InputNoise, MachineConstants, Mechanics, ModelTerms, Prediction, Run};
 use crate::analysis::prep::{self, Prepared, C64};
 
@@ -42,8 +42,8 @@ struct StatMachine<'a> {
     shaft: &'a Shaft,
     k: usize,
     /// Shorted turns (the terminal current adds the loop's, see
-    /// [`WindingAsymmetry`]).
-    wind: Option<WindingAsymmetry>,
+    /// [`WindingAsymmetryTerm`]).
+    wind: Option<WindingAsymmetryTerm>,
     /// An unequal rotor cage.
     cage: Option<CageOverSample>,
     /// A magnetising law: the states are the fluxes of the T-equivalent circuit.
@@ -66,7 +66,7 @@ struct StatMachine<'a> {
 /// (Llr/Lr)^2, 0.2 %, of the fitted one). Given psi_s and psi_r, y = 1/Lm solves
 /// `y = (1/Lm0) (1 + (W / (psi_sat (y + G)))^n)`, W = |psi_s/Lls + psi_r/Llr|,
 /// G = 1/Lls + 1/Llr, by Newton's method from the last solve (f is increasing in y).
-/// The winding and the cage act as in [`WindingAsymmetry`] and [`CageOverSample`], on the
+/// The winding and the cage act as in [`WindingAsymmetryTerm`] and [`CageOverSample`], on the
 /// fluxes' equations.
 #[derive(Clone, Copy)]
 struct SatMachine<'a> {
@@ -200,7 +200,7 @@ impl StatMachine<'_> {
     }
 
     /// The terminal current of the state with the stator voltage `v` (the shorted loop's
-    /// current on top of the machine's, [`WindingAsymmetry::loop_current`]).
+    /// current on top of the machine's, [`WindingAsymmetryTerm::loop_current`]).
     #[inline(always)]
     fn terminal(&self, x: &StatState, v: C64) -> C64 {
         let i = self.current(x);

@@ -23,9 +23,9 @@ pub struct ModelTerms {
     /// Torques on the shaft besides the electromagnetic one and the viscous (B + Bl) w_m.
     pub shaft: Shaft,
     /// The negative sequence (an unbalanced supply, an unequal winding).
-    pub negative_sequence: NegativeSequence,
+    pub negative_sequence: NegativeSequenceTerm,
     /// An unequal stator winding (`None`: symmetric).
-    pub stator_winding: Option<WindingAsymmetry>,
+    pub stator_winding: Option<WindingAsymmetryTerm>,
     /// An unequal rotor cage.
     pub rotor_cage: RotorCage,
     /// Which states of the full-order machine the model integrates.
@@ -100,7 +100,7 @@ impl Shaft {
 
 /// The negative sequence in the two forms of the model.
 #[derive(Debug, Clone, Default)]
-pub struct NegativeSequence {
+pub struct NegativeSequenceTerm {
     /// Negative-sequence current the reduced model adds to its balanced current,
     /// stationary frame [A] (empty: 0); adds. The stationary-frame full-order model takes
     /// its negative sequence from the machine itself (`voltage_gain`, the stator winding)
@@ -212,7 +212,7 @@ impl ModelTerms {
     }
 
     /// Adds a negative-sequence current per sample, stationary frame [A]
-    /// ([`NegativeSequence::current`]).
+    /// ([`NegativeSequenceTerm::current`]).
     pub fn add_negative_sequence_current(&mut self, current: impl Iterator<Item = C64>) {
         compose(&mut self.negative_sequence.current, current, |a, b| a + b);
     }
@@ -256,14 +256,14 @@ impl ModelTerms {
 /// and converts it with `y = c / conj(Z1)` (Z1 the positive-sequence impedance at the log's
 /// mean operating point), so that the fitted value means the same.
 #[derive(Debug, Clone, Copy)]
-pub struct WindingAsymmetry {
+pub struct WindingAsymmetryTerm {
     /// The steady-state ratio i_neg / conj(i_pos) [-].
     pub c: C64,
     /// The full-order loop admittance `y` [S].
     pub y: C64,
 }
 
-impl WindingAsymmetry {
+impl WindingAsymmetryTerm {
     /// The shorted loop's terminal current for the stator voltage `v` [A].
     #[inline(always)]
     pub(super) fn loop_current(&self, v: C64) -> C64 {

@@ -2,8 +2,8 @@
 //! `bench --isolation`'s summaries and confusion matrix.
 
 use monitor_core::Fault;
-use sim_host::bench::isolation::{CaseResult, Confusion, IsolationBench, Outcome};
-use sim_host::bench::{BenchFigures, DetectionLimit, Spread};
+use sim_host::bench::isolation::{CaseResult, IsolationBench, IsolationConfusion, Outcome};
+use sim_host::bench::{BenchFigures, DetectionLimitCase, Spread};
 use sim_host::replay::{angle_source_name, state_name, IsolationName};
 use std::io::Write;
 
@@ -19,7 +19,7 @@ fn spread(s: &Spread, decimals: usize) -> String {
 }
 
 /// `bench`'s figures and, with `--detection`, the detection limits.
-pub fn bench(f: &BenchFigures, limits: Option<&[DetectionLimit]>) -> anyhow::Result<()> {
+pub fn bench(f: &BenchFigures, limits: Option<&[DetectionLimitCase]>) -> anyhow::Result<()> {
     let mut out = crate::cli::stdout();
     writeln!(
         out,
@@ -124,7 +124,7 @@ fn isolation_summaries(out: &mut impl Write, b: &IsolationBench) -> anyhow::Resu
 }
 
 /// One angle mode's confusion matrix (rows: the true faults; columns: what was named).
-fn confusion_matrix(out: &mut impl Write, c: &Confusion) -> anyhow::Result<()> {
+fn confusion_matrix(out: &mut impl Write, c: &IsolationConfusion) -> anyhow::Result<()> {
     writeln!(
         out,
         "\nconfusion matrix, {} (rows: true fault; columns: named at the end; all motors, sizes, loads):",

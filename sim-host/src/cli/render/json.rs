@@ -3,7 +3,7 @@
 use serde::Serialize;
 use sim_host::analysis::compare::CompareReport;
 use sim_host::analysis::explain::ExplainReport;
-use sim_host::bench::{BenchFigures, DetectionLimit};
+use sim_host::bench::{BenchFigures, DetectionLimitCase};
 use sim_host::demo::DemoRun;
 use sim_host::fault_signatures::Table1Row;
 use sim_host::replay::{FaultCandidate, TimelinePoint};
@@ -126,5 +126,5 @@ pub struct BenchReport<'a> {
     pub figures: &'a BenchFigures,
     /// With `--detection`.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub detection_limits: Option<&'a [DetectionLimit]>,
+    pub detection_limits: Option<&'a [DetectionLimitCase]>,
 }

@@ -279,7 +279,9 @@ fn png_staging_file(dir: &Path) -> std::io::Result<tempfile::NamedTempFile> {
 ///
 /// # Errors
 /// Drawing errors (not expected), or no matrix.
-pub fn confusion_svg(matrices: &[sim_host::bench::isolation::Confusion]) -> Result<String, String> {
+pub fn confusion_svg(
+    matrices: &[sim_host::bench::isolation::IsolationConfusion],
+) -> Result<String, String> {
     use plotters::coord::ranged1d::SegmentValue;
     if matrices.is_empty() {
         return Err("no confusion matrix to draw".into());
