@@ -498,6 +498,9 @@ pub enum KeyScope {
     Live,
     /// A log replay.
     Replay,
+    /// The live simulation and a log replay, not the firmware's status lines (which run at
+    /// the board's pace).
+    Simulated,
 }
 
 /// One key binding: the key as printed, the sources it acts in, and what it does.
@@ -560,7 +563,7 @@ pub const KEYS: &[KeyBinding] = &[
     },
     KeyBinding {
         keys: "space",
-        scope: KeyScope::All,
+        scope: KeyScope::Simulated,
         what: "pause / resume (live simulation and replay)",
         footer: "␣ pause",
     },
@@ -601,7 +604,8 @@ pub fn key_help() -> String {
     let mut s = String::from("Keys:\n");
     for k in KEYS {
         let scope = match k.scope {
-            KeyScope::All => "",
+            // (Simulated: the key's words say where it acts.)
+            KeyScope::All | KeyScope::Simulated => "",
             KeyScope::Live => " (live)",
             KeyScope::Replay => " (replay)",
         };

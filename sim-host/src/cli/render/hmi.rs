@@ -459,10 +459,14 @@ fn keys_line(c: &Controls) -> Line<'static> {
         Controls::Replay(_) => KeyScope::Replay,
         Controls::Stdin(_) => KeyScope::All,
     };
+    let simulated = !matches!(c, Controls::Stdin(_));
     let items: Vec<&str> = KEYS
         .iter()
-        .filter(|k| k.scope == scope || k.scope == KeyScope::All)
-        .filter(|k| !(matches!(c, Controls::Stdin(_)) && k.footer.contains("pause")))
+        .filter(|k| {
+            k.scope == scope
+                || k.scope == KeyScope::All
+                || (k.scope == KeyScope::Simulated && simulated)
+        })
         .map(|k| k.footer)
         .collect();
     Line::styled(
