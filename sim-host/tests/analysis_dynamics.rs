@@ -684,7 +684,8 @@ fn a_step_inside_the_start_settling_tail_is_named_as_the_step() {
             error_kind: String::new(),
             transient: None,
         };
-        let kind = |t0: f64| classify(&a.data, &n, &window(t0), Some(te), look).map(|t| t.kind);
+        let kind =
+            |t0: f64| classify(&a.data, &n, &window(t0), Some(te), look).map(|t| t.kind.name());
         for (t0, want) in [
             (te - 0.1, Some("start")),
             (te + 0.05, Some("start")),

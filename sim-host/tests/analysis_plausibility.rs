@@ -20,7 +20,11 @@ fn a_start_is_named_with_the_dynamics_effects_and_a_from() {
     let c = a.compare(&opts(&[])).unwrap().report;
     eprintln!("{:#?}", c.advice);
     let w = &c.worst_windows[0];
-    assert_eq!(w.transient.as_ref().map(|t| t.kind), Some("start"), "{w:?}");
+    assert_eq!(
+        w.transient.as_ref().map(|t| t.kind.name()),
+        Some("start"),
+        "{w:?}"
+    );
     assert!(c.advice[0].contains("flux_dynamics") && c.advice[0].contains("current_dynamics"));
     let from: f64 = c
         .advice

@@ -16,12 +16,41 @@ pub const STEP_MIN: f64 = 0.03;
 /// it a speed transient.
 pub const SPEED_CHANGE_MIN: f64 = 0.03;
 
+/// What kind of transient a window lies in (JSON `start`, `supply_step`, `speed_change`).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum TransientKind {
+    /// A direct-on-line start from standstill.
+    Start,
+    /// A voltage or frequency step of the supply.
+    SupplyStep,
+    /// The speed moves (after a load step, for example).
+    SpeedChange,
+}
+
+impl TransientKind {
+    /// The kind's name (as in the JSON).
+    pub fn name(self) -> &'static str {
+        match self {
+            TransientKind::Start => "start",
+            TransientKind::SupplyStep => "supply_step",
+            TransientKind::SpeedChange => "speed_change",
+        }
+    }
+}
+
+impl std::fmt::Display for TransientKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// The transient a window lies in.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct Transient {
     /// `start` (direct-on-line start from standstill), `supply_step` (voltage or frequency
     /// step) or `speed_change` (the speed moves, e.g. after a load step).
-    pub kind: &'static str,
+    pub kind: TransientKind,
     /// What was seen, in words.
     pub description: String,
 }
@@ -101,7 +130,7 @@ pub fn classify(
                 return classify_events(d, n, &idx);
             }
             Some(Transient {
-                kind: "start",
+                kind: TransientKind::Start,
                 description: format!(
                     "the direct-on-line start (the motor reaches 90 % of its running speed at {te:.2} s)"
                 ),
@@ -140,7 +169,7 @@ fn classify_events(d: &Prepared, n: &MachineConstants, idx: &[usize]) -> Option<
     }
     if !steps.is_empty() {
         return Some(Transient {
-            kind: "supply_step",
+            kind: TransientKind::SupplyStep,
             description: steps.join(" and "),
         });
     }
@@ -149,7 +178,7 @@ fn classify_events(d: &Prepared, n: &MachineConstants, idx: &[usize]) -> Option<
         let ws = super::effects::sync_speed_mech(d, n) * n.np;
         if (hi - lo) / ws > SPEED_CHANGE_MIN {
             return Some(Transient {
-                kind: "speed_change",
+                kind: TransientKind::SpeedChange,
                 description: format!(
                     "the speed changes by {:.0} % of synchronous speed",
                     100.0 * (hi - lo) / ws
@@ -186,7 +215,7 @@ pub fn advice(
         .map(|k| k.name())
         .collect();
     let mut out = Vec::new();
-    let mut kinds: Vec<&str> = tags.iter().flatten().map(|t| t.kind).collect();
+    let mut kinds: Vec<TransientKind> = tags.iter().flatten().map(|t| t.kind).collect();
     kinds.dedup();
     if kinds.is_empty() {
         return (tags, out);
