@@ -241,7 +241,28 @@ pub struct DataInfo {
     /// Duration [s].
     pub duration_s: f64,
     /// Reference frame.
-    pub frame: String,
+    pub frame: AnalysisFrame,
+}
+
+/// The frame the analysis projects the log into (JSON: a phrase, as before).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq, Eq)]
+pub enum AnalysisFrame {
+    /// The rotor-flux frame of a voltage-model flux estimate (a log with voltages).
+    #[serde(rename = "rotor-flux frame (voltage-model flux estimate)")]
+    RotorFlux,
+    /// The supply's frame at the parameter file's frequency (a current-only log).
+    #[serde(rename = "supply frame from the parameter file (current-only log)")]
+    Supply,
+}
+
+impl AnalysisFrame {
+    /// The frame in words (as in the JSON).
+    pub fn describe(self) -> &'static str {
+        match self {
+            AnalysisFrame::RotorFlux => "rotor-flux frame (voltage-model flux estimate)",
+            AnalysisFrame::Supply => "supply frame from the parameter file (current-only log)",
+        }
+    }
 }
 
 /// The effect models of `kinds`, each once, in the order given.
@@ -370,12 +391,11 @@ impl Analysis {
             working_rate_hz: 1.0 / d.dt_s,
             duration_s: d.t_s.last().copied().unwrap_or(0.0)
                 - d.t_s.first().copied().unwrap_or(0.0),
+            // (The voltage-model estimator, not the monitor's current model.)
             frame: if d.channels.voltages {
-                // (The JSON's wording: the voltage-model estimator, not the monitor's
-                // current model.)
-                "rotor-flux frame (voltage-model flux estimate)".into()
+                AnalysisFrame::RotorFlux
             } else {
-                "supply frame from the parameter file (current-only log)".into()
+                AnalysisFrame::Supply
             },
         }
     }

@@ -115,7 +115,7 @@ fn compare_html(log: &str, out: &CompareOutput, charts: &[(String, String)]) -> 
     let r = &out.report;
     let mut h = String::new();
     let _ = write!(h, "<!doctype html><html><head><meta charset=utf-8><title>compare: {}</title><style>{STYLE}</style></head><body>", esc(log));
-    let _ = write!(h, "<h1>Model vs measurement</h1><p>Log <code>{}</code>: {} rows at {:.0} Hz ({:.2} s), analysed at {:.0} Hz in the {}.</p>", esc(log), r.data.rows, r.data.log_rate_hz, r.data.duration_s, r.data.working_rate_hz, esc(&r.data.frame));
+    let _ = write!(h, "<h1>Model vs measurement</h1><p>Log <code>{}</code>: {} rows at {:.0} Hz ({:.2} s), analysed at {:.0} Hz in the {}.</p>", esc(log), r.data.rows, r.data.log_rate_hz, r.data.duration_s, r.data.working_rate_hz, esc(r.data.frame.describe()));
     data_quality(&mut h, &r.data_quality);
     let eff = if r.effects.is_empty() {
         "none (the paper's model, eqs. 28-29)".to_string()
