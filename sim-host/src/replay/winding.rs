@@ -203,20 +203,54 @@ fn features(w: &SequenceWindow) -> [C; 4] {
     [cdiv(w.i.negative(), p), cdiv(w.i.zero(), p), v[0], v[1]]
 }
 
-/// Whether window `w` lies outside the segment `cur` (its features or its `|I1|`).
-fn departs(cur: &[&SequenceWindow], w: &SequenceWindow) -> bool {
-    let f = features(w);
-    let moved = (0..4).any(|k| {
-        let m = mean(cur.iter().map(|w| features(w)[k]));
-        let floor = if k < 2 {
-            SEGMENT_STEP_MIN
-        } else {
-            SEGMENT_VOLTAGE_STEP_MIN
-        };
-        abs(sub(f[k], m)) > floor.max(SEGMENT_STEP_REL * abs(m))
-    });
-    let i1_mean = cur.iter().map(|w| abs(w.i.positive())).sum::<f32>() / cur.len().max(1) as f32;
-    moved || (abs(w.i.positive()) - i1_mean).abs() > SEGMENT_I1_STEP * i1_mean
+/// Running sums of a segment's [`features`] and `|I1|`, so that each new window is judged
+/// against the segment's means in constant time (a steady hour at 60 Hz is 21 600 windows:
+/// recomputing the means for each window was quadratic). The sums are taken in the windows'
+/// order, in the precision [`mean`] uses, so the means are the same to the last bit.
+#[derive(Default)]
+struct SegmentSums {
+    features: [(f64, f64); 4],
+    i1: f32,
+    n: u32,
+}
+
+impl SegmentSums {
+    fn add(&mut self, w: &SequenceWindow) {
+        for (s, f) in self.features.iter_mut().zip(features(w)) {
+            s.0 += f64::from(f.0);
+            s.1 += f64::from(f.1);
+        }
+        self.i1 += abs(w.i.positive());
+        self.n += 1;
+    }
+
+    fn of(w: &SequenceWindow) -> Self {
+        let mut s = SegmentSums::default();
+        s.add(w);
+        s
+    }
+
+    /// Whether window `w` lies outside the segment (its features or its `|I1|`).
+    fn departs(&self, w: &SequenceWindow) -> bool {
+        let n = f64::from(self.n.max(1));
+        let f = features(w);
+        let moved = (0..4).any(|k| {
+            let s = self.features[k];
+            let m = if self.n == 0 {
+                (0.0, 0.0)
+            } else {
+                ((s.0 / n) as f32, (s.1 / n) as f32)
+            };
+            let floor = if k < 2 {
+                SEGMENT_STEP_MIN
+            } else {
+                SEGMENT_VOLTAGE_STEP_MIN
+            };
+            abs(sub(f[k], m)) > floor.max(SEGMENT_STEP_REL * abs(m))
+        });
+        let i1_mean = self.i1 / self.n.max(1) as f32;
+        moved || (abs(w.i.positive()) - i1_mean).abs() > SEGMENT_I1_STEP * i1_mean
+    }
 }
 
 /// The steady segments of `windows` (module docs, step 1). A step must hold for two
@@ -225,13 +259,16 @@ fn departs(cur: &[&SequenceWindow], w: &SequenceWindow) -> bool {
 pub fn segments(windows: &[SequenceWindow]) -> Vec<SequenceSegment> {
     let mut out = Vec::new();
     let mut cur: Vec<&SequenceWindow> = Vec::new();
+    let mut sums = SegmentSums::default();
     let mut pending: Option<&SequenceWindow> = None;
-    let close = |cur: &mut Vec<&SequenceWindow>, out: &mut Vec<SequenceSegment>| {
-        if cur.len() >= MIN_SEGMENT_WINDOWS {
-            out.push(segment_of(cur));
-        }
-        cur.clear();
-    };
+    let close =
+        |cur: &mut Vec<&SequenceWindow>, sums: &mut SegmentSums, out: &mut Vec<SequenceSegment>| {
+            if cur.len() >= MIN_SEGMENT_WINDOWS {
+                out.push(segment_of(cur));
+            }
+            cur.clear();
+            *sums = SegmentSums::default();
+        };
     let mut unsteady = 0usize;
     for w in windows {
         if !w.steady {
@@ -239,31 +276,34 @@ pub fn segments(windows: &[SequenceWindow]) -> Vec<SequenceSegment> {
             // left out of the segment; more end it (a run-up, a ramp).
             unsteady += 1;
             if unsteady > MAX_UNSTEADY_INSIDE {
-                close(&mut cur, &mut out);
+                close(&mut cur, &mut sums, &mut out);
                 pending = None;
             }
             continue;
         }
         unsteady = 0;
-        if cur.is_empty() || !departs(&cur, w) {
+        if cur.is_empty() || !sums.departs(w) {
             pending = None;
             cur.push(w);
+            sums.add(w);
             continue;
         }
         match pending.take() {
             None => pending = Some(w),
             Some(p) => {
-                close(&mut cur, &mut out);
+                close(&mut cur, &mut sums, &mut out);
                 // The first window after a step may straddle it: it starts the new segment
                 // only when the second agrees with it.
-                if !departs(&[p], w) {
+                if !SegmentSums::of(p).departs(w) {
                     cur.push(p);
+                    sums.add(p);
                 }
                 cur.push(w);
+                sums.add(w);
             }
         }
     }
-    close(&mut cur, &mut out);
+    close(&mut cur, &mut sums, &mut out);
     out
 }
 
