@@ -475,8 +475,47 @@ impl Replay {
                     "the lamps lit (first at {t:.2} s) only while the load or the voltage was outside the range commissioned: to the paper's model a load change is a Bl change and the learned means hold only where they were learned, so a fault cannot be told from the new operating point; commission over the whole load and voltage range"
                 ));
         }
+        // Against the nominal machine, lamps that nothing else withholds are judged by the
+        // size of what the isolation names.
+        if withheld.is_empty() {
+            withheld.extend(nominal_cannot_judge(
+                detected,
+                self.last.sensor_fault.any(),
+                isolation,
+            ));
+        }
         withheld
     }
+}
+
+/// Why lamps lit against the parameter file's nominal values are no verdict (`None`: they
+/// are, or nothing was detected). Without a baseline learned on the healthy machine the
+/// residuals measure the machine against the file, and a file from a nameplate is 10-30 %
+/// off ([`isolation::NOMINAL_UNCERTAINTY`]); a winding 60 K warmer than the file's
+/// temperature moves Rs and Rr by 24 %. So a FAULT against the nominal machine needs a
+/// name whose size stands clear of that uncertainty; a change that fits no single fault,
+/// or one within it, is withheld. A sensor-fault lamp (bad samples) is no residual
+/// judgement and stays a fault.
+fn nominal_cannot_judge(
+    detected: bool,
+    sensor_fault: bool,
+    isolation: &IsolationReport,
+) -> Option<String> {
+    if !detected || sensor_fault || isolation.baseline != isolation::IsolationBaseline::Nominal {
+        return None;
+    }
+    let what = match isolation.named.zip(isolation.named_change) {
+        Some((_, c)) if c.abs() > isolation::NOMINAL_UNCERTAINTY => return None,
+        Some((f, c)) => format!(
+            "the nearest single fault, {f} {:+.0} %, is within the parameter file's own uncertainty (+/-{:.0} %)",
+            100.0 * c,
+            100.0 * isolation::NOMINAL_UNCERTAINTY
+        ),
+        None => "the change fits no single fault".to_string(),
+    };
+    Some(format!(
+        "not commissioned: the lamps lit against the parameter file's nominal values and {what}; a file 10-30 % off the machine, or windings warmer than the file assumes (60 K is +24 % on Rs and Rr), move the residuals this much. Commission (--commission START:END) on the healthy machine to judge a change from it"
+    ))
 }
 
 /// The timeline point of an output at `t` of `replay`, with what the panel shows
