@@ -238,9 +238,12 @@ pub fn candidate_text(name: &str, probability: f32, change: Option<f32>) -> Stri
 }
 
 /// A fault's size signed with the parameter's name, `rs +50 %` (`change` relative, 0.5 =
-/// +50 %); the one form every output uses for a size.
+/// +50 %; under 10 % to a tenth of a per cent, `b/bl +0.5 %`); the form the HMI, the demo
+/// and `diagnose`'s timeline use for a size.
 pub fn size_text(name: &str, change: f32) -> String {
-    format!("{name} {:+.0} %", 100.0 * change)
+    // Under 10 % to a tenth of a per cent: "+0 %" would say nothing.
+    let digits = usize::from(change.abs() < 0.095);
+    format!("{name} {:+.digits$} %", 100.0 * change)
 }
 
 /// Fault candidates in words ([`candidate_text`]), with B and Bl as one friction class

@@ -429,8 +429,9 @@ pub fn header_of(
     }
 }
 
-/// The lamp's word (`FAULT`, the amber `MOVED`, or empty with the FAULT lamp off) and the
-/// header ([`header_of`]) without the word repeated: the plain status line, the demo's and
+/// The lamp's word (`FAULT`, the amber `MOVED`, `WATCHING` for lamps whose named fault is
+/// too small for a FAULT (`replay::MIN_FAULT_CHANGE`), or empty with the FAULT lamp off) and
+/// the header ([`header_of`]) without the word repeated: the plain status line, the demo's and
 /// `diagnose`'s state column.
 pub fn lamp_and_header(
     state: &MonitorState,
@@ -442,6 +443,11 @@ pub fn lamp_and_header(
     let lamp = match (state, fault_lamp) {
         (MonitorState::Moved(_), _) => "MOVED",
         (_, true) => "FAULT",
+        // Lamps lit with the FAULT lamp off and a fault named: a name too small for a
+        // FAULT (the one rule), watched.
+        (MonitorState::Fault(_), false) if isolation.is_some_and(|i| i.named.is_some()) => {
+            "WATCHING"
+        }
         (_, false) => "",
     };
     // The lamp's word once: a state that begins with it loses it.

@@ -68,10 +68,14 @@ impl IsolationEvent {
                 name,
                 change,
                 probability,
-            } => format!(
-                "{t_s:9.2} s  named {name} {:+.0} % (p {probability:.2})",
-                100.0 * change
-            ),
+            } => {
+                // A size under 10 % to a tenth of a per cent: "+0 %" says nothing.
+                let digits = usize::from(change.abs() < 0.095);
+                format!(
+                    "{t_s:9.2} s  named {name} {:+.digits$} % (p {probability:.2})",
+                    100.0 * change
+                )
+            }
             IsolationEvent::LoadMoved { t_s, from_a, to_a } => format!(
                 "{t_s:9.2} s  load moved: active current {from_a:.2} -> {to_a:.2} A ({:+.0} %), an operating-point change",
                 100.0 * (to_a / from_a - 1.0)

@@ -123,10 +123,18 @@ impl Replay {
                     .map_or_else(|| self.isolation_now().0.named, |(r, _)| r.named),
                 Some(isolation::IsolationName::Fault(_))
             );
+        // A name too small for a FAULT (the one rule, [`super::MIN_FAULT_CHANGE`]) is
+        // watched: the FAULT lamp stays off and the state says what was seen.
+        let watched = !out.sensor_fault.any()
+            && isolation.as_ref().is_some_and(|(r, _)| {
+                r.named_change
+                    .is_some_and(|c| c.abs() < super::MIN_FAULT_CHANGE)
+            });
         Panel {
             fault_lamp: out.fault_detected
                 && !matches!(state, MonitorState::Moved(_))
-                && !held_for_load,
+                && !held_for_load
+                && !watched,
             isolation,
             state,
         }
