@@ -174,6 +174,16 @@ fn load_reading(load: super::LoadModel, n: &Named) -> bool {
     load == super::LoadModel::Unknown && matches!(n, Named::Friction { .. })
 }
 
+/// What the report concludes from ([`IsolationTracker::concluded`]).
+struct Concluded {
+    /// The isolation judged (joint or single, the load's move read as no deviation).
+    iso: Isolation,
+    /// The joint fit and its number of points, where it is the one judged.
+    joint: Option<(Isolation, usize)>,
+    /// The friction class was read as the load's move.
+    load_moved: bool,
+}
+
 /// How far a parameter file's values may be off the machine's (nameplate estimates are
 /// 10-30 % off): against the nominal parameters (no commissioning), a change this small or
 /// smaller, with every lamp dark, is the file's own error as much as a fault, and is not
@@ -336,9 +346,32 @@ impl IsolationTracker {
     /// tracked (warmer) temperature, which has risen by at least [`REPORTED_RISE_K`] (a
     /// name given while the tracking lagged a fast warming was withdrawn since).
     pub(super) fn heating_explains_lamps(&self) -> bool {
-        let last = self.follower.as_ref().and_then(|f| f.last().copied());
         self.winding_rise_k().is_some_and(|r| r > 0.0)
-            && last.is_some_and(|i| i.state == IsolationState::NoDeviation)
+            && self
+                .concluded()
+                .is_some_and(|c| c.iso.state == IsolationState::NoDeviation)
+    }
+
+    /// The isolation the report concludes from: the joint fit over the operating points
+    /// kept where it names a fault the last point alone does not, else the last point;
+    /// with the load an unknown input, a reading of the friction class is the load's move
+    /// (state [`IsolationState::NoDeviation`]). `None` before any point was isolated.
+    fn concluded(&self) -> Option<Concluded> {
+        let single = self.follower.as_ref().and_then(|f| f.last().copied())?;
+        let joint = self.evidence.joint_beside(&single).map(|(j, n)| (*j, n));
+        let mut iso = joint.map_or(single, |(j, _)| j);
+        let load_moved = iso.named().is_some_and(|n| load_reading(self.load, &n));
+        if load_moved {
+            iso.state = IsolationState::NoDeviation;
+        }
+        if self.load == super::LoadModel::Unknown {
+            without_friction(&mut iso);
+        }
+        Some(Concluded {
+            iso,
+            joint,
+            load_moved,
+        })
     }
 
     /// The verdict sentence `s` with the evidence it was drawn from, where the joint fit over
@@ -402,7 +435,12 @@ impl IsolationTracker {
     /// [`LIST_FROM`] on) when `detected` (a lamp lit or a sensor fault was seen).
     pub(super) fn report(&self, detected: bool) -> (IsolationReport, Vec<FaultCandidate>) {
         let learned = self.follower.as_ref().is_some_and(Follower::learned);
-        let Some(single) = self.follower.as_ref().and_then(|f| f.last().copied()) else {
+        let Some(Concluded {
+            iso,
+            joint,
+            load_moved,
+        }) = self.concluded()
+        else {
             let why = if self.follower.is_none() {
                 "the parameter file's machine cannot be used by the isolation"
             } else {
@@ -410,19 +448,6 @@ impl IsolationTracker {
             };
             return (IsolationReport::not_judged(why, learned), Vec::new());
         };
-        // The joint isolation over the operating points kept, where it names a fault that
-        // the last point alone does not.
-        let joint = self.evidence.joint_beside(&single).map(|(j, n)| (*j, n));
-        let mut iso = joint.map_or(single, |(j, _)| j);
-        // With the load an unknown input, the friction class is the load's move: nothing
-        // deviates from the machine (the load move is an event).
-        let load_moved = iso.named().is_some_and(|n| load_reading(self.load, &n));
-        if load_moved {
-            iso.state = IsolationState::NoDeviation;
-        }
-        if self.load == super::LoadModel::Unknown {
-            without_friction(&mut iso);
-        }
         let candidates = listed_candidates(&iso, detected);
         let moved = self.moved_from_learned();
         let in_file_error = iso
