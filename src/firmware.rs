@@ -197,6 +197,75 @@ struct SampleHw {
     syst: cortex_m::peripheral::SYST,
 }
 
+/// The encoder: TIM4 in quadrature mode on PB6/PB7 with the motor record's pull-ups,
+/// input filter and direction (`motor_source::encoder_setup`).
+fn start_encoder(
+    tim4: Peri<'static, peripherals::TIM4>,
+    a: Peri<'static, peripherals::PB6>,
+    b: Peri<'static, peripherals::PB7>,
+    setup: &EncoderSetup,
+) -> Qei<'static, peripherals::TIM4> {
+    let pull = if setup.pull_up { Pull::Up } else { Pull::None };
+    let qei_config = QeiConfig {
+        ch1_pull: pull,
+        ch2_pull: pull,
+        ..QeiConfig::default()
+    };
+    let qei = Qei::new(tim4, a, b, qei_config);
+    // The input filter on both inputs and the direction (input A's polarity), from the
+    // motor record (`motor_source::encoder_setup`).
+    let regs = pac::TIM4;
+    let filter = pac::timer::vals::FilterValue::from_bits(setup.input_filter);
+    regs.ccmr_input(0).modify(|w| {
+        w.set_icf(0, filter);
+        w.set_icf(1, filter);
+    });
+    regs.ccer().modify(|w| w.set_ccp(0, setup.invert_a));
+    qei
+}
+
+/// 247.5 ADC cycles sampling time (5.8 us at the 42.5 MHz ADC clock): the documented
+/// front end (docs/firmware.md, "Voltage and current sensing") drives each pin through a
+/// 1 kohm / 10 nF anti-alias filter; the datasheet's bound on the source resistance,
+/// R_AIN < t_S / (f_ADC C_ADC ln(2^(N+2))) - R_ADC, with C_ADC 5 pF and R_ADC 1 kohm,
+/// is about 11 kohm at 24.5 cycles and 120 kohm at 247.5; three conversions of
+/// 247.5 + 12.5 cycles take 18.4 us of the 100 us period.
+const SAMPLE_TIME: SampleTime = SampleTime::CYCLES247_5;
+
+/// ADC1's regular sequence va, vb, vc on TIM1's TRGO into its DMA ring.
+fn ring_voltages(
+    adc: Adc<'static, peripherals::ADC1>,
+    dma: Peri<'static, peripherals::DMA1_CH1>,
+    v: board::pins::VoltagePins,
+    ring: &'static mut [u16; RING_LEN],
+) -> RingBufferedAdc<'static, peripherals::ADC1> {
+    let st = SAMPLE_TIME;
+    let sequence = [
+        (v.a.degrade_adc(), st),
+        (v.b.degrade_adc(), st),
+        (v.c.degrade_adc(), st),
+    ];
+    let (trigger, edge) = (triggers::TIM1_TRGO, Exten::RISING_EDGE);
+    adc.into_ring_buffered(dma, ring, Irqs, sequence.into_iter(), trigger, edge)
+}
+
+/// ADC2's regular sequence ia, ib, ic on TIM1's TRGO into its DMA ring.
+fn ring_currents(
+    adc: Adc<'static, peripherals::ADC2>,
+    dma: Peri<'static, peripherals::DMA1_CH2>,
+    i: board::pins::CurrentPins,
+    ring: &'static mut [u16; RING_LEN],
+) -> RingBufferedAdc<'static, peripherals::ADC2> {
+    let st = SAMPLE_TIME;
+    let sequence = [
+        (i.a.degrade_adc(), st),
+        (i.b.degrade_adc(), st),
+        (i.c.degrade_adc(), st),
+    ];
+    let (trigger, edge) = (triggers::TIM1_TRGO, Exten::RISING_EDGE);
+    adc.into_ring_buffered(dma, ring, Irqs, sequence.into_iter(), trigger, edge)
+}
+
 /// Starts the acquisition: the encoder (TIM4 in quadrature mode), the trigger (TIM1 update
 /// -> TRGO at the sample rate) and the two ring-buffered ADCs (ADC1 the voltages, ADC2 the
 /// currents), then the trigger, the timestamps continuing from now.
@@ -209,57 +278,19 @@ fn start_acquisition(
     let ring1 = RING1.init([0; RING_LEN]);
     let ring2 = RING2.init([0; RING_LEN]);
 
-    let pull = if hw.encoder.pull_up {
-        Pull::Up
-    } else {
-        Pull::None
-    };
-    let qei_config = QeiConfig {
-        ch1_pull: pull,
-        ch2_pull: pull,
-        ..QeiConfig::default()
-    };
-    let qei = Qei::new(hw.tim4, hw.enc_a, hw.enc_b, qei_config);
-    // The input filter on both inputs and the direction (input A's polarity), from the
-    // motor record (`motor_source::encoder_setup`).
-    let tim4 = pac::TIM4;
-    let filter = pac::timer::vals::FilterValue::from_bits(hw.encoder.input_filter);
-    tim4.ccmr_input(0).modify(|w| {
-        w.set_icf(0, filter);
-        w.set_icf(1, filter);
-    });
-    tim4.ccer().modify(|w| w.set_ccp(0, hw.encoder.invert_a));
+    let qei = start_encoder(hw.tim4, hw.enc_a, hw.enc_b, &hw.encoder);
 
     // Sample trigger: TIM1 update event -> TRGO -> both ADCs (rising edge).
     let trigger = HwTimer::new(hw.tim1);
     trigger.set_frequency(Hertz(SETTINGS.sample_rate_hz), RoundTo::Slower);
     trigger.set_master_mode(MasterMode::UPDATE);
 
-    // 247.5 ADC cycles sampling time (5.8 us at the 42.5 MHz ADC clock): the documented
-    // front end (docs/firmware.md, "Voltage and current sensing") drives each pin through a
-    // 1 kohm / 10 nF anti-alias filter; the datasheet's bound on the source resistance,
-    // R_AIN < t_S / (f_ADC C_ADC ln(2^(N+2))) - R_ADC, with C_ADC 5 pF and R_ADC 1 kohm,
-    // is about 11 kohm at 24.5 cycles and 120 kohm at 247.5; three conversions of
-    // 247.5 + 12.5 cycles take 18.4 us of the 100 us period.
-    let st = SampleTime::CYCLES247_5;
     // Every step under the set-up deadline (`drive_monitor::setup_guard`): the HAL's waits
     // on ADCAL, ADRDY and ADSTART have no bound of their own.
     let guard = supply::SetupGuard::arm(hw.syst, SetupStep::Adc1);
     let adc1 = Adc::new(hw.adc1, AdcConfig::default());
     guard.step(SetupStep::Ring1);
-    let adc1: RingBufferedAdc<'static, peripherals::ADC1> = adc1.into_ring_buffered(
-        hw.dma1,
-        ring1,
-        Irqs,
-        [
-            (hw.v.a.degrade_adc(), st),
-            (hw.v.b.degrade_adc(), st),
-            (hw.v.c.degrade_adc(), st),
-        ]
-        .into_iter(),
-        triggers::TIM1_TRGO,
-        Exten::RISING_EDGE,
-    );
+    let adc1 = ring_voltages(adc1, hw.dma1, hw.v, ring1);
     // The ADC's reference: VDDA from VREFINT on ADC1's injected channel against the
     // factory's calibration word, once before the rings start (bounded); thread mode then
     // measures it every second.
@@ -269,19 +300,7 @@ fn start_acquisition(
     guard.step(SetupStep::Adc2);
     let adc2 = Adc::new(hw.adc2, AdcConfig::default());
     guard.step(SetupStep::Ring2);
-    let adc2: RingBufferedAdc<'static, peripherals::ADC2> = adc2.into_ring_buffered(
-        hw.dma2,
-        ring2,
-        Irqs,
-        [
-            (hw.i.a.degrade_adc(), st),
-            (hw.i.b.degrade_adc(), st),
-            (hw.i.c.degrade_adc(), st),
-        ]
-        .into_iter(),
-        triggers::TIM1_TRGO,
-        Exten::RISING_EDGE,
-    );
+    let adc2 = ring_currents(adc2, hw.dma2, hw.i, ring2);
     guard.step(SetupStep::Start);
     let mut acq = acquisition::new_acquisition(trigger, adc1, adc2, RING_LEN as u16);
     acquisition::start(&mut acq);
