@@ -28,6 +28,7 @@ use crate::panel::{self, blink_code, winding_code, Mode, PanelInput, PanelLamps,
 use crate::range_watch::RangeWatch;
 use crate::reset_record::PreviousRun;
 use crate::sampling::{AdcSampler, RawFrame, SamplingError, TICK_HZ};
+use crate::supply::{ReferenceAdc, ReferenceChange, ReferenceWatch, REFERENCE_PERIOD_MS};
 use monitor_core::isolation::{Baseline, Evidence, Follower, Named, Step};
 use monitor_core::{
     CommissioningError, CommissioningRun, ConfigError, Fault, Install, Isolation, IsolationState,
@@ -530,6 +531,9 @@ pub struct Supervisor {
     default_motor: bool,
     /// Sensors whose start-up offset was out of bound ([`Supervisor::set_offset_fault`]).
     offset_fault: SensorFlags,
+    /// The ADC's reference, measured at start-up and every second
+    /// ([`crate::supply::ReferenceWatch`]); out of band it flags both sensors.
+    reference: ReferenceWatch,
     /// The commissioned operating range (RAM only) and the "moved" judgement.
     range: RangeWatch,
 }
@@ -563,6 +567,7 @@ impl Supervisor {
             running: false,
             default_motor: false,
             offset_fault: SensorFlags::default(),
+            reference: ReferenceWatch::new(REFERENCE_PERIOD_MS),
             range: RangeWatch::new(),
         }
     }
@@ -576,13 +581,33 @@ impl Supervisor {
     }
 
     /// The start-up check of the ADC's reference (VDDA from VREFINT,
-    /// [`crate::board::ReferenceCheck`]): a reference outside its band, or unreadable,
-    /// scales every reading, so from now on both sensors count as faulty, as an offset out
-    /// of bound does (the panel's "input invalid", the status line's `sens=`).
-    pub fn set_reference(&mut self, check: crate::board::ReferenceCheck) {
-        let bad = check.distrusts_readings();
-        self.offset_fault.voltage |= bad;
-        self.offset_fault.current |= bad;
+    /// [`crate::board::ReferenceCheck`]) at `now_ms`; the periodic checks follow from
+    /// [`Supervisor::poll_reference`]. A reference outside its band, or unreadable, scales
+    /// every reading, so while the latest check says so both sensors count as faulty, as
+    /// an offset out of bound does (the panel's "input invalid", the status line's `sens=`);
+    /// a check in band clears that again. Returns a change of the verdict for the log.
+    pub fn observe_reference(
+        &mut self,
+        check: crate::board::ReferenceCheck,
+        now_ms: u32,
+    ) -> Option<ReferenceChange> {
+        self.reference.observe(check, now_ms)
+    }
+
+    /// The periodic reference check at `now_ms` on `adc` (ADC1's injected VREFINT
+    /// conversion on the board): starts a due measurement or takes its result
+    /// ([`ReferenceWatch::poll`]). Returns a change of the verdict for the log.
+    pub fn poll_reference(
+        &mut self,
+        now_ms: u32,
+        adc: &mut impl ReferenceAdc,
+    ) -> Option<ReferenceChange> {
+        self.reference.poll(now_ms, adc)
+    }
+
+    /// The reference watch (the latest VDDA for the status line).
+    pub fn reference(&self) -> &ReferenceWatch {
+        &self.reference
     }
 
     /// Whether the built-in default motor is monitored (no valid motor record at boot): the
@@ -610,8 +635,9 @@ impl Supervisor {
     /// came, `button` whether the button was pressed since the last tick.
     pub fn tick(&mut self, now_ms: u32, status: Option<MonitorStatus>, button: bool) -> Tick {
         if let Some(mut s) = status {
-            s.sensor_fault.voltage |= self.offset_fault.voltage;
-            s.sensor_fault.current |= self.offset_fault.current;
+            let reference = self.reference.flags_sensors();
+            s.sensor_fault.voltage |= self.offset_fault.voltage || reference;
+            s.sensor_fault.current |= self.offset_fault.current || reference;
             let previous = self.latest.samples;
             self.latest = s;
             self.follow(&s, previous);

@@ -26,6 +26,8 @@
 
 mod acquisition;
 mod failure;
+mod logs;
+mod supply;
 
 use core::mem::MaybeUninit;
 use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
@@ -53,17 +55,16 @@ use drive_monitor::app::{
     PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
 };
 use drive_monitor::board::{self, pins::Board, CurrentCode, Lamp, VoltageCode, LAMP_COUNT};
-use drive_monitor::commissioning::RunEnd;
-use drive_monitor::flash_record::{self, LoadError, RecordStore, StoreError, RECORD_LEN};
-use drive_monitor::liveness::{AdcWait, LivenessChange};
+use drive_monitor::flash_record::{self, LoadError, RecordStore, RECORD_LEN};
+use drive_monitor::liveness::AdcWait;
 use drive_monitor::motor_source::{self, EncoderSetup};
-use drive_monitor::offset_trim::{ChannelTrim, TrimResult, MAX_OFFSET_CODES};
+use drive_monitor::offset_trim::TrimResult;
 use drive_monitor::panel::PanelLamps;
 use drive_monitor::recovery::{self, RecoveryCounts, StepTimeout};
-use drive_monitor::reset_record::{
-    BootPhase, PreviousRun, ResetCause, ResetRecord, ResetSource, RESET_RECORD_LEN,
-};
+use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
 use drive_monitor::sampling::RawFrame;
+use drive_monitor::setup_guard::SetupStep;
+use drive_monitor::supply::BorCheck;
 use monitor_core::motor_record::{MotorRecord, STORED_LEN as MOTOR_RECORD_LEN};
 use monitor_core::Isolation;
 
@@ -192,6 +193,77 @@ struct SampleHw {
     enc_b: Peri<'static, peripherals::PB7>,
     /// The encoder's direction, filter and pull-ups from the motor record.
     encoder: EncoderSetup,
+    /// SysTick: the ADC set-up's deadline (`supply::SetupGuard`).
+    syst: cortex_m::peripheral::SYST,
+}
+
+/// The encoder: TIM4 in quadrature mode on PB6/PB7 with the motor record's pull-ups,
+/// input filter and direction (`motor_source::encoder_setup`).
+fn start_encoder(
+    tim4: Peri<'static, peripherals::TIM4>,
+    a: Peri<'static, peripherals::PB6>,
+    b: Peri<'static, peripherals::PB7>,
+    setup: &EncoderSetup,
+) -> Qei<'static, peripherals::TIM4> {
+    let pull = if setup.pull_up { Pull::Up } else { Pull::None };
+    let qei_config = QeiConfig {
+        ch1_pull: pull,
+        ch2_pull: pull,
+        ..QeiConfig::default()
+    };
+    let qei = Qei::new(tim4, a, b, qei_config);
+    // The input filter on both inputs and the direction (input A's polarity), from the
+    // motor record (`motor_source::encoder_setup`).
+    let regs = pac::TIM4;
+    let filter = pac::timer::vals::FilterValue::from_bits(setup.input_filter);
+    regs.ccmr_input(0).modify(|w| {
+        w.set_icf(0, filter);
+        w.set_icf(1, filter);
+    });
+    regs.ccer().modify(|w| w.set_ccp(0, setup.invert_a));
+    qei
+}
+
+/// 247.5 ADC cycles sampling time (5.8 us at the 42.5 MHz ADC clock): the documented
+/// front end (docs/firmware.md, "Voltage and current sensing") drives each pin through a
+/// 1 kohm / 10 nF anti-alias filter; the datasheet's bound on the source resistance,
+/// R_AIN < t_S / (f_ADC C_ADC ln(2^(N+2))) - R_ADC, with C_ADC 5 pF and R_ADC 1 kohm,
+/// is about 11 kohm at 24.5 cycles and 120 kohm at 247.5; three conversions of
+/// 247.5 + 12.5 cycles take 18.4 us of the 100 us period.
+const SAMPLE_TIME: SampleTime = SampleTime::CYCLES247_5;
+
+/// ADC1's regular sequence va, vb, vc on TIM1's TRGO into its DMA ring.
+fn ring_voltages(
+    adc: Adc<'static, peripherals::ADC1>,
+    dma: Peri<'static, peripherals::DMA1_CH1>,
+    v: board::pins::VoltagePins,
+    ring: &'static mut [u16; RING_LEN],
+) -> RingBufferedAdc<'static, peripherals::ADC1> {
+    let st = SAMPLE_TIME;
+    let sequence = [
+        (v.a.degrade_adc(), st),
+        (v.b.degrade_adc(), st),
+        (v.c.degrade_adc(), st),
+    ];
+    let (trigger, edge) = (triggers::TIM1_TRGO, Exten::RISING_EDGE);
+    adc.into_ring_buffered(dma, ring, Irqs, sequence.into_iter(), trigger, edge)
+}
+
+/// ADC2's regular sequence ia, ib, ic on TIM1's TRGO into its DMA ring.
+fn ring_currents(
+    adc: Adc<'static, peripherals::ADC2>,
+    dma: Peri<'static, peripherals::DMA1_CH2>,
+    i: board::pins::CurrentPins,
+    ring: &'static mut [u16; RING_LEN],
+) -> RingBufferedAdc<'static, peripherals::ADC2> {
+    let st = SAMPLE_TIME;
+    let sequence = [
+        (i.a.degrade_adc(), st),
+        (i.b.degrade_adc(), st),
+        (i.c.degrade_adc(), st),
+    ];
+    let (trigger, edge) = (triggers::TIM1_TRGO, Exten::RISING_EDGE);
+    adc.into_ring_buffered(dma, ring, Irqs, sequence.into_iter(), trigger, edge)
 }
 
 /// Starts the acquisition: the encoder (TIM4 in quadrature mode), the trigger (TIM1 update
@@ -206,75 +278,33 @@ fn start_acquisition(
     let ring1 = RING1.init([0; RING_LEN]);
     let ring2 = RING2.init([0; RING_LEN]);
 
-    let pull = if hw.encoder.pull_up {
-        Pull::Up
-    } else {
-        Pull::None
-    };
-    let qei_config = QeiConfig {
-        ch1_pull: pull,
-        ch2_pull: pull,
-        ..QeiConfig::default()
-    };
-    let qei = Qei::new(hw.tim4, hw.enc_a, hw.enc_b, qei_config);
-    // The input filter on both inputs and the direction (input A's polarity), from the
-    // motor record (`motor_source::encoder_setup`).
-    let tim4 = pac::TIM4;
-    let filter = pac::timer::vals::FilterValue::from_bits(hw.encoder.input_filter);
-    tim4.ccmr_input(0).modify(|w| {
-        w.set_icf(0, filter);
-        w.set_icf(1, filter);
-    });
-    tim4.ccer().modify(|w| w.set_ccp(0, hw.encoder.invert_a));
+    let qei = start_encoder(hw.tim4, hw.enc_a, hw.enc_b, &hw.encoder);
 
     // Sample trigger: TIM1 update event -> TRGO -> both ADCs (rising edge).
     let trigger = HwTimer::new(hw.tim1);
     trigger.set_frequency(Hertz(SETTINGS.sample_rate_hz), RoundTo::Slower);
     trigger.set_master_mode(MasterMode::UPDATE);
 
-    // 247.5 ADC cycles sampling time (5.8 us at the 42.5 MHz ADC clock): the documented
-    // front end (docs/firmware.md, "Voltage and current sensing") drives each pin through a
-    // 1 kohm / 10 nF anti-alias filter; the datasheet's bound on the source resistance,
-    // R_AIN < t_S / (f_ADC C_ADC ln(2^(N+2))) - R_ADC, with C_ADC 5 pF and R_ADC 1 kohm,
-    // is about 11 kohm at 24.5 cycles and 120 kohm at 247.5; three conversions of
-    // 247.5 + 12.5 cycles take 18.4 us of the 100 us period.
-    let st = SampleTime::CYCLES247_5;
-    let mut adc1 = Adc::new(hw.adc1, AdcConfig::default());
-    // The ADC's reference: VDDA from VREFINT against the factory's calibration word, once
-    // before the rings start (the supervisor flags the sensors when it is out of band).
-    let mut vrefint = adc1.enable_vrefint();
-    let code = adc1.blocking_read(&mut vrefint, SampleTime::CYCLES247_5);
-    let cal = pac::VREFINTCAL.data().read();
-    REFERENCE.signal(board::ReferenceCheck::of(code, cal));
-    let adc1: RingBufferedAdc<'static, peripherals::ADC1> = adc1.into_ring_buffered(
-        hw.dma1,
-        ring1,
-        Irqs,
-        [
-            (hw.v.a.degrade_adc(), st),
-            (hw.v.b.degrade_adc(), st),
-            (hw.v.c.degrade_adc(), st),
-        ]
-        .into_iter(),
-        triggers::TIM1_TRGO,
-        Exten::RISING_EDGE,
-    );
+    // Every step under the set-up deadline (`drive_monitor::setup_guard`): the HAL's waits
+    // on ADCAL, ADRDY and ADSTART have no bound of their own.
+    let guard = supply::SetupGuard::arm(hw.syst, SetupStep::Adc1);
+    let adc1 = Adc::new(hw.adc1, AdcConfig::default());
+    guard.step(SetupStep::Ring1);
+    let adc1 = ring_voltages(adc1, hw.dma1, hw.v, ring1);
+    // The ADC's reference: VDDA from VREFINT on ADC1's injected channel against the
+    // factory's calibration word, once before the rings start (bounded); thread mode then
+    // measures it every second.
+    guard.step(SetupStep::Reference);
+    supply::configure_reference();
+    REFERENCE.signal(drive_monitor::supply::measure_now(&mut supply::HwReference));
+    guard.step(SetupStep::Adc2);
     let adc2 = Adc::new(hw.adc2, AdcConfig::default());
-    let adc2: RingBufferedAdc<'static, peripherals::ADC2> = adc2.into_ring_buffered(
-        hw.dma2,
-        ring2,
-        Irqs,
-        [
-            (hw.i.a.degrade_adc(), st),
-            (hw.i.b.degrade_adc(), st),
-            (hw.i.c.degrade_adc(), st),
-        ]
-        .into_iter(),
-        triggers::TIM1_TRGO,
-        Exten::RISING_EDGE,
-    );
+    guard.step(SetupStep::Ring2);
+    let adc2 = ring_currents(adc2, hw.dma2, hw.i, ring2);
+    guard.step(SetupStep::Start);
     let mut acq = acquisition::new_acquisition(trigger, adc1, adc2, RING_LEN as u16);
     acquisition::start(&mut acq);
+    guard.disarm();
     path.sampler_mut().resync(acq.regs.started_us);
     (qei, acq)
 }
@@ -319,7 +349,8 @@ async fn sample_task(hw: SampleHw, mut path: SamplePath) {
     // The HAL's ADC set-up waits on registers without a bound (power-up, calibration,
     // ADRDY, ADSTART): the record says so if the watchdog has to end it.
     set_phase(BootPhase::AdcSetup);
-    write_reset_record(&ResetRecord::setup(BootPhase::AdcSetup).encode());
+    let setup = ResetRecord::setup(BootPhase::AdcSetup).with_bor_level(supply::bor_level());
+    write_reset_record(&setup.encode());
     let (qei, mut acq) = start_acquisition(hw, &mut path);
     write_reset_record(&[0; RESET_RECORD_LEN]);
     set_phase(BootPhase::Sampling);
@@ -529,13 +560,21 @@ fn select_machine(flash: &mut BoardFlash) -> (MotorRecord, SamplePath, bool) {
 async fn main(_spawner: Spawner) {
     let p = embassy_stm32::init(clock_config());
     info!("drive-monitor {} starting", env!("CARGO_PKG_VERSION"));
-    let previous = previous_run();
+    let previous = logs::previous_run();
+    // The brown-out level of the option bytes: reported, not written (`drive_monitor::supply`).
+    let bor = supply::bor_check();
+    logs::log_bor(bor);
 
-    // Cycle counter for the per-sample cost shown in the log.
-    if let Some(mut cp) = cortex_m::Peripherals::take() {
-        cp.DCB.enable_trace();
-        cp.DWT.enable_cycle_counter();
-    }
+    // Cycle counter for the per-sample cost shown in the log; SysTick for the set-up's
+    // deadline.
+    let mut cp = match cortex_m::Peripherals::take() {
+        Some(cp) => cp,
+        // Taken once, here (embassy-stm32 takes none of them).
+        #[allow(clippy::panic)]
+        None => panic!("core peripherals taken twice"),
+    };
+    cp.DCB.enable_trace();
+    cp.DWT.enable_cycle_counter();
 
     let b = Board::take(p);
     let wdg = start_watchdog(b.iwdg);
@@ -553,6 +592,7 @@ async fn main(_spawner: Spawner) {
         wdg,
         max_update_cycles: 0,
         log_div: 0,
+        bor,
     };
     let mut button = ExtiInput::new(b.button, b.button_exti, Pull::Down, Irqs);
 
@@ -585,6 +625,7 @@ async fn main(_spawner: Spawner) {
         enc_a: b.encoder_a,
         enc_b: b.encoder_b,
         encoder: motor_source::encoder_setup(&machine),
+        syst: cp.SYST,
     };
     set_phase(BootPhase::Boot);
     match sample_task(hw, path) {
@@ -620,6 +661,8 @@ struct Thread {
     max_update_cycles: u32,
     /// Periods since the last status line (one every second period: 100 ms).
     log_div: u32,
+    /// The brown-out level found at boot (the status line's `bor=`).
+    bor: BorCheck,
 }
 
 impl Thread {
@@ -633,36 +676,32 @@ impl Thread {
         }
         if let Some(trim) = TRIM.try_take() {
             supervisor.set_offset_fault(&trim);
-            log_trim(&trim);
+            logs::log_trim(&trim);
         }
         if let Some(check) = REFERENCE.try_take() {
-            supervisor.set_reference(check);
-            match check {
-                board::ReferenceCheck::InBand(v) => info!("reference: VDDA {=f32} V", v),
-                board::ReferenceCheck::OutOfBand(v) => error!(
-                    "reference: VDDA {=f32} V outside {=f32}..{=f32} V: every reading is off by that ratio; the sensors are flagged",
-                    v,
-                    board::VDDA_BAND_V.0,
-                    board::VDDA_BAND_V.1
-                ),
-                board::ReferenceCheck::Unreadable => {
-                    error!("reference: VREFINT unreadable; the sensors are flagged")
-                }
+            if let board::ReferenceCheck::InBand(v) = check {
+                info!("reference: VDDA {=f32} V", v);
             }
+            if let Some(change) = supervisor.observe_reference(check, now_ms) {
+                logs::log_reference(change);
+            }
+        }
+        if let Some(change) = supervisor.poll_reference(now_ms, &mut supply::HwReference) {
+            logs::log_reference(change);
         }
         let tick = supervisor.tick(now_ms, status.map(|s| s.monitor), pressed);
         if tick.pet_watchdog {
             self.wdg.pet();
         }
         if let Some(change) = tick.liveness {
-            on_liveness(change);
+            logs::on_liveness(change);
         }
         if let Some(end) = tick.run_ended {
-            log_run_end(end);
+            logs::log_run_end(end);
         }
         let (command, stored) = carry_out(tick.action, &mut self.flash);
         if let Some(stored) = stored {
-            log_stored(&stored);
+            logs::log_stored(&stored);
         }
         if let Some(cmd) = command {
             let sent = with_timeout(
@@ -688,62 +727,9 @@ impl Thread {
                     .map_or(0.0, |f| f.isolator().winding_rise_k()),
                 tick.mode.name(),
                 self.max_update_cycles,
+                (supervisor.reference().vdda_v(), self.bor.status_number()),
             );
         }
-    }
-}
-
-/// Why the previous run ended: the reset record (then erased) and the reset flags (then
-/// cleared), logged.
-fn previous_run() -> PreviousRun {
-    let source = ResetSource::from_csr(pac::RCC.csr().read().0);
-    pac::RCC.csr().modify(|w| w.set_rmvf(true));
-    let previous = PreviousRun::at_boot(&read_reset_record(), source);
-    write_reset_record(&[0; RESET_RECORD_LEN]);
-    info!("reset by {=str}", source.name());
-    match previous {
-        PreviousRun::Clean => {}
-        PreviousRun::WatchdogReset => {
-            error!("previous run ended in a watchdog reset with no reason recorded: the firmware hung")
-        }
-        PreviousRun::ResetDuring { record, source } => warn!(
-            "previous run: {=str} recorded ({=u32}), then a {=str} reset came before the watchdog's",
-            record.message(),
-            record.line_or_ms(),
-            source.name()
-        ),
-        PreviousRun::Recorded(rec) => log_record(&rec),
-    }
-    previous
-}
-
-fn log_record(rec: &ResetRecord) {
-    match rec.cause() {
-        ResetCause::Panic => error!(
-            "previous run ended in a panic: {=str} at {=str}:{=u32}",
-            rec.message(),
-            rec.file(),
-            rec.line_or_ms()
-        ),
-        ResetCause::DefmtPanic => error!(
-            "previous run ended in a defmt panic during {=str}, called from {=u32:#010x} (addr2line -e the ELF; the message is in that run's log)",
-            rec.message(),
-            rec.line_or_ms()
-        ),
-        ResetCause::SetupTimeout => error!(
-            "previous run ended in a watchdog reset: the {=str} set-up did not finish",
-            rec.message()
-        ),
-        ResetCause::HardFault => error!(
-            "previous run ended in a {=str} at pc {=u32:#010x}: {=str} (addr2line -e the ELF)",
-            rec.file(),
-            rec.line_or_ms(),
-            rec.message()
-        ),
-        ResetCause::SampleStall => error!(
-            "previous run ended in a watchdog reset: the sample path had stalled (no samples for {=u32} ms when recorded; recoveries did not help)",
-            rec.line_or_ms()
-        ),
     }
 }
 
@@ -769,72 +755,9 @@ fn install_stored_calibration(
             None
         }
         Err(LoadError::Record(e)) => {
-            warn!("no valid commissioning record: {}", e);
+            warn!("no valid commissioning record: {=str}", e.describe());
             None
         }
-    }
-}
-
-fn on_liveness(change: LivenessChange) {
-    match change {
-        LivenessChange::Stalled { for_ms } => error!(
-            "SAMPLE PATH STALLED: no samples for {=u32} ms (restarts so far {=u32}); watchdog not petted",
-            for_ms,
-            RESTARTS.load(Ordering::Relaxed)
-        ),
-        LivenessChange::RecordStall { for_ms } => {
-            write_reset_record(&ResetRecord::sample_stall(for_ms).encode());
-        }
-        LivenessChange::Recovered { after_ms } => {
-            write_reset_record(&[0; RESET_RECORD_LEN]);
-            warn!("sample path recovered after {=u32} ms", after_ms);
-        }
-    }
-}
-
-/// The start-up offset trim, channel by channel (`drive_monitor::offset_trim`).
-fn log_trim(trim: &TrimResult) {
-    let names = ["va", "vb", "vc", "ia", "ib", "ic"];
-    let channels = trim.voltage.iter().chain(trim.current.iter());
-    for (name, channel) in names.into_iter().zip(channels) {
-        match *channel {
-            ChannelTrim::Trimmed(code) => info!("offset trim {=str}: zero at {=f32} codes, in force", name, code),
-            ChannelTrim::OutOfBound(code) => error!(
-                "offset trim {=str}: zero at {=f32} codes, beyond +-{=f32} of the zero in force: sensor flagged, not used",
-                name,
-                code,
-                MAX_OFFSET_CODES
-            ),
-            ChannelTrim::NotQuiet(spread) => info!(
-                "offset trim {=str}: not quiet (spread {=f32} codes; motor running or supply on): not trimmed",
-                name,
-                spread
-            ),
-        }
-    }
-}
-
-fn log_run_end(end: RunEnd) {
-    match end {
-        RunEnd::Commissioned { run } => info!("commissioning run {=u16}: stored and in force", run),
-        RunEnd::CancelledByUser { run } => info!("commissioning run {=u16}: cancelled", run),
-        RunEnd::Failed { run, why } => error!(
-            "commissioning run {}: FAILED ({=str}); the thresholds in force are unchanged or the flash's",
-            run,
-            why.name()
-        ),
-    }
-}
-
-fn log_stored<E: defmt::Format>(stored: &flash_record::Stored<E>) {
-    match &stored.written {
-        Ok(()) => info!(
-            "commissioning record written, read back: {}",
-            stored.read_back.is_some()
-        ),
-        Err(StoreError::Encode(e)) => error!("commissioning record not written: {}", e),
-        Err(StoreError::Erase(e)) => error!("flash erase failed: {}", e),
-        Err(StoreError::Write(e)) => error!("flash write failed: {}", e),
     }
 }
 
@@ -844,14 +767,17 @@ fn log_stored<E: defmt::Format>(stored: &flash_record::Stored<E>) {
 /// temperature rise the isolation tracks since commissioning (`rise_k` [K]). Its format is
 /// documented once, in docs/firmware.md ("The status line"); `sim-host hmi --stdin` parses it
 /// (`sim_host::hmi::status_line`), and `tests/status_line.rs` renders this format string
-/// and parses it back, so the two cannot drift apart.
+/// and parses it back, so the two cannot drift apart. `supply`: the latest VDDA [V] (0
+/// before the first reading or when unreadable) and the brown-out level (255: reserved).
 fn log_status(
     s: &MonitorStatus,
     iso: Option<&Isolation>,
     rise_k: f32,
     mode: &str,
     max_update_cycles: u32,
+    supply: (f32, u8),
 ) {
+    let (vdda_v, bor) = supply;
     let (top_name, top_p) = s.top.map_or(("none", 0.0), |(f, p)| (f.name(), p));
     let (iso_name, iso_change, iso_p) = isolation_summary(iso);
     let (second_name, second_p) = s.second.map_or(("none", 0.0), |(f, p)| (f.name(), p));
@@ -859,7 +785,7 @@ fn log_status(
     let mid = s.bands.map(|b| b.0);
     let half = s.bands.map(|b| b.1);
     info!(
-        "r={} lamps={} fault={=bool} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32} iqs={=f32}A ids={=f32}A vqs={=f32}V f={=f32}Hz steady={=bool} eval={=bool} sens={=bool},{=bool},{=bool} mid={} half={} iso={=str} iso_change={=f32} iso_p={=f32} wind={=str} wind_i2={=f32} moved={=bool} rise={=f32}K",
+        "r={} lamps={} fault={=bool} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32} iqs={=f32}A ids={=f32}A vqs={=f32}V f={=f32}Hz steady={=bool} eval={=bool} sens={=bool},{=bool},{=bool} mid={} half={} iso={=str} iso_change={=f32} iso_p={=f32} wind={=str} wind_i2={=f32} moved={=bool} rise={=f32}K vdda={=f32}V bor={=u8}",
         s.residuals,
         s.residual_lamps,
         s.fault_detected,
@@ -895,5 +821,7 @@ fn log_status(
         wind_i2,
         s.moved,
         rise_k,
+        vdda_v,
+        bor,
     );
 }

@@ -4,7 +4,7 @@
 //! (per residual r1..r4: mean and spread, in the core's normalized units). It is written
 //! to the page at [`crate::board::RECORD_FLASH_OFFSET`] and read back at boot. Anything
 //! that is not a complete, current-version record with a matching CRC and sane values
-//! is rejected with a [`FlashRecordError`], and the firmware then runs "not commissioned".
+//! is rejected with a [`RecordError`], and the firmware then runs "not commissioned".
 //!
 //! Since version 2 it also stores the fault isolation's healthy baseline
 //! ([`monitor_core::isolation::Baseline`]: the mean and spread of its three parity
@@ -14,7 +14,7 @@
 //! Since version 3 it also stores the operating point that baseline was learned at
 //! ([`Baseline::at`]), so that away from it the isolation allows for the nameplate's error.
 //!
-//! # Layout (little endian, [`RECORD_LEN`] = 96 bytes, a multiple of the G4's 8-byte
+//! # RecordLayout (little endian, [`RECORD_LEN`] = 96 bytes, a multiple of the G4's 8-byte
 //! flash write unit)
 //!
 //! | bytes | field |
@@ -28,37 +28,54 @@
 //! | 52..64 | isolation baseline `spread[0..3]`, `f32` each (zero when absent) |
 //! | 64..88 | the learned point: `i_d, i_q` [A], `v_d, v_q` [V], `we, wr` [rad/s], `f32` each (zero when absent) |
 //! | 88..92 | flags, `u32`: bit 0 set when the isolation baseline is present |
-//! | 92..96 | CRC-32 (IEEE 802.3, reflected, as zlib) of bytes 0..92 |
+//! | 92..96 | CRC-32/ISO-HDLC of bytes 0..92 ([`monitor_core::record::crc32`]) |
+//!
+//! Header, CRC, reader and writer are the project's one record format
+//! ([`monitor_core::record`], [`FORMAT`]; the length field holds the payload's bytes).
 //!
 //! Version 2 records (72 bytes: as above without the learned point, flags at 64..68, the
 //! CRC at 68..72) are still read, with a baseline that has no learned point; version 1
 //! records (48 bytes: the lamps' statistics at 8..40, 4 reserved bytes, the CRC at
 //! 44..48) without an isolation baseline.
 //!
-//! Erased flash reads as all `0xFF`; that is reported as [`FlashRecordError::Erased`].
+//! Erased flash reads as all `0xFF`; that is reported as [`RecordError::Erased`].
 
 use monitor_core::isolation::{Baseline, ParityResiduals, SteadyPoint};
+pub use monitor_core::record::{crc32, RecordError};
+use monitor_core::record::{RecordFormat, RecordLayout, RecordReader, CRC_LEN, HEADER_LEN};
 
-/// Magic bytes at the start of a record.
-pub const RECORD_MAGIC: [u8; 4] = *b"DMCR";
 /// Current record format version. Bump it whenever the layout or the meaning of the
 /// stored numbers changes (for example a new normalization in the core): old records
 /// are then rejected instead of misread.
 pub const RECORD_VERSION: u16 = 3;
 /// Encoded record length in bytes.
 pub const RECORD_LEN: usize = 96;
-const PAYLOAD_LEN: u16 = 84;
-const CRC_OFFSET: usize = 92;
-/// Version 2: length, payload length and CRC offset.
-const V2_LEN: usize = 72;
-const V2_PAYLOAD_LEN: u16 = 60;
-const V2_CRC_OFFSET: usize = 68;
-/// Version 1: length, payload length and CRC offset.
-const V1_LEN: usize = 48;
-const V1_PAYLOAD_LEN: u16 = 32;
-const V1_CRC_OFFSET: usize = 44;
 /// Flag bit: the isolation baseline is present.
 const FLAG_ISOLATION: u32 = 1;
+
+/// The commissioning record's format: magic `DMCR`, version [`RECORD_VERSION`] of
+/// [`RECORD_LEN`] bytes; versions 2 (72 bytes) and 1 (48 bytes) still read.
+pub const FORMAT: RecordFormat = RecordFormat {
+    magic: *b"DMCR",
+    current: RecordLayout {
+        version: RECORD_VERSION,
+        stored_len: RECORD_LEN,
+        length: (RECORD_LEN - HEADER_LEN - CRC_LEN) as u16,
+    },
+    older: &[
+        RecordLayout {
+            version: 2,
+            stored_len: 72,
+            length: 60,
+        },
+        // Version 1's length left out its 4 reserved bytes before the CRC.
+        RecordLayout {
+            version: 1,
+            stored_len: 48,
+            length: 32,
+        },
+    ],
+};
 
 /// Learned healthy statistics of the four residuals, as stored in flash.
 ///
@@ -75,60 +92,6 @@ pub struct CalibrationRecord {
     /// version 1 record); its spreads > 0.
     pub isolation: Option<Baseline>,
 }
-
-/// Why a stored record was rejected.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[non_exhaustive]
-pub enum FlashRecordError {
-    /// Fewer than [`RECORD_LEN`] bytes were given.
-    Truncated,
-    /// The page is erased (all `0xFF`): never commissioned.
-    Erased,
-    /// The magic bytes do not match: not a record of this firmware.
-    BadMagic,
-    /// A record of another format version (the stored version is given).
-    UnsupportedVersion(u16),
-    /// The payload length field does not match this version's layout.
-    BadLength,
-    /// The CRC does not match: the record is corrupt (bit flip, torn write).
-    BadChecksum,
-    /// CRC is fine but a value is not usable (non-finite, or spread < 0).
-    InvalidValue,
-}
-
-impl core::fmt::Display for FlashRecordError {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        match self {
-            Self::Truncated => f.write_str("record truncated"),
-            Self::Erased => f.write_str("no record (erased flash)"),
-            Self::BadMagic => f.write_str("bad record magic"),
-            Self::UnsupportedVersion(v) => write!(f, "unsupported record version {v}"),
-            Self::BadLength => f.write_str("bad record payload length"),
-            Self::BadChecksum => f.write_str("record checksum mismatch"),
-            Self::InvalidValue => f.write_str("record holds an unusable value"),
-        }
-    }
-}
-
-#[cfg(target_os = "none")]
-impl defmt::Format for FlashRecordError {
-    fn format(&self, f: defmt::Formatter<'_>) {
-        match self {
-            Self::Truncated => defmt::write!(f, "Truncated"),
-            Self::Erased => defmt::write!(f, "Erased"),
-            Self::BadMagic => defmt::write!(f, "BadMagic"),
-            Self::UnsupportedVersion(v) => defmt::write!(f, "UnsupportedVersion({=u16})", v),
-            Self::BadLength => defmt::write!(f, "BadLength"),
-            Self::BadChecksum => defmt::write!(f, "BadChecksum"),
-            Self::InvalidValue => defmt::write!(f, "InvalidValue"),
-        }
-    }
-}
-
-/// CRC-32 (IEEE 802.3 polynomial, reflected, init and final XOR 0xFFFF_FFFF; zlib's
-/// `crc32`): the core's one implementation, shared with the motor record. Check value:
-/// `crc32(b"123456789") == 0xCBF4_3926`.
-pub use monitor_core::motor_record::crc32;
 
 fn values_ok(rec: &CalibrationRecord) -> bool {
     rec.mean.iter().all(|m| m.is_finite())
@@ -166,120 +129,80 @@ impl CalibrationRecord {
     /// Encode into the flash layout described in the module docs.
     ///
     /// # Errors
-    /// [`FlashRecordError::InvalidValue`] if a value is non-finite or a spread is negative
-    /// (such a record would be rejected at the next boot anyway).
-    pub fn encode(&self) -> Result<[u8; RECORD_LEN], FlashRecordError> {
+    /// [`RecordError::Invalid`] if a value is non-finite or a spread is negative (such a
+    /// record would be rejected at the next boot anyway).
+    pub fn encode(&self) -> Result<[u8; RECORD_LEN], RecordError> {
         if !values_ok(self) {
-            return Err(FlashRecordError::InvalidValue);
+            return Err(RecordError::Invalid);
         }
-        let mut out = [0u8; RECORD_LEN];
-        let mut w = Writer {
-            buf: &mut out,
-            pos: 0,
-        };
-        w.put(&RECORD_MAGIC);
-        w.put(&RECORD_VERSION.to_le_bytes());
-        w.put(&PAYLOAD_LEN.to_le_bytes());
-        for v in self.mean.iter().chain(self.spread.iter()) {
-            w.put(&v.to_le_bytes());
-        }
+        let mut w = FORMAT.writer::<RECORD_LEN>();
+        w.f32s(&self.mean);
+        w.f32s(&self.spread);
         let iso = self.isolation.unwrap_or(Baseline {
             mean: ParityResiduals::default(),
             spread: ParityResiduals::default(),
             at: SteadyPoint::default(),
         });
-        for v in iso.mean.to_array().iter().chain(&iso.spread.to_array()) {
-            w.put(&v.to_le_bytes());
-        }
-        for v in point_fields(&iso.at) {
-            w.put(&v.to_le_bytes());
-        }
-        let flags = if self.isolation.is_some() {
+        w.f32s(&iso.mean.to_array());
+        w.f32s(&iso.spread.to_array());
+        w.f32s(&point_fields(&iso.at));
+        w.u32(if self.isolation.is_some() {
             FLAG_ISOLATION
         } else {
             0
-        };
-        w.put(&flags.to_le_bytes());
-        let (body, crc_field) = out.split_at_mut(CRC_OFFSET);
-        let crc = crc32(body);
-        for (dst, src) in crc_field.iter_mut().zip(crc.to_le_bytes()) {
-            *dst = src;
+        });
+        Ok(w.finish())
+    }
+
+    /// Decode and validate a record read from flash. Only the record's own bytes are
+    /// looked at; extra bytes (the rest of the page) are ignored.
+    ///
+    /// # Errors
+    /// The record module's checks ([`RecordFormat::open`]: truncated, erased, magic, version,
+    /// length, checksum), then [`RecordError::Invalid`] for unusable values.
+    pub fn decode(bytes: &[u8]) -> Result<Self, RecordError> {
+        let mut r = FORMAT.open(bytes)?;
+        let out = Self::fields(&mut r)?;
+        if !values_ok(&out) {
+            return Err(RecordError::Invalid);
         }
         Ok(out)
     }
 
-    /// Decode and validate a record read from flash. Only the first [`RECORD_LEN`]
-    /// bytes are looked at; extra bytes (the rest of the page) are ignored.
-    ///
-    /// # Errors
-    /// See [`FlashRecordError`]; checks run in the order truncated, erased, magic, version,
-    /// length, checksum, values.
-    pub fn decode(bytes: &[u8]) -> Result<Self, FlashRecordError> {
-        let head = bytes.get(..8).ok_or(FlashRecordError::Truncated)?;
-        if head.iter().all(|&b| b == 0xFF) {
-            return Err(FlashRecordError::Erased);
+    /// The payload's fields as the record's version lays them out (module docs).
+    fn fields(r: &mut RecordReader<'_>) -> Result<Self, RecordError> {
+        let version = r.version();
+        let mean = r.f32s::<4>()?;
+        let spread = r.f32s::<4>()?;
+        if version < 2 {
+            // Version 1: 4 reserved bytes, no isolation baseline.
+            r.take::<4>()?;
+            return Ok(Self {
+                mean,
+                spread,
+                isolation: None,
+            });
         }
-        let mut r = Reader { buf: head, pos: 0 };
-        if r.take::<4>() != RECORD_MAGIC {
-            return Err(FlashRecordError::BadMagic);
-        }
-        let version = u16::from_le_bytes(r.take::<2>());
-        let (len, payload, crc_at) = match version {
-            RECORD_VERSION => (RECORD_LEN, PAYLOAD_LEN, CRC_OFFSET),
-            2 => (V2_LEN, V2_PAYLOAD_LEN, V2_CRC_OFFSET),
-            1 => (V1_LEN, V1_PAYLOAD_LEN, V1_CRC_OFFSET),
-            v => return Err(FlashRecordError::UnsupportedVersion(v)),
+        let mut b = Baseline {
+            mean: ParityResiduals::from_array(r.f32s::<3>()?),
+            spread: ParityResiduals::from_array(r.f32s::<3>()?),
+            at: SteadyPoint::default(),
         };
-        let rec = bytes.get(..len).ok_or(FlashRecordError::Truncated)?;
-        if u16::from_le_bytes(r.take::<2>()) != payload {
-            return Err(FlashRecordError::BadLength);
-        }
-        let stored_crc = u32::from_le_bytes(
-            Reader {
-                buf: rec,
-                pos: crc_at,
-            }
-            .take::<4>(),
-        );
-        let body = rec.get(..crc_at).ok_or(FlashRecordError::Truncated)?;
-        if crc32(body) != stored_crc {
-            return Err(FlashRecordError::BadChecksum);
-        }
-        let mut r = Reader { buf: rec, pos: 8 };
-        let mut out = Self {
-            mean: [0.0; 4],
-            spread: [0.0; 4],
-            isolation: None,
-        };
-        for v in out.mean.iter_mut().chain(out.spread.iter_mut()) {
-            *v = f32::from_le_bytes(r.take::<4>());
-        }
-        if version >= 2 {
-            let mut b = Baseline {
-                mean: r.residuals(),
-                spread: r.residuals(),
-                at: SteadyPoint::default(),
+        if version >= 3 {
+            let [id, iq, vd, vq, we, wr] = r.f32s::<6>()?;
+            b.at = SteadyPoint {
+                i: monitor_core::Dq { d: id, q: iq },
+                v: monitor_core::Dq { d: vd, q: vq },
+                we_rad_s: we,
+                wr_rad_s: wr,
             };
-            if version >= 3 {
-                let mut f = [0.0f32; 6];
-                for v in f.iter_mut() {
-                    *v = f32::from_le_bytes(r.take::<4>());
-                }
-                let [id, iq, vd, vq, we, wr] = f;
-                b.at = SteadyPoint {
-                    i: monitor_core::Dq { d: id, q: iq },
-                    v: monitor_core::Dq { d: vd, q: vq },
-                    we_rad_s: we,
-                    wr_rad_s: wr,
-                };
-            }
-            let flags = u32::from_le_bytes(r.take::<4>());
-            out.isolation = (flags & FLAG_ISOLATION != 0).then_some(b);
         }
-        if !values_ok(&out) {
-            return Err(FlashRecordError::InvalidValue);
-        }
-        Ok(out)
+        let flags = r.u32()?;
+        Ok(Self {
+            mean,
+            spread,
+            isolation: (flags & FLAG_ISOLATION != 0).then_some(b),
+        })
     }
 }
 
@@ -316,7 +239,7 @@ pub enum LoadError<E> {
     /// The store could not be read.
     Read(E),
     /// The bytes are not a valid record.
-    Record(FlashRecordError),
+    Record(RecordError),
 }
 
 /// Reads and validates the stored record.
@@ -343,7 +266,7 @@ pub struct Stored<E> {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StoreError<E> {
     /// The record holds an unusable value and was not written.
-    Encode(FlashRecordError),
+    Encode(RecordError),
     /// The page erase failed.
     Erase(E),
     /// The write failed.
@@ -364,45 +287,6 @@ pub fn store<S: RecordStore>(store: &mut S, rec: &CalibrationRecord) -> Stored<S
     Stored {
         written,
         read_back: load(store).ok(),
-    }
-}
-
-/// Sequential writer into a fixed buffer; silently stops at the end (the layout is
-/// fixed and fits, so that never happens; no panic path either way).
-struct Writer<'a> {
-    buf: &'a mut [u8],
-    pos: usize,
-}
-
-impl Writer<'_> {
-    fn put(&mut self, bytes: &[u8]) {
-        if let Some(dst) = self.buf.get_mut(self.pos..self.pos + bytes.len()) {
-            dst.copy_from_slice(bytes);
-        }
-        self.pos += bytes.len();
-    }
-}
-
-/// Sequential reader; reads past the end yield zeros (callers check the length first).
-struct Reader<'a> {
-    buf: &'a [u8],
-    pos: usize,
-}
-
-impl Reader<'_> {
-    fn take<const N: usize>(&mut self) -> [u8; N] {
-        let mut out = [0u8; N];
-        if let Some(src) = self.buf.get(self.pos..self.pos + N) {
-            out.copy_from_slice(src);
-        }
-        self.pos += N;
-        out
-    }
-
-    /// The next three values `[e_d, e_q, e_T]`.
-    fn residuals(&mut self) -> ParityResiduals {
-        let mut f = || f32::from_le_bytes(self.take::<4>());
-        ParityResiduals::from_array([f(), f(), f()])
     }
 }
 
@@ -480,10 +364,7 @@ mod tests {
         assert_eq!(CalibrationRecord::decode(&page), Ok(want));
         // A flipped bit in its payload is caught by its own CRC.
         page[20] ^= 4;
-        assert_eq!(
-            CalibrationRecord::decode(&page),
-            Err(FlashRecordError::BadChecksum)
-        );
+        assert_eq!(CalibrationRecord::decode(&page), Err(RecordError::Crc));
     }
 
     #[test]
@@ -494,7 +375,20 @@ mod tests {
             spread: ParityResiduals::from_array([0.0, 1e-3, 1e-3]),
             at: SteadyPoint::default(),
         });
-        assert_eq!(r.encode(), Err(FlashRecordError::InvalidValue));
+        assert_eq!(r.encode(), Err(RecordError::Invalid));
+    }
+
+    /// `sample()` as the record's code before the record module wrote it (its own field
+    /// writer and bit-by-bit CRC-32).
+    const WRITTEN_BEFORE: &str = "444d4352030054000ad7233c0ad7a3bca69b443b00000000cdcc4c3d0ad7233d8fc2753d295c8f3d17b7d13817b751b9a69b443b17b7d13917b7d1396f12833a0000604000008840000000c00080a24300009d4300c0974301000000084965b8";
+
+    #[test]
+    fn a_record_written_by_the_former_code_reads_and_is_rewritten_byte_for_byte() {
+        let old: Vec<u8> = (0..WRITTEN_BEFORE.len() / 2)
+            .map(|k| u8::from_str_radix(&WRITTEN_BEFORE[2 * k..2 * k + 2], 16).unwrap())
+            .collect();
+        assert_eq!(CalibrationRecord::decode(&old), Ok(sample()));
+        assert_eq!(sample().encode().unwrap().as_slice(), old.as_slice());
     }
 
     #[test]
@@ -516,8 +410,8 @@ mod tests {
     fn rejects_invalid_values_on_encode() {
         let mut r = sample();
         r.spread[2] = -1.0;
-        assert_eq!(r.encode(), Err(FlashRecordError::InvalidValue));
+        assert_eq!(r.encode(), Err(RecordError::Invalid));
         r.spread[2] = f32::NAN;
-        assert_eq!(r.encode(), Err(FlashRecordError::InvalidValue));
+        assert_eq!(r.encode(), Err(RecordError::Invalid));
     }
 }

@@ -8,13 +8,18 @@
 //! - [`sampling`]: one trigger's six ADC codes + encoder count -> the core's `Sample`;
 //! - [`commissioning`]: the button -> learn -> store procedure around the core's
 //!   commissioning runs;
-//! - [`flash_record`]: the commissioning record's encoding, version and CRC, and storing it;
+//! - [`flash_record`]: the commissioning record (a format of the core's one record module,
+//!   `monitor_core::record`) and storing it;
 //! - [`liveness`]: timeouts on the ADC waits, the watch on the sample counter that pets
 //!   the watchdog;
 //! - [`recovery`]: the acquisition's recovery after an ADC overrun or a DMA error (the
 //!   register sequence in the reference manual's order, over a trait the host rig fakes);
 //! - [`reset_record`]: why the previous run ended (panic, stalled sample path), kept in
 //!   RAM across the reset;
+//! - [`setup_guard`]: the deadline on the ADCs' set-up (a step that does not finish is
+//!   recorded and ends in a reset);
+//! - [`supply`]: the brown-out level in the option bytes and the periodic check of the
+//!   ADC's reference (VDDA through VREFINT);
 //! - [`offset_trim`]: each channel's zero measured at start-up with the motor off, bounded;
 //! - [`panel`]: lamp patterns and blink codes;
 //! - [`app`]: the glue: settings, the per-sample path, the status it hands thread mode,
@@ -54,3 +59,5 @@ pub mod range_watch;
 pub mod recovery;
 pub mod reset_record;
 pub mod sampling;
+pub mod setup_guard;
+pub mod supply;

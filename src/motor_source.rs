@@ -17,7 +17,7 @@ pub enum MachineSource {
     /// A valid motor record in flash.
     Flash,
     /// The built-in default, because the record was rejected for this reason
-    /// ([`RecordError::Magic`]: the page is erased, no record was ever written).
+    /// ([`RecordError::Erased`]: the page is erased, no record was ever written).
     Default(RecordError),
 }
 
@@ -27,8 +27,11 @@ impl MachineSource {
     pub fn describe(&self) -> &'static str {
         match self {
             MachineSource::Flash => "motor record from flash",
-            MachineSource::Default(RecordError::Magic) => "built-in default motor (no record)",
-            MachineSource::Default(RecordError::Version) => {
+            MachineSource::Default(RecordError::Erased) => "built-in default motor (no record)",
+            MachineSource::Default(RecordError::Magic) => {
+                "built-in default motor (no motor record on its page)"
+            }
+            MachineSource::Default(RecordError::Version(_)) => {
                 "built-in default motor (record of another version)"
             }
             MachineSource::Default(RecordError::Crc) => "built-in default motor (record CRC bad)",
@@ -38,6 +41,8 @@ impl MachineSource {
             MachineSource::Default(RecordError::Invalid) => {
                 "built-in default motor (record values rejected)"
             }
+            // `RecordError` is non-exhaustive: a check added to the record module later.
+            MachineSource::Default(_) => "built-in default motor (record rejected)",
         }
     }
 

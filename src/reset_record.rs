@@ -21,32 +21,54 @@
 //! defmt log); their record names the firmware's [`BootPhase`] at the time and the address
 //! the handler was called from ([`ResetRecord::defmt_panic`]).
 //!
-//! # Layout ([`RESET_RECORD_LEN`] = 128 bytes, little endian)
+//! # RecordLayout ([`RESET_RECORD_LEN`] = 128 bytes, little endian, version 2)
+//!
+//! Header, CRC, reader and writer are the project's one record format
+//! ([`monitor_core::record`], [`FORMAT`]); the length field holds the payload's bytes (116).
 //!
 //! | bytes | field |
 //! |---|---|
 //! | 0..4 | magic `b"DMRR"` |
-//! | 4 | cause: 1 = panic, 2 = sample path stalled, 3 = a set-up step did not finish, 4 = a `defmt` panic, 5 = a HardFault or an unhandled exception |
-//! | 5 | message length (0..=[`MESSAGE_LEN`]) |
-//! | 6 | file length (0..=[`FILE_LEN`]) |
-//! | 7 | reserved, zero |
-//! | 8..12 | line (panic), stall time in ms (stall), phase (set-up), return address (`defmt` panic), stacked PC (HardFault), `u32` |
-//! | 12..76 | message, UTF-8, zero padded |
-//! | 76..124 | file (the end of the path), UTF-8, zero padded |
-//! | 124..128 | CRC-32 of bytes 0..124 ([`crate::flash_record::crc32`]) |
+//! | 4..6 | version, `u16` (2) |
+//! | 6..8 | payload length, `u16` (116) |
+//! | 8 | cause: 1 = panic, 2 = sample path stalled, 3 = a set-up step did not finish, 4 = a `defmt` panic, 5 = a HardFault or an unhandled exception, 6 = a set-up step overran its deadline |
+//! | 9 | message length (0..=[`MESSAGE_LEN`]) |
+//! | 10 | file length (0..=[`FILE_LEN`]) |
+//! | 11 | the brown-out reset level in force when the record was written (`FLASH_OPTR.BOR_LEV`, 0..=4; 255 = not recorded; [`crate::supply::BorLevel`]) |
+//! | 12..16 | line (panic), stall time in ms (stall), phase (set-up), return address (`defmt` panic), stacked PC (HardFault), deadline in ms (set-up deadline), `u32` |
+//! | 16..80 | message, UTF-8, zero padded |
+//! | 80..124 | file (the end of the path), UTF-8, zero padded |
+//! | 124..128 | CRC-32/ISO-HDLC of bytes 0..124 ([`monitor_core::record::crc32`]) |
+//!
+//! Version 1 (no version and length fields, the cause at byte 4, a 48-byte file) is not
+//! read: the record lives in RAM across one reset of the same firmware, so a record of
+//! the former layout can only be met once, right after flashing this one, and then reads as
+//! "no reason recorded" (its header is not this format's).
 
-use crate::flash_record::crc32;
+use crate::supply::BorLevel;
+use monitor_core::record::{RecordFormat, RecordLayout, CRC_LEN, HEADER_LEN};
 
 /// Encoded length of a record, bytes.
 pub const RESET_RECORD_LEN: usize = 128;
 /// Longest message kept, bytes (longer ones are cut at a character boundary).
 pub const MESSAGE_LEN: usize = 64;
 /// Longest file path kept, bytes (longer paths keep their end: the file name).
-pub const FILE_LEN: usize = 48;
-const MAGIC: [u8; 4] = *b"DMRR";
-const MESSAGE_AT: usize = 12;
-const FILE_AT: usize = MESSAGE_AT + MESSAGE_LEN;
-const CRC_AT: usize = FILE_AT + FILE_LEN;
+pub const FILE_LEN: usize = 44;
+/// The byte of a record that holds no brown-out level.
+const NO_BOR_LEVEL: u8 = 0xFF;
+
+/// The reset record's format: magic `DMRR`, version 2, [`RESET_RECORD_LEN`] bytes.
+pub const FORMAT: RecordFormat = RecordFormat {
+    magic: *b"DMRR",
+    current: RecordLayout {
+        version: 2,
+        stored_len: RESET_RECORD_LEN,
+        length: (RESET_RECORD_LEN - HEADER_LEN - CRC_LEN) as u16,
+    },
+    older: &[],
+};
+// The fields fill the payload: 4 bytes of cause and lengths, the number, the texts.
+const _: () = assert!(HEADER_LEN + 8 + MESSAGE_LEN + FILE_LEN + CRC_LEN == RESET_RECORD_LEN);
 
 /// What ended the previous run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -67,6 +89,11 @@ pub enum ResetCause {
     /// status registers (`CFSR`, `HFSR`, `BFAR`) in the message, as hexadecimal text
     /// ([`ResetRecord::hard_fault`]).
     HardFault,
+    /// A set-up step of the ADCs did not finish within its deadline
+    /// ([`crate::setup_guard::SETUP_DEADLINE_MS`]): the set-up guard wrote the step's name
+    /// into the message and the deadline into the number, then reset the MCU by software
+    /// ([`ResetRecord::setup_deadline`]).
+    SetupDeadline,
 }
 
 impl ResetCause {
@@ -78,6 +105,7 @@ impl ResetCause {
             ResetCause::SetupTimeout => 3,
             ResetCause::DefmtPanic => 4,
             ResetCause::HardFault => 5,
+            ResetCause::SetupDeadline => 6,
         }
     }
 
@@ -89,6 +117,7 @@ impl ResetCause {
             3 => Some(ResetCause::SetupTimeout),
             4 => Some(ResetCause::DefmtPanic),
             5 => Some(ResetCause::HardFault),
+            6 => Some(ResetCause::SetupDeadline),
             _ => None,
         }
     }
@@ -213,6 +242,8 @@ impl ResetSource {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ResetRecord {
     cause: ResetCause,
+    /// `FLASH_OPTR.BOR_LEV` when written ([`NO_BOR_LEVEL`]: not recorded).
+    bor: u8,
     number: u32,
     message: Text<MESSAGE_LEN>,
     file: Text<FILE_LEN>,
@@ -275,6 +306,7 @@ impl ResetRecord {
     pub fn panic(message: &str, file: &str, line: u32) -> Self {
         Self {
             cause: ResetCause::Panic,
+            bor: NO_BOR_LEVEL,
             number: line,
             message: Text::new(message, false),
             file: Text::new(file, true),
@@ -285,12 +317,9 @@ impl ResetRecord {
     /// formatting would pull `core::fmt` into the firmware) at `location` (file, line)
     /// leaves in the reset record's RAM: what the panic handler writes, and what the next
     /// boot reports ([`PreviousRun::at_boot`]).
-    pub fn on_panic(
-        message: Option<&str>,
-        location: Option<(&str, u32)>,
-    ) -> [u8; RESET_RECORD_LEN] {
+    pub fn on_panic(message: Option<&str>, location: Option<(&str, u32)>) -> Self {
         let (file, line) = location.unwrap_or(("?", 0));
-        Self::panic(message.unwrap_or("(formatted message)"), file, line).encode()
+        Self::panic(message.unwrap_or("(formatted message)"), file, line)
     }
 
     /// A panic through `defmt::panic!` in `phase`, the handler called from `return_address`
@@ -298,6 +327,7 @@ impl ResetRecord {
     pub fn defmt_panic(phase: BootPhase, return_address: u32) -> Self {
         Self {
             cause: ResetCause::DefmtPanic,
+            bor: NO_BOR_LEVEL,
             number: return_address,
             message: Text::new(phase.name(), false),
             file: Text::new("", true),
@@ -361,6 +391,7 @@ impl ResetRecord {
         };
         Self {
             cause: ResetCause::HardFault,
+            bor: NO_BOR_LEVEL,
             number: pc,
             message: Text::new(message, false),
             file: Text::new(file, true),
@@ -373,8 +404,22 @@ impl ResetRecord {
     pub fn setup(phase: BootPhase) -> Self {
         Self {
             cause: ResetCause::SetupTimeout,
+            bor: NO_BOR_LEVEL,
             number: u32::from(phase.number()),
             message: Text::new(phase.name(), false),
+            file: Text::new("", true),
+        }
+    }
+
+    /// A set-up step named `step` that had not finished when its deadline of `deadline_ms`
+    /// ran out (the set-up guard's record, [`crate::setup_guard`]; a software reset
+    /// follows).
+    pub fn setup_deadline(step: &str, deadline_ms: u32) -> Self {
+        Self {
+            cause: ResetCause::SetupDeadline,
+            bor: NO_BOR_LEVEL,
+            number: deadline_ms,
+            message: Text::new(step, false),
             file: Text::new("", true),
         }
     }
@@ -383,6 +428,7 @@ impl ResetRecord {
     pub fn sample_stall(stalled_ms: u32) -> Self {
         Self {
             cause: ResetCause::SampleStall,
+            bor: NO_BOR_LEVEL,
             number: stalled_ms,
             message: Text::new("sample path stalled", false),
             file: Text::new("", true),
@@ -405,59 +451,55 @@ impl ResetRecord {
     }
 
     /// The line of a panic; the time without samples, ms, for a stall; the phase's number
-    /// for a set-up timeout; the return address for a `defmt` panic.
+    /// for a set-up timeout; the return address for a `defmt` panic; the stacked PC for a
+    /// HardFault; the deadline, ms, for a set-up step that overran it.
     pub fn line_or_ms(&self) -> u32 {
         self.number
     }
 
-    /// The bytes to keep in RAM (layout in the module docs).
-    pub fn encode(&self) -> [u8; RESET_RECORD_LEN] {
-        let mut out = [0u8; RESET_RECORD_LEN];
-        let header = [
-            MAGIC[0],
-            MAGIC[1],
-            MAGIC[2],
-            MAGIC[3],
-            self.cause.code(),
-            self.message.len,
-            self.file.len,
-            0,
-        ];
-        let number = self.number.to_le_bytes();
-        let fields = header
-            .iter()
-            .chain(number.iter())
-            .chain(self.message.bytes.iter())
-            .chain(self.file.bytes.iter());
-        for (dst, src) in out.iter_mut().zip(fields) {
-            *dst = *src;
-        }
-        let crc = crc32(out.get(..CRC_AT).unwrap_or(&[]));
-        if let Some(dst) = out.get_mut(CRC_AT..) {
-            dst.copy_from_slice(&crc.to_le_bytes());
-        }
-        out
+    /// The record with the brown-out reset level in force (`FLASH_OPTR.BOR_LEV`, read
+    /// when the record is written; `None`: unreadable).
+    #[must_use]
+    pub fn with_bor_level(mut self, level: Option<BorLevel>) -> Self {
+        self.bor = level.map_or(NO_BOR_LEVEL, BorLevel::number);
+        self
     }
 
-    /// The record in `bytes`, or `None` when they do not hold one (wrong magic or CRC,
-    /// an unknown cause, lengths out of range, text that is not UTF-8).
+    /// The brown-out reset level in force when the record was written (`None`: not
+    /// recorded).
+    pub fn bor_level(&self) -> Option<BorLevel> {
+        BorLevel::from_number(self.bor)
+    }
+
+    /// The bytes to keep in RAM (layout in the module docs).
+    pub fn encode(&self) -> [u8; RESET_RECORD_LEN] {
+        let mut w = FORMAT.writer::<RESET_RECORD_LEN>();
+        w.bytes(&[self.cause.code(), self.message.len, self.file.len, self.bor]);
+        w.u32(self.number);
+        w.bytes(&self.message.bytes);
+        w.bytes(&self.file.bytes);
+        w.finish()
+    }
+
+    /// The record in `bytes`, or `None` when they do not hold one (the record module's
+    /// checks: magic, version, length, CRC; then an unknown cause, lengths out of range,
+    /// text that is not UTF-8).
     pub fn decode(bytes: &[u8; RESET_RECORD_LEN]) -> Option<Self> {
-        let (body, crc) = bytes.split_at(CRC_AT);
-        if body.get(..4)? != MAGIC || crc32(body).to_le_bytes() != *crc {
-            return None;
-        }
-        let cause = ResetCause::from_code(*body.get(4)?)?;
-        let (message_len, file_len) = (*body.get(5)?, *body.get(6)?);
+        let mut r = FORMAT.open(bytes).ok()?;
+        let [cause, message_len, file_len, bor] = r.take::<4>().ok()?;
+        let cause = ResetCause::from_code(cause)?;
         if usize::from(message_len) > MESSAGE_LEN || usize::from(file_len) > FILE_LEN {
             return None;
         }
-        let mut number = [0u8; 4];
-        number.copy_from_slice(body.get(8..12)?);
+        let number = r.u32().ok()?;
+        let message = r.take::<MESSAGE_LEN>().ok()?;
+        let file = r.take::<FILE_LEN>().ok()?;
         Some(Self {
             cause,
-            number: u32::from_le_bytes(number),
-            message: Text::from_bytes(body.get(MESSAGE_AT..FILE_AT)?, message_len)?,
-            file: Text::from_bytes(body.get(FILE_AT..CRC_AT)?, file_len)?,
+            bor,
+            number,
+            message: Text::from_bytes(&message, message_len)?,
+            file: Text::from_bytes(&file, file_len)?,
         })
     }
 }
@@ -521,178 +563,4 @@ impl PreviousRun {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_panic_round_trips_and_long_texts_keep_their_useful_end() {
-        let rec = ResetRecord::panic("index out of bounds", "src/app.rs", 42);
-        let back = ResetRecord::decode(&rec.encode()).unwrap();
-        assert_eq!(back, rec);
-        assert_eq!(
-            (back.cause(), back.message(), back.file(), back.line_or_ms()),
-            (ResetCause::Panic, "index out of bounds", "src/app.rs", 42)
-        );
-        let long_path =
-            "/home/someone/.cargo/registry/src/index/embassy-stm32-0.6.0/src/adc/ringbuffered.rs";
-        // 81 bytes; byte 64 is inside a character, so the cut falls before it.
-        let long_msg = format!("a{}", "é".repeat(40));
-        let rec = ResetRecord::panic(&long_msg, long_path, 7);
-        let back = ResetRecord::decode(&rec.encode()).unwrap();
-        assert_eq!(back.message(), format!("a{}", "é".repeat(31)));
-        assert!(back.file().ends_with("src/adc/ringbuffered.rs"));
-        assert!(back.file().len() <= FILE_LEN);
-        let stall = ResetRecord::sample_stall(300);
-        assert_eq!(ResetRecord::decode(&stall.encode()), Some(stall));
-    }
-
-    #[test]
-    fn anything_but_an_intact_record_reads_as_none() {
-        let good = ResetRecord::panic("boom", "src/main.rs", 1).encode();
-        for bit in 0..RESET_RECORD_LEN * 8 {
-            let mut bad = good;
-            bad[bit / 8] ^= 1 << (bit % 8);
-            assert_eq!(ResetRecord::decode(&bad), None, "bit {bit}");
-        }
-        assert_eq!(ResetRecord::decode(&[0; RESET_RECORD_LEN]), None);
-        assert_eq!(ResetRecord::decode(&[0xA5; RESET_RECORD_LEN]), None);
-        let wd = ResetSource::IndependentWatchdog;
-        assert_eq!(
-            PreviousRun::at_boot(&[0; RESET_RECORD_LEN], wd),
-            PreviousRun::WatchdogReset
-        );
-        assert_eq!(
-            PreviousRun::at_boot(&[0; RESET_RECORD_LEN], ResetSource::Pin),
-            PreviousRun::Clean
-        );
-        assert!(matches!(
-            PreviousRun::at_boot(&good, wd),
-            PreviousRun::Recorded(r) if r.cause() == ResetCause::Panic
-        ));
-    }
-
-    #[test]
-    fn the_reset_flags_name_the_source_most_specific_first() {
-        // RCC_CSR flags (RM0440): OBL 25, PIN 26, BOR 27, SFT 28, IWDG 29, WWDG 30, LPWR 31.
-        let (obl, pin, bor, sft, iwdg, wwdg, lpwr) = (
-            1 << 25,
-            1 << 26,
-            1 << 27,
-            1 << 28,
-            1 << 29,
-            1 << 30,
-            1u32 << 31,
-        );
-        let table = [
-            (0, ResetSource::Unknown),
-            (pin, ResetSource::Pin),
-            // A power-on sets the brown-out and the pin flags.
-            (pin | bor, ResetSource::PowerOnOrBrownOut),
-            // Every internal reset pulses NRST: the pin flag comes with it.
-            (pin | iwdg, ResetSource::IndependentWatchdog),
-            (pin | sft, ResetSource::Software),
-            (pin | wwdg, ResetSource::WindowWatchdog),
-            (pin | obl, ResetSource::OptionBytes),
-            (pin | lpwr, ResetSource::LowPower),
-            // The LSI bits (0, 1) and RMVF (23) are not reset flags.
-            (pin | 0b11 | 1 << 23, ResetSource::Pin),
-            (pin | bor | iwdg, ResetSource::IndependentWatchdog),
-        ];
-        for (csr, source) in table {
-            assert_eq!(ResetSource::from_csr(csr), source, "{csr:#010x}");
-        }
-    }
-
-    #[test]
-    fn a_stall_or_setup_record_is_the_cause_only_after_a_watchdog_reset() {
-        let wd = ResetSource::IndependentWatchdog;
-        for rec in [
-            ResetRecord::sample_stall(300),
-            ResetRecord::setup(BootPhase::AdcSetup),
-        ] {
-            let bytes = rec.encode();
-            assert_eq!(PreviousRun::at_boot(&bytes, wd), PreviousRun::Recorded(rec));
-            for source in [
-                ResetSource::Pin,
-                ResetSource::PowerOnOrBrownOut,
-                ResetSource::Software,
-                ResetSource::Unknown,
-            ] {
-                let previous = PreviousRun::at_boot(&bytes, source);
-                assert_eq!(
-                    previous,
-                    PreviousRun::ResetDuring {
-                        record: rec,
-                        source
-                    }
-                );
-                assert!(previous.failed());
-            }
-        }
-        // A panic is reported whatever reset followed it (the watchdog or the handler's
-        // software reset, or the button while the panel showed it).
-        let panic = ResetRecord::panic("boom", "src/main.rs", 1);
-        for source in [wd, ResetSource::Software, ResetSource::Pin] {
-            assert_eq!(
-                PreviousRun::at_boot(&panic.encode(), source),
-                PreviousRun::Recorded(panic)
-            );
-        }
-        let defmt = ResetRecord::defmt_panic(BootPhase::AdcSetup, 0x0800_1234);
-        let back = ResetRecord::decode(&defmt.encode()).unwrap();
-        assert_eq!(
-            (back.cause(), back.message(), back.line_or_ms()),
-            (ResetCause::DefmtPanic, "adc-setup", 0x0800_1234)
-        );
-        for phase in BootPhase::ALL {
-            assert_eq!(BootPhase::from_number(phase.number()), Some(phase));
-        }
-        assert_eq!(BootPhase::from_number(BootPhase::ALL.len() as u8), None);
-    }
-
-    #[test]
-    fn the_record_a_panic_leaves_is_the_record_the_next_boot_reports() {
-        use std::sync::Mutex;
-        // The no-init RAM of the reset record.
-        static RAM: Mutex<[u8; RESET_RECORD_LEN]> = Mutex::new([0x5A; RESET_RECORD_LEN]);
-        let others = std::panic::take_hook();
-        // The host's panic handler does what the firmware's does with its PanicInfo: the
-        // static message and the location through `ResetRecord::on_panic` into the RAM.
-        std::panic::set_hook(Box::new(|info| {
-            let message = info.payload().downcast_ref::<&str>().copied();
-            let location = info.location().map(|l| (l.file(), l.line()));
-            *RAM.lock().unwrap() = ResetRecord::on_panic(message, location);
-        }));
-        let line = line!() + 1;
-        let literal = std::panic::catch_unwind(|| panic!("sample ring misaligned"));
-        let ram_literal = *RAM.lock().unwrap();
-        let formatted = std::panic::catch_unwind(|| panic!("index {}", std::hint::black_box(7)));
-        let ram_formatted = *RAM.lock().unwrap();
-        std::panic::set_hook(others);
-        assert!(literal.is_err() && formatted.is_err());
-        // The next boot (after the handler's software reset or the watchdog's).
-        for source in [ResetSource::Software, ResetSource::IndependentWatchdog] {
-            let PreviousRun::Recorded(rec) = PreviousRun::at_boot(&ram_literal, source) else {
-                panic!("no record after a panic");
-            };
-            assert_eq!(
-                (rec.cause(), rec.message(), rec.file(), rec.line_or_ms()),
-                (
-                    ResetCause::Panic,
-                    "sample ring misaligned",
-                    "src/reset_record.rs",
-                    line
-                )
-            );
-        }
-        let PreviousRun::Recorded(rec) =
-            PreviousRun::at_boot(&ram_formatted, ResetSource::Software)
-        else {
-            panic!("no record after a formatted panic");
-        };
-        assert_eq!(
-            (rec.message(), rec.line_or_ms()),
-            ("(formatted message)", line + 2)
-        );
-    }
-}
+mod tests;

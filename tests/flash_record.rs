@@ -4,7 +4,7 @@
 
 use drive_monitor::app::{Command, SamplePath};
 use drive_monitor::flash_record::{
-    crc32, CalibrationRecord, FlashRecordError, RECORD_LEN, RECORD_VERSION,
+    crc32, CalibrationRecord, RecordError, RECORD_LEN, RECORD_VERSION,
 };
 use monitor_core::isolation::{Baseline, ParityResiduals};
 
@@ -45,7 +45,7 @@ fn wrong_version_is_rejected_even_with_a_valid_crc() {
     bad[RECORD_LEN - 4..].copy_from_slice(&crc.to_le_bytes());
     assert_eq!(
         CalibrationRecord::decode(&bad),
-        Err(FlashRecordError::UnsupportedVersion(RECORD_VERSION + 1))
+        Err(RecordError::Version(RECORD_VERSION + 1))
     );
 }
 
@@ -55,23 +55,20 @@ fn truncated_erased_and_torn_records_are_rejected() {
     for len in 0..RECORD_LEN {
         assert_eq!(
             CalibrationRecord::decode(&good[..len]),
-            Err(FlashRecordError::Truncated)
+            Err(RecordError::Truncated)
         );
     }
     assert_eq!(
         CalibrationRecord::decode(&[0xFF; 2048]),
-        Err(FlashRecordError::Erased)
+        Err(RecordError::Erased)
     );
     // Torn write: the first 16 bytes made it, the rest is still erased.
     let mut torn = [0xFFu8; RECORD_LEN];
     torn[..16].copy_from_slice(&good[..16]);
-    assert_eq!(
-        CalibrationRecord::decode(&torn),
-        Err(FlashRecordError::BadChecksum)
-    );
+    assert_eq!(CalibrationRecord::decode(&torn), Err(RecordError::Crc));
     assert_eq!(
         CalibrationRecord::decode(&[0u8; RECORD_LEN]),
-        Err(FlashRecordError::BadMagic)
+        Err(RecordError::Magic)
     );
 }
 

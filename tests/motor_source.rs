@@ -51,8 +51,8 @@ fn corrupt_truncated_old_or_missing_records_fall_back_to_the_default() {
     let cases: [(&[u8], RecordError); 4] = [
         (&flipped, RecordError::Crc),
         (&good[..STORED_LEN - 1], RecordError::Truncated),
-        (&old, RecordError::Version),
-        (&[0xFF; 2048], RecordError::Magic),
+        (&old, RecordError::Version(0)),
+        (&[0xFF; 2048], RecordError::Erased),
     ];
     for (bytes, why) in cases {
         let (rec, source) = motor_source::select(bytes);

@@ -73,6 +73,8 @@ fn value(arg: &str) -> &'static str {
         "wind_i2" => "0.041",
         "s.moved" => "true",
         "rise_k" => "54.4",
+        "vdda_v" => "3.301",
+        "bor" => "4",
         other => panic!(
             "log_status prints `{other}`: give it a test value here and teach \
              sim_host::hmi::status_line to read it"

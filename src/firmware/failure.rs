@@ -9,9 +9,10 @@ use defmt::{error, warn};
 use drive_monitor::app::WATCHDOG_TIMEOUT_MS;
 use drive_monitor::board::{Lamp, Port};
 use drive_monitor::panel::PanelLamps;
-use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
+use drive_monitor::reset_record::{BootPhase, ResetRecord};
 use embassy_stm32::pac;
 
+use super::supply::bor_level;
 use super::{write_reset_record, PHASE, WATCHDOG_RUNNING};
 
 /// A HardFault (a bus or memory fault, a usage fault escalated, an undefined instruction):
@@ -26,7 +27,7 @@ unsafe fn HardFault(frame: &cortex_m_rt::ExceptionFrame) -> ! {
     let scb = unsafe { &*cortex_m::peripheral::SCB::PTR };
     let (cfsr, hfsr, bfar) = (scb.cfsr.read(), scb.hfsr.read(), scb.bfar.read());
     let record = ResetRecord::hard_fault(None, frame.pc(), frame.lr(), cfsr, hfsr, bfar);
-    fail(&record.encode())
+    fail(record)
 }
 
 /// An exception or interrupt without a handler: its number into the reset record, then
@@ -40,7 +41,7 @@ unsafe fn DefaultHandler(irqn: i16) {
     let (cfsr, hfsr, bfar) = (scb.cfsr.read(), scb.hfsr.read(), scb.bfar.read());
     let lr = cortex_m::register::lr::read();
     let record = ResetRecord::hard_fault(Some(irqn), 0, lr, cfsr, hfsr, bfar);
-    fail(&record.encode())
+    fail(record)
 }
 
 /// Panic: the reason into the reset record (RAM that survives the reset), then [`fail`].
@@ -50,8 +51,7 @@ unsafe fn DefaultHandler(irqn: i16) {
 fn panic(info: &core::panic::PanicInfo) -> ! {
     cortex_m::interrupt::disable();
     let location = info.location().map(|l| (l.file(), l.line()));
-    let record = ResetRecord::on_panic(info.message().as_str(), location);
-    fail(&record)
+    fail(ResetRecord::on_panic(info.message().as_str(), location))
 }
 
 /// A panic through `defmt::panic!` (the HAL with its `defmt` feature, `defmt::unwrap!`):
@@ -63,15 +63,16 @@ fn defmt_panic() -> ! {
     cortex_m::interrupt::disable();
     let return_address = cortex_m::register::lr::read();
     let phase = BootPhase::from_number(PHASE.load(Ordering::Relaxed)).unwrap_or(BootPhase::Boot);
-    fail(&ResetRecord::defmt_panic(phase, return_address).encode())
+    fail(ResetRecord::defmt_panic(phase, return_address))
 }
 
 /// The end of a failed run: the panel's "monitor failed" pattern on the lamp pins of the
-/// lamp table, `record` into the reset record and the log, then the reset: the watchdog's
+/// lamp table, `record` (with the brown-out level in force) into the reset record and the
+/// log, then the reset: the watchdog's
 /// (no longer petted) after `WATCHDOG_TIMEOUT_MS`, or, when it does not run yet, a
 /// software reset after the same time. The next boot reads the record, logs it and shows
 /// the failed pattern for 5 s before monitoring again.
-fn fail(record: &[u8; RESET_RECORD_LEN]) -> ! {
+fn fail(record: ResetRecord) -> ! {
     // Direct register writes: the HAL objects may be in any state. GPIO clocks are
     // enabled by `embassy_stm32::init` for every port.
     use pac::gpio::vals::Moder;
@@ -94,15 +95,13 @@ fn fail(record: &[u8; RESET_RECORD_LEN]) -> ! {
             port.bsrr().write(|w| w.set_br(n, true));
         }
     }
-    write_reset_record(record);
-    if let Some(rec) = ResetRecord::decode(record) {
-        error!(
-            "MONITOR FAILED: {=str} at {=str}:{=u32}",
-            rec.message(),
-            rec.file(),
-            rec.line_or_ms()
-        );
-    }
+    write_reset_record(&record.with_bor_level(bor_level()).encode());
+    error!(
+        "MONITOR FAILED: {=str} at {=str}:{=u32}",
+        record.message(),
+        record.file(),
+        record.line_or_ms()
+    );
     if !WATCHDOG_RUNNING.load(Ordering::Relaxed) {
         warn!("watchdog not running yet: software reset");
     }

@@ -215,7 +215,7 @@ fn power_loss_during_the_flash_write_leaves_no_record_anywhere() {
     let survivors = Survivors::power_on(rig.survivors.flash.clone());
     assert_eq!(
         CalibrationRecord::decode(&survivors.flash.page),
-        Err(flash_record::FlashRecordError::BadChecksum)
+        Err(flash_record::RecordError::Crc)
     );
     let mut rig = Rig::boot(survivors);
     assert_eq!(rig.previous, PreviousRun::Clean);

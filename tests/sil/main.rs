@@ -195,6 +195,11 @@ struct Rig {
     trims: Vec<TrimResult>,
     seen: Vec<Seen>,
     ended: Vec<RunEnd>,
+    /// VREFINT on ADC1's injected channel, when the test gives one: thread mode polls it
+    /// through `Supervisor::poll_reference` at every tick, as the firmware does.
+    reference: Option<startup::FakeReference>,
+    /// The reference verdict's changes, with the tick's time [ms].
+    reference_changes: Vec<(u32, drive_monitor::supply::ReferenceChange)>,
 }
 
 impl Rig {
@@ -243,6 +248,8 @@ impl Rig {
             trims: Vec::new(),
             seen: Vec::new(),
             ended: Vec::new(),
+            reference: None,
+            reference_changes: Vec::new(),
         }
     }
 
@@ -307,6 +314,11 @@ impl Rig {
     fn thread_tick(&mut self, now_ms: u32) -> Result<(), Reset> {
         let status = self.pending_status.take();
         let button = std::mem::take(&mut self.button);
+        if let Some(adc) = self.reference.as_mut() {
+            if let Some(change) = self.supervisor.poll_reference(now_ms, adc) {
+                self.reference_changes.push((now_ms, change));
+            }
+        }
         let tick = self.supervisor.tick(now_ms, status, button);
         let used = *self.supervisor.latest();
         self.check_agreement(now_ms, &tick, &used);

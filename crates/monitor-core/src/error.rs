@@ -58,6 +58,9 @@ pub enum ConfigCheck {
     BlocksPerPeriod,
     FilterCorner,
     SequenceCorner,
+    FilterCornerHz,
+    FilterSamplePeriod,
+    FilterStability,
     PllBandwidth,
     EncoderCounts,
     EncoderCounterBits,
@@ -113,6 +116,8 @@ impl ConfigCheck {
             Decimation | BlocksPerPeriod => "decimation",
             FilterCorner => "filter_hz",
             SequenceCorner => "sequence_hz",
+            FilterCornerHz | FilterStability => "filter.fc_hz",
+            FilterSamplePeriod => "filter.dt_s",
             PllBandwidth => "pll_bw_hz",
             EncoderCounts => "encoder.counts_per_rev",
             EncoderCounterBits => "encoder.counter_bits",
@@ -177,6 +182,10 @@ impl ConfigCheck {
             FilterCorner | SequenceCorner => {
                 "be positive, below supply_hz/2 and at most 0.2/(2 pi) of the block rate sample_rate_hz/decimation"
             }
+            FilterCornerHz | FilterSamplePeriod => "be finite and positive",
+            FilterStability => {
+                "keep 2 pi fc_hz dt_s below 0.5 (the state-variable filter's Euler step is unstable beyond)"
+            }
             EncoderCounts => "be at least 1",
             EncoderCounterBits => "be 8..=32",
             EncoderTimeout => "be longer than encoder.min_window_s",
@@ -204,6 +213,7 @@ impl ConfigCheck {
             SampleRate | TickRate | SampleRateVsSupply => K::SampleRate,
             Decimation | BlocksPerPeriod => K::Decimation,
             FilterCorner | SequenceCorner | PllBandwidth => K::Filter,
+            FilterCornerHz | FilterSamplePeriod | FilterStability => K::Filter,
             EncoderCounts | EncoderCounterBits | EncoderMinWindow | EncoderTimeout
             | EncoderMaxStep => K::Encoder,
             VoltageLimit | CurrentLimit | SpeedLimit | CurrentSumFraction | VoltageSumFraction

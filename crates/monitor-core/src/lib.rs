@@ -67,6 +67,7 @@ pub mod machine;
 pub mod monitor;
 pub mod motor_record;
 pub mod operating_range;
+pub mod record;
 pub mod residuals;
 pub mod sequence;
 pub mod signature;

@@ -6,7 +6,7 @@
 //!
 //! | offset | size | field |
 //! |---|---|---|
-//! | 0 | 4 | magic [`MAGIC`] (`"MREC"`) |
+//! | 0 | 4 | magic `"MREC"` ([`FORMAT`]) |
 //! | 4 | 2 | version [`VERSION`] |
 //! | 6 | 2 | length [`RECORD_LEN`] |
 //! | 8 | 64 | `[motor]` `rs_ohm rr_ohm ls_h lr_h lm_h j_kgm2 b_nms bl_nms`, `f64` each |
@@ -16,15 +16,17 @@
 //! | 100 | 24 | sensor offsets: currents a, b, c then voltages a, b, c [ADC counts], `f32` each |
 //! | 124 | 2 | encoder lines per revolution, `u16` (counts = 4 x lines) |
 //! | 126 | 2 | encoder direction: 0 forward, 1 reversed, `u16` |
-//! | 128 | 4 | CRC-32 (IEEE 802.3, reflected, poly 0xEDB88320) of bytes 0..128 |
+//! | 128 | 4 | CRC-32/ISO-HDLC of bytes 0..128 ([`crate::record::crc32`]) |
 //!
-//! so the record with its CRC is [`RECORD_LEN`] + 4 = 132 bytes. A record that fails any
-//! check is rejected with a [`RecordError`]; the caller falls back to its built-in default.
+//! so the record with its CRC is [`RECORD_LEN`] + 4 = 132 bytes. Header, CRC, reader and
+//! writer are the project's one record format ([`crate::record`]: the length field holds
+//! the bytes the CRC covers). A record that fails any check is rejected with a
+//! [`RecordError`]; the caller falls back to its built-in default.
 
 use crate::machine::{MotorParameters, SupplyParameters};
+pub use crate::record::RecordError;
+use crate::record::{RecordFormat, RecordLayout, RecordReader};
 
-/// `"MREC"` read as a little-endian `u32`.
-pub const MAGIC: u32 = u32::from_le_bytes(*b"MREC");
 /// The layout's version; a record of another version is [`RecordError::Version`].
 pub const VERSION: u16 = 1;
 /// Bytes covered by the CRC (header and payload).
@@ -32,24 +34,16 @@ pub const RECORD_LEN: usize = 128;
 /// Bytes of a stored record: [`RECORD_LEN`] plus the 4-byte CRC.
 pub const STORED_LEN: usize = RECORD_LEN + 4;
 
-/// Why a stored record was rejected.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum RecordError {
-    /// Fewer than [`STORED_LEN`] bytes.
-    Truncated,
-    /// No [`MAGIC`]: the page holds no record (erased flash reads `0xFF`).
-    Magic,
-    /// A version other than [`VERSION`].
-    Version,
-    /// The length field is not [`RECORD_LEN`].
-    Length,
-    /// The CRC-32 does not match the bytes.
-    Crc,
-    /// The values fail the core's checks ([`MotorParameters::validate`],
-    /// [`SupplyParameters::validate`], positive finite full scales, finite offsets, 1 or more
-    /// encoder lines, direction 0 or 1).
-    Invalid,
-}
+/// The motor record's format: magic `MREC`, version [`VERSION`], [`STORED_LEN`] bytes.
+pub const FORMAT: RecordFormat = RecordFormat {
+    magic: *b"MREC",
+    current: RecordLayout {
+        version: VERSION,
+        stored_len: STORED_LEN,
+        length: RECORD_LEN as u16,
+    },
+    older: &[],
+};
 
 /// The values a motor record holds.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -72,131 +66,71 @@ pub struct MotorRecord {
     pub encoder_reversed: bool,
 }
 
-/// CRC-32 (IEEE 802.3: reflected, polynomial 0xEDB88320, init and final xor 0xFFFFFFFF),
-/// bitwise (no table). `crc32(b"123456789") == 0xCBF4_3926`.
-pub fn crc32(bytes: &[u8]) -> u32 {
-    let mut crc = u32::MAX;
-    for &byte in bytes {
-        crc ^= u32::from(byte);
-        for _ in 0..8 {
-            let mask = (crc & 1).wrapping_neg();
-            crc = (crc >> 1) ^ (0xEDB8_8320 & mask);
-        }
-    }
-    !crc
-}
-
-/// Reads fixed-size fields from the front of a byte slice.
-struct Reader<'a>(&'a [u8]);
-
-impl Reader<'_> {
-    fn take<const N: usize>(&mut self) -> Result<[u8; N], RecordError> {
-        let (head, rest) = self
-            .0
-            .split_first_chunk::<N>()
-            .ok_or(RecordError::Truncated)?;
-        self.0 = rest;
-        Ok(*head)
-    }
-    fn f64(&mut self) -> Result<f64, RecordError> {
-        self.take().map(f64::from_le_bytes)
-    }
-    fn f32(&mut self) -> Result<f32, RecordError> {
-        self.take().map(f32::from_le_bytes)
-    }
-    fn u16(&mut self) -> Result<u16, RecordError> {
-        self.take().map(u16::from_le_bytes)
-    }
-}
-
-/// Appends fixed-size fields to a byte array.
-struct Writer {
-    bytes: [u8; STORED_LEN],
-    at: usize,
-}
-
-impl Writer {
-    fn put(&mut self, field: &[u8]) {
-        let end = self.at + field.len();
-        if let Some(dst) = self.bytes.get_mut(self.at..end) {
-            dst.copy_from_slice(field);
-        }
-        self.at = end;
-    }
-}
-
 impl MotorRecord {
     /// The stored form ([`STORED_LEN`] bytes, layout in the module docs), CRC included.
     pub fn to_bytes(&self) -> [u8; STORED_LEN] {
-        let mut w = Writer {
-            bytes: [0; STORED_LEN],
-            at: 0,
-        };
+        let mut w = FORMAT.writer::<STORED_LEN>();
         let m = &self.motor;
-        w.put(&MAGIC.to_le_bytes());
-        w.put(&VERSION.to_le_bytes());
-        w.put(&(RECORD_LEN as u16).to_le_bytes());
         for x in [
             m.rs_ohm, m.rr_ohm, m.ls_h, m.lr_h, m.lm_h, m.j_kgm2, m.b_nms, m.bl_nms,
         ] {
-            w.put(&x.to_le_bytes());
+            w.f64(x);
         }
-        w.put(&m.poles.to_le_bytes());
-        w.put(&self.supply.v_ll_rms.to_le_bytes());
-        w.put(&self.supply.f_hz.to_le_bytes());
-        w.put(&self.current_full_scale_a.to_le_bytes());
-        w.put(&self.voltage_full_scale_v.to_le_bytes());
-        for x in self
-            .current_offset_counts
-            .iter()
-            .chain(&self.voltage_offset_counts)
-        {
-            w.put(&x.to_le_bytes());
-        }
-        w.put(&self.encoder_lines.to_le_bytes());
-        w.put(&u16::from(self.encoder_reversed).to_le_bytes());
-        let crc = crc32(w.bytes.get(..RECORD_LEN).unwrap_or(&[]));
-        w.put(&crc.to_le_bytes());
-        w.bytes
+        w.u32(m.poles);
+        w.f64(self.supply.v_ll_rms);
+        w.f64(self.supply.f_hz);
+        w.f32(self.current_full_scale_a);
+        w.f32(self.voltage_full_scale_v);
+        w.f32s(&self.current_offset_counts);
+        w.f32s(&self.voltage_offset_counts);
+        w.u16(self.encoder_lines);
+        w.u16(u16::from(self.encoder_reversed));
+        w.finish()
     }
 
     /// Parses and checks a stored record (extra bytes after [`STORED_LEN`] are ignored, so a
     /// whole flash page can be passed).
     ///
     /// # Errors
-    /// The first failed check, in the order [`RecordError::Truncated`], `Magic`, `Version`,
-    /// `Length`, `Crc`, `Invalid`.
+    /// The record module's checks ([`RecordFormat::open`]: truncated, erased, magic, version,
+    /// length, CRC), then [`RecordError::Invalid`] for values the core rejects.
     pub fn parse(bytes: &[u8]) -> Result<MotorRecord, RecordError> {
-        let stored = bytes.get(..STORED_LEN).ok_or(RecordError::Truncated)?;
-        let mut r = Reader(stored);
-        if u32::from_le_bytes(r.take()?) != MAGIC {
-            return Err(RecordError::Magic);
+        let mut r = FORMAT.open(bytes)?;
+        let record = Self::fields(&mut r)?;
+        let scale_ok = |x: f32| x.is_finite() && x > 0.0;
+        let valid = record.motor.validate().is_ok()
+            && record.supply.validate().is_ok()
+            && scale_ok(record.current_full_scale_a)
+            && scale_ok(record.voltage_full_scale_v)
+            && record
+                .current_offset_counts
+                .iter()
+                .chain(&record.voltage_offset_counts)
+                .all(|x| x.is_finite())
+            && record.encoder_lines >= 1;
+        if valid {
+            Ok(record)
+        } else {
+            Err(RecordError::Invalid)
         }
-        if r.u16()? != VERSION {
-            return Err(RecordError::Version);
-        }
-        if usize::from(r.u16()?) != RECORD_LEN {
-            return Err(RecordError::Length);
-        }
-        let (body, crc) = stored
-            .split_last_chunk::<4>()
-            .ok_or(RecordError::Truncated)?;
-        if crc32(body) != u32::from_le_bytes(*crc) {
-            return Err(RecordError::Crc);
-        }
-        let mut f = [0.0f64; 8];
-        for x in &mut f {
-            *x = r.f64()?;
-        }
-        let [rs_ohm, rr_ohm, ls_h, lr_h, lm_h, j_kgm2, b_nms, bl_nms] = f;
-        let poles = u32::from_le_bytes(r.take()?);
+    }
+
+    /// The payload's fields in order (the direction word checked: 0 or 1).
+    fn fields(r: &mut RecordReader<'_>) -> Result<MotorRecord, RecordError> {
+        let [rs_ohm, rr_ohm, ls_h, lr_h, lm_h, j_kgm2, b_nms, bl_nms] = {
+            let mut f = [0.0f64; 8];
+            for x in &mut f {
+                *x = r.f64()?;
+            }
+            f
+        };
         let motor = MotorParameters {
             rs_ohm,
             rr_ohm,
             ls_h,
             lr_h,
             lm_h,
-            poles,
+            poles: r.u32()?,
             j_kgm2,
             b_nms,
             bl_nms,
@@ -207,41 +141,29 @@ impl MotorRecord {
         };
         let current_full_scale_a = r.f32()?;
         let voltage_full_scale_v = r.f32()?;
-        let mut offsets = [0.0f32; 6];
-        for x in &mut offsets {
-            *x = r.f32()?;
-        }
-        let [ia, ib, ic, va, vb, vc] = offsets;
+        let current_offset_counts = r.f32s::<3>()?;
+        let voltage_offset_counts = r.f32s::<3>()?;
         let encoder_lines = r.u16()?;
-        let direction = r.u16()?;
-        let record = MotorRecord {
+        let encoder_reversed = match r.u16()? {
+            0 => false,
+            1 => true,
+            _ => return Err(RecordError::Invalid),
+        };
+        Ok(MotorRecord {
             motor,
             supply,
             current_full_scale_a,
             voltage_full_scale_v,
-            current_offset_counts: [ia, ib, ic],
-            voltage_offset_counts: [va, vb, vc],
+            current_offset_counts,
+            voltage_offset_counts,
             encoder_lines,
-            encoder_reversed: direction == 1,
-        };
-        let scale_ok = |x: f32| x.is_finite() && x > 0.0;
-        let valid = motor.validate().is_ok()
-            && supply.validate().is_ok()
-            && scale_ok(current_full_scale_a)
-            && scale_ok(voltage_full_scale_v)
-            && offsets.iter().all(|x| x.is_finite())
-            && encoder_lines >= 1
-            && direction <= 1;
-        if valid {
-            Ok(record)
-        } else {
-            Err(RecordError::Invalid)
-        }
+            encoder_reversed,
+        })
     }
 }
 
 #[cfg(test)]
-#[allow(clippy::indexing_slicing)]
+#[allow(clippy::indexing_slicing, clippy::unwrap_used)]
 mod tests {
     use super::*;
     use crate::machine::reference::MOTOR_2P2KW;
@@ -259,10 +181,29 @@ mod tests {
         }
     }
 
+    /// `sample()` as the motor record's code before the record module wrote it (its own
+    /// field writer and bit-by-bit CRC-32).
+    const WRITTEN_BEFORE: &str = "4d524543010080009a99999999990d4000000000000004405c8fc2f5285ccf3ff4fdd478e926d13f5c8fc2f5285ccf3fb81e85eb51b88e3f7b14ae47e17a743ff6285c8fc2f5b83f04000000000000000000794000000000000049400000a0410000fa4300e0ff44002800450080ff440000004500c0ff44001000450004010081c1ded8";
+
+    fn from_hex(s: &str) -> Vec<u8> {
+        (0..s.len() / 2)
+            .map(|k| u8::from_str_radix(&s[2 * k..2 * k + 2], 16).unwrap_or(0))
+            .collect()
+    }
+
     #[test]
-    fn crc32_check_value() {
-        // The standard check value of CRC-32/ISO-HDLC.
-        assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
+    fn a_record_written_by_the_former_code_reads_and_is_rewritten_byte_for_byte() {
+        let old = from_hex(WRITTEN_BEFORE);
+        assert_eq!(MotorRecord::parse(&old), Ok(sample()));
+        assert_eq!(sample().to_bytes().as_slice(), old.as_slice());
+    }
+
+    #[test]
+    fn the_fields_fill_the_layout_exactly() {
+        let bytes = sample().to_bytes();
+        let mut r = FORMAT.open(&bytes).unwrap();
+        assert!(MotorRecord::fields(&mut r).is_ok());
+        assert_eq!(r.remaining(), 0);
     }
 
     #[test]
@@ -290,14 +231,14 @@ mod tests {
     #[test]
     fn erased_truncated_old_and_invalid() {
         let bytes = sample().to_bytes();
-        assert_eq!(MotorRecord::parse(&[0xFF; 2048]), Err(RecordError::Magic));
+        assert_eq!(MotorRecord::parse(&[0xFF; 2048]), Err(RecordError::Erased));
         assert_eq!(
             MotorRecord::parse(&bytes[..STORED_LEN - 1]),
             Err(RecordError::Truncated)
         );
         let mut old = bytes;
         old[4] = 0;
-        assert_eq!(MotorRecord::parse(&old), Err(RecordError::Version));
+        assert_eq!(MotorRecord::parse(&old), Err(RecordError::Version(0)));
         let mut bad = sample();
         bad.motor.poles = 3;
         assert_eq!(

@@ -56,7 +56,8 @@ pub use zero::{
     phase_phasors, single_phase_gain, SinglePhaseGain, ZeroSequence, MAX_MISALIGNMENT_DEG,
 };
 
-use crate::filter::Svf;
+use crate::error::ConfigError;
+use crate::filter::{Svf, SvfState};
 use crate::frames::{park, AlphaBeta, Phase, SinCos};
 use crate::machine::MotorModel;
 use micromath::F32Ext;
@@ -93,10 +94,11 @@ pub fn over_positive(p: (f32, f32), n: (f32, f32)) -> (f32, f32) {
 /// Streaming positive/negative-sequence separation.
 #[derive(Debug, Clone, Copy)]
 pub struct SequenceAnalyzer {
-    pd: Svf,
-    pq: Svf,
-    nd: Svf,
-    nq: Svf,
+    filter: Svf,
+    pd: SvfState,
+    pq: SvfState,
+    nd: SvfState,
+    nq: SvfState,
 }
 
 impl SequenceAnalyzer {
@@ -104,14 +106,17 @@ impl SequenceAnalyzer {
     /// other sequence appears at twice the supply frequency and is attenuated by
     /// `(fc / 2f)^2` (1.6e-3 at 50 Hz), so a 10:1 positive sequence leaks less than 2 % into
     /// a negative-sequence reading.
-    pub fn new(fc_hz: f32, dt_s: f32) -> Self {
-        let f = Svf::new(fc_hz, dt_s);
-        SequenceAnalyzer {
-            pd: f,
-            pq: f,
-            nd: f,
-            nq: f,
-        }
+    ///
+    /// # Errors
+    /// [`Svf::new`]'s checks of `fc_hz` [Hz] and the sample period `dt_s` [s].
+    pub fn new(fc_hz: f32, dt_s: f32) -> Result<Self, ConfigError> {
+        Ok(SequenceAnalyzer {
+            filter: Svf::new(fc_hz, dt_s)?,
+            pd: SvfState::default(),
+            pq: SvfState::default(),
+            nd: SvfState::default(),
+            nq: SvfState::default(),
+        })
     }
 
     /// Feeds the current vector and the sin/cos of an angle turning at the supply frequency;
@@ -120,35 +125,36 @@ impl SequenceAnalyzer {
     pub fn update(&mut self, i: AlphaBeta, sc: SinCos) -> ((f32, f32), (f32, f32)) {
         let p = park(i, sc);
         let n = park(i, sc.negated());
-        self.pd.update(p.d);
-        self.pq.update(p.q);
-        self.nd.update(n.d);
-        self.nq.update(n.q);
+        let f = self.filter;
+        f.update(&mut self.pd, p.d);
+        f.update(&mut self.pq, p.q);
+        f.update(&mut self.nd, n.d);
+        f.update(&mut self.nq, n.q);
         (self.positive(), self.negative())
     }
 
     /// The filtered Park components `P = I1 e^{-j theta0}` (frame at +theta) as `(re, im)`.
     pub fn positive(&self) -> (f32, f32) {
-        (self.pd.y, self.pq.y)
+        (self.pd.y(), self.pq.y())
     }
 
     /// `conj(N) = I2 e^{-j theta0}` as `(re, im)` (same rotation as [`Self::positive`], so
     /// `I2/I1 = conj(N)/P`).
     pub fn negative(&self) -> (f32, f32) {
-        (self.nd.y, -self.nq.y)
+        (self.nd.y(), -self.nq.y())
     }
 
     /// |I1|, the positive-sequence current magnitude (phase peak) [A].
     pub fn positive_magnitude(&self) -> f32 {
-        crate::fast_hypot(self.pd.y, self.pq.y)
+        crate::fast_hypot(self.pd.y(), self.pq.y())
     }
 
     /// Ratio, angle and suspect phase, given the model correction `arg Z1` and the
     /// ratio below which no phase is named.
     pub fn result(&self, correction_rad: f32, min_ratio: f32) -> NegativeSequence {
         sequence_result(
-            (self.pd.y, self.pq.y),
-            (self.nd.y, self.nq.y),
+            (self.pd.y(), self.pq.y()),
+            (self.nd.y(), self.nq.y()),
             correction_rad,
             min_ratio,
         )
@@ -454,7 +460,7 @@ mod tests {
         // Phase currents with I1 = 10, I2 = 1 at +40 degrees relative to I1 (phasor convention
         // I2 = (Ia + a^2 Ib + a Ic)/3).
         let dt = 1e-4;
-        let mut s = SequenceAnalyzer::new(2.0, dt);
+        let mut s = SequenceAnalyzer::new(2.0, dt).unwrap();
         let w = TAU * 50.0;
         let phi2 = 40f32.to_radians();
         for k in 0..40000 {

@@ -410,7 +410,8 @@ impl Replay {
                 sample_rate_hz,
                 f64::from(cfg.limits.i_max),
                 f64::from(cfg.limits.v_max),
-            ),
+            )
+            .map_err(config_error)?,
             timing_faults_seen: 0,
             isolation_hold_until: f64::NEG_INFINITY,
             unsettled: unsettled::Unsettled::default(),

@@ -18,7 +18,7 @@ use crate::log::quality::MAX_BRIDGED_GAP_S;
 use crate::log::Row;
 use crate::params::ParamFile;
 use monitor_core::angle::SrfPll;
-use monitor_core::filter::Svf;
+use monitor_core::filter::{Svf, SvfState};
 use monitor_core::frames::{clarke, park, AlphaBeta, SinCos};
 use monitor_core::sequence::{
     single_phase_gain, PhasorFit, SequenceAnalyzer, SinglePhaseGain, ThreePhasors, ZeroSequence,
@@ -119,6 +119,7 @@ pub(super) struct SequenceTracker {
     pll: SrfPll,
     /// Mean square of the current vector, low-passed: the currents' normaliser for the PLL.
     i_ms: Svf,
+    i_ms_state: SvfState,
     seq: SequenceAnalyzer,
     seq_v: SequenceAnalyzer,
     zero_i: ZeroSequence,
@@ -127,6 +128,7 @@ pub(super) struct SequenceTracker {
     last_t: Option<f64>,
     /// The PLL's frequency low-passed (`y`) and the reference angle it turns [rad].
     w_ref: Svf,
+    w_ref_state: SvfState,
     theta_ref: f32,
     /// The reference angle less `w0 t`, unwrapped [rad], and `w0` [rad/s].
     offset: f64,
@@ -139,19 +141,19 @@ pub(super) struct SequenceTracker {
 
 impl SequenceTracker {
     /// A tracker for a log at `sample_rate_hz` with (or without) voltage columns; the
-    /// sample limits `i_max`, `v_max` are the monitor's.
+    /// sample limits `i_max`, `v_max` are the monitor's. Errors: the filters' checks
+    /// ([`Svf::new`]: a sample rate too low for their corners).
     pub fn new(
         params: &ParamFile,
         voltages: bool,
         sample_rate_hz: f64,
         i_max: f64,
         v_max: f64,
-    ) -> Self {
+    ) -> Result<Self, monitor_core::ConfigError> {
         let dt = (1.0 / sample_rate_hz) as f32;
         let f0 = params.supply.f_hz as f32;
-        let mut w_ref = Svf::new(REFERENCE_FC_HZ, dt);
-        w_ref.y = core::f32::consts::TAU * f0;
-        SequenceTracker {
+        let w_ref = Svf::new(REFERENCE_FC_HZ, dt)?;
+        Ok(SequenceTracker {
             dt_s: 1.0 / sample_rate_hz,
             i_max,
             v_max,
@@ -170,13 +172,15 @@ impl SequenceTracker {
                     1.0
                 },
             ),
-            i_ms: Svf::new(2.0, dt),
-            seq: SequenceAnalyzer::new(2.0, dt),
-            seq_v: SequenceAnalyzer::new(2.0, dt),
-            zero_i: ZeroSequence::new(2.0, dt),
-            zero_v: ZeroSequence::new(2.0, dt),
+            i_ms: Svf::new(2.0, dt)?,
+            i_ms_state: SvfState::default(),
+            seq: SequenceAnalyzer::new(2.0, dt)?,
+            seq_v: SequenceAnalyzer::new(2.0, dt)?,
+            zero_i: ZeroSequence::new(2.0, dt)?,
+            zero_v: ZeroSequence::new(2.0, dt)?,
             last_t: None,
             w_ref,
+            w_ref_state: SvfState::at(core::f32::consts::TAU * f0),
             theta_ref: 0.0,
             offset: 0.0,
             w0: std::f64::consts::TAU * params.supply.f_hz,
@@ -184,7 +188,7 @@ impl SequenceTracker {
                 .max(monitor_core::sequence::PHASOR_FIT_MIN_SAMPLES),
             open: OpenWindow::new(),
             windows: Vec::new(),
-        }
+        })
     }
 
     /// Feeds one row at `t` [s since the first row]; `learning`: the monitor is learning
@@ -200,9 +204,9 @@ impl SequenceTracker {
             if missing > 0.5 * self.dt_s && missing <= MAX_BRIDGED_GAP_S {
                 self.pll.skip(missing as f32);
                 self.theta_ref = monitor_core::frames::wrap_angle(
-                    self.theta_ref + self.w_ref.y * missing as f32,
+                    self.theta_ref + self.w_ref_state.y() * missing as f32,
                 );
-                self.offset += (f64::from(self.w_ref.y) - self.w0) * missing;
+                self.offset += (f64::from(self.w_ref_state.y()) - self.w0) * missing;
                 let m = (missing / self.dt_s).round();
                 if m <= FILLED_SAMPLES as f64 {
                     filled = m as usize;
@@ -212,9 +216,10 @@ impl SequenceTracker {
                 self.close_window(wr_rad_s);
             }
         }
-        self.theta_ref =
-            monitor_core::frames::wrap_angle(self.theta_ref + self.w_ref.y * self.dt_s as f32);
-        self.offset += (f64::from(self.w_ref.y) - self.w0) * self.dt_s;
+        self.theta_ref = monitor_core::frames::wrap_angle(
+            self.theta_ref + self.w_ref_state.y() * self.dt_s as f32,
+        );
+        self.offset += (f64::from(self.w_ref_state.y()) - self.w0) * self.dt_s;
         self.offer_window_sample(t, learning);
         let ok = |x: &[f64; 3], max: f64| x.iter().all(|v| v.is_finite() && v.abs() <= max);
         let abc = |x: &[f64; 3]| Abc {
@@ -246,7 +251,7 @@ impl SequenceTracker {
 
     /// Counts a sample into the open window (its time span, the reference's frequency).
     fn offer_window_sample(&mut self, t: f64, learning: bool) {
-        let w = self.w_ref.y;
+        let w = self.w_ref_state.y();
         let o = &mut self.open;
         if o.offered == 0 {
             o.from_s = t;
@@ -272,13 +277,13 @@ impl SequenceTracker {
             }
             _ => {
                 let m2 = i.alpha * i.alpha + i.beta * i.beta;
-                if self.i_ms.y <= 0.0 {
+                if self.i_ms_state.y() <= 0.0 {
                     // The first good sample: the loop starts on the current vector.
-                    self.i_ms.y = m2;
+                    self.i_ms_state.set_y(m2);
                     self.pll.align(i.beta.atan2(i.alpha));
                 }
-                self.i_ms.update(m2);
-                let k = 1.0 / monitor_core::sqrt(self.i_ms.y.max(1e-12));
+                self.i_ms.update(&mut self.i_ms_state, m2);
+                let k = 1.0 / monitor_core::sqrt(self.i_ms_state.y().max(1e-12));
                 self.pll.update(
                     AlphaBeta {
                         alpha: i.alpha * k,
@@ -288,7 +293,8 @@ impl SequenceTracker {
                 );
             }
         }
-        self.w_ref.update(self.pll.omega_rad_s());
+        self.w_ref
+            .update(&mut self.w_ref_state, self.pll.omega_rad_s());
         // A few missing samples: the sequence filters get the vectors turned back to the
         // missing instants (a filter that skips a sample of the other sequence's 2f image
         // keeps an error of about that sample's share).

@@ -3,7 +3,8 @@
 //! sensor-fault hold, and the values derived once from the configuration.
 
 use super::{MonitorConfig, Sample, SensorFlags, SensorLimits};
-use crate::filter::{LowPass, Svf};
+use crate::error::ConfigError;
+use crate::filter::{LowPass, LowPassState, Svf, SvfState};
 use crate::frames::Dq;
 use crate::residuals::{Derivatives, Operating};
 use core::f32::consts::TAU;
@@ -211,57 +212,82 @@ impl BlockSums {
 }
 
 /// The block-rate filters of the d-q quantities: the model's inputs (with derivatives),
-/// the negative-sequence current and V_ds.
+/// the negative-sequence current and V_ds. Three configurations (the model's corner, the
+/// sequences' corner, V_ds's low-pass) and one state per signal.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct DqFilters {
+    /// The model inputs' filter at `filter_hz`.
+    dq: Svf,
+    /// The negative sequences' filter at `sequence_hz`.
+    seq: Svf,
+    /// V_ds's low-pass at `filter_hz`.
+    lp: LowPass,
     /// I_qs [A].
-    pub(super) iqs: Svf,
+    iqs: SvfState,
     /// i_ds [A].
-    pub(super) ids: Svf,
+    ids: SvfState,
     /// V_qs [V].
-    pub(super) vqs: Svf,
+    vqs: SvfState,
     /// The electrical rotor speed [rad/s].
-    pub(super) wr: Svf,
+    wr: SvfState,
     /// The negative sequence's d component [A].
-    pub(super) nd: Svf,
+    nd: SvfState,
     /// The negative sequence's q component [A].
-    pub(super) nq: Svf,
+    nq: SvfState,
     /// The voltage's negative sequence, d and q (each block's last sample) [V]: the
     /// supply's own unbalance, taken out before a winding is named.
-    pub(super) vnd: Svf,
-    pub(super) vnq: Svf,
+    vnd: SvfState,
+    vnq: SvfState,
     /// V_ds of each block's last sample [V].
-    pub(super) vds: LowPass,
+    vds: LowPassState,
 }
 
 impl DqFilters {
     /// The filters at `filter_hz` (the negative sequence's at `sequence_hz`), fed every
     /// `block_dt_s`.
-    pub(super) fn new(cfg: &MonitorConfig, block_dt_s: f32) -> Self {
-        let dq = Svf::new(cfg.filter_hz, block_dt_s);
-        let seq = Svf::new(cfg.sequence_hz, block_dt_s);
-        DqFilters {
-            iqs: dq,
-            ids: dq,
-            vqs: dq,
-            wr: dq,
-            nd: seq,
-            nq: seq,
-            vnd: seq,
-            vnq: seq,
-            vds: LowPass::new(cfg.filter_hz, block_dt_s),
-        }
+    ///
+    /// # Errors
+    /// The filters' own checks ([`Svf::new`], [`LowPass::new`]); a configuration that
+    /// passed [`MonitorConfig::validate`] passes them.
+    pub(super) fn new(cfg: &MonitorConfig, block_dt_s: f32) -> Result<Self, ConfigError> {
+        Ok(DqFilters {
+            dq: Svf::new(cfg.filter_hz, block_dt_s)?,
+            seq: Svf::new(cfg.sequence_hz, block_dt_s)?,
+            lp: LowPass::new(cfg.filter_hz, block_dt_s)?,
+            iqs: SvfState::default(),
+            ids: SvfState::default(),
+            vqs: SvfState::default(),
+            wr: SvfState::default(),
+            nd: SvfState::default(),
+            nq: SvfState::default(),
+            vnd: SvfState::default(),
+            vnq: SvfState::default(),
+            vds: LowPassState::default(),
+        })
     }
 
     /// Feeds a block's means and the electrical rotor speed `wr_rad_s`.
     #[inline(always)]
     pub(super) fn update(&mut self, m: &BlockMeans, wr_rad_s: f32) {
-        self.iqs.update(m.i.q);
-        self.ids.update(m.i.d);
-        self.vqs.update(m.v_q);
-        self.wr.update(wr_rad_s);
-        self.nd.update(m.n.d);
-        self.nq.update(m.n.q);
+        self.dq.update(&mut self.iqs, m.i.q);
+        self.dq.update(&mut self.ids, m.i.d);
+        self.dq.update(&mut self.vqs, m.v_q);
+        self.dq.update(&mut self.wr, wr_rad_s);
+        self.seq.update(&mut self.nd, m.n.d);
+        self.seq.update(&mut self.nq, m.n.q);
+    }
+
+    /// Feeds the voltage's negative sequence of a block's last sample [V].
+    #[inline(always)]
+    pub(super) fn update_voltage_negative(&mut self, vn: Dq) {
+        self.seq.update(&mut self.vnd, vn.d);
+        self.seq.update(&mut self.vnq, vn.q);
+    }
+
+    /// Feeds V_ds of a block's last sample [V] and returns it filtered.
+    #[inline(always)]
+    pub(super) fn update_vds(&mut self, vds: f32) -> f32 {
+        self.lp.update(&mut self.vds, vds)
     }
 
     /// Forgets every state (a restart after a non-finite state).
@@ -285,22 +311,40 @@ impl DqFilters {
     #[inline(always)]
     pub(super) fn operating(&self) -> Operating {
         Operating {
-            iqs: self.iqs.y,
-            i_f: self.ids.y,
-            vqs: self.vqs.y,
-            wr_rad_s: self.wr.y,
+            iqs: self.iqs.y(),
+            i_f: self.ids.y(),
+            vqs: self.vqs.y(),
+            wr_rad_s: self.wr.y(),
         }
+    }
+
+    /// The positive sequence's filtered Park components `(i_ds, I_qs)` [A].
+    #[inline(always)]
+    pub(super) fn positive(&self) -> (f32, f32) {
+        (self.ids.y(), self.iqs.y())
+    }
+
+    /// The current's negative sequence `(d, q)`, filtered [A].
+    #[inline(always)]
+    pub(super) fn negative(&self) -> (f32, f32) {
+        (self.nd.y(), self.nq.y())
+    }
+
+    /// The voltage's negative sequence `(d, q)`, filtered [V].
+    #[inline(always)]
+    pub(super) fn voltage_negative(&self) -> (f32, f32) {
+        (self.vnd.y(), self.vnq.y())
     }
 
     /// The derivatives of eq. (36) for the block's last inputs `iqs` and `wr_rad_s`.
     #[inline(always)]
     pub(super) fn derivatives(&self, iqs: f32, wr_rad_s: f32) -> Derivatives {
         Derivatives {
-            diqs: self.iqs.dy,
-            ddiqs: self.iqs.ddy(iqs),
-            dwr: self.wr.dy,
-            ddwr: self.wr.ddy(wr_rad_s),
-            dvqs: self.vqs.dy,
+            diqs: self.iqs.dy(),
+            ddiqs: self.dq.ddy(&self.iqs, iqs),
+            dwr: self.wr.dy(),
+            ddwr: self.dq.ddy(&self.wr, wr_rad_s),
+            dvqs: self.vqs.dy(),
         }
     }
 
@@ -308,7 +352,7 @@ impl DqFilters {
     /// floor, [`Derived::gate_floor_a`]) per second.
     #[inline(always)]
     pub(super) fn changing(&self, per_s: f32, k: &Derived) -> bool {
-        let fast = |f: &Svf, floor: f32| f.dy.abs() > per_s * (f.y.abs() + floor);
+        let fast = |f: &SvfState, floor: f32| f.dy().abs() > per_s * (f.y().abs() + floor);
         fast(&self.iqs, k.gate_floor_a)
             || fast(&self.ids, k.gate_floor_a)
             || fast(&self.vqs, k.gate_floor_v)
@@ -317,29 +361,46 @@ impl DqFilters {
 }
 
 /// The block-rate low-passes of the running and plausibility checks: |V|^2 and the 3-wire
-/// sums (`|ia + ib + ic|` against `max |i|`, the same for the voltages).
+/// sums (`|ia + ib + ic|` against `max |i|`, the same for the voltages), one configuration
+/// and five states.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Checks {
+    lp: LowPass,
     /// |V|^2 [V^2] (compared with [`Derived::v_run_min2`]: no square root per block).
-    pub(super) vmag2: LowPass,
-    isum: LowPass,
-    imax: LowPass,
-    vsum: LowPass,
-    vmax: LowPass,
+    vmag2: LowPassState,
+    isum: LowPassState,
+    imax: LowPassState,
+    vsum: LowPassState,
+    vmax: LowPassState,
 }
 
 impl Checks {
     /// The low-passes at 5 Hz (or a fifth of the block rate when lower), fed every
     /// `block_dt_s`.
-    pub(super) fn new(block_rate_hz: f32, block_dt_s: f32) -> Self {
-        let lp = LowPass::new(5.0f32.min(0.2 * block_rate_hz), block_dt_s);
-        Checks {
-            vmag2: lp,
-            isum: lp,
-            imax: lp,
-            vsum: lp,
-            vmax: lp,
-        }
+    ///
+    /// # Errors
+    /// [`LowPass::new`]'s checks (a validated configuration passes them).
+    pub(super) fn new(block_rate_hz: f32, block_dt_s: f32) -> Result<Self, ConfigError> {
+        Ok(Checks {
+            lp: LowPass::new(5.0f32.min(0.2 * block_rate_hz), block_dt_s)?,
+            vmag2: LowPassState::default(),
+            isum: LowPassState::default(),
+            imax: LowPassState::default(),
+            vsum: LowPassState::default(),
+            vmax: LowPassState::default(),
+        })
+    }
+
+    /// Feeds |V|^2 [V^2].
+    #[inline(always)]
+    pub(super) fn update_vmag2(&mut self, vmag2: f32) {
+        self.lp.update(&mut self.vmag2, vmag2);
+    }
+
+    /// |V|^2 low-passed [V^2].
+    #[inline(always)]
+    pub(super) fn vmag2(&self) -> f32 {
+        self.vmag2.y()
     }
 
     /// The sum checks on sample `s` (3-wire machine: the phase currents sum to zero, and
@@ -347,18 +408,21 @@ impl Checks {
     #[inline(always)]
     pub(super) fn sums(&mut self, s: &Sample, l: &SensorLimits) -> SensorFlags {
         let i = s.i_abc;
-        let isum = self.isum.update((i.a + i.b + i.c).abs());
-        let imax = self
-            .imax
-            .update(crate::maxf(crate::maxf(i.a.abs(), i.b.abs()), i.c.abs()));
+        let lp = self.lp;
+        let isum = lp.update(&mut self.isum, (i.a + i.b + i.c).abs());
+        let imax = lp.update(
+            &mut self.imax,
+            crate::maxf(crate::maxf(i.a.abs(), i.b.abs()), i.c.abs()),
+        );
         let current = isum > l.current_sum_frac * imax + 1e-3 * l.i_max;
         let mut voltage = false;
         if l.voltage_sum_frac > 0.0 {
             let v = s.v_abc;
-            let vsum = self.vsum.update((v.a + v.b + v.c).abs());
-            let vmax = self
-                .vmax
-                .update(crate::maxf(crate::maxf(v.a.abs(), v.b.abs()), v.c.abs()));
+            let vsum = lp.update(&mut self.vsum, (v.a + v.b + v.c).abs());
+            let vmax = lp.update(
+                &mut self.vmax,
+                crate::maxf(crate::maxf(v.a.abs(), v.b.abs()), v.c.abs()),
+            );
             voltage = vsum > l.voltage_sum_frac * vmax + 1e-3 * l.v_max;
         }
         SensorFlags {

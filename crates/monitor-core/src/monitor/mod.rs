@@ -120,8 +120,8 @@ impl Monitor {
             ),
             extremes: BlockExtremes::default(),
             sums: BlockSums::default(),
-            filters: DqFilters::new(&cfg, block_dt),
-            checks: Checks::new(derived.block_rate_hz, block_dt),
+            filters: DqFilters::new(&cfg, block_dt)?,
+            checks: Checks::new(derived.block_rate_hz, block_dt)?,
             norm: Normaliser::new(
                 &cfg.motor,
                 block::no_load_reference(&cfg),

@@ -180,15 +180,12 @@ impl Monitor {
     fn check_sums(&mut self, s: &Sample, sc: SinCos) {
         let vab = clarke(s.v_abc);
         self.checks
-            .vmag2
-            .update(vab.alpha * vab.alpha + vab.beta * vab.beta);
+            .update_vmag2(vab.alpha * vab.alpha + vab.beta * vab.beta);
         self.out.vds = self
             .filters
-            .vds
-            .update(vab.alpha * sc.cos + vab.beta * sc.sin);
+            .update_vds(vab.alpha * sc.cos + vab.beta * sc.sin);
         let vn = crate::frames::park(vab, sc.negated());
-        self.filters.vnd.update(vn.d);
-        self.filters.vnq.update(vn.q);
+        self.filters.update_voltage_negative(vn);
         let bad = self.checks.sums(s, &self.cfg.limits);
         if bad.current | bad.voltage {
             self.flag(bad);
@@ -227,7 +224,7 @@ impl Monitor {
     #[inline(always)]
     fn update_lamps(&mut self, rn: [f32; 4]) {
         let running = self.settle_left == 0
-            && self.checks.vmag2.y > self.derived.v_run_min2
+            && self.checks.vmag2() > self.derived.v_run_min2
             && !self.out.sensor_fault.any();
         if self.learner.is_active() {
             // Learning on evaluated blocks, or the learned calibration awaiting storage.
@@ -257,13 +254,13 @@ impl Monitor {
         let we = we.abs().max(1.0);
         let corr = asymmetry_correction_rad(&self.cfg.motor, we, slip);
         let f = &self.filters;
-        let p = (f.ids.y, f.iqs.y);
-        let mut out = sequence_result(p, (f.nd.y, f.nq.y), corr, self.cfg.unbalance_min_ratio);
+        let p = f.positive();
+        let mut out = sequence_result(p, f.negative(), corr, self.cfg.unbalance_min_ratio);
         // The phase from the winding's part: the supply's V2/Z2 taken out (module docs of
         // `crate::sequence`).
         let w = winding_asymmetry(
-            over_positive(p, (f.nd.y, f.nq.y)),
-            Some(over_positive(p, (f.vnd.y, f.vnq.y))),
+            over_positive(p, f.negative()),
+            Some(over_positive(p, f.voltage_negative())),
             &self.cfg.motor,
             we,
             slip,

@@ -28,24 +28,32 @@
 //! own zero sequence. Offsets are not gains: they are DC and do not reach the
 //! fundamental-frequency phasors.
 
-use crate::filter::Svf;
+use crate::error::ConfigError;
+use crate::filter::{Svf, SvfState};
 use crate::frames::{Abc, Phase, SinCos};
 
 /// The streaming zero-sequence phasor of three phase signals, demodulated on the same
 /// angle as a [`super::SequenceAnalyzer`] and low-passed by the same filters.
 #[derive(Debug, Clone, Copy)]
 pub struct ZeroSequence {
-    d: Svf,
-    q: Svf,
+    filter: Svf,
+    d: SvfState,
+    q: SvfState,
 }
 
 impl ZeroSequence {
     /// Critically damped second-order filters with corner `fc_hz` (as
     /// [`super::SequenceAnalyzer::new`]; the zero sequence's image at `-theta` appears at
     /// twice the supply frequency and is attenuated by `(fc/2f)^2`).
-    pub fn new(fc_hz: f32, dt_s: f32) -> Self {
-        let f = Svf::new(fc_hz, dt_s);
-        ZeroSequence { d: f, q: f }
+    ///
+    /// # Errors
+    /// [`Svf::new`]'s checks of `fc_hz` [Hz] and the sample period `dt_s` [s].
+    pub fn new(fc_hz: f32, dt_s: f32) -> Result<Self, ConfigError> {
+        Ok(ZeroSequence {
+            filter: Svf::new(fc_hz, dt_s)?,
+            d: SvfState::default(),
+            q: SvfState::default(),
+        })
     }
 
     /// Feeds the three phase values and the sin/cos of the analysis angle; returns the new
@@ -54,12 +62,16 @@ impl ZeroSequence {
     pub fn update(&mut self, x: Abc, sc: SinCos) -> (f32, f32) {
         // x0 e^{-j theta}, times 2: a phase signal Re(X e^{j theta}) demodulates to X/2.
         let x0 = (x.a + x.b + x.c) * (2.0 / 3.0);
-        (self.d.update(x0 * sc.cos), self.q.update(-x0 * sc.sin))
+        let f = self.filter;
+        (
+            f.update(&mut self.d, x0 * sc.cos),
+            f.update(&mut self.q, -x0 * sc.sin),
+        )
     }
 
     /// `I0 e^{-j theta0}` as `(re, im)` (module docs).
     pub fn phasor(&self) -> (f32, f32) {
-        (self.d.y, self.q.y)
+        (self.d.y(), self.q.y())
     }
 }
 

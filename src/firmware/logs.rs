@@ -1,0 +1,189 @@
+//! The firmware's log lines for events: why the previous run ended, the start-up checks
+//! (offset trim, reference, brown-out level), liveness changes and the commissioning's
+//! ends. The status line is `log_status` in `src/firmware.rs`.
+
+use core::sync::atomic::Ordering;
+
+use defmt::{error, info, warn};
+use drive_monitor::board::{ReferenceCheck, VDDA_BAND_V};
+use drive_monitor::commissioning::RunEnd;
+use drive_monitor::flash_record::{self, StoreError};
+use drive_monitor::liveness::LivenessChange;
+use drive_monitor::offset_trim::{ChannelTrim, TrimResult, MAX_OFFSET_CODES};
+use drive_monitor::reset_record::{
+    PreviousRun, ResetCause, ResetRecord, ResetSource, RESET_RECORD_LEN,
+};
+use drive_monitor::supply::{BorCheck, ReferenceChange, BOR_GOAL};
+use embassy_stm32::pac;
+
+use super::supply::bor_level;
+use super::{read_reset_record, write_reset_record, RESTARTS};
+
+/// The boot's brown-out check: the level in force, and below [`BOR_GOAL`] how to raise it
+/// (docs/firmware.md, "Brown-out level"); the firmware does not write the option bytes.
+pub(super) fn log_bor(check: BorCheck) {
+    match check {
+        BorCheck::AtGoal(l) => info!(
+            "brown-out reset level {=u8} (about {=f32} V)",
+            l.number(),
+            l.falling_v()
+        ),
+        BorCheck::BelowGoal(l) => warn!(
+            "brown-out reset level {=u8} (about {=f32} V) is below level {=u8} ({=f32} V): the MCU runs on at a supply far below 3.3 V; raise it: STM32_Programmer_CLI -c port=SWD -ob BOR_LEV={=u8} (docs/firmware.md)",
+            l.number(),
+            l.falling_v(),
+            BOR_GOAL.number(),
+            BOR_GOAL.falling_v(),
+            BOR_GOAL.number()
+        ),
+        BorCheck::Reserved(v) => warn!(
+            "brown-out reset level: FLASH_OPTR.BOR_LEV holds the reserved value {=u8}",
+            v
+        ),
+    }
+}
+
+/// A change of the reference's verdict (`Supervisor::observe_reference`,
+/// `Supervisor::poll_reference`): why the sensors are flagged, or that they are not any more.
+pub(super) fn log_reference(change: ReferenceChange) {
+    match change {
+        ReferenceChange::Flagged(ReferenceCheck::OutOfBand(v)) => error!(
+            "reference: VDDA {=f32} V outside {=f32}..{=f32} V: every reading is off by that ratio; the sensors are flagged until it returns",
+            v,
+            VDDA_BAND_V.0,
+            VDDA_BAND_V.1
+        ),
+        ReferenceChange::Flagged(_) => {
+            error!("reference: VREFINT unreadable; the sensors are flagged until a reading is in band")
+        }
+        ReferenceChange::Cleared(v) => warn!(
+            "reference: VDDA {=f32} V back in band: the sensor flags it set are cleared",
+            v
+        ),
+    }
+}
+
+/// Why the previous run ended: the reset record (then erased) and the reset flags (then
+/// cleared), logged.
+pub(super) fn previous_run() -> PreviousRun {
+    let source = ResetSource::from_csr(pac::RCC.csr().read().0);
+    pac::RCC.csr().modify(|w| w.set_rmvf(true));
+    let previous = PreviousRun::at_boot(&read_reset_record(), source);
+    write_reset_record(&[0; RESET_RECORD_LEN]);
+    info!("reset by {=str}", source.name());
+    match previous {
+        PreviousRun::Clean => {}
+        PreviousRun::WatchdogReset => {
+            error!("previous run ended in a watchdog reset with no reason recorded: the firmware hung")
+        }
+        PreviousRun::ResetDuring { record, source } => warn!(
+            "previous run: {=str} recorded ({=u32}), then a {=str} reset came before the watchdog's",
+            record.message(),
+            record.line_or_ms(),
+            source.name()
+        ),
+        PreviousRun::Recorded(rec) => log_record(&rec),
+    }
+    previous
+}
+
+fn log_record(rec: &ResetRecord) {
+    match rec.cause() {
+        ResetCause::Panic => error!(
+            "previous run ended in a panic: {=str} at {=str}:{=u32}",
+            rec.message(),
+            rec.file(),
+            rec.line_or_ms()
+        ),
+        ResetCause::DefmtPanic => error!(
+            "previous run ended in a defmt panic during {=str}, called from {=u32:#010x} (addr2line -e the ELF; the message is in that run's log)",
+            rec.message(),
+            rec.line_or_ms()
+        ),
+        ResetCause::SetupTimeout => error!(
+            "previous run ended in a watchdog reset: the {=str} set-up did not finish",
+            rec.message()
+        ),
+        ResetCause::HardFault => error!(
+            "previous run ended in a {=str} at pc {=u32:#010x}: {=str} (addr2line -e the ELF)",
+            rec.file(),
+            rec.line_or_ms(),
+            rec.message()
+        ),
+        ResetCause::SetupDeadline => error!(
+            "previous run ended in a software reset: the adc set-up step {=str} did not finish within {=u32} ms",
+            rec.message(),
+            rec.line_or_ms()
+        ),
+        ResetCause::SampleStall => error!(
+            "previous run ended in a watchdog reset: the sample path had stalled (no samples for {=u32} ms when recorded; recoveries did not help)",
+            rec.line_or_ms()
+        ),
+    }
+}
+
+pub(super) fn on_liveness(change: LivenessChange) {
+    match change {
+        LivenessChange::Stalled { for_ms } => error!(
+            "SAMPLE PATH STALLED: no samples for {=u32} ms (restarts so far {=u32}); watchdog not petted",
+            for_ms,
+            RESTARTS.load(Ordering::Relaxed)
+        ),
+        LivenessChange::RecordStall { for_ms } => {
+            let record = ResetRecord::sample_stall(for_ms).with_bor_level(bor_level());
+            write_reset_record(&record.encode());
+        }
+        LivenessChange::Recovered { after_ms } => {
+            write_reset_record(&[0; RESET_RECORD_LEN]);
+            warn!("sample path recovered after {=u32} ms", after_ms);
+        }
+    }
+}
+
+/// The start-up offset trim, channel by channel (`drive_monitor::offset_trim`).
+pub(super) fn log_trim(trim: &TrimResult) {
+    let names = ["va", "vb", "vc", "ia", "ib", "ic"];
+    let channels = trim.voltage.iter().chain(trim.current.iter());
+    for (name, channel) in names.into_iter().zip(channels) {
+        match *channel {
+            ChannelTrim::Trimmed(code) => info!("offset trim {=str}: zero at {=f32} codes, in force", name, code),
+            ChannelTrim::OutOfBound(code) => error!(
+                "offset trim {=str}: zero at {=f32} codes, beyond +-{=f32} of the zero in force: sensor flagged, not used",
+                name,
+                code,
+                MAX_OFFSET_CODES
+            ),
+            ChannelTrim::NotQuiet(spread) => info!(
+                "offset trim {=str}: not quiet (spread {=f32} codes; motor running or supply on): not trimmed",
+                name,
+                spread
+            ),
+        }
+    }
+}
+
+pub(super) fn log_run_end(end: RunEnd) {
+    match end {
+        RunEnd::Commissioned { run } => info!("commissioning run {=u16}: stored and in force", run),
+        RunEnd::CancelledByUser { run } => info!("commissioning run {=u16}: cancelled", run),
+        RunEnd::Failed { run, why } => error!(
+            "commissioning run {}: FAILED ({=str}); the thresholds in force are unchanged or the flash's",
+            run,
+            why.name()
+        ),
+    }
+}
+
+pub(super) fn log_stored<E: defmt::Format>(stored: &flash_record::Stored<E>) {
+    match &stored.written {
+        Ok(()) => info!(
+            "commissioning record written, read back: {}",
+            stored.read_back.is_some()
+        ),
+        Err(StoreError::Encode(e)) => {
+            error!("commissioning record not written: {=str}", e.describe())
+        }
+        Err(StoreError::Erase(e)) => error!("flash erase failed: {}", e),
+        Err(StoreError::Write(e)) => error!("flash write failed: {}", e),
+    }
+}

@@ -1,0 +1,322 @@
+//! The supply the readings depend on: the brown-out reset level in the option bytes and
+//! the ADC's reference VDDA, watched while the firmware runs.
+//!
+//! **Brown-out level.** The STM32G474 holds the MCU in reset while VDD is below the
+//! brown-out threshold that `FLASH_OPTR.BOR_LEV` selects (RM0440, "Power supply
+//! supervisor" and "FLASH option register"). The factory setting is level 0 (about 1.7 V):
+//! the firmware would keep running, and logging readings, far below the NUCLEO's 3.3 V.
+//! The firmware wants [`BOR_GOAL`] (level 4, about 2.8 V falling). It does **not** program
+//! the option bytes itself: an option-byte write that a reset or a power loss interrupts
+//! can leave the device with default or inconsistent option bytes (read protection,
+//! boot source, `DBANK`), which a board in the field should not risk on every boot for a
+//! setting a user makes once. It reads the level at boot ([`BorCheck::of_optr`]), says
+//! on the log and on every status line (`bor=`) which level is in force, and puts the
+//! level into every reset record it writes; `docs/firmware.md` gives the commands that
+//! raise it.
+//!
+//! **Reference.** Every reading scales with VDDA, the ADC's reference. Thread mode measures
+//! it through VREFINT every [`REFERENCE_PERIOD_MS`] ([`ReferenceWatch`]) on ADC1's injected
+//! channel, which leaves the regular conversions and their DMA ring alone; a VDDA outside
+//! [`crate::board::VDDA_BAND_V`], or no usable reading, flags both sensors until a
+//! measurement is in band again.
+
+use crate::board::ReferenceCheck;
+
+/// A brown-out reset level of `FLASH_OPTR.BOR_LEV` (RM0440, "FLASH option register";
+/// the thresholds are the reference manual's approximate falling-edge values).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum BorLevel {
+    /// `000`: about 1.7 V (the factory setting).
+    Level0,
+    /// `001`: about 2.0 V.
+    Level1,
+    /// `010`: about 2.2 V.
+    Level2,
+    /// `011`: about 2.5 V.
+    Level3,
+    /// `100`: about 2.8 V.
+    Level4,
+}
+
+/// The level the firmware wants: the reset releases above about 2.9 V and holds below
+/// about 2.8 V. The NUCLEO's supply is 3.3 V and the reference check flags the readings
+/// below 3.2 V already; below 2.8 V nothing the board measures is worth keeping, and a
+/// clean reset (reported at the next boot as "power-on or brown-out") is better than a
+/// run that goes on with the lamps, the flash writes and the front end out of their
+/// ranges.
+pub const BOR_GOAL: BorLevel = BorLevel::Level4;
+
+impl BorLevel {
+    /// All levels, lowest first.
+    pub const ALL: [BorLevel; 5] = [
+        BorLevel::Level0,
+        BorLevel::Level1,
+        BorLevel::Level2,
+        BorLevel::Level3,
+        BorLevel::Level4,
+    ];
+
+    /// The level's `BOR_LEV` value, 0..=4.
+    pub const fn number(self) -> u8 {
+        self as u8
+    }
+
+    /// The level of a `BOR_LEV` value (`None` for the reserved values 5..=7 and above).
+    pub fn from_number(n: u8) -> Option<BorLevel> {
+        BorLevel::ALL.get(usize::from(n)).copied()
+    }
+
+    /// The level in a value of `FLASH_OPTR` (bits 10:8).
+    pub fn from_optr(optr: u32) -> Option<BorLevel> {
+        BorLevel::from_number(((optr >> 8) & 0b111) as u8)
+    }
+
+    /// The approximate falling threshold [V] (RM0440).
+    pub const fn falling_v(self) -> f32 {
+        match self {
+            BorLevel::Level0 => 1.7,
+            BorLevel::Level1 => 2.0,
+            BorLevel::Level2 => 2.2,
+            BorLevel::Level3 => 2.5,
+            BorLevel::Level4 => 2.8,
+        }
+    }
+}
+
+/// The boot's check of the brown-out level against [`BOR_GOAL`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BorCheck {
+    /// The level in force is [`BOR_GOAL`] (or higher, which the hardware does not have).
+    AtGoal(BorLevel),
+    /// The level in force is below [`BOR_GOAL`]: reported, not changed (module docs).
+    BelowGoal(BorLevel),
+    /// `BOR_LEV` holds a reserved value (5..=7).
+    Reserved(u8),
+}
+
+impl BorCheck {
+    /// The check of a value of `FLASH_OPTR`.
+    pub fn of_optr(optr: u32) -> Self {
+        match BorLevel::from_optr(optr) {
+            Some(level) if level >= BOR_GOAL => BorCheck::AtGoal(level),
+            Some(level) => BorCheck::BelowGoal(level),
+            None => BorCheck::Reserved(((optr >> 8) & 0b111) as u8),
+        }
+    }
+
+    /// The level in force, when it is one.
+    pub fn level(self) -> Option<BorLevel> {
+        match self {
+            BorCheck::AtGoal(l) | BorCheck::BelowGoal(l) => Some(l),
+            BorCheck::Reserved(_) => None,
+        }
+    }
+
+    /// The status line's `bor=` value: the level's number, or 255 for a reserved value.
+    pub fn status_number(self) -> u8 {
+        self.level().map_or(u8::MAX, BorLevel::number)
+    }
+}
+
+/// How often thread mode measures VREFINT while the monitor runs [ms]: fast enough that a
+/// sagging supply is flagged within a second, rare enough that the injected conversion's
+/// 6 us delay of ADC1's regular sequence (once per second, on one sample) does not matter.
+pub const REFERENCE_PERIOD_MS: u32 = 1_000;
+
+/// Longest wait for a started VREFINT conversion [ms]; a conversion takes 6.1 us
+/// (247.5 + 12.5 cycles at 42.5 MHz), so one still pending after this never ran: the
+/// reading counts as unusable ([`ReferenceCheck::Unreadable`]).
+pub const REFERENCE_CONVERSION_TIMEOUT_MS: u32 = 200;
+
+/// Polls of the start-up conversion before it counts as unusable: about 300 us at
+/// 170 MHz, 50 times the conversion's 6.1 us.
+pub const REFERENCE_POLL_LIMIT: u32 = 10_000;
+
+/// One VREFINT conversion on ADC1's injected channel (RM0440, "Injected conversions"):
+/// the firmware implements it on the registers (`JADSTART`, `JEOS`, `JDR1`), the host tests
+/// with a fake.
+pub trait ReferenceAdc {
+    /// The factory's calibration word `VREFINT_CAL`: the reading of VREFINT at
+    /// VDDA = 3.0 V ([`crate::board::vdda_from_vrefint`]).
+    fn calibration(&self) -> u16;
+    /// Starts one conversion (`JADSTART = 1`; a conversion in progress is left alone).
+    fn start(&mut self);
+    /// The result when the conversion has finished (`JEOS` set: `JDR1` read, `JEOS`
+    /// cleared), else `None`.
+    fn result(&mut self) -> Option<u16>;
+}
+
+/// One measurement now, waiting at most [`REFERENCE_POLL_LIMIT`] polls for the result:
+/// the start-up check, before the sample path runs.
+pub fn measure_now(adc: &mut impl ReferenceAdc) -> ReferenceCheck {
+    adc.start();
+    for _ in 0..REFERENCE_POLL_LIMIT {
+        if let Some(code) = adc.result() {
+            return ReferenceCheck::of(code, adc.calibration());
+        }
+    }
+    ReferenceCheck::Unreadable
+}
+
+/// A change of the reference's verdict, for the log.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ReferenceChange {
+    /// The reference is out of band or unreadable: the sensors are flagged from now on.
+    Flagged(ReferenceCheck),
+    /// The reference is back in band (VDDA [V]): the flags it set are cleared.
+    Cleared(f32),
+}
+
+/// Where the periodic measurement stands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum WatchPhase {
+    /// Waiting for the start-up check (nothing is measured before it).
+    NotStarted,
+    /// The next conversion starts at this time [ms].
+    Idle { next_ms: u32 },
+    /// A conversion was started at this time [ms].
+    Converting { since_ms: u32 },
+}
+
+/// The periodic reference check (module docs): a measurement every `period_ms`, the
+/// sensors flagged while the latest is out of band or unreadable.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReferenceWatch {
+    period_ms: u32,
+    phase: WatchPhase,
+    latest: Option<ReferenceCheck>,
+}
+
+impl ReferenceWatch {
+    /// A watch measuring every `period_ms` (at least 1 ms) once the start-up check came
+    /// ([`ReferenceWatch::observe`]).
+    pub fn new(period_ms: u32) -> Self {
+        Self {
+            period_ms: period_ms.max(1),
+            phase: WatchPhase::NotStarted,
+            latest: None,
+        }
+    }
+
+    /// Whether the latest measurement distrusts the readings (out of band or unreadable).
+    pub fn flags_sensors(&self) -> bool {
+        self.latest.is_some_and(|c| c.distrusts_readings())
+    }
+
+    /// The latest VDDA [V] (0 before the start-up check and when unreadable).
+    pub fn vdda_v(&self) -> f32 {
+        match self.latest {
+            Some(ReferenceCheck::InBand(v) | ReferenceCheck::OutOfBand(v)) => v,
+            _ => 0.0,
+        }
+    }
+
+    /// The latest measurement (`None` before the start-up check).
+    pub fn latest(&self) -> Option<ReferenceCheck> {
+        self.latest
+    }
+
+    /// A measurement's result at `now_ms` (the start-up check, or a periodic one): the
+    /// verdict and the next measurement's time; a change of the verdict is returned.
+    pub fn observe(&mut self, check: ReferenceCheck, now_ms: u32) -> Option<ReferenceChange> {
+        let was = self.flags_sensors();
+        self.latest = Some(check);
+        self.phase = WatchPhase::Idle {
+            next_ms: now_ms.wrapping_add(self.period_ms),
+        };
+        match (was, check) {
+            (true, ReferenceCheck::InBand(v)) => Some(ReferenceChange::Cleared(v)),
+            (false, c) if c.distrusts_readings() => Some(ReferenceChange::Flagged(c)),
+            _ => None,
+        }
+    }
+
+    /// One thread-mode period at `now_ms`: starts a due conversion, or takes the result of
+    /// the one running (a result still missing after
+    /// [`REFERENCE_CONVERSION_TIMEOUT_MS`] counts as unreadable). Returns a change of the
+    /// verdict.
+    pub fn poll(&mut self, now_ms: u32, adc: &mut impl ReferenceAdc) -> Option<ReferenceChange> {
+        match self.phase {
+            WatchPhase::NotStarted => None,
+            WatchPhase::Idle { next_ms } => {
+                // Due when `now` has reached `next` (wrapping time: the difference's sign).
+                if now_ms.wrapping_sub(next_ms) < u32::MAX / 2 {
+                    adc.start();
+                    self.phase = WatchPhase::Converting { since_ms: now_ms };
+                }
+                None
+            }
+            WatchPhase::Converting { since_ms } => match adc.result() {
+                Some(code) => self.observe(ReferenceCheck::of(code, adc.calibration()), now_ms),
+                None if now_ms.wrapping_sub(since_ms) >= REFERENCE_CONVERSION_TIMEOUT_MS => {
+                    self.observe(ReferenceCheck::Unreadable, now_ms)
+                }
+                None => None,
+            },
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_brown_out_level_is_read_from_the_option_register() {
+        // The G474's factory option bytes: 0xFFEF_F8AA (BOR_LEV = 000).
+        assert_eq!(
+            BorCheck::of_optr(0xFFEF_F8AA),
+            BorCheck::BelowGoal(BorLevel::Level0)
+        );
+        let at_goal = (0xFFEF_F8AA & !(0b111 << 8)) | (4 << 8);
+        assert_eq!(
+            BorCheck::of_optr(at_goal),
+            BorCheck::AtGoal(BorLevel::Level4)
+        );
+        assert_eq!(BorCheck::of_optr(at_goal).status_number(), 4);
+        let reserved = 0xFFEF_F8AA | (0b111 << 8);
+        assert_eq!(BorCheck::of_optr(reserved), BorCheck::Reserved(7));
+        assert_eq!(BorCheck::of_optr(reserved).status_number(), 255);
+        for level in BorLevel::ALL {
+            assert_eq!(BorLevel::from_number(level.number()), Some(level));
+        }
+        assert!(BorLevel::Level3 < BOR_GOAL);
+    }
+
+    /// A VREFINT that converts at once to the code a given VDDA gives.
+    struct Fake {
+        vdda: f32,
+        cal: u16,
+        pending: bool,
+        converts: bool,
+    }
+
+    impl ReferenceAdc for Fake {
+        fn calibration(&self) -> u16 {
+            self.cal
+        }
+        fn start(&mut self) {
+            self.pending = true;
+        }
+        fn result(&mut self) -> Option<u16> {
+            let done = self.pending && self.converts;
+            self.pending &= !done;
+            done.then(|| (f32::from(self.cal) * 3.0 / self.vdda).round() as u16)
+        }
+    }
+
+    #[test]
+    fn the_start_up_measurement_is_bounded() {
+        let mut adc = Fake {
+            vdda: 3.3,
+            cal: 1655,
+            pending: false,
+            converts: true,
+        };
+        assert!(
+            matches!(measure_now(&mut adc), ReferenceCheck::InBand(v) if (v - 3.3).abs() < 0.01)
+        );
+        adc.converts = false;
+        assert_eq!(measure_now(&mut adc), ReferenceCheck::Unreadable);
+    }
+}
