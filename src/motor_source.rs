@@ -54,7 +54,8 @@ impl MachineSource {
 
 /// The built-in default as a record: [`DEFAULT_MACHINE`], the board's full scales
 /// ([`board::CURRENT_FULL_SCALE_A`], [`board::VOLTAGE_FULL_SCALE_V`]), zero at mid-scale
-/// ([`board::MID_SCALE_CODE`]) and [`board::ENCODER_LINES`] lines counting up.
+/// ([`board::MID_SCALE_CODE`]) and [`board::ENCODER_LINES`] lines counting up, with the
+/// internal pull-ups on.
 pub fn default_record() -> MotorRecord {
     MotorRecord {
         motor: DEFAULT_MACHINE.motor,
@@ -65,6 +66,7 @@ pub fn default_record() -> MotorRecord {
         voltage_offset_counts: [board::MID_SCALE_CODE; 3],
         encoder_lines: board::ENCODER_LINES as u16,
         encoder_reversed: false,
+        encoder_pull_up: true,
     }
 }
 
@@ -141,9 +143,10 @@ pub struct EncoderSetup {
     /// The inputs' filter `ICxF` ([`board::encoder_input_filter`] at twice the supply's
     /// synchronous speed).
     pub input_filter: u8,
-    /// Internal pull-ups on A and B (about 40 kohm): open-collector encoders need a pull-up,
-    /// push-pull ones are not disturbed by it, and an unplugged encoder reads a steady high
-    /// instead of noise.
+    /// Internal pull-ups on A and B (about 40 kohm), the record's `encoder_pull_up`:
+    /// open-collector encoders need a pull-up, push-pull ones are not disturbed by it, and
+    /// an unplugged encoder reads a steady high instead of noise; off for a board with
+    /// pull-ups (or a line receiver) of its own.
     pub pull_up: bool,
 }
 
@@ -159,7 +162,7 @@ pub fn encoder_setup(rec: &MotorRecord) -> EncoderSetup {
             max_rev_per_s,
             board::ENCODER_TIMER_HZ,
         ),
-        pull_up: true,
+        pull_up: rec.encoder_pull_up,
     }
 }
 

@@ -18,6 +18,7 @@ fn other_motor() -> MotorRecord {
         voltage_offset_counts: [2047.5; 3],
         encoder_lines: 2500,
         encoder_reversed: false,
+        encoder_pull_up: true,
     }
 }
 
@@ -134,4 +135,12 @@ fn the_encoder_timer_is_set_up_from_the_record() {
             .encoder
             .counts_per_rev
     );
+    // The pull-ups as the record says, through the record's bytes (the flash page).
+    let rec = MotorRecord {
+        encoder_pull_up: false,
+        ..other_motor()
+    };
+    let (read, source) = motor_source::select(&page_with(&rec.to_bytes()));
+    assert_eq!(source, MachineSource::Flash);
+    assert!(!motor_source::encoder_setup(&read).pull_up);
 }

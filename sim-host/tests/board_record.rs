@@ -52,6 +52,7 @@ fn round_trip_through_the_cli_gives_the_same_parameters() {
     assert_eq!(record.voltage_offset_counts, [2040.25; 3]);
     assert_eq!(record.encoder_lines, 2500);
     assert!(record.encoder_reversed);
+    assert!(record.encoder_pull_up, "pull-ups on unless asked off");
 
     // A flipped bit and a truncated file are refused by the same parser.
     let mut flipped = bytes.clone();
@@ -61,6 +62,34 @@ fn round_trip_through_the_cli_gives_the_same_parameters() {
         MotorRecord::parse(&bytes[..STORED_LEN - 2]),
         Err(RecordError::Truncated)
     );
+}
+
+#[test]
+fn the_encoder_pull_ups_are_written_off_when_asked() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let params = ParamFile::reference_3hp();
+    std::fs::write(dir.path().join("p.toml"), params.to_toml_string()).expect("write");
+    let out = sim_host(
+        &[
+            "board-record",
+            "p.toml",
+            "--out",
+            "motor.bin",
+            "--encoder-no-pull-up",
+        ],
+        dir.path(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let bytes = std::fs::read(dir.path().join("motor.bin")).expect("record written");
+    let record = MotorRecord::parse(&bytes).expect("the core accepts the host's record");
+    assert!(!record.encoder_pull_up && !record.encoder_reversed);
+    // Bit 1 of the encoder flags word at offset 126, version 1 as before.
+    assert_eq!(bytes[126..128], [2, 0]);
+    assert_eq!(bytes[4..6], [1, 0]);
 }
 
 #[test]

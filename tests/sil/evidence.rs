@@ -30,6 +30,7 @@ fn record_3hp() -> MotorRecord {
         voltage_offset_counts: [board::MID_SCALE_CODE; 3],
         encoder_lines: board::ENCODER_LINES as u16,
         encoder_reversed: false,
+        encoder_pull_up: true,
     }
 }
 

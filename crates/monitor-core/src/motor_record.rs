@@ -15,10 +15,21 @@
 //! | 92 | 8 | sensor full scale: current [A], voltage [V], `f32` each |
 //! | 100 | 24 | sensor offsets: currents a, b, c then voltages a, b, c [ADC counts], `f32` each |
 //! | 124 | 2 | encoder lines per revolution, `u16` (counts = 4 x lines) |
-//! | 126 | 2 | encoder direction: 0 forward, 1 reversed, `u16` |
+//! | 126 | 2 | encoder flags, `u16`: bit 0 reversed ([`ENCODER_REVERSED`]), bit 1 internal pull-ups off ([`ENCODER_NO_PULL_UP`]), the other bits 0 |
 //! | 128 | 4 | CRC-32/ISO-HDLC of bytes 0..128 ([`crate::record::crc32`]) |
 //!
-//! so the record with its CRC is [`RECORD_LEN`] + 4 = 132 bytes. Header, CRC, reader and
+//! so the record with its CRC is [`RECORD_LEN`] + 4 = 132 bytes.
+//!
+//! # The encoder flags
+//!
+//! The word at 126 was the encoder's direction (0 forward, 1 reversed), and the firmware
+//! turned the encoder inputs' internal pull-ups on whatever the record said. Bit 1 now
+//! turns them off; its zero value is what every record written before meant, so those
+//! records read unchanged (pull-ups on) and a record with the pull-ups on is written byte for
+//! byte as before, still version 1. A firmware built before this bit rejects a record that
+//! sets it ([`RecordError::Invalid`]: it read only 0 and 1) and falls back to its built-in
+//! default, never to a wrong encoder setting. Any other bit set is
+//! [`RecordError::Invalid`] here too, so a later flag cannot be misread by this reader. Header, CRC, reader and
 //! writer are the project's one record format ([`crate::record`]: the length field holds
 //! the bytes the CRC covers). A record that fails any check is rejected with a
 //! [`RecordError`]; the caller falls back to its built-in default.
@@ -33,6 +44,15 @@ pub const VERSION: u16 = 1;
 pub const RECORD_LEN: usize = 128;
 /// Bytes of a stored record: [`RECORD_LEN`] plus the 4-byte CRC.
 pub const STORED_LEN: usize = RECORD_LEN + 4;
+
+/// Bit 0 of the encoder flags: the encoder counts down when the motor turns forward.
+pub const ENCODER_REVERSED: u16 = 1 << 0;
+/// Bit 1 of the encoder flags: the internal pull-ups on the encoder inputs A and B are off
+/// (clear: on, as in every record written before the bit existed; module docs).
+pub const ENCODER_NO_PULL_UP: u16 = 1 << 1;
+/// The encoder flags this reader knows; a record with any other bit set is
+/// [`RecordError::Invalid`].
+const ENCODER_FLAGS: u16 = ENCODER_REVERSED | ENCODER_NO_PULL_UP;
 
 /// The motor record's format: magic `MREC`, version [`VERSION`], [`STORED_LEN`] bytes.
 pub const FORMAT: RecordFormat = RecordFormat {
@@ -62,8 +82,13 @@ pub struct MotorRecord {
     pub voltage_offset_counts: [f32; 3],
     /// Encoder lines per revolution, >= 1 (quadrature counts are 4 x lines).
     pub encoder_lines: u16,
-    /// The encoder counts down when the motor turns forward.
+    /// The encoder counts down when the motor turns forward ([`ENCODER_REVERSED`]).
     pub encoder_reversed: bool,
+    /// The MCU's internal pull-ups (about 40 kohm) on the encoder inputs A and B: needed by
+    /// an open-collector encoder; off ([`ENCODER_NO_PULL_UP`] set) for one that drives both
+    /// levels or has pull-ups of its own on the board. `true` in records written before the
+    /// flag existed (module docs, "The encoder flags").
+    pub encoder_pull_up: bool,
 }
 
 impl MotorRecord {
@@ -84,8 +109,24 @@ impl MotorRecord {
         w.f32s(&self.current_offset_counts);
         w.f32s(&self.voltage_offset_counts);
         w.u16(self.encoder_lines);
-        w.u16(u16::from(self.encoder_reversed));
+        w.u16(self.encoder_flags());
         w.finish()
+    }
+
+    /// The encoder flags word (module docs): [`ENCODER_REVERSED`] and
+    /// [`ENCODER_NO_PULL_UP`] as the record's fields say.
+    pub fn encoder_flags(&self) -> u16 {
+        let reversed = if self.encoder_reversed {
+            ENCODER_REVERSED
+        } else {
+            0
+        };
+        let no_pull_up = if self.encoder_pull_up {
+            0
+        } else {
+            ENCODER_NO_PULL_UP
+        };
+        reversed | no_pull_up
     }
 
     /// Parses and checks a stored record (extra bytes after [`STORED_LEN`] are ignored, so a
@@ -115,7 +156,7 @@ impl MotorRecord {
         }
     }
 
-    /// The payload's fields in order (the direction word checked: 0 or 1).
+    /// The payload's fields in order (the encoder flags checked: no unknown bit).
     fn fields(r: &mut RecordReader<'_>) -> Result<MotorRecord, RecordError> {
         let [rs_ohm, rr_ohm, ls_h, lr_h, lm_h, j_kgm2, b_nms, bl_nms] = {
             let mut f = [0.0f64; 8];
@@ -144,11 +185,10 @@ impl MotorRecord {
         let current_offset_counts = r.f32s::<3>()?;
         let voltage_offset_counts = r.f32s::<3>()?;
         let encoder_lines = r.u16()?;
-        let encoder_reversed = match r.u16()? {
-            0 => false,
-            1 => true,
-            _ => return Err(RecordError::Invalid),
-        };
+        let flags = r.u16()?;
+        if flags & !ENCODER_FLAGS != 0 {
+            return Err(RecordError::Invalid);
+        }
         Ok(MotorRecord {
             motor,
             supply,
@@ -157,7 +197,8 @@ impl MotorRecord {
             current_offset_counts,
             voltage_offset_counts,
             encoder_lines,
-            encoder_reversed,
+            encoder_reversed: flags & ENCODER_REVERSED != 0,
+            encoder_pull_up: flags & ENCODER_NO_PULL_UP == 0,
         })
     }
 }
@@ -178,6 +219,7 @@ mod tests {
             voltage_offset_counts: [2048.0, 2046.0, 2049.0],
             encoder_lines: 1024,
             encoder_reversed: true,
+            encoder_pull_up: true,
         }
     }
 
@@ -196,6 +238,52 @@ mod tests {
         let old = from_hex(WRITTEN_BEFORE);
         assert_eq!(MotorRecord::parse(&old), Ok(sample()));
         assert_eq!(sample().to_bytes().as_slice(), old.as_slice());
+    }
+
+    #[test]
+    fn a_former_record_reads_with_the_pull_ups_on() {
+        let old = from_hex(WRITTEN_BEFORE);
+        assert_eq!(old[126..128], [1, 0], "the former direction word: reversed");
+        let rec = MotorRecord::parse(&old).unwrap();
+        assert!(rec.encoder_pull_up && rec.encoder_reversed);
+        // The former code's forward record (word 0), re-sealed with its CRC.
+        let mut forward = old.clone();
+        forward[126] = 0;
+        let crc = crate::record::crc32(&forward[..RECORD_LEN]);
+        forward[RECORD_LEN..].copy_from_slice(&crc.to_le_bytes());
+        let rec = MotorRecord::parse(&forward).unwrap();
+        assert!(rec.encoder_pull_up && !rec.encoder_reversed);
+    }
+
+    #[test]
+    fn every_encoder_setting_round_trips_and_unknown_flags_are_refused() {
+        for (reversed, pull_up, word) in [
+            (false, true, 0u16),
+            (true, true, 1),
+            (false, false, 2),
+            (true, false, 3),
+        ] {
+            let rec = MotorRecord {
+                encoder_reversed: reversed,
+                encoder_pull_up: pull_up,
+                ..sample()
+            };
+            let bytes = rec.to_bytes();
+            assert_eq!(bytes[126..128], word.to_le_bytes(), "{reversed} {pull_up}");
+            assert_eq!(bytes[4..6], [1, 0], "still version 1");
+            assert_eq!(MotorRecord::parse(&bytes), Ok(rec));
+        }
+        for word in [4u16, 8, 0x8000, 0xFFFF] {
+            let mut bytes = sample().to_bytes();
+            bytes[126..128].copy_from_slice(&word.to_le_bytes());
+            let crc = crate::record::crc32(&bytes[..RECORD_LEN]);
+            bytes[RECORD_LEN..].copy_from_slice(&crc.to_le_bytes());
+            assert_eq!(
+                MotorRecord::parse(&bytes),
+                Err(RecordError::Invalid),
+                "{word:#x}"
+            );
+        }
     }
 
     #[test]

@@ -1,6 +1,6 @@
 //! `sim-host board-record P.toml --out motor.bin`: the board's motor record (the parameter
 //! file's `[motor]` and `[supply]`, the sensor scaling and offsets, the encoder's line count
-//! and direction) in the layout of `monitor_core::motor_record`, which the firmware reads
+//! direction and pull-ups) in the layout of `monitor_core::motor_record`, which the firmware reads
 //! from its flash page at boot (`docs/firmware.md` has the probe-rs command that writes it).
 //! The output is written atomically and is never the input.
 
@@ -16,7 +16,7 @@ use std::path::PathBuf;
 #[command(
     about = "Write the board's motor record (flash image) from a parameter file",
     long_about = "Write the firmware's motor record: the parameter file's [motor] and [supply], \
-the sensor full scales and zero offsets, and the encoder's line count and direction, as the \
+the sensor full scales and zero offsets, and the encoder's line count, direction and pull-ups, as the \
 132-byte CRC-checked record the firmware reads from flash at boot. The output is written \
 atomically and is never the input.\n\nExample:\n  sim-host board-record P.toml --out motor.bin"
 )]
@@ -44,6 +44,11 @@ pub struct BoardRecordArgs {
     /// The encoder counts down when the motor turns forward.
     #[arg(long)]
     pub encoder_reversed: bool,
+    /// The MCU's internal pull-ups on the encoder inputs off (on by default, as an
+    /// open-collector encoder needs): for an encoder that drives both levels or a board
+    /// with pull-ups of its own.
+    #[arg(long)]
+    pub encoder_no_pull_up: bool,
 }
 
 /// Runs `board-record`.
@@ -63,6 +68,7 @@ pub fn run(args: &BoardRecordArgs) -> anyhow::Result<()> {
         voltage_offset_counts: [args.voltage_offset_counts; 3],
         encoder_lines: args.encoder_lines,
         encoder_reversed: args.encoder_reversed,
+        encoder_pull_up: !args.encoder_no_pull_up,
     };
     let bytes = record.to_bytes();
     if let Err(e) = MotorRecord::parse(&bytes) {
