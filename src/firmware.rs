@@ -55,9 +55,10 @@ use drive_monitor::app::{
     PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
 };
 use drive_monitor::board::{self, pins::Board, CurrentCode, Lamp, VoltageCode, LAMP_COUNT};
-use drive_monitor::flash_record::{self, LoadError, RecordStore, RECORD_LEN};
+use drive_monitor::boot::{self, Booted};
+use drive_monitor::flash_record::{RecordStore, RECORD_LEN};
 use drive_monitor::liveness::AdcWait;
-use drive_monitor::motor_source::{self, EncoderSetup};
+use drive_monitor::motor_source::EncoderSetup;
 use drive_monitor::offset_trim::TrimResult;
 use drive_monitor::panel::PanelLamps;
 use drive_monitor::recovery::{self, RecoveryCounts, StepTimeout};
@@ -65,7 +66,7 @@ use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
 use drive_monitor::sampling::RawFrame;
 use drive_monitor::setup_guard::SetupStep;
 use drive_monitor::supply::BorCheck;
-use monitor_core::motor_record::{MotorRecord, STORED_LEN as MOTOR_RECORD_LEN};
+use monitor_core::motor_record::STORED_LEN as MOTOR_RECORD_LEN;
 use monitor_core::Isolation;
 
 use acquisition::HwAcquisition;
@@ -526,34 +527,16 @@ fn start_watchdog(
     wdg
 }
 
-/// The machine: the motor record in flash, else the built-in default (the reason is
-/// logged; a page that cannot be read counts as erased). Returns the record in force, its
-/// sample path and whether it is the built-in default.
-fn select_machine(flash: &mut BoardFlash) -> (MotorRecord, SamplePath, bool) {
+/// The motor record's page (`board::MOTOR_RECORD_FLASH_OFFSET`), read as erased when the
+/// flash cannot be read (the reason is logged): `drive_monitor::boot` then runs the
+/// built-in default.
+fn read_motor_page(flash: &mut BoardFlash) -> [u8; MOTOR_RECORD_LEN] {
     let mut page = [0xFF_u8; MOTOR_RECORD_LEN];
     if let Err(e) = flash.read_at(board::MOTOR_RECORD_FLASH_OFFSET, &mut page) {
         warn!("motor record page unreadable: {}", e);
+        page = [0xFF; MOTOR_RECORD_LEN];
     }
-    let (mut machine, source) = motor_source::select(&page);
-    info!("{=str}", source.describe());
-    let mut default_motor = source.is_default();
-    let path = match motor_source::sample_path(&machine, SETTINGS.sample_rate_hz) {
-        Ok(p) => p,
-        Err(_) => {
-            // A record the core accepted at boot but not at this sample rate: the default.
-            warn!("motor record rejected at this sample rate: built-in default motor");
-            default_motor = true;
-            machine = motor_source::default_record();
-            match SamplePath::for_board(SETTINGS.sample_rate_hz) {
-                Ok(p) => p,
-                // The settings are constants and a host test (`app::tests`) builds the same
-                // path: this cannot happen, and if it did nothing could be monitored.
-                #[allow(clippy::panic)]
-                Err(_) => panic!("monitor configuration rejected"),
-            }
-        }
-    };
-    (machine, path, default_motor)
+    page
 }
 
 #[embassy_executor::main]
@@ -596,19 +579,26 @@ async fn main(_spawner: Spawner) {
     };
     let mut button = ExtiInput::new(b.button, b.button_exti, Pull::Down, Irqs);
 
-    let (machine, mut path, default_motor) = select_machine(&mut thread.flash);
-    let installed = install_stored_calibration(&mut thread.flash, &mut path);
+    // The boot composition (`drive_monitor::boot`, the function the host's SIL rig boots
+    // through): the machine, its sample path, isolator and encoder set-up, the stored
+    // calibration and the supervisor, each failure with its fallback, logged.
+    let page = read_motor_page(&mut thread.flash);
+    let booted = match boot::boot(&page, &mut thread.flash, &SETTINGS, previous, 0) {
+        Ok(b) => b,
+        // The built-in default at the constant sample rate: a host test (`app::tests`)
+        // builds the same path, so this cannot happen, and if it did nothing could be
+        // monitored.
+        #[allow(clippy::panic)]
+        Err(_) => panic!("monitor configuration rejected"),
+    };
+    logs::log_boot(&booted);
+    let Booted {
+        machine,
+        path,
+        mut supervisor,
+        ..
+    } = booted;
     let boot = Instant::now();
-    let mut supervisor = Supervisor::new(&SETTINGS, previous, 0, path.status());
-    supervisor.set_default_motor(default_motor);
-    if !default_motor {
-        supervisor.set_isolator(motor_source::isolator(&machine).ok());
-    }
-    if let Some(rec) = installed {
-        if supervisor.restore_isolation(&rec) {
-            info!("isolation baseline restored from the record");
-        }
-    }
 
     // High-priority executor for the sample path.
     interrupt::UART4.set_priority(Priority::P1);
@@ -624,7 +614,7 @@ async fn main(_spawner: Spawner) {
         tim4: b.encoder_timer,
         enc_a: b.encoder_a,
         enc_b: b.encoder_b,
-        encoder: motor_source::encoder_setup(&machine),
+        encoder: machine.encoder,
         syst: cp.SYST,
     };
     set_phase(BootPhase::Boot);
@@ -729,34 +719,6 @@ impl Thread {
                 self.max_update_cycles,
                 (supervisor.reference().vdda_v(), self.bor.status_number()),
             );
-        }
-    }
-}
-
-/// Reads the commissioning record and gives it to the core; returns it when the core
-/// accepted it.
-fn install_stored_calibration(
-    flash: &mut BoardFlash,
-    path: &mut SamplePath,
-) -> Option<flash_record::CalibrationRecord> {
-    match flash_record::load(flash) {
-        Ok(rec) => match path.command(Command::SetCalibration(rec)) {
-            Ok(()) => {
-                info!("commissioned: record loaded");
-                Some(rec)
-            }
-            Err(_) => {
-                warn!("stored calibration out of the core's range: not commissioned");
-                None
-            }
-        },
-        Err(LoadError::Read(e)) => {
-            warn!("flash read failed: {}: not commissioned", e);
-            None
-        }
-        Err(LoadError::Record(e)) => {
-            warn!("no valid commissioning record: {=str}", e.describe());
-            None
         }
     }
 }

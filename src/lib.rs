@@ -6,6 +6,9 @@
 //!   rate constants, the lamp table (each lamp's pin and meaning, once) and (target only)
 //!   the pin map;
 //! - [`sampling`]: one trigger's six ADC codes + encoder count -> the core's `Sample`;
+//! - [`motor_source`] and [`boot`]: the machine from the motor record (or the built-in
+//!   default) and the boot's composition: sample path, isolator, encoder set-up, stored
+//!   calibration and supervisor, each failure with its fallback;
 //! - [`commissioning`]: the button -> learn -> store procedure around the core's
 //!   commissioning runs;
 //! - [`flash_record`]: the commissioning record (a format of the core's one record module,
@@ -49,6 +52,7 @@
 
 pub mod app;
 pub mod board;
+pub mod boot;
 pub mod commissioning;
 pub mod flash_record;
 pub mod liveness;

@@ -1,11 +1,12 @@
-//! The firmware's log lines for events: why the previous run ended, the start-up checks
-//! (offset trim, reference, brown-out level), liveness changes and the commissioning's
+//! The firmware's log lines for events: why the previous run ended, what the boot put into
+//! force, the start-up checks (offset trim, reference, brown-out level), liveness changes and the commissioning's
 //! ends. The status line is `log_status` in `src/firmware.rs`.
 
 use core::sync::atomic::Ordering;
 
 use defmt::{error, info, warn};
 use drive_monitor::board::{ReferenceCheck, VDDA_BAND_V};
+use drive_monitor::boot::{Booted, CalibrationMissing};
 use drive_monitor::commissioning::RunEnd;
 use drive_monitor::flash_record::{self, StoreError};
 use drive_monitor::liveness::LivenessChange;
@@ -119,6 +120,28 @@ fn log_record(rec: &ResetRecord) {
             "previous run ended in a watchdog reset: the sample path had stalled (no samples for {=u32} ms when recorded; recoveries did not help)",
             rec.line_or_ms()
         ),
+    }
+}
+
+/// What the boot composition (`drive_monitor::boot::boot`) put into force and each fallback
+/// it took: the machine's source, the isolation, the commissioning record.
+pub(super) fn log_boot<E: defmt::Format>(booted: &Booted<E>) {
+    info!("{=str}", booted.machine.source.describe());
+    if booted.machine.isolation.is_err() {
+        warn!("the fault isolation rejects this machine: isolation off, the lamps monitor it (blink code: their top candidate)");
+    }
+    match &booted.calibration {
+        Ok(_) => info!("commissioned: record loaded"),
+        Err(CalibrationMissing::Read(e)) => warn!("flash read failed: {}: not commissioned", e),
+        Err(CalibrationMissing::Record(e)) => {
+            warn!("no valid commissioning record: {=str}", e.describe())
+        }
+        Err(CalibrationMissing::Refused(_)) => {
+            warn!("stored calibration out of the core's range: not commissioned")
+        }
+    }
+    if booted.baseline_restored {
+        info!("isolation baseline restored from the record");
     }
 }
 

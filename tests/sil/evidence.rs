@@ -11,7 +11,6 @@
 
 use super::*;
 use drive_monitor::app::isolation_summary;
-use drive_monitor::motor_source;
 use monitor_core::motor_record::MotorRecord;
 use monitor_core::reference::MOTOR_3HP;
 use sim_host::experiment::simulate_and_replay;
@@ -53,15 +52,12 @@ fn scenario(fault: Option<(Fault, f64)>) -> Scenario {
     sc
 }
 
-/// The board with the 3 hp record (the firmware's boot with a motor record in flash:
-/// `motor_source`), commissioned at 1.5 s, through the whole log; returns the rig.
+/// The board with the 3 hp record in its motor-record page (the firmware's boot
+/// composition, `drive_monitor::boot`), commissioned at 1.5 s, through the whole log; returns the rig.
 fn board_run(sc: &Scenario) -> Rig {
     let rec = record_3hp();
-    let mut rig = Rig::boot(Survivors::power_on(FakeFlash::erased()));
-    rig.path = motor_source::sample_path(&rec, FS).unwrap();
-    rig.supervisor = Supervisor::new(&rig.settings, rig.previous, 0, rig.path.status());
-    rig.supervisor
-        .set_isolator(motor_source::isolator(&rec).ok());
+    let survivors = Survivors::power_on(FakeFlash::erased()).with_motor_page(&rec.to_bytes());
+    let mut rig = Rig::boot(survivors);
     let frames = frames_with(&ParamFile::reference_3hp(), &rig.path, sc);
     rig.run_commissioning(&frames);
     rig

@@ -14,6 +14,7 @@
 //! At every thread tick the rig checks that RAM (the core's thresholds), flash (the record
 //! the next boot would load) and the panel (the RUN lamp's mode) agree.
 
+mod boot_composition;
 mod commissioning;
 mod evidence;
 mod isolation;
@@ -27,6 +28,7 @@ use drive_monitor::app::{
     WATCHDOG_TIMEOUT_MS,
 };
 use drive_monitor::board::{self, RECORD_PAGE_SIZE};
+use drive_monitor::boot;
 use drive_monitor::commissioning::{Failure, RunEnd};
 use drive_monitor::flash_record::{self, CalibrationRecord, RecordStore, RECORD_LEN};
 use drive_monitor::liveness::AdcWait;
@@ -67,7 +69,7 @@ struct FakeFlash {
     writes: u32,
 }
 
-#[derive(Debug)]
+#[derive(Debug, PartialEq)]
 struct FlashError;
 
 impl FakeFlash {
@@ -136,20 +138,40 @@ impl RecordStore for FakeFlash {
 #[derive(Clone, Debug)]
 struct Survivors {
     flash: FakeFlash,
+    /// The motor record's flash page as the firmware reads it at boot.
+    motor_page: Vec<u8>,
     reset_ram: [u8; RESET_RECORD_LEN],
     /// What the reset flags of `RCC_CSR` say at the next boot.
     reset_source: ResetSource,
 }
 
 impl Survivors {
+    /// Power on with `flash` as the commissioning page and the built-in machine's motor
+    /// record on its page (so the panel shows no default-motor mark).
     fn power_on(flash: FakeFlash) -> Self {
         Self {
             flash,
+            motor_page: motor_page(&drive_monitor::motor_source::default_record().to_bytes()),
             // Power-on RAM content: anything.
             reset_ram: [0x5A; RESET_RECORD_LEN],
             reset_source: ResetSource::PowerOnOrBrownOut,
         }
     }
+
+    /// The same with `bytes` at the start of the motor record's page.
+    fn with_motor_page(self, bytes: &[u8]) -> Self {
+        Self {
+            motor_page: motor_page(bytes),
+            ..self
+        }
+    }
+}
+
+/// A motor-record flash page (2 KiB) holding `bytes`, erased after them.
+fn motor_page(bytes: &[u8]) -> Vec<u8> {
+    let mut page = vec![0xFF; RECORD_PAGE_SIZE as usize];
+    page[..bytes.len()].copy_from_slice(bytes);
+    page
 }
 
 /// Why a run of the rig stopped.
@@ -214,21 +236,18 @@ impl Rig {
         // reset button's.
         survivors.reset_source = ResetSource::Pin;
         survivors.flash.power_lost = false;
-        let mut path = SamplePath::for_board(settings.sample_rate_hz).unwrap();
-        let mut installed = None;
-        if let Ok(rec) = flash_record::load(&mut survivors.flash) {
-            // A record the core rejects leaves the default thresholds (logged on the board).
-            if path
-                .command(drive_monitor::app::Command::SetCalibration(rec))
-                .is_ok()
-            {
-                installed = Some(rec);
-            }
-        }
-        let mut supervisor = Supervisor::new(&settings, previous, 0, path.status());
-        if let Some(rec) = installed {
-            supervisor.restore_isolation(&rec);
-        }
+        // The firmware's boot composition: the machine, its sample path and isolator, the
+        // stored calibration (a record the core rejects leaves the default thresholds) and
+        // the supervisor.
+        let booted = boot::boot(
+            &survivors.motor_page,
+            &mut survivors.flash,
+            &settings,
+            previous,
+            0,
+        )
+        .unwrap();
+        let (path, supervisor) = (booted.path, booted.supervisor);
         Rig {
             settings,
             survivors,

@@ -143,11 +143,11 @@ fn a_corrupt_or_old_motor_record_shows_the_default_motor_mark_on_the_panel() {
         (&erased, true),
     ];
     for (page, default) in pages {
-        // The boot's choice (src/firmware.rs: `motor_source::select`), handed to the panel.
-        let (_, source) = motor_source::select(page);
-        assert_eq!(source.is_default(), default, "{source:?}");
-        let mut rig = Rig::boot(Survivors::power_on(FakeFlash::erased()));
-        rig.supervisor.set_default_motor(source.is_default());
+        // The boot composition (`drive_monitor::boot`, as the firmware boots) on that page.
+        let (machine, _, _) = drive_monitor::boot::machine(page, FS).unwrap();
+        assert_eq!(machine.source.is_default(), default, "{:?}", machine.source);
+        let survivors = Survivors::power_on(FakeFlash::erased()).with_motor_page(page);
+        let mut rig = Rig::boot(survivors);
         rig.run(&off, |_, _| {}).unwrap();
         // The RUN lamp's longest lit stretch at the 50 ms ticks.
         let (mut on_ms, mut longest_ms) = (0, 0);
