@@ -9,6 +9,10 @@
 //!   vector table is at 0x0 (the mps2-an386 layout, not the G474's), and run it on
 //!   `qemu-system-arm -M mps2-an386 -cpu cortex-m4 -icount shift=0` with semihosting.
 //!   Exits with QEMU's status (non-zero on any mismatch) and after 300 s at the latest.
+//! - `qemu-rtt [--blocking | --drop-on-contention]`: the same for `crates/rtt-on-m4`, the
+//!   firmware's defmt-rtt logger with a stalled reader against a 10 kHz sample loop (no
+//!   sample may be lost); `--blocking` builds the control with defmt-rtt's blocking mode (the
+//!   samples must stop), `--drop-on-contention` defmt-rtt's other mode, for comparison.
 //!
 //! The QEMU program's data (`crates/core-on-m4/data/{replay,expected}.bin`) is a log from
 //! the sim-host simulator and the host build's answers to it; the root test
@@ -165,17 +169,23 @@ fn fw(check: bool) -> Result<(), String> {
     Ok(())
 }
 
-fn qemu_core() -> Result<ExitCode, String> {
-    let dir = root().join("crates/core-on-m4");
-    run(cargo().current_dir(&dir).args([
-        "build",
-        "--release",
-        "--target",
-        TARGET,
-        "--manifest-path",
-        "Cargo.toml",
-    ]))?;
-    let elf_path = target_dir(&dir).join(TARGET).join("release/core-on-m4");
+/// Builds the QEMU program in `crates/<name>` (release, `thumbv7em-none-eabihf`, with
+/// `features`: cargo's feature arguments), checks that its vector table is at 0x0 (the
+/// mps2-an386 layout, not the G474's) and returns the ELF's path.
+fn build_qemu_program(name: &str, features: &[&str]) -> Result<PathBuf, String> {
+    let dir = root().join("crates").join(name);
+    run(cargo()
+        .current_dir(&dir)
+        .args([
+            "build",
+            "--release",
+            "--target",
+            TARGET,
+            "--manifest-path",
+            "Cargo.toml",
+        ])
+        .args(features))?;
+    let elf_path = target_dir(&dir).join(TARGET).join("release").join(name);
     let elf = std::fs::read(&elf_path).map_err(|e| format!("{}: {e}", elf_path.display()))?;
     let vt = sections(&elf)?
         .into_iter()
@@ -187,6 +197,12 @@ fn qemu_core() -> Result<ExitCode, String> {
             vt.addr
         ));
     }
+    Ok(elf_path)
+}
+
+/// Runs `elf` on `qemu-system-arm -M mps2-an386 -cpu cortex-m4 -icount shift=0` with
+/// semihosting; its exit status, or an error after 300 s.
+fn run_qemu(elf_path: &Path) -> Result<ExitCode, String> {
     let mut child = Command::new("qemu-system-arm")
         .args([
             "-M",
@@ -204,7 +220,7 @@ fn qemu_core() -> Result<ExitCode, String> {
             "enable=on,target=native",
         ])
         .args(["-icount", "shift=0", "-kernel"])
-        .arg(&elf_path)
+        .arg(elf_path)
         .stdin(Stdio::null())
         .spawn()
         .map_err(|e| {
@@ -227,12 +243,33 @@ fn qemu_core() -> Result<ExitCode, String> {
     }
 }
 
+fn qemu_core() -> Result<ExitCode, String> {
+    run_qemu(&build_qemu_program("core-on-m4", &[])?)
+}
+
+/// `qemu-rtt`: the stalled log reader against the 10 kHz sample loop (`crates/rtt-on-m4`)
+/// with the firmware's logger; `--blocking` the control (defmt-rtt's default blocking
+/// mode: the samples must stop), `--drop-on-contention` defmt-rtt's other mode.
+fn qemu_rtt(args: &[String]) -> Result<ExitCode, String> {
+    let features: &[&str] = match args.first().map(String::as_str) {
+        None => &[],
+        Some("--blocking") => &["--no-default-features"],
+        Some("--drop-on-contention") => &["--features", "contention"],
+        Some(other) => return Err(format!("qemu-rtt: unknown option {other}")),
+    };
+    run_qemu(&build_qemu_program("rtt-on-m4", features)?)
+}
+
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let result = match args.first().map(String::as_str) {
         Some("fw") => fw(args.iter().any(|a| a == "--check")).map(|()| ExitCode::SUCCESS),
         Some("qemu-core") => qemu_core(),
-        _ => Err("usage: fwtool fw [--check] | qemu-core".into()),
+        Some("qemu-rtt") => qemu_rtt(&args[1..]),
+        _ => Err(
+            "usage: fwtool fw [--check] | qemu-core | qemu-rtt [--blocking | --drop-on-contention]"
+                .into(),
+        ),
     };
     match result {
         Ok(code) => code,
