@@ -21,6 +21,7 @@ pub mod status_line;
 use crate::demo::MonitorState;
 use crate::params::ParamFile;
 use crate::replay::{FaultCandidate, IsolationName, IsolationReport, Replay};
+use monitor_core::isolation::FaultCall;
 use monitor_core::sequence::min_shorted_fraction;
 use monitor_core::{Fault, IsolationState, MonitorOutput, Phase};
 use std::collections::VecDeque;
@@ -55,8 +56,13 @@ pub struct Snapshot {
     pub residuals: [f32; 4],
     /// Residual lamps r1..r4.
     pub lamps: [bool; 4],
-    /// The fault lamp: a residual lamp or a sensor fault.
+    /// The fault lamp: a residual lamp or a sensor fault, as the one rule calls it
+    /// ([`Snapshot::call`]) where the source makes the call.
     pub fault_lamp: bool,
+    /// The one rule's call on the lamps (`monitor_core::isolation::fault_call`): a replay's
+    /// panel ([`crate::replay::Replay::panel`]), the board's `call=`; `None` where the source
+    /// gives none (the FAULT lamp is then the lamps' detection).
+    pub call: Option<FaultCall>,
     /// Threshold band of each residual in force, (centre, half-width).
     pub bands: Option<[(f32, f32); 4]>,
     /// Learned thresholds are in force (else the fixed ones).
@@ -195,6 +201,7 @@ impl Snapshot {
             residuals: out.residuals,
             lamps: out.lamps,
             fault_lamp: out.fault_detected,
+            call: None,
             bands,
             learned,
             candidates,
@@ -213,18 +220,20 @@ impl Snapshot {
 
 impl Snapshot {
     /// The reading of a replay's output `out` at `t_s` ([`Snapshot::from_output`]) with
-    /// the replay's isolation, and the amber state: where the load or the voltage has left
-    /// the commissioned range ([`Replay::operating_point_moved`]) and neither the isolation
-    /// nor a sensor check names a fault, the state is [`MonitorState::Moved`] and the FAULT
-    /// lamp stays off (the residual lamps show what they show).
+    /// the replay's isolation and its panel ([`Replay::panel`], the demo's and `diagnose`'s
+    /// timeline too): the amber state where the load or the voltage has left the
+    /// commissioned range ([`Replay::operating_point_moved`]) and neither the isolation nor
+    /// a sensor check names a fault, and the FAULT lamp by the one rule (off in the amber
+    /// state, while watching, and against the nominal values for a name within the file's
+    /// uncertainty; the residual lamps show what they show).
     pub fn from_replay(t_s: f64, out: &MonitorOutput, replay: &Replay, params: &ParamFile) -> Self {
         let learned = replay.calibration().is_some();
         let mut s = Snapshot::from_output(t_s, out, replay.threshold_bands(), learned, params);
         s.isolation = Some(IsolationView::of_replay(replay));
-        s.state = replay.state(out);
-        if matches!(s.state, MonitorState::Moved(_)) {
-            s.fault_lamp = false;
-        }
+        let panel = replay.panel(out);
+        s.state = panel.state;
+        s.fault_lamp = panel.fault_lamp;
+        s.call = Some(panel.call);
         s
     }
 }
@@ -387,8 +396,13 @@ impl HmiState {
             return format!("{}: waiting for the first reading", self.title);
         };
         let lamps: String = s.lamps.iter().map(|l| if *l { '●' } else { '○' }).collect();
-        let (lamp, text) =
-            lamp_and_header(&s.state, s.fault_lamp, &s.candidates, s.isolation.as_ref());
+        let (lamp, text) = lamp_and_header(
+            &s.state,
+            s.fault_lamp,
+            s.call,
+            &s.candidates,
+            s.isolation.as_ref(),
+        );
         let lamp = if lamp.is_empty() {
             String::new()
         } else {
@@ -429,26 +443,31 @@ pub fn header_of(
     }
 }
 
-/// The lamp's word (`FAULT`, the amber `MOVED`, `WATCHING` for lamps whose named fault is
-/// too small for a FAULT (`replay::MIN_FAULT_CHANGE`), or empty with the FAULT lamp off) and
-/// the header ([`header_of`]) without the word repeated: the plain status line, the demo's and
-/// `diagnose`'s state column.
+/// The lamp's word and the header ([`header_of`]) without the word repeated: the plain
+/// status line, the demo's and `diagnose`'s state column. The word: `FAULT` with the FAULT
+/// lamp lit, the amber `MOVED`; with lamps lit and the FAULT lamp off, the one rule's call
+/// (`monitor_core::isolation::fault_call`): `WATCHING` for a named fault too small for a
+/// FAULT (`replay::MIN_FAULT_CHANGE`), `NOT JUDGED` against the nominal values with no name
+/// beyond the file's uncertainty (`replay::NOMINAL_UNCERTAINTY`); else empty.
 pub fn lamp_and_header(
     state: &MonitorState,
     fault_lamp: bool,
+    call: Option<FaultCall>,
     candidates: &[(Fault, f32)],
     isolation: Option<&IsolationView>,
 ) -> (&'static str, String) {
     let header = header_of(state, candidates, isolation);
-    let lamp = match (state, fault_lamp) {
-        (MonitorState::Moved(_), _) => "MOVED",
-        (_, true) => "FAULT",
-        // Lamps lit with the FAULT lamp off and a fault named: a name too small for a
-        // FAULT (the one rule), watched.
-        (MonitorState::Fault(_), false) if isolation.is_some_and(|i| i.named.is_some()) => {
+    let lamp = match (state, fault_lamp, call) {
+        (MonitorState::Moved(_), _, _) => "MOVED",
+        (_, true, _) => "FAULT",
+        (MonitorState::Fault(_), false, Some(FaultCall::NotCommissioned)) => "NOT JUDGED",
+        (MonitorState::Fault(_), false, Some(FaultCall::Watching)) => "WATCHING",
+        // Lamps lit with the FAULT lamp off and a fault named, where the source makes no
+        // call: a name too small for a FAULT, watched.
+        (MonitorState::Fault(_), false, _) if isolation.is_some_and(|i| i.named.is_some()) => {
             "WATCHING"
         }
-        (_, false) => "",
+        (_, false, _) => "",
     };
     // The lamp's word once: a state that begins with it loses it.
     let text = match header.strip_prefix("FAULT ") {

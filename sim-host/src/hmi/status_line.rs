@@ -9,7 +9,8 @@
 //! r=[r1, r2, r3, r4] lamps=[b1, b2, b3, b4] fault=B top=NAME(P) 2nd=NAME(P) wm=Xrad/s
 //! zc_locked=.. mode=MODE run=ID:LEARNED/NEEDED overruns=N restarts=N samples=N
 //! max_cyc=N iqs=XA ids=XA vqs=XV f=XHz steady=B eval=B sens=B,B,B mid=[..] half=[..]
-//! iso=NAME iso_change=X iso_p=P wind=PHASE wind_i2=X moved=B rise=XK
+//! iso=NAME iso_change=X iso_p=P wind=PHASE wind_i2=X moved=B rise=XK vdda=XV bor=N
+//! call=CALL
 //! ```
 //!
 //! The parser finds the `key=` fields anywhere in a line, so the decoder's decorations
@@ -21,6 +22,7 @@
 use super::{quit_key, Controls, HmiState, Key, Snapshot, Source, StdinControls};
 use crate::demo::MonitorState;
 use crate::replay::{FaultCandidate, IsolationName};
+use monitor_core::isolation::FaultCall;
 use monitor_core::{Fault, IsolationState};
 use std::io::BufRead;
 use std::sync::mpsc::{channel, Receiver, TryRecvError};
@@ -76,6 +78,10 @@ pub struct FirmwareStatus {
     pub moved: Option<bool>,
     /// The winding temperature rise since commissioning the isolation tracks [K] (`rise=`).
     pub winding_rise_k: Option<f32>,
+    /// The one rule's call on the board's lamps (`call=`: `clear`, `fault`, `watching`,
+    /// `not-commissioned`; `monitor_core::isolation::fault_call`), which lights the board's
+    /// FAULT lamp for `fault` only; `None` from an older firmware (then `fault=` does).
+    pub call: Option<FaultCall>,
 }
 
 /// The isolation fields of a status line (`iso=`, `iso_change=`, `iso_p=`; the firmware's
@@ -218,6 +224,7 @@ pub fn parse(line: &str) -> Option<FirmwareStatus> {
             .map(|p| (p, f("wind_i2").unwrap_or(0.0))),
         moved: b("moved"),
         winding_rise_k: f("rise"),
+        call: field(line, "call").and_then(FaultCall::from_name),
     })
 }
 
@@ -268,7 +275,9 @@ impl FirmwareStatus {
             t_s,
             residuals: self.residuals,
             lamps: self.lamps,
-            fault_lamp: self.fault && !matches!(state, MonitorState::Moved(_)),
+            fault_lamp: self.call.map_or(self.fault, FaultCall::is_fault)
+                && !matches!(state, MonitorState::Moved(_)),
+            call: self.call,
             bands: self.band.map(|(m, h)| [0, 1, 2, 3].map(|k| (m[k], h[k]))),
             learned: self.mode.as_deref() == Some("commissioned"),
             candidates: self.candidates.clone(),

@@ -187,8 +187,9 @@ struct Concluded {
 /// How far a parameter file's values may be off the machine's (nameplate estimates are
 /// 10-30 % off): against the nominal parameters (no commissioning), a change this small or
 /// smaller, with every lamp dark, is the file's own error as much as a fault, and is not
-/// named.
-pub const NOMINAL_UNCERTAINTY: f32 = 0.3;
+/// named; with lamps lit it is no FAULT (the one rule, `monitor_core::isolation::fault_call`).
+/// The core's constant, re-exported.
+pub use monitor_core::isolation::NOMINAL_UNCERTAINTY;
 
 impl IsolationTracker {
     /// A tracker for the nominal machine (`None`: a machine the isolator rejects, then
@@ -770,9 +771,9 @@ const MOVED_SAID_FROM: f32 = 0.05;
 /// The one-sentence verdict of the isolation; `moved`: the current's relative distance
 /// from the learned point ([`IsolationReport::moved_from_learned`]).
 /// A named fault (not the friction class, which a load change moves) whose size is within
-/// [`NOMINAL_UNCERTAINTY`].
+/// [`NOMINAL_UNCERTAINTY`] (`monitor_core::isolation::within_nominal_uncertainty`).
 fn within_nominal_uncertainty(n: &Named) -> bool {
-    matches!(n, Named::Fault(c) if c.change.abs() <= NOMINAL_UNCERTAINTY)
+    matches!(n, Named::Fault(c) if monitor_core::isolation::within_nominal_uncertainty(c.change))
 }
 
 /// A current this far (relative) from the commissioned point's is another operating point:

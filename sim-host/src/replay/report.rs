@@ -4,8 +4,12 @@
 use super::isolation::{self, FaultCandidate, IsolationReport, SensorPhaseReport};
 use super::{serialize_angle_source, CommissioningReport, Replay, UnbalanceBaseline};
 use crate::log::quality::DataQuality;
+use monitor_core::isolation::{fault_call, FaultCall};
 use monitor_core::{AngleSource, CommissioningState, Fault, MonitorOutput, Phase};
 use serde::{Serialize, Serializer};
+
+mod verdict;
+use verdict::{nominal_cannot_judge, sighting, verdict_of};
 
 /// What the monitor is doing at a timeline point, as the panel would show it.
 #[derive(Debug, Clone, PartialEq)]
@@ -114,27 +118,30 @@ impl Replay {
         let evaluated = matches!(own, MonitorState::Healthy | MonitorState::Fault(_));
         let isolation = evaluated.then(|| self.isolation_now());
         let state = self.state_given(out, own, isolation.as_ref().map(|(r, _)| r));
+        // Outside the evaluated points (a transient: the lamps hold) the isolation is
+        // asked once here where the rule or the load's note needs it.
+        let asked = (isolation.is_none() && (out.fault_detected || self.lamps_since_moved))
+            .then(|| self.isolation_now().0);
+        let report = isolation.as_ref().map(|(r, _)| r).or(asked.as_ref());
         // Lamps held through the transient after a load move are the load's, not a fault,
         // unless the isolation names one.
         let held_for_load = self.lamps_since_moved
             && !matches!(
-                isolation
-                    .as_ref()
-                    .map_or_else(|| self.isolation_now().0.named, |(r, _)| r.named),
+                report.and_then(|r| r.named),
                 Some(isolation::IsolationName::Fault(_))
             );
-        // A name too small for a FAULT (the one rule, [`super::MIN_FAULT_CHANGE`]) is
-        // watched: the FAULT lamp stays off and the state says what was seen.
-        let watched = !out.sensor_fault.any()
-            && isolation.as_ref().is_some_and(|(r, _)| {
-                r.named_change
-                    .is_some_and(|c| c.abs() < super::MIN_FAULT_CHANGE)
-            });
+        // The one rule for a FAULT (`monitor_core::isolation::fault_call`), as the verdict
+        // and the board's lamp: a name too small is watched, lamps against the nominal
+        // values with no name beyond the file's +-30 % are no judgement; the FAULT lamp is
+        // lit for a FAULT only.
+        let call = report.map_or(FaultCall::Clear, |r| {
+            fault_call(&sighting(out.fault_detected, out.sensor_fault.any(), r))
+        });
         Panel {
-            fault_lamp: out.fault_detected
+            fault_lamp: call.is_fault()
                 && !matches!(state, MonitorState::Moved(_))
-                && !held_for_load
-                && !watched,
+                && !held_for_load,
+            call,
             isolation,
             state,
         }
@@ -189,8 +196,12 @@ pub struct TimelinePoint {
 pub struct Panel {
     /// The state ([`Replay::state`]).
     pub state: MonitorState,
-    /// The FAULT lamp: a residual lamp or a sensor fault, off in the amber state.
+    /// The FAULT lamp: a residual lamp or a sensor fault that the one rule calls a FAULT
+    /// ([`Panel::call`]), off in the amber state.
     pub fault_lamp: bool,
+    /// The one rule's call on the lamps' detection (`monitor_core::isolation::fault_call`:
+    /// [`FaultCall::Clear`] with every lamp dark).
+    pub call: FaultCall,
     /// What the isolation concluded where the lamps are evaluated (the report and the
     /// candidates listed, [`Replay::isolation_now`]), else `None`.
     pub isolation: Option<(IsolationReport, Vec<FaultCandidate>)>,
@@ -496,36 +507,6 @@ impl Replay {
     }
 }
 
-/// Why lamps lit against the parameter file's nominal values are no verdict (`None`: they
-/// are, or nothing was detected). Without a baseline learned on the healthy machine the
-/// residuals measure the machine against the file, and a file from a nameplate is 10-30 %
-/// off ([`isolation::NOMINAL_UNCERTAINTY`]); a winding 60 K warmer than the file's
-/// temperature moves Rs and Rr by 24 %. So a FAULT against the nominal machine needs a
-/// name whose size stands clear of that uncertainty; a change that fits no single fault,
-/// or one within it, is withheld. A sensor-fault lamp (bad samples) is no residual
-/// judgement and stays a fault.
-fn nominal_cannot_judge(
-    detected: bool,
-    sensor_fault: bool,
-    isolation: &IsolationReport,
-) -> Option<String> {
-    if !detected || sensor_fault || isolation.baseline != isolation::IsolationBaseline::Nominal {
-        return None;
-    }
-    let what = match isolation.named.zip(isolation.named_change) {
-        Some((_, c)) if c.abs() > isolation::NOMINAL_UNCERTAINTY => return None,
-        Some((f, c)) => format!(
-            "the nearest single fault, {f} {:+.0} %, is within the parameter file's own uncertainty (+/-{:.0} %)",
-            100.0 * c,
-            100.0 * isolation::NOMINAL_UNCERTAINTY
-        ),
-        None => "the change fits no single fault".to_string(),
-    };
-    Some(format!(
-        "not commissioned: the lamps lit against the parameter file's nominal values and {what}; a file 10-30 % off the machine, or windings warmer than the file assumes (60 K is +24 % on Rs and Rr), move the residuals this much. Commission (--commission START:END) on the healthy machine to judge a change from it"
-    ))
-}
-
 /// The timeline point of an output at `t` of `replay`, with what the panel shows
 /// ([`Replay::panel`]).
 pub(super) fn timeline_point(
@@ -549,44 +530,4 @@ pub(super) fn timeline_point(
         range_note,
         panel: replay.panel(out),
     }
-}
-
-/// The verdict from the replay's findings: `withheld` the reasons a judgement is withheld
-/// (returned with a watching reason added where it applies), `detected` whether a lamp or
-/// the isolation detected a fault, `winding` whether shorted turns were named against a
-/// healthy reference, `sensor_fault` whether a sensor lamp is lit.
-fn verdict_of(
-    mut withheld: Vec<String>,
-    detected: bool,
-    winding: bool,
-    sensor_fault: bool,
-    isolation: &IsolationReport,
-) -> (Verdict, Vec<String>) {
-    // Shorted turns named against a healthy reference (the change stands clear of what
-    // healthy runs differ by, and its angle of the reference's uncertainty) are a fault
-    // whatever else could not be judged.
-    if winding {
-        return (Verdict::Fault, withheld);
-    }
-    // A named fault too small to send a crew for: watched (the one rule for a FAULT
-    // verdict: a name whose size stands clear of what the file's error and heating move).
-    let small = (!sensor_fault)
-        .then_some(())
-        .and(isolation.named.zip(isolation.named_change))
-        .filter(|(_, c)| c.abs() < super::MIN_FAULT_CHANGE);
-    let verdict = if let (Some((name, c)), true, true) = (small, withheld.is_empty(), detected) {
-        withheld.push(format!(
-            "watching: the isolation names {name} {:+.1} %, below the {:.0} % a fault needs (what a parameter file's error away from the commissioned point and a few kelvin of heating move)",
-            100.0 * c,
-            100.0 * super::MIN_FAULT_CHANGE
-        ));
-        Verdict::Watching
-    } else if withheld.is_empty() && detected {
-        Verdict::Fault
-    } else if !withheld.is_empty() {
-        Verdict::CouldNotJudge
-    } else {
-        Verdict::Healthy
-    };
-    (verdict, withheld)
 }

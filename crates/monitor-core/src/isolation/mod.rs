@@ -143,6 +143,12 @@
 //! [`STEP_S`] at most), never from the per-sample path. [`Follower`] runs the schedule
 //! (averaging the operating point, learning the baseline, isolating) for the firmware and
 //! the host alike.
+//!
+//! # One rule for a FAULT
+//! What a named fault of a given size is called (a FAULT, watched, or no judgement before
+//! commissioning) is one function, [`fault_call`], shared by the host's verdict and panel
+//! and the board's FAULT lamp: [`MIN_FAULT_CHANGE`] and [`NOMINAL_UNCERTAINTY`], with the
+//! reasons, are in its module's docs.
 
 mod follower;
 pub use follower::{
@@ -154,6 +160,11 @@ mod evidence;
 pub use evidence::{Evidence, LEVEL_APART};
 mod isolator;
 pub use isolator::{ANCHOR_LOAD_BAND, ANCHOR_TORQUE_SPREAD, LOAD_LAW_SPREAD, MAX_POINTS};
+mod rule;
+pub use rule::{
+    fault_call, within_nominal_uncertainty, FaultCall, Sighting, MIN_FAULT_CHANGE,
+    NOMINAL_UNCERTAINTY,
+};
 
 use circuit::{Circuit, Sym3};
 
@@ -579,14 +590,6 @@ pub enum Named {
         bl: Candidate,
     },
 }
-
-/// The least relative change of a named fault for a FAULT (a sensor's gain error, a
-/// parameter's change, the friction class in Bl's terms): 5 %, what 13 K of heating does to
-/// a winding's resistance and about what a commissioned parameter file's error leaves at
-/// other operating points. Below it the fault is watched, not reported: the one rule for a
-/// FAULT shared by `diagnose` (the verdict `watching`), the HMI and the board's FAULT lamp
-/// ([`Named::stands_clear`]).
-pub const MIN_FAULT_CHANGE: f32 = 0.05;
 
 impl Named {
     /// The name's size: the fault's change, or Bl's for the friction class.

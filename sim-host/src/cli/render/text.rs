@@ -181,8 +181,13 @@ fn panel_text(p: &Panel) -> String {
         _ => &[],
     };
     let iso = p.isolation.as_ref().map(|(r, c)| IsolationView::new(r, c));
-    let (lamp, text) =
-        sim_host::hmi::lamp_and_header(&p.state, p.fault_lamp, candidates, iso.as_ref());
+    let (lamp, text) = sim_host::hmi::lamp_and_header(
+        &p.state,
+        p.fault_lamp,
+        Some(p.call),
+        candidates,
+        iso.as_ref(),
+    );
     if lamp.is_empty() {
         text
     } else {
