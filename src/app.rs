@@ -29,7 +29,7 @@ use crate::range_watch::RangeWatch;
 use crate::reset_record::PreviousRun;
 use crate::sampling::{AdcSampler, RawFrame, SamplingError, TICK_HZ};
 use crate::supply::{ReferenceAdc, ReferenceChange, ReferenceWatch, REFERENCE_PERIOD_MS};
-use monitor_core::isolation::{Baseline, Evidence, Follower, Named, Step};
+use monitor_core::isolation::{Baseline, Evidence, FaultCall, Follower, Named, Step};
 use monitor_core::{
     CommissioningError, CommissioningRun, ConfigError, Fault, Install, Isolation, IsolationState,
     Isolator, Monitor, MonitorConfig, MotorModel, Operating, Phase, ReferenceMachine, SensorFlags,
@@ -38,6 +38,8 @@ use monitor_core::{
 
 mod isolation;
 pub use isolation::{board_isolator, isolation_summary};
+mod lamps;
+pub use lamps::{panel_call, panel_input, PanelIsolation};
 
 /// The machine the firmware monitors by default: the "2.2 kW" reference machine
 /// (`monitor_core::reference::MOTOR_2P2KW`: 400 V, 50 Hz, 4 poles, Gamma model, Bl for the
@@ -287,56 +289,6 @@ pub struct MonitorStatus {
     pub moved: bool,
 }
 
-/// The panel's inputs ([`PanelInput`], the panel's whole interface) for the latest status
-/// in `mode` and the latest `isolation`
-/// judged against a baseline learned in commissioning (`None` without one): the residual
-/// lamps, the fault lamp (the core's detection, or a fault the isolation names while
-/// commissioned: the panel's module docs), "input invalid" when a sensor fault is flagged with no
-/// residual lamp lit, and the blink code: the isolated fault's (or "not named"); without
-/// a learned isolation baseline the lamps' top candidate's, as the paper's method
-/// gives it (a nameplate's parameters can be 10-30 % off: the isolation against them is
-/// not trusted on the panel, only printed on the status line).
-pub fn panel_input(
-    mode: Mode,
-    status: &MonitorStatus,
-    isolation: Option<&Isolation>,
-    commissioning_failed: bool,
-) -> PanelInput {
-    let named = isolation.and_then(Isolation::named);
-    let fault_code = match (isolation, named) {
-        (_, Some(Named::Fault(c))) => blink_code(c.fault.index() as u8),
-        (_, Some(Named::Friction { .. })) => blink_code(Fault::B.index() as u8),
-        (Some(_), None) => NOT_NAMED_CODE,
-        (None, None) => status
-            .top
-            .map_or(NOT_NAMED_CODE, |(f, _)| blink_code(f.index() as u8)),
-    };
-    // (A name whose size is below the one rule's 5 % is watched, not a FAULT: the core's
-    // `Named::stands_clear`, as `diagnose`'s verdict `watching`.)
-    let named_fault =
-        matches!(named, Some(Named::Fault(_))) && named.is_some_and(|n| n.stands_clear());
-    // The amber "operating point moved" state: no FAULT lamp for the lamps (panel docs).
-    let moved = status.moved && !named_fault && !status.sensor_fault.any();
-    let other_fault = !moved && (status.fault_detected || (named_fault && status.commissioned));
-    // Shorted turns blink their own code while nothing else is shown.
-    let (fault_detected, fault_code) = match status.winding {
-        Some((phase, _)) if !other_fault && !status.sensor_fault.any() => {
-            (true, winding_code(phase.index() as u8))
-        }
-        _ => (other_fault, fault_code),
-    };
-    PanelInput {
-        mode,
-        residual_lamps: status.residual_lamps,
-        fault_detected,
-        input_invalid: status.sensor_fault.any() && !status.residual_lamps.iter().any(|l| *l),
-        fault_code,
-        commissioning_failed,
-        default_motor: false,
-        moved,
-    }
-}
-
 /// The per-sample path: scaling, the core, commands.
 #[derive(Clone, Debug)]
 pub struct SamplePath {
@@ -498,6 +450,9 @@ pub struct Tick {
     pub pet_watchdog: bool,
     /// The panel mode shown.
     pub mode: Mode,
+    /// The one rule's call on the latest status ([`panel_call`]; the status line's `call=`):
+    /// the FAULT lamp is lit for [`FaultCall::Fault`] only.
+    pub call: FaultCall,
     /// The lamps to show.
     pub lamps: PanelLamps,
     /// The commissioning action to carry out ([`carry_out`]).
@@ -690,18 +645,15 @@ impl Supervisor {
         };
         let failed = self.procedure.last_failure().is_some();
         self.latest.moved = self.range.moved(&self.latest);
-        let learned = self
-            .isolation
-            .as_ref()
-            .filter(|f| f.learned())
-            .and_then(|_| self.isolation());
+        let isolation = self.panel_isolation();
         let input = PanelInput {
             default_motor: self.default_motor,
-            ..panel_input(mode, &self.latest, learned, failed)
+            ..panel_input(mode, &self.latest, isolation, failed)
         };
         Tick {
             pet_watchdog: watch.pet_watchdog,
             mode,
+            call: panel_call(&self.latest, isolation),
             lamps: panel::render(&input, now_ms),
             action,
             run_ended,
@@ -737,85 +689,6 @@ pub fn carry_out<S: RecordStore>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::panel::{read_blink_code, render, Lamp};
-
-    /// An isolation that names `fault` with probability `p` and a change of +30 % (the rest
-    /// unknown).
-    fn isolation(fault: Fault, p: f32) -> Isolation {
-        let mut iso = Isolation {
-            state: monitor_core::IsolationState::Isolated,
-            ..Isolation::default()
-        };
-        let k = iso
-            .candidates
-            .iter()
-            .position(|c| c.fault == fault)
-            .unwrap_or(0); // ok: test
-        iso.candidates.swap(0, k);
-        iso.candidates[0].probability = p;
-        iso.candidates[0].change = 0.3;
-        iso.unknown_probability = 1.0 - p;
-        iso
-    }
-
-    #[test]
-    fn the_code_is_the_isolated_fault_and_a_named_fault_shows_when_commissioned() {
-        let mut status = MonitorStatus {
-            commissioned: true,
-            ..MonitorStatus::default()
-        };
-        let at = |inp: &PanelInput| {
-            let trace: Vec<bool> = (0..400u32)
-                .map(|k| render(inp, k * 50).is_on(Lamp::Fault))
-                .collect();
-            read_blink_code(&trace, 50)
-        };
-        // Named, commissioned, lamps quiet: shown with the fault's code.
-        let rr = isolation(Fault::Rr, 0.9);
-        let inp = panel_input(Mode::Commissioned, &status, Some(&rr), false);
-        assert_eq!(at(&inp), Some(2));
-        // The same name 3 % in size is watched, not a FAULT (the one rule's 5 %).
-        let mut small = rr;
-        small.candidates[0].change = 0.03;
-        let inp = panel_input(Mode::Commissioned, &status, Some(&small), false);
-        assert!((0..400u32).all(|k| !render(&inp, k * 50).is_on(Lamp::Fault)));
-        // Not commissioned: the isolation alone does not light the lamp.
-        status.commissioned = false;
-        let inp = panel_input(Mode::NotCommissioned, &status, Some(&rr), false);
-        assert!((0..400u32).all(|k| !render(&inp, k * 50).is_on(Lamp::Fault)));
-        // The lamps detect, the isolation is not sure (p < 0.5): "not named".
-        status.fault_detected = true;
-        let unsure = isolation(Fault::Rs, 0.4);
-        let inp = panel_input(Mode::NotCommissioned, &status, Some(&unsure), false);
-        assert_eq!(at(&inp), Some(NOT_NAMED_CODE));
-        // No learned isolation baseline: the lamps' top candidate, or "not named".
-        let inp = panel_input(Mode::NotCommissioned, &status, None, false);
-        assert_eq!(at(&inp), Some(NOT_NAMED_CODE));
-        status.top = Some((Fault::Lr, 0.5));
-        let inp = panel_input(Mode::NotCommissioned, &status, None, false);
-        assert_eq!(at(&inp), Some(4));
-        status.top = None;
-        // Bl (or B) named: the friction class, code 5, and a load change alone does not
-        // light the lamp.
-        let bl = isolation(Fault::Bl, 0.7);
-        let inp = panel_input(Mode::Commissioned, &status, Some(&bl), false);
-        assert_eq!(at(&inp), Some(5));
-        status.fault_detected = false;
-        status.commissioned = true;
-        let inp = panel_input(Mode::Commissioned, &status, Some(&bl), false);
-        assert!((0..400u32).all(|k| !render(&inp, k * 50).is_on(Lamp::Fault)));
-        // Shorted turns blink their phase's code (11, 12, 13) while nothing else is shown;
-        // a lamp fault keeps its own code.
-        for (k, phase) in Phase::ALL.into_iter().enumerate() {
-            status.winding = Some((phase, 0.05));
-            let inp = panel_input(Mode::Commissioned, &status, None, false);
-            assert_eq!(at(&inp), Some(11 + k as u8), "{phase:?}");
-        }
-        status.fault_detected = true;
-        status.top = Some((Fault::Rs, 0.5));
-        let inp = panel_input(Mode::Commissioned, &status, None, false);
-        assert_eq!(at(&inp), Some(1));
-    }
 
     #[test]
     fn settings_out_of_range_are_named() {

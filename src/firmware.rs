@@ -55,14 +55,14 @@ use drive_monitor::app::{
     PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
 };
 use drive_monitor::board::{self, pins::Board, CurrentCode, Lamp, VoltageCode, LAMP_COUNT};
-use drive_monitor::boot::{self, Booted};
+use drive_monitor::boot::{self, Machine};
 use drive_monitor::flash_record::{RecordStore, RECORD_LEN};
 use drive_monitor::liveness::AdcWait;
 use drive_monitor::motor_source::EncoderSetup;
 use drive_monitor::offset_trim::TrimResult;
 use drive_monitor::panel::PanelLamps;
 use drive_monitor::recovery::{self, RecoveryCounts, StepTimeout};
-use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
+use drive_monitor::reset_record::{BootPhase, PreviousRun, ResetRecord, RESET_RECORD_LEN};
 use drive_monitor::sampling::RawFrame;
 use drive_monitor::setup_guard::SetupStep;
 use drive_monitor::supply::BorCheck;
@@ -539,6 +539,25 @@ fn read_motor_page(flash: &mut BoardFlash) -> [u8; MOTOR_RECORD_LEN] {
     page
 }
 
+/// The boot composition (`drive_monitor::boot`, the function the host's SIL rig boots
+/// through) on the flash's two record pages: the machine, its sample path, isolator and
+/// encoder set-up, the stored calibration and the supervisor, each failure with its
+/// fallback, logged. A plain function, so that what it builds on its way is on the stack,
+/// not kept in the main task's future.
+fn boot_board(flash: &mut BoardFlash, previous: PreviousRun) -> (Machine, SamplePath, Supervisor) {
+    let page = read_motor_page(flash);
+    let booted = match boot::boot(&page, flash, &SETTINGS, previous, 0) {
+        Ok(b) => b,
+        // The built-in default at the constant sample rate: a host test (`app::tests`)
+        // builds the same path, so this cannot happen, and if it did nothing could be
+        // monitored.
+        #[allow(clippy::panic)]
+        Err(_) => panic!("monitor configuration rejected"),
+    };
+    logs::log_boot(&booted);
+    (booted.machine, booted.path, booted.supervisor)
+}
+
 #[embassy_executor::main]
 async fn main(_spawner: Spawner) {
     let p = embassy_stm32::init(clock_config());
@@ -579,25 +598,7 @@ async fn main(_spawner: Spawner) {
     };
     let mut button = ExtiInput::new(b.button, b.button_exti, Pull::Down, Irqs);
 
-    // The boot composition (`drive_monitor::boot`, the function the host's SIL rig boots
-    // through): the machine, its sample path, isolator and encoder set-up, the stored
-    // calibration and the supervisor, each failure with its fallback, logged.
-    let page = read_motor_page(&mut thread.flash);
-    let booted = match boot::boot(&page, &mut thread.flash, &SETTINGS, previous, 0) {
-        Ok(b) => b,
-        // The built-in default at the constant sample rate: a host test (`app::tests`)
-        // builds the same path, so this cannot happen, and if it did nothing could be
-        // monitored.
-        #[allow(clippy::panic)]
-        Err(_) => panic!("monitor configuration rejected"),
-    };
-    logs::log_boot(&booted);
-    let Booted {
-        machine,
-        path,
-        mut supervisor,
-        ..
-    } = booted;
+    let (machine, path, mut supervisor) = boot_board(&mut thread.flash, previous);
     let boot = Instant::now();
 
     // High-priority executor for the sample path.
@@ -715,7 +716,7 @@ impl Thread {
                     .isolation
                     .as_ref()
                     .map_or(0.0, |f| f.isolator().winding_rise_k()),
-                tick.mode.name(),
+                (tick.mode.name(), tick.call.name()),
                 self.max_update_cycles,
                 (supervisor.reference().vdda_v(), self.bor.status_number()),
             );
@@ -726,7 +727,8 @@ impl Thread {
 /// The defmt status line: residuals, lamps, the two top candidates, speed, mode,
 /// counters, the operating point, the gate, the threshold bands, the isolation (the
 /// fault named, its size and probability: `app::isolation_summary`) and the winding
-/// temperature rise the isolation tracks since commissioning (`rise_k` [K]). Its format is
+/// temperature rise the isolation tracks since commissioning (`rise_k` [K]); `panel`: the
+/// panel's mode and the one rule's call on the lamps (`app::panel_call`). Its format is
 /// documented once, in docs/firmware.md ("The status line"); `sim-host hmi --stdin` parses it
 /// (`sim_host::hmi::status_line`), and `tests/status_line.rs` renders this format string
 /// and parses it back, so the two cannot drift apart. `supply`: the latest VDDA [V] (0
@@ -735,11 +737,12 @@ fn log_status(
     s: &MonitorStatus,
     iso: Option<&Isolation>,
     rise_k: f32,
-    mode: &str,
+    panel: (&str, &str),
     max_update_cycles: u32,
     supply: (f32, u8),
 ) {
     let (vdda_v, bor) = supply;
+    let (mode, call) = panel;
     let (top_name, top_p) = s.top.map_or(("none", 0.0), |(f, p)| (f.name(), p));
     let (iso_name, iso_change, iso_p) = isolation_summary(iso);
     let (second_name, second_p) = s.second.map_or(("none", 0.0), |(f, p)| (f.name(), p));
@@ -747,10 +750,11 @@ fn log_status(
     let mid = s.bands.map(|b| b.0);
     let half = s.bands.map(|b| b.1);
     info!(
-        "r={} lamps={} fault={=bool} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32} iqs={=f32}A ids={=f32}A vqs={=f32}V f={=f32}Hz steady={=bool} eval={=bool} sens={=bool},{=bool},{=bool} mid={} half={} iso={=str} iso_change={=f32} iso_p={=f32} wind={=str} wind_i2={=f32} moved={=bool} rise={=f32}K vdda={=f32}V bor={=u8}",
+        "r={} lamps={} fault={=bool} call={=str} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32} iqs={=f32}A ids={=f32}A vqs={=f32}V f={=f32}Hz steady={=bool} eval={=bool} sens={=bool},{=bool},{=bool} mid={} half={} iso={=str} iso_change={=f32} iso_p={=f32} wind={=str} wind_i2={=f32} moved={=bool} rise={=f32}K vdda={=f32}V bor={=u8}",
         s.residuals,
         s.residual_lamps,
         s.fault_detected,
+        call,
         top_name,
         top_p,
         second_name,

@@ -43,7 +43,7 @@
 //!
 //! | pattern | meaning |
 //! |---|---|
-//! | off | no fault detected (also in the "operating point moved" state, above) |
+//! | off | no FAULT: nothing detected, the "operating point moved" state (above), or a detection the one rule for a FAULT does not call one (`app::panel_call`, `monitor_core::isolation::fault_call`: a named fault under 5 % is watched; not commissioned, lamps with no name beyond the file's +-30 % are not judged); the residual lamps still show the core's lamps, the status line's `call=` says which |
 //! | steady on | input invalid: ADC saturated or a sensor fault flagged by the core, no isolation |
 //! | N blinks (250 ms on / 250 ms off), then 1.5 s dark, repeating | fault detected, blink code N (table below) |
 //! | 10 Hz flicker | the last commissioning failed (no progress, unusable statistics or not stored) and no fault is shown; the RUN lamp says which thresholds are in force; press the button to retry |
@@ -69,15 +69,18 @@
 //! steady half second yet since the change. The defmt status line gives the size
 //! (`iso=rr(+0.48)`) and the paper's lamp-pattern candidates.
 //!
-//! The FAULT lamp blinks when the core's lamps detect a fault, and also when the isolation
-//! names a fault (not the friction class, which a load change is to the paper's model)
-//! while the learned baseline of a commissioning run is in force: below the lamps'
-//! thresholds the isolation's three equations can still be outside their healthy spread.
+//! The FAULT lamp blinks for a FAULT of the one rule: when the core's lamps detect a fault,
+//! and also when the isolation names a fault (not the friction class, which a load change is
+//! to the paper's model) while the learned baseline of a commissioning run is in force
+//! (below the lamps' thresholds the isolation's three equations can still be outside their
+//! healthy spread), unless the name is under 5 % (watched) or, not commissioned, nothing is
+//! named beyond the parameter file's +-30 % (not judged).
 //! The isolation's baseline is learned by a commissioning run and stored in the flash
 //! record beside the lamps' thresholds (record version 2; restored at boot): without one
 //! (never commissioned, or a version 1 record) the blink code is the lamps' top candidate
-//! in `Fault::ALL` order, as before the isolation, and the isolation is only printed on the
-//! status line.
+//! in `Fault::ALL` order, as before the isolation, or, not commissioned, the fault named
+//! beyond the file's +-30 % that made the FAULT; otherwise the isolation is only printed on
+//! the status line.
 
 pub use crate::board::Lamp;
 

@@ -3,6 +3,7 @@
 //! the way defmt's decoder prints them, and `sim_host::hmi::status_line::parse` must read
 //! every value back; the firmware docs' "The status line" (docs/firmware.md) documents every field.
 
+use monitor_core::isolation::FaultCall;
 use monitor_core::Fault;
 use sim_host::demo::MonitorState;
 use sim_host::hmi::status_line;
@@ -42,6 +43,7 @@ fn value(arg: &str) -> &'static str {
         "s.residuals" => "[0.0123, -0.1, 0.25, -0.004]",
         "s.residual_lamps" => "[false, true, true, true]",
         "s.fault_detected" => "true",
+        "call" => "fault",
         "top_name" => "b",
         "top_p" => "0.5",
         "second_name" => "bl",
@@ -109,6 +111,7 @@ fn the_hmi_reads_every_field_the_firmware_prints() {
     assert_eq!(s.residuals, [0.0123, -0.1, 0.25, -0.004]);
     assert_eq!(s.lamps, [false, true, true, true]);
     assert!(s.fault);
+    assert_eq!(s.call, Some(FaultCall::Fault));
     assert_eq!(s.candidates, vec![(Fault::B, 0.5), (Fault::Bl, 0.5)]);
     assert_eq!(s.wm_rad_s, Some(150.5));
     assert_eq!(s.mode.as_deref(), Some("commissioned"));
@@ -169,6 +172,24 @@ fn the_hmi_reads_every_field_the_firmware_prints() {
         .expect("read")
         .snapshot(0.0);
     assert!(matches!(snap.state, MonitorState::Fault(_)) && snap.fault_lamp);
+    // The board's call lights its FAULT lamp, not `fault=`: watching (a name under 5 %) and
+    // not commissioned (no name beyond +-30 %) show the lamps lit, the FAULT lamp dark and
+    // the call's word.
+    let fixed = friction.replace("moved=true", "moved=false");
+    for (call, word) in [("watching", "WATCHING"), ("not-commissioned", "NOT JUDGED")] {
+        let snap = status_line::parse(&fixed.replace("call=fault", &format!("call={call}")))
+            .expect("read")
+            .snapshot(0.0);
+        assert!(matches!(snap.state, MonitorState::Fault(_)) && !snap.fault_lamp);
+        let (lamp, _) = sim_host::hmi::lamp_and_header(
+            &snap.state,
+            snap.fault_lamp,
+            snap.call,
+            &snap.candidates,
+            snap.isolation.as_ref(),
+        );
+        assert_eq!(lamp, word);
+    }
 }
 
 #[test]

@@ -8,7 +8,7 @@ use super::*;
 ///
 /// # Errors
 /// The core's [`ConfigError`] if it rejects the machine or the supply (then nothing is
-/// isolated and the blink code says "not named").
+/// isolated and the blink code is the lamps' top candidate).
 pub fn board_isolator() -> Result<Isolator, ConfigError> {
     let supply = DEFAULT_MACHINE.supply;
     Isolator::new(
@@ -45,7 +45,7 @@ pub fn isolation_summary(iso: Option<&Isolation>) -> (&'static str, f32, f32) {
 impl Supervisor {
     /// Isolates against `isolator`'s machine from now on (the motor record's, read at boot;
     /// [`Supervisor::new`] starts with [`board_isolator`]'s built-in default). `None`: the
-    /// machine was rejected, nothing is isolated (the blink code says "not named").
+    /// machine was rejected, nothing is isolated (the blink code is the lamps' top candidate).
     pub fn set_isolator(&mut self, isolator: Option<Isolator>) {
         self.isolation = isolator.map(Follower::new);
         self.run_baseline = None;
@@ -69,6 +69,15 @@ impl Supervisor {
     pub fn isolation(&self) -> Option<&Isolation> {
         let single = self.isolation.as_ref().and_then(Follower::last)?;
         Some(self.evidence.in_force(single))
+    }
+
+    /// The isolation as the panel reads it ([`super::panel_input`], [`super::panel_call`]):
+    /// the latest in force and whether its baseline was learned in commissioning.
+    pub fn panel_isolation(&self) -> super::PanelIsolation<'_> {
+        super::PanelIsolation {
+            latest: self.isolation(),
+            learned: self.isolation.as_ref().is_some_and(Follower::learned),
+        }
     }
 
     /// The isolation baseline in force when it was learned in commissioning (this run or a

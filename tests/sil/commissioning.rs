@@ -57,7 +57,7 @@ fn commission_then_detect_rs_fault_on_the_panel() {
     assert!(status.residual_lamps.iter().any(|l| *l));
     let iso = rig.supervisor.isolation().copied();
     eprintln!("isolation: {iso:?}");
-    let input = panel_input(rig.mode(), &status, iso.as_ref(), false);
+    let input = panel_input(rig.mode(), &status, rig.supervisor.panel_isolation(), false);
     let now = panel::render(&input, 0);
     for (lamp, lit) in Lamp::RESIDUALS.into_iter().zip(status.residual_lamps) {
         assert_eq!(now.is_on(lamp), lit);
@@ -147,7 +147,12 @@ fn timeout_while_the_gate_is_closed_cancels_and_keeps_the_old_record() {
         rig.supervisor.procedure().last_failure(),
         Some(Failure::Stalled)
     );
-    let input = panel_input(Mode::Commissioned, &rig.last().status, None, true);
+    let input = panel_input(
+        Mode::Commissioned,
+        &rig.last().status,
+        Default::default(),
+        true,
+    );
     let flicker: Vec<bool> = (0..10u32)
         .map(|t| panel::render(&input, t * 25).fault)
         .collect();

@@ -190,7 +190,7 @@ fn saturated_adc_lights_the_fault_lamp_steadily() {
     rig.run(&frames, |_, _| {}).unwrap();
     let status = rig.last().status;
     assert!(status.sensor_fault.current);
-    let input = panel_input(rig.mode(), &status, rig.supervisor.isolation(), false);
+    let input = panel_input(rig.mode(), &status, rig.supervisor.panel_isolation(), false);
     assert!(panel::render(&input, 0).is_on(Lamp::Fault));
     assert!(
         panel::render(&input, 777).is_on(Lamp::Fault),

@@ -233,15 +233,16 @@ fn run_phase(syst: &mut cortex_m::peripheral::SYST, phase: u32, flood: bool) -> 
 fn log_status(samples: u32, line: u32) {
     let x = line as f32 * 1e-3;
     let residuals = [0.0123 + x, -0.1, 0.25, -0.004];
-    let lamps = [false, true, true, line % 2 == 0];
+    let lamps = [false, true, true, line.is_multiple_of(2)];
     let bands = [0.001, -0.01, 0.009, 0.0];
     let half = [0.006, 0.011, 0.012, 0.007];
     let zc: Option<bool> = None;
     defmt::info!(
-        "r={} lamps={} fault={=bool} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32} iqs={=f32}A ids={=f32}A vqs={=f32}V f={=f32}Hz steady={=bool} eval={=bool} sens={=bool},{=bool},{=bool} mid={} half={} iso={=str} iso_change={=f32} iso_p={=f32} wind={=str} wind_i2={=f32} moved={=bool} rise={=f32}K vdda={=f32}V bor={=u8}",
+        "r={} lamps={} fault={=bool} call={=str} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32} iqs={=f32}A ids={=f32}A vqs={=f32}V f={=f32}Hz steady={=bool} eval={=bool} sens={=bool},{=bool},{=bool} mid={} half={} iso={=str} iso_change={=f32} iso_p={=f32} wind={=str} wind_i2={=f32} moved={=bool} rise={=f32}K vdda={=f32}V bor={=u8}",
         residuals,
         lamps,
         true,
+        "watching",
         "rr",
         0.5 + x,
         "ls",
