@@ -64,9 +64,9 @@ fn fault_code(status: &MonitorStatus, isolation: PanelIsolation<'_>, call: Fault
 /// in `mode` and the latest `isolation`: the residual lamps; the FAULT lamp for a FAULT of
 /// the one rule only ([`panel_call`]: not for a named fault below 5 %, watched, nor,
 /// not commissioned, for lamps whose isolation names nothing beyond the file's +-30 %), with
-/// its blink code ([`fault_code`]); "input invalid" when a sensor fault is flagged with no
-/// residual lamp lit; shorted turns' own code while nothing else is shown; the amber
-/// "operating point moved" state (the panel's module docs).
+/// its blink code (the isolated fault's, as `fault_code` picks it); "input invalid" when a
+/// sensor fault is flagged with no residual lamp lit; shorted turns' own code while nothing
+/// else is shown; the amber "operating point moved" state (the panel's module docs).
 pub fn panel_input(
     mode: Mode,
     status: &MonitorStatus,
