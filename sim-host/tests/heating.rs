@@ -321,7 +321,7 @@ at_s = 3.0
 "#;
     let sc = Scenario::from_toml_str(scenario, "the test").expect("scenario"); // ok: test
     let off = |p: &ParamFile| {
-        let mut q = p.clone();
+        let mut q = *p;
         let m = &mut q.motor;
         let (lls, llr) = (m.ls_h - m.lm_h, m.lr_h - m.lm_h);
         m.rs_ohm *= 1.2;
@@ -337,8 +337,8 @@ at_s = 3.0
         .into_iter()
         .flat_map(|(name, p)| {
             [
-                (format!("{name}, file true"), p.clone(), p.clone()),
-                (format!("{name}, file off"), p.clone(), off(&p)),
+                (format!("{name}, file true"), p, p),
+                (format!("{name}, file off"), p, off(&p)),
             ]
         })
         .collect();
