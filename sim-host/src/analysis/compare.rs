@@ -88,8 +88,8 @@ impl Analysis {
             &wf,
             &BaseParams::nominal(&self.constants),
             opts.fit_base,
-        );
-        let jac = super::fit::jacobian(&fd, &self.constants, &active_fit, &wf, &f, opts.fit_base);
+        )?;
+        let jac = super::fit::jacobian(&fd, &self.constants, &active_fit, &wf, &f, opts.fit_base)?;
         let not_identified = jac
             .as_ref()
             .map(|j| not_identified_in_words(j, d, &self.constants))
@@ -99,7 +99,7 @@ impl Analysis {
         // fitted values where the parameter count agrees.
         let f = align(&active, f);
         let w = Weights::new(d, 0, usize::MAX);
-        let (pred, renoised) = self.predict_and_renoised(d, &active, &f);
+        let (pred, renoised) = self.predict_and_renoised(d, &active, &f)?;
         let noise_floor = metrics::noise_floor(d, &w, Some((&pred, &renoised)));
         let err: ErrorSummary = metrics::errors(d, &pred, None);
         let (mut worst, all) = metrics::windows(
@@ -117,7 +117,7 @@ impl Analysis {
             w.transient = t;
         }
         let base_parameters = self.base_table(&f.base);
-        let fitted_effects = self.fitted_effects(&active, &f);
+        let fitted_effects = self.fitted_effects(&active, &f)?;
         let mut implausible_because = super::base_implausible(&self.constants, &f.base, d);
         let diverged_at_s = metrics::diverged_at(d, &pred);
         if let Some(t) = diverged_at_s {

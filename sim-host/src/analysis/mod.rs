@@ -83,6 +83,9 @@ pub enum AnalysisError {
         /// Why not.
         source: effects::SetupError,
     },
+    /// Fitted values that do not match the effects they are for.
+    #[error(transparent)]
+    Values(#[from] effects::EffectValuesError),
 }
 
 /// The library's effect names, comma separated (for messages).
@@ -453,7 +456,7 @@ impl Analysis {
         w: &Weights,
         start: &BaseParams,
         fit_base: bool,
-    ) -> FitResult {
+    ) -> Result<FitResult, effects::EffectValuesError> {
         fit::fit(
             fitdata,
             &self.constants,
@@ -465,37 +468,31 @@ impl Analysis {
         )
     }
 
-    fn fitted_effects(&self, active: &[ActiveEffect<'_>], f: &FitResult) -> Vec<FittedEffect> {
+    /// The effects `active` with their fitted values in `f`, as the JSON reports them.
+    fn fitted_effects(
+        &self,
+        active: &[ActiveEffect<'_>],
+        f: &FitResult,
+    ) -> Result<Vec<FittedEffect>, effects::EffectValuesError> {
+        if active.len() != f.effect_params.len() {
+            return Err(effects::EffectValuesError::Effects {
+                expected: active.len(),
+                got: f.effect_params.len(),
+            });
+        }
         active
             .iter()
             .zip(&f.effect_params)
             .map(|(a, p)| {
+                let summary = a.setup.describe(p, &self.data, &self.constants)?;
                 let why = a.setup.implausible(p);
-                FittedEffect {
+                Ok(FittedEffect {
                     effect: a.effect.kind(),
-                    parameters: a
-                        .setup
-                        .params
-                        .iter()
-                        .zip(p)
-                        .map(|(q, v)| {
-                            let reason = q.implausible_because(*v);
-                            (
-                                q.name.clone(),
-                                ParamValue {
-                                    value: *v,
-                                    unit: q.unit.to_string(),
-                                    nominal: None,
-                                    plausible: reason.is_none(),
-                                    implausible_because: reason,
-                                },
-                            )
-                        })
-                        .collect(),
-                    summary: a.setup.describe(p, &self.data, &self.constants),
+                    parameters: parameter_table(&a.setup.params, p),
+                    summary,
                     plausible: why.is_empty(),
                     implausible_because: why,
-                }
+                })
             })
             .collect()
     }
@@ -508,30 +505,66 @@ impl Analysis {
         d: &Prepared,
         active: &[ActiveEffect<'_>],
         f: &FitResult,
-    ) -> (Prediction, Prediction) {
-        rayon::join(
+    ) -> Result<(Prediction, Prediction), effects::EffectValuesError> {
+        let (p, r) = rayon::join(
             || fit::predict(d, &self.constants, active, f),
             || self.renoised(d, active, f),
-        )
+        );
+        Ok((p?, r?))
     }
 
     /// The fitted model run with the inputs' sensor noise added again (white, the level
     /// measured on the inputs), for [`metrics::noise_floor`].
-    fn renoised(&self, d: &Prepared, active: &[ActiveEffect<'_>], f: &FitResult) -> Prediction {
-        let mut terms = fit::terms(d, &self.constants, active, f);
+    fn renoised(
+        &self,
+        d: &Prepared,
+        active: &[ActiveEffect<'_>],
+        f: &FitResult,
+    ) -> Result<Prediction, effects::EffectValuesError> {
+        let mut terms = fit::terms(d, &self.constants, active, f)?;
         let sigma_v = 0.5 * (metrics::white_noise_sigma(&d.vd) + metrics::white_noise_sigma(&d.vq));
         terms.input_noise = Some(simplified_model::InputNoise {
             seed: 0x006e_6f69_7365,
             sigma_v,
             sigma_i: metrics::white_noise_sigma(&d.id),
         });
-        simplified_model::simulate(d, &self.constants, &f.base, &terms)
+        Ok(simplified_model::simulate(
+            d,
+            &self.constants,
+            &f.base,
+            &terms,
+        ))
     }
 
     fn fit_data(&self) -> (Prepared, usize) {
         let m = self.data.len().div_ceil(MAX_FIT_SAMPLES).max(1);
         (coarsen(&self.data, m), m)
     }
+}
+
+/// The JSON table of an effect's parameters `params` with their fitted values `p`: keyed by
+/// each parameter's name, with its declared unit and its plausibility.
+fn parameter_table(
+    params: &[effects::FitParam],
+    p: &[f64],
+) -> std::collections::BTreeMap<String, ParamValue> {
+    params
+        .iter()
+        .zip(p)
+        .map(|(q, v)| {
+            let reason = q.implausible_because(*v);
+            (
+                q.name.clone(),
+                ParamValue {
+                    value: *v,
+                    unit: q.unit().to_string(),
+                    nominal: None,
+                    plausible: reason.is_none(),
+                    implausible_because: reason,
+                },
+            )
+        })
+        .collect()
 }
 
 /// Keeps fitted effect values only where the full-series set-up has the same parameter

@@ -86,7 +86,7 @@ impl Analysis {
         let heldback: Vec<bool> = w_full.train.iter().map(|t| !t).collect();
         let active = self.setup_all(&fd, configured)?;
         let nominal = BaseParams::nominal(&self.constants);
-        let f0 = self.fit_set(&fd, &active, &wf, &nominal, opts.fit_base);
+        let f0 = self.fit_set(&fd, &active, &wf, &nominal, opts.fit_base)?;
         let heldback_fit_series: Vec<bool> = wf.train.iter().map(|t| !t).collect();
         let has_input_transient = transients::input_transients(&fd, &self.constants)
             .iter()
@@ -125,10 +125,10 @@ impl Analysis {
             base.full = Some(full);
         } else {
             let fd = &base.fit_series;
-            let b = fit::predict(fd, &self.constants, &base.active, &base.fit);
+            let b = fit::predict(fd, &self.constants, &base.active, &base.fit)?;
             base.heldback_error_fit_series =
                 metrics::errors(fd, &b, Some(&base.heldback_fit_series)).normalized_rms_error;
-            let renoised = self.renoised(fd, &base.active, &base.fit);
+            let renoised = self.renoised(fd, &base.active, &base.fit)?;
             base.heldback_noise_fit_series =
                 metrics::noise_floor_on(fd, &base.heldback_fit_series, Some((&b, &renoised)));
         }
@@ -137,7 +137,11 @@ impl Analysis {
 
     /// Stage 3: the configured model's base parameters as refitted in `base`, with what
     /// the log identifies of them ([`fit::jacobian`] on the fit series).
-    pub(super) fn base_refit(&self, base: &Baseline<'_>, opts: &Options) -> BaseRefit {
+    pub(super) fn base_refit(
+        &self,
+        base: &Baseline<'_>,
+        opts: &Options,
+    ) -> Result<BaseRefit, AnalysisError> {
         let jac = fit::jacobian(
             &base.fit_series,
             &self.constants,
@@ -145,8 +149,12 @@ impl Analysis {
             &base.fit_weights,
             &base.fit,
             opts.fit_base,
-        );
-        BaseRefit::new(&self.constants, &base.fit.base, jac.as_ref())
+        )?;
+        Ok(BaseRefit::new(
+            &self.constants,
+            &base.fit.base,
+            jac.as_ref(),
+        ))
     }
 
     /// The configured model fitted in `base`, run over the working series and measured
@@ -159,7 +167,7 @@ impl Analysis {
         let d = &self.data;
         let active_full = self.setup_all(d, configured)?;
         let f0_full = align(&active_full, base.fit.clone());
-        let (before, renoised) = self.predict_and_renoised(d, &active_full, &f0_full);
+        let (before, renoised) = self.predict_and_renoised(d, &active_full, &f0_full)?;
         let noise = metrics::noise_floor(d, &base.weights, Some((&before, &renoised)));
         let heldback_noise = metrics::noise_floor_on(d, &base.heldback, Some((&before, &renoised)));
         let error = metrics::errors(d, &before, None).normalized_rms_error;

@@ -148,7 +148,7 @@ impl Analysis {
     /// (`progress` told the fraction done), and, unless `full` already holds them, the
     /// configured model's measures on the working series ([`Analysis::full_series`]).
     /// Predictions are not kept per candidate (memory on long logs); the top one is
-    /// recomputed from its fitted values ([`Analysis::predict_with`]).
+    /// recomputed from its fitted values (`Analysis::predict_with`).
     pub(super) fn fit_candidates(
         &self,
         configured: &[Box<dyn EffectModel>],
@@ -161,7 +161,7 @@ impl Analysis {
         use rayon::prelude::*;
         let done = std::sync::atomic::AtomicUsize::new(0);
         let total = cands.len().max(1);
-        let candidates = || -> Vec<Option<RankedCandidate>> {
+        let candidates = || -> Result<Vec<Option<RankedCandidate>>, AnalysisError> {
             cands
                 .par_iter()
                 .map(|c| {
@@ -175,10 +175,10 @@ impl Analysis {
         // A long log's candidates are ranked on the coarse series: the configured model's
         // run over the working series is only reported, so it runs beside them.
         let (full, results) = match full {
-            Some(f) => (f, candidates()),
+            Some(f) => (f, candidates()?),
             None => {
                 let (f, r) = rayon::join(|| self.full_series(configured, base), candidates);
-                (f?, r)
+                (f?, r?)
             }
         };
         Ok((full, results.into_iter().flatten().collect()))
@@ -191,22 +191,27 @@ impl Analysis {
         c: &dyn EffectModel,
         base: &Baseline<'_>,
         opts: &Options,
-    ) -> Option<RankedCandidate> {
-        c.needs().met_by(&self.data).ok()?;
-        if missing_requirement(c, base).is_some() || self.not_dynamic(c, base).is_some() {
-            return None;
+    ) -> Result<Option<RankedCandidate>, AnalysisError> {
+        if self.cannot_fit(c, base) {
+            return Ok(None);
         }
-        let setup = c.setup(&base.fit_series, &self.constants).ok()?;
+        let Ok(setup) = c.setup(&base.fit_series, &self.constants) else {
+            return Ok(None);
+        };
         let n_parameters = setup.len();
         let set = with_candidate(base, c, setup);
         let fd = &base.fit_series;
-        let f = self.fit_set(fd, &set, &base.fit_weights, &base.fit.base, opts.fit_base);
-        let (error, heldback_error) = self.candidate_errors(base, &set, &f);
-        let full = self.on_working_series(base, &set)?;
+        let f = self.fit_set(fd, &set, &base.fit_weights, &base.fit.base, opts.fit_base)?;
+        let (error, heldback_error) = self.candidate_errors(base, &set, &f)?;
+        let Some(full) = self.on_working_series(base, &set) else {
+            return Ok(None);
+        };
         let f = align(&full, f);
-        let me = self.fitted_effects(&full, &f).pop()?;
-        let why = self.implausible(c, base, &me, &f);
-        Some(RankedCandidate {
+        let Some(me) = self.fitted_effects(&full, &f)?.pop() else {
+            return Ok(None);
+        };
+        let why = self.implausible(c, base, &me, &f)?;
+        Ok(Some(RankedCandidate {
             candidate: EffectCandidate {
                 effect: c.kind(),
                 normalized_rms_error: error,
@@ -226,7 +231,16 @@ impl Analysis {
             },
             fit: f,
             setups: full.into_iter().map(|a| a.setup).collect(),
-        })
+        }))
+    }
+
+    /// True when candidate `c` cannot be fitted on this log: a channel it needs is
+    /// missing, an effect it needs is not in the model, or it is a dynamics effect the log
+    /// cannot show ([`Analysis::cannot_rank`] says why).
+    fn cannot_fit(&self, c: &dyn EffectModel, base: &Baseline<'_>) -> bool {
+        c.needs().met_by(&self.data).is_err()
+            || missing_requirement(c, base).is_some()
+            || self.not_dynamic(c, base).is_some()
     }
 
     /// A candidate model's errors over the whole log and on the held-back windows, on the
@@ -236,16 +250,16 @@ impl Analysis {
         base: &Baseline<'_>,
         set: &[ActiveEffect<'_>],
         f: &FitResult,
-    ) -> (f64, f64) {
+    ) -> Result<(f64, f64), AnalysisError> {
         let (series, mask) = if base.coarsening == 1 {
             (&self.data, &base.heldback)
         } else {
             (&base.fit_series, &base.heldback_fit_series)
         };
-        let pred = fit::predict(series, &self.constants, set, f);
+        let pred = fit::predict(series, &self.constants, set, f)?;
         let e = metrics::errors(series, &pred, None).normalized_rms_error;
         let ev = metrics::errors(series, &pred, Some(mask)).normalized_rms_error;
-        (e, ev)
+        Ok((e, ev))
     }
 
     /// The effects of `set` set up on the working series (data-dependent set-ups redone
@@ -271,35 +285,31 @@ impl Analysis {
     }
 
     /// Why candidate `c`'s fit (its fitted effect `me`, the whole fit `f`) is not
-    /// plausible: its own values out of range, what the current spectrum says against a
-    /// cage asymmetry, and a base parameter its refit takes out of range. One the configured model's own fit already has out of
-    /// range does not count against it (the verdict reports that apart).
+    /// plausible: its own values out of range, what a measurement of the log independent
+    /// of the fit says against them ([`EffectModel::contradicted_by`]), and a base
+    /// parameter its refit takes out of range. One the configured model's own fit already
+    /// has out of range does not count against it (the verdict reports that apart).
     fn implausible(
         &self,
         c: &dyn EffectModel,
         base: &Baseline<'_>,
         me: &FittedEffect,
         f: &FitResult,
-    ) -> Vec<String> {
+    ) -> Result<Vec<String>, AnalysisError> {
         let d = &self.data;
         let already: Vec<&str> = base_out_of_range(&self.constants, &base.fit.base, d)
             .into_iter()
             .map(|(k, _)| k)
             .collect();
         let mut why = me.implausible_because.clone();
-        // A cage asymmetry is named only when the current spectrum agrees with the fit.
-        if c.kind() == EffectKind::RotorAsymmetry {
-            let delta = me.parameters.get("delta").map(|p| p.value);
-            why.extend(delta.and_then(|dl| {
-                crate::analysis::rotor_asymmetry::spectrum_contradicts(d, self.constants.np, dl)
-            }));
-        }
+        let fitted = f.effect_params.last().map_or(&[][..], Vec::as_slice);
+        why.extend(c.contradicted_by(d, &self.constants, fitted)?);
         why.extend(
             base_out_of_range(&self.constants, &f.base, d)
                 .into_iter()
                 .filter(|(k, _)| !already.contains(k))
                 .map(|(_, w)| w),
         );
-        why
+        Ok(why)
     }
 }

@@ -179,7 +179,7 @@ impl Analysis {
         // 2. The configured model fitted and measured: what candidates are compared with.
         let mut base = self.baseline(&configured, opts)?;
         // 3. Its base parameters refitted, with what the log identifies of them.
-        let refit = self.base_refit(&base, opts);
+        let refit = self.base_refit(&base, opts)?;
         // 4. Whether its error is structural (dynamics missing through a transient).
         let structural = structural_error(&base, &names);
         // 5. The library's effects not in the model; those that cannot be ranked, and why.
@@ -210,7 +210,7 @@ impl Analysis {
             return self.explain_recentred(opts, progress, refit, because);
         }
         // 8. The report and its verdict.
-        Ok(withhold_if_untrusted(self.explain_report(found, refit)))
+        Ok(withhold_if_untrusted(self.explain_report(found, refit)?))
     }
 }
 

@@ -119,16 +119,20 @@ impl Analysis {
 
     /// Stage 8: the report of `found`, with the verdict and the prediction of the model
     /// with the candidate it names.
-    pub(super) fn explain_report(&self, found: Findings<'_>, refit: BaseRefit) -> ExplainOutput {
+    pub(super) fn explain_report(
+        &self,
+        found: Findings<'_>,
+        refit: BaseRefit,
+    ) -> Result<ExplainOutput, AnalysisError> {
         let o = found.outcome;
         let verdict = self.verdict(&found);
         let after = match found.ranked.first() {
             Some(r) if !o.unexplained => {
-                Some((r.candidate.effect, self.predict_with(&found.names, r)))
+                Some((r.candidate.effect, self.predict_with(&found.names, r)?))
             }
             _ => None,
         };
-        ExplainOutput {
+        Ok(ExplainOutput {
             report: ExplainReport {
                 effects: found.names,
                 baseline_normalized_rms_error: found.full.error,
@@ -145,7 +149,7 @@ impl Analysis {
             },
             before: found.full.before,
             after,
-        }
+        })
     }
 
     /// The verdict ([`verdict`]) with the notes on implausible candidates and on an
@@ -166,7 +170,11 @@ impl Analysis {
 
     /// The prediction of the configured model (`names`) with candidate `r` added, from
     /// their fitted values, on the working series.
-    fn predict_with(&self, names: &[EffectKind], r: &RankedCandidate) -> Prediction {
+    fn predict_with(
+        &self,
+        names: &[EffectKind],
+        r: &RankedCandidate,
+    ) -> Result<Prediction, AnalysisError> {
         let kinds: Vec<EffectKind> = names.iter().copied().chain([r.candidate.effect]).collect();
         let boxes = resolve(&kinds);
         let model = FittedModel {
@@ -180,7 +188,7 @@ impl Analysis {
                 .collect(),
             fit: r.fit.clone(),
         };
-        model.predict(&self.data, &self.constants)
+        Ok(model.predict(&self.data, &self.constants)?)
     }
 }
 
