@@ -16,7 +16,8 @@ use super::lm::{self, LeastSquares};
 use super::metrics::{measured, predicted, Weights};
 use super::prep::{Prepared, C64};
 use super::simplified_model::{
-    rotations, simulate, simulate_rot, BaseParams, MachineConstants, ModelTerms, Prediction,
+    rotations, simulate, simulate_rot, BaseParameter, BaseParams, MachineConstants, ModelTerms,
+    Prediction,
 };
 use nalgebra::DMatrix;
 use rayon::prelude::*;
@@ -375,8 +376,8 @@ impl std::fmt::Display for FittedModel<'_> {
 /// How well a log identifies one base parameter (`compare`'s `identifiability`).
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct ParameterSensitivity {
-    /// Base parameter key (as in `base_parameters`).
-    pub parameter: &'static str,
+    /// Base parameter (its key as in `base_parameters`).
+    pub parameter: BaseParameter,
     /// Change of the model error (normalized, root-sum over the channels) that a 10 %
     /// change of this parameter causes when every other fitted parameter is refitted to
     /// compensate: `0.1 |x_i| / sqrt((J^T J)^-1_ii)`, J the Jacobian of the data residuals
@@ -439,8 +440,7 @@ pub fn jacobian(
     }
     prob.terms(&x)?;
     let g = Gram::of(&relative_columns(&prob, &x, &mag));
-    let names = ["ra_ohm", "ls_h", "b_plus_bl_nms", "j_kgm2"];
-    let base = names
+    let base = BaseParameter::ALL
         .iter()
         .enumerate()
         .map(|(i, &name)| {

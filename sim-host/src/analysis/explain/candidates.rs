@@ -7,6 +7,7 @@ use super::ranking::RankedCandidate;
 use super::{explained_fraction, EffectCandidate};
 use crate::analysis::effects::{EffectModel, SetupError};
 use crate::analysis::fit::{self, ActiveEffect, FitResult};
+use crate::analysis::simplified_model::BaseParameter;
 use crate::analysis::{align, base_out_of_range, metrics, transients};
 use crate::analysis::{Analysis, AnalysisError, FittedEffect, Options};
 use monitor_core::EffectKind;
@@ -297,7 +298,7 @@ impl Analysis {
         f: &FitResult,
     ) -> Result<Vec<String>, AnalysisError> {
         let d = &self.data;
-        let already: Vec<&str> = base_out_of_range(&self.constants, &base.fit.base, d)
+        let already: Vec<BaseParameter> = base_out_of_range(&self.constants, &base.fit.base, d)
             .into_iter()
             .map(|(k, _)| k)
             .collect();

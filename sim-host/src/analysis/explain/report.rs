@@ -89,7 +89,7 @@ impl Analysis {
         let flagged = base_out_of_range(&self.constants, &found.base.fit.base, &self.data);
         flagged
             .iter()
-            .any(|(k, _)| refit.identifies(k))
+            .any(|(k, _)| refit.identifies(*k))
             .then(|| flagged.into_iter().map(|(_, why)| why).collect())
     }
 
