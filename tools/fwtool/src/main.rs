@@ -166,6 +166,13 @@ fn fw(check: bool) -> Result<(), String> {
 }
 
 fn qemu_core() -> Result<ExitCode, String> {
+    let elf_path = build_core_for_qemu()?;
+    run_in_qemu(&elf_path)
+}
+
+/// Builds `crates/core-on-m4` for the QEMU board and checks that its vector table is at
+/// 0x0 (the mps2-an386 memory layout, not the G474's); the ELF's path.
+fn build_core_for_qemu() -> Result<PathBuf, String> {
     let dir = root().join("crates/core-on-m4");
     run(cargo().current_dir(&dir).args([
         "build",
@@ -187,6 +194,12 @@ fn qemu_core() -> Result<ExitCode, String> {
             vt.addr
         ));
     }
+    Ok(elf_path)
+}
+
+/// Runs the ELF `elf_path` on QEMU's mps2-an386 (a Cortex-M4) with semihosting, at most
+/// 300 s; its exit status.
+fn run_in_qemu(elf_path: &Path) -> Result<ExitCode, String> {
     let mut child = Command::new("qemu-system-arm")
         .args([
             "-M",
@@ -204,7 +217,7 @@ fn qemu_core() -> Result<ExitCode, String> {
             "enable=on,target=native",
         ])
         .args(["-icount", "shift=0", "-kernel"])
-        .arg(&elf_path)
+        .arg(elf_path)
         .stdin(Stdio::null())
         .spawn()
         .map_err(|e| {
