@@ -129,31 +129,9 @@ impl DemoRun {
 pub fn run(story: Story) -> Result<DemoRun, ExperimentError> {
     let params = ParamFile::reference_3hp();
     let (fault, change) = story.fault();
-    let (proto, load) = match story {
-        Story::Service { .. } => (
-            Protocol {
-                duration_s: 11.0,
-                fault_at_s: SERVICE_FAULT_AT_S,
-                ..Protocol::default()
-            },
-            // Service: the load is an unknown input.
-            crate::replay::LoadModel::Unknown,
-        ),
-        Story::Paper { .. } => (
-            Protocol {
-                duration_s: 8.0,
-                fault_at_s: 5.0,
-                ..Protocol::default()
-            },
-            // The paper's scenario: its fixed viscous load, a Bl change is a fault.
-            crate::replay::LoadModel::Viscous,
-        ),
-    };
+    let (proto, load) = story.protocol();
     let mut sc = scenario(Some((fault, change)), &proto);
-    let steps = match story {
-        Story::Service { .. } => vec![(LOAD_STEP_AT_S, LOAD_STEP_SCALE), (LOAD_BACK_AT_S, 1.0)],
-        Story::Paper { .. } => Vec::new(),
-    };
+    let steps = story.load_steps();
     for &(t_s, scale) in &steps {
         sc.load.steps.push(crate::sim::LoadStep {
             t_s,
@@ -167,24 +145,17 @@ pub fn run(story: Story) -> Result<DemoRun, ExperimentError> {
         load,
         ..ReplayOptions::default()
     };
-    let mut next = 0.0;
-    let mut announced = false;
-    let mut steps_left = steps.as_slice();
+    let mut timeline = Timeline {
+        next: 0.0,
+        announced: false,
+        steps_left: &steps,
+        fault_at_s: proto.fault_at_s,
+    };
     let mut points = Vec::new();
     let mut replay = Replay::new(&params, sc.sensors.channels(), sc.sample_rate_hz, opts)?;
     simulate(&params, &sc, |row| {
         let o = replay.push(row);
-        if row.t_s + 1e-9 >= next {
-            next += TIMELINE_STEP_S;
-            let fault_injected = !announced && row.t_s >= proto.fault_at_s;
-            announced |= fault_injected;
-            let load_step = match steps_left.split_first() {
-                Some((&(t, scale), rest)) if row.t_s + 1e-9 >= t => {
-                    steps_left = rest;
-                    Some(scale)
-                }
-                _ => None,
-            };
+        if let Some((fault_injected, load_step)) = timeline.tick(row.t_s) {
             points.push(DemoPoint {
                 t_s: row.t_s,
                 speed_rpm: f64::from(o.speed_rad_s * 60.0 / std::f32::consts::TAU),
@@ -203,4 +174,72 @@ pub fn run(story: Story) -> Result<DemoRun, ExperimentError> {
         points,
         report: replay.finish(),
     })
+}
+
+impl Story {
+    /// The protocol the story runs, and what the replay is told of the load: in service
+    /// the load is an unknown input; the paper's scenario has its fixed viscous load, and
+    /// a Bl change is a fault.
+    fn protocol(self) -> (Protocol, crate::replay::LoadModel) {
+        match self {
+            Story::Service { .. } => (
+                Protocol {
+                    duration_s: 11.0,
+                    fault_at_s: SERVICE_FAULT_AT_S,
+                    ..Protocol::default()
+                },
+                crate::replay::LoadModel::Unknown,
+            ),
+            Story::Paper { .. } => (
+                Protocol {
+                    duration_s: 8.0,
+                    fault_at_s: 5.0,
+                    ..Protocol::default()
+                },
+                crate::replay::LoadModel::Viscous,
+            ),
+        }
+    }
+
+    /// The story's load steps: (time [s], Bl as a multiple of the file's).
+    fn load_steps(self) -> Vec<(f64, f64)> {
+        match self {
+            Story::Service { .. } => vec![(LOAD_STEP_AT_S, LOAD_STEP_SCALE), (LOAD_BACK_AT_S, 1.0)],
+            Story::Paper { .. } => Vec::new(),
+        }
+    }
+}
+
+/// When the demo's timeline takes a point (every [`TIMELINE_STEP_S`]) and what it marks:
+/// the first point at or after the fault, a load step since the last point.
+struct Timeline<'a> {
+    /// The next point's time [s].
+    next: f64,
+    /// The fault was marked.
+    announced: bool,
+    /// The load steps not yet marked: (time [s], scale).
+    steps_left: &'a [(f64, f64)],
+    /// The fault's time [s].
+    fault_at_s: f64,
+}
+
+impl Timeline<'_> {
+    /// At a row of time `t_s`: `None` between points; at a point, whether the fault is
+    /// injected here and the scale of a load step here.
+    fn tick(&mut self, t_s: f64) -> Option<(bool, Option<f64>)> {
+        if t_s + 1e-9 < self.next {
+            return None;
+        }
+        self.next += TIMELINE_STEP_S;
+        let fault_injected = !self.announced && t_s >= self.fault_at_s;
+        self.announced |= fault_injected;
+        let load_step = match self.steps_left.split_first() {
+            Some((&(t, scale), rest)) if t_s + 1e-9 >= t => {
+                self.steps_left = rest;
+                Some(scale)
+            }
+            _ => None,
+        };
+        Some((fault_injected, load_step))
+    }
 }

@@ -165,22 +165,10 @@ pub fn run_case(
         })
         .collect();
     let rep = replay.finish();
-    let lamps: Vec<bool> = (1..=4)
-        .map(|k| rep.lamps.get(&format!("r{k}")).copied().unwrap_or(false))
-        .collect();
-    let mut signature = [0u8; 4];
-    for (s, l) in signature.iter_mut().zip(&lamps) {
-        *s = u8::from(*l);
-    }
-    let mut paper = [0u8; 4];
-    for (p, x) in paper.iter_mut().zip(fault.paper_signature()) {
-        *p = u8::from(x);
-    }
-    let matrix = monitor_core::signature::signatures_for(proto.angle_source);
-    let mut expected = [0u8; 4];
-    for (e, x) in expected.iter_mut().zip(matrix[fault.index()]) {
-        *e = u8::from(x);
-    }
+    let signature =
+        bits((1..=4).map(|k| rep.lamps.get(&format!("r{k}")).copied().unwrap_or(false)));
+    let paper = bits(fault.paper_signature());
+    let expected = bits(monitor_core::signature::signatures_for(proto.angle_source)[fault.index()]);
     let residuals = rep.timeline.last().map(|p| p.residuals).unwrap_or_default();
     Ok(Table1Row {
         fault,
@@ -198,6 +186,15 @@ pub fn run_case(
         name_delay_s: rep.isolation.first_named.map(|g| g.t_s - proto.fault_at_s),
         names_given,
     })
+}
+
+/// Four lamps as 0/1.
+fn bits(lamps: impl IntoIterator<Item = bool>) -> [u8; 4] {
+    let mut b = [0u8; 4];
+    for (s, l) in b.iter_mut().zip(lamps) {
+        *s = u8::from(l);
+    }
+    b
 }
 
 /// Runs all 18 cases (in parallel) in Table 1 order, +50 % before -50 %.

@@ -41,7 +41,27 @@ pub struct MotorEntry {
     pub baseline: Vec<PathBuf>,
     /// What is known of its load: `unknown` (default) or `viscous`.
     #[serde(default)]
-    pub load: Option<String>,
+    pub load: Option<MotorLoad>,
+}
+
+/// What is known of a motor's load (the table's `load`, lower case).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MotorLoad {
+    /// An unknown input (real service): [`LoadModel::Unknown`].
+    Unknown,
+    /// The paper's fixed viscous load: [`LoadModel::Viscous`].
+    Viscous,
+}
+
+impl MotorLoad {
+    /// The replay's load model.
+    pub fn model(self) -> LoadModel {
+        match self {
+            MotorLoad::Unknown => LoadModel::Unknown,
+            MotorLoad::Viscous => LoadModel::Viscous,
+        }
+    }
 }
 
 /// The motor table.
@@ -104,14 +124,6 @@ impl MotorTable {
             return Err(bad("no [[motor]] in it".into()));
         }
         for m in &mut t.motor {
-            if let Some(l) = &m.load {
-                if l != "unknown" && l != "viscous" {
-                    return Err(bad(format!(
-                        "motor {}: load = \"{l}\" is neither \"unknown\" nor \"viscous\"",
-                        m.name
-                    )));
-                }
-            }
             if let Some([a, b]) = m.commission {
                 if !(b > a && a >= 0.0) {
                     return Err(bad(format!(
@@ -311,10 +323,7 @@ pub fn row_for(m: &MotorEntry, log: &Path) -> FleetRow {
     let req = DiagnoseRequest {
         commission: m.commission.map(|[a, b]| (a, b)),
         baseline: m.baseline.clone(),
-        load: match m.load.as_deref() {
-            Some("viscous") => LoadModel::Viscous,
-            _ => LoadModel::Unknown,
-        },
+        load: m.load.map_or(LoadModel::Unknown, MotorLoad::model),
         ..DiagnoseRequest::default()
     };
     match diagnose(ParamsSource::Path(&m.params), log, &req, &mut |_| {}) {

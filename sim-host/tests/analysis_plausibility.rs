@@ -2,6 +2,7 @@
 //! `compare` gives when its worst windows are a start or a step (issue 10).
 mod analysis_common;
 use analysis_common::*;
+use sim_host::analysis::simplified_model::BaseParameter;
 use sim_host::sim::{Scenario, SupplyStep};
 
 /// A direct-on-line start from standstill, then steady running: 3 s at 5 kHz.
@@ -71,7 +72,11 @@ fn inertia_is_not_identified_when_the_speed_never_changes() {
         .report;
     eprintln!("{:#?}\n{:#?}", c.identifiability, c.not_identified);
     let j = c.identifiability.as_ref().unwrap();
-    let jj = j.base.iter().find(|b| b.parameter == "j_kgm2").unwrap();
+    let jj = j
+        .base
+        .iter()
+        .find(|b| b.parameter == BaseParameter::J)
+        .unwrap();
     assert!(!jj.identified, "{j:?}");
     assert!(
         c.not_identified
@@ -105,7 +110,7 @@ fn inertia_is_not_identified_when_the_speed_never_changes() {
     assert!(
         j.base
             .iter()
-            .find(|b| b.parameter == "j_kgm2")
+            .find(|b| b.parameter == BaseParameter::J)
             .unwrap()
             .identified,
         "{j:?}"

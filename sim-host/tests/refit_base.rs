@@ -12,6 +12,7 @@ mod analysis_common;
 use analysis_common::*;
 use monitor_core::EffectKind;
 use sim_host::analysis::refit::BaseRefit;
+use sim_host::analysis::simplified_model::BaseParameter;
 use sim_host::params::ParamFile;
 
 /// The model the protocol starts from (a full-order simulator always has these).
@@ -50,13 +51,13 @@ fn off(p: &ParamFile, which: &str) -> ParamFile {
 }
 
 /// The true value of a base parameter of `truth` (as `BaseRefit` keys them).
-fn true_value(truth: &ParamFile, key: &str) -> f64 {
+fn true_value(truth: &ParamFile, key: BaseParameter) -> f64 {
     let n = sim_host::analysis::simplified_model::MachineConstants::from_params(truth);
     match key {
-        "ra_ohm" => n.ra_ohm,
-        "ls_h" => n.ls_h,
-        "b_plus_bl_nms" => n.btot_nms,
-        _ => n.j_kgm2,
+        BaseParameter::Ra => n.ra_ohm,
+        BaseParameter::Ls => n.ls_h,
+        BaseParameter::BPlusBl => n.btot_nms,
+        BaseParameter::J => n.j_kgm2,
     }
 }
 
@@ -105,7 +106,7 @@ fn judge(which: &str, name: &str, error: &str) -> (Vec<String>, BaseRefit) {
 }
 
 /// The refitted value of `key` is within `tol` of the truth, and the words name it.
-fn refitted_to_truth(which: &str, refit: &BaseRefit, key: &str, tol: f64) -> Vec<String> {
+fn refitted_to_truth(which: &str, refit: &BaseRefit, key: BaseParameter, tol: f64) -> Vec<String> {
     let truth = true_value(&motor(which), key);
     let r = refit
         .parameters
@@ -119,7 +120,7 @@ fn refitted_to_truth(which: &str, refit: &BaseRefit, key: &str, tol: f64) -> Vec
             r.refitted, r.identified
         ));
     }
-    if !refit.in_words().contains(key) {
+    if !refit.in_words().contains(key.key()) {
         f.push(format!("{which}: {key} not said: {}", refit.in_words()));
     }
     f
@@ -165,10 +166,10 @@ fn two_parameters_20_percent_off_still_name_the_hidden_effect() {
             let ls = refit
                 .parameters
                 .iter()
-                .find(|r| r.parameter == "ls_h")
+                .find(|r| r.parameter == BaseParameter::Ls)
                 .unwrap();
             if ls.identified {
-                failures.extend(refitted_to_truth(which, &refit, "ls_h", 0.05));
+                failures.extend(refitted_to_truth(which, &refit, BaseParameter::Ls, 0.05));
             } else if !refit.in_words().contains("not identified") {
                 failures.push(format!("{which} {name}: ls_h not identified, not said"));
             }
@@ -205,7 +206,7 @@ fn a_file_that_does_not_fit_is_recentred_before_effects_are_judged() {
         let j = refit
             .parameters
             .iter()
-            .find(|r| r.parameter == "j_kgm2")
+            .find(|r| r.parameter == BaseParameter::J)
             .unwrap();
         let words = refit.in_words();
         if j.identified {
@@ -214,7 +215,7 @@ fn a_file_that_does_not_fit_is_recentred_before_effects_are_judged() {
             if !refit.recentred || !words.contains("does not fit") {
                 failures.push(format!("{which} {name}: not recentred: {words}"));
             }
-            failures.extend(refitted_to_truth(which, &refit, "j_kgm2", 0.10));
+            failures.extend(refitted_to_truth(which, &refit, BaseParameter::J, 0.10));
         } else {
             // Not identified: said, and no wrong name (ranked first and claimed).
             if !words.contains("not identified") || !words.contains("j_kgm2") {

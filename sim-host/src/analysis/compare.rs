@@ -69,99 +69,163 @@ impl Analysis {
     /// A configured effect whose needs the log does not meet.
     pub fn compare(&self, opts: &Options) -> Result<CompareOutput, AnalysisError> {
         let d = &self.data;
-        let mut skipped = Vec::new();
         let unbalance = self.unbalance();
         let info = self.info();
         if !d.channels.voltages {
             return Ok(self.compare_current_only(opts, unbalance, info));
         }
+        let mut skipped = Vec::new();
         if !d.channels.speed {
             skipped.push("omega_r not compared: the log has no wm_rad_s column (the model still predicts it)".into());
         }
         let list = resolve(&opts.effects);
-        let (fd, _) = self.fit_data();
-        let active_fit = self.setup_all(&fd, &list)?;
-        let wf = Weights::new(&fd, 0, super::MAX_FIT_SAMPLES);
-        let f = self.fit_set(
-            &fd,
-            &active_fit,
-            &wf,
-            &BaseParams::nominal(&self.constants),
-            opts.fit_base,
-        );
-        let jac = super::fit::jacobian(&fd, &self.constants, &active_fit, &wf, &f, opts.fit_base);
-        let not_identified = jac
-            .as_ref()
-            .map(|j| not_identified_in_words(j, d, &self.constants))
-            .unwrap_or_default();
+        let fitted = self.fit_for_compare(&list, opts)?;
         let active = self.setup_all(d, &list)?;
         // Data-dependent set-ups (load steps) are recomputed on the full series; keep the
         // fitted values where the parameter count agrees.
-        let f = align(&active, f);
-        let w = Weights::new(d, 0, usize::MAX);
-        let (pred, renoised) = self.predict_and_renoised(d, &active, &f);
-        let noise_floor = metrics::noise_floor(d, &w, Some((&pred, &renoised)));
-        let err: ErrorSummary = metrics::errors(d, &pred, None);
-        let (mut worst, all) = metrics::windows(
-            d,
-            &pred,
-            &w,
-            self.params.supply.v_phase_peak(),
-            self.constants.np,
-            40,
-            3,
-        );
-        let in_model: Vec<EffectKind> = list.iter().map(|e| e.kind()).collect();
-        let (tags, advice) = super::transients::advice(d, &self.constants, &worst, &in_model);
-        for (w, t) in worst.iter_mut().zip(tags) {
-            w.transient = t;
-        }
-        let base_parameters = self.base_table(&f.base);
-        let fitted_effects = self.fitted_effects(&active, &f);
-        let mut implausible_because = super::base_implausible(&self.constants, &f.base, d);
-        let diverged_at_s = metrics::diverged_at(d, &pred);
-        if let Some(t) = diverged_at_s {
-            implausible_because.insert(
-                0,
-                format!(
-                    "the model diverged at {t:.3} s (its predicted current left {}x the largest measured): the error \
-                     {:.4} measures nothing; add the effects the advice names, or leave the start out (--from)",
-                    metrics::DIVERGED_CURRENT_RATIO,
-                    err.normalized_rms_error
-                ),
-            );
-        }
-        for fe in &fitted_effects {
-            implausible_because.extend(
-                fe.implausible_because
-                    .iter()
-                    .map(|w| format!("{}: {w}", fe.effect)),
-            );
-        }
+        let f = align(&active, fitted.fit);
+        let m = self.measure_compare(&active, &f, &list)?;
+        let fitted_effects = self.fitted_effects(&active, &f)?;
+        let implausible_because = self.compare_implausible(&f, &m, &fitted_effects);
         Ok(CompareOutput {
             report: CompareReport {
                 effects: list.iter().map(|e| e.kind()).collect(),
-                normalized_rms_error: err.normalized_rms_error,
-                diverged_at_s,
-                noise_floor,
-                channels: err.channels,
-                worst_windows: worst,
-                advice,
-                base_parameters,
+                normalized_rms_error: m.err.normalized_rms_error,
+                diverged_at_s: m.diverged_at_s,
+                noise_floor: m.noise_floor,
+                channels: m.err.channels,
+                worst_windows: m.worst,
+                advice: m.advice,
+                base_parameters: self.base_table(&f.base),
                 fitted_effects,
                 plausible: implausible_because.is_empty(),
                 implausible_because,
-                identifiability: jac,
-                not_identified,
+                identifiability: fitted.jacobian,
+                not_identified: fitted.not_identified,
                 skipped,
                 unbalance,
                 data: info,
                 data_quality: self.quality.clone(),
             },
-            prediction: pred,
-            all_windows: all,
+            prediction: m.prediction,
+            all_windows: m.all_windows,
         })
     }
+
+    /// The configured model (`list`) fitted on the fit series (coarse for a long log),
+    /// with what the log identifies of its base parameters.
+    fn fit_for_compare(
+        &self,
+        list: &[Box<dyn super::effects::EffectModel>],
+        opts: &Options,
+    ) -> Result<FittedForCompare, AnalysisError> {
+        let (fd, _) = self.fit_data();
+        let active_fit = self.setup_all(&fd, list)?;
+        let wf = Weights::new(&fd, 0, super::MAX_FIT_SAMPLES);
+        let nominal = BaseParams::nominal(&self.constants);
+        let fit = self.fit_set(&fd, &active_fit, &wf, &nominal, opts.fit_base)?;
+        let jacobian =
+            super::fit::jacobian(&fd, &self.constants, &active_fit, &wf, &fit, opts.fit_base)?;
+        let not_identified = jacobian
+            .as_ref()
+            .map(|j| not_identified_in_words(j, &self.data, &self.constants))
+            .unwrap_or_default();
+        Ok(FittedForCompare {
+            fit,
+            jacobian,
+            not_identified,
+        })
+    }
+
+    /// The fitted model `f` of the effects `active` (the configured `list`) run over the
+    /// working series and measured: its errors, noise floor, windows (the worst tagged
+    /// with the transient they lie in) and the advice on them.
+    fn measure_compare(
+        &self,
+        active: &[super::fit::ActiveEffect<'_>],
+        f: &super::fit::FitResult,
+        list: &[Box<dyn super::effects::EffectModel>],
+    ) -> Result<CompareMeasures, AnalysisError> {
+        let d = &self.data;
+        let w = Weights::new(d, 0, usize::MAX);
+        let (pred, renoised) = self.predict_and_renoised(d, active, f)?;
+        let noise_floor = metrics::noise_floor(d, &w, Some((&pred, &renoised)));
+        let err: ErrorSummary = metrics::errors(d, &pred, None);
+        let v_rated = self.params.supply.v_phase_peak();
+        let (mut worst, all) = metrics::windows(d, &pred, &w, v_rated, self.constants.np, 40, 3);
+        let in_model: Vec<EffectKind> = list.iter().map(|e| e.kind()).collect();
+        let (tags, advice) = super::transients::advice(d, &self.constants, &worst, &in_model);
+        for (w, t) in worst.iter_mut().zip(tags) {
+            w.transient = t;
+        }
+        Ok(CompareMeasures {
+            diverged_at_s: metrics::diverged_at(d, &pred),
+            noise_floor,
+            err,
+            worst,
+            all_windows: all,
+            advice,
+            prediction: pred,
+        })
+    }
+
+    /// Why `compare`'s fit `f` is not plausible: a diverged prediction first, then the
+    /// base parameters and the fitted effects out of their physical ranges.
+    fn compare_implausible(
+        &self,
+        f: &super::fit::FitResult,
+        m: &CompareMeasures,
+        fitted_effects: &[FittedEffect],
+    ) -> Vec<String> {
+        let mut why = super::base_implausible(&self.constants, &f.base, &self.data);
+        if let Some(t) = m.diverged_at_s {
+            why.insert(
+                0,
+                format!(
+                    "the model diverged at {t:.3} s (its predicted current left {}x the largest measured): the error \
+                     {:.4} measures nothing; add the effects the advice names, or leave the start out (--from)",
+                    metrics::DIVERGED_CURRENT_RATIO,
+                    m.err.normalized_rms_error
+                ),
+            );
+        }
+        for fe in fitted_effects {
+            why.extend(
+                fe.implausible_because
+                    .iter()
+                    .map(|w| format!("{}: {w}", fe.effect)),
+            );
+        }
+        why
+    }
+}
+
+/// `compare`'s fit on the fit series and what the log identifies.
+struct FittedForCompare {
+    /// The fit.
+    fit: super::fit::FitResult,
+    /// The fit's Jacobian (`None` when the base parameters were not fitted).
+    jacobian: Option<super::fit::Jacobian>,
+    /// The base parameters not identified, in words.
+    not_identified: Vec<String>,
+}
+
+/// `compare`'s measures of the fitted model on the working series.
+struct CompareMeasures {
+    /// Where the prediction diverged [s].
+    diverged_at_s: Option<f64>,
+    /// The noise floor.
+    noise_floor: f64,
+    /// The errors over the whole log.
+    err: ErrorSummary,
+    /// The worst windows, tagged with their transients.
+    worst: Vec<WorstWindow>,
+    /// Every window.
+    all_windows: Vec<WorstWindow>,
+    /// The advice on the worst windows.
+    advice: Vec<String>,
+    /// The prediction.
+    prediction: Prediction,
 }
 
 impl Analysis {
@@ -199,6 +263,69 @@ impl Analysis {
     }
 }
 
+/// How much the log's measured speed, flux current and load current change, each
+/// relative to its largest magnitude (the speed `None` without a speed column): what
+/// identifies the base parameters.
+struct Spans {
+    speed: Option<f64>,
+    flux: f64,
+    load: f64,
+    /// The log's highest synchronous speed [rpm].
+    sync_rpm: f64,
+}
+
+impl Spans {
+    fn of(d: &super::prep::Prepared, n: &super::simplified_model::MachineConstants) -> Self {
+        let span = |x: &[f64]| {
+            let (lo, hi) = x
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                    (a.min(v), b.max(v))
+                });
+            let scale = x.iter().fold(0.0f64, |a, &v| a.max(v.abs())).max(1e-9);
+            if hi >= lo {
+                (hi - lo) / scale
+            } else {
+                0.0
+            }
+        };
+        Spans {
+            speed: d.channels.speed.then(|| span(&d.omega_r)),
+            flux: span(&d.i_f),
+            load: span(&d.iq),
+            sync_rpm: super::effects::sync_speed_mech(d, n) * 60.0 / (2.0 * std::f64::consts::PI),
+        }
+    }
+
+    /// Why the log does not identify base parameter `p`, in words.
+    fn why_not(&self, p: super::simplified_model::BaseParameter) -> String {
+        use super::simplified_model::BaseParameter::{BPlusBl, Ls, Ra, J};
+        match (p, self.speed) {
+            (J, Some(s)) if s < 0.02 => format!(
+                "the speed never changes in this log (it spans {:.1} % of its largest value)",
+                100.0 * s
+            ),
+            (J, Some(_)) => "the speed changes too little or too slowly for the inertia torque to matter next to the other torques".into(),
+            (J | BPlusBl, None) => "the log has no speed column, and the currents alone hardly depend on it".into(),
+            (BPlusBl, Some(s)) if s < 0.02 => format!(
+                "the speed never changes in this log (spans {:.1} %, synchronous {:.0} rpm): a viscous torque cannot be told from a constant one",
+                100.0 * s,
+                self.sync_rpm
+            ),
+            (BPlusBl, Some(_)) => "the speed-dependent load torque is too small next to the other torques".into(),
+            (Ls, _) if self.flux < 0.05 => format!(
+                "the flux current hardly changes (spans {:.1} %), so Ls trades off against Ra at one operating point",
+                100.0 * self.flux
+            ),
+            (Ra, _) if self.load < 0.05 => format!(
+                "the load current hardly changes (spans {:.1} %), so Ra trades off against Ls at one operating point",
+                100.0 * self.load
+            ),
+            _ => "the other fitted parameters compensate its change".into(),
+        }
+    }
+}
+
 /// The base parameters a Jacobian finds unidentified, each with the reason the log gives:
 /// how much the measured speed, flux current and load current change over it.
 fn not_identified_in_words(
@@ -206,57 +333,15 @@ fn not_identified_in_words(
     d: &super::prep::Prepared,
     n: &super::simplified_model::MachineConstants,
 ) -> Vec<String> {
-    let span = |x: &[f64]| {
-        let (lo, hi) = x
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                (a.min(v), b.max(v))
-            });
-        let scale = x.iter().fold(0.0f64, |a, &v| a.max(v.abs())).max(1e-9);
-        if hi >= lo {
-            (hi - lo) / scale
-        } else {
-            0.0
-        }
-    };
-    let speed_span = if d.channels.speed {
-        Some(span(&d.omega_r))
-    } else {
-        None
-    };
-    let flux_span = span(&d.i_f);
-    let load_span = span(&d.iq);
-    let sync_rpm = super::effects::sync_speed_mech(d, n) * 60.0 / (2.0 * std::f64::consts::PI);
+    let spans = Spans::of(d, n);
     j.base
         .iter()
         .filter(|p| !p.identified)
         .map(|p| {
-            let why = match (p.parameter, speed_span) {
-                ("j_kgm2", Some(s)) if s < 0.02 => format!(
-                    "the speed never changes in this log (it spans {:.1} % of its largest value)",
-                    100.0 * s
-                ),
-                ("j_kgm2", Some(_)) => "the speed changes too little or too slowly for the inertia torque to matter next to the other torques".into(),
-                ("j_kgm2" | "b_plus_bl_nms", None) => "the log has no speed column, and the currents alone hardly depend on it".into(),
-                ("b_plus_bl_nms", Some(s)) if s < 0.02 => format!(
-                    "the speed never changes in this log (spans {:.1} %, synchronous {:.0} rpm): a viscous torque cannot be told from a constant one",
-                    100.0 * s,
-                    sync_rpm
-                ),
-                ("b_plus_bl_nms", Some(_)) => "the speed-dependent load torque is too small next to the other torques".into(),
-                ("ls_h", _) if flux_span < 0.05 => format!(
-                    "the flux current hardly changes (spans {:.1} %), so Ls trades off against Ra at one operating point",
-                    100.0 * flux_span
-                ),
-                ("ra_ohm", _) if load_span < 0.05 => format!(
-                    "the load current hardly changes (spans {:.1} %), so Ra trades off against Ls at one operating point",
-                    100.0 * load_span
-                ),
-                _ => "the other fitted parameters compensate its change".into(),
-            };
             format!(
-                "{} is not identified: {why} (a 10 % change moves the error by {:.4}, below {})",
+                "{} is not identified: {} (a 10 % change moves the error by {:.4}, below {})",
                 p.parameter,
+                spans.why_not(p.parameter),
                 p.error_change_per_10_percent,
                 super::fit::IDENTIFIED_MIN
             )

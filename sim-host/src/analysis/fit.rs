@@ -11,12 +11,13 @@
 //! solver is [`super::lm`] (apart from the model; it reports how it ended, [`FitResult::report`]);
 //! bounds are enforced by clamping.
 
-use super::effects::{EffectModel, FitSetup};
+use super::effects::{EffectModel, EffectValuesError, FitSetup};
 use super::lm::{self, LeastSquares};
 use super::metrics::{measured, predicted, Weights};
 use super::prep::{Prepared, C64};
 use super::simplified_model::{
-    rotations, simulate, simulate_rot, BaseParams, MachineConstants, ModelTerms, Prediction,
+    rotations, simulate, simulate_rot, BaseParameter, BaseParams, MachineConstants, ModelTerms,
+    Prediction,
 };
 use nalgebra::DMatrix;
 use rayon::prelude::*;
@@ -101,16 +102,23 @@ impl<'a> Problem<'a> {
 
     /// The effects' contributions for the effect parameters in `x` (the base parameters do
     /// not enter them).
-    fn terms(&self, x: &[f64]) -> ModelTerms {
+    fn terms(&self, x: &[f64]) -> Result<ModelTerms, EffectValuesError> {
         let mut terms = ModelTerms::default();
-        for (e, p) in effect_values(self.effects, &x[N_BASE..]) {
-            e.setup.contribute(p, self.d, self.n, &mut terms);
+        for (e, p) in effect_values(self.effects, x.get(N_BASE..).unwrap_or(&[]))? {
+            e.setup.contribute(p, self.d, self.n, &mut terms)?;
         }
-        terms
+        Ok(terms)
     }
 
     fn residuals_of(&self, x: &[f64]) -> Vec<f64> {
-        self.residuals_with(x, &self.terms(x))
+        self.residuals(x, &self.terms(x))
+    }
+
+    /// The residuals of a point the model cannot be run at: 1e3 each (as for a prediction
+    /// that ends early).
+    fn failed_point(&self) -> Vec<f64> {
+        let priors = if self.fit_base { N_BASE } else { 0 };
+        vec![1e3; self.w.n_channels() * self.targets.len() + priors]
     }
 
     /// The same residuals as [`Weights::residuals`] on the training samples (the measured
@@ -145,13 +153,18 @@ impl<'a> Problem<'a> {
 }
 
 impl LeastSquares for Problem<'_> {
-    /// The effects' terms: only the effects' parameters enter them.
-    type Cache = ModelTerms;
-    fn cache(&self, x: &[f64]) -> ModelTerms {
+    /// The effects' terms: only the effects' parameters enter them. (A point whose values
+    /// do not match the effects cannot occur: [`fit`] checks its start, and the solver
+    /// changes values, not their number; it would count as a failed point.)
+    type Cache = Result<ModelTerms, EffectValuesError>;
+    fn cache(&self, x: &[f64]) -> Result<ModelTerms, EffectValuesError> {
         self.terms(x)
     }
-    fn residuals(&self, x: &[f64], terms: &ModelTerms) -> Vec<f64> {
-        self.residuals_with(x, terms)
+    fn residuals(&self, x: &[f64], terms: &Result<ModelTerms, EffectValuesError>) -> Vec<f64> {
+        match terms {
+            Ok(t) => self.residuals_with(x, t),
+            Err(_) => self.failed_point(),
+        }
     }
     fn keeps_cache(&self, i: usize) -> bool {
         i < N_BASE
@@ -166,21 +179,57 @@ pub fn btot_scale(n: &MachineConstants, d: &Prepared) -> f64 {
 }
 
 /// Each effect with its slice of the effect values `values` (laid out in the effects'
-/// order, each set-up's parameter count; a short `values` ends the list).
+/// order, each set-up's parameter count).
+///
+/// # Errors
+/// [`EffectValuesError::Total`] when `values` does not hold one value per parameter of
+/// the effects.
 fn effect_values<'e, 'v>(
     effects: &'e [ActiveEffect<'e>],
     values: &'v [f64],
-) -> impl Iterator<Item = (&'e ActiveEffect<'e>, &'v [f64])> {
-    let mut o = 0;
-    effects.iter().map_while(move |e| {
-        let p = values.get(o..o + e.setup.len())?;
-        o += e.setup.len();
-        Some((e, p))
-    })
+) -> Result<Vec<(&'e ActiveEffect<'e>, &'v [f64])>, EffectValuesError> {
+    let expected: usize = effects.iter().map(|e| e.setup.len()).sum();
+    if values.len() != expected {
+        return Err(EffectValuesError::Total {
+            expected,
+            got: values.len(),
+        });
+    }
+    let mut rest = values;
+    Ok(effects
+        .iter()
+        .map(|e| {
+            let (p, tail) = rest.split_at(e.setup.len());
+            rest = tail;
+            (e, p)
+        })
+        .collect())
+}
+
+/// Each effect with its fitted values `values` (one set per effect, in order).
+///
+/// # Errors
+/// [`EffectValuesError::Effects`] when there is not one set per effect (a set of the
+/// wrong length is refused where it is used, [`FitSetup::contribute`]).
+fn paired<'e, 'v>(
+    effects: &'e [ActiveEffect<'e>],
+    values: &'v [Vec<f64>],
+) -> Result<impl Iterator<Item = (&'e ActiveEffect<'e>, &'v Vec<f64>)>, EffectValuesError> {
+    if effects.len() != values.len() {
+        return Err(EffectValuesError::Effects {
+            expected: effects.len(),
+            got: values.len(),
+        });
+    }
+    Ok(effects.iter().zip(values))
 }
 
 /// Fits base parameters (unless `fit_base` is false: nominal values are kept) and the
 /// effects' parameters, starting from `start` (base) and each set-up's initial values.
+///
+/// # Errors
+/// [`EffectValuesError`] when an effect refuses its set-up's own values (a set-up whose
+/// parameters do not match its contribution).
 pub fn fit(
     d: &Prepared,
     n: &MachineConstants,
@@ -189,7 +238,7 @@ pub fn fit(
     start: &BaseParams,
     fit_base: bool,
     max_iter: usize,
-) -> FitResult {
+) -> Result<FitResult, EffectValuesError> {
     let prob = Problem::new(d, n, effects, w, fit_base);
     let bs = prob.btot_scale;
     let mut x = vec![
@@ -209,13 +258,14 @@ pub fn fit(
     }
     let free: Vec<usize> = (0..x.len()).filter(|&i| fit_base || i >= N_BASE).collect();
     let bounds = lm::Bounds { lo, hi, scale };
+    prob.terms(&x)?;
     // From `x`, then from each effect's other starts (`FitSetup::alt_init`, one effect's
     // at a time): the lowest final cost wins.
     let mut best = lm::solve(&prob, x.clone(), &bounds, &free, max_iter);
     let mut o = N_BASE;
     for e in effects {
         let k = e.setup.len();
-        for alt in e.setup.alt_init.iter().filter(|a| a.len() == k) {
+        for alt in e.setup.alt_init() {
             let mut y = x.clone();
             y[o..o + k].copy_from_slice(alt);
             let r = lm::solve(&prob, y, &bounds, &free, max_iter);
@@ -226,37 +276,45 @@ pub fn fit(
         o += k;
     }
     let (x, report) = best;
-    FitResult {
+    Ok(FitResult {
         base: Problem::base(&x),
-        effect_params: effect_values(effects, &x[N_BASE..])
+        effect_params: effect_values(effects, x.get(N_BASE..).unwrap_or(&[]))?
+            .into_iter()
             .map(|(_, p)| p.to_vec())
             .collect(),
         report,
-    }
+    })
 }
 
 /// The effects' terms for fitted values.
+///
+/// # Errors
+/// [`EffectValuesError`] when `f` does not hold one set of values per effect, each with
+/// one value per parameter.
 pub fn terms(
     d: &Prepared,
     n: &MachineConstants,
     effects: &[ActiveEffect<'_>],
     f: &FitResult,
-) -> ModelTerms {
+) -> Result<ModelTerms, EffectValuesError> {
     let mut terms = ModelTerms::default();
-    for (e, p) in effects.iter().zip(&f.effect_params) {
-        e.setup.contribute(p, d, n, &mut terms);
+    for (e, p) in paired(effects, &f.effect_params)? {
+        e.setup.contribute(p, d, n, &mut terms)?;
     }
-    terms
+    Ok(terms)
 }
 
 /// Simulates the model with fitted values.
+///
+/// # Errors
+/// As [`terms`].
 pub fn predict(
     d: &Prepared,
     n: &MachineConstants,
     effects: &[ActiveEffect<'_>],
     f: &FitResult,
-) -> Prediction {
-    simulate(d, n, &f.base, &terms(d, n, effects, f))
+) -> Result<Prediction, EffectValuesError> {
+    Ok(simulate(d, n, &f.base, &terms(d, n, effects, f)?))
 }
 
 /// A fitted model as a value: the effects set up on a series, the fitted base and effect
@@ -271,7 +329,14 @@ pub struct FittedModel<'a> {
 
 impl FittedModel<'_> {
     /// The model's prediction on `d` (the series its effects were set up on).
-    pub fn predict(&self, d: &Prepared, n: &MachineConstants) -> Prediction {
+    ///
+    /// # Errors
+    /// As [`terms`]: the fitted values do not match the effects.
+    pub fn predict(
+        &self,
+        d: &Prepared,
+        n: &MachineConstants,
+    ) -> Result<Prediction, EffectValuesError> {
         predict(d, n, &self.effects, &self.fit)
     }
 }
@@ -294,7 +359,7 @@ impl std::fmt::Display for FittedModel<'_> {
         )?;
         for (e, p) in self.effects.iter().zip(&self.fit.effect_params) {
             for (q, v) in e.setup.params.iter().zip(p) {
-                write!(f, "; {} = {} {}", q.name, sig(*v), q.unit)?;
+                write!(f, "; {} = {} {}", q.name, sig(*v), q.unit())?;
             }
         }
         let r = &self.fit.report;
@@ -311,8 +376,8 @@ impl std::fmt::Display for FittedModel<'_> {
 /// How well a log identifies one base parameter (`compare`'s `identifiability`).
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct ParameterSensitivity {
-    /// Base parameter key (as in `base_parameters`).
-    pub parameter: &'static str,
+    /// Base parameter (its key as in `base_parameters`).
+    pub parameter: BaseParameter,
     /// Change of the model error (normalized, root-sum over the channels) that a 10 %
     /// change of this parameter causes when every other fitted parameter is refitted to
     /// compensate: `0.1 |x_i| / sqrt((J^T J)^-1_ii)`, J the Jacobian of the data residuals
@@ -343,6 +408,9 @@ pub struct Jacobian {
 /// The data Jacobian at the fitted point `f` (forward differences, in parallel), relative
 /// to each parameter's magnitude, and what it says about the base parameters. `None` when
 /// the base parameters were not fitted.
+///
+/// # Errors
+/// As [`terms`]: the fitted values do not match the effects.
 pub fn jacobian(
     d: &Prepared,
     n: &MachineConstants,
@@ -350,9 +418,9 @@ pub fn jacobian(
     w: &Weights,
     f: &FitResult,
     fit_base: bool,
-) -> Option<Jacobian> {
+) -> Result<Option<Jacobian>, EffectValuesError> {
     if !fit_base {
-        return None;
+        return Ok(None);
     }
     // Data residuals only: the priors are not information from the log.
     let prob = Problem::new(d, n, effects, w, false);
@@ -364,15 +432,15 @@ pub fn jacobian(
         f.base.j_scale,
     ];
     let mut mag = vec![1.0, 1.0, f.base.btot_nms.abs().max(0.1 * bs), 1.0];
-    for (e, p) in effects.iter().zip(&f.effect_params) {
+    for (e, p) in paired(effects, &f.effect_params)? {
         x.extend_from_slice(p);
         for (v, q) in p.iter().zip(&e.setup.params) {
             mag.push(v.abs().max(q.scale));
         }
     }
+    prob.terms(&x)?;
     let g = Gram::of(&relative_columns(&prob, &x, &mag));
-    let names = ["ra_ohm", "ls_h", "b_plus_bl_nms", "j_kgm2"];
-    let base = names
+    let base = BaseParameter::ALL
         .iter()
         .enumerate()
         .map(|(i, &name)| {
@@ -389,12 +457,12 @@ pub fn jacobian(
             }
         })
         .collect();
-    Some(Jacobian {
+    Ok(Some(Jacobian {
         n_parameters: x.len(),
         rank: g.rank(),
         condition_number: g.condition_number(),
         base,
-    })
+    }))
 }
 
 /// The Jacobian's columns at `x`, each relative to its parameter's magnitude `mag`
@@ -526,6 +594,10 @@ mod fitted_model_tests {
             "{s}"
         );
         // An empty series predicts nothing (and does not panic).
-        assert!(m.predict(&d, &n).iq.is_empty());
+        assert!(m
+            .predict(&d, &n)
+            .expect("one value per parameter")
+            .iq
+            .is_empty());
     }
 }

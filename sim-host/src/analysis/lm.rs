@@ -104,81 +104,108 @@ pub fn cost_of(r: &[f64]) -> f64 {
 /// the parameter vector and how the solve ended.
 pub fn solve<P: LeastSquares>(
     prob: &P,
-    mut x: Vec<f64>,
+    x: Vec<f64>,
     b: &Bounds,
     free: &[usize],
     max_iter: usize,
 ) -> (Vec<f64>, Report) {
-    let mut cache = prob.cache(&x);
-    let mut r = prob.residuals(&x, &cache);
-    let mut cost = cost_of(&r);
-    let mut lambda = 1e-3;
-    let mut small_steps = 0;
+    let mut p = Point::at(prob, x);
     let mut report = Report {
         iterations: 0,
-        cost,
+        cost: p.cost,
         termination: Termination::IterationLimit,
     };
     if free.is_empty() {
         report.termination = Termination::NothingToFit;
-        return (x, report);
+        return (p.x, report);
     }
+    let mut lambda = 1e-3;
+    let mut small_steps = 0;
     // Cost after each iteration, for the slow-progress rule.
     let mut history: Vec<f64> = Vec::with_capacity(max_iter + 1);
-    history.push(cost);
+    history.push(p.cost);
     for it in 0..max_iter {
         report.iterations = it + 1;
-        let (jtj, jtr) = normal_equations(prob, &x, &r, &cache, b, free);
-        let m = free.len();
-        let mut improved = false;
-        for _ in 0..DAMPING_TRIES {
-            let mut aug = jtj.clone();
-            for a in 0..m {
-                aug[(a, a)] += lambda * jtj[(a, a)].max(1e-12) + 1e-12;
-            }
-            let step = match aug.cholesky() {
-                Some(ch) => ch.solve(&(-&jtr)),
-                None => {
-                    lambda *= 10.0;
-                    continue;
-                }
-            };
-            let mut xn = x.clone();
-            for (a, &i) in free.iter().enumerate() {
-                xn[i] = (x[i] + step[a]).clamp(b.lo[i], b.hi[i]);
-            }
-            let cn_cache = prob.cache(&xn);
-            let rn = prob.residuals(&xn, &cn_cache);
-            let cn = cost_of(&rn);
-            if cn.is_finite() && cn < cost {
-                let rel = (cost - cn) / cost.max(1e-300);
-                x = xn;
-                r = rn;
-                cache = cn_cache;
-                cost = cn;
-                lambda = (lambda / 3.0).max(1e-9);
-                improved = true;
-                small_steps = if rel < REL_TOL { small_steps + 1 } else { 0 };
-                break;
-            }
-            lambda *= 8.0;
-        }
-        report.cost = cost;
-        if !improved {
+        let step = damped_step(prob, &mut p, &mut lambda, b, free);
+        report.cost = p.cost;
+        let Some(rel) = step else {
             report.termination = Termination::Stalled;
             break;
-        }
+        };
+        small_steps = if rel < REL_TOL { small_steps + 1 } else { 0 };
         if small_steps >= 2 {
             report.termination = Termination::Converged;
             break;
         }
-        history.push(cost);
+        history.push(p.cost);
         if slow_progress(&history) {
             report.termination = Termination::SlowProgress;
             break;
         }
     }
-    (x, report)
+    (p.x, report)
+}
+
+/// The solver's point: the parameters, their residuals, the residuals' cache and the cost.
+struct Point<C> {
+    x: Vec<f64>,
+    r: Vec<f64>,
+    cache: C,
+    cost: f64,
+}
+
+impl<C> Point<C> {
+    /// The point `x` of `prob`.
+    fn at<P: LeastSquares<Cache = C>>(prob: &P, x: Vec<f64>) -> Self {
+        let cache = prob.cache(&x);
+        let r = prob.residuals(&x, &cache);
+        Point {
+            cost: cost_of(&r),
+            x,
+            r,
+            cache,
+        }
+    }
+}
+
+/// One iteration: the normal equations at `p`, then Marquardt's step tried with the
+/// damping `lambda` raised (x10 when the damped matrix is not positive definite, x8 when
+/// the step does not lower the cost) up to [`DAMPING_TRIES`] times. The first step that
+/// lowers the cost is taken (`p` moves there, the damping falls by 3) and its relative
+/// decrease returned; `None` when none did.
+fn damped_step<P: LeastSquares>(
+    prob: &P,
+    p: &mut Point<P::Cache>,
+    lambda: &mut f64,
+    b: &Bounds,
+    free: &[usize],
+) -> Option<f64> {
+    let (jtj, jtr) = normal_equations(prob, &p.x, &p.r, &p.cache, b, free);
+    let m = free.len();
+    for _ in 0..DAMPING_TRIES {
+        let mut aug = jtj.clone();
+        for a in 0..m {
+            aug[(a, a)] += *lambda * jtj[(a, a)].max(1e-12) + 1e-12;
+        }
+        let Some(ch) = aug.cholesky() else {
+            *lambda *= 10.0;
+            continue;
+        };
+        let step = ch.solve(&(-&jtr));
+        let mut xn = p.x.clone();
+        for (a, &i) in free.iter().enumerate() {
+            xn[i] = (p.x[i] + step[a]).clamp(b.lo[i], b.hi[i]);
+        }
+        let next = Point::at(prob, xn);
+        if next.cost.is_finite() && next.cost < p.cost {
+            let rel = (p.cost - next.cost) / p.cost.max(1e-300);
+            *p = next;
+            *lambda = (*lambda / 3.0).max(1e-9);
+            return Some(rel);
+        }
+        *lambda *= 8.0;
+    }
+    None
 }
 
 /// True when the last entry of `history` (the cost after each iteration, the start first)

@@ -56,7 +56,7 @@ use metrics::Weights;
 use monitor_core::EffectKind;
 use prep::{Prepared, ReadOptions, C64};
 use serde::Serialize;
-use simplified_model::{BaseParams, MachineConstants, Prediction};
+use simplified_model::{BaseParameter, BaseParams, MachineConstants, Prediction};
 use std::path::Path;
 
 /// Largest number of samples a fit simulates (longer logs are fitted on a coarser series
@@ -83,6 +83,9 @@ pub enum AnalysisError {
         /// Why not.
         source: effects::SetupError,
     },
+    /// Fitted values that do not match the effects they are for.
+    #[error(transparent)]
+    Values(#[from] effects::EffectValuesError),
 }
 
 /// The library's effect names, comma separated (for messages).
@@ -157,29 +160,21 @@ pub struct FittedEffect {
     pub implausible_because: Vec<String>,
 }
 
-/// A fitted base parameter with its unit and physical range ([`effects::plausible`]).
+/// A fitted base parameter with its physical range ([`effects::plausible`]).
 struct BaseValue {
-    /// JSON key.
-    key: &'static str,
+    /// Which.
+    key: BaseParameter,
     value: f64,
-    unit: &'static str,
     range: crate::params::PlausibleRange,
     /// Where the range comes from.
     basis: &'static str,
 }
 
 impl BaseValue {
-    fn new(
-        key: &'static str,
-        value: f64,
-        (lo, hi): (f64, f64),
-        unit: &'static str,
-        basis: &'static str,
-    ) -> Self {
+    fn new(key: BaseParameter, value: f64, (lo, hi): (f64, f64), basis: &'static str) -> Self {
         BaseValue {
             key,
             value,
-            unit,
             range: crate::params::PlausibleRange { lo, hi },
             basis,
         }
@@ -187,7 +182,8 @@ impl BaseValue {
 
     /// Why the value is not plausible (`None`: it is).
     fn implausible_because(&self) -> Option<String> {
-        effects::outside(self.key, self.unit, self.value, &self.range, self.basis)
+        let (key, unit) = (self.key.key(), self.key.unit());
+        effects::outside(key, unit, self.value, &self.range, self.basis)
     }
 }
 
@@ -198,13 +194,13 @@ fn base_values(n: &MachineConstants, b: &BaseParams, d: &Prepared) -> [BaseValue
         .max(3.0 * n.btot_nms);
     let rel = |r: (f64, f64), x: f64| (r.0 * x, r.1 * x);
     [
-        BaseValue::new("ra_ohm", n.ra_ohm * b.ra_scale, rel(pl::RA_RATIO, n.ra_ohm), "ohm",
+        BaseValue::new(BaseParameter::Ra, n.ra_ohm * b.ra_scale, rel(pl::RA_RATIO, n.ra_ohm),
             "Ra follows the winding temperature: -20 C to 155 C is 0.84-1.53 x the 20 C value, plus 10 % data-sheet tolerance"),
-        BaseValue::new("ls_h", n.ls_h * b.ls_scale, rel(pl::LS_RATIO, n.ls_h), "H",
+        BaseValue::new(BaseParameter::Ls, n.ls_h * b.ls_scale, rel(pl::LS_RATIO, n.ls_h),
             "Ls moves at most about 30 % with saturation and tolerance"),
-        BaseValue::new("b_plus_bl_nms", b.btot_nms, (0.0, bmax), "N m s/rad",
+        BaseValue::new(BaseParameter::BPlusBl, b.btot_nms, (0.0, bmax),
             "a viscous load carries at most 1.5 x the rated torque at synchronous speed"),
-        BaseValue::new("j_kgm2", n.j_kgm2 * b.j_scale, rel(pl::J_RATIO, n.j_kgm2), "kg m^2",
+        BaseValue::new(BaseParameter::J, n.j_kgm2 * b.j_scale, rel(pl::J_RATIO, n.j_kgm2),
             "the coupled load's inertia is the usual unknown, but a factor 3 either way is another machine"),
     ]
 }
@@ -214,7 +210,7 @@ fn base_out_of_range(
     n: &MachineConstants,
     b: &BaseParams,
     d: &Prepared,
-) -> Vec<(&'static str, String)> {
+) -> Vec<(BaseParameter, String)> {
     base_values(n, b, d)
         .iter()
         .filter_map(|v| Some((v.key, v.implausible_because()?)))
@@ -287,39 +283,13 @@ fn coarsen(d: &Prepared, m: usize) -> Prepared {
             .map(|c| c.iter().sum::<f64>() / m as f64)
             .collect()
     };
-    // Rotating vectors are averaged in the frame they are constant in (sign +1: the
-    // positive-sequence d-q frame, -1: the negative-sequence frame) and rotated back with
-    // the block's mean angle; a plain average over a supply period would cancel them.
-    // One pass for the three vectors: each sample's rotation is computed once.
     let theta_c = avg(&d.theta);
-    let zero = C64::new(0.0, 0.0);
+    let rotated = rotating_block_means(d, m, &theta_c);
     let has_v = d.v_neg.len() == d.len();
-    let rotated: Vec<(C64, C64, C64)> = d
-        .theta
-        .par_chunks_exact(m)
-        .enumerate()
-        .zip(&theta_c)
-        .map(|((b, th), &tc)| {
-            let (mut si, mut sv, mut sn) = (zero, zero, zero);
-            for (j, &t) in th.iter().enumerate() {
-                let k = b * m + j;
-                let r = C64::from_polar(1.0, -t); // e^{-j theta}
-                let rc = r.conj(); // e^{+j theta}
-                si += d.i_ab[k] * r;
-                if has_v {
-                    sv += d.v_neg[k] * rc;
-                }
-                sn += d.i_neg[k] * rc;
-            }
-            let back = C64::from_polar(1.0, tc);
-            let mf = m as f64;
-            (si / mf * back, sv / mf * back.conj(), sn / mf * back.conj())
-        })
-        .collect();
     Prepared {
         t_s: avg(&d.t_s),
         dt_s: d.dt_s * m as f64,
-        theta: theta_c.clone(),
+        theta: theta_c,
         omega_s: avg(&d.omega_s),
         vd: avg(&d.vd),
         vq: avg(&d.vq),
@@ -346,6 +316,39 @@ fn coarsen(d: &Prepared, m: usize) -> Prepared {
         block_rows: d.block_rows,
         log_start_s: d.log_start_s,
     }
+}
+
+/// The block means of `d`'s rotating vectors over blocks of `m` (the current i_ab, the
+/// negative-sequence voltage and current), each block's mean angle `theta_c`. Rotating
+/// vectors are averaged in the frame they are constant in (the positive-sequence d-q frame
+/// for i_ab, the negative-sequence frame for the others) and rotated back with the block's
+/// mean angle; a plain average over a supply period would cancel them. One pass for the
+/// three vectors: each sample's rotation is computed once.
+fn rotating_block_means(d: &Prepared, m: usize, theta_c: &[f64]) -> Vec<(C64, C64, C64)> {
+    use rayon::prelude::*;
+    let zero = C64::new(0.0, 0.0);
+    let has_v = d.v_neg.len() == d.len();
+    d.theta
+        .par_chunks_exact(m)
+        .enumerate()
+        .zip(theta_c)
+        .map(|((b, th), &tc)| {
+            let (mut si, mut sv, mut sn) = (zero, zero, zero);
+            for (j, &t) in th.iter().enumerate() {
+                let k = b * m + j;
+                let r = C64::from_polar(1.0, -t); // e^{-j theta}
+                let rc = r.conj(); // e^{+j theta}
+                si += d.i_ab[k] * r;
+                if has_v {
+                    sv += d.v_neg[k] * rc;
+                }
+                sn += d.i_neg[k] * rc;
+            }
+            let back = C64::from_polar(1.0, tc);
+            let mf = m as f64;
+            (si / mf * back, sv / mf * back.conj(), sn / mf * back.conj())
+        })
+        .collect()
 }
 
 impl Analysis {
@@ -409,10 +412,10 @@ impl Analysis {
             .map(|(v, nom)| {
                 let reason = v.implausible_because();
                 (
-                    v.key.to_string(),
+                    v.key.key().to_string(),
                     ParamValue {
                         value: v.value,
-                        unit: v.unit.to_string(),
+                        unit: v.key.unit().to_string(),
                         nominal: Some(nom),
                         plausible: reason.is_none(),
                         implausible_because: reason,
@@ -453,7 +456,7 @@ impl Analysis {
         w: &Weights,
         start: &BaseParams,
         fit_base: bool,
-    ) -> FitResult {
+    ) -> Result<FitResult, effects::EffectValuesError> {
         fit::fit(
             fitdata,
             &self.constants,
@@ -465,37 +468,31 @@ impl Analysis {
         )
     }
 
-    fn fitted_effects(&self, active: &[ActiveEffect<'_>], f: &FitResult) -> Vec<FittedEffect> {
+    /// The effects `active` with their fitted values in `f`, as the JSON reports them.
+    fn fitted_effects(
+        &self,
+        active: &[ActiveEffect<'_>],
+        f: &FitResult,
+    ) -> Result<Vec<FittedEffect>, effects::EffectValuesError> {
+        if active.len() != f.effect_params.len() {
+            return Err(effects::EffectValuesError::Effects {
+                expected: active.len(),
+                got: f.effect_params.len(),
+            });
+        }
         active
             .iter()
             .zip(&f.effect_params)
             .map(|(a, p)| {
+                let summary = a.setup.describe(p, &self.data, &self.constants)?;
                 let why = a.setup.implausible(p);
-                FittedEffect {
+                Ok(FittedEffect {
                     effect: a.effect.kind(),
-                    parameters: a
-                        .setup
-                        .params
-                        .iter()
-                        .zip(p)
-                        .map(|(q, v)| {
-                            let reason = q.implausible_because(*v);
-                            (
-                                q.name.clone(),
-                                ParamValue {
-                                    value: *v,
-                                    unit: q.unit.to_string(),
-                                    nominal: None,
-                                    plausible: reason.is_none(),
-                                    implausible_because: reason,
-                                },
-                            )
-                        })
-                        .collect(),
-                    summary: a.setup.describe(p, &self.data, &self.constants),
+                    parameters: parameter_table(&a.setup.params, p),
+                    summary,
                     plausible: why.is_empty(),
                     implausible_because: why,
-                }
+                })
             })
             .collect()
     }
@@ -508,30 +505,66 @@ impl Analysis {
         d: &Prepared,
         active: &[ActiveEffect<'_>],
         f: &FitResult,
-    ) -> (Prediction, Prediction) {
-        rayon::join(
+    ) -> Result<(Prediction, Prediction), effects::EffectValuesError> {
+        let (p, r) = rayon::join(
             || fit::predict(d, &self.constants, active, f),
             || self.renoised(d, active, f),
-        )
+        );
+        Ok((p?, r?))
     }
 
     /// The fitted model run with the inputs' sensor noise added again (white, the level
     /// measured on the inputs), for [`metrics::noise_floor`].
-    fn renoised(&self, d: &Prepared, active: &[ActiveEffect<'_>], f: &FitResult) -> Prediction {
-        let mut terms = fit::terms(d, &self.constants, active, f);
+    fn renoised(
+        &self,
+        d: &Prepared,
+        active: &[ActiveEffect<'_>],
+        f: &FitResult,
+    ) -> Result<Prediction, effects::EffectValuesError> {
+        let mut terms = fit::terms(d, &self.constants, active, f)?;
         let sigma_v = 0.5 * (metrics::white_noise_sigma(&d.vd) + metrics::white_noise_sigma(&d.vq));
         terms.input_noise = Some(simplified_model::InputNoise {
             seed: 0x006e_6f69_7365,
             sigma_v,
             sigma_i: metrics::white_noise_sigma(&d.id),
         });
-        simplified_model::simulate(d, &self.constants, &f.base, &terms)
+        Ok(simplified_model::simulate(
+            d,
+            &self.constants,
+            &f.base,
+            &terms,
+        ))
     }
 
     fn fit_data(&self) -> (Prepared, usize) {
         let m = self.data.len().div_ceil(MAX_FIT_SAMPLES).max(1);
         (coarsen(&self.data, m), m)
     }
+}
+
+/// The JSON table of an effect's parameters `params` with their fitted values `p`: keyed by
+/// each parameter's name, with its declared unit and its plausibility.
+fn parameter_table(
+    params: &[effects::FitParam],
+    p: &[f64],
+) -> std::collections::BTreeMap<String, ParamValue> {
+    params
+        .iter()
+        .zip(p)
+        .map(|(q, v)| {
+            let reason = q.implausible_because(*v);
+            (
+                q.name.clone(),
+                ParamValue {
+                    value: *v,
+                    unit: q.unit().to_string(),
+                    nominal: None,
+                    plausible: reason.is_none(),
+                    implausible_because: reason,
+                },
+            )
+        })
+        .collect()
 }
 
 /// Keeps fitted effect values only where the full-series set-up has the same parameter

@@ -23,7 +23,7 @@
 //! gives that advice instead).
 
 use super::fit::Jacobian;
-use super::simplified_model::{BaseParams, MachineConstants};
+use super::simplified_model::{BaseParameter, BaseParams, MachineConstants};
 use crate::params::ParamFile;
 use serde::Serialize;
 
@@ -35,9 +35,9 @@ pub const REPORT_MIN_CHANGE: f64 = 0.02;
 /// log identifies it.
 #[derive(Debug, Clone, Serialize)]
 pub struct RefittedParameter {
-    /// Key, as in `compare`'s `base_parameters` (`ra_ohm`, `ls_h`, `b_plus_bl_nms`,
-    /// `j_kgm2`).
-    pub parameter: &'static str,
+    /// Which (JSON: its key, as in `compare`'s `base_parameters`: `ra_ohm`, `ls_h`,
+    /// `b_plus_bl_nms`, `j_kgm2`).
+    pub parameter: BaseParameter,
     /// Unit.
     pub unit: &'static str,
     /// The parameter file's value.
@@ -77,23 +77,23 @@ pub struct BaseRefit {
 impl BaseRefit {
     /// The refit `b` of the file's constants `n`, with the identifiability of `jac`.
     pub fn new(n: &MachineConstants, b: &BaseParams, jac: Option<&Jacobian>) -> Self {
-        let identified = |key: &str| {
+        let identified = |key: BaseParameter| {
             jac.and_then(|j| j.base.iter().find(|s| s.parameter == key))
                 .is_some_and(|s| s.identified)
         };
-        let p = |parameter, unit, configured: f64, refitted: f64| RefittedParameter {
+        let p = |parameter: BaseParameter, configured: f64, refitted: f64| RefittedParameter {
             parameter,
-            unit,
+            unit: parameter.unit(),
             configured,
             refitted,
             identified: identified(parameter),
         };
         BaseRefit {
             parameters: vec![
-                p("ra_ohm", "ohm", n.ra_ohm, n.ra_ohm * b.ra_scale),
-                p("ls_h", "H", n.ls_h, n.ls_h * b.ls_scale),
-                p("b_plus_bl_nms", "N m s/rad", n.btot_nms, b.btot_nms),
-                p("j_kgm2", "kg m^2", n.j_kgm2, n.j_kgm2 * b.j_scale),
+                p(BaseParameter::Ra, n.ra_ohm, n.ra_ohm * b.ra_scale),
+                p(BaseParameter::Ls, n.ls_h, n.ls_h * b.ls_scale),
+                p(BaseParameter::BPlusBl, n.btot_nms, b.btot_nms),
+                p(BaseParameter::J, n.j_kgm2, n.j_kgm2 * b.j_scale),
             ],
             recentred: false,
             because: vec![],
@@ -101,7 +101,7 @@ impl BaseRefit {
     }
 
     /// Whether the log identifies base parameter `key`.
-    pub fn identifies(&self, key: &str) -> bool {
+    pub fn identifies(&self, key: BaseParameter) -> bool {
         self.parameters
             .iter()
             .any(|r| r.parameter == key && r.identified)
@@ -115,21 +115,21 @@ impl BaseRefit {
         let m = &mut q.motor;
         for r in self.parameters.iter().filter(|r| r.identified) {
             let s = r.change() + 1.0;
-            if !(s.is_finite() && s > 0.0) && r.parameter != "b_plus_bl_nms" {
+            if !(s.is_finite() && s > 0.0) && r.parameter != BaseParameter::BPlusBl {
                 continue;
             }
             match r.parameter {
-                "ra_ohm" => {
+                BaseParameter::Ra => {
                     m.rs_ohm *= s;
                     m.rr_ohm *= s;
                 }
-                "ls_h" => {
+                BaseParameter::Ls => {
                     m.ls_h *= s;
                     m.lm_h *= s;
                     m.lr_h *= s;
                 }
-                "j_kgm2" => m.j_kgm2 *= s,
-                _ => {
+                BaseParameter::J => m.j_kgm2 *= s,
+                BaseParameter::BPlusBl => {
                     let btot = r.refitted.max(0.0);
                     m.b_nms = m.b_nms.min(btot);
                     m.bl_nms = btot - m.b_nms;
@@ -162,7 +162,7 @@ impl BaseRefit {
             .parameters
             .iter()
             .filter(|r| !r.identified)
-            .map(|r| r.parameter)
+            .map(|r| r.parameter.key())
             .collect();
         let mut parts = Vec::new();
         if self.recentred {
@@ -206,12 +206,11 @@ mod tests {
     }
 
     fn jac(identified: [bool; 4]) -> Jacobian {
-        let names = ["ra_ohm", "ls_h", "b_plus_bl_nms", "j_kgm2"];
         Jacobian {
             n_parameters: 4,
             rank: 4,
             condition_number: 1.0,
-            base: names
+            base: BaseParameter::ALL
                 .iter()
                 .zip(identified)
                 .map(|(&parameter, identified)| ParameterSensitivity {

@@ -305,96 +305,161 @@ pub fn mcsa(d: &Prepared, np: f64, bars: Option<f64>, delta: Option<f64>) -> Mcs
         equivalent_broken_bars: bars.zip(delta).map(|(nb, dl)| broken_bars_of_delta(dl, nb)),
         ..Default::default()
     };
-    let no = |mut r: McsaReport, why: String| {
-        r.cannot_judge_because = Some(format!("cannot judge: {why}"));
-        r
-    };
     if d.omega_r.len() != d.len() || d.len() < 16 {
-        return no(r, "needs the speed column wm_rad_s for the slip".into());
+        return cannot_judge(r, "needs the speed column wm_rad_s for the slip".into());
     }
     let (a, slip) = steady_stretch(d);
     // The last 0.2 s block itself off the final quarter's slip: no steady stretch at all
     // (the log ends in a step or a start).
-    let (Some(&t_a), Some(&t_end)) = (d.t_s.get(a), d.t_s.last()) else {
-        return no(r, "the slip is not steady at the end of the log".into());
+    let Some(st) = Stretch::at_end(d, &slip, a) else {
+        return cannot_judge(r, "the slip is not steady at the end of the log".into());
     };
-    if d.len() - a < 16 {
-        return no(r, "the slip is not steady at the end of the log".into());
-    }
-    let mean_of = |a: usize| {
-        let seg = a..d.len();
-        let s = slip[seg.clone()].iter().sum::<f64>() / seg.len().max(1) as f64;
-        let f1 = d.omega_s[seg.clone()].iter().map(|w| w.abs()).sum::<f64>()
-            / seg.len().max(1) as f64
-            / (2.0 * PI);
-        (s, f1)
-    };
-    let (s, f1) = mean_of(a);
-    // A long steady stretch is cut to MAX_STRETCH_S (or 4x the length the sidebands need).
-    let keep_s = MAX_STRETCH_S.max(4.0 * MIN_BINS / (2.0 * s * f1).max(1e-9));
-    let keep = ((keep_s / d.dt_s) as usize).max(16);
-    let (a, t_a, s, f1) = if d.len() - a > keep {
-        let a = d.len() - keep;
-        let (s, f1) = mean_of(a);
-        (a, d.t_s.get(a).copied().unwrap_or(t_a), s, f1)
-    } else {
-        (a, t_a, s, f1)
-    };
-    let seg = a..d.len();
-    let t_len = (d.len() - a) as f64 * d.dt_s;
-    r.window_s = vec![t_a, t_end];
-    r.slip = Some(s);
-    r.fundamental_hz = Some(f1);
-    r.resolution_hz = Some(1.0 / t_len.max(d.dt_s));
-    if s < MIN_SLIP {
-        return no(
+    r.window_s = vec![st.t_a, st.t_end];
+    r.slip = Some(st.s);
+    r.fundamental_hz = Some(st.f1);
+    r.resolution_hz = Some(1.0 / st.t_len.max(d.dt_s));
+    if st.s < MIN_SLIP {
+        return cannot_judge(
             r,
             format!(
                 "the slip {:.4} is below {MIN_SLIP} (no load): the sidebands sit on the fundamental",
-                s
+                st.s
             ),
         );
     }
-    let fs = 2.0 * s * f1;
-    r.sideband_hz = vec![(1.0 - 2.0 * s) * f1, (1.0 + 2.0 * s) * f1];
+    let fs = 2.0 * st.s * st.f1;
+    r.sideband_hz = vec![(1.0 - 2.0 * st.s) * st.f1, (1.0 + 2.0 * st.s) * st.f1];
     r.resolution_needed_hz = Some(fs / MIN_BINS);
-    let (lo, hi) = slip[seg.clone()]
-        .chunks(((0.2 / d.dt_s) as usize).max(1))
-        .map(|c| c.iter().sum::<f64>() / c.len() as f64)
-        .fold((f64::MAX, f64::MIN), |(l, h), x| (l.min(x), h.max(x)));
-    if hi - lo > 2.0 * SLIP_STEADY * s {
-        return no(r, format!("the slip is not steady ({lo:.4}..{hi:.4})"));
+    if let Some(why) = st.unsteady_or_short(d, &slip, fs) {
+        return cannot_judge(r, why);
     }
-    if t_len < MIN_BINS / fs {
-        return no(
-            r,
-            format!(
-                "the steady stretch is {t_len:.2} s; {:.2} s are needed to resolve sidebands 2sf = {fs:.2} Hz from the fundamental ({MIN_BINS} bins of a Blackman-Harris window)",
-                MIN_BINS / fs
-            ),
-        );
-    }
-    let ia: Vec<f64> = d.i_ab[seg.clone()].iter().map(|c| c.re).collect();
     // One planner for both spectra (same length: the plan and its twiddles are reused).
     let mut planner = rustfft::FftPlanner::new();
-    let (df, amp) = spectrum(&mut planner, &ia, d.dt_s, (1.5 * f1).max(f1 + 1.6 * fs));
+    current_sidebands(&mut r, d, &st, fs, &mut planner);
+    speed_ripple(&mut r, d, &st, np, fs, &mut planner);
+    r.judged = true;
+    r
+}
+
+/// The report `r` with the reason it cannot judge.
+fn cannot_judge(mut r: McsaReport, why: String) -> McsaReport {
+    r.cannot_judge_because = Some(format!("cannot judge: {why}"));
+    r
+}
+
+/// The steady stretch at the end of the log the spectra are taken over.
+struct Stretch {
+    /// Its first sample (it runs to the log's end).
+    a: usize,
+    /// Its first and last time [s].
+    t_a: f64,
+    t_end: f64,
+    /// Its mean slip and supply frequency [Hz].
+    s: f64,
+    f1: f64,
+    /// Its length [s].
+    t_len: f64,
+}
+
+impl Stretch {
+    /// The stretch from sample `a` (where [`steady_stretch`] found the slip `slip` steady)
+    /// to the end, cut to [`MAX_STRETCH_S`] (or 4x the length the sidebands need) when
+    /// longer; `None` when it holds fewer than 16 samples.
+    fn at_end(d: &Prepared, slip: &[f64], a: usize) -> Option<Self> {
+        let (Some(&t_a), Some(&t_end)) = (d.t_s.get(a), d.t_s.last()) else {
+            return None;
+        };
+        if d.len() - a < 16 {
+            return None;
+        }
+        let mean_of = |a: usize| {
+            let seg = a..d.len();
+            let s = slip[seg.clone()].iter().sum::<f64>() / seg.len().max(1) as f64;
+            let f1 = d.omega_s[seg.clone()].iter().map(|w| w.abs()).sum::<f64>()
+                / seg.len().max(1) as f64
+                / (2.0 * PI);
+            (s, f1)
+        };
+        let (s, f1) = mean_of(a);
+        let keep_s = MAX_STRETCH_S.max(4.0 * MIN_BINS / (2.0 * s * f1).max(1e-9));
+        let keep = ((keep_s / d.dt_s) as usize).max(16);
+        let (a, t_a, s, f1) = if d.len() - a > keep {
+            let a = d.len() - keep;
+            let (s, f1) = mean_of(a);
+            (a, d.t_s.get(a).copied().unwrap_or(t_a), s, f1)
+        } else {
+            (a, t_a, s, f1)
+        };
+        Some(Stretch {
+            a,
+            t_a,
+            t_end,
+            s,
+            f1,
+            t_len: (d.len() - a) as f64 * d.dt_s,
+        })
+    }
+
+    /// Why the stretch cannot resolve sidebands at `fs` = 2 s f from the fundamental: its
+    /// slip (0.2 s means) moves by more than twice [`SLIP_STEADY`], or it is shorter than
+    /// [`MIN_BINS`] / `fs`. `None` when it can.
+    fn unsteady_or_short(&self, d: &Prepared, slip: &[f64], fs: f64) -> Option<String> {
+        let (lo, hi) = slip[self.a..d.len()]
+            .chunks(((0.2 / d.dt_s) as usize).max(1))
+            .map(|c| c.iter().sum::<f64>() / c.len() as f64)
+            .fold((f64::MAX, f64::MIN), |(l, h), x| (l.min(x), h.max(x)));
+        if hi - lo > 2.0 * SLIP_STEADY * self.s {
+            return Some(format!("the slip is not steady ({lo:.4}..{hi:.4})"));
+        }
+        let t_len = self.t_len;
+        (t_len < MIN_BINS / fs).then(|| format!(
+            "the steady stretch is {t_len:.2} s; {:.2} s are needed to resolve sidebands 2sf = {fs:.2} Hz from the fundamental ({MIN_BINS} bins of a Blackman-Harris window)",
+            MIN_BINS / fs
+        ))
+    }
+}
+
+/// The phase-a current's sidebands at `fs` = 2 s f either side of the fundamental over
+/// the stretch `st`, in dB below it, the estimates from them, and the spectrum around the
+/// fundamental.
+fn current_sidebands(
+    r: &mut McsaReport,
+    d: &Prepared,
+    st: &Stretch,
+    fs: f64,
+    planner: &mut rustfft::FftPlanner<f64>,
+) {
+    let seg = st.a..d.len();
+    let f1 = st.f1;
+    let ia: Vec<f64> = d.i_ab[seg.clone()].iter().map(|c| c.re).collect();
+    let (df, amp) = spectrum(planner, &ia, d.dt_s, (1.5 * f1).max(f1 + 1.6 * fs));
     let (ff, af) = peak(df, &amp, f1, 0.3 * fs);
     let db = |x: f64| 20.0 * (x.max(1e-300) / af.max(1e-300)).log10();
     let (_, al) = peak(df, &amp, ff - fs, SLIP_STEADY * fs);
     let (_, au) = peak(df, &amp, ff + fs, SLIP_STEADY * fs);
     r.lower_sideband_db = Some(db(al));
     r.upper_sideband_db = Some(db(au));
-    spectral_estimate(&mut r, d, seg.clone());
+    spectral_estimate(r, d, seg);
     r.spectrum = (((0.5 * f1) / df) as usize..((1.5 * f1) / df).min(amp.len() as f64) as usize)
         .map(|k| (k as f64 * df, db(amp[k])))
         .collect();
-    let wm: Vec<f64> = d.omega_r[seg].iter().map(|w| w / np).collect();
-    let (dfw, aw) = spectrum(&mut planner, &wm, d.dt_s, 1.3 * fs);
+}
+
+/// The mechanical speed's ripple at about `fs` = 2 s f over the stretch `st` (`np` pole
+/// pairs).
+fn speed_ripple(
+    r: &mut McsaReport,
+    d: &Prepared,
+    st: &Stretch,
+    np: f64,
+    fs: f64,
+    planner: &mut rustfft::FftPlanner<f64>,
+) {
+    let wm: Vec<f64> = d.omega_r[st.a..d.len()].iter().map(|w| w / np).collect();
+    let (dfw, aw) = spectrum(planner, &wm, d.dt_s, 1.3 * fs);
     let (fw, a_w) = peak(dfw, &aw, fs, 0.2 * fs);
     r.speed_ripple_hz = Some(fw);
     r.speed_ripple_rad_s = Some(a_w);
-    r.judged = true;
-    r
 }
 
 #[cfg(test)]

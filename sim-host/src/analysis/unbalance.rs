@@ -106,12 +106,48 @@ pub fn analyse(d: &Prepared, n: &MachineConstants) -> UnbalanceAnalysis {
         .channels
         .voltages
         .then(|| (s.v_neg2 / s.v_pos2.max(1e-12)).sqrt());
-    let c = s.cross / s.i_pos2.max(1e-12);
-    let cv = s.cross_v / s.i_pos2.max(1e-12);
     let w = s.omega_s / s.count;
     let phase_rms_a = s.phase2.map(|p| (p / s.count).sqrt());
-    let slip = operating_slip(d, n, &s);
-    // The core's one faulty-phase method, in its convention I2/I1 = conj(c), V2/I1 = conj(cv).
+    let (asym, eps) = winding_of(d, n, &s, w);
+    let cannot_judge = cannot_judge(d, &s, w);
+    let suspect = asym.suspect_phase.filter(|_| cannot_judge.is_none());
+    let summary = match &cannot_judge {
+        Some(why) => format!(
+            "cannot judge the unbalance (negative sequence {:.1} %): {why}",
+            100.0 * ratio,
+        ),
+        None => Found {
+            ratio,
+            vratio,
+            supply_explains: suspect.is_none() && f64::from(asym.supply_ratio) > 0.5 * ratio,
+            shorted_fraction: eps,
+            phase_rms_a,
+        }
+        .in_words(d, suspect),
+    };
+    UnbalanceAnalysis {
+        negative_sequence_ratio: ratio,
+        voltage_negative_sequence_ratio: vratio,
+        suspect_phase: suspect.map(|p| p.name().to_string()),
+        phase_rms_a,
+        summary,
+        cannot_judge_because: cannot_judge,
+    }
+}
+
+/// The winding asymmetry of the sums `s` by the core's one faulty-phase method (in its
+/// convention I2/I1 = conj(c), V2/I1 = conj(cv)) at the mean supply frequency `w`
+/// [rad/s] and the operating slip, and the least fraction of the suspect phase's turns
+/// shorted (a bolted short).
+fn winding_of(
+    d: &Prepared,
+    n: &MachineConstants,
+    s: &SequenceSums,
+    w: f64,
+) -> (monitor_core::sequence::WindingAsymmetry, f64) {
+    let c = s.cross / s.i_pos2.max(1e-12);
+    let cv = s.cross_v / s.i_pos2.max(1e-12);
+    let slip = operating_slip(d, n, s);
     let (we, sl) = (w.abs().max(1.0) as f32, slip as f32);
     // A current-only log cannot tell a winding from the supply's unbalance or the machine's
     // own build asymmetry: below a healthy machine's inherent asymmetry no phase is named.
@@ -128,53 +164,59 @@ pub fn analyse(d: &Prepared, n: &MachineConstants) -> UnbalanceAnalysis {
         sl,
         min_ratio,
     );
-    let cannot_judge = cannot_judge(d, &s, w);
-    let suspect = asym.suspect_phase.filter(|_| cannot_judge.is_none());
-    let supply_explains = suspect.is_none() && f64::from(asym.supply_ratio) > 0.5 * ratio;
     let eps = f64::from(monitor_core::sequence::min_shorted_fraction(
         &n.core_model,
         we,
         sl,
         asym.ratio,
     ));
-    let summary = match (suspect, supply_explains) {
-        _ if cannot_judge.is_some() => format!(
-            "cannot judge the unbalance (negative sequence {:.1} %): {}",
-            100.0 * ratio,
-            cannot_judge.as_deref().unwrap_or_default()
-        ),
-        (Some(p), _) => {
-            let mean_rms = phase_rms_a.iter().sum::<f64>() / 3.0;
-            let dev = phase_rms_a[p.index()] - mean_rms;
-            format!(
-                "negative-sequence current {:.1} % of positive sequence{}: phase {} winding differs (shorted turns: at least {:.1} % of its turns, as a bolted short; its current is {:.1} % {} the mean)",
+    (asym, eps)
+}
+
+/// What the unbalance analysis found on a series it can judge.
+struct Found {
+    /// Negative over positive sequence current.
+    ratio: f64,
+    /// Negative over positive sequence voltage (`None`: no voltages).
+    vratio: Option<f64>,
+    /// No phase named, and the supply's unbalance accounts for the current's.
+    supply_explains: bool,
+    /// The least fraction of the suspect phase's turns shorted.
+    shorted_fraction: f64,
+    /// Per-phase RMS currents [A].
+    phase_rms_a: [f64; 3],
+}
+
+impl Found {
+    /// The summary sentence, `suspect` the phase named.
+    fn in_words(&self, d: &Prepared, suspect: Option<monitor_core::Phase>) -> String {
+        let ratio = self.ratio;
+        match (suspect, self.supply_explains) {
+            (Some(p), _) => {
+                let mean_rms = self.phase_rms_a.iter().sum::<f64>() / 3.0;
+                let dev = self.phase_rms_a[p.index()] - mean_rms;
+                format!(
+                    "negative-sequence current {:.1} % of positive sequence{}: phase {} winding differs (shorted turns: at least {:.1} % of its turns, as a bolted short; its current is {:.1} % {} the mean)",
+                    100.0 * ratio,
+                    if d.channels.voltages { "" } else { " (current-only log: supply assumed balanced, from the parameter file)" },
+                    p.name(),
+                    100.0 * self.shorted_fraction,
+                    100.0 * dev.abs() / mean_rms.max(1e-12),
+                    if dev > 0.0 { "above" } else { "below" },
+                )
+            }
+            (None, true) => format!(
+                "negative-sequence current {:.1} %, caused by the supply's {:.1} % voltage unbalance (no winding suspected)",
                 100.0 * ratio,
-                if d.channels.voltages { "" } else { " (current-only log: supply assumed balanced, from the parameter file)" },
-                p.name(),
-                100.0 * eps,
-                100.0 * dev.abs() / mean_rms.max(1e-12),
-                if dev > 0.0 { "above" } else { "below" },
-            )
+                100.0 * self.vratio.unwrap_or(0.0)
+            ),
+            (None, false) if !d.channels.voltages && ratio >= 0.01 => format!(
+                "negative sequence {:.1} %: cannot judge the phase (a current-only log: below a healthy machine's own asymmetry of {:.0} % a winding cannot be told from the supply's unbalance or the machine's build; diagnose --baseline with a healthy log judges it)",
+                100.0 * ratio,
+                100.0 * monitor_core::sequence::INHERENT_ASYMMETRY_RATIO
+            ),
+            (None, false) => format!("currents balanced (negative sequence {:.2} %)", 100.0 * ratio),
         }
-        (None, true) => format!(
-            "negative-sequence current {:.1} %, caused by the supply's {:.1} % voltage unbalance (no winding suspected)",
-            100.0 * ratio,
-            100.0 * vratio.unwrap_or(0.0)
-        ),
-        (None, false) if !d.channels.voltages && ratio >= 0.01 => format!(
-            "negative sequence {:.1} %: cannot judge the phase (a current-only log: below a healthy machine's own asymmetry of {:.0} % a winding cannot be told from the supply's unbalance or the machine's build; diagnose --baseline with a healthy log judges it)",
-            100.0 * ratio,
-            100.0 * monitor_core::sequence::INHERENT_ASYMMETRY_RATIO
-        ),
-        (None, false) => format!("currents balanced (negative sequence {:.2} %)", 100.0 * ratio),
-    };
-    UnbalanceAnalysis {
-        negative_sequence_ratio: ratio,
-        voltage_negative_sequence_ratio: vratio,
-        suspect_phase: suspect.map(|p| p.name().to_string()),
-        phase_rms_a,
-        summary,
-        cannot_judge_because: cannot_judge,
     }
 }
 

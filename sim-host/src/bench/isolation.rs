@@ -274,24 +274,6 @@ pub fn judge(
         (None, _) => Outcome::Nothing,
     };
     let right = named == Outcome::Named(want);
-    let mut wrong_names: Vec<String> = row
-        .names_given
-        .iter()
-        .filter(|g| g.name != want)
-        .map(|g| format!("{} at {:+.2} s", g.name, g.t_s))
-        .collect();
-    for c in &row.isolation_candidates {
-        let ok = c.fault == f || (friction && matches!(c.fault, Fault::B | Fault::Bl));
-        let (name, p) = (c.fault, c.probability);
-        if p >= 0.5
-            && !ok
-            && !wrong_names
-                .iter()
-                .any(|w| w.starts_with(&format!("{name} ")))
-        {
-            wrong_names.push(format!("{name} p={p:.2} at the end"));
-        }
-    }
     let size_error = (right && !friction)
         .then(|| {
             row.named_change
@@ -303,14 +285,8 @@ pub fn judge(
         .iter()
         .find(|g| g.name == want && g.t_s >= 0.0)
         .map(|g| g.t_s);
-    let after_fault = |t: &Option<f64>| t.is_some_and(|t| t >= 0.0);
-    let detected = row.detection_delay_s.is_some()
-        || row.names_given.iter().any(|g| g.t_s >= 0.0)
-        || after_fault(&row.name_delay_s)
-        || matches!(
-            row.isolation_state,
-            IsolationState::Isolated | IsolationState::Unknown
-        );
+    let wrong_names = wrong_names(row, f, want);
+    let detected = detected(row);
     CaseResult {
         motor: motor.to_string(),
         mode,
@@ -327,6 +303,42 @@ pub fn judge(
         state: row.isolation_state,
         candidates: row.isolation_candidates.clone(),
     }
+}
+
+/// The wrong names of a case of fault `f` (named `want` when right): each name given
+/// during the run other than `want` (`name at +t s` from the fault), then each other
+/// candidate at probability >= 0.5 at the end not already listed (B and Bl are one
+/// friction class).
+fn wrong_names(row: &Table1Row, f: Fault, want: IsolationName) -> Vec<String> {
+    let friction = matches!(f, Fault::B | Fault::Bl);
+    let mut wrong: Vec<String> = row
+        .names_given
+        .iter()
+        .filter(|g| g.name != want)
+        .map(|g| format!("{} at {:+.2} s", g.name, g.t_s))
+        .collect();
+    for c in &row.isolation_candidates {
+        let ok = c.fault == f || (friction && matches!(c.fault, Fault::B | Fault::Bl));
+        let (name, p) = (c.fault, c.probability);
+        if p >= 0.5 && !ok && !wrong.iter().any(|w| w.starts_with(&format!("{name} "))) {
+            wrong.push(format!("{name} p={p:.2} at the end"));
+        }
+    }
+    wrong
+}
+
+/// Whether a case was detected: a lamp lit after the fault, a name given after it, or the
+/// isolation saw a deviation (named a fault, an unknown fault, or candidates it could not
+/// separate).
+fn detected(row: &Table1Row) -> bool {
+    let after_fault = |t: &Option<f64>| t.is_some_and(|t| t >= 0.0);
+    row.detection_delay_s.is_some()
+        || row.names_given.iter().any(|g| g.t_s >= 0.0)
+        || after_fault(&row.name_delay_s)
+        || matches!(
+            row.isolation_state,
+            IsolationState::Isolated | IsolationState::Unknown
+        )
 }
 
 /// One line of the summary: a motor in one angle mode.

@@ -122,12 +122,33 @@ pub fn measure(repeat: u32) -> Result<BenchFigures, ExperimentError> {
         std::hint::black_box(acc);
         Ok((n, s.step_s))
     })?;
+    let t_csv = time_with_csv(repeat, &params, &sc)?;
+    let (coarse, err) = step_error(&params, &sc, step)?;
+    let t_mon = time_monitor(repeat, &params, &sc, &coarse)?;
+    Ok(BenchFigures {
+        repeat: repeat.max(1),
+        sim_in_memory_s_per_s: t_mem.map(|t| sc.duration_s / t),
+        sim_with_csv_s_per_s: t_csv.map(|t| sc.duration_s / t),
+        max_current_error_a: err,
+        step_s: step,
+        monitor_ns_per_sample: t_mon,
+        rows,
+    })
+}
+
+/// The wall times [s] of the scenario `sc` simulated and written to a CSV file in a
+/// temporary folder.
+fn time_with_csv(
+    repeat: u32,
+    params: &ParamFile,
+    sc: &Scenario,
+) -> Result<Spread, ExperimentError> {
     let dir = tempfile::tempdir()?;
     let path = dir.path().join("bench.csv");
-    let (t_csv, _) = timed(repeat, || {
+    let (t_csv, ()) = timed(repeat, || {
         let mut w = LogWriter::create(&path, sc.sensors.channels())?;
         let mut err = None;
-        simulate(&params, &sc, |r: &Row| {
+        simulate(params, sc, |r: &Row| {
             if err.is_none() {
                 if let Err(e) = w.write_row(r) {
                     err = Some(e);
@@ -140,24 +161,42 @@ pub fn measure(repeat: u32) -> Result<BenchFigures, ExperimentError> {
         w.finish()?;
         Ok(())
     })?;
-    // Accuracy against a 100x finer step.
-    let coarse = crate::sim::simulate_to_vec(&params, &sc)?;
+    Ok(t_csv)
+}
+
+/// The rows of the scenario `sc` at the integrator step `step` [s], and their largest
+/// phase-current difference [A] against a run with a 100x finer step.
+fn step_error(
+    params: &ParamFile,
+    sc: &Scenario,
+    step: f64,
+) -> Result<(Vec<Row>, f64), ExperimentError> {
+    let coarse = crate::sim::simulate_to_vec(params, sc)?;
     let fine_sc = Scenario {
         max_step_s: Some(step / 100.0),
         ..sc.clone()
     };
-    let fine = crate::sim::simulate_to_vec(&params, &fine_sc)?;
+    let fine = crate::sim::simulate_to_vec(params, &fine_sc)?;
     let mut err = 0.0f64;
     for (a, b) in coarse.iter().zip(&fine) {
         for k in 0..3 {
             err = err.max((a.i_abc[k] - b.i_abc[k]).abs());
         }
     }
-    // Monitor per sample.
-    let cfg = monitor_config_for_log(&params, sc.sample_rate_hz, &ReplayOptions::default());
+    Ok((coarse, err))
+}
+
+/// The core `Monitor`'s time per sample [ns] over the rows `rows` of the scenario `sc`.
+fn time_monitor(
+    repeat: u32,
+    params: &ParamFile,
+    sc: &Scenario,
+    rows: &[Row],
+) -> Result<Spread, ExperimentError> {
+    let cfg = monitor_config_for_log(params, sc.sample_rate_hz, &ReplayOptions::default());
     let mut sampler = LogSampler::default();
-    let samples: Vec<_> = coarse.iter().map(|r| sampler.sample(r)).collect();
-    let (t_mon, _) = timed(repeat, || {
+    let samples: Vec<_> = rows.iter().map(|r| sampler.sample(r)).collect();
+    let (t_mon, ()) = timed(repeat, || {
         let mut m = Monitor::new(cfg).map_err(|source| crate::replay::ReplayError::Config {
             source,
             sample_rate_hz: sc.sample_rate_hz,
@@ -170,15 +209,7 @@ pub fn measure(repeat: u32) -> Result<BenchFigures, ExperimentError> {
         Ok(())
     })?;
     let per_sample_ns = 1e9 / samples.len().max(1) as f64;
-    Ok(BenchFigures {
-        repeat: repeat.max(1),
-        sim_in_memory_s_per_s: t_mem.map(|t| sc.duration_s / t),
-        sim_with_csv_s_per_s: t_csv.map(|t| sc.duration_s / t),
-        max_current_error_a: err,
-        step_s: step,
-        monitor_ns_per_sample: t_mon.map(|t| t * per_sample_ns),
-        rows,
-    })
+    Ok(t_mon.map(|t| t * per_sample_ns))
 }
 
 /// Smallest detected change of one fault (the fault detection bar of `docs/performance.md`).
@@ -203,15 +234,13 @@ pub struct DetectionLimitCase {
 pub fn detection_limits(
     on_case: &(dyn Fn() + Sync),
 ) -> Result<Vec<DetectionLimitCase>, DetectionError> {
-    use crate::service_profile::watch;
-    use crate::sim::FaultSpec;
     use rayon::prelude::*;
     let motors = [
         ("3 hp", ParamFile::reference_3hp(), 7u64),
         ("2.2 kW", ParamFile::reference_2p2kw(), 11u64),
     ];
     for (name, p, seed) in &motors {
-        let w = watch(p, *seed, 60.0, None)?;
+        let w = crate::service_profile::watch(p, *seed, 60.0, None)?;
         if w.alarm_samples > 0 {
             return Err(DetectionError::FalseAlarm {
                 motor: name.to_string(),
@@ -230,20 +259,7 @@ pub fn detection_limits(
     let found: Vec<(String, Fault, f64, Option<f64>)> = cases
         .par_iter()
         .map(|(n, p, seed, f, sign)| {
-            let detected = |x: f64| -> bool {
-                let spec = FaultSpec::at_change(*f, 50.0, sign * x);
-                watch(p, *seed, 60.0, Some(spec))
-                    .map(|w| w.first_alarm_s.is_some_and(|t| t >= 50.0))
-                    .unwrap_or(false)
-            };
-            // Smallest detected change on a log grid from 0.25 % to 90 % (a grid, not a
-            // bisection: detection need not be monotonic, e.g. a voltage reading falling
-            // below the "motor running" level is no longer evaluated).
-            const GRID: [f64; 14] = [
-                0.0025, 0.004, 0.006, 0.01, 0.015, 0.025, 0.04, 0.06, 0.1, 0.15, 0.25, 0.4, 0.6,
-                0.9,
-            ];
-            let r = GRID.iter().copied().find(|x| detected(*x));
+            let r = smallest_detected(p, *seed, *f, *sign);
             on_case();
             (n.to_string(), *f, *sign, r)
         })
@@ -266,6 +282,24 @@ pub fn detection_limits(
         }
     }
     Ok(out)
+}
+
+/// The smallest change of fault `f` in the direction `sign` (+1, -1) on a log grid from
+/// 0.25 % to 90 % that lights a lamp within 10 s of its onset at 50 s in the service
+/// profile of the machine `p` (noise seed `seed`); `None`: not even 90 %. A grid, not a
+/// bisection: detection need not be monotonic (e.g. a voltage reading falling below the
+/// "motor running" level is no longer evaluated).
+fn smallest_detected(p: &ParamFile, seed: u64, f: Fault, sign: f64) -> Option<f64> {
+    const GRID: [f64; 14] = [
+        0.0025, 0.004, 0.006, 0.01, 0.015, 0.025, 0.04, 0.06, 0.1, 0.15, 0.25, 0.4, 0.6, 0.9,
+    ];
+    let detected = |x: f64| -> bool {
+        let spec = crate::sim::FaultSpec::at_change(f, 50.0, sign * x);
+        crate::service_profile::watch(p, seed, 60.0, Some(spec))
+            .map(|w| w.first_alarm_s.is_some_and(|t| t >= 50.0))
+            .unwrap_or(false)
+    };
+    GRID.iter().copied().find(|x| detected(*x))
 }
 
 /// Why the detection-limit study could not run.

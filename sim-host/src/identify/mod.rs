@@ -29,172 +29,16 @@ pub mod mechanics;
 pub mod model;
 mod output;
 mod refuse;
+mod samples;
 
 use crate::analysis::lm::{self, Bounds};
-use crate::log::{Channels, Row};
 use crate::params::ParamFile;
 use model::{CurrentFit, IdentifiedCircuit, N_PARAMS};
-use nalgebra::Complex;
 use serde::Serialize;
 
 pub use output::{inverse_gamma_line, to_toml};
 pub use refuse::{refusal, MAX_FIT_ERROR};
-
-/// Why identification could not run (one line each).
-#[derive(Debug, thiserror::Error)]
-pub enum IdentifyError {
-    /// The log cannot drive the model (no voltages, too short, non-finite values...).
-    #[error("{0}")]
-    Log(String),
-    /// The start parameter file is not a machine the model can simulate.
-    #[error("{0}")]
-    Start(String),
-}
-
-/// The log's samples as the model needs them.
-#[derive(Debug, Clone)]
-pub struct Samples {
-    /// Sample interval [s].
-    pub dt_s: f64,
-    /// Time of the first sample [s].
-    pub t0_s: f64,
-    /// Phase voltages, alpha and beta (amplitude-invariant Clarke) [V].
-    pub v_ab: Vec<[f64; 2]>,
-    /// Phase currents, alpha and beta [A].
-    pub i_ab: Vec<[f64; 2]>,
-    /// Mechanical speed [rad/s], when the log has it.
-    pub wm_rad_s: Option<Vec<f64>>,
-    /// RMS of the measured current vector [A] (> 0).
-    pub i_rms_a: f64,
-    /// The log starts de-energised (first current below 5 % of the first 0.1 s's peak).
-    pub starts_dead: bool,
-    /// The supply's voltage vector at the first sample, alpha + j beta [V].
-    pub v0: Complex<f64>,
-    /// The supply's angular frequency over the first 0.1 s [rad/s].
-    pub supply_w_rad_s: f64,
-}
-
-/// Shortest log `identify` accepts [s].
-pub const MIN_DURATION_S: f64 = 0.2;
-
-fn clarke(x: [f64; 3]) -> [f64; 2] {
-    [
-        (2.0 * x[0] - x[1] - x[2]) / 3.0,
-        (x[1] - x[2]) / 3f64.sqrt(),
-    ]
-}
-
-impl Samples {
-    /// The rows of `channels` between `from_s` and `to_s`.
-    ///
-    /// # Errors
-    /// [`IdentifyError::Log`]: no voltages, a non-finite value (naming its time), times
-    /// that are not regular, fewer than [`MIN_DURATION_S`] seconds, no current.
-    pub fn from_rows(
-        rows: &[Row],
-        channels: Channels,
-        from_s: f64,
-        to_s: f64,
-    ) -> Result<Samples, IdentifyError> {
-        let bad = |m: String| Err(IdentifyError::Log(m));
-        if !channels.voltages {
-            return bad("the log has no voltages (va_V, vb_V, vc_V): identify drives the model with the measured phase voltages".into());
-        }
-        let rows: Vec<&Row> = rows
-            .iter()
-            .filter(|r| r.t_s >= from_s && r.t_s <= to_s)
-            .collect();
-        let times: Vec<f64> = rows.iter().map(|r| r.t_s).collect();
-        let rate = crate::log::sample_rate_hz(&times).unwrap_or(0.0);
-        let span = times.last().zip(times.first()).map_or(0.0, |(b, a)| b - a);
-        if rate.is_nan() || rate <= 0.0 || span < MIN_DURATION_S {
-            return bad(format!(
-                "{span:.3} s of log in the window: identify needs at least {MIN_DURATION_S} s of regular samples"
-            ));
-        }
-        let dt_s = 1.0 / rate;
-        if let Some(w) = times
-            .windows(2)
-            .find(|w| ((w[1] - w[0]) * rate - 1.0).abs() > 0.25)
-        {
-            return bad(format!(
-                "the samples are not regular at t = {} s (an interval of {:.3e} s where the rate gives {dt_s:.3e} s): \
-                 give a window without gaps (--from/--to)",
-                w[0],
-                w[1] - w[0]
-            ));
-        }
-        let mut s = Samples {
-            dt_s,
-            t0_s: times.first().copied().unwrap_or(0.0),
-            v_ab: Vec::with_capacity(rows.len()),
-            i_ab: Vec::with_capacity(rows.len()),
-            wm_rad_s: channels.speed.then(Vec::new),
-            i_rms_a: 0.0,
-            starts_dead: false,
-            v0: Complex::new(0.0, 0.0),
-            supply_w_rad_s: 0.0,
-        };
-        for r in rows {
-            let v = r.v_abc.unwrap_or([f64::NAN; 3]);
-            let finite = v.iter().chain(&r.i_abc).all(|x| x.is_finite())
-                && r.wm_rad_s.is_none_or(f64::is_finite);
-            if !finite {
-                return bad(format!(
-                    "a value that is not a number at t = {} s: give a window without it (--from/--to)",
-                    r.t_s
-                ));
-            }
-            s.v_ab.push(clarke(v));
-            s.i_ab.push(clarke(r.i_abc));
-            if let Some(w) = s.wm_rad_s.as_mut() {
-                w.push(r.wm_rad_s.unwrap_or(0.0));
-            }
-        }
-        s.finish_head()?;
-        Ok(s)
-    }
-
-    /// The current's RMS, the supply's phasor and frequency, and whether the log starts
-    /// de-energised.
-    fn finish_head(&mut self) -> Result<(), IdentifyError> {
-        let n = self.i_ab.len();
-        let sq: f64 = self.i_ab.iter().map(|i| i[0] * i[0] + i[1] * i[1]).sum();
-        self.i_rms_a = (sq / n.max(1) as f64).sqrt();
-        if self.i_rms_a.is_nan() || self.i_rms_a <= 0.0 {
-            return Err(IdentifyError::Log(
-                "the currents are zero throughout: nothing to identify".into(),
-            ));
-        }
-        let head = ((0.1 / self.dt_s) as usize).clamp(2, n);
-        let norm = |i: &[f64; 2]| i[0].hypot(i[1]);
-        let peak = self.i_ab[..head].iter().map(norm).fold(0.0, f64::max);
-        self.starts_dead = self.i_ab.first().is_none_or(|i| norm(i) < 0.05 * peak);
-        let c = |v: &[f64; 2]| Complex::new(v[0], v[1]);
-        let turn: f64 = self.v_ab[..head]
-            .windows(2)
-            .map(|w| (c(&w[1]) * c(&w[0]).conj()).arg())
-            .sum();
-        let w = turn / ((head - 1) as f64 * self.dt_s);
-        self.supply_w_rad_s = w;
-        // The positive-sequence phasor at t0 by least squares over the head (v_k = V
-        // e^{j w t_k}): the mean of v_k e^{-j w t_k}, a single sample's noise averaged out.
-        self.v0 = self.v_ab[..head]
-            .iter()
-            .enumerate()
-            .map(|(k, v)| c(v) * Complex::from_polar(1.0, -w * k as f64 * self.dt_s))
-            .sum::<Complex<f64>>()
-            / head as f64;
-        if !self.starts_dead && self.wm_rad_s.is_none() {
-            return Err(IdentifyError::Log(
-                "the log starts in running and has no speed (wm_rad_s): identify needs the speed channel, \
-                 or a log that starts from standstill (a direct-on-line start)"
-                    .into(),
-            ));
-        }
-        Ok(())
-    }
-}
+pub use samples::{IdentifyError, Samples, MIN_DURATION_S};
 
 /// The identified parameters' names, keys and units, in [`IdentifiedCircuit::to_vec`]'s order.
 pub const PARAMS: [(&str, &str, &str); N_PARAMS] = [
@@ -318,7 +162,7 @@ pub const MAX_ITER: usize = 60;
 /// The start circuit from a parameter file.
 ///
 /// # Errors
-/// [`IdentifyError::Start`] when it is not a machine (non-positive values).
+/// [`IdentifyError::NotAMachine`] when it is not a machine (non-positive values).
 pub fn start_circuit(p: &ParamFile) -> Result<IdentifiedCircuit, IdentifyError> {
     let m = &p.motor;
     let (lls, llr) = (m.ls_h - m.lm_h, m.lr_h - m.lm_h);
@@ -330,11 +174,15 @@ pub fn start_circuit(p: &ParamFile) -> Result<IdentifiedCircuit, IdentifyError> 
         && llr >= 0.0
         && m.poles >= 2;
     if !ok {
-        return Err(IdentifyError::Start(format!(
-            "the start parameter file is not a machine identify can start from (Rs {}, Rr {}, Lls {lls}, Llr {llr}, \
-             Lm {}, J {}, poles {}): each must be > 0 (Lls, Llr >= 0, their sum > 0)",
-            m.rs_ohm, m.rr_ohm, m.lm_h, m.j_kgm2, m.poles
-        )));
+        return Err(IdentifyError::NotAMachine {
+            rs_ohm: m.rs_ohm,
+            rr_ohm: m.rr_ohm,
+            lls_h: lls,
+            llr_h: llr,
+            lm_h: m.lm_h,
+            j_kgm2: m.j_kgm2,
+            poles: m.poles,
+        });
     }
     Ok(IdentifiedCircuit {
         rs_ohm: m.rs_ohm,
@@ -385,37 +233,11 @@ pub fn identify(
     let n_res = 2 * s.i_ab.len();
     let cost0 = lm::cost_of(&lm::LeastSquares::residuals(&prob, &x0, &()));
     progress(0.05);
-    // The solve in rounds, for the progress bar.
-    let rounds = 6;
-    let (mut x, mut rep, mut iterations) = (x0, None, 0);
-    for k in 0..rounds {
-        let (xn, mut r) = lm::solve(&prob, x, &b, &free, MAX_ITER / rounds);
-        x = xn;
-        iterations += r.iterations;
-        r.iterations = iterations;
-        let done = r.termination != lm::Termination::IterationLimit;
-        rep = Some(r);
-        progress(0.05 + 0.8 * (k + 1) as f64 / rounds as f64);
-        if done {
-            break;
-        }
-    }
-    let solver = rep.unwrap_or(lm::Report {
-        iterations: 0,
-        cost: cost0,
-        termination: lm::Termination::NothingToFit,
-    });
+    let (x, solver) = solve_in_rounds(&prob, x0, &b, &free, cost0, progress);
     let sigma = log_sigmas(&prob, &x, &b, &free, solver.cost, n_res);
-    let circuit = prob.circuit(&x);
-    let mut estimates: Vec<Estimate> = (0..N_PARAMS)
-        .map(|k| {
-            let p = circuit.to_vec()[k];
-            let sg = free.iter().position(|&i| i == k).map(|a| sigma[a]);
-            estimate(k, c0.to_vec()[k], p, sg)
-        })
-        .collect();
+    let mut estimates = estimates_of(&prob, &x, &free, &sigma);
     if speed {
-        let mech = mechanics::fit(&circuit, s);
+        let mech = mechanics::fit(&prob.circuit(&x), s);
         estimates[4] = estimate_or(4, c0.j_kgm2, mech.j);
         estimates[5] = estimate_or(5, c0.b_total_nms, mech.b_total);
     }
@@ -435,6 +257,53 @@ pub fn identify(
         relative_rms_error: rel_rms(solver.cost, n_res),
         solver,
     })
+}
+
+/// The fit of `prob` from `x0` (cost `cost0`) over the parameters `free`, solved in six
+/// rounds of at most a sixth of [`MAX_ITER`] iterations each, for the progress bar
+/// (`progress` from 0.05 to 0.85); the rounds stop when the solver does for another
+/// reason than its iteration limit. The optimum and how the solve ended.
+fn solve_in_rounds(
+    prob: &CurrentFit<'_>,
+    x0: Vec<f64>,
+    b: &Bounds,
+    free: &[usize],
+    cost0: f64,
+    progress: &mut dyn FnMut(f64),
+) -> (Vec<f64>, lm::Report) {
+    let rounds = 6;
+    let (mut x, mut rep, mut iterations) = (x0, None, 0);
+    for k in 0..rounds {
+        let (xn, mut r) = lm::solve(prob, x, b, free, MAX_ITER / rounds);
+        x = xn;
+        iterations += r.iterations;
+        r.iterations = iterations;
+        let done = r.termination != lm::Termination::IterationLimit;
+        rep = Some(r);
+        progress(0.05 + 0.8 * (k + 1) as f64 / rounds as f64);
+        if done {
+            break;
+        }
+    }
+    let solver = rep.unwrap_or(lm::Report {
+        iterations: 0,
+        cost: cost0,
+        termination: lm::Termination::NothingToFit,
+    });
+    (x, solver)
+}
+
+/// The estimate of each parameter of [`PARAMS`] at the optimum `x`, with its log-space
+/// standard deviation `sigma` where it was `free` (the others keep the start's value).
+fn estimates_of(prob: &CurrentFit<'_>, x: &[f64], free: &[usize], sigma: &[f64]) -> Vec<Estimate> {
+    let circuit = prob.circuit(x);
+    (0..N_PARAMS)
+        .map(|k| {
+            let p = circuit.to_vec()[k];
+            let sg = free.iter().position(|&i| i == k).map(|a| sigma[a]);
+            estimate(k, prob.start.to_vec()[k], p, sg)
+        })
+        .collect()
 }
 
 /// The log-space standard deviations of the free parameters at `x`: the square roots of

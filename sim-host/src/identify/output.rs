@@ -70,8 +70,6 @@ fn source(e: &Estimate) -> String {
 /// The TOML text of the identified parameter file. `start_text` is the start file's text
 /// (its `[columns]` table is copied), `start_name` and `log_name` name the inputs.
 pub fn to_toml(id: &Identification, start_text: &str, start_name: &str, log_name: &str) -> String {
-    let m = &id.params.motor;
-    let e = |k: usize| id.estimates.get(k).map(source).unwrap_or_default();
     let mut s = format!(
         "# Identified by `sim-host identify` (docs/own-motor.md) from {log_name}, {:.3}..{:.3} s\n\
          # ({} samples, {}), starting from {start_name}.\n\
@@ -87,30 +85,7 @@ pub fn to_toml(id: &Identification, start_text: &str, start_name: &str, log_name
     if let Some(g) = id.inverse_gamma {
         s.push_str(&format!("{}\n", inverse_gamma_line("# ", &g)));
     }
-    let share = id.stator_leakage_share;
-    let lines = [
-        ("rs_ohm", m.rs_ohm, e(0)),
-        ("rr_ohm", m.rr_ohm, e(1)),
-        (
-            "ls_h",
-            m.ls_h,
-            format!("Lm + Lls, Lls = {share:.3} x (Lls + Llr): Lls + Llr {} (the split kept from the start file: the terminals cannot tell it)", e(2)),
-        ),
-        ("lr_h", m.lr_h, format!("Lm + Llr, Llr = {:.3} x (Lls + Llr)", 1.0 - share)),
-        ("lm_h", m.lm_h, e(3)),
-    ];
-    for (key, v, why) in lines {
-        s.push_str(&toml_entry(key, v, &why));
-    }
-    s.push_str(&format!("poles = {} # from the start file\n", m.poles));
-    s.push_str(&toml_entry("j_kgm2", m.j_kgm2, &e(4)));
-    let b = e(5);
-    s.push_str(&toml_entry(
-        "b_nms",
-        m.b_nms,
-        &format!("B + Bl {b}; split in the start file's ratio B : Bl"),
-    ));
-    s.push_str(&toml_entry("bl_nms", m.bl_nms, "the rest of B + Bl"));
+    s.push_str(&motor_entries(id));
     s.push_str("[supply]\n");
     s.push_str(&toml_entry(
         "v_ll_rms",
@@ -131,6 +106,39 @@ pub fn to_toml(id: &Identification, start_text: &str, start_name: &str, log_name
         );
         s.push_str(&crate::params::columns_entries_toml(&columns));
     }
+    s
+}
+
+/// The `[motor]` table's entries of the identified file, each with where its value came
+/// from.
+fn motor_entries(id: &Identification) -> String {
+    let m = &id.params.motor;
+    let e = |k: usize| id.estimates.get(k).map(source).unwrap_or_default();
+    let share = id.stator_leakage_share;
+    let lines = [
+        ("rs_ohm", m.rs_ohm, e(0)),
+        ("rr_ohm", m.rr_ohm, e(1)),
+        (
+            "ls_h",
+            m.ls_h,
+            format!("Lm + Lls, Lls = {share:.3} x (Lls + Llr): Lls + Llr {} (the split kept from the start file: the terminals cannot tell it)", e(2)),
+        ),
+        ("lr_h", m.lr_h, format!("Lm + Llr, Llr = {:.3} x (Lls + Llr)", 1.0 - share)),
+        ("lm_h", m.lm_h, e(3)),
+    ];
+    let mut s = String::new();
+    for (key, v, why) in lines {
+        s.push_str(&toml_entry(key, v, &why));
+    }
+    s.push_str(&format!("poles = {} # from the start file\n", m.poles));
+    s.push_str(&toml_entry("j_kgm2", m.j_kgm2, &e(4)));
+    let b = e(5);
+    s.push_str(&toml_entry(
+        "b_nms",
+        m.b_nms,
+        &format!("B + Bl {b}; split in the start file's ratio B : Bl"),
+    ));
+    s.push_str(&toml_entry("bl_nms", m.bl_nms, "the rest of B + Bl"));
     s
 }
 

@@ -89,6 +89,7 @@
 //! Other code gets only [`Row`]s of sensor readings ([`simulate`]); the true state
 //! ([`Truth`]) is available to tests through [`simulate_with_truth`] and never enters a row.
 
+mod effect_spec;
 mod faults;
 pub(crate) mod machine;
 mod resolve;
@@ -98,10 +99,11 @@ mod sensors;
 mod steady;
 mod thermometer;
 
+pub use effect_spec::EffectSpec;
 pub use faults::{FaultSpec, SensorFaultMode};
 pub use scenario::{
-    EffectSpec, LoadKind, LoadSpec, LoadStep, Scenario, SupplySpec, SupplyStep, Workload,
-    DEFAULT_MAX_STEP_S, MIN_STEP_S, SAMPLE_RATE_RANGE_HZ,
+    LoadKind, LoadSpec, LoadStep, Scenario, SupplySpec, SupplyStep, Workload, DEFAULT_MAX_STEP_S,
+    MIN_STEP_S, SAMPLE_RATE_RANGE_HZ,
 };
 pub use sensors::SensorSpec;
 pub use steady::{

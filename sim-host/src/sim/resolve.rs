@@ -3,9 +3,10 @@
 //! winding temperature) and the builder of the [`Machine`] they give.
 
 use super::machine::{LoadLaw, Machine, MachineError, SatLaw, TurnLoop};
-use super::{EffectSpec, FaultSpec, LoadKind, Scenario, SimError};
+use super::{EffectSpec, FaultSpec, LoadKind, Scenario, ScenarioEvent, SimError};
 use crate::params::ParamFile;
 use monitor_core::{Fault, MotorParameters};
+use std::f64::consts::PI;
 
 /// The effects of a scenario, resolved to the numbers the machine and the loop need.
 #[derive(Debug, Clone, Default)]
@@ -58,78 +59,18 @@ impl ResolvedEffects {
         m: &MotorParameters,
         rated: RatedPoint,
     ) -> Result<Self, SimError> {
-        let RatedPoint {
-            vpk0,
-            we0,
-            t_rated,
-            w_sync,
-            bl_base,
-        } = rated;
         let mut eff = ResolvedEffects::default();
         for e in &scenario.effects {
-            match *e {
-                EffectSpec::ThermalDrift {
-                    rise_k,
-                    tau_s,
-                    at_s,
-                    r_th_k_per_w,
-                    alpha_per_k,
-                    rotor,
-                } => {
-                    eff.thermal = Some(Thermal {
-                        rise_k: if r_th_k_per_w.is_some() {
-                            None
-                        } else {
-                            Some(rise_k.unwrap_or(60.0))
-                        },
-                        tau_s,
-                        at_s,
-                        r_th: r_th_k_per_w.unwrap_or(0.0),
-                        alpha: alpha_per_k,
-                        rotor,
-                    })
-                }
-                EffectSpec::Saturation {
-                    psi_sat_wb,
-                    psi_sat_ratio,
-                    exponent,
-                } => {
-                    eff.sat = Some(SatLaw {
-                        psi_sat_wb: psi_sat_wb.unwrap_or(psi_sat_ratio * vpk0 / we0),
-                        exponent,
-                    })
-                }
-                EffectSpec::IronLoss {
-                    rfe_ohm,
-                    rfe_over_xm,
-                } => eff.rfe = Some(rfe_ohm.unwrap_or(rfe_over_xm * we0 * m.lm_h)),
-                EffectSpec::CoulombFriction {
-                    torque_nm,
-                    omega0_rad_s,
-                } => eff.coulomb = Some((torque_nm.unwrap_or(0.02 * t_rated), omega0_rad_s)),
-                EffectSpec::Windage { k_nms2 } => {
-                    eff.windage = k_nms2.unwrap_or(0.05 * t_rated / (w_sync * w_sync))
-                }
-                EffectSpec::LoadTorque { torque_nm } => {
-                    if scenario.load.kind == LoadKind::Torque {
-                        return Err(SimError::Invalid {
-                            key: "effects.load_torque".into(),
-                            message: "the load is already a torque load (load.kind = \"torque\")"
-                                .into(),
-                        });
-                    }
-                    eff.load_torque = Some(torque_nm.unwrap_or(bl_base * w_sync));
-                }
-                EffectSpec::SupplyUnbalance {
-                    fraction,
-                    angle_deg,
-                } => eff.unbalance = Some((fraction, angle_deg.to_radians())),
-                EffectSpec::PhaseAsymmetry {
-                    phase,
-                    fraction,
-                    fault_resistance_ohm,
-                } => eff.asym = Some((phase.index(), fraction, fault_resistance_ohm)),
-                EffectSpec::RotorAsymmetry { .. } => eff.rotor_delta = e.rotor_delta()?,
+            match e {
+                EffectSpec::ThermalDrift { .. }
+                | EffectSpec::Saturation { .. }
+                | EffectSpec::IronLoss { .. } => eff.add_winding_and_core(e, m, rated),
+                EffectSpec::CoulombFriction { .. }
+                | EffectSpec::Windage { .. }
+                | EffectSpec::LoadTorque { .. } => eff.add_shaft(e, scenario, rated)?,
+                EffectSpec::SupplyUnbalance { .. }
+                | EffectSpec::PhaseAsymmetry { .. }
+                | EffectSpec::RotorAsymmetry { .. } => eff.add_asymmetry(e)?,
                 EffectSpec::FluxDynamics {}
                 | EffectSpec::CurrentDynamics {}
                 | EffectSpec::DAxisDynamics {}
@@ -137,6 +78,103 @@ impl ResolvedEffects {
             }
         }
         Ok(eff)
+    }
+
+    /// The winding's temperature, the main flux's saturation (default: `psi_sat_ratio`
+    /// times the rated flux), the core loss (default: `rfe_over_xm` times Xm).
+    fn add_winding_and_core(&mut self, e: &EffectSpec, m: &MotorParameters, rated: RatedPoint) {
+        let RatedPoint { vpk0, we0, .. } = rated;
+        match *e {
+            EffectSpec::ThermalDrift {
+                rise_k,
+                tau_s,
+                at_s,
+                r_th_k_per_w,
+                alpha_per_k,
+                rotor,
+            } => {
+                self.thermal = Some(Thermal {
+                    // A loss-driven temperature (a thermal resistance) has no set rise.
+                    rise_k: r_th_k_per_w.is_none().then(|| rise_k.unwrap_or(60.0)),
+                    tau_s,
+                    at_s,
+                    r_th: r_th_k_per_w.unwrap_or(0.0),
+                    alpha: alpha_per_k,
+                    rotor,
+                })
+            }
+            EffectSpec::Saturation {
+                psi_sat_wb,
+                psi_sat_ratio,
+                exponent,
+            } => {
+                self.sat = Some(SatLaw {
+                    psi_sat_wb: psi_sat_wb.unwrap_or(psi_sat_ratio * vpk0 / we0),
+                    exponent,
+                })
+            }
+            EffectSpec::IronLoss {
+                rfe_ohm,
+                rfe_over_xm,
+            } => self.rfe = Some(rfe_ohm.unwrap_or(rfe_over_xm * we0 * m.lm_h)),
+            _ => {}
+        }
+    }
+
+    /// The shaft's torques: dry friction (default 2 % of the rated torque), windage
+    /// (default 5 % of it at synchronous speed), a load torque (default the viscous
+    /// load's at synchronous speed; refused on a torque load).
+    fn add_shaft(
+        &mut self,
+        e: &EffectSpec,
+        scenario: &Scenario,
+        rated: RatedPoint,
+    ) -> Result<(), SimError> {
+        let RatedPoint {
+            t_rated,
+            w_sync,
+            bl_base,
+            ..
+        } = rated;
+        match *e {
+            EffectSpec::CoulombFriction {
+                torque_nm,
+                omega0_rad_s,
+            } => self.coulomb = Some((torque_nm.unwrap_or(0.02 * t_rated), omega0_rad_s)),
+            EffectSpec::Windage { k_nms2 } => {
+                self.windage = k_nms2.unwrap_or(0.05 * t_rated / (w_sync * w_sync))
+            }
+            EffectSpec::LoadTorque { torque_nm } => {
+                if scenario.load.kind == LoadKind::Torque {
+                    return Err(SimError::Invalid {
+                        key: "effects.load_torque".into(),
+                        message: "the load is already a torque load (load.kind = \"torque\")"
+                            .into(),
+                    });
+                }
+                self.load_torque = Some(torque_nm.unwrap_or(bl_base * w_sync));
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// The asymmetries: the supply's unbalance, shorted turns, an unequal rotor cage.
+    fn add_asymmetry(&mut self, e: &EffectSpec) -> Result<(), SimError> {
+        match *e {
+            EffectSpec::SupplyUnbalance {
+                fraction,
+                angle_deg,
+            } => self.unbalance = Some((fraction, angle_deg.to_radians())),
+            EffectSpec::PhaseAsymmetry {
+                phase,
+                fraction,
+                fault_resistance_ohm,
+            } => self.asym = Some((phase.index(), fraction, fault_resistance_ohm)),
+            EffectSpec::RotorAsymmetry { .. } => self.rotor_delta = e.rotor_delta()?,
+            _ => {}
+        }
+        Ok(())
     }
 }
 
@@ -289,4 +327,51 @@ pub(super) fn rated_torque(
         t_rated = m.bl_nms * w_sync;
     }
     t_rated
+}
+
+/// The machine's rated point on the scenario's supply (`v_ll` [V RMS], `f0` [Hz]) with
+/// `np` pole pairs, which the effects' defaults scale with.
+pub(super) fn rated_point(
+    params: &ParamFile,
+    scenario: &Scenario,
+    v_ll: f64,
+    f0: f64,
+    np: f64,
+) -> RatedPoint {
+    let vpk0 = v_ll * (2.0f64 / 3.0).sqrt();
+    let we0 = 2.0 * PI * f0;
+    let bl_base = scenario.load.bl_nms.unwrap_or(params.motor.bl_nms);
+    let w_sync = we0 / np;
+    RatedPoint {
+        vpk0,
+        we0,
+        t_rated: rated_torque(params, scenario, w_sync, bl_base),
+        w_sync,
+        bl_base,
+    }
+}
+
+/// The machine of `builder` at the scales `scales`, after checking that every parameter
+/// set the run's faults (`events`) lead to is a machine too.
+///
+/// # Errors
+/// [`SimError::Invalid`] blaming the key the builder names.
+pub(super) fn checked_machine(
+    builder: &MachineBuilder<'_>,
+    scales: ParameterScales,
+    events: &[(u64, ScenarioEvent)],
+) -> Result<Machine, SimError> {
+    let invalid = |e: MachineError| SimError::Invalid {
+        key: builder.blamed_key().to_string(),
+        message: e.to_string(),
+    };
+    let machine = builder.build(&scales).map_err(invalid)?;
+    let mut scratch = scales;
+    for (_, ev) in events {
+        if let ScenarioEvent::Fault(f) = ev {
+            scratch.apply_fault(f);
+            builder.build(&scratch).map_err(invalid)?;
+        }
+    }
+    Ok(machine)
 }

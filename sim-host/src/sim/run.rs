@@ -1,8 +1,10 @@
 //! One simulation run: the stiff supply, the scenario's events at their output samples,
 //! the integration loop and the true state of each output sample.
 
-use super::machine::{Machine, MachineError};
-use super::resolve::{rated_torque, MachineBuilder, ParameterScales, RatedPoint, ResolvedEffects};
+use super::machine::Machine;
+use super::resolve::{
+    checked_machine, rated_point, MachineBuilder, ParameterScales, ResolvedEffects,
+};
 use super::sensors::Sensors;
 use super::{LoadKind, Scenario, ScenarioEvent, SimError, SimSummary, SupplyStep, Truth};
 use crate::log::Row;
@@ -272,18 +274,7 @@ impl<'a> Run<'a> {
         let v_ll = scenario.supply.v_ll_rms.unwrap_or(params.supply.v_ll_rms);
         let f0 = scenario.supply.f_hz.unwrap_or(params.supply.f_hz);
         let np = m.model::<f64>().np();
-        let vpk0 = v_ll * (2.0f64 / 3.0).sqrt();
-        let we0 = 2.0 * PI * f0;
-        let bl_base = scenario.load.bl_nms.unwrap_or(m.bl_nms);
-        let w_sync = we0 / np;
-        let t_rated = rated_torque(params, scenario, w_sync, bl_base);
-        let rated = RatedPoint {
-            vpk0,
-            we0,
-            t_rated,
-            w_sync,
-            bl_base,
-        };
+        let rated = rated_point(params, scenario, v_ll, f0, np);
         let eff = ResolvedEffects::new(scenario, m, rated)?;
         let torque_load = scenario.load.kind == LoadKind::Torque || eff.load_torque.is_some();
         let scales = ParameterScales {
@@ -294,27 +285,14 @@ impl<'a> Run<'a> {
             m,
             eff,
             torque_load,
-            bl_base,
+            bl_base: rated.bl_base,
         };
-        let rate = scenario.sample_rate_hz;
-        let dt = 1.0 / rate;
+        let dt = 1.0 / scenario.sample_rate_hz;
         let work = scenario.workload();
         // At most 1e7 (1 s period over the 0.1 us floor of `validate`).
         let nsub = u32::try_from(work.steps_per_row).unwrap_or(u32::MAX);
-        let h = dt / f64::from(nsub);
         let events = scenario_events(scenario);
-        let invalid = |e: MachineError| SimError::Invalid {
-            key: builder.blamed_key().to_string(),
-            message: e.to_string(),
-        };
-        let machine = builder.build(&scales).map_err(invalid)?;
-        let mut scratch = scales;
-        for (_, ev) in &events {
-            if let ScenarioEvent::Fault(f) = ev {
-                scratch.apply_fault(f);
-                builder.build(&scratch).map_err(invalid)?;
-            }
-        }
+        let machine = checked_machine(&builder, scales, &events)?;
         let ranges = SensorRanges::new(m, v_ll, f0);
         let sp = &scenario.sensors;
         let sensors = Sensors::new(
@@ -323,7 +301,8 @@ impl<'a> Run<'a> {
             sp.i_range_a.unwrap_or(ranges.i_range_a),
             scenario.seed,
         );
-        let supply = Supply::new(vpk0, we0, h, builder.eff.unbalance);
+        let h = dt / f64::from(nsub);
+        let supply = Supply::new(rated.vpk0, rated.we0, h, builder.eff.unbalance);
         Ok(Run {
             scenario,
             builder,
@@ -521,6 +500,18 @@ impl<'a> Run<'a> {
     }
 }
 
+/// Phase values of an alpha-beta vector (amplitude-invariant Clarke).
+fn abc_of(a: [f64; 2]) -> [f64; 3] {
+    inverse_clarke(
+        AlphaBeta {
+            alpha: a[0],
+            beta: a[1],
+        },
+        0.0,
+    )
+    .to_array()
+}
+
 /// The true quantities at state `x` with the shorted loop's current `i_f` (0 without a turn
 /// fault) and the supply `v`.
 #[allow(clippy::too_many_arguments)]
@@ -545,22 +536,12 @@ fn truth(
     let (loop_loss, loop_stored) = model
         .turn
         .map_or((0.0, 0.0), |l| (l.loss_w(i_f), l.stored_j(i_f)));
-    let abc = |a: [f64; 2]| {
-        inverse_clarke(
-            AlphaBeta {
-                alpha: a[0],
-                beta: a[1],
-            },
-            0.0,
-        )
-        .to_array()
-    };
     let te = model.torque(pr, c.i_r);
     let wm = x[4];
     Truth {
         t_s: t,
-        v_abc: abc(v),
-        i_abc: abc(it),
+        v_abc: abc_of(v),
+        i_abc: abc_of(it),
         v_ab: v,
         i_ab: it,
         psi_s: ps,

@@ -168,38 +168,8 @@ impl Sensors {
                 &mut self.rng,
             );
         }
-        let wm = if self.speed {
-            let x = match self.w_fault {
-                ChanFault::None => tr.wm_rad_s,
-                ChanFault::Gain(g) => g * tr.wm_rad_s,
-                ChanFault::Offset(o) => tr.wm_rad_s + o,
-                ChanFault::Zero => 0.0,
-                ChanFault::Stuck => self.w_last,
-            };
-            let y = if self.w_sigma > 0.0 && self.w_fault != ChanFault::Stuck {
-                let n: f64 = StandardNormal.sample(&mut self.rng);
-                x + self.w_sigma * n
-            } else {
-                x
-            };
-            self.w_last = y;
-            Some(y)
-        } else {
-            None
-        };
-        let dth = tr.theta_m_rad - self.theta_prev;
-        self.theta_prev = tr.theta_m_rad;
-        match self.w_fault {
-            ChanFault::None => self.theta_sensed += dth,
-            ChanFault::Gain(g) => self.theta_sensed += g * dth,
-            ChanFault::Offset(o) => self.theta_sensed += dth + o * dt_s,
-            ChanFault::Zero | ChanFault::Stuck => {}
-        }
-        let enc = if self.encoder {
-            Some((self.theta_sensed * self.counts_per_rad).floor() as i64)
-        } else {
-            None
-        };
+        let wm = self.speed.then(|| self.read_speed(tr));
+        let enc = self.read_encoder(tr, dt_s);
         Row {
             t_s: tr.t_s,
             v_abc: if self.voltages { Some(v) } else { None },
@@ -211,6 +181,40 @@ impl Sensors {
                 .as_mut()
                 .map(|th| th.read(tr.t_s, tr.temperature_rise_k, dt_s)),
         }
+    }
+
+    /// The speed sensor's reading of `tr` (its fault, then its noise unless stuck).
+    fn read_speed(&mut self, tr: &Truth) -> f64 {
+        let x = match self.w_fault {
+            ChanFault::None => tr.wm_rad_s,
+            ChanFault::Gain(g) => g * tr.wm_rad_s,
+            ChanFault::Offset(o) => tr.wm_rad_s + o,
+            ChanFault::Zero => 0.0,
+            ChanFault::Stuck => self.w_last,
+        };
+        let y = if self.w_sigma > 0.0 && self.w_fault != ChanFault::Stuck {
+            let n: f64 = StandardNormal.sample(&mut self.rng);
+            x + self.w_sigma * n
+        } else {
+            x
+        };
+        self.w_last = y;
+        y
+    }
+
+    /// The encoder's count at `tr` (`None` without an encoder): the sensed angle follows
+    /// the true one through the speed sensor's fault (`dt_s` since the last call).
+    fn read_encoder(&mut self, tr: &Truth, dt_s: f64) -> Option<i64> {
+        let dth = tr.theta_m_rad - self.theta_prev;
+        self.theta_prev = tr.theta_m_rad;
+        match self.w_fault {
+            ChanFault::None => self.theta_sensed += dth,
+            ChanFault::Gain(g) => self.theta_sensed += g * dth,
+            ChanFault::Offset(o) => self.theta_sensed += dth + o * dt_s,
+            ChanFault::Zero | ChanFault::Stuck => {}
+        }
+        self.encoder
+            .then(|| (self.theta_sensed * self.counts_per_rad).floor() as i64)
     }
 
     #[inline(always)]

@@ -1,6 +1,9 @@
 //! `current_dynamics`: the stator current transient (La dI/dt).
 
-use super::{dynamics_param, About, Contribution, EffectModel, FitSetup, ParamSpec, SetupError};
+use super::{
+    declared_values, dynamics_param, plausible, About, Contribution, EffectModel, EffectParam,
+    EffectValuesError, FitSetup, SetupError,
+};
 use crate::analysis::prep::Prepared;
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms};
 use monitor_core::EffectKind;
@@ -9,16 +12,37 @@ use monitor_core::EffectKind;
 #[derive(Debug, Clone, Copy)]
 pub struct CurrentDynamics;
 
+/// The effect's parameter.
+const PARAMS: [EffectParam; 1] = [EffectParam {
+    name: "la_h",
+    unit: "H",
+    doc: "transient inductance La = sigma Ls",
+    range: plausible::DYNAMICS_RATIO,
+    per: Some("the nominal sigma Ls"),
+    basis: plausible::DYNAMICS_BASIS,
+}];
+
+/// The effect's fitted value ([`PARAMS`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CurrentDynamicsValues {
+    /// The transient inductance La = sigma Ls [H].
+    pub la_h: f64,
+}
+
+impl TryFrom<&[f64]> for CurrentDynamicsValues {
+    type Error = EffectValuesError;
+    fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
+        let [la_h] = declared_values(EffectKind::CurrentDynamics, &PARAMS, v)?;
+        Ok(CurrentDynamicsValues { la_h })
+    }
+}
+
 /// What `CurrentDynamics` is ([`About`]).
 const ABOUT: About = About {
     kind: EffectKind::CurrentDynamics,
     description: "The stator current cannot jump: the transient inductance La = sigma Ls delays I_qs by Ta = La/Ra (a few ms) after every voltage change.",
     equations: "La dI_qs/dt = V_qs - Ra I_qs - Psi omega_r (eq. 28 with its derivative term) instead of the quasi-static I_qs = (V_qs - Psi omega_r)/Ra.",
-    parameters: &[ParamSpec {
-        name: "la_h",
-        unit: "H",
-        description: "transient inductance La = sigma Ls",
-    }],
+    parameters: &PARAMS,
 };
 
 impl EffectModel for CurrentDynamics {
@@ -29,21 +53,28 @@ impl EffectModel for CurrentDynamics {
         Some(n.la_h / n.ra_ohm)
     }
     fn setup(&self, _d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
-        Ok(FitSetup::new(*self).param(dynamics_param("la_h", "H", n.la_h)))
+        let [p] = &PARAMS;
+        Ok(FitSetup::new(*self, vec![dynamics_param(p, n.la_h)])?)
     }
 }
 
 impl Contribution for CurrentDynamics {
-    /// The stator current's derivative term with the fitted La.
-    fn contribute(&self, p: &[f64], _d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
-        if let &[la_h] = p {
-            t.dynamics.stator_current_la_h = Some(la_h);
-        }
+    type Values = CurrentDynamicsValues;
+    fn values(&self, v: &[f64]) -> Result<CurrentDynamicsValues, EffectValuesError> {
+        CurrentDynamicsValues::try_from(v)
     }
-    fn describe(&self, p: &[f64], _d: &Prepared, n: &MachineConstants) -> String {
-        let &[la_h] = p else {
-            return String::new();
-        };
+    /// The stator current's derivative term with the fitted La.
+    fn contribute(
+        &self,
+        p: &CurrentDynamicsValues,
+        _d: &Prepared,
+        _n: &MachineConstants,
+        t: &mut ModelTerms,
+    ) {
+        t.dynamics.stator_current_la_h = Some(p.la_h);
+    }
+    fn describe(&self, p: &CurrentDynamicsValues, _d: &Prepared, n: &MachineConstants) -> String {
+        let la_h = p.la_h;
         format!(
             "stator current lags voltage changes: La = {:.1} mH (nominal sigma Ls = {:.1} mH), electrical time constant about {:.1} ms",
             1000.0 * la_h,

@@ -1,8 +1,8 @@
 //! `iron_loss`: core loss.
 
 use super::{
-    plausible, rated_flux_wb, sync_speed_mech, About, Contribution, EffectModel, FitParam,
-    FitSetup, ParamSpec, SetupError,
+    declared_values, plausible, rated_flux_wb, sync_speed_mech, About, Contribution, EffectModel,
+    EffectParam, EffectValuesError, FitSetup, SetupError,
 };
 use crate::analysis::prep::Prepared;
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms};
@@ -19,16 +19,38 @@ struct OnLog {
     xm_ohm: f64,
 }
 
+/// Iron loss's parameters: the conductance's range runs from a slightly negative one
+/// (1 % of 1/Xm) to 1/Rfe for the least plausible Rfe, [`plausible::RFE_OVER_XM_MIN`] x Xm.
+const PARAMS: [EffectParam; 1] = [EffectParam {
+    name: "g_fe_s",
+    unit: "S",
+    doc: "core-loss conductance 1/Rfe",
+    range: (-0.01, 1.0 / plausible::RFE_OVER_XM_MIN),
+    per: Some("1/Xm at the log's highest supply frequency"),
+    basis: plausible::G_FE_BASIS,
+}];
+
+/// Iron loss's fitted values ([`PARAMS`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IronLossValues {
+    /// The core-loss conductance 1/Rfe [S].
+    pub g_fe_s: f64,
+}
+
+impl TryFrom<&[f64]> for IronLossValues {
+    type Error = EffectValuesError;
+    fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
+        let [g_fe_s] = declared_values(EffectKind::IronLoss, &PARAMS, v)?;
+        Ok(IronLossValues { g_fe_s })
+    }
+}
+
 /// What `IronLoss` is ([`About`]).
 const ABOUT: About = About {
     kind: EffectKind::IronLoss,
     description: "Eddy-current and hysteresis losses in the core draw a current in phase with the air-gap voltage, modelled as a resistance Rfe across the magnetising branch.",
     equations: "I_qs(measured) = I_qs(torque, eq. 28) + omega_s Ls i_f / Rfe; only the torque part drives eq. (29); Rs carries the core-loss current too (V_qs - Rs i_fe in eq. 28); the flux current is I_ds + omega_s sigma Ls I_qs / Rfe; and the voltage-model frame, built from the terminal current, is turned by (Lr/Lm) sigma Ls omega_s Ls / (Lm Rfe) against the rotor flux, which the model undoes.",
-    parameters: &[ParamSpec {
-        name: "g_fe_s",
-        unit: "S",
-        description: "core-loss conductance 1/Rfe",
-    }],
+    parameters: &PARAMS,
 };
 
 impl EffectModel for IronLoss {
@@ -38,33 +60,34 @@ impl EffectModel for IronLoss {
     fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let w = sync_speed_mech(d, n) * n.np;
         let xm = w * n.lm_h;
-        Ok(FitSetup::new(OnLog { xm_ohm: xm }).param(
-            FitParam::new(
-                "g_fe_s",
-                "S",
-                1.0 / (100.0 * xm),
-                (-0.2 / xm, 1.0 / xm),
-                0.02 / xm,
-            )
-            .physical(
-                (-0.01 / xm, 1.0 / (plausible::RFE_OVER_XM_MIN * xm)),
-                plausible::G_FE_BASIS,
-            ),
-        ))
+        let [g_fe_s] = &PARAMS;
+        let params = vec![g_fe_s.fit(
+            1.0 / (100.0 * xm),
+            (-0.2 / xm, 1.0 / xm),
+            0.02 / xm,
+            1.0 / xm,
+        )];
+        Ok(FitSetup::new(OnLog { xm_ohm: xm }, params)?)
     }
 }
 
 impl Contribution for OnLog {
-    /// The core-loss conductance.
-    fn contribute(&self, p: &[f64], _d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
-        if let &[g_fe_s] = p {
-            t.magnetising.core_loss_s += g_fe_s;
-        }
+    type Values = IronLossValues;
+    fn values(&self, v: &[f64]) -> Result<IronLossValues, EffectValuesError> {
+        IronLossValues::try_from(v)
     }
-    fn describe(&self, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
-        let &[g] = p else {
-            return String::new();
-        };
+    /// The core-loss conductance.
+    fn contribute(
+        &self,
+        p: &IronLossValues,
+        _d: &Prepared,
+        _n: &MachineConstants,
+        t: &mut ModelTerms,
+    ) {
+        t.magnetising.core_loss_s += p.g_fe_s;
+    }
+    fn describe(&self, p: &IronLossValues, d: &Prepared, n: &MachineConstants) -> String {
+        let g = p.g_fe_s;
         let xm = self.xm_ohm;
         let psi = rated_flux_wb(d);
         let w = sync_speed_mech(d, n) * n.np;

@@ -1,8 +1,8 @@
 //! `load_torque`: the load as a torque input.
 
 use super::{
-    plausible, About, Confusion, Contribution, EffectEvidence, EffectModel, FitParam, FitSetup,
-    Needs, ParamSpec, SetupError, LOAD_STEP_MIN,
+    plausible, About, Confusion, Contribution, EffectEvidence, EffectModel, EffectParam,
+    EffectValuesError, FitSetup, Needs, SetupError, LOAD_STEP_MIN,
 };
 use crate::analysis::change_point::{Cumulative, Search};
 use crate::analysis::prep::{Prepared, C64};
@@ -193,16 +193,39 @@ struct Steps {
     from_s: Vec<f64>,
 }
 
+/// The load torque's parameter: one level per segment the log's torque balance shows
+/// ([`load_segments`]). The one parameter whose JSON key carries data: each segment's key
+/// names it, `level_{k}_from_{T}_s` ([`level_key`]); the keys stay as they were.
+const LEVEL: EffectParam = EffectParam {
+    name: "level_k_from_T_s",
+    unit: "N m",
+    doc: "load torque in segment k, which starts at T s (one parameter per detected segment)",
+    range: plausible::LOAD_RATIO,
+    per: Some("the rated torque estimate"),
+    basis: plausible::LOAD_BASIS,
+};
+
+/// The load torque's parameters: the per-segment level ([`LEVEL`]).
+const PARAMS: [EffectParam; 1] = [LEVEL];
+
+/// The JSON key of the level of segment `k` (from 1) that starts at `from_s` [s].
+fn level_key(k: usize, from_s: f64) -> String {
+    format!("level_{k}_from_{from_s:.2}_s")
+}
+
+/// The load torque's fitted values: one level per segment [N m], in time order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadLevels {
+    /// The segments' levels [N m].
+    pub levels_nm: Vec<f64>,
+}
+
 /// What `LoadTorque` is ([`About`]).
 const ABOUT: About = About {
     kind: EffectKind::LoadTorque,
     description: "The load is a torque imposed by the driven machine (possibly switched in steps), not the paper's viscous Bl*omega.",
     equations: "J dw_m/dt = Kf I_qs - (B + Bl) w_m - T_L(t), T_L piecewise constant; the step times come from change-point detection on the torque balance's residual (measured speed and current, current-model rotor flux), placed within their sample; the levels are fitted.",
-    parameters: &[ParamSpec {
-        name: "level_k",
-        unit: "N m",
-        description: "load torque in segment k (one parameter per detected segment)",
-    }],
+    parameters: &PARAMS,
 };
 
 impl EffectModel for LoadTorque {
@@ -237,34 +260,43 @@ impl EffectModel for LoadTorque {
             ));
         }
         let t = n.torque_scale_nm;
-        let r = plausible::LOAD_RATIO;
         let from_s = segments.iter().map(|s| s.from_s).collect();
         // Initial levels: the observer's mean torque beyond the viscous line per segment.
-        Ok(segments
+        let params = segments
             .iter()
             .enumerate()
-            .fold(FitSetup::new(Steps { from_s }), |s, (k, seg)| {
-                s.param(
-                    FitParam::new(
-                        format!("level_{}_from_{:.2}_s", k + 1, seg.from_s),
-                        "N m",
-                        seg.level_nm.clamp(-3.0 * t, 3.0 * t),
-                        (-3.0 * t, 3.0 * t),
-                        0.2 * t,
-                    )
-                    .physical_scaled(r, t, plausible::LOAD_BASIS),
-                )
-            }))
+            .map(|(k, seg)| {
+                let init = seg.level_nm.clamp(-3.0 * t, 3.0 * t);
+                LEVEL
+                    .fit(init, (-3.0 * t, 3.0 * t), 0.2 * t, t)
+                    .named(level_key(k + 1, seg.from_s))
+            })
+            .collect();
+        Ok(FitSetup::new(Steps { from_s }, params)?)
     }
 }
 
 impl Contribution for Steps {
+    type Values = LoadLevels;
+    /// One level per segment.
+    fn values(&self, v: &[f64]) -> Result<LoadLevels, EffectValuesError> {
+        if v.len() != self.from_s.len() {
+            return Err(EffectValuesError::Count {
+                effect: EffectKind::LoadTorque,
+                expected: self.from_s.len(),
+                got: v.len(),
+            });
+        }
+        Ok(LoadLevels {
+            levels_nm: v.to_vec(),
+        })
+    }
     /// The piecewise-constant load torque per working interval `k..k+1`: the mean over
     /// the interval, so a step inside an interval counts with the part of it after the
     /// step.
-    fn contribute(&self, p: &[f64], d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
+    fn contribute(&self, p: &LoadLevels, d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
         let from = &self.from_s;
-        let level = |i: usize| p.get(i).copied().unwrap_or(0.0);
+        let level = |i: usize| p.levels_nm.get(i).copied().unwrap_or(0.0);
         let h = d.dt_s;
         let mut seg = 0usize;
         t.add_load_torque(d.t_s.iter().map(|&t| {
@@ -280,11 +312,11 @@ impl Contribution for Steps {
             }
         }));
     }
-    fn describe(&self, p: &[f64], _d: &Prepared, _n: &MachineConstants) -> String {
+    fn describe(&self, p: &LoadLevels, _d: &Prepared, _n: &MachineConstants) -> String {
         let parts: Vec<String> = self
             .from_s
             .iter()
-            .zip(p)
+            .zip(&p.levels_nm)
             .map(|(t, v)| format!("{v:.2} N m from {t:.4} s"))
             .collect();
         format!(

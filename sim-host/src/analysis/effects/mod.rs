@@ -1,33 +1,23 @@
 //! The effect library: named physical effects the simplified model can be extended with.
 //!
 //! Every effect implements [`EffectModel`]: which [`EffectKind`] it is (its name in the
-//! JSON documents and on the command line, `docs/design.md`), a physical description, its
-//! parameters with units, the way it changes the model equations in words (all declared
+//! JSON documents and on the command line, `docs/design.md`), a physical description, the
+//! way it changes the model equations in words and its parameters, each declared once as
+//! an [`EffectParam`] (name, unit, meaning, physical range and its source; all declared
 //! as one [`About`]), and [`EffectModel::setup`]: the effect set up on a log
-//! ([`FitSetup`]), its parameters typed ([`FitParam`]: name, unit, start, bounds, scale,
-//! physical range and its source) and its [`Contribution`] to the model for given values:
-//! what it writes into the model's physical channels
-//! ([`crate::analysis::simplified_model::ModelTerms`]) and a sentence a drives engineer
-//! understands for fitted values. The trait's other methods have defaults (voltages
-//! needed, nothing required first, no time constant, not confusable); an effect writes
-//! what differs. [`model_of`] gives the model of a kind (the registry: one line per
+//! ([`FitSetup`]: its parameters with start, bounds and scale on this log, [`FitParam`])
+//! and its [`Contribution`] to the model for its typed values (e.g. [`WindageValues`],
+//! built from the fit's values with a `Result`: a count that does not match is an
+//! [`EffectValuesError`], never a dropped effect): what it writes into the model's
+//! physical channels ([`crate::analysis::simplified_model::ModelTerms`]) and a sentence a
+//! drives engineer understands for fitted values. The trait's other methods have defaults
+//! (voltages needed, nothing required first, no time constant, not confusable); an effect
+//! writes what differs. [`model_of`] gives the model of a kind (the registry: one line per
 //! effect). (The simulator injects the same effects with `crate::sim::EffectSpec`.)
 //!
-//! | name | parameters | model change |
-//! |---|---|---|
-//! | `thermal_drift` | rise_k \[K\], tau_s \[s\] | Rs, Rr x (1 + 0.00393 dT(t)), dT = rise (1 - e^{-t/tau}) |
-//! | `saturation` | psi_sat_wb \[Wb\], exponent \[-\] | Lm = Lm0 / (1 + (Lm i_f / psi_sat)^n) |
-//! | `iron_loss` | g_fe_s \[S\] (= 1/Rfe) | I_qs += omega_s Ls i_f / Rfe (core-loss current) |
-//! | `coulomb_friction` | torque_nm \[N m\] | load += Tc tanh(w_m / 1 rad/s) |
-//! | `windage` | k_nms2 \[N m s^2/rad^2\] | load += k w_m abs(w_m) |
-//! | `load_torque` | level_1..level_k \[N m\] | load += piecewise-constant T_L(t) (steps found in the data to the sample: `crate::analysis::change_point`) |
-//! | `supply_unbalance` | y_re, y_im \[-\] | i_neg = (y_re + j y_im) v_neg / conj(Z2), Z2 from the nominal parameters at the negative-sequence slip 2 - s; full-order: the machine driven by V_pos + y V_neg |
-//! | `phase_asymmetry` | c_re, c_im \[-\] | i_neg = (c_re + j c_im) conj(i_pos); full-order: the unequal winding (`simplified_model::WindingAsymmetryTerm`) |
-//! | `flux_dynamics` | tau_r_s \[s\] | psi_r/Lm = phi, dphi/dt = (i_f - phi)/tau_r; slip and torque from phi |
-//! | `current_dynamics` | la_h \[H\] | La dI_qs/dt = V_qs - Ra I_qs - Psi omega_r (eq. 28's derivative term) |
-//! | `rotor_asymmetry` | delta \[-\], phi_rad \[rad\] | Rr in Ra x (1 + (delta/3)(1 - cos(2 (Np theta_m - theta) + phi))); full-order: rotor resistance Rr (I + (2/3) delta u u^T) |
-//! | `d_axis_dynamics` | (none) | I_ds predicted from V_ds by the d-axis stator equation instead of measured |
-//! | `cross_coupling_dynamics` | (none) | q-axis rotor flux and the slip coupling between the axes (psi_qr != 0 in transients) |
+//! The effects, their parameters and the changes to the model are listed in
+//! docs/design.md §9; its table of the parameters is checked against the declarations
+//! (`sim-host/tests/effect_parameters.rs`).
 //!
 //! With `d_axis_dynamics` or `cross_coupling_dynamics` in the model, the model is the
 //! full-order machine of `simplified_model::simulate` (inverse-Gamma form, states I_ds,
@@ -54,37 +44,29 @@ mod switch;
 mod thermal_drift;
 mod windage;
 
-pub use coulomb_friction::CoulombFriction;
+pub use coulomb_friction::{CoulombFriction, CoulombFrictionValues};
 pub use cross_coupling_dynamics::CROSS_COUPLING_DYNAMICS;
-pub use current_dynamics::CurrentDynamics;
+pub use current_dynamics::{CurrentDynamics, CurrentDynamicsValues};
 pub use d_axis_dynamics::D_AXIS_DYNAMICS;
-pub use flux_dynamics::FluxDynamics;
+pub use flux_dynamics::{FluxDynamics, FluxDynamicsValues};
 pub use impedance::{z1_pos, z2_neg, z2_neg_at};
-pub use iron_loss::IronLoss;
-pub use load_torque::{load_segments, LoadSegment, LoadTorque};
-pub use phase_asymmetry::{asymmetry_phase, PhaseAsymmetry};
-pub use rotor_asymmetry::{RotorAsymmetry, DELTA_BASIS, DELTA_RANGE};
-pub use saturation::Saturation;
-pub use setup::{outside, Contribution, FitParam, FitSetup, SetupError};
-pub use supply_unbalance::SupplyUnbalance;
+pub use iron_loss::{IronLoss, IronLossValues};
+pub use load_torque::{load_segments, LoadLevels, LoadSegment, LoadTorque};
+pub use phase_asymmetry::{asymmetry_phase, PhaseAsymmetry, PhaseAsymmetryValues};
+pub use rotor_asymmetry::{RotorAsymmetry, RotorAsymmetryValues, DELTA_BASIS, DELTA_RANGE};
+pub use saturation::{Saturation, SaturationValues};
+pub use setup::{
+    declared_values, outside, Contribution, EffectParam, EffectValuesError, FitParam, FitSetup,
+    SetupError,
+};
+pub use supply_unbalance::{SupplyUnbalance, SupplyUnbalanceValues};
 pub use switch::StateSwitch;
-pub use thermal_drift::{ThermalDrift, ALPHA_CU_PER_K};
-pub use windage::Windage;
+pub use thermal_drift::{ThermalDrift, ThermalDriftValues, ALPHA_CU_PER_K};
+pub use windage::{Windage, WindageValues};
 
 use super::prep::Prepared;
 use super::simplified_model::MachineConstants;
 use monitor_core::EffectKind;
-
-/// One parameter of an effect.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct ParamSpec {
-    /// Name (JSON key).
-    pub name: &'static str,
-    /// Unit.
-    pub unit: &'static str,
-    /// What it is.
-    pub description: &'static str,
-}
 
 /// What a log must carry for an effect to be fitted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -182,8 +164,9 @@ pub struct About {
     pub description: &'static str,
     /// How the effect changes the model equations (text with the equation).
     pub equations: &'static str,
-    /// Parameters with units (the set-up gives the data-dependent list; empty: none).
-    pub parameters: &'static [ParamSpec],
+    /// The parameters, each declared once (empty: none; `load_torque` declares the
+    /// pattern of its per-segment levels).
+    pub parameters: &'static [EffectParam],
 }
 
 /// How a physical effect of the library changes the simplified model. An effect declares
@@ -204,9 +187,9 @@ pub trait EffectModel: Send + Sync {
     fn equations(&self) -> &'static str {
         self.about().equations
     }
-    /// Parameters with units (documentation; [`EffectModel::setup`] gives the
-    /// data-dependent list).
-    fn parameters(&self) -> &'static [ParamSpec] {
+    /// The parameters' declarations ([`EffectModel::setup`] gives the data-dependent
+    /// list).
+    fn parameters(&self) -> &'static [EffectParam] {
         self.about().parameters
     }
     /// Channels the log must have. Default: the voltages.
@@ -244,6 +227,21 @@ pub trait EffectModel: Send + Sync {
     fn evidence(&self, _e: &EffectEvidence<'_>) -> Option<bool> {
         None
     }
+    /// What a measurement of the log `d` independent of the fit says against the fitted
+    /// values `fitted` (in the set-up's order): the reason they are not plausible, or
+    /// `None` (the default: nothing). `explain` ranks a contradicted candidate as an
+    /// implausible one.
+    ///
+    /// # Errors
+    /// [`EffectValuesError`] when `fitted` does not hold one value per parameter.
+    fn contradicted_by(
+        &self,
+        _d: &Prepared,
+        _n: &MachineConstants,
+        _fitted: &[f64],
+    ) -> Result<Option<String>, EffectValuesError> {
+        Ok(None)
+    }
     /// The effect set up on this data: its parameters (start, bounds, physical range) and
     /// its contribution to the model, with what it precomputes from the data.
     ///
@@ -252,18 +250,16 @@ pub trait EffectModel: Send + Sync {
     fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError>;
 }
 
-/// A dynamics effect's parameter about its nominal value `nominal`: fitted within 0.3 to
-/// 3 times it from the nominal value, plausible within [`plausible::DYNAMICS_RATIO`] of it.
-fn dynamics_param(name: &'static str, unit: &'static str, nominal: f64) -> FitParam {
-    let r = plausible::DYNAMICS_RATIO;
-    FitParam::new(
-        name,
-        unit,
+/// A dynamics effect's parameter `p` about its nominal value `nominal`: fitted within 0.3
+/// to 3 times it from the nominal value, plausible within its declared range
+/// ([`plausible::DYNAMICS_RATIO`]) of it.
+fn dynamics_param(p: &EffectParam, nominal: f64) -> FitParam {
+    p.fit(
         nominal,
         (0.3 * nominal, 3.0 * nominal),
         0.2 * nominal,
+        nominal,
     )
-    .physical_scaled(r, nominal, plausible::DYNAMICS_BASIS)
 }
 
 /// The log's duration [s] (at least one sample period; 1 s for an empty series).

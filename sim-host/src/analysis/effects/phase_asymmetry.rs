@@ -2,8 +2,8 @@
 
 use super::impedance::z1_pos;
 use super::{
-    plausible, supply_unbalanced, About, Confusion, Contribution, EffectEvidence, EffectModel,
-    FitParam, FitSetup, Needs, ParamSpec, SetupError,
+    declared_values, plausible, supply_unbalanced, About, Confusion, Contribution, EffectEvidence,
+    EffectModel, EffectParam, EffectValuesError, FitSetup, Needs, SetupError,
 };
 use crate::analysis::prep::{Prepared, C64};
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms, WindingAsymmetryTerm};
@@ -39,23 +39,49 @@ pub fn asymmetry_phase(
     (phase, f64::from(eps))
 }
 
+/// Phase asymmetry's parameters.
+const PARAMS: [EffectParam; 2] = [
+    EffectParam {
+        name: "c_re",
+        unit: "1",
+        doc: "real part of i_neg / conj(i_pos)",
+        range: plausible::ASYM_C,
+        per: None,
+        basis: plausible::ASYM_BASIS,
+    },
+    EffectParam {
+        name: "c_im",
+        unit: "1",
+        doc: "imaginary part of i_neg / conj(i_pos)",
+        range: plausible::ASYM_C,
+        per: None,
+        basis: plausible::ASYM_BASIS,
+    },
+];
+
+/// Phase asymmetry's fitted values ([`PARAMS`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PhaseAsymmetryValues {
+    /// i_neg / conj(i_pos), real part [1].
+    pub c_re: f64,
+    /// Its imaginary part [1].
+    pub c_im: f64,
+}
+
+impl TryFrom<&[f64]> for PhaseAsymmetryValues {
+    type Error = EffectValuesError;
+    fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
+        let [c_re, c_im] = declared_values(EffectKind::PhaseAsymmetry, &PARAMS, v)?;
+        Ok(PhaseAsymmetryValues { c_re, c_im })
+    }
+}
+
 /// What `PhaseAsymmetry` is ([`About`]).
 const ABOUT: About = About {
     kind: EffectKind::PhaseAsymmetry,
     description: "One stator winding differs from the other two (inter-turn short, bad joint): the machine draws a negative-sequence current proportional to its load current even from a balanced supply.",
     equations: "Reduced model: i_abc = balanced model current + i_neg, i_neg = (c_re + j c_im) conj(i_pos). Shorted turns (a fraction mu of phase k through r_f; Tallam, Habetler, Harley 2002) give c = (mu/(3 R_f)) e^{j 2 th_k} conj(Z1), R_f = Rs (1 - 2mu/3) + r_f/mu. Full-order model (all dynamics effects in): the machine stays symmetric and the terminals draw the shorted loop's current |y| v + y conj(v), y = c / conj(Z1) at the log's mean operating point, so c means the same in both.",
-    parameters: &[
-        ParamSpec {
-            name: "c_re",
-            unit: "1",
-            description: "real part of i_neg / conj(i_pos)",
-        },
-        ParamSpec {
-            name: "c_im",
-            unit: "1",
-            description: "imaginary part of i_neg / conj(i_pos)",
-        },
-    ],
+    parameters: &PARAMS,
 };
 
 impl EffectModel for PhaseAsymmetry {
@@ -82,35 +108,37 @@ impl EffectModel for PhaseAsymmetry {
         } else {
             C64::new(0.0, 0.0)
         };
-        let c = |name| {
-            FitParam::new(name, "1", 0.0, (-1.0, 1.0), 0.02)
-                .physical(plausible::ASYM_C, plausible::ASYM_BASIS)
-        };
-        Ok(FitSetup::new(OnLog { y_over_c: k })
-            .param(FitParam {
-                init: 0.01,
-                ..c("c_re")
-            })
-            .param(c("c_im")))
+        let [c_re, c_im] = &PARAMS;
+        let params = vec![
+            c_re.fit(0.01, (-1.0, 1.0), 0.02, 1.0),
+            c_im.fit(0.0, (-1.0, 1.0), 0.02, 1.0),
+        ];
+        Ok(FitSetup::new(OnLog { y_over_c: k }, params)?)
     }
 }
 
 impl Contribution for OnLog {
+    type Values = PhaseAsymmetryValues;
+    fn values(&self, v: &[f64]) -> Result<PhaseAsymmetryValues, EffectValuesError> {
+        PhaseAsymmetryValues::try_from(v)
+    }
     /// The shorted turns in their two forms (`c` and `y`).
-    fn contribute(&self, p: &[f64], _d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
-        let &[c_re, c_im] = p else { return };
-        let c = C64::new(c_re, c_im);
+    fn contribute(
+        &self,
+        p: &PhaseAsymmetryValues,
+        _d: &Prepared,
+        _n: &MachineConstants,
+        t: &mut ModelTerms,
+    ) {
+        let c = C64::new(p.c_re, p.c_im);
         t.stator_winding = Some(WindingAsymmetryTerm {
             c,
             y: c * self.y_over_c,
         });
     }
-    fn describe(&self, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
-        let &[c_re, c_im] = p else {
-            return String::new();
-        };
+    fn describe(&self, p: &PhaseAsymmetryValues, d: &Prepared, n: &MachineConstants) -> String {
         let (w, slip) = operating_point(d, n);
-        let c = C64::new(c_re, c_im);
+        let c = C64::new(p.c_re, p.c_im);
         let (ph, eps) = asymmetry_phase(c, n, w, slip);
         format!(
             "phase {} winding differs: negative-sequence current {:.1} % of the positive-sequence current; shorted turns in that phase, at least {:.1} % of its turns (a bolted short; a fault resistance means more)",

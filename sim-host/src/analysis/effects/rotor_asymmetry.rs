@@ -33,9 +33,12 @@
 //! resistance matrix in its rotor flux equation (`simplified_model::RotorCage::asymmetry`), with the same
 //! (delta, phi); the terms above are then unused.
 
-use super::{About, Contribution, EffectModel, FitParam, FitSetup, Needs, ParamSpec, SetupError};
+use super::{
+    declared_values, About, Contribution, EffectModel, EffectParam, EffectValuesError, FitSetup,
+    Needs, SetupError,
+};
 use crate::analysis::prep::{zero_phase_lpf, Prepared, I_F_SMOOTH_HZ};
-use crate::analysis::rotor_asymmetry::mcsa;
+use crate::analysis::rotor_asymmetry::{mcsa, spectrum_contradicts};
 use crate::analysis::simplified_model::{CageAsymmetry, MachineConstants, ModelTerms};
 use crate::sim::machine::broken_bars_of_delta;
 use monitor_core::EffectKind;
@@ -51,6 +54,43 @@ pub const DELTA_RANGE: (f64, f64) = (0.0, 1.0);
 
 /// Basis of [`DELTA_RANGE`].
 pub const DELTA_BASIS: &str = "delta = 3n/(N - 3n): up to N/6 adjacent broken bars (4.7 of 28; Kliman et al. 1988, Bellini et al. 2001)";
+
+/// The cage asymmetry's parameters.
+const PARAMS: [EffectParam; 2] = [
+    EffectParam {
+        name: "delta",
+        unit: "1",
+        doc: "relative rotor phase resistance asymmetry (one rotor phase Rr (1 + delta)); n broken bars of N: delta = 3n/(N - 3n)",
+        range: DELTA_RANGE,
+        per: None,
+        basis: DELTA_BASIS,
+    },
+    EffectParam {
+        name: "phi_rad",
+        unit: "rad",
+        doc: "twice the angle of the faulty rotor phase at the log's start (a nuisance parameter)",
+        range: (f64::NEG_INFINITY, f64::INFINITY),
+        per: None,
+        basis: "any angle",
+    },
+];
+
+/// The cage asymmetry's fitted values ([`PARAMS`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RotorAsymmetryValues {
+    /// The relative rotor phase resistance asymmetry [1].
+    pub delta: f64,
+    /// Twice the faulty rotor phase's angle at the log's start [rad].
+    pub phi_rad: f64,
+}
+
+impl TryFrom<&[f64]> for RotorAsymmetryValues {
+    type Error = EffectValuesError;
+    fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
+        let [delta, phi_rad] = declared_values(EffectKind::RotorAsymmetry, &PARAMS, v)?;
+        Ok(RotorAsymmetryValues { delta, phi_rad })
+    }
+}
 
 /// The library entry (see the module doc).
 #[derive(Debug, Clone, Copy)]
@@ -135,18 +175,7 @@ const ABOUT: About = About {
     kind: EffectKind::RotorAsymmetry,
     description: "The rotor cage is not symmetric (broken rotor bars, a cracked end ring): the rotor resistance seen by the stator field changes at twice the slip frequency, which modulates the torque and the current: (1 - 2s) f and (1 + 2s) f sidebands in the stator current, 2 s f ripple in speed.",
     equations: "Rr in Ra = Rs + (Ls/Lr) Rr is multiplied by 1 + (delta/3)(1 - cos(2 (Np theta_m - theta) + phi)): the q-q element of the rotor resistance matrix Rr I + (2/3) Rr delta u u^T, u along the faulty rotor phase; Np theta_m integrates the measured speed. In the full-order model (all dynamics effects in) the whole matrix acts in the rotor flux equation.",
-    parameters: &[
-        ParamSpec {
-            name: "delta",
-            unit: "1",
-            description: "relative rotor phase resistance asymmetry (one rotor phase Rr (1 + delta)); n broken bars of N: delta = 3n/(N - 3n)",
-        },
-        ParamSpec {
-            name: "phi_rad",
-            unit: "rad",
-            description: "twice the angle of the faulty rotor phase at the log's start (a nuisance parameter)",
-        },
-    ],
+    parameters: &PARAMS,
 };
 
 impl EffectModel for RotorAsymmetry {
@@ -165,38 +194,48 @@ impl EffectModel for RotorAsymmetry {
         }
         let ripple = id_ripple(d, &ang);
         let (delta0, phi0) = initial_estimate(d, &ang, &ripple);
-        let mut s = FitSetup::new(OnLog {
+        let [delta, phi_rad] = &PARAMS;
+        let params = vec![
+            delta.fit(delta0, (0.0, 2.0), 0.05, 1.0),
+            phi_rad.fit(phi0, (phi0 - 4.0 * PI, phi0 + 4.0 * PI), 0.3, 1.0),
+        ];
+        let on_log = OnLog {
             double_slip_angle: ang,
             id_ripple: ripple,
-        })
-        .param(
-            FitParam::new("delta", "1", delta0, (0.0, 2.0), 0.05)
-                .physical(DELTA_RANGE, DELTA_BASIS),
-        )
-        .param(
-            FitParam::new(
-                "phi_rad",
-                "rad",
-                phi0,
-                (phi0 - 4.0 * PI, phi0 + 4.0 * PI),
-                0.3,
-            )
-            .physical((f64::NEG_INFINITY, f64::INFINITY), "any angle"),
-        );
+        };
         // The I_ds ripple's phase can be half a turn off through starts and steps (found on
         // the 11 kW machine with its true parameters: the fit ended at delta = 0 and
         // explained nothing).
-        s.alt_init = vec![vec![delta0, phi0 + PI]];
-        Ok(s)
+        Ok(FitSetup::new(on_log, params)?.with_alt_init(vec![vec![delta0, phi0 + PI]])?)
+    }
+    fn contradicted_by(
+        &self,
+        d: &Prepared,
+        n: &MachineConstants,
+        fitted: &[f64],
+    ) -> Result<Option<String>, EffectValuesError> {
+        // A cage asymmetry is named only when the current spectrum agrees with the fit.
+        let v = RotorAsymmetryValues::try_from(fitted)?;
+        Ok(spectrum_contradicts(d, n.np, v.delta))
     }
 }
 
 impl Contribution for OnLog {
+    type Values = RotorAsymmetryValues;
+    fn values(&self, v: &[f64]) -> Result<RotorAsymmetryValues, EffectValuesError> {
+        RotorAsymmetryValues::try_from(v)
+    }
     /// The reduced model's rotor resistance scale and flux drive, and the full-order
     /// model's cage.
-    fn contribute(&self, p: &[f64], d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
+    fn contribute(
+        &self,
+        p: &RotorAsymmetryValues,
+        d: &Prepared,
+        _n: &MachineConstants,
+        t: &mut ModelTerms,
+    ) {
         let len = d.len();
-        let &[delta, phi] = p else { return };
+        let (delta, phi) = (p.delta, p.phi_rad);
         let (ang, id_ripple) = (&self.double_slip_angle, &self.id_ripple);
         if ang.len() != len || id_ripple.len() != len {
             return;
@@ -228,10 +267,8 @@ impl Contribution for OnLog {
         let start = zero_phase_lpf(&drive[..head], d.dt_s, I_F_SMOOTH_HZ)[0];
         t.drive_rotor_flux(drive.into_iter(), start);
     }
-    fn describe(&self, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
-        let &[delta, _] = p else {
-            return String::new();
-        };
+    fn describe(&self, p: &RotorAsymmetryValues, d: &Prepared, n: &MachineConstants) -> String {
+        let delta = p.delta;
         let m = mcsa(d, n.np, None, Some(delta));
         let sb = match (m.lower_sideband_db, m.upper_sideband_db) {
             (Some(l), Some(u)) => format!(

@@ -1,8 +1,8 @@
 //! `saturation`: main-flux saturation.
 
 use super::{
-    plausible, rated_flux_wb, About, Contribution, EffectModel, FitParam, FitSetup, ParamSpec,
-    SetupError,
+    declared_values, plausible, rated_flux_wb, About, Contribution, EffectModel, EffectParam,
+    EffectValuesError, FitSetup, SetupError,
 };
 use crate::analysis::prep::Prepared;
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms, SaturationLaw};
@@ -85,23 +85,52 @@ fn sat_factors(lm0: f64, i_f: &[f64], psi_sat: f64, nexp: f64) -> Vec<f64> {
         .collect()
 }
 
+/// Saturation's parameters.
+const PARAMS: [EffectParam; 2] = [
+    EffectParam {
+        name: "psi_sat_wb",
+        unit: "Wb",
+        doc: "flux linkage at which Lm has halved",
+        range: plausible::PSI_SAT_RATIO,
+        per: Some("the log's flux level |V|/omega_s"),
+        basis: plausible::PSI_SAT_BASIS,
+    },
+    EffectParam {
+        name: "exponent",
+        unit: "1",
+        doc: "sharpness of the saturation knee",
+        range: (2.0, 14.0),
+        per: None,
+        basis: "the fit's bounds",
+    },
+];
+
+/// Saturation's fitted values ([`PARAMS`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SaturationValues {
+    /// The flux linkage at which Lm has halved [Wb].
+    pub psi_sat_wb: f64,
+    /// The knee's exponent [1].
+    pub exponent: f64,
+}
+
+impl TryFrom<&[f64]> for SaturationValues {
+    type Error = EffectValuesError;
+    fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
+        let [psi_sat_wb, exponent] = declared_values(EffectKind::Saturation, &PARAMS, v)?;
+        Ok(SaturationValues {
+            psi_sat_wb,
+            exponent,
+        })
+    }
+}
+
 /// What `Saturation` is ([`About`]).
 const ABOUT: About = About {
     kind: EffectKind::Saturation,
     description: "The iron of the main flux path saturates: the magnetising inductance Lm falls as the magnetising current (the flux level) rises.",
     equations: "Lm(i_f) = Lm0 / (1 + (Lm(i_f) i_f / psi_sat)^n), solved per sample; Ls = Lls + Lm and Kf (Lm^2/Lr) in eqs. (28)-(29) follow. In the full-order model (all dynamics effects in) the same law acts on the model's own magnetising flux |psi_m| = Lm |i_s + i_r|, the fluxes of the T-equivalent circuit being its states.",
-    parameters: &[
-        ParamSpec {
-            name: "psi_sat_wb",
-            unit: "Wb",
-            description: "flux linkage at which Lm has halved",
-        },
-        ParamSpec {
-            name: "exponent",
-            unit: "1",
-            description: "sharpness of the saturation knee",
-        },
-    ],
+    parameters: &PARAMS,
 };
 
 impl EffectModel for Saturation {
@@ -110,27 +139,34 @@ impl EffectModel for Saturation {
     }
     fn setup(&self, d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let psi = rated_flux_wb(d);
-        let r = plausible::PSI_SAT_RATIO;
-        Ok(FitSetup::new(OnLog { rated_flux_wb: psi })
-            .param(
-                FitParam::new(
-                    "psi_sat_wb",
-                    "Wb",
-                    1.2 * psi,
-                    (0.5 * psi, 5.0 * psi),
-                    0.2 * psi,
-                )
-                .physical_scaled(r, psi, plausible::PSI_SAT_BASIS),
-            )
-            .param(FitParam::new("exponent", "1", 7.0, (2.0, 14.0), 2.0)))
+        let [psi_sat_wb, exponent] = &PARAMS;
+        let params = vec![
+            psi_sat_wb.fit(1.2 * psi, (0.5 * psi, 5.0 * psi), 0.2 * psi, psi),
+            // Fitted anywhere within its plausible range.
+            exponent.fit(7.0, exponent.range, 2.0, 1.0),
+        ];
+        Ok(FitSetup::new(OnLog { rated_flux_wb: psi }, params)?)
     }
 }
 
 impl Contribution for OnLog {
+    type Values = SaturationValues;
+    fn values(&self, v: &[f64]) -> Result<SaturationValues, EffectValuesError> {
+        SaturationValues::try_from(v)
+    }
     /// Lm's scale from the measured i_f per sample (the reduced model) and the law itself
     /// (the full-order model saturates with its own magnetising flux).
-    fn contribute(&self, p: &[f64], d: &Prepared, n: &MachineConstants, t: &mut ModelTerms) {
-        let &[psi_sat_wb, exponent] = p else { return };
+    fn contribute(
+        &self,
+        p: &SaturationValues,
+        d: &Prepared,
+        n: &MachineConstants,
+        t: &mut ModelTerms,
+    ) {
+        let SaturationValues {
+            psi_sat_wb,
+            exponent,
+        } = *p;
         t.scale_magnetising_inductance(
             sat_factors(n.lm_h, &d.i_f, psi_sat_wb, exponent).into_iter(),
         );
@@ -139,10 +175,8 @@ impl Contribution for OnLog {
             exponent,
         });
     }
-    fn describe(&self, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
-        let &[psi_sat, nexp] = p else {
-            return String::new();
-        };
+    fn describe(&self, p: &SaturationValues, d: &Prepared, n: &MachineConstants) -> String {
+        let (psi_sat, nexp) = (p.psi_sat_wb, p.exponent);
         // The factor falls monotonically with |i_f|: its extremes are at the extremes of |i_f|.
         let (mut imin, mut imax) = (f64::INFINITY, f64::NEG_INFINITY);
         for &i in &d.i_f {

@@ -5,6 +5,7 @@ use super::sig;
 use crate::analysis::prep::Prepared;
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms};
 use crate::params::PlausibleRange;
+use monitor_core::EffectKind;
 use std::sync::Arc;
 
 /// Why an effect cannot be fitted on a log (one line, the effect's name put before it by
@@ -24,6 +25,9 @@ pub enum SetupError {
     /// The log holds nothing the effect could fit (the reason in words).
     #[error("{0}")]
     NothingToFit(&'static str),
+    /// The set-up's parameters do not match its contribution's typed values.
+    #[error(transparent)]
+    Values(#[from] EffectValuesError),
 }
 
 /// ` (because)`, or nothing.
@@ -35,15 +39,59 @@ fn because_of(because: &str) -> String {
     }
 }
 
-/// One fitted parameter of an effect: its name and unit (JSON key and unit), where the fit
-/// starts, the bounds it keeps to, its typical magnitude, and the physical range a fitted
-/// value must lie in to be plausible, with the range's source.
+/// One parameter of an effect, declared once: its name (the JSON key, and the docs'),
+/// unit, meaning, physical range and that range's source. The fit's set-up
+/// ([`EffectParam::fit`]), the JSON (`parameters`, keyed by the name, with the unit) and
+/// docs/design.md's table of the effects' parameters (checked against the declarations by
+/// `sim-host/tests/effect_parameters.rs`) come from it; an effect's typed values (e.g.
+/// `WindageValues`) are built from the fit's values in the declarations' order.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EffectParam {
+    /// Name: the JSON key (`load_torque`'s levels: the pattern of one key per segment,
+    /// `level_k_from_T_s`).
+    pub name: &'static str,
+    /// Unit (`1`: dimensionless).
+    pub unit: &'static str,
+    /// What it is, in a few words.
+    pub doc: &'static str,
+    /// Physical range: a fitted value outside it is not plausible. In `unit` when `per` is
+    /// `None`, else a multiple of what `per` names (the set-up gives its value on the log).
+    pub range: (f64, f64),
+    /// What [`EffectParam::range`] is relative to, in words (`None`: absolute).
+    pub per: Option<&'static str>,
+    /// Where [`EffectParam::range`] comes from.
+    pub basis: &'static str,
+}
+
+impl EffectParam {
+    /// The parameter fitted from `init` within `lo..=hi`, of magnitude `scale` (> 0), with
+    /// its physical range `range` times `per_value`, the value on the log of what
+    /// [`EffectParam::per`] names (1 for an absolute range).
+    pub fn fit(&self, init: f64, (lo, hi): (f64, f64), scale: f64, per_value: f64) -> FitParam {
+        FitParam {
+            declared: *self,
+            name: self.name.to_string(),
+            init,
+            lo,
+            hi,
+            scale,
+            plausible: PlausibleRange {
+                lo: self.range.0 * per_value,
+                hi: self.range.1 * per_value,
+            },
+        }
+    }
+}
+
+/// One fitted parameter of an effect set up on a log: its declaration, its JSON key,
+/// where the fit starts, the bounds it keeps to, its typical magnitude, and its physical
+/// range on this log.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FitParam {
-    /// Name (JSON key; for `load_torque` one per segment).
+    /// The declaration (unit, meaning, range and its source).
+    pub declared: EffectParam,
+    /// The JSON key: the declaration's name (for `load_torque` one key per segment).
     pub name: String,
-    /// Unit.
-    pub unit: &'static str,
     /// Initial value.
     pub init: f64,
     /// Lower bound of the fit.
@@ -52,52 +100,80 @@ pub struct FitParam {
     pub hi: f64,
     /// Typical magnitude (finite-difference steps and conditioning), > 0.
     pub scale: f64,
-    /// Physical range: a fitted value outside it is not plausible.
+    /// Physical range on this log: a fitted value outside it is not plausible.
     pub plausible: PlausibleRange,
-    /// Where [`FitParam::plausible`] comes from.
-    pub basis: &'static str,
 }
 
 impl FitParam {
-    /// A parameter fitted from `init` within `lo..=hi`, of magnitude `scale`; plausible
-    /// anywhere within the bounds until [`FitParam::physical`] says otherwise.
-    pub fn new(
-        name: impl Into<String>,
-        unit: &'static str,
-        init: f64,
-        (lo, hi): (f64, f64),
-        scale: f64,
-    ) -> Self {
-        FitParam {
-            name: name.into(),
-            unit,
-            init,
-            lo,
-            hi,
-            scale,
-            plausible: PlausibleRange { lo, hi },
-            basis: "the fit's bounds",
-        }
+    /// The unit (the declaration's).
+    pub fn unit(&self) -> &'static str {
+        self.declared.unit
     }
 
-    /// The parameter with the physical range `lo..=hi` from `basis`.
-    pub fn physical(mut self, (lo, hi): (f64, f64), basis: &'static str) -> Self {
-        self.plausible = PlausibleRange { lo, hi };
-        self.basis = basis;
+    /// Where [`FitParam::plausible`] comes from (the declaration's basis).
+    pub fn basis(&self) -> &'static str {
+        self.declared.basis
+    }
+
+    /// The parameter under the JSON key `name` (the per-segment keys of `load_torque`).
+    pub fn named(mut self, name: String) -> Self {
+        self.name = name;
         self
-    }
-
-    /// The parameter with the physical range `lo * scale ..= hi * scale` from `basis` (a
-    /// range relative to a scale of the machine or the log).
-    pub fn physical_scaled(self, (lo, hi): (f64, f64), scale: f64, basis: &'static str) -> Self {
-        self.physical((lo * scale, hi * scale), basis)
     }
 
     /// Why the value `v` is not physically plausible (`None`: it is), naming value, unit,
     /// range and the range's basis.
     pub fn implausible_because(&self, v: f64) -> Option<String> {
-        outside(&self.name, self.unit, v, &self.plausible, self.basis)
+        outside(&self.name, self.unit(), v, &self.plausible, self.basis())
     }
+}
+
+/// The fit's values of an effect's parameters in number: `values` in the declared order
+/// of `declared`, as an array to destructure into the effect's typed values.
+///
+/// # Errors
+/// [`EffectValuesError::Count`] when `values` does not hold one value per declaration.
+pub fn declared_values<const N: usize>(
+    effect: EffectKind,
+    declared: &[EffectParam; N],
+    values: &[f64],
+) -> Result<[f64; N], EffectValuesError> {
+    <[f64; N]>::try_from(values).map_err(|_| EffectValuesError::Count {
+        effect,
+        expected: declared.len(),
+        got: values.len(),
+    })
+}
+
+/// Fitted values that do not match the effects they are for: never dropped silently.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum EffectValuesError {
+    /// An effect got another number of values than it has parameters.
+    #[error("{effect}: {got} fitted values for its {expected} parameters")]
+    Count {
+        /// Which effect.
+        effect: EffectKind,
+        /// Its parameters on this log.
+        expected: usize,
+        /// The values given.
+        got: usize,
+    },
+    /// Another number of values than the effects have parameters in all.
+    #[error("{got} fitted values for the effects' {expected} parameters")]
+    Total {
+        /// The effects' parameters.
+        expected: usize,
+        /// The values given.
+        got: usize,
+    },
+    /// Another number of value sets than effects.
+    #[error("{got} sets of fitted values for {expected} effects")]
+    Effects {
+        /// The effects in the model.
+        expected: usize,
+        /// The value sets given.
+        got: usize,
+    },
 }
 
 /// Why the value `v` of quantity `name` [`unit`] is not physically plausible (`None`: it
@@ -121,28 +197,80 @@ pub fn outside(
 }
 
 /// What an effect set up on a log contributes to the model: the effect with the numbers
-/// its set-up took from the data (for example the load-step times).
-pub trait Contribution: Send + Sync {
-    /// Writes the effect's contribution for parameter values `p` (in the set-up's order)
-    /// into `terms`.
-    fn contribute(&self, p: &[f64], d: &Prepared, n: &MachineConstants, terms: &mut ModelTerms);
-    /// The fitted values `p` in words a drives engineer understands.
-    fn describe(&self, p: &[f64], d: &Prepared, n: &MachineConstants) -> String;
+/// its set-up took from the data (for example the load-step times), for its typed values.
+pub trait Contribution: Send + Sync + 'static {
+    /// The effect's values, typed (one field per declared parameter, e.g.
+    /// `WindageValues`).
+    type Values;
+    /// The fit's values `values` (in the set-up's order) typed.
+    ///
+    /// # Errors
+    /// [`EffectValuesError::Count`] when there is not one value per parameter.
+    fn values(&self, values: &[f64]) -> Result<Self::Values, EffectValuesError>;
+    /// Writes the effect's contribution for the values `p` into `terms`.
+    fn contribute(
+        &self,
+        p: &Self::Values,
+        d: &Prepared,
+        n: &MachineConstants,
+        terms: &mut ModelTerms,
+    );
+    /// The values `p` in words a drives engineer understands.
+    fn describe(&self, p: &Self::Values, d: &Prepared, n: &MachineConstants) -> String;
+}
+
+/// A [`Contribution`] behind the fit's untyped values (what [`FitSetup`] holds).
+trait UntypedContribution: Send + Sync {
+    fn contribute(
+        &self,
+        p: &[f64],
+        d: &Prepared,
+        n: &MachineConstants,
+        terms: &mut ModelTerms,
+    ) -> Result<(), EffectValuesError>;
+    fn describe(
+        &self,
+        p: &[f64],
+        d: &Prepared,
+        n: &MachineConstants,
+    ) -> Result<String, EffectValuesError>;
+    fn check(&self, p: &[f64]) -> Result<(), EffectValuesError>;
+}
+
+impl<C: Contribution> UntypedContribution for C {
+    fn contribute(
+        &self,
+        p: &[f64],
+        d: &Prepared,
+        n: &MachineConstants,
+        terms: &mut ModelTerms,
+    ) -> Result<(), EffectValuesError> {
+        Contribution::contribute(self, &self.values(p)?, d, n, terms);
+        Ok(())
+    }
+    fn describe(
+        &self,
+        p: &[f64],
+        d: &Prepared,
+        n: &MachineConstants,
+    ) -> Result<String, EffectValuesError> {
+        Ok(Contribution::describe(self, &self.values(p)?, d, n))
+    }
+    fn check(&self, p: &[f64]) -> Result<(), EffectValuesError> {
+        self.values(p).map(|_| ())
+    }
 }
 
 /// An effect set up on a log ([`super::EffectModel::setup`]): its parameters, other
-/// starting points for the fit, and its contribution to the model.
+/// starting points for the fit, and its contribution to the model. Built with a `Result`:
+/// the parameters and every other start are checked against the contribution's typed
+/// values.
 #[derive(Clone)]
 pub struct FitSetup {
     /// The fitted parameters, in the order of the values the fit passes.
     pub params: Vec<FitParam>,
-    /// Other starting values the fit also tries, each a whole set of values (empty: the
-    /// parameters' `init` only). For a cost with separate valleys: an amplitude and a
-    /// phase, started half a turn off, descend to the amplitude's zero bound, where the
-    /// phase's gradient vanishes and the fit stays. The start that ends at the lowest cost
-    /// wins (`crate::analysis::fit::fit`).
-    pub alt_init: Vec<Vec<f64>>,
-    contribution: Arc<dyn Contribution>,
+    alt_init: Vec<Vec<f64>>,
+    contribution: Arc<dyn UntypedContribution>,
 }
 
 impl std::fmt::Debug for FitSetup {
@@ -155,19 +283,41 @@ impl std::fmt::Debug for FitSetup {
 }
 
 impl FitSetup {
-    /// A set-up without parameters whose contribution is `c`.
-    pub fn new(c: impl Contribution + 'static) -> Self {
-        FitSetup {
-            params: Vec::new(),
+    /// The set-up of the parameters `params` (in the order of `c`'s typed values) whose
+    /// contribution is `c`.
+    ///
+    /// # Errors
+    /// [`EffectValuesError::Count`] when `c` does not take one value per parameter.
+    pub fn new(c: impl Contribution, params: Vec<FitParam>) -> Result<Self, EffectValuesError> {
+        let init: Vec<f64> = params.iter().map(|p| p.init).collect();
+        c.values(&init)?;
+        Ok(FitSetup {
+            params,
             alt_init: Vec::new(),
             contribution: Arc::new(c),
-        }
+        })
     }
 
-    /// The set-up with parameter `p` appended.
-    pub fn param(mut self, p: FitParam) -> Self {
-        self.params.push(p);
-        self
+    /// The set-up with other starting values the fit also tries, each a whole set of
+    /// values. For a cost with separate valleys: an amplitude and a phase, started half a
+    /// turn off, descend to the amplitude's zero bound, where the phase's gradient
+    /// vanishes and the fit stays. The start that ends at the lowest cost wins
+    /// (`crate::analysis::fit::fit`).
+    ///
+    /// # Errors
+    /// [`EffectValuesError::Count`] when a start does not hold one value per parameter.
+    pub fn with_alt_init(mut self, starts: Vec<Vec<f64>>) -> Result<Self, EffectValuesError> {
+        for s in &starts {
+            self.contribution.check(s)?;
+        }
+        self.alt_init = starts;
+        Ok(self)
+    }
+
+    /// The other starting values ([`FitSetup::with_alt_init`]; empty: the parameters'
+    /// `init` only).
+    pub fn alt_init(&self) -> &[Vec<f64>] {
+        &self.alt_init
     }
 
     /// Number of parameters.
@@ -205,18 +355,29 @@ impl FitSetup {
     }
 
     /// The effect's contribution to the model for the values `p` ([`Contribution`]).
+    ///
+    /// # Errors
+    /// [`EffectValuesError::Count`] when `p` does not hold one value per parameter.
     pub fn contribute(
         &self,
         p: &[f64],
         d: &Prepared,
         n: &MachineConstants,
         terms: &mut ModelTerms,
-    ) {
-        self.contribution.contribute(p, d, n, terms);
+    ) -> Result<(), EffectValuesError> {
+        self.contribution.contribute(p, d, n, terms)
     }
 
     /// The values `p` in words ([`Contribution::describe`]).
-    pub fn describe(&self, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
+    ///
+    /// # Errors
+    /// [`EffectValuesError::Count`] when `p` does not hold one value per parameter.
+    pub fn describe(
+        &self,
+        p: &[f64],
+        d: &Prepared,
+        n: &MachineConstants,
+    ) -> Result<String, EffectValuesError> {
         self.contribution.describe(p, d, n)
     }
 }

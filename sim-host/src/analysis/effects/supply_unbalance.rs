@@ -2,8 +2,8 @@
 
 use super::impedance::{z2_neg, z2_neg_at};
 use super::{
-    plausible, supply_unbalanced, sync_speed_mech, About, Confusion, Contribution, EffectEvidence,
-    EffectModel, FitParam, FitSetup, ParamSpec, SetupError,
+    declared_values, plausible, supply_unbalanced, sync_speed_mech, About, Confusion, Contribution,
+    EffectEvidence, EffectModel, EffectParam, EffectValuesError, FitSetup, SetupError,
 };
 use crate::analysis::prep::{Prepared, C64};
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms};
@@ -13,25 +13,49 @@ use monitor_core::EffectKind;
 #[derive(Debug, Clone, Copy)]
 pub struct SupplyUnbalance;
 
+/// Supply unbalance's parameters.
+const PARAMS: [EffectParam; 2] = [
+    EffectParam {
+        name: "y_re",
+        unit: "1",
+        doc: "real part of the negative-sequence admittance relative to nominal 1/Z2",
+        range: plausible::Y2_RE,
+        per: None,
+        basis: plausible::Y2_BASIS,
+    },
+    EffectParam {
+        name: "y_im",
+        unit: "1",
+        doc: "imaginary part of the negative-sequence admittance relative to nominal 1/Z2",
+        range: plausible::Y2_IM,
+        per: None,
+        basis: plausible::Y2_BASIS,
+    },
+];
+
+/// Supply unbalance's fitted values ([`PARAMS`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SupplyUnbalanceValues {
+    /// The negative-sequence admittance relative to nominal 1/Z2, real part [1].
+    pub y_re: f64,
+    /// Its imaginary part [1].
+    pub y_im: f64,
+}
+
+impl TryFrom<&[f64]> for SupplyUnbalanceValues {
+    type Error = EffectValuesError;
+    fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
+        let [y_re, y_im] = declared_values(EffectKind::SupplyUnbalance, &PARAMS, v)?;
+        Ok(SupplyUnbalanceValues { y_re, y_im })
+    }
+}
+
 /// What `SupplyUnbalance` is ([`About`]).
 const ABOUT: About = About {
     kind: EffectKind::SupplyUnbalance,
     description: "The supply voltages are not balanced: a negative-sequence voltage drives a negative-sequence current through the machine's small negative-sequence impedance (2f ripple in the d-q frame).",
     equations: "i_abc = balanced model current + i_neg, i_neg = (y_re + j y_im) v_neg / conj(Z2(omega_s)), Z2 = Rs + j w Lls + (j w Lm)||(Rr/s2 + j w Llr) at the negative-sequence slip s2 = 1 + omega_r/omega_s (2 without a speed column); the balanced model is driven by the positive-sequence V_qs. Full-order model (all dynamics effects in): the machine is driven by V_pos + (y_re + j y_im) V_neg, and its own equations give the negative-sequence current (through a start, and with the 2f torque and speed ripple).",
-    parameters: &[
-        ParamSpec {
-            name: "y_re",
-            unit: "1",
-            description:
-                "real part of the negative-sequence admittance relative to nominal 1/Z2",
-        },
-        ParamSpec {
-            name: "y_im",
-            unit: "1",
-            description:
-                "imaginary part of the negative-sequence admittance relative to nominal 1/Z2",
-        },
-    ],
+    parameters: &PARAMS,
 };
 
 impl EffectModel for SupplyUnbalance {
@@ -49,24 +73,30 @@ impl EffectModel for SupplyUnbalance {
         Some(supply_unbalanced(e))
     }
     fn setup(&self, _d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, SetupError> {
-        Ok(FitSetup::new(*self)
-            .param(
-                FitParam::new("y_re", "1", 0.5, (-5.0, 5.0), 0.2)
-                    .physical(plausible::Y2_RE, plausible::Y2_BASIS),
-            )
-            .param(
-                FitParam::new("y_im", "1", 0.0, (-5.0, 5.0), 0.2)
-                    .physical(plausible::Y2_IM, plausible::Y2_BASIS),
-            ))
+        let [y_re, y_im] = &PARAMS;
+        let params = vec![
+            y_re.fit(0.5, (-5.0, 5.0), 0.2, 1.0),
+            y_im.fit(0.0, (-5.0, 5.0), 0.2, 1.0),
+        ];
+        Ok(FitSetup::new(*self, params)?)
     }
 }
 
 impl Contribution for SupplyUnbalance {
+    type Values = SupplyUnbalanceValues;
+    fn values(&self, v: &[f64]) -> Result<SupplyUnbalanceValues, EffectValuesError> {
+        SupplyUnbalanceValues::try_from(v)
+    }
     /// The reduced model's negative-sequence current `y v_neg / conj(Z2)` per sample, and
     /// the full-order model's drive `y v_neg` of the machine.
-    fn contribute(&self, p: &[f64], d: &Prepared, n: &MachineConstants, t: &mut ModelTerms) {
-        let &[y_re, y_im] = p else { return };
-        let y = C64::new(y_re, y_im);
+    fn contribute(
+        &self,
+        p: &SupplyUnbalanceValues,
+        d: &Prepared,
+        n: &MachineConstants,
+        t: &mut ModelTerms,
+    ) {
+        let y = C64::new(p.y_re, p.y_im);
         t.add_negative_sequence_current((0..d.len()).map(|k| {
             // The measured speed gives the negative-sequence slip; without it the rotor
             // is taken as near synchronous speed (slip 2).
@@ -79,10 +109,8 @@ impl Contribution for SupplyUnbalance {
         }));
         t.negative_sequence.voltage_gain = Some(y);
     }
-    fn describe(&self, p: &[f64], d: &Prepared, n: &MachineConstants) -> String {
-        let &[y_re, y_im] = p else {
-            return String::new();
-        };
+    fn describe(&self, p: &SupplyUnbalanceValues, d: &Prepared, n: &MachineConstants) -> String {
+        let (y_re, y_im) = (p.y_re, p.y_im);
         let (mut vn, mut vp) = (0.0, 0.0);
         for k in 0..d.len() {
             vn += d.v_neg[k].norm_sqr();

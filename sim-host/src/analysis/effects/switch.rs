@@ -1,7 +1,9 @@
 //! A small generic effect for the rungs of the dynamics ladder that add no parameter: each
 //! only switches one state of the full-order machine on ([`StateSwitch`]).
 
-use super::{About, Contribution, EffectModel, FitSetup, SetupError};
+use super::{
+    declared_values, About, Contribution, EffectModel, EffectValuesError, FitSetup, SetupError,
+};
 use crate::analysis::prep::Prepared;
 use crate::analysis::simplified_model::{Dynamics, MachineConstants, ModelTerms};
 use monitor_core::EffectKind;
@@ -33,15 +35,21 @@ impl EffectModel for StateSwitch {
         Some(n.la_h / n.ra_ohm)
     }
     fn setup(&self, _d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, SetupError> {
-        Ok(FitSetup::new(*self))
+        Ok(FitSetup::new(*self, Vec::new())?)
     }
 }
 
 impl Contribution for StateSwitch {
-    fn contribute(&self, _p: &[f64], _d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
+    /// No values.
+    type Values = ();
+    fn values(&self, v: &[f64]) -> Result<(), EffectValuesError> {
+        let [] = declared_values(self.about.kind, &[], v)?;
+        Ok(())
+    }
+    fn contribute(&self, _p: &(), _d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
         (self.switch_on)(&mut t.dynamics);
     }
-    fn describe(&self, _p: &[f64], _d: &Prepared, n: &MachineConstants) -> String {
+    fn describe(&self, _p: &(), _d: &Prepared, n: &MachineConstants) -> String {
         (self.summary)(n)
     }
 }

@@ -1,8 +1,8 @@
 //! `thermal_drift`: winding temperature rise.
 
 use super::{
-    duration, plausible, About, Contribution, EffectModel, FitParam, FitSetup, ParamSpec,
-    SetupError,
+    declared_values, duration, plausible, About, Contribution, EffectModel, EffectParam,
+    EffectValuesError, FitSetup, SetupError,
 };
 use crate::analysis::prep::Prepared;
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms};
@@ -15,23 +15,49 @@ pub const ALPHA_CU_PER_K: f64 = 0.00393;
 #[derive(Debug, Clone, Copy)]
 pub struct ThermalDrift;
 
+/// Thermal drift's parameters.
+const PARAMS: [EffectParam; 2] = [
+    EffectParam {
+        name: "rise_k",
+        unit: "K",
+        doc: "final winding temperature rise",
+        range: plausible::RISE_K,
+        per: None,
+        basis: plausible::RISE_K_BASIS,
+    },
+    EffectParam {
+        name: "tau_s",
+        unit: "s",
+        doc: "thermal time constant",
+        range: plausible::TAU_S,
+        per: None,
+        basis: plausible::TAU_S_BASIS,
+    },
+];
+
+/// Thermal drift's fitted values ([`PARAMS`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ThermalDriftValues {
+    /// The final temperature rise [K] (negative: cooling).
+    pub rise_k: f64,
+    /// The thermal time constant [s].
+    pub tau_s: f64,
+}
+
+impl TryFrom<&[f64]> for ThermalDriftValues {
+    type Error = EffectValuesError;
+    fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
+        let [rise_k, tau_s] = declared_values(EffectKind::ThermalDrift, &PARAMS, v)?;
+        Ok(ThermalDriftValues { rise_k, tau_s })
+    }
+}
+
 /// What `ThermalDrift` is ([`About`]).
 const ABOUT: About = About {
     kind: EffectKind::ThermalDrift,
     description: "The windings heat up with load, so the stator and rotor resistances rise (copper: +0.393 %/K; 20 -> 90 C is +27 %).",
     equations: "Rs(t), Rr(t) = R (1 + 0.00393 dT(t)), dT(t) = rise_k (1 - exp(-(t - t0)/tau_s)); Ra = Rs + (Ls/Lr) Rr in eq. (28) follows; in the full-order model the rotor time constant Lr/Rr follows too.",
-    parameters: &[
-        ParamSpec {
-            name: "rise_k",
-            unit: "K",
-            description: "final winding temperature rise",
-        },
-        ParamSpec {
-            name: "tau_s",
-            unit: "s",
-            description: "thermal time constant",
-        },
-    ],
+    parameters: &PARAMS,
 };
 
 impl EffectModel for ThermalDrift {
@@ -40,22 +66,29 @@ impl EffectModel for ThermalDrift {
     }
     fn setup(&self, d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let t = duration(d);
-        Ok(FitSetup::new(*self)
-            .param(
-                FitParam::new("rise_k", "K", 10.0, (-100.0, 400.0), 20.0)
-                    .physical(plausible::RISE_K, plausible::RISE_K_BASIS),
-            )
-            .param(
-                FitParam::new("tau_s", "s", t / 3.0, (t / 200.0, 20.0 * t), t / 3.0)
-                    .physical(plausible::TAU_S, plausible::TAU_S_BASIS),
-            ))
+        let [rise_k, tau_s] = &PARAMS;
+        let params = vec![
+            rise_k.fit(10.0, (-100.0, 400.0), 20.0, 1.0),
+            tau_s.fit(t / 3.0, (t / 200.0, 20.0 * t), t / 3.0, 1.0),
+        ];
+        Ok(FitSetup::new(*self, params)?)
     }
 }
 
 impl Contribution for ThermalDrift {
+    type Values = ThermalDriftValues;
+    fn values(&self, v: &[f64]) -> Result<ThermalDriftValues, EffectValuesError> {
+        ThermalDriftValues::try_from(v)
+    }
     /// The resistance scale 1 + alpha dT(t) per sample (Rs and Rr alike).
-    fn contribute(&self, p: &[f64], d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
-        let &[rise_k, tau_s] = p else { return };
+    fn contribute(
+        &self,
+        p: &ThermalDriftValues,
+        d: &Prepared,
+        _n: &MachineConstants,
+        t: &mut ModelTerms,
+    ) {
+        let ThermalDriftValues { rise_k, tau_s } = *p;
         let t0 = d.t_s.first().copied().unwrap_or(0.0);
         let tau = tau_s.max(1e-6);
         t.scale_resistances(
@@ -64,10 +97,8 @@ impl Contribution for ThermalDrift {
                 .map(|t| 1.0 + ALPHA_CU_PER_K * rise_k * (1.0 - (-(t - t0) / tau).exp())),
         );
     }
-    fn describe(&self, p: &[f64], d: &Prepared, _n: &MachineConstants) -> String {
-        let &[rise_k, tau_s] = p else {
-            return String::new();
-        };
+    fn describe(&self, p: &ThermalDriftValues, d: &Prepared, _n: &MachineConstants) -> String {
+        let ThermalDriftValues { rise_k, tau_s } = *p;
         let t = duration(d);
         let dt_end = rise_k * (1.0 - (-t / tau_s.max(1e-6)).exp());
         format!(

@@ -1,8 +1,8 @@
 //! `windage`: fan and air drag.
 
 use super::{
-    plausible, sync_speed_mech, About, Contribution, EffectModel, FitParam, FitSetup, ParamSpec,
-    SetupError,
+    declared_values, plausible, sync_speed_mech, About, Contribution, EffectModel, EffectParam,
+    EffectValuesError, FitSetup, SetupError,
 };
 use crate::analysis::prep::Prepared;
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms, SpeedTorque};
@@ -11,6 +11,31 @@ use monitor_core::EffectKind;
 /// Fan / windage torque.
 #[derive(Debug, Clone, Copy)]
 pub struct Windage;
+
+/// Windage's parameters.
+const PARAMS: [EffectParam; 1] = [EffectParam {
+    name: "k_nms2",
+    unit: "N m s^2/rad^2",
+    doc: "windage coefficient k",
+    range: plausible::WINDAGE_RATIO,
+    per: Some("the rated torque estimate over the square of the log's highest synchronous speed"),
+    basis: plausible::WINDAGE_BASIS,
+}];
+
+/// Windage's fitted values ([`PARAMS`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WindageValues {
+    /// The drag coefficient k [N m s^2/rad^2].
+    pub k_nms2: f64,
+}
+
+impl TryFrom<&[f64]> for WindageValues {
+    type Error = EffectValuesError;
+    fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
+        let [k_nms2] = declared_values(EffectKind::Windage, &PARAMS, v)?;
+        Ok(WindageValues { k_nms2 })
+    }
+}
 
 /// Windage set up on a log: the log's highest synchronous speed.
 struct OnLog {
@@ -36,11 +61,7 @@ const ABOUT: About = About {
     kind: EffectKind::Windage,
     description: "Fan and air drag: a load torque growing with the square of speed.",
     equations: "J dw_m/dt = Kf I_qs - (B + Bl) w_m - k w_m |w_m|  (eq. 29 plus a quadratic drag).",
-    parameters: &[ParamSpec {
-        name: "k_nms2",
-        unit: "N m s^2/rad^2",
-        description: "windage coefficient k",
-    }],
+    parameters: &PARAMS,
 };
 
 impl EffectModel for Windage {
@@ -50,35 +71,34 @@ impl EffectModel for Windage {
     fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let w = sync_speed_mech(d, n);
         let k = n.torque_scale_nm / (w * w);
-        let r = plausible::WINDAGE_RATIO;
-        Ok(FitSetup::new(OnLog {
-            sync_speed_rad_s: w,
-        })
-        .param(
-            FitParam::new(
-                "k_nms2",
-                "N m s^2/rad^2",
-                0.01 * k,
-                (-0.1 * k, 2.0 * k),
-                0.05 * k,
-            )
-            .physical_scaled(r, k, plausible::WINDAGE_BASIS),
-        ))
+        let [k_nms2] = &PARAMS;
+        let params = vec![k_nms2.fit(0.01 * k, (-0.1 * k, 2.0 * k), 0.05 * k, k)];
+        Ok(FitSetup::new(
+            OnLog {
+                sync_speed_rad_s: w,
+            },
+            params,
+        )?)
     }
 }
 
 impl Contribution for OnLog {
-    /// The drag torque on the shaft.
-    fn contribute(&self, p: &[f64], _d: &Prepared, _n: &MachineConstants, t: &mut ModelTerms) {
-        if let &[k_nms2] = p {
-            t.add_speed_torque(Drag { k_nms2 });
-        }
+    type Values = WindageValues;
+    fn values(&self, v: &[f64]) -> Result<WindageValues, EffectValuesError> {
+        WindageValues::try_from(v)
     }
-    fn describe(&self, p: &[f64], _d: &Prepared, n: &MachineConstants) -> String {
-        let &[k] = p else {
-            return String::new();
-        };
-        let w = self.sync_speed_rad_s;
+    /// The drag torque on the shaft.
+    fn contribute(
+        &self,
+        p: &WindageValues,
+        _d: &Prepared,
+        _n: &MachineConstants,
+        t: &mut ModelTerms,
+    ) {
+        t.add_speed_torque(Drag { k_nms2: p.k_nms2 });
+    }
+    fn describe(&self, p: &WindageValues, _d: &Prepared, n: &MachineConstants) -> String {
+        let (k, w) = (p.k_nms2, self.sync_speed_rad_s);
         format!(
             "speed-squared drag k = {:.3e} N m s^2/rad^2: {:.2} N m at synchronous speed ({:.1} % of the rated torque estimate)",
             k,

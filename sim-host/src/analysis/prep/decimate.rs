@@ -333,22 +333,6 @@ fn regrid(d: &mut Decimated, first: f64, tw: f64) -> f64 {
         *d = src;
         return 0.0;
     }
-    let reference = if src.v_ab.len() == n_src {
-        &src.v_ab
-    } else {
-        &src.i_ab
-    };
-    let c = |x: [f32; 2]| C64::new(f64::from(x[0]), f64::from(x[1]));
-    let omega_at = |j: usize| {
-        let (p, q) = if j >= 1 { (j - 1, j) } else { (0, 1) };
-        let (a, b) = (c(reference[p]), c(reference[q]));
-        let dt = src.t_s[q] - src.t_s[p];
-        if a.norm() * b.norm() > 0.0 && dt > 0.0 {
-            (b * a.conj()).arg() / dt
-        } else {
-            0.0
-        }
-    };
     let last = src.t_s[n_src - 1];
     let mut out = Decimated {
         channels: src.channels,
@@ -370,36 +354,69 @@ fn regrid(d: &mut Decimated, first: f64, tw: f64) -> f64 {
         while j + 2 < n_src && src.t_s[j + 1] <= g {
             j += 1;
         }
-        let b = j + 1;
-        let (ta, tb) = (src.t_s[j], src.t_s[b]);
-        let w = if tb > ta {
-            ((g - ta) / (tb - ta)).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
+        let (ta, tb) = (src.t_s[j], src.t_s[j + 1]);
         if (g - ta).abs() > 0.5 * tw && (tb - g).abs() > 0.5 * tw {
             bridged += tw;
         }
-        let omega = omega_at(j);
-        let turn = |x: &[[f32; 2]]| {
-            let pa = c(x[j]) * C64::from_polar(1.0, omega * (g - ta));
-            let pb = c(x[b]) * C64::from_polar(1.0, omega * (g - tb));
-            let v = pa * (1.0 - w) + pb * w;
-            [v.re as f32, v.im as f32]
-        };
-        let lin = |x: &[f32]| (f64::from(x[j]) * (1.0 - w) + f64::from(x[b]) * w) as f32;
-        out.t_s.push(g);
-        out.i_ab.push(turn(&src.i_ab));
-        out.i0.push(lin(&src.i0));
-        if src.v_ab.len() == n_src {
-            out.v_ab.push(turn(&src.v_ab));
-        }
-        if src.wm.len() == n_src {
-            out.wm.push(lin(&src.wm));
-        }
+        push_between(&mut out, &src, j, g);
     }
     *d = out;
     bridged
+}
+
+/// A stored vector sample as a complex number.
+fn c64(x: [f32; 2]) -> C64 {
+    C64::new(f64::from(x[0]), f64::from(x[1]))
+}
+
+/// The rotation rate [rad/s] of `src`'s reference vector (the voltage, the current for a
+/// current-only log) at sample `j`: its phase step between the samples `j - 1` and `j`
+/// (0 and 1 at the start); 0 where a sample is zero.
+fn rotation_at(src: &Decimated, j: usize) -> f64 {
+    let reference = if src.v_ab.len() == src.t_s.len() {
+        &src.v_ab
+    } else {
+        &src.i_ab
+    };
+    let (p, q) = if j >= 1 { (j - 1, j) } else { (0, 1) };
+    let (a, b) = (c64(reference[p]), c64(reference[q]));
+    let dt = src.t_s[q] - src.t_s[p];
+    if a.norm() * b.norm() > 0.0 && dt > 0.0 {
+        (b * a.conj()).arg() / dt
+    } else {
+        0.0
+    }
+}
+
+/// Appends to `out` the grid point at time `g` between `src`'s samples `j` and `j + 1`:
+/// the vectors turned to `g` along the local rotation from each side and weighted
+/// linearly, the scalars interpolated linearly ([`regrid`]).
+fn push_between(out: &mut Decimated, src: &Decimated, j: usize, g: f64) {
+    let n_src = src.t_s.len();
+    let b = j + 1;
+    let (ta, tb) = (src.t_s[j], src.t_s[b]);
+    let w = if tb > ta {
+        ((g - ta) / (tb - ta)).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let omega = rotation_at(src, j);
+    let turn = |x: &[[f32; 2]]| {
+        let pa = c64(x[j]) * C64::from_polar(1.0, omega * (g - ta));
+        let pb = c64(x[b]) * C64::from_polar(1.0, omega * (g - tb));
+        let v = pa * (1.0 - w) + pb * w;
+        [v.re as f32, v.im as f32]
+    };
+    let lin = |x: &[f32]| (f64::from(x[j]) * (1.0 - w) + f64::from(x[b]) * w) as f32;
+    out.t_s.push(g);
+    out.i_ab.push(turn(&src.i_ab));
+    out.i0.push(lin(&src.i0));
+    if src.v_ab.len() == n_src {
+        out.v_ab.push(turn(&src.v_ab));
+    }
+    if src.wm.len() == n_src {
+        out.wm.push(lin(&src.wm));
+    }
 }
 
 /// Block average of the rows of one block of the sample grid: time, current vector and

@@ -57,9 +57,28 @@ impl FullMachine {
         wk: f64,
         np: f64,
     ) -> (FullState, FullState) {
+        let x = self.algebraic(sw, x, v.1, id_in, if_in, wk, np);
+        let dx = self.derivative(sw, &x, v, wk, np * x.wm);
+        (x, dx)
+    }
+
+    /// The state `x` with its parts that are algebraic under the switches `sw` put in: the
+    /// measured I_ds, the flux of the current, a quasi-static q flux, the quasi-static
+    /// I_qs of the q voltage `vq`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn algebraic(
+        &self,
+        sw: Switches,
+        x: &FullState,
+        vq: f64,
+        id_in: f64,
+        if_in: f64,
+        wk: f64,
+        np: f64,
+    ) -> FullState {
         let mut x = *x;
         let wr = np * x.wm;
-        let r = self.rs + self.rr;
         if !sw.id {
             x.id = id_in;
         }
@@ -74,8 +93,25 @@ impl FullMachine {
             x.pq = (self.rr * x.iq - (wk - wr) * x.pd) / self.a.max(1e-9);
         }
         if !sw.iq {
-            x.iq = (v.1 - wk * self.l_sigma * x.id + self.a * x.pq - wr * x.pd) / r;
+            x.iq =
+                (vq - wk * self.l_sigma * x.id + self.a * x.pq - wr * x.pd) / (self.rs + self.rr);
         }
+        x
+    }
+
+    /// The derivative of the dynamic states of `x` under the switches `sw` (the others'
+    /// 0; the speed's is the caller's), `v` = (V_ds, V_qs), `wk` the frame speed and `wr`
+    /// the electrical rotor speed [rad/s].
+    #[inline(always)]
+    fn derivative(
+        &self,
+        sw: Switches,
+        x: &FullState,
+        v: (f64, f64),
+        wk: f64,
+        wr: f64,
+    ) -> FullState {
+        let r = self.rs + self.rr;
         let inv_ls = 1.0 / self.l_sigma.max(1e-9);
         let did = if sw.id {
             (v.0 - r * x.id + wk * self.l_sigma * x.iq + self.a * x.pd + wr * x.pq) * inv_ls
@@ -100,16 +136,13 @@ impl FullMachine {
         } else {
             (0.0, 0.0)
         };
-        (
-            x,
-            FullState {
-                id: did,
-                iq: diq,
-                pd: dpd,
-                pq: dpq,
-                wm: 0.0,
-            },
-        )
+        FullState {
+            id: did,
+            iq: diq,
+            pd: dpd,
+            pq: dpq,
+            wm: 0.0,
+        }
     }
 }
 

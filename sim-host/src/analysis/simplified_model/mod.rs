@@ -146,6 +146,60 @@ impl BaseParams {
     }
 }
 
+/// One of the four base parameters the data identify (the JSON keys of `compare`'s
+/// `base_parameters`, `identifiability.base` and `explain`'s `base_refit`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum BaseParameter {
+    /// Ra = Rs + (Ls/Lr) Rr [ohm].
+    #[serde(rename = "ra_ohm")]
+    Ra,
+    /// Ls, the Psi = Ls i_f coefficient [H].
+    #[serde(rename = "ls_h")]
+    Ls,
+    /// B + Bl, the shaft's viscous coefficient [N m s/rad].
+    #[serde(rename = "b_plus_bl_nms")]
+    BPlusBl,
+    /// J, the inertia [kg m^2].
+    #[serde(rename = "j_kgm2")]
+    J,
+}
+
+impl BaseParameter {
+    /// The four, in the order of the fit's parameter vector ([`BaseParams`]' fields).
+    pub const ALL: [BaseParameter; 4] = [
+        BaseParameter::Ra,
+        BaseParameter::Ls,
+        BaseParameter::BPlusBl,
+        BaseParameter::J,
+    ];
+
+    /// The JSON key (`ra_ohm`, `ls_h`, `b_plus_bl_nms`, `j_kgm2`).
+    pub fn key(self) -> &'static str {
+        match self {
+            BaseParameter::Ra => "ra_ohm",
+            BaseParameter::Ls => "ls_h",
+            BaseParameter::BPlusBl => "b_plus_bl_nms",
+            BaseParameter::J => "j_kgm2",
+        }
+    }
+
+    /// The unit.
+    pub fn unit(self) -> &'static str {
+        match self {
+            BaseParameter::Ra => "ohm",
+            BaseParameter::Ls => "H",
+            BaseParameter::BPlusBl => "N m s/rad",
+            BaseParameter::J => "kg m^2",
+        }
+    }
+}
+
+impl std::fmt::Display for BaseParameter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.key())
+    }
+}
+
 /// The shaft's constants of a run: J [kg m^2] and B + Bl [N m s/rad] of the base
 /// parameters, held physical (J at least 1e-9, B + Bl at least 0).
 #[derive(Debug, Clone, Copy)]

@@ -309,7 +309,7 @@ fn phase_step(a: C64, b: C64) -> f64 {
 /// sensors, true parameters (2.2 kW, 11 kW; 2, 5, 10 kHz): `normalized_rms_error`
 /// 0.0003-0.0007 (on the simulator's own rows at the log rate, point samples: below 1e-5).
 pub(super) fn simulate_stationary(run: Run<'_>, rot_at: impl Fn(usize) -> C64) -> Prediction {
-    let Run { d, n, t, .. } = run;
+    let Run { d, t, .. } = run;
     // With a magnetising law the machine saturates with its own flux ([`SatMachine`]), not
     // with the reduced model's scale from the measured i_f.
     let Some(full) = FullRun::new(run, t.magnetising.law.is_some()) else {
@@ -332,29 +332,7 @@ pub(super) fn simulate_stationary(run: Run<'_>, rot_at: impl Fn(usize) -> C64) -
     let mut cage = CageAngle::new(d, t);
     let lm_guess = std::cell::Cell::new(0.0);
     for k in 0..len {
-        let sm = StatMachine {
-            m: full.machine(k),
-            np: n.np,
-            mech: full.mech,
-            shaft: &t.shaft,
-            k,
-            wind: t.stator_winding,
-            cage: cage.at(d, k),
-            sat: None,
-        };
-        let sm = match t.magnetising.law {
-            Some(law) => {
-                let sat = SatMachine::new(n, &sm.m, law, &lm_guess);
-                if k == 0 {
-                    x = sat.linear_to_fluxes(&sm.m, &x);
-                }
-                StatMachine {
-                    sat: Some(sat),
-                    ..sm
-                }
-            }
-            None => sm,
-        };
+        let sm = form.machine_at(k, cage.at(d, k), &lm_guess, &mut x);
         form.output(&sm, &x, k, rot_at(k), &mut out);
         if k + 1 == len {
             break;
@@ -375,6 +353,48 @@ pub(super) fn simulate_stationary(run: Run<'_>, rot_at: impl Fn(usize) -> C64) -
 struct StatForm<'a> {
     full: &'a FullRun<'a>,
     volt: StatVoltage,
+}
+
+impl<'a> StatForm<'a> {
+    /// The machine at sample `k` with its unequal cage there `cage`. With the terms'
+    /// magnetising law it saturates with its own flux ([`SatMachine`], `lm_guess` its last
+    /// solve), and at the first sample the state `x`'s linear fluxes become the saturated
+    /// machine's.
+    fn machine_at<'g>(
+        &self,
+        k: usize,
+        cage: Option<CageOverSample>,
+        lm_guess: &'g std::cell::Cell<f64>,
+        x: &mut StatState,
+    ) -> StatMachine<'g>
+    where
+        'a: 'g,
+    {
+        let Run { n, t, .. } = self.full.run;
+        let sm = StatMachine {
+            m: self.full.machine(k),
+            np: n.np,
+            mech: self.full.mech,
+            shaft: &t.shaft,
+            k,
+            wind: t.stator_winding,
+            cage,
+            sat: None,
+        };
+        match t.magnetising.law {
+            Some(law) => {
+                let sat = SatMachine::new(n, &sm.m, law, lm_guess);
+                if k == 0 {
+                    *x = sat.linear_to_fluxes(&sm.m, x);
+                }
+                StatMachine {
+                    sat: Some(sat),
+                    ..sm
+                }
+            }
+            None => sm,
+        }
+    }
 }
 
 impl StatForm<'_> {
@@ -502,16 +522,7 @@ impl StatVoltage {
             .map(|k| C64::new(d.vd[k], d.vq[k]) * rot_at(k))
             .collect();
         if let Some(nz) = noise {
-            use rand::SeedableRng;
-            use rand_distr::{Distribution, StandardNormal};
-            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(nz.seed);
-            for v in &mut v_mean {
-                let (a, b): (f64, f64) = (
-                    StandardNormal.sample(&mut rng),
-                    StandardNormal.sample(&mut rng),
-                );
-                *v += C64::new(a, b) * nz.sigma_v;
-            }
+            add_white_noise(&mut v_mean, nz);
         }
         // The voltage's phase step over each working sample [rad].
         let ph: Vec<f64> = (0..len)
@@ -521,21 +532,7 @@ impl StatVoltage {
             })
             .collect();
         let gains: Vec<f64> = ph.iter().map(|&p| block_gain(p / dt, h, factor)).collect();
-        // The voltage before the block mean.
-        let v_at = |k: usize| v_mean[k] / gains[k];
-        // How far the voltage leaves its rotation over each working sample (relative); a
-        // supply step is an outlier of it: above SUPPLY_STEP_REL and ten times the median
-        // (harmonics in a real supply move the vector off its circle every sample).
-        let dev: Vec<f64> = (0..len)
-            .map(|k| {
-                if k == 0 || k + 1 >= len {
-                    return 0.0;
-                }
-                let (v0, v1) = (v_at(k), v_at(k + 1));
-                (v1 - v0 * C64::from_polar(1.0, ph[k - 1])).norm()
-                    / v0.norm().max(v1.norm()).max(1e-12)
-            })
-            .collect();
+        let dev = off_rotation(&v_mean, &gains, &ph);
         let step_thr = prep::SUPPLY_STEP_REL.max(10.0 * median(&dev));
         StatVoltage {
             v_mean,
@@ -545,6 +542,39 @@ impl StatVoltage {
             step_thr,
         }
     }
+}
+
+/// Adds `nz`'s white noise (seeded, standard deviation `sigma_v`) to each component of
+/// every voltage sample of `v`.
+fn add_white_noise(v: &mut [C64], nz: InputNoise) {
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, StandardNormal};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(nz.seed);
+    for v in v {
+        let (a, b): (f64, f64) = (
+            StandardNormal.sample(&mut rng),
+            StandardNormal.sample(&mut rng),
+        );
+        *v += C64::new(a, b) * nz.sigma_v;
+    }
+}
+
+/// How far the voltage before the block mean (`v_mean / gains`) leaves its rotation (the
+/// phase steps `ph`) over each working sample, relative to its magnitude (0 at the ends);
+/// a supply step is an outlier of it: above [`prep::SUPPLY_STEP_REL`] and ten times the
+/// median (harmonics in a real supply move the vector off its circle every sample).
+fn off_rotation(v_mean: &[C64], gains: &[f64], ph: &[f64]) -> Vec<f64> {
+    let len = v_mean.len();
+    let v_at = |k: usize| v_mean[k] / gains[k];
+    (0..len)
+        .map(|k| {
+            if k == 0 || k + 1 >= len {
+                return 0.0;
+            }
+            let (v0, v1) = (v_at(k), v_at(k + 1));
+            (v1 - v0 * C64::from_polar(1.0, ph[k - 1])).norm() / v0.norm().max(v1.norm()).max(1e-12)
+        })
+        .collect()
 }
 
 /// The angle 2 theta_a + phi of the faulty rotor phase for [`CageOverSample`] (`None`

@@ -216,13 +216,42 @@ fn zoom(d: &Prepared, worst: &[WorstWindow]) -> (usize, usize) {
 /// error spectrum.
 pub fn compare_charts(d: &Prepared, out: &CompareOutput) -> Vec<Chart<'static>> {
     let p = &out.prediction;
-    let mut v = Vec::new();
     if p.iq.is_empty() {
-        return v;
+        return Vec::new();
     }
+    let eiq: Vec<f64> = p.iq.iter().zip(&d.iq).map(|(a, b)| a - b).collect();
+    let mut v = overlays(d, p, &eiq, &out.report.worst_windows);
+    v.extend(errors_over_time(d, p, &eiq));
+    v.extend(condition_charts(d, &out.all_windows));
+    v.push(Chart {
+        stem: "error_spectrum",
+        title: "Spectrum of the q-axis current's error",
+        x_label: "frequency [Hz]",
+        y_label: "amplitude [A]",
+        series: vec![Series {
+            label: "I_qs error".into(),
+            points: plot::thin(&metrics::spectrum(&eiq, d.dt_s), MAX_POINTS),
+            color: 4,
+            scatter: false,
+            dashed: false,
+        }],
+        log_y: true,
+        omitted: None,
+    });
+    v
+}
+
+/// The measured and predicted I_qs and speed over the log, I_qs zoomed where its error
+/// `eiq` is worst, and the phase current around the worst window of `worst`.
+fn overlays(
+    d: &Prepared,
+    p: &Prediction,
+    eiq: &[f64],
+    worst: &[WorstWindow],
+) -> Vec<Chart<'static>> {
     let t = &d.t_s;
     let per = period_samples(d);
-    v.push(over_time(
+    let mut v = vec![over_time(
         "overlay_iqs",
         "q-axis current I_qs: measured vs model",
         "I_qs [A]",
@@ -230,7 +259,7 @@ pub fn compare_charts(d: &Prepared, out: &CompareOutput) -> Vec<Chart<'static>> 
             trace("measured", t, &d.iq, per, 0),
             trace("model", t, &p.iq, per, 1),
         ],
-    ));
+    )];
     if d.channels.speed {
         v.push(over_time(
             "overlay_omega_r",
@@ -242,10 +271,9 @@ pub fn compare_charts(d: &Prepared, out: &CompareOutput) -> Vec<Chart<'static>> 
             ],
         ));
     }
-    let eiq: Vec<f64> = p.iq.iter().zip(&d.iq).map(|(a, b)| a - b).collect();
     v.extend(zooms(
         t,
-        &worst_spans(&eiq, per),
+        &worst_spans(eiq, per),
         ["zoom_iqs_1", "zoom_iqs_2"],
         [
             "q-axis current, a few supply periods where the model is worst: measured vs model",
@@ -253,7 +281,7 @@ pub fn compare_charts(d: &Prepared, out: &CompareOutput) -> Vec<Chart<'static>> 
         ],
         &[("measured", &d.iq, 0, false), ("model", &p.iq, 1, false)],
     ));
-    let (a, b) = zoom(d, &out.report.worst_windows);
+    let (a, b) = zoom(d, worst);
     v.push(over_time(
         "overlay_ia",
         "Phase current i_a around the worst window: measured vs model",
@@ -273,12 +301,19 @@ pub fn compare_charts(d: &Prepared, out: &CompareOutput) -> Vec<Chart<'static>> 
             ),
         ],
     ));
-    v.push(over_time(
+    v
+}
+
+/// The model's errors over time: I_qs (`eiq`) and, with a speed column, the speed.
+fn errors_over_time(d: &Prepared, p: &Prediction, eiq: &[f64]) -> Vec<Chart<'static>> {
+    let t = &d.t_s;
+    let per = period_samples(d);
+    let mut v = vec![over_time(
         "error_time",
         "Error of the q-axis current vs time (model - measured)",
         "I_qs error [A]",
-        vec![trace("I_qs error", t, &eiq, per, 1)],
-    ));
+        vec![trace("I_qs error", t, eiq, per, 1)],
+    )];
     if d.channels.speed {
         let e: Vec<f64> = p
             .omega_r
@@ -293,22 +328,6 @@ pub fn compare_charts(d: &Prepared, out: &CompareOutput) -> Vec<Chart<'static>> 
             vec![trace("omega_r error", t, &e, per, 2)],
         ));
     }
-    v.extend(condition_charts(d, &out.all_windows));
-    v.push(Chart {
-        stem: "error_spectrum",
-        title: "Spectrum of the q-axis current's error",
-        x_label: "frequency [Hz]",
-        y_label: "amplitude [A]",
-        series: vec![Series {
-            label: "I_qs error".into(),
-            points: plot::thin(&metrics::spectrum(&eiq, d.dt_s), MAX_POINTS),
-            color: 4,
-            scatter: false,
-            dashed: false,
-        }],
-        log_y: true,
-        omitted: None,
-    });
     v
 }
 
@@ -424,6 +443,19 @@ pub fn explain_charts(
             overlay(&d.omega_r, &|p| &p.omega_r),
         ));
     }
+    v.extend(before_after_errors(d, before_p, after));
+    v
+}
+
+/// `explain`'s I_qs zoomed where the model before is worst, and its error before and
+/// after adding the top effect.
+fn before_after_errors(
+    d: &Prepared,
+    before_p: &Prediction,
+    after: Option<&(monitor_core::EffectKind, Prediction)>,
+) -> Vec<Chart<'static>> {
+    let t = &d.t_s;
+    let per = period_samples(d);
     let error = |p: &Prediction| {
         p.iq.iter()
             .zip(&d.iq)
@@ -437,7 +469,7 @@ pub fn explain_charts(
         zs.push((label, &p.iq, 2, false));
     }
     zs.push(("model before", &before_p.iq, 1, true));
-    v.extend(zooms(
+    let mut v = zooms(
         t,
         &worst_spans(&e_before, per),
         ["zoom_before_after_iqs_1", "zoom_before_after_iqs_2"],
@@ -446,7 +478,7 @@ pub fn explain_charts(
             "q-axis current, a few supply periods where the model before is second worst",
         ],
         &zs,
-    ));
+    );
     let mut s = Vec::new();
     if let Some((name, p)) = after {
         s.push(trace(&format!("error with {name}"), t, &error(p), per, 2));

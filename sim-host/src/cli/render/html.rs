@@ -6,7 +6,7 @@
 
 use super::{charts, plot};
 use plot::Chart;
-use sim_host::analysis::compare::CompareOutput;
+use sim_host::analysis::compare::{CompareOutput, CompareReport};
 use sim_host::analysis::explain::ExplainOutput;
 use sim_host::analysis::rotor_asymmetry::McsaReport;
 use sim_host::analysis::Analysis;
@@ -126,24 +126,8 @@ fn compare_html(log: &str, out: &CompareOutput, charts: &[(String, String)]) -> 
     for s in &r.skipped {
         let _ = write!(h, "<p><i>{}</i></p>", esc(s));
     }
-    h.push_str("<h2>Error per channel</h2><table><tr><th class=l>channel</th><th>RMS error</th><th>RMS measured</th><th>normalized</th></tr>");
-    for c in &r.channels {
-        let _ = write!(
-            h,
-            "<tr><td class=l>{}</td><td>{:.4}</td><td>{:.4}</td><td>{:.4}</td></tr>",
-            c.channel, c.rms_error, c.rms_measured, c.normalized
-        );
-    }
-    h.push_str("</table><h2>Where the model fails most</h2><table><tr><th>from [s]</th><th>to [s]</th><th>error</th><th>speed [rpm]</th><th>load I_qs [A]</th><th>voltage [%]</th><th>supply [Hz]</th><th>since start [s]</th><th class=l>error is mostly</th></tr>");
-    for w in &r.worst_windows {
-        let transient = w
-            .transient
-            .as_ref()
-            .map(|t| format!("; transient ({}): {}", t.kind, t.description))
-            .unwrap_or_default();
-        let _ = write!(h, "<tr><td>{:.2}</td><td>{:.2}</td><td>{:.4}</td><td>{}</td><td>{:.2}</td><td>{:.1}</td><td>{:.1}</td><td>{:.2}</td><td class=l>{}{}</td></tr>", w.t_start_s, w.t_end_s, w.normalized_rms_error, w.condition.speed_rpm.map(|s| format!("{s:.0}")).unwrap_or("-".into()), w.condition.load_current_a, w.condition.voltage_percent, w.condition.supply_hz, w.condition.time_since_start_s, esc(&w.error_kind), esc(&transient));
-    }
-    h.push_str("</table>");
+    channels_table(&mut h, r);
+    worst_windows_table(&mut h, r);
     if !r.advice.is_empty() {
         h.push_str("<h2>Advice</h2><ul>");
         for a in &r.advice {
@@ -151,19 +135,7 @@ fn compare_html(log: &str, out: &CompareOutput, charts: &[(String, String)]) -> 
         }
         h.push_str("</ul>");
     }
-    h.push_str("<h2>Fitted parameters</h2><p>Nominal values are never exact; the parameters the data identify are refitted.</p><table><tr><th class=l>parameter</th><th>fitted</th><th>nominal</th><th class=l>unit</th><th class=l>plausible</th></tr>");
-    for (k, v) in &r.base_parameters {
-        let _ = write!(
-            h,
-            "<tr><td class=l>{}</td><td>{:.5}</td><td>{:.5}</td><td class=l>{}</td><td class=l>{}</td></tr>",
-            k,
-            v.value,
-            v.nominal.unwrap_or(f64::NAN),
-            esc(&v.unit),
-            if v.plausible { "yes" } else { "[not plausible]" }
-        );
-    }
-    h.push_str("</table>");
+    base_parameters_table(&mut h, r);
     for w in &r.implausible_because {
         let _ = write!(h, "<p>not plausible: {}</p>", esc(w));
     }
@@ -186,6 +158,50 @@ fn compare_html(log: &str, out: &CompareOutput, charts: &[(String, String)]) -> 
     }
     h.push_str("<p>Next step: <code>sim-host explain</code> ranks the physical effects that could remove this error.</p></body></html>");
     h
+}
+
+/// `compare`'s error per channel, as a table.
+fn channels_table(h: &mut String, r: &CompareReport) {
+    h.push_str("<h2>Error per channel</h2><table><tr><th class=l>channel</th><th>RMS error</th><th>RMS measured</th><th>normalized</th></tr>");
+    for c in &r.channels {
+        let _ = write!(
+            h,
+            "<tr><td class=l>{}</td><td>{:.4}</td><td>{:.4}</td><td>{:.4}</td></tr>",
+            c.channel, c.rms_error, c.rms_measured, c.normalized
+        );
+    }
+    h.push_str("</table>");
+}
+
+/// `compare`'s worst windows with their conditions and transients, as a table.
+fn worst_windows_table(h: &mut String, r: &CompareReport) {
+    h.push_str("<h2>Where the model fails most</h2><table><tr><th>from [s]</th><th>to [s]</th><th>error</th><th>speed [rpm]</th><th>load I_qs [A]</th><th>voltage [%]</th><th>supply [Hz]</th><th>since start [s]</th><th class=l>error is mostly</th></tr>");
+    for w in &r.worst_windows {
+        let transient = w
+            .transient
+            .as_ref()
+            .map(|t| format!("; transient ({}): {}", t.kind, t.description))
+            .unwrap_or_default();
+        let _ = write!(h, "<tr><td>{:.2}</td><td>{:.2}</td><td>{:.4}</td><td>{}</td><td>{:.2}</td><td>{:.1}</td><td>{:.1}</td><td>{:.2}</td><td class=l>{}{}</td></tr>", w.t_start_s, w.t_end_s, w.normalized_rms_error, w.condition.speed_rpm.map(|s| format!("{s:.0}")).unwrap_or("-".into()), w.condition.load_current_a, w.condition.voltage_percent, w.condition.supply_hz, w.condition.time_since_start_s, esc(&w.error_kind), esc(&transient));
+    }
+    h.push_str("</table>");
+}
+
+/// `compare`'s refitted base parameters against their nominal values, as a table.
+fn base_parameters_table(h: &mut String, r: &CompareReport) {
+    h.push_str("<h2>Fitted parameters</h2><p>Nominal values are never exact; the parameters the data identify are refitted.</p><table><tr><th class=l>parameter</th><th>fitted</th><th>nominal</th><th class=l>unit</th><th class=l>plausible</th></tr>");
+    for (k, v) in &r.base_parameters {
+        let _ = write!(
+            h,
+            "<tr><td class=l>{}</td><td>{:.5}</td><td>{:.5}</td><td class=l>{}</td><td class=l>{}</td></tr>",
+            k,
+            v.value,
+            v.nominal.unwrap_or(f64::NAN),
+            esc(&v.unit),
+            if v.plausible { "yes" } else { "[not plausible]" }
+        );
+    }
+    h.push_str("</table>");
 }
 
 /// The `explain` report page.

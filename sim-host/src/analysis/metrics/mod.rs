@@ -8,8 +8,11 @@
 
 use super::prep::{phase_values, Prepared, C64};
 use super::simplified_model::Prediction;
-use rayon::prelude::*;
 use serde::Serialize;
+
+mod worst;
+
+pub use worst::{error_kind, windows, Condition, WorstWindow};
 
 /// Channel names, in order.
 pub const CHANNELS: [&str; 5] = ["iqs_A", "omega_r_rad_s", "ia_A", "ib_A", "ic_A"];
@@ -437,145 +440,6 @@ pub fn dominant_frequency(x: &[f64], dt: f64) -> f64 {
     } else {
         best.0
     }
-}
-
-/// A time span where the model fails most.
-#[derive(Debug, Clone, Serialize)]
-pub struct WorstWindow {
-    /// Start [s].
-    pub t_start_s: f64,
-    /// End [s].
-    pub t_end_s: f64,
-    /// `normalized_rms_error` in this window (channels normalised by their whole-log RMS).
-    pub normalized_rms_error: f64,
-    /// Operating condition in the window.
-    pub condition: Condition,
-    /// Dominant frequency of the I_qs error here [Hz] (0 = a steady offset).
-    pub dominant_error_hz: f64,
-    /// That frequency in words ("2f ripple (100 Hz = 2 x supply)", "offset", ...).
-    pub error_kind: String,
-    /// The transient the window lies in (start, supply step, speed change), when `compare`
-    /// found one ([`super::transients`]); null in steady operation.
-    pub transient: Option<super::transients::Transient>,
-}
-
-/// Operating condition of a window (means over the window).
-#[derive(Debug, Clone, Serialize)]
-pub struct Condition {
-    /// Mechanical speed [rpm] (null without speed).
-    pub speed_rpm: Option<f64>,
-    /// Load (torque-producing) current I_qs [A].
-    pub load_current_a: f64,
-    /// Positive-sequence voltage amplitude [V peak, phase].
-    pub voltage_v: f64,
-    /// Voltage as a percentage of the parameter file's rated value.
-    pub voltage_percent: f64,
-    /// Supply (frame) frequency [Hz].
-    pub supply_hz: f64,
-    /// Time since the log's first row [s] (the motor start for a log that starts with it).
-    pub time_since_start_s: f64,
-}
-
-/// Names an error frequency relative to the supply frequency.
-pub fn error_kind(f: f64, fs: f64) -> String {
-    if f < 1e-9 {
-        return "steady offset".into();
-    }
-    if f < 5.0 {
-        return format!("slow drift ({f:.1} Hz)");
-    }
-    for (m, name) in [(1.0, "1f"), (2.0, "2f ripple"), (6.0, "6f")] {
-        if fs > 1.0 && (f - m * fs).abs() < 0.12 * fs {
-            return format!("{name} ({f:.0} Hz = {m:.0} x supply {fs:.0} Hz)");
-        }
-    }
-    format!("{f:.0} Hz")
-}
-
-/// Per-window errors: window start/end [s], window error, condition, plus the error
-/// signal of I_qs; and the `count` worst windows (non-adjacent).
-pub fn windows(
-    d: &Prepared,
-    p: &Prediction,
-    w: &Weights,
-    v_rated: f64,
-    np: f64,
-    n_windows: usize,
-    count: usize,
-) -> (Vec<WorstWindow>, Vec<WorstWindow>) {
-    let len = d.len().min(p.iq.len());
-    let nw = n_windows.clamp(1, len.max(1));
-    let t0 = d.log_start_s;
-    let nc = w.n_channels().max(1) as f64;
-    // Windows are independent (each with its own spectrum): computed in parallel, in order.
-    let all: Vec<WorstWindow> = (0..nw)
-        .into_par_iter()
-        .map(|wi| {
-            let a = wi * len / nw;
-            let b = ((wi + 1) * len / nw).max(a + 1).min(len);
-            let mut se = [0.0f64; 5];
-            let (mut sw, mut siq, mut sv, mut sf) = (0.0, 0.0, 0.0, 0.0);
-            let mut err_iq = Vec::with_capacity(b - a);
-            for k in a..b {
-                let m = measured(d, k);
-                let q = predicted(d, p, k);
-                for c in 0..5 {
-                    se[c] += (q[c] - m[c]).powi(2);
-                }
-                err_iq.push(q[0] - m[0]);
-                sw += d.omega_r.get(k).copied().unwrap_or(0.0);
-                siq += d.iq[k];
-                if !d.vq.is_empty() {
-                    sv += d.vq[k].hypot(d.vd[k]);
-                }
-                sf += d.omega_s[k];
-            }
-            let n = (b - a) as f64;
-            let mut e = 0.0;
-            for c in 0..5 {
-                e += (se[c] / n).sqrt() * w.inv_rms[c];
-            }
-            let fsup = sf / n / (2.0 * std::f64::consts::PI);
-            let f = dominant_frequency(&err_iq, d.dt_s);
-            WorstWindow {
-                t_start_s: d.t_s[a],
-                t_end_s: d.t_s[b - 1],
-                normalized_rms_error: e / nc,
-                condition: Condition {
-                    speed_rpm: if d.channels.speed {
-                        Some(sw / n / np * 60.0 / (2.0 * std::f64::consts::PI))
-                    } else {
-                        None
-                    },
-                    load_current_a: siq / n,
-                    voltage_v: sv / n,
-                    voltage_percent: 100.0 * (sv / n) / v_rated.max(1e-9),
-                    supply_hz: fsup,
-                    time_since_start_s: d.t_s[a] - t0,
-                },
-                dominant_error_hz: f,
-                error_kind: error_kind(f, fsup.abs()),
-                transient: None,
-            }
-        })
-        .collect();
-    let mut idx: Vec<usize> = (0..all.len()).collect();
-    idx.sort_by(|&a, &b| {
-        all[b]
-            .normalized_rms_error
-            .total_cmp(&all[a].normalized_rms_error)
-    });
-    let mut picked: Vec<usize> = Vec::new();
-    for i in idx {
-        if picked.len() >= count {
-            break;
-        }
-        if picked.iter().all(|&j| (j as isize - i as isize).abs() > 1) {
-            picked.push(i);
-        }
-    }
-    let worst = picked.iter().map(|&i| all[i].clone()).collect();
-    (worst, all)
 }
 
 #[cfg(test)]

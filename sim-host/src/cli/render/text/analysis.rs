@@ -1,0 +1,179 @@
+//! The text reports of the model-vs-measurement commands, `compare` and `explain`.
+
+use super::diagnose::data_quality;
+use super::number;
+use sim_host::analysis::compare::CompareReport;
+use sim_host::analysis::explain::ExplainReport;
+use std::io::Write;
+use std::path::Path;
+
+/// The effects of a model, as the text tables name it: `bare` without effects, else
+/// `prefix` and the names joined by `sep`.
+fn model_name(effects: &[monitor_core::EffectKind], bare: &str, prefix: &str, sep: &str) -> String {
+    if effects.is_empty() {
+        bare.to_string()
+    } else {
+        let names: Vec<&str> = effects.iter().map(|e| e.name()).collect();
+        format!("{prefix}{}", names.join(sep))
+    }
+}
+
+/// `compare`'s errors, worst windows and fitted values.
+pub fn compare(log: &Path, r: &CompareReport) -> anyhow::Result<()> {
+    let mut out = crate::cli::stdout();
+    writeln!(out, "compare {}", log.display())?;
+    data_quality(&mut out, &r.data_quality)?;
+    writeln!(
+        out,
+        "  model: {}",
+        model_name(
+            &r.effects,
+            "paper's simplified model (eqs. 28-29)",
+            "paper's model + ",
+            " + "
+        )
+    )?;
+    match r.diverged_at_s {
+        Some(t) => writeln!(
+            out,
+            "  normalized_rms_error: not judged: the model diverged at {t:.3} s (see 'not plausible' below)"
+        )?,
+        None => writeln!(
+            out,
+            "  normalized_rms_error {}   (noise floor {})",
+            number(r.normalized_rms_error),
+            number(r.noise_floor)
+        )?,
+    }
+    for ch in &r.channels {
+        writeln!(
+            out,
+            "  {:<14} rms error {:>10.4}  of rms {:>10.4}  ({:.2} %)",
+            ch.channel,
+            ch.rms_error,
+            ch.rms_measured,
+            100.0 * ch.normalized
+        )?;
+    }
+    worst_windows(&mut out, r)?;
+    for a in &r.advice {
+        writeln!(out, "  advice: {a}")?;
+    }
+    fitted(&mut out, r)?;
+    for s in &r.skipped {
+        writeln!(out, "  skipped: {s}")?;
+    }
+    writeln!(out, "  unbalance: {}", r.unbalance.summary)?;
+    Ok(())
+}
+
+/// The windows where the model fails most, with their conditions and transients.
+fn worst_windows(out: &mut impl Write, r: &CompareReport) -> anyhow::Result<()> {
+    if r.worst_windows.is_empty() {
+        return Ok(());
+    }
+    writeln!(out, "  worst windows:")?;
+    for w in &r.worst_windows {
+        writeln!(
+            out,
+            "    {:>7.2}-{:<7.2} s  error {:.4}  speed {} rpm, I_qs {:.2} A, voltage {:.0} %, {:.1} Hz, {:.2} s after start; error mostly {}",
+            w.t_start_s,
+            w.t_end_s,
+            w.normalized_rms_error,
+            w.condition.speed_rpm.map(|s| format!("{s:.0}")).unwrap_or("-".into()),
+            w.condition.load_current_a,
+            w.condition.voltage_percent,
+            w.condition.supply_hz,
+            w.condition.time_since_start_s,
+            w.error_kind
+        )?;
+        if let Some(t) = &w.transient {
+            writeln!(out, "      transient ({}): {}", t.kind, t.description)?;
+        }
+    }
+    Ok(())
+}
+
+/// The fitted effects and base parameters, what is not plausible and what the log does
+/// not identify.
+fn fitted(out: &mut impl Write, r: &CompareReport) -> anyhow::Result<()> {
+    for e in &r.fitted_effects {
+        writeln!(out, "  {}: {}", e.effect, e.summary)?;
+    }
+    for (k, v) in &r.base_parameters {
+        writeln!(
+            out,
+            "  fitted {:<14} {:>12.5} {} (nominal {:.5}){}",
+            k,
+            v.value,
+            v.unit,
+            v.nominal.unwrap_or(f64::NAN),
+            if v.plausible { "" } else { "  [not plausible]" }
+        )?;
+    }
+    for w in &r.implausible_because {
+        writeln!(out, "  not plausible: {w}")?;
+    }
+    if let Some(j) = &r.identifiability {
+        writeln!(
+            out,
+            "  identifiability: Jacobian rank {} of {}, condition number {:.3e}",
+            j.rank, j.n_parameters, j.condition_number
+        )?;
+    }
+    for w in &r.not_identified {
+        writeln!(out, "  {w}")?;
+    }
+    Ok(())
+}
+
+/// `explain`'s ranking and verdict.
+pub fn explain(log: &Path, r: &ExplainReport) -> anyhow::Result<()> {
+    let mut out = crate::cli::stdout();
+    writeln!(out, "explain {}", log.display())?;
+    data_quality(&mut out, &r.data_quality)?;
+    writeln!(
+        out,
+        "  model as configured: {}; error {} (held-back {}), noise floor {}",
+        model_name(&r.effects, "paper's model", "", ","),
+        number(r.baseline_normalized_rms_error),
+        number(r.baseline_validation_normalized_rms_error),
+        number(r.noise_floor)
+    )?;
+    // The answer first, then how it was reached.
+    writeln!(out, "{}", r.verdict)?;
+    writeln!(
+        out,
+        "  ranking: the plausible fits by the error they leave on the held-back part of the log, then the fits whose parameters are not physical (a fit that explains much with an impossible value is no explanation)"
+    )?;
+    writeln!(
+        out,
+        "  {:<4} {:<18} {:>10} {:>10} {:>10}  fitted",
+        "rank", "effect", "error", "held-back", "explained"
+    )?;
+    for (i, k) in r.ranking.iter().enumerate() {
+        writeln!(
+            out,
+            "  {:<4} {:<18} {:>10} {:>10} {:>9.0}%  {}",
+            i + 1,
+            k.effect.name(),
+            number(k.normalized_rms_error),
+            number(k.validation_normalized_rms_error),
+            100.0 * k.explained_fraction,
+            k.summary
+        )?;
+        for w in &k.implausible_because {
+            writeln!(out, "       not plausible: {w}")?;
+        }
+    }
+    for s in &r.skipped {
+        writeln!(out, "  skipped: {s}")?;
+    }
+    writeln!(out, "  unbalance: {}", r.unbalance.summary)?;
+    if let Some(words) = r.base_refit.as_ref().map(|b| b.in_words()) {
+        if !words.is_empty() {
+            writeln!(out, "  {words}")?;
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,403 @@
+//! `diagnose`'s text report: the timeline, what was found, the unbalance, the
+//! commissioning, the data quality and the verdict (also the demo's).
+
+use super::{candidate_list, lamp, panel_text};
+use monitor_core::Phase;
+use sim_host::demo::MonitorState;
+use sim_host::log::quality::DataQuality;
+use sim_host::replay::{
+    angle_source_name, CommissioningReport, DiagnoseReport, Diagnosed, IsolationName, Verdict,
+};
+use std::io::Write;
+use std::path::Path;
+
+/// The temperature channel's line (`None` for a log without the column): the reading and
+/// the rise the isolation compensates Rs and Rr with, or why the channel is not used.
+fn temperature_line(t: &sim_host::replay::TemperatureReport) -> Option<String> {
+    let status = t.temperature_channel.as_deref()?;
+    let reading = t
+        .winding_temperature_c
+        .map_or("no reading".to_string(), |c| format!("{c:.1} degC"));
+    Some(match (status.strip_prefix("not used: "), t.measured_rise_k) {
+        (Some(why), _) => format!(
+            "temperature channel not used: {why}; heating tracked from the resistances (last reading {reading})"
+        ),
+        (None, Some(rise)) => format!(
+            "winding temperature: {reading}, {rise:+.1} K since commissioning (temperature channel; Rs and Rr compensated, copper 0.393 %/K)"
+        ),
+        (None, None) => format!("winding temperature: {reading} (temperature channel)"),
+    })
+}
+
+/// The verdict line of `diagnose` and the demo.
+pub(super) fn verdict(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
+    let u = &rep.unbalance;
+    if let (Verdict::Fault, Some(p), Some(_)) = (rep.verdict, u.suspect_phase, u.baseline) {
+        let also = if rep.verdict_withheld_because.is_empty() {
+            String::new()
+        } else {
+            format!("; not judged: {}", rep.verdict_withheld_because.join("; "))
+        };
+        let named = named_fault(rep);
+        writeln!(
+            out,
+            "verdict: FAULT{}{} shorted turns in phase {} (the negative sequence changed by {:.1} % of I1, confidence {:.2}){also}",
+            named,
+            if named.is_empty() { "" } else { " and" },
+            p.name(),
+            100.0 * u.winding_ratio,
+            u.phase_confidence
+        )?;
+        return Ok(());
+    }
+    match rep.verdict {
+        Verdict::Fault if rep.lamps.values().any(|l| *l) || !rep.candidates.is_empty() => {
+            writeln!(out, "verdict: FAULT{}", named_fault(rep))?
+        }
+        // Dark lamps and no candidate at the end: say what the verdict rests on.
+        Verdict::Fault => writeln!(
+            out,
+            "verdict: FAULT: the lamps lit at {}{}; they are dark at the end and the isolation names no single fault",
+            rep.first_detection_s
+                .map_or("-".into(), |t| format!("{t:.2} s")),
+            if rep.detections.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    " (the lamps' matching named {})",
+                    rep.detections
+                        .iter()
+                        .map(|d| format!("{} at {:.2} s", IsolationName::expected(d.fault), d.t_s))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            }
+        )?,
+        Verdict::Healthy => writeln!(out, "verdict: healthy")?,
+        Verdict::Watching => writeln!(
+            out,
+            "verdict: {}",
+            rep.verdict_withheld_because.join("; ")
+        )?,
+        Verdict::CouldNotJudge => writeln!(
+            out,
+            "verdict: could not judge: {}",
+            rep.verdict_withheld_because.join("; ")
+        )?,
+    }
+    Ok(())
+}
+
+/// The fault the isolation named, with its size and phase, as ` rs +50 %` (empty when it
+/// named none).
+fn named_fault(rep: &DiagnoseReport) -> String {
+    let Some(IsolationName::Fault(f)) = rep.isolation.named else {
+        return String::new();
+    };
+    let c = rep.candidates.iter().find(|c| c.fault == f);
+    let size = c
+        .and_then(|c| c.change)
+        .or(rep.isolation.named_change)
+        .map_or(String::new(), |x| format!(" {:+.0} %", 100.0 * x));
+    let phase = c
+        .and_then(|c| c.phase)
+        .map_or(String::new(), |p| format!(" (phase {})", p.name()));
+    format!(" {}{size}{phase}", f.name())
+}
+
+/// `diagnose`'s timeline, lamps, candidates and unbalance.
+pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
+    let rep = &d.report;
+    let mut out = crate::cli::stdout();
+    writeln!(
+        out,
+        "diagnose {} ({} rows, {:.0} Hz, angle: {})",
+        log.display(),
+        rep.rows,
+        d.sample_rate_hz,
+        angle_source_name(rep.angle_source)
+    )?;
+    data_quality(&mut out, &rep.data_quality)?;
+    commissioning(&mut out, &rep.commissioning)?;
+    for s in &rep.skipped {
+        writeln!(out, "skipped: {s}")?;
+    }
+    if rep.skipped.is_empty() {
+        timeline(&mut out, rep)?;
+        findings(&mut out, rep)?;
+        events(&mut out, &rep.isolation)?;
+    }
+    unbalance(&mut out, &rep.unbalance)?;
+    for n in &rep.commissioning.outside_range {
+        writeln!(out, "note at {:.2} s: {}", n.t_s, n.note)?;
+    }
+    verdict(&mut out, rep)
+}
+
+/// The timeline: time, speed, residuals, lamps and the panel's state per point.
+fn timeline(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
+    writeln!(
+        out,
+        "\n  time    speed   r1      r2      r3      r4      lamps     state"
+    )?;
+    for p in &rep.timeline {
+        let lamps: String = p.lamps.iter().map(|l| lamp(*l)).collect();
+        let r = p.residuals;
+        writeln!(
+            out,
+            "{:6.2} s {:6.1} {:+.4} {:+.4} {:+.4} {:+.4}  {lamps}  {}{}",
+            p.t_s,
+            p.speed_rad_s,
+            r[0],
+            r[1],
+            r[2],
+            r[3],
+            panel_text(&p.panel),
+            p.range_note
+                .as_ref()
+                .filter(|_| !matches!(p.panel.state, MonitorState::Moved(_)))
+                .map(|n| format!("  [{n}]"))
+                .unwrap_or_default()
+        )?;
+    }
+    Ok(())
+}
+
+/// What the run found: the final lamps, the first detection, the candidates, the
+/// isolation's verdict with its detection limits, the temperature, what cannot be
+/// separated.
+fn findings(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
+    let lit: Vec<&str> = rep
+        .lamps
+        .iter()
+        .filter(|(_, v)| **v)
+        .map(|(k, _)| k.as_str())
+        .collect();
+    writeln!(
+        out,
+        "\nfinal lamps: {}",
+        if lit.is_empty() {
+            "none".to_string()
+        } else {
+            lit.join(" ")
+        }
+    )?;
+    match rep.first_detection_s {
+        Some(t) => writeln!(out, "first detection: {t:.2} s")?,
+        None => writeln!(out, "first detection: none")?,
+    }
+    writeln!(out, "candidates: {}", candidate_list(&rep.candidates))?;
+    writeln!(
+        out,
+        "lamps' candidates (signature matching): {}",
+        candidate_list(&rep.signature_candidates)
+    )?;
+    writeln!(out, "isolation: {}", rep.isolation.verdict)?;
+    if let Some(line) = detection_limits_line(&rep.isolation.detection_limits) {
+        writeln!(out, "{line}")?;
+    }
+    if let Some(line) = temperature_line(&rep.isolation.temperature) {
+        writeln!(out, "{line}")?;
+    }
+    for g in &rep.isolation.groups {
+        writeln!(
+            out,
+            "  cannot be separated: {} ({})",
+            g.faults
+                .iter()
+                .map(|f| f.name())
+                .collect::<Vec<_>>()
+                .join(" / "),
+            g.reason
+        )?;
+    }
+    Ok(())
+}
+
+/// The healthy verdict's detection limits in a line (none without them).
+fn detection_limits_line(limits: &[sim_host::replay::DetectionLimit]) -> Option<String> {
+    (!limits.is_empty()).then(|| {
+        format!(
+            "  smallest changes the isolation detects at the commissioned point (smaller ones pass as healthy; a FAULT also needs {:.0} %): {}",
+            100.0 * sim_host::replay::MIN_FAULT_CHANGE,
+            limits
+                .iter()
+                .map(|l| format!("{} {}", l.fault.name(), limit_pct(l.change)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    })
+}
+
+/// A detection limit in per cent with two significant digits (0.106 -> "11 %",
+/// 0.0016 -> "0.16 %").
+fn limit_pct(change: f32) -> String {
+    let p = 100.0 * change;
+    if p >= 10.0 {
+        format!("{p:.0} %")
+    } else if p >= 1.0 {
+        format!("{p:.1} %")
+    } else {
+        format!("{p:.2} %")
+    }
+}
+
+/// Segments of the negative sequence the text report lists (the JSON has up to
+/// `sim_host::replay::winding::MAX_SEGMENTS`).
+const SEGMENTS_LISTED: usize = 8;
+
+/// The negative-sequence analysis: the whole log's ratio and phase, its steady stretches,
+/// and the winding's judgement in a sentence.
+fn unbalance(out: &mut impl Write, u: &sim_host::replay::UnbalanceReport) -> anyhow::Result<()> {
+    writeln!(
+        out,
+        "unbalance: |I2|/|I1| = {:.2} %, suspect phase: {}",
+        100.0 * u.negative_sequence_ratio,
+        u.suspect_phase.map_or("none", Phase::name)
+    )?;
+    if u.segments.len() > 1 {
+        stretches(out, u)?;
+    }
+    let against = match (u.baseline, u.baseline_runs) {
+        (Some(sim_host::replay::BaselineSource::File), 1) => "against 1 healthy run".to_string(),
+        (Some(sim_host::replay::BaselineSource::File), n) => format!(
+            "against the mean of {n} healthy runs (their spread {:.1} %)",
+            100.0 * u.baseline_spread.unwrap_or(0.0)
+        ),
+        (Some(sim_host::replay::BaselineSource::Commissioning), _) => {
+            "against the commissioning window".to_string()
+        }
+        (None, _) => "with no healthy baseline".to_string(),
+    };
+    let reference = u.operating_point.map(|o| {
+        format!(
+            "reference angle {:.0} +/- {:.0} deg, {}",
+            u.correction_deg,
+            u.correction_uncertainty_deg,
+            o.describe()
+        )
+    });
+    match (u.suspect_phase, &u.phase_not_judged) {
+        (Some(p), _) => writeln!(
+            out,
+            "winding: shorted turns in phase {} (confidence {:.2}): the negative sequence changed by {:.1} % of I1 {against}, least change {:.1} %; {}",
+            p.name(),
+            u.phase_confidence,
+            100.0 * u.winding_ratio,
+            100.0 * u.least_change,
+            reference.unwrap_or_default()
+        )?,
+        (None, Some(why)) => writeln!(out, "winding: {why}")?,
+        (None, None) => {}
+    }
+    Ok(())
+}
+
+/// The steady stretches of the negative sequence (the first [`SEGMENTS_LISTED`]), the
+/// judged one marked.
+fn stretches(out: &mut impl Write, u: &sim_host::replay::UnbalanceReport) -> anyhow::Result<()> {
+    writeln!(out, "  steady stretches (least-squares phasors):")?;
+    for (k, s) in u.segments.iter().enumerate().take(SEGMENTS_LISTED) {
+        writeln!(
+            out,
+            "    at {:.2}..{:.2} s: |I1| {:.3} A, I2/I1 {:.1} % at {:.0} deg{}",
+            s.from_s,
+            s.to_s,
+            s.i1_peak_a,
+            100.0 * s.negative_sequence_ratio,
+            s.angle_deg,
+            if u.judged_segment == Some(k) {
+                "  <- judged"
+            } else {
+                ""
+            }
+        )?;
+    }
+    if u.segments.len() > SEGMENTS_LISTED {
+        writeln!(
+            out,
+            "    ... {} more (--json lists them)",
+            u.segments.len() - SEGMENTS_LISTED
+        )?;
+    }
+    Ok(())
+}
+
+/// Most load moves the text report lists (every name is listed; `--json` has up to
+/// [`sim_host::replay::MAX_EVENTS`] events).
+const LOAD_MOVES_LISTED: usize = 10;
+
+/// The isolation's events with their times: every name, and the first
+/// [`LOAD_MOVES_LISTED`] load moves.
+fn events(out: &mut impl Write, iso: &sim_host::replay::IsolationReport) -> anyhow::Result<()> {
+    use sim_host::replay::IsolationEvent;
+    if iso.events.is_empty() {
+        return Ok(());
+    }
+    let moves = iso
+        .events
+        .iter()
+        .filter(|e| matches!(e, IsolationEvent::LoadMoved { .. }))
+        .count();
+    writeln!(out, "events:")?;
+    let mut listed = 0;
+    for e in &iso.events {
+        if matches!(e, IsolationEvent::LoadMoved { .. }) {
+            listed += 1;
+            if listed > LOAD_MOVES_LISTED {
+                continue;
+            }
+        }
+        writeln!(out, "  {}", e.line())?;
+    }
+    let more = moves.saturating_sub(LOAD_MOVES_LISTED) + iso.events_dropped;
+    if more > 0 {
+        writeln!(
+            out,
+            "  ... and {more} more load moves (diagnose --json lists the first 200 events)"
+        )?;
+    }
+    Ok(())
+}
+
+/// The data-quality stage's finding in one line, and what was done about it.
+pub(super) fn data_quality(out: &mut impl Write, q: &DataQuality) -> anyhow::Result<()> {
+    writeln!(out, "data quality: {}", q.summary())?;
+    for a in &q.actions {
+        writeln!(out, "  done: {a}")?;
+    }
+    if !q.trusted {
+        writeln!(out, "  NOT TRUSTED: {}", q.not_trusted_because.join("; "))?;
+    }
+    Ok(())
+}
+
+/// What `diagnose` did about its thresholds.
+fn commissioning(out: &mut impl Write, c: &CommissioningReport) -> anyhow::Result<()> {
+    writeln!(out, "thresholds: {}", c.thresholds)?;
+    if c.state == sim_host::replay::CommissioningOutcome::Learned {
+        let span = |s: Option<[f32; 2]>, u: &str| {
+            s.map(|[a, b]| format!("{a:.1}..{b:.1} {u}"))
+                .unwrap_or_else(|| "-".into())
+        };
+        writeln!(
+            out,
+            "  learned {:.2} s of evaluated running; load (active current) {}, voltage |V| {}",
+            c.seconds_evaluated,
+            span(c.load_current_a, "A"),
+            span(c.voltage_v, "V")
+        )?;
+    }
+    if let Some(p) = &c.first_quasi_steady {
+        let r = p.residuals;
+        writeln!(
+            out,
+            "  first quasi-steady point {:.2} s: r1..r4 = {:+.4} {:+.4} {:+.4} {:+.4}",
+            p.t_s, r[0], r[1], r[2], r[3]
+        )?;
+    }
+    if let Some(a) = &c.advice {
+        writeln!(out, "  {a}")?;
+    }
+    Ok(())
+}
