@@ -23,11 +23,13 @@
 mod commission;
 mod diagnose;
 mod events;
+mod front;
 mod isolation;
 mod pipe;
 mod report;
 mod sequences;
 mod temperature;
+mod trig;
 mod unsettled;
 mod winding;
 
@@ -212,6 +214,23 @@ pub fn monitor_config_for_log(
     cfg
 }
 
+/// The sequence analysis of a replay of a log with `channels` at `sample_rate_hz` (the
+/// sample limits the monitor's, [`monitor_config_for_log`]).
+fn sequence_front(
+    params: &ParamFile,
+    channels: Channels,
+    sample_rate_hz: f64,
+) -> sequences::SequenceFront {
+    let cfg = monitor_config_for_log(params, sample_rate_hz, &ReplayOptions::default());
+    sequences::SequenceFront::new(
+        params,
+        channels.voltages,
+        sample_rate_hz,
+        f64::from(cfg.limits.i_max),
+        f64::from(cfg.limits.v_max),
+    )
+}
+
 /// Converts log rows to core samples, synthesising encoder counts from speed if needed
 /// (the host's counterpart of the firmware's `drive_monitor::sampling::AdcSampler`).
 ///
@@ -325,8 +344,11 @@ pub struct Replay {
     last: MonitorOutput,
     t0: Option<f64>,
     isolation: IsolationTracker,
-    /// The symmetrical components, sample by sample ([`sequences::SequenceTracker`]).
-    sequences: sequences::SequenceTracker,
+    /// The symmetrical components, sample by sample ([`sequences::SequenceFront`]; on the
+    /// reading thread in `diagnose`, whose steps come with the rows: [`Replay::push_step`]).
+    seq_front: sequences::SequenceFront,
+    /// The least-squares windows with the monitor's learning and speed.
+    book: sequences::WindowBook,
     /// The lamps lit now first lit while the operating point had moved (or the load
     /// explained them), and have not all been dark since: their release after the load came
     /// back is still the amber state.
@@ -339,6 +361,9 @@ pub struct Replay {
     unsettled: unsettled::Unsettled,
     /// The monitor's settling time after a restart [s].
     settle_s: f64,
+    /// Added to every row's encoder count after a clock reset: the turn over the bridged
+    /// time ([`Replay::clock_reset`]).
+    enc_offset: i64,
 }
 
 impl Replay {
@@ -404,33 +429,47 @@ impl Replay {
                 opts.load,
             ),
             lamps_since_moved: false,
-            sequences: sequences::SequenceTracker::new(
-                params,
-                channels.voltages,
-                sample_rate_hz,
-                f64::from(cfg.limits.i_max),
-                f64::from(cfg.limits.v_max),
-            ),
+            seq_front: sequence_front(params, channels, sample_rate_hz),
+            book: sequences::WindowBook::new(),
             timing_faults_seen: 0,
             isolation_hold_until: f64::NEG_INFINITY,
             unsettled: unsettled::Unsettled::default(),
             settle_s: f64::from(cfg.settle_s),
+            enc_offset: 0,
         })
     }
 
     /// Feeds one row; returns the monitor's output (default output for current-only logs).
     pub fn push(&mut self, row: &Row) -> MonitorOutput {
+        let t = row.t_s - *self.t0.get_or_insert(row.t_s);
+        let step = self.seq_front.track(row, t);
+        self.book.take(&mut self.seq_front);
+        self.push_step(row, &step);
+        self.last
+    }
+
+    /// [`Replay::push`] with the sequence analysis' step for the row already taken (by a
+    /// [`sequences::SequenceFront`] of its own on another thread, whose closed windows were
+    /// queued first: [`Replay::queue_window`]).
+    fn push_step(&mut self, row: &Row, step: &sequences::SequenceStep) {
         self.rows += 1;
         let t0 = *self.t0.get_or_insert(row.t_s);
         let t = row.t_s - t0;
         let learning = matches!(self.last.commissioning, CommissioningState::Learning(_));
         let wr = self.monitor.as_ref().map(|_| self.last.operating.wr_rad_s);
-        self.sequences.track(row, t, learning, wr);
+        self.book.row(step, learning, wr);
         let Some(mon) = self.monitor.as_mut() else {
-            return self.last;
+            return;
         };
         self.commission.before(mon, t);
-        let s = self.sampler.sample(row);
+        let s = if self.enc_offset == 0 {
+            self.sampler.sample(row)
+        } else {
+            self.sampler.sample(&Row {
+                enc_count: row.enc_count.map(|c| c.wrapping_add(self.enc_offset)),
+                ..*row
+            })
+        };
         let out = *mon.update(&s);
         let range_note = self.commission.after(mon, t, &out);
         self.evaluated |= out.evaluating;
@@ -461,7 +500,7 @@ impl Replay {
             self.evaluated,
             self.commission.thresholds_trusted(&out),
         );
-        let point = self.sequences.steady_point(out.operating.wr_rad_s);
+        let point = step.point(out.operating.wr_rad_s);
         // After a restart of the monitor's estimators (a long gap, a clock reset) the
         // isolation waits out the monitor's settling time too: the restarted frame's
         // vectors look steady before they are right.
@@ -510,7 +549,42 @@ impl Replay {
         }
         self.track_judged(&out);
         self.last = out;
-        out
+    }
+
+    /// The acquisition clock was reset before the next row (`diagnose` carries the time on
+    /// by [`front::CLOCK_RESET_GAP_S`]): the encoder count handed on goes on by the turn
+    /// over the bridged time at the monitor's speed (the count the data-quality stage hands
+    /// on continues with no step).
+    fn clock_reset(&mut self) {
+        let w = self
+            .monitor
+            .as_ref()
+            .map_or(0.0, |m| f64::from(m.output().speed_rad_s));
+        let turned = w * front::CLOCK_RESET_GAP_S / std::f64::consts::TAU;
+        self.enc_offset = self
+            .enc_offset
+            .wrapping_add((turned * f64::from(COUNTS_PER_REV)).round() as i64);
+    }
+
+    /// `row` with the encoder offset of the clock resets so far ([`Replay::clock_reset`]):
+    /// the row as the monitor sees it.
+    fn with_encoder_offset(&self, row: &Row) -> Row {
+        Row {
+            enc_count: row.enc_count.map(|c| c.wrapping_add(self.enc_offset)),
+            ..*row
+        }
+    }
+
+    /// Queues a window the sequence analysis closed on another thread, before the step of
+    /// the row it closed at ([`Replay::push_step`]).
+    fn queue_window(&mut self, w: Option<SequenceWindow>) {
+        self.book.queue(w);
+    }
+
+    /// Takes over the sequence analysis that ran on another thread, once every row was
+    /// pushed: its last window is the replay's to close ([`Replay::finish`]).
+    fn set_sequence_front(&mut self, front: sequences::SequenceFront) {
+        self.seq_front = front;
     }
 
     /// The running the lamps were judged on ([`MIN_JUDGED_S`]), and whether the lamps lit

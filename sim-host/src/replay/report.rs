@@ -342,8 +342,11 @@ impl Replay {
     /// caller to fill).
     pub fn finish(mut self) -> DiagnoseReport {
         let out = self.last;
-        self.sequences
-            .finish(self.monitor.as_ref().map(|_| out.operating.wr_rad_s));
+        if self.seq_front.finish() {
+            self.book.take(&mut self.seq_front);
+            self.book
+                .close(self.monitor.as_ref().map(|_| out.operating.wr_rad_s));
+        }
         let mut skipped = Vec::new();
         if !self.channels.voltages {
             skipped.push(
