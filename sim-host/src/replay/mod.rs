@@ -341,7 +341,9 @@ pub struct Replay {
     next_point: f64,
     dt_s: f64,
     max_abs: [f32; 4],
-    last: MonitorOutput,
+    /// What the next row needs of the monitor's output after the last row (a copy of the
+    /// whole output per row is what it saves).
+    last: LastOutput,
     t0: Option<f64>,
     isolation: IsolationTracker,
     /// The symmetrical components, sample by sample ([`sequences::SequenceFront`]; on the
@@ -416,7 +418,7 @@ impl Replay {
             next_point: 0.0,
             dt_s: 1.0 / sample_rate_hz,
             max_abs: [0.0; 4],
-            last: MonitorOutput::default(),
+            last: LastOutput::default(),
             t0: None,
             isolation: IsolationTracker::new(
                 Isolator::new(
@@ -445,7 +447,14 @@ impl Replay {
         let step = self.seq_front.track(row, t);
         self.book.take(&mut self.seq_front);
         self.push_step(row, &step);
-        self.last
+        self.output()
+    }
+
+    /// The monitor's last output (the default for a current-only log).
+    fn output(&self) -> MonitorOutput {
+        self.monitor
+            .as_ref()
+            .map_or_else(MonitorOutput::default, |m| *m.output())
     }
 
     /// [`Replay::push`] with the sequence analysis' step for the row already taken (by a
@@ -455,9 +464,8 @@ impl Replay {
         self.rows += 1;
         let t0 = *self.t0.get_or_insert(row.t_s);
         let t = row.t_s - t0;
-        let learning = matches!(self.last.commissioning, CommissioningState::Learning(_));
-        let wr = self.monitor.as_ref().map(|_| self.last.operating.wr_rad_s);
-        self.book.row(step, learning, wr);
+        let wr = self.monitor.as_ref().map(|_| self.last.wr_rad_s);
+        self.book.row(step, self.last.learning, wr);
         let Some(mon) = self.monitor.as_mut() else {
             return;
         };
@@ -470,8 +478,13 @@ impl Replay {
                 ..*row
             })
         };
-        let out = *mon.update(&s);
-        let range_note = self.commission.after(mon, t, &out);
+        mon.update(&s);
+        let Some(mon) = self.monitor.as_ref() else {
+            return;
+        };
+        // (The output is read where the monitor keeps it: no copy per row.)
+        let out = mon.output();
+        let range_note = self.commission.after(mon, t, out);
         self.evaluated |= out.evaluating;
         if out.evaluating {
             for (m, r) in self.max_abs.iter_mut().zip(out.residuals) {
@@ -481,7 +494,7 @@ impl Replay {
         // With a commissioning window asked for, lamps lit on the fixed thresholds before
         // the learned ones are in force are not detections: the window says the nominal
         // parameters are not to be trusted (a sensor fault counts at any time).
-        let counts = out.sensor_fault.any() || self.commission.thresholds_trusted(&out);
+        let counts = out.sensor_fault.any() || self.commission.thresholds_trusted(out);
         // The bands only matter (and are only looked up) while the gate holds the lamps or a
         // lamp is lit.
         let bands = if out.quasi_steady && !out.fault_detected {
@@ -491,14 +504,14 @@ impl Replay {
         };
         self.unsettled.after(
             t,
-            &out,
+            out,
             if out.quasi_steady {
                 [(0.0, 0.0); 4]
             } else {
                 bands
             },
             self.evaluated,
-            self.commission.thresholds_trusted(&out),
+            self.commission.thresholds_trusted(out),
         );
         let point = step.point(out.operating.wr_rad_s);
         // After a restart of the monitor's estimators (a long gap, a clock reset) the
@@ -512,7 +525,7 @@ impl Replay {
         self.isolation.after(
             t,
             self.dt_s,
-            &out,
+            out,
             &point,
             counts && settled,
             row.t_winding_c,
@@ -522,9 +535,9 @@ impl Replay {
             // are evaluated (quasi-steady) and a lit lamp's residual is outside its band: a
             // lamp held through a transient, or after its residual came back (the load
             // returned into the range), detects nothing new there.
-            let current = out.evaluating && lit_outside_band(&out, bands);
+            let current = out.evaluating && lit_outside_band(out, bands);
             self.detected_in_range |=
-                out.sensor_fault.any() || (current && !self.commission.outside_learned_range(&out));
+                out.sensor_fault.any() || (current && !self.commission.outside_learned_range(out));
             if self.first_detection.is_none() {
                 self.first_detection = Some(t);
             }
@@ -544,11 +557,21 @@ impl Replay {
                 let steps = ((t - self.next_point) / self.opts.timeline_step_s).floor() + 1.0;
                 self.next_point += steps * self.opts.timeline_step_s;
             }
-            let point = timeline_point(self, t, &out, range_note);
+            let point = timeline_point(self, t, out, range_note);
             self.timeline.push(point);
         }
-        self.track_judged(&out);
-        self.last = out;
+        // The running the lamps were judged on ([`MIN_JUDGED_S`]), and whether the lamps lit
+        // now lit while the load had moved.
+        if out.evaluating && out.quasi_steady && self.commission.thresholds_trusted(out) {
+            self.judged_s += self.dt_s;
+        }
+        if !out.lamps.iter().any(|l| *l) {
+            self.lamps_since_moved = false;
+        } else if self.commission.moved_note(out).is_some() || self.isolation.load_explains_lamps()
+        {
+            self.lamps_since_moved = true;
+        }
+        self.last = LastOutput::of(out);
     }
 
     /// The acquisition clock was reset before the next row (`diagnose` carries the time on
@@ -585,20 +608,6 @@ impl Replay {
     /// pushed: its last window is the replay's to close ([`Replay::finish`]).
     fn set_sequence_front(&mut self, front: sequences::SequenceFront) {
         self.seq_front = front;
-    }
-
-    /// The running the lamps were judged on ([`MIN_JUDGED_S`]), and whether the lamps lit
-    /// now lit while the load had moved.
-    fn track_judged(&mut self, out: &MonitorOutput) {
-        if out.evaluating && out.quasi_steady && self.commission.thresholds_trusted(out) {
-            self.judged_s += self.dt_s;
-        }
-        if !out.lamps.iter().any(|l| *l) {
-            self.lamps_since_moved = false;
-        } else if self.commission.moved_note(out).is_some() || self.isolation.load_explains_lamps()
-        {
-            self.lamps_since_moved = true;
-        }
     }
 
     /// The learned calibration (mean and spread of r1..r4), once commissioning is done.
@@ -646,7 +655,7 @@ impl Replay {
 
     /// A sensor fault was flagged at the end (the lamps' detections then stand).
     fn out_sensor_fault_seen(&self) -> bool {
-        self.last.sensor_fault.any()
+        self.last.sensor_fault
     }
 
     /// Every name the isolation gave so far (a fault or the friction class `b/bl`), each
@@ -679,6 +688,27 @@ impl Replay {
     /// True when a commissioning window was asked for and not learned.
     pub fn commissioning_incomplete(&self) -> bool {
         self.monitor.is_some() && self.commission.incomplete()
+    }
+}
+
+/// What a replay keeps of the monitor's output after a row for the next one.
+#[derive(Debug, Clone, Copy, Default)]
+struct LastOutput {
+    /// The commissioning window is being learned.
+    learning: bool,
+    /// The electrical rotor speed [rad/s].
+    wr_rad_s: f32,
+    /// A sensor fault is flagged.
+    sensor_fault: bool,
+}
+
+impl LastOutput {
+    fn of(out: &MonitorOutput) -> Self {
+        LastOutput {
+            learning: matches!(out.commissioning, CommissioningState::Learning(_)),
+            wr_rad_s: out.operating.wr_rad_s,
+            sensor_fault: out.sensor_fault.any(),
+        }
     }
 }
 

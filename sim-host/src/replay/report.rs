@@ -341,7 +341,7 @@ impl Replay {
     /// Ends the replay and builds the report (`data_quality` left at its default for the
     /// caller to fill).
     pub fn finish(mut self) -> DiagnoseReport {
-        let out = self.last;
+        let out = self.output();
         if self.seq_front.finish() {
             self.book.take(&mut self.seq_front);
             self.book
