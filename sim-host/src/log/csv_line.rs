@@ -702,16 +702,3 @@ mod tests {
         }
     }
 }
-#[cfg(test)]
-mod probe {
-    use super::*;
-    #[test]
-    fn probe_plain() {
-        let cols = Cols::new(&[0, 1, 2, 3, 4, 5, 6, 7], 8);
-        let mut row = [0f64; MAX_COLS];
-        let b = b"0.0001,326.3672,-154.49219,-171.67969,1.574707,-0.7324219,-0.76904297,6.408294e-9\n0.0002,1,2,3,4,5,6,7\n";
-        let r = parse_line_plain(b, 0, &cols, &mut row);
-        eprintln!("{r:?} {row:?} plain {}", cols.plain);
-        assert!(r.is_some());
-    }
-}
