@@ -498,7 +498,6 @@ fn parse_block_w<const W: usize>(
     Some(blank)
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -520,7 +519,6 @@ mod tests {
         assert!(!parse_block(b"1,2,3x\n", &cols, &mut out));
         assert!(!parse_block(b"1,2,\"3\"\n", &cols, &mut out));
     }
-
 
     #[test]
     fn line_ends_and_skipped_columns() {

@@ -299,4 +299,3 @@ fn withhold_healthy_over_unjudged(report: &mut DiagnoseReport, q: &DataQuality) 
         ));
     }
 }
-

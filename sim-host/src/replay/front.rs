@@ -289,7 +289,11 @@ impl<F: Feeder> ReplaySink<'_, F> {
     fn note_not_judged(&mut self, row: &Row, why: &'static str) {
         let t = row.t_s + self.time_offset;
         // (The replay's time: from its first row, or that of the first row to come.)
-        let t = if self.began { t - self.t0.unwrap_or(t) } else { t };
+        let t = if self.began {
+            t - self.t0.unwrap_or(t)
+        } else {
+            t
+        };
         match self.handled.not_judged.last_mut() {
             Some(last) if last.2 == why && t - last.1 <= MAX_BRIDGED_GAP_S => last.1 = t,
             _ => self.handled.not_judged.push((t, t, why)),

@@ -13,6 +13,7 @@
 //!   the angle: on real recordings of shorted turns a 15 % negative sequence read as
 //!   2.4 %), and the fit is exact for any offset of it.
 
+use super::trig::sin_cos_pair;
 use super::{FILLED_SAMPLES, SENSOR_PHASE_MIN_RATIO};
 use crate::log::quality::MAX_BRIDGED_GAP_S;
 use crate::log::Row;
@@ -20,10 +21,7 @@ use crate::params::ParamFile;
 use monitor_core::angle::SrfPll;
 use monitor_core::filter::Svf;
 use monitor_core::frames::{clarke, park, AlphaBeta, SinCos};
-use super::trig::sin_cos_pair;
-use monitor_core::sequence::{
-    single_phase_gain, PhasorFit, SinglePhaseGain, ThreePhasors,
-};
+use monitor_core::sequence::{single_phase_gain, PhasorFit, SinglePhaseGain, ThreePhasors};
 use monitor_core::Abc;
 use monitor_core::SteadyPoint as IsolationPoint;
 use std::collections::VecDeque;
