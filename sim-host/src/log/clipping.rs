@@ -70,6 +70,14 @@ impl Extremes {
     /// noisy sine).
     #[inline(always)]
     fn push(&mut self, x: f64) {
+        // Strictly between the extremes (most samples; never the first, where they are
+        // equal): both runs end, nothing else changes.
+        if x < self.max && x > self.min {
+            self.n += 1;
+            self.run_max = 0;
+            self.run_min = 0;
+            return;
+        }
         if self.n == 0 {
             *self = Extremes {
                 n: 1,

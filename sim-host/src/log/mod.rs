@@ -26,6 +26,7 @@
 
 pub mod clipping;
 mod columns_error;
+mod csv_line;
 mod exact;
 mod fast;
 pub mod mapping;

@@ -23,11 +23,13 @@
 mod commission;
 mod diagnose;
 mod events;
+mod front;
 mod isolation;
 mod pipe;
 mod report;
 mod sequences;
 mod temperature;
+mod trig;
 mod unsettled;
 mod winding;
 
@@ -212,6 +214,24 @@ pub fn monitor_config_for_log(
     cfg
 }
 
+/// The sequence analysis of a replay of a log with `channels` at `sample_rate_hz` (the
+/// sample limits the monitor's, [`monitor_config_for_log`]). Errors: the filters' checks
+/// ([`sequences::SequenceFront::new`]).
+fn sequence_front(
+    params: &ParamFile,
+    channels: Channels,
+    sample_rate_hz: f64,
+) -> Result<sequences::SequenceFront, monitor_core::ConfigError> {
+    let cfg = monitor_config_for_log(params, sample_rate_hz, &ReplayOptions::default());
+    sequences::SequenceFront::new(
+        params,
+        channels.voltages,
+        sample_rate_hz,
+        f64::from(cfg.limits.i_max),
+        f64::from(cfg.limits.v_max),
+    )
+}
+
 /// Converts log rows to core samples, synthesising encoder counts from speed if needed
 /// (the host's counterpart of the firmware's `drive_monitor::sampling::AdcSampler`).
 ///
@@ -322,11 +342,16 @@ pub struct Replay {
     next_point: f64,
     dt_s: f64,
     max_abs: [f32; 4],
-    last: MonitorOutput,
+    /// What the next row needs of the monitor's output after the last row (a copy of the
+    /// whole output per row is what it saves).
+    last: LastOutput,
     t0: Option<f64>,
     isolation: IsolationTracker,
-    /// The symmetrical components, sample by sample ([`sequences::SequenceTracker`]).
-    sequences: sequences::SequenceTracker,
+    /// The symmetrical components, sample by sample ([`sequences::SequenceFront`]; on the
+    /// reading thread in `diagnose`, whose steps come with the rows: [`Replay::push_step`]).
+    seq_front: sequences::SequenceFront,
+    /// The least-squares windows with the monitor's learning and speed.
+    book: sequences::WindowBook,
     /// The lamps lit now first lit while the operating point had moved (or the load
     /// explained them), and have not all been dark since: their release after the load came
     /// back is still the amber state.
@@ -339,6 +364,9 @@ pub struct Replay {
     unsettled: unsettled::Unsettled,
     /// The monitor's settling time after a restart [s].
     settle_s: f64,
+    /// Added to every row's encoder count after a clock reset: the turn over the bridged
+    /// time ([`Replay::clock_reset`]).
+    enc_offset: i64,
 }
 
 impl Replay {
@@ -391,7 +419,7 @@ impl Replay {
             next_point: 0.0,
             dt_s: 1.0 / sample_rate_hz,
             max_abs: [0.0; 4],
-            last: MonitorOutput::default(),
+            last: LastOutput::default(),
             t0: None,
             isolation: IsolationTracker::new(
                 Isolator::new(
@@ -404,36 +432,60 @@ impl Replay {
                 opts.load,
             ),
             lamps_since_moved: false,
-            sequences: sequences::SequenceTracker::new(
-                params,
-                channels.voltages,
-                sample_rate_hz,
-                f64::from(cfg.limits.i_max),
-                f64::from(cfg.limits.v_max),
-            )
-            .map_err(config_error)?,
+            seq_front: sequence_front(params, channels, sample_rate_hz).map_err(config_error)?,
+            book: sequences::WindowBook::new(),
             timing_faults_seen: 0,
             isolation_hold_until: f64::NEG_INFINITY,
             unsettled: unsettled::Unsettled::default(),
             settle_s: f64::from(cfg.settle_s),
+            enc_offset: 0,
         })
     }
 
     /// Feeds one row; returns the monitor's output (default output for current-only logs).
     pub fn push(&mut self, row: &Row) -> MonitorOutput {
+        let t = row.t_s - *self.t0.get_or_insert(row.t_s);
+        let step = self.seq_front.track(row, t);
+        self.book.take(&mut self.seq_front);
+        self.push_step(row, &step);
+        self.output()
+    }
+
+    /// The monitor's last output (the default for a current-only log).
+    fn output(&self) -> MonitorOutput {
+        self.monitor
+            .as_ref()
+            .map_or_else(MonitorOutput::default, |m| *m.output())
+    }
+
+    /// [`Replay::push`] with the sequence analysis' step for the row already taken (by a
+    /// [`sequences::SequenceFront`] of its own on another thread, whose closed windows were
+    /// queued first: [`Replay::queue_window`]).
+    fn push_step(&mut self, row: &Row, step: &sequences::SequenceStep) {
         self.rows += 1;
         let t0 = *self.t0.get_or_insert(row.t_s);
         let t = row.t_s - t0;
-        let learning = matches!(self.last.commissioning, CommissioningState::Learning(_));
-        let wr = self.monitor.as_ref().map(|_| self.last.operating.wr_rad_s);
-        self.sequences.track(row, t, learning, wr);
+        let wr = self.monitor.as_ref().map(|_| self.last.wr_rad_s);
+        self.book.row(step, self.last.learning, wr);
         let Some(mon) = self.monitor.as_mut() else {
-            return self.last;
+            return;
         };
         self.commission.before(mon, t);
-        let s = self.sampler.sample(row);
-        let out = *mon.update(&s);
-        let range_note = self.commission.after(mon, t, &out);
+        let s = if self.enc_offset == 0 {
+            self.sampler.sample(row)
+        } else {
+            self.sampler.sample(&Row {
+                enc_count: row.enc_count.map(|c| c.wrapping_add(self.enc_offset)),
+                ..*row
+            })
+        };
+        mon.update(&s);
+        let Some(mon) = self.monitor.as_ref() else {
+            return;
+        };
+        // (The output is read where the monitor keeps it: no copy per row.)
+        let out = mon.output();
+        let range_note = self.commission.after(mon, t, out);
         self.evaluated |= out.evaluating;
         if out.evaluating {
             for (m, r) in self.max_abs.iter_mut().zip(out.residuals) {
@@ -443,7 +495,7 @@ impl Replay {
         // With a commissioning window asked for, lamps lit on the fixed thresholds before
         // the learned ones are in force are not detections: the window says the nominal
         // parameters are not to be trusted (a sensor fault counts at any time).
-        let counts = out.sensor_fault.any() || self.commission.thresholds_trusted(&out);
+        let counts = out.sensor_fault.any() || self.commission.thresholds_trusted(out);
         // The bands only matter (and are only looked up) while the gate holds the lamps or a
         // lamp is lit.
         let bands = if out.quasi_steady && !out.fault_detected {
@@ -453,16 +505,16 @@ impl Replay {
         };
         self.unsettled.after(
             t,
-            &out,
+            out,
             if out.quasi_steady {
                 [(0.0, 0.0); 4]
             } else {
                 bands
             },
             self.evaluated,
-            self.commission.thresholds_trusted(&out),
+            self.commission.thresholds_trusted(out),
         );
-        let point = self.sequences.steady_point(out.operating.wr_rad_s);
+        let point = step.point(out.operating.wr_rad_s);
         // After a restart of the monitor's estimators (a long gap, a clock reset) the
         // isolation waits out the monitor's settling time too: the restarted frame's
         // vectors look steady before they are right.
@@ -474,7 +526,7 @@ impl Replay {
         self.isolation.after(
             t,
             self.dt_s,
-            &out,
+            out,
             &point,
             counts && settled,
             row.t_winding_c,
@@ -484,9 +536,9 @@ impl Replay {
             // are evaluated (quasi-steady) and a lit lamp's residual is outside its band: a
             // lamp held through a transient, or after its residual came back (the load
             // returned into the range), detects nothing new there.
-            let current = out.evaluating && lit_outside_band(&out, bands);
+            let current = out.evaluating && lit_outside_band(out, bands);
             self.detected_in_range |=
-                out.sensor_fault.any() || (current && !self.commission.outside_learned_range(&out));
+                out.sensor_fault.any() || (current && !self.commission.outside_learned_range(out));
             if self.first_detection.is_none() {
                 self.first_detection = Some(t);
             }
@@ -506,17 +558,11 @@ impl Replay {
                 let steps = ((t - self.next_point) / self.opts.timeline_step_s).floor() + 1.0;
                 self.next_point += steps * self.opts.timeline_step_s;
             }
-            let point = timeline_point(self, t, &out, range_note);
+            let point = timeline_point(self, t, out, range_note);
             self.timeline.push(point);
         }
-        self.track_judged(&out);
-        self.last = out;
-        out
-    }
-
-    /// The running the lamps were judged on ([`MIN_JUDGED_S`]), and whether the lamps lit
-    /// now lit while the load had moved.
-    fn track_judged(&mut self, out: &MonitorOutput) {
+        // The running the lamps were judged on ([`MIN_JUDGED_S`]), and whether the lamps lit
+        // now lit while the load had moved.
         if out.evaluating && out.quasi_steady && self.commission.thresholds_trusted(out) {
             self.judged_s += self.dt_s;
         }
@@ -526,6 +572,43 @@ impl Replay {
         {
             self.lamps_since_moved = true;
         }
+        self.last = LastOutput::of(out);
+    }
+
+    /// The acquisition clock was reset before the next row (`diagnose` carries the time on
+    /// by [`front::CLOCK_RESET_GAP_S`]): the encoder count handed on goes on by the turn
+    /// over the bridged time at the monitor's speed (the count the data-quality stage hands
+    /// on continues with no step).
+    fn clock_reset(&mut self) {
+        let w = self
+            .monitor
+            .as_ref()
+            .map_or(0.0, |m| f64::from(m.output().speed_rad_s));
+        let turned = w * front::CLOCK_RESET_GAP_S / std::f64::consts::TAU;
+        self.enc_offset = self
+            .enc_offset
+            .wrapping_add((turned * f64::from(COUNTS_PER_REV)).round() as i64);
+    }
+
+    /// `row` with the encoder offset of the clock resets so far ([`Replay::clock_reset`]):
+    /// the row as the monitor sees it.
+    fn with_encoder_offset(&self, row: &Row) -> Row {
+        Row {
+            enc_count: row.enc_count.map(|c| c.wrapping_add(self.enc_offset)),
+            ..*row
+        }
+    }
+
+    /// Queues a window the sequence analysis closed on another thread, before the step of
+    /// the row it closed at ([`Replay::push_step`]).
+    fn queue_window(&mut self, w: Option<SequenceWindow>) {
+        self.book.queue(w);
+    }
+
+    /// Takes over the sequence analysis that ran on another thread, once every row was
+    /// pushed: its last window is the replay's to close ([`Replay::finish`]).
+    fn set_sequence_front(&mut self, front: sequences::SequenceFront) {
+        self.seq_front = front;
     }
 
     /// The learned calibration (mean and spread of r1..r4), once commissioning is done.
@@ -573,7 +656,7 @@ impl Replay {
 
     /// A sensor fault was flagged at the end (the lamps' detections then stand).
     fn out_sensor_fault_seen(&self) -> bool {
-        self.last.sensor_fault.any()
+        self.last.sensor_fault
     }
 
     /// Every name the isolation gave so far (a fault or the friction class `b/bl`), each
@@ -606,6 +689,27 @@ impl Replay {
     /// True when a commissioning window was asked for and not learned.
     pub fn commissioning_incomplete(&self) -> bool {
         self.monitor.is_some() && self.commission.incomplete()
+    }
+}
+
+/// What a replay keeps of the monitor's output after a row for the next one.
+#[derive(Debug, Clone, Copy, Default)]
+struct LastOutput {
+    /// The commissioning window is being learned.
+    learning: bool,
+    /// The electrical rotor speed [rad/s].
+    wr_rad_s: f32,
+    /// A sensor fault is flagged.
+    sensor_fault: bool,
+}
+
+impl LastOutput {
+    fn of(out: &MonitorOutput) -> Self {
+        LastOutput {
+            learning: matches!(out.commissioning, CommissioningState::Learning(_)),
+            wr_rad_s: out.operating.wr_rad_s,
+            sensor_fault: out.sensor_fault.any(),
+        }
     }
 }
 

@@ -1,252 +1,228 @@
-//! The replay on a thread of its own: the data-quality stage (on the reading thread) hands
-//! what it passes on to a [`CleanSink`] on another thread, in batches over a bounded
-//! channel, so that the stage and the replay run side by side on two cores (the parsing
-//! workers fill in the rest; docs/performance.md, "diagnose of a 1 h log").
+//! The replay on a thread of its own: the reading thread runs the data-quality stage, the
+//! glitch and clock handling before the replay ([`super::front::ReplaySink`]) and the
+//! sequence analysis' filters ([`SequenceFront`], which need nothing but the rows); it
+//! hands the rows with their sequence steps, in batches over a bounded channel, to the
+//! monitor, the isolation and the bookkeeping on another thread ([`Replay::push_step`]).
+//! The two run side by side on two cores (the parsing workers fill in the rest;
+//! docs/performance.md, "diagnose of a 1 h log").
 //!
-//! The sink sees the same calls in the same order as without the thread: the replay's
-//! results are the same, bit for bit. [`CleanSink::begin`] is answered synchronously (a
-//! sink that cannot be configured stops the read at once, as without the thread). A sink
-//! that asks to stop later ([`CleanSink::row`] or [`CleanSink::new_segment`] returning
-//! false) stops the stage at the next batch: up to [`BATCH`] rows more are read and
-//! dropped (the replay's sink never asks that).
+//! The replay sees the same rows in the same order, with the same steps, as without the
+//! thread ([`Replay::push`] runs the same two halves one after the other): the results are
+//! the same, bit for bit. The replay's configuration at the time base is answered
+//! synchronously (a configuration the core rejects stops the read at once, as without the
+//! thread).
 
-use crate::log::quality::{BadCells, CleanSink, SegmentBreak, TimeBase};
-use crate::log::Row;
-use std::sync::atomic::{AtomicBool, Ordering};
+use super::front::Feeder;
+use super::sequences::{SequenceFront, SequenceStep};
+use super::{sequence_front, Replay, ReplayError, ReplayOptions, SequenceWindow};
+use crate::log::{Channels, Row};
+use crate::params::ParamFile;
 use std::sync::mpsc::{channel, sync_channel, Receiver, Sender, SyncSender};
 
-/// Calls per batch (about 110 bytes each).
+/// Calls per batch (about 150 bytes each).
 const BATCH: usize = 4096;
 /// Batches on their way at most (the reading thread waits beyond: bounded memory).
 const IN_FLIGHT: usize = 4;
 
-/// One call of the [`CleanSink`] interface.
+/// One call to the replay's thread.
+#[allow(clippy::large_enum_variant)]
 enum Call {
-    Begin(TimeBase),
-    Row(Row, BadCells),
-    Segment(SegmentBreak),
+    /// Configure the replay at this sample rate [Hz] (answered).
+    Begin(f64),
+    /// A window the sequence analysis closed ([`Replay::queue_window`]).
+    Window(Option<SequenceWindow>),
+    /// One row and its sequence step.
+    Row(Row, SequenceStep),
+    /// The acquisition clock was reset before the next row ([`Replay::clock_reset`]).
+    ClockReset,
+    /// Forget everything: the rows come again.
     Restart,
+    /// The read is over: the sequence analysis as it ended ([`Replay::set_sequence_front`]).
+    End(Box<SequenceFront>),
 }
 
-/// The reading thread's end: a [`CleanSink`] that batches the calls (given to the read by
-/// [`on_own_thread`]).
-pub(super) struct Pipe<'s> {
+/// The reading thread's end: a [`Feeder`] that runs the sequence analysis and batches the
+/// calls (given to the read by [`on_own_thread`]).
+pub(super) struct Pipe<'a> {
+    params: &'a ParamFile,
+    channels: Channels,
     tx: SyncSender<Vec<Call>>,
     /// Emptied batches coming back (their memory reused).
     back: Receiver<Vec<Call>>,
-    /// The answer to [`CleanSink::begin`].
+    /// The answer to [`Call::Begin`].
     began: Receiver<bool>,
     batch: Vec<Call>,
-    /// Set by the other end when its sink asked to stop.
-    stop: &'s AtomicBool,
+    front: Option<SequenceFront>,
+    /// The first row's time (the replay's time 0) [s].
+    t0: Option<f64>,
+    /// The other end is gone.
+    closed: bool,
 }
 
 impl Pipe<'_> {
-    /// Sends the batch; false when the other end asked to stop or is gone.
-    fn flush(&mut self) -> bool {
-        if !self.batch.is_empty() {
-            let next = self
-                .back
-                .try_recv()
-                .unwrap_or_else(|_| Vec::with_capacity(BATCH));
-            let full = std::mem::replace(&mut self.batch, next);
-            if self.tx.send(full).is_err() {
-                return false;
-            }
+    /// Sends the batch.
+    fn flush(&mut self) {
+        if self.batch.is_empty() || self.closed {
+            return;
         }
-        !self.stop.load(Ordering::Relaxed)
+        let next = self
+            .back
+            .try_recv()
+            .unwrap_or_else(|_| Vec::with_capacity(BATCH));
+        let full = std::mem::replace(&mut self.batch, next);
+        self.closed = self.tx.send(full).is_err();
     }
 
-    fn push(&mut self, c: Call) -> bool {
+    fn push(&mut self, c: Call) {
         self.batch.push(c);
-        self.batch.len() < BATCH || self.flush()
+        if self.batch.len() >= BATCH {
+            self.flush();
+        }
+    }
+
+    /// The read is over: the sequence analysis goes to the replay, and every call is sent.
+    fn end(&mut self) {
+        if let Some(f) = self.front.take() {
+            self.push(Call::End(Box::new(f)));
+        }
+        self.flush();
     }
 }
 
-impl CleanSink for Pipe<'_> {
-    fn begin(&mut self, base: &TimeBase) -> bool {
-        self.batch.push(Call::Begin(*base));
-        self.flush() && self.began.recv().unwrap_or(false)
+impl Feeder for Pipe<'_> {
+    fn begin(&mut self, rate_hz: f64) -> bool {
+        // (A rate the filters refuse is refused by the replay's own start too: `began` is false.)
+        self.front = sequence_front(self.params, self.channels, rate_hz).ok();
+        self.t0 = None;
+        self.push(Call::Begin(rate_hz));
+        self.flush();
+        !self.closed && self.began.recv().unwrap_or(false)
     }
 
-    fn row(&mut self, row: &Row, bad: BadCells) -> bool {
-        self.push(Call::Row(*row, bad))
+    fn row(&mut self, row: &Row) {
+        let Some(front) = self.front.as_mut() else {
+            return;
+        };
+        let t = row.t_s - *self.t0.get_or_insert(row.t_s);
+        let step = front.track(row, t);
+        while let Some(w) = self.front.as_mut().and_then(SequenceFront::take_closed) {
+            self.push(Call::Window(w));
+        }
+        self.push(Call::Row(*row, step));
     }
 
-    fn new_segment(&mut self, why: SegmentBreak) -> bool {
-        self.push(Call::Segment(why))
+    fn clock_reset(&mut self) {
+        self.push(Call::ClockReset);
     }
 
     fn restart(&mut self) {
+        self.front = None;
+        self.t0 = None;
         self.push(Call::Restart);
     }
 }
 
-/// The other thread's end: hands every call to `sink` in order, none after the sink asked
-/// to stop (the stage would not have passed them on).
-fn receive<S: CleanSink>(
-    sink: &mut S,
-    rx: Receiver<Vec<Call>>,
-    back: Sender<Vec<Call>>,
-    began: Sender<bool>,
-    stop: &AtomicBool,
-) {
-    let mut stopped = false;
-    for mut batch in rx {
-        for c in batch.drain(..) {
-            let go = match c {
-                Call::Begin(base) => {
-                    let ok = !stopped && sink.begin(&base);
-                    // (The reading thread waits for this answer.)
-                    let _ = began.send(ok);
-                    ok
+/// The replay's thread's end: the replay, configured at [`Call::Begin`].
+struct Back<'a> {
+    params: &'a ParamFile,
+    channels: Channels,
+    opts: ReplayOptions,
+    replay: Option<Replay>,
+    error: Option<ReplayError>,
+}
+
+impl Back<'_> {
+    /// One call; `began` gets the answer to [`Call::Begin`].
+    fn call(&mut self, c: Call, began: &Sender<bool>) {
+        match c {
+            Call::Begin(rate) => {
+                match Replay::new(self.params, self.channels, rate, self.opts) {
+                    Ok(r) => self.replay = Some(r),
+                    Err(e) => self.error = Some(e),
                 }
-                _ if stopped => false,
-                Call::Row(row, bad) => sink.row(&row, bad),
-                Call::Segment(why) => sink.new_segment(why),
-                Call::Restart => {
-                    sink.restart();
-                    true
+                // (The reading thread waits for this answer.)
+                let _ = began.send(self.replay.is_some());
+            }
+            Call::Restart => {
+                self.replay = None;
+                self.error = None;
+            }
+            c => {
+                let Some(r) = self.replay.as_mut() else {
+                    return;
+                };
+                match c {
+                    Call::Window(w) => r.queue_window(w),
+                    Call::Row(row, step) => r.push_step(&row, &step),
+                    Call::ClockReset => r.clock_reset(),
+                    Call::End(front) => r.set_sequence_front(*front),
+                    Call::Begin(_) | Call::Restart => {}
                 }
-            };
-            if !go && !stopped {
-                stopped = true;
-                stop.store(true, Ordering::Relaxed);
             }
         }
-        // (The reading thread may be gone already.)
-        let _ = back.send(batch);
     }
 }
 
-/// Runs `read` on this thread with a [`Pipe`] whose calls reach `sink` on a thread of its
-/// own (module docs); returns `read`'s result once `sink` has had every call.
-pub(super) fn on_own_thread<S, R>(sink: &mut S, read: impl FnOnce(&mut Pipe<'_>) -> R) -> R
-where
-    S: CleanSink + Send,
-{
-    let stop = AtomicBool::new(false);
+/// Receives every batch and hands it to `back` in order, returning the emptied batches.
+fn receive(
+    back: &mut Back<'_>,
+    rx: Receiver<Vec<Call>>,
+    empty: Sender<Vec<Call>>,
+    began: Sender<bool>,
+) {
+    for mut batch in rx {
+        for c in batch.drain(..) {
+            back.call(c, &began);
+        }
+        // (The reading thread may be gone already.)
+        let _ = empty.send(batch);
+    }
+}
+
+/// Runs `read` on this thread with a [`Pipe`] whose rows reach a replay of a log of
+/// `params`' machine with `channels` on a thread of its own (module docs); returns `read`'s
+/// result once the replay has had every row, and the replay (`None` when it was never
+/// configured) or the error configuring it.
+pub(super) fn on_own_thread<R>(
+    params: &ParamFile,
+    channels: Channels,
+    opts: ReplayOptions,
+    read: impl FnOnce(&mut Pipe<'_>) -> R,
+) -> (R, Result<Option<Replay>, ReplayError>) {
     let (tx, rx) = sync_channel(IN_FLIGHT);
-    let (back_tx, back) = channel();
-    let (began_tx, began) = channel();
-    std::thread::scope(|s| {
-        let stop = &stop;
-        s.spawn(move || receive(sink, rx, back_tx, began_tx, stop));
+    let (empty_tx, empty_rx) = channel();
+    let (began_tx, began_rx) = channel();
+    let mut back = Back {
+        params,
+        channels,
+        opts,
+        replay: None,
+        error: None,
+    };
+    let r = std::thread::scope(|s| {
+        let b = &mut back;
+        s.spawn(move || receive(b, rx, empty_tx, began_tx));
         let mut pipe = Pipe {
+            params,
+            channels,
             tx,
-            back,
-            began,
+            back: empty_rx,
+            began: began_rx,
             batch: Vec::with_capacity(BATCH),
-            stop,
+            front: None,
+            t0: None,
+            closed: false,
         };
         let r = read(&mut pipe);
-        pipe.flush();
+        pipe.end();
         // (Dropping the pipe closes the channel: the thread ends after the last batch,
         // and the scope waits for it.)
         drop(pipe);
         r
-    })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::log::quality::TimeUnit;
-
-    /// Records every call; refuses to begin or stops after `stop_after` rows when asked.
-    #[derive(Default)]
-    struct Recorder {
-        calls: Vec<String>,
-        refuse_begin: bool,
-        stop_after: Option<usize>,
-        rows: usize,
-    }
-
-    impl CleanSink for Recorder {
-        fn begin(&mut self, base: &TimeBase) -> bool {
-            self.calls.push(format!("begin {}", base.sample_rate_hz));
-            !self.refuse_begin
-        }
-        fn row(&mut self, row: &Row, bad: BadCells) -> bool {
-            self.rows += 1;
-            self.calls.push(format!("row {} {}", row.t_s, bad.any()));
-            self.stop_after.is_none_or(|n| self.rows < n)
-        }
-        fn new_segment(&mut self, why: SegmentBreak) -> bool {
-            self.calls.push(format!("segment {why:?}"));
-            true
-        }
-        fn restart(&mut self) {
-            self.calls.push("restart".to_string());
-        }
-    }
-
-    fn row(t: f64) -> Row {
-        Row {
-            t_s: t,
-            v_abc: None,
-            i_abc: [t, -t, 0.0],
-            wm_rad_s: None,
-            enc_count: None,
-            t_winding_c: None,
-        }
-    }
-
-    /// Feeds `n` rows (a segment break and a restart among them) into `sink`; the answers
-    /// of the calls, and whether the feed ran to its end.
-    fn feed(sink: &mut dyn CleanSink, n: usize) -> (Vec<bool>, bool) {
-        let base = TimeBase {
-            unit: TimeUnit::S,
-            sample_rate_hz: 1000.0,
-            t0_s: 0.0,
-        };
-        let mut answers = vec![sink.begin(&base)];
-        if !answers[0] {
-            return (answers, false);
-        }
-        for k in 0..n {
-            if k == 5000 {
-                answers.push(sink.new_segment(SegmentBreak::Gap(2.0)));
-            }
-            if k == 7000 {
-                sink.restart();
-            }
-            if !sink.row(&row(k as f64), BadCells::default()) {
-                return (answers, false);
-            }
-        }
-        (answers, true)
-    }
-
-    #[test]
-    fn the_sink_gets_the_same_calls_in_the_same_order() {
-        for n in [0, 1, BATCH - 1, BATCH, 3 * BATCH + 17] {
-            let mut direct = Recorder::default();
-            let d = feed(&mut direct, n);
-            let mut piped = Recorder::default();
-            let p = on_own_thread(&mut piped, |pipe| feed(pipe, n));
-            assert_eq!(d, p, "{n} rows");
-            assert_eq!(direct.calls, piped.calls, "{n} rows");
-        }
-    }
-
-    #[test]
-    fn a_refused_begin_stops_at_once_and_a_stop_within_a_batch() {
-        let mut piped = Recorder {
-            refuse_begin: true,
-            ..Recorder::default()
-        };
-        let (answers, ran) = on_own_thread(&mut piped, |pipe| feed(pipe, 100));
-        assert_eq!((answers, ran), (vec![false], false));
-        assert_eq!(piped.calls.len(), 1);
-        // A stop asked at row 10: the reading side learns it at the next batch and the
-        // sink gets no row after the tenth.
-        let mut piped = Recorder {
-            stop_after: Some(10),
-            ..Recorder::default()
-        };
-        let (_, ran) = on_own_thread(&mut piped, |pipe| feed(pipe, 10 * BATCH));
-        assert!(!ran);
-        assert_eq!(piped.rows, 10);
-    }
+    });
+    let replay = match back.error {
+        Some(e) => Err(e),
+        None => Ok(back.replay),
+    };
+    (r, replay)
 }

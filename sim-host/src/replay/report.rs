@@ -360,9 +360,12 @@ impl Replay {
     /// Ends the replay and builds the report (`data_quality` left at its default for the
     /// caller to fill).
     pub fn finish(mut self) -> DiagnoseReport {
-        let out = self.last;
-        self.sequences
-            .finish(self.monitor.as_ref().map(|_| out.operating.wr_rad_s));
+        let out = self.output();
+        if self.seq_front.finish() {
+            self.book.take(&mut self.seq_front);
+            self.book
+                .close(self.monitor.as_ref().map(|_| out.operating.wr_rad_s));
+        }
         let mut skipped = Vec::new();
         if !self.channels.voltages {
             skipped.push(
@@ -499,7 +502,7 @@ impl Replay {
         if withheld.is_empty() {
             withheld.extend(nominal_cannot_judge(
                 detected,
-                self.last.sensor_fault.any(),
+                self.last.sensor_fault,
                 isolation,
             ));
         }

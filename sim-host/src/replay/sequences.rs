@@ -3,7 +3,7 @@
 //!
 //! Two analyses run on one PLL (locked to the voltages where logged, else to the
 //! amplitude-normalised current vector):
-//! - filtered Park sequences ([`SequenceAnalyzer`], 2 Hz) on the PLL's own angle: the
+//! - filtered Park sequences ([`SequenceAnalyzer`](monitor_core::sequence::SequenceAnalyzer), 2 Hz) on the PLL's own angle: the
 //!   steady point the isolation evaluates ([`SequenceTracker::steady_point`]);
 //! - least-squares phasors ([`PhasorFit`]) over windows of [`WINDOW_PERIODS`] supply
 //!   periods on a reference angle that turns at the PLL's frequency low-passed at
@@ -13,6 +13,7 @@
 //!   the angle: on real recordings of shorted turns a 15 % negative sequence read as
 //!   2.4 %), and the fit is exact for any offset of it.
 
+use super::trig::sin_cos_pair;
 use super::{FILLED_SAMPLES, SENSOR_PHASE_MIN_RATIO};
 use crate::log::quality::MAX_BRIDGED_GAP_S;
 use crate::log::Row;
@@ -20,11 +21,10 @@ use crate::params::ParamFile;
 use monitor_core::angle::SrfPll;
 use monitor_core::filter::{Svf, SvfState};
 use monitor_core::frames::{clarke, park, AlphaBeta, SinCos};
-use monitor_core::sequence::{
-    single_phase_gain, PhasorFit, SequenceAnalyzer, SinglePhaseGain, ThreePhasors, ZeroSequence,
-};
+use monitor_core::sequence::{single_phase_gain, PhasorFit, SinglePhaseGain, ThreePhasors};
 use monitor_core::Abc;
 use monitor_core::SteadyPoint as IsolationPoint;
+use std::collections::VecDeque;
 
 /// Supply periods per least-squares window (at the nominal frequency): 0.17 s at 60 Hz,
 /// 0.2 s at 50 Hz. Short enough to see a fault switched on and off within a few seconds,
@@ -86,7 +86,6 @@ struct OpenWindow {
     offset_sum: f64,
     w_min: f32,
     w_max: f32,
-    learning: bool,
 }
 
 impl OpenWindow {
@@ -102,14 +101,49 @@ impl OpenWindow {
             offset_sum: 0.0,
             w_min: f32::INFINITY,
             w_max: 0.0,
-            learning: true,
         }
     }
 }
 
-/// The sequences of every log, sample by sample (module docs).
+/// The positive sequence of a vector on an angle turning at the supply frequency: the
+/// Park components filtered as the core's [`SequenceAnalyzer`](monitor_core::sequence::SequenceAnalyzer) filters them (the steady
+/// point needs no more of it).
+#[derive(Debug, Clone, Copy)]
+struct Positive {
+    filter: Svf,
+    d: SvfState,
+    q: SvfState,
+}
+
+impl Positive {
+    fn new(fc_hz: f32, dt_s: f32) -> Result<Self, monitor_core::ConfigError> {
+        Ok(Positive {
+            filter: Svf::new(fc_hz, dt_s)?,
+            d: SvfState::default(),
+            q: SvfState::default(),
+        })
+    }
+
+    /// [`SequenceAnalyzer::update`](monitor_core::sequence::SequenceAnalyzer::update)'s positive sequence.
+    #[inline]
+    fn update(&mut self, x: AlphaBeta, sc: SinCos) {
+        let p = park(x, sc);
+        self.filter.update(&mut self.d, p.d);
+        self.filter.update(&mut self.q, p.q);
+    }
+
+    /// [`SequenceAnalyzer::positive`](monitor_core::sequence::SequenceAnalyzer::positive).
+    fn value(&self) -> (f32, f32) {
+        (self.d.y(), self.q.y())
+    }
+}
+
+/// The sequences of every log, sample by sample (module docs): the filters and the fits,
+/// which need nothing but the rows (the monitor's learning and speed, which the windows
+/// carry, are the [`WindowBook`]'s), so that they can run on another thread than the
+/// monitor.
 #[derive(Debug, Clone)]
-pub(super) struct SequenceTracker {
+pub(super) struct SequenceFront {
     dt_s: f64,
     i_max: f64,
     v_max: f64,
@@ -120,10 +154,9 @@ pub(super) struct SequenceTracker {
     /// Mean square of the current vector, low-passed: the currents' normaliser for the PLL.
     i_ms: Svf,
     i_ms_state: SvfState,
-    seq: SequenceAnalyzer,
-    seq_v: SequenceAnalyzer,
-    zero_i: ZeroSequence,
-    zero_v: ZeroSequence,
+    /// The positive sequences of the currents and the voltages on the PLL's angle.
+    seq: Positive,
+    seq_v: Positive,
     /// Time of the last row seen [s].
     last_t: Option<f64>,
     /// The PLL's frequency low-passed (`y`) and the reference angle it turns [rad].
@@ -136,10 +169,104 @@ pub(super) struct SequenceTracker {
     /// Samples per least-squares window.
     window_len: u32,
     open: OpenWindow,
+    /// The windows closed and not yet taken by the book, in order: `None` for one that had
+    /// no solution (the book's learning flag restarts all the same).
+    closed: VecDeque<Option<SequenceWindow>>,
+}
+
+/// What [`SequenceFront::track`] found at one row: the steady point's vectors (the
+/// monitor's speed is added by [`SequenceStep::point`]) and whether the open window was
+/// closed before the row's sample (a gap the data-quality stage does not bridge) or after
+/// it (full).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(super) struct SequenceStep {
+    i: (f32, f32),
+    v: (f32, f32),
+    we_rad_s: f32,
+    closed_before: bool,
+    closed_after: bool,
+}
+
+impl SequenceStep {
+    /// The steady-state vectors for the isolation: the positive sequences of voltage and
+    /// current on the PLL's angle, its frequency, and the monitor's electrical speed
+    /// `wr_rad_s` (encoder, filtered).
+    pub fn point(&self, wr_rad_s: f32) -> IsolationPoint {
+        IsolationPoint {
+            i: monitor_core::Dq {
+                d: self.i.0,
+                q: self.i.1,
+            },
+            v: monitor_core::Dq {
+                d: self.v.0,
+                q: self.v.1,
+            },
+            we_rad_s: self.we_rad_s,
+            wr_rad_s,
+        }
+    }
+}
+
+/// The least-squares windows with what the monitor adds to them: whether the commissioning
+/// window's learning covered every sample, and the monitor's speed where the window closed.
+#[derive(Debug, Clone, Default)]
+pub(super) struct WindowBook {
+    /// The open window's samples were all offered while learning.
+    learning: bool,
+    /// Windows closed by the front, not yet booked.
+    queue: VecDeque<Option<SequenceWindow>>,
     windows: Vec<SequenceWindow>,
 }
 
-impl SequenceTracker {
+impl WindowBook {
+    /// An empty book.
+    pub fn new() -> Self {
+        WindowBook {
+            learning: true,
+            ..WindowBook::default()
+        }
+    }
+
+    /// Takes the windows the front closed (in order).
+    pub fn take(&mut self, front: &mut SequenceFront) {
+        self.queue.extend(front.closed.drain(..));
+    }
+
+    /// Queues one window the front closed (the other thread's end of [`WindowBook::take`]).
+    pub fn queue(&mut self, w: Option<SequenceWindow>) {
+        self.queue.push_back(w);
+    }
+
+    /// Books one row's step: `learning` whether the monitor was learning its commissioning
+    /// window, `wr_rad_s` its electrical speed, both at the row before (where the log has a
+    /// speed).
+    pub fn row(&mut self, step: &SequenceStep, learning: bool, wr_rad_s: Option<f32>) {
+        if step.closed_before {
+            self.close(wr_rad_s);
+        }
+        self.learning &= learning;
+        if step.closed_after {
+            self.close(wr_rad_s);
+        }
+    }
+
+    /// Ends the open window (the front closed it).
+    pub fn close(&mut self, wr_rad_s: Option<f32>) {
+        if let Some(mut w) = self.queue.pop_front().flatten() {
+            w.learning = self.learning;
+            w.wr_rad_s = wr_rad_s;
+            self.windows.push(w);
+        }
+        self.learning = true;
+    }
+
+    /// The least-squares windows so far (the open one left out).
+    pub fn windows(&self) -> &[SequenceWindow] {
+        &self.windows
+    }
+}
+
+impl SequenceFront {
     /// A tracker for a log at `sample_rate_hz` with (or without) voltage columns; the
     /// sample limits `i_max`, `v_max` are the monitor's. Errors: the filters' checks
     /// ([`Svf::new`]: a sample rate too low for their corners).
@@ -152,8 +279,7 @@ impl SequenceTracker {
     ) -> Result<Self, monitor_core::ConfigError> {
         let dt = (1.0 / sample_rate_hz) as f32;
         let f0 = params.supply.f_hz as f32;
-        let w_ref = Svf::new(REFERENCE_FC_HZ, dt)?;
-        Ok(SequenceTracker {
+        Ok(SequenceFront {
             dt_s: 1.0 / sample_rate_hz,
             i_max,
             v_max,
@@ -174,12 +300,10 @@ impl SequenceTracker {
             ),
             i_ms: Svf::new(2.0, dt)?,
             i_ms_state: SvfState::default(),
-            seq: SequenceAnalyzer::new(2.0, dt)?,
-            seq_v: SequenceAnalyzer::new(2.0, dt)?,
-            zero_i: ZeroSequence::new(2.0, dt)?,
-            zero_v: ZeroSequence::new(2.0, dt)?,
+            seq: Positive::new(2.0, dt)?,
+            seq_v: Positive::new(2.0, dt)?,
             last_t: None,
-            w_ref,
+            w_ref: Svf::new(REFERENCE_FC_HZ, dt)?,
             w_ref_state: SvfState::at(core::f32::consts::TAU * f0),
             theta_ref: 0.0,
             offset: 0.0,
@@ -187,18 +311,18 @@ impl SequenceTracker {
             window_len: ((WINDOW_PERIODS * sample_rate_hz / params.supply.f_hz).round() as u32)
                 .max(monitor_core::sequence::PHASOR_FIT_MIN_SAMPLES),
             open: OpenWindow::new(),
-            windows: Vec::new(),
+            closed: VecDeque::new(),
         })
     }
 
-    /// Feeds one row at `t` [s since the first row]; `learning`: the monitor is learning
-    /// its commissioning window; `wr_rad_s`: the monitor's electrical rotor speed where the
-    /// log has one. A row with a bad current is held out (the monitor holds such samples
-    /// out itself); a bad voltage leaves the voltages' analysis alone.
-    pub fn track(&mut self, row: &Row, t: f64, learning: bool, wr_rad_s: Option<f32>) {
+    /// Feeds one row at `t` [s since the first row]. A row with a bad current is held out
+    /// (the monitor holds such samples out itself); a bad voltage leaves the voltages'
+    /// analysis alone.
+    pub fn track(&mut self, row: &Row, t: f64) -> SequenceStep {
         // Samples missing from the stream: the angles advance over the missing time at
         // their frequency (as the monitor's frame does), so that the sequences stay put.
         let mut filled = 0usize;
+        let mut step = SequenceStep::default();
         if let Some(prev) = self.last_t.replace(t) {
             let missing = t - prev - self.dt_s;
             if missing > 0.5 * self.dt_s && missing <= MAX_BRIDGED_GAP_S {
@@ -213,14 +337,15 @@ impl SequenceTracker {
                 }
             } else if missing > MAX_BRIDGED_GAP_S {
                 // A gap the data-quality stage does not bridge: the window ends there.
-                self.close_window(wr_rad_s);
+                self.close_window();
+                step.closed_before = true;
             }
         }
         self.theta_ref = monitor_core::frames::wrap_angle(
             self.theta_ref + self.w_ref_state.y() * self.dt_s as f32,
         );
         self.offset += (f64::from(self.w_ref_state.y()) - self.w0) * self.dt_s;
-        self.offer_window_sample(t, learning);
+        self.offer_window_sample(t);
         let ok = |x: &[f64; 3], max: f64| x.iter().all(|v| v.is_finite() && v.abs() <= max);
         let abc = |x: &[f64; 3]| Abc {
             a: x[0] as f32,
@@ -237,20 +362,25 @@ impl SequenceTracker {
             if self.voltages && v_abc.is_none() {
                 self.open.bad_v += 1;
             }
-            self.filtered(i_abc, v_abc, filled);
-            let sc = SinCos::from_angle(self.theta_ref);
+            let (sc_pll, sc) = sin_cos_pair(self.pll.theta_pll(), self.theta_ref);
+            self.filtered(i_abc, v_abc, filled, sc_pll);
             self.open.fit_i.update(sc, i_abc);
             if let Some(v) = v_abc {
                 self.open.fit_v.update(sc, v);
             }
         }
         if self.open.offered >= self.window_len {
-            self.close_window(wr_rad_s);
+            self.close_window();
+            step.closed_after = true;
         }
+        step.i = self.seq.value();
+        step.v = self.seq_v.value();
+        step.we_rad_s = self.pll.omega_rad_s();
+        step
     }
 
     /// Counts a sample into the open window (its time span, the reference's frequency).
-    fn offer_window_sample(&mut self, t: f64, learning: bool) {
+    fn offer_window_sample(&mut self, t: f64) {
         let w = self.w_ref_state.y();
         let o = &mut self.open;
         if o.offered == 0 {
@@ -262,15 +392,14 @@ impl SequenceTracker {
         o.offset_sum += self.offset;
         o.w_min = o.w_min.min(w);
         o.w_max = o.w_max.max(w);
-        o.learning &= learning;
     }
 
     /// The PLL and the filtered sequences (the isolation's steady point); the reference
     /// frequency follows the PLL's.
-    fn filtered(&mut self, i_abc: Abc, v_abc: Option<Abc>, filled: usize) {
+    /// `sc` is the sin/cos of the PLL's angle.
+    fn filtered(&mut self, i_abc: Abc, v_abc: Option<Abc>, filled: usize, sc: SinCos) {
         let i = clarke(i_abc);
         let v = v_abc.map(clarke);
-        let sc = SinCos::from_angle(self.pll.theta_pll());
         match v {
             Some(v) if self.pll_on_voltage => {
                 self.pll.update(v, sc);
@@ -315,27 +444,30 @@ impl SequenceTracker {
             }
         }
         self.seq.update(i, sc);
-        self.zero_i.update(i_abc, sc);
-        if let (Some(v), Some(v_abc)) = (v, v_abc) {
+        if let Some(v) = v {
             self.seq_v.update(v, sc);
-            self.zero_v.update(v_abc, sc);
         }
     }
 
-    /// Ends the open window: solves its fits and keeps it (when it has a solution).
-    fn close_window(&mut self, wr_rad_s: Option<f32>) {
+    /// Ends the open window: solves its fits and queues it for the book (`None` when it
+    /// has no solution).
+    fn close_window(&mut self) {
         let o = std::mem::replace(&mut self.open, OpenWindow::new());
+        self.closed.push_back(self.solved(&o));
+    }
+
+    /// The window `o` solved, `None` when empty or without a solution. (The learning flag
+    /// and the monitor's speed are the book's.)
+    fn solved(&self, o: &OpenWindow) -> Option<SequenceWindow> {
         if o.offered == 0 {
-            return;
+            return None;
         }
-        let Some(i) = o.fit_i.solve() else {
-            return;
-        };
+        let i = o.fit_i.solve()?;
         let w_mean = (o.w_sum / f64::from(o.offered)) as f32;
         let complete = f64::from(i.samples) >= MIN_WINDOW_FILL * f64::from(self.window_len);
         let steady =
             complete && w_mean > 0.0 && (o.w_max - o.w_min) <= STEADY_FREQUENCY_RANGE * w_mean;
-        self.windows.push(SequenceWindow {
+        Some(SequenceWindow {
             from_s: o.from_s,
             to_s: o.to_s,
             i,
@@ -344,36 +476,26 @@ impl SequenceTracker {
                 .flatten(),
             we_rad_s: w_mean,
             offset_rad: o.offset_sum / f64::from(o.offered),
-            wr_rad_s,
+            wr_rad_s: None,
             complete,
             steady,
-            learning: o.learning,
-        });
+            learning: true,
+        })
     }
 
-    /// Ends the analysis: the last window, if it holds at least half a window's samples.
-    pub fn finish(&mut self, wr_rad_s: Option<f32>) {
-        if f64::from(self.open.offered) >= 0.5 * f64::from(self.window_len) {
-            self.close_window(wr_rad_s);
+    /// The next window closed and not yet taken (`Some(None)`: one without a solution).
+    pub fn take_closed(&mut self) -> Option<Option<SequenceWindow>> {
+        self.closed.pop_front()
+    }
+
+    /// Ends the analysis: closes the last window if it holds at least half a window's
+    /// samples (true; the book then closes it too).
+    pub fn finish(&mut self) -> bool {
+        let last = f64::from(self.open.offered) >= 0.5 * f64::from(self.window_len);
+        if last {
+            self.close_window();
         }
-    }
-
-    /// The least-squares windows so far (the open one left out).
-    pub fn windows(&self) -> &[SequenceWindow] {
-        &self.windows
-    }
-
-    /// The steady-state vectors for the isolation: the positive sequences of voltage and
-    /// current on the PLL's angle, its frequency, and the monitor's electrical speed
-    /// `wr_rad_s` (encoder, filtered).
-    pub fn steady_point(&self, wr_rad_s: f32) -> IsolationPoint {
-        let (v, i) = (self.seq_v.positive(), self.seq.positive());
-        IsolationPoint {
-            i: monitor_core::Dq { d: i.0, q: i.1 },
-            v: monitor_core::Dq { d: v.0, q: v.1 },
-            we_rad_s: self.pll.omega_rad_s(),
-            wr_rad_s,
-        }
+        last
     }
 }
 

@@ -679,7 +679,7 @@ impl Judge {
 impl Replay {
     /// The negative-sequence report (module docs).
     pub(super) fn unbalance_report(&self) -> UnbalanceReport {
-        let windows = self.sequences.windows();
+        let windows = self.book.windows();
         let segs = segments(windows);
         let (measured, whole_ratio) = measured_of(windows, &segs);
         let s0 = if self.channels.voltages {

@@ -516,38 +516,51 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         }
         let before = bad;
         self.stuck.check(&r, &mut bad);
-        for c in Column::ALL {
-            if bad.has(c) && !before.has(c) {
-                *self.q.stuck_cells.entry(c.name().to_string()).or_insert(0) += 1;
-            }
+        if bad != before {
+            self.count_stuck(before, bad);
         }
-        self.clips.push(&r, |c| !bad.has(c));
         if bad.any() {
-            self.q.bad_rows += 1;
-            for c in Column::ALL {
-                if bad.has(c) {
-                    *self.q.bad_cells.entry(c.name().to_string()).or_insert(0) += 1;
-                    let x = r.value(c).unwrap_or(f64::NAN);
-                    let (finite, beyond) = (x.is_finite(), self.limits.beyond(c, x));
-                    self.cells_out[c as usize][0] += u64::from(!finite);
-                    self.cells_out[c as usize][1] += u64::from(finite && beyond);
-                }
-            }
-            let start = self.burst.map_or(r.t_s, |b| b.0);
-            self.burst = Some((start, r.t_s));
+            self.bad_row(&r, bad);
+            self.wiring.interrupt();
         } else {
+            self.clips.push(&r, |_| true);
             self.end_burst();
             self.crossings.push(r.t_s, r.i_abc[0], 1.0);
             if let Some(w) = r.wm_rad_s {
                 self.speed.push(w);
             }
-        }
-        if bad.any() {
-            self.wiring.interrupt();
-        } else {
             self.wiring.push(&r);
         }
         self.sink.row(&r, bad)
+    }
+
+    /// Counts the cells the stuck tracker marked (`before`: the row's bad cells without).
+    #[cold]
+    fn count_stuck(&mut self, before: BadCells, bad: BadCells) {
+        for c in Column::ALL {
+            if bad.has(c) && !before.has(c) {
+                *self.q.stuck_cells.entry(c.name().to_string()).or_insert(0) += 1;
+            }
+        }
+    }
+
+    /// A row with bad cells: its good cells counted for the clipping, the bad ones by
+    /// column and kind, the burst it belongs to.
+    #[cold]
+    fn bad_row(&mut self, r: &Row, bad: BadCells) {
+        self.clips.push(r, |c| !bad.has(c));
+        self.q.bad_rows += 1;
+        for c in Column::ALL {
+            if bad.has(c) {
+                *self.q.bad_cells.entry(c.name().to_string()).or_insert(0) += 1;
+                let x = r.value(c).unwrap_or(f64::NAN);
+                let (finite, beyond) = (x.is_finite(), self.limits.beyond(c, x));
+                self.cells_out[c as usize][0] += u64::from(!finite);
+                self.cells_out[c as usize][1] += u64::from(finite && beyond);
+            }
+        }
+        let start = self.burst.map_or(r.t_s, |b| b.0);
+        self.burst = Some((start, r.t_s));
     }
 
     /// A row dropped for its time: counts the stretches of them.

@@ -15,6 +15,9 @@ pub(super) struct SpeedScale {
     sync_rad_s: f64,
     hist: Vec<u64>,
     count: u64,
+    /// The last speed counted (its bits) and its bin: a speed channel read from an encoder
+    /// repeats its value for many rows, and the bin's logarithm is then taken once.
+    last: Option<(u64, usize)>,
 }
 
 /// Below this many rows with a speed nothing is judged.
@@ -31,17 +34,26 @@ impl SpeedScale {
             sync_rad_s,
             hist: vec![0; BINS],
             count: 0,
+            last: None,
         }
     }
 
     /// One passed row's mechanical speed [rad/s, as read].
     pub(super) fn push(&mut self, wm_rad_s: f64) {
-        let r = wm_rad_s.abs() / self.sync_rad_s;
-        if !(r.is_finite() && self.sync_rad_s > 0.0) {
-            return;
-        }
-        let x = ((r.max(1e-3).log10() + 3.0) / DECADES * BINS as f64) as usize;
-        if let Some(b) = self.hist.get_mut(x.min(BINS - 1)) {
+        let bin = match self.last {
+            Some((bits, bin)) if bits == wm_rad_s.to_bits() => bin,
+            _ => {
+                let r = wm_rad_s.abs() / self.sync_rad_s;
+                if !(r.is_finite() && self.sync_rad_s > 0.0) {
+                    return;
+                }
+                let x = ((r.max(1e-3).log10() + 3.0) / DECADES * BINS as f64) as usize;
+                let bin = x.min(BINS - 1);
+                self.last = Some((wm_rad_s.to_bits(), bin));
+                bin
+            }
+        };
+        if let Some(b) = self.hist.get_mut(bin) {
             *b += 1;
         }
         self.count += 1;

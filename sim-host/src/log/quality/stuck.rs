@@ -25,8 +25,15 @@ pub const STUCK_PERIODS: f64 = 0.25;
 /// ... and at least this many rows.
 pub const STUCK_MIN_SAMPLES: u32 = 8;
 
-const VOLTAGES: [Column; 3] = [Column::Va, Column::Vb, Column::Vc];
-const CURRENTS: [Column; 3] = [Column::Ia, Column::Ib, Column::Ic];
+/// The six phase channels, voltages then currents.
+const PHASES: [Column; 6] = [
+    Column::Va,
+    Column::Vb,
+    Column::Vc,
+    Column::Ia,
+    Column::Ib,
+    Column::Ic,
+];
 
 /// Runs of identical readings of the six phase channels; see the module documentation.
 #[derive(Debug, Clone, Default)]
@@ -55,8 +62,8 @@ impl StuckTracker {
     pub fn check(&mut self, row: &Row, bad: &mut BadCells) {
         let v = row.v_abc.unwrap_or([f64::NAN; 3]);
         let values = [v[0], v[1], v[2], row.i_abc[0], row.i_abc[1], row.i_abc[2]];
-        let cols = [VOLTAGES, CURRENTS].concat();
-        for ((run, x), c) in self.runs.iter_mut().zip(values).zip(&cols) {
+        let mut longest = 0;
+        for ((run, x), c) in self.runs.iter_mut().zip(values).zip(&PHASES) {
             if bad.has(*c) || !x.is_finite() {
                 *run = (f64::NAN, 0);
             } else if x == run.0 {
@@ -64,12 +71,20 @@ impl StuckTracker {
             } else {
                 *run = (x, 1);
             }
+            longest = longest.max(run.1);
         }
+        // (Every row of a live log ends here: no run is long.)
+        if longest >= self.run_min {
+            self.mark(row.v_abc.is_some(), bad);
+        }
+    }
+
+    /// Marks the stuck cells of the row just followed.
+    fn mark(&self, has_v: bool, bad: &mut BadCells) {
         let stuck: [bool; 6] = std::array::from_fn(|k| self.runs[k].1 >= self.run_min);
         let alive = |set: &[bool]| set.iter().any(|s| !s);
         let (sv, si) = (&stuck[..3], &stuck[3..]);
-        let has_v = row.v_abc.is_some();
-        for (k, c) in cols.iter().enumerate() {
+        for (k, c) in PHASES.iter().enumerate() {
             let (own, other) = if k < 3 { (sv, si) } else { (si, sv) };
             let other_alive = if k < 3 {
                 alive(other)
@@ -107,7 +122,7 @@ mod tests {
         for r in rows {
             let mut b = BadCells::default();
             tr.check(r, &mut b);
-            for (k, c) in [VOLTAGES, CURRENTS].concat().iter().enumerate() {
+            for (k, c) in PHASES.iter().enumerate() {
                 n[k] += u32::from(b.has(*c));
             }
         }
