@@ -232,6 +232,51 @@ fn sequence_front(
     )
 }
 
+/// The core sample of `row` from `sampler`, its encoder count moved on by `enc_offset`
+/// (counts handed on over a clock reset: [`Replay`]'s `enc_offset`).
+fn sample_of(sampler: &mut LogSampler, enc_offset: i64, row: &Row) -> Sample {
+    if enc_offset == 0 {
+        sampler.sample(row)
+    } else {
+        sampler.sample(&Row {
+            enc_count: row.enc_count.map(|c| c.wrapping_add(enc_offset)),
+            ..*row
+        })
+    }
+}
+
+/// Books a counted detection at `t` [s]: the first one's time, and each fault the output
+/// ranks first the first time it does.
+fn note_detection(
+    first: &mut Option<f64>,
+    detections: &mut Vec<Detection>,
+    t: f64,
+    out: &MonitorOutput,
+) {
+    if first.is_none() {
+        *first = Some(t);
+    }
+    if let Some((fault, _)) = out.top() {
+        if !detections.iter().any(|d| d.fault == fault) {
+            detections.push(Detection { fault, t_s: t });
+        }
+    }
+}
+
+/// Whether the sample at `t` [s] (interval `dt_s`) is the one nearest the timeline step
+/// `next` (half a sample early counts); if so, `next` moves on by `step_s`, past `t` after a
+/// gap (one point for the gap, not one per step missed).
+fn timeline_step_due(next: &mut f64, t: f64, dt_s: f64, step_s: f64) -> bool {
+    if t + 0.5 * dt_s < *next {
+        return false;
+    }
+    *next += step_s;
+    if *next <= t {
+        *next += (((t - *next) / step_s).floor() + 1.0) * step_s;
+    }
+    true
+}
+
 /// Converts log rows to core samples, synthesising encoder counts from speed if needed
 /// (the host's counterpart of the firmware's `drive_monitor::sampling::AdcSampler`).
 ///
@@ -471,15 +516,7 @@ impl Replay {
             return;
         };
         self.commission.before(mon, t);
-        let s = if self.enc_offset == 0 {
-            self.sampler.sample(row)
-        } else {
-            self.sampler.sample(&Row {
-                enc_count: row.enc_count.map(|c| c.wrapping_add(self.enc_offset)),
-                ..*row
-            })
-        };
-        mon.update(&s);
+        mon.update(&sample_of(&mut self.sampler, self.enc_offset, row));
         let Some(mon) = self.monitor.as_ref() else {
             return;
         };
@@ -539,25 +576,16 @@ impl Replay {
             let current = out.evaluating && lit_outside_band(out, bands);
             self.detected_in_range |=
                 out.sensor_fault.any() || (current && !self.commission.outside_learned_range(out));
-            if self.first_detection.is_none() {
-                self.first_detection = Some(t);
-            }
-            if let Some((fault, _)) = out.top() {
-                if !self.detections.iter().any(|d| d.fault == fault) {
-                    self.detections.push(Detection { fault, t_s: t });
-                }
-            }
+            note_detection(&mut self.first_detection, &mut self.detections, t, out);
         }
         // The sample nearest each timeline step (half a sample early counts: the data-quality
         // stage's sample clock may put the sample at the step a hair before it).
-        if t + 0.5 * self.dt_s >= self.next_point {
-            self.next_point += self.opts.timeline_step_s;
-            if self.next_point <= t {
-                // After a gap: the next step after this sample, not one point per step
-                // missed.
-                let steps = ((t - self.next_point) / self.opts.timeline_step_s).floor() + 1.0;
-                self.next_point += steps * self.opts.timeline_step_s;
-            }
+        if timeline_step_due(
+            &mut self.next_point,
+            t,
+            self.dt_s,
+            self.opts.timeline_step_s,
+        ) {
             let point = timeline_point(self, t, out, range_note);
             self.timeline.push(point);
         }
