@@ -102,12 +102,13 @@ impl RowSink for Copy<'_> {
     }
 }
 
-/// Runs `convert`.
+/// Checks that the output is none of the inputs and opens the input log (its channels
+/// mapped by the `--params` file's `[columns]` table, if given).
 ///
 /// # Errors
-/// An output that is the input, an unreadable or malformed input (one line naming the
-/// file, line and column), an I/O error writing the output, or [`super::Interrupted`].
-pub fn run(args: &ConvertArgs) -> anyhow::Result<()> {
+/// An output that is an input, an unreadable parameter file, an unreadable or malformed
+/// input.
+fn open_input(args: &ConvertArgs) -> anyhow::Result<LogFile> {
     let mut inputs = vec![args.input.as_path()];
     inputs.extend(args.params.as_deref());
     OutputGuard::new(&inputs).check_files(&[&args.output])?;
@@ -119,7 +120,16 @@ pub fn run(args: &ConvertArgs) -> anyhow::Result<()> {
         group: args.group.clone(),
         columns,
     };
-    let file = LogFile::open_with(&args.input, &opts)?;
+    Ok(LogFile::open_with(&args.input, &opts)?)
+}
+
+/// Runs `convert`.
+///
+/// # Errors
+/// An output that is the input, an unreadable or malformed input (one line naming the
+/// file, line and column), an I/O error writing the output, or [`super::Interrupted`].
+pub fn run(args: &ConvertArgs) -> anyhow::Result<()> {
+    let file = open_input(args)?;
     let start = Instant::now();
     let interruption = Interruption::catch()?;
     let big = std::fs::metadata(&args.input)

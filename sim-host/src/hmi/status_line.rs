@@ -231,35 +231,7 @@ pub fn parse(line: &str) -> Option<FirmwareStatus> {
 impl FirmwareStatus {
     /// The reading on the screen at `t_s`.
     pub fn snapshot(&self, t_s: f64) -> Snapshot {
-        let commissioning = self.mode.as_deref() == Some("commissioning");
-        let state = match self.run {
-            Some((_, l, n)) if commissioning && n > 0 => {
-                MonitorState::Commissioning((l as f32 / n as f32).min(1.0))
-            }
-            _ if commissioning => MonitorState::Commissioning(0.0),
-            _ if self.steady == Some(false) => MonitorState::Transient,
-            _ if self.evaluating == Some(false) => MonitorState::Starting,
-            _ if self.fault && !self.candidates.is_empty() => {
-                MonitorState::Fault(self.candidates.clone())
-            }
-            _ => MonitorState::Healthy,
-        };
-        let named_fault = self
-            .isolation
-            .as_ref()
-            .is_some_and(|i| matches!(i.view().named, Some(IsolationName::Fault(_))));
-        let sensor = self.sensors.is_some_and(|s| s.iter().any(|x| *x));
-        let state = match state {
-            MonitorState::Healthy | MonitorState::Fault(_)
-                if self.moved == Some(true) && !named_fault && !sensor =>
-            {
-                MonitorState::Moved(
-                    "the board says the load or the voltage left the commissioned range"
-                        .to_string(),
-                )
-            }
-            other => other,
-        };
+        let state = self.state();
         let sensor_faults = self.sensors.map_or(Vec::new(), |s| {
             [
                 Fault::CurrentSensor,
@@ -297,6 +269,46 @@ impl FirmwareStatus {
                 winding_rise_k: self.winding_rise_k,
                 ..i.view()
             }),
+        }
+    }
+
+    /// The monitor's state the fields say: commissioning (with its progress), transient,
+    /// starting, fault (the candidates) or healthy, then [`Self::moved_state`].
+    fn state(&self) -> MonitorState {
+        let commissioning = self.mode.as_deref() == Some("commissioning");
+        let state = match self.run {
+            Some((_, l, n)) if commissioning && n > 0 => {
+                MonitorState::Commissioning((l as f32 / n as f32).min(1.0))
+            }
+            _ if commissioning => MonitorState::Commissioning(0.0),
+            _ if self.steady == Some(false) => MonitorState::Transient,
+            _ if self.evaluating == Some(false) => MonitorState::Starting,
+            _ if self.fault && !self.candidates.is_empty() => {
+                MonitorState::Fault(self.candidates.clone())
+            }
+            _ => MonitorState::Healthy,
+        };
+        self.moved_state(state)
+    }
+
+    /// `state` as moved when healthy or a fault but the board says the operating point left
+    /// the commissioned range (`moved`), with no isolated fault and no sensor fault to name.
+    fn moved_state(&self, state: MonitorState) -> MonitorState {
+        let named_fault = self
+            .isolation
+            .as_ref()
+            .is_some_and(|i| matches!(i.view().named, Some(IsolationName::Fault(_))));
+        let sensor = self.sensors.is_some_and(|s| s.iter().any(|x| *x));
+        match state {
+            MonitorState::Healthy | MonitorState::Fault(_)
+                if self.moved == Some(true) && !named_fault && !sensor =>
+            {
+                MonitorState::Moved(
+                    "the board says the load or the voltage left the commissioned range"
+                        .to_string(),
+                )
+            }
+            other => other,
         }
     }
 }

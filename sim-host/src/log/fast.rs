@@ -17,7 +17,7 @@
 use super::csv_line::{parse_block_with, Cols};
 use super::exact::row_from_values;
 use super::mapping::TimeKind;
-use super::reader::LogFile;
+use super::reader::{ColumnMap, LogFile};
 use super::{Column, LogError, Row};
 use rayon::prelude::*;
 use std::fs::File;
@@ -39,13 +39,28 @@ struct BlockReader {
     /// Free buffers.
     pool: Vec<Vec<u8>>,
     eof: bool,
+    /// Bytes of the file read so far, the header's included.
+    read: u64,
 }
 
 impl BlockReader {
+    /// A reader of `log`'s data lines (from the end of its header), `block` bytes per block.
+    fn open(log: &LogFile, block: usize) -> std::io::Result<Self> {
+        let mut f = File::open(log.path())?;
+        f.seek(SeekFrom::Start(log.header_bytes()))?;
+        Ok(BlockReader {
+            f,
+            block: block.max(1),
+            carry: Vec::new(),
+            pool: Vec::new(),
+            eof: false,
+            read: log.header_bytes(),
+        })
+    }
+
     /// Reads up to `count` blocks; an empty result at the end of the file.
-    fn batch(&mut self, count: usize) -> std::io::Result<(Vec<Vec<u8>>, u64)> {
+    fn batch(&mut self, count: usize) -> std::io::Result<Vec<Vec<u8>>> {
         let mut blocks = Vec::with_capacity(count);
-        let mut bytes = 0u64;
         while blocks.len() < count && !self.eof {
             let mut buf = self
                 .pool
@@ -56,7 +71,7 @@ impl BlockReader {
             let k = (&mut self.f)
                 .take(self.block as u64)
                 .read_to_end(&mut buf)?;
-            bytes += k as u64;
+            self.read += k as u64;
             if k < self.block {
                 self.eof = true;
             }
@@ -78,7 +93,7 @@ impl BlockReader {
                 None => self.carry = buf,
             }
         }
-        Ok((blocks, bytes))
+        Ok(blocks)
     }
 }
 
@@ -102,38 +117,15 @@ pub(super) fn for_each_row(
         path: log.shown().to_string(),
         source,
     };
-    let mut f = File::open(log.path()).map_err(io)?;
-    f.seek(SeekFrom::Start(log.header_bytes())).map_err(io)?;
     let total = log.len_bytes().max(1) as f64;
-    // The present columns, in `Column::ALL` order: slot j of a parsed row is column
-    // `present[j]`.
     let columns = log.columns();
-    let present: Vec<usize> = (0..Column::ALL.len())
-        .filter(|&c| columns.field[c].is_some())
-        .collect();
-    let idx: Vec<usize> = present.iter().filter_map(|&c| columns.field[c]).collect();
-    let cols = Cols::new(&idx, columns.n_fields);
+    let (present, cols) = slot_layout(columns);
     // (Run by the parsing workers: the reading thread only hands the rows over.)
-    let to_row = |slots: &[f64]| {
-        let mut v = [0.0f64; Column::COUNT];
-        for (&c, &x) in present.iter().zip(slots) {
-            v[c] = x;
-        }
-        row_from_values(&v, columns)
-    };
-    let mut reader = BlockReader {
-        f,
-        block: block.max(1),
-        carry: Vec::new(),
-        pool: Vec::new(),
-        eof: false,
-    };
+    let to_row = |slots: &[f64]| row_of_slots(&present, slots, columns);
+    let mut reader = BlockReader::open(log, block).map_err(io)?;
     let per_batch = rayon::current_num_threads().max(1) * 2;
-    let mut read_bytes = log.header_bytes();
-    // Pipeline: read batch k+1 (one task) | parse batch k (parallel) | hand over batch k-1
-    // (this thread, so `on_row` need not be Send).
-    let (mut to_parse, b) = reader.batch(per_batch).map_err(io)?;
-    read_bytes += b;
+    // Pipeline: read batch k+1 | parse batch k | hand over batch k-1 (one [`turn`]).
+    let mut to_parse = reader.batch(per_batch).map_err(io)?;
     let mut to_hand: Option<Vec<Option<Parsed>>> = None;
     let mut outs: Vec<Parsed> = Vec::new();
     let blank = AtomicU64::new(0);
@@ -141,44 +133,102 @@ pub(super) fn for_each_row(
         if to_parse.is_empty() && to_hand.is_none() {
             return Ok(Some(blank.into_inner()));
         }
-        let mut next: Option<std::io::Result<(Vec<Vec<u8>>, u64)>> = None;
-        let mut parsed: Option<Vec<Option<Parsed>>> = None;
-        let mut verdict: Option<bool> = None;
-        let mut free_outs: Vec<Parsed> = Vec::new();
-        rayon::in_place_scope(|s| {
-            if !reader.eof {
-                let (rd, nx) = (&mut reader, &mut next);
-                s.spawn(move |_| *nx = Some(rd.batch(per_batch)));
-            }
-            if !to_parse.is_empty() {
-                let bufs: Vec<Parsed> = (0..to_parse.len())
-                    .map(|_| outs.pop().unwrap_or_default())
-                    .collect();
-                let (blocks, cols, pr, to_row, blank) =
-                    (&to_parse, &cols, &mut parsed, &to_row, &blank);
-                s.spawn(move |_| *pr = Some(parse_blocks(blocks, bufs, cols, to_row, blank)));
-            }
-            if let Some(batch) = to_hand.take() {
-                verdict = hand_over(batch, on_row, &mut free_outs);
-            }
-        });
-        match verdict {
+        let read_bytes = reader.read;
+        let parse = (&cols, &to_row, &blank);
+        let t = turn(
+            &mut reader,
+            per_batch,
+            &to_parse,
+            to_hand.take(),
+            parse,
+            &mut outs,
+            on_row,
+        );
+        match t.verdict {
             Some(true) => return Ok(Some(blank.into_inner())),
             Some(false) => return Ok(None),
             None => {}
         }
-        outs.append(&mut free_outs);
         progress((read_bytes as f64 / total).min(1.0));
         reader.pool.append(&mut to_parse);
-        to_hand = parsed;
-        match next {
-            Some(r) => {
-                let (blocks, b) = r.map_err(io)?;
-                to_parse = blocks;
-                read_bytes += b;
-            }
-            None => to_parse = Vec::new(),
+        to_hand = t.parsed;
+        to_parse = match t.next {
+            Some(r) => r.map_err(io)?,
+            None => Vec::new(),
+        };
+    }
+}
+
+/// The row of a parsed line: slot j of `slots` is column `present[j]` ([`slot_layout`]),
+/// the absent columns 0 before [`row_from_values`].
+#[inline]
+fn row_of_slots(present: &[usize], slots: &[f64], columns: &ColumnMap) -> Row {
+    let mut v = [0.0f64; Column::COUNT];
+    for (&c, &x) in present.iter().zip(slots) {
+        v[c] = x;
+    }
+    row_from_values(&v, columns)
+}
+
+/// The present columns of `columns` in [`Column::ALL`] order (slot j of a parsed row is
+/// column `present[j]`) and the fields the parser picks for them.
+fn slot_layout(columns: &ColumnMap) -> (Vec<usize>, Cols) {
+    let present: Vec<usize> = (0..Column::ALL.len())
+        .filter(|&c| columns.field[c].is_some())
+        .collect();
+    let idx: Vec<usize> = present.iter().filter_map(|&c| columns.field[c]).collect();
+    let cols = Cols::new(&idx, columns.n_fields);
+    (present, cols)
+}
+
+/// What one turn of the pipeline gives.
+struct Turn {
+    /// The next batch's blocks (`None`: the file was read to its end).
+    next: Option<std::io::Result<Vec<Vec<u8>>>>,
+    /// The current batch's rows per block ([`parse_blocks`]; `None`: nothing to parse).
+    parsed: Option<Vec<Option<Parsed>>>,
+    /// [`hand_over`]'s verdict on the previous batch (`None`: go on).
+    verdict: Option<bool>,
+}
+
+/// One turn of the pipeline, the three stages overlapping: reads the next batch (one
+/// task) | parses `to_parse` (parallel, into buffers from `outs`) | hands `to_hand` over to
+/// `on_row` (this thread, so `on_row` need not be Send; its emptied buffers go back to
+/// `outs`). `parse`: the parser's columns, the row builder and the blank-line count.
+fn turn(
+    reader: &mut BlockReader,
+    per_batch: usize,
+    to_parse: &[Vec<u8>],
+    to_hand: Option<Vec<Option<Parsed>>>,
+    parse: (&Cols, &(impl Fn(&[f64]) -> Row + Sync), &AtomicU64),
+    outs: &mut Vec<Parsed>,
+    on_row: &mut dyn FnMut(&Row) -> bool,
+) -> Turn {
+    let mut next: Option<std::io::Result<Vec<Vec<u8>>>> = None;
+    let mut parsed: Option<Vec<Option<Parsed>>> = None;
+    let mut verdict: Option<bool> = None;
+    let mut free_outs: Vec<Parsed> = Vec::new();
+    rayon::in_place_scope(|s| {
+        if !reader.eof {
+            let (rd, nx) = (&mut *reader, &mut next);
+            s.spawn(move |_| *nx = Some(rd.batch(per_batch)));
         }
+        if !to_parse.is_empty() {
+            let bufs: Vec<Parsed> = (0..to_parse.len())
+                .map(|_| outs.pop().unwrap_or_default())
+                .collect();
+            let ((cols, to_row, blank), pr) = (parse, &mut parsed);
+            s.spawn(move |_| *pr = Some(parse_blocks(to_parse, bufs, cols, to_row, blank)));
+        }
+        if let Some(batch) = to_hand {
+            verdict = hand_over(batch, on_row, &mut free_outs);
+        }
+    });
+    outs.append(&mut free_outs);
+    Turn {
+        next,
+        parsed,
+        verdict,
     }
 }
 

@@ -13,16 +13,18 @@
 //! encoding, uncompressed (sensor noise does not compress), [`ROW_GROUP_ROWS`] rows per row
 //! group.
 
-use super::mapping::ColumnMapping;
+use super::mapping::{ChannelUnit, ColumnMapping};
 use super::reader::{BinarySource, ColumnMap, LogFile};
 use super::{Channels, Column, LogError, Row};
 use parquet::basic::{Compression, Encoding, LogicalType, TimeUnit, Type as PhysicalType};
 use parquet::column::reader::{ColumnReader, ColumnReaderImpl};
 use parquet::data_type::{DataType, DoubleType, FloatType, Int64Type};
 use parquet::errors::ParquetError;
+use parquet::file::metadata::ParquetMetaData;
 use parquet::file::properties::{EnabledStatistics, WriterProperties};
 use parquet::file::reader::{FileReader, SerializedFileReader};
 use parquet::file::writer::SerializedFileWriter;
+use parquet::schema::types::SchemaDescriptor;
 use rayon::prelude::*;
 use std::fs::File;
 use std::path::Path;
@@ -70,6 +72,104 @@ fn timestamp_unit(t: Option<&LogicalType>) -> Option<&'static str> {
 /// One decoded row group: the values of each [`Column::ALL`] column (empty when absent).
 type Decoded = [Vec<f64>; Column::COUNT];
 
+/// The units of the mapped columns, indexed like [`Column::ALL`]
+/// ([`super::mapping::resolve_unit`]: the mapping's, checked against a timestamp column's).
+///
+/// # Errors
+/// [`LogError::NotALog`] for a mapped column that does not hold numbers; [`LogError::Unit`]
+/// as `resolve_unit`.
+fn column_units(
+    schema: &SchemaDescriptor,
+    columns: &ColumnMap,
+    found: &[String],
+    mapping: &ColumnMapping,
+    shown: &str,
+) -> Result<[Option<ChannelUnit>; Column::COUNT], LogError> {
+    let mut units = [None; Column::COUNT];
+    for (k, c) in Column::ALL.iter().enumerate() {
+        let Some(j) = columns.field[k] else { continue };
+        let ty = schema.column(j).physical_type();
+        if !matches!(
+            ty,
+            PhysicalType::DOUBLE | PhysicalType::FLOAT | PhysicalType::INT32 | PhysicalType::INT64
+        ) {
+            return Err(not_a_log(
+                shown,
+                format!("column '{}' is of type {ty}: it must hold numbers (DOUBLE, FLOAT, INT32 or INT64)", found[j]),
+            ));
+        }
+        let recorded = timestamp_unit(schema.column(j).logical_type_ref());
+        units[k] =
+            super::mapping::resolve_unit(shown, *c, &found[j], mapping.unit_of(*c), recorded)?;
+    }
+    Ok(units)
+}
+
+/// Refuses a log without a time (no time column, no sample rate) that has a timestamp
+/// column, naming it and how to map it.
+///
+/// # Errors
+/// [`LogError::MissingColumn`] in that case.
+fn check_unmapped_timestamp(
+    schema: &SchemaDescriptor,
+    columns: &ColumnMap,
+    found: &[String],
+    mapping: &ColumnMapping,
+    shown: &str,
+) -> Result<(), LogError> {
+    if columns.of(Column::Time).is_some() || columns.sample_rate_hz.is_some() {
+        return Ok(());
+    }
+    let Some(j) =
+        (0..found.len()).find(|&j| timestamp_unit(schema.column(j).logical_type_ref()).is_some())
+    else {
+        return Ok(());
+    };
+    Err(super::mapping::missing_column_with(
+        shown,
+        mapping.name_of(Column::Time),
+        " (every analysis needs the time)",
+        found,
+        &format!(
+            "; column '{}' is a timestamp: make it the time in the parameter file's [columns] table: t_s = {{ name = \"{}\" }} (its unit, {}, is read from the file; docs/design.md)",
+            found[j],
+            found[j],
+            timestamp_unit(schema.column(j).logical_type_ref()).unwrap_or("epoch_ms")
+        ),
+    ))
+}
+
+/// Refuses a file whose mapped columns (`field`: leaf indices) are compressed with a codec
+/// this build does not read (uncompressed, snappy and lz4 are read).
+///
+/// # Errors
+/// [`LogError::NotALog`] naming the column and its codec.
+fn check_codecs(
+    meta: &ParquetMetaData,
+    field: &[Option<usize>],
+    shown: &str,
+) -> Result<(), LogError> {
+    let schema = meta.file_metadata().schema_descr();
+    for rg in meta.row_groups() {
+        for j in field.iter().flatten() {
+            let codec = rg.column(*j).compression();
+            if !matches!(
+                codec,
+                Compression::UNCOMPRESSED
+                    | Compression::SNAPPY
+                    | Compression::LZ4_RAW
+                    | Compression::LZ4
+            ) {
+                return Err(not_a_log(
+                    shown,
+                    format!("column '{}' is compressed with {codec}, which this build does not read (uncompressed, snappy or lz4): rewrite the file with one of those", schema.column(*j).name()),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 impl ParquetSource {
     /// Opens `path` and maps the schema's columns.
     ///
@@ -93,64 +193,11 @@ impl ParquetSource {
             .map(|j| schema.column(j).path().string())
             .collect();
         let mut columns = ColumnMap::locate(&found, mapping, shown)?;
-        let mut units = [None; Column::COUNT];
-        for (k, c) in Column::ALL.iter().enumerate() {
-            let Some(j) = columns.field[k] else { continue };
-            let ty = schema.column(j).physical_type();
-            if !matches!(
-                ty,
-                PhysicalType::DOUBLE
-                    | PhysicalType::FLOAT
-                    | PhysicalType::INT32
-                    | PhysicalType::INT64
-            ) {
-                return Err(not_a_log(
-                    shown,
-                    format!("column '{}' is of type {ty}: it must hold numbers (DOUBLE, FLOAT, INT32 or INT64)", found[j]),
-                ));
-            }
-            let recorded = timestamp_unit(schema.column(j).logical_type_ref());
-            units[k] =
-                super::mapping::resolve_unit(shown, *c, &found[j], mapping.unit_of(*c), recorded)?;
-        }
+        let units = column_units(schema, &columns, &found, mapping, shown)?;
         columns.set_units(&units, mapping);
-        if columns.of(Column::Time).is_none() && columns.sample_rate_hz.is_none() {
-            if let Some(j) = (0..found.len())
-                .find(|&j| timestamp_unit(schema.column(j).logical_type_ref()).is_some())
-            {
-                return Err(super::mapping::missing_column_with(
-                    shown,
-                    mapping.name_of(Column::Time),
-                    " (every analysis needs the time)",
-                    &found,
-                    &format!(
-                        "; column '{}' is a timestamp: make it the time in the parameter file's [columns] table: t_s = {{ name = \"{}\" }} (its unit, {}, is read from the file; docs/design.md)",
-                        found[j],
-                        found[j],
-                        timestamp_unit(schema.column(j).logical_type_ref()).unwrap_or("epoch_ms")
-                    ),
-                ));
-            }
-        }
+        check_unmapped_timestamp(schema, &columns, &found, mapping, shown)?;
         super::reader::check_columns(&columns, shown, true, mapping, &found)?;
-        let field = columns.field;
-        for rg in meta.row_groups() {
-            for j in field.iter().flatten() {
-                let codec = rg.column(*j).compression();
-                if !matches!(
-                    codec,
-                    Compression::UNCOMPRESSED
-                        | Compression::SNAPPY
-                        | Compression::LZ4_RAW
-                        | Compression::LZ4
-                ) {
-                    return Err(not_a_log(
-                        shown,
-                        format!("column '{}' is compressed with {codec}, which this build does not read (uncompressed, snappy or lz4): rewrite the file with one of those", schema.column(*j).name()),
-                    ));
-                }
-            }
-        }
+        check_codecs(meta, &columns.field, shown)?;
         let groups = meta
             .row_groups()
             .iter()
@@ -203,19 +250,9 @@ impl BinarySource for ParquetSource {
                             return;
                         }
                     };
-                    let n = cols.iter().find(|c| !c.is_empty()).map_or(0, Vec::len);
-                    let mut v = [0.0f64; Column::COUNT];
-                    for i in 0..n {
-                        for (k, c) in cols.iter().enumerate() {
-                            if let Some(x) = c.get(i) {
-                                v[k] = *x;
-                            }
-                        }
-                        handed += 1;
-                        if !on_row(&super::exact::row_from_values(&v, columns)) {
-                            outcome = Some(Ok(()));
-                            return;
-                        }
+                    if !hand_rows(&cols, columns, &mut handed, on_row) {
+                        outcome = Some(Ok(()));
+                        return;
                     }
                     progress((handed as f64 / total).min(1.0));
                 }
@@ -228,6 +265,31 @@ impl BinarySource for ParquetSource {
         }
         Ok(handed)
     }
+}
+
+/// Hands the rows of one decoded row group to `on_row`, counting them in `handed`; false
+/// when `on_row` asked to stop.
+#[inline]
+fn hand_rows(
+    cols: &Decoded,
+    columns: &ColumnMap,
+    handed: &mut u64,
+    on_row: &mut dyn FnMut(&Row) -> bool,
+) -> bool {
+    let n = cols.iter().find(|c| !c.is_empty()).map_or(0, Vec::len);
+    let mut v = [0.0f64; Column::COUNT];
+    for i in 0..n {
+        for (k, c) in cols.iter().enumerate() {
+            if let Some(x) = c.get(i) {
+                v[k] = *x;
+            }
+        }
+        *handed += 1;
+        if !on_row(&super::exact::row_from_values(&v, columns)) {
+            return false;
+        }
+    }
+    true
 }
 
 /// Decodes row group `g` (its own file handle: the parquet crate's `File` reader seeks a

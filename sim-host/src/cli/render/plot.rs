@@ -7,6 +7,8 @@
 //! needed, in CI or on a user's machine. Outputs are written atomically (temporary file,
 //! then rename).
 
+use plotters::coord::ranged1d::{SegmentedCoord, ValueFormatter};
+use plotters::coord::types::RangedCoordi32;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -137,6 +139,10 @@ fn ranges(c: &Chart) -> ((f64, f64), (f64, f64)) {
     }
 }
 
+/// Draws chart `c` into `root` (`text`: with title, axis labels, tick labels and legend).
+///
+/// # Errors
+/// Drawing errors of the backend, or the font does not register.
 fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     c: &Chart,
@@ -158,72 +164,110 @@ where
             .x_label_area_size(40)
             .y_label_area_size(70);
     }
-    macro_rules! body {
-        ($chart:expr) => {{
-            let mut chart = $chart;
-            {
-                let mut mesh = chart.configure_mesh();
-                if text {
-                    mesh.x_desc(c.x_label).y_desc(c.y_label);
-                } else {
-                    mesh.x_labels(0).y_labels(0);
-                }
-                mesh.draw().map_err(e)?;
-            }
-            for s in &c.series {
-                let col = PALETTE[s.color % PALETTE.len()];
-                let pts: Vec<(f64, f64)> = s
-                    .points
-                    .iter()
-                    .copied()
-                    .filter(|p| p.0.is_finite() && p.1.is_finite() && (!c.log_y || p.1 > 0.0))
-                    .collect();
-                if s.scatter {
-                    let a = chart
-                        .draw_series(pts.iter().map(|&p| Circle::new(p, 3, col.filled())))
-                        .map_err(e)?;
-                    if text {
-                        a.label(s.label.clone())
-                            .legend(move |(x, y)| Circle::new((x + 10, y), 4, col.filled()));
-                    }
-                } else if s.dashed {
-                    let a = chart
-                        .draw_series(DashedLineSeries::new(pts, 6, 4, col.stroke_width(2)))
-                        .map_err(e)?;
-                    if text {
-                        a.label(s.label.clone()).legend(move |(x, y)| {
-                            PathElement::new(vec![(x, y), (x + 8, y)], col.stroke_width(2))
-                        });
-                    }
-                } else {
-                    let a = chart
-                        .draw_series(LineSeries::new(pts, col.stroke_width(1)))
-                        .map_err(e)?;
-                    if text {
-                        a.label(s.label.clone()).legend(move |(x, y)| {
-                            PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2))
-                        });
-                    }
-                }
-            }
-            if text {
-                chart
-                    .configure_series_labels()
-                    .background_style(WHITE.mix(0.85))
-                    .border_style(BLACK)
-                    .draw()
-                    .map_err(e)?;
-            }
-        }};
-    }
     if c.log_y {
-        body!(b
+        let chart = b
             .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
-            .map_err(e)?);
+            .map_err(e)?;
+        draw_plot(chart, c, text)?;
     } else {
-        body!(b.build_cartesian_2d(x0..x1, y0..y1).map_err(e)?);
+        draw_plot(b.build_cartesian_2d(x0..x1, y0..y1).map_err(e)?, c, text)?;
     }
     root.present().map_err(e)?;
+    Ok(())
+}
+
+/// Draws the mesh, every series of `c` and (with `text`) the axis descriptions and the
+/// legend into the built `chart` (linear or logarithmic y axis).
+///
+/// # Errors
+/// Drawing errors of the backend.
+fn draw_plot<'a, DB, X, Y>(
+    mut chart: ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    c: &Chart,
+    text: bool,
+) -> Result<(), String>
+where
+    DB: DrawingBackend + 'a,
+    DB::ErrorType: 'static,
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    {
+        let mut mesh = chart.configure_mesh();
+        if text {
+            mesh.x_desc(c.x_label).y_desc(c.y_label);
+        } else {
+            mesh.x_labels(0).y_labels(0);
+        }
+        mesh.draw().map_err(e)?;
+    }
+    for s in &c.series {
+        draw_series(&mut chart, s, c.log_y, text)?;
+    }
+    if text {
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(e)?;
+    }
+    Ok(())
+}
+
+/// Draws one series (points, dashed or solid line) and, with `text`, its legend entry;
+/// non-finite points (and, with `log_y`, points not above 0) are left out.
+///
+/// # Errors
+/// Drawing errors of the backend.
+fn draw_series<DB, X, Y>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<X, Y>>,
+    s: &Series,
+    log_y: bool,
+    text: bool,
+) -> Result<(), String>
+where
+    DB: DrawingBackend,
+    DB::ErrorType: 'static,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    let col = PALETTE[s.color % PALETTE.len()];
+    let pts: Vec<(f64, f64)> = s
+        .points
+        .iter()
+        .copied()
+        .filter(|p| p.0.is_finite() && p.1.is_finite() && (!log_y || p.1 > 0.0))
+        .collect();
+    if s.scatter {
+        let a = chart
+            .draw_series(pts.iter().map(|&p| Circle::new(p, 3, col.filled())))
+            .map_err(e)?;
+        if text {
+            a.label(s.label.clone())
+                .legend(move |(x, y)| Circle::new((x + 10, y), 4, col.filled()));
+        }
+    } else if s.dashed {
+        let a = chart
+            .draw_series(DashedLineSeries::new(pts, 6, 4, col.stroke_width(2)))
+            .map_err(e)?;
+        if text {
+            a.label(s.label.clone()).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 8, y)], col.stroke_width(2))
+            });
+        }
+    } else {
+        let a = chart
+            .draw_series(LineSeries::new(pts, col.stroke_width(1)))
+            .map_err(e)?;
+        if text {
+            a.label(s.label.clone()).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2))
+            });
+        }
+    }
     Ok(())
 }
 
@@ -282,7 +326,6 @@ fn png_staging_file(dir: &Path) -> std::io::Result<tempfile::NamedTempFile> {
 pub fn confusion_svg(
     matrices: &[sim_host::bench::isolation::IsolationConfusion],
 ) -> Result<String, String> {
-    use plotters::coord::ranged1d::SegmentValue;
     if matrices.is_empty() {
         return Err("no confusion matrix to draw".into());
     }
@@ -291,88 +334,126 @@ pub fn confusion_svg(
     {
         let width = 620 * matrices.len() as u32;
         let root = SVGBackend::with_string(&mut s, (width, 600)).into_drawing_area();
-        let e = |x: DrawingAreaErrorKind<std::io::Error>| x.to_string();
-        root.fill(&WHITE).map_err(e)?;
+        root.fill(&WHITE).map_err(svg_err)?;
         let panels = root.split_evenly((1, matrices.len()));
         for (area, m) in panels.iter().zip(matrices) {
-            let (nr, nc) = (m.rows.len() as i32, m.columns.len() as i32);
-            let max = m.counts.iter().flatten().copied().max().unwrap_or(0).max(1);
-            let mut chart = ChartBuilder::on(area)
-                .caption(
-                    format!(
-                        "isolation bench, angle mode {}",
-                        sim_host::replay::angle_source_name(m.mode)
-                    ),
-                    ("sans-serif", 18),
-                )
-                .margin(10)
-                .x_label_area_size(110)
-                .y_label_area_size(110)
-                .build_cartesian_2d((0..nc).into_segmented(), (0..nr).into_segmented())
-                .map_err(e)?;
-            let columns: Vec<String> = m.columns.iter().map(|c| c.to_string()).collect();
-            let rows: Vec<String> = m.rows.iter().map(|f| f.to_string()).collect();
-            let label = |names: &[String], v: &SegmentValue<i32>, flip: bool| match v {
-                SegmentValue::CenterOf(i) => {
-                    let k = if flip { names.len() as i32 - 1 - i } else { *i };
-                    names.get(k as usize).cloned().unwrap_or_default()
-                }
-                _ => String::new(),
-            };
-            chart
-                .configure_mesh()
-                .disable_mesh()
-                .x_labels(nc as usize)
-                .y_labels(nr as usize)
-                .x_label_formatter(&|v| label(&columns, v, false))
-                .y_label_formatter(&|v| label(&rows, v, true))
-                .x_label_style(
-                    ("sans-serif", 13)
-                        .into_font()
-                        .transform(FontTransform::Rotate90),
-                )
-                .y_label_style(("sans-serif", 13))
-                .x_desc("named by the isolation")
-                .y_desc("true fault")
-                .draw()
-                .map_err(e)?;
-            for (r, row) in m.counts.iter().enumerate() {
-                let y = nr - 1 - r as i32;
-                for (c, n) in row.iter().enumerate() {
-                    let x = c as i32;
-                    let f = f64::from(*n) / f64::from(max);
-                    let shade = |full: f64| (255.0 - (255.0 - full) * f) as u8;
-                    let fill = RGBColor(shade(31.0), shade(90.0), shade(180.0));
-                    chart
-                        .draw_series(std::iter::once(Rectangle::new(
-                            [
-                                (SegmentValue::Exact(x), SegmentValue::Exact(y)),
-                                (SegmentValue::Exact(x + 1), SegmentValue::Exact(y + 1)),
-                            ],
-                            fill.filled(),
-                        )))
-                        .map_err(e)?;
-                    if *n > 0 {
-                        let colour = if f > 0.5 { WHITE } else { BLACK };
-                        chart
-                            .draw_series(std::iter::once(Text::new(
-                                n.to_string(),
-                                (SegmentValue::CenterOf(x), SegmentValue::CenterOf(y)),
-                                ("sans-serif", 14).into_font().color(&colour).pos(
-                                    plotters::style::text_anchor::Pos::new(
-                                        plotters::style::text_anchor::HPos::Center,
-                                        plotters::style::text_anchor::VPos::Center,
-                                    ),
-                                ),
-                            )))
-                            .map_err(e)?;
-                    }
-                }
-            }
+            confusion_panel(area, m)?;
         }
-        root.present().map_err(e)?;
+        root.present().map_err(svg_err)?;
     }
     Ok(s)
+}
+
+/// A drawing error of the SVG backend as text.
+fn svg_err(x: DrawingAreaErrorKind<std::io::Error>) -> String {
+    x.to_string()
+}
+
+/// One heatmap panel: columns the names the isolation gave, rows the true faults (the
+/// first row at the top), both as segments `0..n`.
+type Heatmap<'a, 'b> = ChartContext<
+    'a,
+    SVGBackend<'b>,
+    Cartesian2d<SegmentedCoord<RangedCoordi32>, SegmentedCoord<RangedCoordi32>>,
+>;
+
+/// Draws the confusion matrix `m` of one angle mode into `area`: caption, labelled axes
+/// and one shaded cell per count.
+///
+/// # Errors
+/// Drawing errors (not expected).
+fn confusion_panel(
+    area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+    m: &sim_host::bench::isolation::IsolationConfusion,
+) -> Result<(), String> {
+    let (nr, nc) = (m.rows.len() as i32, m.columns.len() as i32);
+    let max = m.counts.iter().flatten().copied().max().unwrap_or(0).max(1);
+    let mut chart = ChartBuilder::on(area)
+        .caption(
+            format!(
+                "isolation bench, angle mode {}",
+                sim_host::replay::angle_source_name(m.mode)
+            ),
+            ("sans-serif", 18),
+        )
+        .margin(10)
+        .x_label_area_size(110)
+        .y_label_area_size(110)
+        .build_cartesian_2d((0..nc).into_segmented(), (0..nr).into_segmented())
+        .map_err(svg_err)?;
+    let columns: Vec<String> = m.columns.iter().map(|c| c.to_string()).collect();
+    let rows: Vec<String> = m.rows.iter().map(|f| f.to_string()).collect();
+    let label = |names: &[String], v: &SegmentValue<i32>, flip: bool| match v {
+        SegmentValue::CenterOf(i) => {
+            let k = if flip { names.len() as i32 - 1 - i } else { *i };
+            names.get(k as usize).cloned().unwrap_or_default()
+        }
+        _ => String::new(),
+    };
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_labels(nc as usize)
+        .y_labels(nr as usize)
+        .x_label_formatter(&|v| label(&columns, v, false))
+        .y_label_formatter(&|v| label(&rows, v, true))
+        .x_label_style(
+            ("sans-serif", 13)
+                .into_font()
+                .transform(FontTransform::Rotate90),
+        )
+        .y_label_style(("sans-serif", 13))
+        .x_desc("named by the isolation")
+        .y_desc("true fault")
+        .draw()
+        .map_err(svg_err)?;
+    for (r, row) in m.counts.iter().enumerate() {
+        for (c, n) in row.iter().enumerate() {
+            confusion_cell(&mut chart, (c as i32, nr - 1 - r as i32), *n, max)?;
+        }
+    }
+    Ok(())
+}
+
+/// Draws the heatmap cell at segment `(x, y)`: shaded by `n / max` (white for 0, the
+/// palette's blue for `max`), with the count `n` centred in it unless 0.
+///
+/// # Errors
+/// Drawing errors (not expected).
+fn confusion_cell(
+    chart: &mut Heatmap<'_, '_>,
+    (x, y): (i32, i32),
+    n: u32,
+    max: u32,
+) -> Result<(), String> {
+    let f = f64::from(n) / f64::from(max);
+    let shade = |full: f64| (255.0 - (255.0 - full) * f) as u8;
+    let fill = RGBColor(shade(31.0), shade(90.0), shade(180.0));
+    chart
+        .draw_series(std::iter::once(Rectangle::new(
+            [
+                (SegmentValue::Exact(x), SegmentValue::Exact(y)),
+                (SegmentValue::Exact(x + 1), SegmentValue::Exact(y + 1)),
+            ],
+            fill.filled(),
+        )))
+        .map_err(svg_err)?;
+    if n > 0 {
+        let colour = if f > 0.5 { WHITE } else { BLACK };
+        chart
+            .draw_series(std::iter::once(Text::new(
+                n.to_string(),
+                (SegmentValue::CenterOf(x), SegmentValue::CenterOf(y)),
+                ("sans-serif", 14).into_font().color(&colour).pos(
+                    plotters::style::text_anchor::Pos::new(
+                        plotters::style::text_anchor::HPos::Center,
+                        plotters::style::text_anchor::VPos::Center,
+                    ),
+                ),
+            )))
+            .map_err(svg_err)?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]

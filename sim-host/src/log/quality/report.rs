@@ -150,6 +150,14 @@ impl DataQuality {
 
     /// What the timestamps say: their unit, rows dropped, gaps, segments, jitter.
     fn assess_time(&self, found: &mut Findings) {
+        self.assess_dropped_time(found);
+        self.assess_gaps(found);
+        self.assess_clock(found);
+    }
+
+    /// The time's unit and the rows dropped for their time (repeated, backward, not a
+    /// number): many scattered ones leave no stretch of the log to trust.
+    fn assess_dropped_time(&self, found: &mut Findings) {
         let Findings { warn, distrust } = found;
         let rows = self.rows_read.max(1) as f64;
         if self.time_unit != TimeUnit::S {
@@ -174,6 +182,12 @@ impl DataQuality {
                 100.0 * dropped_time as f64 / rows
             ));
         }
+    }
+
+    /// The gaps in the time: bridged ones, the share of samples missing, the segments the
+    /// log falls into.
+    fn assess_gaps(&self, found: &mut Findings) {
+        let Findings { warn, distrust } = found;
         if self.gaps_bridged > 0 {
             warn.push(format!(
                 "{} samples missing in {} gaps (longest {:.4} s), bridged with the real elapsed time",
@@ -197,6 +211,12 @@ impl DataQuality {
                 self.clock_resets
             ));
         }
+    }
+
+    /// The sample clock: timestamps corrected onto it, their jitter, irregular intervals.
+    fn assess_clock(&self, found: &mut Findings) {
+        let Findings { warn, distrust } = found;
+        let rows = self.rows_read.max(1) as f64;
         if self.timestamp_glitches > 0 {
             warn.push(format!(
                 "{} timestamps off the sample grid corrected",
@@ -226,8 +246,14 @@ impl DataQuality {
 
     /// What the cells say: bad cells and their bursts, the currents' frequency, clipping.
     fn assess_cells(&self, supply_hz: f64, found: &mut Findings) {
-        let Findings { warn, distrust } = found;
-        let rows = self.rows_read.max(1) as f64;
+        self.assess_bad_cells(found);
+        self.assess_channels(found);
+        self.assess_signals(supply_hz, found);
+    }
+
+    /// Blank lines skipped and rows held out for bad cells.
+    fn assess_bad_cells(&self, found: &mut Findings) {
+        let warn = &mut found.warn;
         if self.blank_lines > 0 {
             warn.push(format!("{} blank lines skipped", self.blank_lines));
         }
@@ -245,6 +271,13 @@ impl DataQuality {
                 self.longest_burst_s
             ));
         }
+    }
+
+    /// The channels: wiring faults, stuck channels, bad cells in short glitches all through
+    /// the log.
+    fn assess_channels(&self, found: &mut Findings) {
+        let Findings { warn, distrust } = found;
+        let rows = self.rows_read.max(1) as f64;
         for w in &self.wiring {
             distrust.push(w.clone());
         }
@@ -267,6 +300,12 @@ impl DataQuality {
                 100.0 * self.rows_in_short_bursts as f64 / rows
             ));
         }
+    }
+
+    /// The signals: the currents' frequency against the supply's [Hz], the speed's unit,
+    /// clipping channels.
+    fn assess_signals(&self, supply_hz: f64, found: &mut Findings) {
+        let Findings { warn, distrust } = found;
         if let Some(f) = self.current_frequency_hz {
             if (f / supply_hz - 1.0).abs() > SUPPLY_MISMATCH {
                 warn.push(format!(

@@ -17,11 +17,14 @@
 //! segment's times), so LabVIEW and DIAdem show a time axis.
 
 use super::reader::{BinarySource, ColumnMap, LogFile, OpenOptions};
-use super::{Channels, Column, LogError, Row};
+use super::{Column, LogError, Row};
 use std::fs::File;
-use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
+use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
 use tdms_rs::{DataType, PropertyValue, TdmsFile};
+
+mod writer;
+pub(super) use writer::{finish, TdmsLogWriter};
 
 /// Rows per written segment.
 pub const SEGMENT_ROWS: usize = 1 << 16;
@@ -77,42 +80,40 @@ fn number(p: &PropertyValue) -> Option<f64> {
     })
 }
 
-/// Refuses the layouts `tdms-rs` would misread and files that end early: walks the
-/// segments' lead-ins (28 bytes each); returns the bytes of raw data they hold
-/// ([`check_chunks`] compares them with the channels' lengths).
-fn walk_segments(path: &Path, shown: &str) -> Result<u64, LogError> {
-    let io = |source| LogError::Io {
-        path: shown.to_string(),
-        source,
-    };
-    let mut f = File::open(path).map_err(io)?;
-    let len = f.metadata().map_err(io)?.len();
-    if len == 0 {
-        return Err(not_a_log(shown, "the TDMS file is empty (0 bytes)".into()));
-    }
-    let truncated = |why: String| {
-        not_a_log(
-            shown,
-            format!("the TDMS file is truncated: {why} (an interrupted recording or copy; re-export it, or rewrite it with LabVIEW's TDMS Defragment)"),
-        )
-    };
-    if len < 28 {
-        return Err(truncated(format!(
-            "{len} bytes, shorter than one segment's 28-byte lead-in"
-        )));
-    }
-    let mut pos = 0u64;
-    let mut raw = 0u64;
-    let refuse = |what: &str| {
-        not_a_log(
-            shown,
-            format!("TDMS with {what} is not read here: rewrite it with LabVIEW's TDMS Defragment (one plain segment layout) or convert it to CSV or Parquet"),
-        )
-    };
-    while pos + 28 <= len {
-        f.seek(SeekFrom::Start(pos)).map_err(io)?;
-        let mut lead = [0u8; 28];
-        f.read_exact(&mut lead).map_err(io)?;
+/// A TDMS file too short for what its segments declare, as [`LogError::NotALog`]
+/// (`why`: what is missing).
+fn truncated(shown: &str, why: String) -> LogError {
+    not_a_log(
+        shown,
+        format!("the TDMS file is truncated: {why} (an interrupted recording or copy; re-export it, or rewrite it with LabVIEW's TDMS Defragment)"),
+    )
+}
+
+/// A TDMS layout not read here (`what`: "big-endian data", ...), as [`LogError::NotALog`].
+fn refused_layout(shown: &str, what: &str) -> LogError {
+    not_a_log(
+        shown,
+        format!("TDMS with {what} is not read here: rewrite it with LabVIEW's TDMS Defragment (one plain segment layout) or convert it to CSV or Parquet"),
+    )
+}
+
+/// One segment's lead-in (28 bytes).
+struct LeadIn {
+    /// The table-of-contents mask (kTocMetaData = bit 1, ...).
+    mask: u32,
+    /// Bytes after the lead-in (`u64::MAX`: up to the end of the file).
+    next: u64,
+    /// Offset of the raw data in the bytes after the lead-in.
+    raw_off: u64,
+}
+
+impl LeadIn {
+    /// Parses the lead-in at byte `pos`.
+    ///
+    /// # Errors
+    /// [`LogError::NotALog`] without the `TDSm` tag, or for a layout `tdms-rs` would misread
+    /// (big-endian, interleaved or DAQmx raw data, incremental metadata).
+    fn parse(lead: &[u8; 28], pos: u64, shown: &str) -> Result<Self, LogError> {
         if &lead[0..4] != b"TDSm" {
             return Err(not_a_log(
                 shown,
@@ -127,20 +128,57 @@ fn walk_segments(path: &Path, shown: &str) -> Result<u64, LogError> {
         };
         let mask = word(4);
         if mask & (1 << 6) != 0 {
-            return Err(refuse("big-endian data"));
+            return Err(refused_layout(shown, "big-endian data"));
         }
         if mask & (1 << 5) != 0 {
-            return Err(refuse("interleaved data"));
+            return Err(refused_layout(shown, "interleaved data"));
         }
         if mask & (1 << 7) != 0 {
-            return Err(refuse("DAQmx raw data"));
+            return Err(refused_layout(shown, "DAQmx raw data"));
         }
         if mask & (1 << 1) != 0 && mask & (1 << 2) == 0 {
-            return Err(refuse("incremental metadata"));
+            return Err(refused_layout(shown, "incremental metadata"));
         }
-        let (next, raw_off) = (long(12), long(20));
+        Ok(LeadIn {
+            mask,
+            next: long(12),
+            raw_off: long(20),
+        })
+    }
+}
+
+/// Refuses the layouts `tdms-rs` would misread and files that end early: walks the
+/// segments' lead-ins (28 bytes each, [`LeadIn`]); returns the bytes of raw data they hold
+/// ([`check_chunks`] compares them with the channels' lengths).
+fn walk_segments(path: &Path, shown: &str) -> Result<u64, LogError> {
+    let io = |source| LogError::Io {
+        path: shown.to_string(),
+        source,
+    };
+    let mut f = File::open(path).map_err(io)?;
+    let len = f.metadata().map_err(io)?.len();
+    if len == 0 {
+        return Err(not_a_log(shown, "the TDMS file is empty (0 bytes)".into()));
+    }
+    if len < 28 {
+        return Err(truncated(
+            shown,
+            format!("{len} bytes, shorter than one segment's 28-byte lead-in"),
+        ));
+    }
+    let mut pos = 0u64;
+    let mut raw = 0u64;
+    while pos + 28 <= len {
+        f.seek(SeekFrom::Start(pos)).map_err(io)?;
+        let mut lead = [0u8; 28];
+        f.read_exact(&mut lead).map_err(io)?;
+        let LeadIn {
+            mask,
+            next,
+            raw_off,
+        } = LeadIn::parse(&lead, pos, shown)?;
         if next != u64::MAX && (pos + 28).saturating_add(next) > len {
-            return Err(truncated(format!(
+            return Err(truncated(shown, format!(
                 "the segment at byte {pos} declares {next} bytes after its lead-in, the file has {} more",
                 len - pos - 28
             )));
@@ -156,10 +194,13 @@ fn walk_segments(path: &Path, shown: &str) -> Result<u64, LogError> {
         pos = end;
     }
     if pos < len {
-        return Err(truncated(format!(
-            "{} bytes after the last segment, less than a lead-in",
-            len - pos
-        )));
+        return Err(truncated(
+            shown,
+            format!(
+                "{} bytes after the last segment, less than a lead-in",
+                len - pos
+            ),
+        ));
     }
     Ok(raw)
 }
@@ -167,12 +208,6 @@ fn walk_segments(path: &Path, shown: &str) -> Result<u64, LogError> {
 /// Refuses a file whose raw data (`raw` bytes, [`walk_segments`]) is not exactly what the
 /// channels' lengths account for (several data chunks in a segment).
 fn check_chunks(shown: &str, raw: u64, file: &TdmsFile) -> Result<(), LogError> {
-    let refuse = |what: &str| {
-        not_a_log(
-            shown,
-            format!("TDMS with {what} is not read here: rewrite it with LabVIEW's TDMS Defragment (one plain segment layout) or convert it to CSV or Parquet"),
-        )
-    };
     let mut expected = 0u64;
     for g in file.groups() {
         for c in g.channels() {
@@ -185,7 +220,7 @@ fn check_chunks(shown: &str, raw: u64, file: &TdmsFile) -> Result<(), LogError> 
         }
     }
     if raw != expected {
-        return Err(refuse("several data chunks in a segment"));
+        return Err(refused_layout(shown, "several data chunks in a segment"));
     }
     Ok(())
 }
@@ -252,6 +287,110 @@ fn channel_unit(
     super::mapping::resolve_unit(shown, c, ch.name(), mapping.unit_of(c), recorded)
 }
 
+/// The units of the mapped channels of a group ([`channel_unit`]), indexed like
+/// [`Column::ALL`], and their (name, length) in that order.
+type ChannelFacts = (
+    [Option<super::ChannelUnit>; Column::COUNT],
+    Vec<(String, usize)>,
+);
+
+/// The units and lengths of the mapped channels of group `g` ([`ChannelFacts`]).
+///
+/// # Errors
+/// As [`channel_unit`].
+fn channel_facts(
+    g: &tdms_rs::TdmsGroup<'_>,
+    columns: &ColumnMap,
+    mapping: &super::ColumnMapping,
+    shown: &str,
+) -> Result<ChannelFacts, LogError> {
+    let mut lens = Vec::new();
+    let mut units = [None; Column::COUNT];
+    for (k, c) in Column::ALL.iter().enumerate() {
+        if columns.field[k].is_none() {
+            continue;
+        }
+        let Some(ch) = g.channel(&columns.names[k]) else {
+            continue;
+        };
+        units[k] = channel_unit(&ch, *c, mapping, shown)?;
+        lens.push((columns.names[k].clone(), ch.len()));
+    }
+    Ok((units, lens))
+}
+
+/// Where the time of group `g` comes from: the mapped time channel, else the waveform
+/// properties of the mapped `ia_A` channel (`wf_increment` > 0 [s]).
+///
+/// # Errors
+/// [`LogError::MissingColumn`] when neither is there (naming a channel that has
+/// `wf_increment` under another name, if one does).
+fn time_source(
+    g: &tdms_rs::TdmsGroup<'_>,
+    columns: &ColumnMap,
+    mapping: &super::ColumnMapping,
+    found: &[String],
+    shown: &str,
+) -> Result<TimeSource, LogError> {
+    if columns.of(Column::Time).is_some() {
+        return Ok(TimeSource::Channel);
+    }
+    let wave = g.channel(mapping.name_of(Column::Ia)).and_then(|ch| {
+        let inc = ch.property("wf_increment").and_then(number)?;
+        let start = ch
+            .property("wf_start_offset")
+            .and_then(number)
+            .unwrap_or(0.0);
+        (inc.is_finite() && inc > 0.0).then_some(TimeSource::Waveform {
+            start,
+            increment: inc,
+        })
+    });
+    if let Some(w) = wave {
+        return Ok(w);
+    }
+    // A channel timed by its waveform properties under another name: say so.
+    let elsewhere = g
+        .channels()
+        .find(|ch| ch.property("wf_increment").is_some())
+        .map(|ch| {
+            format!(
+                "; channel '{}' has wf_increment: map it to ia_A in [columns] and the time comes from it",
+                ch.name()
+            )
+        })
+        .unwrap_or_default();
+    Err(super::mapping::missing_column(
+        shown,
+        Column::Time,
+        mapping,
+        found,
+        &format!(
+            "every analysis needs the time: a {} channel, or wf_increment on {}{elsewhere}",
+            mapping.name_of(Column::Time),
+            mapping.name_of(Column::Ia)
+        ),
+    ))
+}
+
+/// The rows of group `group`: the common length of its channels (`lens`: name, length).
+///
+/// # Errors
+/// [`LogError::NotALog`] for channels of different lengths.
+fn common_length(lens: &[(String, usize)], group: &str, shown: &str) -> Result<usize, LogError> {
+    let rows = lens.first().map(|l| l.1).unwrap_or(0);
+    if let Some((n, l)) = lens.iter().find(|l| l.1 != rows) {
+        return Err(not_a_log(
+            shown,
+            format!(
+                "channels of different lengths in group '{group}': {} has {rows} values, {n} {l}",
+                lens[0].0
+            ),
+        ));
+    }
+    Ok(rows)
+}
+
 impl TdmsSource {
     /// Opens `path`: picks the group, maps the schema's channels and the time source.
     ///
@@ -277,57 +416,8 @@ impl TdmsSource {
             .ok_or_else(|| not_a_log(shown, format!("no group '{name}'")))?;
         let found: Vec<String> = g.channels().map(|c| c.name().to_string()).collect();
         let mut columns = ColumnMap::locate(&found, mapping, shown)?;
-        let mut lens = Vec::new();
-        let mut units = [None; Column::COUNT];
-        for (k, c) in Column::ALL.iter().enumerate() {
-            if columns.field[k].is_none() {
-                continue;
-            }
-            let Some(ch) = g.channel(&columns.names[k]) else {
-                continue;
-            };
-            units[k] = channel_unit(&ch, *c, mapping, shown)?;
-            lens.push((columns.names[k].clone(), ch.len()));
-        }
-        let wave = g.channel(mapping.name_of(Column::Ia)).and_then(|ch| {
-            let inc = ch.property("wf_increment").and_then(number)?;
-            let start = ch
-                .property("wf_start_offset")
-                .and_then(number)
-                .unwrap_or(0.0);
-            (inc.is_finite() && inc > 0.0).then_some(TimeSource::Waveform {
-                start,
-                increment: inc,
-            })
-        });
-        let time = if columns.of(Column::Time).is_some() {
-            TimeSource::Channel
-        } else if let Some(w) = wave {
-            w
-        } else {
-            // A channel timed by its waveform properties under another name: say so.
-            let elsewhere = g
-                .channels()
-                .find(|ch| ch.property("wf_increment").is_some())
-                .map(|ch| {
-                    format!(
-                        "; channel '{}' has wf_increment: map it to ia_A in [columns] and the time comes from it",
-                        ch.name()
-                    )
-                })
-                .unwrap_or_default();
-            return Err(super::mapping::missing_column(
-                shown,
-                Column::Time,
-                mapping,
-                &found,
-                &format!(
-                    "every analysis needs the time: a {} channel, or wf_increment on {}{elsewhere}",
-                    mapping.name_of(Column::Time),
-                    mapping.name_of(Column::Ia)
-                ),
-            ));
-        };
+        let (units, lens) = channel_facts(&g, &columns, mapping, shown)?;
+        let time = time_source(&g, &columns, mapping, &found, shown)?;
         super::reader::check_columns(
             &columns,
             shown,
@@ -337,16 +427,7 @@ impl TdmsSource {
         )?;
         // (The waveform time is in seconds: wf_increment's unit.)
         columns.set_units(&units, mapping);
-        let rows = lens.first().map(|l| l.1).unwrap_or(0);
-        if let Some((n, l)) = lens.iter().find(|l| l.1 != rows) {
-            return Err(not_a_log(
-                shown,
-                format!(
-                    "channels of different lengths in group '{name}': {} has {rows} values, {n} {l}",
-                    lens[0].0
-                ),
-            ));
-        }
+        let rows = common_length(&lens, &name, shown)?;
         Ok((
             TdmsSource {
                 group: name,
@@ -457,169 +538,4 @@ fn read_f64(
         }
         _ => Err(tdms_rs::TdmsError::TypeMismatch),
     }
-}
-
-/// The streaming TDMS writer behind [`super::LogWriter`] for `.tdms` outputs: rows are
-/// buffered per channel and written as one segment per [`SEGMENT_ROWS`] rows.
-pub(super) struct TdmsLogWriter {
-    channels: Channels,
-    t: Vec<f64>,
-    /// Voltages a, b, c, currents a, b, c, speed (the SGL channels, in `Column` order).
-    f: [Vec<f32>; 7],
-    enc: Vec<i64>,
-    /// Segments written so far.
-    segments: u64,
-    /// The present SGL channels: (column, index into `f`).
-    sgl: Vec<(Column, usize)>,
-}
-
-/// Appends a TDMS string (u32 length, UTF-8 bytes).
-fn put_str(b: &mut Vec<u8>, s: &str) {
-    b.extend_from_slice(&(s.len() as u32).to_le_bytes());
-    b.extend_from_slice(s.as_bytes());
-}
-
-/// Appends a DBL property.
-fn put_f64_property(b: &mut Vec<u8>, name: &str, x: f64) {
-    put_str(b, name);
-    b.extend_from_slice(&10u32.to_le_bytes());
-    b.extend_from_slice(&x.to_le_bytes());
-}
-
-impl TdmsLogWriter {
-    /// A writer for a log with `channels`.
-    pub fn new(channels: Channels) -> Self {
-        let sgl = Column::MEASURED
-            .into_iter()
-            .enumerate()
-            .filter(|(_, c)| channels.has(*c))
-            .map(|(k, c)| (c, k))
-            .collect();
-        TdmsLogWriter {
-            channels,
-            t: Vec::with_capacity(SEGMENT_ROWS),
-            f: Default::default(),
-            enc: Vec::new(),
-            segments: 0,
-            sgl,
-        }
-    }
-
-    /// The bytes of one row (for size estimates).
-    pub fn row_bytes(channels: Channels) -> u64 {
-        let sgl = 3 + if channels.voltages { 3 } else { 0 } + u64::from(channels.speed);
-        8 + 4 * sgl + if channels.encoder { 8 } else { 0 }
-    }
-
-    /// Buffers a row; writes a segment when [`SEGMENT_ROWS`] are buffered.
-    pub fn write_row<W: Write>(&mut self, out: &mut W, r: &Row) -> std::io::Result<()> {
-        self.t.push(r.t_s);
-        let v = r.v_abc.unwrap_or_default();
-        let vals = [
-            v[0],
-            v[1],
-            v[2],
-            r.i_abc[0],
-            r.i_abc[1],
-            r.i_abc[2],
-            r.wm_rad_s.unwrap_or_default(),
-        ];
-        for &(_, k) in &self.sgl {
-            self.f[k].push(vals[k] as f32);
-        }
-        if self.channels.encoder {
-            self.enc.push(r.enc_count.unwrap_or_default());
-        }
-        if self.t.len() >= SEGMENT_ROWS {
-            self.flush_segment(out)?;
-        }
-        Ok(())
-    }
-
-    /// Writes the buffered rows as one segment (nothing when none are buffered, except an
-    /// empty log's one metadata segment, so that the file names its channels).
-    pub fn flush_segment<W: Write>(&mut self, out: &mut W) -> std::io::Result<()> {
-        let n = self.t.len();
-        if n == 0 && self.segments > 0 {
-            return Ok(());
-        }
-        let first = self.segments == 0;
-        let mut chans: Vec<(Column, u32)> = vec![(Column::Time, 10)];
-        chans.extend(self.sgl.iter().map(|&(c, _)| (c, 9)));
-        if self.channels.encoder {
-            chans.push((Column::Encoder, 4));
-        }
-        let (start, increment) = if first {
-            let rate = super::sample_rate_hz(&self.t);
-            (
-                self.t.first().copied().unwrap_or(0.0),
-                rate.map_or(0.0, |r| 1.0 / r),
-            )
-        } else {
-            (0.0, 0.0)
-        };
-        let mut meta = Vec::new();
-        let objects = chans.len() as u32 + if first { 2 } else { 0 };
-        meta.extend_from_slice(&objects.to_le_bytes());
-        if first {
-            for path in ["/".to_string(), format!("/'{GROUP}'")] {
-                put_str(&mut meta, &path);
-                meta.extend_from_slice(&u32::MAX.to_le_bytes());
-                meta.extend_from_slice(&0u32.to_le_bytes());
-            }
-        }
-        for (c, ty) in &chans {
-            put_str(&mut meta, &format!("/'{GROUP}'/'{}'", c.name()));
-            meta.extend_from_slice(&20u32.to_le_bytes());
-            meta.extend_from_slice(&ty.to_le_bytes());
-            meta.extend_from_slice(&1u32.to_le_bytes());
-            meta.extend_from_slice(&(n as u64).to_le_bytes());
-            if first && increment > 0.0 {
-                meta.extend_from_slice(&2u32.to_le_bytes());
-                put_f64_property(&mut meta, "wf_increment", increment);
-                put_f64_property(&mut meta, "wf_start_offset", start);
-            } else {
-                meta.extend_from_slice(&0u32.to_le_bytes());
-            }
-        }
-        let raw_len = n as u64 * Self::row_bytes(self.channels);
-        let mut lead = Vec::with_capacity(28);
-        lead.extend_from_slice(b"TDSm");
-        // kTocMetaData | kTocNewObjList | kTocRawData
-        lead.extend_from_slice(&((1u32 << 1) | (1 << 2) | (1 << 3)).to_le_bytes());
-        lead.extend_from_slice(&4713u32.to_le_bytes());
-        lead.extend_from_slice(&(meta.len() as u64 + raw_len).to_le_bytes());
-        lead.extend_from_slice(&(meta.len() as u64).to_le_bytes());
-        out.write_all(&lead)?;
-        out.write_all(&meta)?;
-        let mut raw = Vec::with_capacity(8 * n);
-        for x in &self.t {
-            raw.extend_from_slice(&x.to_le_bytes());
-        }
-        out.write_all(&raw)?;
-        for &(_, k) in &self.sgl {
-            raw.clear();
-            for x in &self.f[k] {
-                raw.extend_from_slice(&x.to_le_bytes());
-            }
-            out.write_all(&raw)?;
-        }
-        raw.clear();
-        for x in &self.enc {
-            raw.extend_from_slice(&x.to_le_bytes());
-        }
-        out.write_all(&raw)?;
-        self.t.clear();
-        self.f.iter_mut().for_each(Vec::clear);
-        self.enc.clear();
-        self.segments += 1;
-        Ok(())
-    }
-}
-
-/// Convenience for tests and [`super::LogWriter`]: flush the last segment into a buffered
-/// file.
-pub(super) fn finish(w: &mut TdmsLogWriter, out: &mut BufWriter<File>) -> std::io::Result<()> {
-    w.flush_segment(out)?;
-    out.flush()
 }
