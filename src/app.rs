@@ -589,60 +589,21 @@ impl Supervisor {
     /// One period at `now_ms`: `status` is the sample task's latest status if a new one
     /// came, `button` whether the button was pressed since the last tick.
     pub fn tick(&mut self, now_ms: u32, status: Option<MonitorStatus>, button: bool) -> Tick {
-        if let Some(mut s) = status {
-            let reference = self.reference.flags_sensors();
-            s.sensor_fault.voltage |= self.offset_fault.voltage || reference;
-            s.sensor_fault.current |= self.offset_fault.current || reference;
-            let previous = self.latest.samples;
-            self.latest = s;
-            self.follow(&s, previous);
-            self.range.observe(&s);
+        if let Some(s) = status {
+            self.take_status(s);
         }
         let watch = self.watch.poll(self.latest.samples, now_ms);
-        let pressed = button
-            && self
-                .last_press_ms
-                .is_none_or(|t| now_ms.wrapping_sub(t) >= BUTTON_DEBOUNCE_MS);
-        if button {
-            self.last_press_ms = Some(now_ms);
-        }
-        let mut action = Action::None;
-        let mut run_ended = None;
-        if !watch.stalled {
-            if pressed {
-                action = self.procedure.button(&self.latest.run, now_ms);
-            }
-            if action == Action::None {
-                let step = self.procedure.on_status(&self.latest.run, now_ms);
-                action = step.action;
-                run_ended = step.ended;
-            }
-            if let Some(RunEnd::Commissioned { run }) = run_ended {
-                self.range.commit(run);
-            }
-        }
+        let pressed = self.debounce(button, now_ms);
+        let (mut action, run_ended) = if watch.stalled {
+            (Action::None, None)
+        } else {
+            self.commissioning_step(pressed, now_ms)
+        };
         if let Action::Store { record, .. } = &mut action {
             record.isolation = self.run_baseline;
         }
-        // The wrapping clock has reached `t` when `now - t` is "small" (less than half the
-        // clock's range).
-        if self
-            .failed_until_ms
-            .is_some_and(|t| now_ms.wrapping_sub(t) < u32::MAX / 2)
-        {
-            self.failed_until_ms = None;
-        }
-        let mode = if self.failed_until_ms.is_some() {
-            Mode::Failed
-        } else if watch.stalled {
-            Mode::SamplingStalled
-        } else if self.latest.run.stage.is_active() {
-            Mode::Commissioning
-        } else if self.latest.commissioned {
-            Mode::Commissioned
-        } else {
-            Mode::NotCommissioned
-        };
+        self.expire_failed_show(now_ms);
+        let mode = self.mode(watch.stalled);
         let failed = self.procedure.last_failure().is_some();
         self.latest.moved = self.range.moved(&self.latest);
         let isolation = self.panel_isolation();
@@ -658,6 +619,80 @@ impl Supervisor {
             action,
             run_ended,
             liveness: watch.change,
+        }
+    }
+
+    /// Takes a new status `s` from the sample task as the latest: adds the sensor faults
+    /// thread mode knows of (an offset out of bound, a reference out of band), then feeds
+    /// the fault isolation and the operating range with it.
+    fn take_status(&mut self, mut s: MonitorStatus) {
+        let reference = self.reference.flags_sensors();
+        s.sensor_fault.voltage |= self.offset_fault.voltage || reference;
+        s.sensor_fault.current |= self.offset_fault.current || reference;
+        let previous = self.latest.samples;
+        self.latest = s;
+        self.follow(&s, previous);
+        self.range.observe(&s);
+    }
+
+    /// Whether `button` (pressed since the last tick) counts as a press at `now_ms`: not
+    /// within [`BUTTON_DEBOUNCE_MS`] of the previous press (every press restarts that time).
+    fn debounce(&mut self, button: bool, now_ms: u32) -> bool {
+        let pressed = button
+            && self
+                .last_press_ms
+                .is_none_or(|t| now_ms.wrapping_sub(t) >= BUTTON_DEBOUNCE_MS);
+        if button {
+            self.last_press_ms = Some(now_ms);
+        }
+        pressed
+    }
+
+    /// The commissioning procedure's step at `now_ms` while samples flow: a debounced
+    /// press (`pressed`) first, else the latest run's progress. Returns the action and a
+    /// run that ended (a commissioned one puts its operating range into force).
+    fn commissioning_step(&mut self, pressed: bool, now_ms: u32) -> (Action, Option<RunEnd>) {
+        let mut action = Action::None;
+        let mut run_ended = None;
+        if pressed {
+            action = self.procedure.button(&self.latest.run, now_ms);
+        }
+        if action == Action::None {
+            let step = self.procedure.on_status(&self.latest.run, now_ms);
+            action = step.action;
+            run_ended = step.ended;
+        }
+        if let Some(RunEnd::Commissioned { run }) = run_ended {
+            self.range.commit(run);
+        }
+        (action, run_ended)
+    }
+
+    /// Ends the boot's "monitor failed" show once `now_ms` has reached its end.
+    fn expire_failed_show(&mut self, now_ms: u32) {
+        // The wrapping clock has reached `t` when `now - t` is "small" (less than half the
+        // clock's range).
+        if self
+            .failed_until_ms
+            .is_some_and(|t| now_ms.wrapping_sub(t) < u32::MAX / 2)
+        {
+            self.failed_until_ms = None;
+        }
+    }
+
+    /// The panel mode: the boot's "monitor failed" show first, then a `stalled` sample
+    /// path, an active commissioning run, and whether learned thresholds are in force.
+    fn mode(&self, stalled: bool) -> Mode {
+        if self.failed_until_ms.is_some() {
+            Mode::Failed
+        } else if stalled {
+            Mode::SamplingStalled
+        } else if self.latest.run.stage.is_active() {
+            Mode::Commissioning
+        } else if self.latest.commissioned {
+            Mode::Commissioned
+        } else {
+            Mode::NotCommissioned
         }
     }
 }
