@@ -40,6 +40,7 @@ use embassy_stm32::exti::{self, ExtiInput};
 use embassy_stm32::flash::{Blocking, Flash};
 use embassy_stm32::gpio::{Level, Output, Pull, Speed};
 use embassy_stm32::interrupt::{InterruptExt, Priority};
+use embassy_stm32::mode::Async;
 use embassy_stm32::time::Hertz;
 use embassy_stm32::timer::low_level::{MasterMode, RoundTo, Timer as HwTimer};
 use embassy_stm32::timer::qei::{Config as QeiConfig, Qei};
@@ -48,14 +49,15 @@ use embassy_stm32::{bind_interrupts, dma, interrupt, pac, peripherals, triggers,
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
-use embassy_time::{with_deadline, with_timeout, Duration, Instant, Timer};
+use embassy_time::{with_deadline, with_timeout, Duration, Instant, TimeoutError, Timer};
 
 use drive_monitor::app::{
-    carry_out, isolation_summary, Command, MonitorStatus, SamplePath, Settings, Supervisor,
+    carry_out, isolation_summary, Command, MonitorStatus, SamplePath, Settings, Supervisor, Tick,
     PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
 };
 use drive_monitor::board::{self, pins::Board, CurrentCode, Lamp, VoltageCode, LAMP_COUNT};
 use drive_monitor::boot::{self, Machine};
+use drive_monitor::commissioning::Action;
 use drive_monitor::flash_record::{RecordStore, RECORD_LEN};
 use drive_monitor::liveness::AdcWait;
 use drive_monitor::motor_source::EncoderSetup;
@@ -345,18 +347,13 @@ fn process_half(
     }
 }
 
+/// The sample task: sets up the acquisition, then per DMA half (one sample) waits for both
+/// ADCs' data, bounded by [`AdcWait`]'s timeout; recovers the acquisition when no data came
+/// or the DMA lapped the reader, else applies thread mode's commands and runs the sample
+/// path on the half.
 #[embassy_executor::task]
 async fn sample_task(hw: SampleHw, mut path: SamplePath) {
-    // The HAL's ADC set-up waits on registers without a bound (power-up, calibration,
-    // ADRDY, ADSTART): the record says so if the watchdog has to end it.
-    set_phase(BootPhase::AdcSetup);
-    let setup = ResetRecord::setup(BootPhase::AdcSetup).with_bor_level(supply::bor_level());
-    write_reset_record(&setup.encode());
-    let (qei, mut acq) = start_acquisition(hw, &mut path);
-    write_reset_record(&[0; RESET_RECORD_LEN]);
-    set_phase(BootPhase::Sampling);
-    info!("sampling at {=u32} Hz", SETTINGS.sample_rate_hz);
-
+    let (qei, mut acq) = set_up_acquisition(hw, &mut path);
     let mut wait = AdcWait::new(SETTINGS.sample_rate_hz);
     let timeout = Duration::from_micros(u64::from(wait.timeout_us()));
     let mut half1 = [0u16; SAMPLES_PER_HALF * CHANNELS];
@@ -370,68 +367,106 @@ async fn sample_task(hw: SampleHw, mut path: SamplePath) {
             (r1.is_ok(), r2.is_ok())
         })
         .await;
-        let recover_now = match read {
-            Ok((ok1, ok2)) => {
-                if let Some(n) = wait.data() {
-                    warn!("sampling resumed after {=u32} recoveries", n);
-                }
-                if !(ok1 && ok2) {
-                    // The DMA lapped the reader: samples were lost.
-                    let n = OVERRUNS.fetch_add(1, Ordering::Relaxed) + 1;
-                    warn!(
-                        "ADC DMA ring lapped #{=u32} (adc1 {} adc2 {})",
-                        n, !ok1, !ok2
-                    );
-                }
-                !(ok1 && ok2)
-            }
-            Err(_) => {
-                // No data within the timeout: an ADC overrun, a DMA error, or a stopped
-                // trigger (thread mode shows a stall and stops petting the watchdog until
-                // samples flow again).
-                let restart = wait.timed_out();
-                RESTARTS.fetch_add(1, Ordering::Relaxed);
-                if restart.log {
-                    error!(
-                        "no ADC data for {=u32} us: recovering the acquisition (attempt {=u32})",
-                        wait.timeout_us(),
-                        restart.attempt
-                    );
-                }
-                true
-            }
-        };
-        if recover_now {
-            // One sequence for every cause (drive_monitor::recovery): trigger, ADCs and
-            // DMA stopped, OVR and TEIF cleared, DMA re-armed, ADCs and trigger restarted;
-            // the timestamps continue from the restart (the gap shows).
-            set_phase(BootPhase::Recovery);
-            let result = recovery::recover(&mut acq);
-            path.sampler_mut().resync(acq.regs.started_us);
-            set_phase(BootPhase::Sampling);
-            counts.count(result);
-            match result {
-                Ok(f) if f.adc_overrun || f.dma_error => warn!(
-                    "acquisition recovered: adc overrun {=bool}, dma error {=bool} (recoveries {=u32}, overruns {=u32}, dma errors {=u32})",
-                    f.adc_overrun,
-                    f.dma_error,
-                    counts.recoveries,
-                    counts.adc_overruns,
-                    counts.dma_errors
-                ),
-                Ok(_) => {}
-                Err(StepTimeout(step)) => {
-                    error!("acquisition recovery stopped at {=str}: timed out", step.name())
-                }
-            }
+        if needs_recovery(read, &mut wait) {
+            recover_acquisition(&mut acq, &mut path, &mut counts);
             continue;
         }
-        while let Ok(cmd) = COMMANDS.try_receive() {
-            if let Err(e) = path.command(cmd) {
-                warn!("core refused a command: {=str}", e.describe());
-            }
-        }
+        apply_commands(&mut path);
         process_half(&mut path, &half1, &half2, qei.count(), &mut max_cycles);
+    }
+}
+
+/// [`start_acquisition`] under the reset record: the HAL's ADC set-up waits on registers
+/// without a bound (power-up, calibration, ADRDY, ADSTART), so the record says so if the
+/// watchdog has to end it; cleared once sampling runs.
+fn set_up_acquisition(
+    hw: SampleHw,
+    path: &mut SamplePath,
+) -> (Qei<'static, peripherals::TIM4>, HwAcquisition) {
+    set_phase(BootPhase::AdcSetup);
+    let setup = ResetRecord::setup(BootPhase::AdcSetup).with_bor_level(supply::bor_level());
+    write_reset_record(&setup.encode());
+    let started = start_acquisition(hw, path);
+    write_reset_record(&[0; RESET_RECORD_LEN]);
+    set_phase(BootPhase::Sampling);
+    info!("sampling at {=u32} Hz", SETTINGS.sample_rate_hz);
+    started
+}
+
+/// Whether the acquisition needs the recovery after the wait for one half: `read` is both
+/// ADCs' read result (`true`: read, `false`: the DMA lapped the reader and samples were
+/// lost), or the timeout's error when no data came within it (an ADC overrun, a DMA error,
+/// or a stopped trigger: thread mode shows a stall and stops petting the watchdog until
+/// samples flow again). Counts and logs each cause on `wait` and the counters.
+#[inline]
+fn needs_recovery(read: Result<(bool, bool), TimeoutError>, wait: &mut AdcWait) -> bool {
+    match read {
+        Ok((ok1, ok2)) => {
+            if let Some(n) = wait.data() {
+                warn!("sampling resumed after {=u32} recoveries", n);
+            }
+            if !(ok1 && ok2) {
+                let n = OVERRUNS.fetch_add(1, Ordering::Relaxed) + 1;
+                warn!(
+                    "ADC DMA ring lapped #{=u32} (adc1 {} adc2 {})",
+                    n, !ok1, !ok2
+                );
+            }
+            !(ok1 && ok2)
+        }
+        Err(_) => {
+            let restart = wait.timed_out();
+            RESTARTS.fetch_add(1, Ordering::Relaxed);
+            if restart.log {
+                error!(
+                    "no ADC data for {=u32} us: recovering the acquisition (attempt {=u32})",
+                    wait.timeout_us(),
+                    restart.attempt
+                );
+            }
+            true
+        }
+    }
+}
+
+/// One recovery of the acquisition, the sequence for every cause (drive_monitor::recovery):
+/// trigger, ADCs and DMA stopped, OVR and TEIF cleared, DMA re-armed, ADCs and trigger
+/// restarted; the timestamps continue from the restart (the gap shows). Counted in
+/// `counts` and logged.
+fn recover_acquisition(
+    acq: &mut HwAcquisition,
+    path: &mut SamplePath,
+    counts: &mut RecoveryCounts,
+) {
+    set_phase(BootPhase::Recovery);
+    let result = recovery::recover(acq);
+    path.sampler_mut().resync(acq.regs.started_us);
+    set_phase(BootPhase::Sampling);
+    counts.count(result);
+    match result {
+        Ok(f) if f.adc_overrun || f.dma_error => warn!(
+            "acquisition recovered: adc overrun {=bool}, dma error {=bool} (recoveries {=u32}, overruns {=u32}, dma errors {=u32})",
+            f.adc_overrun,
+            f.dma_error,
+            counts.recoveries,
+            counts.adc_overruns,
+            counts.dma_errors
+        ),
+        Ok(_) => {}
+        Err(StepTimeout(step)) => {
+            error!("acquisition recovery stopped at {=str}: timed out", step.name())
+        }
+    }
+}
+
+/// Applies thread mode's queued commands to the sample path (between two samples); a
+/// refused one is logged.
+#[inline]
+fn apply_commands(path: &mut SamplePath) {
+    while let Ok(cmd) = COMMANDS.try_receive() {
+        if let Err(e) = path.command(cmd) {
+            warn!("core refused a command: {=str}", e.describe());
+        }
     }
 }
 
@@ -558,6 +593,9 @@ fn boot_board(flash: &mut BoardFlash, previous: PreviousRun) -> (Machine, Sample
     (booted.machine, booted.path, booted.supervisor)
 }
 
+/// Boot in thread mode (clocks, the reason the previous run ended, the brown-out level,
+/// the watchdog, the flash records), then the sample task on the high-priority executor and
+/// thread mode's periods ([`Thread::run`]).
 #[embassy_executor::main]
 async fn main(_spawner: Spawner) {
     let p = embassy_stm32::init(clock_config());
@@ -566,28 +604,11 @@ async fn main(_spawner: Spawner) {
     // The brown-out level of the option bytes: reported, not written (`drive_monitor::supply`).
     let bor = supply::bor_check();
     logs::log_bor(bor);
-
-    // Cycle counter for the per-sample cost shown in the log; SysTick for the set-up's
-    // deadline.
-    let mut cp = match cortex_m::Peripherals::take() {
-        Some(cp) => cp,
-        // Taken once, here (embassy-stm32 takes none of them).
-        #[allow(clippy::panic)]
-        None => panic!("core peripherals taken twice"),
-    };
-    cp.DCB.enable_trace();
-    cp.DWT.enable_cycle_counter();
+    let cp = core_peripherals();
 
     let b = Board::take(p);
     let wdg = start_watchdog(b.iwdg);
-    // The flash driver (built for dual-bank) panics on single-bank option bytes: check
-    // first and run without the records instead (the built-in motor, not commissioned).
-    set_phase(BootPhase::Flash);
-    let dual_bank = pac::FLASH.optr().read().dbank();
-    if !dual_bank {
-        error!("option bytes: single-bank flash (DBANK = 0); the records need dual-bank: set DBANK with STM32CubeProgrammer. Running with the built-in motor, not commissioned");
-    }
-
+    let dual_bank = dual_bank_flash();
     let mut thread = Thread {
         lamps: PanelPins::new(b.lamps),
         flash: BoardFlash(dual_bank.then(|| Flash::new_blocking(b.flash))),
@@ -600,10 +621,6 @@ async fn main(_spawner: Spawner) {
 
     let (machine, path, mut supervisor) = boot_board(&mut thread.flash, previous);
     let boot = Instant::now();
-
-    // High-priority executor for the sample path.
-    interrupt::UART4.set_priority(Priority::P1);
-    let high = EXECUTOR_HIGH.start(interrupt::UART4);
     let hw = SampleHw {
         adc1: b.adc1,
         adc2: b.adc2,
@@ -618,27 +635,48 @@ async fn main(_spawner: Spawner) {
         encoder: machine.encoder,
         syst: cp.SYST,
     };
+    spawn_sample_task(hw, path);
+    thread.run(&mut supervisor, &mut button, boot).await
+}
+
+/// The Cortex-M core peripherals, with the cycle counter running (for the per-sample cost
+/// shown in the log); their SysTick is the ADC set-up's deadline.
+fn core_peripherals() -> cortex_m::Peripherals {
+    let mut cp = match cortex_m::Peripherals::take() {
+        Some(cp) => cp,
+        // Taken once, here (embassy-stm32 takes none of them).
+        #[allow(clippy::panic)]
+        None => panic!("core peripherals taken twice"),
+    };
+    cp.DCB.enable_trace();
+    cp.DWT.enable_cycle_counter();
+    cp
+}
+
+/// Whether the option bytes select dual-bank flash, which the record pages need. The flash
+/// driver (built for dual-bank) panics on single-bank option bytes: the firmware checks
+/// first and runs without the records instead (the built-in motor, not commissioned),
+/// saying so in the log.
+fn dual_bank_flash() -> bool {
+    set_phase(BootPhase::Flash);
+    let dual_bank = pac::FLASH.optr().read().dbank();
+    if !dual_bank {
+        error!("option bytes: single-bank flash (DBANK = 0); the records need dual-bank: set DBANK with STM32CubeProgrammer. Running with the built-in motor, not commissioned");
+    }
+    dual_bank
+}
+
+/// Starts the high-priority executor (UART4's vector at NVIC priority P1, above thread
+/// mode) and spawns the sample task on it with its hardware `hw` and the sample `path`.
+fn spawn_sample_task(hw: SampleHw, path: SamplePath) {
+    interrupt::UART4.set_priority(Priority::P1);
+    let high = EXECUTOR_HIGH.start(interrupt::UART4);
     set_phase(BootPhase::Boot);
     match sample_task(hw, path) {
         Ok(task) => high.spawn(task),
         // A task that is spawned once, at boot: the pool cannot be full.
         #[allow(clippy::panic)]
         Err(_) => panic!("sample task not spawned"),
-    }
-
-    let period = Duration::from_millis(u64::from(PANEL_PERIOD_MS));
-    let mut next = Instant::now() + period;
-    loop {
-        // The period's wait is the wait for the button: a press at any time is seen.
-        let pressed = with_deadline(next, button.wait_for_rising_edge())
-            .await
-            .is_ok();
-        if pressed {
-            Timer::at(next).await;
-        }
-        next += period;
-        let now_ms = boot.elapsed().as_millis() as u32;
-        thread.period(&mut supervisor, now_ms, pressed).await;
     }
 }
 
@@ -657,6 +695,30 @@ struct Thread {
 }
 
 impl Thread {
+    /// Thread mode's periods, every [`PANEL_PERIOD_MS`] from boot (`boot`, the clock's
+    /// zero): the period's wait is the wait for the `button`, so a press at any time is
+    /// seen.
+    async fn run(
+        &mut self,
+        supervisor: &mut Supervisor,
+        button: &mut ExtiInput<'static, Async>,
+        boot: Instant,
+    ) -> ! {
+        let period = Duration::from_millis(u64::from(PANEL_PERIOD_MS));
+        let mut next = Instant::now() + period;
+        loop {
+            let pressed = with_deadline(next, button.wait_for_rising_edge())
+                .await
+                .is_ok();
+            if pressed {
+                Timer::at(next).await;
+            }
+            next += period;
+            let now_ms = boot.elapsed().as_millis() as u32;
+            self.period(supervisor, now_ms, pressed).await;
+        }
+    }
+
     /// One period at `now_ms`: the supervisor's tick on the latest status and the button,
     /// then its consequences (watchdog, logs, the commissioning action with its command
     /// to the sample task, the lamps) and every second period the status line.
@@ -669,17 +731,7 @@ impl Thread {
             supervisor.set_offset_fault(&trim);
             logs::log_trim(&trim);
         }
-        if let Some(check) = REFERENCE.try_take() {
-            if let board::ReferenceCheck::InBand(v) = check {
-                info!("reference: VDDA {=f32} V", v);
-            }
-            if let Some(change) = supervisor.observe_reference(check, now_ms) {
-                logs::log_reference(change);
-            }
-        }
-        if let Some(change) = supervisor.poll_reference(now_ms, &mut supply::HwReference) {
-            logs::log_reference(change);
-        }
+        check_reference(supervisor, now_ms);
         let tick = supervisor.tick(now_ms, status.map(|s| s.monitor), pressed);
         if tick.pet_watchdog {
             self.wdg.pet();
@@ -690,7 +742,21 @@ impl Thread {
         if let Some(end) = tick.run_ended {
             logs::log_run_end(end);
         }
-        let (command, stored) = carry_out(tick.action, &mut self.flash);
+        self.carry_out(tick.action).await;
+        self.lamps.show(&tick.lamps);
+        self.log_div += 1;
+        if self.log_div >= 2 {
+            self.log_div = 0;
+            self.status_line(supervisor, &tick);
+        }
+    }
+
+    /// Carries out the commissioning `action` ([`carry_out`]: the record stored in flash
+    /// first, logged) and sends its command to the sample task, waiting at most
+    /// [`COMMAND_SEND_TIMEOUT_MS`] for a slot in the queue (else the command is dropped and
+    /// logged).
+    async fn carry_out(&mut self, action: Action) {
+        let (command, stored) = carry_out(action, &mut self.flash);
         if let Some(stored) = stored {
             logs::log_stored(&stored);
         }
@@ -704,23 +770,39 @@ impl Thread {
                 error!("command queue full: {=str} dropped", cmd.name());
             }
         }
-        self.lamps.show(&tick.lamps);
+    }
 
-        self.log_div += 1;
-        if self.log_div >= 2 {
-            self.log_div = 0;
-            log_status(
-                supervisor.latest(),
-                supervisor.isolation(),
-                supervisor
-                    .isolation
-                    .as_ref()
-                    .map_or(0.0, |f| f.isolator().winding_rise_k()),
-                (tick.mode.name(), tick.call.name()),
-                self.max_update_cycles,
-                (supervisor.reference().vdda_v(), self.bor.status_number()),
-            );
+    /// The status line ([`log_status`]) on the supervisor's latest status and isolation and
+    /// the period's `tick` (the panel's mode and call).
+    fn status_line(&self, supervisor: &Supervisor, tick: &Tick) {
+        log_status(
+            supervisor.latest(),
+            supervisor.isolation(),
+            supervisor
+                .isolation
+                .as_ref()
+                .map_or(0.0, |f| f.isolator().winding_rise_k()),
+            (tick.mode.name(), tick.call.name()),
+            self.max_update_cycles,
+            (supervisor.reference().vdda_v(), self.bor.status_number()),
+        );
+    }
+}
+
+/// The checks of the ADC's reference at `now_ms`: the start-up one from the sample task
+/// (`REFERENCE`, once, its VDDA logged) and the periodic one on ADC1's injected channel,
+/// observed by the `supervisor`; a change of the verdict is logged.
+fn check_reference(supervisor: &mut Supervisor, now_ms: u32) {
+    if let Some(check) = REFERENCE.try_take() {
+        if let board::ReferenceCheck::InBand(v) = check {
+            info!("reference: VDDA {=f32} V", v);
         }
+        if let Some(change) = supervisor.observe_reference(check, now_ms) {
+            logs::log_reference(change);
+        }
+    }
+    if let Some(change) = supervisor.poll_reference(now_ms, &mut supply::HwReference) {
+        logs::log_reference(change);
     }
 }
 
