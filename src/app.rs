@@ -1,10 +1,10 @@
 //! The firmware's application logic, hardware-free: what runs per sample, what the sample
 //! task hands over, and what thread mode does with it.
 //!
-//! - [`SamplePath`] runs in the high-priority sample task: [`RawFrame`] -> [`Sample`] ->
-//!   [`Monitor::update`], and applies [`Command`]s between samples. Bounded work, no
-//!   panics, no allocation, no copy of the core's output per sample: every
-//!   [`Settings::status_every`] samples the task hands thread mode a small
+//! - [`SamplePath`] (`app/sample_path.rs`) runs in the high-priority sample task:
+//!   [`RawFrame`] -> [`Sample`] -> [`Monitor::update`], and applies [`Command`]s between
+//!   samples. Bounded work, no panics, no allocation, no copy of the core's output per
+//!   sample: every [`Settings::status_every`] samples the task hands thread mode a small
 //!   [`MonitorStatus`] ([`SamplePath::status`]).
 //! - [`Supervisor`] runs in thread mode every [`PANEL_PERIOD_MS`]: the button, the
 //!   commissioning procedure ([`CommissioningProcedure`]), the liveness watch
@@ -18,28 +18,31 @@
 //! firmware (`src/firmware.rs`) only adds the hardware around them.
 //!
 //! [`Sample`]: monitor_core::Sample
+//! [`RawFrame`]: crate::sampling::RawFrame
+//! [`Monitor::update`]: monitor_core::Monitor::update
 
-use crate::board::{self, FrontEnd};
+use crate::board;
 use crate::commissioning::{Action, CommissioningProcedure, RunEnd};
 use crate::flash_record::{self, CalibrationRecord, RecordStore, Stored};
 use crate::liveness::{LivenessChange, SampleWatch};
-use crate::offset_trim::{OffsetTrim, TrimResult};
+use crate::offset_trim::TrimResult;
 use crate::panel::{self, blink_code, winding_code, Mode, PanelInput, PanelLamps, NOT_NAMED_CODE};
 use crate::range_watch::RangeWatch;
 use crate::reset_record::PreviousRun;
-use crate::sampling::{AdcSampler, RawFrame, SamplingError, TICK_HZ};
+use crate::sampling::TICK_HZ;
 use crate::supply::{ReferenceAdc, ReferenceChange, ReferenceWatch, REFERENCE_PERIOD_MS};
 use monitor_core::isolation::{Baseline, Evidence, FaultCall, Follower, Named, Step};
 use monitor_core::{
-    CommissioningError, CommissioningRun, ConfigError, Fault, Install, Isolation, IsolationState,
-    Isolator, Monitor, MonitorConfig, MotorModel, Operating, Phase, ReferenceMachine, SensorFlags,
-    SteadyPoint,
+    CommissioningRun, ConfigError, Fault, Isolation, IsolationState, Isolator, MonitorConfig,
+    MotorModel, Operating, Phase, ReferenceMachine, SensorFlags, SteadyPoint,
 };
 
 mod isolation;
 pub use isolation::{board_isolator, isolation_summary};
 mod lamps;
 pub use lamps::{panel_call, panel_input, PanelIsolation};
+mod sample_path;
+pub use sample_path::{AppError, Command, CommandError, SamplePath};
 
 /// The machine the firmware monitors by default: the "2.2 kW" reference machine
 /// (`monitor_core::reference::MOTOR_2P2KW`: 400 V, 50 Hz, 4 poles, Gamma model, Bl for the
@@ -156,85 +159,6 @@ impl Default for Settings {
     }
 }
 
-/// Why the application could not be built.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum AppError {
-    /// The core rejected the configuration.
-    Config(ConfigError),
-    /// The sample rate does not fit the timestamp clock.
-    Sampling(SamplingError),
-}
-
-/// Requests from thread mode to the sample task (applied between two samples).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Command {
-    /// Start a commissioning run of `duration_s` seconds of evaluated running; the learned
-    /// calibration goes into force once stored ([`Install::AfterStorage`]).
-    StartCommissioning {
-        /// Learning time, s (> 0).
-        duration_s: f32,
-    },
-    /// Cancel run `run` if it is still learning.
-    CancelCommissioning {
-        /// The run's id.
-        run: u16,
-    },
-    /// The flash holds `stored` after storing run `run`'s calibration (read back): the
-    /// core puts exactly that into force (`None`: the default thresholds) and ends the run.
-    CalibrationStored {
-        /// The run's id.
-        run: u16,
-        /// The record read back (`None`: no valid record).
-        stored: Option<CalibrationRecord>,
-    },
-    /// Install a calibration read from flash at boot.
-    SetCalibration(CalibrationRecord),
-}
-
-/// Why the core did not carry out a [`Command`] as asked.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum CommandError {
-    /// A start was refused.
-    Commissioning(CommissioningError),
-    /// A cancel found that run not learning (it had ended or learned already).
-    NotLearning,
-    /// A stored or stored-back calibration is out of the core's range (the default
-    /// thresholds are in force for `CalibrationStored`; the previous ones for
-    /// `SetCalibration`).
-    Calibration(ConfigError),
-}
-
-impl CommandError {
-    /// A short description for logs.
-    pub fn describe(&self) -> &'static str {
-        match self {
-            CommandError::Commissioning(CommissioningError::Duration) => {
-                "commissioning refused: bad duration"
-            }
-            CommandError::Commissioning(CommissioningError::Busy) => {
-                "commissioning refused: a run is active"
-            }
-            CommandError::Commissioning(CommissioningError::StaleRun) => {
-                "commissioning report for an older run"
-            }
-            CommandError::NotLearning => "cancel: the run is not learning",
-            CommandError::Calibration(_) => "calibration out of the core's range",
-        }
-    }
-}
-
-impl Command {
-    /// A short name for logs.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Command::StartCommissioning { .. } => "start-commissioning",
-            Command::CancelCommissioning { .. } => "cancel-commissioning",
-            Command::CalibrationStored { .. } => "calibration-stored",
-            Command::SetCalibration(_) => "set-calibration",
-        }
-    }
-}
-
 /// What the sample task hands thread mode: the little the panel, the supervision and the
 /// log line need, built every [`Settings::status_every`] samples.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -287,160 +211,6 @@ pub struct MonitorStatus {
     /// ([`RangeWatch::moved`]), false as the sample path hands it ([`panel_input`] shows
     /// the amber state only when no fault is named).
     pub moved: bool,
-}
-
-/// The per-sample path: scaling, the core, commands.
-#[derive(Clone, Debug)]
-pub struct SamplePath {
-    monitor: Monitor,
-    sampler: AdcSampler,
-    samples: u32,
-    trim: OffsetTrim,
-}
-
-impl SamplePath {
-    /// Build from a core configuration, the board's front end and the sample rate.
-    ///
-    /// # Errors
-    /// [`AppError`] if the core or the sampler rejects the settings.
-    pub fn new(
-        cfg: MonitorConfig,
-        front_end: FrontEnd,
-        sample_rate_hz: u32,
-    ) -> Result<Self, AppError> {
-        Ok(Self {
-            monitor: Monitor::new(cfg).map_err(AppError::Config)?,
-            sampler: AdcSampler::new(front_end, sample_rate_hz).map_err(AppError::Sampling)?,
-            samples: 0,
-            trim: OffsetTrim::new(&front_end),
-        })
-    }
-
-    /// The board setup at `sample_rate_hz` (the [`Settings`] value): the configuration of
-    /// [`board_monitor_config`] and the default front end.
-    ///
-    /// # Errors
-    /// As [`SamplePath::new`].
-    pub fn for_board(sample_rate_hz: u32) -> Result<Self, AppError> {
-        Self::new(
-            board_monitor_config(sample_rate_hz),
-            FrontEnd::DEFAULT,
-            sample_rate_hz,
-        )
-    }
-
-    /// Apply a command.
-    ///
-    /// # Errors
-    /// [`CommandError`] when the core refused or could not do what was asked (see there
-    /// for what is in force then).
-    pub fn command(&mut self, cmd: Command) -> Result<(), CommandError> {
-        let m = &mut self.monitor;
-        match cmd {
-            Command::StartCommissioning { duration_s } => m
-                .start_commissioning_with(duration_s, Install::AfterStorage)
-                .map(|_| ())
-                .map_err(CommandError::Commissioning),
-            Command::CancelCommissioning { run } => m
-                .cancel_commissioning(run)
-                .then_some(())
-                .ok_or(CommandError::NotLearning),
-            Command::CalibrationStored { run, stored } => m
-                .calibration_stored(run, stored.map(Into::into))
-                .map_err(CommandError::Calibration),
-            Command::SetCalibration(rec) => m
-                .set_calibration(rec.into())
-                .map_err(CommandError::Calibration),
-        }
-    }
-
-    /// The start-up offset trim ([`crate::offset_trim`]): adds `raw` (the frame also given
-    /// to [`SamplePath::on_frame`]) and, at the [`crate::offset_trim::TRIM_SAMPLES`]th
-    /// frame, puts the trimmed channels' offsets into force in the front end and returns the
-    /// result (the out-of-bound channels go to [`Supervisor::set_offset_fault`]). `None`
-    /// before and after (then it returns at once).
-    pub fn trim_offsets(&mut self, raw: &RawFrame) -> Option<TrimResult> {
-        let trim = self.trim.add(raw)?;
-        let mut fe = *self.sampler.front_end();
-        let channels = (fe.voltage.iter_mut().zip(trim.voltage))
-            .chain(fe.current.iter_mut().zip(trim.current));
-        for (scale, channel) in channels {
-            if let Some(offset) = channel.offset() {
-                scale.offset_code = offset;
-            }
-        }
-        self.sampler.set_front_end(fe);
-        Some(trim)
-    }
-
-    /// The ADC sampler (for timestamp resynchronisation after lost samples).
-    pub fn sampler_mut(&mut self) -> &mut AdcSampler {
-        &mut self.sampler
-    }
-
-    /// The ADC sampler.
-    pub fn sampler(&self) -> &AdcSampler {
-        &self.sampler
-    }
-
-    /// The core monitor.
-    pub fn monitor(&self) -> &Monitor {
-        &self.monitor
-    }
-
-    /// Samples processed since boot (wrapping).
-    pub fn samples(&self) -> u32 {
-        self.samples
-    }
-
-    /// Process one trigger's readings.
-    #[inline]
-    pub fn on_frame(&mut self, raw: &RawFrame) {
-        let sample = self.sampler.build(raw);
-        self.monitor.update(&sample);
-        self.samples = self.samples.wrapping_add(1);
-    }
-
-    /// The status for thread mode, from the latest output.
-    pub fn status(&self) -> MonitorStatus {
-        let o = self.monitor.output();
-        let top = o.top();
-        let second = o
-            .diagnosis
-            .probabilities
-            .iter()
-            .zip(Fault::ALL)
-            .filter(|(p, f)| **p > 0.0 && Some(*f) != top.map(|t| t.0))
-            .fold(None::<(Fault, f32)>, |best, (p, f)| match best {
-                Some((_, bp)) if bp >= *p => best,
-                _ => Some((f, *p)),
-            });
-        MonitorStatus {
-            samples: self.samples,
-            residuals: o.residuals,
-            residual_lamps: o.lamps,
-            fault_detected: o.fault_detected,
-            sensor_fault: o.sensor_fault,
-            top,
-            second,
-            speed_rad_s: o.speed_rad_s,
-            zero_crossing_locked: o.zero_crossing_locked,
-            commissioned: self.monitor.calibration().is_some(),
-            run: self.monitor.commissioning(),
-            operating: o.operating,
-            frame_hz: o.frame_omega_rad_s / core::f32::consts::TAU,
-            quasi_steady: o.quasi_steady,
-            evaluating: o.evaluating,
-            bands: self.monitor.threshold_bands(),
-            point: SteadyPoint::from_output(o),
-            winding: o
-                .unbalance
-                .suspect_phase
-                .map(|p| (p, o.unbalance.winding_ratio)),
-            vds: o.vds,
-            moved: false,
-        }
-    }
 }
 
 /// What thread mode does after one [`Supervisor::tick`].
@@ -589,60 +359,21 @@ impl Supervisor {
     /// One period at `now_ms`: `status` is the sample task's latest status if a new one
     /// came, `button` whether the button was pressed since the last tick.
     pub fn tick(&mut self, now_ms: u32, status: Option<MonitorStatus>, button: bool) -> Tick {
-        if let Some(mut s) = status {
-            let reference = self.reference.flags_sensors();
-            s.sensor_fault.voltage |= self.offset_fault.voltage || reference;
-            s.sensor_fault.current |= self.offset_fault.current || reference;
-            let previous = self.latest.samples;
-            self.latest = s;
-            self.follow(&s, previous);
-            self.range.observe(&s);
+        if let Some(s) = status {
+            self.take_status(s);
         }
         let watch = self.watch.poll(self.latest.samples, now_ms);
-        let pressed = button
-            && self
-                .last_press_ms
-                .is_none_or(|t| now_ms.wrapping_sub(t) >= BUTTON_DEBOUNCE_MS);
-        if button {
-            self.last_press_ms = Some(now_ms);
-        }
-        let mut action = Action::None;
-        let mut run_ended = None;
-        if !watch.stalled {
-            if pressed {
-                action = self.procedure.button(&self.latest.run, now_ms);
-            }
-            if action == Action::None {
-                let step = self.procedure.on_status(&self.latest.run, now_ms);
-                action = step.action;
-                run_ended = step.ended;
-            }
-            if let Some(RunEnd::Commissioned { run }) = run_ended {
-                self.range.commit(run);
-            }
-        }
+        let pressed = self.debounce(button, now_ms);
+        let (mut action, run_ended) = if watch.stalled {
+            (Action::None, None)
+        } else {
+            self.commissioning_step(pressed, now_ms)
+        };
         if let Action::Store { record, .. } = &mut action {
             record.isolation = self.run_baseline;
         }
-        // The wrapping clock has reached `t` when `now - t` is "small" (less than half the
-        // clock's range).
-        if self
-            .failed_until_ms
-            .is_some_and(|t| now_ms.wrapping_sub(t) < u32::MAX / 2)
-        {
-            self.failed_until_ms = None;
-        }
-        let mode = if self.failed_until_ms.is_some() {
-            Mode::Failed
-        } else if watch.stalled {
-            Mode::SamplingStalled
-        } else if self.latest.run.stage.is_active() {
-            Mode::Commissioning
-        } else if self.latest.commissioned {
-            Mode::Commissioned
-        } else {
-            Mode::NotCommissioned
-        };
+        self.expire_failed_show(now_ms);
+        let mode = self.mode(watch.stalled);
         let failed = self.procedure.last_failure().is_some();
         self.latest.moved = self.range.moved(&self.latest);
         let isolation = self.panel_isolation();
@@ -658,6 +389,80 @@ impl Supervisor {
             action,
             run_ended,
             liveness: watch.change,
+        }
+    }
+
+    /// Takes a new status `s` from the sample task as the latest: adds the sensor faults
+    /// thread mode knows of (an offset out of bound, a reference out of band), then feeds
+    /// the fault isolation and the operating range with it.
+    fn take_status(&mut self, mut s: MonitorStatus) {
+        let reference = self.reference.flags_sensors();
+        s.sensor_fault.voltage |= self.offset_fault.voltage || reference;
+        s.sensor_fault.current |= self.offset_fault.current || reference;
+        let previous = self.latest.samples;
+        self.latest = s;
+        self.follow(&s, previous);
+        self.range.observe(&s);
+    }
+
+    /// Whether `button` (pressed since the last tick) counts as a press at `now_ms`: not
+    /// within [`BUTTON_DEBOUNCE_MS`] of the previous press (every press restarts that time).
+    fn debounce(&mut self, button: bool, now_ms: u32) -> bool {
+        let pressed = button
+            && self
+                .last_press_ms
+                .is_none_or(|t| now_ms.wrapping_sub(t) >= BUTTON_DEBOUNCE_MS);
+        if button {
+            self.last_press_ms = Some(now_ms);
+        }
+        pressed
+    }
+
+    /// The commissioning procedure's step at `now_ms` while samples flow: a debounced
+    /// press (`pressed`) first, else the latest run's progress. Returns the action and a
+    /// run that ended (a commissioned one puts its operating range into force).
+    fn commissioning_step(&mut self, pressed: bool, now_ms: u32) -> (Action, Option<RunEnd>) {
+        let mut action = Action::None;
+        let mut run_ended = None;
+        if pressed {
+            action = self.procedure.button(&self.latest.run, now_ms);
+        }
+        if action == Action::None {
+            let step = self.procedure.on_status(&self.latest.run, now_ms);
+            action = step.action;
+            run_ended = step.ended;
+        }
+        if let Some(RunEnd::Commissioned { run }) = run_ended {
+            self.range.commit(run);
+        }
+        (action, run_ended)
+    }
+
+    /// Ends the boot's "monitor failed" show once `now_ms` has reached its end.
+    fn expire_failed_show(&mut self, now_ms: u32) {
+        // The wrapping clock has reached `t` when `now - t` is "small" (less than half the
+        // clock's range).
+        if self
+            .failed_until_ms
+            .is_some_and(|t| now_ms.wrapping_sub(t) < u32::MAX / 2)
+        {
+            self.failed_until_ms = None;
+        }
+    }
+
+    /// The panel mode: the boot's "monitor failed" show first, then a `stalled` sample
+    /// path, an active commissioning run, and whether learned thresholds are in force.
+    fn mode(&self, stalled: bool) -> Mode {
+        if self.failed_until_ms.is_some() {
+            Mode::Failed
+        } else if stalled {
+            Mode::SamplingStalled
+        } else if self.latest.run.stage.is_active() {
+            Mode::Commissioning
+        } else if self.latest.commissioned {
+            Mode::Commissioned
+        } else {
+            Mode::NotCommissioned
         }
     }
 }

@@ -28,7 +28,7 @@
 //! [`CommissioningRun`] and button presses and carry out the returned [`Action`].
 
 use crate::flash_record::CalibrationRecord;
-use monitor_core::{CommissioningFailure, CommissioningRun, RunStage};
+use monitor_core::{Calibration, CommissioningFailure, CommissioningRun, RunStage};
 
 /// Why the last commissioning attempt failed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -282,83 +282,76 @@ impl CommissioningProcedure {
         };
     }
 
+    /// One step of following the run: what the run's stage at `now_ms` asks for.
     fn following(&mut self, run: &CommissioningRun, now_ms: u32) -> CommissioningStep {
         let Tracking::Following {
-            run: id,
-            started_ms,
-            mut blocks,
-            mut progress_ms,
-            mut cancel,
-            mut stored_ms,
+            run: id, cancel, ..
         } = self.tracking
         else {
             return CommissioningStep::NOTHING;
         };
-        let since = |t: u32| now_ms.wrapping_sub(t);
-        let step = match run.stage {
-            RunStage::Learning if run.blocks_learned != blocks => {
-                blocks = run.blocks_learned;
-                progress_ms = now_ms;
-                CommissioningStep::NOTHING
-            }
-            RunStage::Learning => {
-                let due = match cancel {
-                    None => since(progress_ms) >= self.stall_timeout_ms,
-                    Some((_, sent_ms)) => since(sent_ms) >= Self::RETRY_MS,
-                };
-                if due {
-                    let reason = cancel.map_or(CancelReason::Stalled, |(r, _)| r);
-                    cancel = Some((reason, now_ms));
-                    CommissioningStep::act(Action::Cancel { run: id })
-                } else {
-                    CommissioningStep::NOTHING
-                }
-            }
-            RunStage::AwaitingStorage(cal) => {
-                if stored_ms.is_some_and(|t| since(t) < Self::RETRY_MS) {
-                    CommissioningStep::NOTHING
-                } else {
-                    stored_ms = Some(now_ms);
-                    CommissioningStep::act(Action::Store {
-                        run: id,
-                        record: cal.into(),
-                    })
-                }
-            }
-            RunStage::Done => return self.end(RunEnd::Commissioned { run: id }),
-            RunStage::Failed(CommissioningFailure::Cancelled) => {
-                return self.end(match cancel {
-                    Some((CancelReason::User, _)) => RunEnd::CancelledByUser { run: id },
-                    Some((CancelReason::Stalled, _)) => RunEnd::Failed {
-                        run: Some(id),
-                        why: Failure::Stalled,
-                    },
-                    None => RunEnd::Failed {
-                        run: Some(id),
-                        why: Failure::Core(CommissioningFailure::Cancelled),
-                    },
-                })
-            }
-            RunStage::Failed(why) => {
-                return self.end(RunEnd::Failed {
-                    run: Some(id),
-                    why: Failure::Core(why),
-                })
-            }
+        match run.stage {
+            RunStage::Learning => self.learning(run.blocks_learned, now_ms),
+            RunStage::AwaitingStorage(cal) => self.awaiting_storage(cal, now_ms),
+            RunStage::Done => self.end(RunEnd::Commissioned { run: id }),
+            RunStage::Failed(why) => self.end(failed_end(id, why, cancel)),
             RunStage::Idle => {
                 self.tracking = Tracking::Idle;
-                return CommissioningStep::NOTHING;
+                CommissioningStep::NOTHING
             }
-        };
-        self.tracking = Tracking::Following {
+        }
+    }
+
+    /// The followed run is learning and has learned `blocks_learned` evaluated blocks at
+    /// `now_ms`: progress restarts the stall time; without progress for the stall time, a
+    /// cancel (repeated after [`Self::RETRY_MS`] while the core has not acted on it).
+    fn learning(&mut self, blocks_learned: u32, now_ms: u32) -> CommissioningStep {
+        let stall_timeout_ms = self.stall_timeout_ms;
+        let Tracking::Following {
             run: id,
-            started_ms,
             blocks,
             progress_ms,
             cancel,
-            stored_ms,
+            ..
+        } = &mut self.tracking
+        else {
+            return CommissioningStep::NOTHING;
         };
-        step
+        if blocks_learned != *blocks {
+            *blocks = blocks_learned;
+            *progress_ms = now_ms;
+            return CommissioningStep::NOTHING;
+        }
+        let since = |t: u32| now_ms.wrapping_sub(t);
+        let due = match *cancel {
+            None => since(*progress_ms) >= stall_timeout_ms,
+            Some((_, sent_ms)) => since(sent_ms) >= Self::RETRY_MS,
+        };
+        if !due {
+            return CommissioningStep::NOTHING;
+        }
+        let reason = cancel.map_or(CancelReason::Stalled, |(r, _)| r);
+        *cancel = Some((reason, now_ms));
+        CommissioningStep::act(Action::Cancel { run: *id })
+    }
+
+    /// The followed run waits for its calibration `cal` to be stored at `now_ms`:
+    /// hands it over, again after [`Self::RETRY_MS`] while the core still waits.
+    fn awaiting_storage(&mut self, cal: Calibration, now_ms: u32) -> CommissioningStep {
+        let Tracking::Following {
+            run: id, stored_ms, ..
+        } = &mut self.tracking
+        else {
+            return CommissioningStep::NOTHING;
+        };
+        if stored_ms.is_some_and(|t| now_ms.wrapping_sub(t) < Self::RETRY_MS) {
+            return CommissioningStep::NOTHING;
+        }
+        *stored_ms = Some(now_ms);
+        CommissioningStep::act(Action::Store {
+            run: *id,
+            record: cal.into(),
+        })
     }
 
     fn end(&mut self, end: RunEnd) -> CommissioningStep {
@@ -371,6 +364,25 @@ impl CommissioningProcedure {
             action: Action::None,
             ended: Some(end),
         }
+    }
+}
+
+/// How followed run `id` ended when the core reports it failed for `why`, given the cancel
+/// the procedure sent (if any): a cancel is the user's, or the stall's, or (none sent) the
+/// core's own reason.
+fn failed_end(id: u16, why: CommissioningFailure, cancel: Option<(CancelReason, u32)>) -> RunEnd {
+    match (why, cancel) {
+        (CommissioningFailure::Cancelled, Some((CancelReason::User, _))) => {
+            RunEnd::CancelledByUser { run: id }
+        }
+        (CommissioningFailure::Cancelled, Some((CancelReason::Stalled, _))) => RunEnd::Failed {
+            run: Some(id),
+            why: Failure::Stalled,
+        },
+        (why, _) => RunEnd::Failed {
+            run: Some(id),
+            why: Failure::Core(why),
+        },
     }
 }
 

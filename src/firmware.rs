@@ -1,12 +1,12 @@
 //! The STM32G474RE firmware: hardware tasks around the hardware-free logic in the library.
 //!
 //! Tasks and priorities:
-//! - `sample_task` on an interrupt executor (UART4 vector, NVIC priority P1, above thread
-//!   mode): TIM1 TRGO triggers ADC1 (va, vb, vc) and ADC2 (ia, ib, ic) at the sample rate
+//! - `sample_task` (`firmware/sample_task.rs`) on an interrupt executor (UART4 vector, NVIC
+//!   priority P1, above thread mode): TIM1 TRGO triggers ADC1 (va, vb, vc) and ADC2 (ia, ib, ic) at the sample rate
 //!   of [`SETTINGS`]; each ADC fills a DMA ring of two samples, so every sample wakes the
 //!   task (half- and full-transfer interrupts). The task reads the encoder counter (TIM4)
 //!   and runs `SamplePath::on_frame` (scaling and `Monitor::update`). Every wait for ADC
-//!   data has a timeout ([`AdcWait`]): when it expires (an ADC overrun, a DMA transfer
+//!   data has a timeout (`drive_monitor::liveness::AdcWait`): when it expires (an ADC overrun, a DMA transfer
 //!   error, a stopped trigger) or the DMA lapped the reader, the acquisition is recovered
 //!   by `drive_monitor::recovery::recover` on the registers (`firmware/acquisition.rs`):
 //!   trigger, ADCs and DMA stopped, `OVR` and `TEIF` cleared, DMA re-armed, ADCs and
@@ -27,6 +27,7 @@
 mod acquisition;
 mod failure;
 mod logs;
+mod sample_task;
 mod supply;
 
 use core::mem::MaybeUninit;
@@ -35,41 +36,34 @@ use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
 use defmt::{error, info, warn};
 use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, Spawner};
-use embassy_stm32::adc::{Adc, AdcChannel, AdcConfig, Exten, RingBufferedAdc, SampleTime};
 use embassy_stm32::exti::{self, ExtiInput};
 use embassy_stm32::flash::{Blocking, Flash};
 use embassy_stm32::gpio::{Level, Output, Pull, Speed};
 use embassy_stm32::interrupt::{InterruptExt, Priority};
-use embassy_stm32::time::Hertz;
-use embassy_stm32::timer::low_level::{MasterMode, RoundTo, Timer as HwTimer};
-use embassy_stm32::timer::qei::{Config as QeiConfig, Qei};
+use embassy_stm32::mode::Async;
 use embassy_stm32::wdg::IndependentWatchdog;
-use embassy_stm32::{bind_interrupts, dma, interrupt, pac, peripherals, triggers, Peri};
+use embassy_stm32::{bind_interrupts, dma, interrupt, pac, peripherals, Peri};
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 use embassy_time::{with_deadline, with_timeout, Duration, Instant, Timer};
 
 use drive_monitor::app::{
-    carry_out, isolation_summary, Command, MonitorStatus, SamplePath, Settings, Supervisor,
+    carry_out, isolation_summary, Command, MonitorStatus, SamplePath, Settings, Supervisor, Tick,
     PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
 };
-use drive_monitor::board::{self, pins::Board, CurrentCode, Lamp, VoltageCode, LAMP_COUNT};
+use drive_monitor::board::{self, pins::Board, Lamp, LAMP_COUNT};
 use drive_monitor::boot::{self, Machine};
+use drive_monitor::commissioning::Action;
 use drive_monitor::flash_record::{RecordStore, RECORD_LEN};
-use drive_monitor::liveness::AdcWait;
-use drive_monitor::motor_source::EncoderSetup;
 use drive_monitor::offset_trim::TrimResult;
 use drive_monitor::panel::PanelLamps;
-use drive_monitor::recovery::{self, RecoveryCounts, StepTimeout};
-use drive_monitor::reset_record::{BootPhase, PreviousRun, ResetRecord, RESET_RECORD_LEN};
-use drive_monitor::sampling::RawFrame;
-use drive_monitor::setup_guard::SetupStep;
+use drive_monitor::reset_record::{BootPhase, PreviousRun, RESET_RECORD_LEN};
 use drive_monitor::supply::BorCheck;
 use monitor_core::motor_record::STORED_LEN as MOTOR_RECORD_LEN;
 use monitor_core::Isolation;
 
-use acquisition::HwAcquisition;
+use sample_task::{sample_task, SampleHw};
 
 bind_interrupts!(struct Irqs {
     DMA1_CHANNEL1 => acquisition::AdcDmaInterrupt<peripherals::DMA1_CH1, 0>;
@@ -105,13 +99,6 @@ unsafe impl
 /// same configuration function the host tests use.
 const SETTINGS: Settings = Settings::DEFAULT;
 const _: () = assert!(SETTINGS.validate().is_ok(), "SETTINGS out of range");
-/// Samples per DMA half buffer: 1, so every sample is processed as it arrives and the
-/// encoder is read within microseconds of the conversion.
-const SAMPLES_PER_HALF: usize = 1;
-/// ADC channels per ADC.
-const CHANNELS: usize = 3;
-/// DMA ring length per ADC, in 16-bit words (two halves).
-const RING_LEN: usize = 2 * SAMPLES_PER_HALF * CHANNELS;
 /// Longest wait for a command slot in the queue, ms (the sample task empties it at every
 /// sample).
 const COMMAND_SEND_TIMEOUT_MS: u64 = 100;
@@ -178,261 +165,6 @@ unsafe fn UART4() {
     // SAFETY: UART4 is not used as a UART; its vector is dedicated to this executor,
     // which is started once in `main` before the interrupt is enabled.
     unsafe { EXECUTOR_HIGH.on_interrupt() }
-}
-
-/// Everything the sample task owns.
-struct SampleHw {
-    adc1: Peri<'static, peripherals::ADC1>,
-    adc2: Peri<'static, peripherals::ADC2>,
-    dma1: Peri<'static, peripherals::DMA1_CH1>,
-    dma2: Peri<'static, peripherals::DMA1_CH2>,
-    tim1: Peri<'static, peripherals::TIM1>,
-    v: board::pins::VoltagePins,
-    i: board::pins::CurrentPins,
-    tim4: Peri<'static, peripherals::TIM4>,
-    enc_a: Peri<'static, peripherals::PB6>,
-    enc_b: Peri<'static, peripherals::PB7>,
-    /// The encoder's direction, filter and pull-ups from the motor record.
-    encoder: EncoderSetup,
-    /// SysTick: the ADC set-up's deadline (`supply::SetupGuard`).
-    syst: cortex_m::peripheral::SYST,
-}
-
-/// The encoder: TIM4 in quadrature mode on PB6/PB7 with the motor record's pull-ups,
-/// input filter and direction (`motor_source::encoder_setup`).
-fn start_encoder(
-    tim4: Peri<'static, peripherals::TIM4>,
-    a: Peri<'static, peripherals::PB6>,
-    b: Peri<'static, peripherals::PB7>,
-    setup: &EncoderSetup,
-) -> Qei<'static, peripherals::TIM4> {
-    let pull = if setup.pull_up { Pull::Up } else { Pull::None };
-    let qei_config = QeiConfig {
-        ch1_pull: pull,
-        ch2_pull: pull,
-        ..QeiConfig::default()
-    };
-    let qei = Qei::new(tim4, a, b, qei_config);
-    // The input filter on both inputs and the direction (input A's polarity), from the
-    // motor record (`motor_source::encoder_setup`).
-    let regs = pac::TIM4;
-    let filter = pac::timer::vals::FilterValue::from_bits(setup.input_filter);
-    regs.ccmr_input(0).modify(|w| {
-        w.set_icf(0, filter);
-        w.set_icf(1, filter);
-    });
-    regs.ccer().modify(|w| w.set_ccp(0, setup.invert_a));
-    qei
-}
-
-/// 247.5 ADC cycles sampling time (5.8 us at the 42.5 MHz ADC clock): the documented
-/// front end (docs/firmware.md, "Voltage and current sensing") drives each pin through a
-/// 1 kohm / 10 nF anti-alias filter; the datasheet's bound on the source resistance,
-/// R_AIN < t_S / (f_ADC C_ADC ln(2^(N+2))) - R_ADC, with C_ADC 5 pF and R_ADC 1 kohm,
-/// is about 11 kohm at 24.5 cycles and 120 kohm at 247.5; three conversions of
-/// 247.5 + 12.5 cycles take 18.4 us of the 100 us period.
-const SAMPLE_TIME: SampleTime = SampleTime::CYCLES247_5;
-
-/// ADC1's regular sequence va, vb, vc on TIM1's TRGO into its DMA ring.
-fn ring_voltages(
-    adc: Adc<'static, peripherals::ADC1>,
-    dma: Peri<'static, peripherals::DMA1_CH1>,
-    v: board::pins::VoltagePins,
-    ring: &'static mut [u16; RING_LEN],
-) -> RingBufferedAdc<'static, peripherals::ADC1> {
-    let st = SAMPLE_TIME;
-    let sequence = [
-        (v.a.degrade_adc(), st),
-        (v.b.degrade_adc(), st),
-        (v.c.degrade_adc(), st),
-    ];
-    let (trigger, edge) = (triggers::TIM1_TRGO, Exten::RISING_EDGE);
-    adc.into_ring_buffered(dma, ring, Irqs, sequence.into_iter(), trigger, edge)
-}
-
-/// ADC2's regular sequence ia, ib, ic on TIM1's TRGO into its DMA ring.
-fn ring_currents(
-    adc: Adc<'static, peripherals::ADC2>,
-    dma: Peri<'static, peripherals::DMA1_CH2>,
-    i: board::pins::CurrentPins,
-    ring: &'static mut [u16; RING_LEN],
-) -> RingBufferedAdc<'static, peripherals::ADC2> {
-    let st = SAMPLE_TIME;
-    let sequence = [
-        (i.a.degrade_adc(), st),
-        (i.b.degrade_adc(), st),
-        (i.c.degrade_adc(), st),
-    ];
-    let (trigger, edge) = (triggers::TIM1_TRGO, Exten::RISING_EDGE);
-    adc.into_ring_buffered(dma, ring, Irqs, sequence.into_iter(), trigger, edge)
-}
-
-/// Starts the acquisition: the encoder (TIM4 in quadrature mode), the trigger (TIM1 update
-/// -> TRGO at the sample rate) and the two ring-buffered ADCs (ADC1 the voltages, ADC2 the
-/// currents), then the trigger, the timestamps continuing from now.
-fn start_acquisition(
-    hw: SampleHw,
-    path: &mut SamplePath,
-) -> (Qei<'static, peripherals::TIM4>, HwAcquisition) {
-    static RING1: static_cell::StaticCell<[u16; RING_LEN]> = static_cell::StaticCell::new();
-    static RING2: static_cell::StaticCell<[u16; RING_LEN]> = static_cell::StaticCell::new();
-    let ring1 = RING1.init([0; RING_LEN]);
-    let ring2 = RING2.init([0; RING_LEN]);
-
-    let qei = start_encoder(hw.tim4, hw.enc_a, hw.enc_b, &hw.encoder);
-
-    // Sample trigger: TIM1 update event -> TRGO -> both ADCs (rising edge).
-    let trigger = HwTimer::new(hw.tim1);
-    trigger.set_frequency(Hertz(SETTINGS.sample_rate_hz), RoundTo::Slower);
-    trigger.set_master_mode(MasterMode::UPDATE);
-
-    // Every step under the set-up deadline (`drive_monitor::setup_guard`): the HAL's waits
-    // on ADCAL, ADRDY and ADSTART have no bound of their own.
-    let guard = supply::SetupGuard::arm(hw.syst, SetupStep::Adc1);
-    let adc1 = Adc::new(hw.adc1, AdcConfig::default());
-    guard.step(SetupStep::Ring1);
-    let adc1 = ring_voltages(adc1, hw.dma1, hw.v, ring1);
-    // The ADC's reference: VDDA from VREFINT on ADC1's injected channel against the
-    // factory's calibration word, once before the rings start (bounded); thread mode then
-    // measures it every second.
-    guard.step(SetupStep::Reference);
-    supply::configure_reference();
-    REFERENCE.signal(drive_monitor::supply::measure_now(&mut supply::HwReference));
-    guard.step(SetupStep::Adc2);
-    let adc2 = Adc::new(hw.adc2, AdcConfig::default());
-    guard.step(SetupStep::Ring2);
-    let adc2 = ring_currents(adc2, hw.dma2, hw.i, ring2);
-    guard.step(SetupStep::Start);
-    let mut acq = acquisition::new_acquisition(trigger, adc1, adc2, RING_LEN as u16);
-    acquisition::start(&mut acq);
-    guard.disarm();
-    path.sampler_mut().resync(acq.regs.started_us);
-    (qei, acq)
-}
-
-/// Runs the sample path on the readings of one DMA half (`v` from ADC1, `i` from ADC2)
-/// with the encoder count read after them; hands thread mode a status every
-/// `status_every` samples. `max_cycles`: the longest `on_frame` so far, in CPU cycles.
-fn process_half(
-    path: &mut SamplePath,
-    v: &[u16],
-    i: &[u16],
-    encoder_count: u16,
-    max_cycles: &mut u32,
-) {
-    for (v, i) in v.chunks_exact(CHANNELS).zip(i.chunks_exact(CHANNELS)) {
-        let (&[va, vb, vc], &[ia, ib, ic]) = (v, i) else {
-            continue;
-        };
-        let raw = RawFrame {
-            v: [VoltageCode(va), VoltageCode(vb), VoltageCode(vc)],
-            i: [CurrentCode(ia), CurrentCode(ib), CurrentCode(ic)],
-            encoder_count,
-        };
-        if let Some(trim) = path.trim_offsets(&raw) {
-            TRIM.signal(trim);
-        }
-        let t0 = cortex_m::peripheral::DWT::cycle_count();
-        path.on_frame(&raw);
-        let dt = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t0);
-        *max_cycles = (*max_cycles).max(dt);
-        if path.samples().is_multiple_of(SETTINGS.status_every()) {
-            STATUS.signal(Status {
-                monitor: path.status(),
-                max_update_cycles: *max_cycles,
-            });
-        }
-    }
-}
-
-#[embassy_executor::task]
-async fn sample_task(hw: SampleHw, mut path: SamplePath) {
-    // The HAL's ADC set-up waits on registers without a bound (power-up, calibration,
-    // ADRDY, ADSTART): the record says so if the watchdog has to end it.
-    set_phase(BootPhase::AdcSetup);
-    let setup = ResetRecord::setup(BootPhase::AdcSetup).with_bor_level(supply::bor_level());
-    write_reset_record(&setup.encode());
-    let (qei, mut acq) = start_acquisition(hw, &mut path);
-    write_reset_record(&[0; RESET_RECORD_LEN]);
-    set_phase(BootPhase::Sampling);
-    info!("sampling at {=u32} Hz", SETTINGS.sample_rate_hz);
-
-    let mut wait = AdcWait::new(SETTINGS.sample_rate_hz);
-    let timeout = Duration::from_micros(u64::from(wait.timeout_us()));
-    let mut half1 = [0u16; SAMPLES_PER_HALF * CHANNELS];
-    let mut half2 = [0u16; SAMPLES_PER_HALF * CHANNELS];
-    let mut max_cycles: u32 = 0;
-    let mut counts = RecoveryCounts::default();
-    loop {
-        let read = with_timeout(timeout, async {
-            let r1 = acq.regs.adc1.read(&mut half1).await;
-            let r2 = acq.regs.adc2.read(&mut half2).await;
-            (r1.is_ok(), r2.is_ok())
-        })
-        .await;
-        let recover_now = match read {
-            Ok((ok1, ok2)) => {
-                if let Some(n) = wait.data() {
-                    warn!("sampling resumed after {=u32} recoveries", n);
-                }
-                if !(ok1 && ok2) {
-                    // The DMA lapped the reader: samples were lost.
-                    let n = OVERRUNS.fetch_add(1, Ordering::Relaxed) + 1;
-                    warn!(
-                        "ADC DMA ring lapped #{=u32} (adc1 {} adc2 {})",
-                        n, !ok1, !ok2
-                    );
-                }
-                !(ok1 && ok2)
-            }
-            Err(_) => {
-                // No data within the timeout: an ADC overrun, a DMA error, or a stopped
-                // trigger (thread mode shows a stall and stops petting the watchdog until
-                // samples flow again).
-                let restart = wait.timed_out();
-                RESTARTS.fetch_add(1, Ordering::Relaxed);
-                if restart.log {
-                    error!(
-                        "no ADC data for {=u32} us: recovering the acquisition (attempt {=u32})",
-                        wait.timeout_us(),
-                        restart.attempt
-                    );
-                }
-                true
-            }
-        };
-        if recover_now {
-            // One sequence for every cause (drive_monitor::recovery): trigger, ADCs and
-            // DMA stopped, OVR and TEIF cleared, DMA re-armed, ADCs and trigger restarted;
-            // the timestamps continue from the restart (the gap shows).
-            set_phase(BootPhase::Recovery);
-            let result = recovery::recover(&mut acq);
-            path.sampler_mut().resync(acq.regs.started_us);
-            set_phase(BootPhase::Sampling);
-            counts.count(result);
-            match result {
-                Ok(f) if f.adc_overrun || f.dma_error => warn!(
-                    "acquisition recovered: adc overrun {=bool}, dma error {=bool} (recoveries {=u32}, overruns {=u32}, dma errors {=u32})",
-                    f.adc_overrun,
-                    f.dma_error,
-                    counts.recoveries,
-                    counts.adc_overruns,
-                    counts.dma_errors
-                ),
-                Ok(_) => {}
-                Err(StepTimeout(step)) => {
-                    error!("acquisition recovery stopped at {=str}: timed out", step.name())
-                }
-            }
-            continue;
-        }
-        while let Ok(cmd) = COMMANDS.try_receive() {
-            if let Err(e) = path.command(cmd) {
-                warn!("core refused a command: {=str}", e.describe());
-            }
-        }
-        process_half(&mut path, &half1, &half2, qei.count(), &mut max_cycles);
-    }
 }
 
 /// The six lamp outputs, in [`Lamp::ALL`] order.
@@ -558,6 +290,9 @@ fn boot_board(flash: &mut BoardFlash, previous: PreviousRun) -> (Machine, Sample
     (booted.machine, booted.path, booted.supervisor)
 }
 
+/// Boot in thread mode (clocks, the reason the previous run ended, the brown-out level,
+/// the watchdog, the flash records), then the sample task on the high-priority executor and
+/// thread mode's periods ([`Thread::run`]).
 #[embassy_executor::main]
 async fn main(_spawner: Spawner) {
     let p = embassy_stm32::init(clock_config());
@@ -566,28 +301,11 @@ async fn main(_spawner: Spawner) {
     // The brown-out level of the option bytes: reported, not written (`drive_monitor::supply`).
     let bor = supply::bor_check();
     logs::log_bor(bor);
-
-    // Cycle counter for the per-sample cost shown in the log; SysTick for the set-up's
-    // deadline.
-    let mut cp = match cortex_m::Peripherals::take() {
-        Some(cp) => cp,
-        // Taken once, here (embassy-stm32 takes none of them).
-        #[allow(clippy::panic)]
-        None => panic!("core peripherals taken twice"),
-    };
-    cp.DCB.enable_trace();
-    cp.DWT.enable_cycle_counter();
+    let cp = core_peripherals();
 
     let b = Board::take(p);
     let wdg = start_watchdog(b.iwdg);
-    // The flash driver (built for dual-bank) panics on single-bank option bytes: check
-    // first and run without the records instead (the built-in motor, not commissioned).
-    set_phase(BootPhase::Flash);
-    let dual_bank = pac::FLASH.optr().read().dbank();
-    if !dual_bank {
-        error!("option bytes: single-bank flash (DBANK = 0); the records need dual-bank: set DBANK with STM32CubeProgrammer. Running with the built-in motor, not commissioned");
-    }
-
+    let dual_bank = dual_bank_flash();
     let mut thread = Thread {
         lamps: PanelPins::new(b.lamps),
         flash: BoardFlash(dual_bank.then(|| Flash::new_blocking(b.flash))),
@@ -600,10 +318,6 @@ async fn main(_spawner: Spawner) {
 
     let (machine, path, mut supervisor) = boot_board(&mut thread.flash, previous);
     let boot = Instant::now();
-
-    // High-priority executor for the sample path.
-    interrupt::UART4.set_priority(Priority::P1);
-    let high = EXECUTOR_HIGH.start(interrupt::UART4);
     let hw = SampleHw {
         adc1: b.adc1,
         adc2: b.adc2,
@@ -618,27 +332,48 @@ async fn main(_spawner: Spawner) {
         encoder: machine.encoder,
         syst: cp.SYST,
     };
+    spawn_sample_task(hw, path);
+    thread.run(&mut supervisor, &mut button, boot).await
+}
+
+/// The Cortex-M core peripherals, with the cycle counter running (for the per-sample cost
+/// shown in the log); their SysTick is the ADC set-up's deadline.
+fn core_peripherals() -> cortex_m::Peripherals {
+    let mut cp = match cortex_m::Peripherals::take() {
+        Some(cp) => cp,
+        // Taken once, here (embassy-stm32 takes none of them).
+        #[allow(clippy::panic)]
+        None => panic!("core peripherals taken twice"),
+    };
+    cp.DCB.enable_trace();
+    cp.DWT.enable_cycle_counter();
+    cp
+}
+
+/// Whether the option bytes select dual-bank flash, which the record pages need. The flash
+/// driver (built for dual-bank) panics on single-bank option bytes: the firmware checks
+/// first and runs without the records instead (the built-in motor, not commissioned),
+/// saying so in the log.
+fn dual_bank_flash() -> bool {
+    set_phase(BootPhase::Flash);
+    let dual_bank = pac::FLASH.optr().read().dbank();
+    if !dual_bank {
+        error!("option bytes: single-bank flash (DBANK = 0); the records need dual-bank: set DBANK with STM32CubeProgrammer. Running with the built-in motor, not commissioned");
+    }
+    dual_bank
+}
+
+/// Starts the high-priority executor (UART4's vector at NVIC priority P1, above thread
+/// mode) and spawns the sample task on it with its hardware `hw` and the sample `path`.
+fn spawn_sample_task(hw: SampleHw, path: SamplePath) {
+    interrupt::UART4.set_priority(Priority::P1);
+    let high = EXECUTOR_HIGH.start(interrupt::UART4);
     set_phase(BootPhase::Boot);
     match sample_task(hw, path) {
         Ok(task) => high.spawn(task),
         // A task that is spawned once, at boot: the pool cannot be full.
         #[allow(clippy::panic)]
         Err(_) => panic!("sample task not spawned"),
-    }
-
-    let period = Duration::from_millis(u64::from(PANEL_PERIOD_MS));
-    let mut next = Instant::now() + period;
-    loop {
-        // The period's wait is the wait for the button: a press at any time is seen.
-        let pressed = with_deadline(next, button.wait_for_rising_edge())
-            .await
-            .is_ok();
-        if pressed {
-            Timer::at(next).await;
-        }
-        next += period;
-        let now_ms = boot.elapsed().as_millis() as u32;
-        thread.period(&mut supervisor, now_ms, pressed).await;
     }
 }
 
@@ -657,6 +392,30 @@ struct Thread {
 }
 
 impl Thread {
+    /// Thread mode's periods, every [`PANEL_PERIOD_MS`] from boot (`boot`, the clock's
+    /// zero): the period's wait is the wait for the `button`, so a press at any time is
+    /// seen.
+    async fn run(
+        &mut self,
+        supervisor: &mut Supervisor,
+        button: &mut ExtiInput<'static, Async>,
+        boot: Instant,
+    ) -> ! {
+        let period = Duration::from_millis(u64::from(PANEL_PERIOD_MS));
+        let mut next = Instant::now() + period;
+        loop {
+            let pressed = with_deadline(next, button.wait_for_rising_edge())
+                .await
+                .is_ok();
+            if pressed {
+                Timer::at(next).await;
+            }
+            next += period;
+            let now_ms = boot.elapsed().as_millis() as u32;
+            self.period(supervisor, now_ms, pressed).await;
+        }
+    }
+
     /// One period at `now_ms`: the supervisor's tick on the latest status and the button,
     /// then its consequences (watchdog, logs, the commissioning action with its command
     /// to the sample task, the lamps) and every second period the status line.
@@ -669,17 +428,7 @@ impl Thread {
             supervisor.set_offset_fault(&trim);
             logs::log_trim(&trim);
         }
-        if let Some(check) = REFERENCE.try_take() {
-            if let board::ReferenceCheck::InBand(v) = check {
-                info!("reference: VDDA {=f32} V", v);
-            }
-            if let Some(change) = supervisor.observe_reference(check, now_ms) {
-                logs::log_reference(change);
-            }
-        }
-        if let Some(change) = supervisor.poll_reference(now_ms, &mut supply::HwReference) {
-            logs::log_reference(change);
-        }
+        check_reference(supervisor, now_ms);
         let tick = supervisor.tick(now_ms, status.map(|s| s.monitor), pressed);
         if tick.pet_watchdog {
             self.wdg.pet();
@@ -690,7 +439,21 @@ impl Thread {
         if let Some(end) = tick.run_ended {
             logs::log_run_end(end);
         }
-        let (command, stored) = carry_out(tick.action, &mut self.flash);
+        self.carry_out(tick.action).await;
+        self.lamps.show(&tick.lamps);
+        self.log_div += 1;
+        if self.log_div >= 2 {
+            self.log_div = 0;
+            self.status_line(supervisor, &tick);
+        }
+    }
+
+    /// Carries out the commissioning `action` ([`carry_out`]: the record stored in flash
+    /// first, logged) and sends its command to the sample task, waiting at most
+    /// [`COMMAND_SEND_TIMEOUT_MS`] for a slot in the queue (else the command is dropped and
+    /// logged).
+    async fn carry_out(&mut self, action: Action) {
+        let (command, stored) = carry_out(action, &mut self.flash);
         if let Some(stored) = stored {
             logs::log_stored(&stored);
         }
@@ -704,23 +467,39 @@ impl Thread {
                 error!("command queue full: {=str} dropped", cmd.name());
             }
         }
-        self.lamps.show(&tick.lamps);
+    }
 
-        self.log_div += 1;
-        if self.log_div >= 2 {
-            self.log_div = 0;
-            log_status(
-                supervisor.latest(),
-                supervisor.isolation(),
-                supervisor
-                    .isolation
-                    .as_ref()
-                    .map_or(0.0, |f| f.isolator().winding_rise_k()),
-                (tick.mode.name(), tick.call.name()),
-                self.max_update_cycles,
-                (supervisor.reference().vdda_v(), self.bor.status_number()),
-            );
+    /// The status line ([`log_status`]) on the supervisor's latest status and isolation and
+    /// the period's `tick` (the panel's mode and call).
+    fn status_line(&self, supervisor: &Supervisor, tick: &Tick) {
+        log_status(
+            supervisor.latest(),
+            supervisor.isolation(),
+            supervisor
+                .isolation
+                .as_ref()
+                .map_or(0.0, |f| f.isolator().winding_rise_k()),
+            (tick.mode.name(), tick.call.name()),
+            self.max_update_cycles,
+            (supervisor.reference().vdda_v(), self.bor.status_number()),
+        );
+    }
+}
+
+/// The checks of the ADC's reference at `now_ms`: the start-up one from the sample task
+/// (`REFERENCE`, once, its VDDA logged) and the periodic one on ADC1's injected channel,
+/// observed by the `supervisor`; a change of the verdict is logged.
+fn check_reference(supervisor: &mut Supervisor, now_ms: u32) {
+    if let Some(check) = REFERENCE.try_take() {
+        if let board::ReferenceCheck::InBand(v) = check {
+            info!("reference: VDDA {=f32} V", v);
         }
+        if let Some(change) = supervisor.observe_reference(check, now_ms) {
+            logs::log_reference(change);
+        }
+    }
+    if let Some(change) = supervisor.poll_reference(now_ms, &mut supply::HwReference) {
+        logs::log_reference(change);
     }
 }
 

@@ -43,6 +43,7 @@ fn the_per_sample_code_logs_nothing() {
     let mut found = Vec::new();
     for f in [
         "src/app.rs",
+        "src/app/sample_path.rs",
         "src/sampling.rs",
         "src/liveness.rs",
         "src/recovery.rs",

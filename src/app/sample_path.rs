@@ -1,0 +1,245 @@
+//! The per-sample path of the sample task ([`SamplePath`]: [`RawFrame`] -> `Sample` ->
+//! [`Monitor::update`], the start-up offset trim, the status for thread mode) and the
+//! [`Command`]s thread mode sends it, applied between two samples.
+
+use super::{board_monitor_config, MonitorStatus};
+use crate::board::FrontEnd;
+use crate::flash_record::CalibrationRecord;
+use crate::offset_trim::{OffsetTrim, TrimResult};
+use crate::sampling::{AdcSampler, RawFrame, SamplingError};
+use monitor_core::{
+    CommissioningError, ConfigError, Fault, Install, Monitor, MonitorConfig, SteadyPoint,
+};
+
+/// Why the application could not be built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AppError {
+    /// The core rejected the configuration.
+    Config(ConfigError),
+    /// The sample rate does not fit the timestamp clock.
+    Sampling(SamplingError),
+}
+
+/// Requests from thread mode to the sample task (applied between two samples).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Command {
+    /// Start a commissioning run of `duration_s` seconds of evaluated running; the learned
+    /// calibration goes into force once stored ([`Install::AfterStorage`]).
+    StartCommissioning {
+        /// Learning time, s (> 0).
+        duration_s: f32,
+    },
+    /// Cancel run `run` if it is still learning.
+    CancelCommissioning {
+        /// The run's id.
+        run: u16,
+    },
+    /// The flash holds `stored` after storing run `run`'s calibration (read back): the
+    /// core puts exactly that into force (`None`: the default thresholds) and ends the run.
+    CalibrationStored {
+        /// The run's id.
+        run: u16,
+        /// The record read back (`None`: no valid record).
+        stored: Option<CalibrationRecord>,
+    },
+    /// Install a calibration read from flash at boot.
+    SetCalibration(CalibrationRecord),
+}
+
+/// Why the core did not carry out a [`Command`] as asked.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CommandError {
+    /// A start was refused.
+    Commissioning(CommissioningError),
+    /// A cancel found that run not learning (it had ended or learned already).
+    NotLearning,
+    /// A stored or stored-back calibration is out of the core's range (the default
+    /// thresholds are in force for `CalibrationStored`; the previous ones for
+    /// `SetCalibration`).
+    Calibration(ConfigError),
+}
+
+impl CommandError {
+    /// A short description for logs.
+    pub fn describe(&self) -> &'static str {
+        match self {
+            CommandError::Commissioning(CommissioningError::Duration) => {
+                "commissioning refused: bad duration"
+            }
+            CommandError::Commissioning(CommissioningError::Busy) => {
+                "commissioning refused: a run is active"
+            }
+            CommandError::Commissioning(CommissioningError::StaleRun) => {
+                "commissioning report for an older run"
+            }
+            CommandError::NotLearning => "cancel: the run is not learning",
+            CommandError::Calibration(_) => "calibration out of the core's range",
+        }
+    }
+}
+
+impl Command {
+    /// A short name for logs.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Command::StartCommissioning { .. } => "start-commissioning",
+            Command::CancelCommissioning { .. } => "cancel-commissioning",
+            Command::CalibrationStored { .. } => "calibration-stored",
+            Command::SetCalibration(_) => "set-calibration",
+        }
+    }
+}
+
+/// The per-sample path: scaling, the core, commands.
+#[derive(Clone, Debug)]
+pub struct SamplePath {
+    monitor: Monitor,
+    sampler: AdcSampler,
+    samples: u32,
+    trim: OffsetTrim,
+}
+
+impl SamplePath {
+    /// Build from a core configuration, the board's front end and the sample rate.
+    ///
+    /// # Errors
+    /// [`AppError`] if the core or the sampler rejects the settings.
+    pub fn new(
+        cfg: MonitorConfig,
+        front_end: FrontEnd,
+        sample_rate_hz: u32,
+    ) -> Result<Self, AppError> {
+        Ok(Self {
+            monitor: Monitor::new(cfg).map_err(AppError::Config)?,
+            sampler: AdcSampler::new(front_end, sample_rate_hz).map_err(AppError::Sampling)?,
+            samples: 0,
+            trim: OffsetTrim::new(&front_end),
+        })
+    }
+
+    /// The board setup at `sample_rate_hz` (the [`Settings`](super::Settings) value): the configuration of
+    /// [`board_monitor_config`] and the default front end.
+    ///
+    /// # Errors
+    /// As [`SamplePath::new`].
+    pub fn for_board(sample_rate_hz: u32) -> Result<Self, AppError> {
+        Self::new(
+            board_monitor_config(sample_rate_hz),
+            FrontEnd::DEFAULT,
+            sample_rate_hz,
+        )
+    }
+
+    /// Apply a command.
+    ///
+    /// # Errors
+    /// [`CommandError`] when the core refused or could not do what was asked (see there
+    /// for what is in force then).
+    pub fn command(&mut self, cmd: Command) -> Result<(), CommandError> {
+        let m = &mut self.monitor;
+        match cmd {
+            Command::StartCommissioning { duration_s } => m
+                .start_commissioning_with(duration_s, Install::AfterStorage)
+                .map(|_| ())
+                .map_err(CommandError::Commissioning),
+            Command::CancelCommissioning { run } => m
+                .cancel_commissioning(run)
+                .then_some(())
+                .ok_or(CommandError::NotLearning),
+            Command::CalibrationStored { run, stored } => m
+                .calibration_stored(run, stored.map(Into::into))
+                .map_err(CommandError::Calibration),
+            Command::SetCalibration(rec) => m
+                .set_calibration(rec.into())
+                .map_err(CommandError::Calibration),
+        }
+    }
+
+    /// The start-up offset trim ([`crate::offset_trim`]): adds `raw` (the frame also given
+    /// to [`SamplePath::on_frame`]) and, at the [`crate::offset_trim::TRIM_SAMPLES`]th
+    /// frame, puts the trimmed channels' offsets into force in the front end and returns the
+    /// result (the out-of-bound channels go to [`Supervisor::set_offset_fault`](super::Supervisor::set_offset_fault)). `None`
+    /// before and after (then it returns at once).
+    pub fn trim_offsets(&mut self, raw: &RawFrame) -> Option<TrimResult> {
+        let trim = self.trim.add(raw)?;
+        let mut fe = *self.sampler.front_end();
+        let channels = (fe.voltage.iter_mut().zip(trim.voltage))
+            .chain(fe.current.iter_mut().zip(trim.current));
+        for (scale, channel) in channels {
+            if let Some(offset) = channel.offset() {
+                scale.offset_code = offset;
+            }
+        }
+        self.sampler.set_front_end(fe);
+        Some(trim)
+    }
+
+    /// The ADC sampler (for timestamp resynchronisation after lost samples).
+    pub fn sampler_mut(&mut self) -> &mut AdcSampler {
+        &mut self.sampler
+    }
+
+    /// The ADC sampler.
+    pub fn sampler(&self) -> &AdcSampler {
+        &self.sampler
+    }
+
+    /// The core monitor.
+    pub fn monitor(&self) -> &Monitor {
+        &self.monitor
+    }
+
+    /// Samples processed since boot (wrapping).
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    /// Process one trigger's readings.
+    #[inline]
+    pub fn on_frame(&mut self, raw: &RawFrame) {
+        let sample = self.sampler.build(raw);
+        self.monitor.update(&sample);
+        self.samples = self.samples.wrapping_add(1);
+    }
+
+    /// The status for thread mode, from the latest output.
+    pub fn status(&self) -> MonitorStatus {
+        let o = self.monitor.output();
+        let top = o.top();
+        let second = o
+            .diagnosis
+            .probabilities
+            .iter()
+            .zip(Fault::ALL)
+            .filter(|(p, f)| **p > 0.0 && Some(*f) != top.map(|t| t.0))
+            .fold(None::<(Fault, f32)>, |best, (p, f)| match best {
+                Some((_, bp)) if bp >= *p => best,
+                _ => Some((f, *p)),
+            });
+        MonitorStatus {
+            samples: self.samples,
+            residuals: o.residuals,
+            residual_lamps: o.lamps,
+            fault_detected: o.fault_detected,
+            sensor_fault: o.sensor_fault,
+            top,
+            second,
+            speed_rad_s: o.speed_rad_s,
+            zero_crossing_locked: o.zero_crossing_locked,
+            commissioned: self.monitor.calibration().is_some(),
+            run: self.monitor.commissioning(),
+            operating: o.operating,
+            frame_hz: o.frame_omega_rad_s / core::f32::consts::TAU,
+            quasi_steady: o.quasi_steady,
+            evaluating: o.evaluating,
+            bands: self.monitor.threshold_bands(),
+            point: SteadyPoint::from_output(o),
+            winding: o
+                .unbalance
+                .suspect_phase
+                .map(|p| (p, o.unbalance.winding_ratio)),
+            vds: o.vds,
+            moved: false,
+        }
+    }
+}

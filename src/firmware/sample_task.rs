@@ -1,0 +1,328 @@
+//! The sample task (on the high-priority interrupt executor): the acquisition's set-up
+//! (encoder, trigger, the two ring-buffered ADCs, the start-up check of the ADC's
+//! reference) under the set-up deadline and the reset record, then per sample the wait for
+//! both ADCs' data, the recovery when none came or the DMA lapped the reader, thread mode's
+//! commands and the sample path on the readings (`SamplePath::on_frame`), with a status for
+//! thread mode every `status_every` samples.
+
+use core::sync::atomic::Ordering;
+
+use defmt::{error, info, warn};
+use drive_monitor::app::SamplePath;
+use drive_monitor::board::{self, CurrentCode, VoltageCode};
+use drive_monitor::liveness::AdcWait;
+use drive_monitor::motor_source::EncoderSetup;
+use drive_monitor::recovery::{self, RecoveryCounts, StepTimeout};
+use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
+use drive_monitor::sampling::RawFrame;
+use drive_monitor::setup_guard::SetupStep;
+use embassy_stm32::adc::{Adc, AdcChannel, AdcConfig, Exten, RingBufferedAdc, SampleTime};
+use embassy_stm32::gpio::Pull;
+use embassy_stm32::time::Hertz;
+use embassy_stm32::timer::low_level::{MasterMode, RoundTo, Timer as HwTimer};
+use embassy_stm32::timer::qei::{Config as QeiConfig, Qei};
+use embassy_stm32::{pac, peripherals, triggers, Peri};
+use embassy_time::{with_timeout, Duration, TimeoutError};
+
+use super::acquisition::{self, HwAcquisition};
+use super::supply;
+use super::{
+    set_phase, write_reset_record, Irqs, Status, COMMANDS, OVERRUNS, REFERENCE, RESTARTS, SETTINGS,
+    STATUS, TRIM,
+};
+
+/// Samples per DMA half buffer: 1, so every sample is processed as it arrives and the
+/// encoder is read within microseconds of the conversion.
+const SAMPLES_PER_HALF: usize = 1;
+/// ADC channels per ADC.
+const CHANNELS: usize = 3;
+/// DMA ring length per ADC, in 16-bit words (two halves).
+const RING_LEN: usize = 2 * SAMPLES_PER_HALF * CHANNELS;
+
+/// Everything the sample task owns.
+pub(super) struct SampleHw {
+    pub(super) adc1: Peri<'static, peripherals::ADC1>,
+    pub(super) adc2: Peri<'static, peripherals::ADC2>,
+    pub(super) dma1: Peri<'static, peripherals::DMA1_CH1>,
+    pub(super) dma2: Peri<'static, peripherals::DMA1_CH2>,
+    pub(super) tim1: Peri<'static, peripherals::TIM1>,
+    pub(super) v: board::pins::VoltagePins,
+    pub(super) i: board::pins::CurrentPins,
+    pub(super) tim4: Peri<'static, peripherals::TIM4>,
+    pub(super) enc_a: Peri<'static, peripherals::PB6>,
+    pub(super) enc_b: Peri<'static, peripherals::PB7>,
+    /// The encoder's direction, filter and pull-ups from the motor record.
+    pub(super) encoder: EncoderSetup,
+    /// SysTick: the ADC set-up's deadline (`supply::SetupGuard`).
+    pub(super) syst: cortex_m::peripheral::SYST,
+}
+
+/// The encoder: TIM4 in quadrature mode on PB6/PB7 with the motor record's pull-ups,
+/// input filter and direction (`motor_source::encoder_setup`).
+fn start_encoder(
+    tim4: Peri<'static, peripherals::TIM4>,
+    a: Peri<'static, peripherals::PB6>,
+    b: Peri<'static, peripherals::PB7>,
+    setup: &EncoderSetup,
+) -> Qei<'static, peripherals::TIM4> {
+    let pull = if setup.pull_up { Pull::Up } else { Pull::None };
+    let qei_config = QeiConfig {
+        ch1_pull: pull,
+        ch2_pull: pull,
+        ..QeiConfig::default()
+    };
+    let qei = Qei::new(tim4, a, b, qei_config);
+    // The input filter on both inputs and the direction (input A's polarity), from the
+    // motor record (`motor_source::encoder_setup`).
+    let regs = pac::TIM4;
+    let filter = pac::timer::vals::FilterValue::from_bits(setup.input_filter);
+    regs.ccmr_input(0).modify(|w| {
+        w.set_icf(0, filter);
+        w.set_icf(1, filter);
+    });
+    regs.ccer().modify(|w| w.set_ccp(0, setup.invert_a));
+    qei
+}
+
+/// 247.5 ADC cycles sampling time (5.8 us at the 42.5 MHz ADC clock): the documented
+/// front end (docs/firmware.md, "Voltage and current sensing") drives each pin through a
+/// 1 kohm / 10 nF anti-alias filter; the datasheet's bound on the source resistance,
+/// R_AIN < t_S / (f_ADC C_ADC ln(2^(N+2))) - R_ADC, with C_ADC 5 pF and R_ADC 1 kohm,
+/// is about 11 kohm at 24.5 cycles and 120 kohm at 247.5; three conversions of
+/// 247.5 + 12.5 cycles take 18.4 us of the 100 us period.
+const SAMPLE_TIME: SampleTime = SampleTime::CYCLES247_5;
+
+/// ADC1's regular sequence va, vb, vc on TIM1's TRGO into its DMA ring.
+fn ring_voltages(
+    adc: Adc<'static, peripherals::ADC1>,
+    dma: Peri<'static, peripherals::DMA1_CH1>,
+    v: board::pins::VoltagePins,
+    ring: &'static mut [u16; RING_LEN],
+) -> RingBufferedAdc<'static, peripherals::ADC1> {
+    let st = SAMPLE_TIME;
+    let sequence = [
+        (v.a.degrade_adc(), st),
+        (v.b.degrade_adc(), st),
+        (v.c.degrade_adc(), st),
+    ];
+    let (trigger, edge) = (triggers::TIM1_TRGO, Exten::RISING_EDGE);
+    adc.into_ring_buffered(dma, ring, Irqs, sequence.into_iter(), trigger, edge)
+}
+
+/// ADC2's regular sequence ia, ib, ic on TIM1's TRGO into its DMA ring.
+fn ring_currents(
+    adc: Adc<'static, peripherals::ADC2>,
+    dma: Peri<'static, peripherals::DMA1_CH2>,
+    i: board::pins::CurrentPins,
+    ring: &'static mut [u16; RING_LEN],
+) -> RingBufferedAdc<'static, peripherals::ADC2> {
+    let st = SAMPLE_TIME;
+    let sequence = [
+        (i.a.degrade_adc(), st),
+        (i.b.degrade_adc(), st),
+        (i.c.degrade_adc(), st),
+    ];
+    let (trigger, edge) = (triggers::TIM1_TRGO, Exten::RISING_EDGE);
+    adc.into_ring_buffered(dma, ring, Irqs, sequence.into_iter(), trigger, edge)
+}
+
+/// Starts the acquisition: the encoder (TIM4 in quadrature mode), the trigger (TIM1 update
+/// -> TRGO at the sample rate) and the two ring-buffered ADCs (ADC1 the voltages, ADC2 the
+/// currents), then the trigger, the timestamps continuing from now.
+fn start_acquisition(
+    hw: SampleHw,
+    path: &mut SamplePath,
+) -> (Qei<'static, peripherals::TIM4>, HwAcquisition) {
+    static RING1: static_cell::StaticCell<[u16; RING_LEN]> = static_cell::StaticCell::new();
+    static RING2: static_cell::StaticCell<[u16; RING_LEN]> = static_cell::StaticCell::new();
+    let ring1 = RING1.init([0; RING_LEN]);
+    let ring2 = RING2.init([0; RING_LEN]);
+
+    let qei = start_encoder(hw.tim4, hw.enc_a, hw.enc_b, &hw.encoder);
+
+    // Sample trigger: TIM1 update event -> TRGO -> both ADCs (rising edge).
+    let trigger = HwTimer::new(hw.tim1);
+    trigger.set_frequency(Hertz(SETTINGS.sample_rate_hz), RoundTo::Slower);
+    trigger.set_master_mode(MasterMode::UPDATE);
+
+    // Every step under the set-up deadline (`drive_monitor::setup_guard`): the HAL's waits
+    // on ADCAL, ADRDY and ADSTART have no bound of their own.
+    let guard = supply::SetupGuard::arm(hw.syst, SetupStep::Adc1);
+    let adc1 = Adc::new(hw.adc1, AdcConfig::default());
+    guard.step(SetupStep::Ring1);
+    let adc1 = ring_voltages(adc1, hw.dma1, hw.v, ring1);
+    // The ADC's reference: VDDA from VREFINT on ADC1's injected channel against the
+    // factory's calibration word, once before the rings start (bounded); thread mode then
+    // measures it every second.
+    guard.step(SetupStep::Reference);
+    supply::configure_reference();
+    REFERENCE.signal(drive_monitor::supply::measure_now(&mut supply::HwReference));
+    guard.step(SetupStep::Adc2);
+    let adc2 = Adc::new(hw.adc2, AdcConfig::default());
+    guard.step(SetupStep::Ring2);
+    let adc2 = ring_currents(adc2, hw.dma2, hw.i, ring2);
+    guard.step(SetupStep::Start);
+    let mut acq = acquisition::new_acquisition(trigger, adc1, adc2, RING_LEN as u16);
+    acquisition::start(&mut acq);
+    guard.disarm();
+    path.sampler_mut().resync(acq.regs.started_us);
+    (qei, acq)
+}
+
+/// Runs the sample path on the readings of one DMA half (`v` from ADC1, `i` from ADC2)
+/// with the encoder count read after them; hands thread mode a status every
+/// `status_every` samples. `max_cycles`: the longest `on_frame` so far, in CPU cycles.
+fn process_half(
+    path: &mut SamplePath,
+    v: &[u16],
+    i: &[u16],
+    encoder_count: u16,
+    max_cycles: &mut u32,
+) {
+    for (v, i) in v.chunks_exact(CHANNELS).zip(i.chunks_exact(CHANNELS)) {
+        let (&[va, vb, vc], &[ia, ib, ic]) = (v, i) else {
+            continue;
+        };
+        let raw = RawFrame {
+            v: [VoltageCode(va), VoltageCode(vb), VoltageCode(vc)],
+            i: [CurrentCode(ia), CurrentCode(ib), CurrentCode(ic)],
+            encoder_count,
+        };
+        if let Some(trim) = path.trim_offsets(&raw) {
+            TRIM.signal(trim);
+        }
+        let t0 = cortex_m::peripheral::DWT::cycle_count();
+        path.on_frame(&raw);
+        let dt = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t0);
+        *max_cycles = (*max_cycles).max(dt);
+        if path.samples().is_multiple_of(SETTINGS.status_every()) {
+            STATUS.signal(Status {
+                monitor: path.status(),
+                max_update_cycles: *max_cycles,
+            });
+        }
+    }
+}
+
+/// The sample task: sets up the acquisition, then per DMA half (one sample) waits for both
+/// ADCs' data, bounded by [`AdcWait`]'s timeout; recovers the acquisition when no data came
+/// or the DMA lapped the reader, else applies thread mode's commands and runs the sample
+/// path on the half.
+#[embassy_executor::task]
+pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
+    let (qei, mut acq) = set_up_acquisition(hw, &mut path);
+    let mut wait = AdcWait::new(SETTINGS.sample_rate_hz);
+    let timeout = Duration::from_micros(u64::from(wait.timeout_us()));
+    let mut half1 = [0u16; SAMPLES_PER_HALF * CHANNELS];
+    let mut half2 = [0u16; SAMPLES_PER_HALF * CHANNELS];
+    let mut max_cycles: u32 = 0;
+    let mut counts = RecoveryCounts::default();
+    loop {
+        let read = with_timeout(timeout, async {
+            let r1 = acq.regs.adc1.read(&mut half1).await;
+            let r2 = acq.regs.adc2.read(&mut half2).await;
+            (r1.is_ok(), r2.is_ok())
+        })
+        .await;
+        if needs_recovery(read, &mut wait) {
+            recover_acquisition(&mut acq, &mut path, &mut counts);
+            continue;
+        }
+        apply_commands(&mut path);
+        process_half(&mut path, &half1, &half2, qei.count(), &mut max_cycles);
+    }
+}
+
+/// [`start_acquisition`] under the reset record: the HAL's ADC set-up waits on registers
+/// without a bound (power-up, calibration, ADRDY, ADSTART), so the record says so if the
+/// watchdog has to end it; cleared once sampling runs.
+fn set_up_acquisition(
+    hw: SampleHw,
+    path: &mut SamplePath,
+) -> (Qei<'static, peripherals::TIM4>, HwAcquisition) {
+    set_phase(BootPhase::AdcSetup);
+    let setup = ResetRecord::setup(BootPhase::AdcSetup).with_bor_level(supply::bor_level());
+    write_reset_record(&setup.encode());
+    let started = start_acquisition(hw, path);
+    write_reset_record(&[0; RESET_RECORD_LEN]);
+    set_phase(BootPhase::Sampling);
+    info!("sampling at {=u32} Hz", SETTINGS.sample_rate_hz);
+    started
+}
+
+/// Whether the acquisition needs the recovery after the wait for one half: `read` is both
+/// ADCs' read result (`true`: read, `false`: the DMA lapped the reader and samples were
+/// lost), or the timeout's error when no data came within it (an ADC overrun, a DMA error,
+/// or a stopped trigger: thread mode shows a stall and stops petting the watchdog until
+/// samples flow again). Counts and logs each cause on `wait` and the counters.
+#[inline]
+fn needs_recovery(read: Result<(bool, bool), TimeoutError>, wait: &mut AdcWait) -> bool {
+    match read {
+        Ok((ok1, ok2)) => {
+            if let Some(n) = wait.data() {
+                warn!("sampling resumed after {=u32} recoveries", n);
+            }
+            if !(ok1 && ok2) {
+                let n = OVERRUNS.fetch_add(1, Ordering::Relaxed) + 1;
+                warn!(
+                    "ADC DMA ring lapped #{=u32} (adc1 {} adc2 {})",
+                    n, !ok1, !ok2
+                );
+            }
+            !(ok1 && ok2)
+        }
+        Err(_) => {
+            let restart = wait.timed_out();
+            RESTARTS.fetch_add(1, Ordering::Relaxed);
+            if restart.log {
+                error!(
+                    "no ADC data for {=u32} us: recovering the acquisition (attempt {=u32})",
+                    wait.timeout_us(),
+                    restart.attempt
+                );
+            }
+            true
+        }
+    }
+}
+
+/// One recovery of the acquisition, the sequence for every cause (drive_monitor::recovery):
+/// trigger, ADCs and DMA stopped, OVR and TEIF cleared, DMA re-armed, ADCs and trigger
+/// restarted; the timestamps continue from the restart (the gap shows). Counted in
+/// `counts` and logged.
+fn recover_acquisition(
+    acq: &mut HwAcquisition,
+    path: &mut SamplePath,
+    counts: &mut RecoveryCounts,
+) {
+    set_phase(BootPhase::Recovery);
+    let result = recovery::recover(acq);
+    path.sampler_mut().resync(acq.regs.started_us);
+    set_phase(BootPhase::Sampling);
+    counts.count(result);
+    match result {
+        Ok(f) if f.adc_overrun || f.dma_error => warn!(
+            "acquisition recovered: adc overrun {=bool}, dma error {=bool} (recoveries {=u32}, overruns {=u32}, dma errors {=u32})",
+            f.adc_overrun,
+            f.dma_error,
+            counts.recoveries,
+            counts.adc_overruns,
+            counts.dma_errors
+        ),
+        Ok(_) => {}
+        Err(StepTimeout(step)) => {
+            error!("acquisition recovery stopped at {=str}: timed out", step.name())
+        }
+    }
+}
+
+/// Applies thread mode's queued commands to the sample path (between two samples); a
+/// refused one is logged.
+#[inline]
+fn apply_commands(path: &mut SamplePath) {
+    while let Ok(cmd) = COMMANDS.try_receive() {
+        if let Err(e) = path.command(cmd) {
+            warn!("core refused a command: {=str}", e.describe());
+        }
+    }
+}
