@@ -157,6 +157,16 @@ pub enum Step {
     Unconfirmed(Isolation),
 }
 
+/// The time step `dt_s` [s] as observed: a non-finite or negative value counts as 0.
+#[inline]
+fn observed_dt(dt_s: f32) -> f32 {
+    if dt_s.is_finite() && dt_s > 0.0 {
+        dt_s
+    } else {
+        0.0
+    }
+}
+
 /// What a result names, for the confirmation: a fault's index, the friction class, or
 /// nothing.
 fn name_key(iso: &Isolation) -> Option<usize> {
@@ -272,13 +282,29 @@ impl Follower {
     /// half a second of steady running). A point that is not steady against the average
     /// restarts it.
     pub fn observe(&mut self, p: &SteadyPoint, dt_s: f32, usable: bool, learning: bool) -> Step {
-        let dt = if dt_s.is_finite() && dt_s > 0.0 {
-            dt_s
-        } else {
-            0.0
-        };
+        let dt = observed_dt(dt_s);
         // Saturate: only "long enough or not" matters.
         self.since_isolation_s = crate::minf(self.since_isolation_s + dt, 2.0 * CONFIRM_S);
+        let ended = self.follow_learning(learning, dt);
+        if !usable {
+            self.restart();
+            return ended.map_or(Step::Waiting, Step::LearningEnded);
+        }
+        if !self.sum_point(p, dt) {
+            return ended.map_or(Step::Waiting, Step::LearningEnded);
+        }
+        self.close_block();
+        if let Some(ok) = ended {
+            return Step::LearningEnded(ok);
+        }
+        self.step_averaged(learning)
+    }
+
+    /// Follows commissioning's `learning` flag over `dt` [s]: its end puts the learned
+    /// baseline into force (`Some(true)` when it went into force, `Some(false)` when it did
+    /// not), its start sets the learning time to 0; `None` when learning did not end.
+    #[inline]
+    fn follow_learning(&mut self, learning: bool, dt: f32) -> Option<bool> {
         let mut ended = None;
         if self.learning && !learning {
             let ok = self.isolator.finish_learning();
@@ -292,10 +318,15 @@ impl Follower {
             self.learning_s += dt;
         }
         self.learning = learning;
-        if !usable {
-            self.restart();
-            return ended.map_or(Step::Waiting, Step::LearningEnded);
-        }
+        ended
+    }
+
+    /// Sums the usable point `p`, weighted by `dt` [s], into the block (a point outside the
+    /// band restarts the average and the settling, [`SETTLE_S`]). True when the block is
+    /// [`STEP_S`] long and settled, to be closed; a block that ends while settling is
+    /// dropped (module docs).
+    #[inline]
+    fn sum_point(&mut self, p: &SteadyPoint, dt: f32) -> bool {
         if self.reference().is_some_and(|r| !r.admits(p)) {
             self.restart();
             self.settling_s = SETTLE_S;
@@ -307,18 +338,20 @@ impl Follower {
         self.block_s += dt;
         // (Float sums of the time steps: a thousandth of slack.)
         if self.block_s < 0.999 * STEP_S {
-            return ended.map_or(Step::Waiting, Step::LearningEnded);
+            return false;
         }
         if self.settling_s > 0.0 {
             // Still settling: the block is dropped (module docs).
             self.block_sum = SteadyPoint::default();
             self.block_s = 0.0;
-            return ended.map_or(Step::Waiting, Step::LearningEnded);
+            return false;
         }
-        self.close_block();
-        if let Some(ok) = ended {
-            return Step::LearningEnded(ok);
-        }
+        true
+    }
+
+    /// After a block closed: the averaged point learned (`learning`) or isolated, once it
+    /// has been averaged for [`AVERAGE_S`]; [`Step::Waiting`] before.
+    fn step_averaged(&mut self, learning: bool) -> Step {
         let averaged_s = self.filled as f32 * STEP_S;
         let Some(avg) = self.mean() else {
             return Step::Waiting;
@@ -333,41 +366,62 @@ impl Follower {
             self.isolator.learn_at(&avg, t);
             Step::Learned
         } else {
-            let scale = crate::sqrt(AVERAGE_MAX_S / averaged_s);
-            let mut result = self.isolator.isolate_scaled(&avg, scale);
+            self.isolate_averaged(&avg, averaged_s)
+        }
+    }
+
+    /// Isolates the point `avg` averaged for `averaged_s` [s], its spreads scaled by
+    /// `sqrt(AVERAGE_MAX_S / averaged_s)`: heating is tracked and the point judged again;
+    /// the onset of a deviation begins the average again ([`Step::Waiting`]); else the
+    /// result goes to the confirmation ([`Follower::confirm`]).
+    fn isolate_averaged(&mut self, avg: &SteadyPoint, averaged_s: f32) -> Step {
+        let scale = crate::sqrt(AVERAGE_MAX_S / averaged_s);
+        let mut result = self.isolator.isolate_scaled(avg, scale);
+        let onset = self.at_onset();
+        let heating = self.heating_in(&result, onset);
+        if self.learned && heating {
             // Heating is not a fault: the machine judged against warms with the winding,
             // and the point is judged again (module docs of `crate::isolation`).
-            let was_healthy = self
-                .last
-                .is_none_or(|l| l.state == super::IsolationState::NoDeviation);
-            // (Only a full average can hold blocks from before a change that stayed inside
-            // the band; one begun after a band restart cannot.)
-            let full = self.filled >= BLOCKS;
-            let onset = was_healthy && full && !self.onset_restarted;
-            let warming = self.isolator.winding_rise_k().abs() >= super::WARMING_K;
-            // (A warming that begins is judged on blocks after the onset, as a fault is:
-            // the blend of a step fault's onset can fit a small heating best.)
-            let heating = result.heating_explains()
-                || (warming && result.heating_continues())
-                || (!onset && result.heating_begins());
-            if self.learned && heating {
-                self.track(result.heating.factor);
-                result = self.isolator.isolate_scaled(&avg, scale);
-            }
-            let deviates = matches!(
-                result.state,
-                super::IsolationState::Isolated | super::IsolationState::Unknown
-            );
-            if deviates && !heating && onset {
-                // The onset of a deviation: the average is begun again after it (module
-                // docs).
-                self.onset_restarted = true;
-                self.restart();
-                self.settling_s = SETTLE_S;
-                return Step::Waiting;
-            }
-            self.confirm(result)
+            self.track(result.heating.factor);
+            result = self.isolator.isolate_scaled(avg, scale);
         }
+        let deviates = matches!(
+            result.state,
+            super::IsolationState::Isolated | super::IsolationState::Unknown
+        );
+        if deviates && !heating && onset {
+            // The onset of a deviation: the average is begun again after it (module
+            // docs).
+            self.onset_restarted = true;
+            self.restart();
+            self.settling_s = SETTLE_S;
+            return Step::Waiting;
+        }
+        self.confirm(result)
+    }
+
+    /// A deviation now would be an onset (module docs): the latest result in force was
+    /// healthy (or none), the average is full ([`BLOCKS`]) and was not begun again at an
+    /// onset since the point last left the band.
+    fn at_onset(&self) -> bool {
+        let was_healthy = self
+            .last
+            .is_none_or(|l| l.state == super::IsolationState::NoDeviation);
+        // (Only a full average can hold blocks from before a change that stayed inside
+        // the band; one begun after a band restart cannot.)
+        let full = self.filled >= BLOCKS;
+        was_healthy && full && !self.onset_restarted
+    }
+
+    /// `result` is read as heating: it explains the residuals, or continues a warming of
+    /// at least [`super::WARMING_K`] in force, or begins one away from an `onset`.
+    fn heating_in(&self, result: &Isolation, onset: bool) -> bool {
+        let warming = self.isolator.winding_rise_k().abs() >= super::WARMING_K;
+        // (A warming that begins is judged on blocks after the onset, as a fault is:
+        // the blend of a step fault's onset can fit a small heating best.)
+        result.heating_explains()
+            || (warming && result.heating_continues())
+            || (!onset && result.heating_begins())
     }
 
     /// Takes a further heating of factor `k` into the machine judged against: the whole of
