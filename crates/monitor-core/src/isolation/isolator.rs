@@ -538,6 +538,48 @@ impl Isolator {
         anchor: Option<&SteadyPoint>,
     ) -> Isolation {
         let mut out = Isolation::default();
+        let (used, n) = self.weighted_points(points);
+        let used = used.get(..n).unwrap_or(&[]);
+        let Some((first, _, _)) = used.first() else {
+            return out;
+        };
+        let load = anchor.and_then(|a| Some((*a, self.torque_nm(a, None)?)));
+        let chi0 = self.chi2_points(used, load, None);
+        out.deviation = crate::sqrt(chi0);
+        if let Some(e0) = self.residuals(first, None) {
+            out.residuals = e0 - self.baseline.mean;
+        }
+        // Each point adds two or three equations: the detection threshold grows with them.
+        if chi0 < DETECT_CHI2 * n as f32 {
+            out.state = IsolationState::NoDeviation;
+            return out;
+        }
+        let mut fits = [(0.0f32, 1.0f32); FAULT_COUNT];
+        for (fit, f) in fits.iter_mut().zip(Fault::ALL) {
+            *fit = fit_factor(|k| self.chi2_points(used, load, Some((f, k))));
+        }
+        let heat = golden(
+            |k| self.warmer(k).chi2_points(used, load, None),
+            HEATING_K_MIN / self.heating_factor,
+            HEATING_K_MAX / self.heating_factor,
+            HEATING_STEPS,
+        );
+        rank(&mut out, &mut fits, heat, chi0);
+        if let Some(e0) = self.residuals(first, None) {
+            out.separation_deg = self.separation(first, &e0, &out.candidates);
+        }
+        out
+    }
+
+    /// The usable points of `points` (at most [`MAX_POINTS`], the first ones) with their
+    /// weights: each point's voltage-equation weight ([`Isolator::weight`],
+    /// [`Sym3::voltage_only`]) under the baseline's spreads times its spread scale (>= 1;
+    /// values below 1 or not finite count as 1), and that scale. Returns the array and how
+    /// many of it are filled.
+    fn weighted_points(
+        &self,
+        points: &[(SteadyPoint, f32)],
+    ) -> ([WeightedPoint; MAX_POINTS], usize) {
         let mut used = [(SteadyPoint::default(), Sym3::default(), 1.0f32); MAX_POINTS];
         let mut n = 0;
         for (p, scale) in points.iter().take(MAX_POINTS) {
@@ -559,49 +601,27 @@ impl Isolator {
                 n += 1;
             }
         }
-        let used = used.get(..n).unwrap_or(&[]);
-        let Some((first, _, _)) = used.first() else {
-            return out;
-        };
-        let load = anchor.and_then(|a| Some((*a, self.torque_nm(a, None)?)));
-        // The load is compared at the first point only: the first steady point of the
-        // deviation, the one nearest the anchor in time.
-        let chi_with = |iso: &Isolator, h: Option<(Fault, f32)>| -> f32 {
-            let first = used
-                .first()
-                .map_or(0.0, |(p, _, k)| iso.chi2_load(p, h, load, *k));
-            first
-                + used
-                    .iter()
-                    .map(|(p, w, _)| iso.chi2_at(p, h, w))
-                    .sum::<f32>()
-        };
-        let chi = |h: Option<(Fault, f32)>| chi_with(self, h);
-        let chi0 = chi(None);
-        out.deviation = crate::sqrt(chi0);
-        if let Some(e0) = self.residuals(first, None) {
-            out.residuals = e0 - self.baseline.mean;
-        }
-        // Each point adds two or three equations: the detection threshold grows with them.
-        if chi0 < DETECT_CHI2 * n as f32 {
-            out.state = IsolationState::NoDeviation;
-            return out;
-        }
-        let mut fits = [(0.0f32, 1.0f32); FAULT_COUNT];
-        for (fit, f) in fits.iter_mut().zip(Fault::ALL) {
-            *fit = fit_factor(|k| chi(Some((f, k))));
-        }
-        let heat = golden(
-            |k| chi_with(&self.warmer(k), None),
-            HEATING_K_MIN / self.heating_factor,
-            HEATING_K_MAX / self.heating_factor,
-            HEATING_STEPS,
-        );
-        rank(&mut out, &mut fits, heat, chi0);
-        if let Some(e0) = self.residuals(first, None) {
-            out.separation_deg = self.separation(first, &e0, &out.candidates);
-        }
-        out
+        (used, n)
+    }
+
+    /// The joint misfit of hypothesis `h` over the weighted points `used`: the torque
+    /// comparison with the anchor's `load` at the first point ([`Isolator::chi2_load`];
+    /// the first steady point of the deviation, the one nearest the anchor in time) plus
+    /// each point's voltage-equation misfit ([`Isolator::chi2_at`]).
+    fn chi2_points(
+        &self,
+        used: &[WeightedPoint],
+        load: Option<(SteadyPoint, f32)>,
+        h: Option<(Fault, f32)>,
+    ) -> f32 {
+        let first = used
+            .first()
+            .map_or(0.0, |(p, _, k)| self.chi2_load(p, h, load, *k));
+        first
+            + used
+                .iter()
+                .map(|(p, w, _)| self.chi2_at(p, h, w))
+                .sum::<f32>()
     }
 
     /// The air-gap torque the circuit gives at `p` under hypothesis `h` [N m]
@@ -827,6 +847,10 @@ pub const ANCHOR_TORQUE_SPREAD: f32 = 2.0 * LEARNED_SPREAD_FLOOR.torque;
 
 /// Most operating points [`Isolator::isolate_points`] combines.
 pub const MAX_POINTS: usize = 4;
+
+/// One operating point of the joint isolation: the point, its voltage-equation weight and
+/// its spread scale (>= 1) ([`Isolator::isolate_points_anchored`]).
+type WeightedPoint = (SteadyPoint, Sym3, f32);
 
 /// Best factor `k` of a misfit `chi(k)` over [`K_MIN`]..[`K_MAX`]: a geometric grid of
 /// [`GRID`] points (and `k = 1`), then [`GOLDEN_STEPS`] of golden section around the best
