@@ -62,8 +62,7 @@ impl Evidence {
             IsolationState::Isolated | IsolationState::Unknown
         ) || result.heating_explains()
         {
-            self.len = 0;
-            self.joint = None;
+            self.forget();
             if result.state == IsolationState::NoDeviation {
                 self.anchor = follower.averaged().map(|(p, _)| p);
             }
@@ -72,6 +71,40 @@ impl Evidence {
         let Some((p, scale)) = follower.averaged() else {
             return;
         };
+        if self.load_moved(follower, result, &(p, scale)) {
+            self.forget();
+            self.anchor = Some(p);
+            return;
+        }
+        let a = active_current(&p);
+        if !a.is_finite() {
+            return;
+        }
+        self.keep(p, scale, a);
+        let enough = self.len >= 2 || self.anchor.is_some();
+        self.joint = enough.then(|| {
+            follower
+                .isolator()
+                .isolate_points_anchored(self.kept(), self.anchor.as_ref())
+        });
+    }
+
+    /// Forgets the points kept and the joint isolation (the anchor stays).
+    fn forget(&mut self) {
+        self.len = 0;
+        self.joint = None;
+    }
+
+    /// The deviation `result` of the averaged `point` (with its spread scale) is a load
+    /// that moved, not a fault: the single point reads it as the friction class, no
+    /// evidence is kept yet, and the stator-voltage equations alone deviate by less than
+    /// [`LOAD_MOVED_SIGMA`].
+    fn load_moved(
+        &self,
+        follower: &Follower,
+        result: &Isolation,
+        point: &(SteadyPoint, f32),
+    ) -> bool {
         // A deviation the single point reads as the friction class that the stator-voltage
         // equations do not see (within LOAD_MOVED_SIGMA: the load moved) is an
         // operating-point change, not a fault: before any evidence of a fault it is the new
@@ -80,19 +113,15 @@ impl Evidence {
         // than LOAD_MOVED_SIGMA; the points before the load move still tell it).
         let iso = follower.isolator();
         let friction = matches!(result.named(), Some(Named::Friction { .. }));
-        if friction
+        friction
             && self.len == 0
-            && iso.isolate_points(&[(p, scale)]).deviation < LOAD_MOVED_SIGMA
-        {
-            self.len = 0;
-            self.joint = None;
-            self.anchor = Some(p);
-            return;
-        }
-        let a = active_current(&p);
-        if !a.is_finite() {
-            return;
-        }
+            && iso.isolate_points(core::slice::from_ref(point)).deviation < LOAD_MOVED_SIGMA
+    }
+
+    /// Keeps the point `p` (spread scale `scale`, active current `a` [A]): it replaces the
+    /// kept point at its load level (within [`LEVEL_APART`]), except a first point compared
+    /// with the anchor, else it is added ([`Evidence::push`]).
+    fn keep(&mut self, p: SteadyPoint, scale: f32, a: f32) {
         let same_level = self.kept().iter().position(|(q, _)| {
             let b = active_current(q);
             (a - b).abs() < LEVEL_APART * b.abs().max(a.abs())
@@ -107,28 +136,26 @@ impl Evidence {
                     *slot = (p, scale);
                 }
             }
-            None => {
-                if self.len >= MAX_POINTS {
-                    // The first point, at the anchor's load, is the one the torque
-                    // comparison holds for: the oldest after it goes.
-                    let oldest = usize::from(self.anchor.is_some() && self.len > 1);
-                    if let Some(tail) = self.kept_mut().get_mut(oldest..) {
-                        tail.rotate_left(1);
-                    }
-                    self.len -= 1;
-                }
-                if let Some(slot) = self.points.get_mut(self.len) {
-                    *slot = (p, scale);
-                    self.len += 1;
-                }
-            }
+            None => self.push(p, scale),
         }
-        let enough = self.len >= 2 || self.anchor.is_some();
-        self.joint = enough.then(|| {
-            follower
-                .isolator()
-                .isolate_points_anchored(self.kept(), self.anchor.as_ref())
-        });
+    }
+
+    /// Adds the point `p` (spread scale `scale`) after the kept ones; beyond
+    /// [`MAX_POINTS`] the oldest is dropped (the oldest after the first with an anchor).
+    fn push(&mut self, p: SteadyPoint, scale: f32) {
+        if self.len >= MAX_POINTS {
+            // The first point, at the anchor's load, is the one the torque
+            // comparison holds for: the oldest after it goes.
+            let oldest = usize::from(self.anchor.is_some() && self.len > 1);
+            if let Some(tail) = self.kept_mut().get_mut(oldest..) {
+                tail.rotate_left(1);
+            }
+            self.len -= 1;
+        }
+        if let Some(slot) = self.points.get_mut(self.len) {
+            *slot = (p, scale);
+            self.len += 1;
+        }
     }
 
     /// The points kept, oldest first.

@@ -44,8 +44,10 @@
 //!
 //! [`DEFAULT_SPREAD`]: super::DEFAULT_SPREAD
 
+mod band;
+
 use super::{Isolation, Isolator, SteadyPoint};
-use crate::fast_hypot;
+use band::SteadyBand;
 
 /// Shortest average of the operating point that is isolated or learned [s] (module docs).
 pub const AVERAGE_S: f32 = 0.5;
@@ -83,62 +85,6 @@ pub fn steady_against(p: &SteadyPoint, avg: &SteadyPoint) -> bool {
     SteadyBand::of(*avg).admits(p)
 }
 
-/// [`steady_against`] for one average, its limits computed once (the follower judges every
-/// point against the same average until a block closes).
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct SteadyBand {
-    avg: SteadyPoint,
-    /// [`STEADY_FRACTION`] of the current's magnitude (at least 1e-6 A) [A].
-    i: f32,
-    /// [`STEADY_FRACTION`] of the voltage's magnitude (at least 1e-6 V) [V].
-    v: f32,
-    /// [`STEADY_FRACTION`] of the supply's speed (at least 1 rad/s) [rad/s].
-    w: f32,
-}
-
-impl SteadyBand {
-    fn of(avg: SteadyPoint) -> Self {
-        let i = crate::maxf(fast_hypot(avg.i.d, avg.i.q), 1e-6);
-        let v = crate::maxf(fast_hypot(avg.v.d, avg.v.q), 1e-6);
-        let w = crate::maxf(avg.we_rad_s.abs(), 1.0);
-        SteadyBand {
-            avg,
-            i: STEADY_FRACTION * i,
-            v: STEADY_FRACTION * v,
-            w: STEADY_FRACTION * w,
-        }
-    }
-
-    fn admits(&self, p: &SteadyPoint) -> bool {
-        let avg = &self.avg;
-        hypot_within(p.i.d - avg.i.d, p.i.q - avg.i.q, self.i)
-            && hypot_within(p.v.d - avg.v.d, p.v.q - avg.v.q, self.v)
-            && (p.we_rad_s - avg.we_rad_s).abs() <= self.w
-            && (p.wr_rad_s - avg.wr_rad_s).abs() <= self.w
-    }
-}
-
-/// `fast_hypot(x, y) <= limit`, the same answer, with the square root taken only within
-/// 0.1 % of the limit. Elsewhere `x^2 + y^2` (the same sum `fast_hypot` takes the root of)
-/// against `limit^2` decides: for a normal sum, [`crate::sqrt`] is within 2e-6 of the true
-/// root (micromath's estimate, within 6.1 %, refined by two Newton steps: 1.7e-3, then
-/// 1.5e-6, plus f32 rounding), far inside the 0.1 % margin. Zero, subnormal, infinite or
-/// NaN sums and limits, and limits that are not positive, take the root.
-#[inline]
-fn hypot_within(x: f32, y: f32, limit: f32) -> bool {
-    let s = x * x + y * y;
-    let l2 = limit * limit;
-    if limit > 0.0 && s.is_normal() && l2.is_normal() {
-        if s < 0.998 * l2 {
-            return true;
-        }
-        if s > 1.002 * l2 {
-            return false;
-        }
-    }
-    fast_hypot(x, y) <= limit
-}
-
 /// What one [`Follower::observe`] did.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Step {
@@ -155,6 +101,16 @@ pub enum Step {
     /// The averaged point was isolated but names a fault that has not been named for
     /// [`CONFIRM_S`] yet: [`Follower::last`] keeps the previous result.
     Unconfirmed(Isolation),
+}
+
+/// The time step `dt_s` [s] as observed: a non-finite or negative value counts as 0.
+#[inline]
+fn observed_dt(dt_s: f32) -> f32 {
+    if dt_s.is_finite() && dt_s > 0.0 {
+        dt_s
+    } else {
+        0.0
+    }
 }
 
 /// What a result names, for the confirmation: a fault's index, the friction class, or
@@ -272,13 +228,29 @@ impl Follower {
     /// half a second of steady running). A point that is not steady against the average
     /// restarts it.
     pub fn observe(&mut self, p: &SteadyPoint, dt_s: f32, usable: bool, learning: bool) -> Step {
-        let dt = if dt_s.is_finite() && dt_s > 0.0 {
-            dt_s
-        } else {
-            0.0
-        };
+        let dt = observed_dt(dt_s);
         // Saturate: only "long enough or not" matters.
         self.since_isolation_s = crate::minf(self.since_isolation_s + dt, 2.0 * CONFIRM_S);
+        let ended = self.follow_learning(learning, dt);
+        if !usable {
+            self.restart();
+            return ended.map_or(Step::Waiting, Step::LearningEnded);
+        }
+        if !self.sum_point(p, dt) {
+            return ended.map_or(Step::Waiting, Step::LearningEnded);
+        }
+        self.close_block();
+        if let Some(ok) = ended {
+            return Step::LearningEnded(ok);
+        }
+        self.step_averaged(learning)
+    }
+
+    /// Follows commissioning's `learning` flag over `dt` [s]: its end puts the learned
+    /// baseline into force (`Some(true)` when it went into force, `Some(false)` when it did
+    /// not), its start sets the learning time to 0; `None` when learning did not end.
+    #[inline]
+    fn follow_learning(&mut self, learning: bool, dt: f32) -> Option<bool> {
         let mut ended = None;
         if self.learning && !learning {
             let ok = self.isolator.finish_learning();
@@ -292,10 +264,15 @@ impl Follower {
             self.learning_s += dt;
         }
         self.learning = learning;
-        if !usable {
-            self.restart();
-            return ended.map_or(Step::Waiting, Step::LearningEnded);
-        }
+        ended
+    }
+
+    /// Sums the usable point `p`, weighted by `dt` [s], into the block (a point outside the
+    /// band restarts the average and the settling, [`SETTLE_S`]). True when the block is
+    /// [`STEP_S`] long and settled, to be closed; a block that ends while settling is
+    /// dropped (module docs).
+    #[inline]
+    fn sum_point(&mut self, p: &SteadyPoint, dt: f32) -> bool {
         if self.reference().is_some_and(|r| !r.admits(p)) {
             self.restart();
             self.settling_s = SETTLE_S;
@@ -307,18 +284,20 @@ impl Follower {
         self.block_s += dt;
         // (Float sums of the time steps: a thousandth of slack.)
         if self.block_s < 0.999 * STEP_S {
-            return ended.map_or(Step::Waiting, Step::LearningEnded);
+            return false;
         }
         if self.settling_s > 0.0 {
             // Still settling: the block is dropped (module docs).
             self.block_sum = SteadyPoint::default();
             self.block_s = 0.0;
-            return ended.map_or(Step::Waiting, Step::LearningEnded);
+            return false;
         }
-        self.close_block();
-        if let Some(ok) = ended {
-            return Step::LearningEnded(ok);
-        }
+        true
+    }
+
+    /// After a block closed: the averaged point learned (`learning`) or isolated, once it
+    /// has been averaged for [`AVERAGE_S`]; [`Step::Waiting`] before.
+    fn step_averaged(&mut self, learning: bool) -> Step {
         let averaged_s = self.filled as f32 * STEP_S;
         let Some(avg) = self.mean() else {
             return Step::Waiting;
@@ -333,41 +312,62 @@ impl Follower {
             self.isolator.learn_at(&avg, t);
             Step::Learned
         } else {
-            let scale = crate::sqrt(AVERAGE_MAX_S / averaged_s);
-            let mut result = self.isolator.isolate_scaled(&avg, scale);
+            self.isolate_averaged(&avg, averaged_s)
+        }
+    }
+
+    /// Isolates the point `avg` averaged for `averaged_s` [s], its spreads scaled by
+    /// `sqrt(AVERAGE_MAX_S / averaged_s)`: heating is tracked and the point judged again;
+    /// the onset of a deviation begins the average again ([`Step::Waiting`]); else the
+    /// result goes to the confirmation ([`Follower::confirm`]).
+    fn isolate_averaged(&mut self, avg: &SteadyPoint, averaged_s: f32) -> Step {
+        let scale = crate::sqrt(AVERAGE_MAX_S / averaged_s);
+        let mut result = self.isolator.isolate_scaled(avg, scale);
+        let onset = self.at_onset();
+        let heating = self.heating_in(&result, onset);
+        if self.learned && heating {
             // Heating is not a fault: the machine judged against warms with the winding,
             // and the point is judged again (module docs of `crate::isolation`).
-            let was_healthy = self
-                .last
-                .is_none_or(|l| l.state == super::IsolationState::NoDeviation);
-            // (Only a full average can hold blocks from before a change that stayed inside
-            // the band; one begun after a band restart cannot.)
-            let full = self.filled >= BLOCKS;
-            let onset = was_healthy && full && !self.onset_restarted;
-            let warming = self.isolator.winding_rise_k().abs() >= super::WARMING_K;
-            // (A warming that begins is judged on blocks after the onset, as a fault is:
-            // the blend of a step fault's onset can fit a small heating best.)
-            let heating = result.heating_explains()
-                || (warming && result.heating_continues())
-                || (!onset && result.heating_begins());
-            if self.learned && heating {
-                self.track(result.heating.factor);
-                result = self.isolator.isolate_scaled(&avg, scale);
-            }
-            let deviates = matches!(
-                result.state,
-                super::IsolationState::Isolated | super::IsolationState::Unknown
-            );
-            if deviates && !heating && onset {
-                // The onset of a deviation: the average is begun again after it (module
-                // docs).
-                self.onset_restarted = true;
-                self.restart();
-                self.settling_s = SETTLE_S;
-                return Step::Waiting;
-            }
-            self.confirm(result)
+            self.track(result.heating.factor);
+            result = self.isolator.isolate_scaled(avg, scale);
         }
+        let deviates = matches!(
+            result.state,
+            super::IsolationState::Isolated | super::IsolationState::Unknown
+        );
+        if deviates && !heating && onset {
+            // The onset of a deviation: the average is begun again after it (module
+            // docs).
+            self.onset_restarted = true;
+            self.restart();
+            self.settling_s = SETTLE_S;
+            return Step::Waiting;
+        }
+        self.confirm(result)
+    }
+
+    /// A deviation now would be an onset (module docs): the latest result in force was
+    /// healthy (or none), the average is full ([`BLOCKS`]) and was not begun again at an
+    /// onset since the point last left the band.
+    fn at_onset(&self) -> bool {
+        let was_healthy = self
+            .last
+            .is_none_or(|l| l.state == super::IsolationState::NoDeviation);
+        // (Only a full average can hold blocks from before a change that stayed inside
+        // the band; one begun after a band restart cannot.)
+        let full = self.filled >= BLOCKS;
+        was_healthy && full && !self.onset_restarted
+    }
+
+    /// `result` is read as heating: it explains the residuals, or continues a warming of
+    /// at least [`super::WARMING_K`] in force, or begins one away from an `onset`.
+    fn heating_in(&self, result: &Isolation, onset: bool) -> bool {
+        let warming = self.isolator.winding_rise_k().abs() >= super::WARMING_K;
+        // (A warming that begins is judged on blocks after the onset, as a fault is:
+        // the blend of a step fault's onset can fit a small heating best.)
+        result.heating_explains()
+            || (warming && result.heating_continues())
+            || (!onset && result.heating_begins())
     }
 
     /// Takes a further heating of factor `k` into the machine judged against: the whole of
@@ -501,71 +501,5 @@ impl Follower {
     /// The isolator (its baseline, its torque scale).
     pub fn isolator(&self) -> &Isolator {
         &self.isolator
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The shortcut gives `fast_hypot`'s answer: random magnitudes over the whole f32 range,
-    /// points near the limit, and the special values.
-    #[test]
-    fn hypot_within_answers_as_the_root() {
-        let mut r: u32 = 0x9E37_79B9;
-        let mut next = || {
-            r ^= r << 13;
-            r ^= r >> 17;
-            r ^= r << 5;
-            r
-        };
-        let special = [
-            0.0,
-            -0.0,
-            f32::MIN_POSITIVE,
-            1e-40,
-            f32::MAX,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            f32::NAN,
-        ];
-        let mut cases = 0;
-        for k in 0..2_000_000 {
-            let (x, y, limit) = match k % 4 {
-                // Any bit patterns.
-                0 => (
-                    f32::from_bits(next()),
-                    f32::from_bits(next()),
-                    f32::from_bits(next()),
-                ),
-                // Ordinary magnitudes.
-                1 => {
-                    let u = |n: u32| (n as f32 / u32::MAX as f32 - 0.5) * 20.0;
-                    (u(next()), u(next()), u(next()).abs())
-                }
-                // Near the limit: within 1 % of it, either side.
-                2 => {
-                    let (x, y) = (
-                        (next() as f32 / u32::MAX as f32 - 0.5) * 300.0,
-                        (next() as f32 / u32::MAX as f32 - 0.5) * 300.0,
-                    );
-                    let f = 1.0 + (next() as f32 / u32::MAX as f32 - 0.5) * 0.02;
-                    (x, y, fast_hypot(x, y) * f)
-                }
-                // Special values.
-                _ => {
-                    let n = special.len() as u32;
-                    let pick = |v: u32| special[(v % n) as usize];
-                    (pick(next()), pick(next()), pick(next()))
-                }
-            };
-            assert_eq!(
-                hypot_within(x, y, limit),
-                fast_hypot(x, y) <= limit,
-                "{x:e} {y:e} {limit:e}"
-            );
-            cases += 1;
-        }
-        assert_eq!(cases, 2_000_000);
     }
 }

@@ -1,0 +1,234 @@
+//! The isolation at one operating point: every fault named alone with its size (or not
+//! named), the friction class, the unknown fault, a learned baseline, and the points,
+//! supplies and baselines it refuses.
+
+use super::*;
+
+#[test]
+fn the_healthy_machine_has_zero_residuals_at_its_steady_state() {
+    for (name, m, v, we) in machines() {
+        let iso = Isolator::new(m.model(), v as f32, (we / core::f64::consts::TAU) as f32).unwrap(); // ok: test
+        let p = measure(&m, v, we, None, 1.0);
+        let e = iso.residuals(&p, None).unwrap(); // ok: test
+        assert!(e.to_array().iter().all(|x| x.abs() < 1e-4), "{name}: {e:?}");
+        assert_eq!(iso.isolate(&p).state, IsolationState::NoDeviation, "{name}");
+    }
+}
+
+/// Cases that cannot be named alone, and why (asserted: not named wrongly instead).
+fn not_separable(name: &str, f: Fault, change: f64) -> bool {
+    // The 3 hp machine: Rs, Ls and Lr at 10 % move |V - Z I| by under 0.2 % of |V|,
+    // about one spread (below detection); its leakage change of 50 % points where a
+    // 3 % Rr change does (0.1-2 deg apart). Rr at 10 %: a 0.3 % speed-sensor error
+    // fits too (the rotor circuit depends on Rr/slip; only the torque balance helps).
+    (name == "3 hp" && change.abs() < 0.2 && matches!(f, Fault::Rs | Fault::Ls | Fault::Lr))
+        || (name == "3 hp" && f == Fault::Ls)
+        || (name == "3 hp" && f == Fault::Rr && change.abs() < 0.2)
+        || (name == "11 kW" && f == Fault::Rs && change.abs() < 0.2)
+}
+
+#[test]
+fn every_fault_is_named_alone_with_its_size_or_not_named_at_all() {
+    let mut named = 0;
+    for (name, m, v, we) in machines() {
+        let iso = Isolator::new(m.model(), v as f32, (we / core::f64::consts::TAU) as f32).unwrap(); // ok: test
+        for f in Fault::ALL {
+            for change in [-0.5f64, 0.5, -0.1, 0.1] {
+                let k = 1.0 + change;
+                let p = measure(&faulty(&m, Some(f), k), v, we, Some(f), k);
+                let out = iso.isolate(&p);
+                // Never a wrong fault at probability 0.5 or more.
+                for c in &out.candidates {
+                    let friction = matches!(f, Fault::B | Fault::Bl)
+                        && matches!(c.fault, Fault::B | Fault::Bl);
+                    assert!(
+                        c.fault == f || friction || c.probability < 0.5,
+                        "{name} {f} {change}: {} named at {}",
+                        c.fault,
+                        c.probability
+                    );
+                }
+                let expected = !matches!(f, Fault::B | Fault::Bl)
+                    && !not_separable(name, f, change)
+                    && (change.abs() > 0.2
+                        || matches!(
+                            f,
+                            Fault::Rs
+                                | Fault::Rr
+                                | Fault::CurrentSensor
+                                | Fault::VoltageSensor
+                                | Fault::SpeedSensor
+                        )
+                        || name == "2.2 kW"
+                        || name == "11 kW");
+                if !expected {
+                    continue;
+                }
+                let top = out
+                    .named_fault()
+                    .unwrap_or_else(|| panic!("{name} {f} {change}: not named: {out:?}")); // ok: test
+                assert_eq!(top.fault, f, "{name} {f} {change}: {out:?}");
+                assert!(
+                    (f64::from(top.change) - change).abs() < 0.2 * change.abs(),
+                    "{name} {f} {change}: size {}",
+                    top.change
+                );
+                named += 1;
+            }
+        }
+    }
+    // 3 machines x 7 faults x 4 sizes, minus the documented exceptions.
+    assert!(named >= 70, "{named} named");
+}
+
+#[test]
+fn b_and_bl_are_one_friction_class() {
+    let (_, m, v, we) = machines()[1];
+    let iso = Isolator::new(m.model(), v as f32, 60.0).unwrap(); // ok: test
+    let p = measure(&faulty(&m, Some(Fault::Bl), 1.5), v, we, None, 1.0);
+    let out = iso.isolate(&p);
+    let top2: Vec<Fault> = out.candidates[..2].iter().map(|c| c.fault).collect();
+    assert!(
+        top2.contains(&Fault::B) && top2.contains(&Fault::Bl),
+        "{out:?}"
+    );
+    assert!(out.separation_deg < 1.0, "{}", out.separation_deg);
+    let bl = out
+        .candidates
+        .iter()
+        .find(|c| c.fault == Fault::Bl)
+        .unwrap(); // ok: test
+    assert!((bl.change - 0.5).abs() < 0.1, "{}", bl.change);
+    assert!(
+        out.named_fault().is_none(),
+        "neither is named alone: {out:?}"
+    );
+    assert!(
+        matches!(out.named(), Some(Named::Friction { .. })),
+        "{out:?}"
+    );
+}
+
+#[test]
+fn a_change_no_fault_explains_is_unknown_not_a_wrong_name() {
+    // Rs and Lr both changed: no single fault's direction fits.
+    let (_, m, v, we) = machines()[1];
+    let iso = Isolator::new(m.model(), v as f32, 60.0).unwrap(); // ok: test
+    let mut t = faulty(&m, Some(Fault::Rs), 1.6);
+    t.lr_h = (m.lr_h - m.lm_h) * 0.4 + m.lm_h;
+    t.bl_nms *= 0.6;
+    let out = iso.isolate(&measure(&t, v, we, None, 1.0));
+    assert!(out.deviation > 10.0);
+    assert!(
+        out.candidates.iter().all(|c| c.probability < 0.5),
+        "{out:?}"
+    );
+}
+
+#[test]
+fn a_learned_baseline_absorbs_a_nameplate_that_is_off() {
+    // Nominal parameters 20 % off; learning on the healthy machine at two loads, then
+    // an Rr fault is named from the change.
+    let (_, m, v, we) = machines()[0];
+    let mut off = m;
+    off.rs_ohm *= 1.2;
+    off.lm_h *= 0.8;
+    off.ls_h = off.lm_h;
+    off.lr_h = m.lr_h - m.lm_h + off.lm_h;
+    let mut iso = Isolator::new(off.model(), v as f32, 50.0).unwrap(); // ok: test
+    assert_ne!(
+        iso.isolate(&measure(&m, v, we, None, 1.0)).state,
+        IsolationState::NoDeviation
+    );
+    for n in 0..20 {
+        let mut load = m;
+        load.bl_nms *= 0.95 + 0.005 * n as f64;
+        iso.learn(&measure(&load, v, we, None, 1.0));
+    }
+    assert!(iso.finish_learning());
+    let healthy = iso.isolate(&measure(&m, v, we, None, 1.0));
+    assert_eq!(healthy.state, IsolationState::NoDeviation, "{healthy:?}");
+    let out = iso.isolate(&measure(
+        &faulty(&m, Some(Fault::Rr), 1.5),
+        v,
+        we,
+        None,
+        1.0,
+    ));
+    // Learned over a 10 % load range and widened for the nameplate's error away from
+    // the learned point, the torque balance no longer tells Rr from a speed-sensor
+    // error (directions 0.2 deg apart): they share the probability, neither is named
+    // alone, and Rr's size is right.
+    let rr = out.candidates.iter().find(|c| c.fault == Fault::Rr);
+    let rr = rr.unwrap(); // ok: test
+    assert!(rr.probability >= 0.4, "{out:?}");
+    assert!((rr.change - 0.5).abs() < 0.05, "{out:?}");
+    assert!(
+        matches!(out.named_fault().map(|c| c.fault), None | Some(Fault::Rr)),
+        "{out:?}"
+    );
+}
+
+#[test]
+fn unusable_points_are_not_judged() {
+    let (_, m, v, _) = machines()[1];
+    let iso = Isolator::new(m.model(), v as f32, 60.0).unwrap(); // ok: test
+    for p in [
+        SteadyPoint::default(),
+        SteadyPoint {
+            i: Dq {
+                d: f32::NAN,
+                q: 1.0,
+            },
+            v: Dq { d: 0.0, q: 100.0 },
+            we_rad_s: 377.0,
+            wr_rad_s: 370.0,
+        },
+    ] {
+        assert_eq!(iso.isolate(&p).state, IsolationState::NotJudged);
+    }
+    assert!(Isolator::new(m.model(), f32::NAN, 60.0).is_err());
+}
+
+/// A supply or a baseline the isolation cannot use is refused with the field it names.
+#[test]
+fn a_bad_supply_or_baseline_names_its_field() {
+    let (_, m, v, we) = machines()[0];
+    let f = (we / core::f64::consts::TAU) as f32;
+    let check = |r: Result<Isolator, crate::ConfigError>| r.err().map(|e| e.field());
+    assert_eq!(
+        check(Isolator::new(m.model(), f32::NAN, f)),
+        Some("v_phase_peak")
+    );
+    assert_eq!(
+        check(Isolator::new(m.model(), v as f32, 0.0)),
+        Some("supply_hz")
+    );
+    assert_eq!(
+        check(Isolator::new(m.model(), v as f32, f32::INFINITY)),
+        Some("supply_hz")
+    );
+    let mut bad_motor = m.model();
+    bad_motor.rs_ohm = -1.0;
+    assert_eq!(
+        check(Isolator::new(bad_motor, v as f32, f)),
+        Some("motor.rs_ohm")
+    );
+    let mut iso = Isolator::new(m.model(), v as f32, f).unwrap(); // ok: test
+    let before = iso.baseline();
+    let mut b = Baseline::default();
+    b.mean.torque = f32::NAN;
+    let e = iso.set_baseline(b).unwrap_err(); // ok: test
+    assert_eq!(
+        (e.kind(), e.field()),
+        (crate::ConfigErrorKind::Baseline, "baseline.mean")
+    );
+    b = Baseline::default();
+    b.spread.voltage_q = f32::INFINITY;
+    assert_eq!(
+        iso.set_baseline(b).map_err(|e| e.field()),
+        Err("baseline.spread")
+    );
+    assert_eq!(iso.baseline(), before, "a refused baseline changes nothing");
+    assert_eq!(iso.set_baseline(Baseline::default()), Ok(()));
+}
