@@ -13,10 +13,13 @@
 //!    `path` dependency) and names none.
 //! 3. **The panel is a leaf** (firmware, `src/panel.rs`): it uses nothing from `app`.
 //! 4. **Files**: no `.rs` file in `crates/`, `src/`, `sim-host/`, `tests/` or `tools/` over
-//!    [`MAX_FILE_LINES`] lines (`wc -l`).
+//!    [`MAX_FILE_LINES`] lines (`wc -l`), but for the few in [`LONG_FILES`], each with
+//!    its reason and its own ceiling.
 //! 5. **Functions**: no function outside tests over [`MAX_FN_LINES`] lines, counted from
 //!    the line of `fn` to the line of its closing brace (`#[cfg(test)]` modules, `#[test]`
-//!    functions, `tests/` and `benches/` folders are tests).
+//!    functions, `tests/` and `benches/` folders are tests), but for the few in
+//!    [`LONG_FUNCTIONS`], each with its reason and its own ceiling. An entry of either list
+//!    that is no longer needed fails the test too (the lists only shrink).
 //! 6. **The repository stands alone**: no tracked `.rs`, `.toml` or `.md` file names the
 //!    team's design file or its shared folder ([`FOREIGN`]); a user who clones the
 //!    repository has neither. The paper is cited by its title, the design by `docs/`.
@@ -50,9 +53,13 @@ const LAYERS: [(&str, u8); 15] = [
 ];
 
 /// Longest `.rs` file [lines].
-const MAX_FILE_LINES: usize = 900;
+const MAX_FILE_LINES: usize = 600;
 /// Longest non-test function [lines].
-const MAX_FN_LINES: usize = 100;
+const MAX_FN_LINES: usize = 60;
+/// Files allowed over [`MAX_FILE_LINES`]: (path, lines at most, why).
+const LONG_FILES: &[(&str, usize, &str)] = &[];
+/// Functions allowed over [`MAX_FN_LINES`]: (path, function, lines at most, why).
+const LONG_FUNCTIONS: &[(&str, &str, usize, &str)] = &[];
 /// The workspace's folders of Rust code.
 const CODE_DIRS: [&str; 5] = ["crates/", "src/", "sim-host/", "tests/", "tools/"];
 /// References to files outside the repository (spelled in two parts, so that this file
@@ -273,26 +280,40 @@ fn the_firmware_panel_is_a_leaf() {
 }
 
 #[test]
-fn no_rust_file_over_900_lines() {
-    let bad = files()
-        .into_iter()
-        .filter(|f| is_code(f))
-        .filter_map(|f| {
-            let n = read(&f).lines().count();
-            (n > MAX_FILE_LINES).then(|| {
-                format!(
-                    "{f}:{}: file size: {n} lines, more than {MAX_FILE_LINES}",
-                    MAX_FILE_LINES + 1
-                )
-            })
-        })
-        .collect();
-    verdict("no .rs file over 900 lines", bad);
+fn no_rust_file_over_600_lines() {
+    let mut bad = Vec::new();
+    let mut used = Vec::new();
+    for f in files().into_iter().filter(|f| is_code(f)) {
+        let n = read(&f).lines().count();
+        let allowed = LONG_FILES.iter().find(|(path, _, _)| *path == f);
+        let max = allowed.map_or(MAX_FILE_LINES, |(_, max, _)| *max);
+        if allowed.is_some() {
+            used.push(f.clone());
+        }
+        if n > max {
+            bad.push(format!(
+                "{f}:{}: file size: {n} lines, more than {max}",
+                max + 1
+            ));
+        } else if n <= MAX_FILE_LINES && allowed.is_some() {
+            bad.push(format!(
+                "{f}: file size: {n} lines, within {MAX_FILE_LINES}: drop it from LONG_FILES"
+            ));
+        }
+    }
+    for (path, _, _) in LONG_FILES {
+        if !used.iter().any(|u| u == path) {
+            bad.push(format!(
+                "{path}: in LONG_FILES but not a code file of the workspace"
+            ));
+        }
+    }
+    verdict("no .rs file over 600 lines", bad);
 }
 
 #[test]
-fn no_function_over_100_lines_outside_tests() {
-    let mut bad = Vec::new();
+fn no_function_over_60_lines_outside_tests() {
+    let mut found = Vec::new();
     for rel in files() {
         if !is_code(&rel) || is_test_file(&rel) {
             continue;
@@ -303,9 +324,39 @@ fn no_function_over_100_lines_outside_tests() {
             found: Vec::new(),
         };
         v.visit_file(&parse(&rel));
-        bad.extend(v.found);
+        found.extend(v.found);
     }
-    verdict("no function over 100 lines outside tests", bad);
+    let mut bad = Vec::new();
+    let mut used = vec![false; LONG_FUNCTIONS.len()];
+    for line in found {
+        let allowed = LONG_FUNCTIONS
+            .iter()
+            .enumerate()
+            .find(|(_, (path, name, _, _))| {
+                line.starts_with(&format!("{path}:")) && line.contains(&format!("`{name}` is "))
+            });
+        let lines = line
+            .split("` is ")
+            .nth(1)
+            .and_then(|rest| rest.split(' ').next())
+            .and_then(|n| n.parse::<usize>().ok());
+        match (allowed, lines) {
+            (Some((k, (_, _, max, _))), Some(n)) if n <= *max => used[k] = true,
+            (Some((k, (_, _, max, _))), _) => {
+                used[k] = true;
+                bad.push(format!("{line} (its LONG_FUNCTIONS ceiling: {max})"));
+            }
+            (None, _) => bad.push(line),
+        }
+    }
+    for ((path, name, _, _), u) in LONG_FUNCTIONS.iter().zip(used) {
+        if !u {
+            bad.push(format!(
+                "{path}: `{name}` in LONG_FUNCTIONS but within {MAX_FN_LINES} lines (or gone): drop it"
+            ));
+        }
+    }
+    verdict("no function over 60 lines outside tests", bad);
 }
 
 #[test]
