@@ -230,7 +230,6 @@ impl IsolationTracker {
         temperature_c: Option<f64>,
     ) {
         self.end_t = t;
-        let load = self.load;
         let Some(follower) = self.follower.as_mut() else {
             return;
         };
@@ -261,40 +260,51 @@ impl IsolationTracker {
             let lag = follower.measured_rise_k().map(|_| follower.probe_lag_k());
             self.temperature.after_isolation(t, &result, lag);
             self.evidence.after(follower, &result);
-            // A fault one point cannot name may be named from several (evidence across
-            // operating points).
-            let joint = self
-                .evidence
-                .joint_beside(&result)
-                .and_then(|(j, _)| j.named());
-            // (The joint fit's fault before the friction class of the last point: a load
-            // that moved is, to the paper's model, a Bl change.)
-            let named = joint
-                .or(result.named())
-                .filter(|n| learned || self.lamps_lit || !within_nominal_uncertainty(n))
-                .filter(|n| !load_reading(load, n));
             if let Some((p, _)) = follower.averaged() {
                 self.events.point(t, &p);
             }
-            if let Some(n) = named {
-                let given = NameGiven {
-                    name: IsolationName::of(&n),
-                    t_s: t,
-                };
-                self.first_named.get_or_insert(given);
-                if !self.names.iter().any(|g| g.name == given.name) {
-                    self.names.push(given);
-                    let (change, p) = match n {
-                        Named::Fault(c) => (c.change, c.probability),
-                        Named::Friction {
-                            probability, bl, ..
-                        } => (bl.change, probability),
-                    };
-                    self.events.named(t, given.name, change, p);
-                }
+            if let Some(n) = self.name_of(&result, learned) {
+                self.give_name(t, n);
             }
             self.last_t = t;
             self.last_point = *point;
+        }
+    }
+
+    /// The name the isolation gives after `result` (`learned`: a learned baseline is in
+    /// force): a fault one point cannot name may be named from several (evidence across
+    /// operating points). The joint fit's fault goes before the friction class of the last
+    /// point (a load that moved is, to the paper's model, a Bl change); against the nominal
+    /// parameters with every lamp dark a change within their uncertainty is not named, nor,
+    /// with the load unknown, the friction class.
+    fn name_of(&self, result: &Isolation, learned: bool) -> Option<Named> {
+        let joint = self
+            .evidence
+            .joint_beside(result)
+            .and_then(|(j, _)| j.named());
+        joint
+            .or(result.named())
+            .filter(|n| learned || self.lamps_lit || !within_nominal_uncertainty(n))
+            .filter(|n| !load_reading(self.load, n))
+    }
+
+    /// Books the name `n` given at `t` [s]: the first name, and each name the first time it
+    /// is given (with its event).
+    fn give_name(&mut self, t: f64, n: Named) {
+        let given = NameGiven {
+            name: IsolationName::of(&n),
+            t_s: t,
+        };
+        self.first_named.get_or_insert(given);
+        if !self.names.iter().any(|g| g.name == given.name) {
+            self.names.push(given);
+            let (change, p) = match n {
+                Named::Fault(c) => (c.change, c.probability),
+                Named::Friction {
+                    probability, bl, ..
+                } => (bl.change, probability),
+            };
+            self.events.named(t, given.name, change, p);
         }
     }
 
@@ -432,16 +442,46 @@ impl IsolationTracker {
         (i0 > 0.0 && r.is_finite()).then_some(r)
     }
 
+    /// The report's sentence on `c` (`in_file_error`: the name within the parameter file's
+    /// uncertainty, not given; `detected`: a lamp lit or a sensor fault was seen; `moved`:
+    /// the current's change from the learned point).
+    fn verdict(
+        &self,
+        c: &Concluded,
+        in_file_error: Option<Named>,
+        detected: bool,
+        moved: Option<f32>,
+    ) -> String {
+        let iso = &c.iso;
+        if let Some(Named::Fault(c)) = in_file_error {
+            format!(
+                "The nearest fault, {} {} (p {:.2}), is within the parameter file's own uncertainty (+/-{:.0} %) while every lamp stayed dark: not named. Commission on the healthy machine to judge changes this small.",
+                c.fault,
+                pct(c.change),
+                c.probability,
+                100.0 * NOMINAL_UNCERTAINTY
+            )
+        } else if self.end_t - self.last_t > STALE_S {
+            format!(
+                "{} (judged at {:.2} s; the operating point was not steady in the last {:.1} s of the log)",
+                verdict_sentence(iso, detected, moved).trim_end_matches('.'),
+                self.last_t,
+                self.end_t - self.last_t
+            )
+        } else if let Some(warm) = self.heating_sentence(iso.state) {
+            warm
+        } else if c.load_moved {
+            self.load_moved_sentence()
+        } else {
+            self.with_evidence(verdict_sentence(iso, detected, moved), c.joint)
+        }
+    }
+
     /// The report, and the candidates for `diagnose` (most probable first, those from
     /// [`LIST_FROM`] on) when `detected` (a lamp lit or a sensor fault was seen).
     pub(super) fn report(&self, detected: bool) -> (IsolationReport, Vec<FaultCandidate>) {
         let learned = self.follower.as_ref().is_some_and(Follower::learned);
-        let Some(Concluded {
-            iso,
-            joint,
-            load_moved,
-        }) = self.concluded()
-        else {
+        let Some(concluded) = self.concluded() else {
             let why = if self.follower.is_none() {
                 "the parameter file's machine cannot be used by the isolation"
             } else {
@@ -449,6 +489,7 @@ impl IsolationTracker {
             };
             return (IsolationReport::not_judged(why, learned), Vec::new());
         };
+        let iso = concluded.iso;
         let candidates = listed_candidates(&iso, detected);
         let moved = self.moved_from_learned();
         let in_file_error = iso
@@ -462,28 +503,7 @@ impl IsolationTracker {
                 Named::Fault(c) => c.change,
                 Named::Friction { bl, .. } => bl.change,
             }),
-            verdict: if let Some(Named::Fault(c)) = in_file_error {
-                format!(
-                    "The nearest fault, {} {} (p {:.2}), is within the parameter file's own uncertainty (+/-{:.0} %) while every lamp stayed dark: not named. Commission on the healthy machine to judge changes this small.",
-                    c.fault,
-                    pct(c.change),
-                    c.probability,
-                    100.0 * NOMINAL_UNCERTAINTY
-                )
-            } else if self.end_t - self.last_t > STALE_S {
-                format!(
-                    "{} (judged at {:.2} s; the operating point was not steady in the last {:.1} s of the log)",
-                    verdict_sentence(&iso, detected, moved).trim_end_matches('.'),
-                    self.last_t,
-                    self.end_t - self.last_t
-                )
-            } else if let Some(warm) = self.heating_sentence(iso.state) {
-                warm
-            } else if load_moved {
-                self.load_moved_sentence()
-            } else {
-                self.with_evidence(verdict_sentence(&iso, detected, moved), joint)
-            },
+            verdict: self.verdict(&concluded, in_file_error, detected, moved),
             moved_from_learned: moved,
             winding_rise_k: self.winding_rise_k(),
             temperature: self.temperature.report(),

@@ -687,19 +687,7 @@ impl Replay {
         } else {
             DEFAULT_SPREAD_CURRENTS
         };
-        // The commissioning window's reference: its steady windows.
-        let learned: Vec<&SequenceWindow> =
-            windows.iter().filter(|w| w.steady && w.learning).collect();
-        let learned = (learned.len() >= MIN_SEGMENT_WINDOWS).then(|| {
-            let s = segment_of(&learned);
-            Reference {
-                r: s.r,
-                v2: s.v2,
-                i1: s.i1_peak_a,
-                sigma: s0,
-                source: Some(BaselineSource::Commissioning),
-            }
-        });
+        let learned = learned_reference(windows, s0);
         let judge = Judge {
             m: self.params.motor.model(),
             v_nominal: self.params.supply.v_phase_peak() as f32,
@@ -713,15 +701,7 @@ impl Replay {
             .enumerate()
             .map(|(k, seg)| judge.judge(k, seg))
             .collect();
-        // The segment whose change stands out most from its spread among those that name a
-        // phase, else the one that stands out most (a short segment's own scatter counts).
-        let z = |j: &Judged| abs(j.change) / j.sigma.max(1e-6);
-        let largest = |it: &mut dyn Iterator<Item = &Judged>| {
-            it.max_by(|a, b| z(a).total_cmp(&z(b))).map(|j| j.index)
-        };
-        let pick = largest(&mut judged.iter().filter(|j| j.judgement.phase.is_some()))
-            .or_else(|| largest(&mut judged.iter()))
-            .and_then(|k| judged.get(k));
+        let pick = standing_out(&judged);
         // The sensors at the log's end (as the isolation's candidates are).
         let (gi, gv) = segs.last().map_or((None, None), sensor_phases);
         let file = self.opts.unbalance_baseline;
@@ -750,18 +730,50 @@ impl Replay {
             baseline: file.map(|_| BaselineSource::File),
         };
         match pick {
-            None => {
-                report.phase_not_judged = Some(format!(
-                    "cannot judge the phase: no steady stretch of at least {} least-squares windows ({:.2} s): the log is too short or its operating point never settled",
-                    MIN_SEGMENT_WINDOWS,
-                    MIN_SEGMENT_WINDOWS as f64 * super::sequences::WINDOW_PERIODS / self.params.supply.f_hz
-                ));
-            }
+            None => report.phase_not_judged = Some(no_stretch_reason(self.params.supply.f_hz)),
             Some(j) => fill_judgement(&mut report, j, &segs),
         }
         report.segments = listed_segments(segs, pick.map(|j| j.index));
         report
     }
+}
+
+/// The commissioning window's reference: its steady windows' (`s0`: the default spread),
+/// where there are enough of them.
+fn learned_reference(windows: &[SequenceWindow], s0: f32) -> Option<Reference> {
+    let learned: Vec<&SequenceWindow> = windows.iter().filter(|w| w.steady && w.learning).collect();
+    (learned.len() >= MIN_SEGMENT_WINDOWS).then(|| {
+        let s = segment_of(&learned);
+        Reference {
+            r: s.r,
+            v2: s.v2,
+            i1: s.i1_peak_a,
+            sigma: s0,
+            source: Some(BaselineSource::Commissioning),
+        }
+    })
+}
+
+/// The segment whose change stands out most from its spread among those that name a
+/// phase, else the one that stands out most (a short segment's own scatter counts).
+fn standing_out(judged: &[Judged]) -> Option<&Judged> {
+    let z = |j: &Judged| abs(j.change) / j.sigma.max(1e-6);
+    let largest = |it: &mut dyn Iterator<Item = &Judged>| {
+        it.max_by(|a, b| z(a).total_cmp(&z(b))).map(|j| j.index)
+    };
+    largest(&mut judged.iter().filter(|j| j.judgement.phase.is_some()))
+        .or_else(|| largest(&mut judged.iter()))
+        .and_then(|k| judged.get(k))
+}
+
+/// Why the phase is not judged when no segment is steady long enough (`f_hz`: the supply
+/// frequency).
+fn no_stretch_reason(f_hz: f64) -> String {
+    format!(
+        "cannot judge the phase: no steady stretch of at least {} least-squares windows ({:.2} s): the log is too short or its operating point never settled",
+        MIN_SEGMENT_WINDOWS,
+        MIN_SEGMENT_WINDOWS as f64 * super::sequences::WINDOW_PERIODS / f_hz
+    )
 }
 
 /// The judged segment's keys of the report.
