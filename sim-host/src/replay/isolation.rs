@@ -332,7 +332,7 @@ impl IsolationTracker {
     /// learned at: `|I| / |I_learned| - 1` (0.3: 30 % more current); `None` without a
     /// learned baseline or its point.
     /// The tracked winding temperature rise [K] when a learned baseline is in force and it
-    /// is at least [`REPORTED_RISE_K`] either way.
+    /// is at least [`report::REPORTED_RISE_K`] either way.
     pub(super) fn winding_rise_k(&self) -> Option<f32> {
         let f = self.follower.as_ref().filter(|f| f.learned())?;
         let rise = f.isolator().winding_rise_k();
@@ -341,7 +341,7 @@ impl IsolationTracker {
 
     /// The lamps' detections, and any name given on the way, are explained by the
     /// winding's heating: the last isolation found no deviation from the machine at its
-    /// tracked (warmer) temperature, which has risen by at least [`REPORTED_RISE_K`] (a
+    /// tracked (warmer) temperature, which has risen by at least [`report::REPORTED_RISE_K`] (a
     /// name given while the tracking lagged a fast warming was withdrawn since).
     pub(super) fn heating_explains_lamps(&self) -> bool {
         self.winding_rise_k().is_some_and(|r| r > 0.0)

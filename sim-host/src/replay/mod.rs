@@ -2,10 +2,11 @@
 //! runs ([`monitor_core::Monitor`]), fed row by row; what `sim-host diagnose` runs
 //! ([`diagnose_file`]).
 //!
-//! The host converts each CSV row into a core [`Sample`] ([`LogSampler`], the host's
-//! counterpart of the firmware's ADC sampler): voltages and currents as f32,
-//! the encoder count (from `enc_count`, or synthesised by integrating `wm_rad_s` on a
-//! 4096-count disc when the log has only a speed column), and a 1 MHz timestamp.
+//! The host converts each CSV row into a core [`Sample`](monitor_core::Sample)
+//! ([`LogSampler`], the host's counterpart of the firmware's ADC sampler): voltages and
+//! currents as f32, the encoder count (from `enc_count`, or synthesised by integrating
+//! `wm_rad_s` on a 4096-count disc when the log has only a speed column), and a 1 MHz
+//! timestamp.
 //! Logs without voltages or without speed cannot feed the residuals (every residual of
 //! eq. 37 needs Vqs or omega_r); for those only the negative-sequence analysis runs, on an
 //! angle from an SRF-PLL locked to the currents, and the report says what was skipped and
