@@ -2,10 +2,11 @@
 //! runs ([`monitor_core::Monitor`]), fed row by row; what `sim-host diagnose` runs
 //! ([`diagnose_file`]).
 //!
-//! The host converts each CSV row into a core [`Sample`] ([`LogSampler`], the host's
-//! counterpart of the firmware's ADC sampler): voltages and currents as f32,
-//! the encoder count (from `enc_count`, or synthesised by integrating `wm_rad_s` on a
-//! 4096-count disc when the log has only a speed column), and a 1 MHz timestamp.
+//! The host converts each CSV row into a core [`Sample`](monitor_core::Sample)
+//! ([`LogSampler`], the host's counterpart of the firmware's ADC sampler): voltages and
+//! currents as f32, the encoder count (from `enc_count`, or synthesised by integrating
+//! `wm_rad_s` on a 4096-count disc when the log has only a speed column), and a 1 MHz
+//! timestamp.
 //! Logs without voltages or without speed cannot feed the residuals (every residual of
 //! eq. 37 needs Vqs or omega_r); for those only the negative-sequence analysis runs, on an
 //! angle from an SRF-PLL locked to the currents, and the report says what was skipped and
@@ -25,9 +26,12 @@ mod diagnose;
 mod events;
 mod front;
 mod isolation;
+mod options;
 mod pipe;
 mod report;
+mod sampler;
 mod sequences;
+mod step;
 mod temperature;
 mod trig;
 mod unsettled;
@@ -48,10 +52,12 @@ pub use isolation::{
     state_name, DetectionLimit, FaultCandidate, IsolationBaseline, IsolationGroup, IsolationName,
     IsolationReport, NameGiven, SensorPhaseReport, NOMINAL_UNCERTAINTY,
 };
+pub use options::{monitor_config_for_log, LoadModel, ReplayOptions};
 pub use report::{
     BaselineSource, Detection, DiagnoseReport, MonitorState, Panel, TimelinePoint, UnbalanceReport,
     Verdict,
 };
+pub use sampler::LogSampler;
 pub use sequences::{SequenceWindow, WINDOW_PERIODS};
 pub use temperature::TemperatureReport;
 pub use winding::{
@@ -63,11 +69,14 @@ use crate::log::{Channels, LogError, Row};
 use crate::params::ParamFile;
 use commission::CommissionTracker;
 use isolation::IsolationTracker;
-use monitor_core::{
-    Abc, AngleSource, CommissioningState, ConfigError, Isolator, Monitor, MonitorConfig,
-    MonitorOutput, ResidualForm, Sample,
-};
+use monitor_core::{AngleSource, ConfigError, Isolator, Monitor, MonitorOutput};
+use options::check_commission_window;
+use sampler::sample_of;
 use serde::Serialize;
+use step::{
+    bands_needed, detected_in_range, lamps_since_moved, note_detection, note_residuals,
+    timeline_step_due, LastOutput, RestartHold, NO_BANDS,
+};
 
 /// Timestamp tick rate used for replays [Hz].
 pub const TICK_HZ: f64 = 1.0e6;
@@ -120,47 +129,6 @@ pub enum ReplayError {
     Log(#[from] LogError),
 }
 
-/// Replay options.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ReplayOptions {
-    /// Frame angle source.
-    pub angle_source: AngleSource,
-    /// Residual form for the lamps.
-    pub residual_form: ResidualForm,
-    /// Commissioning window [start, end) in log seconds; None = fixed thresholds.
-    pub commission: Option<(f64, f64)>,
-    /// Report a commissioning window that was not learned instead of refusing.
-    pub allow_incomplete: bool,
-    /// Timeline resolution [s] (one point per interval).
-    pub timeline_step_s: f64,
-    /// The healthy machine's negative sequence to judge the winding against (`diagnose
-    /// --baseline HEALTHY.csv`); without it, the one learned in the commissioning window,
-    /// else none ([`UnbalanceBaseline`]).
-    pub unbalance_baseline: Option<HealthyReference>,
-    /// What is known of the load ([`LoadModel`]; `diagnose --load`).
-    pub load: LoadModel,
-}
-
-/// What the replay knows of the load torque.
-///
-/// The paper's model has a fixed viscous load `Bl wr` (eq. 4), so to it any change of the
-/// load is a change of Bl, and the friction class B/Bl is one of its faults (Table 1). In
-/// service the load moves all day and nothing tells a change of the load from a change of
-/// the friction: with the load as an unknown input B and Bl cannot be judged, and a reading
-/// of them is an operating-point change.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum LoadModel {
-    /// The load is an unknown input (real service; the default): the friction class is
-    /// never named, its reading is reported as a load move (an event and the verdict
-    /// sentence); electrical faults are named from the stator-voltage equations and, at a
-    /// load measured just before a deviation, the torque against it.
-    #[default]
-    Unknown,
-    /// The paper's fixed viscous load (Table 1, the demo): a B/Bl change is a fault, named
-    /// as the friction class `b/bl`.
-    Viscous,
-}
-
 /// The healthy machine's negative sequence, relative to its positive sequence: what a
 /// motor's own asymmetry and the sensors' mismatch put there before any fault. The
 /// winding analysis judges the change from it (`unbalance.baseline`).
@@ -174,44 +142,15 @@ pub struct UnbalanceBaseline {
     pub i1_peak_a: f32,
 }
 
-impl Default for ReplayOptions {
-    fn default() -> Self {
-        ReplayOptions {
-            angle_source: AngleSource::RotorFluxCurrentModel,
-            residual_form: ResidualForm::Steady,
-            commission: None,
-            allow_incomplete: false,
-            timeline_step_s: 0.1,
-            unbalance_baseline: None,
-            load: LoadModel::Unknown,
-        }
-    }
-}
-
-/// The monitor configuration for replaying a log: the parameter file's machine and supply
-/// at the log's sample rate, 1 MHz timestamps. The sensor limits are the log's
-/// ([`ParamFile::log_limits`]: twice the sensor ranges, because a log does not say its ADC
-/// ranges), the same the data-quality stage judges cells by. (The firmware's configuration is `drive_monitor::app`'s
-/// `board_monitor_config`.)
-pub fn monitor_config_for_log(
-    p: &ParamFile,
-    sample_rate_hz: f64,
-    opts: &ReplayOptions,
-) -> MonitorConfig {
-    let mut cfg = MonitorConfig::new(
-        p.motor.model(),
-        p.supply.f_hz as f32,
-        p.supply.v_ll_rms as f32,
-        sample_rate_hz as f32,
+/// The isolation's tracker for a replay of a log with `channels` under `params` (no
+/// isolator for a machine it rejects), `load` what is known of the load.
+fn isolation_tracker(params: &ParamFile, channels: Channels, load: LoadModel) -> IsolationTracker {
+    let isolator = Isolator::new(
+        params.motor.model(),
+        params.supply.v_phase_peak() as f32,
+        params.supply.f_hz as f32,
     );
-    cfg.angle_source = opts.angle_source;
-    cfg.residual_form = opts.residual_form;
-    cfg.tick_hz = TICK_HZ as f32;
-    let limits = p.log_limits();
-    cfg.limits.v_max = limits.v_max_v;
-    cfg.limits.i_max = limits.i_max_a;
-    cfg.limits.max_speed_rad_s = limits.wm_max_rad_s;
-    cfg
+    IsolationTracker::new(isolator.ok(), channels.temperature, load)
 }
 
 /// The sequence analysis of a replay of a log with `channels` at `sample_rate_hz` (the
@@ -230,139 +169,6 @@ fn sequence_front(
         f64::from(cfg.limits.i_max),
         f64::from(cfg.limits.v_max),
     )
-}
-
-/// The core sample of `row` from `sampler`, its encoder count moved on by `enc_offset`
-/// (counts handed on over a clock reset: [`Replay`]'s `enc_offset`).
-fn sample_of(sampler: &mut LogSampler, enc_offset: i64, row: &Row) -> Sample {
-    if enc_offset == 0 {
-        sampler.sample(row)
-    } else {
-        sampler.sample(&Row {
-            enc_count: row.enc_count.map(|c| c.wrapping_add(enc_offset)),
-            ..*row
-        })
-    }
-}
-
-/// Books a counted detection at `t` [s]: the first one's time, and each fault the output
-/// ranks first the first time it does.
-fn note_detection(
-    first: &mut Option<f64>,
-    detections: &mut Vec<Detection>,
-    t: f64,
-    out: &MonitorOutput,
-) {
-    if first.is_none() {
-        *first = Some(t);
-    }
-    if let Some((fault, _)) = out.top() {
-        if !detections.iter().any(|d| d.fault == fault) {
-            detections.push(Detection { fault, t_s: t });
-        }
-    }
-}
-
-/// Whether the sample at `t` [s] (interval `dt_s`) is the one nearest the timeline step
-/// `next` (half a sample early counts); if so, `next` moves on by `step_s`, past `t` after a
-/// gap (one point for the gap, not one per step missed).
-fn timeline_step_due(next: &mut f64, t: f64, dt_s: f64, step_s: f64) -> bool {
-    if t + 0.5 * dt_s < *next {
-        return false;
-    }
-    *next += step_s;
-    if *next <= t {
-        *next += (((t - *next) / step_s).floor() + 1.0) * step_s;
-    }
-    true
-}
-
-/// Converts log rows to core samples, synthesising encoder counts from speed if needed
-/// (the host's counterpart of the firmware's `drive_monitor::sampling::AdcSampler`).
-///
-/// The count handed to the core is one continuous count: each row advances it by the
-/// encoder's own step where this row and the one before carry `enc_count`, else by the
-/// speed channel's `floor(theta_m C / 2 pi)` step (`theta_m` the integral of `wm_rad_s`,
-/// `C` = [`COUNTS_PER_REV`]), else not at all. A log that switches between the two (the
-/// data-quality stage drops a bad count where the speed channel is good) gives no jump.
-#[derive(Debug, Clone, Default)]
-pub struct LogSampler {
-    theta_m: f64,
-    last_t: Option<f64>,
-    /// The last row's encoder count, if it had one.
-    last_enc: Option<i64>,
-    /// The count handed on (`None` before the first row).
-    count: Option<i64>,
-    /// The speed channel's synthesised count at the last row.
-    synth: i64,
-}
-
-impl LogSampler {
-    /// The core sample for `row` (voltages 0 when the log has none).
-    pub fn sample(&mut self, row: &Row) -> Sample {
-        if let (Some(t0), Some(w)) = (self.last_t, row.wm_rad_s) {
-            self.theta_m += w * (row.t_s - t0);
-        }
-        let synth = floor_i64(self.theta_m / std::f64::consts::TAU * f64::from(COUNTS_PER_REV));
-        let count = match (self.count, row.enc_count, self.last_enc) {
-            (None, Some(c), _) => c,
-            (None, None, _) => synth,
-            (Some(n), Some(c), Some(l)) => n.wrapping_add(c.wrapping_sub(l)),
-            (Some(n), _, _) if row.wm_rad_s.is_some() => {
-                n.wrapping_add(synth.wrapping_sub(self.synth))
-            }
-            (Some(n), _, _) => n,
-        };
-        self.count = Some(count);
-        self.synth = synth;
-        self.last_enc = row.enc_count;
-        let count = count as u32;
-        self.last_t = Some(row.t_s);
-        let v = row.v_abc.unwrap_or([0.0; 3]);
-        let i = row.i_abc;
-        Sample {
-            v_abc: Abc {
-                a: v[0] as f32,
-                b: v[1] as f32,
-                c: v[2] as f32,
-            },
-            i_abc: Abc {
-                a: i[0] as f32,
-                b: i[1] as f32,
-                c: i[2] as f32,
-            },
-            encoder_count: count,
-            timestamp_ticks: round_i64(row.t_s * TICK_HZ) as u32,
-            v_saturated: false,
-            i_saturated: false,
-        }
-    }
-}
-
-/// `x.floor() as i64` (saturating; 0 for NaN) without a call into libm: the baseline
-/// x86-64 target has no rounding instruction, and the replay converts every row.
-fn floor_i64(x: f64) -> i64 {
-    let t = x as i64;
-    // `t as f64` is exact wherever x has a fraction (|x| < 2^52).
-    if (t as f64) > x {
-        t.saturating_sub(1)
-    } else {
-        t
-    }
-}
-
-/// `x.round() as i64` (half away from zero, saturating; 0 for NaN), as [`floor_i64`].
-fn round_i64(x: f64) -> i64 {
-    let t = x as i64;
-    // Exact wherever x has a fraction (|x| < 2^52).
-    let frac = x - t as f64;
-    if frac >= 0.5 {
-        t.saturating_add(1)
-    } else if frac <= -0.5 {
-        t.saturating_sub(1)
-    } else {
-        t
-    }
 }
 
 /// Streaming replay: feed rows, then [`Replay::finish`].
@@ -401,14 +207,10 @@ pub struct Replay {
     /// explained them), and have not all been dark since: their release after the load came
     /// back is still the amber state.
     lamps_since_moved: bool,
-    /// The monitor's count of timing faults (estimator restarts) at the last row.
-    timing_faults_seen: u32,
-    /// The isolation ignores points until this time [s] (the settling after a restart).
-    isolation_hold_until: f64,
+    /// The isolation's wait after a restart of the monitor's estimators.
+    restart: RestartHold,
     /// The stretch where the quasi-steady gate held the lamps, at the log's end.
     unsettled: unsettled::Unsettled,
-    /// The monitor's settling time after a restart [s].
-    settle_s: f64,
     /// Added to every row's encoder count after a clock reset: the turn over the bridged
     /// time ([`Replay::clock_reset`]).
     enc_offset: i64,
@@ -427,13 +229,7 @@ impl Replay {
         sample_rate_hz: f64,
         opts: ReplayOptions,
     ) -> Result<Self, ReplayError> {
-        if let Some((a, b)) = opts.commission {
-            if !(b > a && a >= 0.0 && b.is_finite()) {
-                return Err(ReplayError::Option(format!(
-                    "--commission {a}:{b}: the window must be START:END with 0 <= START < END, both finite (seconds)"
-                )));
-            }
-        }
+        check_commission_window(opts.commission)?;
         let cfg = monitor_config_for_log(params, sample_rate_hz, &opts);
         let config_error = |source| ReplayError::Config {
             source,
@@ -466,23 +262,12 @@ impl Replay {
             max_abs: [0.0; 4],
             last: LastOutput::default(),
             t0: None,
-            isolation: IsolationTracker::new(
-                Isolator::new(
-                    params.motor.model(),
-                    params.supply.v_phase_peak() as f32,
-                    params.supply.f_hz as f32,
-                )
-                .ok(),
-                channels.temperature,
-                opts.load,
-            ),
+            isolation: isolation_tracker(params, channels, opts.load),
             lamps_since_moved: false,
             seq_front: sequence_front(params, channels, sample_rate_hz).map_err(config_error)?,
             book: sequences::WindowBook::new(),
-            timing_faults_seen: 0,
-            isolation_hold_until: f64::NEG_INFINITY,
+            restart: RestartHold::new(f64::from(cfg.settle_s)),
             unsettled: unsettled::Unsettled::default(),
-            settle_s: f64::from(cfg.settle_s),
             enc_offset: 0,
         })
     }
@@ -523,43 +308,18 @@ impl Replay {
         // (The output is read where the monitor keeps it: no copy per row.)
         let out = mon.output();
         let range_note = self.commission.after(mon, t, out);
-        self.evaluated |= out.evaluating;
-        if out.evaluating {
-            for (m, r) in self.max_abs.iter_mut().zip(out.residuals) {
-                *m = m.max(r.abs());
-            }
-        }
+        note_residuals(&mut self.evaluated, &mut self.max_abs, out);
         // With a commissioning window asked for, lamps lit on the fixed thresholds before
         // the learned ones are in force are not detections: the window says the nominal
         // parameters are not to be trusted (a sensor fault counts at any time).
         let counts = out.sensor_fault.any() || self.commission.thresholds_trusted(out);
-        // The bands only matter (and are only looked up) while the gate holds the lamps or a
-        // lamp is lit.
-        let bands = if out.quasi_steady && !out.fault_detected {
-            [(0.0, 0.0); 4]
-        } else {
-            mon.threshold_bands()
-        };
-        self.unsettled.after(
-            t,
-            out,
-            if out.quasi_steady {
-                [(0.0, 0.0); 4]
-            } else {
-                bands
-            },
-            self.evaluated,
-            self.commission.thresholds_trusted(out),
-        );
+        let bands = bands_needed(mon, out);
+        let trusted = self.commission.thresholds_trusted(out);
+        let held_bands = if out.quasi_steady { NO_BANDS } else { bands };
+        self.unsettled
+            .after(t, out, held_bands, self.evaluated, trusted);
         let point = step.point(out.operating.wr_rad_s);
-        // After a restart of the monitor's estimators (a long gap, a clock reset) the
-        // isolation waits out the monitor's settling time too: the restarted frame's
-        // vectors look steady before they are right.
-        if out.timing.timing_faults != self.timing_faults_seen {
-            self.timing_faults_seen = out.timing.timing_faults;
-            self.isolation_hold_until = t + self.settle_s;
-        }
-        let settled = t >= self.isolation_hold_until;
+        let settled = self.restart.settled(t, out);
         self.isolation.after(
             t,
             self.dt_s,
@@ -569,37 +329,26 @@ impl Replay {
             row.t_winding_c,
         );
         if out.fault_detected && counts {
-            // A detection counts as one inside the commissioned range only while the lamps
-            // are evaluated (quasi-steady) and a lit lamp's residual is outside its band: a
-            // lamp held through a transient, or after its residual came back (the load
-            // returned into the range), detects nothing new there.
-            let current = out.evaluating && lit_outside_band(out, bands);
-            self.detected_in_range |=
-                out.sensor_fault.any() || (current && !self.commission.outside_learned_range(out));
+            self.detected_in_range |= detected_in_range(&self.commission, out, bands);
             note_detection(&mut self.first_detection, &mut self.detections, t, out);
         }
         // The sample nearest each timeline step (half a sample early counts: the data-quality
         // stage's sample clock may put the sample at the step a hair before it).
-        if timeline_step_due(
-            &mut self.next_point,
-            t,
-            self.dt_s,
-            self.opts.timeline_step_s,
-        ) {
+        let (dt_s, step_s) = (self.dt_s, self.opts.timeline_step_s);
+        if timeline_step_due(&mut self.next_point, t, dt_s, step_s) {
             let point = timeline_point(self, t, out, range_note);
             self.timeline.push(point);
         }
-        // The running the lamps were judged on ([`MIN_JUDGED_S`]), and whether the lamps lit
-        // now lit while the load had moved.
-        if out.evaluating && out.quasi_steady && self.commission.thresholds_trusted(out) {
+        // The running the lamps were judged on ([`MIN_JUDGED_S`]).
+        if out.evaluating && out.quasi_steady && trusted {
             self.judged_s += self.dt_s;
         }
-        if !out.lamps.iter().any(|l| *l) {
-            self.lamps_since_moved = false;
-        } else if self.commission.moved_note(out).is_some() || self.isolation.load_explains_lamps()
-        {
-            self.lamps_since_moved = true;
-        }
+        self.lamps_since_moved = lamps_since_moved(
+            self.lamps_since_moved,
+            out,
+            &self.commission,
+            &self.isolation,
+        );
         self.last = LastOutput::of(out);
     }
 
@@ -720,36 +469,6 @@ impl Replay {
     }
 }
 
-/// What a replay keeps of the monitor's output after a row for the next one.
-#[derive(Debug, Clone, Copy, Default)]
-struct LastOutput {
-    /// The commissioning window is being learned.
-    learning: bool,
-    /// The electrical rotor speed [rad/s].
-    wr_rad_s: f32,
-    /// A sensor fault is flagged.
-    sensor_fault: bool,
-}
-
-impl LastOutput {
-    fn of(out: &MonitorOutput) -> Self {
-        LastOutput {
-            learning: matches!(out.commissioning, CommissioningState::Learning(_)),
-            wr_rad_s: out.operating.wr_rad_s,
-            sensor_fault: out.sensor_fault.any(),
-        }
-    }
-}
-
-/// Whether a lit lamp's residual lies outside its band `(centre, half-width)` now.
-fn lit_outside_band(out: &MonitorOutput, bands: [(f32, f32); 4]) -> bool {
-    out.lamps
-        .iter()
-        .zip(out.residuals)
-        .zip(bands)
-        .any(|((lit, r), (c, h))| *lit && (r - c).abs() > h)
-}
-
 /// Serialises an angle source by its command-line name ([`angle_source_name`]).
 pub(crate) fn serialize_angle_source<S: serde::Serializer>(
     a: &AngleSource,
@@ -764,72 +483,5 @@ pub fn angle_source_name(a: AngleSource) -> &'static str {
         AngleSource::ZeroCrossing => "zero-crossing",
         AngleSource::Pll => "pll",
         AngleSource::RotorFluxCurrentModel => "rotor-flux",
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::log::quality::CellLimits;
-
-    #[test]
-    fn floor_and_round_as_std() {
-        let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
-        let mut values = vec![
-            0.0,
-            -0.0,
-            0.5,
-            -0.5,
-            1.5,
-            -1.5,
-            2.5,
-            0.499_999_999_999_999_94,
-            -0.499_999_999_999_999_94,
-            4_503_599_627_370_495.5,
-            -4_503_599_627_370_495.5,
-            9.223_372_036_854_775e18,
-            -9.223_372_036_854_775e18,
-            1e300,
-            -1e300,
-            f64::NAN,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-        ];
-        for k in 0..100_000 {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            let v = f64::from_bits(x);
-            values.push(v);
-            values.push(((x >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 10f64.powi(k % 20));
-            values.push((k as f64 - 50_000.0) * 0.25);
-        }
-        for v in values {
-            assert_eq!(floor_i64(v), v.floor() as i64, "{v:e}");
-            assert_eq!(round_i64(v), v.round() as i64, "{v:e}");
-        }
-    }
-
-    #[test]
-    fn the_monitor_and_the_quality_stage_judge_a_log_by_the_same_limits() {
-        for p in [ParamFile::reference_2p2kw(), ParamFile::reference_3hp()] {
-            let cfg = monitor_config_for_log(&p, 10_000.0, &ReplayOptions::default());
-            let cells = CellLimits::for_params(&p);
-            assert_eq!(f64::from(cfg.limits.v_max), cells.v_max);
-            assert_eq!(f64::from(cfg.limits.i_max), cells.i_max);
-            assert_eq!(f64::from(cfg.limits.max_speed_rad_s), cells.wm_max);
-            // The speed limit is the core's own default for the supply.
-            let core = MonitorConfig::new(
-                p.motor.model(),
-                p.supply.f_hz as f32,
-                p.supply.v_ll_rms as f32,
-                10_000.0,
-            );
-            assert_eq!(cfg.limits.max_speed_rad_s, core.limits.max_speed_rad_s);
-            // Twice the sensor ranges.
-            let r = p.sensor_ranges();
-            assert_eq!(cells.v_max, 2.0 * r.v_range_v);
-            assert_eq!(cells.i_max, 2.0 * r.i_range_a);
-        }
     }
 }

@@ -4,6 +4,7 @@
 use super::isolation::{self, FaultCandidate, IsolationReport, SensorPhaseReport};
 use super::{serialize_angle_source, CommissioningReport, Replay, UnbalanceBaseline};
 use crate::log::quality::DataQuality;
+use crate::log::Channels;
 use monitor_core::isolation::{fault_call, FaultCall};
 use monitor_core::{AngleSource, CommissioningState, Fault, MonitorOutput, Phase};
 use serde::{Serialize, Serializer};
@@ -356,6 +357,66 @@ pub enum Verdict {
     Watching,
 }
 
+/// The analyses a log with `channels` cannot feed, with the column they need (the report's
+/// `skipped`).
+fn skipped_analyses(channels: Channels) -> Vec<String> {
+    let mut skipped = Vec::new();
+    if !channels.voltages {
+        skipped.push(
+            "residuals r1..r4 and fault signatures: need the voltages va_V, vb_V, vc_V (Vqs)"
+                .to_string(),
+        );
+    } else if !(channels.speed || channels.encoder) {
+        skipped.push(
+            "residuals r1..r4 and fault signatures: need the speed (wm_rad_s or enc_count)"
+                .to_string(),
+        );
+    }
+    skipped
+}
+
+/// The final lamps' matching against the signature matrix: the faults with a probability,
+/// most probable first (the report's `signature_candidates`).
+fn signature_candidates(out: &MonitorOutput) -> Vec<FaultCandidate> {
+    let mut candidates: Vec<FaultCandidate> = Fault::ALL
+        .iter()
+        .zip(out.diagnosis.probabilities)
+        .filter(|(_, p)| *p > 0.0)
+        .map(|(f, p)| FaultCandidate {
+            fault: *f,
+            probability: p,
+            change: None,
+            phase: None,
+        })
+        .collect();
+    candidates.sort_by(|a, b| b.probability.total_cmp(&a.probability));
+    candidates
+}
+
+/// Outside the commissioned range at the end (`note`: where the point moved), a deviation no
+/// single fault explains is the new operating point's, said calmly (the verdict withholds a
+/// judgement).
+fn note_moved_point(isolation: &mut IsolationReport, note: &str) {
+    if isolation.state == monitor_core::IsolationState::Unknown {
+        isolation.verdict = format!(
+            "Not judged as a fault: the operating point moved outside the commissioned range ({note}), where the healthy baseline does not hold; the deviation there ({:.0} standard deviations) fits no single fault, as a new load would not. Commission over this load to judge it.",
+            isolation.deviation_sigma
+        );
+    }
+}
+
+/// The final lamps, `{"r1": bool, ..}`.
+fn final_lamps(out: &MonitorOutput) -> std::collections::BTreeMap<String, bool> {
+    (0..4)
+        .map(|k| {
+            (
+                format!("r{}", k + 1),
+                out.lamps.get(k).copied().unwrap_or(false),
+            )
+        })
+        .collect()
+}
+
 impl Replay {
     /// Ends the replay and builds the report (`data_quality` left at its default for the
     /// caller to fill).
@@ -366,42 +427,13 @@ impl Replay {
             self.book
                 .close(self.monitor.as_ref().map(|_| out.operating.wr_rad_s));
         }
-        let mut skipped = Vec::new();
-        if !self.channels.voltages {
-            skipped.push(
-                "residuals r1..r4 and fault signatures: need the voltages va_V, vb_V, vc_V (Vqs)"
-                    .to_string(),
-            );
-        } else if !(self.channels.speed || self.channels.encoder) {
-            skipped.push(
-                "residuals r1..r4 and fault signatures: need the speed (wm_rad_s or enc_count)"
-                    .to_string(),
-            );
-        }
+        let skipped = skipped_analyses(self.channels);
         let unbalance = self.unbalance_report();
-        let mut signature_candidates: Vec<FaultCandidate> = Fault::ALL
-            .iter()
-            .zip(out.diagnosis.probabilities)
-            .filter(|(_, p)| *p > 0.0)
-            .map(|(f, p)| FaultCandidate {
-                fault: *f,
-                probability: p,
-                change: None,
-                phase: None,
-            })
-            .collect();
-        signature_candidates.sort_by(|a, b| b.probability.total_cmp(&a.probability));
+        let signature_candidates = signature_candidates(&out);
         let detected = self.detected();
         let (mut isolation, mut isolated) = self.isolation.report(detected);
-        // Outside the commissioned range at the end, a deviation no single fault explains
-        // is the new operating point's, said calmly (the verdict withholds a judgement).
-        if isolation.state == monitor_core::IsolationState::Unknown {
-            if let Some(note) = self.commission.moved_note(&out) {
-                isolation.verdict = format!(
-                    "Not judged as a fault: the operating point moved outside the commissioned range ({note}), where the healthy baseline does not hold; the deviation there ({:.0} standard deviations) fits no single fault, as a new load would not. Commission over this load to judge it.",
-                    isolation.deviation_sigma
-                );
-            }
+        if let Some(note) = self.commission.moved_note(&out) {
+            note_moved_point(&mut isolation, &note);
         }
         isolation::refine_single_phase(
             &mut isolation,
@@ -414,14 +446,7 @@ impl Replay {
         } else {
             isolated
         };
-        let lamps = (0..4)
-            .map(|k| {
-                (
-                    format!("r{}", k + 1),
-                    out.lamps.get(k).copied().unwrap_or(false),
-                )
-            })
-            .collect();
+        let lamps = final_lamps(&out);
         let withheld = self.withheld(&skipped, detected, &isolation);
         let winding = unbalance.suspect_phase.is_some() && unbalance.baseline.is_some();
         let (verdict, withheld) = verdict_of(

@@ -1,0 +1,167 @@
+//! The replay's per-row steps after the monitor's output ([`super::Replay::push_step`]):
+//! each reads the output by reference and updates the fields it is given.
+
+use super::commission::CommissionTracker;
+use super::isolation::IsolationTracker;
+use super::report::Detection;
+use monitor_core::{CommissioningState, Monitor, MonitorOutput};
+
+/// No bands (centre and half-width 0): what is passed where the bands are not needed.
+pub(super) const NO_BANDS: [(f32, f32); 4] = [(0.0, 0.0); 4];
+
+/// Books the residuals of `out`: whether the lamps were ever evaluated, and the largest
+/// |residual| of each while evaluating.
+#[inline]
+pub(super) fn note_residuals(evaluated: &mut bool, max_abs: &mut [f32; 4], out: &MonitorOutput) {
+    *evaluated |= out.evaluating;
+    if out.evaluating {
+        for (m, r) in max_abs.iter_mut().zip(out.residuals) {
+            *m = m.max(r.abs());
+        }
+    }
+}
+
+/// The threshold bands in force: they only matter (and are only looked up) while the gate
+/// holds the lamps or a lamp is lit ([`NO_BANDS`] otherwise).
+#[inline]
+pub(super) fn bands_needed(mon: &Monitor, out: &MonitorOutput) -> [(f32, f32); 4] {
+    if out.quasi_steady && !out.fault_detected {
+        NO_BANDS
+    } else {
+        mon.threshold_bands()
+    }
+}
+
+/// After a restart of the monitor's estimators (a long gap, a clock reset) the isolation
+/// waits out the monitor's settling time too: the restarted frame's vectors look steady
+/// before they are right.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct RestartHold {
+    /// The monitor's count of timing faults (estimator restarts) at the last row.
+    timing_faults_seen: u32,
+    /// The isolation ignores points until this time [s].
+    hold_until: f64,
+    /// The monitor's settling time after a restart [s].
+    settle_s: f64,
+}
+
+impl RestartHold {
+    /// No restart yet; `settle_s`: the monitor's settling time [s].
+    pub(super) fn new(settle_s: f64) -> Self {
+        RestartHold {
+            timing_faults_seen: 0,
+            hold_until: f64::NEG_INFINITY,
+            settle_s,
+        }
+    }
+
+    /// Whether the isolation may use the point at `t` [s] (a restart counted in `out`
+    /// starts a new hold).
+    #[inline]
+    pub(super) fn settled(&mut self, t: f64, out: &MonitorOutput) -> bool {
+        if out.timing.timing_faults != self.timing_faults_seen {
+            self.timing_faults_seen = out.timing.timing_faults;
+            self.hold_until = t + self.settle_s;
+        }
+        t >= self.hold_until
+    }
+}
+
+/// Whether a counted detection in `out` is one inside the commissioned range: a sensor
+/// fault, or lamps evaluated (quasi-steady) with a lit lamp's residual outside its band
+/// (`bands`) inside the learned range. A lamp held through a transient, or after its
+/// residual came back (the load returned into the range), detects nothing new there.
+#[inline]
+pub(super) fn detected_in_range(
+    commission: &CommissionTracker,
+    out: &MonitorOutput,
+    bands: [(f32, f32); 4],
+) -> bool {
+    let current = out.evaluating && lit_outside_band(out, bands);
+    out.sensor_fault.any() || (current && !commission.outside_learned_range(out))
+}
+
+/// Books a counted detection at `t` [s]: the first one's time, and each fault the output
+/// ranks first the first time it does.
+#[inline]
+pub(super) fn note_detection(
+    first: &mut Option<f64>,
+    detections: &mut Vec<Detection>,
+    t: f64,
+    out: &MonitorOutput,
+) {
+    if first.is_none() {
+        *first = Some(t);
+    }
+    if let Some((fault, _)) = out.top() {
+        if !detections.iter().any(|d| d.fault == fault) {
+            detections.push(Detection { fault, t_s: t });
+        }
+    }
+}
+
+/// Whether the sample at `t` [s] (interval `dt_s`) is the one nearest the timeline step
+/// `next` (half a sample early counts); if so, `next` moves on by `step_s`, past `t` after a
+/// gap (one point for the gap, not one per step missed).
+#[inline]
+pub(super) fn timeline_step_due(next: &mut f64, t: f64, dt_s: f64, step_s: f64) -> bool {
+    if t + 0.5 * dt_s < *next {
+        return false;
+    }
+    *next += step_s;
+    if *next <= t {
+        *next += (((t - *next) / step_s).floor() + 1.0) * step_s;
+    }
+    true
+}
+
+/// Whether the lamps lit now first lit while the load had moved (or the load explained
+/// them), `was` the answer at the last row: false once every lamp is dark.
+#[inline]
+pub(super) fn lamps_since_moved(
+    was: bool,
+    out: &MonitorOutput,
+    commission: &CommissionTracker,
+    isolation: &IsolationTracker,
+) -> bool {
+    if !out.lamps.iter().any(|l| *l) {
+        false
+    } else if commission.moved_note(out).is_some() || isolation.load_explains_lamps() {
+        true
+    } else {
+        was
+    }
+}
+
+/// What a replay keeps of the monitor's output after a row for the next one.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct LastOutput {
+    /// The commissioning window is being learned.
+    pub(super) learning: bool,
+    /// The electrical rotor speed [rad/s].
+    pub(super) wr_rad_s: f32,
+    /// A sensor fault is flagged.
+    pub(super) sensor_fault: bool,
+}
+
+impl LastOutput {
+    /// What the next row needs of `out`.
+    #[inline]
+    pub(super) fn of(out: &MonitorOutput) -> Self {
+        LastOutput {
+            learning: matches!(out.commissioning, CommissioningState::Learning(_)),
+            wr_rad_s: out.operating.wr_rad_s,
+            sensor_fault: out.sensor_fault.any(),
+        }
+    }
+}
+
+/// Whether a lit lamp's residual lies outside its band `(centre, half-width)` now.
+#[inline]
+pub(super) fn lit_outside_band(out: &MonitorOutput, bands: [(f32, f32); 4]) -> bool {
+    out.lamps
+        .iter()
+        .zip(out.residuals)
+        .zip(bands)
+        .any(|((lit, r), (c, h))| *lit && (r - c).abs() > h)
+}
