@@ -31,7 +31,8 @@ use crate::range_watch::RangeWatch;
 use crate::reset_record::PreviousRun;
 use crate::sampling::TICK_HZ;
 use crate::supply::{ReferenceAdc, ReferenceChange, ReferenceWatch, REFERENCE_PERIOD_MS};
-use monitor_core::isolation::{Baseline, Evidence, FaultCall, Follower, Named, Step};
+use monitor_core::isolation::{Baseline, Evidence, Follower, Named, Step};
+use monitor_core::verdict::Verdict;
 use monitor_core::{
     CommissioningRun, ConfigError, Fault, Isolation, IsolationState, Isolator, MonitorConfig,
     MotorModel, Operating, Phase, ReferenceMachine, SensorFlags, SteadyPoint,
@@ -204,6 +205,9 @@ pub struct MonitorStatus {
     /// winding's part of `|I2/I1|` (the supply's unbalance taken out; named only above a
     /// healthy machine's own asymmetry, `monitor_core::sequence::INHERENT_ASYMMETRY_RATIO`).
     pub winding: Option<(Phase, f32)>,
+    /// The winding phase's confidence, 0..1 (`monitor_core::NegativeSequence::phase_confidence`;
+    /// 0 without a phase): the decision table's confidence of shorted turns on the board.
+    pub winding_confidence: f32,
     /// The filtered `V_ds` [V] (with `operating`: the operating point without the frame's
     /// angle, [`RangeWatch::point`]).
     pub vds: f32,
@@ -220,9 +224,9 @@ pub struct Tick {
     pub pet_watchdog: bool,
     /// The panel mode shown.
     pub mode: Mode,
-    /// The one rule's call on the latest status ([`panel_call`]; the status line's `call=`):
-    /// the FAULT lamp is lit for [`FaultCall::Fault`] only.
-    pub call: FaultCall,
+    /// The decision table's verdict on the latest status ([`panel_call`]; the status line's
+    /// `call=`): the FAULT lamp blinks for [`Verdict::Fault`] only.
+    pub call: Verdict,
     /// The lamps to show.
     pub lamps: PanelLamps,
     /// The commissioning action to carry out ([`carry_out`]).
@@ -384,7 +388,7 @@ impl Supervisor {
         Tick {
             pet_watchdog: watch.pet_watchdog,
             mode,
-            call: panel_call(&self.latest, isolation),
+            call: panel_call(&self.latest, isolation).verdict,
             lamps: panel::render(&input, now_ms),
             action,
             run_ended,

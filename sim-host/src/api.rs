@@ -320,9 +320,18 @@ impl AnalysisRequest {
     }
 }
 
-/// `explain`'s JSON document: the report plus the motor current signature analysis.
+/// `explain`'s JSON document: the one verdict's headline, the report, and the motor current
+/// signature analysis.
 #[derive(Debug, serde::Serialize)]
 pub struct ExplainDocument {
+    /// The one verdict `diagnose` gives on the same log and parameter file, as its line
+    /// (`explain` opens with it: the model's discrepancy is read beside what the motor was
+    /// judged to have).
+    pub headline: String,
+    /// That verdict (`fault`, `watching`, `healthy`, `could_not_judge`).
+    pub motor_verdict: crate::replay::Verdict,
+    /// The finding that verdict rests on (null for healthy and nothing judged).
+    pub verdict_finding: Option<crate::replay::FindingReport>,
     /// The ranking and its verdict.
     #[serde(flatten)]
     pub report: crate::analysis::explain::ExplainReport,
@@ -375,13 +384,58 @@ pub fn explain(
     req: &AnalysisRequest,
 ) -> Result<serde_json::Value, ApiError> {
     let a = load_analysis(params, log, req, &mut |_| {})?;
+    let judged = verdict_for_explain(params, log, req.group.clone());
     let out = a.explain(&req.options(), &|_| {})?;
     let rotor_asymmetry = mcsa_beside(&a, &out.report, req.rotor_bars);
-    let doc = ExplainDocument {
-        report: out.report,
-        rotor_asymmetry,
-    };
+    let doc = ExplainDocument::new(judged.as_ref(), out.report, rotor_asymmetry);
     Ok(serde_json::to_value(&doc).unwrap_or_default())
+}
+
+/// The verdict `diagnose` gives `log` with its defaults (no commissioning, no baseline; the
+/// TDMS `group`), which `explain` opens with; the error's message where `diagnose` cannot
+/// judge the log at all.
+pub fn verdict_for_explain(
+    params: ParamsSource<'_>,
+    log: &Path,
+    group: Option<String>,
+) -> Result<crate::replay::DiagnoseReport, String> {
+    let req = DiagnoseRequest {
+        group,
+        ..DiagnoseRequest::default()
+    };
+    diagnose(params, log, &req, &mut |_| {})
+        .map(|d| d.report)
+        .map_err(|e| e.to_string())
+}
+
+impl ExplainDocument {
+    /// The document of an `explain` report beside the verdict `diagnose` gave the same log
+    /// (`judged`; its error where it gave none).
+    pub fn new(
+        judged: Result<&crate::replay::DiagnoseReport, &String>,
+        report: crate::analysis::explain::ExplainReport,
+        rotor_asymmetry: crate::analysis::rotor_asymmetry::McsaReport,
+    ) -> Self {
+        let (headline, motor_verdict, verdict_finding) = match judged {
+            Ok(j) => (
+                format!("verdict: {}", j.verdict_line),
+                j.verdict,
+                j.verdict_finding.clone(),
+            ),
+            Err(e) => (
+                format!("verdict: could not judge: {e}"),
+                crate::replay::Verdict::CouldNotJudge,
+                None,
+            ),
+        };
+        ExplainDocument {
+            headline,
+            motor_verdict,
+            verdict_finding,
+            report,
+            rotor_asymmetry,
+        }
+    }
 }
 
 /// `identify`'s result: the identification and the parameter file it writes.

@@ -19,7 +19,7 @@
 //! one character).
 
 use crate::api::{diagnose, ApiError, DiagnoseRequest, ParamsSource};
-use crate::replay::{DiagnoseReport, IsolationEvent, IsolationName, LoadModel};
+use crate::replay::{DiagnoseReport, IsolationEvent, LoadModel};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -191,13 +191,16 @@ pub struct FleetRow {
     pub rate_hz: Option<f64>,
     /// `fault`, `healthy`, `could_not_judge`, `watching`; null with an error.
     pub verdict: Option<String>,
-    /// The fault named (Table 1's name, `b/bl`, or `shorted_turns`), if any.
+    /// The fault the verdict names (a FAULT's or a watched one: Table 1's name,
+    /// `shorted_turns`, `broken_bars`), if any.
     pub fault: Option<String>,
-    /// Its relative size (0.5: +50 %; shorted turns: the negative sequence's change over I1).
+    /// Its size in its finding's unit (`size_unit`: a relative change, 0.5 is +50 %; for
+    /// shorted turns the negative sequence's change over I1; for broken bars dB below the
+    /// supply line).
     pub size: Option<f64>,
     /// Its phase (`a`, `b`, `c`), where it has one.
     pub phase: Option<String>,
-    /// The name's probability (shorted turns: the phase's confidence).
+    /// Its calibrated confidence, 0..1.
     pub confidence: Option<f64>,
     /// When the lamps first lit [s].
     pub first_detection_s: Option<f64>,
@@ -231,34 +234,18 @@ impl FleetRow {
 
     /// The row of a report.
     pub fn of_report(motor: &str, file: &Path, r: &DiagnoseReport) -> Self {
-        let u = &r.unbalance;
-        let named = match r.isolation.named {
-            Some(IsolationName::Fault(f)) => {
-                let c = r.candidates.iter().find(|c| c.fault == f);
-                Some((
-                    f.name().to_string(),
-                    c.and_then(|c| c.change).or(r.isolation.named_change),
-                    c.and_then(|c| c.phase).map(|p| p.name().to_string()),
-                    c.map(|c| c.probability),
-                ))
-            }
-            Some(IsolationName::Friction) => {
-                Some(("b/bl".to_string(), r.isolation.named_change, None, None))
-            }
-            None => None,
-        };
-        let winding = (u.suspect_phase.is_some() && u.baseline.is_some()).then(|| {
-            (
-                "shorted_turns".to_string(),
-                Some(u.winding_ratio),
-                u.suspect_phase.map(|p| p.name().to_string()),
-                Some(u.phase_confidence),
-            )
-        });
+        // The verdict's own finding: the fault, size, phase and confidence the verdict line
+        // gives (a watched or a FAULT name; none for healthy or could not judge).
+        let named = r.verdict_finding.as_ref().and_then(|f| f.named());
         // f32 figures as their shortest decimals (0.105, not 0.10517956316471100).
         let short = |x: f32| x.to_string().parse::<f64>().unwrap_or(f64::from(x));
-        let (fault, size, phase, confidence) = match named.or(winding) {
-            Some((f, s, p, c)) => (Some(f), s.map(short), p, c.map(short)),
+        let (fault, size, phase, confidence) = match named {
+            Some(n) => (
+                Some(n.fault.name().to_string()),
+                Some(short(sim_host_size(n.size))),
+                n.phase.map(|p| p.name().to_string()),
+                Some(short(n.confidence)),
+            ),
             None => (None, None, None, None),
         };
         FleetRow {
@@ -266,9 +253,7 @@ impl FleetRow {
             file: file.display().to_string(),
             rows: Some(r.data_quality.rows_read),
             rate_hz: Some(r.data_quality.sample_rate_hz),
-            verdict: serde_json::to_value(r.verdict)
-                .ok()
-                .and_then(|v| v.as_str().map(str::to_string)),
+            verdict: Some(r.verdict.name().to_string()),
             fault,
             size,
             phase,
@@ -383,4 +368,9 @@ mod tests {
             assert!(e.to_string().starts_with("bad motor table t.toml"), "{e}");
         }
     }
+}
+
+/// A size's value as the fleet row gives it.
+fn sim_host_size(size: monitor_core::verdict::Size) -> f32 {
+    crate::replay::verdict::size_parts(size).0
 }

@@ -238,6 +238,7 @@ impl SamplePath {
                 .unbalance
                 .suspect_phase
                 .map(|p| (p, o.unbalance.winding_ratio)),
+            winding_confidence: o.unbalance.phase_confidence,
             vds: o.vds,
             moved: false,
         }

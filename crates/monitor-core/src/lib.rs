@@ -72,6 +72,7 @@ pub mod residuals;
 pub mod sequence;
 pub mod signature;
 pub mod threshold;
+pub mod verdict;
 
 pub use angle::AngleSource;
 pub use commissioning::{

@@ -218,6 +218,12 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
     charts.push(render::mcsa::CHART);
     c.check(&charts)?;
     let a = c.load()?;
+    // The one verdict on the same log, which explain opens with.
+    let judged = sim_host::api::verdict_for_explain(
+        sim_host::api::ParamsSource::Path(&c.params),
+        &c.log,
+        c.group.clone(),
+    );
     let opts = c.options();
     // compare's result is printed (or kept for the JSON document) before explain runs, and
     // its prediction dropped, so memory stays at explain's.
@@ -248,10 +254,7 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
         &out,
         &mcsa,
     )?;
-    let doc = sim_host::api::ExplainDocument {
-        report: out.report,
-        rotor_asymmetry: mcsa,
-    };
+    let doc = sim_host::api::ExplainDocument::new(judged.as_ref(), out.report, mcsa);
     match (c.json, compared) {
         (true, Some(cmp)) => render::json::print(&render::json::ExplainWithCompare {
             compare: &cmp,
@@ -259,7 +262,7 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
         }),
         (true, None) => render::json::print(&doc),
         (false, _) => {
-            render::text::explain(&c.log, &doc.report)?;
+            render::text::explain(&c.log, &doc.headline, &doc.report)?;
             print!("{}", render::mcsa::text(&doc.rotor_asymmetry));
             Ok(())
         }

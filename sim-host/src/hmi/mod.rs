@@ -24,8 +24,8 @@ pub use keys::{key_help, Key, KeyBinding, KeyScope, KEYS};
 use crate::demo::MonitorState;
 use crate::params::ParamFile;
 use crate::replay::{FaultCandidate, IsolationName, IsolationReport, Replay};
-use monitor_core::isolation::FaultCall;
 use monitor_core::sequence::min_shorted_fraction;
+use monitor_core::verdict::Verdict;
 use monitor_core::{Fault, IsolationState, MonitorOutput, Phase};
 use std::collections::VecDeque;
 
@@ -59,13 +59,13 @@ pub struct Snapshot {
     pub residuals: [f32; 4],
     /// Residual lamps r1..r4.
     pub lamps: [bool; 4],
-    /// The fault lamp: a residual lamp or a sensor fault, as the one rule calls it
-    /// ([`Snapshot::call`]) where the source makes the call.
+    /// The fault lamp: lit for the decision table's FAULT ([`Snapshot::call`]) where the
+    /// source makes the call.
     pub fault_lamp: bool,
-    /// The one rule's call on the lamps (`monitor_core::isolation::fault_call`): a replay's
+    /// The decision table's verdict at this moment (`monitor_core::verdict`): a replay's
     /// panel ([`crate::replay::Replay::panel`]), the board's `call=`; `None` where the source
     /// gives none (the FAULT lamp is then the lamps' detection).
-    pub call: Option<FaultCall>,
+    pub call: Option<Verdict>,
     /// Threshold band of each residual in force, (centre, half-width).
     pub bands: Option<[(f32, f32); 4]>,
     /// Learned thresholds are in force (else the fixed ones).
@@ -448,14 +448,14 @@ pub fn header_of(
 
 /// The lamp's word and the header ([`header_of`]) without the word repeated: the plain
 /// status line, the demo's and `diagnose`'s state column. The word: `FAULT` with the FAULT
-/// lamp lit, the amber `MOVED`; with lamps lit and the FAULT lamp off, the one rule's call
-/// (`monitor_core::isolation::fault_call`): `WATCHING` for a named fault too small for a
-/// FAULT (`replay::MIN_FAULT_CHANGE`), `NOT JUDGED` against the nominal values with no name
-/// beyond the file's uncertainty (`replay::NOMINAL_UNCERTAINTY`); else empty.
+/// lamp lit, the amber `MOVED`; with lamps lit and the FAULT lamp off, the decision table's
+/// verdict (`monitor_core::verdict`): `WATCHING` for a name below what a FAULT needs (its
+/// size, `replay::MIN_FAULT_CHANGE`, or its confidence) or lamps no single fault explains,
+/// `NOT JUDGED` where the data or the parameter file cannot carry a verdict; else empty.
 pub fn lamp_and_header(
     state: &MonitorState,
     fault_lamp: bool,
-    call: Option<FaultCall>,
+    call: Option<Verdict>,
     candidates: &[(Fault, f32)],
     isolation: Option<&IsolationView>,
 ) -> (&'static str, String) {
@@ -463,8 +463,8 @@ pub fn lamp_and_header(
     let lamp = match (state, fault_lamp, call) {
         (MonitorState::Moved(_), _, _) => "MOVED",
         (_, true, _) => "FAULT",
-        (MonitorState::Fault(_), false, Some(FaultCall::NotCommissioned)) => "NOT JUDGED",
-        (MonitorState::Fault(_), false, Some(FaultCall::Watching)) => "WATCHING",
+        (MonitorState::Fault(_), false, Some(Verdict::CouldNotJudge)) => "NOT JUDGED",
+        (MonitorState::Fault(_), false, Some(Verdict::Watching)) => "WATCHING",
         // Lamps lit with the FAULT lamp off and a fault named, where the source makes no
         // call: a name too small for a FAULT, watched.
         (MonitorState::Fault(_), false, _) if isolation.is_some_and(|i| i.named.is_some()) => {

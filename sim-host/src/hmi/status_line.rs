@@ -22,7 +22,7 @@
 use super::{quit_key, Controls, HmiState, Key, Snapshot, Source, StdinControls};
 use crate::demo::MonitorState;
 use crate::replay::{FaultCandidate, IsolationName};
-use monitor_core::isolation::FaultCall;
+use monitor_core::verdict::Verdict;
 use monitor_core::{Fault, IsolationState};
 use std::io::BufRead;
 use std::sync::mpsc::{channel, Receiver, TryRecvError};
@@ -78,10 +78,11 @@ pub struct FirmwareStatus {
     pub moved: Option<bool>,
     /// The winding temperature rise since commissioning the isolation tracks [K] (`rise=`).
     pub winding_rise_k: Option<f32>,
-    /// The one rule's call on the board's lamps (`call=`: `clear`, `fault`, `watching`,
-    /// `not-commissioned`; `monitor_core::isolation::fault_call`), which lights the board's
+    /// The decision table's verdict on the board (`call=`: `healthy`, `fault`, `watching`,
+    /// `could_not_judge`; `monitor_core::verdict`; older firmware's `clear` and
+    /// `not-commissioned` read as `healthy` and `could_not_judge`), which lights the board's
     /// FAULT lamp for `fault` only; `None` from an older firmware (then `fault=` does).
-    pub call: Option<FaultCall>,
+    pub call: Option<Verdict>,
 }
 
 /// The isolation fields of a status line (`iso=`, `iso_change=`, `iso_p=`; the firmware's
@@ -224,7 +225,7 @@ pub fn parse(line: &str) -> Option<FirmwareStatus> {
             .map(|p| (p, f("wind_i2").unwrap_or(0.0))),
         moved: b("moved"),
         winding_rise_k: f("rise"),
-        call: field(line, "call").and_then(FaultCall::from_name),
+        call: field(line, "call").and_then(call_of),
     })
 }
 
@@ -247,7 +248,7 @@ impl FirmwareStatus {
             t_s,
             residuals: self.residuals,
             lamps: self.lamps,
-            fault_lamp: self.call.map_or(self.fault, FaultCall::is_fault)
+            fault_lamp: self.call.map_or(self.fault, |c| c == Verdict::Fault)
                 && !matches!(state, MonitorState::Moved(_)),
             call: self.call,
             bands: self.band.map(|(m, h)| [0, 1, 2, 3].map(|k| (m[k], h[k]))),
@@ -458,5 +459,15 @@ impl Source for StdinStatus {
             "firmware status lines on standard input",
             Controls::Stdin(self.controls.clone()),
         )
+    }
+}
+
+/// The verdict of a status line's `call=` field: the decision table's names, and the
+/// names of older firmware's one rule (`clear`, `not-commissioned`).
+fn call_of(name: &str) -> Option<Verdict> {
+    match name {
+        "clear" => Some(Verdict::Healthy),
+        "not-commissioned" => Some(Verdict::CouldNotJudge),
+        other => Verdict::from_name(other),
     }
 }

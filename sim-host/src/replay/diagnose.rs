@@ -3,10 +3,10 @@
 //! output (the live HMI's log source).
 
 use super::front::{Direct, Handled, ReplaySink, CLOCK_RESET_GAP_S};
-use super::{pipe, DiagnoseReport, Replay, ReplayError, ReplayOptions, Verdict};
+use super::verdict::findings::data_quality_finding;
+use super::{pipe, DiagnoseReport, Replay, ReplayError, ReplayOptions};
 use crate::log::quality::{
     CellLimits, CleanSink, DataQuality, NotJudged, QualityStage, MAX_BRIDGED_GAP_S,
-    MAX_NOT_JUDGED_FRACTION,
 };
 use crate::log::{Channels, LogError, LogFile, OpenOptions, Row, RowSink};
 use crate::params::ParamFile;
@@ -199,18 +199,10 @@ fn conclude(
         return Err(ReplayError::IncompleteCommissioning { why });
     }
     let can_residuals = replay.monitor.is_some();
+    let sensors = replay.output().sensor_fault;
     let mut report = replay.finish();
     describe_actions(&mut quality, can_residuals, handled);
-    withhold_healthy_over_unjudged(&mut report, &quality);
-    if !quality.trusted {
-        report.verdict = Verdict::CouldNotJudge;
-        report.verdict_withheld_because.extend(
-            quality
-                .not_trusted_because
-                .iter()
-                .map(|w| format!("data quality: {w}")),
-        );
-    }
+    report.put_finding(data_quality_finding(&quality, sensors));
     report.data_quality = quality;
     Ok(Diagnosed {
         report,
@@ -275,27 +267,6 @@ fn describe_actions(q: &mut DataQuality, monitor: bool, sink: &Handled) {
         q.warnings.push(format!(
             "{:.2}..{:.2} s not judged: {}",
             n.from_s, n.to_s, n.why
-        ));
-    }
-}
-
-/// A "healthy" verdict is withheld when more than [`MAX_NOT_JUDGED_FRACTION`] of the log
-/// was not judged: a fault may hide there (a fault found elsewhere stands).
-fn withhold_healthy_over_unjudged(report: &mut DiagnoseReport, q: &DataQuality) {
-    let unjudged: f64 = q.not_judged.iter().map(|n| n.to_s - n.from_s).sum();
-    if report.verdict == Verdict::Healthy
-        && unjudged > MAX_NOT_JUDGED_FRACTION * q.duration_s.max(f64::MIN_POSITIVE)
-    {
-        report.verdict = Verdict::CouldNotJudge;
-        report.verdict_withheld_because.push(format!(
-            "{unjudged:.2} s of the {:.2} s log could not be judged (over {:.0} %): {}",
-            q.duration_s,
-            100.0 * MAX_NOT_JUDGED_FRACTION,
-            q.not_judged
-                .iter()
-                .map(|n| format!("{:.2}..{:.2} s, {}", n.from_s, n.to_s, n.why))
-                .collect::<Vec<_>>()
-                .join("; ")
         ));
     }
 }

@@ -35,6 +35,7 @@ mod step;
 mod temperature;
 mod trig;
 mod unsettled;
+pub mod verdict;
 mod winding;
 
 use report::timeline_point;
@@ -55,11 +56,11 @@ pub use isolation::{
 pub use options::{monitor_config_for_log, LoadModel, ReplayOptions};
 pub use report::{
     BaselineSource, Detection, DiagnoseReport, MonitorState, Panel, TimelinePoint, UnbalanceReport,
-    Verdict,
 };
 pub use sampler::LogSampler;
 pub use sequences::{SequenceWindow, WINDOW_PERIODS};
 pub use temperature::TemperatureReport;
+pub use verdict::{FindingReport, Rule, Verdict};
 pub use winding::{
     segments, HealthyReference, OperatingPointSource, SequenceSegment, DEFAULT_SPREAD_CURRENTS,
     DEFAULT_SPREAD_VOLTAGES, LEAST_CHANGE_SPREADS, NO_BASELINE_SPREAD, NO_BASELINE_SPREAD_VOLTAGES,

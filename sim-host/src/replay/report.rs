@@ -2,15 +2,15 @@
 //! analysis, the verdict, built by [`Replay::finish`].
 
 use super::isolation::{self, FaultCandidate, IsolationReport, SensorPhaseReport};
+use super::verdict::{self, findings, FindingReport};
 use super::{serialize_angle_source, CommissioningReport, Replay, UnbalanceBaseline};
 use crate::log::quality::DataQuality;
 use crate::log::Channels;
-use monitor_core::isolation::{fault_call, FaultCall};
+use monitor_core::verdict::{FaultName, Glance, Named, Size};
 use monitor_core::{AngleSource, CommissioningState, Fault, MonitorOutput, Phase};
 use serde::{Serialize, Serializer};
 
-mod verdict;
-use verdict::{nominal_cannot_judge, sighting, verdict_of};
+pub use super::verdict::{Rule, Verdict};
 
 /// What the monitor is doing at a timeline point, as the panel would show it.
 #[derive(Debug, Clone, PartialEq)]
@@ -122,26 +122,21 @@ impl Replay {
         // Outside the evaluated points (a transient: the lamps hold) the isolation is
         // asked once here where the rule or the load's note needs it.
         let asked = (isolation.is_none() && (out.fault_detected || self.lamps_since_moved))
-            .then(|| self.isolation_now().0);
-        let report = isolation.as_ref().map(|(r, _)| r).or(asked.as_ref());
+            .then(|| self.isolation_now());
+        let report = isolation.as_ref().or(asked.as_ref());
         // Lamps held through the transient after a load move are the load's, not a fault,
         // unless the isolation names one.
         let held_for_load = self.lamps_since_moved
             && !matches!(
-                report.and_then(|r| r.named),
+                report.and_then(|(r, _)| r.named),
                 Some(isolation::IsolationName::Fault(_))
             );
-        // The one rule for a FAULT (`monitor_core::isolation::fault_call`), as the verdict
-        // and the board's lamp: a name too small is watched, lamps against the nominal
-        // values with no name beyond the file's +-30 % are no judgement; the FAULT lamp is
-        // lit for a FAULT only.
-        let call = report.map_or(FaultCall::Clear, |r| {
-            fault_call(&sighting(out.fault_detected, out.sensor_fault.any(), r))
-        });
+        // The decision table (`monitor_core::verdict`), as the verdict and the board's
+        // lamp read it: the FAULT lamp is lit for a named fault at even odds or better only.
+        let moved = matches!(state, MonitorState::Moved(_)) || held_for_load;
+        let call = glance(out, report, moved).decide().verdict;
         Panel {
-            fault_lamp: call.is_fault()
-                && !matches!(state, MonitorState::Moved(_))
-                && !held_for_load,
+            fault_lamp: call == Verdict::Fault && !moved,
             call,
             isolation,
             state,
@@ -158,6 +153,44 @@ pub const LOAD_MOVED_NOTE: &str =
 /// back into the commissioned range.
 pub const LOAD_BACK_NOTE: &str =
     "the load came back; the lamps that lit while it had moved are going out";
+
+/// The moment's evidence as the decision table reads it (the board's
+/// `monitor_core::verdict::Glance`): the lamps, the sensor flags, the isolation's name with
+/// its candidate's probability, its baseline, whether the operating point explains the
+/// lamps (`moved`), and the core's winding phase.
+fn glance(
+    out: &MonitorOutput,
+    report: Option<&(IsolationReport, Vec<FaultCandidate>)>,
+    moved: bool,
+) -> Glance {
+    let named = report.and_then(|(r, c)| match r.named {
+        Some(isolation::IsolationName::Fault(f)) => {
+            let cand = c.iter().find(|c| c.fault == f);
+            Some(Named {
+                fault: FaultName::Table1(f),
+                size: Size::Relative(cand.and_then(|c| c.change).or(r.named_change)?),
+                phase: cand.and_then(|c| c.phase),
+                confidence: cand.map_or(0.0, |c| c.probability),
+            })
+        }
+        _ => None,
+    });
+    let friction = report.is_some_and(|(r, _)| r.named == Some(isolation::IsolationName::Friction));
+    Glance {
+        lamps_lit: out.fault_detected,
+        sensor_fault: out.sensor_fault.any(),
+        named,
+        commissioned: report
+            .is_some_and(|(r, _)| r.baseline == isolation::IsolationBaseline::Learned),
+        moved: moved || friction,
+        winding: out.unbalance.suspect_phase.map(|p| Named {
+            fault: FaultName::ShortedTurns,
+            size: Size::OfPositiveSequence(out.unbalance.winding_ratio),
+            phase: Some(p),
+            confidence: out.unbalance.phase_confidence,
+        }),
+    }
+}
 
 /// One point of the diagnosis timeline.
 #[derive(Debug, Clone, Serialize)]
@@ -197,12 +230,12 @@ pub struct TimelinePoint {
 pub struct Panel {
     /// The state ([`Replay::state`]).
     pub state: MonitorState,
-    /// The FAULT lamp: a residual lamp or a sensor fault that the one rule calls a FAULT
-    /// ([`Panel::call`]), off in the amber state.
+    /// The FAULT lamp: the decision table's FAULT ([`Panel::call`]), off in the amber
+    /// state.
     pub fault_lamp: bool,
-    /// The one rule's call on the lamps' detection (`monitor_core::isolation::fault_call`:
-    /// [`FaultCall::Clear`] with every lamp dark).
-    pub call: FaultCall,
+    /// The decision table's verdict at this output (`monitor_core::verdict::Glance`, the
+    /// board's rule).
+    pub call: Verdict,
     /// What the isolation concluded where the lamps are evaluated (the report and the
     /// candidates listed, [`Replay::isolation_now`]), else `None`.
     pub isolation: Option<(IsolationReport, Vec<FaultCandidate>)>,
@@ -298,9 +331,25 @@ impl Serialize for Detection {
 /// `commissioning`).
 #[derive(Debug, Clone, Serialize)]
 pub struct DiagnoseReport {
-    /// `fault`, `healthy` or `could not judge` ([`Verdict`]).
+    /// The one verdict (`fault`, `watching`, `healthy`, `could_not_judge`): the decision
+    /// table over `findings` ([`super::verdict`]).
     pub verdict: Verdict,
-    /// Why the verdict could not be given (empty otherwise).
+    /// The verdict's line as `diagnose` prints it after `verdict: `.
+    pub verdict_line: String,
+    /// The row of the decision table that decided (`named`, `data_untrusted`, `file_misfit`,
+    /// `watching`, `unexplained`, `out_of_range`, `healthy`, `nothing_judged`).
+    pub verdict_rule: Rule,
+    /// The finding the verdict rests on (null for healthy and for nothing judged).
+    pub verdict_finding: Option<FindingReport>,
+    /// Every analysis' finding: residuals, winding, rotor, operating point, data quality,
+    /// parameter fit.
+    pub findings: Vec<FindingReport>,
+    /// What was judged, against what (`residuals against commissioning`, ...).
+    pub judged: Vec<String>,
+    /// What could not be judged, and why.
+    pub not_judged: Vec<String>,
+    /// Why the verdict is not a FAULT or healthy (empty for those): the deciding finding,
+    /// then what could not be judged.
     pub verdict_withheld_because: Vec<String>,
     /// Final lamps `{"r1":bool,..}`.
     pub lamps: std::collections::BTreeMap<String, bool>,
@@ -337,24 +386,6 @@ pub struct DiagnoseReport {
     pub max_abs_residual: [f32; 4],
     /// Timeline (one point per `timeline_step_s`).
     pub timeline: Vec<TimelinePoint>,
-}
-
-/// `diagnose`'s overall answer.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Verdict {
-    /// A lamp lit, a sensor fault was seen, or the isolation named a fault (other than
-    /// the friction class, which a load change also moves).
-    Fault,
-    /// Evaluated, and no lamp lit.
-    Healthy,
-    /// The data or the setup does not allow an answer (see `verdict_withheld_because`).
-    CouldNotJudge,
-    /// A fault was named, but its size is below [`super::MIN_FAULT_CHANGE`]: what a
-    /// parameter file's error away from the commissioned point and a few kelvin of heating
-    /// move; the motor is watched, no crew is sent (the reason in
-    /// `verdict_withheld_because`).
-    Watching,
 }
 
 /// The analyses a log with `channels` cannot feed, with the column they need (the report's
@@ -447,22 +478,29 @@ impl Replay {
             isolated
         };
         let lamps = final_lamps(&out);
-        let withheld = self.withheld(&skipped, detected, &isolation);
-        let winding = unbalance.suspect_phase.is_some() && unbalance.baseline.is_some();
-        let (verdict, withheld) = verdict_of(
-            withheld,
+        let residual = self.residual_finding(&findings::ResidualInputs {
+            out: &out,
+            isolation: &isolation,
+            candidates: &candidates,
             detected,
-            winding,
-            out.sensor_fault.any(),
-            &isolation,
-        );
-        DiagnoseReport {
-            verdict,
-            verdict_withheld_because: if verdict == Verdict::Fault && detected {
-                Vec::new()
-            } else {
-                withheld
-            },
+            skipped: &skipped,
+        });
+        let mut found = vec![
+            residual.clone(),
+            findings::winding_finding(&unbalance),
+            self.operating_point_finding(&out, &isolation),
+            self.parameter_fit_finding(&residual, &isolation),
+        ];
+        found.extend(findings::sensor_flag_finding(out.sensor_fault));
+        let mut report = DiagnoseReport {
+            verdict: Verdict::CouldNotJudge,
+            verdict_line: String::new(),
+            verdict_rule: Rule::NothingJudged,
+            verdict_finding: None,
+            findings: found,
+            judged: Vec::new(),
+            not_judged: Vec::new(),
+            verdict_withheld_because: Vec::new(),
             lamps,
             candidates,
             isolation,
@@ -478,60 +516,31 @@ impl Replay {
             rows: self.rows,
             max_abs_residual: self.max_abs,
             timeline: self.timeline,
-        }
+        };
+        report.conclude();
+        report
+    }
+}
+
+impl DiagnoseReport {
+    /// Decides the verdict from the report's `findings` by the decision table
+    /// ([`super::verdict::conclude`]) and writes it into the verdict's keys. Call again
+    /// after adding or replacing a finding.
+    pub fn conclude(&mut self) {
+        let c = verdict::conclude(&self.findings);
+        self.verdict = c.verdict;
+        self.verdict_rule = c.rule;
+        self.verdict_line = c.line;
+        self.verdict_finding = c.finding;
+        self.judged = c.judged;
+        self.not_judged = c.not_judged;
+        self.verdict_withheld_because = c.withheld_because;
     }
 
-    /// Why the verdict is withheld (empty: it is not): `skipped` (what the log could not
-    /// feed), then the replay's own reasons; `detected` whether a lamp or the isolation
-    /// detected a fault, `isolation` the isolation's report.
-    fn withheld(
-        &self,
-        skipped: &[String],
-        detected: bool,
-        isolation: &IsolationReport,
-    ) -> Vec<String> {
-        let mut withheld = skipped.to_vec();
-        if self.monitor.is_some() && !self.evaluated && self.first_detection.is_none() {
-            withheld.push(
-                    "the lamps were never evaluated (the motor never ran settled and quasi-steady with voltage)"
-                        .to_string(),
-                );
-        } else if self.monitor.is_some() && !detected && self.judged_s < super::MIN_JUDGED_S {
-            withheld.push(format!(
-                "the lamps were judged on only {:.2} s of settled, quasi-steady running (a healthy verdict needs at least {:.1} s): the log is all start or transient, or ends too soon after commissioning",
-                self.judged_s,
-                super::MIN_JUDGED_S
-            ));
-        }
-        if let Some(why) = self.commission.why_incomplete() {
-            withheld.push(why);
-        }
-        if let Some(why) = self.commission.nominal_misfit() {
-            withheld.push(why);
-        }
-        if let (Some(why), false) = (self.unsettled.withheld(), detected) {
-            withheld.push(why);
-        }
-        // The isolation allows for a move away from its learned point (its covariance
-        // widens there: `monitor_core::isolation`), so a fault it names is a verdict even
-        // where the lamps' learned means do not hold; only lamps alone are withheld.
-        let named_fault = matches!(isolation.named, Some(isolation::IsolationName::Fault(_)));
-        if let (Some(t), false, false) = (self.first_detection, self.detected_in_range, named_fault)
-        {
-            withheld.push(format!(
-                    "the lamps lit (first at {t:.2} s) only while the load or the voltage was outside the range commissioned: to the paper's model a load change is a Bl change and the learned means hold only where they were learned, so a fault cannot be told from the new operating point; commission over the whole load and voltage range"
-                ));
-        }
-        // Against the nominal machine, lamps that nothing else withholds are judged by the
-        // size of what the isolation names.
-        if withheld.is_empty() {
-            withheld.extend(nominal_cannot_judge(
-                detected,
-                self.last.sensor_fault,
-                isolation,
-            ));
-        }
-        withheld
+    /// Replaces (or adds) the finding of its source and decides again.
+    pub fn put_finding(&mut self, f: FindingReport) {
+        verdict::put(&mut self.findings, f);
+        self.conclude();
     }
 }
 

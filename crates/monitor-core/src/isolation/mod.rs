@@ -144,11 +144,11 @@
 //! (averaging the operating point, learning the baseline, isolating) for the firmware and
 //! the host alike.
 //!
-//! # One rule for a FAULT
+//! # What a name is called
 //! What a named fault of a given size is called (a FAULT, watched, or no judgement before
-//! commissioning) is one function, [`fault_call`], shared by the host's verdict and panel
-//! and the board's FAULT lamp: [`MIN_FAULT_CHANGE`] and [`NOMINAL_UNCERTAINTY`], with the
-//! reasons, are in its module's docs.
+//! commissioning) is the decision table of [`crate::verdict`], shared by the host's verdict
+//! and panel and the board's FAULT lamp; the sizes it reads, [`MIN_FAULT_CHANGE`] and
+//! [`NOMINAL_UNCERTAINTY`], with their reasons, are here.
 
 mod follower;
 pub use follower::{
@@ -166,10 +166,7 @@ pub use outcome::{
     WARMING_EXPLAINS, WARMING_K,
 };
 mod rule;
-pub use rule::{
-    fault_call, within_nominal_uncertainty, FaultCall, Sighting, MIN_FAULT_CHANGE,
-    NOMINAL_UNCERTAINTY,
-};
+pub use rule::{within_nominal_uncertainty, MIN_FAULT_CHANGE, NOMINAL_UNCERTAINTY};
 
 use circuit::{Circuit, Sym3};
 

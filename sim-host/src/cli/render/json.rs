@@ -38,6 +38,10 @@ pub struct DemoReport<'a> {
     /// The isolation's events (load moves and names, with times).
     events: &'a [sim_host::replay::IsolationEvent],
     verdict: sim_host::replay::Verdict,
+    /// The verdict's line, as `diagnose` prints it.
+    verdict_line: &'a str,
+    /// The finding the verdict rests on.
+    verdict_finding: Option<&'a sim_host::replay::FindingReport>,
     named: &'a [FaultCandidate],
     correct_fault_among_candidates: bool,
     lamps: &'a BTreeMap<String, bool>,
@@ -58,6 +62,8 @@ pub fn demo(run: &DemoRun) -> DemoReport<'_> {
         detected_after_s: run.detected_after_s(),
         events: &run.report.isolation.events,
         verdict: run.report.verdict,
+        verdict_line: &run.report.verdict_line,
+        verdict_finding: run.report.verdict_finding.as_ref(),
         named: &run.report.candidates,
         correct_fault_among_candidates: run.correct_fault_named(),
         lamps: &run.report.lamps,

@@ -128,9 +128,11 @@ fn fitted(out: &mut impl Write, r: &CompareReport) -> anyhow::Result<()> {
 }
 
 /// `explain`'s ranking and verdict.
-pub fn explain(log: &Path, r: &ExplainReport) -> anyhow::Result<()> {
+pub fn explain(log: &Path, headline: &str, r: &ExplainReport) -> anyhow::Result<()> {
     let mut out = crate::cli::stdout();
     writeln!(out, "explain {}", log.display())?;
+    // The one verdict first (what `diagnose` gives the same log), then the model's story.
+    writeln!(out, "{headline}")?;
     data_quality(&mut out, &r.data_quality)?;
     writeln!(
         out,

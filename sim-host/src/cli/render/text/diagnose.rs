@@ -5,9 +5,7 @@ use super::{candidate_list, lamp, panel_text};
 use monitor_core::Phase;
 use sim_host::demo::MonitorState;
 use sim_host::log::quality::DataQuality;
-use sim_host::replay::{
-    angle_source_name, CommissioningReport, DiagnoseReport, Diagnosed, IsolationName, Verdict,
-};
+use sim_host::replay::{angle_source_name, CommissioningReport, DiagnoseReport, Diagnosed};
 use std::io::Write;
 use std::path::Path;
 
@@ -29,80 +27,34 @@ fn temperature_line(t: &sim_host::replay::TemperatureReport) -> Option<String> {
     })
 }
 
-/// The verdict line of `diagnose` and the demo.
+/// The verdict line of `diagnose` and the demo: the decision table's line
+/// (`DiagnoseReport::verdict_line`), as the JSON and Python give it.
 pub(super) fn verdict(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
-    let u = &rep.unbalance;
-    if let (Verdict::Fault, Some(p), Some(_)) = (rep.verdict, u.suspect_phase, u.baseline) {
-        let also = if rep.verdict_withheld_because.is_empty() {
-            String::new()
-        } else {
-            format!("; not judged: {}", rep.verdict_withheld_because.join("; "))
-        };
-        let named = named_fault(rep);
-        writeln!(
-            out,
-            "verdict: FAULT{}{} shorted turns in phase {} (the negative sequence changed by {:.1} % of I1, confidence {:.2}){also}",
-            named,
-            if named.is_empty() { "" } else { " and" },
-            p.name(),
-            100.0 * u.winding_ratio,
-            u.phase_confidence
-        )?;
-        return Ok(());
-    }
-    match rep.verdict {
-        Verdict::Fault if rep.lamps.values().any(|l| *l) || !rep.candidates.is_empty() => {
-            writeln!(out, "verdict: FAULT{}", named_fault(rep))?
-        }
-        // Dark lamps and no candidate at the end: say what the verdict rests on.
-        Verdict::Fault => writeln!(
-            out,
-            "verdict: FAULT: the lamps lit at {}{}; they are dark at the end and the isolation names no single fault",
-            rep.first_detection_s
-                .map_or("-".into(), |t| format!("{t:.2} s")),
-            if rep.detections.is_empty() {
-                String::new()
-            } else {
-                format!(
-                    " (the lamps' matching named {})",
-                    rep.detections
-                        .iter()
-                        .map(|d| format!("{} at {:.2} s", IsolationName::expected(d.fault), d.t_s))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                )
-            }
-        )?,
-        Verdict::Healthy => writeln!(out, "verdict: healthy")?,
-        Verdict::Watching => writeln!(
-            out,
-            "verdict: {}",
-            rep.verdict_withheld_because.join("; ")
-        )?,
-        Verdict::CouldNotJudge => writeln!(
-            out,
-            "verdict: could not judge: {}",
-            rep.verdict_withheld_because.join("; ")
-        )?,
-    }
+    writeln!(out, "verdict: {}", rep.verdict_line)?;
     Ok(())
 }
 
-/// The fault the isolation named, with its size and phase, as ` rs +50 %` (empty when it
-/// named none).
-fn named_fault(rep: &DiagnoseReport) -> String {
-    let Some(IsolationName::Fault(f)) = rep.isolation.named else {
-        return String::new();
-    };
-    let c = rep.candidates.iter().find(|c| c.fault == f);
-    let size = c
-        .and_then(|c| c.change)
-        .or(rep.isolation.named_change)
-        .map_or(String::new(), |x| format!(" {:+.0} %", 100.0 * x));
-    let phase = c
-        .and_then(|c| c.phase)
-        .map_or(String::new(), |p| format!(" (phase {})", p.name()));
-    format!(" {}{size}{phase}", f.name())
+/// Every analysis' finding, one line each: its source, what it concluded and against what,
+/// and its sentence (the evidence the verdict's decision table read).
+fn findings_block(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
+    writeln!(out, "findings:")?;
+    for f in &rep.findings {
+        let named = f.named().map_or(String::new(), |n| {
+            format!(
+                " (confidence {:.2}; {})",
+                n.confidence,
+                sim_host::replay::verdict::against_text(f.source(), f.finding.against)
+            )
+        });
+        writeln!(
+            out,
+            "  {:<16} {:<12} {}{named}",
+            f.source().name(),
+            f.state_name(),
+            f.summary
+        )?;
+    }
+    Ok(())
 }
 
 /// `diagnose`'s timeline, lamps, candidates and unbalance.
@@ -131,6 +83,7 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
     for n in &rep.commissioning.outside_range {
         writeln!(out, "note at {:.2} s: {}", n.t_s, n.note)?;
     }
+    findings_block(&mut out, rep)?;
     verdict(&mut out, rep)
 }
 

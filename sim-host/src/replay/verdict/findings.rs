@@ -1,0 +1,393 @@
+//! The replay's findings, one per analysis, as the decision table reads them
+//! ([`super::FindingReport`]). Each says what it found and what it was judged against, or
+//! why it could not judge.
+
+use super::words::{fault_text, pct};
+use super::FindingReport;
+use crate::log::quality::{DataQuality, MAX_NOT_JUDGED_FRACTION};
+use crate::replay::isolation::{FaultCandidate, IsolationBaseline, IsolationName, IsolationReport};
+use crate::replay::{BaselineSource, Replay, UnbalanceReport, MIN_JUDGED_S};
+use monitor_core::verdict::{Against, FaultName, Named, Size, Source, State};
+use monitor_core::{MonitorOutput, SensorFlags};
+
+/// What the residual finding is drawn from, besides the replay's own state: the final output,
+/// the isolation's report and candidates, whether a fault was detected, and the analyses the
+/// log could not feed.
+pub(in crate::replay) struct ResidualInputs<'a> {
+    /// The monitor's last output.
+    pub out: &'a MonitorOutput,
+    /// The isolation's report.
+    pub isolation: &'a IsolationReport,
+    /// Its candidates (sizes and phases of one phase's sensors).
+    pub candidates: &'a [FaultCandidate],
+    /// A lamp or the isolation detected a fault (after heating and load moves).
+    pub detected: bool,
+    /// The analyses the log could not feed (the report's `skipped`).
+    pub skipped: &'a [String],
+}
+
+/// The isolation's baseline as the table reads it.
+fn isolation_against(iso: &IsolationReport) -> Against {
+    match iso.baseline {
+        IsolationBaseline::Learned => Against::Commissioning,
+        IsolationBaseline::Nominal => Against::ParameterFile,
+    }
+}
+
+/// The residuals' brief phrase (`residuals against commissioning`).
+fn residual_brief(against: Against) -> String {
+    format!(
+        "residuals {}",
+        super::words::against_text(Source::Residuals, against)
+    )
+}
+
+impl Replay {
+    /// Why the residuals could not be judged at all, where they could not.
+    fn residuals_not_judged(&self, inp: &ResidualInputs<'_>) -> Option<String> {
+        if self.monitor.is_none() {
+            return Some(inp.skipped.first().cloned().unwrap_or_else(|| {
+                "residuals r1..r4: need the voltages and the speed".to_string()
+            }));
+        }
+        if let Some(why) = self.commission.why_incomplete() {
+            return Some(why);
+        }
+        if !self.evaluated && self.first_detection.is_none() {
+            return Some(
+                "the lamps were never evaluated (the motor never ran settled and quasi-steady with voltage)"
+                    .to_string(),
+            );
+        }
+        if inp.detected {
+            return None;
+        }
+        if self.judged_s < MIN_JUDGED_S {
+            return Some(format!(
+                "the lamps were judged on only {:.2} s of settled, quasi-steady running ({MIN_JUDGED_S:.1} s needed): the log is all start or transient, or ends too soon after commissioning",
+                self.judged_s
+            ));
+        }
+        self.unsettled.withheld()
+    }
+
+    /// The residual lamps' and the isolation's finding.
+    pub(in crate::replay) fn residual_finding(&self, inp: &ResidualInputs<'_>) -> FindingReport {
+        let against = isolation_against(inp.isolation);
+        let brief = residual_brief(against);
+        let of = |state, summary: String| {
+            FindingReport::new(Source::Residuals, state, against, summary, brief.clone())
+        };
+        if let Some(why) = self.residuals_not_judged(inp) {
+            return FindingReport::new(
+                Source::Residuals,
+                State::NotJudged,
+                against,
+                why.clone(),
+                format!("residuals: {why}"),
+            );
+        }
+        let iso = inp.isolation;
+        if let (Some(IsolationName::Fault(f)), true) = (iso.named, inp.detected) {
+            let c = inp.candidates.iter().find(|c| c.fault == f);
+            let change = c.and_then(|c| c.change).or(iso.named_change);
+            let named = Named {
+                fault: FaultName::Table1(f),
+                size: Size::Relative(change.unwrap_or(f32::NAN)),
+                phase: c.and_then(|c| c.phase),
+                confidence: c.map_or(0.0, |c| c.probability),
+            };
+            return of(State::Named(named), iso.verdict.clone());
+        }
+        let lit_end = inp.out.lamps.iter().any(|l| *l);
+        let ever_lit = self.first_detection.is_some() || lit_end;
+        if ever_lit && self.isolation.heating_explains_lamps() {
+            return of(State::Explained, iso.verdict.clone());
+        }
+        // The lamps' matching read only the load term: a load move, unless the isolation's
+        // steady-state equations find a change no single fault (nor the load) explains.
+        let lamps_read_load =
+            self.only_load_named() && iso.state != monitor_core::IsolationState::Unknown;
+        if ever_lit && (self.isolation.load_explains_lamps() || lamps_read_load) {
+            return of(
+                State::Explained,
+                format!(
+                    "the lamps lit for a load move (to the paper's model a load change is a Bl change): {}",
+                    iso.verdict
+                ),
+            );
+        }
+        if let Some(IsolationName::Friction) = iso.named {
+            return of(
+                State::Explained,
+                format!(
+                    "the friction class b/bl {}: to the paper's model a load change is a Bl change, an operating-point change, not a fault ({})",
+                    iso.named_change.map_or(String::new(), pct),
+                    iso.verdict
+                ),
+            );
+        }
+        if !inp.detected && !lit_end {
+            return of(State::Clear, iso.verdict.clone());
+        }
+        if let (Some(t), false) = (self.first_detection, self.detected_in_range) {
+            return of(
+                State::OutOfRange,
+                format!(
+                    "the lamps lit (first at {t:.2} s) only while the load or the voltage was outside the range commissioned: the learned means hold only where they were learned; commission over the whole load and voltage range ({})",
+                    iso.verdict
+                ),
+            );
+        }
+        of(State::Unexplained, iso.verdict.clone())
+    }
+
+    /// With the load an unknown input, the lamps' matching only ever named the friction
+    /// class (the load term): a load move.
+    fn only_load_named(&self) -> bool {
+        self.opts.load == crate::replay::LoadModel::Unknown
+            && !self.detections.is_empty()
+            && self
+                .detections
+                .iter()
+                .all(|d| matches!(d.fault, monitor_core::Fault::B | monitor_core::Fault::Bl))
+    }
+
+    /// Whether the parameter file fits the log where nothing was commissioned: judged from
+    /// the residual finding `residual` and the first quasi-steady point against the file.
+    pub(in crate::replay) fn parameter_fit_finding(
+        &self,
+        residual: &FindingReport,
+        iso: &IsolationReport,
+    ) -> FindingReport {
+        let brief = "parameter file".to_string();
+        let of = |state, against, summary: String| {
+            FindingReport::new(Source::ParameterFit, state, against, summary, brief.clone())
+        };
+        if iso.baseline == IsolationBaseline::Learned {
+            return of(
+                State::Clear,
+                Against::Commissioning,
+                "commissioned: the residuals are judged against the healthy motor learned in commissioning, not the file's values".to_string(),
+            );
+        }
+        if self.monitor.is_none() {
+            return of(
+                State::NotJudged,
+                Against::ParameterFile,
+                "the residuals against the file need the voltages and the speed".to_string(),
+            );
+        }
+        let misfit = |why: String| {
+            of(
+                State::Unexplained,
+                Against::ParameterFile,
+                format!(
+                    "the parameter file does not fit this log (commission on the healthy motor, or identify it: sim-host identify): {why}"
+                ),
+            )
+        };
+        match residual.finding.state {
+            State::Unexplained | State::OutOfRange => return misfit(iso.verdict.clone()),
+            State::Named(n) if !n.stands_clear(Against::ParameterFile) => {
+                return misfit(format!(
+                    "the nearest single fault, {}, is within the file's own uncertainty (+/-{:.0} %); a file 10-30 % off the machine, or windings 60 K warmer than the file assumes, move the residuals this much",
+                    fault_text(&n),
+                    100.0 * monitor_core::isolation::NOMINAL_UNCERTAINTY
+                ))
+            }
+            State::Named(_) => {}
+            _ => {
+                if let Some(why) = self.commission.nominal_misfit() {
+                    return misfit(why);
+                }
+            }
+        }
+        of(
+            State::Clear,
+            Against::ParameterFile,
+            "the residuals against the file's nominal values stay within their fixed thresholds"
+                .to_string(),
+        )
+    }
+
+    /// The operating point's finding: load moves and heating (they explain lamps; never a
+    /// fault).
+    pub(in crate::replay) fn operating_point_finding(
+        &self,
+        out: &MonitorOutput,
+        iso: &IsolationReport,
+    ) -> FindingReport {
+        let brief = "operating point".to_string();
+        let against = isolation_against(iso);
+        let of = |state, summary: String| {
+            FindingReport::new(
+                Source::OperatingPoint,
+                state,
+                against,
+                summary,
+                brief.clone(),
+            )
+        };
+        if self.monitor.is_none() {
+            return of(
+                State::NotJudged,
+                "the load and the heating need the voltages and the speed".to_string(),
+            );
+        }
+        let moves = iso
+            .events
+            .iter()
+            .filter(|e| matches!(e, crate::replay::IsolationEvent::LoadMoved { .. }))
+            .count();
+        let mut said = Vec::new();
+        if let Some(note) = self.commission.moved_note(out) {
+            said.push(format!("outside the commissioned range at the end: {note}"));
+        }
+        if moves > 0 {
+            said.push(format!(
+                "the load moved {moves} time{}",
+                if moves == 1 { "" } else { "s" }
+            ));
+        }
+        if let Some(rise) = iso.winding_rise_k {
+            said.push(format!(
+                "the windings warmed by {rise:.0} K since commissioning"
+            ));
+        }
+        if said.is_empty() {
+            return of(State::Clear, "steady: no load move, no heating".to_string());
+        }
+        of(State::Explained, said.join("; "))
+    }
+}
+
+/// The winding's finding from the negative-sequence report.
+pub(in crate::replay) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
+    let against = match u.baseline {
+        Some(BaselineSource::File) => Against::HealthyRuns,
+        Some(BaselineSource::Commissioning) => Against::Commissioning,
+        None => Against::Nothing,
+    };
+    let runs = if u.baseline_runs > 0 && against == Against::HealthyRuns {
+        format!(
+            "winding against {} healthy run{}",
+            u.baseline_runs,
+            if u.baseline_runs == 1 { "" } else { "s" }
+        )
+    } else {
+        format!(
+            "winding {}",
+            super::words::against_text(Source::Winding, against)
+        )
+    };
+    let of = |state, summary: String| {
+        FindingReport::new(Source::Winding, state, against, summary, runs.clone())
+    };
+    let change = format!(
+        "the negative sequence changed by {:.1} % of I1 (least change {:.1} %)",
+        100.0 * u.winding_ratio,
+        100.0 * u.least_change
+    );
+    if let Some(p) = u.suspect_phase {
+        let named = Named {
+            fault: FaultName::ShortedTurns,
+            size: Size::OfPositiveSequence(u.winding_ratio),
+            phase: Some(p),
+            confidence: u.phase_confidence,
+        };
+        return of(
+            State::Named(named),
+            format!("shorted turns in phase {}: {change}", p.name()),
+        );
+    }
+    if u.judged_segment.is_none() {
+        let why = u
+            .phase_not_judged
+            .clone()
+            .unwrap_or_else(|| "no steady stretch".to_string());
+        return FindingReport::new(
+            Source::Winding,
+            State::NotJudged,
+            against,
+            why.clone(),
+            format!("winding: {why}"),
+        );
+    }
+    if u.winding_ratio >= u.least_change && u.least_change > 0.0 {
+        let why = u.phase_not_judged.clone().unwrap_or_default();
+        return of(
+            State::Unexplained,
+            format!("the winding's negative sequence stands out but names no phase: {why}"),
+        );
+    }
+    of(State::Clear, format!("no shorted turns: {change}"))
+}
+
+/// The data-quality finding: what the stage does not trust, the stretches not judged, and
+/// the sensors' readings no machine gives at the end (`sensors`, the core's flags).
+pub(in crate::replay) fn data_quality_finding(
+    q: &DataQuality,
+    sensors: SensorFlags,
+) -> FindingReport {
+    let of = |state, summary: String| {
+        FindingReport::new(
+            Source::DataQuality,
+            state,
+            Against::Nothing,
+            summary,
+            "data quality".to_string(),
+        )
+    };
+    if !q.trusted {
+        return of(
+            State::Unexplained,
+            format!("data quality: {}", q.not_trusted_because.join("; ")),
+        );
+    }
+    let unjudged: f64 = q.not_judged.iter().map(|n| n.to_s - n.from_s).sum();
+    if unjudged > MAX_NOT_JUDGED_FRACTION * q.duration_s.max(f64::MIN_POSITIVE) {
+        return of(
+            State::Unexplained,
+            format!(
+                "{unjudged:.2} s of the {:.2} s log could not be judged (over {:.0} %): {}",
+                q.duration_s,
+                100.0 * MAX_NOT_JUDGED_FRACTION,
+                q.not_judged
+                    .iter()
+                    .map(|n| format!("{:.2}..{:.2} s, {}", n.from_s, n.to_s, n.why))
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            ),
+        );
+    }
+    if let Some(s) = sensor_flag_finding(sensors) {
+        return s;
+    }
+    of(State::Clear, format!("data quality: {}", q.summary()))
+}
+
+/// The core's sensor flags at the end of a replay as a data-quality finding (readings no
+/// machine gives: a sensor or its wiring, not the motor); `None` with no flag set.
+pub(in crate::replay) fn sensor_flag_finding(s: SensorFlags) -> Option<FindingReport> {
+    let which: Vec<&str> = [
+        (s.current, "current"),
+        (s.voltage, "voltage"),
+        (s.speed, "speed (encoder)"),
+    ]
+    .into_iter()
+    .filter_map(|(on, w)| on.then_some(w))
+    .collect();
+    (!which.is_empty()).then(|| {
+        FindingReport::new(
+            Source::DataQuality,
+            State::Unexplained,
+            Against::Nothing,
+            format!(
+                "the {} sensor readings at the end of the log are impossible for any machine (not a number, saturated, phases not summing to zero, or an encoder jump): check the sensors and their wiring; the motor cannot be judged from them",
+                which.join(" and ")
+            ),
+            "data quality".to_string(),
+        )
+    })
+}
