@@ -3,7 +3,7 @@
 //! the way defmt's decoder prints them, and `sim_host::hmi::status_line::parse` must read
 //! every value back; the firmware docs' "The status line" (docs/firmware.md) documents every field.
 
-use monitor_core::isolation::FaultCall;
+use monitor_core::verdict::Verdict;
 use monitor_core::Fault;
 use sim_host::demo::MonitorState;
 use sim_host::hmi::status_line;
@@ -111,7 +111,7 @@ fn the_hmi_reads_every_field_the_firmware_prints() {
     assert_eq!(s.residuals, [0.0123, -0.1, 0.25, -0.004]);
     assert_eq!(s.lamps, [false, true, true, true]);
     assert!(s.fault);
-    assert_eq!(s.call, Some(FaultCall::Fault));
+    assert_eq!(s.call, Some(Verdict::Fault));
     assert_eq!(s.candidates, vec![(Fault::B, 0.5), (Fault::Bl, 0.5)]);
     assert_eq!(s.wm_rad_s, Some(150.5));
     assert_eq!(s.mode.as_deref(), Some("commissioned"));
@@ -172,11 +172,15 @@ fn the_hmi_reads_every_field_the_firmware_prints() {
         .expect("read")
         .snapshot(0.0);
     assert!(matches!(snap.state, MonitorState::Fault(_)) && snap.fault_lamp);
-    // The board's call lights its FAULT lamp, not `fault=`: watching (a name under 5 %) and
-    // not commissioned (no name beyond +-30 %) show the lamps lit, the FAULT lamp dark and
-    // the call's word.
+    // The board's verdict lights its FAULT lamp, not `fault=`: watching (a name under 5 %)
+    // and could not judge (no name beyond +-30 % against the record's values; older
+    // firmware's `not-commissioned`) show the lamps lit, the FAULT lamp dark and the word.
     let fixed = friction.replace("moved=true", "moved=false");
-    for (call, word) in [("watching", "WATCHING"), ("not-commissioned", "NOT JUDGED")] {
+    for (call, word) in [
+        ("watching", "WATCHING"),
+        ("could_not_judge", "NOT JUDGED"),
+        ("not-commissioned", "NOT JUDGED"),
+    ] {
         let snap = status_line::parse(&fixed.replace("call=fault", &format!("call={call}")))
             .expect("read")
             .snapshot(0.0);

@@ -398,21 +398,19 @@ pub fn verdict_for_explain(
     params: ParamsSource<'_>,
     log: &Path,
     group: Option<String>,
-) -> Result<crate::replay::DiagnoseReport, String> {
+) -> Result<crate::replay::DiagnoseReport, ApiError> {
     let req = DiagnoseRequest {
         group,
         ..DiagnoseRequest::default()
     };
-    diagnose(params, log, &req, &mut |_| {})
-        .map(|d| d.report)
-        .map_err(|e| e.to_string())
+    diagnose(params, log, &req, &mut |_| {}).map(|d| d.report)
 }
 
 impl ExplainDocument {
     /// The document of an `explain` report beside the verdict `diagnose` gave the same log
     /// (`judged`; its error where it gave none).
     pub fn new(
-        judged: Result<&crate::replay::DiagnoseReport, &String>,
+        judged: Result<&crate::replay::DiagnoseReport, &ApiError>,
         report: crate::analysis::explain::ExplainReport,
         rotor_asymmetry: crate::analysis::rotor_asymmetry::McsaReport,
     ) -> Self {

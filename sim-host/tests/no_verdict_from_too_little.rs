@@ -81,11 +81,18 @@ fn a_change_too_small_to_matter_is_watched_not_a_fault() {
     );
     // The lamps do see the change (it is real), ...
     assert!(d["first_detection_s"].as_f64().is_some(), "{d}");
-    // ... but it is no FAULT: a name below 5 % is watched, with its size.
+    // ... but it is no FAULT: a name below 5 % (or the friction class, which a load change
+    // moves as much) is watched, with its size.
     assert_ne!(d["verdict"], "fault", "{d}");
     if let Some(c) = iso["named_change"].as_f64() {
         assert!(c.abs() < 0.05, "{iso}");
         assert_eq!(d["verdict"], "watching", "{d}");
+        assert!(
+            d["verdict_line"]
+                .as_str()
+                .is_some_and(|l| l.starts_with("WATCHING")),
+            "{d}"
+        );
     }
     // Every name and candidate carries a size that is not zero.
     for c in d["candidates"].as_array().into_iter().flatten() {

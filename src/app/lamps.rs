@@ -4,7 +4,9 @@
 //! "operating point moved" state.
 
 use super::*;
-use monitor_core::verdict::{Decision, FaultName, Glance, Named as Name, Size, Source, Verdict};
+use monitor_core::verdict::{
+    Decision, FaultName, FindingSource, Glance, NamedFault as Name, Size, Verdict,
+};
 
 /// The isolation as the panel reads it: the latest one in force
 /// ([`Supervisor::isolation`]) and whether it judges against a baseline learned in
@@ -39,15 +41,20 @@ pub fn panel_glance(status: &MonitorStatus, isolation: PanelIsolation<'_>) -> Gl
     Glance {
         lamps_lit: status.fault_detected,
         sensor_fault: status.sensor_fault.any(),
-        named: named.as_ref().and_then(Name::of_isolation),
+        named: named.as_ref().map(Name::of_isolation),
         commissioned: status.commissioned,
         moved: status.moved || friction,
-        winding: status.winding.map(|(phase, ratio)| Name {
-            fault: FaultName::ShortedTurns,
-            size: Size::OfPositiveSequence(ratio),
-            phase: Some(phase),
-            confidence: status.winding_confidence,
-        }),
+        // Shorted turns count where the lamps are judged (a start's or a step's transient
+        // unbalances the currents for a while).
+        winding: status
+            .winding
+            .filter(|_| status.evaluating && status.quasi_steady)
+            .map(|(phase, ratio)| Name {
+                fault: FaultName::ShortedTurns,
+                size: Size::OfPositiveSequence(ratio),
+                phase: Some(phase),
+                confidence: status.winding_confidence,
+            }),
     }
 }
 
@@ -67,7 +74,7 @@ fn fault_code(glance: &Glance, d: Decision) -> Option<u8> {
     let finding = d.by.and_then(|k| glance.findings().get(k).copied())?;
     let named = finding.named()?;
     match (finding.source, named.fault, named.phase) {
-        (Source::Winding, _, Some(p)) => Some(winding_code(p.index() as u8)),
+        (FindingSource::Winding, _, Some(p)) => Some(winding_code(p.index() as u8)),
         (_, FaultName::Table1(f), _) => Some(blink_code(f.index() as u8)),
         _ => None,
     }
@@ -157,6 +164,8 @@ mod tests {
     fn commissioned() -> MonitorStatus {
         MonitorStatus {
             commissioned: true,
+            evaluating: true,
+            quasi_steady: true,
             ..MonitorStatus::default()
         }
     }
@@ -196,6 +205,11 @@ mod tests {
             assert_eq!(code(&inp), Some(11 + k as u8), "{phase:?}");
             status.winding_confidence = 0.3;
             assert!(dark(&panel_input(m, &status, none, false)), "{phase:?}");
+            // A transient (a start, a step) unbalances the currents: no winding then.
+            status.winding_confidence = 0.8;
+            status.quasi_steady = false;
+            assert!(dark(&panel_input(m, &status, none, false)), "{phase:?}");
+            status.quasi_steady = true;
         }
         // A named lamp fault more confident than the winding keeps its own code.
         status.fault_detected = true;

@@ -1,6 +1,6 @@
 //! The one verdict: every analysis' finding in, one verdict out, by one decision table.
 //!
-//! Each analysis of a monitor yields a [`Finding`]: where it comes from ([`Source`]: the
+//! Each analysis of a monitor yields a [`Finding`]: where it comes from ([`FindingSource`]: the
 //! residual lamps and their isolation, the winding's negative sequence, the rotor's current
 //! spectrum, the operating point, the data's quality, whether the parameter file fits), what
 //! it concluded ([`State`]), and what it was judged against ([`Against`]). [`decide`] turns
@@ -14,14 +14,14 @@
 //!
 //! | row | when | verdict |
 //! |---|---|---|
-//! | 1 [`Rule::Named`] | a finding names a fault whose size stands clear ([`Named::stands_clear`]) at a confidence of at least [`FAULT_CONFIDENCE`] | **fault**: that finding (the most confident; equal ones in [`Source`] order) |
+//! | 1 [`Rule::Named`] | a finding names a fault whose size stands clear ([`Named::stands_clear`]) at a confidence of at least [`FAULT_CONFIDENCE`] | **fault**: that finding (the most confident; equal ones in [`FindingSource`] order) |
 //! | 2 [`Rule::DataUntrusted`] | the data-quality finding does not trust the data | **could not judge**: what is wrong with the data |
 //! | 3 [`Rule::FileMisfit`] | the parameter-fit finding says the file does not fit the log (not commissioned, a change no single fault explains, or one within the file's own uncertainty) | **could not judge**: the parameter file does not fit this log |
 //! | 4 [`Rule::Watching`] | a finding names a fault below the confidence or the size a FAULT needs | **watching**: the most confident of them |
 //! | 5 [`Rule::Unexplained`] | a finding's change stands out that no single fault explains (against a commissioned baseline) | **watching**: the change, with nothing named |
 //! | 6 [`Rule::OutOfRange`] | the residuals saw their change only where the operating point had left the range they were judged over | **could not judge**: commission over that range |
-//! | 7 [`Rule::Healthy`] | the residuals, the winding or the rotor were judged, and none found anything it cannot explain | **healthy**: what was judged |
-//! | 8 [`Rule::NothingJudged`] | otherwise | **could not judge**: nothing could be judged |
+//! | 7 [`Rule::Healthy`] | the residuals, the winding or the rotor were judged, none found anything it cannot explain, and none that could run on this log was kept from judging ([`State::NotJudged`]) | **healthy**: what was judged, and what the log lacked for the others |
+//! | 8 [`Rule::NothingJudged`] | otherwise: nothing judged, or an analysis the log kept from judging | **could not judge**: what could not be judged and why |
 //!
 //! Two findings that disagree: a name at or above [`FAULT_CONFIDENCE`] wins over everything
 //! else (row 1), so the winding's shorted turns beside residual lamps that fit no single
@@ -59,7 +59,7 @@ pub const ROTOR_FAULT_DB: f32 = 48.0;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
-pub enum Source {
+pub enum FindingSource {
     /// The data-quality stage (bad cells, gaps, clipped or swapped channels; the core's sensor
     /// flags: readings no machine gives).
     DataQuality,
@@ -76,34 +76,37 @@ pub enum Source {
     OperatingPoint,
 }
 
-impl Source {
+impl FindingSource {
     /// Every source, in precedence order.
-    pub const ALL: [Source; 6] = [
-        Source::DataQuality,
-        Source::ParameterFit,
-        Source::Winding,
-        Source::Rotor,
-        Source::Residuals,
-        Source::OperatingPoint,
+    pub const ALL: [FindingSource; 6] = [
+        FindingSource::DataQuality,
+        FindingSource::ParameterFit,
+        FindingSource::Winding,
+        FindingSource::Rotor,
+        FindingSource::Residuals,
+        FindingSource::OperatingPoint,
     ];
 
     /// The name in reports: `data_quality`, `parameter_fit`, `winding`, `rotor`,
     /// `residuals`, `operating_point`.
     pub const fn name(self) -> &'static str {
         match self {
-            Source::DataQuality => "data_quality",
-            Source::ParameterFit => "parameter_fit",
-            Source::Winding => "winding",
-            Source::Rotor => "rotor",
-            Source::Residuals => "residuals",
-            Source::OperatingPoint => "operating_point",
+            FindingSource::DataQuality => "data_quality",
+            FindingSource::ParameterFit => "parameter_fit",
+            FindingSource::Winding => "winding",
+            FindingSource::Rotor => "rotor",
+            FindingSource::Residuals => "residuals",
+            FindingSource::OperatingPoint => "operating_point",
         }
     }
 
     /// Whether the source judges the motor for faults (the residuals, the winding, the rotor),
     /// rather than the conditions of the judgement (the data, the file, the operating point).
     pub const fn judges_faults(self) -> bool {
-        matches!(self, Source::Residuals | Source::Winding | Source::Rotor)
+        matches!(
+            self,
+            FindingSource::Residuals | FindingSource::Winding | FindingSource::Rotor
+        )
     }
 }
 
@@ -143,9 +146,13 @@ impl Against {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FaultName {
     /// One of the paper's Table 1 faults (a parameter's change or a sensor's gain error; never
-    /// B or Bl: the friction class is a load move to the paper's model, an operating-point
-    /// finding).
+    /// B or Bl alone: see [`FaultName::Friction`]).
     Table1(Fault),
+    /// The friction class B/Bl (`b/bl`): B and Bl scale the same load term and cannot be
+    /// separated, and a load change moves it as a fault of either would. It is watched, never
+    /// a FAULT ([`NamedFault::stands_clear`]): no log without a load model tells a bearing
+    /// from the load.
+    Friction,
     /// Shorted turns in one phase's winding.
     ShortedTurns,
     /// Broken rotor bars (or a cracked end ring, a high-resistance joint).
@@ -153,11 +160,12 @@ pub enum FaultName {
 }
 
 impl FaultName {
-    /// The name in reports: Table 1's names (`rs` ... `speed_sensor`), `shorted_turns`,
-    /// `broken_bars`.
+    /// The name in reports: Table 1's names (`rs` ... `speed_sensor`), `b/bl`,
+    /// `shorted_turns`, `broken_bars`.
     pub fn name(self) -> &'static str {
         match self {
             FaultName::Table1(f) => f.name(),
+            FaultName::Friction => "b/bl",
             FaultName::ShortedTurns => "shorted_turns",
             FaultName::BrokenBars => "broken_bars",
         }
@@ -179,7 +187,7 @@ pub enum Size {
 
 /// A named fault with its size, phase and confidence.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Named {
+pub struct NamedFault {
     /// The fault.
     pub fault: FaultName,
     /// Its size.
@@ -190,7 +198,7 @@ pub struct Named {
     pub confidence: f32,
 }
 
-impl Named {
+impl NamedFault {
     /// Whether the size stands clear of what a healthy motor and its parameter file move, so
     /// that a crew would act on it, against `against`:
     /// - a relative change: at least [`MIN_FAULT_CHANGE`] (5 %: 13 K of heating on a winding,
@@ -199,10 +207,14 @@ impl Named {
     ///   ([`crate::isolation::NOMINAL_UNCERTAINTY`], 30 %);
     /// - a sideband at [`ROTOR_FAULT_DB`] or less below the supply line;
     /// - shorted turns: always (their analysis names a phase only for a change that stands
-    ///   clear of a healthy machine's asymmetry); a fraction of turns above zero.
+    ///   clear of a healthy machine's asymmetry); a fraction of turns above zero;
+    /// - the friction class: never (a load change moves it as much).
     ///
     /// A size that is not a number never stands clear.
     pub fn stands_clear(&self, against: Against) -> bool {
+        if self.fault == FaultName::Friction {
+            return false;
+        }
         match self.size {
             Size::Relative(c) => {
                 c.abs() >= MIN_FAULT_CHANGE
@@ -214,17 +226,23 @@ impl Named {
     }
 
     /// The isolation's name as the verdict reads it: a Table 1 fault with its change and its
-    /// probability as the confidence; `None` for the friction class (a load move to the
-    /// paper's model, an operating-point matter).
-    pub fn of_isolation(n: &crate::isolation::Named) -> Option<Named> {
+    /// probability as the confidence, or the friction class with Bl's change.
+    pub fn of_isolation(n: &crate::isolation::Named) -> NamedFault {
         match n {
-            crate::isolation::Named::Fault(c) => Some(Named {
+            crate::isolation::Named::Fault(c) => NamedFault {
                 fault: FaultName::Table1(c.fault),
                 size: Size::Relative(c.change),
                 phase: None,
                 confidence: c.probability,
-            }),
-            crate::isolation::Named::Friction { .. } => None,
+            },
+            crate::isolation::Named::Friction {
+                probability, bl, ..
+            } => NamedFault {
+                fault: FaultName::Friction,
+                size: Size::Relative(bl.change),
+                phase: None,
+                confidence: *probability,
+            },
         }
     }
 
@@ -239,18 +257,24 @@ impl Named {
 /// What a finding concluded.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum State {
-    /// The log could not feed this analysis (a missing channel, too short, never steady).
+    /// The log lacks what this analysis needs (a channel it does not have, a load the
+    /// analysis needs, a record too short for its resolution): listed, and a verdict of
+    /// healthy may still rest on the others.
+    Unavailable,
+    /// The analysis could run on this log but the log did not let it judge (never settled,
+    /// too short after commissioning, the end unsettled with the residuals far off, the
+    /// commissioning window not learned): no verdict of healthy while this stands.
     NotJudged,
     /// Judged: nothing found.
     Clear,
     /// A fault named, with its size.
-    Named(Named),
+    Named(NamedFault),
     /// A change stands out that no single fault explains (several faults, an unknown fault);
-    /// for [`Source::ParameterFit`]: the file does not fit the log; for
-    /// [`Source::DataQuality`]: the data cannot carry a verdict.
+    /// for [`FindingSource::ParameterFit`]: the file does not fit the log; for
+    /// [`FindingSource::DataQuality`]: the data cannot carry a verdict.
     Unexplained,
     /// The analysis saw a change (lit lamps) that the operating point explains (a load that
-    /// moved, heating): judged, no fault. For [`Source::OperatingPoint`]: it explains one.
+    /// moved, heating): judged, no fault. For [`FindingSource::OperatingPoint`]: it explains one.
     Explained,
     /// The analysis saw its change only where the operating point had left the range it was
     /// judged over (the load outside the commissioned range): not judged there.
@@ -261,7 +285,7 @@ pub enum State {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Finding {
     /// Where it comes from.
-    pub source: Source,
+    pub source: FindingSource,
     /// What it concluded.
     pub state: State,
     /// What it was judged against.
@@ -270,7 +294,7 @@ pub struct Finding {
 
 impl Finding {
     /// A finding of `source` in `state` against `against`.
-    pub const fn new(source: Source, state: State, against: Against) -> Self {
+    pub const fn new(source: FindingSource, state: State, against: Against) -> Self {
         Finding {
             source,
             state,
@@ -279,7 +303,7 @@ impl Finding {
     }
 
     /// The name, when the finding names a fault.
-    pub fn named(&self) -> Option<&Named> {
+    pub fn named(&self) -> Option<&NamedFault> {
         match &self.state {
             State::Named(n) => Some(n),
             _ => None,
@@ -369,9 +393,9 @@ pub struct Decision {
 }
 
 /// The most confident named finding among `findings` that `keep` accepts (equal confidences:
-/// the first in [`Source`] order); its index.
+/// the first in [`FindingSource`] order); its index.
 fn most_confident(findings: &[Finding], keep: impl Fn(&Finding) -> bool) -> Option<usize> {
-    let mut best: Option<(usize, f32, Source)> = None;
+    let mut best: Option<(usize, f32, FindingSource)> = None;
     for (k, f) in findings.iter().enumerate() {
         let Some(n) = f.named() else { continue };
         if !keep(f) {
@@ -397,7 +421,7 @@ fn most_confident(findings: &[Finding], keep: impl Fn(&Finding) -> bool) -> Opti
 /// The first finding of `source` in a state `pick` accepts; its index.
 fn first_of(
     findings: &[Finding],
-    source: Option<Source>,
+    source: Option<FindingSource>,
     pick: impl Fn(&State) -> bool,
 ) -> Option<usize> {
     findings
@@ -414,10 +438,10 @@ pub fn decide(findings: &[Finding]) -> Decision {
         return of(Verdict::Fault, Rule::Named, Some(k));
     }
     let unexplained = |s: &State| matches!(s, State::Unexplained);
-    if let Some(k) = first_of(findings, Some(Source::DataQuality), unexplained) {
+    if let Some(k) = first_of(findings, Some(FindingSource::DataQuality), unexplained) {
         return of(Verdict::CouldNotJudge, Rule::DataUntrusted, Some(k));
     }
-    if let Some(k) = first_of(findings, Some(Source::ParameterFit), unexplained) {
+    if let Some(k) = first_of(findings, Some(FindingSource::ParameterFit), unexplained) {
         return of(Verdict::CouldNotJudge, Rule::FileMisfit, Some(k));
     }
     if let Some(k) = most_confident(findings, |_| true) {
@@ -436,7 +460,10 @@ pub fn decide(findings: &[Finding]) -> Decision {
     let judged = findings
         .iter()
         .any(|f| fault_source(f) && matches!(f.state, State::Clear | State::Explained));
-    if judged {
+    let kept_from_judging = findings
+        .iter()
+        .any(|f| fault_source(f) && matches!(f.state, State::NotJudged));
+    if judged && !kept_from_judging {
         return of(Verdict::Healthy, Rule::Healthy, None);
     }
     of(Verdict::CouldNotJudge, Rule::NothingJudged, None)
@@ -452,9 +479,9 @@ pub struct Glance {
     pub lamps_lit: bool,
     /// A sensor gives readings no machine gives (the core's sensor flags).
     pub sensor_fault: bool,
-    /// What the isolation names now (a Table 1 fault with its size and probability; not the
-    /// friction class), if anything.
-    pub named: Option<Named>,
+    /// What the isolation names now (a Table 1 fault or the friction class, with its size and
+    /// probability), if anything.
+    pub named: Option<NamedFault>,
     /// The isolation and the lamps judge against a baseline learned in commissioning (else
     /// against the parameter file's nominal values).
     pub commissioned: bool,
@@ -462,7 +489,7 @@ pub struct Glance {
     /// range, or the isolation reads the lamps' change as the load's (the friction class).
     pub moved: bool,
     /// Shorted turns named by the negative-sequence analysis, if any.
-    pub winding: Option<Named>,
+    pub winding: Option<NamedFault>,
 }
 
 impl Glance {
@@ -501,16 +528,20 @@ impl Glance {
             }
         };
         [
-            Finding::new(Source::Residuals, residual, against),
-            Finding::new(Source::ParameterFit, state(misfit), Against::ParameterFile),
+            Finding::new(FindingSource::Residuals, residual, against),
             Finding::new(
-                Source::DataQuality,
+                FindingSource::ParameterFit,
+                state(misfit),
+                Against::ParameterFile,
+            ),
+            Finding::new(
+                FindingSource::DataQuality,
                 state(self.sensor_fault),
                 Against::Nothing,
             ),
             Finding::new(
-                Source::Winding,
-                self.winding.map_or(State::NotJudged, State::Named),
+                FindingSource::Winding,
+                self.winding.map_or(State::Unavailable, State::Named),
                 Against::Nothing,
             ),
         ]

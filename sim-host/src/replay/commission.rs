@@ -337,6 +337,11 @@ impl CommissionTracker {
         self.requested.is_some() && !self.learned_ok()
     }
 
+    /// A window was asked for and learned: the lamps' thresholds are the motor's own.
+    pub(super) fn learned(&self) -> bool {
+        self.requested.is_some() && self.learned_ok()
+    }
+
     fn learned_ok(&self) -> bool {
         !self.cancelled && self.ended_at.is_some() && self.learned.0 >= self.learned.1
     }

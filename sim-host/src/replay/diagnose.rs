@@ -202,7 +202,13 @@ fn conclude(
     let sensors = replay.output().sensor_fault;
     let mut report = replay.finish();
     describe_actions(&mut quality, can_residuals, handled);
-    report.put_finding(data_quality_finding(&quality, sensors));
+    let dq = data_quality_finding(&quality, sensors);
+    // Data the stage does not trust carry no finding (the sensors' impossible readings at
+    // the end are the core's own finding: a sensor the isolation names with its size stands).
+    if !quality.trusted || dq_unjudged(&quality) {
+        report.distrust(&dq.summary);
+    }
+    report.put_finding(dq);
     report.data_quality = quality;
     Ok(Diagnosed {
         report,
@@ -269,4 +275,11 @@ fn describe_actions(q: &mut DataQuality, monitor: bool, sink: &Handled) {
             n.from_s, n.to_s, n.why
         ));
     }
+}
+
+/// More of the log could not be judged than a verdict allows
+/// ([`crate::log::quality::MAX_NOT_JUDGED_FRACTION`]).
+fn dq_unjudged(q: &DataQuality) -> bool {
+    let unjudged: f64 = q.not_judged.iter().map(|n| n.to_s - n.from_s).sum();
+    unjudged > crate::log::quality::MAX_NOT_JUDGED_FRACTION * q.duration_s.max(f64::MIN_POSITIVE)
 }

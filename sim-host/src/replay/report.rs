@@ -2,11 +2,10 @@
 //! analysis, the verdict, built by [`Replay::finish`].
 
 use super::isolation::{self, FaultCandidate, IsolationReport, SensorPhaseReport};
-use super::verdict::{self, findings, FindingReport};
+use super::verdict::{findings, glance, FindingReport};
 use super::{serialize_angle_source, CommissioningReport, Replay, UnbalanceBaseline};
 use crate::log::quality::DataQuality;
 use crate::log::Channels;
-use monitor_core::verdict::{FaultName, Glance, Named, Size};
 use monitor_core::{AngleSource, CommissioningState, Fault, MonitorOutput, Phase};
 use serde::{Serialize, Serializer};
 
@@ -153,44 +152,6 @@ pub const LOAD_MOVED_NOTE: &str =
 /// back into the commissioned range.
 pub const LOAD_BACK_NOTE: &str =
     "the load came back; the lamps that lit while it had moved are going out";
-
-/// The moment's evidence as the decision table reads it (the board's
-/// `monitor_core::verdict::Glance`): the lamps, the sensor flags, the isolation's name with
-/// its candidate's probability, its baseline, whether the operating point explains the
-/// lamps (`moved`), and the core's winding phase.
-fn glance(
-    out: &MonitorOutput,
-    report: Option<&(IsolationReport, Vec<FaultCandidate>)>,
-    moved: bool,
-) -> Glance {
-    let named = report.and_then(|(r, c)| match r.named {
-        Some(isolation::IsolationName::Fault(f)) => {
-            let cand = c.iter().find(|c| c.fault == f);
-            Some(Named {
-                fault: FaultName::Table1(f),
-                size: Size::Relative(cand.and_then(|c| c.change).or(r.named_change)?),
-                phase: cand.and_then(|c| c.phase),
-                confidence: cand.map_or(0.0, |c| c.probability),
-            })
-        }
-        _ => None,
-    });
-    let friction = report.is_some_and(|(r, _)| r.named == Some(isolation::IsolationName::Friction));
-    Glance {
-        lamps_lit: out.fault_detected,
-        sensor_fault: out.sensor_fault.any(),
-        named,
-        commissioned: report
-            .is_some_and(|(r, _)| r.baseline == isolation::IsolationBaseline::Learned),
-        moved: moved || friction,
-        winding: out.unbalance.suspect_phase.map(|p| Named {
-            fault: FaultName::ShortedTurns,
-            size: Size::OfPositiveSequence(out.unbalance.winding_ratio),
-            phase: Some(p),
-            confidence: out.unbalance.phase_confidence,
-        }),
-    }
-}
 
 /// One point of the diagnosis timeline.
 #[derive(Debug, Clone, Serialize)]
@@ -449,6 +410,33 @@ fn final_lamps(out: &MonitorOutput) -> std::collections::BTreeMap<String, bool> 
 }
 
 impl Replay {
+    /// The isolation's report at the end, with the candidates the report lists (the lamps'
+    /// own for a sensor's impossible reading): the moved point's sentence, one phase's
+    /// sensor from the zero sequence.
+    fn final_isolation(
+        &self,
+        out: &MonitorOutput,
+        unbalance: &UnbalanceReport,
+        detected: bool,
+        signature_candidates: &[FaultCandidate],
+    ) -> (IsolationReport, Vec<FaultCandidate>) {
+        let (mut isolation, mut isolated) = self.isolation.report(detected);
+        if let Some(note) = self.commission.moved_note(out) {
+            note_moved_point(&mut isolation, &note);
+        }
+        isolation::refine_single_phase(
+            &mut isolation,
+            &mut isolated,
+            unbalance.current_sensor_phase.as_ref(),
+            unbalance.voltage_sensor_phase.as_ref(),
+        );
+        if out.sensor_fault.any() {
+            (isolation, signature_candidates.to_vec())
+        } else {
+            (isolation, isolated)
+        }
+    }
+
     /// Ends the replay and builds the report (`data_quality` left at its default for the
     /// caller to fill).
     pub fn finish(mut self) -> DiagnoseReport {
@@ -462,36 +450,19 @@ impl Replay {
         let unbalance = self.unbalance_report();
         let signature_candidates = signature_candidates(&out);
         let detected = self.detected();
-        let (mut isolation, mut isolated) = self.isolation.report(detected);
-        if let Some(note) = self.commission.moved_note(&out) {
-            note_moved_point(&mut isolation, &note);
-        }
-        isolation::refine_single_phase(
-            &mut isolation,
-            &mut isolated,
-            unbalance.current_sensor_phase.as_ref(),
-            unbalance.voltage_sensor_phase.as_ref(),
-        );
-        let candidates = if out.sensor_fault.any() {
-            signature_candidates.clone()
-        } else {
-            isolated
-        };
+        let (isolation, candidates) =
+            self.final_isolation(&out, &unbalance, detected, &signature_candidates);
         let lamps = final_lamps(&out);
-        let residual = self.residual_finding(&findings::ResidualInputs {
-            out: &out,
-            isolation: &isolation,
-            candidates: &candidates,
-            detected,
-            skipped: &skipped,
-        });
-        let mut found = vec![
-            residual.clone(),
-            findings::winding_finding(&unbalance),
-            self.operating_point_finding(&out, &isolation),
-            self.parameter_fit_finding(&residual, &isolation),
-        ];
-        found.extend(findings::sensor_flag_finding(out.sensor_fault));
+        let found = self.findings(
+            &findings::ResidualInputs {
+                out: &out,
+                isolation: &isolation,
+                candidates: &candidates,
+                detected,
+                skipped: &skipped,
+            },
+            &unbalance,
+        );
         let mut report = DiagnoseReport {
             verdict: Verdict::CouldNotJudge,
             verdict_line: String::new(),
@@ -519,28 +490,6 @@ impl Replay {
         };
         report.conclude();
         report
-    }
-}
-
-impl DiagnoseReport {
-    /// Decides the verdict from the report's `findings` by the decision table
-    /// ([`super::verdict::conclude`]) and writes it into the verdict's keys. Call again
-    /// after adding or replacing a finding.
-    pub fn conclude(&mut self) {
-        let c = verdict::conclude(&self.findings);
-        self.verdict = c.verdict;
-        self.verdict_rule = c.rule;
-        self.verdict_line = c.line;
-        self.verdict_finding = c.finding;
-        self.judged = c.judged;
-        self.not_judged = c.not_judged;
-        self.verdict_withheld_because = c.withheld_because;
-    }
-
-    /// Replaces (or adds) the finding of its source and decides again.
-    pub fn put_finding(&mut self, f: FindingReport) {
-        verdict::put(&mut self.findings, f);
-        self.conclude();
     }
 }
 

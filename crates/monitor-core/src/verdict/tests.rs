@@ -4,7 +4,7 @@ use super::*;
 use crate::isolation::NOMINAL_UNCERTAINTY;
 
 fn named(
-    source: Source,
+    source: FindingSource,
     fault: FaultName,
     size: Size,
     confidence: f32,
@@ -12,7 +12,7 @@ fn named(
 ) -> Finding {
     Finding::new(
         source,
-        State::Named(Named {
+        State::Named(NamedFault {
             fault,
             size,
             phase: None,
@@ -24,7 +24,7 @@ fn named(
 
 fn rs(change: f32, confidence: f32, against: Against) -> Finding {
     named(
-        Source::Residuals,
+        FindingSource::Residuals,
         FaultName::Table1(Fault::Rs),
         Size::Relative(change),
         confidence,
@@ -34,17 +34,17 @@ fn rs(change: f32, confidence: f32, against: Against) -> Finding {
 
 fn turns(confidence: f32) -> Finding {
     Finding {
-        state: State::Named(Named {
+        state: State::Named(NamedFault {
             fault: FaultName::ShortedTurns,
             size: Size::OfPositiveSequence(0.12),
             phase: Some(Phase::C),
             confidence,
         }),
-        ..Finding::new(Source::Winding, State::NotJudged, Against::Nothing)
+        ..Finding::new(FindingSource::Winding, State::NotJudged, Against::Nothing)
     }
 }
 
-fn state(source: Source, state: State) -> Finding {
+fn state(source: FindingSource, state: State) -> Finding {
     Finding::new(source, state, Against::Commissioning)
 }
 
@@ -71,6 +71,20 @@ fn a_fault_needs_a_name_a_size_that_stands_clear_and_even_odds() {
 }
 
 #[test]
+fn the_friction_class_is_watched_never_a_fault() {
+    let friction = named(
+        FindingSource::Residuals,
+        FaultName::Friction,
+        Size::Relative(0.5),
+        1.0,
+        Against::Commissioning,
+    );
+    let d = decide(&[friction]);
+    assert_eq!((d.verdict, d.rule), (Verdict::Watching, Rule::Watching));
+    assert_eq!(FaultName::Friction.name(), "b/bl");
+}
+
+#[test]
 fn against_the_nominal_file_a_name_must_stand_clear_of_the_files_uncertainty() {
     let f = Against::ParameterFile;
     let within = NOMINAL_UNCERTAINTY - 0.01;
@@ -90,7 +104,7 @@ fn against_the_nominal_file_a_name_must_stand_clear_of_the_files_uncertainty() {
 fn the_rotor_is_a_fault_from_the_cracked_bar_band_on() {
     let bars = |db: f32, p: f32| {
         named(
-            Source::Rotor,
+            FindingSource::Rotor,
             FaultName::BrokenBars,
             Size::DbBelowLine(db),
             p,
@@ -107,14 +121,14 @@ fn the_rotor_is_a_fault_from_the_cracked_bar_band_on() {
 fn a_confident_name_wins_over_every_reason_not_to_judge() {
     // "could not judge" beside a finding at >= 0.5 would contradict the report.
     let others = [
-        state(Source::DataQuality, State::Unexplained),
+        state(FindingSource::DataQuality, State::Unexplained),
         Finding::new(
-            Source::ParameterFit,
+            FindingSource::ParameterFit,
             State::Unexplained,
             Against::ParameterFile,
         ),
-        state(Source::Residuals, State::NotJudged),
-        state(Source::OperatingPoint, State::OutOfRange),
+        state(FindingSource::Residuals, State::NotJudged),
+        state(FindingSource::OperatingPoint, State::OutOfRange),
     ];
     let mut findings = others.to_vec();
     findings.push(turns(0.7));
@@ -125,13 +139,13 @@ fn a_confident_name_wins_over_every_reason_not_to_judge() {
 #[test]
 fn bad_data_and_a_misfit_file_come_before_watching_and_healthy() {
     let weak = rs(0.2, 0.3, Against::Commissioning);
-    let data = state(Source::DataQuality, State::Unexplained);
+    let data = state(FindingSource::DataQuality, State::Unexplained);
     let file = Finding::new(
-        Source::ParameterFit,
+        FindingSource::ParameterFit,
         State::Unexplained,
         Against::ParameterFile,
     );
-    let clear = state(Source::Residuals, State::Clear);
+    let clear = state(FindingSource::Residuals, State::Clear);
     let d = decide(&[clear, weak, data]);
     assert_eq!(
         (d.verdict, d.rule),
@@ -149,15 +163,18 @@ fn bad_data_and_a_misfit_file_come_before_watching_and_healthy() {
 #[test]
 fn an_unexplained_change_is_watched_never_healthy() {
     let d = decide(&[
-        state(Source::Winding, State::Clear),
-        state(Source::Residuals, State::Unexplained),
+        state(FindingSource::Winding, State::Clear),
+        state(FindingSource::Residuals, State::Unexplained),
     ]);
     assert_eq!(
         (d.verdict, d.rule, d.by),
         (Verdict::Watching, Rule::Unexplained, Some(1))
     );
     // A weak name comes before an unexplained change (it says more).
-    let d = decide(&[state(Source::Residuals, State::Unexplained), turns(0.3)]);
+    let d = decide(&[
+        state(FindingSource::Residuals, State::Unexplained),
+        turns(0.3),
+    ]);
     assert_eq!(
         (d.verdict, d.rule, d.by),
         (Verdict::Watching, Rule::Watching, Some(1))
@@ -167,16 +184,16 @@ fn an_unexplained_change_is_watched_never_healthy() {
 #[test]
 fn lamps_outside_the_range_judged_are_not_judged_and_explained_lamps_are_healthy() {
     let d = decide(&[
-        state(Source::Residuals, State::OutOfRange),
-        state(Source::Winding, State::Clear),
+        state(FindingSource::Residuals, State::OutOfRange),
+        state(FindingSource::Winding, State::Clear),
     ]);
     assert_eq!(
         (d.verdict, d.rule),
         (Verdict::CouldNotJudge, Rule::OutOfRange)
     );
     let d = decide(&[
-        state(Source::Residuals, State::Explained),
-        state(Source::OperatingPoint, State::Explained),
+        state(FindingSource::Residuals, State::Explained),
+        state(FindingSource::OperatingPoint, State::Explained),
     ]);
     assert_eq!((d.verdict, d.rule), (Verdict::Healthy, Rule::Healthy));
 }
@@ -185,17 +202,33 @@ fn lamps_outside_the_range_judged_are_not_judged_and_explained_lamps_are_healthy
 fn healthy_needs_a_fault_analysis_that_was_judged() {
     // The conditions alone (data, file, operating point) judge no fault.
     let d = decide(&[
-        state(Source::DataQuality, State::Clear),
-        state(Source::OperatingPoint, State::Clear),
-        state(Source::Residuals, State::NotJudged),
+        state(FindingSource::DataQuality, State::Clear),
+        state(FindingSource::OperatingPoint, State::Clear),
+        state(FindingSource::Residuals, State::NotJudged),
     ]);
     assert_eq!(
         (d.verdict, d.rule),
         (Verdict::CouldNotJudge, Rule::NothingJudged)
     );
     assert_eq!(decide(&[]).rule, Rule::NothingJudged);
-    let d = decide(&[state(Source::Rotor, State::Clear)]);
+    let d = decide(&[state(FindingSource::Rotor, State::Clear)]);
     assert_eq!(d.verdict, Verdict::Healthy);
+    // A missing channel leaves the others to judge; an analysis the log kept from judging
+    // (the end unsettled with the residuals far off) leaves no verdict of healthy.
+    let clear_winding = state(FindingSource::Winding, State::Clear);
+    let d = decide(&[
+        clear_winding,
+        state(FindingSource::Residuals, State::Unavailable),
+    ]);
+    assert_eq!(d.verdict, Verdict::Healthy);
+    let d = decide(&[
+        clear_winding,
+        state(FindingSource::Residuals, State::NotJudged),
+    ]);
+    assert_eq!(
+        (d.verdict, d.rule),
+        (Verdict::CouldNotJudge, Rule::NothingJudged)
+    );
 }
 
 #[test]
@@ -217,12 +250,15 @@ fn the_verdict_does_not_depend_on_the_order_of_the_findings() {
         &[
             rs(0.5, 0.6, c),
             turns(0.8),
-            state(Source::DataQuality, State::Clear),
+            state(FindingSource::DataQuality, State::Clear),
         ],
-        &[state(Source::Residuals, State::Unexplained), turns(0.2)],
         &[
-            state(Source::OperatingPoint, State::OutOfRange),
-            state(Source::Rotor, State::Clear),
+            state(FindingSource::Residuals, State::Unexplained),
+            turns(0.2),
+        ],
+        &[
+            state(FindingSource::OperatingPoint, State::OutOfRange),
+            state(FindingSource::Rotor, State::Clear),
         ],
     ];
     for set in sets {
@@ -251,8 +287,8 @@ fn names_round_trip() {
     assert_eq!(FaultName::ShortedTurns.name(), "shorted_turns");
 }
 
-fn glance_rs(change: f32, p: f32) -> Option<Named> {
-    Some(Named {
+fn glance_rs(change: f32, p: f32) -> Option<NamedFault> {
+    Some(NamedFault {
         fault: FaultName::Table1(Fault::Rs),
         size: Size::Relative(change),
         phase: None,
@@ -274,7 +310,7 @@ fn a_glance_is_judged_by_the_same_table() {
         ..commissioned
     };
     assert_eq!(named.decide().verdict, Verdict::Fault);
-    // Named below the lamps' thresholds against a learned baseline: still a FAULT.
+    // NamedFault below the lamps' thresholds against a learned baseline: still a FAULT.
     let quiet = Glance {
         lamps_lit: false,
         ..named

@@ -2,12 +2,12 @@
 //! ([`super::FindingReport`]). Each says what it found and what it was judged against, or
 //! why it could not judge.
 
-use super::words::{fault_text, pct};
+use super::words::fault_text;
 use super::FindingReport;
 use crate::log::quality::{DataQuality, MAX_NOT_JUDGED_FRACTION};
 use crate::replay::isolation::{FaultCandidate, IsolationBaseline, IsolationName, IsolationReport};
 use crate::replay::{BaselineSource, Replay, UnbalanceReport, MIN_JUDGED_S};
-use monitor_core::verdict::{Against, FaultName, Named, Size, Source, State};
+use monitor_core::verdict::{Against, FaultName, FindingSource, NamedFault, Size, State};
 use monitor_core::{MonitorOutput, SensorFlags};
 
 /// What the residual finding is drawn from, besides the replay's own state: the final output,
@@ -26,11 +26,35 @@ pub(in crate::replay) struct ResidualInputs<'a> {
     pub skipped: &'a [String],
 }
 
-/// The isolation's baseline as the table reads it.
-fn isolation_against(iso: &IsolationReport) -> Against {
-    match iso.baseline {
-        IsolationBaseline::Learned => Against::Commissioning,
-        IsolationBaseline::Nominal => Against::ParameterFile,
+/// What the isolation names, as the verdict reads it: a Table 1 fault with its candidate's
+/// size, phase and probability, or (with the paper's viscous load) the friction class with
+/// Bl's size and the probability of B and Bl together; `None` when it names nothing.
+pub(in crate::replay) fn isolation_name(
+    iso: &IsolationReport,
+    candidates: &[FaultCandidate],
+) -> Option<NamedFault> {
+    let p = |f: monitor_core::Fault| {
+        candidates
+            .iter()
+            .find(|c| c.fault == f)
+            .map_or(0.0, |c| c.probability)
+    };
+    match iso.named? {
+        IsolationName::Fault(f) => {
+            let c = candidates.iter().find(|c| c.fault == f);
+            Some(NamedFault {
+                fault: FaultName::Table1(f),
+                size: Size::Relative(c.and_then(|c| c.change).or(iso.named_change)?),
+                phase: c.and_then(|c| c.phase),
+                confidence: p(f),
+            })
+        }
+        IsolationName::Friction => Some(NamedFault {
+            fault: FaultName::Friction,
+            size: Size::Relative(iso.named_change?),
+            phase: None,
+            confidence: (p(monitor_core::Fault::B) + p(monitor_core::Fault::Bl)).min(1.0),
+        }),
     }
 }
 
@@ -38,11 +62,21 @@ fn isolation_against(iso: &IsolationReport) -> Against {
 fn residual_brief(against: Against) -> String {
     format!(
         "residuals {}",
-        super::words::against_text(Source::Residuals, against)
+        super::words::against_text(FindingSource::Residuals, against)
     )
 }
 
 impl Replay {
+    /// What the residuals are judged against: commissioning where a window was learned (the
+    /// lamps' thresholds) or the isolation learned its baseline, else the parameter file.
+    fn residuals_against(&self, iso: &IsolationReport) -> Against {
+        if self.commission.learned() || iso.baseline == IsolationBaseline::Learned {
+            Against::Commissioning
+        } else {
+            Against::ParameterFile
+        }
+    }
+
     /// Why the residuals could not be judged at all, where they could not.
     fn residuals_not_judged(&self, inp: &ResidualInputs<'_>) -> Option<String> {
         if self.monitor.is_none() {
@@ -73,59 +107,42 @@ impl Replay {
 
     /// The residual lamps' and the isolation's finding.
     pub(in crate::replay) fn residual_finding(&self, inp: &ResidualInputs<'_>) -> FindingReport {
-        let against = isolation_against(inp.isolation);
+        let against = self.residuals_against(inp.isolation);
         let brief = residual_brief(against);
         let of = |state, summary: String| {
-            FindingReport::new(Source::Residuals, state, against, summary, brief.clone())
+            FindingReport::new(
+                FindingSource::Residuals,
+                state,
+                against,
+                summary,
+                brief.clone(),
+            )
         };
         if let Some(why) = self.residuals_not_judged(inp) {
+            // A log without the voltages or the speed lacks what they need; else the log
+            // kept them from judging.
+            let state = if self.monitor.is_none() {
+                State::Unavailable
+            } else {
+                State::NotJudged
+            };
             return FindingReport::new(
-                Source::Residuals,
-                State::NotJudged,
+                FindingSource::Residuals,
+                state,
                 against,
                 why.clone(),
                 format!("residuals: {why}"),
             );
         }
         let iso = inp.isolation;
-        if let (Some(IsolationName::Fault(f)), true) = (iso.named, inp.detected) {
-            let c = inp.candidates.iter().find(|c| c.fault == f);
-            let change = c.and_then(|c| c.change).or(iso.named_change);
-            let named = Named {
-                fault: FaultName::Table1(f),
-                size: Size::Relative(change.unwrap_or(f32::NAN)),
-                phase: c.and_then(|c| c.phase),
-                confidence: c.map_or(0.0, |c| c.probability),
-            };
+        if let Some(named) = isolation_name(iso, inp.candidates).filter(|_| inp.detected) {
             return of(State::Named(named), iso.verdict.clone());
         }
         let lit_end = inp.out.lamps.iter().any(|l| *l);
-        let ever_lit = self.first_detection.is_some() || lit_end;
-        if ever_lit && self.isolation.heating_explains_lamps() {
-            return of(State::Explained, iso.verdict.clone());
-        }
-        // The lamps' matching read only the load term: a load move, unless the isolation's
-        // steady-state equations find a change no single fault (nor the load) explains.
-        let lamps_read_load =
-            self.only_load_named() && iso.state != monitor_core::IsolationState::Unknown;
-        if ever_lit && (self.isolation.load_explains_lamps() || lamps_read_load) {
-            return of(
-                State::Explained,
-                format!(
-                    "the lamps lit for a load move (to the paper's model a load change is a Bl change): {}",
-                    iso.verdict
-                ),
-            );
-        }
-        if let Some(IsolationName::Friction) = iso.named {
-            return of(
-                State::Explained,
-                format!(
-                    "the friction class b/bl {}: to the paper's model a load change is a Bl change, an operating-point change, not a fault ({})",
-                    iso.named_change.map_or(String::new(), pct),
-                    iso.verdict
-                ),
-            );
+        if let Some((why, what)) = self.operating_point_explains(inp, lit_end) {
+            let mut f = of(State::Explained, why);
+            f.brief = format!("{brief} (the lamps lit for {what}, not a fault)");
+            return f;
         }
         if !inp.detected && !lit_end {
             return of(State::Clear, iso.verdict.clone());
@@ -140,6 +157,38 @@ impl Replay {
             );
         }
         of(State::Unexplained, iso.verdict.clone())
+    }
+
+    /// Why the lamps that lit are the operating point's (heating, a load move), where they
+    /// are: the sentence, and a short phrase
+    /// (`62 K of heating`); `lit_end` whether a lamp is lit at the end.
+    fn operating_point_explains(
+        &self,
+        inp: &ResidualInputs<'_>,
+        lit_end: bool,
+    ) -> Option<(String, String)> {
+        let iso = inp.isolation;
+        let ever_lit = self.first_detection.is_some() || lit_end;
+        if ever_lit && self.isolation.heating_explains_lamps() {
+            let rise = iso
+                .winding_rise_k
+                .map_or("heating".to_string(), |k| format!("{k:.0} K of heating"));
+            return Some((iso.verdict.clone(), rise));
+        }
+        // The lamps' matching read only the load term: a load move, unless the isolation's
+        // steady-state equations find a change no single fault (nor the load) explains.
+        let lamps_read_load =
+            self.only_load_named() && iso.state != monitor_core::IsolationState::Unknown;
+        if ever_lit && (self.isolation.load_explains_lamps() || lamps_read_load) {
+            return Some((
+                format!(
+                    "the lamps lit for a load move (to the paper's model a load change is a Bl change): {}",
+                    iso.verdict
+                ),
+                "a load move".to_string(),
+            ));
+        }
+        None
     }
 
     /// With the load an unknown input, the lamps' matching only ever named the friction
@@ -162,9 +211,15 @@ impl Replay {
     ) -> FindingReport {
         let brief = "parameter file".to_string();
         let of = |state, against, summary: String| {
-            FindingReport::new(Source::ParameterFit, state, against, summary, brief.clone())
+            FindingReport::new(
+                FindingSource::ParameterFit,
+                state,
+                against,
+                summary,
+                brief.clone(),
+            )
         };
-        if iso.baseline == IsolationBaseline::Learned {
+        if self.residuals_against(iso) == Against::Commissioning {
             return of(
                 State::Clear,
                 Against::Commissioning,
@@ -173,7 +228,7 @@ impl Replay {
         }
         if self.monitor.is_none() {
             return of(
-                State::NotJudged,
+                State::Unavailable,
                 Against::ParameterFile,
                 "the residuals against the file need the voltages and the speed".to_string(),
             );
@@ -187,21 +242,8 @@ impl Replay {
                 ),
             )
         };
-        match residual.finding.state {
-            State::Unexplained | State::OutOfRange => return misfit(iso.verdict.clone()),
-            State::Named(n) if !n.stands_clear(Against::ParameterFile) => {
-                return misfit(format!(
-                    "the nearest single fault, {}, is within the file's own uncertainty (+/-{:.0} %); a file 10-30 % off the machine, or windings 60 K warmer than the file assumes, move the residuals this much",
-                    fault_text(&n),
-                    100.0 * monitor_core::isolation::NOMINAL_UNCERTAINTY
-                ))
-            }
-            State::Named(_) => {}
-            _ => {
-                if let Some(why) = self.commission.nominal_misfit() {
-                    return misfit(why);
-                }
-            }
+        if let Some(why) = self.file_misfit(residual, iso) {
+            return misfit(why);
         }
         of(
             State::Clear,
@@ -209,6 +251,22 @@ impl Replay {
             "the residuals against the file's nominal values stay within their fixed thresholds"
                 .to_string(),
         )
+    }
+
+    /// Why the parameter file does not fit the log, judged against its nominal values from
+    /// the residual finding: a change no single fault explains, a name within the file's own
+    /// uncertainty, or the first quasi-steady point already past the fixed thresholds.
+    fn file_misfit(&self, residual: &FindingReport, iso: &IsolationReport) -> Option<String> {
+        match residual.finding.state {
+            State::Unexplained | State::OutOfRange => Some(iso.verdict.clone()),
+            State::Named(n) if !n.stands_clear(Against::ParameterFile) => Some(format!(
+                "the nearest single fault, {}, is within the file's own uncertainty (+/-{:.0} %); a file 10-30 % off the machine, or windings 60 K warmer than the file assumes, move the residuals this much",
+                fault_text(&n),
+                100.0 * monitor_core::isolation::NOMINAL_UNCERTAINTY
+            )),
+            State::Named(_) => None,
+            _ => self.commission.nominal_misfit(),
+        }
     }
 
     /// The operating point's finding: load moves and heating (they explain lamps; never a
@@ -219,10 +277,10 @@ impl Replay {
         iso: &IsolationReport,
     ) -> FindingReport {
         let brief = "operating point".to_string();
-        let against = isolation_against(iso);
+        let against = self.residuals_against(iso);
         let of = |state, summary: String| {
             FindingReport::new(
-                Source::OperatingPoint,
+                FindingSource::OperatingPoint,
                 state,
                 against,
                 summary,
@@ -231,7 +289,7 @@ impl Replay {
         };
         if self.monitor.is_none() {
             return of(
-                State::NotJudged,
+                State::Unavailable,
                 "the load and the heating need the voltages and the speed".to_string(),
             );
         }
@@ -262,14 +320,15 @@ impl Replay {
     }
 }
 
-/// The winding's finding from the negative-sequence report.
-pub(in crate::replay) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
+/// What the winding was judged against, and the brief phrase (`winding against 2 healthy
+/// runs`).
+fn winding_against(u: &UnbalanceReport) -> (Against, String) {
     let against = match u.baseline {
         Some(BaselineSource::File) => Against::HealthyRuns,
         Some(BaselineSource::Commissioning) => Against::Commissioning,
         None => Against::Nothing,
     };
-    let runs = if u.baseline_runs > 0 && against == Against::HealthyRuns {
+    let brief = if u.baseline_runs > 0 && against == Against::HealthyRuns {
         format!(
             "winding against {} healthy run{}",
             u.baseline_runs,
@@ -278,11 +337,23 @@ pub(in crate::replay) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
     } else {
         format!(
             "winding {}",
-            super::words::against_text(Source::Winding, against)
+            super::words::against_text(FindingSource::Winding, against)
         )
     };
+    (against, brief)
+}
+
+/// The winding's finding from the negative-sequence report.
+pub(in crate::replay) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
+    let (against, runs) = winding_against(u);
     let of = |state, summary: String| {
-        FindingReport::new(Source::Winding, state, against, summary, runs.clone())
+        FindingReport::new(
+            FindingSource::Winding,
+            state,
+            against,
+            summary,
+            runs.clone(),
+        )
     };
     let change = format!(
         "the negative sequence changed by {:.1} % of I1 (least change {:.1} %)",
@@ -290,7 +361,7 @@ pub(in crate::replay) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
         100.0 * u.least_change
     );
     if let Some(p) = u.suspect_phase {
-        let named = Named {
+        let named = NamedFault {
             fault: FaultName::ShortedTurns,
             size: Size::OfPositiveSequence(u.winding_ratio),
             phase: Some(p),
@@ -307,8 +378,8 @@ pub(in crate::replay) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
             .clone()
             .unwrap_or_else(|| "no steady stretch".to_string());
         return FindingReport::new(
-            Source::Winding,
-            State::NotJudged,
+            FindingSource::Winding,
+            State::Unavailable,
             against,
             why.clone(),
             format!("winding: {why}"),
@@ -332,7 +403,7 @@ pub(in crate::replay) fn data_quality_finding(
 ) -> FindingReport {
     let of = |state, summary: String| {
         FindingReport::new(
-            Source::DataQuality,
+            FindingSource::DataQuality,
             state,
             Against::Nothing,
             summary,
@@ -380,7 +451,7 @@ pub(in crate::replay) fn sensor_flag_finding(s: SensorFlags) -> Option<FindingRe
     .collect();
     (!which.is_empty()).then(|| {
         FindingReport::new(
-            Source::DataQuality,
+            FindingSource::DataQuality,
             State::Unexplained,
             Against::Nothing,
             format!(

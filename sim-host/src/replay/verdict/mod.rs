@@ -21,8 +21,8 @@ pub(super) mod findings;
 mod words;
 pub use words::{against_text, fault_text, pct};
 
-use monitor_core::verdict::{decide, Finding, Named, Size, State};
-pub use monitor_core::verdict::{Against, Rule, Source, Verdict};
+use monitor_core::verdict::{decide, Finding, NamedFault, Size, State};
+pub use monitor_core::verdict::{Against, FindingSource, Rule, Verdict};
 use monitor_core::Phase;
 use serde::{Serialize, Serializer};
 
@@ -44,7 +44,7 @@ impl FindingReport {
     /// A finding of `source` in `state` against `against`, with its sentence and its brief
     /// phrase.
     pub fn new(
-        source: Source,
+        source: FindingSource,
         state: State,
         against: Against,
         summary: String,
@@ -58,19 +58,21 @@ impl FindingReport {
     }
 
     /// Where it comes from.
-    pub fn source(&self) -> Source {
+    pub fn source(&self) -> FindingSource {
         self.finding.source
     }
 
     /// The named fault, where there is one.
-    pub fn named(&self) -> Option<&Named> {
+    pub fn named(&self) -> Option<&NamedFault> {
         self.finding.named()
     }
 
-    /// The state's name in the JSON: `not_judged`, `clear`, `named`, `unexplained`,
+    /// The state's name in the JSON: `unavailable` (the log lacks what the analysis
+    /// needs), `not_judged` (the log kept it from judging), `clear`, `named`, `unexplained`,
     /// `explained`, `out_of_range`.
     pub fn state_name(&self) -> &'static str {
         match self.finding.state {
+            State::Unavailable => "unavailable",
             State::NotJudged => "not_judged",
             State::Clear => "clear",
             State::Named(_) => "named",
@@ -87,7 +89,7 @@ impl FindingReport {
 /// `phase`, `confidence` (null without a name), `against`, `summary`.
 #[derive(Serialize)]
 struct FindingJson<'a> {
-    source: Source,
+    source: FindingSource,
     state: &'static str,
     fault: Option<&'static str>,
     size: Option<f32>,
@@ -181,6 +183,106 @@ pub fn put(findings: &mut Vec<FindingReport>, f: FindingReport) {
         Some(g) => *g = f,
         None => findings.push(f),
     }
+}
+
+use crate::replay::{DiagnoseReport, IsolationReport, Replay, UnbalanceReport};
+use monitor_core::verdict::{FaultName, Glance};
+use monitor_core::MonitorOutput;
+
+impl Replay {
+    /// Every analysis' finding at the end of the replay (the data quality's is added by the
+    /// caller that ran the data-quality stage, `diagnose`): the residuals, the winding, the
+    /// operating point, the parameter file's fit, and the sensors' impossible readings.
+    pub(in crate::replay) fn findings(
+        &self,
+        inp: &findings::ResidualInputs<'_>,
+        unbalance: &UnbalanceReport,
+    ) -> Vec<FindingReport> {
+        let residual = self.residual_finding(inp);
+        let mut found = vec![
+            residual.clone(),
+            findings::winding_finding(unbalance),
+            self.operating_point_finding(inp.out, inp.isolation),
+            self.parameter_fit_finding(&residual, inp.isolation),
+        ];
+        found.extend(findings::sensor_flag_finding(inp.out.sensor_fault));
+        found
+    }
+}
+
+impl DiagnoseReport {
+    /// Decides the verdict from the report's `findings` by the decision table
+    /// ([`conclude`]) and writes it into the verdict's keys. Call again
+    /// after adding or replacing a finding.
+    pub fn conclude(&mut self) {
+        let c = conclude(&self.findings);
+        self.verdict = c.verdict;
+        self.verdict_rule = c.rule;
+        self.verdict_line = c.line;
+        self.verdict_finding = c.finding;
+        self.judged = c.judged;
+        self.not_judged = c.not_judged;
+        self.verdict_withheld_because = c.withheld_because;
+    }
+
+    /// Data that cannot carry a verdict (`why`): every fault-judging finding that judged
+    /// something becomes "not judged", with what it would have said; decided again.
+    pub fn distrust(&mut self, why: &str) {
+        for f in &mut self.findings {
+            if f.source().judges_faults()
+                && f.finding.state != monitor_core::verdict::State::NotJudged
+            {
+                f.summary = format!("not judged ({why}); it read: {}", f.summary);
+                f.brief = format!("{}: {why}", f.source().name());
+                f.finding.state = monitor_core::verdict::State::NotJudged;
+            }
+        }
+        self.conclude();
+    }
+
+    /// Replaces (or adds) the finding of its source and decides again.
+    pub fn put_finding(&mut self, f: FindingReport) {
+        put(&mut self.findings, f);
+        self.conclude();
+    }
+}
+
+/// The moment's evidence as the decision table reads it (the board's
+/// `monitor_core::verdict::Glance`): the lamps, the sensor flags, the isolation's name with
+/// its candidate's probability, its baseline, whether the operating point explains the
+/// lamps (`moved`), and the core's winding phase.
+pub(in crate::replay) fn glance(
+    out: &MonitorOutput,
+    report: Option<&(IsolationReport, Vec<crate::replay::FaultCandidate>)>,
+    moved: bool,
+) -> Glance {
+    let named = report.and_then(|(r, c)| findings::isolation_name(r, c));
+    let friction =
+        report.is_some_and(|(r, _)| r.named == Some(crate::replay::IsolationName::Friction));
+    Glance {
+        lamps_lit: out.fault_detected,
+        sensor_fault: out.sensor_fault.any(),
+        named,
+        commissioned: report
+            .is_some_and(|(r, _)| r.baseline == crate::replay::IsolationBaseline::Learned),
+        moved: moved || friction,
+        // The core's winding phase counts where the lamps are judged (settled, quasi-steady):
+        // a start's or a step's transient unbalances the currents for a while.
+        winding: steady_phase(out).map(|p| NamedFault {
+            fault: FaultName::ShortedTurns,
+            size: Size::OfPositiveSequence(out.unbalance.winding_ratio),
+            phase: Some(p),
+            confidence: out.unbalance.phase_confidence,
+        }),
+    }
+}
+
+/// The core's winding phase at `out` where the lamps are judged (evaluating, quasi-steady),
+/// else `None`.
+fn steady_phase(out: &MonitorOutput) -> Option<Phase> {
+    out.unbalance
+        .suspect_phase
+        .filter(|_| out.evaluating && out.quasi_steady)
 }
 
 #[cfg(test)]

@@ -5,10 +5,16 @@ use super::*;
 use monitor_core::verdict::FaultName;
 use monitor_core::Fault;
 
-fn named(source: Source, fault: FaultName, size: Size, p: f32, against: Against) -> FindingReport {
+fn named(
+    source: FindingSource,
+    fault: FaultName,
+    size: Size,
+    p: f32,
+    against: Against,
+) -> FindingReport {
     FindingReport::new(
         source,
-        State::Named(Named {
+        State::Named(NamedFault {
             fault,
             size,
             phase: Some(Phase::C),
@@ -20,7 +26,7 @@ fn named(source: Source, fault: FaultName, size: Size, p: f32, against: Against)
     )
 }
 
-fn plain(source: Source, state: State, brief: &str) -> FindingReport {
+fn plain(source: FindingSource, state: State, brief: &str) -> FindingReport {
     FindingReport::new(
         source,
         state,
@@ -34,14 +40,14 @@ fn plain(source: Source, state: State, brief: &str) -> FindingReport {
 fn a_fault_line_names_the_fault_its_size_phase_and_confidence() {
     let f = [
         named(
-            Source::Winding,
+            FindingSource::Winding,
             FaultName::ShortedTurns,
             Size::OfPositiveSequence(0.125),
             0.72,
             Against::WithinLog,
         ),
         plain(
-            Source::Residuals,
+            FindingSource::Residuals,
             State::NotJudged,
             "residuals: need the voltages",
         ),
@@ -69,21 +75,25 @@ fn a_fault_line_names_the_fault_its_size_phase_and_confidence() {
 fn a_healthy_line_says_what_was_judged_and_what_was_not() {
     let f = [
         plain(
-            Source::Residuals,
+            FindingSource::Residuals,
             State::Clear,
             "residuals against commissioning",
         ),
         plain(
-            Source::Winding,
+            FindingSource::Winding,
             State::Clear,
             "winding against 2 healthy runs",
         ),
         plain(
-            Source::Rotor,
-            State::NotJudged,
+            FindingSource::Rotor,
+            State::Unavailable,
             "rotor: the slip is too small",
         ),
-        plain(Source::OperatingPoint, State::Clear, "operating point"),
+        plain(
+            FindingSource::OperatingPoint,
+            State::Clear,
+            "operating point",
+        ),
     ];
     let c = conclude(&f);
     assert_eq!(c.verdict, Verdict::Healthy);
@@ -96,7 +106,7 @@ fn a_healthy_line_says_what_was_judged_and_what_was_not() {
 #[test]
 fn a_watched_name_says_why_it_is_no_fault() {
     let f = [named(
-        Source::Residuals,
+        FindingSource::Residuals,
         FaultName::Table1(Fault::Rr),
         Size::Relative(0.03),
         0.9,
@@ -108,7 +118,7 @@ fn a_watched_name_says_why_it_is_no_fault() {
     assert!(c.line.contains("below the 5 %"), "{}", c.line);
     assert_eq!(c.withheld_because, vec!["residuals named".to_string()]);
     let weak = [named(
-        Source::Residuals,
+        FindingSource::Residuals,
         FaultName::Table1(Fault::Rr),
         Size::Relative(0.3),
         0.3,
@@ -125,9 +135,13 @@ fn a_watched_name_says_why_it_is_no_fault() {
 #[test]
 fn could_not_judge_gives_the_deciding_reason_and_other_names_are_listed() {
     let f = [
-        plain(Source::DataQuality, State::Unexplained, "data quality"),
+        plain(
+            FindingSource::DataQuality,
+            State::Unexplained,
+            "data quality",
+        ),
         named(
-            Source::Winding,
+            FindingSource::Winding,
             FaultName::ShortedTurns,
             Size::OfPositiveSequence(0.05),
             0.2,
@@ -140,14 +154,14 @@ fn could_not_judge_gives_the_deciding_reason_and_other_names_are_listed() {
     // A FAULT lists the others that were named.
     let f = [
         named(
-            Source::Residuals,
+            FindingSource::Residuals,
             FaultName::Table1(Fault::Rs),
             Size::Relative(0.5),
             0.95,
             Against::Commissioning,
         ),
         named(
-            Source::Winding,
+            FindingSource::Winding,
             FaultName::ShortedTurns,
             Size::OfPositiveSequence(0.05),
             0.2,
@@ -166,7 +180,7 @@ fn could_not_judge_gives_the_deciding_reason_and_other_names_are_listed() {
 #[test]
 fn findings_serialise_with_their_name_size_unit_and_confidence() {
     let f = named(
-        Source::Rotor,
+        FindingSource::Rotor,
         FaultName::BrokenBars,
         Size::DbBelowLine(41.0),
         0.8,
@@ -179,7 +193,7 @@ fn findings_serialise_with_their_name_size_unit_and_confidence() {
     assert_eq!(v["size_unit"], "db_below_line");
     assert_eq!(v["size"], 41.0);
     assert_eq!(v["against"], "nothing");
-    let p = plain(Source::Residuals, State::OutOfRange, "x");
+    let p = plain(FindingSource::Residuals, State::OutOfRange, "x");
     let v = serde_json::to_value(&p).expect("serialises"); // ok: test
     assert_eq!(v["state"], "out_of_range");
     assert!(v["fault"].is_null() && v["confidence"].is_null());
@@ -187,9 +201,12 @@ fn findings_serialise_with_their_name_size_unit_and_confidence() {
 
 #[test]
 fn put_replaces_the_finding_of_a_source() {
-    let mut f = vec![plain(Source::Residuals, State::Clear, "a")];
-    put(&mut f, plain(Source::DataQuality, State::Clear, "b"));
-    put(&mut f, plain(Source::Residuals, State::Unexplained, "c"));
+    let mut f = vec![plain(FindingSource::Residuals, State::Clear, "a")];
+    put(&mut f, plain(FindingSource::DataQuality, State::Clear, "b"));
+    put(
+        &mut f,
+        plain(FindingSource::Residuals, State::Unexplained, "c"),
+    );
     assert_eq!(f.len(), 2);
     assert_eq!(f[0].brief, "c");
 }

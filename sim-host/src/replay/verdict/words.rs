@@ -3,14 +3,15 @@
 use super::FindingReport;
 use monitor_core::isolation::{MIN_FAULT_CHANGE, NOMINAL_UNCERTAINTY};
 use monitor_core::verdict::{
-    Against, Decision, FaultName, Named, Rule, Size, Source, State, Verdict, FAULT_CONFIDENCE,
+    Against, Decision, FaultName, FindingSource, NamedFault, Rule, Size, State, Verdict,
+    FAULT_CONFIDENCE,
 };
 
 /// The fault-judging findings that were judged, as their brief phrases.
 pub(super) fn judged(findings: &[FindingReport]) -> Vec<String> {
     findings
         .iter()
-        .filter(|f| f.source().judges_faults() && !matches!(f.finding.state, State::NotJudged))
+        .filter(|f| f.source().judges_faults() && !not_judged_state(&f.finding.state))
         .map(|f| f.brief.clone())
         .collect()
 }
@@ -19,9 +20,14 @@ pub(super) fn judged(findings: &[FindingReport]) -> Vec<String> {
 pub(super) fn not_judged(findings: &[FindingReport]) -> Vec<String> {
     findings
         .iter()
-        .filter(|f| f.source().judges_faults() && matches!(f.finding.state, State::NotJudged))
+        .filter(|f| f.source().judges_faults() && not_judged_state(&f.finding.state))
         .map(|f| f.brief.clone())
         .collect()
+}
+
+/// A state that judged nothing: not judged, or unavailable.
+fn not_judged_state(s: &State) -> bool {
+    matches!(s, State::NotJudged | State::Unavailable)
 }
 
 /// A relative change as the reports print it: `+50 %`, to a tenth of a per cent under 10 %.
@@ -33,7 +39,7 @@ pub fn pct(x: f32) -> String {
 /// The fault of `n` with its size and phase: `rs +50 %`, `current_sensor +20 % (phase b)`,
 /// `shorted turns in phase c: the negative sequence changed by 12.5 % of I1`, `broken rotor
 /// bars: the (1 - 2s) f sideband 41.0 dB below the supply line`.
-pub fn fault_text(n: &Named) -> String {
+pub fn fault_text(n: &NamedFault) -> String {
     let phase = n.phase.map(|p| p.name());
     match (n.fault, n.size) {
         (FaultName::ShortedTurns, size) => {
@@ -50,6 +56,7 @@ pub fn fault_text(n: &Named) -> String {
             }
         }
         (FaultName::BrokenBars, size) => format!("broken rotor bars: {}", size_text(size)),
+        (FaultName::Friction, size) => format!("b/bl {}", size_text(size)),
         (FaultName::Table1(f), size) => {
             let p = phase.map_or(String::new(), |p| format!(" (phase {p})"));
             format!("{} {}{p}", f.name(), size_text(size))
@@ -70,20 +77,20 @@ fn size_text(size: Size) -> String {
 }
 
 /// What a finding of `source` was judged against, in words.
-pub fn against_text(source: Source, a: Against) -> &'static str {
+pub fn against_text(source: FindingSource, a: Against) -> &'static str {
     match (a, source) {
         (Against::Commissioning, _) => "against commissioning",
         (Against::HealthyRuns, _) => "against healthy runs",
         (Against::WithinLog, _) => "against a healthy stretch of the same log",
         (Against::ParameterFile, _) => "against the parameter file",
-        (Against::Nothing, Source::Winding) => "against a healthy machine's own asymmetry",
-        (Against::Nothing, Source::Rotor) => "against the MCSA severity bands",
+        (Against::Nothing, FindingSource::Winding) => "against a healthy machine's own asymmetry",
+        (Against::Nothing, FindingSource::Rotor) => "against the MCSA severity bands",
         (Against::Nothing, _) => "against physics alone",
     }
 }
 
 /// Why a name is watched rather than a FAULT.
-fn why_watched(n: &Named, against: Against) -> String {
+fn why_watched(n: &NamedFault, against: Against) -> String {
     if !(n.confidence >= FAULT_CONFIDENCE) {
         return format!(
             "confidence {:.2}, below the {FAULT_CONFIDENCE:.2} a FAULT needs",
@@ -91,6 +98,10 @@ fn why_watched(n: &Named, against: Against) -> String {
         );
     }
     match n.size {
+        _ if n.fault == FaultName::Friction => format!(
+            "confidence {:.2}; the friction class: a load change moves it as a bearing's friction would, so it is watched, never a FAULT",
+            n.confidence
+        ),
         Size::Relative(_) if against == Against::ParameterFile => format!(
             "confidence {:.2}; within the parameter file's own uncertainty (+/-{:.0} %): commission to judge a change this small",
             n.confidence,
