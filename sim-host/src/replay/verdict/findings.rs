@@ -136,7 +136,18 @@ impl Replay {
         }
         let iso = inp.isolation;
         if let Some(named) = isolation_name(iso, inp.candidates).filter(|_| inp.detected) {
-            return of(State::Named(named), iso.verdict.clone());
+            // Against the file's nominal values a name within the file's own uncertainty is
+            // no name: the change is the file's as much as a fault's (the parameter fit
+            // says so).
+            let in_file_error = against == Against::ParameterFile
+                && matches!(named.fault, FaultName::Table1(_))
+                && !named.stands_clear(against);
+            let state = if in_file_error {
+                State::Unexplained
+            } else {
+                State::Named(named)
+            };
+            return of(state, iso.verdict.clone());
         }
         let lit_end = inp.out.lamps.iter().any(|l| *l);
         if let Some((why, what)) = self.operating_point_explains(inp, lit_end) {
@@ -257,13 +268,23 @@ impl Replay {
     /// the residual finding: a change no single fault explains, a name within the file's own
     /// uncertainty, or the first quasi-steady point already past the fixed thresholds.
     fn file_misfit(&self, residual: &FindingReport, iso: &IsolationReport) -> Option<String> {
-        match residual.finding.state {
-            State::Unexplained | State::OutOfRange => Some(iso.verdict.clone()),
-            State::Named(n) if !n.stands_clear(Against::ParameterFile) => Some(format!(
-                "the nearest single fault, {}, is within the file's own uncertainty (+/-{:.0} %); a file 10-30 % off the machine, or windings 60 K warmer than the file assumes, move the residuals this much",
-                fault_text(&n),
+        let within = |what: String| {
+            format!(
+                "the nearest single fault, {what}, is within the file's own uncertainty (+/-{:.0} %); a file 10-30 % off the machine, or windings 60 K warmer than the file assumes, move the residuals this much",
                 100.0 * monitor_core::isolation::NOMINAL_UNCERTAINTY
-            )),
+            )
+        };
+        match residual.finding.state {
+            State::Unexplained => Some(match (iso.named, iso.named_change) {
+                (Some(IsolationName::Fault(f)), Some(c)) => {
+                    within(format!("{} {}", f.name(), super::words::pct(c)))
+                }
+                _ => iso.verdict.clone(),
+            }),
+            State::OutOfRange => Some(iso.verdict.clone()),
+            State::Named(n) if !n.stands_clear(Against::ParameterFile) => {
+                Some(within(fault_text(&n)))
+            }
             State::Named(_) => None,
             _ => self.commission.nominal_misfit(),
         }
