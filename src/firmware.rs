@@ -507,7 +507,7 @@ fn check_reference(supervisor: &mut Supervisor, now_ms: u32) {
 /// counters, the operating point, the gate, the threshold bands, the isolation (the
 /// fault named, its size and probability: `app::isolation_summary`) and the winding
 /// temperature rise the isolation tracks since commissioning (`rise_k` [K]); `panel`: the
-/// panel's mode and the one rule's call on the lamps (`app::panel_call`). Its format is
+/// panel's mode and the one verdict on the lamps (`app::panel_call`). Its format is
 /// documented once, in docs/firmware.md ("The status line"); `sim-host hmi --stdin` parses it
 /// (`sim_host::hmi::status_line`), and `tests/status_line.rs` renders this format string
 /// and parses it back, so the two cannot drift apart. `supply`: the latest VDDA [V] (0

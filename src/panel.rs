@@ -43,7 +43,7 @@
 //!
 //! | pattern | meaning |
 //! |---|---|
-//! | off | no FAULT: nothing detected, the "operating point moved" state (above), or a detection the one rule for a FAULT does not call one (`app::panel_call`, `monitor_core::isolation::fault_call`: a named fault under 5 % is watched; not commissioned, lamps with no name beyond the file's +-30 % are not judged); the residual lamps still show the core's lamps, the status line's `call=` says which |
+//! | off | no FAULT: nothing detected, the "operating point moved" state (above), or a detection the one verdict does not call a FAULT (`app::panel_call`, the core's decision table `monitor_core::verdict`: a name below 0.5 probability, under 5 % or the friction class is watched; lamps with nothing named are watched; not commissioned, lamps with no name beyond the file's +-30 % are not judged); the residual lamps still show the core's lamps, the status line's `call=` says which |
 //! | steady on | input invalid: ADC saturated or a sensor fault flagged by the core, no isolation |
 //! | N blinks (250 ms on / 250 ms off), then 1.5 s dark, repeating | fault detected, blink code N (table below) |
 //! | 10 Hz flicker | the last commissioning failed (no progress, unusable statistics or not stored) and no fault is shown; the RUN lamp says which thresholds are in force; press the button to retry |
@@ -54,33 +54,27 @@
 //!
 //! | N | 1 | 2 | 3 | 4 | 5 | 6 | 7 | 8 | 9 | 10 | 11 | 12 | 13 |
 //! |---|---|---|---|---|---|---|---|---|---|---|---|---|---|
-//! | fault | Rs | Rr | Ls | Lr | friction B/Bl | (Bl: not used, shown as 5) | current sensor | voltage sensor | speed sensor | detected, **not named** | shorted turns, phase a | phase b | phase c |
+//! | fault | Rs | Rr | Ls | Lr | (friction B/Bl: not used, watched) | (Bl: not used) | current sensor | voltage sensor | speed sensor | (not used: a FAULT always names its fault) | shorted turns, phase a | phase b | phase c |
 //!
 //! Codes 11-13 name the phase of shorted turns (the core's negative-sequence analysis,
 //! `monitor_core::sequence`: the supply's own unbalance taken out with the measured
-//! voltages, the phase from the angle of the rest against the power-factor angle). They
-//! show only while no other fault is detected, and only for a winding part above a healthy
-//! machine's own asymmetry (3 % of I2/I1; the board keeps no healthy baseline of it). The
-//! status line gives the phase and the size (`wind=b wind_i2=0.041`).
+//! voltages, the phase from the angle of the rest against the power-factor angle), for a
+//! winding part above a healthy machine's own asymmetry (3 % of I2/I1; the board keeps no
+//! healthy baseline of it) at a confidence of 0.5 or more, while the lamps are judged (a
+//! start or a step unbalances the currents for a while). The status line gives the phase and
+//! the size (`wind=b wind_i2=0.041`).
 //!
-//! B and Bl cannot be separated at any operating point (they scale the same load term), so
-//! the friction class blinks 5. Code 10 means the lamps or the isolation saw a fault that
-//! the isolation could not name: an unknown fault (no fault's direction fits), or no
-//! steady half second yet since the change. The defmt status line gives the size
-//! (`iso=rr(+0.48)`) and the paper's lamp-pattern candidates.
-//!
-//! The FAULT lamp blinks for a FAULT of the one rule: when the core's lamps detect a fault,
-//! and also when the isolation names a fault (not the friction class, which a load change is
-//! to the paper's model) while the learned baseline of a commissioning run is in force
-//! (below the lamps' thresholds the isolation's three equations can still be outside their
-//! healthy spread), unless the name is under 5 % (watched) or, not commissioned, nothing is
-//! named beyond the parameter file's +-30 % (not judged).
+//! The FAULT lamp blinks for the one verdict's FAULT (`app::panel_call`, the core's decision
+//! table): a named fault (the isolation's, or shorted turns) with its size, at a probability
+//! of 0.5 or more, 5 % or more against the commissioned baseline or beyond the file's +-30 %
+//! against the nominal values. B and Bl cannot be separated at any operating point (they
+//! scale the same load term) and a load change moves them as much: the friction class is
+//! watched, never a FAULT (the amber state, above). The lamps' own detection with nothing
+//! named is watched too, so code 10 is no longer shown. The defmt status line gives the
+//! isolation's name and size (`iso=rr(+0.48)`) and the paper's lamp-pattern candidates.
 //! The isolation's baseline is learned by a commissioning run and stored in the flash
-//! record beside the lamps' thresholds (record version 2; restored at boot): without one
-//! (never commissioned, or a version 1 record) the blink code is the lamps' top candidate
-//! in `Fault::ALL` order, as before the isolation, or, not commissioned, the fault named
-//! beyond the file's +-30 % that made the FAULT; otherwise the isolation is only printed on
-//! the status line.
+//! record beside the lamps' thresholds (record version 2; restored at boot); without one
+//! (never commissioned, or a version 1 record) the sizes are against the nominal values.
 
 pub use crate::board::Lamp;
 

@@ -226,9 +226,9 @@ impl Snapshot {
     /// the replay's isolation and its panel ([`Replay::panel`], the demo's and `diagnose`'s
     /// timeline too): the amber state where the load or the voltage has left the
     /// commissioned range ([`Replay::operating_point_moved`]) and neither the isolation nor
-    /// a sensor check names a fault, and the FAULT lamp by the one rule (off in the amber
-    /// state, while watching, and against the nominal values for a name within the file's
-    /// uncertainty; the residual lamps show what they show).
+    /// a sensor check names a fault, and the FAULT lamp by the one verdict's table (off in
+    /// the amber state, while watching, and against the nominal values for a name within the
+    /// file's uncertainty; the residual lamps show what they show).
     pub fn from_replay(t_s: f64, out: &MonitorOutput, replay: &Replay, params: &ParamFile) -> Self {
         let learned = replay.calibration().is_some();
         let mut s = Snapshot::from_output(t_s, out, replay.threshold_bands(), learned, params);

@@ -193,7 +193,7 @@ struct Concluded {
 /// How far a parameter file's values may be off the machine's (nameplate estimates are
 /// 10-30 % off): against the nominal parameters (no commissioning), a change this small or
 /// smaller, with every lamp dark, is the file's own error as much as a fault, and is not
-/// named; with lamps lit it is no FAULT (the one rule, `monitor_core::isolation::fault_call`).
+/// named; with lamps lit it is no FAULT (the one verdict's table, `monitor_core::verdict`).
 /// The core's constant, re-exported.
 pub use monitor_core::isolation::NOMINAL_UNCERTAINTY;
 

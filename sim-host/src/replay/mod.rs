@@ -99,10 +99,11 @@ pub const BASELINE_I1_TOLERANCE: f32 = 0.1;
 /// judge" with how much was judged. One rule for `diagnose`, the HMI's log replay and the
 /// demo (all report through [`Replay::finish`]).
 pub const MIN_JUDGED_S: f64 = 1.0;
-/// The least relative change of a named fault for the verdict `fault`: the core's one rule
-/// ([`monitor_core::isolation::MIN_FAULT_CHANGE`], 5 %), shared by `diagnose`, the HMI's log
-/// replay, the demo ([`Replay::finish`]) and the board's FAULT lamp. Below it the verdict is
-/// `watching`, with the name and its size.
+/// The least relative change of a named fault for the verdict `fault`: the core's
+/// ([`monitor_core::isolation::MIN_FAULT_CHANGE`], 5 %), read by the one verdict's decision
+/// table (`monitor_core::verdict`) for `diagnose`, the HMI's log replay, the demo
+/// ([`Replay::finish`]) and the board's FAULT lamp. Below it the verdict is `watching`, with
+/// the name and its size.
 pub const MIN_FAULT_CHANGE: f32 = monitor_core::isolation::MIN_FAULT_CHANGE;
 
 /// Errors from setting up or running a replay.
