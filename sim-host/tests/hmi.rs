@@ -111,6 +111,53 @@ fn live_simulation_commissions_and_a_key_injects_a_fault() {
     assert_eq!(s.lamps, [false; 4], "{:?} {:?}", s.residuals, s.state);
 }
 
+/// A load step of 10-40 % on the commissioned live motor is the amber MOVED state or
+/// healthy, never a FAULT (it used to turn red `FAULT b/bl +10 %` while `diagnose` called the
+/// same step healthy): every reading after the step, by the one verdict's table.
+#[test]
+fn a_load_step_of_10_to_40_percent_is_never_a_fault_on_the_live_screen() {
+    for steps in [1usize, 4] {
+        let mut live = LiveSim::demo_motor().expect("reference motor");
+        let mut state = live.initial_state();
+        run(&mut live, &mut state, 1.5);
+        assert!(live.key(Key::Char('c'), &mut state));
+        run(&mut live, &mut state, 4.5);
+        assert!(state.latest.as_ref().is_some_and(|s| s.learned));
+        for _ in 0..steps {
+            live.key(Key::Char('+'), &mut state);
+        }
+        let mut seen = Vec::new();
+        for _ in 0..24 {
+            live.advance(0.25, &mut state);
+            let s = state.latest.clone().expect("readings");
+            let (word, _) = sim_host::hmi::lamp_and_header(
+                &s.state,
+                s.fault_lamp,
+                s.call,
+                &[],
+                s.isolation.as_ref(),
+            );
+            seen.push((word, s.call));
+            assert!(
+                !s.fault_lamp && word != "FAULT",
+                "+{} %: {word} {:?} {:?}",
+                10 * steps,
+                s.call,
+                s.state
+            );
+        }
+        eprintln!("+{} %: {seen:?}", 10 * steps);
+        // Settled on the new load: the amber state (or healthy once the lamps are out),
+        // neither FAULT nor WATCHING.
+        let settled = &seen[seen.len() - 8..];
+        assert!(
+            settled.iter().all(|(w, _)| w.is_empty() || *w == "MOVED"),
+            "+{} %: {settled:?}",
+            10 * steps
+        );
+    }
+}
+
 #[test]
 fn live_simulation_steps_the_load_and_the_supply() {
     let mut live = LiveSim::demo_motor().expect("reference motor");

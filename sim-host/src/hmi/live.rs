@@ -90,8 +90,10 @@ impl LiveSim {
         // live run has no end), commissioning starts on the `c` key.
         let opts = ReplayOptions {
             timeline_step_s: f64::INFINITY,
-            // The demo's scenario, live: the paper's fixed viscous load.
-            load: crate::replay::LoadModel::Viscous,
+            // The load is an unknown input, as `diagnose` reads it by default: a load step
+            // (`+`, `-`, the paper's Bl switch) is the load's move, the amber state, never a
+            // FAULT (the simulated load itself is the paper's viscous one).
+            load: crate::replay::LoadModel::Unknown,
             ..ReplayOptions::default()
         };
         let channels = crate::sim::SensorSpec::default().channels();
