@@ -32,16 +32,20 @@ impl PanelIsolation<'_> {
 
 /// The moment's evidence as the decision table reads it (`monitor_core::verdict::Glance`):
 /// the core's lamps, its sensor flags, the isolation's name (a Table 1 fault with its size
-/// and probability; the friction class is the load's move to the paper's model, and makes
-/// the operating point "moved"), whether the learned thresholds are in force, the range
-/// watch's "moved", and shorted turns with the core's phase confidence.
+/// and probability), whether the learned thresholds are in force, the range watch's "moved",
+/// and shorted turns with the core's phase confidence. The board knows no load model: as the
+/// host's `diagnose` by default, it reads the load as an unknown input, so the friction
+/// class is the load's move (the operating point "moved"), not a name.
 pub fn panel_glance(status: &MonitorStatus, isolation: PanelIsolation<'_>) -> Glance {
     let named = isolation.named(status.commissioned);
     let friction = matches!(named, Some(Named::Friction { .. }));
     Glance {
         lamps_lit: status.fault_detected,
         sensor_fault: status.sensor_fault.any(),
-        named: named.as_ref().map(Name::of_isolation),
+        named: named
+            .filter(|_| !friction)
+            .as_ref()
+            .map(Name::of_isolation),
         commissioned: status.commissioned,
         moved: status.moved || friction,
         // Shorted turns count where the lamps are judged (a start's or a step's transient

@@ -21,6 +21,7 @@ mod isolation;
 mod liveness;
 mod moved;
 mod recovery;
+mod same_state;
 mod startup;
 
 use drive_monitor::app::{
