@@ -242,7 +242,7 @@ impl FleetRow {
         let (fault, size, phase, confidence) = match named {
             Some(n) => (
                 Some(n.fault.name().to_string()),
-                Some(short(sim_host_size(n.size))),
+                Some(short(crate::replay::verdict::size_parts(n.size).0)),
                 n.phase.map(|p| p.name().to_string()),
                 Some(short(n.confidence)),
             ),
@@ -368,9 +368,4 @@ mod tests {
             assert!(e.to_string().starts_with("bad motor table t.toml"), "{e}");
         }
     }
-}
-
-/// A size's value as the fleet row gives it.
-fn sim_host_size(size: monitor_core::verdict::Size) -> f32 {
-    crate::replay::verdict::size_parts(size).0
 }

@@ -42,10 +42,7 @@ pub fn panel_glance(status: &MonitorStatus, isolation: PanelIsolation<'_>) -> Gl
     Glance {
         lamps_lit: status.fault_detected,
         sensor_fault: status.sensor_fault.any(),
-        named: named
-            .filter(|_| !friction)
-            .as_ref()
-            .map(Name::of_isolation),
+        named: named.filter(|_| !friction).as_ref().map(Name::of_isolation),
         commissioned: status.commissioned,
         moved: status.moved || friction,
         // Shorted turns count where the lamps are judged (a start's or a step's transient

@@ -91,7 +91,11 @@ pub fn against_text(source: FindingSource, a: Against) -> &'static str {
 
 /// Why a name is watched rather than a FAULT.
 fn why_watched(n: &NamedFault, against: Against) -> String {
-    if !(n.confidence >= FAULT_CONFIDENCE) {
+    // (A confidence that is not a number is below it.)
+    if n.confidence
+        .partial_cmp(&FAULT_CONFIDENCE)
+        .is_none_or(|o| o.is_lt())
+    {
         return format!(
             "confidence {:.2}, below the {FAULT_CONFIDENCE:.2} a FAULT needs",
             n.confidence
