@@ -12,9 +12,9 @@
 //! Franceschini, Tassoni, Kliman, IEEE Trans. Ind. Appl. 37(5), 2001). It is an
 //! approximation: it takes the broken bars' current as redistributed over the healthy
 //! bars of one rotor pole pitch, and ignores inter-bar currents (which make real
-//! sidebands smaller) and the end-ring resistance. The formula lives with the machine model
-//! the simulator integrates (`crate::sim`'s machine, `delta_of_broken_bars` and its
-//! inverse `broken_bars_of_delta`); the analysis only reads it.
+//! sidebands smaller) and the end-ring resistance. The formula lives in the core
+//! (`monitor_core::rotor_cage`, shared with the simulator and `diagnose`'s rotor finding);
+//! the analysis only reads it.
 //!
 //! # MCSA resolution
 //! The sidebands lie 2 s f from the fundamental (3.6 Hz for the 3 hp motor at 3 % slip),
@@ -58,7 +58,7 @@
 //! `rotor_asymmetry` only when the two agree ([`fit_and_spectrum_agree`]).
 
 use super::prep::Prepared;
-use crate::sim::machine::broken_bars_of_delta;
+use monitor_core::rotor_cage::{broken_bars_of_delta, delta_of_sideband_ratio};
 use rustfft::num_complex::Complex;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -89,7 +89,10 @@ pub const AGREE_FACTOR: f64 = 2.0;
 pub fn spectral_delta(lower_db: f64, upper_db: f64, q_share: f64) -> Option<f64> {
     let lin = |db: f64| 10f64.powf(db / 20.0);
     let r = (lin(lower_db) + lin(upper_db)) / q_share;
-    (q_share > 0.0 && r.is_finite() && r < 1.0).then(|| 3.0 * r / (1.0 - r))
+    if !(q_share > 0.0) {
+        return None;
+    }
+    delta_of_sideband_ratio(r)
 }
 
 /// True when the spectrum's delta and the fit's agree within [`AGREE_FACTOR`] of each
