@@ -318,6 +318,8 @@ pub struct DiagnoseReport {
     pub first_detection_s: Option<f64>,
     /// Negative-sequence analysis of the currents.
     pub unbalance: UnbalanceReport,
+    /// The rotor: broken bars from the current's sidebands (`super::rotor`).
+    pub rotor: super::RotorReport,
     /// Faults ever named while the lamps were lit, with the time first named.
     pub detections: Vec<Detection>,
     /// Analyses skipped for lack of a column, with the reason.
@@ -422,11 +424,7 @@ impl Replay {
     /// caller to fill).
     pub fn finish(mut self) -> DiagnoseReport {
         let out = self.output();
-        if self.seq_front.finish() {
-            self.book.take(&mut self.seq_front);
-            self.book
-                .close(self.monitor.as_ref().map(|_| out.operating.wr_rad_s));
-        }
+        self.close_sequences(&out);
         let skipped = skipped_analyses(self.channels);
         let unbalance = self.unbalance_report();
         let signature_candidates = signature_candidates(&out);
@@ -469,6 +467,7 @@ impl Replay {
             signature_candidates,
             first_detection_s: self.first_detection,
             unbalance,
+            rotor: super::rotor::rotor_report(self.seq_front.rotor(), &self.params),
             detections: self.detections,
             skipped,
             angle_source: self.opts.angle_source,
@@ -478,6 +477,16 @@ impl Replay {
             rows: self.rows,
             max_abs_residual: self.max_abs,
             timeline: self.timeline,
+        }
+    }
+
+    /// Closes the sequence analysis' last window (the front's, then the book's, with the
+    /// monitor's speed in `out`).
+    fn close_sequences(&mut self, out: &MonitorOutput) {
+        if self.seq_front.finish() {
+            self.book.take(&mut self.seq_front);
+            self.book
+                .close(self.monitor.as_ref().map(|_| out.operating.wr_rad_s));
         }
     }
 

@@ -105,7 +105,7 @@ fn named_fault(rep: &DiagnoseReport) -> String {
     format!(" {}{size}{phase}", f.name())
 }
 
-/// `diagnose`'s timeline, lamps, candidates and unbalance.
+/// `diagnose`'s timeline, lamps, candidates, unbalance and rotor.
 pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
     let rep = &d.report;
     let mut out = crate::cli::stdout();
@@ -128,6 +128,8 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
         events(&mut out, &rep.isolation)?;
     }
     unbalance(&mut out, &rep.unbalance)?;
+    // The rotor's finding or why there is none, in one line ("rotor: ...").
+    writeln!(out, "{}", rep.rotor.sentence)?;
     for n in &rep.commissioning.outside_range {
         writeln!(out, "note at {:.2} s: {}", n.t_s, n.note)?;
     }
