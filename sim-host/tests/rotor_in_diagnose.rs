@@ -474,3 +474,75 @@ fn what_is_missing_is_said() {
         r.sentence
     );
 }
+
+/// A record of `which` at 70 % of its rated torque with `broken` bars, the load stepping to
+/// the rated torque `step_at_s` into the record; voltages, currents, speed at 5 kHz.
+fn record_with_step(which: &str, broken: f64, record_s: f64, step_at_s: f64) -> Vec<Row> {
+    let (p, rated, settle) = motor(which);
+    let start = settle + 1.5;
+    let mut s = Scenario::steady(start + record_s, 5000.0);
+    s.sensors = SensorSpec::default();
+    let step = |t_s: f64, nm: f64| LoadStep {
+        t_s,
+        torque_nm: Some(nm),
+        bl_scale: None,
+    };
+    s.load = LoadSpec {
+        kind: LoadKind::Torque,
+        torque_nm: Some(0.0),
+        bl_nms: None,
+        steps: vec![step(settle, 0.7 * rated), step(start + step_at_s, rated)],
+    };
+    if broken > 0.0 {
+        s.effects = vec![EffectSpec::RotorAsymmetry {
+            delta: None,
+            broken_bars: Some(broken),
+            bars: Some(f64::from(BARS)),
+        }];
+    }
+    let rows = simulate_to_vec(&p, &s).expect("simulated"); // ok: test
+    let keep = (record_s * 5000.0).round() as usize;
+    rows[rows.len() - keep..].to_vec()
+}
+
+#[test]
+fn the_lamps_are_evaluated_on_a_steady_broken_bar_record_and_a_load_step_still_holds_them() {
+    // The core's quasi-steady gate closes on the d-q quantities' filtered derivatives; a
+    // broken bar's 2 s f torque ripple moves them as a transient would, and held the gate
+    // closed until its 5 s timeout (a shorter record: "the lamps were never evaluated").
+    // The ripple rule opens it once the operating point's slow trend has been steady
+    // (`monitor_core::MonitorConfig::steady_gate_per_s`). A load step (70 % to 100 %)
+    // still closes it, with a broken cage and without.
+    let mut failures = Vec::new();
+    for (which, broken) in [("3hp", 1.0), ("3hp", 2.0), ("2p2kw", 1.0), ("2p2kw", 0.0)] {
+        let (p, _, _) = motor(which);
+        let rep = diagnose(
+            &p,
+            &record(which, 1.0, broken, 5.0, 5000.0, true),
+            true,
+            true,
+        );
+        let first = rep.timeline.iter().find(|t| t.evaluating).map(|t| t.t_s);
+        let never = rep
+            .verdict_withheld_because
+            .iter()
+            .any(|w| w.contains("never evaluated"));
+        eprintln!("{which} {broken} bars: first evaluated at {first:?} s of a 5 s record");
+        if first.is_none_or(|t| t > 3.5) || never {
+            failures.push(format!(
+                "{which} {broken} bars: first evaluated at {first:?}"
+            ));
+        }
+        let rep = diagnose(&p, &record_with_step(which, broken, 7.0, 4.5), true, true);
+        let held = rep
+            .timeline
+            .iter()
+            .filter(|t| t.t_s > 4.5 && t.t_s < 5.5)
+            .any(|t| !t.quasi_steady);
+        let after = rep.timeline.iter().any(|t| t.t_s > 5.5 && t.evaluating);
+        if !held || !after {
+            failures.push(format!("{which} {broken} bars, load step at 4.5 s: gate closed after it {held}, evaluated again {after}"));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
