@@ -143,3 +143,53 @@ fn the_record_kept_is_bounded() {
     let first = front.blocks().front().unwrap().t_s;
     assert!((first - 100.0).abs() < 1.0, "{first}");
 }
+
+/// The streaming part's cost per row (docs/performance.md): 36 M rows of a 10 kHz record,
+/// from 4000 rows held in cache. A measurement, run on demand:
+/// `cargo test --release -p sim-host --lib rotor::tests::cost_per_row -- --ignored --nocapture`;
+/// it fails above 50 ns a row (ten times what it takes).
+#[test]
+#[ignore]
+fn cost_per_row() {
+    let (n, rate, reps) = (4000usize, 10_000.0, 9000usize);
+    let input: Vec<(AlphaBeta, SinCos, Row)> = (0..n)
+        .map(|k| {
+            let t = k as f64 / rate;
+            let th = TAU * 50.0 * t;
+            let i = AlphaBeta {
+                alpha: (10.0 * th.cos()) as f32,
+                beta: (10.0 * th.sin()) as f32,
+            };
+            let sc = SinCos {
+                sin: th.sin() as f32,
+                cos: th.cos() as f32,
+            };
+            let row = Row {
+                t_s: t,
+                v_abc: None,
+                i_abc: [0.0; 3],
+                wm_rad_s: Some(150.0),
+                enc_count: None,
+                t_winding_c: None,
+            };
+            (i, sc, row)
+        })
+        .collect();
+    let mut front = RotorFront::new(rate, 50.0, MAX_STRETCH_S);
+    let start = std::time::Instant::now();
+    for rep in 0..reps {
+        for (i, sc, row) in &input {
+            let t = row.t_s + rep as f64 * n as f64 / rate;
+            front.row(Some(*std::hint::black_box(i)), *sc, t, 0.001, row);
+            front.end_of_row(314.0);
+        }
+    }
+    let ns = start.elapsed().as_secs_f64() / (reps * n) as f64 * 1e9;
+    let mb =
+        front.blocks().len() as f64 * std::mem::size_of::<super::baseband::Block>() as f64 / 1e6;
+    eprintln!(
+        "{ns:.2} ns per row; {} blocks kept ({mb:.1} MB)",
+        front.blocks().len()
+    );
+    assert!(ns < 50.0, "{ns} ns per row");
+}
