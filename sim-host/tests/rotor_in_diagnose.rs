@@ -459,7 +459,8 @@ fn what_is_missing_is_said() {
     );
     assert!(r.largest_possible_db.is_some_and(|x| x < -54.0), "{r:?}");
     assert_eq!(r.confidence, None);
-    // No speed and broken bars: the slip from the sideband pair, the bars named.
+    // No speed and broken bars: the slip from the sideband pair, the level and band read;
+    // a pair taken for the rotor's by assumption stays a finding below one half.
     let rows = record("3hp", 1.0, 1.0, 4.0, 2000.0, false);
     let r = diagnose(&p, &rows, false, false).rotor;
     assert_eq!(r.slip_source, Some(SlipSource::Sidebands), "{}", r.sentence);
@@ -468,11 +469,8 @@ fn what_is_missing_is_said() {
         "{}",
         r.sentence
     );
-    assert!(
-        r.confidence.unwrap() >= 0.5 && r.sentence.contains("broken rotor bars"),
-        "{}",
-        r.sentence
-    );
+    assert_eq!(r.band, Some(RotorBand::SeveralBrokenBars), "{}", r.sentence);
+    assert!(r.confidence.unwrap() < 0.5, "{}", r.sentence);
 }
 
 /// A record of `which` at 70 % of its rated torque with `broken` bars, the load stepping to
@@ -542,6 +540,43 @@ fn the_lamps_are_evaluated_on_a_steady_broken_bar_record_and_a_load_step_still_h
         let after = rep.timeline.iter().any(|t| t.t_s > 5.5 && t.evaluating);
         if !held || !after {
             failures.push(format!("{which} {broken} bars, load step at 4.5 s: gate closed after it {held}, evaluated again {after}"));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn real_recordings_of_a_healthy_cage_give_no_rotor_fault() {
+    // The 26 ITSC recordings (examples/recordings/itsc: a 0.75 hp motor at no load, its
+    // cage healthy, shorted turns in 24 of them; currents only, 1 kHz, 5 s). No speed: the
+    // slip only from a pair about the line, which here is the bench's own modulation (the
+    // short switched on and off, the supply), never a rotor fault at >= 0.5.
+    let folder =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/recordings/itsc");
+    let (params, columns) = sim_host::log::mapping::load_params(&folder.join("baldor_0p75hp.toml"))
+        .expect("parameter file"); // ok: test
+    let mut names: Vec<std::path::PathBuf> = std::fs::read_dir(&folder)
+        .expect("the recordings") // ok: test
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "csv"))
+        .collect();
+    names.sort();
+    assert_eq!(names.len(), 26);
+    let mut failures = Vec::new();
+    for path in names {
+        let open = sim_host::log::OpenOptions {
+            group: None,
+            columns: columns.clone(),
+        };
+        let file = sim_host::log::LogFile::open_with(&path, &open).expect("recording"); // ok: test
+        let rep =
+            sim_host::replay::diagnose_log(&params, &file, ReplayOptions::default(), &mut |_| {})
+                .expect("diagnose") // ok: test
+                .report;
+        let r = rep.rotor;
+        eprintln!("{}: {}", path.display(), r.sentence);
+        if r.confidence.is_some_and(|c| c >= 0.5) {
+            failures.push(format!("{}: {}", path.display(), r.sentence));
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));

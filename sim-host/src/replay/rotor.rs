@@ -16,10 +16,12 @@
 //!    stays within [`LOAD_STEADY`].
 //! 3. The slip: from the speed channel (`wm_rad_s` or `enc_count`), else from a symmetric
 //!    pair about the line in the stretch's spectrum standing [`PAIR_SNR_DB`] above its
-//!    noise: the sidebands themselves at -/+ 2 s f, or the rotation-frequency components
-//!    at -/+ f_r = -/+ f (1 - s) / Np (eccentricity, always present to some degree in a
-//!    real machine); else "cannot judge", with the largest component anywhere the
-//!    sidebands could be.
+//!    noise: the rotation-frequency components at -/+ f_r = -/+ f (1 - s) / Np
+//!    (eccentricity, always present to some degree in a real machine), else the sidebands
+//!    themselves at -/+ 2 s f; else "cannot judge", with the largest component anywhere
+//!    the sidebands could be. A pair is only as good as its identification: another
+//!    modulation of the current at the same distance (a load's, the supply's) gives a
+//!    wrong slip (module docs' limits in `docs/rotor.md`).
 //! 4. The spectra ([`spectrum`]): Welch segments of at most 20 s, each re-centred on its
 //!    supply frequency, Blackman-Harris window, zero-padded 4x; the sidebands read as the
 //!    largest bin within [`SLIP_STEADY`] of 2 s f (each segment at its own slip),
@@ -52,7 +54,8 @@
 //! below one half, a cracked bar or worse above). The measured level is taken net of what
 //! the record's noise gives in the search interval (its expected largest bin); the
 //! probability is the normal distribution of the distance to the edge over the reading's
-//! noise and the edge's own spread ([`judge::fault_probability`]). What is not in it: a
+//! noise and the edge's own spread ([`judge::fault_probability`]); where the slip came from
+//! the sideband pair itself, at most [`PAIR_ONLY_CONFIDENCE`]. What is not in it: a
 //! healthy cage's own asymmetry, and load oscillations at 2 s f (a reciprocating load, a
 //! gearbox) that put the same sidebands into the current; the bands take the first as
 //! below 54 dB, the second needs the load's knowledge.
@@ -108,6 +111,13 @@ pub const MAX_STRETCH_S: f64 = 300.0;
 /// [dB of power]: a noise bin exceeds its mean by 10 dB with probability e^-10, both of a
 /// pair at once about e^-20.
 pub const PAIR_SNR_DB: f64 = 10.0;
+/// The largest confidence a finding whose slip came from the sideband pair itself may
+/// have: the pair is taken for the rotor's only by assumption (another modulation of the
+/// current at the same distance from the line, a load's, the supply's, a winding fault
+/// switched on and off, makes the same pair: on real recordings of shorted turns at no
+/// load, pairs at 2-9 Hz from the line read 42-50 dB below it), so it stays a finding
+/// below one half, to be confirmed by a speed or the rotation harmonics.
+pub const PAIR_ONLY_CONFIDENCE: f64 = 0.45;
 /// The fault edge [dB relative to the line]: 48 dB below it, where Thomson and Fenger's
 /// bands pass from "watch" to a cracked bar or joint (module docs).
 pub const FAULT_EDGE_DB: f64 = -48.0;

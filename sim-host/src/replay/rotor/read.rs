@@ -139,11 +139,17 @@ fn slip_from_pairs(
     let noise = avg.noise((clear, f), &[], k)?;
     let side = (2.0 * MIN_SLIP * f).max(clear)..2.0 * MAX_SLIP * f;
     let rot = f * (1.0 - MAX_SLIP) / m.np..f * (1.0 - MIN_SLIP) / m.np;
-    if let Some(d) = pair(&avg, side.clone(), noise) {
-        return Some((d / (2.0 * f), SlipSource::Sidebands));
+    // The rotation harmonics first (present in every real machine, and no sign of a fault),
+    // then the sidebands; a pair whose refined distance gives a slip outside the range
+    // searched is something else.
+    let plausible = |s: f64| (0.0..=MAX_SLIP).contains(&s);
+    let from_rotation = pair(&avg, rot, noise).map(|d| 1.0 - m.np * d / f);
+    if let Some(s) = from_rotation.filter(|s| plausible(*s)) {
+        return Some((s, SlipSource::Eccentricity));
     }
-    if let Some(d) = pair(&avg, rot, noise) {
-        return Some((1.0 - m.np * d / f, SlipSource::Eccentricity));
+    let from_sidebands = pair(&avg, side.clone(), noise).map(|d| d / (2.0 * f));
+    if let Some(s) = from_sidebands.filter(|s| plausible(*s)) {
+        return Some((s, SlipSource::Sidebands));
     }
     let (_, largest) = avg.peak(-side.end, -side.start);
     r.largest_possible_db = Some(10.0 * largest.max(1e-30).log10());
@@ -294,7 +300,10 @@ fn judge(mut r: RotorReport, x: &Reading, m: &Machine) -> RotorReport {
     r.level_db = Some(level);
     r.upper_sideband_db = Some(db(x.upper));
     r.noise_floor_db = Some(db(floor));
-    let p = fault_probability(x.lower, x.noise, x.bins, x.k);
+    let mut p = fault_probability(x.lower, x.noise, x.bins, x.k);
+    if r.slip_source == Some(SlipSource::Sidebands) {
+        p = p.min(super::PAIR_ONLY_CONFIDENCE);
+    }
     r.confidence = Some(p);
     let share = torque_share(s, TAU * f, m.tau_r_s);
     r.torque_current_share = Some(share);
@@ -317,7 +326,12 @@ fn judge(mut r: RotorReport, x: &Reading, m: &Machine) -> RotorReport {
 fn sentence(r: &RotorReport, at_noise: bool) -> String {
     let level = -r.level_db.unwrap_or(f64::NAN);
     let p = r.confidence.unwrap_or(0.0);
-    let head = r.band.map_or("", |b| b.finding());
+    let head = match (r.slip_source, r.band) {
+        (Some(SlipSource::Sidebands), Some(b)) if b != super::RotorBand::NoSign => {
+            "unconfirmed: a pair about the line taken for the sidebands (no speed to confirm the slip)"
+        }
+        (_, b) => b.map_or("", |b| b.finding()),
+    };
     let noise = if at_noise {
         " (at the current's noise)"
     } else {
