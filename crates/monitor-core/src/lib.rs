@@ -20,8 +20,9 @@
 //!
 //! The crate also holds the vocabulary every part of the workspace shares: [`Fault`] (Table
 //! 1's faults), [`EffectKind`] (the effect library's names), [`Phase`], the parameter
-//! file's [`MotorParameters`] with its one conversion to [`MotorModel`], and the
-//! [`reference`](mod@reference) machines (2.2 kW and 3 hp). With the `serde` feature (the
+//! file's [`MotorParameters`] with its one conversion to [`MotorModel`], the
+//! [`reference`](mod@reference) machines (2.2 kW and 3 hp), and the broken-bar relation of
+//! the squirrel cage ([`rotor_cage`]). With the `serde` feature (the
 //! host enables it) they serialise under the names of the parameter file and the JSON
 //! reports (`docs/design.md`).
 //!
@@ -69,6 +70,7 @@ pub mod motor_record;
 pub mod operating_range;
 pub mod record;
 pub mod residuals;
+pub mod rotor_cage;
 pub mod sequence;
 pub mod signature;
 pub mod threshold;

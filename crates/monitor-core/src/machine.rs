@@ -146,6 +146,14 @@ pub struct MotorParameters {
     pub b_nms: f64,
     /// Viscous load coefficient Bl, on the shaft [N m s/rad], >= 0 (the paper's load model).
     pub bl_nms: f64,
+    /// Number of rotor bars of the squirrel cage, where known (optional key; the host's
+    /// rotor finding gives a number of broken bars only with it, [`crate::rotor_cage`]).
+    /// The equations and the board's motor record do not use it.
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "Option::is_none")
+    )]
+    pub rotor_bars: Option<u32>,
 }
 
 impl MotorParameters {
@@ -245,6 +253,7 @@ pub mod reference {
             j_kgm2: 0.015,
             b_nms: 0.005,
             bl_nms: 0.0975,
+            rotor_bars: None,
         },
         supply: SupplyParameters {
             v_ll_rms: 400.0,
@@ -272,6 +281,7 @@ pub mod reference {
             j_kgm2: 0.089,
             b_nms: 0.002,
             bl_nms: 0.045,
+            rotor_bars: None,
         },
         supply: SupplyParameters {
             v_ll_rms: 220.0,

@@ -175,6 +175,7 @@ impl MotorRecord {
             j_kgm2,
             b_nms,
             bl_nms,
+            rotor_bars: None,
         };
         let supply = SupplyParameters {
             v_ll_rms: r.f64()?,

@@ -12,9 +12,9 @@
 //! Franceschini, Tassoni, Kliman, IEEE Trans. Ind. Appl. 37(5), 2001). It is an
 //! approximation: it takes the broken bars' current as redistributed over the healthy
 //! bars of one rotor pole pitch, and ignores inter-bar currents (which make real
-//! sidebands smaller) and the end-ring resistance. The formula lives with the machine model
-//! the simulator integrates (`crate::sim`'s machine, `delta_of_broken_bars` and its
-//! inverse `broken_bars_of_delta`); the analysis only reads it.
+//! sidebands smaller) and the end-ring resistance. The formula lives in the core
+//! (`monitor_core::rotor_cage`, shared with the simulator and `diagnose`'s rotor finding);
+//! the analysis only reads it.
 //!
 //! # MCSA resolution
 //! The sidebands lie 2 s f from the fundamental (3.6 Hz for the 3 hp motor at 3 % slip),
@@ -58,24 +58,19 @@
 //! `rotor_asymmetry` only when the two agree ([`fit_and_spectrum_agree`]).
 
 use super::prep::Prepared;
-use crate::sim::machine::broken_bars_of_delta;
+/// The MCSA's shared rules and constants, one home with `diagnose`'s rotor finding
+/// ([`crate::replay`]'s `rotor`): the Blackman-Harris window, its main lobe, the resolution
+/// rule, the least and the steady slip, the longest stretch read (a longer steady stretch
+/// is cut to its last `max(MAX_STRETCH_S, 4 MIN_BINS / (2 s f))` seconds).
+pub use crate::replay::{
+    blackman_harris, BLACKMAN_HARRIS_4, MAIN_LOBE_HALF_BINS, MAX_STRETCH_S, MIN_BINS, MIN_SLIP,
+    SLIP_STEADY,
+};
+use monitor_core::rotor_cage::{broken_bars_of_delta, delta_of_sideband_ratio};
 use rustfft::num_complex::Complex;
 use serde::Serialize;
 use std::f64::consts::PI;
 
-/// Half-width of the 4-term Blackman-Harris window's main lobe [bins of 1/T] (Harris
-/// 1978; module doc).
-pub const MAIN_LOBE_HALF_BINS: f64 = 4.0;
-/// Fewest frequency bins between the fundamental and a sideband: the sideband's search
-/// interval, +/- [`SLIP_STEADY`] of 2 s f, clear of the fundamental's main lobe,
-/// `MAIN_LOBE_HALF_BINS / (1 - SLIP_STEADY)` = 5 (module doc).
-pub const MIN_BINS: f64 = 5.0;
-// The sideband's search interval starts (1 - SLIP_STEADY) MIN_BINS bins from the
-// fundamental: at the main lobe's edge or beyond (checked when compiled).
-const _: () = assert!(MIN_BINS * (1.0 - SLIP_STEADY) >= MAIN_LOBE_HALF_BINS - 1e-9);
-/// The 4-term Blackman-Harris window's coefficients a0..a3 (-92 dB sidelobes; Harris
-/// 1978): w(k) = a0 - a1 cos(2 pi k/n) + a2 cos(4 pi k/n) - a3 cos(6 pi k/n).
-pub const BLACKMAN_HARRIS_4: [f64; 4] = [0.35875, 0.48829, 0.14128, 0.01168];
 /// The spectrum's and the fit's delta agree when they are within this factor (2) of each
 /// other ([`fit_and_spectrum_agree`]): the spectral relation's approximations (module doc)
 /// are well within it, a healthy cage's fitted noise (a small delta, no sidebands) is not.
@@ -89,7 +84,10 @@ pub const AGREE_FACTOR: f64 = 2.0;
 pub fn spectral_delta(lower_db: f64, upper_db: f64, q_share: f64) -> Option<f64> {
     let lin = |db: f64| 10f64.powf(db / 20.0);
     let r = (lin(lower_db) + lin(upper_db)) / q_share;
-    (q_share > 0.0 && r.is_finite() && r < 1.0).then(|| 3.0 * r / (1.0 - r))
+    if q_share.is_nan() || q_share <= 0.0 {
+        return None;
+    }
+    delta_of_sideband_ratio(r)
 }
 
 /// True when the spectrum's delta and the fit's agree within [`AGREE_FACTOR`] of each
@@ -100,18 +98,6 @@ pub fn fit_and_spectrum_agree(fit_delta: f64, spectral_delta: f64) -> bool {
         && spectral_delta <= AGREE_FACTOR * fit_delta
         && fit_delta <= AGREE_FACTOR * spectral_delta
 }
-/// Smallest slip the sidebands are judged at: below it they sit within 2 s f = 0.6 Hz
-/// (at 50 Hz) of the fundamental, a run of 17 s at least, and no-load slip is noise.
-pub const MIN_SLIP: f64 = 0.003;
-/// Largest variation of the slip over the analysed stretch, relative to its mean.
-pub const SLIP_STEADY: f64 = 0.2;
-/// Longest stretch the sidebands are read from [s]: a longer steady stretch is cut to its
-/// last `max(MAX_STRETCH_S, 4 MIN_BINS / (2 s f))` seconds, 4x the resolution the
-/// sidebands need (module doc). 300 s resolve 3.3 mHz; a 1 h log's whole stretch would be
-/// a 16 M-point transform (about 3 s of CPU and 256 MB) and sharpen nothing the report
-/// reads: the leakage criterion is met, and the noise floor per bin is already far below
-/// a healthy cage's sidebands.
-pub const MAX_STRETCH_S: f64 = 300.0;
 
 /// The motor current signature analysis of a log (`explain`'s `rotor_asymmetry` key).
 #[derive(Debug, Clone, Serialize, Default)]
@@ -188,13 +174,6 @@ fn steady_stretch(d: &Prepared) -> (usize, Vec<f64>) {
         k -= blk;
     }
     (start, slip)
-}
-
-/// The 4-term Blackman-Harris window [`BLACKMAN_HARRIS_4`] at sample `k` of `n`.
-fn blackman_harris(k: usize, n: usize) -> f64 {
-    let [a0, a1, a2, a3] = BLACKMAN_HARRIS_4;
-    let x = 2.0 * PI * k as f64 / n.max(1) as f64;
-    a0 - a1 * x.cos() + a2 * (2.0 * x).cos() - a3 * (3.0 * x).cos()
 }
 
 /// Blackman-Harris-windowed amplitude spectrum of `x` sampled every `dt`, zero-padded 4x: (bin

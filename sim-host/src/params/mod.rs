@@ -333,6 +333,36 @@ mod tests {
         assert!(e.contains("motor.rr_ohm must be positive"), "{e}");
     }
 
+    #[test]
+    fn the_rotor_bars_are_optional_and_checked() {
+        assert_eq!(
+            ParamFile::from_toml_str(DESIGN_EXAMPLE, "x")
+                .unwrap()
+                .motor
+                .rotor_bars,
+            None
+        );
+        let with = DESIGN_EXAMPLE.replace("poles = 4\n", "poles = 4\nrotor_bars = 28\n");
+        let p = ParamFile::from_toml_str(&with, "x").unwrap();
+        assert_eq!(p.motor.rotor_bars, Some(28));
+        // Written back only where given.
+        assert!(p.to_toml_string().contains("rotor_bars = 28"));
+        assert!(!ParamFile::reference_3hp()
+            .to_toml_string()
+            .contains("rotor_bars"));
+        // A typo stays an error; a count no cage has is refused naming the key.
+        let typo = DESIGN_EXAMPLE.replace("poles = 4\n", "poles = 4\nrotor_bar = 28\n");
+        let e = ParamFile::from_toml_str(&typo, "x")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("rotor_bar"), "{e}");
+        let e = refused("poles = 4\n", "poles = 4\nrotor_bars = 3\n");
+        assert!(
+            e.contains("motor.rotor_bars = 3") && e.contains("8..=300"),
+            "{e}"
+        );
+    }
+
     /// Krause, Wasynczuk and Sudhoff's machines (60 Hz, 4 poles; reactances at 60 Hz):
     /// (name, v_ll_rms, rs, xls = xlr, xm, rr, j).
     const KRAUSE: [(&str, f64, f64, f64, f64, f64, f64); 4] = [

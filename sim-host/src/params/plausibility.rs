@@ -76,6 +76,11 @@ pub mod plausible {
     /// the rated power (no-load current 25 % to 60 % of rated at power factor 0.7 to 0.9),
     /// hence the extra margin of about 4x at both ends.
     pub const INERTIA_CONSTANT_S: R = R::new(0.002, 100.0);
+    /// Rotor bars of the cage, the optional `rotor_bars` key: 8..=300 (small motors have
+    /// about 16-30 bars, large ones up to about 150; below 8 a cage has fewer bars than a
+    /// two-pole machine's pole pitch needs for the broken-bar relation
+    /// `monitor_core::rotor_cage`, whose `3n < N` a single broken bar must meet).
+    pub const ROTOR_BARS: core::ops::RangeInclusive<u32> = 8..=300;
 }
 
 /// A parameter file value outside the range of real machines: the key, its value, the
@@ -207,7 +212,8 @@ impl ParamFile {
         Ok(())
     }
 
-    /// The poles (even, in [`plausible::POLES`]), the supply frequency and voltage.
+    /// The poles (even, in [`plausible::POLES`]), the rotor bars where given
+    /// ([`plausible::ROTOR_BARS`]), the supply frequency and voltage.
     fn check_poles_and_supply(&self) -> Result<(), Implausible> {
         let (m, s) = (&self.motor, &self.supply);
         let fail = |key: &'static str, message: String| Err(Implausible { key, message });
@@ -219,6 +225,16 @@ impl ParamFile {
                     m.poles,
                     plausible::POLES.start(),
                     plausible::POLES.end()
+                ),
+            );
+        }
+        if let Some(n) = m.rotor_bars.filter(|n| !plausible::ROTOR_BARS.contains(n)) {
+            return fail(
+                "motor.rotor_bars",
+                format!(
+                    "motor.rotor_bars = {n} is implausible: plausible {}..={}",
+                    plausible::ROTOR_BARS.start(),
+                    plausible::ROTOR_BARS.end()
                 ),
             );
         }

@@ -29,6 +29,7 @@ mod isolation;
 mod options;
 mod pipe;
 mod report;
+mod rotor;
 mod sampler;
 mod sequences;
 mod step;
@@ -56,6 +57,11 @@ pub use isolation::{
 pub use options::{monitor_config_for_log, LoadModel, ReplayOptions};
 pub use report::{
     BaselineSource, Detection, DiagnoseReport, MonitorState, Panel, TimelinePoint, UnbalanceReport,
+};
+pub use rotor::{
+    band_of, blackman_harris, RotorBand, RotorReport, SlipSource, BLACKMAN_HARRIS_4,
+    EDGE_SPREAD_DB, FAULT_EDGE_DB, MAIN_LOBE_HALF_BINS, MAX_SLIP, MAX_STRETCH_S, MIN_BINS,
+    MIN_SLIP, SLIP_STEADY,
 };
 pub use sampler::LogSampler;
 pub use sequences::{SequenceWindow, WINDOW_PERIODS};

@@ -328,6 +328,8 @@ pub struct DiagnoseReport {
     pub first_detection_s: Option<f64>,
     /// Negative-sequence analysis of the currents.
     pub unbalance: UnbalanceReport,
+    /// The rotor: broken bars from the current's sidebands (`super::rotor`).
+    pub rotor: super::RotorReport,
     /// Faults ever named while the lamps were lit, with the time first named.
     pub detections: Vec<Detection>,
     /// Analyses skipped for lack of a column, with the reason.
@@ -441,11 +443,7 @@ impl Replay {
     /// caller to fill).
     pub fn finish(mut self) -> DiagnoseReport {
         let out = self.output();
-        if self.seq_front.finish() {
-            self.book.take(&mut self.seq_front);
-            self.book
-                .close(self.monitor.as_ref().map(|_| out.operating.wr_rad_s));
-        }
+        self.close_sequences(&out);
         let skipped = skipped_analyses(self.channels);
         let unbalance = self.unbalance_report();
         let signature_candidates = signature_candidates(&out);
@@ -453,6 +451,7 @@ impl Replay {
         let (isolation, candidates) =
             self.final_isolation(&out, &unbalance, detected, &signature_candidates);
         let lamps = final_lamps(&out);
+        let rotor = super::rotor::rotor_report(self.seq_front.rotor(), &self.params);
         let found = self.findings(
             &findings::ResidualInputs {
                 out: &out,
@@ -462,6 +461,7 @@ impl Replay {
                 skipped: &skipped,
             },
             &unbalance,
+            &rotor,
         );
         let mut report = DiagnoseReport {
             verdict: Verdict::CouldNotJudge,
@@ -478,6 +478,7 @@ impl Replay {
             signature_candidates,
             first_detection_s: self.first_detection,
             unbalance,
+            rotor,
             detections: self.detections,
             skipped,
             angle_source: self.opts.angle_source,
@@ -490,6 +491,16 @@ impl Replay {
         };
         report.conclude();
         report
+    }
+
+    /// Closes the sequence analysis' last window (the front's, then the book's, with the
+    /// monitor's speed in `out`).
+    fn close_sequences(&mut self, out: &MonitorOutput) {
+        if self.seq_front.finish() {
+            self.book.take(&mut self.seq_front);
+            self.book
+                .close(self.monitor.as_ref().map(|_| out.operating.wr_rad_s));
+        }
     }
 }
 

@@ -172,6 +172,9 @@ pub(super) struct SequenceFront {
     /// The windows closed and not yet taken by the book, in order: `None` for one that had
     /// no solution (the book's learning flag restarts all the same).
     closed: VecDeque<Option<SequenceWindow>>,
+    /// The rotor finding's demodulated current on the reference angle
+    /// ([`super::rotor::RotorFront`]).
+    rotor: super::rotor::RotorFront,
 }
 
 /// What [`SequenceFront::track`] found at one row: the steady point's vectors (the
@@ -312,6 +315,11 @@ impl SequenceFront {
                 .max(monitor_core::sequence::PHASOR_FIT_MIN_SAMPLES),
             open: OpenWindow::new(),
             closed: VecDeque::new(),
+            rotor: super::rotor::RotorFront::new(
+                sample_rate_hz,
+                params.supply.f_hz,
+                super::rotor::MAX_STRETCH_S,
+            ),
         })
     }
 
@@ -319,28 +327,11 @@ impl SequenceFront {
     /// (the monitor holds such samples out itself); a bad voltage leaves the voltages'
     /// analysis alone.
     pub fn track(&mut self, row: &Row, t: f64) -> SequenceStep {
-        // Samples missing from the stream: the angles advance over the missing time at
-        // their frequency (as the monitor's frame does), so that the sequences stay put.
-        let mut filled = 0usize;
-        let mut step = SequenceStep::default();
-        if let Some(prev) = self.last_t.replace(t) {
-            let missing = t - prev - self.dt_s;
-            if missing > 0.5 * self.dt_s && missing <= MAX_BRIDGED_GAP_S {
-                self.pll.skip(missing as f32);
-                self.theta_ref = monitor_core::frames::wrap_angle(
-                    self.theta_ref + self.w_ref_state.y() * missing as f32,
-                );
-                self.offset += (f64::from(self.w_ref_state.y()) - self.w0) * missing;
-                let m = (missing / self.dt_s).round();
-                if m <= FILLED_SAMPLES as f64 {
-                    filled = m as usize;
-                }
-            } else if missing > MAX_BRIDGED_GAP_S {
-                // A gap the data-quality stage does not bridge: the window ends there.
-                self.close_window();
-                step.closed_before = true;
-            }
-        }
+        let (filled, closed_before) = self.bridge(t);
+        let mut step = SequenceStep {
+            closed_before,
+            ..SequenceStep::default()
+        };
         self.theta_ref = monitor_core::frames::wrap_angle(
             self.theta_ref + self.w_ref_state.y() * self.dt_s as f32,
         );
@@ -363,12 +354,17 @@ impl SequenceFront {
                 self.open.bad_v += 1;
             }
             let (sc_pll, sc) = sin_cos_pair(self.pll.theta_pll(), self.theta_ref);
-            self.filtered(i_abc, v_abc, filled, sc_pll);
+            let i = clarke(i_abc);
+            self.filtered(i, v_abc.map(clarke), filled, sc_pll);
+            self.rotor.row(Some(i), sc, t, self.offset, row);
             self.open.fit_i.update(sc, i_abc);
             if let Some(v) = v_abc {
                 self.open.fit_v.update(sc, v);
             }
+        } else {
+            self.rotor.row(None, SinCos::default(), t, self.offset, row);
         }
+        self.rotor.end_of_row(self.w_ref_state.y());
         if self.open.offered >= self.window_len {
             self.close_window();
             step.closed_after = true;
@@ -377,6 +373,39 @@ impl SequenceFront {
         step.v = self.seq_v.value();
         step.we_rad_s = self.pll.omega_rad_s();
         step
+    }
+
+    /// Samples missing from the stream before the row at `t` [s]: the angles advance over
+    /// the missing time at their frequency (as the monitor's frame does), so that the
+    /// sequences stay put; a gap the data-quality stage does not bridge ends the window.
+    /// Returns the samples to fill in (up to [`FILLED_SAMPLES`]) and whether the window
+    /// was closed.
+    fn bridge(&mut self, t: f64) -> (usize, bool) {
+        let Some(prev) = self.last_t.replace(t) else {
+            return (0, false);
+        };
+        let missing = t - prev - self.dt_s;
+        if missing > 0.5 * self.dt_s && missing <= MAX_BRIDGED_GAP_S {
+            self.pll.skip(missing as f32);
+            self.theta_ref = monitor_core::frames::wrap_angle(
+                self.theta_ref + self.w_ref_state.y() * missing as f32,
+            );
+            self.offset += (f64::from(self.w_ref_state.y()) - self.w0) * missing;
+            let m = (missing / self.dt_s).round();
+            self.rotor.skip(m as u32);
+            let filled = if m <= FILLED_SAMPLES as f64 {
+                m as usize
+            } else {
+                0
+            };
+            return (filled, false);
+        }
+        if missing > MAX_BRIDGED_GAP_S {
+            self.close_window();
+            self.rotor.break_off();
+            return (0, true);
+        }
+        (0, false)
     }
 
     /// Counts a sample into the open window (its time span, the reference's frequency).
@@ -394,12 +423,10 @@ impl SequenceFront {
         o.w_max = o.w_max.max(w);
     }
 
-    /// The PLL and the filtered sequences (the isolation's steady point); the reference
-    /// frequency follows the PLL's.
+    /// The PLL and the filtered sequences (the isolation's steady point) of the current
+    /// vector `i` and the voltage vector `v`; the reference frequency follows the PLL's.
     /// `sc` is the sin/cos of the PLL's angle.
-    fn filtered(&mut self, i_abc: Abc, v_abc: Option<Abc>, filled: usize, sc: SinCos) {
-        let i = clarke(i_abc);
-        let v = v_abc.map(clarke);
+    fn filtered(&mut self, i: AlphaBeta, v: Option<AlphaBeta>, filled: usize, sc: SinCos) {
         match v {
             Some(v) if self.pll_on_voltage => {
                 self.pll.update(v, sc);
@@ -481,6 +508,11 @@ impl SequenceFront {
             steady,
             learning: true,
         })
+    }
+
+    /// The rotor finding's demodulated record ([`super::rotor::RotorFront`]).
+    pub fn rotor(&self) -> &super::rotor::RotorFront {
+        &self.rotor
     }
 
     /// The next window closed and not yet taken (`Some(None)`: one without a solution).

@@ -475,40 +475,8 @@ impl Machine {
     }
 }
 
-/// The rotor phase resistance asymmetry `delta` of a cage of `bars` bars with `n` adjacent
-/// broken bars: `delta = 3n / (N - 3n)` (rotor phase a's resistance Rr (1 + delta), the
-/// asymmetry this machine integrates).
-///
-/// Kliman, Koegl, Stein, Endicott, Madden, "Noninvasive detection of broken rotor bars in
-/// operating induction motors", IEEE Trans. Energy Convers. 3(4), 1988; Bellini,
-/// Filippetti, Franceschini, Tassoni, Kliman, "Quantitative evaluation of induction motor
-/// broken bars by means of electrical signature analysis", IEEE Trans. Ind. Appl. 37(5),
-/// 2001. An approximation: the broken bars' current is taken as redistributed over the
-/// healthy bars of one rotor pole pitch; inter-bar currents (which make real sidebands
-/// smaller) and the end-ring resistance are ignored. Valid for `0 <= n < N/3` (the
-/// scenario checks it); at `n = N/3` the result is infinite.
-pub fn delta_of_broken_bars(n: f64, bars: f64) -> f64 {
-    3.0 * n / (bars - 3.0 * n)
-}
-
-/// The number of adjacent broken bars `n = delta N / (3 (1 + delta))` of a cage of `bars`
-/// bars equivalent to the asymmetry `delta` (the inverse of [`delta_of_broken_bars`], same
-/// sources and approximation; `delta >= 0`).
-pub fn broken_bars_of_delta(delta: f64, bars: f64) -> f64 {
-    delta * bars / (3.0 * (1.0 + delta))
-}
-
-#[cfg(test)]
-mod broken_bar_tests {
-    use super::{broken_bars_of_delta, delta_of_broken_bars};
-
-    #[test]
-    fn broken_bars_and_delta_are_inverse() {
-        // One broken bar of 28: 3/25 = 0.12.
-        assert!((delta_of_broken_bars(1.0, 28.0) - 0.12).abs() < 1e-12);
-        for (n, nb) in [(1.0, 28.0), (2.0, 40.0), (3.0, 36.0)] {
-            let d = delta_of_broken_bars(n, nb);
-            assert!((broken_bars_of_delta(d, nb) - n).abs() < 1e-12);
-        }
-    }
-}
+/// The broken-bar relation `delta = 3n / (N - 3n)` of the asymmetry this machine
+/// integrates (rotor phase a's resistance Rr (1 + delta)) and its inverse: their one home
+/// is the core's [`monitor_core::rotor_cage`] (sources and approximations there), shared
+/// with the analysis and `diagnose`'s rotor finding.
+pub use monitor_core::rotor_cage::{broken_bars_of_delta, delta_of_broken_bars};

@@ -100,6 +100,7 @@ impl Machine {
                 j_kgm2: self.j,
                 b_nms: 0.005 * 1000.0 * self.p_kw / (w_rated * w_rated),
                 bl_nms: 1000.0 * self.p_kw / (w_rated * w_rated),
+                rotor_bars: None,
             },
             supply: SupplyParameters {
                 v_ll_rms: self.v_ll,

@@ -25,6 +25,7 @@ pub fn small_0p37kw() -> ParamFile {
             j_kgm2: 0.0009,
             b_nms: 0.005 * bl,
             bl_nms: bl,
+            rotor_bars: None,
         },
         supply: SupplyParameters {
             v_ll_rms: 400.0,

@@ -101,6 +101,7 @@ fn motor_11kw() -> MotorParameters {
         j_kgm2: 0.04,
         b_nms: 0.003,
         bl_nms: 0.11,
+        rotor_bars: None,
     }
 }
 

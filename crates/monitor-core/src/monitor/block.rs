@@ -240,6 +240,8 @@ pub(super) struct DqFilters {
     vnq: SvfState,
     /// V_ds of each block's last sample [V].
     vds: LowPassState,
+    /// The model inputs' slow trend, for the quasi-steady gate ([`Trend`]).
+    trend: Trend,
 }
 
 impl DqFilters {
@@ -263,6 +265,7 @@ impl DqFilters {
             vnd: SvfState::default(),
             vnq: SvfState::default(),
             vds: LowPassState::default(),
+            trend: Trend::new(block_dt_s)?,
         })
     }
 
@@ -275,6 +278,8 @@ impl DqFilters {
         self.dq.update(&mut self.wr, wr_rad_s);
         self.seq.update(&mut self.nd, m.n.d);
         self.seq.update(&mut self.nq, m.n.q);
+        self.trend
+            .update([self.iqs.y(), self.ids.y(), self.vqs.y(), self.wr.y()]);
     }
 
     /// Feeds the voltage's negative sequence of a block's last sample [V].
@@ -305,6 +310,10 @@ impl DqFilters {
             f.reset();
         }
         self.vds.reset();
+        self.trend = Trend {
+            states: Default::default(),
+            ..self.trend
+        };
     }
 
     /// The filtered model inputs.
@@ -357,6 +366,72 @@ impl DqFilters {
             || fast(&self.ids, k.gate_floor_a)
             || fast(&self.vqs, k.gate_floor_v)
             || fast(&self.wr, k.gate_floor_rad_s)
+    }
+
+    /// Whether the slow trend of I_qs, i_ds, V_qs or wr ([`Trend`]) moves faster than
+    /// `per_s` of itself (plus its floor) per second.
+    #[inline(always)]
+    pub(super) fn trend_changing(&self, per_s: f32, k: &Derived) -> bool {
+        self.trend.changing(
+            per_s,
+            [
+                k.gate_floor_a,
+                k.gate_floor_a,
+                k.gate_floor_v,
+                k.gate_floor_rad_s,
+            ],
+        )
+    }
+}
+
+/// Corner of the quasi-steady gate's trend filters [Hz]: two first-order low-passes in
+/// cascade pass a ripple at `f` by about `(TREND_HZ / f)^2` (a broken rotor bar's `2 s f`
+/// torque ripple at 1-10 Hz by 1/4 to 1/400) and follow a load or supply step within about
+/// a second.
+pub(super) const TREND_HZ: f32 = 0.5;
+
+/// The slow trend of the model inputs (I_qs, i_ds, V_qs, wr, filtered): each through two
+/// first-order low-passes at [`TREND_HZ`] in cascade; its rate of change is the second
+/// stage's derivative, `w_c (s1 - s2)`. A ripple moves the fast filters' derivatives but
+/// not the trend; a transient moves both (the gate's use: `MonitorConfig::steady_gate_per_s`).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Trend {
+    lp: LowPass,
+    /// `2 pi TREND_HZ` [rad/s].
+    wc: f32,
+    /// The two stages of each input.
+    states: [[LowPassState; 2]; 4],
+}
+
+impl Trend {
+    /// The filters fed every `block_dt_s` [s].
+    ///
+    /// # Errors
+    /// [`LowPass::new`]'s checks (a validated configuration passes them).
+    fn new(block_dt_s: f32) -> Result<Self, ConfigError> {
+        Ok(Trend {
+            lp: LowPass::new(TREND_HZ, block_dt_s)?,
+            wc: core::f32::consts::TAU * TREND_HZ,
+            states: Default::default(),
+        })
+    }
+
+    /// Feeds the inputs `x`.
+    #[inline(always)]
+    fn update(&mut self, x: [f32; 4]) {
+        for (s, x) in self.states.iter_mut().zip(x) {
+            let [a, b] = s;
+            let y = self.lp.update(a, x);
+            self.lp.update(b, y);
+        }
+    }
+
+    /// Whether any trend moves faster than `per_s` of itself plus its `floors` per second.
+    #[inline(always)]
+    fn changing(&self, per_s: f32, floors: [f32; 4]) -> bool {
+        self.states.iter().zip(floors).any(|([a, b], floor)| {
+            (self.wc * (a.y() - b.y())).abs() > per_s * (b.y().abs() + floor)
+        })
     }
 }
 

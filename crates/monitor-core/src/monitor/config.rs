@@ -84,7 +84,12 @@ pub struct MonitorConfig {
     /// of eq. (37) describe the machine only in steady state (the paper: "false alarms in
     /// transients"). 0 disables the gate. Default 0.1 /s: above the derivative noise of the
     /// 5 Hz filters on 0.1 %-noise sensors (~0.03 /s), below a 5 % supply step's flux
-    /// transient (~0.5 /s) and a 30 % load step's (~0.15 /s).
+    /// transient (~0.5 /s) and a 30 % load step's (~0.15 /s). A ripple moves the
+    /// derivatives too (a broken rotor bar's `2 s f` torque ripple of a few % at 1-10 Hz:
+    /// 0.2-3 /s), without moving the operating point: a closure longer than three hold
+    /// times while the quantities' slow trend (two 0.5 Hz low-passes) has been steady for
+    /// two is taken for a ripple, and the gate opens (1.5 s after a steady record starts,
+    /// instead of the timeout's 5 s).
     pub steady_gate_per_s: f32,
     /// How long the gate stays closed after the last fast change [s] (default 0.5).
     pub gate_hold_s: f32,

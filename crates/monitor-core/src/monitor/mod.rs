@@ -93,6 +93,9 @@ pub struct Monitor {
     gate_left: u32,
     /// Blocks the gate has been closed for.
     gate_closed_for: u32,
+    /// Blocks the operating point's slow trend has been steady for (the gate's ripple
+    /// rule, `MonitorConfig::steady_gate_per_s`).
+    trend_steady_for: u32,
     /// Timestamp of the last sample of the previous block, once there was one.
     block_end_ticks: Option<u32>,
     /// The lamps last matched against the signatures (`None`: match at the next block).
@@ -139,6 +142,7 @@ impl Monitor {
             report_countdown: 0,
             gate_left: 0,
             gate_closed_for: 0,
+            trend_steady_for: 0,
             block_end_ticks: None,
             matched_lamps: None,
             out: MonitorOutput {

@@ -11,6 +11,16 @@ use crate::sequence::{
 };
 use crate::signature::{match_signature, Diagnosis, Fault, FAULT_COUNT};
 
+/// The gate's ripple rule (`MonitorConfig::steady_gate_per_s`): the gate opens after it
+/// has been closed for this many hold times (`gate_hold_s`, 1.5 s by default) while the
+/// operating point's slow trend has been steady for [`RIPPLE_TREND_HOLDS`]: longer than a
+/// load or supply step's transient keeps it closed, so a persistent closure over a steady
+/// trend is a ripple the steady-state model averages over, not a transient.
+const RIPPLE_CLOSED_HOLDS: u32 = 3;
+/// How long the trend must have been steady for the ripple rule [hold times] (1 s by
+/// default): a step's trend moves for about a second (the trend filters' corner, 0.5 Hz).
+const RIPPLE_TREND_HOLDS: u32 = 2;
+
 impl Monitor {
     /// Holds the sensor faults in `bad` for a second and names them outright.
     #[cold]
@@ -199,7 +209,10 @@ impl Monitor {
         self.settle_left = self.settle_left.saturating_sub(1);
     }
 
-    /// Quasi-steady-state gate on the filtered derivatives (`steady_gate_per_s`).
+    /// Quasi-steady-state gate on the filtered derivatives (`steady_gate_per_s`), with its
+    /// timeout and its ripple rule: a closure longer than [`RIPPLE_CLOSED_HOLDS`] holds
+    /// while the slow trend has been steady for [`RIPPLE_TREND_HOLDS`] holds is a ripple
+    /// (a broken rotor bar's `2 s f` torque ripple, a pulsating load), not a transient.
     #[inline(always)]
     fn update_gate(&mut self) {
         let g = self.cfg.steady_gate_per_s;
@@ -209,14 +222,23 @@ impl Monitor {
             } else {
                 self.gate_left = self.gate_left.saturating_sub(1);
             }
+            if self.filters.trend_changing(g, &self.derived) {
+                self.trend_steady_for = 0;
+            } else {
+                self.trend_steady_for = self.trend_steady_for.saturating_add(1);
+            }
         }
         if self.gate_left == 0 {
             self.gate_closed_for = 0;
         } else {
             self.gate_closed_for = self.gate_closed_for.saturating_add(1);
         }
-        self.out.quasi_steady =
-            self.gate_left == 0 || self.gate_closed_for > self.derived.gate_timeout_blocks;
+        let hold = self.derived.gate_blocks.max(1);
+        let ripple = self.gate_closed_for > RIPPLE_CLOSED_HOLDS.saturating_mul(hold)
+            && self.trend_steady_for > RIPPLE_TREND_HOLDS.saturating_mul(hold);
+        self.out.quasi_steady = self.gate_left == 0
+            || ripple
+            || self.gate_closed_for > self.derived.gate_timeout_blocks;
     }
 
     /// Commissioning (learning the healthy statistics) or the lamp logic, on the normalised

@@ -416,6 +416,52 @@ pub(in crate::replay) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
     of(State::Clear, format!("no shorted turns: {change}"))
 }
 
+/// The rotor's finding from the current spectrum (MCSA): broken bars named from the band "a
+/// cracked bar or a high-resistance joint likely" on (48 dB or less below the supply line,
+/// `monitor_core::verdict::ROTOR_FAULT_DB`), with the spectrum's confidence; quieter
+/// sidebands ("no sign", and the "watch" band, which practice trends rather than acts on)
+/// are judged clear, with their level; a record the spectrum could not read is unavailable.
+pub(in crate::replay) fn rotor_finding(r: &crate::replay::RotorReport) -> FindingReport {
+    use crate::replay::RotorBand;
+    let of = |state, summary: String, brief: String| {
+        FindingReport::new(
+            FindingSource::Rotor,
+            state,
+            Against::Nothing,
+            summary,
+            brief,
+        )
+    };
+    let (Some(level), Some(band), true) = (r.level_db, r.band, r.judged) else {
+        let why = r
+            .cannot_judge_because
+            .clone()
+            .unwrap_or_else(|| "the sidebands were not read".to_string());
+        return of(State::Unavailable, why.clone(), format!("rotor: {why}"));
+    };
+    let below = -level as f32;
+    let brief = format!("rotor sidebands {below:.0} dB below the supply line");
+    match band {
+        RotorBand::NoSign | RotorBand::Watch => {
+            let brief = if band == RotorBand::Watch {
+                format!("{brief} (the watch band: trend it)")
+            } else {
+                brief
+            };
+            of(State::Clear, r.sentence.clone(), brief)
+        }
+        _ => {
+            let named = NamedFault {
+                fault: FaultName::BrokenBars,
+                size: Size::DbBelowLine(below),
+                phase: None,
+                confidence: r.confidence.unwrap_or(0.0) as f32,
+            };
+            of(State::Named(named), r.sentence.clone(), brief)
+        }
+    }
+}
+
 /// The data-quality finding: what the stage does not trust, the stretches not judged, and
 /// the sensors' readings no machine gives at the end (`sensors`, the core's flags).
 pub(in crate::replay) fn data_quality_finding(

@@ -192,16 +192,19 @@ use monitor_core::MonitorOutput;
 impl Replay {
     /// Every analysis' finding at the end of the replay (the data quality's is added by the
     /// caller that ran the data-quality stage, `diagnose`): the residuals, the winding, the
-    /// operating point, the parameter file's fit, and the sensors' impossible readings.
+    /// rotor, the operating point, the parameter file's fit, and the sensors' impossible
+    /// readings.
     pub(in crate::replay) fn findings(
         &self,
         inp: &findings::ResidualInputs<'_>,
         unbalance: &UnbalanceReport,
+        rotor: &crate::replay::RotorReport,
     ) -> Vec<FindingReport> {
         let residual = self.residual_finding(inp);
         let mut found = vec![
             residual.clone(),
             findings::winding_finding(unbalance),
+            findings::rotor_finding(rotor),
             self.operating_point_finding(inp.out, inp.isolation),
             self.parameter_fit_finding(&residual, inp.isolation),
         ];

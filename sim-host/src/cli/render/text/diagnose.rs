@@ -57,7 +57,7 @@ fn findings_block(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<
     Ok(())
 }
 
-/// `diagnose`'s timeline, lamps, candidates and unbalance.
+/// `diagnose`'s timeline, lamps, candidates, unbalance and rotor.
 pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
     let rep = &d.report;
     let mut out = crate::cli::stdout();
@@ -80,6 +80,8 @@ pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
         events(&mut out, &rep.isolation)?;
     }
     unbalance(&mut out, &rep.unbalance)?;
+    // The rotor's finding or why there is none, in one line ("rotor: ...").
+    writeln!(out, "{}", rep.rotor.sentence)?;
     for n in &rep.commissioning.outside_range {
         writeln!(out, "note at {:.2} s: {}", n.t_s, n.note)?;
     }
