@@ -55,7 +55,15 @@ pub fn fault_text(n: &NamedFault) -> String {
                 None => format!("shorted turns: {what}"),
             }
         }
-        (FaultName::BrokenBars, size) => format!("broken rotor bars: {}", size_text(size)),
+        (FaultName::BrokenBars, size) => {
+            let band = match size {
+                Size::DbBelowLine(db) => {
+                    format!(" ({})", crate::replay::band_of(-f64::from(db)).words())
+                }
+                _ => String::new(),
+            };
+            format!("broken rotor bars: {}{band}", size_text(size))
+        }
         (FaultName::Friction, size) => format!("b/bl {}", size_text(size)),
         (FaultName::Table1(f), size) => {
             let p = phase.map_or(String::new(), |p| format!(" (phase {p})"));
