@@ -247,7 +247,7 @@ impl FleetRow {
             }
             None => None,
         };
-        let winding = (u.suspect_phase.is_some() && u.baseline.is_some()).then(|| {
+        let winding = u.names_a_short().then(|| {
             (
                 "shorted_turns".to_string(),
                 Some(u.winding_ratio),

@@ -50,8 +50,13 @@
 //! [`slip_for_current`] estimates it from the current magnitude.
 
 mod phasor_fit;
+mod posterior;
 mod zero;
 pub use phasor_fit::{PhasorFit, ThreePhasors, MIN_SAMPLES as PHASOR_FIT_MIN_SAMPLES};
+pub use posterior::{
+    least_change, ln_no_short, ln_short, phase_posterior, PhasePosterior, ShortModel,
+    LOOP_ANGLE_SD_DEG, NO_SHORT_PRIOR, SHORT_RATIO_MAX, SHORT_RATIO_MIN,
+};
 pub use zero::{
     phase_phasors, single_phase_gain, SinglePhaseGain, ZeroSequence, MAX_MISALIGNMENT_DEG,
 };

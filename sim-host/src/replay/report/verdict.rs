@@ -54,8 +54,9 @@ pub(super) fn nominal_cannot_judge(
 
 /// The verdict from the replay's findings: `withheld` the reasons a judgement is withheld
 /// (returned with a watching reason added where it applies), `detected` whether a lamp or
-/// the isolation detected a fault, `winding` whether shorted turns were named against a
-/// healthy reference, `sensor_fault` whether a sensor lamp is lit.
+/// the isolation detected a fault, `winding` whether shorted turns were named at a
+/// probability of at least one half (`UnbalanceReport::names_a_short`), `sensor_fault`
+/// whether a sensor lamp is lit.
 pub(super) fn verdict_of(
     mut withheld: Vec<String>,
     detected: bool,
@@ -63,9 +64,8 @@ pub(super) fn verdict_of(
     sensor_fault: bool,
     isolation: &IsolationReport,
 ) -> (Verdict, Vec<String>) {
-    // Shorted turns named against a healthy reference (the change stands clear of what
-    // healthy runs differ by, and its angle of the reference's uncertainty) are a fault
-    // whatever else could not be judged.
+    // Shorted turns named at a probability of at least one half (a calibrated
+    // probability, `docs/isolation.md`) are a fault whatever else could not be judged.
     if winding {
         return (Verdict::Fault, withheld);
     }

@@ -6,7 +6,8 @@ use monitor_core::Phase;
 use sim_host::demo::MonitorState;
 use sim_host::log::quality::DataQuality;
 use sim_host::replay::{
-    angle_source_name, CommissioningReport, DiagnoseReport, Diagnosed, IsolationName, Verdict,
+    angle_source_name, CommissioningReport, DiagnoseReport, Diagnosed, IsolationName,
+    JudgedAgainst, Verdict,
 };
 use std::io::Write;
 use std::path::Path;
@@ -32,7 +33,7 @@ fn temperature_line(t: &sim_host::replay::TemperatureReport) -> Option<String> {
 /// The verdict line of `diagnose` and the demo.
 pub(super) fn verdict(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
     let u = &rep.unbalance;
-    if let (Verdict::Fault, Some(p), Some(_)) = (rep.verdict, u.suspect_phase, u.baseline) {
+    if let (Verdict::Fault, Some(p), true) = (rep.verdict, u.suspect_phase, u.names_a_short()) {
         let also = if rep.verdict_withheld_because.is_empty() {
             String::new()
         } else {
@@ -41,7 +42,7 @@ pub(super) fn verdict(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Res
         let named = named_fault(rep);
         writeln!(
             out,
-            "verdict: FAULT{}{} shorted turns in phase {} (the negative sequence changed by {:.1} % of I1, confidence {:.2}){also}",
+            "verdict: FAULT{}{} shorted turns in phase {} (the negative sequence changed by {:.1} % of I1, probability {:.2}){also}",
             named,
             if named.is_empty() { "" } else { " and" },
             p.name(),
@@ -258,15 +259,22 @@ fn unbalance(out: &mut impl Write, u: &sim_host::replay::UnbalanceReport) -> any
     if u.segments.len() > 1 {
         stretches(out, u)?;
     }
-    let against = match (u.baseline, u.baseline_runs) {
-        (Some(sim_host::replay::BaselineSource::File), 1) => "against 1 healthy run".to_string(),
-        (Some(sim_host::replay::BaselineSource::File), n) => format!(
+    let against = match (u.judged_against, u.baseline_runs) {
+        (Some(JudgedAgainst::HealthyRuns), 1) => "against 1 healthy run".to_string(),
+        (Some(JudgedAgainst::HealthyRuns), n) => format!(
             "against the mean of {n} healthy runs (their spread {:.1} %)",
             100.0 * u.baseline_spread.unwrap_or(0.0)
         ),
-        (Some(sim_host::replay::BaselineSource::Commissioning), _) => {
-            "against the commissioning window".to_string()
+        (Some(JudgedAgainst::WithinTheLog), _) => {
+            match u.reference_segment.and_then(|k| u.segments.get(k)) {
+                Some(r) => format!(
+                    "against the stretch at {:.1}..{:.1} s of the log",
+                    r.from_s, r.to_s
+                ),
+                None => JudgedAgainst::WithinTheLog.describe().to_string(),
+            }
         }
+        (Some(a), _) => a.describe().to_string(),
         (None, _) => "with no healthy baseline".to_string(),
     };
     let reference = u.operating_point.map(|o| {
@@ -280,7 +288,7 @@ fn unbalance(out: &mut impl Write, u: &sim_host::replay::UnbalanceReport) -> any
     match (u.suspect_phase, &u.phase_not_judged) {
         (Some(p), _) => writeln!(
             out,
-            "winding: shorted turns in phase {} (confidence {:.2}): the negative sequence changed by {:.1} % of I1 {against}, least change {:.1} %; {}",
+            "winding: shorted turns in phase {} (probability {:.2}): the negative sequence changed by {:.1} % of I1 {against}, least change {:.1} %; {}",
             p.name(),
             u.phase_confidence,
             100.0 * u.winding_ratio,
@@ -289,6 +297,9 @@ fn unbalance(out: &mut impl Write, u: &sim_host::replay::UnbalanceReport) -> any
         )?,
         (None, Some(why)) => writeln!(out, "winding: {why}")?,
         (None, None) => {}
+    }
+    if let Some(w) = &u.least_change_widened {
+        writeln!(out, "  {w}")?;
     }
     Ok(())
 }
