@@ -89,22 +89,34 @@ pub const HEALTHY_RUN_DIFFERENCE_CURRENTS: f32 = 0.021;
 /// The same with voltages logged (the supply's part taken out): two healthy runs of a
 /// 1.1 kW motor, measured on recordings not in this repository, differ by 1.3 %.
 pub const HEALTHY_RUN_DIFFERENCE_VOLTAGES: f32 = 0.013;
+/// `|Z1/Z2|` of the ITSC motor at no load (its parameter file): how much its negative-
+/// sequence current magnifies the supply's `V2/V1`, where the spreads below were measured.
+pub const MEASURED_Z_RATIO: f32 = 5.1;
 /// The default spread `s0` of a healthy run's reading without voltages, each component:
 /// half of [`HEALTHY_RUN_DIFFERENCE_CURRENTS`], so that the RMS size of the change between
 /// two healthy runs, `2 s0`, is what two healthy runs of one motor were measured to
-/// differ by (never less).
+/// differ by (never less). A motor that magnifies the supply's unbalance more gets more
+/// ([`SUPPLY_DRIFT_BETWEEN_RUNS`]).
 pub const DEFAULT_SPREAD_CURRENTS: f32 = 0.5 * HEALTHY_RUN_DIFFERENCE_CURRENTS;
 /// The same with voltages: half of [`HEALTHY_RUN_DIFFERENCE_VOLTAGES`].
 pub const DEFAULT_SPREAD_VOLTAGES: f32 = 0.5 * HEALTHY_RUN_DIFFERENCE_VOLTAGES;
+/// How much the supply's `V2/V1` drifts between runs (each component): the ITSC runs'
+/// [`DEFAULT_SPREAD_CURRENTS`] through their motor's [`MEASURED_Z_RATIO`]. Without
+/// voltages a healthy run's spread is at least this times the motor's `|Z1/Z2|`.
+pub const SUPPLY_DRIFT_BETWEEN_RUNS: f32 = DEFAULT_SPREAD_CURRENTS / MEASURED_Z_RATIO;
 /// Spread of a healthy stretch's reading about another stretch of the same log, each
 /// component: 0.4 % of `|I1|`, what the healthy stretches of different runs of one
 /// session of the ITSC recordings (minutes apart, run 001) scatter by (0.38 %); stretches
-/// of one run (seconds apart) scatter by 0.15 %.
+/// of one run (seconds apart) scatter by 0.15 %. Without voltages a motor that magnifies
+/// the supply's drift more gets more, in proportion to `|Z1/Z2|`.
 pub const WITHIN_LOG_SPREAD: f32 = 0.004;
-/// Without any healthy reference and without voltages, the spread is a healthy machine's
-/// own asymmetry ([`INHERENT_ASYMMETRY_RATIO`], 3 % each component): with the supply's
-/// unbalance, which the currents alone cannot tell from it, a healthy motor's `I2/I1`
-/// reaches twice that.
+/// A typical supply's `V2/V1`, each component (its size mostly below 1 %; public grids
+/// keep it below 2 %, EN 50160): without voltages and without any healthy reference, a
+/// healthy machine reads this times its `|Z1/Z2|` on top of its own asymmetry.
+pub const SUPPLY_UNBALANCE_SPREAD: f32 = 0.007;
+/// A healthy machine's own asymmetry as a spread ([`INHERENT_ASYMMETRY_RATIO`], 3 % each
+/// component), judged against nothing; without voltages the supply's part
+/// ([`SUPPLY_UNBALANCE_SPREAD`] times `|Z1/Z2|`) is added.
 pub const NO_BASELINE_SPREAD: f32 = INHERENT_ASYMMETRY_RATIO;
 /// Without a healthy reference but with voltages (the supply's part taken out): half of
 /// it.
@@ -344,6 +356,13 @@ impl From<UnbalanceBaseline> for HealthyReference {
     }
 }
 
+/// [`HealthyReference::change_sigma`] of `runs` runs whose readings' squared distances
+/// from their mean sum to `sum_sq_dev`, with the default spread `s0`.
+pub(crate) fn pooled_change_sigma(s0: f32, runs: u32, sum_sq_dev: f32) -> f32 {
+    let n = runs.max(1) as f32;
+    ((2.0 * s0 * s0 + sum_sq_dev) / (2.0 * n)).sqrt() * (1.0 + 1.0 / n).sqrt()
+}
+
 impl HealthyReference {
     /// The reference made of several healthy runs (`diagnose --baseline` with several
     /// logs); `None` for none.
@@ -393,7 +412,7 @@ impl HealthyReference {
     /// The spread of a new healthy reading's change from the runs' mean (each component):
     /// `sigma_run sqrt(1 + 1/n)`.
     pub fn change_sigma(&self, s0: f32) -> f32 {
-        self.sigma(s0) * (1.0 + 1.0 / self.runs.max(1) as f32).sqrt()
+        pooled_change_sigma(s0, self.runs, self.sum_sq_dev)
     }
 }
 

@@ -14,7 +14,11 @@
 //!
 //! Under a short the loop itself draws `|1 + r|` of `I1` (Tallam; `|r|` from the reading,
 //! `|(M - R)/(a^k - M)|`, its angle the reference angle): the healthy current at the
-//! stretch is `I1/|1 + r|`, and only the rest of the change of `I1` is the load's.
+//! stretch is `I1/|1 + r|`, and only the rest of the change of `I1` is the load's. That
+//! rest is evidence too: the load stayed (the rest within [`SAME_LOAD_CURRENT_SD`]) or it
+//! moved (anywhere within a factor of [`LOAD_MOVE_RANGE`]), each as likely as the other
+//! ([`Anchor::ln_current`]). So a stretch whose `|I1|` rose with its negative sequence
+//! carries the short, not the one it is judged against.
 
 use super::probability::Reading;
 use super::{abs, cdiv, sub, C};
@@ -27,6 +31,13 @@ pub const SPLITS: usize = 9;
 /// Relative error of the model's account of the move (the turn `d` and the ratio `q`
 /// near no load, where `arg Z1` turns fast with the load).
 pub const MOVE_MODEL_ERROR: f32 = 0.3;
+
+/// Spread of `ln |I1|` between two stretches at one load: the supply's voltage and the
+/// shorted loop's share of the current beyond Tallam's (on the real recordings the loop
+/// raises `|I1|` by up to 5 % more than `|1 + r|` at the reference angle).
+pub const SAME_LOAD_CURRENT_SD: f32 = 0.03;
+/// A load that moved changes `|I1|` by up to this factor either way.
+pub const LOAD_MOVE_RANGE: f32 = 2.0;
 
 /// The model's `arg Z1` at a stretch's operating point when it draws `|I1|` = the given
 /// current [A, peak] (what a healthy machine would draw there), where known.
@@ -51,6 +62,34 @@ impl Anchor {
     /// `(I1_R/I1_h) e^{jd}` at stretch `rd` under no short (`None`) or a short in a phase
     /// (module docs).
     fn turn(&self, rd: &Reading, short: Option<Phase>, angle_at: AngleAt<'_>) -> C {
+        let q = self.current_ratio(rd, short);
+        let i1_h = self.i1 / q;
+        let d = match (self.z1, angle_at(rd, i1_h)) {
+            (Some(a), Some(b)) => b - a,
+            _ => 0.0,
+        };
+        (q * d.cos(), q * d.sin())
+    }
+
+    /// `ln` of the density of the change of `|I1|` that the short does not draw:
+    /// `e = ln(I1_h/I1_R)`, the load stayed or moved (module docs).
+    fn ln_current(&self, rd: &Reading, short: Option<Phase>) -> f32 {
+        let e = -self.current_ratio(rd, short).ln();
+        if !e.is_finite() {
+            return 0.0;
+        }
+        let sd = SAME_LOAD_CURRENT_SD;
+        let stayed = (-(e * e) / (2.0 * sd * sd)).exp() / ((std::f32::consts::TAU).sqrt() * sd);
+        let moved = if e.abs() <= LOAD_MOVE_RANGE.ln() {
+            0.5 / LOAD_MOVE_RANGE.ln()
+        } else {
+            0.0
+        };
+        (0.5 * stayed + 0.5 * moved).max(1e-30).ln()
+    }
+
+    /// `I1_R/I1_h`: the reference's current over the healthy current at the stretch.
+    fn current_ratio(&self, rd: &Reading, short: Option<Phase>) -> f32 {
         // The loop's size from the reading, its angle the reference's: a hypothesis whose
         // phase does not fit the reading does not get a loop that turns I1 to fit.
         let loop_share = short.map_or(1.0, |p| {
@@ -64,12 +103,11 @@ impl Anchor {
             }
         });
         let i1_h = rd.i1 / loop_share;
-        let q = if i1_h > 0.0 { self.i1 / i1_h } else { 1.0 };
-        let d = match (self.z1, angle_at(rd, i1_h)) {
-            (Some(a), Some(b)) => b - a,
-            _ => 0.0,
-        };
-        (q * d.cos(), q * d.sin())
+        if i1_h > 0.0 && self.i1 > 0.0 {
+            self.i1 / i1_h
+        } else {
+            1.0
+        }
     }
 
     /// How far another operating point may move the reference (the length of the
@@ -98,7 +136,8 @@ impl Anchor {
 
     /// `ln` of the density of `rd`'s reading under a hypothesis (`short`), given `f(R', s)`,
     /// its `ln` density about a reference `R'` with spread `s` at one operating point:
-    /// averaged over where the reference may have moved (module docs).
+    /// averaged over where the reference may have moved, times the density of the change
+    /// of `|I1|` the short does not draw (module docs).
     pub fn ln_density(
         &self,
         rd: &Reading,
@@ -108,8 +147,9 @@ impl Anchor {
         f: &dyn Fn(C, f32) -> f32,
     ) -> f32 {
         let t = self.turn(rd, short, angle_at);
+        let current = self.ln_current(rd, short);
         if self.voltages {
-            return f(self.w, same.hypot(self.moved(t)));
+            return current + f(self.w, same.hypot(self.moved(t)));
         }
         let w = self.w;
         let end = (w.0 * t.0 - w.1 * t.1, w.0 * t.1 + w.1 * t.0);
@@ -123,6 +163,6 @@ impl Anchor {
         if !m.is_finite() {
             return m;
         }
-        m + (terms.iter().map(|x| (x - m).exp()).sum::<f32>() / SPLITS as f32).ln()
+        current + m + (terms.iter().map(|x| (x - m).exp()).sum::<f32>() / SPLITS as f32).ln()
     }
 }

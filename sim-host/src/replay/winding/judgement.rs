@@ -6,8 +6,8 @@ use super::probability::{judge_alone, judge_external, judge_within, External, Ju
 use super::{
     abs, cdiv, mean, measured_of, segment_of, segments, sub, HealthyReference, JudgedAgainst,
     OperatingPointSource, PhaseProbabilities, SequenceSegment, C, CURRENT_MODEL_UNCERTAINTY,
-    DEFAULT_SPREAD_CURRENTS, DEFAULT_SPREAD_VOLTAGES, FULL_LOAD_SLIP_MAX, MAX_SEGMENTS,
-    MEASURED_REFERENCE_UNCERTAINTY_DEG, MIN_SEGMENT_WINDOWS, SLIP_MODEL_UNCERTAINTY,
+    FULL_LOAD_SLIP_MAX, MAX_SEGMENTS, MEASURED_REFERENCE_UNCERTAINTY_DEG, MIN_SEGMENT_WINDOWS,
+    SLIP_MODEL_UNCERTAINTY,
 };
 use crate::replay::report::BaselineSource;
 use crate::replay::sequences::{sensor_phase, SequenceWindow};
@@ -17,13 +17,12 @@ use monitor_core::sequence::{
 };
 use monitor_core::MotorModel;
 
-/// What every stretch is judged with: the model, the nominal supply, whether the speed is
-/// measured, and the default spread of a healthy run.
+/// What every stretch is judged with: the model, the nominal supply, and whether the
+/// speed is measured.
 struct Judge {
     m: MotorModel,
     v_nominal: f32,
     speed: bool,
-    s0: f32,
 }
 
 impl Judge {
@@ -128,6 +127,25 @@ impl Judge {
             sem: seg.sem,
             op,
             z1_angle: self.z1_angle(seg.we, seg.wr, seg.i1_peak_a),
+            z_ratio: self.z_ratio(seg.we, op.2),
+        }
+    }
+
+    /// The model's `|Z1/Z2|` at slip `s` (`None`: the largest of no load and
+    /// [`FULL_LOAD_SLIP_MAX`]).
+    fn z_ratio(&self, we: f32, s: Option<f32>) -> f32 {
+        let at = |s: f32| {
+            let z1 = abs(equivalent_impedance(&self.m, we, s));
+            let z2 = abs(equivalent_impedance(&self.m, we, 2.0 - s));
+            if z2 > 0.0 {
+                z1 / z2
+            } else {
+                1.0
+            }
+        };
+        match s {
+            Some(s) => at(s),
+            None => at(1e-4).max(at(FULL_LOAD_SLIP_MAX)),
         }
     }
 }
@@ -158,16 +176,10 @@ impl Replay {
         let windows = self.book.windows();
         let segs = segments(windows);
         let (measured, whole_ratio) = measured_of(windows, &segs);
-        let voltages = self.channels.voltages;
         let judge = Judge {
             m: self.params.motor.model(),
             v_nominal: self.params.supply.v_phase_peak() as f32,
             speed: self.monitor.is_some(),
-            s0: if voltages {
-                DEFAULT_SPREAD_VOLTAGES
-            } else {
-                DEFAULT_SPREAD_CURRENTS
-            },
         };
         let readings: Vec<Reading> = segs
             .iter()
@@ -251,7 +263,8 @@ fn from_runs(judge: &Judge, f: &HealthyReference, we0: f32) -> Outside {
             i1: f.mean.i1_peak_a,
             wr: f.mean.wr_rad_s,
             z1_angle: judge.z1_angle(we0, f.mean.wr_rad_s, f.mean.i1_peak_a),
-            sigma: f.change_sigma(judge.s0),
+            runs: f.runs,
+            sum_sq_dev: f.sum_sq_dev,
             against: JudgedAgainst::HealthyRuns,
         },
     }
@@ -270,7 +283,8 @@ fn learned_reference(judge: &Judge, windows: &[SequenceWindow], we0: f32) -> Opt
                 i1: s.i1_peak_a,
                 wr: s.wr,
                 z1_angle: judge.z1_angle(we0, s.wr, s.i1_peak_a),
-                sigma: judge.s0 * std::f32::consts::SQRT_2,
+                runs: 1,
+                sum_sq_dev: 0.0,
                 against: JudgedAgainst::Commissioning,
             },
         }

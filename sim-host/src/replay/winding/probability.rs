@@ -15,8 +15,9 @@
 
 use super::anchor::{Anchor, AngleAt};
 use super::{
-    abs, sub, JudgedAgainst, OperatingPointSource, C, NO_BASELINE_SPREAD,
-    NO_BASELINE_SPREAD_VOLTAGES, WITHIN_LOG_SPREAD,
+    abs, pooled_change_sigma, sub, JudgedAgainst, OperatingPointSource, C, DEFAULT_SPREAD_CURRENTS,
+    DEFAULT_SPREAD_VOLTAGES, MEASURED_Z_RATIO, NO_BASELINE_SPREAD, NO_BASELINE_SPREAD_VOLTAGES,
+    SUPPLY_DRIFT_BETWEEN_RUNS, SUPPLY_UNBALANCE_SPREAD, WITHIN_LOG_SPREAD,
 };
 use monitor_core::sequence::{ln_no_short, ln_short, phase_posterior, PhasePosterior, ShortModel};
 use monitor_core::Phase;
@@ -46,6 +47,9 @@ pub(super) struct Reading {
     /// current's magnitude gives it (to turn a reference's supply part to the stretch's
     /// load), else `None`.
     pub z1_angle: Option<f32>,
+    /// The model's `|Z1/Z2|` there (the largest over the range of loads where the
+    /// operating point is not known): how much the supply's `V2/V1` shows in `I2/I1`.
+    pub z_ratio: f32,
 }
 
 impl Reading {
@@ -61,15 +65,33 @@ impl Reading {
         }
     }
 
-    /// A healthy machine's own asymmetry as a spread for this stretch, with its own
-    /// standard error.
+    /// A healthy machine's own asymmetry as a spread for this stretch (with the supply's
+    /// unbalance through `|Z1/Z2|` without voltages), with its own standard error.
     fn alone_sigma(&self) -> f32 {
         let own = if self.voltages {
             NO_BASELINE_SPREAD_VOLTAGES
         } else {
-            NO_BASELINE_SPREAD
+            NO_BASELINE_SPREAD.hypot(SUPPLY_UNBALANCE_SPREAD * self.z_ratio)
         };
         own.hypot(self.sem)
+    }
+
+    /// The default spread of one healthy run's reading at this stretch (each component).
+    pub fn run_sigma(&self) -> f32 {
+        if self.voltages {
+            DEFAULT_SPREAD_VOLTAGES
+        } else {
+            DEFAULT_SPREAD_CURRENTS.max(SUPPLY_DRIFT_BETWEEN_RUNS * self.z_ratio)
+        }
+    }
+
+    /// The spread of a healthy stretch about another of the same log (each component).
+    fn within_sigma(&self) -> f32 {
+        if self.voltages {
+            WITHIN_LOG_SPREAD
+        } else {
+            WITHIN_LOG_SPREAD.max(WITHIN_LOG_SPREAD / MEASURED_Z_RATIO * self.z_ratio)
+        }
     }
 }
 
@@ -83,8 +105,10 @@ pub(super) struct External {
     pub wr: Option<f32>,
     /// The model's `arg Z1` at its operating point, where known.
     pub z1_angle: Option<f32>,
-    /// The spread of a healthy stretch's change from it (each component).
-    pub sigma: f32,
+    /// How many healthy runs it is the mean of (1 for the commissioning window).
+    pub runs: u32,
+    /// `sum |h_i - mean|^2` of their readings (0 for one).
+    pub sum_sq_dev: f32,
     /// Which it is.
     pub against: JudgedAgainst,
 }
@@ -158,7 +182,8 @@ pub(super) fn judge_external(
                 i1: ext.i1,
                 z1: ext.z1_angle,
             };
-            let same = ext.sigma.hypot(rd.sem);
+            let change = pooled_change_sigma(rd.run_sigma(), ext.runs, ext.sum_sq_dev);
+            let same = change.hypot(rd.sem);
             (rd, anchor, same, abs(sub(rd.w, w_ref)) / same.max(1e-6))
         })
         .max_by(|a, b| a.3.total_cmp(&b.3))?;
@@ -194,8 +219,8 @@ pub(super) fn judge_alone(rd: &Reading) -> Judged {
 
 /// The spread of the change between two stretches of one log at one operating point.
 fn pair_same(i: &Reading, j: &Reading) -> f32 {
-    let w2 = 2.0 * WITHIN_LOG_SPREAD * WITHIN_LOG_SPREAD;
-    (w2 + i.sem * i.sem + j.sem * j.sem).sqrt()
+    let w = i.within_sigma().max(j.within_sigma());
+    (2.0 * w * w + i.sem * i.sem + j.sem * j.sem).sqrt()
 }
 
 /// Stretch `r` as the reference of another.
