@@ -100,7 +100,7 @@ fn judge(
 /// The parameter file as a nameplate gives it: the rotor resistance 20 % high and the
 /// leakages 15 % low (the simulated machine is `p`).
 fn nameplate_off(p: &ParamFile) -> ParamFile {
-    let mut q = p.clone();
+    let mut q = *p;
     let m = &mut q.motor;
     m.rr_ohm *= 1.2;
     let (lls, llr) = (m.ls_h - m.lm_h, m.lr_h - m.lm_h);

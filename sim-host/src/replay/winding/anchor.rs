@@ -89,7 +89,7 @@ impl Anchor {
     }
 
     /// `I1_R/I1_h`: the reference's current over the healthy current at the stretch.
-    fn current_ratio(&self, rd: &Reading, short: Option<Phase>) -> f32 {
+    pub fn current_ratio(&self, rd: &Reading, short: Option<Phase>) -> f32 {
         // The loop's size from the reading, its angle the reference's: a hypothesis whose
         // phase does not fit the reading does not get a loop that turns I1 to fit.
         let loop_share = short.map_or(1.0, |p| {

@@ -175,39 +175,46 @@ impl Replay {
     pub(in crate::replay) fn unbalance_report(&self) -> UnbalanceReport {
         let windows = self.book.windows();
         let segs = segments(windows);
-        let (measured, whole_ratio) = measured_of(windows, &segs);
         let judge = Judge {
             m: self.params.motor.model(),
             v_nominal: self.params.supply.v_phase_peak() as f32,
             speed: self.monitor.is_some(),
         };
-        let readings: Vec<Reading> = segs
-            .iter()
-            .enumerate()
-            .map(|(k, seg)| judge.reading(k, seg))
-            .collect();
-        let file = self.opts.unbalance_baseline;
         let we0 = std::f32::consts::TAU * self.params.supply.f_hz as f32;
-        let angle_at = |rd: &Reading, i1: f32| judge.z1_angle(rd.we, rd.wr, i1);
-        let outside = file
+        let outside = self
+            .opts
+            .unbalance_baseline
             .map(|f| from_runs(&judge, &f, we0))
             .or_else(|| learned_reference(&judge, windows, we0));
-        let judged = match &outside {
-            Some(o) => {
-                let part = |rd: &Reading| {
-                    let v2 = o.v2.filter(|_| rd.voltages);
-                    let slip = rd.op.2.unwrap_or(0.0).max(1e-4);
-                    winding_part(o.r, v2, &judge.m, rd.we, slip)
-                };
-                judge_external(&readings, &o.ext, &part, &angle_at)
+        let judged = judge_stretches(&judge, &segs, outside.as_ref());
+        let mut report = self.report_without_judgement(windows, &segs, outside.as_ref());
+        match &judged {
+            None => report.phase_not_judged = Some(no_stretch_reason(self.params.supply.f_hz)),
+            Some(j) => {
+                fill_judgement(&mut report, j, &segs);
+                let poles = self.params.motor.poles.max(2) as f32 / 2.0;
+                if let Some(o) = &outside {
+                    report.least_change_widened = super::reasons::widened(j, &o.ext, poles);
+                }
             }
-            None => {
-                judge_within(&readings, &angle_at).or_else(|| readings.first().map(judge_alone))
-            }
-        };
+        }
+        report.segments = listed_segments(segs, judged.map(|j| j.index));
+        report
+    }
+
+    /// The report's keys that do not depend on the judgement (`outside`: the healthy
+    /// reference from outside the log, if any).
+    fn report_without_judgement(
+        &self,
+        windows: &[SequenceWindow],
+        segs: &[SequenceSegment],
+        outside: Option<&Outside>,
+    ) -> UnbalanceReport {
+        let (measured, whole_ratio) = measured_of(windows, segs);
+        let file = self.opts.unbalance_baseline;
         // The sensors at the log's end (as the isolation's candidates are).
         let (gi, gv) = segs.last().map_or((None, None), sensor_phases);
-        let mut report = UnbalanceReport {
+        UnbalanceReport {
             negative_sequence_ratio: whole_ratio,
             suspect_phase: None,
             phase_confidence: 0.0,
@@ -233,23 +240,37 @@ impl Replay {
             current_sensor_phase: gi.as_ref().map(SensorPhaseReport::from),
             voltage_sensor_phase: gv.as_ref().map(SensorPhaseReport::from),
             measured,
-            baseline: outside.as_ref().map(|o| match o.ext.against {
+            baseline: outside.map(|o| match o.ext.against {
                 JudgedAgainst::Commissioning => BaselineSource::Commissioning,
                 _ => BaselineSource::File,
             }),
-        };
-        match &judged {
-            None => report.phase_not_judged = Some(no_stretch_reason(self.params.supply.f_hz)),
-            Some(j) => {
-                fill_judgement(&mut report, j, &segs);
-                let poles = self.params.motor.poles.max(2) as f32 / 2.0;
-                if let Some(o) = &outside {
-                    report.least_change_widened = super::reasons::widened(j, &o.ext, poles);
-                }
-            }
         }
-        report.segments = listed_segments(segs, judged.map(|j| j.index));
-        report
+    }
+}
+
+/// The stretches judged (module docs, steps 3 and 4): against the reference from outside
+/// the log where there is one, else against each other, else one against nothing.
+fn judge_stretches(
+    judge: &Judge,
+    segs: &[SequenceSegment],
+    outside: Option<&Outside>,
+) -> Option<Judged> {
+    let readings: Vec<Reading> = segs
+        .iter()
+        .enumerate()
+        .map(|(k, seg)| judge.reading(k, seg))
+        .collect();
+    let angle_at = |rd: &Reading, i1: f32| judge.z1_angle(rd.we, rd.wr, i1);
+    match outside {
+        Some(o) => {
+            let part = |rd: &Reading| {
+                let v2 = o.v2.filter(|_| rd.voltages);
+                let slip = rd.op.2.unwrap_or(0.0).max(1e-4);
+                winding_part(o.r, v2, &judge.m, rd.we, slip)
+            };
+            judge_external(&readings, &o.ext, &part, &angle_at)
+        }
+        None => judge_within(&readings, &angle_at).or_else(|| readings.first().map(judge_alone)),
     }
 }
 
@@ -325,9 +346,10 @@ fn fill_judgement(report: &mut UnbalanceReport, j: &Judged, segs: &[SequenceSegm
     report.least_change = least.unwrap_or(0.0);
     report.spread = j.sigma;
     report.judged_against = Some(j.against);
-    report.phase_not_judged = segs
-        .get(j.index)
-        .and_then(|s| super::reasons::not_named(j, s, least));
+    report.phase_not_judged = segs.get(j.index).and_then(|s| {
+        let reference = j.reference.and_then(|k| segs.get(k));
+        super::reasons::not_named(j, s, reference, least)
+    });
     report.judged_segment = Some(j.index.min(MAX_SEGMENTS - 1));
     report.reference_segment = j.reference.filter(|&k| k < MAX_SEGMENTS);
 }

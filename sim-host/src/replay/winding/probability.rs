@@ -139,6 +139,9 @@ pub(super) struct Judged {
     pub against: JudgedAgainst,
     /// The stretch's reading (its reference angle).
     pub reading: Reading,
+    /// Against an outside reference: how much the load changed `|I1|` from it (relative),
+    /// the named short's own share taken out.
+    pub load_i1_change: Option<f32>,
 }
 
 /// The posterior of `rd` against `anchor` (spread `same` at one operating point), each
@@ -188,7 +191,9 @@ pub(super) fn judge_external(
         })
         .max_by(|a, b| a.3.total_cmp(&b.3))?;
     let (posterior, sigma) = posterior_against(rd, &anchor, same, angle_at);
+    let q = anchor.current_ratio(rd, posterior.named().map(|n| n.0));
     Some(Judged {
+        load_i1_change: Some(1.0 / q - 1.0),
         index: rd.index,
         reference: None,
         change: sub(rd.w, anchor.w),
@@ -214,6 +219,7 @@ pub(super) fn judge_alone(rd: &Reading) -> Judged {
         posterior: phase_posterior(rd.w, (0.0, 0.0), sigma, &rd.model()),
         against: JudgedAgainst::Nothing,
         reading: *rd,
+        load_i1_change: None,
     }
 }
 
@@ -246,14 +252,16 @@ pub(super) fn judge_within(readings: &[Reading], angle_at: AngleAt<'_>) -> Optio
             let z = |x: &Reading| abs(sub(x.w, i.w)) / pair_same(i, x).max(1e-6);
             z(a).total_cmp(&z(b))
         })?;
-    Some(Pair::judge(i, j, angle_at).judged())
+    Some(Pair::judge(i, j, pair_same(i, j), angle_at).judged())
 }
 
 /// The two stretches' hypotheses (module docs), as `ln` of prior times likelihood.
 struct Pair<'a> {
     i: &'a Reading,
     j: &'a Reading,
-    /// The spread of the change under no short.
+    /// The spread of the change at one operating point, and under no short.
+    same_point: f32,
+    /// See `same_point`.
     sw: f32,
     none: f32,
     /// Per phase: the short in `j` only, in `i` only, in both.
@@ -270,12 +278,13 @@ fn ln_sum(xs: &[f32]) -> f32 {
 }
 
 impl<'a> Pair<'a> {
-    fn judge(i: &'a Reading, j: &'a Reading, angle_at: AngleAt<'_>) -> Self {
+    /// The hypotheses of stretch `j` against stretch `i`, their change scattering by
+    /// `same_point` at one operating point.
+    fn judge(i: &'a Reading, j: &'a Reading, same_point: f32, angle_at: AngleAt<'_>) -> Self {
         let zero = (0.0, 0.0);
         let (hi, hj) = (i.alone_sigma(), j.alone_sigma());
         let healthy_i = ln_no_short(i.w, zero, hi);
         let healthy_j = ln_no_short(j.w, zero, hj);
-        let same_point = pair_same(i, j);
         let (from_i, from_j) = (anchor_of(i, j), anchor_of(j, i));
         let sw = from_i.spread(j, same_point, None, angle_at);
         let same = from_i.ln_density(j, same_point, None, angle_at, &|r, s| {
@@ -301,6 +310,7 @@ impl<'a> Pair<'a> {
         Pair {
             i,
             j,
+            same_point,
             sw,
             none: 0.5f32.ln() + healthy_i + same,
             short,
@@ -342,10 +352,11 @@ impl<'a> Pair<'a> {
             change,
             supply_ratio: index.supply,
             sigma,
-            sigma_same_point: sigma,
+            sigma_same_point: if which == 2 { sigma } else { self.same_point },
             posterior,
             against,
             reading: *index,
+            load_i1_change: None,
         }
     }
 }

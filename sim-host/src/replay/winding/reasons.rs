@@ -11,9 +11,15 @@ use monitor_core::Phase;
 pub const BALANCED_RATIO: f32 = 0.005;
 
 /// Why the judged stretch names no phase, in a sentence; `None` when it names one, or when
-/// the change is below [`BALANCED_RATIO`] (nothing to judge). `least` is the least change
+/// the change is below [`BALANCED_RATIO`] (nothing to judge). `seg` is the judged stretch,
+/// `reference` the stretch it was judged against within the log, `least` the least change
 /// that names a phase (fraction of `|I1|`; `None`: none does).
-pub(super) fn not_named(j: &Judged, seg: &SequenceSegment, least: Option<f32>) -> Option<String> {
+pub(super) fn not_named(
+    j: &Judged,
+    seg: &SequenceSegment,
+    reference: Option<&SequenceSegment>,
+    least: Option<f32>,
+) -> Option<String> {
     let p = j.posterior;
     if p.named().is_some() {
         return None;
@@ -21,7 +27,7 @@ pub(super) fn not_named(j: &Judged, seg: &SequenceSegment, least: Option<f32>) -
     let change = 100.0 * abs(j.change);
     let at = format!("{:.1}..{:.1} s", seg.from_s, seg.to_s);
     let (phase, best) = p.most_probable();
-    if p.short() > p.no_short && least.map_or(true, |l| abs(j.change) >= l) {
+    if p.short() > p.no_short && least.is_none_or(|l| abs(j.change) >= l) {
         // A short is the more probable, but no one phase is.
         let dev = deviation_deg(j, phase);
         let u = j.reading.model().angle_sd_rad.to_degrees();
@@ -45,9 +51,14 @@ pub(super) fn not_named(j: &Judged, seg: &SequenceSegment, least: Option<f32>) -
         JudgedAgainst::Nothing => format!(
             "cannot judge the phase: the negative sequence ({change:.1} % of I1 at {at}) is within what a healthy machine's own asymmetry may reach ({least}) and there is no healthy baseline (give --baseline with healthy logs of this motor, or commission)"
         ),
-        JudgedAgainst::WithinTheLog => format!(
-            "no phase: the negative sequence changed by {change:.1} % of I1 at {at} from the log's healthiest stretch, within what stretches of one healthy run differ by ({least})"
-        ),
+        JudgedAgainst::WithinTheLog => {
+            let from = reference.map_or(String::new(), |r| {
+                format!(" from the stretch at {:.1}..{:.1} s", r.from_s, r.to_s)
+            });
+            format!(
+                "no phase: the negative sequence changed by {change:.1} % of I1 at {at}{from}, within what stretches of one healthy log differ by at their loads ({least}), and neither stands clear of a healthy machine's own asymmetry"
+            )
+        }
         JudgedAgainst::HealthyRuns | JudgedAgainst::Commissioning => format!(
             "no phase: the change of the negative sequence ({change:.1} % of I1 at {at}) is within what healthy runs differ by ({least})"
         ),
@@ -74,12 +85,13 @@ fn neighbour(j: &Judged, phase: Phase) -> Phase {
 }
 
 /// The sentence that the outside reference `ext` ran at another operating point than the
-/// judged stretch (`|I1|` beyond [`SEGMENT_I1_STEP`] or the speed beyond
-/// [`OPERATING_SPEED_STEP`]) and the least change was widened for it; `None` at the same
-/// point. `pole_pairs` turns the electrical speed into the shaft's.
+/// judged stretch (`|I1|`, the named short's own share taken out, beyond
+/// [`SEGMENT_I1_STEP`], or the speed beyond [`OPERATING_SPEED_STEP`]) and the least change
+/// was widened for it; `None` at the same point. `pole_pairs` turns the electrical speed
+/// into the shaft's.
 pub(super) fn widened(j: &Judged, ext: &External, pole_pairs: f32) -> Option<String> {
     let rd = &j.reading;
-    let i1 = (rd.i1 > 0.0).then(|| rd.i1 / ext.i1.max(1e-9) - 1.0);
+    let i1 = j.load_i1_change.filter(|d| d.is_finite());
     let speed = rd.wr.zip(ext.wr).map(|(a, b)| a - b);
     let i1_moved = i1.filter(|d| d.abs() > SEGMENT_I1_STEP);
     let speed_moved = speed.filter(|d| d.abs() > OPERATING_SPEED_STEP * rd.we);
@@ -89,9 +101,14 @@ pub(super) fn widened(j: &Judged, ext: &External, pole_pairs: f32) -> Option<Str
     let mut how = Vec::new();
     if let Some(d) = i1 {
         how.push(format!(
-            "|I1| {:.0} % {}",
+            "|I1| {:.0} % {}{}",
             100.0 * d.abs(),
-            if d > 0.0 { "higher" } else { "lower" }
+            if d > 0.0 { "higher" } else { "lower" },
+            if j.posterior.named().is_some() {
+                " beyond the short's own share"
+            } else {
+                ""
+            }
         ));
     }
     if let Some(d) = speed {
@@ -110,7 +127,7 @@ pub(super) fn widened(j: &Judged, ext: &External, pole_pairs: f32) -> Option<Str
     // Two decimals where one would not show the widening.
     let digits = if (to - from) < 0.05 { 2 } else { 1 };
     Some(format!(
-        "{what} ran at another operating point than the judged stretch ({}; another load, or the short's own current): the least change widened from {from:.digits$} % to {to:.digits$} % (the negative sequence a healthy motor has moves with the load)",
+        "{what} ran at another operating point than the judged stretch ({}): the least change widened from {from:.digits$} % to {to:.digits$} % (the negative sequence a healthy motor has moves with the load)",
         how.join(", "),
     ))
 }
