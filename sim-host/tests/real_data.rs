@@ -315,7 +315,8 @@ fn common_daq_rates_give_the_verdicts_of_10_khz() {
         );
     }
     // Current-only logs of shorted turns in phase b: at 1 kHz the faulty-phase analysis
-    // runs and names the phase it names at 10 kHz.
+    // runs and names the phase it names at 10 kHz; named at a probability of 0.5 or more
+    // it is the verdict (the residuals need the voltages).
     let asym = "[[effects]]\nname = \"phase_asymmetry\"\nphase = \"b\"\nfraction = 0.08\n";
     let mut phases = Vec::new();
     for rate in [10_000.0, 1000.0] {
@@ -336,6 +337,9 @@ fn common_daq_rates_give_the_verdicts_of_10_khz() {
         );
         phases.push(d["unbalance"]["suspect_phase"].clone());
         assert!(d["skipped"].to_string().contains("voltages"));
+        let p = d["unbalance"]["phase_confidence"].as_f64().unwrap_or(0.0);
+        assert!(p >= 0.5, "{rate} Hz: {}", d["unbalance"]);
+
         // The residuals need the voltages, the winding does not: its phase is the verdict.
         assert_eq!(d["verdict"], "fault", "{}", d["verdict_line"]);
         assert_eq!(d["verdict_finding"]["fault"], "shorted_turns");

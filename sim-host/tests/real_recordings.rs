@@ -3,13 +3,14 @@
 //! one phase's turns shorted, the three line currents only, 1 kHz, 5 s, headerless CSV as
 //! published, read through the parameter file's `[columns]` table.
 //!
-//! What must hold (the issue "Real recordings, right answers"):
+//! What must hold (the issues "Real recordings, right answers" and "One verdict from all
+//! the evidence"):
 //! - every recording is read as published, and `unbalance.negative_sequence_ratio` lies
 //!   within 5 % (relative) of an independent least-squares fit written here;
-//! - against a baseline of the healthy runs the shorted phase is right in at least 22 of
-//!   the 24 fault recordings, never wrong at a confidence of 0.5 or more, and each healthy
-//!   run judged against the other gets no phase;
-//! - without a baseline no recording gets a wrong phase;
+//! - without a baseline the shorted phase is named at a probability of 0.5 or more in at
+//!   least 20 of the 24 fault recordings; against the two healthy runs in at least 23;
+//!   never a wrong phase at 0.5 or more in either mode; each healthy run alone, and
+//!   judged against the other, names no phase at 0.5 or more;
 //! - the same estimate holds on simulated logs up to 30 % negative sequence, with and
 //!   without voltages, at 1 and 10 kHz.
 
@@ -200,68 +201,75 @@ fn without_its_columns_table_a_published_file_is_refused_with_the_table_to_write
     );
 }
 
-#[test]
-fn the_shorted_phase_is_named_against_the_healthy_runs() {
-    let base = healthy_reference(&["SC_HLT_001", "SC_HLT_002"]);
-    let (mut right, mut total, mut failures) = (0, 0, Vec::new());
+/// Counts of one mode: the right phase at 0.5 or more, a wrong one at 0.5 or more, and
+/// neither (no phase, or one below 0.5).
+#[derive(Debug, Default)]
+struct Tally {
+    right: u32,
+    wrong: Vec<String>,
+    below: u32,
+}
+
+/// Every fault recording judged with `baseline`, counted.
+fn tally(baseline: Option<HealthyReference>, mode: &str) -> Tally {
+    let mut t = Tally::default();
     for name in recordings() {
         let Some(phase) = shorted(&name) else {
             continue;
         };
-        total += 1;
-        let u = judge(&name, Some(base));
+        let u = judge(&name, baseline);
         let got = u
             .suspect_phase
             .map(|p| p.name().chars().next().unwrap_or('?'));
         eprintln!(
-            "{name}: {got:?} confidence {:.2}, change {:.1} % at {:.0} deg, reference {:.0} +/- {:.0} deg{}",
+            "{mode} {name}: {got:?} probability {:.2} (no short {:.2}), change {:.1} % at {:.0} deg against {:?}, reference {:.0} +/- {:.0} deg{}",
             u.phase_confidence,
+            u.phase_probabilities.no_short,
             100.0 * u.winding_ratio,
             u.angle_deg,
+            u.judged_against,
             u.correction_deg,
             u.correction_uncertainty_deg,
             u.phase_not_judged.as_deref().map(|w| format!(" ({w})")).unwrap_or_default()
         );
-        if got == Some(phase) {
-            right += 1;
-        } else if got.is_some() && u.phase_confidence >= 0.5 {
-            failures.push(format!(
-                "{name}: wrong phase {got:?} at {:.2}",
-                u.phase_confidence
-            ));
+        match (got, u.names_a_short()) {
+            (Some(g), true) if g == phase => t.right += 1,
+            (_, true) => t
+                .wrong
+                .push(format!("{name}: {got:?} at {:.2}", u.phase_confidence)),
+            (_, false) => t.below += 1,
         }
     }
-    eprintln!("shorted phase right in {right} of {total}");
-    assert_eq!(total, 24);
-    assert!(right >= 22, "{right} of {total}");
-    assert!(failures.is_empty(), "{failures:#?}");
-    // Each healthy run against the other: no phase.
-    for (run, other) in [("SC_HLT_001", "SC_HLT_002"), ("SC_HLT_002", "SC_HLT_001")] {
-        let u = judge(run, Some(healthy_reference(&[other])));
-        assert_eq!(u.suspect_phase, None, "{run} against {other}: {u:?}");
+    eprintln!("{mode}: {t:?}");
+    t
+}
+
+#[test]
+fn without_a_baseline_the_shorted_phase_is_named_from_the_log_itself() {
+    // Each record switches the short on and off: its healthy stretches are the reference.
+    let t = tally(None, "no baseline");
+    assert_eq!(t.right + t.wrong.len() as u32 + t.below, 24);
+    assert!(t.right >= 20, "{t:?}");
+    assert!(t.wrong.is_empty(), "{t:?}");
+    for run in ["SC_HLT_001", "SC_HLT_002"] {
+        let u = judge(run, None);
+        assert!(!u.names_a_short(), "{run}: {u:?}");
         assert!(u.phase_not_judged.is_some(), "{run}: say why");
     }
 }
 
 #[test]
-fn without_a_baseline_no_recording_gets_a_wrong_phase() {
-    let (mut right, mut cannot) = (0, 0);
-    for name in recordings() {
-        let u = judge(&name, None);
-        let got = u
-            .suspect_phase
-            .map(|p| p.name().chars().next().unwrap_or('?'));
-        match (shorted(&name), got) {
-            (_, None) => {
-                assert!(u.phase_not_judged.is_some(), "{name}: say why");
-                cannot += 1;
-            }
-            (Some(p), Some(g)) if p == g => right += 1,
-            (want, Some(g)) => panic!("{name}: {g} named, shorted {want:?}: {u:?}"),
-        }
+fn the_shorted_phase_is_named_against_the_healthy_runs() {
+    let base = healthy_reference(&["SC_HLT_001", "SC_HLT_002"]);
+    let t = tally(Some(base), "against the healthy runs");
+    assert!(t.right >= 23, "{t:?}");
+    assert!(t.wrong.is_empty(), "{t:?}");
+    // Each healthy run against the other: no phase.
+    for (run, other) in [("SC_HLT_001", "SC_HLT_002"), ("SC_HLT_002", "SC_HLT_001")] {
+        let u = judge(run, Some(healthy_reference(&[other])));
+        assert!(!u.names_a_short(), "{run} against {other}: {u:?}");
+        assert!(u.phase_not_judged.is_some(), "{run}: say why");
     }
-    eprintln!("without a baseline: right {right}, cannot judge {cannot}");
-    assert!(right >= 12, "{right}");
 }
 
 /// A simulated log with a negative sequence of `unbalance` of the supply (and the currents

@@ -46,12 +46,19 @@
 //!
 //! This is the workspace's one faulty-phase method ([`suspect_phase`]): the monitor, the
 //! host's replay of current-only logs and the host's model-vs-measurement analysis all
-//! name the phase with it. Where the slip is not measured (a log with currents only),
+//! name the phase with it; how probable each phase is, with the uncertainties of the
+//! reference and of the healthy machine's own negative sequence, is [`phase_posterior`]'s
+//! (`posterior`). Where the slip is not measured (a log with currents only),
 //! [`slip_for_current`] estimates it from the current magnitude.
 
 mod phasor_fit;
+mod posterior;
 mod zero;
 pub use phasor_fit::{PhasorFit, ThreePhasors, MIN_SAMPLES as PHASOR_FIT_MIN_SAMPLES};
+pub use posterior::{
+    least_change, ln_no_short, ln_short, phase_posterior, PhasePosterior, ShortModel,
+    LOOP_ANGLE_SD_DEG, NO_SHORT_PRIOR, SHORT_RATIO_MAX, SHORT_RATIO_MIN,
+};
 pub use zero::{
     phase_phasors, single_phase_gain, SinglePhaseGain, ZeroSequence, MAX_MISALIGNMENT_DEG,
 };
@@ -353,94 +360,14 @@ pub fn asymmetry_correction_rad(m: &MotorModel, we: f32, s: f32) -> f32 {
 
 /// How far the angle `I2/I1` minus the correction lies inside its phase's 120-degree sector:
 /// 1 on the sector's centre, 0 on its border with the next phase (`1 - |dev| / 60 deg`).
-/// A reading near 0 names a phase by a hair; the phase's confidence in the reports.
+/// A reading near 0 names a phase by a hair. The board's measure (the monitor's
+/// [`NegativeSequence::phase_confidence`]); the host's reports give a probability
+/// instead ([`phase_posterior`]).
 pub fn phase_confidence(i2_over_i1_angle_rad: f32, correction_rad: f32) -> f32 {
     let third = core::f32::consts::TAU / 3.0;
     let x = crate::frames::wrap_angle(i2_over_i1_angle_rad - correction_rad) / third;
     let dev = x - F32Ext::round(x);
     crate::maxf(0.0, 1.0 - 2.0 * F32Ext::abs(dev))
-}
-
-/// Why [`judge_phase`] names no phase.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PhaseNotNamed {
-    /// The change is smaller than the least change that may name a phase (what a healthy
-    /// machine's negative sequence moves by between runs).
-    BelowLeastChange,
-    /// The angle lies so near the border between two phases' sectors that the reference
-    /// angle's and the measurement's uncertainties reach across it.
-    NearBorder,
-}
-
-/// A change of the negative sequence judged for the phase it points at, with its
-/// uncertainties ([`judge_phase`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PhaseJudgement {
-    /// The phase, or `None` ([`PhaseJudgement::not_named`] says why).
-    pub phase: Option<Phase>,
-    /// The phase whose sector the angle lies in, named or not.
-    pub nearest: Phase,
-    /// 0..1: `1 - (|dev| + u)/60 deg` with `dev` the angle's distance from its sector's
-    /// centre and `u = hypot(u_ref, u_meas)` the angle's uncertainty; 0 without a phase.
-    pub confidence: f32,
-    /// `|dev|` [rad].
-    pub deviation_rad: f32,
-    /// `u` [rad]: the reference angle's uncertainty and the measurement's,
-    /// `u_meas = asin(min(1, spread / |change|))`, combined.
-    pub uncertainty_rad: f32,
-    /// Why no phase is named; `None` when one is.
-    pub not_named: Option<PhaseNotNamed>,
-}
-
-/// The workspace's one rule from a change of the negative sequence to a phase, with its
-/// uncertainties: the change `change = dI2/I1` (re, im; the measured `I2/I1` less a
-/// healthy reference's, the supply's part taken out where it is known), the reference
-/// angle `correction_rad` (`arg Z1`, [`asymmetry_correction_rad`], or measured as
-/// `arg(V1/I1)`) and its uncertainty `correction_uncertainty_rad` (>= 0), `spread` the
-/// standard deviation of the change's components that the healthy reference and the
-/// measurement leave (>= 0, fraction of I1), and `least_change` the smallest `|change|`
-/// that may name a phase.
-///
-/// A phase is named when `|change| >= least_change` and the angle `arg(change) -
-/// correction` lies inside its phase's 120-degree sector by more than its uncertainty
-/// `u = hypot(correction_uncertainty, asin(min(1, spread/|change|)))` (the confidence is
-/// then above 0); the sector is [`suspect_phase`]'s. Non-finite input names nothing.
-pub fn judge_phase(
-    change: (f32, f32),
-    correction_rad: f32,
-    correction_uncertainty_rad: f32,
-    spread: f32,
-    least_change: f32,
-) -> PhaseJudgement {
-    let mag = crate::fast_hypot(change.0, change.1);
-    let angle = F32Ext::atan2(change.1, change.0);
-    let third = core::f32::consts::TAU / 3.0;
-    let x = crate::frames::wrap_angle(angle - correction_rad) / third;
-    let dev = F32Ext::abs(x - F32Ext::round(x)) * third;
-    let nearest = suspect_phase(angle, correction_rad);
-    let u_meas = if mag > 0.0 {
-        F32Ext::asin(crate::minf(1.0, crate::maxf(0.0, spread) / mag))
-    } else {
-        core::f32::consts::FRAC_PI_2
-    };
-    let u = crate::fast_hypot(crate::maxf(0.0, correction_uncertainty_rad), u_meas);
-    let confidence = 1.0 - (dev + u) / (0.5 * third);
-    let finite = mag.is_finite() && confidence.is_finite() && least_change.is_finite();
-    let not_named = if !(finite && mag >= least_change) {
-        Some(PhaseNotNamed::BelowLeastChange)
-    } else if !(confidence > 0.0) {
-        Some(PhaseNotNamed::NearBorder)
-    } else {
-        None
-    };
-    PhaseJudgement {
-        phase: not_named.is_none().then_some(nearest),
-        nearest,
-        confidence: if not_named.is_none() { confidence } else { 0.0 },
-        deviation_rad: dev,
-        uncertainty_rad: u,
-        not_named,
-    }
 }
 
 /// A healthy machine's own negative sequence, `|I2/I1|` from its winding and core
@@ -491,34 +418,6 @@ mod tests {
         assert!((u.negative_sequence_ratio - 0.1).abs() < 0.003, "{u:?}");
         assert!((u.angle_rad - phi2).abs() < 0.03, "{u:?}");
         assert_eq!(u.suspect_phase, Some(Phase::A));
-    }
-
-    #[test]
-    fn a_phase_is_named_only_clear_of_its_uncertainties() {
-        let d = |x: f32| x.to_radians();
-        let at = |m: f32, deg: f32| (m * d(deg).cos(), m * d(deg).sin());
-        // 10 % at the correction + 120 deg: phase b, on its sector's centre.
-        let j = judge_phase(at(0.1, 190.0), d(70.0), d(10.0), 0.01, 0.025);
-        assert_eq!(j.phase, Some(Phase::B), "{j:?}");
-        // u = hypot(10, asin(0.1)) = 11.6 deg: confidence 1 - 11.6/60.
-        assert!((j.confidence - (1.0 - 11.6 / 60.0)).abs() < 0.01, "{j:?}");
-        // Below the least change: nothing, however well placed.
-        let j = judge_phase(at(0.02, 190.0), d(70.0), 0.0, 0.0, 0.025);
-        assert_eq!(j.not_named, Some(PhaseNotNamed::BelowLeastChange));
-        assert_eq!((j.phase, j.confidence), (None, 0.0));
-        // 50 deg off the centre with 15 deg of reference uncertainty: across the border.
-        let j = judge_phase(at(0.2, 120.0), d(70.0), d(15.0), 0.005, 0.025);
-        assert_eq!(j.not_named, Some(PhaseNotNamed::NearBorder), "{j:?}");
-        assert_eq!(j.nearest, Phase::A);
-        // The same angle with a sure reference: phase a, at a low confidence.
-        let j = judge_phase(at(0.2, 120.0), d(70.0), 0.0, 0.005, 0.025);
-        assert_eq!(j.phase, Some(Phase::A), "{j:?}");
-        assert!(j.confidence > 0.0 && j.confidence < 0.2, "{j:?}");
-        // A change the size of its spread cannot point anywhere.
-        let j = judge_phase(at(0.03, 70.0), d(70.0), 0.0, 0.03, 0.025);
-        assert_eq!(j.not_named, Some(PhaseNotNamed::NearBorder), "{j:?}");
-        let j = judge_phase((f32::NAN, 0.0), 0.0, 0.0, 0.0, 0.01);
-        assert_eq!(j.phase, None);
     }
 
     #[test]

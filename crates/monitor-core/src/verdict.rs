@@ -120,7 +120,7 @@ pub enum Against {
     /// Healthy runs of the same motor given by the user (`diagnose --baseline`).
     HealthyRuns,
     /// A healthy stretch of the same log (a fault switched on or off within it).
-    WithinLog,
+    WithinTheLog,
     /// The parameter file's nominal values.
     ParameterFile,
     /// Physics and practice alone (a healthy machine's own asymmetry, the MCSA severity
@@ -135,7 +135,7 @@ impl Against {
         match self {
             Against::Commissioning => "commissioning",
             Against::HealthyRuns => "healthy_runs",
-            Against::WithinLog => "within_log",
+            Against::WithinTheLog => "within_the_log",
             Against::ParameterFile => "parameter_file",
             Against::Nothing => "nothing",
         }

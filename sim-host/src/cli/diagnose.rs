@@ -39,11 +39,15 @@ switched on and off within the log is a stretch of its own), against the healthy
 load if possible; several files, or a folder of them): their mean is the reference and their \
 spread, with a default spread counted as one run, sets the least change that names a phase \
 (JSON unbalance.least_change, baseline_runs, baseline_spread). Without --baseline, the \
---commission window's; without either, no phase below twice a healthy machine's own \
-asymmetry (6 %). The reference angle is measured from the voltages where logged, else the \
-model's at the measured speed, else at the current's magnitude when the parameter file can \
-draw it, else unknown between no load and full load; its uncertainty lowers the phase's \
-confidence (unbalance.operating_point, correction_uncertainty_deg).\n\nA winding (or frame) \
+--commission window's; without either, the log's own healthy stretch when it has one (a \
+short switched on within the log), else a healthy machine's own asymmetry \
+(unbalance.judged_against). A baseline at another operating point widens the least change \
+and says so (unbalance.least_change_widened). The reference angle is measured from the \
+voltages where logged, else the model's at the measured speed, else at the current's \
+magnitude when the parameter file can draw it, else unknown between no load and full load. \
+unbalance.phase_confidence is the probability that the winding has a short in the named \
+phase, with its uncertainties (unbalance.phase_probabilities, operating_point, \
+correction_uncertainty_deg); a FAULT needs 0.5.\n\nA winding (or frame) \
 temperature column, t_winding_c in degC (or a DAQ's channel in degC, K or degF through the \
 parameter file's [columns] table), compensates Rs and Rr with the rise measured since \
 commissioning (copper 0.393 %/K) instead of tracking it from the residuals; JSON \

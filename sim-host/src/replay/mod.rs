@@ -68,8 +68,10 @@ pub use sequences::{SequenceWindow, WINDOW_PERIODS};
 pub use temperature::TemperatureReport;
 pub use verdict::{FindingReport, Rule, Verdict};
 pub use winding::{
-    segments, HealthyReference, OperatingPointSource, SequenceSegment, DEFAULT_SPREAD_CURRENTS,
-    DEFAULT_SPREAD_VOLTAGES, LEAST_CHANGE_SPREADS, NO_BASELINE_SPREAD, NO_BASELINE_SPREAD_VOLTAGES,
+    describe_against, segments, Against, HealthyReference, OperatingPointSource,
+    PhaseProbabilities, SequenceSegment, BALANCED_RATIO, DEFAULT_SPREAD_CURRENTS,
+    DEFAULT_SPREAD_VOLTAGES, HEALTHY_RUN_DIFFERENCE_CURRENTS, HEALTHY_RUN_DIFFERENCE_VOLTAGES,
+    NO_BASELINE_SPREAD, NO_BASELINE_SPREAD_VOLTAGES, WINDING_FAULT_PROBABILITY, WITHIN_LOG_SPREAD,
 };
 
 use crate::log::{Channels, LogError, Row};
@@ -148,6 +150,9 @@ pub struct UnbalanceBaseline {
     pub v2_over_i1: Option<[f32; 2]>,
     /// |I1| [A, peak] where it was taken (the operating point).
     pub i1_peak_a: f32,
+    /// The electrical rotor speed [rad/s] where it was taken, where the log has a speed
+    /// (the operating point).
+    pub wr_rad_s: Option<f32>,
 }
 
 /// The isolation's tracker for a replay of a log with `channels` under `params` (no

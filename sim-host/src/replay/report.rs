@@ -209,10 +209,14 @@ pub struct UnbalanceReport {
     pub negative_sequence_ratio: f32,
     /// The winding's faulty phase (JSON "a", "b", "c"), or null.
     pub suspect_phase: Option<Phase>,
-    /// The phase's confidence, 0..1: 1 with the angle on its phase's sector centre, 0 on the
-    /// border with the next phase (`monitor_core::sequence::phase_confidence`); 0 without a
-    /// phase.
+    /// The probability that the winding has a short in `suspect_phase` (that there is a
+    /// short, and in that phase), 0..1; 0 without a phase. A phase is named when it is
+    /// more probable than no short; a FAULT needs
+    /// [`super::WINDING_FAULT_PROBABILITY`]. How it is computed and calibrated:
+    /// `docs/isolation.md`, "The phase's probability".
     pub phase_confidence: f32,
+    /// The probabilities of no short and of a short in each phase.
+    pub phase_probabilities: super::PhaseProbabilities,
     /// Why no phase is judged although the currents are unbalanced, or null: no healthy
     /// baseline, and the winding part is within a healthy machine's own asymmetry
     /// (`monitor_core::sequence::INHERENT_ASYMMETRY_RATIO`).
@@ -233,18 +237,28 @@ pub struct UnbalanceReport {
     pub operating_point: Option<super::OperatingPointSource>,
     /// The slip the reference angle was taken at, where one was used.
     pub slip: Option<f32>,
-    /// The least change of the winding's negative sequence (fraction of |I1|) that may
-    /// name a phase: twice the healthy reference's spread.
+    /// The least change of the winding's negative sequence (fraction of |I1|) that names
+    /// a phase at [`super::WINDING_FAULT_PROBABILITY`] (on its sector's centre, with the
+    /// judged spread and reference angle); 0 when none does.
     pub least_change: f32,
+    /// Where the reference ran at another operating point than the judged stretch: a
+    /// sentence saying so and how much the least change was widened for it; else null.
+    pub least_change_widened: Option<String>,
     /// The spread the change is judged with (each component, fraction of |I1|): the
-    /// healthy reference's and the judged segment's own.
+    /// healthy reference's, the judged stretch's own and, at another operating point,
+    /// what the load moves.
     pub spread: f32,
+    /// What the change was judged against (null when nothing was judged).
+    pub judged_against: Option<super::Against>,
     /// How many healthy runs `--baseline` gave (0: none).
     pub baseline_runs: u32,
     /// Their RMS distance from their mean (`|I2/I1|` units), null for fewer than two.
     pub baseline_spread: Option<f32>,
     /// Index into `segments` of the one judged (the largest change), null without one.
     pub judged_segment: Option<usize>,
+    /// Index into `segments` of the stretch it was judged against, when judged within
+    /// the log; else null.
+    pub reference_segment: Option<usize>,
     /// The log's steady stretches of negative sequence, in time order.
     pub segments: Vec<super::SequenceSegment>,
     /// One phase's current sensor with a gain error, from the zero sequence of the three
@@ -259,6 +273,14 @@ pub struct UnbalanceReport {
     /// The healthy negative sequence the winding is judged against ([`BaselineSource`]),
     /// or null (none: the supply's part alone is taken out).
     pub baseline: Option<BaselineSource>,
+}
+
+impl UnbalanceReport {
+    /// Whether the winding's finding carries a FAULT: a phase named at a probability of
+    /// at least [`super::WINDING_FAULT_PROBABILITY`].
+    pub fn names_a_short(&self) -> bool {
+        self.suspect_phase.is_some() && self.phase_confidence >= super::WINDING_FAULT_PROBABILITY
+    }
 }
 
 /// Where the healthy negative sequence the winding is judged against comes from.

@@ -344,11 +344,11 @@ impl Replay {
 /// What the winding was judged against, and the brief phrase (`winding against 2 healthy
 /// runs`).
 fn winding_against(u: &UnbalanceReport) -> (Against, String) {
-    let against = match u.baseline {
+    let against = u.judged_against.unwrap_or(match u.baseline {
         Some(BaselineSource::File) => Against::HealthyRuns,
         Some(BaselineSource::Commissioning) => Against::Commissioning,
         None => Against::Nothing,
-    };
+    });
     let brief = if u.baseline_runs > 0 && against == Against::HealthyRuns {
         format!(
             "winding against {} healthy run{}",
@@ -364,20 +364,27 @@ fn winding_against(u: &UnbalanceReport) -> (Against, String) {
     (against, brief)
 }
 
-/// The winding's finding from the negative-sequence report.
+/// The winding's finding from the negative-sequence report: shorted turns named with the
+/// phase's calibrated probability where a phase is more probable than no short (a FAULT
+/// from 0.5 on), clear where no short is the more probable, unavailable without a steady
+/// stretch.
 pub(in crate::replay) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
-    let (against, runs) = winding_against(u);
+    let (against, brief) = winding_against(u);
     let of = |state, summary: String| {
         FindingReport::new(
             FindingSource::Winding,
             state,
             against,
             summary,
-            runs.clone(),
+            brief.clone(),
         )
     };
+    let widened = u
+        .least_change_widened
+        .as_ref()
+        .map_or(String::new(), |w| format!("; {w}"));
     let change = format!(
-        "the negative sequence changed by {:.1} % of I1 (least change {:.1} %)",
+        "the negative sequence changed by {:.1} % of I1 (least change {:.1} %){widened}",
         100.0 * u.winding_ratio,
         100.0 * u.least_change
     );
@@ -406,14 +413,11 @@ pub(in crate::replay) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
             format!("winding: {why}"),
         );
     }
-    if u.winding_ratio >= u.least_change && u.least_change > 0.0 {
-        let why = u.phase_not_judged.clone().unwrap_or_default();
-        return of(
-            State::Unexplained,
-            format!("the winding's negative sequence stands out but names no phase: {why}"),
-        );
-    }
-    of(State::Clear, format!("no shorted turns: {change}"))
+    let why = u
+        .phase_not_judged
+        .as_ref()
+        .map_or(String::new(), |w| format!(" ({w})"));
+    of(State::Clear, format!("no shorted turns: {change}{why}"))
 }
 
 /// The rotor's finding from the current spectrum (MCSA): broken bars named from the band "a

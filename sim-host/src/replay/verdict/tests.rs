@@ -44,7 +44,7 @@ fn a_fault_line_names_the_fault_its_size_phase_and_confidence() {
             FaultName::ShortedTurns,
             Size::OfPositiveSequence(0.125),
             0.72,
-            Against::WithinLog,
+            Against::WithinTheLog,
         ),
         plain(
             FindingSource::Residuals,

@@ -5,7 +5,9 @@ use super::{candidate_list, lamp, panel_text};
 use monitor_core::Phase;
 use sim_host::demo::MonitorState;
 use sim_host::log::quality::DataQuality;
-use sim_host::replay::{angle_source_name, CommissioningReport, DiagnoseReport, Diagnosed};
+use sim_host::replay::{
+    angle_source_name, describe_against, Against, CommissioningReport, DiagnoseReport, Diagnosed,
+};
 use std::io::Write;
 use std::path::Path;
 
@@ -213,15 +215,22 @@ fn unbalance(out: &mut impl Write, u: &sim_host::replay::UnbalanceReport) -> any
     if u.segments.len() > 1 {
         stretches(out, u)?;
     }
-    let against = match (u.baseline, u.baseline_runs) {
-        (Some(sim_host::replay::BaselineSource::File), 1) => "against 1 healthy run".to_string(),
-        (Some(sim_host::replay::BaselineSource::File), n) => format!(
+    let against = match (u.judged_against, u.baseline_runs) {
+        (Some(Against::HealthyRuns), 1) => "against 1 healthy run".to_string(),
+        (Some(Against::HealthyRuns), n) => format!(
             "against the mean of {n} healthy runs (their spread {:.1} %)",
             100.0 * u.baseline_spread.unwrap_or(0.0)
         ),
-        (Some(sim_host::replay::BaselineSource::Commissioning), _) => {
-            "against the commissioning window".to_string()
+        (Some(Against::WithinTheLog), _) => {
+            match u.reference_segment.and_then(|k| u.segments.get(k)) {
+                Some(r) => format!(
+                    "against the stretch at {:.1}..{:.1} s of the log",
+                    r.from_s, r.to_s
+                ),
+                None => describe_against(Against::WithinTheLog).to_string(),
+            }
         }
+        (Some(a), _) => describe_against(a).to_string(),
         (None, _) => "with no healthy baseline".to_string(),
     };
     let reference = u.operating_point.map(|o| {
@@ -235,7 +244,7 @@ fn unbalance(out: &mut impl Write, u: &sim_host::replay::UnbalanceReport) -> any
     match (u.suspect_phase, &u.phase_not_judged) {
         (Some(p), _) => writeln!(
             out,
-            "winding: shorted turns in phase {} (confidence {:.2}): the negative sequence changed by {:.1} % of I1 {against}, least change {:.1} %; {}",
+            "winding: shorted turns in phase {} (probability {:.2}): the negative sequence changed by {:.1} % of I1 {against}, least change {:.1} %; {}",
             p.name(),
             u.phase_confidence,
             100.0 * u.winding_ratio,
@@ -244,6 +253,9 @@ fn unbalance(out: &mut impl Write, u: &sim_host::replay::UnbalanceReport) -> any
         )?,
         (None, Some(why)) => writeln!(out, "winding: {why}")?,
         (None, None) => {}
+    }
+    if let Some(w) = &u.least_change_widened {
+        writeln!(out, "  {w}")?;
     }
     Ok(())
 }
