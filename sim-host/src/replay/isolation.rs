@@ -239,6 +239,7 @@ impl IsolationTracker {
         let Some(follower) = self.follower.as_mut() else {
             return;
         };
+        self.events.sample(t, dt_s, point);
         let learning = matches!(out.commissioning, CommissioningState::Learning(_));
         // Running: the monitor evaluates its lamps, or its commissioning has learned a
         // block (it learns on running, quasi-steady blocks only, and does not evaluate
