@@ -38,7 +38,11 @@ fn moves(events: &[IsolationEvent]) -> Vec<f64> {
 /// within it; `None` when so, else the case in words.
 fn check(name: &str, listed: &[f64], steps: &[f64], must: &[f64]) -> Option<String> {
     let near = |t: f64, of: &[f64]| of.iter().any(|s| (t - s).abs() <= WITHIN_S);
-    let stray: Vec<f64> = listed.iter().copied().filter(|t| !near(*t, steps)).collect();
+    let stray: Vec<f64> = listed
+        .iter()
+        .copied()
+        .filter(|t| !near(*t, steps))
+        .collect();
     let missed: Vec<f64> = must.iter().copied().filter(|s| !near(*s, listed)).collect();
     let line = format!("{name}: steps {steps:?}, listed {listed:?}");
     eprintln!("{line}");

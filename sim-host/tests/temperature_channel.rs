@@ -137,13 +137,17 @@ fn an_rs_fault_on_a_warm_motor_is_named_against_the_warm_rs() {
             assert!(cold_size > 0.5, "{cold_size}");
             // On the 3 hp motor Rs is 1.6 % of the impedance: one operating point leaves
             // rs shared with the voltage sensor and friction (as on a cold motor), so rs
-            // is among the candidates of a FAULT verdict.
-            let ok = if *name == "3 hp" {
-                r.verdict == Verdict::Fault
-                    && rs.is_some_and(|(p, c)| p >= 0.2 && (c - 0.3).abs() <= 0.075)
-            } else {
-                r.isolation.named == Some(IsolationName::Fault(Fault::Rs))
-                    && (c - 0.3).abs() <= 0.075
+            // is among the candidates of a FAULT verdict. On the 2.2 kW motor the probe's
+            // lag (the temperature is known to a few kelvin) leaves rs at p 0.5-0.9 beside
+            // the voltage sensor (issue 48's calibrated probability): named, or the same.
+            let named_rs = r.isolation.named == Some(IsolationName::Fault(Fault::Rs))
+                && (c - 0.3).abs() <= 0.075;
+            let shared = r.verdict == Verdict::Fault
+                && r.isolation.named.is_none()
+                && rs.is_some_and(|(p, c)| p >= 0.2 && (c - 0.3).abs() <= 0.075);
+            let ok = match *name {
+                "0.37 kW" => named_rs,
+                _ => named_rs || shared,
             };
             (!ok).then_some(line)
         })

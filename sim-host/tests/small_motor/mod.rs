@@ -9,6 +9,7 @@ use std::f64::consts::TAU;
 /// The 0.37 kW, 400 V, 50 Hz, 4-pole machine (Rs 30, Rr 24, Xls = Xlr 16, Xm 260 ohm at
 /// 50 Hz), J of a 71-frame motor, the paper's viscous load at its rated torque (2.57 N m
 /// at 1375 rpm).
+#[allow(dead_code)] // (not every test of the motors uses it)
 pub fn small_0p37kw() -> ParamFile {
     let w = TAU * 50.0;
     let (lm, ll) = (260.0 / w, 16.0 / w);
@@ -34,6 +35,7 @@ pub fn small_0p37kw() -> ParamFile {
 }
 
 /// The 3 hp and 2.2 kW reference motors and the 0.37 kW machine, with their names.
+#[allow(dead_code)] // (not every test of the motors uses it)
 pub fn three_motors() -> Vec<(&'static str, ParamFile)> {
     vec![
         ("3 hp", ParamFile::reference_3hp()),

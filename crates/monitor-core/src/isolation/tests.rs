@@ -136,6 +136,7 @@ fn warmed(m: &MotorParameters, rise_k: f64) -> MotorParameters {
     }
 }
 
+mod calibration;
 mod heating;
 mod operating_points;
 mod single_point;

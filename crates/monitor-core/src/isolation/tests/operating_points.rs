@@ -186,14 +186,19 @@ fn faults_that_coincide_at_one_point_part_over_several() {
             other => panic!("three points: {other:?} {joint:?}"), // ok: test
         }
     }
+    // Over two points Rr and the speed sensor keep their names; the 3 hp machine's Rs
+    // (1.6 % of its impedance) is the leading candidate with its size, a rotor-leakage
+    // change keeping p 0.2 (below the name's 0.9).
     for f in [Fault::Rs, Fault::Rr, Fault::SpeedSensor] {
         let pts = [at_load(f, 1.3, 1.0), at_load(f, 1.3, 0.7)];
         let joint = iso.isolate_points(&pts);
+        let lead = joint.candidates[0];
+        assert_eq!(lead.fault, f, "{joint:?}");
+        assert!((lead.change - 0.3).abs() <= 0.03, "{f}: {lead:?}");
         match joint.named() {
-            Some(Named::Fault(c)) if c.fault == f => {
-                assert!((c.change - 0.3).abs() <= 0.03, "{f}: {c:?}")
-            }
-            other => panic!("{f}: {other:?}"), // ok: test
+            Some(Named::Fault(c)) => assert_eq!(c.fault, f),
+            None => assert_eq!(f, Fault::Rs, "{joint:?}"),
+            other => panic!("{f}: {other:?} {joint:?}"), // ok: test
         }
     }
 }
