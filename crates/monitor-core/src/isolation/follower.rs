@@ -45,8 +45,9 @@
 //! A change may also arrive while a deviation is already there (an untracked warming, a
 //! fault that names nothing yet), where the onset's rule does not look. So every average of
 //! at least twice [`AVERAGE_S`] is split in halves, and where the residuals of the newer
-//! half differ from those of the older by more than the healthy scatter allows (the
-//! difference across the heating direction, so that a winding that warms does not count),
+//! half differ from those of the older by more than the healthy scatter allows (less what
+//! the winding can have warmed between them, 10 K/s, along the heating direction, so that a
+//! winding that warms does not count),
 //! the average is begun again after it with the same settling (measured on the isolation's
 //! tuning sweep: a rotor-leakage step on a 37 kW motor whose untracked warming already
 //! deviated was named `ls` at p 0.93 half a second after the step, from the blend).
@@ -54,6 +55,7 @@
 //! [`DEFAULT_SPREAD`]: super::DEFAULT_SPREAD
 
 mod band;
+mod temperature;
 
 use super::{Isolation, Isolator, SteadyPoint};
 use band::SteadyBand;
@@ -171,10 +173,14 @@ pub struct Follower {
     since_judged_s: f32,
     /// How fast the winding was last seen to warm or cool [K/s] (the tracked rise's step
     /// over the time since the heating tracked before it), at least
-    /// [`super::HEATING_DRIFT_K_PER_S`].
+    /// [`super::HEATING_DRIFT_K_PER_S`] once it was seen warming; 0 before.
     warming_k_per_s: f32,
     /// Time since the heating was last tracked [s].
     since_tracked_s: f32,
+    /// A deviation needed more warming than the winding could have gained since its
+    /// temperature was judged: a step, which stays one (the time since is not counted on
+    /// until the temperature is judged again).
+    step_seen: bool,
 }
 
 impl Follower {
@@ -201,8 +207,9 @@ impl Follower {
             measured_rise_k: None,
             probe_lag_k: 0.0,
             since_judged_s: 0.0,
-            warming_k_per_s: super::HEATING_DRIFT_K_PER_S,
+            warming_k_per_s: 0.0,
             since_tracked_s: 0.0,
+            step_seen: false,
         }
     }
 
@@ -254,7 +261,9 @@ impl Follower {
         // Saturate: only "long enough or not" matters.
         self.since_isolation_s = crate::minf(self.since_isolation_s + dt, 2.0 * CONFIRM_S);
         // (Saturates where the reach covers the whole range: 185 K at 10 K/s.)
-        self.since_judged_s = crate::minf(self.since_judged_s + dt, 20.0);
+        if !self.step_seen {
+            self.since_judged_s = crate::minf(self.since_judged_s + dt, 20.0);
+        }
         self.since_tracked_s = crate::minf(self.since_tracked_s + dt, 1000.0);
         let ended = self.follow_learning(learning, dt);
         if !usable {
@@ -362,23 +371,10 @@ impl Follower {
         if self.learned && heating {
             // Heating is not a fault: the machine judged against warms with the winding,
             // and the point is judged again (module docs of `crate::isolation`).
-            let before = self.isolator.winding_rise_k();
-            self.track(result.heating.factor);
-            let step = (self.isolator.winding_rise_k() - before).abs();
-            let rate = step / crate::maxf(self.since_tracked_s, STEP_S);
-            if rate.is_finite() {
-                self.warming_k_per_s = crate::maxf(rate, super::HEATING_DRIFT_K_PER_S);
-            }
-            self.since_tracked_s = 0.0;
+            self.track_with_rate(result.heating.factor);
             result = self.isolator.isolate_scaled(avg, scale);
         }
-        // (A temperature channel judges the winding's temperature all the time.)
-        if (self.learned && heating)
-            || result.state == super::IsolationState::NoDeviation
-            || self.measured_rise_k.is_some()
-        {
-            self.since_judged_s = 0.0;
-        }
+        self.note_temperature((&result, avg, scale), self.learned && heating);
         let deviates = matches!(
             result.state,
             super::IsolationState::Isolated | super::IsolationState::Unknown
@@ -416,47 +412,6 @@ impl Follower {
         result.heating_explains()
             || (warming && result.heating_continues())
             || (!onset && result.heating_begins())
-    }
-
-    /// Takes a further heating of factor `k` into the machine judged against: the whole of
-    /// it without a measured rise, else only the probe's lag within +-[`PROBE_LAG_K`] of
-    /// the measured rise ([`Follower::set_measured_rise_k`]).
-    fn track(&mut self, k: f32) {
-        let Some(measured) = self.measured_rise_k else {
-            self.isolator.track_heating(k);
-            return;
-        };
-        let wanted = (self.isolator.heating_factor() * k - 1.0) / super::COPPER_ALPHA_PER_K;
-        let lag = crate::minf(crate::maxf(wanted - measured, -PROBE_LAG_K), PROBE_LAG_K);
-        if lag.is_finite() && self.isolator.set_winding_rise_k(measured + lag) {
-            self.probe_lag_k = lag;
-        }
-    }
-
-    /// The average holds a change (module docs, "Settling, and the onset of a deviation"):
-    /// once it spans at least twice [`AVERAGE_S`], the residuals of its older and newer
-    /// halves differ by more than the healthy scatter allows
-    /// ([`Isolator::changed_between`]).
-    fn changed_within(&self) -> bool {
-        let half = self.filled / 2;
-        if (half as f32) * STEP_S < AVERAGE_S - 0.5 * STEP_S {
-            return false;
-        }
-        // The filled blocks are the `filled` slots before `next`, newest first.
-        let mean_of = |from: usize, n: usize| {
-            let mut sum = SteadyPoint::default();
-            for k in from..from + n {
-                let slot = (self.next + BLOCKS - 1 - k) % BLOCKS;
-                if let Some(b) = self.blocks.get(slot) {
-                    sum.add_scaled(b, 1.0);
-                }
-            }
-            sum.scale(1.0 / n as f32);
-            sum
-        };
-        let (newer, older) = (mean_of(0, half), mean_of(half, half));
-        let scale = crate::sqrt(AVERAGE_MAX_S / (half as f32 * STEP_S));
-        self.isolator.changed_between(&older, &newer, scale)
     }
 
     /// Drops the average: the next point starts a new one.

@@ -7,9 +7,7 @@ mod points;
 mod search;
 mod weight;
 pub use heating::HEATING_LAG_SIGMA_K;
-pub use points::{
-    ANCHOR_LOAD_BAND, ANCHOR_LOAD_DRIFT, ANCHOR_TORQUE_SPREAD, LOAD_LAW_SPREAD, MAX_POINTS,
-};
+pub use points::{ANCHOR_LOAD_BAND, ANCHOR_TORQUE_SPREAD, LOAD_LAW_SPREAD, MAX_POINTS};
 
 use super::*;
 use crate::error::{ensure, ConfigCheck, ConfigError};

@@ -142,12 +142,11 @@
 //!   [`HEATING_RATE_K_PER_S`] per second, [`Isolator::set_heating_reach_k`]): a step larger
 //!   than that is a fault, not heating. Every fault is fitted with the tracked
 //!   temperature's lag allowed for, one standard deviation [`HEATING_LAG_SIGMA_K`] on a
-//!   warm machine plus the warming rate last seen times the time since (at least
-//!   [`HEATING_DRIFT_K_PER_S`]); the joint fit over operating points allows for it in its
-//!   weights.
-//! - **The load is unknown.** The anchor's torque comparison allows for a load that drifted
-//!   inside its band ([`ANCHOR_LOAD_DRIFT`]); against the file's nominal values with the load
-//!   an unknown input ([`Isolator::set_load_unknown`]) the torque balance is left out.
+//!   warm machine plus the warming rate last seen (at least [`HEATING_DRIFT_K_PER_S`] once
+//!   it was seen warming) times the time since; the joint fit over operating points allows
+//!   for it in its weights.
+//! - **The load is unknown.** Against the file's nominal values with the load an unknown
+//!   input ([`Isolator::set_load_unknown`]) the torque balance is left out.
 //!
 //! Faults that cannot be separated:
 //! - **B and Bl**: both scale the same load term `(B + Bl) wr`; the directions coincide at
@@ -189,8 +188,7 @@ mod evidence;
 pub use evidence::{Evidence, LEVEL_APART};
 mod isolator;
 pub use isolator::{
-    ANCHOR_LOAD_BAND, ANCHOR_LOAD_DRIFT, ANCHOR_TORQUE_SPREAD, HEATING_LAG_SIGMA_K,
-    LOAD_LAW_SPREAD, MAX_POINTS,
+    ANCHOR_LOAD_BAND, ANCHOR_TORQUE_SPREAD, HEATING_LAG_SIGMA_K, LOAD_LAW_SPREAD, MAX_POINTS,
 };
 mod outcome;
 pub use outcome::{
@@ -229,9 +227,10 @@ pub const UNKNOWN_CHI2: f32 = 25.0;
 /// [`HEATING_ONSET_K`], is no heating ([`Isolator::set_heating_reach_k`]).
 pub const HEATING_RATE_K_PER_S: f32 = 10.0;
 /// The least warming rate the tracked temperature's uncertainty grows by while it is not
-/// judged [K/s] ([`Isolator::set_heating_reach_k`]; the [`Follower`] uses the rate it last
-/// saw, at least this): a motor at its working temperature drifts by a fraction of a kelvin
-/// a second as its load moves.
+/// judged, once the winding was seen warming [K/s] ([`Isolator::set_heating_reach_k`]; the
+/// [`Follower`] uses the rate it last saw, at least this; a winding never seen warming has
+/// none): a motor at its working temperature drifts by a fraction of a kelvin a second as
+/// its load moves.
 pub const HEATING_DRIFT_K_PER_S: f32 = 0.1;
 /// Temperature coefficient of copper's resistance near 20 °C [1/K] (IEC 60228; IEEE Std 112
 /// corrects resistances with 234.5 + T, the same 0.393 %/K at 20 °C).

@@ -28,6 +28,25 @@ impl Isolator {
         self.lag_sigma_k = crate::minf(base + rate * since, self.heating_reach_k);
     }
 
+    /// The deviation of `result` needs more warming than the reach allows
+    /// ([`Isolator::set_heating_reach_k`]): it deviates, heating takes no part in its
+    /// ranking (its misfit beyond [`HEATING_MAX_MISFIT`]), and the heating fit sits at the
+    /// reach's warm end (a step: the [`Follower`] keeps it one until the temperature is
+    /// judged again).
+    pub fn beyond_heating_reach(&self, result: &Isolation) -> bool {
+        let deviates = matches!(
+            result.state,
+            IsolationState::Isolated | IsolationState::Unknown
+        );
+        let reach = 1.0 + COPPER_ALPHA_PER_K * self.heating_reach_k;
+        let (_, hi) = self.heating_range();
+        let binding = reach.is_finite() && hi >= reach * (1.0 - 1e-4);
+        deviates
+            && binding
+            && result.heating.misfit > HEATING_MAX_MISFIT
+            && result.heating.factor >= hi * (1.0 - 1e-3)
+    }
+
     /// The heating hypothesis' range of factors relative to the tracked machine: the whole
     /// [`HEATING_K_MIN`]..[`HEATING_K_MAX`], within the reach
     /// ([`Isolator::set_heating_reach_k`]).
@@ -110,20 +129,20 @@ impl Isolator {
 
     /// The residuals at `newer` differ from those at `older` (two means of the same
     /// operating point's blocks, each's spreads the baseline's times `spread_scale`) by more
-    /// than the healthy scatter allows: the difference, less its part along the heating
-    /// direction (a winding that warms moves them that way), has a misfit of
-    /// [`DETECT_CHI2`] or more under the two means' spreads together. False where either
-    /// gives no residuals.
+    /// than the healthy scatter allows: the difference, less a warming of at most
+    /// `warming_k` [K] along the heating direction (a winding that warms moves them that
+    /// way), has a misfit of [`DETECT_CHI2`] or more under the two means' spreads together.
+    /// False where either gives no residuals.
     pub fn changed_between(
         &self,
-        older: &SteadyPoint,
-        newer: &SteadyPoint,
+        (older, newer): (&SteadyPoint, &SteadyPoint),
         spread_scale: f32,
+        warming_k: f32,
     ) -> bool {
         let (Some(a), Some(b)) = (self.residuals(older, None), self.residuals(newer, None)) else {
             return false;
         };
-        let Some(h) = self.warmer(1.0 + LEARN_DK).residuals(newer, None) else {
+        let Some(h) = self.warmer(1.0 + COPPER_ALPHA_PER_K).residuals(newer, None) else {
             return false;
         };
         // Whitened by both means' spreads: sqrt(2) times one's.
@@ -132,10 +151,16 @@ impl Isolator {
             .spread
             .map(|x| x * core::f32::consts::SQRT_2 * crate::maxf(spread_scale, 1.0));
         let d = (b - a).zip_map(s, |x, y| x / y).to_array();
+        // The heating direction per kelvin.
         let h = (h - b).zip_map(s, |x, y| x / y).to_array();
         let dot = |x: &[f32; 3], y: &[f32; 3]| x.iter().zip(y).map(|(u, v)| u * v).sum::<f32>();
         let hh = dot(&h, &h);
-        let along = if hh > 0.0 { dot(&d, &h) / hh } else { 0.0 };
+        let reach = if warming_k > 0.0 { warming_k } else { 0.0 };
+        let along = if hh > 0.0 {
+            crate::minf(crate::maxf(dot(&d, &h) / hh, -reach), reach)
+        } else {
+            0.0
+        };
         let rest = d
             .iter()
             .zip(h)

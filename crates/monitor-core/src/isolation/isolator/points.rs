@@ -152,8 +152,8 @@ impl Isolator {
     /// current moved by at most [`ANCHOR_LOAD_BAND`] from the anchor's (else no term), and
     /// as the paper's viscous load `T0 wr / wr0` there; the spread is
     /// [`ANCHOR_TORQUE_SPREAD`] times `scale`, widened by [`LOAD_LAW_SPREAD`] times the
-    /// speed's relative change times `T0`, the load's own drift ([`ANCHOR_LOAD_DRIFT`]) and
-    /// the tracked temperature's lag `s_lag` (in the torque balance's units).
+    /// speed's relative change times `T0`, and the tracked temperature's lag `s_lag` (in the
+    /// torque balance's units).
     fn chi2_load(
         &self,
         p: &SteadyPoint,
@@ -184,10 +184,8 @@ impl Isolator {
         // off leaves several per cent, and the change of that error between the anchor and
         // a faulty point is of its order).
         let s_file = self.baseline.mean.torque;
-        // The load itself may have drifted within the band without a step.
-        let s_drift = ANCHOR_LOAD_DRIFT * t0 / self.torque_base_nm;
         let d = (te - t_load) / self.torque_base_nm;
-        let var = s * s + s_law * s_law + s_file * s_file + s_drift * s_drift + s_lag * s_lag;
+        let var = s * s + s_law * s_law + s_file * s_file + s_lag * s_lag;
         if var > 0.0 {
             d * d / var
         } else {
@@ -202,12 +200,6 @@ impl Isolator {
 /// power: at a constant load the faults of the list move it by their losses, a few per
 /// cent (Rr +50 % about 3 %), while a load step of 10 % or more moves it by about as much.
 pub const ANCHOR_LOAD_BAND: f32 = 0.06;
-
-/// One standard deviation of the load's own drift at the anchor's operating point, as a
-/// fraction of its torque ([`Isolator::isolate_points_anchored`]): a load that moves by less
-/// than [`ANCHOR_LOAD_BAND`] is taken as the anchor's, but it may have moved that much
-/// (uniform over +-6 %: 3.5 %).
-pub const ANCHOR_LOAD_DRIFT: f32 = 0.035;
 
 /// Uncertainty of the load's speed law around the paper's viscous `T ~ wr`
 /// ([`Isolator::isolate_points_anchored`]): the exponent 1 +- 0.25, times the speed's

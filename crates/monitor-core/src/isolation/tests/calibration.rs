@@ -96,23 +96,28 @@ fn heating_is_bounded_by_how_fast_a_winding_warms() {
     }
 }
 
-/// The halves of an average: the same point, or one warmer by a few kelvin (the heating
-/// direction is taken out), hold no change; a point after a current sensor's 2 % step, or
-/// after Rs +30 %, does.
+/// The halves of an average: the same point, or one warmer by the 5 K a winding may have
+/// warmed between them, hold no change; a point after a current sensor's 2 % step, after
+/// Rs +30 %, or after Rr +20 % (which points almost where heating does) does.
 #[test]
 fn a_change_inside_an_average_is_found_across_the_heating_direction() {
     for (name, m, v, we) in machines() {
         let iso = floor_isolator(&m, v, we);
         let healthy = measure(&m, v, we, None, 1.0);
-        assert!(!iso.changed_between(&healthy, &healthy, 1.0), "{name}");
+        let changed = |p: &SteadyPoint| iso.changed_between((&healthy, p), 1.0, 5.0);
+        assert!(!changed(&healthy), "{name}");
         let warm = measure(&warmed(&m, 5.0), v, we, None, 1.0);
-        assert!(!iso.changed_between(&healthy, &warm, 1.0), "{name}: 5 K");
+        assert!(!changed(&warm), "{name}: 5 K");
         let sensor = measure(&m, v, we, Some(Fault::CurrentSensor), 1.02);
-        assert!(
-            iso.changed_between(&healthy, &sensor, 1.0),
-            "{name}: sensor"
-        );
+        assert!(changed(&sensor), "{name}: sensor");
         let rs = measure(&faulty(&m, Some(Fault::Rs), 1.3), v, we, None, 1.0);
-        assert!(iso.changed_between(&healthy, &rs, 1.0), "{name}: rs");
+        assert!(changed(&rs), "{name}: rs");
+        let rr = measure(&faulty(&m, Some(Fault::Rr), 1.2), v, we, None, 1.0);
+        assert!(changed(&rr), "{name}: rr");
+        // Without the warming's allowance the 5 K warmer point is a change too.
+        assert!(
+            iso.changed_between((&healthy, &warm), 1.0, 0.0),
+            "{name}: 5 K, no allowance"
+        );
     }
 }

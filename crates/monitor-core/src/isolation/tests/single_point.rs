@@ -41,7 +41,7 @@ fn every_fault_is_named_alone_with_its_size_or_not_named_at_all() {
     let mut named = 0;
     let mut missed = std::vec::Vec::new();
     for (name, m, v, we) in machines() {
-        let iso = Isolator::new(m.model(), v as f32, (we / core::f64::consts::TAU) as f32).unwrap(); // ok: test
+        let iso = commissioned_isolator(&m, v, we, &[1.0]);
         for f in Fault::ALL {
             for change in [-0.5f64, 0.5, -0.1, 0.1] {
                 let k = 1.0 + change;
