@@ -185,21 +185,25 @@ fn a_resistance_fault_is_still_named_on_a_warm_motor_and_not_taken_for_heating()
                 r.verdict, r.isolation.named, r.isolation.winding_rise_k
             );
             eprintln!("{warm}");
-            // Named alone on the 2.2 kW and 0.37 kW machines; on the 3 hp motor (Rs is
-            // 1.6 % of its impedance) the tracked temperature's lag leaves rs shared with
-            // voltage_sensor and b/bl: no name reaches the confidence a FAULT needs, so the
-            // verdict is WATCHING (never healthy) with rs +30 % among the candidates.
+            // Named alone on the 0.37 kW machine. On the 3 hp motor (Rs is 1.6 % of its
+            // impedance) and the 2.2 kW one, the tracked temperature's lag (the winding may
+            // have warmed a few kelvin more since it was last judged) leaves rs shared with
+            // voltage_sensor (rs p 0.26-0.50): no name reaches the confidence a FAULT needs,
+            // so the verdict is WATCHING (never healthy) with rs +30 % among the candidates,
+            // and no other fault is named.
             let rs = r
                 .candidates
                 .iter()
                 .find(|c| c.fault == Fault::Rs)
                 .map(|c| (c.probability, f64::from(c.change.unwrap_or(f32::NAN))));
-            let warm_ok = if *name == "3 hp" {
-                matches!(r.verdict, Verdict::Fault | Verdict::Watching)
-                    && rs.is_some_and(|(p, c)| p >= 0.2 && (c - 0.3).abs() <= 0.075)
+            let named_rs = r.isolation.named == Some(IsolationName::Fault(Fault::Rs))
+                && (c - 0.3).abs() <= 0.075;
+            let warm_ok = if *name == "0.37 kW" {
+                named_rs
             } else {
-                r.isolation.named == Some(IsolationName::Fault(Fault::Rs))
-                    && (c - 0.3).abs() <= 0.075
+                (named_rs || r.isolation.named.is_none())
+                    && matches!(r.verdict, Verdict::Fault | Verdict::Watching)
+                    && rs.is_some_and(|(p, c)| p >= 0.2 && (c - 0.3).abs() <= 0.075)
             };
             // Cold, Rr +30 % at 8 s: a fault, not a rise.
             let r = run(p, 14.0, 0.0, 1.0, Some((Fault::Rr, 8.0, 0.3)));
@@ -208,11 +212,66 @@ fn a_resistance_fault_is_still_named_on_a_warm_motor_and_not_taken_for_heating()
                 r.verdict, r.isolation.named, r.isolation.winding_rise_k
             );
             eprintln!("{cold}");
-            let cold_ok = r.isolation.named == Some(IsolationName::Fault(Fault::Rr))
-                && r.verdict == Verdict::Fault;
+            // (Named alone on the 3 hp and 2.2 kW motors; on the 0.37 kW one a tripled
+            // leakage fits too, rr p 0.6-0.86: then rr is the leading candidate.)
+            let rr_top = r.candidates.first().is_some_and(|c| {
+                c.fault == Fault::Rr && c.change.is_some_and(|k| (k - 0.3).abs() <= 0.075)
+            });
+            let cold_ok = r.verdict == Verdict::Fault
+                && (r.isolation.named == Some(IsolationName::Fault(Fault::Rr))
+                    || (r.isolation.named.is_none() && rr_top));
             [(!warm_ok).then_some(warm), (!cold_ok).then_some(cold)]
         })
         .flatten()
+        .collect();
+    assert!(bad.is_empty(), "{bad:#?}");
+}
+
+/// Krause's 50 hp motor warming 100 K with a 30 s time constant, commissioned cold (issue
+/// 48): its Rs is under 1 % of its impedance, so heating moves the residuals where an Rr
+/// change and a speed reading a fraction of a per cent off do (0.8 degrees apart). Before,
+/// names were given on the way (`rr +2.8 %` p 0.56, `voltage_sensor +0.7 %` p 0.66,
+/// `speed_sensor -0.2 %` p 0.65) and the issue's log ended in a FAULT (speed_sensor p 0.37,
+/// rr p 0.26). Now: no name at any time, no FAULT, the rise within 15 K; 60 s at 2 kHz and
+/// 5 kHz, commissioned over 1.5-3.5 s and 3-4.5 s.
+#[test]
+fn a_50hp_motor_warming_fast_is_heating_and_names_nothing() {
+    let p = small_motor::krause_50hp();
+    let cases = [
+        ((1.5, 3.5), 2000.0),
+        ((3.0, 4.5), 2000.0),
+        ((3.0, 4.5), 5000.0),
+    ];
+    let bad: Vec<String> = cases
+        .par_iter()
+        .filter_map(|&(window, rate)| {
+            let mut sc = Scenario::steady(60.0, rate);
+            sc.sensors = SensorSpec::default();
+            sc.seed = 5;
+            let from = window.1 + 0.5;
+            let r = small_motor::replay_warming_from(&p, sc, (100.0, 30.0, from), None, window);
+            let truth = rise_at(100.0, 30.0, 60.0 - from);
+            let names: Vec<String> = r
+                .isolation
+                .events
+                .iter()
+                .filter(|e| matches!(e, sim_host::replay::IsolationEvent::Named { .. }))
+                .map(|e| e.line())
+                .collect();
+            let strong = r.candidates.iter().find(|c| c.probability >= 0.5);
+            let seen = r.isolation.winding_rise_k;
+            let line = format!(
+                "50 hp +100 K tau 30 s ({truth:.0} K), commissioned {window:?} at {rate} Hz: {:?}, named {:?}, names given {names:?}, p>=0.5 {strong:?}, rise {seen:?}",
+                r.verdict, r.isolation.named
+            );
+            eprintln!("{line}");
+            let ok = r.verdict != Verdict::Fault
+                && r.isolation.named.is_none()
+                && names.is_empty()
+                && strong.is_none()
+                && seen.is_some_and(|s| (f64::from(s) - truth).abs() <= 15.0);
+            (!ok).then_some(line)
+        })
         .collect();
     assert!(bad.is_empty(), "{bad:#?}");
 }
@@ -240,8 +299,13 @@ fn an_hour_of_warming_with_a_real_time_constant() {
 /// parameter file's nominal machine, so a winding 60 K warmer than the file (Rs and Rr
 /// +24 %) lights them. That is no FAULT: the verdict is "could not judge", saying the
 /// change is within what a nameplate's file and heating explain, and asking for
-/// commissioning. A change that stands clear of the file's uncertainty (Rr +60 % on the
-/// cold motor) is still a FAULT with its name.
+/// commissioning; the isolation's report says heating explains the change (issue 48). A
+/// change that stands clear of the file's uncertainty (Rr +60 % on the cold motor) is among
+/// the candidates with its size, and no other fault is named. (Before issue 48 it was named
+/// `rr` and a FAULT. Against the file's nominal values, with the load an unknown input, the
+/// single point is judged on the stator-voltage equations alone, where a speed reading 1-2 %
+/// off moves them as Rr +60 % does; with the file's own directions uncertain, the two share
+/// the probability and neither is named.)
 #[test]
 fn an_uncommissioned_motor_that_warms_is_not_judged_a_fault() {
     let replay = |p: &ParamFile, rise_k: f64, fault: Option<(Fault, f64, f64)>| {
@@ -271,19 +335,33 @@ fn an_uncommissioned_motor_that_warms_is_not_judged_a_fault() {
                 "{name} warming 60 K, not commissioned: {:?}: {why}",
                 warm.verdict
             );
-            if warm.verdict == Verdict::Fault || !why.contains("does not fit") {
-                bad.push(format!("{name} warming: {:?} ({why})", warm.verdict));
-            }
-            let faulty = replay(p, 0.0, Some((Fault::Rr, 20.0, 0.6)));
-            eprintln!(
-                "{name} Rr +60 % at 20 s, not commissioned: {:?}, named {:?} {:?}",
-                faulty.verdict, faulty.isolation.named, faulty.isolation.named_change
-            );
-            if faulty.verdict != Verdict::Fault
-                || faulty.isolation.named != Some(IsolationName::Fault(Fault::Rr))
+            // Against a file never commissioned, heating that explains the change is said
+            // as heating, and the verdict is never a FAULT.
+            if warm.verdict == Verdict::Fault
+                || !(why.contains("not commissioned") || why.contains("does not fit"))
+                || !warm.isolation.heating_explains
             {
                 bad.push(format!(
-                    "{name} Rr +60 %: {:?}, named {:?}",
+                    "{name} warming: {:?} ({why}), heating explains {}",
+                    warm.verdict, warm.isolation.heating_explains
+                ));
+            }
+            let faulty = replay(p, 0.0, Some((Fault::Rr, 20.0, 0.6)));
+            let rr = faulty
+                .candidates
+                .iter()
+                .find(|c| c.fault == Fault::Rr)
+                .and_then(|c| c.change)
+                .map(f64::from);
+            eprintln!(
+                "{name} Rr +60 % at 20 s, not commissioned: {:?}, named {:?} {:?}, rr among the candidates {rr:?}",
+                faulty.verdict, faulty.isolation.named, faulty.isolation.named_change
+            );
+            let rr_named = faulty.isolation.named == Some(IsolationName::Fault(Fault::Rr));
+            let rr_size = rr.is_some_and(|c| (c - 0.6).abs() <= 0.12);
+            if !(rr_named || faulty.isolation.named.is_none()) || !rr_size {
+                bad.push(format!(
+                    "{name} Rr +60 %: {:?}, named {:?}, rr {rr:?}",
                     faulty.verdict, faulty.isolation.named
                 ));
             }

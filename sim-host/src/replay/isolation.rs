@@ -155,10 +155,11 @@ fn without_friction(iso: &mut Isolation) {
         .sort_by(|a, b| b.probability.total_cmp(&a.probability));
 }
 
-/// The candidates `diagnose` lists for `iso` when `detected` (most probable first, those
-/// from [`LIST_FROM`] on; an unknown fault's three nearest only; none without a deviation).
-fn listed_candidates(iso: &Isolation, detected: bool) -> Vec<FaultCandidate> {
-    if !detected || iso.state == IsolationState::NoDeviation {
+/// The candidates `diagnose` lists for `iso` when `shown` (a lamp lit or a name given, or
+/// a deviation from a learned baseline; most probable first, those from [`LIST_FROM`] on;
+/// an unknown fault's three nearest only; none without a deviation).
+fn listed_candidates(iso: &Isolation, shown: bool) -> Vec<FaultCandidate> {
+    if !shown || iso.state == IsolationState::NoDeviation {
         return Vec::new();
     }
     let listed = if iso.state == IsolationState::Unknown {
@@ -206,6 +207,10 @@ impl IsolationTracker {
         temperature_column: bool,
         load: super::LoadModel,
     ) -> Self {
+        let isolator = isolator.map(|mut i| {
+            i.set_load_unknown(load == super::LoadModel::Unknown);
+            i
+        });
         IsolationTracker {
             follower: isolator.map(Follower::new),
             first_named: None,
@@ -239,6 +244,7 @@ impl IsolationTracker {
         let Some(follower) = self.follower.as_mut() else {
             return;
         };
+        self.events.sample(t, dt_s, point);
         let learning = matches!(out.commissioning, CommissioningState::Learning(_));
         // Running: the monitor evaluates its lamps, or its commissioning has learned a
         // block (it learns on running, quasi-steady blocks only, and does not evaluate
@@ -290,7 +296,7 @@ impl IsolationTracker {
             .and_then(|(j, _)| j.named());
         joint
             .or(result.named())
-            .filter(|n| learned || self.lamps_lit || !within_nominal_uncertainty(n))
+            .filter(|n| learned || !within_nominal_uncertainty(n))
             .filter(|n| !load_reading(self.load, n))
     }
 
@@ -337,6 +343,22 @@ impl IsolationTracker {
         let f = self.follower.as_ref().filter(|f| f.learned())?;
         let rise = f.isolator().winding_rise_k();
         (rise.abs() >= REPORTED_RISE_K).then_some(rise)
+    }
+
+    /// The winding's heating explains the deviation ([`IsolationReport::heating_explains`]):
+    /// against commissioning, [`IsolationTracker::heating_explains_lamps`]; against the
+    /// parameter file, the last isolation's heating hypothesis (Rs and Rr together) is more
+    /// probable than every fault and the unknown fault, within the healthy scatter, with
+    /// the rise above the file's temperature it needs [K].
+    fn heating_explains(&self, learned: bool, iso: &Isolation) -> Option<f32> {
+        if learned {
+            return self
+                .heating_explains_lamps()
+                .then(|| self.winding_rise_k())
+                .flatten();
+        }
+        let rise = (iso.heating.factor - 1.0) / monitor_core::isolation::COPPER_ALPHA_PER_K;
+        (iso.heating_continues() && rise.abs() >= REPORTED_RISE_K).then_some(rise)
     }
 
     /// The lamps' detections, and any name given on the way, are explained by the
@@ -395,7 +417,8 @@ impl IsolationTracker {
     }
 
     /// The report, and the candidates for `diagnose` (most probable first, those from
-    /// [`LIST_FROM`] on) when `detected` (a lamp lit or a sensor fault was seen).
+    /// [`LIST_FROM`] on) when `detected` (a lamp lit or a sensor fault was seen) or the
+    /// isolation deviates from a learned baseline.
     pub(super) fn report(&self, detected: bool) -> (IsolationReport, Vec<FaultCandidate>) {
         let learned = self.follower.as_ref().is_some_and(Follower::learned);
         let Some(concluded) = self.concluded() else {
@@ -407,22 +430,28 @@ impl IsolationTracker {
             return (IsolationReport::not_judged(why, learned), Vec::new());
         };
         let iso = concluded.iso;
-        let candidates = listed_candidates(&iso, detected);
+        // (A deviation from a learned baseline that names no fault alone is still a finding:
+        // its candidates are listed, with their probabilities.)
+        let candidates = listed_candidates(&iso, detected || learned);
         let moved = self.moved_from_learned();
         let in_file_error = iso
             .named()
-            .filter(|n| !learned && !self.lamps_lit && within_nominal_uncertainty(n));
+            .filter(|n| !learned && within_nominal_uncertainty(n));
         let named = iso.named().filter(|_| in_file_error.is_none());
+        let heating = self.heating_explains(learned, &iso);
         let report = IsolationReport {
             state: iso.state,
             named: named.map(|n| IsolationName::of(&n)),
-            named_change: named.map(|n| match n {
-                Named::Fault(c) => c.change,
-                Named::Friction { bl, .. } => bl.change,
-            }),
+            named_change: named.map(|n| n.change()),
+            named_probability: named.map(|n| n.probability()),
             verdict: self.verdict(&concluded, in_file_error, detected, moved),
             moved_from_learned: moved,
-            winding_rise_k: self.winding_rise_k(),
+            winding_rise_k: if learned {
+                self.winding_rise_k()
+            } else {
+                heating
+            },
+            heating_explains: heating.is_some(),
             temperature: self.temperature.report(),
             judged_at_s: self.last_t,
             groups: groups(&iso),

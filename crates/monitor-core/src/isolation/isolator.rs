@@ -2,13 +2,16 @@
 //! size fit of each fault (module docs of [`crate::isolation`]); the joint isolation over
 //! several operating points in `points`, the searches and the ranking in `search`.
 
+mod heating;
 mod points;
 mod search;
+mod weight;
+pub use heating::HEATING_LAG_SIGMA_K;
 pub use points::{ANCHOR_LOAD_BAND, ANCHOR_TORQUE_SPREAD, LOAD_LAW_SPREAD, MAX_POINTS};
 
 use super::*;
 use crate::error::{ensure, ConfigCheck, ConfigError};
-use search::{fit_factor, golden, rank};
+use search::{fit_factor, rank};
 
 impl Isolator {
     /// An isolator for the nominal `motor` on a supply of peak phase voltage
@@ -42,6 +45,9 @@ impl Isolator {
             learning: Learning::default(),
             heating_factor: 1.0,
             learned_range: crate::OperatingRange::EMPTY,
+            heating_reach_k: f32::INFINITY,
+            lag_sigma_k: 0.0,
+            torque_unknown: false,
         })
     }
 
@@ -229,21 +235,6 @@ impl Isolator {
         ok
     }
 
-    /// The measured point `q` lies within the load span the baseline was learned over, and
-    /// that span is a range ([`WIDE_SPAN`]), with the voltage within the learned range's
-    /// margin (module docs, "Over a commissioned range").
-    fn within_learned_span(&self, q: &SteadyPoint) -> bool {
-        let r = self.learned_range;
-        let p = q.operating_point();
-        match r.load_a {
-            Some([lo, hi]) => {
-                let wide = hi - lo >= WIDE_SPAN * crate::maxf(lo.abs(), hi.abs());
-                wide && p.load_a >= lo && p.load_a <= hi && r.voltage_outside(p).is_none()
-            }
-            None => false,
-        }
-    }
-
     /// The parity residuals at `p` under hypothesis `h` (`None`: the nominal machine and
     /// sensors); `None` when the point is not usable (no voltage or current, frequency
     /// not positive, non-finite values).
@@ -282,58 +273,6 @@ impl Isolator {
             wr_rad_s: wr,
         };
         (c, q)
-    }
-
-    /// The weight (inverse covariance) of the residuals at the measured point `q`: the
-    /// inverse of `S = D + sum_j d_j d_j^T`, `D = diag(spread^2)`, with `d_j` how
-    /// much more the residuals move at `q` than at the learned point when circuit
-    /// parameter `j` (Rs, Rr, the leakages, Lm) is [`NAMEPLATE_UNCERTAINTY`] off (module
-    /// docs, "Away from the learned point"). Without a learned point, or where a point is
-    /// not usable: `D^-1`.
-    #[inline(never)]
-    fn weight(&self, q: &SteadyPoint) -> Sym3 {
-        let s = self.baseline.spread;
-        let diag = Sym3::diagonal_weight(&s);
-        if self.within_learned_span(q) {
-            return diag;
-        }
-        let (at, c0) = (self.baseline.at, self.circuit());
-        let (Some(e_here), Some(e_at)) = (self.eval(&c0, q), self.eval(&c0, &at)) else {
-            return diag;
-        };
-        let [a, b, z] = s.to_array();
-        let mut cov = Sym3 {
-            xx: a * a,
-            yy: b * b,
-            zz: z * z,
-            ..Sym3::default()
-        };
-        // d_j for a NAMEPLATE_UNCERTAINTY error, and what that error leaves at the learned
-        // point in the voltage residuals (the evidence for how far off the nameplate is).
-        let mut d = [ParityResiduals::default(); 5];
-        let mut expected = 0.0f32;
-        for (j, dj) in d.iter_mut().enumerate() {
-            let (Some(h), Some(t)) = (
-                self.eval(&c0.nameplate_off(j), q),
-                self.eval(&c0.nameplate_off(j), &at),
-            ) else {
-                return diag;
-            };
-            let g = t - e_at;
-            expected += g.voltage_d * g.voltage_d + g.voltage_q * g.voltage_q;
-            *dj = (h - e_here) - g;
-        }
-        let (md, mq) = (self.baseline.mean.voltage_d, self.baseline.mean.voltage_q);
-        let seen = crate::sqrt((md * md + mq * mq) / expected);
-        let u = if seen.is_finite() {
-            crate::minf(crate::maxf(seen, NAMEPLATE_FLOOR), 1.0)
-        } else {
-            1.0
-        };
-        for dj in d {
-            cov.add_outer(&dj.map(|x| u * x));
-        }
-        cov.inverse().unwrap_or(diag)
     }
 
     /// The parity residuals of circuit `c` at the (corrected) readings `q` (see
@@ -394,6 +333,12 @@ impl Isolator {
         let b = self.baseline;
         out.residuals = e0 - b.mean;
         let w = self.weight(p);
+        // Against the parameter file's nominal values, with the load an unknown input, the
+        // torque balance (true only for the file's load) is left out.
+        let w = match self.torque_unknown && !self.learned_point() {
+            true => w.voltage_only().unwrap_or(w),
+            false => w,
+        };
         let chi0 = self.chi2_at(p, None, &w);
         out.deviation = crate::sqrt(chi0);
         if chi0 < DETECT_CHI2 {
@@ -405,17 +350,33 @@ impl Isolator {
             *fit = self.fit(p, f, &w);
         }
         let heat = self.fit_heating(p, &w);
-        rank(&mut out, &mut fits, heat, chi0);
+        let eps = self.direction_uncertainty();
+        rank(&mut out, &mut fits, heat, (chi0, 3.0), eps);
         // On a warm machine a fault is judged with the tracked temperature's lag allowed
         // for (heating itself is decided on the single fits above).
-        if (self.heating_factor - 1.0).abs() >= WARM_FACTOR && !out.heating_explains() {
+        if !out.heating_explains() {
             for (fit, f) in fits.iter_mut().zip(Fault::ALL) {
                 *fit = self.fit_on_warm(p, f, &w, *fit);
             }
-            rank(&mut out, &mut fits, heat, chi0);
+            rank(&mut out, &mut fits, heat, (chi0, 3.0), eps);
         }
         out.separation_deg = self.separation(p, &e0, &out.candidates);
         out
+    }
+
+    /// Whether the load is an unknown input (`diagnose`'s default): then, against the
+    /// parameter file's nominal values (no learned baseline), the single point is judged on
+    /// the stator-voltage equations alone, as the joint isolation always is; the torque
+    /// balance holds only for the file's load. Against a learned baseline the torque's
+    /// learned mean holds the commissioned load, and a load that moves reads as the
+    /// friction class (module docs, "The load before the deviation").
+    pub fn set_load_unknown(&mut self, unknown: bool) {
+        self.torque_unknown = unknown;
+    }
+
+    /// A learned baseline with its operating point is in force.
+    pub(super) fn learned_point(&self) -> bool {
+        self.residuals(&self.baseline.at, None).is_some()
     }
 
     /// The smallest relative change of fault `f` the isolation detects at the operating
@@ -446,59 +407,6 @@ impl Isolator {
             Some(e) => w.quadratic(&(e - self.baseline.mean)),
             None => f32::INFINITY,
         }
-    }
-
-    /// The heating hypothesis' best factor `k` (Rs and Rr of the tracked machine both times
-    /// `k`, the total within [`HEATING_K_MIN`]..[`HEATING_K_MAX`]): golden section (the
-    /// misfit is unimodal over so narrow a range). Returns `(chi2, k)`.
-    #[inline(never)]
-    fn fit_heating(&self, p: &SteadyPoint, w: &Sym3) -> (f32, f32) {
-        golden(
-            |k| self.warmer(k).chi2_at(p, None, w),
-            HEATING_K_MIN / self.heating_factor,
-            HEATING_K_MAX / self.heating_factor,
-            HEATING_STEPS,
-        )
-    }
-
-    /// This isolator with the tracked winding `k` times warmer (Rs and Rr times `k`).
-    fn warmer(&self, k: f32) -> Isolator {
-        let mut t = *self;
-        t.heating_factor *= k;
-        t
-    }
-
-    /// Fault `f`'s fit on a warm machine (one whose heating was tracked): the tracked
-    /// temperature lags the winding's (the tracking follows only deviations the isolation
-    /// detects), and a fault judged against a lagging temperature would carry the lag into
-    /// its direction. The lag is a second, penalised parameter: the misfit adds
-    /// `(lag / HEATING_LAG_SIGMA_K)^2` (the tracked temperature's own uncertainty as a
-    /// prior), within +-[`HEATING_LAG_K`]. Two rounds of alternating fits, the lag for the
-    /// fault's size, then the size on the machine so warmed; returns the better of
-    /// `(chi2, k)` and `single`.
-    #[inline(never)]
-    fn fit_on_warm(&self, p: &SteadyPoint, f: Fault, w: &Sym3, single: (f32, f32)) -> (f32, f32) {
-        let d = HEATING_LAG_K * COPPER_ALPHA_PER_K;
-        let prior = |k: f32| {
-            let lag = (k - 1.0) / (COPPER_ALPHA_PER_K * HEATING_LAG_SIGMA_K);
-            lag * lag
-        };
-        let mut best = single;
-        let mut kf = single.1;
-        for _ in 0..2 {
-            let (_, kh) = golden(
-                |k| self.warmer(k).chi2_at(p, Some((f, kf)), w) + prior(k),
-                1.0 - d,
-                1.0 + d,
-                LAG_STEPS,
-            );
-            let (c, k) = self.warmer(kh).fit(p, f, w);
-            kf = k;
-            if c + prior(kh) < best.0 {
-                best = (c + prior(kh), k);
-            }
-        }
-        best
     }
 
     /// Best factor `k` for fault `f`: geometric grid, then golden section around the best
@@ -555,21 +463,3 @@ impl Isolator {
         }
     }
 }
-
-/// Golden-section steps of the heating fit: its bracket (0.90..1.63 of the tracked factor)
-/// shrunk by 0.618^20, to 1e-4 of the factor (0.03 K).
-const HEATING_STEPS: usize = 20;
-/// How far the tracked winding temperature may lag the winding's when a fault is fitted on
-/// a warm machine [K] (the tracking follows only deviations the isolation detects, 4
-/// standard deviations: measured up to 3 K behind on the 3 hp motor warming 60 K with a
-/// 10 s time constant).
-const HEATING_LAG_K: f32 = 10.0;
-/// One standard deviation of the tracked temperature's lag [K]: the prior of a fault's fit
-/// on a warm machine ([`Isolator::fit_on_warm`]); 3 K, the lag measured on the 3 hp motor
-/// warming 60 K with a 10 s time constant.
-const HEATING_LAG_SIGMA_K: f32 = 3.0;
-/// Golden-section steps of the lag's fit: +-10 K shrunk by 0.618^12, to 0.07 K.
-const LAG_STEPS: usize = 12;
-/// A tracked heating factor this far from 1 makes the machine "warm" for the faults' fits
-/// ([`Isolator::fit_on_warm`]): 0.004, 1 K.
-const WARM_FACTOR: f32 = COPPER_ALPHA_PER_K;

@@ -120,6 +120,34 @@
 //! about the trend, and the tracked heating factor at the window's end `1 - r t_end` (the
 //! rise since the window began). Otherwise mean and spread are the plain ones.
 //!
+//! # How sure a name is
+//! The probabilities are meant as calibrated ones: of the faults named at probability p,
+//! about p are right (measured on simulated logs the rules were not tuned on: the host's
+//! `tests/isolation_calibration.rs`, docs/isolation.md "How often a name is right"). What
+//! keeps them so:
+//!
+//! - **The directions' own uncertainty.** Each fault's direction is computed on the
+//!   parameter file's machine; a file that is off moves it by about as much. The ranking's
+//!   temperature is `T = max(1 + eps^2 chi2_0 / n, chi2_min / 2)` (`n` the equations):
+//!   a model error of `eps` times the deviation, spread over the equations. `eps` is
+//!   [`DIRECTION_UNCERTAINTY`] times [`NAMEPLATE_UNCERTAINTY`] times the evidenced fraction
+//!   of it ([`NAMEPLATE_FLOOR`]..1, module docs "Away from the learned point"), and
+//!   [`NAMEPLATE_UNCERTAINTY`] itself against the file's nominal values.
+//! - **A name stands apart.** A fault is named at [`NAME_PROBABILITY`] or more,
+//!   [`NAME_MARGIN`] ahead of the runner-up: another fault, heating or the unknown fault;
+//!   and with a size inside [`K_MIN`]..[`K_MAX`] (at the end of the range the change may be
+//!   larger, and a file far off fits there too). Below it the fault is a leading candidate.
+//! - **Heating as fast as a winding can warm.** Heating is bounded by how far the winding
+//!   can have warmed since its temperature was last judged ([`HEATING_ONSET_K`] plus
+//!   [`HEATING_RATE_K_PER_S`] per second, [`Isolator::set_heating_reach_k`]): a step larger
+//!   than that is a fault, not heating. Every fault is fitted with the tracked
+//!   temperature's lag allowed for, one standard deviation [`HEATING_LAG_SIGMA_K`] on a
+//!   warm machine plus the warming rate last seen (at least [`HEATING_DRIFT_K_PER_S`] once
+//!   it was seen warming) times the time since; the joint fit over operating points allows
+//!   for it in its weights.
+//! - **The load is unknown.** Against the file's nominal values with the load an unknown
+//!   input ([`Isolator::set_load_unknown`]) the torque balance is left out.
+//!
 //! Faults that cannot be separated:
 //! - **B and Bl**: both scale the same load term `(B + Bl) wr`; the directions coincide at
 //!   every operating point (one friction class; the size is given for each as if it alone
@@ -159,7 +187,9 @@ mod circuit;
 mod evidence;
 pub use evidence::{Evidence, LEVEL_APART};
 mod isolator;
-pub use isolator::{ANCHOR_LOAD_BAND, ANCHOR_TORQUE_SPREAD, LOAD_LAW_SPREAD, MAX_POINTS};
+pub use isolator::{
+    ANCHOR_LOAD_BAND, ANCHOR_TORQUE_SPREAD, HEATING_LAG_SIGMA_K, LOAD_LAW_SPREAD, MAX_POINTS,
+};
 mod outcome;
 pub use outcome::{
     Candidate, Heating, Isolation, IsolationState, Named, HEATING_MAX_MISFIT, HEATING_ONSET_K,
@@ -188,6 +218,17 @@ const GOLDEN_STEPS: usize = 16;
 /// Misfit given to the unknown-fault hypothesis: 5 spreads on the 2 residual dimensions
 /// left after fitting a size.
 pub const UNKNOWN_CHI2: f32 = 25.0;
+/// The fastest a winding warms [K/s]: a copper winding's adiabatic rate at a locked
+/// rotor's current density (about 10 K/s; module docs, "Heating is not a fault"). A heating
+/// step larger than this rate allows since the temperature was last judged, plus
+/// [`HEATING_ONSET_K`], is no heating ([`Isolator::set_heating_reach_k`]).
+pub const HEATING_RATE_K_PER_S: f32 = 10.0;
+/// The least warming rate the tracked temperature's uncertainty grows by while it is not
+/// judged, once the winding was seen warming [K/s] ([`Isolator::set_heating_reach_k`]; the
+/// [`Follower`] uses the rate it last saw, at least this; a winding never seen warming has
+/// none): a motor at its working temperature drifts by a fraction of a kelvin a second as
+/// its load moves.
+pub const HEATING_DRIFT_K_PER_S: f32 = 0.1;
 /// Temperature coefficient of copper's resistance near 20 °C [1/K] (IEC 60228; IEEE Std 112
 /// corrects resistances with 234.5 + T, the same 0.393 %/K at 20 °C).
 pub const COPPER_ALPHA_PER_K: f32 = 0.00393;
@@ -213,6 +254,8 @@ pub const DETECT_CHI2: f32 = 16.0;
 /// faults whose directions coincide share the probability about evenly (0.50 / 0.50 up to
 /// rounding), and neither is named.
 pub const NAME_MARGIN: f32 = 0.1;
+/// The least probability of a fault named alone (module docs, "How sure a name is").
+pub const NAME_PROBABILITY: f32 = 0.9;
 /// Relative uncertainty of the nameplate's circuit parameters (Rs, Rr, both leakages and
 /// Lm): parameters from a nameplate or a datasheet are commonly 10-30 % off the machine
 /// (equivalent-circuit parameters from IEEE 112 / IEC 60034-28 tests of the same motor
@@ -230,6 +273,11 @@ pub const NAMEPLATE_UNCERTAINTY: f32 = 0.2;
 /// isolation bench named 391 of 432 cases right and 8 wrongly (rotor resistance +-50 % at
 /// 0.6 load taken for a speed-sensor error); at 0.25, 409 and 1 (as without widening).
 pub const NAMEPLATE_FLOOR: f32 = 0.25;
+
+/// The relative uncertainty of a fault's direction in the residual space against a learned
+/// baseline, per unit of the parameter file's evidenced error (module docs, "How sure a
+/// name is").
+pub const DIRECTION_UNCERTAINTY: f32 = 0.1;
 
 /// The steady-state operating point the isolation works on: the stator voltage and current
 /// vectors in one frame turning at the supply frequency, and the two speeds.
@@ -468,6 +516,14 @@ pub struct Isolator {
     /// (module docs, "Over a commissioned range"); empty for a baseline put into force by
     /// [`Isolator::set_baseline`].
     learned_range: crate::OperatingRange,
+    /// How far the winding can have warmed or cooled since its temperature was last
+    /// judged [K] ([`Isolator::set_heating_reach_k`]); infinite: the whole range.
+    heating_reach_k: f32,
+    /// One standard deviation of the tracked temperature's lag behind the winding's [K]
+    /// ([`Isolator::set_heating_reach_k`]).
+    lag_sigma_k: f32,
+    /// The load is an unknown input ([`Isolator::set_load_unknown`]).
+    torque_unknown: bool,
 }
 
 #[cfg(test)]

@@ -178,7 +178,7 @@ impl Default for Isolation {
 /// What the isolation names.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Named {
-    /// One fault, with probability at least 0.5.
+    /// One fault, with probability at least [`NAME_PROBABILITY`].
     Fault(Candidate),
     /// The friction class B/Bl (they cannot be separated): their summed probability is at
     /// least 0.5; the sizes are each one's own.
@@ -201,6 +201,14 @@ impl Named {
         }
     }
 
+    /// The name's probability: the fault's, or the friction class's (B's and Bl's summed).
+    pub fn probability(&self) -> f32 {
+        match self {
+            Named::Fault(c) => c.probability,
+            Named::Friction { probability, .. } => *probability,
+        }
+    }
+
     /// The name's size stands clear of what heating and the parameter file's error move:
     /// `|change| >= MIN_FAULT_CHANGE` ([`MIN_FAULT_CHANGE`]).
     pub fn stands_clear(&self) -> bool {
@@ -209,16 +217,29 @@ impl Named {
 }
 
 impl Isolation {
-    /// The fault (or the friction class) named: state [`IsolationState::Isolated`] and
-    /// probability at least 0.5; `None` otherwise.
+    /// The fault (or the friction class) named: state [`IsolationState::Isolated`]; a
+    /// fault alone at probability [`NAME_PROBABILITY`] or more, [`NAME_MARGIN`] ahead of
+    /// the runner-up (another fault, heating or the unknown fault), its size inside the
+    /// range searched; the friction class at 0.5 or more; `None` otherwise (module docs,
+    /// "How sure a name is").
     pub fn named(&self) -> Option<Named> {
         if self.state != IsolationState::Isolated {
             return None;
         }
         let top = *self.candidates.first()?;
         if !matches!(top.fault, Fault::B | Fault::Bl) {
-            let second = self.candidates.get(1).map_or(0.0, |c| c.probability);
-            let alone = top.probability >= 0.5 && top.probability - second >= NAME_MARGIN;
+            // The runner-up: another fault, heating or the unknown fault.
+            let second = self
+                .candidates
+                .get(1)
+                .map_or(0.0, |c| c.probability)
+                .max(self.heating.probability)
+                .max(self.unknown_probability);
+            // (A size at the end of the range searched is no size: the change may be
+            // larger, and a parameter file far off fits there too.)
+            let alone = top.probability >= NAME_PROBABILITY
+                && top.probability - second >= NAME_MARGIN
+                && !top.at_limit;
             return alone.then_some(Named::Fault(top));
         }
         let find = |f: Fault| self.candidates.iter().find(|c| c.fault == f).copied();

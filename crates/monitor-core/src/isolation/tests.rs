@@ -127,6 +127,25 @@ fn floor_isolator(m: &MotorParameters, v: f64, we: f64) -> Isolator {
     iso
 }
 
+/// An isolator for `m` commissioned over the healthy machine's steady states at `loads`
+/// (multiples of its viscous load): the learned mean is zero (the parameter file is the
+/// machine), the spreads at their floor, and the commissioned range spans the loads, so
+/// the directions are as sure as a file that fits makes them (module docs, "How sure a
+/// name is"); against the nominal values alone the file could be 20 % off.
+fn commissioned_isolator(m: &MotorParameters, v: f64, we: f64, loads: &[f64]) -> Isolator {
+    let mut iso = Isolator::new(m.model(), v as f32, (we / core::f64::consts::TAU) as f32).unwrap(); // ok: test
+    for load in loads {
+        let mut t = *m;
+        t.bl_nms *= load;
+        let p = measure(&t, v, we, None, 1.0);
+        for _ in 0..MIN_LEARNED_POINTS {
+            iso.learn(&p);
+        }
+    }
+    assert!(iso.finish_learning());
+    iso
+}
+
 /// The machine warmed by `rise_k`: Rs and Rr times 1 + alpha rise.
 fn warmed(m: &MotorParameters, rise_k: f64) -> MotorParameters {
     let k = 1.0 + f64::from(COPPER_ALPHA_PER_K) * rise_k;
@@ -137,6 +156,7 @@ fn warmed(m: &MotorParameters, rise_k: f64) -> MotorParameters {
     }
 }
 
+mod calibration;
 mod heating;
 mod operating_points;
 mod single_point;

@@ -18,6 +18,22 @@
 //! [`RESET_RUN`] rows in a row are bad but move plausibly among themselves, the counter was
 //! re-zeroed: they become the new reference, and the count handed on continues from the
 //! last good one advanced by the run's own motion.
+//!
+//! A shaft also cannot change its speed from one row to the next by much: a count that
+//! lies further than
+//!
+//! `e_max = 2 + K w_max dt C / (2 pi) / 16`
+//!
+//! (a sixteenth of `N_max`'s motion part: a quarter of the monitor's own largest believable
+//! step) from where the last good count's motion carries it (`last + v dt`, `v` the good
+//! counts' rate smoothed over about four rows) is a bad cell too, even within `N_max`. A
+//! damaged count a few hundred off the true one, or a burst of two whose second row moves
+//! plausibly from the first, used to pass (the second judged against the last good count
+//! two rows back, with twice the room) while the true count after it was held out: the
+//! count handed on jumped out and back, and the monitor, whose own bound is `N_max / K`,
+//! flagged the speed sensor (`tests/bad_encoder_cells.rs`). A genuine speed change moves
+//! the count by far less: a 2.2 kW motor starting direct-on-line at 2000 rad/s^2 changes its
+//! step by 0.3 counts per row at 5 kHz, 1.3 at 1 kHz, against `e_max` of 10 and 43.
 
 /// Counts per revolution the replay assumes for `enc_count` (4 x 1024 lines, the core's
 /// `EncoderConfig` default).
@@ -29,6 +45,13 @@ pub const STEP_MARGIN: f64 = 4.0;
 pub const RESET_RUN: u32 = 64;
 /// Counter widths whose wrap is undone [bits].
 const WRAP_BITS: [u32; 3] = [16, 24, 32];
+/// The largest departure of a good count from the last good count's motion, as a fraction
+/// of `N_max`'s motion part (module docs): a sixteenth, a quarter of the monitor's own bound.
+const SPIKE_FRACTION: f64 = 1.0 / 16.0;
+/// The smoothing of the good counts' rate: each good step moves it by this fraction of the
+/// difference (about four rows' memory: the counts' quantisation averaged, a starting
+/// motor's rising rate followed within a fraction of a count).
+const RATE_GAIN: f64 = 0.25;
 
 /// What [`EncoderTrack::check`] made of a count.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -46,14 +69,16 @@ pub struct EncoderTrack {
     rate_max: f64,
     /// Last good raw count and its time.
     last: Option<(i64, f64)>,
+    /// The good counts' smoothed rate [counts/s], once two good counts were seen.
+    rate: Option<f64>,
     /// Offset from raw counts to the continuous count handed on.
     offset: i64,
     /// After a restart: the last count handed on, where the next one continues.
     pending_base: Option<i64>,
     /// The current run of bad but mutually plausible counts: length, last raw, last time.
     run: (u32, i64, f64),
-    /// The first raw count of that run.
-    run_first: i64,
+    /// The first raw count of that run, and its time [s].
+    run_first: (i64, f64),
     /// Wraps undone.
     pub wraps: u64,
     /// Re-zeroed counters followed.
@@ -74,12 +99,33 @@ impl EncoderTrack {
         (self.rate_max * dt_s.max(0.0)).min(1e15) as i64 + 2
     }
 
+    /// The step `s` over `dt_s` follows the last good count's motion within `e_max` (module
+    /// docs); any step does before a rate is known.
+    fn follows_motion(&self, s: i64, dt_s: f64) -> bool {
+        match self.rate {
+            Some(v) if dt_s > 0.0 => {
+                let e_max = 2.0 + SPIKE_FRACTION * self.rate_max * dt_s;
+                (s as f64 - v * dt_s).abs() <= e_max
+            }
+            _ => true,
+        }
+    }
+
+    /// A good step `s` over `dt_s` moves the smoothed rate.
+    fn learn_rate(&mut self, s: i64, dt_s: f64) {
+        if dt_s > 0.0 {
+            let v = s as f64 / dt_s;
+            self.rate = Some(self.rate.map_or(v, |r| r + RATE_GAIN * (v - r)));
+        }
+    }
+
     /// Forget the reference (a clock reset: time and count start again); the count handed
     /// on continues from the last good one.
     pub fn restart(&mut self) {
         if let Some((raw, _)) = self.last.take() {
             self.pending_base = Some(raw.wrapping_add(self.offset));
         }
+        self.rate = None;
         self.run = (0, 0, f64::NAN);
     }
 
@@ -114,16 +160,17 @@ impl EncoderTrack {
             })
         };
         match step {
-            Some(s) => {
+            Some(s) if self.follows_motion(s, t_s - last_t) => {
                 if s != d {
                     self.wraps += 1;
                     self.offset = self.offset.wrapping_add(s.wrapping_sub(d));
                 }
+                self.learn_rate(s, t_s - last_t);
                 self.last = Some((raw, t_s));
                 self.run.0 = 0;
                 EncoderCell::Good(raw.wrapping_add(self.offset))
             }
-            None => self.jump(raw, t_s, last),
+            _ => self.jump(raw, t_s, last),
         }
     }
 
@@ -134,7 +181,7 @@ impl EncoderTrack {
         let plausible =
             n > 0 && raw.wrapping_sub(prev).unsigned_abs() <= self.max_step(t_s - prev_t) as u64;
         if !plausible {
-            self.run_first = raw;
+            self.run_first = (raw, t_s);
         }
         self.run = (if plausible { n + 1 } else { 1 }, raw, t_s);
         if self.run.0 < RESET_RUN {
@@ -144,8 +191,12 @@ impl EncoderTrack {
         // filled or held out downstream).
         // The run moved as the shaft did: the count handed on advances by the run's motion
         // and one step of its mean rate (the step into the run is unknown).
-        let moved = raw.wrapping_sub(self.run_first);
+        let moved = raw.wrapping_sub(self.run_first.0);
         let step = moved / i64::from(RESET_RUN - 1);
+        // The shaft's motion from here on is the run's own (a counter frozen while the
+        // shaft turned is followed as frozen: the monitor then sees the stopped reading).
+        let span = t_s - self.run_first.1;
+        self.rate = (span > 0.0).then(|| moved as f64 / span);
         let handed = last
             .wrapping_add(self.offset)
             .wrapping_add(moved)
@@ -204,6 +255,59 @@ mod tests {
             for k in (0..3000).filter(|&k| k != 2000) {
                 assert_eq!(out[k], EncoderCell::Good(want[k].0), "{bad} at {k}");
             }
+        }
+    }
+
+    #[test]
+    fn a_count_off_its_track_is_bad_even_within_the_largest_step() {
+        // 628 rad/s at 5 kHz: N_max is 4 x 82 + 2 counts per row, e_max 2 + 82 / 4.
+        for (off, rows) in [(60i64, 1usize), (-60, 1), (300, 2), (-400, 2), (90, 3)] {
+            let mut xs = counts(3000);
+            for x in &mut xs[2000..2000 + rows] {
+                x.0 += off;
+            }
+            let mut tr = EncoderTrack::new(628.0);
+            let out = run(&mut tr, &xs);
+            let want = counts(3000);
+            for (k, o) in out.iter().enumerate() {
+                let bad = (2000..2000 + rows).contains(&k);
+                let expected = if bad {
+                    EncoderCell::Bad
+                } else {
+                    EncoderCell::Good(want[k].0)
+                };
+                assert_eq!(*o, expected, "{off} over {rows} rows, at {k}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_motor_starting_hard_passes() {
+        // 5000 rad/s^2 from rest to 300 rad/s, at 1 and 5 kHz: the count's steps grow by
+        // up to 3.3 counts per row.
+        for rate in [1000.0, 5000.0] {
+            let xs: Vec<(i64, f64)> = (0..(rate as usize))
+                .map(|k| {
+                    let t = k as f64 / rate;
+                    let theta = if t < 0.06 {
+                        2500.0 * t * t
+                    } else {
+                        9.0 + 300.0 * (t - 0.06)
+                    };
+                    (
+                        (theta * COUNTS_PER_REV / std::f64::consts::TAU).round() as i64,
+                        t,
+                    )
+                })
+                .collect();
+            let mut tr = EncoderTrack::new(628.0);
+            let out = run(&mut tr, &xs);
+            assert!(
+                out.iter()
+                    .zip(&xs)
+                    .all(|(o, (c, _))| *o == EncoderCell::Good(*c)),
+                "{rate} Hz"
+            );
         }
     }
 

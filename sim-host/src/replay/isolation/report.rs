@@ -114,6 +114,9 @@ pub struct IsolationReport {
     pub named: Option<IsolationName>,
     /// The named fault's estimated relative change (for `b/bl`: Bl's), or null.
     pub named_change: Option<f32>,
+    /// The probability that the named fault is the fault (for `b/bl`: the class's), or
+    /// null: a calibrated probability (docs/isolation.md, "How often a name is right").
+    pub named_probability: Option<f32>,
     /// One sentence.
     pub verdict: String,
     /// Candidates that cannot be separated at the last operating point, with the reason.
@@ -142,9 +145,17 @@ pub struct IsolationReport {
     pub moved_from_learned: Option<f32>,
     /// The winding's temperature rise since commissioning the isolation tracked [K]
     /// (Rs and Rr together, copper 0.393 %/K: [`monitor_core::isolation`], "Heating is not
-    /// a fault"); absent (JSON) below [`REPORTED_RISE_K`] or without a learned baseline.
+    /// a fault"); without a learned baseline, the rise above the parameter file's
+    /// temperature that explains the change where heating does
+    /// ([`IsolationReport::heating_explains`]); absent (JSON) below [`REPORTED_RISE_K`].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub winding_rise_k: Option<f32>,
+    /// The windings' heating explains the change from the baseline: against commissioning,
+    /// the warm machine's steady-state equations fit (a tracked rise of [`REPORTED_RISE_K`]
+    /// or more); against the parameter file, heating (Rs and Rr together) is the most
+    /// probable explanation, more than any fault or the unknown fault, within the healthy
+    /// scatter.
+    pub heating_explains: bool,
     /// What happened, with times: each name the first time it was given (with its size and
     /// probability) and each load move ([`IsolationEvent`]), at most [`crate::replay::MAX_EVENTS`].
     pub events: Vec<IsolationEvent>,
@@ -204,6 +215,7 @@ impl IsolationReport {
             state: IsolationState::NotJudged,
             named: None,
             named_change: None,
+            named_probability: None,
             verdict: format!("The fault could not be isolated: {why}."),
             groups: Vec::new(),
             deviation_sigma: 0.0,
@@ -214,6 +226,7 @@ impl IsolationReport {
             judged_at_s: 0.0,
             moved_from_learned: None,
             winding_rise_k: None,
+            heating_explains: false,
             temperature: Default::default(),
             baseline: baseline_name(learned),
             first_named: None,

@@ -26,6 +26,21 @@ impl IsolationTracker {
         ))
     }
 
+    /// Against the parameter file's nominal values (not commissioned), the sentence of a
+    /// change that heating explains ([`IsolationTracker::heating_explains`]).
+    fn file_heating_sentence(&self, iso: &Isolation) -> Option<String> {
+        if self.follower.as_ref().is_none_or(|f| f.learned()) {
+            return None;
+        }
+        let rise = self.heating_explains(false, iso)?;
+        Some(format!(
+            "The change is what windings about {:.0} K {} than the parameter file assumes give (Rs and Rr {} together, copper 0.393 %/K): heating, not a fault. Against the file's nominal values a change this small is as much the file's own error; commission on the healthy machine to judge it.",
+            rise.abs(),
+            if rise > 0.0 { "warmer" } else { "cooler" },
+            pct(rise * monitor_core::isolation::COPPER_ALPHA_PER_K)
+        ))
+    }
+
     /// The verdict sentence `s` with the evidence it was drawn from, where the joint fit over
     /// the operating points kept (`joint`: its isolation and the number of points) named it.
     fn with_evidence(&self, s: String, joint: Option<(Isolation, usize)>) -> String {
@@ -74,11 +89,12 @@ impl IsolationTracker {
         let iso = &c.iso;
         if let Some(Named::Fault(c)) = in_file_error {
             format!(
-                "The nearest fault, {} {} (p {:.2}), is within the parameter file's own uncertainty (+/-{:.0} %) while every lamp stayed dark: not named. Commission on the healthy machine to judge changes this small.",
+                "The nearest fault, {} {} (p {:.2}), is within the parameter file's own uncertainty (+/-{:.0} %){}: not named, a file that far off the machine moves the residuals as much. Commission on the healthy machine to judge changes this small.",
                 c.fault,
                 pct(c.change),
                 c.probability,
-                100.0 * NOMINAL_UNCERTAINTY
+                100.0 * NOMINAL_UNCERTAINTY,
+                if self.lamps_lit { "" } else { " while every lamp stayed dark" }
             )
         } else if self.end_t - self.last_t > STALE_S {
             format!(
@@ -88,6 +104,8 @@ impl IsolationTracker {
                 self.end_t - self.last_t
             )
         } else if let Some(warm) = self.heating_sentence(iso.state) {
+            warm
+        } else if let Some(warm) = self.file_heating_sentence(iso) {
             warm
         } else if c.load_moved {
             self.load_moved_sentence()

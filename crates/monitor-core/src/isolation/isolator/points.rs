@@ -2,6 +2,7 @@
 //! docs of [`crate::isolation`]): each hypothesis fitted jointly over the points, with the
 //! torque compared with the load known at an anchor.
 
+use super::heating::HEATING_STEPS;
 use super::search::{fit_factor, golden, rank};
 use super::*;
 
@@ -42,7 +43,7 @@ impl Isolator {
         let mut out = Isolation::default();
         let (used, n) = self.weighted_points(points);
         let used = used.get(..n).unwrap_or(&[]);
-        let Some((first, _, _)) = used.first() else {
+        let Some((first, _, _, _)) = used.first() else {
             return out;
         };
         let load = anchor.and_then(|a| Some((*a, self.torque_nm(a, None)?)));
@@ -60,13 +61,21 @@ impl Isolator {
         for (fit, f) in fits.iter_mut().zip(Fault::ALL) {
             *fit = fit_factor(|k| self.chi2_points(used, load, Some((f, k))));
         }
+        let (lo, hi) = self.heating_range();
         let heat = golden(
             |k| self.warmer(k).chi2_points(used, load, None),
-            HEATING_K_MIN / self.heating_factor,
-            HEATING_K_MAX / self.heating_factor,
+            lo,
+            hi,
             HEATING_STEPS,
         );
-        rank(&mut out, &mut fits, heat, chi0);
+        let dims = 2.0 * n as f32 + if load.is_some() { 1.0 } else { 0.0 };
+        rank(
+            &mut out,
+            &mut fits,
+            heat,
+            (chi0, dims),
+            self.direction_uncertainty(),
+        );
         if let Some(e0) = self.residuals(first, None) {
             out.separation_deg = self.separation(first, &e0, &out.candidates);
         }
@@ -74,15 +83,16 @@ impl Isolator {
     }
 
     /// The usable points of `points` (at most [`MAX_POINTS`], the first ones) with their
-    /// weights: each point's voltage-equation weight ([`Isolator::weight`],
-    /// [`Sym3::voltage_only`]) under the baseline's spreads times its spread scale (>= 1;
-    /// values below 1 or not finite count as 1), and that scale. Returns the array and how
-    /// many of it are filled.
+    /// weights: each point's voltage-equation weight with the tracked temperature's lag
+    /// allowed for ([`Isolator::weight_with_lag`], [`Sym3::voltage_only`]) under the
+    /// baseline's spreads times its spread scale (>= 1; values below 1 or not finite count
+    /// as 1), that scale, and the lag's torque spread. Returns the array and how many of it
+    /// are filled.
     fn weighted_points(
         &self,
         points: &[(SteadyPoint, f32)],
     ) -> ([WeightedPoint; MAX_POINTS], usize) {
-        let mut used = [(SteadyPoint::default(), Sym3::default(), 1.0f32); MAX_POINTS];
+        let mut used = [(SteadyPoint::default(), Sym3::default(), 1.0f32, 0.0f32); MAX_POINTS];
         let mut n = 0;
         for (p, scale) in points.iter().take(MAX_POINTS) {
             let k = if scale.is_finite() {
@@ -95,11 +105,12 @@ impl Isolator {
             if self.residuals(p, None).is_none() {
                 continue;
             }
-            let Some(w) = scaled.weight(p).voltage_only() else {
+            let (w, lag_torque) = scaled.weight_with_lag(p);
+            let Some(w) = w.voltage_only() else {
                 continue;
             };
             if let Some(slot) = used.get_mut(n) {
-                *slot = (*p, w, k);
+                *slot = (*p, w, k, lag_torque);
                 n += 1;
             }
         }
@@ -118,11 +129,11 @@ impl Isolator {
     ) -> f32 {
         let first = used
             .first()
-            .map_or(0.0, |(p, _, k)| self.chi2_load(p, h, load, *k));
+            .map_or(0.0, |(p, _, k, lag)| self.chi2_load(p, h, load, (*k, *lag)));
         first
             + used
                 .iter()
-                .map(|(p, w, _)| self.chi2_at(p, h, w))
+                .map(|(p, w, _, _)| self.chi2_at(p, h, w))
                 .sum::<f32>()
     }
 
@@ -141,13 +152,14 @@ impl Isolator {
     /// current moved by at most [`ANCHOR_LOAD_BAND`] from the anchor's (else no term), and
     /// as the paper's viscous load `T0 wr / wr0` there; the spread is
     /// [`ANCHOR_TORQUE_SPREAD`] times `scale`, widened by [`LOAD_LAW_SPREAD`] times the
-    /// speed's relative change times `T0`.
+    /// speed's relative change times `T0`, and the tracked temperature's lag `s_lag` (in the
+    /// torque balance's units).
     fn chi2_load(
         &self,
         p: &SteadyPoint,
         h: Option<(Fault, f32)>,
         load: Option<(SteadyPoint, f32)>,
-        scale: f32,
+        (scale, s_lag): (f32, f32),
     ) -> f32 {
         let Some((a, t0)) = load else {
             return 0.0;
@@ -173,7 +185,7 @@ impl Isolator {
         // a faulty point is of its order).
         let s_file = self.baseline.mean.torque;
         let d = (te - t_load) / self.torque_base_nm;
-        let var = s * s + s_law * s_law + s_file * s_file;
+        let var = s * s + s_law * s_law + s_file * s_file + s_lag * s_lag;
         if var > 0.0 {
             d * d / var
         } else {
@@ -202,6 +214,7 @@ pub const ANCHOR_TORQUE_SPREAD: f32 = 2.0 * LEARNED_SPREAD_FLOOR.torque;
 /// Most operating points [`Isolator::isolate_points`] combines.
 pub const MAX_POINTS: usize = 4;
 
-/// One operating point of the joint isolation: the point, its voltage-equation weight and
-/// its spread scale (>= 1) ([`Isolator::isolate_points_anchored`]).
-type WeightedPoint = (SteadyPoint, Sym3, f32);
+/// One operating point of the joint isolation: the point, its voltage-equation weight, its
+/// spread scale (>= 1) and the tracked temperature's lag in the torque balance
+/// ([`Isolator::isolate_points_anchored`]).
+type WeightedPoint = (SteadyPoint, Sym3, f32, f32);

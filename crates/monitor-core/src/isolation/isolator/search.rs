@@ -32,14 +32,16 @@ pub(super) fn golden(chi: impl Fn(f32) -> f32, lo: f32, hi: f32, steps: usize) -
 }
 
 /// Ranks the faults' fits `(chi2, k)`, the heating fit `heat` and the unknown fault into
-/// `out` (candidates, probabilities, state), for a deviation of misfit `chi0` (module
-/// docs). B and Bl scale the same load term: one friction class with one misfit (each
-/// keeps the size it needs on its own).
+/// `out` (candidates, probabilities, state), for a deviation of misfit `chi0` over `dims`
+/// equations, with the fault directions known to a relative `eps` (module docs,
+/// "How sure a name is"). B and Bl scale the same load term: one friction class with one
+/// misfit (each keeps the size it needs on its own).
 pub(super) fn rank(
     out: &mut Isolation,
     fits: &mut [(f32, f32); FAULT_COUNT],
     heat: (f32, f32),
-    chi0: f32,
+    (chi0, dims): (f32, f32),
+    eps: f32,
 ) {
     let friction = [Fault::B.index(), Fault::Bl.index()];
     let chi_friction = friction
@@ -60,7 +62,7 @@ pub(super) fn rank(
         |a, (c, _)| crate::minf(a, *c),
     );
     let chi_unknown = crate::maxf(UNKNOWN_CHI2, 0.1 * chi0);
-    let t = crate::maxf(1.0, 0.5 * chi_min);
+    let t = temperature(chi_min, (chi0, dims), eps);
     let w = |c: f32| F32Ext::exp(-(c - chi_min) / (2.0 * t));
     let mut total = w(chi_unknown);
     for (c, _) in fits.iter() {
@@ -91,6 +93,15 @@ pub(super) fn rank(
     } else {
         IsolationState::Isolated
     };
+}
+
+/// The ranking's temperature (module docs of [`crate::isolation`], "How sure a name is"):
+/// the directions' own uncertainty (a model error of `eps` times the deviation of misfit
+/// `chi0`, spread over `dims` equations), or a poor best fit (`chi_min` over the two
+/// degrees of freedom left), whichever is larger.
+fn temperature(chi_min: f32, (chi0, dims): (f32, f32), eps: f32) -> f32 {
+    let t_model = 1.0 + eps * eps * chi0 / crate::maxf(dims, 1.0);
+    crate::maxf(t_model, 0.5 * chi_min)
 }
 
 /// Best factor `k` of a misfit `chi(k)` over [`K_MIN`]..[`K_MAX`]: a geometric grid of

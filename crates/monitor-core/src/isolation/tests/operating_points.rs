@@ -146,7 +146,7 @@ fn a_load_change_with_a_fault_and_a_nameplate_that_is_off() {
 #[test]
 fn faults_that_coincide_at_one_point_part_over_several() {
     let (_, m, v, we) = machines()[1];
-    let iso = Isolator::new(m.model(), v as f32, (we / core::f64::consts::TAU) as f32).unwrap(); // ok: test
+    let iso = commissioned_isolator(&m, v, we, &[1.0, 0.7, 0.5]);
     let at_load = |f: Fault, k: f64, load: f64| {
         let mut t = faulty(&m, Some(f), k);
         t.bl_nms *= load;
@@ -186,28 +186,38 @@ fn faults_that_coincide_at_one_point_part_over_several() {
             other => panic!("three points: {other:?} {joint:?}"), // ok: test
         }
     }
+    // Over two points Rr and the speed sensor keep their names; the 3 hp machine's Rs
+    // (1.6 % of its impedance) is the leading candidate with its size, a rotor-leakage
+    // change keeping p 0.2 (below the name's 0.9).
     for f in [Fault::Rs, Fault::Rr, Fault::SpeedSensor] {
         let pts = [at_load(f, 1.3, 1.0), at_load(f, 1.3, 0.7)];
         let joint = iso.isolate_points(&pts);
+        let lead = joint.candidates[0];
+        assert_eq!(lead.fault, f, "{joint:?}");
+        assert!((lead.change - 0.3).abs() <= 0.03, "{f}: {lead:?}");
         match joint.named() {
-            Some(Named::Fault(c)) if c.fault == f => {
-                assert!((c.change - 0.3).abs() <= 0.03, "{f}: {c:?}")
-            }
-            other => panic!("{f}: {other:?}"), // ok: test
+            Some(Named::Fault(c)) => assert_eq!(c.fault, f),
+            None => assert_eq!(f, Fault::Rs, "{joint:?}"),
+            other => panic!("{f}: {other:?} {joint:?}"), // ok: test
         }
     }
 }
 
 /// The evidence across operating points through the follower, on the 3 hp machine's
-/// analytic steady states: healthy at rated load (the anchor), then Ls x1.5 at rated load,
-/// where the single point does not name it, and at four lighter load levels 20 % or more
-/// apart. The evidence names Ls with its size at every level after the first, and beyond
-/// [`MAX_POINTS`] levels it keeps that many.
+/// analytic steady states, commissioned over the load range: healthy at rated load (the
+/// anchor), then Ls x1.5 at rated load, where the single point does not name it, and at four
+/// lighter load levels (0.75, 0.6, 0.48 and 0.38 of it, 20 % apart). The evidence names Ls with its size
+/// at every level after the first, and beyond [`MAX_POINTS`] levels it keeps that many.
 #[test]
 fn the_evidence_names_ls_over_load_levels_and_keeps_max_points() {
     let (_, m, v, we) = machines()[1];
-    let iso = Isolator::new(m.model(), v as f32, (we / core::f64::consts::TAU) as f32).unwrap(); // ok: test
-    let mut f = Follower::new(iso);
+    // Commissioned over the load range (the file is the machine: learned mean zero).
+    let mut f = Follower::new(commissioned_isolator(
+        &m,
+        v,
+        we,
+        &[1.0, 0.75, 0.55, 0.4, 0.3],
+    ));
     let mut ev = Evidence::default();
     let at_load = |fault: Option<Fault>, load: f64| {
         let mut t = faulty(&m, fault, 1.5);
@@ -228,9 +238,12 @@ fn the_evidence_names_ls_over_load_levels_and_keeps_max_points() {
     assert!(single.named_fault().is_none(), "one point: {single:?}");
     assert!(ev.anchored(), "the healthy point is the anchor");
     let mut kept = std::vec::Vec::new();
-    for load in [0.75, 0.55, 0.4, 0.3] {
+    for load in [0.75, 0.6, 0.48, 0.38] {
         run(at_load(Some(Fault::Ls), load), &mut f, &mut ev);
-        let (joint, n) = ev.named().unwrap(); // ok: test
+        let last = *f.last().unwrap(); // ok: test
+        let (joint, n) = ev
+            .named()
+            .unwrap_or_else(|| panic!("{load}: nothing named over the points: {last:?}")); // ok: test
         let c = joint.named_fault().unwrap(); // ok: test
         assert_eq!(c.fault, Fault::Ls, "{load}: {joint:?}");
         assert!((c.change - 0.5).abs() <= 0.05, "{load}: {c:?}");

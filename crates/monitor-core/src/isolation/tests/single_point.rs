@@ -21,17 +21,27 @@ fn not_separable(name: &str, f: Fault, change: f64) -> bool {
     // about one spread (below detection); its leakage change of 50 % points where a
     // 3 % Rr change does (0.1-2 deg apart). Rr at 10 %: a 0.3 % speed-sensor error
     // fits too (the rotor circuit depends on Rr/slip; only the torque balance helps).
+    //
+    // With the name's probability of 0.9 (issue 48: names below it were right too seldom on
+    // the calibration sweep), more stay shared at one point with the default spreads: Rr
+    // at 10 % on every machine and at -50 % on the 3 hp one (the speed sensor keeps 0.13-0.39:
+    // only the torque balance's load term tells them apart), the 2.2 kW machine's rotor
+    // leakage at 10 % (its magnetising inductance keeps 0.24-0.27). They are the leading
+    // candidate with their size (asserted below), and never a wrong name.
     (name == "3 hp" && change.abs() < 0.2 && matches!(f, Fault::Rs | Fault::Ls | Fault::Lr))
         || (name == "3 hp" && f == Fault::Ls)
-        || (name == "3 hp" && f == Fault::Rr && change.abs() < 0.2)
+        || (name == "3 hp" && f == Fault::Rr)
+        || (f == Fault::Rr && change.abs() < 0.2)
+        || (name == "2.2 kW" && f == Fault::Lr && change.abs() < 0.2)
         || (name == "11 kW" && f == Fault::Rs && change.abs() < 0.2)
 }
 
 #[test]
 fn every_fault_is_named_alone_with_its_size_or_not_named_at_all() {
     let mut named = 0;
+    let mut missed = std::vec::Vec::new();
     for (name, m, v, we) in machines() {
-        let iso = Isolator::new(m.model(), v as f32, (we / core::f64::consts::TAU) as f32).unwrap(); // ok: test
+        let iso = commissioned_isolator(&m, v, we, &[1.0]);
         for f in Fault::ALL {
             for change in [-0.5f64, 0.5, -0.1, 0.1] {
                 let k = 1.0 + change;
@@ -62,11 +72,33 @@ fn every_fault_is_named_alone_with_its_size_or_not_named_at_all() {
                         || name == "2.2 kW"
                         || name == "11 kW");
                 if !expected {
+                    // Not named alone, but where it is detected the leading candidate
+                    // with its size (the 3 hp machine's small Rs, Ls and Lr changes are
+                    // below detection).
+                    let lead = out.candidates.first().filter(|c| c.fault == f);
+                    let hidden = out.state == IsolationState::NoDeviation
+                        || matches!(f, Fault::B | Fault::Bl)
+                        || (name == "3 hp" && f == Fault::Ls);
+                    assert!(
+                        hidden
+                            || lead.is_some_and(|c| {
+                                (f64::from(c.change) - change).abs() < 0.2 * change.abs()
+                            }),
+                        "{name} {f} {change}: not leading: {out:?}"
+                    );
                     continue;
                 }
-                let top = out
-                    .named_fault()
-                    .unwrap_or_else(|| panic!("{name} {f} {change}: not named: {out:?}")); // ok: test
+                let Some(top) = out.named_fault() else {
+                    missed.push(std::format!(
+                        "{name} {f} {change}: not named: {:?}",
+                        out.candidates
+                            .iter()
+                            .take(2)
+                            .map(|c| (c.fault, c.probability, c.change))
+                            .collect::<std::vec::Vec<_>>()
+                    ));
+                    continue;
+                };
                 assert_eq!(top.fault, f, "{name} {f} {change}: {out:?}");
                 assert!(
                     (f64::from(top.change) - change).abs() < 0.2 * change.abs(),
@@ -78,7 +110,8 @@ fn every_fault_is_named_alone_with_its_size_or_not_named_at_all() {
         }
     }
     // 3 machines x 7 faults x 4 sizes, minus the documented exceptions.
-    assert!(named >= 70, "{named} named");
+    assert!(missed.is_empty(), "{missed:#?}");
+    assert!(named >= 60, "{named} named");
 }
 
 #[test]
