@@ -303,4 +303,11 @@ fn the_ranking_reads_beside_the_verdicts_fault() {
         sim_host::api::beside_verdict(&healthy, &report, &mcsa),
         None
     );
+    // A log without voltages: no model, no ranking; the sentence says so.
+    report.baseline_normalized_rms_error = f64::NAN;
+    let b = sim_host::api::beside_verdict(&turns, &report, &mcsa).expect("a sentence");
+    assert!(
+        b.contains("could not run") && b.contains("ranks no effect"),
+        "{b}"
+    );
 }

@@ -137,7 +137,8 @@ impl ExplainDocument {
 /// what the verdict judged from, and why a ranking that does not name the fault does not
 /// contradict it (module doc). A Table 1 fault (a parameter's or a sensor's change) is
 /// absorbed by the base parameters `explain` refits before it ranks, so it shows in the
-/// refit, not in the ranking.
+/// refit, not in the ranking. On a log without voltages the model does not run: the sentence
+/// says so and points at the unbalance line.
 pub fn beside_verdict(
     finding: &FindingReport,
     report: &ExplainReport,
@@ -154,6 +155,12 @@ pub fn beside_verdict(
             ));
         }
     };
+    if !report.baseline_normalized_rms_error.is_finite() {
+        return Some(format!(
+            "beside the verdict ({fault}): the model could not run on this log (no voltages), so explain ranks no effect; the verdict's analysis judged the motor, and the unbalance line below is the whole log's average ({})",
+            report.unbalance.summary
+        ));
+    }
     let place = place_of(effect, report);
     if place.agrees {
         return Some(format!(
@@ -169,8 +176,13 @@ pub fn beside_verdict(
         _ => (
             "the negative-sequence current, stretch by stretch",
             format!(
-                "the negative sequence is {:.1} % of the current over the whole log",
-                100.0 * report.unbalance.negative_sequence_ratio
+                "the negative sequence is {:.1} % of the current on average{}",
+                100.0 * report.unbalance.negative_sequence_ratio,
+                match (&report.unbalance.suspect_phase, named.phase) {
+                    (Some(p), Some(q)) if p.as_str() == q.name() => String::new(),
+                    (Some(p), _) => format!(" (the unbalance line's average points at phase {p})"),
+                    (None, _) => " (the unbalance line's average names no phase)".into(),
+                }
             ),
         ),
     };
