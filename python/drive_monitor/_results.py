@@ -125,8 +125,11 @@ class ExplainResult(Result):
 
     @property
     def ranking_frame(self):
-        """The ranking as a DataFrame (effect, errors, explained fraction, plausibility)."""
+        """The ranking as a DataFrame (rank, standing, effect, errors, explained fraction,
+        plausibility): ranked candidates first, then ``no_effect``, then ``not_plausible``."""
         keep = (
+            "rank",
+            "standing",
             "effect",
             "normalized_rms_error",
             "validation_normalized_rms_error",

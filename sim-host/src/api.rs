@@ -18,6 +18,9 @@ use crate::replay::{
 use monitor_core::{AngleSource, EffectKind, ResidualForm};
 use std::path::{Path, PathBuf};
 
+mod explain_doc;
+pub use explain_doc::{beside_verdict, explain, mcsa_beside, verdict_for_explain, ExplainDocument};
+
 /// A failed call: the command line's one-line message, and its kind.
 #[derive(Debug, thiserror::Error)]
 pub enum ApiError {
@@ -320,46 +323,6 @@ impl AnalysisRequest {
     }
 }
 
-/// `explain`'s JSON document: the one verdict's headline, the report, and the motor current
-/// signature analysis.
-#[derive(Debug, serde::Serialize)]
-pub struct ExplainDocument {
-    /// The one verdict `diagnose` gives on the same log and parameter file, as its line
-    /// (`explain` opens with it: the model's discrepancy is read beside what the motor was
-    /// judged to have).
-    pub headline: String,
-    /// That verdict (`fault`, `watching`, `healthy`, `could_not_judge`).
-    pub motor_verdict: crate::replay::Verdict,
-    /// The finding that verdict rests on (null for healthy and nothing judged).
-    pub verdict_finding: Option<crate::replay::FindingReport>,
-    /// The ranking and its verdict.
-    #[serde(flatten)]
-    pub report: crate::analysis::explain::ExplainReport,
-    /// The motor current signature analysis (broken rotor bars).
-    pub rotor_asymmetry: crate::analysis::rotor_asymmetry::McsaReport,
-}
-
-/// The motor current signature analysis beside `explain`'s ranking (the fitted
-/// `rotor_asymmetry`'s delta, where ranked).
-pub fn mcsa_beside(
-    a: &Analysis,
-    report: &crate::analysis::explain::ExplainReport,
-    rotor_bars: Option<u32>,
-) -> crate::analysis::rotor_asymmetry::McsaReport {
-    let delta = report
-        .ranking
-        .iter()
-        .find(|r| r.effect == EffectKind::RotorAsymmetry)
-        .and_then(|r| r.parameters.get("delta"))
-        .map(|p| p.value);
-    crate::analysis::rotor_asymmetry::mcsa(
-        &a.data,
-        a.constants.np,
-        rotor_bars.map(f64::from),
-        delta,
-    )
-}
-
 /// `compare --json`'s document.
 ///
 /// # Errors
@@ -372,68 +335,6 @@ pub fn compare(
     let a = load_analysis(params, log, req, &mut |_| {})?;
     let out = a.compare(&req.options())?;
     Ok(serde_json::to_value(&out.report).unwrap_or_default())
-}
-
-/// `explain --json`'s document.
-///
-/// # Errors
-/// As [`compare`].
-pub fn explain(
-    params: ParamsSource<'_>,
-    log: &Path,
-    req: &AnalysisRequest,
-) -> Result<serde_json::Value, ApiError> {
-    let a = load_analysis(params, log, req, &mut |_| {})?;
-    let judged = verdict_for_explain(params, log, req.group.clone());
-    let out = a.explain(&req.options(), &|_| {})?;
-    let rotor_asymmetry = mcsa_beside(&a, &out.report, req.rotor_bars);
-    let doc = ExplainDocument::new(judged.as_ref(), out.report, rotor_asymmetry);
-    Ok(serde_json::to_value(&doc).unwrap_or_default())
-}
-
-/// The verdict `diagnose` gives `log` with its defaults (no commissioning, no baseline; the
-/// TDMS `group`), which `explain` opens with; the error's message where `diagnose` cannot
-/// judge the log at all.
-pub fn verdict_for_explain(
-    params: ParamsSource<'_>,
-    log: &Path,
-    group: Option<String>,
-) -> Result<crate::replay::DiagnoseReport, ApiError> {
-    let req = DiagnoseRequest {
-        group,
-        ..DiagnoseRequest::default()
-    };
-    diagnose(params, log, &req, &mut |_| {}).map(|d| d.report)
-}
-
-impl ExplainDocument {
-    /// The document of an `explain` report beside the verdict `diagnose` gave the same log
-    /// (`judged`; its error where it gave none).
-    pub fn new(
-        judged: Result<&crate::replay::DiagnoseReport, &ApiError>,
-        report: crate::analysis::explain::ExplainReport,
-        rotor_asymmetry: crate::analysis::rotor_asymmetry::McsaReport,
-    ) -> Self {
-        let (headline, motor_verdict, verdict_finding) = match judged {
-            Ok(j) => (
-                format!("verdict: {}", j.verdict_line),
-                j.verdict,
-                j.verdict_finding.clone(),
-            ),
-            Err(e) => (
-                format!("verdict: could not judge: {e}"),
-                crate::replay::Verdict::CouldNotJudge,
-                None,
-            ),
-        };
-        ExplainDocument {
-            headline,
-            motor_verdict,
-            verdict_finding,
-            report,
-            rotor_asymmetry,
-        }
-    }
 }
 
 /// `identify`'s result: the identification and the parameter file it writes.

@@ -87,3 +87,227 @@ fn a_diverged_model_reports_no_error_figure() {
     let ok = json(&run(&["compare", "--json", "--to", "2.4"], &params, &log));
     assert!(ok.get("diverged_at_s").is_none(), "{ok}");
 }
+
+/// The motulator log's paths (a start and a load step; the repository's).
+fn motulator() -> (std::path::PathBuf, std::path::PathBuf) {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/logs");
+    (
+        root.join("motulator_2p2kw_dol.toml"),
+        root.join("motulator_2p2kw_dol.csv"),
+    )
+}
+
+/// `explain`'s text reads like its verdict: the one verdict first, then explain's own answer
+/// on the model's error, the motor's own analyses (unbalance, rotor spectrum) before the
+/// ranking; the ranking's table holds only ranked candidates (no fit that is not plausible,
+/// none that explains under the floor); those with no effect in one line, those not
+/// plausible in a section of their own; no dimensionless value with a unit "1"; and every
+/// dynamics effect it skips is in `compare`'s advice with the same words.
+#[test]
+fn explains_text_reads_like_its_verdict() {
+    let (params, log) = motulator();
+    let text = String::from_utf8(run(&["explain"], &params, &log)).expect("utf-8");
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(lines[0].starts_with("explain "), "{text}");
+    assert!(lines[1].starts_with("verdict: "), "{text}");
+    let at = |needle: &str| {
+        lines
+            .iter()
+            .position(|l| l.starts_with(needle))
+            .unwrap_or_else(|| panic!("no line {needle:?} in:\n{text}"))
+    };
+    let (answer, rotor, ranking) = (
+        at("model's error: "),
+        at("  rotor (motor current signature analysis)"),
+        at("  ranking: "),
+    );
+    let (none, implausible) = (at("  no effect "), at("  not plausible "));
+    assert!(answer < rotor && rotor < ranking && ranking < none && none < implausible);
+    assert!(at("  unbalance: ") < ranking, "{text}");
+    let e = json(&run(&["explain", "--json"], &params, &log));
+    let ranking_json = e["ranking"].as_array().expect("ranking");
+    let of = |standing: &str| -> Vec<String> {
+        ranking_json
+            .iter()
+            .filter(|c| c["standing"] == standing)
+            .map(|c| c["effect"].as_str().unwrap_or_default().to_string())
+            .collect()
+    };
+    let table = &lines[ranking + 2..none];
+    assert_eq!(table.len(), of("candidate").len(), "{text}");
+    for bad in of("not_plausible").iter().chain(&of("no_effect")) {
+        assert!(
+            !table.iter().any(|l| l.contains(&format!(" {bad} "))),
+            "{bad} in the ranking:\n{text}"
+        );
+        let listed = if of("no_effect").contains(bad) {
+            lines[none].contains(bad.as_str())
+        } else {
+            lines[implausible..]
+                .iter()
+                .any(|l| l.starts_with(&format!("    {bad} (")))
+        };
+        assert!(listed, "{bad} not listed apart:\n{text}");
+    }
+    assert!(
+        !of("not_plausible").is_empty() && !of("no_effect").is_empty(),
+        "{e}"
+    );
+    assert!(
+        !text.contains(" 1 is outside") && !text.contains(" 1 ("),
+        "{text}"
+    );
+    // The same reasons as compare's advice, word for word.
+    let cmp = String::from_utf8(run(&["compare"], &params, &log)).expect("utf-8");
+    for l in lines.iter().filter_map(|l| l.strip_prefix("  skipped: ")) {
+        if l.contains("dynamics: ") {
+            assert!(
+                cmp.contains(&format!("  advice: {l}\n")),
+                "{l} not in:\n{cmp}"
+            );
+        }
+    }
+}
+
+/// The rotor's current signature is in explain's main text (before the ranking), and with
+/// the rotor's bar count (`--rotor-bars`, the one place `rotor_asymmetry::rotor_bar_count`
+/// reads it from) the number of broken bars is given; without it, how to get it. A 3 hp
+/// motor with two adjacent broken bars of 28, rated load (`examples/scenarios`).
+#[test]
+fn broken_bars_are_counted_in_the_main_text() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let params = root.join("examples/params/3hp.toml");
+    let log = dir.path().join("bars.csv");
+    Command::cargo_bin("sim-host")
+        .unwrap()
+        .args(["simulate", "--params"])
+        .arg(&params)
+        .arg("--scenario")
+        .arg(root.join("examples/scenarios/effect_rotor_asymmetry.toml"))
+        .arg("--out")
+        .arg(&log)
+        .assert()
+        .success();
+    let text = |extra: &[&str]| {
+        let args = [&["explain", "--from", "3"][..], extra].concat();
+        String::from_utf8(run(&args, &params, &log)).expect("utf-8")
+    };
+    let with = text(&["--rotor-bars", "28"]);
+    let bars = with
+        .find("adjacent broken bars of 28")
+        .unwrap_or_else(|| panic!("no bar count:\n{with}"));
+    let ranking = with.find("  ranking: ").expect("ranking");
+    assert!(bars < ranking, "{with}");
+    // Two broken bars: the sidebands say 1.5 to 2.5 (the spectral estimate's bound).
+    let n: f64 = with
+        .lines()
+        .find(|l| l.contains("from the sidebands"))
+        .and_then(|l| l.split("about ").nth(1))
+        .and_then(|s| s.split(' ').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("no spectral count:\n{with}"));
+    assert!((1.5..=2.5).contains(&n), "{n}");
+    let without = text(&[]);
+    assert!(without.contains("--rotor-bars N"), "{without}");
+    assert!(!without.contains("adjacent broken bars of"), "{without}");
+}
+
+/// How the ranking reads beside the verdict's named fault (`api::beside_verdict`): broken
+/// bars beside a `rotor_asymmetry` whose fit is not physical say that the two do not
+/// contradict each other and why (the sideband's share of the current); the same fault
+/// ranked first says the ranking agrees; shorted turns name the negative sequence; a Table 1
+/// fault points at the refitted base parameters. On the motulator log's report, its
+/// candidates set by hand.
+#[test]
+fn the_ranking_reads_beside_the_verdicts_fault() {
+    use monitor_core::verdict::{Against, FaultName, FindingSource, NamedFault, Size, State};
+    use sim_host::analysis::explain::Standing;
+    use sim_host::replay::FindingReport;
+    let (params, log) = motulator();
+    let p = sim_host::params::ParamFile::load(&params).unwrap();
+    let a = analyse(&log, &p, 0.0);
+    let mut report = a.explain(&opts(&[]), &|_| {}).unwrap().report;
+    let mut mcsa = sim_host::api::mcsa_beside(&a, &report, None);
+    mcsa.lower_sideband_db = Some(-42.0);
+    let named = |fault, size, source| {
+        let n = NamedFault {
+            fault,
+            size,
+            phase: None,
+            confidence: 0.9,
+        };
+        FindingReport::new(
+            source,
+            State::Named(n),
+            Against::Nothing,
+            "x".into(),
+            "y".into(),
+        )
+    };
+    let bars = named(
+        FaultName::BrokenBars,
+        Size::DbBelowLine(42.0),
+        FindingSource::Rotor,
+    );
+    let set = |r: &mut sim_host::analysis::explain::ExplainReport, s: Standing, k| {
+        let c = r
+            .ranking
+            .iter_mut()
+            .find(|c| c.effect == monitor_core::EffectKind::RotorAsymmetry)
+            .expect("rotor_asymmetry fitted");
+        (c.standing, c.rank, c.plausible) = (s, k, s != Standing::NotPlausible);
+        if !c.plausible && c.implausible_because.is_empty() {
+            c.implausible_because = vec!["delta = 0.9 is out of range".into()];
+        }
+    };
+    set(&mut report, Standing::NotPlausible, None);
+    let b = sim_host::api::beside_verdict(&bars, &report, &mcsa).expect("a sentence");
+    assert!(
+        b.contains("do not contradict") && b.contains("42.0 dB"),
+        "{b}"
+    );
+    assert!(b.contains("not physical") && !b.contains("agrees"), "{b}");
+    assert!(b.contains("0.79 % of the current"), "{b}"); // 10^(-42/20)
+    set(&mut report, Standing::Candidate, Some(1));
+    let b = sim_host::api::beside_verdict(&bars, &report, &mcsa).expect("a sentence");
+    assert!(
+        b.contains("the ranking agrees: rotor_asymmetry is rank 1"),
+        "{b}"
+    );
+    let turns = named(
+        FaultName::ShortedTurns,
+        Size::OfPositiveSequence(0.05),
+        FindingSource::Winding,
+    );
+    let b = sim_host::api::beside_verdict(&turns, &report, &mcsa).expect("a sentence");
+    assert!(
+        b.contains("negative-sequence current") && b.contains("phase_asymmetry"),
+        "{b}"
+    );
+    let rs = named(
+        FaultName::Table1(monitor_core::signature::Fault::Rs),
+        Size::Relative(0.5),
+        FindingSource::Residuals,
+    );
+    let b = sim_host::api::beside_verdict(&rs, &report, &mcsa).expect("a sentence");
+    assert!(b.contains("rs +50 %") && b.contains("refit"), "{b}");
+    let healthy = FindingReport::new(
+        FindingSource::Rotor,
+        State::Clear,
+        Against::Nothing,
+        "x".into(),
+        "y".into(),
+    );
+    assert_eq!(
+        sim_host::api::beside_verdict(&healthy, &report, &mcsa),
+        None
+    );
+    // A log without voltages: no model, no ranking; the sentence says so.
+    report.baseline_normalized_rms_error = f64::NAN;
+    let b = sim_host::api::beside_verdict(&turns, &report, &mcsa).expect("a sentence");
+    assert!(
+        b.contains("could not run") && b.contains("ranks no effect"),
+        "{b}"
+    );
+}

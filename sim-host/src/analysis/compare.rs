@@ -84,7 +84,7 @@ impl Analysis {
         // Data-dependent set-ups (load steps) are recomputed on the full series; keep the
         // fitted values where the parameter count agrees.
         let f = align(&active, fitted.fit);
-        let m = self.measure_compare(&active, &f, &list)?;
+        let m = self.measure_compare(&active, &f, &list, fitted.span)?;
         let fitted_effects = self.fitted_effects(&active, &f)?;
         let implausible_because = self.compare_implausible(&f, &m, &fitted_effects);
         Ok(CompareOutput {
@@ -134,17 +134,20 @@ impl Analysis {
             fit,
             jacobian,
             not_identified,
+            span: super::transients::Span::of(&fd, &self.constants),
         })
     }
 
     /// The fitted model `f` of the effects `active` (the configured `list`) run over the
     /// working series and measured: its errors, noise floor, windows (the worst tagged
-    /// with the transient they lie in) and the advice on them.
+    /// with the transient they lie in) and the advice on them, by the rule `explain` skips
+    /// dynamics effects by on the fit series' `span` ([`super::transients::dynamics_plan`]).
     fn measure_compare(
         &self,
         active: &[super::fit::ActiveEffect<'_>],
         f: &super::fit::FitResult,
         list: &[Box<dyn super::effects::EffectModel>],
+        span: super::transients::Span,
     ) -> Result<CompareMeasures, AnalysisError> {
         let d = &self.data;
         let w = Weights::new(d, 0, usize::MAX);
@@ -154,7 +157,9 @@ impl Analysis {
         let v_rated = self.params.supply.v_phase_peak();
         let (mut worst, all) = metrics::windows(d, &pred, &w, v_rated, self.constants.np, 40, 3);
         let in_model: Vec<EffectKind> = list.iter().map(|e| e.kind()).collect();
-        let (tags, advice) = super::transients::advice(d, &self.constants, &worst, &in_model);
+        let plan = super::transients::dynamics_plan(span, &self.constants, &in_model);
+        let (tags, advice) =
+            super::transients::advice(d, &self.constants, &worst, &in_model, &plan);
         for (w, t) in worst.iter_mut().zip(tags) {
             w.transient = t;
         }
@@ -208,6 +213,8 @@ struct FittedForCompare {
     jacobian: Option<super::fit::Jacobian>,
     /// The base parameters not identified, in words.
     not_identified: Vec<String>,
+    /// What the fit series offers the dynamics effects (the advice's rule).
+    span: super::transients::Span,
 }
 
 /// `compare`'s measures of the fitted model on the working series.

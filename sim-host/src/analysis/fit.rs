@@ -359,7 +359,12 @@ impl std::fmt::Display for FittedModel<'_> {
         )?;
         for (e, p) in self.effects.iter().zip(&self.fit.effect_params) {
             for (q, v) in e.setup.params.iter().zip(p) {
-                write!(f, "; {} = {} {}", q.name, sig(*v), q.unit())?;
+                write!(
+                    f,
+                    "; {} = {}",
+                    q.name,
+                    super::effects::with_unit(&sig(*v), q.unit())
+                )?;
             }
         }
         let r = &self.fit.report;

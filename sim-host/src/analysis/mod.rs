@@ -151,7 +151,8 @@ pub struct FittedEffect {
     pub effect: EffectKind,
     /// Parameters.
     pub parameters: std::collections::BTreeMap<String, ParamValue>,
-    /// In words.
+    /// In words; for values outside their physical range, that the fit is not physical
+    /// and why ([`effects::not_physical`]).
     pub summary: String,
     /// False when a fitted value is outside its physical range.
     pub plausible: bool,
@@ -484,8 +485,12 @@ impl Analysis {
             .iter()
             .zip(&f.effect_params)
             .map(|(a, p)| {
-                let summary = a.setup.describe(p, &self.data, &self.constants)?;
                 let why = a.setup.implausible(p);
+                let summary = if why.is_empty() {
+                    a.setup.describe(p, &self.data, &self.constants)?
+                } else {
+                    effects::not_physical(&why)
+                };
                 Ok(FittedEffect {
                     effect: a.effect.kind(),
                     parameters: parameter_table(&a.setup.params, p),

@@ -99,6 +99,15 @@ pub fn fit_and_spectrum_agree(fit_delta: f64, spectral_delta: f64) -> bool {
         && fit_delta <= AGREE_FACTOR * spectral_delta
 }
 
+/// The rotor's bar count N for the broken-bar figures, from the one place every caller
+/// reads it: `given` (`explain --rotor-bars N`) when given; else the parameter file's
+/// (`_params`: its `[motor]` table holds no bar count yet; its key is read here once it
+/// does). A count turns the fitted and the spectral asymmetry into adjacent broken bars
+/// ([`McsaReport::equivalent_broken_bars`], [`McsaReport::spectral_broken_bars`]).
+pub fn rotor_bar_count(_params: &crate::params::ParamFile, given: Option<u32>) -> Option<f64> {
+    given.map(f64::from)
+}
+
 /// The motor current signature analysis of a log (`explain`'s `rotor_asymmetry` key).
 #[derive(Debug, Clone, Serialize, Default)]
 pub struct McsaReport {
@@ -123,7 +132,7 @@ pub struct McsaReport {
     pub speed_ripple_rad_s: Option<f64>,
     /// Fitted (or given) delta the broken-bar figure is computed from.
     pub delta: Option<f64>,
-    /// Rotor bar count N given by `--rotor-bars`.
+    /// Rotor bar count N ([`rotor_bar_count`]: `--rotor-bars`, or the parameter file).
     pub rotor_bars: Option<f64>,
     /// Equivalent adjacent broken bars n = delta N / (3 (1 + delta)) (null without a bar
     /// count or without a fitted delta).
@@ -232,9 +241,11 @@ pub fn spectrum_contradicts(d: &Prepared, np: f64, fit_delta: f64) -> Option<Str
     let spectral = m.spectral_delta?;
     (m.fit_and_spectrum_agree == Some(false)).then(|| {
         format!(
-            "the current spectrum's sidebands ({:.1} / {:.1} dB) say delta {spectral:.3}, not the fitted {fit_delta:.3} (within {AGREE_FACTOR}x)",
+            "the current spectrum's sidebands ({:.1} / {:.1} dB) say delta {}, not the fitted {} (within {AGREE_FACTOR}x)",
             m.lower_sideband_db.unwrap_or(f64::NAN),
             m.upper_sideband_db.unwrap_or(f64::NAN),
+            super::effects::sig(spectral),
+            super::effects::sig(fit_delta),
         )
     })
 }

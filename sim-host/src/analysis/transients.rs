@@ -1,8 +1,11 @@
 //! Transients in a log: the direct-on-line start and the steps of the supply voltage,
 //! the supply frequency or the speed, found from the measured signals. `compare` uses them
 //! to say when its worst windows are a transient, which dynamics effects cover it, and
-//! from where (`--from`) the log is past the start.
+//! from where (`--from`) the log is past the start; `explain` and `compare` decide by one
+//! rule ([`not_proposed`]) whether a dynamics effect is proposed on a log, so that
+//! `compare`'s advice and `explain`'s `skipped` give the same reasons.
 
+use super::effects::{model_of, EffectModel};
 use super::metrics::WorstWindow;
 use super::prep::Prepared;
 use super::simplified_model::MachineConstants;
@@ -195,13 +198,123 @@ pub fn settling_s(n: &MachineConstants) -> f64 {
     5.0 * n.lr_h / n.rr_ohm
 }
 
-/// The advice `compare` prints when its worst windows are transients: which dynamics
-/// effects not in the model cover them, and (for a start) the `--from` past it.
+/// Why a library effect is not proposed on a log (`explain`'s `skipped`, and `compare`'s
+/// advice on the dynamics effects): the one rule both commands print
+/// ([`not_proposed`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NotProposed {
+    /// Effects it needs in the model first ([`EffectModel::requires`]).
+    #[error("needs {} in the model first", names(.0))]
+    Requires(Vec<EffectKind>),
+    /// Its time constant `tau_s` [s] is shorter than 3 samples of the fit series (period
+    /// `dt_s` [s]).
+    #[error("the fit series of this long log ({:.0} Hz) cannot resolve a {:.1} ms time constant; analyse a shorter window with --from/--to", 1.0 / dt_s, 1000.0 * tau_s)]
+    Unresolved {
+        /// Sample period of the fit series [s].
+        dt_s: f64,
+        /// The effect's time constant [s].
+        tau_s: f64,
+    },
+    /// A dynamics effect (time constant `tau_s` [s]) on a log without a start or a supply
+    /// step.
+    #[error("no start or supply step in the analysed span (voltage and frequency within {:.0} %): its {:.1} ms dynamics have nothing to act on", 100.0 * STEP_MIN, 1000.0 * tau_s)]
+    NoTransient {
+        /// The effect's time constant [s].
+        tau_s: f64,
+    },
+}
+
+/// Effect names, comma separated.
+fn names(kinds: &[EffectKind]) -> String {
+    kinds
+        .iter()
+        .map(|k| k.name())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// What the analysed span offers an effect with a time constant: the sample period of the
+/// series the fits run on (a long log's coarse copy) and whether that series holds a
+/// transient of the model's inputs ([`input_transients`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Span {
+    /// Sample period of the fit series [s].
+    pub dt_s: f64,
+    /// Whether it holds a start or a supply step.
+    pub input_transient: bool,
+}
+
+impl Span {
+    /// The span of the fit series `fit_series` of machine `n`.
+    pub fn of(fit_series: &Prepared, n: &MachineConstants) -> Self {
+        Span {
+            dt_s: fit_series.dt_s,
+            input_transient: input_transients(fit_series, n).iter().any(|&t| t),
+        }
+    }
+}
+
+/// The one rule for whether effect `e` is proposed on a span (`None`: it is), with the
+/// model holding `in_model`: for a dynamics effect (one that declares a time constant,
+/// [`EffectModel::time_constant_s`]), its time constant is shorter than 3 samples of the
+/// (coarse) fit series of a long log, or the span holds no transient of the model's inputs
+/// for its dynamics to act on (said first: then no rung of the dynamics ladder is
+/// proposed); else an effect it needs first ([`EffectModel::requires`]) is missing. Without a start or a supply step the electrical states
+/// follow the inputs quasi-statically (a load step moves the speed at the mechanical
+/// rate), the full-order machine's steady state is the paper's model, and what a dynamics
+/// effect's extra states gain there they gain by absorbing another effect
+/// (docs/model-vs-measurement.md, "How it works"). `explain` skips such an effect with
+/// this reason; `compare`'s advice prints the same ([`dynamics_plan`]).
+pub fn not_proposed(
+    e: &dyn EffectModel,
+    span: Span,
+    n: &MachineConstants,
+    in_model: &[EffectKind],
+) -> Option<NotProposed> {
+    if let Some(tau_s) = e.time_constant_s(n) {
+        if span.dt_s > tau_s / 3.0 {
+            return Some(NotProposed::Unresolved {
+                dt_s: span.dt_s,
+                tau_s,
+            });
+        }
+        if !span.input_transient {
+            return Some(NotProposed::NoTransient { tau_s });
+        }
+    }
+    let missing: Vec<EffectKind> = e
+        .requires()
+        .iter()
+        .copied()
+        .filter(|k| !in_model.contains(k))
+        .collect();
+    (!missing.is_empty()).then_some(NotProposed::Requires(missing))
+}
+
+/// Every dynamics effect of the library not in the model (`in_model`), in the library's
+/// order, with why it is not proposed on the span ([`not_proposed`]; `None`: proposed).
+pub fn dynamics_plan(
+    span: Span,
+    n: &MachineConstants,
+    in_model: &[EffectKind],
+) -> Vec<(EffectKind, Option<NotProposed>)> {
+    EffectKind::ALL
+        .iter()
+        .filter(|k| k.is_dynamics() && !in_model.contains(k))
+        .map(|&k| (k, not_proposed(model_of(k).as_ref(), span, n, in_model)))
+        .collect()
+}
+
+/// The advice `compare` prints when its worst windows are transients: the dynamics effects
+/// not in the model that [`dynamics_plan`] proposes on this span (with the `--effects` that
+/// adds them), each one it does not propose with the reason `explain` gives for skipping it
+/// (`name: why`, the same words), and, after a start, the `--from` past it.
 pub fn advice(
     d: &Prepared,
     n: &MachineConstants,
     worst: &[WorstWindow],
     in_model: &[EffectKind],
+    plan: &[(EffectKind, Option<NotProposed>)],
 ) -> (Vec<Option<Transient>>, Vec<String>) {
     let start = start_end_s(d);
     let look = settling_s(n);
@@ -209,15 +322,8 @@ pub fn advice(
         .iter()
         .map(|w| classify(d, n, w, start, look))
         .collect();
-    let missing: Vec<&str> = EffectKind::ALL
-        .iter()
-        .filter(|k| k.is_dynamics() && !in_model.contains(k))
-        .map(|k| k.name())
-        .collect();
     let mut out = Vec::new();
-    let mut kinds: Vec<TransientKind> = tags.iter().flatten().map(|t| t.kind).collect();
-    kinds.dedup();
-    if kinds.is_empty() {
+    if tags.iter().all(Option::is_none) {
         return (tags, out);
     }
     let spans: Vec<String> = worst
@@ -228,24 +334,15 @@ pub fn advice(
                 .map(|t| format!("{:.2}-{:.2} s: {}", w.t_start_s, w.t_end_s, t.description))
         })
         .collect();
-    let cover = if missing.is_empty() {
-        "every dynamics effect is already in the model; what remains there is another effect or a parameter error".to_string()
-    } else {
-        let all: Vec<&str> = in_model
-            .iter()
-            .map(|k| k.name())
-            .chain(missing.iter().copied())
-            .collect();
-        format!(
-            "the model's dynamics effects cover transients: add {} (--effects {})",
-            missing.join(", "),
-            all.join(",")
-        )
-    };
     out.push(format!(
-        "the worst windows are transients ({}); {cover}",
-        spans.join("; ")
+        "the worst windows are transients ({}); {}",
+        spans.join("; "),
+        cover(plan, in_model)
     ));
+    out.extend(
+        plan.iter()
+            .filter_map(|(k, why)| why.as_ref().map(|w| format!("{k}: {w}"))),
+    );
     if let Some(te) = start {
         let from = ((te + look) * 10.0).ceil() / 10.0;
         out.push(format!(
@@ -253,6 +350,32 @@ pub fn advice(
         ));
     }
     (tags, out)
+}
+
+/// What the dynamics effects of `plan` do for the transients, in words: those proposed
+/// with the `--effects` that adds them to `in_model`, or why none is.
+fn cover(plan: &[(EffectKind, Option<NotProposed>)], in_model: &[EffectKind]) -> String {
+    let proposed: Vec<&str> = plan
+        .iter()
+        .filter(|(_, why)| why.is_none())
+        .map(|(k, _)| k.name())
+        .collect();
+    if plan.is_empty() {
+        return "every dynamics effect is already in the model; what remains there is another effect or a parameter error".to_string();
+    }
+    if proposed.is_empty() {
+        return "the dynamics effects are not proposed on this span (why below, as explain skips them)".to_string();
+    }
+    let all: Vec<&str> = in_model
+        .iter()
+        .map(|k| k.name())
+        .chain(proposed.iter().copied())
+        .collect();
+    format!(
+        "the model's dynamics effects cover a start or a supply step: add {} (--effects {})",
+        proposed.join(", "),
+        all.join(",")
+    )
 }
 
 /// The samples of `d` that lie in a transient of the model's inputs: within the

@@ -7,8 +7,9 @@
 //! `diagnose` names it): the fitted `i_neg = c conj(i_pos)` and `v_neg = cv conj(i_pos)`
 //! give `I2/I1 = conj(c)` and `V2/I1 = conj(cv)`; the part `V2/Z2` that the supply's own
 //! unbalance drives is taken out, and the angle of what is left, minus `arg Z1` at the
-//! log's operating slip, points at the winding. Below what the supply's part and the noise
-//! explain, no winding is suspect. The slip is
+//! log's operating slip, points at the winding. Below what the supply's part explains, or
+//! below a healthy machine's own asymmetry ([`NAMED_WINDING_MIN`], 3 %: there is no healthy
+//! reference here), no winding is suspect. The slip is
 //! the measured one (`1 - omega_r/omega_s`), or, without a speed column, the one at which
 //! the equivalent circuit draws the measured current (`monitor_core::sequence::slip_for_current`).
 
@@ -23,8 +24,9 @@ pub struct UnbalanceAnalysis {
     pub negative_sequence_ratio: f64,
     /// Same for the voltages (null without voltage columns).
     pub voltage_negative_sequence_ratio: Option<f64>,
-    /// Phase whose winding most likely differs ("a"/"b"/"c"), null when balanced
-    /// (ratio below 1 %) or when the voltage unbalance explains the current unbalance.
+    /// Phase whose winding most likely differs ("a"/"b"/"c"), null when the winding's part
+    /// is within a healthy machine's own asymmetry ([`NAMED_WINDING_MIN`]) or when the
+    /// voltage unbalance explains the current unbalance.
     pub suspect_phase: Option<String>,
     /// RMS phase currents [A] a, b, c.
     pub phase_rms_a: [f64; 3],
@@ -120,6 +122,7 @@ pub fn analyse(d: &Prepared, n: &MachineConstants) -> UnbalanceAnalysis {
             ratio,
             vratio,
             supply_explains: suspect.is_none() && f64::from(asym.supply_ratio) > 0.5 * ratio,
+            winding_ratio: f64::from(asym.ratio),
             shorted_fraction: eps,
             phase_rms_a,
         }
@@ -135,6 +138,16 @@ pub fn analyse(d: &Prepared, n: &MachineConstants) -> UnbalanceAnalysis {
     }
 }
 
+/// The least winding part of the negative sequence, `|I2w/I1|`, that names a phase here: a
+/// healthy machine's own asymmetry ([`monitor_core::sequence::INHERENT_ASYMMETRY_RATIO`],
+/// 3 %), with or without voltages. This analysis has no healthy reference; the part below
+/// it is the machine's build (winding and core tolerances), which a healthy motor carries
+/// too, so the phase it points at is no fault. It is the least change `diagnose`'s winding
+/// judgement asks of a log with voltages and without a baseline (`replay::winding`: twice
+/// its spread, half this ratio); a current-only log cannot take the supply's part out, and
+/// `diagnose` asks twice as much there, with its stretches and confidence.
+pub const NAMED_WINDING_MIN: f64 = monitor_core::sequence::INHERENT_ASYMMETRY_RATIO as f64;
+
 /// The winding asymmetry of the sums `s` by the core's one faulty-phase method (in its
 /// convention I2/I1 = conj(c), V2/I1 = conj(cv)) at the mean supply frequency `w`
 /// [rad/s] and the operating slip, and the least fraction of the suspect phase's turns
@@ -145,24 +158,29 @@ fn winding_of(
     s: &SequenceSums,
     w: f64,
 ) -> (monitor_core::sequence::WindingAsymmetry, f64) {
-    let c = s.cross / s.i_pos2.max(1e-12);
+    winding_part(d, n, s, w, s.cross / s.i_pos2.max(1e-12))
+}
+
+/// [`winding_of`] for a given `c` (`i_neg = c conj(i_pos)`, e.g. the fitted
+/// `phase_asymmetry`): the supply's part (the log's `V2`, where voltages are logged) taken
+/// out, named from [`NAMED_WINDING_MIN`] on.
+fn winding_part(
+    d: &Prepared,
+    n: &MachineConstants,
+    s: &SequenceSums,
+    w: f64,
+    c: C64,
+) -> (monitor_core::sequence::WindingAsymmetry, f64) {
     let cv = s.cross_v / s.i_pos2.max(1e-12);
     let slip = operating_slip(d, n, s);
     let (we, sl) = (w.abs().max(1.0) as f32, slip as f32);
-    // A current-only log cannot tell a winding from the supply's unbalance or the machine's
-    // own build asymmetry: below a healthy machine's inherent asymmetry no phase is named.
-    let min_ratio = if d.channels.voltages {
-        0.01
-    } else {
-        monitor_core::sequence::INHERENT_ASYMMETRY_RATIO
-    };
     let asym = monitor_core::sequence::winding_asymmetry(
         (c.re as f32, -c.im as f32),
         d.channels.voltages.then_some((cv.re as f32, -cv.im as f32)),
         &n.core_model,
         we,
         sl,
-        min_ratio,
+        NAMED_WINDING_MIN as f32,
     );
     let eps = f64::from(monitor_core::sequence::min_shorted_fraction(
         &n.core_model,
@@ -181,6 +199,9 @@ struct Found {
     vratio: Option<f64>,
     /// No phase named, and the supply's unbalance accounts for the current's.
     supply_explains: bool,
+    /// The winding's part `|I2w/I1|` (the supply's part taken out where voltages are
+    /// logged).
+    winding_ratio: f64,
     /// The least fraction of the suspect phase's turns shorted.
     shorted_fraction: f64,
     /// Per-phase RMS currents [A].
@@ -209,6 +230,12 @@ impl Found {
                 "negative-sequence current {:.1} %, caused by the supply's {:.1} % voltage unbalance (no winding suspected)",
                 100.0 * ratio,
                 100.0 * self.vratio.unwrap_or(0.0)
+            ),
+            (None, false) if d.channels.voltages && ratio >= 0.01 => format!(
+                "negative-sequence current {:.1} % of positive sequence, the winding's part of it {:.1} % (the supply's taken out): within a healthy machine's own asymmetry of {:.0} %, so no winding is named (diagnose --baseline with a healthy run of this motor judges a smaller change)",
+                100.0 * ratio,
+                100.0 * self.winding_ratio,
+                100.0 * NAMED_WINDING_MIN
             ),
             (None, false) if !d.channels.voltages && ratio >= 0.01 => format!(
                 "negative sequence {:.1} %: cannot judge the phase (a current-only log: below a healthy machine's own asymmetry of {:.0} % a winding cannot be told from the supply's unbalance or the machine's build; diagnose --baseline with a healthy log judges it)",
@@ -247,6 +274,31 @@ fn cannot_judge(d: &Prepared, s: &SequenceSums, omega_s: f64) -> Option<String> 
         ));
     }
     None
+}
+
+/// The winding a negative-sequence current `i_neg = c conj(i_pos)` on the log `d` names:
+/// the phase and the least fraction of its turns shorted (a bolted short), by the same
+/// rule as the unbalance analysis (the supply's part taken out where voltages are logged;
+/// nothing below [`NAMED_WINDING_MIN`]). `None` when it names none; then
+/// [`WindingPart::ratio`] says how large the winding part is.
+pub fn winding_named_by(d: &Prepared, n: &MachineConstants, c: C64) -> WindingPart {
+    let s = SequenceSums::new(d, d.len() / 10);
+    let (asym, eps) = winding_part(d, n, &s, s.omega_s / s.count, c);
+    WindingPart {
+        ratio: f64::from(asym.ratio),
+        named: asym.suspect_phase.map(|p| (p, eps)),
+    }
+}
+
+/// What [`winding_named_by`] found.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WindingPart {
+    /// The winding's part of the negative sequence, `|I2w/I1|` (the supply's part taken
+    /// out where voltages are logged).
+    pub ratio: f64,
+    /// The phase named and the least fraction of its turns shorted; `None` below
+    /// [`NAMED_WINDING_MIN`].
+    pub named: Option<(monitor_core::Phase, f64)>,
 }
 
 /// The log's mean supply angular frequency [rad/s] and slip over its last 90 % (module

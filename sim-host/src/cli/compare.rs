@@ -151,7 +151,9 @@ and fitted together with the base parameters (Ra, Ls, B+Bl, J). The dynamics eff
 with a time constant) are proposed only when the analysed span holds a start or a supply \
 step; with all four the model is the full-order machine. Candidates are ranked by the error \
 on held-back time windows the fit never saw, so an effect that only fits noise does not \
-win; a fit outside its physical range is marked plausible: false and never named. The base \
+win; a fit outside its physical range is marked plausible: false, is listed apart with its reason \
+and never named, and a plausible fit that explains under 5 % of the held-back error is no \
+candidate (listed apart as no effect). The base \
 parameters refitted to the log are printed with the parameter file's values, and those the \
 log does not identify are named; when the file's values do not fit the log at all (the \
 refit outside their physical range), the model is first recentred on the identified refitted \
@@ -163,11 +165,15 @@ sim-host explain --params motor.toml run.csv          # which effect is missing?
 sim-host explain --compare --params motor.toml run.csv  # both, reading a long log once\n  \
 sim-host compare --params motor.toml run.csv --effects load_torque   # the error falls\n  \
 sim-host explain --params motor.toml run.csv --effects load_torque   # anything else?\n\n\
-JSON (--json): baseline_normalized_rms_error, ranking [{effect, normalized_rms_error, \
+The text opens with the verdict diagnose gives the same log, then explain's answer on the \
+model's error and, where the verdict names a fault, how the ranking relates to it.\n\n\
+JSON (--json): headline, motor_verdict, verdict_finding, beside_verdict, \
+baseline_normalized_rms_error, ranking [{effect, rank, standing (candidate | no_effect | \
+not_plausible), normalized_rms_error, \
 explained_fraction, validation_normalized_rms_error, n_parameters, parameters, summary, \
 plausible, implausible_because, fit {iterations, cost, termination: converged | slow_progress | \
 iteration_limit | stalled | nothing_to_fit}}], \
-unexplained, verdict, skipped, unbalance, noise_floor, data_quality, rotor_asymmetry (the \
+no_effect, unexplained, verdict, skipped, unbalance, noise_floor, data_quality, rotor_asymmetry (the \
 motor current signature analysis: lower_sideband_db, upper_sideband_db, slip, sideband_hz, \
 speed_ripple_hz, speed_ripple_rad_s, delta, equivalent_broken_bars (with --rotor-bars N), \
 spectral_delta, spectral_broken_bars, fit_and_spectrum_agree, window_s, resolution_hz, \
@@ -184,8 +190,8 @@ pub struct ExplainArgs {
     /// ...}; --plot and --report get explain's charts and report.
     #[arg(long)]
     pub compare: bool,
-    /// Rotor bar count N: the `rotor_asymmetry` report gives the fitted asymmetry as an
-    /// equivalent number of adjacent broken bars, n = delta N / (3 (1 + delta)).
+    /// Rotor bar count N: the `rotor_asymmetry` report gives the fitted and the sidebands'
+    /// asymmetry as a number of adjacent broken bars, n = delta N / (3 (1 + delta)).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(6..))]
     pub rotor_bars: Option<u32>,
 }
@@ -246,25 +252,21 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
     pb.finish_and_clear();
     // The motor current signature analysis, with the fitted rotor_asymmetry's delta.
     let mcsa = sim_host::api::mcsa_beside(&a, &out.report, args.rotor_bars);
+    let doc = sim_host::api::ExplainDocument::new(judged.as_ref(), out.report, mcsa);
     render::html::write_explain(
         c.plot.as_deref(),
         c.report.as_deref(),
         &c.log,
         &a,
-        &out,
-        &mcsa,
+        (&out.before, out.after.as_ref()),
+        &doc,
     )?;
-    let doc = sim_host::api::ExplainDocument::new(judged.as_ref(), out.report, mcsa);
     match (c.json, compared) {
         (true, Some(cmp)) => render::json::print(&render::json::ExplainWithCompare {
             compare: &cmp,
             explain: &doc,
         }),
         (true, None) => render::json::print(&doc),
-        (false, _) => {
-            render::text::explain(&c.log, &doc.headline, &doc.report)?;
-            print!("{}", render::mcsa::text(&doc.rotor_asymmetry));
-            Ok(())
-        }
+        (false, _) => render::text::explain(&c.log, &doc),
     }
 }

@@ -56,8 +56,8 @@ pub use phase_asymmetry::{asymmetry_phase, PhaseAsymmetry, PhaseAsymmetryValues}
 pub use rotor_asymmetry::{RotorAsymmetry, RotorAsymmetryValues, DELTA_BASIS, DELTA_RANGE};
 pub use saturation::{Saturation, SaturationValues};
 pub use setup::{
-    declared_values, outside, Contribution, EffectParam, EffectValuesError, FitParam, FitSetup,
-    SetupError,
+    declared_values, outside, with_unit, Contribution, EffectParam, EffectValuesError, FitParam,
+    FitSetup, SetupError, DIMENSIONLESS,
 };
 pub use supply_unbalance::{SupplyUnbalance, SupplyUnbalanceValues};
 pub use switch::StateSwitch;
@@ -139,6 +139,13 @@ pub const LOAD_STEP_MIN: f64 = 0.03;
 /// True when the supply's measured voltage unbalance accounts for the current unbalance.
 pub(crate) fn supply_unbalanced(e: &EffectEvidence<'_>) -> bool {
     !e.winding_suspected && e.voltage_unbalance.unwrap_or(0.0) > VOLTAGE_UNBALANCE_MIN
+}
+
+/// The sentence of a fit whose values are not physical (`why`: one reason per value, as
+/// [`outside`] words them): it says so, and gives no reading of the values (a fit that
+/// needs 400 K of heating is not "about 34 K of heating").
+pub fn not_physical(why: &[String]) -> String {
+    format!("not physical, so no explanation: {}", why.join("; "))
 }
 
 /// A number with 3 significant digits, for messages.

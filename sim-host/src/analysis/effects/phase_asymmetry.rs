@@ -7,7 +7,7 @@ use super::{
 };
 use crate::analysis::prep::{Prepared, C64};
 use crate::analysis::simplified_model::{MachineConstants, ModelTerms, WindingAsymmetryTerm};
-use crate::analysis::unbalance::operating_point;
+use crate::analysis::unbalance::{operating_point, winding_named_by, NAMED_WINDING_MIN};
 use monitor_core::EffectKind;
 
 /// One stator winding differs.
@@ -136,15 +136,25 @@ impl Contribution for OnLog {
             y: c * self.y_over_c,
         });
     }
+    /// The winding named by the unbalance analysis' rule
+    /// ([`crate::analysis::unbalance::winding_named_by`]): a phase only for a winding part
+    /// beyond a healthy machine's own asymmetry, with the supply's part taken out.
     fn describe(&self, p: &PhaseAsymmetryValues, d: &Prepared, n: &MachineConstants) -> String {
-        let (w, slip) = operating_point(d, n);
         let c = C64::new(p.c_re, p.c_im);
-        let (ph, eps) = asymmetry_phase(c, n, w, slip);
-        format!(
-            "phase {} winding differs: negative-sequence current {:.1} % of the positive-sequence current; shorted turns in that phase, at least {:.1} % of its turns (a bolted short; a fault resistance means more)",
-            ph.name(),
-            100.0 * c.norm(),
-            100.0 * eps,
-        )
+        let part = winding_named_by(d, n, c);
+        match part.named {
+            Some((ph, eps)) => format!(
+                "phase {} winding differs: negative-sequence current {:.1} % of the positive-sequence current; shorted turns in that phase, at least {:.1} % of its turns (a bolted short; a fault resistance means more)",
+                ph.name(),
+                100.0 * c.norm(),
+                100.0 * eps,
+            ),
+            None => format!(
+                "negative-sequence current {:.1} % of the positive-sequence current, the winding's part of it {:.1} % (the supply's taken out): within a healthy machine's own asymmetry of {:.0} %, so no winding is named",
+                100.0 * c.norm(),
+                100.0 * part.ratio,
+                100.0 * NAMED_WINDING_MIN,
+            ),
+        }
     }
 }

@@ -178,7 +178,7 @@ pub enum EffectValuesError {
 
 /// Why the value `v` of quantity `name` [`unit`] is not physically plausible (`None`: it
 /// lies in `range`): `name = v unit is outside the physical range lo..hi unit (basis)`,
-/// numbers to 3 significant digits.
+/// numbers to 3 significant digits, a dimensionless value without a unit ([`with_unit`]).
 pub fn outside(
     name: &str,
     unit: &str,
@@ -188,12 +188,26 @@ pub fn outside(
 ) -> Option<String> {
     (!range.contains(v)).then(|| {
         format!(
-            "{name} = {} {unit} is outside the physical range {}..{} {unit} ({basis})",
-            sig(v),
+            "{name} = {} is outside the physical range {}..{} ({basis})",
+            with_unit(&sig(v), unit),
             sig(range.lo),
-            sig(range.hi)
+            with_unit(&sig(range.hi), unit)
         )
     })
+}
+
+/// The unit SI writes for a dimensionless quantity (the declarations' and the JSON's
+/// `unit`): a text never prints it after a number.
+pub const DIMENSIONLESS: &str = "1";
+
+/// A number (already formatted) with its unit as a text prints it: `5.00 K`, and a
+/// dimensionless value ([`DIMENSIONLESS`], or no unit) as the bare number `5.00`.
+pub fn with_unit(number: &str, unit: &str) -> String {
+    if unit.is_empty() || unit == DIMENSIONLESS {
+        number.to_string()
+    } else {
+        format!("{number} {unit}")
+    }
 }
 
 /// What an effect set up on a log contributes to the model: the effect with the numbers

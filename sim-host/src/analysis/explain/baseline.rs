@@ -36,9 +36,10 @@ pub(super) struct Baseline<'a> {
     /// The noise floor of the held-back windows of the fit series
     /// ([`metrics::noise_floor_on`]).
     pub(super) heldback_noise_fit_series: f64,
-    /// Whether the fit series holds a transient of the model's inputs (a start or a
-    /// supply step, [`transients::input_transients`]).
-    pub(super) has_input_transient: bool,
+    /// What the fit series offers a dynamics effect: its sample period and whether it
+    /// holds a transient of the model's inputs (a start or a supply step,
+    /// [`transients::input_transients`]).
+    pub(super) span: transients::Span,
     /// The measures on the working series, when the fit series is the working series
     /// (else computed while the candidates are fitted: [`Analysis::full_series`]).
     pub(super) full: Option<FullSeries>,
@@ -65,7 +66,7 @@ pub(super) struct FullSeries {
 /// follow: the verdict says so, and recentring on them would judge effects against that
 /// error.
 pub(super) fn structural_error(base: &Baseline<'_>, names: &[EffectKind]) -> bool {
-    base.has_input_transient
+    base.span.input_transient
         && ![EffectKind::FluxDynamics, EffectKind::CurrentDynamics]
             .iter()
             .all(|k| names.contains(k))
@@ -88,9 +89,7 @@ impl Analysis {
         let nominal = BaseParams::nominal(&self.constants);
         let f0 = self.fit_set(&fd, &active, &wf, &nominal, opts.fit_base)?;
         let heldback_fit_series: Vec<bool> = wf.train.iter().map(|t| !t).collect();
-        let has_input_transient = transients::input_transients(&fd, &self.constants)
-            .iter()
-            .any(|&t| t);
+        let span = transients::Span::of(&fd, &self.constants);
         let mut base = Baseline {
             fit_series: fd,
             coarsening: m,
@@ -102,7 +101,7 @@ impl Analysis {
             fit: f0,
             heldback_error_fit_series: f64::NAN,
             heldback_noise_fit_series: f64::NAN,
-            has_input_transient,
+            span,
             full: None,
         };
         self.measure_baseline(configured, &mut base)?;

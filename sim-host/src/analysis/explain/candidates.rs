@@ -4,8 +4,8 @@
 
 use super::baseline::{Baseline, FullSeries};
 use super::ranking::RankedCandidate;
-use super::{explained_fraction, EffectCandidate};
-use crate::analysis::effects::{EffectModel, SetupError};
+use super::{explained_fraction, EffectCandidate, Standing};
+use crate::analysis::effects::{self, EffectModel, SetupError};
 use crate::analysis::fit::{self, ActiveEffect, FitResult};
 use crate::analysis::simplified_model::BaseParameter;
 use crate::analysis::{align, base_out_of_range, metrics, transients};
@@ -27,49 +27,14 @@ pub(super) fn candidates<'a>(
 /// Why `explain` does not rank a candidate on this log (the report's `skipped`).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub(super) enum NotRanked {
-    /// Effects it needs in the model first ([`EffectModel::requires`]).
-    #[error("needs {} in the model first", names(.0))]
-    Requires(Vec<EffectKind>),
-    /// Its time constant `tau_s` [s] is shorter than 3 samples of the fit series (period
-    /// `dt_s` [s]).
-    #[error("the fit series of this long log ({:.0} Hz) cannot resolve a {:.1} ms time constant; analyse a shorter window with --from/--to", 1.0 / dt_s, 1000.0 * tau_s)]
-    Unresolved {
-        /// Sample period of the fit series [s].
-        dt_s: f64,
-        /// The effect's time constant [s].
-        tau_s: f64,
-    },
-    /// A dynamics effect (time constant `tau_s` [s]) on a log without a start or a supply
-    /// step.
-    #[error("no start or supply step in the analysed span (voltage and frequency within {:.0} %): its {:.1} ms dynamics have nothing to act on", 100.0 * transients::STEP_MIN, 1000.0 * tau_s)]
-    NoTransient {
-        /// The effect's time constant [s].
-        tau_s: f64,
-    },
+    /// The rule `compare`'s advice follows too: an effect needed first, a time constant
+    /// the fit series cannot resolve, no start or supply step
+    /// ([`transients::not_proposed`]).
+    #[error(transparent)]
+    NotProposed(transients::NotProposed),
     /// The log lacks a channel, or the set-up refuses the data.
     #[error(transparent)]
     Setup(SetupError),
-}
-
-/// Effect names, comma separated.
-fn names(kinds: &[EffectKind]) -> String {
-    kinds
-        .iter()
-        .map(|k| k.name())
-        .collect::<Vec<_>>()
-        .join(", ")
-}
-
-/// The effects `c` needs in the model first ([`EffectModel::requires`]) that the
-/// configured model lacks, as the reason it is not proposed yet.
-fn missing_requirement(c: &dyn EffectModel, base: &Baseline<'_>) -> Option<NotRanked> {
-    let missing: Vec<EffectKind> = c
-        .requires()
-        .iter()
-        .copied()
-        .filter(|k| !base.active.iter().any(|a| a.effect.kind() == *k))
-        .collect();
-    (!missing.is_empty()).then_some(NotRanked::Requires(missing))
 }
 
 /// The configured effects of `base`, each starting from its baseline fit, with candidate
@@ -109,17 +74,12 @@ impl Analysis {
             .collect()
     }
 
-    /// Why a candidate cannot be ranked on this log, if it cannot: an effect it needs in
-    /// the model first, a dynamics effect whose time constant the (coarse) fit series of a
-    /// long log cannot resolve or that has no transient to act on, a missing channel, or a
-    /// set-up the data refuse (e.g. `load_torque` on a log without a load change: said,
-    /// not dropped).
+    /// Why a candidate cannot be ranked on this log, if it cannot: the rule `compare`'s
+    /// advice follows too ([`Analysis::not_proposed`]), a missing channel, or a set-up the
+    /// data refuse (e.g. `load_torque` on a log without a load change: said, not dropped).
     fn cannot_rank(&self, c: &dyn EffectModel, base: &Baseline<'_>) -> Option<NotRanked> {
-        if let Some(m) = missing_requirement(c, base) {
-            return Some(m);
-        }
-        if let Some(m) = self.not_dynamic(c, base) {
-            return Some(m);
+        if let Some(m) = self.not_proposed(c, base) {
+            return Some(NotRanked::NotProposed(m));
         }
         let setup = c
             .needs()
@@ -128,21 +88,15 @@ impl Analysis {
         setup.err().map(NotRanked::Setup)
     }
 
-    /// Why a dynamics effect (one that declares a time constant,
-    /// [`EffectModel::time_constant_s`]) is not proposed on this log: its time constant is
-    /// shorter than 3 samples of the (coarse) fit series of a long log, or the log has no
-    /// transient of the model's inputs for its dynamics to act on. Without a start or a
-    /// supply step the electrical states follow the inputs quasi-statically (a load step
-    /// moves the speed at the mechanical rate), the full-order machine's steady state is
-    /// the paper's model, and what a dynamics effect's extra states gain there they gain by
-    /// absorbing another effect (docs/model-vs-measurement.md, "How it works").
-    fn not_dynamic(&self, c: &dyn EffectModel, base: &Baseline<'_>) -> Option<NotRanked> {
-        let tau_s = c.time_constant_s(&self.constants)?;
-        let dt_s = base.fit_series.dt_s;
-        if dt_s > tau_s / 3.0 {
-            return Some(NotRanked::Unresolved { dt_s, tau_s });
-        }
-        (!base.has_input_transient).then_some(NotRanked::NoTransient { tau_s })
+    /// Whether candidate `c` is proposed on the fit series of `base` with the configured
+    /// model's effects ([`transients::not_proposed`], the rule `compare`'s advice prints).
+    fn not_proposed(
+        &self,
+        c: &dyn EffectModel,
+        base: &Baseline<'_>,
+    ) -> Option<transients::NotProposed> {
+        let in_model: Vec<EffectKind> = base.active.iter().map(|a| a.effect.kind()).collect();
+        transients::not_proposed(c, base.span, &self.constants, &in_model)
     }
 
     /// Stage 6 (fit): every candidate of `cands` that can be ranked, fitted in parallel
@@ -212,9 +166,17 @@ impl Analysis {
             return Ok(None);
         };
         let why = self.implausible(c, base, &me, &f)?;
+        let summary = if why.is_empty() {
+            me.summary
+        } else {
+            effects::not_physical(&why)
+        };
         Ok(Some(RankedCandidate {
             candidate: EffectCandidate {
                 effect: c.kind(),
+                // Given by `stand` once every candidate is ranked.
+                rank: None,
+                standing: Standing::Candidate,
                 normalized_rms_error: error,
                 explained_fraction: explained_fraction(
                     base.heldback_error_fit_series,
@@ -224,7 +186,7 @@ impl Analysis {
                 validation_normalized_rms_error: heldback_error,
                 n_parameters,
                 parameters: me.parameters,
-                summary: me.summary,
+                summary,
                 description: c.description().to_string(),
                 plausible: why.is_empty(),
                 implausible_because: why,
@@ -236,12 +198,9 @@ impl Analysis {
     }
 
     /// True when candidate `c` cannot be fitted on this log: a channel it needs is
-    /// missing, an effect it needs is not in the model, or it is a dynamics effect the log
-    /// cannot show ([`Analysis::cannot_rank`] says why).
+    /// missing, or it is not proposed on it ([`Analysis::cannot_rank`] says why).
     fn cannot_fit(&self, c: &dyn EffectModel, base: &Baseline<'_>) -> bool {
-        c.needs().met_by(&self.data).is_err()
-            || missing_requirement(c, base).is_some()
-            || self.not_dynamic(c, base).is_some()
+        c.needs().met_by(&self.data).is_err() || self.not_proposed(c, base).is_some()
     }
 
     /// A candidate model's errors over the whole log and on the held-back windows, on the

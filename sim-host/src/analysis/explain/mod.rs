@@ -13,7 +13,8 @@
 //! 5. the candidates (the library's effects not in the model) and those that cannot be
 //!    ranked on this log, with why (`candidates`, `Analysis::skipped`, `candidates.rs`);
 //! 6. each candidate added, fitted and measured (`Analysis::fit_candidates`), then ranked
-//!    (`rank`, `Outcome`, `ranking.rs`);
+//!    (`rank`), each given its standing (`stand`: a candidate, no effect, not plausible)
+//!    and the ranking's outcome read (`Outcome`, `ranking.rs`);
 //! 7. the model recentred on the refitted base parameters and explained again, when the
 //!    file's values do not fit and nothing could be named (`Analysis::recentre_because`,
 //!    `Analysis::explain_recentred`);
@@ -33,12 +34,42 @@ use super::{resolve, Analysis, AnalysisError, DataInfo, Options, ParamValue};
 use baseline::structural_error;
 use candidates::candidates;
 use monitor_core::EffectKind;
-use ranking::{rank, Outcome};
+use ranking::{rank, stand, Outcome};
 use report::{withhold_if_untrusted, Findings};
 use serde::Serialize;
 
 /// A candidate explaining less than this fraction of the held-back error is not claimed.
 pub const EXPLAINED_MIN: f64 = 0.5;
+/// A plausible fit explaining less than this fraction (5 %) of the held-back error beyond
+/// the noise ([`explained_fraction`]) is no candidate: it has no effect on this log and is
+/// listed apart (`no_effect`), without a rank. 5 % is what two or three extra parameters
+/// cost in the ranking ([`PARAM_PENALTY`], 2 % of the held-back error each): below it a
+/// fit's gain on windows it never saw is no more than extra freedom buys.
+pub const EXPLAINS_MIN: f64 = 0.05;
+
+/// Where a fitted candidate stands in `explain`'s report (JSON `standing`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Standing {
+    /// Plausible, and explains at least [`EXPLAINS_MIN`] of the held-back error: ranked.
+    Candidate,
+    /// Plausible, but explains less than [`EXPLAINS_MIN`]: no effect on this log.
+    NoEffect,
+    /// A fitted value is outside its physical range (or contradicted by the log): no
+    /// explanation, whatever it would explain.
+    NotPlausible,
+}
+
+impl Standing {
+    /// The name in the JSON (`candidate`, `no_effect`, `not_plausible`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Standing::Candidate => "candidate",
+            Standing::NoEffect => "no_effect",
+            Standing::NotPlausible => "not_plausible",
+        }
+    }
+}
 /// A baseline within this factor of the noise floor has nothing left to explain
 /// (1.12 = a model error beyond the noise of half the noise floor).
 pub const NOISE_MARGIN: f64 = 1.12;
@@ -78,6 +109,11 @@ pub fn explained_fraction(e_base: f64, e_with: f64, noise: f64) -> f64 {
 pub struct EffectCandidate {
     /// Which effect.
     pub effect: EffectKind,
+    /// Its rank among the candidates (1 = best), null for a fit with no effect or not
+    /// plausible ([`Standing`]).
+    pub rank: Option<usize>,
+    /// Whether it is a candidate, has no effect, or is not plausible.
+    pub standing: Standing,
     /// `normalized_rms_error` over the whole log with this effect added.
     pub normalized_rms_error: f64,
     /// Fraction of the held-back model error beyond the noise floor explained
@@ -89,13 +125,14 @@ pub struct EffectCandidate {
     pub n_parameters: usize,
     /// Fitted parameters.
     pub parameters: std::collections::BTreeMap<String, ParamValue>,
-    /// In words.
+    /// In words; for a fit that is not plausible, that it is not physical and why
+    /// ([`effects::not_physical`]), never the reading of its values.
     pub summary: String,
     /// What the effect is.
     pub description: String,
     /// False when a fitted value (the effect's, or a base parameter refitted with it) is
-    /// outside its physical range ([`effects::plausible`]): such a candidate is ranked after
-    /// every plausible one and never named by the verdict.
+    /// outside its physical range ([`effects::plausible`]): such a candidate stands after
+    /// every plausible one, has no rank and is never named by the verdict.
     pub plausible: bool,
     /// Why not (one entry per value out of range; empty when plausible).
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -116,8 +153,12 @@ pub struct ExplainReport {
     pub baseline_validation_normalized_rms_error: f64,
     /// Noise floor.
     pub noise_floor: f64,
-    /// Candidates, best first.
+    /// Every fitted candidate: the ranked ones best first (`rank` 1, 2, ...), then those
+    /// with no effect on this log, then those not plausible ([`Standing`]).
     pub ranking: Vec<EffectCandidate>,
+    /// The plausible fits that explain less than [`EXPLAINS_MIN`] of the held-back error:
+    /// no candidates (they are in `ranking` with `standing: no_effect` and no rank).
+    pub no_effect: Vec<EffectKind>,
     /// True when no candidate explains the error well.
     pub unexplained: bool,
     /// The conclusion in words.
@@ -192,6 +233,7 @@ impl Analysis {
             self.fit_candidates(&configured, &base, full, &cands, opts, progress)?;
         let unbalance = self.unbalance();
         rank(&mut ranked, &unbalance, self.constants.torque_scale_nm);
+        stand(&mut ranked);
         let found = Findings {
             outcome: Outcome::of(&ranked, &full),
             names,

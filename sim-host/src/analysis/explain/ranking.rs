@@ -2,7 +2,10 @@
 //! (nothing left to explain, or nothing explained well enough).
 
 use super::baseline::FullSeries;
-use super::{EffectCandidate, EXPLAINED_MIN, MIN_MODEL_ERROR, NOISE_MARGIN, PARAM_PENALTY};
+use super::{
+    EffectCandidate, Standing, EXPLAINED_MIN, EXPLAINS_MIN, MIN_MODEL_ERROR, NOISE_MARGIN,
+    PARAM_PENALTY,
+};
 use crate::analysis::effects::{self, EffectEvidence, FitSetup};
 use crate::analysis::fit::FitResult;
 use crate::analysis::unbalance::UnbalanceAnalysis;
@@ -100,5 +103,32 @@ pub(super) fn rank(
     };
     if says(first) == Some(false) && says(second) != Some(false) {
         ranked.swap(0, 1);
+    }
+}
+
+/// Each candidate's standing, in the order of [`rank`]: a plausible fit that explains at
+/// least [`EXPLAINS_MIN`] of the held-back error is a candidate and gets its rank (1, 2,
+/// ...); a plausible one that explains less has no effect on this log; an implausible one
+/// is not plausible whatever it explains. The candidates first, then those without effect,
+/// then the implausible ones (each group in the ranking's order), so that an implausible
+/// fit never stands ahead of a plausible one.
+pub(super) fn stand(ranked: &mut [RankedCandidate]) {
+    for r in ranked.iter_mut() {
+        let c = &mut r.candidate;
+        c.standing = if !c.plausible {
+            Standing::NotPlausible
+        } else if c.explained_fraction >= EXPLAINS_MIN {
+            Standing::Candidate
+        } else {
+            Standing::NoEffect
+        };
+    }
+    ranked.sort_by_key(|r| r.candidate.standing);
+    let mut k = 0;
+    for r in ranked.iter_mut() {
+        r.candidate.rank = (r.candidate.standing == Standing::Candidate).then(|| {
+            k += 1;
+            k
+        });
     }
 }

@@ -4,7 +4,10 @@
 
 use super::baseline::{Baseline, FullSeries};
 use super::ranking::{Outcome, RankedCandidate};
-use super::{ExplainOutput, ExplainReport, EXPLAINED_MIN, MIN_MODEL_ERROR, NOISE_MARGIN};
+use super::{
+    ExplainOutput, ExplainReport, Standing, EXPLAINED_MIN, EXPLAINS_MIN, MIN_MODEL_ERROR,
+    NOISE_MARGIN,
+};
 use crate::analysis::effects::SetupError;
 use crate::analysis::fit::{ActiveEffect, FittedModel};
 use crate::analysis::refit::BaseRefit;
@@ -58,6 +61,7 @@ impl Analysis {
                 baseline_validation_normalized_rms_error: f64::NAN,
                 noise_floor: f64::NAN,
                 ranking: vec![],
+                no_effect: vec![],
                 unexplained: unbalance.suspect_phase.is_none(),
                 verdict,
                 skipped,
@@ -138,6 +142,12 @@ impl Analysis {
                 baseline_normalized_rms_error: found.full.error,
                 baseline_validation_normalized_rms_error: found.full.heldback_error,
                 noise_floor: found.full.noise,
+                no_effect: found
+                    .ranked
+                    .iter()
+                    .filter(|c| c.candidate.standing == Standing::NoEffect)
+                    .map(|c| c.candidate.effect)
+                    .collect(),
                 ranking: found.ranked.into_iter().map(|c| c.candidate).collect(),
                 unexplained: o.unexplained,
                 verdict,
@@ -210,8 +220,8 @@ pub(super) fn withhold_if_untrusted(mut out: ExplainOutput) -> ExplainOutput {
 }
 
 /// The verdict's note on candidates whose fits are not physically plausible: those that
-/// would have explained more than the one named (or the threshold) are listed with the
-/// first reason, so that a user sees why they are not the answer.
+/// would have explained more than the one named (and at least [`EXPLAINS_MIN`]) are listed
+/// with the first reason, so that a user sees why they are not the answer.
 fn implausible_note(ranked: &[RankedCandidate]) -> String {
     let top_plausible = ranked
         .iter()
@@ -220,7 +230,11 @@ fn implausible_note(ranked: &[RankedCandidate]) -> String {
         .unwrap_or(f64::INFINITY);
     let listed: Vec<String> = ranked
         .iter()
-        .filter(|c| !c.candidate.plausible && c.score() < top_plausible)
+        .filter(|c| {
+            !c.candidate.plausible
+                && c.score() < top_plausible
+                && c.candidate.explained_fraction >= EXPLAINS_MIN
+        })
         .map(|c| {
             format!(
                 "{} would explain {:.0} % but {}",
@@ -238,7 +252,7 @@ fn implausible_note(ranked: &[RankedCandidate]) -> String {
         String::new()
     } else {
         format!(
-            ". Not plausible, so ranked last and not named: {}",
+            ". Not plausible, so not ranked and not named: {}",
             listed.join("; ")
         )
     }
@@ -270,11 +284,15 @@ fn verdict(found: &Findings<'_>, best: Option<&RankedCandidate>) -> String {
                     .join(",")
             )
         }
-        Some(r) => format!(
+        Some(r) if r.candidate.standing == Standing::Candidate => format!(
             "unexplained: the best candidate ({}) explains only {:.0} % of the held-back error (threshold {:.0} %); the error is not one of the library's effects",
             r.candidate.effect,
             100.0 * r.candidate.explained_fraction,
             100.0 * EXPLAINED_MIN
+        ),
+        Some(_) => format!(
+            "unexplained: no plausible effect of the library explains {:.0} % of the held-back error or more; the error is not one of the library's effects",
+            100.0 * EXPLAINS_MIN
         ),
         None => "unexplained: no candidate could be fitted with physically plausible values".into(),
     }

@@ -5,11 +5,12 @@
 //! the PNG copies sit beside it for slides and tickets. Every file is written atomically.
 
 use super::{charts, plot};
+use monitor_core::EffectKind;
 use plot::Chart;
 use sim_host::analysis::compare::{CompareOutput, CompareReport};
-use sim_host::analysis::explain::ExplainOutput;
-use sim_host::analysis::rotor_asymmetry::McsaReport;
+use sim_host::analysis::simplified_model::Prediction;
 use sim_host::analysis::Analysis;
+use sim_host::api::ExplainDocument;
 use sim_host::log::quality::DataQuality;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -86,19 +87,19 @@ pub fn write_explain(
     report: Option<&Path>,
     log: &Path,
     a: &Analysis,
-    out: &ExplainOutput,
-    mcsa: &McsaReport,
+    (before, after): (&Prediction, Option<&(EffectKind, Prediction)>),
+    doc: &ExplainDocument,
 ) -> anyhow::Result<()> {
     let log = log.display().to_string();
     write_outputs(
         plot,
         report,
         || {
-            let mut v = charts::explain_charts(&a.data, &out.before, out.after.as_ref());
-            v.extend(super::mcsa::chart(mcsa));
+            let mut v = charts::explain_charts(&a.data, before, after);
+            v.extend(super::mcsa::chart(&doc.rotor_asymmetry));
             v
         },
-        |svgs| explain_html(&log, out, mcsa, svgs),
+        |svgs| explain_html(&log, doc, svgs),
     )
 }
 
@@ -205,17 +206,17 @@ fn base_parameters_table(h: &mut String, r: &CompareReport) {
 }
 
 /// The `explain` report page.
-fn explain_html(
-    log: &str,
-    out: &ExplainOutput,
-    mcsa: &McsaReport,
-    charts: &[(String, String)],
-) -> String {
-    let r = &out.report;
+fn explain_html(log: &str, doc: &ExplainDocument, charts: &[(String, String)]) -> String {
+    let (r, mcsa) = (&doc.report, &doc.rotor_asymmetry);
     let mut h = String::new();
     let _ = write!(h, "<!doctype html><html><head><meta charset=utf-8><title>explain: {}</title><style>{STYLE}</style></head><body>", esc(log));
     let _ = write!(h, "<h1>Which physical effect is missing?</h1><p>Log <code>{}</code>. Effects already in the model: {}.</p>", esc(log), if r.effects.is_empty() { "none".into() } else { effect_list(&r.effects) });
-    let _ = write!(h, "<p class=v>{}</p>", esc(&r.verdict));
+    // The one verdict first, then explain's own answer and how the two relate.
+    let _ = write!(h, "<p><b>{}</b></p>", esc(&doc.headline));
+    let _ = write!(h, "<p class=v>The model's error: {}</p>", esc(&r.verdict));
+    if let Some(b) = &doc.beside_verdict {
+        let _ = write!(h, "<p>{}</p>", esc(b));
+    }
     if let Some(words) = r.base_refit.as_ref().map(|b| b.in_words()) {
         if !words.is_empty() {
             let _ = write!(h, "<p>{}</p>", esc(&words));
@@ -224,16 +225,16 @@ fn explain_html(
     data_quality(&mut h, &r.data_quality);
     let _ = write!(h, "<p>Error of the model as configured: {:.4} (whole log), {:.4} on the held-back windows the fits never saw; noise floor {:.4}. Each candidate below was added to the model and fitted together with the base parameters; ranking is by the held-back error, so an effect that only fits noise does not win.</p>", r.baseline_normalized_rms_error, r.baseline_validation_normalized_rms_error, r.noise_floor);
     h.push_str("<table><tr><th>rank</th><th class=l>effect</th><th>error</th><th>held-back error</th><th>explained</th><th>params</th><th class=l>fitted, in words</th></tr>");
-    for (i, c) in r.ranking.iter().enumerate() {
-        let flags: String = c
-            .implausible_because
-            .iter()
-            .map(|w| format!(" [not plausible] {}", esc(w)))
-            .collect();
-        let _ = write!(h, "<tr><td>{}</td><td class=l>{}</td><td>{:.4}</td><td>{:.4}</td><td>{:.0} %</td><td>{}</td><td class=l>{}{flags}</td></tr>", i + 1, c.effect, c.normalized_rms_error, c.validation_normalized_rms_error, 100.0 * c.explained_fraction, c.n_parameters, esc(&c.summary));
+    // Ranked candidates, then those with no effect, then those not plausible (no rank).
+    for c in &r.ranking {
+        let rank = c.rank.map_or_else(
+            || format!("[{}]", c.standing.name().replace('_', " ")),
+            |k| k.to_string(),
+        );
+        let _ = write!(h, "<tr><td>{rank}</td><td class=l>{}</td><td>{:.4}</td><td>{:.4}</td><td>{:.0} %</td><td>{}</td><td class=l>{}</td></tr>", c.effect, c.normalized_rms_error, c.validation_normalized_rms_error, 100.0 * c.explained_fraction, c.n_parameters, esc(&c.summary));
     }
     h.push_str("</table>");
-    if let Some(c) = r.ranking.first() {
+    if let Some(c) = r.ranking.first().filter(|c| c.rank.is_some()) {
         let _ = write!(h, "<h2>Before / after</h2><table><tr><th class=l>model</th><th>held-back windows</th><th>whole log</th></tr><tr><td class=l>as configured</td><td>{:.4}</td><td>{:.4}</td></tr><tr><td class=l>+ {}</td><td>{:.4}</td><td>{:.4}</td></tr></table>", r.baseline_validation_normalized_rms_error, r.baseline_normalized_rms_error, c.effect, c.validation_normalized_rms_error, c.normalized_rms_error);
     }
     for s in &r.skipped {

@@ -9,24 +9,24 @@ pub const CHART: &str = "mcsa_spectrum";
 
 /// Text lines of the report (for the human table).
 pub fn text(r: &McsaReport) -> String {
-    let mut s = String::from("rotor asymmetry (motor current signature analysis):\n");
+    let mut s = String::from("  rotor (motor current signature analysis):\n");
     match (
         &r.cannot_judge_because,
         r.lower_sideband_db,
         r.upper_sideband_db,
     ) {
-        (Some(why), _, _) => s.push_str(&format!("  {why}\n")),
+        (Some(why), _, _) => s.push_str(&format!("    {why}\n")),
         (None, Some(l), Some(u)) => {
             let f = |i: usize| r.sideband_hz.get(i).copied().unwrap_or(f64::NAN);
             s.push_str(&format!(
-                "  sidebands: {l:.1} dB at (1-2s)f = {:.2} Hz, {u:.1} dB at (1+2s)f = {:.2} Hz (below the fundamental {:.2} Hz; slip {:.4})\n",
+                "    sidebands: {l:.1} dB at (1-2s)f = {:.2} Hz, {u:.1} dB at (1+2s)f = {:.2} Hz (below the fundamental {:.2} Hz; slip {:.4})\n",
                 f(0),
                 f(1),
                 r.fundamental_hz.unwrap_or(f64::NAN),
                 r.slip.unwrap_or(f64::NAN)
             ));
             s.push_str(&format!(
-                "  speed ripple at 2sf = {:.2} Hz: {:.4} rad/s peak; resolution {:.3} Hz (needed {:.3} Hz) over {:.2}..{:.2} s\n",
+                "    speed ripple at 2sf = {:.2} Hz: {:.4} rad/s peak; resolution {:.3} Hz (needed {:.3} Hz) over {:.2}..{:.2} s\n",
                 r.speed_ripple_hz.unwrap_or(f64::NAN),
                 r.speed_ripple_rad_s.unwrap_or(f64::NAN),
                 r.resolution_hz.unwrap_or(f64::NAN),
@@ -39,22 +39,25 @@ pub fn text(r: &McsaReport) -> String {
     }
     if let (Some(n), Some(nb)) = (r.equivalent_broken_bars, r.rotor_bars) {
         s.push_str(&format!(
-            "  fitted delta {:.3}: about {n:.1} adjacent broken bars of {nb:.0} (delta = 3n/(N - 3n), an approximation)\n",
+            "    fitted delta {:.3}: about {n:.1} adjacent broken bars of {nb:.0} (delta = 3n/(N - 3n), an approximation)\n",
             r.delta.unwrap_or(f64::NAN)
         ));
     }
     if let Some(d) = r.spectral_delta {
-        let bars = r
-            .spectral_broken_bars
-            .map(|n| format!(": about {n:.1} adjacent broken bars"))
-            .unwrap_or_default();
+        let bars = match (r.spectral_broken_bars, r.rotor_bars) {
+            (Some(n), Some(nb)) => format!(": about {n:.1} adjacent broken bars of {nb:.0}"),
+            (None, None) => {
+                " (the number of broken bars needs the rotor's bar count: --rotor-bars N)".into()
+            }
+            _ => String::new(),
+        };
         let agree = match r.fit_and_spectrum_agree {
             Some(true) => "; the fit and the spectrum agree",
             Some(false) => "; the fit and the spectrum disagree, so rotor_asymmetry is not named",
             None => "",
         };
         s.push_str(&format!(
-            "  from the sidebands: delta {d:.3}{bars}{agree}\n"
+            "    from the sidebands: delta {d:.3}{bars}{agree}\n"
         ));
     }
     s

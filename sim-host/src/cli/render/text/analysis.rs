@@ -3,7 +3,8 @@
 use super::diagnose::data_quality;
 use super::number;
 use sim_host::analysis::compare::CompareReport;
-use sim_host::analysis::explain::ExplainReport;
+use sim_host::analysis::explain::{ExplainReport, Standing, EXPLAINS_MIN};
+use sim_host::api::ExplainDocument;
 use std::io::Write;
 use std::path::Path;
 
@@ -127,12 +128,16 @@ fn fitted(out: &mut impl Write, r: &CompareReport) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// `explain`'s ranking and verdict.
-pub fn explain(log: &Path, headline: &str, r: &ExplainReport) -> anyhow::Result<()> {
+/// `explain`'s report: the one verdict first, then explain's own answer on the model's error
+/// and how it reads beside the verdict, the motor's own analyses (the unbalance, the rotor's
+/// current signature), the ranked candidates, those with no effect in one line, those not
+/// plausible apart with their reasons, what was skipped, and the refitted base parameters.
+pub fn explain(log: &Path, doc: &ExplainDocument) -> anyhow::Result<()> {
+    let r = &doc.report;
     let mut out = crate::cli::stdout();
     writeln!(out, "explain {}", log.display())?;
     // The one verdict first (what `diagnose` gives the same log), then the model's story.
-    writeln!(out, "{headline}")?;
+    writeln!(out, "{}", doc.headline)?;
     data_quality(&mut out, &r.data_quality)?;
     writeln!(
         out,
@@ -142,40 +147,93 @@ pub fn explain(log: &Path, headline: &str, r: &ExplainReport) -> anyhow::Result<
         number(r.baseline_validation_normalized_rms_error),
         number(r.noise_floor)
     )?;
-    // The answer first, then how it was reached.
-    writeln!(out, "{}", r.verdict)?;
-    writeln!(
-        out,
-        "  ranking: the plausible fits by the error they leave on the held-back part of the log, then the fits whose parameters are not physical (a fit that explains much with an impossible value is no explanation)"
-    )?;
-    writeln!(
-        out,
-        "  {:<4} {:<18} {:>10} {:>10} {:>10}  fitted",
-        "rank", "effect", "error", "held-back", "explained"
-    )?;
-    for (i, k) in r.ranking.iter().enumerate() {
+    // Explain's own answer, then how it reads beside the verdict.
+    writeln!(out, "model's error: {}", r.verdict)?;
+    if let Some(b) = &doc.beside_verdict {
+        writeln!(out, "  {b}")?;
+    }
+    writeln!(out, "  unbalance: {}", r.unbalance.summary)?;
+    write!(out, "{}", super::super::mcsa::text(&doc.rotor_asymmetry))?;
+    ranking(&mut out, r)?;
+    for s in &r.skipped {
+        writeln!(out, "  skipped: {s}")?;
+    }
+    if let Some(words) = r.base_refit.as_ref().map(|b| b.in_words()) {
+        if !words.is_empty() {
+            writeln!(out, "  {words}")?;
+        }
+    }
+    Ok(())
+}
+
+/// The ranked candidates (plausible, explaining at least [`EXPLAINS_MIN`]) as a table, then
+/// the fits without effect and those not plausible apart ([`apart`]).
+fn ranking(out: &mut impl Write, r: &ExplainReport) -> anyhow::Result<()> {
+    let of = |s: Standing| r.ranking.iter().filter(move |c| c.standing == s);
+    let ranked: Vec<_> = of(Standing::Candidate).collect();
+    if ranked.is_empty() {
+        writeln!(
+            out,
+            "  ranking: no candidate (no plausible effect explains {:.0} % of the held-back error beyond the noise or more)",
+            100.0 * EXPLAINS_MIN
+        )?;
+    } else {
+        writeln!(
+            out,
+            "  ranking: the plausible effects that explain at least {:.0} % of the held-back error beyond the noise, by the error they leave on the held-back part of the log",
+            100.0 * EXPLAINS_MIN
+        )?;
+        writeln!(
+            out,
+            "  {:<4} {:<18} {:>10} {:>10} {:>10}  fitted",
+            "rank", "effect", "error", "held-back", "explained"
+        )?;
+    }
+    for k in ranked {
         writeln!(
             out,
             "  {:<4} {:<18} {:>10} {:>10} {:>9.0}%  {}",
-            i + 1,
+            k.rank.unwrap_or_default(),
             k.effect.name(),
             number(k.normalized_rms_error),
             number(k.validation_normalized_rms_error),
             100.0 * k.explained_fraction,
             k.summary
         )?;
-        for w in &k.implausible_because {
-            writeln!(out, "       not plausible: {w}")?;
-        }
     }
-    for s in &r.skipped {
-        writeln!(out, "  skipped: {s}")?;
+    apart(out, r)
+}
+
+/// The plausible fits with no effect, in one line, and those not plausible, each with its
+/// reasons, under a heading of their own.
+fn apart(out: &mut impl Write, r: &ExplainReport) -> anyhow::Result<()> {
+    let of = |s: Standing| r.ranking.iter().filter(move |c| c.standing == s);
+    let none: Vec<String> = of(Standing::NoEffect)
+        .map(|c| format!("{} ({:.1} %)", c.effect, 100.0 * c.explained_fraction))
+        .collect();
+    if !none.is_empty() {
+        writeln!(
+            out,
+            "  no effect (plausible, but explain under {:.0} %): {}",
+            100.0 * EXPLAINS_MIN,
+            none.join(", ")
+        )?;
     }
-    writeln!(out, "  unbalance: {}", r.unbalance.summary)?;
-    if let Some(words) = r.base_refit.as_ref().map(|b| b.in_words()) {
-        if !words.is_empty() {
-            writeln!(out, "  {words}")?;
-        }
+    let mut implausible = of(Standing::NotPlausible).peekable();
+    if implausible.peek().is_some() {
+        writeln!(
+            out,
+            "  not plausible (fitted only with values no machine has: no explanation, whatever they would explain):"
+        )?;
+    }
+    for c in implausible {
+        writeln!(
+            out,
+            "    {} ({:.0} %): {}",
+            c.effect,
+            100.0 * c.explained_fraction,
+            c.implausible_because.join("; ")
+        )?;
     }
     Ok(())
 }
