@@ -154,23 +154,24 @@ fn rs_plus_50_is_the_same_fault_and_size_on_the_three() {
     }
 }
 
-/// The paper's fixed viscous load (the demo, the HMI's simulated demo motor, and `diagnose
-/// --load viscous`): a Bl change is the fault b/bl, shown in the amber state. With the load
-/// an unknown input (`diagnose`'s default) the same log is a load move: amber, without a
-/// name.
+/// The paper's fixed viscous load (the demo and `diagnose --load viscous`): a Bl change is
+/// the fault b/bl, shown in the amber state. With the load an unknown input (`diagnose`'s
+/// default, and the live HMI's: a load step of 10-40 % is never a FAULT there, issue 48) the
+/// same change is a load move: amber, without a name.
 #[test]
 fn bl_plus_50_is_the_amber_state_with_the_friction_class_on_the_three() {
     let proto = protocol();
     let sc = scenario(Some((Fault::Bl, 0.5)), &proto);
-    let unknown = diagnose(&sc);
-    assert!(
-        unknown.starts_with("MOVED operating point moved") && !unknown.contains("b/bl"),
-        "diagnose with the load unknown: {unknown}"
-    );
+    for (who, unknown) in [("diagnose", diagnose(&sc)), ("hmi", hmi(&['6']))] {
+        assert!(
+            unknown.starts_with("MOVED operating point moved") && !unknown.contains("b/bl"),
+            "{who} with the load unknown: {unknown}"
+        );
+        assert!(!unknown.contains("FAULT"), "{who}: a red FAULT: {unknown}");
+    }
     let states = [
         ("demo", demo("bl")),
         ("diagnose", diagnose_with(&sc, &["--load", "viscous"])),
-        ("hmi", hmi(&['6'])),
     ];
     for (who, s) in &states {
         no_bare_percentage(s);

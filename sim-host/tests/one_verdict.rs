@@ -267,10 +267,10 @@ fn contradictions(d: &Value, text: &str) -> Vec<String> {
                 ));
             }
             let name = f["fault"].as_str().unwrap_or("?");
-            let shown = if name == "shorted_turns" {
-                "shorted turns"
-            } else {
-                name
+            let shown = match name {
+                "shorted_turns" => "shorted turns",
+                "broken_bars" => "broken rotor bars",
+                _ => name,
             };
             if !line.contains(shown) {
                 bad.push(format!("the FAULT line does not name {name}: {line}"));

@@ -496,10 +496,10 @@ fn a_nameplate_20_percent_off_gets_no_confident_verdict() {
 }
 
 #[test]
-fn lamps_lit_only_outside_the_commissioned_range_are_no_verdict() {
+fn lamps_lit_only_outside_the_commissioned_range_for_a_load_move_are_no_fault() {
     // Another simulator's log (motulator, 2.2 kW direct-on-line start, a load step at
-    // 3.5 s), commissioned at no load: the lamps light at the load step, and the verdict
-    // says why it cannot tell a fault from it.
+    // 2.5 s), commissioned at no load: the lamps light after the load step, and the verdict
+    // says what they lit for.
     let data = repo().join("examples/logs");
     let (p, log) = (
         data.join("motulator_2p2kw_dol.toml"),
@@ -519,10 +519,23 @@ fn lamps_lit_only_outside_the_commissioned_range_are_no_verdict() {
     assert!(o.status.success());
     let d: Value = serde_json::from_slice(&o.stdout).expect("json");
     assert!(d["first_detection_s"].as_f64().is_some_and(|t| t > 3.4));
-    assert_eq!(d["verdict"], "could_not_judge");
-    assert!(d["verdict_withheld_because"]
-        .to_string()
-        .contains("outside the range commissioned"));
+    // The lamps' matching reads the load term (b/bl), the load move is an event, and the
+    // isolation at the new load finds the stator-voltage equations of the parameter file's
+    // machine fit (issue 48): the lamps lit for a load move, so the motor is healthy, and the
+    // verdict says so in its residual finding, never "FAULT b/bl".
+    assert_eq!(d["verdict"], "healthy", "{}", d["verdict_line"]);
+    let residuals = d["findings"]
+        .as_array()
+        .and_then(|f| f.iter().find(|f| f["source"] == "residuals"))
+        .expect("a residual finding");
+    assert_eq!(residuals["state"], "explained", "{residuals}");
+    assert!(
+        d["verdict_line"].to_string().contains("load move"),
+        "{}",
+        d["verdict_line"]
+    );
+    let events = d["isolation"]["events"].to_string();
+    assert!(events.contains("load_moved"), "{events}");
 }
 
 /// The same candidates: the same faults in the same order, probabilities within 0.05 and

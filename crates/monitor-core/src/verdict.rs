@@ -119,7 +119,8 @@ pub enum Against {
     Commissioning,
     /// Healthy runs of the same motor given by the user (`diagnose --baseline`).
     HealthyRuns,
-    /// A healthy stretch of the same log (a fault switched on or off within it).
+    /// The log's own steady stretches against each other: a fault switched on or off within
+    /// the log is a change between them (one that was on throughout is not).
     WithinTheLog,
     /// The parameter file's nominal values.
     ParameterFile,

@@ -95,7 +95,8 @@ pub const BLACKMAN_HARRIS_4: [f64; 4] = [0.35875, 0.48829, 0.14128, 0.01168];
 /// too little rotor current for a broken bar to show.
 pub const MIN_SLIP: f64 = 0.003;
 /// Largest slip a pair of components about the line is taken for the sidebands or the
-/// rotation harmonics at (small motors run at up to about 8 % at rated load).
+/// rotation harmonics at (small motors run at up to about 8 % at rated load); a stretch
+/// whose slip from the speed is larger (a start, an overload) is not judged.
 pub const MAX_SLIP: f64 = 0.12;
 /// Largest variation of the slip over the analysed stretch, relative to its mean; also
 /// the half-width of the sidebands' search interval relative to 2 s f.

@@ -207,6 +207,9 @@ fn read_and_judge(
     if s < MIN_SLIP {
         return cannot(r, format!("the slip {:.2} % is below {:.1} % (no load): the sidebands sit on the line, and a cage carries too little current for a broken bar to show", 100.0 * s, 100.0 * MIN_SLIP));
     }
+    if s > MAX_SLIP {
+        return cannot(r, format!("the slip {:.1} % is above {:.0} %: a start or an overload, not a steady running point the severity bands grade", 100.0 * s, 100.0 * MAX_SLIP));
+    }
     let t = stretch.len() as f64 * bs;
     if t < MIN_BINS / fs {
         r.resolution_hz = Some(1.0 / t.max(bs));

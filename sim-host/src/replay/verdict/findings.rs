@@ -119,20 +119,7 @@ impl Replay {
             )
         };
         if let Some(why) = self.residuals_not_judged(inp) {
-            // A log without the voltages or the speed lacks what they need; else the log
-            // kept them from judging.
-            let state = if self.monitor.is_none() {
-                State::Unavailable
-            } else {
-                State::NotJudged
-            };
-            return FindingReport::new(
-                FindingSource::Residuals,
-                state,
-                against,
-                why.clone(),
-                format!("residuals: {why}"),
-            );
+            return self.residuals_unjudged(against, why);
         }
         let iso = inp.isolation;
         if let Some(named) = isolation_name(iso, inp.candidates).filter(|_| inp.detected) {
@@ -168,6 +155,19 @@ impl Replay {
             );
         }
         of(State::Unexplained, iso.verdict.clone())
+    }
+
+    /// The residual finding where they could not be judged (`why`): a log without the
+    /// voltages or the speed lacks what they need (unavailable); else the log kept them
+    /// from judging (not judged).
+    fn residuals_unjudged(&self, against: Against, why: String) -> FindingReport {
+        let state = if self.monitor.is_none() {
+            State::Unavailable
+        } else {
+            State::NotJudged
+        };
+        let brief = format!("residuals: {why}");
+        FindingReport::new(FindingSource::Residuals, state, against, why, brief)
     }
 
     /// Why the lamps that lit are the operating point's (heating, a load move), where they

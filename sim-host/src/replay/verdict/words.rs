@@ -89,7 +89,10 @@ pub fn against_text(source: FindingSource, a: Against) -> &'static str {
     match (a, source) {
         (Against::Commissioning, _) => "against commissioning",
         (Against::HealthyRuns, _) => "against healthy runs",
-        (Against::WithinTheLog, _) => "against a healthy stretch of the same log",
+        (Against::WithinTheLog, FindingSource::Winding) => {
+            "against the log's own stretches and a healthy machine's asymmetry"
+        }
+        (Against::WithinTheLog, _) => "against the log's own stretches",
         (Against::ParameterFile, _) => "against the parameter file",
         (Against::Nothing, FindingSource::Winding) => "against a healthy machine's own asymmetry",
         (Against::Nothing, FindingSource::Rotor) => "against the MCSA severity bands",

@@ -124,8 +124,14 @@ pub(super) fn widened(j: &Judged, ext: &External, pole_pairs: f32) -> Option<Str
     };
     let pct = |s: f32| least_change_of(j, s).map_or(f32::INFINITY, |l| 100.0 * l);
     let (from, to) = (pct(j.sigma_same_point), pct(j.sigma));
-    // Two decimals where one would not show the widening.
+    // Two decimals where one would not show the widening; none worth a word at two.
     let digits = if (to - from) < 0.05 { 2 } else { 1 };
+    if !(to - from >= 0.005) {
+        return Some(format!(
+            "{what} ran at another operating point than the judged stretch ({}), which the least change {from:.digits$} % already covers",
+            how.join(", "),
+        ));
+    }
     Some(format!(
         "{what} ran at another operating point than the judged stretch ({}): the least change widened from {from:.digits$} % to {to:.digits$} % (the negative sequence a healthy motor has moves with the load)",
         how.join(", "),
