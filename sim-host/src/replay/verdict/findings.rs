@@ -417,7 +417,39 @@ pub(in crate::replay) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
         .phase_not_judged
         .as_ref()
         .map_or(String::new(), |w| format!(" ({w})"));
+    if let Some((p, prob)) = watched_phase(&u.phase_probabilities) {
+        // Not named (no short is the most probable), but a short too probable to call the
+        // winding clear: watched, never healthy.
+        let named = NamedFault {
+            fault: FaultName::ShortedTurns,
+            size: Size::OfPositiveSequence(u.winding_ratio),
+            phase: Some(p),
+            confidence: prob,
+        };
+        return of(
+            State::Named(named),
+            format!(
+                "a short in phase {} is not ruled out (probability {prob:.2}, no short {:.2}): {change}{why}",
+                p.name(),
+                u.phase_probabilities.no_short
+            ),
+        );
+    }
     of(State::Clear, format!("no shorted turns: {change}{why}"))
+}
+
+/// The least probability of a short in one phase at which the winding is not clear
+/// ([`winding_finding`]): a short in a phase at 1 in 5 is worth watching.
+pub const WINDING_WATCH_PROBABILITY: f32 = 0.2;
+
+/// The most probable shorted phase and its probability, where it has
+/// [`WINDING_WATCH_PROBABILITY`] or more.
+fn watched_phase(pp: &crate::replay::PhaseProbabilities) -> Option<(monitor_core::Phase, f32)> {
+    use monitor_core::Phase;
+    [(Phase::A, pp.a), (Phase::B, pp.b), (Phase::C, pp.c)]
+        .into_iter()
+        .max_by(|x, y| x.1.total_cmp(&y.1))
+        .filter(|(_, p)| *p >= WINDING_WATCH_PROBABILITY)
 }
 
 /// The rotor's finding from the current spectrum (MCSA): broken bars named from the band "a
