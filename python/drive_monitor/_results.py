@@ -69,9 +69,22 @@ def _frame(rows: List[Dict[str, Any]]):
 
 
 class DiagnoseResult(Result):
-    """``diagnose``'s report. Keys: ``verdict``, ``verdict_withheld_because``, ``lamps``,
-    ``candidates``, ``isolation``, ``unbalance``, ``commissioning``, ``data_quality``,
-    ``first_detection_s``, ``timeline``, ... (docs/design.md)."""
+    """``diagnose``'s report. Keys: ``verdict`` (``fault``, ``watching``, ``healthy``,
+    ``could_not_judge``), ``verdict_line`` (the one line every output shows),
+    ``verdict_finding`` (the finding the verdict rests on: ``source``, ``state``, ``fault``,
+    ``size``, ``size_unit``, ``phase``, ``confidence``, ``against``, ``summary``),
+    ``findings`` (one per analysis), ``judged``, ``not_judged``,
+    ``verdict_withheld_because``, ``lamps``, ``candidates``, ``isolation``, ``unbalance``,
+    ``rotor``, ``commissioning``, ``data_quality``, ``first_detection_s``, ``timeline``, ...
+    (docs/isolation.md, "One verdict from all the evidence")."""
+
+    @property
+    def findings_frame(self):
+        """The analyses' findings as a DataFrame, one row per analysis (``source``:
+        residuals, winding, rotor, operating_point, parameter_fit, data_quality; ``state``,
+        ``fault``, ``size``, ``size_unit``, ``phase``, ``confidence``, ``against``,
+        ``summary``): what the verdict was decided from."""
+        return _frame(self._doc.get("findings", []))
 
     @property
     def timeline(self):

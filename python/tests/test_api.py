@@ -55,6 +55,27 @@ def test_real_recordings_with_a_baseline(repo):
     assert r.unbalance.suspect_phase == "c"
     assert r.verdict == "fault"
     assert len(r.segments) == 2
+    # One verdict: the finding it rests on names the phase, with a confidence of 0.5 or
+    # more, and the line says what it was judged against.
+    f = r.verdict_finding
+    assert (f.source, f.fault, f.phase) == ("winding", "shorted_turns", "c")
+    assert f.confidence >= 0.5
+    assert r.verdict_line.startswith("FAULT shorted turns in phase c") and "healthy runs" in r.verdict_line
+
+
+def test_the_verdict_line_is_the_commands_and_the_findings_a_frame(repo, sim_host):
+    r = dm.diagnose(repo / MOTULATOR, repo / MOTULATOR_P, commission=(1.5, 2.4))
+    text = subprocess.run(
+        [sim_host, "diagnose", "--params", MOTULATOR_P, MOTULATOR, "--commission", "1.5:2.4"],
+        cwd=repo, capture_output=True, text=True, check=True,
+    ).stdout
+    assert f"verdict: {r.verdict_line}" in text.splitlines()
+    frame = r.findings_frame
+    assert set(frame["source"]) == {"residuals", "winding", "rotor", "operating_point",
+                                    "parameter_fit", "data_quality"}
+    # A healthy verdict says what was judged, and nothing it rests on is a named fault.
+    assert r.verdict == "healthy" and r.verdict_line.startswith("healthy: ")
+    assert not (frame["state"] == "named").any()
 
 
 def test_compare_explain_identify_nameplate(repo, sim_host):

@@ -388,15 +388,17 @@ pub(in crate::replay) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
         100.0 * u.winding_ratio,
         100.0 * u.least_change
     );
-    if let Some(p) = u.suspect_phase {
-        let named = NamedFault {
+    let short = |phase, confidence| {
+        State::Named(NamedFault {
             fault: FaultName::ShortedTurns,
             size: Size::OfPositiveSequence(u.winding_ratio),
-            phase: Some(p),
-            confidence: u.phase_confidence,
-        };
+            phase: Some(phase),
+            confidence,
+        })
+    };
+    if let Some(p) = u.suspect_phase {
         return of(
-            State::Named(named),
+            short(p, u.phase_confidence),
             format!("shorted turns in phase {}: {change}", p.name()),
         );
     }
@@ -420,14 +422,8 @@ pub(in crate::replay) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
     if let Some((p, prob)) = watched_phase(&u.phase_probabilities) {
         // Not named (no short is the most probable), but a short too probable to call the
         // winding clear: watched, never healthy.
-        let named = NamedFault {
-            fault: FaultName::ShortedTurns,
-            size: Size::OfPositiveSequence(u.winding_ratio),
-            phase: Some(p),
-            confidence: prob,
-        };
         return of(
-            State::Named(named),
+            short(p, prob),
             format!(
                 "a short in phase {} is not ruled out (probability {prob:.2}, no short {:.2}): {change}{why}",
                 p.name(),
