@@ -177,10 +177,6 @@ pub struct Follower {
     warming_k_per_s: f32,
     /// Time since the heating was last tracked [s].
     since_tracked_s: f32,
-    /// A deviation needed more warming than the winding could have gained since its
-    /// temperature was judged: a step, which stays one (the time since is not counted on
-    /// until the temperature is judged again).
-    step_seen: bool,
 }
 
 impl Follower {
@@ -209,7 +205,6 @@ impl Follower {
             since_judged_s: 0.0,
             warming_k_per_s: 0.0,
             since_tracked_s: 0.0,
-            step_seen: false,
         }
     }
 
@@ -261,9 +256,7 @@ impl Follower {
         // Saturate: only "long enough or not" matters.
         self.since_isolation_s = crate::minf(self.since_isolation_s + dt, 2.0 * CONFIRM_S);
         // (Saturates where the reach covers the whole range: 185 K at 10 K/s.)
-        if !self.step_seen {
-            self.since_judged_s = crate::minf(self.since_judged_s + dt, 20.0);
-        }
+        self.since_judged_s = crate::minf(self.since_judged_s + dt, 20.0);
         self.since_tracked_s = crate::minf(self.since_tracked_s + dt, 1000.0);
         let ended = self.follow_learning(learning, dt);
         if !usable {

@@ -126,7 +126,7 @@ pub(super) fn widened(j: &Judged, ext: &External, pole_pairs: f32) -> Option<Str
     let (from, to) = (pct(j.sigma_same_point), pct(j.sigma));
     // Two decimals where one would not show the widening; none worth a word at two.
     let digits = if (to - from) < 0.05 { 2 } else { 1 };
-    if !(to - from >= 0.005) {
+    if (to - from).is_nan() || to - from < 0.005 {
         return Some(format!(
             "{what} ran at another operating point than the judged stretch ({}), which the least change {from:.digits$} % already covers",
             how.join(", "),

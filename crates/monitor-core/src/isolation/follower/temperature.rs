@@ -25,9 +25,8 @@ impl Follower {
     /// `tracked`: heating was taken into the machine): the winding's temperature is judged
     /// where the machine at it fits (no deviation, or one the friction class explains with
     /// the stator-voltage equations within the healthy scatter: the load moved), where
-    /// heating was tracked, and all the time with a temperature channel; a deviation that
-    /// needs more warming than the winding could have gained is a step and stays one until
-    /// then ([`Isolator::set_heating_reach_k`], [`Isolator::beyond_heating_reach`]).
+    /// heating was tracked, and all the time with a temperature channel (the reach of the
+    /// heating hypothesis grows with the time since: [`Isolator::set_heating_reach_k`]).
     pub(super) fn note_temperature(
         &mut self,
         (result, point, scale): (&Isolation, &SteadyPoint, f32),
@@ -48,9 +47,6 @@ impl Follower {
         let fits = result.state == crate::isolation::IsolationState::NoDeviation || load_moved;
         if tracked || fits || self.measured_rise_k.is_some() {
             self.since_judged_s = 0.0;
-            self.step_seen = false;
-        } else if false && self.isolator.beyond_heating_reach(result) {
-            self.step_seen = true;
         }
     }
 

@@ -28,25 +28,6 @@ impl Isolator {
         self.lag_sigma_k = crate::minf(base + rate * since, self.heating_reach_k);
     }
 
-    /// The deviation of `result` needs more warming than the reach allows
-    /// ([`Isolator::set_heating_reach_k`]): it deviates, heating takes no part in its
-    /// ranking (its misfit beyond [`HEATING_MAX_MISFIT`]), and the heating fit sits at the
-    /// reach's warm end (a step: the [`Follower`] keeps it one until the temperature is
-    /// judged again).
-    pub fn beyond_heating_reach(&self, result: &Isolation) -> bool {
-        let deviates = matches!(
-            result.state,
-            IsolationState::Isolated | IsolationState::Unknown
-        );
-        let reach = 1.0 + COPPER_ALPHA_PER_K * self.heating_reach_k;
-        let (_, hi) = self.heating_range();
-        let binding = reach.is_finite() && hi >= reach * (1.0 - 1e-4);
-        deviates
-            && binding
-            && result.heating.misfit > HEATING_MAX_MISFIT
-            && result.heating.factor >= hi * (1.0 - 1e-3)
-    }
-
     /// The heating hypothesis' range of factors relative to the tracked machine: the whole
     /// [`HEATING_K_MIN`]..[`HEATING_K_MAX`], within the reach
     /// ([`Isolator::set_heating_reach_k`]).
