@@ -403,17 +403,7 @@ pub(in crate::replay) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
         );
     }
     if u.judged_segment.is_none() {
-        let why = u
-            .phase_not_judged
-            .clone()
-            .unwrap_or_else(|| "no steady stretch".to_string());
-        return FindingReport::new(
-            FindingSource::Winding,
-            State::Unavailable,
-            against,
-            why.clone(),
-            format!("winding: {why}"),
-        );
+        return winding_unavailable(u, against);
     }
     let why = u
         .phase_not_judged
@@ -432,6 +422,22 @@ pub(in crate::replay) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
         );
     }
     of(State::Clear, format!("no shorted turns: {change}{why}"))
+}
+
+/// The winding's finding where no steady stretch was judged: unavailable, with the reason.
+fn winding_unavailable(u: &UnbalanceReport, against: Against) -> FindingReport {
+    let why = u
+        .phase_not_judged
+        .clone()
+        .unwrap_or_else(|| "no steady stretch".to_string());
+    let brief = format!("winding: {why}");
+    FindingReport::new(
+        FindingSource::Winding,
+        State::Unavailable,
+        against,
+        why,
+        brief,
+    )
 }
 
 /// The least probability of a short in one phase at which the winding is not clear
