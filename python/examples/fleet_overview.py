@@ -39,7 +39,7 @@ def main(out_dir: Path) -> None:
     motors, logs = [], []
     for k, (size, fault, change) in enumerate(PLANT):
         name = f"{size}_m{k:02d}"
-        scenario = f"duration_s = 6.0\nsample_rate_hz = 4000.0\nseed = {k + 1}\n"
+        scenario = f"duration_s = 8.0\nsample_rate_hz = 4000.0\nseed = {k + 1}\n"
         if fault:
             scenario += f'[[faults]]\nkind = "{fault}"\nat_s = 4.0\nchange = {change}\n'
         log = out_dir / f"{name}_day1.parquet"

@@ -26,7 +26,7 @@ def plant(tmp_path_factory, repo):
     logs = []
     for name, (params, _f) in MOTORS.items():
         for k, fault in enumerate(FAULTS):
-            sc = f"duration_s = 6.0\nsample_rate_hz = 4000.0\nseed = {k + 1}\n"
+            sc = f"duration_s = 8.0\nsample_rate_hz = 4000.0\nseed = {k + 1}\n"
             if fault:
                 sc += f'[[faults]]\nkind = "{fault[0]}"\nat_s = 4.0\nchange = {fault[1]}\n'
                 if fault[0].endswith("_sensor"):
