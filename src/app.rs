@@ -27,7 +27,7 @@ use crate::flash_record::{self, CalibrationRecord, RecordStore, Stored};
 use crate::liveness::{LivenessChange, SampleWatch};
 use crate::offset_trim::TrimResult;
 use crate::panel::{self, blink_code, winding_code, Mode, PanelInput, PanelLamps, NOT_NAMED_CODE};
-use crate::range_watch::RangeWatch;
+use crate::range_watch::{Moment, RangeWatch};
 use crate::reset_record::PreviousRun;
 use crate::sampling::TICK_HZ;
 use crate::supply::{ReferenceAdc, ReferenceChange, ReferenceWatch, REFERENCE_PERIOD_MS};
@@ -35,7 +35,7 @@ use monitor_core::isolation::{Baseline, Evidence, Follower, Named, Step};
 use monitor_core::verdict::Verdict;
 use monitor_core::{
     CommissioningRun, ConfigError, Fault, Isolation, IsolationState, Isolator, MonitorConfig,
-    MotorModel, Operating, Phase, ReferenceMachine, SensorFlags, SteadyPoint,
+    MotorModel, Operating, OperatingPoint, Phase, ReferenceMachine, SensorFlags, SteadyPoint,
 };
 
 mod isolation;
@@ -69,7 +69,7 @@ pub fn default_motor() -> MotorModel {
 /// `sample_rate_hz`, 1 MHz timestamps, a 16-bit x4 encoder counter with
 /// [`board::ENCODER_COUNTS_PER_REV`] counts per revolution, and sensor limits equal to the
 /// front end's full scale (a reading beyond it cannot be real). (The host's configuration
-/// for replaying a log is `sim_host::replay::monitor_config_for_log`.)
+/// for replaying a log is `monitor_replay::monitor_config_for_log`.)
 pub fn board_monitor_config(sample_rate_hz: u32) -> MonitorConfig {
     let supply = DEFAULT_MACHINE.supply;
     let mut cfg = MonitorConfig::new(
@@ -209,12 +209,37 @@ pub struct MonitorStatus {
     /// 0 without a phase): the decision table's confidence of shorted turns on the board.
     pub winding_confidence: f32,
     /// The filtered `V_ds` [V] (with `operating`: the operating point without the frame's
-    /// angle, [`RangeWatch::point`]).
+    /// angle, [`MonitorStatus::operating_point`]).
     pub vds: f32,
     /// The operating point has left the commissioned range: set by [`Supervisor::tick`]
     /// ([`RangeWatch::moved`]), false as the sample path hands it ([`panel_input`] shows
     /// the amber state only when no fault is named).
     pub moved: bool,
+}
+
+impl MonitorStatus {
+    /// The operating point without the d-q frame's angle ([`OperatingPoint::from_dq`] of
+    /// `V_ds`, `V_qs`, `i_ds`, `I_qs`): what the commissioned range is learned and judged on.
+    pub fn operating_point(&self) -> OperatingPoint {
+        OperatingPoint::from_dq(
+            self.vds,
+            self.operating.vqs,
+            self.operating.i_f,
+            self.operating.iqs,
+        )
+    }
+
+    /// What the operating-range watch reads of this status.
+    pub fn range_moment(&self) -> Moment {
+        Moment {
+            point: self.operating_point(),
+            stage: self.run.stage,
+            run: self.run.id,
+            quasi_steady: self.quasi_steady,
+            commissioned: self.commissioned,
+            evaluating: self.evaluating,
+        }
+    }
 }
 
 /// What thread mode does after one [`Supervisor::tick`].
@@ -379,7 +404,7 @@ impl Supervisor {
         self.expire_failed_show(now_ms);
         let mode = self.mode(watch.stalled);
         let failed = self.procedure.last_failure().is_some();
-        self.latest.moved = self.range.moved(&self.latest);
+        self.latest.moved = self.range.moved(&self.latest.range_moment());
         let isolation = self.panel_isolation();
         let input = PanelInput {
             default_motor: self.default_motor,
@@ -406,7 +431,7 @@ impl Supervisor {
         let previous = self.latest.samples;
         self.latest = s;
         self.follow(&s, previous);
-        self.range.observe(&s);
+        self.range.observe(&s.range_moment());
     }
 
     /// Whether `button` (pressed since the last tick) counts as a press at `now_ms`: not

@@ -76,7 +76,7 @@
 //! record beside the lamps' thresholds (record version 2; restored at boot); without one
 //! (never commissioned, or a version 1 record) the sizes are against the nominal values.
 
-pub use crate::board::Lamp;
+use crate::board::Lamp;
 
 /// State of the six lamps (`true` = lit), one field per lamp.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

@@ -16,8 +16,26 @@
 //! does not judge "moved" (the flash record holds the thresholds and the isolation
 //! baseline, not the range).
 
-use crate::app::MonitorStatus;
 use monitor_core::{OperatingPoint, OperatingRange, RunStage};
+
+/// What the watch reads of one status the sample task hands over (the app builds it,
+/// `MonitorStatus::range_moment`; this module knows nothing of the app).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Moment {
+    /// The status's operating point ([`OperatingPoint::from_dq`] of its `V_ds`, `V_qs`,
+    /// `i_ds`, `I_qs`).
+    pub point: OperatingPoint,
+    /// The commissioning run's stage.
+    pub stage: RunStage,
+    /// The commissioning run's id.
+    pub run: u16,
+    /// The quasi-steady gate is open.
+    pub quasi_steady: bool,
+    /// Thresholds learned by commissioning are in force.
+    pub commissioned: bool,
+    /// The lamps are evaluated (past the warm-up).
+    pub evaluating: bool,
+}
 
 /// The commissioned range and the one being learned (module docs).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -37,24 +55,18 @@ impl RangeWatch {
         }
     }
 
-    /// The operating point of a status ([`OperatingPoint::from_dq`] of its `V_ds`, `V_qs`,
-    /// `i_ds`, `I_qs`).
-    pub fn point(s: &MonitorStatus) -> OperatingPoint {
-        OperatingPoint::from_dq(s.vds, s.operating.vqs, s.operating.i_f, s.operating.iqs)
-    }
-
     /// Feeds a status: while its run learns and the quasi-steady gate is open, widens that
     /// run's range (a new run starts from nothing).
-    pub fn observe(&mut self, s: &MonitorStatus) {
-        if s.run.stage != RunStage::Learning || !s.quasi_steady {
+    pub fn observe(&mut self, s: &Moment) {
+        if s.stage != RunStage::Learning || !s.quasi_steady {
             return;
         }
-        let id = s.run.id;
+        let id = s.run;
         if !matches!(self.learning, Some((run, _)) if run == id) {
             self.learning = Some((id, OperatingRange::EMPTY));
         }
         if let Some((_, range)) = &mut self.learning {
-            range.learn(Self::point(s));
+            range.learn(s.point);
         }
     }
 
@@ -74,10 +86,7 @@ impl RangeWatch {
 
     /// The status's operating point has left the commissioned range (beyond the core's
     /// margin) while the learned thresholds are in force and the lamps are evaluated.
-    pub fn moved(&self, s: &MonitorStatus) -> bool {
-        s.commissioned
-            && s.evaluating
-            && !s.run.stage.is_active()
-            && self.commissioned.moved(Self::point(s))
+    pub fn moved(&self, s: &Moment) -> bool {
+        s.commissioned && s.evaluating && !s.stage.is_active() && self.commissioned.moved(s.point)
     }
 }

@@ -38,7 +38,7 @@ pub enum SamplingError {
 }
 
 /// Converts [`RawFrame`]s (ADC codes and the encoder counter) to [`Sample`]s: the
-/// firmware's sampler (the host's counterpart for log rows is `sim_host::replay::LogSampler`).
+/// firmware's sampler (the host's counterpart for log rows is `monitor_replay::LogSampler`).
 /// No panics, no allocation.
 #[derive(Clone, Copy, Debug)]
 pub struct AdcSampler {

@@ -18,8 +18,8 @@ mod scenario;
 
 use monitor_core::Fault;
 use monitor_core::Monitor;
-use sim_host::params::ParamFile;
-use sim_host::sim::{simulate, FaultSpec, LoadKind, LoadSpec, Scenario};
+use monitor_io::params::ParamFile;
+use monitor_sim::{simulate, FaultSpec, LoadKind, LoadSpec, Scenario};
 use std::path::PathBuf;
 
 const START_S: f64 = 2.0;

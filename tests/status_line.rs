@@ -5,7 +5,7 @@
 
 use monitor_core::verdict::Verdict;
 use monitor_core::Fault;
-use sim_host::demo::MonitorState;
+use monitor_studies::demo::MonitorState;
 use sim_host::hmi::status_line;
 use std::path::PathBuf;
 

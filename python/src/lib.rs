@@ -1,5 +1,5 @@
 //! `drive_monitor._native`: the Python package's bindings to the library the `sim-host`
-//! command line runs (`sim_host::api`, `sim_host::fleet`). Every function takes paths (the
+//! command line runs (`monitor_api`, `monitor_api::fleet`). Every function takes paths (the
 //! Python layer writes in-memory data to a temporary Parquet file first) and returns the
 //! command's `--json` document as a string, so a result is the command line's, key for key.
 //!
@@ -7,10 +7,10 @@
 //! an `InternalError`); errors are the exception classes below, carrying the command line's
 //! one-line message.
 
+use monitor_api::{self as api, ApiError, ErrorKind, ParamsSource};
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;
 use pyo3::prelude::*;
-use sim_host::api::{self, ApiError, ErrorKind, ParamsSource};
 use std::path::PathBuf;
 
 create_exception!(
@@ -91,10 +91,10 @@ fn json<T: serde::Serialize>(v: &T) -> PyResult<String> {
     serde_json::to_string(v).map_err(|e| InternalError::new_err(e.to_string()))
 }
 
-fn load_of(name: &str) -> PyResult<sim_host::replay::LoadModel> {
+fn load_of(name: &str) -> PyResult<monitor_replay::LoadModel> {
     match name {
-        "unknown" => Ok(sim_host::replay::LoadModel::Unknown),
-        "viscous" => Ok(sim_host::replay::LoadModel::Viscous),
+        "unknown" => Ok(monitor_replay::LoadModel::Unknown),
+        "viscous" => Ok(monitor_replay::LoadModel::Viscous),
         other => Err(OptionError::new_err(format!(
             "load = '{other}': give 'unknown' or 'viscous'"
         ))),
@@ -285,7 +285,7 @@ fn params_from_nameplate(
     nema_design: &str,
     columns_from: Option<PathBuf>,
 ) -> PyResult<String> {
-    use sim_host::nameplate::{Connection, Nameplate, NemaDesign};
+    use monitor_io::nameplate::{Connection, Nameplate, NemaDesign};
     let connection = match connection {
         "star" => Connection::Star,
         "delta" => Connection::Delta,
@@ -355,16 +355,16 @@ fn fleet_row(
 ) -> PyResult<String> {
     run(py, || {
         let table =
-            sim_host::fleet::MotorTable::from_toml_str(&table_toml, "the motor table", &base)
+            monitor_api::fleet::MotorTable::from_toml_str(&table_toml, "the motor table", &base)
                 .map_err(|e| OptionError::new_err(e.to_string()))?;
-        json(&sim_host::fleet::row_shown(&table, &log, &shown))
+        json(&monitor_api::fleet::row_shown(&table, &log, &shown))
     })
 }
 
 /// The fleet table's columns, in order.
 #[pyfunction]
 fn fleet_columns() -> Vec<&'static str> {
-    sim_host::fleet::COLUMNS.to_vec()
+    monitor_api::fleet::COLUMNS.to_vec()
 }
 
 /// The Rust extension of `drive_monitor`.

@@ -18,9 +18,9 @@
 mod alloc_tuning;
 mod common;
 
-use sim_host::analysis::{prep::ReadOptions, Analysis, Options};
-use sim_host::log::{LogFile, LogWriter, Row};
-use sim_host::params::ParamFile;
+use monitor_analysis::{prep::ReadOptions, Analysis, Options};
+use monitor_io::log::{LogFile, LogWriter, Row};
+use monitor_io::params::ParamFile;
 use std::time::Instant;
 
 fn peak_rss_mb() -> f64 {
@@ -68,7 +68,7 @@ fn convert(from: &std::path::Path, to: &std::path::Path) {
     let file = LogFile::open(from).expect("open log");
     let mut w = LogWriter::create(to, file.channels()).expect("create");
     struct Sink<'a>(&'a mut LogWriter);
-    impl sim_host::log::RowSink for Sink<'_> {
+    impl monitor_io::log::RowSink for Sink<'_> {
         fn row(&mut self, r: &Row) -> bool {
             self.0.write_row(r).is_ok()
         }

@@ -23,7 +23,7 @@
 
 mod common;
 
-use sim_host::params::ParamFile;
+use monitor_io::params::ParamFile;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};

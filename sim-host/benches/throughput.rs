@@ -10,8 +10,8 @@
 #![allow(missing_docs)]
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use sim_host::params::ParamFile;
-use sim_host::sim::{simulate, Scenario, SensorSpec};
+use monitor_io::params::ParamFile;
+use monitor_sim::{simulate, Scenario, SensorSpec};
 
 fn reference(c: &mut Criterion) {
     let p = ParamFile::reference_2p2kw();

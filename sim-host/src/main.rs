@@ -95,5 +95,5 @@ fn one_line_error(e: &anyhow::Error) -> String {
             msg.push_str(&c);
         }
     }
-    sim_host::one_line(&msg)
+    monitor_io::one_line(&msg)
 }

@@ -246,7 +246,7 @@ fn current_only_log_through_the_binary() {
     let dir = tempfile::tempdir().unwrap();
     let truth = motor("2p2");
     let mut s = scenario("2p2", None, 1);
-    s.effects = vec![sim_host::sim::EffectSpec::PhaseAsymmetry {
+    s.effects = vec![monitor_sim::EffectSpec::PhaseAsymmetry {
         phase: monitor_core::Phase::C,
         fraction: 0.05,
         fault_resistance_ohm: None,

@@ -11,8 +11,8 @@ mod analysis_common;
 mod dynamics_recovery;
 
 use analysis_common::*;
-use sim_host::params::ParamFile;
-use sim_host::sim::{Scenario, SupplyStep};
+use monitor_io::params::ParamFile;
+use monitor_sim::{Scenario, SupplyStep};
 
 /// All four dynamics effects: the full-order T-equivalent machine.
 const FULL: [&str; 4] = [
@@ -152,7 +152,7 @@ fn supply_unbalance_fits_the_true_admittance() {
         for (fraction, angle_deg) in [(0.02, 0.0), (0.04, 70.0)] {
             let p = params(which);
             let mut s = transients(which, 5000.0);
-            s.effects = vec![sim_host::sim::EffectSpec::SupplyUnbalance {
+            s.effects = vec![monitor_sim::EffectSpec::SupplyUnbalance {
                 fraction,
                 angle_deg,
             }];
@@ -196,7 +196,7 @@ fn sync_speed_mech(p: &ParamFile) -> f64 {
 /// The T-equivalent circuit's torque at standstill on the rated supply [N m]:
 /// `3 |I_r|^2 Rr / omega_sync,mech`.
 fn locked_rotor_torque(p: &ParamFile) -> f64 {
-    use sim_host::analysis::prep::C64;
+    use monitor_analysis::prep::C64;
     let m = &p.motor;
     let w = 2.0 * std::f64::consts::PI * p.supply.f_hz;
     let (zm, zr) = (
@@ -229,11 +229,11 @@ fn hidden_case(
         // drives it backwards from the start; there half of it.
         monitor_core::EffectKind::LoadTorque => {
             let default = truth.motor.bl_nms * sync_speed_mech(&truth);
-            sim_host::sim::EffectSpec::LoadTorque {
+            monitor_sim::EffectSpec::LoadTorque {
                 torque_nm: (default > locked_rotor_torque(&truth)).then_some(0.5 * default),
             }
         }
-        k => sim_host::sim::EffectSpec::with_defaults(k),
+        k => monitor_sim::EffectSpec::with_defaults(k),
     }];
     let log = write_log(
         dir,
@@ -375,8 +375,8 @@ fn hidden_effects_under_transients_probe() {
 /// All four states of the full-order machine dynamic, with the true La and Lr/Rr of `m`.
 fn full_order_dynamics(
     m: &monitor_core::MotorModel<f64>,
-) -> sim_host::analysis::simplified_model::Dynamics {
-    sim_host::analysis::simplified_model::Dynamics {
+) -> monitor_analysis::simplified_model::Dynamics {
+    monitor_analysis::simplified_model::Dynamics {
         stator_current_la_h: Some(m.la_h()),
         rotor_flux_tau_s: Some(m.lr_h / m.rr_ohm),
         stator_d_axis: true,
@@ -392,7 +392,7 @@ fn full_order_dynamics(
 /// 0.007-0.023.
 #[test]
 fn full_order_model_reproduces_the_simulator() {
-    use sim_host::analysis::{metrics, simplified_model as sm};
+    use monitor_analysis::{metrics, simplified_model as sm};
     let dir = tempfile::tempdir().unwrap();
     let mut failures = Vec::new();
     for (which, rate) in [
@@ -404,7 +404,7 @@ fn full_order_model_reproduces_the_simulator() {
         let p = params(which);
         let m = p.motor.model::<f64>();
         let mut s = transients(which, rate);
-        s.sensors = sim_host::sim::SensorSpec::ideal();
+        s.sensors = monitor_sim::SensorSpec::ideal();
         let log = write_log(dir.path(), &format!("ideal_{which}_{rate}"), &p, &s, false);
         let a = analyse(&log, &p, 0.0);
         let terms = sm::ModelTerms {
@@ -430,15 +430,15 @@ fn full_order_model_reproduces_the_simulator() {
 /// motors), 10x or more below the unsaturated model (measured 0.050 and 0.023).
 #[test]
 fn saturated_full_order_model_reproduces_the_simulator() {
-    use sim_host::analysis::{metrics, simplified_model as sm};
+    use monitor_analysis::{metrics, simplified_model as sm};
     let dir = tempfile::tempdir().unwrap();
     let mut failures = Vec::new();
     for which in ["2p2", "3hp"] {
         let p = params(which);
         let m = p.motor.model::<f64>();
         let mut s = transients(which, 5000.0);
-        s.sensors = sim_host::sim::SensorSpec::ideal();
-        s.effects = vec![sim_host::sim::EffectSpec::with_defaults(
+        s.sensors = monitor_sim::SensorSpec::ideal();
+        s.effects = vec![monitor_sim::EffectSpec::with_defaults(
             monitor_core::EffectKind::Saturation,
         )];
         let log = write_log(dir.path(), &format!("sat_{which}"), &p, &s, false);
@@ -479,9 +479,9 @@ fn saturated_full_order_model_reproduces_the_simulator() {
 /// back to 50 Hz at 2.4 s was called "the direct-on-line start".
 #[test]
 fn a_step_inside_the_start_settling_tail_is_named_as_the_step() {
-    use sim_host::analysis::metrics::{Condition, WorstWindow};
-    use sim_host::analysis::simplified_model::MachineConstants;
-    use sim_host::analysis::transients::{classify, settling_s, start_end_s};
+    use monitor_analysis::metrics::{Condition, WorstWindow};
+    use monitor_analysis::simplified_model::MachineConstants;
+    use monitor_analysis::transients::{classify, settling_s, start_end_s};
     let dir = tempfile::tempdir().unwrap();
     let mut failures = Vec::new();
     for which in ["2p2", "3hp", "11kw"] {

@@ -16,7 +16,7 @@
 mod analysis_common;
 use analysis_common::*;
 use monitor_core::EffectKind;
-use sim_host::sim::EffectSpec;
+use monitor_sim::EffectSpec;
 
 const DYNAMICS: [&str; 2] = ["flux_dynamics", "current_dynamics"];
 
@@ -156,7 +156,7 @@ fn effect_free_data_claims_nothing() {
             ex.noise_floor
         );
         assert!(
-            ex.unexplained || best < sim_host::analysis::explain::EXPLAINED_MIN,
+            ex.unexplained || best < monitor_analysis::explain::EXPLAINED_MIN,
             "{which}/{noise}: claimed {:?}",
             ex.ranking.first().map(|c| &c.effect)
         );
@@ -209,7 +209,7 @@ fn motulator_log_points_at_load_torque() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/logs");
     let log = root.join("motulator_2p2kw_dol.csv");
     assert!(log.exists(), "{} is part of the repository", log.display());
-    let p = sim_host::params::ParamFile::load(&root.join("motulator_2p2kw_dol.toml")).unwrap();
+    let p = monitor_io::params::ParamFile::load(&root.join("motulator_2p2kw_dol.toml")).unwrap();
     let a = analyse(&log, &p, 0.8);
     let ex = a.explain(&opts(&[]), &|_| {}).unwrap().report;
     eprintln!("{}", ex.verdict);

@@ -2,11 +2,11 @@
 //! `compare` gives when its worst windows are a start or a step (issue 10).
 mod analysis_common;
 use analysis_common::*;
+use monitor_analysis::effects::library;
+use monitor_analysis::explain::{ExplainReport, Standing, EXPLAINS_MIN};
+use monitor_analysis::simplified_model::BaseParameter;
 use monitor_core::EffectKind;
-use sim_host::analysis::effects::library;
-use sim_host::analysis::explain::{ExplainReport, Standing, EXPLAINS_MIN};
-use sim_host::analysis::simplified_model::BaseParameter;
-use sim_host::sim::{LoadKind, LoadSpec, LoadStep, Scenario, SupplyStep};
+use monitor_sim::{LoadKind, LoadSpec, LoadStep, Scenario, SupplyStep};
 
 /// A direct-on-line start from standstill, then steady running: 3 s at 5 kHz.
 fn dol() -> Scenario {
@@ -241,7 +241,7 @@ fn assert_standings(case: &str, ex: &ExplainReport) {
 #[test]
 fn the_motulator_logs_implausible_fits_stand_apart_and_print_no_unit_one() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/logs");
-    let p = sim_host::params::ParamFile::load(&root.join("motulator_2p2kw_dol.toml")).unwrap();
+    let p = monitor_io::params::ParamFile::load(&root.join("motulator_2p2kw_dol.toml")).unwrap();
     let a = analyse(&root.join("motulator_2p2kw_dol.csv"), &p, 0.0);
     let ex = a.explain(&opts(&[]), &|_| {}).unwrap().report;
     assert_standings("motulator", &ex);
@@ -319,7 +319,7 @@ fn compare_advice_and_explain_skipped_agree() {
     let dir = tempfile::tempdir().unwrap();
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/logs");
     let motulator =
-        sim_host::params::ParamFile::load(&root.join("motulator_2p2kw_dol.toml")).unwrap();
+        monitor_io::params::ParamFile::load(&root.join("motulator_2p2kw_dol.toml")).unwrap();
     let p = motor("2p2");
     let dol_log = write_log(dir.path(), "dol", &p, &dol(), false);
     // Load steps of 1.3x the rated torque every 0.4 s from 2.5 s (the speed moves by 6 %

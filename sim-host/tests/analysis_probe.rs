@@ -30,7 +30,7 @@ fn probe() {
         let base_env = std::env::var("BASE").unwrap_or_default();
         let base: Vec<&str> = base_env.split(',').filter(|s| !s.is_empty()).collect();
         if let Ok(g) = std::env::var("TRUTH_G") {
-            use sim_host::analysis::simplified_model::{
+            use monitor_analysis::simplified_model::{
                 simulate, BaseParams, Dynamics, Magnetising, ModelTerms,
             };
             let n = &a.constants;
@@ -49,7 +49,7 @@ fn probe() {
                 ..Default::default()
             };
             let p = simulate(&a.data, n, &BaseParams::nominal(n), &t);
-            let e = sim_host::analysis::metrics::errors(&a.data, &p, None);
+            let e = monitor_analysis::metrics::errors(&a.data, &p, None);
             println!(
                 "truth model (Rfe = {g} Xm): error {:.4}",
                 e.normalized_rms_error
@@ -144,8 +144,8 @@ fn read_speed() {
     let t = std::time::Instant::now();
     /// Counts rows.
     struct Count(u64);
-    impl sim_host::log::RowSink for Count {
-        fn row(&mut self, _: &sim_host::log::Row) -> bool {
+    impl monitor_io::log::RowSink for Count {
+        fn row(&mut self, _: &monitor_io::log::Row) -> bool {
             self.0 += 1;
             true
         }
@@ -153,7 +153,7 @@ fn read_speed() {
             self.0 = 0;
         }
     }
-    let file = sim_host::log::LogFile::open(std::path::Path::new(&path)).unwrap();
+    let file = monitor_io::log::LogFile::open(std::path::Path::new(&path)).unwrap();
     let mut n = Count(0);
     file.for_each_row(&mut |_| {}, &mut n).unwrap();
     println!(
@@ -162,8 +162,8 @@ fn read_speed() {
         t.elapsed().as_secs_f64()
     );
     let t = std::time::Instant::now();
-    let params = sim_host::params::ParamFile::reference_2p2kw();
-    let (d, _) = sim_host::analysis::prep::decimate_log(
+    let params = monitor_io::params::ParamFile::reference_2p2kw();
+    let (d, _) = monitor_analysis::prep::decimate_log(
         std::path::Path::new(&path),
         &params,
         Default::default(),
@@ -176,7 +176,7 @@ fn read_speed() {
         t.elapsed().as_secs_f64()
     );
     let t = std::time::Instant::now();
-    let p = sim_host::analysis::prep::voltage_model_flux_frame(&d, &params);
+    let p = monitor_analysis::prep::voltage_model_flux_frame(&d, &params);
     println!(
         "frame: {} samples in {:.2} s",
         p.len(),
@@ -186,8 +186,8 @@ fn read_speed() {
 
 fn dump_csv(
     path: &str,
-    a: &sim_host::analysis::Analysis,
-    pr: &sim_host::analysis::simplified_model::Prediction,
+    a: &monitor_analysis::Analysis,
+    pr: &monitor_analysis::simplified_model::Prediction,
 ) {
     use std::io::Write;
     let mut f = std::io::BufWriter::new(std::fs::File::create(path).unwrap());

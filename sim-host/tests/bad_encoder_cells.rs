@@ -13,9 +13,9 @@
 //! the encoder and the verdict was `FAULT` with the lamps' matching naming speed_sensor).
 //! About 4 s in the test profile.
 
-use sim_host::api::{self, DiagnoseRequest, ParamsSource};
-use sim_host::log::Log;
-use sim_host::replay::{IsolationName, Verdict};
+use monitor_api::{self as api, DiagnoseRequest, ParamsSource};
+use monitor_io::log::Log;
+use monitor_replay::{IsolationName, Verdict};
 use std::path::{Path, PathBuf};
 
 const SCENARIO: &str = "duration_s = 8.0\nsample_rate_hz = 5000.0\nseed = 5\n[sensors]\nencoder = true\nspeed = false\n";
@@ -74,7 +74,7 @@ fn counts_off(log: &Log, base: i64, step: i64) -> (Log, usize) {
 /// as [`spoil`] does to the CSV text.
 fn no_counts(log: &Log) -> Log {
     let kinds = [
-        sim_host::log::ENC_COUNT_UNREADABLE,
+        monitor_io::log::ENC_COUNT_UNREADABLE,
         1_000_000_000_000,
         99_999_999,
         -3,

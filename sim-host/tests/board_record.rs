@@ -2,7 +2,7 @@
 //! runs) agree, and the command refuses bad input with one line.
 
 use monitor_core::motor_record::{MotorRecord, RecordError, STORED_LEN};
-use sim_host::params::ParamFile;
+use monitor_io::params::ParamFile;
 use std::path::Path;
 use std::process::{Command, Output};
 

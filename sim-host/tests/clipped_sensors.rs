@@ -5,23 +5,23 @@
 //! the default front end is not clipped.
 
 use monitor_core::Fault;
-use sim_host::fault_signatures::{scenario, Protocol};
-use sim_host::log::Channels;
-use sim_host::params::ParamFile;
-use sim_host::replay::{diagnose_rows, IsolationName, ReplayOptions, Verdict};
+use monitor_io::log::Channels;
+use monitor_io::params::ParamFile;
+use monitor_replay::{diagnose_rows, IsolationName, ReplayOptions, Verdict};
+use monitor_studies::fault_signatures::{scenario, Protocol};
 
 fn diagnose(
     p: &ParamFile,
     fault: Option<(Fault, f64)>,
     v_range_v: Option<f64>,
-) -> sim_host::replay::DiagnoseReport {
+) -> monitor_replay::DiagnoseReport {
     let proto = Protocol {
         sample_rate_hz: 5000.0,
         v_range_v,
         ..Protocol::default()
     };
     let sc = scenario(fault, &proto);
-    let rows = sim_host::sim::simulate_to_vec(p, &sc).expect("simulate"); // ok: test
+    let rows = monitor_sim::simulate_to_vec(p, &sc).expect("simulate"); // ok: test
     let channels = Channels {
         voltages: true,
         speed: true,

@@ -12,7 +12,7 @@ mod daq_writers;
 
 use assert_cmd::Command;
 use daq_writers::{columns_table, daq_csv, daq_example_line, daq_parquet, daq_tdms};
-use sim_host::log::{Log, Row};
+use monitor_io::log::{Log, Row};
 use std::f64::consts::TAU;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -425,8 +425,8 @@ fn missing_values_duplicates_and_blank_lines_follow_one_rule() {
 #[test]
 #[ignore = "writes the example log under examples/; run on purpose"]
 fn write_the_daq_example() {
-    use sim_host::params::ParamFile;
-    use sim_host::sim::{simulate, Scenario};
+    use monitor_io::params::ParamFile;
+    use monitor_sim::{simulate, Scenario};
     let params = ParamFile::load(&repo().join("examples/params/2p2kw.toml")).expect("params");
     let sc = Scenario::load(&repo().join("examples/scenarios/daq_2p2kw.toml")).expect("sc");
     let mut text = String::from("Time,Ia,Ib,Ic,Va,Vb,Vc,Speed\n");
@@ -508,10 +508,10 @@ fn a_file_without_header_or_time_reads_through_columns_by_place() {
     let by_place = "[columns]\nt_s = { sample_rate_hz = 1000.0 }\nia_A = { column = 1 }\nib_A = { column = 2 }\nic_A = { column = 3 }\n";
     let p = params_with(dir.path(), "p.toml", by_place);
     let read = |log: &Path| {
-        let (_, columns) = sim_host::log::mapping::load_params(&p).expect("params");
-        let file = sim_host::log::LogFile::open_with(
+        let (_, columns) = monitor_io::log::mapping::load_params(&p).expect("params");
+        let file = monitor_io::log::LogFile::open_with(
             log,
-            &sim_host::log::OpenOptions {
+            &monitor_io::log::OpenOptions {
                 group: None,
                 columns,
             },

@@ -3,12 +3,12 @@
 //! gate for a while), and the healthy log stays healthy after it; a window with less than
 //! the stated minimum of quasi-steady running is refused, saying how much was found.
 
-use sim_host::log::Channels;
-use sim_host::params::ParamFile;
-use sim_host::replay::{diagnose_rows, ReplayError, ReplayOptions, Verdict, MIN_LEARNED_S};
-use sim_host::sim::{simulate_to_vec, Scenario};
+use monitor_io::log::Channels;
+use monitor_io::params::ParamFile;
+use monitor_replay::{diagnose_rows, ReplayError, ReplayOptions, Verdict, MIN_LEARNED_S};
+use monitor_sim::{simulate_to_vec, Scenario};
 
-fn supply_steps_log(p: &ParamFile, seed: u64) -> Vec<sim_host::log::Row> {
+fn supply_steps_log(p: &ParamFile, seed: u64) -> Vec<monitor_io::log::Row> {
     let steps: Vec<String> = (1..8)
         .map(|k| {
             let v = if k % 2 == 1 { 1.08 } else { 0.92 };
@@ -43,7 +43,7 @@ fn a_window_with_supply_steps_inside_is_learned_and_the_log_stays_healthy() {
         let r = diagnose_rows(&p, channels(), &rows, opts).expect("learned"); // ok: test
         assert_eq!(
             r.commissioning.state,
-            sim_host::replay::CommissioningOutcome::Learned
+            monitor_replay::CommissioningOutcome::Learned
         );
         let learned = r.commissioning.seconds_evaluated;
         // Less than the window (the steps closed the gate), at least the minimum.

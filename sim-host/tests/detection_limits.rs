@@ -6,9 +6,9 @@
 //! change of twice that limit must be seen (the limit is a real one, not a bound that
 //! excuses everything). About 1 s in the test profile.
 
+use monitor_api::{self as api, DiagnoseRequest, ParamsSource};
 use monitor_core::Fault;
-use sim_host::api::{self, DiagnoseRequest, ParamsSource};
-use sim_host::replay::{DiagnoseReport, IsolationName, Verdict};
+use monitor_replay::{DiagnoseReport, IsolationName, Verdict};
 
 /// A 50 hp, 460 V, 60 Hz motor (Krause's 50 hp machine's per-phase values).
 const PARAMS_50HP: &str = "[motor]\nrs_ohm = 0.087\nrr_ohm = 0.228\nls_h = 0.03549685747426239\nlr_h = 0.03549685747426239\nlm_h = 0.03469577759403319\npoles = 4\nj_kgm2 = 1.662\nb_nms = 0.009\nbl_nms = 0.9\n[supply]\nv_ll_rms = 460.0\nf_hz = 60.0\n";

@@ -6,13 +6,13 @@
 //! healthy, six parametric faults (+-50 %, at 5 s), two sensor gain faults, and three
 //! effects no fault is (a warming, main-flux saturation, iron loss), 8 s at 4 kHz with the
 //! default 12-bit noisy sensors and the paper's viscous load. Each is written to a CSV file
-//! and judged through the library calls the command line runs (`sim_host::api`):
+//! and judged through the library calls the command line runs (`monitor_api`):
 //! `diagnose --commission 2:4` and `explain --from 1.5` (after the start). About 20 s in the test
 //! profile on 2 cores.
 
+use monitor_api::{self as api, AnalysisRequest, DiagnoseRequest, ParamsSource};
+use monitor_replay::Verdict;
 use rayon::prelude::*;
-use sim_host::api::{self, AnalysisRequest, DiagnoseRequest, ParamsSource};
-use sim_host::replay::Verdict;
 use std::path::{Path, PathBuf};
 
 /// One log's scenario: its name and the TOML lines after the header.

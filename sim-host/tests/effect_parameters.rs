@@ -4,12 +4,10 @@
 //! without its line there fails here, and the message holds the table to paste.
 //! The typed values refuse a count that does not match.
 
-use sim_host::analysis::effects::{
-    library, model_of, EffectParam, EffectValuesError, WindageValues,
-};
-use sim_host::analysis::prep::Prepared;
-use sim_host::analysis::simplified_model::MachineConstants;
-use sim_host::params::ParamFile;
+use monitor_analysis::effects::{library, model_of, EffectParam, EffectValuesError, WindageValues};
+use monitor_analysis::prep::Prepared;
+use monitor_analysis::simplified_model::MachineConstants;
+use monitor_io::params::ParamFile;
 use std::path::Path;
 
 /// A range bound as the docs write it: whole numbers without a point, others to 3 decimals

@@ -221,14 +221,14 @@ fn broken_bars_are_counted_in_the_main_text() {
 /// candidates set by hand.
 #[test]
 fn the_ranking_reads_beside_the_verdicts_fault() {
+    use monitor_analysis::explain::Standing;
     use monitor_core::verdict::{Against, FaultName, FindingSource, NamedFault, Size, State};
-    use sim_host::analysis::explain::Standing;
-    use sim_host::replay::FindingReport;
+    use monitor_replay::FindingReport;
     let (params, log) = motulator();
-    let p = sim_host::params::ParamFile::load(&params).unwrap();
+    let p = monitor_io::params::ParamFile::load(&params).unwrap();
     let a = analyse(&log, &p, 0.0);
     let mut report = a.explain(&opts(&[]), &|_| {}).unwrap().report;
-    let mut mcsa = sim_host::api::mcsa_beside(&a, &report, None);
+    let mut mcsa = monitor_api::mcsa_beside(&a, &report, None);
     mcsa.lower_sideband_db = Some(-42.0);
     let named = |fault, size, source| {
         let n = NamedFault {
@@ -250,7 +250,7 @@ fn the_ranking_reads_beside_the_verdicts_fault() {
         Size::DbBelowLine(42.0),
         FindingSource::Rotor,
     );
-    let set = |r: &mut sim_host::analysis::explain::ExplainReport, s: Standing, k| {
+    let set = |r: &mut monitor_analysis::explain::ExplainReport, s: Standing, k| {
         let c = r
             .ranking
             .iter_mut()
@@ -262,7 +262,7 @@ fn the_ranking_reads_beside_the_verdicts_fault() {
         }
     };
     set(&mut report, Standing::NotPlausible, None);
-    let b = sim_host::api::beside_verdict(&bars, &report, &mcsa).expect("a sentence");
+    let b = monitor_api::beside_verdict(&bars, &report, &mcsa).expect("a sentence");
     assert!(
         b.contains("do not contradict") && b.contains("42.0 dB"),
         "{b}"
@@ -270,7 +270,7 @@ fn the_ranking_reads_beside_the_verdicts_fault() {
     assert!(b.contains("not physical") && !b.contains("agrees"), "{b}");
     assert!(b.contains("0.79 % of the current"), "{b}"); // 10^(-42/20)
     set(&mut report, Standing::Candidate, Some(1));
-    let b = sim_host::api::beside_verdict(&bars, &report, &mcsa).expect("a sentence");
+    let b = monitor_api::beside_verdict(&bars, &report, &mcsa).expect("a sentence");
     assert!(
         b.contains("the ranking agrees: rotor_asymmetry is rank 1"),
         "{b}"
@@ -280,7 +280,7 @@ fn the_ranking_reads_beside_the_verdicts_fault() {
         Size::OfPositiveSequence(0.05),
         FindingSource::Winding,
     );
-    let b = sim_host::api::beside_verdict(&turns, &report, &mcsa).expect("a sentence");
+    let b = monitor_api::beside_verdict(&turns, &report, &mcsa).expect("a sentence");
     assert!(
         b.contains("negative-sequence current") && b.contains("phase_asymmetry"),
         "{b}"
@@ -290,7 +290,7 @@ fn the_ranking_reads_beside_the_verdicts_fault() {
         Size::Relative(0.5),
         FindingSource::Residuals,
     );
-    let b = sim_host::api::beside_verdict(&rs, &report, &mcsa).expect("a sentence");
+    let b = monitor_api::beside_verdict(&rs, &report, &mcsa).expect("a sentence");
     assert!(b.contains("rs +50 %") && b.contains("refit"), "{b}");
     let healthy = FindingReport::new(
         FindingSource::Rotor,
@@ -299,13 +299,10 @@ fn the_ranking_reads_beside_the_verdicts_fault() {
         "x".into(),
         "y".into(),
     );
-    assert_eq!(
-        sim_host::api::beside_verdict(&healthy, &report, &mcsa),
-        None
-    );
+    assert_eq!(monitor_api::beside_verdict(&healthy, &report, &mcsa), None);
     // A log without voltages: no model, no ranking; the sentence says so.
     report.baseline_normalized_rms_error = f64::NAN;
-    let b = sim_host::api::beside_verdict(&turns, &report, &mcsa).expect("a sentence");
+    let b = monitor_api::beside_verdict(&turns, &report, &mcsa).expect("a sentence");
     assert!(
         b.contains("could not run") && b.contains("ranks no effect"),
         "{b}"

@@ -4,10 +4,10 @@
 
 use monitor_core::AngleSource;
 use monitor_core::Phase;
+use monitor_io::params::ParamFile;
+use monitor_replay::{diagnose_rows, BaselineSource, ReplayOptions};
+use monitor_sim::{simulate_to_vec, EffectSpec, LoadKind, LoadSpec, Scenario, SensorSpec};
 use rayon::prelude::*;
-use sim_host::params::ParamFile;
-use sim_host::replay::{diagnose_rows, BaselineSource, ReplayOptions};
-use sim_host::sim::{simulate_to_vec, EffectSpec, LoadKind, LoadSpec, Scenario, SensorSpec};
 
 fn run(
     params: &ParamFile,
@@ -102,8 +102,8 @@ fn balanced_machine_names_no_phase() {
 fn diagnose_and_the_analysis_name_the_same_phase() {
     // One faulty-phase method for the whole workspace: the monitor (diagnose) and the
     // model-vs-measurement analysis (compare/explain) agree on the same log.
-    use sim_host::analysis::{prep::ReadOptions, Analysis};
-    use sim_host::log::Log;
+    use monitor_analysis::{prep::ReadOptions, Analysis};
+    use monitor_io::log::Log;
     let dir = tempfile::tempdir().unwrap();
     let p = ParamFile::reference_2p2kw();
     for (phase, name) in [(Phase::B, "b"), (Phase::C, "c")] {
@@ -149,7 +149,7 @@ fn run_unbalanced(
     unbalance: f64,
     angle_deg: f64,
     short: Option<(Phase, f64)>,
-) -> sim_host::replay::UnbalanceReport {
+) -> monitor_replay::UnbalanceReport {
     let mut sc = Scenario::steady(4.0, 10_000.0);
     sc.seed = 17 + (1000.0 * unbalance + angle_deg) as u64;
     sc.sensors = SensorSpec::default();
@@ -249,13 +249,13 @@ fn mismatched(
     params: &ParamFile,
     shorted: Option<(Phase, f64)>,
     seed: u64,
-) -> Vec<sim_host::log::Row> {
+) -> Vec<monitor_io::log::Row> {
     let mut sc = Scenario::steady(6.0, 5_000.0);
     sc.seed = seed;
     sc.sensors = SensorSpec::default();
     for (phase, change) in [(Phase::A, 0.012), (Phase::B, -0.01)] {
         let mut f =
-            sim_host::sim::FaultSpec::sensor_gain(monitor_core::Fault::CurrentSensor, 0.0, change);
+            monitor_sim::FaultSpec::sensor_gain(monitor_core::Fault::CurrentSensor, 0.0, change);
         f.phase = Some(phase);
         sc.faults.push(f);
     }
@@ -283,7 +283,7 @@ fn a_healthy_baseline_takes_the_motors_own_asymmetry_out() {
     let mut blamed_without = 0;
     for params in [ParamFile::reference_2p2kw(), ParamFile::reference_3hp()] {
         let channels = SensorSpec::default().channels();
-        let replay = |rows: &[sim_host::log::Row], opts: ReplayOptions| {
+        let replay = |rows: &[monitor_io::log::Row], opts: ReplayOptions| {
             diagnose_rows(&params, channels, rows, opts).expect("replay") // ok: test
         };
         let healthy = mismatched(&params, None, 11);

@@ -24,10 +24,10 @@
 mod small_motor;
 
 use monitor_core::Fault;
+use monitor_io::params::ParamFile;
+use monitor_replay::{DiagnoseReport, IsolationName, Verdict};
+use monitor_sim::{Scenario, SensorSpec};
 use rayon::prelude::*;
-use sim_host::params::ParamFile;
-use sim_host::replay::{DiagnoseReport, IsolationName, Verdict};
-use sim_host::sim::{Scenario, SensorSpec};
 use std::path::Path;
 
 fn motors() -> Vec<(&'static str, ParamFile)> {
@@ -255,7 +255,7 @@ fn a_50hp_motor_warming_fast_is_heating_and_names_nothing() {
                 .isolation
                 .events
                 .iter()
-                .filter(|e| matches!(e, sim_host::replay::IsolationEvent::Named { .. }))
+                .filter(|e| matches!(e, monitor_replay::IsolationEvent::Named { .. }))
                 .map(|e| e.line())
                 .collect();
             let strong = r.candidates.iter().find(|c| c.probability >= 0.5);
@@ -318,10 +318,10 @@ fn an_uncommissioned_motor_that_warms_is_not_judged_a_fault() {
         }
         if let Some((f, at_s, change)) = fault {
             sc.faults
-                .push(sim_host::sim::FaultSpec::parametric(f, at_s, change));
+                .push(monitor_sim::FaultSpec::parametric(f, at_s, change));
         }
-        let opts = sim_host::replay::ReplayOptions::default();
-        sim_host::experiment::simulate_and_replay(p, p, &sc, opts, |_, _| {})
+        let opts = monitor_replay::ReplayOptions::default();
+        monitor_studies::experiment::simulate_and_replay(p, p, &sc, opts, |_, _| {})
             .expect("runs") // ok: test
             .finish()
     };
@@ -423,13 +423,14 @@ at_s = 3.0
     let bad: Vec<String> = cases
         .par_iter()
         .filter_map(|(name, truth, file)| {
-            let opts = sim_host::replay::ReplayOptions {
+            let opts = monitor_replay::ReplayOptions {
                 commission: Some((2.0, 8.0)),
                 ..Default::default()
             };
-            let r = sim_host::experiment::simulate_and_replay(truth, file, &sc, opts, |_, _| {})
-                .expect("runs") // ok: test
-                .finish();
+            let r =
+                monitor_studies::experiment::simulate_and_replay(truth, file, &sc, opts, |_, _| {})
+                    .expect("runs") // ok: test
+                    .finish();
             let rise = r.isolation.winding_rise_k.map(f64::from);
             eprintln!(
                 "{name}: {:?}, named {:?}, rise {rise:?} K (true {true_rise:.1} K)",

@@ -4,16 +4,16 @@
 //! `src/cli/render/hmi.rs`; a real terminal: `hmi_tmux.rs`.)
 
 use monitor_core::Fault;
-use sim_host::demo::MonitorState;
-use sim_host::fault_signatures::{scenario, Protocol};
+use monitor_io::log::Log;
+use monitor_io::params::ParamFile;
+use monitor_replay::ReplayOptions;
+use monitor_sim::simulate_to_vec;
+use monitor_studies::demo::MonitorState;
+use monitor_studies::fault_signatures::{scenario, Protocol};
 use sim_host::hmi::live::LiveSim;
 use sim_host::hmi::log_replay::LogReplay;
 use sim_host::hmi::status_line::{self, StdinStatus};
 use sim_host::hmi::{Controls, HmiState, Key, Source, Speed};
-use sim_host::log::Log;
-use sim_host::params::ParamFile;
-use sim_host::replay::ReplayOptions;
-use sim_host::sim::simulate_to_vec;
 
 /// Runs the live source for `seconds` of simulated time, in 0.25 s steps as the screen
 /// would.

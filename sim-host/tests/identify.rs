@@ -15,11 +15,11 @@ mod identify_machines;
 
 use assert_cmd::Command;
 use identify_machines::{machines, Machine};
-use sim_host::identify::{identify, Identification, InverseGamma, Samples};
-use sim_host::log::{Channels, Row};
-use sim_host::nameplate::estimate;
-use sim_host::params::ParamFile;
-use sim_host::sim::{Scenario, SensorSpec, SupplyStep};
+use monitor_analysis::identify::{identify, Identification, InverseGamma, Samples};
+use monitor_io::log::{Channels, Row};
+use monitor_io::nameplate::estimate;
+use monitor_io::params::ParamFile;
+use monitor_sim::{Scenario, SensorSpec, SupplyStep};
 use std::f64::consts::TAU;
 
 /// A start from standstill with ±8 % supply steps every 0.5 s from 1 s (time for the
@@ -37,7 +37,7 @@ fn healthy_log(m: &Machine, rate_hz: f64, duration_s: f64) -> Vec<Row> {
             f_hz: None,
         })
         .collect();
-    sim_host::sim::simulate_to_vec(&m.truth(), &sc).expect("simulates")
+    monitor_sim::simulate_to_vec(&m.truth(), &sc).expect("simulates")
 }
 
 fn channels() -> Channels {
@@ -335,7 +335,7 @@ fn steady_running_at_one_point_says_what_it_cannot_identify() {
     // No supply steps: a start, then 1.5 s of steady running at one point, fitted alone.
     let mut sc = Scenario::steady(3.0, 5000.0);
     sc.sensors = SensorSpec::default();
-    let rows = sim_host::sim::simulate_to_vec(&m.truth(), &sc).expect("simulates");
+    let rows = monitor_sim::simulate_to_vec(&m.truth(), &sc).expect("simulates");
     let s = Samples::from_rows(&rows, channels(), 1.5, f64::INFINITY).expect("samples");
     assert!(!s.starts_dead);
     let id = identify(&m.start(), &s, &mut |_| {}).expect("runs");
@@ -425,16 +425,16 @@ fn named(
     told: &ParamFile,
     fault: monitor_core::Fault,
     change: f64,
-) -> Option<sim_host::replay::IsolationName> {
-    use sim_host::fault_signatures::{scenario, Protocol};
+) -> Option<monitor_replay::IsolationName> {
+    use monitor_studies::fault_signatures::{scenario, Protocol};
     let proto = Protocol::default();
-    let opts = sim_host::replay::ReplayOptions {
+    let opts = monitor_replay::ReplayOptions {
         angle_source: proto.angle_source,
         commission: Some(proto.commission),
         ..Default::default()
     };
     let sc = scenario(Some((fault, change)), &proto);
-    sim_host::experiment::simulate_and_replay(truth, told, &sc, opts, |_, _| {})
+    monitor_studies::experiment::simulate_and_replay(truth, told, &sc, opts, |_, _| {})
         .expect("runs")
         .finish()
         .isolation
@@ -445,9 +445,9 @@ fn named(
 /// run (a start with the viscous load, 10 kHz, 12-bit sensors), 4 s, from its nameplate
 /// estimate.
 fn identified(truth: &ParamFile, m: &Machine) -> ParamFile {
-    use sim_host::fault_signatures::{scenario, Protocol};
+    use monitor_studies::fault_signatures::{scenario, Protocol};
     let proto = Protocol::default();
-    let rows = sim_host::sim::simulate_to_vec(truth, &scenario(None, &proto)).expect("simulates");
+    let rows = monitor_sim::simulate_to_vec(truth, &scenario(None, &proto)).expect("simulates");
     let s = Samples::from_rows(&rows, channels(), 0.0, 4.0).expect("samples");
     identify(&m.start(), &s, &mut |_| {})
         .expect("identifies")

@@ -3,7 +3,7 @@
 //! sensors at 5 kHz -> the core -> the replay's isolation, on both reference motors and on
 //! a third machine the code was not developed on (`examples/params/11kw_2pole.toml`).
 //!
-//! Protocol (`sim_host::fault_signatures`): direct-on-line start, the paper's viscous load,
+//! Protocol (`monitor_studies::fault_signatures`): direct-on-line start, the paper's viscous load,
 //! commissioning 2..4 s (the isolation's baseline is learned there), the fault at 4.5 s
 //! (the 11 kW machine: 3..5 s and 5.5 s, its start settles later).
 //!
@@ -17,10 +17,10 @@
 //!   fault.
 
 use monitor_core::Fault;
+use monitor_io::params::ParamFile;
+use monitor_replay::{state_name, FaultCandidate, IsolationName};
+use monitor_studies::fault_signatures::{run_case, Protocol, Table1Row};
 use rayon::prelude::*;
-use sim_host::fault_signatures::{run_case, Protocol, Table1Row};
-use sim_host::params::ParamFile;
-use sim_host::replay::{state_name, FaultCandidate, IsolationName};
 use std::path::Path;
 
 fn machines() -> Vec<(&'static str, ParamFile)> {

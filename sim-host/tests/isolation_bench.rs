@@ -1,4 +1,4 @@
-//! `sim-host bench --isolation`'s library part ([`sim_host::bench::isolation`]) on a small
+//! `sim-host bench --isolation`'s library part ([`monitor_studies::bench::isolation`]) on a small
 //! plan: the 2.2 kW machine, Rr and the current sensor at -50/-10/+10/+50 %, both loads, the
 //! rotor-flux mode (16 runs). The bench must find every one, name at least 12 (measured: the
 //! current sensor's 8 and Rr's 4 at the file's load; Rr at 0.6 of it is the leading
@@ -6,8 +6,8 @@
 //! confusion matrix must count every case once.
 
 use monitor_core::{AngleSource, Fault, IsolationState};
-use sim_host::bench::isolation::{motors, run, BenchPlan, CHANGES, LOADS};
-use sim_host::replay::{angle_source_name, FaultCandidate, IsolationName, NameGiven};
+use monitor_replay::{angle_source_name, FaultCandidate, IsolationName, NameGiven};
+use monitor_studies::bench::isolation::{motors, run, BenchPlan, CHANGES, LOADS};
 
 #[test]
 fn the_bench_finds_names_and_counts() {
@@ -92,8 +92,8 @@ fn the_bench_finds_names_and_counts() {
 #[test]
 fn a_wrong_name_is_counted() {
     // A row in which the isolation named rr for an Ls fault at the end, after naming ls.
-    use sim_host::bench::isolation::judge;
-    use sim_host::fault_signatures::Table1Row;
+    use monitor_studies::bench::isolation::judge;
+    use monitor_studies::fault_signatures::Table1Row;
     let name = |n: &str| IsolationName::from_name(n).expect("a name"); // ok: test
     let row = Table1Row {
         fault: Fault::Ls,

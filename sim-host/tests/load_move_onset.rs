@@ -1,6 +1,6 @@
 //! Load moves are listed where they began (issue 48): `diagnose`'s `isolation.events`
 //! dates a load move back to the time the active current left its old level, found after
-//! the fact (`sim_host::replay`'s event log keeps the active current's recent block means).
+//! the fact (`monitor_replay`'s event log keeps the active current's recent block means).
 //! Before, a move was listed at the steady point that showed it, 0.8-1.4 s late (the demo's
 //! steps at 5.0 s and 6.5 s at 5.82 s and 7.34 s).
 //!
@@ -14,10 +14,10 @@
 
 mod small_motor;
 
+use monitor_io::params::ParamFile;
+use monitor_replay::{IsolationEvent, ReplayOptions};
+use monitor_sim::{LoadSpec, LoadStep, Scenario, SensorSpec};
 use rayon::prelude::*;
-use sim_host::params::ParamFile;
-use sim_host::replay::{IsolationEvent, ReplayOptions};
-use sim_host::sim::{LoadSpec, LoadStep, Scenario, SensorSpec};
 use std::path::Path;
 
 /// The bar: a move listed within 0.2 s of the step it names.
@@ -52,10 +52,11 @@ fn check(name: &str, listed: &[f64], steps: &[f64], must: &[f64]) -> Option<Stri
 
 #[test]
 fn the_demos_load_steps_are_listed_where_they_began() {
-    let run = sim_host::demo::run(sim_host::demo::Story::service()).expect("the demo runs");
+    let run =
+        monitor_studies::demo::run(monitor_studies::demo::Story::service()).expect("the demo runs");
     let steps = [
-        sim_host::demo::LOAD_STEP_AT_S,
-        sim_host::demo::LOAD_BACK_AT_S,
+        monitor_studies::demo::LOAD_STEP_AT_S,
+        monitor_studies::demo::LOAD_BACK_AT_S,
     ];
     let listed = moves(&run.report.isolation.events);
     let bad = check("demo", &listed, &steps, &steps);
@@ -101,7 +102,7 @@ fn replay_steps(p: &ParamFile, change: f64, commission: Option<(f64, f64)>) -> V
         commission,
         ..Default::default()
     };
-    let r = sim_host::experiment::simulate_and_replay(p, p, &sc, opts, |_, _| {})
+    let r = monitor_studies::experiment::simulate_and_replay(p, p, &sc, opts, |_, _| {})
         .expect("runs")
         .finish();
     moves(&r.isolation.events)

@@ -1,13 +1,13 @@
 //! Load steps located to the sample (`load_torque`'s change-point detection,
-//! `sim_host::analysis::change_point`): one step in the log is one step in the fit, where
+//! `monitor_analysis::change_point`): one step in the log is one step in the fit, where
 //! it is and of its size, on a log another simulator made and on the project's simulator;
 //! a log without a step gets none.
 mod analysis_common;
 use analysis_common::*;
+use monitor_analysis::effects::{load_segments, model_of, LoadSegment};
+use monitor_analysis::{Analysis, FittedEffect};
 use monitor_core::EffectKind;
-use sim_host::analysis::effects::{load_segments, model_of, LoadSegment};
-use sim_host::analysis::{Analysis, FittedEffect};
-use sim_host::sim::{LoadKind, LoadSpec, LoadStep, Scenario};
+use monitor_sim::{LoadKind, LoadSpec, LoadStep, Scenario};
 
 /// The four dynamics effects: the full-order machine.
 const DYNAMICS: [&str; 4] = [
@@ -60,7 +60,7 @@ fn segments(a: &Analysis) -> Vec<LoadSegment> {
 fn motulator_load_step_is_found_where_it_is() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/logs");
     let log = root.join("motulator_2p2kw_dol.csv");
-    let p = sim_host::params::ParamFile::load(&root.join("motulator_2p2kw_dol.toml")).unwrap();
+    let p = monitor_io::params::ParamFile::load(&root.join("motulator_2p2kw_dol.toml")).unwrap();
     let a = analyse(&log, &p, f64::NEG_INFINITY);
     let seg = segments(&a);
     assert_eq!(seg.len(), 2, "one step: {seg:?}");
@@ -77,7 +77,7 @@ fn motulator_load_step_is_found_where_it_is() {
     let start = Analysis::load(
         &log,
         p,
-        sim_host::analysis::prep::ReadOptions {
+        monitor_analysis::prep::ReadOptions {
             from_s: f64::NEG_INFINITY,
             to_s: 2.4,
         },

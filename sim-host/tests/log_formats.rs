@@ -1,14 +1,14 @@
-//! The log formats behind the one reader (`sim_host::log`): CSV, TDMS and Parquet give the
+//! The log formats behind the one reader (`monitor_io::log`): CSV, TDMS and Parquet give the
 //! same rows, the same verdicts and figures and the same one-line errors; `convert` copies
 //! a log between them exactly; TDMS files from elsewhere (several groups, time in the
 //! waveform properties, layouts not read) are handled as documented.
 
 use assert_cmd::Command;
-use sim_host::analysis::{prep::ReadOptions, Analysis, Options};
-use sim_host::log::{Channels, Format, Log, LogFile, LogWriter, OpenOptions, Row};
-use sim_host::params::ParamFile;
-use sim_host::replay::{diagnose_file, ReplayOptions};
-use sim_host::sim::{simulate, Scenario};
+use monitor_analysis::{prep::ReadOptions, Analysis, Options};
+use monitor_io::log::{Channels, Format, Log, LogFile, LogWriter, OpenOptions, Row};
+use monitor_io::params::ParamFile;
+use monitor_replay::{diagnose_file, ReplayOptions};
+use monitor_sim::{simulate, Scenario};
 use std::path::{Path, PathBuf};
 
 fn bin() -> Command {

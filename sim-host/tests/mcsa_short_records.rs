@@ -17,8 +17,8 @@
 mod analysis_common;
 
 use analysis_common::{analyse, loaded_start, motor, settle_s, sweep, write_log};
-use sim_host::analysis::rotor_asymmetry::{fit_and_spectrum_agree, mcsa, McsaReport, MIN_BINS};
-use sim_host::sim::{EffectSpec, Scenario, SensorSpec};
+use monitor_analysis::rotor_asymmetry::{fit_and_spectrum_agree, mcsa, McsaReport, MIN_BINS};
+use monitor_sim::{EffectSpec, Scenario, SensorSpec};
 
 /// Bars of the cage (the simulator's broken bars are of this many, and the analysis is
 /// told it).

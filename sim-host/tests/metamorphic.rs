@@ -9,10 +9,10 @@
 //! set runs with both speed channels.
 
 use monitor_core::Fault;
-use sim_host::log::{Channels, Row, ENC_COUNT_UNREADABLE};
-use sim_host::params::ParamFile;
-use sim_host::replay::{diagnose_rows, DiagnoseReport, IsolationName, ReplayOptions, Verdict};
-use sim_host::sim::{simulate_to_vec, Scenario};
+use monitor_io::log::{Channels, Row, ENC_COUNT_UNREADABLE};
+use monitor_io::params::ParamFile;
+use monitor_replay::{diagnose_rows, DiagnoseReport, IsolationName, ReplayOptions, Verdict};
+use monitor_sim::{simulate_to_vec, Scenario};
 
 const RATE_HZ: f64 = 5000.0;
 

@@ -15,10 +15,10 @@
 
 mod small_motor;
 
+use monitor_io::params::ParamFile;
+use monitor_replay::{DiagnoseReport, IsolationEvent, IsolationName, ReplayOptions};
+use monitor_sim::{EffectSpec, FaultSpec, LoadSpec, LoadStep, Scenario, SensorSpec};
 use rayon::prelude::*;
-use sim_host::params::ParamFile;
-use sim_host::replay::{DiagnoseReport, IsolationEvent, IsolationName, ReplayOptions};
-use sim_host::sim::{EffectSpec, FaultSpec, LoadSpec, LoadStep, Scenario, SensorSpec};
 
 /// The days logged.
 const DAYS: [u32; 4] = [3, 12, 21, 30];
@@ -70,7 +70,7 @@ fn day_log(p: &ParamFile, day: u32, rs_change: f64, seed: u64) -> Scenario {
 }
 
 fn replay(p: &ParamFile, sc: &Scenario) -> DiagnoseReport {
-    sim_host::experiment::simulate_and_replay(p, p, sc, ReplayOptions::default(), |_, _| {})
+    monitor_studies::experiment::simulate_and_replay(p, p, sc, ReplayOptions::default(), |_, _| {})
         .expect("runs")
         .finish()
 }

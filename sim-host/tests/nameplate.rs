@@ -1,14 +1,14 @@
 //! `params from-nameplate` against six machines, 0.37 kW to 50 hp (five published): each nameplate is computed
 //! here, at rated power, from the machine's published T-equivalent circuit by the
 //! textbook steady-state model below (independent of the simulator and of
-//! `sim_host::nameplate`), rounded as a nameplate prints it, and the estimate must give
+//! `monitor_io::nameplate`), rounded as a nameplate prints it, and the estimate must give
 //! Rs, Rr, the total leakage Lls + Llr and Lm within 35 % of the circuit's. Also: the
 //! refusals name the option, and the written TOML loads.
 
 use assert_cmd::Command;
+use monitor_io::nameplate::{estimate, Connection, Nameplate, NemaDesign};
+use monitor_io::params::ParamFile;
 use nalgebra::Complex;
-use sim_host::nameplate::{estimate, Connection, Nameplate, NemaDesign};
-use sim_host::params::ParamFile;
 use std::f64::consts::{PI, TAU};
 
 /// A published machine: per-phase star-equivalent T-circuit, reactances at the rated

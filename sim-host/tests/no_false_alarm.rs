@@ -4,9 +4,9 @@
 //! cycle of steps, because to the paper's model a load change is a Bl change).
 
 use monitor_core::Fault;
-use sim_host::params::ParamFile;
-use sim_host::service_profile::{watch, watch_mismatched};
-use sim_host::sim::FaultSpec;
+use monitor_io::params::ParamFile;
+use monitor_sim::FaultSpec;
+use monitor_studies::service_profile::{watch, watch_mismatched};
 
 #[test]
 fn sixty_seconds_of_healthy_service_light_no_lamp() {

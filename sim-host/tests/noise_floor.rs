@@ -17,11 +17,11 @@ mod analysis_common;
 #[allow(dead_code)]
 mod small_motor;
 use analysis_common::*;
+use monitor_io::log::{Channels, Log, Row};
+use monitor_io::params::{ParamFile, SensorRanges};
+use monitor_sim::{Scenario, SupplyStep};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-use sim_host::log::{Channels, Log, Row};
-use sim_host::params::{ParamFile, SensorRanges};
-use sim_host::sim::{Scenario, SupplyStep};
 use std::f64::consts::{PI, TAU};
 use std::path::{Path, PathBuf};
 
@@ -49,7 +49,7 @@ const SUPPLY: [(f64, f64, f64); 4] = [
 /// Where a log comes from.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Source {
-    /// The project's simulator (`sim_host::sim`), default 12-bit sensors.
+    /// The project's simulator (`monitor_sim`), default 12-bit sensors.
     Simulator,
     /// The textbook machine of [`textbook_rows`], 12-bit-like sensors added here.
     Textbook,
@@ -91,7 +91,7 @@ fn add_sensors(rows: &mut [Row], v_range: f64, i_range: f64, seed: u64) {
 /// fed by the balanced supply [`SUPPLY`] (phase peak sqrt(2/3) V_ll), integrated by RK4 in
 /// steps of at most 5 us and point-sampled at `rate_hz`; ideal sensors.
 fn textbook_rows(p: &ParamFile, rate_hz: f64) -> Vec<Row> {
-    use sim_host::analysis::prep::C64;
+    use monitor_analysis::prep::C64;
     let m = &p.motor;
     let np = f64::from(m.poles) / 2.0;
     let det = m.ls_h * m.lr_h - m.lm_h * m.lm_h;
@@ -266,7 +266,7 @@ fn effect_free_log(
 /// alone as the reduced model's phase currents see it, then as the full-order model's
 /// do), and with `ideal` the same log's error without sensors (the model's own share).
 fn accuracy(dir: &Path, source: Source, which: &str, rate_hz: f64, ideal: bool) -> (f64, f64) {
-    use sim_host::analysis::metrics::{noise_floor, Weights};
+    use monitor_analysis::metrics::{noise_floor, Weights};
     let (log, p) = effect_free_log(dir, source, which, rate_hz, true);
     let a = analyse(&log, &p, 0.0);
     let out = a.compare(&opts(&FULL)).unwrap();

@@ -7,12 +7,12 @@
 
 use assert_cmd::Command;
 use monitor_core::Fault;
-use sim_host::fault_signatures::{scenario, Protocol};
+use monitor_io::log::Log;
+use monitor_io::params::ParamFile;
+use monitor_sim::{simulate_to_vec, LoadStep, Scenario};
+use monitor_studies::fault_signatures::{scenario, Protocol};
 use sim_host::hmi::live::LiveSim;
 use sim_host::hmi::{HmiState, Key, Source};
-use sim_host::log::Log;
-use sim_host::params::ParamFile;
-use sim_host::sim::{simulate_to_vec, LoadStep, Scenario};
 use std::path::Path;
 
 /// The demo's protocol: commissioning 2-4 s, the fault at 5 s, 8 s in all.

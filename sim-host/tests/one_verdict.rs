@@ -294,24 +294,24 @@ fn contradictions(d: &Value, text: &str) -> Vec<String> {
 /// The fleet's row of a report agrees with its verdict (the same fault, phase and
 /// confidence).
 fn fleet_row_disagrees(case: &Case) -> Option<String> {
-    let (params, columns) = sim_host::log::mapping::load_params(&case.params).expect("params"); // ok: test
-    let file = sim_host::log::LogFile::open_with(
+    let (params, columns) = monitor_io::log::mapping::load_params(&case.params).expect("params"); // ok: test
+    let file = monitor_io::log::LogFile::open_with(
         &case.log,
-        &sim_host::log::OpenOptions {
+        &monitor_io::log::OpenOptions {
             group: None,
             columns,
         },
     )
     .expect("log"); // ok: test
-    let report = sim_host::replay::diagnose_log(
+    let report = monitor_replay::diagnose_log(
         &params,
         &file,
-        sim_host::replay::ReplayOptions::default(),
+        monitor_replay::ReplayOptions::default(),
         &mut |_| {},
     )
     .expect("diagnose") // ok: test
     .report;
-    let row = sim_host::fleet::FleetRow::of_report("m", &case.log, &report);
+    let row = monitor_api::fleet::FleetRow::of_report("m", &case.log, &report);
     let named = report.verdict_finding.as_ref().and_then(|f| f.named());
     let same = row.verdict.as_deref() == Some(report.verdict.name())
         && row.fault.as_deref() == named.map(|n| n.fault.name())

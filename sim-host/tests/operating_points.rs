@@ -10,11 +10,11 @@
 //! load stepped to 0.7 at 8 s and 0.5 at 11 s: about 2 s in the test profile.
 
 use monitor_core::Fault;
+use monitor_io::params::ParamFile;
+use monitor_replay::{DiagnoseReport, IsolationName, ReplayOptions, Verdict};
+use monitor_sim::{FaultSpec, LoadStep, Scenario, SensorSpec};
+use monitor_studies::experiment::simulate_and_replay;
 use rayon::prelude::*;
-use sim_host::experiment::simulate_and_replay;
-use sim_host::params::ParamFile;
-use sim_host::replay::{DiagnoseReport, IsolationName, ReplayOptions, Verdict};
-use sim_host::sim::{FaultSpec, LoadStep, Scenario, SensorSpec};
 
 fn run(fault: Option<(Fault, f64)>, steps: bool) -> DiagnoseReport {
     let p = ParamFile::reference_3hp();

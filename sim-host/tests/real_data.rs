@@ -11,10 +11,10 @@ mod log_mutations;
 
 use assert_cmd::Command;
 use log_mutations::mutations;
+use monitor_io::log::{Channels, Log, Row};
+use monitor_io::params::ParamFile;
+use monitor_sim::{simulate_to_vec, Scenario};
 use serde_json::Value;
-use sim_host::log::{Channels, Log, Row};
-use sim_host::params::ParamFile;
-use sim_host::sim::{simulate_to_vec, Scenario};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 

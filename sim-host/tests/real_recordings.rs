@@ -14,10 +14,10 @@
 //! - the same estimate holds on simulated logs up to 30 % negative sequence, with and
 //!   without voltages, at 1 and 10 kHz.
 
-use sim_host::log::mapping::load_params;
-use sim_host::log::{LogFile, OpenOptions, Row};
-use sim_host::params::ParamFile;
-use sim_host::replay::{
+use monitor_io::log::mapping::load_params;
+use monitor_io::log::{LogFile, OpenOptions, Row};
+use monitor_io::params::ParamFile;
+use monitor_replay::{
     diagnose_log, diagnose_rows, HealthyReference, ReplayOptions, UnbalanceReport,
 };
 use std::path::{Path, PathBuf};
@@ -185,7 +185,7 @@ fn the_recordings_are_read_as_published_and_the_negative_sequence_is_exact() {
 #[test]
 fn without_its_columns_table_a_published_file_is_refused_with_the_table_to_write() {
     let p = ParamFile::reference_3hp();
-    let e = sim_host::replay::diagnose_file(
+    let e = monitor_replay::diagnose_file(
         &p,
         &folder().join("SC_HLT_001.csv"),
         ReplayOptions::default(),
@@ -275,7 +275,7 @@ fn the_shorted_phase_is_named_against_the_healthy_runs() {
 /// A simulated log with a negative sequence of `unbalance` of the supply (and the currents
 /// it drives), at `rate_hz`, with or without voltages.
 fn simulated(unbalance: f64, rate_hz: f64, voltages: bool) -> (ParamFile, Vec<Row>, bool) {
-    use sim_host::sim::{simulate_to_vec, EffectSpec, Scenario, SensorSpec};
+    use monitor_sim::{simulate_to_vec, EffectSpec, Scenario, SensorSpec};
     let p = ParamFile::reference_2p2kw();
     let mut sc = Scenario::steady(3.0, rate_hz);
     sc.sensors = SensorSpec {
@@ -301,7 +301,7 @@ fn the_estimate_holds_on_simulated_logs_up_to_thirty_percent() {
         (0.04, 10_000.0, false),
     ] {
         let (p, rows, volts) = simulated(unbalance, rate, voltages);
-        let channels = sim_host::log::Channels {
+        let channels = monitor_io::log::Channels {
             voltages: volts,
             ..Default::default()
         };

@@ -10,10 +10,10 @@
 //! effect on both motors with every file error.
 mod analysis_common;
 use analysis_common::*;
+use monitor_analysis::refit::BaseRefit;
+use monitor_analysis::simplified_model::BaseParameter;
 use monitor_core::EffectKind;
-use sim_host::analysis::refit::BaseRefit;
-use sim_host::analysis::simplified_model::BaseParameter;
-use sim_host::params::ParamFile;
+use monitor_io::params::ParamFile;
 
 /// The model the protocol starts from (a full-order simulator always has these).
 const DYNAMICS: [&str; 2] = ["flux_dynamics", "current_dynamics"];
@@ -52,7 +52,7 @@ fn off(p: &ParamFile, which: &str) -> ParamFile {
 
 /// The true value of a base parameter of `truth` (as `BaseRefit` keys them).
 fn true_value(truth: &ParamFile, key: BaseParameter) -> f64 {
-    let n = sim_host::analysis::simplified_model::MachineConstants::from_params(truth);
+    let n = monitor_analysis::simplified_model::MachineConstants::from_params(truth);
     match key {
         BaseParameter::Ra => n.ra_ohm,
         BaseParameter::Ls => n.ls_h,

@@ -16,10 +16,10 @@ mod analysis_common;
 use analysis_common::{
     analyse, in_this_run, loaded_start, motor, opts, settle_s, sweep, write_log,
 };
+use monitor_analysis::rotor_asymmetry::{mcsa, McsaReport};
 use monitor_core::EffectKind;
-use sim_host::analysis::rotor_asymmetry::{mcsa, McsaReport};
-use sim_host::params::ParamFile;
-use sim_host::sim::{self, EffectSpec, Scenario, Truth};
+use monitor_io::params::ParamFile;
+use monitor_sim::{self as sim, EffectSpec, Scenario, Truth};
 use std::f64::consts::PI;
 
 /// Direct-on-line start, the load switched on at the settle time, `delta` injected.

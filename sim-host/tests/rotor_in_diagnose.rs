@@ -15,10 +15,10 @@
 #[allow(dead_code)] // (the 0.37 kW machine only)
 mod small_motor;
 
-use sim_host::log::{Channels, Row};
-use sim_host::params::ParamFile;
-use sim_host::replay::{diagnose_rows, DiagnoseReport, ReplayOptions, RotorBand, SlipSource};
-use sim_host::sim::{
+use monitor_io::log::{Channels, Row};
+use monitor_io::params::ParamFile;
+use monitor_replay::{diagnose_rows, DiagnoseReport, ReplayOptions, RotorBand, SlipSource};
+use monitor_sim::{
     simulate_to_vec, EffectSpec, LoadKind, LoadSpec, LoadStep, Scenario, SensorSpec,
 };
 use std::f64::consts::TAU;
@@ -299,7 +299,7 @@ fn synthetic(
 
 /// `diagnose` of a synthetic record (currents and speed, the 2.2 kW machine's file: 50 Hz,
 /// 4 poles).
-fn diagnose_synthetic(rows: &[Row]) -> sim_host::replay::RotorReport {
+fn diagnose_synthetic(rows: &[Row]) -> monitor_replay::RotorReport {
     let mut p = ParamFile::reference_2p2kw();
     p.motor.rotor_bars = Some(BARS);
     diagnose(&p, rows, false, true).rotor
@@ -553,8 +553,9 @@ fn real_recordings_of_a_healthy_cage_give_no_rotor_fault() {
     // short switched on and off, the supply), never a rotor fault at >= 0.5.
     let folder =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/recordings/itsc");
-    let (params, columns) = sim_host::log::mapping::load_params(&folder.join("baldor_0p75hp.toml"))
-        .expect("parameter file"); // ok: test
+    let (params, columns) =
+        monitor_io::log::mapping::load_params(&folder.join("baldor_0p75hp.toml"))
+            .expect("parameter file"); // ok: test
     let mut names: Vec<std::path::PathBuf> = std::fs::read_dir(&folder)
         .expect("the recordings") // ok: test
         .filter_map(|e| e.ok().map(|e| e.path()))
@@ -564,13 +565,13 @@ fn real_recordings_of_a_healthy_cage_give_no_rotor_fault() {
     assert_eq!(names.len(), 26);
     let mut failures = Vec::new();
     for path in names {
-        let open = sim_host::log::OpenOptions {
+        let open = monitor_io::log::OpenOptions {
             group: None,
             columns: columns.clone(),
         };
-        let file = sim_host::log::LogFile::open_with(&path, &open).expect("recording"); // ok: test
+        let file = monitor_io::log::LogFile::open_with(&path, &open).expect("recording"); // ok: test
         let rep =
-            sim_host::replay::diagnose_log(&params, &file, ReplayOptions::default(), &mut |_| {})
+            monitor_replay::diagnose_log(&params, &file, ReplayOptions::default(), &mut |_| {})
                 .expect("diagnose") // ok: test
                 .report;
         let r = rep.rotor;

@@ -9,10 +9,10 @@
 //! 7.5 kHz was refused ("filter corner out of range").
 
 use monitor_core::Fault;
+use monitor_io::params::ParamFile;
+use monitor_replay::{diagnose_rows, ReplayOptions, Verdict};
+use monitor_studies::fault_signatures::{run_case, scenario, Protocol};
 use rayon::prelude::*;
-use sim_host::fault_signatures::{run_case, scenario, Protocol};
-use sim_host::params::ParamFile;
-use sim_host::replay::{diagnose_rows, ReplayOptions, Verdict};
 
 const RATES_HZ: [f64; 7] = [1000.0, 1428.6, 2000.0, 5000.0, 10_000.0, 20_000.0, 50_000.0];
 
@@ -105,7 +105,7 @@ fn every_rate_keeps_a_healthy_run_quiet() {
                 ..Protocol::default()
             };
             let sc = scenario(None, &proto);
-            let rows = sim_host::sim::simulate_to_vec(p, &sc).expect("simulate");
+            let rows = monitor_sim::simulate_to_vec(p, &sc).expect("simulate");
             let opts = ReplayOptions {
                 commission: Some(proto.commission),
                 ..ReplayOptions::default()
@@ -113,7 +113,7 @@ fn every_rate_keeps_a_healthy_run_quiet() {
             let rep = diagnose_rows(p, sc.sensors.channels(), &rows, opts).expect("replay");
             let quiet = rep.verdict == Verdict::Healthy
                 && rep.first_detection_s.is_none()
-                && rep.commissioning.state == sim_host::replay::CommissioningOutcome::Learned
+                && rep.commissioning.state == monitor_replay::CommissioningOutcome::Learned
                 && rep.data_quality.trusted
                 && (rep.data_quality.sample_rate_hz / rate - 1.0).abs() < 1e-4;
             (!quiet).then(|| {

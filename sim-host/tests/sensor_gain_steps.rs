@@ -14,11 +14,11 @@
 mod small_motor;
 
 use monitor_core::Fault;
+use monitor_io::params::ParamFile;
+use monitor_replay::{DiagnoseReport, ReplayOptions, Verdict};
+use monitor_sim::{FaultSpec, Scenario, SensorSpec};
+use monitor_studies::experiment::simulate_and_replay;
 use rayon::prelude::*;
-use sim_host::experiment::simulate_and_replay;
-use sim_host::params::ParamFile;
-use sim_host::replay::{DiagnoseReport, ReplayOptions, Verdict};
-use sim_host::sim::{FaultSpec, Scenario, SensorSpec};
 
 fn motors() -> Vec<(&'static str, ParamFile)> {
     small_motor::three_motors()

@@ -6,10 +6,10 @@
 //! 11 kW machine the code was not developed on; the replay is not told the phase.
 
 use monitor_core::{Fault, Phase};
+use monitor_io::params::ParamFile;
+use monitor_replay::{diagnose_rows, DiagnoseReport, ReplayOptions};
+use monitor_sim::{simulate_to_vec, EffectSpec, FaultSpec, Scenario, SensorSpec};
 use rayon::prelude::*;
-use sim_host::params::ParamFile;
-use sim_host::replay::{diagnose_rows, DiagnoseReport, ReplayOptions};
-use sim_host::sim::{simulate_to_vec, EffectSpec, FaultSpec, Scenario, SensorSpec};
 
 /// The parameter files: (name, file, commissioning window, fault time).
 fn motors() -> Vec<(&'static str, ParamFile, (f64, f64), f64)> {
@@ -136,7 +136,7 @@ fn current_only_1khz_names_the_sensor_not_a_winding() {
         f.phase = Some(Phase::C);
         sc.faults.push(f);
         let rows = simulate_to_vec(&p, &sc).expect("simulate"); // ok: test
-        let currents_only = sim_host::log::Channels {
+        let currents_only = monitor_io::log::Channels {
             voltages: false,
             speed: false,
             encoder: false,

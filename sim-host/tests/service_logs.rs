@@ -8,7 +8,7 @@
 //! runner-up) with its size within 25 %, in at least 90 % of the cases; no other name (a
 //! wrong fault, or the friction class b/bl) is ever given; the healthy logs name nothing.
 //!
-//! Each log is 52 s at 5 kHz ([`sim_host::service_profile::moving_load`]: the load steps
+//! Each log is 52 s at 5 kHz ([`monitor_studies::service_profile::moving_load`]: the load steps
 //! every 4 s, commissioned 2-24 s over five levels, 0.7 to 1.3 x Bl, the fault at 26 s,
 //! then six more levels drawn from the seed). The seeds are the case's index plus 900 (not
 //! tuned on). The whole table (51 logs, about 10 s on two cores in the test profile) runs
@@ -18,12 +18,12 @@
 //! with their size, no wrong name, the healthy logs name nothing.
 
 use monitor_core::Fault;
+use monitor_io::params::ParamFile;
+use monitor_replay::{IsolationEvent, IsolationName, NameGiven, ReplayOptions};
+use monitor_sim::FaultSpec;
+use monitor_studies::experiment::simulate_and_replay;
+use monitor_studies::service_profile::{moving_load, MOVING_COMMISSION};
 use rayon::prelude::*;
-use sim_host::experiment::simulate_and_replay;
-use sim_host::params::ParamFile;
-use sim_host::replay::{IsolationEvent, IsolationName, NameGiven, ReplayOptions};
-use sim_host::service_profile::{moving_load, MOVING_COMMISSION};
-use sim_host::sim::FaultSpec;
 use std::f64::consts::TAU;
 
 /// Length of a service log [s] and its sample rate [Hz].
@@ -341,11 +341,11 @@ fn an_hour_with_load_steps_and_a_rotor_fault_at_50_min() {
         return;
     }
     let p = ParamFile::reference_2p2kw();
-    let mut sc = sim_host::sim::Scenario::steady(3600.0, 2000.0);
-    sc.sensors = sim_host::sim::SensorSpec::default();
+    let mut sc = monitor_sim::Scenario::steady(3600.0, 2000.0);
+    sc.sensors = monitor_sim::SensorSpec::default();
     sc.seed = 77;
     sc.load.steps = [(600.0, 0.7), (1500.0, 1.2), (2400.0, 0.9)]
-        .map(|(t_s, k)| sim_host::sim::LoadStep {
+        .map(|(t_s, k)| monitor_sim::LoadStep {
             t_s,
             torque_nm: None,
             bl_scale: Some(k),

@@ -3,9 +3,9 @@
 //! the supply, torque balances of the friction laws.
 
 use monitor_core::{EffectKind, Fault};
-use sim_host::params::ParamFile;
-use sim_host::sim::{
-    self, EffectSpec, FaultSpec, LoadKind, Scenario, SensorSpec, SteadyLoad, Truth,
+use monitor_io::params::ParamFile;
+use monitor_sim::{
+    self as sim, EffectSpec, FaultSpec, LoadKind, Scenario, SensorSpec, SteadyLoad, Truth,
 };
 
 fn run(p: &ParamFile, sc: &Scenario) -> Vec<Truth> {

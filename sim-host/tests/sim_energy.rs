@@ -3,8 +3,8 @@
 //! direct-on-line start (large transients), with dW/dt by fourth-order central differences (20 kHz).
 
 use monitor_core::{EffectKind, Phase};
-use sim_host::params::ParamFile;
-use sim_host::sim::{self, EffectSpec, Scenario, Truth};
+use monitor_io::params::ParamFile;
+use monitor_sim::{self as sim, EffectSpec, Scenario, Truth};
 
 fn balance(p: &ParamFile, effects: Vec<EffectSpec>) -> f64 {
     let rate = 20_000.0;

@@ -1,9 +1,9 @@
 //! Scenario files: the examples parse and run; bad keys are named; the CLI writes a CSV in
 //! the log schema (`docs/design.md`) and refuses to overwrite an input.
 
-use sim_host::log::Log;
-use sim_host::params::ParamFile;
-use sim_host::sim::{self, Scenario};
+use monitor_io::log::Log;
+use monitor_io::params::ParamFile;
+use monitor_sim::{self as sim, Scenario};
 use std::path::PathBuf;
 
 fn examples() -> PathBuf {

@@ -2,9 +2,9 @@
 
 use monitor_core::Fault;
 use monitor_core::Phase;
-use sim_host::log::Row;
-use sim_host::params::ParamFile;
-use sim_host::sim::{self, FaultSpec, Scenario, SensorFaultMode, SensorSpec};
+use monitor_io::log::Row;
+use monitor_io::params::ParamFile;
+use monitor_sim::{self as sim, FaultSpec, Scenario, SensorFaultMode, SensorSpec};
 
 fn pair(sensors: SensorSpec, faults: Vec<FaultSpec>, seed: u64) -> (Vec<Row>, Vec<Row>) {
     let p = ParamFile::reference_2p2kw();

@@ -1,8 +1,8 @@
 //! The simulator against the analytic steady state of the T-equivalent circuit
 //! (stator current RMS, torque, slip) for both reference motors at no load and full load.
 
-use sim_host::params::ParamFile;
-use sim_host::sim::{self, LoadKind, LoadStep, Scenario, SteadyLoad};
+use monitor_io::params::ParamFile;
+use monitor_sim::{self as sim, LoadKind, LoadStep, Scenario, SteadyLoad};
 
 /// Runs `duration_s` with a torque load stepped to `torque_nm` at 0.3 s and returns
 /// (phase current RMS, mean torque, mean slip) over the last `cycles` supply cycles.

@@ -9,8 +9,8 @@
 //! r4 still names B/Bl at distance one).
 
 use monitor_core::{Fault, ROTOR_FLUX_SIGNATURES, TABLE1};
-use sim_host::fault_signatures::{run_all, Protocol};
-use sim_host::params::ParamFile;
+use monitor_io::params::ParamFile;
+use monitor_studies::fault_signatures::{run_all, Protocol};
 
 #[test]
 fn table1_end_to_end_matches_the_physics_for_every_fault_and_sign() {
@@ -58,14 +58,14 @@ fn healthy_run_lights_nothing_in_the_table1_protocol() {
     // The same protocol without a fault: no lamp, no candidate.
     let p = ParamFile::reference_3hp();
     let proto = Protocol::default();
-    let sc = sim_host::fault_signatures::scenario(None, &proto);
-    let rows = sim_host::sim::simulate_to_vec(&p, &sc).expect("simulate");
-    let opts = sim_host::replay::ReplayOptions {
+    let sc = monitor_studies::fault_signatures::scenario(None, &proto);
+    let rows = monitor_sim::simulate_to_vec(&p, &sc).expect("simulate");
+    let opts = monitor_replay::ReplayOptions {
         commission: Some(proto.commission),
         ..Default::default()
     };
     let rep =
-        sim_host::replay::diagnose_rows(&p, sc.sensors.channels(), &rows, opts).expect("replay");
+        monitor_replay::diagnose_rows(&p, sc.sensors.channels(), &rows, opts).expect("replay");
     assert!(rep.lamps.values().all(|l| !l), "{:?}", rep.lamps);
     assert!(rep.candidates.is_empty());
     assert_eq!(rep.first_detection_s, None);

@@ -1,6 +1,6 @@
 //! A log with a winding-temperature channel (`t_winding_c`): the isolation compensates Rs
 //! and Rr with the measured rise since commissioning (copper 0.393 %/K) instead of inferring
-//! it from the residuals, and does not use a channel that lies (`sim_host::replay`,
+//! it from the residuals, and does not use a channel that lies (`monitor_replay`,
 //! "Heating is not a fault" in docs/isolation.md).
 //!
 //! The motors (the 3 hp and 2.2 kW reference motors and a 0.37 kW machine) are commissioned
@@ -24,11 +24,11 @@
 mod small_motor;
 
 use monitor_core::Fault;
+use monitor_io::log::{ChannelUnit, Column, ColumnMapping, LogFile, OpenOptions, Row};
+use monitor_io::params::ParamFile;
+use monitor_replay::{DiagnoseReport, IsolationName, Verdict};
+use monitor_sim::{Scenario, SensorSpec, TemperatureSpec};
 use rayon::prelude::*;
-use sim_host::log::{ChannelUnit, Column, ColumnMapping, LogFile, OpenOptions, Row};
-use sim_host::params::ParamFile;
-use sim_host::replay::{DiagnoseReport, IsolationName, Verdict};
-use sim_host::sim::{Scenario, SensorSpec, TemperatureSpec};
 
 /// Copper's temperature coefficient [1/K] (IEC 60228).
 const ALPHA: f64 = 0.00393;
@@ -327,7 +327,7 @@ fn the_column_is_read_in_the_daqs_units() {
 /// was (its noise has a stream of its own).
 #[test]
 fn the_simulated_channel_is_a_slow_probe_and_leaves_the_other_columns_alone() {
-    use sim_host::sim::{simulate, EffectSpec};
+    use monitor_sim::{simulate, EffectSpec};
     let p = ParamFile::reference_2p2kw();
     let rows = |probe: Option<TemperatureSpec>| {
         let mut sc = Scenario::steady(10.0, 2000.0);

@@ -6,12 +6,12 @@
 //! 1 % gain mismatch of two current sensors.
 
 use monitor_core::Phase;
-use rayon::prelude::*;
-use sim_host::params::ParamFile;
-use sim_host::replay::{diagnose_rows, HealthyReference, ReplayOptions, UnbalanceReport};
-use sim_host::sim::{
+use monitor_io::params::ParamFile;
+use monitor_replay::{diagnose_rows, HealthyReference, ReplayOptions, UnbalanceReport};
+use monitor_sim::{
     simulate_to_vec, simulate_with_truth, EffectSpec, LoadKind, LoadSpec, Scenario, SensorSpec,
 };
+use rayon::prelude::*;
 use std::f64::consts::{PI, TAU};
 
 /// A made-up 11 kW, 400 V, 50 Hz, 4-pole machine with textbook per-unit values (the
@@ -33,7 +33,7 @@ fn motors() -> [(ParamFile, f64, &'static str); 3] {
     ]
 }
 
-type C = sim_host::analysis::prep::C64;
+type C = monitor_analysis::prep::C64;
 
 /// The T-equivalent circuit's impedance per phase at slip `s` (textbook).
 fn z_t(p: &ParamFile, we: f64, s: f64) -> C {
@@ -138,7 +138,7 @@ struct Case {
     shaft: bool,
 }
 
-fn record(p: &ParamFile, c: &Case) -> (Vec<sim_host::log::Row>, SensorSpec) {
+fn record(p: &ParamFile, c: &Case) -> (Vec<monitor_io::log::Row>, SensorSpec) {
     let mut sc = Scenario::steady(4.0, c.rate_hz);
     sc.seed = c.seed;
     sc.sensors = SensorSpec {
@@ -153,7 +153,7 @@ fn record(p: &ParamFile, c: &Case) -> (Vec<sim_host::log::Row>, SensorSpec) {
         kind: LoadKind::Torque,
         torque_nm: Some(0.0),
         bl_nms: None,
-        steps: vec![sim_host::sim::LoadStep {
+        steps: vec![monitor_sim::LoadStep {
             t_s: 0.3,
             torque_nm: Some(c.load_nm),
             bl_scale: None,
@@ -175,7 +175,7 @@ fn record(p: &ParamFile, c: &Case) -> (Vec<sim_host::log::Row>, SensorSpec) {
     for (phase, g) in [Phase::A, Phase::B].into_iter().zip(c.gains) {
         if g != 0.0 {
             let mut f =
-                sim_host::sim::FaultSpec::sensor_gain(monitor_core::Fault::CurrentSensor, 0.0, g);
+                monitor_sim::FaultSpec::sensor_gain(monitor_core::Fault::CurrentSensor, 0.0, g);
             f.phase = Some(phase);
             sc.faults.push(f);
         }
@@ -357,7 +357,7 @@ fn the_monitor_the_board_runs_names_the_phase_on_an_unbalanced_supply() {
     // motors, 10 kHz with the shaft measured (the board's inputs): the right phase or none,
     // and healthy motors on that supply: none.
     use monitor_core::Monitor;
-    use sim_host::replay::{monitor_config_for_log, LogSampler};
+    use monitor_replay::{monitor_config_for_log, LogSampler};
     let mut failures = Vec::new();
     let mut named = 0;
     for (p, rated, name) in motors() {

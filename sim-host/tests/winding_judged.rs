@@ -17,10 +17,10 @@
 //! reading that moves with the load.
 
 use monitor_core::Phase;
-use sim_host::log::Row;
-use sim_host::params::ParamFile;
-use sim_host::replay::{diagnose_rows, Against, HealthyReference, ReplayOptions, UnbalanceReport};
-use sim_host::sim::{
+use monitor_io::log::Row;
+use monitor_io::params::ParamFile;
+use monitor_replay::{diagnose_rows, Against, HealthyReference, ReplayOptions, UnbalanceReport};
+use monitor_sim::{
     simulate_to_vec, EffectSpec, FaultSpec, LoadKind, LoadSpec, Scenario, SensorSpec,
 };
 
@@ -50,7 +50,7 @@ fn log(p: &ParamFile, run: &Run) -> Vec<Row> {
         kind: LoadKind::Torque,
         torque_nm: Some(0.0),
         bl_nms: None,
-        steps: vec![sim_host::sim::LoadStep {
+        steps: vec![monitor_sim::LoadStep {
             t_s: 0.3,
             torque_nm: Some(load_nm),
             bl_scale: None,

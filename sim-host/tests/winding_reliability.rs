@@ -15,16 +15,16 @@
 //! `MONITOR_FULL_SWEEPS=1` draws four times as many simulated logs.
 
 use monitor_core::Phase;
-use rayon::prelude::*;
-use sim_host::log::mapping::load_params;
-use sim_host::log::{LogFile, OpenOptions, Row};
-use sim_host::params::ParamFile;
-use sim_host::replay::{
+use monitor_io::log::mapping::load_params;
+use monitor_io::log::{LogFile, OpenOptions, Row};
+use monitor_io::params::ParamFile;
+use monitor_replay::{
     diagnose_log, diagnose_rows, HealthyReference, ReplayOptions, UnbalanceReport,
 };
-use sim_host::sim::{
+use monitor_sim::{
     simulate_to_vec, EffectSpec, FaultSpec, LoadKind, LoadSpec, Scenario, SensorSpec,
 };
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// One judgement: the most probable phase's probability, whether the report names it
@@ -238,7 +238,7 @@ fn simulate(
         kind: LoadKind::Torque,
         torque_nm: Some(0.0),
         bl_nms: None,
-        steps: vec![sim_host::sim::LoadStep {
+        steps: vec![monitor_sim::LoadStep {
             t_s: 0.3,
             torque_nm: Some(load * rated),
             bl_scale: None,

@@ -115,7 +115,8 @@ pub fn panel_input(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::panel::{read_blink_code, render, Lamp};
+    use crate::board::Lamp;
+    use crate::panel::{read_blink_code, render};
 
     /// An isolation that names `fault` with probability `p` and a change of `change` (the
     /// rest unknown).

@@ -13,9 +13,9 @@ use super::*;
 use drive_monitor::app::isolation_summary;
 use monitor_core::motor_record::MotorRecord;
 use monitor_core::reference::MOTOR_3HP;
-use sim_host::experiment::simulate_and_replay;
-use sim_host::replay::{IsolationName, ReplayOptions};
-use sim_host::sim::SensorSpec;
+use monitor_replay::{IsolationName, ReplayOptions};
+use monitor_sim::SensorSpec;
+use monitor_studies::experiment::simulate_and_replay;
 
 /// The 3 hp machine as a motor record: the board's front end with a 25 A current full
 /// scale (its rated current is about 12 A peak) and the board's encoder.

@@ -28,21 +28,22 @@ use drive_monitor::app::{
     carry_out, panel_input, MonitorStatus, SamplePath, Settings, Supervisor, Tick, PANEL_PERIOD_MS,
     WATCHDOG_TIMEOUT_MS,
 };
+use drive_monitor::board::Lamp;
 use drive_monitor::board::{self, RECORD_PAGE_SIZE};
 use drive_monitor::boot;
 use drive_monitor::commissioning::{Failure, RunEnd};
 use drive_monitor::flash_record::{self, CalibrationRecord, RecordStore, RECORD_LEN};
 use drive_monitor::liveness::AdcWait;
 use drive_monitor::offset_trim::TrimResult;
-use drive_monitor::panel::{self, Lamp, Mode, PanelLamps};
+use drive_monitor::panel::{self, Mode, PanelLamps};
 use drive_monitor::recovery::{Faults, StepTimeout};
 use drive_monitor::reset_record::{
     PreviousRun, ResetCause, ResetRecord, ResetSource, RESET_RECORD_LEN,
 };
 use drive_monitor::sampling::RawFrame;
 use monitor_core::{Abc, Calibration, CommissioningFailure, Fault, RunStage};
-use sim_host::params::ParamFile;
-use sim_host::sim::{simulate_to_vec, FaultSpec, LoadStep, Scenario};
+use monitor_io::params::ParamFile;
+use monitor_sim::{simulate_to_vec, FaultSpec, LoadStep, Scenario};
 
 const FS: u32 = board::DEFAULT_SAMPLE_RATE_HZ;
 const PERIODS_PER_MS: u64 = FS as u64 / 1000;

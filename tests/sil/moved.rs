@@ -53,7 +53,7 @@ fn a_load_step_with_no_fault_is_the_moved_state_not_a_fault() {
         "moved in {moved} of {} ticks after the step; range {:?}, point {:?}",
         after.len(),
         rig.supervisor.range().commissioned(),
-        drive_monitor::range_watch::RangeWatch::point(&rig.last().status)
+        rig.last().status.operating_point()
     );
     assert!(
         rig.seen

@@ -1,13 +1,13 @@
 //! The same state for the same log (issue "One verdict from all the evidence"): the board's
 //! sample path and panel (this rig) and the host's replay (`diagnose`'s timeline and the
-//! HMI's panel, `sim_host::replay::Replay::panel`) run one simulated log, commissioned over
+//! HMI's panel, `monitor_replay::Replay::panel`) run one simulated log, commissioned over
 //! the same stretch, with load steps of +10 % and +40 % and a fault; at every half second
 //! away from the changes they show the same verdict (`call=` on the board, the panel's call
 //! on the host), the FAULT lamp lit on both or neither, and a load step is never a FAULT.
 
 use super::*;
 use monitor_core::verdict::Verdict;
-use sim_host::replay::{diagnose_rows, MonitorState, ReplayOptions};
+use monitor_replay::{diagnose_rows, MonitorState, ReplayOptions};
 
 /// Seconds after a change (a load step, the fault) in which the two may still differ: the
 /// board's statuses come every 100 samples and its isolation every 0.1 s, the host's every

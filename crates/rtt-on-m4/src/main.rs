@@ -38,8 +38,8 @@
 #![no_std]
 #![no_main]
 
-#[macro_use]
-mod semihosting;
+use qemu_semihosting as semihosting;
+use qemu_semihosting::println;
 mod hw;
 
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering::Relaxed};

@@ -1,9 +1,9 @@
 //! What the long-log benchmarks share (`analysis`, `diagnose`): the 1 h, 10 kHz log they
 //! read, and the figures of the machine they run on (load average, CPU time from `/proc`).
 
-use sim_host::log::{Channels, LogWriter};
-use sim_host::params::ParamFile;
-use sim_host::sim::{self, EffectSpec, Scenario, SensorSpec};
+use monitor_io::log::{Channels, LogWriter};
+use monitor_io::params::ParamFile;
+use monitor_sim::{self as sim, EffectSpec, Scenario, SensorSpec};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 

@@ -1,6 +1,6 @@
 //! `sim-host bench`: the performance figures (`docs/performance.md`), measured on this machine
-//! ([`sim_host::bench`]); with `--isolation`, the isolation's bench
-//! ([`sim_host::bench::isolation`]).
+//! ([`monitor_studies::bench`]); with `--isolation`, the isolation's bench
+//! ([`monitor_studies::bench::isolation`]).
 
 use super::{output_guard::OutputGuard, progress, render};
 use clap::Args;
@@ -59,10 +59,10 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     if args.isolation {
         return run_isolation(args);
     }
-    let figures = sim_host::bench::measure(args.repeat)?;
+    let figures = monitor_studies::bench::measure(args.repeat)?;
     let limits = if args.detection {
         let bar = progress::bar(36, "detection limits", true);
-        let l = sim_host::bench::detection_limits(&|| bar.inc(1))?;
+        let l = monitor_studies::bench::detection_limits(&|| bar.inc(1))?;
         bar.finish_and_clear();
         Some(l)
     } else {
@@ -80,7 +80,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
 
 /// `bench --isolation`.
 fn run_isolation(args: &BenchArgs) -> anyhow::Result<()> {
-    use sim_host::bench::isolation::{run, BenchPlan};
+    use monitor_studies::bench::isolation::{run, BenchPlan};
     if let Some(dir) = &args.plot {
         OutputGuard::new(&[]).check_folder(dir, &[CONFUSION_SVG.to_string()])?;
     }
@@ -93,7 +93,7 @@ fn run_isolation(args: &BenchArgs) -> anyhow::Result<()> {
             .map_err(|e| anyhow::anyhow!("cannot create the plot folder {}: {e}", dir.display()))?;
         let svg = render::plot::confusion_svg(&result.confusion).map_err(anyhow::Error::msg)?;
         let path = dir.join(CONFUSION_SVG);
-        sim_host::log::write_atomic(&path, svg.as_bytes())
+        monitor_io::log::write_atomic(&path, svg.as_bytes())
             .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
         eprintln!("wrote {}", path.display());
     }

@@ -1,10 +1,10 @@
 //! `sim-host compare` and `sim-host explain`: the paper's simplified model against a
-//! measurement log ([`sim_host::analysis`]).
+//! measurement log ([`monitor_analysis`]).
 
 use super::output_guard::OutputGuard;
 use super::{progress, render};
+use monitor_analysis::{Analysis, Options};
 use monitor_core::EffectKind;
-use sim_host::analysis::{Analysis, Options};
 use std::path::PathBuf;
 
 /// Options shared by `compare` and `explain`.
@@ -78,14 +78,14 @@ impl Common {
             .unwrap_or(false);
         let pb = progress::bar(progress::FRACTION_STEPS, "reading log", big);
         let req = self.request(None);
-        let a = sim_host::api::load_analysis(
-            sim_host::api::ParamsSource::Path(&self.params),
+        let a = monitor_api::load_analysis(
+            monitor_api::ParamsSource::Path(&self.params),
             &self.log,
             &req,
             &mut |f| progress::set_fraction(&pb, f),
         )
         .map_err(|e| match e.kind() {
-            sim_host::api::ErrorKind::Params | sim_host::api::ErrorKind::Option => {
+            monitor_api::ErrorKind::Params | monitor_api::ErrorKind::Option => {
                 anyhow::Error::new(e)
             }
             _ => anyhow::Error::new(e).context("cannot analyse the log"),
@@ -96,8 +96,8 @@ impl Common {
     }
 
     /// The library's request for these options.
-    fn request(&self, rotor_bars: Option<u32>) -> sim_host::api::AnalysisRequest {
-        sim_host::api::AnalysisRequest {
+    fn request(&self, rotor_bars: Option<u32>) -> monitor_api::AnalysisRequest {
+        monitor_api::AnalysisRequest {
             effects: self.effects.clone(),
             from_s: self.from,
             to_s: self.to,
@@ -225,8 +225,8 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
     c.check(&charts)?;
     let a = c.load()?;
     // The one verdict on the same log, which explain opens with.
-    let judged = sim_host::api::verdict_for_explain(
-        sim_host::api::ParamsSource::Path(&c.params),
+    let judged = monitor_api::verdict_for_explain(
+        monitor_api::ParamsSource::Path(&c.params),
         &c.log,
         c.group.clone(),
     );
@@ -251,8 +251,8 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
     let out = a.explain(&opts, &move |f| progress::set_fraction(&pbc, f))?;
     pb.finish_and_clear();
     // The motor current signature analysis, with the fitted rotor_asymmetry's delta.
-    let mcsa = sim_host::api::mcsa_beside(&a, &out.report, args.rotor_bars);
-    let doc = sim_host::api::ExplainDocument::new(judged.as_ref(), out.report, mcsa);
+    let mcsa = monitor_api::mcsa_beside(&a, &out.report, args.rotor_bars);
+    let doc = monitor_api::ExplainDocument::new(judged.as_ref(), out.report, mcsa);
     render::html::write_explain(
         c.plot.as_deref(),
         c.report.as_deref(),

@@ -1,4 +1,4 @@
-//! `sim-host demo`: the main job in a few seconds ([`sim_host::demo`]).
+//! `sim-host demo`: the main job in a few seconds ([`monitor_studies::demo`]).
 
 use super::render;
 use clap::Args;
@@ -53,7 +53,7 @@ fn parse_change(s: &str) -> Result<f64, String> {
 /// # Errors
 /// Simulator errors (not expected for the reference motor) or an I/O error on stdout.
 pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
-    use sim_host::demo::Story;
+    use monitor_studies::demo::Story;
     let story = if args.paper {
         Story::Paper {
             fault: args.fault.unwrap_or(Fault::Bl),
@@ -65,7 +65,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
             change: args.change,
         }
     };
-    let run = sim_host::demo::run(story)?;
+    let run = monitor_studies::demo::run(story)?;
     if args.json {
         render::json::print(&render::json::demo(&run))
     } else {

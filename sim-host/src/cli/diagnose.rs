@@ -1,4 +1,4 @@
-//! `sim-host diagnose`: replay a log through the core ([`sim_host::replay::diagnose_file`])
+//! `sim-host diagnose`: replay a log through the core ([`monitor_replay::diagnose_file`])
 //! and report lamps, candidates and the negative-sequence analysis.
 
 use super::{progress, render, AngleArg, LoadArg, ResidualArg};
@@ -110,7 +110,7 @@ pub struct DiagnoseArgs {
 pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
     // (Read once here for the swapped-arguments message.)
     super::load_params_for(&args.params, &args.log)?;
-    let req = sim_host::api::DiagnoseRequest {
+    let req = monitor_api::DiagnoseRequest {
         commission: args.commission,
         allow_incomplete: args.allow_incomplete,
         baseline: args.baseline.clone(),
@@ -124,8 +124,8 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         .map(|m| m.len() > 20_000_000)
         .unwrap_or(false);
     let bar = progress::bar(progress::FRACTION_STEPS, "reading log", big);
-    let d = sim_host::api::diagnose(
-        sim_host::api::ParamsSource::Path(&args.params),
+    let d = monitor_api::diagnose(
+        monitor_api::ParamsSource::Path(&args.params),
         &args.log,
         &req,
         &mut |f| progress::set_fraction(&bar, f),

@@ -1,4 +1,4 @@
-//! `sim-host fleet`: many motors' logs judged on one machine ([`sim_host::fleet`]), one row
+//! `sim-host fleet`: many motors' logs judged on one machine ([`monitor_api::fleet`]), one row
 //! per log, as CSV or JSON: the same table the Python package's Dask run returns.
 
 use super::render;
@@ -39,16 +39,16 @@ pub struct FleetArgs {
 /// A motor table that cannot be read, or an error writing to standard output (a log's own
 /// error is its row's).
 pub fn run(args: &FleetArgs) -> anyhow::Result<()> {
-    let table = sim_host::fleet::MotorTable::load(&args.motors)?;
-    let rows: Vec<sim_host::fleet::FleetRow> = args
+    let table = monitor_api::fleet::MotorTable::load(&args.motors)?;
+    let rows: Vec<monitor_api::fleet::FleetRow> = args
         .logs
         .par_iter()
-        .map(|log| sim_host::fleet::row(&table, log))
+        .map(|log| monitor_api::fleet::row(&table, log))
         .collect();
     if args.json {
         return render::json::print(&rows);
     }
-    // (The header comes from the rows' field names: sim_host::fleet::COLUMNS.)
+    // (The header comes from the rows' field names: monitor_api::fleet::COLUMNS.)
     let mut w = csv::Writer::from_writer(super::stdout());
     for r in &rows {
         w.serialize(r)?;

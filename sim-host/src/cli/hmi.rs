@@ -7,12 +7,12 @@ use super::render::hmi::render;
 use super::{AngleArg, ResidualArg};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
+use monitor_replay::ReplayOptions;
 use ratatui::crossterm::event::{self, Event, KeyCode, KeyEventKind, KeyModifiers};
 use sim_host::hmi::live::LiveSim;
 use sim_host::hmi::log_replay::LogReplay;
 use sim_host::hmi::status_line::StdinStatus;
 use sim_host::hmi::{key_help, HmiState, Key, Source, Speed};
-use sim_host::replay::ReplayOptions;
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -116,7 +116,7 @@ pub fn run(args: &HmiArgs) -> anyhow::Result<()> {
     let loaded = args
         .params
         .as_deref()
-        .map(sim_host::log::mapping::load_params)
+        .map(monitor_io::log::mapping::load_params)
         .transpose()?;
     let (params, columns) = match loaded {
         Some((p, c)) => (Some(p), c),
@@ -143,7 +143,7 @@ pub fn run(args: &HmiArgs) -> anyhow::Result<()> {
         } else {
             args.speed.into()
         };
-        let open = sim_host::log::OpenOptions {
+        let open = monitor_io::log::OpenOptions {
             columns,
             ..Default::default()
         };
@@ -151,7 +151,7 @@ pub fn run(args: &HmiArgs) -> anyhow::Result<()> {
     } else if let Some(p) = params {
         Box::new(LiveSim::new(
             p,
-            sim_host::fault_signatures::Protocol::default().sample_rate_hz,
+            monitor_studies::fault_signatures::Protocol::default().sample_rate_hz,
         )?)
     } else {
         Box::new(LiveSim::demo_motor()?)

@@ -1,11 +1,11 @@
 //! `sim-host identify`: the T-equivalent circuit and the mechanics from a log of the
-//! healthy machine (`sim_host::identify`), starting from a parameter file; the result
+//! healthy machine (`monitor_analysis::identify`), starting from a parameter file; the result
 //! written atomically, never over an input, nor over an existing file without `--force`.
 
 use super::output_guard::OutputGuard;
 use super::progress;
 use clap::Args;
-use sim_host::identify::{self, Identification};
+use monitor_analysis::identify::{self, Identification};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -93,8 +93,8 @@ pub fn run(args: &IdentifyArgs) -> anyhow::Result<()> {
     // (Read once here for the swapped-arguments message.)
     super::load_params_for(&args.params, &args.log)?;
     let pb = progress::bar(progress::FRACTION_STEPS, "identify", true);
-    let done = sim_host::api::identify(
-        sim_host::api::ParamsSource::Path(&args.params),
+    let done = monitor_api::identify(
+        monitor_api::ParamsSource::Path(&args.params),
         &args.log,
         args.from,
         args.to,
@@ -102,7 +102,7 @@ pub fn run(args: &IdentifyArgs) -> anyhow::Result<()> {
         &mut |f| progress::set_fraction(&pb, f),
     );
     pb.finish_and_clear();
-    let sim_host::api::Identified {
+    let monitor_api::Identified {
         identification: id,
         toml,
     } = done?;

@@ -135,11 +135,11 @@ pub enum LoadArg {
     Viscous,
 }
 
-impl From<LoadArg> for sim_host::replay::LoadModel {
+impl From<LoadArg> for monitor_replay::LoadModel {
     fn from(a: LoadArg) -> Self {
         match a {
-            LoadArg::Unknown => sim_host::replay::LoadModel::Unknown,
-            LoadArg::Viscous => sim_host::replay::LoadModel::Viscous,
+            LoadArg::Unknown => monitor_replay::LoadModel::Unknown,
+            LoadArg::Viscous => monitor_replay::LoadModel::Viscous,
         }
     }
 }
@@ -172,7 +172,7 @@ pub fn parse_fault(s: &str) -> Result<Fault, String> {
 
 /// Parses an effect name of the library.
 pub fn parse_effect(s: &str) -> Result<EffectKind, String> {
-    sim_host::analysis::parse_effect(s.trim()).map_err(|e| e.to_string())
+    monitor_analysis::parse_effect(s.trim()).map_err(|e| e.to_string())
 }
 
 /// A time on the command line [s]: a finite number >= 0 (negative values reach this
@@ -218,7 +218,7 @@ pub fn parse_window(s: &str) -> Result<(f64, f64), String> {
 }
 
 /// Reads the parameter file `params` and its `[columns]` mapping for the log `log`
-/// (`sim_host::log::mapping::load_params`). When it cannot be read as a parameter file and
+/// (`monitor_io::log::mapping::load_params`). When it cannot be read as a parameter file and
 /// the two look swapped (the parameter file named like a log, the log like a TOML file), the
 /// one-line error says so.
 ///
@@ -227,14 +227,17 @@ pub fn parse_window(s: &str) -> Result<(f64, f64), String> {
 pub fn load_params_for(
     params: &std::path::Path,
     log: &std::path::Path,
-) -> anyhow::Result<(sim_host::params::ParamFile, sim_host::log::ColumnMapping)> {
+) -> anyhow::Result<(
+    monitor_io::params::ParamFile,
+    monitor_io::log::ColumnMapping,
+)> {
     let ext = |p: &std::path::Path| {
         p.extension()
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase)
             .unwrap_or_default()
     };
-    sim_host::log::mapping::load_params(params).map_err(|e| {
+    monitor_io::log::mapping::load_params(params).map_err(|e| {
         let looks_log = ["csv", "tdms", "parquet"].contains(&ext(params).as_str());
         if looks_log || ext(log) == "toml" {
             anyhow::anyhow!(
@@ -259,7 +262,7 @@ pub fn load_params_for(
 /// "writing PATH" with the I/O error.
 pub fn write_out(out: Option<&std::path::Path>, bytes: &[u8]) -> anyhow::Result<()> {
     if let Some(out) = out {
-        anyhow::Context::with_context(sim_host::log::write_atomic(out, bytes), || {
+        anyhow::Context::with_context(monitor_io::log::write_atomic(out, bytes), || {
             format!("writing {}", out.display())
         })?;
     }

@@ -1,10 +1,10 @@
 //! `sim-host params ...`: commands that make a parameter file. `params from-nameplate`
-//! estimates one from a motor's nameplate (`sim_host::nameplate`); the output is written
+//! estimates one from a motor's nameplate (`monitor_io::nameplate`); the output is written
 //! atomically and never over an existing file unless `--force`.
 
 use super::output_guard::OutputGuard;
 use clap::{Args, Subcommand, ValueEnum};
-use sim_host::nameplate::{Connection, Nameplate, NemaDesign};
+use monitor_io::nameplate::{Connection, Nameplate, NemaDesign};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -181,11 +181,11 @@ pub fn run_from_nameplate(args: &FromNameplateArgs) -> anyhow::Result<()> {
         OutputGuard::new(&[]).check_new_file(out, args.force)?;
     }
     let (estimate, toml) =
-        sim_host::api::params_from_nameplate(&args.nameplate(), args.columns_from.as_deref())?;
+        monitor_api::params_from_nameplate(&args.nameplate(), args.columns_from.as_deref())?;
     super::write_out(args.out.as_deref(), toml.as_bytes())?;
     let mut stdout = super::stdout();
     if args.json {
-        let doc = sim_host::api::nameplate_document(&estimate, &toml, args.out.as_deref());
+        let doc = monitor_api::nameplate_document(&estimate, &toml, args.out.as_deref());
         writeln!(stdout, "{}", serde_json::to_string_pretty(&doc)?)?;
     } else if let Some(out) = &args.out {
         writeln!(stdout, "wrote {}", out.display())?;

@@ -1,10 +1,10 @@
 //! `sim-host table1`: reproduce the paper's Table 1 end to end
-//! ([`sim_host::fault_signatures`]).
+//! ([`monitor_studies::fault_signatures`]).
 
 use super::{progress, render, AngleArg};
 use clap::Args;
-use sim_host::fault_signatures::{run_all, Protocol};
-use sim_host::params::ParamFile;
+use monitor_io::params::ParamFile;
+use monitor_studies::fault_signatures::{run_all, Protocol};
 use std::path::PathBuf;
 
 /// Arguments of `table1`.

@@ -1,20 +1,20 @@
 //! The live simulation behind `sim-host hmi` (no arguments): the demo's motor (the
 //! 3 hp reference motor started direct-on-line with the paper's viscous load and 12-bit
-//! noisy sensors, [`crate::demo`]) simulated as it is watched, its sensor rows fed to the
+//! noisy sensors, [`monitor_studies::demo`]) simulated as it is watched, its sensor rows fed to the
 //! core row by row, with the paper's switches: each Table 1 fault on and off, load and
 //! supply steps, commissioning.
 //!
-//! The simulator ([`crate::sim::simulate_interactive`]) and the monitor run on a worker
+//! The simulator ([`monitor_sim::simulate_interactive`]) and the monitor run on a worker
 //! thread that advances exactly as many rows as [`LiveSim::run_for`] asks and answers
 //! with the readings ([`Snapshot`], every [`SNAPSHOT_EVERY_S`] of simulated time): the
 //! simulation is deterministic whatever the screen's pace, and tests drive it directly.
 
 use super::{quit_key, Controls, HmiState, Key, LiveControls, Snapshot, Source, SNAPSHOT_EVERY_S};
-use crate::fault_signatures::{scenario, Protocol};
-use crate::params::ParamFile;
-use crate::replay::{Replay, ReplayOptions};
-use crate::sim::{simulate_interactive, FaultSpec, LoadStep, ScenarioEvent, SupplyStep};
 use monitor_core::{CommissioningState, Fault, RunStage};
+use monitor_io::params::ParamFile;
+use monitor_replay::{Replay, ReplayOptions};
+use monitor_sim::{simulate_interactive, FaultSpec, LoadStep, ScenarioEvent, SupplyStep};
+use monitor_studies::fault_signatures::{scenario, Protocol};
 use std::ops::ControlFlow;
 use std::sync::mpsc::{channel, Receiver, Sender};
 use std::thread::JoinHandle;
@@ -55,7 +55,7 @@ pub struct LiveSim {
     sample_rate_hz: f64,
     tx: Option<Sender<Command>>,
     rx: Receiver<Reply>,
-    worker: Option<JoinHandle<Result<(), crate::sim::SimError>>>,
+    worker: Option<JoinHandle<Result<(), monitor_sim::SimError>>>,
     /// Simulated time [s] so far.
     t_s: f64,
     controls: LiveControls,
@@ -68,7 +68,7 @@ impl LiveSim {
     ///
     /// # Errors
     /// The core refuses the configuration (not expected for the reference motor).
-    pub fn demo_motor() -> Result<Self, crate::experiment::ExperimentError> {
+    pub fn demo_motor() -> Result<Self, monitor_studies::experiment::ExperimentError> {
         let mut live = Self::new(
             ParamFile::reference_3hp(),
             Protocol::default().sample_rate_hz,
@@ -85,7 +85,7 @@ impl LiveSim {
     pub fn new(
         params: ParamFile,
         sample_rate_hz: f64,
-    ) -> Result<Self, crate::experiment::ExperimentError> {
+    ) -> Result<Self, monitor_studies::experiment::ExperimentError> {
         // The replay's monitor and isolation, fed row by row; its timeline is not kept (a
         // live run has no end), commissioning starts on the `c` key.
         let opts = ReplayOptions {
@@ -93,10 +93,10 @@ impl LiveSim {
             // The load is an unknown input, as `diagnose` reads it by default: a load step
             // (`+`, `-`, the paper's Bl switch) is the load's move, the amber state, never a
             // FAULT (the simulated load itself is the paper's viscous one).
-            load: crate::replay::LoadModel::Unknown,
+            load: monitor_replay::LoadModel::Unknown,
             ..ReplayOptions::default()
         };
-        let channels = crate::sim::SensorSpec::default().channels();
+        let channels = monitor_sim::SensorSpec::default().channels();
         let replay = Replay::new(&params, channels, sample_rate_hz, opts)?;
         let (tx, cmd_rx) = channel();
         let (reply_tx, rx) = channel();
@@ -308,9 +308,9 @@ struct Worker {
 impl Worker {
     fn run(
         mut self,
-        sc: &crate::sim::Scenario,
+        sc: &monitor_sim::Scenario,
         rx: &Receiver<Command>,
-    ) -> Result<(), crate::sim::SimError> {
+    ) -> Result<(), monitor_sim::SimError> {
         let params = self.params;
         simulate_interactive(&params, sc, |row, events| {
             if self.wait_for_work(rx, events).is_break() {

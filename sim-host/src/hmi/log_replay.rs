@@ -1,6 +1,6 @@
 //! A log replayed on the HMI (`sim-host hmi LOG --params P`): the log goes through the
 //! one reader, the data-quality stage and the core exactly as `diagnose` replays it
-//! ([`crate::replay::diagnose_file_observed`]), on a worker thread that keeps a reading
+//! ([`monitor_replay::diagnose_file_observed`]), on a worker thread that keeps a reading
 //! every [`SNAPSHOT_EVERY_S`] of log time; the screen plays those readings back at 1x,
 //! 10x or as fast as they come, with pause and seek. The data-quality warnings and the
 //! verdict appear when the whole log is analysed.
@@ -9,10 +9,10 @@ use super::{
     quit_key, Controls, HmiState, Key, PlaybackControls, Snapshot, Source, Speed, HISTORY_S,
     SNAPSHOT_EVERY_S,
 };
-use crate::log::{LogFile, OpenOptions, Row};
-use crate::params::ParamFile;
-use crate::replay::{diagnose_file_observed, Replay, ReplayError, ReplayObserver, ReplayOptions};
 use monitor_core::MonitorOutput;
+use monitor_io::log::{LogFile, OpenOptions, Row};
+use monitor_io::params::ParamFile;
+use monitor_replay::{diagnose_file_observed, Replay, ReplayError, ReplayObserver, ReplayOptions};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::thread::JoinHandle;
@@ -162,7 +162,7 @@ fn analyse(
                 .and_then(|v| v.as_str().map(str::to_string));
             a.verdict = v;
         }
-        Err(e) => a.error = Some(crate::one_line(&e.to_string())),
+        Err(e) => a.error = Some(monitor_io::one_line(&e.to_string())),
     }
 }
 

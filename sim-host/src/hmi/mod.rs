@@ -6,7 +6,7 @@
 //!   Table 1 fault on and off (the paper's `Enable_F_*` switches), step the load and the
 //!   supply, and start commissioning;
 //! - [`log_replay::LogReplay`]: a log replayed through the data-quality stage and the core
-//!   ([`crate::replay::diagnose_file_observed`], the one reader: every format the reader
+//!   ([`monitor_replay::diagnose_file_observed`], the one reader: every format the reader
 //!   takes), played back at 1x, 10x or as fast as it is analysed, with pause and seek;
 //! - [`status_line::StdinStatus`]: the firmware's defmt status lines
 //!   (`cargo fw-run | sim-host hmi --stdin`), parsed by [`status_line::parse`].
@@ -21,12 +21,12 @@ pub mod status_line;
 
 pub use keys::{key_help, Key, KeyBinding, KeyScope, KEYS};
 
-use crate::demo::MonitorState;
-use crate::params::ParamFile;
-use crate::replay::{FaultCandidate, IsolationName, IsolationReport, Replay};
 use monitor_core::sequence::min_shorted_fraction;
 use monitor_core::verdict::Verdict;
 use monitor_core::{Fault, IsolationState, MonitorOutput, Phase};
+use monitor_io::params::ParamFile;
+use monitor_replay::{FaultCandidate, IsolationName, IsolationReport, Replay};
+use monitor_studies::demo::MonitorState;
 use std::collections::VecDeque;
 
 /// Seconds of residuals the strip chart shows.
@@ -63,7 +63,7 @@ pub struct Snapshot {
     /// source makes the call.
     pub fault_lamp: bool,
     /// The decision table's verdict at this moment (`monitor_core::verdict`): a replay's
-    /// panel ([`crate::replay::Replay::panel`]), the board's `call=`; `None` where the source
+    /// panel ([`monitor_replay::Replay::panel`]), the board's `call=`; `None` where the source
     /// gives none (the FAULT lamp is then the lamps' detection).
     pub call: Option<Verdict>,
     /// Threshold band of each residual in force, (centre, half-width).
@@ -93,7 +93,7 @@ pub struct Snapshot {
     pub isolation: Option<IsolationView>,
 }
 
-/// The isolation's conclusion as the screen shows it ([`crate::replay::IsolationReport`]).
+/// The isolation's conclusion as the screen shows it ([`monitor_replay::IsolationReport`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct IsolationView {
     /// The conclusion.
@@ -143,7 +143,9 @@ impl IsolationView {
     fn conclusion(&self) -> String {
         let sized = |n: IsolationName, x: Option<f32>| {
             let n = n.to_string();
-            x.map_or(n.clone(), |c| crate::fault_signatures::size_text(&n, c))
+            x.map_or(n.clone(), |c| {
+                monitor_studies::fault_signatures::size_text(&n, c)
+            })
         };
         let names = |n: usize, sep: &str| {
             self.candidates
@@ -438,7 +440,9 @@ pub fn header_of(
         (Some(iso), MonitorState::Fault(_)) => format!(
             "{} | {}",
             iso.text(),
-            crate::fault_signatures::signature_text(candidates.iter().map(|(f, p)| (*f, *p)))
+            monitor_studies::fault_signatures::signature_text(
+                candidates.iter().map(|(f, p)| (*f, *p))
+            )
         ),
         (Some(iso), MonitorState::Moved(note)) => format!("moved: {} | {note}", iso.text()),
         (Some(iso), _) => format!("{} | named: {}", state_text(state, candidates), iso.text()),
@@ -488,8 +492,9 @@ pub fn state_text(state: &MonitorState, candidates: &[(Fault, f32)]) -> String {
         MonitorState::Starting => "starting (settling)".to_string(),
         MonitorState::Healthy => "healthy".to_string(),
         MonitorState::Fault(_) => {
-            let sig =
-                crate::fault_signatures::signature_text(candidates.iter().map(|(f, p)| (*f, *p)));
+            let sig = monitor_studies::fault_signatures::signature_text(
+                candidates.iter().map(|(f, p)| (*f, *p)),
+            );
             format!("FAULT ({sig})")
         }
         MonitorState::Moved(note) => format!("operating point moved: {note}"),

@@ -20,10 +20,10 @@
 //! a level (`INFO`, `WARN`, `ERROR`) become events on the screen.
 
 use super::{quit_key, Controls, HmiState, Key, Snapshot, Source, StdinControls};
-use crate::demo::MonitorState;
-use crate::replay::{FaultCandidate, IsolationName};
 use monitor_core::verdict::Verdict;
 use monitor_core::{Fault, IsolationState};
+use monitor_replay::{FaultCandidate, IsolationName};
+use monitor_studies::demo::MonitorState;
 use std::io::BufRead;
 use std::sync::mpsc::{channel, Receiver, TryRecvError};
 

@@ -13,12 +13,12 @@
 //! ```
 #![allow(dead_code, missing_docs)]
 
+use monitor_analysis::{prep::ReadOptions, Analysis, Options};
 use monitor_core::EffectKind;
-use sim_host::analysis::{prep::ReadOptions, Analysis, Options};
-use sim_host::log::{Channels, Log};
-use sim_host::params::ParamFile;
-use sim_host::sim::{
-    self, EffectSpec, LoadKind, LoadSpec, LoadStep, Scenario, SensorSpec, SupplyStep,
+use monitor_io::log::{Channels, Log};
+use monitor_io::params::ParamFile;
+use monitor_sim::{
+    self as sim, EffectSpec, LoadKind, LoadSpec, LoadStep, Scenario, SensorSpec, SupplyStep,
 };
 use std::path::{Path, PathBuf};
 

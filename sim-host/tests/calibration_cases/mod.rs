@@ -4,11 +4,11 @@
 
 use super::small_motor;
 use monitor_core::{AngleSource, Fault};
+use monitor_io::params::ParamFile;
+use monitor_replay::{IsolationEvent, IsolationName, ReplayOptions};
+use monitor_sim::{EffectSpec, FaultSpec, LoadSpec, LoadStep, Scenario, SensorSpec};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use sim_host::params::ParamFile;
-use sim_host::replay::{IsolationEvent, IsolationName, ReplayOptions};
-use sim_host::sim::{EffectSpec, FaultSpec, LoadSpec, LoadStep, Scenario, SensorSpec};
 
 /// The three motors.
 pub fn motors() -> [(&'static str, ParamFile); 3] {
@@ -198,7 +198,7 @@ pub fn setup(c: &Case) -> (ParamFile, ParamFile, Scenario, ReplayOptions) {
 /// Simulates and replays case `c`, scored.
 pub fn run(c: Case) -> Outcome {
     let (truth, file, sc, opts) = setup(&c);
-    let r = sim_host::experiment::simulate_and_replay(&truth, &file, &sc, opts, |_, _| {})
+    let r = monitor_studies::experiment::simulate_and_replay(&truth, &file, &sc, opts, |_, _| {})
         .expect("runs")
         .finish();
     let want = right_name(c.fault);

@@ -2,7 +2,7 @@
 //! named and ordered its way, with an extra channel, time in ms (or ISO 8601 text, or a
 //! Parquet timestamp), currents in mA and speed in rpm, in CSV, TDMS and Parquet.
 
-use sim_host::log::Row;
+use monitor_io::log::Row;
 use std::f64::consts::TAU;
 use std::fmt::Write as _;
 use std::path::Path;

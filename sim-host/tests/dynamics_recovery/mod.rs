@@ -89,7 +89,7 @@ fn effect_parameters_are_recovered_through_transients() {
                 continue;
             }
             let mut s = transients(which, rate);
-            s.effects = vec![sim_host::sim::EffectSpec::with_defaults(kind)];
+            s.effects = vec![monitor_sim::EffectSpec::with_defaults(kind)];
             let log = write_log(
                 dir.path(),
                 &format!("{which}_{}", kind.name()),

@@ -3,9 +3,9 @@
 //! estimates from it.
 
 use monitor_core::{MotorParameters, SupplyParameters};
-use sim_host::nameplate::{estimate, Connection, Nameplate, NemaDesign};
-use sim_host::params::ParamFile;
-use sim_host::sim::steady_state_at;
+use monitor_io::nameplate::{estimate, Connection, Nameplate, NemaDesign};
+use monitor_io::params::ParamFile;
+use monitor_sim::steady_state_at;
 use std::f64::consts::TAU;
 
 /// A machine: name, rated kW, V_ll, Hz, [Rs, Rr, Lls, Llr, Lm] (ohm, H), J [kg m^2].

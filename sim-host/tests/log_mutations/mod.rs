@@ -3,8 +3,8 @@
 //! report about it.
 
 use super::f;
+use monitor_io::log::Row;
 use serde_json::Value;
-use sim_host::log::Row;
 
 /// Mutations of a clean log, each named, with what the data-quality stage must report.
 pub type Mutation = (&'static str, fn(&[Row]) -> Vec<Row>, fn(&Value) -> bool);

@@ -3,7 +3,7 @@
 //! published circuit), and the three motors as a list.
 
 use monitor_core::{MotorParameters, SupplyParameters};
-use sim_host::params::ParamFile;
+use monitor_io::params::ParamFile;
 use std::f64::consts::TAU;
 
 /// The 0.37 kW, 400 V, 50 Hz, 4-pole machine (Rs 30, Rr 24, Xls = Xlr 16, Xm 260 ohm at
@@ -51,10 +51,10 @@ pub fn three_motors() -> Vec<(&'static str, ParamFile)> {
 #[allow(dead_code)] // (not every test of the three motors warms them)
 pub fn replay_warming(
     p: &ParamFile,
-    sc: sim_host::sim::Scenario,
+    sc: monitor_sim::Scenario,
     (rise_k, tau_s): (f64, f64),
     fault: Option<(monitor_core::Fault, f64, f64)>,
-) -> sim_host::replay::DiagnoseReport {
+) -> monitor_replay::DiagnoseReport {
     replay_warming_from(p, sc, (rise_k, tau_s, 4.0), fault, (1.5, 3.5))
 }
 
@@ -62,12 +62,12 @@ pub fn replay_warming(
 #[allow(dead_code)] // (not every test of the three motors warms them)
 pub fn replay_warming_from(
     p: &ParamFile,
-    mut sc: sim_host::sim::Scenario,
+    mut sc: monitor_sim::Scenario,
     (rise_k, tau_s, at_s): (f64, f64, f64),
     fault: Option<(monitor_core::Fault, f64, f64)>,
     commission: (f64, f64),
-) -> sim_host::replay::DiagnoseReport {
-    use sim_host::sim::{EffectSpec, FaultSpec};
+) -> monitor_replay::DiagnoseReport {
+    use monitor_sim::{EffectSpec, FaultSpec};
     if rise_k > 0.0 {
         let toml = format!(
             "name = \"thermal_drift\"\nrise_k = {rise_k}\ntau_s = {tau_s}\nat_s = {at_s}\n"
@@ -78,11 +78,11 @@ pub fn replay_warming_from(
     if let Some((f, at_s, change)) = fault {
         sc.faults.push(FaultSpec::parametric(f, at_s, change));
     }
-    let opts = sim_host::replay::ReplayOptions {
+    let opts = monitor_replay::ReplayOptions {
         commission: Some(commission),
         ..Default::default()
     };
-    sim_host::experiment::simulate_and_replay(p, p, &sc, opts, |_, _| {})
+    monitor_studies::experiment::simulate_and_replay(p, p, &sc, opts, |_, _| {})
         .expect("runs")
         .finish()
 }

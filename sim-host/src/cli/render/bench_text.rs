@@ -2,9 +2,9 @@
 //! `bench --isolation`'s summaries and confusion matrix.
 
 use monitor_core::Fault;
-use sim_host::bench::isolation::{CaseResult, IsolationBench, IsolationConfusion, Outcome};
-use sim_host::bench::{BenchFigures, DetectionLimitCase, Spread};
-use sim_host::replay::{angle_source_name, state_name, IsolationName};
+use monitor_replay::{angle_source_name, state_name, IsolationName};
+use monitor_studies::bench::isolation::{CaseResult, IsolationBench, IsolationConfusion, Outcome};
+use monitor_studies::bench::{BenchFigures, DetectionLimitCase, Spread};
 use std::io::Write;
 
 /// A timing as "median (min-max)".

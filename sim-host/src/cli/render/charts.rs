@@ -1,10 +1,10 @@
 //! The chart sets of `compare` and `explain` (drawn and written by [`super::plot`]).
 
 use super::plot::{self, Chart, Series};
-use sim_host::analysis::compare::CompareOutput;
-use sim_host::analysis::metrics::{self, WorstWindow};
-use sim_host::analysis::prep::Prepared;
-use sim_host::analysis::simplified_model::Prediction;
+use monitor_analysis::compare::CompareOutput;
+use monitor_analysis::metrics::{self, WorstWindow};
+use monitor_analysis::prep::Prepared;
+use monitor_analysis::simplified_model::Prediction;
 
 /// The charts `compare` writes (file stems; each as `.svg` and `.png`; the zoomed panels
 /// only for a log long enough to be drawn as envelopes, a scatter only where the log spans

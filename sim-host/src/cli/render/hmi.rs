@@ -10,13 +10,13 @@
 //! the source's controls; warnings and events; keys
 //! ```
 
+use monitor_studies::demo::MonitorState;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::{Color, Modifier, Style};
 use ratatui::symbols::Marker;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Axis, Block, Borders, Chart, Dataset, GraphType, Paragraph};
 use ratatui::Frame;
-use sim_host::demo::MonitorState;
 use sim_host::hmi::{header_text, Controls, HmiState, KeyScope, Snapshot, HISTORY_S, KEYS};
 
 /// Colours of r1..r4 (lamps' labels, bars and chart).

@@ -5,13 +5,13 @@
 //! the PNG copies sit beside it for slides and tickets. Every file is written atomically.
 
 use super::{charts, plot};
+use monitor_analysis::compare::{CompareOutput, CompareReport};
+use monitor_analysis::simplified_model::Prediction;
+use monitor_analysis::Analysis;
+use monitor_api::ExplainDocument;
 use monitor_core::EffectKind;
+use monitor_io::log::quality::DataQuality;
 use plot::Chart;
-use sim_host::analysis::compare::{CompareOutput, CompareReport};
-use sim_host::analysis::simplified_model::Prediction;
-use sim_host::analysis::Analysis;
-use sim_host::api::ExplainDocument;
-use sim_host::log::quality::DataQuality;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -52,7 +52,7 @@ fn write_outputs(
     if let Some(dir) = report {
         let svgs = write_charts(dir, &charts)?;
         let path = dir.join(REPORT_FILE);
-        sim_host::log::write_atomic(&path, page(&svgs).as_bytes())
+        monitor_io::log::write_atomic(&path, page(&svgs).as_bytes())
             .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
         // Not eprintln!: a closed stderr must not panic after the report is written.
         let _ = std::io::Write::write_all(

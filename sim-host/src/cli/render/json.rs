@@ -1,13 +1,13 @@
 //! The JSON renderer: every command's `--json` document, printed the one way.
 
+use monitor_analysis::compare::CompareReport;
+use monitor_analysis::explain::ExplainReport;
+use monitor_replay::{FaultCandidate, TimelinePoint};
+use monitor_sim::SimSummary;
+use monitor_studies::bench::{BenchFigures, DetectionLimitCase};
+use monitor_studies::demo::DemoRun;
+use monitor_studies::fault_signatures::Table1Row;
 use serde::Serialize;
-use sim_host::analysis::compare::CompareReport;
-use sim_host::analysis::explain::ExplainReport;
-use sim_host::bench::{BenchFigures, DetectionLimitCase};
-use sim_host::demo::DemoRun;
-use sim_host::fault_signatures::Table1Row;
-use sim_host::replay::{FaultCandidate, TimelinePoint};
-use sim_host::sim::SimSummary;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -36,12 +36,12 @@ pub struct DemoReport<'a> {
     /// Seconds from the fault to the first red FAULT state, null when none came.
     detected_after_s: Option<f64>,
     /// The isolation's events (load moves and names, with times).
-    events: &'a [sim_host::replay::IsolationEvent],
-    verdict: sim_host::replay::Verdict,
+    events: &'a [monitor_replay::IsolationEvent],
+    verdict: monitor_replay::Verdict,
     /// The verdict's line, as `diagnose` prints it.
     verdict_line: &'a str,
     /// The finding the verdict rests on.
-    verdict_finding: Option<&'a sim_host::replay::FindingReport>,
+    verdict_finding: Option<&'a monitor_replay::FindingReport>,
     named: &'a [FaultCandidate],
     correct_fault_among_candidates: bool,
     lamps: &'a BTreeMap<String, bool>,
@@ -52,8 +52,8 @@ pub struct DemoReport<'a> {
 pub fn demo(run: &DemoRun) -> DemoReport<'_> {
     DemoReport {
         story: match run.story {
-            sim_host::demo::Story::Service { .. } => "service",
-            sim_host::demo::Story::Paper { .. } => "paper",
+            monitor_studies::demo::Story::Service { .. } => "service",
+            monitor_studies::demo::Story::Paper { .. } => "paper",
         },
         fault_injected: run.fault.name(),
         change: run.change,
@@ -108,7 +108,7 @@ impl Table1Report {
         let matches_paper = rows.iter().filter(|r| r.signature == r.paper).count();
         Table1Report {
             motor,
-            angle_source: sim_host::replay::angle_source_name(angle).into(),
+            angle_source: monitor_replay::angle_source_name(angle).into(),
             rows,
             matches_paper,
         }

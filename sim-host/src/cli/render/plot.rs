@@ -292,7 +292,7 @@ fn png(path: &Path, c: &Chart, text: bool) -> Result<(), String> {
 pub fn write(dir: &Path, c: &Chart) -> Result<(String, Vec<PathBuf>), String> {
     let svg = svg_string(c)?;
     let svg_path = dir.join(format!("{}.svg", c.stem));
-    sim_host::log::write_atomic(&svg_path, svg.as_bytes())
+    monitor_io::log::write_atomic(&svg_path, svg.as_bytes())
         .map_err(|e| format!("{}: {e}", svg_path.display()))?;
     let png_path = dir.join(format!("{}.png", c.stem));
     let tmp = png_staging_file(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
@@ -304,7 +304,7 @@ pub fn write(dir: &Path, c: &Chart) -> Result<(String, Vec<PathBuf>), String> {
 
 /// The PNG's temporary file in `dir`: a random name created exclusively (it can never be an
 /// existing file, so never an input), the mode of any new file (0o666 less the umask, as
-/// `sim_host::log::write_atomic` gives the SVG), deleted when drawing fails.
+/// `monitor_io::log::write_atomic` gives the SVG), deleted when drawing fails.
 fn png_staging_file(dir: &Path) -> std::io::Result<tempfile::NamedTempFile> {
     let mut b = tempfile::Builder::new();
     // The image encoder picks the format from the extension.
@@ -324,7 +324,7 @@ fn png_staging_file(dir: &Path) -> std::io::Result<tempfile::NamedTempFile> {
 /// # Errors
 /// Drawing errors (not expected), or no matrix.
 pub fn confusion_svg(
-    matrices: &[sim_host::bench::isolation::IsolationConfusion],
+    matrices: &[monitor_studies::bench::isolation::IsolationConfusion],
 ) -> Result<String, String> {
     if matrices.is_empty() {
         return Err("no confusion matrix to draw".into());
@@ -364,7 +364,7 @@ type Heatmap<'a, 'b> = ChartContext<
 /// Drawing errors (not expected).
 fn confusion_panel(
     area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
-    m: &sim_host::bench::isolation::IsolationConfusion,
+    m: &monitor_studies::bench::isolation::IsolationConfusion,
 ) -> Result<(), String> {
     let (nr, nc) = (m.rows.len() as i32, m.columns.len() as i32);
     let max = m.counts.iter().flatten().copied().max().unwrap_or(0).max(1);
@@ -372,7 +372,7 @@ fn confusion_panel(
         .caption(
             format!(
                 "isolation bench, angle mode {}",
-                sim_host::replay::angle_source_name(m.mode)
+                monitor_replay::angle_source_name(m.mode)
             ),
             ("sans-serif", 18),
         )

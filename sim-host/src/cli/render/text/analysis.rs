@@ -2,9 +2,9 @@
 
 use super::diagnose::data_quality;
 use super::number;
-use sim_host::analysis::compare::CompareReport;
-use sim_host::analysis::explain::{ExplainReport, Standing, EXPLAINS_MIN};
-use sim_host::api::ExplainDocument;
+use monitor_analysis::compare::CompareReport;
+use monitor_analysis::explain::{ExplainReport, Standing, EXPLAINS_MIN};
+use monitor_api::ExplainDocument;
 use std::io::Write;
 use std::path::Path;
 

@@ -11,11 +11,11 @@ pub use diagnose::diagnose;
 use super::json::Table1Report;
 use diagnose::verdict;
 use monitor_core::IsolationState;
-use sim_host::demo::{DemoRun, MonitorState};
+use monitor_io::log::quality::DataQuality;
+use monitor_replay::{state_name, IsolationName, Panel};
+use monitor_sim::SimSummary;
+use monitor_studies::demo::{DemoRun, MonitorState};
 use sim_host::hmi::IsolationView;
-use sim_host::log::quality::DataQuality;
-use sim_host::replay::{state_name, IsolationName, Panel};
-use sim_host::sim::SimSummary;
 use std::io::Write;
 use std::path::Path;
 
@@ -64,7 +64,7 @@ pub fn demo(run: &DemoRun) -> anyhow::Result<()> {
 
 /// The demo's story: the motor, the load, the commissioning and the fault.
 fn demo_story(out: &mut impl Write, run: &DemoRun) -> anyhow::Result<()> {
-    use sim_host::demo::{Story, LOAD_BACK_AT_S, LOAD_STEP_AT_S, LOAD_STEP_SCALE};
+    use monitor_studies::demo::{Story, LOAD_BACK_AT_S, LOAD_STEP_AT_S, LOAD_STEP_SCALE};
     let fault = format!("{} {:+.0} %", run.fault.name(), 100.0 * run.change);
     match run.story {
         Story::Service { .. } => writeln!(
@@ -89,7 +89,7 @@ fn demo_story(out: &mut impl Write, run: &DemoRun) -> anyhow::Result<()> {
 /// the isolation, and a note on the friction class.
 fn demo_conclusion(out: &mut impl Write, run: &DemoRun) -> anyhow::Result<()> {
     for e in &run.report.isolation.events {
-        if matches!(e, sim_host::replay::IsolationEvent::LoadMoved { .. }) {
+        if matches!(e, monitor_replay::IsolationEvent::LoadMoved { .. }) {
             writeln!(out, "event: {} (not a fault)", e.line().trim())?;
         }
     }
@@ -128,11 +128,11 @@ fn demo_conclusion(out: &mut impl Write, run: &DemoRun) -> anyhow::Result<()> {
 }
 
 /// Candidates as `rr p 0.76 (rr +50 %), speed_sensor p 0.24 (speed_sensor -2 %)`, or `none`.
-fn candidate_list(c: &[sim_host::replay::FaultCandidate]) -> String {
+fn candidate_list(c: &[monitor_replay::FaultCandidate]) -> String {
     if c.is_empty() {
         return "none".into();
     }
-    sim_host::fault_signatures::candidates_text(
+    monitor_studies::fault_signatures::candidates_text(
         c.iter().map(|c| (c.fault, c.probability, c.change)),
     )
     .join(", ")

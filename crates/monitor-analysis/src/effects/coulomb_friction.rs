@@ -1,0 +1,110 @@
+//! `coulomb_friction`: dry friction.
+
+use super::{
+    declared_values, plausible, About, Confusion, Contribution, EffectModel, EffectParam,
+    EffectValuesError, FitSetup, SetupError,
+};
+use crate::prep::Prepared;
+use crate::simplified_model::{MachineConstants, ModelTerms, SpeedTorque};
+use monitor_core::EffectKind;
+
+/// Dry friction.
+#[derive(Debug, Clone, Copy)]
+pub struct CoulombFriction;
+
+/// Dry friction's parameters.
+const PARAMS: [EffectParam; 1] = [EffectParam {
+    name: "torque_nm",
+    unit: "N m",
+    doc: "dry friction torque Tc",
+    range: plausible::COULOMB_RATIO,
+    per: Some("the rated torque estimate"),
+    basis: plausible::COULOMB_BASIS,
+}];
+
+/// Dry friction's fitted values ([`PARAMS`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CoulombFrictionValues {
+    /// The friction torque Tc [N m].
+    pub torque_nm: f64,
+}
+
+impl TryFrom<&[f64]> for CoulombFrictionValues {
+    type Error = EffectValuesError;
+    fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
+        let [torque_nm] = declared_values(EffectKind::CoulombFriction, &PARAMS, v)?;
+        Ok(CoulombFrictionValues { torque_nm })
+    }
+}
+
+/// A dry friction torque `Tc tanh(w_m / 1 rad/s)` on the shaft.
+#[derive(Debug, Clone, Copy)]
+struct DryFriction {
+    /// Tc [N m].
+    torque_nm: f64,
+}
+
+impl SpeedTorque for DryFriction {
+    fn torque_nm(&self, wm_rad_s: f64) -> f64 {
+        // (No tanh when there is no dry friction: 0 x tanh(w) is 0.)
+        if self.torque_nm != 0.0 {
+            self.torque_nm * (wm_rad_s / 1.0).tanh()
+        } else {
+            0.0
+        }
+    }
+}
+
+/// What `CoulombFriction` is ([`About`]).
+const ABOUT: About = About {
+    kind: EffectKind::CoulombFriction,
+    description: "Dry friction (bearings, seals, brushes): a constant torque opposing rotation whatever the speed.",
+    equations: "J dw_m/dt = Kf I_qs - (B + Bl) w_m - Tc tanh(w_m / 1 rad/s)  (eq. 29 plus a constant friction torque).",
+    parameters: &PARAMS,
+};
+
+impl EffectModel for CoulombFriction {
+    fn about(&self) -> &About {
+        &ABOUT
+    }
+    fn confused_with(&self) -> &'static [Confusion] {
+        &[Confusion {
+            with: EffectKind::LoadTorque,
+            within: 1.10,
+        }]
+    }
+    fn setup(&self, _d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
+        let t = n.torque_scale_nm;
+        let [torque_nm] = &PARAMS;
+        let params = vec![torque_nm.fit(0.01 * t, (-0.1 * t, t), 0.05 * t, t)];
+        Ok(FitSetup::new(*self, params)?)
+    }
+}
+
+impl Contribution for CoulombFriction {
+    type Values = CoulombFrictionValues;
+    fn values(&self, v: &[f64]) -> Result<CoulombFrictionValues, EffectValuesError> {
+        CoulombFrictionValues::try_from(v)
+    }
+    /// The friction torque on the shaft.
+    fn contribute(
+        &self,
+        p: &CoulombFrictionValues,
+        _d: &Prepared,
+        _n: &MachineConstants,
+        t: &mut ModelTerms,
+    ) {
+        t.add_speed_torque(DryFriction {
+            torque_nm: p.torque_nm,
+        });
+    }
+    fn describe(&self, p: &CoulombFrictionValues, _d: &Prepared, n: &MachineConstants) -> String {
+        let tc = p.torque_nm;
+        format!(
+            "constant friction torque of about {:.2} N m ({:.1} % of the rated torque estimate {:.1} N m), independent of speed",
+            tc,
+            100.0 * tc / n.torque_scale_nm,
+            n.torque_scale_nm
+        )
+    }
+}

@@ -1,0 +1,235 @@
+//! `saturation`: main-flux saturation.
+
+use super::{
+    declared_values, plausible, rated_flux_wb, About, Contribution, EffectModel, EffectParam,
+    EffectValuesError, FitSetup, SetupError,
+};
+use crate::prep::Prepared;
+use crate::simplified_model::{MachineConstants, ModelTerms, SaturationLaw};
+use monitor_core::EffectKind;
+
+/// Main-flux saturation.
+#[derive(Debug, Clone, Copy)]
+pub struct Saturation;
+
+/// Saturation set up on a log: the log's flux level.
+struct OnLog {
+    /// The log's flux level `|V| / omega_s` [Wb] (`rated_flux_wb`).
+    rated_flux_wb: f64,
+}
+
+/// Lm / Lm0 for magnetising current `im` [A]: solves x (1 + (x a)^n) = 1, a = Lm0 im / psi_sat.
+fn sat_factor(lm0: f64, im: f64, psi_sat: f64, nexp: f64) -> f64 {
+    sat_factor_from(lm0, im, psi_sat, nexp, 1.0)
+}
+
+/// [`sat_factor`] by Newton's method from the guess `x0`, to |dx| < 1e-12. Solved for
+/// y = x a: g(y) = y + y^(n+1) - a = 0 (convex and increasing, one power per step).
+fn sat_factor_from(lm0: f64, im: f64, psi_sat: f64, nexp: f64, x0: f64) -> f64 {
+    let a = (lm0 * im.abs() / psi_sat.max(1e-9)).max(0.0);
+    if a < 1e-6 {
+        return 1.0;
+    }
+    let (lo, hi) = (1e-3 * a, a);
+    let mut y = (x0.clamp(1e-3, 1.0) * a).clamp(lo, hi);
+    for _ in 0..30 {
+        let yn = y.powf(nexp);
+        let g = y + y * yn - a;
+        let gp = 1.0 + (nexp + 1.0) * yn;
+        let ny = (y - g / gp).clamp(lo, hi);
+        if (ny - y).abs() < 1e-12 * a {
+            y = ny;
+            break;
+        }
+        y = ny;
+    }
+    y / a
+}
+
+/// [`sat_factor`] for every sample of `i_f`. The current changes little between samples,
+/// so each solve starts from the previous one moved along the tangent (dy/da = 1/g'(y)),
+/// a guess within about (da)^2 of the root; a Newton step shorter than 1e-7 a then leaves
+/// an error below about 1e-13 (quadratic convergence) and ends the solve. Where the guess
+/// is poor (the first sample, a jump), the iteration goes on as in [`sat_factor_from`].
+fn sat_factors(lm0: f64, i_f: &[f64], psi_sat: f64, nexp: f64) -> Vec<f64> {
+    let k = lm0 / psi_sat.max(1e-9);
+    // Previous sample: a, y and 1/g'(y) (None: no usable previous solve).
+    let mut prev: Option<(f64, f64, f64)> = None;
+    i_f.iter()
+        .map(|&i| {
+            let a = (k * i.abs()).max(0.0);
+            if a < 1e-6 {
+                prev = None;
+                return 1.0;
+            }
+            let (lo, hi) = (1e-3 * a, a);
+            let mut y = match prev {
+                Some((pa, py, inv_gp)) => (py + (a - pa) * inv_gp).clamp(lo, hi),
+                None => a,
+            };
+            let mut inv_gp = 1.0;
+            for it in 0..30 {
+                let yn = y.powf(nexp);
+                let g = y + y * yn - a;
+                inv_gp = 1.0 / (1.0 + (nexp + 1.0) * yn);
+                let ny = (y - g * inv_gp).clamp(lo, hi);
+                let step = (ny - y).abs();
+                y = ny;
+                if step < 1e-12 * a || (it == 0 && prev.is_some() && step < 1e-7 * a) {
+                    break;
+                }
+            }
+            prev = Some((a, y, inv_gp));
+            y / a
+        })
+        .collect()
+}
+
+/// Saturation's parameters.
+const PARAMS: [EffectParam; 2] = [
+    EffectParam {
+        name: "psi_sat_wb",
+        unit: "Wb",
+        doc: "flux linkage at which Lm has halved",
+        range: plausible::PSI_SAT_RATIO,
+        per: Some("the log's flux level |V|/omega_s"),
+        basis: plausible::PSI_SAT_BASIS,
+    },
+    EffectParam {
+        name: "exponent",
+        unit: "1",
+        doc: "sharpness of the saturation knee",
+        range: (2.0, 14.0),
+        per: None,
+        basis: "the fit's bounds",
+    },
+];
+
+/// Saturation's fitted values ([`PARAMS`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SaturationValues {
+    /// The flux linkage at which Lm has halved [Wb].
+    pub psi_sat_wb: f64,
+    /// The knee's exponent [1].
+    pub exponent: f64,
+}
+
+impl TryFrom<&[f64]> for SaturationValues {
+    type Error = EffectValuesError;
+    fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
+        let [psi_sat_wb, exponent] = declared_values(EffectKind::Saturation, &PARAMS, v)?;
+        Ok(SaturationValues {
+            psi_sat_wb,
+            exponent,
+        })
+    }
+}
+
+/// What `Saturation` is ([`About`]).
+const ABOUT: About = About {
+    kind: EffectKind::Saturation,
+    description: "The iron of the main flux path saturates: the magnetising inductance Lm falls as the magnetising current (the flux level) rises.",
+    equations: "Lm(i_f) = Lm0 / (1 + (Lm(i_f) i_f / psi_sat)^n), solved per sample; Ls = Lls + Lm and Kf (Lm^2/Lr) in eqs. (28)-(29) follow. In the full-order model (all dynamics effects in) the same law acts on the model's own magnetising flux |psi_m| = Lm |i_s + i_r|, the fluxes of the T-equivalent circuit being its states.",
+    parameters: &PARAMS,
+};
+
+impl EffectModel for Saturation {
+    fn about(&self) -> &About {
+        &ABOUT
+    }
+    fn setup(&self, d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, SetupError> {
+        let psi = rated_flux_wb(d);
+        let [psi_sat_wb, exponent] = &PARAMS;
+        let params = vec![
+            psi_sat_wb.fit(1.2 * psi, (0.5 * psi, 5.0 * psi), 0.2 * psi, psi),
+            // Fitted anywhere within its plausible range.
+            exponent.fit(7.0, exponent.range, 2.0, 1.0),
+        ];
+        Ok(FitSetup::new(OnLog { rated_flux_wb: psi }, params)?)
+    }
+}
+
+impl Contribution for OnLog {
+    type Values = SaturationValues;
+    fn values(&self, v: &[f64]) -> Result<SaturationValues, EffectValuesError> {
+        SaturationValues::try_from(v)
+    }
+    /// Lm's scale from the measured i_f per sample (the reduced model) and the law itself
+    /// (the full-order model saturates with its own magnetising flux).
+    fn contribute(
+        &self,
+        p: &SaturationValues,
+        d: &Prepared,
+        n: &MachineConstants,
+        t: &mut ModelTerms,
+    ) {
+        let SaturationValues {
+            psi_sat_wb,
+            exponent,
+        } = *p;
+        t.scale_magnetising_inductance(
+            sat_factors(n.lm_h, &d.i_f, psi_sat_wb, exponent).into_iter(),
+        );
+        t.magnetising.law = Some(SaturationLaw {
+            psi_sat_wb,
+            exponent,
+        });
+    }
+    fn describe(&self, p: &SaturationValues, d: &Prepared, n: &MachineConstants) -> String {
+        let (psi_sat, nexp) = (p.psi_sat_wb, p.exponent);
+        // The factor falls monotonically with |i_f|: its extremes are at the extremes of |i_f|.
+        let (mut imin, mut imax) = (f64::INFINITY, f64::NEG_INFINITY);
+        for &i in &d.i_f {
+            imin = imin.min(i.abs());
+            imax = imax.max(i.abs());
+        }
+        let (lo, hi) = if imax >= imin {
+            (
+                sat_factor(n.lm_h, imax, psi_sat, nexp),
+                sat_factor(n.lm_h, imin, psi_sat, nexp),
+            )
+        } else {
+            (f64::INFINITY, 0.0)
+        };
+        format!(
+            "magnetising inductance falls with flux: Lm is {:.0} % to {:.0} % of its unsaturated value over this log (saturation flux {:.2} Wb = {:.2} x the rated flux, knee exponent {:.1})",
+            lo * 100.0,
+            hi * 100.0,
+            psi_sat,
+            psi_sat / self.rated_flux_wb,
+            nexp
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn saturation_factor_solves_its_equation() {
+        let x = sat_factor(0.245, 4.0, 1.0, 6.0);
+        let a = 0.245 * 4.0 / 1.0;
+        assert!((x * (1.0 + (x * a).powf(6.0)) - 1.0).abs() < 1e-9);
+        // Warm starts from anywhere reach the same root.
+        for x0 in [1.0, 0.9, 0.5, 0.01] {
+            let y = sat_factor_from(0.245, 4.0, 1.0, 6.0, x0);
+            assert!((x - y).abs() < 1e-12, "{x0}: {x} vs {y}");
+        }
+        let v = sat_factors(0.245, &[0.0, 1.0, 4.0, -4.0, 8.0, 3.9], 1.0, 6.0);
+        for (i, y) in [0.0, 1.0, 4.0, -4.0, 8.0, 3.9].iter().zip(v) {
+            assert!((sat_factor(0.245, *i, 1.0, 6.0) - y).abs() < 1e-12);
+        }
+        // A slowly varying current (the warm-started solves end after one step).
+        for nexp in [2.0, 7.0, 14.0] {
+            let i_f: Vec<f64> = (0..2000)
+                .map(|k| 4.0 + 0.5 * (k as f64 * 0.01).sin())
+                .collect();
+            let v = sat_factors(0.245, &i_f, 0.9, nexp);
+            for (i, y) in i_f.iter().zip(v) {
+                let x = sat_factor(0.245, *i, 0.9, nexp);
+                assert!((x - y).abs() < 1e-12 * x, "{nexp} {i}: {x} vs {y}");
+            }
+        }
+    }
+}

@@ -1,0 +1,371 @@
+//! Many motors' logs judged at once (`sim-host fleet`, and the Python package's
+//! `drive_monitor.fleet.diagnose_many` on Dask): a motor table says which parameter file,
+//! commissioning window and healthy baseline belong to which motor, and which logs are its;
+//! each log gives one row ([`FleetRow`]), a bad file a row with its error.
+//!
+//! The motor table (TOML), paths relative to the table's folder:
+//!
+//! ```toml
+//! [[motor]]
+//! name = "pump_7"
+//! params = "params/pump_7.toml"    # the motor's parameter file ([columns] included)
+//! logs = "pump_7_*"                # which logs are this motor's: a pattern on the file name
+//! commission = [2.0, 4.0]          # optional: --commission START:END
+//! baseline = ["healthy/pump_7"]    # optional: healthy logs or folders (--baseline)
+//! load = "unknown"                 # optional: "unknown" (default) or "viscous"
+//! ```
+//!
+//! A log belongs to the first motor whose pattern matches its file name (`*` any text, `?`
+//! one character).
+
+use crate::{diagnose, ApiError, DiagnoseRequest, ParamsSource};
+use monitor_replay::{DiagnoseReport, IsolationEvent, LoadModel};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// One motor of the table.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotorEntry {
+    /// The motor's name (the rows' `motor`).
+    pub name: String,
+    /// Its parameter file.
+    pub params: PathBuf,
+    /// The pattern its logs' file names match.
+    pub logs: String,
+    /// Its commissioning window [s], if the logs are judged against one.
+    #[serde(default)]
+    pub commission: Option<[f64; 2]>,
+    /// Healthy logs of it (files or folders).
+    #[serde(default)]
+    pub baseline: Vec<PathBuf>,
+    /// What is known of its load: `unknown` (default) or `viscous`.
+    #[serde(default)]
+    pub load: Option<MotorLoad>,
+}
+
+/// What is known of a motor's load (the table's `load`, lower case).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MotorLoad {
+    /// An unknown input (real service): [`LoadModel::Unknown`].
+    Unknown,
+    /// The paper's fixed viscous load: [`LoadModel::Viscous`].
+    Viscous,
+}
+
+impl MotorLoad {
+    /// The replay's load model.
+    pub fn model(self) -> LoadModel {
+        match self {
+            MotorLoad::Unknown => LoadModel::Unknown,
+            MotorLoad::Viscous => LoadModel::Viscous,
+        }
+    }
+}
+
+/// The motor table.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotorTable {
+    /// The motors, in the order their patterns are tried.
+    pub motor: Vec<MotorEntry>,
+}
+
+/// Errors reading the motor table.
+#[derive(Debug, thiserror::Error)]
+pub enum FleetError {
+    /// The file cannot be read.
+    #[error("cannot read the motor table {path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// Not a motor table.
+    #[error("bad motor table {path}: {message}")]
+    Toml {
+        /// The file.
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+impl MotorTable {
+    /// Reads a motor table; its relative paths are made relative to its folder.
+    ///
+    /// # Errors
+    /// [`FleetError`] naming the file and what is wrong (an unknown key, a motor without
+    /// `params`, a load that is neither `unknown` nor `viscous`, an empty table).
+    pub fn load(path: &Path) -> Result<Self, FleetError> {
+        let shown = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| FleetError::Io {
+            path: shown.clone(),
+            source,
+        })?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        Self::from_toml_str(&text, &shown, base)
+    }
+
+    /// Parses a motor table's text; relative paths are taken from `base`.
+    ///
+    /// # Errors
+    /// As [`MotorTable::load`].
+    pub fn from_toml_str(text: &str, shown: &str, base: &Path) -> Result<Self, FleetError> {
+        let bad = |message: String| FleetError::Toml {
+            path: shown.to_string(),
+            message,
+        };
+        let mut t: MotorTable =
+            toml::from_str(text).map_err(|e| bad(monitor_io::one_line(&e.to_string())))?;
+        if t.motor.is_empty() {
+            return Err(bad("no [[motor]] in it".into()));
+        }
+        for m in &mut t.motor {
+            if let Some([a, b]) = m.commission {
+                if !(b > a && a >= 0.0) {
+                    return Err(bad(format!(
+                        "motor {}: commission = [{a}, {b}] is not [START, END] with 0 <= START < END",
+                        m.name
+                    )));
+                }
+            }
+            m.params = from_base(base, &m.params);
+            m.baseline = m.baseline.iter().map(|p| from_base(base, p)).collect();
+        }
+        Ok(t)
+    }
+
+    /// The motor a log belongs to: the first whose pattern matches the log's file name.
+    pub fn motor_of(&self, log: &Path) -> Option<&MotorEntry> {
+        let name = log.file_name()?.to_string_lossy();
+        self.motor.iter().find(|m| wildcard(&m.logs, &name))
+    }
+}
+
+/// `p` taken from `base` when relative.
+fn from_base(base: &Path, p: &Path) -> PathBuf {
+    if p.is_relative() {
+        base.join(p)
+    } else {
+        p.to_path_buf()
+    }
+}
+
+/// Whether `text` matches `pattern` (`*` any run of characters, `?` one character).
+pub fn wildcard(pattern: &str, text: &str) -> bool {
+    let (p, t): (Vec<char>, Vec<char>) = (pattern.chars().collect(), text.chars().collect());
+    // Iterative matching with one backtrack point for the last `*`.
+    let (mut i, mut j, mut star, mut mark) = (0usize, 0usize, None::<usize>, 0usize);
+    while j < t.len() {
+        if i < p.len() && (p[i] == '?' || p[i] == t[j]) {
+            i += 1;
+            j += 1;
+        } else if i < p.len() && p[i] == '*' {
+            star = Some(i);
+            mark = j;
+            i += 1;
+        } else if let Some(s) = star {
+            i = s + 1;
+            mark += 1;
+            j = mark;
+        } else {
+            return false;
+        }
+    }
+    p[i..].iter().all(|c| *c == '*')
+}
+
+/// One log's row of the fleet table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FleetRow {
+    /// The motor's name (empty when no motor's pattern matches the file).
+    pub motor: String,
+    /// The log.
+    pub file: String,
+    /// Rows read.
+    pub rows: Option<u64>,
+    /// The log's sample rate [Hz].
+    pub rate_hz: Option<f64>,
+    /// `fault`, `healthy`, `could_not_judge`, `watching`; null with an error.
+    pub verdict: Option<String>,
+    /// The fault the verdict names (a FAULT's or a watched one: Table 1's name,
+    /// `shorted_turns`, `broken_bars`), if any.
+    pub fault: Option<String>,
+    /// Its size in its finding's unit (`size_unit`: a relative change, 0.5 is +50 %; for
+    /// shorted turns the negative sequence's change over I1; for broken bars dB below the
+    /// supply line).
+    pub size: Option<f64>,
+    /// Its phase (`a`, `b`, `c`), where it has one.
+    pub phase: Option<String>,
+    /// Its calibrated confidence, 0..1.
+    pub confidence: Option<f64>,
+    /// When the lamps first lit [s].
+    pub first_detection_s: Option<f64>,
+    /// How many load moves the log showed.
+    pub load_moves: Option<u64>,
+    /// The data-quality summary.
+    pub data_quality: Option<String>,
+    /// Why the log gave no verdict (a bad file, no motor, a bad option), else null.
+    pub error: Option<String>,
+}
+
+impl FleetRow {
+    /// The row of a log that gave no report.
+    pub fn failed(motor: &str, file: &Path, error: String) -> Self {
+        FleetRow {
+            motor: motor.to_string(),
+            file: file.display().to_string(),
+            rows: None,
+            rate_hz: None,
+            verdict: None,
+            fault: None,
+            size: None,
+            phase: None,
+            confidence: None,
+            first_detection_s: None,
+            load_moves: None,
+            data_quality: None,
+            error: Some(error),
+        }
+    }
+
+    /// The row of a report.
+    pub fn of_report(motor: &str, file: &Path, r: &DiagnoseReport) -> Self {
+        // The verdict's own finding: the fault, size, phase and confidence the verdict line
+        // gives (a watched or a FAULT name; none for healthy or could not judge).
+        let named = r.verdict_finding.as_ref().and_then(|f| f.named());
+        // f32 figures as their shortest decimals (0.105, not 0.10517956316471100).
+        let short = |x: f32| x.to_string().parse::<f64>().unwrap_or(f64::from(x));
+        let (fault, size, phase, confidence) = match named {
+            Some(n) => (
+                Some(n.fault.name().to_string()),
+                Some(short(monitor_replay::verdict::size_parts(n.size).0)),
+                n.phase.map(|p| p.name().to_string()),
+                Some(short(n.confidence)),
+            ),
+            None => (None, None, None, None),
+        };
+        FleetRow {
+            motor: motor.to_string(),
+            file: file.display().to_string(),
+            rows: Some(r.data_quality.rows_read),
+            rate_hz: Some(r.data_quality.sample_rate_hz),
+            verdict: Some(r.verdict.name().to_string()),
+            fault,
+            size,
+            phase,
+            confidence,
+            first_detection_s: r.first_detection_s,
+            load_moves: Some(
+                r.isolation
+                    .events
+                    .iter()
+                    .filter(|e| matches!(e, IsolationEvent::LoadMoved { .. }))
+                    .count() as u64,
+            ),
+            data_quality: Some(r.data_quality.summary()),
+            error: None,
+        }
+    }
+}
+
+/// The row of one log: its motor from `table`, diagnosed with that motor's file, window,
+/// baseline and load. Never fails: an error is the row's `error`.
+pub fn row(table: &MotorTable, log: &Path) -> FleetRow {
+    match table.motor_of(log) {
+        Some(m) => row_for(m, log),
+        None => FleetRow::failed(
+            "",
+            log,
+            "no motor of the table matches this file's name".to_string(),
+        ),
+    }
+}
+
+/// The row of `log` (shown as `shown`: a URL it was fetched from, say), its motor found by
+/// `shown`'s file name.
+pub fn row_shown(table: &MotorTable, log: &Path, shown: &str) -> FleetRow {
+    let mut r = match table.motor_of(Path::new(shown)) {
+        Some(m) => row_for(m, log),
+        None => FleetRow::failed(
+            "",
+            log,
+            "no motor of the table matches this file's name".to_string(),
+        ),
+    };
+    r.file = shown.to_string();
+    if let Some(e) = &mut r.error {
+        *e = e.replace(&log.display().to_string(), shown);
+    }
+    r
+}
+
+/// The row of `log` as motor `m`'s.
+pub fn row_for(m: &MotorEntry, log: &Path) -> FleetRow {
+    let req = DiagnoseRequest {
+        commission: m.commission.map(|[a, b]| (a, b)),
+        baseline: m.baseline.clone(),
+        load: m.load.map_or(LoadModel::Unknown, MotorLoad::model),
+        ..DiagnoseRequest::default()
+    };
+    match diagnose(ParamsSource::Path(&m.params), log, &req, &mut |_| {}) {
+        Ok(d) => FleetRow::of_report(&m.name, log, &d.report),
+        Err(e) => FleetRow::failed(&m.name, log, one_line_error(&e)),
+    }
+}
+
+fn one_line_error(e: &ApiError) -> String {
+    monitor_io::one_line(&e.to_string())
+}
+
+/// The columns of the fleet table, in order (the CSV's header).
+pub const COLUMNS: [&str; 13] = [
+    "motor",
+    "file",
+    "rows",
+    "rate_hz",
+    "verdict",
+    "fault",
+    "size",
+    "phase",
+    "confidence",
+    "first_detection_s",
+    "load_moves",
+    "data_quality",
+    "error",
+];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn patterns_and_the_table() {
+        assert!(wildcard("pump_7_*", "pump_7_2026-11-01.csv"));
+        assert!(wildcard("*.csv", "a.csv"));
+        assert!(wildcard("p?mp*", "pump"));
+        assert!(!wildcard("pump_7_*", "pump_8_x.csv"));
+        assert!(!wildcard("a*b", "acbx"));
+        let t = MotorTable::from_toml_str(
+            "[[motor]]\nname = \"m\"\nparams = \"p.toml\"\nlogs = \"m_*\"\ncommission = [1.0, 2.0]\n",
+            "t.toml",
+            Path::new("/x"),
+        )
+        .unwrap();
+        assert_eq!(t.motor[0].params, Path::new("/x/p.toml"));
+        assert!(t.motor_of(Path::new("/logs/m_1.csv")).is_some());
+        assert!(t.motor_of(Path::new("/logs/n_1.csv")).is_none());
+        for bad in [
+            "[[motor]]\nname = \"m\"\nparams = \"p\"\nlogs = \"*\"\nload = \"heavy\"\n",
+            "[[motor]]\nname = \"m\"\nparams = \"p\"\nlogs = \"*\"\ncommission = [2.0, 1.0]\n",
+            "[[motor]]\nname = \"m\"\nparams = \"p\"\nlogs = \"*\"\ncolour = 1\n",
+            "",
+        ] {
+            let e = MotorTable::from_toml_str(bad, "t.toml", Path::new(".")).unwrap_err();
+            assert!(e.to_string().starts_with("bad motor table t.toml"), "{e}");
+        }
+    }
+}

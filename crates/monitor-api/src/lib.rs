@@ -1,0 +1,489 @@
+//! The library's one-call interface: what each command computes, from a log file and a
+//! parameter file (a path, or the file's TOML text), as the value the command's `--json`
+//! prints. The command line and the Python package (`python/`) both call these, so a
+//! document is the same whoever asked for it.
+//!
+//! Errors are [`ApiError`]s whose `Display` is the command line's one-line message; their
+//! kind ([`ApiError::kind`]) says which: a bad parameter file, a bad log, a bad option, or
+//! an analysis that cannot run on this log.
+
+use monitor_analysis::prep::ReadOptions;
+use monitor_analysis::{Analysis, AnalysisError, Options};
+use monitor_core::{AngleSource, EffectKind, ResidualForm};
+use monitor_io::log::mapping::ColumnMapping;
+use monitor_io::log::{LogError, LogFile, OpenOptions};
+use monitor_io::params::{ParamError, ParamFile};
+use monitor_replay::{
+    diagnose_log, HealthyReference, LoadModel, ReplayError, ReplayOptions, UnbalanceBaseline,
+};
+use std::path::{Path, PathBuf};
+
+mod explain_doc;
+pub mod fleet;
+pub use explain_doc::{beside_verdict, explain, mcsa_beside, verdict_for_explain, ExplainDocument};
+
+/// A failed call: the command line's one-line message, and its kind.
+#[derive(Debug, thiserror::Error)]
+pub enum ApiError {
+    /// The parameter file cannot be read, or is not one.
+    #[error(transparent)]
+    Params(#[from] ParamError),
+    /// The log cannot be read, or is not one.
+    #[error(transparent)]
+    Log(#[from] LogError),
+    /// An option is wrong (a window, a baseline, a name).
+    #[error("{0}")]
+    Option(String),
+    /// The replay could not run (its configuration, an incomplete commissioning).
+    #[error(transparent)]
+    Replay(#[from] ReplayError),
+    /// The analysis could not run on this log.
+    #[error(transparent)]
+    Analysis(#[from] AnalysisError),
+}
+
+/// The kinds of [`ApiError`] (the Python package's exception classes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ErrorKind {
+    /// [`ApiError::Params`].
+    Params,
+    /// [`ApiError::Log`].
+    Log,
+    /// [`ApiError::Option`].
+    Option,
+    /// [`ApiError::Replay`] and [`ApiError::Analysis`].
+    Analysis,
+}
+
+impl ApiError {
+    /// Which kind of error this is.
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            ApiError::Params(_) => ErrorKind::Params,
+            ApiError::Log(_) | ApiError::Replay(ReplayError::Log(_)) => ErrorKind::Log,
+            ApiError::Analysis(AnalysisError::Log(_)) => ErrorKind::Log,
+            ApiError::Option(_) | ApiError::Replay(ReplayError::Option(_)) => ErrorKind::Option,
+            ApiError::Replay(_) | ApiError::Analysis(_) => ErrorKind::Analysis,
+        }
+    }
+}
+
+/// A parameter file: its path, or its TOML text.
+#[derive(Debug, Clone, Copy)]
+pub enum ParamsSource<'a> {
+    /// A file.
+    Path(&'a Path),
+    /// The file's text (`origin` names it in messages).
+    Toml {
+        /// The TOML text.
+        text: &'a str,
+        /// How messages name it.
+        origin: &'a str,
+    },
+}
+
+/// Reads a parameter file and its `[columns]` mapping (the machine's pole pairs for
+/// `Hz_el`), as every command that reads a log does.
+///
+/// # Errors
+/// [`ApiError::Params`] naming the file and the key.
+pub fn load_params(source: ParamsSource<'_>) -> Result<(ParamFile, ColumnMapping), ApiError> {
+    match source {
+        ParamsSource::Path(p) => Ok(monitor_io::log::mapping::load_params(p)?),
+        ParamsSource::Toml { text, origin } => {
+            let (p, table) = ParamFile::from_toml_str_with_columns(text, origin)?;
+            let columns = ColumnMapping::from_table(&table, p.motor.poles / 2).map_err(|e| {
+                ParamError::Columns {
+                    path: origin.to_string(),
+                    message: e.to_string(),
+                }
+            })?;
+            Ok((p, columns))
+        }
+    }
+}
+
+/// What `diagnose` is asked (its command-line options).
+#[derive(Debug, Clone)]
+pub struct DiagnoseRequest {
+    /// `--commission START:END` [s].
+    pub commission: Option<(f64, f64)>,
+    /// `--allow-incomplete`.
+    pub allow_incomplete: bool,
+    /// `--baseline`: healthy logs of the same motor (files, or folders of them).
+    pub baseline: Vec<PathBuf>,
+    /// `--load`.
+    pub load: LoadModel,
+    /// `--angle`.
+    pub angle_source: AngleSource,
+    /// `--residuals`.
+    pub residual_form: ResidualForm,
+    /// `--timeline-step` [s].
+    pub timeline_step_s: f64,
+    /// `--group` (TDMS).
+    pub group: Option<String>,
+}
+
+impl Default for DiagnoseRequest {
+    fn default() -> Self {
+        DiagnoseRequest {
+            commission: None,
+            allow_incomplete: false,
+            baseline: Vec::new(),
+            load: LoadModel::Unknown,
+            angle_source: AngleSource::RotorFluxCurrentModel,
+            residual_form: ResidualForm::Steady,
+            timeline_step_s: 0.5,
+            group: None,
+        }
+    }
+}
+
+/// The logs of `--baseline`: each file as given, each folder's log files (CSV, TDMS,
+/// Parquet, by extension) in name order.
+///
+/// # Errors
+/// [`ApiError::Option`] for a folder without logs, or one that cannot be read.
+pub fn baseline_files(given: &[PathBuf]) -> Result<Vec<PathBuf>, ApiError> {
+    let mut files = Vec::new();
+    for p in given {
+        if !p.is_dir() {
+            files.push(p.clone());
+            continue;
+        }
+        let mut in_dir: Vec<PathBuf> = std::fs::read_dir(p)
+            .map_err(|e| ApiError::Option(format!("--baseline {}: {e}", p.display())))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|f| {
+                f.is_file()
+                    && f.extension().and_then(|x| x.to_str()).is_some_and(|x| {
+                        ["csv", "tdms", "parquet"].contains(&x.to_ascii_lowercase().as_str())
+                    })
+            })
+            .collect();
+        if in_dir.is_empty() {
+            return Err(ApiError::Option(format!(
+                "--baseline {}: the folder holds no log (.csv, .tdms or .parquet)",
+                p.display()
+            )));
+        }
+        in_dir.sort();
+        files.extend(in_dir);
+    }
+    Ok(files)
+}
+
+/// True when `a` and `b` name the same file.
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    }
+}
+
+/// The negative sequence of the healthy log `path` (replayed without commissioning).
+fn baseline_of(
+    params: &ParamFile,
+    path: &Path,
+    open: &OpenOptions,
+    opts: ReplayOptions,
+) -> Result<UnbalanceBaseline, ApiError> {
+    let file =
+        LogFile::open_with(path, open).map_err(|e| ApiError::Option(format!("--baseline: {e}")))?;
+    let opts = ReplayOptions {
+        commission: None,
+        ..opts
+    };
+    let d = diagnose_log(params, &file, opts, &mut |_| {})
+        .map_err(|e| ApiError::Option(format!("--baseline {}: {e}", path.display())))?;
+    if d.report.unbalance.measured.i2_over_i1 == [0.0, 0.0] {
+        return Err(ApiError::Option(format!(
+            "--baseline {}: no positive-sequence current in that log (the motor never ran)",
+            path.display()
+        )));
+    }
+    Ok(d.report.unbalance.measured)
+}
+
+/// `diagnose`: replays `log` through the core with the parameter file `params`; the report
+/// `--json` prints. `progress` gets the fraction of the log read.
+///
+/// # Errors
+/// A bad parameter file, log or option ([`ApiError`]), each a one-line message.
+pub fn diagnose(
+    params: ParamsSource<'_>,
+    log: &Path,
+    req: &DiagnoseRequest,
+    progress: &mut dyn FnMut(f64),
+) -> Result<monitor_replay::Diagnosed, ApiError> {
+    let (params, columns) = load_params(params)?;
+    let open = OpenOptions {
+        group: req.group.clone(),
+        columns,
+    };
+    let mut opts = ReplayOptions {
+        angle_source: req.angle_source,
+        residual_form: req.residual_form,
+        commission: req.commission,
+        allow_incomplete: req.allow_incomplete,
+        timeline_step_s: req.timeline_step_s.max(1e-4),
+        unbalance_baseline: None,
+        load: req.load,
+    };
+    if !req.baseline.is_empty() {
+        let files = baseline_files(&req.baseline)?;
+        if let Some(same) = files.iter().find(|f| same_file(f, log)) {
+            return Err(ApiError::Option(format!(
+                "--baseline {}: that is the log being judged; give healthy logs of the same motor",
+                same.display()
+            )));
+        }
+        let runs = files
+            .iter()
+            .map(|f| baseline_of(&params, f, &open, opts))
+            .collect::<Result<Vec<_>, _>>()?;
+        opts.unbalance_baseline = HealthyReference::from_runs(&runs);
+    }
+    let file = LogFile::open_with(log, &open)?;
+    diagnose_log(&params, &file, opts, progress).map_err(|e| match e {
+        // Log errors name the file already; the monitor's configuration does not.
+        ReplayError::Config { .. } => ApiError::Option(format!("{}: {e}", log.display())),
+        e => e.into(),
+    })
+}
+
+/// What `compare` and `explain` are asked (their shared options).
+#[derive(Debug, Clone, Default)]
+pub struct AnalysisRequest {
+    /// `--effects`: effects already in the model.
+    pub effects: Vec<EffectKind>,
+    /// `--from` [s].
+    pub from_s: Option<f64>,
+    /// `--to` [s].
+    pub to_s: Option<f64>,
+    /// `--no-fit`: keep the base parameters as the file gives them.
+    pub no_fit: bool,
+    /// `--group` (TDMS).
+    pub group: Option<String>,
+    /// `explain --rotor-bars`.
+    pub rotor_bars: Option<u32>,
+}
+
+/// Supply periods the analysed window of `compare` and `explain` must hold (0.5 s at
+/// 50 Hz): fewer leave a transient's tail and the noise to judge the model by.
+pub const MIN_ANALYSED_PERIODS: f64 = 25.0;
+
+/// Reads the log for `compare`/`explain` and checks its analysed window.
+///
+/// # Errors
+/// A bad parameter file or log; [`ApiError::Option`] for a window under
+/// [`MIN_ANALYSED_PERIODS`] supply periods.
+pub fn load_analysis(
+    params: ParamsSource<'_>,
+    log: &Path,
+    req: &AnalysisRequest,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Analysis, ApiError> {
+    let (params, columns) = load_params(params)?;
+    let file = LogFile::open_with(
+        log,
+        &OpenOptions {
+            group: req.group.clone(),
+            columns,
+        },
+    )?;
+    let opts = ReadOptions {
+        from_s: req.from_s.unwrap_or(f64::NEG_INFINITY),
+        to_s: req.to_s.unwrap_or(f64::INFINITY),
+    };
+    let a = Analysis::load_file(&file, params, opts, progress)?;
+    let span = match (a.data.t_s.first(), a.data.t_s.last()) {
+        (Some(t0), Some(t1)) => t1 - t0,
+        _ => 0.0,
+    };
+    let least = MIN_ANALYSED_PERIODS / a.params.supply.f_hz;
+    if span.is_nan() || span < least {
+        return Err(ApiError::Option(format!(
+            "{}: the analysed window is {:.3} s ({:.1} supply periods): at least {:.2} s ({MIN_ANALYSED_PERIODS:.0} periods) are needed to judge the model (widen --from/--to)",
+            log.display(),
+            span,
+            span * a.params.supply.f_hz,
+            least
+        )));
+    }
+    Ok(a)
+}
+
+impl AnalysisRequest {
+    /// The analysis' options.
+    pub fn options(&self) -> Options {
+        Options {
+            effects: self.effects.clone(),
+            fit_base: !self.no_fit,
+        }
+    }
+}
+
+/// `compare --json`'s document.
+///
+/// # Errors
+/// As [`load_analysis`], and an effect the log cannot carry.
+pub fn compare(
+    params: ParamsSource<'_>,
+    log: &Path,
+    req: &AnalysisRequest,
+) -> Result<serde_json::Value, ApiError> {
+    let a = load_analysis(params, log, req, &mut |_| {})?;
+    let out = a.compare(&req.options())?;
+    Ok(serde_json::to_value(&out.report).unwrap_or_default())
+}
+
+/// `identify`'s result: the identification and the parameter file it writes.
+#[derive(Debug, Clone)]
+pub struct Identified {
+    /// The estimates, the errors, the solver's report.
+    pub identification: monitor_analysis::identify::Identification,
+    /// The identified parameter file's text (with the start file's `[columns]`).
+    pub toml: String,
+}
+
+/// `identify`: the circuit and the mechanics of the start file's machine from `log`
+/// (`--from`/`--to` its window), or a refusal naming the likely cause
+/// ([`monitor_analysis::identify::refusal`]).
+///
+/// # Errors
+/// A bad parameter file or log; [`ApiError::Option`] for a window that ends before it
+/// starts, a log the model cannot be driven by, or a refused identification.
+pub fn identify(
+    params: ParamsSource<'_>,
+    log: &Path,
+    from_s: Option<f64>,
+    to_s: Option<f64>,
+    group: Option<String>,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Identified, ApiError> {
+    if let (Some(a), Some(b)) = (from_s, to_s) {
+        if b <= a {
+            return Err(ApiError::Option(format!(
+                "--to ({b}) must be after --from ({a})"
+            )));
+        }
+    }
+    let (start_text, start_name) = match params {
+        ParamsSource::Path(p) => (
+            std::fs::read_to_string(p).map_err(|source| ParamError::Io {
+                path: p.display().to_string(),
+                source,
+            })?,
+            p.display().to_string(),
+        ),
+        ParamsSource::Toml { text, origin } => (text.to_string(), origin.to_string()),
+    };
+    let (start, columns) = load_params(params)?;
+    let file = LogFile::open_with(log, &OpenOptions { group, columns })?;
+    let mut rows: Vec<monitor_io::log::Row> = Vec::new();
+    file.for_each_row(&mut |f| progress(0.1 * f), &mut rows)?;
+    let samples = monitor_analysis::identify::Samples::from_rows(
+        &rows,
+        file.channels(),
+        from_s.unwrap_or(f64::NEG_INFINITY),
+        to_s.unwrap_or(f64::INFINITY),
+    )
+    .map_err(|e| ApiError::Option(format!("cannot identify from {}: {e}", log.display())))?;
+    drop(rows);
+    let id =
+        monitor_analysis::identify::identify(&start, &samples, &mut |f| progress(0.1 + 0.9 * f))
+            .map_err(|e| {
+                ApiError::Option(format!("cannot identify from {}: {e}", log.display()))
+            })?;
+    if let Some(why) = monitor_analysis::identify::refusal(&start, &samples, &id) {
+        return Err(ApiError::Option(format!(
+            "identify {}: {why}; no parameter file written",
+            log.display()
+        )));
+    }
+    let toml = monitor_analysis::identify::to_toml(
+        &id,
+        &start_text,
+        &start_name,
+        &log.display().to_string(),
+    );
+    Ok(Identified {
+        identification: id,
+        toml,
+    })
+}
+
+/// `params from-nameplate`: the estimate and its parameter file's text, with the
+/// `[columns]` table of `columns_from` carried over (`--columns-from`).
+///
+/// # Errors
+/// [`ApiError::Option`] for a refused nameplate (naming the field); a bad `columns_from`.
+pub fn params_from_nameplate(
+    n: &monitor_io::nameplate::Nameplate,
+    columns_from: Option<&Path>,
+) -> Result<(monitor_io::nameplate::NameplateEstimate, String), ApiError> {
+    let estimate =
+        monitor_io::nameplate::estimate(n).map_err(|e| ApiError::Option(e.to_string()))?;
+    let mut toml = estimate.to_toml();
+    if let Some(from) = columns_from {
+        let table = monitor_io::params::load_columns_table(from)?;
+        // Checked as every command that reads a log checks it.
+        ColumnMapping::from_table(&table, estimate.poles / 2).map_err(|m| {
+            ApiError::Option(format!("--columns-from {}: [columns] {m}", from.display()))
+        })?;
+        toml.push_str(&format!(
+            "\n# The log's channels and units, from {}.\n[columns]\n{}",
+            from.display(),
+            monitor_io::params::columns_entries_toml(&table)
+        ));
+    }
+    Ok((estimate, toml))
+}
+
+/// `params from-nameplate --json`'s document (`out`: where the file was written, if it was).
+pub fn nameplate_document(
+    estimate: &monitor_io::nameplate::NameplateEstimate,
+    toml: &str,
+    out: Option<&Path>,
+) -> serde_json::Value {
+    serde_json::json!({
+        "nameplate": estimate.nameplate,
+        "poles": estimate.poles,
+        "poles_inferred": estimate.poles_inferred,
+        "slip": estimate.slip,
+        "values": estimate.values,
+        "out": out.map(|p| p.display().to_string()),
+        "toml": toml,
+    })
+}
+
+/// `simulate` into the log `out` (its format by extension), the scenario given as TOML
+/// text; the run's summary. The log is written whole or not at all.
+///
+/// # Errors
+/// A bad parameter file or scenario ([`ApiError::Option`] naming the key), or a write error.
+pub fn simulate_to_file(
+    params: ParamsSource<'_>,
+    scenario_toml: &str,
+    out: &Path,
+) -> Result<monitor_sim::SimSummary, ApiError> {
+    let (params, _) = load_params(params)?;
+    let sc = monitor_sim::Scenario::from_toml_str(scenario_toml, "the scenario")
+        .map_err(|e| ApiError::Option(e.to_string()))?;
+    let mut w = monitor_io::log::LogWriter::create(out, sc.sensors.channels())?;
+    let mut err = None;
+    let summary = monitor_sim::simulate_while(&params, &sc, |r| match w.write_row(r) {
+        Ok(()) => std::ops::ControlFlow::Continue(()),
+        Err(e) => {
+            err = Some(e);
+            std::ops::ControlFlow::Break(())
+        }
+    })
+    .map_err(|e| ApiError::Option(e.to_string()))?;
+    if let Some(e) = err {
+        return Err(e.into());
+    }
+    w.finish()?;
+    summary.ok_or_else(|| ApiError::Option("the simulation was interrupted".to_string()))
+}

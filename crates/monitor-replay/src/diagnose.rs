@@ -1,0 +1,286 @@
+//! A log through the data-quality stage and a [`Replay`]: what `sim-host diagnose` runs
+//! ([`diagnose_file`]), the glitch bursts filled or held out, and the observer of every
+//! output (the live HMI's log source).
+
+use super::front::{Direct, Handled, ReplaySink, CLOCK_RESET_GAP_S};
+use super::verdict::findings::data_quality_finding;
+use super::{pipe, DiagnoseReport, Replay, ReplayError, ReplayOptions};
+use monitor_core::MonitorOutput;
+use monitor_io::log::quality::{
+    CellLimits, CleanSink, DataQuality, NotJudged, QualityStage, MAX_BRIDGED_GAP_S,
+};
+use monitor_io::log::{Channels, LogError, LogFile, OpenOptions, Row, RowSink};
+use monitor_io::params::ParamFile;
+use std::path::Path;
+
+/// A log replayed by [`diagnose_file`] or [`diagnose_rows`].
+#[derive(Debug, Clone)]
+pub struct Diagnosed {
+    /// The report (`diagnose --json`), `data_quality` included.
+    pub report: DiagnoseReport,
+    /// The log's nominal sample rate (the data-quality stage's) [Hz].
+    pub sample_rate_hz: f64,
+}
+
+/// Replays rows held in memory, through the data-quality stage, and returns the report.
+///
+/// # Errors
+/// As [`diagnose_file`].
+pub fn diagnose_rows(
+    params: &ParamFile,
+    channels: Channels,
+    rows: &[Row],
+    opts: ReplayOptions,
+) -> Result<DiagnoseReport, ReplayError> {
+    replay_through_quality(params, channels, "the log", opts, |stage| {
+        for r in rows {
+            if !stage.row(r) {
+                break;
+            }
+        }
+        Ok(())
+    })
+    .map(|d| d.report)
+}
+
+/// Streams a log file through the data-quality stage and the core (`sim-host
+/// diagnose`): the stage's time base configures the monitor, and every row is replayed,
+/// with bounded memory whatever the log's length.
+///
+/// # Errors
+/// [`ReplayError::Log`] naming the file, line and column, or the stage's time-base
+/// errors (a log without rows or sampled below 8 samples per supply period, with the rate
+/// needed); [`ReplayError::Config`] when the core rejects the configuration;
+/// [`ReplayError::IncompleteCommissioning`] for a window not learned without
+/// `allow_incomplete`.
+pub fn diagnose_file(
+    params: &ParamFile,
+    path: &Path,
+    opts: ReplayOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Diagnosed, ReplayError> {
+    diagnose_log(params, &LogFile::open(path)?, opts, progress)
+}
+
+/// [`diagnose_file`] on a log already opened (any format, a TDMS group chosen:
+/// [`LogFile::open_with`]).
+///
+/// # Errors
+/// As [`diagnose_file`].
+pub fn diagnose_log(
+    params: &ParamFile,
+    file: &LogFile,
+    opts: ReplayOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Diagnosed, ReplayError> {
+    replay_through_quality(params, file.channels(), file.shown(), opts, |stage| {
+        file.for_each_row(progress, stage).map(|_| ())
+    })
+}
+
+/// Watches a replay row by row ([`diagnose_file_observed`]): the live HMI's log source.
+pub trait ReplayObserver {
+    /// The monitor's output after `row` (as the data-quality stage passed it on, glitches
+    /// filled in); `replay` for its time base and thresholds ([`Replay::time_of`],
+    /// [`Replay::threshold_bands`]).
+    fn output(&mut self, row: &Row, out: &MonitorOutput, replay: &Replay);
+    /// The replay starts again from the log's first row (the reader's fast path handed
+    /// over to the exact reader): forget every output so far.
+    fn restart(&mut self);
+}
+
+/// [`diagnose_file`] that hands every replayed row's output to `observer` as it goes, the
+/// log opened with `open` (a TDMS group, the parameter file's `[columns]` mapping).
+///
+/// # Errors
+/// As [`diagnose_file`].
+pub fn diagnose_file_observed(
+    params: &ParamFile,
+    path: &Path,
+    open: &OpenOptions,
+    opts: ReplayOptions,
+    progress: &mut dyn FnMut(f64),
+    observer: &mut dyn ReplayObserver,
+) -> Result<Diagnosed, ReplayError> {
+    let file = LogFile::open_with(path, open)?;
+    replay_observed(
+        params,
+        file.channels(),
+        file.shown(),
+        opts,
+        Some(observer),
+        |stage| file.for_each_row(progress, stage).map(|_| ()),
+    )
+}
+
+/// Runs `feed` into the data-quality stage in front of a replay; builds the report.
+fn replay_through_quality(
+    params: &ParamFile,
+    channels: Channels,
+    shown: &str,
+    opts: ReplayOptions,
+    feed: impl FnOnce(&mut dyn RowSink) -> Result<(), LogError>,
+) -> Result<Diagnosed, ReplayError> {
+    replay_observed(params, channels, shown, opts, None, feed)
+}
+
+/// [`replay_through_quality`] with an optional observer of every output. Without one,
+/// the replay runs on a thread of its own beside the data-quality stage ([`pipe`]: the
+/// same results, on two cores).
+fn replay_observed<'a>(
+    params: &'a ParamFile,
+    channels: Channels,
+    shown: &str,
+    opts: ReplayOptions,
+    observer: Option<&'a mut dyn ReplayObserver>,
+    feed: impl FnOnce(&mut dyn RowSink) -> Result<(), LogError>,
+) -> Result<Diagnosed, ReplayError> {
+    match observer {
+        None => {
+            let ((read, quality, handled), replay) =
+                pipe::on_own_thread(params, channels, opts, |p| {
+                    let mut sink = ReplaySink::new(params, p);
+                    let (read, quality) = through_quality(&mut sink, params, shown, feed);
+                    (read, quality, sink.into_parts().1)
+                });
+            conclude(replay?, &handled, read, quality, shown, opts)
+        }
+        Some(o) => {
+            let direct = Direct::new(params, channels, opts, Some(o));
+            let mut sink = ReplaySink::new(params, direct);
+            let (read, quality) = through_quality(&mut sink, params, shown, feed);
+            let (mut direct, handled) = sink.into_parts();
+            if let Some(e) = direct.error.take() {
+                return Err(e);
+            }
+            conclude(direct.replay.take(), &handled, read, quality, shown, opts)
+        }
+    }
+}
+
+/// Runs `feed` into the data-quality stage in front of `clean`: the read's result and
+/// the stage's report.
+fn through_quality<S: CleanSink>(
+    clean: &mut S,
+    params: &ParamFile,
+    shown: &str,
+    feed: impl FnOnce(&mut dyn RowSink) -> Result<(), LogError>,
+) -> (Result<(), LogError>, Result<DataQuality, LogError>) {
+    let mut stage = QualityStage::new(clean, CellLimits::for_params(params), shown);
+    let read = feed(&mut stage);
+    (read, stage.finish())
+}
+
+/// The report of a replay whose rows have all been read (`None`: never configured), after
+/// `handled`.
+fn conclude(
+    replay: Option<Replay>,
+    handled: &Handled,
+    read: Result<(), LogError>,
+    quality: Result<DataQuality, LogError>,
+    shown: &str,
+    opts: ReplayOptions,
+) -> Result<Diagnosed, ReplayError> {
+    read?;
+    let mut quality = quality?;
+    let Some(replay) = replay else {
+        return Err(ReplayError::Option(format!("{shown}: no rows to replay")));
+    };
+    if replay.commissioning_incomplete() && !opts.allow_incomplete {
+        let mut why = replay.commission.why_incomplete().unwrap_or_default();
+        // What the data-quality stage distrusts is often why nothing was learned (swapped
+        // channels, a dead sensor): say it in the same line.
+        if !quality.trusted {
+            why = format!(
+                "{why}; data quality: {}",
+                quality.not_trusted_because.join("; ")
+            );
+        }
+        return Err(ReplayError::IncompleteCommissioning { why });
+    }
+    let can_residuals = replay.monitor.is_some();
+    let sensors = replay.output().sensor_fault;
+    let mut report = replay.finish();
+    describe_actions(&mut quality, can_residuals, handled);
+    let dq = data_quality_finding(&quality, sensors);
+    // Data the stage does not trust carry no finding (the sensors' impossible readings at
+    // the end are the core's own finding: a sensor the isolation names with its size stands).
+    if !quality.trusted || dq_unjudged(&quality) {
+        report.distrust(&dq.summary);
+    }
+    report.put_finding(dq);
+    report.data_quality = quality;
+    Ok(Diagnosed {
+        report,
+        sample_rate_hz: handled.rate_hz,
+    })
+}
+
+/// What `diagnose` did about what the stage found, in the report's `actions`.
+fn describe_actions(q: &mut DataQuality, monitor: bool, sink: &Handled) {
+    let who = if monitor {
+        "the monitor"
+    } else {
+        "the unbalance analysis"
+    };
+    if q.gaps_bridged > 0 {
+        q.actions.push(format!(
+            "short gaps: {who} advanced its estimators over the real elapsed time"
+        ));
+    }
+    if q.long_gaps > 0 || q.clock_resets > 0 {
+        q.actions.push(format!(
+            "long gaps and clock resets: {who} restarted its estimators and settled again"
+        ));
+    }
+    if sink.short_bursts > 0 {
+        q.actions.push(format!(
+            "{} bursts of bad cells up to {MAX_BRIDGED_GAP_S} s: {} rows of glitches within a quarter supply period filled in between their neighbours along the rotation, the longer bursts left out and bridged like gaps",
+            sink.short_bursts, sink.filled_rows
+        ));
+    }
+    if sink.long_bursts > 0 {
+        q.actions.push(format!(
+            "{} bursts of bad cells longer than {MAX_BRIDGED_GAP_S} s: given to {who}, which holds them out and flags the sensor",
+            sink.long_bursts
+        ));
+    }
+    if q.repeated_or_backward_rows + q.non_finite_times > 0 {
+        q.actions
+            .push("rows with a repeated, backward or unreadable time: dropped".to_string());
+    }
+    if sink.rows_other_rate > 0 {
+        q.actions.push(format!(
+            "{} rows at another sample rate resampled onto the monitor's {:.0} Hz clock (interpolated along the rotation)",
+            sink.rows_other_rate, sink.rate_hz
+        ));
+    }
+    if q.clock_resets > 0 {
+        q.actions.push(format!(
+            "after each clock reset the replay's time goes on from the last row's plus {CLOCK_RESET_GAP_S} s (the times reported are the replay's)"
+        ));
+    }
+    q.not_judged = sink
+        .not_judged
+        .iter()
+        .map(|&(from_s, to_s, why)| NotJudged {
+            from_s,
+            to_s,
+            why: why.to_string(),
+        })
+        .collect();
+    for n in &q.not_judged {
+        q.warnings.push(format!(
+            "{:.2}..{:.2} s not judged: {}",
+            n.from_s, n.to_s, n.why
+        ));
+    }
+}
+
+/// More of the log could not be judged than a verdict allows
+/// ([`monitor_io::log::quality::MAX_NOT_JUDGED_FRACTION`]).
+fn dq_unjudged(q: &DataQuality) -> bool {
+    let unjudged: f64 = q.not_judged.iter().map(|n| n.to_s - n.from_s).sum();
+    unjudged
+        > monitor_io::log::quality::MAX_NOT_JUDGED_FRACTION * q.duration_s.max(f64::MIN_POSITIVE)
+}

@@ -1,0 +1,483 @@
+//! The fault isolation of a replay: the core's [`Isolator`] fed from the monitor's
+//! outputs, its baseline learned over the commissioning window, and what `diagnose`
+//! reports about it (JSON `isolation`, the candidates' `change`).
+//!
+//! The isolator works on a steady operating point: the positive-sequence voltage and current
+//! vectors of the replay's sequence analysis (one angle from a PLL on the voltages, so the
+//! point does not depend on the monitor's frame, which a speed-sensor or rotor-parameter
+//! fault detunes), the PLL's frequency and the monitor's electrical speed (encoder),
+//! averaged once the monitor has settled, with no sensor fault, and isolated (or, while
+//! commissioning learns, added to the baseline) on the core's schedule
+//! ([`monitor_core::isolation::Follower`]: the same code the firmware runs; the firmware
+//! feeds it the monitor's own outputs, [`SteadyPoint::from_output`]).
+
+mod report;
+mod sentences;
+
+use monitor_core::isolation::{Follower, Named, Step, DEFAULT_SPREAD};
+use monitor_core::{
+    CommissioningState, Fault, Isolation, IsolationState, Isolator, MonitorOutput, SteadyPoint,
+};
+pub(super) use report::refine_single_phase;
+use report::{baseline_name, groups, REPORTED_RISE_K};
+pub use report::{
+    state_name, DetectionLimit, FaultCandidate, IsolationBaseline, IsolationGroup, IsolationReport,
+    SensorPhaseReport,
+};
+use serde::{Serialize, Serializer};
+use std::fmt;
+
+/// A reported isolation older than this at the log's end says so [s].
+pub const STALE_S: f64 = 1.0;
+
+/// A candidate is listed from this probability on.
+pub const LIST_FROM: f32 = 0.01;
+
+/// What the isolation names, as the reports say it: one fault, or the friction class
+/// (`b/bl`: B and Bl scale the same term of the torque balance and cannot be separated,
+/// and to the paper's model a load change is a Bl change). Serialised as its name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum IsolationName {
+    /// One fault (never B or Bl alone: they are the friction class).
+    Fault(Fault),
+    /// The friction class B/Bl.
+    Friction,
+}
+
+impl IsolationName {
+    /// The name the isolation should give for `fault`: its own, the friction class for B
+    /// and Bl.
+    pub fn expected(fault: Fault) -> Self {
+        match fault {
+            Fault::B | Fault::Bl => IsolationName::Friction,
+            f => IsolationName::Fault(f),
+        }
+    }
+
+    /// The name of the core's conclusion.
+    pub fn of(named: &Named) -> Self {
+        match named {
+            Named::Fault(c) => IsolationName::Fault(c.fault),
+            Named::Friction { .. } => IsolationName::Friction,
+        }
+    }
+
+    /// The fault's name ([`Fault::name`]) or `b/bl`.
+    pub fn name(self) -> &'static str {
+        match self {
+            IsolationName::Fault(f) => f.name(),
+            IsolationName::Friction => "b/bl",
+        }
+    }
+
+    /// The name back from its text ([`IsolationName::name`]); `None` for any other text.
+    pub fn from_name(s: &str) -> Option<Self> {
+        if s == "b/bl" {
+            Some(IsolationName::Friction)
+        } else {
+            Fault::from_name(s).map(IsolationName::Fault)
+        }
+    }
+}
+
+impl fmt::Display for IsolationName {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl Serialize for IsolationName {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+/// A name the isolation gave, with the first time it gave it [s]. Serialised as the pair
+/// `[name, t_s]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NameGiven {
+    /// What was named.
+    pub name: IsolationName,
+    /// When it was first named [s] (the replay's time, or as the caller shifts it).
+    pub t_s: f64,
+}
+
+impl Serialize for NameGiven {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        (self.name, self.t_s).serialize(s)
+    }
+}
+
+/// Serialises an [`IsolationState`] by its report name ([`state_name`]), for
+/// `#[serde(serialize_with = "serialize_state")]` on a report's field (the studies' rows).
+pub fn serialize_state<S: Serializer>(state: &IsolationState, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(state_name(*state))
+}
+
+/// Follows the monitor's outputs and isolates (the core's [`Follower`] schedule).
+pub(super) struct IsolationTracker {
+    follower: Option<Follower>,
+    first_named: Option<NameGiven>,
+    /// Every name given, with the first time it was given [s].
+    names: Vec<NameGiven>,
+    /// The monitor has evaluated once (settled, voltage present).
+    running: bool,
+    /// Time of the last isolation and of the last sample [s].
+    last_t: f64,
+    end_t: f64,
+    /// The operating point of the last isolation.
+    last_point: SteadyPoint,
+    /// A lamp lit while lamps counted.
+    lamps_lit: bool,
+    /// The operating points kept since a deviation, and their joint isolation.
+    evidence: monitor_core::isolation::Evidence,
+    /// What is known of the load ([`super::LoadModel`]).
+    load: super::LoadModel,
+    /// Names and load moves, with times.
+    events: super::events::EventLog,
+    /// The log's temperature channel (`t_winding_c`), when it has one.
+    temperature: super::temperature::TemperatureChannel,
+}
+
+/// With the load an unknown input, B and Bl are not candidates (their change is the load's
+/// move): their probabilities are set to zero and they go last, so that no list, group or
+/// sentence offers them (the others keep their probabilities). Applied after the name is
+/// decided ([`IsolationTracker::report`]).
+fn without_friction(iso: &mut Isolation) {
+    for c in iso.candidates.iter_mut() {
+        if matches!(c.fault, Fault::B | Fault::Bl) {
+            c.probability = 0.0;
+        }
+    }
+    iso.candidates
+        .sort_by(|a, b| b.probability.total_cmp(&a.probability));
+}
+
+/// The candidates `diagnose` lists for `iso` when `shown` (a lamp lit or a name given, or
+/// a deviation from a learned baseline; most probable first, those from [`LIST_FROM`] on;
+/// an unknown fault's three nearest only; none without a deviation).
+fn listed_candidates(iso: &Isolation, shown: bool) -> Vec<FaultCandidate> {
+    if !shown || iso.state == IsolationState::NoDeviation {
+        return Vec::new();
+    }
+    let listed = if iso.state == IsolationState::Unknown {
+        3
+    } else {
+        iso.candidates.len()
+    };
+    iso.candidates
+        .iter()
+        .take(listed)
+        .filter(|c| c.probability >= LIST_FROM)
+        .map(FaultCandidate::from)
+        .collect()
+}
+
+/// `n` is the friction class while the load is an unknown input: a load move, not a name
+/// ([`super::LoadModel::Unknown`]).
+fn load_reading(load: super::LoadModel, n: &Named) -> bool {
+    load == super::LoadModel::Unknown && matches!(n, Named::Friction { .. })
+}
+
+/// What the report concludes from ([`IsolationTracker::concluded`]).
+struct Concluded {
+    /// The isolation judged (joint or single, the load's move read as no deviation).
+    iso: Isolation,
+    /// The joint fit and its number of points, where it is the one judged.
+    joint: Option<(Isolation, usize)>,
+    /// The friction class was read as the load's move.
+    load_moved: bool,
+}
+
+/// How far a parameter file's values may be off the machine's (nameplate estimates are
+/// 10-30 % off): against the nominal parameters (no commissioning), a change this small or
+/// smaller, with every lamp dark, is the file's own error as much as a fault, and is not
+/// named; with lamps lit it is no FAULT (the one verdict's table, `monitor_core::verdict`).
+/// The core's constant, re-exported.
+pub use monitor_core::isolation::NOMINAL_UNCERTAINTY;
+
+impl IsolationTracker {
+    /// A tracker for the nominal machine (`None`: a machine the isolator rejects, then
+    /// nothing is isolated and the report says so), of a log with a temperature column
+    /// (`temperature_column`) or without; `load`: what is known of the load.
+    pub(super) fn new(
+        isolator: Option<Isolator>,
+        temperature_column: bool,
+        load: super::LoadModel,
+    ) -> Self {
+        let isolator = isolator.map(|mut i| {
+            i.set_load_unknown(load == super::LoadModel::Unknown);
+            i
+        });
+        IsolationTracker {
+            follower: isolator.map(Follower::new),
+            first_named: None,
+            names: Vec::new(),
+            running: false,
+            last_t: 0.0,
+            end_t: 0.0,
+            last_point: SteadyPoint::default(),
+            lamps_lit: false,
+            evidence: monitor_core::isolation::Evidence::default(),
+            load,
+            events: super::events::EventLog::default(),
+            temperature: super::temperature::TemperatureChannel::new(temperature_column),
+        }
+    }
+
+    /// After the monitor's output for the sample at `t` (`dt_s` after the previous one);
+    /// `point`: the steady-state vectors at this sample (module docs); `counts`: lamps and
+    /// detections count now (the learned thresholds are in force, or none were asked for);
+    /// `temperature_c`: the log's temperature reading, if it has the column.
+    pub(super) fn after(
+        &mut self,
+        t: f64,
+        dt_s: f64,
+        out: &MonitorOutput,
+        point: &SteadyPoint,
+        counts: bool,
+        temperature_c: Option<f64>,
+    ) {
+        self.end_t = t;
+        let Some(follower) = self.follower.as_mut() else {
+            return;
+        };
+        self.events.sample(t, dt_s, point);
+        let learning = matches!(out.commissioning, CommissioningState::Learning(_));
+        // Running: the monitor evaluates its lamps, or its commissioning has learned a
+        // block (it learns on running, quasi-steady blocks only, and does not evaluate
+        // meanwhile: a window that opens before the first evaluation would otherwise teach
+        // the isolation nothing).
+        let learned_blocks =
+            matches!(out.commissioning, CommissioningState::Learning(f) if f > 0.0);
+        self.running |= out.evaluating || learned_blocks;
+        let usable = self.running && !out.sensor_fault.any() && (learning || counts);
+        self.lamps_lit |= counts && out.fault_detected;
+        let learned = follower.learned();
+        if learned {
+            // Load moves are measured from the commissioned point, and recorded at every
+            // quasi-steady output (the isolation does not run outside the learned range).
+            self.events.seed(&follower.isolator().baseline().at);
+            if usable && out.quasi_steady {
+                self.events.point(t, point);
+            }
+        }
+        self.temperature
+            .put_in_force(follower, t, temperature_c, learning);
+        // Quasi-steady by the vectors themselves (the monitor's gate follows its own frame,
+        // which a sensor fault can detune).
+        if let Step::Isolated(result) = follower.observe(point, dt_s as f32, usable, learning) {
+            let lag = follower.measured_rise_k().map(|_| follower.probe_lag_k());
+            self.temperature.after_isolation(t, &result, lag);
+            self.evidence.after(follower, &result);
+            if let Some((p, _)) = follower.averaged() {
+                self.events.point(t, &p);
+            }
+            if let Some(n) = self.name_of(&result, learned) {
+                self.give_name(t, n);
+            }
+            self.last_t = t;
+            self.last_point = *point;
+        }
+    }
+
+    /// The name the isolation gives after `result` (`learned`: a learned baseline is in
+    /// force): a fault one point cannot name may be named from several (evidence across
+    /// operating points). The joint fit's fault goes before the friction class of the last
+    /// point (a load that moved is, to the paper's model, a Bl change); against the nominal
+    /// parameters with every lamp dark a change within their uncertainty is not named, nor,
+    /// with the load unknown, the friction class.
+    fn name_of(&self, result: &Isolation, learned: bool) -> Option<Named> {
+        let joint = self
+            .evidence
+            .joint_beside(result)
+            .and_then(|(j, _)| j.named());
+        joint
+            .or(result.named())
+            .filter(|n| learned || !within_nominal_uncertainty(n))
+            .filter(|n| !load_reading(self.load, n))
+    }
+
+    /// Books the name `n` given at `t` [s]: the first name, and each name the first time it
+    /// is given (with its event).
+    fn give_name(&mut self, t: f64, n: Named) {
+        let given = NameGiven {
+            name: IsolationName::of(&n),
+            t_s: t,
+        };
+        self.first_named.get_or_insert(given);
+        if !self.names.iter().any(|g| g.name == given.name) {
+            self.names.push(given);
+            let (change, p) = match n {
+                Named::Fault(c) => (c.change, c.probability),
+                Named::Friction {
+                    probability, bl, ..
+                } => (bl.change, probability),
+            };
+            self.events.named(t, given.name, change, p);
+        }
+    }
+
+    /// Every name the isolation gave so far (a fault or the friction class), each with the
+    /// first time it was given [s], in that order.
+    pub(super) fn names(&self) -> &[NameGiven] {
+        &self.names
+    }
+
+    /// The isolation named a fault other than the friction class at some point (a load
+    /// change is, to the paper's model, a Bl change: that is left to the lamps and the
+    /// commissioned range).
+    pub(super) fn named_a_fault(&self) -> bool {
+        self.first_named
+            .is_some_and(|g| g.name != IsolationName::Friction)
+    }
+
+    /// How far the current of the last isolation is from the one the learned baseline was
+    /// learned at: `|I| / |I_learned| - 1` (0.3: 30 % more current); `None` without a
+    /// learned baseline or its point.
+    /// The tracked winding temperature rise [K] when a learned baseline is in force and it
+    /// is at least [`report::REPORTED_RISE_K`] either way.
+    pub(super) fn winding_rise_k(&self) -> Option<f32> {
+        let f = self.follower.as_ref().filter(|f| f.learned())?;
+        let rise = f.isolator().winding_rise_k();
+        (rise.abs() >= REPORTED_RISE_K).then_some(rise)
+    }
+
+    /// The winding's heating explains the deviation ([`IsolationReport::heating_explains`]):
+    /// against commissioning, [`IsolationTracker::heating_explains_lamps`]; against the
+    /// parameter file, the last isolation's heating hypothesis (Rs and Rr together) is more
+    /// probable than every fault and the unknown fault, within the healthy scatter, with
+    /// the rise above the file's temperature it needs [K].
+    fn heating_explains(&self, learned: bool, iso: &Isolation) -> Option<f32> {
+        if learned {
+            return self
+                .heating_explains_lamps()
+                .then(|| self.winding_rise_k())
+                .flatten();
+        }
+        let rise = (iso.heating.factor - 1.0) / monitor_core::isolation::COPPER_ALPHA_PER_K;
+        (iso.heating_continues() && rise.abs() >= REPORTED_RISE_K).then_some(rise)
+    }
+
+    /// The lamps' detections, and any name given on the way, are explained by the
+    /// winding's heating: the last isolation found no deviation from the machine at its
+    /// tracked (warmer) temperature, which has risen by at least [`report::REPORTED_RISE_K`] (a
+    /// name given while the tracking lagged a fast warming was withdrawn since).
+    pub(super) fn heating_explains_lamps(&self) -> bool {
+        self.winding_rise_k().is_some_and(|r| r > 0.0)
+            && self
+                .concluded()
+                .is_some_and(|c| c.iso.state == IsolationState::NoDeviation)
+    }
+
+    /// The isolation the report concludes from: the joint fit over the operating points
+    /// kept where it names a fault the last point alone does not, else the last point;
+    /// with the load an unknown input, a reading of the friction class is the load's move
+    /// (state [`IsolationState::NoDeviation`]). `None` before any point was isolated.
+    fn concluded(&self) -> Option<Concluded> {
+        let single = self.follower.as_ref().and_then(|f| f.last().copied())?;
+        let joint = self.evidence.joint_beside(&single).map(|(j, n)| (*j, n));
+        let mut iso = joint.map_or(single, |(j, _)| j);
+        let load_moved = iso.named().is_some_and(|n| load_reading(self.load, &n));
+        if load_moved {
+            iso.state = IsolationState::NoDeviation;
+        }
+        if self.load == super::LoadModel::Unknown {
+            without_friction(&mut iso);
+        }
+        Some(Concluded {
+            iso,
+            joint,
+            load_moved,
+        })
+    }
+
+    /// With the load an unknown input ([`super::LoadModel::Unknown`]), the lamps' detections
+    /// are the load's move: the last isolation reads the friction class (the load), the
+    /// operating points since name no fault, and no fault was ever named.
+    pub(super) fn load_explains_lamps(&self) -> bool {
+        let last = self.follower.as_ref().and_then(|f| f.last().copied());
+        let friction = last
+            .and_then(|i| i.named())
+            .is_some_and(|n| load_reading(self.load, &n));
+        friction && self.evidence.named().is_none() && !self.named_a_fault()
+    }
+
+    fn moved_from_learned(&self) -> Option<f32> {
+        let f = self.follower.as_ref().filter(|f| f.learned())?;
+        let at = f.isolator().baseline().at;
+        let (i0, i1) = (
+            at.i.d.hypot(at.i.q),
+            self.last_point.i.d.hypot(self.last_point.i.q),
+        );
+        let r = i1 / i0 - 1.0;
+        (i0 > 0.0 && r.is_finite()).then_some(r)
+    }
+
+    /// The report, and the candidates for `diagnose` (most probable first, those from
+    /// [`LIST_FROM`] on) when `detected` (a lamp lit or a sensor fault was seen) or the
+    /// isolation deviates from a learned baseline.
+    pub(super) fn report(&self, detected: bool) -> (IsolationReport, Vec<FaultCandidate>) {
+        let learned = self.follower.as_ref().is_some_and(Follower::learned);
+        let Some(concluded) = self.concluded() else {
+            let why = if self.follower.is_none() {
+                "the parameter file's machine cannot be used by the isolation"
+            } else {
+                "no settled, quasi-steady operating point with voltage was evaluated"
+            };
+            return (IsolationReport::not_judged(why, learned), Vec::new());
+        };
+        let iso = concluded.iso;
+        // (A deviation from a learned baseline that names no fault alone is still a finding:
+        // its candidates are listed, with their probabilities.)
+        let candidates = listed_candidates(&iso, detected || learned);
+        let moved = self.moved_from_learned();
+        let in_file_error = iso
+            .named()
+            .filter(|n| !learned && within_nominal_uncertainty(n));
+        let named = iso.named().filter(|_| in_file_error.is_none());
+        let heating = self.heating_explains(learned, &iso);
+        let report = IsolationReport {
+            state: iso.state,
+            named: named.map(|n| IsolationName::of(&n)),
+            named_change: named.map(|n| n.change()),
+            named_probability: named.map(|n| n.probability()),
+            verdict: self.verdict(&concluded, in_file_error, detected, moved),
+            moved_from_learned: moved,
+            winding_rise_k: if learned {
+                self.winding_rise_k()
+            } else {
+                heating
+            },
+            heating_explains: heating.is_some(),
+            temperature: self.temperature.report(),
+            judged_at_s: self.last_t,
+            groups: groups(&iso),
+            deviation_sigma: iso.deviation,
+            unknown_probability: iso.unknown_probability,
+            separation_deg: iso.separation_deg,
+            residuals: iso.residuals.to_array(),
+            spread: self
+                .follower
+                .as_ref()
+                .map_or(DEFAULT_SPREAD, |f| f.isolator().baseline().spread)
+                .to_array(),
+            baseline: baseline_name(learned),
+            first_named: self.first_named,
+            events: self.events.events().to_vec(),
+            events_dropped: self.events.dropped(),
+            detection_limits: if learned && iso.state == IsolationState::NoDeviation {
+                self.detection_limits()
+            } else {
+                Vec::new()
+            },
+        };
+        (report, candidates)
+    }
+}
+
+/// A named fault (not the friction class, which a load change moves) whose size is within
+/// [`NOMINAL_UNCERTAINTY`] (`monitor_core::isolation::within_nominal_uncertainty`).
+fn within_nominal_uncertainty(n: &Named) -> bool {
+    matches!(n, Named::Fault(c) if monitor_core::isolation::within_nominal_uncertainty(c.change))
+}

@@ -1,0 +1,228 @@
+//! The replay on a thread of its own: the reading thread runs the data-quality stage, the
+//! glitch and clock handling before the replay ([`super::front::ReplaySink`]) and the
+//! sequence analysis' filters ([`SequenceFront`], which need nothing but the rows); it
+//! hands the rows with their sequence steps, in batches over a bounded channel, to the
+//! monitor, the isolation and the bookkeeping on another thread ([`Replay::push_step`]).
+//! The two run side by side on two cores (the parsing workers fill in the rest;
+//! docs/performance.md, "diagnose of a 1 h log").
+//!
+//! The replay sees the same rows in the same order, with the same steps, as without the
+//! thread ([`Replay::push`] runs the same two halves one after the other): the results are
+//! the same, bit for bit. The replay's configuration at the time base is answered
+//! synchronously (a configuration the core rejects stops the read at once, as without the
+//! thread).
+
+use super::front::Feeder;
+use super::sequences::{SequenceFront, SequenceStep};
+use super::{sequence_front, Replay, ReplayError, ReplayOptions, SequenceWindow};
+use monitor_io::log::{Channels, Row};
+use monitor_io::params::ParamFile;
+use std::sync::mpsc::{channel, sync_channel, Receiver, Sender, SyncSender};
+
+/// Calls per batch (about 150 bytes each).
+const BATCH: usize = 4096;
+/// Batches on their way at most (the reading thread waits beyond: bounded memory).
+const IN_FLIGHT: usize = 4;
+
+/// One call to the replay's thread.
+#[allow(clippy::large_enum_variant)]
+enum Call {
+    /// Configure the replay at this sample rate [Hz] (answered).
+    Begin(f64),
+    /// A window the sequence analysis closed ([`Replay::queue_window`]).
+    Window(Option<SequenceWindow>),
+    /// One row and its sequence step.
+    Row(Row, SequenceStep),
+    /// The acquisition clock was reset before the next row ([`Replay::clock_reset`]).
+    ClockReset,
+    /// Forget everything: the rows come again.
+    Restart,
+    /// The read is over: the sequence analysis as it ended ([`Replay::set_sequence_front`]).
+    End(Box<SequenceFront>),
+}
+
+/// The reading thread's end: a [`Feeder`] that runs the sequence analysis and batches the
+/// calls (given to the read by [`on_own_thread`]).
+pub(super) struct Pipe<'a> {
+    params: &'a ParamFile,
+    channels: Channels,
+    tx: SyncSender<Vec<Call>>,
+    /// Emptied batches coming back (their memory reused).
+    back: Receiver<Vec<Call>>,
+    /// The answer to [`Call::Begin`].
+    began: Receiver<bool>,
+    batch: Vec<Call>,
+    front: Option<SequenceFront>,
+    /// The first row's time (the replay's time 0) [s].
+    t0: Option<f64>,
+    /// The other end is gone.
+    closed: bool,
+}
+
+impl Pipe<'_> {
+    /// Sends the batch.
+    fn flush(&mut self) {
+        if self.batch.is_empty() || self.closed {
+            return;
+        }
+        let next = self
+            .back
+            .try_recv()
+            .unwrap_or_else(|_| Vec::with_capacity(BATCH));
+        let full = std::mem::replace(&mut self.batch, next);
+        self.closed = self.tx.send(full).is_err();
+    }
+
+    fn push(&mut self, c: Call) {
+        self.batch.push(c);
+        if self.batch.len() >= BATCH {
+            self.flush();
+        }
+    }
+
+    /// The read is over: the sequence analysis goes to the replay, and every call is sent.
+    fn end(&mut self) {
+        if let Some(f) = self.front.take() {
+            self.push(Call::End(Box::new(f)));
+        }
+        self.flush();
+    }
+}
+
+impl Feeder for Pipe<'_> {
+    fn begin(&mut self, rate_hz: f64) -> bool {
+        // (A rate the filters refuse is refused by the replay's own start too: `began` is false.)
+        self.front = sequence_front(self.params, self.channels, rate_hz).ok();
+        self.t0 = None;
+        self.push(Call::Begin(rate_hz));
+        self.flush();
+        !self.closed && self.began.recv().unwrap_or(false)
+    }
+
+    fn row(&mut self, row: &Row) {
+        let Some(front) = self.front.as_mut() else {
+            return;
+        };
+        let t = row.t_s - *self.t0.get_or_insert(row.t_s);
+        let step = front.track(row, t);
+        while let Some(w) = self.front.as_mut().and_then(SequenceFront::take_closed) {
+            self.push(Call::Window(w));
+        }
+        self.push(Call::Row(*row, step));
+    }
+
+    fn clock_reset(&mut self) {
+        self.push(Call::ClockReset);
+    }
+
+    fn restart(&mut self) {
+        self.front = None;
+        self.t0 = None;
+        self.push(Call::Restart);
+    }
+}
+
+/// The replay's thread's end: the replay, configured at [`Call::Begin`].
+struct Back<'a> {
+    params: &'a ParamFile,
+    channels: Channels,
+    opts: ReplayOptions,
+    replay: Option<Replay>,
+    error: Option<ReplayError>,
+}
+
+impl Back<'_> {
+    /// One call; `began` gets the answer to [`Call::Begin`].
+    fn call(&mut self, c: Call, began: &Sender<bool>) {
+        match c {
+            Call::Begin(rate) => {
+                match Replay::new(self.params, self.channels, rate, self.opts) {
+                    Ok(r) => self.replay = Some(r),
+                    Err(e) => self.error = Some(e),
+                }
+                // (The reading thread waits for this answer.)
+                let _ = began.send(self.replay.is_some());
+            }
+            Call::Restart => {
+                self.replay = None;
+                self.error = None;
+            }
+            c => {
+                let Some(r) = self.replay.as_mut() else {
+                    return;
+                };
+                match c {
+                    Call::Window(w) => r.queue_window(w),
+                    Call::Row(row, step) => r.push_step(&row, &step),
+                    Call::ClockReset => r.clock_reset(),
+                    Call::End(front) => r.set_sequence_front(*front),
+                    Call::Begin(_) | Call::Restart => {}
+                }
+            }
+        }
+    }
+}
+
+/// Receives every batch and hands it to `back` in order, returning the emptied batches.
+fn receive(
+    back: &mut Back<'_>,
+    rx: Receiver<Vec<Call>>,
+    empty: Sender<Vec<Call>>,
+    began: Sender<bool>,
+) {
+    for mut batch in rx {
+        for c in batch.drain(..) {
+            back.call(c, &began);
+        }
+        // (The reading thread may be gone already.)
+        let _ = empty.send(batch);
+    }
+}
+
+/// Runs `read` on this thread with a [`Pipe`] whose rows reach a replay of a log of
+/// `params`' machine with `channels` on a thread of its own (module docs); returns `read`'s
+/// result once the replay has had every row, and the replay (`None` when it was never
+/// configured) or the error configuring it.
+pub(super) fn on_own_thread<R>(
+    params: &ParamFile,
+    channels: Channels,
+    opts: ReplayOptions,
+    read: impl FnOnce(&mut Pipe<'_>) -> R,
+) -> (R, Result<Option<Replay>, ReplayError>) {
+    let (tx, rx) = sync_channel(IN_FLIGHT);
+    let (empty_tx, empty_rx) = channel();
+    let (began_tx, began_rx) = channel();
+    let mut back = Back {
+        params,
+        channels,
+        opts,
+        replay: None,
+        error: None,
+    };
+    let r = std::thread::scope(|s| {
+        let b = &mut back;
+        s.spawn(move || receive(b, rx, empty_tx, began_tx));
+        let mut pipe = Pipe {
+            params,
+            channels,
+            tx,
+            back: empty_rx,
+            began: began_rx,
+            batch: Vec::with_capacity(BATCH),
+            front: None,
+            t0: None,
+            closed: false,
+        };
+        let r = read(&mut pipe);
+        pipe.end();
+        // (Dropping the pipe closes the channel: the thread ends after the last batch,
+        // and the scope waits for it.)
+        drop(pipe);
+        r
+    });
+    let replay = match back.error {
+        Some(e) => Err(e),
+        None => Ok(back.replay),
+    };
+    (r, replay)
+}

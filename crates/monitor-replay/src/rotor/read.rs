@@ -1,0 +1,358 @@
+//! The rotor finding at the end of a replay ([`rotor_report`]): the steady stretch, the
+//! slip, the sidebands read from the Welch segments, and the judgement (module docs of
+//! `super`).
+
+use super::baseband::{Block, RotorFront};
+use super::judge::{band_of, bars_of, fault_probability, noise_max, torque_share};
+use super::spectrum::{segments, spectrum, Spectrum, SEGMENT_S};
+use super::stretch::{chunks, longest_run, Chunk};
+use super::{
+    Machine, RotorReport, SlipSource, MAIN_LOBE_HALF_BINS, MAX_SLIP, MIN_BINS, MIN_SLIP,
+    PAIR_SNR_DB, SLIP_STEADY,
+};
+use monitor_io::params::ParamFile;
+use std::f64::consts::TAU;
+use std::ops::Range;
+
+/// The sidebands read over a stretch's segments, relative to the line.
+#[derive(Debug, Clone, Copy, Default)]
+struct Reading {
+    /// Mean power of the lower and upper sidebands' largest bins.
+    lower: f64,
+    upper: f64,
+    /// Mean noise power per bin near them.
+    noise: f64,
+    /// Independent bins searched per sideband.
+    bins: f64,
+    /// Segments averaged.
+    k: usize,
+    /// Their resolution [Hz], mean supply frequency [Hz] and mean slip.
+    resolution_hz: f64,
+    f_supply: f64,
+    slip: f64,
+}
+
+/// The rotor finding of the record `front` of a log of the machine `params` (module docs
+/// of `super`): judged, or "cannot judge" with what was missing.
+pub fn rotor_report(front: &RotorFront, params: &ParamFile) -> RotorReport {
+    let m = Machine::of(params);
+    let r = RotorReport {
+        rotor_bars: m.bars,
+        ..RotorReport::default()
+    };
+    let blocks: Vec<Block> = front.blocks().iter().copied().collect();
+    let bs = front.block_s();
+    if blocks.len() < 16 {
+        return cannot(r, "no current to read: the log holds less than two supply periods of good current samples".into());
+    }
+    let by_speed = blocks.iter().any(|b| b.wm.is_finite());
+    let ch = chunks(&blocks, bs, m.np);
+    let Some(run) = longest_run(&ch, by_speed) else {
+        let what = if by_speed { "the slip" } else { "the current" };
+        return cannot(r, format!("{what} is steady in no stretch of 0.2 s chunks"));
+    };
+    let span = span_of(&ch, run.clone());
+    let mut r = r;
+    r.window_s = [span.start, span.end - 1]
+        .iter()
+        .filter_map(|&k| blocks.get(k).map(|b| b.t_s))
+        .collect();
+    let stretch = blocks.get(span).unwrap_or(&[]);
+    let mut planner = rustfft::FftPlanner::new();
+    let slip = if by_speed {
+        let s = ch.get(run).unwrap_or(&[]);
+        Some((
+            s.iter().map(|c| c.slip).sum::<f64>() / s.len().max(1) as f64,
+            SlipSource::Speed,
+        ))
+    } else {
+        slip_from_pairs(&mut r, &mut planner, stretch, bs, &m)
+    };
+    let Some((s, source)) = slip else {
+        return r;
+    };
+    r.slip = Some(s);
+    r.slip_source = Some(source);
+    read_and_judge(r, &mut planner, stretch, bs, &m, (by_speed, s))
+}
+
+/// The blocks of the chunks `run`.
+fn span_of(ch: &[Chunk], run: Range<usize>) -> Range<usize> {
+    let first = ch.get(run.start).map_or(0, |c| c.first);
+    let end = ch.get(run.end.wrapping_sub(1)).map_or(first, |c| c.end);
+    first..end
+}
+
+/// `r` with the reason it cannot judge.
+fn cannot(mut r: RotorReport, why: String) -> RotorReport {
+    r.judged = false;
+    r.sentence = format!("rotor: cannot judge: {why}");
+    r.cannot_judge_because = Some(format!("cannot judge: {why}"));
+    r
+}
+
+/// The segments' length in blocks for sidebands `fs` [Hz] from the line (at least
+/// [`SEGMENT_S`], and twice what [`MIN_BINS`] needs), blocks `bs` [s] apart.
+fn segment_blocks(fs: f64, bs: f64) -> usize {
+    ((SEGMENT_S.max(2.0 * MIN_BINS / fs.max(1e-9)) / bs).round() as usize).max(16)
+}
+
+/// The spectra of `stretch`'s segments ([`segments`]) of `seg_blocks` blocks.
+fn spectra<'a>(
+    planner: &'a mut rustfft::FftPlanner<f64>,
+    stretch: &'a [Block],
+    bs: f64,
+    m: &'a Machine,
+    seg_blocks: usize,
+) -> impl Iterator<Item = Spectrum> + 'a {
+    segments(0..stretch.len(), seg_blocks)
+        .into_iter()
+        .filter_map(move |r| spectrum(planner, stretch.get(r)?, bs, TAU * m.f0, m.np))
+}
+
+/// The slip from a pair about the line in the stretch's averaged spectrum: the sidebands
+/// themselves, else the rotation harmonics (module docs of `super`); `None`, with `r` saying
+/// why and the largest component where the sidebands could be, when neither stands
+/// [`PAIR_SNR_DB`] above the noise.
+fn slip_from_pairs(
+    r: &mut RotorReport,
+    planner: &mut rustfft::FftPlanner<f64>,
+    stretch: &[Block],
+    bs: f64,
+    m: &Machine,
+) -> Option<(f64, SlipSource)> {
+    let fs_min = 2.0 * MIN_SLIP * m.f0;
+    let mut avg: Option<Spectrum> = None;
+    let mut k = 0usize;
+    for s in spectra(planner, stretch, bs, m, segment_blocks(fs_min, bs)) {
+        k += 1;
+        match avg.as_mut() {
+            Some(a) => a.add(&s),
+            None => avg = Some(s),
+        }
+    }
+    let mut avg = avg?;
+    avg.scale(k as f64);
+    let f = avg.f_supply.abs();
+    let res = avg.resolution_hz;
+    let clear = (MAIN_LOBE_HALF_BINS + 1.0) * res;
+    let noise = avg.noise((clear, f), &[], k)?;
+    let side = (2.0 * MIN_SLIP * f).max(clear)..2.0 * MAX_SLIP * f;
+    let rot = f * (1.0 - MAX_SLIP) / m.np..f * (1.0 - MIN_SLIP) / m.np;
+    // The rotation harmonics first (present in every real machine, and no sign of a fault),
+    // then the sidebands; a pair whose refined distance gives a slip outside the range
+    // searched is something else.
+    let plausible = |s: f64| (0.0..=MAX_SLIP).contains(&s);
+    let from_rotation = pair(&avg, rot, noise).map(|d| 1.0 - m.np * d / f);
+    if let Some(s) = from_rotation.filter(|s| plausible(*s)) {
+        return Some((s, SlipSource::Eccentricity));
+    }
+    let from_sidebands = pair(&avg, side.clone(), noise).map(|d| d / (2.0 * f));
+    if let Some(s) = from_sidebands.filter(|s| plausible(*s)) {
+        return Some((s, SlipSource::Sidebands));
+    }
+    let (_, largest) = avg.peak(-side.end, -side.start);
+    r.largest_possible_db = Some(10.0 * largest.max(1e-30).log10());
+    *r = cannot(
+        std::mem::take(r),
+        format!(
+            "the slip is unknown: the log has no speed (wm_rad_s or enc_count), and no pair of sidebands (1 -/+ 2s) f nor of rotation harmonics f -/+ f_r stands {PAIR_SNR_DB:.0} dB above the current's noise; the largest component where the lower sideband could be (slips {:.1}..{:.0} %) is {:.1} dB below the line",
+            100.0 * MIN_SLIP,
+            100.0 * MAX_SLIP,
+            -10.0 * largest.max(1e-30).log10()
+        ),
+    );
+    None
+}
+
+/// The Blackman-Harris window's highest sidelobe [dB] (Harris 1978): what a line leaks
+/// outside its main lobe.
+const SIDELOBE_DB: f64 = -92.0;
+
+/// The distance [Hz] of the strongest symmetric pair about the line at distances in
+/// `range` [Hz] whose weaker member stands [`PAIR_SNR_DB`] above the `noise` per bin (and
+/// above the window's sidelobes)
+/// (members within one resolution bin of `-/+ d`; `d` refined to half their distance).
+fn pair(s: &Spectrum, range: Range<f64>, noise: f64) -> Option<f64> {
+    let res = s.resolution_hz;
+    // Above the noise and above the window's own leakage (its sidelobes, -92 dB: a
+    // noise-free record's line leaks a symmetric "pair" there).
+    let need = noise.max(10f64.powf(SIDELOBE_DB / 10.0)) * 10f64.powf(PAIR_SNR_DB / 10.0);
+    let steps = ((range.end - range.start) / s.df).max(0.0) as usize;
+    (0..=steps)
+        .map(|j| range.start + j as f64 * s.df)
+        .map(|d| {
+            let lo = s.peak(-d - res, -d + res);
+            let hi = s.peak(d - res, d + res);
+            (0.5 * (hi.0 - lo.0), lo.1.min(hi.1))
+        })
+        .filter(|&(d, p)| p >= need && d > 0.0)
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(d, _)| d)
+}
+
+/// Reads the sidebands over `stretch` at the slip (`per_segment`: each segment's own from
+/// the speed, else `s` throughout) and judges them.
+fn read_and_judge(
+    mut r: RotorReport,
+    planner: &mut rustfft::FftPlanner<f64>,
+    stretch: &[Block],
+    bs: f64,
+    m: &Machine,
+    (per_segment, s): (bool, f64),
+) -> RotorReport {
+    let f = m.f0;
+    let fs = 2.0 * s.abs() * f;
+    r.resolution_needed_hz = Some(fs / MIN_BINS);
+    if s < MIN_SLIP {
+        return cannot(r, format!("the slip {:.2} % is below {:.1} % (no load): the sidebands sit on the line, and a cage carries too little current for a broken bar to show", 100.0 * s, 100.0 * MIN_SLIP));
+    }
+    if s > MAX_SLIP {
+        return cannot(r, format!("the slip {:.1} % is above {:.0} %: a start or an overload, not a steady running point the severity bands grade", 100.0 * s, 100.0 * MAX_SLIP));
+    }
+    let t = stretch.len() as f64 * bs;
+    if t < MIN_BINS / fs {
+        r.resolution_hz = Some(1.0 / t.max(bs));
+        return cannot(r, format!("the steady stretch is {t:.2} s; {:.2} s are needed to resolve sidebands 2sf = {fs:.2} Hz from the line ({MIN_BINS} bins of a Blackman-Harris window)", MIN_BINS / fs));
+    }
+    let mut sum = Reading::default();
+    for sp in spectra(planner, stretch, bs, m, segment_blocks(fs, bs)) {
+        let slip = if per_segment { sp.slip } else { s };
+        if let Some(x) = read_segment(&sp, slip) {
+            add(&mut sum, &x);
+        }
+    }
+    if sum.k == 0 {
+        return cannot(r, "no supply line in the current's spectrum".into());
+    }
+    let k = sum.k as f64;
+    for x in [
+        &mut sum.lower,
+        &mut sum.upper,
+        &mut sum.noise,
+        &mut sum.bins,
+    ] {
+        *x /= k;
+    }
+    sum.resolution_hz /= k;
+    sum.f_supply /= k;
+    sum.slip /= k;
+    judge(r, &sum, m)
+}
+
+/// Adds segment reading `x` into `sum`.
+fn add(sum: &mut Reading, x: &Reading) {
+    sum.lower += x.lower;
+    sum.upper += x.upper;
+    sum.noise += x.noise;
+    sum.bins += x.bins;
+    sum.k += 1;
+    sum.resolution_hz += x.resolution_hz;
+    sum.f_supply += x.f_supply;
+    sum.slip += x.slip;
+}
+
+/// One segment's sidebands at slip `s`: the largest bins within [`SLIP_STEADY`] of
+/// `-/+ 2 s f` (the lower on the side opposite the supply's rotation) and the noise near
+/// them (the median outside the sidebands' intervals and their second harmonics').
+fn read_segment(sp: &Spectrum, s: f64) -> Option<Reading> {
+    let f = sp.f_supply;
+    let c = 2.0 * s * f.abs();
+    if c.is_nan() || c <= 0.0 {
+        return None;
+    }
+    let h = SLIP_STEADY * c;
+    let dir = if f < 0.0 { 1.0 } else { -1.0 };
+    let (_, lower) = sp.peak(dir * c - h, dir * c + h);
+    let (_, upper) = sp.peak(-dir * c - h, -dir * c + h);
+    let res = sp.resolution_hz;
+    let wide = h + MAIN_LOBE_HALF_BINS * res;
+    let skip = [
+        (c - wide, c + wide),
+        (-c - wide, -c + wide),
+        (2.0 * c - 2.0 * wide, 2.0 * c + 2.0 * wide),
+        (-2.0 * c - 2.0 * wide, -2.0 * c + 2.0 * wide),
+    ];
+    let region = (MAIN_LOBE_HALF_BINS * res, (3.0 * c).max(c + 40.0 * res));
+    let noise = sp
+        .noise(region, &skip, 1)
+        .or_else(|| sp.noise((region.0, f.abs()), &skip, 1))?;
+    Some(Reading {
+        lower,
+        upper,
+        noise,
+        bins: (2.0 * h / res).max(1.0),
+        k: 1,
+        resolution_hz: res,
+        f_supply: f.abs(),
+        slip: s,
+    })
+}
+
+/// The judgement of the averaged reading `x` (module docs of `super`).
+fn judge(mut r: RotorReport, x: &Reading, m: &Machine) -> RotorReport {
+    let db = |p: f64| 10.0 * p.max(1e-30).log10();
+    let (s, f) = (x.slip, x.f_supply);
+    r.slip = Some(s);
+    r.supply_hz = Some(f);
+    r.sideband_hz = vec![(1.0 - 2.0 * s) * f, (1.0 + 2.0 * s) * f];
+    r.segments = x.k;
+    r.resolution_hz = Some(x.resolution_hz);
+    let level = db(x.lower);
+    let floor = noise_max(x.noise, x.bins);
+    r.level_db = Some(level);
+    r.upper_sideband_db = Some(db(x.upper));
+    r.noise_floor_db = Some(db(floor));
+    let mut p = fault_probability(x.lower, x.noise, x.bins, x.k);
+    if r.slip_source == Some(SlipSource::Sidebands) {
+        p = p.min(super::PAIR_ONLY_CONFIDENCE);
+    }
+    r.confidence = Some(p);
+    let share = torque_share(s, TAU * f, m.tau_r_s);
+    r.torque_current_share = Some(share);
+    (r.delta, r.broken_bars) = bars_of(x.lower.sqrt(), x.upper.sqrt(), share, m.bars);
+    // A reading at the noise says only "below the noise": a judgement where the noise is
+    // below what a healthy cage reads, none above it.
+    let at_noise = x.lower < 2.0 * floor;
+    if at_noise && db(floor) > super::RotorBand::NoSign.upper_db() {
+        return cannot(r, format!("the current's noise reads {:.1} dB below the line where the (1 - 2s) f sideband is read, above the 54 dB a healthy cage is told at: a longer steady record or quieter current sensors lower it", -db(floor)));
+    }
+    let band = band_of(level);
+    r.band = Some(band);
+    r.band_meaning = Some(band.words().to_string());
+    r.judged = true;
+    r.sentence = sentence(&r, at_noise);
+    r
+}
+
+/// The report's one sentence.
+fn sentence(r: &RotorReport, at_noise: bool) -> String {
+    let level = -r.level_db.unwrap_or(f64::NAN);
+    let p = r.confidence.unwrap_or(0.0);
+    let head = match (r.slip_source, r.band) {
+        (Some(SlipSource::Sidebands), Some(b)) if b != super::RotorBand::NoSign => {
+            "unconfirmed: a pair about the line taken for the sidebands (no speed to confirm the slip)"
+        }
+        (_, b) => b.map_or("", |b| b.finding()),
+    };
+    let noise = if at_noise {
+        " (at the current's noise)"
+    } else {
+        ""
+    };
+    let bars = match (r.broken_bars, r.rotor_bars) {
+        (Some(n), Some(nb)) if p >= 0.5 => format!("; about {n:.1} adjacent broken bars of {nb}"),
+        _ => String::new(),
+    };
+    let source = match r.slip_source {
+        Some(SlipSource::Speed) => "the speed",
+        Some(SlipSource::Eccentricity) => "the rotation harmonics",
+        _ => "the sideband pair",
+    };
+    format!(
+        "rotor: {head}: the (1-2s)f sideband is {level:.1} dB below the supply line{noise} (band {}), confidence {p:.2}{bars}; slip {:.2} % from {source}, {:.1} s read",
+        r.band.map_or("", |b| b.words()),
+        100.0 * r.slip.unwrap_or(f64::NAN),
+        r.window_s.last().unwrap_or(&0.0) - r.window_s.first().unwrap_or(&0.0),
+    )
+}

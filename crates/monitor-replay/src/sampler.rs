@@ -1,0 +1,151 @@
+//! Log rows as core samples ([`LogSampler`]): the host's counterpart of the firmware's ADC
+//! sampler.
+
+use super::{COUNTS_PER_REV, TICK_HZ};
+use monitor_core::{Abc, Sample};
+use monitor_io::log::Row;
+
+/// The core sample of `row` from `sampler`, its encoder count moved on by `enc_offset`
+/// (counts handed on over a clock reset: [`super::Replay`]'s `enc_offset`).
+#[inline]
+pub(super) fn sample_of(sampler: &mut LogSampler, enc_offset: i64, row: &Row) -> Sample {
+    if enc_offset == 0 {
+        sampler.sample(row)
+    } else {
+        sampler.sample(&Row {
+            enc_count: row.enc_count.map(|c| c.wrapping_add(enc_offset)),
+            ..*row
+        })
+    }
+}
+
+/// Converts log rows to core samples, synthesising encoder counts from speed if needed
+/// (the host's counterpart of the firmware's `drive_monitor::sampling::AdcSampler`).
+///
+/// The count handed to the core is one continuous count: each row advances it by the
+/// encoder's own step where this row and the one before carry `enc_count`, else by the
+/// speed channel's `floor(theta_m C / 2 pi)` step (`theta_m` the integral of `wm_rad_s`,
+/// `C` = [`COUNTS_PER_REV`]), else not at all. A log that switches between the two (the
+/// data-quality stage drops a bad count where the speed channel is good) gives no jump.
+#[derive(Debug, Clone, Default)]
+pub struct LogSampler {
+    theta_m: f64,
+    last_t: Option<f64>,
+    /// The last row's encoder count, if it had one.
+    last_enc: Option<i64>,
+    /// The count handed on (`None` before the first row).
+    count: Option<i64>,
+    /// The speed channel's synthesised count at the last row.
+    synth: i64,
+}
+
+impl LogSampler {
+    /// The core sample for `row` (voltages 0 when the log has none).
+    pub fn sample(&mut self, row: &Row) -> Sample {
+        if let (Some(t0), Some(w)) = (self.last_t, row.wm_rad_s) {
+            self.theta_m += w * (row.t_s - t0);
+        }
+        let synth = floor_i64(self.theta_m / std::f64::consts::TAU * f64::from(COUNTS_PER_REV));
+        let count = match (self.count, row.enc_count, self.last_enc) {
+            (None, Some(c), _) => c,
+            (None, None, _) => synth,
+            (Some(n), Some(c), Some(l)) => n.wrapping_add(c.wrapping_sub(l)),
+            (Some(n), _, _) if row.wm_rad_s.is_some() => {
+                n.wrapping_add(synth.wrapping_sub(self.synth))
+            }
+            (Some(n), _, _) => n,
+        };
+        self.count = Some(count);
+        self.synth = synth;
+        self.last_enc = row.enc_count;
+        let count = count as u32;
+        self.last_t = Some(row.t_s);
+        let v = row.v_abc.unwrap_or([0.0; 3]);
+        let i = row.i_abc;
+        Sample {
+            v_abc: Abc {
+                a: v[0] as f32,
+                b: v[1] as f32,
+                c: v[2] as f32,
+            },
+            i_abc: Abc {
+                a: i[0] as f32,
+                b: i[1] as f32,
+                c: i[2] as f32,
+            },
+            encoder_count: count,
+            timestamp_ticks: round_i64(row.t_s * TICK_HZ) as u32,
+            v_saturated: false,
+            i_saturated: false,
+        }
+    }
+}
+
+/// `x.floor() as i64` (saturating; 0 for NaN) without a call into libm: the baseline
+/// x86-64 target has no rounding instruction, and the replay converts every row.
+fn floor_i64(x: f64) -> i64 {
+    let t = x as i64;
+    // `t as f64` is exact wherever x has a fraction (|x| < 2^52).
+    if (t as f64) > x {
+        t.saturating_sub(1)
+    } else {
+        t
+    }
+}
+
+/// `x.round() as i64` (half away from zero, saturating; 0 for NaN), as [`floor_i64`].
+fn round_i64(x: f64) -> i64 {
+    let t = x as i64;
+    // Exact wherever x has a fraction (|x| < 2^52).
+    let frac = x - t as f64;
+    if frac >= 0.5 {
+        t.saturating_add(1)
+    } else if frac <= -0.5 {
+        t.saturating_sub(1)
+    } else {
+        t
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn floor_and_round_as_std() {
+        let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+        let mut values = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            -1.5,
+            2.5,
+            0.499_999_999_999_999_94,
+            -0.499_999_999_999_999_94,
+            4_503_599_627_370_495.5,
+            -4_503_599_627_370_495.5,
+            9.223_372_036_854_775e18,
+            -9.223_372_036_854_775e18,
+            1e300,
+            -1e300,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        for k in 0..100_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let v = f64::from_bits(x);
+            values.push(v);
+            values.push(((x >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 10f64.powi(k % 20));
+            values.push((k as f64 - 50_000.0) * 0.25);
+        }
+        for v in values {
+            assert_eq!(floor_i64(v), v.floor() as i64, "{v:e}");
+            assert_eq!(round_i64(v), v.round() as i64, "{v:e}");
+        }
+    }
+}

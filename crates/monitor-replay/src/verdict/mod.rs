@@ -1,0 +1,290 @@
+//! The one verdict of a replay: every analysis yields a finding ([`FindingReport`]), and one
+//! function, the core's decision table (`monitor_core::verdict::decide`, the same code the
+//! board's FAULT lamp runs), turns them into the verdict every output shows ([`decide_report`]):
+//! `diagnose`'s last line and its JSON (`verdict`, `verdict_line`, `verdict_finding`,
+//! `findings`, `judged`, `not_judged`), `explain`'s headline, the Python result, the fleet's
+//! row and the HMI. The table itself, row by row, is in `docs/isolation.md` ("One verdict").
+//!
+//! The findings (built by the replay, [`findings`]):
+//! - **residuals**: the lamps r1..r4 and their isolation (Table 1's fault with its size, the
+//!   isolation's probability as the confidence), against commissioning or the file;
+//! - **winding**: the negative sequence's change (shorted turns, with the phase and its
+//!   confidence);
+//! - **rotor**: the current spectrum's (1 - 2s) f sideband (broken bars, with the MCSA band);
+//! - **operating point**: load moves and heating (they explain lamps; never a fault);
+//! - **data quality**: what the data-quality stage does not trust, and the sensors' readings
+//!   no machine gives;
+//! - **parameter fit**: whether the parameter file fits the log where nothing was
+//!   commissioned.
+
+pub(super) mod findings;
+mod words;
+pub use words::{against_text, fault_text, pct};
+
+use monitor_core::verdict::{decide, Finding, NamedFault, Size, State};
+pub use monitor_core::verdict::{Against, FindingSource, Rule, Verdict};
+use monitor_core::Phase;
+use serde::{Serialize, Serializer};
+
+/// One finding as the report gives it (JSON `findings[]`, `verdict_finding`): the core's
+/// [`Finding`] and a sentence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FindingReport {
+    /// What the decision table reads.
+    pub finding: Finding,
+    /// One sentence: what was found, or why nothing could be judged.
+    pub summary: String,
+    /// A short phrase for the verdict's lists: what was judged and against what
+    /// (`residuals against commissioning`, `rotor sidebands 58 dB below the supply line`), or
+    /// for a finding not judged, why (`rotor: the slip is below 0.003 (no load)`).
+    pub brief: String,
+}
+
+impl FindingReport {
+    /// A finding of `source` in `state` against `against`, with its sentence and its brief
+    /// phrase.
+    pub fn new(
+        source: FindingSource,
+        state: State,
+        against: Against,
+        summary: String,
+        brief: String,
+    ) -> Self {
+        FindingReport {
+            finding: Finding::new(source, state, against),
+            summary,
+            brief,
+        }
+    }
+
+    /// Where it comes from.
+    pub fn source(&self) -> FindingSource {
+        self.finding.source
+    }
+
+    /// The named fault, where there is one.
+    pub fn named(&self) -> Option<&NamedFault> {
+        self.finding.named()
+    }
+
+    /// The state's name in the JSON: `unavailable` (the log lacks what the analysis
+    /// needs), `not_judged` (the log kept it from judging), `clear`, `named`, `unexplained`,
+    /// `explained`, `out_of_range`.
+    pub fn state_name(&self) -> &'static str {
+        match self.finding.state {
+            State::Unavailable => "unavailable",
+            State::NotJudged => "not_judged",
+            State::Clear => "clear",
+            State::Named(_) => "named",
+            State::Unexplained => "unexplained",
+            State::Explained => "explained",
+            State::OutOfRange => "out_of_range",
+        }
+    }
+}
+
+/// The JSON form of a [`FindingReport`]: `source`, `state`, `fault`, `size`, `size_unit`
+/// (`relative`: 0.5 is +50 %; `of_i1`: a fraction of the positive-sequence current;
+/// `turns_fraction`: of the phase's turns; `db_below_line`: dB below the supply line),
+/// `phase`, `confidence` (null without a name), `against`, `summary`.
+#[derive(Serialize)]
+struct FindingJson<'a> {
+    source: FindingSource,
+    state: &'static str,
+    fault: Option<&'static str>,
+    size: Option<f32>,
+    size_unit: Option<&'static str>,
+    phase: Option<Phase>,
+    confidence: Option<f32>,
+    against: Against,
+    summary: &'a str,
+}
+
+/// A size's value and the JSON name of its unit.
+pub fn size_parts(size: Size) -> (f32, &'static str) {
+    match size {
+        Size::Relative(x) => (x, "relative"),
+        Size::OfPositiveSequence(x) => (x, "of_i1"),
+        Size::TurnsFraction(x) => (x, "turns_fraction"),
+        Size::DbBelowLine(x) => (x, "db_below_line"),
+    }
+}
+
+impl Serialize for FindingReport {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let n = self.named();
+        let size = n.map(|n| size_parts(n.size));
+        FindingJson {
+            source: self.source(),
+            state: self.state_name(),
+            fault: n.map(|n| n.fault.name()),
+            size: size.map(|s| s.0),
+            size_unit: size.map(|s| s.1),
+            phase: n.and_then(|n| n.phase),
+            confidence: n.map(|n| n.confidence),
+            against: self.finding.against,
+            summary: &self.summary,
+        }
+        .serialize(s)
+    }
+}
+
+/// What the decision table concluded, in the report's words.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Conclusion {
+    /// The verdict.
+    pub verdict: Verdict,
+    /// The row of the table that decided.
+    pub rule: Rule,
+    /// The finding it rests on, where one decided.
+    pub finding: Option<FindingReport>,
+    /// The verdict's line as printed after `verdict: ` (`FAULT rs +50 % (confidence 1.00;
+    /// residuals against commissioning)`, `healthy: residuals against commissioning; ...`).
+    pub line: String,
+    /// What was judged, one phrase per analysis (`residuals against commissioning`).
+    pub judged: Vec<String>,
+    /// What could not be judged, and why (`rotor: ...`).
+    pub not_judged: Vec<String>,
+    /// Why the verdict is not a FAULT or healthy, where it is not (watching, could not
+    /// judge): the deciding finding's sentence, then what could not be judged.
+    pub withheld_because: Vec<String>,
+}
+
+/// The verdict of `findings` by the core's decision table, with its line and lists.
+pub fn conclude(findings: &[FindingReport]) -> Conclusion {
+    let core: Vec<Finding> = findings.iter().map(|f| f.finding).collect();
+    let d = decide(&core);
+    let finding = d.by.and_then(|k| findings.get(k)).cloned();
+    let judged = words::judged(findings);
+    let not_judged = words::not_judged(findings);
+    let line = words::line(d, finding.as_ref(), findings, &judged, &not_judged);
+    let withheld_because = match d.verdict {
+        Verdict::Fault | Verdict::Healthy => Vec::new(),
+        Verdict::Watching | Verdict::CouldNotJudge => finding
+            .iter()
+            .map(|f| f.summary.clone())
+            .chain(not_judged.iter().cloned())
+            .collect(),
+    };
+    Conclusion {
+        verdict: d.verdict,
+        rule: d.rule,
+        finding,
+        line,
+        judged,
+        not_judged,
+        withheld_because,
+    }
+}
+
+/// Replaces the finding of `source` in `findings` (or adds it).
+pub fn put(findings: &mut Vec<FindingReport>, f: FindingReport) {
+    match findings.iter_mut().find(|g| g.source() == f.source()) {
+        Some(g) => *g = f,
+        None => findings.push(f),
+    }
+}
+
+use crate::{DiagnoseReport, IsolationReport, Replay, UnbalanceReport};
+use monitor_core::verdict::{FaultName, Glance};
+use monitor_core::MonitorOutput;
+
+impl Replay {
+    /// Every analysis' finding at the end of the replay (the data quality's is added by the
+    /// caller that ran the data-quality stage, `diagnose`): the residuals, the winding, the
+    /// rotor, the operating point, the parameter file's fit, and the sensors' impossible
+    /// readings.
+    pub(crate) fn findings(
+        &self,
+        inp: &findings::ResidualInputs<'_>,
+        unbalance: &UnbalanceReport,
+        rotor: &crate::RotorReport,
+    ) -> Vec<FindingReport> {
+        let residual = self.residual_finding(inp);
+        let mut found = vec![
+            residual.clone(),
+            findings::winding_finding(unbalance),
+            findings::rotor_finding(rotor),
+            self.operating_point_finding(inp.out, inp.isolation),
+            self.parameter_fit_finding(&residual, inp.isolation),
+        ];
+        found.extend(findings::sensor_flag_finding(inp.out.sensor_fault));
+        found
+    }
+}
+
+impl DiagnoseReport {
+    /// Decides the verdict from the report's `findings` by the decision table
+    /// ([`conclude`]) and writes it into the verdict's keys. Call again
+    /// after adding or replacing a finding.
+    pub fn conclude(&mut self) {
+        let c = conclude(&self.findings);
+        self.verdict = c.verdict;
+        self.verdict_rule = c.rule;
+        self.verdict_line = c.line;
+        self.verdict_finding = c.finding;
+        self.judged = c.judged;
+        self.not_judged = c.not_judged;
+        self.verdict_withheld_because = c.withheld_because;
+    }
+
+    /// Data that cannot carry a verdict (`why`): every fault-judging finding that judged
+    /// something becomes "not judged", with what it would have said; decided again.
+    pub fn distrust(&mut self, why: &str) {
+        for f in &mut self.findings {
+            if f.source().judges_faults()
+                && f.finding.state != monitor_core::verdict::State::NotJudged
+            {
+                f.summary = format!("not judged ({why}); it read: {}", f.summary);
+                f.brief = format!("{}: {why}", f.source().name());
+                f.finding.state = monitor_core::verdict::State::NotJudged;
+            }
+        }
+        self.conclude();
+    }
+
+    /// Replaces (or adds) the finding of its source and decides again.
+    pub fn put_finding(&mut self, f: FindingReport) {
+        put(&mut self.findings, f);
+        self.conclude();
+    }
+}
+
+/// The moment's evidence as the decision table reads it (the board's
+/// `monitor_core::verdict::Glance`): the lamps, the sensor flags, the isolation's name with
+/// its candidate's probability, its baseline, whether the operating point explains the
+/// lamps (`moved`), and the core's winding phase.
+pub(crate) fn glance(
+    out: &MonitorOutput,
+    report: Option<&(IsolationReport, Vec<crate::FaultCandidate>)>,
+    moved: bool,
+) -> Glance {
+    let named = report.and_then(|(r, c)| findings::isolation_name(r, c));
+    let friction = report.is_some_and(|(r, _)| r.named == Some(crate::IsolationName::Friction));
+    Glance {
+        lamps_lit: out.fault_detected,
+        sensor_fault: out.sensor_fault.any(),
+        named,
+        commissioned: report.is_some_and(|(r, _)| r.baseline == crate::IsolationBaseline::Learned),
+        moved: moved || friction,
+        // The core's winding phase counts where the lamps are judged (settled, quasi-steady):
+        // a start's or a step's transient unbalances the currents for a while.
+        winding: steady_phase(out).map(|p| NamedFault {
+            fault: FaultName::ShortedTurns,
+            size: Size::OfPositiveSequence(out.unbalance.winding_ratio),
+            phase: Some(p),
+            confidence: out.unbalance.phase_confidence,
+        }),
+    }
+}
+
+/// The core's winding phase at `out` where the lamps are judged (evaluating, quasi-steady),
+/// else `None`.
+fn steady_phase(out: &MonitorOutput) -> Option<Phase> {
+    out.unbalance
+        .suspect_phase
+        .filter(|_| out.evaluating && out.quasi_steady)
+}
+
+#[cfg(test)]
+mod tests;
