@@ -167,11 +167,11 @@ def diagnose(
     params: ParamsLike,
     commission: Optional[Tuple[float, float]] = None,
     baseline: Optional[Union[LogLike, Sequence[LogLike]]] = None,
-    load: str = "unknown",
-    angle: str = "rotor-flux",
-    residuals: str = "steady",
+    load: Optional[str] = None,
+    angle: Optional[str] = None,
+    residuals: Optional[str] = None,
     allow_incomplete: bool = False,
-    timeline_step: float = 0.5,
+    timeline_step: Optional[float] = None,
     group: Optional[str] = None,
 ) -> DiagnoseResult:
     """Replay a log through the monitor's core: lamps, the named fault with its size and
@@ -188,16 +188,17 @@ def diagnose(
     baseline : log or list of logs, optional
         Healthy logs of the same motor (files, folders, or data): the winding's negative
         sequence is judged against their mean, their spread sets the least change.
-    load : {"unknown", "viscous"}
-        What is known of the load ("unknown": a load change is a load move, never a fault).
-    angle : {"rotor-flux", "pll", "zero-crossing"}
-        The frame's angle source.
-    residuals : {"steady", "full"}
-        The residual form the lamps act on (eq. 37 or eq. 36).
+    load : {"unknown", "viscous"}, optional
+        What is known of the load ("unknown", the default: a load change is a load move,
+        never a fault).
+    angle : {"rotor-flux", "pll", "zero-crossing"}, optional
+        The frame's angle source (default "rotor-flux").
+    residuals : {"steady", "full"}, optional
+        The residual form the lamps act on (eq. 37, the default, or eq. 36).
     allow_incomplete : bool
         Report even when the commissioning window was not learned.
-    timeline_step : float
-        Timeline resolution [s].
+    timeline_step : float, optional
+        Timeline resolution [s] (default: the command line's, 0.5 s).
     group : str, optional
         The TDMS group holding the channels.
 
@@ -228,7 +229,7 @@ def diagnose(
                 angle=angle,
                 residuals=residuals,
                 allow_incomplete=allow_incomplete,
-                timeline_step=float(timeline_step),
+                timeline_step=None if timeline_step is None else float(timeline_step),
                 group=group,
             )
     finally:

@@ -31,11 +31,11 @@ def diagnose(
     params: ParamsLike,
     commission: Optional[Tuple[float, float]] = ...,
     baseline: Optional[Union[LogLike, Sequence[LogLike]]] = ...,
-    load: str = ...,
-    angle: str = ...,
-    residuals: str = ...,
+    load: Optional[str] = ...,
+    angle: Optional[str] = ...,
+    residuals: Optional[str] = ...,
     allow_incomplete: bool = ...,
-    timeline_step: float = ...,
+    timeline_step: Optional[float] = ...,
     group: Optional[str] = ...,
 ) -> DiagnoseResult: ...
 def compare(

@@ -16,11 +16,11 @@ def diagnose(
     params_is_text: bool = ...,
     commission: Optional[Tuple[float, float]] = ...,
     baseline: List[str] = ...,
-    load: str = ...,
-    angle: str = ...,
-    residuals: str = ...,
+    load: Optional[str] = ...,
+    angle: Optional[str] = ...,
+    residuals: Optional[str] = ...,
     allow_incomplete: bool = ...,
-    timeline_step: float = ...,
+    timeline_step: Optional[float] = ...,
     group: Optional[str] = ...,
 ) -> str: ...
 def compare(

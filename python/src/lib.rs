@@ -137,7 +137,7 @@ fn effects_of(names: &[String]) -> PyResult<Vec<monitor_core::EffectKind>> {
 
 /// `diagnose --json` of the log at `log` with the parameter file `params`.
 #[pyfunction]
-#[pyo3(signature = (log, params, params_is_text=false, commission=None, baseline=Vec::new(), load="unknown", angle="rotor-flux", residuals="steady", allow_incomplete=false, timeline_step=0.5, group=None))]
+#[pyo3(signature = (log, params, params_is_text=false, commission=None, baseline=Vec::new(), load=None, angle=None, residuals=None, allow_incomplete=false, timeline_step=None, group=None))]
 #[allow(clippy::too_many_arguments)]
 fn diagnose(
     py: Python<'_>,
@@ -146,21 +146,27 @@ fn diagnose(
     params_is_text: bool,
     commission: Option<(f64, f64)>,
     baseline: Vec<PathBuf>,
-    load: &str,
-    angle: &str,
-    residuals: &str,
+    load: Option<&str>,
+    angle: Option<&str>,
+    residuals: Option<&str>,
     allow_incomplete: bool,
-    timeline_step: f64,
+    timeline_step: Option<f64>,
     group: Option<String>,
 ) -> PyResult<String> {
+    // An option not given keeps the one default (`DiagnoseRequest::default`, the command
+    // line's too).
+    let d = api::DiagnoseRequest::default();
     let req = api::DiagnoseRequest {
         commission,
         allow_incomplete,
         baseline,
-        load: load_of(load)?,
-        angle_source: angle_of(angle)?,
-        residual_form: residuals_of(residuals)?,
-        timeline_step_s: timeline_step,
+        load: load.map(load_of).transpose()?.unwrap_or(d.load),
+        angle_source: angle.map(angle_of).transpose()?.unwrap_or(d.angle_source),
+        residual_form: residuals
+            .map(residuals_of)
+            .transpose()?
+            .unwrap_or(d.residual_form),
+        timeline_step_s: timeline_step.unwrap_or(d.timeline_step_s),
         group,
     };
     run(py, || {

@@ -40,6 +40,15 @@ pub enum ApiError {
     /// The analysis could not run on this log.
     #[error(transparent)]
     Analysis(#[from] AnalysisError),
+    /// The parameter file given is a log (or the log a parameter file): the arguments look
+    /// swapped.
+    #[error("--params {params} is a log, not a parameter file{also}: the arguments look swapped (give --params P.toml LOG)")]
+    Swapped {
+        /// The path given as the parameter file.
+        params: String,
+        /// ", and LOG a parameter file" when the log given is a `.toml`, else empty.
+        also: String,
+    },
 }
 
 /// The kinds of [`ApiError`] (the Python package's exception classes).
@@ -59,7 +68,7 @@ impl ApiError {
     /// Which kind of error this is.
     pub fn kind(&self) -> ErrorKind {
         match self {
-            ApiError::Params(_) => ErrorKind::Params,
+            ApiError::Params(_) | ApiError::Swapped { .. } => ErrorKind::Params,
             ApiError::Log(_) | ApiError::Replay(ReplayError::Log(_)) => ErrorKind::Log,
             ApiError::Analysis(AnalysisError::Log(_)) => ErrorKind::Log,
             ApiError::Option(_) | ApiError::Replay(ReplayError::Option(_)) => ErrorKind::Option,
@@ -103,6 +112,44 @@ pub fn load_params(source: ParamsSource<'_>) -> Result<(ParamFile, ColumnMapping
     }
 }
 
+/// Reads the parameter file for a command on `log` (once per command): as [`load_params`],
+/// and when the file cannot be read as one and the two paths look swapped (a log's
+/// extension given as `--params`, or a `.toml` given as the log), [`ApiError::Swapped`].
+///
+/// # Errors
+/// As [`load_params`]; [`ApiError::Swapped`].
+pub fn load_params_for(
+    source: ParamsSource<'_>,
+    log: &Path,
+) -> Result<(ParamFile, ColumnMapping), ApiError> {
+    load_params(source).map_err(|e| swapped(source, log).unwrap_or(e))
+}
+
+/// [`ApiError::Swapped`] when `source` and `log` look swapped (as [`load_params_for`]
+/// says).
+fn swapped(source: ParamsSource<'_>, log: &Path) -> Option<ApiError> {
+    let ext = |p: &Path| {
+        p.extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .unwrap_or_default()
+    };
+    let ParamsSource::Path(params) = source else {
+        return None;
+    };
+    let log_is_toml = ext(log) == "toml";
+    (["csv", "tdms", "parquet"].contains(&ext(params).as_str()) || log_is_toml).then(|| {
+        ApiError::Swapped {
+            params: params.display().to_string(),
+            also: if log_is_toml {
+                format!(", and {} a parameter file", log.display())
+            } else {
+                String::new()
+            },
+        }
+    })
+}
+
 /// What `diagnose` is asked (its command-line options).
 #[derive(Debug, Clone)]
 pub struct DiagnoseRequest {
@@ -124,17 +171,35 @@ pub struct DiagnoseRequest {
     pub group: Option<String>,
 }
 
+/// Every default is [`ReplayOptions`]'s (no baseline, no TDMS group).
 impl Default for DiagnoseRequest {
     fn default() -> Self {
+        let r = ReplayOptions::default();
         DiagnoseRequest {
-            commission: None,
-            allow_incomplete: false,
+            commission: r.commission,
+            allow_incomplete: r.allow_incomplete,
             baseline: Vec::new(),
-            load: LoadModel::Unknown,
-            angle_source: AngleSource::RotorFluxCurrentModel,
-            residual_form: ResidualForm::Steady,
-            timeline_step_s: 0.5,
+            load: r.load,
+            angle_source: r.angle_source,
+            residual_form: r.residual_form,
+            timeline_step_s: r.timeline_step_s,
             group: None,
+        }
+    }
+}
+
+impl DiagnoseRequest {
+    /// The replay's options for this request (the healthy reference is filled from
+    /// `baseline` by [`diagnose`]).
+    pub fn replay_options(&self) -> ReplayOptions {
+        ReplayOptions {
+            angle_source: self.angle_source,
+            residual_form: self.residual_form,
+            commission: self.commission,
+            allow_incomplete: self.allow_incomplete,
+            timeline_step_s: self.timeline_step_s.max(1e-4),
+            unbalance_baseline: None,
+            load: self.load,
         }
     }
 }
@@ -216,20 +281,12 @@ pub fn diagnose(
     req: &DiagnoseRequest,
     progress: &mut dyn FnMut(f64),
 ) -> Result<monitor_replay::Diagnosed, ApiError> {
-    let (params, columns) = load_params(params)?;
+    let (params, columns) = load_params_for(params, log)?;
     let open = OpenOptions {
         group: req.group.clone(),
         columns,
     };
-    let mut opts = ReplayOptions {
-        angle_source: req.angle_source,
-        residual_form: req.residual_form,
-        commission: req.commission,
-        allow_incomplete: req.allow_incomplete,
-        timeline_step_s: req.timeline_step_s.max(1e-4),
-        unbalance_baseline: None,
-        load: req.load,
-    };
+    let mut opts = req.replay_options();
     if !req.baseline.is_empty() {
         let files = baseline_files(&req.baseline)?;
         if let Some(same) = files.iter().find(|f| same_file(f, log)) {
@@ -284,7 +341,7 @@ pub fn load_analysis(
     req: &AnalysisRequest,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Analysis, ApiError> {
-    let (params, columns) = load_params(params)?;
+    let (params, columns) = load_params_for(params, log)?;
     let file = LogFile::open_with(
         log,
         &OpenOptions {
@@ -369,17 +426,24 @@ pub fn identify(
             )));
         }
     }
+    // The file is read once: its text is the identified file's template.
     let (start_text, start_name) = match params {
         ParamsSource::Path(p) => (
-            std::fs::read_to_string(p).map_err(|source| ParamError::Io {
-                path: p.display().to_string(),
-                source,
+            std::fs::read_to_string(p).map_err(|source| {
+                swapped(params, log).unwrap_or(ApiError::Params(ParamError::Io {
+                    path: p.display().to_string(),
+                    source,
+                }))
             })?,
             p.display().to_string(),
         ),
         ParamsSource::Toml { text, origin } => (text.to_string(), origin.to_string()),
     };
-    let (start, columns) = load_params(params)?;
+    let (start, columns) = load_params(ParamsSource::Toml {
+        text: &start_text,
+        origin: &start_name,
+    })
+    .map_err(|e| swapped(params, log).unwrap_or(e))?;
     let file = LogFile::open_with(log, &OpenOptions { group, columns })?;
     let mut rows: Vec<monitor_io::log::Row> = Vec::new();
     file.for_each_row(&mut |f| progress(0.1 * f), &mut rows)?;

@@ -16,7 +16,8 @@ pub struct ReplayOptions {
     pub commission: Option<(f64, f64)>,
     /// Report a commissioning window that was not learned instead of refusing.
     pub allow_incomplete: bool,
-    /// Timeline resolution [s] (one point per interval).
+    /// Timeline resolution [s] (one point per interval; default 0.5 s, the one default of
+    /// `diagnose --timeline-step`, the API and Python).
     pub timeline_step_s: f64,
     /// The healthy machine's negative sequence to judge the winding against (`diagnose
     /// --baseline HEALTHY.csv`); without it, the one learned in the commissioning window,
@@ -46,6 +47,9 @@ pub enum LoadModel {
     Viscous,
 }
 
+/// The one home of `diagnose`'s defaults: the command line, the API
+/// (`monitor_api::DiagnoseRequest`), the fleet run and the Python package take theirs from
+/// here.
 impl Default for ReplayOptions {
     fn default() -> Self {
         ReplayOptions {
@@ -53,7 +57,7 @@ impl Default for ReplayOptions {
             residual_form: ResidualForm::Steady,
             commission: None,
             allow_incomplete: false,
-            timeline_step_s: 0.1,
+            timeline_step_s: 0.5,
             unbalance_baseline: None,
             load: LoadModel::Unknown,
         }

@@ -71,8 +71,6 @@ impl Common {
 
     /// Reads the parameter file and the log (with a progress bar for large logs).
     fn load(&self) -> anyhow::Result<Analysis> {
-        // (Read once here for the swapped-arguments message.)
-        super::load_params_for(&self.params, &self.log)?;
         let big = std::fs::metadata(&self.log)
             .map(|m| m.len() > 20_000_000)
             .unwrap_or(false);

@@ -84,22 +84,28 @@ pub struct DiagnoseArgs {
     #[arg(long, value_name = "HEALTHY", num_args = 1.., action = clap::ArgAction::Append)]
     pub baseline: Vec<PathBuf>,
     /// Frame angle source.
-    #[arg(long, value_enum, default_value_t = AngleArg::RotorFlux)]
+    #[arg(long, value_enum, default_value_t = defaults().angle_source.into())]
     pub angle: AngleArg,
     /// Residual form the lamps act on.
-    #[arg(long, value_enum, default_value_t = ResidualArg::Steady)]
+    #[arg(long, value_enum, default_value_t = defaults().residual_form.into())]
     pub residuals: ResidualArg,
     /// What is known of the load: `unknown` (service: a load change is an operating-point
     /// change, never a named fault) or `viscous` (the paper's fixed viscous load: a B/Bl
     /// change is the fault `b/bl`).
-    #[arg(long, value_enum, default_value_t = LoadArg::Unknown)]
+    #[arg(long, value_enum, default_value_t = defaults().load.into())]
     pub load: LoadArg,
     /// Timeline resolution in the output [s].
-    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true, value_parser = super::parse_positive_seconds)]
+    #[arg(long, default_value_t = defaults().timeline_step_s, allow_negative_numbers = true, value_parser = super::parse_positive_seconds)]
     pub timeline_step: f64,
     /// Print one JSON document on stdout instead of the table.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `diagnose`'s defaults: the API request's, whose one home is the replay's options
+/// (`monitor_replay::ReplayOptions::default`).
+fn defaults() -> monitor_api::DiagnoseRequest {
+    monitor_api::DiagnoseRequest::default()
 }
 
 /// Runs `diagnose`.
@@ -108,8 +114,6 @@ pub struct DiagnoseArgs {
 /// Bad parameter file or log (one line naming the file, line and column), or a log the
 /// core cannot be configured for.
 pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
-    // (Read once here for the swapped-arguments message.)
-    super::load_params_for(&args.params, &args.log)?;
     let req = monitor_api::DiagnoseRequest {
         commission: args.commission,
         allow_incomplete: args.allow_incomplete,

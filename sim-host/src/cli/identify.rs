@@ -90,8 +90,6 @@ fn check(args: &IdentifyArgs) -> anyhow::Result<()> {
 /// Bad input (one line naming the file, the column or the problem), or a write error.
 pub fn run(args: &IdentifyArgs) -> anyhow::Result<()> {
     check(args)?;
-    // (Read once here for the swapped-arguments message.)
-    super::load_params_for(&args.params, &args.log)?;
     let pb = progress::bar(progress::FRACTION_STEPS, "identify", true);
     let done = monitor_api::identify(
         monitor_api::ParamsSource::Path(&args.params),

@@ -125,6 +125,16 @@ impl From<AngleArg> for AngleSource {
     }
 }
 
+impl From<AngleSource> for AngleArg {
+    fn from(a: AngleSource) -> Self {
+        match a {
+            AngleSource::RotorFluxCurrentModel => AngleArg::RotorFlux,
+            AngleSource::Pll => AngleArg::Pll,
+            AngleSource::ZeroCrossing => AngleArg::ZeroCrossing,
+        }
+    }
+}
+
 /// What is known of the load, on the command line (`diagnose --load`, `hmi --load`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum LoadArg {
@@ -144,6 +154,15 @@ impl From<LoadArg> for monitor_replay::LoadModel {
     }
 }
 
+impl From<monitor_replay::LoadModel> for LoadArg {
+    fn from(a: monitor_replay::LoadModel) -> Self {
+        match a {
+            monitor_replay::LoadModel::Unknown => LoadArg::Unknown,
+            monitor_replay::LoadModel::Viscous => LoadArg::Viscous,
+        }
+    }
+}
+
 /// Residual form on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum ResidualArg {
@@ -158,6 +177,15 @@ impl From<ResidualArg> for ResidualForm {
         match a {
             ResidualArg::Steady => ResidualForm::Steady,
             ResidualArg::Full => ResidualForm::Full,
+        }
+    }
+}
+
+impl From<ResidualForm> for ResidualArg {
+    fn from(a: ResidualForm) -> Self {
+        match a {
+            ResidualForm::Steady => ResidualArg::Steady,
+            ResidualForm::Full => ResidualArg::Full,
         }
     }
 }
@@ -215,44 +243,6 @@ pub fn parse_window(s: &str) -> Result<(f64, f64), String> {
         return Err(format!("'{s}': END must be a finite number of seconds"));
     }
     Ok((a, b))
-}
-
-/// Reads the parameter file `params` and its `[columns]` mapping for the log `log`
-/// (`monitor_io::log::mapping::load_params`). When it cannot be read as a parameter file and
-/// the two look swapped (the parameter file named like a log, the log like a TOML file), the
-/// one-line error says so.
-///
-/// # Errors
-/// The parameter file's error, with the swap named where it looks like one.
-pub fn load_params_for(
-    params: &std::path::Path,
-    log: &std::path::Path,
-) -> anyhow::Result<(
-    monitor_io::params::ParamFile,
-    monitor_io::log::ColumnMapping,
-)> {
-    let ext = |p: &std::path::Path| {
-        p.extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase)
-            .unwrap_or_default()
-    };
-    monitor_io::log::mapping::load_params(params).map_err(|e| {
-        let looks_log = ["csv", "tdms", "parquet"].contains(&ext(params).as_str());
-        if looks_log || ext(log) == "toml" {
-            anyhow::anyhow!(
-                "--params {} is a log, not a parameter file{}: the arguments look swapped (give --params P.toml LOG)",
-                params.display(),
-                if ext(log) == "toml" {
-                    format!(", and {} a parameter file", log.display())
-                } else {
-                    String::new()
-                }
-            )
-        } else {
-            e.into()
-        }
-    })
 }
 
 /// Writes `bytes` to `out` atomically when an output was asked for (`--out`); nothing
