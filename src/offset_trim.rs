@@ -149,7 +149,7 @@ fn judge(sum: u32, sum_sq: u64, n: u32, zero: f32) -> ChannelTrim {
     let s = u64::from(sum);
     // n^2 var = n sum_sq - sum^2, exact in integers (>= 0 for any real data).
     let n2_var = n64.saturating_mul(sum_sq).saturating_sub(s * s);
-    let spread = monitor_core::sqrt(n2_var as f32) / n64 as f32;
+    let spread = monitor_core::math::sqrt(n2_var as f32) / n64 as f32;
     let mean = sum as f32 / n64 as f32;
     if spread > QUIET_SPREAD_CODES {
         ChannelTrim::NotQuiet(spread)

@@ -166,12 +166,12 @@ impl SrfPll {
         // q component only: V_q = -alpha sin + beta cos.
         let e = (-v.alpha * sc_pll.sin + v.beta * sc_pll.cos) * self.inv_v;
         // max/min rather than clamp: no panic path, NaN-safe (NaN input leaves the bound).
-        self.integ = crate::minf(
-            crate::maxf(self.integ + self.ki * e * self.dt, -self.w0),
+        self.integ = crate::math::minf(
+            crate::math::maxf(self.integ + self.ki * e * self.dt, -self.w0),
             self.w0,
         );
-        self.omega = crate::minf(
-            crate::maxf(self.w0 + self.integ + self.kp * e, 0.0),
+        self.omega = crate::math::minf(
+            crate::math::maxf(self.w0 + self.integ + self.kp * e, 0.0),
             2.0 * self.w0,
         );
         self.theta_pll = wrap_angle(self.theta_pll + self.omega * self.dt);

@@ -120,7 +120,7 @@ impl CommissioningRun {
         if self.blocks_needed == 0 {
             return 0.0;
         }
-        crate::minf(self.blocks_learned as f32 / self.blocks_needed as f32, 1.0)
+        crate::math::minf(self.blocks_learned as f32 / self.blocks_needed as f32, 1.0)
     }
 }
 

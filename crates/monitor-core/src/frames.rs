@@ -245,7 +245,7 @@ impl SinCos {
         if !(n2.is_finite() && n2 > min_norm * min_norm) {
             return None;
         }
-        let inv = 1.0 / crate::sqrt(n2);
+        let inv = 1.0 / crate::math::sqrt(n2);
         Some(SinCos {
             sin: y * inv,
             cos: x * inv,

@@ -22,7 +22,8 @@
 //! The host's replay (`diagnose`, the HMI, the demo) and the firmware's panel use this one
 //! rule. Pure arithmetic on `f32`, no allocation, no panic.
 
-use crate::{fast_hypot, maxf, minf, MonitorOutput};
+use crate::math::{fast_hypot, maxf, minf};
+use crate::MonitorOutput;
 
 /// Departure from the commissioned range that counts as "moved" (fraction of the range's
 /// largest magnitude): 20 %. A load step of that size is what the learned means do not

@@ -145,7 +145,7 @@ impl Normaliser {
             if !v.is_finite() {
                 return None;
             }
-            *o = crate::minf(crate::maxf(v, -1.0), 1.0);
+            *o = crate::math::minf(crate::math::maxf(v, -1.0), 1.0);
         }
         Some(out)
     }

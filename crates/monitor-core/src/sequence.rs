@@ -153,7 +153,7 @@ impl SequenceAnalyzer {
 
     /// |I1|, the positive-sequence current magnitude (phase peak) [A].
     pub fn positive_magnitude(&self) -> f32 {
-        crate::fast_hypot(self.pd.y(), self.pq.y())
+        crate::math::fast_hypot(self.pd.y(), self.pq.y())
     }
 
     /// Ratio, angle and suspect phase, given the model correction `arg Z1` and the
@@ -181,7 +181,7 @@ pub fn sequence_result(
     if !(p2 > 1e-12 && n2.is_finite()) {
         return NegativeSequence::default();
     }
-    let ratio = crate::sqrt(n2 / p2);
+    let ratio = crate::math::sqrt(n2 / p2);
     let angle = crate::frames::wrap_angle(F32Ext::atan2(-n.1, n.0) - F32Ext::atan2(p.1, p.0));
     let suspect = (ratio >= min_ratio).then(|| suspect_phase(angle, correction_rad));
     NegativeSequence {
@@ -261,15 +261,15 @@ pub fn winding_asymmetry(
             let (sr, si) = ((vr * zr + vi * zi) / d, (vi * zr - vr * zi) / d);
             wr -= sr;
             wi -= si;
-            supply_ratio = crate::fast_hypot(sr, si);
+            supply_ratio = crate::math::fast_hypot(sr, si);
         }
     }
-    let ratio = crate::fast_hypot(wr, wi);
+    let ratio = crate::math::fast_hypot(wr, wi);
     if !(ratio.is_finite() && supply_ratio.is_finite()) {
         return WindingAsymmetry::default();
     }
     let angle = F32Ext::atan2(wi, wr);
-    let floor = crate::maxf(min_ratio, SUPPLY_PART_UNCERTAINTY * supply_ratio);
+    let floor = crate::math::maxf(min_ratio, SUPPLY_PART_UNCERTAINTY * supply_ratio);
     let corr = asymmetry_correction_rad(m, we, s);
     let named = ratio >= floor;
     WindingAsymmetry {
@@ -298,7 +298,7 @@ pub fn shorted_turns_mmf_ratio(ratio: f32) -> f32 {
 /// resistance means more turns for the same `I2`. 0 when `Z1` is not positive.
 pub fn min_shorted_fraction(m: &MotorModel, we: f32, s: f32, ratio: f32) -> f32 {
     let z1 = equivalent_impedance(m, we, s);
-    let z1n = crate::fast_hypot(z1.0, z1.1);
+    let z1n = crate::math::fast_hypot(z1.0, z1.1);
     if !(z1n > 0.0) {
         return 0.0;
     }
@@ -316,7 +316,7 @@ pub fn slip_for_current(m: &MotorModel, v_peak: f32, we: f32, i1_peak: f32) -> f
     for _ in 0..40 {
         let mid = 0.5 * (lo + hi);
         let z = equivalent_impedance(m, we, mid);
-        let i = v_peak / crate::fast_hypot(z.0, z.1);
+        let i = v_peak / crate::math::fast_hypot(z.0, z.1);
         if i < i1_peak {
             lo = mid;
         } else {
@@ -367,7 +367,7 @@ pub fn phase_confidence(i2_over_i1_angle_rad: f32, correction_rad: f32) -> f32 {
     let third = core::f32::consts::TAU / 3.0;
     let x = crate::frames::wrap_angle(i2_over_i1_angle_rad - correction_rad) / third;
     let dev = x - F32Ext::round(x);
-    crate::maxf(0.0, 1.0 - 2.0 * F32Ext::abs(dev))
+    crate::math::maxf(0.0, 1.0 - 2.0 * F32Ext::abs(dev))
 }
 
 /// A healthy machine's own negative sequence, `|I2/I1|` from its winding and core

@@ -116,7 +116,7 @@ impl Welford {
         let n = self.n.max(1) as f32;
         let mut spread = [0.0; 4];
         for (s, m2) in spread.iter_mut().zip(self.m2) {
-            *s = crate::sqrt(crate::maxf(m2 / n, 0.0));
+            *s = crate::math::sqrt(crate::math::maxf(m2 / n, 0.0));
         }
         Calibration {
             mean: self.mean,
@@ -175,7 +175,7 @@ impl Lamps {
                 let m = c.mean.get(k).copied().unwrap_or(0.0);
                 let s = c.spread.get(k).copied().unwrap_or(0.0);
                 let min = self.cfg.min_band.get(k).copied().unwrap_or(0.01);
-                (m, crate::maxf(self.cfg.k_sigma * s, min))
+                (m, crate::math::maxf(self.cfg.k_sigma * s, min))
             }
             None => (0.0, self.cfg.fixed.get(k).copied().unwrap_or(0.03)),
         }

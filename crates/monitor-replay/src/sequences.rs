@@ -439,7 +439,7 @@ impl SequenceFront {
                     self.pll.align(i.beta.atan2(i.alpha));
                 }
                 self.i_ms.update(&mut self.i_ms_state, m2);
-                let k = 1.0 / monitor_core::sqrt(self.i_ms_state.y().max(1e-12));
+                let k = 1.0 / monitor_core::math::sqrt(self.i_ms_state.y().max(1e-12));
                 self.pll.update(
                     AlphaBeta {
                         alpha: i.alpha * k,

@@ -258,7 +258,7 @@ fn sub(a: C, b: C) -> C {
 }
 
 fn abs(a: C) -> f32 {
-    monitor_core::fast_hypot(a.0, a.1)
+    monitor_core::math::fast_hypot(a.0, a.1)
 }
 
 /// Mean of complex values.

@@ -254,10 +254,10 @@ impl Follower {
     pub fn observe(&mut self, p: &SteadyPoint, dt_s: f32, usable: bool, learning: bool) -> Step {
         let dt = observed_dt(dt_s);
         // Saturate: only "long enough or not" matters.
-        self.since_isolation_s = crate::minf(self.since_isolation_s + dt, 2.0 * CONFIRM_S);
+        self.since_isolation_s = crate::math::minf(self.since_isolation_s + dt, 2.0 * CONFIRM_S);
         // (Saturates where the reach covers the whole range: 185 K at 10 K/s.)
-        self.since_judged_s = crate::minf(self.since_judged_s + dt, 20.0);
-        self.since_tracked_s = crate::minf(self.since_tracked_s + dt, 1000.0);
+        self.since_judged_s = crate::math::minf(self.since_judged_s + dt, 20.0);
+        self.since_tracked_s = crate::math::minf(self.since_tracked_s + dt, 1000.0);
         let ended = self.follow_learning(learning, dt);
         if !usable {
             self.restart();
@@ -305,7 +305,7 @@ impl Follower {
             self.settling_s = SETTLE_S;
             self.onset_restarted = false;
         } else {
-            self.settling_s = crate::maxf(self.settling_s - dt, 0.0);
+            self.settling_s = crate::math::maxf(self.settling_s - dt, 0.0);
         }
         self.block_sum.add_scaled(p, dt);
         self.block_s += dt;
@@ -335,7 +335,7 @@ impl Follower {
         }
         if learning {
             // (The averaged point's time: the middle of its blocks.)
-            let t = crate::maxf(self.learning_s - 0.5 * averaged_s, 0.0);
+            let t = crate::math::maxf(self.learning_s - 0.5 * averaged_s, 0.0);
             self.isolator.learn_at(&avg, t);
             Step::Learned
         } else {
@@ -354,7 +354,7 @@ impl Follower {
             self.settling_s = SETTLE_S;
             return Step::Waiting;
         }
-        let scale = crate::sqrt(AVERAGE_MAX_S / averaged_s);
+        let scale = crate::math::sqrt(AVERAGE_MAX_S / averaged_s);
         // How far the winding can have moved since its temperature was last judged.
         self.isolator
             .set_heating_reach_k(self.since_judged_s, self.warming_k_per_s);
@@ -468,7 +468,7 @@ impl Follower {
     fn confirm(&mut self, result: Isolation) -> Step {
         let key = name_key(&result);
         if key == self.pending {
-            self.held_s = crate::minf(self.held_s + self.since_isolation_s, 2.0 * CONFIRM_S);
+            self.held_s = crate::math::minf(self.held_s + self.since_isolation_s, 2.0 * CONFIRM_S);
         } else {
             self.pending = key;
             self.held_s = 0.0;
@@ -490,7 +490,7 @@ impl Follower {
         if averaged_s < AVERAGE_S - 0.5 * STEP_S {
             return None;
         }
-        Some((self.mean()?, crate::sqrt(AVERAGE_MAX_S / averaged_s)))
+        Some((self.mean()?, crate::math::sqrt(AVERAGE_MAX_S / averaged_s)))
     }
 
     /// The latest isolation in force, if any was made.

@@ -76,8 +76,8 @@ impl Isolator {
     /// is not finite and positive changes nothing.
     pub fn track_heating(&mut self, k: f32) {
         if k.is_finite() && k > 0.0 {
-            self.heating_factor = crate::minf(
-                crate::maxf(self.heating_factor * k, HEATING_K_MIN),
+            self.heating_factor = crate::math::minf(
+                crate::math::maxf(self.heating_factor * k, HEATING_K_MIN),
                 HEATING_K_MAX,
             );
         }
@@ -120,7 +120,7 @@ impl Isolator {
         }
         b.spread = b
             .spread
-            .zip_map(DEFAULT_SPREAD, |s, d| crate::maxf(s, 0.2 * d));
+            .zip_map(DEFAULT_SPREAD, |s, d| crate::math::maxf(s, 0.2 * d));
         self.baseline = b;
         self.learned_range = crate::OperatingRange::EMPTY;
         Ok(())
@@ -199,7 +199,7 @@ impl Isolator {
         let one_load = l
             .range
             .load_a
-            .is_some_and(|[lo, hi]| hi - lo < WIDE_SPAN * crate::maxf(lo.abs(), hi.abs()));
+            .is_some_and(|[lo, hi]| hi - lo < WIDE_SPAN * crate::math::maxf(lo.abs(), hi.abs()));
         let remaining = ss0 - r * num;
         let rise = -r * l.t_last;
         let warming = one_load
@@ -217,8 +217,8 @@ impl Isolator {
             .zip(l.sums.iter().zip(l.shift))
             .zip(LEARNED_SPREAD_FLOOR.to_array())
         {
-            let var = crate::maxf(xx - 2.0 * r * xu + r * r * uu, 0.0) / (n - 1.0);
-            *s = crate::maxf(2.0 * crate::sqrt(var), floor);
+            let var = crate::math::maxf(xx - 2.0 * r * xu + r * r * uu, 0.0) / (n - 1.0);
+            *s = crate::math::maxf(2.0 * crate::math::sqrt(var), floor);
             *m = shift + (sums.x - r * sums.u) / n;
         }
         let ok = self
@@ -280,8 +280,8 @@ impl Isolator {
     #[inline(never)]
     fn eval(&self, c: &Circuit, q: &SteadyPoint) -> Option<ParityResiduals> {
         let (i, v, we, wr) = (q.i, q.v, q.we_rad_s, q.wr_rad_s);
-        let vmag = crate::fast_hypot(v.d, v.q);
-        let imag = crate::fast_hypot(i.d, i.q);
+        let vmag = crate::math::fast_hypot(v.d, v.q);
+        let imag = crate::math::fast_hypot(i.d, i.q);
         if !(we > 0.0 && vmag > 0.0 && imag > 0.0 && wr.is_finite()) {
             return None;
         }
@@ -314,7 +314,7 @@ impl Isolator {
     /// scatters more ([`Follower`]: `sqrt(AVERAGE_MAX_S / averaged)`).
     pub fn isolate_scaled(&self, p: &SteadyPoint, spread_scale: f32) -> Isolation {
         let k = if spread_scale.is_finite() {
-            crate::maxf(spread_scale, 1.0)
+            crate::math::maxf(spread_scale, 1.0)
         } else {
             1.0
         };
@@ -340,7 +340,7 @@ impl Isolator {
             false => w,
         };
         let chi0 = self.chi2_at(p, None, &w);
-        out.deviation = crate::sqrt(chi0);
+        out.deviation = crate::math::sqrt(chi0);
         if chi0 < DETECT_CHI2 {
             out.state = IsolationState::NoDeviation;
             return out;
@@ -393,7 +393,7 @@ impl Isolator {
         let e0 = self.residuals(p, None)?;
         let e1 = self.residuals(p, Some((f, 1.0 + LIMIT_DK)))?;
         let q = w.quadratic(&(e1 - e0)) / (LIMIT_DK * LIMIT_DK);
-        (q.is_finite() && q > 0.0).then(|| crate::sqrt(DETECT_CHI2 / q))
+        (q.is_finite() && q > 0.0).then(|| crate::math::sqrt(DETECT_CHI2 / q))
     }
 
     /// The misfit of hypothesis `h` (fault `f` of factor `k`; `None`: the healthy machine)
@@ -439,12 +439,12 @@ impl Isolator {
             return 180.0;
         };
         let dot: f32 = a.iter().zip(b).map(|(x, y)| x * y).sum();
-        let na = crate::sqrt(a.iter().map(|x| x * x).sum());
-        let nb = crate::sqrt(b.iter().map(|x| x * x).sum());
+        let na = crate::math::sqrt(a.iter().map(|x| x * x).sum());
+        let nb = crate::math::sqrt(b.iter().map(|x| x * x).sum());
         if !(na > 0.0 && nb > 0.0) {
             return 180.0;
         }
-        let cos = crate::minf(crate::maxf(dot / (na * nb), -1.0), 1.0);
+        let cos = crate::math::minf(crate::math::maxf(dot / (na * nb), -1.0), 1.0);
         F32Ext::acos(cos).to_degrees()
     }
 

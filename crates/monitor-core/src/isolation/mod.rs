@@ -495,9 +495,9 @@ impl TrendSums {
     /// The centred sums `(Sxx, Sxu, Suu)` of `n` points (`Sxx`, `Suu` at least 0).
     fn centred(&self, n: f32) -> (f32, f32, f32) {
         (
-            crate::maxf(self.xx - self.x * self.x / n, 0.0),
+            crate::math::maxf(self.xx - self.x * self.x / n, 0.0),
             self.xu - self.x * self.u / n,
-            crate::maxf(self.uu - self.u * self.u / n, 0.0),
+            crate::math::maxf(self.uu - self.u * self.u / n, 0.0),
         )
     }
 }

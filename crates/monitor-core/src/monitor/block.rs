@@ -487,7 +487,7 @@ impl Checks {
         let isum = lp.update(&mut self.isum, (i.a + i.b + i.c).abs());
         let imax = lp.update(
             &mut self.imax,
-            crate::maxf(crate::maxf(i.a.abs(), i.b.abs()), i.c.abs()),
+            crate::math::maxf(crate::math::maxf(i.a.abs(), i.b.abs()), i.c.abs()),
         );
         let current = isum > l.current_sum_frac * imax + 1e-3 * l.i_max;
         let mut voltage = false;
@@ -496,7 +496,7 @@ impl Checks {
             let vsum = lp.update(&mut self.vsum, (v.a + v.b + v.c).abs());
             let vmax = lp.update(
                 &mut self.vmax,
-                crate::maxf(crate::maxf(v.a.abs(), v.b.abs()), v.c.abs()),
+                crate::math::maxf(crate::math::maxf(v.a.abs(), v.b.abs()), v.c.abs()),
             );
             voltage = vsum > l.voltage_sum_frac * vmax + 1e-3 * l.v_max;
         }

@@ -112,8 +112,8 @@ pub const TARGET_BLOCK_RATE_HZ: f32 = 400.0;
 /// at least 6 blocks per supply period (so the negative sequence's 2f ripple stays below a
 /// third of the block rate). 25 at 10 kHz, 2 at 1 kHz (60 Hz) or 3 (50 Hz), 125 at 50 kHz.
 pub fn decimation_for(sample_rate_hz: f32, supply_hz: f32) -> u16 {
-    let mut d = crate::minf(
-        crate::maxf(sample_rate_hz / TARGET_BLOCK_RATE_HZ + 0.5, 1.0),
+    let mut d = crate::math::minf(
+        crate::math::maxf(sample_rate_hz / TARGET_BLOCK_RATE_HZ + 0.5, 1.0),
         1000.0,
     ) as u16;
     while d > 1 && sample_rate_hz / f32::from(d) < 6.0 * supply_hz {
@@ -163,7 +163,7 @@ impl MonitorConfig {
             },
             settle_s: 1.0,
             min_voltage_frac: 0.3,
-            pll_bw_hz: crate::minf(20.0, sample_rate_hz / 50.0),
+            pll_bw_hz: crate::math::minf(20.0, sample_rate_hz / 50.0),
             sequence_hz: 2.0,
             unbalance_min_ratio: crate::sequence::INHERENT_ASYMMETRY_RATIO,
             floor_fraction: 0.02,

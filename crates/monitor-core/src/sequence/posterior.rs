@@ -84,7 +84,10 @@ impl ShortModel {
         let loop_sd = LOOP_ANGLE_SD_DEG.to_radians();
         ShortModel {
             reference_rad,
-            angle_sd_rad: crate::fast_hypot(crate::maxf(0.0, reference_sd_rad), loop_sd),
+            angle_sd_rad: crate::math::fast_hypot(
+                crate::math::maxf(0.0, reference_sd_rad),
+                loop_sd,
+            ),
             on_faulty_current: false,
         }
     }
@@ -143,7 +146,7 @@ impl PhasePosterior {
     pub fn normalised(ln_no_short: f32, ln_phases: [f32; 3]) -> Self {
         let max = ln_phases
             .iter()
-            .fold(ln_no_short, |m, &l| crate::maxf(m, l));
+            .fold(ln_no_short, |m, &l| crate::math::maxf(m, l));
         if !max.is_finite() || ln_phases.iter().any(|l| l.is_nan()) || ln_no_short.is_nan() {
             return PhasePosterior {
                 no_short: 1.0,
@@ -195,7 +198,7 @@ fn exp_neg(x: f32) -> f32 {
     if x < -80.0 {
         0.0
     } else {
-        F32Ext::exp(crate::minf(x, 0.0))
+        F32Ext::exp(crate::math::minf(x, 0.0))
     }
 }
 
@@ -248,10 +251,16 @@ pub fn ln_short(m: C, r: C, phase: Phase, model: &ShortModel, sigma: f32) -> f32
     let (den_m, den_r) = (one_less(m), one_less(r));
     let d = (m.0 - r.0, m.1 - r.1);
     let (c, jac) = if model.on_faulty_current {
-        (cdiv(d, den_r), 1.0 / crate::fast_hypot(den_r.0, den_r.1))
+        (
+            cdiv(d, den_r),
+            1.0 / crate::math::fast_hypot(den_r.0, den_r.1),
+        )
     } else {
         let n2 = den_m.0 * den_m.0 + den_m.1 * den_m.1;
-        (cdiv(d, den_m), crate::fast_hypot(den_r.0, den_r.1) / n2)
+        (
+            cdiv(d, den_m),
+            crate::math::fast_hypot(den_r.0, den_r.1) / n2,
+        )
     };
     let ok = c.0.is_finite() && c.1.is_finite() && jac.is_finite() && jac > 0.0;
     if !(ok && sigma > 0.0 && model.angle_sd_rad > 0.0) {
@@ -268,8 +277,8 @@ pub fn ln_short(m: C, r: C, phase: Phase, model: &ShortModel, sigma: f32) -> f32
 /// (`max`: the prior's largest size).
 fn short_density(c: C, centre: f32, sd: f32, s: f32, max: f32) -> f32 {
     let span = (max / SHORT_RATIO_MIN).ln();
-    let mag = crate::fast_hypot(c.0, c.1);
-    let clamp = |x: f32| crate::minf(max, crate::maxf(SHORT_RATIO_MIN, x));
+    let mag = crate::math::fast_hypot(c.0, c.1);
+    let clamp = |x: f32| crate::math::minf(max, crate::math::maxf(SHORT_RATIO_MIN, x));
     let (mut lo, mut hi) = (clamp(mag - GRID_SPREADS * s), clamp(mag + GRID_SPREADS * s));
     if hi <= lo * 1.0001 {
         // The noise's support lies beyond one end of the prior: its last stretch.
@@ -299,7 +308,7 @@ fn short_density(c: C, centre: f32, sd: f32, s: f32, max: f32) -> f32 {
     let mut max = f32::NEG_INFINITY;
     for i in 0..GRID {
         for j in 0..GRID {
-            max = crate::maxf(max, term(i, j));
+            max = crate::math::maxf(max, term(i, j));
         }
     }
     if !max.is_finite() {
@@ -321,7 +330,7 @@ fn ln_wrapped_gauss(x: f32, sd: f32) -> f32 {
     let tau = core::f32::consts::TAU;
     let q = |d: f32| -(d * d) / (2.0 * sd * sd);
     let (a, b, c) = (q(x), q(x - tau), q(x + tau));
-    let m = crate::maxf(a, crate::maxf(b, c));
+    let m = crate::math::maxf(a, crate::math::maxf(b, c));
     m + (exp_neg(a - m) + exp_neg(b - m) + exp_neg(c - m)).ln() - (tau.sqrt() * sd).ln()
 }
 

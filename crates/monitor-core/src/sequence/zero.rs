@@ -127,8 +127,8 @@ pub fn single_phase_gain(
     z: (f32, f32),
     min_ratio: f32,
 ) -> Option<SinglePhaseGain> {
-    let i1 = crate::fast_hypot(p.0, p.1);
-    let z3 = 3.0 * crate::fast_hypot(z.0, z.1);
+    let i1 = crate::math::fast_hypot(p.0, p.1);
+    let z3 = 3.0 * crate::math::fast_hypot(z.0, z.1);
     if !(i1 > 1e-9 && z3.is_finite() && n.0.is_finite() && n.1.is_finite()) {
         return None;
     }
@@ -216,7 +216,7 @@ mod tests {
             assert!((g.gain_error - (k - 1.0)).abs() < 1e-3, "{k}: {g:?}");
             // The correction takes the sensor's negative sequence out.
             let c = g.corrected_negative(p, n, z);
-            assert!(crate::fast_hypot(c.0, c.1) < 1e-4 * 5.0, "{c:?}");
+            assert!(crate::math::fast_hypot(c.0, c.1) < 1e-4 * 5.0, "{c:?}");
         }
         // A winding asymmetry or a supply unbalance: a negative sequence, and (three wires)
         // no zero sequence: nothing named.

@@ -2,8 +2,8 @@
 //! quantity, its limits computed once per average.
 
 use super::STEADY_FRACTION;
-use crate::fast_hypot;
 use crate::isolation::SteadyPoint;
+use crate::math::fast_hypot;
 
 /// [`steady_against`](super::steady_against) for one average, its limits computed once (the follower judges every
 /// point against the same average until a block closes).
@@ -22,9 +22,9 @@ pub(super) struct SteadyBand {
 impl SteadyBand {
     /// The band about the average `avg`.
     pub(super) fn of(avg: SteadyPoint) -> Self {
-        let i = crate::maxf(fast_hypot(avg.i.d, avg.i.q), 1e-6);
-        let v = crate::maxf(fast_hypot(avg.v.d, avg.v.q), 1e-6);
-        let w = crate::maxf(avg.we_rad_s.abs(), 1.0);
+        let i = crate::math::maxf(fast_hypot(avg.i.d, avg.i.q), 1e-6);
+        let v = crate::math::maxf(fast_hypot(avg.v.d, avg.v.q), 1e-6);
+        let w = crate::math::maxf(avg.we_rad_s.abs(), 1.0);
         SteadyBand {
             avg,
             i: STEADY_FRACTION * i,

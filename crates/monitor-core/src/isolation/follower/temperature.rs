@@ -14,9 +14,9 @@ impl Follower {
         let before = self.isolator.winding_rise_k();
         self.track(k);
         let step = (self.isolator.winding_rise_k() - before).abs();
-        let rate = step / crate::maxf(self.since_tracked_s, STEP_S);
+        let rate = step / crate::math::maxf(self.since_tracked_s, STEP_S);
         if rate.is_finite() {
-            self.warming_k_per_s = crate::maxf(rate, crate::isolation::HEATING_DRIFT_K_PER_S);
+            self.warming_k_per_s = crate::math::maxf(rate, crate::isolation::HEATING_DRIFT_K_PER_S);
         }
         self.since_tracked_s = 0.0;
     }
@@ -60,7 +60,10 @@ impl Follower {
         };
         let wanted =
             (self.isolator.heating_factor() * k - 1.0) / crate::isolation::COPPER_ALPHA_PER_K;
-        let lag = crate::minf(crate::maxf(wanted - measured, -PROBE_LAG_K), PROBE_LAG_K);
+        let lag = crate::math::minf(
+            crate::math::maxf(wanted - measured, -PROBE_LAG_K),
+            PROBE_LAG_K,
+        );
         if lag.is_finite() && self.isolator.set_winding_rise_k(measured + lag) {
             self.probe_lag_k = lag;
         }
@@ -89,7 +92,7 @@ impl Follower {
         };
         let (newer, older) = (mean_of(0, half), mean_of(half, half));
         let span_s = half as f32 * STEP_S;
-        let scale = crate::sqrt(AVERAGE_MAX_S / span_s);
+        let scale = crate::math::sqrt(AVERAGE_MAX_S / span_s);
         // (The halves' means are a half's span apart: the winding may have warmed as fast as
         // a winding can in that time.)
         let warming_k = crate::isolation::HEATING_RATE_K_PER_S * span_s;

@@ -25,7 +25,7 @@ impl Isolator {
         // gained since it was last judged.
         let warm = (self.heating_factor - 1.0).abs() >= COPPER_ALPHA_PER_K;
         let base = if warm { HEATING_LAG_SIGMA_K } else { 0.0 };
-        self.lag_sigma_k = crate::minf(base + rate * since, self.heating_reach_k);
+        self.lag_sigma_k = crate::math::minf(base + rate * since, self.heating_reach_k);
     }
 
     /// The heating hypothesis' range of factors relative to the tracked machine: the whole
@@ -38,7 +38,10 @@ impl Isolator {
             HEATING_K_MAX / self.heating_factor,
         );
         if reach.is_finite() {
-            (crate::maxf(lo, 1.0 - reach), crate::minf(hi, 1.0 + reach))
+            (
+                crate::math::maxf(lo, 1.0 - reach),
+                crate::math::minf(hi, 1.0 + reach),
+            )
         } else {
             (lo, hi)
         }
@@ -84,7 +87,7 @@ impl Isolator {
         if !(self.lag_sigma_k > 0.0) {
             return single;
         }
-        let lag_max = crate::minf(self.heating_reach_k, HEATING_LAG_K * self.lag_sigma_k);
+        let lag_max = crate::math::minf(self.heating_reach_k, HEATING_LAG_K * self.lag_sigma_k);
         let d = lag_max * COPPER_ALPHA_PER_K;
         let prior = |k: f32| {
             let lag = (k - 1.0) / (COPPER_ALPHA_PER_K * self.lag_sigma_k);
@@ -130,7 +133,7 @@ impl Isolator {
         let s = self
             .baseline
             .spread
-            .map(|x| x * core::f32::consts::SQRT_2 * crate::maxf(spread_scale, 1.0));
+            .map(|x| x * core::f32::consts::SQRT_2 * crate::math::maxf(spread_scale, 1.0));
         let d = (b - a).zip_map(s, |x, y| x / y).to_array();
         // The heating direction per kelvin.
         let h = (h - b).zip_map(s, |x, y| x / y).to_array();
@@ -138,7 +141,7 @@ impl Isolator {
         let hh = dot(&h, &h);
         let reach = if warming_k > 0.0 { warming_k } else { 0.0 };
         let along = if hh > 0.0 {
-            crate::minf(crate::maxf(dot(&d, &h) / hh, -reach), reach)
+            crate::math::minf(crate::math::maxf(dot(&d, &h) / hh, -reach), reach)
         } else {
             0.0
         };

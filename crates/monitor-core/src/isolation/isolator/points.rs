@@ -48,7 +48,7 @@ impl Isolator {
         };
         let load = anchor.and_then(|a| Some((*a, self.torque_nm(a, None)?)));
         let chi0 = self.chi2_points(used, load, None);
-        out.deviation = crate::sqrt(chi0);
+        out.deviation = crate::math::sqrt(chi0);
         if let Some(e0) = self.residuals(first, None) {
             out.residuals = e0 - self.baseline.mean;
         }
@@ -96,7 +96,7 @@ impl Isolator {
         let mut n = 0;
         for (p, scale) in points.iter().take(MAX_POINTS) {
             let k = if scale.is_finite() {
-                crate::maxf(*scale, 1.0)
+                crate::math::maxf(*scale, 1.0)
             } else {
                 1.0
             };
@@ -168,14 +168,14 @@ impl Isolator {
         let ((_, q), qa) = (self.hypothesis(p, h), a);
         let active = |x: &SteadyPoint| x.operating_point().load_a;
         let (ia, i0) = (active(&q), active(&qa));
-        let moved = (ia - i0) / crate::maxf(i0.abs(), 1e-6);
+        let moved = (ia - i0) / crate::math::maxf(i0.abs(), 1e-6);
         if !(moved.abs() <= ANCHOR_LOAD_BAND) {
             return 0.0;
         }
         let Some(te) = self.torque_nm(p, h) else {
             return f32::INFINITY;
         };
-        let speed = q.wr_rad_s / crate::maxf(qa.wr_rad_s.abs(), 1.0);
+        let speed = q.wr_rad_s / crate::math::maxf(qa.wr_rad_s.abs(), 1.0);
         let t_load = t0 * speed;
         let s_law = LOAD_LAW_SPREAD * (speed - 1.0) * t0 / self.torque_base_nm;
         let s = ANCHOR_TORQUE_SPREAD * scale;

@@ -47,7 +47,7 @@ pub(super) fn rank(
     let chi_friction = friction
         .iter()
         .filter_map(|k| fits.get(*k))
-        .fold(f32::INFINITY, |a, (c, _)| crate::minf(a, *c));
+        .fold(f32::INFINITY, |a, (c, _)| crate::math::minf(a, *c));
     for k in friction {
         if let Some((c, _)) = fits.get_mut(k) {
             *c = chi_friction;
@@ -56,12 +56,12 @@ pub(super) fn rank(
     // Heating takes part in the ranking only where it can explain the deviation (misfit
     // within HEATING_MAX_MISFIT): elsewhere the faults rank among themselves as without it.
     let (chi_heat, k_heat) = heat;
-    let heat_in = crate::sqrt(chi_heat) <= HEATING_MAX_MISFIT;
+    let heat_in = crate::math::sqrt(chi_heat) <= HEATING_MAX_MISFIT;
     let chi_min = fits.iter().fold(
         if heat_in { chi_heat } else { f32::INFINITY },
-        |a, (c, _)| crate::minf(a, *c),
+        |a, (c, _)| crate::math::minf(a, *c),
     );
-    let chi_unknown = crate::maxf(UNKNOWN_CHI2, 0.1 * chi0);
+    let chi_unknown = crate::math::maxf(UNKNOWN_CHI2, 0.1 * chi0);
     let t = temperature(chi_min, (chi0, dims), eps);
     let w = |c: f32| F32Ext::exp(-(c - chi_min) / (2.0 * t));
     let mut total = w(chi_unknown);
@@ -74,14 +74,14 @@ pub(super) fn rank(
     out.heating = Heating {
         probability: if heat_in { w(chi_heat) / total } else { 0.0 },
         factor: k_heat,
-        misfit: crate::sqrt(chi_heat),
+        misfit: crate::math::sqrt(chi_heat),
     };
     for ((cand, (c, k)), f) in out.candidates.iter_mut().zip(*fits).zip(Fault::ALL) {
         *cand = Candidate {
             fault: f,
             probability: w(c) / total,
             change: k - 1.0,
-            misfit: crate::sqrt(c),
+            misfit: crate::math::sqrt(c),
             at_limit: k <= K_MIN * 1.001 || k >= K_MAX * 0.999,
         };
     }
@@ -100,8 +100,8 @@ pub(super) fn rank(
 /// `chi0`, spread over `dims` equations), or a poor best fit (`chi_min` over the two
 /// degrees of freedom left), whichever is larger.
 fn temperature(chi_min: f32, (chi0, dims): (f32, f32), eps: f32) -> f32 {
-    let t_model = 1.0 + eps * eps * chi0 / crate::maxf(dims, 1.0);
-    crate::maxf(t_model, 0.5 * chi_min)
+    let t_model = 1.0 + eps * eps * chi0 / crate::math::maxf(dims, 1.0);
+    crate::math::maxf(t_model, 0.5 * chi_min)
 }
 
 /// Best factor `k` of a misfit `chi(k)` over [`K_MIN`]..[`K_MAX`]: a geometric grid of
@@ -120,8 +120,8 @@ pub(super) fn fit_factor(chi: impl Fn(f32) -> f32) -> (f32, f32) {
     }
     let (c, x) = golden(
         &chi,
-        crate::maxf(best_k / step, K_MIN),
-        crate::minf(best_k * step, K_MAX),
+        crate::math::maxf(best_k / step, K_MIN),
+        crate::math::minf(best_k * step, K_MAX),
         GOLDEN_STEPS,
     );
     if c < best_c {

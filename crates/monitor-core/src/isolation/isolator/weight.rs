@@ -13,7 +13,7 @@ impl Isolator {
         let p = q.operating_point();
         match r.load_a {
             Some([lo, hi]) => {
-                let wide = hi - lo >= WIDE_SPAN * crate::maxf(lo.abs(), hi.abs());
+                let wide = hi - lo >= WIDE_SPAN * crate::math::maxf(lo.abs(), hi.abs());
                 wide && p.load_a >= lo && p.load_a <= hi && r.voltage_outside(p).is_none()
             }
             None => false,
@@ -108,9 +108,9 @@ impl Isolator {
             expected += g.voltage_d * g.voltage_d + g.voltage_q * g.voltage_q;
         }
         let (md, mq) = (self.baseline.mean.voltage_d, self.baseline.mean.voltage_q);
-        let seen = crate::sqrt((md * md + mq * mq) / expected);
+        let seen = crate::math::sqrt((md * md + mq * mq) / expected);
         Some(if seen.is_finite() {
-            crate::minf(crate::maxf(seen, NAMEPLATE_FLOOR), 1.0)
+            crate::math::minf(crate::math::maxf(seen, NAMEPLATE_FLOOR), 1.0)
         } else {
             1.0
         })
