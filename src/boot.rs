@@ -5,16 +5,16 @@
 //! The firmware (`src/firmware.rs`) reads the two flash pages and hands the motor page's
 //! bytes and the commissioning store to [`boot`], then logs what [`Booted`] says
 //! (`firmware/logs.rs`) and starts the sample task with [`Booted::path`] and the encoder
-//! with [`Machine::encoder`]. The host's software-in-the-loop rig (`tests/sil/`) boots
+//! with [`BootMachine::encoder`]. The host's software-in-the-loop rig (`tests/sil/`) boots
 //! through the same function, so every SIL test runs this composition.
 //!
 //! Every failure has one defined fallback, and [`Booted`] says which was taken:
 //!
 //! | what failed | fallback | said by |
 //! |---|---|---|
-//! | the motor record: erased page, bad CRC, truncated, another version, values the core rejects | the built-in default machine ([`motor_source::default_record`]) | [`Machine::source`] ([`MachineSource::describe`]); the panel's default-motor mark |
+//! | the motor record: erased page, bad CRC, truncated, another version, values the core rejects | the built-in default machine ([`motor_source::default_record`]) | [`BootMachine::source`] ([`MachineSource::describe`]); the panel's default-motor mark |
 //! | a valid record's machine at the firmware's sample rate ([`SamplePath::new`]) | the built-in default machine | [`MachineSource::Default`] with [`RecordError::Invalid`] |
-//! | the isolation of the record's machine ([`Isolator::new`]) | the record's machine monitored by the lamps, nothing isolated (the blink code is the lamps' top candidate, the status line says `iso=not-judged`) | [`Machine::isolation`] |
+//! | the isolation of the record's machine ([`Isolator::new`]) | the record's machine monitored by the lamps, nothing isolated (the blink code is the lamps' top candidate, the status line says `iso=not-judged`) | [`BootMachine::isolation`] |
 //! | the commissioning record: unreadable, invalid, refused by the core | not commissioned (the default thresholds) | [`Booted::calibration`] |
 //! | the built-in default at the firmware's sample rate | none: [`boot`] returns the error (the settings are constants a host test checks, so this cannot happen) | `Err` |
 
@@ -27,12 +27,12 @@ use monitor_core::{ConfigError, Isolator};
 
 /// The machine in force after boot and how its hardware is set up.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Machine {
+pub struct BootMachine {
     /// The motor record in force: the flash page's, or [`motor_source::default_record`].
     pub record: MotorRecord,
     /// Where it came from (the boot log's line, the panel's default-motor mark).
     pub source: MachineSource,
-    /// The encoder timer's set-up from [`Machine::record`] (counts, direction, filter,
+    /// The encoder timer's set-up from [`BootMachine::record`] (counts, direction, filter,
     /// pull-ups: [`motor_source::encoder_setup`]).
     pub encoder: EncoderSetup,
     /// `Ok`: the fault isolation judges against this machine; `Err`: the core's isolation
@@ -57,7 +57,7 @@ pub enum CalibrationMissing<E> {
 #[derive(Clone, Debug)]
 pub struct Booted<E> {
     /// The machine in force and its hardware set-up.
-    pub machine: Machine,
+    pub machine: BootMachine,
     /// The sample path for the sample task, the stored calibration in force when
     /// [`Booted::calibration`] is `Ok`.
     pub path: SamplePath,
@@ -82,7 +82,7 @@ pub struct Booted<E> {
 pub fn machine(
     page: &[u8],
     sample_rate_hz: u32,
-) -> Result<(Machine, SamplePath, Option<Isolator>), AppError> {
+) -> Result<(BootMachine, SamplePath, Option<Isolator>), AppError> {
     let (mut record, mut source) = motor_source::select(page);
     let path = match motor_source::sample_path(&record, sample_rate_hz) {
         Ok(path) => path,
@@ -94,7 +94,7 @@ pub fn machine(
         }
     };
     let isolator = motor_source::isolator(&record);
-    let machine = Machine {
+    let machine = BootMachine {
         record,
         source,
         encoder: motor_source::encoder_setup(&record),

@@ -53,7 +53,7 @@ use drive_monitor::app::{
     PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
 };
 use drive_monitor::board::{self, pins::Board, Lamp, LAMP_COUNT};
-use drive_monitor::boot::{self, Machine};
+use drive_monitor::boot::{self, BootMachine};
 use drive_monitor::commissioning::Action;
 use drive_monitor::flash_record::{RecordStore, RECORD_LEN};
 use drive_monitor::offset_trim::TrimResult;
@@ -276,7 +276,10 @@ fn read_motor_page(flash: &mut BoardFlash) -> [u8; MOTOR_RECORD_LEN] {
 /// encoder set-up, the stored calibration and the supervisor, each failure with its
 /// fallback, logged. A plain function, so that what it builds on its way is on the stack,
 /// not kept in the main task's future.
-fn boot_board(flash: &mut BoardFlash, previous: PreviousRun) -> (Machine, SamplePath, Supervisor) {
+fn boot_board(
+    flash: &mut BoardFlash,
+    previous: PreviousRun,
+) -> (BootMachine, SamplePath, Supervisor) {
     let page = read_motor_page(flash);
     let booted = match boot::boot(&page, flash, &SETTINGS, previous, 0) {
         Ok(b) => b,

@@ -38,7 +38,7 @@ print(w, cpu, df.height, pl.__version__)";
 
 /// One run's figures.
 #[derive(Debug, Clone, Copy)]
-struct Run {
+struct BenchRun {
     wall_s: f64,
     cpu_s: f64,
     rss_mb: f64,
@@ -54,7 +54,7 @@ fn peak_rss_mb(pid: u32) -> Option<f64> {
 
 /// Runs `cmd` with stdout to `out`; its wall and CPU time (this process's children's) and
 /// peak resident memory. Panics when it fails: a benchmark has nothing to report then.
-fn measure(mut cmd: Command, out: &Path) -> Run {
+fn measure(mut cmd: Command, out: &Path) -> BenchRun {
     // (Fields 13 and 14: the CPU time of the children waited for.)
     let c0 = common::stat_seconds(13);
     let t0 = Instant::now();
@@ -74,7 +74,7 @@ fn measure(mut cmd: Command, out: &Path) -> Run {
     };
     let wall_s = t0.elapsed().as_secs_f64();
     assert!(status.success(), "{cmd:?} failed: {status}");
-    Run {
+    BenchRun {
         wall_s,
         cpu_s: common::stat_seconds(13) - c0,
         rss_mb: rss,
@@ -82,7 +82,7 @@ fn measure(mut cmd: Command, out: &Path) -> Run {
 }
 
 /// `sim-host diagnose --json` of `log`: the run and the report's rows.
-fn diagnose(log: &Path, params: &Path, out: &Path) -> (Run, f64) {
+fn diagnose(log: &Path, params: &Path, out: &Path) -> (BenchRun, f64) {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_sim-host"));
     cmd.arg("diagnose")
         .arg("--params")
@@ -97,14 +97,14 @@ fn diagnose(log: &Path, params: &Path, out: &Path) -> (Run, f64) {
 
 /// polars' `read_csv` of `log` in `python`: the call's wall and CPU time, the process's
 /// peak memory, and polars' version.
-fn polars(python: &str, log: &Path, out: &Path) -> (Run, String) {
+fn polars(python: &str, log: &Path, out: &Path) -> (BenchRun, String) {
     let mut cmd = Command::new(python);
     cmd.arg("-c").arg(POLARS_SCRIPT).arg(log);
     let whole = measure(cmd, out);
     let text = std::fs::read_to_string(out).unwrap_or_default();
     let f: Vec<&str> = text.split_whitespace().collect();
     let num = |k: usize| f.get(k).and_then(|s| s.parse::<f64>().ok());
-    let run = Run {
+    let run = BenchRun {
         wall_s: num(0).unwrap_or(whole.wall_s),
         cpu_s: num(1).unwrap_or(whole.cpu_s),
         rss_mb: whole.rss_mb,
@@ -158,7 +158,7 @@ fn median(mut x: Vec<f64>) -> f64 {
     }
 }
 
-fn print_run(what: &str, k: u32, repeat: u32, r: &Run, load: &str) {
+fn print_run(what: &str, k: u32, repeat: u32, r: &BenchRun, load: &str) {
     println!(
         "round {k}/{repeat} {what:<16} wall {:6.2} s  CPU {:6.2} s  peak RSS {:6.0} MB  (load average before: {load})",
         r.wall_s, r.cpu_s, r.rss_mb
@@ -166,7 +166,7 @@ fn print_run(what: &str, k: u32, repeat: u32, r: &Run, load: &str) {
 }
 
 /// The medians of `runs` and, with polars', the ratios.
-fn summary(what: &str, runs: &[Run], polars: Option<(f64, f64)>) {
+fn summary(what: &str, runs: &[BenchRun], polars: Option<(f64, f64)>) {
     let wall = median(runs.iter().map(|r| r.wall_s).collect());
     let cpu = median(runs.iter().map(|r| r.cpu_s).collect());
     let rss = median(runs.iter().map(|r| r.rss_mb).collect());

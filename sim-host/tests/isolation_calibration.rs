@@ -31,7 +31,7 @@
 mod calibration_cases;
 mod small_motor;
 
-use calibration_cases::{draw, motors, right_name, run, Outcome, Scored};
+use calibration_cases::{draw, motors, right_name, run, CaseOutcome, Scored};
 use rayon::prelude::*;
 
 /// The probability bins of the table: [lower, upper).
@@ -82,7 +82,7 @@ fn print_table(title: &str, scored: &[Scored]) -> (usize, usize) {
 /// returns the wrong names at the end and on the way in words, and the two (names, right)
 /// counts.
 fn sweep(from: u64, n: u64) -> (Vec<String>, (usize, usize), (usize, usize)) {
-    let outcomes: Vec<Outcome> = (from..from + n)
+    let outcomes: Vec<CaseOutcome> = (from..from + n)
         .map(draw)
         .collect::<Vec<_>>()
         .into_par_iter()
@@ -126,7 +126,7 @@ fn sweep(from: u64, n: u64) -> (Vec<String>, (usize, usize), (usize, usize)) {
         from + n
     );
     for commissioned in [true, false] {
-        let of = |o: &&Outcome| o.case.commissioned == commissioned;
+        let of = |o: &&CaseOutcome| o.case.commissioned == commissioned;
         let last_n = outcomes.iter().filter(of).filter_map(|o| o.last).count();
         let last_ok = outcomes
             .iter()

@@ -105,7 +105,7 @@ fn every_case() -> Vec<(usize, Option<(Fault, f64)>)> {
 }
 
 /// One service log's outcome.
-struct Outcome {
+struct CaseOutcome {
     motor: &'static str,
     fault: Option<(Fault, f64)>,
     /// What the isolation names at the log's end, and its size.
@@ -118,7 +118,7 @@ struct Outcome {
     spread: [f32; 3],
 }
 
-impl Outcome {
+impl CaseOutcome {
     /// Named alone at the end with the size within 25 %.
     fn right(&self) -> bool {
         let Some((f, change)) = self.fault else {
@@ -200,7 +200,7 @@ fn run_with(
     nominal: &ParamFile,
     fault: Option<(Fault, f64)>,
     seed: u64,
-) -> Outcome {
+) -> CaseOutcome {
     let mut sc = moving_load(p, seed, DURATION_S, RATE_HZ);
     if let Some((f, change)) = fault {
         sc.faults.push(FaultSpec::at_change(f, FAULT_AT_S, change));
@@ -212,7 +212,7 @@ fn run_with(
     let replay = simulate_and_replay(p, nominal, &sc, opts, |_, _| {}).expect("runs");
     let given = replay.isolation_names().to_vec();
     let r = replay.finish();
-    Outcome {
+    CaseOutcome {
         motor,
         fault,
         named: r.isolation.named,
@@ -225,9 +225,9 @@ fn run_with(
 
 /// Runs the cases (motor index, fault) and prints the table; returns the outcomes. `off`:
 /// the monitor is told [`nameplate_off`]'s parameters.
-fn table(cases: &[(usize, Option<(Fault, f64)>)], off: bool) -> Vec<Outcome> {
+fn table(cases: &[(usize, Option<(Fault, f64)>)], off: bool) -> Vec<CaseOutcome> {
     let ms = motors();
-    let out: Vec<Outcome> = cases
+    let out: Vec<CaseOutcome> = cases
         .par_iter()
         .enumerate()
         .map(|(k, &(m, fault))| {
@@ -243,7 +243,7 @@ fn table(cases: &[(usize, Option<(Fault, f64)>)], off: bool) -> Vec<Outcome> {
     for o in &out {
         eprintln!("{}", o.row());
     }
-    let faulty: Vec<&Outcome> = out.iter().filter(|o| o.fault.is_some()).collect();
+    let faulty: Vec<&CaseOutcome> = out.iter().filter(|o| o.fault.is_some()).collect();
     let right = faulty.iter().filter(|o| o.right()).count();
     let wrong = out.iter().filter(|o| !o.wrong().is_empty()).count();
     eprintln!(
@@ -256,7 +256,7 @@ fn table(cases: &[(usize, Option<(Fault, f64)>)], off: bool) -> Vec<Outcome> {
 }
 
 /// The bar's failures, in words.
-fn bar_failures(out: &[Outcome]) -> Vec<String> {
+fn bar_failures(out: &[CaseOutcome]) -> Vec<String> {
     let faulty = out.iter().filter(|o| o.fault.is_some()).count();
     let right = out.iter().filter(|o| o.right()).count();
     let mut bad: Vec<String> = out
@@ -291,7 +291,7 @@ fn service_logs_of_the_2p2kw_motor_a_subset() {
     let wrong: Vec<String> = out
         .iter()
         .filter(|o| !o.wrong().is_empty())
-        .map(Outcome::row)
+        .map(CaseOutcome::row)
         .collect();
     assert!(wrong.is_empty(), "{wrong:#?}");
     let right = out.iter().filter(|o| o.right()).count();
@@ -324,7 +324,7 @@ fn service_logs_with_a_nameplate_that_is_off_name_nothing_wrong() {
     let wrong: Vec<String> = out
         .iter()
         .filter(|o| !o.wrong().is_empty())
-        .map(Outcome::row)
+        .map(CaseOutcome::row)
         .collect();
     assert!(wrong.is_empty(), "{wrong:#?}");
 }

@@ -30,14 +30,14 @@ use std::path::{Path, PathBuf};
 /// One judgement: the most probable phase's probability, whether the report names it
 /// (it is more probable than no short), and whether that phase is the shorted one.
 #[derive(Debug, Clone)]
-struct Outcome {
+struct CaseOutcome {
     what: String,
     probability: f32,
     named: bool,
     right: bool,
 }
 
-fn outcome(what: String, u: &UnbalanceReport, shorted: Option<Phase>) -> Outcome {
+fn outcome(what: String, u: &UnbalanceReport, shorted: Option<Phase>) -> CaseOutcome {
     let p = u.phase_probabilities;
     let (phase, probability) = [(Phase::A, p.a), (Phase::B, p.b), (Phase::C, p.c)]
         .into_iter()
@@ -50,7 +50,7 @@ fn outcome(what: String, u: &UnbalanceReport, shorted: Option<Phase>) -> Outcome
         );
         assert_eq!(u.phase_confidence, probability, "{what}");
     }
-    Outcome {
+    CaseOutcome {
         what,
         probability,
         named: u.suspect_phase.is_some(),
@@ -86,7 +86,7 @@ fn itsc_judge(name: &str, baseline: Option<HealthyReference>) -> UnbalanceReport
 }
 
 /// Run 002 of every condition: alone, and against the other session's healthy run.
-fn itsc_run_002() -> Vec<Outcome> {
+fn itsc_run_002() -> Vec<CaseOutcome> {
     let other = HealthyReference::from_runs(&[itsc_judge("SC_HLT_001", None).measured]);
     let mut names: Vec<String> = std::fs::read_dir(itsc())
         .expect("the recordings' folder") // ok: test
@@ -273,7 +273,7 @@ fn simulate(
 
 /// The case judged: its log (healthy until the short's switch-on, if any), against its
 /// baseline runs (the supply's unbalance drifted between them).
-fn judge_case(c: &Case, motors: &[(ParamFile, f64)]) -> Outcome {
+fn judge_case(c: &Case, motors: &[(ParamFile, f64)]) -> CaseOutcome {
     let (p, rated) = &motors[c.motor];
     let healthy = simulate(p, *rated, c, c.load, c.unbalance, None, c.seed);
     let rows = match c.short {
@@ -332,7 +332,7 @@ fn judge_case(c: &Case, motors: &[(ParamFile, f64)]) -> Outcome {
     outcome(format!("{c:?}"), &u, c.short.map(|s| s.0))
 }
 
-fn simulated(n: usize) -> Vec<Outcome> {
+fn simulated(n: usize) -> Vec<CaseOutcome> {
     let mut d = Draw(0x9E37_79B9_7F4A_7C15);
     let cases: Vec<Case> = (0..n).map(|k| draw_case(&mut d, 1000 + k as u64)).collect();
     let motors = motors();
@@ -353,7 +353,7 @@ const BINS: [(f32, f32); 6] = [
 
 /// The reliability table: per bin, the judgements and the fraction whose most probable
 /// phase is the shorted one.
-fn table(what: &str, outcomes: &[Outcome]) -> Vec<(usize, usize)> {
+fn table(what: &str, outcomes: &[CaseOutcome]) -> Vec<(usize, usize)> {
     let named = outcomes.iter().filter(|o| o.named).count();
     eprintln!(
         "{what}: {} judgements, {named} named a phase",
@@ -384,7 +384,7 @@ fn table(what: &str, outcomes: &[Outcome]) -> Vec<(usize, usize)> {
 }
 
 /// Of the phases named at 0.5 or more, the fraction right (1 for none).
-fn right_at_half(outcomes: &[Outcome]) -> (usize, usize) {
+fn right_at_half(outcomes: &[CaseOutcome]) -> (usize, usize) {
     let sure: Vec<_> = outcomes
         .iter()
         .filter(|o| o.named && o.probability >= 0.5)
@@ -412,7 +412,7 @@ fn phases_named_at_one_half_or_more_are_right_at_least_95_percent_of_the_time() 
             failures.push(format!("{what}: {right} of {n}"));
         }
     }
-    let all: Vec<Outcome> = itsc.iter().chain(&sim).cloned().collect();
+    let all: Vec<CaseOutcome> = itsc.iter().chain(&sim).cloned().collect();
     table("together", &all);
     // The table must be about something: most shorts named, not all hedged below 0.5.
     let (n, _) = right_at_half(&sim);

@@ -125,6 +125,26 @@ pub fn load_params_for(
     load_params(source).map_err(|e| swapped(source, log).unwrap_or(e))
 }
 
+/// The parameter file's TOML text and how messages name it.
+///
+/// # Errors
+/// [`ParamError::Io`] for a file that cannot be read; [`ApiError::Swapped`] where the
+/// arguments look swapped.
+fn params_text(source: ParamsSource<'_>, log: &Path) -> Result<(String, String), ApiError> {
+    match source {
+        ParamsSource::Path(p) => Ok((
+            std::fs::read_to_string(p).map_err(|e| {
+                swapped(source, log).unwrap_or(ApiError::Params(ParamError::Io {
+                    path: p.display().to_string(),
+                    source: e,
+                }))
+            })?,
+            p.display().to_string(),
+        )),
+        ParamsSource::Toml { text, origin } => Ok((text.to_string(), origin.to_string())),
+    }
+}
+
 /// [`ApiError::Swapped`] when `source` and `log` look swapped (as [`load_params_for`]
 /// says).
 fn swapped(source: ParamsSource<'_>, log: &Path) -> Option<ApiError> {
@@ -427,18 +447,7 @@ pub fn identify(
         }
     }
     // The file is read once: its text is the identified file's template.
-    let (start_text, start_name) = match params {
-        ParamsSource::Path(p) => (
-            std::fs::read_to_string(p).map_err(|source| {
-                swapped(params, log).unwrap_or(ApiError::Params(ParamError::Io {
-                    path: p.display().to_string(),
-                    source,
-                }))
-            })?,
-            p.display().to_string(),
-        ),
-        ParamsSource::Toml { text, origin } => (text.to_string(), origin.to_string()),
-    };
+    let (start_text, start_name) = params_text(params, log)?;
     let (start, columns) = load_params(ParamsSource::Toml {
         text: &start_text,
         origin: &start_name,

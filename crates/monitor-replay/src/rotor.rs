@@ -258,7 +258,7 @@ pub struct RotorReport {
 
 /// What the rotor finding needs of the parameter file and the log.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Machine {
+pub(super) struct RotorMachine {
     /// Pole pairs.
     pub np: f64,
     /// Nominal supply frequency [Hz].
@@ -269,10 +269,10 @@ pub(super) struct Machine {
     pub bars: Option<u32>,
 }
 
-impl Machine {
+impl RotorMachine {
     /// The machine of `p`.
     pub fn of(p: &ParamFile) -> Self {
-        Machine {
+        RotorMachine {
             np: f64::from(p.motor.poles / 2).max(1.0),
             f0: p.supply.f_hz,
             tau_r_s: p.motor.lr_h / p.motor.rr_ohm,

@@ -243,9 +243,9 @@ pub struct SequenceSegment {
     learning: bool,
 }
 
-type C = (f32, f32);
+type RatioPhasor = (f32, f32);
 
-fn cdiv(a: C, b: C) -> C {
+fn cdiv(a: RatioPhasor, b: RatioPhasor) -> RatioPhasor {
     let d = b.0 * b.0 + b.1 * b.1;
     if d.is_nan() || d <= 0.0 {
         return (0.0, 0.0);
@@ -253,16 +253,16 @@ fn cdiv(a: C, b: C) -> C {
     ((a.0 * b.0 + a.1 * b.1) / d, (a.1 * b.0 - a.0 * b.1) / d)
 }
 
-fn sub(a: C, b: C) -> C {
+fn sub(a: RatioPhasor, b: RatioPhasor) -> RatioPhasor {
     (a.0 - b.0, a.1 - b.1)
 }
 
-fn abs(a: C) -> f32 {
+fn abs(a: RatioPhasor) -> f32 {
     monitor_core::math::fast_hypot(a.0, a.1)
 }
 
 /// Mean of complex values.
-fn mean(xs: impl Iterator<Item = C>) -> C {
+fn mean(xs: impl Iterator<Item = RatioPhasor>) -> RatioPhasor {
     let (mut s, mut n) = ((0.0f64, 0.0f64), 0u32);
     for x in xs {
         s.0 += f64::from(x.0);
@@ -278,7 +278,7 @@ fn mean(xs: impl Iterator<Item = C>) -> C {
 /// One segment's means.
 pub(super) fn segment_of(ws: &[&SequenceWindow]) -> SequenceSegment {
     let n = ws.len();
-    let rs: Vec<C> = ws
+    let rs: Vec<RatioPhasor> = ws
         .iter()
         .map(|w| cdiv(w.i.negative(), w.i.positive()))
         .collect();
@@ -448,7 +448,7 @@ fn measured_of(windows: &[SequenceWindow], segs: &[SequenceSegment]) -> (Unbalan
             .iter()
             .map(|w| (0.5 * (w.from_s + w.to_s), w.offset_rad)),
     );
-    let turned = |w: &SequenceWindow, x: C| {
+    let turned = |w: &SequenceWindow, x: RatioPhasor| {
         let d = (w.offset_rad - line.0 - line.1 * 0.5 * (w.from_s + w.to_s)) as f32;
         let (sn, cs) = d.sin_cos();
         (x.0 * cs - x.1 * sn, x.0 * sn + x.1 * cs)

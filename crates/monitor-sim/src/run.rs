@@ -136,14 +136,14 @@ fn scenario_events(scenario: &Scenario) -> Vec<(u64, ScenarioEvent)> {
 pub(super) fn checked_run<'a>(
     params: &'a ParamFile,
     scenario: &'a Scenario,
-) -> Result<Run<'a>, SimError> {
+) -> Result<SimRun<'a>, SimError> {
     scenario.validate()?;
     params.check().map_err(|e| SimError::Invalid {
         key: "params".into(),
         message: e.to_string(),
     })?;
     check_against_run(params, scenario)?;
-    Run::new(params, scenario)
+    SimRun::new(params, scenario)
 }
 
 /// Supply frequencies a run accepts, as multiples of the parameter file's (a V/f drive
@@ -251,7 +251,7 @@ fn check_sensor_faults(params: &ParamFile, sc: &Scenario) -> Result<(), SimError
 }
 
 /// One simulation run: the resolved scenario and the state of the loop.
-pub(super) struct Run<'a> {
+pub(super) struct SimRun<'a> {
     scenario: &'a Scenario,
     builder: MachineBuilder<'a>,
     scales: ParameterScales,
@@ -266,7 +266,7 @@ pub(super) struct Run<'a> {
     np: f64,
 }
 
-impl<'a> Run<'a> {
+impl<'a> SimRun<'a> {
     /// Resolves the scenario and checks every parameter set the run will pass through,
     /// before the first row.
     fn new(params: &'a ParamFile, scenario: &'a Scenario) -> Result<Self, SimError> {
@@ -303,7 +303,7 @@ impl<'a> Run<'a> {
         );
         let h = dt / f64::from(nsub);
         let supply = Supply::new(rated.vpk0, rated.we0, h, builder.eff.unbalance);
-        Ok(Run {
+        Ok(SimRun {
             scenario,
             builder,
             scales,
@@ -387,7 +387,7 @@ impl<'a> Run<'a> {
         }
     }
 
-    /// [`Run::run`] whose callback may add events ([`simulate_interactive`]).
+    /// [`SimRun::run`] whose callback may add events ([`simulate_interactive`]).
     pub(super) fn run_with_events(
         mut self,
         mut on_row: impl FnMut(&Row, &Truth, &mut Vec<ScenarioEvent>) -> ControlFlow<()>,

@@ -119,7 +119,7 @@ unsafe fn NonMaskableInt() {
 }
 
 /// What one phase measured.
-struct Phase {
+struct StallPhase {
     samples: u32,
     triggers: u32,
     max_late_ticks: u32,
@@ -169,7 +169,7 @@ fn main() -> ! {
 
 /// Prints one phase's figures; true when no sample was lost, every sample came less than a
 /// period late and log lines were lost (overwritten unread, or dropped whole).
-fn report(name: &str, p: &Phase, period_ticks: u32, instructions_per_tick: f32) -> bool {
+fn report(name: &str, p: &StallPhase, period_ticks: u32, instructions_per_tick: f32) -> bool {
     let lost = p.triggers.saturating_sub(p.samples);
     let overwritten = p.bytes.saturating_sub(hw::rtt_size() - 1);
     println!("{}_samples={}", name, p.samples);
@@ -190,7 +190,7 @@ fn report(name: &str, p: &Phase, period_ticks: u32, instructions_per_tick: f32) 
 /// One phase: SysTick samples until [`SAMPLES_PER_PHASE`]; thread mode logs the status
 /// line every [`STATUS_EVERY`] sample periods by TIMER0, or back to back (`flood`), and
 /// counts the bytes the logger wrote.
-fn run_phase(syst: &mut cortex_m::peripheral::SYST, phase: u32, flood: bool) -> Phase {
+fn run_phase(syst: &mut cortex_m::peripheral::SYST, phase: u32, flood: bool) -> StallPhase {
     PHASE.store(phase, Relaxed);
     SAMPLES.store(0, Relaxed);
     MAX_LATE.store(0, Relaxed);
@@ -218,7 +218,7 @@ fn run_phase(syst: &mut cortex_m::peripheral::SYST, phase: u32, flood: bool) -> 
             lines += 1;
         }
     }
-    Phase {
+    StallPhase {
         samples: SAMPLES.load(Relaxed),
         triggers: TRIGGERS.load(Relaxed),
         max_late_ticks: MAX_LATE.load(Relaxed),

@@ -33,7 +33,7 @@ pub const FREQUENCY_STEP_HZ: f64 = 1.0;
 const LIVE_DURATION_S: f64 = 1.0e5;
 
 /// What the screen asks the worker.
-enum Command {
+enum LiveCommand {
     /// Simulate this many rows, then answer.
     Run(u64),
     /// An event from the next row on.
@@ -42,7 +42,7 @@ enum Command {
     Commission,
 }
 
-/// The worker's answer to [`Command::Run`].
+/// The worker's answer to [`LiveCommand::Run`].
 struct Reply {
     snapshots: Vec<Snapshot>,
     messages: Vec<String>,
@@ -53,7 +53,7 @@ pub struct LiveSim {
     name: String,
     params: ParamFile,
     sample_rate_hz: f64,
-    tx: Option<Sender<Command>>,
+    tx: Option<Sender<LiveCommand>>,
     rx: Receiver<Reply>,
     worker: Option<JoinHandle<Result<(), monitor_sim::SimError>>>,
     /// Simulated time [s] so far.
@@ -163,7 +163,7 @@ impl LiveSim {
         let sent = self
             .tx
             .as_ref()
-            .is_some_and(|tx| tx.send(Command::Run(rows)).is_ok());
+            .is_some_and(|tx| tx.send(LiveCommand::Run(rows)).is_ok());
         match self.rx.recv() {
             Ok(r) if sent => {
                 self.t_s += rows as f64 / self.sample_rate_hz;
@@ -237,7 +237,7 @@ impl LiveSim {
     /// why it could not start).
     pub fn commission(&mut self) {
         if let Some(tx) = &self.tx {
-            let _ = tx.send(Command::Commission);
+            let _ = tx.send(LiveCommand::Commission);
         }
     }
 
@@ -253,7 +253,7 @@ impl LiveSim {
 
     fn send(&self, ev: ScenarioEvent) {
         if let Some(tx) = &self.tx {
-            let _ = tx.send(Command::Event(ev));
+            let _ = tx.send(LiveCommand::Event(ev));
         }
     }
 
@@ -309,7 +309,7 @@ impl Worker {
     fn run(
         mut self,
         sc: &monitor_sim::Scenario,
-        rx: &Receiver<Command>,
+        rx: &Receiver<LiveCommand>,
     ) -> Result<(), monitor_sim::SimError> {
         let params = self.params;
         simulate_interactive(&params, sc, |row, events| {
@@ -335,7 +335,7 @@ impl Worker {
     /// and commands arriving meanwhile are queued or carried out.
     fn wait_for_work(
         &mut self,
-        rx: &Receiver<Command>,
+        rx: &Receiver<LiveCommand>,
         events: &mut Vec<ScenarioEvent>,
     ) -> ControlFlow<()> {
         while self.budget == 0 {
@@ -350,12 +350,12 @@ impl Worker {
                 }
             }
             match rx.recv() {
-                Ok(Command::Run(n)) => {
+                Ok(LiveCommand::Run(n)) => {
                     self.budget = n;
                     self.answer_due = true;
                 }
-                Ok(Command::Event(e)) => events.push(e),
-                Ok(Command::Commission) => self.commission(),
+                Ok(LiveCommand::Event(e)) => events.push(e),
+                Ok(LiveCommand::Commission) => self.commission(),
                 Err(_) => return ControlFlow::Break(()),
             }
         }

@@ -26,7 +26,7 @@ const BATCH: usize = 64;
 
 /// What the worker has found so far.
 #[derive(Debug, Default)]
-struct Analysis {
+struct ReplayAnalysis {
     snapshots: Vec<Snapshot>,
     done: bool,
     warnings: Vec<String>,
@@ -37,7 +37,7 @@ struct Analysis {
 /// The log replay source.
 pub struct LogReplay {
     path: PathBuf,
-    shared: Arc<Mutex<Analysis>>,
+    shared: Arc<Mutex<ReplayAnalysis>>,
     worker: Option<JoinHandle<()>>,
     controls: PlaybackControls,
     /// Warnings already shown.
@@ -73,7 +73,7 @@ impl LogReplay {
         speed: Speed,
     ) -> Result<Self, ReplayError> {
         LogFile::open_with(path, &open)?;
-        let shared = Arc::new(Mutex::new(Analysis::default()));
+        let shared = Arc::new(Mutex::new(ReplayAnalysis::default()));
         let worker = {
             let shared = Arc::clone(&shared);
             let path = path.to_path_buf();
@@ -113,7 +113,7 @@ impl LogReplay {
     }
 
     /// Shows the reading at the playback position and the residuals before it.
-    fn show(&self, a: &Analysis, state: &mut HmiState) {
+    fn show(&self, a: &ReplayAnalysis, state: &mut HmiState) {
         let pos = self.controls.position_s;
         let end = a.snapshots.partition_point(|s| s.t_s <= pos + 1e-9);
         let start = a.snapshots[..end].partition_point(|s| s.t_s < pos - HISTORY_S);
@@ -138,7 +138,7 @@ fn analyse(
     path: &Path,
     open: &OpenOptions,
     opts: ReplayOptions,
-    shared: &Arc<Mutex<Analysis>>,
+    shared: &Arc<Mutex<ReplayAnalysis>>,
 ) {
     let mut keeper = Keeper {
         params: *params,
@@ -169,7 +169,7 @@ fn analyse(
 /// Keeps a reading every [`SNAPSHOT_EVERY_S`] and hands them over in batches.
 struct Keeper {
     params: ParamFile,
-    shared: Arc<Mutex<Analysis>>,
+    shared: Arc<Mutex<ReplayAnalysis>>,
     pending: Vec<Snapshot>,
     next_s: f64,
     stop: bool,

@@ -164,7 +164,7 @@ pub struct Scored {
 
 /// One case's outcome.
 #[derive(Debug, Clone)]
-pub struct Outcome {
+pub struct CaseOutcome {
     pub case: Case,
     /// The name at the end.
     pub last: Option<(IsolationName, Scored, f32)>,
@@ -196,7 +196,7 @@ pub fn setup(c: &Case) -> (ParamFile, ParamFile, Scenario, ReplayOptions) {
 }
 
 /// Simulates and replays case `c`, scored.
-pub fn run(c: Case) -> Outcome {
+pub fn run(c: Case) -> CaseOutcome {
     let (truth, file, sc, opts) = setup(&c);
     let r = monitor_studies::experiment::simulate_and_replay(&truth, &file, &sc, opts, |_, _| {})
         .expect("runs")
@@ -224,7 +224,7 @@ pub fn run(c: Case) -> Outcome {
             IsolationEvent::LoadMoved { .. } => None,
         })
         .collect();
-    Outcome {
+    CaseOutcome {
         case: c,
         last,
         given,

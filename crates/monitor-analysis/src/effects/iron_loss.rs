@@ -14,7 +14,7 @@ pub struct IronLoss;
 
 /// Iron loss set up on a log: the magnetising reactance at the log's highest supply
 /// frequency.
-struct OnLog {
+struct IronLossOnLog {
     /// Xm [ohm].
     xm_ohm: f64,
 }
@@ -67,11 +67,11 @@ impl EffectModel for IronLoss {
             0.02 / xm,
             1.0 / xm,
         )];
-        Ok(FitSetup::new(OnLog { xm_ohm: xm }, params)?)
+        Ok(FitSetup::new(IronLossOnLog { xm_ohm: xm }, params)?)
     }
 }
 
-impl Contribution for OnLog {
+impl Contribution for IronLossOnLog {
     type Values = IronLossValues;
     fn values(&self, v: &[f64]) -> Result<IronLossValues, EffectValuesError> {
         IronLossValues::try_from(v)

@@ -16,7 +16,7 @@ pub struct PhaseAsymmetry;
 
 /// The shorted turns set up on a log: the full-order form's loop admittance over `c`,
 /// `y / c = 1 / conj(Z1)` at the log's mean operating point ([`WindingAsymmetryTerm`]).
-struct OnLog {
+struct PhaseAsymmetryOnLog {
     y_over_c: C64,
 }
 
@@ -113,11 +113,11 @@ impl EffectModel for PhaseAsymmetry {
             c_re.fit(0.01, (-1.0, 1.0), 0.02, 1.0),
             c_im.fit(0.0, (-1.0, 1.0), 0.02, 1.0),
         ];
-        Ok(FitSetup::new(OnLog { y_over_c: k }, params)?)
+        Ok(FitSetup::new(PhaseAsymmetryOnLog { y_over_c: k }, params)?)
     }
 }
 
-impl Contribution for OnLog {
+impl Contribution for PhaseAsymmetryOnLog {
     type Values = PhaseAsymmetryValues;
     fn values(&self, v: &[f64]) -> Result<PhaseAsymmetryValues, EffectValuesError> {
         PhaseAsymmetryValues::try_from(v)

@@ -98,7 +98,7 @@ pub struct RotorAsymmetry;
 
 /// The cage set up on a log: per working sample, twice the rotor's electrical angle
 /// against the analysis frame and the measured I_ds ripple.
-struct OnLog {
+struct RotorAsymmetryOnLog {
     /// 2 (Np theta_m - theta) [rad] ([`double_slip_angle`]).
     double_slip_angle: Vec<f64>,
     /// The I_ds ripple [A] ([`id_ripple`]).
@@ -199,7 +199,7 @@ impl EffectModel for RotorAsymmetry {
             delta.fit(delta0, (0.0, 2.0), 0.05, 1.0),
             phi_rad.fit(phi0, (phi0 - 4.0 * PI, phi0 + 4.0 * PI), 0.3, 1.0),
         ];
-        let on_log = OnLog {
+        let on_log = RotorAsymmetryOnLog {
             double_slip_angle: ang,
             id_ripple: ripple,
         };
@@ -220,7 +220,7 @@ impl EffectModel for RotorAsymmetry {
     }
 }
 
-impl Contribution for OnLog {
+impl Contribution for RotorAsymmetryOnLog {
     type Values = RotorAsymmetryValues;
     fn values(&self, v: &[f64]) -> Result<RotorAsymmetryValues, EffectValuesError> {
         RotorAsymmetryValues::try_from(v)

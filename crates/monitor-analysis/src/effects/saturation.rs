@@ -13,7 +13,7 @@ use monitor_core::EffectKind;
 pub struct Saturation;
 
 /// Saturation set up on a log: the log's flux level.
-struct OnLog {
+struct SaturationOnLog {
     /// The log's flux level `|V| / omega_s` [Wb] (`rated_flux_wb`).
     rated_flux_wb: f64,
 }
@@ -145,11 +145,14 @@ impl EffectModel for Saturation {
             // Fitted anywhere within its plausible range.
             exponent.fit(7.0, exponent.range, 2.0, 1.0),
         ];
-        Ok(FitSetup::new(OnLog { rated_flux_wb: psi }, params)?)
+        Ok(FitSetup::new(
+            SaturationOnLog { rated_flux_wb: psi },
+            params,
+        )?)
     }
 }
 
-impl Contribution for OnLog {
+impl Contribution for SaturationOnLog {
     type Values = SaturationValues;
     fn values(&self, v: &[f64]) -> Result<SaturationValues, EffectValuesError> {
         SaturationValues::try_from(v)

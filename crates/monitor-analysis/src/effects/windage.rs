@@ -38,7 +38,7 @@ impl TryFrom<&[f64]> for WindageValues {
 }
 
 /// Windage set up on a log: the log's highest synchronous speed.
-struct OnLog {
+struct WindageOnLog {
     /// [rad/s], mechanical.
     sync_speed_rad_s: f64,
 }
@@ -74,7 +74,7 @@ impl EffectModel for Windage {
         let [k_nms2] = &PARAMS;
         let params = vec![k_nms2.fit(0.01 * k, (-0.1 * k, 2.0 * k), 0.05 * k, k)];
         Ok(FitSetup::new(
-            OnLog {
+            WindageOnLog {
                 sync_speed_rad_s: w,
             },
             params,
@@ -82,7 +82,7 @@ impl EffectModel for Windage {
     }
 }
 
-impl Contribution for OnLog {
+impl Contribution for WindageOnLog {
     type Values = WindageValues;
     fn values(&self, v: &[f64]) -> Result<WindageValues, EffectValuesError> {
         WindageValues::try_from(v)

@@ -13,7 +13,7 @@ use crate::{align, transients, Analysis, AnalysisError, Options, MAX_FIT_SAMPLES
 use monitor_core::EffectKind;
 
 /// The configured model fitted and measured: what every candidate is compared with.
-pub(super) struct Baseline<'a> {
+pub(super) struct ExplainBaseline<'a> {
     /// The series the fits run on (the working series, or a coarser one for long logs).
     pub(super) fit_series: Prepared,
     /// The fit series' coarsening factor (1: the working series).
@@ -65,7 +65,7 @@ pub(super) struct FullSeries {
 /// `current_dynamics`) flags its base parameters because they absorb what it cannot
 /// follow: the verdict says so, and recentring on them would judge effects against that
 /// error.
-pub(super) fn structural_error(base: &Baseline<'_>, names: &[EffectKind]) -> bool {
+pub(super) fn structural_error(base: &ExplainBaseline<'_>, names: &[EffectKind]) -> bool {
     base.span.input_transient
         && ![EffectKind::FluxDynamics, EffectKind::CurrentDynamics]
             .iter()
@@ -75,12 +75,12 @@ pub(super) fn structural_error(base: &Baseline<'_>, names: &[EffectKind]) -> boo
 impl Analysis {
     /// Stage 2: fits the configured model and measures it on the fit series (for a long
     /// log, the coarser series the candidates are ranked on); when that is the working
-    /// series, on the whole log and the held-back windows too ([`Baseline::full`]).
+    /// series, on the whole log and the held-back windows too ([`ExplainBaseline::full`]).
     pub(super) fn baseline<'a>(
         &self,
         configured: &'a [Box<dyn EffectModel>],
         opts: &Options,
-    ) -> Result<Baseline<'a>, AnalysisError> {
+    ) -> Result<ExplainBaseline<'a>, AnalysisError> {
         let (fd, m) = self.fit_data();
         let wf = Weights::new(&fd, HOLDOUT_WINDOWS, MAX_FIT_SAMPLES);
         let w_full = Weights::new(&self.data, HOLDOUT_WINDOWS, usize::MAX);
@@ -90,7 +90,7 @@ impl Analysis {
         let f0 = self.fit_set(&fd, &active, &wf, &nominal, opts.fit_base)?;
         let heldback_fit_series: Vec<bool> = wf.train.iter().map(|t| !t).collect();
         let span = transients::Span::of(&fd, &self.constants);
-        let mut base = Baseline {
+        let mut base = ExplainBaseline {
             fit_series: fd,
             coarsening: m,
             fit_weights: wf,
@@ -110,12 +110,12 @@ impl Analysis {
 
     /// The baseline's held-back error and noise floor on the fit series: from the
     /// working series' measures when the fit series is the working series (kept in
-    /// [`Baseline::full`]); for a long log (fitted on a coarser series) on that series,
+    /// [`ExplainBaseline::full`]); for a long log (fitted on a coarser series) on that series,
     /// where the candidates are ranked too.
     fn measure_baseline(
         &self,
         configured: &[Box<dyn EffectModel>],
-        base: &mut Baseline<'_>,
+        base: &mut ExplainBaseline<'_>,
     ) -> Result<(), AnalysisError> {
         if base.coarsening == 1 {
             let full = self.full_series(configured, base)?;
@@ -138,7 +138,7 @@ impl Analysis {
     /// the log identifies of them ([`fit::jacobian`] on the fit series).
     pub(super) fn base_refit(
         &self,
-        base: &Baseline<'_>,
+        base: &ExplainBaseline<'_>,
         opts: &Options,
     ) -> Result<BaseRefit, AnalysisError> {
         let jac = fit::jacobian(
@@ -161,7 +161,7 @@ impl Analysis {
     pub(super) fn full_series(
         &self,
         configured: &[Box<dyn EffectModel>],
-        base: &Baseline<'_>,
+        base: &ExplainBaseline<'_>,
     ) -> Result<FullSeries, AnalysisError> {
         let d = &self.data;
         let active_full = self.setup_all(d, configured)?;

@@ -2,7 +2,7 @@
 //! them cannot be ranked on this log (and why), and each rankable candidate added to the
 //! configured model, fitted and measured on the held-back windows.
 
-use super::baseline::{Baseline, FullSeries};
+use super::baseline::{ExplainBaseline, FullSeries};
 use super::ranking::RankedCandidate;
 use super::{explained_fraction, EffectCandidate, Standing};
 use crate::effects::{self, EffectModel, SetupError};
@@ -40,7 +40,7 @@ pub(super) enum NotRanked {
 /// The configured effects of `base`, each starting from its baseline fit, with candidate
 /// `c` (set up as `setup`) added last.
 fn with_candidate<'a>(
-    base: &Baseline<'a>,
+    base: &ExplainBaseline<'a>,
     c: &'a dyn EffectModel,
     setup: crate::effects::FitSetup,
 ) -> Vec<ActiveEffect<'a>> {
@@ -64,7 +64,11 @@ fn with_candidate<'a>(
 impl Analysis {
     /// Stage 5: the candidates of `cands` that cannot be ranked on this log, each as
     /// `name: why` ([`Analysis::cannot_rank`]).
-    pub(super) fn skipped(&self, cands: &[&dyn EffectModel], base: &Baseline<'_>) -> Vec<String> {
+    pub(super) fn skipped(
+        &self,
+        cands: &[&dyn EffectModel],
+        base: &ExplainBaseline<'_>,
+    ) -> Vec<String> {
         cands
             .iter()
             .filter_map(|c| {
@@ -77,7 +81,7 @@ impl Analysis {
     /// Why a candidate cannot be ranked on this log, if it cannot: the rule `compare`'s
     /// advice follows too ([`Analysis::not_proposed`]), a missing channel, or a set-up the
     /// data refuse (e.g. `load_torque` on a log without a load change: said, not dropped).
-    fn cannot_rank(&self, c: &dyn EffectModel, base: &Baseline<'_>) -> Option<NotRanked> {
+    fn cannot_rank(&self, c: &dyn EffectModel, base: &ExplainBaseline<'_>) -> Option<NotRanked> {
         if let Some(m) = self.not_proposed(c, base) {
             return Some(NotRanked::NotProposed(m));
         }
@@ -93,7 +97,7 @@ impl Analysis {
     fn not_proposed(
         &self,
         c: &dyn EffectModel,
-        base: &Baseline<'_>,
+        base: &ExplainBaseline<'_>,
     ) -> Option<transients::NotProposed> {
         let in_model: Vec<EffectKind> = base.active.iter().map(|a| a.effect.kind()).collect();
         transients::not_proposed(c, base.span, &self.constants, &in_model)
@@ -107,7 +111,7 @@ impl Analysis {
     pub(super) fn fit_candidates(
         &self,
         configured: &[Box<dyn EffectModel>],
-        base: &Baseline<'_>,
+        base: &ExplainBaseline<'_>,
         full: Option<FullSeries>,
         cands: &[&dyn EffectModel],
         opts: &Options,
@@ -144,7 +148,7 @@ impl Analysis {
     fn evaluate_candidate(
         &self,
         c: &dyn EffectModel,
-        base: &Baseline<'_>,
+        base: &ExplainBaseline<'_>,
         opts: &Options,
     ) -> Result<Option<RankedCandidate>, AnalysisError> {
         if self.cannot_fit(c, base) {
@@ -199,7 +203,7 @@ impl Analysis {
 
     /// True when candidate `c` cannot be fitted on this log: a channel it needs is
     /// missing, or it is not proposed on it ([`Analysis::cannot_rank`] says why).
-    fn cannot_fit(&self, c: &dyn EffectModel, base: &Baseline<'_>) -> bool {
+    fn cannot_fit(&self, c: &dyn EffectModel, base: &ExplainBaseline<'_>) -> bool {
         c.needs().met_by(&self.data).is_err() || self.not_proposed(c, base).is_some()
     }
 
@@ -207,7 +211,7 @@ impl Analysis {
     /// series it was fitted on (the working series, or its coarse copy).
     fn candidate_errors(
         &self,
-        base: &Baseline<'_>,
+        base: &ExplainBaseline<'_>,
         set: &[ActiveEffect<'_>],
         f: &FitResult,
     ) -> Result<(f64, f64), AnalysisError> {
@@ -226,7 +230,7 @@ impl Analysis {
     /// when the fit ran on a coarse copy); `None` when a set-up refuses it.
     fn on_working_series<'a>(
         &self,
-        base: &Baseline<'_>,
+        base: &ExplainBaseline<'_>,
         set: &[ActiveEffect<'a>],
     ) -> Option<Vec<ActiveEffect<'a>>> {
         set.iter()
@@ -252,7 +256,7 @@ impl Analysis {
     fn implausible(
         &self,
         c: &dyn EffectModel,
-        base: &Baseline<'_>,
+        base: &ExplainBaseline<'_>,
         me: &FittedEffect,
         f: &FitResult,
     ) -> Result<Vec<String>, AnalysisError> {

@@ -14,7 +14,7 @@
 //!    ranked on this log, with why (`candidates`, `Analysis::skipped`, `candidates.rs`);
 //! 6. each candidate added, fitted and measured (`Analysis::fit_candidates`), then ranked
 //!    (`rank`), each given its standing (`stand`: a candidate, no effect, not plausible)
-//!    and the ranking's outcome read (`Outcome`, `ranking.rs`);
+//!    and the ranking's outcome read (`CandidateOutcome`, `ranking.rs`);
 //! 7. the model recentred on the refitted base parameters and explained again, when the
 //!    file's values do not fit and nothing could be named (`Analysis::recentre_because`,
 //!    `Analysis::explain_recentred`);
@@ -34,8 +34,8 @@ use super::{resolve, Analysis, AnalysisError, DataInfo, Options, ParamValue};
 use baseline::structural_error;
 use candidates::candidates;
 use monitor_core::EffectKind;
-use ranking::{rank, stand, Outcome};
-use report::{withhold_if_untrusted, Findings};
+use ranking::{rank, stand, CandidateOutcome};
+use report::{withhold_if_untrusted, ExplainFindings};
 use serde::Serialize;
 
 /// A candidate explaining less than this fraction of the held-back error is not claimed.
@@ -234,8 +234,8 @@ impl Analysis {
         let unbalance = self.unbalance();
         rank(&mut ranked, &unbalance, self.constants.torque_scale_nm);
         stand(&mut ranked);
-        let found = Findings {
-            outcome: Outcome::of(&ranked, &full),
+        let found = ExplainFindings {
+            outcome: CandidateOutcome::of(&ranked, &full),
             names,
             base,
             full,

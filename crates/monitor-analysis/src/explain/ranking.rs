@@ -31,7 +31,7 @@ impl RankedCandidate {
 /// What the ranking says: whether the model's error is already at the noise floor, and
 /// whether no plausible candidate explains enough of it.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Outcome {
+pub(super) struct CandidateOutcome {
     /// The configured model's held-back error is within [`NOISE_MARGIN`] of the noise
     /// floor, or below [`MIN_MODEL_ERROR`]: nothing to explain.
     pub(super) near_noise: bool,
@@ -40,7 +40,7 @@ pub(super) struct Outcome {
     pub(super) unexplained: bool,
 }
 
-impl Outcome {
+impl CandidateOutcome {
     /// The outcome of the ranking `ranked` (best first) against the configured model's
     /// measures `full`.
     pub(super) fn of(ranked: &[RankedCandidate], full: &FullSeries) -> Self {
@@ -51,7 +51,7 @@ impl Outcome {
             .unwrap_or(0.0);
         let near_noise =
             full.heldback_error <= (NOISE_MARGIN * full.heldback_noise).max(MIN_MODEL_ERROR);
-        Outcome {
+        CandidateOutcome {
             near_noise,
             unexplained: best < EXPLAINED_MIN || near_noise,
         }

@@ -2,8 +2,8 @@
 //! on its refitted base parameters when the file's do not fit, and the report with its
 //! verdict.
 
-use super::baseline::{Baseline, FullSeries};
-use super::ranking::{Outcome, RankedCandidate};
+use super::baseline::{ExplainBaseline, FullSeries};
+use super::ranking::{CandidateOutcome, RankedCandidate};
 use super::{
     ExplainOutput, ExplainReport, Standing, EXPLAINED_MIN, EXPLAINS_MIN, MIN_MODEL_ERROR,
     NOISE_MARGIN,
@@ -18,17 +18,17 @@ use crate::{Analysis, AnalysisError, Options};
 use monitor_core::EffectKind;
 
 /// What stages 2 to 6 found on a log with voltages: the report's material.
-pub(super) struct Findings<'a> {
+pub(super) struct ExplainFindings<'a> {
     /// The effects in the configured model.
     pub(super) names: Vec<EffectKind>,
     /// The configured model fitted on the fit series.
-    pub(super) base: Baseline<'a>,
+    pub(super) base: ExplainBaseline<'a>,
     /// The configured model on the working series.
     pub(super) full: FullSeries,
     /// The candidates, best first.
     pub(super) ranked: Vec<RankedCandidate>,
     /// What the ranking says.
-    pub(super) outcome: Outcome,
+    pub(super) outcome: CandidateOutcome,
     /// Candidates not ranked and why.
     pub(super) skipped: Vec<String>,
     /// The unbalance analysis.
@@ -82,7 +82,7 @@ impl Analysis {
     /// structural, and the log identifies a base parameter whose refit is out of range.
     pub(super) fn recentre_because(
         &self,
-        found: &Findings<'_>,
+        found: &ExplainFindings<'_>,
         refit: &BaseRefit,
         structural: bool,
     ) -> Option<Vec<String>> {
@@ -125,7 +125,7 @@ impl Analysis {
     /// with the candidate it names.
     pub(super) fn explain_report(
         &self,
-        found: Findings<'_>,
+        found: ExplainFindings<'_>,
         refit: BaseRefit,
     ) -> Result<ExplainOutput, AnalysisError> {
         let o = found.outcome;
@@ -164,7 +164,7 @@ impl Analysis {
 
     /// The verdict ([`verdict`]) with the notes on implausible candidates and on an
     /// implausible fit of the configured model itself.
-    fn verdict(&self, found: &Findings<'_>) -> String {
+    fn verdict(&self, found: &ExplainFindings<'_>) -> String {
         let first_plausible = found.ranked.iter().find(|c| c.candidate.plausible);
         let mut v = verdict(found, first_plausible);
         v.push_str(&implausible_note(&found.ranked));
@@ -259,7 +259,7 @@ fn implausible_note(ranked: &[RankedCandidate]) -> String {
 }
 
 /// The conclusion in words, `best` the first plausible candidate.
-fn verdict(found: &Findings<'_>, best: Option<&RankedCandidate>) -> String {
+fn verdict(found: &ExplainFindings<'_>, best: Option<&RankedCandidate>) -> String {
     let (full, o) = (&found.full, found.outcome);
     match best {
         _ if o.near_noise => format!(

@@ -17,7 +17,7 @@ use nalgebra::DMatrix;
 pub const WINDOW_S: f64 = 0.02;
 
 /// The judged result of a parameter: `(value, lo, hi)` or why it was not identified.
-pub type Judged = Result<(f64, f64, f64), NotIdentified>;
+pub type MechanicsJudged = Result<(f64, f64, f64), NotIdentified>;
 
 /// Why a parameter was not identified (its `Display` is the report's sentence,
 /// `not_identified_because`).
@@ -63,9 +63,9 @@ pub enum NotIdentified {
 #[derive(Debug, Clone)]
 pub struct Mechanics {
     /// J [kg m^2].
-    pub j: Judged,
+    pub j: MechanicsJudged,
     /// B + Bl [N m s/rad].
-    pub b_total: Judged,
+    pub b_total: MechanicsJudged,
 }
 
 /// A log-space estimate: `value` and the standard deviation of `ln(value)`.
@@ -80,7 +80,7 @@ pub struct LogEstimate {
 impl LogEstimate {
     /// The 95 % interval `value exp(+-1.96 sigma)`; not identified when it is wider than
     /// the value or sigma is not finite.
-    pub fn judged(&self) -> Judged {
+    pub fn judged(&self) -> MechanicsJudged {
         let (v, sg) = (self.value, self.sigma);
         if !sg.is_finite() {
             return Err(NotIdentified::Flat);
@@ -95,7 +95,7 @@ impl LogEstimate {
 
 /// A linear estimate's judgement: `value +- 1.96 sigma`, not identified when that is wider
 /// than the value or the value is not positive.
-fn judged_linear(v: f64, sg: f64) -> Judged {
+fn judged_linear(v: f64, sg: f64) -> MechanicsJudged {
     if !sg.is_finite() {
         return Err(NotIdentified::Flat);
     }

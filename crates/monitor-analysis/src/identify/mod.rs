@@ -371,7 +371,7 @@ fn estimate(k: usize, start: f64, p: f64, sigma: Option<f64>) -> Estimate {
 }
 
 /// The estimate of parameter `k` from a judged value.
-fn estimate_or(k: usize, start: f64, e: mechanics::Judged) -> Estimate {
+fn estimate_or(k: usize, start: f64, e: mechanics::MechanicsJudged) -> Estimate {
     let (name, key, unit) = PARAMS[k];
     let (value, lo, hi, why) = match e {
         Ok((v, lo, hi)) => (Some(v), Some(lo), Some(hi), None),

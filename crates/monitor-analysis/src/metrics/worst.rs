@@ -73,7 +73,7 @@ pub fn windows(
 ) -> (Vec<WorstWindow>, Vec<WorstWindow>) {
     let len = d.len().min(p.iq.len());
     let nw = n_windows.clamp(1, len.max(1));
-    let on = Machine { v_rated, np };
+    let on = RatedMachine { v_rated, np };
     // Windows are independent (each with its own spectrum): computed in parallel, in order.
     let all: Vec<WorstWindow> = (0..nw)
         .into_par_iter()
@@ -89,7 +89,7 @@ pub fn windows(
 
 /// The rated voltage [V peak, phase] and pole pairs a window's condition is given with.
 #[derive(Debug, Clone, Copy)]
-struct Machine {
+struct RatedMachine {
     v_rated: f64,
     np: f64,
 }
@@ -135,7 +135,14 @@ impl WindowSums {
 
     /// The window `a..b` these sums are of: its error (channels normalised by `w`), its
     /// operating condition and the dominant frequency of its I_qs error.
-    fn window(&self, d: &Prepared, w: &Weights, a: usize, b: usize, on: Machine) -> WorstWindow {
+    fn window(
+        &self,
+        d: &Prepared,
+        w: &Weights,
+        a: usize,
+        b: usize,
+        on: RatedMachine,
+    ) -> WorstWindow {
         let n = (b - a) as f64;
         let mut e = 0.0;
         for c in 0..5 {

@@ -80,7 +80,7 @@ struct Working<'a> {
 
 /// The analysis frame: its Park angle [rad] (unwrapped), speed [rad/s] and rotation
 /// e^{j theta}.
-struct Frame {
+struct FluxFrame {
     theta: Vec<f64>,
     omega_s: Vec<f64>,
     rot: Vec<C64>,
@@ -89,7 +89,7 @@ struct Frame {
 impl Working<'_> {
     /// The frame: the voltage-model rotor-flux angle, smoothed (the nominal supply angle
     /// for a current-only log).
-    fn frame(&self, p: &ParamFile) -> Frame {
+    fn frame(&self, p: &ParamFile) -> FluxFrame {
         let (d, dt) = (self.d, self.dt);
         let theta = if d.channels.voltages {
             let raw = flux_angle(self.v_ab, self.i_ab, dt, p);
@@ -103,7 +103,7 @@ impl Working<'_> {
             .iter()
             .map(|&th| C64::new(th.cos(), th.sin()))
             .collect();
-        Frame {
+        FluxFrame {
             theta,
             omega_s,
             rot,
@@ -118,7 +118,7 @@ impl Working<'_> {
     /// signal then leaks volts into the negative sequence for the low-pass's memory
     /// (0.2 s): 4 V on an 11 kW start, which the model takes as its input. A current-only
     /// log separates in the analysis frame `frame`.
-    fn sequences(&self, frame: Option<&Frame>) -> (Vec<C64>, Vec<C64>) {
+    fn sequences(&self, frame: Option<&FluxFrame>) -> (Vec<C64>, Vec<C64>) {
         let (d, dt) = (self.d, self.dt);
         let voltages = d.channels.voltages;
         let (sep_theta, sep_omega) = match frame {

@@ -3,7 +3,7 @@
 //! machine at a sample, the initial state, the run's set-up ([`FullRun`]).
 
 use super::reduced::initial_state;
-use super::{BaseParams, MachineConstants, Mechanics, ModelTerms, Prediction, Run};
+use super::{BaseParams, MachineConstants, ModelMechanics, ModelRun, ModelTerms, Prediction};
 use crate::prep::{Prepared, C64};
 
 /// The machine of the full-order form at one sample (inverse-Gamma equivalent of the
@@ -240,8 +240,8 @@ pub(super) fn full_initial_state(
 /// the machine at each sample and the initial state. `None` when there is nothing to
 /// simulate (no samples, or no voltages to drive the model).
 pub(super) struct FullRun<'a> {
-    pub(super) run: Run<'a>,
-    pub(super) mech: Mechanics,
+    pub(super) run: ModelRun<'a>,
+    pub(super) mech: ModelMechanics,
     /// The initial state ([`full_initial_state`]).
     pub(super) x0: FullState,
     /// The machine's Lm starts unsaturated at every sample (the stationary model's own
@@ -250,15 +250,15 @@ pub(super) struct FullRun<'a> {
 }
 
 impl<'a> FullRun<'a> {
-    pub(super) fn new(run: Run<'a>, unsaturated: bool) -> Option<Self> {
-        let Run { d, n, b, .. } = run;
+    pub(super) fn new(run: ModelRun<'a>, unsaturated: bool) -> Option<Self> {
+        let ModelRun { d, n, b, .. } = run;
         let len = d.len();
         if len == 0 || d.vq.len() != len {
             return None;
         }
         let mut full = FullRun {
             run,
-            mech: Mechanics::new(n, b),
+            mech: ModelMechanics::new(n, b),
             x0: FullState::default(),
             unsaturated,
         };
@@ -268,7 +268,7 @@ impl<'a> FullRun<'a> {
 
     /// The machine at sample `k`.
     pub(super) fn machine(&self, k: usize) -> FullMachine {
-        let Run { n, b, t, .. } = self.run;
+        let ModelRun { n, b, t, .. } = self.run;
         if self.unsaturated {
             FullMachine::at_lm(n, b, t, k, 1.0)
         } else {
@@ -293,7 +293,7 @@ impl<'a> FullRun<'a> {
 /// sample, inputs linear between samples (L_sigma/R is about 7 samples at 2 kHz, RK4's
 /// error is below 1e-6 of a step). Core loss adds g j omega_k psi_s to the output current
 /// (no feedback: 1 % of the current at Rfe = 8 Xm).
-pub(super) fn simulate_full(run: Run<'_>, rot_at: impl Fn(usize) -> C64) -> Prediction {
+pub(super) fn simulate_full(run: ModelRun<'_>, rot_at: impl Fn(usize) -> C64) -> Prediction {
     let Some(full) = FullRun::new(run, false) else {
         return Prediction::default();
     };
@@ -377,7 +377,7 @@ impl FrameForm<'_> {
         rot: C64,
         out: &mut Prediction,
     ) {
-        let Run { d, n, t, .. } = self.full.run;
+        let ModelRun { d, n, t, .. } = self.full.run;
         let (v0, id0, if0) = self.input(k, 0.0);
         let (xa, _) = m.deriv(self.sw, x, v0, id0, if0, wk, n.np);
         let ineg = t.reduced_i_neg(d, k);
@@ -397,7 +397,7 @@ impl FrameForm<'_> {
     /// state turned by what the frame turned beyond `wk`.
     fn step(&self, k: usize, m: &FullMachine, wk: f64, x: &FullState) -> FullState {
         let (d, np) = (self.full.run.d, self.full.run.n.np);
-        let Mechanics { j, btot } = self.full.mech;
+        let ModelMechanics { j, btot } = self.full.mech;
         let dt = d.dt_s;
         let f = |st: &FullState, s: f64| -> FullState {
             let (v, idm, ifm) = self.input(k, s);

@@ -203,14 +203,14 @@ impl std::fmt::Display for BaseParameter {
 /// The shaft's constants of a run: J [kg m^2] and B + Bl [N m s/rad] of the base
 /// parameters, held physical (J at least 1e-9, B + Bl at least 0).
 #[derive(Debug, Clone, Copy)]
-struct Mechanics {
+struct ModelMechanics {
     j: f64,
     btot: f64,
 }
 
-impl Mechanics {
+impl ModelMechanics {
     fn new(n: &MachineConstants, b: &BaseParams) -> Self {
-        Mechanics {
+        ModelMechanics {
             j: (n.j_kgm2 * b.j_scale).max(1e-9),
             btot: b.btot_nms.max(0.0),
         }
@@ -303,7 +303,7 @@ fn simulate_with(
     t: &ModelTerms,
     rot_at: impl Fn(usize) -> C64,
 ) -> Prediction {
-    let run = Run { d, n, b, t };
+    let run = ModelRun { d, n, b, t };
     if t.dynamics.is_full_order() {
         stationary::simulate_stationary(run, rot_at)
     } else if t.dynamics.needs_full_form() {
@@ -316,7 +316,7 @@ fn simulate_with(
 /// One run of the model: the working series, the machine's constants, the base
 /// parameters and the effects' terms.
 #[derive(Clone, Copy)]
-struct Run<'a> {
+struct ModelRun<'a> {
     d: &'a Prepared,
     n: &'a MachineConstants,
     b: &'a BaseParams,

@@ -1,6 +1,6 @@
 //! The reduced model: the paper's simplified model with the effects' steady-state terms.
 
-use super::{InputNoise, MachineConstants, Mechanics, ModelTerms, Prediction, Run};
+use super::{InputNoise, MachineConstants, ModelMechanics, ModelRun, ModelTerms, Prediction};
 use crate::prep::{Prepared, C64};
 
 /// The model's inputs at one working sample: V_ds, V_qs, I_ds, i_f, positive-sequence I_qs.
@@ -158,8 +158,8 @@ impl CoreLoss {
 
 /// The reduced model's constants over a run.
 struct Reduced<'a> {
-    run: Run<'a>,
-    mech: Mechanics,
+    run: ModelRun<'a>,
+    mech: ModelMechanics,
     /// Rs and the rotor term of Ra with the refitted Ra scale [ohm].
     rs0: f64,
     rr0: f64,
@@ -173,7 +173,7 @@ struct Reduced<'a> {
 
 /// The reduced model's state: speed [rad/s, mechanical], I_qs [A], the normalised rotor
 /// flux phi = psi_r/Lm [A] and its driven deviation [A].
-struct State {
+struct ReducedState {
     wm: f64,
     iq: f64,
     phi: f64,
@@ -199,12 +199,12 @@ struct FluxTerms {
 }
 
 impl<'a> Reduced<'a> {
-    fn new(run: Run<'a>) -> Self {
-        let Run { d, n, b, t } = run;
+    fn new(run: ModelRun<'a>) -> Self {
+        let ModelRun { d, n, b, t } = run;
         let dt = d.dt_s;
         Reduced {
             run,
-            mech: Mechanics::new(n, b),
+            mech: ModelMechanics::new(n, b),
             rs0: n.rs_ohm * b.ra_scale,
             rr0: n.rr_a_ohm * b.ra_scale,
             i_f_ref: d.id.iter().fold(0.0f64, |a, &x| a.max(x.abs())).max(1e-6),
@@ -217,10 +217,10 @@ impl<'a> Reduced<'a> {
     }
 
     /// The initial state (the measurement's first 10 ms, the flux at i_f).
-    fn initial(&self) -> State {
+    fn initial(&self) -> ReducedState {
         let (wm, iq) = initial_state(self.run.d, self.run.n);
         let start = self.run.t.rotor_cage.flux_drive_start;
-        State {
+        ReducedState {
             wm,
             iq,
             phi: self.run.d.i_f[0] + start,
@@ -245,7 +245,7 @@ impl<'a> Reduced<'a> {
 
     /// The core loss at sample `k`; at the first sample the states start from the
     /// machine's own currents, not the terminal ones.
-    fn core_loss(&self, k: usize, m: &AtSample, x: Inputs, s: &mut State) -> CoreLoss {
+    fn core_loss(&self, k: usize, m: &AtSample, x: Inputs, s: &mut ReducedState) -> CoreLoss {
         let g = self.run.t.magnetising.core_loss_s;
         if g == 0.0 {
             return CoreLoss::none(x);
@@ -261,7 +261,7 @@ impl<'a> Reduced<'a> {
     /// The rotor flux at sample `k` (phi = psi_r / Lm [A]): with rotor-flux dynamics it
     /// follows the raw I_ds through the rotor time constant; without, it is i_f (plus the
     /// deviation the flux drive makes through the nominal rotor time constant).
-    fn flux(&self, k: usize, m: &AtSample, cl: &CoreLoss, s: &mut State) -> FluxTerms {
+    fn flux(&self, k: usize, m: &AtSample, cl: &CoreLoss, s: &mut ReducedState) -> FluxTerms {
         let (ls, lmr, rs, rr) = (m.ls, m.lmr, m.rs, m.rr);
         let ls_scale = self.run.b.ls_scale;
         let cage = &self.run.t.rotor_cage;
@@ -307,9 +307,9 @@ impl<'a> Reduced<'a> {
 
     /// Eqs. (28)-(29) over one sample: the new I_qs and speed from V_qs `vq` [V] (the
     /// speed semi-implicit, so the step is stable at any working rate).
-    fn mechanics(&self, k: usize, m: &AtSample, f: &FluxTerms, vq: f64, s: &mut State) {
+    fn mechanics(&self, k: usize, m: &AtSample, f: &FluxTerms, vq: f64, s: &mut ReducedState) {
         let (n, dt) = (self.run.n, self.run.d.dt_s);
-        let Mechanics { j, btot } = self.mech;
+        let ModelMechanics { j, btot } = self.mech;
         let kt = 1.5 * n.np * m.lmr * f.phi_t; // Te = kt * iq  [N m/A]
         let extra = |w: f64| self.run.t.shaft.extra_nm(k, w);
         let (psi_p, rden) = (f.psi_p, f.rden);
@@ -335,7 +335,7 @@ impl<'a> Reduced<'a> {
     /// current, the predicted q current (with the core loss' frame tilt undone, and the
     /// shorted-turn loop's in-phase current `|y| V_qs`, which makes no torque), the
     /// negative sequence added.
-    fn output(&self, k: usize, rot: C64, cl: &CoreLoss, s: &State, out: &mut Prediction) {
+    fn output(&self, k: usize, rot: C64, cl: &CoreLoss, s: &ReducedState, out: &mut Prediction) {
         let d = self.run.d;
         let ineg = self.run.t.reduced_i_neg(d, k);
         let loop_q = self
@@ -361,7 +361,7 @@ impl<'a> Reduced<'a> {
 /// The reduced model (no full-order dynamics: see the module doc of [`super`]) over the
 /// working series, `rot_at(k)` the frame rotation `e^{j theta_k}`.
 #[inline(always)]
-pub(super) fn simulate_reduced(run: Run<'_>, rot_at: impl Fn(usize) -> C64) -> Prediction {
+pub(super) fn simulate_reduced(run: ModelRun<'_>, rot_at: impl Fn(usize) -> C64) -> Prediction {
     let d = run.d;
     let len = d.len();
     let mut out = Prediction::with_capacity(len);

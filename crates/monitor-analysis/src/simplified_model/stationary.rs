@@ -5,7 +5,7 @@ mod voltage;
 
 use super::full_order::{FullMachine, FullRun};
 use super::terms::{SaturationLaw, Shaft, WindingAsymmetryTerm};
-use super::{MachineConstants, Mechanics, ModelTerms, Prediction, Run};
+use super::{MachineConstants, ModelMechanics, ModelRun, ModelTerms, Prediction};
 use crate::prep::{Prepared, C64};
 use voltage::StatVoltage;
 
@@ -40,7 +40,7 @@ struct CageOverSample {
 struct StatMachine<'a> {
     m: FullMachine,
     np: f64,
-    mech: Mechanics,
+    mech: ModelMechanics,
     /// The shaft's extra torques and the sample they are taken at.
     shaft: &'a Shaft,
     k: usize,
@@ -312,8 +312,8 @@ fn phase_step(a: C64, b: C64) -> f64 {
 /// Measured on effect-free simulated logs with a start, a V/f step and a dip, ideal
 /// sensors, true parameters (2.2 kW, 11 kW; 2, 5, 10 kHz): `normalized_rms_error`
 /// 0.0003-0.0007 (on the simulator's own rows at the log rate, point samples: below 1e-5).
-pub(super) fn simulate_stationary(run: Run<'_>, rot_at: impl Fn(usize) -> C64) -> Prediction {
-    let Run { d, t, .. } = run;
+pub(super) fn simulate_stationary(run: ModelRun<'_>, rot_at: impl Fn(usize) -> C64) -> Prediction {
+    let ModelRun { d, t, .. } = run;
     // With a magnetising law the machine saturates with its own flux ([`SatMachine`]), not
     // with the reduced model's scale from the measured i_f.
     let Some(full) = FullRun::new(run, t.magnetising.law.is_some()) else {
@@ -374,7 +374,7 @@ impl<'a> StatForm<'a> {
     where
         'a: 'g,
     {
-        let Run { n, t, .. } = self.full.run;
+        let ModelRun { n, t, .. } = self.full.run;
         let sm = StatMachine {
             m: self.full.machine(k),
             np: n.np,
@@ -412,7 +412,7 @@ impl StatForm<'_> {
         rot: C64,
         out: &mut Prediction,
     ) {
-        let Run { d, n, t, .. } = self.full.run;
+        let ModelRun { d, n, t, .. } = self.full.run;
         // With a negative-sequence voltage drive the negative sequence is in the machine's
         // own current.
         let ineg = match t.negative_sequence.voltage_gain {
@@ -440,7 +440,7 @@ impl StatForm<'_> {
     /// before the block mean at `k` and `k + 1`: RK4 along the rotation, or across a supply
     /// step placed where the measured current says it fell.
     fn step(&self, sm: &StatMachine<'_>, x: &StatState, k: usize, v: [C64; 2]) -> StatState {
-        let Run { d, t, .. } = self.full.run;
+        let ModelRun { d, t, .. } = self.full.run;
         let (volt, dt) = (&self.volt, d.dt_s);
         let [v_cur, v_next] = v;
         // The negative sequence (a negative-sequence voltage drive), rotating the other way.

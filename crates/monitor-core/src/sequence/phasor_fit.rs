@@ -59,21 +59,21 @@ pub struct ThreePhasors {
     pub samples: u32,
 }
 
-type C = (f64, f64);
+type Phasor64 = (f64, f64);
 
-const A: C = (-0.5, 0.866_025_403_784_438_6);
-const A2: C = (-0.5, -0.866_025_403_784_438_6);
+const A: Phasor64 = (-0.5, 0.866_025_403_784_438_6);
+const A2: Phasor64 = (-0.5, -0.866_025_403_784_438_6);
 
-fn mul(x: C, y: C) -> C {
+fn mul(x: Phasor64, y: Phasor64) -> Phasor64 {
     (x.0 * y.0 - x.1 * y.1, x.0 * y.1 + x.1 * y.0)
 }
 
-fn c64(x: (f32, f32)) -> C {
+fn c64(x: (f32, f32)) -> Phasor64 {
     (f64::from(x.0), f64::from(x.1))
 }
 
 /// `(x + u y + v z)/3` as `(re, im)` in single precision.
-fn combine(x: C, u: C, y: C, v: C, z: C) -> (f32, f32) {
+fn combine(x: Phasor64, u: Phasor64, y: Phasor64, v: Phasor64, z: Phasor64) -> (f32, f32) {
     let (uy, vz) = (mul(u, y), mul(v, z));
     (
         ((x.0 + uy.0 + vz.0) / 3.0) as f32,

@@ -40,7 +40,7 @@ use crate::frames::{wrap_angle, Phase};
 use micromath::F32Ext;
 
 /// A complex number (re, im).
-type C = (f32, f32);
+type Phasor32 = (f32, f32);
 
 /// Smallest size `|r|` of the shorted loop (`|I2/I1|` it draws, about) the prior allows:
 /// below the noise of any current sensor.
@@ -111,7 +111,7 @@ impl ShortModel {
 
     /// The reading `M` of a short of size `x` on its phase-a sector centre on a healthy
     /// reference of zero.
-    fn reading_of(&self, x: f32) -> C {
+    fn reading_of(&self, x: f32) -> Phasor32 {
         let w = unit(self.reference_rad);
         let r = (x * w.0, x * w.1);
         if self.on_faulty_current {
@@ -204,16 +204,16 @@ fn exp_neg(x: f32) -> f32 {
 
 /// `ln` of the density of a two-component Gaussian with standard deviation `s` in each
 /// component at `d`.
-fn ln_gauss2(d: C, s: f32) -> f32 {
+fn ln_gauss2(d: Phasor32, s: f32) -> f32 {
     let s2 = s * s;
     -(d.0 * d.0 + d.1 * d.1) / (2.0 * s2) - (core::f32::consts::TAU * s2).ln()
 }
 
-fn cmul(a: C, b: C) -> C {
+fn cmul(a: Phasor32, b: Phasor32) -> Phasor32 {
     (a.0 * b.0 - a.1 * b.1, a.0 * b.1 + a.1 * b.0)
 }
 
-fn cdiv(a: C, b: C) -> C {
+fn cdiv(a: Phasor32, b: Phasor32) -> Phasor32 {
     let d = b.0 * b.0 + b.1 * b.1;
     if !(d > 0.0) {
         return (f32::NAN, f32::NAN);
@@ -221,7 +221,7 @@ fn cdiv(a: C, b: C) -> C {
     ((a.0 * b.0 + a.1 * b.1) / d, (a.1 * b.0 - a.0 * b.1) / d)
 }
 
-fn unit(angle: f32) -> C {
+fn unit(angle: f32) -> Phasor32 {
     let (s, c) = F32Ext::sin_cos(angle);
     (c, s)
 }
@@ -229,7 +229,7 @@ fn unit(angle: f32) -> C {
 /// `ln` of the density of the reading `m = I2/I1` about the healthy reference `r` when
 /// nothing is shorted: each component of `m - r` Gaussian with standard deviation `sigma`
 /// (> 0; fraction of `|I1|`). Non-finite for a non-positive `sigma`.
-pub fn ln_no_short(m: C, r: C, sigma: f32) -> f32 {
+pub fn ln_no_short(m: Phasor32, r: Phasor32, sigma: f32) -> f32 {
     ln_gauss2((m.0 - r.0, m.1 - r.1), sigma)
 }
 
@@ -240,11 +240,11 @@ pub fn ln_no_short(m: C, r: C, sigma: f32) -> f32 {
 /// derivative `J` (`(1 - r a^-k)/(1 - m a^-k)^2`, or `1/(1 - r a^-k)`), and the density
 /// of `c` under the short's prior ([`ShortModel`]) times `|J|^2`. A reading that is no
 /// number gives `-inf`.
-pub fn ln_short(m: C, r: C, phase: Phase, model: &ShortModel, sigma: f32) -> f32 {
+pub fn ln_short(m: Phasor32, r: Phasor32, phase: Phase, model: &ShortModel, sigma: f32) -> f32 {
     let third = core::f32::consts::TAU / 3.0;
     let turn = phase.index() as f32 * third;
     let a_minus_k = unit(-turn);
-    let one_less = |x: C| {
+    let one_less = |x: Phasor32| {
         let y = cmul(x, a_minus_k);
         (1.0 - y.0, -y.1)
     };
@@ -275,7 +275,7 @@ pub fn ln_short(m: C, r: C, phase: Phase, model: &ShortModel, sigma: f32) -> f32
 /// (uniform in `ln |w|`, a wrapped Gaussian of standard deviation `sd` about `centre` in
 /// angle) convolved with the noise (module docs), on a grid over the noise's support.
 /// (`max`: the prior's largest size).
-fn short_density(c: C, centre: f32, sd: f32, s: f32, max: f32) -> f32 {
+fn short_density(c: Phasor32, centre: f32, sd: f32, s: f32, max: f32) -> f32 {
     let span = (max / SHORT_RATIO_MIN).ln();
     let mag = crate::math::fast_hypot(c.0, c.1);
     let clamp = |x: f32| crate::math::minf(max, crate::math::maxf(SHORT_RATIO_MIN, x));
@@ -337,7 +337,7 @@ fn ln_wrapped_gauss(x: f32, sd: f32) -> f32 {
 /// The posterior of a reading `m = I2/I1` against one healthy reference `r` with the
 /// spread `sigma` (> 0, each component) under `model`: [`ln_no_short`] and [`ln_short`]
 /// for each phase, with the priors ([`PhasePosterior::from_ln`]).
-pub fn phase_posterior(m: C, r: C, sigma: f32, model: &ShortModel) -> PhasePosterior {
+pub fn phase_posterior(m: Phasor32, r: Phasor32, sigma: f32, model: &ShortModel) -> PhasePosterior {
     PhasePosterior::from_ln(
         ln_no_short(m, r, sigma),
         Phase::ALL.map(|p| ln_short(m, r, p, model, sigma)),

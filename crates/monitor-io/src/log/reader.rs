@@ -218,7 +218,7 @@ pub(super) trait BinarySource {
 
 /// Where the rows come from.
 #[derive(Debug, Clone)]
-enum Source {
+enum ReadSource {
     /// A CSV: the header's length (the data start after it).
     Csv { header_bytes: u64 },
     /// A TDMS file.
@@ -237,7 +237,7 @@ pub struct LogFile {
     channels: Channels,
     len_bytes: u64,
     est_rows: f64,
-    source: Source,
+    source: ReadSource,
 }
 
 /// Bytes of the file's head read to estimate the bytes per row.
@@ -287,12 +287,12 @@ impl LogFile {
             Format::Tdms => {
                 let (t, c) = super::tdms::TdmsSource::open(path, &shown, opts)?;
                 let n = t.rows() as f64;
-                (c, Source::Tdms(t), n)
+                (c, ReadSource::Tdms(t), n)
             }
             Format::Parquet => {
                 let (p, c) = super::parquet::ParquetSource::open(path, &shown, &opts.columns)?;
                 let n = p.rows() as f64;
-                (c, Source::Parquet(p), n)
+                (c, ReadSource::Parquet(p), n)
             }
         };
         Ok(LogFile {
@@ -313,7 +313,7 @@ impl LogFile {
         shown: &str,
         len_bytes: u64,
         mapping: &ColumnMapping,
-    ) -> Result<(ColumnMap, Source, f64), LogError> {
+    ) -> Result<(ColumnMap, ReadSource, f64), LogError> {
         let io = |source| LogError::Io {
             path: shown.to_string(),
             source,
@@ -331,16 +331,16 @@ impl LogFile {
         let lines = head.iter().filter(|&&b| b == b'\n').count().max(1);
         let bytes_per_row = (head.len() as f64 / lines as f64).max(1.0);
         let est_rows = len_bytes.saturating_sub(header_bytes) as f64 / bytes_per_row;
-        let source = Source::Csv { header_bytes };
+        let source = ReadSource::Csv { header_bytes };
         Ok((columns, source, est_rows))
     }
 
     /// The log's format.
     pub fn format(&self) -> Format {
         match self.source {
-            Source::Csv { .. } => Format::Csv,
-            Source::Tdms(_) => Format::Tdms,
-            Source::Parquet(_) => Format::Parquet,
+            ReadSource::Csv { .. } => Format::Csv,
+            ReadSource::Tdms(_) => Format::Tdms,
+            ReadSource::Parquet(_) => Format::Parquet,
         }
     }
 
@@ -413,9 +413,9 @@ impl LogFile {
         sink: &mut dyn RowSink,
     ) -> Result<u64, LogError> {
         let binary: &dyn BinarySource = match &self.source {
-            Source::Csv { .. } => return self.csv_rows(progress, sink),
-            Source::Tdms(t) => t,
-            Source::Parquet(p) => p,
+            ReadSource::Csv { .. } => return self.csv_rows(progress, sink),
+            ReadSource::Tdms(t) => t,
+            ReadSource::Parquet(p) => p,
         };
         binary.for_each_row(self, progress, &mut |r| sink.row(r))
     }
@@ -461,7 +461,7 @@ impl LogFile {
 
     pub(super) fn header_bytes(&self) -> u64 {
         match self.source {
-            Source::Csv { header_bytes } => header_bytes,
+            ReadSource::Csv { header_bytes } => header_bytes,
             _ => 0,
         }
     }

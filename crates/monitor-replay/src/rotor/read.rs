@@ -7,7 +7,7 @@ use super::judge::{band_of, bars_of, fault_probability, noise_max, torque_share}
 use super::spectrum::{segments, spectrum, Spectrum, SEGMENT_S};
 use super::stretch::{chunks, longest_run, Chunk};
 use super::{
-    Machine, RotorReport, SlipSource, MAIN_LOBE_HALF_BINS, MAX_SLIP, MIN_BINS, MIN_SLIP,
+    RotorMachine, RotorReport, SlipSource, MAIN_LOBE_HALF_BINS, MAX_SLIP, MIN_BINS, MIN_SLIP,
     PAIR_SNR_DB, SLIP_STEADY,
 };
 use monitor_io::params::ParamFile;
@@ -16,7 +16,7 @@ use std::ops::Range;
 
 /// The sidebands read over a stretch's segments, relative to the line.
 #[derive(Debug, Clone, Copy, Default)]
-struct Reading {
+struct SidebandReading {
     /// Mean power of the lower and upper sidebands' largest bins.
     lower: f64,
     upper: f64,
@@ -35,7 +35,7 @@ struct Reading {
 /// The rotor finding of the record `front` of a log of the machine `params` (module docs
 /// of `super`): judged, or "cannot judge" with what was missing.
 pub fn rotor_report(front: &RotorFront, params: &ParamFile) -> RotorReport {
-    let m = Machine::of(params);
+    let m = RotorMachine::of(params);
     let r = RotorReport {
         rotor_bars: m.bars,
         ..RotorReport::default()
@@ -102,7 +102,7 @@ fn spectra<'a>(
     planner: &'a mut rustfft::FftPlanner<f64>,
     stretch: &'a [Block],
     bs: f64,
-    m: &'a Machine,
+    m: &'a RotorMachine,
     seg_blocks: usize,
 ) -> impl Iterator<Item = Spectrum> + 'a {
     segments(0..stretch.len(), seg_blocks)
@@ -119,7 +119,7 @@ fn slip_from_pairs(
     planner: &mut rustfft::FftPlanner<f64>,
     stretch: &[Block],
     bs: f64,
-    m: &Machine,
+    m: &RotorMachine,
 ) -> Option<(f64, SlipSource)> {
     let fs_min = 2.0 * MIN_SLIP * m.f0;
     let mut avg: Option<Spectrum> = None;
@@ -198,7 +198,7 @@ fn read_and_judge(
     planner: &mut rustfft::FftPlanner<f64>,
     stretch: &[Block],
     bs: f64,
-    m: &Machine,
+    m: &RotorMachine,
     (per_segment, s): (bool, f64),
 ) -> RotorReport {
     let f = m.f0;
@@ -215,7 +215,7 @@ fn read_and_judge(
         r.resolution_hz = Some(1.0 / t.max(bs));
         return cannot(r, format!("the steady stretch is {t:.2} s; {:.2} s are needed to resolve sidebands 2sf = {fs:.2} Hz from the line ({MIN_BINS} bins of a Blackman-Harris window)", MIN_BINS / fs));
     }
-    let mut sum = Reading::default();
+    let mut sum = SidebandReading::default();
     for sp in spectra(planner, stretch, bs, m, segment_blocks(fs, bs)) {
         let slip = if per_segment { sp.slip } else { s };
         if let Some(x) = read_segment(&sp, slip) {
@@ -241,7 +241,7 @@ fn read_and_judge(
 }
 
 /// Adds segment reading `x` into `sum`.
-fn add(sum: &mut Reading, x: &Reading) {
+fn add(sum: &mut SidebandReading, x: &SidebandReading) {
     sum.lower += x.lower;
     sum.upper += x.upper;
     sum.noise += x.noise;
@@ -255,7 +255,7 @@ fn add(sum: &mut Reading, x: &Reading) {
 /// One segment's sidebands at slip `s`: the largest bins within [`SLIP_STEADY`] of
 /// `-/+ 2 s f` (the lower on the side opposite the supply's rotation) and the noise near
 /// them (the median outside the sidebands' intervals and their second harmonics').
-fn read_segment(sp: &Spectrum, s: f64) -> Option<Reading> {
+fn read_segment(sp: &Spectrum, s: f64) -> Option<SidebandReading> {
     let f = sp.f_supply;
     let c = 2.0 * s * f.abs();
     if c.is_nan() || c <= 0.0 {
@@ -277,7 +277,7 @@ fn read_segment(sp: &Spectrum, s: f64) -> Option<Reading> {
     let noise = sp
         .noise(region, &skip, 1)
         .or_else(|| sp.noise((region.0, f.abs()), &skip, 1))?;
-    Some(Reading {
+    Some(SidebandReading {
         lower,
         upper,
         noise,
@@ -290,7 +290,7 @@ fn read_segment(sp: &Spectrum, s: f64) -> Option<Reading> {
 }
 
 /// The judgement of the averaged reading `x` (module docs of `super`).
-fn judge(mut r: RotorReport, x: &Reading, m: &Machine) -> RotorReport {
+fn judge(mut r: RotorReport, x: &SidebandReading, m: &RotorMachine) -> RotorReport {
     let db = |p: f64| 10.0 * p.max(1e-30).log10();
     let (s, f) = (x.slip, x.f_supply);
     r.slip = Some(s);

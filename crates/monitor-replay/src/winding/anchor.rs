@@ -20,8 +20,8 @@
 //! ([`Anchor::ln_current`]). So a stretch whose `|I1|` rose with its negative sequence
 //! carries the short, not the one it is judged against.
 
-use super::probability::Reading;
-use super::{abs, cdiv, sub, C};
+use super::probability::PhaseReading;
+use super::{abs, cdiv, sub, RatioPhasor};
 use monitor_core::sequence::SUPPLY_PART_UNCERTAINTY;
 use monitor_core::Phase;
 
@@ -41,13 +41,13 @@ pub const LOAD_MOVE_RANGE: f32 = 2.0;
 
 /// The model's `arg Z1` at a stretch's operating point when it draws `|I1|` = the given
 /// current [A, peak] (what a healthy machine would draw there), where known.
-pub(super) type AngleAt<'a> = &'a dyn Fn(&Reading, f32) -> Option<f32>;
+pub(super) type AngleAt<'a> = &'a dyn Fn(&PhaseReading, f32) -> Option<f32>;
 
 /// What a stretch's change is taken from.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Anchor {
     /// The reference's reading (its winding part with voltages).
-    pub w: C,
+    pub w: RatioPhasor,
     /// The supply's part taken out of it (0 without voltages).
     pub supply: f32,
     /// Both the reference and the stretch have voltages.
@@ -61,7 +61,7 @@ pub(super) struct Anchor {
 impl Anchor {
     /// `(I1_R/I1_h) e^{jd}` at stretch `rd` under no short (`None`) or a short in a phase
     /// (module docs).
-    fn turn(&self, rd: &Reading, short: Option<Phase>, angle_at: AngleAt<'_>) -> C {
+    fn turn(&self, rd: &PhaseReading, short: Option<Phase>, angle_at: AngleAt<'_>) -> RatioPhasor {
         let q = self.current_ratio(rd, short);
         let i1_h = self.i1 / q;
         let d = match (self.z1, angle_at(rd, i1_h)) {
@@ -73,7 +73,7 @@ impl Anchor {
 
     /// `ln` of the density of the change of `|I1|` that the short does not draw:
     /// `e = ln(I1_h/I1_R)`, the load stayed or moved (module docs).
-    fn ln_current(&self, rd: &Reading, short: Option<Phase>) -> f32 {
+    fn ln_current(&self, rd: &PhaseReading, short: Option<Phase>) -> f32 {
         let e = -self.current_ratio(rd, short).ln();
         if !e.is_finite() {
             return 0.0;
@@ -89,7 +89,7 @@ impl Anchor {
     }
 
     /// `I1_R/I1_h`: the reference's current over the healthy current at the stretch.
-    pub fn current_ratio(&self, rd: &Reading, short: Option<Phase>) -> f32 {
+    pub fn current_ratio(&self, rd: &PhaseReading, short: Option<Phase>) -> f32 {
         // The loop's size from the reading, its angle the reference's: a hypothesis whose
         // phase does not fit the reading does not get a loop that turns I1 to fit.
         let loop_share = short.map_or(1.0, |p| {
@@ -112,7 +112,7 @@ impl Anchor {
 
     /// How far another operating point may move the reference (the length of the
     /// segment without voltages, the model's error on the supply's part with them).
-    fn moved(&self, t: C) -> f32 {
+    fn moved(&self, t: RatioPhasor) -> f32 {
         let k = abs((1.0 - t.0, -t.1));
         if self.voltages {
             SUPPLY_PART_UNCERTAINTY * self.supply * k
@@ -126,7 +126,7 @@ impl Anchor {
     /// sentence's.
     pub fn spread(
         &self,
-        rd: &Reading,
+        rd: &PhaseReading,
         same: f32,
         short: Option<Phase>,
         angle_at: AngleAt<'_>,
@@ -140,11 +140,11 @@ impl Anchor {
     /// of `|I1|` the short does not draw (module docs).
     pub fn ln_density(
         &self,
-        rd: &Reading,
+        rd: &PhaseReading,
         same: f32,
         short: Option<Phase>,
         angle_at: AngleAt<'_>,
-        f: &dyn Fn(C, f32) -> f32,
+        f: &dyn Fn(RatioPhasor, f32) -> f32,
     ) -> f32 {
         let t = self.turn(rd, short, angle_at);
         let current = self.ln_current(rd, short);

@@ -2,12 +2,14 @@
 //! against (module docs of [`super`], steps 2, 3 and 5), and the negative-sequence report
 //! (`unbalance`) built from the judgement.
 
-use super::probability::{judge_alone, judge_external, judge_within, External, Judged, Reading};
+use super::probability::{
+    judge_alone, judge_external, judge_within, External, PhaseJudged, PhaseReading,
+};
 use super::{
     abs, cdiv, mean, measured_of, segment_of, segments, sub, Against, HealthyReference,
-    OperatingPointSource, PhaseProbabilities, SequenceSegment, C, CURRENT_MODEL_UNCERTAINTY,
-    FULL_LOAD_SLIP_MAX, MAX_SEGMENTS, MEASURED_REFERENCE_UNCERTAINTY_DEG, MIN_SEGMENT_WINDOWS,
-    SLIP_MODEL_UNCERTAINTY,
+    OperatingPointSource, PhaseProbabilities, RatioPhasor, SequenceSegment,
+    CURRENT_MODEL_UNCERTAINTY, FULL_LOAD_SLIP_MAX, MAX_SEGMENTS,
+    MEASURED_REFERENCE_UNCERTAINTY_DEG, MIN_SEGMENT_WINDOWS, SLIP_MODEL_UNCERTAINTY,
 };
 use crate::report::BaselineSource;
 use crate::sequences::{sensor_phase, SequenceWindow};
@@ -102,7 +104,7 @@ impl Judge {
     /// One stretch's reading (module docs, step 2): the sensors' own negative sequence
     /// taken out; with one voltage sensor wrong the voltages cannot say how much of `I2`
     /// the supply drives, and the currents alone judge.
-    fn reading(&self, index: usize, seg: &SequenceSegment) -> Reading {
+    fn reading(&self, index: usize, seg: &SequenceSegment) -> PhaseReading {
         let op = self.reference_angle(seg);
         let slip = op.2.unwrap_or(0.0).max(1e-4);
         let (gi, gv) = sensor_phases(seg);
@@ -116,7 +118,7 @@ impl Judge {
         };
         let v2 = seg.v2.filter(|_| gv.is_none());
         let (w, supply) = winding_part(r, v2, &self.m, seg.we, slip);
-        Reading {
+        PhaseReading {
             index,
             w,
             supply,
@@ -152,7 +154,13 @@ impl Judge {
 
 /// The winding part `I2/I1 - V2/(Z2 I1)` of a reading (module docs, step 2), and the
 /// supply's part `|V2/Z2|/|I1|` (0 without voltages).
-fn winding_part(i2: C, v2: Option<C>, m: &MotorModel, we: f32, s: f32) -> (C, f32) {
+fn winding_part(
+    i2: RatioPhasor,
+    v2: Option<RatioPhasor>,
+    m: &MotorModel,
+    we: f32,
+    s: f32,
+) -> (RatioPhasor, f32) {
     match v2 {
         Some(v2) => {
             let z2 = equivalent_impedance(m, we, 2.0 - s);
@@ -165,8 +173,8 @@ fn winding_part(i2: C, v2: Option<C>, m: &MotorModel, we: f32, s: f32) -> (C, f3
 
 /// A healthy reference's `I2/I1` and `V2/I1`, and what [`External`] needs of it.
 struct Outside {
-    r: C,
-    v2: Option<C>,
+    r: RatioPhasor,
+    v2: Option<RatioPhasor>,
     ext: External,
 }
 
@@ -254,16 +262,16 @@ fn judge_stretches(
     judge: &Judge,
     segs: &[SequenceSegment],
     outside: Option<&Outside>,
-) -> Option<Judged> {
-    let readings: Vec<Reading> = segs
+) -> Option<PhaseJudged> {
+    let readings: Vec<PhaseReading> = segs
         .iter()
         .enumerate()
         .map(|(k, seg)| judge.reading(k, seg))
         .collect();
-    let angle_at = |rd: &Reading, i1: f32| judge.z1_angle(rd.we, rd.wr, i1);
+    let angle_at = |rd: &PhaseReading, i1: f32| judge.z1_angle(rd.we, rd.wr, i1);
     match outside {
         Some(o) => {
-            let part = |rd: &Reading| {
+            let part = |rd: &PhaseReading| {
                 let v2 = o.v2.filter(|_| rd.voltages);
                 let slip = rd.op.2.unwrap_or(0.0).max(1e-4);
                 winding_part(o.r, v2, &judge.m, rd.we, slip)
@@ -323,7 +331,7 @@ fn no_stretch_reason(f_hz: f64) -> String {
 }
 
 /// The judged stretch's keys of the report.
-fn fill_judgement(report: &mut UnbalanceReport, j: &Judged, segs: &[SequenceSegment]) {
+fn fill_judgement(report: &mut UnbalanceReport, j: &PhaseJudged, segs: &[SequenceSegment]) {
     let p = j.posterior;
     let named = p.named();
     report.suspect_phase = named.map(|n| n.0);
@@ -356,7 +364,7 @@ fn fill_judgement(report: &mut UnbalanceReport, j: &Judged, segs: &[SequenceSegm
 
 /// The least change that names a phase at [`super::WINDING_FAULT_PROBABILITY`] with the
 /// spread `sigma` at the judged stretch's reference angle (`None` when none does).
-pub(super) fn least_change_of(j: &Judged, sigma: f32) -> Option<f32> {
+pub(super) fn least_change_of(j: &PhaseJudged, sigma: f32) -> Option<f32> {
     least_change(sigma, &j.reading.model(), super::WINDING_FAULT_PROBABILITY)
 }
 

@@ -15,20 +15,21 @@
 
 use super::anchor::{Anchor, AngleAt};
 use super::{
-    abs, pooled_change_sigma, sub, Against, OperatingPointSource, C, DEFAULT_SPREAD_CURRENTS,
-    DEFAULT_SPREAD_VOLTAGES, MEASURED_Z_RATIO, NO_BASELINE_SPREAD, NO_BASELINE_SPREAD_VOLTAGES,
-    SUPPLY_DRIFT_BETWEEN_RUNS, SUPPLY_UNBALANCE_SPREAD, WITHIN_LOG_SPREAD,
+    abs, pooled_change_sigma, sub, Against, OperatingPointSource, RatioPhasor,
+    DEFAULT_SPREAD_CURRENTS, DEFAULT_SPREAD_VOLTAGES, MEASURED_Z_RATIO, NO_BASELINE_SPREAD,
+    NO_BASELINE_SPREAD_VOLTAGES, SUPPLY_DRIFT_BETWEEN_RUNS, SUPPLY_UNBALANCE_SPREAD,
+    WITHIN_LOG_SPREAD,
 };
 use monitor_core::sequence::{ln_no_short, ln_short, phase_posterior, PhasePosterior, ShortModel};
 use monitor_core::Phase;
 
 /// One stretch's reading, ready to judge (module docs of [`super`], step 2).
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Reading {
+pub(super) struct PhaseReading {
     /// Index of the stretch.
     pub index: usize,
     /// The winding's part of `I2/I1` (sensors' and, with voltages, the supply's parts out).
-    pub w: C,
+    pub w: RatioPhasor,
     /// The supply's part `|V2/Z2|/|I1|` that was taken out (0 without voltages).
     pub supply: f32,
     /// The stretch has voltages.
@@ -52,7 +53,7 @@ pub(super) struct Reading {
     pub z_ratio: f32,
 }
 
-impl Reading {
+impl PhaseReading {
     /// The short's model at this stretch's reference angle.
     pub fn model(&self) -> ShortModel {
         match self.op.3 {
@@ -115,17 +116,17 @@ pub(super) struct External {
 
 /// What the reference's own negative sequence at a stretch's operating point is: its
 /// winding part and the supply's part taken out of it.
-pub(super) type ReferencePart<'a> = &'a dyn Fn(&Reading) -> (C, f32);
+pub(super) type ReferencePart<'a> = &'a dyn Fn(&PhaseReading) -> (RatioPhasor, f32);
 
 /// A stretch judged.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Judged {
+pub(super) struct PhaseJudged {
     /// The stretch judged (the one that changed most).
     pub index: usize,
     /// The stretch it was judged against, within the log.
     pub reference: Option<usize>,
     /// Its change from the reference (fraction of `|I1|`).
-    pub change: C,
+    pub change: RatioPhasor,
     /// The supply's part taken out of the stretch's reading.
     pub supply_ratio: f32,
     /// The change's spread (each component), and before the widening for another
@@ -138,7 +139,7 @@ pub(super) struct Judged {
     /// What it was judged against.
     pub against: Against,
     /// The stretch's reading (its reference angle).
-    pub reading: Reading,
+    pub reading: PhaseReading,
     /// Against an outside reference: how much the load changed `|I1|` from it (relative),
     /// the named short's own share taken out.
     pub load_i1_change: Option<f32>,
@@ -148,7 +149,7 @@ pub(super) struct Judged {
 /// hypothesis with its own account of another operating point ([`Anchor::ln_density`]);
 /// with the spread under no short ([`Anchor::spread`]).
 fn posterior_against(
-    rd: &Reading,
+    rd: &PhaseReading,
     anchor: &Anchor,
     same: f32,
     angle_at: AngleAt<'_>,
@@ -169,11 +170,11 @@ fn posterior_against(
 /// Every stretch against an outside reference; the one whose change stands out most from
 /// its spread at one operating point is judged.
 pub(super) fn judge_external(
-    readings: &[Reading],
+    readings: &[PhaseReading],
     ext: &External,
     part: ReferencePart<'_>,
     angle_at: AngleAt<'_>,
-) -> Option<Judged> {
+) -> Option<PhaseJudged> {
     let (rd, anchor, same, _) = readings
         .iter()
         .map(|rd| {
@@ -192,7 +193,7 @@ pub(super) fn judge_external(
         .max_by(|a, b| a.3.total_cmp(&b.3))?;
     let (posterior, sigma) = posterior_against(rd, &anchor, same, angle_at);
     let q = anchor.current_ratio(rd, posterior.named().map(|n| n.0));
-    Some(Judged {
+    Some(PhaseJudged {
         load_i1_change: Some(1.0 / q - 1.0),
         index: rd.index,
         reference: None,
@@ -207,9 +208,9 @@ pub(super) fn judge_external(
 }
 
 /// One stretch against nothing: `R = 0`, a healthy machine's own asymmetry the spread.
-pub(super) fn judge_alone(rd: &Reading) -> Judged {
+pub(super) fn judge_alone(rd: &PhaseReading) -> PhaseJudged {
     let sigma = rd.alone_sigma();
-    Judged {
+    PhaseJudged {
         index: rd.index,
         reference: None,
         change: rd.w,
@@ -224,13 +225,13 @@ pub(super) fn judge_alone(rd: &Reading) -> Judged {
 }
 
 /// The spread of the change between two stretches of one log at one operating point.
-fn pair_same(i: &Reading, j: &Reading) -> f32 {
+fn pair_same(i: &PhaseReading, j: &PhaseReading) -> f32 {
     let w = i.within_sigma().max(j.within_sigma());
     (2.0 * w * w + i.sem * i.sem + j.sem * j.sem).sqrt()
 }
 
 /// Stretch `r` as the reference of another.
-fn anchor_of(r: &Reading, other: &Reading) -> Anchor {
+fn anchor_of(r: &PhaseReading, other: &PhaseReading) -> Anchor {
     Anchor {
         w: r.w,
         supply: r.supply,
@@ -241,7 +242,10 @@ fn anchor_of(r: &Reading, other: &Reading) -> Anchor {
 }
 
 /// The log's stretches against each other (module docs): `None` for fewer than two.
-pub(super) fn judge_within(readings: &[Reading], angle_at: AngleAt<'_>) -> Option<Judged> {
+pub(super) fn judge_within(
+    readings: &[PhaseReading],
+    angle_at: AngleAt<'_>,
+) -> Option<PhaseJudged> {
     let i = readings
         .iter()
         .min_by(|a, b| abs(a.w).total_cmp(&abs(b.w)))?;
@@ -249,7 +253,7 @@ pub(super) fn judge_within(readings: &[Reading], angle_at: AngleAt<'_>) -> Optio
         .iter()
         .filter(|r| r.index != i.index)
         .max_by(|a, b| {
-            let z = |x: &Reading| abs(sub(x.w, i.w)) / pair_same(i, x).max(1e-6);
+            let z = |x: &PhaseReading| abs(sub(x.w, i.w)) / pair_same(i, x).max(1e-6);
             z(a).total_cmp(&z(b))
         })?;
     Some(Pair::judge(i, j, pair_same(i, j), angle_at).judged())
@@ -257,8 +261,8 @@ pub(super) fn judge_within(readings: &[Reading], angle_at: AngleAt<'_>) -> Optio
 
 /// The two stretches' hypotheses (module docs), as `ln` of prior times likelihood.
 struct Pair<'a> {
-    i: &'a Reading,
-    j: &'a Reading,
+    i: &'a PhaseReading,
+    j: &'a PhaseReading,
     /// The spread of the change at one operating point, and under no short.
     same_point: f32,
     /// See `same_point`.
@@ -280,7 +284,12 @@ fn ln_sum(xs: &[f32]) -> f32 {
 impl<'a> Pair<'a> {
     /// The hypotheses of stretch `j` against stretch `i`, their change scattering by
     /// `same_point` at one operating point.
-    fn judge(i: &'a Reading, j: &'a Reading, same_point: f32, angle_at: AngleAt<'_>) -> Self {
+    fn judge(
+        i: &'a PhaseReading,
+        j: &'a PhaseReading,
+        same_point: f32,
+        angle_at: AngleAt<'_>,
+    ) -> Self {
         let zero = (0.0, 0.0);
         let (hi, hj) = (i.alone_sigma(), j.alone_sigma());
         let healthy_i = ln_no_short(i.w, zero, hi);
@@ -319,7 +328,7 @@ impl<'a> Pair<'a> {
 
     /// The judgement: the probabilities, and the stretch and change the named phase
     /// rests on (the short in `j`, in `i`, or in both: then `i` against nothing).
-    fn judged(&self) -> Judged {
+    fn judged(&self) -> PhaseJudged {
         let posterior = PhasePosterior::normalised(self.none, self.short.map(|s| ln_sum(&s)));
         // The hypothesis the named phase rests on; with none named, the change between
         // the two stretches.
@@ -346,7 +355,7 @@ impl<'a> Pair<'a> {
             ),
             _ => (i, None, i.w, i.alone_sigma(), Against::Nothing),
         };
-        Judged {
+        PhaseJudged {
             index: index.index,
             reference,
             change,

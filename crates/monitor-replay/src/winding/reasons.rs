@@ -2,7 +2,7 @@
 //! another operating point (the least change widened for it).
 
 use super::judgement::least_change_of;
-use super::probability::{External, Judged};
+use super::probability::{External, PhaseJudged};
 use super::{abs, Against, SequenceSegment, OPERATING_SPEED_STEP, SEGMENT_I1_STEP};
 use monitor_core::Phase;
 
@@ -15,7 +15,7 @@ pub const BALANCED_RATIO: f32 = 0.005;
 /// `reference` the stretch it was judged against within the log, `least` the least change
 /// that names a phase (fraction of `|I1|`; `None`: none does).
 pub(super) fn not_named(
-    j: &Judged,
+    j: &PhaseJudged,
     seg: &SequenceSegment,
     reference: Option<&SequenceSegment>,
     least: Option<f32>,
@@ -66,7 +66,7 @@ pub(super) fn not_named(
 }
 
 /// How far the change's angle lies from `phase`'s sector centre [deg].
-fn deviation_deg(j: &Judged, phase: Phase) -> f32 {
+fn deviation_deg(j: &PhaseJudged, phase: Phase) -> f32 {
     let third = std::f32::consts::TAU / 3.0;
     let centre = j.reading.op.0 + phase.index() as f32 * third;
     let ang = j.change.1.atan2(j.change.0);
@@ -76,7 +76,7 @@ fn deviation_deg(j: &Judged, phase: Phase) -> f32 {
 }
 
 /// The phase on the other side of `phase`'s sector border nearest the change.
-fn neighbour(j: &Judged, phase: Phase) -> Phase {
+fn neighbour(j: &PhaseJudged, phase: Phase) -> Phase {
     let third = std::f32::consts::TAU / 3.0;
     let centre = j.reading.op.0 + phase.index() as f32 * third;
     let ang = j.change.1.atan2(j.change.0);
@@ -89,7 +89,7 @@ fn neighbour(j: &Judged, phase: Phase) -> Phase {
 /// [`SEGMENT_I1_STEP`], or the speed beyond [`OPERATING_SPEED_STEP`]) and the least change
 /// was widened for it; `None` at the same point. `pole_pairs` turns the electrical speed
 /// into the shaft's.
-pub(super) fn widened(j: &Judged, ext: &External, pole_pairs: f32) -> Option<String> {
+pub(super) fn widened(j: &PhaseJudged, ext: &External, pole_pairs: f32) -> Option<String> {
     let rd = &j.reading;
     let i1 = j.load_i1_change.filter(|d| d.is_finite());
     let speed = rd.wr.zip(ext.wr).map(|(a, b)| a - b);

@@ -5,15 +5,15 @@
 //! pieces by the first pass, is one stretch again).
 
 use super::{
-    abs, cdiv, sub, SequenceSegment, C, MAX_UNSTEADY_INSIDE, MIN_SEGMENT_WINDOWS, SEGMENT_I1_STEP,
-    SEGMENT_STEP_MIN, SEGMENT_STEP_REL, SEGMENT_VOLTAGE_STEP_MIN,
+    abs, cdiv, sub, RatioPhasor, SequenceSegment, MAX_UNSTEADY_INSIDE, MIN_SEGMENT_WINDOWS,
+    SEGMENT_I1_STEP, SEGMENT_STEP_MIN, SEGMENT_STEP_REL, SEGMENT_VOLTAGE_STEP_MIN,
 };
 use crate::sequences::SequenceWindow;
 
 /// A window's features that a segment holds still: `I2/I1`, `I0/I1` and, with voltages,
 /// `V2/V1`, `V0/V1` (a sensor's gain step moves the zero sequences, a winding or the
 /// supply the negative ones).
-fn features(w: &SequenceWindow) -> [C; 4] {
+fn features(w: &SequenceWindow) -> [RatioPhasor; 4] {
     let p = w.i.positive();
     let v = w.v.map_or([(0.0, 0.0); 2], |v| {
         let p = v.positive();
@@ -58,7 +58,7 @@ impl SegmentSums {
     }
 
     /// The means: the features and `|I1|`.
-    fn means(&self) -> ([C; 4], f32) {
+    fn means(&self) -> ([RatioPhasor; 4], f32) {
         let n = f64::from(self.n.max(1));
         (
             self.features.map(|s| ((s.0 / n) as f32, (s.1 / n) as f32)),
@@ -71,7 +71,7 @@ impl SegmentSums {
     /// zero sequence and `|I1|` also get that share of the negative sequence's size (a
     /// shorted loop's current moves all three: a fault current that wobbles moves them
     /// together).
-    fn departs_at(&self, f: [C; 4], i1: f32) -> bool {
+    fn departs_at(&self, f: [RatioPhasor; 4], i1: f32) -> bool {
         let (m, i1_mean) = self.means();
         let i2 = abs(m[0]);
         let moved = (0..4).any(|k| {

@@ -37,16 +37,16 @@ pub const LOADS: [f64; 2] = [1.0, 0.6];
 /// The two angle modes: the monitor's rotor-flux frame and the paper's voltage PLL.
 pub const MODES: [AngleSource; 2] = [AngleSource::RotorFluxCurrentModel, AngleSource::Pll];
 /// Columns of the confusion matrix after the nine faults.
-pub const EXTRA_COLUMNS: [Outcome; 3] = [
-    Outcome::Named(IsolationName::Friction),
-    Outcome::Unknown,
-    Outcome::Nothing,
+pub const EXTRA_COLUMNS: [CaseOutcome; 3] = [
+    CaseOutcome::Named(IsolationName::Friction),
+    CaseOutcome::Unknown,
+    CaseOutcome::Nothing,
 ];
 
 /// What the isolation concluded at the end of a case: the confusion matrix's column.
-/// Serialised as its name ([`Outcome::name`]).
+/// Serialised as its name ([`CaseOutcome::name`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Outcome {
+pub enum CaseOutcome {
     /// A fault, or the friction class, named alone.
     Named(IsolationName),
     /// An unknown fault: no fault of the list explains the change.
@@ -55,24 +55,24 @@ pub enum Outcome {
     Nothing,
 }
 
-impl Outcome {
+impl CaseOutcome {
     /// The name (`rr`, `b/bl`), `unknown` or `none`.
     pub fn name(self) -> &'static str {
         match self {
-            Outcome::Named(n) => n.name(),
-            Outcome::Unknown => "unknown",
-            Outcome::Nothing => "none",
+            CaseOutcome::Named(n) => n.name(),
+            CaseOutcome::Unknown => "unknown",
+            CaseOutcome::Nothing => "none",
         }
     }
 }
 
-impl fmt::Display for Outcome {
+impl fmt::Display for CaseOutcome {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
     }
 }
 
-impl Serialize for Outcome {
+impl Serialize for CaseOutcome {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         s.serialize_str(self.name())
     }
@@ -237,7 +237,7 @@ pub struct CaseResult {
     pub detected: bool,
     /// The confusion matrix's column: the name at the end (`b/bl` for the friction
     /// class), `unknown`, or `none` (nothing named alone).
-    pub named: Outcome,
+    pub named: CaseOutcome,
     /// `named` is the true fault (`b/bl` for B and Bl).
     pub right: bool,
     /// The isolation's estimated change of the named fault at the end.
@@ -269,11 +269,11 @@ pub fn judge(
     let want = IsolationName::expected(f);
     let friction = matches!(f, Fault::B | Fault::Bl);
     let named = match (row.named, row.isolation_state) {
-        (Some(n), _) => Outcome::Named(n),
-        (None, IsolationState::Unknown) => Outcome::Unknown,
-        (None, _) => Outcome::Nothing,
+        (Some(n), _) => CaseOutcome::Named(n),
+        (None, IsolationState::Unknown) => CaseOutcome::Unknown,
+        (None, _) => CaseOutcome::Nothing,
     };
-    let right = named == Outcome::Named(want);
+    let right = named == CaseOutcome::Named(want);
     let size_error = (right && !friction)
         .then(|| {
             row.named_change
@@ -374,7 +374,7 @@ pub struct IsolationConfusion {
     /// Row labels (true faults).
     pub rows: Vec<Fault>,
     /// Column labels: the nine faults, `b/bl`, `unknown`, `none`.
-    pub columns: Vec<Outcome>,
+    pub columns: Vec<CaseOutcome>,
     /// Counts, `counts[row][column]`.
     pub counts: Vec<Vec<u32>>,
 }
@@ -429,9 +429,9 @@ pub fn summarise(motor: &str, mode: AngleSource, cases: &[CaseResult]) -> Summar
 
 /// The confusion matrix of the cases in `mode` (rows: `faults`).
 pub fn confusion(mode: AngleSource, faults: &[Fault], cases: &[CaseResult]) -> IsolationConfusion {
-    let columns: Vec<Outcome> = Fault::ALL
+    let columns: Vec<CaseOutcome> = Fault::ALL
         .iter()
-        .map(|f| Outcome::Named(IsolationName::Fault(*f)))
+        .map(|f| CaseOutcome::Named(IsolationName::Fault(*f)))
         .chain(EXTRA_COLUMNS)
         .collect();
     let counts = faults

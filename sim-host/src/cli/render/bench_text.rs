@@ -3,7 +3,9 @@
 
 use monitor_core::Fault;
 use monitor_replay::{angle_source_name, state_name, IsolationName};
-use monitor_studies::bench::isolation::{CaseResult, IsolationBench, IsolationConfusion, Outcome};
+use monitor_studies::bench::isolation::{
+    CaseOutcome, CaseResult, IsolationBench, IsolationConfusion,
+};
 use monitor_studies::bench::{BenchFigures, DetectionLimitCase, Spread};
 use std::io::Write;
 
@@ -130,11 +132,11 @@ fn confusion_matrix(out: &mut impl Write, c: &IsolationConfusion) -> anyhow::Res
         "\nconfusion matrix, {} (rows: true fault; columns: named at the end; all motors, sizes, loads):",
         angle_source_name(c.mode)
     )?;
-    let short = |o: &Outcome| match o {
-        Outcome::Named(IsolationName::Fault(Fault::CurrentSensor)) => "i_sens",
-        Outcome::Named(IsolationName::Fault(Fault::VoltageSensor)) => "v_sens",
-        Outcome::Named(IsolationName::Fault(Fault::SpeedSensor)) => "w_sens",
-        Outcome::Unknown => "unkn",
+    let short = |o: &CaseOutcome| match o {
+        CaseOutcome::Named(IsolationName::Fault(Fault::CurrentSensor)) => "i_sens",
+        CaseOutcome::Named(IsolationName::Fault(Fault::VoltageSensor)) => "v_sens",
+        CaseOutcome::Named(IsolationName::Fault(Fault::SpeedSensor)) => "w_sens",
+        CaseOutcome::Unknown => "unkn",
         o => o.name(),
     };
     write!(out, "{:<15}", "true \\ named")?;

@@ -121,7 +121,7 @@ fn is_zero(n: &u64) -> bool {
 
 /// What the assessment found: warnings, and reasons not to trust the log.
 #[derive(Debug, Default)]
-struct Findings {
+struct QualityFindings {
     warn: Vec<String>,
     distrust: Vec<String>,
 }
@@ -140,7 +140,7 @@ pub struct ClippedChannel {
 impl DataQuality {
     /// Fills `warnings`, `trusted` and `not_trusted_because` from the counts.
     pub(super) fn assess(&mut self, supply_hz: f64) {
-        let mut found = Findings::default();
+        let mut found = QualityFindings::default();
         self.assess_time(&mut found);
         self.assess_cells(supply_hz, &mut found);
         self.trusted = found.distrust.is_empty();
@@ -149,7 +149,7 @@ impl DataQuality {
     }
 
     /// What the timestamps say: their unit, rows dropped, gaps, segments, jitter.
-    fn assess_time(&self, found: &mut Findings) {
+    fn assess_time(&self, found: &mut QualityFindings) {
         self.assess_dropped_time(found);
         self.assess_gaps(found);
         self.assess_clock(found);
@@ -157,8 +157,8 @@ impl DataQuality {
 
     /// The time's unit and the rows dropped for their time (repeated, backward, not a
     /// number): many scattered ones leave no stretch of the log to trust.
-    fn assess_dropped_time(&self, found: &mut Findings) {
-        let Findings { warn, distrust } = found;
+    fn assess_dropped_time(&self, found: &mut QualityFindings) {
+        let QualityFindings { warn, distrust } = found;
         let rows = self.rows_read.max(1) as f64;
         if self.time_unit != TimeUnit::S {
             warn.push(format!(
@@ -186,8 +186,8 @@ impl DataQuality {
 
     /// The gaps in the time: bridged ones, the share of samples missing, the segments the
     /// log falls into.
-    fn assess_gaps(&self, found: &mut Findings) {
-        let Findings { warn, distrust } = found;
+    fn assess_gaps(&self, found: &mut QualityFindings) {
+        let QualityFindings { warn, distrust } = found;
         if self.gaps_bridged > 0 {
             warn.push(format!(
                 "{} samples missing in {} gaps (longest {:.4} s), bridged with the real elapsed time",
@@ -214,8 +214,8 @@ impl DataQuality {
     }
 
     /// The sample clock: timestamps corrected onto it, their jitter, irregular intervals.
-    fn assess_clock(&self, found: &mut Findings) {
-        let Findings { warn, distrust } = found;
+    fn assess_clock(&self, found: &mut QualityFindings) {
+        let QualityFindings { warn, distrust } = found;
         let rows = self.rows_read.max(1) as f64;
         if self.timestamp_glitches > 0 {
             warn.push(format!(
@@ -245,14 +245,14 @@ impl DataQuality {
     }
 
     /// What the cells say: bad cells and their bursts, the currents' frequency, clipping.
-    fn assess_cells(&self, supply_hz: f64, found: &mut Findings) {
+    fn assess_cells(&self, supply_hz: f64, found: &mut QualityFindings) {
         self.assess_bad_cells(found);
         self.assess_channels(found);
         self.assess_signals(supply_hz, found);
     }
 
     /// Blank lines skipped and rows held out for bad cells.
-    fn assess_bad_cells(&self, found: &mut Findings) {
+    fn assess_bad_cells(&self, found: &mut QualityFindings) {
         let warn = &mut found.warn;
         if self.blank_lines > 0 {
             warn.push(format!("{} blank lines skipped", self.blank_lines));
@@ -275,8 +275,8 @@ impl DataQuality {
 
     /// The channels: wiring faults, stuck channels, bad cells in short glitches all through
     /// the log.
-    fn assess_channels(&self, found: &mut Findings) {
-        let Findings { warn, distrust } = found;
+    fn assess_channels(&self, found: &mut QualityFindings) {
+        let QualityFindings { warn, distrust } = found;
         let rows = self.rows_read.max(1) as f64;
         for w in &self.wiring {
             distrust.push(w.clone());
@@ -304,8 +304,8 @@ impl DataQuality {
 
     /// The signals: the currents' frequency against the supply's [Hz], the speed's unit,
     /// clipping channels.
-    fn assess_signals(&self, supply_hz: f64, found: &mut Findings) {
-        let Findings { warn, distrust } = found;
+    fn assess_signals(&self, supply_hz: f64, found: &mut QualityFindings) {
+        let QualityFindings { warn, distrust } = found;
         if let Some(f) = self.current_frequency_hz {
             if (f / supply_hz - 1.0).abs() > SUPPLY_MISMATCH {
                 warn.push(format!(
