@@ -23,7 +23,7 @@
 //! first 20 ms block, so the date is within about one block of the step plus the machine's
 //! own mechanical response (tens of milliseconds on the reference motors).
 
-use super::isolation::IsolationName;
+use super::isolation_name::IsolationName;
 use monitor_core::SteadyPoint;
 use serde::Serialize;
 use std::collections::VecDeque;

@@ -26,6 +26,7 @@ mod diagnose;
 mod events;
 mod front;
 mod isolation;
+mod isolation_name;
 mod options;
 mod pipe;
 mod report;

@@ -49,6 +49,7 @@
 mod anchor;
 mod judgement;
 mod probability;
+mod reading;
 mod reasons;
 mod segments;
 

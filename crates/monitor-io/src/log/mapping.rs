@@ -25,9 +25,10 @@
 //! Missing columns are reported with the channels the log has and the closest of them
 //! ([`missing_column`]).
 
-pub use super::columns_error::ColumnsError;
+mod columns_error;
 use super::{Column, LogError};
 use crate::params::{ColumnsTable, ParamError, ParamFile};
+pub use columns_error::ColumnsError;
 
 mod iso8601;
 mod suggest;

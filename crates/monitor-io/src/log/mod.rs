@@ -25,7 +25,6 @@
 //!   half-written output and never touches an input.
 
 pub mod clipping;
-mod columns_error;
 mod csv_line;
 mod exact;
 mod fast;

@@ -20,7 +20,7 @@
 //! ([`Anchor::ln_current`]). So a stretch whose `|I1|` rose with its negative sequence
 //! carries the short, not the one it is judged against.
 
-use super::probability::PhaseReading;
+use super::reading::PhaseReading;
 use super::{abs, cdiv, sub, RatioPhasor};
 use monitor_core::sequence::SUPPLY_PART_UNCERTAINTY;
 use monitor_core::Phase;

@@ -15,7 +15,7 @@ use crate::report::BaselineSource;
 use crate::sequences::{sensor_phase, SequenceWindow};
 use crate::{Replay, SensorPhaseReport, UnbalanceReport};
 use monitor_core::sequence::{
-    asymmetry_correction_rad, equivalent_impedance, least_change, slip_for_current, SinglePhaseGain,
+    asymmetry_correction_rad, equivalent_impedance, slip_for_current, SinglePhaseGain,
 };
 use monitor_core::MotorModel;
 
@@ -350,7 +350,7 @@ fn fill_judgement(report: &mut UnbalanceReport, j: &PhaseJudged, segs: &[Sequenc
     report.correction_uncertainty_deg = op.1.to_degrees();
     report.operating_point = Some(op.3);
     report.slip = op.2;
-    let least = least_change_of(j, j.sigma);
+    let least = j.least_change_at(j.sigma);
     report.least_change = least.unwrap_or(0.0);
     report.spread = j.sigma;
     report.judged_against = Some(j.against);
@@ -360,12 +360,6 @@ fn fill_judgement(report: &mut UnbalanceReport, j: &PhaseJudged, segs: &[Sequenc
     });
     report.judged_segment = Some(j.index.min(MAX_SEGMENTS - 1));
     report.reference_segment = j.reference.filter(|&k| k < MAX_SEGMENTS);
-}
-
-/// The least change that names a phase at [`super::WINDING_FAULT_PROBABILITY`] with the
-/// spread `sigma` at the judged stretch's reference angle (`None` when none does).
-pub(super) fn least_change_of(j: &PhaseJudged, sigma: f32) -> Option<f32> {
-    least_change(sigma, &j.reading.model(), super::WINDING_FAULT_PROBABILITY)
 }
 
 /// One phase's current sensor and voltage sensor with a gain error in a stretch (the zero

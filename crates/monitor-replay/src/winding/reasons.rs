@@ -1,7 +1,6 @@
 //! The winding judgement's sentences: why no phase is named, and that a baseline ran at
 //! another operating point (the least change widened for it).
 
-use super::judgement::least_change_of;
 use super::probability::{External, PhaseJudged};
 use super::{abs, Against, SequenceSegment, OPERATING_SPEED_STEP, SEGMENT_I1_STEP};
 use monitor_core::Phase;
@@ -122,7 +121,7 @@ pub(super) fn widened(j: &PhaseJudged, ext: &External, pole_pairs: f32) -> Optio
         Against::Commissioning => "the commissioning window",
         _ => "the baseline",
     };
-    let pct = |s: f32| least_change_of(j, s).map_or(f32::INFINITY, |l| 100.0 * l);
+    let pct = |s: f32| j.least_change_at(s).map_or(f32::INFINITY, |l| 100.0 * l);
     let (from, to) = (pct(j.sigma_same_point), pct(j.sigma));
     // Two decimals where one would not show the widening; none worth a word at two.
     let digits = if (to - from) < 0.05 { 2 } else { 1 };

@@ -1,7 +1,7 @@
 //! The `[columns]` table's and the column mapping's errors ([`ColumnsError`]).
 
-use super::mapping::{ChannelUnit, SAMPLE_RATE_RANGE_HZ};
-use super::Column;
+use super::{ChannelUnit, SAMPLE_RATE_RANGE_HZ};
+use crate::log::Column;
 
 /// What is wrong with a `[columns]` table or a mapping call, naming the key or column (the
 /// messages are one line each; [`crate::params::ParamError::Columns`] carries them with the file's name).
