@@ -9,7 +9,9 @@
 //!    `monitor-studies`, `monitor-api`): a module uses only modules of a lower layer of
 //!    its crate; a module the table does not list is in the crate's base layer. Checked on
 //!    every `use` and every path (`crate::`, `super::`, `self::`), tests inside `src/`
-//!    included. docs/architecture.md names every crate of `crates/`.
+//!    included. docs/architecture.md names every crate of `crates/`. No two files of a
+//!    crate reach each other (an import circle), but a module and its own submodules and
+//!    the circles of [`CIRCLES_LEFT`].
 //! 2. **The core stands alone**: `monitor-core` depends on no crate of the workspace (no
 //!    `path` dependency) and names none.
 //! 3. **Files**: no `.rs` file in `crates/`, `src/`, `sim-host/`, `tests/` or `tools/` over
@@ -30,8 +32,10 @@
 
 mod architecture_syntax;
 
+use architecture_syntax::circles::{circles, reached, ModPath};
+use architecture_syntax::files::{files, is_code, is_test_file, parse, read, verdict, workspace};
 use architecture_syntax::{module_of, top_module, LongFunctions, Paths};
-use std::path::{Path, PathBuf};
+
 use syn::visit::Visit;
 
 /// The modules of one crate: (the crate's `src/` folder, its base layer's name, the
@@ -85,6 +89,35 @@ const INSIDE: &[Inside] = &[
     ("crates/monitor-api/src/", &[("fleet", 2)]),
 ];
 
+/// The `src/` folders whose files are checked for import circles (every crate of the
+/// workspace with more than one file).
+const CRATE_SOURCES: [&str; 9] = [
+    "src/",
+    "crates/monitor-core/src/",
+    "crates/monitor-io/src/",
+    "crates/monitor-sim/src/",
+    "crates/monitor-replay/src/",
+    "crates/monitor-analysis/src/",
+    "crates/monitor-studies/src/",
+    "crates/monitor-api/src/",
+    "sim-host/src/",
+];
+
+/// Import circles still there: (crate's `src/`, the files as `a::b` paths, why). An entry
+/// no longer found fails the test (the list only shrinks).
+const CIRCLES_LEFT: &[(&str, &[&str], &str)] = &[(
+    "crates/monitor-io/src/",
+    &[
+        "log::exact",
+        "log::fast",
+        "log::parquet",
+        "log::reader",
+        "log::tdms",
+    ],
+    "the formats implement reading for `LogFile` and use its column map; a registry of \
+     readers below `LogFile` is the next step",
+)];
+
 /// Longest `.rs` file [lines].
 const MAX_FILE_LINES: usize = 600;
 /// Longest non-test function [lines].
@@ -93,8 +126,6 @@ const MAX_FN_LINES: usize = 60;
 const LONG_FILES: &[(&str, usize, &str)] = &[];
 /// Functions allowed over [`MAX_FN_LINES`]: (path, function, lines at most, why).
 const LONG_FUNCTIONS: &[(&str, &str, usize, &str)] = &[];
-/// The workspace's folders of Rust code.
-const CODE_DIRS: [&str; 5] = ["crates/", "src/", "sim-host/", "tests/", "tools/"];
 /// References to files outside the repository (spelled in two parts, so that this file
 /// does not hold them).
 const FOREIGN: [&str; 2] = [concat!("DESIGN", ".md"), concat!("..", "/shared")];
@@ -112,82 +143,6 @@ const WORKSPACE_CRATES: [&str; 11] = [
     "core_on_m4",
     "fwtool",
 ];
-
-fn workspace() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("..")
-        .canonicalize()
-        .expect("the workspace folder")
-}
-
-/// The workspace's files (relative paths with `/`), tracked by git, else found by walking.
-fn files() -> Vec<String> {
-    let root = workspace();
-    let git = std::process::Command::new("git")
-        .arg("-C")
-        .arg(&root)
-        .args(["ls-files", "-z"])
-        .output();
-    if let Ok(out) = git {
-        if out.status.success() && !out.stdout.is_empty() {
-            return String::from_utf8_lossy(&out.stdout)
-                .split('\0')
-                .filter(|f| !f.is_empty() && root.join(f).is_file())
-                .map(str::to_string)
-                .collect();
-        }
-    }
-    let mut found = Vec::new();
-    walk(&root, &root, &mut found);
-    found
-}
-
-fn walk(root: &Path, dir: &Path, found: &mut Vec<String>) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for e in entries.flatten() {
-        let path = e.path();
-        let name = e.file_name().to_string_lossy().to_string();
-        if name.starts_with('.') || name == "target" {
-            continue;
-        }
-        if path.is_dir() {
-            walk(root, &path, found);
-        } else if let Ok(rel) = path.strip_prefix(root) {
-            found.push(rel.to_string_lossy().replace('\\', "/"));
-        }
-    }
-}
-
-fn read(rel: &str) -> String {
-    std::fs::read_to_string(workspace().join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"))
-}
-
-fn parse(rel: &str) -> syn::File {
-    syn::parse_file(&read(rel)).unwrap_or_else(|e| {
-        let at = e.span().start();
-        panic!("{rel}:{}:{}: cannot parse: {e}", at.line, at.column + 1)
-    })
-}
-
-/// Fails with every violation, one per line.
-fn verdict(rule: &str, violations: Vec<String>) {
-    assert!(
-        violations.is_empty(),
-        "{} violation(s) of the rule \"{rule}\":\n{}",
-        violations.len(),
-        violations.join("\n")
-    );
-}
-
-fn is_code(rel: &str) -> bool {
-    rel.ends_with(".rs") && CODE_DIRS.iter().any(|d| rel.starts_with(d))
-}
-
-fn is_test_file(rel: &str) -> bool {
-    rel.starts_with("tests/") || rel.contains("/tests/") || rel.contains("/benches/")
-}
 
 /// The layer of `module` inside the crate of `table` (the base, 1, when not listed).
 fn layer(table: &[(&str, u8)], module: &str) -> u8 {
@@ -237,6 +192,54 @@ fn modules_inside_a_crate_point_one_way() {
         }
     }
     verdict("modules inside a crate point one way", bad);
+}
+
+#[test]
+fn no_import_circle_between_files() {
+    let mut bad = Vec::new();
+    let mut used = vec![false; CIRCLES_LEFT.len()];
+    let all = files();
+    for dir in CRATE_SOURCES {
+        let in_crate: Vec<(&String, ModPath)> = all
+            .iter()
+            .filter(|f| f.starts_with(dir) && f.ends_with(".rs") && !is_test_file(f))
+            .filter(|f| !f.ends_with("/tests.rs") && !f.ends_with("_tests.rs"))
+            .map(|f| {
+                let rel = &f[dir.len()..];
+                let m = if rel == "main.rs" {
+                    Vec::new()
+                } else {
+                    module_of(rel)
+                };
+                (f, m)
+            })
+            .collect();
+        let known: std::collections::BTreeSet<ModPath> =
+            in_crate.iter().map(|(_, m)| m.clone()).collect();
+        let mut edges = std::collections::BTreeMap::new();
+        for (f, m) in &in_crate {
+            let uses = Paths::of(&parse(f), m.clone());
+            edges.insert(m.clone(), reached(m, &uses, &known));
+        }
+        for group in circles(&edges) {
+            let names: Vec<String> = group.iter().map(|m| m.join("::")).collect();
+            let left = CIRCLES_LEFT
+                .iter()
+                .position(|(d, files, _)| *d == dir && files.iter().eq(names.iter()));
+            match left {
+                Some(k) => used[k] = true,
+                None => bad.push(format!("{dir}: import circle between {}", names.join(", "))),
+            }
+        }
+    }
+    for ((dir, files, _), u) in CIRCLES_LEFT.iter().zip(used) {
+        if !u {
+            bad.push(format!(
+                "{dir}: {files:?} in CIRCLES_LEFT but no longer a circle: drop it"
+            ));
+        }
+    }
+    verdict("no import circle between files", bad);
 }
 
 /// Every crate of `crates/` (a folder with a `Cargo.toml`) is named in
@@ -441,6 +444,20 @@ fn the_checks_catch_what_they_should() {
     let firmware = INSIDE[0].1;
     assert!(layer(firmware, "panel") < layer(firmware, "app"));
     assert_eq!(layer(firmware, "not_a_module"), 1);
+    // Two sibling files that reach each other are a circle; a module and its own
+    // submodule are not.
+    let m = |p: &str| -> ModPath { p.split("::").map(str::to_string).collect() };
+    let known: std::collections::BTreeSet<ModPath> =
+        [m("a"), m("b"), m("a::c")].into_iter().collect();
+    let file: syn::File = syn::parse_str("use super::b::X; use crate::a::c::Y;").unwrap();
+    let from_a = reached(&m("a"), &Paths::of(&file, m("a")), &known);
+    assert_eq!(from_a, [m("a::c"), m("b")].into_iter().collect());
+    let mut edges = std::collections::BTreeMap::new();
+    edges.insert(m("a"), from_a);
+    edges.insert(m("a::c"), [m("a")].into_iter().collect());
+    assert!(circles(&edges).is_empty(), "{:?}", circles(&edges));
+    edges.insert(m("b"), [m("a")].into_iter().collect());
+    assert_eq!(circles(&edges), vec![vec![m("a"), m("b")]]);
 }
 
 /// 6. **Typed errors**: no library function of the core, the firmware or a host library returns

@@ -3,6 +3,9 @@
 //! ([`top_module`]), a file's module path ([`module_of`]), and the long functions outside
 //! tests ([`LongFunctions`]).
 
+pub mod circles;
+pub mod files;
+
 use syn::visit::Visit;
 
 /// True for `#[cfg(test)]` (or a `cfg` naming `test`) and `#[test]`.
