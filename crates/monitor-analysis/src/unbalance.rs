@@ -175,8 +175,13 @@ fn winding_part(
     let slip = operating_slip(d, n, s);
     let (we, sl) = (w.abs().max(1.0) as f32, slip as f32);
     let asym = monitor_core::sequence::winding_asymmetry(
-        (c.re as f32, -c.im as f32),
-        d.channels.voltages.then_some((cv.re as f32, -cv.im as f32)),
+        monitor_core::sequence::Complex32::new(c.re as f32, -c.im as f32),
+        d.channels
+            .voltages
+            .then_some(monitor_core::sequence::Complex32::new(
+                cv.re as f32,
+                -cv.im as f32,
+            )),
         &n.core_model,
         we,
         sl,

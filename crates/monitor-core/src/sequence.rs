@@ -68,6 +68,8 @@ use crate::filter::{Svf, SvfState};
 use crate::frames::{park, AlphaBeta, Phase, SinCos};
 use crate::machine::MotorModel;
 use micromath::F32Ext;
+/// A phasor: a complex number `re + j im` (`num_complex::Complex32`).
+pub use num_complex::Complex32;
 
 /// Result of the negative-sequence analysis of the currents.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -86,16 +88,14 @@ pub struct NegativeSequence {
     pub phase_confidence: f32,
 }
 
-/// `conj(N)/P` as `(re, im)`: a Park pair's negative-sequence phasor over the positive
-/// sequence's (`P = (pd, pq)` at +theta, `N = (nd, nq)` at -theta; module docs), e.g.
-/// `I2/I1` or, with the voltages' `N`, `V2/I1` [ohm]. (0, 0) for `|P|` ~ 0.
-pub fn over_positive(p: (f32, f32), n: (f32, f32)) -> (f32, f32) {
-    let p2 = p.0 * p.0 + p.1 * p.1;
-    if !(p2 > 1e-12) {
-        return (0.0, 0.0);
+/// `conj(N)/P`: a Park pair's negative-sequence phasor over the positive sequence's
+/// (`P = pd + j pq` at +theta, `N = nd + j nq` at -theta; module docs), e.g. `I2/I1` or,
+/// with the voltages' `N`, `V2/I1` [ohm]. 0 for `|P|` ~ 0.
+pub fn over_positive(p: Complex32, n: Complex32) -> Complex32 {
+    if !(p.norm_sqr() > 1e-12) {
+        return Complex32::new(0.0, 0.0);
     }
-    let (a, b) = (n.0, -n.1);
-    ((a * p.0 + b * p.1) / p2, (b * p.0 - a * p.1) / p2)
+    n.conj() / p
 }
 
 /// Streaming positive/negative-sequence separation.
@@ -129,7 +129,7 @@ impl SequenceAnalyzer {
     /// Feeds the current vector and the sin/cos of an angle turning at the supply frequency;
     /// returns the new filtered sequences ([`Self::positive`], [`Self::negative`]).
     #[inline]
-    pub fn update(&mut self, i: AlphaBeta, sc: SinCos) -> ((f32, f32), (f32, f32)) {
+    pub fn update(&mut self, i: AlphaBeta, sc: SinCos) -> (Complex32, Complex32) {
         let p = park(i, sc);
         let n = park(i, sc.negated());
         let f = self.filter;
@@ -140,15 +140,15 @@ impl SequenceAnalyzer {
         (self.positive(), self.negative())
     }
 
-    /// The filtered Park components `P = I1 e^{-j theta0}` (frame at +theta) as `(re, im)`.
-    pub fn positive(&self) -> (f32, f32) {
-        (self.pd.y(), self.pq.y())
+    /// The filtered Park components `P = I1 e^{-j theta0}` (frame at +theta).
+    pub fn positive(&self) -> Complex32 {
+        Complex32::new(self.pd.y(), self.pq.y())
     }
 
-    /// `conj(N) = I2 e^{-j theta0}` as `(re, im)` (same rotation as [`Self::positive`], so
+    /// `conj(N) = I2 e^{-j theta0}` (same rotation as [`Self::positive`], so
     /// `I2/I1 = conj(N)/P`).
-    pub fn negative(&self) -> (f32, f32) {
-        (self.nd.y(), -self.nq.y())
+    pub fn negative(&self) -> Complex32 {
+        Complex32::new(self.nd.y(), -self.nq.y())
     }
 
     /// |I1|, the positive-sequence current magnitude (phase peak) [A].
@@ -160,29 +160,29 @@ impl SequenceAnalyzer {
     /// ratio below which no phase is named.
     pub fn result(&self, correction_rad: f32, min_ratio: f32) -> NegativeSequence {
         sequence_result(
-            (self.pd.y(), self.pq.y()),
-            (self.nd.y(), self.nq.y()),
+            Complex32::new(self.pd.y(), self.pq.y()),
+            Complex32::new(self.nd.y(), self.nq.y()),
             correction_rad,
             min_ratio,
         )
     }
 }
 
-/// Ratio, angle and suspect phase from the filtered Park components `P = (pd, pq)` (frame
-/// at +theta) and `N = (nd, nq)` (at -theta): `I2/I1 = conj(N)/P` (module docs).
+/// Ratio, angle and suspect phase from the filtered Park components `P = pd + j pq` (frame
+/// at +theta) and `N = nd + j nq` (at -theta): `I2/I1 = conj(N)/P` (module docs).
 pub fn sequence_result(
-    p: (f32, f32),
-    n: (f32, f32),
+    p: Complex32,
+    n: Complex32,
     correction_rad: f32,
     min_ratio: f32,
 ) -> NegativeSequence {
-    let p2 = p.0 * p.0 + p.1 * p.1;
-    let n2 = n.0 * n.0 + n.1 * n.1;
+    let p2 = p.norm_sqr();
+    let n2 = n.norm_sqr();
     if !(p2 > 1e-12 && n2.is_finite()) {
         return NegativeSequence::default();
     }
     let ratio = crate::math::sqrt(n2 / p2);
-    let angle = crate::frames::wrap_angle(F32Ext::atan2(-n.1, n.0) - F32Ext::atan2(p.1, p.0));
+    let angle = crate::frames::wrap_angle(F32Ext::atan2(-n.im, n.re) - F32Ext::atan2(p.im, p.re));
     let suspect = (ratio >= min_ratio).then(|| suspect_phase(angle, correction_rad));
     NegativeSequence {
         negative_sequence_ratio: ratio,
@@ -236,7 +236,7 @@ pub const SUPPLY_PART_UNCERTAINTY: f32 = 0.3;
 /// what is left is the winding's (module docs: `I2w/I1 ~ (mu/3)(Z1/Z_f) a^k`), and
 /// [`suspect_phase`] names its phase.
 ///
-/// Inputs as complex numbers `(re, im)` in the core's phasor convention, relative to the
+/// Inputs as complex numbers in the core's phasor convention, relative to the
 /// positive-sequence current: `i2_over_i1 = I2/I1` and, where voltages are measured,
 /// `v2_over_i1 = V2/I1` [ohm] (both from Park with one angle: [`SequenceAnalyzer`] gives
 /// `I2/I1 = conj(N)/P`). `we` [rad/s], slip `s`.
@@ -245,30 +245,28 @@ pub const SUPPLY_PART_UNCERTAINTY: f32 = 0.3;
 /// [`SUPPLY_PART_UNCERTAINTY`] times `|V2/Z2|/|I1|` (what an imperfect `Z2` leaves of the
 /// supply's part). Without voltages the supply is assumed balanced.
 pub fn winding_asymmetry(
-    i2_over_i1: (f32, f32),
-    v2_over_i1: Option<(f32, f32)>,
+    i2_over_i1: Complex32,
+    v2_over_i1: Option<Complex32>,
     m: &MotorModel,
     we: f32,
     s: f32,
     min_ratio: f32,
 ) -> WindingAsymmetry {
-    let (mut wr, mut wi) = i2_over_i1;
+    let mut w = i2_over_i1;
     let mut supply_ratio = 0.0;
-    if let Some((vr, vi)) = v2_over_i1 {
-        let (zr, zi) = equivalent_impedance(m, we, 2.0 - s);
-        let d = zr * zr + zi * zi;
-        if d > 0.0 {
-            let (sr, si) = ((vr * zr + vi * zi) / d, (vi * zr - vr * zi) / d);
-            wr -= sr;
-            wi -= si;
-            supply_ratio = crate::math::fast_hypot(sr, si);
+    if let Some(v2) = v2_over_i1 {
+        let z2 = equivalent_impedance(m, we, 2.0 - s);
+        if z2.norm_sqr() > 0.0 {
+            let supply = v2 / z2;
+            w -= supply;
+            supply_ratio = crate::math::fast_hypot(supply.re, supply.im);
         }
     }
-    let ratio = crate::math::fast_hypot(wr, wi);
+    let ratio = crate::math::fast_hypot(w.re, w.im);
     if !(ratio.is_finite() && supply_ratio.is_finite()) {
         return WindingAsymmetry::default();
     }
-    let angle = F32Ext::atan2(wi, wr);
+    let angle = F32Ext::atan2(w.im, w.re);
     let floor = crate::math::maxf(min_ratio, SUPPLY_PART_UNCERTAINTY * supply_ratio);
     let corr = asymmetry_correction_rad(m, we, s);
     let named = ratio >= floor;
@@ -298,7 +296,7 @@ pub fn shorted_turns_mmf_ratio(ratio: f32) -> f32 {
 /// resistance means more turns for the same `I2`. 0 when `Z1` is not positive.
 pub fn min_shorted_fraction(m: &MotorModel, we: f32, s: f32, ratio: f32) -> f32 {
     let z1 = equivalent_impedance(m, we, s);
-    let z1n = crate::math::fast_hypot(z1.0, z1.1);
+    let z1n = crate::math::fast_hypot(z1.re, z1.im);
     if !(z1n > 0.0) {
         return 0.0;
     }
@@ -316,7 +314,7 @@ pub fn slip_for_current(m: &MotorModel, v_peak: f32, we: f32, i1_peak: f32) -> f
     for _ in 0..40 {
         let mid = 0.5 * (lo + hi);
         let z = equivalent_impedance(m, we, mid);
-        let i = v_peak / crate::math::fast_hypot(z.0, z.1);
+        let i = v_peak / crate::math::fast_hypot(z.re, z.im);
         if i < i1_peak {
             lo = mid;
         } else {
@@ -327,9 +325,9 @@ pub fn slip_for_current(m: &MotorModel, v_peak: f32, we: f32, i1_peak: f32) -> f
 }
 
 /// Impedance of the T-equivalent circuit per phase at slip `s` and supply `we` [rad/s]:
-/// `Z = Rs + j we Lls + (j we Lm || (Rr/s + j we Llr))`, as (re, im) [ohm].
+/// `Z = Rs + j we Lls + (j we Lm || (Rr/s + j we Llr))` [ohm].
 /// `s` is kept at least 1e-4 in magnitude.
-pub fn equivalent_impedance(m: &MotorModel, we: f32, s: f32) -> (f32, f32) {
+pub fn equivalent_impedance(m: &MotorModel, we: f32, s: f32) -> Complex32 {
     let s = if s.abs() < 1e-4 {
         1e-4f32.copysign(s)
     } else {
@@ -346,7 +344,7 @@ pub fn equivalent_impedance(m: &MotorModel, we: f32, s: f32) -> (f32, f32) {
     } else {
         (0.0, 0.0)
     };
-    (m.rs_ohm + pr, we * (m.ls_h - m.lm_h) + pi)
+    Complex32::new(m.rs_ohm + pr, we * (m.ls_h - m.lm_h) + pi)
 }
 
 /// `arg Z1 = arg Z(s)` [rad], the positive-sequence power-factor angle: the angle between a
@@ -355,7 +353,7 @@ pub fn equivalent_impedance(m: &MotorModel, we: f32, s: f32) -> (f32, f32) {
 /// `Z_f`). Supply `we` [rad/s], slip `s` (kept at least 1e-4 in magnitude).
 pub fn asymmetry_correction_rad(m: &MotorModel, we: f32, s: f32) -> f32 {
     let z1 = equivalent_impedance(m, we, s);
-    F32Ext::atan2(z1.1, z1.0)
+    F32Ext::atan2(z1.im, z1.re)
 }
 
 /// How far the angle `I2/I1` minus the correction lies inside its phase's 120-degree sector:
@@ -426,7 +424,7 @@ mod tests {
         let m = crate::testing::motor_3hp();
         // No load: Z1 ~ Rs + j Xs is nearly inductive; Z2 ~ Rs + Rr/2 + j(Xls + Xlr).
         let z1 = equivalent_impedance(&m, w, 1e-4);
-        assert!((z1.1 - 26.884).abs() < 0.05 && z1.0 < 0.6, "{z1:?}");
+        assert!((z1.im - 26.884).abs() < 0.05 && z1.re < 0.6, "{z1:?}");
         let c0 = asymmetry_correction_rad(&m, w, 0.001);
         let c5 = asymmetry_correction_rad(&m, w, 0.05);
         // The correction falls with load as Z1 turns resistive.

@@ -18,7 +18,9 @@ use super::{FILLED_SAMPLES, SENSOR_PHASE_MIN_RATIO};
 use monitor_core::angle::SrfPll;
 use monitor_core::filter::{Svf, SvfState};
 use monitor_core::frames::{clarke, park, AlphaBeta, SinCos};
-use monitor_core::sequence::{single_phase_gain, PhasorFit, SinglePhaseGain, ThreePhasors};
+use monitor_core::sequence::{
+    single_phase_gain, Complex32, PhasorFit, SinglePhaseGain, ThreePhasors,
+};
 use monitor_core::Abc;
 use monitor_core::SteadyPoint as IsolationPoint;
 use monitor_io::log::quality::MAX_BRIDGED_GAP_S;
@@ -534,6 +536,6 @@ impl SequenceFront {
 /// One phase's sensor gain error in a set of phasors (the zero sequence,
 /// [`single_phase_gain`]), evidence from [`SENSOR_PHASE_MIN_RATIO`] on: `p`, `n`, `z` the
 /// positive, negative and zero sequences with one rotation.
-pub(super) fn sensor_phase(p: (f32, f32), n: (f32, f32), z: (f32, f32)) -> Option<SinglePhaseGain> {
+pub(super) fn sensor_phase(p: Complex32, n: Complex32, z: Complex32) -> Option<SinglePhaseGain> {
     single_phase_gain(p, n, z, SENSOR_PHASE_MIN_RATIO)
 }

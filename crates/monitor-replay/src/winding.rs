@@ -58,7 +58,8 @@ pub use segments::segments;
 
 use super::sequences::SequenceWindow;
 use super::UnbalanceBaseline;
-use monitor_core::sequence::INHERENT_ASYMMETRY_RATIO;
+use monitor_core::sequence::{Complex32, INHERENT_ASYMMETRY_RATIO};
+use num_complex::Complex64;
 use serde::Serialize;
 
 /// Fewest least-squares windows a steady stretch holds (0.5 s at 60 Hz).
@@ -220,22 +221,22 @@ pub struct SequenceSegment {
     pub negative_sequence_ratio: f32,
     /// arg(I2/I1) [deg].
     pub angle_deg: f32,
-    /// Mean `I2/I1` (re, im) and its standard error (each component) over the windows.
+    /// Mean `I2/I1` and its standard error (each component) over the windows.
     #[serde(skip)]
-    r: (f32, f32),
+    r: Complex32,
     #[serde(skip)]
     sem: f32,
     /// Mean `V2/I1` and `V1/I1` [ohm] where every window has voltages.
     #[serde(skip)]
-    v2: Option<(f32, f32)>,
+    v2: Option<Complex32>,
     #[serde(skip)]
-    v1: Option<(f32, f32)>,
+    v1: Option<Complex32>,
     /// Mean phasors (one rotation) of the currents' and the voltages' positive, negative
     /// and zero sequences, for the sensor check.
     #[serde(skip)]
-    pnz: [(f32, f32); 3],
+    pnz: [Complex32; 3],
     #[serde(skip)]
-    v_pnz: Option<[(f32, f32); 3]>,
+    v_pnz: Option<[Complex32; 3]>,
     #[serde(skip)]
     we: f32,
     #[serde(skip)]
@@ -244,48 +245,58 @@ pub struct SequenceSegment {
     learning: bool,
 }
 
-type RatioPhasor = (f32, f32);
-
-fn cdiv(a: RatioPhasor, b: RatioPhasor) -> RatioPhasor {
-    let d = b.0 * b.0 + b.1 * b.1;
+/// `a / b`, 0 for a zero or non-number `|b|`.
+fn cdiv(a: Complex32, b: Complex32) -> Complex32 {
+    let d = b.norm_sqr();
     if d.is_nan() || d <= 0.0 {
-        return (0.0, 0.0);
+        return Complex32::new(0.0, 0.0);
     }
-    ((a.0 * b.0 + a.1 * b.1) / d, (a.1 * b.0 - a.0 * b.1) / d)
+    a / b
 }
 
-fn sub(a: RatioPhasor, b: RatioPhasor) -> RatioPhasor {
-    (a.0 - b.0, a.1 - b.1)
+/// `|a|` (the core's hypotenuse).
+fn abs(a: Complex32) -> f32 {
+    monitor_core::math::fast_hypot(a.re, a.im)
 }
 
-fn abs(a: RatioPhasor) -> f32 {
-    monitor_core::math::fast_hypot(a.0, a.1)
+/// `arg a` [deg].
+fn arg_deg(a: Complex32) -> f32 {
+    a.im.atan2(a.re).to_degrees()
 }
 
-/// Mean of complex values.
-fn mean(xs: impl Iterator<Item = RatioPhasor>) -> RatioPhasor {
-    let (mut s, mut n) = ((0.0f64, 0.0f64), 0u32);
+/// Mean of complex values (summed in double precision).
+fn mean(xs: impl Iterator<Item = Complex32>) -> Complex32 {
+    let (mut s, mut n) = (Complex64::new(0.0, 0.0), 0u32);
     for x in xs {
-        s.0 += f64::from(x.0);
-        s.1 += f64::from(x.1);
+        s += Complex64::new(f64::from(x.re), f64::from(x.im));
         n += 1;
     }
     if n == 0 {
-        return (0.0, 0.0);
+        return Complex32::new(0.0, 0.0);
     }
-    ((s.0 / f64::from(n)) as f32, (s.1 / f64::from(n)) as f32)
+    let m = s / f64::from(n);
+    Complex32::new(m.re as f32, m.im as f32)
+}
+
+/// A phasor from its JSON pair `[re, im]`.
+fn of_pair(x: [f32; 2]) -> Complex32 {
+    Complex32::new(x[0], x[1])
+}
+
+/// A phasor's JSON pair `[re, im]`.
+fn pair(x: Complex32) -> [f32; 2] {
+    [x.re, x.im]
 }
 
 /// One segment's means.
 pub(super) fn segment_of(ws: &[&SequenceWindow]) -> SequenceSegment {
     let n = ws.len();
-    let rs: Vec<RatioPhasor> = ws
+    let rs: Vec<Complex32> = ws
         .iter()
         .map(|w| cdiv(w.i.negative(), w.i.positive()))
         .collect();
     let r = mean(rs.iter().copied());
-    let var =
-        rs.iter().map(|x| abs(sub(*x, r)).powi(2)).sum::<f32>() / (2.0 * (n.max(2) - 1) as f32);
+    let var = rs.iter().map(|x| abs(*x - r).powi(2)).sum::<f32>() / (2.0 * (n.max(2) - 1) as f32);
     let volts: Option<Vec<_>> = ws
         .iter()
         .map(|w| w.v.map(|v| (v, w.i.positive())))
@@ -303,7 +314,7 @@ pub(super) fn segment_of(ws: &[&SequenceWindow]) -> SequenceSegment {
         windows: n as u32,
         i1_peak_a: ws.iter().map(|w| abs(w.i.positive())).sum::<f32>() / n as f32,
         negative_sequence_ratio: abs(r),
-        angle_deg: r.1.atan2(r.0).to_degrees(),
+        angle_deg: arg_deg(r),
         r,
         sem: (var / n as f32).sqrt(),
         v2,
@@ -363,17 +374,16 @@ impl HealthyReference {
         if n == 0 {
             return None;
         }
-        let c = |x: [f32; 2]| (x[0], x[1]);
-        let i2 = mean(runs.iter().map(|r| c(r.i2_over_i1)));
+        let i2 = mean(runs.iter().map(|r| of_pair(r.i2_over_i1)));
         let v2 = runs
             .iter()
-            .map(|r| r.v2_over_i1.map(c))
+            .map(|r| r.v2_over_i1.map(of_pair))
             .collect::<Option<Vec<_>>>()
             .map(|v| mean(v.into_iter()));
         Some(HealthyReference {
             mean: UnbalanceBaseline {
-                i2_over_i1: [i2.0, i2.1],
-                v2_over_i1: v2.map(|v| [v.0, v.1]),
+                i2_over_i1: pair(i2),
+                v2_over_i1: v2.map(pair),
                 i1_peak_a: runs.iter().map(|r| r.i1_peak_a).sum::<f32>() / n as f32,
                 wr_rad_s: runs
                     .iter()
@@ -384,7 +394,7 @@ impl HealthyReference {
             runs: n as u32,
             sum_sq_dev: runs
                 .iter()
-                .map(|r| abs(sub(c(r.i2_over_i1), i2)).powi(2))
+                .map(|r| abs(of_pair(r.i2_over_i1) - i2).powi(2))
                 .sum(),
         })
     }
@@ -421,8 +431,8 @@ fn measured_of(windows: &[SequenceWindow], segs: &[SequenceSegment]) -> (Unbalan
             wr_rad_s: None,
         },
         |s| UnbalanceBaseline {
-            i2_over_i1: [s.r.0, s.r.1],
-            v2_over_i1: s.v2.map(|v| [v.0, v.1]),
+            i2_over_i1: pair(s.r),
+            v2_over_i1: s.v2.map(pair),
             i1_peak_a: s.i1_peak_a,
             wr_rad_s: s.wr,
         },
@@ -449,10 +459,10 @@ fn measured_of(windows: &[SequenceWindow], segs: &[SequenceSegment]) -> (Unbalan
             .iter()
             .map(|w| (0.5 * (w.from_s + w.to_s), w.offset_rad)),
     );
-    let turned = |w: &SequenceWindow, x: RatioPhasor| {
+    let turned = |w: &SequenceWindow, x: Complex32| {
         let d = (w.offset_rad - line.0 - line.1 * 0.5 * (w.from_s + w.to_s)) as f32;
         let (sn, cs) = d.sin_cos();
-        (x.0 * cs - x.1 * sn, x.0 * sn + x.1 * cs)
+        x * Complex32::new(cs, sn)
     };
     let p = mean(whole.iter().map(|w| turned(w, w.i.positive())));
     let n = mean(whole.iter().map(|w| turned(w, w.i.negative())));

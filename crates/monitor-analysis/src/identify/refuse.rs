@@ -27,7 +27,7 @@ pub fn refusal(
     let v = params.supply.v_phase_peak() as f32;
     let i_at = |s: f32| {
         let z = monitor_core::sequence::equivalent_impedance(&m, we, s);
-        f64::from(v / z.0.hypot(z.1))
+        f64::from(v / z.re.hypot(z.im))
     };
     let (lo, hi) = (0.3 * i_at(1e-4), 1.2 * i_at(1.0));
     let i = samples.i_rms_a;

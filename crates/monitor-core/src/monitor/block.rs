@@ -7,6 +7,7 @@ use crate::error::ConfigError;
 use crate::filter::{LowPass, LowPassState, Svf, SvfState};
 use crate::frames::Dq;
 use crate::residuals::{Derivatives, Operating};
+use crate::sequence::Complex32;
 use core::f32::consts::TAU;
 
 /// Values derived once from the configuration (the per-sample state is apart, in
@@ -329,20 +330,20 @@ impl DqFilters {
 
     /// The positive sequence's filtered Park components `(i_ds, I_qs)` [A].
     #[inline(always)]
-    pub(super) fn positive(&self) -> (f32, f32) {
-        (self.ids.y(), self.iqs.y())
+    pub(super) fn positive(&self) -> Complex32 {
+        Complex32::new(self.ids.y(), self.iqs.y())
     }
 
     /// The current's negative sequence `(d, q)`, filtered [A].
     #[inline(always)]
-    pub(super) fn negative(&self) -> (f32, f32) {
-        (self.nd.y(), self.nq.y())
+    pub(super) fn negative(&self) -> Complex32 {
+        Complex32::new(self.nd.y(), self.nq.y())
     }
 
     /// The voltage's negative sequence `(d, q)`, filtered [V].
     #[inline(always)]
-    pub(super) fn voltage_negative(&self) -> (f32, f32) {
-        (self.vnd.y(), self.vnq.y())
+    pub(super) fn voltage_negative(&self) -> Complex32 {
+        Complex32::new(self.vnd.y(), self.vnq.y())
     }
 
     /// The derivatives of eq. (36) for the block's last inputs `iqs` and `wr_rad_s`.

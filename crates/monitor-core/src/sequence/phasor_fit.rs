@@ -30,7 +30,9 @@
 //! that is software floating point, so the board's per-sample path does not call this; the
 //! host's replay does, per window of whole supply periods.
 
+use super::Complex32;
 use crate::frames::{Abc, SinCos};
+use num_complex::Complex64;
 
 /// Fewest samples a window needs before [`PhasorFit::solve`] gives phasors (three
 /// unknowns per phase, and enough of a period to tell cos from sin).
@@ -49,58 +51,53 @@ pub struct PhasorFit {
     x: [[f64; 3]; 3],
 }
 
-/// The three phase phasors of a window (`x = Re(X e^{j theta})`, as `(re, im)`), in the
+/// The three phase phasors of a window (`x = Re(X e^{j theta})`), in the
 /// reference's frame: every phasor carries the same rotation `e^{-j theta0}`.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct ThreePhasors {
     /// Phases a, b, c.
-    pub phases: [(f32, f32); 3],
+    pub phases: [Complex32; 3],
     /// Samples the fit used.
     pub samples: u32,
 }
 
-type Phasor64 = (f64, f64);
+/// The operator `a = e^{j 2 pi/3}` (double precision: the sequences are formed in it).
+const A: Complex64 = Complex64::new(-0.5, 0.866_025_403_784_438_6);
+/// `a^2 = e^{-j 2 pi/3}`.
+const A2: Complex64 = Complex64::new(-0.5, -0.866_025_403_784_438_6);
+/// 1.
+const ONE: Complex64 = Complex64::new(1.0, 0.0);
 
-const A: Phasor64 = (-0.5, 0.866_025_403_784_438_6);
-const A2: Phasor64 = (-0.5, -0.866_025_403_784_438_6);
-
-fn mul(x: Phasor64, y: Phasor64) -> Phasor64 {
-    (x.0 * y.0 - x.1 * y.1, x.0 * y.1 + x.1 * y.0)
+fn c64(x: Complex32) -> Complex64 {
+    Complex64::new(f64::from(x.re), f64::from(x.im))
 }
 
-fn c64(x: (f32, f32)) -> Phasor64 {
-    (f64::from(x.0), f64::from(x.1))
-}
-
-/// `(x + u y + v z)/3` as `(re, im)` in single precision.
-fn combine(x: Phasor64, u: Phasor64, y: Phasor64, v: Phasor64, z: Phasor64) -> (f32, f32) {
-    let (uy, vz) = (mul(u, y), mul(v, z));
-    (
-        ((x.0 + uy.0 + vz.0) / 3.0) as f32,
-        ((x.1 + uy.1 + vz.1) / 3.0) as f32,
-    )
+/// `(x + u y + v z)/3` in single precision.
+fn combine(x: Complex64, u: Complex64, y: Complex64, v: Complex64, z: Complex64) -> Complex32 {
+    let s = (x + u * y + v * z) / 3.0;
+    Complex32::new(s.re as f32, s.im as f32)
 }
 
 impl ThreePhasors {
     /// The positive-sequence phasor `I1 e^{-j theta0} = (Xa + a Xb + a^2 Xc)/3` (as
     /// [`super::SequenceAnalyzer::positive`]).
-    pub fn positive(&self) -> (f32, f32) {
+    pub fn positive(&self) -> Complex32 {
         let [a, b, c] = self.phases.map(c64);
         combine(a, A, b, A2, c)
     }
 
     /// The negative-sequence phasor `I2 e^{-j theta0} = (Xa + a^2 Xb + a Xc)/3` (as
     /// [`super::SequenceAnalyzer::negative`]: `I2/I1 = negative / positive`).
-    pub fn negative(&self) -> (f32, f32) {
+    pub fn negative(&self) -> Complex32 {
         let [a, b, c] = self.phases.map(c64);
         combine(a, A2, b, A, c)
     }
 
     /// The zero-sequence phasor `I0 e^{-j theta0} = (Xa + Xb + Xc)/3` (as
     /// [`super::ZeroSequence::phasor`]).
-    pub fn zero(&self) -> (f32, f32) {
+    pub fn zero(&self) -> Complex32 {
         let [a, b, c] = self.phases.map(c64);
-        combine(a, (1.0, 0.0), b, (1.0, 0.0), c)
+        combine(a, ONE, b, ONE, c)
     }
 }
 
@@ -168,7 +165,7 @@ impl PhasorFit {
         let phases = self.x.map(|[xc, xs, x]| {
             let a = i00 * xc + i01 * xs + i02 * x;
             let b = i01 * xc + i11 * xs + i12 * x;
-            (a as f32, -b as f32)
+            Complex32::new(a as f32, -b as f32)
         });
         Some(ThreePhasors {
             phases,
@@ -217,9 +214,8 @@ mod tests {
     }
 
     fn ratio(ph: &ThreePhasors) -> (f64, f64) {
-        let (p, n) = (c64(ph.positive()), c64(ph.negative()));
-        let d = p.0 * p.0 + p.1 * p.1;
-        (((n.0 * p.0 + n.1 * p.1) / d), ((n.1 * p.0 - n.0 * p.1) / d))
+        let r = c64(ph.negative()) / c64(ph.positive());
+        (r.re, r.im)
     }
 
     #[test]
@@ -238,7 +234,7 @@ mod tests {
             assert!((m - 0.3).abs() < tol, "fs {fs} n {n}: {m}");
             assert!((a - 50.0).abs() < 0.2, "fs {fs} n {n}: {a}");
             let z = c64(ph.zero());
-            assert!((z.0.hypot(z.1) - 0.5).abs() < 2e-4, "{z:?}");
+            assert!((z.re.hypot(z.im) - 0.5).abs() < 2e-4, "{z:?}");
         }
     }
 

@@ -36,11 +36,9 @@
 //! `sigma` (a supply whose unbalance changed, a baseline at another load without the
 //! widening for it) makes the probabilities too sure of a short.
 
+use super::Complex32;
 use crate::frames::{wrap_angle, Phase};
 use micromath::F32Ext;
-
-/// A complex number (re, im).
-type Phasor32 = (f32, f32);
 
 /// Smallest size `|r|` of the shorted loop (`|I2/I1|` it draws, about) the prior allows:
 /// below the noise of any current sensor.
@@ -111,13 +109,12 @@ impl ShortModel {
 
     /// The reading `M` of a short of size `x` on its phase-a sector centre on a healthy
     /// reference of zero.
-    fn reading_of(&self, x: f32) -> Phasor32 {
-        let w = unit(self.reference_rad);
-        let r = (x * w.0, x * w.1);
+    fn reading_of(&self, x: f32) -> Complex32 {
+        let r = unit(self.reference_rad) * x;
         if self.on_faulty_current {
             r
         } else {
-            cdiv(r, (1.0 + r.0, r.1))
+            cdiv(r, Complex32::new(1.0 + r.re, r.im))
         }
     }
 }
@@ -204,33 +201,30 @@ fn exp_neg(x: f32) -> f32 {
 
 /// `ln` of the density of a two-component Gaussian with standard deviation `s` in each
 /// component at `d`.
-fn ln_gauss2(d: Phasor32, s: f32) -> f32 {
+fn ln_gauss2(d: Complex32, s: f32) -> f32 {
     let s2 = s * s;
-    -(d.0 * d.0 + d.1 * d.1) / (2.0 * s2) - (core::f32::consts::TAU * s2).ln()
+    -d.norm_sqr() / (2.0 * s2) - (core::f32::consts::TAU * s2).ln()
 }
 
-fn cmul(a: Phasor32, b: Phasor32) -> Phasor32 {
-    (a.0 * b.0 - a.1 * b.1, a.0 * b.1 + a.1 * b.0)
-}
-
-fn cdiv(a: Phasor32, b: Phasor32) -> Phasor32 {
-    let d = b.0 * b.0 + b.1 * b.1;
-    if !(d > 0.0) {
-        return (f32::NAN, f32::NAN);
+/// `a / b`, NaN for `b = 0`.
+fn cdiv(a: Complex32, b: Complex32) -> Complex32 {
+    if !(b.norm_sqr() > 0.0) {
+        return Complex32::new(f32::NAN, f32::NAN);
     }
-    ((a.0 * b.0 + a.1 * b.1) / d, (a.1 * b.0 - a.0 * b.1) / d)
+    a / b
 }
 
-fn unit(angle: f32) -> Phasor32 {
+/// `e^{j angle}`.
+fn unit(angle: f32) -> Complex32 {
     let (s, c) = F32Ext::sin_cos(angle);
-    (c, s)
+    Complex32::new(c, s)
 }
 
 /// `ln` of the density of the reading `m = I2/I1` about the healthy reference `r` when
 /// nothing is shorted: each component of `m - r` Gaussian with standard deviation `sigma`
 /// (> 0; fraction of `|I1|`). Non-finite for a non-positive `sigma`.
-pub fn ln_no_short(m: Phasor32, r: Phasor32, sigma: f32) -> f32 {
-    ln_gauss2((m.0 - r.0, m.1 - r.1), sigma)
+pub fn ln_no_short(m: Complex32, r: Complex32, sigma: f32) -> f32 {
+    ln_gauss2(m - r, sigma)
 }
 
 /// `ln` of the density of the reading `m = I2/I1` about the healthy reference `r` when a
@@ -240,29 +234,28 @@ pub fn ln_no_short(m: Phasor32, r: Phasor32, sigma: f32) -> f32 {
 /// derivative `J` (`(1 - r a^-k)/(1 - m a^-k)^2`, or `1/(1 - r a^-k)`), and the density
 /// of `c` under the short's prior ([`ShortModel`]) times `|J|^2`. A reading that is no
 /// number gives `-inf`.
-pub fn ln_short(m: Phasor32, r: Phasor32, phase: Phase, model: &ShortModel, sigma: f32) -> f32 {
+pub fn ln_short(m: Complex32, r: Complex32, phase: Phase, model: &ShortModel, sigma: f32) -> f32 {
     let third = core::f32::consts::TAU / 3.0;
     let turn = phase.index() as f32 * third;
     let a_minus_k = unit(-turn);
-    let one_less = |x: Phasor32| {
-        let y = cmul(x, a_minus_k);
-        (1.0 - y.0, -y.1)
+    let one_less = |x: Complex32| {
+        let y = x * a_minus_k;
+        Complex32::new(1.0 - y.re, -y.im)
     };
     let (den_m, den_r) = (one_less(m), one_less(r));
-    let d = (m.0 - r.0, m.1 - r.1);
+    let d = m - r;
     let (c, jac) = if model.on_faulty_current {
         (
             cdiv(d, den_r),
-            1.0 / crate::math::fast_hypot(den_r.0, den_r.1),
+            1.0 / crate::math::fast_hypot(den_r.re, den_r.im),
         )
     } else {
-        let n2 = den_m.0 * den_m.0 + den_m.1 * den_m.1;
         (
             cdiv(d, den_m),
-            crate::math::fast_hypot(den_r.0, den_r.1) / n2,
+            crate::math::fast_hypot(den_r.re, den_r.im) / den_m.norm_sqr(),
         )
     };
-    let ok = c.0.is_finite() && c.1.is_finite() && jac.is_finite() && jac > 0.0;
+    let ok = c.re.is_finite() && c.im.is_finite() && jac.is_finite() && jac > 0.0;
     if !(ok && sigma > 0.0 && model.angle_sd_rad > 0.0) {
         return f32::NEG_INFINITY;
     }
@@ -275,9 +268,9 @@ pub fn ln_short(m: Phasor32, r: Phasor32, phase: Phase, model: &ShortModel, sigm
 /// (uniform in `ln |w|`, a wrapped Gaussian of standard deviation `sd` about `centre` in
 /// angle) convolved with the noise (module docs), on a grid over the noise's support.
 /// (`max`: the prior's largest size).
-fn short_density(c: Phasor32, centre: f32, sd: f32, s: f32, max: f32) -> f32 {
+fn short_density(c: Complex32, centre: f32, sd: f32, s: f32, max: f32) -> f32 {
     let span = (max / SHORT_RATIO_MIN).ln();
-    let mag = crate::math::fast_hypot(c.0, c.1);
+    let mag = crate::math::fast_hypot(c.re, c.im);
     let clamp = |x: f32| crate::math::minf(max, crate::math::maxf(SHORT_RATIO_MIN, x));
     let (mut lo, mut hi) = (clamp(mag - GRID_SPREADS * s), clamp(mag + GRID_SPREADS * s));
     if hi <= lo * 1.0001 {
@@ -296,14 +289,13 @@ fn short_density(c: Phasor32, centre: f32, sd: f32, s: f32, max: f32) -> f32 {
         core::f32::consts::PI
     };
     let dphi = 2.0 * half / GRID as f32;
-    let phi0 = F32Ext::atan2(c.1, c.0) - half;
+    let phi0 = F32Ext::atan2(c.im, c.re) - half;
     let ln_cell = (du * dphi).ln() - span.ln();
     // Two passes: the largest term, then the sum below it (log-sum-exp).
     let term = |i: usize, j: usize| {
         let rho = F32Ext::exp(u0 + (i as f32 + 0.5) * du);
         let phi = phi0 + (j as f32 + 0.5) * dphi;
-        let w = unit(phi);
-        ln_wrapped_gauss(phi - centre, sd) + ln_gauss2((c.0 - rho * w.0, c.1 - rho * w.1), s)
+        ln_wrapped_gauss(phi - centre, sd) + ln_gauss2(c - unit(phi) * rho, s)
     };
     let mut max = f32::NEG_INFINITY;
     for i in 0..GRID {
@@ -337,7 +329,12 @@ fn ln_wrapped_gauss(x: f32, sd: f32) -> f32 {
 /// The posterior of a reading `m = I2/I1` against one healthy reference `r` with the
 /// spread `sigma` (> 0, each component) under `model`: [`ln_no_short`] and [`ln_short`]
 /// for each phase, with the priors ([`PhasePosterior::from_ln`]).
-pub fn phase_posterior(m: Phasor32, r: Phasor32, sigma: f32, model: &ShortModel) -> PhasePosterior {
+pub fn phase_posterior(
+    m: Complex32,
+    r: Complex32,
+    sigma: f32,
+    model: &ShortModel,
+) -> PhasePosterior {
     PhasePosterior::from_ln(
         ln_no_short(m, r, sigma),
         Phase::ALL.map(|p| ln_short(m, r, p, model, sigma)),
@@ -350,7 +347,9 @@ pub fn phase_posterior(m: Phasor32, r: Phasor32, sigma: f32, model: &ShortModel)
 /// the prior's sizes to 0.1 %. `None` when not even the largest reaches it (an angle too
 /// uncertain, or a spread too wide, to name a phase).
 pub fn least_change(sigma: f32, model: &ShortModel, target: f32) -> Option<f32> {
-    let p_at = |x: f32| phase_posterior(model.reading_of(x), (0.0, 0.0), sigma, model).phases[0];
+    let p_at = |x: f32| {
+        phase_posterior(model.reading_of(x), Complex32::new(0.0, 0.0), sigma, model).phases[0]
+    };
     let max = model.max_size();
     if !(p_at(max) >= target) {
         return None;
@@ -380,7 +379,7 @@ mod tests {
     /// density is the prior's own density at the reading, `g(arg c) / (|c|^2 ln(max/min))`.
     #[test]
     fn the_grid_integral_is_the_prior_density_for_a_sharp_reading() {
-        let c = (0.1 * (70.0 * D).cos(), 0.1 * (70.0 * D).sin());
+        let c = Complex32::new(0.1 * (70.0 * D).cos(), 0.1 * (70.0 * D).sin());
         let sd = 20.0 * D;
         let got = short_density(c, 60.0 * D, sd, 1e-4, SHORT_RATIO_MAX);
         let g = (-(10.0f32 * D).powi(2) / (2.0 * sd * sd)).exp()
@@ -393,22 +392,27 @@ mod tests {
     fn a_large_change_on_a_sector_centre_names_its_phase_and_a_small_one_none() {
         let model = ShortModel::new(60.0 * D, 10.0 * D);
         // Phase b's centre: 60 + 120 deg.
-        let at = |x: f32, deg: f32| (x * (deg * D).cos(), x * (deg * D).sin());
-        let p = phase_posterior(at(0.10, 180.0), (0.0, 0.0), 0.01, &model);
+        let at = |x: f32, deg: f32| Complex32::new(x * (deg * D).cos(), x * (deg * D).sin());
+        let p = phase_posterior(at(0.10, 180.0), Complex32::new(0.0, 0.0), 0.01, &model);
         assert_eq!(p.named().map(|n| n.0), Some(Phase::B), "{p:?}");
         assert!(p.phases[1] > 0.99, "{p:?}");
         // A change of one spread: no short is the more probable.
-        let p = phase_posterior(at(0.01, 180.0), (0.0, 0.0), 0.01, &model);
+        let p = phase_posterior(at(0.01, 180.0), Complex32::new(0.0, 0.0), 0.01, &model);
         assert!(p.no_short > 0.5 && p.named().is_none(), "{p:?}");
         // On the border of a and b (120 deg): the two share it (a small reading, where
         // the loop's own share of I1 barely turns the border).
-        let p = phase_posterior(at(0.02, 120.0), (0.0, 0.0), 0.002, &model);
+        let p = phase_posterior(at(0.02, 120.0), Complex32::new(0.0, 0.0), 0.002, &model);
         assert!((p.phases[0] - p.phases[1]).abs() < 0.2, "{p:?}");
         assert!(p.phases[0] < 0.6 && p.phases[1] < 0.6, "{p:?}");
         let sum = p.no_short + p.phases.iter().sum::<f32>();
         assert!((sum - 1.0).abs() < 1e-4);
         // No number, no short.
-        let p = phase_posterior((f32::NAN, 0.0), (0.0, 0.0), 0.01, &model);
+        let p = phase_posterior(
+            Complex32::new(f32::NAN, 0.0),
+            Complex32::new(0.0, 0.0),
+            0.01,
+            &model,
+        );
         assert_eq!(p.no_short, 1.0);
     }
 

@@ -28,6 +28,7 @@
 //! own zero sequence. Offsets are not gains: they are DC and do not reach the
 //! fundamental-frequency phasors.
 
+use super::Complex32;
 use crate::error::ConfigError;
 use crate::filter::{Svf, SvfState};
 use crate::frames::{Abc, Phase, SinCos};
@@ -59,19 +60,19 @@ impl ZeroSequence {
     /// Feeds the three phase values and the sin/cos of the analysis angle; returns the new
     /// phasor ([`Self::phasor`]).
     #[inline]
-    pub fn update(&mut self, x: Abc, sc: SinCos) -> (f32, f32) {
+    pub fn update(&mut self, x: Abc, sc: SinCos) -> Complex32 {
         // x0 e^{-j theta}, times 2: a phase signal Re(X e^{j theta}) demodulates to X/2.
         let x0 = (x.a + x.b + x.c) * (2.0 / 3.0);
         let f = self.filter;
-        (
+        Complex32::new(
             f.update(&mut self.d, x0 * sc.cos),
             f.update(&mut self.q, -x0 * sc.sin),
         )
     }
 
-    /// `I0 e^{-j theta0}` as `(re, im)` (module docs).
-    pub fn phasor(&self) -> (f32, f32) {
-        (self.d.y(), self.q.y())
+    /// `I0 e^{-j theta0}` (module docs).
+    pub fn phasor(&self) -> Complex32 {
+        Complex32::new(self.d.y(), self.q.y())
     }
 }
 
@@ -92,25 +93,15 @@ pub struct SinglePhaseGain {
 /// the other phases are 120 degrees off; noise and a second, smaller error turn it a few.
 pub const MAX_MISALIGNMENT_DEG: f32 = 20.0;
 
-const A: (f32, f32) = (-0.5, 0.866_025_4);
-const A2: (f32, f32) = (-0.5, -0.866_025_4);
-
-fn mul(x: (f32, f32), y: (f32, f32)) -> (f32, f32) {
-    (x.0 * y.0 - x.1 * y.1, x.0 * y.1 + x.1 * y.0)
-}
-
-fn add3(x: (f32, f32), y: (f32, f32), z: (f32, f32)) -> (f32, f32) {
-    (x.0 + y.0 + z.0, x.1 + y.1 + z.1)
-}
+/// The operator `a = e^{j 2 pi/3}`.
+const A: Complex32 = Complex32::new(-0.5, 0.866_025_4);
+/// `a^2 = e^{-j 2 pi/3}`.
+const A2: Complex32 = Complex32::new(-0.5, -0.866_025_4);
 
 /// The measured phase phasors `[Xa, Xb, Xc]` from the sequence phasors `p = I1`,
 /// `n = I2` and `z = I0` (all with the same rotation; module docs).
-pub fn phase_phasors(p: (f32, f32), n: (f32, f32), z: (f32, f32)) -> [(f32, f32); 3] {
-    [
-        add3(z, p, n),
-        add3(z, mul(A2, p), mul(A, n)),
-        add3(z, mul(A, p), mul(A2, n)),
-    ]
+pub fn phase_phasors(p: Complex32, n: Complex32, z: Complex32) -> [Complex32; 3] {
+    [z + p + n, z + A2 * p + A * n, z + A * p + A2 * n]
 }
 
 /// The one phase sensor whose gain error explains the zero sequence `z` of a set with
@@ -122,14 +113,14 @@ pub fn phase_phasors(p: (f32, f32), n: (f32, f32), z: (f32, f32)) -> [(f32, f32)
 /// [`MAX_MISALIGNMENT_DEG`] off (not one sensor's gain: two sensors, a neutral conductor),
 /// when the gain would not be positive, or on non-finite input.
 pub fn single_phase_gain(
-    p: (f32, f32),
-    n: (f32, f32),
-    z: (f32, f32),
+    p: Complex32,
+    n: Complex32,
+    z: Complex32,
     min_ratio: f32,
 ) -> Option<SinglePhaseGain> {
-    let i1 = crate::math::fast_hypot(p.0, p.1);
-    let z3 = 3.0 * crate::math::fast_hypot(z.0, z.1);
-    if !(i1 > 1e-9 && z3.is_finite() && n.0.is_finite() && n.1.is_finite()) {
+    let i1 = crate::math::fast_hypot(p.re, p.im);
+    let z3 = 3.0 * crate::math::fast_hypot(z.re, z.im);
+    if !(i1 > 1e-9 && z3.is_finite() && n.re.is_finite() && n.im.is_finite()) {
         return None;
     }
     let ratio = z3 / i1;
@@ -139,18 +130,18 @@ pub fn single_phase_gain(
     let x = phase_phasors(p, n, z);
     let mut best: Option<(Phase, f32, f32)> = None;
     for (phase, xp) in Phase::ALL.into_iter().zip(x) {
-        let x2 = xp.0 * xp.0 + xp.1 * xp.1;
+        let x2 = xp.norm_sqr();
         if !(x2 > 1e-18) {
             continue;
         }
         // g = 3 z / xp
-        let g = (
-            3.0 * (z.0 * xp.0 + z.1 * xp.1) / x2,
-            3.0 * (z.1 * xp.0 - z.0 * xp.1) / x2,
+        let g = Complex32::new(
+            3.0 * (z.re * xp.re + z.im * xp.im) / x2,
+            3.0 * (z.im * xp.re - z.re * xp.im) / x2,
         );
-        let off = micromath::F32Ext::atan2(g.1.abs(), g.0.abs()).to_degrees();
+        let off = micromath::F32Ext::atan2(g.im.abs(), g.re.abs()).to_degrees();
         if best.is_none_or(|(_, _, o)| off < o) {
-            best = Some((phase, g.0, off));
+            best = Some((phase, g.re, off));
         }
     }
     let (phase, g, off) = best?;
@@ -169,18 +160,17 @@ impl SinglePhaseGain {
     /// The negative sequence `n` (with its positive sequence `p` and zero sequence `z`)
     /// with this sensor's error taken out: phase `p`'s phasor divided by its gain before the
     /// sequences are formed again (module docs). Returns `n` unchanged on a zero gain.
-    pub fn corrected_negative(&self, p: (f32, f32), n: (f32, f32), z: (f32, f32)) -> (f32, f32) {
+    pub fn corrected_negative(&self, p: Complex32, n: Complex32, z: Complex32) -> Complex32 {
         let k = 1.0 + self.gain_error;
         if !(k > 0.0) {
             return n;
         }
         let mut x = phase_phasors(p, n, z);
         if let Some(xp) = x.get_mut(self.phase.index()) {
-            *xp = (xp.0 / k, xp.1 / k);
+            *xp /= k;
         }
         // I2 = (Xa + a^2 Xb + a Xc) / 3
-        let s = add3(x[0], mul(A2, x[1]), mul(A, x[2]));
-        (s.0 / 3.0, s.1 / 3.0)
+        (x[0] + A2 * x[1] + A * x[2]) / 3.0
     }
 }
 
@@ -190,19 +180,18 @@ mod tests {
 
     /// Sequences of a measured set: the true balanced (or unbalanced) phasors with one
     /// sensor's gain `k`.
-    fn sequences(x: [(f32, f32); 3], phase: usize, k: f32) -> [(f32, f32); 3] {
+    fn sequences(x: [Complex32; 3], phase: usize, k: f32) -> [Complex32; 3] {
         let mut m = x;
-        m[phase] = (x[phase].0 * k, x[phase].1 * k);
-        let third = |s: (f32, f32)| (s.0 / 3.0, s.1 / 3.0);
+        m[phase] = x[phase] * k;
         [
-            third(add3(m[0], mul(A, m[1]), mul(A2, m[2]))),
-            third(add3(m[0], mul(A2, m[1]), mul(A, m[2]))),
-            third(add3(m[0], m[1], m[2])),
+            (m[0] + A * m[1] + A2 * m[2]) / 3.0,
+            (m[0] + A2 * m[1] + A * m[2]) / 3.0,
+            (m[0] + m[1] + m[2]) / 3.0,
         ]
     }
 
-    fn balanced(amp: f32, phi: f32) -> [(f32, f32); 3] {
-        let at = |a: f32| (amp * (phi + a).cos(), amp * (phi + a).sin());
+    fn balanced(amp: f32, phi: f32) -> [Complex32; 3] {
+        let at = |a: f32| Complex32::new(amp * (phi + a).cos(), amp * (phi + a).sin());
         let t = core::f32::consts::TAU / 3.0;
         [at(0.0), at(-t), at(t)]
     }
@@ -216,18 +205,24 @@ mod tests {
             assert!((g.gain_error - (k - 1.0)).abs() < 1e-3, "{k}: {g:?}");
             // The correction takes the sensor's negative sequence out.
             let c = g.corrected_negative(p, n, z);
-            assert!(crate::math::fast_hypot(c.0, c.1) < 1e-4 * 5.0, "{c:?}");
+            assert!(crate::math::fast_hypot(c.re, c.im) < 1e-4 * 5.0, "{c:?}");
         }
         // A winding asymmetry or a supply unbalance: a negative sequence, and (three wires)
         // no zero sequence: nothing named.
-        assert!(single_phase_gain((5.0, 0.0), (0.3, 0.1), (0.0, 0.0), 0.005).is_none());
+        assert!(single_phase_gain(
+            Complex32::new(5.0, 0.0),
+            Complex32::new(0.3, 0.1),
+            Complex32::new(0.0, 0.0),
+            0.005
+        )
+        .is_none());
         // Two sensors off by opposite amounts: the zero sequence points nowhere near one
         // phase's axis.
         let mut x = balanced(5.0, 0.0);
-        x[0] = (x[0].0 * 1.1, x[0].1 * 1.1);
+        x[0] *= 1.1;
         let [p, n, z] = sequences(x, 1, 0.9);
         assert!(single_phase_gain(p, n, z, 0.005).is_none());
         // Non-finite input.
-        assert!(single_phase_gain((f32::NAN, 0.0), n, z, 0.005).is_none());
+        assert!(single_phase_gain(Complex32::new(f32::NAN, 0.0), n, z, 0.005).is_none());
     }
 }

@@ -21,7 +21,7 @@
 //! carries the short, not the one it is judged against.
 
 use super::reading::PhaseReading;
-use super::{abs, cdiv, sub, RatioPhasor};
+use super::{abs, cdiv, Complex32};
 use monitor_core::sequence::SUPPLY_PART_UNCERTAINTY;
 use monitor_core::Phase;
 
@@ -47,7 +47,7 @@ pub(super) type AngleAt<'a> = &'a dyn Fn(&PhaseReading, f32) -> Option<f32>;
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Anchor {
     /// The reference's reading (its winding part with voltages).
-    pub w: RatioPhasor,
+    pub w: Complex32,
     /// The supply's part taken out of it (0 without voltages).
     pub supply: f32,
     /// Both the reference and the stretch have voltages.
@@ -61,14 +61,14 @@ pub(super) struct Anchor {
 impl Anchor {
     /// `(I1_R/I1_h) e^{jd}` at stretch `rd` under no short (`None`) or a short in a phase
     /// (module docs).
-    fn turn(&self, rd: &PhaseReading, short: Option<Phase>, angle_at: AngleAt<'_>) -> RatioPhasor {
+    fn turn(&self, rd: &PhaseReading, short: Option<Phase>, angle_at: AngleAt<'_>) -> Complex32 {
         let q = self.current_ratio(rd, short);
         let i1_h = self.i1 / q;
         let d = match (self.z1, angle_at(rd, i1_h)) {
             (Some(a), Some(b)) => b - a,
             _ => 0.0,
         };
-        (q * d.cos(), q * d.sin())
+        Complex32::new(q * d.cos(), q * d.sin())
     }
 
     /// `ln` of the density of the change of `|I1|` that the short does not draw:
@@ -94,7 +94,10 @@ impl Anchor {
         // phase does not fit the reading does not get a loop that turns I1 to fit.
         let loop_share = short.map_or(1.0, |p| {
             let turn = std::f32::consts::TAU / 3.0 * p.index() as f32;
-            let r = abs(cdiv(sub(rd.w, self.w), sub((turn.cos(), turn.sin()), rd.w)));
+            let r = abs(cdiv(
+                rd.w - self.w,
+                Complex32::new(turn.cos(), turn.sin()) - rd.w,
+            ));
             let g = (1.0 + 2.0 * r * rd.op.0.cos() + r * r).sqrt();
             if g.is_finite() && g > 0.0 {
                 g
@@ -112,8 +115,8 @@ impl Anchor {
 
     /// How far another operating point may move the reference (the length of the
     /// segment without voltages, the model's error on the supply's part with them).
-    fn moved(&self, t: RatioPhasor) -> f32 {
-        let k = abs((1.0 - t.0, -t.1));
+    fn moved(&self, t: Complex32) -> f32 {
+        let k = abs(Complex32::new(1.0 - t.re, -t.im));
         if self.voltages {
             SUPPLY_PART_UNCERTAINTY * self.supply * k
         } else {
@@ -144,7 +147,7 @@ impl Anchor {
         same: f32,
         short: Option<Phase>,
         angle_at: AngleAt<'_>,
-        f: &dyn Fn(RatioPhasor, f32) -> f32,
+        f: &dyn Fn(Complex32, f32) -> f32,
     ) -> f32 {
         let t = self.turn(rd, short, angle_at);
         let current = self.ln_current(rd, short);
@@ -152,12 +155,11 @@ impl Anchor {
             return current + f(self.w, same.hypot(self.moved(t)));
         }
         let w = self.w;
-        let end = (w.0 * t.0 - w.1 * t.1, w.0 * t.1 + w.1 * t.0);
-        let seg = sub(end, w);
+        let seg = w * t - w;
         let s = same.hypot(MOVE_MODEL_ERROR * abs(seg));
         let terms: [f32; SPLITS] = std::array::from_fn(|k| {
             let l = k as f32 / (SPLITS - 1) as f32;
-            f((w.0 + l * seg.0, w.1 + l * seg.1), s)
+            f(w + seg * l, s)
         });
         let m = terms.iter().copied().fold(f32::NEG_INFINITY, f32::max);
         if !m.is_finite() {

@@ -6,10 +6,10 @@ use super::probability::{
     judge_alone, judge_external, judge_within, External, PhaseJudged, PhaseReading,
 };
 use super::{
-    abs, cdiv, mean, measured_of, segment_of, segments, sub, Against, HealthyReference,
-    OperatingPointSource, PhaseProbabilities, RatioPhasor, SequenceSegment,
-    CURRENT_MODEL_UNCERTAINTY, FULL_LOAD_SLIP_MAX, MAX_SEGMENTS,
-    MEASURED_REFERENCE_UNCERTAINTY_DEG, MIN_SEGMENT_WINDOWS, SLIP_MODEL_UNCERTAINTY,
+    abs, cdiv, mean, measured_of, segment_of, segments, Against, Complex32, HealthyReference,
+    OperatingPointSource, PhaseProbabilities, SequenceSegment, CURRENT_MODEL_UNCERTAINTY,
+    FULL_LOAD_SLIP_MAX, MAX_SEGMENTS, MEASURED_REFERENCE_UNCERTAINTY_DEG, MIN_SEGMENT_WINDOWS,
+    SLIP_MODEL_UNCERTAINTY,
 };
 use crate::report::BaselineSource;
 use crate::sequences::{sensor_phase, SequenceWindow};
@@ -65,7 +65,7 @@ impl Judge {
         let corr = |s: f32| asymmetry_correction_rad(m, we, s);
         if let Some(v1) = seg.v1 {
             let u = MEASURED_REFERENCE_UNCERTAINTY_DEG.to_radians();
-            return (v1.1.atan2(v1.0), u, None, OperatingPointSource::Voltages);
+            return (v1.im.atan2(v1.re), u, None, OperatingPointSource::Voltages);
         }
         let spread = |s: f32, lo: f32, hi: f32| {
             let c = corr(s);
@@ -110,10 +110,7 @@ impl Judge {
         let (gi, gv) = sensor_phases(seg);
         let [p, n, z] = seg.pnz;
         let r = match gi {
-            Some(g) => {
-                let d = sub(cdiv(g.corrected_negative(p, n, z), p), cdiv(n, p));
-                (seg.r.0 + d.0, seg.r.1 + d.1)
-            }
+            Some(g) => seg.r + (cdiv(g.corrected_negative(p, n, z), p) - cdiv(n, p)),
             None => seg.r,
         };
         let v2 = seg.v2.filter(|_| gv.is_none());
@@ -155,17 +152,17 @@ impl Judge {
 /// The winding part `I2/I1 - V2/(Z2 I1)` of a reading (module docs, step 2), and the
 /// supply's part `|V2/Z2|/|I1|` (0 without voltages).
 fn winding_part(
-    i2: RatioPhasor,
-    v2: Option<RatioPhasor>,
+    i2: Complex32,
+    v2: Option<Complex32>,
     m: &MotorModel,
     we: f32,
     s: f32,
-) -> (RatioPhasor, f32) {
+) -> (Complex32, f32) {
     match v2 {
         Some(v2) => {
             let z2 = equivalent_impedance(m, we, 2.0 - s);
             let supply = cdiv(v2, z2);
-            (sub(i2, supply), abs(supply))
+            ((i2 - supply), abs(supply))
         }
         None => (i2, 0.0),
     }
@@ -173,8 +170,8 @@ fn winding_part(
 
 /// A healthy reference's `I2/I1` and `V2/I1`, and what [`External`] needs of it.
 struct Outside {
-    r: RatioPhasor,
-    v2: Option<RatioPhasor>,
+    r: Complex32,
+    v2: Option<Complex32>,
     ext: External,
 }
 
@@ -284,10 +281,9 @@ fn judge_stretches(
 
 /// The `--baseline` runs as a reference: their mean, the spread of a change from it.
 fn from_runs(judge: &Judge, f: &HealthyReference, we0: f32) -> Outside {
-    let c = |x: [f32; 2]| (x[0], x[1]);
     Outside {
-        r: c(f.mean.i2_over_i1),
-        v2: f.mean.v2_over_i1.map(c),
+        r: super::of_pair(f.mean.i2_over_i1),
+        v2: f.mean.v2_over_i1.map(super::of_pair),
         ext: External {
             i1: f.mean.i1_peak_a,
             wr: f.mean.wr_rad_s,
@@ -343,7 +339,7 @@ fn fill_judgement(report: &mut UnbalanceReport, j: &PhaseJudged, segs: &[Sequenc
         c: p.phases[2],
     };
     let op = j.reading.op;
-    report.angle_deg = j.change.1.atan2(j.change.0).to_degrees();
+    report.angle_deg = super::arg_deg(j.change);
     report.winding_ratio = abs(j.change);
     report.supply_ratio = j.supply_ratio;
     report.correction_deg = op.0.to_degrees();

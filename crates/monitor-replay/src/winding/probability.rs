@@ -15,7 +15,7 @@
 
 use super::anchor::{Anchor, AngleAt};
 pub(super) use super::reading::PhaseReading;
-use super::{abs, pooled_change_sigma, sub, Against, RatioPhasor};
+use super::{abs, pooled_change_sigma, Against, Complex32};
 use monitor_core::sequence::{ln_no_short, ln_short, phase_posterior, PhasePosterior};
 use monitor_core::Phase;
 
@@ -39,7 +39,7 @@ pub(super) struct External {
 
 /// What the reference's own negative sequence at a stretch's operating point is: its
 /// winding part and the supply's part taken out of it.
-pub(super) type ReferencePart<'a> = &'a dyn Fn(&PhaseReading) -> (RatioPhasor, f32);
+pub(super) type ReferencePart<'a> = &'a dyn Fn(&PhaseReading) -> (Complex32, f32);
 
 /// A stretch judged.
 #[derive(Debug, Clone, Copy)]
@@ -49,7 +49,7 @@ pub(super) struct PhaseJudged {
     /// The stretch it was judged against, within the log.
     pub reference: Option<usize>,
     /// Its change from the reference (fraction of `|I1|`).
-    pub change: RatioPhasor,
+    pub change: Complex32,
     /// The supply's part taken out of the stretch's reading.
     pub supply_ratio: f32,
     /// The change's spread (each component), and before the widening for another
@@ -111,7 +111,7 @@ pub(super) fn judge_external(
             };
             let change = pooled_change_sigma(rd.run_sigma(), ext.runs, ext.sum_sq_dev);
             let same = change.hypot(rd.sem);
-            (rd, anchor, same, abs(sub(rd.w, w_ref)) / same.max(1e-6))
+            (rd, anchor, same, abs(rd.w - w_ref) / same.max(1e-6))
         })
         .max_by(|a, b| a.3.total_cmp(&b.3))?;
     let (posterior, sigma) = posterior_against(rd, &anchor, same, angle_at);
@@ -120,7 +120,7 @@ pub(super) fn judge_external(
         load_i1_change: Some(1.0 / q - 1.0),
         index: rd.index,
         reference: None,
-        change: sub(rd.w, anchor.w),
+        change: (rd.w - anchor.w),
         supply_ratio: rd.supply,
         sigma,
         sigma_same_point: same,
@@ -140,7 +140,7 @@ pub(super) fn judge_alone(rd: &PhaseReading) -> PhaseJudged {
         supply_ratio: rd.supply,
         sigma,
         sigma_same_point: sigma,
-        posterior: phase_posterior(rd.w, (0.0, 0.0), sigma, &rd.model()),
+        posterior: phase_posterior(rd.w, Complex32::new(0.0, 0.0), sigma, &rd.model()),
         against: Against::Nothing,
         reading: *rd,
         load_i1_change: None,
@@ -176,7 +176,7 @@ pub(super) fn judge_within(
         .iter()
         .filter(|r| r.index != i.index)
         .max_by(|a, b| {
-            let z = |x: &PhaseReading| abs(sub(x.w, i.w)) / pair_same(i, x).max(1e-6);
+            let z = |x: &PhaseReading| abs(x.w - i.w) / pair_same(i, x).max(1e-6);
             z(a).total_cmp(&z(b))
         })?;
     Some(Pair::judge(i, j, pair_same(i, j), angle_at).judged())
@@ -213,7 +213,7 @@ impl<'a> Pair<'a> {
         same_point: f32,
         angle_at: AngleAt<'_>,
     ) -> Self {
-        let zero = (0.0, 0.0);
+        let zero = Complex32::new(0.0, 0.0);
         let (hi, hj) = (i.alone_sigma(), j.alone_sigma());
         let healthy_i = ln_no_short(i.w, zero, hi);
         let healthy_j = ln_no_short(j.w, zero, hj);
@@ -265,14 +265,14 @@ impl<'a> Pair<'a> {
             0 => (
                 j,
                 Some(i.index),
-                sub(j.w, i.w),
+                (j.w - i.w),
                 self.sw,
                 Against::WithinTheLog,
             ),
             1 => (
                 i,
                 Some(j.index),
-                sub(i.w, j.w),
+                (i.w - j.w),
                 self.sw,
                 Against::WithinTheLog,
             ),

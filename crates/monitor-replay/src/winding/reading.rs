@@ -2,7 +2,7 @@
 //! (below the anchor and the probability that read it).
 
 use super::{
-    OperatingPointSource, RatioPhasor, DEFAULT_SPREAD_CURRENTS, DEFAULT_SPREAD_VOLTAGES,
+    Complex32, OperatingPointSource, DEFAULT_SPREAD_CURRENTS, DEFAULT_SPREAD_VOLTAGES,
     MEASURED_Z_RATIO, NO_BASELINE_SPREAD, NO_BASELINE_SPREAD_VOLTAGES, SUPPLY_DRIFT_BETWEEN_RUNS,
     SUPPLY_UNBALANCE_SPREAD, WITHIN_LOG_SPREAD,
 };
@@ -14,7 +14,7 @@ pub(super) struct PhaseReading {
     /// Index of the stretch.
     pub index: usize,
     /// The winding's part of `I2/I1` (sensors' and, with voltages, the supply's parts out).
-    pub w: RatioPhasor,
+    pub w: Complex32,
     /// The supply's part `|V2/Z2|/|I1|` that was taken out (0 without voltages).
     pub supply: f32,
     /// The stretch has voltages.

@@ -68,7 +68,7 @@ pub(super) fn not_named(
 fn deviation_deg(j: &PhaseJudged, phase: Phase) -> f32 {
     let third = std::f32::consts::TAU / 3.0;
     let centre = j.reading.op.0 + phase.index() as f32 * third;
-    let ang = j.change.1.atan2(j.change.0);
+    let ang = j.change.im.atan2(j.change.re);
     monitor_core::frames::wrap_angle(ang - centre)
         .abs()
         .to_degrees()
@@ -78,7 +78,7 @@ fn deviation_deg(j: &PhaseJudged, phase: Phase) -> f32 {
 fn neighbour(j: &PhaseJudged, phase: Phase) -> Phase {
     let third = std::f32::consts::TAU / 3.0;
     let centre = j.reading.op.0 + phase.index() as f32 * third;
-    let ang = j.change.1.atan2(j.change.0);
+    let ang = j.change.im.atan2(j.change.re);
     let side = monitor_core::frames::wrap_angle(ang - centre);
     Phase::from_turns(phase.index() as i32 + if side > 0.0 { 1 } else { -1 })
 }

@@ -5,17 +5,18 @@
 //! pieces by the first pass, is one stretch again).
 
 use super::{
-    abs, cdiv, sub, RatioPhasor, SequenceSegment, MAX_UNSTEADY_INSIDE, MIN_SEGMENT_WINDOWS,
+    abs, cdiv, Complex32, SequenceSegment, MAX_UNSTEADY_INSIDE, MIN_SEGMENT_WINDOWS,
     SEGMENT_I1_STEP, SEGMENT_STEP_MIN, SEGMENT_STEP_REL, SEGMENT_VOLTAGE_STEP_MIN,
 };
 use crate::sequences::SequenceWindow;
+use num_complex::Complex64;
 
 /// A window's features that a segment holds still: `I2/I1`, `I0/I1` and, with voltages,
 /// `V2/V1`, `V0/V1` (a sensor's gain step moves the zero sequences, a winding or the
 /// supply the negative ones).
-fn features(w: &SequenceWindow) -> [RatioPhasor; 4] {
+fn features(w: &SequenceWindow) -> [Complex32; 4] {
     let p = w.i.positive();
-    let v = w.v.map_or([(0.0, 0.0); 2], |v| {
+    let v = w.v.map_or([Complex32::new(0.0, 0.0); 2], |v| {
         let p = v.positive();
         [cdiv(v.negative(), p), cdiv(v.zero(), p)]
     });
@@ -27,7 +28,7 @@ fn features(w: &SequenceWindow) -> [RatioPhasor; 4] {
 /// recomputing the means for each window was quadratic).
 #[derive(Default, Clone, Copy)]
 struct SegmentSums {
-    features: [(f64, f64); 4],
+    features: [Complex64; 4],
     i1: f32,
     n: u32,
 }
@@ -35,8 +36,7 @@ struct SegmentSums {
 impl SegmentSums {
     fn add(&mut self, w: &SequenceWindow) {
         for (s, f) in self.features.iter_mut().zip(features(w)) {
-            s.0 += f64::from(f.0);
-            s.1 += f64::from(f.1);
+            *s += Complex64::new(f64::from(f.re), f64::from(f.im));
         }
         self.i1 += abs(w.i.positive());
         self.n += 1;
@@ -44,8 +44,7 @@ impl SegmentSums {
 
     fn join(&mut self, o: &SegmentSums) {
         for (s, f) in self.features.iter_mut().zip(o.features) {
-            s.0 += f.0;
-            s.1 += f.1;
+            *s += f;
         }
         self.i1 += o.i1;
         self.n += o.n;
@@ -58,10 +57,11 @@ impl SegmentSums {
     }
 
     /// The means: the features and `|I1|`.
-    fn means(&self) -> ([RatioPhasor; 4], f32) {
+    fn means(&self) -> ([Complex32; 4], f32) {
         let n = f64::from(self.n.max(1));
         (
-            self.features.map(|s| ((s.0 / n) as f32, (s.1 / n) as f32)),
+            self.features
+                .map(|s| Complex32::new((s.re / n) as f32, (s.im / n) as f32)),
             self.i1 / self.n.max(1) as f32,
         )
     }
@@ -71,7 +71,7 @@ impl SegmentSums {
     /// zero sequence and `|I1|` also get that share of the negative sequence's size (a
     /// shorted loop's current moves all three: a fault current that wobbles moves them
     /// together).
-    fn departs_at(&self, f: [RatioPhasor; 4], i1: f32) -> bool {
+    fn departs_at(&self, f: [Complex32; 4], i1: f32) -> bool {
         let (m, i1_mean) = self.means();
         let i2 = abs(m[0]);
         let moved = (0..4).any(|k| {
@@ -81,7 +81,7 @@ impl SegmentSums {
                 1 => (SEGMENT_STEP_MIN, abs(mk).max(i2)),
                 _ => (SEGMENT_VOLTAGE_STEP_MIN, abs(mk)),
             };
-            abs(sub(fk, mk)) > floor.max(SEGMENT_STEP_REL * scale)
+            abs(fk - mk) > floor.max(SEGMENT_STEP_REL * scale)
         });
         let i1_tol = SEGMENT_I1_STEP.max(SEGMENT_STEP_REL * i2);
         moved || (i1 - i1_mean).abs() > i1_tol * i1_mean
