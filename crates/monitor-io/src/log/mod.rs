@@ -26,17 +26,21 @@
 
 pub mod clipping;
 mod columns_error;
+mod csv_header;
 mod csv_line;
 mod exact;
 mod fast;
 pub mod mapping;
+mod memory;
 pub mod parquet;
 pub mod quality;
 mod reader;
 pub mod tdms;
+mod typed;
 mod writer;
 
 pub use mapping::{ChannelUnit, ColumnMapping};
+pub use memory::{MemoryLog, MemoryValues};
 pub use reader::{LogFile, OpenOptions, RowSink};
 pub use writer::{write_atomic, LogWriter};
 

@@ -225,6 +225,8 @@ enum Source {
     Tdms(super::tdms::TdmsSource),
     /// A Parquet file.
     Parquet(super::parquet::ParquetSource),
+    /// Data in memory ([`super::MemoryLog`]).
+    Memory(super::memory::MemorySource),
 }
 
 /// A log opened for reading: its path, format, columns and size. Cheap to keep; every read
@@ -306,6 +308,44 @@ impl LogFile {
         })
     }
 
+    /// A log held in memory, shown in messages as `shown` ("DataFrame"), read through the
+    /// same path as a file's: the `[columns]` mapping and units of `opts`, the columns
+    /// checked as a Parquet file's, the same rows for the data-quality stage. Its
+    /// [`LogFile::format`] is Parquet's (typed columns) and its [`LogFile::path`] is
+    /// `shown`.
+    ///
+    /// # Errors
+    /// As [`LogFile::open_with`] for a Parquet file; a `group` (a TDMS group) given is
+    /// [`LogError::NotALog`].
+    pub fn from_memory(
+        log: std::sync::Arc<super::MemoryLog>,
+        shown: &str,
+        opts: &OpenOptions,
+    ) -> Result<Self, LogError> {
+        if let Some(g) = &opts.group {
+            return Err(LogError::NotALog {
+                path: shown.to_string(),
+                why: format!("--group '{g}' names a TDMS group, and data in memory has no groups"),
+            });
+        }
+        let (m, columns) = super::memory::MemorySource::open(log, shown, &opts.columns)?;
+        let rows = m.rows();
+        Ok(LogFile {
+            path: PathBuf::from(shown),
+            shown: shown.to_string(),
+            channels: channels_of(&columns),
+            len_bytes: rows * 8 * Column::COUNT as u64,
+            est_rows: rows as f64,
+            columns,
+            source: Source::Memory(m),
+        })
+    }
+
+    /// True for a log held in memory ([`LogFile::from_memory`]).
+    pub fn is_in_memory(&self) -> bool {
+        matches!(self.source, Source::Memory(_))
+    }
+
     /// Opens a CSV log of `len_bytes` bytes: parses its header, estimates its rows from the
     /// first rows' size.
     fn open_csv(
@@ -326,7 +366,7 @@ impl LogFile {
         r.take(HEAD_BYTES as u64)
             .read_to_end(&mut head)
             .map_err(io)?;
-        let (columns, has_header) = parse_header(&header, shown, mapping)?;
+        let (columns, has_header) = super::csv_header::parse_header(&header, shown, mapping)?;
         let header_bytes = if has_header { header.len() as u64 } else { 0 };
         let lines = head.iter().filter(|&&b| b == b'\n').count().max(1);
         let bytes_per_row = (head.len() as f64 / lines as f64).max(1.0);
@@ -340,7 +380,8 @@ impl LogFile {
         match self.source {
             Source::Csv { .. } => Format::Csv,
             Source::Tdms(_) => Format::Tdms,
-            Source::Parquet(_) => Format::Parquet,
+            // Typed columns, read as a Parquet file's.
+            Source::Parquet(_) | Source::Memory(_) => Format::Parquet,
         }
     }
 
@@ -416,6 +457,7 @@ impl LogFile {
             Source::Csv { .. } => return self.csv_rows(progress, sink),
             Source::Tdms(t) => t,
             Source::Parquet(p) => p,
+            Source::Memory(m) => m,
         };
         binary.for_each_row(self, progress, &mut |r| sink.row(r))
     }
@@ -476,70 +518,6 @@ fn channels_of(columns: &ColumnMap) -> Channels {
         encoder: has(Column::Encoder),
         temperature: has(Column::Temperature),
     }
-}
-
-/// Parses the header line (CSV quoting allowed, names trimmed) into the column map; true
-/// with it when line 1 is a header. A first line of numbers is data when `[columns]` maps
-/// the channels by their place (a file without a header row); without such a mapping it
-/// is refused with the table to write.
-fn parse_header(
-    line: &[u8],
-    shown: &str,
-    mapping: &ColumnMapping,
-) -> Result<(ColumnMap, bool), LogError> {
-    let mut rdr = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .has_headers(false)
-        .terminator(csv::Terminator::Any(b'\n'))
-        .from_reader(line);
-    let mut rec = csv::StringRecord::new();
-    let ok = rdr.read_record(&mut rec).map_err(|e| LogError::Csv {
-        path: shown.to_string(),
-        line: 1,
-        message: crate::one_line(&e.to_string()),
-    })?;
-    if !ok {
-        return Err(LogError::NotALog {
-            path: shown.to_string(),
-            why: "the file is empty: line 1 must be the header (t_s, ia_A, ib_A, ic_A, ...)"
-                .to_string(),
-        });
-    }
-    if rec.iter().all(|h| h.is_empty()) {
-        return Err(LogError::NotALog {
-            path: shown.to_string(),
-            why: "the file is empty: line 1 must be the header (t_s, ia_A, ib_A, ic_A, ...)"
-                .to_string(),
-        });
-    }
-    if rec.len() == 1 {
-        if let Some(sep) = [';', '\t', '|'].into_iter().find(|c| rec[0].contains(*c)) {
-            return Err(LogError::NotALog {
-                path: shown.to_string(),
-                why: format!(
-                    "the fields are separated by {sep:?}: the log must be comma-separated (docs/design.md)"
-                ),
-            });
-        }
-    }
-    let numbers = rec.get(0).is_some_and(|h| h.parse::<f64>().is_ok());
-    if numbers && !mapping.by_position() {
-        return Err(LogError::NotALog {
-            path: shown.to_string(),
-            why: format!(
-                "line 1 holds numbers: the file has no header row naming the columns; say which of its {} fields is which, by place, in the parameter file's [columns] table, and the sample rate if no field is the time, e.g. t_s = {{ sample_rate_hz = 1000.0 }}, ia_A = {{ column = 1 }}, ib_A = {{ column = 2 }}, ic_A = {{ column = 3 }} (docs/design.md)",
-                rec.len()
-            ),
-        });
-    }
-    let found: Vec<String> = if numbers {
-        (1..=rec.len()).map(|k| format!("column {k}")).collect()
-    } else {
-        rec.iter().map(str::to_string).collect()
-    };
-    let map = ColumnMap::locate(&found, mapping, shown)?;
-    check_columns(&map, shown, true, mapping, &found)?;
-    Ok((map, !numbers))
 }
 
 /// The columns every log needs, in every format: `t_s` (unless `need_time` is false: a
