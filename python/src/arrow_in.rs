@@ -21,21 +21,68 @@ use monitor_io::log::{MemoryLog, MemoryValues};
 use pyo3::prelude::*;
 use pyo3::types::{PyCapsule, PyCapsuleMethods};
 
+/// Data that cannot be read as a log's columns (the package raises it as a `LogError`).
+#[derive(Debug, thiserror::Error)]
+pub enum ArrowInError {
+    /// The object gives no Arrow stream.
+    #[error("{origin}: not readable as Arrow data ({why})")]
+    NotArrow {
+        /// How messages name the data.
+        origin: String,
+        /// What went wrong.
+        why: String,
+    },
+    /// The stream failed while it was read.
+    #[error("{origin}: cannot read its Arrow stream: {why}")]
+    Stream {
+        /// How messages name the data.
+        origin: String,
+        /// The stream's error.
+        why: String,
+    },
+    /// A batch's column is of another type than the schema says.
+    #[error("{origin}: a batch's column of type {found} differs from the schema's")]
+    Batch {
+        /// How messages name the data.
+        origin: String,
+        /// The column's type.
+        found: String,
+    },
+}
+
+fn not_arrow(origin: &str, why: impl ToString) -> ArrowInError {
+    ArrowInError::NotArrow {
+        origin: origin.to_string(),
+        why: why.to_string(),
+    }
+}
+
+fn stream_error(origin: &str, why: impl ToString) -> ArrowInError {
+    ArrowInError::Stream {
+        origin: origin.to_string(),
+        why: why.to_string(),
+    }
+}
+
 /// Takes the Arrow stream out of a `arrow_array_stream` capsule (the capsule is left with
 /// a released stream, which its destructor ignores).
 ///
 /// # Errors
-/// `what` (a `LogError`'s message) when the capsule is not an Arrow stream.
+/// [`ArrowInError::NotArrow`] naming `origin` when the capsule is not an Arrow stream.
 #[allow(unsafe_code)]
-fn take_stream(capsule: &Bound<'_, PyCapsule>, what: &str) -> Result<FFI_ArrowArrayStream, String> {
+fn take_stream(
+    capsule: &Bound<'_, PyCapsule>,
+    origin: &str,
+) -> Result<FFI_ArrowArrayStream, ArrowInError> {
     let named = capsule
         .name()
         .ok()
         .flatten()
         .is_some_and(|n| n.to_bytes() == b"arrow_array_stream");
     if !named || capsule.pointer().is_null() {
-        return Err(format!(
-            "{what}: __arrow_c_stream__ did not return an Arrow stream"
+        return Err(not_arrow(
+            origin,
+            "__arrow_c_stream__ did not return an Arrow stream",
         ));
     }
     // SAFETY: a capsule named "arrow_array_stream" holds a valid, initialised, aligned
@@ -119,17 +166,16 @@ fn holds_numbers(t: &DataType) -> bool {
 /// messages ("DataFrame", "pyarrow Table", "dict").
 ///
 /// # Errors
-/// A message naming `origin` when `data` has no Arrow stream or the stream fails.
-pub fn memory_log(data: &Bound<'_, PyAny>, origin: &str) -> Result<MemoryLog, String> {
+/// [`ArrowInError`] naming `origin` when `data` has no Arrow stream or the stream fails.
+pub fn memory_log(data: &Bound<'_, PyAny>, origin: &str) -> Result<MemoryLog, ArrowInError> {
     let capsule = data
         .call_method0("__arrow_c_stream__")
-        .map_err(|e| format!("{origin}: not readable as Arrow data ({e})"))?;
+        .map_err(|e| not_arrow(origin, e))?;
     let capsule = capsule
         .downcast::<PyCapsule>()
-        .map_err(|_| format!("{origin}: __arrow_c_stream__ did not return a capsule"))?;
+        .map_err(|_| not_arrow(origin, "__arrow_c_stream__ did not return a capsule"))?;
     let stream = take_stream(capsule, origin)?;
-    let reader = RecordBatchStreamReader::try_new(stream)
-        .map_err(|e| format!("{origin}: cannot read its Arrow stream: {e}"))?;
+    let reader = RecordBatchStreamReader::try_new(stream).map_err(|e| stream_error(origin, e))?;
     let schema = reader.schema();
     let fields = schema.fields();
     let mut values: Vec<Option<Vec<f64>>> = fields
@@ -137,14 +183,12 @@ pub fn memory_log(data: &Bound<'_, PyAny>, origin: &str) -> Result<MemoryLog, St
         .map(|f| holds_numbers(f.data_type()).then(Vec::new))
         .collect();
     for batch in reader {
-        let batch = batch.map_err(|e| format!("{origin}: cannot read its Arrow stream: {e}"))?;
+        let batch = batch.map_err(|e| stream_error(origin, e))?;
         for (col, out) in batch.columns().iter().zip(values.iter_mut()) {
             let Some(out) = out else { continue };
-            append(col.as_ref(), out).ok_or_else(|| {
-                format!(
-                    "{origin}: a batch's column of type {} differs from the schema's",
-                    col.data_type()
-                )
+            append(col.as_ref(), out).ok_or_else(|| ArrowInError::Batch {
+                origin: origin.to_string(),
+                found: col.data_type().to_string(),
             })?;
         }
     }

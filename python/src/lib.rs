@@ -97,7 +97,8 @@ fn log_source(log: &Bound<'_, PyAny>, origin: Option<&str>) -> PyResult<LogSourc
     match origin {
         None => Ok(LogSource::File(log.extract::<PathBuf>()?)),
         Some(origin) => {
-            let data = arrow_in::memory_log(log, origin).map_err(LogError::new_err)?;
+            let data =
+                arrow_in::memory_log(log, origin).map_err(|e| LogError::new_err(e.to_string()))?;
             Ok(LogSource::data(data, origin))
         }
     }
