@@ -10,16 +10,21 @@ Logs
     pyarrow Table, or a dict of numpy arrays, with the schema's column names (``t_s``,
     ``va_V``, ``vb_V``, ``vc_V``, ``ia_A``, ``ib_A``, ``ic_A``, ``wm_rad_s``; SI units) or
     the DAQ's own, mapped by the parameter file's ``[columns]`` table as for files.
-    In-memory data is written to a temporary Parquet file and read by the same reader.
+    In-memory data goes to the library through Arrow's C stream interface (no temporary
+    file) and is read through the same path as a file: the same results, and messages that
+    name it ("DataFrame: missing column 'ia_A'"). Any object with ``__arrow_c_stream__``
+    (a polars DataFrame, ...) is read too.
 
 Parameter files
     A path, or a dict with the file's sections (``{"motor": {...}, "supply": {...},
     "columns": {...}}``).
 
 Errors
-    :class:`DriveMonitorError` and its subclasses :class:`ParamsError`, :class:`LogError`,
-    :class:`OptionError`, :class:`AnalysisError` (and :class:`InternalError` for a bug),
-    each carrying the command line's one-line message. No Rust panic crosses into Python.
+    :class:`DriveMonitorError` and its subclasses :class:`ParamsError` (a parameter file or
+    dict, a fleet's motor table), :class:`LogError`, :class:`OptionError`,
+    :class:`AnalysisError` (and :class:`InternalError` for a bug), each carrying the
+    command line's one-line message; the class is the library error's kind, never read
+    from the message. No Rust panic crosses into Python.
     The GIL is released while the library runs, so threads (and Dask) run in parallel.
 
 The fleet run over many motors' logs on Dask is :func:`drive_monitor.fleet.diagnose_many`.
@@ -31,7 +36,7 @@ import json
 import os
 import tempfile
 from pathlib import Path
-from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
+from typing import TYPE_CHECKING, Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
 
 from . import _native
 from ._native import (
@@ -72,9 +77,16 @@ __all__ = [
     "InternalError",
 ]
 
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+
 PathLike = Union[str, "os.PathLike[str]"]
-LogLike = Any  # a path, a pandas DataFrame, a pyarrow Table, or a dict of arrays
+#: A log: a path, a pandas DataFrame, a pyarrow Table, a dict of arrays, or any object
+#: with ``__arrow_c_stream__``.
+LogLike = Any
 ParamsLike = Union[PathLike, Dict[str, Any]]
+#: A commissioning window: ``(start_s, end_s)`` or the command line's ``"START:END"``.
+CommissionLike = Union[Tuple[float, float], Sequence[float], str]
 
 
 def _toml_value(v: Any) -> str:
@@ -88,7 +100,7 @@ def _toml_value(v: Any) -> str:
         return "{ " + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + " }"
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_toml_value(x) for x in v) + "]"
-    raise OptionError(f"parameter value {v!r} is not a number, text, table or list")
+    raise ParamsError(f"the parameter dict: value {v!r} is not a number, text, table or list")
 
 
 def _params_toml(params: Dict[str, Any]) -> str:
@@ -96,7 +108,10 @@ def _params_toml(params: Dict[str, Any]) -> str:
     lines: List[str] = []
     for section, table in params.items():
         if not isinstance(table, dict):
-            raise OptionError(f"parameter section {section!r} is not a table")
+            raise ParamsError(
+                f"the parameter dict: section {section!r} is {table!r}, not a table of keys "
+                f"(e.g. {{{section!r}: {{...}}}})"
+            )
         lines.append(f"[{section}]")
         for k, v in table.items():
             lines.append(f"{k} = {_toml_value(v)}")
@@ -110,62 +125,61 @@ def _params(params: ParamsLike) -> Tuple[str, bool]:
     return os.fspath(params), False
 
 
-class _LogFile:
-    """A log for the native functions: its path, written to a temporary Parquet file first
-    when the data is in memory (removed on exit)."""
-
-    def __init__(self, log: LogLike):
-        self._tmp: Optional[str] = None
-        if isinstance(log, (str, os.PathLike)):
-            self.path = os.fspath(log)
-            return
-        table = _to_arrow(log)
-        import pyarrow.parquet as pq
-
-        fd, tmp = tempfile.mkstemp(suffix=".parquet", prefix="drive_monitor_")
-        os.close(fd)
-        pq.write_table(table, tmp)
-        self._tmp = tmp
-        self.path = tmp
-
-    def __enter__(self) -> "_LogFile":
-        return self
-
-    def __exit__(self, *exc: Any) -> None:
-        if self._tmp is not None:
-            try:
-                os.remove(self._tmp)
-            except OSError:
-                pass
-
-
-def _to_arrow(log: Any):
-    """A pyarrow Table of a DataFrame, a Table, or a dict of 1-D arrays (columns as float64
-    where numeric)."""
+def _log(log: LogLike) -> Tuple[Any, Optional[str]]:
+    """(log, origin) for the native functions: a path as it is (origin ``None``), or data
+    in memory as an object with ``__arrow_c_stream__`` and the name messages give it."""
+    if isinstance(log, (str, os.PathLike)):
+        return os.fspath(log), None
     import pyarrow as pa
 
     if isinstance(log, pa.Table):
-        return log
+        return log, "pyarrow Table"
     try:
         import pandas as pd
 
         if isinstance(log, pd.DataFrame):
-            return pa.Table.from_pandas(log, preserve_index=False)
+            return pa.Table.from_pandas(log, preserve_index=False), "DataFrame"
     except ImportError:  # pragma: no cover - pandas is a dependency
         pass
     if isinstance(log, dict):
         import numpy as np
 
-        return pa.table({str(k): np.asarray(v) for k, v in log.items()})
+        try:
+            return pa.table({str(k): np.asarray(v) for k, v in log.items()}), "dict"
+        except (pa.ArrowException, ValueError, TypeError) as e:
+            raise LogError(f"dict: not a table of columns of one length ({e})") from None
+    if hasattr(log, "__arrow_c_stream__"):
+        return log, type(log).__name__
     raise LogError(
-        f"log: a path, a pandas DataFrame, a pyarrow Table or a dict of arrays, not {type(log).__name__}"
+        "log: a path, a pandas DataFrame, a pyarrow Table, a dict of arrays or an object with "
+        f"__arrow_c_stream__, not {type(log).__name__}"
     )
+
+
+def _commission(commission: Optional[CommissionLike]) -> Optional[Tuple[float, float]]:
+    """The window ``(start_s, end_s)`` of ``"START:END"`` or a pair."""
+    if commission is None:
+        return None
+    how = "give (start_s, end_s) or 'START:END' in seconds, e.g. (1.5, 2.4) or '1.5:2.4'"
+    if isinstance(commission, str):
+        parts = commission.split(":")
+    elif isinstance(commission, (tuple, list)):
+        parts = list(commission)
+    else:
+        raise OptionError(f"commission = {commission!r}: {how}")
+    if len(parts) != 2:
+        raise OptionError(f"commission = {commission!r}: two values, the start and the end; {how}")
+    try:
+        a, b = (float(x) for x in parts)
+    except (TypeError, ValueError):
+        raise OptionError(f"commission = {commission!r}: not numbers; {how}") from None
+    return a, b
 
 
 def diagnose(
     log: LogLike,
     params: ParamsLike,
-    commission: Optional[Tuple[float, float]] = None,
+    commission: Optional[CommissionLike] = None,
     baseline: Optional[Union[LogLike, Sequence[LogLike]]] = None,
     load: Optional[str] = None,
     angle: Optional[str] = None,
@@ -183,8 +197,9 @@ def diagnose(
         The measurement (see the module's doc for the columns).
     params : path or dict
         The motor's parameter file.
-    commission : (start_s, end_s), optional
-        Learn the healthy thresholds over this window of the log [s].
+    commission : (start_s, end_s) or "START:END", optional
+        Learn the healthy thresholds over this window of the log [s] (``(1.5, 2.4)`` or
+        the command line's ``"1.5:2.4"``).
     baseline : log or list of logs, optional
         Healthy logs of the same motor (files, folders, or data): the winding's negative
         sequence is judged against their mean, their spread sets the least change.
@@ -213,28 +228,25 @@ def diagnose(
     ParamsError, LogError, OptionError, AnalysisError
     """
     p, is_text = _params(params)
+    window = _commission(commission)
     base = [] if baseline is None else (
         list(baseline) if isinstance(baseline, (list, tuple)) else [baseline]
     )
-    files = [_LogFile(b) for b in base]
-    try:
-        with _LogFile(log) as f:
-            doc = _native.diagnose(
-                f.path,
-                p,
-                params_is_text=is_text,
-                commission=None if commission is None else (float(commission[0]), float(commission[1])),
-                baseline=[b.path for b in files],
-                load=load,
-                angle=angle,
-                residuals=residuals,
-                allow_incomplete=allow_incomplete,
-                timeline_step=None if timeline_step is None else float(timeline_step),
-                group=group,
-            )
-    finally:
-        for b in files:
-            b.__exit__()
+    data, origin = _log(log)
+    doc = _native.diagnose(
+        data,
+        p,
+        log_origin=origin,
+        params_is_text=is_text,
+        commission=window,
+        baseline=[_log(b) for b in base],
+        load=load,
+        angle=angle,
+        residuals=residuals,
+        allow_incomplete=allow_incomplete,
+        timeline_step=None if timeline_step is None else float(timeline_step),
+        group=group,
+    )
     return DiagnoseResult(json.loads(doc))
 
 
@@ -269,10 +281,14 @@ def compare(
     ``from_s``/``to_s`` limit the analysed window [s] (at least 25 supply periods).
     """
     p, is_text = _params(params)
-    with _LogFile(log) as f:
-        doc = _native.compare(
-            f.path, p, params_is_text=is_text, **_analysis_kwargs(effects, from_s, to_s, no_fit, group)
-        )
+    data, origin = _log(log)
+    doc = _native.compare(
+        data,
+        p,
+        log_origin=origin,
+        params_is_text=is_text,
+        **_analysis_kwargs(effects, from_s, to_s, no_fit, group),
+    )
     return CompareResult(json.loads(doc))
 
 
@@ -289,14 +305,15 @@ def explain(
     """Rank the physical effects missing from the model by how much of its error each
     explains: ``ranking``, ``verdict``, ``unexplained`` (``sim-host explain``)."""
     p, is_text = _params(params)
-    with _LogFile(log) as f:
-        doc = _native.explain(
-            f.path,
-            p,
-            params_is_text=is_text,
-            rotor_bars=rotor_bars,
-            **_analysis_kwargs(effects, from_s, to_s, no_fit, group),
-        )
+    data, origin = _log(log)
+    doc = _native.explain(
+        data,
+        p,
+        log_origin=origin,
+        params_is_text=is_text,
+        rotor_bars=rotor_bars,
+        **_analysis_kwargs(effects, from_s, to_s, no_fit, group),
+    )
     return ExplainResult(json.loads(doc))
 
 
@@ -316,15 +333,16 @@ def identify(
     values raise :class:`OptionError` naming the likely cause.
     """
     p, is_text = _params(params)
-    with _LogFile(log) as f:
-        doc = _native.identify(
-            f.path,
-            p,
-            params_is_text=is_text,
-            from_s=None if from_s is None else float(from_s),
-            to_s=None if to_s is None else float(to_s),
-            group=group,
-        )
+    data, origin = _log(log)
+    doc = _native.identify(
+        data,
+        p,
+        log_origin=origin,
+        params_is_text=is_text,
+        from_s=None if from_s is None else float(from_s),
+        to_s=None if to_s is None else float(to_s),
+        group=group,
+    )
     return IdentifyResult(json.loads(doc))
 
 
@@ -366,7 +384,7 @@ def simulate(
     params: ParamsLike,
     scenario: Union[PathLike, str],
     out: Optional[PathLike] = None,
-):
+) -> "pd.DataFrame":
     """Simulate the motor of ``params`` through ``scenario`` (a scenario file, or its TOML
     text) with the project's simulator (``sim-host simulate``).
 

@@ -1,7 +1,10 @@
-"""Type stubs of the Rust extension (drive_monitor._native). Every function returns the
-command's ``--json`` document as a string; the package's Python layer wraps it."""
+"""Type stubs of the Rust extension (drive_monitor._native), its one description for type
+checkers (the package's own modules are annotated in place; tests/test_stubs.py holds this
+file to the extension). Every function returns the command's ``--json`` document as a
+string; the package's Python layer wraps it. A ``log`` is a path when ``log_origin`` is
+``None``, else an object with ``__arrow_c_stream__`` that messages call ``log_origin``."""
 
-from typing import List, Optional, Tuple
+from typing import Any, List, Optional, Tuple
 
 class DriveMonitorError(Exception): ...
 class ParamsError(DriveMonitorError): ...
@@ -11,11 +14,12 @@ class AnalysisError(DriveMonitorError): ...
 class InternalError(DriveMonitorError): ...
 
 def diagnose(
-    log: str,
+    log: Any,
     params: str,
+    log_origin: Optional[str] = ...,
     params_is_text: bool = ...,
     commission: Optional[Tuple[float, float]] = ...,
-    baseline: List[str] = ...,
+    baseline: List[Tuple[Any, Optional[str]]] = ...,
     load: Optional[str] = ...,
     angle: Optional[str] = ...,
     residuals: Optional[str] = ...,
@@ -24,8 +28,9 @@ def diagnose(
     group: Optional[str] = ...,
 ) -> str: ...
 def compare(
-    log: str,
+    log: Any,
     params: str,
+    log_origin: Optional[str] = ...,
     params_is_text: bool = ...,
     effects: List[str] = ...,
     from_s: Optional[float] = ...,
@@ -34,8 +39,9 @@ def compare(
     group: Optional[str] = ...,
 ) -> str: ...
 def explain(
-    log: str,
+    log: Any,
     params: str,
+    log_origin: Optional[str] = ...,
     params_is_text: bool = ...,
     effects: List[str] = ...,
     from_s: Optional[float] = ...,
@@ -45,8 +51,9 @@ def explain(
     rotor_bars: Optional[int] = ...,
 ) -> str: ...
 def identify(
-    log: str,
+    log: Any,
     params: str,
+    log_origin: Optional[str] = ...,
     params_is_text: bool = ...,
     from_s: Optional[float] = ...,
     to_s: Optional[float] = ...,
@@ -69,3 +76,5 @@ def params_from_nameplate(
 def simulate(params: str, scenario_toml: str, out: str, params_is_text: bool = ...) -> str: ...
 def fleet_row(table_toml: str, base: str, log: str, shown: str) -> str: ...
 def fleet_columns() -> List[str]: ...
+def fleet_read_table(path: str, base: str) -> str: ...
+def fleet_check_table(text: str, shown: str, base: str) -> None: ...

@@ -18,9 +18,14 @@ import json
 import os
 import tempfile
 from pathlib import Path
-from typing import Any, Dict, Iterable, List, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Any, Dict, List, Optional, Sequence, Union
 
 from . import _native
+from ._native import OptionError, ParamsError
+
+if TYPE_CHECKING:  # pragma: no cover
+    import distributed
+    import pandas as pd
 
 __all__ = ["diagnose_many", "local_cluster", "worker_environ", "motor_table_toml", "COLUMNS"]
 
@@ -37,7 +42,7 @@ def _toml_value(v: Any) -> str:
         return json.dumps(os.fspath(v))
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_toml_value(x) for x in v) + "]"
-    raise ValueError(f"motor table value {v!r} is not a number, text or list")
+    raise ParamsError(f"the motor table (rows): value {v!r} is not a number, text or list")
 
 
 def worker_environ() -> Dict[str, str]:
@@ -59,7 +64,7 @@ def worker_environ() -> Dict[str, str]:
     }
 
 
-def local_cluster(n_workers: Optional[int] = None):
+def local_cluster(n_workers: Optional[int] = None) -> "distributed.LocalCluster":
     """A ``LocalCluster`` for the fleet run: one single-threaded worker process per core
     (``n_workers`` to choose), each started with :func:`worker_environ`."""
     import dask
@@ -71,11 +76,25 @@ def local_cluster(n_workers: Optional[int] = None):
         )
 
 
-def motor_table_toml(motors: Any) -> str:
-    """The TOML text of a motor table given as rows (a DataFrame or a list of dicts), or read
-    from a TOML file (a path)."""
-    if isinstance(motors, (str, os.PathLike)) and Path(os.fspath(motors)).exists():
-        return Path(os.fspath(motors)).read_text()
+def _is_path(motors: Any) -> bool:
+    return isinstance(motors, (str, os.PathLike))
+
+
+def motor_table_toml(motors: Any, base: Optional[Union[str, "os.PathLike[str]"]] = None) -> str:
+    """The TOML text of a motor table read from a TOML file (a path), or given as rows (a
+    DataFrame or a list of dicts), checked by the library (relative paths from ``base``:
+    by default the file's folder, or the working directory for rows).
+
+    Raises
+    ------
+    ParamsError
+        Naming the file (or "the motor table (rows)"): it cannot be read, it is not a motor
+        table (an unknown key, a motor without ``params``, no motor at all, ...).
+    """
+    if _is_path(motors):
+        path = Path(os.fspath(motors))
+        folder = base if base is not None else path.resolve().parent
+        return _native.fleet_read_table(os.fspath(path), os.fspath(folder))
     try:
         import pandas as pd
 
@@ -83,6 +102,11 @@ def motor_table_toml(motors: Any) -> str:
             motors = motors.to_dict(orient="records")
     except ImportError:  # pragma: no cover
         pass
+    if not isinstance(motors, (list, tuple)) or not all(isinstance(m, dict) for m in motors):
+        raise ParamsError(
+            "the motor table: give a TOML file's path, a DataFrame or a list of dicts "
+            f"(name, params, logs, ...), not {type(motors).__name__}"
+        )
     out = []
     for m in motors:
         out.append("[[motor]]")
@@ -90,7 +114,9 @@ def motor_table_toml(motors: Any) -> str:
             if v is None or (isinstance(v, float) and v != v):
                 continue
             out.append(f"{k} = {_toml_value(v)}")
-    return "\n".join(out) + "\n"
+    text = "\n".join(out) + "\n"
+    _native.fleet_check_table(text, "the motor table (rows)", os.fspath(base or os.getcwd()))
+    return text
 
 
 def _expand(logs: Union[str, Sequence[str]], storage_options: Optional[Dict[str, Any]]) -> List[str]:
@@ -101,6 +127,8 @@ def _expand(logs: Union[str, Sequence[str]], storage_options: Optional[Dict[str,
             import fsspec
 
             fs, _, paths = fsspec.get_fs_token_paths(pattern, storage_options=storage_options or {})
+            if not paths:
+                raise OptionError(f"logs: the pattern {pattern!r} matches no file")
             protocol = fs.protocol if isinstance(fs.protocol, str) else fs.protocol[0]
             if protocol in ("file", "local"):
                 return sorted(paths)
@@ -148,7 +176,7 @@ def diagnose_many(
     client: Any = None,
     storage_options: Optional[Dict[str, Any]] = None,
     base: Optional[Union[str, "os.PathLike[str]"]] = None,
-):
+) -> "pd.DataFrame":
     """Diagnose many motors' logs on a Dask cluster; one row per log.
 
     Parameters
@@ -172,16 +200,21 @@ def diagnose_many(
     pandas.DataFrame
         One row per log, columns :data:`COLUMNS`: motor, file, rows, rate_hz, verdict, fault,
         size, phase, confidence, first_detection_s, load_moves, data_quality, error.
+
+    Raises
+    ------
+    ParamsError
+        The motor table cannot be read or is not one (naming the file).
+    OptionError
+        A glob that matches no file (naming the pattern).
     """
     import pandas as pd
 
-    table = motor_table_toml(motors)
     if base is None:
         base = (
-            str(Path(os.fspath(motors)).resolve().parent)
-            if isinstance(motors, (str, os.PathLike))
-            else os.getcwd()
+            str(Path(os.fspath(motors)).resolve().parent) if _is_path(motors) else os.getcwd()
         )
+    table = motor_table_toml(motors, base)
     paths = _expand(logs, storage_options)
     own = client is None
     cluster = None

@@ -1,17 +1,21 @@
 //! `drive_monitor._native`: the Python package's bindings to the library the `sim-host`
-//! command line runs (`monitor_api`, `monitor_api::fleet`). Every function takes paths (the
-//! Python layer writes in-memory data to a temporary Parquet file first) and returns the
-//! command's `--json` document as a string, so a result is the command line's, key for key.
+//! command line runs (`monitor_api`, `monitor_api::fleet`). A log is a path, or in-memory
+//! data with `__arrow_c_stream__` (imported through Arrow's C stream interface,
+//! [`arrow_in`], and read by the library through the same path as a file); every function
+//! returns the command's `--json` document as a string, so a result is the command line's,
+//! key for key.
 //!
 //! The GIL is released while the Rust code runs; a panic never crosses into Python (it is
 //! an `InternalError`); errors are the exception classes below, carrying the command line's
 //! one-line message.
 
-use monitor_api::{self as api, ApiError, ErrorKind, ParamsSource};
+use monitor_api::{self as api, ApiError, ErrorKind, LogSource, ParamsSource};
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;
 use pyo3::prelude::*;
 use std::path::PathBuf;
+
+mod arrow_in;
 
 create_exception!(
     _native,
@@ -87,6 +91,19 @@ fn params_source<'a>(params: &'a str, is_text: bool) -> ParamsSource<'a> {
     }
 }
 
+/// A log: the path `log` when `origin` is `None`, else the in-memory data `log` (an object
+/// with `__arrow_c_stream__`) that messages call `origin`.
+fn log_source(log: &Bound<'_, PyAny>, origin: Option<&str>) -> PyResult<LogSource> {
+    match origin {
+        None => Ok(LogSource::File(log.extract::<PathBuf>()?)),
+        Some(origin) => {
+            let data =
+                arrow_in::memory_log(log, origin).map_err(|e| LogError::new_err(e.to_string()))?;
+            Ok(LogSource::data(data, origin))
+        }
+    }
+}
+
 fn json<T: serde::Serialize>(v: &T) -> PyResult<String> {
     serde_json::to_string(v).map_err(|e| InternalError::new_err(e.to_string()))
 }
@@ -137,15 +154,16 @@ fn effects_of(names: &[String]) -> PyResult<Vec<monitor_core::EffectKind>> {
 
 /// `diagnose --json` of the log at `log` with the parameter file `params`.
 #[pyfunction]
-#[pyo3(signature = (log, params, params_is_text=false, commission=None, baseline=Vec::new(), load=None, angle=None, residuals=None, allow_incomplete=false, timeline_step=None, group=None))]
+#[pyo3(signature = (log, params, log_origin=None, params_is_text=false, commission=None, baseline=Vec::new(), load=None, angle=None, residuals=None, allow_incomplete=false, timeline_step=None, group=None))]
 #[allow(clippy::too_many_arguments)]
 fn diagnose(
     py: Python<'_>,
-    log: PathBuf,
+    log: &Bound<'_, PyAny>,
     params: String,
+    log_origin: Option<String>,
     params_is_text: bool,
     commission: Option<(f64, f64)>,
-    baseline: Vec<PathBuf>,
+    baseline: Vec<(Bound<'_, PyAny>, Option<String>)>,
     load: Option<&str>,
     angle: Option<&str>,
     residuals: Option<&str>,
@@ -159,7 +177,10 @@ fn diagnose(
     let req = api::DiagnoseRequest {
         commission,
         allow_incomplete,
-        baseline,
+        baseline: baseline
+            .iter()
+            .map(|(b, origin)| log_source(b, origin.as_deref()))
+            .collect::<PyResult<_>>()?,
         load: load.map(load_of).transpose()?.unwrap_or(d.load),
         angle_source: angle.map(angle_of).transpose()?.unwrap_or(d.angle_source),
         residual_form: residuals
@@ -169,10 +190,11 @@ fn diagnose(
         timeline_step_s: timeline_step.unwrap_or(d.timeline_step_s),
         group,
     };
+    let log = log_source(log, log_origin.as_deref())?;
     run(py, || {
         let d = api::diagnose(
             params_source(&params, params_is_text),
-            &log,
+            log,
             &req,
             &mut |_| {},
         )
@@ -201,12 +223,13 @@ fn analysis_request(
 
 /// `compare --json`.
 #[pyfunction]
-#[pyo3(signature = (log, params, params_is_text=false, effects=Vec::new(), from_s=None, to_s=None, no_fit=false, group=None))]
+#[pyo3(signature = (log, params, log_origin=None, params_is_text=false, effects=Vec::new(), from_s=None, to_s=None, no_fit=false, group=None))]
 #[allow(clippy::too_many_arguments)]
 fn compare(
     py: Python<'_>,
-    log: PathBuf,
+    log: &Bound<'_, PyAny>,
     params: String,
+    log_origin: Option<String>,
     params_is_text: bool,
     effects: Vec<String>,
     from_s: Option<f64>,
@@ -215,19 +238,21 @@ fn compare(
     group: Option<String>,
 ) -> PyResult<String> {
     let req = analysis_request(&effects, from_s, to_s, no_fit, group, None)?;
+    let log = log_source(log, log_origin.as_deref())?;
     run(py, || {
-        json(&api::compare(params_source(&params, params_is_text), &log, &req).map_err(to_py)?)
+        json(&api::compare(params_source(&params, params_is_text), log, &req).map_err(to_py)?)
     })
 }
 
 /// `explain --json`.
 #[pyfunction]
-#[pyo3(signature = (log, params, params_is_text=false, effects=Vec::new(), from_s=None, to_s=None, no_fit=false, group=None, rotor_bars=None))]
+#[pyo3(signature = (log, params, log_origin=None, params_is_text=false, effects=Vec::new(), from_s=None, to_s=None, no_fit=false, group=None, rotor_bars=None))]
 #[allow(clippy::too_many_arguments)]
 fn explain(
     py: Python<'_>,
-    log: PathBuf,
+    log: &Bound<'_, PyAny>,
     params: String,
+    log_origin: Option<String>,
     params_is_text: bool,
     effects: Vec<String>,
     from_s: Option<f64>,
@@ -237,27 +262,31 @@ fn explain(
     rotor_bars: Option<u32>,
 ) -> PyResult<String> {
     let req = analysis_request(&effects, from_s, to_s, no_fit, group, rotor_bars)?;
+    let log = log_source(log, log_origin.as_deref())?;
     run(py, || {
-        json(&api::explain(params_source(&params, params_is_text), &log, &req).map_err(to_py)?)
+        json(&api::explain(params_source(&params, params_is_text), log, &req).map_err(to_py)?)
     })
 }
 
 /// `identify --json`: `{"identification": ..., "out": null, "toml": ...}`.
 #[pyfunction]
-#[pyo3(signature = (log, params, params_is_text=false, from_s=None, to_s=None, group=None))]
+#[pyo3(signature = (log, params, log_origin=None, params_is_text=false, from_s=None, to_s=None, group=None))]
+#[allow(clippy::too_many_arguments)]
 fn identify(
     py: Python<'_>,
-    log: PathBuf,
+    log: &Bound<'_, PyAny>,
     params: String,
+    log_origin: Option<String>,
     params_is_text: bool,
     from_s: Option<f64>,
     to_s: Option<f64>,
     group: Option<String>,
 ) -> PyResult<String> {
+    let log = log_source(log, log_origin.as_deref())?;
     run(py, || {
         let id = api::identify(
             params_source(&params, params_is_text),
-            &log,
+            log,
             from_s,
             to_s,
             group,
@@ -362,9 +391,39 @@ fn fleet_row(
     run(py, || {
         let table =
             monitor_api::fleet::MotorTable::from_toml_str(&table_toml, "the motor table", &base)
-                .map_err(|e| OptionError::new_err(e.to_string()))?;
+                .map_err(|e| ParamsError::new_err(e.to_string()))?;
         json(&monitor_api::fleet::row_shown(&table, &log, &shown))
     })
+}
+
+/// The text of the motor table file at `path`, checked (its relative paths from `base`).
+///
+/// # Errors
+/// [`ParamsError`] naming the file: it cannot be read, or it is not a motor table.
+#[pyfunction]
+fn fleet_read_table(path: PathBuf, base: PathBuf) -> PyResult<String> {
+    let text = std::fs::read_to_string(&path).map_err(|source| {
+        ParamsError::new_err(
+            monitor_api::fleet::FleetError::Io {
+                path: path.display().to_string(),
+                source,
+            }
+            .to_string(),
+        )
+    })?;
+    fleet_check_table(&text, &path.display().to_string(), base)?;
+    Ok(text)
+}
+
+/// Checks a motor table's text (`shown` in messages; relative paths from `base`).
+///
+/// # Errors
+/// [`ParamsError`] naming `shown` and what is wrong.
+#[pyfunction]
+fn fleet_check_table(text: &str, shown: &str, base: PathBuf) -> PyResult<()> {
+    monitor_api::fleet::MotorTable::from_toml_str(text, shown, &base)
+        .map(|_| ())
+        .map_err(|e| ParamsError::new_err(e.to_string()))
 }
 
 /// The fleet table's columns, in order.
@@ -391,5 +450,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_row, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_columns, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet_read_table, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet_check_table, m)?)?;
     Ok(())
 }

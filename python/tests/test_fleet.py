@@ -87,3 +87,26 @@ def test_a_glob_and_rows_as_the_motor_table(plant, repo):
     with LocalCluster(n_workers=1, threads_per_worker=1, processes=False) as cluster, Client(cluster) as client:
         rows = fleet.diagnose_many(str(d / "m3hp_0*.parquet"), motors, client=client)
     assert len(rows) == 8 and (rows.motor == "m3hp").all()
+
+
+def test_a_missing_or_bad_motor_table_is_a_params_error_naming_it(plant, tmp_path):
+    _d, logs, _table = plant
+    with pytest.raises(dm.ParamsError) as e:
+        fleet.diagnose_many(logs, str(tmp_path / "nope.toml"))
+    assert "nope.toml" in str(e.value) and "\n" not in str(e.value), str(e.value)
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[[motor]]\nname = "m"\nlogs = "*"\n')  # no params
+    with pytest.raises(dm.ParamsError) as e:
+        fleet.diagnose_many(logs, bad)
+    assert "bad.toml" in str(e.value) and "params" in str(e.value), str(e.value)
+    with pytest.raises(dm.ParamsError) as e:
+        fleet.diagnose_many(logs, [{"name": "m", "logs": "*", "colour": "red"}])
+    assert "the motor table (rows)" in str(e.value), str(e.value)
+
+
+def test_a_glob_that_matches_nothing_is_an_error_naming_it(plant, tmp_path):
+    _d, _logs, table = plant
+    pattern = str(tmp_path / "none_*.parquet")
+    with pytest.raises(dm.OptionError) as e:
+        fleet.diagnose_many(pattern, table)
+    assert pattern in str(e.value) and "matches no file" in str(e.value), str(e.value)

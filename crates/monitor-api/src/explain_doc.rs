@@ -11,7 +11,9 @@
 //! effect (a load step, heating) is no fault. [`beside_verdict`] says which of these holds
 //! for the log, so that a ranking never reads as if it contradicted the verdict.
 
-use super::{diagnose, load_analysis, AnalysisRequest, ApiError, DiagnoseRequest, ParamsSource};
+use super::{
+    diagnose, load_analysis, AnalysisRequest, ApiError, DiagnoseRequest, LogSource, ParamsSource,
+};
 use monitor_analysis::explain::{EffectCandidate, ExplainReport, Standing};
 use monitor_analysis::rotor_asymmetry::{self, McsaReport};
 use monitor_analysis::Analysis;
@@ -19,7 +21,6 @@ use monitor_core::verdict::FaultName;
 use monitor_core::EffectKind;
 use monitor_replay::verdict::fault_text;
 use monitor_replay::{DiagnoseReport, FindingReport, Verdict};
-use std::path::Path;
 
 /// `explain`'s JSON document: the one verdict's headline, the report, how the ranking
 /// relates to the verdict's finding, and the motor current signature analysis.
@@ -68,9 +69,10 @@ pub fn mcsa_beside(a: &Analysis, report: &ExplainReport, rotor_bars: Option<u32>
 /// As [`super::compare`].
 pub fn explain(
     params: ParamsSource<'_>,
-    log: &Path,
+    log: impl Into<LogSource>,
     req: &AnalysisRequest,
 ) -> Result<serde_json::Value, ApiError> {
+    let log = &log.into();
     let a = load_analysis(params, log, req, &mut |_| {})?;
     let judged = verdict_for_explain(params, log, req.group.clone());
     let out = a.explain(&req.options(), &|_| {})?;
@@ -87,7 +89,7 @@ pub fn explain(
 /// As [`super::diagnose`].
 pub fn verdict_for_explain(
     params: ParamsSource<'_>,
-    log: &Path,
+    log: impl Into<LogSource>,
     group: Option<String>,
 ) -> Result<DiagnoseReport, ApiError> {
     let req = DiagnoseRequest {

@@ -18,7 +18,7 @@
 //! A log belongs to the first motor whose pattern matches its file name (`*` any text, `?`
 //! one character).
 
-use crate::{diagnose, ApiError, DiagnoseRequest, ParamsSource};
+use crate::{diagnose, ApiError, DiagnoseRequest, LogSource, ParamsSource};
 use monitor_replay::{DiagnoseReport, IsolationEvent, LoadModel};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -307,7 +307,7 @@ pub fn row_shown(table: &MotorTable, log: &Path, shown: &str) -> FleetRow {
 pub fn row_for(m: &MotorEntry, log: &Path) -> FleetRow {
     let req = DiagnoseRequest {
         commission: m.commission.map(|[a, b]| (a, b)),
-        baseline: m.baseline.clone(),
+        baseline: m.baseline.iter().map(LogSource::from).collect(),
         load: m.load.map_or(LoadModel::Unknown, MotorLoad::model),
         ..DiagnoseRequest::default()
     };

@@ -11,7 +11,7 @@ use monitor_analysis::prep::ReadOptions;
 use monitor_analysis::{Analysis, AnalysisError, Options};
 use monitor_core::{AngleSource, EffectKind, ResidualForm};
 use monitor_io::log::mapping::ColumnMapping;
-use monitor_io::log::{LogError, LogFile, OpenOptions};
+use monitor_io::log::{LogError, OpenOptions};
 use monitor_io::params::{ParamError, ParamFile};
 use monitor_replay::{
     diagnose_log, HealthyReference, LoadModel, ReplayError, ReplayOptions, UnbalanceBaseline,
@@ -20,7 +20,9 @@ use std::path::{Path, PathBuf};
 
 mod explain_doc;
 pub mod fleet;
+mod log_source;
 pub use explain_doc::{beside_verdict, explain, mcsa_beside, verdict_for_explain, ExplainDocument};
+pub use log_source::LogSource;
 
 /// A failed call: the command line's one-line message, and its kind.
 #[derive(Debug, thiserror::Error)]
@@ -120,7 +122,7 @@ pub fn load_params(source: ParamsSource<'_>) -> Result<(ParamFile, ColumnMapping
 /// As [`load_params`]; [`ApiError::Swapped`].
 pub fn load_params_for(
     source: ParamsSource<'_>,
-    log: &Path,
+    log: &LogSource,
 ) -> Result<(ParamFile, ColumnMapping), ApiError> {
     load_params(source).map_err(|e| swapped(source, log).unwrap_or(e))
 }
@@ -130,7 +132,7 @@ pub fn load_params_for(
 /// # Errors
 /// [`ParamError::Io`] for a file that cannot be read; [`ApiError::Swapped`] where the
 /// arguments look swapped.
-fn params_text(source: ParamsSource<'_>, log: &Path) -> Result<(String, String), ApiError> {
+fn params_text(source: ParamsSource<'_>, log: &LogSource) -> Result<(String, String), ApiError> {
     match source {
         ParamsSource::Path(p) => Ok((
             std::fs::read_to_string(p).map_err(|e| {
@@ -147,7 +149,7 @@ fn params_text(source: ParamsSource<'_>, log: &Path) -> Result<(String, String),
 
 /// [`ApiError::Swapped`] when `source` and `log` look swapped (as [`load_params_for`]
 /// says).
-fn swapped(source: ParamsSource<'_>, log: &Path) -> Option<ApiError> {
+fn swapped(source: ParamsSource<'_>, log: &LogSource) -> Option<ApiError> {
     let ext = |p: &Path| {
         p.extension()
             .and_then(|e| e.to_str())
@@ -157,12 +159,12 @@ fn swapped(source: ParamsSource<'_>, log: &Path) -> Option<ApiError> {
     let ParamsSource::Path(params) = source else {
         return None;
     };
-    let log_is_toml = ext(log) == "toml";
+    let log_is_toml = log.path().is_some_and(|l| ext(l) == "toml");
     (["csv", "tdms", "parquet"].contains(&ext(params).as_str()) || log_is_toml).then(|| {
         ApiError::Swapped {
             params: params.display().to_string(),
             also: if log_is_toml {
-                format!(", and {} a parameter file", log.display())
+                format!(", and {} a parameter file", log.shown())
             } else {
                 String::new()
             },
@@ -177,8 +179,8 @@ pub struct DiagnoseRequest {
     pub commission: Option<(f64, f64)>,
     /// `--allow-incomplete`.
     pub allow_incomplete: bool,
-    /// `--baseline`: healthy logs of the same motor (files, or folders of them).
-    pub baseline: Vec<PathBuf>,
+    /// `--baseline`: healthy logs of the same motor (files, folders of them, or data).
+    pub baseline: Vec<LogSource>,
     /// `--load`.
     pub load: LoadModel,
     /// `--angle`.
@@ -224,18 +226,18 @@ impl DiagnoseRequest {
     }
 }
 
-/// The logs of `--baseline`: each file as given, each folder's log files (CSV, TDMS,
-/// Parquet, by extension) in name order.
+/// The logs of `--baseline`: each file and each data as given, each folder's log files
+/// (CSV, TDMS, Parquet, by extension) in name order.
 ///
 /// # Errors
 /// [`ApiError::Option`] for a folder without logs, or one that cannot be read.
-pub fn baseline_files(given: &[PathBuf]) -> Result<Vec<PathBuf>, ApiError> {
+pub fn baseline_files(given: &[LogSource]) -> Result<Vec<LogSource>, ApiError> {
     let mut files = Vec::new();
-    for p in given {
-        if !p.is_dir() {
-            files.push(p.clone());
+    for g in given {
+        let Some(p) = g.path().filter(|p| p.is_dir()) else {
+            files.push(g.clone());
             continue;
-        }
+        };
         let mut in_dir: Vec<PathBuf> = std::fs::read_dir(p)
             .map_err(|e| ApiError::Option(format!("--baseline {}: {e}", p.display())))?
             .filter_map(|e| e.ok().map(|e| e.path()))
@@ -253,15 +255,21 @@ pub fn baseline_files(given: &[PathBuf]) -> Result<Vec<PathBuf>, ApiError> {
             )));
         }
         in_dir.sort();
-        files.extend(in_dir);
+        files.extend(in_dir.into_iter().map(LogSource::File));
     }
     Ok(files)
 }
 
-/// True when `a` and `b` name the same file.
-fn same_file(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(x), Ok(y)) => x == y,
+/// True when `a` and `b` name the same file (or are the same data).
+fn same_file(a: &LogSource, b: &LogSource) -> bool {
+    match (a, b) {
+        (LogSource::File(a), LogSource::File(b)) => match (a.canonicalize(), b.canonicalize()) {
+            (Ok(x), Ok(y)) => x == y,
+            _ => false,
+        },
+        (LogSource::Data { log: a, .. }, LogSource::Data { log: b, .. }) => {
+            std::sync::Arc::ptr_eq(a, b)
+        }
         _ => false,
     }
 }
@@ -269,22 +277,23 @@ fn same_file(a: &Path, b: &Path) -> bool {
 /// The negative sequence of the healthy log `path` (replayed without commissioning).
 fn baseline_of(
     params: &ParamFile,
-    path: &Path,
+    path: &LogSource,
     open: &OpenOptions,
     opts: ReplayOptions,
 ) -> Result<UnbalanceBaseline, ApiError> {
-    let file =
-        LogFile::open_with(path, open).map_err(|e| ApiError::Option(format!("--baseline: {e}")))?;
+    let file = path
+        .open(open)
+        .map_err(|e| ApiError::Option(format!("--baseline: {e}")))?;
     let opts = ReplayOptions {
         commission: None,
         ..opts
     };
     let d = diagnose_log(params, &file, opts, &mut |_| {})
-        .map_err(|e| ApiError::Option(format!("--baseline {}: {e}", path.display())))?;
+        .map_err(|e| ApiError::Option(format!("--baseline {}: {e}", path.shown())))?;
     if d.report.unbalance.measured.i2_over_i1 == [0.0, 0.0] {
         return Err(ApiError::Option(format!(
             "--baseline {}: no positive-sequence current in that log (the motor never ran)",
-            path.display()
+            path.shown()
         )));
     }
     Ok(d.report.unbalance.measured)
@@ -297,10 +306,11 @@ fn baseline_of(
 /// A bad parameter file, log or option ([`ApiError`]), each a one-line message.
 pub fn diagnose(
     params: ParamsSource<'_>,
-    log: &Path,
+    log: impl Into<LogSource>,
     req: &DiagnoseRequest,
     progress: &mut dyn FnMut(f64),
 ) -> Result<monitor_replay::Diagnosed, ApiError> {
+    let log = &log.into();
     let (params, columns) = load_params_for(params, log)?;
     let open = OpenOptions {
         group: req.group.clone(),
@@ -312,7 +322,7 @@ pub fn diagnose(
         if let Some(same) = files.iter().find(|f| same_file(f, log)) {
             return Err(ApiError::Option(format!(
                 "--baseline {}: that is the log being judged; give healthy logs of the same motor",
-                same.display()
+                same.shown()
             )));
         }
         let runs = files
@@ -321,10 +331,10 @@ pub fn diagnose(
             .collect::<Result<Vec<_>, _>>()?;
         opts.unbalance_baseline = HealthyReference::from_runs(&runs);
     }
-    let file = LogFile::open_with(log, &open)?;
+    let file = log.open(&open)?;
     diagnose_log(&params, &file, opts, progress).map_err(|e| match e {
         // Log errors name the file already; the monitor's configuration does not.
-        ReplayError::Config { .. } => ApiError::Option(format!("{}: {e}", log.display())),
+        ReplayError::Config { .. } => ApiError::Option(format!("{}: {e}", log.shown())),
         e => e.into(),
     })
 }
@@ -357,18 +367,16 @@ pub const MIN_ANALYSED_PERIODS: f64 = 25.0;
 /// [`MIN_ANALYSED_PERIODS`] supply periods.
 pub fn load_analysis(
     params: ParamsSource<'_>,
-    log: &Path,
+    log: impl Into<LogSource>,
     req: &AnalysisRequest,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Analysis, ApiError> {
+    let log = &log.into();
     let (params, columns) = load_params_for(params, log)?;
-    let file = LogFile::open_with(
-        log,
-        &OpenOptions {
-            group: req.group.clone(),
-            columns,
-        },
-    )?;
+    let file = log.open(&OpenOptions {
+        group: req.group.clone(),
+        columns,
+    })?;
     let opts = ReadOptions {
         from_s: req.from_s.unwrap_or(f64::NEG_INFINITY),
         to_s: req.to_s.unwrap_or(f64::INFINITY),
@@ -382,7 +390,7 @@ pub fn load_analysis(
     if span.is_nan() || span < least {
         return Err(ApiError::Option(format!(
             "{}: the analysed window is {:.3} s ({:.1} supply periods): at least {:.2} s ({MIN_ANALYSED_PERIODS:.0} periods) are needed to judge the model (widen --from/--to)",
-            log.display(),
+            log.shown(),
             span,
             span * a.params.supply.f_hz,
             least
@@ -407,7 +415,7 @@ impl AnalysisRequest {
 /// As [`load_analysis`], and an effect the log cannot carry.
 pub fn compare(
     params: ParamsSource<'_>,
-    log: &Path,
+    log: impl Into<LogSource>,
     req: &AnalysisRequest,
 ) -> Result<serde_json::Value, ApiError> {
     let a = load_analysis(params, log, req, &mut |_| {})?;
@@ -433,12 +441,13 @@ pub struct Identified {
 /// starts, a log the model cannot be driven by, or a refused identification.
 pub fn identify(
     params: ParamsSource<'_>,
-    log: &Path,
+    log: impl Into<LogSource>,
     from_s: Option<f64>,
     to_s: Option<f64>,
     group: Option<String>,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Identified, ApiError> {
+    let log = &log.into();
     if let (Some(a), Some(b)) = (from_s, to_s) {
         if b <= a {
             return Err(ApiError::Option(format!(
@@ -453,7 +462,7 @@ pub fn identify(
         origin: &start_name,
     })
     .map_err(|e| swapped(params, log).unwrap_or(e))?;
-    let file = LogFile::open_with(log, &OpenOptions { group, columns })?;
+    let file = log.open(&OpenOptions { group, columns })?;
     let mut rows: Vec<monitor_io::log::Row> = Vec::new();
     file.for_each_row(&mut |f| progress(0.1 * f), &mut rows)?;
     let samples = monitor_analysis::identify::Samples::from_rows(
@@ -462,25 +471,18 @@ pub fn identify(
         from_s.unwrap_or(f64::NEG_INFINITY),
         to_s.unwrap_or(f64::INFINITY),
     )
-    .map_err(|e| ApiError::Option(format!("cannot identify from {}: {e}", log.display())))?;
+    .map_err(|e| ApiError::Option(format!("cannot identify from {}: {e}", log.shown())))?;
     drop(rows);
     let id =
         monitor_analysis::identify::identify(&start, &samples, &mut |f| progress(0.1 + 0.9 * f))
-            .map_err(|e| {
-                ApiError::Option(format!("cannot identify from {}: {e}", log.display()))
-            })?;
+            .map_err(|e| ApiError::Option(format!("cannot identify from {}: {e}", log.shown())))?;
     if let Some(why) = monitor_analysis::identify::refusal(&start, &samples, &id) {
         return Err(ApiError::Option(format!(
             "identify {}: {why}; no parameter file written",
-            log.display()
+            log.shown()
         )));
     }
-    let toml = monitor_analysis::identify::to_toml(
-        &id,
-        &start_text,
-        &start_name,
-        &log.display().to_string(),
-    );
+    let toml = monitor_analysis::identify::to_toml(&id, &start_text, &start_name, &log.shown());
     Ok(Identified {
         identification: id,
         toml,

@@ -117,7 +117,11 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
     let req = monitor_api::DiagnoseRequest {
         commission: args.commission,
         allow_incomplete: args.allow_incomplete,
-        baseline: args.baseline.clone(),
+        baseline: args
+            .baseline
+            .iter()
+            .map(monitor_api::LogSource::from)
+            .collect(),
         load: args.load.into(),
         angle_source: args.angle.into(),
         residual_form: args.residuals.into(),

@@ -6,7 +6,7 @@
 //! ISO 8601 text ([`super::mapping`]).
 
 use super::mapping::{parse_iso8601, TimeKind};
-use super::reader::{ColumnMap, LogFile};
+use super::source::{row_from_values, ColumnMap, Opened};
 use super::{Column, LogError, Row};
 use std::fs::File;
 use std::io::BufReader;
@@ -27,7 +27,7 @@ pub(super) struct ExactRows {
 
 impl ExactRows {
     /// Opens the file and skips its header line (a file without one starts with data).
-    pub fn new(log: &LogFile) -> Result<Self, LogError> {
+    pub fn new(log: &Opened<'_>) -> Result<Self, LogError> {
         let shown = log.shown().to_string();
         let f = File::open(log.path()).map_err(|source| LogError::Io {
             path: shown.clone(),
@@ -147,34 +147,6 @@ impl ExactRows {
             v[c as usize] = self.cell(c, line)?.unwrap_or(0.0);
         }
         Ok(Some(row_from_values(&v, &self.columns)))
-    }
-}
-
-/// The row of the values of every schema column (in [`Column::ALL`] order; absent columns
-/// are ignored) for a log with `columns`.
-#[inline]
-pub(super) fn row_from_values(v: &[f64; Column::COUNT], columns: &ColumnMap) -> Row {
-    let has = |c: Column| columns.of(c).is_some();
-    // To the schema's SI units: one multiplication per cell (none without a mapping).
-    let k = &columns.scale;
-    let t_winding_c = has(Column::Temperature).then(|| (v[9] + columns.temp_offset) * k[9]);
-    if !columns.scaled {
-        return Row {
-            t_s: v[0],
-            v_abc: has(Column::Va).then_some([v[1], v[2], v[3]]),
-            i_abc: [v[4], v[5], v[6]],
-            wm_rad_s: has(Column::Speed).then_some(v[7]),
-            enc_count: has(Column::Encoder).then_some(super::enc_count_of(v[8])),
-            t_winding_c,
-        };
-    }
-    Row {
-        t_s: v[0] * k[0],
-        v_abc: has(Column::Va).then_some([v[1] * k[1], v[2] * k[2], v[3] * k[3]]),
-        i_abc: [v[4] * k[4], v[5] * k[5], v[6] * k[6]],
-        wm_rad_s: has(Column::Speed).then_some(v[7] * k[7]),
-        enc_count: has(Column::Encoder).then_some(super::enc_count_of(v[8])),
-        t_winding_c,
     }
 }
 

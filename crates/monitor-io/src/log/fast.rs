@@ -15,9 +15,9 @@
 //! times that do not increase are handed over: the data-quality stage judges them.
 
 use super::csv_line::{parse_block_with, Cols};
-use super::exact::row_from_values;
 use super::mapping::TimeKind;
-use super::reader::{ColumnMap, LogFile};
+use super::source::row_from_values;
+use super::source::{ColumnMap, Opened};
 use super::{Column, LogError, Row};
 use rayon::prelude::*;
 use std::fs::File;
@@ -45,7 +45,7 @@ struct BlockReader {
 
 impl BlockReader {
     /// A reader of `log`'s data lines (from the end of its header), `block` bytes per block.
-    fn open(log: &LogFile, block: usize) -> std::io::Result<Self> {
+    fn open(log: &Opened<'_>, block: usize) -> std::io::Result<Self> {
         let mut f = File::open(log.path())?;
         f.seek(SeekFrom::Start(log.header_bytes()))?;
         Ok(BlockReader {
@@ -105,7 +105,7 @@ impl BlockReader {
 /// # Errors
 /// I/O errors.
 pub(super) fn for_each_row(
-    log: &LogFile,
+    log: &Opened<'_>,
     block: usize,
     progress: &mut dyn FnMut(f64),
     on_row: &mut dyn FnMut(&Row) -> bool,
@@ -281,12 +281,13 @@ fn hand_over(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::log::LogFile;
     use std::path::Path;
 
     /// The rows of a log through the exact reader.
     fn exact(path: &Path) -> Vec<Row> {
         let log = LogFile::open(path).unwrap();
-        let mut r = super::super::exact::ExactRows::new(&log).unwrap();
+        let mut r = super::super::exact::ExactRows::new(&log.opened()).unwrap();
         let mut v = vec![];
         while let Some(row) = r.next_row().unwrap() {
             v.push(row);
@@ -297,7 +298,7 @@ mod tests {
     fn fast(path: &Path, block: usize) -> (bool, Vec<Row>) {
         let log = LogFile::open(path).unwrap();
         let mut v = vec![];
-        let ok = for_each_row(&log, block, &mut |_| {}, &mut |r| {
+        let ok = for_each_row(&log.opened(), block, &mut |_| {}, &mut |r| {
             v.push(*r);
             true
         })
@@ -338,7 +339,7 @@ mod tests {
         // Stopping early.
         let log = LogFile::open(&path).unwrap();
         let mut n = 0;
-        let ok = for_each_row(&log, 64, &mut |_| {}, &mut |_| {
+        let ok = for_each_row(&log.opened(), 64, &mut |_| {}, &mut |_| {
             n += 1;
             n < 10
         })

@@ -25,18 +25,24 @@
 //!   half-written output and never touches an input.
 
 pub mod clipping;
+mod csv_header;
 mod csv_line;
 mod exact;
 mod fast;
 pub mod mapping;
+mod memory;
 pub mod parquet;
 pub mod quality;
 mod reader;
+mod source;
 pub mod tdms;
+mod typed;
 mod writer;
 
 pub use mapping::{ChannelUnit, ColumnMapping};
-pub use reader::{LogFile, OpenOptions, RowSink};
+pub use memory::{MemoryLog, MemoryValues};
+pub use reader::{LogFile, RowSink};
+pub use source::OpenOptions;
 pub use writer::{write_atomic, LogWriter};
 
 /// A log's file format, chosen by the file's extension (case-insensitive): `.tdms` is TDMS,

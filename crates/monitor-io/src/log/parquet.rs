@@ -13,8 +13,9 @@
 //! encoding, uncompressed (sensor noise does not compress), [`ROW_GROUP_ROWS`] rows per row
 //! group.
 
-use super::mapping::{ChannelUnit, ColumnMapping};
-use super::reader::{BinarySource, ColumnMap, LogFile};
+use super::mapping::ColumnMapping;
+use super::source::{BinarySource, ColumnMap, Opened};
+use super::typed::FieldType;
 use super::{Channels, Column, LogError, Row};
 use parquet::basic::{Compression, Encoding, LogicalType, TimeUnit, Type as PhysicalType};
 use parquet::column::reader::{ColumnReader, ColumnReaderImpl};
@@ -72,71 +73,25 @@ fn timestamp_unit(t: Option<&LogicalType>) -> Option<&'static str> {
 /// One decoded row group: the values of each [`Column::ALL`] column (empty when absent).
 type Decoded = [Vec<f64>; Column::COUNT];
 
-/// The units of the mapped columns, indexed like [`Column::ALL`]
-/// ([`super::mapping::resolve_unit`]: the mapping's, checked against a timestamp column's).
-///
-/// # Errors
-/// [`LogError::NotALog`] for a mapped column that does not hold numbers; [`LogError::Unit`]
-/// as `resolve_unit`.
-fn column_units(
-    schema: &SchemaDescriptor,
-    columns: &ColumnMap,
-    found: &[String],
-    mapping: &ColumnMapping,
-    shown: &str,
-) -> Result<[Option<ChannelUnit>; Column::COUNT], LogError> {
-    let mut units = [None; Column::COUNT];
-    for (k, c) in Column::ALL.iter().enumerate() {
-        let Some(j) = columns.field[k] else { continue };
-        let ty = schema.column(j).physical_type();
-        if !matches!(
-            ty,
-            PhysicalType::DOUBLE | PhysicalType::FLOAT | PhysicalType::INT32 | PhysicalType::INT64
-        ) {
-            return Err(not_a_log(
-                shown,
-                format!("column '{}' is of type {ty}: it must hold numbers (DOUBLE, FLOAT, INT32 or INT64)", found[j]),
-            ));
-        }
-        let recorded = timestamp_unit(schema.column(j).logical_type_ref());
-        units[k] =
-            super::mapping::resolve_unit(shown, *c, &found[j], mapping.unit_of(*c), recorded)?;
-    }
-    Ok(units)
-}
-
-/// Refuses a log without a time (no time column, no sample rate) that has a timestamp
-/// column, naming it and how to map it.
-///
-/// # Errors
-/// [`LogError::MissingColumn`] in that case.
-fn check_unmapped_timestamp(
-    schema: &SchemaDescriptor,
-    columns: &ColumnMap,
-    found: &[String],
-    mapping: &ColumnMapping,
-    shown: &str,
-) -> Result<(), LogError> {
-    if columns.of(Column::Time).is_some() || columns.sample_rate_hz.is_some() {
-        return Ok(());
-    }
-    let Some(j) =
-        (0..found.len()).find(|&j| timestamp_unit(schema.column(j).logical_type_ref()).is_some())
-    else {
-        return Ok(());
-    };
-    Err(super::mapping::missing_column_with(
-        shown,
-        mapping.name_of(Column::Time),
-        " (every analysis needs the time)",
-        found,
-        &format!(
-            "; column '{}' is a timestamp: make it the time in the parameter file's [columns] table: t_s = {{ name = \"{}\" }} (its unit, {}, is read from the file; docs/design.md)",
-            found[j],
-            found[j],
-            timestamp_unit(schema.column(j).logical_type_ref()).unwrap_or("epoch_ms")
-        ),
-    ))
+/// Each leaf column's type, as [`super::typed`] checks them.
+fn field_types(schema: &SchemaDescriptor) -> Vec<FieldType> {
+    (0..schema.num_columns())
+        .map(|j| {
+            let c = schema.column(j);
+            let ty = c.physical_type();
+            FieldType {
+                not_numbers: (!matches!(
+                    ty,
+                    PhysicalType::DOUBLE
+                        | PhysicalType::FLOAT
+                        | PhysicalType::INT32
+                        | PhysicalType::INT64
+                ))
+                .then(|| ty.to_string()),
+                timestamp: timestamp_unit(c.logical_type_ref()),
+            }
+        })
+        .collect()
 }
 
 /// Refuses a file whose mapped columns (`field`: leaf indices) are compressed with a codec
@@ -193,10 +148,20 @@ impl ParquetSource {
             .map(|j| schema.column(j).path().string())
             .collect();
         let mut columns = ColumnMap::locate(&found, mapping, shown)?;
-        let units = column_units(schema, &columns, &found, mapping, shown)?;
+        let types = field_types(schema);
+        let units = super::typed::column_units(
+            &types,
+            &columns,
+            &found,
+            mapping,
+            shown,
+            "DOUBLE, FLOAT, INT32 or INT64",
+        )?;
         columns.set_units(&units, mapping);
-        check_unmapped_timestamp(schema, &columns, &found, mapping, shown)?;
-        super::reader::check_columns(&columns, shown, true, mapping, &found)?;
+        super::typed::check_unmapped_timestamp(
+            &types, &columns, &found, mapping, shown, "the file",
+        )?;
+        super::source::check_columns(&columns, shown, true, mapping, &found)?;
         check_codecs(meta, &columns.field, shown)?;
         let groups = meta
             .row_groups()
@@ -215,7 +180,7 @@ impl BinarySource for ParquetSource {
 
     fn for_each_row(
         &self,
-        log: &LogFile,
+        log: &Opened<'_>,
         progress: &mut dyn FnMut(f64),
         on_row: &mut dyn FnMut(&Row) -> bool,
     ) -> Result<u64, LogError> {
@@ -285,7 +250,7 @@ fn hand_rows(
             }
         }
         *handed += 1;
-        if !on_row(&super::exact::row_from_values(&v, columns)) {
+        if !on_row(&super::source::row_from_values(&v, columns)) {
             return false;
         }
     }
@@ -399,7 +364,7 @@ impl ParquetLogWriter {
 
     /// The bytes of one row (for size estimates).
     pub fn row_bytes(channels: Channels) -> u64 {
-        super::tdms::TdmsLogWriter::row_bytes(channels)
+        super::source::binary_row_bytes(channels)
     }
 
     /// Buffers a row; writes a row group when [`ROW_GROUP_ROWS`] are buffered.

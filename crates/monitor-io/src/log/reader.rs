@@ -2,7 +2,8 @@
 //! rows streamed: a CSV by the fast path with the exact reader behind it, a TDMS or Parquet
 //! log by its format's module ([`super::Format`]).
 
-use super::mapping::{ChannelUnit, ColumnMapping, TimeKind};
+use super::mapping::{ColumnMapping, TimeKind};
+use super::source::{BinarySource, ColumnMap, OpenOptions, Opened};
 use super::{exact, fast, Channels, Column, Format, LogError, Row};
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
@@ -78,144 +79,6 @@ impl RowSink for Vec<Row> {
     }
 }
 
-/// Where each schema column sits in a line (a CSV), a leaf column (Parquet) or the
-/// group's channels (TDMS), and how its values become the schema's: `field[c]` is the
-/// field index of [`Column::ALL`]`[c]`, `None` when the log lacks it.
-#[derive(Debug, Clone, PartialEq)]
-pub(super) struct ColumnMap {
-    pub field: [Option<usize>; Column::COUNT],
-    /// Fields per line (the header's).
-    pub n_fields: usize,
-    /// The factor from each column's unit to the schema's SI unit ([`ColumnMapping`]).
-    pub scale: [f64; Column::COUNT],
-    /// False when every factor is 1 (the rows need no multiplication).
-    pub scaled: bool,
-    /// How the time column is read.
-    pub time: TimeKind,
-    /// A timestamp's factor to seconds, applied after the first row's time is subtracted
-    /// (so that the difference is exact; `scale[0]` is then 1).
-    pub time_factor: f64,
-    /// What is added to the temperature's values before `scale` ([`ChannelUnit::offset`]).
-    pub temp_offset: f64,
-    /// Each column's channel name in the log (the schema's name unless mapped).
-    pub names: [String; Column::COUNT],
-    /// The log has no time column: its rows are samples at this rate [Hz]
-    /// ([`ColumnMapping::sample_rate_hz`]).
-    pub sample_rate_hz: Option<f64>,
-}
-
-impl ColumnMap {
-    /// The columns of a log whose fields (CSV header fields, Parquet leaf columns, TDMS
-    /// channels) are named `found`, each looked up by the name `mapping` gives it, in the
-    /// unit it gives.
-    ///
-    /// # Errors
-    /// [`LogError::DuplicateColumn`] when a name looked up appears twice.
-    pub fn locate(
-        found: &[String],
-        mapping: &ColumnMapping,
-        shown: &str,
-    ) -> Result<Self, LogError> {
-        let mut field = [None; Column::COUNT];
-        for (f, c) in field.iter_mut().zip(Column::ALL) {
-            if let Some(p) = mapping.position_of(c) {
-                // Past the last field: missing (`check_columns` says so).
-                *f = (p < found.len()).then_some(p);
-                continue;
-            }
-            let name = mapping.name_of(c);
-            let mut at = found
-                .iter()
-                .enumerate()
-                .filter(|(_, h)| *h == name)
-                .map(|(i, _)| i);
-            *f = at.next();
-            if let (Some(first), Some(second)) = (*f, at.next()) {
-                return Err(LogError::DuplicateColumn {
-                    path: shown.to_string(),
-                    column: name.to_string(),
-                    first: first + 1,
-                    second: second + 1,
-                });
-            }
-        }
-        let mut map = ColumnMap {
-            field,
-            n_fields: found.len(),
-            scale: [1.0; Column::COUNT],
-            scaled: false,
-            time: TimeKind::Plain,
-            time_factor: 1.0,
-            temp_offset: 0.0,
-            names: Column::ALL.map(|c| mapping.name_of(c).to_string()),
-            sample_rate_hz: mapping.sample_rate_hz(),
-        };
-        map.set_units(&Column::ALL.map(|c| mapping.unit_of(c)), mapping);
-        Ok(map)
-    }
-
-    /// Reads each column in `units` (`None`: the schema's SI unit).
-    pub fn set_units(
-        &mut self,
-        units: &[Option<ChannelUnit>; Column::COUNT],
-        mapping: &ColumnMapping,
-    ) {
-        self.scale = mapping.factors(units);
-        self.temp_offset = units[Column::Temperature as usize].map_or(0.0, ChannelUnit::offset);
-        self.time = units[0].map_or(TimeKind::Plain, ChannelUnit::time_kind);
-        self.time_factor = 1.0;
-        if self.time != TimeKind::Plain {
-            self.time_factor = std::mem::replace(&mut self.scale[0], 1.0);
-        }
-        self.scaled = self.scale.iter().any(|k| *k != 1.0);
-    }
-
-    /// The channel name of field `i` (for messages).
-    pub fn name_of_field(&self, i: usize) -> String {
-        self.field
-            .iter()
-            .position(|f| *f == Some(i))
-            .map(|k| self.names[k].clone())
-            .unwrap_or_else(|| format!("#{i}"))
-    }
-
-    /// The field index of a present column.
-    pub fn of(&self, c: Column) -> Option<usize> {
-        self.field[c as usize]
-    }
-}
-
-/// How to open a log ([`LogFile::open_with`]).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct OpenOptions {
-    /// The TDMS group holding the channels (`--group`); needed only when a TDMS file has
-    /// several groups. An error for the other formats, which have no groups.
-    pub group: Option<String>,
-    /// Which channel holds each schema column, and its unit (the parameter file's
-    /// `[columns]` table; empty: the schema's names and SI units).
-    pub columns: ColumnMapping,
-}
-
-/// A log format read by its own decoder (TDMS, Parquet), whose rows are counted when it
-/// is opened.
-pub(super) trait BinarySource {
-    /// Rows in the log.
-    fn rows(&self) -> u64;
-
-    /// Streams the rows of `log` (opened as this source) in order, as
-    /// [`LogFile::for_each_row`] does; `on_row` returns false to stop. Returns the rows
-    /// handed over.
-    ///
-    /// # Errors
-    /// [`LogError::NotALog`] for a file that cannot be decoded.
-    fn for_each_row(
-        &self,
-        log: &LogFile,
-        progress: &mut dyn FnMut(f64),
-        on_row: &mut dyn FnMut(&Row) -> bool,
-    ) -> Result<u64, LogError>;
-}
-
 /// Where the rows come from.
 #[derive(Debug, Clone)]
 enum ReadSource {
@@ -225,6 +88,8 @@ enum ReadSource {
     Tdms(super::tdms::TdmsSource),
     /// A Parquet file.
     Parquet(super::parquet::ParquetSource),
+    /// Data in memory ([`super::MemoryLog`]).
+    Memory(super::memory::MemorySource),
 }
 
 /// A log opened for reading: its path, format, columns and size. Cheap to keep; every read
@@ -306,6 +171,44 @@ impl LogFile {
         })
     }
 
+    /// A log held in memory, shown in messages as `shown` ("DataFrame"), read through the
+    /// same path as a file's: the `[columns]` mapping and units of `opts`, the columns
+    /// checked as a Parquet file's, the same rows for the data-quality stage. Its
+    /// [`LogFile::format`] is Parquet's (typed columns) and its [`LogFile::path`] is
+    /// `shown`.
+    ///
+    /// # Errors
+    /// As [`LogFile::open_with`] for a Parquet file; a `group` (a TDMS group) given is
+    /// [`LogError::NotALog`].
+    pub fn from_memory(
+        log: std::sync::Arc<super::MemoryLog>,
+        shown: &str,
+        opts: &OpenOptions,
+    ) -> Result<Self, LogError> {
+        if let Some(g) = &opts.group {
+            return Err(LogError::NotALog {
+                path: shown.to_string(),
+                why: format!("--group '{g}' names a TDMS group, and data in memory has no groups"),
+            });
+        }
+        let (m, columns) = super::memory::MemorySource::open(log, shown, &opts.columns)?;
+        let rows = m.rows();
+        Ok(LogFile {
+            path: PathBuf::from(shown),
+            shown: shown.to_string(),
+            channels: channels_of(&columns),
+            len_bytes: rows * 8 * Column::COUNT as u64,
+            est_rows: rows as f64,
+            columns,
+            source: ReadSource::Memory(m),
+        })
+    }
+
+    /// True for a log held in memory ([`LogFile::from_memory`]).
+    pub fn is_in_memory(&self) -> bool {
+        matches!(self.source, ReadSource::Memory(_))
+    }
+
     /// Opens a CSV log of `len_bytes` bytes: parses its header, estimates its rows from the
     /// first rows' size.
     fn open_csv(
@@ -326,7 +229,7 @@ impl LogFile {
         r.take(HEAD_BYTES as u64)
             .read_to_end(&mut head)
             .map_err(io)?;
-        let (columns, has_header) = parse_header(&header, shown, mapping)?;
+        let (columns, has_header) = super::csv_header::parse_header(&header, shown, mapping)?;
         let header_bytes = if has_header { header.len() as u64 } else { 0 };
         let lines = head.iter().filter(|&&b| b == b'\n').count().max(1);
         let bytes_per_row = (head.len() as f64 / lines as f64).max(1.0);
@@ -340,7 +243,8 @@ impl LogFile {
         match self.source {
             ReadSource::Csv { .. } => Format::Csv,
             ReadSource::Tdms(_) => Format::Tdms,
-            ReadSource::Parquet(_) => Format::Parquet,
+            // Typed columns, read as a Parquet file's.
+            ReadSource::Parquet(_) | ReadSource::Memory(_) => Format::Parquet,
         }
     }
 
@@ -416,8 +320,9 @@ impl LogFile {
             ReadSource::Csv { .. } => return self.csv_rows(progress, sink),
             ReadSource::Tdms(t) => t,
             ReadSource::Parquet(p) => p,
+            ReadSource::Memory(m) => m,
         };
-        binary.for_each_row(self, progress, &mut |r| sink.row(r))
+        binary.for_each_row(&self.opened(), progress, &mut |r| sink.row(r))
     }
 
     /// [`LogFile::for_each_row`] of a CSV log: the fast path, else the exact reader.
@@ -427,16 +332,17 @@ impl LogFile {
         sink: &mut dyn RowSink,
     ) -> Result<u64, LogError> {
         let mut handed = 0u64;
-        let accepted = fast::for_each_row(self, fast::BLOCK_BYTES, progress, &mut |row| {
-            handed += 1;
-            sink.row(row)
-        })?;
+        let accepted =
+            fast::for_each_row(&self.opened(), fast::BLOCK_BYTES, progress, &mut |row| {
+                handed += 1;
+                sink.row(row)
+            })?;
         if let Some(blank) = accepted {
             sink.blank_lines(blank);
             return Ok(handed);
         }
         sink.restart();
-        let mut rows = exact::ExactRows::new(self)?;
+        let mut rows = exact::ExactRows::new(&self.opened())?;
         let mut handed = 0u64;
         while let Some(row) = rows.next_row()? {
             handed += 1;
@@ -451,18 +357,17 @@ impl LogFile {
         Ok(handed)
     }
 
-    pub(super) fn columns(&self) -> &ColumnMap {
-        &self.columns
-    }
-
-    pub(super) fn len_bytes(&self) -> u64 {
-        self.len_bytes
-    }
-
-    pub(super) fn header_bytes(&self) -> u64 {
-        match self.source {
-            ReadSource::Csv { header_bytes } => header_bytes,
-            _ => 0,
+    /// What a format's reader needs of this log.
+    pub(super) fn opened(&self) -> Opened<'_> {
+        Opened {
+            path: &self.path,
+            shown: &self.shown,
+            columns: &self.columns,
+            len_bytes: self.len_bytes,
+            header_bytes: match self.source {
+                ReadSource::Csv { header_bytes } => header_bytes,
+                _ => 0,
+            },
         }
     }
 }
@@ -476,110 +381,4 @@ fn channels_of(columns: &ColumnMap) -> Channels {
         encoder: has(Column::Encoder),
         temperature: has(Column::Temperature),
     }
-}
-
-/// Parses the header line (CSV quoting allowed, names trimmed) into the column map; true
-/// with it when line 1 is a header. A first line of numbers is data when `[columns]` maps
-/// the channels by their place (a file without a header row); without such a mapping it
-/// is refused with the table to write.
-fn parse_header(
-    line: &[u8],
-    shown: &str,
-    mapping: &ColumnMapping,
-) -> Result<(ColumnMap, bool), LogError> {
-    let mut rdr = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .has_headers(false)
-        .terminator(csv::Terminator::Any(b'\n'))
-        .from_reader(line);
-    let mut rec = csv::StringRecord::new();
-    let ok = rdr.read_record(&mut rec).map_err(|e| LogError::Csv {
-        path: shown.to_string(),
-        line: 1,
-        message: crate::one_line(&e.to_string()),
-    })?;
-    if !ok {
-        return Err(LogError::NotALog {
-            path: shown.to_string(),
-            why: "the file is empty: line 1 must be the header (t_s, ia_A, ib_A, ic_A, ...)"
-                .to_string(),
-        });
-    }
-    if rec.iter().all(|h| h.is_empty()) {
-        return Err(LogError::NotALog {
-            path: shown.to_string(),
-            why: "the file is empty: line 1 must be the header (t_s, ia_A, ib_A, ic_A, ...)"
-                .to_string(),
-        });
-    }
-    if rec.len() == 1 {
-        if let Some(sep) = [';', '\t', '|'].into_iter().find(|c| rec[0].contains(*c)) {
-            return Err(LogError::NotALog {
-                path: shown.to_string(),
-                why: format!(
-                    "the fields are separated by {sep:?}: the log must be comma-separated (docs/design.md)"
-                ),
-            });
-        }
-    }
-    let numbers = rec.get(0).is_some_and(|h| h.parse::<f64>().is_ok());
-    if numbers && !mapping.by_position() {
-        return Err(LogError::NotALog {
-            path: shown.to_string(),
-            why: format!(
-                "line 1 holds numbers: the file has no header row naming the columns; say which of its {} fields is which, by place, in the parameter file's [columns] table, and the sample rate if no field is the time, e.g. t_s = {{ sample_rate_hz = 1000.0 }}, ia_A = {{ column = 1 }}, ib_A = {{ column = 2 }}, ic_A = {{ column = 3 }} (docs/design.md)",
-                rec.len()
-            ),
-        });
-    }
-    let found: Vec<String> = if numbers {
-        (1..=rec.len()).map(|k| format!("column {k}")).collect()
-    } else {
-        rec.iter().map(str::to_string).collect()
-    };
-    let map = ColumnMap::locate(&found, mapping, shown)?;
-    check_columns(&map, shown, true, mapping, &found)?;
-    Ok((map, !numbers))
-}
-
-/// The columns every log needs, in every format: `t_s` (unless `need_time` is false: a
-/// TDMS log timed by its waveform properties), the three currents, and the voltages as all
-/// three phases or none.
-///
-/// # Errors
-/// [`LogError::MissingColumn`] naming the column and why it is needed, listing the
-/// channels `found` and suggesting the closest ([`super::mapping::missing_column`]).
-pub(super) fn check_columns(
-    map: &ColumnMap,
-    shown: &str,
-    need_time: bool,
-    mapping: &ColumnMapping,
-    found: &[String],
-) -> Result<(), LogError> {
-    let missing =
-        |c: Column, why: &str| super::mapping::missing_column(shown, c, mapping, found, why);
-    if need_time && map.of(Column::Time).is_none() && map.sample_rate_hz.is_none() {
-        return Err(missing(
-            Column::Time,
-            "every analysis needs the time: a time column, or the sample rate of a log without one, t_s = { sample_rate_hz = ... }",
-        ));
-    }
-    for c in [Column::Ia, Column::Ib, Column::Ic] {
-        if map.of(c).is_none() {
-            return Err(missing(
-                c,
-                "the phase currents are the minimum a log must carry",
-            ));
-        }
-    }
-    let volts = [Column::Va, Column::Vb, Column::Vc].map(|c| map.of(c).is_some());
-    if volts.iter().any(|v| *v) {
-        if let Some(k) = volts.iter().position(|v| !v) {
-            return Err(missing(
-                [Column::Va, Column::Vb, Column::Vc][k],
-                "the voltages come as all three phases or none",
-            ));
-        }
-    }
-    Ok(())
 }

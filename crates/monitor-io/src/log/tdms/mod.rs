@@ -16,7 +16,7 @@
 //! as I64. Every channel carries `wf_increment` and `wf_start_offset` (from the first
 //! segment's times), so LabVIEW and DIAdem show a time axis.
 
-use super::reader::{BinarySource, ColumnMap, LogFile, OpenOptions};
+use super::source::{BinarySource, ColumnMap, OpenOptions, Opened};
 use super::{Column, LogError, Row};
 use std::fs::File;
 use std::io::{Read, Seek, SeekFrom};
@@ -418,7 +418,7 @@ impl TdmsSource {
         let mut columns = ColumnMap::locate(&found, mapping, shown)?;
         let (units, lens) = channel_facts(&g, &columns, mapping, shown)?;
         let time = time_source(&g, &columns, mapping, &found, shown)?;
-        super::reader::check_columns(
+        super::source::check_columns(
             &columns,
             shown,
             time == TimeSource::Channel,
@@ -447,7 +447,7 @@ impl BinarySource for TdmsSource {
 
     fn for_each_row(
         &self,
-        log: &LogFile,
+        log: &Opened<'_>,
         progress: &mut dyn FnMut(f64),
         on_row: &mut dyn FnMut(&Row) -> bool,
     ) -> Result<u64, LogError> {
@@ -485,7 +485,7 @@ impl BinarySource for TdmsSource {
                     v[0] = t0 + (start + i) as f64 * increment;
                 }
                 handed += 1;
-                if !on_row(&super::exact::row_from_values(&v, columns)) {
+                if !on_row(&super::source::row_from_values(&v, columns)) {
                     return Ok(handed);
                 }
             }

@@ -54,8 +54,7 @@ impl TdmsLogWriter {
 
     /// The bytes of one row (for size estimates).
     pub fn row_bytes(channels: Channels) -> u64 {
-        let sgl = 3 + if channels.voltages { 3 } else { 0 } + u64::from(channels.speed);
-        8 + 4 * sgl + if channels.encoder { 8 } else { 0 }
+        crate::log::source::binary_row_bytes(channels)
     }
 
     /// Buffers a row; writes a segment when [`SEGMENT_ROWS`] are buffered.
