@@ -12,7 +12,8 @@
 //! for the log, so that a ranking never reads as if it contradicted the verdict.
 
 use super::{
-    diagnose, load_analysis, AnalysisRequest, ApiError, DiagnoseRequest, LogSource, ParamsSource,
+    diagnose, load_analysis, load_params_for, AnalysisRequest, ApiError, DiagnoseRequest,
+    LogSource, ParamsSource,
 };
 use monitor_analysis::explain::{EffectCandidate, ExplainReport, Standing};
 use monitor_analysis::rotor_asymmetry::{self, McsaReport};
@@ -73,8 +74,14 @@ pub fn explain(
     req: &AnalysisRequest,
 ) -> Result<serde_json::Value, ApiError> {
     let log = &log.into();
-    let a = load_analysis(params, log, req, &mut |_| {})?;
-    let judged = verdict_for_explain(params, log, req.group.clone());
+    // The parameter file read once for both calls.
+    let (params, columns) = load_params_for(params, log)?;
+    let read = ParamsSource::Read {
+        params: &params,
+        columns: &columns,
+    };
+    let a = load_analysis(read, log, req, &mut |_| {})?;
+    let judged = verdict_for_explain(read, log, req.group.clone());
     let out = a.explain(&req.options(), &|_| {})?;
     let rotor_asymmetry = mcsa_beside(&a, &out.report, req.rotor_bars);
     let doc = ExplainDocument::new(judged.as_ref(), out.report, rotor_asymmetry);

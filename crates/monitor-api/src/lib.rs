@@ -79,7 +79,8 @@ impl ApiError {
     }
 }
 
-/// A parameter file: its path, or its TOML text.
+/// A parameter file: its path, its TOML text, or its values already read (so that a
+/// command that makes several calls reads the file once).
 #[derive(Debug, Clone, Copy)]
 pub enum ParamsSource<'a> {
     /// A file.
@@ -91,6 +92,13 @@ pub enum ParamsSource<'a> {
         /// How messages name it.
         origin: &'a str,
     },
+    /// The file as [`load_params`] read it.
+    Read {
+        /// Its `[motor]` and `[supply]`.
+        params: &'a ParamFile,
+        /// Its `[columns]` mapping.
+        columns: &'a ColumnMapping,
+    },
 }
 
 /// Reads a parameter file and its `[columns]` mapping (the machine's pole pairs for
@@ -101,6 +109,7 @@ pub enum ParamsSource<'a> {
 pub fn load_params(source: ParamsSource<'_>) -> Result<(ParamFile, ColumnMapping), ApiError> {
     match source {
         ParamsSource::Path(p) => Ok(monitor_io::log::mapping::load_params(p)?),
+        ParamsSource::Read { params, columns } => Ok((*params, columns.clone())),
         ParamsSource::Toml { text, origin } => {
             let (p, table) = ParamFile::from_toml_str_with_columns(text, origin)?;
             let columns = ColumnMapping::from_table(&table, p.motor.poles / 2).map_err(|e| {
@@ -144,6 +153,9 @@ fn params_text(source: ParamsSource<'_>, log: &LogSource) -> Result<(String, Str
             p.display().to_string(),
         )),
         ParamsSource::Toml { text, origin } => Ok((text.to_string(), origin.to_string())),
+        ParamsSource::Read { .. } => Err(ApiError::Option(
+            "identify writes the parameter file it was given with the identified values: give its path or its TOML text".into(),
+        )),
     }
 }
 

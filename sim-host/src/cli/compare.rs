@@ -7,6 +7,12 @@ use monitor_analysis::{Analysis, Options};
 use monitor_core::EffectKind;
 use std::path::PathBuf;
 
+/// A parameter file as read once: its values and its `[columns]` mapping.
+type Params = (
+    monitor_io::params::ParamFile,
+    monitor_io::log::ColumnMapping,
+);
+
 /// Options shared by `compare` and `explain`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct Common {
@@ -69,15 +75,23 @@ impl Common {
         Ok(())
     }
 
-    /// Reads the parameter file and the log (with a progress bar for large logs).
-    fn load(&self) -> anyhow::Result<Analysis> {
+    /// Reads the parameter file (once) and the log (with a progress bar for large logs);
+    /// the file's values are returned for the calls that follow.
+    fn load(&self) -> anyhow::Result<(Analysis, Params)> {
+        let (params, columns) = monitor_api::load_params_for(
+            monitor_api::ParamsSource::Path(&self.params),
+            &monitor_api::LogSource::from(self.log.as_path()),
+        )?;
         let big = std::fs::metadata(&self.log)
             .map(|m| m.len() > 20_000_000)
             .unwrap_or(false);
         let pb = progress::bar(progress::FRACTION_STEPS, "reading log", big);
         let req = self.request(None);
         let a = monitor_api::load_analysis(
-            monitor_api::ParamsSource::Path(&self.params),
+            monitor_api::ParamsSource::Read {
+                params: &params,
+                columns: &columns,
+            },
             &self.log,
             &req,
             &mut |f| progress::set_fraction(&pb, f),
@@ -90,7 +104,7 @@ impl Common {
         })?;
         pb.finish_and_clear();
         render::text::quality_warnings(&a.quality);
-        Ok(a)
+        Ok((a, (params, columns)))
     }
 
     /// The library's request for these options.
@@ -202,7 +216,7 @@ pub struct ExplainArgs {
 pub fn run_compare(args: &CompareArgs) -> anyhow::Result<()> {
     let c = &args.common;
     c.check(&render::charts::COMPARE)?;
-    let a = c.load()?;
+    let (a, _) = c.load()?;
     let out = a.compare(&c.options())?;
     render::html::write_compare(c.plot.as_deref(), c.report.as_deref(), &c.log, &a, &out)?;
     if c.json {
@@ -221,10 +235,13 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
     let mut charts = render::charts::EXPLAIN.to_vec();
     charts.push(render::mcsa::CHART);
     c.check(&charts)?;
-    let a = c.load()?;
+    let (a, (params, columns)) = c.load()?;
     // The one verdict on the same log, which explain opens with.
     let judged = monitor_api::verdict_for_explain(
-        monitor_api::ParamsSource::Path(&c.params),
+        monitor_api::ParamsSource::Read {
+            params: &params,
+            columns: &columns,
+        },
         &c.log,
         c.group.clone(),
     );
