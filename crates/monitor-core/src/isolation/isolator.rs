@@ -13,6 +13,31 @@ use super::*;
 use crate::error::{ensure, ConfigCheck, ConfigError};
 use search::{fit_factor, rank};
 
+/// A measured point with the magnitudes of its voltage and current vectors
+/// ([`fast_hypot`](crate::math::fast_hypot)), computed once for the many hypotheses a
+/// search evaluates at it.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Reading {
+    /// The point (corrected for a sensor hypothesis where one applies).
+    pub q: SteadyPoint,
+    /// `|V|` of `q` [V].
+    pub vmag: f32,
+    /// `|I|` of `q` [A].
+    pub imag: f32,
+}
+
+impl Reading {
+    /// The readings of `q`, magnitudes computed.
+    #[inline]
+    pub fn of(q: &SteadyPoint) -> Self {
+        Reading {
+            q: *q,
+            vmag: crate::math::fast_hypot(q.v.d, q.v.q),
+            imag: crate::math::fast_hypot(q.i.d, q.i.q),
+        }
+    }
+}
+
 impl Isolator {
     /// An isolator for the nominal `motor` on a supply of peak phase voltage
     /// `v_phase_peak` [V] and `supply_hz` [Hz].
@@ -244,44 +269,67 @@ impl Isolator {
     }
 
     /// The circuit and the readings corrected for hypothesis `h`.
-    #[inline(never)]
     fn hypothesis(&self, p: &SteadyPoint, h: Option<(Fault, f32)>) -> (Circuit, SteadyPoint) {
-        let (mut i, mut v, mut wr) = (p.i, p.v, p.wr_rad_s);
-        let mut c = self.circuit();
-        if let Some((f, k)) = h {
-            match f {
-                Fault::CurrentSensor => {
-                    i = Dq {
-                        d: i.d / k,
-                        q: i.q / k,
-                    }
-                }
-                Fault::VoltageSensor => {
-                    v = Dq {
-                        d: v.d / k,
-                        q: v.q / k,
-                    }
-                }
-                Fault::SpeedSensor => wr /= k,
-                _ => c = c.with(f, k, &self.motor),
-            }
+        (self.circuit_of(h), self.reading_of(&Reading::of(p), h).q)
+    }
+
+    /// The circuit of hypothesis `h`: the tracked machine's with the parameter fault's
+    /// factor applied (a sensor hypothesis leaves the circuit alone and corrects the
+    /// readings instead, [`Isolator::reading_of`]).
+    #[inline(never)]
+    fn circuit_of(&self, h: Option<(Fault, f32)>) -> Circuit {
+        let c = self.circuit();
+        match h {
+            Some((f, k)) if !f.is_sensor() => c.with(f, k, &self.motor),
+            _ => c,
         }
-        let q = SteadyPoint {
-            i,
-            v,
-            we_rad_s: p.we_rad_s,
-            wr_rad_s: wr,
-        };
-        (c, q)
+    }
+
+    /// The readings `r` corrected for hypothesis `h` (a sensor's gain `k` divided out; the
+    /// magnitudes of `r` kept where the vector is not corrected).
+    #[inline]
+    fn reading_of(&self, r: &Reading, h: Option<(Fault, f32)>) -> Reading {
+        let p = r.q;
+        match h {
+            Some((Fault::CurrentSensor, k)) => Reading::of(&SteadyPoint {
+                i: Dq {
+                    d: p.i.d / k,
+                    q: p.i.q / k,
+                },
+                ..p
+            }),
+            Some((Fault::VoltageSensor, k)) => Reading::of(&SteadyPoint {
+                v: Dq {
+                    d: p.v.d / k,
+                    q: p.v.q / k,
+                },
+                ..p
+            }),
+            Some((Fault::SpeedSensor, k)) => Reading {
+                q: SteadyPoint {
+                    wr_rad_s: p.wr_rad_s / k,
+                    ..p
+                },
+                ..*r
+            },
+            _ => *r,
+        }
     }
 
     /// The parity residuals of circuit `c` at the (corrected) readings `q` (see
     /// [`Isolator::residuals`]).
-    #[inline(never)]
     fn eval(&self, c: &Circuit, q: &SteadyPoint) -> Option<ParityResiduals> {
+        self.eval_reading(c, &Reading::of(q))
+    }
+
+    /// [`Isolator::eval`] of readings whose magnitudes are already known: the searches
+    /// evaluate one point under many hypotheses, and the parameter faults leave the
+    /// readings (and so `|V|`, `|I|`) as they are.
+    #[inline(never)]
+    fn eval_reading(&self, c: &Circuit, r: &Reading) -> Option<ParityResiduals> {
+        let q = &r.q;
         let (i, v, we, wr) = (q.i, q.v, q.we_rad_s, q.wr_rad_s);
-        let vmag = crate::math::fast_hypot(v.d, v.q);
-        let imag = crate::math::fast_hypot(i.d, i.q);
+        let (vmag, imag) = (r.vmag, r.imag);
         if !(we > 0.0 && vmag > 0.0 && imag > 0.0 && wr.is_finite()) {
             return None;
         }
@@ -339,7 +387,8 @@ impl Isolator {
             true => w.voltage_only().unwrap_or(w),
             false => w,
         };
-        let chi0 = self.chi2_at(p, None, &w);
+        let r = Reading::of(p);
+        let chi0 = self.chi2_at(&r, None, &w);
         out.deviation = crate::math::sqrt(chi0);
         if chi0 < DETECT_CHI2 {
             out.state = IsolationState::NoDeviation;
@@ -347,16 +396,16 @@ impl Isolator {
         }
         let mut fits = [(0.0f32, 1.0f32); FAULT_COUNT];
         for (fit, f) in fits.iter_mut().zip(Fault::ALL) {
-            *fit = self.fit(p, f, &w);
+            *fit = self.fit(&r, f, &w);
         }
-        let heat = self.fit_heating(p, &w);
+        let heat = self.fit_heating(&r, &w);
         let eps = self.direction_uncertainty();
         rank(&mut out, &mut fits, heat, (chi0, 3.0), eps);
         // On a warm machine a fault is judged with the tracked temperature's lag allowed
         // for (heating itself is decided on the single fits above).
         if !out.heating_explains() {
             for (fit, f) in fits.iter_mut().zip(Fault::ALL) {
-                *fit = self.fit_on_warm(p, f, &w, *fit);
+                *fit = self.fit_on_warm(&r, f, &w, *fit);
             }
             rank(&mut out, &mut fits, heat, (chi0, 3.0), eps);
         }
@@ -399,11 +448,17 @@ impl Isolator {
     /// The misfit of hypothesis `h` (fault `f` of factor `k`; `None`: the healthy machine)
     /// against the baseline under the weight `w` ([`Isolator::weight`] at the measured
     /// point, one for every hypothesis so that their misfits compare); unusable points
-    /// count as infinitely bad.
+    /// count as infinitely bad. `r`: the measured point with its magnitudes.
     #[inline(never)]
-    fn chi2_at(&self, p: &SteadyPoint, h: Option<(Fault, f32)>, w: &Sym3) -> f32 {
-        let (c, q) = self.hypothesis(p, h);
-        match self.eval(&c, &q) {
+    fn chi2_at(&self, r: &Reading, h: Option<(Fault, f32)>, w: &Sym3) -> f32 {
+        self.chi2_of(self.eval_reading(&self.circuit_of(h), &self.reading_of(r, h)), w)
+    }
+
+    /// The misfit of residuals `e` against the baseline under the weight `w`; infinite
+    /// for no residuals (an unusable point).
+    #[inline]
+    fn chi2_of(&self, e: Option<ParityResiduals>, w: &Sym3) -> f32 {
+        match e {
             Some(e) => w.quadratic(&(e - self.baseline.mean)),
             None => f32::INFINITY,
         }
@@ -414,8 +469,8 @@ impl Isolator {
     /// faults keeps the firmware's flash small (it runs in thread mode, where a call costs
     /// nothing).
     #[inline(never)]
-    fn fit(&self, p: &SteadyPoint, f: Fault, w: &Sym3) -> (f32, f32) {
-        fit_factor(|k| self.chi2_at(p, Some((f, k)), w))
+    fn fit(&self, r: &Reading, f: Fault, w: &Sym3) -> (f32, f32) {
+        fit_factor(|k| self.chi2_at(r, Some((f, k)), w))
     }
 
     /// Angle between the top two candidates' weighted directions `e(f, k*) - e(nominal)`

@@ -51,10 +51,10 @@ impl Isolator {
     /// `k`, the total within [`HEATING_K_MIN`]..[`HEATING_K_MAX`]): golden section (the
     /// misfit is unimodal over so narrow a range). Returns `(chi2, k)`.
     #[inline(never)]
-    pub(super) fn fit_heating(&self, p: &SteadyPoint, w: &Sym3) -> (f32, f32) {
+    pub(super) fn fit_heating(&self, r: &Reading, w: &Sym3) -> (f32, f32) {
         let (lo, hi) = self.heating_range();
         golden(
-            |k| self.warmer(k).chi2_at(p, None, w),
+            |k| self.warmer(k).chi2_at(r, None, w),
             lo,
             hi,
             HEATING_STEPS,
@@ -79,7 +79,7 @@ impl Isolator {
     #[inline(never)]
     pub(super) fn fit_on_warm(
         &self,
-        p: &SteadyPoint,
+        r: &Reading,
         f: Fault,
         w: &Sym3,
         single: (f32, f32),
@@ -97,12 +97,12 @@ impl Isolator {
         let mut kf = single.1;
         for _ in 0..2 {
             let (_, kh) = golden(
-                |k| self.warmer(k).chi2_at(p, Some((f, kf)), w) + prior(k),
+                |k| self.warmer(k).chi2_at(r, Some((f, kf)), w) + prior(k),
                 1.0 - d,
                 1.0 + d,
                 LAG_STEPS,
             );
-            let (c, k) = self.warmer(kh).fit(p, f, w);
+            let (c, k) = self.warmer(kh).fit(r, f, w);
             kf = k;
             if c + prior(kh) < best.0 {
                 best = (c + prior(kh), k);

@@ -43,13 +43,19 @@ impl Isolator {
         let mut out = Isolation::default();
         let (used, n) = self.weighted_points(points);
         let used = used.get(..n).unwrap_or(&[]);
-        let Some((first, _, _, _)) = used.first() else {
+        let Some(first) = used.first().map(|(r, _, _, _)| r.q) else {
             return out;
         };
-        let load = anchor.and_then(|a| Some((*a, self.torque_nm(a, None)?)));
+        let load = anchor.and_then(|a| {
+            Some(AnchorLoad {
+                torque_nm: self.torque_nm(a, None)?,
+                active_a: a.operating_point().load_a,
+                wr_rad_s: a.wr_rad_s,
+            })
+        });
         let chi0 = self.chi2_points(used, load, None);
         out.deviation = crate::math::sqrt(chi0);
-        if let Some(e0) = self.residuals(first, None) {
+        if let Some(e0) = self.residuals(&first, None) {
             out.residuals = e0 - self.baseline.mean;
         }
         // Each point adds two or three equations: the detection threshold grows with them.
@@ -76,8 +82,8 @@ impl Isolator {
             (chi0, dims),
             self.direction_uncertainty(),
         );
-        if let Some(e0) = self.residuals(first, None) {
-            out.separation_deg = self.separation(first, &e0, &out.candidates);
+        if let Some(e0) = self.residuals(&first, None) {
+            out.separation_deg = self.separation(&first, &e0, &out.candidates);
         }
         out
     }
@@ -92,7 +98,7 @@ impl Isolator {
         &self,
         points: &[(SteadyPoint, f32)],
     ) -> ([WeightedPoint; MAX_POINTS], usize) {
-        let mut used = [(SteadyPoint::default(), Sym3::default(), 1.0f32, 0.0f32); MAX_POINTS];
+        let mut used = [(Reading::default(), Sym3::default(), 1.0f32, 0.0f32); MAX_POINTS];
         let mut n = 0;
         for (p, scale) in points.iter().take(MAX_POINTS) {
             let k = if scale.is_finite() {
@@ -110,7 +116,7 @@ impl Isolator {
                 continue;
             };
             if let Some(slot) = used.get_mut(n) {
-                *slot = (*p, w, k, lag_torque);
+                *slot = (Reading::of(p), w, k, lag_torque);
                 n += 1;
             }
         }
@@ -124,17 +130,25 @@ impl Isolator {
     fn chi2_points(
         &self,
         used: &[WeightedPoint],
-        load: Option<(SteadyPoint, f32)>,
+        load: Option<AnchorLoad>,
         h: Option<(Fault, f32)>,
     ) -> f32 {
-        let first = used
-            .first()
-            .map_or(0.0, |(p, _, k, lag)| self.chi2_load(p, h, load, (*k, *lag)));
-        first
-            + used
-                .iter()
-                .map(|(p, w, _, _)| self.chi2_at(p, h, w))
-                .sum::<f32>()
+        // One circuit for every point; each point's readings corrected for `h`.
+        let c = self.circuit_of(h);
+        let mut first = 0.0;
+        let sum = used
+            .iter()
+            .enumerate()
+            .map(|(n, (r, w, k, lag))| {
+                let r = self.reading_of(r, h);
+                let e = self.eval_reading(&c, &r);
+                if n == 0 {
+                    first = self.chi2_load(&c, &r, e, load, (*k, *lag));
+                }
+                self.chi2_of(e, w)
+            })
+            .sum::<f32>();
+        first + sum
     }
 
     /// The air-gap torque the circuit gives at `p` under hypothesis `h` [N m]
@@ -146,36 +160,39 @@ impl Isolator {
         Some(e.torque * self.torque_base_nm + c.b_total * q.wr_rad_s / c.np)
     }
 
-    /// The misfit of the torque at `p` under `h` against the load known at the anchor
-    /// (`load`: the anchor point and its torque; `None`: no term). Under `h` (its sensor
-    /// correction applied to the point, not to the anchor, measured before) the load is taken as unchanged where the active
-    /// current moved by at most [`ANCHOR_LOAD_BAND`] from the anchor's (else no term), and
-    /// as the paper's viscous load `T0 wr / wr0` there; the spread is
+    /// The misfit of the torque at the point `r` (its readings corrected for the
+    /// hypothesis, `e` its residuals under the hypothesis' circuit `c`) against the load
+    /// known at the anchor (`load`; `None`: no term). The sensor correction applies to the
+    /// point, not to the anchor, measured before; the load is taken as unchanged where the
+    /// active current moved by at most [`ANCHOR_LOAD_BAND`] from the anchor's (else no
+    /// term), and as the paper's viscous load `T0 wr / wr0` there; the spread is
     /// [`ANCHOR_TORQUE_SPREAD`] times `scale`, widened by [`LOAD_LAW_SPREAD`] times the
     /// speed's relative change times `T0`, and the tracked temperature's lag `s_lag` (in the
     /// torque balance's units).
     fn chi2_load(
         &self,
-        p: &SteadyPoint,
-        h: Option<(Fault, f32)>,
-        load: Option<(SteadyPoint, f32)>,
+        c: &Circuit,
+        r: &Reading,
+        e: Option<ParityResiduals>,
+        load: Option<AnchorLoad>,
         (scale, s_lag): (f32, f32),
     ) -> f32 {
-        let Some((a, t0)) = load else {
+        let Some(a) = load else {
             return 0.0;
         };
+        let (q, t0) = (&r.q, a.torque_nm);
         // (The anchor was measured before the deviation: its readings stand as they are.)
-        let ((_, q), qa) = (self.hypothesis(p, h), a);
-        let active = |x: &SteadyPoint| x.operating_point().load_a;
-        let (ia, i0) = (active(&q), active(&qa));
+        let ia = crate::OperatingPoint::with_magnitude(q.v.d, q.v.q, q.i.d, q.i.q, r.vmag).load_a;
+        let i0 = a.active_a;
         let moved = (ia - i0) / crate::math::maxf(i0.abs(), 1e-6);
         if !(moved.abs() <= ANCHOR_LOAD_BAND) {
             return 0.0;
         }
-        let Some(te) = self.torque_nm(p, h) else {
+        let Some(e) = e else {
             return f32::INFINITY;
         };
-        let speed = q.wr_rad_s / crate::math::maxf(qa.wr_rad_s.abs(), 1.0);
+        let te = e.torque * self.torque_base_nm + c.b_total * q.wr_rad_s / c.np;
+        let speed = q.wr_rad_s / crate::math::maxf(a.wr_rad_s.abs(), 1.0);
         let t_load = t0 * speed;
         let s_law = LOAD_LAW_SPREAD * (speed - 1.0) * t0 / self.torque_base_nm;
         let s = ANCHOR_TORQUE_SPREAD * scale;
@@ -217,4 +234,14 @@ pub const MAX_POINTS: usize = 4;
 /// One operating point of the joint isolation: the point, its voltage-equation weight, its
 /// spread scale (>= 1) and the tracked temperature's lag in the torque balance
 /// ([`Isolator::isolate_points_anchored`]).
-type WeightedPoint = (SteadyPoint, Sym3, f32, f32);
+type WeightedPoint = (Reading, Sym3, f32, f32);
+
+/// The load known at the anchor ([`Isolator::isolate_points_anchored`]): the nominal
+/// machine's air-gap torque there [N m], the anchor's active current [A] and its electrical
+/// rotor speed [rad/s].
+#[derive(Debug, Clone, Copy)]
+struct AnchorLoad {
+    torque_nm: f32,
+    active_a: f32,
+    wr_rad_s: f32,
+}
