@@ -13,7 +13,7 @@
 //!   the angle: on real recordings of shorted turns a 15 % negative sequence read as
 //!   2.4 %), and the fit is exact for any offset of it.
 
-use super::trig::sin_cos_pair;
+use super::trig::Oscillator;
 use super::{FILLED_SAMPLES, SENSOR_PHASE_MIN_RATIO};
 use monitor_core::angle::SrfPll;
 use monitor_core::filter::{Svf, SvfState};
@@ -165,6 +165,9 @@ pub(super) struct SequenceFront {
     w_ref: Svf,
     w_ref_state: SvfState,
     theta_ref: f32,
+    /// The sin/cos of the PLL's angle and of the reference angle, by rotation.
+    osc_pll: Oscillator,
+    osc_ref: Oscillator,
     /// The reference angle less `w0 t`, unwrapped [rad], and `w0` [rad/s].
     offset: f64,
     w0: f64,
@@ -311,6 +314,8 @@ impl SequenceFront {
             w_ref: Svf::new(REFERENCE_FC_HZ, dt)?,
             w_ref_state: SvfState::at(core::f32::consts::TAU * f0),
             theta_ref: 0.0,
+            osc_pll: Oscillator::default(),
+            osc_ref: Oscillator::default(),
             offset: 0.0,
             w0: std::f64::consts::TAU * params.supply.f_hz,
             window_len: ((WINDOW_PERIODS * sample_rate_hz / params.supply.f_hz).round() as u32)
@@ -355,7 +360,10 @@ impl SequenceFront {
             if self.voltages && v_abc.is_none() {
                 self.open.bad_v += 1;
             }
-            let (sc_pll, sc) = sin_cos_pair(self.pll.theta_pll(), self.theta_ref);
+            let (sc_pll, sc) = (
+                self.osc_pll.at(self.pll.theta_pll()),
+                self.osc_ref.at(self.theta_ref),
+            );
             let i = clarke(i_abc);
             self.filtered(i, v_abc.map(clarke), filled, sc_pll);
             self.rotor.row(Some(i), sc, t, self.offset, row);

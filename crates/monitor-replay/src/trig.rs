@@ -1,85 +1,95 @@
-//! sin and cos of two angles at once: the values of the core's [`SinCos::from_angle`]
-//! (micromath's approximations), bit for bit, computed on four lanes that the compiler
-//! keeps in one vector register. The sequence analysis turns two angles every sample (the
-//! PLL's and the least-squares reference's).
+//! sin and cos of an angle that advances by small steps, by rotation: a recursive
+//! oscillator ([`Oscillator`]) resynchronised from the angle itself. The sequence analysis
+//! turns two angles every sample (the PLL's and the least-squares reference's); a sin/cos
+//! evaluation per angle and row was a tenth of `diagnose`'s work on the reading thread
+//! (docs/performance.md).
 
-use monitor_core::frames::SinCos;
+use monitor_core::frames::{wrap_angle, SinCos};
 
-/// micromath's `cos` of each lane, operation by operation: `x / (2 pi)`, less the nearest
-/// quarter-shifted integer, then the parabola and its correction.
-#[inline(always)]
-fn cos4(x: [f32; 4]) -> [f32; 4] {
-    x.map(|x| {
-        let mut x = x * (core::f32::consts::FRAC_1_PI / 2.0);
-        let t = x + 0.25;
-        let mut floor = (t as i32) as f32;
-        if t < floor {
-            floor -= 1.0;
-        }
-        x -= 0.25 + floor;
-        x *= 16.0 * (x.abs() - 0.5);
-        x += 0.225 * x * (x.abs() - 1.0);
-        x
-    })
+/// Largest step the oscillator rotates by [rad]: [`SinCos::rotated`]'s series is exact to
+/// 2e-10 up to 0.1 rad (a supply period in 63 samples); a larger step (a low sample rate, a
+/// gap, the PLL aligned) is evaluated afresh.
+const MAX_STEP_RAD: f32 = 0.1;
+
+/// Rotations between two evaluations afresh: f32 rounding adds about 6e-8 per rotation, a
+/// random walk of about 1e-6 over 64 of them (the oscillator's magnitude drifts by as much;
+/// resynchronising also renormalises it).
+const RESYNC_STEPS: u32 = 64;
+
+/// The sin and cos of an angle that moves by small steps (module docs). Each call gives
+/// the sin/cos of the angle passed: the last value rotated by the step from the last angle
+/// where the step is at most [`MAX_STEP_RAD`] and fewer than [`RESYNC_STEPS`] rotations
+/// were made since the last evaluation; else `f32::sin_cos` of the angle (within an ulp or
+/// two of the true values). Error against the true values: below 2e-6. A NaN angle gives
+/// NaN values and the next angle is evaluated afresh.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Oscillator {
+    /// The angle of `sc` [rad] (NaN before the first).
+    angle: f32,
+    sc: SinCos,
+    /// Rotations since the last evaluation.
+    steps: u32,
 }
 
-/// [`SinCos::from_angle`] of `a` and of `b`.
-#[inline]
-pub(super) fn sin_cos_pair(a: f32, b: f32) -> (SinCos, SinCos) {
-    // micromath's sin(x) is cos(x - pi/2).
-    const HALF_PI: f32 = core::f32::consts::PI / 2.0;
-    let [sa, ca, sb, cb] = cos4([a - HALF_PI, a, b - HALF_PI, b]);
-    (SinCos { sin: sa, cos: ca }, SinCos { sin: sb, cos: cb })
+impl Default for Oscillator {
+    fn default() -> Self {
+        Oscillator {
+            angle: f32::NAN,
+            sc: SinCos::default(),
+            steps: 0,
+        }
+    }
+}
+
+impl Oscillator {
+    /// The sin and cos of `angle` [rad] (any value; the step from the last one is wrapped).
+    #[inline]
+    pub fn at(&mut self, angle: f32) -> SinCos {
+        let d = wrap_angle(angle - self.angle);
+        if d.abs() <= MAX_STEP_RAD && self.steps < RESYNC_STEPS {
+            self.sc = self.sc.rotated(d);
+            self.steps += 1;
+        } else {
+            let (sin, cos) = angle.sin_cos();
+            self.sc = SinCos { sin, cos };
+            self.steps = 0;
+        }
+        self.angle = angle;
+        self.sc
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// Against f64 sin/cos along angles as the PLL and the reference turn them (wrapped
+    /// every period), at the sample rates a log has, with frequency wobble, jumps and NaN.
     #[test]
-    fn the_same_values_as_the_core_to_the_last_bit() {
-        let same = |a: f32, b: f32| {
-            let (x, y) = sin_cos_pair(a, b);
-            for (got, want) in [(x, SinCos::from_angle(a)), (y, SinCos::from_angle(b))] {
-                assert_eq!(got.sin.to_bits(), want.sin.to_bits(), "sin {a} {b}");
-                assert_eq!(got.cos.to_bits(), want.cos.to_bits(), "cos {a} {b}");
+    fn follows_the_angle_within_2e_6() {
+        for (rate_hz, f_hz) in [(10_000.0f32, 60.0f32), (50_000.0, 50.0), (1_000.0, 60.0)] {
+            let mut osc = Oscillator::default();
+            let mut theta = 0.3f32;
+            let mut worst = 0.0f64;
+            for n in 0..200_000u32 {
+                let w = core::f32::consts::TAU * f_hz * (1.0 + 0.01 * (n as f32 * 1e-3).sin());
+                theta = wrap_angle(theta + w / rate_hz);
+                if n % 50_000 == 7 {
+                    // A jump (the PLL aligned, a gap bridged).
+                    theta = wrap_angle(theta + 2.0);
+                }
+                let sc = osc.at(theta);
+                let (s, c) = f64::from(theta).sin_cos();
+                worst = worst
+                    .max((f64::from(sc.sin) - s).abs())
+                    .max((f64::from(sc.cos) - c).abs());
             }
-        };
-        let mut s: u32 = 0x2545_F491;
-        for k in 0..400_000 {
-            s ^= s << 13;
-            s ^= s >> 17;
-            s ^= s << 5;
-            // Angles of every magnitude, then the PLL's range finely.
-            let a = if k % 2 == 0 {
-                f32::from_bits(s)
-            } else {
-                (s as f32 / u32::MAX as f32 - 0.5) * 8.0
-            };
-            if a.is_nan() {
-                continue;
-            }
-            same(a, -a);
+            assert!(worst < 2e-6, "{rate_hz} Hz: error {worst:e}");
         }
-        for a in [
-            0.0,
-            -0.0,
-            core::f32::consts::PI,
-            -core::f32::consts::PI,
-            core::f32::consts::FRAC_PI_2,
-            1e-30,
-            3e9,
-            -3e9,
-            1e30,
-            f32::MAX,
-            f32::MIN,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-        ] {
-            same(a, a + 1.0);
-        }
-        // NaN in, NaN out, as the core.
-        let (x, _) = sin_cos_pair(f32::NAN, 0.0);
-        assert!(x.sin.is_nan() && SinCos::from_angle(f32::NAN).sin.is_nan());
+        let mut osc = Oscillator::default();
+        osc.at(1.0);
+        assert!(osc.at(f32::NAN).sin.is_nan());
+        let sc = osc.at(0.5);
+        assert!((sc.sin - 0.5f32.sin()).abs() < 1e-6 && (sc.cos - 0.5f32.cos()).abs() < 1e-6);
     }
 }
