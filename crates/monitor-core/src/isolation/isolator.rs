@@ -451,7 +451,10 @@ impl Isolator {
     /// count as infinitely bad. `r`: the measured point with its magnitudes.
     #[inline(never)]
     fn chi2_at(&self, r: &Reading, h: Option<(Fault, f32)>, w: &Sym3) -> f32 {
-        self.chi2_of(self.eval_reading(&self.circuit_of(h), &self.reading_of(r, h)), w)
+        self.chi2_of(
+            self.eval_reading(&self.circuit_of(h), &self.reading_of(r, h)),
+            w,
+        )
     }
 
     /// The misfit of residuals `e` against the baseline under the weight `w`; infinite
