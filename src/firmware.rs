@@ -31,7 +31,7 @@ mod sample_task;
 mod supply;
 
 use core::mem::MaybeUninit;
-use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
+use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 
 use defmt::{error, info, warn};
 use defmt_rtt as _;
@@ -53,6 +53,8 @@ use drive_monitor::app::{
     PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
 };
 use drive_monitor::board::{self, pins::Board, Lamp, LAMP_COUNT};
+use drive_monitor::clock;
+use drive_monitor::flash_ecc::{CheckedFlash, RawFlash, ReadError};
 use drive_monitor::boot::{self, BootMachine};
 use drive_monitor::commissioning::Action;
 use drive_monitor::flash_record::{RecordStore, RECORD_LEN};
@@ -121,8 +123,6 @@ static RESTARTS: AtomicU32 = AtomicU32::new(0);
 static EXECUTOR_HIGH: InterruptExecutor = InterruptExecutor::new();
 /// What the firmware is doing ([`BootPhase::number`]), for the record of a `defmt` panic.
 static PHASE: AtomicU8 = AtomicU8::new(0);
-/// The independent watchdog runs (else the panic handler resets the MCU itself).
-static WATCHDOG_RUNNING: AtomicBool = AtomicBool::new(false);
 
 fn set_phase(phase: BootPhase) {
     PHASE.store(phase.number(), Ordering::Relaxed);
@@ -193,20 +193,46 @@ enum FlashError {
     SingleBank,
     /// The flash driver's error.
     Driver(embassy_stm32::flash::Error),
+    /// A double ECC error in the page (a torn write): the page is marked bad for this run.
+    Ecc {
+        /// The failing offset from 0x0800_0000.
+        offset: u32,
+    },
+    /// The page was marked bad earlier in this run.
+    MarkedBad,
 }
 
-/// The record pages in the board's flash (`None`: the option bytes are single-bank).
-struct BoardFlash(Option<Flash<'static, Blocking>>);
+/// The flash driver (`None`: the option bytes are single-bank).
+struct Driver(Option<Flash<'static, Blocking>>);
 
-impl BoardFlash {
-    fn driver(&mut self) -> Result<&mut Flash<'static, Blocking>, FlashError> {
+impl Driver {
+    fn get(&mut self) -> Result<&mut Flash<'static, Blocking>, FlashError> {
         self.0.as_mut().ok_or(FlashError::SingleBank)
     }
+}
 
-    fn read_at(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), FlashError> {
-        self.driver()?
+impl RawFlash for Driver {
+    type Error = FlashError;
+    fn read_raw(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), FlashError> {
+        self.get()?
             .blocking_read(offset, buf)
             .map_err(FlashError::Driver)
+    }
+}
+
+/// The record pages in the board's flash, every read checked for ECC double errors
+/// (`drive_monitor::flash_ecc`: the NMI handler latches them in `failure::ECC`).
+struct BoardFlash(CheckedFlash<Driver>);
+
+impl BoardFlash {
+    fn read_at(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), FlashError> {
+        self.0
+            .read(&failure::ECC, offset, buf)
+            .map_err(|e| match e {
+                ReadError::Driver(e) => e,
+                ReadError::Ecc(e) => FlashError::Ecc { offset: e.offset },
+                ReadError::MarkedBad => FlashError::MarkedBad,
+            })
     }
 }
 
@@ -217,12 +243,18 @@ impl RecordStore for BoardFlash {
     }
     fn erase(&mut self) -> Result<(), Self::Error> {
         let from = board::RECORD_FLASH_OFFSET;
-        self.driver()?
+        self.0
+            .raw
+            .get()?
             .blocking_erase(from, from + board::RECORD_PAGE_SIZE)
-            .map_err(FlashError::Driver)
+            .map_err(FlashError::Driver)?;
+        self.0.erased(from);
+        Ok(())
     }
     fn write(&mut self, bytes: &[u8; RECORD_LEN]) -> Result<(), Self::Error> {
-        self.driver()?
+        self.0
+            .raw
+            .get()?
             .blocking_write(board::RECORD_FLASH_OFFSET, bytes)
             .map_err(FlashError::Driver)
     }
@@ -231,14 +263,16 @@ impl RecordStore for BoardFlash {
 fn clock_config() -> embassy_stm32::Config {
     use embassy_stm32::rcc::*;
     let mut config = embassy_stm32::Config::default();
-    // 16 MHz HSI / 4 * 85 / 2 = 170 MHz SYSCLK (the G474's maximum, needs boost mode).
+    // 16 MHz HSI / 4 * 85 / 2 = 170 MHz SYSCLK (the G474's maximum, needs boost mode):
+    // the settings of `drive_monitor::clock`, from which every rate and cycle count is
+    // derived (the registers' encodings: PLLM - 1, PLLN, PLLR / 2 - 1).
     config.rcc.pll = Some(Pll {
         source: PllSource::HSI,
-        prediv: PllPreDiv::DIV4,
-        mul: PllMul::MUL85,
+        prediv: PllPreDiv::from_bits((clock::PLL_PREDIV - 1) as u8),
+        mul: PllMul::from_bits(clock::PLL_MUL as u8),
         divp: None,
         divq: None,
-        divr: Some(PllRDiv::DIV2),
+        divr: Some(PllRDiv::from_bits((clock::PLL_RDIV / 2 - 1) as u8)),
     });
     config.rcc.sys = Sysclk::PLL1_R;
     config.rcc.boost = true;
@@ -255,17 +289,16 @@ fn start_watchdog(
     pac::DBGMCU.apb1lfzr().modify(|w| w.set_iwdg(true));
     let mut wdg = IndependentWatchdog::new(iwdg, WATCHDOG_TIMEOUT_MS * 1000);
     wdg.unleash();
-    WATCHDOG_RUNNING.store(true, Ordering::Relaxed);
     wdg
 }
 
 /// The motor record's page (`board::MOTOR_RECORD_FLASH_OFFSET`), read as erased when the
-/// flash cannot be read (the reason is logged): `drive_monitor::boot` then runs the
-/// built-in default.
+/// flash cannot be read or the read raised an ECC double error (the page is then marked
+/// bad; the reason is logged): `drive_monitor::boot` then runs the built-in default.
 fn read_motor_page(flash: &mut BoardFlash) -> [u8; MOTOR_RECORD_LEN] {
     let mut page = [0xFF_u8; MOTOR_RECORD_LEN];
     if let Err(e) = flash.read_at(board::MOTOR_RECORD_FLASH_OFFSET, &mut page) {
-        warn!("motor record page unreadable: {}", e);
+        warn!("motor record page unreadable: {}; running the built-in motor (write the record again: docs/firmware.md)", e);
         page = [0xFF; MOTOR_RECORD_LEN];
     }
     page
@@ -311,7 +344,9 @@ async fn main(_spawner: Spawner) {
     let dual_bank = dual_bank_flash();
     let mut thread = Thread {
         lamps: PanelPins::new(b.lamps),
-        flash: BoardFlash(dual_bank.then(|| Flash::new_blocking(b.flash))),
+        flash: BoardFlash(CheckedFlash::new(Driver(
+            dual_bank.then(|| Flash::new_blocking(b.flash)),
+        ))),
         wdg,
         max_update_cycles: 0,
         log_div: 0,
