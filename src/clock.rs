@@ -40,7 +40,10 @@ pub const SYSCLK_MAX_HZ: u32 = 170_000_000;
 /// The ADC's largest clock [Hz] (datasheet, single ADC).
 pub const ADC_CLOCK_MAX_HZ: u32 = 60_000_000;
 
-const _: () = assert!(SYSCLK_HZ <= SYSCLK_MAX_HZ, "SYSCLK above the G474's maximum");
+const _: () = assert!(
+    SYSCLK_HZ <= SYSCLK_MAX_HZ,
+    "SYSCLK above the G474's maximum"
+);
 const _: () = assert!(ADC_CLOCK_HZ <= ADC_CLOCK_MAX_HZ, "ADC clock too fast");
 const _: () = assert!(
     HSI_HZ / PLL_PREDIV >= 2_660_000 && HSI_HZ / PLL_PREDIV <= 16_000_000,

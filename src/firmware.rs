@@ -53,10 +53,10 @@ use drive_monitor::app::{
     PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
 };
 use drive_monitor::board::{self, pins::Board, Lamp, LAMP_COUNT};
-use drive_monitor::clock;
-use drive_monitor::flash_ecc::{CheckedFlash, RawFlash, ReadError};
 use drive_monitor::boot::{self, BootMachine};
+use drive_monitor::clock;
 use drive_monitor::commissioning::Action;
+use drive_monitor::flash_ecc::{CheckedFlash, RawFlash, ReadError};
 use drive_monitor::flash_record::{RecordStore, RECORD_LEN};
 use drive_monitor::offset_trim::TrimResult;
 use drive_monitor::panel::PanelLamps;
@@ -224,15 +224,18 @@ impl RawFlash for Driver {
 /// (`drive_monitor::flash_ecc`: the NMI handler latches them in `failure::ECC`).
 struct BoardFlash(CheckedFlash<Driver>);
 
+/// A checked read's error as the firmware logs it.
+fn flash_error(e: ReadError<FlashError>) -> FlashError {
+    match e {
+        ReadError::Driver(e) => e,
+        ReadError::Ecc(e) => FlashError::Ecc { offset: e.offset },
+        ReadError::MarkedBad => FlashError::MarkedBad,
+    }
+}
+
 impl BoardFlash {
     fn read_at(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), FlashError> {
-        self.0
-            .read(&failure::ECC, offset, buf)
-            .map_err(|e| match e {
-                ReadError::Driver(e) => e,
-                ReadError::Ecc(e) => FlashError::Ecc { offset: e.offset },
-                ReadError::MarkedBad => FlashError::MarkedBad,
-            })
+        self.0.read(&failure::ECC, offset, buf).map_err(flash_error)
     }
 }
 
@@ -296,10 +299,11 @@ fn start_watchdog(
 /// flash cannot be read or the read raised an ECC double error (the page is then marked
 /// bad; the reason is logged): `drive_monitor::boot` then runs the built-in default.
 fn read_motor_page(flash: &mut BoardFlash) -> [u8; MOTOR_RECORD_LEN] {
-    let mut page = [0xFF_u8; MOTOR_RECORD_LEN];
-    if let Err(e) = flash.read_at(board::MOTOR_RECORD_FLASH_OFFSET, &mut page) {
-        warn!("motor record page unreadable: {}; running the built-in motor (write the record again: docs/firmware.md)", e);
-        page = [0xFF; MOTOR_RECORD_LEN];
+    let (page, read) = flash
+        .0
+        .read_or_erased::<MOTOR_RECORD_LEN>(&failure::ECC, board::MOTOR_RECORD_FLASH_OFFSET);
+    if let Err(e) = read {
+        warn!("motor record page unreadable: {}; running the built-in motor (write the record again: docs/firmware.md)", flash_error(e));
     }
     page
 }

@@ -51,7 +51,11 @@ pub fn double_error(eccr: u32) -> Option<EccError> {
     if eccr & ECCR_ECCD == 0 || eccr & ECCR_SYSF_ECC != 0 {
         return None;
     }
-    let bank = if eccr & ECCR_BK_ECC != 0 { BANK_SIZE } else { 0 };
+    let bank = if eccr & ECCR_BK_ECC != 0 {
+        BANK_SIZE
+    } else {
+        0
+    };
     Some(EccError {
         offset: bank + (eccr & ECCR_ADDR_MASK),
     })
@@ -233,7 +237,10 @@ mod tests {
         // RM0440 FLASH_ECCR: ECCD bit 31, SYSF_ECC bit 22, BK_ECC bit 21, ADDR_ECC 18:0.
         let eccr = 0x8000_0000 | 0x0020_0000 | 0x3_F010;
         assert_eq!(double_error(eccr), Some(EccError { offset: 0x7_F010 }));
-        assert_eq!(nmi_action(eccr), NmiAction::RecordPageEcc(EccError { offset: 0x7_F010 }));
+        assert_eq!(
+            nmi_action(eccr),
+            NmiAction::RecordPageEcc(EccError { offset: 0x7_F010 })
+        );
         // In the code (bank 1) or the system flash, or no ECCD: the fault path.
         assert_eq!(nmi_action(0x8000_1000), NmiAction::Fault);
         assert_eq!(nmi_action(eccr | ECCR_SYSF_ECC), NmiAction::Fault);

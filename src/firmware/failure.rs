@@ -87,7 +87,12 @@ fn fault_registers(pc: u32, lr: u32) -> FaultRegisters {
 unsafe fn HardFault(frame: &cortex_m_rt::ExceptionFrame) -> ! {
     cortex_m::interrupt::disable();
     let regs = fault_registers(frame.pc(), frame.lr());
-    end(fault_path::on_hard_fault(&GUARD, &mut Registers, None, regs))
+    end(fault_path::on_hard_fault(
+        &GUARD,
+        &mut Registers,
+        None,
+        regs,
+    ))
 }
 
 /// The NMI: a double ECC error in a record page (`FLASH_ECCR.ECCD` with the page's

@@ -18,7 +18,6 @@ use super::write_reset_record;
 /// exception reads when the deadline runs out.
 static SETUP_STEP: AtomicU8 = AtomicU8::new(0);
 
-
 /// The ADCs' set-up under its deadline ([`setup_guard`]): SysTick counts
 /// [`SETUP_DEADLINE_MS`] once; if it runs out while a step is marked, its exception
 /// writes the step into the reset record and resets the MCU.
@@ -33,7 +32,8 @@ impl SetupGuard {
     pub(super) fn arm(mut syst: SYST, first: SetupStep) -> Self {
         SETUP_STEP.store(first.number(), Ordering::SeqCst);
         // 20 ms fits SysTick's 24 bits at 170 MHz / 8 (a host test checks the value).
-        let reload = setup_guard::systick_reload(clock::HCLK_HZ, SETUP_DEADLINE_MS).unwrap_or(0xFF_FFFF);
+        let reload =
+            setup_guard::systick_reload(clock::HCLK_HZ, SETUP_DEADLINE_MS).unwrap_or(0xFF_FFFF);
         syst.set_clock_source(SystClkSource::External);
         syst.set_reload(reload);
         syst.clear_current();

@@ -249,7 +249,9 @@ impl AcqRegisters for AdcDmaModel {
         // ADSTART clears one conversion time from now.
         let a = &mut self.adc[i];
         a.stopping = true;
-        a.busy_until_ns = a.busy_until_ns.max(self.now_ns + u64::from(conversion_ns()));
+        a.busy_until_ns = a
+            .busy_until_ns
+            .max(self.now_ns + u64::from(conversion_ns()));
     }
     fn adc_start(&mut self, i: usize) {
         self.adc[i].adstart = true;
@@ -571,7 +573,10 @@ fn a_stuck_adc_times_the_stop_out_and_a_working_one_stops_within_a_conversion() 
     let t0 = acq.regs.now_ns;
     assert_eq!(recovery::recover(&mut acq), Ok(Faults::default()));
     let took = acq.regs.now_ns - t0;
-    assert!(took <= u64::from(conversion_ns()) + 10 * POLL_NS, "{took} ns");
+    assert!(
+        took <= u64::from(conversion_ns()) + 10 * POLL_NS,
+        "{took} ns"
+    );
 
     let mut acq = AdcDmaModel::running();
     acq.regs.adc[1].stuck = true;
@@ -581,7 +586,10 @@ fn a_stuck_adc_times_the_stop_out_and_a_working_one_stops_within_a_conversion() 
         Err(StepTimeout(RecoveryStep::StopAdc))
     );
     let took_ms = (acq.regs.now_ns - t0) as f64 / 1e6;
-    assert!(took_ms >= POLL_LIMIT as f64 * POLL_NS as f64 / 1e6, "{took_ms} ms");
+    assert!(
+        took_ms >= POLL_LIMIT as f64 * POLL_NS as f64 / 1e6,
+        "{took_ms} ms"
+    );
     assert!(!acq.regs.trigger_on && acq.regs.dma.iter().all(|d| d.en));
     assert!(!acq.regs.sample());
 }
