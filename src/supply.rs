@@ -11,8 +11,8 @@
 //! boot source, `DBANK`), which a board in the field should not risk on every boot for a
 //! setting a user makes once. It reads the level at boot ([`BorCheck::of_optr`]), says
 //! on the log and on every status line (`bor=`) which level is in force, and puts the
-//! level into every reset record it writes; `docs/firmware.md` gives the commands that
-//! raise it.
+//! level into every reset record it writes, and warns at every boot while it is below the
+//! goal; `cargo fw bor` programs level 4 once per board (`docs/firmware.md`, bring-up).
 //!
 //! **Reference.** Every reading scales with VDDA, the ADC's reference. Thread mode measures
 //! it through VREFINT every [`REFERENCE_PERIOD_MS`] ([`ReferenceWatch`]) on ADC1's injected
