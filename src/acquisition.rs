@@ -17,6 +17,15 @@
 //! still folds is what lies near multiples of the trigger rate (80 kHz: the RC's 0.20
 //! times the PWM's small high-order groups there); docs/firmware.md gives the front end's
 //! anti-alias requirement and the figures.
+//!
+//! **The in-band ripple.** A carrier below half the sample rate (4 kHz at 10 kHz), or one
+//! whose groups fold to a few kHz (8 kHz: its second group at 16 kHz lands on 4 kHz, its
+//! first on 2 kHz), is not an alias of the fundamental but ripple in band: tens of volts
+//! at kHz on every reading. It does not move the fundamental, but it moves the monitor's
+//! fast quantities (measured: a 4 kHz inverter lit r1 and r4 on a healthy machine, and the
+//! host's isolation found no steady operating point). [`PwmFilter`] takes it out: two
+//! one-pole low-passes on the six channels alike, the fundamental's gain restored, the
+//! encoder held back by the filters' delay.
 
 use crate::clock;
 
@@ -90,6 +99,145 @@ pub fn average_half(half: &[u16]) -> [u16; CHANNELS] {
     sum.map(|s| ((s + n / 2) / n) as u16)
 }
 
+/// The sum of each channel over the sequences of one half buffer `half` (`[a, b, c, a,
+/// b, c, ...]`) and how many sequences it held: what [`PwmFilter::step`] takes.
+#[inline]
+pub fn sum_half(half: &[u16]) -> ([u32; CHANNELS], u32) {
+    let mut sum = [0u32; CHANNELS];
+    let mut n = 0u32;
+    for seq in half.chunks_exact(CHANNELS) {
+        for (s, &code) in sum.iter_mut().zip(seq) {
+            *s += u32::from(code);
+        }
+        n += 1;
+    }
+    (sum, n)
+}
+
+/// Fractional bits of [`PwmFilter`]'s states.
+const FILTER_FRAC_BITS: u32 = 12;
+/// The first stage's coefficient `a = 2^-2` (a one-pole low-pass `y += a (x - y)` at 10 kHz:
+/// -3 dB at 458 Hz).
+const STAGE1_SHIFT: u32 = 2;
+/// The second stage's coefficient `a = 2^-1` (-3 dB at 1.1 kHz at 10 kHz).
+const STAGE2_SHIFT: u32 = 1;
+/// Samples the encoder count is held back, the filters' delay at the fundamental
+/// (`(1 - a) / a`: 3 and 1 samples) so that the shaft angle goes with the readings.
+pub const ENCODER_DELAY_SAMPLES: usize = 4;
+
+/// The in-band part of an inverter's ripple taken out of the six channels (module docs):
+/// two one-pole low-passes in integer arithmetic on the oversampled sums ([`sum_half`]),
+/// `a = 1/4` then `a = 1/2` at the sample rate (at 10 kHz: -3 dB at 458 Hz and 1.1 kHz;
+/// gain 0.052 at 4 kHz, 0.12 at 2 kHz, where an 8 kHz carrier's second group lands), and
+/// the fundamental's gain restored (`gain_q15`, from [`PwmFilter::new`]'s supply frequency:
+/// at 50 Hz the two stages pass 0.993). All six channels are filtered alike, so the
+/// machine's equations between the voltages and currents hold through it (a linear filter
+/// commutes with a linear machine's equations in steady state); the encoder count is held
+/// back [`ENCODER_DELAY_SAMPLES`] samples to go with them. No allocation, no panics.
+#[derive(Clone, Copy, Debug)]
+pub struct PwmFilter {
+    /// Each channel's two stages (voltages a, b, c, then currents), in sums x 2^12.
+    stages: [[i32; 2]; 2 * CHANNELS],
+    /// The encoder counts of the last samples, oldest first.
+    counts: [u16; ENCODER_DELAY_SAMPLES],
+    /// The inverse of the stages' gain at the supply frequency, x 2^15.
+    gain_q15: i32,
+    primed: bool,
+}
+
+impl PwmFilter {
+    /// A filter at `sample_rate_hz` whose gain at `supply_hz` is restored to 1 (invalid
+    /// rates: no restoring).
+    pub fn new(sample_rate_hz: u32, supply_hz: f32) -> Self {
+        let w = core::f32::consts::TAU * supply_hz / sample_rate_hz as f32;
+        // |a / (1 - b e^{-jw})|^2 of each stage.
+        let gain2 = |shift: u32| {
+            let a = 1.0 / (1u32 << shift) as f32;
+            let b = 1.0 - a;
+            let (re, im) = (1.0 - b * micro_cos(w), b * micro_sin(w));
+            a * a / (re * re + im * im)
+        };
+        let g2 = gain2(STAGE1_SHIFT) * gain2(STAGE2_SHIFT);
+        let gain_q15 = if g2.is_finite() && g2 > 0.25 && g2 <= 1.0 {
+            (32768.0 * sqrt_near_one(1.0 / g2)) as i32
+        } else {
+            32768
+        };
+        Self {
+            stages: [[0; 2]; 2 * CHANNELS],
+            counts: [0; ENCODER_DELAY_SAMPLES],
+            gain_q15,
+            primed: false,
+        }
+    }
+
+    /// One sample: the voltages' and currents' sums over `n` sequences (from [`sum_half`])
+    /// and the encoder count read after them; the filtered codes (rounded, within
+    /// 0..=4095) and the encoder count of [`ENCODER_DELAY_SAMPLES`] samples ago. The first
+    /// sample starts the stages at its own value (no run-up from zero).
+    #[inline]
+    pub fn step(
+        &mut self,
+        v: [u32; CHANNELS],
+        i: [u32; CHANNELS],
+        n: u32,
+        count: u16,
+    ) -> ([u16; CHANNELS], [u16; CHANNELS], u16) {
+        let n = n.max(1) as i32;
+        let primed = self.primed;
+        let gain = self.gain_q15;
+        let mut out = [0u16; 2 * CHANNELS];
+        for ((st, &x), o) in self.stages.iter_mut().zip(v.iter().chain(&i)).zip(&mut out) {
+            // The mean in codes x 2^12 (n <= 8: 4095 x 2^12 < 2^24).
+            let x = ((x as i32) << FILTER_FRAC_BITS) / n;
+            if !primed {
+                *st = [x, x];
+            }
+            st[0] += (x - st[0]) >> STAGE1_SHIFT;
+            st[1] += (st[0] - st[1]) >> STAGE2_SHIFT;
+            // Around mid-scale, so that the gain restores the swing, not the offset.
+            let mid = 2048 << FILTER_FRAC_BITS;
+            let y = mid + (((st[1] - mid) as i64 * gain as i64) >> 15) as i32;
+            let code = (y + (1 << (FILTER_FRAC_BITS - 1))) >> FILTER_FRAC_BITS;
+            *o = code.clamp(0, 4095) as u16;
+        }
+        self.primed = true;
+        if !primed {
+            self.counts = [count; ENCODER_DELAY_SAMPLES];
+        }
+        let delayed = self.counts.first().copied().unwrap_or(count);
+        self.counts.rotate_left(1);
+        if let Some(last) = self.counts.last_mut() {
+            *last = count;
+        }
+        let [va, vb, vc, ia, ib, ic] = out;
+        ([va, vb, vc], [ia, ib, ic], delayed)
+    }
+}
+
+/// `sqrt(x)` for `x` in 1..=4 (the inverse gain squared) by Newton's iteration from `x`:
+/// six steps reach f32's precision there (no `std` on the board).
+fn sqrt_near_one(x: f32) -> f32 {
+    let mut y = x;
+    for _ in 0..6 {
+        y = 0.5 * (y + x / y);
+    }
+    y
+}
+
+/// cos for the filter's set-up (host and board alike: `micromath`-free Taylor series,
+/// accurate to 1e-6 for |x| < 0.5, the supply's angle per sample).
+fn micro_cos(x: f32) -> f32 {
+    let x2 = x * x;
+    1.0 - x2 / 2.0 + x2 * x2 / 24.0 - x2 * x2 * x2 / 720.0
+}
+
+/// sin, as [`micro_cos`].
+fn micro_sin(x: f32) -> f32 {
+    let x2 = x * x;
+    x * (1.0 - x2 / 6.0 + x2 * x2 / 120.0 - x2 * x2 * x2 / 5040.0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -111,6 +259,57 @@ mod tests {
         // a: 100..=107, mean 103.5 -> 104; c: 4095 and 4094 alternating, 4094.5 -> 4095.
         assert_eq!(average_half(&half), [104, 2000, 4095]);
         assert_eq!(average_half(&[]), [0, 0, 0]);
+    }
+
+    /// The filter against an independent model: a one-pole cascade in f64 on a 50 Hz
+    /// sinusoid plus a 4 kHz ripple; the 50 Hz amplitude is kept (the gain restored), the
+    /// ripple falls to the cascade's gain, and the encoder count is held back 4 samples.
+    #[test]
+    fn the_filter_keeps_the_fundamental_and_takes_the_ripple_out() {
+        let fs = 10_000.0_f64;
+        let mut f = PwmFilter::new(10_000, 50.0);
+        let (mut out50, mut out_ripple) = (Vec::new(), Vec::new());
+        for k in 0..4_000u32 {
+            let t = f64::from(k) / fs;
+            let fund = 1000.0 * (std::f64::consts::TAU * 50.0 * t).sin();
+            let ripple = 300.0 * (std::f64::consts::TAU * 4_000.0 * t).sin();
+            let code = |x: f64| ((2048.0 + x) * 8.0).round() as u32;
+            let sum = code(fund + ripple);
+            let (v, _, count) = f.step([sum; 3], [code(0.0); 3], 8, k as u16);
+            if k >= 4 {
+                assert_eq!(count, (k - 4) as u16);
+            }
+            if k >= 2_000 {
+                out50.push((t, f64::from(v[0]) - 2048.0));
+                out_ripple.push(f64::from(v[0]) - 2048.0);
+            }
+        }
+        // The 50 Hz amplitude by a DFT over the last 0.2 s (10 periods).
+        let (mut re, mut im) = (0.0, 0.0);
+        for &(t, y) in &out50 {
+            re += 2.0 * y * (std::f64::consts::TAU * 50.0 * t).cos() / out50.len() as f64;
+            im += 2.0 * y * (std::f64::consts::TAU * 50.0 * t).sin() / out50.len() as f64;
+        }
+        let amp = (re * re + im * im).sqrt();
+        assert!((amp - 1000.0).abs() < 2.0, "{amp}");
+        // The ripple left: the cascade's gain at 4 kHz, |a/(1 - (1-a) e^{-jw})| for a =
+        // 1/4 and 1/2 at w = 0.8 pi: 0.150 x 0.348 = 0.052 (x the gain restored, 1.007).
+        let ripple_gain = |a: f64| {
+            let w = std::f64::consts::TAU * 0.4;
+            let (re, im) = (1.0 - (1.0 - a) * w.cos(), (1.0 - a) * w.sin());
+            a / (re * re + im * im).sqrt()
+        };
+        let expected = 300.0 * ripple_gain(0.25) * ripple_gain(0.5);
+        let residual: Vec<f64> = out50
+            .iter()
+            .map(|&(t, y)| y - amp * ((std::f64::consts::TAU * 50.0 * t) + re.atan2(im)).sin())
+            .collect();
+        let peak = residual.iter().fold(0.0f64, |m, r| m.max(r.abs()));
+        assert!(
+            peak < expected * 1.1 + 1.5 && peak > expected * 0.8,
+            "{peak} against {expected}"
+        );
+        assert_eq!(out_ripple.len(), 2_000);
     }
 
     /// A sinusoid at a multiple of the sample rate (what folds onto DC and the

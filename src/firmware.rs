@@ -373,6 +373,7 @@ async fn main(_spawner: Spawner) {
         enc_b: b.encoder_b,
         encoder: machine.encoder,
         syst: cp.SYST,
+        supply_hz: machine.record.supply.f_hz as f32,
     };
     spawn_sample_task(hw, path);
     thread.run(&mut supervisor, &mut button, boot).await

@@ -48,6 +48,9 @@ pub(super) struct SampleHw {
     pub(super) encoder: EncoderSetup,
     /// SysTick: the ADC set-up's deadline (`supply::SetupGuard`).
     pub(super) syst: cortex_m::peripheral::SYST,
+    /// The supply frequency of the machine monitored [Hz] (the filter's gain is restored
+    /// there: `geometry::PwmFilter`).
+    pub(super) supply_hz: f32,
 }
 
 /// The encoder: TIM4 in quadrature mode on PB6/PB7 with the motor record's pull-ups,
@@ -167,21 +170,24 @@ fn start_acquisition(
 }
 
 /// Runs the sample path on the readings of one DMA half (`v` from ADC1, `i` from ADC2:
-/// [`geometry::OVERSAMPLING`] sequences per sample, averaged) with the encoder count read
-/// after them; hands thread mode a status every `status_every` samples. `max_cycles`: the
-/// longest averaging and `on_frame` so far, in CPU cycles.
+/// [`geometry::OVERSAMPLING`] sequences per sample, summed and filtered by `filter`,
+/// `geometry::PwmFilter`: the inverter's in-band ripple out, the encoder count held back
+/// with it) with the encoder count read after them; hands thread mode a status every
+/// `status_every` samples. `max_cycles`: the longest oversampling, filter and `on_frame`
+/// so far, in CPU cycles.
 fn process_half(
     path: &mut SamplePath,
-    v: &[u16],
-    i: &[u16],
+    filter: &mut geometry::PwmFilter,
+    (v, i): (&[u16], &[u16]),
     encoder_count: u16,
     max_cycles: &mut u32,
 ) {
     let per_sample = HALF_LEN / geometry::SAMPLES_PER_HALF;
     for (v, i) in v.chunks_exact(per_sample).zip(i.chunks_exact(per_sample)) {
         let t0 = cortex_m::peripheral::DWT::cycle_count();
-        let ([va, vb, vc], [ia, ib, ic]) = (geometry::average_half(v), geometry::average_half(i));
-        let averaging = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t0);
+        let ((vs, n), (is, _)) = (geometry::sum_half(v), geometry::sum_half(i));
+        let ([va, vb, vc], [ia, ib, ic], encoder_count) = filter.step(vs, is, n, encoder_count);
+        let filtering = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t0);
         let raw = RawFrame {
             v: [VoltageCode(va), VoltageCode(vb), VoltageCode(vc)],
             i: [CurrentCode(ia), CurrentCode(ib), CurrentCode(ic)],
@@ -192,7 +198,7 @@ fn process_half(
         }
         let t1 = cortex_m::peripheral::DWT::cycle_count();
         path.on_frame(&raw);
-        let dt = averaging + cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t1);
+        let dt = filtering + cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t1);
         *max_cycles = (*max_cycles).max(dt);
         if path.samples().is_multiple_of(SETTINGS.status_every()) {
             STATUS.signal(Status {
@@ -209,6 +215,7 @@ fn process_half(
 /// path on the half.
 #[embassy_executor::task]
 pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
+    let mut filter = geometry::PwmFilter::new(SETTINGS.sample_rate_hz, hw.supply_hz);
     let (qei, mut acq) = set_up_acquisition(hw, &mut path);
     let mut wait = AdcWait::new(SETTINGS.sample_rate_hz);
     let timeout = Duration::from_micros(u64::from(wait.timeout_us()));
@@ -228,7 +235,8 @@ pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
             continue;
         }
         apply_commands(&mut path);
-        process_half(&mut path, &half1, &half2, qei.count(), &mut max_cycles);
+        let halves = (&half1[..], &half2[..]);
+        process_half(&mut path, &mut filter, halves, qei.count(), &mut max_cycles);
     }
 }
 

@@ -92,6 +92,7 @@
 mod effect_spec;
 mod faults;
 pub mod machine;
+pub mod pwm;
 mod resolve;
 mod run;
 mod scenario;
