@@ -26,6 +26,7 @@
 
 mod acquisition;
 mod failure;
+mod flash;
 mod logs;
 mod sample_task;
 mod supply;
@@ -33,11 +34,11 @@ mod supply;
 use core::mem::MaybeUninit;
 use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 
-use defmt::{error, info, warn};
+use defmt::{error, info};
 use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, Spawner};
 use embassy_stm32::exti::{self, ExtiInput};
-use embassy_stm32::flash::{Blocking, Flash};
+use embassy_stm32::flash::Flash;
 use embassy_stm32::gpio::{Level, Output, Pull, Speed};
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::mode::Async;
@@ -56,15 +57,14 @@ use drive_monitor::board::{self, pins::Board, Lamp, LAMP_COUNT};
 use drive_monitor::boot::{self, BootMachine};
 use drive_monitor::clock;
 use drive_monitor::commissioning::Action;
-use drive_monitor::flash_ecc::{CheckedFlash, RawFlash, ReadError};
-use drive_monitor::flash_record::{RecordStore, RECORD_LEN};
 use drive_monitor::offset_trim::TrimResult;
 use drive_monitor::panel::PanelLamps;
 use drive_monitor::reset_record::{BootPhase, PreviousRun, RESET_RECORD_LEN};
 use drive_monitor::supply::BorCheck;
-use monitor_core::motor_record::STORED_LEN as MOTOR_RECORD_LEN;
 use monitor_core::Isolation;
 
+use drive_monitor::flash_ecc::CheckedFlash;
+use flash::{read_motor_page, BoardFlash, Driver};
 use sample_task::{sample_task, SampleHw};
 
 bind_interrupts!(struct Irqs {
@@ -186,83 +186,6 @@ impl PanelPins {
     }
 }
 
-/// Why the board's flash could not be used.
-#[derive(defmt::Format)]
-enum FlashError {
-    /// The option bytes select single-bank flash (the records' pages need dual-bank).
-    SingleBank,
-    /// The flash driver's error.
-    Driver(embassy_stm32::flash::Error),
-    /// A double ECC error in the page (a torn write): the page is marked bad for this run.
-    Ecc {
-        /// The failing offset from 0x0800_0000.
-        offset: u32,
-    },
-    /// The page was marked bad earlier in this run.
-    MarkedBad,
-}
-
-/// The flash driver (`None`: the option bytes are single-bank).
-struct Driver(Option<Flash<'static, Blocking>>);
-
-impl Driver {
-    fn get(&mut self) -> Result<&mut Flash<'static, Blocking>, FlashError> {
-        self.0.as_mut().ok_or(FlashError::SingleBank)
-    }
-}
-
-impl RawFlash for Driver {
-    type Error = FlashError;
-    fn read_raw(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), FlashError> {
-        self.get()?
-            .blocking_read(offset, buf)
-            .map_err(FlashError::Driver)
-    }
-}
-
-/// The record pages in the board's flash, every read checked for ECC double errors
-/// (`drive_monitor::flash_ecc`: the NMI handler latches them in `failure::ECC`).
-struct BoardFlash(CheckedFlash<Driver>);
-
-/// A checked read's error as the firmware logs it.
-fn flash_error(e: ReadError<FlashError>) -> FlashError {
-    match e {
-        ReadError::Driver(e) => e,
-        ReadError::Ecc(e) => FlashError::Ecc { offset: e.offset },
-        ReadError::MarkedBad => FlashError::MarkedBad,
-    }
-}
-
-impl BoardFlash {
-    fn read_at(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), FlashError> {
-        self.0.read(&failure::ECC, offset, buf).map_err(flash_error)
-    }
-}
-
-impl RecordStore for BoardFlash {
-    type Error = FlashError;
-    fn read(&mut self, buf: &mut [u8; RECORD_LEN]) -> Result<(), Self::Error> {
-        self.read_at(board::RECORD_FLASH_OFFSET, buf)
-    }
-    fn erase(&mut self) -> Result<(), Self::Error> {
-        let from = board::RECORD_FLASH_OFFSET;
-        self.0
-            .raw
-            .get()?
-            .blocking_erase(from, from + board::RECORD_PAGE_SIZE)
-            .map_err(FlashError::Driver)?;
-        self.0.erased(from);
-        Ok(())
-    }
-    fn write(&mut self, bytes: &[u8; RECORD_LEN]) -> Result<(), Self::Error> {
-        self.0
-            .raw
-            .get()?
-            .blocking_write(board::RECORD_FLASH_OFFSET, bytes)
-            .map_err(FlashError::Driver)
-    }
-}
-
 fn clock_config() -> embassy_stm32::Config {
     use embassy_stm32::rcc::*;
     let mut config = embassy_stm32::Config::default();
@@ -293,19 +216,6 @@ fn start_watchdog(
     let mut wdg = IndependentWatchdog::new(iwdg, WATCHDOG_TIMEOUT_MS * 1000);
     wdg.unleash();
     wdg
-}
-
-/// The motor record's page (`board::MOTOR_RECORD_FLASH_OFFSET`), read as erased when the
-/// flash cannot be read or the read raised an ECC double error (the page is then marked
-/// bad; the reason is logged): `drive_monitor::boot` then runs the built-in default.
-fn read_motor_page(flash: &mut BoardFlash) -> [u8; MOTOR_RECORD_LEN] {
-    let (page, read) = flash
-        .0
-        .read_or_erased::<MOTOR_RECORD_LEN>(&failure::ECC, board::MOTOR_RECORD_FLASH_OFFSET);
-    if let Err(e) = read {
-        warn!("motor record page unreadable: {}; running the built-in motor (write the record again: docs/firmware.md)", flash_error(e));
-    }
-    page
 }
 
 /// The boot composition (`drive_monitor::boot`, the function the host's SIL rig boots
