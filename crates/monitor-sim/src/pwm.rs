@@ -184,20 +184,22 @@ impl Period {
         segments.push((start + tc, [0.0; 3]));
         // The current ripple: the integral of e / (sigma Ls), its period mean taken out.
         let l = spec.transient_inductance_h;
-        let mut i_start = vec![[0.0; 3]; segments.len()];
+        let mut i_start = Vec::with_capacity(segments.len());
+        let mut i_now = [0.0; 3];
         let mut mean_i = [0.0; 3];
-        for (j, w) in segments.windows(2).enumerate() {
+        i_start.push(i_now);
+        for w in segments.windows(2) {
             let (&(t0, e), &(t1, _)) = (&w[0], &w[1]);
             let dt = t1 - t0;
-            let i0 = i_start[j];
-            for x in 0..3 {
-                mean_i[x] += (i0[x] + e[x] * dt / (2.0 * l)) * dt / tc;
-                i_start[j + 1][x] = i0[x] + e[x] * dt / l;
+            for ((m, i), e) in mean_i.iter_mut().zip(&mut i_now).zip(e) {
+                *m += (*i + e * dt / (2.0 * l)) * dt / tc;
+                *i += e * dt / l;
             }
+            i_start.push(i_now);
         }
         for i in &mut i_start {
-            for x in 0..3 {
-                i[x] -= mean_i[x];
+            for (i, m) in i.iter_mut().zip(&mean_i) {
+                *i -= m;
             }
         }
         Period {
@@ -231,12 +233,12 @@ impl Period {
                 }
                 let now = advance(from, t_from - t0, row.t_s - t0, e, i0, slope, tau);
                 if let Some(v) = o.v_abc.as_mut() {
-                    for x in 0..3 {
-                        v[x] += now[x].v;
+                    for (v, n) in v.iter_mut().zip(&now) {
+                        *v += n.v;
                     }
                 }
-                for x in 0..3 {
-                    o.i_abc[x] += now[x].i;
+                for (i, n) in o.i_abc.iter_mut().zip(&now) {
+                    *i += n.i;
                 }
                 from = now;
                 t_from = row.t_s;
@@ -319,18 +321,18 @@ mod tests {
         let mut mean = [0.0; 3];
         for r in &out {
             let v = r.v_abc.unwrap();
-            for x in 0..3 {
-                let level = v[x] / 200.0;
+            for (m, x) in mean.iter_mut().zip(v) {
+                let level = x / 200.0;
                 assert!(
                     (level - level.round()).abs() < 1e-9 && level.abs() <= 2.0,
                     "{v:?}"
                 );
-                mean[x] += v[x] / 1_000.0;
+                *m += x / 1_000.0;
             }
         }
-        for x in 0..3 {
+        for (m, r) in mean.iter().zip(reference) {
             // The mean of 1000 points of a waveform whose edges fall between them.
-            assert!((mean[x] - reference[x]).abs() < 1.0, "{mean:?}");
+            assert!((m - r).abs() < 1.0, "{mean:?}");
         }
         // The current ripple: zero mean over the period, a triangle of about
         // e dt / L (peak-to-peak under V_dc T_c / (4 L) = 3.75 A).
