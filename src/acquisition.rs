@@ -73,14 +73,16 @@ pub const fn reference_conversion_ns() -> u32 {
     (260 * 1_000_000_000_u64 / clock::ADC_CLOCK_HZ as u64) as u32
 }
 
-// A sequence, even one held up by the reference's injected conversion, ends before the
-// next trigger at the default 10 kHz (12.5 us between triggers): no overrun by design.
-const _: () = assert!(
-    sequence_ns() + reference_conversion_ns()
-        < 1_000_000_000 / trigger_rate_hz(crate::board::DEFAULT_SAMPLE_RATE_HZ)
-);
-const _: () =
-    assert!(clock::timer_divider(trigger_rate_hz(crate::board::DEFAULT_SAMPLE_RATE_HZ)).is_some());
+/// Whether the acquisition fits `sample_rate_hz` (the firmware checks its rate at compile
+/// time): a sequence, even one held up by the reference's injected conversion, ends before
+/// the next trigger (no overrun by design), and the timers' clock divides the trigger rate
+/// exactly.
+pub const fn fits(sample_rate_hz: u32) -> bool {
+    let trigger = trigger_rate_hz(sample_rate_hz);
+    trigger > 0
+        && sequence_ns() + reference_conversion_ns() < 1_000_000_000 / trigger
+        && clock::timer_divider(trigger).is_some()
+}
 
 /// The mean of each channel over the [`OVERSAMPLING`] sequences of one half buffer
 /// `half` (`[a, b, c, a, b, c, ...]`, [`HALF_LEN`] words), rounded to the nearest code.
@@ -103,15 +105,14 @@ pub fn average_half(half: &[u16]) -> [u16; CHANNELS] {
 /// b, c, ...]`) and how many sequences it held: what [`PwmFilter::step`] takes.
 #[inline]
 pub fn sum_half(half: &[u16]) -> ([u32; CHANNELS], u32) {
-    let mut sum = [0u32; CHANNELS];
-    let mut n = 0u32;
-    for seq in half.chunks_exact(CHANNELS) {
-        for (s, &code) in sum.iter_mut().zip(seq) {
-            *s += u32::from(code);
-        }
-        n += 1;
+    let (sequences, _) = half.as_chunks::<CHANNELS>();
+    let [mut a, mut b, mut c] = [0u32; CHANNELS];
+    for &[x, y, z] in sequences {
+        a += u32::from(x);
+        b += u32::from(y);
+        c += u32::from(z);
     }
-    (sum, n)
+    ([a, b, c], sequences.len() as u32)
 }
 
 /// Fractional bits of [`PwmFilter`]'s states.
@@ -138,8 +139,9 @@ pub const ENCODER_DELAY_SAMPLES: usize = 4;
 pub struct PwmFilter {
     /// Each channel's two stages (voltages a, b, c, then currents), in sums x 2^12.
     stages: [[i32; 2]; 2 * CHANNELS],
-    /// The encoder counts of the last samples, oldest first.
+    /// The encoder counts of the last samples, a ring; `at` the oldest.
     counts: [u16; ENCODER_DELAY_SAMPLES],
+    at: usize,
     /// The inverse of the stages' gain at the supply frequency, x 2^15.
     gain_q15: i32,
     primed: bool,
@@ -166,6 +168,7 @@ impl PwmFilter {
         Self {
             stages: [[0; 2]; 2 * CHANNELS],
             counts: [0; ENCODER_DELAY_SAMPLES],
+            at: 0,
             gain_q15,
             primed: false,
         }
@@ -184,35 +187,48 @@ impl PwmFilter {
         count: u16,
     ) -> ([u16; CHANNELS], [u16; CHANNELS], u16) {
         let n = n.max(1) as i32;
-        let primed = self.primed;
-        let gain = self.gain_q15;
-        let mut out = [0u16; 2 * CHANNELS];
-        for ((st, &x), o) in self.stages.iter_mut().zip(v.iter().chain(&i)).zip(&mut out) {
-            // The mean in codes x 2^12 (n <= 8: 4095 x 2^12 < 2^24).
-            let x = ((x as i32) << FILTER_FRAC_BITS) / n;
-            if !primed {
-                *st = [x, x];
-            }
-            st[0] += (x - st[0]) >> STAGE1_SHIFT;
-            st[1] += (st[0] - st[1]) >> STAGE2_SHIFT;
-            // Around mid-scale, so that the gain restores the swing, not the offset.
-            let mid = 2048 << FILTER_FRAC_BITS;
-            let y = mid + (((st[1] - mid) as i64 * gain as i64) >> 15) as i32;
-            let code = (y + (1 << (FILTER_FRAC_BITS - 1))) >> FILTER_FRAC_BITS;
-            *o = code.clamp(0, 4095) as u16;
-        }
+        let (primed, gain) = (self.primed, self.gain_q15);
+        let [va, vb, vc] = v;
+        let [ia, ib, ic] = i;
+        let [s0, s1, s2, s3, s4, s5] = &mut self.stages;
+        let v = [
+            filter_channel(s0, va, n, primed, gain),
+            filter_channel(s1, vb, n, primed, gain),
+            filter_channel(s2, vc, n, primed, gain),
+        ];
+        let i = [
+            filter_channel(s3, ia, n, primed, gain),
+            filter_channel(s4, ib, n, primed, gain),
+            filter_channel(s5, ic, n, primed, gain),
+        ];
         self.primed = true;
         if !primed {
             self.counts = [count; ENCODER_DELAY_SAMPLES];
         }
-        let delayed = self.counts.first().copied().unwrap_or(count);
-        self.counts.rotate_left(1);
-        if let Some(last) = self.counts.last_mut() {
-            *last = count;
-        }
-        let [va, vb, vc, ia, ib, ic] = out;
-        ([va, vb, vc], [ia, ib, ic], delayed)
+        let slot = self.counts.get_mut(self.at % ENCODER_DELAY_SAMPLES);
+        let delayed = slot.map_or(count, |c| core::mem::replace(c, count));
+        self.at = (self.at + 1) % ENCODER_DELAY_SAMPLES;
+        (v, i, delayed)
     }
+}
+
+/// One channel of [`PwmFilter::step`]: the mean of `sum` over `n` sequences in codes x
+/// 2^12 (n <= 8: 4095 x 2^12 < 2^24) through the two stages `st` (started at it when not
+/// `primed`), the gain restored around mid-scale (the swing, not the offset), rounded to
+/// a code within 0..=4095.
+#[inline(always)]
+fn filter_channel(st: &mut [i32; 2], sum: u32, n: i32, primed: bool, gain_q15: i32) -> u16 {
+    let x = ((sum as i32) << FILTER_FRAC_BITS) / n;
+    if !primed {
+        *st = [x, x];
+    }
+    let [a, b] = st;
+    *a += (x - *a) >> STAGE1_SHIFT;
+    *b += (*a - *b) >> STAGE2_SHIFT;
+    let mid = 2048 << FILTER_FRAC_BITS;
+    let y = mid + ((i64::from(*b - mid) * i64::from(gain_q15)) >> 15) as i32;
+    let code = (y + (1 << (FILTER_FRAC_BITS - 1))) >> FILTER_FRAC_BITS;
+    code.clamp(0, 4095) as u16
 }
 
 /// `sqrt(x)` for `x` in 1..=4 (the inverse gain squared) by Newton's iteration from `x`:
@@ -248,6 +264,9 @@ mod tests {
         assert_eq!(conversion_ns(), 870);
         assert!(sequence_ns() < 12_500);
         assert_eq!(trigger_rate_hz(10_000), 80_000);
+        assert!(fits(10_000));
+        // 20 kHz: 6.25 us between triggers, less than a sequence held up by VREFINT.
+        assert!(!fits(20_000));
     }
 
     #[test]

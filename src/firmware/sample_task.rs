@@ -89,6 +89,10 @@ fn start_encoder(
 /// 5 pF and R_ADC 1 kohm, is about 11 kohm at 24.5 cycles.
 const SAMPLE_TIME: SampleTime = SampleTime::CYCLES24_5;
 const _: () = assert!(geometry::SAMPLE_TIME_HALF_CYCLES == 49);
+const _: () = assert!(
+    geometry::fits(SETTINGS.sample_rate_hz),
+    "the oversampled acquisition does not fit the sample rate"
+);
 
 /// ADC1's regular sequence va, vb, vc on TIM1's TRGO into its DMA ring.
 fn ring_voltages(
