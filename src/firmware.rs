@@ -2,24 +2,30 @@
 //!
 //! Tasks and priorities:
 //! - `sample_task` (`firmware/sample_task.rs`) on an interrupt executor (UART4 vector, NVIC
-//!   priority P1, above thread mode): TIM1 TRGO triggers ADC1 (va, vb, vc) and ADC2 (ia, ib, ic) at the sample rate
-//!   of [`SETTINGS`]; each ADC fills a DMA ring of two samples, so every sample wakes the
-//!   task (half- and full-transfer interrupts). The task reads the encoder counter (TIM4)
-//!   and runs `SamplePath::on_frame` (scaling and `Monitor::update`). Every wait for ADC
-//!   data has a timeout (`drive_monitor::liveness::AdcWait`): when it expires (an ADC overrun, a DMA transfer
-//!   error, a stopped trigger) or the DMA lapped the reader, the acquisition is recovered
-//!   by `drive_monitor::recovery::recover` on the registers (`firmware/acquisition.rs`):
-//!   trigger, ADCs and DMA stopped, `OVR` and `TEIF` cleared, DMA re-armed, ADCs and
-//!   trigger restarted, in the reference manual's order. Every `status_every` samples the task hands
-//!   thread mode a small `MonitorStatus`.
+//!   priority P1, above thread mode): TIM1 TRGO triggers ADC1 (va, vb, vc) and ADC2 (ia, ib,
+//!   ic) eight times per sample of [`SETTINGS`]; each ADC fills a DMA ring of two halves of
+//!   eight sequences (`drive_monitor::acquisition`), so every sample wakes the task
+//!   (half- and full-transfer interrupts). The task sums the sequences, runs
+//!   `acquisition::PwmFilter` (an inverter's in-band ripple out), reads the encoder counter
+//!   (TIM4) and runs `SamplePath::on_frame` (scaling and `Monitor::update`). Every wait for
+//!   ADC data has a timeout (`drive_monitor::liveness::AdcWait`): when it expires (an ADC
+//!   overrun, a DMA transfer error, a stopped trigger) or the DMA lapped the reader, the
+//!   acquisition is recovered by `drive_monitor::recovery::recover` on the registers
+//!   (`firmware/acquisition.rs`): trigger, ADCs and DMA stopped (`DMAEN` cleared), `OVR`,
+//!   `EOC`, `EOS` and `TEIF` cleared, DMA re-armed, ADCs and trigger restarted, in the
+//!   reference manual's order. Every `status_every` samples the task hands thread mode a
+//!   small `MonitorStatus`.
 //! - `main` in thread mode: boot (clocks, watchdog, why the previous run ended, flash
 //!   record), then every 50 ms `Supervisor::tick`: button, commissioning procedure, the
 //!   watch on the sample counter (the watchdog is petted only while samples flow), panel;
 //!   it carries out the commissioning action (storing the record in flash) and logs a
 //!   status line every 100 ms.
-//! - The panic handlers (`firmware/failure.rs`, `core`'s and defmt's): "monitor failed" on
-//!   the panel, the reason into the reset record (RAM that survives the reset), then the
-//!   watchdog's reset, or a software reset when the watchdog does not run yet.
+//! - The fault path (`firmware/failure.rs`: the panic handlers, `core`'s and defmt's, the
+//!   HardFault, NMI and default handlers; `drive_monitor::fault_path`): a guard, the reason
+//!   into the reset record (RAM that survives the reset), "monitor failed" on the panel, no
+//!   log, then the watchdog's reset, or a software reset when the watchdog does not run yet.
+//!   An NMI from an ECC double error in a record page is latched instead, and the boot
+//!   falls back (`drive_monitor::flash_ecc`, `firmware/flash.rs`).
 //!
 //! Communication: `COMMANDS` (Channel, thread -> sample task), `STATUS` (Signal, latest
 //! status, sample task -> thread, 100 Hz), `TRIM` (Signal, the start-up offset trim, once).

@@ -11,7 +11,7 @@
 //! - [`board`]: analog front-end scaling (ADC code -> volts/amperes), encoder and sample
 //!   rate constants, the lamp table (each lamp's pin and meaning, once) and (target only)
 //!   the pin map;
-//! - [`sampling`]: one trigger's six ADC codes + encoder count -> the core's `Sample`;
+//! - [`sampling`]: one sample's six ADC codes + encoder count -> the core's `Sample`;
 //! - [`motor_source`] and [`boot`]: the machine from the motor record (or the built-in
 //!   default) and the boot's composition: sample path, isolator, encoder set-up, stored
 //!   calibration and supervisor, each failure with its fallback;

@@ -84,7 +84,8 @@ fn start_encoder(
 /// checked below): with 12.5 cycles of approximation 870 ns a conversion at the 42.5 MHz
 /// ADC clock, 2.6 us a sequence of three, within the 12.5 us between the oversampling's
 /// triggers. The documented front end (docs/firmware.md, "Voltage and current sensing")
-/// drives each pin through a 1 kohm / 10 nF anti-alias filter; the datasheet's bound on
+/// drives each pin through a 1 kohm / 10 nF anti-alias filter (100 nF for an inverter-fed
+/// motor); the datasheet's bound on
 /// the source resistance, R_AIN < t_S / (f_ADC C_ADC ln(2^(N+2))) - R_ADC, with C_ADC
 /// 5 pF and R_ADC 1 kohm, is about 11 kohm at 24.5 cycles.
 const SAMPLE_TIME: SampleTime = SampleTime::CYCLES24_5;
