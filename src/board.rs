@@ -77,9 +77,9 @@ pub const ENCODER_LINES: u32 = 1024;
 /// `4 * 1024 = 4096`.
 pub const ENCODER_COUNTS_PER_REV: u32 = 4 * ENCODER_LINES;
 
-/// Kernel clock of the encoder timer TIM4, Hz: the APB1 timer clock at the 170 MHz system
-/// clock (`firmware.rs`'s clock configuration, APB1 undivided).
-pub const ENCODER_TIMER_HZ: u32 = 170_000_000;
+/// Kernel clock of the encoder timer TIM4, Hz: the APB1 timer clock
+/// ([`crate::clock::TIMER_HZ`], 170 MHz).
+pub const ENCODER_TIMER_HZ: u32 = crate::clock::TIMER_HZ;
 
 /// Length of the timer input filter `ICxF = 0..=15` in timer clocks, with `f_DTS = f_CK_INT`
 /// (`CKD = 0`): `N` consecutive equal samples at `f_SAMPLING` (STM32G4 reference manual

@@ -2,42 +2,49 @@
 //!
 //! Tasks and priorities:
 //! - `sample_task` (`firmware/sample_task.rs`) on an interrupt executor (UART4 vector, NVIC
-//!   priority P1, above thread mode): TIM1 TRGO triggers ADC1 (va, vb, vc) and ADC2 (ia, ib, ic) at the sample rate
-//!   of [`SETTINGS`]; each ADC fills a DMA ring of two samples, so every sample wakes the
-//!   task (half- and full-transfer interrupts). The task reads the encoder counter (TIM4)
-//!   and runs `SamplePath::on_frame` (scaling and `Monitor::update`). Every wait for ADC
-//!   data has a timeout (`drive_monitor::liveness::AdcWait`): when it expires (an ADC overrun, a DMA transfer
-//!   error, a stopped trigger) or the DMA lapped the reader, the acquisition is recovered
-//!   by `drive_monitor::recovery::recover` on the registers (`firmware/acquisition.rs`):
-//!   trigger, ADCs and DMA stopped, `OVR` and `TEIF` cleared, DMA re-armed, ADCs and
-//!   trigger restarted, in the reference manual's order. Every `status_every` samples the task hands
-//!   thread mode a small `MonitorStatus`.
+//!   priority P1, above thread mode): TIM1 TRGO triggers ADC1 (va, vb, vc) and ADC2 (ia, ib,
+//!   ic) eight times per sample of [`SETTINGS`]; each ADC fills a DMA ring of two halves of
+//!   eight sequences (`drive_monitor::acquisition`), so every sample wakes the task
+//!   (half- and full-transfer interrupts). The task sums the sequences, runs
+//!   `acquisition::PwmFilter` (an inverter's in-band ripple out), reads the encoder counter
+//!   (TIM4) and runs `SamplePath::on_frame` (scaling and `Monitor::update`). Every wait for
+//!   ADC data has a timeout (`drive_monitor::liveness::AdcWait`): when it expires (an ADC
+//!   overrun, a DMA transfer error, a stopped trigger) or the DMA lapped the reader, the
+//!   acquisition is recovered by `drive_monitor::recovery::recover` on the registers
+//!   (`firmware/acquisition.rs`): trigger, ADCs and DMA stopped (`DMAEN` cleared), `OVR`,
+//!   `EOC`, `EOS` and `TEIF` cleared, DMA re-armed, ADCs and trigger restarted, in the
+//!   reference manual's order. Every `status_every` samples the task hands thread mode a
+//!   small `MonitorStatus`.
 //! - `main` in thread mode: boot (clocks, watchdog, why the previous run ended, flash
 //!   record), then every 50 ms `Supervisor::tick`: button, commissioning procedure, the
 //!   watch on the sample counter (the watchdog is petted only while samples flow), panel;
 //!   it carries out the commissioning action (storing the record in flash) and logs a
 //!   status line every 100 ms.
-//! - The panic handlers (`firmware/failure.rs`, `core`'s and defmt's): "monitor failed" on
-//!   the panel, the reason into the reset record (RAM that survives the reset), then the
-//!   watchdog's reset, or a software reset when the watchdog does not run yet.
+//! - The fault path (`firmware/failure.rs`: the panic handlers, `core`'s and defmt's, the
+//!   HardFault, NMI and default handlers; `drive_monitor::fault_path`): a guard, the reason
+//!   into the reset record (RAM that survives the reset), "monitor failed" on the panel, no
+//!   log, then the watchdog's reset, or a software reset when the watchdog does not run yet.
+//!   An NMI from an ECC double error in a record page is latched instead, and the boot
+//!   falls back (`drive_monitor::flash_ecc`, `firmware/flash.rs`).
 //!
 //! Communication: `COMMANDS` (Channel, thread -> sample task), `STATUS` (Signal, latest
 //! status, sample task -> thread, 100 Hz), `TRIM` (Signal, the start-up offset trim, once).
 
 mod acquisition;
 mod failure;
+mod flash;
 mod logs;
 mod sample_task;
 mod supply;
 
 use core::mem::MaybeUninit;
-use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
+use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 
-use defmt::{error, info, warn};
+use defmt::{error, info};
 use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, Spawner};
 use embassy_stm32::exti::{self, ExtiInput};
-use embassy_stm32::flash::{Blocking, Flash};
+use embassy_stm32::flash::Flash;
 use embassy_stm32::gpio::{Level, Output, Pull, Speed};
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::mode::Async;
@@ -54,15 +61,16 @@ use drive_monitor::app::{
 };
 use drive_monitor::board::{self, pins::Board, Lamp, LAMP_COUNT};
 use drive_monitor::boot::{self, BootMachine};
+use drive_monitor::clock;
 use drive_monitor::commissioning::Action;
-use drive_monitor::flash_record::{RecordStore, RECORD_LEN};
 use drive_monitor::offset_trim::TrimResult;
 use drive_monitor::panel::PanelLamps;
 use drive_monitor::reset_record::{BootPhase, PreviousRun, RESET_RECORD_LEN};
 use drive_monitor::supply::BorCheck;
-use monitor_core::motor_record::STORED_LEN as MOTOR_RECORD_LEN;
 use monitor_core::Isolation;
 
+use drive_monitor::flash_ecc::CheckedFlash;
+use flash::{read_motor_page, BoardFlash, Driver};
 use sample_task::{sample_task, SampleHw};
 
 bind_interrupts!(struct Irqs {
@@ -121,8 +129,6 @@ static RESTARTS: AtomicU32 = AtomicU32::new(0);
 static EXECUTOR_HIGH: InterruptExecutor = InterruptExecutor::new();
 /// What the firmware is doing ([`BootPhase::number`]), for the record of a `defmt` panic.
 static PHASE: AtomicU8 = AtomicU8::new(0);
-/// The independent watchdog runs (else the panic handler resets the MCU itself).
-static WATCHDOG_RUNNING: AtomicBool = AtomicBool::new(false);
 
 fn set_phase(phase: BootPhase) {
     PHASE.store(phase.number(), Ordering::Relaxed);
@@ -186,59 +192,19 @@ impl PanelPins {
     }
 }
 
-/// Why the board's flash could not be used.
-#[derive(defmt::Format)]
-enum FlashError {
-    /// The option bytes select single-bank flash (the records' pages need dual-bank).
-    SingleBank,
-    /// The flash driver's error.
-    Driver(embassy_stm32::flash::Error),
-}
-
-/// The record pages in the board's flash (`None`: the option bytes are single-bank).
-struct BoardFlash(Option<Flash<'static, Blocking>>);
-
-impl BoardFlash {
-    fn driver(&mut self) -> Result<&mut Flash<'static, Blocking>, FlashError> {
-        self.0.as_mut().ok_or(FlashError::SingleBank)
-    }
-
-    fn read_at(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), FlashError> {
-        self.driver()?
-            .blocking_read(offset, buf)
-            .map_err(FlashError::Driver)
-    }
-}
-
-impl RecordStore for BoardFlash {
-    type Error = FlashError;
-    fn read(&mut self, buf: &mut [u8; RECORD_LEN]) -> Result<(), Self::Error> {
-        self.read_at(board::RECORD_FLASH_OFFSET, buf)
-    }
-    fn erase(&mut self) -> Result<(), Self::Error> {
-        let from = board::RECORD_FLASH_OFFSET;
-        self.driver()?
-            .blocking_erase(from, from + board::RECORD_PAGE_SIZE)
-            .map_err(FlashError::Driver)
-    }
-    fn write(&mut self, bytes: &[u8; RECORD_LEN]) -> Result<(), Self::Error> {
-        self.driver()?
-            .blocking_write(board::RECORD_FLASH_OFFSET, bytes)
-            .map_err(FlashError::Driver)
-    }
-}
-
 fn clock_config() -> embassy_stm32::Config {
     use embassy_stm32::rcc::*;
     let mut config = embassy_stm32::Config::default();
-    // 16 MHz HSI / 4 * 85 / 2 = 170 MHz SYSCLK (the G474's maximum, needs boost mode).
+    // 16 MHz HSI / 4 * 85 / 2 = 170 MHz SYSCLK (the G474's maximum, needs boost mode):
+    // the settings of `drive_monitor::clock`, from which every rate and cycle count is
+    // derived (the registers' encodings: PLLM - 1, PLLN, PLLR / 2 - 1).
     config.rcc.pll = Some(Pll {
         source: PllSource::HSI,
-        prediv: PllPreDiv::DIV4,
-        mul: PllMul::MUL85,
+        prediv: PllPreDiv::from_bits((clock::PLL_PREDIV - 1) as u8),
+        mul: PllMul::from_bits(clock::PLL_MUL as u8),
         divp: None,
         divq: None,
-        divr: Some(PllRDiv::DIV2),
+        divr: Some(PllRDiv::from_bits((clock::PLL_RDIV / 2 - 1) as u8)),
     });
     config.rcc.sys = Sysclk::PLL1_R;
     config.rcc.boost = true;
@@ -255,20 +221,7 @@ fn start_watchdog(
     pac::DBGMCU.apb1lfzr().modify(|w| w.set_iwdg(true));
     let mut wdg = IndependentWatchdog::new(iwdg, WATCHDOG_TIMEOUT_MS * 1000);
     wdg.unleash();
-    WATCHDOG_RUNNING.store(true, Ordering::Relaxed);
     wdg
-}
-
-/// The motor record's page (`board::MOTOR_RECORD_FLASH_OFFSET`), read as erased when the
-/// flash cannot be read (the reason is logged): `drive_monitor::boot` then runs the
-/// built-in default.
-fn read_motor_page(flash: &mut BoardFlash) -> [u8; MOTOR_RECORD_LEN] {
-    let mut page = [0xFF_u8; MOTOR_RECORD_LEN];
-    if let Err(e) = flash.read_at(board::MOTOR_RECORD_FLASH_OFFSET, &mut page) {
-        warn!("motor record page unreadable: {}", e);
-        page = [0xFF; MOTOR_RECORD_LEN];
-    }
-    page
 }
 
 /// The boot composition (`drive_monitor::boot`, the function the host's SIL rig boots
@@ -311,7 +264,9 @@ async fn main(_spawner: Spawner) {
     let dual_bank = dual_bank_flash();
     let mut thread = Thread {
         lamps: PanelPins::new(b.lamps),
-        flash: BoardFlash(dual_bank.then(|| Flash::new_blocking(b.flash))),
+        flash: BoardFlash(CheckedFlash::new(Driver(
+            dual_bank.then(|| Flash::new_blocking(b.flash)),
+        ))),
         wdg,
         max_update_cycles: 0,
         log_div: 0,
@@ -334,6 +289,7 @@ async fn main(_spawner: Spawner) {
         enc_b: b.encoder_b,
         encoder: machine.encoder,
         syst: cp.SYST,
+        supply_hz: machine.record.supply.f_hz as f32,
     };
     spawn_sample_task(hw, path);
     thread.run(&mut supervisor, &mut button, boot).await

@@ -2,10 +2,16 @@
 //!
 //! This library holds everything of the firmware that does not touch a register, so it
 //! builds and is tested on the host (`cargo test`):
+//! - [`clock`]: the clock tree's settings and every rate and cycle count derived from them;
+//! - [`acquisition`]: the ADCs' geometry (channels, oversampling, DMA ring, conversion
+//!   time), shared with the host's model of the ADC and DMA, and the oversampling's mean;
+//! - [`fault_path`]: the end of a failed run (guard, record, panel; no log);
+//! - [`flash_ecc`]: the record pages' ECC double errors (the NMI's decision, the checked
+//!   reads that mark a page bad);
 //! - [`board`]: analog front-end scaling (ADC code -> volts/amperes), encoder and sample
 //!   rate constants, the lamp table (each lamp's pin and meaning, once) and (target only)
 //!   the pin map;
-//! - [`sampling`]: one trigger's six ADC codes + encoder count -> the core's `Sample`;
+//! - [`sampling`]: one sample's six ADC codes + encoder count -> the core's `Sample`;
 //! - [`motor_source`] and [`boot`]: the machine from the motor record (or the built-in
 //!   default) and the boot's composition: sample path, isolator, encoder set-up, stored
 //!   calibration and supervisor, each failure with its fallback;
@@ -50,10 +56,14 @@
     )
 )]
 
+pub mod acquisition;
 pub mod app;
 pub mod board;
 pub mod boot;
+pub mod clock;
 pub mod commissioning;
+pub mod fault_path;
+pub mod flash_ecc;
 pub mod flash_record;
 pub mod liveness;
 pub mod motor_source;

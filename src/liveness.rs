@@ -66,7 +66,7 @@ impl AdcWait {
         }
     }
 
-    /// Longest wait for one trigger's data, us.
+    /// Longest wait for one sample's data, us.
     pub fn timeout_us(&self) -> u32 {
         self.timeout_us
     }

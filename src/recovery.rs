@@ -21,7 +21,7 @@
 //! |---|---|---|
 //! | [`RecoveryStep::StopTrigger`] | TIM1 counter off | no new conversion starts |
 //! | [`RecoveryStep::StopAdc`] | `ADSTP`, then wait for `ADSTART = 0` (bounded) | a conversion in flight ends before the DMA stops (else it would set `OVR` itself) |
-//! | [`RecoveryStep::PauseDma`] | `EN = 0`, then wait for it (bounded) | `CNDTR` may only be written with the channel off |
+//! | [`RecoveryStep::PauseDma`] | `DMAEN = 0` in `ADC_CFGR`, then the channel's `EN = 0` and a wait for it (bounded) | the ADC withdraws its DMA request (a request latched while the channel was off, after a transfer error, would otherwise move one stale word at the re-arm and shift the channels in the ring for good); `CNDTR` may only be written with the channel off |
 //! | [`RecoveryStep::ClearFlags`] | `OVR`, `EOC`, `EOS` (write 1), `TEIF`/`HTIF`/`TCIF` (`DMA_IFCR`) | a latched `OVR` blocks the DMA requests; an `EOC` left set (the data register unread since the overrun) sets `OVR` again at the next conversion |
 //! | [`RecoveryStep::RearmDma`] | `CNDTR` = ring length, ring indices reset, `DMAEN`/`DMACFG` circular, `EN = 1` | the DMA is ready before the ADC asks |
 //! | [`RecoveryStep::StartAdc`] | `ADSTART = 1` (waits for the next trigger) | both ADCs armed before the trigger |
@@ -42,7 +42,7 @@ pub enum RecoveryStep {
     StopTrigger,
     /// Stop both ADCs' conversions and wait until they stopped.
     StopAdc,
-    /// Disable both DMA channels and wait until they are off.
+    /// Clear both ADCs' `DMAEN`, disable both DMA channels and wait until they are off.
     PauseDma,
     /// Clear the ADCs' overrun flags and the DMA channels' interrupt flags.
     ClearFlags,
@@ -209,6 +209,9 @@ pub trait AcqRegisters {
     /// `DMAEN = 1`, `DMACFG` circular in ADC `i`'s `ADC_CFGR` (allowed only with
     /// `ADSTART = 0`).
     fn adc_dma_circular(&mut self, i: usize);
+    /// `DMAEN = 0` in ADC `i`'s `ADC_CFGR` (allowed only with `ADSTART = 0`): the ADC
+    /// issues no DMA request, and withdraws one it raised.
+    fn adc_dma_off(&mut self, i: usize);
     /// `TEIF` of DMA channel `i`.
     fn dma_error(&mut self, i: usize) -> bool;
     /// Clears `TEIF`, `HTIF`, `TCIF` and `GIF` of DMA channel `i` (`DMA_IFCR`).
@@ -266,6 +269,10 @@ impl<R: AcqRegisters> Acquisition for RegisterAcquisition<R> {
     }
 
     fn pause_dma(&mut self) -> Result<(), StepTimeout> {
+        for i in CHANNELS {
+            // ADSTART = 0 here (the step before waited for it), so DMAEN is writable.
+            self.regs.adc_dma_off(i);
+        }
         for i in CHANNELS {
             self.regs.dma_disable(i);
         }

@@ -18,7 +18,8 @@ use monitor_core::{Abc, Sample};
 /// which the core's wrapping differences handle).
 pub const TICK_HZ: u32 = 1_000_000;
 
-/// Raw readings of one trigger.
+/// Raw readings of one sample (on the board the mean of its oversampled sequences,
+/// filtered: `crate::acquisition`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RawFrame {
     /// Voltage codes of phases a, b, c (ADC1 ranks 1..3).

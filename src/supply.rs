@@ -11,8 +11,8 @@
 //! boot source, `DBANK`), which a board in the field should not risk on every boot for a
 //! setting a user makes once. It reads the level at boot ([`BorCheck::of_optr`]), says
 //! on the log and on every status line (`bor=`) which level is in force, and puts the
-//! level into every reset record it writes; `docs/firmware.md` gives the commands that
-//! raise it.
+//! level into every reset record it writes, and warns at every boot while it is below the
+//! goal; `cargo fw bor` programs level 4 once per board (`docs/firmware.md`, bring-up).
 //!
 //! **Reference.** Every reading scales with VDDA, the ADC's reference. Thread mode measures
 //! it through VREFINT every [`REFERENCE_PERIOD_MS`] ([`ReferenceWatch`]) on ADC1's injected
@@ -146,16 +146,26 @@ pub trait ReferenceAdc {
     fn result(&mut self) -> Option<u16>;
 }
 
-/// One measurement now, waiting at most [`REFERENCE_POLL_LIMIT`] polls for the result:
-/// the start-up check, before the sample path runs.
-pub fn measure_now(adc: &mut impl ReferenceAdc) -> ReferenceCheck {
+/// One conversion: started, then at most [`REFERENCE_POLL_LIMIT`] polls for its result.
+fn convert_now(adc: &mut impl ReferenceAdc) -> Option<u16> {
     adc.start();
-    for _ in 0..REFERENCE_POLL_LIMIT {
-        if let Some(code) = adc.result() {
-            return ReferenceCheck::of(code, adc.calibration());
-        }
+    (0..REFERENCE_POLL_LIMIT).find_map(|_| adc.result())
+}
+
+/// One measurement now, each conversion waited for at most [`REFERENCE_POLL_LIMIT`]
+/// polls: the start-up check, right after `VREFEN` was set, before the sample path runs.
+/// The VREFINT buffer needs its start-up time after `VREFEN` (datasheet
+/// `t_start_vrefint`, microseconds) before its output is valid, and the first conversion
+/// samples it within that time: that conversion is **discarded**, and the second, one
+/// conversion time (6.1 us) later, is the measurement.
+pub fn measure_now(adc: &mut impl ReferenceAdc) -> ReferenceCheck {
+    if convert_now(adc).is_none() {
+        return ReferenceCheck::Unreadable;
     }
-    ReferenceCheck::Unreadable
+    match convert_now(adc) {
+        Some(code) => ReferenceCheck::of(code, adc.calibration()),
+        None => ReferenceCheck::Unreadable,
+    }
 }
 
 /// A change of the reference's verdict, for the log.
@@ -289,6 +299,9 @@ mod tests {
         cal: u16,
         pending: bool,
         converts: bool,
+        /// Conversions so far: the first after `VREFEN` samples a buffer still starting
+        /// (its output at half its value).
+        conversions: u32,
     }
 
     impl ReferenceAdc for Fake {
@@ -301,7 +314,10 @@ mod tests {
         fn result(&mut self) -> Option<u16> {
             let done = self.pending && self.converts;
             self.pending &= !done;
-            done.then(|| (f32::from(self.cal) * 3.0 / self.vdda).round() as u16)
+            let settled = self.conversions > 0;
+            self.conversions += u32::from(done);
+            let code = f32::from(self.cal) * 3.0 / self.vdda;
+            done.then(|| if settled { code } else { code / 2.0 }.round() as u16)
         }
     }
 
@@ -312,7 +328,9 @@ mod tests {
             cal: 1655,
             pending: false,
             converts: true,
+            conversions: 0,
         };
+        // The first conversion (the buffer starting) would read VDDA twice too high.
         assert!(
             matches!(measure_now(&mut adc), ReferenceCheck::InBand(v) if (v - 3.3).abs() < 0.01)
         );

@@ -194,7 +194,7 @@ impl SamplePath {
         self.samples
     }
 
-    /// Process one trigger's readings.
+    /// Process one sample's readings.
     #[inline]
     pub fn on_frame(&mut self, raw: &RawFrame) {
         let sample = self.sampler.build(raw);

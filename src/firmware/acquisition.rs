@@ -4,8 +4,8 @@
 //! here are only the single register accesses, in RM0440's terms.
 //!
 //! The ring-buffered ADCs of embassy-stm32 own the DMA channels; what they do not offer
-//! (stopping a conversion without clearing `DMAEN`, clearing `OVR`/`EOC`/`EOS` and `TEIF`,
-//! reloading `CNDTR`) is done on the registers.
+//! (stopping a conversion, clearing `DMAEN` and setting it again, clearing `OVR`/`EOC`/`EOS`
+//! and `TEIF`, reloading `CNDTR`) is done on the registers.
 
 use core::marker::PhantomData;
 
@@ -131,6 +131,10 @@ impl AcqRegisters for HwRegisters {
             w.set_dmaen(Dmaen::ENABLE);
             w.set_dmacfg(Dmacfg::CIRCULAR);
         });
+    }
+
+    fn adc_dma_off(&mut self, i: usize) {
+        adc(i).cfgr().modify(|w| w.set_dmaen(Dmaen::DISABLE));
     }
 
     fn dma_error(&mut self, i: usize) -> bool {

@@ -1,57 +1,157 @@
-//! The end of a failed run: the panic handlers (`core`'s and defmt's), the HardFault and
-//! default exception handlers, and what all do (the panel's "monitor failed" pattern, the
-//! reset record, the reset). Without the exception handlers a fault would end in
-//! cortex-m-rt's endless loop: no record, and before the watchdog runs no reset at all.
+//! The end of a failed run on the registers: the panic handlers (`core`'s and defmt's),
+//! the HardFault, NMI and default exception handlers. What they do is
+//! `drive_monitor::fault_path` (the guard, the reset record first, the panel's "monitor
+//! failed" pattern, no log: a fault may have hit inside a `defmt` frame), the same code
+//! the host tests run; here are only the register reads and the reset. The NMI handler
+//! first asks `drive_monitor::flash_ecc::nmi_action`: a double ECC error in a record page
+//! is latched and the read goes on (the boot falls back), anything else is a fault.
 
 use core::sync::atomic::Ordering;
 
-use defmt::{error, warn};
 use drive_monitor::app::WATCHDOG_TIMEOUT_MS;
 use drive_monitor::board::{Lamp, Port};
+use drive_monitor::clock::CYCLES_PER_MS;
+use drive_monitor::fault_path::{self, FaultBoard, FaultEnd, FaultGuard, FaultRegisters};
+use drive_monitor::flash_ecc::{self, EccLatch, NmiAction};
 use drive_monitor::panel::PanelLamps;
-use drive_monitor::reset_record::{BootPhase, ResetRecord};
+use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
+use drive_monitor::supply::BorLevel;
 use embassy_stm32::pac;
 
 use super::supply::bor_level;
-use super::{write_reset_record, PHASE, WATCHDOG_RUNNING};
+use super::{write_reset_record, PHASE};
+
+/// Taken by the first fault of the run (`fault_path`): a second goes straight to reset.
+static GUARD: FaultGuard = FaultGuard::new();
+/// A double ECC error the NMI handler latched for the record page being read.
+pub(super) static ECC: EccLatch = EccLatch::new();
+
+/// The fault path's board: the reset record's RAM, `FLASH_OPTR` and the lamp pins.
+struct Registers;
+
+impl FaultBoard for Registers {
+    fn bor_level(&mut self) -> Option<BorLevel> {
+        bor_level()
+    }
+
+    fn write_record(&mut self, bytes: &[u8; RESET_RECORD_LEN]) {
+        write_reset_record(bytes);
+    }
+
+    fn show_failed(&mut self) {
+        // Direct register writes: the HAL objects may be in any state. GPIO clocks are
+        // enabled by `embassy_stm32::init` for every port.
+        use pac::gpio::vals::Moder;
+        for lamp in Lamp::ALL {
+            let pin = lamp.pin();
+            let port = match pin.port {
+                Port::A => pac::GPIOA,
+                Port::B => pac::GPIOB,
+                Port::C => pac::GPIOC,
+                Port::D => pac::GPIOD,
+                Port::E => pac::GPIOE,
+                Port::F => pac::GPIOF,
+                Port::G => pac::GPIOG,
+            };
+            let n = usize::from(pin.number);
+            port.moder().modify(|w| w.set_moder(n, Moder::OUTPUT));
+            if PanelLamps::FAILED.is_on(lamp) {
+                port.bsrr().write(|w| w.set_bs(n, true));
+            } else {
+                port.bsrr().write(|w| w.set_br(n, true));
+            }
+        }
+    }
+}
+
+/// The fault status registers with the stacked `pc` and `lr`.
+#[allow(unsafe_code)]
+fn fault_registers(pc: u32, lr: u32) -> FaultRegisters {
+    // SAFETY: the System Control Block's fault status registers, only read; the handlers
+    // run with interrupts off and never return.
+    let scb = unsafe { &*cortex_m::peripheral::SCB::PTR };
+    FaultRegisters {
+        pc,
+        lr,
+        cfsr: scb.cfsr.read(),
+        hfsr: scb.hfsr.read(),
+        bfar: scb.bfar.read(),
+    }
+}
 
 /// A HardFault (a bus or memory fault, a usage fault escalated, an undefined instruction):
-/// the stacked PC and LR and the fault status registers into the reset record, then
-/// [`fail`]: the next boot reports where it happened.
+/// the stacked PC and LR and the fault status registers into the reset record
+/// (`fault_path::on_hard_fault`), then the reset: the next boot reports where it happened.
 #[cortex_m_rt::exception]
 #[allow(unsafe_code)]
 unsafe fn HardFault(frame: &cortex_m_rt::ExceptionFrame) -> ! {
     cortex_m::interrupt::disable();
-    // SAFETY: the System Control Block's fault status registers are read-only here; the
-    // handler runs with interrupts off and never returns.
-    let scb = unsafe { &*cortex_m::peripheral::SCB::PTR };
-    let (cfsr, hfsr, bfar) = (scb.cfsr.read(), scb.hfsr.read(), scb.bfar.read());
-    let record = ResetRecord::hard_fault(None, frame.pc(), frame.lr(), cfsr, hfsr, bfar);
-    fail(record)
+    let regs = fault_registers(frame.pc(), frame.lr());
+    end(fault_path::on_hard_fault(
+        &GUARD,
+        &mut Registers,
+        None,
+        regs,
+    ))
+}
+
+/// The NMI: a double ECC error in a record page (`FLASH_ECCR.ECCD` with the page's
+/// address) is latched and cleared, and the handler returns: the read completes, the
+/// checked read rejects it and the boot falls back (`drive_monitor::flash_ecc`). Any other
+/// NMI is a fault.
+#[cortex_m_rt::exception]
+#[allow(unsafe_code)]
+unsafe fn NonMaskableInt() {
+    // SAFETY (cortex-m-rt asks for an `unsafe fn`: an NMI can preempt anything, even a
+    // critical section): the handler touches only `FLASH_ECCR`, the `ECC` latch (an
+    // atomic) and, for a fault, the fault path, which never returns.
+    let eccr = pac::FLASH.eccr().read();
+    match flash_ecc::nmi_action(eccr.0) {
+        NmiAction::RecordPageEcc(e) => {
+            ECC.latch(e);
+            // Write 1 to clear ECCD (and ECCC); the other bits are read-only or enables.
+            pac::FLASH.eccr().modify(|w| {
+                w.set_eccd(true);
+                w.set_eccc(true);
+            });
+        }
+        NmiAction::Fault => {
+            cortex_m::interrupt::disable();
+            let lr = cortex_m::register::lr::read();
+            end(fault_path::on_hard_fault(
+                &GUARD,
+                &mut Registers,
+                Some(-14),
+                fault_registers(0, lr),
+            ))
+        }
+    }
 }
 
 /// An exception or interrupt without a handler: its number into the reset record, then
-/// [`fail`] (cortex-m-rt's default would spin for ever).
+/// the reset (cortex-m-rt's default would spin for ever).
 #[cortex_m_rt::exception]
 #[allow(unsafe_code)]
 unsafe fn DefaultHandler(irqn: i16) {
     cortex_m::interrupt::disable();
-    // SAFETY: as in `HardFault`.
-    let scb = unsafe { &*cortex_m::peripheral::SCB::PTR };
-    let (cfsr, hfsr, bfar) = (scb.cfsr.read(), scb.hfsr.read(), scb.bfar.read());
-    let lr = cortex_m::register::lr::read();
-    let record = ResetRecord::hard_fault(Some(irqn), 0, lr, cfsr, hfsr, bfar);
-    fail(record)
+    let regs = fault_registers(0, cortex_m::register::lr::read());
+    end(fault_path::on_hard_fault(
+        &GUARD,
+        &mut Registers,
+        Some(irqn),
+        regs,
+    ))
 }
 
-/// Panic: the reason into the reset record (RAM that survives the reset), then [`fail`].
+/// Panic: the reason into the reset record (RAM that survives the reset), then the reset.
 /// Only the static part of the message and the location are kept: formatting the full
 /// message would pull core::fmt (float formatting alone is ~10 KiB of flash).
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
     cortex_m::interrupt::disable();
     let location = info.location().map(|l| (l.file(), l.line()));
-    fail(ResetRecord::on_panic(info.message().as_str(), location))
+    let record = ResetRecord::on_panic(info.message().as_str(), location);
+    end(fault_path::on_fault(&GUARD, &mut Registers, record))
 }
 
 /// A panic through `defmt::panic!` (the HAL with its `defmt` feature, `defmt::unwrap!`):
@@ -63,50 +163,18 @@ fn defmt_panic() -> ! {
     cortex_m::interrupt::disable();
     let return_address = cortex_m::register::lr::read();
     let phase = BootPhase::from_number(PHASE.load(Ordering::Relaxed)).unwrap_or(BootPhase::Boot);
-    fail(ResetRecord::defmt_panic(phase, return_address))
+    let record = ResetRecord::defmt_panic(phase, return_address);
+    end(fault_path::on_fault(&GUARD, &mut Registers, record))
 }
 
-/// The end of a failed run: the panel's "monitor failed" pattern on the lamp pins of the
-/// lamp table, `record` (with the brown-out level in force) into the reset record and the
-/// log, then the reset: the watchdog's
-/// (no longer petted) after `WATCHDOG_TIMEOUT_MS`, or, when it does not run yet, a
-/// software reset after the same time. The next boot reads the record, logs it and shows
+/// The reset after the fault path: at once for a fault inside it (the first record
+/// stands); else after the watchdog's time (at the full clock; longer at the 16 MHz reset
+/// clock) with the failed pattern showing: the watchdog, no longer petted, or the software
+/// reset when it does not run yet. The next boot reads the record, logs it first and shows
 /// the failed pattern for 5 s before monitoring again.
-fn fail(record: ResetRecord) -> ! {
-    // Direct register writes: the HAL objects may be in any state. GPIO clocks are
-    // enabled by `embassy_stm32::init` for every port.
-    use pac::gpio::vals::Moder;
-    for lamp in Lamp::ALL {
-        let pin = lamp.pin();
-        let port = match pin.port {
-            Port::A => pac::GPIOA,
-            Port::B => pac::GPIOB,
-            Port::C => pac::GPIOC,
-            Port::D => pac::GPIOD,
-            Port::E => pac::GPIOE,
-            Port::F => pac::GPIOF,
-            Port::G => pac::GPIOG,
-        };
-        let n = usize::from(pin.number);
-        port.moder().modify(|w| w.set_moder(n, Moder::OUTPUT));
-        if PanelLamps::FAILED.is_on(lamp) {
-            port.bsrr().write(|w| w.set_bs(n, true));
-        } else {
-            port.bsrr().write(|w| w.set_br(n, true));
-        }
+fn end(how: FaultEnd) -> ! {
+    if how == FaultEnd::Recorded {
+        cortex_m::asm::delay(WATCHDOG_TIMEOUT_MS * CYCLES_PER_MS);
     }
-    write_reset_record(&record.with_bor_level(bor_level()).encode());
-    error!(
-        "MONITOR FAILED: {=str} at {=str}:{=u32}",
-        record.message(),
-        record.file(),
-        record.line_or_ms()
-    );
-    if !WATCHDOG_RUNNING.load(Ordering::Relaxed) {
-        warn!("watchdog not running yet: software reset");
-    }
-    // The watchdog's time at the full clock (longer at the 16 MHz reset clock): the failed
-    // pattern shows, then the watchdog or the software reset ends the run.
-    cortex_m::asm::delay(WATCHDOG_TIMEOUT_MS * 170_000);
     cortex_m::peripheral::SCB::sys_reset()
 }

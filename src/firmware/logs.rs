@@ -30,12 +30,11 @@ pub(super) fn log_bor(check: BorCheck) {
             l.falling_v()
         ),
         BorCheck::BelowGoal(l) => warn!(
-            "brown-out reset level {=u8} (about {=f32} V) is below level {=u8} ({=f32} V): the MCU runs on at a supply far below 3.3 V; raise it: STM32_Programmer_CLI -c port=SWD -ob BOR_LEV={=u8} (docs/firmware.md)",
+            "brown-out reset level {=u8} (about {=f32} V) is below level {=u8} ({=f32} V): the MCU runs on at a supply far below 3.3 V; program it once for this board: cargo fw bor (docs/firmware.md, bring-up)",
             l.number(),
             l.falling_v(),
             BOR_GOAL.number(),
-            BOR_GOAL.falling_v(),
-            BOR_GOAL.number()
+            BOR_GOAL.falling_v()
         ),
         BorCheck::Reserved(v) => warn!(
             "brown-out reset level: FLASH_OPTR.BOR_LEV holds the reserved value {=u8}",

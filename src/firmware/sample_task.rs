@@ -8,6 +8,7 @@
 use core::sync::atomic::Ordering;
 
 use defmt::{error, info, warn};
+use drive_monitor::acquisition::{self as geometry, HALF_LEN, RING_LEN};
 use drive_monitor::app::SamplePath;
 use drive_monitor::board::{self, CurrentCode, VoltageCode};
 use drive_monitor::liveness::AdcWait;
@@ -31,14 +32,6 @@ use super::{
     STATUS, TRIM,
 };
 
-/// Samples per DMA half buffer: 1, so every sample is processed as it arrives and the
-/// encoder is read within microseconds of the conversion.
-const SAMPLES_PER_HALF: usize = 1;
-/// ADC channels per ADC.
-const CHANNELS: usize = 3;
-/// DMA ring length per ADC, in 16-bit words (two halves).
-const RING_LEN: usize = 2 * SAMPLES_PER_HALF * CHANNELS;
-
 /// Everything the sample task owns.
 pub(super) struct SampleHw {
     pub(super) adc1: Peri<'static, peripherals::ADC1>,
@@ -55,6 +48,9 @@ pub(super) struct SampleHw {
     pub(super) encoder: EncoderSetup,
     /// SysTick: the ADC set-up's deadline (`supply::SetupGuard`).
     pub(super) syst: cortex_m::peripheral::SYST,
+    /// The supply frequency of the machine monitored [Hz] (the filter's gain is restored
+    /// there: `geometry::PwmFilter`).
+    pub(super) supply_hz: f32,
 }
 
 /// The encoder: TIM4 in quadrature mode on PB6/PB7 with the motor record's pull-ups,
@@ -84,13 +80,20 @@ fn start_encoder(
     qei
 }
 
-/// 247.5 ADC cycles sampling time (5.8 us at the 42.5 MHz ADC clock): the documented
-/// front end (docs/firmware.md, "Voltage and current sensing") drives each pin through a
-/// 1 kohm / 10 nF anti-alias filter; the datasheet's bound on the source resistance,
-/// R_AIN < t_S / (f_ADC C_ADC ln(2^(N+2))) - R_ADC, with C_ADC 5 pF and R_ADC 1 kohm,
-/// is about 11 kohm at 24.5 cycles and 120 kohm at 247.5; three conversions of
-/// 247.5 + 12.5 cycles take 18.4 us of the 100 us period.
-const SAMPLE_TIME: SampleTime = SampleTime::CYCLES247_5;
+/// 24.5 ADC cycles sampling time (`drive_monitor::acquisition::SAMPLE_TIME_HALF_CYCLES`,
+/// checked below): with 12.5 cycles of approximation 870 ns a conversion at the 42.5 MHz
+/// ADC clock, 2.6 us a sequence of three, within the 12.5 us between the oversampling's
+/// triggers. The documented front end (docs/firmware.md, "Voltage and current sensing")
+/// drives each pin through a 1 kohm / 10 nF anti-alias filter (100 nF for an inverter-fed
+/// motor); the datasheet's bound on
+/// the source resistance, R_AIN < t_S / (f_ADC C_ADC ln(2^(N+2))) - R_ADC, with C_ADC
+/// 5 pF and R_ADC 1 kohm, is about 11 kohm at 24.5 cycles.
+const SAMPLE_TIME: SampleTime = SampleTime::CYCLES24_5;
+const _: () = assert!(geometry::SAMPLE_TIME_HALF_CYCLES == 49);
+const _: () = assert!(
+    geometry::fits(SETTINGS.sample_rate_hz),
+    "the oversampled acquisition does not fit the sample rate"
+);
 
 /// ADC1's regular sequence va, vb, vc on TIM1's TRGO into its DMA ring.
 fn ring_voltages(
@@ -140,9 +143,11 @@ fn start_acquisition(
 
     let qei = start_encoder(hw.tim4, hw.enc_a, hw.enc_b, &hw.encoder);
 
-    // Sample trigger: TIM1 update event -> TRGO -> both ADCs (rising edge).
+    // Sample trigger: TIM1 update event -> TRGO -> both ADCs (rising edge), OVERSAMPLING
+    // times per sample (drive_monitor::acquisition: the mean over the sample period).
     let trigger = HwTimer::new(hw.tim1);
-    trigger.set_frequency(Hertz(SETTINGS.sample_rate_hz), RoundTo::Slower);
+    let trigger_hz = geometry::trigger_rate_hz(SETTINGS.sample_rate_hz);
+    trigger.set_frequency(Hertz(trigger_hz), RoundTo::Slower);
     trigger.set_master_mode(MasterMode::UPDATE);
 
     // Every step under the set-up deadline (`drive_monitor::setup_guard`): the HAL's waits
@@ -169,20 +174,25 @@ fn start_acquisition(
     (qei, acq)
 }
 
-/// Runs the sample path on the readings of one DMA half (`v` from ADC1, `i` from ADC2)
-/// with the encoder count read after them; hands thread mode a status every
-/// `status_every` samples. `max_cycles`: the longest `on_frame` so far, in CPU cycles.
+/// Runs the sample path on the readings of one DMA half (`v` from ADC1, `i` from ADC2:
+/// [`geometry::OVERSAMPLING`] sequences per sample, summed and filtered by `filter`,
+/// `geometry::PwmFilter`: the inverter's in-band ripple out, the encoder count held back
+/// with it) with the encoder count read after them; hands thread mode a status every
+/// `status_every` samples. `max_cycles`: the longest oversampling, filter and `on_frame`
+/// so far, in CPU cycles.
 fn process_half(
     path: &mut SamplePath,
-    v: &[u16],
-    i: &[u16],
+    filter: &mut geometry::PwmFilter,
+    (v, i): (&[u16], &[u16]),
     encoder_count: u16,
     max_cycles: &mut u32,
 ) {
-    for (v, i) in v.chunks_exact(CHANNELS).zip(i.chunks_exact(CHANNELS)) {
-        let (&[va, vb, vc], &[ia, ib, ic]) = (v, i) else {
-            continue;
-        };
+    let per_sample = HALF_LEN / geometry::SAMPLES_PER_HALF;
+    for (v, i) in v.chunks_exact(per_sample).zip(i.chunks_exact(per_sample)) {
+        let t0 = cortex_m::peripheral::DWT::cycle_count();
+        let ((vs, n), (is, _)) = (geometry::sum_half(v), geometry::sum_half(i));
+        let ([va, vb, vc], [ia, ib, ic], encoder_count) = filter.step(vs, is, n, encoder_count);
+        let filtering = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t0);
         let raw = RawFrame {
             v: [VoltageCode(va), VoltageCode(vb), VoltageCode(vc)],
             i: [CurrentCode(ia), CurrentCode(ib), CurrentCode(ic)],
@@ -191,9 +201,9 @@ fn process_half(
         if let Some(trim) = path.trim_offsets(&raw) {
             TRIM.signal(trim);
         }
-        let t0 = cortex_m::peripheral::DWT::cycle_count();
+        let t1 = cortex_m::peripheral::DWT::cycle_count();
         path.on_frame(&raw);
-        let dt = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t0);
+        let dt = filtering + cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t1);
         *max_cycles = (*max_cycles).max(dt);
         if path.samples().is_multiple_of(SETTINGS.status_every()) {
             STATUS.signal(Status {
@@ -210,11 +220,12 @@ fn process_half(
 /// path on the half.
 #[embassy_executor::task]
 pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
+    let mut filter = geometry::PwmFilter::new(SETTINGS.sample_rate_hz, hw.supply_hz);
     let (qei, mut acq) = set_up_acquisition(hw, &mut path);
     let mut wait = AdcWait::new(SETTINGS.sample_rate_hz);
     let timeout = Duration::from_micros(u64::from(wait.timeout_us()));
-    let mut half1 = [0u16; SAMPLES_PER_HALF * CHANNELS];
-    let mut half2 = [0u16; SAMPLES_PER_HALF * CHANNELS];
+    let mut half1 = [0u16; HALF_LEN];
+    let mut half2 = [0u16; HALF_LEN];
     let mut max_cycles: u32 = 0;
     let mut counts = RecoveryCounts::default();
     loop {
@@ -229,7 +240,8 @@ pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
             continue;
         }
         apply_commands(&mut path);
-        process_half(&mut path, &half1, &half2, qei.count(), &mut max_cycles);
+        let halves = (&half1[..], &half2[..]);
+        process_half(&mut path, &mut filter, halves, qei.count(), &mut max_cycles);
     }
 }
 

@@ -6,6 +6,7 @@ use core::sync::atomic::{AtomicU8, Ordering};
 
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
+use drive_monitor::clock;
 use drive_monitor::setup_guard::{self, SetupStep, SETUP_DEADLINE_MS};
 use drive_monitor::supply::{BorCheck, BorLevel, ReferenceAdc};
 use embassy_stm32::pac;
@@ -16,9 +17,6 @@ use super::write_reset_record;
 /// The set-up step running (`SetupStep::number`), 0 when no set-up runs: what the SysTick
 /// exception reads when the deadline runs out.
 static SETUP_STEP: AtomicU8 = AtomicU8::new(0);
-
-/// The HCLK the deadline is counted in [Hz] (`clock_config`: 170 MHz).
-const HCLK_HZ: u32 = 170_000_000;
 
 /// The ADCs' set-up under its deadline ([`setup_guard`]): SysTick counts
 /// [`SETUP_DEADLINE_MS`] once; if it runs out while a step is marked, its exception
@@ -34,7 +32,8 @@ impl SetupGuard {
     pub(super) fn arm(mut syst: SYST, first: SetupStep) -> Self {
         SETUP_STEP.store(first.number(), Ordering::SeqCst);
         // 20 ms fits SysTick's 24 bits at 170 MHz / 8 (a host test checks the value).
-        let reload = setup_guard::systick_reload(HCLK_HZ, SETUP_DEADLINE_MS).unwrap_or(0xFF_FFFF);
+        let reload =
+            setup_guard::systick_reload(clock::HCLK_HZ, SETUP_DEADLINE_MS).unwrap_or(0xFF_FFFF);
         syst.set_clock_source(SystClkSource::External);
         syst.set_reload(reload);
         syst.clear_current();

@@ -208,3 +208,99 @@ fn a_stored_isolation_baseline_is_restored_for_the_records_machine() {
     assert!(!booted.baseline_restored);
     assert_eq!(booted.supervisor.isolation_baseline(), None);
 }
+
+/// The board's flash with a torn write: a double word whose ECC does not match at
+/// `torn_at` (an offset from 0x0800_0000). A read over it raises the NMI, which runs the
+/// firmware's decision (`flash_ecc::nmi_action` on the `FLASH_ECCR` value the hardware
+/// shows): a record page's error is latched and the read completes with the wrong bytes; a
+/// fault resets the MCU (`Err(NmiReset)`).
+struct TornFlash<'a> {
+    motor_page: Vec<u8>,
+    torn_at: u32,
+    latch: &'a drive_monitor::flash_ecc::EccLatch,
+    reads: u32,
+}
+
+/// The NMI ended in the fault path: the MCU reset.
+#[derive(Debug, PartialEq)]
+struct NmiReset;
+
+impl drive_monitor::flash_ecc::RawFlash for TornFlash<'_> {
+    type Error = NmiReset;
+    fn read_raw(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), NmiReset> {
+        use drive_monitor::flash_ecc::{nmi_action, NmiAction, BANK_SIZE, ECCR_BK_ECC, ECCR_ECCD};
+        self.reads += 1;
+        let from = (offset - board::MOTOR_RECORD_FLASH_OFFSET) as usize;
+        buf.copy_from_slice(&self.motor_page[from..from + buf.len()]);
+        let end = offset + buf.len() as u32;
+        if (offset..end).contains(&self.torn_at) {
+            let at = (self.torn_at - offset) as usize;
+            buf[at] ^= 0x5A;
+            // Bank 2 (the record pages), the address within the bank.
+            let eccr = ECCR_ECCD | ECCR_BK_ECC | (self.torn_at - BANK_SIZE);
+            match nmi_action(eccr) {
+                NmiAction::RecordPageEcc(e) => self.latch.latch(e),
+                NmiAction::Fault => return Err(NmiReset),
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A torn write in the motor record's page (issue 51): the read raises an ECC double
+/// error and the NMI. The firmware's handler latches it and returns; the checked read
+/// (`CheckedFlash::read_or_erased`, what `read_motor_page` in `src/firmware.rs` calls)
+/// rejects the page, marks it bad (not read again this run) and the boot runs the
+/// built-in motor, with the default-motor mark, at the first boot: no reset, no loop.
+#[test]
+fn an_ecc_error_in_the_motor_page_falls_back_to_the_built_in_motor_and_boots() {
+    use drive_monitor::flash_ecc::{CheckedFlash, EccLatch, ReadError};
+    use monitor_core::motor_record::STORED_LEN;
+    let latch = EccLatch::new();
+    // A good 3 hp record whose page has a torn double word in its record bytes.
+    let torn_at = board::MOTOR_RECORD_FLASH_OFFSET + 40;
+    let mut flash = CheckedFlash::new(TornFlash {
+        motor_page: motor_page(&record_3hp().to_bytes()),
+        torn_at,
+        latch: &latch,
+        reads: 0,
+    });
+    let (page, read) = flash.read_or_erased::<STORED_LEN>(&latch, board::MOTOR_RECORD_FLASH_OFFSET);
+    assert_eq!(
+        read,
+        Err(ReadError::Ecc(drive_monitor::flash_ecc::EccError {
+            offset: torn_at
+        }))
+    );
+    assert!(flash.is_bad(board::MOTOR_RECORD_FLASH_OFFSET));
+    let booted = drive_monitor::boot::boot(
+        &page,
+        &mut FakeFlash::holding(&old_record()),
+        &SETTINGS,
+        PreviousRun::Clean,
+        0,
+    )
+    .expect("the built-in default is always accepted");
+    assert_eq!(
+        booted.machine.source,
+        MachineSource::Default(RecordError::Erased)
+    );
+    assert_eq!(booted.machine.record, motor_source::default_record());
+    assert!(default_mark_shown(&booted));
+    assert_eq!(booted.calibration, Ok(old_record()));
+    // Marked bad: a second read does not touch the flash (no second NMI).
+    let (_, again) = flash.read_or_erased::<STORED_LEN>(&latch, board::MOTOR_RECORD_FLASH_OFFSET);
+    assert_eq!(again, Err(ReadError::MarkedBad));
+    assert_eq!(flash.raw.reads, 1);
+    // The same page without the torn word is the 3 hp machine (the fallback is the ECC's).
+    let mut clean = CheckedFlash::new(TornFlash {
+        motor_page: motor_page(&record_3hp().to_bytes()),
+        torn_at: 0,
+        latch: &latch,
+        reads: 0,
+    });
+    let (page, read) = clean.read_or_erased::<STORED_LEN>(&latch, board::MOTOR_RECORD_FLASH_OFFSET);
+    assert_eq!(read, Ok(()));
+    let booted = boot_on(&page, FakeFlash::erased());
+    assert_eq!(booted.machine.source, MachineSource::Flash);
+}

@@ -199,33 +199,66 @@ fn saturated_adc_lights_the_fault_lamp_steadily() {
     assert!(rig.seen.iter().rev().take(10).all(|s| s.tick.lamps.fault));
 }
 
-/// A HardFault mid-run (issue 43): the handler writes what `ResetRecord::hard_fault` makes
-/// of the stacked PC and LR and the fault status registers, then resets (the watchdog's,
-/// or a software reset before it runs); the next boot reports it with the PC and the
-/// registers, whatever the reset was, and shows "monitor failed".
+/// The fault path's board in the rig: the reset record's RAM of the survivors, the
+/// brown-out level, the lamps' "monitor failed" pattern.
+struct FakeFaultBoard<'a> {
+    reset_ram: &'a mut [u8; RESET_RECORD_LEN],
+    failed_shown: bool,
+    writes: u32,
+}
+
+impl drive_monitor::fault_path::FaultBoard for FakeFaultBoard<'_> {
+    fn bor_level(&mut self) -> Option<drive_monitor::supply::BorLevel> {
+        Some(drive_monitor::supply::BorLevel::Level4)
+    }
+    fn write_record(&mut self, bytes: &[u8; RESET_RECORD_LEN]) {
+        *self.reset_ram = *bytes;
+        self.writes += 1;
+    }
+    fn show_failed(&mut self) {
+        self.failed_shown = true;
+    }
+}
+
+/// A HardFault mid-run (issue 43): the handler's own code path
+/// (`fault_path::on_hard_fault`, what `HardFault` in `src/firmware/failure.rs` calls with
+/// the stacked PC and LR and the fault status registers) writes the record and shows the
+/// failed pattern; after the reset (the watchdog's, or a software reset before it runs)
+/// the next boot reports it with the PC and the registers and shows "monitor failed".
 #[test]
 fn a_hard_fault_leaves_a_record_the_next_boot_reports() {
+    use drive_monitor::fault_path::{on_hard_fault, FaultEnd, FaultGuard, FaultRegisters};
     let frames = steady_frames(1.0);
     let mut rig = Rig::boot(Survivors::power_on(FakeFlash::erased()));
     rig.run(&frames, |_, _| {}).unwrap();
     // A precise bus fault escalated to HardFault: CFSR.PRECISERR | BFARVALID, HFSR.FORCED.
-    let (pc, lr, cfsr, hfsr, bfar) = (
-        0x0800_1A2C,
-        0x0800_1F01,
-        0x0000_8200,
-        0x4000_0000,
-        0x6000_0000,
-    );
+    let regs = FaultRegisters {
+        pc: 0x0800_1A2C,
+        lr: 0x0800_1F01,
+        cfsr: 0x0000_8200,
+        hfsr: 0x4000_0000,
+        bfar: 0x6000_0000,
+    };
     for source in [ResetSource::IndependentWatchdog, ResetSource::Software] {
         let mut survivors = rig.survivors.clone();
-        survivors.reset_ram = ResetRecord::hard_fault(None, pc, lr, cfsr, hfsr, bfar).encode();
+        let guard = FaultGuard::new();
+        let mut board = FakeFaultBoard {
+            reset_ram: &mut survivors.reset_ram,
+            failed_shown: false,
+            writes: 0,
+        };
+        assert_eq!(
+            on_hard_fault(&guard, &mut board, None, regs),
+            FaultEnd::Recorded
+        );
+        assert!(board.failed_shown);
         survivors.reset_source = source;
         let next = Rig::boot(survivors);
         let PreviousRun::Recorded(rec) = next.previous else {
             panic!("{source:?}: {:?}", next.previous);
         };
         assert_eq!(rec.cause(), ResetCause::HardFault);
-        assert_eq!(rec.line_or_ms(), pc);
+        assert_eq!(rec.line_or_ms(), regs.pc);
         assert_eq!(rec.file(), "hard fault");
         assert_eq!(
             rec.message(),
@@ -237,4 +270,43 @@ fn a_hard_fault_leaves_a_record_the_next_boot_reports() {
     let rec = ResetRecord::hard_fault(Some(-1), 0, 0, 0, 0, 0);
     let back = ResetRecord::decode(&rec.encode()).expect("decodes");
     assert_eq!(back.file(), "exception -001");
+}
+
+/// A fault inside the fault path (the first fault hit inside a `defmt` frame, and
+/// `defmt-rtt` panics "taken reentrantly"; or the lamp pins' registers fault): the guard
+/// sends the second straight to the reset, nothing written, and the next boot reports the
+/// first fault, not the panic it caused.
+#[test]
+fn a_second_fault_inside_the_fault_path_resets_at_once_and_keeps_the_first_record() {
+    use drive_monitor::fault_path::FaultRegisters;
+    use drive_monitor::fault_path::{on_fault, on_hard_fault, FaultEnd, FaultGuard};
+    let mut survivors = Survivors::power_on(FakeFlash::erased());
+    let guard = FaultGuard::new();
+    let mut board = FakeFaultBoard {
+        reset_ram: &mut survivors.reset_ram,
+        failed_shown: false,
+        writes: 0,
+    };
+    let first = FaultRegisters {
+        pc: 0x0800_2000,
+        ..FaultRegisters::default()
+    };
+    assert_eq!(
+        on_hard_fault(&guard, &mut board, None, first),
+        FaultEnd::Recorded
+    );
+    // defmt-rtt's reentrancy panic, from inside the first fault's handling.
+    let second = ResetRecord::on_panic(
+        Some("taken reentrantly"),
+        Some(("defmt-rtt/src/lib.rs", 96)),
+    );
+    assert_eq!(on_fault(&guard, &mut board, second), FaultEnd::Reentered);
+    assert_eq!(board.writes, 1);
+    survivors.reset_source = ResetSource::Software;
+    let next = Rig::boot(survivors);
+    let PreviousRun::Recorded(rec) = next.previous else {
+        panic!("{:?}", next.previous);
+    };
+    assert_eq!(rec.cause(), ResetCause::HardFault);
+    assert_eq!(rec.line_or_ms(), 0x0800_2000);
 }

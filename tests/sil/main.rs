@@ -410,7 +410,7 @@ impl Rig {
         for (k, raw) in frames.iter().enumerate() {
             at(self, k);
             // The frame reaches the sample path only when the hardware delivers it.
-            let delivered = self.acq.regs.trigger();
+            let delivered = self.acq.regs.sample();
             self.period(delivered.then_some(raw))?;
         }
         Ok(())

@@ -1,235 +1,64 @@
 //! The acquisition's recovery on a register-level model of the STM32G474's ADC + DMA
-//! (RM0440): each ADC keeps its data register and `EOC` as the hardware does (a result sits
-//! in `ADC_DR` with `EOC = 1` until the DMA reads it; a conversion that ends while `EOC` is
-//! 1 sets `OVR` and, with `OVRMOD = 0`, keeps the old data; while `OVR` is set the ADC
-//! issues no DMA requests), each DMA channel its `EN`, `CNDTR` and `TEIF`, and every
-//! register access checks its precondition (`ADSTP` only while converting, `DMAEN`/`DMACFG`
-//! only with `ADSTART = 0`, `CNDTR` only with the channel off). The firmware's own sequence,
+//! (RM0440) with the firmware's own geometry (`drive_monitor::acquisition`: the ring's
+//! length, the channels per ADC, the oversampling, the conversion time at the ADC clock).
+//! Each ADC keeps its data register and `EOC` as the hardware does (a result sits in
+//! `ADC_DR` with `EOC = 1` until the DMA reads it; a conversion that ends while `EOC` is 1
+//! sets `OVR` and, with `OVRMOD = 0`, keeps the old data; while `OVR` is set the ADC issues
+//! no DMA requests), and its DMA request: raised at each result while `DMAEN = 1`, held by
+//! the DMA while the channel is off, served (one word moved) when the channel is enabled,
+//! withdrawn when `DMAEN` is cleared. Conversions take their time (a sequence of three,
+//! 870 ns each, at every trigger, [`OVERSAMPLING`] triggers per sample); `ADSTP` takes
+//! effect when the conversion in flight ends, and every poll of a register costs the
+//! model's clock time, so the recovery's waits can run out (a stuck ADC never clears
+//! `ADSTART`). Each DMA channel keeps its `EN`, `CNDTR`, `TEIF` and the ring's words (which
+//! channel each holds: a half with a word out of place is counted). Every register access
+//! checks its precondition (`ADSTP` only while converting, `DMAEN`/`DMACFG` only with
+//! `ADSTART = 0`, `CNDTR` only with the channel off). The firmware's own sequence,
 //! `drive_monitor::recovery::RegisterAcquisition` (the code `src/firmware/acquisition.rs`
 //! runs over the real registers), drives it; an overrun, a DMA error and a lapped ring are
 //! injected and the monitor resumes with its state intact. The same sequence with only
-//! `OVR` cleared (the firmware's sequence before the `EOC` clear) re-overruns at the first
-//! conversion and never resumes, as does the firmware's former restart.
+//! `OVR` cleared (before the `EOC` clear) re-overruns at the first conversion and never
+//! resumes, as does the firmware's former restart; without the `DMAEN` clear a DMA error
+//! leaves every later sample's channels shifted by one word.
+
+mod model;
 
 use super::*;
+use drive_monitor::acquisition::{conversion_ns, CHANNELS};
 use drive_monitor::recovery::{
     self, AcqRegisters, Acquisition, AdcFlags, Faults, RecoveryStep, RegisterAcquisition,
-    StepTimeout,
+    StepTimeout, POLL_LIMIT,
 };
+use model::POLL_NS;
+pub(super) use model::{AdcDmaModel, ModelAcq, RING_LEN};
 
-/// The ring's length in DMA transfers (the firmware's `RING_LEN`, two halves of samples).
-pub(super) const RING_LEN: u16 = 12;
-
-/// One ADC as the recovery sees it.
-#[derive(Clone, Copy, Debug, Default)]
-struct AdcModel {
-    adstart: bool,
-    ovr: bool,
-    eoc: bool,
-    eos: bool,
-    /// `ADC_DR`: the number of the conversion whose result it holds.
-    dr: u32,
-    /// `DMAEN` with `DMACFG` circular.
-    dma_circular: bool,
+/// What a weakened sequence leaves out.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Without {
+    /// The `EOC`/`EOS` clear: only `OVR` cleared in `ADC_ISR` (the sequence before the
+    /// `EOC` clear).
+    EocClear,
+    /// The `DMAEN` clear (the sequence before it).
+    DmaenClear,
 }
 
-/// One DMA channel.
-#[derive(Clone, Copy, Debug, Default)]
-struct DmaModel {
-    en: bool,
-    teif: bool,
-    cndtr: u16,
-    /// The results the channel moved, in order (the last few).
-    moved: u32,
-}
+/// The firmware's sequence with one access left out ([`Without`]): every other register
+/// access as the model's.
+struct Weakened<'a>(&'a mut AdcDmaModel, Without);
 
-/// The two ADCs, their DMA channels and the trigger, at register level (module docs).
-#[derive(Clone, Debug)]
-pub(super) struct AdcDmaModel {
-    trigger_on: bool,
-    adc: [AdcModel; 2],
-    dma: [DmaModel; 2],
-    conversions: u32,
-    /// Overruns the hardware latched (each conversion that ended with `EOC` still set).
-    pub(super) overruns: u32,
-    /// Register accesses made against their precondition (RM0440), in words.
-    pub(super) violations: Vec<String>,
-}
-
-/// The acquisition the rig runs: the firmware's sequence over the model.
-pub(super) type ModelAcq = RegisterAcquisition<AdcDmaModel>;
-
-impl AdcDmaModel {
-    pub(super) fn running() -> ModelAcq {
-        let adc = AdcModel {
-            adstart: true,
-            dma_circular: true,
-            ..AdcModel::default()
-        };
-        let dma = DmaModel {
-            en: true,
-            cndtr: RING_LEN,
-            ..DmaModel::default()
-        };
-        RegisterAcquisition {
-            regs: AdcDmaModel {
-                trigger_on: true,
-                adc: [adc; 2],
-                dma: [dma; 2],
-                conversions: 0,
-                overruns: 0,
-                violations: Vec::new(),
-            },
-            ring_len: RING_LEN,
-        }
-    }
-
-    /// One trigger period: each converting ADC ends a conversion (an overrun if `EOC` is
-    /// still set), then its DMA channel takes the result if it can. Whether both results
-    /// reached the rings.
-    pub(super) fn trigger(&mut self) -> bool {
-        if !self.trigger_on {
-            return false;
-        }
-        self.conversions += 1;
-        let mut delivered = [false; 2];
-        for ((a, d), got) in self.adc.iter_mut().zip(&mut self.dma).zip(&mut delivered) {
-            if !a.adstart {
-                continue;
-            }
-            if a.eoc {
-                // OVRMOD = 0: the old result stays in ADC_DR.
-                if !a.ovr {
-                    self.overruns += 1;
-                }
-                a.ovr = true;
-            } else {
-                a.dr = self.conversions;
-                a.eoc = true;
-                a.eos = true;
-            }
-            // The DMA request: none while OVR is set.
-            if a.eoc && !a.ovr && a.dma_circular && d.en {
-                a.eoc = false;
-                d.moved = a.dr;
-                d.cndtr = if d.cndtr <= 1 { RING_LEN } else { d.cndtr - 1 };
-                *got = true;
-            }
-        }
-        delivered == [true; 2]
-    }
-
-    /// A conversion ended before the DMA took the previous result: `OVR` set, the data
-    /// register holding the unread result (`EOC = 1`).
-    pub(super) fn inject_overrun(&mut self) {
-        for a in &mut self.adc {
-            a.ovr = true;
-            a.eoc = true;
-        }
-        self.overruns += 1;
-    }
-
-    /// A DMA transfer error: the hardware sets `TEIF` and clears `EN`.
-    pub(super) fn inject_dma_error(&mut self) {
-        for d in &mut self.dma {
-            d.teif = true;
-            d.en = false;
-        }
-    }
-
-    fn violation(&mut self, what: String) {
-        self.violations.push(what);
-    }
-}
-
-impl AcqRegisters for AdcDmaModel {
-    fn adc_flags(&mut self, i: usize) -> AdcFlags {
-        let a = self.adc[i];
-        AdcFlags {
-            ovr: a.ovr,
-            eoc: a.eoc,
-            eos: a.eos,
-        }
-    }
-    fn adc_clear(&mut self, i: usize, f: AdcFlags) {
-        let a = &mut self.adc[i];
-        a.ovr &= !f.ovr;
-        a.eoc &= !f.eoc;
-        a.eos &= !f.eos;
-    }
-    fn adc_started(&mut self, i: usize) -> bool {
-        self.adc[i].adstart
-    }
-    fn adc_disabling(&mut self, _i: usize) -> bool {
-        false
-    }
-    fn adc_stop(&mut self, i: usize) {
-        if !self.adc[i].adstart {
-            self.violation(format!("ADSTP on ADC{} while ADSTART = 0", i + 1));
-        }
-        // The conversion in flight ends (no result: the model's conversions are instant).
-        self.adc[i].adstart = false;
-    }
-    fn adc_start(&mut self, i: usize) {
-        self.adc[i].adstart = true;
-    }
-    fn adc_dma_circular(&mut self, i: usize) {
-        if self.adc[i].adstart {
-            self.violation(format!(
-                "DMAEN/DMACFG of ADC{} written while ADSTART = 1",
-                i + 1
-            ));
-        }
-        self.adc[i].dma_circular = true;
-    }
-    fn dma_error(&mut self, i: usize) -> bool {
-        self.dma[i].teif
-    }
-    fn dma_clear(&mut self, i: usize) {
-        self.dma[i].teif = false;
-    }
-    fn dma_enabled(&mut self, i: usize) -> bool {
-        self.dma[i].en
-    }
-    fn dma_disable(&mut self, i: usize) {
-        self.dma[i].en = false;
-    }
-    fn dma_reload(&mut self, i: usize, transfers: u16) {
-        if self.dma[i].en {
-            self.violation(format!(
-                "CNDTR of DMA channel {} written while EN = 1",
-                i + 1
-            ));
-        }
-        self.dma[i].cndtr = transfers;
-    }
-    fn dma_enable(&mut self, i: usize) {
-        self.dma[i].en = true;
-    }
-    fn trigger_stop(&mut self) {
-        self.trigger_on = false;
-    }
-    fn trigger_start(&mut self) {
-        self.trigger_on = true;
-    }
-}
-
-/// The firmware's sequence with only `OVR` cleared in `ADC_ISR` (before the `EOC` clear):
-/// every register access as the model's, `EOC` and `EOS` left set.
-struct OnlyOvr<'a>(&'a mut AdcDmaModel);
-
-impl AcqRegisters for OnlyOvr<'_> {
+impl AcqRegisters for Weakened<'_> {
     fn adc_flags(&mut self, i: usize) -> AdcFlags {
         self.0.adc_flags(i)
     }
     fn adc_clear(&mut self, i: usize, f: AdcFlags) {
-        self.0.adc_clear(
-            i,
-            AdcFlags {
+        let f = match self.1 {
+            Without::EocClear => AdcFlags {
                 ovr: f.ovr,
                 ..AdcFlags::default()
             },
-        );
+            Without::DmaenClear => f,
+        };
+        self.0.adc_clear(i, f);
     }
     fn adc_started(&mut self, i: usize) -> bool {
         self.0.adc_started(i)
@@ -245,6 +74,11 @@ impl AcqRegisters for OnlyOvr<'_> {
     }
     fn adc_dma_circular(&mut self, i: usize) {
         self.0.adc_dma_circular(i);
+    }
+    fn adc_dma_off(&mut self, i: usize) {
+        if self.1 != Without::DmaenClear {
+            self.0.adc_dma_off(i);
+        }
     }
     fn dma_error(&mut self, i: usize) -> bool {
         self.0.dma_error(i)
@@ -272,13 +106,23 @@ impl AcqRegisters for OnlyOvr<'_> {
     }
 }
 
-/// The recovery with only `OVR` cleared ([`OnlyOvr`]).
-fn recover_only_ovr(acq: &mut ModelAcq) -> Result<Faults, StepTimeout> {
+/// The recovery without `without` ([`Weakened`]).
+fn recover_weakened(acq: &mut ModelAcq, without: Without) -> Result<Faults, StepTimeout> {
     let mut weak = RegisterAcquisition {
-        regs: OnlyOvr(&mut acq.regs),
+        regs: Weakened(&mut acq.regs, without),
         ring_len: acq.ring_len,
     };
     recovery::recover(&mut weak)
+}
+
+/// The recovery with only `OVR` cleared.
+fn recover_only_ovr(acq: &mut ModelAcq) -> Result<Faults, StepTimeout> {
+    recover_weakened(acq, Without::EocClear)
+}
+
+/// The recovery without the `DMAEN` clear.
+fn recover_keeping_dmaen(acq: &mut ModelAcq) -> Result<Faults, StepTimeout> {
+    recover_weakened(acq, Without::DmaenClear)
 }
 
 /// The firmware's restart before the recovery: the trigger stopped, the DMA paused and
@@ -338,6 +182,8 @@ fn the_monitor_resumes_after_an_adc_overrun_and_a_dma_error_with_its_state_intac
         ]
     );
     assert_eq!(rig.adc.restarts(), 2);
+    // Every sample after the two recoveries had its channels in place.
+    assert_eq!(rig.acq.regs.misaligned_halves, 0);
     // The monitor's state is intact: the same thresholds, the sample counter went on (only
     // the samples of the two gaps are missing), the watchdog petted throughout, the panel
     // commissioned after the run-up (a 2 ms gap is no stall) and no reset record.
@@ -384,7 +230,7 @@ fn the_sequence_on_the_model_clears_what_blocks_the_dma() {
     let mut acq = AdcDmaModel::running();
     acq.regs.inject_dma_error();
     // The ADC goes on converting into a full data register: overrun.
-    assert!(!acq.regs.trigger() && !acq.regs.trigger());
+    assert!(!acq.regs.sample() && !acq.regs.sample());
     assert!(acq.regs.adc_flags(0).ovr && acq.regs.adc_flags(0).eoc);
     assert_eq!(
         recovery::recover(&mut acq),
@@ -393,14 +239,80 @@ fn the_sequence_on_the_model_clears_what_blocks_the_dma() {
             dma_error: true
         })
     );
-    assert!(acq.regs.trigger());
+    assert!(acq.regs.sample());
     assert_eq!(recovery::recover(&mut acq), Ok(Faults::default()));
-    assert!(acq.regs.trigger());
+    assert!(acq.regs.sample());
     assert_eq!(
         RecoveryStep::ORDER.first(),
         Some(&RecoveryStep::StopTrigger)
     );
     assert!(acq.regs.violations.is_empty(), "{:?}", acq.regs.violations);
+    assert_eq!(acq.regs.misaligned_halves, 0);
+}
+
+/// A DMA transfer error leaves a DMA request raised while the channel was off. The
+/// firmware's sequence clears `DMAEN` with the ADC stopped, which withdraws it: after the
+/// recovery every half holds va, vb, vc (ia, ib, ic) in their places. Without the `DMAEN`
+/// clear the re-armed channel serves the stale request first, one word from the data
+/// register, and every later half is shifted by one word: vc read as va, for good.
+#[test]
+fn after_a_dma_error_the_channels_stay_in_place_only_with_the_dmaen_clear() {
+    for (name, restart) in [
+        (
+            "firmware",
+            recovery::recover::<ModelAcq> as fn(&mut ModelAcq) -> Result<Faults, StepTimeout>,
+        ),
+        ("without the DMAEN clear", recover_keeping_dmaen),
+    ] {
+        let mut acq = AdcDmaModel::running();
+        for _ in 0..10 {
+            assert!(acq.regs.sample());
+        }
+        acq.regs.inject_dma_error();
+        assert!(!acq.regs.sample());
+        let faults = restart(&mut acq).unwrap();
+        assert!(faults.dma_error, "{name}");
+        let delivered = (0..100).filter(|_| acq.regs.sample()).count();
+        assert!(delivered >= 99, "{name}: {delivered}");
+        let shifted = acq.regs.misaligned_halves;
+        if name == "firmware" {
+            assert_eq!(shifted, 0, "{name}");
+            assert!(acq.regs.violations.is_empty(), "{:?}", acq.regs.violations);
+        } else {
+            assert!(shifted >= 2 * 99, "{name}: {shifted} halves shifted");
+        }
+    }
+}
+
+/// The waits are bounded: an ADC whose `ADSTART` never clears stops the sequence at
+/// `StopAdc` after [`POLL_LIMIT`] polls (about 3 ms of the model's clock), nothing
+/// re-armed; a working one stops within one conversion time.
+#[test]
+fn a_stuck_adc_times_the_stop_out_and_a_working_one_stops_within_a_conversion() {
+    let mut acq = AdcDmaModel::running();
+    assert!(acq.regs.sample());
+    let t0 = acq.regs.now_ns;
+    assert_eq!(recovery::recover(&mut acq), Ok(Faults::default()));
+    let took = acq.regs.now_ns - t0;
+    assert!(
+        took <= u64::from(conversion_ns()) + 10 * POLL_NS,
+        "{took} ns"
+    );
+
+    let mut acq = AdcDmaModel::running();
+    acq.regs.adc[1].stuck = true;
+    let t0 = acq.regs.now_ns;
+    assert_eq!(
+        recovery::recover(&mut acq),
+        Err(StepTimeout(RecoveryStep::StopAdc))
+    );
+    let took_ms = (acq.regs.now_ns - t0) as f64 / 1e6;
+    assert!(
+        took_ms >= POLL_LIMIT as f64 * POLL_NS as f64 / 1e6,
+        "{took_ms} ms"
+    );
+    assert!(!acq.regs.trigger_on && acq.regs.dma.iter().all(|d| d.en));
+    assert!(!acq.regs.sample());
 }
 
 /// The done-when of the overrun recovery: with the model's `EOC` behaviour, a forced
@@ -465,13 +377,18 @@ fn a_forced_overrun_resumes_within_2_ms_and_without_the_eoc_clear_it_never_does(
 #[test]
 fn a_lapped_ring_is_reloaded_from_its_start() {
     let mut acq = AdcDmaModel::running();
-    for _ in 0..(3 * RING_LEN as usize + 5) {
-        assert!(acq.regs.trigger());
+    // 3 turns and 5 triggers: the ring's position is not at its start.
+    for _ in 0..(3 * RING_LEN as usize / CHANNELS + 5) {
+        acq.regs.trigger();
     }
     assert_ne!(acq.regs.dma[0].cndtr, RING_LEN);
     assert_eq!(recovery::recover(&mut acq), Ok(Faults::default()));
     assert_eq!(acq.regs.dma.map(|d| d.cndtr), [RING_LEN; 2]);
-    assert!(acq.regs.trigger());
+    assert!(acq.regs.sample());
     assert!(acq.regs.violations.is_empty(), "{:?}", acq.regs.violations);
-    assert_eq!(acq.regs.dma[0].moved, acq.regs.conversions);
+    assert_eq!(
+        acq.regs.dma[0].moved,
+        acq.regs.conversions * CHANNELS as u32
+    );
+    assert_eq!(acq.regs.misaligned_halves, 0);
 }

@@ -17,10 +17,21 @@
 //!    mode (not per sample): one isolation of the averaged point and one joint fit over
 //!    [`MAX_POINTS`] operating points with an anchor (the evidence across operating
 //!    points, `monitor_core::isolation::Evidence`).
-//! 4. Prints `name=value` lines and exits 0, or non-zero on any mismatch.
+//! 4. Counts the instructions per sample of the firmware's sampling path ahead of the core
+//!    (`drive_monitor::acquisition`, the same source file: the eight oversampled
+//!    sequences of each ADC summed, `PwmFilter::step`).
+//! 5. Prints `name=value` lines and exits 0, or non-zero on any mismatch.
 #![no_std]
 #![no_main]
 
+// The firmware library's acquisition and clock, compiled here from their own files (the
+// firmware's library pulls embassy on this target; these two need nothing but `core`).
+#[path = "../../../src/acquisition.rs"]
+#[allow(dead_code)]
+mod acquisition;
+#[path = "../../../src/clock.rs"]
+#[allow(dead_code)]
+mod clock;
 mod scenario;
 
 use core::hint::black_box;
@@ -94,6 +105,7 @@ fn main() -> ! {
     let ok = replay_matches_host(&cfg, n, checks, spacing);
     count_instructions(&cfg, n, ticks_per_instr);
     count_isolation(&cfg, n, ticks_per_instr);
+    count_sampling_path(n, ticks_per_instr);
     println!("result={}", if ok { "pass" } else { "FAIL" });
     semihosting::exit(ok)
 }
@@ -269,6 +281,39 @@ fn count_instructions(cfg: &MonitorConfig, n: usize, ticks_per_instr: f32) {
     println!("fast_path={:.0}", fast);
     println!("slow_path_per_call={:.0}", slow);
     println!("whole_pipeline={:.0}", per_sample(t_all, base, n));
+}
+
+/// Counts the instructions per sample of the firmware's sampling path (module docs, 4):
+/// each replay sample's six codes as [`acquisition::OVERSAMPLING`] sequences per ADC,
+/// summed (`sum_half`) and filtered (`PwmFilter::step`), and prints
+/// `sampling_path`; the loop that builds the halves is measured alone and subtracted.
+fn count_sampling_path(n: usize, ticks_per_instr: f32) {
+    use acquisition::{sum_half, PwmFilter, CHANNELS, HALF_LEN};
+    let halves = |k: usize| {
+        let at = scenario::REPLAY_HEADER + k * scenario::SAMPLE_BYTES;
+        let c = |x: usize| scenario::u16_at(REPLAY, at + 2 * x);
+        let (mut v, mut i) = ([0u16; HALF_LEN], [0u16; HALF_LEN]);
+        for (j, (v, i)) in v.iter_mut().zip(i.iter_mut()).enumerate() {
+            *v = c(j % CHANNELS);
+            *i = c(CHANNELS + j % CHANNELS);
+        }
+        (v, i, c(6))
+    };
+    let base = measure(|| {
+        for k in 0..n {
+            black_box(halves(black_box(k)));
+        }
+    });
+    let mut filter = PwmFilter::new(10_000, 50.0);
+    let t = measure(|| {
+        for k in 0..n {
+            let (v, i, count) = halves(black_box(k));
+            let ((vs, m), (is, _)) = (sum_half(black_box(&v)), sum_half(black_box(&i)));
+            black_box(filter.step(vs, is, m, count));
+        }
+    });
+    let per_sample = (t as f32 - base as f32) / ticks_per_instr / n as f32;
+    println!("sampling_path={:.0}", per_sample);
 }
 
 /// Counts the instructions of the isolation's thread-mode work per 0.1 s block (module

@@ -56,7 +56,7 @@ pub fn config() -> MonitorConfig {
     c
 }
 
-fn u16_at(b: &[u8], at: usize) -> u16 {
+pub fn u16_at(b: &[u8], at: usize) -> u16 {
     match b.get(at..at + 2) {
         Some(&[x, y]) => u16::from_le_bytes([x, y]),
         _ => 0,

@@ -70,6 +70,11 @@
 //! Steps and faults act at the first output sample at or after their time. Unknown keys are
 //! errors; messages name the key (and the line for TOML errors).
 //!
+//! # Inverter-fed supply
+//! [`pwm::apply_pwm`] adds a two-level PWM inverter's switching ripple (space-vector
+//! modulation, regular sampled, a single-pole front end) to the voltages and currents of
+//! rows simulated on the sinusoidal supply: a post-processing step, nothing else changes.
+//!
 //! # Faults
 //! `rs, rr`: resistance x (1 + change). `ls, lr`: LEAKAGE inductance x (1 + change), the self
 //! inductances follow (PSIM's convention, `docs/design.md`); for a Gamma-model machine with no
@@ -92,6 +97,7 @@
 mod effect_spec;
 mod faults;
 pub mod machine;
+pub mod pwm;
 mod resolve;
 mod run;
 mod scenario;

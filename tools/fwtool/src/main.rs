@@ -14,6 +14,13 @@
 //!   sample may be lost); `--blocking` builds the control with defmt-rtt's blocking mode (the
 //!   samples must stop), `--drop-on-contention` defmt-rtt's other mode, for comparison.
 //!
+//! - `fw bor [--dry-run]`: program the brown-out reset level 4 (about 2.8 V) into the
+//!   option bytes of the board on the ST-LINK, once per board, with ST's
+//!   `STM32_Programmer_CLI` (which runs RM0440's option-byte sequence: unlock, write
+//!   `FLASH_OPTR`, `OPTSTRT`, `OBL_LAUNCH`), then read the option bytes back. The firmware
+//!   only reads the level and warns at every boot while it is below 4; writing option bytes
+//!   from the firmware would risk them on every boot. `--dry-run` prints the commands.
+//!
 //! The QEMU program's data (`crates/core-on-m4/data/{replay,expected}.bin`) is a log from
 //! the sim-host simulator and the host build's answers to it; the root test
 //! `tests/qemu_replay_data.rs` checks it is current and regenerates it with
@@ -169,6 +176,34 @@ fn fw(check: bool) -> Result<(), String> {
     Ok(())
 }
 
+/// ST's command-line programmer, which writes option bytes (probe-rs writes memory, not
+/// option bytes).
+const ST_PROGRAMMER: &str = "STM32_Programmer_CLI";
+/// The brown-out level the firmware wants (`drive_monitor::supply::BOR_GOAL`).
+const BOR_LEVEL: u8 = 4;
+
+/// `fw bor`: programs `BOR_LEV` = [`BOR_LEVEL`] over SWD and reads the option bytes back;
+/// with `dry_run` only prints the commands.
+fn bor(dry_run: bool) -> Result<(), String> {
+    let program = [
+        "-c".to_string(),
+        "port=SWD".into(),
+        "-ob".into(),
+        format!("BOR_LEV={BOR_LEVEL}"),
+    ];
+    let display = ["-c", "port=SWD", "-ob", "displ"];
+    println!("{ST_PROGRAMMER} {}", program.join(" "));
+    println!("{ST_PROGRAMMER} {}", display.join(" "));
+    if dry_run {
+        println!("(dry run: nothing written; the next boot's log shows `brown-out reset level 4`)");
+        return Ok(());
+    }
+    run(Command::new(ST_PROGRAMMER).args(&program)).map_err(|e| {
+        format!("{e}\n(install STM32CubeProgrammer and put {ST_PROGRAMMER} on PATH, or set BOR_LEV = 4 in its option-byte page)")
+    })?;
+    run(Command::new(ST_PROGRAMMER).args(display))
+}
+
 /// Builds the QEMU program in `crates/<name>` (release, `thumbv7em-none-eabihf`, with
 /// `features`: cargo's feature arguments), checks that its vector table is at 0x0 (the
 /// mps2-an386 layout, not the G474's) and returns the ELF's path.
@@ -263,11 +298,14 @@ fn qemu_rtt(args: &[String]) -> Result<ExitCode, String> {
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let result = match args.first().map(String::as_str) {
+        Some("fw") if args.get(1).map(String::as_str) == Some("bor") => {
+            bor(args.iter().any(|a| a == "--dry-run")).map(|()| ExitCode::SUCCESS)
+        }
         Some("fw") => fw(args.iter().any(|a| a == "--check")).map(|()| ExitCode::SUCCESS),
         Some("qemu-core") => qemu_core(),
         Some("qemu-rtt") => qemu_rtt(&args[1..]),
         _ => Err(
-            "usage: fwtool fw [--check] | qemu-core | qemu-rtt [--blocking | --drop-on-contention]"
+            "usage: fwtool fw [--check] | fw bor [--dry-run] | qemu-core | qemu-rtt [--blocking | --drop-on-contention]"
                 .into(),
         ),
     };

@@ -1,0 +1,349 @@
+//! The acquisition's geometry, written once for the firmware and the host's model of the
+//! ADC and DMA (`tests/sil/recovery.rs`): channels per ADC, oversampling, the DMA ring's
+//! length, the sampling time and the conversion time it gives; and the averaging of the
+//! oversampled sequences into one sample ([`average_half`]).
+//!
+//! **Oversampling against the inverter's PWM.** An inverter switches at 2-16 kHz; its
+//! line-to-neutral voltage is a pulse train whose switching components (around multiples
+//! of the carrier, `m f_c +- n f_1`) are hundreds of volts. Sampled at the monitor's
+//! 10 kHz behind the front end's single-pole 16 kHz RC, a component at `f` folds to
+//! `|f - k f_s|`: 4 kHz switching puts its fifth group (20 kHz +- 50 Hz) onto the
+//! fundamental, 8 kHz its fifth (40 kHz), 16 kHz its fifth (80 kHz), attenuated by the RC
+//! only to 0.62, 0.37 and 0.20. So TIM1 triggers both ADCs [`OVERSAMPLING`] times per
+//! sample (80 kHz) and the sample is the mean of the [`OVERSAMPLING`] sequences spread
+//! evenly over the sample period: a moving average over one whole period, whose gain is
+//! zero at every multiple of the sample rate, where the folding to the fundamental comes
+//! from (`|sin(pi f N / f_t) / (N sin(pi f / f_t))|`, `f_t` the trigger rate). What
+//! still folds is what lies near multiples of the trigger rate (80 kHz: the RC's 0.20
+//! times the PWM's small high-order groups there); docs/firmware.md gives the front end's
+//! anti-alias requirement and the figures.
+//!
+//! **The in-band ripple.** A carrier below half the sample rate (4 kHz at 10 kHz), or one
+//! whose groups fold to a few kHz (8 kHz: its second group at 16 kHz lands on 4 kHz, its
+//! first on 2 kHz), is not an alias of the fundamental but ripple in band: tens of volts
+//! at kHz on every reading. It does not move the fundamental, but it moves the monitor's
+//! fast quantities (measured: a 4 kHz inverter lit r1 and r4 on a healthy machine, and the
+//! host's isolation found no steady operating point). [`PwmFilter`] takes it out: two
+//! one-pole low-passes on the six channels alike, the fundamental's gain restored, the
+//! encoder held back by the filters' delay.
+
+use crate::clock;
+
+/// Channels per ADC: ADC1 va, vb, vc; ADC2 ia, ib, ic.
+pub const CHANNELS: usize = 3;
+/// Sequences (triggers) averaged into one sample (module docs).
+pub const OVERSAMPLING: usize = 8;
+/// Samples per DMA half buffer: 1, so every sample wakes the sample task as it arrives
+/// and the encoder is read within microseconds of the conversions.
+pub const SAMPLES_PER_HALF: usize = 1;
+/// 16-bit words in one DMA half buffer (one sample's sequences).
+pub const HALF_LEN: usize = SAMPLES_PER_HALF * OVERSAMPLING * CHANNELS;
+/// The DMA ring's length per ADC in 16-bit words (two halves), which is also the
+/// channel's `CNDTR` at the start of a turn.
+pub const RING_LEN: usize = 2 * HALF_LEN;
+
+/// The regular channels' sampling time in ADC clock cycles, times 2 (`SMPx` = 24.5
+/// cycles; halves are how RM0440 counts them): the front end drives each pin through
+/// 1 kohm and 10 nF, far below the datasheet's source-resistance bound for 24.5 cycles
+/// (about 11 kohm).
+pub const SAMPLE_TIME_HALF_CYCLES: u32 = 49;
+/// A 12-bit conversion's successive approximation in ADC cycles, times 2 (12.5 cycles).
+pub const CONVERSION_HALF_CYCLES: u32 = 25;
+/// One conversion [ADC clock cycles x 2]: sampling plus approximation (37 cycles).
+pub const CONVERSION_TOTAL_HALF_CYCLES: u32 = SAMPLE_TIME_HALF_CYCLES + CONVERSION_HALF_CYCLES;
+
+/// One conversion [ns] at [`clock::ADC_CLOCK_HZ`] (870 ns).
+pub const fn conversion_ns() -> u32 {
+    (CONVERSION_TOTAL_HALF_CYCLES as u64 * 1_000_000_000 / (2 * clock::ADC_CLOCK_HZ as u64)) as u32
+}
+
+/// One sequence of [`CHANNELS`] conversions [ns] (2.6 us).
+pub const fn sequence_ns() -> u32 {
+    conversion_ns() * CHANNELS as u32
+}
+
+/// The trigger rate [Hz] for `sample_rate_hz`: [`OVERSAMPLING`] sequences per sample.
+pub const fn trigger_rate_hz(sample_rate_hz: u32) -> u32 {
+    sample_rate_hz.saturating_mul(OVERSAMPLING as u32)
+}
+
+/// The longest the injected VREFINT conversion holds a regular sequence up [ns]: 247.5 +
+/// 12.5 cycles (`supply::REFERENCE_SAMPLE_CYCLES`), once a second.
+pub const fn reference_conversion_ns() -> u32 {
+    (260 * 1_000_000_000_u64 / clock::ADC_CLOCK_HZ as u64) as u32
+}
+
+/// Whether the acquisition fits `sample_rate_hz` (the firmware checks its rate at compile
+/// time): a sequence, even one held up by the reference's injected conversion, ends before
+/// the next trigger (no overrun by design), and the timers' clock divides the trigger rate
+/// exactly.
+pub const fn fits(sample_rate_hz: u32) -> bool {
+    let trigger = trigger_rate_hz(sample_rate_hz);
+    trigger > 0
+        && sequence_ns() + reference_conversion_ns() < 1_000_000_000 / trigger
+        && clock::timer_divider(trigger).is_some()
+}
+
+/// The mean of each channel over the [`OVERSAMPLING`] sequences of one half buffer
+/// `half` (`[a, b, c, a, b, c, ...]`, [`HALF_LEN`] words), rounded to the nearest code.
+/// A shorter `half` averages the whole sequences it holds; an empty one gives zeros.
+#[inline]
+pub fn average_half(half: &[u16]) -> [u16; CHANNELS] {
+    let mut sum = [0u32; CHANNELS];
+    let mut n = 0u32;
+    for seq in half.chunks_exact(CHANNELS) {
+        for (s, &code) in sum.iter_mut().zip(seq) {
+            *s += u32::from(code);
+        }
+        n += 1;
+    }
+    let n = n.max(1);
+    sum.map(|s| ((s + n / 2) / n) as u16)
+}
+
+/// The sum of each channel over the sequences of one half buffer `half` (`[a, b, c, a,
+/// b, c, ...]`) and how many sequences it held: what [`PwmFilter::step`] takes.
+#[inline]
+pub fn sum_half(half: &[u16]) -> ([u32; CHANNELS], u32) {
+    let (sequences, _) = half.as_chunks::<CHANNELS>();
+    let [mut a, mut b, mut c] = [0u32; CHANNELS];
+    for &[x, y, z] in sequences {
+        a += u32::from(x);
+        b += u32::from(y);
+        c += u32::from(z);
+    }
+    ([a, b, c], sequences.len() as u32)
+}
+
+/// Fractional bits of [`PwmFilter`]'s states.
+const FILTER_FRAC_BITS: u32 = 12;
+/// The first stage's coefficient `a = 2^-2` (a one-pole low-pass `y += a (x - y)` at 10 kHz:
+/// -3 dB at 458 Hz).
+const STAGE1_SHIFT: u32 = 2;
+/// The second stage's coefficient `a = 2^-1` (-3 dB at 1.1 kHz at 10 kHz).
+const STAGE2_SHIFT: u32 = 1;
+/// Samples the encoder count is held back, the filters' delay at the fundamental
+/// (`(1 - a) / a`: 3 and 1 samples) so that the shaft angle goes with the readings.
+pub const ENCODER_DELAY_SAMPLES: usize = 4;
+
+/// The in-band part of an inverter's ripple taken out of the six channels (module docs):
+/// two one-pole low-passes in integer arithmetic on the oversampled sums ([`sum_half`]),
+/// `a = 1/4` then `a = 1/2` at the sample rate (at 10 kHz: -3 dB at 458 Hz and 1.1 kHz;
+/// gain 0.052 at 4 kHz, 0.12 at 2 kHz, where an 8 kHz carrier's second group lands), and
+/// the fundamental's gain restored (`gain_q15`, from [`PwmFilter::new`]'s supply frequency:
+/// at 50 Hz the two stages pass 0.993). All six channels are filtered alike, so the
+/// machine's equations between the voltages and currents hold through it (a linear filter
+/// commutes with a linear machine's equations in steady state); the encoder count is held
+/// back [`ENCODER_DELAY_SAMPLES`] samples to go with them. No allocation, no panics.
+#[derive(Clone, Copy, Debug)]
+pub struct PwmFilter {
+    /// Each channel's two stages (voltages a, b, c, then currents), in sums x 2^12.
+    stages: [[i32; 2]; 2 * CHANNELS],
+    /// The encoder counts of the last samples, a ring; `at` the oldest.
+    counts: [u16; ENCODER_DELAY_SAMPLES],
+    at: usize,
+    /// The inverse of the stages' gain at the supply frequency, x 2^15.
+    gain_q15: i32,
+    primed: bool,
+}
+
+impl PwmFilter {
+    /// A filter at `sample_rate_hz` whose gain at `supply_hz` is restored to 1 (invalid
+    /// rates: no restoring).
+    pub fn new(sample_rate_hz: u32, supply_hz: f32) -> Self {
+        let w = core::f32::consts::TAU * supply_hz / sample_rate_hz as f32;
+        // |a / (1 - b e^{-jw})|^2 of each stage.
+        let gain2 = |shift: u32| {
+            let a = 1.0 / (1u32 << shift) as f32;
+            let b = 1.0 - a;
+            let (re, im) = (1.0 - b * micro_cos(w), b * micro_sin(w));
+            a * a / (re * re + im * im)
+        };
+        let g2 = gain2(STAGE1_SHIFT) * gain2(STAGE2_SHIFT);
+        let gain_q15 = if g2.is_finite() && g2 > 0.25 && g2 <= 1.0 {
+            (32768.0 * sqrt_near_one(1.0 / g2)) as i32
+        } else {
+            32768
+        };
+        Self {
+            stages: [[0; 2]; 2 * CHANNELS],
+            counts: [0; ENCODER_DELAY_SAMPLES],
+            at: 0,
+            gain_q15,
+            primed: false,
+        }
+    }
+
+    /// One sample: the voltages' and currents' sums over `n` sequences (from [`sum_half`])
+    /// and the encoder count read after them; the filtered codes (rounded, within
+    /// 0..=4095) and the encoder count of [`ENCODER_DELAY_SAMPLES`] samples ago. The first
+    /// sample starts the stages at its own value (no run-up from zero).
+    #[inline]
+    pub fn step(
+        &mut self,
+        v: [u32; CHANNELS],
+        i: [u32; CHANNELS],
+        n: u32,
+        count: u16,
+    ) -> ([u16; CHANNELS], [u16; CHANNELS], u16) {
+        let n = n.max(1) as i32;
+        let (primed, gain) = (self.primed, self.gain_q15);
+        let [va, vb, vc] = v;
+        let [ia, ib, ic] = i;
+        let [s0, s1, s2, s3, s4, s5] = &mut self.stages;
+        let v = [
+            filter_channel(s0, va, n, primed, gain),
+            filter_channel(s1, vb, n, primed, gain),
+            filter_channel(s2, vc, n, primed, gain),
+        ];
+        let i = [
+            filter_channel(s3, ia, n, primed, gain),
+            filter_channel(s4, ib, n, primed, gain),
+            filter_channel(s5, ic, n, primed, gain),
+        ];
+        self.primed = true;
+        if !primed {
+            self.counts = [count; ENCODER_DELAY_SAMPLES];
+        }
+        let slot = self.counts.get_mut(self.at % ENCODER_DELAY_SAMPLES);
+        let delayed = slot.map_or(count, |c| core::mem::replace(c, count));
+        self.at = (self.at + 1) % ENCODER_DELAY_SAMPLES;
+        (v, i, delayed)
+    }
+}
+
+/// One channel of [`PwmFilter::step`]: the mean of `sum` over `n` sequences in codes x
+/// 2^12 (n <= 8: 4095 x 2^12 < 2^24) through the two stages `st` (started at it when not
+/// `primed`), the gain restored around mid-scale (the swing, not the offset), rounded to
+/// a code within 0..=4095.
+#[inline(always)]
+fn filter_channel(st: &mut [i32; 2], sum: u32, n: i32, primed: bool, gain_q15: i32) -> u16 {
+    let x = ((sum as i32) << FILTER_FRAC_BITS) / n;
+    if !primed {
+        *st = [x, x];
+    }
+    let [a, b] = st;
+    *a += (x - *a) >> STAGE1_SHIFT;
+    *b += (*a - *b) >> STAGE2_SHIFT;
+    let mid = 2048 << FILTER_FRAC_BITS;
+    let y = mid + ((i64::from(*b - mid) * i64::from(gain_q15)) >> 15) as i32;
+    let code = (y + (1 << (FILTER_FRAC_BITS - 1))) >> FILTER_FRAC_BITS;
+    code.clamp(0, 4095) as u16
+}
+
+/// `sqrt(x)` for `x` in 1..=4 (the inverse gain squared) by Newton's iteration from `x`:
+/// six steps reach f32's precision there (no `std` on the board).
+fn sqrt_near_one(x: f32) -> f32 {
+    let mut y = x;
+    for _ in 0..6 {
+        y = 0.5 * (y + x / y);
+    }
+    y
+}
+
+/// cos for the filter's set-up (host and board alike: `micromath`-free Taylor series,
+/// accurate to 1e-6 for |x| < 0.5, the supply's angle per sample).
+fn micro_cos(x: f32) -> f32 {
+    let x2 = x * x;
+    1.0 - x2 / 2.0 + x2 * x2 / 24.0 - x2 * x2 * x2 / 720.0
+}
+
+/// sin, as [`micro_cos`].
+fn micro_sin(x: f32) -> f32 {
+    let x2 = x * x;
+    x * (1.0 - x2 / 6.0 + x2 * x2 / 120.0 - x2 * x2 * x2 / 5040.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_geometry_fits_the_period() {
+        assert_eq!(RING_LEN, 48);
+        assert_eq!(conversion_ns(), 870);
+        assert!(sequence_ns() < 12_500);
+        assert_eq!(trigger_rate_hz(10_000), 80_000);
+        assert!(fits(10_000));
+        // 20 kHz: 6.25 us between triggers, less than a sequence held up by VREFINT.
+        assert!(!fits(20_000));
+    }
+
+    #[test]
+    fn the_average_is_per_channel_and_rounds() {
+        let mut half = [0u16; HALF_LEN];
+        for (k, seq) in half.chunks_exact_mut(CHANNELS).enumerate() {
+            seq.copy_from_slice(&[100 + k as u16, 2000, 4095 - (k as u16 % 2)]);
+        }
+        // a: 100..=107, mean 103.5 -> 104; c: 4095 and 4094 alternating, 4094.5 -> 4095.
+        assert_eq!(average_half(&half), [104, 2000, 4095]);
+        assert_eq!(average_half(&[]), [0, 0, 0]);
+    }
+
+    /// The filter against an independent model: a one-pole cascade in f64 on a 50 Hz
+    /// sinusoid plus a 4 kHz ripple; the 50 Hz amplitude is kept (the gain restored), the
+    /// ripple falls to the cascade's gain, and the encoder count is held back 4 samples.
+    #[test]
+    fn the_filter_keeps_the_fundamental_and_takes_the_ripple_out() {
+        let fs = 10_000.0_f64;
+        let mut f = PwmFilter::new(10_000, 50.0);
+        let (mut out50, mut out_ripple) = (Vec::new(), Vec::new());
+        for k in 0..4_000u32 {
+            let t = f64::from(k) / fs;
+            let fund = 1000.0 * (std::f64::consts::TAU * 50.0 * t).sin();
+            let ripple = 300.0 * (std::f64::consts::TAU * 4_000.0 * t).sin();
+            let code = |x: f64| ((2048.0 + x) * 8.0).round() as u32;
+            let sum = code(fund + ripple);
+            let (v, _, count) = f.step([sum; 3], [code(0.0); 3], 8, k as u16);
+            if k >= 4 {
+                assert_eq!(count, (k - 4) as u16);
+            }
+            if k >= 2_000 {
+                out50.push((t, f64::from(v[0]) - 2048.0));
+                out_ripple.push(f64::from(v[0]) - 2048.0);
+            }
+        }
+        // The 50 Hz amplitude by a DFT over the last 0.2 s (10 periods).
+        let (mut re, mut im) = (0.0, 0.0);
+        for &(t, y) in &out50 {
+            re += 2.0 * y * (std::f64::consts::TAU * 50.0 * t).cos() / out50.len() as f64;
+            im += 2.0 * y * (std::f64::consts::TAU * 50.0 * t).sin() / out50.len() as f64;
+        }
+        let amp = (re * re + im * im).sqrt();
+        assert!((amp - 1000.0).abs() < 2.0, "{amp}");
+        // The ripple left: the cascade's gain at 4 kHz, |a/(1 - (1-a) e^{-jw})| for a =
+        // 1/4 and 1/2 at w = 0.8 pi: 0.150 x 0.348 = 0.052 (x the gain restored, 1.007).
+        let ripple_gain = |a: f64| {
+            let w = std::f64::consts::TAU * 0.4;
+            let (re, im) = (1.0 - (1.0 - a) * w.cos(), (1.0 - a) * w.sin());
+            a / (re * re + im * im).sqrt()
+        };
+        let expected = 300.0 * ripple_gain(0.25) * ripple_gain(0.5);
+        let residual: Vec<f64> = out50
+            .iter()
+            .map(|&(t, y)| y - amp * ((std::f64::consts::TAU * 50.0 * t) + re.atan2(im)).sin())
+            .collect();
+        let peak = residual.iter().fold(0.0f64, |m, r| m.max(r.abs()));
+        assert!(
+            peak < expected * 1.1 + 1.5 && peak > expected * 0.8,
+            "{peak} against {expected}"
+        );
+        assert_eq!(out_ripple.len(), 2_000);
+    }
+
+    /// A sinusoid at a multiple of the sample rate (what folds onto DC and the
+    /// fundamental) averages to nothing; one at 50 Hz passes.
+    #[test]
+    fn the_average_nulls_multiples_of_the_sample_rate() {
+        let ft = 80_000.0_f64;
+        for f in [10_000.0, 20_000.0, 40_000.0] {
+            let mut half = [0u16; HALF_LEN];
+            for (k, seq) in half.chunks_exact_mut(CHANNELS).enumerate() {
+                let x = 2048.0 + 1000.0 * (std::f64::consts::TAU * f * k as f64 / ft + 0.3).sin();
+                seq.fill(x.round() as u16);
+            }
+            let avg = average_half(&half);
+            assert!((i32::from(avg[0]) - 2048).abs() <= 1, "{f} Hz: {avg:?}");
+        }
+    }
+}

@@ -1,0 +1,79 @@
+//! The clock tree, written once: the PLL's settings that the firmware's clock
+//! configuration (`clock_config` in `src/firmware.rs`) hands embassy-stm32, and every rate
+//! and cycle count derived from them (the fault path's wait, the set-up deadline's SysTick
+//! reload, the encoder timer's clock, the sample trigger's and the ADC's rates).
+//!
+//! 16 MHz HSI / [`PLL_PREDIV`] x [`PLL_MUL`] / [`PLL_RDIV`] = 170 MHz SYSCLK (the G474's
+//! maximum, with the regulator's boost mode), AHB and APB1/APB2 undivided, so HCLK and the
+//! timers' kernel clocks are SYSCLK too (RM0440, "Clock tree"; a timer on an undivided APB
+//! runs at the APB clock). The ADC12 kernel clock is SYSCLK ([`ADC_CLOCK_DIV`]: the common
+//! prescaler of `ADC12_CCR`, 4, which embassy-stm32 0.6 picks to stay below the ADC's
+//! 60 MHz): 42.5 MHz.
+
+/// The HSI oscillator [Hz] (the PLL's source).
+pub const HSI_HZ: u32 = 16_000_000;
+/// The PLL's input divider `PLLM` (1..=16).
+pub const PLL_PREDIV: u32 = 4;
+/// The PLL's multiplier `PLLN` (8..=127).
+pub const PLL_MUL: u32 = 85;
+/// The PLL's `R` output divider (2, 4, 6 or 8): SYSCLK.
+pub const PLL_RDIV: u32 = 2;
+
+/// SYSCLK [Hz]: `HSI / PLLM x PLLN / PLLR` = 170 MHz.
+pub const SYSCLK_HZ: u32 = HSI_HZ / PLL_PREDIV * PLL_MUL / PLL_RDIV;
+/// HCLK [Hz] (AHB undivided): the CPU's clock, the DWT cycle counter's and SysTick's
+/// (`/ 8` for its external reference).
+pub const HCLK_HZ: u32 = SYSCLK_HZ;
+/// The timers' kernel clock [Hz] (APB1 and APB2 undivided): TIM1 (the sample trigger) and
+/// TIM4 (the encoder).
+pub const TIMER_HZ: u32 = SYSCLK_HZ;
+/// The ADC kernel clock's divider (`ADC12_CCR.PRESC`, with `ADC12SEL` = SYSCLK).
+pub const ADC_CLOCK_DIV: u32 = 4;
+/// The ADC clock [Hz]: 42.5 MHz.
+pub const ADC_CLOCK_HZ: u32 = SYSCLK_HZ / ADC_CLOCK_DIV;
+
+/// CPU cycles per millisecond at [`HCLK_HZ`] (170 000).
+pub const CYCLES_PER_MS: u32 = HCLK_HZ / 1_000;
+
+/// The G474's largest SYSCLK [Hz] (boost mode).
+pub const SYSCLK_MAX_HZ: u32 = 170_000_000;
+/// The ADC's largest clock [Hz] (datasheet, single ADC).
+pub const ADC_CLOCK_MAX_HZ: u32 = 60_000_000;
+
+const _: () = assert!(
+    SYSCLK_HZ <= SYSCLK_MAX_HZ,
+    "SYSCLK above the G474's maximum"
+);
+const _: () = assert!(ADC_CLOCK_HZ <= ADC_CLOCK_MAX_HZ, "ADC clock too fast");
+const _: () = assert!(
+    HSI_HZ / PLL_PREDIV >= 2_660_000 && HSI_HZ / PLL_PREDIV <= 16_000_000,
+    "PLL input out of range"
+);
+
+/// The divider of [`TIMER_HZ`] that gives `rate_hz`, when it is exact (`None` otherwise, or
+/// for 0): the sample trigger's period in timer clocks.
+pub const fn timer_divider(rate_hz: u32) -> Option<u32> {
+    if rate_hz == 0 || !TIMER_HZ.is_multiple_of(rate_hz) {
+        None
+    } else {
+        Some(TIMER_HZ / rate_hz)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_clock_tree_gives_170_mhz_and_the_rates_follow() {
+        // An independent computation: 16 MHz / 4 = 4 MHz PLL input, x 85 = 340 MHz VCO,
+        // / 2 = 170 MHz.
+        assert_eq!(SYSCLK_HZ, 170_000_000);
+        assert_eq!(CYCLES_PER_MS, 170_000);
+        assert_eq!(ADC_CLOCK_HZ, 42_500_000);
+        assert_eq!(timer_divider(10_000), Some(17_000));
+        assert_eq!(timer_divider(80_000), Some(2_125));
+        assert_eq!(timer_divider(30_000), None);
+        assert_eq!(timer_divider(0), None);
+    }
+}

@@ -1,0 +1,103 @@
+//! The record pages in the board's flash: the embassy driver ([`Driver`], `None` with
+//! single-bank option bytes) behind `drive_monitor::flash_ecc::CheckedFlash`, so that
+//! every read of a record page is checked for an ECC double error (the NMI handler in
+//! `failure.rs` latches it in `failure::ECC`) and a bad page falls back.
+
+use defmt::warn;
+use drive_monitor::board;
+use drive_monitor::flash_ecc::{CheckedFlash, RawFlash, ReadError};
+use drive_monitor::flash_record::{RecordStore, RECORD_LEN};
+use embassy_stm32::flash::{Blocking, Flash};
+use monitor_core::motor_record::STORED_LEN as MOTOR_RECORD_LEN;
+
+use super::failure;
+
+/// Why the board's flash could not be used.
+#[derive(defmt::Format)]
+pub(super) enum FlashError {
+    /// The option bytes select single-bank flash (the records' pages need dual-bank).
+    SingleBank,
+    /// The flash driver's error.
+    Driver(embassy_stm32::flash::Error),
+    /// A double ECC error in the page (a torn write): the page is marked bad for this run.
+    Ecc {
+        /// The failing offset from 0x0800_0000.
+        offset: u32,
+    },
+    /// The page was marked bad earlier in this run.
+    MarkedBad,
+}
+
+/// The flash driver (`None`: the option bytes are single-bank).
+pub(super) struct Driver(pub(super) Option<Flash<'static, Blocking>>);
+
+impl Driver {
+    fn get(&mut self) -> Result<&mut Flash<'static, Blocking>, FlashError> {
+        self.0.as_mut().ok_or(FlashError::SingleBank)
+    }
+}
+
+impl RawFlash for Driver {
+    type Error = FlashError;
+    fn read_raw(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), FlashError> {
+        self.get()?
+            .blocking_read(offset, buf)
+            .map_err(FlashError::Driver)
+    }
+}
+
+/// The record pages in the board's flash, every read checked for ECC double errors
+/// (`drive_monitor::flash_ecc`: the NMI handler latches them in `failure::ECC`).
+pub(super) struct BoardFlash(pub(super) CheckedFlash<Driver>);
+
+/// A checked read's error as the firmware logs it.
+fn flash_error(e: ReadError<FlashError>) -> FlashError {
+    match e {
+        ReadError::Driver(e) => e,
+        ReadError::Ecc(e) => FlashError::Ecc { offset: e.offset },
+        ReadError::MarkedBad => FlashError::MarkedBad,
+    }
+}
+
+impl BoardFlash {
+    fn read_at(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), FlashError> {
+        self.0.read(&failure::ECC, offset, buf).map_err(flash_error)
+    }
+}
+
+impl RecordStore for BoardFlash {
+    type Error = FlashError;
+    fn read(&mut self, buf: &mut [u8; RECORD_LEN]) -> Result<(), Self::Error> {
+        self.read_at(board::RECORD_FLASH_OFFSET, buf)
+    }
+    fn erase(&mut self) -> Result<(), Self::Error> {
+        let from = board::RECORD_FLASH_OFFSET;
+        self.0
+            .raw
+            .get()?
+            .blocking_erase(from, from + board::RECORD_PAGE_SIZE)
+            .map_err(FlashError::Driver)?;
+        self.0.erased(from);
+        Ok(())
+    }
+    fn write(&mut self, bytes: &[u8; RECORD_LEN]) -> Result<(), Self::Error> {
+        self.0
+            .raw
+            .get()?
+            .blocking_write(board::RECORD_FLASH_OFFSET, bytes)
+            .map_err(FlashError::Driver)
+    }
+}
+
+/// The motor record's page (`board::MOTOR_RECORD_FLASH_OFFSET`), read as erased when the
+/// flash cannot be read or the read raised an ECC double error (the page is then marked
+/// bad; the reason is logged): `drive_monitor::boot` then runs the built-in default.
+pub(super) fn read_motor_page(flash: &mut BoardFlash) -> [u8; MOTOR_RECORD_LEN] {
+    let (page, read) = flash
+        .0
+        .read_or_erased::<MOTOR_RECORD_LEN>(&failure::ECC, board::MOTOR_RECORD_FLASH_OFFSET);
+    if let Err(e) = read {
+        warn!("motor record page unreadable: {}; running the built-in motor (write the record again: docs/firmware.md)", flash_error(e));
+    }
+    page
+}

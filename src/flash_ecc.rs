@@ -1,0 +1,249 @@
+//! The record pages' ECC errors: a torn flash write must not loop the boot.
+//!
+//! The STM32G474's flash keeps an ECC over every 64-bit double word (RM0440, "Error code
+//! correction (ECC)"). A write that a reset or a power loss cut short can leave a double
+//! word whose ECC does not match: reading it is a **double error**, `ECCD` in
+//! `FLASH_ECCR` with the failing address, and an NMI. Without a handler of its own the NMI
+//! went to the default handler, which records and resets, and the next boot read the page
+//! again: a boot loop.
+//!
+//! The firmware's NMI handler asks [`nmi_action`]: a double error in one of the record
+//! pages (the motor record, the commissioning record) is latched ([`EccLatch`]),
+//! `ECCD` is cleared and the handler returns, so the read completes (with wrong data);
+//! any other NMI (a double error in the code, the clock security system) goes to the
+//! fault path. Every read of a record page goes through [`CheckedFlash`]: it clears the
+//! latch before the read and looks at it after; a double error makes the read fail
+//! ([`ReadError::Ecc`]) and **marks the page bad** for the rest of the run, so it is not
+//! read again; an erase (the next commissioning's store) clears the mark. The boot then
+//! falls back: the built-in motor for the motor record's page, "not commissioned" for the
+//! commissioning record's, and runs.
+
+use core::sync::atomic::{AtomicU32, Ordering};
+
+use crate::board::{MOTOR_RECORD_FLASH_OFFSET, RECORD_FLASH_OFFSET, RECORD_PAGE_SIZE};
+
+/// `FLASH_ECCR.ECCD`: an ECC double error (write 1 to clear).
+pub const ECCR_ECCD: u32 = 1 << 31;
+/// `FLASH_ECCR.BK_ECC`: the error is in bank 2.
+pub const ECCR_BK_ECC: u32 = 1 << 21;
+/// `FLASH_ECCR.SYSF_ECC`: the error is in the system flash.
+pub const ECCR_SYSF_ECC: u32 = 1 << 22;
+/// `FLASH_ECCR.ADDR_ECC`: the failing address within its bank.
+pub const ECCR_ADDR_MASK: u32 = 0x0007_FFFF;
+/// A bank's size in dual-bank mode (512 KiB device): bank 2 starts at this offset.
+pub const BANK_SIZE: u32 = 256 * 1024;
+
+/// The first flash offset of the record pages (the motor record's page).
+pub const RECORD_PAGES_START: u32 = MOTOR_RECORD_FLASH_OFFSET;
+/// One past the last flash offset of the record pages.
+pub const RECORD_PAGES_END: u32 = RECORD_FLASH_OFFSET + RECORD_PAGE_SIZE;
+
+/// A double ECC error: the failing flash offset from 0x0800_0000.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EccError {
+    /// The failing byte offset in the user flash (bank 2 offsets from [`BANK_SIZE`]).
+    pub offset: u32,
+}
+
+/// The double error a value of `FLASH_ECCR` reports (`None`: no `ECCD`, or one in the
+/// system flash, which the firmware does not read).
+pub fn double_error(eccr: u32) -> Option<EccError> {
+    if eccr & ECCR_ECCD == 0 || eccr & ECCR_SYSF_ECC != 0 {
+        return None;
+    }
+    let bank = if eccr & ECCR_BK_ECC != 0 {
+        BANK_SIZE
+    } else {
+        0
+    };
+    Some(EccError {
+        offset: bank + (eccr & ECCR_ADDR_MASK),
+    })
+}
+
+/// What the NMI handler does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NmiAction {
+    /// A double error in a record page: latch it, clear `ECCD`, return (the read
+    /// completes; [`CheckedFlash`] rejects it).
+    RecordPageEcc(EccError),
+    /// Anything else: the fault path (record, reset).
+    Fault,
+}
+
+/// The NMI handler's decision on `FLASH_ECCR`'s value `eccr` (module docs).
+pub fn nmi_action(eccr: u32) -> NmiAction {
+    match double_error(eccr) {
+        Some(e) if (RECORD_PAGES_START..RECORD_PAGES_END).contains(&e.offset) => {
+            NmiAction::RecordPageEcc(e)
+        }
+        _ => NmiAction::Fault,
+    }
+}
+
+/// The double error the NMI handler latched for the read in progress (one at a time;
+/// the firmware has one static).
+#[derive(Debug)]
+pub struct EccLatch(AtomicU32);
+
+/// The latch's "set" bit (offsets are below 2^19).
+const LATCHED: u32 = 1 << 31;
+
+impl EccLatch {
+    /// An empty latch.
+    pub const fn new() -> Self {
+        Self(AtomicU32::new(0))
+    }
+
+    /// Latches `e` (the NMI handler).
+    pub fn latch(&self, e: EccError) {
+        self.0.store(LATCHED | e.offset, Ordering::SeqCst);
+    }
+
+    /// The latched error, and empties the latch.
+    pub fn take(&self) -> Option<EccError> {
+        let v = self.0.swap(0, Ordering::SeqCst);
+        (v & LATCHED != 0).then_some(EccError {
+            offset: v & !LATCHED,
+        })
+    }
+}
+
+impl Default for EccLatch {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// The flash driver's plain accesses.
+pub trait RawFlash {
+    /// The driver's error.
+    type Error;
+    /// Reads `buf.len()` bytes at `offset` (from 0x0800_0000).
+    ///
+    /// # Errors
+    /// The driver's.
+    fn read_raw(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), Self::Error>;
+}
+
+/// Why a checked read failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ReadError<E> {
+    /// The driver's error.
+    Driver(E),
+    /// A double ECC error during this read (the page is marked bad from now on).
+    Ecc(EccError),
+    /// The page was marked bad earlier in this run: not read again.
+    MarkedBad,
+}
+
+/// The record pages' reads with their ECC errors handled (module docs): `raw` and the
+/// pages marked bad in this run (the two record pages).
+#[derive(Debug)]
+pub struct CheckedFlash<F> {
+    /// The driver.
+    pub raw: F,
+    bad: [bool; 2],
+}
+
+/// Which record page `offset` is in (0: the motor record's, 1: the commissioning
+/// record's).
+fn page_index(offset: u32) -> Option<usize> {
+    if (RECORD_PAGES_START..RECORD_FLASH_OFFSET).contains(&offset) {
+        Some(0)
+    } else if (RECORD_FLASH_OFFSET..RECORD_PAGES_END).contains(&offset) {
+        Some(1)
+    } else {
+        None
+    }
+}
+
+impl<F: RawFlash> CheckedFlash<F> {
+    /// `raw` with no page marked bad.
+    pub fn new(raw: F) -> Self {
+        Self {
+            raw,
+            bad: [false; 2],
+        }
+    }
+
+    /// Whether the record page holding `offset` is marked bad.
+    pub fn is_bad(&self, offset: u32) -> bool {
+        page_index(offset).and_then(|i| self.bad.get(i)).copied() == Some(true)
+    }
+
+    fn set_bad(&mut self, offset: u32, bad: bool) {
+        if let Some(b) = page_index(offset).and_then(|i| self.bad.get_mut(i)) {
+            *b = bad;
+        }
+    }
+
+    /// The page holding `offset` was erased: no longer bad.
+    pub fn erased(&mut self, offset: u32) {
+        self.set_bad(offset, false);
+    }
+
+    /// Reads `buf.len()` bytes at `offset`, with the NMI handler's `latch` looked at
+    /// after the read.
+    ///
+    /// # Errors
+    /// [`ReadError::MarkedBad`] without a read when the page is marked bad;
+    /// [`ReadError::Driver`]; [`ReadError::Ecc`] when the read raised a double error (the
+    /// page is then marked bad).
+    pub fn read(
+        &mut self,
+        latch: &EccLatch,
+        offset: u32,
+        buf: &mut [u8],
+    ) -> Result<(), ReadError<F::Error>> {
+        if self.is_bad(offset) {
+            return Err(ReadError::MarkedBad);
+        }
+        let _stale = latch.take();
+        self.raw.read_raw(offset, buf).map_err(ReadError::Driver)?;
+        match latch.take() {
+            Some(e) => {
+                self.set_bad(e.offset, true);
+                self.set_bad(offset, true);
+                Err(ReadError::Ecc(e))
+            }
+            None => Ok(()),
+        }
+    }
+
+    /// A record page of `N` bytes at `offset`, read as erased (all `0xFF`, which no record
+    /// parses from) when the read failed: the boot then takes its fallback. The error, for
+    /// the log.
+    pub fn read_or_erased<const N: usize>(
+        &mut self,
+        latch: &EccLatch,
+        offset: u32,
+    ) -> ([u8; N], Result<(), ReadError<F::Error>>) {
+        let mut page = [0xFF_u8; N];
+        let result = self.read(latch, offset, &mut page);
+        if result.is_err() {
+            page = [0xFF; N];
+        }
+        (page, result)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_eccr_decoding_follows_the_register_layout() {
+        // RM0440 FLASH_ECCR: ECCD bit 31, SYSF_ECC bit 22, BK_ECC bit 21, ADDR_ECC 18:0.
+        let eccr = 0x8000_0000 | 0x0020_0000 | 0x3_F010;
+        assert_eq!(double_error(eccr), Some(EccError { offset: 0x7_F010 }));
+        assert_eq!(
+            nmi_action(eccr),
+            NmiAction::RecordPageEcc(EccError { offset: 0x7_F010 })
+        );
+        // In the code (bank 1) or the system flash, or no ECCD: the fault path.
+        assert_eq!(nmi_action(0x8000_1000), NmiAction::Fault);
+        assert_eq!(nmi_action(eccr | ECCR_SYSF_ECC), NmiAction::Fault);
+        assert_eq!(nmi_action(eccr & !ECCR_ECCD), NmiAction::Fault);
+    }
+}

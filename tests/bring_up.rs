@@ -1,0 +1,63 @@
+//! The bring-up a first board gets (issue 51): `cargo fw-run`'s runner lets the firmware's
+//! own handlers run (probe-rs catches neither the reset nor the HardFault), and
+//! docs/firmware.md's bring-up checklist puts the steps in the order a board needs them:
+//! the motor record into flash, the brown-out level, the run with the handlers visible,
+//! the boot report.
+
+use std::path::Path;
+
+fn read(rel: &str) -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+#[test]
+fn the_runner_lets_the_firmwares_handlers_run() {
+    let config = read(".cargo/config.toml");
+    let runner = config
+        .lines()
+        .find(|l| l.trim_start().starts_with("runner"))
+        .expect("a runner in .cargo/config.toml");
+    for flag in [
+        "probe-rs run",
+        "--chip STM32G474RETx",
+        "--no-catch-reset",
+        "--no-catch-hardfault",
+    ] {
+        assert!(runner.contains(flag), "the runner lacks {flag}: {runner}");
+    }
+}
+
+#[test]
+fn the_bring_up_list_runs_record_brown_out_handlers_boot_report() {
+    let docs = read("docs/firmware.md");
+    let start = docs.find("## Bring-up checklist").expect("the checklist");
+    let end = docs[start + 3..]
+        .find("\n## ")
+        .map_or(docs.len(), |e| start + 3 + e);
+    let list = &docs[start..end];
+    // The numbered items' titles, in order.
+    let titles: Vec<&str> = list
+        .lines()
+        .filter_map(|l| {
+            let (n, rest) = l.split_once(". **")?;
+            n.trim().parse::<u32>().ok()?;
+            rest.split("**").next()
+        })
+        .collect();
+    let at = |what: &str| {
+        titles
+            .iter()
+            .position(|t| t.to_lowercase().contains(what))
+            .unwrap_or_else(|| panic!("no step {what:?} in {titles:?}"))
+    };
+    let order = [
+        at("motor record"),
+        at("brown-out"),
+        at("handlers visible"),
+        at("boot report"),
+    ];
+    assert!(order.windows(2).all(|w| w[0] < w[1]), "{titles:?}");
+    // The brown-out step names the command that programs it.
+    assert!(list.contains("cargo fw bor"));
+}
