@@ -22,6 +22,7 @@
 //! the ratios to polars'.
 
 mod common;
+mod stages;
 
 use monitor_io::params::ParamFile;
 use std::path::{Path, PathBuf};
@@ -81,8 +82,17 @@ fn measure(mut cmd: Command, out: &Path) -> BenchRun {
     }
 }
 
-/// `sim-host diagnose --json` of `log`: the run and the report's rows.
-fn diagnose(log: &Path, params: &Path, out: &Path) -> (BenchRun, f64) {
+/// What a diagnosis concluded: the rows read, the verdict and its finding (the fault named
+/// and its size), compared between the CSV and its Parquet copy.
+#[derive(Debug, PartialEq)]
+struct Concluded {
+    rows: f64,
+    verdict: serde_json::Value,
+    finding: serde_json::Value,
+}
+
+/// `sim-host diagnose --json` of `log`: the run and what it concluded.
+fn diagnose(log: &Path, params: &Path, out: &Path) -> (BenchRun, Concluded) {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_sim-host"));
     cmd.arg("diagnose")
         .arg("--params")
@@ -92,7 +102,12 @@ fn diagnose(log: &Path, params: &Path, out: &Path) -> (BenchRun, f64) {
     let run = measure(cmd, out);
     let report: serde_json::Value =
         serde_json::from_reader(std::fs::File::open(out).expect("output")).expect("JSON");
-    (run, report["rows"].as_f64().unwrap_or(f64::NAN))
+    let concluded = Concluded {
+        rows: report["rows"].as_f64().unwrap_or(f64::NAN),
+        verdict: report["verdict"].clone(),
+        finding: report["verdict_finding"].clone(),
+    };
+    (run, concluded)
 }
 
 /// polars' `read_csv` of `log` in `python`: the call's wall and CPU time, the process's
@@ -220,8 +235,14 @@ fn main() {
         runs_pq.push(r);
         assert_eq!(
             rows, rows_pq,
-            "the CSV and the Parquet copy hold the same rows"
+            "the CSV and the Parquet copy: the same rows, verdict, fault and size"
         );
+        if k == repeat {
+            println!(
+                "verdict (CSV and Parquet): {} {}",
+                rows.verdict, rows.finding
+            );
+        }
     }
     let reference = (!runs_pl.is_empty()).then(|| {
         (
@@ -235,4 +256,6 @@ fn main() {
     summary("diagnose CSV", &runs_csv, reference);
     summary("diagnose Parquet", &runs_pq, reference);
     println!("load average after: {}", common::load_average());
+    let cpu_pq = median(runs_pq.iter().map(|r| r.cpu_s).collect());
+    stages::by_stage(env!("CARGO_BIN_EXE_sim-host"), &pq, &params, cpu_pq);
 }

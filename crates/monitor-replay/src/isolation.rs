@@ -321,9 +321,12 @@ impl IsolationTracker {
     /// are the load's move: the last isolation reads the friction class (the load), the
     /// operating points since name no fault, and no fault was ever named.
     pub(super) fn load_explains_lamps(&self) -> bool {
-        let last = self.follower.as_ref().and_then(|f| f.last().copied());
-        let friction = last
-            .and_then(|i| i.named())
+        // (Read in place: this runs on every row with a lamp lit.)
+        let friction = self
+            .follower
+            .as_ref()
+            .and_then(|f| f.last())
+            .and_then(Isolation::named)
             .is_some_and(|n| load_reading(self.load, &n));
         friction && self.evidence.named().is_none() && !self.named_a_fault()
     }
