@@ -397,10 +397,13 @@ pub(crate) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
         })
     };
     if let Some(p) = u.suspect_phase {
-        return of(
-            short(p, u.phase_confidence),
-            format!("shorted turns in phase {}: {change}", p.name()),
+        // With the level where one was sized: "shorted turns in phase c: about 30 % of the
+        // phase's turns (22-38 %), from ...; the negative sequence changed by ...".
+        let said = u.shorted_turns.map_or_else(
+            || format!("shorted turns in phase {}: {change}", p.name()),
+            |t| format!("{}; {change}", t.sentence()),
         );
+        return of(short(p, u.phase_confidence), said);
     }
     if u.judged_segment.is_none() {
         return winding_unavailable(u, against);

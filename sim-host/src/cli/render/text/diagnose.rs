@@ -254,6 +254,14 @@ fn unbalance(out: &mut impl Write, u: &monitor_replay::UnbalanceReport) -> anyho
         (None, Some(why)) => writeln!(out, "winding: {why}")?,
         (None, None) => {}
     }
+    if let Some(t) = &u.shorted_turns {
+        writeln!(out, "  {}", t.sentence())?;
+    }
+    if let (Some(c), Some(p)) = (&u.shorted_turns, &u.shorted_turns_physics) {
+        if c.basis != p.basis {
+            writeln!(out, "  (the model alone: {})", p.sentence())?;
+        }
+    }
     if let Some(w) = &u.least_change_widened {
         writeln!(out, "  {w}")?;
     }
