@@ -254,6 +254,15 @@ fn unbalance(out: &mut impl Write, u: &monitor_replay::UnbalanceReport) -> anyho
         (None, Some(why)) => writeln!(out, "winding: {why}")?,
         (None, None) => {}
     }
+    shorted_turns(out, u)?;
+    if let Some(w) = &u.least_change_widened {
+        writeln!(out, "  {w}")?;
+    }
+    Ok(())
+}
+
+/// How many turns are shorted, and the model's own estimate where a calibration gave it.
+fn shorted_turns(out: &mut impl Write, u: &monitor_replay::UnbalanceReport) -> anyhow::Result<()> {
     if let Some(t) = &u.shorted_turns {
         writeln!(out, "  {}", t.sentence())?;
     }
@@ -261,9 +270,6 @@ fn unbalance(out: &mut impl Write, u: &monitor_replay::UnbalanceReport) -> anyho
         if c.basis != p.basis {
             writeln!(out, "  (the model alone: {})", p.sentence())?;
         }
-    }
-    if let Some(w) = &u.least_change_widened {
-        writeln!(out, "  {w}")?;
     }
     Ok(())
 }
