@@ -32,7 +32,7 @@
 
 use super::{abs, Complex32, FULL_LOAD_SLIP_MAX};
 use crate::UnbalanceReport;
-use monitor_core::sequence::equivalent_impedance;
+use monitor_core::sequence::{equivalent_impedance, slip_for_current};
 use monitor_core::{MotorModel, Phase};
 use serde::{Deserialize, Serialize};
 
@@ -266,31 +266,58 @@ pub fn fraction_for_loop(r: f32, z1: f32, rw: f32, rf: f32, x_lls: f32, paths: f
     0.5 * (lo + hi)
 }
 
-/// The model's estimate (module docs): `None` without a named phase. `slip`: the
-/// operating point's where known, else no load to [`FULL_LOAD_SLIP_MAX`].
+/// The machine's `|Z1|` at the judged stretch [ohm], the estimate's and the interval's
+/// ends (module docs): measured as `|V1/I1| |1 + r|` where voltages are logged (the
+/// faulty current holds the loop's share); else the model's at the slip from the speed
+/// (the slip within [`super::SLIP_MODEL_UNCERTAINTY`]); else at the slip where the model
+/// draws the healthy part of the current, `|I1| / |1 + r|` (within
+/// [`super::CURRENT_MODEL_UNCERTAINTY`]); else from no load to [`FULL_LOAD_SLIP_MAX`].
+fn z1_range(u: &UnbalanceReport, m: &MotorModel, we: f32, v_peak: f32, r: Complex32) -> [f32; 3] {
+    use super::OperatingPointSource as Op;
+    let z1_at = |s: f32| abs(equivalent_impedance(m, we, s));
+    let one_r = abs(Complex32::new(1.0, 0.0) + r);
+    let seg = u.judged_segment.and_then(|k| u.segments.get(k));
+    if let Some(v1) = seg.and_then(|s| s.v1) {
+        let z = abs(v1) * one_r;
+        return [z, z, z];
+    }
+    match (u.operating_point, u.slip, seg) {
+        (Some(Op::Speed), Some(s), _) => {
+            let k = 1.0 + super::SLIP_MODEL_UNCERTAINTY;
+            [z1_at(s), z1_at(s / k), z1_at(s * k)]
+        }
+        (Some(Op::CurrentMagnitude), Some(_), Some(seg)) => {
+            let i1 = seg.i1_peak_a / one_r.max(1e-3);
+            let at = |i: f32| z1_at(slip_for_current(m, v_peak, we, i));
+            let e = super::CURRENT_MODEL_UNCERTAINTY;
+            [at(i1), at((1.0 - e) * i1), at((1.0 + e) * i1)]
+        }
+        _ => {
+            let (a, b) = (z1_at(1e-4), z1_at(FULL_LOAD_SLIP_MAX));
+            [(a * b).sqrt(), a, b]
+        }
+    }
+}
+
+/// The model's estimate (module docs): `None` without a named phase. `v_peak`: the
+/// supply's phase voltage [V, peak]; `we` its angular frequency [rad/s].
 pub fn physics(
     u: &UnbalanceReport,
     m: &MotorModel,
     we: f32,
+    v_peak: f32,
     opts: &TurnLevelOptions,
 ) -> Option<ShortedTurns> {
     let (phase, r, dr) = loop_ratio(u)?;
     let paths = f32::from(opts.parallel_paths.max(1));
-    let z1_at = |s: f32| abs(equivalent_impedance(m, we, s));
-    let z1s = match u.slip {
-        Some(s) => [z1_at(s), z1_at(s)],
-        None => [z1_at(1e-4), z1_at(FULL_LOAD_SLIP_MAX)],
-    };
+    let z1s = z1_range(u, m, we, v_peak, r);
     let x_lls = we * (m.ls_h - m.lm_h);
     let rs = m.rs_ohm;
     let at = |x: f32, z1: f32, rw: f32, rf_of_rs: f32| {
         fraction_for_loop(x, z1, rw, rf_of_rs * rs, x_lls, paths)
     };
     let x = abs(r);
-    // The point: the geometric mean over the operating point's ends.
-    let fraction = (at(x, z1s[0], rs, FAULT_RESISTANCE_OF_RS)
-        * at(x, z1s[1], rs, FAULT_RESISTANCE_OF_RS))
-    .sqrt();
+    let fraction = at(x, z1s[0], rs, FAULT_RESISTANCE_OF_RS);
     let mut low = fraction;
     let mut high = fraction;
     for z1 in z1s {
