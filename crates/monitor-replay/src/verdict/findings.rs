@@ -391,7 +391,13 @@ pub(crate) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
     let short = |phase, confidence| {
         State::Named(NamedFault {
             fault: FaultName::ShortedTurns,
-            size: Size::OfPositiveSequence(u.winding_ratio),
+            // The shorted fraction of the phase's turns where one was sized, else the
+            // change of the negative sequence.
+            size: u
+                .shorted_turns
+                .map_or(Size::OfPositiveSequence(u.winding_ratio), |t| {
+                    Size::TurnsFraction(t.fraction)
+                }),
             phase: Some(phase),
             confidence,
         })
