@@ -78,8 +78,12 @@ fn judge(p: &ParamFile, c: &Case, baseline: Option<&UnbalanceReport>) -> Unbalan
         .unbalance
 }
 
-/// Every case of one fault path (`rf`, over Rs): `(truth, estimate, low, high, what)`.
-fn sized(rf: f64) -> Vec<(f64, Option<(f64, f64, f64)>, String)> {
+/// One case's injected fraction, its estimate `(fraction, low, high)` where a level was
+/// sized, and what the case was.
+type Sized = (f64, Option<(f64, f64, f64)>, String);
+
+/// Every case of one fault path (`rf`, over Rs).
+fn sized(rf: f64) -> Vec<Sized> {
     let p = ParamFile::reference_3hp();
     let mut groups = Vec::new();
     for load in [0.0, 12.5] {
