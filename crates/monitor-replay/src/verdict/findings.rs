@@ -391,13 +391,7 @@ pub(crate) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
     let short = |phase, confidence| {
         State::Named(NamedFault {
             fault: FaultName::ShortedTurns,
-            // The shorted fraction of the phase's turns where one was sized, else the
-            // change of the negative sequence.
-            size: u
-                .shorted_turns
-                .map_or(Size::OfPositiveSequence(u.winding_ratio), |t| {
-                    Size::TurnsFraction(t.fraction)
-                }),
+            size: winding_size(u),
             phase: Some(phase),
             confidence,
         })
@@ -431,6 +425,15 @@ pub(crate) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
         );
     }
     of(State::Clear, format!("no shorted turns: {change}{why}"))
+}
+
+/// The winding finding's size: the shorted fraction of the phase's turns where one was
+/// sized (`unbalance.shorted_turns`), else the change of the negative sequence.
+fn winding_size(u: &UnbalanceReport) -> Size {
+    u.shorted_turns
+        .map_or(Size::OfPositiveSequence(u.winding_ratio), |t| {
+            Size::TurnsFraction(t.fraction)
+        })
 }
 
 /// The winding's finding where no steady stretch was judged: unavailable, with the reason.
