@@ -352,3 +352,73 @@ pub fn calibrated(u: &UnbalanceReport, cal: &TurnCalibration) -> Option<ShortedT
         loop_ratio: x,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Tallam's loop forward, in double precision (the module docs' step 2, written anew):
+    /// `|r| = (mu/3) |Z1| / |Z_f|`.
+    fn forward(mu: f64, z1: f64, rw: f64, rf: f64, x: f64, p: f64) -> f64 {
+        let re = p * rw * (1.0 - 2.0 * mu / 3.0) + rf / mu;
+        let im = mu * p * x / 3.0;
+        mu / 3.0 * z1 / re.hypot(im)
+    }
+
+    #[test]
+    fn the_inversion_returns_the_fraction_the_loop_was_drawn_with() {
+        for p in [1.0, 2.0] {
+            for mu in [0.01, 0.05, 0.1, 0.3, 0.6] {
+                for rf in [0.0, 0.7, 3.0] {
+                    let r = forward(mu, 50.7, 7.06, rf, 2.13, p);
+                    let got = fraction_for_loop(r as f32, 50.7, 7.06, rf as f32, 2.13, p as f32);
+                    assert!(
+                        (f64::from(got) / mu - 1.0).abs() < 1e-3,
+                        "mu {mu}, r_f {rf}, P {p}: {got}"
+                    );
+                }
+            }
+        }
+        // A loop larger than all the turns could draw reads as all of them; none as none.
+        assert_eq!(fraction_for_loop(50.0, 50.7, 7.06, 0.7, 2.13, 1.0), 1.0);
+        assert_eq!(fraction_for_loop(0.0, 50.7, 7.06, 0.7, 2.13, 1.0), 0.0);
+    }
+
+    #[test]
+    fn the_fault_resistance_and_the_fraction_trade_against_each_other() {
+        // What the terminals cannot separate: a larger fault resistance needs more turns
+        // for the same loop.
+        let r = forward(0.1, 50.7, 7.06, 0.7, 2.13, 1.0) as f32;
+        let bolted = fraction_for_loop(r, 50.7, 7.06, 0.0, 2.13, 1.0);
+        let through = fraction_for_loop(r, 50.7, 7.06, 1.4, 2.13, 1.0);
+        assert!(bolted < 0.1 && through > 0.1, "{bolted} {through}");
+    }
+
+    #[test]
+    fn a_calibration_maps_through_its_levels() {
+        let run = |phase, fraction, loop_ratio| LabelledRun {
+            phase,
+            fraction,
+            loop_ratio,
+        };
+        let cal = TurnCalibration::learn(&[
+            run(Phase::A, 0.1, 0.09),
+            run(Phase::A, 0.1, 0.11),
+            run(Phase::A, 0.2, 0.2),
+            run(Phase::C, 0.3, 0.6),
+        ])
+        .expect("a calibration");
+        assert_eq!(cal.counts, [2, 0, 1]);
+        // The two runs at 10 % scatter by 0.01 about their mean 0.1 (one degree of freedom:
+        // sqrt(2 * 0.01^2 / 1)).
+        assert!((cal.scatter - 0.014_142).abs() < 1e-4, "{}", cal.scatter);
+        let a = |x| cal.fraction(Phase::A, x).expect("points");
+        assert!((a(0.05) - 0.05).abs() < 1e-6);
+        assert!((a(0.15) - 0.15).abs() < 1e-6);
+        // Beyond the last level, on the last segment's slope.
+        assert!((a(0.3) - 0.3).abs() < 1e-6);
+        // Phase c has its own point; phase b borrows all of them.
+        assert!((cal.fraction(Phase::C, 0.3).expect("points") - 0.15).abs() < 1e-6);
+        assert!(cal.fraction(Phase::B, 0.1).is_some());
+    }
+}
