@@ -187,6 +187,8 @@ def diagnose(
     allow_incomplete: bool = False,
     timeline_step: Optional[float] = None,
     group: Optional[str] = None,
+    parallel_paths: Optional[int] = None,
+    turn_calibration: Optional[Union[str, Dict[str, Any]]] = None,
 ) -> DiagnoseResult:
     """Replay a log through the monitor's core: lamps, the named fault with its size and
     phase, the shorted winding's phase, events, verdict (``sim-host diagnose``).
@@ -216,11 +218,19 @@ def diagnose(
         Timeline resolution [s] (default: the command line's, 0.5 s).
     group : str, optional
         The TDMS group holding the channels.
+    parallel_paths : int, optional
+        Parallel paths of each phase of the winding (1, the default; 2 for a double star):
+        the shorted-turn level is sized with one path's resistance.
+    turn_calibration : path or dict, optional
+        A calibration of the shorted-turn level learned from labelled runs of the same
+        motor (the JSON of ``sim-host diagnose --turn-calibration``): the level is read from
+        it instead of the model (``.shorted_turns["basis"]`` says which).
 
     Returns
     -------
     DiagnoseResult
         ``.verdict``, ``.candidates``, ``.isolation``, ``.unbalance``, ... (the JSON keys);
+        ``.shorted_turns`` the level of a named short (fraction, low, high, basis);
         ``.timeline`` as a DataFrame; ``.to_dict()`` the command's ``--json`` document.
 
     Raises
@@ -246,8 +256,19 @@ def diagnose(
         allow_incomplete=allow_incomplete,
         timeline_step=None if timeline_step is None else float(timeline_step),
         group=group,
+        parallel_paths=None if parallel_paths is None else int(parallel_paths),
+        turn_calibration=_calibration_text(turn_calibration),
     )
     return DiagnoseResult(json.loads(doc))
+
+
+def _calibration_text(cal: Optional[Union[str, Dict[str, Any]]]) -> Optional[str]:
+    """A shorted-turn calibration as its JSON text: a dict as it is, a path read."""
+    if cal is None:
+        return None
+    if isinstance(cal, dict):
+        return json.dumps(cal)
+    return Path(cal).read_text()
 
 
 def _analysis_kwargs(

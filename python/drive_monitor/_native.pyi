@@ -26,6 +26,8 @@ def diagnose(
     allow_incomplete: bool = ...,
     timeline_step: Optional[float] = ...,
     group: Optional[str] = ...,
+    parallel_paths: Optional[int] = ...,
+    turn_calibration: Optional[str] = ...,
 ) -> str: ...
 def compare(
     log: Any,

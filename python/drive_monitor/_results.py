@@ -8,7 +8,7 @@ lists of tables, and plain values otherwise. The time series come as pandas Data
 from __future__ import annotations
 
 import copy
-from typing import Any, Dict, List
+from typing import Any, Dict, List, Optional
 
 
 class Result:
@@ -104,6 +104,14 @@ class DiagnoseResult(Result):
     def events(self):
         """The isolation's events (names and load moves, with times) as a DataFrame."""
         return _frame(self._doc.get("isolation", {}).get("events", []))
+
+    @property
+    def shorted_turns(self) -> Optional[Dict[str, Any]]:
+        """How many turns are shorted in the named phase (``unbalance.shorted_turns``):
+        ``phase``, ``fraction`` of its turns, the interval ``low``..``high``, ``basis``
+        (``physics``: the model, no labels; ``calibration``: learned from labelled runs),
+        ``loop_ratio``; None without a named phase."""
+        return self._doc.get("unbalance", {}).get("shorted_turns")
 
     @property
     def segments(self):

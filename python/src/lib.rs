@@ -154,7 +154,7 @@ fn effects_of(names: &[String]) -> PyResult<Vec<monitor_core::EffectKind>> {
 
 /// `diagnose --json` of the log at `log` with the parameter file `params`.
 #[pyfunction]
-#[pyo3(signature = (log, params, log_origin=None, params_is_text=false, commission=None, baseline=Vec::new(), load=None, angle=None, residuals=None, allow_incomplete=false, timeline_step=None, group=None))]
+#[pyo3(signature = (log, params, log_origin=None, params_is_text=false, commission=None, baseline=Vec::new(), load=None, angle=None, residuals=None, allow_incomplete=false, timeline_step=None, group=None, parallel_paths=None, turn_calibration=None))]
 #[allow(clippy::too_many_arguments)]
 fn diagnose(
     py: Python<'_>,
@@ -170,10 +170,17 @@ fn diagnose(
     allow_incomplete: bool,
     timeline_step: Option<f64>,
     group: Option<String>,
+    parallel_paths: Option<u8>,
+    turn_calibration: Option<String>,
 ) -> PyResult<String> {
     // An option not given keeps the one default (`DiagnoseRequest::default`, the command
     // line's too).
     let d = api::DiagnoseRequest::default();
+    // A calibration as its JSON text (`monitor_replay::TurnCalibration`).
+    let calibration = turn_calibration
+        .map(|t| serde_json::from_str::<monitor_replay::TurnCalibration>(&t))
+        .transpose()
+        .map_err(|e| OptionError::new_err(format!("turn_calibration: not a calibration: {e}")))?;
     let req = api::DiagnoseRequest {
         commission,
         allow_incomplete,
@@ -189,6 +196,10 @@ fn diagnose(
             .unwrap_or(d.residual_form),
         timeline_step_s: timeline_step.unwrap_or(d.timeline_step_s),
         group,
+        turn_level: monitor_replay::TurnLevelOptions {
+            parallel_paths: parallel_paths.unwrap_or(d.turn_level.parallel_paths).max(1),
+            calibration: calibration.or(d.turn_level.calibration),
+        },
     };
     let log = log_source(log, log_origin.as_deref())?;
     run(py, || {

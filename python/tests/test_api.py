@@ -144,3 +144,28 @@ def test_the_gil_is_released(repo):
     both = time.perf_counter() - t0
     # With the GIL held, two would take twice as long; allow the machine's noise.
     assert both < 1.8 * single + 0.05, (single, both)
+
+
+def test_the_shorted_turn_level_from_the_model_and_from_a_calibration(repo, sim_host):
+    # 30 % of phase c's turns shorted, a double-star winding: the model's level is the
+    # command's, in the result, the verdict's size and its unit.
+    log, p = repo / ITSC / "SC_A0_B0_C3_001.csv", repo / ITSC / "baldor_0p75hp.toml"
+    r = dm.diagnose(log, p, parallel_paths=2)
+    cli = cli_json(sim_host, "diagnose", "--params", str(p), str(log), "--parallel-paths", "2")
+    assert r.to_dict() == cli
+    t = r.shorted_turns
+    assert t["phase"] == "c" and t["basis"] == "physics"
+    assert t["low"] <= t["fraction"] <= t["high"]
+    assert 0.15 <= t["fraction"] <= 0.35  # within one step of the truth, 30 %
+    assert r.verdict_finding.size_unit == "turns_fraction"
+    assert r.verdict_finding.size == pytest.approx(t["fraction"])
+    # A calibration that puts this run's loop ratio at exactly 30 % of phase c's turns:
+    # the level is read from it, and the model's stays beside it.
+    x = t["loop_ratio"]
+    points = [[[0.0, 0.0]] * 8 for _ in range(3)]
+    points[2][0] = [x, 0.3]
+    cal = {"points": points, "counts": [0, 0, 1], "scatter": 0.01, "runs": 1}
+    c = dm.diagnose(log, p, parallel_paths=2, turn_calibration=cal)
+    assert c.shorted_turns["basis"] == "calibration"
+    assert c.shorted_turns["fraction"] == pytest.approx(0.3, abs=1e-3)
+    assert c.unbalance.shorted_turns_physics["fraction"] == pytest.approx(t["fraction"])

@@ -195,9 +195,11 @@ pub struct FleetRow {
     /// `shorted_turns`, `broken_bars`), if any.
     pub fault: Option<String>,
     /// Its size in its finding's unit (`size_unit`: a relative change, 0.5 is +50 %; for
-    /// shorted turns the negative sequence's change over I1; for broken bars dB below the
-    /// supply line).
+    /// shorted turns the fraction of the phase's turns where one was sized, else the
+    /// negative sequence's change over I1; for broken bars dB below the supply line).
     pub size: Option<f64>,
+    /// The size's unit (`relative`, `turns_fraction`, `of_i1`, `db_below_line`).
+    pub size_unit: Option<String>,
     /// Its phase (`a`, `b`, `c`), where it has one.
     pub phase: Option<String>,
     /// Its calibrated confidence, 0..1.
@@ -208,6 +210,13 @@ pub struct FleetRow {
     pub load_moves: Option<u64>,
     /// The data-quality summary.
     pub data_quality: Option<String>,
+    /// Shorted turns: the interval of the fraction of the phase's turns (low end), where
+    /// a level was sized (`unbalance.shorted_turns`).
+    pub turns_low: Option<f64>,
+    /// Its high end.
+    pub turns_high: Option<f64>,
+    /// Where the level comes from: `physics` (the model, no labels) or `calibration`.
+    pub turns_basis: Option<String>,
     /// Why the log gave no verdict (a bad file, no motor, a bad option), else null.
     pub error: Option<String>,
 }
@@ -223,11 +232,15 @@ impl FleetRow {
             verdict: None,
             fault: None,
             size: None,
+            size_unit: None,
             phase: None,
             confidence: None,
             first_detection_s: None,
             load_moves: None,
             data_quality: None,
+            turns_low: None,
+            turns_high: None,
+            turns_basis: None,
             error: Some(error),
         }
     }
@@ -242,12 +255,17 @@ impl FleetRow {
         let (fault, size, phase, confidence) = match named {
             Some(n) => (
                 Some(n.fault.name().to_string()),
-                Some(short(monitor_replay::verdict::size_parts(n.size).0)),
+                Some(monitor_replay::verdict::size_parts(n.size)),
                 n.phase.map(|p| p.name().to_string()),
                 Some(short(n.confidence)),
             ),
             None => (None, None, None, None),
         };
+        // The level's interval where the verdict's size is it.
+        let turns = r
+            .unbalance
+            .shorted_turns
+            .filter(|_| size.is_some_and(|s| s.1 == "turns_fraction"));
         FleetRow {
             motor: motor.to_string(),
             file: file.display().to_string(),
@@ -255,7 +273,8 @@ impl FleetRow {
             rate_hz: Some(r.data_quality.sample_rate_hz),
             verdict: Some(r.verdict.name().to_string()),
             fault,
-            size,
+            size: size.map(|s| short(s.0)),
+            size_unit: size.map(|s| s.1.to_string()),
             phase,
             confidence,
             first_detection_s: r.first_detection_s,
@@ -267,6 +286,15 @@ impl FleetRow {
                     .count() as u64,
             ),
             data_quality: Some(r.data_quality.summary()),
+            turns_low: turns.map(|t| short(t.low)),
+            turns_high: turns.map(|t| short(t.high)),
+            turns_basis: turns.map(|t| {
+                match t.basis {
+                    monitor_replay::LevelBasis::Physics => "physics",
+                    monitor_replay::LevelBasis::Calibration => "calibration",
+                }
+                .to_string()
+            }),
             error: None,
         }
     }
@@ -322,7 +350,7 @@ fn one_line_error(e: &ApiError) -> String {
 }
 
 /// The columns of the fleet table, in order (the CSV's header).
-pub const COLUMNS: [&str; 13] = [
+pub const COLUMNS: [&str; 17] = [
     "motor",
     "file",
     "rows",
@@ -330,11 +358,15 @@ pub const COLUMNS: [&str; 13] = [
     "verdict",
     "fault",
     "size",
+    "size_unit",
     "phase",
     "confidence",
     "first_detection_s",
     "load_moves",
     "data_quality",
+    "turns_low",
+    "turns_high",
+    "turns_basis",
     "error",
 ];
 

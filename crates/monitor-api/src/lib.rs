@@ -14,15 +14,18 @@ use monitor_io::log::mapping::ColumnMapping;
 use monitor_io::log::{LogError, OpenOptions};
 use monitor_io::params::{ParamError, ParamFile};
 use monitor_replay::{
-    diagnose_log, HealthyReference, LoadModel, ReplayError, ReplayOptions, UnbalanceBaseline,
+    diagnose_log, HealthyReference, LoadModel, ReplayError, ReplayOptions, TurnLevelOptions,
+    UnbalanceBaseline,
 };
 use std::path::{Path, PathBuf};
 
 mod explain_doc;
 pub mod fleet;
 mod log_source;
+mod turn_calibration;
 pub use explain_doc::{beside_verdict, explain, mcsa_beside, verdict_for_explain, ExplainDocument};
 pub use log_source::LogSource;
+pub use turn_calibration::{learn_turn_calibration, Labelled, Learned};
 
 /// A failed call: the command line's one-line message, and its kind.
 #[derive(Debug, thiserror::Error)]
@@ -203,6 +206,8 @@ pub struct DiagnoseRequest {
     pub timeline_step_s: f64,
     /// `--group` (TDMS).
     pub group: Option<String>,
+    /// `--parallel-paths` and `--turn-calibration`: how the shorted-turn level is sized.
+    pub turn_level: TurnLevelOptions,
 }
 
 /// Every default is [`ReplayOptions`]'s (no baseline, no TDMS group).
@@ -218,6 +223,7 @@ impl Default for DiagnoseRequest {
             residual_form: r.residual_form,
             timeline_step_s: r.timeline_step_s,
             group: None,
+            turn_level: r.turn_level,
         }
     }
 }
@@ -234,6 +240,7 @@ impl DiagnoseRequest {
             timeline_step_s: self.timeline_step_s.max(1e-4),
             unbalance_baseline: None,
             load: self.load,
+            turn_level: self.turn_level,
         }
     }
 }

@@ -68,6 +68,9 @@ pub use sampler::LogSampler;
 pub use sequences::{SequenceWindow, WINDOW_PERIODS};
 pub use temperature::TemperatureReport;
 pub use verdict::{FindingReport, Rule, Verdict};
+pub use winding::level::{
+    LabelledRun, LevelBasis, ShortedTurns, TurnCalibration, TurnLevelOptions,
+};
 pub use winding::{
     describe_against, segments, Against, HealthyReference, OperatingPointSource,
     PhaseProbabilities, SequenceSegment, BALANCED_RATIO, DEFAULT_SPREAD_CURRENTS,

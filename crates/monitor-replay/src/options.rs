@@ -25,6 +25,9 @@ pub struct ReplayOptions {
     pub unbalance_baseline: Option<HealthyReference>,
     /// What is known of the load ([`LoadModel`]; `diagnose --load`).
     pub load: LoadModel,
+    /// How the shorted-turn level is sized (`diagnose --parallel-paths`,
+    /// `--turn-calibration`; [`super::winding::level`]).
+    pub turn_level: super::TurnLevelOptions,
 }
 
 /// What the replay knows of the load torque.
@@ -60,6 +63,7 @@ impl Default for ReplayOptions {
             timeline_step_s: 0.5,
             unbalance_baseline: None,
             load: LoadModel::Unknown,
+            turn_level: super::TurnLevelOptions::default(),
         }
     }
 }

@@ -273,6 +273,13 @@ pub struct UnbalanceReport {
     /// The healthy negative sequence the winding is judged against ([`BaselineSource`]),
     /// or null (none: the supply's part alone is taken out).
     pub baseline: Option<BaselineSource>,
+    /// How many turns are shorted in the named phase, with its interval and where it comes
+    /// from (`basis`: `physics`, or `calibration` where one was given); null without a
+    /// named phase ([`super::winding::level`]).
+    pub shorted_turns: Option<super::ShortedTurns>,
+    /// The model's estimate, also where a calibration gave `shorted_turns`; null without a
+    /// named phase.
+    pub shorted_turns_physics: Option<super::ShortedTurns>,
 }
 
 impl UnbalanceReport {

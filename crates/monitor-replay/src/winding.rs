@@ -48,6 +48,7 @@
 
 mod anchor;
 mod judgement;
+pub mod level;
 mod probability;
 mod reading;
 mod reasons;

@@ -129,6 +129,7 @@ pub fn watch_mismatched(
         allow_incomplete: false,
         timeline_step_s: 1.0,
         unbalance_baseline: None,
+        turn_level: Default::default(),
         load: monitor_replay::LoadModel::Unknown,
     };
     let mut w = ServiceWatch::default();

@@ -97,6 +97,18 @@ pub struct DiagnoseArgs {
     /// Timeline resolution in the output [s].
     #[arg(long, default_value_t = defaults().timeline_step_s, allow_negative_numbers = true, value_parser = super::parse_positive_seconds)]
     pub timeline_step: f64,
+    /// Parallel paths of each phase of the winding (1 for a series star or delta, 2 for a
+    /// double star, as the motor's connection diagram says): the shorted turns lie in one
+    /// path, and the shorted-turn level (unbalance.shorted_turns) is sized with that
+    /// path's resistance.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=8))]
+    pub parallel_paths: u8,
+    /// A calibration of the shorted-turn level learned from labelled runs of the same
+    /// motor (JSON, `monitor_replay::TurnCalibration`): the level is read from it instead
+    /// of the model (unbalance.shorted_turns.basis says which; the model's stays in
+    /// unbalance.shorted_turns_physics).
+    #[arg(long, value_name = "FILE")]
+    pub turn_calibration: Option<PathBuf>,
     /// Print one JSON document on stdout instead of the table.
     #[arg(long)]
     pub json: bool,
@@ -127,6 +139,14 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         residual_form: args.residuals.into(),
         timeline_step_s: args.timeline_step,
         group: args.group.clone(),
+        turn_level: monitor_replay::TurnLevelOptions {
+            parallel_paths: args.parallel_paths,
+            calibration: args
+                .turn_calibration
+                .as_ref()
+                .map(|f| read_calibration(f))
+                .transpose()?,
+        },
     };
     let big = std::fs::metadata(&args.log)
         .map(|m| m.len() > 20_000_000)
@@ -145,4 +165,15 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
     } else {
         render::text::diagnose(&args.log, &d)
     }
+}
+
+/// Reads a `--turn-calibration` file.
+///
+/// # Errors
+/// A file that cannot be read or is not a calibration, naming the file.
+fn read_calibration(f: &std::path::Path) -> anyhow::Result<monitor_replay::TurnCalibration> {
+    let text = std::fs::read_to_string(f)
+        .map_err(|e| anyhow::anyhow!("--turn-calibration {}: {e}", f.display()))?;
+    serde_json::from_str(&text)
+        .map_err(|e| anyhow::anyhow!("--turn-calibration {}: not a calibration: {e}", f.display()))
 }

@@ -6,6 +6,7 @@
 
 mod bench;
 mod board_record;
+mod calibrate_turns;
 mod compare;
 pub mod convert;
 mod demo;
@@ -79,6 +80,8 @@ pub enum Cmd {
     Identify(identify::IdentifyArgs),
     // Many motors' logs, one row each.
     Fleet(fleet::FleetArgs),
+    // The shorted-turn level's calibration from labelled runs.
+    CalibrateTurns(calibrate_turns::CalibrateTurnsArgs),
 }
 
 /// Runs a command.
@@ -100,6 +103,7 @@ pub fn run(cmd: Cmd) -> anyhow::Result<()> {
         Cmd::Params(a) => params_cmd::run(a),
         Cmd::Identify(a) => identify::run(a),
         Cmd::Fleet(a) => fleet::run(a),
+        Cmd::CalibrateTurns(a) => calibrate_turns::run(a),
     }
 }
 

@@ -391,16 +391,19 @@ pub(crate) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
     let short = |phase, confidence| {
         State::Named(NamedFault {
             fault: FaultName::ShortedTurns,
-            size: Size::OfPositiveSequence(u.winding_ratio),
+            size: winding_size(u),
             phase: Some(phase),
             confidence,
         })
     };
     if let Some(p) = u.suspect_phase {
-        return of(
-            short(p, u.phase_confidence),
-            format!("shorted turns in phase {}: {change}", p.name()),
+        // With the level where one was sized: "shorted turns in phase c: about 30 % of the
+        // phase's turns (22-38 %), from ...; the negative sequence changed by ...".
+        let said = u.shorted_turns.map_or_else(
+            || format!("shorted turns in phase {}: {change}", p.name()),
+            |t| format!("{}; {change}", t.sentence()),
         );
+        return of(short(p, u.phase_confidence), said);
     }
     if u.judged_segment.is_none() {
         return winding_unavailable(u, against);
@@ -422,6 +425,15 @@ pub(crate) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
         );
     }
     of(State::Clear, format!("no shorted turns: {change}{why}"))
+}
+
+/// The winding finding's size: the shorted fraction of the phase's turns where one was
+/// sized (`unbalance.shorted_turns`), else the change of the negative sequence.
+fn winding_size(u: &UnbalanceReport) -> Size {
+    u.shorted_turns
+        .map_or(Size::OfPositiveSequence(u.winding_ratio), |t| {
+            Size::TurnsFraction(t.fraction)
+        })
 }
 
 /// The winding's finding where no steady stretch was judged: unavailable, with the reason.

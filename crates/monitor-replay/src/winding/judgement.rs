@@ -204,6 +204,13 @@ impl Replay {
             }
         }
         report.segments = listed_segments(segs, judged.map(|j| j.index));
+        let level = self.opts.turn_level;
+        report.shorted_turns_physics =
+            super::level::physics(&report, &judge.m, we0, judge.v_nominal, &level);
+        report.shorted_turns = match level.calibration {
+            Some(cal) => super::level::calibrated(&report, &cal),
+            None => report.shorted_turns_physics,
+        };
         report
     }
 
@@ -249,6 +256,8 @@ impl Replay {
                 Against::Commissioning => BaselineSource::Commissioning,
                 _ => BaselineSource::File,
             }),
+            shorted_turns: None,
+            shorted_turns_physics: None,
         }
     }
 }

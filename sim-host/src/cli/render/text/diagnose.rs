@@ -254,8 +254,22 @@ fn unbalance(out: &mut impl Write, u: &monitor_replay::UnbalanceReport) -> anyho
         (None, Some(why)) => writeln!(out, "winding: {why}")?,
         (None, None) => {}
     }
+    shorted_turns(out, u)?;
     if let Some(w) = &u.least_change_widened {
         writeln!(out, "  {w}")?;
+    }
+    Ok(())
+}
+
+/// How many turns are shorted, and the model's own estimate where a calibration gave it.
+fn shorted_turns(out: &mut impl Write, u: &monitor_replay::UnbalanceReport) -> anyhow::Result<()> {
+    if let Some(t) = &u.shorted_turns {
+        writeln!(out, "  {}", t.sentence())?;
+    }
+    if let (Some(c), Some(p)) = (&u.shorted_turns, &u.shorted_turns_physics) {
+        if c.basis != p.basis {
+            writeln!(out, "  (the model alone: {})", p.sentence())?;
+        }
     }
     Ok(())
 }
