@@ -264,13 +264,8 @@ impl Isolator {
     /// sensors); `None` when the point is not usable (no voltage or current, frequency
     /// not positive, non-finite values).
     pub fn residuals(&self, p: &SteadyPoint, h: Option<(Fault, f32)>) -> Option<ParityResiduals> {
-        let (c, q) = self.hypothesis(p, h);
-        self.eval(&c, &q)
-    }
-
-    /// The circuit and the readings corrected for hypothesis `h`.
-    fn hypothesis(&self, p: &SteadyPoint, h: Option<(Fault, f32)>) -> (Circuit, SteadyPoint) {
-        (self.circuit_of(h), self.reading_of(&Reading::of(p), h).q)
+        let r = self.reading_of(&Reading::of(p), h);
+        self.eval_reading(&self.circuit_of(h), &r)
     }
 
     /// The circuit of hypothesis `h`: the tracked machine's with the parameter fault's

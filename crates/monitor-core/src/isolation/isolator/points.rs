@@ -155,9 +155,9 @@ impl Isolator {
     /// (`Te = e_T T_base + (B + Bl) wr / Np`, the torque of [`ParityResiduals::torque`]);
     /// `None` where the point gives no residuals.
     fn torque_nm(&self, p: &SteadyPoint, h: Option<(Fault, f32)>) -> Option<f32> {
-        let (c, q) = self.hypothesis(p, h);
-        let e = self.eval(&c, &q)?;
-        Some(e.torque * self.torque_base_nm + c.b_total * q.wr_rad_s / c.np)
+        let (c, r) = (self.circuit_of(h), self.reading_of(&Reading::of(p), h));
+        let e = self.eval_reading(&c, &r)?;
+        Some(e.torque * self.torque_base_nm + c.b_total * r.q.wr_rad_s / c.np)
     }
 
     /// The misfit of the torque at the point `r` (its readings corrected for the
