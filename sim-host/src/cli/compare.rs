@@ -78,20 +78,32 @@ impl Common {
     /// Reads the parameter file (once) and the log (with a progress bar for large logs);
     /// the file's values are returned for the calls that follow.
     fn load(&self) -> anyhow::Result<(Analysis, Params)> {
-        let (params, columns) = monitor_api::load_params_for(
+        let (params, columns) = self.read_params()?;
+        let a = self.load_with(&params, &columns)?;
+        Ok((a, (params, columns)))
+    }
+
+    /// Reads the parameter file and its `[columns]` mapping for this log.
+    fn read_params(&self) -> anyhow::Result<Params> {
+        Ok(monitor_api::load_params_for(
             monitor_api::ParamsSource::Path(&self.params),
             &monitor_api::LogSource::from(self.log.as_path()),
-        )?;
+        )?)
+    }
+
+    /// Reads the log for the model's analysis with the parameter file already read.
+    fn load_with(
+        &self,
+        params: &monitor_io::params::ParamFile,
+        columns: &monitor_io::log::ColumnMapping,
+    ) -> anyhow::Result<Analysis> {
         let big = std::fs::metadata(&self.log)
             .map(|m| m.len() > 20_000_000)
             .unwrap_or(false);
         let pb = progress::bar(progress::FRACTION_STEPS, "reading log", big);
         let req = self.request(None);
         let a = monitor_api::load_analysis(
-            monitor_api::ParamsSource::Read {
-                params: &params,
-                columns: &columns,
-            },
+            monitor_api::ParamsSource::Read { params, columns },
             &self.log,
             &req,
             &mut |f| progress::set_fraction(&pb, f),
@@ -104,7 +116,7 @@ impl Common {
         })?;
         pb.finish_and_clear();
         render::text::quality_warnings(&a.quality);
-        Ok((a, (params, columns)))
+        Ok(a)
     }
 
     /// The library's request for these options.
@@ -226,28 +238,25 @@ pub fn run_compare(args: &CompareArgs) -> anyhow::Result<()> {
     }
 }
 
-/// Runs `explain` (and `compare` first with `--compare`).
-///
-/// # Errors
-/// As [`run_compare`].
-pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
+/// What `explain` works out on the calling thread: the log read for the model's analysis,
+/// `compare`'s report with `--compare` (printed first in text mode, its prediction dropped
+/// so that memory stays at explain's), and the ranking.
+type Explained = (
+    Analysis,
+    Option<monitor_analysis::compare::CompareReport>,
+    monitor_analysis::explain::ExplainOutput,
+);
+
+/// Reads the log, runs `compare` with `--compare`, and fits the candidates (with a progress
+/// bar on large logs).
+fn explain_here(
+    args: &ExplainArgs,
+    params: &monitor_io::params::ParamFile,
+    columns: &monitor_io::log::ColumnMapping,
+) -> anyhow::Result<Explained> {
     let c = &args.common;
-    let mut charts = render::charts::EXPLAIN.to_vec();
-    charts.push(render::mcsa::CHART);
-    c.check(&charts)?;
-    let (a, (params, columns)) = c.load()?;
-    // The one verdict on the same log, which explain opens with.
-    let judged = monitor_api::verdict_for_explain(
-        monitor_api::ParamsSource::Read {
-            params: &params,
-            columns: &columns,
-        },
-        &c.log,
-        c.group.clone(),
-    );
+    let a = c.load_with(params, columns)?;
     let opts = c.options();
-    // compare's result is printed (or kept for the JSON document) before explain runs, and
-    // its prediction dropped, so memory stays at explain's.
     let compared = if args.compare {
         let out = a.compare(&opts)?;
         if !c.json {
@@ -265,6 +274,42 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
     let pbc = pb.clone();
     let out = a.explain(&opts, &move |f| progress::set_fraction(&pbc, f))?;
     pb.finish_and_clear();
+    Ok((a, compared, out))
+}
+
+/// Runs `explain` (and `compare` first with `--compare`).
+///
+/// # Errors
+/// As [`run_compare`].
+pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
+    let c = &args.common;
+    let mut charts = render::charts::EXPLAIN.to_vec();
+    charts.push(render::mcsa::CHART);
+    c.check(&charts)?;
+    let (params, columns) = c.read_params()?;
+    // The one verdict on the same log, which explain opens with: `diagnose` reads the log
+    // on a thread of its own while the model's analysis reads it and fits the candidates
+    // here (the two share nothing but the files; the documents are those of running them
+    // one after the other).
+    let (judged, explained) = std::thread::scope(|s| {
+        let verdict = s.spawn(|| {
+            monitor_api::verdict_for_explain(
+                monitor_api::ParamsSource::Read {
+                    params: &params,
+                    columns: &columns,
+                },
+                &c.log,
+                c.group.clone(),
+            )
+        });
+        let explained = explain_here(args, &params, &columns);
+        let judged = verdict
+            .join()
+            .map_err(|_| anyhow::anyhow!("the verdict's thread stopped unexpectedly"));
+        (judged, explained)
+    });
+    let (a, compared, out) = explained?;
+    let judged = judged?;
     // The motor current signature analysis, with the fitted rotor_asymmetry's delta.
     let mcsa = monitor_api::mcsa_beside(&a, &out.report, args.rotor_bars);
     let doc = monitor_api::ExplainDocument::new(judged.as_ref(), out.report, mcsa);
