@@ -158,7 +158,7 @@ pub const COLUMNS: [Column; 34] = [
     c(
         "sideband_db",
         Kind::Real,
-        "the rotor's lower sideband, dB below the line [rotor.level_db]",
+        "the rotor's lower sideband, dB to the line, where judged [rotor.level_db]",
     ),
     c("slip", Kind::Real, "slip [rotor.slip]"),
     c(
@@ -247,6 +247,54 @@ pub struct LogIdentity {
     pub time_s: i64,
 }
 
+impl LogIdentity {
+    /// The identity of the log file at `path` as motor `motor`'s: the hash of its bytes
+    /// (read in 1 MiB pieces) and its time, the file's modification time (the log formats
+    /// read here carry no start time of their own; docs/trend.md).
+    ///
+    /// # Errors
+    /// The file cannot be read or has no modification time.
+    pub fn of_file(motor: &str, path: &std::path::Path) -> std::io::Result<Self> {
+        use std::io::Read;
+        let mut f = std::fs::File::open(path)?;
+        let time = f.metadata()?.modified()?;
+        let mut h: u64 = FNV_OFFSET;
+        let mut buf = vec![0u8; 1 << 20];
+        loop {
+            let n = f.read(&mut buf)?;
+            if n == 0 {
+                break;
+            }
+            h = fnv1a(h, buf.get(..n).unwrap_or_default());
+        }
+        let time_s = match time.duration_since(std::time::UNIX_EPOCH) {
+            Ok(d) => d.as_secs() as i64,
+            Err(e) => -(e.duration().as_secs_f64().ceil() as i64),
+        };
+        Ok(LogIdentity {
+            motor: motor.to_string(),
+            path: path.display().to_string(),
+            hash: format!("{h:016x}"),
+            time_s,
+        })
+    }
+
+    /// The `log_id` of this log (unique in a store): `<hash>:<path>`.
+    pub fn log_id(&self) -> String {
+        format!("{}:{}", self.hash, self.path)
+    }
+}
+
+const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+
+fn fnv1a(mut h: u64, bytes: &[u8]) -> u64 {
+    for b in bytes {
+        h ^= u64::from(*b);
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    h
+}
+
 impl StoredRow {
     /// The value of column `name` (null for an unknown name).
     pub fn get(&self, name: &str) -> &Cell {
@@ -297,7 +345,7 @@ impl StoredRow {
         let txt = |x: Option<String>| x.map_or(Cell::Null, Cell::Text);
         let int = |x: Option<i64>| x.map_or(Cell::Null, Cell::Int);
         let cells = vec![
-            Cell::Text(format!("{}:{}", id.hash, id.path)),
+            Cell::Text(id.log_id()),
             Cell::Text(id.hash.clone()),
             Cell::Text(id.path.clone()),
             Cell::Text(id.motor.clone()),
@@ -323,7 +371,10 @@ impl StoredRow {
             real(num("/unbalance/winding_ratio")),
             real(num("/unbalance/angle_deg")),
             real(num("/unbalance/least_change")),
-            real(num("/rotor/level_db")),
+            real(
+                num("/rotor/level_db")
+                    .filter(|_| doc.pointer("/rotor/judged") == Some(&Value::Bool(true))),
+            ),
             real(num("/rotor/slip")),
             real(num("/unbalance/measured/i1_peak_a")),
             real(num("/unbalance/measured/wr_rad_s")),
@@ -363,12 +414,7 @@ impl Serialize for StoredRow {
 /// FNV-1a, 64 bits, of `bytes`, as 16 hex digits: a log's content identity (not a
 /// cryptographic hash: it tells logs apart, it does not guard against forgery).
 pub fn content_hash(bytes: &[u8]) -> String {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in bytes {
-        h ^= u64::from(*b);
-        h = h.wrapping_mul(0x0100_0000_01b3);
-    }
-    format!("{h:016x}")
+    format!("{:016x}", fnv1a(FNV_OFFSET, bytes))
 }
 
 /// The UTC day `YYYY-MM-DD` of `t_s` seconds since 1970-01-01 (the proleptic Gregorian

@@ -177,6 +177,21 @@ impl Store {
         Ok(Appended::Stored)
     }
 
+    /// Whether a row of the log `log_id` is stored.
+    ///
+    /// # Errors
+    /// [`StoreError::Sqlite`] when the store cannot be read.
+    pub fn contains(&self, log_id: &str) -> Result<bool, StoreError> {
+        self.conn
+            .query_row(
+                &format!("SELECT COUNT(*) FROM {TABLE} WHERE log_id = ?1"),
+                [log_id],
+                |r| r.get::<_, i64>(0),
+            )
+            .map(|n| n > 0)
+            .map_err(|e| sql(&self.path, &e))
+    }
+
     /// The stored rows, by motor and time: only `motor`'s where given, only from
     /// `since_s` (seconds since 1970-01-01 UTC) on where given.
     ///

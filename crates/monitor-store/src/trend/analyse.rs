@@ -65,17 +65,25 @@ pub fn motor_trend(motor: &str, rows: &[&StoredRow], opts: &TrendOptions) -> Mot
     }
 }
 
-/// The operating-point fit of `ind` on the reference rows: the coefficients and the
-/// reference's median covariates, or `None` where it cannot be fitted.
-fn fit_reference(ind: &Indicator, reference: &[&StoredRow]) -> Option<(Vec<f64>, Vec<f64>)> {
-    let usable: Vec<(Vec<f64>, f64)> = reference
+/// The operating-point fit of `ind` on the motor's rows: least squares of the indicator
+/// on its covariates and a linear time term together (so that the covariates' part does
+/// not take up a trend in time), the covariates' coefficients and their median values, or
+/// `None` where it cannot be fitted (too few logs, a covariate that does not vary).
+fn fit_operating_point(ind: &Indicator, rows: &[&StoredRow]) -> Option<(Vec<f64>, Vec<f64>)> {
+    let usable: Vec<(Vec<f64>, f64)> = rows
         .iter()
         .filter_map(|r| {
             let y = r.f64(ind.column)?;
+            let t = r.f64("log_time_s")? / DAY_S;
             let x: Option<Vec<f64>> = ind.covariates.iter().map(|c| r.f64(c)).collect();
-            Some((x?, y))
+            let mut x = x?;
+            x.push(t);
+            Some((x, y))
         })
         .collect();
+    if usable.len() < fit_logs(ind) {
+        return None;
+    }
     let xs: Vec<Vec<f64>> = usable.iter().map(|(x, _)| x.clone()).collect();
     let ys: Vec<f64> = usable.iter().map(|(_, y)| *y).collect();
     let coef = least_squares(&xs, &ys)?;
@@ -88,21 +96,28 @@ fn fit_reference(ind: &Indicator, reference: &[&StoredRow]) -> Option<(Vec<f64>,
     Some((coef, centre?))
 }
 
+/// The fewest logs the operating-point fit is made on: four per coefficient (the
+/// intercept, each covariate, time). With fewer, an indicator that has covariates gives no
+/// alarm: a trend cannot yet be told from the operating point's moves.
+pub fn fit_logs(ind: &Indicator) -> usize {
+    4 * (ind.covariates.len() + 2)
+}
+
 /// One indicator's trend over the window ending at the motor's last row (`rows` by time).
 pub fn indicator_trend(
     ind: &Indicator,
     rows: &[&StoredRow],
     opts: &TrendOptions,
 ) -> IndicatorTrend {
-    let reference: Vec<&StoredRow> = rows.iter().copied().take(opts.reference_logs).collect();
-    let fit = fit_reference(ind, &reference);
+    let fit = fit_operating_point(ind, rows);
     let normalisation = match &fit {
         Some(_) => format!(
-            "least-squares fit on {} over the first {} logs removed",
+            "brought to the median {} (least squares on them and time over the motor's {} logs)",
             ind.covariates.join(" and "),
-            reference.len()
+            rows.len()
         ),
-        None => "raw values (the reference logs cannot fit the operating point)".to_string(),
+        None => "raw values (too few logs, or an operating point that does not vary, to fit)"
+            .to_string(),
     };
     let end_s = rows
         .last()
@@ -159,6 +174,14 @@ pub fn indicator_trend(
         series,
     };
     judge(&mut t, ind, opts, end_s / DAY_S);
+    if fit.is_none() && !ind.covariates.is_empty() && rows.len() < fit_logs(ind) {
+        t.alarm = false;
+        t.normalisation = format!(
+            "not yet: {} logs, the operating-point fit needs {}; no alarm until then",
+            rows.len(),
+            fit_logs(ind)
+        );
+    }
     t
 }
 
@@ -210,11 +233,14 @@ fn judge(t: &mut IndicatorTrend, ind: &Indicator, opts: &TrendOptions, end_days:
     t.scatter = Some(scatter);
     t.moves_scatters = Some(moves);
     t.last = Some(last);
-    t.alarm = significant && big;
     t.days_to_fault = t.fault_level.and_then(|lvl| {
         let d = (lvl - last) / line.slope;
         (d.is_finite() && d >= 0.0 && line.slope > 0.0).then_some(d)
     });
+    // With a FAULT level, a slope that would take longer than the horizon to reach it is
+    // not worth a visit, however significant.
+    let soon = t.fault_level.is_none() || t.days_to_fault.is_some_and(|d| d <= opts.horizon_days);
+    t.alarm = ind.alarms && significant && big && soon;
     let week = |v: f64| 7.0 * v;
     let dir = if line.slope >= 0.0 {
         "rising"
@@ -236,6 +262,7 @@ fn judge(t: &mut IndicatorTrend, ind: &Indicator, opts: &TrendOptions, end_days:
         (false, Some(d)) if d < 365.0 => s.push_str(&format!(
             ": no alarm (FAULT level in about {d:.0} days at this slope)"
         )),
+        (false, _) if !ind.alarms => s.push_str(": shown, not alarmed"),
         (false, _) => s.push_str(": no alarm"),
     }
     t.sentence = s;

@@ -2,15 +2,15 @@
 //!
 //! Per indicator, over the last [`TrendOptions::window_days`] of the motor's logs:
 //!
-//! 1. **Like operating points.** The indicator is normalised for the operating point and
-//!    the windings' temperature: a least-squares fit of it on the covariates the indicator
-//!    depends on (the load, as the positive-sequence current `i1_peak_a`; the windings'
-//!    rise `winding_rise_k` the isolation read), made on the motor's *reference* logs (its
-//!    first [`TrendOptions::reference_logs`] logs), is removed, the value kept at the
-//!    reference logs' median covariates. A season that warms the windings or a load that
-//!    moves from day to day is then not a trend. Where the reference logs cannot fit the
-//!    covariates (too few, or a covariate that does not vary) the raw values are used; the
-//!    report says which ([`IndicatorTrend::normalisation`]).
+//! 1. **Like operating points.** The indicator is brought to the motor's median operating
+//!    point: a least-squares fit of it on the covariates it depends on (the load, as the
+//!    positive-sequence current `i1_peak_a`; the windings' rise `winding_rise_k` the
+//!    isolation read) and on time together, over all the motor's logs, and the covariates'
+//!    part removed (the time term is fitted with them so that they do not take up a trend).
+//!    A season that warms the windings or a load that moves from day to day is then not a
+//!    trend. Where the logs cannot fit the covariates (too few, or a covariate that does
+//!    not vary) the raw values are used; the report says which
+//!    ([`IndicatorTrend::normalisation`]).
 //! 2. **A robust slope.** Theil-Sen's slope per day with Sen's interval
 //!    ([`stats::theil_sen`]), and the indicator's own scatter, 1.4826 x the median absolute
 //!    deviation of the values about the line ([`stats::mad_sigma`]).
@@ -20,7 +20,10 @@
 //!    alone is not enough: a significant slope far inside the noise is not worth a visit,
 //!    and one large scatter is not a trend.
 //! 4. **The projection.** Where the indicator has a FAULT level (the level at which a
-//!    single log's verdict names the fault), the days until the line reaches it.
+//!    single log's verdict names the fault), the days until the line reaches it; for such
+//!    an indicator the alarm also needs the line to reach it within
+//!    [`TrendOptions::horizon_days`] (a significant drift far below the level is not worth
+//!    a visit).
 
 pub mod stats;
 
@@ -47,6 +50,8 @@ pub struct Indicator {
     pub unit: &'static str,
     /// Which way a fault moves it.
     pub direction: Direction,
+    /// Whether its trend raises the alarm (else it is trended and shown only).
+    pub alarms: bool,
     /// The covariates it is normalised on (store columns).
     pub covariates: &'static [&'static str],
     /// The store column holding its FAULT level per log (its median over the reference
@@ -77,8 +82,10 @@ const RISE: &str = "winding_rise_k";
 ///   (`unbalance.least_change`, the level `diagnose`'s verdict uses), normalised on load.
 /// - `residual_d`, `residual_q`, `residual_t`: the isolation's parity residuals against the
 ///   parameter file (a resistance, inductance or load change moves them), normalised on
-///   load and the windings' rise so that heating, which the isolation reads as Rs and Rr
-///   together, is taken out; no FAULT level (the isolation names a fault from their
+///   load and the windings' rise; trended and shown, **not alarmed**: in the simulated
+///   month their dependence on the season's heating and the load is not linear enough for
+///   this fit, and healthy motors' residuals moved by 4 to 19 scatters in two weeks
+///   (docs/trend.md, "Limits"). No FAULT level (the isolation names a fault from their
 ///   direction, not from one level).
 /// - `sideband_db`: the rotor's lower sideband (broken bars grow it), normalised on load;
 ///   its FAULT level is -50 dB below the line ... (the usual MCSA rule of thumb for one
@@ -89,6 +96,7 @@ pub const INDICATORS: [Indicator; 5] = [
         label: "|I2w|/|I1|",
         unit: "of I1",
         direction: Direction::Rising,
+        alarms: true,
         covariates: &[LOAD],
         fault_level: FaultLevel::Column("i2_least_change"),
     },
@@ -97,6 +105,7 @@ pub const INDICATORS: [Indicator; 5] = [
         label: "e_d",
         unit: "pu",
         direction: Direction::Either,
+        alarms: false,
         covariates: &[LOAD, RISE],
         fault_level: FaultLevel::None,
     },
@@ -105,6 +114,7 @@ pub const INDICATORS: [Indicator; 5] = [
         label: "e_q",
         unit: "pu",
         direction: Direction::Either,
+        alarms: false,
         covariates: &[LOAD, RISE],
         fault_level: FaultLevel::None,
     },
@@ -113,6 +123,7 @@ pub const INDICATORS: [Indicator; 5] = [
         label: "e_T",
         unit: "pu",
         direction: Direction::Either,
+        alarms: false,
         covariates: &[LOAD, RISE],
         fault_level: FaultLevel::None,
     },
@@ -121,6 +132,7 @@ pub const INDICATORS: [Indicator; 5] = [
         label: "sideband",
         unit: "dB",
         direction: Direction::Rising,
+        alarms: true,
         covariates: &[LOAD],
         fault_level: FaultLevel::Fixed(-50.0),
     },
@@ -137,8 +149,9 @@ pub struct TrendOptions {
     pub k_scatter: f64,
     /// The fewest logs in the window for a slope.
     pub min_logs: usize,
-    /// How many of the motor's first logs the operating-point fit is made on.
-    pub reference_logs: usize,
+    /// For an indicator with a FAULT level: the alarm needs the line to reach it within
+    /// this many days of the last log.
+    pub horizon_days: f64,
 }
 
 impl Default for TrendOptions {
@@ -148,7 +161,7 @@ impl Default for TrendOptions {
             confidence: 0.95,
             k_scatter: 3.0,
             min_logs: 6,
-            reference_logs: 8,
+            horizon_days: 90.0,
         }
     }
 }
