@@ -8,9 +8,15 @@
 //! day from day 15), the rest are healthy. Each day's logs are judged against the parameter
 //! file, stored, and the trend is taken on the logs up to that day.
 //!
-//! Asserted: each faulty motor is trend-alarmed at least 5 days before the first single log
-//! whose verdict is FAULT (or within the month where no log's verdict is FAULT); no healthy
-//! motor raises a trend alarm on any day. Set `MONITOR_MONTH_STORE=PATH` to keep the
+//! The motors carry a winding temperature probe (the simulator's `t_winding_c` channel,
+//! read without lag): the season's heating raises Rs as much as the loosening connection
+//! does, and only a measured temperature tells them apart (the isolation's own reading of
+//! the rise takes up part of an Rs change).
+//!
+//! Asserted (issue 53's bar): each faulty motor is trend-alarmed at least 5 days before the
+//! first single log whose verdict is FAULT (or within the month where no log's verdict is
+//! FAULT); no healthy motor raises a trend alarm on any day. The second half is not met
+//! yet: its test is ignored, with the reason. Set `MONITOR_MONTH_STORE=PATH` to keep the
 //! month's store (the docs' plot: `sim-host trend --store PATH --plot ...`).
 
 mod small_motor;
@@ -80,7 +86,13 @@ fn day_log(m: &Motor, day: u32, seed: u64) -> Scenario {
     let p = &m.params;
     let mut sc = Scenario::steady(6.0, 4000.0);
     sc.seed = seed;
-    sc.sensors = SensorSpec::default();
+    sc.sensors = SensorSpec {
+        temperature: Some(monitor_sim::TemperatureSpec {
+            tau_s: 0.0,
+            ..monitor_sim::TemperatureSpec::default()
+        }),
+        ..SensorSpec::default()
+    };
     sc.load = LoadSpec {
         bl_nms: Some(p.motor.bl_nms * load(m, day)),
         ..LoadSpec::default()
@@ -221,11 +233,21 @@ fn early(alarm: &Option<(u32, Vec<String>)>, fault: Option<u32>) -> bool {
 }
 
 /// What is met: the growing short is trend-alarmed (on |I2w|/|I1|) at least 5 days before
-/// the first log whose verdict is FAULT, and no healthy motor's |I2w|/|I1| raises an
-/// alarm.
+/// the first log whose verdict is FAULT, the loosening connection within the month (no log
+/// of it is FAULT), and no healthy motor's |I2w|/|I1| raises an alarm.
 #[test]
-fn a_growing_short_is_alarmed_on_the_trend_before_any_log_is_fault() {
+fn a_growing_short_and_a_loosening_connection_are_alarmed_on_the_trend() {
     let month = the_month();
+    let loose = month
+        .iter()
+        .find(|m| m.1 == Health::Loosening)
+        .expect("loose");
+    assert!(
+        early(&loose.3, loose.2),
+        "loosening: alarm {:?}, FAULT {:?}",
+        loose.3,
+        loose.2
+    );
     let short = month.iter().find(|m| m.1 == Health::Short).expect("short");
     assert!(
         early(&short.3, short.2),
@@ -246,9 +268,9 @@ fn a_growing_short_is_alarmed_on_the_trend_before_any_log_is_fault() {
     assert!(false_i2.is_empty(), "{false_i2:?}");
 }
 
-/// The whole of issue 53's bar, not met yet: the loosening connection (Rs +0.5 %/day) is
-/// not alarmed (its indicators, the parity residuals, are not alarmed: docs/trend.md,
-/// "Limits"), and one healthy 2.2 kW motor's rotor sideband alarms on day 25.
+/// The whole of issue 53's bar, not met yet: three of the ten healthy motors raise a trend
+/// alarm late in the month (a parity residual whose operating-point fit leaves a drift, on
+/// day 22; a 2.2 kW motor's rotor sideband on day 26): docs/trend.md, "Limits".
 #[test]
 #[ignore = "issue 53's full bar is not met: see docs/trend.md, Limits"]
 fn a_month_of_daily_logs_alarms_every_fault_and_no_healthy_motor() {

@@ -18,7 +18,8 @@
 //!    for a rising indicator; either side for a two-sided one) *and* the line moves the
 //!    indicator by more than [`TrendOptions::k_scatter`] scatters over the window. Either
 //!    alone is not enough: a significant slope far inside the noise is not worth a visit,
-//!    and one large scatter is not a trend.
+//!    and one large scatter is not a trend. The alarm is raised when it holds on
+//!    [`TrendOptions::confirm_logs`] logs in a row (each judged on the logs up to it).
 //! 4. **The projection.** Where the indicator has a FAULT level (the level at which a
 //!    single log's verdict names the fault), the days until the line reaches it; for such
 //!    an indicator the alarm also needs the line to reach it within
@@ -52,8 +53,9 @@ pub struct Indicator {
     pub direction: Direction,
     /// Whether its trend raises the alarm (else it is trended and shown only).
     pub alarms: bool,
-    /// The covariates it is normalised on (store columns).
-    pub covariates: &'static [&'static str],
+    /// The covariates it is normalised on (store columns): sets in order of preference,
+    /// the first one the motor's logs have used.
+    pub covariates: &'static [&'static [&'static str]],
     /// The store column holding its FAULT level per log (its median over the reference
     /// logs is used), or a fixed level, or none.
     pub fault_level: FaultLevel,
@@ -72,7 +74,11 @@ pub enum FaultLevel {
 
 /// The load covariate.
 const LOAD: &str = "i1_peak_a";
-/// The temperature covariate.
+/// The temperature covariate where the log has a temperature channel: measured, so it
+/// does not take up a resistance change as the isolation's own reading of the rise does.
+const TEMPERATURE: &str = "winding_temperature_c";
+/// The temperature covariate without a channel: the rise the isolation read from Rs and Rr
+/// together (a loosening connection's Rs partly reads as heating in it).
 const RISE: &str = "winding_rise_k";
 
 /// The indicators trended, in the tables' order.
@@ -97,7 +103,7 @@ pub const INDICATORS: [Indicator; 5] = [
         unit: "of I1",
         direction: Direction::Rising,
         alarms: true,
-        covariates: &[LOAD],
+        covariates: &[&[LOAD]],
         fault_level: FaultLevel::Column("i2_least_change"),
     },
     Indicator {
@@ -105,8 +111,8 @@ pub const INDICATORS: [Indicator; 5] = [
         label: "e_d",
         unit: "pu",
         direction: Direction::Either,
-        alarms: false,
-        covariates: &[LOAD, RISE],
+        alarms: true,
+        covariates: &[&[LOAD, TEMPERATURE], &[LOAD, RISE]],
         fault_level: FaultLevel::None,
     },
     Indicator {
@@ -114,8 +120,8 @@ pub const INDICATORS: [Indicator; 5] = [
         label: "e_q",
         unit: "pu",
         direction: Direction::Either,
-        alarms: false,
-        covariates: &[LOAD, RISE],
+        alarms: true,
+        covariates: &[&[LOAD, TEMPERATURE], &[LOAD, RISE]],
         fault_level: FaultLevel::None,
     },
     Indicator {
@@ -123,8 +129,8 @@ pub const INDICATORS: [Indicator; 5] = [
         label: "e_T",
         unit: "pu",
         direction: Direction::Either,
-        alarms: false,
-        covariates: &[LOAD, RISE],
+        alarms: true,
+        covariates: &[&[LOAD, TEMPERATURE], &[LOAD, RISE]],
         fault_level: FaultLevel::None,
     },
     Indicator {
@@ -133,7 +139,7 @@ pub const INDICATORS: [Indicator; 5] = [
         unit: "dB",
         direction: Direction::Rising,
         alarms: true,
-        covariates: &[LOAD],
+        covariates: &[&[LOAD]],
         fault_level: FaultLevel::Fixed(-50.0),
     },
 ];
@@ -152,6 +158,9 @@ pub struct TrendOptions {
     /// For an indicator with a FAULT level: the alarm needs the line to reach it within
     /// this many days of the last log.
     pub horizon_days: f64,
+    /// How many logs in a row (the last and those before it, each judged on the logs up
+    /// to it) must alarm before the alarm is raised.
+    pub confirm_logs: usize,
 }
 
 impl Default for TrendOptions {
@@ -162,6 +171,7 @@ impl Default for TrendOptions {
             k_scatter: 3.0,
             min_logs: 6,
             horizon_days: 90.0,
+            confirm_logs: 2,
         }
     }
 }
