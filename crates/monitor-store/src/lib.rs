@@ -16,7 +16,7 @@ mod store;
 pub mod trend;
 
 pub use row::{
-    content_hash, parse_day, utc_day, Cell, Column, Kind, LogIdentity, StoredRow, COLUMNS,
+    content_hash, parse_day, utc_day, Cell, Kind, LogIdentity, StoreColumn, StoredRow, COLUMNS,
 };
-pub use store::{Appended, Store, StoreError};
+pub use store::{Appended, HistoryError, Store};
 pub use trend::{MotorTrend, TrendOptions};

@@ -5,7 +5,7 @@
 //! folder and renamed, so a reader never sees half a file.
 
 use crate::row::{content_hash, Cell, Kind, StoredRow, COLUMNS};
-use crate::store::StoreError;
+use crate::store::HistoryError;
 use parquet::basic::Compression;
 use parquet::data_type::{ByteArray, ByteArrayType, DoubleType, Int64Type};
 use parquet::file::properties::WriterProperties;
@@ -53,10 +53,10 @@ pub fn file_of(dir: &Path, row: &StoredRow) -> PathBuf {
 /// Writes `row`'s file (temporary name, then renamed).
 ///
 /// # Errors
-/// [`StoreError::Mirror`] when the folder or the file cannot be written.
-pub fn write_row(dir: &Path, row: &StoredRow) -> Result<(), StoreError> {
+/// [`HistoryError::Mirror`] when the folder or the file cannot be written.
+pub fn write_row(dir: &Path, row: &StoredRow) -> Result<(), HistoryError> {
     let path = file_of(dir, row);
-    let bad = |p: &Path, m: String| StoreError::Mirror {
+    let bad = |p: &Path, m: String| HistoryError::Mirror {
         path: p.display().to_string(),
         message: m,
     };
@@ -66,6 +66,54 @@ pub fn write_row(dir: &Path, row: &StoredRow) -> Result<(), StoreError> {
     let file = std::fs::File::create(&tmp).map_err(|e| bad(&tmp, e.to_string()))?;
     write_file(file, row).map_err(|e| bad(&tmp, e.to_string()))?;
     std::fs::rename(&tmp, &path).map_err(|e| bad(&path, e.to_string()))
+}
+
+/// The Parquet schema of the kept columns (all but the partitions), all optional.
+fn schema_of(kept: &[(usize, Kind)]) -> String {
+    let mut schema = String::from("message stored_row {\n");
+    for (i, kind) in kept {
+        let name = COLUMNS.get(*i).map_or("", |c| c.name);
+        schema.push_str(&match kind {
+            Kind::Text => format!("  OPTIONAL BYTE_ARRAY {name} (UTF8);\n"),
+            Kind::Int => format!("  OPTIONAL INT64 {name};\n"),
+            Kind::Real => format!("  OPTIONAL DOUBLE {name};\n"),
+        });
+    }
+    schema.push('}');
+    schema
+}
+
+/// Writes one cell (a column of one row, or a null of the column's `kind`).
+fn write_cell(
+    col: &mut parquet::file::writer::SerializedColumnWriter<'_>,
+    cell: &Cell,
+    kind: Kind,
+) -> Result<(), parquet::errors::ParquetError> {
+    let def = [i16::from(!matches!(cell, Cell::Null))];
+    match (cell, kind) {
+        (Cell::Text(t), _) => col.typed::<ByteArrayType>().write_batch(
+            &[ByteArray::from(t.as_str())],
+            Some(&def),
+            None,
+        )?,
+        (Cell::Int(v), _) => col
+            .typed::<Int64Type>()
+            .write_batch(&[*v], Some(&def), None)?,
+        (Cell::Real(v), _) => col
+            .typed::<DoubleType>()
+            .write_batch(&[*v], Some(&def), None)?,
+        (Cell::Null, Kind::Text) => {
+            col.typed::<ByteArrayType>()
+                .write_batch(&[], Some(&def), None)?
+        }
+        (Cell::Null, Kind::Int) => col
+            .typed::<Int64Type>()
+            .write_batch(&[], Some(&def), None)?,
+        (Cell::Null, Kind::Real) => col
+            .typed::<DoubleType>()
+            .write_batch(&[], Some(&def), None)?,
+    };
+    Ok(())
 }
 
 fn write_file(
@@ -78,17 +126,9 @@ fn write_file(
         .filter(|(_, c)| !PARTITIONS.contains(&c.name))
         .map(|(i, c)| (i, c.kind))
         .collect();
-    let mut schema = String::from("message stored_row {\n");
-    for (i, kind) in &kept {
-        let name = COLUMNS.get(*i).map_or("", |c| c.name);
-        schema.push_str(&match kind {
-            Kind::Text => format!("  OPTIONAL BYTE_ARRAY {name} (UTF8);\n"),
-            Kind::Int => format!("  OPTIONAL INT64 {name};\n"),
-            Kind::Real => format!("  OPTIONAL DOUBLE {name};\n"),
-        });
-    }
-    schema.push('}');
-    let schema = Arc::new(parquet::schema::parser::parse_message_type(&schema)?);
+    let schema = Arc::new(parquet::schema::parser::parse_message_type(&schema_of(
+        &kept,
+    ))?);
     let props = WriterProperties::builder()
         .set_compression(Compression::UNCOMPRESSED)
         .set_created_by(format!("monitor-store {}", env!("CARGO_PKG_VERSION")))
@@ -97,43 +137,8 @@ fn write_file(
     let mut rg = w.next_row_group()?;
     let mut k = 0usize;
     while let Some(mut col) = rg.next_column()? {
-        let cell = kept
-            .get(k)
-            .and_then(|(i, _)| row.cells.get(*i))
-            .unwrap_or(&Cell::Null);
-        let def = [i16::from(!matches!(cell, Cell::Null))];
-        match cell {
-            Cell::Text(t) => {
-                col.typed::<ByteArrayType>().write_batch(
-                    &[ByteArray::from(t.as_str())],
-                    Some(&def),
-                    None,
-                )?;
-            }
-            Cell::Int(v) => {
-                col.typed::<Int64Type>()
-                    .write_batch(&[*v], Some(&def), None)?;
-            }
-            Cell::Real(v) => {
-                col.typed::<DoubleType>()
-                    .write_batch(&[*v], Some(&def), None)?;
-            }
-            Cell::Null => {
-                match kept.get(k).map(|(_, kind)| *kind) {
-                    Some(Kind::Text) => {
-                        col.typed::<ByteArrayType>()
-                            .write_batch(&[], Some(&def), None)?
-                    }
-                    Some(Kind::Int) => {
-                        col.typed::<Int64Type>()
-                            .write_batch(&[], Some(&def), None)?
-                    }
-                    _ => col
-                        .typed::<DoubleType>()
-                        .write_batch(&[], Some(&def), None)?,
-                };
-            }
-        }
+        let (i, kind) = kept.get(k).copied().unwrap_or((usize::MAX, Kind::Real));
+        write_cell(&mut col, row.cells.get(i).unwrap_or(&Cell::Null), kind)?;
         col.close()?;
         k += 1;
     }
@@ -145,12 +150,12 @@ fn write_file(
 /// Removes the temporary files a killed run left under `dir`.
 ///
 /// # Errors
-/// [`StoreError::Mirror`] when the folder cannot be listed or a file removed.
-pub fn remove_temporaries(dir: &Path) -> Result<(), StoreError> {
+/// [`HistoryError::Mirror`] when the folder cannot be listed or a file removed.
+pub fn remove_temporaries(dir: &Path) -> Result<(), HistoryError> {
     if !dir.is_dir() {
         return Ok(());
     }
-    let bad = |p: &Path, e: std::io::Error| StoreError::Mirror {
+    let bad = |p: &Path, e: std::io::Error| HistoryError::Mirror {
         path: p.display().to_string(),
         message: e.to_string(),
     };

@@ -20,7 +20,7 @@ pub enum Kind {
 /// One column of the store: its name, type, and what it holds (with its unit and the
 /// `diagnose --json` key it is taken from).
 #[derive(Debug, Clone, Copy)]
-pub struct Column {
+pub struct StoreColumn {
     /// The column's name (SQLite, Parquet, pandas).
     pub name: &'static str,
     /// Its type.
@@ -29,14 +29,14 @@ pub struct Column {
     pub doc: &'static str,
 }
 
-const fn c(name: &'static str, kind: Kind, doc: &'static str) -> Column {
-    Column { name, kind, doc }
+const fn c(name: &'static str, kind: Kind, doc: &'static str) -> StoreColumn {
+    StoreColumn { name, kind, doc }
 }
 
 /// The columns, in order. The first six say which log of which motor and when; every value
 /// after them is one `diagnose --json` reported (the key in brackets); null where the
 /// diagnosis had none (a fault not named, a rotor not judged).
-pub const COLUMNS: [Column; 34] = [
+pub const COLUMNS: [StoreColumn; 34] = [
     c(
         "log_id",
         Kind::Text,
@@ -321,72 +321,77 @@ impl StoredRow {
     /// The row of one log from its `diagnose --json` document `doc` (the one
     /// `monitor_api::diagnose` reports; `serde_json::to_value` of the report).
     pub fn from_diagnose(id: &LogIdentity, doc: &Value) -> Self {
-        let num = |p: &str| {
-            doc.pointer(p)
-                .and_then(Value::as_f64)
-                .filter(|x| x.is_finite())
-        };
-        let pct = |p: &str| num(p).map(|x| 100.0 * x);
-        let text = |p: &str| doc.pointer(p).and_then(Value::as_str).map(str::to_string);
-        let flag = |p: &str| doc.pointer(p).and_then(Value::as_bool).map(i64::from);
-        let candidate = |fault: &str| {
-            doc.pointer("/candidates")
-                .and_then(Value::as_array)
-                .and_then(|c| c.iter().find(|x| x["fault"] == fault))
-                .and_then(|x| x["change"].as_f64())
-                .map(|x| 100.0 * x)
-        };
-        let named = doc.pointer("/isolation/named").and_then(|v| match v {
-            Value::String(s) => Some(s.clone()),
-            Value::Null => None,
-            other => Some(other.to_string()),
-        });
-        let real = |x: Option<f64>| x.map_or(Cell::Null, Cell::Real);
-        let txt = |x: Option<String>| x.map_or(Cell::Null, Cell::Text);
-        let int = |x: Option<i64>| x.map_or(Cell::Null, Cell::Int);
-        let cells = vec![
+        let mut cells = vec![
             Cell::Text(id.log_id()),
             Cell::Text(id.hash.clone()),
             Cell::Text(id.path.clone()),
             Cell::Text(id.motor.clone()),
             Cell::Int(id.time_s),
             Cell::Text(utc_day(id.time_s)),
-            txt(text("/verdict")),
-            txt(text("/verdict_finding/fault").filter(|_| is_named(doc))),
-            real(num("/verdict_finding/size").filter(|_| is_named(doc))),
-            txt(text("/verdict_finding/size_unit").filter(|_| is_named(doc))),
-            txt(text("/verdict_finding/phase").filter(|_| is_named(doc))),
-            real(num("/verdict_finding/confidence").filter(|_| is_named(doc))),
-            txt(named),
-            real(pct("/isolation/named_change")),
-            real(candidate("rs")),
-            real(candidate("rr")),
-            real(num("/isolation/winding_rise_k")),
-            int(flag("/isolation/heating_explains")),
-            real(num("/isolation/winding_temperature_c")),
-            real(num("/isolation/residuals/0")),
-            real(num("/isolation/residuals/1")),
-            real(num("/isolation/residuals/2")),
-            real(num("/isolation/deviation_sigma")),
-            real(num("/unbalance/winding_ratio")),
-            real(num("/unbalance/angle_deg")),
-            real(num("/unbalance/least_change")),
-            real(
-                num("/rotor/level_db")
-                    .filter(|_| doc.pointer("/rotor/judged") == Some(&Value::Bool(true))),
-            ),
-            real(num("/rotor/slip")),
-            real(num("/unbalance/measured/i1_peak_a")),
-            real(num("/unbalance/measured/wr_rad_s")),
-            real(num("/data_quality/current_frequency_hz")),
-            int(doc
-                .pointer("/data_quality/rows_read")
-                .and_then(Value::as_i64)),
-            real(num("/data_quality/sample_rate_hz")),
-            int(flag("/data_quality/trusted")),
         ];
+        cells.extend(report_cells(doc));
         StoredRow { cells }
     }
+}
+
+/// The cells after the identity's, from the report `doc` (in [`COLUMNS`]' order).
+fn report_cells(doc: &Value) -> Vec<Cell> {
+    let num = |p: &str| {
+        doc.pointer(p)
+            .and_then(Value::as_f64)
+            .filter(|x| x.is_finite())
+    };
+    let text = |p: &str| doc.pointer(p).and_then(Value::as_str).map(str::to_string);
+    let flag = |p: &str| doc.pointer(p).and_then(Value::as_bool).map(i64::from);
+    let candidate = |fault: &str| {
+        doc.pointer("/candidates")
+            .and_then(Value::as_array)
+            .and_then(|c| c.iter().find(|x| x["fault"] == fault))
+            .and_then(|x| x["change"].as_f64())
+            .map(|x| 100.0 * x)
+    };
+    let named = doc.pointer("/isolation/named").and_then(|v| match v {
+        Value::String(s) => Some(s.clone()),
+        Value::Null => None,
+        other => Some(other.to_string()),
+    });
+    let judged = doc.pointer("/rotor/judged") == Some(&Value::Bool(true));
+    let finding = is_named(doc);
+    let real = |x: Option<f64>| x.map_or(Cell::Null, Cell::Real);
+    let txt = |x: Option<String>| x.map_or(Cell::Null, Cell::Text);
+    let int = |x: Option<i64>| x.map_or(Cell::Null, Cell::Int);
+    vec![
+        txt(text("/verdict")),
+        txt(text("/verdict_finding/fault").filter(|_| finding)),
+        real(num("/verdict_finding/size").filter(|_| finding)),
+        txt(text("/verdict_finding/size_unit").filter(|_| finding)),
+        txt(text("/verdict_finding/phase").filter(|_| finding)),
+        real(num("/verdict_finding/confidence").filter(|_| finding)),
+        txt(named),
+        real(num("/isolation/named_change").map(|x| 100.0 * x)),
+        real(candidate("rs")),
+        real(candidate("rr")),
+        real(num("/isolation/winding_rise_k")),
+        int(flag("/isolation/heating_explains")),
+        real(num("/isolation/winding_temperature_c")),
+        real(num("/isolation/residuals/0")),
+        real(num("/isolation/residuals/1")),
+        real(num("/isolation/residuals/2")),
+        real(num("/isolation/deviation_sigma")),
+        real(num("/unbalance/winding_ratio")),
+        real(num("/unbalance/angle_deg")),
+        real(num("/unbalance/least_change")),
+        real(num("/rotor/level_db").filter(|_| judged)),
+        real(num("/rotor/slip")),
+        real(num("/unbalance/measured/i1_peak_a")),
+        real(num("/unbalance/measured/wr_rad_s")),
+        real(num("/data_quality/current_frequency_hz")),
+        int(doc
+            .pointer("/data_quality/rows_read")
+            .and_then(Value::as_i64)),
+        real(num("/data_quality/sample_rate_hz")),
+        int(flag("/data_quality/trusted")),
+    ]
 }
 
 /// The verdict's finding names a fault (a FAULT's or a watched one).

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 /// Errors of the store.
 #[derive(Debug, thiserror::Error)]
-pub enum StoreError {
+pub enum HistoryError {
     /// SQLite failed (the store cannot be opened, is not a store, or a write failed).
     #[error("store {path}: {message}")]
     Sqlite {
@@ -53,9 +53,9 @@ impl Store {
     /// Opens the store at `path`, creating it (and its table) if it does not exist.
     ///
     /// # Errors
-    /// [`StoreError::Sqlite`] when the file cannot be opened or is not an SQLite store of
+    /// [`HistoryError::Sqlite`] when the file cannot be opened or is not an SQLite store of
     /// this schema.
-    pub fn open(path: &Path) -> Result<Self, StoreError> {
+    pub fn open(path: &Path) -> Result<Self, HistoryError> {
         let conn = Connection::open(path).map_err(|e| sql(path, &e))?;
         let s = Store {
             conn,
@@ -68,11 +68,11 @@ impl Store {
     /// Opens an existing store to read it (nothing is created).
     ///
     /// # Errors
-    /// [`StoreError::Missing`] when there is no file at `path`; [`StoreError::Sqlite`] when
+    /// [`HistoryError::Missing`] when there is no file at `path`; [`HistoryError::Sqlite`] when
     /// it is not a store.
-    pub fn open_existing(path: &Path) -> Result<Self, StoreError> {
+    pub fn open_existing(path: &Path) -> Result<Self, HistoryError> {
         if !path.is_file() {
-            return Err(StoreError::Missing(path.display().to_string()));
+            return Err(HistoryError::Missing(path.display().to_string()));
         }
         let conn = Connection::open_with_flags(path, OpenFlags::SQLITE_OPEN_READ_WRITE)
             .map_err(|e| sql(path, &e))?;
@@ -94,7 +94,7 @@ impl Store {
         mirror::dir_of(&self.path)
     }
 
-    fn init(&self) -> Result<(), StoreError> {
+    fn init(&self) -> Result<(), HistoryError> {
         // WAL: a reader (`sim-host trend`) never blocks the writer; synchronous FULL: a
         // committed row survives a power cut, not only a killed process.
         let cols: Vec<String> = COLUMNS
@@ -124,7 +124,7 @@ impl Store {
         self.check_schema()
     }
 
-    fn check_schema(&self) -> Result<(), StoreError> {
+    fn check_schema(&self) -> Result<(), HistoryError> {
         let mut st = self
             .conn
             .prepare(&format!("SELECT name FROM pragma_table_info('{TABLE}')"))
@@ -135,7 +135,7 @@ impl Store {
             .map_err(|e| sql(&self.path, &e))?;
         let want: Vec<&str> = COLUMNS.iter().map(|c| c.name).collect();
         if names != want {
-            return Err(StoreError::Sqlite {
+            return Err(HistoryError::Sqlite {
                 path: self.path.display().to_string(),
                 message: format!(
                     "not a store of this version (table `{TABLE}` has columns {names:?})"
@@ -149,10 +149,10 @@ impl Store {
     /// already stored (the same `log_id`) is skipped: [`Appended::AlreadyStored`].
     ///
     /// # Errors
-    /// [`StoreError`] when SQLite or the mirror cannot be written; SQLite's row is then
+    /// [`HistoryError`] when SQLite or the mirror cannot be written; SQLite's row is then
     /// either whole or absent, and a missing mirror file is written by
     /// [`Store::sync_mirror`].
-    pub fn append(&mut self, row: &StoredRow) -> Result<Appended, StoreError> {
+    pub fn append(&mut self, row: &StoredRow) -> Result<Appended, HistoryError> {
         let names: Vec<&str> = COLUMNS.iter().map(|c| c.name).collect();
         let marks = vec!["?"; names.len()].join(", ");
         let q = format!(
@@ -180,8 +180,8 @@ impl Store {
     /// Whether a row of the log `log_id` is stored.
     ///
     /// # Errors
-    /// [`StoreError::Sqlite`] when the store cannot be read.
-    pub fn contains(&self, log_id: &str) -> Result<bool, StoreError> {
+    /// [`HistoryError::Sqlite`] when the store cannot be read.
+    pub fn contains(&self, log_id: &str) -> Result<bool, HistoryError> {
         self.conn
             .query_row(
                 &format!("SELECT COUNT(*) FROM {TABLE} WHERE log_id = ?1"),
@@ -196,12 +196,12 @@ impl Store {
     /// `since_s` (seconds since 1970-01-01 UTC) on where given.
     ///
     /// # Errors
-    /// [`StoreError::Sqlite`] when the store cannot be read.
+    /// [`HistoryError::Sqlite`] when the store cannot be read.
     pub fn rows(
         &self,
         motor: Option<&str>,
         since_s: Option<i64>,
-    ) -> Result<Vec<StoredRow>, StoreError> {
+    ) -> Result<Vec<StoredRow>, HistoryError> {
         let names: Vec<&str> = COLUMNS.iter().map(|c| c.name).collect();
         let q = format!(
             "SELECT {} FROM {TABLE} WHERE (?1 IS NULL OR motor = ?1) AND (?2 IS NULL OR log_time_s >= ?2) ORDER BY motor, log_time_s, log_id",
@@ -233,8 +233,8 @@ impl Store {
     /// source of truth. Returns how many files were written.
     ///
     /// # Errors
-    /// [`StoreError`] when the store cannot be read or a file cannot be written.
-    pub fn sync_mirror(&self) -> Result<usize, StoreError> {
+    /// [`HistoryError`] when the store cannot be read or a file cannot be written.
+    pub fn sync_mirror(&self) -> Result<usize, HistoryError> {
         let dir = self.mirror_dir();
         mirror::remove_temporaries(&dir)?;
         let mut written = 0;
@@ -248,8 +248,8 @@ impl Store {
     }
 }
 
-fn sql(path: &Path, e: &rusqlite::Error) -> StoreError {
-    StoreError::Sqlite {
+fn sql(path: &Path, e: &rusqlite::Error) -> HistoryError {
+    HistoryError::Sqlite {
         path: path.display().to_string(),
         message: e.to_string(),
     }

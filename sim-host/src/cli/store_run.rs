@@ -15,17 +15,12 @@ enum Judged {
     Stored(PathBuf),
 }
 
-/// Judges `logs` with `table`, appending each report to the store at `path`; the fleet rows
-/// in the logs' order (a log already stored has none). Counts go to stderr.
+/// Opens (or creates) the store and writes the mirror files a killed run left out.
 ///
 /// # Errors
-/// The store cannot be opened or written (a log's own error is its row's).
-pub fn judge_into(
-    table: &MotorTable,
-    logs: &[PathBuf],
-    path: &Path,
-) -> anyhow::Result<Vec<FleetRow>> {
-    let mut store = Store::open(path)?;
+/// The store cannot be opened or its mirror written.
+fn open(path: &Path) -> anyhow::Result<Store> {
+    let store = Store::open(path)?;
     let rebuilt = store.sync_mirror()?;
     if rebuilt > 0 {
         eprintln!(
@@ -33,7 +28,19 @@ pub fn judge_into(
             path.display()
         );
     }
-    // Logs already stored are known before the workers start (one reader: this thread).
+    Ok(store)
+}
+
+/// Each log's identity (where its motor is known and the file readable) and whether it is
+/// stored already: known before the workers start (one reader, this thread).
+///
+/// # Errors
+/// The store cannot be read.
+fn identities(
+    table: &MotorTable,
+    logs: &[PathBuf],
+    store: &Store,
+) -> anyhow::Result<Vec<(Option<LogIdentity>, bool)>> {
     let mut known = Vec::with_capacity(logs.len());
     for log in logs {
         let id = table
@@ -45,6 +52,33 @@ pub fn judge_into(
         };
         known.push((id, stored));
     }
+    Ok(known)
+}
+
+/// One worker's log: already stored, or judged (its fleet row and store row).
+fn judge_one(table: &MotorTable, log: &Path, id: Option<&LogIdentity>, stored: bool) -> Judged {
+    if stored {
+        return Judged::Stored(log.to_path_buf());
+    }
+    let (row, doc) = monitor_api::fleet::row_and_report(table, log);
+    let kept = id
+        .zip(doc.as_ref())
+        .map(|(id, d)| StoredRow::from_diagnose(id, d));
+    Judged::Row(0, Box::new(row), kept)
+}
+
+/// Judges `logs` with `table`, appending each report to the store at `path`; the fleet rows
+/// in the logs' order (a log already stored has none). Counts go to stderr.
+///
+/// # Errors
+/// The store cannot be opened or written (a log's own error is its row's).
+pub fn judge_into(
+    table: &MotorTable,
+    logs: &[PathBuf],
+    path: &Path,
+) -> anyhow::Result<Vec<FleetRow>> {
+    let mut store = open(path)?;
+    let known = identities(table, logs, &store)?;
     let (tx, rx) = std::sync::mpsc::channel::<Judged>();
     let mut rows: Vec<Option<FleetRow>> = vec![None; logs.len()];
     let (mut stored, mut skipped, mut unstored) = (0usize, 0usize, 0usize);
@@ -54,17 +88,12 @@ pub fn judge_into(
             logs.par_iter()
                 .enumerate()
                 .for_each_with(tx, |tx, (i, log)| {
-                    let msg = match known.get(i) {
-                        Some((_, true)) => Judged::Stored(log.clone()),
-                        Some((id, false)) => {
-                            let (row, doc) = monitor_api::fleet::row_and_report(table, log);
-                            let kept = id
-                                .as_ref()
-                                .zip(doc.as_ref())
-                                .map(|(id, d)| StoredRow::from_diagnose(id, d));
-                            Judged::Row(i, Box::new(row), kept)
-                        }
-                        None => return,
+                    let Some((id, stored)) = known.get(i) else {
+                        return;
+                    };
+                    let msg = match judge_one(table, log, id.as_ref(), *stored) {
+                        Judged::Row(_, row, kept) => Judged::Row(i, row, kept),
+                        other => other,
                     };
                     // The receiver lives as long as this scope.
                     let _ = tx.send(msg);

@@ -69,31 +69,7 @@ struct TrendReport<'a> {
 /// No store at the path, not a store, a bad date or window, a plot that cannot be written:
 /// one line each.
 pub fn run(args: &TrendArgs) -> anyhow::Result<()> {
-    if !(args.window_days.is_finite() && args.window_days > 0.0) {
-        anyhow::bail!(
-            "--window-days must be a positive number of days, got {}",
-            args.window_days
-        );
-    }
-    if !(args.k.is_finite() && args.k > 0.0) {
-        anyhow::bail!("--k must be a positive number of scatters, got {}", args.k);
-    }
-    let since = match &args.since {
-        Some(d) => Some(monitor_store::parse_day(d).ok_or_else(|| {
-            anyhow::anyhow!("--since {d}: not a date; give the UTC day as YYYY-MM-DD")
-        })?),
-        None => None,
-    };
-    if let Some(p) = &args.plot {
-        let ext = p.extension().and_then(|e| e.to_str()).unwrap_or_default();
-        if !matches!(ext, "svg" | "png") {
-            anyhow::bail!(
-                "--plot {}: give a file name ending in .svg or .png",
-                p.display()
-            );
-        }
-        super::output_guard::OutputGuard::new(&[args.store.as_path()]).check_files(&[p])?;
-    }
+    let since = check(args)?;
     let store = Store::open_existing(&args.store)?;
     let rebuilt = store.sync_mirror()?;
     if rebuilt > 0 {
@@ -129,6 +105,40 @@ pub fn run(args: &TrendArgs) -> anyhow::Result<()> {
     let mut out = super::stdout();
     print_table(&mut out, &motors, args.motor.is_some())?;
     Ok(())
+}
+
+/// The arguments checked, before anything is read: the window, k, the date (returned as
+/// seconds since 1970-01-01 UTC) and the plot's name.
+///
+/// # Errors
+/// One line naming the option and what it must be.
+fn check(args: &TrendArgs) -> anyhow::Result<Option<i64>> {
+    if !(args.window_days.is_finite() && args.window_days > 0.0) {
+        anyhow::bail!(
+            "--window-days must be a positive number of days, got {}",
+            args.window_days
+        );
+    }
+    if !(args.k.is_finite() && args.k > 0.0) {
+        anyhow::bail!("--k must be a positive number of scatters, got {}", args.k);
+    }
+    let since = match &args.since {
+        Some(d) => Some(monitor_store::parse_day(d).ok_or_else(|| {
+            anyhow::anyhow!("--since {d}: not a date; give the UTC day as YYYY-MM-DD")
+        })?),
+        None => None,
+    };
+    if let Some(p) = &args.plot {
+        let ext = p.extension().and_then(|e| e.to_str()).unwrap_or_default();
+        if !matches!(ext, "svg" | "png") {
+            anyhow::bail!(
+                "--plot {}: give a file name ending in .svg or .png",
+                p.display()
+            );
+        }
+        super::output_guard::OutputGuard::new(&[args.store.as_path()]).check_files(&[p])?;
+    }
+    Ok(since)
 }
 
 /// The text table: a line per motor (ranked), and per indicator with `detail`.

@@ -224,41 +224,24 @@ pub fn indicator_trend(
             covs.join(" and "),
             rows.len()
         ),
-        None => "raw values (too few logs, or an operating point that does not vary, to fit)"
-            .to_string(),
+        None if !covs.is_empty() && rows.len() < fit_logs(covs) => format!(
+            "not yet: {} logs, the operating-point fit needs {}; no alarm until then",
+            rows.len(),
+            fit_logs(covs)
+        ),
+        None => "raw values (an operating point that does not vary)".to_string(),
     };
     let end_s = rows
         .last()
         .and_then(|r| r.f64("log_time_s"))
         .unwrap_or_default();
-    let start_s = end_s - opts.window_days * DAY_S;
-    let series: Vec<TrendPoint> = rows
-        .iter()
-        .filter_map(|r| {
-            let t = r.f64("log_time_s")?;
-            let value = r.f64(ind.column)?;
-            let normalised = match &fit {
-                Some(f) => {
-                    let x: Option<Vec<f64>> = covs.iter().map(|c| r.f64(c)).collect();
-                    value - f.part(&x?)?
-                }
-                None => value,
-            };
-            (t >= start_s - 1.0).then_some(TrendPoint {
-                t_days: t / DAY_S,
-                value,
-                normalised,
-            })
-        })
-        .collect();
-    let level = match ind.fault_level {
-        FaultLevel::None => None,
-        FaultLevel::Fixed(x) => Some(x),
-        FaultLevel::Column(c) => {
-            let mut v: Vec<f64> = rows.iter().filter_map(|r| r.f64(c)).collect();
-            median(&mut v).filter(|x| *x > 0.0)
-        }
-    };
+    let series = series_of(
+        ind,
+        covs,
+        fit.as_ref(),
+        rows,
+        end_s - opts.window_days * DAY_S,
+    );
     let mut t = IndicatorTrend {
         indicator: ind.column.to_string(),
         label: ind.label.to_string(),
@@ -271,7 +254,7 @@ pub fn indicator_trend(
         scatter: None,
         moves_scatters: None,
         last: None,
-        fault_level: level,
+        fault_level: fault_level_of(ind, rows),
         days_to_fault: None,
         alarm: false,
         normalisation,
@@ -281,13 +264,48 @@ pub fn indicator_trend(
     judge(&mut t, ind, opts, end_s / DAY_S);
     if fit.is_none() && !covs.is_empty() && rows.len() < fit_logs(covs) {
         t.alarm = false;
-        t.normalisation = format!(
-            "not yet: {} logs, the operating-point fit needs {}; no alarm until then",
-            rows.len(),
-            fit_logs(covs)
-        );
     }
     t
+}
+
+/// The indicator's points from `start_s` on, normalised with `fit` where there is one.
+fn series_of(
+    ind: &Indicator,
+    covs: &[&str],
+    fit: Option<&OperatingFit>,
+    rows: &[&StoredRow],
+    start_s: f64,
+) -> Vec<TrendPoint> {
+    rows.iter()
+        .filter_map(|r| {
+            let t = r.f64("log_time_s")?;
+            let value = r.f64(ind.column)?;
+            let normalised = match fit {
+                Some(f) => {
+                    let x: Option<Vec<f64>> = covs.iter().map(|c| r.f64(c)).collect();
+                    value - f.part(&x?)?
+                }
+                None => value,
+            };
+            (t >= start_s - 1.0).then_some(TrendPoint {
+                t_days: t / DAY_S,
+                value,
+                normalised,
+            })
+        })
+        .collect()
+}
+
+/// The indicator's FAULT level for these rows, where it has one.
+fn fault_level_of(ind: &Indicator, rows: &[&StoredRow]) -> Option<f64> {
+    match ind.fault_level {
+        FaultLevel::None => None,
+        FaultLevel::Fixed(x) => Some(x),
+        FaultLevel::Column(c) => {
+            let mut v: Vec<f64> = rows.iter().filter_map(|r| r.f64(c)).collect();
+            median(&mut v).filter(|x| *x > 0.0)
+        }
+    }
 }
 
 /// The slope, scatter, alarm, projection and sentence of `t` from its series.
@@ -324,13 +342,12 @@ fn judge(t: &mut IndicatorTrend, ind: &Indicator, opts: &TrendOptions, end_days:
     let span = x.last().copied().unwrap_or_default();
     let moves = line.slope * span / scatter;
     let last = line.intercept + line.slope * (end_days - t0);
-    let significant = match ind.direction {
-        Direction::Rising => line.low > 0.0,
-        Direction::Either => line.low > 0.0 || line.high < 0.0,
-    };
-    let big = match ind.direction {
-        Direction::Rising => moves > opts.k_scatter,
-        Direction::Either => moves.abs() > opts.k_scatter,
+    let (significant, big) = match ind.direction {
+        Direction::Rising => (line.low > 0.0, moves > opts.k_scatter),
+        Direction::Either => (
+            line.low > 0.0 || line.high < 0.0,
+            moves.abs() > opts.k_scatter,
+        ),
     };
     t.slope_per_day = Some(line.slope);
     t.slope_low = Some(line.low);
@@ -350,20 +367,31 @@ fn judge(t: &mut IndicatorTrend, ind: &Indicator, opts: &TrendOptions, end_days:
     // not worth a visit, however significant.
     let soon = t.fault_level.is_none() || t.days_to_fault.is_some_and(|d| d <= opts.horizon_days);
     t.alarm = ind.alarms && significant && big && soon;
-    let week = |v: f64| 7.0 * v;
+    t.sentence = sentence(t, ind, &line, span);
+}
+
+/// "i2_over_i1 rising 0.36 % of I1/week (0.14 to 0.68), 3.3 scatters over 14 days: TREND
+/// ALARM, FAULT level in about 38 days", in the indicator's shown unit.
+fn sentence(
+    t: &IndicatorTrend,
+    ind: &Indicator,
+    line: &super::stats::SenLine,
+    span: f64,
+) -> String {
+    let week = |v: f64| 7.0 * v * ind.scale;
     let dir = if line.slope >= 0.0 {
         "rising"
     } else {
         "falling"
     };
     let mut s = format!(
-        "{name} {dir} {:.3e} {}/week ({:.3e} to {:.3e}), {:.1} scatters over {:.0} days",
-        week(line.slope),
-        ind.unit,
-        week(line.low),
-        week(line.high),
-        moves,
-        span
+        "{} {dir} {} {}/week ({} to {}), {:.1} scatters over {span:.0} days",
+        ind.column,
+        sig3(week(line.slope)),
+        ind.shown_unit,
+        sig3(week(line.low)),
+        sig3(week(line.high)),
+        t.moves_scatters.unwrap_or_default(),
     );
     match (t.alarm, t.days_to_fault) {
         (true, Some(d)) => s.push_str(&format!(": TREND ALARM, FAULT level in about {d:.0} days")),
@@ -374,7 +402,17 @@ fn judge(t: &mut IndicatorTrend, ind: &Indicator, opts: &TrendOptions, end_days:
         (false, _) if !ind.alarms => s.push_str(": shown, not alarmed"),
         (false, _) => s.push_str(": no alarm"),
     }
-    t.sentence = s;
+    s
+}
+
+/// `v` with three significant digits, in plain notation where that is short.
+fn sig3(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || !(1e-3..1e4).contains(&a) {
+        return format!("{v:.2e}");
+    }
+    let decimals = (2 - a.log10().floor() as i32).max(0) as usize;
+    format!("{v:.decimals$}")
 }
 
 /// The UTC day of `t_days` days since 1970-01-01.

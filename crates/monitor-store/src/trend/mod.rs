@@ -47,8 +47,12 @@ pub struct Indicator {
     pub column: &'static str,
     /// A short label for tables and plots.
     pub label: &'static str,
-    /// Its unit.
+    /// Its unit (the store's and the JSON's).
     pub unit: &'static str,
+    /// The factor from `unit` to the unit sentences show it in.
+    pub scale: f64,
+    /// The unit sentences show it in.
+    pub shown_unit: &'static str,
     /// Which way a fault moves it.
     pub direction: Direction,
     /// Whether its trend raises the alarm (else it is trended and shown only).
@@ -101,6 +105,8 @@ pub const INDICATORS: [Indicator; 5] = [
         column: "i2_over_i1",
         label: "|I2w|/|I1|",
         unit: "of I1",
+        scale: 100.0,
+        shown_unit: "% of I1",
         direction: Direction::Rising,
         alarms: true,
         covariates: &[&[LOAD]],
@@ -110,6 +116,8 @@ pub const INDICATORS: [Indicator; 5] = [
         column: "residual_d",
         label: "e_d",
         unit: "pu",
+        scale: 1.0,
+        shown_unit: "pu",
         direction: Direction::Either,
         alarms: true,
         covariates: &[&[LOAD, TEMPERATURE], &[LOAD, RISE]],
@@ -119,6 +127,8 @@ pub const INDICATORS: [Indicator; 5] = [
         column: "residual_q",
         label: "e_q",
         unit: "pu",
+        scale: 1.0,
+        shown_unit: "pu",
         direction: Direction::Either,
         alarms: true,
         covariates: &[&[LOAD, TEMPERATURE], &[LOAD, RISE]],
@@ -128,6 +138,8 @@ pub const INDICATORS: [Indicator; 5] = [
         column: "residual_t",
         label: "e_T",
         unit: "pu",
+        scale: 1.0,
+        shown_unit: "pu",
         direction: Direction::Either,
         alarms: true,
         covariates: &[&[LOAD, TEMPERATURE], &[LOAD, RISE]],
@@ -137,6 +149,8 @@ pub const INDICATORS: [Indicator; 5] = [
         column: "sideband_db",
         label: "sideband",
         unit: "dB",
+        scale: 1.0,
+        shown_unit: "dB",
         direction: Direction::Rising,
         alarms: true,
         covariates: &[&[LOAD]],

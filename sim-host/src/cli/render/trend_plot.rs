@@ -11,6 +11,7 @@
 //! At most [`MAX_MOTORS`] motors are drawn: the first of the ranking (alarmed first).
 
 use monitor_store::trend::{IndicatorTrend, MotorTrend, TrendOptions};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -42,7 +43,7 @@ const PANELS: [(&str, &str, bool); 4] = [
 ];
 
 /// One motor's line in a panel: its name, points (day, value) and palette index.
-type Line = (String, Vec<(f64, f64)>, usize);
+type PlotLine = (String, Vec<(f64, f64)>, usize);
 
 /// One motor's points of one panel: (day, value in the panel's unit).
 fn points(t: &IndicatorTrend, in_scatters: bool, t0: f64) -> Vec<(f64, f64)> {
@@ -112,113 +113,145 @@ where
         .filter_map(|t| t.series.first().map(|p| p.t_days.floor()))
         .fold(f64::INFINITY, f64::min);
     let t0 = if t0.is_finite() { t0 } else { 0.0 };
-    let first_day = monitor_store::trend::day_of(t0);
     let panels = root.split_evenly((PANELS.len(), 1));
-    for (k, ((column, title, in_scatters), area)) in PANELS.iter().zip(&panels).enumerate() {
-        let series: Vec<Line> = motors
-            .iter()
-            .enumerate()
-            .filter_map(|(i, m)| {
-                let t = m.indicators.iter().find(|t| t.indicator == *column)?;
-                Some((m.motor.clone(), points(t, *in_scatters, t0), i))
-            })
-            .collect();
-        let all = series.iter().flat_map(|s| s.1.iter());
-        let (mut x1, mut y0, mut y1) = (1.0f64, f64::INFINITY, f64::NEG_INFINITY);
-        for &(x, y) in all {
-            if x.is_finite() && y.is_finite() {
-                x1 = x1.max(x);
-                y0 = y0.min(y);
-                y1 = y1.max(y);
-            }
-        }
-        // The bands' levels in the panel's unit.
-        let (watch, fault) = if *in_scatters {
-            (opts.k_scatter, None)
-        } else {
-            let mut lv: Vec<f64> = motors
-                .iter()
-                .filter_map(|m| m.indicators.iter().find(|t| t.indicator == *column))
-                .filter_map(|t| t.fault_level)
-                .collect();
-            let f = monitor_store::trend::stats::median(&mut lv).map(|x| 100.0 * x);
-            (f.map_or(f64::INFINITY, |f| 0.5 * f), f)
-        };
-        if !y0.is_finite() {
-            (y0, y1) = (-1.0, 1.0);
-        }
-        y1 = y1.max(fault.map_or(watch, |f| 1.15 * f));
-        if *in_scatters {
-            y0 = y0.min(-1.3 * watch);
-            y1 = y1.max(1.3 * watch);
-        } else {
-            y0 = y0.min(0.0);
-        }
-        let pad = 0.04 * (y1 - y0).max(1e-9);
-        let (y0, y1) = (y0 - pad, y1 + pad);
-        let caption = if k == 0 {
-            format!("{title}; days from {first_day}")
-        } else {
-            title.to_string()
-        };
-        let mut chart = ChartBuilder::on(area)
-            .margin(8)
-            .caption(caption, ("sans-serif", 16))
-            .x_label_area_size(28)
-            .y_label_area_size(60)
-            .build_cartesian_2d(0.0..x1, y0..y1)
-            .map_err(e)?;
-        // The bands.
-        let rect =
-            |lo: f64, hi: f64, c: RGBColor| Rectangle::new([(0.0, lo), (x1, hi)], c.filled());
-        if *in_scatters {
-            chart
-                .draw_series([
-                    rect(y0, -watch, WATCH),
-                    rect(-watch, watch, OK),
-                    rect(watch, y1, WATCH),
-                ])
-                .map_err(e)?;
-        } else {
-            let f = fault.unwrap_or(y1);
-            chart
-                .draw_series([
-                    rect(y0, watch.min(y1), OK),
-                    rect(watch.min(y1), f.min(y1), WATCH),
-                    rect(f.min(y1), y1, FAULT),
-                ])
-                .map_err(e)?;
-        }
-        chart
-            .configure_mesh()
-            .x_desc(if k + 1 == PANELS.len() { "day" } else { "" })
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(e)?;
-        for (name, pts, i) in series {
-            let col = PALETTE[i % PALETTE.len()];
-            chart
-                .draw_series(pts.iter().map(|&p| Circle::new(p, 2, col.filled())))
-                .map_err(e)?;
-            let a = chart
-                .draw_series(LineSeries::new(pts, col.stroke_width(2)))
-                .map_err(e)?;
-            if k == 0 {
-                a.label(name).legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 16, y)], col.stroke_width(2))
-                });
-            }
-        }
-        if k == 0 {
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperLeft)
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .draw()
-                .map_err(e)?;
-        }
+    for (k, (panel, area)) in PANELS.iter().zip(&panels).enumerate() {
+        draw_panel(area, motors, opts, panel, k, t0)?;
     }
     root.present().map_err(e)?;
+    Ok(())
+}
+
+/// The panel's y range and band levels: (y0, y1, WATCH level, FAULT level).
+fn panel_range(
+    series: &[PlotLine],
+    motors: &[&MotorTrend],
+    opts: &TrendOptions,
+    column: &str,
+    in_scatters: bool,
+) -> (f64, f64, f64, Option<f64>) {
+    let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &(_, y) in series.iter().flat_map(|s| s.1.iter()) {
+        if y.is_finite() {
+            y0 = y0.min(y);
+            y1 = y1.max(y);
+        }
+    }
+    let (watch, fault) = if in_scatters {
+        (opts.k_scatter, None)
+    } else {
+        let mut lv: Vec<f64> = motors
+            .iter()
+            .filter_map(|m| m.indicators.iter().find(|t| t.indicator == column))
+            .filter_map(|t| t.fault_level)
+            .collect();
+        let f = monitor_store::trend::stats::median(&mut lv).map(|x| 100.0 * x);
+        (f.map_or(f64::INFINITY, |f| 0.5 * f), f)
+    };
+    if !y0.is_finite() {
+        (y0, y1) = (-1.0, 1.0);
+    }
+    y1 = y1.max(fault.map_or(watch, |f| 1.15 * f));
+    if in_scatters {
+        y0 = y0.min(-1.3 * watch);
+        y1 = y1.max(1.3 * watch);
+    } else {
+        y0 = y0.min(0.0);
+    }
+    let pad = 0.04 * (y1 - y0).max(1e-9);
+    (y0 - pad, y1 + pad, watch, fault)
+}
+
+/// Draws panel `k` (indicator `panel`) of the motors' lines with its bands.
+fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    motors: &[&MotorTrend],
+    opts: &TrendOptions,
+    &(column, title, in_scatters): &(&str, &str, bool),
+    k: usize,
+    t0: f64,
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    let series: Vec<PlotLine> = motors
+        .iter()
+        .enumerate()
+        .filter_map(|(i, m)| {
+            let t = m.indicators.iter().find(|t| t.indicator == column)?;
+            Some((m.motor.clone(), points(t, in_scatters, t0), i))
+        })
+        .collect();
+    let x1 = series
+        .iter()
+        .flat_map(|s| s.1.iter().map(|p| p.0))
+        .fold(1.0f64, f64::max);
+    let (y0, y1, watch, fault) = panel_range(&series, motors, opts, column, in_scatters);
+    let caption = if k == 0 {
+        format!("{title}; days from {}", monitor_store::trend::day_of(t0))
+    } else {
+        title.to_string()
+    };
+    let mut chart = ChartBuilder::on(area)
+        .margin(8)
+        .caption(caption, ("sans-serif", 16))
+        .x_label_area_size(28)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0.0..x1, y0..y1)
+        .map_err(e)?;
+    let rect = |lo: f64, hi: f64, c: RGBColor| Rectangle::new([(0.0, lo), (x1, hi)], c.filled());
+    let bands = if in_scatters {
+        [
+            rect(y0, -watch, WATCH),
+            rect(-watch, watch, OK),
+            rect(watch, y1, WATCH),
+        ]
+    } else {
+        let (w, f) = (watch.min(y1), fault.unwrap_or(y1).min(y1));
+        [rect(y0, w, OK), rect(w, f, WATCH), rect(f, y1, FAULT)]
+    };
+    chart.draw_series(bands).map_err(e)?;
+    chart
+        .configure_mesh()
+        .x_desc(if k + 1 == PANELS.len() { "day" } else { "" })
+        .light_line_style(WHITE.mix(0.0))
+        .draw()
+        .map_err(e)?;
+    draw_lines(&mut chart, series, k == 0)
+}
+
+/// Draws the motors' lines (points joined) and, with `legend`, the legend.
+fn draw_lines<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    series: Vec<PlotLine>,
+    legend: bool,
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    for (name, pts, i) in series {
+        let col = PALETTE[i % PALETTE.len()];
+        chart
+            .draw_series(pts.iter().map(|&p| Circle::new(p, 2, col.filled())))
+            .map_err(e)?;
+        let a = chart
+            .draw_series(LineSeries::new(pts, col.stroke_width(2)))
+            .map_err(e)?;
+        if legend {
+            a.label(name).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], col.stroke_width(2))
+            });
+        }
+    }
+    if legend {
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(e)?;
+    }
     Ok(())
 }
