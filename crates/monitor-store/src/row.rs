@@ -334,6 +334,27 @@ impl StoredRow {
     }
 }
 
+impl StoredRow {
+    /// A row from its JSON object (the one [`StoredRow`]'s `Serialize` writes: keyed by
+    /// the columns' names; a missing key is null), or `None` when a value has the wrong
+    /// type or `log_id` is missing.
+    pub fn from_json(v: &Value) -> Option<Self> {
+        let obj = v.as_object()?;
+        let cells: Option<Vec<Cell>> = COLUMNS
+            .iter()
+            .map(|c| match (obj.get(c.name), c.kind) {
+                (None | Some(Value::Null), _) => Some(Cell::Null),
+                (Some(Value::String(s)), Kind::Text) => Some(Cell::Text(s.clone())),
+                (Some(x), Kind::Int) => x.as_i64().map(Cell::Int),
+                (Some(x), Kind::Real) => x.as_f64().map(Cell::Real),
+                _ => None,
+            })
+            .collect();
+        let row = StoredRow { cells: cells? };
+        (!row.log_id().is_empty()).then_some(row)
+    }
+}
+
 /// The cells after the identity's, from the report `doc` (in [`COLUMNS`]' order).
 fn report_cells(doc: &Value) -> Vec<Cell> {
     let num = |p: &str| {
@@ -513,5 +534,8 @@ mod tests {
         assert_eq!(r.f64("heating_explains"), Some(1.0));
         assert_eq!(r.f64("rows"), Some(4000.0));
         assert_eq!(r.get("isolation_named"), &Cell::Null);
+        let back = StoredRow::from_json(&serde_json::to_value(&r).unwrap()).unwrap();
+        assert_eq!(back, r);
+        assert!(StoredRow::from_json(&serde_json::json!({"log_id": 3})).is_none());
     }
 }

@@ -178,8 +178,16 @@ fn print_table(
             for t in &m.indicators {
                 writeln!(out, "    {}", t.sentence)?;
             }
-            if let Some(t) = m.indicators.first() {
-                writeln!(out, "    normalisation: {}", t.normalisation)?;
+            // Each normalisation once, with the indicators it applies to.
+            let mut seen: Vec<(&str, Vec<&str>)> = Vec::new();
+            for t in &m.indicators {
+                match seen.iter_mut().find(|(n, _)| *n == t.normalisation) {
+                    Some((_, v)) => v.push(&t.indicator),
+                    None => seen.push((&t.normalisation, vec![&t.indicator])),
+                }
+            }
+            for (n, v) in seen {
+                writeln!(out, "    {}: {n}", v.join(", "))?;
             }
         }
     }

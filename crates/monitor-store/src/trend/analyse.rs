@@ -247,7 +247,7 @@ pub fn indicator_trend(
         label: ind.label.to_string(),
         unit: ind.unit.to_string(),
         direction: ind.direction,
-        logs: series.len(),
+        logs: series.iter().filter(|p| p.in_window).count(),
         slope_per_day: None,
         slope_low: None,
         slope_high: None,
@@ -287,10 +287,11 @@ fn series_of(
                 }
                 None => value,
             };
-            (t >= start_s - 1.0).then_some(TrendPoint {
+            Some(TrendPoint {
                 t_days: t / DAY_S,
                 value,
                 normalised,
+                in_window: t >= start_s - 1.0,
             })
         })
         .collect()
@@ -311,19 +312,20 @@ fn fault_level_of(ind: &Indicator, rows: &[&StoredRow]) -> Option<f64> {
 /// The slope, scatter, alarm, projection and sentence of `t` from its series.
 fn judge(t: &mut IndicatorTrend, ind: &Indicator, opts: &TrendOptions, end_days: f64) {
     let name = ind.column;
-    if t.series.len() < opts.min_logs.max(3) {
+    let window: Vec<&TrendPoint> = t.series.iter().filter(|p| p.in_window).collect();
+    if window.len() < opts.min_logs.max(3) {
         t.sentence = format!(
             "{name}: {} logs in the last {} days, too few for a trend (at least {})",
-            t.series.len(),
+            window.len(),
             opts.window_days,
             opts.min_logs.max(3)
         );
         return;
     }
     // Days from the window's first point (the slope's scale does not depend on it).
-    let t0 = t.series.first().map_or(0.0, |p| p.t_days);
-    let x: Vec<f64> = t.series.iter().map(|p| p.t_days - t0).collect();
-    let y: Vec<f64> = t.series.iter().map(|p| p.normalised).collect();
+    let t0 = window.first().map_or(0.0, |p| p.t_days);
+    let x: Vec<f64> = window.iter().map(|p| p.t_days - t0).collect();
+    let y: Vec<f64> = window.iter().map(|p| p.normalised).collect();
     let Some(line) = theil_sen(&x, &y, opts.confidence) else {
         t.sentence = format!("{name}: all logs at one time, no slope");
         return;

@@ -199,6 +199,8 @@ pub struct TrendPoint {
     pub value: f64,
     /// The value at the reference operating point (the value itself where not normalised).
     pub normalised: f64,
+    /// In the window the slope is taken over.
+    pub in_window: bool,
 }
 
 /// One indicator's trend for one motor (JSON: `sim-host trend --json`'s `indicators`).
@@ -212,7 +214,7 @@ pub struct IndicatorTrend {
     pub unit: String,
     /// Which way a fault moves it.
     pub direction: Direction,
-    /// Logs in the window.
+    /// Logs in the window (with a value of the indicator).
     pub logs: usize,
     /// Theil-Sen's slope [unit/day] (null with too few logs).
     pub slope_per_day: Option<f64>,
@@ -236,7 +238,7 @@ pub struct IndicatorTrend {
     pub normalisation: String,
     /// One sentence: "i2_over_i1 rising 0.21 %/week (0.15-0.30), FAULT level in about 9 days".
     pub sentence: String,
-    /// The window's points.
+    /// The motor's points, the window's marked.
     pub series: Vec<TrendPoint>,
 }
 

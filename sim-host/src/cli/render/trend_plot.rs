@@ -76,9 +76,15 @@ pub fn write(path: &Path, motors: &[MotorTrend], opts: &TrendOptions) -> Result<
             .parent()
             .filter(|d| !d.as_os_str().is_empty())
             .unwrap_or(Path::new("."));
-        let tmp = tempfile::Builder::new()
-            .prefix(".sim-host-")
-            .suffix(".png")
+        let mut b = tempfile::Builder::new();
+        b.prefix(".sim-host-").suffix(".png");
+        // The mode of any new file (0o666 less the umask), as the SVG gets.
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            b.permissions(std::fs::Permissions::from_mode(0o666));
+        }
+        let tmp = b
             .tempfile_in(dir)
             .map_err(|e| format!("{}: {e}", dir.display()))?;
         {
