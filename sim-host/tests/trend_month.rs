@@ -15,8 +15,8 @@
 //!
 //! Asserted (issue 53's bar): each faulty motor is trend-alarmed at least 5 days before the
 //! first single log whose verdict is FAULT (or within the month where no log's verdict is
-//! FAULT); no healthy motor raises a trend alarm on any day. The second half is not met
-//! yet: its test is ignored, with the reason. Set `MONITOR_MONTH_STORE=PATH` to keep the
+//! FAULT); no healthy motor raises a trend alarm on any day. Four more months, each with
+//! its own noise, under `MONITOR_FULL_SWEEPS=1`. Set `MONITOR_MONTH_STORE=PATH` to keep the
 //! month's store (the docs' plot: `sim-host trend --store PATH --plot ...`).
 
 mod small_motor;
@@ -168,21 +168,16 @@ fn first_alarm(rows: &[StoredRow], motor: &str) -> Option<(u32, Vec<String>)> {
 /// and the first trend alarm's day with its indicators.
 type Outcome = Vec<(String, Health, Option<u32>, Option<(u32, Vec<String>)>)>;
 
-fn the_month() -> Outcome {
+fn the_month(seed: u64) -> Outcome {
     let started = std::time::Instant::now();
     let motors = motors();
+    let seed0 = seed;
     let cases: Vec<(usize, u32)> = (0..motors.len())
         .flat_map(|m| (1..=DAYS).map(move |d| (m, d)))
         .collect();
     let rows: Vec<StoredRow> = cases
         .par_iter()
-        .map(|&(m, day)| {
-            judge(
-                &motors[m],
-                day,
-                5_300_000 + 1000 * m as u64 + u64::from(day),
-            )
-        })
+        .map(|&(m, day)| judge(&motors[m], day, seed0 + 1000 * m as u64 + u64::from(day)))
         .collect();
     let dir = tempfile::tempdir().expect("tmp");
     let path = match std::env::var_os("MONITOR_MONTH_STORE") {
@@ -232,56 +227,46 @@ fn early(alarm: &Option<(u32, Vec<String>)>, fault: Option<u32>) -> bool {
     }
 }
 
-/// What is met: the growing short is trend-alarmed (on |I2w|/|I1|) at least 5 days before
-/// the first log whose verdict is FAULT, the loosening connection within the month (no log
-/// of it is FAULT), and no healthy motor's |I2w|/|I1| raises an alarm.
-#[test]
-fn a_growing_short_and_a_loosening_connection_are_alarmed_on_the_trend() {
-    let month = the_month();
-    let loose = month
-        .iter()
-        .find(|m| m.1 == Health::Loosening)
-        .expect("loose");
-    assert!(
-        early(&loose.3, loose.2),
-        "loosening: alarm {:?}, FAULT {:?}",
-        loose.3,
-        loose.2
-    );
-    let short = month.iter().find(|m| m.1 == Health::Short).expect("short");
-    assert!(
-        early(&short.3, short.2),
-        "short: alarm {:?}, FAULT {:?}",
-        short.3,
-        short.2
-    );
-    let on_i2 = |a: &Option<(u32, Vec<String>)>| {
-        a.as_ref()
-            .is_some_and(|a| a.1.iter().any(|s| s.starts_with("i2_over_i1")))
-    };
-    assert!(on_i2(&short.3));
-    let false_i2: Vec<&String> = month
-        .iter()
-        .filter(|m| m.1 == Health::Healthy && on_i2(&m.3))
-        .map(|m| &m.0)
-        .collect();
-    assert!(false_i2.is_empty(), "{false_i2:?}");
-}
-
-/// The whole of issue 53's bar, not met yet: three of the ten healthy motors raise a trend
-/// alarm late in the month (a parity residual whose operating-point fit leaves a drift, on
-/// day 22; a 2.2 kW motor's rotor sideband on day 26): docs/trend.md, "Limits".
-#[test]
-#[ignore = "issue 53's full bar is not met: see docs/trend.md, Limits"]
-fn a_month_of_daily_logs_alarms_every_fault_and_no_healthy_motor() {
-    let month = the_month();
-    let bad: Vec<String> = month
+/// Issue 53's bar on one month: each faulty motor alarmed early, no healthy motor alarmed,
+/// the short on its negative sequence.
+fn check(month: &Outcome) -> Vec<String> {
+    let mut bad: Vec<String> = month
         .iter()
         .filter(|m| match m.1 {
             Health::Healthy => m.3.is_some(),
             _ => !early(&m.3, m.2),
         })
         .map(|m| format!("{} ({:?}): alarm {:?}, FAULT {:?}", m.0, m.1, m.3, m.2))
+        .collect();
+    let on_i2 = |a: &Option<(u32, Vec<String>)>| {
+        a.as_ref()
+            .is_some_and(|a| a.1.iter().any(|s| s.starts_with("i2_over_i1")))
+    };
+    if !month.iter().any(|m| m.1 == Health::Short && on_i2(&m.3)) {
+        bad.push("the short is not alarmed on |I2w|/|I1|".into());
+    }
+    bad
+}
+
+#[test]
+fn a_month_of_daily_logs_alarms_each_fault_early_and_no_healthy_motor() {
+    let bad = check(&the_month(5_300_000));
+    assert!(bad.is_empty(), "{bad:#?}");
+}
+
+/// Four more months, each with its own noise (`MONITOR_FULL_SWEEPS=1`, about 20 s).
+#[test]
+fn four_more_months_of_noise_meet_the_same_bar() {
+    if std::env::var("MONITOR_FULL_SWEEPS").map_or(true, |v| v != "1") {
+        eprintln!("four more months: skipped (MONITOR_FULL_SWEEPS=1 runs them)");
+        return;
+    }
+    let bad: Vec<String> = (1..=4)
+        .flat_map(|k| {
+            check(&the_month(k))
+                .into_iter()
+                .map(move |b| format!("seed {k}: {b}"))
+        })
         .collect();
     assert!(bad.is_empty(), "{bad:#?}");
 }

@@ -103,6 +103,8 @@ struct OperatingFit {
     centre: Vec<f64>,
     /// The coefficients of [`features`] (the intercept and time's left out).
     coef: Vec<f64>,
+    /// The scatter of the fit's residuals over all the motor's logs (1.4826 MAD).
+    scatter: f64,
 }
 
 impl OperatingFit {
@@ -183,14 +185,31 @@ fn fit_operating_point(
     let all = least_squares(&xs, &ys)?;
     let n = feature_count(covs.len());
     let coef = all.get(1..=n)?.to_vec();
-    Some(OperatingFit { centre, coef })
+    let resid: Vec<f64> = xs
+        .iter()
+        .zip(&ys)
+        .map(|(x, y)| {
+            let fitted: f64 = all.first().copied().unwrap_or_default()
+                + x.iter()
+                    .zip(all.iter().skip(1))
+                    .map(|(a, b)| a * b)
+                    .sum::<f64>();
+            y - fitted
+        })
+        .collect();
+    let scatter = mad_sigma(&resid).unwrap_or_default();
+    Some(OperatingFit {
+        centre,
+        coef,
+        scatter,
+    })
 }
 
 /// The fewest logs the operating-point fit is made on: three per coefficient (the
 /// intercept, each feature, time). With fewer, an indicator that has covariates gives no
 /// alarm: a trend cannot yet be told from the operating point's moves.
 pub fn fit_logs(covs: &[&str]) -> usize {
-    3 * (feature_count(covs.len()) + 2)
+    4 * (feature_count(covs.len()) + 2)
 }
 
 /// The covariate set `ind` is normalised on for these rows: the first of its sets that
@@ -261,7 +280,13 @@ pub fn indicator_trend(
         sentence: String::new(),
         series,
     };
-    judge(&mut t, ind, opts, end_s / DAY_S);
+    judge(
+        &mut t,
+        ind,
+        opts,
+        end_s / DAY_S,
+        fit.as_ref().map_or(0.0, |f| f.scatter),
+    );
     if fit.is_none() && !covs.is_empty() && rows.len() < fit_logs(covs) {
         t.alarm = false;
     }
@@ -310,7 +335,7 @@ fn fault_level_of(ind: &Indicator, rows: &[&StoredRow]) -> Option<f64> {
 }
 
 /// The slope, scatter, alarm, projection and sentence of `t` from its series.
-fn judge(t: &mut IndicatorTrend, ind: &Indicator, opts: &TrendOptions, end_days: f64) {
+fn judge(t: &mut IndicatorTrend, ind: &Indicator, opts: &TrendOptions, end_days: f64, floor: f64) {
     let name = ind.column;
     let window: Vec<&TrendPoint> = t.series.iter().filter(|p| p.in_window).collect();
     if window.len() < opts.min_logs.max(3) {
@@ -339,6 +364,7 @@ fn judge(t: &mut IndicatorTrend, ind: &Indicator, opts: &TrendOptions, end_days:
     // slope infinitely many scatters.
     let scatter = mad_sigma(&resid)
         .unwrap_or_default()
+        .max(floor)
         .max(1e-9 * y.iter().map(|v| v.abs()).fold(0.0, f64::max))
         .max(f64::MIN_POSITIVE);
     let span = x.last().copied().unwrap_or_default();
