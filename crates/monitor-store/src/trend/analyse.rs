@@ -205,7 +205,7 @@ fn fit_operating_point(
     })
 }
 
-/// The fewest logs the operating-point fit is made on: three per coefficient (the
+/// The fewest logs the operating-point fit is made on: four per coefficient (the
 /// intercept, each feature, time). With fewer, an indicator that has covariates gives no
 /// alarm: a trend cannot yet be told from the operating point's moves.
 pub fn fit_logs(covs: &[&str]) -> usize {
@@ -237,19 +237,7 @@ pub fn indicator_trend(
 ) -> IndicatorTrend {
     let covs = covariates_of(ind, rows);
     let fit = fit_operating_point(ind, covs, rows);
-    let normalisation = match &fit {
-        Some(_) => format!(
-            "brought to the median {} (least squares, second order in them, with time, over the motor's {} logs)",
-            covs.join(" and "),
-            rows.len()
-        ),
-        None if !covs.is_empty() && rows.len() < fit_logs(covs) => format!(
-            "not yet: {} logs, the operating-point fit needs {}; no alarm until then",
-            rows.len(),
-            fit_logs(covs)
-        ),
-        None => "raw values (an operating point that does not vary)".to_string(),
-    };
+    let normalisation = normalisation_of(fit.is_some(), covs, rows.len());
     let end_s = rows
         .last()
         .and_then(|r| r.f64("log_time_s"))
@@ -291,6 +279,23 @@ pub fn indicator_trend(
         t.alarm = false;
     }
     t
+}
+
+/// What the report says of the normalisation (`fitted` or not, on `covs`, over `n` logs).
+fn normalisation_of(fitted: bool, covs: &[&str], n: usize) -> String {
+    if fitted {
+        format!(
+            "brought to the median {} (least squares, second order in them, with time, over the motor's {n} logs)",
+            covs.join(" and ")
+        )
+    } else if !covs.is_empty() && n < fit_logs(covs) {
+        format!(
+            "not yet: {n} logs, the operating-point fit needs {}; no alarm until then",
+            fit_logs(covs)
+        )
+    } else {
+        "raw values (an operating point that does not vary)".to_string()
+    }
 }
 
 /// The indicator's points from `start_s` on, normalised with `fit` where there is one.
@@ -383,19 +388,22 @@ fn judge(t: &mut IndicatorTrend, ind: &Indicator, opts: &TrendOptions, end_days:
     t.scatter = Some(scatter);
     t.moves_scatters = Some(moves);
     t.last = Some(last);
-    // At or past the level already: 0 days.
-    t.days_to_fault = t.fault_level.and_then(|lvl| {
-        if last >= lvl {
-            return Some(0.0);
-        }
-        let d = (lvl - last) / line.slope;
-        (d.is_finite() && line.slope > 0.0).then_some(d)
-    });
+    t.days_to_fault = t.fault_level.and_then(|lvl| days_to(lvl, last, line.slope));
     // With a FAULT level, a slope that would take longer than the horizon to reach it is
     // not worth a visit, however significant.
     let soon = t.fault_level.is_none() || t.days_to_fault.is_some_and(|d| d <= opts.horizon_days);
     t.alarm = ind.alarms && significant && big && soon;
     t.sentence = sentence(t, ind, &line, span);
+}
+
+/// The days until a line at `last` rising by `slope` a day reaches `level`: 0 at or past
+/// it, none where it does not head there.
+fn days_to(level: f64, last: f64, slope: f64) -> Option<f64> {
+    if last >= level {
+        return Some(0.0);
+    }
+    let d = (level - last) / slope;
+    (d.is_finite() && slope > 0.0).then_some(d)
 }
 
 /// "i2_over_i1 rising 0.36 % of I1/week (0.14 to 0.68), 3.3 scatters over 14 days: TREND
