@@ -249,8 +249,8 @@ pub struct LogIdentity {
 
 impl LogIdentity {
     /// The identity of the log file at `path` as motor `motor`'s: the hash of its bytes
-    /// (read in 1 MiB pieces) and its time, the file's modification time (the log formats
-    /// read here carry no start time of their own; docs/trend.md).
+    /// (read in 1 MiB pieces) and its time, the file's modification time (the log reader
+    /// exposes no absolute start time; docs/trend.md).
     ///
     /// # Errors
     /// The file cannot be read or has no modification time.
