@@ -27,7 +27,9 @@ Errors
     from the message. No Rust panic crosses into Python.
     The GIL is released while the library runs, so threads (and Dask) run in parallel.
 
-The fleet run over many motors' logs on Dask is :func:`drive_monitor.fleet.diagnose_many`.
+The fleet run over many motors' logs on Dask is :func:`drive_monitor.fleet.diagnose_many`;
+with ``store=`` it keeps each motor's history, whose trend :func:`trend` reads
+(:mod:`drive_monitor.history`).
 """
 
 from __future__ import annotations
@@ -47,6 +49,7 @@ from ._native import (
     OptionError,
     ParamsError,
 )
+from .history import Trend, trend
 from ._results import (
     CompareResult,
     DiagnoseResult,
@@ -57,6 +60,8 @@ from ._results import (
 )
 
 __all__ = [
+    "trend",
+    "Trend",
     "diagnose",
     "compare",
     "explain",

@@ -10,6 +10,11 @@ Each log is one Dask task: the worker fetches it (any fsspec URL: ``s3://``, ``g
 ``abfs://``, ``http(s)://``; local paths as they are), runs the library's diagnosis (the GIL
 released) and returns the row. A bad file is a row with its ``error``; the run never fails for
 one log. The scheduling, retries and placement are Dask's.
+
+With ``store=PATH`` each judged log is also kept in the motors' history (the store
+``sim-host fleet --store`` writes; :func:`drive_monitor.trend` reads it): the workers return
+the rows, and the client appends them as they come, in one place (one writer, one
+transaction per log), skipping logs already stored.
 """
 
 from __future__ import annotations
@@ -170,12 +175,82 @@ def _row(log: str, table_toml: str, base: str, storage_options: Optional[Dict[st
             os.remove(tmp)
 
 
+def _remote_time(log: str, storage_options: Optional[Dict[str, Any]]) -> Optional[int]:
+    """A remote log's modification time [s since 1970 UTC], where its store says one."""
+    try:
+        import fsspec
+
+        fs, path = fsspec.core.url_to_fs(log, **(storage_options or {}))
+        info = fs.info(path)
+    except Exception:  # no time: the fetched copy's own
+        return None
+    for key in ("mtime", "LastModified", "last_modified", "updated", "created"):
+        v = info.get(key)
+        if v is None:
+            continue
+        if hasattr(v, "timestamp"):
+            return int(v.timestamp())
+        try:
+            return int(float(v))
+        except (TypeError, ValueError):
+            continue
+    return None
+
+
+def _store_row(
+    log: str, table_toml: str, base: str, storage_options: Optional[Dict[str, Any]]
+) -> Dict[str, Any]:
+    """One log's fleet row and store row, on a worker (never raises)."""
+    local = log[len("file://"):] if log.startswith("file://") else log
+    tmp = None
+    try:
+        time_s = None
+        if _is_remote(log):
+            import fsspec
+
+            time_s = _remote_time(log, storage_options)
+            suffix = Path(log.split("?", 1)[0]).suffix
+            fd, tmp = tempfile.mkstemp(suffix=suffix, prefix="drive_monitor_fleet_")
+            os.close(fd)
+            with fsspec.open(log, "rb", **(storage_options or {})) as src, open(tmp, "wb") as dst:
+                while True:
+                    chunk = src.read(1 << 22)
+                    if not chunk:
+                        break
+                    dst.write(chunk)
+            local = tmp
+        return json.loads(_native.fleet_store_row(table_toml, base, local, log, time_s))
+    except Exception as e:
+        row = {c: None for c in COLUMNS}
+        row.update(motor="", file=log, error=f"{type(e).__name__}: {e}")
+        return {"row": row, "stored": None}
+    finally:
+        if tmp is not None and os.path.exists(tmp):
+            os.remove(tmp)
+
+
+def _gather_into_store(client: Any, futures: List[Any], store: str) -> List[Dict[str, Any]]:
+    """The workers' rows in the logs' order, each store row appended as its log finishes
+    (here, in the client: the store's one writer)."""
+    from dask.distributed import as_completed
+
+    index = {f.key: i for i, f in enumerate(futures)}
+    rows: List[Optional[Dict[str, Any]]] = [None] * len(futures)
+    for fut in as_completed(futures):
+        out = fut.result()
+        rows[index[fut.key]] = out["row"]
+        if out["stored"] is not None:
+            _native.store_append(store, json.dumps([out["stored"]]))
+    return [r for r in rows if r is not None]
+
+
 def diagnose_many(
     logs: Union[str, Sequence[str]],
     motors: Any,
     client: Any = None,
     storage_options: Optional[Dict[str, Any]] = None,
     base: Optional[Union[str, "os.PathLike[str]"]] = None,
+    store: Optional[Union[str, "os.PathLike[str]"]] = None,
 ) -> "pd.DataFrame":
     """Diagnose many motors' logs on a Dask cluster; one row per log.
 
@@ -194,6 +269,11 @@ def diagnose_many(
     base : path, optional
         The folder the motor table's relative paths start from (default: the table file's
         folder, or the working directory for rows).
+    store : path, optional
+        Also append each judged log to this store of the motors' history (SQLite, and its
+        Parquet mirror in ``store + ".parquet"``), in the client as the logs finish; a log
+        already stored is not stored twice. Its motor is the table's name, its time the
+        file's modification time (docs/trend.md).
 
     Returns
     -------
@@ -225,14 +305,17 @@ def diagnose_many(
         client = Client(cluster)
     try:
         futures = client.map(
-            _row,
+            _row if store is None else _store_row,
             paths,
             table_toml=table,
             base=os.fspath(base),
             storage_options=storage_options,
             pure=False,
         )
-        rows = client.gather(futures)
+        if store is None:
+            rows = client.gather(futures)
+        else:
+            rows = _gather_into_store(client, futures, os.fspath(store))
     finally:
         if own:
             client.close()

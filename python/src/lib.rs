@@ -16,6 +16,7 @@ use pyo3::prelude::*;
 use std::path::PathBuf;
 
 mod arrow_in;
+mod store;
 
 create_exception!(
     _native,
@@ -463,5 +464,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fleet_columns, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_read_table, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_check_table, m)?)?;
+    m.add_function(wrap_pyfunction!(store::fleet_store_row, m)?)?;
+    m.add_function(wrap_pyfunction!(store::store_append, m)?)?;
+    m.add_function(wrap_pyfunction!(store::store_trend, m)?)?;
+    m.add_function(wrap_pyfunction!(store::store_columns, m)?)?;
     Ok(())
 }

@@ -382,6 +382,7 @@ fn every_command_has_a_help_that_teaches() {
         "bench",
         "hmi",
         "params from-nameplate",
+        "trend",
     ] {
         let o = bin()
             .args(cmd.split(' ').chain(["--help"]))

@@ -331,15 +331,35 @@ pub fn row_shown(table: &MotorTable, log: &Path, shown: &str) -> FleetRow {
     r
 }
 
-/// The row of `log` as motor `m`'s.
-pub fn row_for(m: &MotorEntry, log: &Path) -> FleetRow {
-    let req = DiagnoseRequest {
+/// The row of one log as [`row`] gives it, and the diagnosis's JSON document (the one
+/// `diagnose --json` prints; `None` where the log gave no report): what a store of the
+/// motor's history keeps (`monitor_store::StoredRow::from_diagnose`).
+pub fn row_and_report(table: &MotorTable, log: &Path) -> (FleetRow, Option<serde_json::Value>) {
+    let Some(m) = table.motor_of(log) else {
+        return (row(table, log), None);
+    };
+    match diagnose(ParamsSource::Path(&m.params), log, &request(m), &mut |_| {}) {
+        Ok(d) => (
+            FleetRow::of_report(&m.name, log, &d.report),
+            serde_json::to_value(&d.report).ok(),
+        ),
+        Err(e) => (FleetRow::failed(&m.name, log, one_line_error(&e)), None),
+    }
+}
+
+/// The diagnosis request of motor `m`'s logs.
+fn request(m: &MotorEntry) -> DiagnoseRequest {
+    DiagnoseRequest {
         commission: m.commission.map(|[a, b]| (a, b)),
         baseline: m.baseline.iter().map(LogSource::from).collect(),
         load: m.load.map_or(LoadModel::Unknown, MotorLoad::model),
         ..DiagnoseRequest::default()
-    };
-    match diagnose(ParamsSource::Path(&m.params), log, &req, &mut |_| {}) {
+    }
+}
+
+/// The row of `log` as motor `m`'s.
+pub fn row_for(m: &MotorEntry, log: &Path) -> FleetRow {
+    match diagnose(ParamsSource::Path(&m.params), log, &request(m), &mut |_| {}) {
         Ok(d) => FleetRow::of_report(&m.name, log, &d.report),
         Err(e) => FleetRow::failed(&m.name, log, one_line_error(&e)),
     }

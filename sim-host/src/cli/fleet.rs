@@ -13,14 +13,19 @@ use std::path::PathBuf;
     long_about = "Diagnose many logs of many motors on this machine, in parallel, and print one row \
 per log: motor, file, rows, rate_hz, verdict, fault, size, phase, confidence, \
 first_detection_s, load_moves, data_quality, error. A bad file is a row with its error, never a \
-failed run.\n\nThe motor table (TOML) says which parameter file, commissioning window, healthy \
+failed run.\n\nWith --store PATH each judged log is also appended to a store of the motors' \
+history (SQLite at PATH, one transaction per log, and a Parquet mirror in PATH.parquet/, \
+partitioned by motor and day): its motor is the table's name for it, its time the file's \
+modification time. A log already stored (the same bytes at the same path) is skipped, not \
+judged again; a run killed mid-way loses no stored row, and the next run finishes it. Read the \
+store with `sim-host trend --store PATH` (docs/trend.md).\n\nThe motor table (TOML) says which parameter file, commissioning window, healthy \
 baseline and load belong to which motor, and which logs are its (a pattern on the file name; \
 paths relative to the table's folder):\n\n  [[motor]]\n  name = \"pump_7\"\n  params = \
 \"params/pump_7.toml\"\n  logs = \"pump_7_*\"\n  commission = [2.0, 4.0]   # optional\n  \
 baseline = [\"healthy/pump_7\"]   # optional: healthy logs or folders\n  load = \"unknown\"   # \
 optional: or \"viscous\"\n\nFor hundreds of motors and many machines, the Python package runs the \
 same rows on a Dask cluster (docs/python.md).\n\nExample:\n  sim-host fleet motors.toml logs/*.csv \
---json"
+--json\n  sim-host fleet motors.toml logs/*.csv --store history.db\n  sim-host trend --store history.db"
 )]
 pub struct FleetArgs {
     /// The motor table (TOML).
@@ -31,6 +36,10 @@ pub struct FleetArgs {
     /// Print one JSON document (a list of rows) instead of CSV.
     #[arg(long)]
     pub json: bool,
+    /// Also append each judged log to the store at PATH (SQLite; its Parquet mirror in
+    /// PATH.parquet/), skipping logs already stored.
+    #[arg(long, value_name = "PATH")]
+    pub store: Option<PathBuf>,
 }
 
 /// Runs `fleet`.
@@ -40,11 +49,14 @@ pub struct FleetArgs {
 /// error is its row's).
 pub fn run(args: &FleetArgs) -> anyhow::Result<()> {
     let table = monitor_api::fleet::MotorTable::load(&args.motors)?;
-    let rows: Vec<monitor_api::fleet::FleetRow> = args
-        .logs
-        .par_iter()
-        .map(|log| monitor_api::fleet::row(&table, log))
-        .collect();
+    let rows: Vec<monitor_api::fleet::FleetRow> = match &args.store {
+        Some(path) => super::store_run::judge_into(&table, &args.logs, path)?,
+        None => args
+            .logs
+            .par_iter()
+            .map(|log| monitor_api::fleet::row(&table, log))
+            .collect(),
+    };
     if args.json {
         return render::json::print(&rows);
     }

@@ -19,7 +19,9 @@ mod params_cmd;
 mod progress;
 mod render;
 mod simulate;
+mod store_run;
 mod table1;
+mod trend;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use monitor_core::{AngleSource, EffectKind, Fault, ResidualForm};
@@ -80,6 +82,8 @@ pub enum Cmd {
     Identify(identify::IdentifyArgs),
     // Many motors' logs, one row each.
     Fleet(fleet::FleetArgs),
+    // A motor's history: the trend of its stored logs.
+    Trend(trend::TrendArgs),
     // The shorted-turn level's calibration from labelled runs.
     CalibrateTurns(calibrate_turns::CalibrateTurnsArgs),
 }
@@ -103,6 +107,7 @@ pub fn run(cmd: Cmd) -> anyhow::Result<()> {
         Cmd::Params(a) => params_cmd::run(a),
         Cmd::Identify(a) => identify::run(a),
         Cmd::Fleet(a) => fleet::run(a),
+        Cmd::Trend(a) => trend::run(a),
         Cmd::CalibrateTurns(a) => calibrate_turns::run(a),
     }
 }

@@ -11,3 +11,4 @@ pub mod json;
 pub mod mcsa;
 pub mod plot;
 pub mod text;
+pub mod trend_plot;

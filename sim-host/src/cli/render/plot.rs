@@ -57,7 +57,7 @@ pub const FONT: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");
 ///
 /// # Errors
 /// The embedded font does not parse (not expected: a test draws with it).
-fn register_font() -> Result<(), String> {
+pub fn register_font() -> Result<(), String> {
     static DONE: std::sync::OnceLock<Result<(), String>> = std::sync::OnceLock::new();
     DONE.get_or_init(|| {
         plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)

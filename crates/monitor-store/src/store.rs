@@ -1,0 +1,256 @@
+//! The store itself: an SQLite database (the source of truth, one transaction per log) and
+//! its Parquet mirror partitioned by motor and day.
+
+use crate::mirror;
+use crate::row::{Cell, Kind, StoredRow, COLUMNS};
+use rusqlite::types::{Value as SqlValue, ValueRef};
+use rusqlite::{params_from_iter, Connection, OpenFlags};
+use std::path::{Path, PathBuf};
+
+/// Errors of the store.
+#[derive(Debug, thiserror::Error)]
+pub enum HistoryError {
+    /// SQLite failed (the store cannot be opened, is not a store, or a write failed).
+    #[error("store {path}: {message}")]
+    Sqlite {
+        /// The store's file.
+        path: String,
+        /// SQLite's message.
+        message: String,
+    },
+    /// The Parquet mirror cannot be written.
+    #[error("Parquet mirror {path}: {message}")]
+    Mirror {
+        /// The file or folder.
+        path: String,
+        /// What failed.
+        message: String,
+    },
+    /// Reading a store that does not exist.
+    #[error("no store at {0} (write one with `sim-host fleet ... --store {0}`)")]
+    Missing(String),
+}
+
+/// What [`Store::append`] did with a row.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Appended {
+    /// The row is stored (and mirrored).
+    Stored,
+    /// A row of the same log (`log_id`) was already stored: nothing written.
+    AlreadyStored,
+}
+
+/// A store of judged logs: `PATH` (SQLite) and `PATH.parquet/` (the mirror).
+#[derive(Debug)]
+pub struct Store {
+    conn: Connection,
+    path: PathBuf,
+}
+
+const TABLE: &str = "logs";
+
+impl Store {
+    /// Opens the store at `path`, creating it (and its table) if it does not exist.
+    ///
+    /// # Errors
+    /// [`HistoryError::Sqlite`] when the file cannot be opened or is not an SQLite store of
+    /// this schema.
+    pub fn open(path: &Path) -> Result<Self, HistoryError> {
+        let conn = Connection::open(path).map_err(|e| sql(path, &e))?;
+        let s = Store {
+            conn,
+            path: path.to_path_buf(),
+        };
+        s.init()?;
+        Ok(s)
+    }
+
+    /// Opens an existing store to read it (nothing is created).
+    ///
+    /// # Errors
+    /// [`HistoryError::Missing`] when there is no file at `path`; [`HistoryError::Sqlite`] when
+    /// it is not a store.
+    pub fn open_existing(path: &Path) -> Result<Self, HistoryError> {
+        if !path.is_file() {
+            return Err(HistoryError::Missing(path.display().to_string()));
+        }
+        let conn = Connection::open_with_flags(path, OpenFlags::SQLITE_OPEN_READ_WRITE)
+            .map_err(|e| sql(path, &e))?;
+        let s = Store {
+            conn,
+            path: path.to_path_buf(),
+        };
+        s.check_schema()?;
+        Ok(s)
+    }
+
+    /// The store's SQLite file.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The mirror's folder: the store's path with `.parquet` added.
+    pub fn mirror_dir(&self) -> PathBuf {
+        mirror::dir_of(&self.path)
+    }
+
+    fn init(&self) -> Result<(), HistoryError> {
+        // WAL: a reader (`sim-host trend`) never blocks the writer; synchronous FULL: a
+        // committed row survives a power cut, not only a killed process.
+        let cols: Vec<String> = COLUMNS
+            .iter()
+            .map(|c| {
+                let t = match c.kind {
+                    Kind::Text => "TEXT",
+                    Kind::Int => "INTEGER",
+                    Kind::Real => "REAL",
+                };
+                if c.name == "log_id" {
+                    format!("{} {t} NOT NULL UNIQUE", c.name)
+                } else {
+                    format!("{} {t}", c.name)
+                }
+            })
+            .collect();
+        let ddl = format!(
+            "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL;
+             CREATE TABLE IF NOT EXISTS {TABLE} ({});
+             CREATE INDEX IF NOT EXISTS logs_motor_time ON {TABLE} (motor, log_time_s);",
+            cols.join(", ")
+        );
+        self.conn
+            .execute_batch(&ddl)
+            .map_err(|e| sql(&self.path, &e))?;
+        self.check_schema()
+    }
+
+    fn check_schema(&self) -> Result<(), HistoryError> {
+        let mut st = self
+            .conn
+            .prepare(&format!("SELECT name FROM pragma_table_info('{TABLE}')"))
+            .map_err(|e| sql(&self.path, &e))?;
+        let names: Vec<String> = st
+            .query_map([], |r| r.get(0))
+            .and_then(Iterator::collect)
+            .map_err(|e| sql(&self.path, &e))?;
+        let want: Vec<&str> = COLUMNS.iter().map(|c| c.name).collect();
+        if names != want {
+            return Err(HistoryError::Sqlite {
+                path: self.path.display().to_string(),
+                message: format!(
+                    "not a store of this version (table `{TABLE}` has columns {names:?})"
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// Appends one log's row in one transaction, then writes its Parquet file. A log
+    /// already stored (the same `log_id`) is skipped: [`Appended::AlreadyStored`].
+    ///
+    /// # Errors
+    /// [`HistoryError`] when SQLite or the mirror cannot be written; SQLite's row is then
+    /// either whole or absent, and a missing mirror file is written by
+    /// [`Store::sync_mirror`].
+    pub fn append(&mut self, row: &StoredRow) -> Result<Appended, HistoryError> {
+        let names: Vec<&str> = COLUMNS.iter().map(|c| c.name).collect();
+        let marks = vec!["?"; names.len()].join(", ");
+        let q = format!(
+            "INSERT OR IGNORE INTO {TABLE} ({}) VALUES ({marks})",
+            names.join(", ")
+        );
+        let values = row.cells.iter().map(|c| match c {
+            Cell::Null => SqlValue::Null,
+            Cell::Int(i) => SqlValue::Integer(*i),
+            Cell::Real(x) => SqlValue::Real(*x),
+            Cell::Text(t) => SqlValue::Text(t.clone()),
+        });
+        let tx = self.conn.transaction().map_err(|e| sql(&self.path, &e))?;
+        let n = tx
+            .execute(&q, params_from_iter(values))
+            .map_err(|e| sql(&self.path, &e))?;
+        tx.commit().map_err(|e| sql(&self.path, &e))?;
+        if n == 0 {
+            return Ok(Appended::AlreadyStored);
+        }
+        mirror::write_row(&self.mirror_dir(), row)?;
+        Ok(Appended::Stored)
+    }
+
+    /// Whether a row of the log `log_id` is stored.
+    ///
+    /// # Errors
+    /// [`HistoryError::Sqlite`] when the store cannot be read.
+    pub fn contains(&self, log_id: &str) -> Result<bool, HistoryError> {
+        self.conn
+            .query_row(
+                &format!("SELECT COUNT(*) FROM {TABLE} WHERE log_id = ?1"),
+                [log_id],
+                |r| r.get::<_, i64>(0),
+            )
+            .map(|n| n > 0)
+            .map_err(|e| sql(&self.path, &e))
+    }
+
+    /// The stored rows, by motor and time: only `motor`'s where given, only from
+    /// `since_s` (seconds since 1970-01-01 UTC) on where given.
+    ///
+    /// # Errors
+    /// [`HistoryError::Sqlite`] when the store cannot be read.
+    pub fn rows(
+        &self,
+        motor: Option<&str>,
+        since_s: Option<i64>,
+    ) -> Result<Vec<StoredRow>, HistoryError> {
+        let names: Vec<&str> = COLUMNS.iter().map(|c| c.name).collect();
+        let q = format!(
+            "SELECT {} FROM {TABLE} WHERE (?1 IS NULL OR motor = ?1) AND (?2 IS NULL OR log_time_s >= ?2) ORDER BY motor, log_time_s, log_id",
+            names.join(", ")
+        );
+        let mut st = self.conn.prepare(&q).map_err(|e| sql(&self.path, &e))?;
+        let rows = st
+            .query_map(rusqlite::params![motor, since_s], |r| {
+                let mut cells = Vec::with_capacity(COLUMNS.len());
+                for i in 0..COLUMNS.len() {
+                    cells.push(match r.get_ref(i)? {
+                        ValueRef::Null => Cell::Null,
+                        ValueRef::Integer(v) => Cell::Int(v),
+                        ValueRef::Real(v) => Cell::Real(v),
+                        ValueRef::Text(t) | ValueRef::Blob(t) => {
+                            Cell::Text(String::from_utf8_lossy(t).into_owned())
+                        }
+                    });
+                }
+                Ok(StoredRow { cells })
+            })
+            .and_then(Iterator::collect)
+            .map_err(|e| sql(&self.path, &e))?;
+        Ok(rows)
+    }
+
+    /// Writes the mirror's missing files (a run killed between SQLite's commit and the
+    /// Parquet file's rename) and removes temporary files a killed run left; SQLite is the
+    /// source of truth. Returns how many files were written.
+    ///
+    /// # Errors
+    /// [`HistoryError`] when the store cannot be read or a file cannot be written.
+    pub fn sync_mirror(&self) -> Result<usize, HistoryError> {
+        let dir = self.mirror_dir();
+        mirror::remove_temporaries(&dir)?;
+        let mut written = 0;
+        for row in self.rows(None, None)? {
+            if !mirror::file_of(&dir, &row).is_file() {
+                mirror::write_row(&dir, &row)?;
+                written += 1;
+            }
+        }
+        Ok(written)
+    }
+}
+
+fn sql(path: &Path, e: &rusqlite::Error) -> HistoryError {
+    HistoryError::Sqlite {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    }
+}

@@ -1,0 +1,266 @@
+//! The trend of a motor's indicators across its stored logs, and the alarm on it.
+//!
+//! Per indicator, over the last [`TrendOptions::window_days`] of the motor's logs:
+//!
+//! 1. **Like operating points.** The indicator is brought to the motor's median operating
+//!    point: a least-squares fit of it on the covariates it depends on (the load, as the
+//!    positive-sequence current `i1_peak_a`; the windings' rise `winding_rise_k` the
+//!    isolation read) and on time together, over all the motor's logs, and the covariates'
+//!    part removed (the time term is fitted with them so that they do not take up a trend).
+//!    A season that warms the windings or a load that moves from day to day is then not a
+//!    trend. Where the logs cannot fit the covariates (too few, or a covariate that does
+//!    not vary) the raw values are used; the report says which
+//!    ([`IndicatorTrend::normalisation`]).
+//! 2. **A robust slope.** Theil-Sen's slope per day with Sen's interval
+//!    ([`stats::theil_sen`]), and the indicator's own scatter, 1.4826 x the median absolute
+//!    deviation of the values about the line ([`stats::mad_sigma`]).
+//! 3. **The alarm.** The interval lies wholly on the indicator's bad side of zero (above it
+//!    for a rising indicator; either side for a two-sided one) *and* the line moves the
+//!    indicator by more than [`TrendOptions::k_scatter`] scatters over the window. Either
+//!    alone is not enough: a significant slope far inside the noise is not worth a visit,
+//!    and one large scatter is not a trend. The alarm is raised when it holds on
+//!    [`TrendOptions::confirm_logs`] logs in a row (each judged on the logs up to it).
+//! 4. **The projection.** Where the indicator has a FAULT level (the level at which a
+//!    single log's verdict names the fault), the days until the line reaches it; for such
+//!    an indicator the alarm also needs the line to reach it within
+//!    [`TrendOptions::horizon_days`] (a significant drift far below the level is not worth
+//!    a visit).
+
+pub mod stats;
+
+use serde::Serialize;
+
+/// Which way an indicator moves when a fault grows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Direction {
+    /// Up (the negative sequence, the sideband).
+    Rising,
+    /// Either way (a parity residual).
+    Either,
+}
+
+/// One trended indicator: a store column and what it means.
+#[derive(Debug, Clone, Copy)]
+pub struct Indicator {
+    /// The store column ([`crate::COLUMNS`]).
+    pub column: &'static str,
+    /// A short label for tables and plots.
+    pub label: &'static str,
+    /// Its unit (the store's and the JSON's).
+    pub unit: &'static str,
+    /// The factor from `unit` to the unit sentences show it in.
+    pub scale: f64,
+    /// The unit sentences show it in.
+    pub shown_unit: &'static str,
+    /// Which way a fault moves it.
+    pub direction: Direction,
+    /// Whether its trend raises the alarm (else it is trended and shown only).
+    pub alarms: bool,
+    /// The covariates it is normalised on (store columns): sets in order of preference,
+    /// the first one the motor's logs have used.
+    pub covariates: &'static [&'static [&'static str]],
+    /// The store column holding its FAULT level per log (its median over the reference
+    /// logs is used), or a fixed level, or none.
+    pub fault_level: FaultLevel,
+}
+
+/// Where an indicator's FAULT level comes from.
+#[derive(Debug, Clone, Copy)]
+pub enum FaultLevel {
+    /// No level: the trend alarms, nothing is projected.
+    None,
+    /// A store column's value per log (the median over the motor's logs).
+    Column(&'static str),
+    /// A fixed level in the indicator's unit.
+    Fixed(f64),
+}
+
+/// The load covariate.
+const LOAD: &str = "i1_peak_a";
+/// The temperature covariate where the log has a temperature channel: measured, so it
+/// does not take up a resistance change as the isolation's own reading of the rise does.
+const TEMPERATURE: &str = "winding_temperature_c";
+/// The temperature covariate without a channel: the rise the isolation read from Rs and Rr
+/// together (a loosening connection's Rs partly reads as heating in it).
+const RISE: &str = "winding_rise_k";
+
+/// The indicators trended, in the tables' order.
+///
+/// - `i2_over_i1`: the winding's negative-sequence change (a short grows it); its FAULT
+///   level is the change that names a phase at the winding's FAULT probability
+///   (`unbalance.least_change`, the level `diagnose`'s verdict uses), normalised on load.
+/// - `residual_d`, `residual_q`, `residual_t`: the isolation's parity residuals against the
+///   parameter file (a resistance, inductance or load change moves them), normalised on
+///   load and the windings' rise; trended and shown, **not alarmed**: in the simulated
+///   month their dependence on the season's heating and the load is not linear enough for
+///   this fit, and healthy motors' residuals moved by 4 to 19 scatters in two weeks
+///   (docs/trend.md, "Limits"). No FAULT level (the isolation names a fault from their
+///   direction, not from one level).
+/// - `sideband_db`: the rotor's lower sideband (broken bars grow it), normalised on load;
+///   its FAULT level is -50 dB below the line ... (the usual MCSA rule of thumb for one
+///   broken bar, not a project threshold: docs/trend.md).
+pub const INDICATORS: [Indicator; 5] = [
+    Indicator {
+        column: "i2_over_i1",
+        label: "|I2w|/|I1|",
+        unit: "of I1",
+        scale: 100.0,
+        shown_unit: "% of I1",
+        direction: Direction::Rising,
+        alarms: true,
+        covariates: &[&[LOAD]],
+        fault_level: FaultLevel::Column("i2_least_change"),
+    },
+    Indicator {
+        column: "residual_d",
+        label: "e_d",
+        unit: "pu",
+        scale: 1.0,
+        shown_unit: "pu",
+        direction: Direction::Either,
+        alarms: true,
+        covariates: &[&[LOAD, TEMPERATURE], &[LOAD, RISE]],
+        fault_level: FaultLevel::None,
+    },
+    Indicator {
+        column: "residual_q",
+        label: "e_q",
+        unit: "pu",
+        scale: 1.0,
+        shown_unit: "pu",
+        direction: Direction::Either,
+        alarms: true,
+        covariates: &[&[LOAD, TEMPERATURE], &[LOAD, RISE]],
+        fault_level: FaultLevel::None,
+    },
+    Indicator {
+        column: "residual_t",
+        label: "e_T",
+        unit: "pu",
+        scale: 1.0,
+        shown_unit: "pu",
+        direction: Direction::Either,
+        alarms: true,
+        covariates: &[&[LOAD, TEMPERATURE], &[LOAD, RISE]],
+        fault_level: FaultLevel::None,
+    },
+    Indicator {
+        column: "sideband_db",
+        label: "sideband",
+        unit: "dB",
+        scale: 1.0,
+        shown_unit: "dB",
+        direction: Direction::Rising,
+        alarms: true,
+        covariates: &[&[LOAD]],
+        fault_level: FaultLevel::Fixed(-50.0),
+    },
+];
+
+/// The trend's settings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TrendOptions {
+    /// The window the slope is taken over, ending at the motor's last log [days].
+    pub window_days: f64,
+    /// The interval's two-sided confidence.
+    pub confidence: f64,
+    /// How many scatters the line must move the indicator over the window to alarm.
+    pub k_scatter: f64,
+    /// The fewest logs in the window for a slope.
+    pub min_logs: usize,
+    /// For an indicator with a FAULT level: the alarm needs the line to reach it within
+    /// this many days of the last log.
+    pub horizon_days: f64,
+    /// How many logs in a row (the last and those before it, each judged on the logs up
+    /// to it) must alarm before the alarm is raised.
+    pub confirm_logs: usize,
+}
+
+impl Default for TrendOptions {
+    fn default() -> Self {
+        TrendOptions {
+            window_days: 14.0,
+            confidence: 0.95,
+            k_scatter: 3.0,
+            min_logs: 6,
+            horizon_days: 90.0,
+            confirm_logs: 2,
+        }
+    }
+}
+
+/// One point of an indicator's series.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct TrendPoint {
+    /// Days since 1970-01-01 UTC (fractional).
+    pub t_days: f64,
+    /// The stored value.
+    pub value: f64,
+    /// The value at the reference operating point (the value itself where not normalised).
+    pub normalised: f64,
+    /// In the window the slope is taken over.
+    pub in_window: bool,
+}
+
+/// One indicator's trend for one motor (JSON: `sim-host trend --json`'s `indicators`).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct IndicatorTrend {
+    /// The store column.
+    pub indicator: String,
+    /// Its label.
+    pub label: String,
+    /// Its unit.
+    pub unit: String,
+    /// Which way a fault moves it.
+    pub direction: Direction,
+    /// Logs in the window (with a value of the indicator).
+    pub logs: usize,
+    /// Theil-Sen's slope [unit/day] (null with too few logs).
+    pub slope_per_day: Option<f64>,
+    /// Sen's interval, low end [unit/day].
+    pub slope_low: Option<f64>,
+    /// Its high end [unit/day].
+    pub slope_high: Option<f64>,
+    /// The scatter about the line (1.4826 MAD) [unit].
+    pub scatter: Option<f64>,
+    /// The line's change over the window in scatters (signed): how fast it moves.
+    pub moves_scatters: Option<f64>,
+    /// The line's value at the last log [unit].
+    pub last: Option<f64>,
+    /// The FAULT level [unit], where the indicator has one.
+    pub fault_level: Option<f64>,
+    /// Days from the last log until the line reaches the FAULT level, where it heads there.
+    pub days_to_fault: Option<f64>,
+    /// The trend alarm.
+    pub alarm: bool,
+    /// How the indicator was normalised for the operating point.
+    pub normalisation: String,
+    /// One sentence: "i2_over_i1 rising 0.21 %/week (0.15-0.30), FAULT level in about 9 days".
+    pub sentence: String,
+    /// The motor's points, the window's marked.
+    pub series: Vec<TrendPoint>,
+}
+
+/// One motor's trend (JSON: one element of `sim-host trend --json`'s `motors`).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct MotorTrend {
+    /// The motor.
+    pub motor: String,
+    /// Its logs (all, not only the window's).
+    pub logs: usize,
+    /// The first log's day.
+    pub first_day: String,
+    /// The last log's day.
+    pub last_day: String,
+    /// Any indicator's trend alarm.
+    pub alarm: bool,
+    /// The fastest indicator's |moves_scatters| (the fleet's ranking key).
+    pub fastest_scatters: f64,
+    /// Per indicator.
+    pub indicators: Vec<IndicatorTrend>,
+}
+
+mod analyse;
+
+pub use analyse::{day_of, indicator_trend, motor_trend, trend};

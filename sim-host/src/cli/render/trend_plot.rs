@@ -1,0 +1,263 @@
+//! `sim-host trend --plot`: the motors' indicators over time, one panel per indicator,
+//! with the severity bands drawn (OK green, WATCH amber, FAULT red), written atomically.
+//!
+//! - `|I2w|/|I1|` in % of I1: FAULT from the level at which a single log's verdict names a
+//!   short (the median `unbalance.least_change` of the plotted motors), WATCH from half of
+//!   it, OK below.
+//! - The parity residuals e_d, e_q, e_T in the motor's own scatters from its reference
+//!   (the motor's first logs): OK within ±k scatters, WATCH beyond (they have no FAULT level
+//!   of their own: the isolation names a fault from their direction).
+//!
+//! At most [`MAX_MOTORS`] motors are drawn: the first of the ranking (alarmed first).
+
+use monitor_store::trend::{IndicatorTrend, MotorTrend, TrendOptions};
+use plotters::coord::types::RangedCoordf64;
+use plotters::prelude::*;
+use std::path::Path;
+
+/// The most motors one plot draws.
+pub const MAX_MOTORS: usize = 6;
+
+const PALETTE: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(90, 90, 90),
+];
+const OK: RGBColor = RGBColor(220, 242, 220);
+const WATCH: RGBColor = RGBColor(253, 238, 200);
+const FAULT: RGBColor = RGBColor(250, 215, 215);
+
+/// The panels: indicator column, title, and whether it is drawn in scatters.
+const PANELS: [(&str, &str, bool); 4] = [
+    (
+        "i2_over_i1",
+        "|I2w|/|I1| [% of I1] (a short grows it)",
+        false,
+    ),
+    ("residual_d", "e_d [scatters from the reference]", true),
+    ("residual_q", "e_q [scatters from the reference]", true),
+    ("residual_t", "e_T [scatters from the reference]", true),
+];
+
+/// One motor's line in a panel: its name, points (day, value) and palette index.
+type PlotLine = (String, Vec<(f64, f64)>, usize);
+
+/// One motor's points of one panel: (day, value in the panel's unit).
+fn points(t: &IndicatorTrend, in_scatters: bool, t0: f64) -> Vec<(f64, f64)> {
+    let mut refs: Vec<f64> = t.series.iter().map(|p| p.normalised).collect();
+    let centre = monitor_store::trend::stats::median(&mut refs).unwrap_or_default();
+    let scatter = t.scatter.unwrap_or(1.0).max(f64::MIN_POSITIVE);
+    t.series
+        .iter()
+        .map(|p| {
+            let y = if in_scatters {
+                (p.normalised - centre) / scatter
+            } else {
+                100.0 * p.normalised
+            };
+            (p.t_days - t0, y)
+        })
+        .collect()
+}
+
+/// Draws the plot into `path` (`.svg` or `.png`, by its extension).
+///
+/// # Errors
+/// A drawing or writing error, as one line.
+pub fn write(path: &Path, motors: &[MotorTrend], opts: &TrendOptions) -> Result<(), String> {
+    let shown: Vec<&MotorTrend> = motors.iter().take(MAX_MOTORS).collect();
+    let size = (900u32, 260u32 * PANELS.len() as u32);
+    let png = path.extension().and_then(|e| e.to_str()) == Some("png");
+    if png {
+        let dir = path
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        let mut b = tempfile::Builder::new();
+        b.prefix(".sim-host-").suffix(".png");
+        // The mode of any new file (0o666 less the umask), as the SVG gets.
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            b.permissions(std::fs::Permissions::from_mode(0o666));
+        }
+        let tmp = b
+            .tempfile_in(dir)
+            .map_err(|e| format!("{}: {e}", dir.display()))?;
+        {
+            let root = BitMapBackend::new(tmp.path(), size).into_drawing_area();
+            draw(root, &shown, opts)?;
+        }
+        tmp.persist(path).map_err(|e| e.error.to_string())?;
+        return Ok(());
+    }
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        draw(root, &shown, opts)?;
+    }
+    monitor_io::log::write_atomic(path, svg.as_bytes()).map_err(|e| e.to_string())
+}
+
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, plotters::coord::Shift>,
+    motors: &[&MotorTrend],
+    opts: &TrendOptions,
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    super::plot::register_font()?;
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    root.fill(&WHITE).map_err(e)?;
+    let t0 = motors
+        .iter()
+        .flat_map(|m| m.indicators.iter())
+        .filter_map(|t| t.series.first().map(|p| p.t_days.floor()))
+        .fold(f64::INFINITY, f64::min);
+    let t0 = if t0.is_finite() { t0 } else { 0.0 };
+    let panels = root.split_evenly((PANELS.len(), 1));
+    for (k, (panel, area)) in PANELS.iter().zip(&panels).enumerate() {
+        draw_panel(area, motors, opts, panel, k, t0)?;
+    }
+    root.present().map_err(e)?;
+    Ok(())
+}
+
+/// The panel's y range and band levels: (y0, y1, WATCH level, FAULT level).
+fn panel_range(
+    series: &[PlotLine],
+    motors: &[&MotorTrend],
+    opts: &TrendOptions,
+    column: &str,
+    in_scatters: bool,
+) -> (f64, f64, f64, Option<f64>) {
+    let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &(_, y) in series.iter().flat_map(|s| s.1.iter()) {
+        if y.is_finite() {
+            y0 = y0.min(y);
+            y1 = y1.max(y);
+        }
+    }
+    let (watch, fault) = if in_scatters {
+        (opts.k_scatter, None)
+    } else {
+        let mut lv: Vec<f64> = motors
+            .iter()
+            .filter_map(|m| m.indicators.iter().find(|t| t.indicator == column))
+            .filter_map(|t| t.fault_level)
+            .collect();
+        let f = monitor_store::trend::stats::median(&mut lv).map(|x| 100.0 * x);
+        (f.map_or(f64::INFINITY, |f| 0.5 * f), f)
+    };
+    if !y0.is_finite() {
+        (y0, y1) = (-1.0, 1.0);
+    }
+    y1 = y1.max(fault.map_or(watch, |f| 1.15 * f));
+    if in_scatters {
+        y0 = y0.min(-1.3 * watch);
+        y1 = y1.max(1.3 * watch);
+    } else {
+        y0 = y0.min(0.0);
+    }
+    let pad = 0.04 * (y1 - y0).max(1e-9);
+    (y0 - pad, y1 + pad, watch, fault)
+}
+
+/// Draws panel `k` (indicator `panel`) of the motors' lines with its bands.
+fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    motors: &[&MotorTrend],
+    opts: &TrendOptions,
+    &(column, title, in_scatters): &(&str, &str, bool),
+    k: usize,
+    t0: f64,
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    let series: Vec<PlotLine> = motors
+        .iter()
+        .enumerate()
+        .filter_map(|(i, m)| {
+            let t = m.indicators.iter().find(|t| t.indicator == column)?;
+            Some((m.motor.clone(), points(t, in_scatters, t0), i))
+        })
+        .collect();
+    let x1 = series
+        .iter()
+        .flat_map(|s| s.1.iter().map(|p| p.0))
+        .fold(1.0f64, f64::max);
+    let (y0, y1, watch, fault) = panel_range(&series, motors, opts, column, in_scatters);
+    let caption = if k == 0 {
+        format!("{title}; days from {}", monitor_store::trend::day_of(t0))
+    } else {
+        title.to_string()
+    };
+    let mut chart = ChartBuilder::on(area)
+        .margin(8)
+        .caption(caption, ("sans-serif", 16))
+        .x_label_area_size(28)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0.0..x1, y0..y1)
+        .map_err(e)?;
+    let rect = |lo: f64, hi: f64, c: RGBColor| Rectangle::new([(0.0, lo), (x1, hi)], c.filled());
+    let bands = if in_scatters {
+        [
+            rect(y0, -watch, WATCH),
+            rect(-watch, watch, OK),
+            rect(watch, y1, WATCH),
+        ]
+    } else {
+        let (w, f) = (watch.min(y1), fault.unwrap_or(y1).min(y1));
+        [rect(y0, w, OK), rect(w, f, WATCH), rect(f, y1, FAULT)]
+    };
+    chart.draw_series(bands).map_err(e)?;
+    chart
+        .configure_mesh()
+        .x_desc(if k + 1 == PANELS.len() { "day" } else { "" })
+        .light_line_style(WHITE.mix(0.0))
+        .draw()
+        .map_err(e)?;
+    draw_lines(&mut chart, series, k == 0)
+}
+
+/// Draws the motors' lines (points joined) and, with `legend`, the legend.
+fn draw_lines<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    series: Vec<PlotLine>,
+    legend: bool,
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    for (name, pts, i) in series {
+        let col = PALETTE[i % PALETTE.len()];
+        chart
+            .draw_series(pts.iter().map(|&p| Circle::new(p, 2, col.filled())))
+            .map_err(e)?;
+        let a = chart
+            .draw_series(LineSeries::new(pts, col.stroke_width(2)))
+            .map_err(e)?;
+        if legend {
+            a.label(name).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], col.stroke_width(2))
+            });
+        }
+    }
+    if legend {
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(e)?;
+    }
+    Ok(())
+}
