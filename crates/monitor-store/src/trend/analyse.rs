@@ -275,8 +275,18 @@ pub fn indicator_trend(
         end_s / DAY_S,
         fit.as_ref().map_or(0.0, |f| f.scatter),
     );
-    if fit.is_none() && !covs.is_empty() && rows.len() < fit_logs(covs) {
+    if fit.is_none() && !covs.is_empty() && rows.len() < fit_logs(covs) && t.alarm {
+        // Too few logs to tell a trend from the operating point's moves: no alarm, and the
+        // sentence says so (it never says TREND ALARM where the alarm is not raised).
         t.alarm = false;
+        t.sentence = t.sentence.replace(
+            ": TREND ALARM",
+            &format!(
+                ": no alarm yet ({} logs; the operating-point fit needs {})",
+                rows.len(),
+                fit_logs(covs)
+            ),
+        );
     }
     t
 }
@@ -430,6 +440,7 @@ fn sentence(
         t.moves_scatters.unwrap_or_default(),
     );
     match (t.alarm, t.days_to_fault) {
+        (true, Some(d)) if d < 0.5 => s.push_str(": TREND ALARM, at the FAULT level already"),
         (true, Some(d)) => s.push_str(&format!(": TREND ALARM, FAULT level in about {d:.0} days")),
         (true, None) => s.push_str(": TREND ALARM"),
         (false, Some(d)) if d < 365.0 => s.push_str(&format!(

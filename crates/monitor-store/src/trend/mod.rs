@@ -263,4 +263,4 @@ pub struct MotorTrend {
 
 mod analyse;
 
-pub use analyse::{day_of, indicator_trend, motor_trend, trend};
+pub use analyse::{day_of, fit_logs, indicator_trend, motor_trend, trend};
