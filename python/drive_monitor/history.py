@@ -40,6 +40,7 @@ TREND_COLUMNS: List[str] = [
     "last",
     "fault_level",
     "days_to_fault",
+    "days_to_fault_recent",
     "alarm",
     "normalisation",
     "sentence",

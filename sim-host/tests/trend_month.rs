@@ -164,9 +164,31 @@ fn first_alarm(rows: &[StoredRow], motor: &str) -> Option<(u32, Vec<String>)> {
     })
 }
 
-/// The month's verdicts and alarms: per motor, its health, the first FAULT verdict's day
-/// and the first trend alarm's day with its indicators.
-type Outcome = Vec<(String, Health, Option<u32>, Option<(u32, Vec<String>)>)>;
+/// |I2w|/|I1|'s days to its FAULT level as of `day` for `motor`: the whole window's line's
+/// and the window's second half's (`days_to_fault`, `days_to_fault_recent`).
+fn projection(rows: &[StoredRow], motor: &str, day: u32) -> (Option<f64>, Option<f64>) {
+    let upto: Vec<&StoredRow> = rows
+        .iter()
+        .filter(|r| r.str("motor") == Some(motor))
+        .filter(|r| r.f64("log_time_s").unwrap() < (START_S + i64::from(day) * 86_400) as f64)
+        .collect();
+    let t = trend::motor_trend(motor, &upto, &TrendOptions::default());
+    t.indicators
+        .iter()
+        .find(|i| i.indicator == "i2_over_i1")
+        .map_or((None, None), |i| (i.days_to_fault, i.days_to_fault_recent))
+}
+
+/// The month's verdicts and alarms: per motor, its health, the first FAULT verdict's day,
+/// the first trend alarm's day with its indicators, and |I2w|/|I1|'s projections on that
+/// day ([`projection`]).
+type Outcome = Vec<(
+    String,
+    Health,
+    Option<u32>,
+    Option<(u32, Vec<String>)>,
+    (Option<f64>, Option<f64>),
+)>;
 
 fn the_month(seed: u64) -> Outcome {
     let started = std::time::Instant::now();
@@ -211,7 +233,10 @@ fn the_month(seed: u64) -> Outcome {
         for s in alarm.iter().flat_map(|a| a.1.iter()) {
             eprintln!("    {s}");
         }
-        out.push((m.name.clone(), m.health, first_fault, alarm));
+        let projected = alarm
+            .as_ref()
+            .map_or((None, None), |a| projection(&rows, &m.name, a.0));
+        out.push((m.name.clone(), m.health, first_fault, alarm, projected));
     }
     eprintln!("the month: {:.1} s", started.elapsed().as_secs_f64());
     out
@@ -244,6 +269,25 @@ fn check(month: &Outcome) -> Vec<String> {
     };
     if !month.iter().any(|m| m.1 == Health::Short && on_i2(&m.3)) {
         bad.push("the short is not alarmed on |I2w|/|I1|".into());
+    }
+    // The short began inside the window and grows: the second half's slope must project
+    // the FAULT verdict's day better than the whole window's line.
+    for m in month.iter().filter(|m| m.1 == Health::Short) {
+        if let (Some((a, _)), Some(f), (Some(whole), Some(recent))) = (&m.3, m.2, m.4) {
+            let miss = |d: f64| (f64::from(*a) + d - f64::from(f)).abs();
+            if miss(recent) >= miss(whole) {
+                bad.push(format!(
+                    "{}: the recent slope projects FAULT in {recent:.1} days, the window {whole:.1}, \
+                     on day {a} with FAULT on day {f}",
+                    m.0
+                ));
+            }
+        } else if on_i2(&m.3) {
+            bad.push(format!(
+                "{}: no recent projection at the alarm: {:?}",
+                m.0, m.4
+            ));
+        }
     }
     bad
 }

@@ -75,3 +75,42 @@ fn a_steep_rise_on_too_few_logs_is_reported_as_no_alarm_yet_and_alarmed_once_the
         t.indicators.iter().map(|i| &i.sentence).collect::<Vec<_>>()
     );
 }
+
+/// Day `day`'s log of a motor at one operating point whose negative sequence is flat for
+/// a week and then grows 1 % of I1 a day; its FAULT level 30 % of I1.
+fn bend(day: i64) -> StoredRow {
+    let id = LogIdentity {
+        motor: "m2".into(),
+        path: format!("logs/m2_{day}.csv"),
+        hash: monitor_store::content_hash(format!("m2 {day}").as_bytes()),
+        time_s: 1_793_491_200 + day * 86_400,
+    };
+    let doc = serde_json::json!({
+        "verdict": "watching",
+        "unbalance": {
+            "winding_ratio": 0.01 * (day - 7).max(0) as f64,
+            "least_change": 0.3,
+            "measured": {"i1_peak_a": 10.0}
+        },
+        "data_quality": {"rows_read": 1000, "trusted": true}
+    });
+    StoredRow::from_diagnose(&id, &doc)
+}
+
+#[test]
+fn a_rise_that_began_inside_the_window_is_projected_from_the_window_s_second_half() {
+    // Days 1..=15: flat to day 7, then 0.01 a day; on day 15 the value is 0.08, and the
+    // level 0.3 is 22 days on at the rise's own slope.
+    let rows: Vec<StoredRow> = (1..=15).map(bend).collect();
+    let refs: Vec<&StoredRow> = rows.iter().collect();
+    let t = trend::motor_trend("m2", &refs, &TrendOptions::default());
+    let i2 = t
+        .indicators
+        .iter()
+        .find(|i| i.indicator == "i2_over_i1")
+        .expect("trended");
+    let recent = i2.days_to_fault_recent.expect("recent projection");
+    let whole = i2.days_to_fault.expect("window projection");
+    assert!((recent - 22.0).abs() < 1.0, "recent {recent}, window {whole}");
+    assert!(whole > recent + 5.0, "recent {recent}, window {whole}");
+}

@@ -263,6 +263,7 @@ pub fn indicator_trend(
         last: None,
         fault_level: fault_level_of(ind, rows),
         days_to_fault: None,
+        days_to_fault_recent: None,
         alarm: false,
         normalisation,
         sentence: String::new(),
@@ -399,11 +400,32 @@ fn judge(t: &mut IndicatorTrend, ind: &Indicator, opts: &TrendOptions, end_days:
     t.moves_scatters = Some(moves);
     t.last = Some(last);
     t.days_to_fault = t.fault_level.and_then(|lvl| days_to(lvl, last, line.slope));
+    t.days_to_fault_recent = t
+        .fault_level
+        .and_then(|lvl| recent_days_to(lvl, &x, &y, end_days - t0, opts.confidence));
     // With a FAULT level, a slope that would take longer than the horizon to reach it is
     // not worth a visit, however significant.
     let soon = t.fault_level.is_none() || t.days_to_fault.is_some_and(|d| d <= opts.horizon_days);
     t.alarm = ind.alarms && significant && big && soon;
     t.sentence = sentence(t, ind, &line, span);
+}
+
+/// [`IndicatorTrend::days_to_fault_recent`]: the days to `level` on the Theil-Sen line of
+/// the points `(x, y)` in the second half of the window (`x` from half of the last `x` on),
+/// taken at `end` (same origin as `x`).
+fn recent_days_to(level: f64, x: &[f64], y: &[f64], end: f64, confidence: f64) -> Option<f64> {
+    let half = 0.5 * x.last().copied().unwrap_or_default();
+    let (xr, yr): (Vec<f64>, Vec<f64>) = x
+        .iter()
+        .zip(y)
+        .filter(|(xi, _)| **xi >= half)
+        .map(|(xi, yi)| (*xi, *yi))
+        .unzip();
+    if xr.len() < super::RECENT_MIN_LOGS {
+        return None;
+    }
+    let line = theil_sen(&xr, &yr, confidence)?;
+    days_to(level, line.intercept + line.slope * end, line.slope)
 }
 
 /// The days until a line at `last` rising by `slope` a day reaches `level`: 0 at or past
@@ -441,7 +463,10 @@ fn sentence(
     );
     match (t.alarm, t.days_to_fault) {
         (true, Some(d)) if d < 0.5 => s.push_str(": TREND ALARM, at the FAULT level already"),
-        (true, Some(d)) => s.push_str(&format!(": TREND ALARM, FAULT level in about {d:.0} days")),
+        (true, Some(d)) => {
+            s.push_str(&format!(": TREND ALARM, FAULT level in about {d:.0} days"));
+            s.push_str(&sooner(t.days_to_fault_recent, d, span));
+        }
         (true, None) => s.push_str(": TREND ALARM"),
         (false, Some(d)) if d < 365.0 => s.push_str(&format!(
             ": no alarm (FAULT level in about {d:.0} days at this slope)"
@@ -450,6 +475,19 @@ fn sentence(
         (false, _) => s.push_str(": no alarm"),
     }
     s
+}
+
+/// " (about 7 at the last 7 days' slope)" where the window's second half projects the FAULT
+/// level well sooner (under 0.8 of) the whole window's `d` days; else nothing.
+fn sooner(recent: Option<f64>, d: f64, span: f64) -> String {
+    match recent {
+        Some(r) if r < 0.8 * d => format!(
+            " (about {:.0} at the last {:.0} days' slope)",
+            r.max(0.0),
+            0.5 * span
+        ),
+        _ => String::new(),
+    }
 }
 
 /// `v` with three significant digits, in plain notation where that is short.

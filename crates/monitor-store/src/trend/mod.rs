@@ -232,6 +232,11 @@ pub struct IndicatorTrend {
     pub fault_level: Option<f64>,
     /// Days from the last log until the line reaches the FAULT level, where it heads there.
     pub days_to_fault: Option<f64>,
+    /// The same at the slope of the window's second half alone (Theil-Sen over its logs,
+    /// at least [`RECENT_MIN_LOGS`]), where that heads there: a fault that began inside the
+    /// window, or grows faster as it grows, reaches the level sooner than the whole
+    /// window's line says.
+    pub days_to_fault_recent: Option<f64>,
     /// The trend alarm.
     pub alarm: bool,
     /// How the indicator was normalised for the operating point.
@@ -241,6 +246,9 @@ pub struct IndicatorTrend {
     /// The motor's points, the window's marked.
     pub series: Vec<TrendPoint>,
 }
+
+/// The fewest logs in the window's second half for [`IndicatorTrend::days_to_fault_recent`].
+pub const RECENT_MIN_LOGS: usize = 4;
 
 /// One motor's trend (JSON: one element of `sim-host trend --json`'s `motors`).
 #[derive(Debug, Clone, Serialize, PartialEq)]
