@@ -146,6 +146,27 @@ def _is_remote(log: str) -> bool:
     return "://" in log and not log.startswith("file://")
 
 
+def _fetch(log: str, storage_options: Optional[Dict[str, Any]]) -> str:
+    """A remote log copied (in 4 MiB chunks) to a local temporary file of the same
+    extension; its path (the caller removes it)."""
+    import fsspec
+
+    suffix = Path(log.split("?", 1)[0]).suffix
+    fd, tmp = tempfile.mkstemp(suffix=suffix, prefix="drive_monitor_fleet_")
+    os.close(fd)
+    try:
+        with fsspec.open(log, "rb", **(storage_options or {})) as src, open(tmp, "wb") as dst:
+            while True:
+                chunk = src.read(1 << 22)
+                if not chunk:
+                    break
+                dst.write(chunk)
+    except BaseException:
+        os.remove(tmp)
+        raise
+    return tmp
+
+
 def _row(log: str, table_toml: str, base: str, storage_options: Optional[Dict[str, Any]]) -> Dict[str, Any]:
     """One log's row, on a worker: fetched if remote, diagnosed, its row (never raises)."""
     shown = log
@@ -153,17 +174,7 @@ def _row(log: str, table_toml: str, base: str, storage_options: Optional[Dict[st
     tmp = None
     try:
         if _is_remote(log):
-            import fsspec
-
-            suffix = Path(log.split("?", 1)[0]).suffix
-            fd, tmp = tempfile.mkstemp(suffix=suffix, prefix="drive_monitor_fleet_")
-            os.close(fd)
-            with fsspec.open(log, "rb", **(storage_options or {})) as src, open(tmp, "wb") as dst:
-                while True:
-                    chunk = src.read(1 << 22)
-                    if not chunk:
-                        break
-                    dst.write(chunk)
+            tmp = _fetch(log, storage_options)
             local = tmp
         return json.loads(_native.fleet_row(table_toml, base, local, shown))
     except Exception as e:  # a worker's own failure (a fetch) is the row's error too
@@ -206,18 +217,8 @@ def _store_row(
     try:
         time_s = None
         if _is_remote(log):
-            import fsspec
-
             time_s = _remote_time(log, storage_options)
-            suffix = Path(log.split("?", 1)[0]).suffix
-            fd, tmp = tempfile.mkstemp(suffix=suffix, prefix="drive_monitor_fleet_")
-            os.close(fd)
-            with fsspec.open(log, "rb", **(storage_options or {})) as src, open(tmp, "wb") as dst:
-                while True:
-                    chunk = src.read(1 << 22)
-                    if not chunk:
-                        break
-                    dst.write(chunk)
+            tmp = _fetch(log, storage_options)
             local = tmp
         return json.loads(_native.fleet_store_row(table_toml, base, local, log, time_s))
     except Exception as e:

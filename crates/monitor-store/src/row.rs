@@ -443,47 +443,31 @@ pub fn content_hash(bytes: &[u8]) -> String {
     format!("{:016x}", fnv1a(FNV_OFFSET, bytes))
 }
 
+/// The Julian day number of 1970-01-01.
+const UNIX_EPOCH_JULIAN_DAY: i64 = 2_440_588;
+
 /// The UTC day `YYYY-MM-DD` of `t_s` seconds since 1970-01-01 (the proleptic Gregorian
-/// calendar; H. Hinnant's days-to-civil algorithm).
+/// calendar, by the `time` crate); `invalid-day` outside the years -9999..=9999.
 pub fn utc_day(t_s: i64) -> String {
-    let (y, m, d) = civil_from_days(t_s.div_euclid(86_400));
-    format!("{y:04}-{m:02}-{d:02}")
+    let jd = t_s.div_euclid(86_400) + UNIX_EPOCH_JULIAN_DAY;
+    i32::try_from(jd)
+        .ok()
+        .and_then(|jd| time::Date::from_julian_day(jd).ok())
+        .map_or_else(
+            || "invalid-day".to_string(),
+            |d| format!("{:04}-{:02}-{:02}", d.year(), u8::from(d.month()), d.day()),
+        )
 }
 
-/// Seconds since 1970-01-01 UTC of the day `YYYY-MM-DD` (its midnight), if it is one.
+/// Seconds since 1970-01-01 UTC of the day `YYYY-MM-DD` (its midnight), if it is one (a
+/// real calendar day: `2026-02-30` is not).
 pub fn parse_day(day: &str) -> Option<i64> {
     let mut it = day.trim().splitn(3, '-');
-    let y: i64 = it.next()?.parse().ok()?;
-    let m: i64 = it.next()?.parse().ok()?;
-    let d: i64 = it.next()?.parse().ok()?;
-    if !(1..=12).contains(&m) || !(1..=31).contains(&d) {
-        return None;
-    }
-    let days = days_from_civil(y, m, d);
-    (civil_from_days(days) == (y, m, d)).then_some(days * 86_400)
-}
-
-fn civil_from_days(z: i64) -> (i64, i64, i64) {
-    let z = z + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z.rem_euclid(146_097);
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = doy - (153 * mp + 2) / 5 + 1;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 };
-    let y = yoe + era * 400 + i64::from(m <= 2);
-    (y, m, d)
-}
-
-fn days_from_civil(y: i64, m: i64, d: i64) -> i64 {
-    let y = if m <= 2 { y - 1 } else { y };
-    let era = y.div_euclid(400);
-    let yoe = y.rem_euclid(400);
-    let mp = if m > 2 { m - 3 } else { m + 9 };
-    let doy = (153 * mp + 2) / 5 + d - 1;
-    let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
-    era * 146_097 + doe - 719_468
+    let y: i32 = it.next()?.parse().ok()?;
+    let m: u8 = it.next()?.parse().ok()?;
+    let d: u8 = it.next()?.parse().ok()?;
+    let date = time::Date::from_calendar_date(y, time::Month::try_from(m).ok()?, d).ok()?;
+    Some((i64::from(date.to_julian_day()) - UNIX_EPOCH_JULIAN_DAY) * 86_400)
 }
 
 #[cfg(test)]
@@ -498,6 +482,9 @@ mod tests {
         assert_eq!(utc_day(0), "1970-01-01");
         assert_eq!(utc_day(-1), "1969-12-31");
         assert_eq!(parse_day("2000-03-01"), Some(11_017 * 86_400));
+        assert_eq!(parse_day("2026-02-30"), None);
+        // 2024-02-29: day 19 782 (54 years of 365 days, 13 leap days, 31 + 28 days of 2024).
+        assert_eq!(parse_day("2024-02-29"), Some(19_782 * 86_400));
         assert_eq!(parse_day("2001-02-29"), None);
         assert_eq!(parse_day("soon"), None);
         // FNV-1a's published test vectors: "" and "a".

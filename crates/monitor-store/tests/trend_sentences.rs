@@ -111,6 +111,9 @@ fn a_rise_that_began_inside_the_window_is_projected_from_the_window_s_second_hal
         .expect("trended");
     let recent = i2.days_to_fault_recent.expect("recent projection");
     let whole = i2.days_to_fault.expect("window projection");
-    assert!((recent - 22.0).abs() < 1.0, "recent {recent}, window {whole}");
+    assert!(
+        (recent - 22.0).abs() < 1.0,
+        "recent {recent}, window {whole}"
+    );
     assert!(whole > recent + 5.0, "recent {recent}, window {whole}");
 }
