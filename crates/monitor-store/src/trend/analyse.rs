@@ -276,20 +276,23 @@ pub fn indicator_trend(
         end_s / DAY_S,
         fit.as_ref().map_or(0.0, |f| f.scatter),
     );
-    if fit.is_none() && !covs.is_empty() && rows.len() < fit_logs(covs) && t.alarm {
-        // Too few logs to tell a trend from the operating point's moves: no alarm, and the
-        // sentence says so (it never says TREND ALARM where the alarm is not raised).
+    if fit.is_none() && !covs.is_empty() && rows.len() < fit_logs(covs) {
+        hold_for_fit(&mut t, rows.len(), fit_logs(covs));
+    }
+    t
+}
+
+/// Too few logs (`n` of the `needed`) to tell a trend from the operating point's moves: no
+/// alarm, and the sentence says so (it never says TREND ALARM where the alarm is not
+/// raised).
+fn hold_for_fit(t: &mut IndicatorTrend, n: usize, needed: usize) {
+    if t.alarm {
         t.alarm = false;
         t.sentence = t.sentence.replace(
             ": TREND ALARM",
-            &format!(
-                ": no alarm yet ({} logs; the operating-point fit needs {})",
-                rows.len(),
-                fit_logs(covs)
-            ),
+            &format!(": no alarm yet ({n} logs; the operating-point fit needs {needed})"),
         );
     }
-    t
 }
 
 /// What the report says of the normalisation (`fitted` or not, on `covs`, over `n` logs).
