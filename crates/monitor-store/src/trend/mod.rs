@@ -85,6 +85,22 @@ const TEMPERATURE: &str = "winding_temperature_c";
 /// together (a loosening connection's Rs partly reads as heating in it).
 const RISE: &str = "winding_rise_k";
 
+/// A parity residual as an indicator: either way, per unit, normalised on load and the
+/// windings' temperature (measured, else the isolation's rise), no FAULT level.
+const fn residual(column: &'static str, label: &'static str) -> Indicator {
+    Indicator {
+        column,
+        label,
+        unit: "pu",
+        scale: 1.0,
+        shown_unit: "pu",
+        direction: Direction::Either,
+        alarms: true,
+        covariates: &[&[LOAD, TEMPERATURE], &[LOAD, RISE]],
+        fault_level: FaultLevel::None,
+    }
+}
+
 /// The indicators trended, in the tables' order.
 ///
 /// - `i2_over_i1`: the winding's negative-sequence change (a short grows it); its FAULT
@@ -112,39 +128,9 @@ pub const INDICATORS: [Indicator; 5] = [
         covariates: &[&[LOAD]],
         fault_level: FaultLevel::Column("i2_least_change"),
     },
-    Indicator {
-        column: "residual_d",
-        label: "e_d",
-        unit: "pu",
-        scale: 1.0,
-        shown_unit: "pu",
-        direction: Direction::Either,
-        alarms: true,
-        covariates: &[&[LOAD, TEMPERATURE], &[LOAD, RISE]],
-        fault_level: FaultLevel::None,
-    },
-    Indicator {
-        column: "residual_q",
-        label: "e_q",
-        unit: "pu",
-        scale: 1.0,
-        shown_unit: "pu",
-        direction: Direction::Either,
-        alarms: true,
-        covariates: &[&[LOAD, TEMPERATURE], &[LOAD, RISE]],
-        fault_level: FaultLevel::None,
-    },
-    Indicator {
-        column: "residual_t",
-        label: "e_T",
-        unit: "pu",
-        scale: 1.0,
-        shown_unit: "pu",
-        direction: Direction::Either,
-        alarms: true,
-        covariates: &[&[LOAD, TEMPERATURE], &[LOAD, RISE]],
-        fault_level: FaultLevel::None,
-    },
+    residual("residual_d", "e_d"),
+    residual("residual_q", "e_q"),
+    residual("residual_t", "e_T"),
     Indicator {
         column: "sideband_db",
         label: "sideband",

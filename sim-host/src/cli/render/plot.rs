@@ -66,7 +66,8 @@ pub fn register_font() -> Result<(), String> {
     .clone()
 }
 
-const PALETTE: [RGBColor; 6] = [
+/// The series colours of every chart (matplotlib's first five and a grey), in order.
+pub(crate) const PALETTE: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),

@@ -15,17 +15,11 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::path::Path;
 
+use super::plot::PALETTE;
+
 /// The most motors one plot draws.
 pub const MAX_MOTORS: usize = 6;
 
-const PALETTE: [RGBColor; 6] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(255, 127, 14),
-    RGBColor(148, 103, 189),
-    RGBColor(90, 90, 90),
-];
 const OK: RGBColor = RGBColor(220, 242, 220);
 const WATCH: RGBColor = RGBColor(253, 238, 200);
 const FAULT: RGBColor = RGBColor(250, 215, 215);
