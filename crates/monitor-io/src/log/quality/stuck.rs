@@ -40,8 +40,10 @@ const PHASES: [Column; 6] = [
 pub struct StuckTracker {
     /// Rows a run must last to be stuck.
     run_min: u32,
-    /// Per channel (va, vb, vc, ia, ib, ic): last reading and run length.
-    runs: [(f64, u32); 6],
+    /// Per channel (va, vb, vc, ia, ib, ic): last reading (NaN after a bad cell) ...
+    last: [f64; 6],
+    /// ... and the length of its run (0 after a bad cell).
+    runs: [u32; 6],
 }
 
 impl StuckTracker {
@@ -53,35 +55,63 @@ impl StuckTracker {
             .min(f64::from(u32::MAX / 2)) as u32;
         StuckTracker {
             run_min: run.max(STUCK_MIN_SAMPLES),
-            runs: [(f64::NAN, 0); 6],
+            last: [f64::NAN; 6],
+            runs: [0; 6],
         }
     }
 
     /// Follows `row` and marks its stuck cells in `bad` (cells already bad are left out of
     /// the runs).
+    #[inline]
     pub fn check(&mut self, row: &Row, bad: &mut BadCells) {
         let v = row.v_abc.unwrap_or([f64::NAN; 3]);
         let values = [v[0], v[1], v[2], row.i_abc[0], row.i_abc[1], row.i_abc[2]];
+        // The common row: no phase cell bad, every reading present, finite and changed
+        // (a voltage absent counts as changed: it starts no run). Every run present is one
+        // row long, too short to be stuck.
+        let phase_bad = PHASES.iter().any(|c| bad.has(*c));
+        let has_v = row.v_abc.is_some();
+        let fresh = values
+            .iter()
+            .zip(&self.last)
+            .enumerate()
+            .fold(true, |all, (k, (x, last))| {
+                all & ((k < 3 && !has_v) | ((x != last) & (x.abs() <= f64::MAX)))
+            });
+        if fresh && !phase_bad && self.run_min > 1 {
+            self.last = values;
+            self.runs = if has_v { [1; 6] } else { [0, 0, 0, 1, 1, 1] };
+            return;
+        }
+        self.check_runs(values, row.v_abc.is_some(), bad);
+    }
+
+    /// [`StuckTracker::check`] channel by channel.
+    #[cold]
+    fn check_runs(&mut self, values: [f64; 6], has_v: bool, bad: &mut BadCells) {
         let mut longest = 0;
-        for ((run, x), c) in self.runs.iter_mut().zip(values).zip(&PHASES) {
-            if bad.has(*c) || !x.is_finite() {
-                *run = (f64::NAN, 0);
-            } else if x == run.0 {
-                run.1 = run.1.saturating_add(1);
+        // Selects, not jumps: every channel of a live log changes every row.
+        for k in 0..6 {
+            let x = values[k];
+            let ok = !bad.has(PHASES[k]) && x.is_finite();
+            let run = if ok && x == self.last[k] {
+                self.runs[k].saturating_add(1)
             } else {
-                *run = (x, 1);
-            }
-            longest = longest.max(run.1);
+                u32::from(ok)
+            };
+            self.last[k] = if ok { x } else { f64::NAN };
+            self.runs[k] = run;
+            longest = longest.max(run);
         }
         // (Every row of a live log ends here: no run is long.)
         if longest >= self.run_min {
-            self.mark(row.v_abc.is_some(), bad);
+            self.mark(has_v, bad);
         }
     }
 
     /// Marks the stuck cells of the row just followed.
     fn mark(&self, has_v: bool, bad: &mut BadCells) {
-        let stuck: [bool; 6] = std::array::from_fn(|k| self.runs[k].1 >= self.run_min);
+        let stuck: [bool; 6] = std::array::from_fn(|k| self.runs[k] >= self.run_min);
         let alive = |set: &[bool]| set.iter().any(|s| !s);
         let (sv, si) = (&stuck[..3], &stuck[3..]);
         for (k, c) in PHASES.iter().enumerate() {
