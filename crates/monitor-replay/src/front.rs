@@ -42,6 +42,9 @@ pub(super) struct ReplaySink<'a, F: Feeder> {
     /// case, one copy of the row kept instead of two).
     last_good: Option<Row>,
     fed_good: bool,
+    /// Nothing held or pending: no segment at another rate, no burst, no clock reset (the
+    /// common row's one test).
+    quiet: bool,
     handled: Handled,
 }
 
@@ -184,6 +187,7 @@ impl<'a, F: Feeder> ReplaySink<'a, F> {
             time_offset: 0.0,
             last_good: None,
             fed_good: false,
+            quiet: true,
             handled: Handled::default(),
         }
     }
@@ -431,17 +435,18 @@ impl<F: Feeder> CleanSink for ReplaySink<'_, F> {
         self.began
     }
 
+    #[inline(always)]
     fn row(&mut self, row: &Row, bad: BadCells) -> bool {
         if !self.began {
             return true;
         }
-        if bad.any()
-            || self.other_rate
-            || self.burst_forwarded
-            || !self.burst.is_empty()
-            || self.clock_reset_pending
-        {
-            return self.row_other(row, bad);
+        if bad.any() || !self.quiet {
+            let go = self.row_other(row, bad);
+            self.quiet = !(self.other_rate
+                || self.burst_forwarded
+                || !self.burst.is_empty()
+                || self.clock_reset_pending);
+            return go;
         }
         // A good row with nothing held: replayed as it is.
         self.replay(row);
@@ -466,6 +471,7 @@ impl<F: Feeder> CleanSink for ReplaySink<'_, F> {
                 self.clock_reset_pending = true;
             }
         }
+        self.quiet = !(self.other_rate || self.clock_reset_pending) && self.quiet;
         true
     }
 
@@ -489,6 +495,7 @@ impl<F: Feeder> CleanSink for ReplaySink<'_, F> {
         self.time_offset = 0.0;
         self.last_good = None;
         self.fed_good = false;
+        self.quiet = true;
     }
 }
 

@@ -98,7 +98,8 @@ impl BadCells {
     /// [`BadCells::of`] cell by cell.
     #[cold]
     fn of_each(row: &Row, lim: &CellLimits) -> Self {
-        let out = |x: f64, max: f64| u16::from(!(x.abs() <= max.min(f64::MAX)));
+        let within = |x: f64, max: f64| x.abs() <= max.min(f64::MAX);
+        let out = |x: f64, max: f64| u16::from(!within(x, max));
         let bit = |c: Column| c as u16;
         let mut b = 0u16;
         if let Some(v) = row.v_abc {
@@ -161,9 +162,9 @@ mod tests {
                 let rule = |x: f64, max: f64| !x.is_finite() || x.abs() > max;
                 let b = BadCells::of(&row, &lim);
                 assert_eq!(b.has(Column::Va), rule(x, v_max), "{x} {v_max}");
-                assert_eq!(b.has(Column::Vb), false);
+                assert!(!b.has(Column::Vb));
                 assert_eq!(b.has(Column::Vc), rule(y, v_max), "{y} {v_max}");
-                assert_eq!(b.has(Column::Ia), false);
+                assert!(!b.has(Column::Ia));
                 assert_eq!(b.has(Column::Ib), rule(y, 100.0), "{y}");
                 assert_eq!(b.has(Column::Ic), rule(x, 100.0), "{x}");
                 assert_eq!(b.has(Column::Speed), rule(x * 10.0, 1000.0), "{x}");

@@ -355,7 +355,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         self.jitter.0 += err * err;
         self.jitter.1 += 1;
         if err.abs() <= CLOCK_EXACT * self.period {
-            return self.emit(r, t);
+            return self.pass(r, t);
         }
         self.emit(r, predicted + CLOCK_GAIN * err)
     }
@@ -416,8 +416,14 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
     /// see [`encoder`]), bursts tracked, the good rows counted by the accumulators
     /// ([`signals`]). The row goes on as it came when neither its time nor its count
     /// changed.
-    #[inline]
+    #[inline(never)]
     fn emit(&mut self, r: &Row, t_s: f64) -> bool {
+        self.pass(r, t_s)
+    }
+
+    /// [`QualityStage::emit`] in line (the common row's path).
+    #[inline(always)]
+    fn pass(&mut self, r: &Row, t_s: f64) -> bool {
         self.last_t = t_s;
         self.dropping = false;
         self.q.rows_passed += 1;
@@ -430,7 +436,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             }
         }
         let before = bad;
-        self.stuck.check(r, &mut bad);
+        self.stuck.check_flagged(r, &mut bad);
         if bad != before {
             self.count_stuck(before, bad);
         }
