@@ -38,7 +38,13 @@ pub(super) struct ReplaySink<'a, F: Feeder> {
     clock_reset_pending: bool,
     /// Added to every row's time after a clock reset, so the replay's time goes on [s].
     time_offset: f64,
+    /// The last good row replayed, unless `fed_good` (then it is `last_fed`: the common
+    /// case, one copy of the row kept instead of two).
     last_good: Option<Row>,
+    fed_good: bool,
+    /// Nothing held or pending: no segment at another rate, no burst, no clock reset (the
+    /// common row's one test).
+    quiet: bool,
     handled: Handled,
 }
 
@@ -180,6 +186,8 @@ impl<'a, F: Feeder> ReplaySink<'a, F> {
             clock_reset_pending: false,
             time_offset: 0.0,
             last_good: None,
+            fed_good: false,
+            quiet: true,
             handled: Handled::default(),
         }
     }
@@ -211,19 +219,39 @@ impl<F: Feeder> ReplaySink<'_, F> {
         if !self.began {
             return;
         }
+        if std::mem::take(&mut self.fed_good) {
+            self.last_good = self.last_fed;
+        }
         if std::mem::take(&mut self.clock_reset_pending) {
             if let Some(last) = self.last_fed {
                 self.time_offset = last.t_s + self.time_offset + CLOCK_RESET_GAP_S - row.t_s;
                 self.feeder.clock_reset();
             }
         }
+        self.replay(row);
+    }
+
+    /// Hands a row on at its time plus the offset (the row as it came when that is its
+    /// own time, bit for bit).
+    #[inline]
+    fn replay(&mut self, row: &Row) {
         self.last_fed = Some(*row);
-        let shifted = Row {
-            t_s: row.t_s + self.time_offset,
-            ..*row
-        };
-        self.t0.get_or_insert(shifted.t_s);
-        self.feeder.row(&shifted);
+        let t = row.t_s + self.time_offset;
+        self.t0.get_or_insert(t);
+        if t.to_bits() == row.t_s.to_bits() {
+            self.feeder.row(row);
+        } else {
+            self.feeder.row(&Row { t_s: t, ..*row });
+        }
+    }
+
+    /// The last good row replayed.
+    fn last_good(&self) -> Option<Row> {
+        if self.fed_good {
+            self.last_fed
+        } else {
+            self.last_good
+        }
     }
 
     /// A row with bad cells given to the monitor, which holds them out and flags the
@@ -301,6 +329,60 @@ impl<F: Feeder> ReplaySink<'_, F> {
     }
 }
 
+impl<F: Feeder> ReplaySink<'_, F> {
+    /// [`CleanSink::row`] of a row with bad cells, of a segment at another rate, or after
+    /// rows held or a clock reset.
+    #[cold]
+    fn row_other(&mut self, row: &Row, bad: BadCells) -> bool {
+        let (row, bad) = self.speed_from_tachometer(row, bad);
+        if self.other_rate {
+            self.resample(&row, bad);
+            return true;
+        }
+        if bad.any() && !self.burst_forwarded {
+            // A glitch burst is held until it ends (dropped: the monitor bridges it like a
+            // gap) or outlasts the longest gap bridged (a sensor that has failed: the rows
+            // go to the monitor, which holds them out and flags the sensor).
+            self.burst.push((row, bad));
+            if self.burst.len() as f64 <= MAX_BRIDGED_GAP_S * self.handled.rate_hz {
+                return true;
+            }
+            self.burst_forwarded = true;
+            if !encoder_only(bad) {
+                self.handled.long_bursts += 1;
+            }
+            let burst = std::mem::take(&mut self.burst);
+            for (b, why) in &burst {
+                self.forward_bad(b, *why);
+            }
+            return true;
+        }
+        if bad.any() {
+            self.forward_bad(&row, bad);
+            return true;
+        }
+        if !self.burst.is_empty() && !self.burst_forwarded {
+            self.handled.short_bursts += 1;
+            // A glitch of a few samples is filled in between its good neighbours (the
+            // monitor would otherwise lose the whole block it falls in); a longer one is
+            // left out, a gap the monitor bridges.
+            let short = |a: &Row| (row.t_s - a.t_s) * self.params.supply.f_hz <= FILL_PERIODS;
+            if let Some(a) = self.last_good().filter(short) {
+                let burst = std::mem::take(&mut self.burst);
+                for (b, _) in &burst {
+                    self.feed(&between(&a, &row, b.t_s));
+                }
+                self.handled.filled_rows += burst.len() as u64;
+            }
+        }
+        self.burst.clear();
+        self.burst_forwarded = false;
+        self.feed(&row);
+        self.fed_good = true;
+        true
+    }
+}
+
 /// The row at `t` between rows `a` and `b`. The voltage and current space vectors turn
 /// from `a`'s to `b`'s along the rotation (angle and magnitude interpolated linearly,
 /// exact for a steady balanced set, where a straight line in abc would cut the circle's
@@ -353,55 +435,22 @@ impl<F: Feeder> CleanSink for ReplaySink<'_, F> {
         self.began
     }
 
+    #[inline(always)]
     fn row(&mut self, row: &Row, bad: BadCells) -> bool {
         if !self.began {
             return true;
         }
-        let (row, bad) = self.speed_from_tachometer(row, bad);
-        if self.other_rate {
-            self.resample(&row, bad);
-            return true;
+        if bad.any() || !self.quiet {
+            let go = self.row_other(row, bad);
+            self.quiet = !(self.other_rate
+                || self.burst_forwarded
+                || !self.burst.is_empty()
+                || self.clock_reset_pending);
+            return go;
         }
-        if bad.any() && !self.burst_forwarded {
-            // A glitch burst is held until it ends (dropped: the monitor bridges it like a
-            // gap) or outlasts the longest gap bridged (a sensor that has failed: the rows
-            // go to the monitor, which holds them out and flags the sensor).
-            self.burst.push((row, bad));
-            if self.burst.len() as f64 <= MAX_BRIDGED_GAP_S * self.handled.rate_hz {
-                return true;
-            }
-            self.burst_forwarded = true;
-            if !encoder_only(bad) {
-                self.handled.long_bursts += 1;
-            }
-            let burst = std::mem::take(&mut self.burst);
-            for (b, why) in &burst {
-                self.forward_bad(b, *why);
-            }
-            return true;
-        }
-        if bad.any() {
-            self.forward_bad(&row, bad);
-            return true;
-        }
-        if !self.burst.is_empty() && !self.burst_forwarded {
-            self.handled.short_bursts += 1;
-            // A glitch of a few samples is filled in between its good neighbours (the
-            // monitor would otherwise lose the whole block it falls in); a longer one is
-            // left out, a gap the monitor bridges.
-            let short = |a: &Row| (row.t_s - a.t_s) * self.params.supply.f_hz <= FILL_PERIODS;
-            if let Some(a) = self.last_good.filter(short) {
-                let burst = std::mem::take(&mut self.burst);
-                for (b, _) in &burst {
-                    self.feed(&between(&a, &row, b.t_s));
-                }
-                self.handled.filled_rows += burst.len() as u64;
-            }
-        }
-        self.burst.clear();
-        self.burst_forwarded = false;
-        self.last_good = Some(row);
-        self.feed(&row);
+        // A good row with nothing held: replayed as it is.
+        self.replay(row);
+        self.fed_good = true;
         true
     }
 
@@ -422,6 +471,7 @@ impl<F: Feeder> CleanSink for ReplaySink<'_, F> {
                 self.clock_reset_pending = true;
             }
         }
+        self.quiet = !(self.other_rate || self.clock_reset_pending) && self.quiet;
         true
     }
 
@@ -444,6 +494,8 @@ impl<F: Feeder> CleanSink for ReplaySink<'_, F> {
         self.clock_reset_pending = false;
         self.time_offset = 0.0;
         self.last_good = None;
+        self.fed_good = false;
+        self.quiet = true;
     }
 }
 

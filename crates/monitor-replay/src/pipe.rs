@@ -19,20 +19,17 @@ use monitor_io::log::{Channels, Row};
 use monitor_io::params::ParamFile;
 use std::sync::mpsc::{channel, sync_channel, Receiver, Sender, SyncSender};
 
-/// Calls per batch (about 150 bytes each).
+/// Rows per batch (about 140 bytes each with its step).
 const BATCH: usize = 4096;
 /// Batches on their way at most (the reading thread waits beyond: bounded memory).
 const IN_FLIGHT: usize = 4;
 
-/// One call to the replay's thread.
-#[allow(clippy::large_enum_variant)]
+/// One call to the replay's thread other than a row.
 enum Call {
     /// Configure the replay at this sample rate [Hz] (answered).
     Begin(f64),
     /// A window the sequence analysis closed ([`Replay::queue_window`]).
     Window(Option<SequenceWindow>),
-    /// One row and its sequence step.
-    Row(Row, SequenceStep),
     /// The acquisition clock was reset before the next row ([`Replay::clock_reset`]).
     ClockReset,
     /// Forget everything: the rows come again.
@@ -41,17 +38,36 @@ enum Call {
     End(Box<SequenceFront>),
 }
 
+/// A batch of calls: the rows with their sequence steps side by side, and the other calls,
+/// each after the rows of the batch before it (their number). Sent full, received in that
+/// order, sent back empty (the memory reused).
+struct Batch {
+    rows: Vec<Row>,
+    steps: Vec<SequenceStep>,
+    calls: Vec<(usize, Call)>,
+}
+
+impl Batch {
+    fn with_capacity(n: usize) -> Self {
+        Batch {
+            rows: Vec::with_capacity(n),
+            steps: Vec::with_capacity(n),
+            calls: Vec::new(),
+        }
+    }
+}
+
 /// The reading thread's end: a [`Feeder`] that runs the sequence analysis and batches the
 /// calls (given to the read by [`on_own_thread`]).
 pub(super) struct Pipe<'a> {
     params: &'a ParamFile,
     channels: Channels,
-    tx: SyncSender<Vec<Call>>,
+    tx: SyncSender<Batch>,
     /// Emptied batches coming back (their memory reused).
-    back: Receiver<Vec<Call>>,
+    back: Receiver<Batch>,
     /// The answer to [`Call::Begin`].
     began: Receiver<bool>,
-    batch: Vec<Call>,
+    batch: Batch,
     front: Option<SequenceFront>,
     /// The first row's time (the replay's time 0) [s].
     t0: Option<f64>,
@@ -62,22 +78,20 @@ pub(super) struct Pipe<'a> {
 impl Pipe<'_> {
     /// Sends the batch.
     fn flush(&mut self) {
-        if self.batch.is_empty() || self.closed {
+        if (self.batch.rows.is_empty() && self.batch.calls.is_empty()) || self.closed {
             return;
         }
         let next = self
             .back
             .try_recv()
-            .unwrap_or_else(|_| Vec::with_capacity(BATCH));
+            .unwrap_or_else(|_| Batch::with_capacity(BATCH));
         let full = std::mem::replace(&mut self.batch, next);
         self.closed = self.tx.send(full).is_err();
     }
 
+    /// A call after the rows pushed so far.
     fn push(&mut self, c: Call) {
-        self.batch.push(c);
-        if self.batch.len() >= BATCH {
-            self.flush();
-        }
+        self.batch.calls.push((self.batch.rows.len(), c));
     }
 
     /// The read is over: the sequence analysis goes to the replay, and every call is sent.
@@ -108,7 +122,11 @@ impl Feeder for Pipe<'_> {
         while let Some(w) = self.front.as_mut().and_then(SequenceFront::take_closed) {
             self.push(Call::Window(w));
         }
-        self.push(Call::Row(*row, step));
+        self.batch.rows.push(*row);
+        self.batch.steps.push(step);
+        if self.batch.rows.len() >= BATCH {
+            self.flush();
+        }
     }
 
     fn clock_reset(&mut self) {
@@ -153,7 +171,6 @@ impl Back<'_> {
                 };
                 match c {
                     Call::Window(w) => r.queue_window(w),
-                    Call::Row(row, step) => r.push_step(&row, &step),
                     Call::ClockReset => r.clock_reset(),
                     Call::End(front) => r.set_sequence_front(*front),
                     Call::Begin(_) | Call::Restart => {}
@@ -161,19 +178,37 @@ impl Back<'_> {
             }
         }
     }
+
+    /// Rows with their steps, in order.
+    fn rows(&mut self, rows: &[Row], steps: &[SequenceStep]) {
+        if let Some(r) = self.replay.as_mut() {
+            for (row, step) in rows.iter().zip(steps) {
+                r.push_step(row, step);
+            }
+        }
+    }
 }
 
-/// Receives every batch and hands it to `back` in order, returning the emptied batches.
-fn receive(
-    back: &mut Back<'_>,
-    rx: Receiver<Vec<Call>>,
-    empty: Sender<Vec<Call>>,
-    began: Sender<bool>,
-) {
+/// Receives every batch and hands it to `back` in order (each call after the rows before
+/// it), returning the emptied batches.
+fn receive(back: &mut Back<'_>, rx: Receiver<Batch>, empty: Sender<Batch>, began: Sender<bool>) {
     for mut batch in rx {
-        for c in batch.drain(..) {
+        let mut from = 0;
+        for (at, c) in batch.calls.drain(..) {
+            let to = at.clamp(from, batch.rows.len());
+            back.rows(
+                batch.rows.get(from..to).unwrap_or_default(),
+                batch.steps.get(from..to).unwrap_or_default(),
+            );
+            from = to;
             back.call(c, &began);
         }
+        back.rows(
+            batch.rows.get(from..).unwrap_or_default(),
+            batch.steps.get(from..).unwrap_or_default(),
+        );
+        batch.rows.clear();
+        batch.steps.clear();
         // (The reading thread may be gone already.)
         let _ = empty.send(batch);
     }
@@ -208,7 +243,7 @@ pub(super) fn on_own_thread<R>(
             tx,
             back: empty_rx,
             began: began_rx,
-            batch: Vec::with_capacity(BATCH),
+            batch: Batch::with_capacity(BATCH),
             front: None,
             t0: None,
             closed: false,

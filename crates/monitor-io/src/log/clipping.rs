@@ -99,6 +99,26 @@ impl Extremes {
         self.min = if lt { x } else { self.min };
     }
 
+    /// Counts a series of values, the state kept in registers. A series strictly between
+    /// the extremes (most of a live channel's blocks) only ends the runs and adds to the
+    /// count, as each value's [`Extremes::push`] would.
+    #[inline]
+    fn push_all(&mut self, xs: &[f64]) {
+        let (max, min) = (self.max, self.min);
+        let between = xs.iter().fold(true, |all, &x| all & (x < max) & (x > min));
+        if between && !xs.is_empty() {
+            self.n += xs.len() as u64;
+            self.run_max = 0;
+            self.run_min = 0;
+            return;
+        }
+        let mut e = *self;
+        for &x in xs {
+            e.push(x);
+        }
+        *self = e;
+    }
+
     /// The share of samples at the more frequent extreme and that value, when the channel
     /// is clipped: a channel that varies, with an extreme at least half its largest
     /// magnitude (a flat top, not a stuck zero).
@@ -139,6 +159,21 @@ impl ClipTracker {
             if good(cols[3 + i]) {
                 self.channels[3 + i].push(row.i_abc[i]);
             }
+        }
+    }
+
+    /// Counts a block of rows whose cells are all good, channel by channel (`v`: the
+    /// voltages a, b, c when the rows have them; `i`: the currents), the same counts as
+    /// [`ClipTracker::push`] row by row.
+    pub fn push_block(&mut self, v: Option<[&[f64]; 3]>, i: [&[f64]; 3]) {
+        let (ev, ei) = self.channels.split_at_mut(3);
+        if let Some(v) = v {
+            for (e, xs) in ev.iter_mut().zip(v) {
+                e.push_all(xs);
+            }
+        }
+        for (e, xs) in ei.iter_mut().zip(i) {
+            e.push_all(xs);
         }
     }
 

@@ -78,26 +78,108 @@ impl BadCells {
     /// The bad cells of `row` against `lim`.
     #[inline]
     pub fn of(row: &Row, lim: &CellLimits) -> Self {
-        let mut b = BadCells::default();
-        let bad = |x: f64, max: f64| !x.is_finite() || x.abs() > max;
+        // `|x| <= max` with `max` made finite: false for NaN and the infinities too.
+        let within = |x: f64, max: f64| x.abs() <= max.min(f64::MAX);
+        let i = row.i_abc;
+        let mut good = within(i[0], lim.i_max) & within(i[1], lim.i_max) & within(i[2], lim.i_max);
         if let Some(v) = row.v_abc {
-            for (x, c) in v.iter().zip([Column::Va, Column::Vb, Column::Vc]) {
-                if bad(*x, lim.v_max) {
-                    b.set(c);
-                }
+            good &= within(v[0], lim.v_max) & within(v[1], lim.v_max) & within(v[2], lim.v_max);
+        }
+        if let Some(w) = row.wm_rad_s {
+            good &= within(w, lim.wm_max);
+        }
+        // (Every row of a clean log ends here.)
+        if good && row.enc_count != Some(crate::log::ENC_COUNT_UNREADABLE) {
+            return BadCells(0);
+        }
+        Self::of_each(row, lim)
+    }
+
+    /// [`BadCells::of`] cell by cell.
+    #[cold]
+    fn of_each(row: &Row, lim: &CellLimits) -> Self {
+        let within = |x: f64, max: f64| x.abs() <= max.min(f64::MAX);
+        let out = |x: f64, max: f64| u16::from(!within(x, max));
+        let bit = |c: Column| c as u16;
+        let mut b = 0u16;
+        if let Some(v) = row.v_abc {
+            b |= out(v[0], lim.v_max) << bit(Column::Va)
+                | out(v[1], lim.v_max) << bit(Column::Vb)
+                | out(v[2], lim.v_max) << bit(Column::Vc);
+        }
+        let i = row.i_abc;
+        b |= out(i[0], lim.i_max) << bit(Column::Ia)
+            | out(i[1], lim.i_max) << bit(Column::Ib)
+            | out(i[2], lim.i_max) << bit(Column::Ic);
+        if let Some(w) = row.wm_rad_s {
+            b |= out(w, lim.wm_max) << bit(Column::Speed);
+        }
+        b |= u16::from(row.enc_count == Some(crate::log::ENC_COUNT_UNREADABLE))
+            << bit(Column::Encoder);
+        BadCells(b)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cells against the rule as the module states it: not finite, or beyond the limit.
+    #[test]
+    fn bad_cells_are_the_non_finite_and_those_beyond_the_limits() {
+        let lim = |v_max: f64| CellLimits {
+            v_max,
+            i_max: 100.0,
+            wm_max: 1000.0,
+            supply_hz: 50.0,
+            sync_rad_s: 157.0,
+            pole_pairs: 2.0,
+        };
+        let xs = [
+            0.0,
+            -5.0,
+            99.9,
+            100.0,
+            -100.0,
+            100.1,
+            1e308,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+        ];
+        for v_max in [100.0, f64::INFINITY, f64::NAN] {
+            let lim = lim(v_max);
+            for (k, &x) in xs.iter().enumerate() {
+                let y = xs[(k * 7 + 3) % xs.len()];
+                let row = Row {
+                    t_s: 0.0,
+                    v_abc: Some([x, 1.0, y]),
+                    i_abc: [1.0, y, x],
+                    wm_rad_s: Some(x * 10.0),
+                    enc_count: Some(k as i64),
+                    t_winding_c: None,
+                };
+                let rule = |x: f64, max: f64| !x.is_finite() || x.abs() > max;
+                let b = BadCells::of(&row, &lim);
+                assert_eq!(b.has(Column::Va), rule(x, v_max), "{x} {v_max}");
+                assert!(!b.has(Column::Vb));
+                assert_eq!(b.has(Column::Vc), rule(y, v_max), "{y} {v_max}");
+                assert!(!b.has(Column::Ia));
+                assert_eq!(b.has(Column::Ib), rule(y, 100.0), "{y}");
+                assert_eq!(b.has(Column::Ic), rule(x, 100.0), "{x}");
+                assert_eq!(b.has(Column::Speed), rule(x * 10.0, 1000.0), "{x}");
+                assert!(!b.has(Column::Encoder));
             }
         }
-        for (x, c) in row.i_abc.iter().zip([Column::Ia, Column::Ib, Column::Ic]) {
-            if bad(*x, lim.i_max) {
-                b.set(c);
-            }
-        }
-        if row.wm_rad_s.is_some_and(|w| bad(w, lim.wm_max)) {
-            b.set(Column::Speed);
-        }
-        if row.enc_count == Some(crate::log::ENC_COUNT_UNREADABLE) {
-            b.set(Column::Encoder);
-        }
-        b
+        let unreadable = Row {
+            t_s: 0.0,
+            v_abc: None,
+            i_abc: [1.0; 3],
+            wm_rad_s: None,
+            enc_count: Some(crate::log::ENC_COUNT_UNREADABLE),
+            t_winding_c: None,
+        };
+        let b = BadCells::of(&unreadable, &lim(100.0));
+        assert!(b.has(Column::Encoder) && b.any());
     }
 }

@@ -76,20 +76,18 @@ impl<S: CleanSink> QualityStage<'_, S> {
         if let Some(b) = self.base {
             self.q.duration_s = (self.last_t - b.t0_s).max(0.0);
         }
-        self.q.current_frequency_hz = self.crossings.median_period().map(|p| 1.0 / p);
+        let (clips, crossings, speed, wiring) = self.signals.done();
+        self.q.current_frequency_hz = crossings.median_period().map(|p| 1.0 / p);
         // Running: the currents alternate (at whatever frequency a drive gives them); the
         // synchronous speed scales with that frequency.
         let f_cur = self.q.current_frequency_hz.filter(|f| *f > 1.0);
         let scale = f_cur.map_or(1.0, |f| f / self.limits.supply_hz);
-        self.q.speed_unit = self
-            .speed
-            .finding(f_cur.is_some(), scale, self.limits.pole_pairs);
+        self.q.speed_unit = speed.finding(f_cur.is_some(), scale, self.limits.pole_pairs);
         self.q.timestamp_jitter_rms_s = (self.jitter.0 / self.jitter.1.max(1) as f64).sqrt();
-        self.q.wiring = self.wiring.findings();
+        self.q.wiring = wiring.findings();
         self.q.encoder_wraps = self.encoder.wraps;
         self.q.encoder_resets = self.encoder.resets;
-        self.q.clipped = self
-            .clips
+        self.q.clipped = clips
             .clipped()
             .into_iter()
             .map(|(column, share, value)| ClippedChannel {

@@ -64,6 +64,7 @@ mod cells;
 pub mod encoder;
 mod finish;
 mod report;
+mod signals;
 mod speed_unit;
 pub mod stuck;
 mod time_base;
@@ -75,7 +76,7 @@ pub(in crate::log) use time_base::median_positive;
 pub use time_base::TimeUnit;
 
 use super::{Column, LogError, Row, RowSink};
-use time_base::{time_base, CrossingCounter};
+use time_base::time_base;
 
 /// Rows whose intervals set the nominal sample period and time unit.
 pub const HEAD_ROWS: usize = 2048;
@@ -166,13 +167,11 @@ pub struct QualityStage<'a, S: CleanSink> {
     off_run_counts: (u64, u64),
     back_run: (usize, f64),
     burst: Option<(f64, f64)>,
-    crossings: CrossingCounter,
-    /// The speed channel's median over synchronous ([`speed_unit`]).
-    speed: speed_unit::SpeedScale,
-    clips: super::clipping::ClipTracker,
+    /// The clipping count, the wiring check, the current's zero crossings and the speed
+    /// channel's median over synchronous ([`speed_unit`]).
+    signals: signals::Signals,
     encoder: encoder::EncoderTrack,
     stuck: stuck::StuckTracker,
-    wiring: wiring::WiringCheck,
     jitter: (f64, u64),
     dropping: bool,
     /// Bad cells per column: [not finite, finite but beyond the limits].
@@ -202,12 +201,9 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             off_run_counts: (0, 0),
             back_run: (0, f64::NAN),
             burst: None,
-            crossings: CrossingCounter::default(),
-            speed: speed_unit::SpeedScale::new(limits.sync_rad_s),
-            clips: super::clipping::ClipTracker::default(),
+            signals: signals::Signals::new(limits.sync_rad_s),
             encoder: encoder::EncoderTrack::new(limits.wm_max),
             stuck: stuck::StuckTracker::default(),
-            wiring: wiring::WiringCheck::default(),
             jitter: (0.0, 0),
             dropping: false,
             cells_out: [[0; 2]; Column::COUNT],
@@ -251,49 +247,62 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         let head = std::mem::take(&mut self.head);
         self.q.rows_read = 0;
         for r in &head {
-            if !self.ingest(*r) {
+            if !self.ingest(r) {
                 self.stopped = true;
                 return;
             }
         }
     }
 
-    /// One raw row (time in the log's unit).
-    fn ingest(&mut self, mut r: Row) -> bool {
+    /// One raw row (time in the log's unit). The common row, one period after the last
+    /// with nothing held, goes straight on.
+    #[inline]
+    fn ingest(&mut self, r: &Row) -> bool {
         self.q.rows_read += 1;
-        r.t_s *= self.q.time_unit.seconds();
-        if !r.t_s.is_finite() {
+        let t = r.t_s * self.q.time_unit.seconds();
+        let d = t - self.last_t;
+        if self.pending.is_none() && (d - self.period).abs() <= INTERVAL_TOLERANCE * self.period {
+            // (Never the first row, whose `d` is infinite, nor a time not finite.)
+            self.off_run.clear();
+            self.off_run_counts = (0, 0);
+            self.back_run.0 = 0;
+            return self.emit_on_clock(r, t, 1.0);
+        }
+        self.ingest_other(r, t)
+    }
+
+    /// [`QualityStage::ingest`] of a row at `t` [s] after one held, off the period, or the
+    /// first.
+    #[cold]
+    fn ingest_other(&mut self, r: &Row, t: f64) -> bool {
+        if !t.is_finite() {
             self.q.non_finite_times += 1;
             self.note_dropped();
             return true;
         }
         if self.last_t == f64::NEG_INFINITY {
-            return self.emit(r);
+            return self.emit(r, t);
         }
         if let Some(p) = self.pending.take() {
             let tol = INTERVAL_TOLERANCE * self.period;
-            if (r.t_s - self.last_t - 2.0 * self.period).abs() <= tol {
+            if (t - self.last_t - 2.0 * self.period).abs() <= tol {
                 // p was one glitched timestamp between two rows on the grid.
                 self.q.timestamp_glitches += 1;
-                let fixed = Row {
-                    t_s: self.last_t + self.period,
-                    ..p
-                };
-                if !self.emit(fixed) {
+                if !self.emit(&p, self.last_t + self.period) {
                     return false;
                 }
             } else if !self.settle(p) {
                 return false;
             }
         }
-        let d = r.t_s - self.last_t;
+        let d = t - self.last_t;
         if (d - self.period).abs() <= INTERVAL_TOLERANCE * self.period {
             self.off_run.clear();
             self.off_run_counts = (0, 0);
             self.back_run.0 = 0;
-            return self.emit_on_clock(r, 1.0);
+            return self.emit_on_clock(r, t, 1.0);
         }
-        self.pending = Some(r);
+        self.pending = Some(Row { t_s: t, ..*r });
         true
     }
 
@@ -312,7 +321,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             }
             self.off_run.clear();
             self.off_run_counts = (0, 0);
-            return self.new_segment(SegmentBreak::Gap(d)) && self.emit(p);
+            return self.new_segment(SegmentBreak::Gap(d)) && self.emit(&p, p.t_s);
         }
         let m = (d / self.period).round();
         if m >= 2.0 && (d - m * self.period).abs() <= INTERVAL_TOLERANCE * self.period {
@@ -329,28 +338,26 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
             return false;
         }
         if m >= 2.0 && (d - m * self.period).abs() <= INTERVAL_TOLERANCE * self.period {
-            self.emit_on_clock(p, m)
+            self.emit_on_clock(&p, p.t_s, m)
         } else {
-            self.emit(p)
+            self.emit(&p, p.t_s)
         }
     }
 
-    /// Emits a row `m` periods after the last one on the smoothed sample clock: its time
-    /// moves the clock [`CLOCK_GAIN`] of the way to its own. A row within
+    /// Emits a row at `t` [s], `m` periods after the last one, on the smoothed sample
+    /// clock: its time moves the clock [`CLOCK_GAIN`] of the way to its own. A row within
     /// [`CLOCK_EXACT`] of a period of the clock keeps its own time (a clean log passes
     /// unchanged, to the last bit).
-    fn emit_on_clock(&mut self, r: Row, m: f64) -> bool {
+    #[inline]
+    fn emit_on_clock(&mut self, r: &Row, t: f64, m: f64) -> bool {
         let predicted = self.last_t + m * self.period;
-        let err = r.t_s - predicted;
+        let err = t - predicted;
         self.jitter.0 += err * err;
         self.jitter.1 += 1;
         if err.abs() <= CLOCK_EXACT * self.period {
-            return self.emit(r);
+            return self.pass(r, t);
         }
-        self.emit(Row {
-            t_s: predicted + CLOCK_GAIN * err,
-            ..r
-        })
+        self.emit(r, predicted + CLOCK_GAIN * err)
     }
 
     /// After [`RATE_CHANGE_RUN`] off-period intervals: if they agree, the rate changed.
@@ -396,46 +403,63 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         self.off_run.clear();
         self.off_run_counts = (0, 0);
         self.encoder.restart();
-        self.new_segment(SegmentBreak::ClockReset) && self.emit(p)
+        self.new_segment(SegmentBreak::ClockReset) && self.emit(&p, p.t_s)
     }
 
     fn new_segment(&mut self, why: SegmentBreak) -> bool {
         self.q.segments += 1;
-        self.wiring.interrupt();
+        self.signals.interrupt();
         self.sink.new_segment(why)
     }
 
-    /// Passes a row on: cells judged (the encoder count made continuous, see
-    /// [`encoder`]), bursts and crossings tracked.
-    fn emit(&mut self, mut r: Row) -> bool {
-        self.last_t = r.t_s;
+    /// Passes a row on at `t_s` [s]: cells judged (the encoder count made continuous,
+    /// see [`encoder`]), bursts tracked, the good rows counted by the accumulators
+    /// ([`signals`]). The row goes on as it came when neither its time nor its count
+    /// changed.
+    #[inline(never)]
+    fn emit(&mut self, r: &Row, t_s: f64) -> bool {
+        self.pass(r, t_s)
+    }
+
+    /// [`QualityStage::emit`] in line (the common row's path).
+    #[inline(always)]
+    fn pass(&mut self, r: &Row, t_s: f64) -> bool {
+        self.last_t = t_s;
         self.dropping = false;
         self.q.rows_passed += 1;
-        let mut bad = BadCells::of(&r, &self.limits);
+        let mut bad = BadCells::of(r, &self.limits);
+        let mut enc = r.enc_count;
         if let Some(raw) = r.enc_count {
-            match self.encoder.check(raw, r.t_s) {
-                encoder::EncoderCell::Good(c) => r.enc_count = Some(c),
+            match self.encoder.check(raw, t_s) {
+                encoder::EncoderCell::Good(c) => enc = Some(c),
                 encoder::EncoderCell::Bad => bad.set(Column::Encoder),
             }
         }
         let before = bad;
-        self.stuck.check(&r, &mut bad);
+        self.stuck.check_flagged(r, &mut bad);
         if bad != before {
             self.count_stuck(before, bad);
         }
         if bad.any() {
-            self.bad_row(&r, bad);
-            self.wiring.interrupt();
+            self.bad_row(r, t_s, bad);
         } else {
-            self.clips.push(&r, |_| true);
-            self.end_burst();
-            self.crossings.push(r.t_s, r.i_abc[0], 1.0);
-            if let Some(w) = r.wm_rad_s {
-                self.speed.push(w);
+            if self.burst.is_some() {
+                self.end_burst();
             }
-            self.wiring.push(&r);
+            self.signals.push(r, t_s);
         }
-        self.sink.row(&r, bad)
+        if t_s.to_bits() == r.t_s.to_bits() && enc == r.enc_count {
+            self.sink.row(r, bad)
+        } else {
+            self.sink.row(
+                &Row {
+                    t_s,
+                    enc_count: enc,
+                    ..*r
+                },
+                bad,
+            )
+        }
     }
 
     /// Counts the cells the stuck tracker marked (`before`: the row's bad cells without).
@@ -448,11 +472,12 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         }
     }
 
-    /// A row with bad cells: its good cells counted for the clipping, the bad ones by
-    /// column and kind, the burst it belongs to.
+    /// A row with bad cells, passed on at `t_s`: its good cells counted for the clipping,
+    /// the bad ones by column and kind, the burst it belongs to; the wiring check's
+    /// sequence broken.
     #[cold]
-    fn bad_row(&mut self, r: &Row, bad: BadCells) {
-        self.clips.push(r, |c| !bad.has(c));
+    fn bad_row(&mut self, r: &Row, t_s: f64, bad: BadCells) {
+        self.signals.bad_row(r, |c| !bad.has(c));
         self.q.bad_rows += 1;
         for c in Column::ALL {
             if bad.has(c) {
@@ -463,8 +488,8 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
                 self.cells_out[c as usize][1] += u64::from(finite && beyond);
             }
         }
-        let start = self.burst.map_or(r.t_s, |b| b.0);
-        self.burst = Some((start, r.t_s));
+        let start = self.burst.map_or(t_s, |b| b.0);
+        self.burst = Some((start, t_s));
     }
 
     /// A row dropped for its time: counts the stretches of them.
@@ -475,6 +500,7 @@ impl<'a, S: CleanSink> QualityStage<'a, S> {
         }
     }
 
+    #[cold]
     fn end_burst(&mut self) {
         if let Some((a, b)) = self.burst.take() {
             let length = b - a + self.period;
@@ -493,7 +519,7 @@ impl<S: CleanSink> RowSink for QualityStage<'_, S> {
             return false;
         }
         if self.base.is_some() {
-            let go = self.ingest(*row);
+            let go = self.ingest(row);
             self.stopped = !go;
             return go;
         }
@@ -514,10 +540,9 @@ impl<S: CleanSink> RowSink for QualityStage<'_, S> {
         self.off_run_counts = (0, 0);
         self.back_run = (0, f64::NAN);
         self.burst = None;
-        self.crossings = CrossingCounter::default();
+        self.signals = signals::Signals::new(self.limits.sync_rad_s);
         self.encoder = encoder::EncoderTrack::new(self.limits.wm_max);
         self.stuck = stuck::StuckTracker::default();
-        self.wiring = wiring::WiringCheck::default();
         self.jitter = (0.0, 0);
         self.dropping = false;
         self.cells_out = [[0; 2]; Column::COUNT];

@@ -39,6 +39,7 @@ impl SpeedScale {
     }
 
     /// One passed row's mechanical speed [rad/s, as read].
+    #[inline]
     pub(super) fn push(&mut self, wm_rad_s: f64) {
         let bin = match self.last {
             Some((bits, bin)) if bits == wm_rad_s.to_bits() => bin,
@@ -57,6 +58,27 @@ impl SpeedScale {
             *b += 1;
         }
         self.count += 1;
+    }
+
+    /// [`SpeedScale::push`] of each speed in turn (a run of the last speed counted at
+    /// once).
+    pub(super) fn push_all(&mut self, wm_rad_s: &[f64]) {
+        let mut rest = wm_rad_s;
+        while let Some((&w, tail)) = rest.split_first() {
+            if let Some((bits, bin)) = self.last {
+                let run = rest.iter().take_while(|x| x.to_bits() == bits).count();
+                if run > 0 {
+                    if let Some(b) = self.hist.get_mut(bin) {
+                        *b += run as u64;
+                    }
+                    self.count += run as u64;
+                    rest = rest.get(run..).unwrap_or_default();
+                    continue;
+                }
+            }
+            self.push(w);
+            rest = tail;
+        }
     }
 
     /// The median speed over synchronous, `None` with fewer than [`MIN_ROWS`] rows.

@@ -40,8 +40,10 @@ const PHASES: [Column; 6] = [
 pub struct StuckTracker {
     /// Rows a run must last to be stuck.
     run_min: u32,
-    /// Per channel (va, vb, vc, ia, ib, ic): last reading and run length.
-    runs: [(f64, u32); 6],
+    /// Per channel (va, vb, vc, ia, ib, ic): last reading (NaN after a bad cell) ...
+    last: [f64; 6],
+    /// ... and the length of its run (0 after a bad cell).
+    runs: [u64; 6],
 }
 
 impl StuckTracker {
@@ -53,35 +55,74 @@ impl StuckTracker {
             .min(f64::from(u32::MAX / 2)) as u32;
         StuckTracker {
             run_min: run.max(STUCK_MIN_SAMPLES),
-            runs: [(f64::NAN, 0); 6],
+            last: [f64::NAN; 6],
+            runs: [0; 6],
         }
     }
 
     /// Follows `row` and marks its stuck cells in `bad` (cells already bad are left out of
     /// the runs).
+    #[inline]
     pub fn check(&mut self, row: &Row, bad: &mut BadCells) {
         let v = row.v_abc.unwrap_or([f64::NAN; 3]);
         let values = [v[0], v[1], v[2], row.i_abc[0], row.i_abc[1], row.i_abc[2]];
-        let mut longest = 0;
-        for ((run, x), c) in self.runs.iter_mut().zip(values).zip(&PHASES) {
-            if bad.has(*c) || !x.is_finite() {
-                *run = (f64::NAN, 0);
-            } else if x == run.0 {
-                run.1 = run.1.saturating_add(1);
-            } else {
-                *run = (x, 1);
-            }
-            longest = longest.max(run.1);
+        // Branch-free (every channel of a live log changes nearly every row): per channel
+        // a mask of ones where the cell counts (not bad, finite) and one where it repeats
+        // the last reading; a run goes on, starts at one, or is 0 for a cell left out.
+        let mask = |b: bool| 0u64.wrapping_sub(u64::from(b));
+        let limit = u64::from(self.run_min).wrapping_sub(1);
+        let mut over = 0u64;
+        for (k, (&x, c)) in values.iter().zip(&PHASES).enumerate() {
+            let ok = mask(!bad.has(*c) & (x.abs() <= f64::MAX));
+            let same = mask(x == self.last[k]);
+            let run = ((self.runs[k] & same).wrapping_add(1)) & ok;
+            self.runs[k] = run;
+            self.last[k] = f64::from_bits((x.to_bits() & ok) | (f64::NAN.to_bits() & !ok));
+            // The top bit set when the run is at least `run_min` long.
+            over |= limit.wrapping_sub(run);
         }
         // (Every row of a live log ends here: no run is long.)
-        if longest >= self.run_min {
+        if over >> 63 != 0 {
+            self.mark(row.v_abc.is_some(), bad);
+        }
+    }
+
+    /// [`StuckTracker::check`] of a row whose non-finite phase cells `bad` already flags
+    /// (as [`BadCells::of`] does): the common row, with no phase cell bad, is followed
+    /// without judging each cell again; the same runs, the same marks.
+    #[inline]
+    pub(super) fn check_flagged(&mut self, row: &Row, bad: &mut BadCells) {
+        if PHASES.iter().any(|c| bad.has(*c)) {
+            return self.check(row, bad);
+        }
+        let v = row.v_abc.unwrap_or([f64::NAN; 3]);
+        let values = [v[0], v[1], v[2], row.i_abc[0], row.i_abc[1], row.i_abc[2]];
+        let limit = u64::from(self.run_min).wrapping_sub(1);
+        let mut over = 0u64;
+        for (k, &x) in values.iter().enumerate() {
+            let same = 0u64.wrapping_sub(u64::from(x == self.last[k]));
+            let run = (self.runs[k] & same).wrapping_add(1);
+            self.runs[k] = run;
+            over |= limit.wrapping_sub(run);
+        }
+        self.last = values;
+        if row.v_abc.is_none() {
+            // No voltages: no runs (their NaN never repeats, and is the mark of a cell
+            // left out).
+            self.runs[..3].fill(0);
+            over = limit.wrapping_sub(self.runs[3]) | limit.wrapping_sub(self.runs[4]);
+            over |= limit.wrapping_sub(self.runs[5]);
+        }
+        // The top bit set when a run is at least `run_min` long. (Every row of a live
+        // log ends here: no run is long.)
+        if over >> 63 != 0 {
             self.mark(row.v_abc.is_some(), bad);
         }
     }
 
     /// Marks the stuck cells of the row just followed.
     fn mark(&self, has_v: bool, bad: &mut BadCells) {
-        let stuck: [bool; 6] = std::array::from_fn(|k| self.runs[k].1 >= self.run_min);
+        let stuck: [bool; 6] = std::array::from_fn(|k| self.runs[k] >= u64::from(self.run_min));
         let alive = |set: &[bool]| set.iter().any(|s| !s);
         let (sv, si) = (&stuck[..3], &stuck[3..]);
         for (k, c) in PHASES.iter().enumerate() {
@@ -116,17 +157,51 @@ mod tests {
         }
     }
 
+    /// The cells marked stuck in `rows` (their bad cells those of [`BadCells::of`]), the
+    /// same by [`StuckTracker::check`] and [`StuckTracker::check_flagged`].
     fn marked(rows: &[Row]) -> [u32; 6] {
-        let mut tr = StuckTracker::new(1e-4, 50.0);
+        let lim = super::super::CellLimits {
+            v_max: 1000.0,
+            i_max: 100.0,
+            wm_max: 1000.0,
+            supply_hz: 50.0,
+            sync_rad_s: 157.0,
+            pole_pairs: 2.0,
+        };
+        let (mut tr, mut flagged) = (StuckTracker::new(1e-4, 50.0), StuckTracker::new(1e-4, 50.0));
         let mut n = [0u32; 6];
         for r in rows {
-            let mut b = BadCells::default();
+            let before = BadCells::of(r, &lim);
+            let (mut b, mut f) = (before, before);
             tr.check(r, &mut b);
+            flagged.check_flagged(r, &mut f);
+            assert_eq!(b, f, "{r:?}");
             for (k, c) in PHASES.iter().enumerate() {
-                n[k] += u32::from(b.has(*c));
+                n[k] += u32::from(b.has(*c) && !before.has(*c));
             }
         }
         n
+    }
+
+    #[test]
+    fn without_voltages_or_with_missing_cells_the_currents_are_judged_alone() {
+        let rows: Vec<Row> = (0..20_000)
+            .map(|k| {
+                let mut r = row(k as f64 * 1e-4);
+                r.v_abc = None;
+                if (5000..10_000).contains(&k) {
+                    r.i_abc[1] = -2.0;
+                }
+                if k % 997 == 0 {
+                    r.i_abc[2] = f64::NAN;
+                }
+                r
+            })
+            .collect();
+        let n = marked(&rows);
+        assert_eq!(n[..3], [0, 0, 0]);
+        assert!(n[4] >= 4940 && n[4] <= 4952, "{n:?}");
+        assert_eq!([n[3], n[5]], [0, 0]);
     }
 
     #[test]

@@ -54,20 +54,25 @@ pub(in crate::log) fn median_positive(x: &mut Vec<f64>) -> Option<f64> {
 /// periods between positive-going crossings.
 #[derive(Debug, Clone, Default)]
 pub(super) struct CrossingCounter {
+    state: Crossing,
+    periods: Vec<f64>,
+}
+
+/// The counter's state between samples.
+#[derive(Debug, Clone, Copy, Default)]
+struct Crossing {
     peak: f64,
     positive: Option<bool>,
     last_rise: Option<f64>,
-    periods: Vec<f64>,
     last_t: Option<f64>,
 }
 
-/// Periods kept for the median (a day at 50 Hz is 4.3 million).
-const MAX_PERIODS: usize = 1 << 20;
-
-impl CrossingCounter {
-    pub(super) fn push(&mut self, t: f64, x: f64, decay_s: f64) {
+impl Crossing {
+    /// One sample; the period it ends, if it is a positive-going crossing after another.
+    #[inline(always)]
+    fn step(&mut self, t: f64, x: f64, decay_s: f64) -> Option<f64> {
         if !x.is_finite() {
-            return;
+            return None;
         }
         let dt = self.last_t.map_or(0.0, |l| (t - l).max(0.0));
         self.last_t = Some(t);
@@ -80,15 +85,41 @@ impl CrossingCounter {
         } else {
             self.positive
         };
+        let mut period = None;
         if now == Some(true) && self.positive == Some(false) {
-            if let Some(r) = self.last_rise {
-                if self.periods.len() < MAX_PERIODS {
-                    self.periods.push(t - r);
-                }
-            }
+            period = self.last_rise.map(|r| t - r);
             self.last_rise = Some(t);
         }
         self.positive = now;
+        period
+    }
+}
+
+/// Periods kept for the median (a day at 50 Hz is 4.3 million).
+const MAX_PERIODS: usize = 1 << 20;
+
+impl CrossingCounter {
+    pub(super) fn push(&mut self, t: f64, x: f64, decay_s: f64) {
+        if let Some(p) = self.state.step(t, x, decay_s) {
+            self.keep(p);
+        }
+    }
+
+    /// [`CrossingCounter::push`] of each `(t[k], x[k])`, the state kept in registers.
+    pub(super) fn push_all(&mut self, t: &[f64], x: &[f64], decay_s: f64) {
+        let mut s = self.state;
+        for (&t, &x) in t.iter().zip(x) {
+            if let Some(p) = s.step(t, x, decay_s) {
+                self.keep(p);
+            }
+        }
+        self.state = s;
+    }
+
+    fn keep(&mut self, period: f64) {
+        if self.periods.len() < MAX_PERIODS {
+            self.periods.push(period);
+        }
     }
 
     /// The median period (in the times' unit), from at least two whole periods.

@@ -37,10 +37,71 @@ pub struct WiringCheck {
 }
 
 /// Clarke's alpha and beta of a phase set.
+#[inline(always)]
 fn clarke(x: [f64; 3]) -> [f64; 2] {
     let alpha = (2.0 * x[0] - x[1] - x[2]) / 3.0;
     let beta = (x[1] - x[2]) / 3f64.sqrt();
     [alpha, beta]
+}
+
+/// Rows whose Clarke vectors [`WiringCheck::push_block`] computes at a time.
+const CHUNK: usize = 64;
+
+/// Alpha and beta of up to [`CHUNK`] rows.
+type Clarke = [[f64; CHUNK]; 2];
+
+/// [`clarke`] of each row of a phase set given channel by channel (at most [`CHUNK`] rows).
+fn clarke_all(x: [&[f64]; 3]) -> Clarke {
+    let mut out = [[0.0; CHUNK]; 2];
+    let [a, b] = &mut out;
+    for ((((alpha, beta), x0), x1), x2) in
+        a.iter_mut().zip(b.iter_mut()).zip(x[0]).zip(x[1]).zip(x[2])
+    {
+        [*alpha, *beta] = clarke([*x0, *x1, *x2]);
+    }
+    out
+}
+
+/// Whether both vectors turned (the cross products of consecutive Clarke vectors), and
+/// whether they turned opposite ways, as counts.
+#[inline(always)]
+fn turn_counts(turn_i: f64, turn_v: f64) -> (u64, u64) {
+    let both = (turn_i != 0.0) & (turn_v != 0.0);
+    (
+        u64::from(both),
+        u64::from(both & ((turn_i > 0.0) != (turn_v > 0.0))),
+    )
+}
+
+/// The turns between consecutive rows of the first `m` rows of one chunk: rows on which
+/// both vectors turned, and on which they turned opposite ways.
+fn count_turns(ci: &Clarke, cv: &Clarke, m: usize) -> (u64, u64) {
+    let m = m.min(CHUNK);
+    let (ai, bi, av, bv) = (&ci[0][..m], &ci[1][..m], &cv[0][..m], &cv[1][..m]);
+    let (mut turning, mut opposite) = (0, 0);
+    for k in 1..m {
+        let turn_i = ai[k - 1] * bi[k] - bi[k - 1] * ai[k];
+        let turn_v = av[k - 1] * bv[k] - bv[k - 1] * av[k];
+        let (t, o) = turn_counts(turn_i, turn_v);
+        turning += t;
+        opposite += o;
+    }
+    (turning, opposite)
+}
+
+/// Adds to `equal` the rows on which each pair (ab, bc, ca) of `x` read the same non-zero
+/// value.
+fn count_equal(equal: &mut [u64], x: [&[f64]; 3]) {
+    let same = |p: f64, q: f64| u64::from((p == q) & (p != 0.0));
+    let mut n = [0u64; 3];
+    for ((&a, &b), &c) in x[0].iter().zip(x[1]).zip(x[2]) {
+        n[0] += same(a, b);
+        n[1] += same(b, c);
+        n[2] += same(c, a);
+    }
+    for (e, n) in equal.iter_mut().zip(n) {
+        *e += n;
+    }
 }
 
 impl WiringCheck {
@@ -66,6 +127,41 @@ impl WiringCheck {
                 }
             }
             self.last = Some((ci, cv));
+        }
+    }
+
+    /// Follows a block of rows whose cells are all good, channel by channel (`v`: the
+    /// voltages a, b, c when the rows have them; `i`: the currents, as long): the same
+    /// counts as [`WiringCheck::push`] row by row, in loops the compiler vectorises.
+    pub fn push_block(&mut self, v: Option<[&[f64]; 3]>, i: [&[f64]; 3]) {
+        let n = i[0].len();
+        self.rows += n as u64;
+        count_equal(&mut self.equal[..3], i);
+        let Some(v) = v else {
+            return;
+        };
+        count_equal(&mut self.equal[3..], v);
+        let mut start = 0;
+        while start < n {
+            let m = (n - start).min(CHUNK);
+            let (ci, cv) = (
+                clarke_all(i.map(|c| c.get(start..start + m).unwrap_or_default())),
+                clarke_all(v.map(|c| c.get(start..start + m).unwrap_or_default())),
+            );
+            let first = |c: &Clarke| [c[0][0], c[1][0]];
+            if let Some((pi, pv)) = self.last {
+                let turn_i = pi[0] * first(&ci)[1] - pi[1] * first(&ci)[0];
+                let turn_v = pv[0] * first(&cv)[1] - pv[1] * first(&cv)[0];
+                let (t, o) = turn_counts(turn_i, turn_v);
+                self.turning += t;
+                self.opposite += o;
+            }
+            let (t, o) = count_turns(&ci, &cv, m);
+            self.turning += t;
+            self.opposite += o;
+            let last = |c: &Clarke| [c[0][m - 1], c[1][m - 1]];
+            self.last = Some((last(&ci), last(&cv)));
+            start += m;
         }
     }
 
