@@ -23,6 +23,7 @@
 //! reference angle turns by a step held over a block, whose sin/cos is computed once per
 //! block ([`super::trig::Oscillator::turn`]).
 
+mod block_filter;
 mod lanes;
 mod reference;
 mod slow;
@@ -289,7 +290,12 @@ impl SequenceFront {
                     1.0
                 },
             ),
-            slow: SlowFilters::new(rotor.block_s(), w0 as f32, REFERENCE_FC_HZ)?,
+            slow: SlowFilters::new(
+                1.0 / sample_rate_hz,
+                rotor.per_block(),
+                w0 as f32,
+                REFERENCE_FC_HZ,
+            )?,
             last_t: None,
             reference: Reference::new(1.0 / sample_rate_hz, w0, w0 as f32),
             phi: 0.0,

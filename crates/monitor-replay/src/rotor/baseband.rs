@@ -246,6 +246,11 @@ impl RotorFront {
         &self.blocks
     }
 
+    /// Samples per block.
+    pub fn per_block(&self) -> u32 {
+        self.per_block
+    }
+
     /// A block's length [s].
     pub fn block_s(&self) -> f64 {
         self.block_s

@@ -15,20 +15,21 @@
 //! block when the PLL runs 1 Hz off the reference (a run-up), which changes the mean by
 //! `1 - 0.013^2/24`.
 //!
-//! What the block rate changes against filters stepped every sample: the block mean delays
-//! the input by half a block (1 ms) and the outputs are held over a block (at most 2 ms
-//! old), against the 2 Hz filters' own delay of `2/wc` = 160 ms; the block mean passes the
-//! Park frame's `2f` image (a negative sequence) at `sinc(1/4)` = 0.90 and folds the `6f`
-//! image of the 5th and 7th harmonics onto `2f`, where the 2 Hz filter passes
-//! `(2 Hz/2f)^2` (3e-4 at 60 Hz) of it; the filters' semi-implicit Euler step at `wc T`
-//! = 0.026 instead of 0.0013 moves their step response by about that share of its time
-//! scale; steady values are the same. Rows with a bad current are held out (as before);
+//! What the block rate changes against filters stepped every sample: each filter makes
+//! exactly what the per-sample filter makes of the block's samples replaced by their mean
+//! ([`super::block_filter`]), and its value is given half a block ahead, so the response
+//! and the delay are the per-sample filter's; what differs is the variation within a
+//! block: the block mean passes the Park frame's `2f` image (a negative sequence) at
+//! `sinc(1/4)` = 0.90 and folds the `6f` image of the 5th and 7th harmonics onto `2f`,
+//! where the 2 Hz filter passes `(2 Hz/2f)^2` (3e-4 at 60 Hz) of it, and the outputs
+//! between two blocks are the first-order prediction (within `(wc T)^2` = 7e-4 of a
+//! transient's own size). Rows with a bad current are held out (as before);
 //! samples filled across a short gap count into the block's sequences (the Park
 //! components of a sample turned back by the supply angle and taken on the PLL's angle
 //! turned back as far are the row's own).
 
+use super::block_filter::{BlockState, BlockSvf};
 use super::lanes::Demod;
-use monitor_core::filter::{Svf, SvfState};
 use monitor_core::frames::AlphaBeta;
 use monitor_core::ConfigError;
 
@@ -49,33 +50,33 @@ pub(super) struct SlowFilters {
     filled: Demod,
     /// The 2 Hz filter (the sequences and the normaliser) and the reference's 1 Hz filter,
     /// both at the block rate.
-    seq: Svf,
-    reference: Svf,
-    i: [SvfState; 2],
-    v: [SvfState; 2],
-    ms: SvfState,
-    w: SvfState,
+    seq: BlockSvf,
+    reference: BlockSvf,
+    i: [BlockState; 2],
+    v: [BlockState; 2],
+    ms: BlockState,
+    w: BlockState,
     /// `1/sqrt` of the filtered mean square (0 before the first current).
     k: f32,
 }
 
 impl SlowFilters {
-    /// Filters stepped every `block_s` [s] for a supply of nominal angular frequency `w0`
-    /// [rad/s]; the reference filter's corner `reference_fc_hz`. Errors: [`Svf::new`]'s.
-    pub fn new(block_s: f64, w0: f32, reference_fc_hz: f32) -> Result<Self, ConfigError> {
-        let block = block_s as f32;
+    /// Filters for a log sampled every `dt_s` [s], stepped every `n` samples, for a supply
+    /// of nominal angular frequency `w0` [rad/s]; the reference filter's corner
+    /// `reference_fc_hz`. Errors: [`BlockSvf::new`]'s.
+    pub fn new(dt_s: f64, n: u32, w0: f32, reference_fc_hz: f32) -> Result<Self, ConfigError> {
         Ok(SlowFilters {
             w_sum: 0.0,
             rows: 0,
             m2_sum: 0.0,
             n_m: 0,
             filled: Demod::default(),
-            seq: Svf::new(SEQUENCE_FC_HZ, block)?,
-            reference: Svf::new(reference_fc_hz, block)?,
-            i: [SvfState::default(); 2],
-            v: [SvfState::default(); 2],
-            ms: SvfState::default(),
-            w: SvfState::at(w0),
+            seq: BlockSvf::new(SEQUENCE_FC_HZ, dt_s, n)?,
+            reference: BlockSvf::new(reference_fc_hz, dt_s, n)?,
+            i: [BlockState::default(); 2],
+            v: [BlockState::default(); 2],
+            ms: BlockState::default(),
+            w: BlockState::at(w0),
             k: 0.0,
         })
     }
@@ -83,7 +84,7 @@ impl SlowFilters {
     /// The PLL's frequency low-passed [rad/s] (held over a block).
     #[inline]
     pub fn w_ref(&self) -> f32 {
-        self.w.y()
+        self.w.value()
     }
 
     /// The positive sequences `(d, q)` of the currents and of the voltages on the PLL's
@@ -91,15 +92,15 @@ impl SlowFilters {
     #[inline]
     pub fn positive(&self) -> ((f32, f32), (f32, f32)) {
         (
-            (self.i[0].y(), self.i[1].y()),
-            (self.v[0].y(), self.v[1].y()),
+            (self.i[0].value(), self.i[1].value()),
+            (self.v[0].value(), self.v[1].value()),
         )
     }
 
     /// Whether the normaliser has not started yet (no current seen).
     #[inline]
     pub fn normaliser_unset(&self) -> bool {
-        self.ms.y() <= 0.0
+        self.ms.value() <= 0.0
     }
 
     /// The currents' normaliser for the PLL: `1/sqrt` of the current vector's filtered
@@ -150,22 +151,22 @@ impl SlowFilters {
         };
         if d.n_i > 0 {
             let (dd, q) = turn(d.i, d.n_i);
-            self.seq.update(&mut self.i[0], dd);
-            self.seq.update(&mut self.i[1], q);
+            self.seq.step(&mut self.i[0], dd);
+            self.seq.step(&mut self.i[1], q);
         }
         if d.n_v > 0 {
             let (dd, q) = turn(d.v, d.n_v);
-            self.seq.update(&mut self.v[0], dd);
-            self.seq.update(&mut self.v[1], q);
+            self.seq.step(&mut self.v[0], dd);
+            self.seq.step(&mut self.v[1], q);
         }
         if self.n_m > 0 {
-            let y = self.seq.update(&mut self.ms, self.m2_sum / self.n_m as f32);
+            let y = self.seq.step(&mut self.ms, self.m2_sum / self.n_m as f32);
             self.k = 1.0 / monitor_core::math::sqrt(y.max(1e-12));
         }
         let moved = self.rows > 0;
         if moved {
             self.reference
-                .update(&mut self.w, self.w_sum / self.rows as f32);
+                .step(&mut self.w, self.w_sum / self.rows as f32);
         }
         (self.w_sum, self.rows, self.m2_sum, self.n_m) = (0.0, 0, 0.0, 0);
         moved
