@@ -4,8 +4,9 @@
 //! Two analyses run on one PLL (locked to the voltages where logged, else to the
 //! amplitude-normalised current vector):
 //! - filtered Park sequences ([`SequenceAnalyzer`](monitor_core::sequence::SequenceAnalyzer), 2 Hz) on the PLL's own angle: the
-//!   steady point the isolation evaluates ([`SequenceTracker::steady_point`]);
-//! - least-squares phasors ([`PhasorFit`]) over windows of [`WINDOW_PERIODS`] supply
+//!   steady point the isolation evaluates ([`SequenceTracker::steady_point`]), stepped
+//!   once per block ([`slow`]);
+//! - least-squares phasors ([`PhasorFit`](monitor_core::sequence::PhasorFit)) over windows of [`WINDOW_PERIODS`] supply
 //!   periods on a reference angle that turns at the PLL's frequency low-passed at
 //!   [`REFERENCE_FC_HZ`]: the negative-sequence analysis ([`super::winding`]). The
 //!   reference does not follow the `2f` wobble that a large negative sequence puts into the
@@ -30,7 +31,7 @@ mod slow;
 
 use super::trig::Oscillator;
 use super::{FILLED_SAMPLES, SENSOR_PHASE_MIN_RATIO};
-use lanes::{Demod, WindowSums};
+use lanes::{Demod, FitSums};
 use monitor_core::angle::SrfPll;
 use monitor_core::frames::{clarke, AlphaBeta, SinCos};
 use monitor_core::sequence::{single_phase_gain, Complex32, SinglePhaseGain, ThreePhasors};
@@ -92,7 +93,7 @@ pub struct SequenceWindow {
 #[derive(Debug, Clone, Copy)]
 struct OpenWindow {
     /// The least-squares sums of the currents and the voltages ([`lanes`]).
-    sums: WindowSums,
+    sums: FitSums,
     /// Samples offered (good or not).
     offered: u32,
     /// Voltage samples that were bad (the voltages' fit is then not used).
@@ -106,7 +107,7 @@ struct OpenWindow {
 impl OpenWindow {
     fn new() -> Self {
         OpenWindow {
-            sums: WindowSums::default(),
+            sums: FitSums::default(),
             offered: 0,
             bad_v: 0,
             from_s: 0.0,

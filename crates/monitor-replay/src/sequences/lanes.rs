@@ -1,4 +1,4 @@
-//! The least-squares window's sums ([`WindowSums`]): per sample in single precision, four
+//! The least-squares window's sums ([`FitSums`]): per sample in single precision, four
 //! lanes at a time, over a short block; the blocks added up in double precision.
 //!
 //! [`PhasorFit`]'s sums are double precision because a window holds up to 10^5 samples;
@@ -56,7 +56,7 @@ impl Demod {
 
 /// One block's sums in single precision (module docs).
 #[derive(Debug, Clone, Copy, Default)]
-struct Block {
+struct LaneBlock {
     /// `sum [x_a, x_b, x_c, 1] c`, `... s` and `sum [x_a, x_b, x_c, 1]` of the currents.
     ic: [f32; 4],
     is: [f32; 4],
@@ -71,8 +71,8 @@ struct Block {
 
 /// A least-squares window's sums (module docs): the open block and the window's totals.
 #[derive(Debug, Clone, Copy, Default)]
-pub(super) struct WindowSums {
-    block: Block,
+pub(super) struct FitSums {
+    block: LaneBlock,
     /// Samples in the window's closed blocks.
     n: u32,
     /// `[sum c^2, sum s^2, sum c s, sum c, sum s]` ([`PhasorFit::from_sums`]).
@@ -82,10 +82,13 @@ pub(super) struct WindowSums {
     x_v: [[f64; 3]; 3],
 }
 
-impl WindowSums {
+impl FitSums {
     /// Adds one sample: `sc` the reference's sin/cos, `i` and `v` the phase currents and
     /// voltages `[a, b, c, 1]` (`v` where good).
     #[inline]
+    // Seven arrays indexed alike, lane by lane: the form the vectoriser makes four-lane
+    // products and sums of.
+    #[allow(clippy::needless_range_loop)]
     pub fn add(&mut self, sc: SinCos, i: [f32; 4], v: Option<[f32; 4]>) {
         let (c, s) = (sc.cos, sc.sin);
         let b = &mut self.block;
@@ -163,7 +166,7 @@ mod tests {
     #[test]
     fn gives_the_double_precision_fit_within_1e_6() {
         let (mut sums, mut fit_i, mut fit_v) =
-            (WindowSums::default(), PhasorFit::new(), PhasorFit::new());
+            (FitSums::default(), PhasorFit::new(), PhasorFit::new());
         let tau = std::f64::consts::TAU;
         for k in 0..1667u32 {
             let th = tau * 60.0 * f64::from(k) / 1e4;
@@ -228,7 +231,7 @@ mod tests {
     /// summed sample by sample in double precision.
     #[test]
     fn the_blocks_vectors_are_the_clarke_transform_turned_back() {
-        let mut sums = WindowSums::default();
+        let mut sums = FitSums::default();
         let (mut zi, mut zv) = ([0.0f64; 2], [0.0f64; 2]);
         let tau = std::f64::consts::TAU;
         for k in 0..21u32 {
