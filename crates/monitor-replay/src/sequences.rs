@@ -4,28 +4,44 @@
 //! Two analyses run on one PLL (locked to the voltages where logged, else to the
 //! amplitude-normalised current vector):
 //! - filtered Park sequences ([`SequenceAnalyzer`](monitor_core::sequence::SequenceAnalyzer), 2 Hz) on the PLL's own angle: the
-//!   steady point the isolation evaluates ([`SequenceTracker::steady_point`]);
-//! - least-squares phasors ([`PhasorFit`]) over windows of [`WINDOW_PERIODS`] supply
+//!   steady point the isolation evaluates ([`SequenceTracker::steady_point`]), stepped
+//!   once per block ([`slow`]);
+//! - least-squares phasors ([`PhasorFit`](monitor_core::sequence::PhasorFit)) over windows of [`WINDOW_PERIODS`] supply
 //!   periods on a reference angle that turns at the PLL's frequency low-passed at
 //!   [`REFERENCE_FC_HZ`]: the negative-sequence analysis ([`super::winding`]). The
 //!   reference does not follow the `2f` wobble that a large negative sequence puts into the
 //!   current vector's angle (a PLL that follows it moves part of the negative sequence into
 //!   the angle: on real recordings of shorted turns a 15 % negative sequence read as
 //!   2.4 %), and the fit is exact for any offset of it.
+//!
+//! Per row only what must follow the samples runs: the PLL (its angle is the frame) and
+//! the least-squares sums on the reference angle (single precision over short blocks,
+//! [`lanes`]). The rest is done once per block of an eighth of a supply period (the rotor
+//! demodulator's blocks): the blocks' sums give the current and voltage vectors turned
+//! back by the reference angle, which the rotor's demodulator records and the slow
+//! quantities (the 2 Hz sequences on the PLL's angle, the currents' normaliser, the
+//! reference frequency) are filtered on ([`slow`], where what that changes is stated); the
+//! reference angle turns by a step held over a block, whose sin/cos is computed once per
+//! block ([`super::trig::Oscillator::turn`]).
+
+mod block_filter;
+mod lanes;
+mod reference;
+mod slow;
 
 use super::trig::Oscillator;
 use super::{FILLED_SAMPLES, SENSOR_PHASE_MIN_RATIO};
+use lanes::{Demod, FitSums};
 use monitor_core::angle::SrfPll;
-use monitor_core::filter::{Svf, SvfState};
-use monitor_core::frames::{clarke, park, AlphaBeta, SinCos};
-use monitor_core::sequence::{
-    single_phase_gain, Complex32, PhasorFit, SinglePhaseGain, ThreePhasors,
-};
+use monitor_core::frames::{clarke, AlphaBeta, SinCos};
+use monitor_core::sequence::{single_phase_gain, Complex32, SinglePhaseGain, ThreePhasors};
 use monitor_core::Abc;
 use monitor_core::SteadyPoint as IsolationPoint;
 use monitor_io::log::quality::MAX_BRIDGED_GAP_S;
 use monitor_io::log::Row;
 use monitor_io::params::ParamFile;
+use reference::{RampSums, Reference};
+use slow::SlowFilters;
 use std::collections::VecDeque;
 
 /// Supply periods per least-squares window (at the nominal frequency): 0.17 s at 60 Hz,
@@ -76,67 +92,28 @@ pub struct SequenceWindow {
 /// The window being filled.
 #[derive(Debug, Clone, Copy)]
 struct OpenWindow {
-    fit_i: PhasorFit,
-    fit_v: PhasorFit,
+    /// The least-squares sums of the currents and the voltages ([`lanes`]).
+    sums: FitSums,
     /// Samples offered (good or not).
     offered: u32,
     /// Voltage samples that were bad (the voltages' fit is then not used).
     bad_v: u32,
     from_s: f64,
     to_s: f64,
-    w_sum: f64,
-    offset_sum: f64,
-    w_min: f32,
-    w_max: f32,
+    /// The reference frequency's and offset's sums and range ([`reference`]).
+    ramp: RampSums,
 }
 
 impl OpenWindow {
     fn new() -> Self {
         OpenWindow {
-            fit_i: PhasorFit::new(),
-            fit_v: PhasorFit::new(),
+            sums: FitSums::default(),
             offered: 0,
             bad_v: 0,
             from_s: 0.0,
             to_s: 0.0,
-            w_sum: 0.0,
-            offset_sum: 0.0,
-            w_min: f32::INFINITY,
-            w_max: 0.0,
+            ramp: RampSums::default(),
         }
-    }
-}
-
-/// The positive sequence of a vector on an angle turning at the supply frequency: the
-/// Park components filtered as the core's [`SequenceAnalyzer`](monitor_core::sequence::SequenceAnalyzer) filters them (the steady
-/// point needs no more of it).
-#[derive(Debug, Clone, Copy)]
-struct Positive {
-    filter: Svf,
-    d: SvfState,
-    q: SvfState,
-}
-
-impl Positive {
-    fn new(fc_hz: f32, dt_s: f32) -> Result<Self, monitor_core::ConfigError> {
-        Ok(Positive {
-            filter: Svf::new(fc_hz, dt_s)?,
-            d: SvfState::default(),
-            q: SvfState::default(),
-        })
-    }
-
-    /// [`SequenceAnalyzer::update`](monitor_core::sequence::SequenceAnalyzer::update)'s positive sequence.
-    #[inline]
-    fn update(&mut self, x: AlphaBeta, sc: SinCos) {
-        let p = park(x, sc);
-        self.filter.update(&mut self.d, p.d);
-        self.filter.update(&mut self.q, p.q);
-    }
-
-    /// [`SequenceAnalyzer::positive`](monitor_core::sequence::SequenceAnalyzer::positive).
-    fn value(&self) -> (f32, f32) {
-        (self.d.y(), self.q.y())
     }
 }
 
@@ -147,30 +124,31 @@ impl Positive {
 #[derive(Debug, Clone)]
 pub(super) struct SequenceFront {
     dt_s: f64,
+    dt_f32: f32,
+    /// The monitor's sample limits `i_max`, `v_max` (infinite ones as `f64::MAX`: a
+    /// sample is good when its magnitude is at most the limit, which a non-finite one is
+    /// not).
     i_max: f64,
     v_max: f64,
     voltages: bool,
     /// The PLL follows the voltages (else the normalised currents).
     pll_on_voltage: bool,
     pll: SrfPll,
-    /// Mean square of the current vector, low-passed: the currents' normaliser for the PLL.
-    i_ms: Svf,
-    i_ms_state: SvfState,
-    /// The positive sequences of the currents and the voltages on the PLL's angle.
-    seq: Positive,
-    seq_v: Positive,
+    /// The slow filters ([`slow`]): the positive sequences on the PLL's angle, the
+    /// currents' normaliser for the PLL and the reference frequency.
+    slow: SlowFilters,
     /// Time of the last row seen [s].
     last_t: Option<f64>,
-    /// The PLL's frequency low-passed (`y`) and the reference angle it turns [rad].
-    w_ref: Svf,
-    w_ref_state: SvfState,
-    theta_ref: f32,
-    /// The sin/cos of the PLL's angle and of the reference angle, by rotation.
+    /// The least-squares reference angle and its offset from `w0 t` ([`reference`]).
+    reference: Reference,
+    /// The PLL's angle less the reference angle at the last block's end [rad].
+    phi: f32,
+    /// The open block's vectors on the reference angle from the windows closed within it
+    /// ([`lanes::Demod`]).
+    block: Demod,
+    /// The sin/cos of the PLL's angle by rotation; `sc_pll` that of its present angle.
     osc_pll: Oscillator,
-    osc_ref: Oscillator,
-    /// The reference angle less `w0 t`, unwrapped [rad], and `w0` [rad/s].
-    offset: f64,
-    w0: f64,
+    sc_pll: SinCos,
     /// Samples per least-squares window.
     window_len: u32,
     open: OpenWindow,
@@ -277,7 +255,7 @@ impl WindowBook {
 impl SequenceFront {
     /// A tracker for a log at `sample_rate_hz` with (or without) voltage columns; the
     /// sample limits `i_max`, `v_max` are the monitor's. Errors: the filters' checks
-    /// ([`Svf::new`]: a sample rate too low for their corners).
+    /// ([`Svf`](monitor_core::filter::Svf)`::new`: a sample rate too low for their corners).
     pub fn new(
         params: &ParamFile,
         voltages: bool,
@@ -286,11 +264,18 @@ impl SequenceFront {
         v_max: f64,
     ) -> Result<Self, monitor_core::ConfigError> {
         let dt = (1.0 / sample_rate_hz) as f32;
-        let f0 = params.supply.f_hz as f32;
+        let w0 = std::f64::consts::TAU * params.supply.f_hz;
+        let rotor = super::rotor::RotorFront::new(
+            sample_rate_hz,
+            params.supply.f_hz,
+            super::rotor::MAX_STRETCH_S,
+        );
+        let limit = |max: f64| if max == f64::INFINITY { f64::MAX } else { max };
         Ok(SequenceFront {
             dt_s: 1.0 / sample_rate_hz,
-            i_max,
-            v_max,
+            dt_f32: dt,
+            i_max: limit(i_max),
+            v_max: limit(v_max),
             voltages,
             pll_on_voltage: voltages,
             // Locks to the voltage vector where logged (normalised by its nominal peak),
@@ -298,7 +283,7 @@ impl SequenceFront {
             // loop's gain holds whatever the currents' scale).
             pll: SrfPll::new(
                 dt,
-                f0,
+                params.supply.f_hz as f32,
                 10.0,
                 if voltages {
                     params.supply.v_phase_peak() as f32
@@ -306,27 +291,23 @@ impl SequenceFront {
                     1.0
                 },
             ),
-            i_ms: Svf::new(2.0, dt)?,
-            i_ms_state: SvfState::default(),
-            seq: Positive::new(2.0, dt)?,
-            seq_v: Positive::new(2.0, dt)?,
+            slow: SlowFilters::new(
+                1.0 / sample_rate_hz,
+                rotor.per_block(),
+                w0 as f32,
+                REFERENCE_FC_HZ,
+            )?,
             last_t: None,
-            w_ref: Svf::new(REFERENCE_FC_HZ, dt)?,
-            w_ref_state: SvfState::at(core::f32::consts::TAU * f0),
-            theta_ref: 0.0,
+            reference: Reference::new(1.0 / sample_rate_hz, w0, w0 as f32),
+            phi: 0.0,
+            block: Demod::default(),
             osc_pll: Oscillator::default(),
-            osc_ref: Oscillator::default(),
-            offset: 0.0,
-            w0: std::f64::consts::TAU * params.supply.f_hz,
+            sc_pll: SinCos { sin: 0.0, cos: 1.0 },
             window_len: ((WINDOW_PERIODS * sample_rate_hz / params.supply.f_hz).round() as u32)
                 .max(monitor_core::sequence::PHASOR_FIT_MIN_SAMPLES),
             open: OpenWindow::new(),
             closed: VecDeque::new(),
-            rotor: super::rotor::RotorFront::new(
-                sample_rate_hz,
-                params.supply.f_hz,
-                super::rotor::MAX_STRETCH_S,
-            ),
+            rotor,
         })
     }
 
@@ -335,54 +316,53 @@ impl SequenceFront {
     /// analysis alone.
     pub fn track(&mut self, row: &Row, t: f64) -> SequenceStep {
         let (filled, closed_before) = self.bridge(t);
-        let mut step = SequenceStep {
-            closed_before,
-            ..SequenceStep::default()
+        self.reference.row();
+        let o = &mut self.open;
+        if o.offered == 0 {
+            o.from_s = t;
+        }
+        o.offered += 1;
+        o.to_s = t;
+        let r = &self.reference;
+        self.rotor.mark(t, || r.offset(), row);
+        // Without branches: a NaN fails the comparison, an infinity the finite limit.
+        let ok = |x: &[f64; 3], max: f64| {
+            let le = |v: f64| u8::from(v.abs() <= max);
+            le(x[0]) & le(x[1]) & le(x[2]) != 0
         };
-        self.theta_ref = monitor_core::frames::wrap_angle(
-            self.theta_ref + self.w_ref_state.y() * self.dt_s as f32,
-        );
-        self.offset += (f64::from(self.w_ref_state.y()) - self.w0) * self.dt_s;
-        self.offer_window_sample(t);
-        let ok = |x: &[f64; 3], max: f64| x.iter().all(|v| v.is_finite() && v.abs() <= max);
-        let abc = |x: &[f64; 3]| Abc {
-            a: x[0] as f32,
-            b: x[1] as f32,
-            c: x[2] as f32,
-        };
+        let lanes = |x: &[f64; 3]| [x[0] as f32, x[1] as f32, x[2] as f32, 1.0];
         if ok(&row.i_abc, self.i_max) {
-            let i_abc = abc(&row.i_abc);
-            let v_abc = row
-                .v_abc
-                .as_ref()
-                .filter(|v| self.voltages && ok(v, self.v_max))
-                .map(abc);
+            let i_abc = lanes(&row.i_abc);
+            let v_abc = match &row.v_abc {
+                Some(v) if self.voltages && ok(v, self.v_max) => Some(lanes(v)),
+                _ => None,
+            };
             if self.voltages && v_abc.is_none() {
                 self.open.bad_v += 1;
             }
-            let (sc_pll, sc) = (
-                self.osc_pll.at(self.pll.theta_pll()),
-                self.osc_ref.at(self.theta_ref),
-            );
-            let i = clarke(i_abc);
-            self.filtered(i, v_abc.map(clarke), filled, sc_pll);
-            self.rotor.row(Some(i), sc, t, self.offset, row);
-            self.open.fit_i.update(sc, i_abc);
-            if let Some(v) = v_abc {
-                self.open.fit_v.update(sc, v);
+            let sc = self.reference.sin_cos();
+            self.open.sums.add(sc, i_abc, v_abc);
+            let v = v_abc.map(clarke_of);
+            self.filtered(i_abc, v);
+            if filled > 0 {
+                self.fill(filled, sc, i_abc, v);
             }
-        } else {
-            self.rotor.row(None, SinCos::default(), t, self.offset, row);
         }
-        self.rotor.end_of_row(self.w_ref_state.y());
-        if self.open.offered >= self.window_len {
+        if self.rotor.full() {
+            self.end_block();
+        }
+        let closed_after = self.open.offered >= self.window_len;
+        if closed_after {
             self.close_window();
-            step.closed_after = true;
         }
-        step.i = self.seq.value();
-        step.v = self.seq_v.value();
-        step.we_rad_s = self.pll.omega_rad_s();
-        step
+        let (i, v) = self.slow.positive();
+        SequenceStep {
+            i,
+            v,
+            we_rad_s: self.pll.omega_rad_s(),
+            closed_before,
+            closed_after,
+        }
     }
 
     /// Samples missing from the stream before the row at `t` [s]: the angles advance over
@@ -390,17 +370,25 @@ impl SequenceFront {
     /// sequences stay put; a gap the data-quality stage does not bridge ends the window.
     /// Returns the samples to fill in (up to [`FILLED_SAMPLES`]) and whether the window
     /// was closed.
+    #[inline]
     fn bridge(&mut self, t: f64) -> (usize, bool) {
         let Some(prev) = self.last_t.replace(t) else {
             return (0, false);
         };
         let missing = t - prev - self.dt_s;
-        if missing > 0.5 * self.dt_s && missing <= MAX_BRIDGED_GAP_S {
+        if missing <= 0.5 * self.dt_s {
+            return (0, false);
+        }
+        self.bridge_gap(missing)
+    }
+
+    /// [`SequenceFront::bridge`] over `missing` seconds (more than half a sample).
+    fn bridge_gap(&mut self, missing: f64) -> (usize, bool) {
+        if missing <= MAX_BRIDGED_GAP_S {
             self.pll.skip(missing as f32);
-            self.theta_ref = monitor_core::frames::wrap_angle(
-                self.theta_ref + self.w_ref_state.y() * missing as f32,
-            );
-            self.offset += (f64::from(self.w_ref_state.y()) - self.w0) * missing;
+            self.sc_pll = self.osc_pll.turn(|| self.pll.theta_pll(), None);
+            self.reference.settle(&mut self.open.ramp);
+            self.reference.skip(missing);
             let m = (missing / self.dt_s).round();
             self.rotor.skip(m as u32);
             let filled = if m <= FILLED_SAMPLES as f64 {
@@ -412,107 +400,115 @@ impl SequenceFront {
         }
         if missing > MAX_BRIDGED_GAP_S {
             self.close_window();
+            // The block's filters step on what it has; the rotor's record breaks off.
+            self.slow.step(&std::mem::take(&mut self.block), self.phi);
             self.rotor.break_off();
             return (0, true);
         }
         (0, false)
     }
 
-    /// Counts a sample into the open window (its time span, the reference's frequency).
-    fn offer_window_sample(&mut self, t: f64) {
-        let w = self.w_ref_state.y();
-        let o = &mut self.open;
-        if o.offered == 0 {
-            o.from_s = t;
-        }
-        o.offered += 1;
-        o.to_s = t;
-        o.w_sum += f64::from(w);
-        o.offset_sum += self.offset;
-        o.w_min = o.w_min.min(w);
-        o.w_max = o.w_max.max(w);
-    }
-
-    /// The PLL and the filtered sequences (the isolation's steady point) of the current
-    /// vector `i` and the voltage vector `v`; the reference frequency follows the PLL's.
-    /// `sc` is the sin/cos of the PLL's angle.
-    fn filtered(&mut self, i: AlphaBeta, v: Option<AlphaBeta>, filled: usize, sc: SinCos) {
+    /// The PLL on the phase currents `i_abc` and the voltage vector `v` (where good), and
+    /// the slow filters' share of the row.
+    #[inline]
+    fn filtered(&mut self, i_abc: [f32; 4], v: Option<AlphaBeta>) {
         match v {
             Some(v) if self.pll_on_voltage => {
-                self.pll.update(v, sc);
+                self.pll.update(v, self.sc_pll);
             }
             _ => {
-                let m2 = i.alpha * i.alpha + i.beta * i.beta;
-                if self.i_ms_state.y() <= 0.0 {
+                let i = clarke_of(i_abc);
+                if self.slow.normaliser_unset() {
                     // The first good sample: the loop starts on the current vector.
-                    self.i_ms_state.set_y(m2);
                     self.pll.align(i.beta.atan2(i.alpha));
+                    self.sc_pll = self.osc_pll.turn(|| self.pll.theta_pll(), None);
                 }
-                self.i_ms.update(&mut self.i_ms_state, m2);
-                let k = 1.0 / monitor_core::math::sqrt(self.i_ms_state.y().max(1e-12));
+                let k = self.slow.normaliser(i);
                 self.pll.update(
                     AlphaBeta {
                         alpha: i.alpha * k,
                         beta: i.beta * k,
                     },
-                    sc,
+                    self.sc_pll,
                 );
             }
         }
-        self.w_ref
-            .update(&mut self.w_ref_state, self.pll.omega_rad_s());
-        // A few missing samples: the sequence filters get the vectors turned back to the
-        // missing instants (a filter that skips a sample of the other sequence's 2f image
-        // keeps an error of about that sample's share).
-        let w_dt = self.pll.omega_rad_s() * self.dt_s as f32;
-        for j in (1..=filled).rev() {
-            let back = SinCos::from_angle(j as f32 * w_dt);
-            let turn = |x: AlphaBeta| {
-                let d = park(x, back);
-                AlphaBeta {
-                    alpha: d.d,
-                    beta: d.q,
-                }
-            };
-            let sc_j = SinCos::from_angle(self.pll.theta_pll() - j as f32 * w_dt);
-            self.seq.update(turn(i), sc_j);
-            if let Some(v) = v {
-                self.seq_v.update(turn(v), sc_j);
-            }
+        let w = self.pll.omega_rad_s();
+        self.slow.row(w);
+        // The sin/cos of the PLL's next angle: turned by the step it just made.
+        self.sc_pll = self.osc_pll.advance(self.pll.theta_pll(), w * self.dt_f32);
+    }
+
+    /// `filled` samples missing before a good row (`sc` the reference's sin/cos, `i_abc`
+    /// the phase currents, `v` the voltage vector) into the slow filters (module docs of
+    /// [`slow`]).
+    fn fill(&mut self, filled: usize, sc: SinCos, i_abc: [f32; 4], v: Option<AlphaBeta>) {
+        let back = |x: AlphaBeta| {
+            [
+                x.alpha * sc.cos + x.beta * sc.sin,
+                x.beta * sc.cos - x.alpha * sc.sin,
+            ]
+        };
+        self.slow
+            .fill(filled as u32, back(clarke_of(i_abc)), v.map(back));
+    }
+
+    /// Ends the rotor's block: the least-squares block's vectors on the reference angle
+    /// go to the rotor's record and the slow filters (with the PLL's angle less the
+    /// reference's at the block's last row), and the reference turns at the new frequency.
+    fn end_block(&mut self) {
+        let d = self.open.sums.flush();
+        self.block.add(&d);
+        let b = std::mem::take(&mut self.block);
+        self.rotor.add(b.i, b.n_i);
+        self.reference.settle(&mut self.open.ramp);
+        let offset = self.reference.offset();
+        // The last row's PLL angle: before its update (a step back), if it had one.
+        let phi = monitor_core::frames::wrap_angle(
+            self.pll.theta_pll() - self.pll.omega_rad_s() * self.dt_f32 - self.reference.theta(),
+        );
+        let mid = phi - 0.5 * monitor_core::frames::wrap_angle(phi - self.phi);
+        self.phi = phi;
+        if self.slow.step(&b, mid) {
+            self.reference.set_frequency(self.slow.w_ref());
         }
-        self.seq.update(i, sc);
-        if let Some(v) = v {
-            self.seq_v.update(v, sc);
-        }
+        self.rotor.close_at(self.slow.w_ref(), offset);
     }
 
     /// Ends the open window: solves its fits and queues it for the book (`None` when it
     /// has no solution).
     fn close_window(&mut self) {
-        let o = std::mem::replace(&mut self.open, OpenWindow::new());
-        self.closed.push_back(self.solved(&o));
+        // The window's last block's vectors stay in the rotor's open block.
+        self.block.add(&self.open.sums.flush());
+        self.reference.settle(&mut self.open.ramp);
+        let mut o = std::mem::replace(&mut self.open, OpenWindow::new());
+        self.closed.push_back(self.solved(&mut o));
     }
 
     /// The window `o` solved, `None` when empty or without a solution. (The learning flag
     /// and the monitor's speed are the book's.)
-    fn solved(&self, o: &OpenWindow) -> Option<SequenceWindow> {
+    fn solved(&self, o: &mut OpenWindow) -> Option<SequenceWindow> {
         if o.offered == 0 {
             return None;
         }
-        let i = o.fit_i.solve()?;
-        let w_mean = (o.w_sum / f64::from(o.offered)) as f32;
+        // The voltages' fit shares the currents' regressor sums: it is used only when every
+        // sample with a good current had good voltages.
+        let (fit_i, fit_v, _) = o.sums.fits();
+        let i = fit_i.solve()?;
+        let r = &o.ramp;
+        let w_mean = (r.w_sum / f64::from(o.offered)) as f32;
         let complete = f64::from(i.samples) >= MIN_WINDOW_FILL * f64::from(self.window_len);
         let steady =
-            complete && w_mean > 0.0 && (o.w_max - o.w_min) <= STEADY_FREQUENCY_RANGE * w_mean;
+            complete && w_mean > 0.0 && (r.w_max - r.w_min) <= STEADY_FREQUENCY_RANGE * w_mean;
         Some(SequenceWindow {
             from_s: o.from_s,
             to_s: o.to_s,
             i,
             v: (self.voltages && o.bad_v == 0)
-                .then(|| o.fit_v.solve())
+                .then(|| fit_v.solve())
                 .flatten(),
             we_rad_s: w_mean,
-            offset_rad: o.offset_sum / f64::from(o.offered),
+            offset_rad: r.offset_sum / f64::from(o.offered),
             wr_rad_s: None,
             complete,
             steady,
@@ -546,4 +542,14 @@ impl SequenceFront {
 /// positive, negative and zero sequences with one rotation.
 pub(super) fn sensor_phase(p: Complex32, n: Complex32, z: Complex32) -> Option<SinglePhaseGain> {
     single_phase_gain(p, n, z, SENSOR_PHASE_MIN_RATIO)
+}
+
+/// The current vector of the phase values `[a, b, c, _]` ([`clarke`]).
+#[inline]
+fn clarke_of(x: [f32; 4]) -> AlphaBeta {
+    clarke(Abc {
+        a: x[0],
+        b: x[1],
+        c: x[2],
+    })
 }

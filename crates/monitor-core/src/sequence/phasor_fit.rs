@@ -107,6 +107,14 @@ impl PhasorFit {
         Self::default()
     }
 
+    /// A window's fit from sums formed elsewhere (a host that sums blocks of samples in
+    /// its own way and adds the blocks up): `n` samples, `g` = `[sum c^2, sum s^2, sum c s,
+    /// sum c, sum s]`, and per phase a, b, c `x[p]` = `[sum x_p c, sum x_p s, sum x_p]`
+    /// (module docs). The same fit as [`PhasorFit::update`] on the samples, up to rounding.
+    pub fn from_sums(n: u32, g: [f64; 5], x: [[f64; 3]; 3]) -> Self {
+        PhasorFit { n, g, x }
+    }
+
     /// Samples in the window so far.
     pub fn samples(&self) -> u32 {
         self.n
@@ -236,6 +244,45 @@ mod tests {
             let z = c64(ph.zero());
             assert!((z.re.hypot(z.im) - 0.5).abs() < 2e-4, "{z:?}");
         }
+    }
+
+    #[test]
+    fn the_sums_given_directly_give_the_same_fit() {
+        // Two halves of a window summed apart and added: the fit of the whole window.
+        let (mut first, mut second, mut whole) =
+            (PhasorFit::new(), PhasorFit::new(), PhasorFit::new());
+        for k in 0..400 {
+            let th = TAU * 60.0 * f64::from(k) / 4000.0;
+            let sc = SinCos {
+                sin: th.sin() as f32,
+                cos: th.cos() as f32,
+            };
+            let x = Abc {
+                a: (3.0 * th.cos() + 0.2) as f32,
+                b: (3.0 * (th - TAU / 3.0).cos()) as f32,
+                c: (2.5 * (th + TAU / 3.0).cos()) as f32,
+            };
+            whole.update(sc, x);
+            if k < 150 {
+                first.update(sc, x)
+            } else {
+                second.update(sc, x)
+            }
+        }
+        let add = |a: [f64; 3], b: [f64; 3]| [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
+        let g: [f64; 5] = core::array::from_fn(|k| first.g[k] + second.g[k]);
+        let x = core::array::from_fn(|p| add(first.x[p], second.x[p]));
+        let joined = PhasorFit::from_sums(first.n + second.n, g, x)
+            .solve()
+            .unwrap();
+        let direct = whole.solve().unwrap();
+        assert_eq!(joined.samples, 400);
+        let norm = |z: Complex32| f64::from(z.re).hypot(f64::from(z.im));
+        for (a, b) in joined.phases.iter().zip(direct.phases) {
+            assert!(norm(a - b) < 1e-5, "{a} {b}");
+        }
+        // Phase c is 5/6 of a and b: the fit sees it.
+        assert!((norm(direct.phases[2]) / norm(direct.phases[1]) - 2.5 / 3.0).abs() < 1e-4);
     }
 
     #[test]

@@ -5,8 +5,10 @@
 //! (bounded memory, a few MB whatever the log's length).
 //!
 //! It runs inside the sequence analysis' per-row step (`super::super::sequences`), on the
-//! angle that analysis already turns (its least-squares reference `theta_ref`, whose sin
-//! and cos it computes for every row): a complex product and two sums per row. The
+//! angle that analysis already turns (its least-squares reference `theta_ref`): the
+//! analysis sums the phase currents times that angle's cos and sin for its least-squares
+//! fit anyway, and hands each block the current vector's sum taken from those sums
+//! ([`RotorFront::mark`], [`RotorFront::add`], [`RotorFront::close_at`]). The
 //! reference turns at the PLL's frequency low-passed at 1 Hz, which follows part of the
 //! `2 s f` wobble that large sidebands put into the current vector's angle where the PLL
 //! locks to the currents; each block is therefore turned on by the reference's offset
@@ -16,6 +18,7 @@
 //! (`super::spectrum`).
 
 use crate::COUNTS_PER_REV;
+#[cfg(test)]
 use monitor_core::frames::{AlphaBeta, SinCos};
 use monitor_io::log::{Row, ENC_COUNT_UNREADABLE};
 use std::collections::VecDeque;
@@ -97,22 +100,36 @@ impl RotorFront {
 
     /// One row at `t` [s]: `i` its current vector (None for a bad current), `sc` the sin
     /// and cos of the reference angle at the row, `offset` the reference's offset from
-    /// `w0 t` [rad] and `w` its frequency [rad/s] (module docs).
-    #[inline]
+    /// `w0 t` [rad] (module docs): [`RotorFront::mark`] and [`RotorFront::add`] of
+    /// `i e^{-j theta}` (the tests' way in).
+    #[cfg(test)]
     pub fn row(&mut self, i: Option<AlphaBeta>, sc: SinCos, t: f64, offset: f64, row: &Row) {
+        self.mark(t, || offset, row);
+        self.open.offset_last = offset;
+        if let Some(i) = i {
+            self.add(
+                [
+                    i.alpha * sc.cos + i.beta * sc.sin,
+                    i.beta * sc.cos - i.alpha * sc.sin,
+                ],
+                1,
+            );
+        }
+    }
+
+    /// Counts one row at `t` [s] into the open block (good or not): its time, the row's
+    /// speed, and on a block's first row the reference's offset from `w0 t` [rad]
+    /// (`offset()`); its current is added with [`RotorFront::add`], and the block is
+    /// closed with [`RotorFront::close_at`] (which takes the last row's offset).
+    #[inline]
+    pub fn mark(&mut self, t: f64, offset: impl FnOnce() -> f64, row: &Row) {
         let o = &mut self.open;
         if o.offered == 0 {
             o.t_first = t;
-            o.offset_first = offset;
+            o.offset_first = offset();
         }
         o.offered += 1;
         o.t_last = t;
-        o.offset_last = offset;
-        if let Some(i) = i {
-            o.used += 1;
-            o.z[0] += i.alpha * sc.cos + i.beta * sc.sin;
-            o.z[1] += i.beta * sc.cos - i.alpha * sc.sin;
-        }
         match row.enc_count {
             Some(c) if c != ENC_COUNT_UNREADABLE => {
                 self.last_count = Some((c, t));
@@ -129,6 +146,22 @@ impl RotorFront {
         }
     }
 
+    /// Adds `used` good samples' sum of the current vector turned back by the reference
+    /// angle, `sum i e^{-j theta}` `[re, im]` [A], to the open block.
+    #[inline]
+    pub fn add(&mut self, z: [f32; 2], used: u32) {
+        let o = &mut self.open;
+        o.used += used;
+        o.z[0] += z[0];
+        o.z[1] += z[1];
+    }
+
+    /// Whether the open block is full (the next [`RotorFront::end_of_row`] closes it).
+    #[inline]
+    pub fn full(&self) -> bool {
+        self.open.offered >= self.per_block
+    }
+
     /// `m` samples missing from the stream (a gap the data-quality stage bridges): they
     /// count into the open block's length, so that the blocks stay on the time grid.
     pub fn skip(&mut self, m: u32) {
@@ -138,10 +171,20 @@ impl RotorFront {
     }
 
     /// Closes the open block when it is full; `w_supply` the reference's frequency now
-    /// [rad/s].
-    #[inline]
+    /// [rad/s] (the tests' way out of a row; [`RotorFront::close_at`]).
+    #[cfg(test)]
     pub fn end_of_row(&mut self, w_supply: f32) {
         if self.open.offered >= self.per_block {
+            self.close(w_supply);
+        }
+    }
+
+    /// Closes the open block when it is full ([`RotorFront::full`]): `w_supply` the
+    /// reference's frequency now [rad/s], `offset_last` its offset at the block's last row
+    /// [rad].
+    pub fn close_at(&mut self, w_supply: f32, offset_last: f64) {
+        if self.full() {
+            self.open.offset_last = offset_last;
             self.close(w_supply);
         }
     }
@@ -201,6 +244,11 @@ impl RotorFront {
     /// The record: the kept blocks, oldest first.
     pub fn blocks(&self) -> &VecDeque<Block> {
         &self.blocks
+    }
+
+    /// Samples per block.
+    pub fn per_block(&self) -> u32 {
+        self.per_block
     }
 
     /// A block's length [s].
