@@ -293,11 +293,14 @@ impl CommissionTracker {
 
     /// True when the learned thresholds are in force and the load current or the voltage
     /// is outside the span seen while learning (beyond the reporting margin).
+    /// (The same test as [`CommissionTracker::moved_note`]'s, without its words.)
     pub(super) fn outside_learned_range(&self, out: &MonitorOutput) -> bool {
+        if out.commissioning != CommissioningState::Commissioned {
+            return false;
+        }
         let (i_active, v) = operating_point(out);
-        out.commissioning == CommissioningState::Commissioned
-            && (self.iqs.and_then(|s| outside(s, i_active)).is_some()
-                || self.vqs.and_then(|s| outside(s, v)).is_some())
+        self.iqs.and_then(|s| outside(s, i_active)).is_some()
+            || self.vqs.and_then(|s| outside(s, v)).is_some()
     }
 
     /// Whether lamps on the thresholds now in force count as detections: always without a
