@@ -196,11 +196,14 @@ impl CommissionTracker {
     /// quasi-steady point; returns a note when a lit r2..r4 lamp meets an operating point
     /// outside the learned range.
     pub(super) fn after(&mut self, mon: &Monitor, t: f64, out: &MonitorOutput) -> Option<String> {
-        let run = mon.commissioning();
-        if self.run_id == Some(run.id) {
-            self.learned = (run.blocks_learned, run.blocks_needed);
-            if run.stage == RunStage::Done && self.ended_at.is_none() {
-                self.ended_at = Some(t);
+        // (The run is read only where this replay started one.)
+        if let Some(id) = self.run_id {
+            let run = mon.commissioning();
+            if run.id == id {
+                self.learned = (run.blocks_learned, run.blocks_needed);
+                if run.stage == RunStage::Done && self.ended_at.is_none() {
+                    self.ended_at = Some(t);
+                }
             }
         }
         if matches!(out.commissioning, CommissioningState::Learning(_)) && out.quasi_steady {

@@ -509,6 +509,7 @@ impl Follower {
     /// first block closes, the point is judged against the block being summed, which every
     /// point moves). For a caller that hands on the means of several points at once (the
     /// host's replay) and each point alone where it is not steady.
+    #[inline]
     pub fn steady(&self, p: &SteadyPoint) -> Option<bool> {
         self.mean.map(|b| b.admits(p))
     }
