@@ -11,13 +11,13 @@
 //! ([`monitor_core::isolation::Follower`]: the same code the firmware runs; the firmware
 //! feeds it the monitor's own outputs, [`SteadyPoint::from_output`]).
 
-mod chunk;
+pub(super) mod chunk;
 mod report;
 mod sentences;
 
 pub use crate::isolation_name::{IsolationName, NameGiven};
 use monitor_core::isolation::{Follower, Named, Step, DEFAULT_SPREAD};
-use monitor_core::{Fault, Isolation, IsolationState, Isolator, MonitorOutput, SteadyPoint};
+use monitor_core::{Fault, Isolation, IsolationState, Isolator, SteadyPoint};
 pub(super) use report::refine_single_phase;
 use report::{baseline_name, groups, REPORTED_RISE_K};
 pub use report::{
@@ -167,25 +167,24 @@ impl IsolationTracker {
     }
 
     /// After the monitor's output for the sample at `t` (`dt_s` after the previous one);
-    /// `point`: the steady-state vectors at this sample (module docs); `counts`: lamps and
-    /// detections count now (the learned thresholds are in force, or none were asked for);
-    /// `temperature_c`: the log's temperature reading, if it has the column. The point goes
+    /// `flags`: the output's flags ([`chunk::RowFlags`]), their `counts` whether the lamps and
+    /// detections count now (the learned thresholds are in force, or none were asked for)
+    /// and the monitor has settled after a restart; `point`: the steady-state vectors at
+    /// this sample (module docs); `temperature_c`: the log's temperature reading, if it has the column. The point goes
     /// into the chunk of rows handed on together ([`chunk`]; [`IsolationTracker::flush`]).
     #[inline]
     pub(super) fn after(
         &mut self,
         t: f64,
         dt_s: f64,
-        out: &MonitorOutput,
+        flags: chunk::RowFlags,
         point: &SteadyPoint,
-        counts: bool,
         temperature_c: Option<f64>,
     ) {
         self.end_t = t;
         if self.follower.is_none() {
             return;
         }
-        let flags = chunk::RowFlags::of(out, counts);
         if self.chunk.ends_before(flags) {
             self.flush();
         }

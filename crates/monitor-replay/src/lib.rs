@@ -79,6 +79,7 @@ pub use winding::{
 };
 
 use commission::CommissionTracker;
+use isolation::chunk::RowFlags;
 use isolation::IsolationTracker;
 use monitor_core::{AngleSource, ConfigError, Isolator, Monitor, MonitorOutput};
 use monitor_io::log::{Channels, LogError, Row};
@@ -345,16 +346,18 @@ impl Replay {
         // the learned ones are in force are not detections: the window says the nominal
         // parameters are not to be trusted (a sensor fault counts at any time).
         let trusted = self.commission.thresholds_trusted(out);
-        let counts = out.sensor_fault.any() || trusted;
+        let flags = RowFlags::of(out, trusted);
+        let counts = flags.counts();
         let bands = bands_for(mon, out, counts, self.detected_in_range);
         let held_bands = if out.quasi_steady { NO_BANDS } else { bands };
         let judged = self.evaluated;
-        self.unsettled.after(t, out, held_bands, judged, trusted);
+        self.unsettled
+            .after(t, (out, flags), held_bands, judged, trusted);
         let point = step.point(out.operating.wr_rad_s);
         let settled = self.restart.settled(t, out);
-        let usable = counts && settled;
+        let usable = flags.with_counts(counts && settled);
         let (dt_s, tc) = (self.dt_s, row.t_winding_c);
-        self.isolation.after(t, dt_s, out, &point, usable, tc);
+        self.isolation.after(t, dt_s, usable, &point, tc);
         if out.fault_detected && counts {
             let first = (&mut self.detected_in_range, &mut self.first_detection);
             let booked = (&mut self.detections, &mut self.top_seen);
@@ -377,7 +380,7 @@ impl Replay {
             &self.commission,
             &self.isolation,
         );
-        self.last = LastOutput::of(out);
+        self.last = LastOutput::of(out, flags);
     }
 
     /// The acquisition clock was reset before the next row (`diagnose` carries the time on

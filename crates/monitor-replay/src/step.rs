@@ -2,9 +2,10 @@
 //! each reads the output by reference and updates the fields it is given.
 
 use super::commission::CommissionTracker;
+use super::isolation::chunk::RowFlags;
 use super::isolation::IsolationTracker;
 use super::report::Detection;
-use monitor_core::{CommissioningState, Monitor, MonitorOutput, FAULT_COUNT};
+use monitor_core::{Monitor, MonitorOutput, FAULT_COUNT};
 
 /// No bands (centre and half-width 0): what is passed where the bands are not needed.
 pub(super) const NO_BANDS: [(f32, f32); 4] = [(0.0, 0.0); 4];
@@ -127,7 +128,7 @@ pub(super) fn note_detection(
     if first.is_none() {
         *first = Some(t);
     }
-    if *seen == out.diagnosis.probabilities {
+    if same_bits(seen, &out.diagnosis.probabilities) {
         return;
     }
     *seen = out.diagnosis.probabilities;
@@ -136,6 +137,17 @@ pub(super) fn note_detection(
             detections.push(Detection { fault, t_s: t });
         }
     }
+}
+
+/// Whether `a` and `b` hold the same bits (a cheaper test than `==`, without branches; it
+/// differs from `==` only for NaN and signed zeros, where [`note_detection`] books the same
+/// once more, and nothing changes).
+#[inline]
+fn same_bits(a: &[f32; FAULT_COUNT], b: &[f32; FAULT_COUNT]) -> bool {
+    a.iter()
+        .zip(b)
+        .fold(0, |acc, (x, y)| acc | (x.to_bits() ^ y.to_bits()))
+        == 0
 }
 
 /// Whether the sample at `t` [s] (interval `dt_s`) is the one nearest the timeline step
@@ -182,13 +194,13 @@ pub(super) struct LastOutput {
 }
 
 impl LastOutput {
-    /// What the next row needs of `out`.
+    /// What the next row needs of `out` (with its `flags`).
     #[inline]
-    pub(super) fn of(out: &MonitorOutput) -> Self {
+    pub(super) fn of(out: &MonitorOutput, flags: RowFlags) -> Self {
         LastOutput {
-            learning: matches!(out.commissioning, CommissioningState::Learning(_)),
+            learning: flags.learning(),
             wr_rad_s: out.operating.wr_rad_s,
-            sensor_fault: out.sensor_fault.any(),
+            sensor_fault: flags.sensor_fault(),
         }
     }
 }

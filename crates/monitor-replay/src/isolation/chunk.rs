@@ -17,7 +17,7 @@ use monitor_core::{CommissioningState, MonitorOutput, SteadyPoint};
 
 /// The monitor's output as the isolation reads it, for one row (bits).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub(super) struct RowFlags(u8);
+pub(crate) struct RowFlags(u8);
 
 impl RowFlags {
     const LEARNING: u8 = 1;
@@ -28,23 +28,33 @@ impl RowFlags {
     const FAULT_DETECTED: u8 = 32;
     const QUASI_STEADY: u8 = 64;
 
-    /// The flags of `out`; `counts`: lamps and detections count at this row.
+    /// The flags of `out`, read once per row by the replay's steps; `trusted`: the
+    /// thresholds in force count ([`RowFlags::counts`]: they do, or a sensor fault is
+    /// flagged).
     #[inline]
-    pub(super) fn of(out: &MonitorOutput, counts: bool) -> Self {
+    pub(crate) fn of(out: &MonitorOutput, trusted: bool) -> Self {
         let (learning, learned_blocks) = match out.commissioning {
             CommissioningState::Learning(f) => (true, f > 0.0),
             _ => (false, false),
         };
         let bit = |b: bool, v: u8| if b { v } else { 0 };
+        let sensor_fault = out.sensor_fault.any();
         RowFlags(
             bit(learning, Self::LEARNING)
                 | bit(learned_blocks, Self::LEARNED_BLOCKS)
                 | bit(out.evaluating, Self::EVALUATING)
-                | bit(out.sensor_fault.any(), Self::SENSOR_FAULT)
-                | bit(counts, Self::COUNTS)
+                | bit(sensor_fault, Self::SENSOR_FAULT)
+                | bit(sensor_fault || trusted, Self::COUNTS)
                 | bit(out.fault_detected, Self::FAULT_DETECTED)
                 | bit(out.quasi_steady, Self::QUASI_STEADY),
         )
+    }
+
+    /// The same flags with [`RowFlags::counts`] set to `counts` (the isolation's: the
+    /// lamps count and the monitor has settled after a restart).
+    #[inline]
+    pub(crate) fn with_counts(self, counts: bool) -> Self {
+        RowFlags(self.0 & !Self::COUNTS | if counts { Self::COUNTS } else { 0 })
     }
 
     fn has(self, v: u8) -> bool {
@@ -52,37 +62,37 @@ impl RowFlags {
     }
 
     /// Commissioning learns.
-    pub(super) fn learning(self) -> bool {
+    pub(crate) fn learning(self) -> bool {
         self.has(Self::LEARNING)
     }
 
     /// Commissioning learns and has learned a block.
-    pub(super) fn learned_blocks(self) -> bool {
+    pub(crate) fn learned_blocks(self) -> bool {
         self.has(Self::LEARNED_BLOCKS)
     }
 
     /// The monitor evaluates its lamps.
-    pub(super) fn evaluating(self) -> bool {
+    pub(crate) fn evaluating(self) -> bool {
         self.has(Self::EVALUATING)
     }
 
     /// A sensor fault is flagged.
-    pub(super) fn sensor_fault(self) -> bool {
+    pub(crate) fn sensor_fault(self) -> bool {
         self.has(Self::SENSOR_FAULT)
     }
 
     /// Lamps and detections count.
-    pub(super) fn counts(self) -> bool {
+    pub(crate) fn counts(self) -> bool {
         self.has(Self::COUNTS)
     }
 
     /// A lamp is lit or a sensor fault flagged.
-    pub(super) fn fault_detected(self) -> bool {
+    pub(crate) fn fault_detected(self) -> bool {
         self.has(Self::FAULT_DETECTED)
     }
 
     /// The monitor's quasi-steady gate is open.
-    pub(super) fn quasi_steady(self) -> bool {
+    pub(crate) fn quasi_steady(self) -> bool {
         self.has(Self::QUASI_STEADY)
     }
 }
