@@ -63,7 +63,7 @@ pub(super) struct IsolationTracker {
     temperature: super::temperature::TemperatureChannel,
     /// The rows not yet handed to the follower and the events ([`chunk`]), and the most
     /// rows of a chunk (the core's block).
-    chunk: chunk::Chunk,
+    chunk: chunk::RowChunk,
     chunk_rows: u32,
     /// The time left in the follower's block after the last chunk [s]: a chunk ends where
     /// the block does.
@@ -159,7 +159,7 @@ impl IsolationTracker {
             load,
             events: super::events::EventLog::default(),
             temperature: super::temperature::TemperatureChannel::new(temperature_column),
-            chunk: chunk::Chunk::default(),
+            chunk: chunk::RowChunk::default(),
             chunk_rows: chunk_rows.max(1),
             block_left_s: 0.0,
             load_explains: false,

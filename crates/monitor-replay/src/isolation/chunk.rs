@@ -1,4 +1,4 @@
-//! The rows the isolation's per-row work is done on at once ([`Chunk`]): consecutive rows
+//! The rows the isolation's per-row work is done on at once ([`RowChunk`]): consecutive rows
 //! with the same flags from the monitor's output, at most the core's block of
 //! `decimation` samples (2.5 ms at 10 kHz).
 //!
@@ -99,7 +99,7 @@ impl RowFlags {
 
 /// Rows summed for the isolation (module docs).
 #[derive(Debug, Clone, Copy, Default)]
-pub(super) struct Chunk {
+pub(super) struct RowChunk {
     /// The sum of the rows' points.
     sum: SteadyPoint,
     /// Rows summed.
@@ -123,7 +123,7 @@ pub(super) struct Closed {
     pub(super) flags: RowFlags,
 }
 
-impl Chunk {
+impl RowChunk {
     /// Whether the row with `flags` belongs to another chunk than the rows summed.
     #[inline]
     pub(super) fn ends_before(&self, flags: RowFlags) -> bool {
@@ -165,7 +165,7 @@ impl Chunk {
             span_s: self.span_s,
             flags: self.flags,
         };
-        *self = Chunk::default();
+        *self = RowChunk::default();
         Some(closed)
     }
 }
