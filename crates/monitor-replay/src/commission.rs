@@ -297,10 +297,15 @@ impl CommissionTracker {
     /// True when the learned thresholds are in force and the load current or the voltage
     /// is outside the span seen while learning (beyond the reporting margin).
     /// (The same test as [`CommissionTracker::moved_note`]'s, without its words.)
+    #[inline]
     pub(super) fn outside_learned_range(&self, out: &MonitorOutput) -> bool {
-        if out.commissioning != CommissioningState::Commissioned {
-            return false;
-        }
+        out.commissioning == CommissioningState::Commissioned && self.outside_span(out)
+    }
+
+    /// [`CommissionTracker::outside_learned_range`] with the learned thresholds in force
+    /// (out of line: the replay asks on every row with a lamp lit).
+    #[inline(never)]
+    fn outside_span(&self, out: &MonitorOutput) -> bool {
         let (i_active, v) = operating_point(out);
         self.iqs.and_then(|s| outside(s, i_active)).is_some()
             || self.vqs.and_then(|s| outside(s, v)).is_some()
