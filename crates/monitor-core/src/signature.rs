@@ -170,13 +170,19 @@ pub struct Diagnosis {
 impl Diagnosis {
     /// The most probable fault and its probability (first in Table 1 order on ties).
     pub fn top(&self) -> Option<(Fault, f32)> {
-        let mut best: Option<(Fault, f32)> = None;
-        for (f, p) in Fault::ALL.iter().zip(self.probabilities) {
-            if p > 0.0 && best.is_none_or(|(_, bp)| p > bp) {
-                best = Some((*f, p));
+        // (The first strictly largest positive probability: a running maximum from 0,
+        // without the option in the loop.)
+        let (mut best, mut bp) = (0, 0.0f32);
+        for (k, p) in self.probabilities.iter().enumerate() {
+            if *p > bp {
+                (best, bp) = (k, *p);
             }
         }
-        best
+        if bp > 0.0 {
+            Fault::ALL.get(best).map(|f| (*f, bp))
+        } else {
+            None
+        }
     }
 }
 

@@ -196,11 +196,14 @@ impl CommissionTracker {
     /// quasi-steady point; returns a note when a lit r2..r4 lamp meets an operating point
     /// outside the learned range.
     pub(super) fn after(&mut self, mon: &Monitor, t: f64, out: &MonitorOutput) -> Option<String> {
-        let run = mon.commissioning();
-        if self.run_id == Some(run.id) {
-            self.learned = (run.blocks_learned, run.blocks_needed);
-            if run.stage == RunStage::Done && self.ended_at.is_none() {
-                self.ended_at = Some(t);
+        // (The run is read only where this replay started one.)
+        if let Some(id) = self.run_id {
+            let run = mon.commissioning();
+            if run.id == id {
+                self.learned = (run.blocks_learned, run.blocks_needed);
+                if run.stage == RunStage::Done && self.ended_at.is_none() {
+                    self.ended_at = Some(t);
+                }
             }
         }
         if matches!(out.commissioning, CommissioningState::Learning(_)) && out.quasi_steady {
@@ -293,11 +296,19 @@ impl CommissionTracker {
 
     /// True when the learned thresholds are in force and the load current or the voltage
     /// is outside the span seen while learning (beyond the reporting margin).
+    /// (The same test as [`CommissionTracker::moved_note`]'s, without its words.)
+    #[inline]
     pub(super) fn outside_learned_range(&self, out: &MonitorOutput) -> bool {
+        out.commissioning == CommissioningState::Commissioned && self.outside_span(out)
+    }
+
+    /// [`CommissionTracker::outside_learned_range`] with the learned thresholds in force
+    /// (out of line: the replay asks on every row with a lamp lit).
+    #[inline(never)]
+    fn outside_span(&self, out: &MonitorOutput) -> bool {
         let (i_active, v) = operating_point(out);
-        out.commissioning == CommissioningState::Commissioned
-            && (self.iqs.and_then(|s| outside(s, i_active)).is_some()
-                || self.vqs.and_then(|s| outside(s, v)).is_some())
+        self.iqs.and_then(|s| outside(s, i_active)).is_some()
+            || self.vqs.and_then(|s| outside(s, v)).is_some()
     }
 
     /// Whether lamps on the thresholds now in force count as detections: always without a

@@ -11,14 +11,13 @@
 //! ([`monitor_core::isolation::Follower`]: the same code the firmware runs; the firmware
 //! feeds it the monitor's own outputs, [`SteadyPoint::from_output`]).
 
+pub(super) mod chunk;
 mod report;
 mod sentences;
 
 pub use crate::isolation_name::{IsolationName, NameGiven};
 use monitor_core::isolation::{Follower, Named, Step, DEFAULT_SPREAD};
-use monitor_core::{
-    CommissioningState, Fault, Isolation, IsolationState, Isolator, MonitorOutput, SteadyPoint,
-};
+use monitor_core::{Fault, Isolation, IsolationState, Isolator, SteadyPoint};
 pub(super) use report::refine_single_phase;
 use report::{baseline_name, groups, REPORTED_RISE_K};
 pub use report::{
@@ -62,6 +61,16 @@ pub(super) struct IsolationTracker {
     events: super::events::EventLog,
     /// The log's temperature channel (`t_winding_c`), when it has one.
     temperature: super::temperature::TemperatureChannel,
+    /// The rows not yet handed to the follower and the events ([`chunk`]), and the most
+    /// rows of a chunk (the core's block).
+    chunk: chunk::RowChunk,
+    chunk_rows: u32,
+    /// The time left in the follower's block after the last chunk [s]: a chunk ends where
+    /// the block does.
+    block_left_s: f64,
+    /// [`IsolationTracker::load_explains_lamps`], as of the last chunk (its inputs change
+    /// only there).
+    load_explains: bool,
 }
 
 /// With the load an unknown input, B and Bl are not candidates (their change is the load's
@@ -125,10 +134,13 @@ impl IsolationTracker {
     /// A tracker for the nominal machine (`None`: a machine the isolator rejects, then
     /// nothing is isolated and the report says so), of a log with a temperature column
     /// (`temperature_column`) or without; `load`: what is known of the load.
+    /// `chunk_rows`: the most rows whose points are handed on together (the core's block of
+    /// `decimation` samples, [`chunk`]; at least 1).
     pub(super) fn new(
         isolator: Option<Isolator>,
         temperature_column: bool,
         load: super::LoadModel,
+        chunk_rows: u32,
     ) -> Self {
         let isolator = isolator.map(|mut i| {
             i.set_load_unknown(load == super::LoadModel::Unknown);
@@ -147,51 +159,98 @@ impl IsolationTracker {
             load,
             events: super::events::EventLog::default(),
             temperature: super::temperature::TemperatureChannel::new(temperature_column),
+            chunk: chunk::RowChunk::default(),
+            chunk_rows: chunk_rows.max(1),
+            block_left_s: 0.0,
+            load_explains: false,
         }
     }
 
     /// After the monitor's output for the sample at `t` (`dt_s` after the previous one);
-    /// `point`: the steady-state vectors at this sample (module docs); `counts`: lamps and
-    /// detections count now (the learned thresholds are in force, or none were asked for);
-    /// `temperature_c`: the log's temperature reading, if it has the column.
+    /// `flags`: the output's flags ([`chunk::RowFlags`]), their `counts` whether the lamps and
+    /// detections count now (the learned thresholds are in force, or none were asked for)
+    /// and the monitor has settled after a restart; `point`: the steady-state vectors at
+    /// this sample (module docs); `temperature_c`: the log's temperature reading, if it has the column. The point goes
+    /// into the chunk of rows handed on together ([`chunk`]; [`IsolationTracker::flush`]).
+    #[inline]
     pub(super) fn after(
         &mut self,
         t: f64,
         dt_s: f64,
-        out: &MonitorOutput,
+        flags: chunk::RowFlags,
         point: &SteadyPoint,
-        counts: bool,
         temperature_c: Option<f64>,
     ) {
         self.end_t = t;
+        if self.follower.is_none() {
+            return;
+        }
+        if self.chunk.ends_before(flags) {
+            self.flush();
+        }
+        if let Some(follower) = self
+            .follower
+            .as_mut()
+            .filter(|_| self.temperature.present())
+        {
+            self.temperature
+                .put_in_force(follower, t, temperature_c, flags.learning());
+        }
+        // A point the follower judges against a moving reference, or would not find steady,
+        // goes alone, after the rows before it: its average restarts where it would row by
+        // row ([`chunk`]).
+        let alone = self.usable_with(flags)
+            && self.follower.as_ref().and_then(|f| f.steady(point)) != Some(true);
+        if alone {
+            self.flush();
+        }
+        let rows = self.chunk.add(t, dt_s, point, flags);
+        if rows >= self.chunk_rows || alone || self.chunk.span_s() >= self.block_left_s {
+            self.flush();
+        }
+    }
+
+    /// Whether a point with `flags` is usable by the follower: the monitor runs (now or
+    /// before), no sensor fault, and commissioning learns or the lamps count.
+    #[inline]
+    fn usable_with(&self, flags: chunk::RowFlags) -> bool {
+        let running = self.running || flags.evaluating() || flags.learned_blocks();
+        running && !flags.sensor_fault() && (flags.learning() || flags.counts())
+    }
+
+    /// Hands the rows of the chunk to the events' history and the follower (their mean
+    /// point, the chunk's length; [`chunk`]), and books what the follower isolated; at the
+    /// end of the log, what is left.
+    pub(super) fn flush(&mut self) {
+        let Some(c) = self.chunk.close() else {
+            return;
+        };
+        let usable = self.usable_with(c.flags);
         let Some(follower) = self.follower.as_mut() else {
             return;
         };
-        self.events.sample(t, dt_s, point);
-        let learning = matches!(out.commissioning, CommissioningState::Learning(_));
+        let (t, flags, point) = (c.last_t, c.flags, &c.point);
+        self.events.sample(c.first_t, c.span_s, point);
+        let learning = flags.learning();
         // Running: the monitor evaluates its lamps, or its commissioning has learned a
         // block (it learns on running, quasi-steady blocks only, and does not evaluate
         // meanwhile: a window that opens before the first evaluation would otherwise teach
         // the isolation nothing).
-        let learned_blocks =
-            matches!(out.commissioning, CommissioningState::Learning(f) if f > 0.0);
-        self.running |= out.evaluating || learned_blocks;
-        let usable = self.running && !out.sensor_fault.any() && (learning || counts);
-        self.lamps_lit |= counts && out.fault_detected;
+        self.running |= flags.evaluating() || flags.learned_blocks();
+        let counts = flags.counts();
+        self.lamps_lit |= counts && flags.fault_detected();
         let learned = follower.learned();
         if learned {
             // Load moves are measured from the commissioned point, and recorded at every
             // quasi-steady output (the isolation does not run outside the learned range).
             self.events.seed(&follower.isolator().baseline().at);
-            if usable && out.quasi_steady {
+            if usable && flags.quasi_steady() {
                 self.events.point(t, point);
             }
         }
-        self.temperature
-            .put_in_force(follower, t, temperature_c, learning);
         // Quasi-steady by the vectors themselves (the monitor's gate follows its own frame,
         // which a sensor fault can detune).
-        if let Step::Isolated(result) = follower.observe(point, dt_s as f32, usable, learning) {
+        if let Step::Isolated(result) = follower.observe(point, c.span_s as f32, usable, learning) {
             let lag = follower.measured_rise_k().map(|_| follower.probe_lag_k());
             self.temperature.after_isolation(t, &result, lag);
             self.evidence.after(follower, &result);
@@ -204,6 +263,11 @@ impl IsolationTracker {
             self.last_t = t;
             self.last_point = *point;
         }
+        self.block_left_s = self
+            .follower
+            .as_ref()
+            .map_or(0.0, |f| f64::from(f.block_left_s()));
+        self.load_explains = self.load_explains_now();
     }
 
     /// The name the isolation gives after `result` (`learned`: a learned baseline is in
@@ -321,7 +385,12 @@ impl IsolationTracker {
     /// are the load's move: the last isolation reads the friction class (the load), the
     /// operating points since name no fault, and no fault was ever named.
     pub(super) fn load_explains_lamps(&self) -> bool {
-        // (Read in place: this runs on every row with a lamp lit.)
+        self.load_explains
+    }
+
+    /// [`IsolationTracker::load_explains_lamps`] from the follower's last result, the
+    /// evidence and the names given.
+    fn load_explains_now(&self) -> bool {
         let friction = self
             .follower
             .as_ref()

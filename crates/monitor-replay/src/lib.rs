@@ -79,6 +79,7 @@ pub use winding::{
 };
 
 use commission::CommissionTracker;
+use isolation::chunk::RowFlags;
 use isolation::IsolationTracker;
 use monitor_core::{AngleSource, ConfigError, Isolator, Monitor, MonitorOutput};
 use monitor_io::log::{Channels, LogError, Row};
@@ -87,8 +88,8 @@ use options::check_commission_window;
 use sampler::sample_of;
 use serde::Serialize;
 use step::{
-    bands_needed, detected_in_range, lamps_since_moved, note_detection, note_residuals,
-    timeline_step_due, LastOutput, RestartHold, NO_BANDS,
+    bands_for, book_detection, lamps_since_moved, note_residuals, timeline_step_due, LastOutput,
+    RestartHold, NO_BANDS,
 };
 
 /// Timestamp tick rate used for replays [Hz].
@@ -160,14 +161,25 @@ pub struct UnbalanceBaseline {
 }
 
 /// The isolation's tracker for a replay of a log with `channels` under `params` (no
-/// isolator for a machine it rejects), `load` what is known of the load.
-fn isolation_tracker(params: &ParamFile, channels: Channels, load: LoadModel) -> IsolationTracker {
+/// isolator for a machine it rejects), `load` what is known of the load, `decimation` the
+/// core's block (the rows the tracker hands on together).
+fn isolation_tracker(
+    params: &ParamFile,
+    channels: Channels,
+    load: LoadModel,
+    decimation: u16,
+) -> IsolationTracker {
     let isolator = Isolator::new(
         params.motor.model(),
         params.supply.v_phase_peak() as f32,
         params.supply.f_hz as f32,
     );
-    IsolationTracker::new(isolator.ok(), channels.temperature, load)
+    IsolationTracker::new(
+        isolator.ok(),
+        channels.temperature,
+        load,
+        u32::from(decimation),
+    )
 }
 
 /// The sequence analysis of a replay of a log with `channels` at `sample_rate_hz` (the
@@ -206,6 +218,9 @@ pub struct Replay {
     detected_in_range: bool,
     first_detection: Option<f64>,
     detections: Vec<Detection>,
+    /// The fault probabilities whose first fault is in `detections` already (NaN: none
+    /// yet; [`step::note_detection`]).
+    top_seen: [f32; monitor_core::FAULT_COUNT],
     timeline: Vec<TimelinePoint>,
     next_point: f64,
     dt_s: f64,
@@ -273,13 +288,14 @@ impl Replay {
             detected_in_range: false,
             first_detection: None,
             detections: Vec::new(),
+            top_seen: [f32::NAN; monitor_core::FAULT_COUNT],
             timeline: Vec::new(),
             next_point: 0.0,
             dt_s: 1.0 / sample_rate_hz,
             max_abs: [0.0; 4],
             last: LastOutput::default(),
             t0: None,
-            isolation: isolation_tracker(params, channels, opts.load),
+            isolation: isolation_tracker(params, channels, opts.load, cfg.decimation),
             lamps_since_moved: false,
             seq_front: sequence_front(params, channels, sample_rate_hz).map_err(config_error)?,
             book: sequences::WindowBook::new(),
@@ -329,25 +345,23 @@ impl Replay {
         // With a commissioning window asked for, lamps lit on the fixed thresholds before
         // the learned ones are in force are not detections: the window says the nominal
         // parameters are not to be trusted (a sensor fault counts at any time).
-        let counts = out.sensor_fault.any() || self.commission.thresholds_trusted(out);
-        let bands = bands_needed(mon, out);
         let trusted = self.commission.thresholds_trusted(out);
+        let flags = RowFlags::of(out, trusted);
+        let counts = flags.counts();
+        let bands = bands_for(mon, out, counts, self.detected_in_range);
         let held_bands = if out.quasi_steady { NO_BANDS } else { bands };
+        let judged = self.evaluated;
         self.unsettled
-            .after(t, out, held_bands, self.evaluated, trusted);
+            .after(t, (out, flags), held_bands, judged, trusted);
         let point = step.point(out.operating.wr_rad_s);
         let settled = self.restart.settled(t, out);
-        self.isolation.after(
-            t,
-            self.dt_s,
-            out,
-            &point,
-            counts && settled,
-            row.t_winding_c,
-        );
+        let usable = flags.with_counts(counts && settled);
+        let (dt_s, tc) = (self.dt_s, row.t_winding_c);
+        self.isolation.after(t, dt_s, usable, &point, tc);
         if out.fault_detected && counts {
-            self.detected_in_range |= detected_in_range(&self.commission, out, bands);
-            note_detection(&mut self.first_detection, &mut self.detections, t, out);
+            let first = (&mut self.detected_in_range, &mut self.first_detection);
+            let booked = (&mut self.detections, &mut self.top_seen);
+            book_detection(first, booked, &self.commission, (t, out, bands));
         }
         // The sample nearest each timeline step (half a sample early counts: the data-quality
         // stage's sample clock may put the sample at the step a hair before it).
@@ -366,7 +380,7 @@ impl Replay {
             &self.commission,
             &self.isolation,
         );
-        self.last = LastOutput::of(out);
+        self.last = LastOutput::of(out, flags);
     }
 
     /// The acquisition clock was reset before the next row (`diagnose` carries the time on

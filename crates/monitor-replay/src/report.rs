@@ -471,6 +471,7 @@ impl Replay {
     /// Ends the replay and builds the report (`data_quality` left at its default for the
     /// caller to fill).
     pub fn finish(mut self) -> DiagnoseReport {
+        self.isolation.flush();
         let out = self.output();
         self.close_sequences(&out);
         let skipped = skipped_analyses(self.channels);

@@ -2,9 +2,10 @@
 //! each reads the output by reference and updates the fields it is given.
 
 use super::commission::CommissionTracker;
+use super::isolation::chunk::RowFlags;
 use super::isolation::IsolationTracker;
 use super::report::Detection;
-use monitor_core::{CommissioningState, Monitor, MonitorOutput};
+use monitor_core::{Monitor, MonitorOutput, FAULT_COUNT};
 
 /// No bands (centre and half-width 0): what is passed where the bands are not needed.
 pub(super) const NO_BANDS: [(f32, f32); 4] = [(0.0, 0.0); 4];
@@ -30,6 +31,38 @@ pub(super) fn bands_needed(mon: &Monitor, out: &MonitorOutput) -> [(f32, f32); 4
     } else {
         mon.threshold_bands()
     }
+}
+
+/// The bands a row needs: for the quasi-steady gate's held stretch ([`NO_BANDS`] while
+/// the gate is open) and for a counted detection's first look inside the range
+/// (`detected`: one was found already, and that stays), else [`NO_BANDS`].
+#[inline]
+pub(super) fn bands_for(
+    mon: &Monitor,
+    out: &MonitorOutput,
+    counts: bool,
+    detected: bool,
+) -> [(f32, f32); 4] {
+    if !out.quasi_steady || (out.fault_detected && counts && !detected) {
+        bands_needed(mon, out)
+    } else {
+        NO_BANDS
+    }
+}
+
+/// Books a counted detection at `t` in `out` (with the bands in force `bands`): whether
+/// one was inside the commissioned range (`in_range`, once true it stays:
+/// [`detected_in_range`]), the first one's time, and each fault the output ranks first
+/// ([`note_detection`]).
+#[inline]
+pub(super) fn book_detection(
+    (in_range, first): (&mut bool, &mut Option<f64>),
+    booked: (&mut Vec<Detection>, &mut [f32; FAULT_COUNT]),
+    commission: &CommissionTracker,
+    (t, out, bands): (f64, &MonitorOutput, [(f32, f32); 4]),
+) {
+    *in_range = *in_range || detected_in_range(commission, out, bands);
+    note_detection(first, booked, t, out);
 }
 
 /// After a restart of the monitor's estimators (a long gap, a clock reset) the isolation
@@ -82,22 +115,39 @@ pub(super) fn detected_in_range(
 }
 
 /// Books a counted detection at `t` [s]: the first one's time, and each fault the output
-/// ranks first the first time it does.
+/// ranks first the first time it does. `seen`: the probabilities whose first fault is
+/// booked already (the diagnosis changes only with the lamps: the same one is not ranked
+/// again).
 #[inline]
 pub(super) fn note_detection(
     first: &mut Option<f64>,
-    detections: &mut Vec<Detection>,
+    (detections, seen): (&mut Vec<Detection>, &mut [f32; FAULT_COUNT]),
     t: f64,
     out: &MonitorOutput,
 ) {
     if first.is_none() {
         *first = Some(t);
     }
+    if same_bits(seen, &out.diagnosis.probabilities) {
+        return;
+    }
+    *seen = out.diagnosis.probabilities;
     if let Some((fault, _)) = out.top() {
         if !detections.iter().any(|d| d.fault == fault) {
             detections.push(Detection { fault, t_s: t });
         }
     }
+}
+
+/// Whether `a` and `b` hold the same bits (a cheaper test than `==`, without branches; it
+/// differs from `==` only for NaN and signed zeros, where [`note_detection`] books the same
+/// once more, and nothing changes).
+#[inline]
+fn same_bits(a: &[f32; FAULT_COUNT], b: &[f32; FAULT_COUNT]) -> bool {
+    a.iter()
+        .zip(b)
+        .fold(0, |acc, (x, y)| acc | (x.to_bits() ^ y.to_bits()))
+        == 0
 }
 
 /// Whether the sample at `t` [s] (interval `dt_s`) is the one nearest the timeline step
@@ -116,7 +166,8 @@ pub(super) fn timeline_step_due(next: &mut f64, t: f64, dt_s: f64, step_s: f64) 
 }
 
 /// Whether the lamps lit now first lit while the load had moved (or the load explained
-/// them), `was` the answer at the last row: false once every lamp is dark.
+/// them), `was` the answer at the last row: false once every lamp is dark. (Once true it
+/// stays true while a lamp is lit: the load's checks are made only while it is false.)
 #[inline]
 pub(super) fn lamps_since_moved(
     was: bool,
@@ -126,10 +177,8 @@ pub(super) fn lamps_since_moved(
 ) -> bool {
     if !out.lamps.iter().any(|l| *l) {
         false
-    } else if commission.moved_note(out).is_some() || isolation.load_explains_lamps() {
-        true
     } else {
-        was
+        was || isolation.load_explains_lamps() || commission.outside_learned_range(out)
     }
 }
 
@@ -145,13 +194,13 @@ pub(super) struct LastOutput {
 }
 
 impl LastOutput {
-    /// What the next row needs of `out`.
+    /// What the next row needs of `out` (with its `flags`).
     #[inline]
-    pub(super) fn of(out: &MonitorOutput) -> Self {
+    pub(super) fn of(out: &MonitorOutput, flags: RowFlags) -> Self {
         LastOutput {
-            learning: matches!(out.commissioning, CommissioningState::Learning(_)),
+            learning: flags.learning(),
             wr_rad_s: out.operating.wr_rad_s,
-            sensor_fault: out.sensor_fault.any(),
+            sensor_fault: flags.sensor_fault(),
         }
     }
 }

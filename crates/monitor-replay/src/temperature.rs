@@ -101,6 +101,12 @@ impl TemperatureChannel {
         }
     }
 
+    /// The log has the column.
+    #[inline]
+    pub fn present(&self) -> bool {
+        self.present
+    }
+
     /// The reading at `t` [s] (`None`: the log has no column); `learning`: commissioning
     /// learns now; `learned`: a learned baseline is in force. Returns the measured rise
     /// since commissioning to put in force [K], `None` when the channel is not (or not yet)

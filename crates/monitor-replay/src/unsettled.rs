@@ -8,7 +8,8 @@
 //! nobody judged; when they sit at many times their bands, "healthy" would hide a fault,
 //! so `diagnose` says it could not judge instead ([`Unsettled::withheld`]).
 
-use monitor_core::{CommissioningState, MonitorOutput};
+use super::isolation::chunk::RowFlags;
+use monitor_core::MonitorOutput;
 
 /// How far outside its band a residual must sit, in half-widths, for a held stretch to
 /// withhold the verdict: 3 (a band is the learned mean +- k sigma, so 3 bands are far
@@ -34,19 +35,19 @@ pub(super) struct Unsettled {
 impl Unsettled {
     /// After each sample at time `t`: `bands` are the residuals' bands in force (centre,
     /// half-width), `judged_before` whether the lamps were ever evaluated, `trusted`
-    /// whether the thresholds in force count.
+    /// whether the thresholds in force count, `flags` the output's flags.
+    #[inline]
     pub(super) fn after(
         &mut self,
         t: f64,
-        out: &MonitorOutput,
+        (out, flags): (&MonitorOutput, RowFlags),
         bands: [(f32, f32); 4],
         judged_before: bool,
         trusted: bool,
     ) {
         self.last_s = t;
-        let learning = matches!(out.commissioning, CommissioningState::Learning(_));
-        let held = !out.quasi_steady && judged_before && trusted && !learning;
-        if !held || out.sensor_fault.any() {
+        let held = !flags.quasi_steady() && judged_before && trusted && !flags.learning();
+        if !held || flags.sensor_fault() {
             self.since_s = None;
             self.worst = 0.0;
             return;

@@ -17,7 +17,7 @@
 //! No allocation: the points are kept in an array of [`MAX_POINTS`]; the host's replay and
 //! the firmware's thread mode run this same code.
 
-use super::{Follower, Isolation, IsolationState, Named, SteadyPoint, MAX_POINTS};
+use super::{Follower, Isolation, IsolationState, Named, SearchHints, SteadyPoint, MAX_POINTS};
 
 /// Smallest relative difference of the load (the active current) between two kept points:
 /// 15 %, so that two points are two operating points and not one seen twice.
@@ -48,6 +48,11 @@ pub struct Evidence {
     joint: Option<Isolation>,
     /// The last averaged point judged healthy (no deviation) before the points kept.
     anchor: Option<SteadyPoint>,
+    /// Where the size searches of the joint fit, and of the load's check on one point,
+    /// found each fault the last time (module docs of [`crate::isolation`], "Searches
+    /// started from the last result").
+    hints: SearchHints,
+    moved_hints: SearchHints,
 }
 
 impl Evidence {
@@ -82,10 +87,13 @@ impl Evidence {
         }
         self.keep(p, scale, a);
         let enough = self.len >= 2 || self.anchor.is_some();
+        let kept = self.points.get(..self.len).unwrap_or(&[]);
         self.joint = enough.then(|| {
-            follower
-                .isolator()
-                .isolate_points_anchored(self.kept(), self.anchor.as_ref())
+            follower.isolator().isolate_points_anchored_from(
+                kept,
+                self.anchor.as_ref(),
+                &mut self.hints,
+            )
         });
     }
 
@@ -100,7 +108,7 @@ impl Evidence {
     /// evidence is kept yet, and the stator-voltage equations alone deviate by less than
     /// [`LOAD_MOVED_SIGMA`].
     fn load_moved(
-        &self,
+        &mut self,
         follower: &Follower,
         result: &Isolation,
         point: &(SteadyPoint, f32),
@@ -115,7 +123,14 @@ impl Evidence {
         let friction = matches!(result.named(), Some(Named::Friction { .. }));
         friction
             && self.len == 0
-            && iso.isolate_points(core::slice::from_ref(point)).deviation < LOAD_MOVED_SIGMA
+            && iso
+                .isolate_points_anchored_from(
+                    core::slice::from_ref(point),
+                    None,
+                    &mut self.moved_hints,
+                )
+                .deviation
+                < LOAD_MOVED_SIGMA
     }
 
     /// Keeps the point `p` (spread scale `scale`, active current `a` [A]): it replaces the

@@ -177,6 +177,11 @@ pub struct Follower {
     warming_k_per_s: f32,
     /// Time since the heating was last tracked [s].
     since_tracked_s: f32,
+    /// Where the size searches of the point's isolation, and of its check on the
+    /// stator-voltage equations alone, found each fault the last time (module docs of
+    /// [`crate::isolation`], "Searches started from the last result").
+    hints: super::SearchHints,
+    voltage_hints: super::SearchHints,
 }
 
 impl Follower {
@@ -205,6 +210,8 @@ impl Follower {
             since_judged_s: 0.0,
             warming_k_per_s: 0.0,
             since_tracked_s: 0.0,
+            hints: super::SearchHints::default(),
+            voltage_hints: super::SearchHints::default(),
         }
     }
 
@@ -358,14 +365,18 @@ impl Follower {
         // How far the winding can have moved since its temperature was last judged.
         self.isolator
             .set_heating_reach_k(self.since_judged_s, self.warming_k_per_s);
-        let mut result = self.isolator.isolate_scaled(avg, scale);
+        let mut result = self
+            .isolator
+            .isolate_scaled_from(avg, scale, &mut self.hints);
         let onset = self.at_onset();
         let heating = self.heating_in(&result, onset);
         if self.learned && heating {
             // Heating is not a fault: the machine judged against warms with the winding,
             // and the point is judged again (module docs of `crate::isolation`).
             self.track_with_rate(result.heating.factor);
-            result = self.isolator.isolate_scaled(avg, scale);
+            result = self
+                .isolator
+                .isolate_scaled_from(avg, scale, &mut self.hints);
         }
         self.note_temperature((&result, avg, scale), self.learned && heating);
         let deviates = matches!(
@@ -491,6 +502,23 @@ impl Follower {
             return None;
         }
         Some((self.mean()?, crate::math::sqrt(AVERAGE_MAX_S / averaged_s)))
+    }
+
+    /// Whether [`Follower::observe`] would find `p` steady against the mean of the blocks
+    /// (and not restart the average); `None` where there is no such mean (before the
+    /// first block closes, the point is judged against the block being summed, which every
+    /// point moves). For a caller that hands on the means of several points at once (the
+    /// host's replay) and each point alone where it is not steady.
+    #[inline]
+    pub fn steady(&self, p: &SteadyPoint) -> Option<bool> {
+        self.mean.map(|b| b.admits(p))
+    }
+
+    /// Time left until the block being summed is [`STEP_S`] long and closes [s] (a caller
+    /// that hands on several points at once ends its sum there, where the follower's block
+    /// ends point by point).
+    pub fn block_left_s(&self) -> f32 {
+        0.999 * STEP_S - self.block_s
     }
 
     /// The latest isolation in force, if any was made.

@@ -8,6 +8,7 @@ mod search;
 mod weight;
 pub use heating::HEATING_LAG_SIGMA_K;
 pub use points::{ANCHOR_LOAD_BAND, ANCHOR_TORQUE_SPREAD, LOAD_LAW_SPREAD, MAX_POINTS};
+pub use search::SearchHints;
 
 use super::*;
 use crate::error::{ensure, ConfigCheck, ConfigError};
@@ -356,6 +357,18 @@ impl Isolator {
     /// (>= 1; values below 1 or not finite count as 1): a point averaged for a shorter time
     /// scatters more ([`Follower`]: `sqrt(AVERAGE_MAX_S / averaged)`).
     pub fn isolate_scaled(&self, p: &SteadyPoint, spread_scale: f32) -> Isolation {
+        self.isolate_scaled_from(p, spread_scale, &mut SearchHints::default())
+    }
+
+    /// [`Isolator::isolate_scaled`] with each fault's size searched from where `hints` say
+    /// it was found the last time, and `hints` updated (module docs, "Searches started
+    /// from the last result").
+    pub fn isolate_scaled_from(
+        &self,
+        p: &SteadyPoint,
+        spread_scale: f32,
+        hints: &mut SearchHints,
+    ) -> Isolation {
         let k = if spread_scale.is_finite() {
             crate::math::maxf(spread_scale, 1.0)
         } else {
@@ -363,12 +376,18 @@ impl Isolator {
         };
         let mut scaled = *self;
         scaled.baseline.spread = scaled.baseline.spread.map(|s| s * k);
-        scaled.isolate(p)
+        scaled.isolate_from(p, hints)
     }
 
     /// Isolates the fault at the steady operating point `p` (module docs). Never panics;
     /// an unusable point gives [`IsolationState::NotJudged`].
     pub fn isolate(&self, p: &SteadyPoint) -> Isolation {
+        self.isolate_from(p, &mut SearchHints::default())
+    }
+
+    /// [`Isolator::isolate`] with the size searches started from `hints`
+    /// ([`Isolator::isolate_scaled_from`]).
+    pub fn isolate_from(&self, p: &SteadyPoint, hints: &mut SearchHints) -> Isolation {
         let mut out = Isolation::default();
         let Some(e0) = self.residuals(p, None) else {
             return out;
@@ -390,8 +409,11 @@ impl Isolator {
             return out;
         }
         let mut fits = [(0.0f32, 1.0f32); FAULT_COUNT];
+        let use_hints = hints.begin(self.hint_at(&out), 1);
         for (fit, f) in fits.iter_mut().zip(Fault::ALL) {
-            *fit = self.fit(&r, f, &w);
+            let (found, hint) = self.fit(&r, f, &w, hints.get(f, use_hints));
+            *fit = found;
+            hints.set(f, hint);
         }
         let heat = self.fit_heating(&r, &w);
         let eps = self.direction_uncertainty();
@@ -400,12 +422,22 @@ impl Isolator {
         // for (heating itself is decided on the single fits above).
         if !out.heating_explains() {
             for (fit, f) in fits.iter_mut().zip(Fault::ALL) {
-                *fit = self.fit_on_warm(&r, f, &w, *fit);
+                *fit = self.fit_on_warm(&r, f, &w, (*fit, hints.get(f, use_hints)));
             }
             rank(&mut out, &mut fits, heat, (chi0, 3.0), eps);
         }
         out.separation_deg = self.separation(p, &e0, &out.candidates);
         out
+    }
+
+    /// Where the deviation of `out` lies, for [`SearchHints::begin`]: its residuals in
+    /// spreads and its misfit's root.
+    pub(super) fn hint_at(&self, out: &Isolation) -> [f32; 4] {
+        let [d, q, t] = out
+            .residuals
+            .zip_map(self.baseline.spread, |e, s| e / s)
+            .to_array();
+        [d, q, t, out.deviation]
     }
 
     /// Whether the load is an unknown input (`diagnose`'s default): then, against the
@@ -463,12 +495,12 @@ impl Isolator {
     }
 
     /// Best factor `k` for fault `f`: geometric grid, then golden section around the best
-    /// grid point ([`fit_factor`]). Returns `(chi2, k)`. Not inlined: one copy for the nine
-    /// faults keeps the firmware's flash small (it runs in thread mode, where a call costs
-    /// nothing).
+    /// grid point ([`fit_factor`], from the grid point `hint`). Returns `(chi2, k)` and the
+    /// hint for the next search. Not inlined: one copy for the nine faults keeps the
+    /// firmware's flash small (it runs in thread mode, where a call costs nothing).
     #[inline(never)]
-    fn fit(&self, r: &Reading, f: Fault, w: &Sym3) -> (f32, f32) {
-        fit_factor(|k| self.chi2_at(r, Some((f, k)), w))
+    fn fit(&self, r: &Reading, f: Fault, w: &Sym3, hint: u8) -> ((f32, f32), u8) {
+        fit_factor(|k| self.chi2_at(r, Some((f, k)), w), hint)
     }
 
     /// Angle between the top two candidates' weighted directions `e(f, k*) - e(nominal)`

@@ -165,8 +165,19 @@
 //! - others depend on the operating point (the angle between directions,
 //!   [`Isolation::separation_deg`]).
 //!
+//! # Searches started from the last result
+//! Each fault's size is searched on a grid of [`K_MIN`]..[`K_MAX`] and refined by golden
+//! section. A search repeated on a point that moves little (the [`Follower`]'s isolation
+//! every [`STEP_S`], the [`Evidence`]'s joint fit) starts from the grid point that was best
+//! the last time ([`SearchHints`]): where it is still below its two grid neighbours and
+//! `k = 1`, the rest of the grid is not searched (for a misfit with one minimum over the
+//! grid, the same point and so the same result); the whole grid is searched where the last
+//! whole grid had more than one minimum, where the deviation moved by more than half a
+//! spread or 1 % since the last isolation, where the number of points changed, and every
+//! tenth isolation.
+//!
 //! Cost: about 300 circuit evaluations of some 60 flops each per call (280 for the fits,
-//! 12 for the weight); run it from a
+//! 12 for the weight; about half the fits' from the last result); run it from a
 //! low-priority task (the firmware: thread mode, from the status hand-over, every
 //! [`STEP_S`] at most), never from the per-sample path. [`Follower`] runs the schedule
 //! (averaging the operating point, learning the baseline, isolating) for the firmware and
@@ -188,7 +199,8 @@ mod evidence;
 pub use evidence::{Evidence, LEVEL_APART};
 mod isolator;
 pub use isolator::{
-    ANCHOR_LOAD_BAND, ANCHOR_TORQUE_SPREAD, HEATING_LAG_SIGMA_K, LOAD_LAW_SPREAD, MAX_POINTS,
+    SearchHints, ANCHOR_LOAD_BAND, ANCHOR_TORQUE_SPREAD, HEATING_LAG_SIGMA_K, LOAD_LAW_SPREAD,
+    MAX_POINTS,
 };
 mod outcome;
 pub use outcome::{

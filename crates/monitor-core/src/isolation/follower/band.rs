@@ -34,6 +34,7 @@ impl SteadyBand {
     }
 
     /// Every quantity of `p` within the band ([`steady_against`](super::steady_against)).
+    #[inline]
     pub(super) fn admits(&self, p: &SteadyPoint) -> bool {
         let avg = &self.avg;
         hypot_within(p.i.d - avg.i.d, p.i.q - avg.i.q, self.i)

@@ -41,7 +41,11 @@ impl Follower {
         let load_moved = friction
             && self
                 .isolator
-                .isolate_points(core::slice::from_ref(&(*point, scale)))
+                .isolate_points_anchored_from(
+                    core::slice::from_ref(&(*point, scale)),
+                    None,
+                    &mut self.voltage_hints,
+                )
                 .state
                 == crate::isolation::IsolationState::NoDeviation;
         let fits = result.state == crate::isolation::IsolationState::NoDeviation || load_moved;

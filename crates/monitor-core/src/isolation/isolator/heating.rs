@@ -75,14 +75,15 @@ impl Isolator {
     /// `(lag / HEATING_LAG_SIGMA_K)^2` (the tracked temperature's own uncertainty as a
     /// prior), within +-[`HEATING_LAG_K`]. Two rounds of alternating fits, the lag for the
     /// fault's size, then the size on the machine so warmed; returns the better of
-    /// `(chi2, k)` and `single`.
+    /// `(chi2, k)` and `single`. `hint`: the single fit's grid point, where the size
+    /// searches start ([`SearchHints`]).
     #[inline(never)]
     pub(super) fn fit_on_warm(
         &self,
         r: &Reading,
         f: Fault,
         w: &Sym3,
-        single: (f32, f32),
+        (single, hint): ((f32, f32), u8),
     ) -> (f32, f32) {
         if !(self.lag_sigma_k > 0.0) {
             return single;
@@ -95,6 +96,7 @@ impl Isolator {
         };
         let mut best = single;
         let mut kf = single.1;
+        let mut hint = hint;
         for _ in 0..2 {
             let (_, kh) = golden(
                 |k| self.warmer(k).chi2_at(r, Some((f, kf)), w) + prior(k),
@@ -102,7 +104,8 @@ impl Isolator {
                 1.0 + d,
                 LAG_STEPS,
             );
-            let (c, k) = self.warmer(kh).fit(r, f, w);
+            let ((c, k), next) = self.warmer(kh).fit(r, f, w, hint);
+            hint = next;
             kf = k;
             if c + prior(kh) < best.0 {
                 best = (c + prior(kh), k);

@@ -40,6 +40,18 @@ impl Isolator {
         points: &[(SteadyPoint, f32)],
         anchor: Option<&SteadyPoint>,
     ) -> Isolation {
+        self.isolate_points_anchored_from(points, anchor, &mut SearchHints::default())
+    }
+
+    /// [`Isolator::isolate_points_anchored`] with each fault's size searched from where
+    /// `hints` say it was found the last time, and `hints` updated (module docs, "Searches
+    /// started from the last result").
+    pub fn isolate_points_anchored_from(
+        &self,
+        points: &[(SteadyPoint, f32)],
+        anchor: Option<&SteadyPoint>,
+        hints: &mut SearchHints,
+    ) -> Isolation {
         let mut out = Isolation::default();
         let (used, n) = self.weighted_points(points);
         let used = used.get(..n).unwrap_or(&[]);
@@ -64,8 +76,14 @@ impl Isolator {
             return out;
         }
         let mut fits = [(0.0f32, 1.0f32); FAULT_COUNT];
+        let use_hints = hints.begin(self.hint_at(&out), n);
         for (fit, f) in fits.iter_mut().zip(Fault::ALL) {
-            *fit = fit_factor(|k| self.chi2_points(used, load, Some((f, k))));
+            let (found, hint) = fit_factor(
+                |k| self.chi2_points(used, load, Some((f, k))),
+                hints.get(f, use_hints),
+            );
+            *fit = found;
+            hints.set(f, hint);
         }
         let (lo, hi) = self.heating_range();
         let heat = golden(

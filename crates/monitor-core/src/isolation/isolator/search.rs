@@ -104,31 +104,159 @@ fn temperature(chi_min: f32, (chi0, dims): (f32, f32), eps: f32) -> f32 {
     crate::math::maxf(t_model, 0.5 * chi_min)
 }
 
+/// Where each fault's size search found its best point of the grid the last time, to
+/// start the next search there (module docs of [`crate::isolation`], "Searches started
+/// from the last result"): one per search that is repeated on a moving point (the
+/// follower's single point, the joint fit over the kept points). The default starts every
+/// search afresh.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SearchHints {
+    /// Per fault ([`Fault::ALL`]'s order): 0, no hint; `g + 1`, grid point `g`, the one
+    /// minimum of the misfit over the whole grid when it was last searched.
+    grid: [u8; FAULT_COUNT],
+    /// Isolations since the whole grid was last searched for every fault.
+    since_whole: u8,
+    /// Where the hints were found: the deviation's residuals in spreads, its misfit's
+    /// root, and the number of points ([`SearchHints::begin`]).
+    at: ([f32; 4], usize),
+    /// The hints were used at the last isolation.
+    used: bool,
+}
+
+/// Every this many isolations the whole grid is searched for every fault, hints or not
+/// (once a second on the follower's 0.1 s schedule): a misfit that grew a second minimum
+/// since is found again.
+const WHOLE_GRID_EVERY: u8 = 10;
+
+/// How far the deviation may have moved since the hints were found for them to be used:
+/// half a spread, or [`HINT_MOVE_FRACTION`] of the deviation where that is more (a point
+/// averaged again 0.1 s later moves by a fraction of its scatter).
+const HINT_MOVE_SIGMA: f32 = 0.5;
+/// See [`HINT_MOVE_SIGMA`]: 1 %.
+const HINT_MOVE_FRACTION: f32 = 0.01;
+
+impl SearchHints {
+    /// At the start of an isolation of a deviation `at` (its residuals in spreads and its
+    /// misfit's root) over `points` points: whether the hints are used this time. Not
+    /// where the whole grid is due ([`WHOLE_GRID_EVERY`]), nor where the number of points
+    /// changed or the deviation moved by more than [`HINT_MOVE_SIGMA`] or
+    /// [`HINT_MOVE_FRACTION`] of it since the last isolation.
+    pub(super) fn begin(&mut self, at: [f32; 4], points: usize) -> bool {
+        let (last, n) = self.at;
+        self.at = (at, points);
+        let (mut moved, mut size) = (0.0, 0.0);
+        for (a, b) in at.iter().zip(last) {
+            moved += (a - b) * (a - b);
+            size += a * a;
+        }
+        let near = moved
+            <= crate::math::maxf(
+                HINT_MOVE_SIGMA * HINT_MOVE_SIGMA,
+                HINT_MOVE_FRACTION * HINT_MOVE_FRACTION * size,
+            );
+        self.since_whole = self.since_whole.saturating_add(1);
+        self.used = !(self.since_whole >= WHOLE_GRID_EVERY || n != points || !near);
+        if !self.used {
+            self.since_whole = 0;
+        }
+        self.used
+    }
+
+    /// The last isolation's searches started from the hints ([`SearchHints::begin`]).
+    pub fn used(&self) -> bool {
+        self.used
+    }
+
+    /// Fault `f`'s hint (0: none), where hints are used (`use_hints`).
+    pub(super) fn get(&self, f: Fault, use_hints: bool) -> u8 {
+        let h = self.grid.get(f.index()).copied().unwrap_or(0);
+        if use_hints {
+            h
+        } else {
+            0
+        }
+    }
+
+    /// Sets fault `f`'s hint.
+    pub(super) fn set(&mut self, f: Fault, hint: u8) {
+        if let Some(h) = self.grid.get_mut(f.index()) {
+            *h = hint;
+        }
+    }
+}
+
 /// Best factor `k` of a misfit `chi(k)` over [`K_MIN`]..[`K_MAX`]: a geometric grid of
 /// [`GRID`] points (and `k = 1`), then [`GOLDEN_STEPS`] of golden section around the best
-/// grid point. Returns `(chi2, k)`.
-pub(super) fn fit_factor(chi: impl Fn(f32) -> f32) -> (f32, f32) {
+/// grid point. `hint`: the grid point that was best the last time (`g + 1`; 0: none).
+/// Where it is still a strict local minimum of the grid, below `k = 1`, it is taken as the
+/// grid's best without the rest of the grid (for a misfit unimodal over the grid, the same
+/// point the whole grid finds, so the same result); else the whole grid is searched.
+/// Returns `(chi2, k)` and the hint for the next search: the best grid point where the
+/// whole grid has one minimum, else none.
+pub(super) fn fit_factor(chi: impl Fn(f32) -> f32, hint: u8) -> ((f32, f32), u8) {
     let step = F32Ext::powf(K_MAX / K_MIN, 1.0 / (GRID - 1) as f32);
-    let (mut best_k, mut best_c) = (1.0f32, chi(1.0));
-    let mut k = K_MIN;
-    for _ in 0..GRID {
-        let c = chi(k);
-        if c < best_c {
-            (best_k, best_c) = (k, c);
-        }
-        k *= step;
-    }
+    let c_one = chi(1.0);
+    let ((best_k, best_c), next) = match from_hint(&chi, step, c_one, hint) {
+        Some(best) => (best, hint),
+        None => whole_grid(&chi, step, c_one),
+    };
     let (c, x) = golden(
         &chi,
         crate::math::maxf(best_k / step, K_MIN),
         crate::math::minf(best_k * step, K_MAX),
         GOLDEN_STEPS,
     );
-    if c < best_c {
-        (c, x)
-    } else {
-        (best_c, best_k)
+    let fit = if c < best_c { (c, x) } else { (best_c, best_k) };
+    (fit, next)
+}
+
+/// The grid's best point `(k, chi2)` (`k = 1` first, then the grid in order, a later
+/// point only when strictly better), with its hint: `g + 1` where the grid's misfits
+/// fall strictly to one minimum at `g` and rise strictly after it, else 0 (a second
+/// minimum, a flat stretch, `k = 1` best, a value that is not a number).
+fn whole_grid(chi: &impl Fn(f32) -> f32, step: f32, c_one: f32) -> ((f32, f32), u8) {
+    let (mut best_k, mut best_c, mut best_g) = (1.0f32, c_one, None);
+    let (mut k, mut last, mut turns, mut monotone) = (K_MIN, f32::NAN, 0u32, true);
+    for g in 0..GRID {
+        let c = chi(k);
+        if c < best_c {
+            (best_k, best_c, best_g) = (k, c, Some(g));
+        }
+        if g > 0 {
+            // Falling, then rising once: a turn from a fall to a rise.
+            let (falls, rises) = (c < last, c > last);
+            monotone &= falls || rises;
+            if rises && turns == 0 {
+                turns = 1;
+            } else if falls && turns == 1 {
+                turns = 2;
+            }
+        }
+        last = c;
+        k *= step;
     }
+    let hint = match best_g {
+        Some(g) if monotone && turns <= 1 => g as u8 + 1,
+        _ => 0,
+    };
+    ((best_k, best_c), hint)
+}
+
+/// The hinted grid point `(k, chi2)` where it is strictly below its two neighbours and
+/// `k = 1`'s misfit `c_one` (an inner grid point only); `None` otherwise. The grid's
+/// points are formed as [`whole_grid`] forms them (the same floats).
+fn from_hint(chi: &impl Fn(f32) -> f32, step: f32, c_one: f32, hint: u8) -> Option<(f32, f32)> {
+    let g = usize::from(hint).checked_sub(1)?;
+    if g == 0 || g + 1 >= GRID {
+        return None;
+    }
+    let mut below = K_MIN;
+    for _ in 1..g {
+        below *= step;
+    }
+    let k = below * step;
+    let c = chi(k);
+    (c < c_one && c < chi(below) && c < chi(k * step)).then_some((k, c))
 }
 
 /// Sorts candidates by probability, most probable first (insertion sort: nine entries,
@@ -147,5 +275,55 @@ fn sort_by_probability(c: &mut [Candidate; FAULT_COUNT]) {
             c.swap(j - 1, j);
             j -= 1;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use core::cell::Cell;
+
+    /// A search from its last result finds what the whole grid finds, with half the
+    /// misfits evaluated, on a minimum that drifts over the whole range of sizes, jumps,
+    /// and sits at k = 1 or at the range's ends (where the whole grid is searched again).
+    #[test]
+    fn a_search_from_its_last_result_finds_what_the_grid_finds() {
+        let calls = Cell::new(0u32);
+        let mut hint = 0u8;
+        let (mut warm_calls, mut cold_calls, mut searches) = (0u32, 0u32, 0u32);
+        for j in 0..600 {
+            // The best size: drifting from 0.3 to 3.8 and back, a jump every 150 searches,
+            // and a stretch at k = 1.
+            let x = j as f32 / 300.0;
+            let mut k0 = 0.3 + 3.5 * if x < 1.0 { x } else { 2.0 - x };
+            if j % 150 == 75 {
+                k0 = 4.0 - k0 * 0.5;
+            }
+            if (400..420).contains(&j) {
+                k0 = 1.0;
+            }
+            let chi = |k: f32| {
+                calls.set(calls.get() + 1);
+                let d = (k - k0) / k0;
+                7.0 + 40.0 * d * d + 3.0 * d * d * d * d
+            };
+            calls.set(0);
+            let cold = fit_factor(chi, 0);
+            cold_calls += calls.get();
+            calls.set(0);
+            let warm = fit_factor(chi, hint);
+            warm_calls += calls.get();
+            searches += 1;
+            assert_eq!(warm.0, cold.0, "search {j}, best size {k0}");
+            assert_eq!(warm.1, cold.1, "search {j}: hint");
+            hint = warm.1;
+        }
+        assert_eq!(cold_calls, 44 * searches);
+        // 22 evaluations where the hint holds (4 + the golden section's 18), 47 where it
+        // does not.
+        assert!(
+            warm_calls < 26 * searches,
+            "{warm_calls} for {searches} searches"
+        );
     }
 }
