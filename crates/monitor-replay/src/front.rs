@@ -215,6 +215,7 @@ pub(super) const CLOCK_RESET_GAP_S: f64 = 2.0 * MAX_BRIDGED_GAP_S;
 impl<F: Feeder> ReplaySink<'_, F> {
     /// Replays one row: after a clock reset its time is moved on to follow the last row's
     /// by [`CLOCK_RESET_GAP_S`] (the replay's time never goes back).
+    #[inline]
     fn feed(&mut self, row: &Row) {
         if !self.began {
             return;

@@ -97,6 +97,15 @@ impl StuckTracker {
         }
         let v = row.v_abc.unwrap_or([f64::NAN; 3]);
         let values = [v[0], v[1], v[2], row.i_abc[0], row.i_abc[1], row.i_abc[2]];
+        // The row of a live log: every channel moved (a NaN never repeats), every run
+        // starts again at one (none without voltages), none is long (`run_min` >= 8).
+        let eq = |k: usize| u8::from(values[k] == self.last[k]);
+        if eq(0) | eq(1) | eq(2) | eq(3) | eq(4) | eq(5) == 0 {
+            self.last = values;
+            let v_runs = u64::from(row.v_abc.is_some());
+            self.runs = [v_runs, v_runs, v_runs, 1, 1, 1];
+            return;
+        }
         let limit = u64::from(self.run_min).wrapping_sub(1);
         let mut over = 0u64;
         for (k, &x) in values.iter().enumerate() {
