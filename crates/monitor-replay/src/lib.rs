@@ -339,23 +339,7 @@ impl Replay {
         };
         self.commission.before(mon, t);
         mon.update(&sample_of(&mut self.sampler, self.enc_offset, row));
-        let Some(mon) = self.monitor.as_ref() else {
-            return;
-        };
-        // Between two of the monitor's revisions only its speed moves: what depends on the
-        // rest of the output is done once per revision (once per block) in `block_row`;
-        // every row does what depends on the time or the row.
-        let revision = mon.revision();
-        let fresh = self.view.revision != Some(revision);
-        if fresh {
-            let out = mon.output();
-            let range_note = self.commission.after(mon, t, out);
-            let bands = bands_needed(mon, out);
-            let out = *out;
-            self.block_row(t, &out, bands, (revision, range_note));
-        } else {
-            self.unsettled.tick(t);
-        }
+        let fresh = self.revise(t);
         let Some(mon) = self.monitor.as_ref() else {
             return;
         };
@@ -387,6 +371,27 @@ impl Replay {
         if fresh {
             self.last = LastOutput::of(out, flags);
         }
+    }
+
+    /// Between two of the monitor's revisions ([`Monitor::revision`]) only its speed moves:
+    /// what depends on the rest of the output is done on the revision's first row, in
+    /// [`Replay::block_row`] (whether this row at `t` [s] is one: the answer), every row
+    /// does what depends on its time or its own values ([`Replay::push_step`]).
+    fn revise(&mut self, t: f64) -> bool {
+        let Some(mon) = self.monitor.as_ref() else {
+            return false;
+        };
+        let revision = mon.revision();
+        if self.view.revision == Some(revision) {
+            self.unsettled.tick(t);
+            return false;
+        }
+        let out = mon.output();
+        let range_note = self.commission.after(mon, t, out);
+        let bands = bands_needed(mon, out);
+        let out = *out;
+        self.block_row(t, &out, bands, (revision, range_note));
+        true
     }
 
     /// The part of a row that depends on the monitor's output other than its speed, done
