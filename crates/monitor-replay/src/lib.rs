@@ -88,8 +88,8 @@ use options::check_commission_window;
 use sampler::sample_of;
 use serde::Serialize;
 use step::{
-    bands_for, book_detection, lamps_since_moved, note_residuals, timeline_step_due, LastOutput,
-    RestartHold, NO_BANDS,
+    bands_for, bands_needed, book_detection, lamps_since_moved, note_residuals, timeline_step_due,
+    BlockView, LastOutput, RestartHold, NO_BANDS,
 };
 
 /// Timestamp tick rate used for replays [Hz].
@@ -228,6 +228,9 @@ pub struct Replay {
     /// What the next row needs of the monitor's output after the last row (a copy of the
     /// whole output per row is what it saves).
     last: LastOutput,
+    /// What the rows up to the monitor's next revision take from its output
+    /// ([`Replay::block_row`]).
+    view: BlockView,
     t0: Option<f64>,
     isolation: IsolationTracker,
     /// The symmetrical components, sample by sample ([`sequences::SequenceFront`]; on the
@@ -294,6 +297,7 @@ impl Replay {
             dt_s: 1.0 / sample_rate_hz,
             max_abs: [0.0; 4],
             last: LastOutput::default(),
+            view: BlockView::default(),
             t0: None,
             isolation: isolation_tracker(params, channels, opts.load, cfg.decimation),
             lamps_since_moved: false,
@@ -335,39 +339,23 @@ impl Replay {
         };
         self.commission.before(mon, t);
         mon.update(&sample_of(&mut self.sampler, self.enc_offset, row));
+        let fresh = self.revise(t);
         let Some(mon) = self.monitor.as_ref() else {
             return;
         };
         // (The output is read where the monitor keeps it: no copy per row.)
         let out = mon.output();
-        let range_note = self.commission.after(mon, t, out);
-        note_residuals(&mut self.evaluated, &mut self.max_abs, out);
-        // With a commissioning window asked for, lamps lit on the fixed thresholds before
-        // the learned ones are in force are not detections: the window says the nominal
-        // parameters are not to be trusted (a sensor fault counts at any time).
-        let trusted = self.commission.thresholds_trusted(out);
-        let flags = RowFlags::of(out, trusted);
-        let counts = flags.counts();
-        let bands = bands_for(mon, out, counts, self.detected_in_range);
-        let held_bands = if out.quasi_steady { NO_BANDS } else { bands };
-        let judged = self.evaluated;
-        self.unsettled
-            .after(t, (out, flags), held_bands, judged, trusted);
+        let BlockView { flags, trusted, .. } = self.view;
         let point = step.point(out.operating.wr_rad_s);
         let settled = self.restart.settled(t, out);
-        let usable = flags.with_counts(counts && settled);
+        let usable = flags.with_counts(flags.counts() && settled);
         let (dt_s, tc) = (self.dt_s, row.t_winding_c);
         self.isolation.after(t, dt_s, usable, &point, tc);
-        if out.fault_detected && counts {
-            let first = (&mut self.detected_in_range, &mut self.first_detection);
-            let booked = (&mut self.detections, &mut self.top_seen);
-            book_detection(first, booked, &self.commission, (t, out, bands));
-        }
         // The sample nearest each timeline step (half a sample early counts: the data-quality
         // stage's sample clock may put the sample at the step a hair before it).
         let (dt_s, step_s) = (self.dt_s, self.opts.timeline_step_s);
         if timeline_step_due(&mut self.next_point, t, dt_s, step_s) {
-            let point = timeline_point(self, t, out, range_note);
+            let point = timeline_point(self, t, out, self.view.range_note.clone());
             self.timeline.push(point);
         }
         // The running the lamps were judged on ([`MIN_JUDGED_S`]).
@@ -380,7 +368,67 @@ impl Replay {
             &self.commission,
             &self.isolation,
         );
-        self.last = LastOutput::of(out, flags);
+        if fresh {
+            self.last = LastOutput::of(out, flags);
+        }
+    }
+
+    /// Between two of the monitor's revisions ([`Monitor::revision`]) only its speed moves:
+    /// what depends on the rest of the output is done on the revision's first row, in
+    /// [`Replay::block_row`] (whether this row at `t` [s] is one: the answer), every row
+    /// does what depends on its time or its own values ([`Replay::push_step`]).
+    fn revise(&mut self, t: f64) -> bool {
+        let Some(mon) = self.monitor.as_ref() else {
+            return false;
+        };
+        let revision = mon.revision();
+        if self.view.revision == Some(revision) {
+            self.unsettled.tick(t);
+            return false;
+        }
+        let out = mon.output();
+        let range_note = self.commission.after(mon, t, out);
+        let bands = bands_needed(mon, out);
+        let out = *out;
+        self.block_row(t, &out, bands, (revision, range_note));
+        true
+    }
+
+    /// The part of a row that depends on the monitor's output other than its speed, done
+    /// on the first row of each of its revisions ([`Monitor::revision`]; the rows after it
+    /// up to the next would repeat it to the bit): the residuals' extremes, the flags, the
+    /// held stretch, a counted detection, and what the rows up to the next need (`bands`: the
+    /// threshold bands in force, `range_note`: the commissioned range's note now).
+    fn block_row(
+        &mut self,
+        t: f64,
+        out: &MonitorOutput,
+        bands: [(f32, f32); 4],
+        (revision, range_note): (u32, Option<String>),
+    ) {
+        note_residuals(&mut self.evaluated, &mut self.max_abs, out);
+        // With a commissioning window asked for, lamps lit on the fixed thresholds before
+        // the learned ones are in force are not detections: the window says the nominal
+        // parameters are not to be trusted (a sensor fault counts at any time).
+        let trusted = self.commission.thresholds_trusted(out);
+        let flags = RowFlags::of(out, trusted);
+        let counts = flags.counts();
+        let bands = bands_for(bands, out, counts, self.detected_in_range);
+        let held_bands = if out.quasi_steady { NO_BANDS } else { bands };
+        let judged = self.evaluated;
+        self.unsettled
+            .after(t, (out, flags), held_bands, judged, trusted);
+        if out.fault_detected && counts {
+            let first = (&mut self.detected_in_range, &mut self.first_detection);
+            let booked = (&mut self.detections, &mut self.top_seen);
+            book_detection(first, booked, &self.commission, (t, out, bands));
+        }
+        self.view = BlockView {
+            revision: Some(revision),
+            flags,
+            trusted,
+            range_note,
+        };
     }
 
     /// The acquisition clock was reset before the next row (`diagnose` carries the time on

@@ -33,18 +33,19 @@ pub(super) fn bands_needed(mon: &Monitor, out: &MonitorOutput) -> [(f32, f32); 4
     }
 }
 
-/// The bands a row needs: for the quasi-steady gate's held stretch ([`NO_BANDS`] while
-/// the gate is open) and for a counted detection's first look inside the range
-/// (`detected`: one was found already, and that stays), else [`NO_BANDS`].
+/// The bands a row needs of `needed` (what [`bands_needed`] gave): for the quasi-steady
+/// gate's held stretch ([`NO_BANDS`] while the gate is open) and for a counted detection's
+/// first look inside the range (`detected`: one was found already, and that stays), else
+/// [`NO_BANDS`].
 #[inline]
 pub(super) fn bands_for(
-    mon: &Monitor,
+    needed: [(f32, f32); 4],
     out: &MonitorOutput,
     counts: bool,
     detected: bool,
 ) -> [(f32, f32); 4] {
     if !out.quasi_steady || (out.fault_detected && counts && !detected) {
-        bands_needed(mon, out)
+        needed
     } else {
         NO_BANDS
     }
@@ -180,6 +181,20 @@ pub(super) fn lamps_since_moved(
     } else {
         was || isolation.load_explains_lamps() || commission.outside_learned_range(out)
     }
+}
+
+/// What the rows up to the monitor's next revision ([`Monitor::revision`]) take from its
+/// output, as the revision's first row found it.
+#[derive(Debug, Clone, Default)]
+pub(super) struct BlockView {
+    /// The revision it was taken at (`None`: none yet).
+    pub(super) revision: Option<u32>,
+    /// The output's flags.
+    pub(super) flags: RowFlags,
+    /// Whether the thresholds in force count.
+    pub(super) trusted: bool,
+    /// The note on the commissioned range for the timeline.
+    pub(super) range_note: Option<String>,
 }
 
 /// What a replay keeps of the monitor's output after a row for the next one.

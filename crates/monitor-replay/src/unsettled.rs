@@ -60,6 +60,13 @@ impl Unsettled {
         }
     }
 
+    /// A sample at `t` [s] with the output as at the last [`Unsettled::after`] (only the
+    /// time moves on).
+    #[inline]
+    pub(super) fn tick(&mut self, t: f64) {
+        self.last_s = t;
+    }
+
     /// Why no verdict can be given when the log ended inside a held stretch of at least
     /// [`MIN_HELD_S`] with a residual at [`WORST_BANDS`] or more of its band; `None`
     /// otherwise.

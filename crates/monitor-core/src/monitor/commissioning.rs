@@ -36,6 +36,7 @@ impl Monitor {
             .learner
             .start(duration_s, self.derived.block_rate_hz, install)?;
         self.lamps.reset();
+        self.revision = self.revision.wrapping_add(1);
         Ok(id)
     }
 
@@ -46,6 +47,7 @@ impl Monitor {
     /// by [`Monitor::calibration_stored`], so a late cancel cannot leave a stored record
     /// that the monitor does not use).
     pub fn cancel_commissioning(&mut self, run_id: u16) -> bool {
+        self.revision = self.revision.wrapping_add(1);
         let cancelled = self.learner.cancel(run_id);
         if cancelled {
             self.refresh_commissioning_state();
@@ -67,6 +69,7 @@ impl Monitor {
         } else {
             1
         };
+        self.revision = self.revision.wrapping_add(1);
         let (ended, cal) = self.learner.finish(run_id, min_blocks);
         if let Some(cal) = cal {
             self.lamps.set_calibration(Some(cal));
@@ -148,6 +151,7 @@ impl Monitor {
 
     /// `out.commissioning` from the run and the thresholds in force (after a change).
     pub(super) fn refresh_commissioning_state(&mut self) {
+        self.revision = self.revision.wrapping_add(1);
         let run = self.learner.run();
         self.out.commissioning = if run.stage.is_active() {
             CommissioningState::Learning(run.fraction_done())

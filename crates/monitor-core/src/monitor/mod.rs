@@ -100,6 +100,9 @@ pub struct Monitor {
     block_end_ticks: Option<u32>,
     /// The lamps last matched against the signatures (`None`: match at the next block).
     matched_lamps: Option<[bool; 4]>,
+    /// Bumped (wrapping) wherever the output may change other than its per-sample speed:
+    /// [`Monitor::revision`].
+    revision: u32,
     out: MonitorOutput,
 }
 
@@ -145,6 +148,7 @@ impl Monitor {
             trend_steady_for: 0,
             block_end_ticks: None,
             matched_lamps: None,
+            revision: 0,
             out: MonitorOutput {
                 zero_crossing_locked: (cfg.angle_source == AngleSource::ZeroCrossing)
                     .then_some(false),
@@ -169,6 +173,15 @@ impl Monitor {
     /// The last output.
     pub fn output(&self) -> &MonitorOutput {
         &self.out
+    }
+
+    /// A count (wrapping) that changes whenever the output's fields other than
+    /// `speed_rad_s`, or the threshold bands, may have changed: at each block's end (the
+    /// slow path, once per `decimation` samples), at a sensor flag, and at a commissioning
+    /// call. Between two changes only `speed_rad_s` moves, so a reader of every sample may
+    /// skip what depends on the rest. (Counted off the per-sample path.)
+    pub fn revision(&self) -> u32 {
+        self.revision
     }
 
     /// Processes one sample and returns the updated output. Never panics: a non-finite,

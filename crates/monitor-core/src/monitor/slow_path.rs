@@ -26,6 +26,7 @@ impl Monitor {
     #[cold]
     #[inline(never)]
     pub(super) fn flag(&mut self, bad: SensorFlags) {
+        self.revision = self.revision.wrapping_add(1);
         self.sensor_hold.hold(bad, self.derived.hold_blocks);
         self.out.sensor_fault = self.sensor_hold.flags();
         let sf = self.out.sensor_fault;
@@ -68,6 +69,7 @@ impl Monitor {
     // steps are separate functions for reading; each is inlined here.
     #[inline(never)]
     pub(super) fn slow_path(&mut self, s: &Sample, wr_rad_s: f32, sc: SinCos) {
+        self.revision = self.revision.wrapping_add(1);
         self.block_end(s, wr_rad_s, sc);
         self.frame.take_snapshot();
     }

@@ -169,3 +169,40 @@ fn a_balanced_machine_has_no_winding_part() {
         assert_eq!(u.suspect_phase, None);
     }
 }
+
+/// Between two revisions only the speed moves: the rest of the output and the bands stay
+/// to the bit; the revision moves once per block on a steady stream, and at a speed
+/// sensor's jump and a commissioning call inside a block.
+#[test]
+fn only_the_speed_moves_between_revisions() {
+    let mut m = monitor(AngleSource::RotorFluxCurrentModel);
+    let decimation = u32::from(m.config().decimation);
+    let mut seen = (m.revision(), *m.output(), m.threshold_bands());
+    let mut revisions = 0u32;
+    for k in 0..20 * decimation {
+        let mut s = healthy(k);
+        if k == 7 * decimation + 3 {
+            // An encoder jump: the speed sensor is flagged on this sample.
+            s.encoder_count = s.encoder_count.wrapping_add(1 << 14);
+        }
+        if k == 11 * decimation + 5 {
+            let before = m.revision();
+            assert!(m.start_commissioning(1.0).is_ok());
+            assert_ne!(m.revision(), before);
+        }
+        let out = *m.update(&s);
+        let now = (m.revision(), out, m.threshold_bands());
+        if now.0 == seen.0 {
+            let mut rest = now.1;
+            rest.speed_rad_s = seen.1.speed_rad_s;
+            assert_eq!(rest, seen.1, "sample {k}");
+            assert_eq!(now.2, seen.2, "sample {k}");
+        } else {
+            revisions += 1;
+        }
+        seen = now;
+    }
+    // 20 block ends, the jump's two flags (out and back, inside one block), and the run's
+    // start.
+    assert_eq!(revisions, 23);
+}
