@@ -71,6 +71,10 @@ pub(super) struct IsolationTracker {
     /// [`IsolationTracker::load_explains_lamps`], as of the last chunk (its inputs change
     /// only there).
     load_explains: bool,
+    /// The last point's current and voltage vectors (their bits) and whether the follower
+    /// found them steady ([`IsolationTracker::steady`]); forgotten at each flush (the
+    /// follower's mean moves only there).
+    vectors_seen: Option<([u32; 4], bool)>,
 }
 
 /// With the load an unknown input, B and Bl are not candidates (their change is the load's
@@ -163,6 +167,7 @@ impl IsolationTracker {
             chunk_rows: chunk_rows.max(1),
             block_left_s: 0.0,
             load_explains: false,
+            vectors_seen: None,
         }
     }
 
@@ -199,14 +204,35 @@ impl IsolationTracker {
         // A point the follower judges against a moving reference, or would not find steady,
         // goes alone, after the rows before it: its average restarts where it would row by
         // row ([`chunk`]).
-        let alone = self.usable_with(flags)
-            && self.follower.as_ref().and_then(|f| f.steady(point)) != Some(true);
+        let alone = self.usable_with(flags) && self.steady(point) != Some(true);
         if alone {
             self.flush();
         }
         let rows = self.chunk.add(t, dt_s, point, flags);
         if rows >= self.chunk_rows || alone || self.chunk.span_s() >= self.block_left_s {
             self.flush();
+        }
+    }
+
+    /// The follower's [`Follower::steady`] of `point`: its speeds checked on every row, its
+    /// vectors only where they differ from the last row's to the bit (the sequence
+    /// analysis' vectors move once per block; the follower's mean only at a flush, which
+    /// forgets the last check): the same answer.
+    #[inline]
+    fn steady(&mut self, point: &SteadyPoint) -> Option<bool> {
+        let f = self.follower.as_ref()?;
+        if !f.steady_speeds(point)? {
+            return Some(false);
+        }
+        let (i, v) = (point.i, point.v);
+        let key = [i.d, i.q, v.d, v.q].map(f32::to_bits);
+        match self.vectors_seen {
+            Some((k, ok)) if k == key => Some(ok),
+            _ => {
+                let ok = f.steady_vectors(point)?;
+                self.vectors_seen = Some((key, ok));
+                Some(ok)
+            }
         }
     }
 
@@ -225,6 +251,7 @@ impl IsolationTracker {
         let Some(c) = self.chunk.close() else {
             return;
         };
+        self.vectors_seen = None;
         let usable = self.usable_with(c.flags);
         let Some(follower) = self.follower.as_mut() else {
             return;
