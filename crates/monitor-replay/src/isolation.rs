@@ -26,6 +26,9 @@ pub use report::{
 };
 use serde::Serializer;
 
+/// No vectors checked yet ([`IsolationTracker::steady`]).
+const NO_VECTORS: ([f32; 4], bool) = ([f32::NAN; 4], false);
+
 /// A reported isolation older than this at the log's end says so [s].
 pub const STALE_S: f64 = 1.0;
 
@@ -71,6 +74,10 @@ pub(super) struct IsolationTracker {
     /// [`IsolationTracker::load_explains_lamps`], as of the last chunk (its inputs change
     /// only there).
     load_explains: bool,
+    /// The last point's current and voltage vectors `(i_d, i_q, v_d, v_q)` checked, and
+    /// whether the follower found them steady ([`IsolationTracker::steady`]); NaN: none
+    /// (forgotten at each flush: the follower's mean moves only there).
+    vectors_seen: ([f32; 4], bool),
 }
 
 /// With the load an unknown input, B and Bl are not candidates (their change is the load's
@@ -163,6 +170,7 @@ impl IsolationTracker {
             chunk_rows: chunk_rows.max(1),
             block_left_s: 0.0,
             load_explains: false,
+            vectors_seen: NO_VECTORS,
         }
     }
 
@@ -199,8 +207,7 @@ impl IsolationTracker {
         // A point the follower judges against a moving reference, or would not find steady,
         // goes alone, after the rows before it: its average restarts where it would row by
         // row ([`chunk`]).
-        let alone = self.usable_with(flags)
-            && self.follower.as_ref().and_then(|f| f.steady(point)) != Some(true);
+        let alone = self.usable_with(flags) && self.steady(point) != Some(true);
         if alone {
             self.flush();
         }
@@ -208,6 +215,28 @@ impl IsolationTracker {
         if rows >= self.chunk_rows || alone || self.chunk.span_s() >= self.block_left_s {
             self.flush();
         }
+    }
+
+    /// The follower's [`Follower::steady`] of `point`: its speeds checked on every row, its
+    /// vectors only where they differ from the last row's to the bit (the sequence
+    /// analysis' vectors move once per block; the follower's mean only at a flush, which
+    /// forgets the last check): the same answer.
+    #[inline]
+    fn steady(&mut self, point: &SteadyPoint) -> Option<bool> {
+        let f = self.follower.as_ref()?;
+        if !f.steady_speeds(point)? {
+            return Some(false);
+        }
+        let (i, v) = (point.i, point.v);
+        let ([id, iq, vd, vq], ok) = self.vectors_seen;
+        // (Equal floats give the same answer: the check squares differences, so the signs
+        // of zeros do not matter; a NaN never equals, and is checked again.)
+        if id == i.d && iq == i.q && vd == v.d && vq == v.q {
+            return Some(ok);
+        }
+        let ok = f.steady_vectors(point)?;
+        self.vectors_seen = ([i.d, i.q, v.d, v.q], ok);
+        Some(ok)
     }
 
     /// Whether a point with `flags` is usable by the follower: the monitor runs (now or
@@ -225,6 +254,7 @@ impl IsolationTracker {
         let Some(c) = self.chunk.close() else {
             return;
         };
+        self.vectors_seen = NO_VECTORS;
         let usable = self.usable_with(c.flags);
         let Some(follower) = self.follower.as_mut() else {
             return;

@@ -345,7 +345,12 @@ impl Replay {
         };
         // (The output is read where the monitor keeps it: no copy per row.)
         let out = mon.output();
-        let BlockView { flags, trusted, .. } = self.view;
+        let BlockView {
+            flags,
+            judging,
+            lamps_lit,
+            ..
+        } = self.view;
         let point = step.point(out.operating.wr_rad_s);
         let settled = self.restart.settled(t, out);
         let usable = flags.with_counts(flags.counts() && settled);
@@ -359,11 +364,11 @@ impl Replay {
             self.timeline.push(point);
         }
         // The running the lamps were judged on ([`MIN_JUDGED_S`]).
-        if out.evaluating && out.quasi_steady && trusted {
+        if judging {
             self.judged_s += self.dt_s;
         }
         self.lamps_since_moved = lamps_since_moved(
-            self.lamps_since_moved,
+            (self.lamps_since_moved, lamps_lit),
             out,
             &self.commission,
             &self.isolation,
@@ -426,7 +431,8 @@ impl Replay {
         self.view = BlockView {
             revision: Some(revision),
             flags,
-            trusted,
+            judging: out.evaluating && out.quasi_steady && trusted,
+            lamps_lit: out.lamps.iter().any(|l| *l),
             range_note,
         };
     }

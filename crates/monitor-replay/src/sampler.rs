@@ -30,11 +30,14 @@ pub(super) fn sample_of(sampler: &mut LogSampler, enc_offset: i64, row: &Row) ->
 #[derive(Debug, Clone, Default)]
 pub struct LogSampler {
     theta_m: f64,
-    last_t: Option<f64>,
+    /// A row was sampled: `last_t` and `count` hold its time and count.
+    started: bool,
+    /// The last row's time [s].
+    last_t: f64,
     /// The last row's encoder count, if it had one.
     last_enc: Option<i64>,
-    /// The count handed on (`None` before the first row).
-    count: Option<i64>,
+    /// The count handed on at the last row.
+    count: i64,
     /// The speed channel's synthesised count at the last row.
     synth: i64,
 }
@@ -42,24 +45,32 @@ pub struct LogSampler {
 impl LogSampler {
     /// The core sample for `row` (voltages 0 when the log has none).
     pub fn sample(&mut self, row: &Row) -> Sample {
-        if let (Some(t0), Some(w)) = (self.last_t, row.wm_rad_s) {
-            self.theta_m += w * (row.t_s - t0);
-        }
-        let synth = counts_of(self.theta_m);
-        let count = match (self.count, row.enc_count, self.last_enc) {
-            (None, Some(c), _) => c,
-            (None, None, _) => synth,
-            (Some(n), Some(c), Some(l)) => n.wrapping_add(c.wrapping_sub(l)),
-            (Some(n), _, _) if row.wm_rad_s.is_some() => {
-                n.wrapping_add(synth.wrapping_sub(self.synth))
+        let started = self.started;
+        let synth = match row.wm_rad_s {
+            Some(w) => {
+                if started {
+                    self.theta_m += w * (row.t_s - self.last_t);
+                }
+                counts_of(self.theta_m)
             }
-            (Some(n), _, _) => n,
+            // The angle did not move: its count is the last row's (0 before any row, the
+            // count of the angle 0).
+            None => self.synth,
         };
-        self.count = Some(count);
+        let count = match (started, row.enc_count, self.last_enc) {
+            (false, Some(c), _) => c,
+            (false, None, _) => synth,
+            (true, Some(c), Some(l)) => self.count.wrapping_add(c.wrapping_sub(l)),
+            (true, _, _) if row.wm_rad_s.is_some() => {
+                self.count.wrapping_add(synth.wrapping_sub(self.synth))
+            }
+            (true, _, _) => self.count,
+        };
+        self.started = true;
+        self.count = count;
         self.synth = synth;
         self.last_enc = row.enc_count;
-        let count = count as u32;
-        self.last_t = Some(row.t_s);
+        self.last_t = row.t_s;
         let v = row.v_abc.unwrap_or([0.0; 3]);
         let i = row.i_abc;
         Sample {
@@ -73,7 +84,7 @@ impl LogSampler {
                 b: i[1] as f32,
                 c: i[2] as f32,
             },
-            encoder_count: count,
+            encoder_count: count as u32,
             timestamp_ticks: round_i64(row.t_s * TICK_HZ) as u32,
             v_saturated: false,
             i_saturated: false,

@@ -166,17 +166,18 @@ pub(super) fn timeline_step_due(next: &mut f64, t: f64, dt_s: f64, step_s: f64) 
     true
 }
 
-/// Whether the lamps lit now first lit while the load had moved (or the load explained
-/// them), `was` the answer at the last row: false once every lamp is dark. (Once true it
-/// stays true while a lamp is lit: the load's checks are made only while it is false.)
+/// Whether the lamps lit now (`lit`: a lamp of `out` is lit) first lit while the load had
+/// moved (or the load explained them), `was` the answer at the last row: false once every
+/// lamp is dark. (Once true it stays true while a lamp is lit: the load's checks are made
+/// only while it is false.)
 #[inline]
 pub(super) fn lamps_since_moved(
-    was: bool,
+    (was, lit): (bool, bool),
     out: &MonitorOutput,
     commission: &CommissionTracker,
     isolation: &IsolationTracker,
 ) -> bool {
-    if !out.lamps.iter().any(|l| *l) {
+    if !lit {
         false
     } else {
         was || isolation.load_explains_lamps() || commission.outside_learned_range(out)
@@ -191,8 +192,11 @@ pub(super) struct BlockView {
     pub(super) revision: Option<u32>,
     /// The output's flags.
     pub(super) flags: RowFlags,
-    /// Whether the thresholds in force count.
-    pub(super) trusted: bool,
+    /// The lamps are judged: evaluated, quasi-steady, on thresholds that count
+    /// ([`super::MIN_JUDGED_S`]).
+    pub(super) judging: bool,
+    /// A lamp is lit.
+    pub(super) lamps_lit: bool,
     /// The note on the commissioned range for the timeline.
     pub(super) range_note: Option<String>,
 }

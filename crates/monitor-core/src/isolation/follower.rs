@@ -514,6 +514,23 @@ impl Follower {
         self.mean.map(|b| b.admits(p))
     }
 
+    /// [`Follower::steady`] in two parts: whether the current and voltage vectors of `p`
+    /// are steady (this), and its speeds ([`Follower::steady_speeds`]); `steady(p)` is
+    /// `Some(a && b)` of the two. For a caller whose points keep their vectors over many
+    /// rows (the host's replay: the sequence analysis' vectors move once per block), which
+    /// checks them again only when they or the mean changed (the mean changes only in
+    /// [`Follower::observe`]).
+    #[inline]
+    pub fn steady_vectors(&self, p: &SteadyPoint) -> Option<bool> {
+        self.mean.map(|b| b.admits_vectors(p))
+    }
+
+    /// The speeds' part of [`Follower::steady`] ([`Follower::steady_vectors`]).
+    #[inline]
+    pub fn steady_speeds(&self, p: &SteadyPoint) -> Option<bool> {
+        self.mean.map(|b| b.admits_speeds(p))
+    }
+
     /// Time left until the block being summed is [`STEP_S`] long and closes [s] (a caller
     /// that hands on several points at once ends its sum there, where the follower's block
     /// ends point by point).

@@ -291,28 +291,52 @@ fn short_density(c: Complex32, centre: f32, sd: f32, s: f32, max: f32) -> f32 {
     let dphi = 2.0 * half / GRID as f32;
     let phi0 = F32Ext::atan2(c.im, c.re) - half;
     let ln_cell = (du * dphi).ln() - span.ln();
-    // Two passes: the largest term, then the sum below it (log-sum-exp).
-    let term = |i: usize, j: usize| {
-        let rho = F32Ext::exp(u0 + (i as f32 + 0.5) * du);
+    // The grid's sizes, and its angles' prior and unit vectors, once per row and column;
+    // each term once (the same operations in the same order as term by term).
+    let rho: [f32; GRID] = core::array::from_fn(|i| F32Ext::exp(u0 + (i as f32 + 0.5) * du));
+    let angles: [(f32, Complex32); GRID] = core::array::from_fn(|j| {
         let phi = phi0 + (j as f32 + 0.5) * dphi;
-        ln_wrapped_gauss(phi - centre, sd) + ln_gauss2(c - unit(phi) * rho, s)
-    };
+        (ln_wrapped_gauss(phi - centre, sd), unit(phi))
+    });
+    let gauss = Gauss2::new(s);
+    let mut terms = [[0.0f32; GRID]; GRID];
+    // Two passes: the largest term, then the sum below it (log-sum-exp).
     let mut max = f32::NEG_INFINITY;
-    for i in 0..GRID {
-        for j in 0..GRID {
-            max = crate::math::maxf(max, term(i, j));
+    for (row, rho) in terms.iter_mut().zip(rho) {
+        for (t, (ln_angle, u)) in row.iter_mut().zip(&angles) {
+            *t = ln_angle + gauss.ln_at(c - *u * rho);
+            max = crate::math::maxf(max, *t);
         }
     }
     if !max.is_finite() {
         return f32::NEG_INFINITY;
     }
     let mut sum = 0.0f32;
-    for i in 0..GRID {
-        for j in 0..GRID {
-            sum += exp_neg(term(i, j) - max);
-        }
+    for t in terms.iter().flatten() {
+        sum += exp_neg(t - max);
     }
     max + sum.ln() + ln_cell
+}
+
+/// [`ln_gauss2`] for one `s`, its normalisation's logarithm taken once: `ln_at(d)` is
+/// `ln_gauss2(d, s)` to the bit.
+struct Gauss2 {
+    two_s2: f32,
+    ln_norm: f32,
+}
+
+impl Gauss2 {
+    fn new(s: f32) -> Self {
+        let s2 = s * s;
+        Gauss2 {
+            two_s2: 2.0 * s2,
+            ln_norm: (core::f32::consts::TAU * s2).ln(),
+        }
+    }
+
+    fn ln_at(&self, d: Complex32) -> f32 {
+        -d.norm_sqr() / self.two_s2 - self.ln_norm
+    }
 }
 
 /// `ln` of a wrapped Gaussian's density (standard deviation `sd` [rad], > 0) at the

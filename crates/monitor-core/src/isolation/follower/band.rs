@@ -42,6 +42,24 @@ impl SteadyBand {
             && (p.we_rad_s - avg.we_rad_s).abs() <= self.w
             && (p.wr_rad_s - avg.wr_rad_s).abs() <= self.w
     }
+
+    /// The current and voltage vectors of `p` within the band: with
+    /// [`SteadyBand::admits_speeds`], [`SteadyBand::admits`] in two parts (the host's replay
+    /// checks the vectors, which move once per block, only when they changed).
+    #[inline]
+    pub(super) fn admits_vectors(&self, p: &SteadyPoint) -> bool {
+        let avg = &self.avg;
+        hypot_within(p.i.d - avg.i.d, p.i.q - avg.i.q, self.i)
+            && hypot_within(p.v.d - avg.v.d, p.v.q - avg.v.q, self.v)
+    }
+
+    /// The supply's and the rotor's speeds of `p` within the band (see
+    /// [`SteadyBand::admits_vectors`]).
+    #[inline]
+    pub(super) fn admits_speeds(&self, p: &SteadyPoint) -> bool {
+        let avg = &self.avg;
+        (p.we_rad_s - avg.we_rad_s).abs() <= self.w && (p.wr_rad_s - avg.wr_rad_s).abs() <= self.w
+    }
 }
 
 /// `fast_hypot(x, y) <= limit`, the same answer, with the square root taken only within
