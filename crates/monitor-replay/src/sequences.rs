@@ -342,7 +342,7 @@ impl SequenceFront {
         SequenceStep {
             i,
             v,
-            we_rad_s: self.pll.omega_rad_s(),
+            we_rad_s: self.slow.we(),
             closed_before,
             closed_after,
         }

@@ -1,7 +1,9 @@
 //! The sequence analysis' slow filters on block means ([`SlowFilters`]): the 2 Hz
 //! positive sequences of the currents and the voltages on the PLL's angle (the isolation's
-//! steady point) and the PLL's frequency low-passed at [`super::REFERENCE_FC_HZ`] (the
-//! least-squares reference's).
+//! steady point), the PLL's frequency low-passed at the sequences' 2 Hz (the steady
+//! point's supply frequency: the PLL's own frequency carries the `2f` ripple of a negative
+//! sequence, sampled once per block) and at [`super::REFERENCE_FC_HZ`] (the least-squares
+//! reference's).
 //!
 //! The quantities move at a few hertz at most, so the filters need not run at the log's
 //! rate: they are stepped once per block of an eighth of a supply period (the rotor
@@ -47,6 +49,8 @@ pub(super) struct SlowFilters {
     reference: BlockSvf,
     i: [BlockState; 2],
     v: [BlockState; 2],
+    /// The PLL's frequency at 2 Hz and at the reference's corner.
+    we: BlockState,
     w: BlockState,
 }
 
@@ -61,6 +65,7 @@ impl SlowFilters {
             reference: BlockSvf::new(reference_fc_hz, dt_s, n)?,
             i: [BlockState::default(); 2],
             v: [BlockState::default(); 2],
+            we: BlockState::at(w0),
             w: BlockState::at(w0),
         })
     }
@@ -69,6 +74,12 @@ impl SlowFilters {
     #[inline]
     pub fn w_ref(&self) -> f32 {
         self.w.value()
+    }
+
+    /// The PLL's frequency low-passed at 2 Hz [rad/s] (held over a block).
+    #[inline]
+    pub fn we(&self) -> f32 {
+        self.we.value()
     }
 
     /// The positive sequences `(d, q)` of the currents and of the voltages on the PLL's
@@ -118,6 +129,7 @@ impl SlowFilters {
             self.seq.step(&mut self.v[1], q);
         }
         if moved {
+            self.seq.step(&mut self.we, w_pll);
             self.reference.step(&mut self.w, w_pll);
         }
         moved
