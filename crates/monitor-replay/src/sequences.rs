@@ -219,6 +219,7 @@ impl WindowBook {
     /// Books one row's step: `learning` whether the monitor was learning its commissioning
     /// window, `wr_rad_s` its electrical speed, both at the row before (where the log has a
     /// speed).
+    #[inline]
     pub fn row(&mut self, step: &SequenceStep, learning: bool, wr_rad_s: Option<f32>) {
         if step.closed_before {
             self.close(wr_rad_s);
