@@ -25,14 +25,14 @@
 //! block ([`super::trig::Oscillator::turn`]).
 
 mod block_filter;
+mod block_pll;
 mod lanes;
 mod reference;
 mod slow;
 
-use super::trig::Oscillator;
 use super::{FILLED_SAMPLES, SENSOR_PHASE_MIN_RATIO};
+use block_pll::BlockPll;
 use lanes::{Demod, FitSums};
-use monitor_core::angle::SrfPll;
 use monitor_core::frames::{clarke, AlphaBeta, SinCos};
 use monitor_core::sequence::{single_phase_gain, Complex32, SinglePhaseGain, ThreePhasors};
 use monitor_core::Abc;
@@ -124,31 +124,24 @@ impl OpenWindow {
 #[derive(Debug, Clone)]
 pub(super) struct SequenceFront {
     dt_s: f64,
-    dt_f32: f32,
     /// The monitor's sample limits `i_max`, `v_max` (infinite ones as `f64::MAX`: a
     /// sample is good when its magnitude is at most the limit, which a non-finite one is
     /// not).
     i_max: f64,
     v_max: f64,
     voltages: bool,
-    /// The PLL follows the voltages (else the normalised currents).
-    pll_on_voltage: bool,
-    pll: SrfPll,
-    /// The slow filters ([`slow`]): the positive sequences on the PLL's angle, the
-    /// currents' normaliser for the PLL and the reference frequency.
+    /// The PLL, stepped once per block ([`block_pll`]).
+    pll: BlockPll,
+    /// The slow filters ([`slow`]): the positive sequences on the PLL's angle and the
+    /// reference frequency.
     slow: SlowFilters,
     /// Time of the last row seen [s].
     last_t: Option<f64>,
     /// The least-squares reference angle and its offset from `w0 t` ([`reference`]).
     reference: Reference,
-    /// The PLL's angle less the reference angle at the last block's end [rad].
-    phi: f32,
     /// The open block's vectors on the reference angle from the windows closed within it
     /// ([`lanes::Demod`]).
     block: Demod,
-    /// The sin/cos of the PLL's angle by rotation; `sc_pll` that of its present angle.
-    osc_pll: Oscillator,
-    sc_pll: SinCos,
     /// Samples per least-squares window.
     window_len: u32,
     open: OpenWindow,
@@ -226,6 +219,7 @@ impl WindowBook {
     /// Books one row's step: `learning` whether the monitor was learning its commissioning
     /// window, `wr_rad_s` its electrical speed, both at the row before (where the log has a
     /// speed).
+    #[inline]
     pub fn row(&mut self, step: &SequenceStep, learning: bool, wr_rad_s: Option<f32>) {
         if step.closed_before {
             self.close(wr_rad_s);
@@ -273,23 +267,17 @@ impl SequenceFront {
         let limit = |max: f64| if max == f64::INFINITY { f64::MAX } else { max };
         Ok(SequenceFront {
             dt_s: 1.0 / sample_rate_hz,
-            dt_f32: dt,
             i_max: limit(i_max),
             v_max: limit(v_max),
             voltages,
-            pll_on_voltage: voltages,
             // Locks to the voltage vector where logged (normalised by its nominal peak),
-            // else to the current vector normalised by its own RMS magnitude (so that the
+            // else to the current vector normalised by its own magnitude (so that the
             // loop's gain holds whatever the currents' scale).
-            pll: SrfPll::new(
+            pll: BlockPll::new(
                 dt,
                 params.supply.f_hz as f32,
                 10.0,
-                if voltages {
-                    params.supply.v_phase_peak() as f32
-                } else {
-                    1.0
-                },
+                voltages.then(|| params.supply.v_phase_peak() as f32),
             ),
             slow: SlowFilters::new(
                 1.0 / sample_rate_hz,
@@ -299,10 +287,7 @@ impl SequenceFront {
             )?,
             last_t: None,
             reference: Reference::new(1.0 / sample_rate_hz, w0, w0 as f32),
-            phi: 0.0,
             block: Demod::default(),
-            osc_pll: Oscillator::default(),
-            sc_pll: SinCos { sin: 0.0, cos: 1.0 },
             window_len: ((WINDOW_PERIODS * sample_rate_hz / params.supply.f_hz).round() as u32)
                 .max(monitor_core::sequence::PHASOR_FIT_MIN_SAMPLES),
             open: OpenWindow::new(),
@@ -317,6 +302,7 @@ impl SequenceFront {
     pub fn track(&mut self, row: &Row, t: f64) -> SequenceStep {
         let (filled, closed_before) = self.bridge(t);
         self.reference.row();
+        self.pll.row();
         let o = &mut self.open;
         if o.offered == 0 {
             o.from_s = t;
@@ -342,10 +328,8 @@ impl SequenceFront {
             }
             let sc = self.reference.sin_cos();
             self.open.sums.add(sc, i_abc, v_abc);
-            let v = v_abc.map(clarke_of);
-            self.filtered(i_abc, v);
             if filled > 0 {
-                self.fill(filled, sc, i_abc, v);
+                self.fill(filled, sc, i_abc, v_abc.map(clarke_of));
             }
         }
         if self.rotor.full() {
@@ -359,7 +343,7 @@ impl SequenceFront {
         SequenceStep {
             i,
             v,
-            we_rad_s: self.pll.omega_rad_s(),
+            we_rad_s: self.slow.we(),
             closed_before,
             closed_after,
         }
@@ -385,8 +369,7 @@ impl SequenceFront {
     /// [`SequenceFront::bridge`] over `missing` seconds (more than half a sample).
     fn bridge_gap(&mut self, missing: f64) -> (usize, bool) {
         if missing <= MAX_BRIDGED_GAP_S {
-            self.pll.skip(missing as f32);
-            self.sc_pll = self.osc_pll.turn(|| self.pll.theta_pll(), None);
+            self.pll.skip(missing as f32, self.reference.frequency());
             self.reference.settle(&mut self.open.ramp);
             self.reference.skip(missing);
             let m = (missing / self.dt_s).round();
@@ -401,42 +384,14 @@ impl SequenceFront {
         if missing > MAX_BRIDGED_GAP_S {
             self.close_window();
             // The block's filters step on what it has; the rotor's record breaks off.
-            self.slow.step(&std::mem::take(&mut self.block), self.phi);
+            let b = std::mem::take(&mut self.block);
+            let w_pll = self.pll.omega_rad_s();
+            let mid = self.pll.end_block(&b, self.reference.frequency());
+            self.slow.step(&b, mid, w_pll);
             self.rotor.break_off();
             return (0, true);
         }
         (0, false)
-    }
-
-    /// The PLL on the phase currents `i_abc` and the voltage vector `v` (where good), and
-    /// the slow filters' share of the row.
-    #[inline]
-    fn filtered(&mut self, i_abc: [f32; 4], v: Option<AlphaBeta>) {
-        match v {
-            Some(v) if self.pll_on_voltage => {
-                self.pll.update(v, self.sc_pll);
-            }
-            _ => {
-                let i = clarke_of(i_abc);
-                if self.slow.normaliser_unset() {
-                    // The first good sample: the loop starts on the current vector.
-                    self.pll.align(i.beta.atan2(i.alpha));
-                    self.sc_pll = self.osc_pll.turn(|| self.pll.theta_pll(), None);
-                }
-                let k = self.slow.normaliser(i);
-                self.pll.update(
-                    AlphaBeta {
-                        alpha: i.alpha * k,
-                        beta: i.beta * k,
-                    },
-                    self.sc_pll,
-                );
-            }
-        }
-        let w = self.pll.omega_rad_s();
-        self.slow.row(w);
-        // The sin/cos of the PLL's next angle: turned by the step it just made.
-        self.sc_pll = self.osc_pll.advance(self.pll.theta_pll(), w * self.dt_f32);
     }
 
     /// `filled` samples missing before a good row (`sc` the reference's sin/cos, `i_abc`
@@ -463,13 +418,10 @@ impl SequenceFront {
         self.rotor.add(b.i, b.n_i);
         self.reference.settle(&mut self.open.ramp);
         let offset = self.reference.offset();
-        // The last row's PLL angle: before its update (a step back), if it had one.
-        let phi = monitor_core::frames::wrap_angle(
-            self.pll.theta_pll() - self.pll.omega_rad_s() * self.dt_f32 - self.reference.theta(),
-        );
-        let mid = phi - 0.5 * monitor_core::frames::wrap_angle(phi - self.phi);
-        self.phi = phi;
-        if self.slow.step(&b, mid) {
+        // The frequency the PLL held over the block, then its step on the block.
+        let w_pll = self.pll.omega_rad_s();
+        let mid = self.pll.end_block(&b, self.reference.frequency());
+        if self.slow.step(&b, mid, w_pll) {
             self.reference.set_frequency(self.slow.w_ref());
         }
         self.rotor.close_at(self.slow.w_ref(), offset);

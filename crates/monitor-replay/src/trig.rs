@@ -1,17 +1,15 @@
 //! sin and cos of an angle that advances by small steps, by rotation: a recursive
 //! oscillator ([`Oscillator`]) resynchronised from the angle itself. The sequence analysis
-//! turns two angles every sample (the PLL's and the least-squares reference's); a sin/cos
-//! evaluation per angle and row was a tenth of `diagnose`'s work on the reading thread
-//! (docs/performance.md). The PLL's angle advances by the step the PLL just made
-//! ([`Oscillator::advance`]: the step's sin/cos by a series); the reference's by a step
-//! held over a block of the analysis, whose sin/cos is computed once per block
-//! ([`Oscillator::turn`], [`step_of`]).
+//! turns the least-squares reference's angle every sample; a sin/cos evaluation per row
+//! was a large share of `diagnose`'s work on the reading thread (docs/performance.md). The
+//! angle advances by a step held over a block of the analysis, whose sin/cos is computed
+//! once per block ([`Oscillator::turn`], [`step_of`]).
 
 use monitor_core::frames::SinCos;
 
-/// Largest step the oscillator rotates by [rad]: [`SinCos::rotated`]'s series is exact to
-/// 2e-10 up to 0.1 rad (a supply period in 63 samples); a larger step (a low sample rate, a
-/// gap, the PLL aligned) is evaluated afresh.
+/// Largest step the oscillator rotates by [rad]: [`step_of`]'s series is exact to 3e-11 up
+/// to 0.1 rad (a supply period in 63 samples); with a larger step (a low sample rate) every
+/// angle is evaluated afresh.
 const MAX_STEP_RAD: f32 = 0.1;
 
 /// Rotations between two evaluations afresh: f32 rounding adds about 6e-8 per rotation, a
@@ -67,19 +65,6 @@ impl Oscillator {
         self.sc
     }
 
-    /// The sin and cos of `angle` [rad], which the caller advanced from the last angle by
-    /// `delta` [rad] (its own step, not wrapped): the last value rotated by
-    /// [`SinCos::rotated`]'s series of the step (class docs).
-    #[inline]
-    pub fn advance(&mut self, angle: f32, delta: f32) -> SinCos {
-        if delta.abs() <= MAX_STEP_RAD && self.steps < RESYNC_STEPS {
-            self.sc = self.sc.rotated(delta);
-            self.steps += 1;
-            return self.sc;
-        }
-        self.afresh(angle)
-    }
-
     /// The sin and cos of the angle `angle()` [rad], which the caller turned from the last
     /// angle by a step whose sin/cos is `step` ([`step_of`]; `None`: evaluated afresh): the
     /// last value rotated by it, one complex product (class docs; `angle` is called only
@@ -99,7 +84,7 @@ impl Oscillator {
         }
     }
 
-    /// The angle jumped (a gap bridged, the PLL aligned): the next value is evaluated
+    /// The angle jumped (a gap bridged): the next value is evaluated
     /// afresh.
     pub fn restart(&mut self) {
         self.steps = RESYNC_STEPS;
@@ -110,39 +95,6 @@ impl Oscillator {
 mod tests {
     use super::*;
     use monitor_core::frames::wrap_angle;
-
-    /// Against f64 sin/cos of the angle the steps make (a step of its own each sample, as
-    /// the PLL's; the angle passed for the evaluations afresh is that angle in f32), at the
-    /// sample rates a log has, with frequency wobble, jumps and NaN.
-    #[test]
-    fn advances_with_the_angle_within_3e_6() {
-        for (rate_hz, f_hz) in [(10_000.0f32, 60.0f32), (50_000.0, 50.0), (1_000.0, 60.0)] {
-            let mut osc = Oscillator::default();
-            let mut theta = 0.3f64;
-            let mut worst = 0.0f64;
-            for n in 0..200_000u32 {
-                let w = core::f32::consts::TAU * f_hz * (1.0 + 0.01 * (n as f32 * 1e-3).sin());
-                theta = (theta + f64::from(w / rate_hz)) % std::f64::consts::TAU;
-                if n % 50_000 == 7 {
-                    // A jump (the PLL aligned, a gap bridged).
-                    theta += 2.0;
-                    osc.restart();
-                }
-                let sc = osc.advance(wrap_angle(theta as f32), w / rate_hz);
-                let (s, c) = theta.sin_cos();
-                worst = worst
-                    .max((f64::from(sc.sin) - s).abs())
-                    .max((f64::from(sc.cos) - c).abs());
-            }
-            assert!(worst < 3e-6, "{rate_hz} Hz: error {worst:e}");
-        }
-        let mut osc = Oscillator::default();
-        osc.advance(1.0, 0.0);
-        osc.restart();
-        assert!(osc.advance(f32::NAN, f32::NAN).sin.is_nan());
-        let sc = osc.advance(0.5, 0.01);
-        assert!((sc.sin - 0.5f32.sin()).abs() < 1e-6 && (sc.cos - 0.5f32.cos()).abs() < 1e-6);
-    }
 
     /// Turned by a step held over blocks of 10 (as the reference is), against f64 sin/cos of
     /// the angle the steps make, with a jump (restart) and a step too large to rotate by.

@@ -54,12 +54,6 @@ impl BlockState {
     pub fn y(&self) -> f32 {
         self.y
     }
-
-    /// Moves the value to `y` (a filter whose first input defines its level).
-    pub fn set_y(&mut self, y: f32) {
-        self.y = y;
-        self.ahead = y;
-    }
 }
 
 impl BlockSvf {

@@ -85,6 +85,12 @@ impl Reference {
             .turn(|| wrap_angle(base + step * rows as f32), self.rot)
     }
 
+    /// The frequency the angle turns at [rad/s].
+    #[inline]
+    pub fn frequency(&self) -> f32 {
+        self.w
+    }
+
     /// The present angle [rad].
     pub fn theta(&self) -> f32 {
         wrap_angle(self.theta_base + self.step * self.rows as f32)

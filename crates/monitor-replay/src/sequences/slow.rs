@@ -1,7 +1,9 @@
 //! The sequence analysis' slow filters on block means ([`SlowFilters`]): the 2 Hz
 //! positive sequences of the currents and the voltages on the PLL's angle (the isolation's
-//! steady point), the currents' mean square that normalises them for the PLL, and the
-//! PLL's frequency low-passed at [`super::REFERENCE_FC_HZ`] (the least-squares reference's).
+//! steady point), the PLL's frequency low-passed at the sequences' 2 Hz (the steady
+//! point's supply frequency: the PLL's own frequency carries the `2f` ripple of a negative
+//! sequence, sampled once per block) and at [`super::REFERENCE_FC_HZ`] (the least-squares
+//! reference's).
 //!
 //! The quantities move at a few hertz at most, so the filters need not run at the log's
 //! rate: they are stepped once per block of an eighth of a supply period (the rotor
@@ -30,7 +32,6 @@
 
 use super::block_filter::{BlockState, BlockSvf};
 use super::lanes::Demod;
-use monitor_core::frames::AlphaBeta;
 use monitor_core::ConfigError;
 
 /// Corner of the sequence filters and the currents' normaliser [Hz] (the core's
@@ -40,24 +41,17 @@ const SEQUENCE_FC_HZ: f32 = 2.0;
 /// The slow filters and their open block (module docs).
 #[derive(Debug, Clone)]
 pub(super) struct SlowFilters {
-    /// The PLL's frequency summed over the block's good rows [rad/s], and the rows.
-    w_sum: f32,
-    rows: u32,
-    /// The currents' squared magnitude summed (where the PLL locks to the currents).
-    m2_sum: f32,
-    n_m: u32,
     /// Samples filled in across short gaps, on the reference angle (module docs).
     filled: Demod,
-    /// The 2 Hz filter (the sequences and the normaliser) and the reference's 1 Hz filter,
-    /// both at the block rate.
+    /// The 2 Hz filter (the sequences) and the reference's 1 Hz filter, both at the block
+    /// rate.
     seq: BlockSvf,
     reference: BlockSvf,
     i: [BlockState; 2],
     v: [BlockState; 2],
-    ms: BlockState,
+    /// The PLL's frequency at 2 Hz and at the reference's corner.
+    we: BlockState,
     w: BlockState,
-    /// `1/sqrt` of the filtered mean square (0 before the first current).
-    k: f32,
 }
 
 impl SlowFilters {
@@ -66,18 +60,13 @@ impl SlowFilters {
     /// `reference_fc_hz`. Errors: [`BlockSvf::new`]'s.
     pub fn new(dt_s: f64, n: u32, w0: f32, reference_fc_hz: f32) -> Result<Self, ConfigError> {
         Ok(SlowFilters {
-            w_sum: 0.0,
-            rows: 0,
-            m2_sum: 0.0,
-            n_m: 0,
             filled: Demod::default(),
             seq: BlockSvf::new(SEQUENCE_FC_HZ, dt_s, n)?,
             reference: BlockSvf::new(reference_fc_hz, dt_s, n)?,
             i: [BlockState::default(); 2],
             v: [BlockState::default(); 2],
-            ms: BlockState::default(),
+            we: BlockState::at(w0),
             w: BlockState::at(w0),
-            k: 0.0,
         })
     }
 
@@ -85,6 +74,12 @@ impl SlowFilters {
     #[inline]
     pub fn w_ref(&self) -> f32 {
         self.w.value()
+    }
+
+    /// The PLL's frequency low-passed at 2 Hz [rad/s] (held over a block).
+    #[inline]
+    pub fn we(&self) -> f32 {
+        self.we.value()
     }
 
     /// The positive sequences `(d, q)` of the currents and of the voltages on the PLL's
@@ -95,34 +90,6 @@ impl SlowFilters {
             (self.i[0].value(), self.i[1].value()),
             (self.v[0].value(), self.v[1].value()),
         )
-    }
-
-    /// Whether the normaliser has not started yet (no current seen).
-    #[inline]
-    pub fn normaliser_unset(&self) -> bool {
-        self.ms.value() <= 0.0
-    }
-
-    /// The currents' normaliser for the PLL: `1/sqrt` of the current vector's filtered
-    /// mean square, with `i` counted into it (the first current starts the filter on its
-    /// own square).
-    #[inline]
-    pub fn normaliser(&mut self, i: AlphaBeta) -> f32 {
-        let m2 = i.alpha * i.alpha + i.beta * i.beta;
-        if self.normaliser_unset() {
-            self.ms.set_y(m2);
-            self.k = 1.0 / monitor_core::math::sqrt(m2.max(1e-12));
-        }
-        self.m2_sum += m2;
-        self.n_m += 1;
-        self.k
-    }
-
-    /// One good row: `w_pll` the PLL's frequency after it [rad/s].
-    #[inline]
-    pub fn row(&mut self, w_pll: f32) {
-        self.w_sum += w_pll;
-        self.rows += 1;
     }
 
     /// `m` samples filled in before a row whose vectors turned back by the reference angle
@@ -138,9 +105,11 @@ impl SlowFilters {
     }
 
     /// Steps the filters on a block's means: `d` its sums on the reference angle, `phi`
-    /// the PLL's angle less the reference angle in the block's middle [rad]. Returns true
-    /// when the reference frequency moved (the block had a good row).
-    pub fn step(&mut self, d: &Demod, phi: f32) -> bool {
+    /// the PLL's angle less the reference angle in the block's middle [rad], `w_pll` the
+    /// PLL's frequency over the block [rad/s]. Returns true when the reference frequency
+    /// moved (the block had a good row).
+    pub fn step(&mut self, d: &Demod, phi: f32, w_pll: f32) -> bool {
+        let moved = d.n_i > 0;
         let mut d = *d;
         d.add(&std::mem::take(&mut self.filled));
         let (s, c) = phi.sin_cos();
@@ -159,16 +128,10 @@ impl SlowFilters {
             self.seq.step(&mut self.v[0], dd);
             self.seq.step(&mut self.v[1], q);
         }
-        if self.n_m > 0 {
-            let y = self.seq.step(&mut self.ms, self.m2_sum / self.n_m as f32);
-            self.k = 1.0 / monitor_core::math::sqrt(y.max(1e-12));
-        }
-        let moved = self.rows > 0;
         if moved {
-            self.reference
-                .step(&mut self.w, self.w_sum / self.rows as f32);
+            self.seq.step(&mut self.we, w_pll);
+            self.reference.step(&mut self.w, w_pll);
         }
-        (self.w_sum, self.rows, self.m2_sum, self.n_m) = (0.0, 0, 0.0, 0);
         moved
     }
 }
