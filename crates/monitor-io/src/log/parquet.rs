@@ -16,7 +16,7 @@
 use super::mapping::ColumnMapping;
 use super::source::{BinarySource, ColumnMap, Opened};
 use super::typed::FieldType;
-use super::{Channels, Column, LogError, Row};
+use super::{Channels, Column, LogError, Row, RowSink};
 use parquet::basic::{Compression, Encoding, LogicalType, TimeUnit, Type as PhysicalType};
 use parquet::column::reader::{ColumnReader, ColumnReaderImpl};
 use parquet::data_type::{DataType, DoubleType, FloatType, Int64Type};
@@ -28,6 +28,7 @@ use parquet::file::writer::SerializedFileWriter;
 use parquet::schema::types::SchemaDescriptor;
 use rayon::prelude::*;
 use std::fs::File;
+use std::ops::ControlFlow;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -184,6 +185,15 @@ impl BinarySource for ParquetSource {
         progress: &mut dyn FnMut(f64),
         on_row: &mut dyn FnMut(&Row) -> bool,
     ) -> Result<u64, LogError> {
+        self.for_each_block(log, progress, &mut OnRow(on_row))
+    }
+
+    fn for_each_block(
+        &self,
+        log: &Opened<'_>,
+        progress: &mut dyn FnMut(f64),
+        sink: &mut dyn RowSink,
+    ) -> Result<u64, LogError> {
         let (path, shown, columns) = (log.path(), log.shown(), log.columns());
         let ng = self.groups.len();
         let per_batch = rayon::current_num_threads().max(1) * 2;
@@ -215,7 +225,7 @@ impl BinarySource for ParquetSource {
                             return;
                         }
                     };
-                    if !hand_rows(&cols, columns, &mut handed, on_row) {
+                    if !hand_rows(&cols, columns, &mut handed, sink) {
                         outcome = Some(Ok(()));
                         return;
                     }
@@ -232,6 +242,19 @@ impl BinarySource for ParquetSource {
     }
 }
 
+/// A closure given each row, as a [`RowSink`].
+struct OnRow<'a>(&'a mut dyn FnMut(&Row) -> bool);
+
+impl RowSink for OnRow<'_> {
+    fn row(&mut self, row: &Row) -> bool {
+        (self.0)(row)
+    }
+    fn restart(&mut self) {}
+}
+
+/// Rows handed over at a time ([`RowSink::rows`]).
+const HAND_ROWS: usize = 256;
+
 /// Hands the rows of one decoded row group to `on_row`, counting them in `handed`; false
 /// when `on_row` asked to stop. Each row is built from the columns directly, cut to the
 /// group's length (no bounds checks, no array of the row's values), with the values
@@ -242,12 +265,12 @@ fn hand_rows(
     cols: &Decoded,
     columns: &ColumnMap,
     handed: &mut u64,
-    on_row: &mut dyn FnMut(&Row) -> bool,
+    sink: &mut dyn RowSink,
 ) -> bool {
     let n = cols.iter().find(|c| !c.is_empty()).map_or(0, Vec::len);
     let short = |k: usize| cols[k].len() < n;
     if (0..Column::COUNT).any(|k| columns.field[k].is_some() && short(k)) {
-        return hand_ragged_rows(cols, columns, handed, on_row);
+        return hand_ragged_rows(cols, columns, handed, &mut |r| sink.row(r));
     }
     // An absent column reads as zeros (the general path's value of a cell never set),
     // or as any full column where the row leaves its value out (speed, count,
@@ -264,21 +287,21 @@ fn hand_rows(
     let filler = if zeros.is_empty() { ia } else { &zeros };
     let cut: [&[f64]; Column::COUNT] = std::array::from_fn(|k| cols[k].get(..n).unwrap_or(filler));
     if columns.scaled {
-        hand_columns::<true>(&cut, n, columns, handed, on_row)
+        hand_columns::<true>(&cut, n, columns, handed, sink)
     } else {
-        hand_columns::<false>(&cut, n, columns, handed, on_row)
+        hand_columns::<false>(&cut, n, columns, handed, sink)
     }
 }
 
 /// [`hand_rows`] of columns `c` of `n` values each (`SCALED`: `columns.scaled`, the
-/// values multiplied by their unit's factor).
+/// values multiplied by their unit's factor), [`HAND_ROWS`] rows at a time.
 #[inline(always)]
 fn hand_columns<const SCALED: bool>(
     c: &[&[f64]; Column::COUNT],
     n: usize,
     columns: &ColumnMap,
     handed: &mut u64,
-    on_row: &mut dyn FnMut(&Row) -> bool,
+    sink: &mut dyn RowSink,
 ) -> bool {
     let has = |c: Column| columns.of(c).is_some();
     let (has_v, has_w, has_e, has_temp) = (
@@ -289,22 +312,33 @@ fn hand_columns<const SCALED: bool>(
     );
     let (k, offset) = (&columns.scale, columns.temp_offset);
     let s = |j: usize, x: f64| if SCALED { x * k[j] } else { x };
-    let (t, va, vb, vc) = (&c[0][..n], &c[1][..n], &c[2][..n], &c[3][..n]);
-    let (ia, ib, ic) = (&c[4][..n], &c[5][..n], &c[6][..n]);
-    let (wm, enc, temp) = (&c[7][..n], &c[8][..n], &c[9][..n]);
-    for i in 0..n {
-        let row = Row {
+    let mut rows = Vec::with_capacity(HAND_ROWS.min(n));
+    let mut from = 0;
+    while from < n {
+        let to = (from + HAND_ROWS).min(n);
+        let (t, va, vb, vc) = (
+            &c[0][from..to],
+            &c[1][from..to],
+            &c[2][from..to],
+            &c[3][from..to],
+        );
+        let (ia, ib, ic) = (&c[4][from..to], &c[5][from..to], &c[6][from..to]);
+        let (wm, enc, temp) = (&c[7][from..to], &c[8][from..to], &c[9][from..to]);
+        rows.clear();
+        rows.extend((0..to - from).map(|i| Row {
             t_s: s(0, t[i]),
             v_abc: has_v.then(|| [s(1, va[i]), s(2, vb[i]), s(3, vc[i])]),
             i_abc: [s(4, ia[i]), s(5, ib[i]), s(6, ic[i])],
             wm_rad_s: has_w.then(|| s(7, wm[i])),
             enc_count: has_e.then(|| super::enc_count_of(enc[i])),
             t_winding_c: has_temp.then(|| (temp[i] + offset) * k[9]),
-        };
-        *handed += 1;
-        if !on_row(&row) {
+        }));
+        if let ControlFlow::Break(stop) = sink.rows(&rows) {
+            *handed += stop as u64 + 1;
             return false;
         }
+        *handed += rows.len() as u64;
+        from = to;
     }
     true
 }

@@ -60,6 +60,39 @@ impl StuckTracker {
         }
     }
 
+    /// The readings of `row` the tracker follows (va, vb, vc, ia, ib, ic; NaN for absent
+    /// voltages, which never repeat).
+    #[inline(always)]
+    pub(super) fn readings(row: &Row) -> [f64; 6] {
+        let v = row.v_abc.unwrap_or([f64::NAN; 3]);
+        [v[0], v[1], v[2], row.i_abc[0], row.i_abc[1], row.i_abc[2]]
+    }
+
+    /// Follows a row with no bad phase cell when no run of its reaches the length of a
+    /// stuck channel (true); else leaves the state as it was (false: the row is for
+    /// [`StuckTracker::check_flagged`], which may mark it). The same runs as
+    /// [`StuckTracker::check_flagged`] of the row when it marks nothing.
+    #[inline(always)]
+    pub(super) fn follow_unmarked(&mut self, row: &Row) -> bool {
+        let x = Self::readings(row);
+        let v_on = 0u64.wrapping_sub(u64::from(row.v_abc.is_some()));
+        let mut runs = [0u64; 6];
+        let mut long = false;
+        for (k, run) in runs.iter_mut().enumerate() {
+            let same = 0u64.wrapping_sub(u64::from(x[k] == self.last[k]));
+            // (Without voltages their runs stay at 0.)
+            let on = if k < 3 { v_on } else { u64::MAX };
+            *run = ((self.runs[k] & same).wrapping_add(1)) & on;
+            long |= *run >= u64::from(self.run_min);
+        }
+        if long {
+            return false;
+        }
+        self.last = x;
+        self.runs = runs;
+        true
+    }
+
     /// Follows `row` and marks its stuck cells in `bad` (cells already bad are left out of
     /// the runs).
     #[inline]
