@@ -530,8 +530,19 @@ impl ParquetLogWriter {
 mod tests {
     use super::*;
 
-    /// [`hand_rows`] or [`hand_ragged_rows`].
+    /// [`hand_rows`] (in blocks, [`RowSink::rows`], to a closure's [`OnRow`]) or
+    /// [`hand_ragged_rows`].
     type Hand = fn(&Decoded, &ColumnMap, &mut u64, &mut dyn FnMut(&Row) -> bool) -> bool;
+
+    /// [`hand_rows`] to a closure.
+    fn hand_rows_to(
+        cols: &Decoded,
+        columns: &ColumnMap,
+        handed: &mut u64,
+        on_row: &mut dyn FnMut(&Row) -> bool,
+    ) -> bool {
+        hand_rows(cols, columns, handed, &mut OnRow(on_row))
+    }
 
     /// The rows `hand` gives of `cols` with `columns`, bit by bit (Debug of the bits).
     fn handed(
@@ -560,9 +571,11 @@ mod tests {
 
     /// The columns' rows by the specialised path are the general path's, to the last bit,
     /// with and without units to convert, with columns left out (the time too), and when
-    /// the consumer stops early; a truncated column takes the general path.
+    /// the consumer stops early (in a block of rows too); a truncated column takes the general path.
     #[test]
     fn specialised_rows_are_the_general_rows() {
+        // (Across blocks of rows handed over at once.)
+        const ROWS: usize = 2 * HAND_ROWS + 7;
         let value = |k: usize, i: usize| (k as f64 + 1.0) * 1.37 - (i as f64) * 0.61 + 1e-3;
         for names in [
             &[
@@ -584,7 +597,7 @@ mod tests {
             let mut cols: Decoded = Default::default();
             for (k, c) in cols.iter_mut().enumerate() {
                 if columns.field[k].is_some() {
-                    *c = (0..7).map(|i| value(k, i)).collect();
+                    *c = (0..ROWS).map(|i| value(k, i)).collect();
                 }
             }
             for scaled in [false, true] {
@@ -593,20 +606,21 @@ mod tests {
                     columns.temp_offset = 273.15;
                     columns.scaled = true;
                 }
-                for stop_at in [usize::MAX, 3] {
-                    let fast = handed(hand_rows, &cols, &columns, stop_at);
+                for stop_at in [usize::MAX, 3, HAND_ROWS + 5] {
+                    let fast = handed(hand_rows_to, &cols, &columns, stop_at);
                     let general = handed(hand_ragged_rows, &cols, &columns, stop_at);
                     assert_eq!(fast, general, "{names:?} scaled {scaled}");
-                    assert_eq!(fast.0.len(), 7.min(stop_at));
-                    assert_eq!(fast.2, stop_at > 7);
+                    assert_eq!(fast.0.len(), ROWS.min(stop_at));
+                    assert_eq!(fast.1, ROWS.min(stop_at) as u64);
+                    assert_eq!(fast.2, stop_at > ROWS);
                 }
             }
             // A truncated present column: the general path (its last value kept).
             let last = cols.iter().rposition(|c| !c.is_empty()).unwrap();
             cols[last].truncate(4);
-            let fast = handed(hand_rows, &cols, &columns, usize::MAX);
+            let fast = handed(hand_rows_to, &cols, &columns, usize::MAX);
             assert_eq!(fast, handed(hand_ragged_rows, &cols, &columns, usize::MAX));
-            assert_eq!(fast.1, 7);
+            assert_eq!(fast.1, ROWS as u64);
         }
     }
 }
