@@ -6,7 +6,7 @@
 //! channels' runs and the rows handed on are those of the rows one by one, bit for bit.
 
 use super::stuck::StuckTracker;
-use super::{BadCells, CleanSink, QualityStage, TimeUnit, CLOCK_EXACT, INTERVAL_TOLERANCE};
+use super::{CleanSink, QualityStage, TimeUnit, CLOCK_EXACT, INTERVAL_TOLERANCE};
 use crate::log::{Row, RowSink};
 use std::ops::ControlFlow;
 
@@ -37,29 +37,25 @@ impl<S: CleanSink> QualityStage<'_, S> {
 
     /// The rows at the head of `rows` that are the common row, each after the one before
     /// (the first after the last row passed), and the stuck channels' runs after them;
-    /// see the module documentation.
-    fn common_run(&self, rows: &[Row]) -> (usize, StuckTracker) {
-        let mut stuck = self.stuck.clone();
+    /// see the module documentation. Judged channel by channel on the rows staged
+    /// ([`super::signals::Signals::stage`]).
+    fn common_run(&mut self, rows: &[Row]) -> (usize, StuckTracker) {
         if self.pending.is_some() || self.burst.is_some() || self.q.time_unit != TimeUnit::S {
-            return (0, stuck);
+            return (0, self.stuck.clone());
         }
-        let period = self.period;
-        let (tol, exact) = (INTERVAL_TOLERANCE * period, CLOCK_EXACT * period);
-        let mut last_t = self.last_t;
-        for (k, r) in rows.iter().enumerate() {
-            // (The expressions of `ingest` and `emit_on_clock`; `t_s` is in seconds.)
-            let d = r.t_s - last_t;
-            let err = r.t_s - (last_t + period);
-            let common = ((d - period).abs() <= tol)
-                & (err.abs() <= exact)
-                & r.enc_count.is_none()
-                & BadCells::none_of(r, &self.limits);
-            if !(common && stuck.follow_unmarked(r)) {
-                return (k, stuck);
-            }
-            last_t = r.t_s;
+        let lim = self.limits;
+        let staged = self.signals.stage(rows);
+        let mut n = on_clock(staged.t, self.last_t, self.period);
+        let first = if staged.has_v { 0 } else { 3 };
+        for (k, xs) in staged.x.iter().enumerate().skip(first) {
+            let max = if k < 3 { lim.v_max } else { lim.i_max };
+            n = n.min(within(xs, max));
         }
-        (rows.len(), stuck)
+        if let Some(wm) = staged.wm {
+            n = n.min(within(wm, lim.wm_max));
+        }
+        let stuck = self.stuck.follow_columns(staged.x, staged.has_v, &mut n);
+        (n, stuck)
     }
 
     /// Passes rows of a [`QualityStage::common_run`] on (`stuck`: the runs after them): the
@@ -90,11 +86,42 @@ impl<S: CleanSink> QualityStage<'_, S> {
             let err = r.t_s - (last_t + self.period);
             sq += err * err;
             last_t = r.t_s;
-            self.signals.push(r, r.t_s);
         }
+        self.signals.take_staged(m);
         self.jitter = (sq, self.jitter.1 + m as u64);
         self.last_t = last_t;
         self.stopped = flow.is_break();
         flow
     }
+}
+
+/// The number of times at the head of `t` each one period after the one before (the first
+/// after `last_t`) within [`INTERVAL_TOLERANCE`], and on the sample clock within
+/// [`CLOCK_EXACT`] (the expressions of `ingest` and `emit_on_clock`; times in seconds).
+fn on_clock(t: &[f64], last_t: f64, period: f64) -> usize {
+    let (tol, exact) = (INTERVAL_TOLERANCE * period, CLOCK_EXACT * period);
+    let ok = |prev: f64, t: f64| {
+        ((t - prev - period).abs() <= tol) & ((t - (prev + period)).abs() <= exact)
+    };
+    let Some(&t0) = t.first() else {
+        return 0;
+    };
+    if !ok(last_t, t0) {
+        return 0;
+    }
+    let pairs = t.iter().zip(t.iter().skip(1));
+    if pairs.clone().fold(true, |all, (&a, &b)| all & ok(a, b)) {
+        return t.len();
+    }
+    pairs.take_while(|(&a, &b)| ok(a, b)).count() + 1
+}
+
+/// The number of readings at the head of `xs` within `max` (finite, `|x| <= max`: the
+/// rule of [`BadCells::of`]).
+fn within(xs: &[f64], max: f64) -> usize {
+    let max = max.min(f64::MAX);
+    if xs.iter().fold(true, |all, &x| all & (x.abs() <= max)) {
+        return xs.len();
+    }
+    xs.iter().take_while(|&&x| x.abs() <= max).count()
 }

@@ -93,6 +93,51 @@ impl StuckTracker {
         true
     }
 
+    /// [`StuckTracker::follow_unmarked`] of rows given channel by channel (`x`: the six
+    /// channels' readings of at least `*n` rows, the voltages' left out when `has_v` is
+    /// false): `*n` cut to the rows before the first whose run reaches a stuck one's; the
+    /// tracker after them.
+    pub(super) fn follow_columns(&self, x: [&[f64]; 6], has_v: bool, n: &mut usize) -> Self {
+        let run_min = u64::from(self.run_min);
+        let first = if has_v { 0 } else { 3 };
+        for (k, xs) in x.iter().enumerate().skip(first) {
+            let (mut run, mut last) = (self.runs[k], self.last[k]);
+            for (j, &v) in xs.iter().take(*n).enumerate() {
+                if v == last {
+                    run += 1;
+                    if run >= run_min {
+                        *n = j;
+                        break;
+                    }
+                } else {
+                    run = 1;
+                }
+                last = v;
+            }
+        }
+        let mut out = self.clone();
+        let Some(end) = n.checked_sub(1) else {
+            return out;
+        };
+        for (k, xs) in x.iter().enumerate() {
+            if k < first {
+                (out.last[k], out.runs[k]) = (f64::NAN, 0);
+                continue;
+            }
+            // The run the last row ends: equal readings back from it, and the run before
+            // the first row when they reach it.
+            let xs = &xs[..=end];
+            let back = xs.iter().rev().take_while(|&&v| v == xs[end]).count();
+            let before = if back == xs.len() && xs[end] == self.last[k] {
+                self.runs[k]
+            } else {
+                0
+            };
+            (out.last[k], out.runs[k]) = (xs[end], back as u64 + before);
+        }
+        out
+    }
+
     /// Follows `row` and marks its stuck cells in `bad` (cells already bad are left out of
     /// the runs).
     #[inline]
