@@ -6,7 +6,8 @@
 //! judge); uncompressed, snappy or lz4 (what pandas, pyarrow and Spark write by default; a
 //! file in another codec is refused naming it). The row groups are decoded in parallel
 //! (rayon, a batch ahead of the rows being handed over), so memory is a few row groups
-//! whatever the log's length.
+//! whatever the log's length; the rows are handed over [`HAND_ROWS`] at a time
+//! ([`RowSink::rows`]).
 //!
 //! Writing: `t_s` as DOUBLE, the voltages, currents and speed as FLOAT (the precision of
 //! every writer, see [`super::LogWriter`]), `enc_count` as INT64, all REQUIRED, plain

@@ -100,9 +100,18 @@ impl StuckTracker {
     pub(super) fn follow_columns(&self, x: [&[f64]; 6], has_v: bool, n: &mut usize) -> Self {
         let run_min = u64::from(self.run_min);
         let first = if has_v { 0 } else { 3 };
+        let reach = (self.run_min as usize).saturating_sub(1);
         for (k, xs) in x.iter().enumerate().skip(first) {
             let (mut run, mut last) = (self.runs[k], self.last[k]);
-            for (j, &v) in xs.iter().take(*n).enumerate() {
+            let xs = xs.get(..*n).unwrap_or(xs);
+            // A run as long as a stuck one's either goes on from the last row followed or
+            // has equal readings `run_min - 1` rows apart: without either (a live
+            // channel), no run is looked for.
+            let far = xs.iter().zip(xs.get(reach..).unwrap_or_default());
+            if xs.first() != Some(&last) && !far.fold(false, |any, (a, b)| any | (a == b)) {
+                continue;
+            }
+            for (j, &v) in xs.iter().enumerate() {
                 if v == last {
                     run += 1;
                     if run >= run_min {
