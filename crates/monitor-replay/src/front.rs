@@ -10,6 +10,7 @@ use monitor_core::Abc;
 use monitor_io::log::quality::{BadCells, CleanSink, SegmentBreak, TimeBase, MAX_BRIDGED_GAP_S};
 use monitor_io::log::{Channels, Column, Row};
 use monitor_io::params::ParamFile;
+use std::ops::ControlFlow;
 
 /// The replay behind the data-quality stage: configured when the stage knows the time
 /// base; rows of segments at another sample rate are counted, not replayed (the monitor's
@@ -72,6 +73,9 @@ impl<F: Feeder + ?Sized> Feeder for &mut F {
     fn row(&mut self, row: &Row) {
         (**self).row(row);
     }
+    fn rows(&mut self, rows: &[Row]) {
+        (**self).rows(rows);
+    }
     fn clock_reset(&mut self) {
         (**self).clock_reset();
     }
@@ -88,6 +92,12 @@ pub(super) trait Feeder {
     fn begin(&mut self, rate_hz: f64) -> bool;
     /// One row to replay, its time on the replay's clock.
     fn row(&mut self, row: &Row);
+    /// Rows to replay, in order: [`Feeder::row`] of each in turn (by default).
+    fn rows(&mut self, rows: &[Row]) {
+        for r in rows {
+            self.row(r);
+        }
+    }
     /// The acquisition clock was reset before the next row: the replay's encoder count goes
     /// on over the bridged time ([`Replay::clock_reset`]).
     fn clock_reset(&mut self);
@@ -453,6 +463,33 @@ impl<F: Feeder> CleanSink for ReplaySink<'_, F> {
         self.replay(row);
         self.fed_good = true;
         true
+    }
+
+    fn rows(&mut self, rows: &[Row]) -> ControlFlow<usize> {
+        let off = self.time_offset;
+        let (Some(first), Some(last)) = (rows.first(), rows.last()) else {
+            return ControlFlow::Continue(());
+        };
+        if !self.began {
+            return ControlFlow::Continue(());
+        }
+        if !self.quiet
+            || rows
+                .iter()
+                .any(|r| (r.t_s + off).to_bits() != r.t_s.to_bits())
+        {
+            for r in rows {
+                self.row(r, BadCells::default());
+            }
+            return ControlFlow::Continue(());
+        }
+        // Good rows with nothing held, each at its own time: replayed as they are
+        // ([`ReplaySink::replay`] of each).
+        self.t0.get_or_insert(first.t_s + off);
+        self.last_fed = Some(*last);
+        self.feeder.rows(rows);
+        self.fed_good = true;
+        ControlFlow::Continue(())
     }
 
     fn new_segment(&mut self, why: SegmentBreak) -> bool {

@@ -129,6 +129,34 @@ impl Feeder for Pipe<'_> {
         }
     }
 
+    fn rows(&mut self, rows: &[Row]) {
+        let mut rest = rows;
+        while !rest.is_empty() {
+            let Some(front) = self.front.as_mut() else {
+                return;
+            };
+            let room = BATCH.saturating_sub(self.batch.rows.len()).max(1);
+            let (now, later) = rest.split_at(room.min(rest.len()));
+            let t0 = *self.t0.get_or_insert(now[0].t_s);
+            let b = &mut self.batch;
+            let before = b.rows.len();
+            for (k, row) in now.iter().enumerate() {
+                let step = front.track(row, row.t_s - t0);
+                // (A window closed before the row: a call after the rows before it.)
+                while let Some(w) = front.take_closed() {
+                    b.calls.push((before + k, Call::Window(w)));
+                }
+                b.steps.push(step);
+                // (Row by row: the copy of a whole block is a byte loop to the profilers.)
+                b.rows.push(*row);
+            }
+            if self.batch.rows.len() >= BATCH {
+                self.flush();
+            }
+            rest = later;
+        }
+    }
+
     fn clock_reset(&mut self) {
         self.push(Call::ClockReset);
     }

@@ -6,7 +6,8 @@
 //! judge); uncompressed, snappy or lz4 (what pandas, pyarrow and Spark write by default; a
 //! file in another codec is refused naming it). The row groups are decoded in parallel
 //! (rayon, a batch ahead of the rows being handed over), so memory is a few row groups
-//! whatever the log's length.
+//! whatever the log's length; the rows are handed over [`HAND_ROWS`] at a time
+//! ([`RowSink::rows`]).
 //!
 //! Writing: `t_s` as DOUBLE, the voltages, currents and speed as FLOAT (the precision of
 //! every writer, see [`super::LogWriter`]), `enc_count` as INT64, all REQUIRED, plain
@@ -16,7 +17,7 @@
 use super::mapping::ColumnMapping;
 use super::source::{BinarySource, ColumnMap, Opened};
 use super::typed::FieldType;
-use super::{Channels, Column, LogError, Row};
+use super::{Channels, Column, LogError, Row, RowSink};
 use parquet::basic::{Compression, Encoding, LogicalType, TimeUnit, Type as PhysicalType};
 use parquet::column::reader::{ColumnReader, ColumnReaderImpl};
 use parquet::data_type::{DataType, DoubleType, FloatType, Int64Type};
@@ -28,6 +29,7 @@ use parquet::file::writer::SerializedFileWriter;
 use parquet::schema::types::SchemaDescriptor;
 use rayon::prelude::*;
 use std::fs::File;
+use std::ops::ControlFlow;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -184,6 +186,15 @@ impl BinarySource for ParquetSource {
         progress: &mut dyn FnMut(f64),
         on_row: &mut dyn FnMut(&Row) -> bool,
     ) -> Result<u64, LogError> {
+        self.for_each_block(log, progress, &mut OnRow(on_row))
+    }
+
+    fn for_each_block(
+        &self,
+        log: &Opened<'_>,
+        progress: &mut dyn FnMut(f64),
+        sink: &mut dyn RowSink,
+    ) -> Result<u64, LogError> {
         let (path, shown, columns) = (log.path(), log.shown(), log.columns());
         let ng = self.groups.len();
         let per_batch = rayon::current_num_threads().max(1) * 2;
@@ -215,7 +226,7 @@ impl BinarySource for ParquetSource {
                             return;
                         }
                     };
-                    if !hand_rows(&cols, columns, &mut handed, on_row) {
+                    if !hand_rows(&cols, columns, &mut handed, sink) {
                         outcome = Some(Ok(()));
                         return;
                     }
@@ -232,6 +243,19 @@ impl BinarySource for ParquetSource {
     }
 }
 
+/// A closure given each row, as a [`RowSink`].
+struct OnRow<'a>(&'a mut dyn FnMut(&Row) -> bool);
+
+impl RowSink for OnRow<'_> {
+    fn row(&mut self, row: &Row) -> bool {
+        (self.0)(row)
+    }
+    fn restart(&mut self) {}
+}
+
+/// Rows handed over at a time ([`RowSink::rows`]).
+const HAND_ROWS: usize = 256;
+
 /// Hands the rows of one decoded row group to `on_row`, counting them in `handed`; false
 /// when `on_row` asked to stop. Each row is built from the columns directly, cut to the
 /// group's length (no bounds checks, no array of the row's values), with the values
@@ -242,12 +266,12 @@ fn hand_rows(
     cols: &Decoded,
     columns: &ColumnMap,
     handed: &mut u64,
-    on_row: &mut dyn FnMut(&Row) -> bool,
+    sink: &mut dyn RowSink,
 ) -> bool {
     let n = cols.iter().find(|c| !c.is_empty()).map_or(0, Vec::len);
     let short = |k: usize| cols[k].len() < n;
     if (0..Column::COUNT).any(|k| columns.field[k].is_some() && short(k)) {
-        return hand_ragged_rows(cols, columns, handed, on_row);
+        return hand_ragged_rows(cols, columns, handed, &mut |r| sink.row(r));
     }
     // An absent column reads as zeros (the general path's value of a cell never set),
     // or as any full column where the row leaves its value out (speed, count,
@@ -264,21 +288,21 @@ fn hand_rows(
     let filler = if zeros.is_empty() { ia } else { &zeros };
     let cut: [&[f64]; Column::COUNT] = std::array::from_fn(|k| cols[k].get(..n).unwrap_or(filler));
     if columns.scaled {
-        hand_columns::<true>(&cut, n, columns, handed, on_row)
+        hand_columns::<true>(&cut, n, columns, handed, sink)
     } else {
-        hand_columns::<false>(&cut, n, columns, handed, on_row)
+        hand_columns::<false>(&cut, n, columns, handed, sink)
     }
 }
 
 /// [`hand_rows`] of columns `c` of `n` values each (`SCALED`: `columns.scaled`, the
-/// values multiplied by their unit's factor).
+/// values multiplied by their unit's factor), [`HAND_ROWS`] rows at a time.
 #[inline(always)]
 fn hand_columns<const SCALED: bool>(
     c: &[&[f64]; Column::COUNT],
     n: usize,
     columns: &ColumnMap,
     handed: &mut u64,
-    on_row: &mut dyn FnMut(&Row) -> bool,
+    sink: &mut dyn RowSink,
 ) -> bool {
     let has = |c: Column| columns.of(c).is_some();
     let (has_v, has_w, has_e, has_temp) = (
@@ -289,22 +313,33 @@ fn hand_columns<const SCALED: bool>(
     );
     let (k, offset) = (&columns.scale, columns.temp_offset);
     let s = |j: usize, x: f64| if SCALED { x * k[j] } else { x };
-    let (t, va, vb, vc) = (&c[0][..n], &c[1][..n], &c[2][..n], &c[3][..n]);
-    let (ia, ib, ic) = (&c[4][..n], &c[5][..n], &c[6][..n]);
-    let (wm, enc, temp) = (&c[7][..n], &c[8][..n], &c[9][..n]);
-    for i in 0..n {
-        let row = Row {
+    let mut rows = Vec::with_capacity(HAND_ROWS.min(n));
+    let mut from = 0;
+    while from < n {
+        let to = (from + HAND_ROWS).min(n);
+        let (t, va, vb, vc) = (
+            &c[0][from..to],
+            &c[1][from..to],
+            &c[2][from..to],
+            &c[3][from..to],
+        );
+        let (ia, ib, ic) = (&c[4][from..to], &c[5][from..to], &c[6][from..to]);
+        let (wm, enc, temp) = (&c[7][from..to], &c[8][from..to], &c[9][from..to]);
+        rows.clear();
+        rows.extend((0..to - from).map(|i| Row {
             t_s: s(0, t[i]),
             v_abc: has_v.then(|| [s(1, va[i]), s(2, vb[i]), s(3, vc[i])]),
             i_abc: [s(4, ia[i]), s(5, ib[i]), s(6, ic[i])],
             wm_rad_s: has_w.then(|| s(7, wm[i])),
             enc_count: has_e.then(|| super::enc_count_of(enc[i])),
             t_winding_c: has_temp.then(|| (temp[i] + offset) * k[9]),
-        };
-        *handed += 1;
-        if !on_row(&row) {
+        }));
+        if let ControlFlow::Break(stop) = sink.rows(&rows) {
+            *handed += stop as u64 + 1;
             return false;
         }
+        *handed += rows.len() as u64;
+        from = to;
     }
     true
 }
@@ -493,86 +528,5 @@ impl ParquetLogWriter {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// [`hand_rows`] or [`hand_ragged_rows`].
-    type Hand = fn(&Decoded, &ColumnMap, &mut u64, &mut dyn FnMut(&Row) -> bool) -> bool;
-
-    /// The rows `hand` gives of `cols` with `columns`, bit by bit (Debug of the bits).
-    fn handed(
-        hand: Hand,
-        cols: &Decoded,
-        columns: &ColumnMap,
-        stop_at: usize,
-    ) -> (Vec<String>, u64, bool) {
-        let mut out = Vec::new();
-        let mut n = 0u64;
-        let bits = |x: f64| x.to_bits();
-        let went_on = hand(cols, columns, &mut n, &mut |r: &Row| {
-            out.push(format!(
-                "{} {:?} {:?} {:?} {:?} {:?}",
-                bits(r.t_s),
-                r.v_abc.map(|v| v.map(bits)),
-                r.i_abc.map(bits),
-                r.wm_rad_s.map(bits),
-                r.enc_count,
-                r.t_winding_c.map(bits)
-            ));
-            out.len() < stop_at
-        });
-        (out, n, went_on)
-    }
-
-    /// The columns' rows by the specialised path are the general path's, to the last bit,
-    /// with and without units to convert, with columns left out (the time too), and when
-    /// the consumer stops early; a truncated column takes the general path.
-    #[test]
-    fn specialised_rows_are_the_general_rows() {
-        let value = |k: usize, i: usize| (k as f64 + 1.0) * 1.37 - (i as f64) * 0.61 + 1e-3;
-        for names in [
-            &[
-                "t_s",
-                "va_V",
-                "vb_V",
-                "vc_V",
-                "ia_A",
-                "ib_A",
-                "ic_A",
-                "wm_rad_s",
-                "enc_count",
-            ][..],
-            &["ia_A", "ib_A", "ic_A", "t_winding_c"][..],
-            &["t_s", "ia_A", "ib_A", "ic_A", "enc_count"][..],
-        ] {
-            let found: Vec<String> = names.iter().map(|s| s.to_string()).collect();
-            let mut columns = ColumnMap::locate(&found, &ColumnMapping::default(), "test").unwrap();
-            let mut cols: Decoded = Default::default();
-            for (k, c) in cols.iter_mut().enumerate() {
-                if columns.field[k].is_some() {
-                    *c = (0..7).map(|i| value(k, i)).collect();
-                }
-            }
-            for scaled in [false, true] {
-                if scaled {
-                    columns.scale = std::array::from_fn(|k| 1.0 + 0.1 * k as f64);
-                    columns.temp_offset = 273.15;
-                    columns.scaled = true;
-                }
-                for stop_at in [usize::MAX, 3] {
-                    let fast = handed(hand_rows, &cols, &columns, stop_at);
-                    let general = handed(hand_ragged_rows, &cols, &columns, stop_at);
-                    assert_eq!(fast, general, "{names:?} scaled {scaled}");
-                    assert_eq!(fast.0.len(), 7.min(stop_at));
-                    assert_eq!(fast.2, stop_at > 7);
-                }
-            }
-            // A truncated present column: the general path (its last value kept).
-            let last = cols.iter().rposition(|c| !c.is_empty()).unwrap();
-            cols[last].truncate(4);
-            let fast = handed(hand_rows, &cols, &columns, usize::MAX);
-            assert_eq!(fast, handed(hand_ragged_rows, &cols, &columns, usize::MAX));
-            assert_eq!(fast.1, 7);
-        }
-    }
-}
+#[path = "parquet_tests.rs"]
+mod tests;

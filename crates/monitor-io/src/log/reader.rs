@@ -6,12 +6,22 @@ use super::mapping::{ColumnMapping, TimeKind};
 use super::source::{BinarySource, ColumnMap, OpenOptions, Opened};
 use super::{exact, fast, Channels, Column, Format, LogError, Row};
 use std::io::{BufRead, BufReader, Read};
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
 /// Receives the rows of [`LogFile::for_each_row`].
 pub trait RowSink {
     /// One row, in file order; return false to stop reading.
     fn row(&mut self, row: &Row) -> bool;
+    /// A block of rows in file order (what a columnar reader hands over at once):
+    /// [`ControlFlow::Break`] with the index of the row that asked to stop. The same as
+    /// [`RowSink::row`] of each row in turn, which it is by default.
+    fn rows(&mut self, rows: &[Row]) -> ControlFlow<usize> {
+        match rows.iter().position(|r| !self.row(r)) {
+            Some(k) => ControlFlow::Break(k),
+            None => ControlFlow::Continue(()),
+        }
+    }
     /// Forget every row received so far: the rows will come again from the first one (the
     /// fast path met something it does not accept and the exact reader takes over).
     fn restart(&mut self);
@@ -322,7 +332,7 @@ impl LogFile {
             ReadSource::Parquet(p) => p,
             ReadSource::Memory(m) => m,
         };
-        binary.for_each_row(&self.opened(), progress, &mut |r| sink.row(r))
+        binary.for_each_block(&self.opened(), progress, sink)
     }
 
     /// [`LogFile::for_each_row`] of a CSV log: the fast path, else the exact reader.

@@ -7,7 +7,7 @@
 //! never `LogFile`'s.
 
 use super::mapping::{ChannelUnit, ColumnMapping, TimeKind};
-use super::{Channels, Column, LogError, Row};
+use super::{Channels, Column, LogError, Row, RowSink};
 use std::path::Path;
 
 /// What a format's reader needs of an opened log (`LogFile` hands it down): the file,
@@ -191,6 +191,20 @@ pub(super) trait BinarySource {
         progress: &mut dyn FnMut(f64),
         on_row: &mut dyn FnMut(&Row) -> bool,
     ) -> Result<u64, LogError>;
+
+    /// [`BinarySource::for_each_row`] into `sink`, in blocks of rows where the source
+    /// has them ([`RowSink::rows`]); by default row by row.
+    ///
+    /// # Errors
+    /// As [`BinarySource::for_each_row`].
+    fn for_each_block(
+        &self,
+        log: &Opened<'_>,
+        progress: &mut dyn FnMut(f64),
+        sink: &mut dyn RowSink,
+    ) -> Result<u64, LogError> {
+        self.for_each_row(log, progress, &mut |r| sink.row(r))
+    }
 }
 
 /// The columns every log needs, in every format: `t_s` (unless `need_time` is false: a

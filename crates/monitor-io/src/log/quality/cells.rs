@@ -78,6 +78,16 @@ impl BadCells {
     /// The bad cells of `row` against `lim`.
     #[inline]
     pub fn of(row: &Row, lim: &CellLimits) -> Self {
+        // (Every row of a clean log ends here.)
+        if Self::none_of(row, lim) {
+            return BadCells(0);
+        }
+        Self::of_each(row, lim)
+    }
+
+    /// True when `row` has no bad cell against `lim` ([`BadCells::of`] is empty).
+    #[inline(always)]
+    pub(super) fn none_of(row: &Row, lim: &CellLimits) -> bool {
         // `|x| <= max` with `max` made finite: false for NaN and the infinities too.
         let within = |x: f64, max: f64| x.abs() <= max.min(f64::MAX);
         let i = row.i_abc;
@@ -88,11 +98,7 @@ impl BadCells {
         if let Some(w) = row.wm_rad_s {
             good &= within(w, lim.wm_max);
         }
-        // (Every row of a clean log ends here.)
-        if good && row.enc_count != Some(crate::log::ENC_COUNT_UNREADABLE) {
-            return BadCells(0);
-        }
-        Self::of_each(row, lim)
+        good & (row.enc_count != Some(crate::log::ENC_COUNT_UNREADABLE))
     }
 
     /// [`BadCells::of`] cell by cell.

@@ -60,6 +60,7 @@
 //! [`MAX_BAD_FRACTION`] of the intervals, or more than [`MAX_DROPPED_FRACTION`] of the
 //! samples are missing: the commands then withhold their verdict and say why.
 
+mod block;
 mod cells;
 pub mod encoder;
 mod finish;
@@ -76,6 +77,7 @@ pub(in crate::log) use time_base::median_positive;
 pub use time_base::TimeUnit;
 
 use super::{Column, LogError, Row, RowSink};
+use std::ops::ControlFlow;
 use time_base::time_base;
 
 /// Rows whose intervals set the nominal sample period and time unit.
@@ -146,6 +148,15 @@ pub trait CleanSink {
     /// One row (time strictly after the previous row's within a segment). Return false
     /// to stop.
     fn row(&mut self, row: &Row, bad: BadCells) -> bool;
+    /// Rows with no bad cell, in order: [`ControlFlow::Break`] with the index of the row
+    /// that asked to stop. The same as [`CleanSink::row`] of each in turn, which it is by
+    /// default.
+    fn rows(&mut self, rows: &[Row]) -> ControlFlow<usize> {
+        match rows.iter().position(|r| !self.row(r, BadCells::default())) {
+            Some(k) => ControlFlow::Break(k),
+            None => ControlFlow::Continue(()),
+        }
+    }
     /// The next row starts a new segment. Return false to stop.
     fn new_segment(&mut self, why: SegmentBreak) -> bool;
     /// Forget everything: the rows come again from the first one.
@@ -528,6 +539,10 @@ impl<S: CleanSink> RowSink for QualityStage<'_, S> {
             self.start();
         }
         !self.stopped
+    }
+
+    fn rows(&mut self, rows: &[Row]) -> ControlFlow<usize> {
+        self.block(rows)
     }
 
     fn restart(&mut self) {

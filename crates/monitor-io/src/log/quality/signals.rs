@@ -29,6 +29,24 @@ struct Held {
     wm: [f64; BLOCK],
 }
 
+/// Rows staged ([`Signals::stage`]), channel by channel.
+pub(super) struct Staged<'a> {
+    /// Their times [s].
+    pub t: &'a [f64],
+    /// Voltages a, b, c (not set without voltages), currents a, b, c.
+    pub x: [&'a [f64]; 6],
+    /// The speed, when the rows have one.
+    pub wm: Option<&'a [f64]>,
+    /// The rows have voltages.
+    pub has_v: bool,
+}
+
+/// The channels a row has: voltages (bit 0), a speed (bit 1).
+#[inline(always)]
+fn shape_of(r: &Row) -> u8 {
+    u8::from(r.v_abc.is_some()) | u8::from(r.wm_rad_s.is_some()) << 1
+}
+
 /// The accumulators and the block they have not seen yet; see the module documentation.
 pub(super) struct Signals {
     held: Box<Held>,
@@ -59,7 +77,7 @@ impl Signals {
     /// One row whose cells are all good, passed on at `t_s`.
     #[inline]
     pub(super) fn push(&mut self, r: &Row, t_s: f64) {
-        let shape = u8::from(r.v_abc.is_some()) | u8::from(r.wm_rad_s.is_some()) << 1;
+        let shape = shape_of(r);
         if self.held.len > 0 && self.held.shape != shape {
             self.flush();
         }
@@ -77,6 +95,57 @@ impl Signals {
         h.x[5][k] = r.i_abc[2];
         h.wm[k] = r.wm_rad_s.unwrap_or(0.0);
         h.len = k + 1;
+        if h.len == BLOCK {
+            self.flush();
+        }
+    }
+
+    /// Stages the rows at the head of `rows` that have the shape of the first (voltages or
+    /// not, a speed or not) and no encoder count, as many as the block has room for: their
+    /// channels written behind the rows held, not yet held ([`Signals::take_staged`] holds
+    /// them), for the stage to judge them channel by channel.
+    pub(super) fn stage(&mut self, rows: &[Row]) -> Staged<'_> {
+        let shape = rows.first().map_or(0, shape_of);
+        if self.held.len > 0 && self.held.shape != shape {
+            self.flush();
+        }
+        let h = &mut *self.held;
+        let from = h.len.min(BLOCK - 1);
+        let n = rows
+            .iter()
+            .take(BLOCK - from)
+            .take_while(|r| shape_of(r) == shape && r.enc_count.is_none())
+            .count();
+        h.shape = shape;
+        let rows = &rows[..n];
+        let to = from + n;
+        let [x0, x1, x2, x3, x4, x5] = &mut h.x;
+        let (x0, x1, x2) = (&mut x0[from..to], &mut x1[from..to], &mut x2[from..to]);
+        let (x3, x4, x5) = (&mut x3[from..to], &mut x4[from..to], &mut x5[from..to]);
+        let (t, wm) = (&mut h.t[from..to], &mut h.wm[from..to]);
+        for k in 0..n {
+            let r = &rows[k];
+            t[k] = r.t_s;
+            if let Some(v) = r.v_abc {
+                (x0[k], x1[k], x2[k]) = (v[0], v[1], v[2]);
+            }
+            (x3[k], x4[k], x5[k]) = (r.i_abc[0], r.i_abc[1], r.i_abc[2]);
+            wm[k] = r.wm_rad_s.unwrap_or(0.0);
+        }
+        let x = |c: usize| &h.x[c][from..to];
+        Staged {
+            t: &h.t[from..to],
+            x: [x(0), x(1), x(2), x(3), x(4), x(5)],
+            wm: (shape & 2 != 0).then(|| &h.wm[from..to]),
+            has_v: shape & 1 != 0,
+        }
+    }
+
+    /// Holds the first `n` rows staged ([`Signals::stage`]): what [`Signals::push`] of
+    /// each would have done.
+    pub(super) fn take_staged(&mut self, n: usize) {
+        let h = &mut *self.held;
+        h.len = (h.len + n).min(BLOCK);
         if h.len == BLOCK {
             self.flush();
         }

@@ -60,6 +60,93 @@ impl StuckTracker {
         }
     }
 
+    /// The readings of `row` the tracker follows (va, vb, vc, ia, ib, ic; NaN for absent
+    /// voltages, which never repeat).
+    #[inline(always)]
+    pub(super) fn readings(row: &Row) -> [f64; 6] {
+        let v = row.v_abc.unwrap_or([f64::NAN; 3]);
+        [v[0], v[1], v[2], row.i_abc[0], row.i_abc[1], row.i_abc[2]]
+    }
+
+    /// Follows a row with no bad phase cell when no run of its reaches the length of a
+    /// stuck channel (true); else leaves the state as it was (false: the row is for
+    /// [`StuckTracker::check_flagged`], which may mark it). The same runs as
+    /// [`StuckTracker::check_flagged`] of the row when it marks nothing.
+    #[inline(always)]
+    pub(super) fn follow_unmarked(&mut self, row: &Row) -> bool {
+        let x = Self::readings(row);
+        let v_on = 0u64.wrapping_sub(u64::from(row.v_abc.is_some()));
+        let mut runs = [0u64; 6];
+        let mut long = false;
+        for (k, run) in runs.iter_mut().enumerate() {
+            let same = 0u64.wrapping_sub(u64::from(x[k] == self.last[k]));
+            // (Without voltages their runs stay at 0.)
+            let on = if k < 3 { v_on } else { u64::MAX };
+            *run = ((self.runs[k] & same).wrapping_add(1)) & on;
+            long |= *run >= u64::from(self.run_min);
+        }
+        if long {
+            return false;
+        }
+        self.last = x;
+        self.runs = runs;
+        true
+    }
+
+    /// [`StuckTracker::follow_unmarked`] of rows given channel by channel (`x`: the six
+    /// channels' readings of at least `*n` rows, the voltages' left out when `has_v` is
+    /// false): `*n` cut to the rows before the first whose run reaches a stuck one's; the
+    /// tracker after them.
+    pub(super) fn follow_columns(&self, x: [&[f64]; 6], has_v: bool, n: &mut usize) -> Self {
+        let run_min = u64::from(self.run_min);
+        let first = if has_v { 0 } else { 3 };
+        let reach = (self.run_min as usize).saturating_sub(1);
+        for (k, xs) in x.iter().enumerate().skip(first) {
+            let (mut run, mut last) = (self.runs[k], self.last[k]);
+            let xs = xs.get(..*n).unwrap_or(xs);
+            // A run as long as a stuck one's either goes on from the last row followed or
+            // has equal readings `run_min - 1` rows apart: without either (a live
+            // channel), no run is looked for.
+            let far = xs.iter().zip(xs.get(reach..).unwrap_or_default());
+            if xs.first() != Some(&last) && !far.fold(false, |any, (a, b)| any | (a == b)) {
+                continue;
+            }
+            for (j, &v) in xs.iter().enumerate() {
+                if v == last {
+                    run += 1;
+                    if run >= run_min {
+                        *n = j;
+                        break;
+                    }
+                } else {
+                    run = 1;
+                }
+                last = v;
+            }
+        }
+        let mut out = self.clone();
+        let Some(end) = n.checked_sub(1) else {
+            return out;
+        };
+        for (k, xs) in x.iter().enumerate() {
+            if k < first {
+                (out.last[k], out.runs[k]) = (f64::NAN, 0);
+                continue;
+            }
+            // The run the last row ends: equal readings back from it, and the run before
+            // the first row when they reach it.
+            let xs = &xs[..=end];
+            let back = xs.iter().rev().take_while(|&&v| v == xs[end]).count();
+            let before = if back == xs.len() && xs[end] == self.last[k] {
+                self.runs[k]
+            } else {
+                0
+            };
+            (out.last[k], out.runs[k]) = (xs[end], back as u64 + before);
+        }
+        out
+    }
+
     /// Follows `row` and marks its stuck cells in `bad` (cells already bad are left out of
     /// the runs).
     #[inline]

@@ -111,3 +111,75 @@ fn jittered_timestamps_go_onto_the_sample_clock() {
     assert!(rms < 0.2 * 11.5e-6, "clock error {rms} s RMS");
     assert!(q.timestamp_jitter_rms_s > 1e-5 && q.trusted);
 }
+
+/// Rows handed over in blocks ([`RowSink::rows`]) pass as they do one by one: the same
+/// rows, flags, breaks and report, through gaps, glitches, bad cells, a frozen channel,
+/// quantised readings, jitter, a stretch without voltages and a time in milliseconds.
+#[test]
+fn blocks_of_rows_pass_as_rows_one_by_one() {
+    let mut x = 7u64;
+    let mut noise = move || {
+        x = x
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let mut rows = Vec::new();
+    for k in 0..60_000usize {
+        let mut t = k as f64 * 1e-4;
+        if (20_000..21_000).contains(&k) {
+            t += 2e-5 * noise();
+        }
+        let mut r = row(t);
+        // Quantised (readings repeat), a gap, a glitch, bad cells, a frozen phase.
+        r.i_abc = r.i_abc.map(|i| (i * 8.0).round() / 8.0);
+        if k % 5000 == 17 {
+            r.t_s += 3.3e-5;
+        }
+        if (30_000..30_010).contains(&k) {
+            r.i_abc[1] = f64::NAN;
+        }
+        if (40_000..41_000).contains(&k) {
+            r.i_abc[2] = 1.0;
+        }
+        if (45_000..46_000).contains(&k) {
+            r.v_abc = None;
+        }
+        if !(50_000..50_300).contains(&k) && k != 12_345 {
+            rows.push(r);
+        }
+    }
+    rows.push(rows[rows.len() - 3]);
+    for unit in [1.0, 1e3] {
+        let rows: Vec<Row> = rows
+            .iter()
+            .map(|r| Row {
+                t_s: r.t_s * unit,
+                ..*r
+            })
+            .collect();
+        let mut one = Collect::default();
+        let mut stage = QualityStage::new(&mut one, LIMITS, "t.csv");
+        assert!(rows.iter().all(|r| stage.row(r)));
+        let q_one = stage.finish().unwrap();
+        for block in [1, 7, 256, 4096] {
+            let mut blocks = Collect::default();
+            let mut stage = QualityStage::new(&mut blocks, LIMITS, "t.csv");
+            for b in rows.chunks(block) {
+                assert_eq!(stage.rows(b), ControlFlow::Continue(()));
+            }
+            let q = stage.finish().unwrap();
+            assert_eq!(format!("{q:?}"), format!("{q_one:?}"), "block {block}");
+            assert_eq!(blocks.breaks.len(), one.breaks.len());
+            assert_eq!(blocks.rows.len(), one.rows.len());
+            for (a, b) in blocks.rows.iter().zip(&one.rows) {
+                assert_eq!(format!("{a:?}"), format!("{b:?}"), "block {block}");
+            }
+        }
+        assert!(
+            q_one.glitch_bursts > 0 && q_one.gaps_bridged > 0,
+            "{q_one:?}"
+        );
+        assert!(!q_one.stuck_cells.is_empty(), "{q_one:?}");
+    }
+}
