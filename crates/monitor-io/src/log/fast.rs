@@ -22,6 +22,7 @@ use super::{Column, LogError, Row};
 use rayon::prelude::*;
 use std::fs::File;
 use std::io::{Read, Seek, SeekFrom};
+use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Bytes per block (one parallel work item).
@@ -98,7 +99,9 @@ impl BlockReader {
 }
 
 /// Streams the data rows of `log` in file order, parsing in parallel, `block` bytes per
-/// work item. `on_row` returns false to stop early. `progress` gets the fraction of the file read.
+/// work item, handed to `on_rows` [`HAND_ROWS`] at a time (a sink that judges a block of
+/// rows at once, as the data-quality stage does); it returns [`ControlFlow::Break`] with
+/// the index of the row that asked to stop. `progress` gets the fraction of the file read.
 /// Returns the number of blank lines skipped, or `Ok(None)` when the fast path gave up
 /// (see the module documentation; a time column of ISO 8601 text is the exact reader's).
 ///
@@ -108,7 +111,7 @@ pub(super) fn for_each_row(
     log: &Opened<'_>,
     block: usize,
     progress: &mut dyn FnMut(f64),
-    on_row: &mut dyn FnMut(&Row) -> bool,
+    on_rows: &mut dyn FnMut(&[Row]) -> ControlFlow<usize>,
 ) -> Result<Option<u64>, LogError> {
     if log.columns().time == TimeKind::Iso8601 {
         return Ok(None);
@@ -142,7 +145,7 @@ pub(super) fn for_each_row(
             to_hand.take(),
             parse,
             &mut outs,
-            on_row,
+            on_rows,
         );
         match t.verdict {
             Some(true) => return Ok(Some(blank.into_inner())),
@@ -193,7 +196,7 @@ struct Turn {
 
 /// One turn of the pipeline, the three stages overlapping: reads the next batch (one
 /// task) | parses `to_parse` (parallel, into buffers from `outs`) | hands `to_hand` over to
-/// `on_row` (this thread, so `on_row` need not be Send; its emptied buffers go back to
+/// `on_rows` (this thread, so `on_rows` need not be Send; its emptied buffers go back to
 /// `outs`). `parse`: the parser's columns, the row builder and the blank-line count.
 fn turn(
     reader: &mut BlockReader,
@@ -202,7 +205,7 @@ fn turn(
     to_hand: Option<Vec<Option<Parsed>>>,
     parse: (&Cols, &(impl Fn(&[f64]) -> Row + Sync), &AtomicU64),
     outs: &mut Vec<Parsed>,
-    on_row: &mut dyn FnMut(&Row) -> bool,
+    on_rows: &mut dyn FnMut(&[Row]) -> ControlFlow<usize>,
 ) -> Turn {
     let mut next: Option<std::io::Result<Vec<Vec<u8>>>> = None;
     let mut parsed: Option<Vec<Option<Parsed>>> = None;
@@ -221,7 +224,7 @@ fn turn(
             s.spawn(move |_| *pr = Some(parse_blocks(to_parse, bufs, cols, to_row, blank)));
         }
         if let Some(batch) = to_hand {
-            verdict = hand_over(batch, on_row, &mut free_outs);
+            verdict = hand_over(batch, on_rows, &mut free_outs);
         }
     });
     outs.append(&mut free_outs);
@@ -256,20 +259,23 @@ fn parse_blocks(
         .collect()
 }
 
-/// Hands a parsed batch's rows to `on_row` in order, returning each emptied buffer to
-/// `free`. `Some(false)`: a block was not for the fast path (give up); `Some(true)`:
-/// `on_row` asked to stop; `None`: go on.
+/// Rows handed over at a time (what the data-quality stage judges as one block).
+const HAND_ROWS: usize = 256;
+
+/// Hands a parsed batch's rows to `on_rows` in order, [`HAND_ROWS`] at a time, returning
+/// each emptied buffer to `free`. `Some(false)`: a block was not for the fast path (give
+/// up); `Some(true)`: `on_rows` asked to stop; `None`: go on.
 fn hand_over(
     batch: Vec<Option<Parsed>>,
-    on_row: &mut dyn FnMut(&Row) -> bool,
+    on_rows: &mut dyn FnMut(&[Row]) -> ControlFlow<usize>,
     free: &mut Vec<Parsed>,
 ) -> Option<bool> {
     for p in batch {
         let Some(v) = p else {
             return Some(false);
         };
-        for row in &v {
-            if !on_row(row) {
+        for rows in v.chunks(HAND_ROWS) {
+            if on_rows(rows).is_break() {
                 return Some(true);
             }
         }
@@ -299,8 +305,8 @@ mod tests {
         let log = LogFile::open(path).unwrap();
         let mut v = vec![];
         let ok = for_each_row(&log.opened(), block, &mut |_| {}, &mut |r| {
-            v.push(*r);
-            true
+            v.extend_from_slice(r);
+            ControlFlow::Continue(())
         })
         .unwrap();
         (ok.is_some(), v)
@@ -339,9 +345,14 @@ mod tests {
         // Stopping early.
         let log = LogFile::open(&path).unwrap();
         let mut n = 0;
-        let ok = for_each_row(&log.opened(), 64, &mut |_| {}, &mut |_| {
-            n += 1;
-            n < 10
+        let ok = for_each_row(&log.opened(), 64, &mut |_| {}, &mut |rows| {
+            for k in 0..rows.len() {
+                n += 1;
+                if n == 10 {
+                    return ControlFlow::Break(k);
+                }
+            }
+            ControlFlow::Continue(())
         })
         .unwrap();
         assert!(ok.is_some());

@@ -343,9 +343,13 @@ impl LogFile {
     ) -> Result<u64, LogError> {
         let mut handed = 0u64;
         let accepted =
-            fast::for_each_row(&self.opened(), fast::BLOCK_BYTES, progress, &mut |row| {
-                handed += 1;
-                sink.row(row)
+            fast::for_each_row(&self.opened(), fast::BLOCK_BYTES, progress, &mut |rows| {
+                let flow = sink.rows(rows);
+                handed += match flow {
+                    ControlFlow::Break(k) => k as u64 + 1,
+                    ControlFlow::Continue(()) => rows.len() as u64,
+                };
+                flow
             })?;
         if let Some(blank) = accepted {
             sink.blank_lines(blank);
