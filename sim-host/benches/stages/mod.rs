@@ -19,7 +19,8 @@ const STAGES: [(&str, &[&str]); 9] = [
         &[
             "monitor_io::log::quality",
             "monitor_io::log::clipping",
-            "monitor_replay::front",
+            // (The replay's sink before the pipe; the pipe's `Feeder` is the hand-over.)
+            "monitor_replay::front::ReplaySink",
         ],
     ),
     (
@@ -33,6 +34,8 @@ const STAGES: [(&str, &[&str]); 9] = [
             "rayon",
             "crossbeam",
             "in_place_collect",
+            // (The Parquet rows built from the columns, `hand_columns`' iterator.)
+            "core::iter::adapters::map::Map",
         ],
     ),
     (
