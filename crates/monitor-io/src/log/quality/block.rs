@@ -1,8 +1,8 @@
 //! The stage's path for a block of rows ([`RowSink::rows`]): the longest run of rows at
 //! its head that are all the common row (one period after the last, on the sample clock
 //! within [`CLOCK_EXACT`], no bad cell, no encoder count to follow, no phase channel's run
-//! of equal readings as long as a stuck one's) is judged in one pass and handed on at once ([`CleanSink::rows`]); any other row
-//! goes the row's own way ([`RowSink::row`]). The counts, the accumulators, the stuck
+//! of equal readings as long as a stuck one's) is judged in one pass and handed on at once
+//! ([`CleanSink::rows`]); any other row goes the row's own way ([`RowSink::row`]). The counts, the accumulators, the stuck
 //! channels' runs and the rows handed on are those of the rows one by one, bit for bit.
 
 use super::stuck::StuckTracker;
