@@ -55,6 +55,7 @@ from ._results import (
     DiagnoseResult,
     ExplainResult,
     IdentifyResult,
+    LadderResult,
     NameplateResult,
     Result,
 )
@@ -72,6 +73,7 @@ __all__ = [
     "DiagnoseResult",
     "CompareResult",
     "ExplainResult",
+    "LadderResult",
     "IdentifyResult",
     "NameplateResult",
     "DriveMonitorError",
@@ -327,9 +329,18 @@ def explain(
     no_fit: bool = False,
     group: Optional[str] = None,
     rotor_bars: Optional[int] = None,
-) -> ExplainResult:
+    ladder: bool = False,
+) -> Union[ExplainResult, LadderResult]:
     """Rank the physical effects missing from the model by how much of its error each
-    explains: ``ranking``, ``verdict``, ``unexplained`` (``sim-host explain``)."""
+    explains: ``ranking``, ``verdict``, ``unexplained`` (``sim-host explain``).
+
+    With ``ladder=True``, walk the ladder instead (``sim-host explain --ladder``): add the
+    effect that lowers the held-back error most, keep it when the step passes its test, and
+    go on until the error is within the noise-floor band or nothing plausible helps. The
+    result (:class:`LadderResult`) has ``start``, ``ladder`` (one step each: ``effect``,
+    ``added``, ``fitted``, ``error``, ``heldback_error``, ``noise_floor``,
+    ``ratio_to_floor``, ``significance``, ...), ``stop`` and ``stopped_because``;
+    ``.ladder_frame`` is the steps as a DataFrame."""
     p, is_text = _params(params)
     data, origin = _log(log)
     doc = _native.explain(
@@ -338,8 +349,11 @@ def explain(
         log_origin=origin,
         params_is_text=is_text,
         rotor_bars=rotor_bars,
+        ladder=ladder,
         **_analysis_kwargs(effects, from_s, to_s, no_fit, group),
     )
+    if ladder:
+        return LadderResult(json.loads(doc))
     return ExplainResult(json.loads(doc))
 
 

@@ -51,6 +51,7 @@ def explain(
     no_fit: bool = ...,
     group: Optional[str] = ...,
     rotor_bars: Optional[int] = ...,
+    ladder: bool = ...,
 ) -> str: ...
 def identify(
     log: Any,

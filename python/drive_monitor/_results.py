@@ -161,6 +161,47 @@ class ExplainResult(Result):
         return _frame([{k: r.get(k) for k in keep} for r in self._doc.get("ranking", [])])
 
 
+class LadderResult(Result):
+    """``explain --ladder``'s report. Keys: ``start``, ``ladder`` (the steps in order),
+    ``stop``, ``stopped_because``, ``final_effects``, ``last_round``, ``skipped``,
+    ``split``, ``test``, ``data``, ``data_quality``."""
+
+    @property
+    def ladder_frame(self):
+        """The steps as a DataFrame, step 0 the model as configured: step, effects added,
+        whole-log and held-back error, each as a multiple of its noise floor, the test
+        statistic (``significance``) and the shares of the error beyond the floor explained."""
+        start = self._doc.get("start", {})
+        rows = [
+            {
+                "step": 0,
+                "added": "",
+                "error": start.get("error"),
+                "heldback_error": start.get("heldback_error"),
+                "noise_floor": start.get("noise_floor"),
+                "ratio_to_floor": start.get("ratio_to_floor"),
+                "significance": None,
+                "explained": None,
+                "heldback_explained": None,
+            }
+        ]
+        for k, s in enumerate(self._doc.get("ladder", []), start=1):
+            rows.append(
+                {
+                    "step": k,
+                    "added": "+".join(s.get("added", [])),
+                    "error": s.get("error"),
+                    "heldback_error": s.get("heldback_error"),
+                    "noise_floor": s.get("noise_floor"),
+                    "ratio_to_floor": s.get("ratio_to_floor"),
+                    "significance": s.get("significance"),
+                    "explained": s.get("explained"),
+                    "heldback_explained": s.get("heldback_explained"),
+                }
+            )
+        return _frame(rows)
+
+
 class IdentifyResult(Result):
     """``identify``'s result. Keys: ``identification`` (``estimates``, ``inverse_gamma``,
     ``relative_rms_error``, ``solver``, ...), ``out``, ``toml``."""

@@ -256,9 +256,9 @@ fn compare(
     })
 }
 
-/// `explain --json`.
+/// `explain --json`, or with `ladder` `explain --ladder --json`.
 #[pyfunction]
-#[pyo3(signature = (log, params, log_origin=None, params_is_text=false, effects=Vec::new(), from_s=None, to_s=None, no_fit=false, group=None, rotor_bars=None))]
+#[pyo3(signature = (log, params, log_origin=None, params_is_text=false, effects=Vec::new(), from_s=None, to_s=None, no_fit=false, group=None, rotor_bars=None, ladder=false))]
 #[allow(clippy::too_many_arguments)]
 fn explain(
     py: Python<'_>,
@@ -272,11 +272,18 @@ fn explain(
     no_fit: bool,
     group: Option<String>,
     rotor_bars: Option<u32>,
+    ladder: bool,
 ) -> PyResult<String> {
     let req = analysis_request(&effects, from_s, to_s, no_fit, group, rotor_bars)?;
     let log = log_source(log, log_origin.as_deref())?;
     run(py, || {
-        json(&api::explain(params_source(&params, params_is_text), log, &req).map_err(to_py)?)
+        let params = params_source(&params, params_is_text);
+        let doc = if ladder {
+            api::ladder(params, log, &req)
+        } else {
+            api::explain(params, log, &req)
+        };
+        json(&doc.map_err(to_py)?)
     })
 }
 

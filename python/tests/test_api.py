@@ -96,6 +96,21 @@ def test_compare_explain_identify_nameplate(repo, sim_host):
     assert abs(rs.value / 3.7 - 1) < 0.03
 
 
+def test_explain_ladder_matches_the_cli(repo, sim_host):
+    # The motulator log past its start (load step at 2.5 s): the ladder adds the load torque
+    # the paper's viscous load cannot follow, the whole-log error falls at every step.
+    lad = dm.explain(repo / MOTULATOR, repo / MOTULATOR_P, from_s=0.8, ladder=True)
+    assert lad.to_dict() == cli_json(sim_host, "explain", "--ladder", "--params", MOTULATOR_P,
+                                     MOTULATOR, "--from", "0.8")
+    assert "load_torque" in lad.final_effects
+    errors = [lad.start.error] + [s.error for s in lad.ladder]
+    assert all(b < a for a, b in zip(errors, errors[1:])), errors
+    assert errors[-1] < errors[0] / 5
+    frame = lad.ladder_frame
+    assert list(frame["step"]) == list(range(len(errors)))
+    assert lad.stop in {"noise_floor", "nothing_helps", "library_exhausted"}
+
+
 def test_simulate_returns_the_schema(repo):
     frame = dm.simulate(repo / "examples/params/3hp.toml",
                         "duration_s = 0.5\nsample_rate_hz = 2000.0\nseed = 1\n")

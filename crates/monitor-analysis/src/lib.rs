@@ -275,7 +275,7 @@ fn resolve(kinds: &[EffectKind]) -> Vec<Box<dyn EffectModel>> {
 }
 
 /// Block-averages a working series by `m` (for fitting long logs).
-fn coarsen(d: &Prepared, m: usize) -> Prepared {
+pub(crate) fn coarsen(d: &Prepared, m: usize) -> Prepared {
     use rayon::prelude::*;
     if m <= 1 {
         return d.clone();

@@ -225,7 +225,7 @@ pub enum NotProposed {
 }
 
 /// Effect names, comma separated.
-fn names(kinds: &[EffectKind]) -> String {
+pub(crate) fn names(kinds: &[EffectKind]) -> String {
     kinds
         .iter()
         .map(|k| k.name())

@@ -88,6 +88,22 @@ pub fn explain(
     Ok(serde_json::to_value(&doc).unwrap_or_default())
 }
 
+/// `explain --ladder --json`'s document ([`monitor_analysis::explain::ladder`]): the
+/// ladder's steps from the configured model to the noise floor, and why it stopped.
+///
+/// # Errors
+/// As [`super::compare`].
+pub fn ladder(
+    params: ParamsSource<'_>,
+    log: impl Into<LogSource>,
+    req: &AnalysisRequest,
+) -> Result<serde_json::Value, ApiError> {
+    let log = &log.into();
+    let a = load_analysis(params, log, req, &mut |_| {})?;
+    let report = a.ladder(&req.options(), &|_, _| {})?;
+    Ok(serde_json::to_value(&report).unwrap_or_default())
+}
+
 /// The verdict `diagnose` gives `log` with its defaults (no commissioning, no baseline; the
 /// TDMS `group`), which `explain` opens with; the error's message where `diagnose` cannot
 /// judge the log at all.

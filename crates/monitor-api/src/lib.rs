@@ -23,7 +23,9 @@ mod explain_doc;
 pub mod fleet;
 mod log_source;
 mod turn_calibration;
-pub use explain_doc::{beside_verdict, explain, mcsa_beside, verdict_for_explain, ExplainDocument};
+pub use explain_doc::{
+    beside_verdict, explain, ladder, mcsa_beside, verdict_for_explain, ExplainDocument,
+};
 pub use log_source::LogSource;
 pub use turn_calibration::{learn_turn_calibration, Labelled, Learned};
 

@@ -218,6 +218,19 @@ pub struct ExplainArgs {
     /// asymmetry as a number of adjacent broken bars, n = delta N / (3 (1 + delta)).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(6..))]
     pub rotor_bars: Option<u32>,
+    /// Walk the ladder instead of ranking once: add the effect that lowers the held-back
+    /// error most, keep it when the step passes its test (it removes at least 20 % of the
+    /// held-back error beyond the noise floor and lowers the whole-log error), and go on
+    /// from the new model until the error is within the noise-floor band or nothing
+    /// plausible helps. One row per step; --report draws the error falling onto the floor.
+    /// JSON: start, ladder [{effect, added, fitted {name: {value, unit, low, high}}, error,
+    /// heldback_error, noise_floor, heldback_noise_floor, ratio_to_floor,
+    /// heldback_ratio_to_floor, significance, explained, heldback_explained}], stop
+    /// (noise_floor | nothing_helps | library_exhausted | no_model | untrusted),
+    /// stopped_because, final_effects, last_round, skipped, split, test, data,
+    /// data_quality.
+    #[arg(long, conflicts_with_all = ["compare", "rotor_bars"])]
+    pub ladder: bool,
 }
 
 /// Runs `compare`.
@@ -282,6 +295,9 @@ fn explain_here(
 /// # Errors
 /// As [`run_compare`].
 pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
+    if args.ladder {
+        return run_ladder(&args.common);
+    }
     let c = &args.common;
     let mut charts = render::charts::EXPLAIN.to_vec();
     charts.push(render::mcsa::CHART);
@@ -328,5 +344,34 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
         }),
         (true, None) => render::json::print(&doc),
         (false, _) => render::text::explain(&c.log, &doc),
+    }
+}
+
+/// Runs `explain --ladder`: the log read once, the ladder walked with a progress bar per
+/// step, then the table (or JSON) and, with `--plot`/`--report`, the error falling step by
+/// step onto the noise-floor band.
+///
+/// # Errors
+/// As [`run_compare`].
+fn run_ladder(c: &Common) -> anyhow::Result<()> {
+    c.check(&[render::charts::LADDER])?;
+    let (a, _) = c.load()?;
+    let show = a.data.len() > 20_000;
+    let pb = progress::bar(
+        progress::FRACTION_STEPS,
+        "ladder step 1: fitting candidates",
+        show,
+    );
+    let pbc = pb.clone();
+    let report = a.ladder(&c.options(), &move |step, f| {
+        pbc.set_message(format!("ladder step {step}: fitting candidates"));
+        progress::set_fraction(&pbc, f);
+    })?;
+    pb.finish_and_clear();
+    render::html::write_ladder(c.plot.as_deref(), c.report.as_deref(), &c.log, &report)?;
+    if c.json {
+        render::json::print(&report)
+    } else {
+        render::text::ladder(&c.log, &report)
     }
 }

@@ -23,6 +23,7 @@
 
 mod baseline;
 mod candidates;
+pub mod ladder;
 mod ranking;
 mod report;
 

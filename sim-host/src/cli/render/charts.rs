@@ -2,6 +2,7 @@
 
 use super::plot::{self, Chart, Series};
 use monitor_analysis::compare::CompareOutput;
+use monitor_analysis::explain::ladder::{LadderReport, FLOOR_BAND};
 use monitor_analysis::metrics::{self, WorstWindow};
 use monitor_analysis::prep::Prepared;
 use monitor_analysis::simplified_model::Prediction;
@@ -32,6 +33,59 @@ pub const EXPLAIN: [&str; 5] = [
     "zoom_before_after_iqs_2",
     "before_after_error",
 ];
+
+/// The chart `explain --ladder` writes: the error after each step onto the floor band.
+pub const LADDER: &str = "ladder";
+
+/// `explain --ladder`'s chart: the whole-log and the held-back error after each step (step 0:
+/// the model as configured) on a logarithmic axis, with the noise floor and the band's top
+/// ([`FLOOR_BAND`] times it) as lines: the error falls step by step onto the band.
+pub fn ladder_chart(r: &LadderReport) -> Chart<'static> {
+    let mut whole = vec![(0.0, r.start.error)];
+    let mut held = vec![(0.0, r.start.heldback_error)];
+    let mut floor = vec![(0.0, r.start.noise_floor)];
+    for (k, s) in r.ladder.iter().enumerate() {
+        let x = (k + 1) as f64;
+        whole.push((x, s.error));
+        held.push((x, s.heldback_error));
+        floor.push((x, s.noise_floor));
+    }
+    let band: Vec<(f64, f64)> = floor.iter().map(|&(x, y)| (x, FLOOR_BAND * y)).collect();
+    let line = |label: String, points: Vec<(f64, f64)>, color: usize, dashed: bool| Series {
+        label,
+        points,
+        color,
+        scatter: false,
+        dashed,
+    };
+    let omitted = (!r.start.error.is_finite()).then(|| r.stopped_because.clone());
+    Chart {
+        stem: LADDER,
+        title: "The ladder: the model's error after each step, onto the noise floor",
+        x_label: "step (0: the model as configured; each step adds the effect named in the table)",
+        y_label: "normalized RMS error",
+        series: vec![
+            line("whole log".into(), whole.clone(), 0, false),
+            Series {
+                label: "whole log (each step)".into(),
+                points: whole,
+                color: 0,
+                scatter: true,
+                dashed: false,
+            },
+            line("held-back windows".into(), held, 1, false),
+            line("noise floor".into(), floor, 2, true),
+            line(
+                format!("floor band ({FLOOR_BAND}x the floor)"),
+                band,
+                3,
+                true,
+            ),
+        ],
+        log_y: true,
+        omitted,
+    }
+}
 
 /// Every file a chart set can write (for the output guard).
 pub fn file_names(stems: &[&str]) -> Vec<String> {

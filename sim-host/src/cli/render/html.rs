@@ -6,6 +6,7 @@
 
 use super::{charts, plot};
 use monitor_analysis::compare::{CompareOutput, CompareReport};
+use monitor_analysis::explain::ladder::LadderReport;
 use monitor_analysis::simplified_model::Prediction;
 use monitor_analysis::Analysis;
 use monitor_api::ExplainDocument;
@@ -101,6 +102,78 @@ pub fn write_explain(
         },
         |svgs| explain_html(&log, doc, svgs),
     )
+}
+
+/// `explain --ladder --plot DIR --report DIR`: the chart of the error falling step by step
+/// onto the floor band, and the page with the steps' table.
+pub fn write_ladder(
+    plot: Option<&Path>,
+    report: Option<&Path>,
+    log: &Path,
+    r: &LadderReport,
+) -> anyhow::Result<()> {
+    let log = log.display().to_string();
+    write_outputs(
+        plot,
+        report,
+        || vec![charts::ladder_chart(r)],
+        |svgs| ladder_html(&log, r, svgs),
+    )
+}
+
+/// The ladder's report page.
+fn ladder_html(log: &str, r: &LadderReport, charts: &[(String, String)]) -> String {
+    let mut h = String::new();
+    let _ = write!(h, "<!doctype html><html><head><meta charset=utf-8><meta name=viewport content=\"width=device-width\"><title>ladder: {}</title><style>{STYLE}svg{{max-width:100%;height:auto}}</style></head><body>", esc(log));
+    let _ = write!(h, "<h1>The ladder: model vs measurement, step by step</h1><p>Log <code>{}</code>: {} rows at {:.0} Hz ({:.2} s), analysed at {:.0} Hz.</p>", esc(log), r.data.rows, r.data.log_rate_hz, r.data.duration_s, r.data.working_rate_hz);
+    data_quality(&mut h, &r.data_quality);
+    let start = if r.start.effects.is_empty() {
+        "the paper's model (eqs. 28-29)".to_string()
+    } else {
+        effect_list(&r.start.effects)
+    };
+    let _ = write!(h, "<p class=v>{}</p>", esc(&r.stopped_because));
+    for (title, svg) in charts {
+        let _ = write!(h, "<h3>{}</h3>{svg}", esc(title));
+    }
+    h.push_str("<table><tr><th>step</th><th class=l>effect added</th><th>error</th><th>x floor</th><th>held-back</th><th>x floor</th><th>explained (whole / held-back)</th><th class=l>fitted (physical range)</th></tr>");
+    let _ = write!(h, "<tr><td>0</td><td class=l>{}</td><td>{:.4}</td><td>{:.1}</td><td>{:.4}</td><td>{:.1}</td><td></td><td></td></tr>", esc(&start), r.start.error, r.start.ratio_to_floor, r.start.heldback_error, r.start.heldback_error / r.start.heldback_noise_floor);
+    for (k, s) in r.ladder.iter().enumerate() {
+        let fitted: Vec<String> = s
+            .fitted
+            .iter()
+            .map(|(n, v)| {
+                format!(
+                    "{n} {:.4} {} ({:.3}..{:.3})",
+                    v.value, v.unit, v.low, v.high
+                )
+            })
+            .collect();
+        let _ = write!(h, "<tr><td>{}</td><td class=l>{}</td><td>{:.4}</td><td>{:.1}</td><td>{:.4}</td><td>{:.1}</td><td>{:.0} % / {:.0} %</td><td class=l>{}</td></tr>", k + 1, esc(&effect_list(&s.added)), s.error, s.ratio_to_floor, s.heldback_error, s.heldback_ratio_to_floor, 100.0 * s.explained, 100.0 * s.heldback_explained, esc(&fitted.join("; ")));
+    }
+    h.push_str("</table>");
+    let _ = write!(h, "<p>The test: {}.</p>", esc(&r.test));
+    if !r.last_round.is_empty() {
+        h.push_str("<h2>The last round's other candidates</h2><ul>");
+        for t in &r.last_round {
+            let _ = write!(
+                h,
+                "<li>{}: {}</li>",
+                esc(&effect_list(&t.added)),
+                esc(&t.because)
+            );
+        }
+        h.push_str("</ul>");
+    }
+    if !r.skipped.is_empty() {
+        h.push_str("<h2>Not fitted on this log</h2><ul>");
+        for s in &r.skipped {
+            let _ = write!(h, "<li>{}</li>", esc(s));
+        }
+        h.push_str("</ul>");
+    }
+    h.push_str("</body></html>");
+    h
 }
 
 fn esc(s: &str) -> String {

@@ -3,6 +3,7 @@
 use super::diagnose::data_quality;
 use super::number;
 use monitor_analysis::compare::CompareReport;
+use monitor_analysis::explain::ladder::LadderReport;
 use monitor_analysis::explain::{ExplainReport, Standing, EXPLAINS_MIN};
 use monitor_api::ExplainDocument;
 use std::io::Write;
@@ -236,4 +237,80 @@ fn apart(out: &mut impl Write, r: &ExplainReport) -> anyhow::Result<()> {
         )?;
     }
     Ok(())
+}
+
+/// `explain --ladder`'s table: the model as configured, one row per step (the effect added,
+/// the whole-log and held-back error each with its multiple of the noise floor, the share of
+/// the error beyond the floor the step removed on each, the fitted values with their
+/// physical ranges), then why it stopped, the test, the last round's other candidates and
+/// what could not be fitted.
+pub fn ladder(log: &Path, r: &LadderReport) -> anyhow::Result<()> {
+    let mut out = crate::cli::stdout();
+    writeln!(out, "explain --ladder {}", log.display())?;
+    data_quality(&mut out, &r.data_quality)?;
+    writeln!(
+        out,
+        "  {:<4} {:<34} {:>8} {:>7} {:>9} {:>7} {:>11}  fitted (physical range)",
+        "step", "effect added", "error", "x floor", "held-back", "x floor", "explained"
+    )?;
+    writeln!(
+        out,
+        "  {:<4} {:<34} {:>8} {:>6.1}x {:>9} {:>6.1}x {:>11}  noise floor {} (held-back {})",
+        0,
+        model_name(&r.start.effects, "paper's model", "", ","),
+        number(r.start.error),
+        r.start.ratio_to_floor,
+        number(r.start.heldback_error),
+        r.start.heldback_error / r.start.heldback_noise_floor,
+        "",
+        number(r.start.noise_floor),
+        number(r.start.heldback_noise_floor)
+    )?;
+    for (k, s) in r.ladder.iter().enumerate() {
+        let fitted: Vec<String> = s
+            .fitted
+            .iter()
+            .map(|(n, v)| {
+                format!(
+                    "{n} {} {} ({}..{})",
+                    sig(v.value),
+                    v.unit,
+                    sig(v.low),
+                    sig(v.high)
+                )
+            })
+            .collect();
+        writeln!(
+            out,
+            "  {:<4} {:<34} {:>8} {:>6.1}x {:>9} {:>6.1}x {:>4.0}% / {:>3.0}%  {}",
+            k + 1,
+            model_name(&s.added, "", "+ ", " + "),
+            number(s.error),
+            s.ratio_to_floor,
+            number(s.heldback_error),
+            s.heldback_ratio_to_floor,
+            100.0 * s.explained,
+            100.0 * s.heldback_explained,
+            fitted.join("; ")
+        )?;
+    }
+    writeln!(
+        out,
+        "  (explained: the share of the error beyond the noise floor the step removed, whole log / held-back windows)"
+    )?;
+    writeln!(out, "stopped: {}", r.stopped_because)?;
+    writeln!(out, "  the test: {}", r.test)?;
+    for t in &r.last_round {
+        let names: Vec<&str> = t.added.iter().map(|k| k.name()).collect();
+        writeln!(out, "  not kept: {}: {}", names.join("+"), t.because)?;
+    }
+    for s in &r.skipped {
+        writeln!(out, "  not fitted: {s}")?;
+    }
+    Ok(())
+}
+
+/// A value with four significant digits, in plain or scientific notation by its size.
+fn sig(x: f64) -> String {
+    monitor_analysis::effects::sig(x)
 }

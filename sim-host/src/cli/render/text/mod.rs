@@ -5,7 +5,7 @@
 mod analysis;
 mod diagnose;
 
-pub use analysis::{compare, explain};
+pub use analysis::{compare, explain, ladder};
 pub use diagnose::diagnose;
 
 use super::json::Table1Report;
