@@ -26,6 +26,20 @@
 //! host's isolation found no steady operating point). [`PwmFilter`] takes it out: two
 //! one-pole low-passes on the six channels alike, the fundamental's gain restored, the
 //! encoder held back by the filters' delay.
+//!
+//! **The latency budget.** The sample task copies each DMA half out of the ring after the
+//! half-transfer (or transfer-complete) interrupt, through the DMA interrupt and the
+//! interrupt executor; the DMA writes into that half again [`SAMPLES_PER_HALF`] sample
+//! periods after it completed it. Everything that can delay the copy is a term of
+//! [`worst_latency_cycles`], each at its worst, in CPU cycles of [`clock::HCLK_HZ`]: a log
+//! frame that masked interrupts just before the request ([`LOG_FRAME_CYCLES`], defmt-rtt
+//! holds a critical section for a whole frame, the status line being the longest), the
+//! interrupt's entry, the DMA handler, the other interrupts, the executor and the work on
+//! the half's samples. The ring's depth is the smallest that covers it
+//! ([`samples_per_half_for`]): at 10 kHz and 170 MHz one sample per half (17 000 cycles of
+//! slack) does not, two (34 000) do, with 28 350 cycles worst-case (167 us). The host's model
+//! (`tests/ring_latency.rs`) runs the sample path against that worst case for a simulated
+//! hour and counts no lap.
 
 use crate::clock;
 
@@ -33,14 +47,104 @@ use crate::clock;
 pub const CHANNELS: usize = 3;
 /// Sequences (triggers) averaged into one sample (module docs).
 pub const OVERSAMPLING: usize = 8;
-/// Samples per DMA half buffer: 1, so every sample wakes the sample task as it arrives
-/// and the encoder is read within microseconds of the conversions.
-pub const SAMPLES_PER_HALF: usize = 1;
-/// 16-bit words in one DMA half buffer (one sample's sequences).
-pub const HALF_LEN: usize = SAMPLES_PER_HALF * OVERSAMPLING * CHANNELS;
+/// 16-bit words of one sample's sequences ([`OVERSAMPLING`] x [`CHANNELS`], 24): the unit
+/// [`sum_half`] and [`average_half`] take. (The name is older than the deeper ring: a DMA
+/// half now holds [`SAMPLES_PER_HALF`] of them, [`DMA_HALF_LEN`] words.)
+pub const HALF_LEN: usize = OVERSAMPLING * CHANNELS;
+/// Samples per DMA half buffer, chosen from the latency budget
+/// ([`samples_per_half_for`] at [`BUDGET_SAMPLE_RATE_HZ`]; module docs, "The latency
+/// budget"): 2 at 10 kHz and 170 MHz.
+pub const SAMPLES_PER_HALF: usize = samples_per_half_for(BUDGET_SAMPLE_RATE_HZ);
+/// 16-bit words in one DMA half buffer ([`SAMPLES_PER_HALF`] samples' sequences).
+pub const DMA_HALF_LEN: usize = SAMPLES_PER_HALF * HALF_LEN;
 /// The DMA ring's length per ADC in 16-bit words (two halves), which is also the
 /// channel's `CNDTR` at the start of a turn.
-pub const RING_LEN: usize = 2 * HALF_LEN;
+pub const RING_LEN: usize = 2 * DMA_HALF_LEN;
+
+/// The sample rate the ring is sized for [Hz] (the firmware's `SETTINGS`, checked there at
+/// compile time with [`ring_fits`]).
+pub const BUDGET_SAMPLE_RATE_HZ: u32 = 10_000;
+/// The longest `defmt` frame's instructions, with interrupts masked (defmt-rtt holds a
+/// critical section for a whole frame): the status line, the firmware's longest frame,
+/// measured under QEMU by `cargo qemu-rtt` (`flood_max_late_instructions=8960`: a status
+/// line and the sample's work), rounded up.
+pub const LOG_FRAME_INSTRUCTIONS: u32 = 9_000;
+/// CPU cycles per instruction on the worst path, x 10 (an assumption, not measured: the
+/// G474 at 170 MHz runs the flash with 4 wait states behind the ART cache; loads, taken
+/// branches and cache misses put a frame of 9 000 instructions at 60-110 us): 2.1.
+pub const WORST_CYCLES_PER_INSTRUCTION_X10: u32 = 21;
+/// The Cortex-M4F's interrupt entry with the FPU's lazy stacking and flash wait states
+/// [cycles] (12 cycles from the architecture, more than doubled).
+pub const INTERRUPT_ENTRY_CYCLES: u32 = 30;
+/// One DMA channel's half/full-transfer interrupt: the firmware's check of `TEIF`, then
+/// embassy's handler waking the ring's reader [cycles] (about 150 instructions, x 2.1,
+/// rounded up).
+pub const DMA_HANDLER_CYCLES: u32 = 400;
+/// Other interrupts that may run first at the same or a higher priority: the other ADC's
+/// DMA channel, embassy-time's alarm (TIM15) and the button's EXTI [cycles].
+pub const OTHER_INTERRUPTS_CYCLES: u32 = 1_500;
+/// The interrupt executor from the pended `UART4` to the sample task's code after its
+/// awaits: the poll, the `with_timeout` future and its timer queue entry [cycles].
+pub const EXECUTOR_CYCLES: u32 = 2_000;
+/// One sample's work at its worst [instructions] (`cargo qemu-core`: the sampling path's
+/// 222, the core's fast path 211 and, on every 25th sample, its slow path's 781), plus
+/// copying its 2 x 24 words out of the rings (about 100).
+pub const SAMPLE_WORK_INSTRUCTIONS: u32 = 222 + 211 + 781 + 100;
+
+/// `instructions` at [`WORST_CYCLES_PER_INSTRUCTION_X10`] [cycles], rounded up.
+pub const fn worst_cycles(instructions: u32) -> u32 {
+    (instructions * WORST_CYCLES_PER_INSTRUCTION_X10).div_ceil(10)
+}
+
+/// The longest critical section a log frame may hold [CPU cycles]: 18 900 (111 us at
+/// 170 MHz).
+pub const LOG_FRAME_CYCLES: u32 = worst_cycles(LOG_FRAME_INSTRUCTIONS);
+
+/// The worst-case sample-path latency [CPU cycles] with `samples_per_half` samples per DMA
+/// half: from the half-transfer interrupt's request to the half copied out and its samples
+/// processed, the worst case of every term at once (a log frame that masked interrupts
+/// just before the request, the interrupt, the other interrupts, the executor, the work).
+pub const fn worst_latency_cycles(samples_per_half: u32) -> u32 {
+    LOG_FRAME_CYCLES
+        + INTERRUPT_ENTRY_CYCLES
+        + DMA_HANDLER_CYCLES
+        + OTHER_INTERRUPTS_CYCLES
+        + EXECUTOR_CYCLES
+        + samples_per_half * worst_cycles(SAMPLE_WORK_INSTRUCTIONS)
+}
+
+/// One sample period [CPU cycles] at `sample_rate_hz` (17 000 at 10 kHz; 0 for 0 Hz).
+pub const fn sample_period_cycles(sample_rate_hz: u32) -> u32 {
+    if sample_rate_hz == 0 {
+        0
+    } else {
+        clock::HCLK_HZ / sample_rate_hz
+    }
+}
+
+/// Whether a ring of two halves of `samples_per_half` samples tolerates the worst-case
+/// latency at `sample_rate_hz`: the DMA writes into a half again `samples_per_half`
+/// periods after it completed it, so the half must be read, and its samples processed,
+/// within that time.
+pub const fn ring_fits(sample_rate_hz: u32, samples_per_half: u32) -> bool {
+    samples_per_half > 0
+        && worst_latency_cycles(samples_per_half)
+            <= samples_per_half * sample_period_cycles(sample_rate_hz)
+}
+
+/// The smallest number of samples per DMA half (1..=8) that tolerates the worst-case
+/// latency at `sample_rate_hz` ([`ring_fits`]); 8 when none does (the firmware's
+/// compile-time check then fails).
+pub const fn samples_per_half_for(sample_rate_hz: u32) -> usize {
+    let mut k = 1;
+    while k < 8 {
+        if ring_fits(sample_rate_hz, k) {
+            return k as usize;
+        }
+        k += 1;
+    }
+    8
+}
 
 /// The regular channels' sampling time in ADC clock cycles, times 2 (`SMPx` = 24.5
 /// cycles; halves are how RM0440 counts them): the front end drives each pin through
@@ -113,6 +217,20 @@ pub fn sum_half(half: &[u16]) -> ([u32; CHANNELS], u32) {
         c += u32::from(z);
     }
     ([a, b, c], sequences.len() as u32)
+}
+
+/// The encoder counts of one DMA half's [`SAMPLES_PER_HALF`] samples when the counter is
+/// read once per half, after it (`now`), the previous read being `previous`: spread evenly
+/// between the two (the shortest way round the 16-bit counter), the last sample's count
+/// `now`. The count a sample gets is then off by the reads' latency (at most about one
+/// sample of rotation), as with one sample per half.
+pub fn spread_counts(previous: u16, now: u16) -> [u16; SAMPLES_PER_HALF] {
+    let step = i32::from(now.wrapping_sub(previous) as i16);
+    let n = SAMPLES_PER_HALF as i32;
+    core::array::from_fn(|k| {
+        let part = step * (k as i32 + 1) / n;
+        previous.wrapping_add(part as u16)
+    })
 }
 
 /// Fractional bits of [`PwmFilter`]'s states.
@@ -260,13 +378,41 @@ mod tests {
 
     #[test]
     fn the_geometry_fits_the_period() {
-        assert_eq!(RING_LEN, 48);
+        assert_eq!(RING_LEN, 96);
+        assert_eq!(HALF_LEN, 24);
         assert_eq!(conversion_ns(), 870);
         assert!(sequence_ns() < 12_500);
         assert_eq!(trigger_rate_hz(10_000), 80_000);
         assert!(fits(10_000));
         // 20 kHz: 6.25 us between triggers, less than a sequence held up by VREFINT.
         assert!(!fits(20_000));
+    }
+
+    /// The ring's depth from the budget, against the sums by hand: one sample's work is
+    /// 1 314 instructions, 2 760 cycles at 2.1; the frame 18 900; with 30 + 400 + 1 500 +
+    /// 2 000 the worst case is 25 590 cycles for one sample per half (more than its 17 000
+    /// cycles of slack) and 28 350 for two (under 34 000).
+    #[test]
+    fn the_ring_depth_follows_from_the_latency_budget() {
+        assert_eq!(sample_period_cycles(10_000), 17_000);
+        assert_eq!(LOG_FRAME_CYCLES, 18_900);
+        assert_eq!(worst_latency_cycles(1), 25_590);
+        assert_eq!(worst_latency_cycles(2), 28_350);
+        assert!(!ring_fits(10_000, 1));
+        assert!(ring_fits(10_000, 2));
+        assert_eq!(SAMPLES_PER_HALF, 2);
+        assert_eq!(DMA_HALF_LEN, 48);
+        // A slower rate needs no deeper ring; a faster one a deeper one.
+        assert_eq!(samples_per_half_for(5_000), 1);
+        assert!(samples_per_half_for(20_000) > 2);
+    }
+
+    #[test]
+    fn the_counts_of_a_half_are_spread_between_the_reads() {
+        assert_eq!(spread_counts(100, 140), [120, 140]);
+        // Across the counter's wrap, backwards too.
+        assert_eq!(spread_counts(65_530, 10), [2, 10]);
+        assert_eq!(spread_counts(10, 65_530), [2, 65_530]);
     }
 
     #[test]

@@ -8,7 +8,7 @@
 use core::sync::atomic::Ordering;
 
 use defmt::{error, info, warn};
-use drive_monitor::acquisition::{self as geometry, HALF_LEN, RING_LEN};
+use drive_monitor::acquisition::{self as geometry, DMA_HALF_LEN, HALF_LEN, RING_LEN};
 use drive_monitor::app::SamplePath;
 use drive_monitor::board::{self, CurrentCode, VoltageCode};
 use drive_monitor::liveness::AdcWait;
@@ -90,6 +90,10 @@ fn start_encoder(
 /// 5 pF and R_ADC 1 kohm, is about 11 kohm at 24.5 cycles.
 const SAMPLE_TIME: SampleTime = SampleTime::CYCLES24_5;
 const _: () = assert!(geometry::SAMPLE_TIME_HALF_CYCLES == 49);
+const _: () = assert!(
+    geometry::ring_fits(SETTINGS.sample_rate_hz, geometry::SAMPLES_PER_HALF as u32),
+    "the DMA ring does not cover the worst-case latency at the sample rate"
+);
 const _: () = assert!(
     geometry::fits(SETTINGS.sample_rate_hz),
     "the oversampled acquisition does not fit the sample rate"
@@ -175,20 +179,20 @@ fn start_acquisition(
 }
 
 /// Runs the sample path on the readings of one DMA half (`v` from ADC1, `i` from ADC2:
-/// [`geometry::OVERSAMPLING`] sequences per sample, summed and filtered by `filter`,
-/// `geometry::PwmFilter`: the inverter's in-band ripple out, the encoder count held back
-/// with it) with the encoder count read after them; hands thread mode a status every
-/// `status_every` samples. `max_cycles`: the longest oversampling, filter and `on_frame`
-/// so far, in CPU cycles.
+/// [`geometry::SAMPLES_PER_HALF`] samples of [`geometry::OVERSAMPLING`] sequences, each
+/// sample summed and filtered by `filter`, `geometry::PwmFilter`: the inverter's in-band
+/// ripple out, the encoder count held back with it) with the encoder counts of its samples
+/// (`counts`); hands thread mode a status every `status_every` samples. `max_cycles`: the
+/// longest oversampling, filter and `on_frame` of one sample so far, in CPU cycles.
 fn process_half(
     path: &mut SamplePath,
     filter: &mut geometry::PwmFilter,
     (v, i): (&[u16], &[u16]),
-    encoder_count: u16,
+    counts: [u16; geometry::SAMPLES_PER_HALF],
     max_cycles: &mut u32,
 ) {
-    let per_sample = HALF_LEN / geometry::SAMPLES_PER_HALF;
-    for (v, i) in v.chunks_exact(per_sample).zip(i.chunks_exact(per_sample)) {
+    let samples = v.chunks_exact(HALF_LEN).zip(i.chunks_exact(HALF_LEN));
+    for ((v, i), encoder_count) in samples.zip(counts) {
         let t0 = cortex_m::peripheral::DWT::cycle_count();
         let ((vs, n), (is, _)) = (geometry::sum_half(v), geometry::sum_half(i));
         let ([va, vb, vc], [ia, ib, ic], encoder_count) = filter.step(vs, is, n, encoder_count);
@@ -214,7 +218,8 @@ fn process_half(
     }
 }
 
-/// The sample task: sets up the acquisition, then per DMA half (one sample) waits for both
+/// The sample task: sets up the acquisition, then per DMA half (`SAMPLES_PER_HALF`
+/// samples, the ring's depth from the latency budget) waits for both
 /// ADCs' data, bounded by [`AdcWait`]'s timeout; recovers the acquisition when no data came
 /// or the DMA lapped the reader, else applies thread mode's commands and runs the sample
 /// path on the half.
@@ -224,8 +229,9 @@ pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
     let (qei, mut acq) = set_up_acquisition(hw, &mut path);
     let mut wait = AdcWait::new(SETTINGS.sample_rate_hz);
     let timeout = Duration::from_micros(u64::from(wait.timeout_us()));
-    let mut half1 = [0u16; HALF_LEN];
-    let mut half2 = [0u16; HALF_LEN];
+    let mut half1 = [0u16; DMA_HALF_LEN];
+    let mut half2 = [0u16; DMA_HALF_LEN];
+    let mut last_count = qei.count();
     let mut max_cycles: u32 = 0;
     let mut counts = RecoveryCounts::default();
     loop {
@@ -237,11 +243,15 @@ pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
         .await;
         if needs_recovery(read, &mut wait) {
             recover_acquisition(&mut acq, &mut path, &mut counts);
+            last_count = qei.count();
             continue;
         }
         apply_commands(&mut path);
         let halves = (&half1[..], &half2[..]);
-        process_half(&mut path, &mut filter, halves, qei.count(), &mut max_cycles);
+        let count = qei.count();
+        let counts = geometry::spread_counts(last_count, count);
+        last_count = count;
+        process_half(&mut path, &mut filter, halves, counts, &mut max_cycles);
     }
 }
 
