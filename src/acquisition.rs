@@ -115,10 +115,9 @@ pub const fn worst_latency_cycles(samples_per_half: u32) -> u32 {
 
 /// One sample period [CPU cycles] at `sample_rate_hz` (17 000 at 10 kHz; 0 for 0 Hz).
 pub const fn sample_period_cycles(sample_rate_hz: u32) -> u32 {
-    if sample_rate_hz == 0 {
-        0
-    } else {
-        clock::HCLK_HZ / sample_rate_hz
+    match clock::HCLK_HZ.checked_div(sample_rate_hz) {
+        Some(c) => c,
+        None => 0,
     }
 }
 

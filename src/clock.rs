@@ -27,8 +27,43 @@ pub const HCLK_HZ: u32 = SYSCLK_HZ;
 /// The timers' kernel clock [Hz] (APB1 and APB2 undivided): TIM1 (the sample trigger) and
 /// TIM4 (the encoder).
 pub const TIMER_HZ: u32 = SYSCLK_HZ;
-/// The ADC kernel clock's divider (`ADC12_CCR.PRESC`, with `ADC12SEL` = SYSCLK).
-pub const ADC_CLOCK_DIV: u32 = 4;
+/// The ADC kernel clock's divider (`ADC12_CCR.PRESC`, with `ADC12SEL` = SYSCLK): the
+/// smallest that keeps the ADC clock within [`ADC_CLOCK_MAX_HZ`], which is embassy's
+/// choice too; read back at the set-up ([`ADC_PRESC`]).
+pub const ADC_CLOCK_DIV: u32 = adc_clock_divider(SYSCLK_HZ);
+
+/// The smallest divider of `ADC12_CCR.PRESC` that brings `kernel_hz` within
+/// [`ADC_CLOCK_MAX_HZ`] (256 when none does).
+pub const fn adc_clock_divider(kernel_hz: u32) -> u32 {
+    const DIVIDERS: [u32; 12] = [1, 2, 4, 6, 8, 10, 12, 16, 32, 64, 128, 256];
+    let mut rest: &[u32] = &DIVIDERS;
+    while let [div, tail @ ..] = rest {
+        if kernel_hz / *div <= ADC_CLOCK_MAX_HZ {
+            return *div;
+        }
+        rest = tail;
+    }
+    256
+}
+/// `ADC12_CCR.PRESC`'s encoding of [`ADC_CLOCK_DIV`] (RM0440: 0 /1, 1 /2, 2 /4, 3 /6, 4 /8,
+/// 5 /10, 6 /12, 7 /16, 8 /32, 9 /64, 10 /128, 11 /256; 0xFF for a divider it has not):
+/// embassy-stm32 0.6 picks the divider itself in `Adc::new`; the firmware reads the field
+/// back after the set-up (`adc_rules::create_pair`) and reports a difference.
+pub const ADC_PRESC: u32 = match ADC_CLOCK_DIV {
+    1 => 0,
+    2 => 1,
+    4 => 2,
+    6 => 3,
+    8 => 4,
+    10 => 5,
+    12 => 6,
+    16 => 7,
+    32 => 8,
+    64 => 9,
+    128 => 10,
+    256 => 11,
+    _ => 0xFF,
+};
 /// The ADC clock [Hz]: 42.5 MHz.
 pub const ADC_CLOCK_HZ: u32 = SYSCLK_HZ / ADC_CLOCK_DIV;
 
@@ -71,6 +106,7 @@ mod tests {
         assert_eq!(SYSCLK_HZ, 170_000_000);
         assert_eq!(CYCLES_PER_MS, 170_000);
         assert_eq!(ADC_CLOCK_HZ, 42_500_000);
+        assert_eq!(ADC_PRESC, 0b0010);
         assert_eq!(timer_divider(10_000), Some(17_000));
         assert_eq!(timer_divider(80_000), Some(2_125));
         assert_eq!(timer_divider(30_000), None);

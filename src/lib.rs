@@ -5,6 +5,8 @@
 //! - [`clock`]: the clock tree's settings and every rate and cycle count derived from them;
 //! - [`acquisition`]: the ADCs' geometry (channels, oversampling, DMA ring, conversion
 //!   time), shared with the host's model of the ADC and DMA, and the oversampling's mean;
+//! - [`adc_rules`]: the ADC's register rules the HAL does not keep (set-only bits, the
+//!   common prescaler, `DMAEN`, the first conversion after an idle, VREFINT's start-up);
 //! - [`fault_path`]: the end of a failed run (guard, record, panel; no log);
 //! - [`flash_ecc`]: the record pages' ECC double errors (the NMI's decision, the checked
 //!   reads that mark a page bad);
@@ -57,6 +59,7 @@
 )]
 
 pub mod acquisition;
+pub mod adc_rules;
 pub mod app;
 pub mod board;
 pub mod boot;

@@ -9,14 +9,16 @@
 
 use core::marker::PhantomData;
 
+use drive_monitor::adc_rules::AdcPairSetup;
 use drive_monitor::recovery::{AcqRegisters, AdcFlags, RegisterAcquisition};
 use embassy_stm32::adc::RingBufferedAdc;
+use embassy_stm32::adc::{Adc, AdcConfig};
 use embassy_stm32::dma;
 use embassy_stm32::interrupt::typelevel::Handler;
 use embassy_stm32::pac;
-use embassy_stm32::pac::adc::vals::{Adstp, Dmacfg, Dmaen};
-use embassy_stm32::peripherals;
+use embassy_stm32::pac::adc::vals::{Dmacfg, Dmaen};
 use embassy_stm32::timer::low_level::Timer as HwTimer;
+use embassy_stm32::{peripherals, Peri};
 use embassy_time::Instant;
 
 /// The two ADCs' registers, ADC1 (voltages) then ADC2 (currents).
@@ -66,6 +68,39 @@ pub(super) fn new_acquisition(
     }
 }
 
+/// The ADC pair's set-up (`adc_rules::create_pair`) on embassy's `Adc::new` and the
+/// registers: the peripherals go in, the two drivers come out.
+pub(super) struct HwPair {
+    pub(super) p1: Option<Peri<'static, peripherals::ADC1>>,
+    pub(super) p2: Option<Peri<'static, peripherals::ADC2>>,
+    pub(super) adc1: Option<Adc<'static, peripherals::ADC1>>,
+    pub(super) adc2: Option<Adc<'static, peripherals::ADC2>>,
+}
+
+impl AdcPairSetup for HwPair {
+    fn create(&mut self, i: usize) {
+        if i == 0 {
+            if let Some(p) = self.p1.take() {
+                self.adc1 = Some(Adc::new(p, AdcConfig::default()));
+            }
+        } else if let Some(p) = self.p2.take() {
+            self.adc2 = Some(Adc::new(p, AdcConfig::default()));
+        }
+    }
+
+    fn cr(&mut self, i: usize) -> u32 {
+        adc(i).cr().read().0
+    }
+
+    fn write_cr(&mut self, i: usize, value: u32) {
+        adc(i).cr().write_value(pac::adc::regs::Cr(value));
+    }
+
+    fn prescaler(&mut self) -> u32 {
+        u32::from(pac::ADC12_COMMON.ccr().read().presc().to_bits())
+    }
+}
+
 /// The first start: both rings and ADCs, then the trigger.
 pub(super) fn start(acq: &mut HwAcquisition) {
     acq.regs.adc1.start();
@@ -110,20 +145,14 @@ impl AcqRegisters for HwRegisters {
         });
     }
 
-    fn adc_started(&mut self, i: usize) -> bool {
-        adc(i).cr().read().adstart()
+    fn adc_cr(&mut self, i: usize) -> u32 {
+        adc(i).cr().read().0
     }
 
-    fn adc_disabling(&mut self, i: usize) -> bool {
-        adc(i).cr().read().addis()
-    }
-
-    fn adc_stop(&mut self, i: usize) {
-        adc(i).cr().modify(|w| w.set_adstp(Adstp::STOP));
-    }
-
-    fn adc_start(&mut self, i: usize) {
-        adc(i).cr().modify(|w| w.set_adstart(true));
+    fn adc_cr_write(&mut self, i: usize, value: u32) {
+        // The whole register as the sequence computed it (`adc_rules::cr_setting`: one
+        // set-only bit, the ordinary bits as read), not a read-modify-write.
+        adc(i).cr().write_value(pac::adc::regs::Cr(value));
     }
 
     fn adc_dma_circular(&mut self, i: usize) {

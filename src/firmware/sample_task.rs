@@ -9,15 +9,17 @@ use core::sync::atomic::Ordering;
 
 use defmt::{error, info, warn};
 use drive_monitor::acquisition::{self as geometry, DMA_HALF_LEN, HALF_LEN, RING_LEN};
+use drive_monitor::adc_rules::{self, IdleDiscard, PairError};
 use drive_monitor::app::SamplePath;
 use drive_monitor::board::{self, CurrentCode, VoltageCode};
+use drive_monitor::clock;
 use drive_monitor::liveness::AdcWait;
 use drive_monitor::motor_source::EncoderSetup;
 use drive_monitor::recovery::{self, RecoveryCounts, StepTimeout};
 use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
 use drive_monitor::sampling::RawFrame;
 use drive_monitor::setup_guard::SetupStep;
-use embassy_stm32::adc::{Adc, AdcChannel, AdcConfig, Exten, RingBufferedAdc, SampleTime};
+use embassy_stm32::adc::{Adc, AdcChannel, Exten, RingBufferedAdc, SampleTime};
 use embassy_stm32::gpio::Pull;
 use embassy_stm32::time::Hertz;
 use embassy_stm32::timer::low_level::{MasterMode, RoundTo, Timer as HwTimer};
@@ -157,7 +159,31 @@ fn start_acquisition(
     // Every step under the set-up deadline (`drive_monitor::setup_guard`): the HAL's waits
     // on ADCAL, ADRDY and ADSTART have no bound of their own.
     let guard = supply::SetupGuard::arm(hw.syst, SetupStep::Adc1);
-    let adc1 = Adc::new(hw.adc1, AdcConfig::default());
+    // Both drivers, the common prescaler written only with both ADCs disabled and read
+    // back (`drive_monitor::adc_rules::create_pair`).
+    let mut pair = acquisition::HwPair {
+        p1: Some(hw.adc1),
+        p2: Some(hw.adc2),
+        adc1: None,
+        adc2: None,
+    };
+    match adc_rules::create_pair(&mut pair) {
+        Ok(()) => {}
+        Err(PairError::NotDisabled) => error!("ADC1 did not disable before ADC2's set-up"),
+        Err(PairError::Prescaler(p)) => error!(
+            "ADC12_CCR.PRESC reads {=u32}, not {=u32}: the ADC clock is not {=u32} Hz, the conversion times are off",
+            p,
+            clock::ADC_PRESC,
+            clock::ADC_CLOCK_HZ
+        ),
+    }
+    let (Some(adc1), Some(adc2)) = (pair.adc1.take(), pair.adc2.take()) else {
+        // `create_pair` creates both, always.
+        #[allow(clippy::panic)]
+        {
+            panic!("ADC drivers not created")
+        }
+    };
     guard.step(SetupStep::Ring1);
     let adc1 = ring_voltages(adc1, hw.dma1, hw.v, ring1);
     // The ADC's reference: VDDA from VREFINT on ADC1's injected channel against the
@@ -166,8 +192,6 @@ fn start_acquisition(
     guard.step(SetupStep::Reference);
     supply::configure_reference();
     REFERENCE.signal(drive_monitor::supply::measure_now(&mut supply::HwReference));
-    guard.step(SetupStep::Adc2);
-    let adc2 = Adc::new(hw.adc2, AdcConfig::default());
     guard.step(SetupStep::Ring2);
     let adc2 = ring_currents(adc2, hw.dma2, hw.i, ring2);
     guard.step(SetupStep::Start);
@@ -189,10 +213,16 @@ fn process_half(
     filter: &mut geometry::PwmFilter,
     (v, i): (&[u16], &[u16]),
     counts: [u16; geometry::SAMPLES_PER_HALF],
+    discard: &mut IdleDiscard,
     max_cycles: &mut u32,
 ) {
     let samples = v.chunks_exact(HALF_LEN).zip(i.chunks_exact(HALF_LEN));
     for ((v, i), encoder_count) in samples.zip(counts) {
+        if discard.drop_next() {
+            // The first sample after a long idle (errata): dropped, its time skipped.
+            path.sampler_mut().skip();
+            continue;
+        }
         let t0 = cortex_m::peripheral::DWT::cycle_count();
         let ((vs, n), (is, _)) = (geometry::sum_half(v), geometry::sum_half(i));
         let ([va, vb, vc], [ia, ib, ic], encoder_count) = filter.step(vs, is, n, encoder_count);
@@ -232,6 +262,10 @@ pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
     let mut half1 = [0u16; DMA_HALF_LEN];
     let mut half2 = [0u16; DMA_HALF_LEN];
     let mut last_count = qei.count();
+    // The ADCs idled since their set-up: the first sample is dropped (errata).
+    let mut discard = IdleDiscard::default();
+    discard.on_start(u32::MAX);
+    let mut last_data_us = acq.regs.started_us;
     let mut max_cycles: u32 = 0;
     let mut counts = RecoveryCounts::default();
     loop {
@@ -244,6 +278,7 @@ pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
         if needs_recovery(read, &mut wait) {
             recover_acquisition(&mut acq, &mut path, &mut counts);
             last_count = qei.count();
+            discard.on_start(acq.regs.started_us.wrapping_sub(last_data_us));
             continue;
         }
         apply_commands(&mut path);
@@ -251,7 +286,15 @@ pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
         let count = qei.count();
         let counts = geometry::spread_counts(last_count, count);
         last_count = count;
-        process_half(&mut path, &mut filter, halves, counts, &mut max_cycles);
+        last_data_us = embassy_time::Instant::now().as_micros() as u32;
+        process_half(
+            &mut path,
+            &mut filter,
+            halves,
+            counts,
+            &mut discard,
+            &mut max_cycles,
+        );
     }
 }
 
