@@ -10,6 +10,10 @@
 //! prescaler of `ADC12_CCR`, 4, which embassy-stm32 0.6 picks to stay below the ADC's
 //! 60 MHz): 42.5 MHz.
 
+/// The longest the firmware waits for the crystal (HSE) to start before it falls back to
+/// the HSI [ms].
+pub const HSE_STARTUP_TIMEOUT_MS: u32 = 100;
+
 /// The HSI oscillator [Hz] (the PLL's source).
 pub const HSI_HZ: u32 = 16_000_000;
 /// The PLL's input divider `PLLM` (1..=16).

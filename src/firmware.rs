@@ -61,12 +61,12 @@ use drive_monitor::app::{
 };
 use drive_monitor::board::{self, pins::Board, Lamp, LAMP_COUNT};
 use drive_monitor::boot::{self, BootMachine};
-use drive_monitor::clock;
 use drive_monitor::commissioning::Action;
 use drive_monitor::offset_trim::TrimResult;
 use drive_monitor::panel::PanelLamps;
 use drive_monitor::reset_record::{BootPhase, PreviousRun, RESET_RECORD_LEN};
 use drive_monitor::supply::BorCheck;
+use drive_monitor::{clock, debug_halt, watchdog};
 use monitor_core::Isolation;
 
 use drive_monitor::flash_ecc::CheckedFlash;
@@ -213,14 +213,45 @@ fn clock_config() -> embassy_stm32::Config {
     config
 }
 
-/// The independent watchdog, started, and frozen while a debugger halts the core
-/// (`DBGMCU_APB1FZR1.DBG_IWDG_STOP`): stepping through the firmware does not reset it.
+/// The first thing `main` does, before the clock set-up (which waits for the crystal and
+/// the PLL): what a debugger's halt freezes (`drive_monitor::debug_halt::FROZEN`: TIM1, the
+/// sample trigger; TIM15, embassy-time's clock; the IWDG), then the independent watchdog
+/// started with the boot's timeout (`drive_monitor::watchdog::BOOT_SETTING`, 1 s, covering
+/// the boot's budget at the fastest LSI). On the registers, before embassy-stm32's `init`
+/// (`firmware/under_the_hal.rs` lists why); `start_watchdog` shortens it once the boot ran.
+fn start_boot_watchdog() {
+    let frozen = debug_halt::FROZEN;
+    pac::DBGMCU.apb2fzr().modify(|w| {
+        w.set_tim1(frozen.trigger);
+        w.set_tim15(frozen.time_base);
+    });
+    pac::DBGMCU
+        .apb1lfzr()
+        .modify(|w| w.set_iwdg(frozen.watchdog));
+    let setting = watchdog::BOOT_SETTING;
+    let iwdg = pac::IWDG;
+    // Start (the LSI with it), unlock PR/RLR, the boot's timeout, reload.
+    iwdg.kr().write(|w| w.set_key(pac::iwdg::vals::Key::START));
+    iwdg.kr().write(|w| w.set_key(pac::iwdg::vals::Key::ENABLE));
+    iwdg.pr()
+        .write(|w| w.set_pr(pac::iwdg::vals::Pr::from_bits(setting.pr)));
+    iwdg.rlr().write(|w| w.set_rl(setting.rlr));
+    // The new values reach the LSI domain within a few LSI periods (bounded: 48 us each).
+    let mut polls = 0u32;
+    while (iwdg.sr().read().pvu() || iwdg.sr().read().rvu()) && polls < 100_000 {
+        polls += 1;
+    }
+    iwdg.kr().write(|w| w.set_key(pac::iwdg::vals::Key::RESET));
+}
+
+/// The independent watchdog at its running timeout (`WATCHDOG_TIMEOUT_MS`, 500 ms): it
+/// runs since [`start_boot_watchdog`]; embassy's driver writes the shorter timeout.
 fn start_watchdog(
     iwdg: Peri<'static, peripherals::IWDG>,
 ) -> IndependentWatchdog<'static, peripherals::IWDG> {
-    pac::DBGMCU.apb1lfzr().modify(|w| w.set_iwdg(true));
     let mut wdg = IndependentWatchdog::new(iwdg, WATCHDOG_TIMEOUT_MS * 1000);
     wdg.unleash();
+    wdg.pet();
     wdg
 }
 
@@ -251,6 +282,7 @@ fn boot_board(
 /// thread mode's periods ([`Thread::run`]).
 #[embassy_executor::main]
 async fn main(_spawner: Spawner) {
+    start_boot_watchdog();
     let p = embassy_stm32::init(clock_config());
     info!("drive-monitor {} starting", env!("CARGO_PKG_VERSION"));
     let previous = logs::previous_run();

@@ -7,6 +7,9 @@
 //!   time), shared with the host's model of the ADC and DMA, and the oversampling's mean;
 //! - [`adc_rules`]: the ADC's register rules the HAL does not keep (set-only bits, the
 //!   common prescaler, `DMAEN`, the first conversion after an idle, VREFINT's start-up);
+//! - [`debug_halt`]: what a debugger's halt freezes (the trigger, the time base, the
+//!   watchdog);
+//! - [`watchdog`]: the watchdog started first, with a first timeout covering the boot;
 //! - [`fault_path`]: the end of a failed run (guard, record, panel; no log);
 //! - [`flash_ecc`]: the record pages' ECC double errors (the NMI's decision, the checked
 //!   reads that mark a page bad);
@@ -65,6 +68,7 @@ pub mod board;
 pub mod boot;
 pub mod clock;
 pub mod commissioning;
+pub mod debug_halt;
 pub mod fault_path;
 pub mod flash_ecc;
 pub mod flash_record;
@@ -78,3 +82,4 @@ pub mod reset_record;
 pub mod sampling;
 pub mod setup_guard;
 pub mod supply;
+pub mod watchdog;
