@@ -61,12 +61,13 @@ use drive_monitor::app::{
 };
 use drive_monitor::board::{self, pins::Board, Lamp, LAMP_COUNT};
 use drive_monitor::boot::{self, BootMachine};
+use drive_monitor::clock::{self, ClockSource};
 use drive_monitor::commissioning::Action;
 use drive_monitor::offset_trim::TrimResult;
 use drive_monitor::panel::PanelLamps;
 use drive_monitor::reset_record::{BootPhase, PreviousRun, RESET_RECORD_LEN};
 use drive_monitor::supply::BorCheck;
-use drive_monitor::{clock, debug_halt, watchdog};
+use drive_monitor::{debug_halt, watchdog};
 use monitor_core::Isolation;
 
 use drive_monitor::flash_ecc::CheckedFlash;
@@ -192,15 +193,45 @@ impl PanelPins {
     }
 }
 
-fn clock_config() -> embassy_stm32::Config {
+/// Starts the board's 24 MHz crystal (HSE) on the registers and waits for it at most
+/// `clock::HSE_STARTUP_TIMEOUT_MS` (the core runs on the 16 MHz HSI after reset: 16 000
+/// cycles a millisecond): embassy-stm32's clock set-up waits for `HSERDY` without a bound,
+/// so it is handed the crystal only once it runs. A crystal that did not start is
+/// switched off again and the clock falls back to the HSI (`ClockSource::Hsi`).
+fn start_crystal() -> ClockSource {
+    pac::RCC.cr().modify(|w| w.set_hseon(true));
+    for _ in 0..clock::HSE_STARTUP_TIMEOUT_MS {
+        if pac::RCC.cr().read().hserdy() {
+            return ClockSource::Hse;
+        }
+        cortex_m::asm::delay(clock::HSI_HZ / 1_000);
+    }
+    if pac::RCC.cr().read().hserdy() {
+        return ClockSource::Hse;
+    }
+    pac::RCC.cr().modify(|w| w.set_hseon(false));
+    ClockSource::Hsi
+}
+
+fn clock_config(source: ClockSource) -> embassy_stm32::Config {
     use embassy_stm32::rcc::*;
     let mut config = embassy_stm32::Config::default();
-    // 16 MHz HSI / 4 * 85 / 2 = 170 MHz SYSCLK (the G474's maximum, needs boost mode):
-    // the settings of `drive_monitor::clock`, from which every rate and cycle count is
-    // derived (the registers' encodings: PLLM - 1, PLLN, PLLR / 2 - 1).
+    // 24 MHz HSE / 6 (or 16 MHz HSI / 4) * 85 / 2 = 170 MHz SYSCLK (the G474's maximum,
+    // needs boost mode): the settings of `drive_monitor::clock`, from which every rate and
+    // cycle count is derived (the registers' encodings: PLLM - 1, PLLN, PLLR / 2 - 1).
+    let pll_source = match source {
+        ClockSource::Hse => {
+            config.rcc.hse = Some(Hse {
+                freq: embassy_stm32::time::Hertz(clock::HSE_HZ),
+                mode: HseMode::Oscillator,
+            });
+            PllSource::HSE
+        }
+        ClockSource::Hsi => PllSource::HSI,
+    };
     config.rcc.pll = Some(Pll {
-        source: PllSource::HSI,
-        prediv: PllPreDiv::from_bits((clock::PLL_PREDIV - 1) as u8),
+        source: pll_source,
+        prediv: PllPreDiv::from_bits((source.prediv() - 1) as u8),
         mul: PllMul::from_bits(clock::PLL_MUL as u8),
         divp: None,
         divq: None,
@@ -283,8 +314,10 @@ fn boot_board(
 #[embassy_executor::main]
 async fn main(_spawner: Spawner) {
     start_boot_watchdog();
-    let p = embassy_stm32::init(clock_config());
+    let source = start_crystal();
+    let p = embassy_stm32::init(clock_config(source));
     info!("drive-monitor {} starting", env!("CARGO_PKG_VERSION"));
+    logs::log_clock(source);
     let previous = logs::previous_run();
     // The brown-out level of the option bytes: reported, not written (`drive_monitor::supply`).
     let bor = supply::bor_check();
@@ -307,6 +340,7 @@ async fn main(_spawner: Spawner) {
     let mut button = ExtiInput::new(b.button, b.button_exti, Pull::Down, Irqs);
 
     let (machine, path, mut supervisor) = boot_board(&mut thread.flash, previous);
+    supervisor.set_clock_fallback(source == ClockSource::Hsi);
     let boot = Instant::now();
     let hw = SampleHw {
         adc1: b.adc1,
