@@ -66,7 +66,7 @@ use drive_monitor::commissioning::Action;
 use drive_monitor::offset_trim::TrimResult;
 use drive_monitor::panel::PanelLamps;
 use drive_monitor::reset_record::{BootPhase, PreviousRun, RESET_RECORD_LEN};
-use drive_monitor::supply::BorCheck;
+use drive_monitor::supply::{BorCheck, BorGate};
 use drive_monitor::{debug_halt, watchdog};
 use monitor_core::Isolation;
 
@@ -329,9 +329,12 @@ async fn main(_spawner: Spawner) {
     let dual_bank = dual_bank_flash();
     let mut thread = Thread {
         lamps: PanelPins::new(b.lamps),
-        flash: BoardFlash(CheckedFlash::new(Driver(
-            dual_bank.then(|| Flash::new_blocking(b.flash)),
-        ))),
+        flash: BorGate {
+            store: BoardFlash(CheckedFlash::new(Driver(
+                dual_bank.then(|| Flash::new_blocking(b.flash)),
+            ))),
+            bor,
+        },
         wdg,
         max_update_cycles: 0,
         log_div: 0,
@@ -339,7 +342,7 @@ async fn main(_spawner: Spawner) {
     };
     let mut button = ExtiInput::new(b.button, b.button_exti, Pull::Down, Irqs);
 
-    let (machine, path, mut supervisor) = boot_board(&mut thread.flash, previous);
+    let (machine, path, mut supervisor) = boot_board(&mut thread.flash.store, previous);
     supervisor.set_clock_fallback(source == ClockSource::Hsi);
     let boot = Instant::now();
     let hw = SampleHw {
@@ -406,7 +409,8 @@ fn spawn_sample_task(hw: SampleHw, path: SamplePath) {
 /// the log's state.
 struct Thread {
     lamps: PanelPins,
-    flash: BoardFlash,
+    /// The record pages, erases and writes refused below the brown-out goal.
+    flash: BorGate<BoardFlash>,
     wdg: IndependentWatchdog<'static, peripherals::IWDG>,
     /// The sample task's longest `Monitor::update` so far, in CPU cycles (from its status).
     max_update_cycles: u32,

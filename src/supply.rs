@@ -13,6 +13,8 @@
 //! on the log and on every status line (`bor=`) which level is in force, and puts the
 //! level into every reset record it writes, and warns at every boot while it is below the
 //! goal; `cargo fw bor` programs level 4 once per board (`docs/firmware.md`, bring-up).
+//! Until it is in force, the flash records are refused ([`BorGate`]): a sag during a
+//! commissioning's erase or write would tear the record at level 0.
 //!
 //! **Reference.** Every reading scales with VDDA, the ADC's reference. Thread mode measures
 //! it through VREFINT every [`REFERENCE_PERIOD_MS`] ([`ReferenceWatch`]) on ADC1's injected
@@ -112,9 +114,57 @@ impl BorCheck {
         }
     }
 
+    /// Whether the flash records may be erased and written: only at [`BOR_GOAL`]. Below it
+    /// a supply sag during an erase or a write (the commissioning's, a few ms each) would
+    /// tear the record instead of resetting the MCU first ([`BorGate`]).
+    pub fn allows_flash_writes(self) -> bool {
+        matches!(self, BorCheck::AtGoal(_))
+    }
+
     /// The status line's `bor=` value: the level's number, or 255 for a reserved value.
     pub fn status_number(self) -> u8 {
         self.level().map_or(u8::MAX, BorLevel::number)
+    }
+}
+
+/// A store error that says the brown-out level refused the erase or the write
+/// ([`BorGate`]).
+pub trait FromBorRefusal {
+    /// The error for a write refused at the brown-out level `check`.
+    fn bor_refused(check: BorCheck) -> Self;
+}
+
+/// A record store whose erases and writes are refused while the brown-out level is below
+/// [`BOR_GOAL`] ([`BorCheck::allows_flash_writes`]): the commissioning then ends "not
+/// stored", and the boot report says why (`cargo fw bor` programs the level once per
+/// board). Reads pass.
+#[derive(Debug)]
+pub struct BorGate<S> {
+    /// The store.
+    pub store: S,
+    /// The brown-out level found at boot.
+    pub bor: BorCheck,
+}
+
+impl<S: crate::flash_record::RecordStore> crate::flash_record::RecordStore for BorGate<S>
+where
+    S::Error: FromBorRefusal,
+{
+    type Error = S::Error;
+    fn read(&mut self, buf: &mut [u8; crate::flash_record::RECORD_LEN]) -> Result<(), S::Error> {
+        self.store.read(buf)
+    }
+    fn erase(&mut self) -> Result<(), S::Error> {
+        if !self.bor.allows_flash_writes() {
+            return Err(S::Error::bor_refused(self.bor));
+        }
+        self.store.erase()
+    }
+    fn write(&mut self, bytes: &[u8; crate::flash_record::RECORD_LEN]) -> Result<(), S::Error> {
+        if !self.bor.allows_flash_writes() {
+            return Err(S::Error::bor_refused(self.bor));
+        }
+        self.store.write(bytes)
     }
 }
 

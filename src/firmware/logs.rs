@@ -31,14 +31,14 @@ pub(super) fn log_bor(check: BorCheck) {
             l.falling_v()
         ),
         BorCheck::BelowGoal(l) => warn!(
-            "brown-out reset level {=u8} (about {=f32} V) is below level {=u8} ({=f32} V): the MCU runs on at a supply far below 3.3 V; program it once for this board: cargo fw bor (docs/firmware.md, bring-up)",
+            "brown-out reset level {=u8} (about {=f32} V) is below level {=u8} ({=f32} V): the MCU runs on at a supply far below 3.3 V, and flash records are refused (a sag during an erase or a write would tear them); program it once for this board: cargo fw bor (docs/firmware.md, bring-up)",
             l.number(),
             l.falling_v(),
             BOR_GOAL.number(),
             BOR_GOAL.falling_v()
         ),
         BorCheck::Reserved(v) => warn!(
-            "brown-out reset level: FLASH_OPTR.BOR_LEV holds the reserved value {=u8}",
+            "brown-out reset level: FLASH_OPTR.BOR_LEV holds the reserved value {=u8}; flash records are refused",
             v
         ),
     }
