@@ -74,6 +74,11 @@ use drive_monitor::flash_ecc::CheckedFlash;
 use flash::{read_motor_page, BoardFlash, Driver};
 use sample_task::{sample_task, SampleHw};
 
+// Every defmt frame carries the time since boot in microseconds (embassy-time's clock; what
+// embassy-time's `defmt-timestamp-uptime` feature defines, written here so the build's
+// features stay as they are). Frames logged before `init` would read 0; none are.
+defmt::timestamp!("{=u64:us}", embassy_time::Instant::now().as_micros());
+
 bind_interrupts!(struct Irqs {
     DMA1_CHANNEL1 => acquisition::AdcDmaInterrupt<peripherals::DMA1_CH1, 0>;
     DMA1_CHANNEL2 => acquisition::AdcDmaInterrupt<peripherals::DMA1_CH2, 1>;

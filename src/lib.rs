@@ -9,6 +9,8 @@
 //!   common prescaler, `DMAEN`, the first conversion after an idle, VREFINT's start-up);
 //! - [`debug_halt`]: what a debugger's halt freezes (the trigger, the time base, the
 //!   watchdog);
+//! - [`under_the_hal`]: where the firmware writes registers under embassy-stm32, why, and
+//!   the HAL version that was checked;
 //! - [`watchdog`]: the watchdog started first, with a first timeout covering the boot;
 //! - [`fault_path`]: the end of a failed run (guard, record, panel; no log);
 //! - [`flash_ecc`]: the record pages' ECC double errors (the NMI's decision, the checked
@@ -82,4 +84,5 @@ pub mod reset_record;
 pub mod sampling;
 pub mod setup_guard;
 pub mod supply;
+pub mod under_the_hal;
 pub mod watchdog;

@@ -40,3 +40,17 @@ fn the_crystal_is_started_with_a_bound_before_init_and_the_hsi_is_the_fallback()
         assert!(config.contains(needle), "clock_config lacks {needle}");
     }
 }
+
+/// Every defmt frame has a timestamp (the time since boot in us, embassy-time's clock).
+#[test]
+fn the_log_has_timestamps() {
+    let src = firmware("src/firmware.rs");
+    let line = src
+        .lines()
+        .find(|l| l.starts_with("defmt::timestamp!("))
+        .expect("a defmt timestamp in src/firmware.rs");
+    assert!(
+        line.contains("{=u64:us}") && line.contains("Instant::now()"),
+        "{line}"
+    );
+}
