@@ -61,6 +61,32 @@ pub const DMA_HALF_LEN: usize = SAMPLES_PER_HALF * HALF_LEN;
 /// channel's `CNDTR` at the start of a turn.
 pub const RING_LEN: usize = 2 * DMA_HALF_LEN;
 
+/// The encoder latch's ring length in counts: TIM1's trigger makes the encoder timer
+/// capture its count (TIM4 channel 3 on `TRC`, the trigger's `TRGO`) and the capture's DMA
+/// request copies it into a ring of its own, one count per sequence, the same two halves
+/// as the ADCs' rings (32).
+pub const LATCH_LEN: usize = RING_LEN / CHANNELS;
+/// Counts in one half of the latch's ring (16).
+pub const LATCH_HALF_LEN: usize = LATCH_LEN / 2;
+
+/// One sample's encoder count from the counts latched at its [`OVERSAMPLING`] triggers
+/// (`latched`, oldest first): their mean, the shortest way round the 16-bit counter from
+/// the first, rounded; the instant of the readings' mean, as the oversampled sum is. An
+/// empty slice gives 0.
+#[inline]
+pub fn sample_count(latched: &[u16]) -> u16 {
+    let Some(&first) = latched.first() else {
+        return 0;
+    };
+    let n = latched.len() as i32;
+    let sum: i32 = latched
+        .iter()
+        .map(|&c| i32::from(c.wrapping_sub(first) as i16))
+        .sum();
+    let mean = (2 * sum + n).div_euclid(2 * n);
+    first.wrapping_add(mean as u16)
+}
+
 /// The sample rate the ring is sized for [Hz] (the firmware's `SETTINGS`, checked there at
 /// compile time with [`ring_fits`]).
 pub const BUDGET_SAMPLE_RATE_HZ: u32 = 10_000;
@@ -218,20 +244,6 @@ pub fn sum_half(half: &[u16]) -> ([u32; CHANNELS], u32) {
         c += u32::from(z);
     }
     ([a, b, c], sequences.len() as u32)
-}
-
-/// The encoder counts of one DMA half's [`SAMPLES_PER_HALF`] samples when the counter is
-/// read once per half, after it (`now`), the previous read being `previous`: spread evenly
-/// between the two (the shortest way round the 16-bit counter), the last sample's count
-/// `now`. The count a sample gets is then off by the reads' latency (at most about one
-/// sample of rotation), as with one sample per half.
-pub fn spread_counts(previous: u16, now: u16) -> [u16; SAMPLES_PER_HALF] {
-    let step = i32::from(now.wrapping_sub(previous) as i16);
-    let n = SAMPLES_PER_HALF as i32;
-    core::array::from_fn(|k| {
-        let part = step * (k as i32 + 1) / n;
-        previous.wrapping_add(part as u16)
-    })
 }
 
 /// Fractional bits of [`PwmFilter`]'s states.
@@ -408,12 +420,18 @@ mod tests {
         assert!(samples_per_half_for(20_000) > 2);
     }
 
+    /// A sample's count is the mean of its latched counts, across the counter's wrap and
+    /// backwards too.
     #[test]
-    fn the_counts_of_a_half_are_spread_between_the_reads() {
-        assert_eq!(spread_counts(100, 140), [120, 140]);
-        // Across the counter's wrap, backwards too.
-        assert_eq!(spread_counts(65_530, 10), [2, 10]);
-        assert_eq!(spread_counts(10, 65_530), [2, 65_530]);
+    fn a_samples_count_is_the_mean_of_its_latched_counts() {
+        assert_eq!(sample_count(&[100, 102, 104, 106, 108, 110, 112, 114]), 107);
+        assert_eq!(sample_count(&[65_534, 65_535, 0, 1]), 0);
+        assert_eq!(
+            sample_count(&[3, 2, 1, 0, 65_535, 65_534, 65_533, 65_532]),
+            0
+        );
+        assert_eq!(sample_count(&[7]), 7);
+        assert_eq!(sample_count(&[]), 0);
     }
 
     #[test]

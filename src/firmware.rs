@@ -6,8 +6,9 @@
 //!   ic) eight times per sample of [`SETTINGS`]; each ADC fills a DMA ring of two halves of
 //!   eight sequences (`drive_monitor::acquisition`), so every sample wakes the task
 //!   (half- and full-transfer interrupts). The task sums the sequences, runs
-//!   `acquisition::PwmFilter` (an inverter's in-band ripple out), reads the encoder counter
-//!   (TIM4) and runs `SamplePath::on_frame` (scaling and `Monitor::update`). Every wait for
+//!   `acquisition::PwmFilter` (an inverter's in-band ripple out), takes the encoder counts
+//!   TIM4 latched at the same triggers (its capture on TIM1's TRGO, copied by DMA1 channel 3
+//!   into a ring beside the ADCs') and runs `SamplePath::on_frame` (scaling and `Monitor::update`). Every wait for
 //!   ADC data has a timeout (`drive_monitor::liveness::AdcWait`): when it expires (an ADC
 //!   overrun, a DMA transfer error, a stopped trigger) or the DMA lapped the reader, the
 //!   acquisition is recovered by `drive_monitor::recovery::recover` on the registers
@@ -82,6 +83,7 @@ defmt::timestamp!("{=u64:us}", embassy_time::Instant::now().as_micros());
 bind_interrupts!(struct Irqs {
     DMA1_CHANNEL1 => acquisition::AdcDmaInterrupt<peripherals::DMA1_CH1, 0>;
     DMA1_CHANNEL2 => acquisition::AdcDmaInterrupt<peripherals::DMA1_CH2, 1>;
+    DMA1_CHANNEL3 => acquisition::AdcDmaInterrupt<peripherals::DMA1_CH3, 2>;
     EXTI15_10 => exti::InterruptHandler<interrupt::typelevel::EXTI15_10>;
 });
 
@@ -103,6 +105,15 @@ unsafe impl
     interrupt::typelevel::Binding<
         interrupt::typelevel::DMA1_CHANNEL2,
         dma::InterruptHandler<peripherals::DMA1_CH2>,
+    > for Irqs
+{
+}
+// SAFETY: as above, for channel 3 (the encoder latch's ring).
+#[allow(unsafe_code)]
+unsafe impl
+    interrupt::typelevel::Binding<
+        interrupt::typelevel::DMA1_CHANNEL3,
+        dma::InterruptHandler<peripherals::DMA1_CH3>,
     > for Irqs
 {
 }
@@ -355,6 +366,7 @@ async fn main(_spawner: Spawner) {
         adc2: b.adc2,
         dma1: b.adc1_dma,
         dma2: b.adc2_dma,
+        dma3: b.encoder_dma,
         tim1: b.trigger_timer,
         v: b.voltage,
         i: b.current,

@@ -21,9 +21,9 @@
 //! |---|---|---|
 //! | [`RecoveryStep::StopTrigger`] | TIM1 counter off | no new conversion starts |
 //! | [`RecoveryStep::StopAdc`] | `ADSTP` (written alone: `adc_rules::cr_setting`), then wait for `ADSTART = 0` and `JADSTART = 0` (bounded) | a conversion in flight ends before the DMA stops (else it would set `OVR` itself); `DMAEN` may change only with no regular and no injected conversion ongoing |
-//! | [`RecoveryStep::PauseDma`] | `DMAEN = 0` in `ADC_CFGR`, then the channel's `EN = 0` and a wait for it (bounded) | the ADC withdraws its DMA request (a request latched while the channel was off, after a transfer error, would otherwise move one stale word at the re-arm and shift the channels in the ring for good); `CNDTR` may only be written with the channel off |
+//! | [`RecoveryStep::PauseDma`] | `DMAEN = 0` in `ADC_CFGR`, then the channels' `EN = 0` (the encoder latch's too) and a wait for them (bounded) | the ADC withdraws its DMA request (a request latched while the channel was off, after a transfer error, would otherwise move one stale word at the re-arm and shift the channels in the ring for good); `CNDTR` may only be written with the channel off |
 //! | [`RecoveryStep::ClearFlags`] | `OVR`, `EOC`, `EOS` (write 1), `TEIF`/`HTIF`/`TCIF` (`DMA_IFCR`) | a latched `OVR` blocks the DMA requests; an `EOC` left set (the data register unread since the overrun) sets `OVR` again at the next conversion |
-//! | [`RecoveryStep::RearmDma`] | `CNDTR` = ring length, ring indices reset, `DMAEN`/`DMACFG` circular, `EN = 1` | the DMA is ready before the ADC asks |
+//! | [`RecoveryStep::RearmDma`] | `CNDTR` = ring length, ring indices reset (the encoder latch's ring too), `DMAEN`/`DMACFG` circular, `EN = 1` | the DMA is ready before the ADC asks |
 //! | [`RecoveryStep::StartAdc`] | `ADSTART = 1`, written alone (waits for the next trigger) | both ADCs armed before the trigger |
 //! | [`RecoveryStep::StartTrigger`] | TIM1 counter on, timestamps continue from now | ADC1 and ADC2 start on the same trigger |
 //!
@@ -224,6 +224,19 @@ pub trait AcqRegisters {
     fn dma_reload(&mut self, i: usize, transfers: u16);
     /// Enables DMA channel `i` (`EN = 1`).
     fn dma_enable(&mut self, i: usize);
+    /// Disables the encoder latch's DMA channel (`EN = 0`): the channel that copies the
+    /// encoder timer's captured count at every trigger into its ring
+    /// (`acquisition::LATCH_LEN`).
+    fn latch_disable(&mut self);
+    /// `EN` of the encoder latch's DMA channel.
+    fn latch_enabled(&mut self) -> bool;
+    /// Clears the latch channel's `TEIF`, `HTIF`, `TCIF`, `GIF`.
+    fn latch_clear(&mut self);
+    /// Writes the latch channel's `CNDTR` (allowed only with `EN = 0`) and resets its
+    /// ring's read position to match.
+    fn latch_reload(&mut self, transfers: u16);
+    /// Enables the latch channel (`EN = 1`).
+    fn latch_enable(&mut self);
     /// Stops the sample trigger (TIM1's counter).
     fn trigger_stop(&mut self);
     /// Starts the sample trigger.
@@ -281,9 +294,10 @@ impl<R: AcqRegisters> Acquisition for RegisterAcquisition<R> {
         for i in CHANNELS {
             self.regs.dma_disable(i);
         }
+        self.regs.latch_disable();
         let regs = &mut self.regs;
         poll_until(RecoveryStep::PauseDma, POLL_LIMIT, || {
-            CHANNELS.iter().all(|&i| !regs.dma_enabled(i))
+            CHANNELS.iter().all(|&i| !regs.dma_enabled(i)) && !regs.latch_enabled()
         })
     }
 
@@ -292,6 +306,7 @@ impl<R: AcqRegisters> Acquisition for RegisterAcquisition<R> {
             self.regs.adc_clear(i, AdcFlags::RECOVERY_CLEAR);
             self.regs.dma_clear(i);
         }
+        self.regs.latch_clear();
     }
 
     fn rearm_dma(&mut self) {
@@ -299,6 +314,11 @@ impl<R: AcqRegisters> Acquisition for RegisterAcquisition<R> {
             // The channel is off: CNDTR is writable.
             self.regs.dma_reload(i, self.ring_len);
         }
+        // The encoder latch from its ring's start too, one count per sequence: the counts
+        // stay at the places of the conversions of the same trigger.
+        let channels = crate::acquisition::CHANNELS as u16;
+        self.regs.latch_reload(self.ring_len / channels);
+        self.regs.latch_enable();
         for i in CHANNELS {
             // ADSTART = 0 here, so DMAEN/DMACFG are writable.
             self.regs.adc_dma_circular(i);

@@ -13,7 +13,7 @@ use drive_monitor::adc_rules::AdcPairSetup;
 use drive_monitor::recovery::{AcqRegisters, AdcFlags, RegisterAcquisition};
 use embassy_stm32::adc::RingBufferedAdc;
 use embassy_stm32::adc::{Adc, AdcConfig};
-use embassy_stm32::dma;
+use embassy_stm32::dma::{self, ReadableRingBuffer};
 use embassy_stm32::interrupt::typelevel::Handler;
 use embassy_stm32::pac;
 use embassy_stm32::pac::adc::vals::{Dmacfg, Dmaen};
@@ -25,6 +25,8 @@ use embassy_time::Instant;
 const ADCS: [pac::adc::Adc; 2] = [pac::ADC1, pac::ADC2];
 /// The DMA1 channels of the two rings (register index: channel 1 is index 0).
 const DMA_CHANNELS: [usize; 2] = [0, 1];
+/// The DMA1 channel of the encoder latch's ring (channel 3).
+const LATCH_CHANNEL: usize = 2;
 
 /// The acquisition: trigger timer and the two ring-buffered ADCs, as the recovery drives
 /// them ([`RegisterAcquisition`] over [`HwRegisters`]).
@@ -35,6 +37,8 @@ pub(super) struct HwRegisters {
     pub(super) trigger: HwTimer<'static, peripherals::TIM1>,
     pub(super) adc1: RingBufferedAdc<'static, peripherals::ADC1>,
     pub(super) adc2: RingBufferedAdc<'static, peripherals::ADC2>,
+    /// The encoder latch: TIM4's count captured at every trigger, one per sequence.
+    pub(super) latch: ReadableRingBuffer<'static, u16>,
     /// When the trigger was last started, us (the timestamps continue from there).
     pub(super) started_us: u32,
 }
@@ -52,9 +56,10 @@ pub(super) fn new_acquisition(
     trigger: HwTimer<'static, peripherals::TIM1>,
     adc1: RingBufferedAdc<'static, peripherals::ADC1>,
     adc2: RingBufferedAdc<'static, peripherals::ADC2>,
+    latch: ReadableRingBuffer<'static, u16>,
     ring_len: u16,
 ) -> HwAcquisition {
-    for n in DMA_CHANNELS {
+    for n in DMA_CHANNELS.into_iter().chain([LATCH_CHANNEL]) {
         pac::DMA1.ch(n).cr().modify(|w| w.set_teie(false));
     }
     RegisterAcquisition {
@@ -62,6 +67,7 @@ pub(super) fn new_acquisition(
             trigger,
             adc1,
             adc2,
+            latch,
             started_us: 0,
         },
         ring_len,
@@ -103,6 +109,7 @@ impl AdcPairSetup for HwPair {
 
 /// The first start: both rings and ADCs, then the trigger.
 pub(super) fn start(acq: &mut HwAcquisition) {
+    acq.regs.latch.start();
     acq.regs.adc1.start();
     acq.regs.adc2.start();
     acq.regs.trigger_start();
@@ -205,6 +212,35 @@ impl AcqRegisters for HwRegisters {
 
     fn dma_enable(&mut self, i: usize) {
         pac::DMA1.ch(dma(i)).cr().modify(|w| w.set_en(true));
+    }
+
+    fn latch_disable(&mut self) {
+        self.latch.request_pause();
+    }
+
+    fn latch_enabled(&mut self) -> bool {
+        pac::DMA1.ch(LATCH_CHANNEL).cr().read().en()
+    }
+
+    fn latch_clear(&mut self) {
+        pac::DMA1.ifcr().write(|w| {
+            w.set_teif(LATCH_CHANNEL, true);
+            w.set_htif(LATCH_CHANNEL, true);
+            w.set_tcif(LATCH_CHANNEL, true);
+            w.set_gif(LATCH_CHANNEL, true);
+        });
+    }
+
+    fn latch_reload(&mut self, transfers: u16) {
+        pac::DMA1
+            .ch(LATCH_CHANNEL)
+            .ndtr()
+            .write(|w| w.set_ndt(transfers));
+        self.latch.clear();
+    }
+
+    fn latch_enable(&mut self) {
+        pac::DMA1.ch(LATCH_CHANNEL).cr().modify(|w| w.set_en(true));
     }
 
     fn trigger_stop(&mut self) {

@@ -20,6 +20,7 @@ use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
 use drive_monitor::sampling::RawFrame;
 use drive_monitor::setup_guard::SetupStep;
 use embassy_stm32::adc::{Adc, AdcChannel, Exten, RingBufferedAdc, SampleTime};
+use embassy_stm32::dma::{self, ReadableRingBuffer, TransferOptions};
 use embassy_stm32::gpio::Pull;
 use embassy_stm32::time::Hertz;
 use embassy_stm32::timer::low_level::{MasterMode, RoundTo, Timer as HwTimer};
@@ -40,6 +41,8 @@ pub(super) struct SampleHw {
     pub(super) adc2: Peri<'static, peripherals::ADC2>,
     pub(super) dma1: Peri<'static, peripherals::DMA1_CH1>,
     pub(super) dma2: Peri<'static, peripherals::DMA1_CH2>,
+    /// The encoder latch's DMA channel (TIM4's capture at the trigger).
+    pub(super) dma3: Peri<'static, peripherals::DMA1_CH3>,
     pub(super) tim1: Peri<'static, peripherals::TIM1>,
     pub(super) v: board::pins::VoltagePins,
     pub(super) i: board::pins::CurrentPins,
@@ -79,7 +82,38 @@ fn start_encoder(
         w.set_icf(1, filter);
     });
     regs.ccer().modify(|w| w.set_ccp(0, setup.invert_a));
+    // The count latched at the sample trigger: channel 3 captures the counter on TRC, the
+    // internal trigger ITR0 (TIM1's TRGO, RM0440 "TIMx internal trigger connection"; the
+    // encoder mode does not use the trigger input), rising edge, and each capture raises
+    // a DMA request (`CC3DE`) that copies `CCR3` into the latch's ring.
+    regs.smcr().modify(|w| w.set_ts(pac::timer::vals::Ts::ITR0));
+    regs.ccmr_input(1)
+        .modify(|w| w.set_ccs(0, pac::timer::vals::CcmrInputCcs::TRC));
+    regs.ccer().modify(|w| {
+        w.set_ccp(2, false);
+        w.set_cce(2, true);
+    });
+    regs.dier().modify(|w| w.set_ccde(2, true));
     qei
+}
+
+/// The encoder latch's ring: DMA1 channel 3 on TIM4's channel-3 request, from `CCR3` into
+/// `ring` (one count per trigger: `geometry::LATCH_LEN`), circular, not started.
+fn latch_ring(
+    dma: Peri<'static, peripherals::DMA1_CH3>,
+    ring: &'static mut [u16; geometry::LATCH_LEN],
+) -> ReadableRingBuffer<'static, u16> {
+    use embassy_stm32::timer::{Ch3, Dma as TimerDma};
+    let request = TimerDma::<peripherals::TIM4, Ch3>::request(&*dma);
+    let ccr3 = pac::TIM4.ccr(2).as_ptr() as *mut u16;
+    // Circular with the half- and full-transfer interrupts (the ring buffer sets them).
+    let options = TransferOptions::default();
+    #[allow(unsafe_code)]
+    // SAFETY: `ccr3` is TIM4's capture register, a peripheral address valid for the whole
+    // run; `ring` is 'static and only this ring buffer writes it.
+    unsafe {
+        ReadableRingBuffer::new(dma::Channel::new(dma, Irqs), request, ccr3, ring, options)
+    }
 }
 
 /// 24.5 ADC cycles sampling time (`drive_monitor::acquisition::SAMPLE_TIME_HALF_CYCLES`,
@@ -144,8 +178,11 @@ fn start_acquisition(
 ) -> (Qei<'static, peripherals::TIM4>, HwAcquisition) {
     static RING1: static_cell::StaticCell<[u16; RING_LEN]> = static_cell::StaticCell::new();
     static RING2: static_cell::StaticCell<[u16; RING_LEN]> = static_cell::StaticCell::new();
+    static LATCH: static_cell::StaticCell<[u16; geometry::LATCH_LEN]> =
+        static_cell::StaticCell::new();
     let ring1 = RING1.init([0; RING_LEN]);
     let ring2 = RING2.init([0; RING_LEN]);
+    let latch = latch_ring(hw.dma3, LATCH.init([0; geometry::LATCH_LEN]));
 
     let qei = start_encoder(hw.tim4, hw.enc_a, hw.enc_b, &hw.encoder);
 
@@ -195,7 +232,7 @@ fn start_acquisition(
     guard.step(SetupStep::Ring2);
     let adc2 = ring_currents(adc2, hw.dma2, hw.i, ring2);
     guard.step(SetupStep::Start);
-    let mut acq = acquisition::new_acquisition(trigger, adc1, adc2, RING_LEN as u16);
+    let mut acq = acquisition::new_acquisition(trigger, adc1, adc2, latch, RING_LEN as u16);
     acquisition::start(&mut acq);
     guard.disarm();
     path.sampler_mut().resync(acq.regs.started_us);
@@ -206,7 +243,8 @@ fn start_acquisition(
 /// [`geometry::SAMPLES_PER_HALF`] samples of [`geometry::OVERSAMPLING`] sequences, each
 /// sample summed and filtered by `filter`, `geometry::PwmFilter`: the inverter's in-band
 /// ripple out, the encoder count held back with it) with the encoder counts of its samples
-/// (`counts`); hands thread mode a status every `status_every` samples. `max_cycles`: the
+/// (`counts`: each the mean of the counts TIM4 latched at the sample's triggers,
+/// `geometry::sample_count`); hands thread mode a status every `status_every` samples. `max_cycles`: the
 /// longest oversampling, filter and `on_frame` of one sample so far, in CPU cycles.
 fn process_half(
     path: &mut SamplePath,
@@ -256,12 +294,13 @@ fn process_half(
 #[embassy_executor::task]
 pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
     let mut filter = geometry::PwmFilter::new(SETTINGS.sample_rate_hz, hw.supply_hz);
-    let (qei, mut acq) = set_up_acquisition(hw, &mut path);
+    // The encoder driver is kept (its timer counts); the count is read from the latch.
+    let (_qei, mut acq) = set_up_acquisition(hw, &mut path);
     let mut wait = AdcWait::new(SETTINGS.sample_rate_hz);
     let timeout = Duration::from_micros(u64::from(wait.timeout_us()));
     let mut half1 = [0u16; DMA_HALF_LEN];
     let mut half2 = [0u16; DMA_HALF_LEN];
-    let mut last_count = qei.count();
+    let mut latched = [0u16; geometry::LATCH_HALF_LEN];
     // The ADCs idled since their set-up: the first sample is dropped (errata).
     let mut discard = IdleDiscard::default();
     discard.on_start(u32::MAX);
@@ -272,20 +311,22 @@ pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
         let read = with_timeout(timeout, async {
             let r1 = acq.regs.adc1.read(&mut half1).await;
             let r2 = acq.regs.adc2.read(&mut half2).await;
-            (r1.is_ok(), r2.is_ok())
+            // The counts latched at the same triggers (the latch's half is complete at the
+            // last trigger, before the conversions it started).
+            let r3 = acq.regs.latch.read_exact(&mut latched).await;
+            (r1.is_ok(), r2.is_ok() && r3.is_ok())
         })
         .await;
         if needs_recovery(read, &mut wait) {
             recover_acquisition(&mut acq, &mut path, &mut counts);
-            last_count = qei.count();
             discard.on_start(acq.regs.started_us.wrapping_sub(last_data_us));
             continue;
         }
         apply_commands(&mut path);
         let halves = (&half1[..], &half2[..]);
-        let count = qei.count();
-        let counts = geometry::spread_counts(last_count, count);
-        last_count = count;
+        let mut sequences = latched.chunks_exact(geometry::OVERSAMPLING);
+        let counts: [u16; geometry::SAMPLES_PER_HALF] =
+            core::array::from_fn(|_| sequences.next().map_or(0, geometry::sample_count));
         last_data_us = embassy_time::Instant::now().as_micros() as u32;
         process_half(
             &mut path,

@@ -44,6 +44,8 @@ enum Without {
     JadstartWait,
     /// Writing one set-only bit of `ADC_CR` alone (a read-modify-write instead).
     SetOnlyMask,
+    /// The encoder latch's reload with the ADCs' rings.
+    LatchReload,
 }
 
 /// The firmware's sequence with one access left out ([`Without`]): every other register
@@ -105,6 +107,23 @@ impl AcqRegisters for Weakened<'_> {
     }
     fn dma_enable(&mut self, i: usize) {
         self.0.dma_enable(i);
+    }
+    fn latch_disable(&mut self) {
+        self.0.latch_disable();
+    }
+    fn latch_enabled(&mut self) -> bool {
+        self.0.latch_enabled()
+    }
+    fn latch_clear(&mut self) {
+        self.0.latch_clear();
+    }
+    fn latch_reload(&mut self, transfers: u16) {
+        if self.1 != Without::LatchReload {
+            self.0.latch_reload(transfers);
+        }
+    }
+    fn latch_enable(&mut self) {
+        self.0.latch_enable();
     }
     fn trigger_stop(&mut self) {
         self.0.trigger_stop();
@@ -480,4 +499,37 @@ fn the_first_sample_after_a_long_idle_is_dropped_and_none_after_a_short_one() {
     assert!(violations.is_empty(), "{violations:?}");
     let (bad, dropped, _) = run(5);
     assert_eq!((bad, dropped), (0, 0));
+}
+
+/// The encoder count latched in hardware at the trigger (TIM4's capture on TIM1's `TRGO`,
+/// copied by a DMA channel into a ring beside the ADCs'): every sample's latched counts
+/// come from the triggers of its own conversions, through a lapped ring, an overrun and a
+/// DMA error and their recoveries. Without the latch's reload in the recovery the ADCs'
+/// rings restart from their start and the latch's does not: the counts belong to other
+/// triggers.
+#[test]
+fn the_latched_encoder_count_belongs_to_the_conversions_of_its_sample() {
+    let run = |without: Option<Without>| {
+        let mut acq = AdcDmaModel::running();
+        for k in 0..2_000 {
+            if k == 500 {
+                acq.regs.inject_overrun();
+            }
+            if k == 1_000 {
+                acq.regs.inject_dma_error();
+            }
+            if k == 1_500 || !acq.regs.sample() && k % 20 == 0 {
+                match without {
+                    None => recovery::recover(&mut acq).unwrap(),
+                    Some(w) => recover_weakened(&mut acq, w).unwrap(),
+                };
+            }
+        }
+        (acq.regs.paired_samples, acq.regs.unpaired_samples)
+    };
+    let (checked, unpaired) = run(None);
+    assert!(checked > 3_000, "{checked}");
+    assert_eq!(unpaired, 0);
+    let (_, unpaired) = run(Some(Without::LatchReload));
+    assert!(unpaired > 100, "{unpaired}");
 }

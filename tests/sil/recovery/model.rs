@@ -3,7 +3,8 @@
 
 use super::super::FS;
 use drive_monitor::acquisition::{
-    conversion_ns, trigger_rate_hz, CHANNELS, HALF_LEN, OVERSAMPLING, RING_LEN as FW_RING_LEN,
+    conversion_ns, trigger_rate_hz, CHANNELS, HALF_LEN, LATCH_LEN, OVERSAMPLING,
+    RING_LEN as FW_RING_LEN,
 };
 use drive_monitor::recovery::{AcqRegisters, AdcFlags, RegisterAcquisition};
 
@@ -67,14 +68,33 @@ pub(crate) struct DmaModel {
     pub(crate) moved: u32,
     /// The rank of the word at each ring position.
     pub(crate) ring: [usize; FW_RING_LEN],
+    /// The trigger whose sequence each ring position's word came from.
+    pub(crate) ids: [u64; FW_RING_LEN],
     /// Halves completed since the last sample was taken.
     pub(crate) halves: u32,
+}
+
+/// The encoder latch: TIM4's capture at each trigger, copied by its DMA channel into a
+/// ring of [`LATCH_LEN`] counts.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LatchModel {
+    pub(crate) en: bool,
+    pub(crate) cndtr: u16,
+    /// The trigger each ring position's count was captured at.
+    pub(crate) ids: [u64; LATCH_LEN],
 }
 
 /// The two ADCs, their DMA channels and the trigger, at register level (module docs).
 #[derive(Clone, Debug)]
 pub(crate) struct AdcDmaModel {
     pub(crate) trigger_on: bool,
+    /// Triggers so far (each one's id).
+    pub(crate) triggers: u64,
+    pub(crate) latch: LatchModel,
+    /// Completed sample blocks whose conversions and latched counts came from different
+    /// triggers (the count does not belong to the readings), and those checked.
+    pub(crate) unpaired_samples: u32,
+    pub(crate) paired_samples: u32,
     pub(crate) adc: [AdcModel; 2],
     pub(crate) dma: [DmaModel; 2],
     /// The model's clock [ns].
@@ -108,11 +128,20 @@ impl AdcDmaModel {
             request: false,
             moved: 0,
             ring: [0; FW_RING_LEN],
+            ids: [0; FW_RING_LEN],
             halves: 0,
         };
         RegisterAcquisition {
             regs: AdcDmaModel {
                 trigger_on: true,
+                triggers: 0,
+                latch: LatchModel {
+                    en: true,
+                    cndtr: LATCH_LEN as u16,
+                    ids: [0; LATCH_LEN],
+                },
+                unpaired_samples: 0,
+                paired_samples: 0,
                 adc: [adc; 2],
                 dma: [dma; 2],
                 now_ns: 0,
@@ -136,6 +165,7 @@ impl AdcDmaModel {
         a.eoc = false;
         let at = usize::from(RING_LEN - d.cndtr);
         d.ring[at] = a.dr;
+        d.ids[at] = self.triggers.wrapping_sub(1);
         d.moved += 1;
         d.cndtr = if d.cndtr <= 1 { RING_LEN } else { d.cndtr - 1 };
         if (at + 1) % HALF_LEN == 0 {
@@ -144,6 +174,12 @@ impl AdcDmaModel {
             self.misaligned_halves += u32::from(!aligned);
             self.last_block_bad[i] = (0..HALF_LEN).any(|k| d.ring[half + k] & BAD != 0);
             d.halves += 1;
+            // The sample's latched counts sit at the same place of the latch's ring.
+            let first = half / CHANNELS;
+            let paired = (0..OVERSAMPLING)
+                .all(|s| self.latch.ids.get(first + s) == d.ids.get(half + s * CHANNELS));
+            self.paired_samples += 1;
+            self.unpaired_samples += u32::from(!paired);
         }
     }
 
@@ -156,6 +192,18 @@ impl AdcDmaModel {
         let t0 = self.now_ns;
         if self.trigger_on {
             self.conversions += 1;
+            // TIM4 captures its count at the trigger; the capture's DMA request moves it.
+            let l = &mut self.latch;
+            if l.en {
+                let at = LATCH_LEN - usize::from(l.cndtr);
+                l.ids[at] = self.triggers;
+                l.cndtr = if l.cndtr <= 1 {
+                    LATCH_LEN as u16
+                } else {
+                    l.cndtr - 1
+                };
+            }
+            self.triggers += 1;
             for rank in 0..CHANNELS {
                 let end = t0 + (rank as u64 + 1) * u64::from(conversion_ns());
                 for i in 0..2 {
@@ -342,6 +390,23 @@ impl AcqRegisters for AdcDmaModel {
         self.dma[i].en = true;
         // A request raised while the channel was off is served now.
         self.serve(i);
+    }
+    fn latch_disable(&mut self) {
+        self.latch.en = false;
+    }
+    fn latch_enabled(&mut self) -> bool {
+        self.now_ns += POLL_NS;
+        self.latch.en
+    }
+    fn latch_clear(&mut self) {}
+    fn latch_reload(&mut self, transfers: u16) {
+        if self.latch.en {
+            self.violation("CNDTR of the latch's DMA channel written while EN = 1".into());
+        }
+        self.latch.cndtr = transfers;
+    }
+    fn latch_enable(&mut self) {
+        self.latch.en = true;
     }
     fn trigger_stop(&mut self) {
         self.trigger_on = false;
