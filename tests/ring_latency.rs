@@ -109,6 +109,7 @@ fn simulate(samples_per_half: u64, seconds: u64, frame: u64) -> Run {
 fn the_ring_is_never_lapped_over_an_hour_at_the_worst_case_latency() {
     let k = SAMPLES_PER_HALF as u64;
     let run = simulate(k, 3_600, u64::from(LOG_FRAME_CYCLES));
+    println!("{run:?}");
     assert_eq!(run.halves, 3_600 * u64::from(FS) / k);
     assert!(run.frames > 1_000_000, "{run:?}");
     assert_eq!(run.laps, 0, "{run:?}");
