@@ -132,3 +132,74 @@ fn one_sample_per_half_is_lapped_by_the_same_log() {
     let run = simulate(SAMPLES_PER_HALF as u64, 60, longer);
     assert_eq!(run.laps, 0, "{run:?}");
 }
+
+/// The status line cannot hold interrupts off longer than the budget's frame: its bytes
+/// at their worst (the line `cargo qemu-rtt` measured, 197 B, with each of its six name
+/// fields at the longest name the firmware can log instead of the QEMU program's, plus
+/// the timestamp's 10 bytes at most and one byte of framing for every 7 added) are within
+/// `LOG_FRAME_MAX_BYTES`, on which the budget's frame is computed. A field added to the line,
+/// or a longer name, fails here until the budget (and so the ring's depth) covers it.
+#[test]
+fn the_status_line_fits_the_log_frame_budget() {
+    use drive_monitor::acquisition::{LOG_FRAME_MAX_BYTES, LOG_MEASURED_BYTES};
+    use drive_monitor::panel::Mode;
+    use monitor_core::verdict::Verdict;
+    use monitor_core::{Fault, Phase};
+
+    let read = |rel: &str| {
+        std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap()
+    };
+    // The six string arguments the QEMU program logs, in the line's order.
+    let qemu = read("crates/rtt-on-m4/src/main.rs");
+    let call = &qemu[qemu.find("info!(").expect("the status line")..];
+    let args = &call[call.find("\",").expect("the format's end") + 2..];
+    let args = &args[..args.find(");").expect("the call's end")];
+    let measured: Vec<&str> = args.split('"').skip(1).step_by(2).collect();
+    assert_eq!(measured.len(), 6, "{measured:?}");
+    // The firmware's longest in each field: call, top, 2nd, mode, iso, wind.
+    let faults: Vec<&str> = Fault::ALL.iter().map(|f| f.name()).collect();
+    let longest = |names: &[&str]| names.iter().map(|n| n.len()).max().unwrap_or(0);
+    let calls = [
+        Verdict::Fault,
+        Verdict::Watching,
+        Verdict::Healthy,
+        Verdict::CouldNotJudge,
+    ]
+    .map(Verdict::name);
+    let modes = [
+        Mode::NotCommissioned,
+        Mode::Commissioning,
+        Mode::Commissioned,
+        Mode::SamplingStalled,
+        Mode::Failed,
+    ]
+    .map(Mode::name);
+    let candidates: Vec<&str> = faults.iter().copied().chain(["none"]).collect();
+    let isolation: Vec<&str> = faults
+        .iter()
+        .copied()
+        .chain(["b/bl", "none", "not-judged", "unknown"])
+        .collect();
+    let winding: Vec<&str> = Phase::ALL
+        .iter()
+        .map(|p| p.name())
+        .chain(["none"])
+        .collect();
+    let worst = [
+        longest(&calls),
+        longest(&candidates),
+        longest(&candidates),
+        longest(&modes),
+        longest(&isolation),
+        longest(&winding),
+    ];
+    let added: usize = worst
+        .iter()
+        .zip(&measured)
+        .map(|(w, m)| w.saturating_sub(m.len()))
+        .sum();
+    let bound = LOG_MEASURED_BYTES as usize + added + 10 + added.div_ceil(7);
+    println!("status line: at most {bound} B ({added} B of longer names)");
+    assert!(added > 0);
+    assert!(bound <= LOG_FRAME_MAX_BYTES as usize, "{bound} B");
+}
