@@ -65,9 +65,9 @@ pub const RING_LEN: usize = 2 * DMA_HALF_LEN;
 /// The encoder latch's ring length in counts: TIM1's trigger makes the encoder timer
 /// capture its count (TIM4 channel 3 on `TRC`, the trigger's `TRGO`) and the capture's DMA
 /// request copies it into a ring of its own, one count per sequence, the same two halves
-/// as the ADCs' rings (32).
+/// as the ADCs' rings (48).
 pub const LATCH_LEN: usize = RING_LEN / CHANNELS;
-/// Counts in one half of the latch's ring (16).
+/// Counts in one half of the latch's ring (24).
 pub const LATCH_HALF_LEN: usize = LATCH_LEN / 2;
 
 /// One sample's encoder count from the counts latched at its [`OVERSAMPLING`] triggers
