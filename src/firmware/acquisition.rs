@@ -10,7 +10,7 @@
 use core::marker::PhantomData;
 
 use drive_monitor::adc_rules::AdcPairSetup;
-use drive_monitor::recovery::{AcqRegisters, AdcFlags, RegisterAcquisition};
+use drive_monitor::recovery::{AcqRegisters, Acquisition, AdcFlags, RegisterAcquisition};
 use embassy_stm32::adc::RingBufferedAdc;
 use embassy_stm32::adc::{Adc, AdcConfig};
 use embassy_stm32::dma::{self, ReadableRingBuffer};
@@ -107,12 +107,16 @@ impl AdcPairSetup for HwPair {
     }
 }
 
-/// The first start: both rings and ADCs, then the trigger.
+/// The first start: the rings (the ADCs' and the encoder latch's) armed, both ADCs started,
+/// then the trigger, with the recovery's own steps (`RegisterAcquisition`: `CNDTR`, the
+/// rings' positions, `DMAEN` circular, `EN`, then `ADSTART` written alone), not the HAL's
+/// `RingBufferedAdc::start`, whose read-modify-write of `ADC_CR` writes `ADEN` back with
+/// `ADSTART` (`drive_monitor::adc_rules`). The rings' `EN` set here is what the HAL's
+/// `read` looks at (`is_running`), so it does not start them again.
 pub(super) fn start(acq: &mut HwAcquisition) {
-    acq.regs.latch.start();
-    acq.regs.adc1.start();
-    acq.regs.adc2.start();
-    acq.regs.trigger_start();
+    acq.rearm_dma();
+    acq.start_adc();
+    acq.start_trigger();
 }
 
 /// ADC `i`'s registers (0: ADC1, else ADC2).
