@@ -155,6 +155,20 @@ impl AdcDmaModel {
         }
     }
 
+    /// The acquisition as the set-up leaves it before the first start: the ADCs enabled,
+    /// `DMAEN` circular (the HAL's `configure_dma`), nothing converting, the DMA channels
+    /// and the latch's off, the trigger stopped.
+    pub(crate) fn stopped() -> ModelAcq {
+        let mut acq = Self::running();
+        acq.regs.trigger_on = false;
+        acq.regs.latch.en = false;
+        for (a, d) in acq.regs.adc.iter_mut().zip(&mut acq.regs.dma) {
+            a.adstart = false;
+            d.en = false;
+        }
+        acq
+    }
+
     /// The DMA serves channel `i`'s request: one word from `ADC_DR` into the ring.
     fn serve(&mut self, i: usize) {
         let (a, d) = (&mut self.adc[i], &mut self.dma[i]);
