@@ -26,6 +26,21 @@
 //! host's isolation found no steady operating point). [`PwmFilter`] takes it out: two
 //! one-pole low-passes on the six channels alike, the fundamental's gain restored, the
 //! encoder held back by the filters' delay.
+//!
+//! **The latency budget.** The sample task copies each DMA half out of the ring after the
+//! half-transfer (or transfer-complete) interrupt, through the DMA interrupt and the
+//! interrupt executor; the DMA writes into that half again [`SAMPLES_PER_HALF`] sample
+//! periods after it completed it. Everything that can delay the copy is a term of
+//! [`worst_latency_cycles`], each at its worst, in CPU cycles of [`clock::HCLK_HZ`]: a log
+//! frame that masked interrupts just before the request ([`LOG_FRAME_CYCLES`], defmt-rtt
+//! holds a critical section for a whole frame, the status line being the longest), the
+//! interrupt's entry, the DMA handler, the other interrupts, the executor and the work on
+//! the half's samples. The ring's depth is the smallest that covers it
+//! ([`samples_per_half_for`]): at 10 kHz and 170 MHz one sample per half (17 000 cycles of
+//! slack) does not, nor do two (34 000 against 34 889), three (51 000) do, with 37 760
+//! cycles worst-case (222 us). The host's model
+//! (`tests/ring_latency.rs`) runs the sample path against that worst case for a simulated
+//! hour and counts no lap.
 
 use crate::clock;
 
@@ -33,14 +48,141 @@ use crate::clock;
 pub const CHANNELS: usize = 3;
 /// Sequences (triggers) averaged into one sample (module docs).
 pub const OVERSAMPLING: usize = 8;
-/// Samples per DMA half buffer: 1, so every sample wakes the sample task as it arrives
-/// and the encoder is read within microseconds of the conversions.
-pub const SAMPLES_PER_HALF: usize = 1;
-/// 16-bit words in one DMA half buffer (one sample's sequences).
-pub const HALF_LEN: usize = SAMPLES_PER_HALF * OVERSAMPLING * CHANNELS;
+/// 16-bit words of one sample's sequences ([`OVERSAMPLING`] x [`CHANNELS`], 24): the unit
+/// [`sum_half`] and [`average_half`] take. (The name is older than the deeper ring: a DMA
+/// half now holds [`SAMPLES_PER_HALF`] of them, [`DMA_HALF_LEN`] words.)
+pub const HALF_LEN: usize = OVERSAMPLING * CHANNELS;
+/// Samples per DMA half buffer, chosen from the latency budget
+/// ([`samples_per_half_for`] at [`BUDGET_SAMPLE_RATE_HZ`]; module docs, "The latency
+/// budget"): 3 at 10 kHz and 170 MHz.
+pub const SAMPLES_PER_HALF: usize = samples_per_half_for(BUDGET_SAMPLE_RATE_HZ);
+/// 16-bit words in one DMA half buffer ([`SAMPLES_PER_HALF`] samples' sequences).
+pub const DMA_HALF_LEN: usize = SAMPLES_PER_HALF * HALF_LEN;
 /// The DMA ring's length per ADC in 16-bit words (two halves), which is also the
 /// channel's `CNDTR` at the start of a turn.
-pub const RING_LEN: usize = 2 * HALF_LEN;
+pub const RING_LEN: usize = 2 * DMA_HALF_LEN;
+
+/// The encoder latch's ring length in counts: TIM1's trigger makes the encoder timer
+/// capture its count (TIM4 channel 3 on `TRC`, the trigger's `TRGO`) and the capture's DMA
+/// request copies it into a ring of its own, one count per sequence, the same two halves
+/// as the ADCs' rings (48).
+pub const LATCH_LEN: usize = RING_LEN / CHANNELS;
+/// Counts in one half of the latch's ring (24).
+pub const LATCH_HALF_LEN: usize = LATCH_LEN / 2;
+
+/// One sample's encoder count from the counts latched at its [`OVERSAMPLING`] triggers
+/// (`latched`, oldest first): their mean, the shortest way round the 16-bit counter from
+/// the first, rounded; the instant of the readings' mean, as the oversampled sum is. An
+/// empty slice gives 0.
+#[inline]
+pub fn sample_count(latched: &[u16]) -> u16 {
+    let Some(&first) = latched.first() else {
+        return 0;
+    };
+    let n = latched.len() as i32;
+    let sum: i32 = latched
+        .iter()
+        .map(|&c| i32::from(c.wrapping_sub(first) as i16))
+        .sum();
+    let mean = (2 * sum + n).div_euclid(2 * n);
+    first.wrapping_add(mean as u16)
+}
+
+/// The sample rate the ring is sized for [Hz] (the firmware's `SETTINGS`, checked there at
+/// compile time with [`ring_fits`]).
+pub const BUDGET_SAMPLE_RATE_HZ: u32 = 10_000;
+/// The status line's bytes as `cargo qemu-rtt` measured them (`bytes_a_reader_finds=195`,
+/// 1 965 B for ten lines: 197 B a line), with the names the QEMU program logs.
+pub const LOG_MEASURED_BYTES: u32 = 197;
+/// The instructions that line took with interrupts masked under QEMU
+/// (`flood_max_late_instructions=8960`: defmt-rtt holds a critical section for a whole
+/// frame, encoding and copying it byte by byte).
+pub const LOG_MEASURED_INSTRUCTIONS: u32 = 8_960;
+/// The longest frame the firmware logs [bytes]: the status line with the longest name in
+/// each of its six name fields, the frame's timestamp and the framing's overhead
+/// (`tests/ring_latency.rs` computes the bound from the names and fails when the line
+/// outgrows it).
+pub const LOG_FRAME_MAX_BYTES: u32 = 264;
+/// The longest frame's instructions, with interrupts masked: the measured line's cost per
+/// byte times [`LOG_FRAME_MAX_BYTES`], rounded up (12 008).
+pub const LOG_FRAME_INSTRUCTIONS: u32 =
+    (LOG_MEASURED_INSTRUCTIONS * LOG_FRAME_MAX_BYTES).div_ceil(LOG_MEASURED_BYTES);
+/// CPU cycles per instruction on the worst path, x 10 (an assumption, not measured: the
+/// G474 at 170 MHz runs the flash with 4 wait states behind the ART cache; loads, taken
+/// branches and cache misses put a frame of 9 000 instructions at 60-110 us): 2.1.
+pub const WORST_CYCLES_PER_INSTRUCTION_X10: u32 = 21;
+/// The Cortex-M4F's interrupt entry with the FPU's lazy stacking and flash wait states
+/// [cycles] (12 cycles from the architecture, more than doubled).
+pub const INTERRUPT_ENTRY_CYCLES: u32 = 30;
+/// One DMA channel's half/full-transfer interrupt: the firmware's check of `TEIF`, then
+/// embassy's handler waking the ring's reader [cycles] (about 150 instructions, x 2.1,
+/// rounded up).
+pub const DMA_HANDLER_CYCLES: u32 = 400;
+/// Other interrupts that may run first at the same or a higher priority: the other ADC's
+/// DMA channel, embassy-time's alarm (TIM15) and the button's EXTI [cycles].
+pub const OTHER_INTERRUPTS_CYCLES: u32 = 1_500;
+/// The interrupt executor from the pended `UART4` to the sample task's code after its
+/// awaits: the poll, the `with_timeout` future and its timer queue entry [cycles].
+pub const EXECUTOR_CYCLES: u32 = 2_000;
+/// One sample's work at its worst [instructions] (`cargo qemu-core`: the sampling path's
+/// 222, the core's fast path 211 and, on every 25th sample, its slow path's 784), plus
+/// copying its 2 x 24 words out of the rings (about 100) and the mean of its 8 latched
+/// encoder counts ([`sample_count`], about 50; not traced).
+pub const SAMPLE_WORK_INSTRUCTIONS: u32 = 222 + 211 + 784 + 100 + 50;
+
+/// `instructions` at [`WORST_CYCLES_PER_INSTRUCTION_X10`] [cycles], rounded up.
+pub const fn worst_cycles(instructions: u32) -> u32 {
+    (instructions * WORST_CYCLES_PER_INSTRUCTION_X10).div_ceil(10)
+}
+
+/// The longest critical section a log frame may hold [CPU cycles]: 25 217 (148 us at
+/// 170 MHz).
+pub const LOG_FRAME_CYCLES: u32 = worst_cycles(LOG_FRAME_INSTRUCTIONS);
+
+/// The worst-case sample-path latency [CPU cycles] with `samples_per_half` samples per DMA
+/// half: from the half-transfer interrupt's request to the half copied out and its samples
+/// processed, the worst case of every term at once (a log frame that masked interrupts
+/// just before the request, the interrupt, the other interrupts, the executor, the work).
+pub const fn worst_latency_cycles(samples_per_half: u32) -> u32 {
+    LOG_FRAME_CYCLES
+        + INTERRUPT_ENTRY_CYCLES
+        + DMA_HANDLER_CYCLES
+        + OTHER_INTERRUPTS_CYCLES
+        + EXECUTOR_CYCLES
+        + samples_per_half * worst_cycles(SAMPLE_WORK_INSTRUCTIONS)
+}
+
+/// One sample period [CPU cycles] at `sample_rate_hz` (17 000 at 10 kHz; 0 for 0 Hz).
+pub const fn sample_period_cycles(sample_rate_hz: u32) -> u32 {
+    match clock::HCLK_HZ.checked_div(sample_rate_hz) {
+        Some(c) => c,
+        None => 0,
+    }
+}
+
+/// Whether a ring of two halves of `samples_per_half` samples tolerates the worst-case
+/// latency at `sample_rate_hz`: the DMA writes into a half again `samples_per_half`
+/// periods after it completed it, so the half must be read, and its samples processed,
+/// within that time.
+pub const fn ring_fits(sample_rate_hz: u32, samples_per_half: u32) -> bool {
+    samples_per_half > 0
+        && worst_latency_cycles(samples_per_half)
+            <= samples_per_half * sample_period_cycles(sample_rate_hz)
+}
+
+/// The smallest number of samples per DMA half (1..=8) that tolerates the worst-case
+/// latency at `sample_rate_hz` ([`ring_fits`]); 8 when none does (the firmware's
+/// compile-time check then fails).
+pub const fn samples_per_half_for(sample_rate_hz: u32) -> usize {
+    let mut k = 1;
+    while k < 8 {
+        if ring_fits(sample_rate_hz, k) {
+            return k as usize;
+        }
+        k += 1;
+    }
+    8
+}
 
 /// The regular channels' sampling time in ADC clock cycles, times 2 (`SMPx` = 24.5
 /// cycles; halves are how RM0440 counts them): the front end drives each pin through
@@ -260,13 +402,52 @@ mod tests {
 
     #[test]
     fn the_geometry_fits_the_period() {
-        assert_eq!(RING_LEN, 48);
+        assert_eq!(RING_LEN, 144);
+        assert_eq!(HALF_LEN, 24);
         assert_eq!(conversion_ns(), 870);
         assert!(sequence_ns() < 12_500);
         assert_eq!(trigger_rate_hz(10_000), 80_000);
         assert!(fits(10_000));
         // 20 kHz: 6.25 us between triggers, less than a sequence held up by VREFINT.
         assert!(!fits(20_000));
+    }
+
+    /// The ring's depth from the budget, against the sums by hand: one sample's work is
+    /// 1 367 instructions, 2 871 cycles at 2.1 (2 870.7 rounded up); the frame 8 960 x
+    /// 264 / 197 = 12 007.3, 12 008 instructions, 25 216.8, 25 217 cycles; with 30 + 400 +
+    /// 1 500 + 2 000 the worst case is 32 018 cycles for one sample per half (more than its
+    /// 17 000 of slack), 34 889 for two (more than 34 000) and 37 760 for three (under
+    /// 51 000).
+    #[test]
+    fn the_ring_depth_follows_from_the_latency_budget() {
+        assert_eq!(sample_period_cycles(10_000), 17_000);
+        assert_eq!(LOG_FRAME_INSTRUCTIONS, 12_008);
+        assert_eq!(LOG_FRAME_CYCLES, 25_217);
+        assert_eq!(worst_latency_cycles(1), 32_018);
+        assert_eq!(worst_latency_cycles(2), 34_889);
+        assert_eq!(worst_latency_cycles(3), 37_760);
+        assert!(!ring_fits(10_000, 1));
+        assert!(!ring_fits(10_000, 2));
+        assert!(ring_fits(10_000, 3));
+        assert_eq!(SAMPLES_PER_HALF, 3);
+        assert_eq!(DMA_HALF_LEN, 72);
+        // A slower rate needs a shallower ring; a faster one a deeper one.
+        assert_eq!(samples_per_half_for(5_000), 1);
+        assert!(samples_per_half_for(20_000) > 3);
+    }
+
+    /// A sample's count is the mean of its latched counts, across the counter's wrap and
+    /// backwards too.
+    #[test]
+    fn a_samples_count_is_the_mean_of_its_latched_counts() {
+        assert_eq!(sample_count(&[100, 102, 104, 106, 108, 110, 112, 114]), 107);
+        assert_eq!(sample_count(&[65_534, 65_535, 0, 1]), 0);
+        assert_eq!(
+            sample_count(&[3, 2, 1, 0, 65_535, 65_534, 65_533, 65_532]),
+            0
+        );
+        assert_eq!(sample_count(&[7]), 7);
+        assert_eq!(sample_count(&[]), 0);
     }
 
     #[test]

@@ -283,6 +283,8 @@ pub struct Supervisor {
     running: bool,
     /// The built-in default motor is monitored (the panel marks it).
     default_motor: bool,
+    /// The clock runs on the HSI: the crystal did not start (the panel marks it).
+    clock_fallback: bool,
     /// Sensors whose start-up offset was out of bound ([`Supervisor::set_offset_fault`]).
     offset_fault: SensorFlags,
     /// The ADC's reference, measured at start-up and every second
@@ -320,6 +322,7 @@ impl Supervisor {
             sample_rate_hz: settings.sample_rate_hz,
             running: false,
             default_motor: false,
+            clock_fallback: false,
             offset_fault: SensorFlags::default(),
             reference: ReferenceWatch::new(REFERENCE_PERIOD_MS),
             range: RangeWatch::new(),
@@ -370,6 +373,13 @@ impl Supervisor {
         self.default_motor = default_motor;
     }
 
+    /// Whether the clock fell back to the internal oscillator (the crystal did not start):
+    /// the panel shows it ([`crate::panel`], "Clock on the internal oscillator"). Off until
+    /// set.
+    pub fn set_clock_fallback(&mut self, fallback: bool) {
+        self.clock_fallback = fallback;
+    }
+
     /// The commissioned operating range and the "moved" judgement.
     pub fn range(&self) -> &RangeWatch {
         &self.range
@@ -408,6 +418,7 @@ impl Supervisor {
         let isolation = self.panel_isolation();
         let input = PanelInput {
             default_motor: self.default_motor,
+            clock_fallback: self.clock_fallback,
             ..panel_input(mode, &self.latest, isolation, failed)
         };
         Tick {

@@ -382,6 +382,8 @@ pub mod pins {
         pub adc1_dma: Peri<'static, p::DMA1_CH1>,
         /// DMA channel for ADC2's ring buffer.
         pub adc2_dma: Peri<'static, p::DMA1_CH2>,
+        /// DMA channel for the encoder latch's ring (TIM4's capture at the trigger).
+        pub encoder_dma: Peri<'static, p::DMA1_CH3>,
         /// Sample trigger timer (TRGO on update).
         pub trigger_timer: Peri<'static, p::TIM1>,
         /// Voltage inputs.
@@ -414,6 +416,7 @@ pub mod pins {
                 adc2: p.ADC2,
                 adc1_dma: p.DMA1_CH1,
                 adc2_dma: p.DMA1_CH2,
+                encoder_dma: p.DMA1_CH3,
                 trigger_timer: p.TIM1,
                 voltage: VoltagePins {
                     a: p.PA0,

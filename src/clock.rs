@@ -3,32 +3,135 @@
 //! and cycle count derived from them (the fault path's wait, the set-up deadline's SysTick
 //! reload, the encoder timer's clock, the sample trigger's and the ADC's rates).
 //!
-//! 16 MHz HSI / [`PLL_PREDIV`] x [`PLL_MUL`] / [`PLL_RDIV`] = 170 MHz SYSCLK (the G474's
+//! The source is the NUCLEO-G474RE's 24 MHz crystal (HSE, [`ClockSource::Hse`]): 24 MHz /
+//! [`HSE_PREDIV`] x [`PLL_MUL`] / [`PLL_RDIV`] = 170 MHz. When the crystal does not start
+//! within [`HSE_STARTUP_TIMEOUT_MS`] the firmware falls back to the internal 16 MHz
+//! oscillator ([`ClockSource::Hsi`]): 16 MHz HSI / [`PLL_PREDIV`] x [`PLL_MUL`] /
+//! [`PLL_RDIV`], the same 170 MHz SYSCLK (the G474's
 //! maximum, with the regulator's boost mode), AHB and APB1/APB2 undivided, so HCLK and the
 //! timers' kernel clocks are SYSCLK too (RM0440, "Clock tree"; a timer on an undivided APB
 //! runs at the APB clock). The ADC12 kernel clock is SYSCLK ([`ADC_CLOCK_DIV`]: the common
 //! prescaler of `ADC12_CCR`, 4, which embassy-stm32 0.6 picks to stay below the ADC's
 //! 60 MHz): 42.5 MHz.
 
-/// The HSI oscillator [Hz] (the PLL's source).
+/// The longest the firmware waits for the crystal (HSE) to start before it falls back to
+/// the HSI [ms].
+pub const HSE_STARTUP_TIMEOUT_MS: u32 = 100;
+
+/// The board's crystal (HSE, NUCLEO-G474RE's X3) [Hz].
+pub const HSE_HZ: u32 = 24_000_000;
+/// The PLL's input divider `PLLM` (1..=16) with the crystal: 4 MHz into the PLL.
+pub const HSE_PREDIV: u32 = 6;
+/// The time base's error with the crystal [ppm]: an assumption for a 24 MHz crystal of
+/// the board's kind (initial tolerance, temperature and ageing together); check the part
+/// fitted (the board's bill of materials).
+pub const HSE_ERROR_PPM: u32 = 50;
+/// The HSI oscillator [Hz] (the fallback source).
 pub const HSI_HZ: u32 = 16_000_000;
-/// The PLL's input divider `PLLM` (1..=16).
+/// The PLL's input divider `PLLM` (1..=16) with the HSI: 4 MHz into the PLL.
 pub const PLL_PREDIV: u32 = 4;
+/// The time base's error with the HSI [ppm]: +-1 % over temperature (datasheet).
+pub const HSI_ERROR_PPM: u32 = 10_000;
+
+/// The PLL's source.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ClockSource {
+    /// The 24 MHz crystal ([`HSE_HZ`]).
+    Hse,
+    /// The internal 16 MHz oscillator ([`HSI_HZ`]): the crystal did not start.
+    Hsi,
+}
+
+impl ClockSource {
+    /// The PLL's input divider `PLLM` for this source (4 MHz into the PLL).
+    pub const fn prediv(self) -> u32 {
+        match self {
+            ClockSource::Hse => HSE_PREDIV,
+            ClockSource::Hsi => PLL_PREDIV,
+        }
+    }
+
+    /// The source's frequency [Hz].
+    pub const fn hz(self) -> u32 {
+        match self {
+            ClockSource::Hse => HSE_HZ,
+            ClockSource::Hsi => HSI_HZ,
+        }
+    }
+
+    /// SYSCLK from this source [Hz].
+    pub const fn sysclk_hz(self) -> u32 {
+        self.hz() / self.prediv() * PLL_MUL / PLL_RDIV
+    }
+
+    /// The time base's error [ppm]: every rate the monitor measures (supply frequency,
+    /// speed, slip, time constants) is off by up to this much.
+    pub const fn error_ppm(self) -> u32 {
+        match self {
+            ClockSource::Hse => HSE_ERROR_PPM,
+            ClockSource::Hsi => HSI_ERROR_PPM,
+        }
+    }
+
+    /// A short name for the boot report.
+    pub const fn name(self) -> &'static str {
+        match self {
+            ClockSource::Hse => "24 MHz crystal (HSE)",
+            ClockSource::Hsi => "internal oscillator (HSI, +-1 %): the crystal did not start",
+        }
+    }
+}
 /// The PLL's multiplier `PLLN` (8..=127).
 pub const PLL_MUL: u32 = 85;
 /// The PLL's `R` output divider (2, 4, 6 or 8): SYSCLK.
 pub const PLL_RDIV: u32 = 2;
 
-/// SYSCLK [Hz]: `HSI / PLLM x PLLN / PLLR` = 170 MHz.
-pub const SYSCLK_HZ: u32 = HSI_HZ / PLL_PREDIV * PLL_MUL / PLL_RDIV;
+/// SYSCLK [Hz]: `HSE / PLLM x PLLN / PLLR` = 170 MHz (the same from the HSI, checked
+/// below).
+pub const SYSCLK_HZ: u32 = ClockSource::Hse.sysclk_hz();
 /// HCLK [Hz] (AHB undivided): the CPU's clock, the DWT cycle counter's and SysTick's
 /// (`/ 8` for its external reference).
 pub const HCLK_HZ: u32 = SYSCLK_HZ;
 /// The timers' kernel clock [Hz] (APB1 and APB2 undivided): TIM1 (the sample trigger) and
 /// TIM4 (the encoder).
 pub const TIMER_HZ: u32 = SYSCLK_HZ;
-/// The ADC kernel clock's divider (`ADC12_CCR.PRESC`, with `ADC12SEL` = SYSCLK).
-pub const ADC_CLOCK_DIV: u32 = 4;
+/// The ADC kernel clock's divider (`ADC12_CCR.PRESC`, with `ADC12SEL` = SYSCLK): the
+/// smallest that keeps the ADC clock within [`ADC_CLOCK_MAX_HZ`], which is embassy's
+/// choice too; read back at the set-up ([`ADC_PRESC`]).
+pub const ADC_CLOCK_DIV: u32 = adc_clock_divider(SYSCLK_HZ);
+
+/// The smallest divider of `ADC12_CCR.PRESC` that brings `kernel_hz` within
+/// [`ADC_CLOCK_MAX_HZ`] (256 when none does).
+pub const fn adc_clock_divider(kernel_hz: u32) -> u32 {
+    const DIVIDERS: [u32; 12] = [1, 2, 4, 6, 8, 10, 12, 16, 32, 64, 128, 256];
+    let mut rest: &[u32] = &DIVIDERS;
+    while let [div, tail @ ..] = rest {
+        if kernel_hz / *div <= ADC_CLOCK_MAX_HZ {
+            return *div;
+        }
+        rest = tail;
+    }
+    256
+}
+/// `ADC12_CCR.PRESC`'s encoding of [`ADC_CLOCK_DIV`] (RM0440: 0 /1, 1 /2, 2 /4, 3 /6, 4 /8,
+/// 5 /10, 6 /12, 7 /16, 8 /32, 9 /64, 10 /128, 11 /256; 0xFF for a divider it has not):
+/// embassy-stm32 0.6 picks the divider itself in `Adc::new`; the firmware reads the field
+/// back after the set-up (`adc_rules::create_pair`) and reports a difference.
+pub const ADC_PRESC: u32 = match ADC_CLOCK_DIV {
+    1 => 0,
+    2 => 1,
+    4 => 2,
+    6 => 3,
+    8 => 4,
+    10 => 5,
+    12 => 6,
+    16 => 7,
+    32 => 8,
+    64 => 9,
+    128 => 10,
+    256 => 11,
+    _ => 0xFF,
+};
 /// The ADC clock [Hz]: 42.5 MHz.
 pub const ADC_CLOCK_HZ: u32 = SYSCLK_HZ / ADC_CLOCK_DIV;
 
@@ -49,6 +152,14 @@ const _: () = assert!(
     HSI_HZ / PLL_PREDIV >= 2_660_000 && HSI_HZ / PLL_PREDIV <= 16_000_000,
     "PLL input out of range"
 );
+const _: () = assert!(
+    HSE_HZ / HSE_PREDIV >= 2_660_000 && HSE_HZ / HSE_PREDIV <= 16_000_000,
+    "PLL input out of range"
+);
+const _: () = assert!(
+    ClockSource::Hsi.sysclk_hz() == SYSCLK_HZ && HSE_HZ.is_multiple_of(HSE_PREDIV),
+    "the fallback gives another SYSCLK"
+);
 
 /// The divider of [`TIMER_HZ`] that gives `rate_hz`, when it is exact (`None` otherwise, or
 /// for 0): the sample trigger's period in timer clocks.
@@ -66,11 +177,15 @@ mod tests {
 
     #[test]
     fn the_clock_tree_gives_170_mhz_and_the_rates_follow() {
-        // An independent computation: 16 MHz / 4 = 4 MHz PLL input, x 85 = 340 MHz VCO,
-        // / 2 = 170 MHz.
+        // An independent computation: 24 MHz / 6 (16 MHz / 4 from the HSI) = 4 MHz PLL
+        // input, x 85 = 340 MHz VCO, / 2 = 170 MHz.
         assert_eq!(SYSCLK_HZ, 170_000_000);
+        assert_eq!(ClockSource::Hse.sysclk_hz(), 170_000_000);
+        assert_eq!(ClockSource::Hsi.sysclk_hz(), 170_000_000);
+        assert_eq!(ClockSource::Hse.prediv(), 6);
         assert_eq!(CYCLES_PER_MS, 170_000);
         assert_eq!(ADC_CLOCK_HZ, 42_500_000);
+        assert_eq!(ADC_PRESC, 0b0010);
         assert_eq!(timer_divider(10_000), Some(17_000));
         assert_eq!(timer_divider(80_000), Some(2_125));
         assert_eq!(timer_divider(30_000), None);

@@ -6,8 +6,9 @@
 //!   ic) eight times per sample of [`SETTINGS`]; each ADC fills a DMA ring of two halves of
 //!   eight sequences (`drive_monitor::acquisition`), so every sample wakes the task
 //!   (half- and full-transfer interrupts). The task sums the sequences, runs
-//!   `acquisition::PwmFilter` (an inverter's in-band ripple out), reads the encoder counter
-//!   (TIM4) and runs `SamplePath::on_frame` (scaling and `Monitor::update`). Every wait for
+//!   `acquisition::PwmFilter` (an inverter's in-band ripple out), takes the encoder counts
+//!   TIM4 latched at the same triggers (its capture on TIM1's TRGO, copied by DMA1 channel 3
+//!   into a ring beside the ADCs') and runs `SamplePath::on_frame` (scaling and `Monitor::update`). Every wait for
 //!   ADC data has a timeout (`drive_monitor::liveness::AdcWait`): when it expires (an ADC
 //!   overrun, a DMA transfer error, a stopped trigger) or the DMA lapped the reader, the
 //!   acquisition is recovered by `drive_monitor::recovery::recover` on the registers
@@ -61,21 +62,28 @@ use drive_monitor::app::{
 };
 use drive_monitor::board::{self, pins::Board, Lamp, LAMP_COUNT};
 use drive_monitor::boot::{self, BootMachine};
-use drive_monitor::clock;
+use drive_monitor::clock::{self, ClockSource};
 use drive_monitor::commissioning::Action;
 use drive_monitor::offset_trim::TrimResult;
 use drive_monitor::panel::PanelLamps;
 use drive_monitor::reset_record::{BootPhase, PreviousRun, RESET_RECORD_LEN};
-use drive_monitor::supply::BorCheck;
+use drive_monitor::supply::{BorCheck, BorGate};
+use drive_monitor::{debug_halt, watchdog};
 use monitor_core::Isolation;
 
 use drive_monitor::flash_ecc::CheckedFlash;
 use flash::{read_motor_page, BoardFlash, Driver};
 use sample_task::{sample_task, SampleHw};
 
+// Every defmt frame carries the time since boot in microseconds (embassy-time's clock; what
+// embassy-time's `defmt-timestamp-uptime` feature defines, written here so the build's
+// features stay as they are). Frames logged before `init` would read 0; none are.
+defmt::timestamp!("{=u64:us}", embassy_time::Instant::now().as_micros());
+
 bind_interrupts!(struct Irqs {
     DMA1_CHANNEL1 => acquisition::AdcDmaInterrupt<peripherals::DMA1_CH1, 0>;
     DMA1_CHANNEL2 => acquisition::AdcDmaInterrupt<peripherals::DMA1_CH2, 1>;
+    DMA1_CHANNEL3 => acquisition::AdcDmaInterrupt<peripherals::DMA1_CH3, 2>;
     EXTI15_10 => exti::InterruptHandler<interrupt::typelevel::EXTI15_10>;
 });
 
@@ -97,6 +105,15 @@ unsafe impl
     interrupt::typelevel::Binding<
         interrupt::typelevel::DMA1_CHANNEL2,
         dma::InterruptHandler<peripherals::DMA1_CH2>,
+    > for Irqs
+{
+}
+// SAFETY: as above, for channel 3 (the encoder latch's ring).
+#[allow(unsafe_code)]
+unsafe impl
+    interrupt::typelevel::Binding<
+        interrupt::typelevel::DMA1_CHANNEL3,
+        dma::InterruptHandler<peripherals::DMA1_CH3>,
     > for Irqs
 {
 }
@@ -192,15 +209,45 @@ impl PanelPins {
     }
 }
 
-fn clock_config() -> embassy_stm32::Config {
+/// Starts the board's 24 MHz crystal (HSE) on the registers and waits for it at most
+/// `clock::HSE_STARTUP_TIMEOUT_MS` (the core runs on the 16 MHz HSI after reset: 16 000
+/// cycles a millisecond): embassy-stm32's clock set-up waits for `HSERDY` without a bound,
+/// so it is handed the crystal only once it runs. A crystal that did not start is
+/// switched off again and the clock falls back to the HSI (`ClockSource::Hsi`).
+fn start_crystal() -> ClockSource {
+    pac::RCC.cr().modify(|w| w.set_hseon(true));
+    for _ in 0..clock::HSE_STARTUP_TIMEOUT_MS {
+        if pac::RCC.cr().read().hserdy() {
+            return ClockSource::Hse;
+        }
+        cortex_m::asm::delay(clock::HSI_HZ / 1_000);
+    }
+    if pac::RCC.cr().read().hserdy() {
+        return ClockSource::Hse;
+    }
+    pac::RCC.cr().modify(|w| w.set_hseon(false));
+    ClockSource::Hsi
+}
+
+fn clock_config(source: ClockSource) -> embassy_stm32::Config {
     use embassy_stm32::rcc::*;
     let mut config = embassy_stm32::Config::default();
-    // 16 MHz HSI / 4 * 85 / 2 = 170 MHz SYSCLK (the G474's maximum, needs boost mode):
-    // the settings of `drive_monitor::clock`, from which every rate and cycle count is
-    // derived (the registers' encodings: PLLM - 1, PLLN, PLLR / 2 - 1).
+    // 24 MHz HSE / 6 (or 16 MHz HSI / 4) * 85 / 2 = 170 MHz SYSCLK (the G474's maximum,
+    // needs boost mode): the settings of `drive_monitor::clock`, from which every rate and
+    // cycle count is derived (the registers' encodings: PLLM - 1, PLLN, PLLR / 2 - 1).
+    let pll_source = match source {
+        ClockSource::Hse => {
+            config.rcc.hse = Some(Hse {
+                freq: embassy_stm32::time::Hertz(clock::HSE_HZ),
+                mode: HseMode::Oscillator,
+            });
+            PllSource::HSE
+        }
+        ClockSource::Hsi => PllSource::HSI,
+    };
     config.rcc.pll = Some(Pll {
-        source: PllSource::HSI,
-        prediv: PllPreDiv::from_bits((clock::PLL_PREDIV - 1) as u8),
+        source: pll_source,
+        prediv: PllPreDiv::from_bits((source.prediv() - 1) as u8),
         mul: PllMul::from_bits(clock::PLL_MUL as u8),
         divp: None,
         divq: None,
@@ -213,14 +260,45 @@ fn clock_config() -> embassy_stm32::Config {
     config
 }
 
-/// The independent watchdog, started, and frozen while a debugger halts the core
-/// (`DBGMCU_APB1FZR1.DBG_IWDG_STOP`): stepping through the firmware does not reset it.
+/// The first thing `main` does, before the clock set-up (which waits for the crystal and
+/// the PLL): what a debugger's halt freezes (`drive_monitor::debug_halt::FROZEN`: TIM1, the
+/// sample trigger; TIM15, embassy-time's clock; the IWDG), then the independent watchdog
+/// started with the boot's timeout (`drive_monitor::watchdog::BOOT_SETTING`, 1 s, covering
+/// the boot's budget at the fastest LSI). On the registers, before embassy-stm32's `init`
+/// (`firmware/under_the_hal.rs` lists why); `start_watchdog` shortens it once the boot ran.
+fn start_boot_watchdog() {
+    let frozen = debug_halt::FROZEN;
+    pac::DBGMCU.apb2fzr().modify(|w| {
+        w.set_tim1(frozen.trigger);
+        w.set_tim15(frozen.time_base);
+    });
+    pac::DBGMCU
+        .apb1lfzr()
+        .modify(|w| w.set_iwdg(frozen.watchdog));
+    let setting = watchdog::BOOT_SETTING;
+    let iwdg = pac::IWDG;
+    // Start (the LSI with it), unlock PR/RLR, the boot's timeout, reload.
+    iwdg.kr().write(|w| w.set_key(pac::iwdg::vals::Key::START));
+    iwdg.kr().write(|w| w.set_key(pac::iwdg::vals::Key::ENABLE));
+    iwdg.pr()
+        .write(|w| w.set_pr(pac::iwdg::vals::Pr::from_bits(setting.pr)));
+    iwdg.rlr().write(|w| w.set_rl(setting.rlr));
+    // The new values reach the LSI domain within a few LSI periods (bounded: 48 us each).
+    let mut polls = 0u32;
+    while (iwdg.sr().read().pvu() || iwdg.sr().read().rvu()) && polls < 100_000 {
+        polls += 1;
+    }
+    iwdg.kr().write(|w| w.set_key(pac::iwdg::vals::Key::RESET));
+}
+
+/// The independent watchdog at its running timeout (`WATCHDOG_TIMEOUT_MS`, 500 ms): it
+/// runs since [`start_boot_watchdog`]; embassy's driver writes the shorter timeout.
 fn start_watchdog(
     iwdg: Peri<'static, peripherals::IWDG>,
 ) -> IndependentWatchdog<'static, peripherals::IWDG> {
-    pac::DBGMCU.apb1lfzr().modify(|w| w.set_iwdg(true));
     let mut wdg = IndependentWatchdog::new(iwdg, WATCHDOG_TIMEOUT_MS * 1000);
     wdg.unleash();
+    wdg.pet();
     wdg
 }
 
@@ -251,8 +329,11 @@ fn boot_board(
 /// thread mode's periods ([`Thread::run`]).
 #[embassy_executor::main]
 async fn main(_spawner: Spawner) {
-    let p = embassy_stm32::init(clock_config());
+    start_boot_watchdog();
+    let source = start_crystal();
+    let p = embassy_stm32::init(clock_config(source));
     info!("drive-monitor {} starting", env!("CARGO_PKG_VERSION"));
+    logs::log_clock(source);
     let previous = logs::previous_run();
     // The brown-out level of the option bytes: reported, not written (`drive_monitor::supply`).
     let bor = supply::bor_check();
@@ -264,9 +345,12 @@ async fn main(_spawner: Spawner) {
     let dual_bank = dual_bank_flash();
     let mut thread = Thread {
         lamps: PanelPins::new(b.lamps),
-        flash: BoardFlash(CheckedFlash::new(Driver(
-            dual_bank.then(|| Flash::new_blocking(b.flash)),
-        ))),
+        flash: BorGate {
+            store: BoardFlash(CheckedFlash::new(Driver(
+                dual_bank.then(|| Flash::new_blocking(b.flash)),
+            ))),
+            bor,
+        },
         wdg,
         max_update_cycles: 0,
         log_div: 0,
@@ -274,13 +358,15 @@ async fn main(_spawner: Spawner) {
     };
     let mut button = ExtiInput::new(b.button, b.button_exti, Pull::Down, Irqs);
 
-    let (machine, path, mut supervisor) = boot_board(&mut thread.flash, previous);
+    let (machine, path, mut supervisor) = boot_board(&mut thread.flash.store, previous);
+    supervisor.set_clock_fallback(source == ClockSource::Hsi);
     let boot = Instant::now();
     let hw = SampleHw {
         adc1: b.adc1,
         adc2: b.adc2,
         dma1: b.adc1_dma,
         dma2: b.adc2_dma,
+        dma3: b.encoder_dma,
         tim1: b.trigger_timer,
         v: b.voltage,
         i: b.current,
@@ -340,7 +426,8 @@ fn spawn_sample_task(hw: SampleHw, path: SamplePath) {
 /// the log's state.
 struct Thread {
     lamps: PanelPins,
-    flash: BoardFlash,
+    /// The record pages, erases and writes refused below the brown-out goal.
+    flash: BorGate<BoardFlash>,
     wdg: IndependentWatchdog<'static, peripherals::IWDG>,
     /// The sample task's longest `Monitor::update` so far, in CPU cycles (from its status).
     max_update_cycles: u32,

@@ -5,6 +5,13 @@
 //! - [`clock`]: the clock tree's settings and every rate and cycle count derived from them;
 //! - [`acquisition`]: the ADCs' geometry (channels, oversampling, DMA ring, conversion
 //!   time), shared with the host's model of the ADC and DMA, and the oversampling's mean;
+//! - [`adc_rules`]: the ADC's register rules the HAL does not keep (set-only bits, the
+//!   common prescaler, `DMAEN`, the first conversion after an idle, VREFINT's start-up);
+//! - [`debug_halt`]: what a debugger's halt freezes (the trigger, the time base, the
+//!   watchdog);
+//! - [`under_the_hal`]: where the firmware writes registers under embassy-stm32, why, and
+//!   the HAL version that was checked;
+//! - [`watchdog`]: the watchdog started first, with a first timeout covering the boot;
 //! - [`fault_path`]: the end of a failed run (guard, record, panel; no log);
 //! - [`flash_ecc`]: the record pages' ECC double errors (the NMI's decision, the checked
 //!   reads that mark a page bad);
@@ -57,11 +64,13 @@
 )]
 
 pub mod acquisition;
+pub mod adc_rules;
 pub mod app;
 pub mod board;
 pub mod boot;
 pub mod clock;
 pub mod commissioning;
+pub mod debug_halt;
 pub mod fault_path;
 pub mod flash_ecc;
 pub mod flash_record;
@@ -75,3 +84,5 @@ pub mod reset_record;
 pub mod sampling;
 pub mod setup_guard;
 pub mod supply;
+pub mod under_the_hal;
+pub mod watchdog;

@@ -20,7 +20,10 @@
 //! option bytes are single-bank and the flash is not used), the firmware monitors the
 //! built-in default machine: then, in the three monitoring/commissioning patterns above,
 //! the RUN lamp is lit **steadily for the first 2 s of every 10 s**, dark for 0.5 s, then
-//! shows its pattern as above for 7.5 s. No other state lights the RUN lamp for more than
+//! shows its pattern as above for 7.5 s. **Clock on the internal oscillator**: when the
+//! board's 24 MHz crystal did not start and the clock fell back to the HSI (+-1 %), the RUN
+//! lamp is lit steadily from 5 s to 7 s of every 10 s, then dark for 0.5 s (both marks
+//! show together when both apply). No other state lights the RUN lamp for more than
 //! 500 ms at a time.
 //!
 //! The RUN lamp is never off for more than 1.7 s while the monitor runs, so "RUN off and
@@ -171,6 +174,9 @@ pub struct PanelInput {
     /// The built-in default motor is monitored (no valid motor record): the RUN lamp's
     /// steady 2 s of every 10 s (module docs).
     pub default_motor: bool,
+    /// The crystal (HSE) did not start and the clock runs on the internal oscillator
+    /// (HSI, +-1 %): the RUN lamp's steady 2 s from 5 s of every 10 s (module docs).
+    pub clock_fallback: bool,
     /// Commissioned, and the operating point (load or voltage) has left the commissioned
     /// range with no fault named: the RUN lamp's triple flash, the "amber" state (module
     /// docs). The application clears `fault_detected` for the lamps' detection then.
@@ -204,6 +210,9 @@ const DEFAULT_MOTOR_PERIOD_MS: u32 = 10_000;
 const DEFAULT_MOTOR_ON_MS: u32 = 2_000;
 /// The dark gap after it, ms (so the mark is never longer than 2 s).
 const DEFAULT_MOTOR_GAP_MS: u32 = 500;
+/// Where the "clock on the internal oscillator" mark starts in the same 10 s period, ms:
+/// the same 2 s steady and 0.5 s dark, apart from the default motor's.
+const CLOCK_FALLBACK_AT_MS: u32 = 5_000;
 
 /// Fault lamp state at `t_ms` for blink code `n` (>= 1): `n` pulses of 250 ms in 500 ms
 /// slots, then 1.5 s dark; period `n * 500 + 1500` ms.
@@ -245,9 +254,12 @@ pub fn render(input: &PanelInput, t_ms: u32) -> PanelLamps {
     }
     let learning = input.mode == Mode::Commissioning;
     let mark_phase = t_ms % DEFAULT_MOTOR_PERIOD_MS;
-    let run = match input.default_motor {
-        true if mark_phase < DEFAULT_MOTOR_ON_MS => true,
-        true if mark_phase < DEFAULT_MOTOR_ON_MS + DEFAULT_MOTOR_GAP_MS => false,
+    let clock_phase = mark_phase.wrapping_sub(CLOCK_FALLBACK_AT_MS);
+    let run = match (input.default_motor, input.clock_fallback) {
+        (true, _) if mark_phase < DEFAULT_MOTOR_ON_MS => true,
+        (true, _) if mark_phase < DEFAULT_MOTOR_ON_MS + DEFAULT_MOTOR_GAP_MS => false,
+        (_, true) if clock_phase < DEFAULT_MOTOR_ON_MS => true,
+        (_, true) if clock_phase < DEFAULT_MOTOR_ON_MS + DEFAULT_MOTOR_GAP_MS => false,
         _ if input.moved && input.mode == Mode::Commissioned => moved_run_lamp(t_ms),
         _ => run_lamp(input.mode, t_ms),
     };
@@ -319,6 +331,7 @@ mod tests {
             fault_code: 4,
             commissioning_failed: false,
             default_motor: false,
+            clock_fallback: false,
             moved: false,
         }
     }
@@ -369,6 +382,24 @@ mod tests {
             .map(|k| render(&inp, k * 50).is_on(Lamp::Fault))
             .collect();
         assert_eq!(read_blink_code(&trace, 50), Some(4));
+    }
+
+    /// The crystal's fallback mark: the RUN lamp steady from 5 s to 7 s of every 10 s, the
+    /// mode's pattern elsewhere; apart from (and together with) the default motor's.
+    #[test]
+    fn the_clock_fallback_lights_the_run_lamp_for_2_s_from_5_s_in_10() {
+        for mode in NORMAL {
+            let mut inp = input(mode);
+            inp.clock_fallback = true;
+            assert_eq!(longest_run_on_ms(&inp), 2_000, "{mode:?}");
+            assert!((0..200u32).all(|k| render(&inp, 15_000 + k * 10).run));
+            assert!((0..50u32).all(|k| !render(&inp, 17_000 + k * 10).run));
+            let own = |t: u32| render(&input(mode), t).run;
+            assert!((0..500u32).all(|k| render(&inp, k * 10).run == own(k * 10)));
+            inp.default_motor = true;
+            assert!((0..200u32).all(|k| render(&inp, k * 10).run));
+            assert!((0..200u32).all(|k| render(&inp, 5_000 + k * 10).run));
+        }
     }
 
     const NORMAL: [Mode; 3] = [

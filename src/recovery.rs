@@ -20,11 +20,11 @@
 //! | step | what | why this order |
 //! |---|---|---|
 //! | [`RecoveryStep::StopTrigger`] | TIM1 counter off | no new conversion starts |
-//! | [`RecoveryStep::StopAdc`] | `ADSTP`, then wait for `ADSTART = 0` (bounded) | a conversion in flight ends before the DMA stops (else it would set `OVR` itself) |
-//! | [`RecoveryStep::PauseDma`] | `DMAEN = 0` in `ADC_CFGR`, then the channel's `EN = 0` and a wait for it (bounded) | the ADC withdraws its DMA request (a request latched while the channel was off, after a transfer error, would otherwise move one stale word at the re-arm and shift the channels in the ring for good); `CNDTR` may only be written with the channel off |
+//! | [`RecoveryStep::StopAdc`] | `ADSTP` (written alone: `adc_rules::cr_setting`), then wait for `ADSTART = 0` and `JADSTART = 0` (bounded) | a conversion in flight ends before the DMA stops (else it would set `OVR` itself); `DMAEN` may change only with no regular and no injected conversion ongoing |
+//! | [`RecoveryStep::PauseDma`] | `DMAEN = 0` in `ADC_CFGR`, then the channels' `EN = 0` (the encoder latch's too) and a wait for them (bounded) | the ADC withdraws its DMA request (a request latched while the channel was off, after a transfer error, would otherwise move one stale word at the re-arm and shift the channels in the ring for good); `CNDTR` may only be written with the channel off |
 //! | [`RecoveryStep::ClearFlags`] | `OVR`, `EOC`, `EOS` (write 1), `TEIF`/`HTIF`/`TCIF` (`DMA_IFCR`) | a latched `OVR` blocks the DMA requests; an `EOC` left set (the data register unread since the overrun) sets `OVR` again at the next conversion |
-//! | [`RecoveryStep::RearmDma`] | `CNDTR` = ring length, ring indices reset, `DMAEN`/`DMACFG` circular, `EN = 1` | the DMA is ready before the ADC asks |
-//! | [`RecoveryStep::StartAdc`] | `ADSTART = 1` (waits for the next trigger) | both ADCs armed before the trigger |
+//! | [`RecoveryStep::RearmDma`] | `CNDTR` = ring length, ring indices reset (the encoder latch's ring too), `DMAEN`/`DMACFG` circular, `EN = 1` | the DMA is ready before the ADC asks |
+//! | [`RecoveryStep::StartAdc`] | `ADSTART = 1`, written alone (waits for the next trigger) | both ADCs armed before the trigger |
 //! | [`RecoveryStep::StartTrigger`] | TIM1 counter on, timestamps continue from now | ADC1 and ADC2 start on the same trigger |
 //!
 //! The sequence is written once, over the [`Acquisition`] trait, and its register accesses
@@ -34,6 +34,8 @@
 //! and checks every access's precondition (`tests/sil/recovery.rs`), into which they inject
 //! an overrun, a DMA error and a lapped ring. The monitor itself (its thresholds, the commissioning state, the
 //! counters) is not touched by a recovery: only the acquisition restarts.
+
+use crate::adc_rules::{cr_setting, ADDIS, ADSTART, ADSTP, JADSTART};
 
 /// One step of the recovery sequence, in its order (module docs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -198,19 +200,16 @@ pub trait AcqRegisters {
     fn adc_flags(&mut self, i: usize) -> AdcFlags;
     /// Writes 1 to the flags set in `f` of ADC `i`'s `ADC_ISR` (clears them).
     fn adc_clear(&mut self, i: usize, f: AdcFlags);
-    /// `ADSTART` of ADC `i`: its regular conversions are on.
-    fn adc_started(&mut self, i: usize) -> bool;
-    /// `ADDIS` of ADC `i`: it is being disabled.
-    fn adc_disabling(&mut self, i: usize) -> bool;
-    /// Sets `ADSTP` of ADC `i` (allowed only with `ADSTART = 1` and `ADDIS = 0`).
-    fn adc_stop(&mut self, i: usize);
-    /// Sets `ADSTART` of ADC `i`.
-    fn adc_start(&mut self, i: usize);
+    /// `ADC_CR` of ADC `i` (the bits of [`crate::adc_rules`]).
+    fn adc_cr(&mut self, i: usize) -> u32;
+    /// Writes `value` to ADC `i`'s `ADC_CR`: the sequence writes one set-only bit at a time
+    /// ([`crate::adc_rules::cr_setting`]); `ADSTP` only with `ADSTART = 1` and `ADDIS = 0`.
+    fn adc_cr_write(&mut self, i: usize, value: u32);
     /// `DMAEN = 1`, `DMACFG` circular in ADC `i`'s `ADC_CFGR` (allowed only with
     /// `ADSTART = 0`).
     fn adc_dma_circular(&mut self, i: usize);
-    /// `DMAEN = 0` in ADC `i`'s `ADC_CFGR` (allowed only with `ADSTART = 0`): the ADC
-    /// issues no DMA request, and withdraws one it raised.
+    /// `DMAEN = 0` in ADC `i`'s `ADC_CFGR` (allowed only with `ADSTART = 0` and
+    /// `JADSTART = 0`): the ADC issues no DMA request, and withdraws one it raised.
     fn adc_dma_off(&mut self, i: usize);
     /// `TEIF` of DMA channel `i`.
     fn dma_error(&mut self, i: usize) -> bool;
@@ -225,6 +224,19 @@ pub trait AcqRegisters {
     fn dma_reload(&mut self, i: usize, transfers: u16);
     /// Enables DMA channel `i` (`EN = 1`).
     fn dma_enable(&mut self, i: usize);
+    /// Disables the encoder latch's DMA channel (`EN = 0`): the channel that copies the
+    /// encoder timer's captured count at every trigger into its ring
+    /// (`acquisition::LATCH_LEN`).
+    fn latch_disable(&mut self);
+    /// `EN` of the encoder latch's DMA channel.
+    fn latch_enabled(&mut self) -> bool;
+    /// Clears the latch channel's `TEIF`, `HTIF`, `TCIF`, `GIF`.
+    fn latch_clear(&mut self);
+    /// Writes the latch channel's `CNDTR` (allowed only with `EN = 0`) and resets its
+    /// ring's read position to match.
+    fn latch_reload(&mut self, transfers: u16);
+    /// Enables the latch channel (`EN = 1`).
+    fn latch_enable(&mut self);
     /// Stops the sample trigger (TIM1's counter).
     fn trigger_stop(&mut self);
     /// Starts the sample trigger.
@@ -258,27 +270,34 @@ impl<R: AcqRegisters> Acquisition for RegisterAcquisition<R> {
 
     fn stop_adc(&mut self) -> Result<(), StepTimeout> {
         for i in CHANNELS {
-            if self.regs.adc_started(i) && !self.regs.adc_disabling(i) {
-                self.regs.adc_stop(i);
+            let cr = self.regs.adc_cr(i);
+            if cr & ADSTART != 0 && cr & ADDIS == 0 {
+                self.regs.adc_cr_write(i, cr_setting(cr, ADSTP));
             }
         }
+        // The regular conversions stopped and an injected one (the reference's, from thread
+        // mode) ended: DMAEN may change only with neither ongoing.
         let regs = &mut self.regs;
         poll_until(RecoveryStep::StopAdc, POLL_LIMIT, || {
-            CHANNELS.iter().all(|&i| !regs.adc_started(i))
+            CHANNELS
+                .iter()
+                .all(|&i| regs.adc_cr(i) & (ADSTART | JADSTART) == 0)
         })
     }
 
     fn pause_dma(&mut self) -> Result<(), StepTimeout> {
         for i in CHANNELS {
-            // ADSTART = 0 here (the step before waited for it), so DMAEN is writable.
+            // ADSTART = JADSTART = 0 here (the step before waited for both): DMAEN is
+            // writable.
             self.regs.adc_dma_off(i);
         }
         for i in CHANNELS {
             self.regs.dma_disable(i);
         }
+        self.regs.latch_disable();
         let regs = &mut self.regs;
         poll_until(RecoveryStep::PauseDma, POLL_LIMIT, || {
-            CHANNELS.iter().all(|&i| !regs.dma_enabled(i))
+            CHANNELS.iter().all(|&i| !regs.dma_enabled(i)) && !regs.latch_enabled()
         })
     }
 
@@ -287,6 +306,7 @@ impl<R: AcqRegisters> Acquisition for RegisterAcquisition<R> {
             self.regs.adc_clear(i, AdcFlags::RECOVERY_CLEAR);
             self.regs.dma_clear(i);
         }
+        self.regs.latch_clear();
     }
 
     fn rearm_dma(&mut self) {
@@ -294,6 +314,11 @@ impl<R: AcqRegisters> Acquisition for RegisterAcquisition<R> {
             // The channel is off: CNDTR is writable.
             self.regs.dma_reload(i, self.ring_len);
         }
+        // The encoder latch from its ring's start too, one count per sequence: the counts
+        // stay at the places of the conversions of the same trigger.
+        let channels = crate::acquisition::CHANNELS as u16;
+        self.regs.latch_reload(self.ring_len / channels);
+        self.regs.latch_enable();
         for i in CHANNELS {
             // ADSTART = 0 here, so DMAEN/DMACFG are writable.
             self.regs.adc_dma_circular(i);
@@ -305,7 +330,8 @@ impl<R: AcqRegisters> Acquisition for RegisterAcquisition<R> {
 
     fn start_adc(&mut self) {
         for i in CHANNELS {
-            self.regs.adc_start(i);
+            let cr = self.regs.adc_cr(i);
+            self.regs.adc_cr_write(i, cr_setting(cr, ADSTART));
         }
     }
 

@@ -83,6 +83,11 @@ impl AdcSampler {
         self.front_end = front_end;
     }
 
+    /// Skips one sample's timestamp (a sample dropped, `adc_rules::IdleDiscard`).
+    pub fn skip(&mut self) {
+        self.next_ticks = self.next_ticks.wrapping_add(self.ticks_per_sample);
+    }
+
     /// Continue the timestamps from `now_ticks` (after lost samples).
     pub fn resync(&mut self, now_ticks: u32) {
         self.next_ticks = now_ticks;

@@ -13,6 +13,8 @@
 //! on the log and on every status line (`bor=`) which level is in force, and puts the
 //! level into every reset record it writes, and warns at every boot while it is below the
 //! goal; `cargo fw bor` programs level 4 once per board (`docs/firmware.md`, bring-up).
+//! Until it is in force, the flash records are refused ([`BorGate`]): a sag during a
+//! commissioning's erase or write would tear the record at level 0.
 //!
 //! **Reference.** Every reading scales with VDDA, the ADC's reference. Thread mode measures
 //! it through VREFINT every [`REFERENCE_PERIOD_MS`] ([`ReferenceWatch`]) on ADC1's injected
@@ -112,9 +114,57 @@ impl BorCheck {
         }
     }
 
+    /// Whether the flash records may be erased and written: only at [`BOR_GOAL`]. Below it
+    /// a supply sag during an erase or a write (the commissioning's, a few ms each) would
+    /// tear the record instead of resetting the MCU first ([`BorGate`]).
+    pub fn allows_flash_writes(self) -> bool {
+        matches!(self, BorCheck::AtGoal(_))
+    }
+
     /// The status line's `bor=` value: the level's number, or 255 for a reserved value.
     pub fn status_number(self) -> u8 {
         self.level().map_or(u8::MAX, BorLevel::number)
+    }
+}
+
+/// A store error that says the brown-out level refused the erase or the write
+/// ([`BorGate`]).
+pub trait FromBorRefusal {
+    /// The error for a write refused at the brown-out level `check`.
+    fn bor_refused(check: BorCheck) -> Self;
+}
+
+/// A record store whose erases and writes are refused while the brown-out level is below
+/// [`BOR_GOAL`] ([`BorCheck::allows_flash_writes`]): the commissioning then ends "not
+/// stored", and the boot report says why (`cargo fw bor` programs the level once per
+/// board). Reads pass.
+#[derive(Debug)]
+pub struct BorGate<S> {
+    /// The store.
+    pub store: S,
+    /// The brown-out level found at boot.
+    pub bor: BorCheck,
+}
+
+impl<S: crate::flash_record::RecordStore> crate::flash_record::RecordStore for BorGate<S>
+where
+    S::Error: FromBorRefusal,
+{
+    type Error = S::Error;
+    fn read(&mut self, buf: &mut [u8; crate::flash_record::RECORD_LEN]) -> Result<(), S::Error> {
+        self.store.read(buf)
+    }
+    fn erase(&mut self) -> Result<(), S::Error> {
+        if !self.bor.allows_flash_writes() {
+            return Err(S::Error::bor_refused(self.bor));
+        }
+        self.store.erase()
+    }
+    fn write(&mut self, bytes: &[u8; crate::flash_record::RECORD_LEN]) -> Result<(), S::Error> {
+        if !self.bor.allows_flash_writes() {
+            return Err(S::Error::bor_refused(self.bor));
+        }
+        self.store.write(bytes)
     }
 }
 
@@ -139,6 +189,11 @@ pub trait ReferenceAdc {
     /// The factory's calibration word `VREFINT_CAL`: the reading of VREFINT at
     /// VDDA = 3.0 V ([`crate::board::vdda_from_vrefint`]).
     fn calibration(&self) -> u16;
+    /// Switches the VREFINT buffer on (`ADC12_CCR.VREFEN`); its output is valid only after
+    /// its start-up time ([`crate::adc_rules::VREFINT_START_US`]).
+    fn enable(&mut self);
+    /// Waits `us` microseconds (on the board a bounded busy wait on the CPU clock).
+    fn wait_us(&mut self, us: u32);
     /// Starts one conversion (`JADSTART = 1`; a conversion in progress is left alone).
     fn start(&mut self);
     /// The result when the conversion has finished (`JEOS` set: `JDR1` read, `JEOS`
@@ -153,12 +208,16 @@ fn convert_now(adc: &mut impl ReferenceAdc) -> Option<u16> {
 }
 
 /// One measurement now, each conversion waited for at most [`REFERENCE_POLL_LIMIT`]
-/// polls: the start-up check, right after `VREFEN` was set, before the sample path runs.
-/// The VREFINT buffer needs its start-up time after `VREFEN` (datasheet
-/// `t_start_vrefint`, microseconds) before its output is valid, and the first conversion
-/// samples it within that time: that conversion is **discarded**, and the second, one
-/// conversion time (6.1 us) later, is the measurement.
+/// polls: the start-up check, before the sample path runs. It switches the VREFINT buffer
+/// on (`VREFEN`) and waits its start-up time (datasheet `tstart_vrefint`, up to
+/// [`crate::adc_rules::VREFINT_START_US`]) before the first conversion: converted earlier,
+/// the buffer's output is not valid (the former check converted right after `VREFEN` and
+/// kept the second conversion, which sampled 6-12 us after it). The first conversion is
+/// still discarded (the ADC's own first after an idle, `adc_rules`), the second is the
+/// measurement.
 pub fn measure_now(adc: &mut impl ReferenceAdc) -> ReferenceCheck {
+    adc.enable();
+    adc.wait_us(crate::adc_rules::VREFINT_START_US);
     if convert_now(adc).is_none() {
         return ReferenceCheck::Unreadable;
     }
@@ -293,20 +352,30 @@ mod tests {
         assert!(BorLevel::Level3 < BOR_GOAL);
     }
 
-    /// A VREFINT that converts at once to the code a given VDDA gives.
+    /// A VREFINT that converts to the code a given VDDA gives, on a clock: each
+    /// conversion samples for 5.8 us and ends 6.1 us after its start; one that begins
+    /// sampling less than 12 us (ST's longest `tstart_vrefint`) after `VREFEN` reads the
+    /// buffer still starting (its output at half its value).
     struct Fake {
         vdda: f32,
         cal: u16,
         pending: bool,
         converts: bool,
-        /// Conversions so far: the first after `VREFEN` samples a buffer still starting
-        /// (its output at half its value).
-        conversions: u32,
+        /// Time since `VREFEN` [us] (`None`: not enabled).
+        since_enable_us: Option<f32>,
     }
 
     impl ReferenceAdc for Fake {
         fn calibration(&self) -> u16 {
             self.cal
+        }
+        fn enable(&mut self) {
+            self.since_enable_us.get_or_insert(0.0);
+        }
+        fn wait_us(&mut self, us: u32) {
+            if let Some(t) = self.since_enable_us.as_mut() {
+                *t += us as f32;
+            }
         }
         fn start(&mut self) {
             self.pending = true;
@@ -314,8 +383,14 @@ mod tests {
         fn result(&mut self) -> Option<u16> {
             let done = self.pending && self.converts;
             self.pending &= !done;
-            let settled = self.conversions > 0;
-            self.conversions += u32::from(done);
+            let sampled_at = self.since_enable_us;
+            if done {
+                self.wait_us(0);
+                if let Some(t) = self.since_enable_us.as_mut() {
+                    *t += 6.1;
+                }
+            }
+            let settled = sampled_at.is_some_and(|t| t >= 12.0);
             let code = f32::from(self.cal) * 3.0 / self.vdda;
             done.then(|| if settled { code } else { code / 2.0 }.round() as u16)
         }
@@ -328,9 +403,10 @@ mod tests {
             cal: 1655,
             pending: false,
             converts: true,
-            conversions: 0,
+            since_enable_us: None,
         };
-        // The first conversion (the buffer starting) would read VDDA twice too high.
+        // A conversion within 12 us of VREFEN (the buffer starting) would read VDDA twice
+        // too high: the former check's kept conversion sampled at 6.1 us.
         assert!(
             matches!(measure_now(&mut adc), ReferenceCheck::InBand(v) if (v - 3.3).abs() < 0.01)
         );

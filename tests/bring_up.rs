@@ -1,8 +1,8 @@
 //! The bring-up a first board gets (issue 51): `cargo fw-run`'s runner lets the firmware's
 //! own handlers run (probe-rs catches neither the reset nor the HardFault), and
 //! docs/firmware.md's bring-up checklist puts the steps in the order a board needs them:
-//! the motor record into flash, the brown-out level, the run with the handlers visible,
-//! the boot report.
+//! the motor record into flash, the crystal, the debugger, the brown-out level, the run
+//! with the handlers visible, the boot report.
 
 use std::path::Path;
 
@@ -53,6 +53,8 @@ fn the_bring_up_list_runs_record_brown_out_handlers_boot_report() {
     };
     let order = [
         at("motor record"),
+        at("crystal"),
+        at("debugger"),
         at("brown-out"),
         at("handlers visible"),
         at("boot report"),

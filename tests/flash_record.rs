@@ -89,3 +89,62 @@ fn values_out_of_the_cores_range_are_not_applied() {
     assert!(path.command(Command::SetCalibration(record())).is_ok());
     assert!(path.monitor().calibration().is_some());
 }
+
+/// Flash records refused below the brown-out goal (`drive_monitor::supply::BorGate`): a
+/// commissioning's record at the factory's level 0 is neither erased nor written (the page
+/// keeps the old record, and the store says why); at level 4 it is stored.
+#[test]
+fn records_are_refused_while_the_brown_out_level_is_below_the_goal() {
+    use drive_monitor::flash_record::{store, RecordStore, StoreError};
+    use drive_monitor::supply::{BorCheck, BorGate, BorLevel, FromBorRefusal};
+
+    #[derive(Debug, PartialEq)]
+    enum E {
+        Bor(BorCheck),
+    }
+    impl FromBorRefusal for E {
+        fn bor_refused(check: BorCheck) -> Self {
+            E::Bor(check)
+        }
+    }
+    struct Page([u8; RECORD_LEN], u32);
+    impl RecordStore for Page {
+        type Error = E;
+        fn read(&mut self, buf: &mut [u8; RECORD_LEN]) -> Result<(), E> {
+            *buf = self.0;
+            Ok(())
+        }
+        fn erase(&mut self) -> Result<(), E> {
+            self.0 = [0xFF; RECORD_LEN];
+            self.1 += 1;
+            Ok(())
+        }
+        fn write(&mut self, bytes: &[u8; RECORD_LEN]) -> Result<(), E> {
+            self.0 = *bytes;
+            self.1 += 1;
+            Ok(())
+        }
+    }
+    let old = record().encode().unwrap();
+    let mut new = record();
+    new.mean[0] = 0.02;
+    let factory = BorCheck::of_optr(0xFFEF_F8AA);
+    assert_eq!(factory, BorCheck::BelowGoal(BorLevel::Level0));
+    let mut gate = BorGate {
+        store: Page(old, 0),
+        bor: factory,
+    };
+    let stored = store(&mut gate, &new);
+    assert_eq!(stored.written, Err(StoreError::Erase(E::Bor(factory))));
+    assert_eq!((gate.store.0, gate.store.1), (old, 0));
+    assert_eq!(stored.read_back, Some(record()));
+
+    let at_goal = BorCheck::of_optr((0xFFEF_F8AA & !(0b111 << 8)) | (4 << 8));
+    let mut gate = BorGate {
+        store: Page(old, 0),
+        bor: at_goal,
+    };
+    let stored = store(&mut gate, &new);
+    assert_eq!(stored.written, Ok(()));
+    assert_eq!(stored.read_back, Some(new));
+}

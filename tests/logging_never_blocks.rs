@@ -1,7 +1,7 @@
 //! The sample path cannot be stalled by the log (issue 43). probe-rs puts the RTT channel in
 //! blocking mode, and defmt-rtt would then wait, with interrupts off, for the host to read:
 //! a slow reader (`cargo fw-run | sim-host hmi --stdin`) or a detached probe would hold the
-//! sample task past its 2-sample DMA ring's 100-200 us of slack. Two facts keep it from
+//! sample task past its DMA ring's slack (300 us: src/acquisition.rs, the latency budget). Two facts keep it from
 //! happening, checked here on the sources:
 //! 1. the firmware's defmt-rtt is built with `disable-blocking-mode`: with a full RTT
 //!    buffer it writes on over the unread bytes and returns at once (`defmt-rtt` 1.3's

@@ -108,6 +108,7 @@ pub fn panel_input(
         fault_code: code.unwrap_or(NOT_NAMED_CODE),
         commissioning_failed,
         default_motor: false,
+        clock_fallback: false,
         moved,
     }
 }

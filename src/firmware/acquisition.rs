@@ -9,20 +9,24 @@
 
 use core::marker::PhantomData;
 
-use drive_monitor::recovery::{AcqRegisters, AdcFlags, RegisterAcquisition};
+use drive_monitor::adc_rules::AdcPairSetup;
+use drive_monitor::recovery::{AcqRegisters, Acquisition, AdcFlags, RegisterAcquisition};
 use embassy_stm32::adc::RingBufferedAdc;
-use embassy_stm32::dma;
+use embassy_stm32::adc::{Adc, AdcConfig};
+use embassy_stm32::dma::{self, ReadableRingBuffer};
 use embassy_stm32::interrupt::typelevel::Handler;
 use embassy_stm32::pac;
-use embassy_stm32::pac::adc::vals::{Adstp, Dmacfg, Dmaen};
-use embassy_stm32::peripherals;
+use embassy_stm32::pac::adc::vals::{Dmacfg, Dmaen};
 use embassy_stm32::timer::low_level::Timer as HwTimer;
+use embassy_stm32::{peripherals, Peri};
 use embassy_time::Instant;
 
 /// The two ADCs' registers, ADC1 (voltages) then ADC2 (currents).
 const ADCS: [pac::adc::Adc; 2] = [pac::ADC1, pac::ADC2];
 /// The DMA1 channels of the two rings (register index: channel 1 is index 0).
 const DMA_CHANNELS: [usize; 2] = [0, 1];
+/// The DMA1 channel of the encoder latch's ring (channel 3).
+const LATCH_CHANNEL: usize = 2;
 
 /// The acquisition: trigger timer and the two ring-buffered ADCs, as the recovery drives
 /// them ([`RegisterAcquisition`] over [`HwRegisters`]).
@@ -33,6 +37,8 @@ pub(super) struct HwRegisters {
     pub(super) trigger: HwTimer<'static, peripherals::TIM1>,
     pub(super) adc1: RingBufferedAdc<'static, peripherals::ADC1>,
     pub(super) adc2: RingBufferedAdc<'static, peripherals::ADC2>,
+    /// The encoder latch: TIM4's count captured at every trigger, one per sequence.
+    pub(super) latch: ReadableRingBuffer<'static, u16>,
     /// When the trigger was last started, us (the timestamps continue from there).
     pub(super) started_us: u32,
 }
@@ -50,9 +56,10 @@ pub(super) fn new_acquisition(
     trigger: HwTimer<'static, peripherals::TIM1>,
     adc1: RingBufferedAdc<'static, peripherals::ADC1>,
     adc2: RingBufferedAdc<'static, peripherals::ADC2>,
+    latch: ReadableRingBuffer<'static, u16>,
     ring_len: u16,
 ) -> HwAcquisition {
-    for n in DMA_CHANNELS {
+    for n in DMA_CHANNELS.into_iter().chain([LATCH_CHANNEL]) {
         pac::DMA1.ch(n).cr().modify(|w| w.set_teie(false));
     }
     RegisterAcquisition {
@@ -60,17 +67,56 @@ pub(super) fn new_acquisition(
             trigger,
             adc1,
             adc2,
+            latch,
             started_us: 0,
         },
         ring_len,
     }
 }
 
-/// The first start: both rings and ADCs, then the trigger.
+/// The ADC pair's set-up (`adc_rules::create_pair`) on embassy's `Adc::new` and the
+/// registers: the peripherals go in, the two drivers come out.
+pub(super) struct HwPair {
+    pub(super) p1: Option<Peri<'static, peripherals::ADC1>>,
+    pub(super) p2: Option<Peri<'static, peripherals::ADC2>>,
+    pub(super) adc1: Option<Adc<'static, peripherals::ADC1>>,
+    pub(super) adc2: Option<Adc<'static, peripherals::ADC2>>,
+}
+
+impl AdcPairSetup for HwPair {
+    fn create(&mut self, i: usize) {
+        if i == 0 {
+            if let Some(p) = self.p1.take() {
+                self.adc1 = Some(Adc::new(p, AdcConfig::default()));
+            }
+        } else if let Some(p) = self.p2.take() {
+            self.adc2 = Some(Adc::new(p, AdcConfig::default()));
+        }
+    }
+
+    fn cr(&mut self, i: usize) -> u32 {
+        adc(i).cr().read().0
+    }
+
+    fn write_cr(&mut self, i: usize, value: u32) {
+        adc(i).cr().write_value(pac::adc::regs::Cr(value));
+    }
+
+    fn prescaler(&mut self) -> u32 {
+        u32::from(pac::ADC12_COMMON.ccr().read().presc().to_bits())
+    }
+}
+
+/// The first start: the rings (the ADCs' and the encoder latch's) armed, both ADCs started,
+/// then the trigger, with the recovery's own steps (`RegisterAcquisition`: `CNDTR`, the
+/// rings' positions, `DMAEN` circular, `EN`, then `ADSTART` written alone), not the HAL's
+/// `RingBufferedAdc::start`, whose read-modify-write of `ADC_CR` writes `ADEN` back with
+/// `ADSTART` (`drive_monitor::adc_rules`). The rings' `EN` set here is what the HAL's
+/// `read` looks at (`is_running`), so it does not start them again.
 pub(super) fn start(acq: &mut HwAcquisition) {
-    acq.regs.adc1.start();
-    acq.regs.adc2.start();
-    acq.regs.trigger_start();
+    acq.rearm_dma();
+    acq.start_adc();
+    acq.start_trigger();
 }
 
 /// ADC `i`'s registers (0: ADC1, else ADC2).
@@ -110,20 +156,14 @@ impl AcqRegisters for HwRegisters {
         });
     }
 
-    fn adc_started(&mut self, i: usize) -> bool {
-        adc(i).cr().read().adstart()
+    fn adc_cr(&mut self, i: usize) -> u32 {
+        adc(i).cr().read().0
     }
 
-    fn adc_disabling(&mut self, i: usize) -> bool {
-        adc(i).cr().read().addis()
-    }
-
-    fn adc_stop(&mut self, i: usize) {
-        adc(i).cr().modify(|w| w.set_adstp(Adstp::STOP));
-    }
-
-    fn adc_start(&mut self, i: usize) {
-        adc(i).cr().modify(|w| w.set_adstart(true));
+    fn adc_cr_write(&mut self, i: usize, value: u32) {
+        // The whole register as the sequence computed it (`adc_rules::cr_setting`: one
+        // set-only bit, the ordinary bits as read), not a read-modify-write.
+        adc(i).cr().write_value(pac::adc::regs::Cr(value));
     }
 
     fn adc_dma_circular(&mut self, i: usize) {
@@ -176,6 +216,35 @@ impl AcqRegisters for HwRegisters {
 
     fn dma_enable(&mut self, i: usize) {
         pac::DMA1.ch(dma(i)).cr().modify(|w| w.set_en(true));
+    }
+
+    fn latch_disable(&mut self) {
+        self.latch.request_pause();
+    }
+
+    fn latch_enabled(&mut self) -> bool {
+        pac::DMA1.ch(LATCH_CHANNEL).cr().read().en()
+    }
+
+    fn latch_clear(&mut self) {
+        pac::DMA1.ifcr().write(|w| {
+            w.set_teif(LATCH_CHANNEL, true);
+            w.set_htif(LATCH_CHANNEL, true);
+            w.set_tcif(LATCH_CHANNEL, true);
+            w.set_gif(LATCH_CHANNEL, true);
+        });
+    }
+
+    fn latch_reload(&mut self, transfers: u16) {
+        pac::DMA1
+            .ch(LATCH_CHANNEL)
+            .ndtr()
+            .write(|w| w.set_ndt(transfers));
+        self.latch.clear();
+    }
+
+    fn latch_enable(&mut self) {
+        pac::DMA1.ch(LATCH_CHANNEL).cr().modify(|w| w.set_en(true));
     }
 
     fn trigger_stop(&mut self) {

@@ -7,6 +7,7 @@ use defmt::warn;
 use drive_monitor::board;
 use drive_monitor::flash_ecc::{CheckedFlash, RawFlash, ReadError};
 use drive_monitor::flash_record::{RecordStore, RECORD_LEN};
+use drive_monitor::supply::{BorCheck, FromBorRefusal};
 use embassy_stm32::flash::{Blocking, Flash};
 use monitor_core::motor_record::STORED_LEN as MOTOR_RECORD_LEN;
 
@@ -26,6 +27,15 @@ pub(super) enum FlashError {
     },
     /// The page was marked bad earlier in this run.
     MarkedBad,
+    /// Erases and writes are refused: the brown-out level (`BOR_LEV`, 255: reserved) is
+    /// below the goal (`drive_monitor::supply::BorGate`; `cargo fw bor`).
+    BrownOutLevel(u8),
+}
+
+impl FromBorRefusal for FlashError {
+    fn bor_refused(check: BorCheck) -> Self {
+        FlashError::BrownOutLevel(check.status_number())
+    }
 }
 
 /// The flash driver (`None`: the option bytes are single-bank).

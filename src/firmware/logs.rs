@@ -7,6 +7,7 @@ use core::sync::atomic::Ordering;
 use defmt::{error, info, warn};
 use drive_monitor::board::{ReferenceCheck, VDDA_BAND_V};
 use drive_monitor::boot::{Booted, CalibrationMissing};
+use drive_monitor::clock::ClockSource;
 use drive_monitor::commissioning::RunEnd;
 use drive_monitor::flash_record::{self, StoreError};
 use drive_monitor::liveness::LivenessChange;
@@ -30,15 +31,32 @@ pub(super) fn log_bor(check: BorCheck) {
             l.falling_v()
         ),
         BorCheck::BelowGoal(l) => warn!(
-            "brown-out reset level {=u8} (about {=f32} V) is below level {=u8} ({=f32} V): the MCU runs on at a supply far below 3.3 V; program it once for this board: cargo fw bor (docs/firmware.md, bring-up)",
+            "brown-out reset level {=u8} (about {=f32} V) is below level {=u8} ({=f32} V): the MCU runs on at a supply far below 3.3 V, and flash records are refused (a sag during an erase or a write would tear them); program it once for this board: cargo fw bor (docs/firmware.md, bring-up)",
             l.number(),
             l.falling_v(),
             BOR_GOAL.number(),
             BOR_GOAL.falling_v()
         ),
         BorCheck::Reserved(v) => warn!(
-            "brown-out reset level: FLASH_OPTR.BOR_LEV holds the reserved value {=u8}",
+            "brown-out reset level: FLASH_OPTR.BOR_LEV holds the reserved value {=u8}; flash records are refused",
             v
+        ),
+    }
+}
+
+/// The clock's source (`drive_monitor::clock::ClockSource`) and the time base's error it
+/// implies.
+pub(super) fn log_clock(source: ClockSource) {
+    match source {
+        ClockSource::Hse => info!(
+            "clock: {=str}, time base within +-{=u32} ppm",
+            source.name(),
+            source.error_ppm()
+        ),
+        ClockSource::Hsi => warn!(
+            "clock: {=str}; frequencies, speeds and time constants are known to +-{=u32} ppm only (the RUN lamp's steady 2 s from 5 s of every 10 s)",
+            source.name(),
+            source.error_ppm()
         ),
     }
 }

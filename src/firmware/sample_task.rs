@@ -8,16 +8,19 @@
 use core::sync::atomic::Ordering;
 
 use defmt::{error, info, warn};
-use drive_monitor::acquisition::{self as geometry, HALF_LEN, RING_LEN};
+use drive_monitor::acquisition::{self as geometry, DMA_HALF_LEN, HALF_LEN, RING_LEN};
+use drive_monitor::adc_rules::{self, IdleDiscard, PairError};
 use drive_monitor::app::SamplePath;
 use drive_monitor::board::{self, CurrentCode, VoltageCode};
+use drive_monitor::clock;
 use drive_monitor::liveness::AdcWait;
 use drive_monitor::motor_source::EncoderSetup;
 use drive_monitor::recovery::{self, RecoveryCounts, StepTimeout};
 use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
 use drive_monitor::sampling::RawFrame;
 use drive_monitor::setup_guard::SetupStep;
-use embassy_stm32::adc::{Adc, AdcChannel, AdcConfig, Exten, RingBufferedAdc, SampleTime};
+use embassy_stm32::adc::{Adc, AdcChannel, Exten, RingBufferedAdc, SampleTime};
+use embassy_stm32::dma::{self, ReadableRingBuffer, TransferOptions};
 use embassy_stm32::gpio::Pull;
 use embassy_stm32::time::Hertz;
 use embassy_stm32::timer::low_level::{MasterMode, RoundTo, Timer as HwTimer};
@@ -38,6 +41,8 @@ pub(super) struct SampleHw {
     pub(super) adc2: Peri<'static, peripherals::ADC2>,
     pub(super) dma1: Peri<'static, peripherals::DMA1_CH1>,
     pub(super) dma2: Peri<'static, peripherals::DMA1_CH2>,
+    /// The encoder latch's DMA channel (TIM4's capture at the trigger).
+    pub(super) dma3: Peri<'static, peripherals::DMA1_CH3>,
     pub(super) tim1: Peri<'static, peripherals::TIM1>,
     pub(super) v: board::pins::VoltagePins,
     pub(super) i: board::pins::CurrentPins,
@@ -77,7 +82,38 @@ fn start_encoder(
         w.set_icf(1, filter);
     });
     regs.ccer().modify(|w| w.set_ccp(0, setup.invert_a));
+    // The count latched at the sample trigger: channel 3 captures the counter on TRC, the
+    // internal trigger ITR0 (TIM1's TRGO, RM0440 "TIMx internal trigger connection"; the
+    // encoder mode does not use the trigger input), rising edge, and each capture raises
+    // a DMA request (`CC3DE`) that copies `CCR3` into the latch's ring.
+    regs.smcr().modify(|w| w.set_ts(pac::timer::vals::Ts::ITR0));
+    regs.ccmr_input(1)
+        .modify(|w| w.set_ccs(0, pac::timer::vals::CcmrInputCcs::TRC));
+    regs.ccer().modify(|w| {
+        w.set_ccp(2, false);
+        w.set_cce(2, true);
+    });
+    regs.dier().modify(|w| w.set_ccde(2, true));
     qei
+}
+
+/// The encoder latch's ring: DMA1 channel 3 on TIM4's channel-3 request, from `CCR3` into
+/// `ring` (one count per trigger: `geometry::LATCH_LEN`), circular, not started.
+fn latch_ring(
+    dma: Peri<'static, peripherals::DMA1_CH3>,
+    ring: &'static mut [u16; geometry::LATCH_LEN],
+) -> ReadableRingBuffer<'static, u16> {
+    use embassy_stm32::timer::{Ch3, Dma as TimerDma};
+    let request = TimerDma::<peripherals::TIM4, Ch3>::request(&*dma);
+    let ccr3 = pac::TIM4.ccr(2).as_ptr() as *mut u16;
+    // Circular with the half- and full-transfer interrupts (the ring buffer sets them).
+    let options = TransferOptions::default();
+    #[allow(unsafe_code)]
+    // SAFETY: `ccr3` is TIM4's capture register, a peripheral address valid for the whole
+    // run; `ring` is 'static and only this ring buffer writes it.
+    unsafe {
+        ReadableRingBuffer::new(dma::Channel::new(dma, Irqs), request, ccr3, ring, options)
+    }
 }
 
 /// 24.5 ADC cycles sampling time (`drive_monitor::acquisition::SAMPLE_TIME_HALF_CYCLES`,
@@ -90,6 +126,10 @@ fn start_encoder(
 /// 5 pF and R_ADC 1 kohm, is about 11 kohm at 24.5 cycles.
 const SAMPLE_TIME: SampleTime = SampleTime::CYCLES24_5;
 const _: () = assert!(geometry::SAMPLE_TIME_HALF_CYCLES == 49);
+const _: () = assert!(
+    geometry::ring_fits(SETTINGS.sample_rate_hz, geometry::SAMPLES_PER_HALF as u32),
+    "the DMA ring does not cover the worst-case latency at the sample rate"
+);
 const _: () = assert!(
     geometry::fits(SETTINGS.sample_rate_hz),
     "the oversampled acquisition does not fit the sample rate"
@@ -138,8 +178,11 @@ fn start_acquisition(
 ) -> (Qei<'static, peripherals::TIM4>, HwAcquisition) {
     static RING1: static_cell::StaticCell<[u16; RING_LEN]> = static_cell::StaticCell::new();
     static RING2: static_cell::StaticCell<[u16; RING_LEN]> = static_cell::StaticCell::new();
+    static LATCH: static_cell::StaticCell<[u16; geometry::LATCH_LEN]> =
+        static_cell::StaticCell::new();
     let ring1 = RING1.init([0; RING_LEN]);
     let ring2 = RING2.init([0; RING_LEN]);
+    let latch = latch_ring(hw.dma3, LATCH.init([0; geometry::LATCH_LEN]));
 
     let qei = start_encoder(hw.tim4, hw.enc_a, hw.enc_b, &hw.encoder);
 
@@ -153,7 +196,31 @@ fn start_acquisition(
     // Every step under the set-up deadline (`drive_monitor::setup_guard`): the HAL's waits
     // on ADCAL, ADRDY and ADSTART have no bound of their own.
     let guard = supply::SetupGuard::arm(hw.syst, SetupStep::Adc1);
-    let adc1 = Adc::new(hw.adc1, AdcConfig::default());
+    // Both drivers, the common prescaler written only with both ADCs disabled and read
+    // back (`drive_monitor::adc_rules::create_pair`).
+    let mut pair = acquisition::HwPair {
+        p1: Some(hw.adc1),
+        p2: Some(hw.adc2),
+        adc1: None,
+        adc2: None,
+    };
+    match adc_rules::create_pair(&mut pair) {
+        Ok(()) => {}
+        Err(PairError::NotDisabled) => error!("ADC1 did not disable before ADC2's set-up"),
+        Err(PairError::Prescaler(p)) => error!(
+            "ADC12_CCR.PRESC reads {=u32}, not {=u32}: the ADC clock is not {=u32} Hz, the conversion times are off",
+            p,
+            clock::ADC_PRESC,
+            clock::ADC_CLOCK_HZ
+        ),
+    }
+    let (Some(adc1), Some(adc2)) = (pair.adc1.take(), pair.adc2.take()) else {
+        // `create_pair` creates both, always.
+        #[allow(clippy::panic)]
+        {
+            panic!("ADC drivers not created")
+        }
+    };
     guard.step(SetupStep::Ring1);
     let adc1 = ring_voltages(adc1, hw.dma1, hw.v, ring1);
     // The ADC's reference: VDDA from VREFINT on ADC1's injected channel against the
@@ -162,12 +229,10 @@ fn start_acquisition(
     guard.step(SetupStep::Reference);
     supply::configure_reference();
     REFERENCE.signal(drive_monitor::supply::measure_now(&mut supply::HwReference));
-    guard.step(SetupStep::Adc2);
-    let adc2 = Adc::new(hw.adc2, AdcConfig::default());
     guard.step(SetupStep::Ring2);
     let adc2 = ring_currents(adc2, hw.dma2, hw.i, ring2);
     guard.step(SetupStep::Start);
-    let mut acq = acquisition::new_acquisition(trigger, adc1, adc2, RING_LEN as u16);
+    let mut acq = acquisition::new_acquisition(trigger, adc1, adc2, latch, RING_LEN as u16);
     acquisition::start(&mut acq);
     guard.disarm();
     path.sampler_mut().resync(acq.regs.started_us);
@@ -175,20 +240,27 @@ fn start_acquisition(
 }
 
 /// Runs the sample path on the readings of one DMA half (`v` from ADC1, `i` from ADC2:
-/// [`geometry::OVERSAMPLING`] sequences per sample, summed and filtered by `filter`,
-/// `geometry::PwmFilter`: the inverter's in-band ripple out, the encoder count held back
-/// with it) with the encoder count read after them; hands thread mode a status every
-/// `status_every` samples. `max_cycles`: the longest oversampling, filter and `on_frame`
-/// so far, in CPU cycles.
+/// [`geometry::SAMPLES_PER_HALF`] samples of [`geometry::OVERSAMPLING`] sequences, each
+/// sample summed and filtered by `filter`, `geometry::PwmFilter`: the inverter's in-band
+/// ripple out, the encoder count held back with it) with the encoder counts of its samples
+/// (`counts`: each the mean of the counts TIM4 latched at the sample's triggers,
+/// `geometry::sample_count`); hands thread mode a status every `status_every` samples. `max_cycles`: the
+/// longest oversampling, filter and `on_frame` of one sample so far, in CPU cycles.
 fn process_half(
     path: &mut SamplePath,
     filter: &mut geometry::PwmFilter,
     (v, i): (&[u16], &[u16]),
-    encoder_count: u16,
+    counts: [u16; geometry::SAMPLES_PER_HALF],
+    discard: &mut IdleDiscard,
     max_cycles: &mut u32,
 ) {
-    let per_sample = HALF_LEN / geometry::SAMPLES_PER_HALF;
-    for (v, i) in v.chunks_exact(per_sample).zip(i.chunks_exact(per_sample)) {
+    let samples = v.chunks_exact(HALF_LEN).zip(i.chunks_exact(HALF_LEN));
+    for ((v, i), encoder_count) in samples.zip(counts) {
+        if discard.drop_next() {
+            // The first sample after a long idle (errata): dropped, its time skipped.
+            path.sampler_mut().skip();
+            continue;
+        }
         let t0 = cortex_m::peripheral::DWT::cycle_count();
         let ((vs, n), (is, _)) = (geometry::sum_half(v), geometry::sum_half(i));
         let ([va, vb, vc], [ia, ib, ic], encoder_count) = filter.step(vs, is, n, encoder_count);
@@ -214,34 +286,56 @@ fn process_half(
     }
 }
 
-/// The sample task: sets up the acquisition, then per DMA half (one sample) waits for both
+/// The sample task: sets up the acquisition, then per DMA half (`SAMPLES_PER_HALF`
+/// samples, the ring's depth from the latency budget) waits for both
 /// ADCs' data, bounded by [`AdcWait`]'s timeout; recovers the acquisition when no data came
 /// or the DMA lapped the reader, else applies thread mode's commands and runs the sample
 /// path on the half.
 #[embassy_executor::task]
 pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
     let mut filter = geometry::PwmFilter::new(SETTINGS.sample_rate_hz, hw.supply_hz);
-    let (qei, mut acq) = set_up_acquisition(hw, &mut path);
+    // The encoder driver is kept (its timer counts); the count is read from the latch.
+    let (_qei, mut acq) = set_up_acquisition(hw, &mut path);
     let mut wait = AdcWait::new(SETTINGS.sample_rate_hz);
     let timeout = Duration::from_micros(u64::from(wait.timeout_us()));
-    let mut half1 = [0u16; HALF_LEN];
-    let mut half2 = [0u16; HALF_LEN];
+    let mut half1 = [0u16; DMA_HALF_LEN];
+    let mut half2 = [0u16; DMA_HALF_LEN];
+    let mut latched = [0u16; geometry::LATCH_HALF_LEN];
+    // The ADCs idled since their set-up: the first sample is dropped (errata).
+    let mut discard = IdleDiscard::default();
+    discard.on_start(u32::MAX);
+    let mut last_data_us = acq.regs.started_us;
     let mut max_cycles: u32 = 0;
     let mut counts = RecoveryCounts::default();
     loop {
         let read = with_timeout(timeout, async {
             let r1 = acq.regs.adc1.read(&mut half1).await;
             let r2 = acq.regs.adc2.read(&mut half2).await;
-            (r1.is_ok(), r2.is_ok())
+            // The counts latched at the same triggers (the latch's half is complete at the
+            // last trigger, before the conversions it started).
+            let r3 = acq.regs.latch.read_exact(&mut latched).await;
+            (r1.is_ok(), r2.is_ok() && r3.is_ok())
         })
         .await;
         if needs_recovery(read, &mut wait) {
             recover_acquisition(&mut acq, &mut path, &mut counts);
+            discard.on_start(acq.regs.started_us.wrapping_sub(last_data_us));
             continue;
         }
         apply_commands(&mut path);
         let halves = (&half1[..], &half2[..]);
-        process_half(&mut path, &mut filter, halves, qei.count(), &mut max_cycles);
+        let mut sequences = latched.chunks_exact(geometry::OVERSAMPLING);
+        let counts: [u16; geometry::SAMPLES_PER_HALF] =
+            core::array::from_fn(|_| sequences.next().map_or(0, geometry::sample_count));
+        last_data_us = embassy_time::Instant::now().as_micros() as u32;
+        process_half(
+            &mut path,
+            &mut filter,
+            halves,
+            counts,
+            &mut discard,
+            &mut max_cycles,
+        );
     }
 }
 

@@ -6,9 +6,9 @@ use core::sync::atomic::{AtomicU8, Ordering};
 
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
-use drive_monitor::clock;
 use drive_monitor::setup_guard::{self, SetupStep, SETUP_DEADLINE_MS};
 use drive_monitor::supply::{BorCheck, BorLevel, ReferenceAdc};
+use drive_monitor::{adc_rules, clock};
 use embassy_stm32::pac;
 use embassy_stm32::pac::adc::vals::{Exten, SampleTime};
 
@@ -81,12 +81,12 @@ const VREFINT_CHANNEL: u8 = 18;
 
 /// Sets ADC1's injected sequence to one conversion of VREFINT, software-triggered, with
 /// 247.5 cycles of sampling time (5.8 us; VREFINT needs at least 4 us, datasheet
-/// `t_S_vrefint`), and turns the VREFINT buffer on (`ADC12_CCR.VREFEN`). Call with ADC1
+/// `t_S_vrefint`); the VREFINT buffer is switched on by the measurement
+/// (`supply::measure_now`, then its start-up time). Call with ADC1
 /// enabled and `ADSTART = JADSTART = 0` (after `into_ring_buffered`, before the ring
 /// starts): `SMPR2` and `JSQR` are writable only then. The regular sequence's sample
 /// times are `SMPR1` and channels 10..17 of `SMPR2`; channel 18's field is this one's.
 pub(super) fn configure_reference() {
-    pac::ADC12_COMMON.ccr().modify(|w| w.set_vrefen(true));
     let adc = pac::ADC1;
     adc.smpr2()
         .modify(|w| w.set_smp(usize::from(VREFINT_CHANNEL - 10), SampleTime::CYCLES247_5));
@@ -108,10 +108,23 @@ impl ReferenceAdc for HwReference {
         pac::VREFINTCAL.data().read()
     }
 
+    fn enable(&mut self) {
+        pac::ADC12_COMMON.ccr().modify(|w| w.set_vrefen(true));
+    }
+
+    fn wait_us(&mut self, us: u32) {
+        cortex_m::asm::delay(us.saturating_mul(clock::HCLK_HZ / 1_000_000));
+    }
+
     fn start(&mut self) {
-        // A read-modify-write of ADC1_CR, which the sample task's recovery writes too
-        // (ADSTP, ADSTART): not interleaved with it.
-        cortex_m::interrupt::free(|_| pac::ADC1.cr().modify(|w| w.set_jadstart(true)));
+        // JADSTART written alone (`adc_rules::cr_setting`: no other set-only bit written
+        // back), in a critical section: the sample task's recovery writes ADC1_CR too
+        // (ADSTP, ADSTART), and its read and write must not interleave with this one.
+        cortex_m::interrupt::free(|_| {
+            let cr = pac::ADC1.cr().read().0;
+            let value = adc_rules::cr_setting(cr, adc_rules::JADSTART);
+            pac::ADC1.cr().write_value(pac::adc::regs::Cr(value));
+        });
     }
 
     fn result(&mut self) -> Option<u16> {

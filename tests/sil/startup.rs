@@ -242,6 +242,8 @@ impl drive_monitor::supply::ReferenceAdc for FakeReference {
     fn calibration(&self) -> u16 {
         self.cal
     }
+    fn enable(&mut self) {}
+    fn wait_us(&mut self, _us: u32) {}
     fn start(&mut self) {
         self.pending = true;
     }

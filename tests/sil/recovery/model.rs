@@ -3,7 +3,8 @@
 
 use super::super::FS;
 use drive_monitor::acquisition::{
-    conversion_ns, trigger_rate_hz, CHANNELS, HALF_LEN, OVERSAMPLING, RING_LEN as FW_RING_LEN,
+    conversion_ns, trigger_rate_hz, CHANNELS, HALF_LEN, LATCH_LEN, OVERSAMPLING,
+    RING_LEN as FW_RING_LEN,
 };
 use drive_monitor::recovery::{AcqRegisters, AdcFlags, RegisterAcquisition};
 
@@ -12,10 +13,34 @@ pub(crate) const RING_LEN: u16 = FW_RING_LEN as u16;
 /// The model's time one poll of a register takes [ns] (about 10 cycles at 170 MHz).
 pub(crate) const POLL_NS: u64 = 60;
 
+// ADC_CR's bits (RM0440, "ADC control register"), the model's own copy.
+pub(crate) const CR_ADEN: u32 = 1 << 0;
+pub(crate) const CR_ADDIS: u32 = 1 << 1;
+pub(crate) const CR_ADSTART: u32 = 1 << 2;
+pub(crate) const CR_JADSTART: u32 = 1 << 3;
+pub(crate) const CR_ADSTP: u32 = 1 << 4;
+pub(crate) const CR_JADSTP: u32 = 1 << 5;
+pub(crate) const CR_ADVREGEN: u32 = 1 << 28;
+pub(crate) const CR_ADCAL: u32 = 1 << 31;
+/// The bits software sets and hardware clears.
+pub(crate) const CR_SET_ONLY: u32 =
+    CR_ADEN | CR_ADDIS | CR_ADSTART | CR_JADSTART | CR_ADSTP | CR_JADSTP | CR_ADCAL;
+/// The idle time after which the first conversion may be wrong (G4 errata) [ns].
+pub(crate) const IDLE_ERRATUM_NS: u64 = 1_000_000;
+/// VREFINT's injected conversion: 247.5 + 12.5 cycles at 42.5 MHz [ns].
+pub(crate) const INJECTED_NS: u64 = 6_118;
+/// A ring word's rank marked as a conversion the errata make wrong.
+pub(crate) const BAD: usize = 0x100;
+
 /// One ADC as the recovery sees it.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct AdcModel {
     pub(crate) adstart: bool,
+    /// An injected conversion (the reference's) is ongoing until `injected_until_ns`.
+    pub(crate) jadstart: bool,
+    pub(crate) injected_until_ns: u64,
+    /// The last conversion's end [ns] (`None`: none since the model began).
+    pub(crate) last_conversion_ns: Option<u64>,
     pub(crate) ovr: bool,
     pub(crate) eoc: bool,
     pub(crate) eos: bool,
@@ -43,14 +68,33 @@ pub(crate) struct DmaModel {
     pub(crate) moved: u32,
     /// The rank of the word at each ring position.
     pub(crate) ring: [usize; FW_RING_LEN],
+    /// The trigger whose sequence each ring position's word came from.
+    pub(crate) ids: [u64; FW_RING_LEN],
     /// Halves completed since the last sample was taken.
     pub(crate) halves: u32,
+}
+
+/// The encoder latch: TIM4's capture at each trigger, copied by its DMA channel into a
+/// ring of [`LATCH_LEN`] counts.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LatchModel {
+    pub(crate) en: bool,
+    pub(crate) cndtr: u16,
+    /// The trigger each ring position's count was captured at.
+    pub(crate) ids: [u64; LATCH_LEN],
 }
 
 /// The two ADCs, their DMA channels and the trigger, at register level (module docs).
 #[derive(Clone, Debug)]
 pub(crate) struct AdcDmaModel {
     pub(crate) trigger_on: bool,
+    /// Triggers so far (each one's id).
+    pub(crate) triggers: u64,
+    pub(crate) latch: LatchModel,
+    /// Completed sample blocks whose conversions and latched counts came from different
+    /// triggers (the count does not belong to the readings), and those checked.
+    pub(crate) unpaired_samples: u32,
+    pub(crate) paired_samples: u32,
     pub(crate) adc: [AdcModel; 2],
     pub(crate) dma: [DmaModel; 2],
     /// The model's clock [ns].
@@ -62,6 +106,9 @@ pub(crate) struct AdcDmaModel {
     pub(crate) misaligned_halves: u32,
     /// Register accesses made against their precondition (RM0440), in words.
     pub(crate) violations: Vec<String>,
+    /// Whether the last sample block completed on each channel held a word the errata
+    /// make wrong (the first conversion after more than 1 ms idle).
+    pub(crate) last_block_bad: [bool; 2],
 }
 
 /// The acquisition the rig runs: the firmware's sequence over the model.
@@ -81,11 +128,20 @@ impl AdcDmaModel {
             request: false,
             moved: 0,
             ring: [0; FW_RING_LEN],
+            ids: [0; FW_RING_LEN],
             halves: 0,
         };
         RegisterAcquisition {
             regs: AdcDmaModel {
                 trigger_on: true,
+                triggers: 0,
+                latch: LatchModel {
+                    en: true,
+                    cndtr: LATCH_LEN as u16,
+                    ids: [0; LATCH_LEN],
+                },
+                unpaired_samples: 0,
+                paired_samples: 0,
                 adc: [adc; 2],
                 dma: [dma; 2],
                 now_ns: 0,
@@ -93,9 +149,24 @@ impl AdcDmaModel {
                 overruns: 0,
                 misaligned_halves: 0,
                 violations: Vec::new(),
+                last_block_bad: [false; 2],
             },
             ring_len: RING_LEN,
         }
+    }
+
+    /// The acquisition as the set-up leaves it before the first start: the ADCs enabled,
+    /// `DMAEN` circular (the HAL's `configure_dma`), nothing converting, the DMA channels
+    /// and the latch's off, the trigger stopped.
+    pub(crate) fn stopped() -> ModelAcq {
+        let mut acq = Self::running();
+        acq.regs.trigger_on = false;
+        acq.regs.latch.en = false;
+        for (a, d) in acq.regs.adc.iter_mut().zip(&mut acq.regs.dma) {
+            a.adstart = false;
+            d.en = false;
+        }
+        acq
     }
 
     /// The DMA serves channel `i`'s request: one word from `ADC_DR` into the ring.
@@ -108,13 +179,21 @@ impl AdcDmaModel {
         a.eoc = false;
         let at = usize::from(RING_LEN - d.cndtr);
         d.ring[at] = a.dr;
+        d.ids[at] = self.triggers.wrapping_sub(1);
         d.moved += 1;
         d.cndtr = if d.cndtr <= 1 { RING_LEN } else { d.cndtr - 1 };
         if (at + 1) % HALF_LEN == 0 {
             let half = at + 1 - HALF_LEN;
-            let aligned = (0..HALF_LEN).all(|k| d.ring[half + k] == k % CHANNELS);
+            let aligned = (0..HALF_LEN).all(|k| d.ring[half + k] & !BAD == k % CHANNELS);
             self.misaligned_halves += u32::from(!aligned);
+            self.last_block_bad[i] = (0..HALF_LEN).any(|k| d.ring[half + k] & BAD != 0);
             d.halves += 1;
+            // The sample's latched counts sit at the same place of the latch's ring.
+            let first = half / CHANNELS;
+            let paired = (0..OVERSAMPLING)
+                .all(|s| self.latch.ids.get(first + s) == d.ids.get(half + s * CHANNELS));
+            self.paired_samples += 1;
+            self.unpaired_samples += u32::from(!paired);
         }
     }
 
@@ -127,6 +206,18 @@ impl AdcDmaModel {
         let t0 = self.now_ns;
         if self.trigger_on {
             self.conversions += 1;
+            // TIM4 captures its count at the trigger; the capture's DMA request moves it.
+            let l = &mut self.latch;
+            if l.en {
+                let at = LATCH_LEN - usize::from(l.cndtr);
+                l.ids[at] = self.triggers;
+                l.cndtr = if l.cndtr <= 1 {
+                    LATCH_LEN as u16
+                } else {
+                    l.cndtr - 1
+                };
+            }
+            self.triggers += 1;
             for rank in 0..CHANNELS {
                 let end = t0 + (rank as u64 + 1) * u64::from(conversion_ns());
                 for i in 0..2 {
@@ -142,7 +233,12 @@ impl AdcDmaModel {
                         self.overruns += u32::from(first);
                         continue;
                     }
-                    a.dr = rank;
+                    // The first conversion after more than 1 ms idle may be wrong (errata).
+                    let idle = a
+                        .last_conversion_ns
+                        .is_none_or(|t| end - t > IDLE_ERRATUM_NS);
+                    a.last_conversion_ns = Some(end);
+                    a.dr = rank | if idle { BAD } else { 0 };
                     a.eoc = true;
                     a.eos = rank + 1 == CHANNELS;
                     if a.dma_circular && !a.ovr {
@@ -186,6 +282,14 @@ impl AdcDmaModel {
         }
     }
 
+    /// Thread mode starts the reference's injected conversion on ADC1 now (it interrupts
+    /// a regular one, which the model does not time; it keeps `JADSTART` for its 6.1 us).
+    pub(crate) fn start_injected(&mut self) {
+        let a = &mut self.adc[0];
+        a.jadstart = true;
+        a.injected_until_ns = self.now_ns + INJECTED_NS;
+    }
+
     fn violation(&mut self, what: String) {
         self.violations.push(what);
     }
@@ -206,32 +310,49 @@ impl AcqRegisters for AdcDmaModel {
         a.eoc &= !f.eoc;
         a.eos &= !f.eos;
     }
-    fn adc_started(&mut self, i: usize) -> bool {
+    fn adc_cr(&mut self, i: usize) -> u32 {
         self.now_ns += POLL_NS;
+        let now = self.now_ns;
         let a = &mut self.adc[i];
-        if a.stopping && !a.stuck && self.now_ns >= a.busy_until_ns {
+        if a.stopping && !a.stuck && now >= a.busy_until_ns {
             a.adstart = false;
             a.stopping = false;
         }
-        a.adstart
-    }
-    fn adc_disabling(&mut self, _i: usize) -> bool {
-        false
-    }
-    fn adc_stop(&mut self, i: usize) {
-        if !self.adc[i].adstart {
-            self.violation(format!("ADSTP on ADC{} while ADSTART = 0", i + 1));
+        if a.jadstart && now >= a.injected_until_ns {
+            a.jadstart = false;
         }
-        // The conversion in flight (one may have started at the trigger) ends first:
-        // ADSTART clears one conversion time from now.
-        let a = &mut self.adc[i];
-        a.stopping = true;
-        a.busy_until_ns = a
-            .busy_until_ns
-            .max(self.now_ns + u64::from(conversion_ns()));
+        let bit = |on: bool, b: u32| if on { b } else { 0 };
+        CR_ADVREGEN
+            | CR_ADEN
+            | bit(a.adstart, CR_ADSTART)
+            | bit(a.stopping, CR_ADSTP)
+            | bit(a.jadstart, CR_JADSTART)
     }
-    fn adc_start(&mut self, i: usize) {
-        self.adc[i].adstart = true;
+    fn adc_cr_write(&mut self, i: usize, value: u32) {
+        let set = value & CR_SET_ONLY;
+        if set.count_ones() > 1 {
+            self.violation(format!(
+                "ADC{}_CR written with several set-only bits ({set:#x}): a read-modify-write",
+                i + 1
+            ));
+        }
+        if value & CR_ADVREGEN == 0 {
+            self.violation(format!("ADC{}_CR written with ADVREGEN = 0", i + 1));
+        }
+        if value & CR_ADSTP != 0 {
+            if !self.adc[i].adstart || value & CR_ADDIS != 0 {
+                self.violation(format!("ADSTP on ADC{} while ADSTART = 0", i + 1));
+            }
+            // The conversion in flight (one may have started at the trigger) ends first:
+            // ADSTART clears one conversion time from now.
+            let now = self.now_ns;
+            let a = &mut self.adc[i];
+            a.stopping = true;
+            a.busy_until_ns = a.busy_until_ns.max(now + u64::from(conversion_ns()));
+        }
+        if value & CR_ADSTART != 0 {
+            self.adc[i].adstart = true;
+        }
     }
     fn adc_dma_circular(&mut self, i: usize) {
         if self.adc[i].adstart {
@@ -246,6 +367,10 @@ impl AcqRegisters for AdcDmaModel {
         if self.adc[i].adstart {
             // The hardware ignores the write.
             self.violation(format!("DMAEN of ADC{} cleared while ADSTART = 1", i + 1));
+            return;
+        }
+        if self.adc[i].jadstart {
+            self.violation(format!("DMAEN of ADC{} cleared while JADSTART = 1", i + 1));
             return;
         }
         self.adc[i].dma_circular = false;
@@ -279,6 +404,23 @@ impl AcqRegisters for AdcDmaModel {
         self.dma[i].en = true;
         // A request raised while the channel was off is served now.
         self.serve(i);
+    }
+    fn latch_disable(&mut self) {
+        self.latch.en = false;
+    }
+    fn latch_enabled(&mut self) -> bool {
+        self.now_ns += POLL_NS;
+        self.latch.en
+    }
+    fn latch_clear(&mut self) {}
+    fn latch_reload(&mut self, transfers: u16) {
+        if self.latch.en {
+            self.violation("CNDTR of the latch's DMA channel written while EN = 1".into());
+        }
+        self.latch.cndtr = transfers;
+    }
+    fn latch_enable(&mut self) {
+        self.latch.en = true;
     }
     fn trigger_stop(&mut self) {
         self.trigger_on = false;

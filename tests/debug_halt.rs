@@ -1,0 +1,100 @@
+//! A debugger's halt against what the firmware freezes (`drive_monitor::debug_halt`), on a
+//! model of the board's clocks: during a halt of the core each of TIM1 (the trigger, and
+//! with it the ADCs' conversions and the DMA), TIM15 (embassy-time: the sample task's
+//! timeout) and the IWDG runs on unless frozen. After the halt the model says whether the
+//! DMA lapped the ring (it wrote more samples than the ring holds beyond the unread ones),
+//! whether the sample task's wait timed out (a recovery) and whether the watchdog reset
+//! the MCU. And the boot starts the watchdog, and sets the freeze, before anything else.
+
+use drive_monitor::acquisition::SAMPLES_PER_HALF;
+use drive_monitor::app::WATCHDOG_TIMEOUT_MS;
+use drive_monitor::debug_halt::{Freeze, FROZEN};
+use drive_monitor::liveness::AdcWait;
+
+const FS: u32 = 10_000;
+
+#[derive(Debug, PartialEq, Eq)]
+struct AfterHalt {
+    lapped: bool,
+    recovered: bool,
+    reset: bool,
+}
+
+/// A halt of `halt_ms` with `freeze`, the sample task waiting for the next half (none
+/// unread: the worst case is a full ring's room, two halves) and the watchdog petted just
+/// before.
+fn halt(freeze: Freeze, halt_ms: u32) -> AfterHalt {
+    let samples_during = if freeze.trigger {
+        0
+    } else {
+        halt_ms * FS / 1_000
+    };
+    let ring_samples = 2 * SAMPLES_PER_HALF as u32;
+    // The task's wait began at most one half before the halt.
+    let waited_us = if freeze.time_base { 0 } else { halt_ms * 1_000 };
+    let timeout_us = AdcWait::new(FS).timeout_us();
+    AfterHalt {
+        lapped: samples_during > ring_samples,
+        recovered: waited_us >= timeout_us,
+        reset: !freeze.watchdog && halt_ms >= WATCHDOG_TIMEOUT_MS,
+    }
+}
+
+#[test]
+fn a_breakpoint_stops_sampling_cleanly_and_resumes_without_a_recovery() {
+    for halt_ms in [1, 100, 2_000, 60_000] {
+        assert_eq!(
+            halt(FROZEN, halt_ms),
+            AfterHalt {
+                lapped: false,
+                recovered: false,
+                reset: false
+            },
+            "{halt_ms} ms"
+        );
+    }
+    // Each part of the freeze is needed: without it the halt laps the ring, times the
+    // wait out or resets the MCU.
+    let without_trigger = Freeze {
+        trigger: false,
+        ..FROZEN
+    };
+    assert!(halt(without_trigger, 100).lapped);
+    let without_time = Freeze {
+        time_base: false,
+        ..FROZEN
+    };
+    assert!(halt(without_time, 100).recovered);
+    let without_watchdog = Freeze {
+        watchdog: false,
+        ..FROZEN
+    };
+    assert!(halt(without_watchdog, 2_000).reset);
+}
+
+/// `main` starts the watchdog (with the freeze) before embassy-stm32's `init`, whose clock
+/// set-up waits for the crystal and the PLL.
+#[test]
+fn the_watchdog_and_the_freeze_come_first_in_main() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/firmware.rs");
+    let src = std::fs::read_to_string(path).unwrap();
+    let main = &src[src.find("async fn main(").expect("main")..];
+    let first = main
+        .find("start_boot_watchdog();")
+        .expect("the boot watchdog in main");
+    let init = main.find("embassy_stm32::init(").expect("init in main");
+    assert!(first < init, "the watchdog starts after init");
+    let body = &src[src
+        .find("fn start_boot_watchdog()")
+        .expect("its definition")..];
+    let body = &body[..body.find("\n}\n").expect("its end")];
+    for needle in [
+        "debug_halt::FROZEN",
+        "set_tim1(",
+        "set_tim15(",
+        "set_iwdg(",
+        "Key::START",
+    ] {
+        assert!(body.contains(needle), "start_boot_watchdog lacks {needle}");
+    }
+}
