@@ -695,6 +695,24 @@ impl Analysis {
             set.push(e);
             out.push(set);
         }
+        // The full-order machine at once: every dynamics effect the model lacks (those with
+        // a time constant, and what needs one of them), when two or more can be fitted. A
+        // start or a step can need all of them before any one fits with values a machine
+        // has (one alone takes its time constant out of range to follow the others' part).
+        let dynamics: Vec<&dyn EffectModel> = lib
+            .iter()
+            .map(|e| e.as_ref())
+            .filter(|e| !rung.kinds.contains(&e.kind()) && cannot(*e).is_none())
+            .filter(|e| {
+                e.time_constant_s(&self.constants).is_some()
+                    || e.requires()
+                        .iter()
+                        .any(|r| model_of_has_time_constant(lib, *r, &self.constants))
+            })
+            .collect();
+        if dynamics.len() >= 2 {
+            out.push(dynamics);
+        }
         (out, skipped)
     }
 
@@ -805,6 +823,22 @@ impl Analysis {
                     .into_iter()
                     .map(|w| format!("{}: {w}", a.effect.kind())),
             );
+            // A value pinned at a bound of its fit is no minimum the log shows: the solver
+            // pushed it as far as it was let (a fit of the model's numerical residue).
+            for (q, v) in a.setup.params.iter().zip(p) {
+                let pinned = |b: f64| b.is_finite() && b != 0.0 && (v - b).abs() <= 1e-3 * b.abs();
+                if pinned(q.lo) || pinned(q.hi) {
+                    why.push(format!(
+                        "{}: {} = {} {} is at the bound of its fit ({}..{}), not a value the log shows",
+                        a.effect.kind(),
+                        q.name,
+                        effects::sig(*v),
+                        q.unit(),
+                        effects::sig(q.lo),
+                        effects::sig(q.hi)
+                    ));
+                }
+            }
             why.extend(a.effect.contradicted_by(d, &self.constants, p)?);
         }
         why.extend(
@@ -842,6 +876,7 @@ impl Analysis {
                 .then(a.score().total_cmp(&b.score()))
         });
         let before = rung.models.len();
+        self.evidence_decides(&mut fitted, before);
         let mut tried = Vec::new();
         let mut kept = None;
         for c in fitted {
@@ -894,6 +929,47 @@ impl Analysis {
             kept = Some((next, step));
         }
         Ok((kept, tried))
+    }
+
+    /// When the first two plausible single candidates of `fitted` (in the round's order)
+    /// are effects that declare each other confusable and score within the declared factor,
+    /// the log's evidence decides, as in `explain`'s ranking: a first one it contradicts goes
+    /// second unless it contradicts the other too (a constant load torque and Coulomb
+    /// friction are one equation at a speed that never reverses).
+    fn evidence_decides<'a>(&self, fitted: &mut [Fitted<'a>], before: usize) {
+        let (Some(a), Some(b)) = (fitted.first(), fitted.get(1)) else {
+            return;
+        };
+        if !a.implausible.is_empty() || !b.implausible.is_empty() {
+            return;
+        }
+        let single = |c: &Fitted<'a>| -> Option<&'a dyn EffectModel> {
+            (c.models.len() == before + 1)
+                .then(|| c.models.get(before).copied())
+                .flatten()
+        };
+        let (Some(ea), Some(eb)) = (single(a), single(b)) else {
+            return;
+        };
+        let Some(conf) = ea.confused_with().iter().find(|c| c.with == eb.kind()) else {
+            return;
+        };
+        if b.score() > conf.within * a.score() {
+            return;
+        }
+        let unbalance = self.unbalance();
+        let says = |c: &Fitted<'a>, e: &dyn EffectModel| {
+            let fitted = c.fit.effect_params.last().map(Vec::as_slice).unwrap_or(&[]);
+            e.evidence(&effects::EffectEvidence {
+                voltage_unbalance: unbalance.voltage_negative_sequence_ratio,
+                winding_suspected: unbalance.suspect_phase.is_some(),
+                torque_scale_nm: self.constants.torque_scale_nm,
+                fitted,
+            })
+        };
+        if says(a, ea) == Some(false) && says(b, eb) != Some(false) {
+            fitted.swap(0, 1);
+        }
     }
 
     /// The ladder step that took the model from `rung` to `next` by adding `c`.
@@ -958,20 +1034,36 @@ impl Analysis {
     }
 }
 
+/// True when the library's effect `k` declares a time constant (a dynamics effect).
+fn model_of_has_time_constant(
+    lib: &[Box<dyn EffectModel>],
+    k: EffectKind,
+    n: &MachineConstants,
+) -> bool {
+    lib.iter()
+        .any(|e| e.kind() == k && e.time_constant_s(n).is_some())
+}
+
 /// How many single candidates [`pairs_of`] pairs: those that lowered the training cost
 /// most.
 pub const PAIR_FROM: usize = 4;
 
 /// The pairs a round tries when no single candidate passes: every two of the [`PAIR_FROM`]
-/// plausible candidates of `fitted` (fits of one round, the model's own `before` effects
+/// single-effect candidates of `fitted` (plausible or not, not diverged) (fits of one round, the model's own `before` effects
 /// first in each) that lowered the training cost most, each pair's effects in the order
 /// fitted. A held-back error can rise with one effect of a pair and fall with both: with a
 /// start's cross coupling but no load torque, the fit uses the coupling to follow the
 /// acceleration a missing load explains.
 fn pairs_of<'a>(fitted: &[Fitted<'a>], before: usize) -> Vec<Vec<&'a dyn EffectModel>> {
+    // Implausible fits too: one effect alone may take its values out of range to carry its
+    // partner's part.
     let mut by_cost: Vec<&Fitted<'a>> = fitted
         .iter()
-        .filter(|c| c.implausible.is_empty() && c.heldback_fit_series.is_finite())
+        .filter(|c| {
+            c.models.len() == before + 1
+                && c.heldback_fit_series.is_finite()
+                && c.heldback_fit_series > 0.0
+        })
         .collect();
     by_cost.sort_by(|a, b| a.fit.report.cost.total_cmp(&b.fit.report.cost));
     let top: Vec<Vec<&'a dyn EffectModel>> = by_cost
@@ -1025,8 +1117,13 @@ fn at_floor(rung: &Rung<'_>) -> Option<String> {
 fn nothing_helps(rung: &Rung<'_>, tried: &[Tried]) -> String {
     let r = rung.error / rung.noise;
     let rh = rung.heldback_error / rung.heldback_noise;
-    let best = tried
+    // The plausible candidate that came closest to passing (else the first tried).
+    let closest = tried
         .iter()
+        .filter(|t| !t.because.starts_with("not physical") && !t.because.contains("diverged"))
+        .max_by(|a, b| a.significance.total_cmp(&b.significance));
+    let best = closest
+        .or(tried.first())
         .map(|t| {
             format!(
                 "{} ({})",
@@ -1038,7 +1135,6 @@ fn nothing_helps(rung: &Rung<'_>, tried: &[Tried]) -> String {
                 t.because
             )
         })
-        .next()
         .unwrap_or_else(|| "no candidate could be fitted".into());
     format!(
         "no plausible candidate passes the step's test: the whole-log error {} is {r:.2}x its noise floor and the held-back error {} is {rh:.2}x its floor; the best candidate was {best}. What is left is beyond the effect library (or below what the log can show)",

@@ -255,13 +255,13 @@ pub fn ladder(log: &Path, r: &LadderReport) -> anyhow::Result<()> {
     )?;
     writeln!(
         out,
-        "  {:<4} {:<34} {:>8} {:>6.1}x {:>9} {:>6.1}x {:>11}  noise floor {} (held-back {})",
+        "  {:<4} {:<34} {:>8} {:>7} {:>9} {:>7} {:>11}  noise floor {} (held-back {})",
         0,
         model_name(&r.start.effects, "paper's model", "", ","),
         number(r.start.error),
-        r.start.ratio_to_floor,
+        times(r.start.ratio_to_floor),
         number(r.start.heldback_error),
-        r.start.heldback_error / r.start.heldback_noise_floor,
+        times(r.start.heldback_error / r.start.heldback_noise_floor),
         "",
         number(r.start.noise_floor),
         number(r.start.heldback_noise_floor)
@@ -282,13 +282,13 @@ pub fn ladder(log: &Path, r: &LadderReport) -> anyhow::Result<()> {
             .collect();
         writeln!(
             out,
-            "  {:<4} {:<34} {:>8} {:>6.1}x {:>9} {:>6.1}x {:>4.0}% / {:>3.0}%  {}",
+            "  {:<4} {:<34} {:>8} {:>7} {:>9} {:>7} {:>4.0}% / {:>3.0}%  {}",
             k + 1,
             model_name(&s.added, "", "+ ", " + "),
             number(s.error),
-            s.ratio_to_floor,
+            times(s.ratio_to_floor),
             number(s.heldback_error),
-            s.heldback_ratio_to_floor,
+            times(s.heldback_ratio_to_floor),
             100.0 * s.explained,
             100.0 * s.heldback_explained,
             fitted.join("; ")
@@ -308,6 +308,16 @@ pub fn ladder(log: &Path, r: &LadderReport) -> anyhow::Result<()> {
         writeln!(out, "  not fitted: {s}")?;
     }
     Ok(())
+}
+
+/// A multiple of the noise floor as the table prints it (`12.3x`); beyond 999x (a noise-free
+/// log's floor is next to nothing) `>999x`, the ratio saying no more there.
+fn times(r: f64) -> String {
+    if r.is_finite() && r < 999.5 {
+        format!("{r:.1}x")
+    } else {
+        ">999x".into()
+    }
 }
 
 /// A value with four significant digits, in plain or scientific notation by its size.

@@ -1,0 +1,147 @@
+//! `explain --ladder` as a user runs it: the table, the JSON document, the HTML report with
+//! the error falling step by step onto the floor band, and a log the model cannot run on.
+//! (The physics of the ladder, on logs of a textbook machine written inside the test, is
+//! `ladder_matrix.rs`.)
+use assert_cmd::Command;
+use std::path::{Path, PathBuf};
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn motulator() -> (PathBuf, PathBuf) {
+    let r = repo();
+    (
+        r.join("examples/logs/motulator_2p2kw_dol.toml"),
+        r.join("examples/logs/motulator_2p2kw_dol.csv"),
+    )
+}
+
+fn ladder(extra: &[&str], params: &Path, log: &Path) -> std::process::Output {
+    Command::cargo_bin("sim-host")
+        .unwrap()
+        .args(["explain", "--ladder"])
+        .args(extra)
+        .arg("--params")
+        .arg(params)
+        .arg(log)
+        .output()
+        .unwrap()
+}
+
+/// The motulator log past its start: the paper's viscous load cannot follow the load step
+/// at 2.5 s; the ladder adds the load torque first, the whole-log error falls at every step,
+/// and the document says why it stopped with the numbers that decided.
+#[test]
+fn the_ladder_finds_the_load_step_and_the_error_falls_at_every_step() {
+    let (p, log) = motulator();
+    let out = ladder(&["--json", "--from", "0.8"], &p, &log);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for key in [
+        "start",
+        "ladder",
+        "stop",
+        "stopped_because",
+        "final_effects",
+        "last_round",
+        "skipped",
+        "split",
+        "test",
+        "data_quality",
+    ] {
+        assert!(v.get(key).is_some(), "missing key {key}");
+    }
+    let steps = v["ladder"].as_array().unwrap();
+    assert!(!steps.is_empty());
+    assert_eq!(steps[0]["effect"], "load_torque", "{:#}", steps[0]);
+    for s in steps {
+        for key in [
+            "effect",
+            "fitted",
+            "error",
+            "heldback_error",
+            "noise_floor",
+            "ratio_to_floor",
+            "significance",
+        ] {
+            assert!(s.get(key).is_some(), "step lacks {key}: {s:#}");
+        }
+        // Each fitted value with its physical range, inside it (the step is plausible).
+        for (name, f) in s["fitted"].as_object().unwrap() {
+            let (x, lo, hi) = (
+                f["value"].as_f64().unwrap(),
+                f["low"].as_f64().unwrap(),
+                f["high"].as_f64().unwrap(),
+            );
+            assert!(lo <= x && x <= hi, "{name}: {x} outside {lo}..{hi}");
+        }
+        assert!(s["significance"].as_f64().unwrap() >= 0.1);
+    }
+    let mut errors = vec![v["start"]["error"].as_f64().unwrap()];
+    errors.extend(steps.iter().map(|s| s["error"].as_f64().unwrap()));
+    assert!(errors.windows(2).all(|w| w[1] < w[0]), "{errors:?}");
+    // The noise-free log: the load torque alone cuts the error more than 5x (0.37 -> 0.03),
+    // the full-order machine's dynamics then to below 0.003.
+    assert!(errors[1] < errors[0] / 5.0, "{errors:?}");
+    assert!(*errors.last().unwrap() < 0.003, "{errors:?}");
+    let why = v["stopped_because"].as_str().unwrap();
+    assert!(why.contains("noise floor"), "{why}");
+    // Every plausible strata split holds back about half the log.
+    let share = v["split"]["heldback_share"].as_f64().unwrap();
+    assert!((0.4..0.6).contains(&share), "{share}");
+}
+
+/// The table a user reads, and the report: the chart of the error falling onto the floor
+/// band and the steps' table, one self-contained page.
+#[test]
+fn the_table_and_the_report_show_every_step() {
+    let (p, log) = motulator();
+    let dir = tempfile::tempdir().unwrap();
+    let report = dir.path().join("out");
+    let out = ladder(
+        &["--from", "0.8", "--to", "3.5", "--report", report.to_str().unwrap()],
+        &p,
+        &log,
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("+ load_torque"), "{text}");
+    assert!(text.contains("x floor"), "{text}");
+    assert!(text.lines().any(|l| l.starts_with("stopped: ")), "{text}");
+    let html = std::fs::read_to_string(report.join("report.html")).unwrap();
+    assert!(html.contains("<svg"), "the chart is inline");
+    assert!(html.contains("load_torque"));
+    assert!(html.contains("floor band"));
+    assert!(report.join("ladder.png").exists() && report.join("ladder.svg").exists());
+}
+
+/// A log without voltages: the model cannot run, so the ladder adds nothing and says why
+/// (never a step, never an error exit).
+#[test]
+fn a_current_only_log_adds_nothing_and_says_why() {
+    let (p, log) = motulator();
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(&log).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let keep: Vec<usize> = ["t_s", "ia_A", "ib_A", "ic_A"]
+        .iter()
+        .map(|c| header.iter().position(|h| h == c).unwrap())
+        .collect();
+    let mut csv = String::from("t_s,ia_A,ib_A,ic_A\n");
+    for l in lines.take(20_000) {
+        let cells: Vec<&str> = l.split(',').collect();
+        let row: Vec<&str> = keep.iter().map(|&k| cells[k]).collect();
+        csv.push_str(&row.join(","));
+        csv.push('\n');
+    }
+    let current_only = dir.path().join("currents.csv");
+    std::fs::write(&current_only, csv).unwrap();
+    let out = ladder(&["--json"], &p, &current_only);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["stop"], "no_model");
+    assert!(v["ladder"].as_array().unwrap().is_empty());
+    assert!(v["stopped_because"].as_str().unwrap().contains("no voltages"));
+}
