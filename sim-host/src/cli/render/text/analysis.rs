@@ -267,32 +267,7 @@ pub fn ladder(log: &Path, r: &LadderReport) -> anyhow::Result<()> {
         number(r.start.heldback_noise_floor)
     )?;
     for (k, s) in r.ladder.iter().enumerate() {
-        let fitted: Vec<String> = s
-            .fitted
-            .iter()
-            .map(|(n, v)| {
-                format!(
-                    "{n} {} {} ({}..{})",
-                    sig(v.value),
-                    v.unit,
-                    sig(v.low),
-                    sig(v.high)
-                )
-            })
-            .collect();
-        writeln!(
-            out,
-            "  {:<4} {:<34} {:>8} {:>7} {:>9} {:>7} {:>4.0}% / {:>3.0}%  {}",
-            k + 1,
-            model_name(&s.added, "", "+ ", " + "),
-            number(s.error),
-            times(s.ratio_to_floor),
-            number(s.heldback_error),
-            times(s.heldback_ratio_to_floor),
-            100.0 * s.explained,
-            100.0 * s.heldback_explained,
-            fitted.join("; ")
-        )?;
+        writeln!(out, "{}", ladder_row(k + 1, s))?;
     }
     writeln!(
         out,
@@ -308,6 +283,35 @@ pub fn ladder(log: &Path, r: &LadderReport) -> anyhow::Result<()> {
         writeln!(out, "  not fitted: {s}")?;
     }
     Ok(())
+}
+
+/// One step's row of the ladder's table (`k`: its number).
+fn ladder_row(k: usize, s: &monitor_analysis::explain::ladder::LadderStep) -> String {
+    let fitted: Vec<String> = s
+        .fitted
+        .iter()
+        .map(|(n, v)| {
+            format!(
+                "{n} {} {} ({}..{})",
+                sig(v.value),
+                v.unit,
+                sig(v.low),
+                sig(v.high)
+            )
+        })
+        .collect();
+    format!(
+        "  {:<4} {:<34} {:>8} {:>7} {:>9} {:>7} {:>4.0}% / {:>3.0}%  {}",
+        k,
+        model_name(&s.added, "", "+ ", " + "),
+        number(s.error),
+        times(s.ratio_to_floor),
+        number(s.heldback_error),
+        times(s.heldback_ratio_to_floor),
+        100.0 * s.explained,
+        100.0 * s.heldback_explained,
+        fitted.join("; ")
+    )
 }
 
 /// A multiple of the noise floor as the table prints it (`12.3x`); beyond 999x (a noise-free

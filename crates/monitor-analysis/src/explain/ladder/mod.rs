@@ -1,0 +1,422 @@
+//! `explain --ladder`: forward selection over the effect library, from the configured model
+//! to the noise floor.
+//!
+//! Each step fits every effect of the library not yet in the model (the dynamics effects
+//! are candidates like the others; one that needs another first, such as
+//! `cross_coupling_dynamics` after `d_axis_dynamics`, is tried together with it), each
+//! starting from the previous step's fit (nested fits: the step's solver starts where the
+//! model stood, so a candidate can only lower the training error). The plausible candidate
+//! with the lowest held-back error (each parameter costing [`PARAM_PENALTY`] of it) is kept
+//! when the step passes its test ([`STEP_MIN`]) and lowers the whole-log error; the ladder
+//! stops when the error is within the noise-floor band ([`FLOOR_BAND`], on the whole log and
+//! on the held-back part) or when no plausible candidate passes, and says which.
+//!
+//! # The held-back split
+//! The log is cut into strata by its events ([`strata`]: the start, supply or speed
+//! transients, load moves, steady stretches), and every stratum into an even number of
+//! alternating windows ([`stratified_heldback`]), so that each kind of event the log holds
+//! falls in both the fitted and the held-back part. A fixed interleave of the whole log
+//! can put a log's only load step in the fitted part and leave the held-back windows blind
+//! to the effect that explains it.
+//!
+//! # The test a step passes
+//! A step is kept when the candidate removes at least [`STEP_MIN`] (20 %) of the held-back
+//! error beyond the noise floor that the model had before the step
+//! ([`super::explained_fraction`], each parameter costing [`PARAM_PENALTY`] of the
+//! held-back error), and lowers the whole-log error. The held-back error is an
+//! out-of-sample estimate: a candidate that only fits noise does not lower it, and one that
+//! absorbs another effect lowers it less than the effect itself. An information criterion
+//! (AIC, BIC) would count each of the log's 10⁴-10⁶ samples as an independent observation,
+//! while a model's error is structural and correlated over whole events: every candidate
+//! would pass. The threshold is the largest share a candidate without effect removed on the
+//! effect-free control logs of the test matrix (a textbook machine written inside the test,
+//! three sizes, starts and steps: under 10 %), doubled (docs/model-vs-measurement.md).
+
+mod round;
+mod split;
+
+pub use split::stratified_heldback;
+
+use super::{NOISE_MARGIN, PARAM_PENALTY};
+use crate::effects::{self, EffectModel};
+use crate::simplified_model::BaseParams;
+use crate::DataInfo;
+use crate::{resolve, transients, Analysis, AnalysisError, Options};
+use monitor_core::EffectKind;
+use round::{pairs_of, Rung, Series};
+use serde::Serialize;
+use split::{mask_on, weights_for};
+use std::collections::BTreeMap;
+
+/// A step must remove at least this share (20 %) of the held-back error beyond the noise
+/// floor that the model had before it (module doc, "The test a step passes").
+pub const STEP_MIN: f64 = 0.1;
+/// The noise-floor band: an error within this factor of its noise floor, on the whole log
+/// and on the held-back part, has nothing left to explain (the same margin as
+/// [`NOISE_MARGIN`]: a model error beyond the noise of half the noise floor).
+pub const FLOOR_BAND: f64 = NOISE_MARGIN;
+/// Longest held-back or fitted window of a stratum [s] before it is cut further: a steady
+/// stretch is interleaved at least this finely.
+pub const WINDOW_MAX_S: f64 = 0.5;
+/// Longest window of an event's stratum (a start, a transient, a load move) [s]: an event
+/// is interleaved finely, so that its fastest part (a start's acceleration) is in both
+/// parts.
+pub const EVENT_WINDOW_MAX_S: f64 = 0.08;
+/// Largest number of samples a ladder's fit simulates (a longer log is fitted on a coarser
+/// copy and measured on the working series). A third of explain's
+/// ([`crate::MAX_FIT_SAMPLES`]): a round fits every candidate, a ladder has several rounds,
+/// and a few parameters are fitted as well from 20 000 samples (a 10 s log at 2 kHz still
+/// resolves the stator transient time constant, 3 samples or more of it: the dynamics
+/// effects are refused on a series that does not, [`transients::not_proposed`]).
+pub const LADDER_FIT_SAMPLES: usize = 20_000;
+/// How many single candidates the pair search pairs: those that lowered the training cost
+/// most.
+pub const PAIR_FROM: usize = 4;
+/// Supply periods in the shortest window of a stratum (an event's stratum is cut into two
+/// windows at least, each this long where the event allows).
+pub const WINDOW_MIN_PERIODS: f64 = 2.0;
+
+/// One fitted value of a ladder step, with its physical range.
+#[derive(Debug, Clone, Serialize)]
+pub struct RangedValue {
+    /// The value.
+    pub value: f64,
+    /// Its unit.
+    pub unit: String,
+    /// The smallest physically plausible value on this log.
+    pub low: f64,
+    /// The largest physically plausible value on this log.
+    pub high: f64,
+}
+
+/// One step of the ladder (JSON `ladder[]`).
+#[derive(Debug, Clone, Serialize)]
+pub struct LadderStep {
+    /// The effect added (for a pair, the one that needed the other).
+    pub effect: EffectKind,
+    /// Every effect the step added: `effect`, and before it one it needs first
+    /// ([`EffectModel::requires`]) when the model lacked it.
+    pub added: Vec<EffectKind>,
+    /// The added effects' fitted values with their physical ranges, by parameter name
+    /// (prefixed `effect.` when the step added two).
+    pub fitted: BTreeMap<String, RangedValue>,
+    /// The effects' values in words.
+    pub summary: String,
+    /// `normalized_rms_error` over the whole log after the step.
+    pub error: f64,
+    /// `normalized_rms_error` on the held-back windows after the step.
+    pub heldback_error: f64,
+    /// The whole log's noise floor for the model after the step.
+    pub noise_floor: f64,
+    /// The held-back windows' noise floor.
+    pub heldback_noise_floor: f64,
+    /// `error / noise_floor`.
+    pub ratio_to_floor: f64,
+    /// `heldback_error / heldback_noise_floor`.
+    pub heldback_ratio_to_floor: f64,
+    /// The step's test statistic: the share of the held-back error beyond the noise floor
+    /// removed by the step, each parameter costing [`PARAM_PENALTY`] ([`STEP_MIN`]).
+    pub significance: f64,
+    /// Share of the whole-log error beyond the noise floor the step removed.
+    pub explained: f64,
+    /// Share of the held-back error beyond the noise floor the step removed.
+    pub heldback_explained: f64,
+}
+
+/// Where the model stood before the first step (JSON `start`).
+#[derive(Debug, Clone, Serialize)]
+pub struct LadderStart {
+    /// The configured effects.
+    pub effects: Vec<EffectKind>,
+    /// `normalized_rms_error` over the whole log.
+    pub error: f64,
+    /// On the held-back windows.
+    pub heldback_error: f64,
+    /// The whole log's noise floor.
+    pub noise_floor: f64,
+    /// The held-back windows' noise floor.
+    pub heldback_noise_floor: f64,
+    /// `error / noise_floor`.
+    pub ratio_to_floor: f64,
+}
+
+/// A candidate of the last round that was not kept, and why (JSON `last_round`).
+#[derive(Debug, Clone, Serialize)]
+pub struct Tried {
+    /// The effect (with what it needed first, as in [`LadderStep::added`]).
+    pub added: Vec<EffectKind>,
+    /// Its held-back error.
+    pub heldback_error: f64,
+    /// Its test statistic ([`LadderStep::significance`]).
+    pub significance: f64,
+    /// Why it was not kept.
+    pub because: String,
+}
+
+/// Why the ladder stopped (JSON `stop`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stop {
+    /// The error is within the noise-floor band on the whole log and the held-back part.
+    NoiseFloor,
+    /// No plausible candidate passed the step's test.
+    NothingHelps,
+    /// Every effect of the library is in the model.
+    LibraryExhausted,
+    /// The model cannot run on the log (no voltages).
+    NoModel,
+    /// The data-quality stage does not trust the log: nothing is claimed from it.
+    Untrusted,
+}
+
+/// The ladder's report (JSON of `explain --ladder`).
+#[derive(Debug, Clone, Serialize)]
+pub struct LadderReport {
+    /// The model before the first step.
+    pub start: LadderStart,
+    /// The steps in order.
+    pub ladder: Vec<LadderStep>,
+    /// Why it stopped ([`Stop`]).
+    pub stop: Stop,
+    /// The same in words, naming the numbers that decided.
+    pub stopped_because: String,
+    /// The effects in the model at the end.
+    pub final_effects: Vec<EffectKind>,
+    /// The last round's candidates that were not kept, best first.
+    pub last_round: Vec<Tried>,
+    /// Effects never fitted on this log, each as `name: why`.
+    pub skipped: Vec<String>,
+    /// The held-back split: the strata of the log and how much of it is held back.
+    pub split: SplitInfo,
+    /// The rule each step passed (in words, for the report).
+    pub test: String,
+    /// Facts about the data.
+    pub data: DataInfo,
+    /// What the data-quality stage found and what the analysis did about it.
+    pub data_quality: monitor_io::log::quality::DataQuality,
+}
+
+/// The held-back split of the ladder (JSON `split`).
+#[derive(Debug, Clone, Serialize)]
+pub struct SplitInfo {
+    /// The strata, each `{kind, t_start_s, t_end_s, windows}`.
+    pub strata: Vec<Stratum>,
+    /// Share of the log's samples held back.
+    pub heldback_share: f64,
+}
+
+/// One stratum of the log.
+#[derive(Debug, Clone, Serialize)]
+pub struct Stratum {
+    /// `start`, `transient` (a supply or speed step), `load_move` or `steady`.
+    pub kind: &'static str,
+    /// Its start [s].
+    pub t_start_s: f64,
+    /// Its end [s].
+    pub t_end_s: f64,
+    /// Its windows, half of them held back.
+    pub windows: usize,
+}
+
+impl Analysis {
+    /// `explain --ladder`: forward selection over the effect library from the configured
+    /// model (module doc). `progress` gets the step (1-based) and the fraction of its
+    /// candidates fitted.
+    ///
+    /// # Errors
+    /// A configured effect whose needs the log does not meet.
+    pub fn ladder(
+        &self,
+        opts: &Options,
+        progress: &(dyn Fn(usize, f64) + Sync),
+    ) -> Result<LadderReport, AnalysisError> {
+        let d = &self.data;
+        let (held, strata) = stratified_heldback(d, &self.constants);
+        let mut report = LadderReport {
+            start: LadderStart {
+                effects: opts.effects.clone(),
+                error: f64::NAN,
+                heldback_error: f64::NAN,
+                noise_floor: f64::NAN,
+                heldback_noise_floor: f64::NAN,
+                ratio_to_floor: f64::NAN,
+            },
+            ladder: Vec::new(),
+            stop: Stop::NoModel,
+            stopped_because: String::new(),
+            final_effects: opts.effects.clone(),
+            last_round: Vec::new(),
+            skipped: Vec::new(),
+            split: SplitInfo {
+                heldback_share: held.iter().filter(|h| **h).count() as f64
+                    / d.len().max(1) as f64,
+                strata,
+            },
+            test: format!(
+                "a step is kept when it removes at least {:.0} % of the held-back error beyond the noise floor (each parameter costing {:.0} % of the held-back error) and lowers the whole-log error; the ladder stops within {FLOOR_BAND}x the noise floor on the whole log and the held-back part",
+                100.0 * STEP_MIN,
+                100.0 * PARAM_PENALTY
+            ),
+            data: self.info(),
+            data_quality: self.quality.clone(),
+        };
+        if let Some((stop, why)) = self.refused() {
+            report.stop = stop;
+            report.stopped_because = why;
+            return Ok(report);
+        }
+        let sr = self.ladder_series(held);
+        let configured = resolve(&opts.effects);
+        let active = self.setup_all(&sr.fd, &configured)?;
+        let nominal = BaseParams::nominal(&self.constants);
+        let f0 = self.fit_set(&sr.fd, &active, &sr.wf, &nominal, opts.fit_base)?;
+        let models: Vec<&dyn EffectModel> = configured.iter().map(|e| e.as_ref()).collect();
+        let rung = self.measure_rung(models, f0, &sr)?;
+        let lib = effects::library();
+        report.start = LadderStart {
+            effects: opts.effects.clone(),
+            error: rung.error,
+            heldback_error: rung.heldback_error,
+            noise_floor: rung.noise,
+            heldback_noise_floor: rung.heldback_noise,
+            ratio_to_floor: rung.error / rung.noise,
+        };
+        self.walk(&lib, rung, &sr, opts, progress, &mut report)?;
+        Ok(report)
+    }
+
+    /// Why the ladder cannot start on this log, if it cannot: no voltages (the model cannot
+    /// run), or a log the data-quality stage does not trust.
+    fn refused(&self) -> Option<(Stop, String)> {
+        if !self.data.channels.voltages {
+            return Some((Stop::NoModel, "the log has no voltages: the model cannot run, so no effect can be added (the unbalance analysis needs only the currents: explain without the ladder gives it)".to_string()));
+        }
+        (!self.quality.trusted).then(|| {
+            (
+                Stop::Untrusted,
+                format!(
+                    "could not judge: the data-quality stage does not trust the log ({})",
+                    self.quality.not_trusted_because.join("; ")
+                ),
+            )
+        })
+    }
+
+    /// The series the ladder's fits run on: a copy of at most [`LADDER_FIT_SAMPLES`] samples
+    /// (a round fits every candidate, and a ladder has several rounds), with the held-back
+    /// mask `held` of the working series carried over.
+    fn ladder_series(&self, held: Vec<bool>) -> Series {
+        let m = self.data.len().div_ceil(LADDER_FIT_SAMPLES).max(1);
+        let fd = crate::coarsen(&self.data, m);
+        let held_fd = if m == 1 {
+            held.clone()
+        } else {
+            mask_on(&fd, &self.data, &held)
+        };
+        Series {
+            wf: weights_for(&fd, &held_fd, LADDER_FIT_SAMPLES),
+            span: transients::Span::of(&fd, &self.constants),
+            fd,
+            m,
+            held,
+            held_fd,
+        }
+    }
+
+    /// The steps from `rung` until the floor band or nothing helps, into `report`: each
+    /// round fits the candidates of `lib` (then pairs, when no single one passes) and keeps
+    /// at most one.
+    fn walk<'a>(
+        &self,
+        lib: &'a [Box<dyn EffectModel>],
+        mut rung: Rung<'a>,
+        sr: &Series,
+        opts: &Options,
+        progress: &(dyn Fn(usize, f64) + Sync),
+        report: &mut LadderReport,
+    ) -> Result<(), AnalysisError> {
+        let mut step_no = 0;
+        let (stop, why) = loop {
+            if let Some(why) = at_floor(&rung) {
+                break (Stop::NoiseFloor, why);
+            }
+            step_no += 1;
+            let (cands, skipped) = self.ladder_candidates(lib, &rung, sr);
+            report.skipped = skipped;
+            if cands.is_empty() {
+                let why = "no effect of the library is left to add on this log";
+                break (Stop::LibraryExhausted, why.to_string());
+            }
+            let fitted =
+                self.fit_round(&cands, &rung, sr, opts, &|f| progress(step_no, 0.7 * f))?;
+            let pairs = pairs_of(&fitted, rung.models.len());
+            let (mut kept, mut tried) = self.choose(fitted, &rung, sr)?;
+            if kept.is_none() && !pairs.is_empty() {
+                // No single effect passes: two that need each other (a load torque and the
+                // cross coupling of a start, two hidden effects at once) are tried together.
+                let fitted = self.fit_round(&pairs, &rung, sr, opts, &|f| {
+                    progress(step_no, 0.7 + 0.3 * f)
+                })?;
+                let (k2, t2) = self.choose(fitted, &rung, sr)?;
+                kept = k2;
+                tried.extend(t2);
+            }
+            report.last_round = tried;
+            let Some((next, step)) = kept else {
+                break (Stop::NothingHelps, nothing_helps(&rung, &report.last_round));
+            };
+            report.ladder.push(step);
+            rung = next;
+        };
+        report.stop = stop;
+        report.stopped_because = why;
+        report.final_effects = rung.kinds.clone();
+        Ok(())
+    }
+}
+
+/// Why the ladder stops at `rung` for the noise floor, if it does: both the whole-log and
+/// the held-back error within [`FLOOR_BAND`] of their floors (the sentence names both).
+fn at_floor(rung: &Rung<'_>) -> Option<String> {
+    let r = rung.error / rung.noise;
+    let rh = rung.heldback_error / rung.heldback_noise;
+    (r <= FLOOR_BAND && rh <= FLOOR_BAND).then(|| {
+        format!(
+            "at the noise floor: the whole-log error {} is {r:.2}x its noise floor {} and the held-back error {} is {rh:.2}x its floor {} (both within {FLOOR_BAND}x): nothing is left to explain",
+            effects::sig(rung.error),
+            effects::sig(rung.noise),
+            effects::sig(rung.heldback_error),
+            effects::sig(rung.heldback_noise)
+        )
+    })
+}
+
+/// Why no candidate helps, naming the numbers that decided.
+fn nothing_helps(rung: &Rung<'_>, tried: &[Tried]) -> String {
+    let r = rung.error / rung.noise;
+    let rh = rung.heldback_error / rung.heldback_noise;
+    // The plausible candidate that came closest to passing (else the first tried).
+    let closest = tried
+        .iter()
+        .filter(|t| !t.because.starts_with("not physical") && !t.because.contains("diverged"))
+        .max_by(|a, b| a.significance.total_cmp(&b.significance));
+    let best = closest
+        .or(tried.first())
+        .map(|t| {
+            format!(
+                "{} ({})",
+                t.added
+                    .iter()
+                    .map(|k| k.name())
+                    .collect::<Vec<_>>()
+                    .join("+"),
+                t.because
+            )
+        })
+        .unwrap_or_else(|| "no candidate could be fitted".into());
+    format!(
+        "no plausible candidate passes the step's test: the whole-log error {} is {r:.2}x its noise floor and the held-back error {} is {rh:.2}x its floor; the best candidate was {best}. What is left is beyond the effect library (or below what the log can show)",
+        effects::sig(rung.error),
+        effects::sig(rung.heldback_error),
+    )
+}

@@ -1,0 +1,643 @@
+//! One round of the ladder: the candidates, each fitted nested from the model of the step
+//! before, and the choice of the one kept (the test of [`super::STEP_MIN`]).
+
+use super::split::weights_for;
+use super::{LadderStep, RangedValue, Tried, PAIR_FROM, STEP_MIN};
+use crate::effects::{self, EffectModel};
+use crate::explain::{explained_fraction, PARAM_PENALTY};
+use crate::fit::{self, ActiveEffect, FitResult};
+use crate::metrics::{self, Weights};
+use crate::prep::Prepared;
+use crate::simplified_model::{BaseParameter, BaseParams, MachineConstants};
+use crate::{align, base_out_of_range, transients, Analysis, AnalysisError, Options};
+use monitor_core::EffectKind;
+use std::collections::BTreeMap;
+
+/// The step a round keeps: the model after it and the step's report.
+pub(super) type Kept<'a> = (Rung<'a>, LadderStep);
+
+/// What a round found: the step kept (if any) and the candidates not kept, with why.
+pub(super) type Round<'a> = (Option<Kept<'a>>, Vec<Tried>);
+
+/// The series a ladder's fits run on, with its held-back split.
+pub(super) struct Series {
+    /// The copy of the working series the fits run on.
+    pub(super) fd: Prepared,
+    /// Its coarsening factor (1: the working series itself).
+    pub(super) m: usize,
+    /// The held-back mask of the working series.
+    pub(super) held: Vec<bool>,
+    /// The held-back mask of the fit series.
+    pub(super) held_fd: Vec<bool>,
+    /// The fit's weights (training on the samples not held back).
+    pub(super) wf: Weights,
+    /// What the fit series offers a dynamics effect.
+    pub(super) span: transients::Span,
+}
+
+/// The model of a ladder step: its effects, their set-ups on the fit series, and the fit.
+pub(super) struct Rung<'a> {
+    pub(super) kinds: Vec<EffectKind>,
+    pub(super) models: Vec<&'a dyn EffectModel>,
+    pub(super) fit: FitResult,
+    /// Whole-log and held-back error and floors on the working series.
+    pub(super) error: f64,
+    pub(super) heldback_error: f64,
+    pub(super) noise: f64,
+    pub(super) heldback_noise: f64,
+    /// The held-back error on the fit series (what candidates are ranked on).
+    pub(super) heldback_fit_series: f64,
+    pub(super) heldback_noise_fit_series: f64,
+}
+
+/// A candidate fitted in one round.
+pub(super) struct Fitted<'a> {
+    models: Vec<&'a dyn EffectModel>,
+    fit: FitResult,
+    n_parameters: usize,
+    heldback_fit_series: f64,
+    implausible: Vec<String>,
+}
+
+impl Fitted<'_> {
+    fn score(&self) -> f64 {
+        self.heldback_fit_series * (1.0 + PARAM_PENALTY * self.n_parameters as f64)
+    }
+    fn added(&self, before: usize) -> Vec<EffectKind> {
+        self.models.iter().skip(before).map(|m| m.kind()).collect()
+    }
+}
+
+impl Analysis {
+    /// The model `models` fitted as `fit` on the fit series, measured on the working
+    /// series: whole log, held-back part, and their noise floors.
+    pub(super) fn measure_rung<'a>(
+        &self,
+        models: Vec<&'a dyn EffectModel>,
+        fit: FitResult,
+        sr: &Series,
+    ) -> Result<Rung<'a>, AnalysisError> {
+        let (fd, m, held, held_fd) = (&sr.fd, sr.m, &sr.held[..], &sr.held_fd[..]);
+        let d = &self.data;
+        let active: Vec<ActiveEffect<'a>> = models
+            .iter()
+            .map(|e| {
+                e.setup(d, &self.constants)
+                    .map(|setup| ActiveEffect { effect: *e, setup })
+                    .map_err(|source| AnalysisError::Effect {
+                        effect: e.kind(),
+                        source,
+                    })
+            })
+            .collect::<Result<_, _>>()?;
+        let f_full = align(&active, fit.clone());
+        let (pred, renoised) = self.predict_and_renoised(d, &active, &f_full)?;
+        let w = weights_for(d, held, usize::MAX);
+        let noise = metrics::noise_floor(d, &w, Some((&pred, &renoised)));
+        let heldback_noise = metrics::noise_floor_on(d, held, Some((&pred, &renoised)));
+        let error = metrics::errors(d, &pred, None).normalized_rms_error;
+        let heldback_error = metrics::errors(d, &pred, Some(held)).normalized_rms_error;
+        let (hb_fd, hn_fd) = if m == 1 {
+            (heldback_error, heldback_noise)
+        } else {
+            let fa = self.setup_list(fd, &models)?;
+            let fit_a = align(&fa, fit.clone());
+            let (p, r) = self.predict_and_renoised(fd, &fa, &fit_a)?;
+            (
+                metrics::errors(fd, &p, Some(held_fd)).normalized_rms_error,
+                metrics::noise_floor_on(fd, held_fd, Some((&p, &r))),
+            )
+        };
+        Ok(Rung {
+            kinds: models.iter().map(|e| e.kind()).collect(),
+            models,
+            fit,
+            error,
+            heldback_error,
+            noise,
+            heldback_noise,
+            heldback_fit_series: hb_fd,
+            heldback_noise_fit_series: hn_fd,
+        })
+    }
+
+    /// `models` set up on `d`.
+    fn setup_list<'a>(
+        &self,
+        d: &Prepared,
+        models: &[&'a dyn EffectModel],
+    ) -> Result<Vec<ActiveEffect<'a>>, AnalysisError> {
+        models
+            .iter()
+            .map(|e| {
+                e.needs()
+                    .met_by(d)
+                    .and_then(|()| e.setup(d, &self.constants))
+                    .map(|setup| ActiveEffect { effect: *e, setup })
+                    .map_err(|source| AnalysisError::Effect {
+                        effect: e.kind(),
+                        source,
+                    })
+            })
+            .collect()
+    }
+
+    /// Why effect `e` of `lib` cannot be fitted on this log (`None`: it can): a missing
+    /// channel, a set-up the data refuse, a time constant the fit series cannot resolve.
+    /// What an effect needs first is tried with it ([`Analysis::ladder_candidates`]), not a
+    /// reason to skip it; a dynamics effect competes on any log (its held-back error
+    /// decides), not only through a start or a supply step.
+    fn ladder_cannot_fit(
+        &self,
+        lib: &[Box<dyn EffectModel>],
+        e: &dyn EffectModel,
+        sr: &Series,
+    ) -> Option<String> {
+        let all: Vec<EffectKind> = lib.iter().map(|x| x.kind()).collect();
+        let resolvable = transients::Span {
+            input_transient: true,
+            ..sr.span
+        };
+        if let Some(t) = transients::not_proposed(e, resolvable, &self.constants, &all) {
+            return Some(t.to_string());
+        }
+        e.needs()
+            .met_by(&self.data)
+            .and_then(|()| e.setup(&sr.fd, &self.constants).map(|_| ()))
+            .err()
+            .map(|s| s.to_string())
+    }
+
+    /// The round's candidates: each library effect not in the model, preceded by what it
+    /// needs first and the model lacks, and the full-order machine at once
+    /// ([`full_order`]); and the effects that cannot be fitted on this log, each as
+    /// `name: why` ([`Analysis::ladder_cannot_fit`]).
+    pub(super) fn ladder_candidates<'a>(
+        &self,
+        lib: &'a [Box<dyn EffectModel>],
+        rung: &Rung<'_>,
+        sr: &Series,
+    ) -> (Vec<Vec<&'a dyn EffectModel>>, Vec<String>) {
+        let fits = |e: &dyn EffectModel| self.ladder_cannot_fit(lib, e, sr).is_none();
+        let mut out = Vec::new();
+        let mut skipped = Vec::new();
+        for e in lib.iter().map(|e| e.as_ref()) {
+            if rung.kinds.contains(&e.kind()) {
+                continue;
+            }
+            if let Some(why) = self.ladder_cannot_fit(lib, e, sr) {
+                skipped.push(format!("{}: {why}", e.kind()));
+                continue;
+            }
+            let missing: Vec<Option<&dyn EffectModel>> = e
+                .requires()
+                .iter()
+                .filter(|r| !rung.kinds.contains(r))
+                .map(|r| {
+                    lib.iter()
+                        .map(|x| x.as_ref())
+                        .find(|x| x.kind() == *r && fits(*x))
+                })
+                .collect();
+            let Some(mut set) = missing.into_iter().collect::<Option<Vec<_>>>() else {
+                skipped.push(format!(
+                    "{}: needs {} first, which cannot be fitted on this log",
+                    e.kind(),
+                    transients::names(e.requires())
+                ));
+                continue;
+            };
+            set.push(e);
+            out.push(set);
+        }
+        let dynamics = full_order(lib, &rung.kinds, &self.constants, &fits);
+        if dynamics.len() >= 2 {
+            out.push(dynamics);
+        }
+        (out, skipped)
+    }
+
+    /// Every candidate of the round added to the model of `rung`, fitted from its fit on the
+    /// fit series `fd` (in parallel), with its held-back error there and what makes it
+    /// implausible.
+    pub(super) fn fit_round<'a>(
+        &self,
+        cands: &[Vec<&'a dyn EffectModel>],
+        rung: &Rung<'a>,
+        sr: &Series,
+        opts: &Options,
+        progress: &(dyn Fn(f64) + Sync),
+    ) -> Result<Vec<Fitted<'a>>, AnalysisError> {
+        use rayon::prelude::*;
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        let total = cands.len().max(1);
+        let out: Vec<Option<Fitted<'a>>> = cands
+            .par_iter()
+            .map(|c| {
+                let r = self.fit_candidate(c, rung, sr, opts);
+                let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                progress(k as f64 / total as f64);
+                r
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(out.into_iter().flatten().collect())
+    }
+
+    /// One candidate `c` (effects to add, in order) fitted with the model of `rung`.
+    fn fit_candidate<'a>(
+        &self,
+        c: &[&'a dyn EffectModel],
+        rung: &Rung<'a>,
+        sr: &Series,
+        opts: &Options,
+    ) -> Result<Option<Fitted<'a>>, AnalysisError> {
+        let Some(set) = self.nested(c, rung, &sr.fd) else {
+            return Ok(None);
+        };
+        let n_parameters = set
+            .iter()
+            .skip(rung.models.len())
+            .map(|a| a.setup.len())
+            .sum();
+        // Nested: from where the model stood. A pair (or an effect with what it needs
+        // first) can trade off against a base parameter (a load torque against B + Bl,
+        // which absorbed it while the model had no load torque): it is also fitted from the
+        // nominal base parameters, and the lower training cost wins, so the nested fit's
+        // cost is never exceeded.
+        let mut f = self.fit_set(&sr.fd, &set, &sr.wf, &rung.fit.base, opts.fit_base)?;
+        if opts.fit_base && c.len() > 1 {
+            let nominal = BaseParams::nominal(&self.constants);
+            let g = self.fit_set(&sr.fd, &set, &sr.wf, &nominal, true)?;
+            if g.report.cost < f.report.cost {
+                f = g;
+            }
+        }
+        let pred = fit::predict(&sr.fd, &self.constants, &set, &f)?;
+        let hb = metrics::errors(&sr.fd, &pred, Some(&sr.held_fd)).normalized_rms_error;
+        let why = self.implausible_step(&set, rung, &f, sr.m)?;
+        Ok(Some(Fitted {
+            models: set.iter().map(|a| a.effect).collect(),
+            fit: f,
+            n_parameters,
+            heldback_fit_series: hb,
+            implausible: why,
+        }))
+    }
+
+    /// The model of `rung` set up on `fd`, each effect starting from its fitted values, with
+    /// the candidate's effects `c` added last (from their own starts); `None` when a set-up
+    /// refuses the series.
+    fn nested<'a>(
+        &self,
+        c: &[&'a dyn EffectModel],
+        rung: &Rung<'a>,
+        fd: &Prepared,
+    ) -> Option<Vec<ActiveEffect<'a>>> {
+        let starts = rung.fit.effect_params.iter().map(Some);
+        let mut set = Vec::new();
+        for (e, p) in rung
+            .models
+            .iter()
+            .zip(starts)
+            .chain(c.iter().map(|e| (e, None)))
+        {
+            let mut setup = e.setup(fd, &self.constants).ok()?;
+            if let Some(p) = p {
+                setup.start_from(p);
+            }
+            set.push(ActiveEffect { effect: *e, setup });
+        }
+        Some(set)
+    }
+
+    /// Why the step that adds the effects of `set` after the model of `rung`, fitted as
+    /// `f`, is not plausible (empty: it is): an added effect's value outside its physical
+    /// range, pinned at a bound of its fit, or contradicted by a measurement of the log
+    /// ([`EffectModel::contradicted_by`]); a base parameter the fit takes out of range that
+    /// the model's own fit had in range.
+    fn implausible_step(
+        &self,
+        set: &[ActiveEffect<'_>],
+        rung: &Rung<'_>,
+        f: &FitResult,
+        m: usize,
+    ) -> Result<Vec<String>, AnalysisError> {
+        let d = &self.data;
+        let already: Vec<BaseParameter> = base_out_of_range(&self.constants, &rung.fit.base, d)
+            .into_iter()
+            .map(|(k, _)| k)
+            .collect();
+        let mut why = Vec::new();
+        for (i, a) in set.iter().enumerate().skip(rung.models.len()) {
+            let p = f.effect_params.get(i).map_or(&[][..], Vec::as_slice);
+            // The plausible ranges are those of the working series' set-up (a long log's
+            // coarse copy may have fewer load segments: its own set-up then).
+            let s_full = (m > 1)
+                .then(|| a.effect.setup(d, &self.constants).ok())
+                .flatten();
+            let setup = s_full
+                .as_ref()
+                .filter(|s| s.len() == p.len())
+                .unwrap_or(&a.setup);
+            let kind = a.effect.kind();
+            why.extend(
+                setup
+                    .implausible(p)
+                    .into_iter()
+                    .map(|w| format!("{kind}: {w}")),
+            );
+            why.extend(pinned(kind, &a.setup, p));
+            why.extend(a.effect.contradicted_by(d, &self.constants, p)?);
+        }
+        why.extend(
+            base_out_of_range(&self.constants, &f.base, d)
+                .into_iter()
+                .filter(|(k, _)| !already.contains(k))
+                .map(|(_, w)| w),
+        );
+        Ok(why)
+    }
+
+    /// The round's choice: the plausible candidates by their penalised held-back error,
+    /// the first that passes the step's test and lowers the whole-log error; the others
+    /// tried with why they were not kept.
+    pub(super) fn choose<'a>(
+        &self,
+        mut fitted: Vec<Fitted<'a>>,
+        rung: &Rung<'a>,
+        sr: &Series,
+    ) -> Result<Round<'a>, AnalysisError> {
+        fitted.sort_by(|a, b| {
+            a.implausible
+                .is_empty()
+                .cmp(&b.implausible.is_empty())
+                .reverse()
+                .then(a.score().total_cmp(&b.score()))
+        });
+        let before = rung.models.len();
+        self.evidence_decides(&mut fitted, before);
+        let mut tried = Vec::new();
+        let mut kept = None;
+        for c in fitted {
+            let sig = significance(rung, &c);
+            let because = if kept.is_some() {
+                Some("a better candidate was kept".to_string())
+            } else {
+                match self.take(&c, rung, sr, sig)? {
+                    Ok(k) => {
+                        kept = Some(k);
+                        None
+                    }
+                    Err(why) => Some(why),
+                }
+            };
+            if let Some(because) = because {
+                tried.push(Tried {
+                    added: c.added(before),
+                    heldback_error: c.heldback_fit_series,
+                    significance: sig,
+                    because,
+                });
+            }
+        }
+        Ok((kept, tried))
+    }
+
+    /// Candidate `c` (its test statistic `sig`) taken as the step from `rung`: the new rung
+    /// and the step, or why it is not kept (diverged, not physical, below the test, or the
+    /// whole-log error would rise).
+    fn take<'a>(
+        &self,
+        c: &Fitted<'a>,
+        rung: &Rung<'a>,
+        sr: &Series,
+        sig: f64,
+    ) -> Result<Result<Kept<'a>, String>, AnalysisError> {
+        if !(c.heldback_fit_series.is_finite() && c.heldback_fit_series > 0.0) {
+            return Ok(Err(
+                "the model with it could not be run through the log (it diverged)".into(),
+            ));
+        }
+        if !c.implausible.is_empty() {
+            return Ok(Err(format!("not physical: {}", c.implausible.join("; "))));
+        }
+        if sig < STEP_MIN {
+            return Ok(Err(format!(
+                "removes {:.0} % of the held-back error beyond the noise floor (the test asks {:.0} %)",
+                100.0 * sig,
+                100.0 * STEP_MIN
+            )));
+        }
+        let next = self.measure_rung(c.models.clone(), c.fit.clone(), sr)?;
+        if !next.error.is_finite() || !next.heldback_error.is_finite() {
+            return Ok(Err(
+                "the model with it could not be run through the whole log (it diverged)".into(),
+            ));
+        }
+        if next.error >= rung.error {
+            return Ok(Err(format!(
+                "the whole-log error would rise {} -> {} (held-back windows only improved)",
+                effects::sig(rung.error),
+                effects::sig(next.error)
+            )));
+        }
+        let step = self.step_of(c, &c.added(rung.models.len()), rung, &next, sig)?;
+        Ok(Ok((next, step)))
+    }
+
+    /// When the first two plausible single candidates of `fitted` (in the round's order)
+    /// are effects that declare each other confusable and score within the declared factor,
+    /// the log's evidence decides, as in `explain`'s ranking: a first one it contradicts goes
+    /// second unless it contradicts the other too (a constant load torque and Coulomb
+    /// friction are one equation at a speed that never reverses).
+    fn evidence_decides<'a>(&self, fitted: &mut [Fitted<'a>], before: usize) {
+        let (Some(a), Some(b)) = (fitted.first(), fitted.get(1)) else {
+            return;
+        };
+        if !a.implausible.is_empty() || !b.implausible.is_empty() {
+            return;
+        }
+        let single = |c: &Fitted<'a>| -> Option<&'a dyn EffectModel> {
+            (c.models.len() == before + 1)
+                .then(|| c.models.get(before).copied())
+                .flatten()
+        };
+        let (Some(ea), Some(eb)) = (single(a), single(b)) else {
+            return;
+        };
+        let Some(conf) = ea.confused_with().iter().find(|c| c.with == eb.kind()) else {
+            return;
+        };
+        if b.score() > conf.within * a.score() {
+            return;
+        }
+        let unbalance = self.unbalance();
+        let says = |c: &Fitted<'a>, e: &dyn EffectModel| {
+            let fitted = c.fit.effect_params.last().map(Vec::as_slice).unwrap_or(&[]);
+            e.evidence(&effects::EffectEvidence {
+                voltage_unbalance: unbalance.voltage_negative_sequence_ratio,
+                winding_suspected: unbalance.suspect_phase.is_some(),
+                torque_scale_nm: self.constants.torque_scale_nm,
+                fitted,
+            })
+        };
+        if says(a, ea) == Some(false) && says(b, eb) != Some(false) {
+            fitted.swap(0, 1);
+        }
+    }
+
+    /// The ladder step that took the model from `rung` to `next` by adding `c`.
+    fn step_of(
+        &self,
+        c: &Fitted<'_>,
+        added: &[EffectKind],
+        rung: &Rung<'_>,
+        next: &Rung<'_>,
+        sig: f64,
+    ) -> Result<LadderStep, AnalysisError> {
+        let d = &self.data;
+        let before = rung.models.len();
+        let mut fitted = BTreeMap::new();
+        let mut words = Vec::new();
+        for (i, e) in c.models.iter().enumerate().skip(before) {
+            let p = c.fit.effect_params.get(i).map_or(&[][..], Vec::as_slice);
+            let Ok(setup) = e.setup(d, &self.constants) else {
+                continue;
+            };
+            // A long log's coarse copy may have fewer load segments than the working series.
+            if setup.len() != p.len() {
+                continue;
+            }
+            for (q, v) in setup.params.iter().zip(p) {
+                let key = if added.len() > 1 {
+                    format!("{}.{}", e.kind(), q.name)
+                } else {
+                    q.name.clone()
+                };
+                fitted.insert(
+                    key,
+                    RangedValue {
+                        value: *v,
+                        unit: q.unit().to_string(),
+                        low: q.plausible.lo,
+                        high: q.plausible.hi,
+                    },
+                );
+            }
+            words.push(setup.describe(p, d, &self.constants)?);
+        }
+        Ok(LadderStep {
+            effect: added.last().copied().unwrap_or(EffectKind::LoadTorque),
+            added: added.to_vec(),
+            fitted,
+            summary: words.join("; "),
+            error: next.error,
+            heldback_error: next.heldback_error,
+            noise_floor: next.noise,
+            heldback_noise_floor: next.heldback_noise,
+            ratio_to_floor: next.error / next.noise,
+            heldback_ratio_to_floor: next.heldback_error / next.heldback_noise,
+            significance: sig,
+            explained: explained_fraction(rung.error, next.error, next.noise),
+            heldback_explained: explained_fraction(
+                rung.heldback_error,
+                next.heldback_error,
+                next.heldback_noise,
+            ),
+        })
+    }
+}
+
+/// The values of `p` pinned at a bound of their fit in `setup` (effect `kind`), each in
+/// words: no minimum the log shows, the solver pushed it as far as it was let (a fit of the
+/// model's numerical residue). A bound at 0 does not count (no effect at all: the step's
+/// test refuses that).
+fn pinned(kind: EffectKind, setup: &effects::FitSetup, p: &[f64]) -> Vec<String> {
+    let at = |v: f64, b: f64| b.is_finite() && b != 0.0 && (v - b).abs() <= 1e-3 * b.abs();
+    setup
+        .params
+        .iter()
+        .zip(p)
+        .filter(|(q, v)| at(**v, q.lo) || at(**v, q.hi))
+        .map(|(q, v)| {
+            format!(
+                "{kind}: {} = {} {} is at the bound of its fit ({}..{}), not a value the log shows",
+                q.name,
+                effects::sig(*v),
+                q.unit(),
+                effects::sig(q.lo),
+                effects::sig(q.hi)
+            )
+        })
+        .collect()
+}
+
+/// The full-order machine at once: every dynamics effect of `lib` not in the model `have`
+/// that `fits` the log (those with a time constant, and what needs one of them). A start or
+/// a step can need all of them before any one fits with values a machine has: one alone
+/// takes its time constant out of range to follow the others' part.
+fn full_order<'a>(
+    lib: &'a [Box<dyn EffectModel>],
+    have: &[EffectKind],
+    n: &MachineConstants,
+    fits: &dyn Fn(&dyn EffectModel) -> bool,
+) -> Vec<&'a dyn EffectModel> {
+    let timed = |k: EffectKind| {
+        lib.iter()
+            .any(|e| e.kind() == k && e.time_constant_s(n).is_some())
+    };
+    lib.iter()
+        .map(|e| e.as_ref())
+        .filter(|e| !have.contains(&e.kind()) && fits(*e))
+        .filter(|e| e.time_constant_s(n).is_some() || e.requires().iter().any(|r| timed(*r)))
+        .collect()
+}
+
+/// The pairs a round tries when no single candidate passes: every two of the [`PAIR_FROM`]
+/// single-effect candidates of `fitted` (plausible or not, not diverged) (fits of one round, the model's own `before` effects
+/// first in each) that lowered the training cost most, each pair's effects in the order
+/// fitted. A held-back error can rise with one effect of a pair and fall with both: with a
+/// start's cross coupling but no load torque, the fit uses the coupling to follow the
+/// acceleration a missing load explains.
+pub(super) fn pairs_of<'a>(fitted: &[Fitted<'a>], before: usize) -> Vec<Vec<&'a dyn EffectModel>> {
+    // Implausible fits too: one effect alone may take its values out of range to carry its
+    // partner's part.
+    let mut by_cost: Vec<&Fitted<'a>> = fitted
+        .iter()
+        .filter(|c| {
+            c.models.len() == before + 1
+                && c.heldback_fit_series.is_finite()
+                && c.heldback_fit_series > 0.0
+        })
+        .collect();
+    by_cost.sort_by(|a, b| a.fit.report.cost.total_cmp(&b.fit.report.cost));
+    let top: Vec<Vec<&'a dyn EffectModel>> = by_cost
+        .iter()
+        .take(PAIR_FROM)
+        .map(|c| c.models.iter().skip(before).copied().collect())
+        .collect();
+    let mut out = Vec::new();
+    for i in 0..top.len() {
+        for j in (i + 1)..top.len() {
+            let mut set = top[i].clone();
+            for e in &top[j] {
+                if !set.iter().any(|x| x.kind() == e.kind()) {
+                    set.push(*e);
+                }
+            }
+            out.push(set);
+        }
+    }
+    out
+}
+
+/// The step's test statistic for candidate `c` on the model of `rung`: the share of the
+/// held-back error beyond the noise floor it removes, its held-back error first raised by
+/// [`PARAM_PENALTY`] per parameter.
+fn significance(rung: &Rung<'_>, c: &Fitted<'_>) -> f64 {
+    explained_fraction(
+        rung.heldback_fit_series,
+        c.score(),
+        rung.heldback_noise_fit_series,
+    )
+}
