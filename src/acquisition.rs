@@ -44,8 +44,10 @@
 
 use crate::clock;
 
-/// Channels per ADC: ADC1 va, vb, vc; ADC2 ia, ib, ic.
-pub const CHANNELS: usize = 3;
+/// Channels per ADC: ADC1 va, vb, vc; ADC2 ia, ib, ic (the regular sequence's length,
+/// [`crate::adc_rules::CHANNELS`], kept there so that the recovery below this module
+/// re-arms the encoder latch with it too).
+pub use crate::adc_rules::CHANNELS;
 /// Sequences (triggers) averaged into one sample (module docs).
 pub const OVERSAMPLING: usize = 8;
 /// 16-bit words of one sample's sequences ([`OVERSAMPLING`] x [`CHANNELS`], 24): the unit

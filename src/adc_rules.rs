@@ -19,8 +19,22 @@
 //!   [`IdleDiscard`] drops the first sample after a start or a restart that idled longer.
 //! - **VREFINT's start-up** (`tstart_vrefint`, up to 12 us after `VREFEN`):
 //!   `supply::measure_now` waits [`VREFINT_START_US`] before its conversions.
+//!
+//! Two constants live here because the modules on both sides of the acquisition use them
+//! and this module is below both: [`POLL_LIMIT`], the bound of every wait on an ADC or DMA
+//! register (the pair's set-up here, the recovery's waits in `recovery`), and [`CHANNELS`],
+//! the regular sequence's length of each ADC (`acquisition`'s geometry and the recovery's
+//! re-arming of the encoder latch, one count per sequence).
 
-use crate::recovery::POLL_LIMIT;
+/// Polls of a register the firmware's bounded waits on the ADCs and the DMA allow (the
+/// pair's set-up here, the recovery's steps in `recovery::poll_until`): each poll a few
+/// cycles, about 1 ms at 170 MHz, far above the 1-2 conversion times an `ADSTP` or a DMA
+/// disable takes.
+pub const POLL_LIMIT: u32 = 50_000;
+
+/// Channels per ADC, the length of each ADC's regular sequence (`ADC_SQR1.L` + 1): ADC1
+/// va, vb, vc; ADC2 ia, ib, ic. `acquisition::CHANNELS` is this constant.
+pub const CHANNELS: usize = 3;
 
 /// `ADC_CR.ADEN` (bit 0): enable (set-only).
 pub const ADEN: u32 = 1 << 0;

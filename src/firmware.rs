@@ -35,11 +35,11 @@ mod acquisition;
 mod failure;
 mod flash;
 mod logs;
+mod reset_ram;
 mod sample_task;
 mod supply;
 
-use core::mem::MaybeUninit;
-use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
+use core::sync::atomic::{AtomicU32, Ordering};
 
 use defmt::{error, info};
 use defmt_rtt as _;
@@ -66,10 +66,11 @@ use drive_monitor::clock::{self, ClockSource};
 use drive_monitor::commissioning::Action;
 use drive_monitor::offset_trim::TrimResult;
 use drive_monitor::panel::PanelLamps;
-use drive_monitor::reset_record::{BootPhase, PreviousRun, RESET_RECORD_LEN};
+use drive_monitor::reset_record::{BootPhase, PreviousRun};
 use drive_monitor::supply::{BorCheck, BorGate};
 use drive_monitor::{debug_halt, watchdog};
 use monitor_core::Isolation;
+use reset_ram::set_phase;
 
 use drive_monitor::flash_ecc::CheckedFlash;
 use flash::{read_motor_page, BoardFlash, Driver};
@@ -144,44 +145,6 @@ static REFERENCE: Signal<CriticalSectionRawMutex, board::ReferenceCheck> = Signa
 static OVERRUNS: AtomicU32 = AtomicU32::new(0);
 static RESTARTS: AtomicU32 = AtomicU32::new(0);
 static EXECUTOR_HIGH: InterruptExecutor = InterruptExecutor::new();
-/// What the firmware is doing ([`BootPhase::number`]), for the record of a `defmt` panic.
-static PHASE: AtomicU8 = AtomicU8::new(0);
-
-fn set_phase(phase: BootPhase) {
-    PHASE.store(phase.number(), Ordering::Relaxed);
-}
-
-/// The reset record: RAM in cortex-m-rt's `.uninit` section, which the start-up code
-/// neither zeroes nor initialises, so it keeps its content across a reset.
-// The one placed item of the firmware: `.uninit` is cortex-m-rt's NOLOAD section in RAM.
-#[allow(unsafe_code)]
-#[link_section = ".uninit.RESET_RECORD"]
-static mut RESET_RECORD: MaybeUninit<[u8; RESET_RECORD_LEN]> = MaybeUninit::uninit();
-
-/// The reset record's bytes (whatever they are: power-on garbage fails the record's check).
-#[allow(unsafe_code)]
-fn read_reset_record() -> [u8; RESET_RECORD_LEN] {
-    // SAFETY: a plain byte array read through a raw pointer, volatile so the compiler makes
-    // no assumption about its (possibly never written) content; the only other accesses
-    // are the writes below, from thread mode and from the panic handler with interrupts
-    // off, never concurrent with this read at boot.
-    unsafe { core::ptr::read_volatile(core::ptr::addr_of!(RESET_RECORD).cast()) }
-}
-
-/// Overwrites the reset record.
-#[allow(unsafe_code)]
-fn write_reset_record(bytes: &[u8; RESET_RECORD_LEN]) {
-    // SAFETY: as in `read_reset_record`; thread mode and the panic handler (interrupts
-    // off, never returns) are the only writers and cannot interleave with each other
-    // except by the panic handler overwriting, which is what it should do.
-    unsafe {
-        core::ptr::write_volatile(
-            core::ptr::addr_of_mut!(RESET_RECORD).cast::<[u8; RESET_RECORD_LEN]>(),
-            *bytes,
-        )
-    }
-}
-
 #[interrupt]
 #[allow(unsafe_code)]
 unsafe fn UART4() {

@@ -35,7 +35,7 @@
 //! an overrun, a DMA error and a lapped ring. The monitor itself (its thresholds, the commissioning state, the
 //! counters) is not touched by a recovery: only the acquisition restarts.
 
-use crate::adc_rules::{cr_setting, ADDIS, ADSTART, ADSTP, JADSTART};
+use crate::adc_rules::{self, cr_setting, ADDIS, ADSTART, ADSTP, JADSTART};
 
 /// One step of the recovery sequence, in its order (module docs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -98,9 +98,9 @@ pub struct Faults {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct StepTimeout(pub RecoveryStep);
 
-/// Polls of a register the sequence's waits allow (each a few cycles: about 1 ms at
-/// 170 MHz, far above the 1-2 conversion times an `ADSTP` or a DMA disable takes).
-pub const POLL_LIMIT: u32 = 50_000;
+/// Polls of a register the sequence's waits allow ([`crate::adc_rules::POLL_LIMIT`], the
+/// ADC set-up's bound too, kept there, below both).
+pub use crate::adc_rules::POLL_LIMIT;
 
 /// Polls `done` up to `limit` times; `Err(StepTimeout(step))` when it never returned true.
 /// The firmware's bounded waits on a register (here and in the ADC set-up).
@@ -316,7 +316,7 @@ impl<R: AcqRegisters> Acquisition for RegisterAcquisition<R> {
         }
         // The encoder latch from its ring's start too, one count per sequence: the counts
         // stay at the places of the conversions of the same trigger.
-        let channels = crate::acquisition::CHANNELS as u16;
+        let channels = adc_rules::CHANNELS as u16;
         self.regs.latch_reload(self.ring_len / channels);
         self.regs.latch_enable();
         for i in CHANNELS {

@@ -18,8 +18,8 @@ use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
 use drive_monitor::supply::BorLevel;
 use embassy_stm32::pac;
 
+use super::reset_ram::{write_reset_record, PHASE};
 use super::supply::bor_level;
-use super::{write_reset_record, PHASE};
 
 /// Taken by the first fault of the run (`fault_path`): a second goes straight to reset.
 static GUARD: FaultGuard = FaultGuard::new();

@@ -18,8 +18,9 @@ use drive_monitor::reset_record::{
 use drive_monitor::supply::{BorCheck, ReferenceChange, BOR_GOAL};
 use embassy_stm32::pac;
 
+use super::reset_ram::{read_reset_record, write_reset_record};
 use super::supply::bor_level;
-use super::{read_reset_record, write_reset_record, RESTARTS};
+use super::RESTARTS;
 
 /// The boot's brown-out check: the level in force, and below [`BOR_GOAL`] how to raise it
 /// (docs/firmware.md, "Brown-out level"); the firmware does not write the option bytes.

@@ -29,11 +29,9 @@ use embassy_stm32::{pac, peripherals, triggers, Peri};
 use embassy_time::{with_timeout, Duration, TimeoutError};
 
 use super::acquisition::{self, HwAcquisition};
+use super::reset_ram::{set_phase, write_reset_record};
 use super::supply;
-use super::{
-    set_phase, write_reset_record, Irqs, Status, COMMANDS, OVERRUNS, REFERENCE, RESTARTS, SETTINGS,
-    STATUS, TRIM,
-};
+use super::{Irqs, Status, COMMANDS, OVERRUNS, REFERENCE, RESTARTS, SETTINGS, STATUS, TRIM};
 
 /// Everything the sample task owns.
 pub(super) struct SampleHw {
@@ -169,38 +167,30 @@ fn ring_currents(
     adc.into_ring_buffered(dma, ring, Irqs, sequence.into_iter(), trigger, edge)
 }
 
-/// Starts the acquisition: the encoder (TIM4 in quadrature mode), the trigger (TIM1 update
-/// -> TRGO at the sample rate) and the two ring-buffered ADCs (ADC1 the voltages, ADC2 the
-/// currents), then the trigger, the timestamps continuing from now.
-fn start_acquisition(
-    hw: SampleHw,
-    path: &mut SamplePath,
-) -> (Qei<'static, peripherals::TIM4>, HwAcquisition) {
-    static RING1: static_cell::StaticCell<[u16; RING_LEN]> = static_cell::StaticCell::new();
-    static RING2: static_cell::StaticCell<[u16; RING_LEN]> = static_cell::StaticCell::new();
-    static LATCH: static_cell::StaticCell<[u16; geometry::LATCH_LEN]> =
-        static_cell::StaticCell::new();
-    let ring1 = RING1.init([0; RING_LEN]);
-    let ring2 = RING2.init([0; RING_LEN]);
-    let latch = latch_ring(hw.dma3, LATCH.init([0; geometry::LATCH_LEN]));
-
-    let qei = start_encoder(hw.tim4, hw.enc_a, hw.enc_b, &hw.encoder);
-
-    // Sample trigger: TIM1 update event -> TRGO -> both ADCs (rising edge), OVERSAMPLING
-    // times per sample (drive_monitor::acquisition: the mean over the sample period).
-    let trigger = HwTimer::new(hw.tim1);
+/// The sample trigger: TIM1's update event -> TRGO -> both ADCs (rising edge),
+/// `OVERSAMPLING` times per sample (`drive_monitor::acquisition`: the mean over the sample
+/// period), at the rate of [`SETTINGS`]; not started yet.
+fn sample_trigger(tim1: Peri<'static, peripherals::TIM1>) -> HwTimer<'static, peripherals::TIM1> {
+    let trigger = HwTimer::new(tim1);
     let trigger_hz = geometry::trigger_rate_hz(SETTINGS.sample_rate_hz);
     trigger.set_frequency(Hertz(trigger_hz), RoundTo::Slower);
     trigger.set_master_mode(MasterMode::UPDATE);
+    trigger
+}
 
-    // Every step under the set-up deadline (`drive_monitor::setup_guard`): the HAL's waits
-    // on ADCAL, ADRDY and ADSTART have no bound of their own.
-    let guard = supply::SetupGuard::arm(hw.syst, SetupStep::Adc1);
-    // Both drivers, the common prescaler written only with both ADCs disabled and read
-    // back (`drive_monitor::adc_rules::create_pair`).
+/// Both ADC drivers, the common prescaler written only with both ADCs disabled and read
+/// back (`drive_monitor::adc_rules::create_pair`); a rule the set-up could not keep is
+/// logged.
+fn create_adcs(
+    p1: Peri<'static, peripherals::ADC1>,
+    p2: Peri<'static, peripherals::ADC2>,
+) -> (
+    Adc<'static, peripherals::ADC1>,
+    Adc<'static, peripherals::ADC2>,
+) {
     let mut pair = acquisition::HwPair {
-        p1: Some(hw.adc1),
-        p2: Some(hw.adc2),
+        p1: Some(p1),
+        p2: Some(p2),
         adc1: None,
         adc2: None,
     };
@@ -221,6 +211,32 @@ fn start_acquisition(
             panic!("ADC drivers not created")
         }
     };
+    (adc1, adc2)
+}
+
+/// Starts the acquisition: the encoder (TIM4 in quadrature mode), the trigger (TIM1 update
+/// -> TRGO at the sample rate) and the two ring-buffered ADCs (ADC1 the voltages, ADC2 the
+/// currents), then the trigger, the timestamps continuing from now.
+fn start_acquisition(
+    hw: SampleHw,
+    path: &mut SamplePath,
+) -> (Qei<'static, peripherals::TIM4>, HwAcquisition) {
+    static RING1: static_cell::StaticCell<[u16; RING_LEN]> = static_cell::StaticCell::new();
+    static RING2: static_cell::StaticCell<[u16; RING_LEN]> = static_cell::StaticCell::new();
+    static LATCH: static_cell::StaticCell<[u16; geometry::LATCH_LEN]> =
+        static_cell::StaticCell::new();
+    let ring1 = RING1.init([0; RING_LEN]);
+    let ring2 = RING2.init([0; RING_LEN]);
+    let latch = latch_ring(hw.dma3, LATCH.init([0; geometry::LATCH_LEN]));
+
+    let qei = start_encoder(hw.tim4, hw.enc_a, hw.enc_b, &hw.encoder);
+
+    let trigger = sample_trigger(hw.tim1);
+
+    // Every step under the set-up deadline (`drive_monitor::setup_guard`): the HAL's waits
+    // on ADCAL, ADRDY and ADSTART have no bound of their own.
+    let guard = supply::SetupGuard::arm(hw.syst, SetupStep::Adc1);
+    let (adc1, adc2) = create_adcs(hw.adc1, hw.adc2);
     guard.step(SetupStep::Ring1);
     let adc1 = ring_voltages(adc1, hw.dma1, hw.v, ring1);
     // The ADC's reference: VDDA from VREFINT on ADC1's injected channel against the

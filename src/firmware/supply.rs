@@ -12,7 +12,7 @@ use drive_monitor::{adc_rules, clock};
 use embassy_stm32::pac;
 use embassy_stm32::pac::adc::vals::{Exten, SampleTime};
 
-use super::write_reset_record;
+use super::reset_ram::write_reset_record;
 
 /// The set-up step running (`SetupStep::number`), 0 when no set-up runs: what the SysTick
 /// exception reads when the deadline runs out.
