@@ -34,7 +34,7 @@ pub const PSI_SAT_BASIS: &str = "magnetisation curves of standard motors: Lm hal
 /// Rfe of about 10 to 60 Xm); a negative conductance (beyond 1 % of 1/Xm) is not physical.
 pub const RFE_OVER_XM_MIN: f64 = 3.0;
 /// Basis of [`RFE_OVER_XM_MIN`].
-pub const G_FE_BASIS: &str = "core loss of 1-5 % of rated power (IEC 60034-2-1): Rfe of 10-60 x Xm, at least 3 x Xm; never negative";
+pub const G_FE_BASIS: &str = "core loss of 1-5 % of rated power (IEC 60034-2-1): Rfe of 10-60 x Xm, at least 3 x Xm; never negative, but for 1 % of 1/Xm left to the noise of the fit";
 /// Dry friction torque relative to the rated torque estimate: -0.02..0.25. Bearing and
 /// seal friction of the motor itself is below 1 to 2 % of its rated torque (SKF rolling
 /// bearing friction model); a driven machine's breakaway torque (gears, seals) adds up
