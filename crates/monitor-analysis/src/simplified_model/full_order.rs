@@ -180,7 +180,11 @@ impl FullMachine {
             .dynamics
             .stator_current_la_h
             .unwrap_or(b.ls_scale * (n.lls_h + lm - lm * lm / lr))
-            .clamp(1e-3 * ls, 0.9 * ls);
+            // max/min, not clamp: a trial point of the solver with a NaN or negative Ls
+            // (its values diverged) gives a NaN here, which the fit counts as a failed point;
+            // clamp would panic on the reversed bounds (seen on a 50 hp log's ladder).
+            .max(1e-3 * ls)
+            .min(0.9 * ls);
         let l_m = ls - l_sigma;
         // A winding temperature heats the cage too: the fitted rotor time constant is the
         // cold one, and a = Rr/Lr follows the resistance scale.
