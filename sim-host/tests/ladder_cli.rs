@@ -36,7 +36,11 @@ fn ladder(extra: &[&str], params: &Path, log: &Path) -> std::process::Output {
 fn the_ladder_finds_the_load_step_and_the_error_falls_at_every_step() {
     let (p, log) = motulator();
     let out = ladder(&["--json", "--from", "0.8"], &p, &log);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     for key in [
         "start",
@@ -100,11 +104,22 @@ fn the_table_and_the_report_show_every_step() {
     let dir = tempfile::tempdir().unwrap();
     let report = dir.path().join("out");
     let out = ladder(
-        &["--from", "0.8", "--to", "3.5", "--report", report.to_str().unwrap()],
+        &[
+            "--from",
+            "0.8",
+            "--to",
+            "3.5",
+            "--report",
+            report.to_str().unwrap(),
+        ],
         &p,
         &log,
     );
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.contains("+ load_torque"), "{text}");
     assert!(text.contains("x floor"), "{text}");
@@ -139,9 +154,16 @@ fn a_current_only_log_adds_nothing_and_says_why() {
     let current_only = dir.path().join("currents.csv");
     std::fs::write(&current_only, csv).unwrap();
     let out = ladder(&["--json"], &p, &current_only);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["stop"], "no_model");
     assert!(v["ladder"].as_array().unwrap().is_empty());
-    assert!(v["stopped_because"].as_str().unwrap().contains("no voltages"));
+    assert!(v["stopped_because"]
+        .as_str()
+        .unwrap()
+        .contains("no voltages"));
 }
