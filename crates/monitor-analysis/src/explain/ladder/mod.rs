@@ -32,6 +32,7 @@
 //! effect-free control logs of the test matrix (a textbook machine written inside the test,
 //! three sizes, starts and steps: under 10 %), doubled (docs/model-vs-measurement.md).
 
+mod choice;
 mod round;
 mod split;
 
@@ -43,7 +44,7 @@ use crate::simplified_model::BaseParams;
 use crate::DataInfo;
 use crate::{resolve, transients, Analysis, AnalysisError, Options};
 use monitor_core::EffectKind;
-use round::{pairs_of, Rung, Series};
+use round::{pairs_of, LadderSeries, Rung};
 use serde::Serialize;
 use split::{mask_on, weights_for};
 use std::collections::BTreeMap;
@@ -305,7 +306,7 @@ impl Analysis {
     /// The series the ladder's fits run on: a copy of at most [`LADDER_FIT_SAMPLES`] samples
     /// (a round fits every candidate, and a ladder has several rounds), with the held-back
     /// mask `held` of the working series carried over.
-    fn ladder_series(&self, held: Vec<bool>) -> Series {
+    fn ladder_series(&self, held: Vec<bool>) -> LadderSeries {
         let m = self.data.len().div_ceil(LADDER_FIT_SAMPLES).max(1);
         let fd = crate::coarsen(&self.data, m);
         let held_fd = if m == 1 {
@@ -313,7 +314,7 @@ impl Analysis {
         } else {
             mask_on(&fd, &self.data, &held)
         };
-        Series {
+        LadderSeries {
             wf: weights_for(&fd, &held_fd, LADDER_FIT_SAMPLES),
             span: transients::Span::of(&fd, &self.constants),
             fd,
@@ -330,7 +331,7 @@ impl Analysis {
         &self,
         lib: &'a [Box<dyn EffectModel>],
         mut rung: Rung<'a>,
-        sr: &Series,
+        sr: &LadderSeries,
         opts: &Options,
         progress: &(dyn Fn(usize, f64) + Sync),
         report: &mut LadderReport,

@@ -2,25 +2,18 @@
 //! before, and the choice of the one kept (the test of [`super::STEP_MIN`]).
 
 use super::split::weights_for;
-use super::{LadderStep, RangedValue, Tried, PAIR_FROM, STEP_MIN};
+use super::PAIR_FROM;
 use crate::effects::{self, EffectModel};
-use crate::explain::{explained_fraction, PARAM_PENALTY};
+use crate::explain::PARAM_PENALTY;
 use crate::fit::{self, ActiveEffect, FitResult};
 use crate::metrics::{self, Weights};
 use crate::prep::Prepared;
 use crate::simplified_model::{BaseParameter, BaseParams, MachineConstants};
 use crate::{align, base_out_of_range, transients, Analysis, AnalysisError, Options};
 use monitor_core::EffectKind;
-use std::collections::BTreeMap;
-
-/// The step a round keeps: the model after it and the step's report.
-pub(super) type Kept<'a> = (Rung<'a>, LadderStep);
-
-/// What a round found: the step kept (if any) and the candidates not kept, with why.
-pub(super) type Round<'a> = (Option<Kept<'a>>, Vec<Tried>);
 
 /// The series a ladder's fits run on, with its held-back split.
-pub(super) struct Series {
+pub(super) struct LadderSeries {
     /// The copy of the working series the fits run on.
     pub(super) fd: Prepared,
     /// Its coarsening factor (1: the working series itself).
@@ -52,18 +45,20 @@ pub(super) struct Rung<'a> {
 
 /// A candidate fitted in one round.
 pub(super) struct Fitted<'a> {
-    models: Vec<&'a dyn EffectModel>,
-    fit: FitResult,
-    n_parameters: usize,
-    heldback_fit_series: f64,
-    implausible: Vec<String>,
+    pub(super) models: Vec<&'a dyn EffectModel>,
+    pub(super) fit: FitResult,
+    pub(super) n_parameters: usize,
+    pub(super) heldback_fit_series: f64,
+    pub(super) implausible: Vec<String>,
 }
 
 impl Fitted<'_> {
-    fn score(&self) -> f64 {
+    /// The held-back error on the fit series, each parameter costing [`PARAM_PENALTY`].
+    pub(super) fn score(&self) -> f64 {
         self.heldback_fit_series * (1.0 + PARAM_PENALTY * self.n_parameters as f64)
     }
-    fn added(&self, before: usize) -> Vec<EffectKind> {
+    /// The effects the candidate adds to a model of `before` effects.
+    pub(super) fn added(&self, before: usize) -> Vec<EffectKind> {
         self.models.iter().skip(before).map(|m| m.kind()).collect()
     }
 }
@@ -75,7 +70,7 @@ impl Analysis {
         &self,
         models: Vec<&'a dyn EffectModel>,
         fit: FitResult,
-        sr: &Series,
+        sr: &LadderSeries,
     ) -> Result<Rung<'a>, AnalysisError> {
         let (fd, m, held, held_fd) = (&sr.fd, sr.m, &sr.held[..], &sr.held_fd[..]);
         let d = &self.data;
@@ -151,7 +146,7 @@ impl Analysis {
         &self,
         lib: &[Box<dyn EffectModel>],
         e: &dyn EffectModel,
-        sr: &Series,
+        sr: &LadderSeries,
     ) -> Option<String> {
         let all: Vec<EffectKind> = lib.iter().map(|x| x.kind()).collect();
         let resolvable = transients::Span {
@@ -176,7 +171,7 @@ impl Analysis {
         &self,
         lib: &'a [Box<dyn EffectModel>],
         rung: &Rung<'_>,
-        sr: &Series,
+        sr: &LadderSeries,
     ) -> (Vec<Vec<&'a dyn EffectModel>>, Vec<String>) {
         let fits = |e: &dyn EffectModel| self.ladder_cannot_fit(lib, e, sr).is_none();
         let mut out = Vec::new();
@@ -224,7 +219,7 @@ impl Analysis {
         &self,
         cands: &[Vec<&'a dyn EffectModel>],
         rung: &Rung<'a>,
-        sr: &Series,
+        sr: &LadderSeries,
         opts: &Options,
         progress: &(dyn Fn(f64) + Sync),
     ) -> Result<Vec<Fitted<'a>>, AnalysisError> {
@@ -248,7 +243,7 @@ impl Analysis {
         &self,
         c: &[&'a dyn EffectModel],
         rung: &Rung<'a>,
-        sr: &Series,
+        sr: &LadderSeries,
         opts: &Options,
     ) -> Result<Option<Fitted<'a>>, AnalysisError> {
         let Some(set) = self.nested(c, rung, &sr.fd) else {
@@ -357,195 +352,6 @@ impl Analysis {
         );
         Ok(why)
     }
-
-    /// The round's choice: the plausible candidates by their penalised held-back error,
-    /// the first that passes the step's test and lowers the whole-log error; the others
-    /// tried with why they were not kept.
-    pub(super) fn choose<'a>(
-        &self,
-        mut fitted: Vec<Fitted<'a>>,
-        rung: &Rung<'a>,
-        sr: &Series,
-    ) -> Result<Round<'a>, AnalysisError> {
-        fitted.sort_by(|a, b| {
-            a.implausible
-                .is_empty()
-                .cmp(&b.implausible.is_empty())
-                .reverse()
-                .then(a.score().total_cmp(&b.score()))
-        });
-        let before = rung.models.len();
-        self.evidence_decides(&mut fitted, before);
-        let mut tried = Vec::new();
-        let mut kept = None;
-        for c in fitted {
-            let sig = significance(rung, &c);
-            let because = if kept.is_some() {
-                Some("a better candidate was kept".to_string())
-            } else {
-                match self.take(&c, rung, sr, sig)? {
-                    Ok(k) => {
-                        kept = Some(k);
-                        None
-                    }
-                    Err(why) => Some(why),
-                }
-            };
-            if let Some(because) = because {
-                tried.push(Tried {
-                    added: c.added(before),
-                    heldback_error: c.heldback_fit_series,
-                    significance: sig,
-                    because,
-                });
-            }
-        }
-        Ok((kept, tried))
-    }
-
-    /// Candidate `c` (its test statistic `sig`) taken as the step from `rung`: the new rung
-    /// and the step, or why it is not kept (diverged, not physical, below the test, or the
-    /// whole-log error would rise).
-    fn take<'a>(
-        &self,
-        c: &Fitted<'a>,
-        rung: &Rung<'a>,
-        sr: &Series,
-        sig: f64,
-    ) -> Result<Result<Kept<'a>, String>, AnalysisError> {
-        if !(c.heldback_fit_series.is_finite() && c.heldback_fit_series > 0.0) {
-            return Ok(Err(
-                "the model with it could not be run through the log (it diverged)".into(),
-            ));
-        }
-        if !c.implausible.is_empty() {
-            return Ok(Err(format!("not physical: {}", c.implausible.join("; "))));
-        }
-        if sig < STEP_MIN {
-            return Ok(Err(format!(
-                "removes {:.0} % of the held-back error beyond the noise floor (the test asks {:.0} %)",
-                100.0 * sig,
-                100.0 * STEP_MIN
-            )));
-        }
-        let next = self.measure_rung(c.models.clone(), c.fit.clone(), sr)?;
-        if !next.error.is_finite() || !next.heldback_error.is_finite() {
-            return Ok(Err(
-                "the model with it could not be run through the whole log (it diverged)".into(),
-            ));
-        }
-        if next.error >= rung.error {
-            return Ok(Err(format!(
-                "the whole-log error would rise {} -> {} (held-back windows only improved)",
-                effects::sig(rung.error),
-                effects::sig(next.error)
-            )));
-        }
-        let step = self.step_of(c, &c.added(rung.models.len()), rung, &next, sig)?;
-        Ok(Ok((next, step)))
-    }
-
-    /// When the first two plausible single candidates of `fitted` (in the round's order)
-    /// are effects that declare each other confusable and score within the declared factor,
-    /// the log's evidence decides, as in `explain`'s ranking: a first one it contradicts goes
-    /// second unless it contradicts the other too (a constant load torque and Coulomb
-    /// friction are one equation at a speed that never reverses).
-    fn evidence_decides<'a>(&self, fitted: &mut [Fitted<'a>], before: usize) {
-        let (Some(a), Some(b)) = (fitted.first(), fitted.get(1)) else {
-            return;
-        };
-        if !a.implausible.is_empty() || !b.implausible.is_empty() {
-            return;
-        }
-        let single = |c: &Fitted<'a>| -> Option<&'a dyn EffectModel> {
-            (c.models.len() == before + 1)
-                .then(|| c.models.get(before).copied())
-                .flatten()
-        };
-        let (Some(ea), Some(eb)) = (single(a), single(b)) else {
-            return;
-        };
-        let Some(conf) = ea.confused_with().iter().find(|c| c.with == eb.kind()) else {
-            return;
-        };
-        if b.score() > conf.within * a.score() {
-            return;
-        }
-        let unbalance = self.unbalance();
-        let says = |c: &Fitted<'a>, e: &dyn EffectModel| {
-            let fitted = c.fit.effect_params.last().map(Vec::as_slice).unwrap_or(&[]);
-            e.evidence(&effects::EffectEvidence {
-                voltage_unbalance: unbalance.voltage_negative_sequence_ratio,
-                winding_suspected: unbalance.suspect_phase.is_some(),
-                torque_scale_nm: self.constants.torque_scale_nm,
-                fitted,
-            })
-        };
-        if says(a, ea) == Some(false) && says(b, eb) != Some(false) {
-            fitted.swap(0, 1);
-        }
-    }
-
-    /// The ladder step that took the model from `rung` to `next` by adding `c`.
-    fn step_of(
-        &self,
-        c: &Fitted<'_>,
-        added: &[EffectKind],
-        rung: &Rung<'_>,
-        next: &Rung<'_>,
-        sig: f64,
-    ) -> Result<LadderStep, AnalysisError> {
-        let d = &self.data;
-        let before = rung.models.len();
-        let mut fitted = BTreeMap::new();
-        let mut words = Vec::new();
-        for (i, e) in c.models.iter().enumerate().skip(before) {
-            let p = c.fit.effect_params.get(i).map_or(&[][..], Vec::as_slice);
-            let Ok(setup) = e.setup(d, &self.constants) else {
-                continue;
-            };
-            // A long log's coarse copy may have fewer load segments than the working series.
-            if setup.len() != p.len() {
-                continue;
-            }
-            for (q, v) in setup.params.iter().zip(p) {
-                let key = if added.len() > 1 {
-                    format!("{}.{}", e.kind(), q.name)
-                } else {
-                    q.name.clone()
-                };
-                fitted.insert(
-                    key,
-                    RangedValue {
-                        value: *v,
-                        unit: q.unit().to_string(),
-                        low: q.plausible.lo,
-                        high: q.plausible.hi,
-                    },
-                );
-            }
-            words.push(setup.describe(p, d, &self.constants)?);
-        }
-        Ok(LadderStep {
-            effect: added.last().copied().unwrap_or(EffectKind::LoadTorque),
-            added: added.to_vec(),
-            fitted,
-            summary: words.join("; "),
-            error: next.error,
-            heldback_error: next.heldback_error,
-            noise_floor: next.noise,
-            heldback_noise_floor: next.heldback_noise,
-            ratio_to_floor: next.error / next.noise,
-            heldback_ratio_to_floor: next.heldback_error / next.heldback_noise,
-            significance: sig,
-            explained: explained_fraction(rung.error, next.error, next.noise),
-            heldback_explained: explained_fraction(
-                rung.heldback_error,
-                next.heldback_error,
-                next.heldback_noise,
-            ),
-        })
-    }
 }
 
 /// The values of `p` pinned at a bound of their fit in `setup` (effect `kind`), each in
@@ -629,15 +435,4 @@ pub(super) fn pairs_of<'a>(fitted: &[Fitted<'a>], before: usize) -> Vec<Vec<&'a 
         }
     }
     out
-}
-
-/// The step's test statistic for candidate `c` on the model of `rung`: the share of the
-/// held-back error beyond the noise floor it removes, its held-back error first raised by
-/// [`PARAM_PENALTY`] per parameter.
-fn significance(rung: &Rung<'_>, c: &Fitted<'_>) -> f64 {
-    explained_fraction(
-        rung.heldback_fit_series,
-        c.score(),
-        rung.heldback_noise_fit_series,
-    )
 }

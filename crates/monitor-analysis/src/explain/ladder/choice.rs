@@ -1,0 +1,230 @@
+//! The choice of a round: the fitted candidates in order (the log's evidence between two
+//! confusable ones), the first that passes the step's test ([`STEP_MIN`]) and lowers the
+//! whole-log error kept, the step's report.
+
+use super::round::{Fitted, Rung};
+use super::{LadderSeries, LadderStep, RangedValue, Tried, STEP_MIN};
+use crate::effects::{self, EffectModel};
+use crate::explain::explained_fraction;
+use crate::{Analysis, AnalysisError};
+use monitor_core::EffectKind;
+use std::collections::BTreeMap;
+
+/// The step a round keeps: the model after it and the step's report.
+pub(super) type Kept<'a> = (Rung<'a>, LadderStep);
+
+/// What a round found: the step kept (if any) and the candidates not kept, with why.
+pub(super) type Round<'a> = (Option<Kept<'a>>, Vec<Tried>);
+
+/// A candidate taken as a round's step, or why it is not kept.
+enum Take<'a> {
+    /// The model after the step and the step's report.
+    Kept(Box<Kept<'a>>),
+    /// Why not (in words, for `last_round`).
+    Not(String),
+}
+
+impl Analysis {
+    /// The round's choice: the plausible candidates by their penalised held-back error,
+    /// the first that passes the step's test and lowers the whole-log error; the others
+    /// tried with why they were not kept.
+    pub(super) fn choose<'a>(
+        &self,
+        mut fitted: Vec<Fitted<'a>>,
+        rung: &Rung<'a>,
+        sr: &LadderSeries,
+    ) -> Result<Round<'a>, AnalysisError> {
+        fitted.sort_by(|a, b| {
+            a.implausible
+                .is_empty()
+                .cmp(&b.implausible.is_empty())
+                .reverse()
+                .then(a.score().total_cmp(&b.score()))
+        });
+        let before = rung.models.len();
+        self.evidence_decides(&mut fitted, before);
+        let mut tried = Vec::new();
+        let mut kept = None;
+        for c in fitted {
+            let sig = significance(rung, &c);
+            let because = if kept.is_some() {
+                Some("a better candidate was kept".to_string())
+            } else {
+                match self.take(&c, rung, sr, sig)? {
+                    Take::Kept(k) => {
+                        kept = Some(*k);
+                        None
+                    }
+                    Take::Not(why) => Some(why),
+                }
+            };
+            if let Some(because) = because {
+                tried.push(Tried {
+                    added: c.added(before),
+                    heldback_error: c.heldback_fit_series,
+                    significance: sig,
+                    because,
+                });
+            }
+        }
+        Ok((kept, tried))
+    }
+
+    /// Candidate `c` (its test statistic `sig`) taken as the step from `rung`: the new rung
+    /// and the step, or why it is not kept (diverged, not physical, below the test, or the
+    /// whole-log error would rise).
+    fn take<'a>(
+        &self,
+        c: &Fitted<'a>,
+        rung: &Rung<'a>,
+        sr: &LadderSeries,
+        sig: f64,
+    ) -> Result<Take<'a>, AnalysisError> {
+        if !(c.heldback_fit_series.is_finite() && c.heldback_fit_series > 0.0) {
+            return Ok(Take::Not(
+                "the model with it could not be run through the log (it diverged)".into(),
+            ));
+        }
+        if !c.implausible.is_empty() {
+            return Ok(Take::Not(format!(
+                "not physical: {}",
+                c.implausible.join("; ")
+            )));
+        }
+        if sig < STEP_MIN {
+            return Ok(Take::Not(format!(
+                "removes {:.0} % of the held-back error beyond the noise floor (the test asks {:.0} %)",
+                100.0 * sig,
+                100.0 * STEP_MIN
+            )));
+        }
+        let next = self.measure_rung(c.models.clone(), c.fit.clone(), sr)?;
+        if !next.error.is_finite() || !next.heldback_error.is_finite() {
+            return Ok(Take::Not(
+                "the model with it could not be run through the whole log (it diverged)".into(),
+            ));
+        }
+        if next.error >= rung.error {
+            return Ok(Take::Not(format!(
+                "the whole-log error would rise {} -> {} (held-back windows only improved)",
+                effects::sig(rung.error),
+                effects::sig(next.error)
+            )));
+        }
+        let step = self.step_of(c, &c.added(rung.models.len()), rung, &next, sig)?;
+        Ok(Take::Kept(Box::new((next, step))))
+    }
+
+    /// When the first two plausible single candidates of `fitted` (in the round's order)
+    /// are effects that declare each other confusable and score within the declared factor,
+    /// the log's evidence decides, as in `explain`'s ranking: a first one it contradicts goes
+    /// second unless it contradicts the other too (a constant load torque and Coulomb
+    /// friction are one equation at a speed that never reverses).
+    fn evidence_decides<'a>(&self, fitted: &mut [Fitted<'a>], before: usize) {
+        let (Some(a), Some(b)) = (fitted.first(), fitted.get(1)) else {
+            return;
+        };
+        if !a.implausible.is_empty() || !b.implausible.is_empty() {
+            return;
+        }
+        let single = |c: &Fitted<'a>| -> Option<&'a dyn EffectModel> {
+            (c.models.len() == before + 1)
+                .then(|| c.models.get(before).copied())
+                .flatten()
+        };
+        let (Some(ea), Some(eb)) = (single(a), single(b)) else {
+            return;
+        };
+        let Some(conf) = ea.confused_with().iter().find(|c| c.with == eb.kind()) else {
+            return;
+        };
+        if b.score() > conf.within * a.score() {
+            return;
+        }
+        let unbalance = self.unbalance();
+        let says = |c: &Fitted<'a>, e: &dyn EffectModel| {
+            let fitted = c.fit.effect_params.last().map(Vec::as_slice).unwrap_or(&[]);
+            e.evidence(&effects::EffectEvidence {
+                voltage_unbalance: unbalance.voltage_negative_sequence_ratio,
+                winding_suspected: unbalance.suspect_phase.is_some(),
+                torque_scale_nm: self.constants.torque_scale_nm,
+                fitted,
+            })
+        };
+        if says(a, ea) == Some(false) && says(b, eb) != Some(false) {
+            fitted.swap(0, 1);
+        }
+    }
+
+    /// The ladder step that took the model from `rung` to `next` by adding `c`.
+    fn step_of(
+        &self,
+        c: &Fitted<'_>,
+        added: &[EffectKind],
+        rung: &Rung<'_>,
+        next: &Rung<'_>,
+        sig: f64,
+    ) -> Result<LadderStep, AnalysisError> {
+        let d = &self.data;
+        let before = rung.models.len();
+        let mut fitted = BTreeMap::new();
+        let mut words = Vec::new();
+        for (i, e) in c.models.iter().enumerate().skip(before) {
+            let p = c.fit.effect_params.get(i).map_or(&[][..], Vec::as_slice);
+            let Ok(setup) = e.setup(d, &self.constants) else {
+                continue;
+            };
+            // A long log's coarse copy may have fewer load segments than the working series.
+            if setup.len() != p.len() {
+                continue;
+            }
+            for (q, v) in setup.params.iter().zip(p) {
+                let key = if added.len() > 1 {
+                    format!("{}.{}", e.kind(), q.name)
+                } else {
+                    q.name.clone()
+                };
+                fitted.insert(
+                    key,
+                    RangedValue {
+                        value: *v,
+                        unit: q.unit().to_string(),
+                        low: q.plausible.lo,
+                        high: q.plausible.hi,
+                    },
+                );
+            }
+            words.push(setup.describe(p, d, &self.constants)?);
+        }
+        Ok(LadderStep {
+            effect: added.last().copied().unwrap_or(EffectKind::LoadTorque),
+            added: added.to_vec(),
+            fitted,
+            summary: words.join("; "),
+            error: next.error,
+            heldback_error: next.heldback_error,
+            noise_floor: next.noise,
+            heldback_noise_floor: next.heldback_noise,
+            ratio_to_floor: next.error / next.noise,
+            heldback_ratio_to_floor: next.heldback_error / next.heldback_noise,
+            significance: sig,
+            explained: explained_fraction(rung.error, next.error, next.noise),
+            heldback_explained: explained_fraction(
+                rung.heldback_error,
+                next.heldback_error,
+                next.heldback_noise,
+            ),
+        })
+    }
+}
+
+/// The step's test statistic for candidate `c` on the model of `rung`: the share of the
+/// held-back error beyond the noise floor it removes, its held-back error first raised by
+/// [`PARAM_PENALTY`] per parameter.
+fn significance(rung: &Rung<'_>, c: &Fitted<'_>) -> f64 {
+    explained_fraction(
+        rung.heldback_fit_series,
+        c.score(),
+        rung.heldback_noise_fit_series,
+    )
+}
