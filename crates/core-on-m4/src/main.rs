@@ -24,11 +24,14 @@
 #![no_std]
 #![no_main]
 
-// The firmware library's acquisition and clock, compiled here from their own files (the
-// firmware's library pulls embassy on this target; these two need nothing but `core`).
+// The firmware library's acquisition, its ADC rules and clock, compiled here from their own
+// files (the firmware's library pulls embassy on this target; these need nothing but `core`).
 #[path = "../../../src/acquisition.rs"]
 #[allow(dead_code)]
 mod acquisition;
+#[path = "../../../src/adc_rules.rs"]
+#[allow(dead_code)]
+mod adc_rules;
 #[path = "../../../src/clock.rs"]
 #[allow(dead_code)]
 mod clock;
