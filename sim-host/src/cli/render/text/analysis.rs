@@ -315,9 +315,12 @@ fn ladder_row(k: usize, s: &monitor_analysis::explain::ladder::LadderStep) -> St
 }
 
 /// A multiple of the noise floor as the table prints it (`12.3x`); beyond 999x (a noise-free
-/// log's floor is next to nothing) `>999x`, the ratio saying no more there.
+/// log's floor is next to nothing) `>999x`, the ratio saying no more there; `-` where no
+/// error was measured (the model could not run).
 fn times(r: f64) -> String {
-    if r.is_finite() && r < 999.5 {
+    if !r.is_finite() {
+        "-".into()
+    } else if r < 999.5 {
         format!("{r:.1}x")
     } else {
         ">999x".into()
