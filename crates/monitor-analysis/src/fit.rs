@@ -14,10 +14,10 @@
 use super::effects::{EffectModel, EffectValuesError, FitSetup};
 use super::lm::{self, LeastSquares};
 use super::metrics::{measured, predicted, Weights};
-use super::prep::{Prepared, C64};
+use super::prep::Prepared;
 use super::simplified_model::{
     rotations, simulate, simulate_rot, BaseParameter, BaseParams, MachineConstants, ModelTerms,
-    Prediction,
+    Prediction, Rotations,
 };
 use nalgebra::DMatrix;
 use rayon::prelude::*;
@@ -56,7 +56,7 @@ struct Problem<'a> {
     btot_scale: f64,
     fit_base: bool,
     /// Frame rotations of `d` (the same for every simulation).
-    rot: Vec<C64>,
+    rot: Rotations,
     /// The training samples the residuals use, with their measured channels (fixed).
     targets: Vec<(usize, [f64; 5])>,
     /// 1/sqrt(number of targets).

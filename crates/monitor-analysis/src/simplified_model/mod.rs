@@ -268,30 +268,55 @@ pub fn simulate(d: &Prepared, n: &MachineConstants, b: &BaseParams, t: &ModelTer
     simulate_with(d, n, b, t, |k| C64::new(d.theta[k].cos(), d.theta[k].sin()))
 }
 
-/// The frame rotation `e^{j theta_k}` of every sample of `d` (what [`simulate_rot`] takes).
-pub fn rotations(d: &Prepared) -> Vec<C64> {
-    d.theta
+/// What every run of the model on one working series shares, computed once for the many
+/// simulations of a fit: the frame rotation `e^{j theta_k}` of every sample, and the
+/// stationary-frame model's voltage input (its phase steps, the block mean's gains and the
+/// supply steps), built at the first full-order run.
+pub struct Rotations {
+    /// `e^{j theta_k}` per working sample.
+    rot: Vec<C64>,
+    /// The full-order model's voltage input without input noise (built on first use).
+    stat: std::sync::OnceLock<stationary::StatVoltage>,
+}
+
+/// The frame rotations of every sample of `d` (what [`simulate_rot`] takes).
+pub fn rotations(d: &Prepared) -> Rotations {
+    let rot = d
+        .theta
         .iter()
         .map(|th| {
             let (s, c) = th.sin_cos();
             C64::new(c, s)
         })
-        .collect()
+        .collect();
+    Rotations {
+        rot,
+        stat: std::sync::OnceLock::new(),
+    }
 }
 
 /// [`simulate`] with the frame rotations precomputed ([`rotations`] of the same data), for
-/// the many simulations of a fit.
+/// the many simulations of a fit: the same prediction, without recomputing what depends on
+/// the series alone.
 pub fn simulate_rot(
     d: &Prepared,
-    rot: &[C64],
+    rot: &Rotations,
     n: &MachineConstants,
     b: &BaseParams,
     t: &ModelTerms,
 ) -> Prediction {
-    if rot.len() != d.len() {
+    if rot.rot.len() != d.len() {
         return simulate(d, n, b, t);
     }
-    simulate_with(d, n, b, t, |k| rot[k])
+    let rot_at = |k: usize| rot.rot[k];
+    if t.dynamics.is_full_order() && t.input_noise.is_none() {
+        let volt = rot
+            .stat
+            .get_or_init(|| stationary::StatVoltage::new(d, &rot_at, None));
+        let run = ModelRun { d, n, b, t };
+        return stationary::simulate_stationary_with(run, rot_at, volt);
+    }
+    simulate_with(d, n, b, t, rot_at)
 }
 
 /// The form of the model the dynamics channel asks for, `rot_at(k)` the frame rotation.

@@ -7,7 +7,7 @@ use super::full_order::{FullMachine, FullRun};
 use super::terms::{SaturationLaw, Shaft, WindingAsymmetryTerm};
 use super::{MachineConstants, ModelMechanics, ModelRun, ModelTerms, Prediction};
 use crate::prep::{Prepared, C64};
-use voltage::StatVoltage;
+pub(super) use voltage::StatVoltage;
 
 /// The state of the stationary-frame full-order model: stator current, rotor flux
 /// psi_R (both alpha + j beta), mechanical speed.
@@ -140,18 +140,19 @@ impl<'a> SatMachine<'a> {
 }
 
 impl StatMachine<'_> {
-    /// The derivative at time `tau` into the working sample [s] (the rotor's angle).
+    /// The derivative at the time into the working sample where the unequal cage has
+    /// turned by `turn` = `e^{j w2 tau}` since the sample's start (1 without one).
     #[inline(always)]
-    fn deriv(&self, x: &StatState, v: C64, tau: f64) -> StatState {
+    fn deriv(&self, x: &StatState, v: C64, turn: C64) -> StatState {
         if let Some(sat) = &self.sat {
-            return self.deriv_sat(sat, x, v, tau);
+            return self.deriv_sat(sat, x, v, turn);
         }
         let m = &self.m;
         let wr = self.np * x.wm;
         // Rotor: q = Rr' i - a psi_R, dpsi_R/dt = (I + D) q + j omega_r psi_R.
         let mut q = x.i * m.rr - x.psi * m.a;
         if let Some(c) = &self.cage {
-            let u = c.u0 * C64::from_polar(1.0, c.w2 * tau);
+            let u = c.u0 * turn;
             q += (q + u * q.conj()) * c.d3;
         }
         let dpsi = q + C64::new(0.0, wr) * x.psi;
@@ -167,12 +168,12 @@ impl StatMachine<'_> {
 
     /// [`StatMachine::deriv`] of the saturated machine ([`SatMachine`]).
     #[inline(always)]
-    fn deriv_sat(&self, sat: &SatMachine, x: &StatState, v: C64, tau: f64) -> StatState {
+    fn deriv_sat(&self, sat: &SatMachine, x: &StatState, v: C64, turn: C64) -> StatState {
         let (i_s, i_r) = sat.currents(x.i, x.psi);
         let wr = self.np * x.wm;
         let mut ri = i_r * sat.rr;
         if let Some(c) = &self.cage {
-            let u = c.u0 * C64::from_polar(1.0, c.w2 * tau);
+            let u = c.u0 * turn;
             ri += (ri + u * ri.conj()) * c.d3;
         }
         let te = 1.5 * self.np * (x.psi * i_r.conj()).im;
@@ -221,10 +222,22 @@ impl StatMachine<'_> {
             psi: a.psi + b.psi * s,
             wm: a.wm + b.wm * s,
         };
-        let k1 = self.deriv(x, v[0], t0);
-        let k2 = self.deriv(&add(x, &k1, 0.5 * h), v[1], t0 + 0.5 * h);
-        let k3 = self.deriv(&add(x, &k2, 0.5 * h), v[1], t0 + 0.5 * h);
-        let k4 = self.deriv(&add(x, &k3, h), v[2], t0 + h);
+        // The unequal cage's turn at the start, the middle and the end (one turn of half
+        // the step, squared; none without a cage).
+        let one = C64::new(1.0, 0.0);
+        let (r0, r_half) = match &self.cage {
+            Some(c) if t0 != 0.0 => (
+                C64::from_polar(1.0, c.w2 * t0),
+                C64::from_polar(1.0, c.w2 * 0.5 * h),
+            ),
+            Some(c) => (one, C64::from_polar(1.0, c.w2 * 0.5 * h)),
+            None => (one, one),
+        };
+        let r_mid = r0 * r_half;
+        let k1 = self.deriv(x, v[0], r0);
+        let k2 = self.deriv(&add(x, &k1, 0.5 * h), v[1], r_mid);
+        let k3 = self.deriv(&add(x, &k2, 0.5 * h), v[1], r_mid);
+        let k4 = self.deriv(&add(x, &k3, h), v[2], r_mid * r_half);
         StatState {
             i: x.i + (k1.i + (k2.i + k3.i) * 2.0 + k4.i) * (h / 6.0),
             psi: x.psi + (k1.psi + (k2.psi + k3.psi) * 2.0 + k4.psi) * (h / 6.0),
@@ -313,6 +326,18 @@ fn phase_step(a: C64, b: C64) -> f64 {
 /// sensors, true parameters (2.2 kW, 11 kW; 2, 5, 10 kHz): `normalized_rms_error`
 /// 0.0003-0.0007 (on the simulator's own rows at the log rate, point samples: below 1e-5).
 pub(super) fn simulate_stationary(run: ModelRun<'_>, rot_at: impl Fn(usize) -> C64) -> Prediction {
+    let volt = StatVoltage::new(run.d, &rot_at, run.t.input_noise);
+    simulate_stationary_with(run, rot_at, &volt)
+}
+
+/// [`simulate_stationary`] with the voltage input `volt` built beforehand
+/// ([`StatVoltage::new`] of the same series, rotations and input noise): it depends on the
+/// series alone, so a fit's many runs share it.
+pub(super) fn simulate_stationary_with(
+    run: ModelRun<'_>,
+    rot_at: impl Fn(usize) -> C64,
+    volt: &StatVoltage,
+) -> Prediction {
     let ModelRun { d, t, .. } = run;
     // With a magnetising law the machine saturates with its own flux ([`SatMachine`]), not
     // with the reduced model's scale from the measured i_f.
@@ -322,10 +347,7 @@ pub(super) fn simulate_stationary(run: ModelRun<'_>, rot_at: impl Fn(usize) -> C
     let len = d.len();
     let mut out = Prediction::with_capacity(len);
     out.predicts_d_axis = true;
-    let form = StatForm {
-        full: &full,
-        volt: StatVoltage::new(d, &rot_at, t.input_noise),
-    };
+    let form = StatForm { full: &full, volt };
     let (x0, r0) = (full.x0, rot_at(0));
     let mut x = StatState {
         i: C64::new(x0.id, x0.iq) * r0,
@@ -356,7 +378,7 @@ pub(super) fn simulate_stationary(run: ModelRun<'_>, rot_at: impl Fn(usize) -> C
 /// The stationary-frame model over one run: its set-up and its voltage input.
 struct StatForm<'a> {
     full: &'a FullRun<'a>,
-    volt: StatVoltage,
+    volt: &'a StatVoltage,
 }
 
 impl<'a> StatForm<'a> {
@@ -471,7 +493,7 @@ impl StatForm<'_> {
             };
             sm.across_step(x, dt, phi.clamp(0.0, 1.0), s0, s1, w)
         } else {
-            let half = C64::from_polar(1.0, 0.5 * ph[k]);
+            let half = volt.half[k];
             let vm = (v_cur * half + v_next * half.conj()) * 0.5
                 + (vn0 * half.conj() + vn1 * half) * 0.5;
             sm.rk4(x, dt, [v0, vm, v1], 0.0)

@@ -7,7 +7,7 @@ use crate::simplified_model::InputNoise;
 
 /// The stationary-frame model's voltage input, per working sample (see
 /// [`super::simulate_stationary`]).
-pub(super) struct StatVoltage {
+pub(crate) struct StatVoltage {
     /// Positive-sequence voltage, stationary frame, after the block mean [V].
     pub(super) v_mean: Vec<C64>,
     /// The voltage's phase step over each working sample [rad].
@@ -18,6 +18,8 @@ pub(super) struct StatVoltage {
     pub(super) dev: Vec<f64>,
     /// `dev` above this is a supply step.
     pub(super) step_thr: f64,
+    /// `e^{j ph/2}`: half of each working sample's phase step.
+    pub(super) half: Vec<C64>,
 }
 
 impl StatVoltage {
@@ -32,7 +34,7 @@ impl StatVoltage {
     /// given (the renoised run of `metrics::noise_floor`: the sensors' noise, as it is in
     /// the measured series, again, so that the steps, the phase steps and the block
     /// mean's gains below see it as they see the measured noise).
-    pub(super) fn new(
+    pub(crate) fn new(
         d: &Prepared,
         rot_at: &impl Fn(usize) -> C64,
         noise: Option<InputNoise>,
@@ -69,12 +71,14 @@ impl StatVoltage {
         let gains: Vec<f64> = ph.iter().map(|&p| block_gain(p / dt, h, factor)).collect();
         let dev = off_rotation(&v_mean, &gains, &ph);
         let step_thr = prep::SUPPLY_STEP_REL.max(10.0 * median(&dev));
+        let half = ph.iter().map(|&p| C64::from_polar(1.0, 0.5 * p)).collect();
         StatVoltage {
             v_mean,
             ph,
             gains,
             dev,
             step_thr,
+            half,
         }
     }
 }
