@@ -67,8 +67,8 @@ fn convert(from: &std::path::Path, to: &std::path::Path) {
     let t = Instant::now();
     let file = LogFile::open(from).expect("open log");
     let mut w = LogWriter::create(to, file.channels()).expect("create");
-    struct Sink<'a>(&'a mut LogWriter);
-    impl monitor_io::log::RowSink for Sink<'_> {
+    struct RowsToWriter<'a>(&'a mut LogWriter);
+    impl monitor_io::log::RowSink for RowsToWriter<'_> {
         fn row(&mut self, r: &Row) -> bool {
             self.0.write_row(r).is_ok()
         }
@@ -76,7 +76,7 @@ fn convert(from: &std::path::Path, to: &std::path::Path) {
             panic!("the generated log is read by the fast path, which does not restart");
         }
     }
-    file.for_each_row(&mut |_| {}, &mut Sink(&mut w))
+    file.for_each_row(&mut |_| {}, &mut RowsToWriter(&mut w))
         .expect("read");
     w.finish().expect("finish");
     eprintln!(

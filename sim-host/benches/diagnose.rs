@@ -85,14 +85,14 @@ fn measure(mut cmd: Command, out: &Path) -> BenchRun {
 /// What a diagnosis concluded: the rows read, the verdict and its finding (the fault named
 /// and its size), compared between the CSV and its Parquet copy.
 #[derive(Debug, PartialEq)]
-struct Concluded {
+struct DiagnosisConclusion {
     rows: f64,
     verdict: serde_json::Value,
     finding: serde_json::Value,
 }
 
 /// `sim-host diagnose --json` of `log`: the run and what it concluded.
-fn diagnose(log: &Path, params: &Path, out: &Path) -> (BenchRun, Concluded) {
+fn diagnose(log: &Path, params: &Path, out: &Path) -> (BenchRun, DiagnosisConclusion) {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_sim-host"));
     cmd.arg("diagnose")
         .arg("--params")
@@ -102,7 +102,7 @@ fn diagnose(log: &Path, params: &Path, out: &Path) -> (BenchRun, Concluded) {
     let run = measure(cmd, out);
     let report: serde_json::Value =
         serde_json::from_reader(std::fs::File::open(out).expect("output")).expect("JSON");
-    let concluded = Concluded {
+    let concluded = DiagnosisConclusion {
         rows: report["rows"].as_f64().unwrap_or(f64::NAN),
         verdict: report["verdict"].clone(),
         finding: report["verdict_finding"].clone(),

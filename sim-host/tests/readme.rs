@@ -170,6 +170,36 @@ fn the_readme_walkthroughs_print_what_the_readme_shows() {
     assert!(n >= 4, "only {n} walkthroughs found");
 }
 
+/// The README names every command `sim-host --help` lists (as `` `command``, in its table),
+/// so that a newcomer finds each one.
+#[test]
+fn the_readme_names_every_command() {
+    let o = assert_cmd::Command::cargo_bin("sim-host")
+        .expect("binary")
+        .arg("--help")
+        .output()
+        .expect("run");
+    let help = String::from_utf8_lossy(&o.stdout).to_string();
+    let commands: Vec<&str> = help
+        .lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .filter_map(|l| l.split_whitespace().next())
+        .filter(|c| *c != "help")
+        .collect();
+    assert!(commands.len() >= 10, "commands found: {commands:?}");
+    let md = std::fs::read_to_string(repo().join("README.md")).expect("read the README");
+    let missing: Vec<&&str> = commands
+        .iter()
+        .filter(|c| !md.contains(&format!("| `{c}")))
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "README.md's command table does not name {missing:?}"
+    );
+}
+
 #[test]
 fn shown_lines_match_with_elisions() {
     assert!(matches("a ... c", "a b c"));

@@ -10,13 +10,15 @@
 //! - [`trend`]: per motor and indicator, Theil-Sen's slope with Sen's interval, against the
 //!   indicator's own scatter, at like operating points; the alarm and the days to FAULT.
 
+mod error;
 pub mod mirror;
 pub mod row;
 mod store;
 pub mod trend;
 
+pub use error::HistoryError;
 pub use row::{
     content_hash, parse_day, utc_day, Cell, Kind, LogIdentity, StoreColumn, StoredRow, COLUMNS,
 };
-pub use store::{Appended, HistoryError, Store};
+pub use store::{Appended, Store};
 pub use trend::{MotorTrend, TrendOptions};

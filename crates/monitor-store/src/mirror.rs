@@ -4,8 +4,8 @@
 //! not repeated inside the files). Each file is written under a temporary name in its
 //! folder and renamed, so a reader never sees half a file.
 
+use crate::error::HistoryError;
 use crate::row::{content_hash, Cell, Kind, StoredRow, COLUMNS};
-use crate::store::HistoryError;
 use parquet::basic::Compression;
 use parquet::data_type::{ByteArray, ByteArrayType, DoubleType, Int64Type};
 use parquet::file::properties::WriterProperties;

@@ -1,35 +1,12 @@
 //! The store itself: an SQLite database (the source of truth, one transaction per log) and
 //! its Parquet mirror partitioned by motor and day.
 
+use crate::error::HistoryError;
 use crate::mirror;
 use crate::row::{Cell, Kind, StoredRow, COLUMNS};
 use rusqlite::types::{Value as SqlValue, ValueRef};
 use rusqlite::{params_from_iter, Connection, OpenFlags};
 use std::path::{Path, PathBuf};
-
-/// Errors of the store.
-#[derive(Debug, thiserror::Error)]
-pub enum HistoryError {
-    /// SQLite failed (the store cannot be opened, is not a store, or a write failed).
-    #[error("store {path}: {message}")]
-    Sqlite {
-        /// The store's file.
-        path: String,
-        /// SQLite's message.
-        message: String,
-    },
-    /// The Parquet mirror cannot be written.
-    #[error("Parquet mirror {path}: {message}")]
-    Mirror {
-        /// The file or folder.
-        path: String,
-        /// What failed.
-        message: String,
-    },
-    /// Reading a store that does not exist.
-    #[error("no store at {0} (write one with `sim-host fleet ... --store {0}`)")]
-    Missing(String),
-}
 
 /// What [`Store::append`] did with a row.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -8,6 +8,7 @@
 //! stderr for inputs above 20 MB when it is a terminal.
 
 use super::output_guard::OutputGuard;
+use super::render::json::Converted;
 use super::{progress, render, Interruption};
 use clap::Args;
 use monitor_io::log::{Format, LogFile, LogWriter, OpenOptions, Row, RowSink};
@@ -45,25 +46,6 @@ pub struct ConvertArgs {
     /// Print one JSON summary document on stdout instead of the text summary.
     #[arg(long)]
     pub json: bool,
-}
-
-/// What `convert` did.
-#[derive(Debug, serde::Serialize)]
-pub struct Converted {
-    /// The input path.
-    pub input: String,
-    /// Its format.
-    pub input_format: &'static str,
-    /// The output path.
-    pub output: String,
-    /// Its format.
-    pub output_format: &'static str,
-    /// Rows copied.
-    pub rows: u64,
-    /// Size of the output [bytes].
-    pub output_bytes: u64,
-    /// Wall time [s].
-    pub wall_s: f64,
 }
 
 /// Forwards rows to the writer until an error or a signal.

@@ -8,16 +8,30 @@ use std::collections::{BTreeMap, BTreeSet};
 /// root is empty).
 pub type ModPath = Vec<String>;
 
+/// The names a file's `use`s bring into scope: (the module the `use` is written in, the
+/// name) -> the path it imports.
+type Imports<'a> = BTreeMap<(&'a [String], &'a str), &'a [String]>;
+
 /// The file modules of `known` that the paths `uses` of the file `file` reach (the longest
-/// known prefix of each `crate::`, `super::` or `self::` path), the file itself left out.
-/// Paths written inside a test module are left out.
+/// known prefix of each `crate::`, `super::` or `self::` path, and of each path that starts
+/// with a name such a `use` imported), the file itself left out. Paths written inside a
+/// test module are left out.
 pub fn reached(file: &ModPath, uses: &[PathUse], known: &BTreeSet<ModPath>) -> BTreeSet<ModPath> {
+    let imports: Imports = uses
+        .iter()
+        .filter_map(|u| {
+            Some((
+                (u.module.as_slice(), u.binds.as_deref()?),
+                u.segments.as_slice(),
+            ))
+        })
+        .collect();
     let mut out = BTreeSet::new();
     for u in uses {
         if u.module.iter().any(|m| m == "tests") {
             continue;
         }
-        let s = &u.segments;
+        let s = &written_out(u, &imports);
         let (base, rest): (ModPath, &[String]) = match s.first().map(String::as_str) {
             Some("crate") => (Vec::new(), &s[1..]),
             Some("self") => (u.module.clone(), &s[1..]),
@@ -44,6 +58,26 @@ pub fn reached(file: &ModPath, uses: &[PathUse], known: &BTreeSet<ModPath>) -> B
             out.insert(t);
         }
     }
+    out
+}
+
+/// The segments of `u`, a path in code that starts with a name a `use` of its module
+/// imported written out through that `use` (`render::text::f` after `use super::render;`
+/// is `super::render::text::f`).
+fn written_out(u: &PathUse, imports: &Imports) -> Vec<String> {
+    let s = &u.segments;
+    let first = s.first().map_or("", String::as_str);
+    if u.binds.is_some() || matches!(first, "crate" | "self" | "super") {
+        return s.clone();
+    }
+    let Some(path) = imports.get(&(u.module.as_slice(), first)) else {
+        return s.clone();
+    };
+    let mut out = path.to_vec();
+    if out.last().is_some_and(|l| l == "self") {
+        out.pop();
+    }
+    out.extend(s[1..].iter().cloned());
     out
 }
 
@@ -93,4 +127,34 @@ pub fn circles(edges: &BTreeMap<ModPath, BTreeSet<ModPath>>) -> Vec<Vec<ModPath>
         }
     }
     groups
+}
+
+/// A circle through a module a `use` imported is found: `cli::convert` imports
+/// `super::render` and calls `render::text::f`, and `cli::render::text` uses
+/// `crate::cli::convert::X` (the shape of a circle the command line had).
+#[test]
+fn a_circle_through_an_imported_module_is_found() {
+    use super::Paths;
+    let m = |p: &str| -> ModPath { p.split("::").map(str::to_string).collect() };
+    let known: BTreeSet<ModPath> = [
+        m("cli"),
+        m("cli::convert"),
+        m("cli::render"),
+        m("cli::render::text"),
+    ]
+    .into_iter()
+    .collect();
+    let convert: syn::File =
+        syn::parse_str("use super::render; fn run() { render::text::f(); }").unwrap();
+    let text: syn::File = syn::parse_str("fn f(c: &crate::cli::convert::X) {}").unwrap();
+    let mut edges = BTreeMap::new();
+    for (module, file) in [("cli::convert", &convert), ("cli::render::text", &text)] {
+        let uses = Paths::of(file, m(module));
+        edges.insert(m(module), reached(&m(module), &uses, &known));
+    }
+    assert!(edges[&m("cli::convert")].contains(&m("cli::render::text")));
+    assert_eq!(
+        circles(&edges),
+        vec![vec![m("cli::convert"), m("cli::render::text")]]
+    );
 }

@@ -87,3 +87,36 @@ pub fn is_code(rel: &str) -> bool {
 pub fn is_test_file(rel: &str) -> bool {
     rel.starts_with("tests/") || rel.contains("/tests/") || rel.contains("/benches/")
 }
+
+/// The workspace's packages: (the folder of each tracked `Cargo.toml` with a `[package]`,
+/// ending in `/`, empty for the root; the package's name).
+pub fn packages() -> Vec<(String, String)> {
+    files()
+        .into_iter()
+        .filter(|f| f == "Cargo.toml" || f.ends_with("/Cargo.toml"))
+        .filter_map(|f| {
+            let toml: toml::Table = read(&f).parse().ok()?;
+            let name = toml.get("package")?.get("name")?.as_str()?.to_string();
+            Some((f.trim_end_matches("Cargo.toml").to_string(), name))
+        })
+        .collect()
+}
+
+/// The `src/` folders of the workspace's packages with more than one `.rs` file there: the
+/// crates whose files can reach each other.
+pub fn crate_sources() -> Vec<String> {
+    let all = files();
+    let mut out: Vec<String> = packages()
+        .into_iter()
+        .map(|(dir, _)| format!("{dir}src/"))
+        .filter(|src| {
+            all.iter()
+                .filter(|f| f.starts_with(src.as_str()) && f.ends_with(".rs"))
+                .count()
+                > 1
+        })
+        .collect();
+    out.sort();
+    out.dedup();
+    out
+}

@@ -27,6 +27,9 @@ pub struct PathUse {
     pub segments: Vec<String>,
     /// Its line.
     pub line: usize,
+    /// For a `use`, the name it brings into scope (its last segment, its `as` name, or the
+    /// module of a `self`); `None` for a glob and for a path written in code.
+    pub binds: Option<String>,
 }
 
 /// Collects every path and `use` of a file.
@@ -58,14 +61,20 @@ impl Paths {
                 self.use_tree(&p.tree, prefix, line);
             }
             syn::UseTree::Name(n) => {
-                prefix.push(n.ident.to_string());
-                self.push(prefix, line);
+                let name = n.ident.to_string();
+                let binds = if name == "self" {
+                    prefix.last().cloned()
+                } else {
+                    Some(name.clone())
+                };
+                prefix.push(name);
+                self.push(prefix, line, binds);
             }
             syn::UseTree::Rename(r) => {
                 prefix.push(r.ident.to_string());
-                self.push(prefix, line);
+                self.push(prefix, line, Some(r.rename.to_string()));
             }
-            syn::UseTree::Glob(_) => self.push(prefix, line),
+            syn::UseTree::Glob(_) => self.push(prefix, line, None),
             syn::UseTree::Group(g) => {
                 for t in &g.items {
                     self.use_tree(t, prefix.clone(), line);
@@ -74,12 +83,13 @@ impl Paths {
         }
     }
 
-    fn push(&mut self, segments: Vec<String>, line: usize) {
+    fn push(&mut self, segments: Vec<String>, line: usize, binds: Option<String>) {
         if !segments.is_empty() {
             self.found.push(PathUse {
                 module: self.module.clone(),
                 segments,
                 line,
+                binds,
             });
         }
     }
@@ -105,7 +115,7 @@ impl<'ast> Visit<'ast> for Paths {
             if let Some(first) = p.segments.first() {
                 let line = first.ident.span().start().line;
                 let segs = p.segments.iter().map(|s| s.ident.to_string()).collect();
-                self.push(segs, line);
+                self.push(segs, line, None);
             }
         }
         syn::visit::visit_path(self, p);

@@ -115,6 +115,25 @@ impl Table1Report {
     }
 }
 
+/// What `convert` did (the JSON document; the text line is drawn from it too).
+#[derive(Debug, Serialize)]
+pub struct Converted {
+    /// The input path.
+    pub input: String,
+    /// Its format.
+    pub input_format: &'static str,
+    /// The output path.
+    pub output: String,
+    /// Its format.
+    pub output_format: &'static str,
+    /// Rows copied.
+    pub rows: u64,
+    /// Size of the output [bytes].
+    pub output_bytes: u64,
+    /// Wall time [s].
+    pub wall_s: f64,
+}
+
 /// `explain --compare --json`: both documents.
 #[derive(Serialize)]
 pub struct ExplainWithCompare<'a, E: Serialize = ExplainReport> {

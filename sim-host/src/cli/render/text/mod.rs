@@ -8,7 +8,7 @@ mod diagnose;
 pub use analysis::{compare, explain, ladder};
 pub use diagnose::diagnose;
 
-use super::json::Table1Report;
+use super::json::{Converted, Table1Report};
 use diagnose::verdict;
 use monitor_core::IsolationState;
 use monitor_io::log::quality::DataQuality;
@@ -155,7 +155,7 @@ pub fn simulate(path: &Path, wall_s: f64, s: &SimSummary) -> anyhow::Result<()> 
 }
 
 /// `convert`'s one line.
-pub fn convert(c: &crate::cli::convert::Converted) -> anyhow::Result<()> {
+pub fn convert(c: &Converted) -> anyhow::Result<()> {
     writeln!(
         crate::cli::stdout(),
         "converted {} ({}) to {} ({}): {} rows, {:.1} MB, in {:.2} s",

@@ -1,0 +1,25 @@
+//! The store's errors, below the store and its mirror, which both return them.
+
+/// Errors of the store.
+#[derive(Debug, thiserror::Error)]
+pub enum HistoryError {
+    /// SQLite failed (the store cannot be opened, is not a store, or a write failed).
+    #[error("store {path}: {message}")]
+    Sqlite {
+        /// The store's file.
+        path: String,
+        /// SQLite's message.
+        message: String,
+    },
+    /// The Parquet mirror cannot be written.
+    #[error("Parquet mirror {path}: {message}")]
+    Mirror {
+        /// The file or folder.
+        path: String,
+        /// What failed.
+        message: String,
+    },
+    /// Reading a store that does not exist.
+    #[error("no store at {0} (write one with `sim-host fleet ... --store {0}`)")]
+    Missing(String),
+}
