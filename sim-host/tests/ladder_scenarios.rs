@@ -95,7 +95,9 @@ fn named(effect: &str, truth: Option<(&str, f64)>) {
             "{effect}: {p} = {fitted}, injected {x}"
         );
     }
-    println!("{effect}: named ({effects:?}), ends at {ratio:.2}x the floor, {fall:.0}x below the start");
+    println!(
+        "{effect}: named ({effects:?}), ends at {ratio:.2}x the floor, {fall:.0}x below the start"
+    );
 }
 
 fn full() -> bool {
