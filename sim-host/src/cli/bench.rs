@@ -69,12 +69,15 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         None
     };
     if args.json {
-        render::json::print(&render::json::BenchReport {
-            figures: &figures,
-            detection_limits: limits.as_deref(),
-        })
+        render::json::print(
+            &mut crate::cli::stdout(),
+            &render::json::BenchReport {
+                figures: &figures,
+                detection_limits: limits.as_deref(),
+            },
+        )
     } else {
-        render::bench_text::bench(&figures, limits.as_deref())
+        render::bench_text::bench(&mut crate::cli::stdout(), &figures, limits.as_deref())
     }
 }
 
@@ -98,8 +101,8 @@ fn run_isolation(args: &BenchArgs) -> anyhow::Result<()> {
         eprintln!("wrote {}", path.display());
     }
     if args.json {
-        render::json::print(&result)
+        render::json::print(&mut crate::cli::stdout(), &result)
     } else {
-        render::bench_text::isolation_bench(&result)
+        render::bench_text::isolation_bench(&mut crate::cli::stdout(), &result)
     }
 }

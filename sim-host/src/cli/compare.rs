@@ -245,9 +245,9 @@ pub fn run_compare(args: &CompareArgs) -> anyhow::Result<()> {
     let out = a.compare(&c.options())?;
     render::html::write_compare(c.plot.as_deref(), c.report.as_deref(), &c.log, &a, &out)?;
     if c.json {
-        render::json::print(&out.report)
+        render::json::print(&mut crate::cli::stdout(), &out.report)
     } else {
-        render::text::compare(&c.log, &out.report)
+        render::text::compare(&mut crate::cli::stdout(), &c.log, &out.report)
     }
 }
 
@@ -273,7 +273,7 @@ fn explain_here(
     let compared = if args.compare {
         let out = a.compare(&opts)?;
         if !c.json {
-            render::text::compare(&c.log, &out.report)?;
+            render::text::compare(&mut crate::cli::stdout(), &c.log, &out.report)?;
         }
         Some(out.report)
     } else {
@@ -338,12 +338,15 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
         &doc,
     )?;
     match (c.json, compared) {
-        (true, Some(cmp)) => render::json::print(&render::json::ExplainWithCompare {
-            compare: &cmp,
-            explain: &doc,
-        }),
-        (true, None) => render::json::print(&doc),
-        (false, _) => render::text::explain(&c.log, &doc),
+        (true, Some(cmp)) => render::json::print(
+            &mut crate::cli::stdout(),
+            &render::json::ExplainWithCompare {
+                compare: &cmp,
+                explain: &doc,
+            },
+        ),
+        (true, None) => render::json::print(&mut crate::cli::stdout(), &doc),
+        (false, _) => render::text::explain(&mut crate::cli::stdout(), &c.log, &doc),
     }
 }
 
@@ -370,8 +373,8 @@ fn run_ladder(c: &Common) -> anyhow::Result<()> {
     pb.finish_and_clear();
     render::html::write_ladder(c.plot.as_deref(), c.report.as_deref(), &c.log, &report)?;
     if c.json {
-        render::json::print(&report)
+        render::json::print(&mut crate::cli::stdout(), &report)
     } else {
-        render::text::ladder(&c.log, &report)
+        render::text::ladder(&mut crate::cli::stdout(), &c.log, &report)
     }
 }

@@ -155,8 +155,8 @@ pub fn run(args: &ConvertArgs) -> anyhow::Result<()> {
         wall_s: start.elapsed().as_secs_f64(),
     };
     if args.json {
-        render::json::print(&done)
+        render::json::print(&mut crate::cli::stdout(), &done)
     } else {
-        render::text::convert(&done)
+        render::text::convert(&mut crate::cli::stdout(), &done)
     }
 }

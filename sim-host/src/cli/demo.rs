@@ -67,8 +67,8 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     };
     let run = monitor_studies::demo::run(story)?;
     if args.json {
-        render::json::print(&render::json::demo(&run))
+        render::json::print(&mut crate::cli::stdout(), &render::json::demo(&run))
     } else {
-        render::text::demo(&run)
+        render::text::demo(&mut crate::cli::stdout(), &run)
     }
 }

@@ -161,9 +161,9 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
     bar.finish_and_clear();
     render::text::quality_warnings(&d.report.data_quality);
     if args.json {
-        render::json::print(&d.report)
+        render::json::print(&mut crate::cli::stdout(), &d.report)
     } else {
-        render::text::diagnose(&args.log, &d)
+        render::text::diagnose(&mut crate::cli::stdout(), &args.log, &d)
     }
 }
 

@@ -58,7 +58,7 @@ pub fn run(args: &FleetArgs) -> anyhow::Result<()> {
             .collect(),
     };
     if args.json {
-        return render::json::print(&rows);
+        return render::json::print(&mut crate::cli::stdout(), &rows);
     }
     // (The header comes from the rows' field names: monitor_api::fleet::COLUMNS.)
     let mut w = csv::Writer::from_writer(super::stdout());

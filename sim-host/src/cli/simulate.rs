@@ -136,10 +136,11 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     };
     w.finish()?;
     let wall_s = start.elapsed().as_secs_f64();
+    let out = &mut crate::cli::stdout();
     if args.json {
-        render::json::print(&render::json::simulate(&args.out, wall_s, &summary))
+        render::json::print(out, &render::json::simulate(&args.out, wall_s, &summary))
     } else {
-        render::text::simulate(&args.out, wall_s, &summary)
+        render::text::simulate(out, &args.out, wall_s, &summary)
     }
 }
 

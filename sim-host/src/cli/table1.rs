@@ -50,8 +50,8 @@ pub fn run(args: &Table1Args) -> anyhow::Result<()> {
     bar.finish_and_clear();
     let table = render::json::Table1Report::new(name, proto.angle_source, rows);
     if args.json {
-        render::json::print(&table)
+        render::json::print(&mut crate::cli::stdout(), &table)
     } else {
-        render::text::table1(&table)
+        render::text::table1(&mut crate::cli::stdout(), &table)
     }
 }

@@ -96,11 +96,14 @@ pub fn run(args: &TrendArgs) -> anyhow::Result<()> {
             .map_err(|e| anyhow::anyhow!("--plot {}: {e}", p.display()))?;
     }
     if args.json {
-        return render::json::print(&TrendReport {
-            store: args.store.display().to_string(),
-            options: opts,
-            motors: &motors,
-        });
+        return render::json::print(
+            &mut crate::cli::stdout(),
+            &TrendReport {
+                store: args.store.display().to_string(),
+                options: opts,
+                motors: &motors,
+            },
+        );
     }
     let mut out = super::stdout();
     print_table(&mut out, &motors, args.motor.is_some())?;

@@ -21,8 +21,11 @@ fn spread(s: &Spread, decimals: usize) -> String {
 }
 
 /// `bench`'s figures and, with `--detection`, the detection limits.
-pub fn bench(f: &BenchFigures, limits: Option<&[DetectionLimitCase]>) -> anyhow::Result<()> {
-    let mut out = crate::cli::stdout();
+pub fn bench(
+    out: &mut dyn std::io::Write,
+    f: &BenchFigures,
+    limits: Option<&[DetectionLimitCase]>,
+) -> anyhow::Result<()> {
     writeln!(
         out,
         "reference scenario: 2.2 kW, direct-on-line, 14.6 N m from 2.5 s, 10 s at 10 kHz ({} rows); median (range) of {} runs",
@@ -79,8 +82,7 @@ pub fn bench(f: &BenchFigures, limits: Option<&[DetectionLimitCase]>) -> anyhow:
 ///
 /// # Errors
 /// Stdout errors.
-pub fn isolation_bench(b: &IsolationBench) -> anyhow::Result<()> {
-    let mut out = crate::cli::stdout();
+pub fn isolation_bench(mut out: &mut dyn std::io::Write, b: &IsolationBench) -> anyhow::Result<()> {
     isolation_summaries(&mut out, b)?;
     for c in &b.confusion {
         confusion_matrix(&mut out, c)?;

@@ -16,11 +16,10 @@ use std::path::Path;
 ///
 /// # Errors
 /// Serialisation or stdout errors.
-pub fn print<T: Serialize + ?Sized>(v: &T) -> anyhow::Result<()> {
-    use std::io::Write;
+pub fn print<T: Serialize + ?Sized>(out: &mut dyn std::io::Write, v: &T) -> anyhow::Result<()> {
     let mut doc = serde_json::to_vec_pretty(v)?;
     doc.push(b'\n');
-    crate::cli::stdout().write_all(&doc)?;
+    out.write_all(&doc)?;
     Ok(())
 }
 

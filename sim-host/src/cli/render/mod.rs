@@ -1,7 +1,8 @@
 //! One renderer per output format, as a CLI tool keeps its exporters: [`text`] (the human
-//! tables; [`bench_text`] the benchmarks'), [`json`] (one document on stdout), [`html`] (the report page and the chart
-//! files), with the chart sets in [`charts`] drawn by [`plot`]; [`hmi`] draws the live
-//! HMI's screen.
+//! tables; [`bench_text`] the benchmarks'), [`json`] (one document), [`html`] (the report
+//! page and the chart files), with the chart sets in [`charts`] drawn by [`plot`]; [`hmi`]
+//! draws the live HMI's screen. The text and JSON renderers write to the writer they are
+//! given (the commands pass [`crate::cli::stdout`]; a test can pass a `Vec<u8>`).
 
 pub mod bench_text;
 pub mod charts;

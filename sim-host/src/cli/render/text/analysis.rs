@@ -21,8 +21,11 @@ fn model_name(effects: &[monitor_core::EffectKind], bare: &str, prefix: &str, se
 }
 
 /// `compare`'s errors, worst windows and fitted values.
-pub fn compare(log: &Path, r: &CompareReport) -> anyhow::Result<()> {
-    let mut out = crate::cli::stdout();
+pub fn compare(
+    mut out: &mut dyn std::io::Write,
+    log: &Path,
+    r: &CompareReport,
+) -> anyhow::Result<()> {
     writeln!(out, "compare {}", log.display())?;
     data_quality(&mut out, &r.data_quality)?;
     writeln!(
@@ -133,9 +136,12 @@ fn fitted(out: &mut impl Write, r: &CompareReport) -> anyhow::Result<()> {
 /// and how it reads beside the verdict, the motor's own analyses (the unbalance, the rotor's
 /// current signature), the ranked candidates, those with no effect in one line, those not
 /// plausible apart with their reasons, what was skipped, and the refitted base parameters.
-pub fn explain(log: &Path, doc: &ExplainDocument) -> anyhow::Result<()> {
+pub fn explain(
+    mut out: &mut dyn std::io::Write,
+    log: &Path,
+    doc: &ExplainDocument,
+) -> anyhow::Result<()> {
     let r = &doc.report;
-    let mut out = crate::cli::stdout();
     writeln!(out, "explain {}", log.display())?;
     // The one verdict first (what `diagnose` gives the same log), then the model's story.
     writeln!(out, "{}", doc.headline)?;
@@ -244,8 +250,11 @@ fn apart(out: &mut impl Write, r: &ExplainReport) -> anyhow::Result<()> {
 /// the error beyond the floor the step removed on each, the fitted values with their
 /// physical ranges), then why it stopped, the test, the last round's other candidates and
 /// what could not be fitted.
-pub fn ladder(log: &Path, r: &LadderReport) -> anyhow::Result<()> {
-    let mut out = crate::cli::stdout();
+pub fn ladder(
+    mut out: &mut dyn std::io::Write,
+    log: &Path,
+    r: &LadderReport,
+) -> anyhow::Result<()> {
     writeln!(out, "explain --ladder {}", log.display())?;
     data_quality(&mut out, &r.data_quality)?;
     writeln!(

@@ -60,9 +60,8 @@ fn findings_block(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<
 }
 
 /// `diagnose`'s timeline, lamps, candidates, unbalance and rotor.
-pub fn diagnose(log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
+pub fn diagnose(mut out: &mut dyn std::io::Write, log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
     let rep = &d.report;
-    let mut out = crate::cli::stdout();
     writeln!(
         out,
         "diagnose {} ({} rows, {:.0} Hz, angle: {})",

@@ -38,8 +38,7 @@ fn number(x: f64) -> String {
 }
 
 /// The demo's timeline and conclusion.
-pub fn demo(run: &DemoRun) -> anyhow::Result<()> {
-    let mut out = crate::cli::stdout();
+pub fn demo(mut out: &mut dyn std::io::Write, run: &DemoRun) -> anyhow::Result<()> {
     demo_story(&mut out, run)?;
     writeln!(out, "  time   speed rpm   r1 r2 r3 r4   state")?;
     for p in &run.points {
@@ -139,9 +138,14 @@ fn candidate_list(c: &[monitor_replay::FaultCandidate]) -> String {
 }
 
 /// `simulate`'s one-line summary.
-pub fn simulate(path: &Path, wall_s: f64, s: &SimSummary) -> anyhow::Result<()> {
+pub fn simulate(
+    out: &mut dyn std::io::Write,
+    path: &Path,
+    wall_s: f64,
+    s: &SimSummary,
+) -> anyhow::Result<()> {
     writeln!(
-        crate::cli::stdout(),
+        out,
         "wrote {} rows ({} s at {} Hz) to {} in {:.2} s; final speed {:.2} rad/s, slip {:.4}",
         s.rows,
         s.duration_s,
@@ -155,9 +159,9 @@ pub fn simulate(path: &Path, wall_s: f64, s: &SimSummary) -> anyhow::Result<()> 
 }
 
 /// `convert`'s one line.
-pub fn convert(c: &Converted) -> anyhow::Result<()> {
+pub fn convert(out: &mut dyn std::io::Write, c: &Converted) -> anyhow::Result<()> {
     writeln!(
-        crate::cli::stdout(),
+        out,
         "converted {} ({}) to {} ({}): {} rows, {:.1} MB, in {:.2} s",
         c.input,
         c.input_format,
@@ -208,8 +212,7 @@ pub fn quality_warnings(q: &DataQuality) {
 }
 
 /// `table1`'s measured signatures beside the paper's and the physical ones.
-pub fn table1(t: &Table1Report) -> anyhow::Result<()> {
-    let mut out = crate::cli::stdout();
+pub fn table1(out: &mut dyn std::io::Write, t: &Table1Report) -> anyhow::Result<()> {
     writeln!(
         out,
         "Table 1 end to end — {}, angle: {}",
