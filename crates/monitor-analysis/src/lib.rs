@@ -219,6 +219,26 @@ fn base_out_of_range(
         .collect()
 }
 
+/// Why the base parameters `after` are implausible where `before` (the model the step
+/// started from) was not: each base parameter a fit takes out of its physical range, in
+/// words; one the model already had out of range is not the step's doing.
+fn base_newly_out_of_range(
+    n: &MachineConstants,
+    before: &BaseParams,
+    after: &BaseParams,
+    d: &Prepared,
+) -> Vec<String> {
+    let already: Vec<BaseParameter> = base_out_of_range(n, before, d)
+        .into_iter()
+        .map(|(k, _)| k)
+        .collect();
+    base_out_of_range(n, after, d)
+        .into_iter()
+        .filter(|(k, _)| !already.contains(k))
+        .map(|(_, w)| w)
+        .collect()
+}
+
 /// The reasons fitted base parameters are not physically plausible (empty: plausible).
 pub fn base_implausible(n: &MachineConstants, b: &BaseParams, d: &Prepared) -> Vec<String> {
     base_out_of_range(n, b, d)

@@ -7,8 +7,7 @@ use super::ranking::RankedCandidate;
 use super::{explained_fraction, EffectCandidate, Standing};
 use crate::effects::{self, EffectModel, SetupError};
 use crate::fit::{self, ActiveEffect, FitResult};
-use crate::simplified_model::BaseParameter;
-use crate::{align, base_out_of_range, metrics, transients};
+use crate::{align, base_newly_out_of_range, metrics, transients};
 use crate::{Analysis, AnalysisError, FittedEffect, Options};
 use monitor_core::EffectKind;
 
@@ -261,19 +260,15 @@ impl Analysis {
         f: &FitResult,
     ) -> Result<Vec<String>, AnalysisError> {
         let d = &self.data;
-        let already: Vec<BaseParameter> = base_out_of_range(&self.constants, &base.fit.base, d)
-            .into_iter()
-            .map(|(k, _)| k)
-            .collect();
         let mut why = me.implausible_because.clone();
         let fitted = f.effect_params.last().map_or(&[][..], Vec::as_slice);
         why.extend(c.contradicted_by(d, &self.constants, fitted)?);
-        why.extend(
-            base_out_of_range(&self.constants, &f.base, d)
-                .into_iter()
-                .filter(|(k, _)| !already.contains(k))
-                .map(|(_, w)| w),
-        );
+        why.extend(base_newly_out_of_range(
+            &self.constants,
+            &base.fit.base,
+            &f.base,
+            d,
+        ));
         Ok(why)
     }
 }

@@ -8,8 +8,8 @@ use crate::explain::PARAM_PENALTY;
 use crate::fit::{self, ActiveEffect, FitResult};
 use crate::metrics::{self, Weights};
 use crate::prep::Prepared;
-use crate::simplified_model::{BaseParameter, BaseParams, MachineConstants};
-use crate::{align, base_out_of_range, transients, Analysis, AnalysisError, Options};
+use crate::simplified_model::{BaseParams, MachineConstants};
+use crate::{align, base_newly_out_of_range, transients, Analysis, AnalysisError, Options};
 use monitor_core::EffectKind;
 
 /// The series a ladder's fits run on, with its held-back split.
@@ -318,10 +318,6 @@ impl Analysis {
         m: usize,
     ) -> Result<Vec<String>, AnalysisError> {
         let d = &self.data;
-        let already: Vec<BaseParameter> = base_out_of_range(&self.constants, &rung.fit.base, d)
-            .into_iter()
-            .map(|(k, _)| k)
-            .collect();
         let mut why = Vec::new();
         for (i, a) in set.iter().enumerate().skip(rung.models.len()) {
             let p = f.effect_params.get(i).map_or(&[][..], Vec::as_slice);
@@ -344,12 +340,12 @@ impl Analysis {
             why.extend(pinned(kind, &a.setup, p));
             why.extend(a.effect.contradicted_by(d, &self.constants, p)?);
         }
-        why.extend(
-            base_out_of_range(&self.constants, &f.base, d)
-                .into_iter()
-                .filter(|(k, _)| !already.contains(k))
-                .map(|(_, w)| w),
-        );
+        why.extend(base_newly_out_of_range(
+            &self.constants,
+            &rung.fit.base,
+            &f.base,
+            d,
+        ));
         Ok(why)
     }
 }
