@@ -1,7 +1,11 @@
-//! What a replay is asked to do ([`ReplayOptions`], [`LoadModel`]) and the monitor
-//! configuration it runs with ([`monitor_config_for_log`]).
+//! What a replay is asked to do ([`ReplayOptions`], [`LoadModel`]), the typed values a
+//! front end parses its words into ([`CommissionWindow`], [`TimelineStep`]), the one check
+//! of them all ([`ReplayOptions::validate`]) and its error ([`OptionError`], naming the
+//! field, never a front end's spelling of it), and the monitor configuration a replay runs
+//! with ([`monitor_config_for_log`]).
 
-use super::{HealthyReference, ReplayError, TICK_HZ};
+use super::option_values::{check_parallel_paths, CommissionWindow, OptionError, TimelineStep};
+use super::{HealthyReference, TICK_HZ};
 use monitor_core::{AngleSource, MonitorConfig, ResidualForm};
 use monitor_io::params::ParamFile;
 
@@ -12,21 +16,22 @@ pub struct ReplayOptions {
     pub angle_source: AngleSource,
     /// Residual form for the lamps.
     pub residual_form: ResidualForm,
-    /// Commissioning window [start, end) in log seconds; None = fixed thresholds.
+    /// Commissioning window [start, end) in log seconds; None = fixed thresholds. Checked
+    /// by [`ReplayOptions::validate`] as [`CommissionWindow::new`] checks it.
     pub commission: Option<(f64, f64)>,
     /// Report a commissioning window that was not learned instead of refusing.
     pub allow_incomplete: bool,
-    /// Timeline resolution [s] (one point per interval; default 0.5 s, the one default of
-    /// `diagnose --timeline-step`, the API and Python).
-    pub timeline_step_s: f64,
-    /// The healthy machine's negative sequence to judge the winding against (`diagnose
-    /// --baseline HEALTHY.csv`); without it, the one learned in the commissioning window,
-    /// else none ([`super::UnbalanceBaseline`]).
+    /// Timeline resolution (one point per interval; default 0.5 s, the one default of
+    /// the command line, the API and Python).
+    pub timeline_step: TimelineStep,
+    /// The healthy machine's negative sequence to judge the winding against (the field
+    /// `baseline` of a request: healthy logs); without it, the one learned in the
+    /// commissioning window, else none ([`super::UnbalanceBaseline`]).
     pub unbalance_baseline: Option<HealthyReference>,
-    /// What is known of the load ([`LoadModel`]; `diagnose --load`).
+    /// What is known of the load ([`LoadModel`]; the field `load`).
     pub load: LoadModel,
-    /// How the shorted-turn level is sized (`diagnose --parallel-paths`,
-    /// `--turn-calibration`; [`super::winding::level`]).
+    /// How the shorted-turn level is sized (the fields `parallel_paths`, 1..=8 as
+    /// [`super::PARALLEL_PATHS`] says, and `turn_calibration`; [`super::winding::level`]).
     pub turn_level: super::TurnLevelOptions,
 }
 
@@ -60,7 +65,7 @@ impl Default for ReplayOptions {
             residual_form: ResidualForm::Steady,
             commission: None,
             allow_incomplete: false,
-            timeline_step_s: 0.5,
+            timeline_step: TimelineStep::DEFAULT,
             unbalance_baseline: None,
             load: LoadModel::Unknown,
             turn_level: super::TurnLevelOptions::default(),
@@ -94,16 +99,21 @@ pub fn monitor_config_for_log(
     cfg
 }
 
-/// Checks a commissioning window asked for: `0 <= START < END`, both finite.
-pub(super) fn check_commission_window(window: Option<(f64, f64)>) -> Result<(), ReplayError> {
-    if let Some((a, b)) = window {
-        if !(b > a && a >= 0.0 && b.is_finite()) {
-            return Err(ReplayError::Option(format!(
-                "--commission {a}:{b}: the window must be START:END with 0 <= START < END, both finite (seconds)"
-            )));
+impl ReplayOptions {
+    /// The one check of the options every front end calls (the command line, Python, the
+    /// HMI, the fleet; [`super::Replay::new`] too): the commissioning window as
+    /// [`CommissionWindow::new`] checks it, `parallel_paths` in [`super::PARALLEL_PATHS`] (the
+    /// time step is positive by construction, [`TimelineStep`]).
+    ///
+    /// # Errors
+    /// [`OptionError`] naming the field (`commission`, `parallel_paths`).
+    pub fn validate(&self) -> Result<(), OptionError> {
+        if let Some((a, b)) = self.commission {
+            CommissionWindow::new(a, b)?;
         }
+        check_parallel_paths(i64::from(self.turn_level.parallel_paths))?;
+        Ok(())
     }
-    Ok(())
 }
 
 #[cfg(test)]
