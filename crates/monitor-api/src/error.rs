@@ -134,7 +134,11 @@ impl ApiError {
     pub fn spelled(&self, spell: &dyn Spelling) -> String {
         match self {
             ApiError::Option(e) => e.spelled(spell),
+            ApiError::Log(e)
+            | ApiError::Replay(ReplayError::Log(e))
+            | ApiError::Analysis(AnalysisError::Log(e)) => e.spelled(&|name| spell.key(name)),
             ApiError::Replay(e) => e.spelled(spell),
+            ApiError::Nameplate(e) => e.spelled(&|name| spell.key(name)),
             ApiError::Swapped { params, also } => format!(
                 "{} is a log, not a parameter file{also}: the arguments look swapped (give {} LOG)",
                 spell.option(OptionField::Params, params),

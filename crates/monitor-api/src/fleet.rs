@@ -11,7 +11,7 @@
 //! params = "params/pump_7.toml"    # the motor's parameter file ([columns] included)
 //! logs = "pump_7_*"                # which logs are this motor's: a pattern on the file name
 //! commission = [2.0, 4.0]          # optional: --commission START:END
-//! baseline = ["healthy/pump_7"]    # optional: healthy logs or folders (--baseline)
+//! baseline = ["healthy/pump_7"]    # optional: healthy logs or folders (a request's baseline)
 //! load = "unknown"                 # optional: "unknown" (default) or "viscous"
 //! ```
 //!

@@ -27,7 +27,6 @@ mod events;
 mod front;
 mod isolation;
 mod isolation_name;
-mod option_values;
 mod options;
 mod pipe;
 mod report;
@@ -56,11 +55,10 @@ pub use isolation::{
     state_name, DetectionLimit, FaultCandidate, IsolationBaseline, IsolationGroup, IsolationName,
     IsolationReport, NameGiven, SensorPhaseReport, NOMINAL_UNCERTAINTY,
 };
-pub use option_values::{
-    check_parallel_paths, CommissionWindow, FieldNames, OptionError, OptionField, Spelling,
-    TimelineStep, PARALLEL_PATHS,
+pub use options::{
+    check_parallel_paths, monitor_config_for_log, CommissionWindow, FieldNames, LoadModel,
+    OptionError, OptionField, ReplayOptions, Spelling, TimelineStep, PARALLEL_PATHS,
 };
-pub use options::{monitor_config_for_log, LoadModel, ReplayOptions};
 pub use report::{
     BaselineSource, Detection, DiagnoseReport, MonitorState, Panel, TimelinePoint, UnbalanceReport,
 };

@@ -24,6 +24,10 @@ impl Spelling for CliWords {
             format!("--{flag} {value}")
         }
     }
+
+    fn key(&self, name: &str) -> String {
+        format!("--{}", name.replace('_', "-"))
+    }
 }
 
 /// One error of a chain in the command line's words: a library error that names fields
@@ -35,6 +39,12 @@ pub fn error_text(e: &(dyn std::error::Error + 'static)) -> String {
         e.spelled(&CliWords)
     } else if let Some(e) = e.downcast_ref::<monitor_replay::OptionError>() {
         e.spelled(&CliWords)
+    } else if let Some(e) = e.downcast_ref::<monitor_io::log::LogError>() {
+        e.spelled(&|name| CliWords.key(name))
+    } else if let Some(monitor_store::HistoryError::Missing(p)) =
+        e.downcast_ref::<monitor_store::HistoryError>()
+    {
+        format!("no store at {p} (write one with `sim-host fleet ... --store {p}`)")
     } else {
         e.to_string()
     }
