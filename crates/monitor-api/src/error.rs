@@ -75,7 +75,9 @@ pub enum ApiError {
         what: &'static str,
         /// How messages name the log.
         log: String,
-        /// Why (the refusal ends "; no parameter file written").
+        /// Why (the refusal ends "; no parameter file written"); it names the window's
+        /// fields as `from_s` and `to_s` ([`ApiError::spelled`] says them in a front
+        /// end's words).
         why: String,
     },
     /// A labelled run for a turn calibration is wrong, or none named its phase.
@@ -161,6 +163,16 @@ impl ApiError {
                 spell.option(OptionField::From, ""),
                 spell.option(OptionField::To, "")
             ),
+            ApiError::Identify { what, log, why } => {
+                let mut why = why.clone();
+                for field in [OptionField::From, OptionField::To] {
+                    if let Some(at) = why.rfind(field.name()) {
+                        let said = spell.option(field, "");
+                        why.replace_range(at..at + field.name().len(), &said);
+                    }
+                }
+                format!("{what} {log}: {why}")
+            }
             e => e.to_string(),
         }
     }

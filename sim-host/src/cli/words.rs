@@ -86,5 +86,16 @@ mod tests {
             "--timeline-step 0"
         );
         assert!(parse_timeline_step("0").is_err() && parse_parallel_paths("9").is_err());
+        let e = ApiError::Identify {
+            what: "cannot identify from",
+            log: "a.csv".into(),
+            why: "a gap: give a window without it (from_s/to_s)".into(),
+        };
+        assert!(e.spelled(&CliWords).ends_with("(--from/--to)"), "{e}");
+        let e = ApiError::WindowOrder {
+            from_s: 2.0,
+            to_s: 1.0,
+        };
+        assert_eq!(e.spelled(&CliWords), "--to (1) must be after --from (2)");
     }
 }
