@@ -170,13 +170,13 @@ def _commission(commission: Optional[CommissionLike]) -> Optional[Union[Tuple[fl
         return commission
     how = "give (start_s, end_s) or 'START:END' in seconds, e.g. (1.5, 2.4) or '1.5:2.4'"
     if not isinstance(commission, (tuple, list)):
-        raise OptionError(f"commission={commission!r}: {how}")
+        raise OptionError(f"commission = {commission!r}: {how}")
     if len(commission) != 2:
-        raise OptionError(f"commission={commission!r}: two values, the start and the end; {how}")
+        raise OptionError(f"commission = {commission!r}: two values, the start and the end; {how}")
     try:
         a, b = (float(x) for x in commission)
     except (TypeError, ValueError):
-        raise OptionError(f"commission={commission!r}: not numbers; {how}") from None
+        raise OptionError(f"commission = {commission!r}: not numbers; {how}") from None
     return a, b
 
 

@@ -55,7 +55,8 @@ create_exception!(
     "A bug: the library panicked (please report it with the call)."
 );
 
-/// Python's spelling of the library's fields: its keyword arguments (`commission=2:4`).
+/// Python's spelling of the library's fields: its keyword arguments, as its other messages
+/// name them (`commission = 4:2`, `load = 'heavy'`).
 struct PyWords;
 
 impl monitor_replay::Spelling for PyWords {
@@ -63,7 +64,7 @@ impl monitor_replay::Spelling for PyWords {
         if value.is_empty() {
             field.name().to_string()
         } else {
-            format!("{}={value}", field.name())
+            format!("{} = {value}", field.name())
         }
     }
 }

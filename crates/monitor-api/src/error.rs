@@ -1,7 +1,7 @@
 //! The one-call interface's error ([`ApiError`]) and its kinds ([`ErrorKind`]). Each
 //! variant names the option or field it is about ([`OptionField`]) in the library's words
 //! (`Display`); a front end says it in its own ([`ApiError::spelled`]: the command line's
-//! `--commission`, Python's `commission=`).
+//! `--commission`, Python's keyword, `commission = 4:2`).
 
 use monitor_analysis::AnalysisError;
 use monitor_io::log::LogError;
@@ -131,8 +131,8 @@ impl ApiError {
     }
 
     /// The message in a front end's words: `spell` names the options and fields it refers
-    /// to (the command line as `--commission 4:2`, Python as `commission=4:2`); the
-    /// library's own is `Display`'s ([`FieldNames`]).
+    /// to (the command line as `--commission 4:2`, Python as its keyword,
+    /// `commission = 4:2`); the library's own is `Display`'s ([`FieldNames`]).
     pub fn spelled(&self, spell: &dyn Spelling) -> String {
         match self {
             ApiError::Option(e) => e.spelled(spell),
