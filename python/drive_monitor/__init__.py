@@ -163,21 +163,18 @@ def _log(log: LogLike) -> Tuple[Any, Optional[str]]:
     )
 
 
-def _commission(commission: Optional[CommissionLike]) -> Optional[Tuple[float, float]]:
-    """The window ``(start_s, end_s)`` of ``"START:END"`` or a pair."""
-    if commission is None:
-        return None
+def _commission(commission: Optional[CommissionLike]) -> Optional[Union[Tuple[float, float], str]]:
+    """The window as the library takes it: ``"START:END"`` as given (the library's one
+    parser reads it), a pair as ``(start_s, end_s)``; the library checks both."""
+    if commission is None or isinstance(commission, str):
+        return commission
     how = "give (start_s, end_s) or 'START:END' in seconds, e.g. (1.5, 2.4) or '1.5:2.4'"
-    if isinstance(commission, str):
-        parts = commission.split(":")
-    elif isinstance(commission, (tuple, list)):
-        parts = list(commission)
-    else:
+    if not isinstance(commission, (tuple, list)):
         raise OptionError(f"commission = {commission!r}: {how}")
-    if len(parts) != 2:
+    if len(commission) != 2:
         raise OptionError(f"commission = {commission!r}: two values, the start and the end; {how}")
     try:
-        a, b = (float(x) for x in parts)
+        a, b = (float(x) for x in commission)
     except (TypeError, ValueError):
         raise OptionError(f"commission = {commission!r}: not numbers; {how}") from None
     return a, b
@@ -222,11 +219,12 @@ def diagnose(
     allow_incomplete : bool
         Report even when the commissioning window was not learned.
     timeline_step : float, optional
-        Timeline resolution [s] (default: the command line's, 0.5 s).
+        Timeline resolution [s] (default: the command line's, 0.5 s); finite and > 0, a
+        step of 0 is refused (``OptionError``) as on the command line.
     group : str, optional
         The TDMS group holding the channels.
     parallel_paths : int, optional
-        Parallel paths of each phase of the winding (1, the default; 2 for a double star):
+        Parallel paths of each phase of the winding, 1..8 (1, the default; 2 for a double star):
         the shorted-turn level is sized with one path's resistance.
     turn_calibration : path or dict, optional
         A calibration of the shorted-turn level learned from labelled runs of the same

@@ -4,7 +4,7 @@ file to the extension). Every function returns the command's ``--json`` document
 string; the package's Python layer wraps it. A ``log`` is a path when ``log_origin`` is
 ``None``, else an object with ``__arrow_c_stream__`` that messages call ``log_origin``."""
 
-from typing import Any, List, Optional, Tuple
+from typing import Any, List, Optional, Tuple, Union
 
 class DriveMonitorError(Exception): ...
 class ParamsError(DriveMonitorError): ...
@@ -18,7 +18,7 @@ def diagnose(
     params: str,
     log_origin: Optional[str] = ...,
     params_is_text: bool = ...,
-    commission: Optional[Tuple[float, float]] = ...,
+    commission: Optional[Union[Tuple[float, float], str]] = ...,
     baseline: List[Tuple[Any, Optional[str]]] = ...,
     load: Optional[str] = ...,
     angle: Optional[str] = ...,

@@ -55,9 +55,23 @@ create_exception!(
     "A bug: the library panicked (please report it with the call)."
 );
 
-/// The exception of an [`ApiError`].
+/// Python's spelling of the library's fields: its keyword arguments, as its other messages
+/// name them (`commission = 4:2`, `load = 'heavy'`).
+struct PyWords;
+
+impl monitor_replay::Spelling for PyWords {
+    fn option(&self, field: monitor_replay::OptionField, value: &str) -> String {
+        if value.is_empty() {
+            field.name().to_string()
+        } else {
+            format!("{} = {value}", field.name())
+        }
+    }
+}
+
+/// The exception of an [`ApiError`], its message in Python's words ([`PyWords`]).
 fn to_py(e: ApiError) -> PyErr {
-    let msg = e.to_string();
+    let msg = e.spelled(&PyWords);
     match e.kind() {
         ErrorKind::Params => ParamsError::new_err(msg),
         ErrorKind::Log => LogError::new_err(msg),
@@ -153,6 +167,74 @@ fn effects_of(names: &[String]) -> PyResult<Vec<monitor_core::EffectKind>> {
         .collect()
 }
 
+/// A commissioning window as Python gives it: `"START:END"` or `(start_s, end_s)`.
+#[derive(FromPyObject)]
+enum CommissionArg {
+    /// `"START:END"` [s].
+    Text(String),
+    /// `(start_s, end_s)` [s].
+    Pair(f64, f64),
+}
+
+impl CommissionArg {
+    /// The window, by the library's one parser and check.
+    fn window(&self) -> Result<monitor_replay::CommissionWindow, ApiError> {
+        Ok(match self {
+            CommissionArg::Text(s) => s.parse()?,
+            CommissionArg::Pair(a, b) => monitor_replay::CommissionWindow::new(*a, *b)?,
+        })
+    }
+}
+
+/// The request's replay options from Python's keywords (an option not given keeps the one
+/// default, `ReplayOptions::default`, the command line's too).
+#[allow(clippy::too_many_arguments)]
+fn replay_options(
+    commission: Option<CommissionArg>,
+    load: Option<&str>,
+    angle: Option<&str>,
+    residuals: Option<&str>,
+    allow_incomplete: bool,
+    timeline_step: Option<f64>,
+    parallel_paths: Option<i64>,
+    turn_calibration: Option<String>,
+) -> PyResult<monitor_replay::ReplayOptions> {
+    let d = monitor_replay::ReplayOptions::default();
+    // A calibration as its JSON text (`monitor_replay::TurnCalibration`).
+    let calibration = turn_calibration
+        .map(|t| serde_json::from_str::<monitor_replay::TurnCalibration>(&t))
+        .transpose()
+        .map_err(|e| OptionError::new_err(format!("turn_calibration: not a calibration: {e}")))?;
+    let parallel_paths = match parallel_paths {
+        None => d.turn_level.parallel_paths,
+        Some(n) => monitor_replay::check_parallel_paths(n).map_err(|e| to_py(e.into()))?,
+    };
+    Ok(monitor_replay::ReplayOptions {
+        commission: commission
+            .map(|c| c.window())
+            .transpose()
+            .map_err(to_py)?
+            .map(monitor_replay::CommissionWindow::seconds),
+        allow_incomplete,
+        load: load.map(load_of).transpose()?.unwrap_or(d.load),
+        angle_source: angle.map(angle_of).transpose()?.unwrap_or(d.angle_source),
+        residual_form: residuals
+            .map(residuals_of)
+            .transpose()?
+            .unwrap_or(d.residual_form),
+        timeline_step: timeline_step
+            .map(monitor_replay::TimelineStep::new)
+            .transpose()
+            .map_err(|e| to_py(e.into()))?
+            .unwrap_or(d.timeline_step),
+        unbalance_baseline: None,
+        turn_level: monitor_replay::TurnLevelOptions {
+            parallel_paths,
+            calibration: calibration.or(d.turn_level.calibration),
+        },
+    })
+}
+
 /// `diagnose --json` of the log at `log` with the parameter file `params`.
 #[pyfunction]
 #[pyo3(signature = (log, params, log_origin=None, params_is_text=false, commission=None, baseline=Vec::new(), load=None, angle=None, residuals=None, allow_incomplete=false, timeline_step=None, group=None, parallel_paths=None, turn_calibration=None))]
@@ -163,7 +245,7 @@ fn diagnose(
     params: String,
     log_origin: Option<String>,
     params_is_text: bool,
-    commission: Option<(f64, f64)>,
+    commission: Option<CommissionArg>,
     baseline: Vec<(Bound<'_, PyAny>, Option<String>)>,
     load: Option<&str>,
     angle: Option<&str>,
@@ -171,37 +253,27 @@ fn diagnose(
     allow_incomplete: bool,
     timeline_step: Option<f64>,
     group: Option<String>,
-    parallel_paths: Option<u8>,
+    parallel_paths: Option<i64>,
     turn_calibration: Option<String>,
 ) -> PyResult<String> {
-    // An option not given keeps the one default (`DiagnoseRequest::default`, the command
-    // line's too).
-    let d = api::DiagnoseRequest::default();
-    // A calibration as its JSON text (`monitor_replay::TurnCalibration`).
-    let calibration = turn_calibration
-        .map(|t| serde_json::from_str::<monitor_replay::TurnCalibration>(&t))
-        .transpose()
-        .map_err(|e| OptionError::new_err(format!("turn_calibration: not a calibration: {e}")))?;
     let req = api::DiagnoseRequest {
-        commission,
-        allow_incomplete,
+        options: replay_options(
+            commission,
+            load,
+            angle,
+            residuals,
+            allow_incomplete,
+            timeline_step,
+            parallel_paths,
+            turn_calibration,
+        )?,
         baseline: baseline
             .iter()
             .map(|(b, origin)| log_source(b, origin.as_deref()))
             .collect::<PyResult<_>>()?,
-        load: load.map(load_of).transpose()?.unwrap_or(d.load),
-        angle_source: angle.map(angle_of).transpose()?.unwrap_or(d.angle_source),
-        residual_form: residuals
-            .map(residuals_of)
-            .transpose()?
-            .unwrap_or(d.residual_form),
-        timeline_step_s: timeline_step.unwrap_or(d.timeline_step_s),
         group,
-        turn_level: monitor_replay::TurnLevelOptions {
-            parallel_paths: parallel_paths.unwrap_or(d.turn_level.parallel_paths).max(1),
-            calibration: calibration.or(d.turn_level.calibration),
-        },
     };
+    req.validate().map_err(to_py)?;
     let log = log_source(log, log_origin.as_deref())?;
     run(py, || {
         let d = api::diagnose(

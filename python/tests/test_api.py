@@ -125,7 +125,12 @@ def test_simulate_returns_the_schema(repo):
         (lambda r: dm.diagnose(r / MOTULATOR, {"motor": {"rs_ohm": 1.0}}), dm.ParamsError, "missing"),
         (lambda r: dm.diagnose(r / "nosuch.csv", r / MOTULATOR_P), dm.LogError, "nosuch.csv"),
         (lambda r: dm.diagnose({"t_s": np.zeros(3)}, r / MOTULATOR_P), dm.LogError, "ia_A"),
-        (lambda r: dm.diagnose(r / MOTULATOR, r / MOTULATOR_P, commission=(3.0, 2.0)), dm.OptionError, "--commission"),
+        (lambda r: dm.diagnose(r / MOTULATOR, r / MOTULATOR_P, commission=(3.0, 2.0)), dm.OptionError, "commission = 3:2"),
+        (lambda r: dm.diagnose(r / MOTULATOR, r / MOTULATOR_P, commission="4:x"), dm.OptionError, "commission = 4:x"),
+        # The one check of every front end: a step of 0 is refused (not clamped), as on
+        # the command line, and parallel paths are 1..=8.
+        (lambda r: dm.diagnose(r / MOTULATOR, r / MOTULATOR_P, timeline_step=0), dm.OptionError, "timeline_step = 0"),
+        (lambda r: dm.diagnose(r / MOTULATOR, r / MOTULATOR_P, parallel_paths=0), dm.OptionError, "parallel_paths = 0"),
         (lambda r: dm.diagnose(r / MOTULATOR, r / MOTULATOR_P, load="heavy"), dm.OptionError, "load"),
         (lambda r: dm.compare(r / MOTULATOR, r / MOTULATOR_P, from_s=4.99), dm.OptionError, "at least"),
         (lambda r: dm.identify(r / ITSC / "SC_HLT_001.csv", r / ITSC / "baldor_0p75hp.toml"), dm.OptionError, "identify"),

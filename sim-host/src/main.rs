@@ -84,12 +84,13 @@ fn report(line: &str) {
     let _ = writeln!(std::io::stderr().lock(), "{line}");
 }
 
-/// The error and its causes on one line; a cause whose text the message already holds
+/// The error and its causes on one line, in the command line's words (a library error
+/// names its fields by their flags, `cli::words`); a cause whose text the message already holds
 /// (many errors quote their source) is not repeated.
 fn one_line_error(e: &anyhow::Error) -> String {
-    let mut msg = e.to_string();
+    let mut msg = cli::words::error_text(e.as_ref());
     for cause in e.chain().skip(1) {
-        let c = cause.to_string();
+        let c = cli::words::error_text(cause);
         if !msg.contains(&c) {
             msg.push_str(": ");
             msg.push_str(&c);

@@ -117,7 +117,10 @@ fn bad_encoder_cells_do_not_make_a_speed_sensor_fault() {
         }
     }
     let req = DiagnoseRequest {
-        commission: Some((2.0, 4.0)),
+        options: monitor_replay::ReplayOptions {
+            commission: Some((2.0, 4.0)),
+            ..Default::default()
+        },
         ..Default::default()
     };
     let mut bad_verdicts = Vec::new();

@@ -73,7 +73,7 @@ fn a_window_with_too_little_steady_running_says_how_much_it_found() {
         ..ReplayOptions::default()
     };
     match diagnose_rows(&p, channels(), &rows, opts) {
-        Err(ReplayError::IncompleteCommissioning { why }) => {
+        Err(ReplayError::IncompleteCommissioning { why, .. }) => {
             assert!(
                 why.contains("learned") && why.contains("at least needed"),
                 "{why}"

@@ -24,7 +24,10 @@ fn run(dir: &std::path::Path, change: f64) -> DiagnoseReport {
     );
     api::simulate_to_file(source(), &scenario, &log).expect("simulates");
     let req = DiagnoseRequest {
-        commission: Some((3.0, 4.5)),
+        options: monitor_replay::ReplayOptions {
+            commission: Some((3.0, 4.5)),
+            ..Default::default()
+        },
         ..Default::default()
     };
     api::diagnose(source(), &log, &req, &mut |_| {})

@@ -86,7 +86,10 @@ fn diagnose_and_explain_agree_on_twenty_logs() {
             let log = simulate(dir.path(), motor, case);
             let p = params(motor);
             let req = DiagnoseRequest {
-                commission: Some((2.0, 4.0)),
+                options: monitor_replay::ReplayOptions {
+                    commission: Some((2.0, 4.0)),
+                    ..Default::default()
+                },
                 ..Default::default()
             };
             let d = api::diagnose(ParamsSource::Path(&p), &log, &req, &mut |_| {})

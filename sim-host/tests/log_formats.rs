@@ -355,7 +355,7 @@ fn tdms_groups_and_waveform_time() {
     let e = open_error(&f, &OpenOptions::default());
     assert_eq!(
         e,
-        "LOG: the TDMS file has several groups ('Motor', 'Ambient'): name one with --group"
+        "LOG: the TDMS file has several groups ('Motor', 'Ambient'): name one with group"
     );
     let e = open_error(
         &f,

@@ -301,7 +301,8 @@ fn good() -> Nameplate {
     nameplate(&machines()[0], false)
 }
 
-/// The message of refusing `n`: one line, starting with the option.
+/// The message of refusing `n`: one line, starting with the field's name (the library's
+/// words; the command line says `--efficiency`, as the binary's test below checks).
 fn refused(n: Nameplate, field: &str) -> String {
     let e = estimate(&n).expect_err("refused").to_string();
     assert!(e.starts_with(field), "{field}: {e}");
@@ -318,7 +319,7 @@ fn nameplates_no_induction_motor_can_have_are_refused_naming_the_option() {
                 efficiency: eta,
                 ..good()
             },
-            "--efficiency",
+            "efficiency",
         );
     }
     for pf in [1.3, 1.0, 0.0, f64::INFINITY] {
@@ -327,7 +328,7 @@ fn nameplates_no_induction_motor_can_have_are_refused_naming_the_option() {
                 power_factor: pf,
                 ..good()
             },
-            "--power-factor",
+            "power_factor",
         );
     }
     // At and above synchronous speed (1500 rpm for 4 poles at 50 Hz), and above a 2-pole
@@ -339,7 +340,7 @@ fn nameplates_no_induction_motor_can_have_are_refused_naming_the_option() {
                 poles: Some(4),
                 ..good()
             },
-            "--speed-rpm",
+            "speed_rpm",
         );
         assert!(e.contains("synchronous"), "{e}");
     }
@@ -348,7 +349,7 @@ fn nameplates_no_induction_motor_can_have_are_refused_naming_the_option() {
             speed_rpm: 3100.0,
             ..good()
         },
-        "--speed-rpm",
+        "speed_rpm",
     );
     // 1000 rpm at 50 Hz: 6 poles would be synchronous, 4 poles a slip of 33 %.
     let e = refused(
@@ -356,15 +357,15 @@ fn nameplates_no_induction_motor_can_have_are_refused_naming_the_option() {
             speed_rpm: 1000.0,
             ..good()
         },
-        "--speed-rpm",
+        "speed_rpm",
     );
-    assert!(e.contains("--poles"), "{e}");
+    assert!(e.ends_with("give poles"), "{e}");
     refused(
         Nameplate {
             poles: Some(5),
             ..good()
         },
-        "--poles",
+        "poles",
     );
     // 10 rpm at 50 Hz would be a 598-pole machine.
     refused(
@@ -372,32 +373,32 @@ fn nameplates_no_induction_motor_can_have_are_refused_naming_the_option() {
             speed_rpm: 10.0,
             ..good()
         },
-        "--speed-rpm",
+        "speed_rpm",
     );
     for (field, n) in [
         (
-            "--power-kw",
+            "power_kw",
             Nameplate {
                 power_kw: -2.2,
                 ..good()
             },
         ),
         (
-            "--current-a",
+            "current_a",
             Nameplate {
                 current_a: f64::NAN,
                 ..good()
             },
         ),
         (
-            "--voltage-v",
+            "voltage_v",
             Nameplate {
                 voltage_v: 0.0,
                 ..good()
             },
         ),
         (
-            "--frequency-hz",
+            "frequency_hz",
             Nameplate {
                 frequency_hz: 5000.0,
                 ..good()
@@ -413,9 +414,9 @@ fn nameplates_no_induction_motor_can_have_are_refused_naming_the_option() {
             power_kw: 22.0,
             ..good()
         },
-        "--power-kw",
+        "power_kw",
     );
-    assert!(e.contains("--current-a") && e.contains("ratio"), "{e}");
+    assert!(e.contains("current_a") && e.contains("ratio"), "{e}");
     // An efficiency the slip forbids: the rotor copper loss alone is slip x air-gap power.
     let n = good();
     let slip = 1.0 - n.speed_rpm / 1500.0;
@@ -425,7 +426,7 @@ fn nameplates_no_induction_motor_can_have_are_refused_naming_the_option() {
             power_factor: n.power_factor * n.efficiency / (1.005 - slip),
             ..n
         },
-        "--efficiency",
+        "efficiency",
     );
     assert!(e.contains("slip"), "{e}");
 }

@@ -52,7 +52,7 @@ fn the_board_and_the_host_show_the_same_state_for_the_same_log() {
     let rows = simulate_to_vec(&params, &scenario).expect("simulation"); // ok: test
     let opts = ReplayOptions {
         commission: Some((1.5, learned_until)),
-        timeline_step_s: 0.05,
+        timeline_step: monitor_replay::TimelineStep::of(0.05),
         ..ReplayOptions::default()
     };
     let host = diagnose_rows(&params, scenario.sensors.channels(), &rows, opts).expect("replay"); // ok: test

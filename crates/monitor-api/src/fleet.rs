@@ -11,7 +11,7 @@
 //! params = "params/pump_7.toml"    # the motor's parameter file ([columns] included)
 //! logs = "pump_7_*"                # which logs are this motor's: a pattern on the file name
 //! commission = [2.0, 4.0]          # optional: --commission START:END
-//! baseline = ["healthy/pump_7"]    # optional: healthy logs or folders (--baseline)
+//! baseline = ["healthy/pump_7"]    # optional: healthy logs or folders (a request's baseline)
 //! load = "unknown"                 # optional: "unknown" (default) or "viscous"
 //! ```
 //!
@@ -19,7 +19,7 @@
 //! one character).
 
 use crate::{diagnose, ApiError, DiagnoseRequest, LogSource, ParamsSource};
-use monitor_replay::{DiagnoseReport, IsolationEvent, LoadModel};
+use monitor_replay::{DiagnoseReport, IsolationEvent, LoadModel, ReplayOptions};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -124,14 +124,10 @@ impl MotorTable {
             return Err(bad("no [[motor]] in it".into()));
         }
         for m in &mut t.motor {
-            if let Some([a, b]) = m.commission {
-                if !(b > a && a >= 0.0) {
-                    return Err(bad(format!(
-                        "motor {}: commission = [{a}, {b}] is not [START, END] with 0 <= START < END",
-                        m.name
-                    )));
-                }
-            }
+            // The one check of a request, as every front end's.
+            request(m)
+                .validate()
+                .map_err(|e| bad(format!("motor {}: {e}", m.name)))?;
             m.params = from_base(base, &m.params);
             m.baseline = m.baseline.iter().map(|p| from_base(base, p)).collect();
         }
@@ -350,10 +346,13 @@ pub fn row_and_report(table: &MotorTable, log: &Path) -> (FleetRow, Option<serde
 /// The diagnosis request of motor `m`'s logs.
 fn request(m: &MotorEntry) -> DiagnoseRequest {
     DiagnoseRequest {
-        commission: m.commission.map(|[a, b]| (a, b)),
+        options: ReplayOptions {
+            commission: m.commission.map(|[a, b]| (a, b)),
+            load: m.load.map_or(LoadModel::Unknown, MotorLoad::model),
+            ..ReplayOptions::default()
+        },
         baseline: m.baseline.iter().map(LogSource::from).collect(),
-        load: m.load.map_or(LoadModel::Unknown, MotorLoad::model),
-        ..DiagnoseRequest::default()
+        group: None,
     }
 }
 

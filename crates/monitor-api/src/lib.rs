@@ -3,86 +3,34 @@
 //! prints. The command line and the Python package (`python/`) both call these, so a
 //! document is the same whoever asked for it.
 //!
-//! Errors are [`ApiError`]s whose `Display` is the command line's one-line message; their
-//! kind ([`ApiError::kind`]) says which: a bad parameter file, a bad log, a bad option, or
-//! an analysis that cannot run on this log.
+//! Errors are [`ApiError`]s, one line each, naming the option or field they are about in
+//! the library's words (`commission`, `params`); a front end says them in its own
+//! ([`ApiError::spelled`]). Their kind ([`ApiError::kind`]) says which: a bad parameter
+//! file, a bad log, a bad option, or an analysis that cannot run on this log.
 
 use monitor_analysis::prep::ReadOptions;
-use monitor_analysis::{Analysis, AnalysisError, Options};
-use monitor_core::{AngleSource, EffectKind, ResidualForm};
+use monitor_analysis::{Analysis, Options};
+use monitor_core::EffectKind;
 use monitor_io::log::mapping::ColumnMapping;
-use monitor_io::log::{LogError, OpenOptions};
+use monitor_io::log::OpenOptions;
 use monitor_io::params::{ParamError, ParamFile};
 use monitor_replay::{
-    diagnose_log, HealthyReference, LoadModel, ReplayError, ReplayOptions, TurnLevelOptions,
+    diagnose_log, HealthyReference, OptionError, OptionField, ReplayError, ReplayOptions,
     UnbalanceBaseline,
 };
 use std::path::{Path, PathBuf};
 
+mod error;
 mod explain_doc;
 pub mod fleet;
 mod log_source;
 mod turn_calibration;
+pub use error::{ApiError, ErrorKind};
 pub use explain_doc::{
     beside_verdict, explain, ladder, mcsa_beside, verdict_for_explain, ExplainDocument,
 };
 pub use log_source::LogSource;
 pub use turn_calibration::{learn_turn_calibration, Labelled, Learned};
-
-/// A failed call: the command line's one-line message, and its kind.
-#[derive(Debug, thiserror::Error)]
-pub enum ApiError {
-    /// The parameter file cannot be read, or is not one.
-    #[error(transparent)]
-    Params(#[from] ParamError),
-    /// The log cannot be read, or is not one.
-    #[error(transparent)]
-    Log(#[from] LogError),
-    /// An option is wrong (a window, a baseline, a name).
-    #[error("{0}")]
-    Option(String),
-    /// The replay could not run (its configuration, an incomplete commissioning).
-    #[error(transparent)]
-    Replay(#[from] ReplayError),
-    /// The analysis could not run on this log.
-    #[error(transparent)]
-    Analysis(#[from] AnalysisError),
-    /// The parameter file given is a log (or the log a parameter file): the arguments look
-    /// swapped.
-    #[error("--params {params} is a log, not a parameter file{also}: the arguments look swapped (give --params P.toml LOG)")]
-    Swapped {
-        /// The path given as the parameter file.
-        params: String,
-        /// ", and LOG a parameter file" when the log given is a `.toml`, else empty.
-        also: String,
-    },
-}
-
-/// The kinds of [`ApiError`] (the Python package's exception classes).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ErrorKind {
-    /// [`ApiError::Params`].
-    Params,
-    /// [`ApiError::Log`].
-    Log,
-    /// [`ApiError::Option`].
-    Option,
-    /// [`ApiError::Replay`] and [`ApiError::Analysis`].
-    Analysis,
-}
-
-impl ApiError {
-    /// Which kind of error this is.
-    pub fn kind(&self) -> ErrorKind {
-        match self {
-            ApiError::Params(_) | ApiError::Swapped { .. } => ErrorKind::Params,
-            ApiError::Log(_) | ApiError::Replay(ReplayError::Log(_)) => ErrorKind::Log,
-            ApiError::Analysis(AnalysisError::Log(_)) => ErrorKind::Log,
-            ApiError::Option(_) | ApiError::Replay(ReplayError::Option(_)) => ErrorKind::Option,
-            ApiError::Replay(_) | ApiError::Analysis(_) => ErrorKind::Analysis,
-        }
-    }
-}
 
 /// A parameter file: its path, its TOML text, or its values already read (so that a
 /// command that makes several calls reads the file once).
@@ -158,9 +106,7 @@ fn params_text(source: ParamsSource<'_>, log: &LogSource) -> Result<(String, Str
             p.display().to_string(),
         )),
         ParamsSource::Toml { text, origin } => Ok((text.to_string(), origin.to_string())),
-        ParamsSource::Read { .. } => Err(ApiError::Option(
-            "identify writes the parameter file it was given with the identified values: give its path or its TOML text".into(),
-        )),
+        ParamsSource::Read { .. } => Err(ApiError::ParamsTextNeeded),
     }
 }
 
@@ -189,69 +135,39 @@ fn swapped(source: ParamsSource<'_>, log: &LogSource) -> Option<ApiError> {
     })
 }
 
-/// What `diagnose` is asked (its command-line options).
-#[derive(Debug, Clone)]
+/// What `diagnose` is asked: the replay's options and the few fields of a request alone.
+/// Every default is [`ReplayOptions`]'s (no baseline, no TDMS group); every front end (the
+/// command line, Python, the HMI, the fleet) checks a request with
+/// [`DiagnoseRequest::validate`] ([`diagnose`] does too).
+#[derive(Debug, Clone, Default)]
 pub struct DiagnoseRequest {
-    /// `--commission START:END` [s].
-    pub commission: Option<(f64, f64)>,
-    /// `--allow-incomplete`.
-    pub allow_incomplete: bool,
-    /// `--baseline`: healthy logs of the same motor (files, folders of them, or data).
+    /// The replay's options (the healthy reference, `unbalance_baseline`, is filled from
+    /// `baseline` by [`diagnose`]).
+    pub options: ReplayOptions,
+    /// Healthy logs of the same motor (files, folders of them, or data; the field
+    /// `baseline`).
     pub baseline: Vec<LogSource>,
-    /// `--load`.
-    pub load: LoadModel,
-    /// `--angle`.
-    pub angle_source: AngleSource,
-    /// `--residuals`.
-    pub residual_form: ResidualForm,
-    /// `--timeline-step` [s].
-    pub timeline_step_s: f64,
-    /// `--group` (TDMS).
+    /// The TDMS group holding the channels (the field `group`).
     pub group: Option<String>,
-    /// `--parallel-paths` and `--turn-calibration`: how the shorted-turn level is sized.
-    pub turn_level: TurnLevelOptions,
-}
-
-/// Every default is [`ReplayOptions`]'s (no baseline, no TDMS group).
-impl Default for DiagnoseRequest {
-    fn default() -> Self {
-        let r = ReplayOptions::default();
-        DiagnoseRequest {
-            commission: r.commission,
-            allow_incomplete: r.allow_incomplete,
-            baseline: Vec::new(),
-            load: r.load,
-            angle_source: r.angle_source,
-            residual_form: r.residual_form,
-            timeline_step_s: r.timeline_step_s,
-            group: None,
-            turn_level: r.turn_level,
-        }
-    }
 }
 
 impl DiagnoseRequest {
-    /// The replay's options for this request (the healthy reference is filled from
-    /// `baseline` by [`diagnose`]).
-    pub fn replay_options(&self) -> ReplayOptions {
-        ReplayOptions {
-            angle_source: self.angle_source,
-            residual_form: self.residual_form,
-            commission: self.commission,
-            allow_incomplete: self.allow_incomplete,
-            timeline_step_s: self.timeline_step_s.max(1e-4),
-            unbalance_baseline: None,
-            load: self.load,
-            turn_level: self.turn_level,
-        }
+    /// The one check of a request, the same for every front end: the options as
+    /// [`ReplayOptions::validate`] checks them.
+    ///
+    /// # Errors
+    /// [`ApiError::Option`] naming the field (`commission`, `parallel_paths`).
+    pub fn validate(&self) -> Result<(), ApiError> {
+        Ok(self.options.validate()?)
     }
 }
 
-/// The logs of `--baseline`: each file and each data as given, each folder's log files
+/// The logs of a request's `baseline`: each file and each data as given, each folder's log files
 /// (CSV, TDMS, Parquet, by extension) in name order.
 ///
 /// # Errors
-/// [`ApiError::Option`] for a folder without logs, or one that cannot be read.
+/// [`ApiError::Option`] naming `baseline` for a folder without logs, or one that cannot be
+/// read.
 pub fn baseline_files(given: &[LogSource]) -> Result<Vec<LogSource>, ApiError> {
     let mut files = Vec::new();
     for g in given {
@@ -260,7 +176,7 @@ pub fn baseline_files(given: &[LogSource]) -> Result<Vec<LogSource>, ApiError> {
             continue;
         };
         let mut in_dir: Vec<PathBuf> = std::fs::read_dir(p)
-            .map_err(|e| ApiError::Option(format!("--baseline {}: {e}", p.display())))?
+            .map_err(|e| baseline_error(&p.display().to_string(), e))?
             .filter_map(|e| e.ok().map(|e| e.path()))
             .filter(|f| {
                 f.is_file()
@@ -270,15 +186,20 @@ pub fn baseline_files(given: &[LogSource]) -> Result<Vec<LogSource>, ApiError> {
             })
             .collect();
         if in_dir.is_empty() {
-            return Err(ApiError::Option(format!(
-                "--baseline {}: the folder holds no log (.csv, .tdms or .parquet)",
-                p.display()
-            )));
+            return Err(baseline_error(
+                &p.display().to_string(),
+                "the folder holds no log (.csv, .tdms or .parquet)",
+            ));
         }
         in_dir.sort();
         files.extend(in_dir.into_iter().map(LogSource::File));
     }
     Ok(files)
+}
+
+/// A refused `baseline` (`shown`, or empty for the field alone).
+fn baseline_error(shown: &str, why: impl ToString) -> ApiError {
+    OptionError::new(OptionField::Baseline, shown, why.to_string()).into()
 }
 
 /// True when `a` and `b` name the same file (or are the same data).
@@ -302,20 +223,18 @@ fn baseline_of(
     open: &OpenOptions,
     opts: ReplayOptions,
 ) -> Result<UnbalanceBaseline, ApiError> {
-    let file = path
-        .open(open)
-        .map_err(|e| ApiError::Option(format!("--baseline: {e}")))?;
+    let file = path.open(open).map_err(|e| baseline_error("", e))?;
     let opts = ReplayOptions {
         commission: None,
         ..opts
     };
     let d = diagnose_log(params, &file, opts, &mut |_| {})
-        .map_err(|e| ApiError::Option(format!("--baseline {}: {e}", path.shown())))?;
+        .map_err(|e| baseline_error(&path.shown(), e))?;
     if d.report.unbalance.measured.i2_over_i1 == [0.0, 0.0] {
-        return Err(ApiError::Option(format!(
-            "--baseline {}: no positive-sequence current in that log (the motor never ran)",
-            path.shown()
-        )));
+        return Err(baseline_error(
+            &path.shown(),
+            "no positive-sequence current in that log (the motor never ran)",
+        ));
     }
     Ok(d.report.unbalance.measured)
 }
@@ -337,14 +256,15 @@ pub fn diagnose(
         group: req.group.clone(),
         columns,
     };
-    let mut opts = req.replay_options();
+    req.validate()?;
+    let mut opts = req.options;
     if !req.baseline.is_empty() {
         let files = baseline_files(&req.baseline)?;
         if let Some(same) = files.iter().find(|f| same_file(f, log)) {
-            return Err(ApiError::Option(format!(
-                "--baseline {}: that is the log being judged; give healthy logs of the same motor",
-                same.shown()
-            )));
+            return Err(baseline_error(
+                &same.shown(),
+                "that is the log being judged; give healthy logs of the same motor",
+            ));
         }
         let runs = files
             .iter()
@@ -355,7 +275,10 @@ pub fn diagnose(
     let file = log.open(&open)?;
     diagnose_log(&params, &file, opts, progress).map_err(|e| match e {
         // Log errors name the file already; the monitor's configuration does not.
-        ReplayError::Config { .. } => ApiError::Option(format!("{}: {e}", log.shown())),
+        e @ ReplayError::Config { .. } => ApiError::Config {
+            log: log.shown(),
+            source: e,
+        },
         e => e.into(),
     })
 }
@@ -384,7 +307,7 @@ pub const MIN_ANALYSED_PERIODS: f64 = 25.0;
 /// Reads the log for `compare`/`explain` and checks its analysed window.
 ///
 /// # Errors
-/// A bad parameter file or log; [`ApiError::Option`] for a window under
+/// A bad parameter file or log; [`ApiError::ShortWindow`] for a window under
 /// [`MIN_ANALYSED_PERIODS`] supply periods.
 pub fn load_analysis(
     params: ParamsSource<'_>,
@@ -409,13 +332,12 @@ pub fn load_analysis(
     };
     let least = MIN_ANALYSED_PERIODS / a.params.supply.f_hz;
     if span.is_nan() || span < least {
-        return Err(ApiError::Option(format!(
-            "{}: the analysed window is {:.3} s ({:.1} supply periods): at least {:.2} s ({MIN_ANALYSED_PERIODS:.0} periods) are needed to judge the model (widen --from/--to)",
-            log.shown(),
-            span,
-            span * a.params.supply.f_hz,
-            least
-        )));
+        return Err(ApiError::ShortWindow {
+            log: log.shown(),
+            span_s: span,
+            f_hz: a.params.supply.f_hz,
+            least_s: least,
+        });
     }
     Ok(a)
 }
@@ -458,7 +380,7 @@ pub struct Identified {
 /// ([`monitor_analysis::identify::refusal`]).
 ///
 /// # Errors
-/// A bad parameter file or log; [`ApiError::Option`] for a window that ends before it
+/// A bad parameter file or log; [`ApiError::WindowOrder`] for a window that ends before it
 /// starts, a log the model cannot be driven by, or a refused identification.
 pub fn identify(
     params: ParamsSource<'_>,
@@ -471,9 +393,7 @@ pub fn identify(
     let log = &log.into();
     if let (Some(a), Some(b)) = (from_s, to_s) {
         if b <= a {
-            return Err(ApiError::Option(format!(
-                "--to ({b}) must be after --from ({a})"
-            )));
+            return Err(ApiError::WindowOrder { from_s: a, to_s: b });
         }
     }
     // The file is read once: its text is the identified file's template.
@@ -492,16 +412,17 @@ pub fn identify(
         from_s.unwrap_or(f64::NEG_INFINITY),
         to_s.unwrap_or(f64::INFINITY),
     )
-    .map_err(|e| ApiError::Option(format!("cannot identify from {}: {e}", log.shown())))?;
+    .map_err(|e| cannot_identify(log, e))?;
     drop(rows);
     let id =
         monitor_analysis::identify::identify(&start, &samples, &mut |f| progress(0.1 + 0.9 * f))
-            .map_err(|e| ApiError::Option(format!("cannot identify from {}: {e}", log.shown())))?;
+            .map_err(|e| cannot_identify(log, e))?;
     if let Some(why) = monitor_analysis::identify::refusal(&start, &samples, &id) {
-        return Err(ApiError::Option(format!(
-            "identify {}: {why}; no parameter file written",
-            log.shown()
-        )));
+        return Err(ApiError::Identify {
+            what: "identify",
+            log: log.shown(),
+            why: format!("{why}; no parameter file written"),
+        });
     }
     let toml = monitor_analysis::identify::to_toml(&id, &start_text, &start_name, &log.shown());
     Ok(Identified {
@@ -510,23 +431,36 @@ pub fn identify(
     })
 }
 
+/// [`ApiError::Identify`]: the identification cannot run on `log`.
+fn cannot_identify(log: &LogSource, why: impl ToString) -> ApiError {
+    ApiError::Identify {
+        what: "cannot identify from",
+        log: log.shown(),
+        why: why.to_string(),
+    }
+}
+
 /// `params from-nameplate`: the estimate and its parameter file's text, with the
 /// `[columns]` table of `columns_from` carried over (`--columns-from`).
 ///
 /// # Errors
-/// [`ApiError::Option`] for a refused nameplate (naming the field); a bad `columns_from`.
+/// [`ApiError::Nameplate`] for a refused nameplate (naming the field); [`ApiError::Option`]
+/// naming `columns_from` for a bad `[columns]` there.
 pub fn params_from_nameplate(
     n: &monitor_io::nameplate::Nameplate,
     columns_from: Option<&Path>,
 ) -> Result<(monitor_io::nameplate::NameplateEstimate, String), ApiError> {
-    let estimate =
-        monitor_io::nameplate::estimate(n).map_err(|e| ApiError::Option(e.to_string()))?;
+    let estimate = monitor_io::nameplate::estimate(n)?;
     let mut toml = estimate.to_toml();
     if let Some(from) = columns_from {
         let table = monitor_io::params::load_columns_table(from)?;
         // Checked as every command that reads a log checks it.
         ColumnMapping::from_table(&table, estimate.poles / 2).map_err(|m| {
-            ApiError::Option(format!("--columns-from {}: [columns] {m}", from.display()))
+            OptionError::new(
+                OptionField::ColumnsFrom,
+                from.display().to_string(),
+                format!("[columns] {m}"),
+            )
         })?;
         toml.push_str(&format!(
             "\n# The log's channels and units, from {}.\n[columns]\n{}",
@@ -558,15 +492,15 @@ pub fn nameplate_document(
 /// text; the run's summary. The log is written whole or not at all.
 ///
 /// # Errors
-/// A bad parameter file or scenario ([`ApiError::Option`] naming the key), or a write error.
+/// A bad parameter file or scenario ([`ApiError::Simulation`] naming the key), a write
+/// error, [`ApiError::Interrupted`].
 pub fn simulate_to_file(
     params: ParamsSource<'_>,
     scenario_toml: &str,
     out: &Path,
 ) -> Result<monitor_sim::SimSummary, ApiError> {
     let (params, _) = load_params(params)?;
-    let sc = monitor_sim::Scenario::from_toml_str(scenario_toml, "the scenario")
-        .map_err(|e| ApiError::Option(e.to_string()))?;
+    let sc = monitor_sim::Scenario::from_toml_str(scenario_toml, "the scenario")?;
     let mut w = monitor_io::log::LogWriter::create(out, sc.sensors.channels())?;
     let mut err = None;
     let summary = monitor_sim::simulate_while(&params, &sc, |r| match w.write_row(r) {
@@ -575,11 +509,10 @@ pub fn simulate_to_file(
             err = Some(e);
             std::ops::ControlFlow::Break(())
         }
-    })
-    .map_err(|e| ApiError::Option(e.to_string()))?;
+    })?;
     if let Some(e) = err {
         return Err(e.into());
     }
     w.finish()?;
-    summary.ok_or_else(|| ApiError::Option("the simulation was interrupted".to_string()))
+    summary.ok_or(ApiError::Interrupted)
 }

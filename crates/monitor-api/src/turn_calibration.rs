@@ -42,11 +42,11 @@ pub fn learn_turn_calibration(
     req: &DiagnoseRequest,
 ) -> Result<Learned, ApiError> {
     let mut req = req.clone();
-    req.turn_level.calibration = None;
+    req.options.turn_level.calibration = None;
     let (mut runs, mut used, mut left_out) = (Vec::new(), Vec::new(), Vec::new());
     for l in labelled {
         if !(l.fraction > 0.0 && l.fraction <= 1.0) {
-            return Err(ApiError::Option(format!(
+            return Err(ApiError::Labels(format!(
                 "{}: a shorted fraction of {} is outside 0..100 %",
                 l.log.shown(),
                 l.fraction
@@ -72,7 +72,7 @@ pub fn learn_turn_calibration(
         }
     }
     let calibration = TurnCalibration::learn(&runs).ok_or_else(|| {
-        ApiError::Option("no labelled run named its phase: nothing to learn".to_string())
+        ApiError::Labels("no labelled run named its phase: nothing to learn".to_string())
     })?;
     Ok(Learned {
         calibration,

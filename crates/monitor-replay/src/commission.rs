@@ -357,19 +357,24 @@ impl CommissionTracker {
         !self.cancelled && self.ended_at.is_some() && self.learned.0 >= self.learned.1
     }
 
-    /// Why the window is incomplete, in one line (for the error and the report).
+    /// Why the window is incomplete, in one line (for the report; the error says it
+    /// with [`CommissionTracker::not_learned`]).
     pub(super) fn why_incomplete(&self) -> Option<String> {
+        let (window, why) = self.not_learned()?;
+        Some(format!("--commission {window}: {why}"))
+    }
+
+    /// The window asked for (`START:END`) and why it was not learned, where it was not.
+    pub(super) fn not_learned(&self) -> Option<(String, String)> {
         let (a, b) = self.requested?;
         if self.learned_ok() {
             return None;
         }
         let end = self.last_t;
-        Some(match self.started_at {
-            None => format!(
-                "--commission {a}:{b}: the log ends at {end:.2} s, before the window starts"
-            ),
+        let why = match self.started_at {
+            None => format!("the log ends at {end:.2} s, before the window starts"),
             Some(_) => format!(
-                "--commission {a}:{b}: learned {:.2} s of evaluated running by {:.2} s, {:.2} s at least needed ({}); the lamps were off while learning",
+                "learned {:.2} s of evaluated running by {:.2} s, {:.2} s at least needed ({}); the lamps were off while learning",
                 self.seconds(self.learned.0),
                 self.ended_at.unwrap_or(end),
                 min_learned_s(a, b),
@@ -379,7 +384,8 @@ impl CommissionTracker {
                     "the log ended first"
                 }
             ),
-        })
+        };
+        Some((format!("{a}:{b}"), why))
     }
 
     fn seconds(&self, blocks: u32) -> f64 {

@@ -184,10 +184,12 @@ fn conclude(
     read?;
     let mut quality = quality?;
     let Some(replay) = replay else {
-        return Err(ReplayError::Option(format!("{shown}: no rows to replay")));
+        return Err(ReplayError::NoRows {
+            log: shown.to_string(),
+        });
     };
     if replay.commissioning_incomplete() && !opts.allow_incomplete {
-        let mut why = replay.commission.why_incomplete().unwrap_or_default();
+        let (window, mut why) = replay.commission.not_learned().unwrap_or_default();
         // What the data-quality stage distrusts is often why nothing was learned (swapped
         // channels, a dead sensor): say it in the same line.
         if !quality.trusted {
@@ -196,7 +198,7 @@ fn conclude(
                 quality.not_trusted_because.join("; ")
             );
         }
-        return Err(ReplayError::IncompleteCommissioning { why });
+        return Err(ReplayError::IncompleteCommissioning { window, why });
     }
     let can_residuals = replay.monitor.is_some();
     let sensors = replay.output().sensor_fault;

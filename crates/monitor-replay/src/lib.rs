@@ -55,7 +55,10 @@ pub use isolation::{
     state_name, DetectionLimit, FaultCandidate, IsolationBaseline, IsolationGroup, IsolationName,
     IsolationReport, NameGiven, SensorPhaseReport, NOMINAL_UNCERTAINTY,
 };
-pub use options::{monitor_config_for_log, LoadModel, ReplayOptions};
+pub use options::{
+    check_parallel_paths, monitor_config_for_log, CommissionWindow, FieldNames, LoadModel,
+    OptionError, OptionField, ReplayOptions, Spelling, TimelineStep, PARALLEL_PATHS,
+};
 pub use report::{
     BaselineSource, Detection, DiagnoseReport, MonitorState, Panel, TimelinePoint, UnbalanceReport,
 };
@@ -84,7 +87,6 @@ use isolation::IsolationTracker;
 use monitor_core::{AngleSource, ConfigError, Isolator, Monitor, MonitorOutput};
 use monitor_io::log::{Channels, LogError, Row};
 use monitor_io::params::ParamFile;
-use options::check_commission_window;
 use sampler::sample_of;
 use serde::Serialize;
 use step::{
@@ -130,18 +132,41 @@ pub enum ReplayError {
         /// The log's sample rate.
         sample_rate_hz: f64,
     },
-    /// A bad option.
-    #[error("{0}")]
-    Option(String),
-    /// The commissioning window was not learned (and `--allow-incomplete` was not given).
-    #[error("{why}: give a window inside the log's healthy running, or --allow-incomplete to report with the fixed thresholds")]
+    /// An option the replay does not take, naming its field.
+    #[error(transparent)]
+    Option(#[from] OptionError),
+    /// The log holds no row to replay.
+    #[error("{log}: no rows to replay")]
+    NoRows {
+        /// How messages name the log.
+        log: String,
+    },
+    /// The commissioning window was not learned (and `allow_incomplete` was not asked).
+    #[error("{}", self.spelled(&FieldNames))]
     IncompleteCommissioning {
+        /// The window asked for (`START:END`).
+        window: String,
         /// What happened.
         why: String,
     },
     /// Reading the log failed.
     #[error(transparent)]
     Log(#[from] LogError),
+}
+
+impl ReplayError {
+    /// The message in a front end's words (`spell` names the options it refers to).
+    pub fn spelled(&self, spell: &dyn Spelling) -> String {
+        match self {
+            ReplayError::Option(e) => e.spelled(spell),
+            ReplayError::IncompleteCommissioning { window, why } => format!(
+                "{}: {why}: give a window inside the log's healthy running, or {} to report with the fixed thresholds",
+                spell.option(OptionField::Commission, window),
+                spell.option(OptionField::AllowIncomplete, "")
+            ),
+            e => e.to_string(),
+        }
+    }
 }
 
 /// The healthy machine's negative sequence, relative to its positive sequence: what a
@@ -256,15 +281,15 @@ impl Replay {
     ///
     /// # Errors
     /// [`ReplayError::Config`] when the core rejects the configuration (e.g. a sample rate
-    /// below 8x the supply frequency); [`ReplayError::Option`] for a commissioning window
-    /// that is not `0 <= START < END`, both finite.
+    /// below 8x the supply frequency); [`ReplayError::Option`] for options
+    /// [`ReplayOptions::validate`] refuses.
     pub fn new(
         params: &ParamFile,
         channels: Channels,
         sample_rate_hz: f64,
         opts: ReplayOptions,
     ) -> Result<Self, ReplayError> {
-        check_commission_window(opts.commission)?;
+        opts.validate()?;
         let cfg = monitor_config_for_log(params, sample_rate_hz, &opts);
         let config_error = |source| ReplayError::Config {
             source,
@@ -358,7 +383,7 @@ impl Replay {
         self.isolation.after(t, dt_s, usable, &point, tc);
         // The sample nearest each timeline step (half a sample early counts: the data-quality
         // stage's sample clock may put the sample at the step a hair before it).
-        let (dt_s, step_s) = (self.dt_s, self.opts.timeline_step_s);
+        let (dt_s, step_s) = (self.dt_s, self.opts.timeline_step.seconds());
         if timeline_step_due(&mut self.next_point, t, dt_s, step_s) {
             let point = timeline_point(self, t, out, self.view.range_note.clone());
             self.timeline.push(point);

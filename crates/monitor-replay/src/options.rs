@@ -1,9 +1,18 @@
-//! What a replay is asked to do ([`ReplayOptions`], [`LoadModel`]) and the monitor
-//! configuration it runs with ([`monitor_config_for_log`]).
+//! What a replay is asked to do ([`ReplayOptions`], [`LoadModel`]), the typed values a
+//! front end parses its words into, each parsed and checked in one place
+//! ([`CommissionWindow`], `START:END` seconds; [`TimelineStep`], positive by construction;
+//! [`PARALLEL_PATHS`]), the one check of them all ([`ReplayOptions::validate`]) and its
+//! error ([`OptionError`], naming the field, [`OptionField`], never a front end's spelling
+//! of it: the command line says it as its flags, Python as its keywords, [`Spelling`]),
+//! and the monitor configuration a replay runs with ([`monitor_config_for_log`]).
 
-use super::{HealthyReference, ReplayError, TICK_HZ};
+use super::{HealthyReference, TICK_HZ};
 use monitor_core::{AngleSource, MonitorConfig, ResidualForm};
 use monitor_io::params::ParamFile;
+use serde::Serialize;
+use std::fmt;
+use std::ops::RangeInclusive;
+use std::str::FromStr;
 
 /// Replay options.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -12,21 +21,22 @@ pub struct ReplayOptions {
     pub angle_source: AngleSource,
     /// Residual form for the lamps.
     pub residual_form: ResidualForm,
-    /// Commissioning window [start, end) in log seconds; None = fixed thresholds.
+    /// Commissioning window [start, end) in log seconds; None = fixed thresholds. Checked
+    /// by [`ReplayOptions::validate`] as [`CommissionWindow::new`] checks it.
     pub commission: Option<(f64, f64)>,
     /// Report a commissioning window that was not learned instead of refusing.
     pub allow_incomplete: bool,
-    /// Timeline resolution [s] (one point per interval; default 0.5 s, the one default of
-    /// `diagnose --timeline-step`, the API and Python).
-    pub timeline_step_s: f64,
-    /// The healthy machine's negative sequence to judge the winding against (`diagnose
-    /// --baseline HEALTHY.csv`); without it, the one learned in the commissioning window,
-    /// else none ([`super::UnbalanceBaseline`]).
+    /// Timeline resolution (one point per interval; default 0.5 s, the one default of
+    /// the command line, the API and Python).
+    pub timeline_step: TimelineStep,
+    /// The healthy machine's negative sequence to judge the winding against (the field
+    /// `baseline` of a request: healthy logs); without it, the one learned in the
+    /// commissioning window, else none ([`super::UnbalanceBaseline`]).
     pub unbalance_baseline: Option<HealthyReference>,
-    /// What is known of the load ([`LoadModel`]; `diagnose --load`).
+    /// What is known of the load ([`LoadModel`]; the field `load`).
     pub load: LoadModel,
-    /// How the shorted-turn level is sized (`diagnose --parallel-paths`,
-    /// `--turn-calibration`; [`super::winding::level`]).
+    /// How the shorted-turn level is sized (the fields `parallel_paths`, 1..=8 as
+    /// [`PARALLEL_PATHS`] says, and `turn_calibration`; [`super::winding::level`]).
     pub turn_level: super::TurnLevelOptions,
 }
 
@@ -60,7 +70,7 @@ impl Default for ReplayOptions {
             residual_form: ResidualForm::Steady,
             commission: None,
             allow_incomplete: false,
-            timeline_step_s: 0.5,
+            timeline_step: TimelineStep::DEFAULT,
             unbalance_baseline: None,
             load: LoadModel::Unknown,
             turn_level: super::TurnLevelOptions::default(),
@@ -94,16 +104,304 @@ pub fn monitor_config_for_log(
     cfg
 }
 
-/// Checks a commissioning window asked for: `0 <= START < END`, both finite.
-pub(super) fn check_commission_window(window: Option<(f64, f64)>) -> Result<(), ReplayError> {
-    if let Some((a, b)) = window {
-        if !(b > a && a >= 0.0 && b.is_finite()) {
-            return Err(ReplayError::Option(format!(
-                "--commission {a}:{b}: the window must be START:END with 0 <= START < END, both finite (seconds)"
-            )));
+impl ReplayOptions {
+    /// The one check of the options every front end calls (the command line, Python, the
+    /// HMI, the fleet; [`super::Replay::new`] too): the commissioning window as
+    /// [`CommissionWindow::new`] checks it, `parallel_paths` in [`PARALLEL_PATHS`] (the
+    /// time step is positive by construction, [`TimelineStep`]).
+    ///
+    /// # Errors
+    /// [`OptionError`] naming the field (`commission`, `parallel_paths`).
+    pub fn validate(&self) -> Result<(), OptionError> {
+        if let Some((a, b)) = self.commission {
+            CommissionWindow::new(a, b)?;
+        }
+        check_parallel_paths(i64::from(self.turn_level.parallel_paths))?;
+        Ok(())
+    }
+}
+
+/// The parallel paths per phase a winding may have (the field `parallel_paths`): 1 for a
+/// series star or delta, 2 for a double star, at most 8.
+pub const PARALLEL_PATHS: RangeInclusive<u8> = 1..=8;
+
+/// An option or a request's field, by the name the library gives it (the Python keyword
+/// and the fleet table's key where they have one).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum OptionField {
+    /// The parameter file (`params`).
+    Params,
+    /// The commissioning window (`commission`, [`CommissionWindow`]).
+    Commission,
+    /// Report an incomplete commissioning (`allow_incomplete`).
+    AllowIncomplete,
+    /// The timeline's step (`timeline_step`, [`TimelineStep`]).
+    TimelineStep,
+    /// The winding's parallel paths (`parallel_paths`, [`PARALLEL_PATHS`]).
+    ParallelPaths,
+    /// A calibration of the shorted-turn level (`turn_calibration`).
+    TurnCalibration,
+    /// Healthy logs of the same motor (`baseline`).
+    Baseline,
+    /// What is known of the load (`load`).
+    Load,
+    /// The TDMS group (`group`).
+    Group,
+    /// The analysed window's start (`from_s`).
+    From,
+    /// The analysed window's end (`to_s`).
+    To,
+    /// Effects already in the model (`effects`).
+    Effects,
+    /// The parameter file whose `[columns]` a nameplate estimate carries (`columns_from`).
+    ColumnsFrom,
+}
+
+impl OptionField {
+    /// The field's name (`commission`, `timeline_step`, ...).
+    pub const fn name(self) -> &'static str {
+        match self {
+            OptionField::Params => "params",
+            OptionField::Commission => "commission",
+            OptionField::AllowIncomplete => "allow_incomplete",
+            OptionField::TimelineStep => "timeline_step",
+            OptionField::ParallelPaths => "parallel_paths",
+            OptionField::TurnCalibration => "turn_calibration",
+            OptionField::Baseline => "baseline",
+            OptionField::Load => "load",
+            OptionField::Group => "group",
+            OptionField::From => "from_s",
+            OptionField::To => "to_s",
+            OptionField::Effects => "effects",
+            OptionField::ColumnsFrom => "columns_from",
         }
     }
-    Ok(())
+}
+
+impl fmt::Display for OptionField {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// How a front end names a field given a value, so that its messages speak its words.
+pub trait Spelling {
+    /// `field` given `value` (empty: the field alone, as in a hint) in the front end's
+    /// words.
+    fn option(&self, field: OptionField, value: &str) -> String;
+
+    /// Any other field a message names by its name (a nameplate's `speed_rpm`), in the
+    /// front end's words; the library's own name unless a front end says otherwise.
+    fn key(&self, name: &str) -> String {
+        name.to_string()
+    }
+}
+
+/// The library's own words: `commission = 4:2` (a fleet table's), the field alone
+/// without a value; what the errors' `Display` says.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FieldNames;
+
+impl Spelling for FieldNames {
+    fn option(&self, field: OptionField, value: &str) -> String {
+        if value.is_empty() {
+            field.name().to_string()
+        } else {
+            format!("{} = {value}", field.name())
+        }
+    }
+}
+
+/// A value an option does not take: the field, the value as given, and why.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{}: {why}", FieldNames.option(*field, value))]
+pub struct OptionError {
+    /// The option.
+    pub field: OptionField,
+    /// The value as given (empty where the field alone is meant).
+    pub value: String,
+    /// What is wrong, and what to give instead.
+    pub why: String,
+}
+
+impl OptionError {
+    /// `field` refused `value` because of `why`.
+    pub fn new(field: OptionField, value: impl Into<String>, why: impl Into<String>) -> Self {
+        OptionError {
+            field,
+            value: value.into(),
+            why: why.into(),
+        }
+    }
+
+    /// The message in a front end's words (`spell`).
+    pub fn spelled(&self, spell: &dyn Spelling) -> String {
+        format!("{}: {}", spell.option(self.field, &self.value), self.why)
+    }
+}
+
+/// Checks the winding's parallel paths (the field `parallel_paths`), given as any whole
+/// number.
+///
+/// # Errors
+/// [`OptionError`] for a count outside [`PARALLEL_PATHS`].
+pub fn check_parallel_paths(n: i64) -> Result<u8, OptionError> {
+    match u8::try_from(n) {
+        Ok(p) if PARALLEL_PATHS.contains(&p) => Ok(p),
+        _ => {
+        Err(OptionError::new(
+            OptionField::ParallelPaths,
+            n.to_string(),
+            "give the parallel paths of each phase, 1..=8 (1 for a series star or delta, 2 for a double star)",
+        ))
+        }
+    }
+}
+
+/// A commissioning window `[start, end)` in log seconds: `0 <= start < end`, both finite,
+/// by construction. Written and parsed as `START:END` (`"2:4"`); serialized as
+/// `[start, end]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CommissionWindow {
+    start_s: f64,
+    end_s: f64,
+}
+
+impl CommissionWindow {
+    /// The window `[start_s, end_s)` [s].
+    ///
+    /// # Errors
+    /// [`OptionError`] naming `commission` unless `0 <= start_s < end_s`, both finite.
+    pub fn new(start_s: f64, end_s: f64) -> Result<Self, OptionError> {
+        if end_s > start_s && start_s >= 0.0 && end_s.is_finite() {
+            Ok(CommissionWindow { start_s, end_s })
+        } else {
+            Err(OptionError::new(
+                OptionField::Commission,
+                format!("{start_s}:{end_s}"),
+                "the window must be START:END with 0 <= START < END, both finite (seconds)",
+            ))
+        }
+    }
+
+    /// The start [s].
+    pub fn start_s(self) -> f64 {
+        self.start_s
+    }
+
+    /// The end [s].
+    pub fn end_s(self) -> f64 {
+        self.end_s
+    }
+
+    /// `(start, end)` [s], as [`super::ReplayOptions::commission`] holds it.
+    pub fn seconds(self) -> (f64, f64) {
+        (self.start_s, self.end_s)
+    }
+}
+
+impl fmt::Display for CommissionWindow {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}", self.start_s, self.end_s)
+    }
+}
+
+impl Serialize for CommissionWindow {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        [self.start_s, self.end_s].serialize(s)
+    }
+}
+
+/// The one parser of a commissioning window: `START:END` in seconds (`"2:4"`, `"1.5:2.4"`).
+impl FromStr for CommissionWindow {
+    type Err = OptionError;
+
+    fn from_str(s: &str) -> Result<Self, OptionError> {
+        let bad = |why: String| OptionError::new(OptionField::Commission, s, why);
+        let (a, b) = s
+            .split_once(':')
+            .ok_or_else(|| bad("not START:END (seconds), e.g. 2:4".into()))?;
+        let number = |x: &str| {
+            x.trim()
+                .parse::<f64>()
+                .map_err(|_| bad(format!("'{}' is not a number of seconds", x.trim())))
+        };
+        CommissionWindow::new(number(a)?, number(b)?)
+    }
+}
+
+/// The timeline's step [s]: one point per step of the log; finite and > 0 by construction
+/// (but [`TimelineStep::NONE`]).
+#[derive(Debug, Clone, Copy, PartialEq, PartialOrd)]
+pub struct TimelineStep(f64);
+
+impl TimelineStep {
+    /// The one default, 0.5 s (the command line's, the API's, Python's).
+    pub const DEFAULT: TimelineStep = TimelineStep(0.5);
+    /// No timeline (a step no log reaches: the HMI's live view keeps none).
+    pub const NONE: TimelineStep = TimelineStep(f64::INFINITY);
+
+    /// A step of `seconds`.
+    ///
+    /// # Errors
+    /// [`OptionError`] naming `timeline_step` unless finite and > 0.
+    pub fn new(seconds: f64) -> Result<Self, OptionError> {
+        if seconds.is_finite() && seconds > 0.0 {
+            Ok(TimelineStep(seconds))
+        } else {
+            Err(OptionError::new(
+                OptionField::TimelineStep,
+                seconds.to_string(),
+                "give a finite number of seconds > 0",
+            ))
+        }
+    }
+
+    /// A step of `seconds` known valid where it is written (a constant: use it in a
+    /// `const` so that a bad one fails the build).
+    ///
+    /// # Panics
+    /// Unless `seconds` is finite and > 0.
+    pub const fn of(seconds: f64) -> Self {
+        assert!(
+            seconds.is_finite() && seconds > 0.0,
+            "a timeline step > 0 s"
+        );
+        TimelineStep(seconds)
+    }
+
+    /// The step [s] (> 0; infinite for [`TimelineStep::NONE`]).
+    pub fn seconds(self) -> f64 {
+        self.0
+    }
+}
+
+impl fmt::Display for TimelineStep {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.0)
+    }
+}
+
+impl Default for TimelineStep {
+    fn default() -> Self {
+        TimelineStep::DEFAULT
+    }
+}
+
+/// The one parser of a time step: a number of seconds > 0 (`"0.5"`).
+impl FromStr for TimelineStep {
+    type Err = OptionError;
+
+    fn from_str(s: &str) -> Result<Self, OptionError> {
+        let x = s.trim().parse::<f64>().map_err(|_| {
+            OptionError::new(
+                OptionField::TimelineStep,
+                s,
+                format!("'{}' is not a number of seconds", s.trim()),
+            )
+        })?;
+        TimelineStep::new(x)
+    }
 }
 
 #[cfg(test)]
@@ -132,5 +430,30 @@ mod tests {
             assert_eq!(cells.v_max, 2.0 * r.v_range_v);
             assert_eq!(cells.i_max, 2.0 * r.i_range_a);
         }
+    }
+
+    #[test]
+    fn a_window_is_parsed_and_checked_in_one_place() {
+        let w: CommissionWindow = "1.5:2.4".parse().unwrap();
+        assert_eq!(w.seconds(), (1.5, 2.4));
+        assert_eq!(w.to_string(), "1.5:2.4");
+        for bad in ["4:2", "2", "a:3", "-1:2", "1:inf", "2:2"] {
+            let e = bad.parse::<CommissionWindow>().unwrap_err();
+            assert_eq!(e.field, OptionField::Commission, "{bad}");
+            assert!(e.to_string().starts_with("commission = "), "{e}");
+        }
+    }
+
+    #[test]
+    fn a_step_is_positive_and_finite() {
+        assert_eq!(TimelineStep::default().seconds(), 0.5);
+        assert_eq!("0.25".parse::<TimelineStep>().unwrap().seconds(), 0.25);
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            let e = TimelineStep::new(bad).unwrap_err();
+            assert_eq!(e.field, OptionField::TimelineStep);
+        }
+        assert!("x".parse::<TimelineStep>().is_err());
+        assert!(check_parallel_paths(0).is_err() && check_parallel_paths(9).is_err());
+        assert_eq!(check_parallel_paths(8), Ok(8));
     }
 }

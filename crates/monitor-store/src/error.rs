@@ -20,6 +20,6 @@ pub enum HistoryError {
         message: String,
     },
     /// Reading a store that does not exist.
-    #[error("no store at {0} (write one with `sim-host fleet ... --store {0}`)")]
+    #[error("no store at {0} (a fleet run writes one where it is given a store)")]
     Missing(String),
 }

@@ -141,7 +141,7 @@ pub fn run(story: Story) -> Result<DemoRun, ExperimentError> {
     }
     let opts = ReplayOptions {
         commission: Some(proto.commission),
-        timeline_step_s: TIMELINE_STEP_S,
+        timeline_step: const { monitor_replay::TimelineStep::of(TIMELINE_STEP_S) },
         load,
         ..ReplayOptions::default()
     };

@@ -154,7 +154,7 @@ pub fn run_case(
         load: monitor_replay::LoadModel::Viscous,
         // The row's residuals are the timeline's last point: the mean of the run's last
         // RESIDUAL_MEAN_S.
-        timeline_step_s: RESIDUAL_MEAN_S,
+        timeline_step: const { monitor_replay::TimelineStep::of(RESIDUAL_MEAN_S) },
         ..ReplayOptions::default()
     };
     let mut first_lamp: Option<f64> = None;

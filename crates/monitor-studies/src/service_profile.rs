@@ -127,7 +127,7 @@ pub fn watch_mismatched(
         residual_form: ResidualForm::Steady,
         commission: Some(COMMISSION),
         allow_incomplete: false,
-        timeline_step_s: 1.0,
+        timeline_step: const { monitor_replay::TimelineStep::of(1.0) },
         unbalance_baseline: None,
         turn_level: Default::default(),
         load: monitor_replay::LoadModel::Unknown,

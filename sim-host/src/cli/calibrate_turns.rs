@@ -30,7 +30,7 @@ pub struct CalibrateTurnsArgs {
     #[arg(required = true, value_name = "LOG=PHASE:PERCENT", value_parser = parse_labelled)]
     pub labelled: Vec<(PathBuf, Phase, f32)>,
     /// Parallel paths of each phase of the winding (as for diagnose).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=8))]
+    #[arg(long, default_value_t = 1, value_parser = super::words::parse_parallel_paths)]
     pub parallel_paths: u8,
     /// Healthy logs of the same motor (as for diagnose); without, each run is judged
     /// within itself.
@@ -68,12 +68,13 @@ fn parse_labelled(s: &str) -> Result<(PathBuf, Phase, f32), String> {
 /// not writable.
 pub fn run(args: &CalibrateTurnsArgs) -> anyhow::Result<()> {
     let mut req = monitor_api::DiagnoseRequest::default();
-    req.turn_level.parallel_paths = args.parallel_paths;
+    req.options.turn_level.parallel_paths = args.parallel_paths;
     req.baseline = args
         .baseline
         .iter()
         .map(monitor_api::LogSource::from)
         .collect();
+    req.validate()?;
     let labelled: Vec<monitor_api::Labelled> = args
         .labelled
         .iter()

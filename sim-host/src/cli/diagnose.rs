@@ -70,8 +70,8 @@ pub struct DiagnoseArgs {
     pub group: Option<String>,
     /// Learn healthy thresholds over START:END seconds of the log (healthy running that
     /// covers the load and voltage range to be monitored).
-    #[arg(long, value_name = "START:END", value_parser = super::parse_window)]
-    pub commission: Option<(f64, f64)>,
+    #[arg(long, value_name = "START:END", value_parser = super::words::parse_window)]
+    pub commission: Option<monitor_replay::CommissionWindow>,
     /// Report even when the --commission window was not learned (the log ends first, or
     /// the motor was not quasi-steady long enough); the fixed thresholds are used and the
     /// verdict is withheld.
@@ -84,24 +84,24 @@ pub struct DiagnoseArgs {
     #[arg(long, value_name = "HEALTHY", num_args = 1.., action = clap::ArgAction::Append)]
     pub baseline: Vec<PathBuf>,
     /// Frame angle source.
-    #[arg(long, value_enum, default_value_t = defaults().angle_source.into())]
+    #[arg(long, value_enum, default_value_t = defaults().options.angle_source.into())]
     pub angle: AngleArg,
     /// Residual form the lamps act on.
-    #[arg(long, value_enum, default_value_t = defaults().residual_form.into())]
+    #[arg(long, value_enum, default_value_t = defaults().options.residual_form.into())]
     pub residuals: ResidualArg,
     /// What is known of the load: `unknown` (service: a load change is an operating-point
     /// change, never a named fault) or `viscous` (the paper's fixed viscous load: a B/Bl
     /// change is the fault `b/bl`).
-    #[arg(long, value_enum, default_value_t = defaults().load.into())]
+    #[arg(long, value_enum, default_value_t = defaults().options.load.into())]
     pub load: LoadArg,
     /// Timeline resolution in the output [s].
-    #[arg(long, default_value_t = defaults().timeline_step_s, allow_negative_numbers = true, value_parser = super::parse_positive_seconds)]
-    pub timeline_step: f64,
+    #[arg(long, default_value_t = defaults().options.timeline_step, allow_negative_numbers = true, value_parser = super::words::parse_timeline_step)]
+    pub timeline_step: monitor_replay::TimelineStep,
     /// Parallel paths of each phase of the winding (1 for a series star or delta, 2 for a
     /// double star, as the motor's connection diagram says): the shorted turns lie in one
     /// path, and the shorted-turn level (unbalance.shorted_turns) is sized with that
     /// path's resistance.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=8))]
+    #[arg(long, default_value_t = defaults().options.turn_level.parallel_paths, value_parser = super::words::parse_parallel_paths)]
     pub parallel_paths: u8,
     /// A calibration of the shorted-turn level learned from labelled runs of the same
     /// motor (JSON, `monitor_replay::TurnCalibration`): the level is read from it instead
@@ -127,27 +127,33 @@ fn defaults() -> monitor_api::DiagnoseRequest {
 /// core cannot be configured for.
 pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
     let req = monitor_api::DiagnoseRequest {
-        commission: args.commission,
-        allow_incomplete: args.allow_incomplete,
+        options: monitor_replay::ReplayOptions {
+            angle_source: args.angle.into(),
+            residual_form: args.residuals.into(),
+            commission: args
+                .commission
+                .map(monitor_replay::CommissionWindow::seconds),
+            allow_incomplete: args.allow_incomplete,
+            timeline_step: args.timeline_step,
+            unbalance_baseline: None,
+            load: args.load.into(),
+            turn_level: monitor_replay::TurnLevelOptions {
+                parallel_paths: args.parallel_paths,
+                calibration: args
+                    .turn_calibration
+                    .as_ref()
+                    .map(|f| read_calibration(f))
+                    .transpose()?,
+            },
+        },
         baseline: args
             .baseline
             .iter()
             .map(monitor_api::LogSource::from)
             .collect(),
-        load: args.load.into(),
-        angle_source: args.angle.into(),
-        residual_form: args.residuals.into(),
-        timeline_step_s: args.timeline_step,
         group: args.group.clone(),
-        turn_level: monitor_replay::TurnLevelOptions {
-            parallel_paths: args.parallel_paths,
-            calibration: args
-                .turn_calibration
-                .as_ref()
-                .map(|f| read_calibration(f))
-                .transpose()?,
-        },
     };
+    req.validate()?;
     let big = std::fs::metadata(&args.log)
         .map(|m| m.len() > 20_000_000)
         .unwrap_or(false);

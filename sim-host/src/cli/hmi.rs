@@ -56,8 +56,8 @@ pub struct HmiArgs {
     #[arg(long, value_enum, default_value_t = SpeedArg::X1)]
     pub speed: SpeedArg,
     /// Replay: learn healthy thresholds over START:END seconds of the log (as diagnose).
-    #[arg(long, value_name = "START:END", value_parser = super::parse_window)]
-    pub commission: Option<(f64, f64)>,
+    #[arg(long, value_name = "START:END", value_parser = super::words::parse_window)]
+    pub commission: Option<monitor_replay::CommissionWindow>,
     /// Replay: frame angle source.
     #[arg(long, value_enum, default_value_t = AngleArg::RotorFlux)]
     pub angle: AngleArg,
@@ -132,10 +132,13 @@ pub fn run(args: &HmiArgs) -> anyhow::Result<()> {
         let opts = ReplayOptions {
             angle_source: args.angle.into(),
             residual_form: args.residuals.into(),
-            commission: args.commission,
+            commission: args
+                .commission
+                .map(monitor_replay::CommissionWindow::seconds),
             allow_incomplete: true,
             ..ReplayOptions::default()
         };
+        opts.validate()?;
         // Plain text at `max` walks the log at 1x on a clock of its own that does not wait
         // (a status line every --every seconds of the log, none skipped).
         let speed = if plain_text && args.speed == SpeedArg::Max {

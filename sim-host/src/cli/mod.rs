@@ -22,6 +22,7 @@ mod simulate;
 mod store_run;
 mod table1;
 mod trend;
+pub mod words;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use monitor_core::{AngleSource, EffectKind, Fault, ResidualForm};
@@ -230,28 +231,6 @@ pub fn parse_positive_seconds(s: &str) -> Result<f64, String> {
         x if x > 0.0 => Ok(x),
         x => Err(format!("{x} s: give a finite number of seconds > 0")),
     }
-}
-
-/// Parses `START:END` (seconds).
-pub fn parse_window(s: &str) -> Result<(f64, f64), String> {
-    let (a, b) = s
-        .split_once(':')
-        .ok_or_else(|| format!("'{s}' is not START:END (seconds), e.g. 2:4"))?;
-    let a: f64 = a
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{a}' is not a number of seconds"))?;
-    let b: f64 = b
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{b}' is not a number of seconds"))?;
-    if !(a >= 0.0 && b > a) {
-        return Err(format!("'{s}': need 0 <= START < END"));
-    }
-    if !b.is_finite() {
-        return Err(format!("'{s}': END must be a finite number of seconds"));
-    }
-    Ok((a, b))
 }
 
 /// Writes `bytes` to `out` atomically when an output was asked for (`--out`); nothing

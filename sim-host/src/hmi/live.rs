@@ -89,7 +89,7 @@ impl LiveSim {
         // The replay's monitor and isolation, fed row by row; its timeline is not kept (a
         // live run has no end), commissioning starts on the `c` key.
         let opts = ReplayOptions {
-            timeline_step_s: f64::INFINITY,
+            timeline_step: monitor_replay::TimelineStep::NONE,
             // The load is an unknown input, as `diagnose` reads it by default: a load step
             // (`+`, `-`, the paper's Bl switch) is the load's move, the amber state, never a
             // FAULT (the simulated load itself is the paper's viscous one).

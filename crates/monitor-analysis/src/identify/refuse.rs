@@ -46,7 +46,7 @@ pub fn refusal(
     let stalled = matches!(id.solver.termination, crate::lm::Termination::Stalled);
     if id.relative_rms_error > MAX_FIT_ERROR || (stalled && id.relative_rms_error > 0.03) {
         return Some(format!(
-            "the fit leaves a current error of {:.1} % of its RMS (solver {}; a good log leaves under 1 %): the model does not fit this log: check the [columns] mapping and units, give --from to leave out what the model cannot follow, or start from a parameter file of this machine",
+            "the fit leaves a current error of {:.1} % of its RMS (solver {}; a good log leaves under 1 %): the model does not fit this log: check the [columns] mapping and units, give from_s to leave out what the model cannot follow, or start from a parameter file of this machine",
             100.0 * id.relative_rms_error,
             id.solver.termination
         ));

@@ -17,7 +17,7 @@ pub enum IdentifyError {
         span_s: f64,
     },
     /// An interval between samples is not the rate's.
-    #[error("the samples are not regular at t = {at_s} s (an interval of {interval_s:.3e} s where the rate gives {dt_s:.3e} s): give a window without gaps (--from/--to)")]
+    #[error("the samples are not regular at t = {at_s} s (an interval of {interval_s:.3e} s where the rate gives {dt_s:.3e} s): give a window without gaps (from_s/to_s)")]
     Irregular {
         /// Where [s].
         at_s: f64,
@@ -28,7 +28,7 @@ pub enum IdentifyError {
     },
     /// A value that is not a number.
     #[error(
-        "a value that is not a number at t = {at_s} s: give a window without it (--from/--to)"
+        "a value that is not a number at t = {at_s} s: give a window without it (from_s/to_s)"
     )]
     NotANumber {
         /// Where [s].

@@ -29,6 +29,7 @@ mod csv_header;
 mod csv_line;
 mod exact;
 mod fast;
+mod format;
 pub mod mapping;
 mod memory;
 pub mod parquet;
@@ -39,60 +40,12 @@ pub mod tdms;
 mod typed;
 mod writer;
 
+pub use format::Format;
 pub use mapping::{ChannelUnit, ColumnMapping};
 pub use memory::{MemoryLog, MemoryValues};
 pub use reader::{LogFile, RowSink};
 pub use source::OpenOptions;
 pub use writer::{write_atomic, LogWriter};
-
-/// A log's file format, chosen by the file's extension (case-insensitive): `.tdms` is TDMS,
-/// `.parquet` or `.pq` Parquet, anything else CSV (`.csv`, `.txt`, none).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Format {
-    /// Comma-separated text with a header row (the schema of `docs/design.md`).
-    Csv,
-    /// NI TDMS, one group of channels.
-    Tdms,
-    /// Apache Parquet, one number column per channel.
-    Parquet,
-}
-
-impl Format {
-    /// Every format.
-    pub const ALL: [Format; 3] = [Format::Csv, Format::Tdms, Format::Parquet];
-
-    /// The format of a path, by its extension.
-    pub fn of_path(path: &std::path::Path) -> Format {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase)
-            .unwrap_or_default();
-        match ext.as_str() {
-            "tdms" => Format::Tdms,
-            "parquet" | "pq" => Format::Parquet,
-            _ => Format::Csv,
-        }
-    }
-
-    /// The format's name ("CSV", "TDMS", "Parquet").
-    pub fn name(self) -> &'static str {
-        match self {
-            Format::Csv => "CSV",
-            Format::Tdms => "TDMS",
-            Format::Parquet => "Parquet",
-        }
-    }
-
-    /// The usual extension, without the dot.
-    pub fn extension(self) -> &'static str {
-        match self {
-            Format::Csv => "csv",
-            Format::Tdms => "tdms",
-            Format::Parquet => "parquet",
-        }
-    }
-}
 
 /// Errors reading or writing a log. Every message is one line and names the problem.
 #[derive(Debug, thiserror::Error)]
@@ -189,6 +142,18 @@ pub enum LogError {
         line: u64,
         /// What is wrong.
         message: String,
+    },
+    /// A TDMS group asked of a log that has none (`given`), or a TDMS file of several
+    /// groups and none asked (`given` is `None`; `why` lists them). The option is named
+    /// `group` ([`LogError::spelled`] names it in a front end's words).
+    #[error("{}", self.spelled(&|name| name.to_string()))]
+    Group {
+        /// The file.
+        path: String,
+        /// The group asked for.
+        given: Option<String>,
+        /// What is wrong.
+        why: String,
     },
     /// The file is not a log in the schema (empty, another separator, no header).
     #[error("{path}: {why}")]

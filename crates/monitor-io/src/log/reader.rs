@@ -143,10 +143,11 @@ impl LogFile {
         let shown = path.display().to_string();
         let format = Format::of_path(path);
         if let (Some(g), Format::Csv | Format::Parquet) = (&opts.group, format) {
-            return Err(LogError::NotALog {
+            return Err(LogError::Group {
                 path: shown,
+                given: Some(g.clone()),
                 why: format!(
-                    "--group '{g}' names a TDMS group, and a {} log has no groups",
+                    "names a TDMS group, and a {} log has no groups",
                     format.name()
                 ),
             });
@@ -196,9 +197,10 @@ impl LogFile {
         opts: &OpenOptions,
     ) -> Result<Self, LogError> {
         if let Some(g) = &opts.group {
-            return Err(LogError::NotALog {
+            return Err(LogError::Group {
                 path: shown.to_string(),
-                why: format!("--group '{g}' names a TDMS group, and data in memory has no groups"),
+                given: Some(g.clone()),
+                why: "names a TDMS group, and data in memory has no groups".to_string(),
             });
         }
         let (m, columns) = super::memory::MemorySource::open(log, shown, &opts.columns)?;
@@ -394,5 +396,25 @@ fn channels_of(columns: &ColumnMap) -> Channels {
         speed: has(Column::Speed),
         encoder: has(Column::Encoder),
         temperature: has(Column::Temperature),
+    }
+}
+/// A log error in a front end's words.
+impl LogError {
+    /// The message with the options it refers to named by `name` (the command line: its
+    /// flag, `--group`); the library's words name them by their field (`group`).
+    pub fn spelled(&self, name: &dyn Fn(&str) -> String) -> String {
+        match self {
+            LogError::Group {
+                path,
+                given: Some(g),
+                why,
+            } => format!("{path}: {} '{g}' {why}", name("group")),
+            LogError::Group {
+                path,
+                given: None,
+                why,
+            } => format!("{path}: {why}: name one with {}", name("group")),
+            e => e.to_string(),
+        }
     }
 }

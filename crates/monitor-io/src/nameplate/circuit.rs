@@ -1,7 +1,7 @@
 //! The circuit of a nameplate under one set of the method's closing assumptions (the
 //! module documentation's steps 2 to 6), and the sets of assumptions its ranges come from.
 
-use super::{field_error, Nameplate, NameplateError};
+use super::{field_error, field_error_naming, Nameplate, NameplateError};
 use crate::params::plausible;
 use nalgebra::Complex;
 use std::f64::consts::TAU;
@@ -104,7 +104,7 @@ pub(super) fn poles_and_slip(n: &Nameplate) -> Result<(u32, bool, f64), Nameplat
 fn given_poles(p: u32) -> Result<u32, NameplateError> {
     if !(plausible::POLES.contains(&p) && p.is_multiple_of(2)) {
         return Err(field_error(
-            "--poles",
+            "poles",
             format!(
                 "{p} is not an even number in {}..={}",
                 plausible::POLES.start(),
@@ -123,7 +123,7 @@ fn inferred_poles(n: &Nameplate) -> Result<u32, NameplateError> {
     let pairs = k.ceil() - 1.0;
     if pairs < 1.0 {
         return Err(field_error(
-            "--speed-rpm",
+            "speed_rpm",
             format!(
                 "{} rpm is at or above the synchronous speed of a 2-pole motor at \
                  {f} Hz ({} rpm): an induction motor runs below synchronous speed",
@@ -135,7 +135,7 @@ fn inferred_poles(n: &Nameplate) -> Result<u32, NameplateError> {
     let poles = (2.0 * pairs).min(f64::from(u32::MAX)) as u32;
     if !plausible::POLES.contains(&poles) {
         return Err(field_error(
-            "--speed-rpm",
+            "speed_rpm",
             format!(
                 "{} rpm at {f} Hz would need {poles} poles, more than {}",
                 n.speed_rpm,
@@ -154,7 +154,7 @@ fn rated_slip(n: &Nameplate, poles: u32, inferred: bool) -> Result<f64, Nameplat
     let slip = (n_sync - n.speed_rpm) / n_sync;
     if slip <= 0.0 {
         return Err(field_error(
-            "--speed-rpm",
+            "speed_rpm",
             format!(
                 "{} rpm is at or above the synchronous speed {n_sync} rpm of {poles} poles at \
                  {f} Hz: an induction motor runs below synchronous speed",
@@ -163,9 +163,10 @@ fn rated_slip(n: &Nameplate, poles: u32, inferred: bool) -> Result<f64, Nameplat
         ));
     }
     if slip > MAX_SLIP {
-        let hint = if inferred { "; give --poles" } else { "" };
-        return Err(field_error(
-            "--speed-rpm",
+        let hint = if inferred { "; give poles" } else { "" };
+        return Err(field_error_naming(
+            "speed_rpm",
+            if inferred { &["poles"] } else { &[] as &[&str] },
             format!(
                 "{} rpm is a slip of {:.1} % below the synchronous {n_sync} rpm of {poles} \
                  poles at {f} Hz: not a rated speed (rated slips are below {:.0} %){hint}",
@@ -222,10 +223,11 @@ pub(super) fn circuit(
         stator_share: a.stator_share,
     };
     let no_circuit = || {
-        field_error(
-            "--power-factor",
+        field_error_naming(
+            "power_factor",
+            &["efficiency"],
             format!(
-                "{} with --efficiency {} and the slip {:.2} %: no T-equivalent circuit has \
+                "{} with efficiency {} and the slip {:.2} %: no T-equivalent circuit has \
                  this rated point (check both)",
                 n.power_factor,
                 n.efficiency,
@@ -275,7 +277,7 @@ fn stator_resistance(
     let rs = (p_in - p_ag) / (3.0 * r.i_a * r.i_a);
     if rs.is_nan() || rs <= 0.0 {
         return Err(field_error(
-            "--efficiency",
+            "efficiency",
             format!(
                 "{} is too high for the slip {:.2} %: the rotor copper loss alone (slip x \
                  air-gap power) needs an efficiency below about 1 - slip = {:.3}",
@@ -325,7 +327,7 @@ impl RestOfImpedance {
         };
         if lr(1e-6 * zb) >= target || lr(2.0 * zb) <= target {
             return Err(field_error(
-                "--locked-rotor-ratio",
+                "locked_rotor_ratio",
                 format!(
                     "{k} cannot be reached by this machine's circuit (its resistances \
                      alone allow at most {:.2})",

@@ -71,24 +71,68 @@ use circuit::{
 use std::f64::consts::TAU;
 pub use toml_text::{toml_entry, toml_number};
 
-/// Errors of [`estimate`]: each names the command line option it blames.
+/// Errors of [`estimate`]: each names the nameplate's field it blames by its name in
+/// [`Nameplate`] (`efficiency`, `speed_rpm`, ...); a front end says it in its own words
+/// ([`NameplateError::spelled`]: the command line's `--efficiency`).
 #[derive(Debug, thiserror::Error)]
 pub enum NameplateError {
     /// A nameplate value no induction machine can have.
     #[error("{field} {message}")]
     Field {
-        /// The option blamed (`--efficiency`, `--speed-rpm`, ...).
+        /// The field blamed (`efficiency`, `speed_rpm`, ...).
         field: &'static str,
         /// What is wrong, with the value and the limit (one line).
         message: String,
+        /// The other fields the message names (each by its name, its last occurrence in
+        /// `message` the one meant).
+        mentions: &'static [&'static str],
     },
     /// The estimated circuit is refused by the parameter file's own checks.
     #[error("the estimate is not a plausible machine: {0}")]
     Params(#[from] ParamError),
 }
 
+impl NameplateError {
+    /// The message with each field named by `name` (the command line: its flag).
+    pub fn spelled(&self, name: &dyn Fn(&str) -> String) -> String {
+        match self {
+            NameplateError::Field {
+                field,
+                message,
+                mentions,
+            } => {
+                let mut message = message.clone();
+                for m in *mentions {
+                    if let Some(at) = message.rfind(m) {
+                        message.replace_range(at..at + m.len(), &name(m));
+                    }
+                }
+                format!("{} {message}", name(field))
+            }
+            e => e.to_string(),
+        }
+    }
+}
+
 fn field_error(field: &'static str, message: String) -> NameplateError {
-    NameplateError::Field { field, message }
+    NameplateError::Field {
+        field,
+        message,
+        mentions: &[],
+    }
+}
+
+/// As [`field_error`], the message naming the fields `mentions` too.
+fn field_error_naming(
+    field: &'static str,
+    mentions: &'static [&'static str],
+    message: String,
+) -> NameplateError {
+    NameplateError::Field {
+        field,
+        message,
+        mentions,
+    }
 }
 
 /// How the stator winding is connected. The nameplate's voltage and current are the line
@@ -209,14 +253,14 @@ fn positive(field: &'static str, v: f64, unit: &str) -> Result<(), NameplateErro
 
 /// Checks each field on its own, then the consistency of P with sqrt 3 V I cos phi eta.
 fn check_fields(n: &Nameplate) -> Result<(), NameplateError> {
-    positive("--power-kw", n.power_kw, " kW")?;
-    positive("--voltage-v", n.voltage_v, " V")?;
-    positive("--current-a", n.current_a, " A")?;
-    positive("--frequency-hz", n.frequency_hz, " Hz")?;
-    positive("--speed-rpm", n.speed_rpm, " rpm")?;
+    positive("power_kw", n.power_kw, " kW")?;
+    positive("voltage_v", n.voltage_v, " V")?;
+    positive("current_a", n.current_a, " A")?;
+    positive("frequency_hz", n.frequency_hz, " Hz")?;
+    positive("speed_rpm", n.speed_rpm, " rpm")?;
     for (field, v) in [
-        ("--power-factor", n.power_factor),
-        ("--efficiency", n.efficiency),
+        ("power_factor", n.power_factor),
+        ("efficiency", n.efficiency),
     ] {
         if !(v.is_finite() && v > 0.0 && v < 1.0) {
             return Err(field_error(
@@ -229,8 +273,8 @@ fn check_fields(n: &Nameplate) -> Result<(), NameplateError> {
         }
     }
     for (field, v, unit, r) in [
-        ("--voltage-v", n.voltage_v, "V", plausible::V_LL_RMS),
-        ("--frequency-hz", n.frequency_hz, "Hz", plausible::F_HZ),
+        ("voltage_v", n.voltage_v, "V", plausible::V_LL_RMS),
+        ("frequency_hz", n.frequency_hz, "Hz", plausible::F_HZ),
     ] {
         if !r.contains(v) {
             return Err(field_error(
@@ -242,7 +286,7 @@ fn check_fields(n: &Nameplate) -> Result<(), NameplateError> {
     if let Some(k) = n.locked_rotor_ratio {
         if !(k.is_finite() && (1.5..=15.0).contains(&k)) {
             return Err(field_error(
-                "--locked-rotor-ratio",
+                "locked_rotor_ratio",
                 format!("{k} is not a locked-rotor current ratio IA/IN (1.5..15; typical 5..9)"),
             ));
         }
@@ -251,11 +295,12 @@ fn check_fields(n: &Nameplate) -> Result<(), NameplateError> {
         3f64.sqrt() * n.voltage_v * n.current_a * n.power_factor * n.efficiency / 1000.0;
     let ratio = n.power_kw / electrical_kw;
     if !(ratio > 1.0 - CONSISTENCY && ratio < 1.0 + CONSISTENCY) {
-        return Err(field_error(
-            "--power-kw",
+        return Err(field_error_naming(
+            "power_kw",
+            &["voltage_v", "current_a", "power_factor", "efficiency"],
             format!(
-                "{} kW disagrees with sqrt3 x --voltage-v x --current-a x --power-factor x \
-                 --efficiency = {electrical_kw:.4} kW (ratio {ratio:.3}; a real nameplate \
+                "{} kW disagrees with sqrt3 x voltage_v x current_a x power_factor x \
+                 efficiency = {electrical_kw:.4} kW (ratio {ratio:.3}; a real nameplate \
                  agrees within {:.0} %): check each value, and that the current is the one \
                  for this voltage",
                 n.power_kw,

@@ -228,8 +228,8 @@ fn check_chunks(shown: &str, raw: u64, file: &TdmsFile) -> Result<(), LogError> 
 /// The group to read: `group` when the file has it, else the file's only group.
 ///
 /// # Errors
-/// [`LogError::NotALog`] for a group that is not there, a file without groups, or several
-/// groups and none named (the message lists them).
+/// [`LogError::NotALog`] for a group that is not there or a file without groups;
+/// [`LogError::Group`] for several groups and none named (the message lists them).
 fn pick_group(names: &[String], group: Option<&str>, shown: &str) -> Result<String, LogError> {
     let listed = || {
         names
@@ -247,13 +247,11 @@ fn pick_group(names: &[String], group: Option<&str>, shown: &str) -> Result<Stri
         None => match names {
             [one] => Ok(one.clone()),
             [] => Err(not_a_log(shown, "the TDMS file has no group".into())),
-            _ => Err(not_a_log(
-                shown,
-                format!(
-                    "the TDMS file has several groups ({}): name one with --group",
-                    listed()
-                ),
-            )),
+            _ => Err(LogError::Group {
+                path: shown.to_string(),
+                given: None,
+                why: format!("the TDMS file has several groups ({})", listed()),
+            }),
         },
     }
 }

@@ -1,0 +1,179 @@
+//! The one-call interface's error ([`ApiError`]) and its kinds ([`ErrorKind`]). Each
+//! variant names the option or field it is about ([`OptionField`]) in the library's words
+//! (`Display`); a front end says it in its own ([`ApiError::spelled`]: the command line's
+//! `--commission`, Python's keyword, `commission = 4:2`).
+
+use monitor_analysis::AnalysisError;
+use monitor_io::log::LogError;
+use monitor_io::params::ParamError;
+use monitor_replay::{FieldNames, OptionError, OptionField, ReplayError, Spelling};
+
+/// A failed call: one line naming the file, the field or the option, and its kind.
+#[derive(Debug, thiserror::Error)]
+pub enum ApiError {
+    /// The parameter file cannot be read, or is not one.
+    #[error(transparent)]
+    Params(#[from] ParamError),
+    /// The log cannot be read, or is not one.
+    #[error(transparent)]
+    Log(#[from] LogError),
+    /// An option's value is refused (a window, a step, a baseline), naming the field.
+    #[error(transparent)]
+    Option(#[from] OptionError),
+    /// The replay could not run (its configuration, an incomplete commissioning).
+    #[error(transparent)]
+    Replay(#[from] ReplayError),
+    /// The monitor cannot be configured for this log (its sample rate, the machine).
+    #[error("{log}: {source}")]
+    Config {
+        /// How messages name the log.
+        log: String,
+        /// The replay's refusal ([`ReplayError::Config`]).
+        source: ReplayError,
+    },
+    /// The analysis could not run on this log.
+    #[error(transparent)]
+    Analysis(#[from] AnalysisError),
+    /// The parameter file given is a log (or the log a parameter file): the arguments look
+    /// swapped.
+    #[error("{}", self.spelled(&FieldNames))]
+    Swapped {
+        /// The path given as the parameter file.
+        params: String,
+        /// ", and LOG a parameter file" when the log given is a `.toml`, else empty.
+        also: String,
+    },
+    /// The analysed window ends before it starts (`to_s <= from_s`) [s].
+    #[error("{}", self.spelled(&FieldNames))]
+    WindowOrder {
+        /// The start [s].
+        from_s: f64,
+        /// The end [s].
+        to_s: f64,
+    },
+    /// The analysed window is too short to judge the model by (under
+    /// [`crate::MIN_ANALYSED_PERIODS`] supply periods).
+    #[error("{}", self.spelled(&FieldNames))]
+    ShortWindow {
+        /// How messages name the log.
+        log: String,
+        /// The window's span [s].
+        span_s: f64,
+        /// The supply frequency [Hz].
+        f_hz: f64,
+        /// The least span [s].
+        least_s: f64,
+    },
+    /// `identify` was given the parameter file's values, not its text or path (it writes
+    /// the file it was given with the identified values).
+    #[error("identify writes the parameter file it was given with the identified values: give its path or its TOML text")]
+    ParamsTextNeeded,
+    /// The identification could not run on this log, or refused its result.
+    #[error("{what} {log}: {why}")]
+    Identify {
+        /// "cannot identify from" or "identify".
+        what: &'static str,
+        /// How messages name the log.
+        log: String,
+        /// Why (the refusal ends "; no parameter file written"); it names the window's
+        /// fields as `from_s` and `to_s` ([`ApiError::spelled`] says them in a front
+        /// end's words).
+        why: String,
+    },
+    /// A labelled run for a turn calibration is wrong, or none named its phase.
+    #[error("{0}")]
+    Labels(String),
+    /// A nameplate refused, naming its field.
+    #[error(transparent)]
+    Nameplate(#[from] monitor_io::nameplate::NameplateError),
+    /// A scenario refused (naming the key) or a simulation that failed.
+    #[error(transparent)]
+    Simulation(#[from] monitor_sim::SimError),
+    /// The simulation was interrupted.
+    #[error("the simulation was interrupted")]
+    Interrupted,
+}
+
+/// The kinds of [`ApiError`] (the Python package's exception classes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ErrorKind {
+    /// [`ApiError::Params`], [`ApiError::Swapped`].
+    Params,
+    /// [`ApiError::Log`], and a replay's or an analysis' log error.
+    Log,
+    /// [`ApiError::Option`] and every refusal of what was asked (a window, a
+    /// configuration, a nameplate, a scenario, labels).
+    Option,
+    /// [`ApiError::Replay`] and [`ApiError::Analysis`].
+    Analysis,
+}
+
+impl ApiError {
+    /// Which kind of error this is.
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            ApiError::Params(_) | ApiError::Swapped { .. } => ErrorKind::Params,
+            ApiError::Log(_) | ApiError::Replay(ReplayError::Log(_)) => ErrorKind::Log,
+            ApiError::Analysis(AnalysisError::Log(_)) => ErrorKind::Log,
+            ApiError::Replay(ReplayError::Option(_)) => ErrorKind::Option,
+            ApiError::Replay(_) | ApiError::Analysis(_) => ErrorKind::Analysis,
+            ApiError::Option(_)
+            | ApiError::Config { .. }
+            | ApiError::WindowOrder { .. }
+            | ApiError::ShortWindow { .. }
+            | ApiError::ParamsTextNeeded
+            | ApiError::Identify { .. }
+            | ApiError::Labels(_)
+            | ApiError::Nameplate(_)
+            | ApiError::Simulation(_)
+            | ApiError::Interrupted => ErrorKind::Option,
+        }
+    }
+
+    /// The message in a front end's words: `spell` names the options and fields it refers
+    /// to (the command line as `--commission 4:2`, Python as its keyword,
+    /// `commission = 4:2`); the library's own is `Display`'s ([`FieldNames`]).
+    pub fn spelled(&self, spell: &dyn Spelling) -> String {
+        match self {
+            ApiError::Option(e) => e.spelled(spell),
+            ApiError::Log(e)
+            | ApiError::Replay(ReplayError::Log(e))
+            | ApiError::Analysis(AnalysisError::Log(e)) => e.spelled(&|name| spell.key(name)),
+            ApiError::Replay(e) => e.spelled(spell),
+            ApiError::Nameplate(e) => e.spelled(&|name| spell.key(name)),
+            ApiError::Swapped { params, also } => format!(
+                "{} is a log, not a parameter file{also}: the arguments look swapped (give {} LOG)",
+                spell.option(OptionField::Params, params),
+                spell.option(OptionField::Params, "P.toml")
+            ),
+            ApiError::WindowOrder { from_s, to_s } => format!(
+                "{} ({to_s}) must be after {} ({from_s})",
+                spell.option(OptionField::To, ""),
+                spell.option(OptionField::From, "")
+            ),
+            ApiError::ShortWindow {
+                log,
+                span_s,
+                f_hz,
+                least_s,
+            } => format!(
+                "{log}: the analysed window is {span_s:.3} s ({:.1} supply periods): at least {least_s:.2} s ({:.0} periods) are needed to judge the model (widen {}/{})",
+                span_s * f_hz,
+                crate::MIN_ANALYSED_PERIODS,
+                spell.option(OptionField::From, ""),
+                spell.option(OptionField::To, "")
+            ),
+            ApiError::Identify { what, log, why } => {
+                let mut why = why.clone();
+                for field in [OptionField::From, OptionField::To] {
+                    if let Some(at) = why.rfind(field.name()) {
+                        let said = spell.option(field, "");
+                        why.replace_range(at..at + field.name().len(), &said);
+                    }
+                }
+                format!("{what} {log}: {why}")
+            }
+            e => e.to_string(),
+        }
+    }
+}

@@ -1,0 +1,101 @@
+//! The command line's words for the library's: a field is named by its flag
+//! (`commission` -> `--commission 4:2`), and the library's typed values are parsed by the
+//! library's one parser, their refusals shown as clap shows a bad value.
+
+use monitor_api::ApiError;
+use monitor_replay::{
+    check_parallel_paths, CommissionWindow, OptionField, ReplayError, Spelling, TimelineStep,
+};
+
+/// The command line's spelling of the library's fields: their flags.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct CliWords;
+
+impl Spelling for CliWords {
+    fn option(&self, field: OptionField, value: &str) -> String {
+        let flag = match field {
+            OptionField::From => "from".to_string(),
+            OptionField::To => "to".to_string(),
+            f => f.name().replace('_', "-"),
+        };
+        if value.is_empty() {
+            format!("--{flag}")
+        } else {
+            format!("--{flag} {value}")
+        }
+    }
+
+    fn key(&self, name: &str) -> String {
+        format!("--{}", name.replace('_', "-"))
+    }
+}
+
+/// One error of a chain in the command line's words: a library error that names fields
+/// names their flags; any other as it displays.
+pub fn error_text(e: &(dyn std::error::Error + 'static)) -> String {
+    if let Some(e) = e.downcast_ref::<ApiError>() {
+        e.spelled(&CliWords)
+    } else if let Some(e) = e.downcast_ref::<ReplayError>() {
+        e.spelled(&CliWords)
+    } else if let Some(e) = e.downcast_ref::<monitor_replay::OptionError>() {
+        e.spelled(&CliWords)
+    } else if let Some(e) = e.downcast_ref::<monitor_io::log::LogError>() {
+        e.spelled(&|name| CliWords.key(name))
+    } else if let Some(monitor_store::HistoryError::Missing(p)) =
+        e.downcast_ref::<monitor_store::HistoryError>()
+    {
+        format!("no store at {p} (write one with `sim-host fleet ... --store {p}`)")
+    } else {
+        e.to_string()
+    }
+}
+
+/// `--commission START:END`, by the library's one parser of a window.
+pub fn parse_window(s: &str) -> Result<CommissionWindow, String> {
+    s.parse().map_err(|e: monitor_replay::OptionError| e.why)
+}
+
+/// `--timeline-step SECONDS`, by the library's one parser of a step (> 0, finite).
+pub fn parse_timeline_step(s: &str) -> Result<TimelineStep, String> {
+    s.parse().map_err(|e: monitor_replay::OptionError| e.why)
+}
+
+/// `--parallel-paths N`: a whole number in the library's range (1..=8).
+pub fn parse_parallel_paths(s: &str) -> Result<u8, String> {
+    let n = s
+        .trim()
+        .parse::<i64>()
+        .map_err(|_| format!("'{s}' is not a whole number of paths (1..=8)"))?;
+    check_parallel_paths(n).map_err(|e| e.why)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fields_are_named_by_their_flags() {
+        let e = monitor_replay::CommissionWindow::new(4.0, 2.0).unwrap_err();
+        assert_eq!(
+            e.spelled(&CliWords),
+            "--commission 4:2: the window must be START:END with 0 <= START < END, both finite (seconds)"
+        );
+        assert_eq!(CliWords.option(OptionField::From, ""), "--from");
+        assert_eq!(
+            CliWords.option(OptionField::TimelineStep, "0"),
+            "--timeline-step 0"
+        );
+        assert!(parse_timeline_step("0").is_err() && parse_parallel_paths("9").is_err());
+        let e = ApiError::Identify {
+            what: "cannot identify from",
+            log: "a.csv".into(),
+            why: "a gap: give a window without it (from_s/to_s)".into(),
+        };
+        assert!(e.spelled(&CliWords).ends_with("(--from/--to)"), "{e}");
+        let e = ApiError::WindowOrder {
+            from_s: 2.0,
+            to_s: 1.0,
+        };
+        assert_eq!(e.spelled(&CliWords), "--to (1) must be after --from (2)");
+    }
+}
