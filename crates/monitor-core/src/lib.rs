@@ -96,7 +96,10 @@ pub use monitor::{
 pub use operating_range::{OperatingPoint, OperatingRange};
 pub use residuals::Operating;
 pub use sequence::NegativeSequence;
-pub use signature::{Diagnosis, Fault, FAULT_COUNT, ROTOR_FLUX_SIGNATURES, TABLE1};
+pub use signature::{
+    Diagnosis, Fault, FaultEntry, FaultTarget, MachineParameter, SensorChannel, FAULTS,
+    FAULT_COUNT, ROTOR_FLUX_SIGNATURES, TABLE1,
+};
 pub use threshold::{Calibration, ThresholdConfig};
 
 #[cfg(test)]
