@@ -431,7 +431,9 @@ mod tests {
         assert_eq!(codes, (1..=9).collect::<Vec<u8>>());
         assert_eq!(NOT_NAMED_CODE, 10);
         assert_eq!([0, 1, 2].map(winding_code), [11, 12, 13]);
-        assert!(codes.iter().all(|c| *c < NOT_NAMED_CODE && NOT_NAMED_CODE < WINDING_CODE_A));
+        assert!(codes
+            .iter()
+            .all(|c| *c < NOT_NAMED_CODE && NOT_NAMED_CODE < WINDING_CODE_A));
     }
 
     #[test]
