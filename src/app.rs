@@ -44,6 +44,8 @@ mod lamps;
 pub use lamps::{panel_call, panel_input, PanelIsolation};
 mod sample_path;
 pub use sample_path::{AppError, Command, CommandError, SamplePath};
+mod status_line;
+pub use status_line::status_line;
 
 /// The machine the firmware monitors by default: the "2.2 kW" reference machine
 /// (`monitor_core::reference::MOTOR_2P2KW`: 400 V, 50 Hz, 4 poles, Gamma model, Bl for the

@@ -57,7 +57,7 @@ use embassy_sync::signal::Signal;
 use embassy_time::{with_deadline, with_timeout, Duration, Instant, Timer};
 
 use drive_monitor::app::{
-    carry_out, isolation_summary, Command, MonitorStatus, SamplePath, Settings, Supervisor, Tick,
+    carry_out, status_line, Command, MonitorStatus, SamplePath, Settings, Supervisor, Tick,
     PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
 };
 use drive_monitor::board::{self, pins::Board, Lamp, LAMP_COUNT};
@@ -512,70 +512,24 @@ fn check_reference(supervisor: &mut Supervisor, now_ms: u32) {
     }
 }
 
-/// The defmt status line: residuals, lamps, the two top candidates, speed, mode,
-/// counters, the operating point, the gate, the threshold bands, the isolation (the
-/// fault named, its size and probability: `app::isolation_summary`) and the winding
-/// temperature rise the isolation tracks since commissioning (`rise_k` [K]); `panel`: the
-/// panel's mode and the one verdict on the lamps (`app::panel_call`). Its format is
-/// documented once, in docs/firmware.md ("The status line"); `sim-host hmi --stdin` parses it
-/// (`sim_host::hmi::status_line`), and `tests/status_line.rs` renders this format string
-/// and parses it back, so the two cannot drift apart. `supply`: the latest VDDA [V] (0
-/// before the first reading or when unreadable) and the brown-out level (255: reserved).
+/// The defmt status line (`app::status_line`, written in the core's one format,
+/// `monitor_core::status_line`, which `sim-host hmi --stdin` parses with the same module):
+/// residuals, lamps, the two top candidates, speed, mode, counters, the operating point, the
+/// gate, the threshold bands, the isolation and the winding temperature rise (`rise_k` [K]);
+/// `panel`: the panel's mode and the one verdict on the lamps (`app::panel_call`);
+/// `supply`: the latest VDDA [V] and the brown-out level. Its fields are documented once,
+/// in docs/firmware.md ("The status line").
 fn log_status(
     s: &MonitorStatus,
     iso: Option<&Isolation>,
     rise_k: f32,
-    panel: (&str, &str),
+    panel: (&'static str, &'static str),
     max_update_cycles: u32,
     supply: (f32, u8),
 ) {
-    let (vdda_v, bor) = supply;
-    let (mode, call) = panel;
-    let (top_name, top_p) = s.top.map_or(("none", 0.0), |(f, p)| (f.name(), p));
-    let (iso_name, iso_change, iso_p) = isolation_summary(iso);
-    let (second_name, second_p) = s.second.map_or(("none", 0.0), |(f, p)| (f.name(), p));
-    let (wind_name, wind_i2) = s.winding.map_or(("none", 0.0), |(p, r)| (p.name(), r));
-    let mid = s.bands.map(|b| b.0);
-    let half = s.bands.map(|b| b.1);
-    info!(
-        "r={} lamps={} fault={=bool} call={=str} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32} iqs={=f32}A ids={=f32}A vqs={=f32}V f={=f32}Hz steady={=bool} eval={=bool} sens={=bool},{=bool},{=bool} mid={} half={} iso={=str} iso_change={=f32} iso_p={=f32} wind={=str} wind_i2={=f32} moved={=bool} rise={=f32}K vdda={=f32}V bor={=u8}",
-        s.residuals,
-        s.residual_lamps,
-        s.fault_detected,
-        call,
-        top_name,
-        top_p,
-        second_name,
-        second_p,
-        s.speed_rad_s,
-        s.zero_crossing_locked,
-        mode,
-        s.run.id,
-        s.run.blocks_learned,
-        s.run.blocks_needed,
+    let restarts = (
         OVERRUNS.load(Ordering::Relaxed),
         RESTARTS.load(Ordering::Relaxed),
-        s.samples,
-        max_update_cycles,
-        s.operating.iqs,
-        s.operating.i_f,
-        s.operating.vqs,
-        s.frame_hz,
-        s.quasi_steady,
-        s.evaluating,
-        s.sensor_fault.current,
-        s.sensor_fault.voltage,
-        s.sensor_fault.speed,
-        mid,
-        half,
-        iso_name,
-        iso_change,
-        iso_p,
-        wind_name,
-        wind_i2,
-        s.moved,
-        rise_k,
-        vdda_v,
-        bor,
     );
+    status_line(s, iso, rise_k, panel, max_update_cycles, restarts, supply).log_info();
 }

@@ -53,7 +53,9 @@
 //!
 //! The blink code names the fault the **isolation** found (`monitor_core::isolation`: the
 //! full steady-state equations, which separate what the paper's four lamps cannot), in
-//! the core's `Fault::ALL` order plus one:
+//! the core's fault list's order plus one (`monitor_core::FAULTS`; the codes after the
+//! faults, "not named" and the three phases of shorted turns, follow the list's length, so
+//! a fault added to the list gets the next code and moves them up by one):
 //!
 //! | N | 1 | 2 | 3 | 4 | 5 | 6 | 7 | 8 | 9 | 10 | 11 | 12 | 13 |
 //! |---|---|---|---|---|---|---|---|---|---|---|---|---|---|
@@ -166,8 +168,8 @@ pub struct PanelInput {
     /// Input invalid (ADC saturated / sensor fault flag).
     pub input_invalid: bool,
     /// Blink code of the fault shown: 1..=9 ([`blink_code`] of the isolated fault; 5 for
-    /// the friction class), [`NOT_NAMED_CODE`], or 11..=13 for shorted turns
-    /// ([`winding_code`]).
+    /// the friction class), [`NOT_NAMED_CODE`] (10), or 11..=13 for shorted turns
+    /// ([`winding_code`]); the numbers follow the core's fault list (module docs).
     pub fault_code: u8,
     /// The last commissioning attempt failed (shown while no fault is).
     pub commissioning_failed: bool,
@@ -183,11 +185,21 @@ pub struct PanelInput {
     pub moved: bool,
 }
 
-/// Blink code of a fault detected that the isolation did not name (module docs).
-pub const NOT_NAMED_CODE: u8 = 10;
+/// Blink code of a fault detected that the isolation did not name (module docs): the one
+/// after the last fault's ([`blink_code`] of the core's fault list, `monitor_core::FAULTS`),
+/// 10 with Table 1's nine faults, so a fault added to the list cannot collide with it.
+pub const NOT_NAMED_CODE: u8 = blink_code(FAULT_CODES);
 
-/// Blink code of shorted turns in phase a; b and c follow (12, 13; module docs).
-pub const WINDING_CODE_A: u8 = 11;
+/// Blink code of shorted turns in phase a; b and c follow (module docs): after
+/// [`NOT_NAMED_CODE`] (11, 12, 13 with Table 1's nine faults).
+pub const WINDING_CODE_A: u8 = NOT_NAMED_CODE + 1;
+
+/// The number of faults with a blink code: the core's fault list's length (at most 240,
+/// so the winding codes after them fit a `u8`).
+const FAULT_CODES: u8 = {
+    assert!(monitor_core::FAULT_COUNT <= 240, "blink codes are one byte");
+    monitor_core::FAULT_COUNT as u8
+};
 
 /// Blink code of shorted turns in the phase of index `phase_index` (0, 1, 2 for a, b, c):
 /// 11, 12, 13.
@@ -195,7 +207,8 @@ pub const fn winding_code(phase_index: u8) -> u8 {
     WINDING_CODE_A.saturating_add(phase_index)
 }
 
-/// Blink code of a candidate index: `index + 1` (1..=9).
+/// Blink code of a candidate index (`monitor_core::Fault::index`): `index + 1` (1..=9 for
+/// Table 1's nine faults).
 pub const fn blink_code(candidate_index: u8) -> u8 {
     candidate_index.saturating_add(1)
 }
@@ -407,6 +420,21 @@ mod tests {
         Mode::Commissioning,
         Mode::Commissioned,
     ];
+
+    #[test]
+    fn the_codes_follow_the_fault_list_and_never_collide() {
+        // Table 1's nine faults keep their codes: 1..=9, then 10 (not named), 11..=13.
+        let codes: Vec<u8> = monitor_core::Fault::ALL
+            .iter()
+            .map(|f| blink_code(f.index() as u8))
+            .collect();
+        assert_eq!(codes, (1..=9).collect::<Vec<u8>>());
+        assert_eq!(NOT_NAMED_CODE, 10);
+        assert_eq!([0, 1, 2].map(winding_code), [11, 12, 13]);
+        assert!(codes
+            .iter()
+            .all(|c| *c < NOT_NAMED_CODE && NOT_NAMED_CODE < WINDING_CODE_A));
+    }
 
     #[test]
     fn blink_code_round_trips_for_every_candidate() {

@@ -415,3 +415,86 @@ fn the_help_and_the_readme_list_the_keys() {
         assert!(readme.contains(line), "docs/hmi.md lacks `{line}`");
     }
 }
+
+/// The firmware's full status line, written by the core's writer (the one the board uses),
+/// on the screen: the isolation with the rise, the winding, the sensor fault, the moved and
+/// the could-not-judge states.
+#[test]
+fn the_firmwares_full_line_on_the_screen() {
+    use monitor_core::status_line::StatusLine;
+    use monitor_core::verdict::Verdict;
+    let written = StatusLine {
+        residuals: [0.0123, -0.1, 0.25, -0.004],
+        lamps: [false, true, true, true],
+        fault: true,
+        call: "fault",
+        top: ("b", 0.5),
+        second: ("bl", 0.5),
+        speed_rad_s: 150.5,
+        mode: "commissioned",
+        run: (2, 4000, 4000),
+        quasi_steady: true,
+        evaluating: true,
+        sensors: (false, true, false),
+        isolation: ("rr", 0.48, 0.93),
+        winding: ("b", 0.041),
+        moved: true,
+        winding_rise_k: 54.4,
+        ..StatusLine::default()
+    };
+    let line = format!("INFO  {written}");
+    let s = status_line::parse(&line).unwrap_or_else(|| panic!("not read: {line}"));
+    assert_eq!(s.call, Some(Verdict::Fault));
+    assert_eq!(s.candidates, vec![(Fault::B, 0.5), (Fault::Bl, 0.5)]);
+    let snap = s.snapshot(0.0);
+    let iso = snap
+        .isolation
+        .as_ref()
+        .expect("the isolation on the screen");
+    assert!(
+        iso.text().ends_with("; windings +54 K (heating)"),
+        "{}",
+        iso.text()
+    );
+    assert_eq!(
+        (iso.named.map(|n| n.name()), iso.change),
+        (Some("rr"), Some(0.48))
+    );
+    assert_eq!(
+        snap.asymmetry.map(|a| (a.phase, a.ratio)),
+        Some((monitor_core::Phase::B, 0.041))
+    );
+    assert!(snap.learned && snap.fault_lamp);
+    assert_eq!(snap.sensor_faults, vec![Fault::VoltageSensor]);
+    assert!(matches!(snap.state, MonitorState::Fault(_)));
+    // The friction class named (a load change, to the paper's model) and no sensor fault:
+    // the board's "operating point moved" state, no FAULT lamp; `moved=false` keeps the fault.
+    let friction = line
+        .replace("iso=rr", "iso=b/bl")
+        .replace("sens=false,true,false", "sens=false,false,false");
+    let snap = status_line::parse(&friction).expect("read").snapshot(0.0);
+    assert!(matches!(snap.state, MonitorState::Moved(_)) && !snap.fault_lamp);
+    let fixed = friction.replace("moved=true", "moved=false");
+    let snap = status_line::parse(&fixed).expect("read").snapshot(0.0);
+    assert!(matches!(snap.state, MonitorState::Fault(_)) && snap.fault_lamp);
+    // The board's verdict lights its FAULT lamp, not `fault=`: watching and could not judge
+    // (older firmware's `not-commissioned`) show the lamps lit, the FAULT lamp dark and the word.
+    for (call, word) in [
+        ("watching", "WATCHING"),
+        ("could_not_judge", "NOT JUDGED"),
+        ("not-commissioned", "NOT JUDGED"),
+    ] {
+        let snap = status_line::parse(&fixed.replace("call=fault", &format!("call={call}")))
+            .expect("read")
+            .snapshot(0.0);
+        assert!(matches!(snap.state, MonitorState::Fault(_)) && !snap.fault_lamp);
+        let (lamp, _) = sim_host::hmi::lamp_and_header(
+            &snap.state,
+            snap.fault_lamp,
+            snap.call,
+            &snap.candidates,
+            snap.isolation.as_ref(),
+        );
+        assert_eq!(lamp, word);
+    }
+}

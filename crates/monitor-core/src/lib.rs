@@ -24,7 +24,8 @@
 //! [`reference`](mod@reference) machines (2.2 kW and 3 hp), and the broken-bar relation of
 //! the squirrel cage ([`rotor_cage`]). With the `serde` feature (the
 //! host enables it) they serialise under the names of the parameter file and the JSON
-//! reports (`docs/design.md`).
+//! reports (`docs/design.md`). The firmware's status line, its format, writer and parser,
+//! is here too ([`status_line`]): the board writes it, the host's HMI reads it.
 //!
 //! ```
 //! use monitor_core::{reference, Abc, Fault, Monitor, MonitorConfig, Sample};
@@ -74,6 +75,7 @@ pub mod residuals;
 pub mod rotor_cage;
 pub mod sequence;
 pub mod signature;
+pub mod status_line;
 pub mod threshold;
 pub mod verdict;
 
@@ -94,7 +96,10 @@ pub use monitor::{
 pub use operating_range::{OperatingPoint, OperatingRange};
 pub use residuals::Operating;
 pub use sequence::NegativeSequence;
-pub use signature::{Diagnosis, Fault, FAULT_COUNT, ROTOR_FLUX_SIGNATURES, TABLE1};
+pub use signature::{
+    Diagnosis, Fault, FaultEntry, FaultTarget, MachineParameter, SensorChannel, FAULTS,
+    FAULT_COUNT, ROTOR_FLUX_SIGNATURES, TABLE1,
+};
 pub use threshold::{Calibration, ThresholdConfig};
 
 #[cfg(test)]

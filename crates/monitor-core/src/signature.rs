@@ -64,37 +64,186 @@ impl core::fmt::Display for Fault {
     }
 }
 
-/// Number of faults in Table 1.
+/// Number of faults in Table 1 (the length of the one list, [`FAULTS`]).
 pub const FAULT_COUNT: usize = 9;
 
+/// A machine parameter a fault scales by its factor `k = 1 + change`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum MachineParameter {
+    /// The stator resistance Rs.
+    Rs,
+    /// The rotor resistance Rr.
+    Rr,
+    /// The stator leakage inductance Lls (Lm instead on a machine without it, [`Fault::Ls`]).
+    StatorLeakage,
+    /// The rotor leakage inductance Llr (Lm instead on a machine without it, [`Fault::Lr`]).
+    RotorLeakage,
+    /// The machine's friction B.
+    MachineFriction,
+    /// The load's friction Bl.
+    LoadFriction,
+}
+
+/// A sensor whose gain a fault changes (its reading `k` times the truth).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum SensorChannel {
+    /// The phase currents (the model's Iqs).
+    Current,
+    /// The phase voltages (the model's Vqs).
+    Voltage,
+    /// The shaft speed (the encoder, omega_r).
+    Speed,
+}
+
+/// What a fault changes: a machine parameter or a sensor (the simulator injects it there,
+/// the isolation hypothesises it there).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum FaultTarget {
+    /// A parameter of the machine, scaled.
+    Parameter(MachineParameter),
+    /// A sensor's gain.
+    Sensor(SensorChannel),
+}
+
+/// One fault of the list: everything the workspace derives from it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FaultEntry {
+    /// The fault (its index in the list is its [`Fault::index`]).
+    pub fault: Fault,
+    /// Its name ([`Fault::name`]).
+    pub name: &'static str,
+    /// What it changes ([`Fault::target`]).
+    pub target: FaultTarget,
+    /// The paper's Table 1 row, r1..r4 ([`TABLE1`]).
+    pub table1: [bool; 4],
+    /// The physical row in rotor-flux orientation, r1..r4 ([`ROTOR_FLUX_SIGNATURES`],
+    /// module docs).
+    pub rotor_flux: [bool; 4],
+}
+
+/// The faults of Table 1, in its order: the one list the fault vocabulary derives from
+/// ([`Fault::ALL`], [`Fault::name`], [`Fault::target`], [`TABLE1`],
+/// [`ROTOR_FLUX_SIGNATURES`]; the panel's blink codes, the HMI's keys, the isolation's
+/// hypotheses and the simulator's fault injection through them). docs/architecture.md,
+/// "Adding a fault", says what else a new fault needs.
+pub const FAULTS: [FaultEntry; FAULT_COUNT] = {
+    use FaultTarget::{Parameter, Sensor};
+    use MachineParameter as P;
+    const fn row(
+        fault: Fault,
+        name: &'static str,
+        target: FaultTarget,
+        table1: [bool; 4],
+        rotor_flux: [bool; 4],
+    ) -> FaultEntry {
+        FaultEntry {
+            fault,
+            name,
+            target,
+            table1,
+            rotor_flux,
+        }
+    }
+    let (t, f) = (true, false);
+    [
+        row(
+            Fault::Rs,
+            "rs",
+            Parameter(P::Rs),
+            [t, f, f, t],
+            [t, f, t, t],
+        ),
+        row(
+            Fault::Rr,
+            "rr",
+            Parameter(P::Rr),
+            [t, f, f, t],
+            [t, t, t, t],
+        ),
+        row(
+            Fault::Ls,
+            "ls",
+            Parameter(P::StatorLeakage),
+            [t, f, t, t],
+            [t, f, t, t],
+        ),
+        row(
+            Fault::Lr,
+            "lr",
+            Parameter(P::RotorLeakage),
+            [t, t, t, t],
+            [t, t, t, t],
+        ),
+        row(
+            Fault::B,
+            "b",
+            Parameter(P::MachineFriction),
+            [f, t, t, t],
+            [f, t, t, t],
+        ),
+        row(
+            Fault::Bl,
+            "bl",
+            Parameter(P::LoadFriction),
+            [f, t, t, t],
+            [f, t, t, t],
+        ),
+        // Current sensor: the paper's Iqs; physically the phase currents.
+        row(
+            Fault::CurrentSensor,
+            "current_sensor",
+            Sensor(SensorChannel::Current),
+            [t, t, t, f],
+            [t, t, t, t],
+        ),
+        row(
+            Fault::VoltageSensor,
+            "voltage_sensor",
+            Sensor(SensorChannel::Voltage),
+            [t, f, t, t],
+            [t, f, t, t],
+        ),
+        // Speed sensor: omega_r, the encoder.
+        row(
+            Fault::SpeedSensor,
+            "speed_sensor",
+            Sensor(SensorChannel::Speed),
+            [t, t, f, t],
+            [t, t, t, t],
+        ),
+    ]
+};
+
+/// Column `what` of [`FAULTS`] (0: the fault, for the check that row `k` is fault `k`).
+#[allow(clippy::indexing_slicing)] // const evaluation: an index out of range does not compile
+const fn column(what: u8) -> ([Fault; FAULT_COUNT], [[bool; 4]; FAULT_COUNT]) {
+    let mut faults = [Fault::Rs; FAULT_COUNT];
+    let mut rows = [[false; 4]; FAULT_COUNT];
+    let mut k = 0;
+    while k < FAULT_COUNT {
+        faults[k] = FAULTS[k].fault;
+        assert!(
+            FAULTS[k].fault as usize == k,
+            "FAULTS is in the enum's order"
+        );
+        rows[k] = if what == 1 {
+            FAULTS[k].table1
+        } else {
+            FAULTS[k].rotor_flux
+        };
+        k += 1;
+    }
+    (faults, rows)
+}
+
 impl Fault {
-    /// Every fault, in Table 1's order (the index of the probability arrays).
-    pub const ALL: [Fault; FAULT_COUNT] = [
-        Fault::Rs,
-        Fault::Rr,
-        Fault::Ls,
-        Fault::Lr,
-        Fault::B,
-        Fault::Bl,
-        Fault::CurrentSensor,
-        Fault::VoltageSensor,
-        Fault::SpeedSensor,
-    ];
+    /// Every fault, in Table 1's order (the index of the probability arrays; [`FAULTS`]).
+    pub const ALL: [Fault; FAULT_COUNT] = column(0).0;
 
     /// The name in scenario files, on the command line and in JSON reports (`rs, rr, ls, lr,
-    /// b, bl, current_sensor, voltage_sensor, speed_sensor`; `docs/design.md`).
+    /// b, bl, current_sensor, voltage_sensor, speed_sensor`; `docs/design.md`; [`FAULTS`]).
     pub fn name(self) -> &'static str {
-        match self {
-            Fault::Rs => "rs",
-            Fault::Rr => "rr",
-            Fault::Ls => "ls",
-            Fault::Lr => "lr",
-            Fault::B => "b",
-            Fault::Bl => "bl",
-            Fault::CurrentSensor => "current_sensor",
-            Fault::VoltageSensor => "voltage_sensor",
-            Fault::SpeedSensor => "speed_sensor",
-        }
+        FAULTS.get(self.index()).map_or("", |e| e.name)
     }
 
     /// Parses a name of [`Fault::name`] (exact, lower case).
@@ -107,6 +256,13 @@ impl Fault {
         self as usize
     }
 
+    /// What the fault changes ([`FAULTS`]).
+    pub fn target(self) -> FaultTarget {
+        FAULTS
+            .get(self.index())
+            .map_or(FaultTarget::Sensor(SensorChannel::Speed), |e| e.target)
+    }
+
     /// The paper's Table 1 row for this fault (r1..r4).
     pub fn paper_signature(self) -> [bool; 4] {
         TABLE1.get(self.index()).copied().unwrap_or([false; 4])
@@ -114,39 +270,16 @@ impl Fault {
 
     /// True for the sensor faults.
     pub fn is_sensor(self) -> bool {
-        matches!(
-            self,
-            Fault::CurrentSensor | Fault::VoltageSensor | Fault::SpeedSensor
-        )
+        matches!(self.target(), FaultTarget::Sensor(_))
     }
 }
 
-/// The paper's Table 1, rows in [`Fault::ALL`] order, columns r1..r4.
-pub const TABLE1: [[bool; 4]; FAULT_COUNT] = [
-    [true, false, false, true], // Rs
-    [true, false, false, true], // Rr
-    [true, false, true, true],  // Ls
-    [true, true, true, true],   // Lr
-    [false, true, true, true],  // B
-    [false, true, true, true],  // Bl
-    [true, true, true, false],  // current sensor (Iqs)
-    [true, false, true, true],  // voltage sensor (Vqs)
-    [true, true, false, true],  // speed sensor (omega_r)
-];
+/// The paper's Table 1, rows in [`Fault::ALL`] order, columns r1..r4 ([`FAULTS`]).
+pub const TABLE1: [[bool; 4]; FAULT_COUNT] = column(1).1;
 
 /// Physical signatures for rotor-flux orientation (module docs), rows in [`Fault::ALL`]
-/// order, columns r1..r4.
-pub const ROTOR_FLUX_SIGNATURES: [[bool; 4]; FAULT_COUNT] = [
-    [true, false, true, true], // Rs
-    [true, true, true, true],  // Rr
-    [true, false, true, true], // Ls
-    [true, true, true, true],  // Lr
-    [false, true, true, true], // B
-    [false, true, true, true], // Bl
-    [true, true, true, true],  // current sensor (phase currents)
-    [true, false, true, true], // voltage sensor
-    [true, true, true, true],  // speed sensor (encoder)
-];
+/// order, columns r1..r4 ([`FAULTS`]).
+pub const ROTOR_FLUX_SIGNATURES: [[bool; 4]; FAULT_COUNT] = column(2).1;
 
 /// The fault signature matrix for a frame: the physical one ([`ROTOR_FLUX_SIGNATURES`])
 /// in rotor-flux orientation, the paper's [`TABLE1`] in voltage orientation (module docs).

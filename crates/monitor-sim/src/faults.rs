@@ -3,7 +3,7 @@
 
 use super::scenario::{invalid, not_negative};
 use super::SimError;
-use monitor_core::{Fault, Phase};
+use monitor_core::{Fault, FaultTarget, Phase, SensorChannel};
 use serde::{Deserialize, Serialize};
 
 /// What a sensor fault does to the reading x.
@@ -120,7 +120,7 @@ impl FaultSpec {
             }
             _ => {}
         }
-        if self.phase.is_some() && self.kind == Fault::SpeedSensor {
+        if self.phase.is_some() && self.kind.target() == FaultTarget::Sensor(SensorChannel::Speed) {
             return invalid("faults.phase", "the speed sensor has no phases".into());
         }
         Ok(())

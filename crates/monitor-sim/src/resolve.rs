@@ -4,7 +4,7 @@
 
 use super::machine::{LoadLaw, Machine, MachineError, SatLaw, TurnLoop};
 use super::{EffectSpec, FaultSpec, LoadKind, Scenario, ScenarioEvent, SimError};
-use monitor_core::{Fault, MotorParameters};
+use monitor_core::{FaultTarget, MachineParameter, MotorParameters};
 use monitor_io::params::ParamFile;
 use std::f64::consts::PI;
 
@@ -213,18 +213,21 @@ impl Default for ParameterScales {
 }
 
 impl ParameterScales {
-    /// Applies a parametric fault (sensor faults act on the sensors, not here).
+    /// Applies a parametric fault to the parameter the core's fault list names for it
+    /// ([`monitor_core::Fault::target`]; sensor faults act on the sensors, not here).
     pub(super) fn apply_fault(&mut self, f: &FaultSpec) {
         let k = 1.0 + f.change.unwrap_or(0.0);
-        match f.kind {
-            Fault::Rs => self.rs *= k,
-            Fault::Rr => self.rr *= k,
-            Fault::Ls => self.lls *= k,
-            Fault::Lr => self.llr *= k,
-            Fault::B => self.b *= k,
-            Fault::Bl => self.bl *= k,
-            Fault::CurrentSensor | Fault::VoltageSensor | Fault::SpeedSensor => {}
-        }
+        let FaultTarget::Parameter(p) = f.kind.target() else {
+            return;
+        };
+        *match p {
+            MachineParameter::Rs => &mut self.rs,
+            MachineParameter::Rr => &mut self.rr,
+            MachineParameter::StatorLeakage => &mut self.lls,
+            MachineParameter::RotorLeakage => &mut self.llr,
+            MachineParameter::MachineFriction => &mut self.b,
+            MachineParameter::LoadFriction => &mut self.bl,
+        } *= k;
     }
 }
 

@@ -233,9 +233,10 @@ fn check_sensor_faults(params: &ParamFile, sc: &Scenario) -> Result<(), SimError
                 ),
             });
         }
-        let range = match f.kind {
-            monitor_core::Fault::VoltageSensor => ranges.v_range_v,
-            monitor_core::Fault::CurrentSensor => ranges.i_range_a,
+        use monitor_core::{FaultTarget::Sensor, SensorChannel};
+        let range = match f.kind.target() {
+            Sensor(SensorChannel::Voltage) => ranges.v_range_v,
+            Sensor(SensorChannel::Current) => ranges.i_range_a,
             _ => wm_max,
         };
         if let Some(o) = f.offset.filter(|o| o.abs() > range) {

@@ -4,7 +4,7 @@ use super::faults::{FaultSpec, SensorFaultMode};
 use super::scenario::{d_true, invalid, not_negative, positive};
 use super::thermometer::{TemperatureSpec, Thermometer};
 use super::{SimError, Truth};
-use monitor_core::Fault;
+use monitor_core::{FaultTarget, SensorChannel};
 use monitor_io::log::{Channels, Row};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -126,17 +126,20 @@ impl Sensors {
         }
     }
 
-    /// Switches a sensor fault on.
+    /// Switches a sensor fault on (on the sensor the core's fault list names for it,
+    /// [`monitor_core::Fault::target`]).
     pub fn apply_fault(&mut self, f: &FaultSpec) {
         let cf = ChanFault::from_spec(f);
-        let target = match f.kind {
-            Fault::CurrentSensor => &mut self.i_fault,
-            Fault::VoltageSensor => &mut self.v_fault,
-            Fault::SpeedSensor => {
+        let FaultTarget::Sensor(channel) = f.kind.target() else {
+            return;
+        };
+        let target = match channel {
+            SensorChannel::Current => &mut self.i_fault,
+            SensorChannel::Voltage => &mut self.v_fault,
+            SensorChannel::Speed => {
                 self.w_fault = cf;
                 return;
             }
-            _ => return,
         };
         match f.phase {
             Some(p) => target[p.index()] = cf,

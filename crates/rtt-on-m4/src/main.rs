@@ -13,8 +13,9 @@
 //!   17 000 are the G474's cycles in 100 us at 170 MHz, counted as one instruction each),
 //!   its work a loop of 464 instructions (per sample on the board, `cargo qemu-core`: the
 //!   core's 242 and the sampling path's 222 ahead of it);
-//! - thread mode logs the firmware's status line with `log_status`'s format string
-//!   (`src/firmware.rs`; `tests/logging_never_blocks.rs` checks that the two are the same).
+//! - thread mode logs the firmware's status line with its format string (the core's
+//!   `monitor_core::status_line::FORMAT`; `tests/logging_never_blocks.rs` checks that the two
+//!   are the same).
 //!
 //! Two phases of [`SAMPLES_PER_PHASE`] samples, 1 s of the board each: the status line
 //! every 1 000 samples (100 ms, the firmware's status rate), then status lines back to
@@ -233,7 +234,7 @@ fn run_phase(syst: &mut cortex_m::peripheral::SYST, phase: u32, flood: bool) -> 
     }
 }
 
-/// The firmware's status line (`log_status` in `src/firmware.rs`: the same format string,
+/// The firmware's status line (`monitor_core::status_line::FORMAT`: the same format string,
 /// arguments of the same types) with values that change from line to line.
 fn log_status(samples: u32, line: u32) {
     let x = line as f32 * 1e-3;

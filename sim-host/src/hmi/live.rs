@@ -426,11 +426,13 @@ impl Source for LiveSim {
         let Key::Char(c) = key else {
             return quit_key(key, state);
         };
+        if let Some(f) = super::fault_of_key(c) {
+            let e = self.toggle_fault(f);
+            state.event(e);
+            state.controls = Controls::Live(self.controls.clone());
+            return true;
+        }
         let event = match c {
-            '1'..='9' => {
-                let k = c as usize - '1' as usize;
-                Some(self.toggle_fault(Fault::ALL[k]))
-            }
             '0' => self.clear_faults(),
             's' => Some(self.next_change()),
             '+' | '=' => Some(self.step_load(LOAD_STEP)),

@@ -11,7 +11,7 @@
 //! - [`status_line::StdinStatus`]: the firmware's defmt status lines
 //!   (`cargo fw-run | sim-host hmi --stdin`), parsed by [`status_line::parse`].
 //!
-//! The keys are one table, [`KEYS`] (the screen's footer, `--help` and docs/hmi.md use it).
+//! The keys are one table, [`keys`] (the screen's footer, `--help` and docs/hmi.md use it).
 //! Drawing is the binary's (`src/cli/render/hmi.rs`): a pure function of [`HmiState`].
 
 mod keys;
@@ -19,7 +19,9 @@ pub mod live;
 pub mod log_replay;
 pub mod status_line;
 
-pub use keys::{key_help, Key, KeyBinding, KeyScope, KEYS};
+pub use keys::{
+    fault_key, fault_of_key, key_help, keys, Key, KeyBinding, KeyScope, FAULT_KEY_CHARS,
+};
 
 use monitor_core::sequence::min_shorted_fraction;
 use monitor_core::verdict::Verdict;

@@ -1,25 +1,15 @@
 //! The firmware's defmt status line, read back (`cargo fw-run | sim-host hmi --stdin`).
 //!
-//! The line's format is documented once, in docs/firmware.md ("The status line", section
-//! "Build, flash, logs"); the firmware prints it (`log_status` in `src/firmware.rs`) and
-//! the root test `tests/status_line.rs` renders the firmware's own format string with
-//! known values and parses it here. One line:
-//!
-//! ```text
-//! r=[r1, r2, r3, r4] lamps=[b1, b2, b3, b4] fault=B top=NAME(P) 2nd=NAME(P) wm=Xrad/s
-//! zc_locked=.. mode=MODE run=ID:LEARNED/NEEDED overruns=N restarts=N samples=N
-//! max_cyc=N iqs=XA ids=XA vqs=XV f=XHz steady=B eval=B sens=B,B,B mid=[..] half=[..]
-//! iso=NAME iso_change=X iso_p=P wind=PHASE wind_i2=X moved=B rise=XK vdda=XV bor=N
-//! call=CALL
-//! ```
-//!
-//! The parser finds the `key=` fields anywhere in a line, so the decoder's decorations
-//! (a timestamp, the level, colours, the location, on the same or the next line) do not
-//! matter; a line is a status line when it has `r=[..]`, `lamps=[..]` and `fault=`.
-//! Fields an older firmware does not print are `None` on the screen. Other log lines with
-//! a level (`INFO`, `WARN`, `ERROR`) become events on the screen.
+//! The line's format, its writer and its parser are the core's one module,
+//! [`monitor_core::status_line`] (the firmware writes with it); its fields are documented
+//! once, in docs/firmware.md ("The status line"). Here the decoder's output is read line by
+//! line: terminal colours taken out, the core's [`parse`](monitor_core::status_line::parse)
+//! applied, and the reading turned into the screen's [`Snapshot`]. Fields an older firmware
+//! does not print are `None` on the screen. Other log lines with a level (`INFO`, `WARN`,
+//! `ERROR`) become events on the screen.
 
 use super::{quit_key, Controls, HmiState, Key, Snapshot, Source, StdinControls};
+use monitor_core::status_line::StatusReading;
 use monitor_core::verdict::Verdict;
 use monitor_core::{Fault, IsolationState};
 use monitor_replay::{FaultCandidate, IsolationName};
@@ -97,60 +87,6 @@ pub struct FirmwareIsolation {
     pub probability: f32,
 }
 
-/// The value of field `key` in `line` (`key=` at the start or after a space), up to the
-/// next field; `None` when absent.
-fn field<'a>(line: &'a str, key: &str) -> Option<&'a str> {
-    let pat = format!("{key}=");
-    let mut from = 0;
-    while let Some(k) = line[from..].find(&pat) {
-        let at = from + k;
-        if at == 0 || line[..at].ends_with(' ') {
-            let rest = &line[at + pat.len()..];
-            let end = if rest.starts_with('[') {
-                rest.find(']').map_or(rest.len(), |e| e + 1)
-            } else {
-                rest.find(char::is_whitespace).unwrap_or(rest.len())
-            };
-            return Some(&rest[..end]);
-        }
-        from = at + pat.len();
-    }
-    None
-}
-
-/// A number with a unit suffix (`151.2rad/s`, `4.1A`).
-fn number(v: &str) -> Option<f32> {
-    let end = v
-        .find(|c: char| !(c.is_ascii_digit() || matches!(c, '.' | '-' | '+' | 'e' | 'E')))
-        .unwrap_or(v.len());
-    v[..end].parse().ok()
-}
-
-fn list(v: &str) -> Option<Vec<&str>> {
-    let inner = v.strip_prefix('[')?.strip_suffix(']')?;
-    Some(inner.split(',').map(str::trim).collect())
-}
-
-fn floats4(v: &str) -> Option<[f32; 4]> {
-    let l = list(v)?;
-    let x: Vec<f32> = l.iter().filter_map(|s| s.parse().ok()).collect();
-    x.try_into().ok()
-}
-
-fn bools4(v: &str) -> Option<[bool; 4]> {
-    let l = list(v)?;
-    let x: Vec<bool> = l.iter().filter_map(|s| s.parse().ok()).collect();
-    x.try_into().ok()
-}
-
-/// `name(p)`: a candidate, `None` for `none`.
-fn candidate(v: &str) -> Option<(Fault, f32)> {
-    let (name, p) = v.split_once('(')?;
-    let f = Fault::from_name(name)?;
-    let p = number(p)?;
-    (p > 0.0).then_some((f, p))
-}
-
 /// The line without terminal colour sequences (`ESC [ ... letter`).
 pub fn strip_ansi(line: &str) -> String {
     let mut out = String::with_capacity(line.len());
@@ -169,64 +105,44 @@ pub fn strip_ansi(line: &str) -> String {
     out
 }
 
-/// Parses one line of the decoder's output; `None` when it is not a status line.
+/// Parses one line of the decoder's output (terminal colours taken out, then the core's
+/// [`monitor_core::status_line::parse`]); `None` when it is not a status line.
 pub fn parse(line: &str) -> Option<FirmwareStatus> {
-    let line = strip_ansi(line);
-    let line = line.trim();
-    let residuals = floats4(field(line, "r")?)?;
-    let lamps = bools4(field(line, "lamps")?)?;
-    let fault = field(line, "fault")?.parse().ok()?;
-    let f = |k| field(line, k).and_then(number);
-    let b = |k| field(line, k).and_then(|v| v.parse::<bool>().ok());
-    let run = field(line, "run").and_then(|v| {
-        let (id, rest) = v.split_once(':')?;
-        let (l, n) = rest.split_once('/')?;
-        Some((id.parse().ok()?, l.parse().ok()?, n.parse().ok()?))
-    });
-    let sensors = field(line, "sens").and_then(|v| {
-        let x: Vec<bool> = v.split(',').filter_map(|s| s.parse().ok()).collect();
-        x.try_into().ok()
-    });
-    let band = field(line, "mid")
-        .and_then(floats4)
-        .zip(field(line, "half").and_then(floats4));
-    let isolation = field(line, "iso").map(|named| FirmwareIsolation {
-        named: named.to_string(),
-        change: f("iso_change").unwrap_or(0.0),
-        probability: f("iso_p").unwrap_or(0.0),
-    });
-    let timestamp_s = line
-        .split_whitespace()
-        .next()
-        .and_then(|t| t.parse::<f64>().ok());
-    Some(FirmwareStatus {
-        timestamp_s,
-        residuals,
-        lamps,
-        fault,
-        candidates: ["top", "2nd"]
-            .iter()
-            .filter_map(|k| field(line, k).and_then(candidate))
-            .collect(),
-        wm_rad_s: f("wm"),
-        mode: field(line, "mode").map(str::to_string),
-        run,
-        iqs_a: f("iqs"),
-        ids_a: f("ids"),
-        vqs_v: f("vqs"),
-        supply_hz: f("f"),
-        steady: b("steady"),
-        evaluating: b("eval"),
-        sensors,
-        band,
-        isolation,
-        winding: field(line, "wind")
-            .and_then(monitor_core::Phase::from_name)
-            .map(|p| (p, f("wind_i2").unwrap_or(0.0))),
-        moved: b("moved"),
-        winding_rise_k: f("rise"),
-        call: field(line, "call").and_then(call_of),
-    })
+    monitor_core::status_line::parse(&strip_ansi(line)).map(FirmwareStatus::from)
+}
+
+impl From<StatusReading<'_>> for FirmwareStatus {
+    fn from(r: StatusReading<'_>) -> Self {
+        FirmwareStatus {
+            timestamp_s: r.timestamp_s,
+            residuals: r.residuals,
+            lamps: r.lamps,
+            fault: r.fault,
+            candidates: r.candidates.into_iter().flatten().collect(),
+            wm_rad_s: r.speed_rad_s,
+            mode: r.mode.map(str::to_string),
+            run: r.run,
+            iqs_a: r.iqs_a,
+            ids_a: r.ids_a,
+            vqs_v: r.vqs_v,
+            supply_hz: r.frame_hz,
+            steady: r.quasi_steady,
+            evaluating: r.evaluating,
+            sensors: r.sensors,
+            band: r.band,
+            isolation: r
+                .isolation
+                .map(|(named, change, probability)| FirmwareIsolation {
+                    named: named.to_string(),
+                    change,
+                    probability,
+                }),
+            winding: r.winding,
+            moved: r.moved,
+            winding_rise_k: r.winding_rise_k,
+            call: r.call,
+        }
+    }
 }
 
 impl FirmwareStatus {
@@ -459,15 +375,5 @@ impl Source for StdinStatus {
             "firmware status lines on standard input",
             Controls::Stdin(self.controls.clone()),
         )
-    }
-}
-
-/// The verdict of a status line's `call=` field: the decision table's names, and the
-/// names of older firmware's one rule (`clear`, `not-commissioned`).
-fn call_of(name: &str) -> Option<Verdict> {
-    match name {
-        "clear" => Some(Verdict::Healthy),
-        "not-commissioned" => Some(Verdict::CouldNotJudge),
-        other => Verdict::from_name(other),
     }
 }

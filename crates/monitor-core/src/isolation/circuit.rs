@@ -1,6 +1,7 @@
 //! The machine's circuit under a hypothesis, and the 3 x 3 algebra of the residuals.
 
 use super::*;
+use crate::{FaultTarget, MachineParameter};
 
 /// The machine's circuit parameters under a hypothesis.
 #[derive(Debug, Clone, Copy)]
@@ -114,18 +115,22 @@ impl Circuit {
         self
     }
 
-    /// The circuit with parameter fault `f` of factor `k`. The `ls` and `lr` faults scale
+    /// The circuit with parameter fault `f` of factor `k` (the parameter its
+    /// [`Fault::target`] names; a sensor fault leaves it alone). The `ls` and `lr` faults scale
     /// the leakage inductances ([`Fault::Ls`]: the paper's simulator PSIM's Ls and Lr are the
     /// leakages); on a side
     /// without leakage (a Gamma-model machine) they scale Lm, as the simulator does.
     pub(super) fn with(mut self, f: Fault, k: f32, m: &MotorModel) -> Self {
         let (lls, llr) = (m.lls_h(), m.llr_h());
         let tiny = 1e-9 * m.lm_h;
-        match f {
-            Fault::Rs => self.rs *= k,
-            Fault::Rr => self.rr *= k,
-            Fault::Ls | Fault::Lr => {
-                let (l_side, side_is_s) = if f == Fault::Ls {
+        let FaultTarget::Parameter(p) = f.target() else {
+            return self;
+        };
+        match p {
+            MachineParameter::Rs => self.rs *= k,
+            MachineParameter::Rr => self.rr *= k,
+            MachineParameter::StatorLeakage | MachineParameter::RotorLeakage => {
+                let (l_side, side_is_s) = if p == MachineParameter::StatorLeakage {
                     (lls, true)
                 } else {
                     (llr, false)
@@ -140,9 +145,8 @@ impl Circuit {
                     self.lr = llr * k + m.lm_h;
                 }
             }
-            Fault::B => self.b_total = m.b_nms * k + m.bl_nms,
-            Fault::Bl => self.b_total = m.b_nms + m.bl_nms * k,
-            Fault::CurrentSensor | Fault::VoltageSensor | Fault::SpeedSensor => {}
+            MachineParameter::MachineFriction => self.b_total = m.b_nms * k + m.bl_nms,
+            MachineParameter::LoadFriction => self.b_total = m.b_nms + m.bl_nms * k,
         }
         self
     }

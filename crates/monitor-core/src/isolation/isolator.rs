@@ -12,6 +12,7 @@ pub use search::SearchHints;
 
 use super::*;
 use crate::error::{ensure, ConfigCheck, ConfigError};
+use crate::{FaultTarget, SensorChannel};
 use search::{fit_factor, rank};
 
 /// A measured point with the magnitudes of its voltage and current vectors
@@ -286,22 +287,22 @@ impl Isolator {
     #[inline]
     fn reading_of(&self, r: &Reading, h: Option<(Fault, f32)>) -> Reading {
         let p = r.q;
-        match h {
-            Some((Fault::CurrentSensor, k)) => Reading::of(&SteadyPoint {
+        match h.map(|(f, k)| (f.target(), k)) {
+            Some((FaultTarget::Sensor(SensorChannel::Current), k)) => Reading::of(&SteadyPoint {
                 i: Dq {
                     d: p.i.d / k,
                     q: p.i.q / k,
                 },
                 ..p
             }),
-            Some((Fault::VoltageSensor, k)) => Reading::of(&SteadyPoint {
+            Some((FaultTarget::Sensor(SensorChannel::Voltage), k)) => Reading::of(&SteadyPoint {
                 v: Dq {
                     d: p.v.d / k,
                     q: p.v.q / k,
                 },
                 ..p
             }),
-            Some((Fault::SpeedSensor, k)) => Reading {
+            Some((FaultTarget::Sensor(SensorChannel::Speed), k)) => Reading {
                 q: SteadyPoint {
                     wr_rad_s: p.wr_rad_s / k,
                     ..p

@@ -17,7 +17,7 @@ use ratatui::symbols::Marker;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Axis, Block, Borders, Chart, Dataset, GraphType, Paragraph};
 use ratatui::Frame;
-use sim_host::hmi::{header_text, Controls, HmiState, KeyScope, Snapshot, HISTORY_S, KEYS};
+use sim_host::hmi::{header_text, keys, Controls, HmiState, KeyScope, Snapshot, HISTORY_S};
 
 /// Colours of r1..r4 (lamps' labels, bars and chart).
 const COLOURS: [Color; 4] = [Color::Cyan, Color::Magenta, Color::Yellow, Color::Green];
@@ -452,7 +452,7 @@ fn notes(state: &HmiState) -> Vec<Line<'static>> {
     vec![warning, event]
 }
 
-/// The keys of the source, from the one list [`KEYS`].
+/// The keys of the source, from the one list ([`keys`]).
 fn keys_line(c: &Controls) -> Line<'static> {
     let scope = match c {
         Controls::Live(_) => KeyScope::Live,
@@ -460,14 +460,15 @@ fn keys_line(c: &Controls) -> Line<'static> {
         Controls::Stdin(_) => KeyScope::All,
     };
     let simulated = !matches!(c, Controls::Stdin(_));
-    let items: Vec<&str> = KEYS
+    let keys = keys();
+    let items: Vec<&str> = keys
         .iter()
         .filter(|k| {
             k.scope == scope
                 || k.scope == KeyScope::All
                 || (k.scope == KeyScope::Simulated && simulated)
         })
-        .map(|k| k.footer)
+        .map(|k| k.footer.as_ref())
         .collect();
     Line::styled(
         format!(" {}", items.join(" ")),
