@@ -4,7 +4,11 @@
 
 use super::front::{Direct, Handled, ReplaySink, CLOCK_RESET_GAP_S};
 use super::verdict::findings::data_quality_finding;
-use super::{pipe, DiagnoseReport, Replay, ReplayError, ReplayOptions};
+use super::error::ReplayError;
+use super::options::ReplayOptions;
+use super::pipe;
+use super::replay::Replay;
+use super::report::DiagnoseReport;
 use monitor_core::MonitorOutput;
 use monitor_io::log::quality::{
     CellLimits, CleanSink, DataQuality, NotJudged, QualityStage, MAX_BRIDGED_GAP_S,

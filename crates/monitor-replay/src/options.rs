@@ -6,13 +6,32 @@
 //! of it: the command line says it as its flags, Python as its keywords, [`Spelling`]),
 //! and the monitor configuration a replay runs with ([`monitor_config_for_log`]).
 
-use super::{HealthyReference, TICK_HZ};
+use super::baseline::HealthyReference;
+use super::sampler::TICK_HZ;
 use monitor_core::{AngleSource, MonitorConfig, ResidualForm};
 use monitor_io::params::ParamFile;
 use serde::Serialize;
 use std::fmt;
 use std::ops::RangeInclusive;
 use std::str::FromStr;
+
+/// Serialises an angle source by its command-line name ([`angle_source_name`]), for
+/// `#[serde(serialize_with = "serialize_angle_source")]` on a report's field.
+pub fn serialize_angle_source<S: serde::Serializer>(
+    a: &AngleSource,
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    s.serialize_str(angle_source_name(*a))
+}
+
+/// Name of an angle source as used on the command line.
+pub fn angle_source_name(a: AngleSource) -> &'static str {
+    match a {
+        AngleSource::ZeroCrossing => "zero-crossing",
+        AngleSource::Pll => "pll",
+        AngleSource::RotorFluxCurrentModel => "rotor-flux",
+    }
+}
 
 /// Replay options.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -31,13 +50,13 @@ pub struct ReplayOptions {
     pub timeline_step: TimelineStep,
     /// The healthy machine's negative sequence to judge the winding against (the field
     /// `baseline` of a request: healthy logs); without it, the one learned in the
-    /// commissioning window, else none ([`super::UnbalanceBaseline`]).
+    /// commissioning window, else none ([`super::baseline::UnbalanceBaseline`]).
     pub unbalance_baseline: Option<HealthyReference>,
     /// What is known of the load ([`LoadModel`]; the field `load`).
     pub load: LoadModel,
     /// How the shorted-turn level is sized (the fields `parallel_paths`, 1..=8 as
     /// [`PARALLEL_PATHS`] says, and `turn_calibration`; [`super::winding::level`]).
-    pub turn_level: super::TurnLevelOptions,
+    pub turn_level: super::winding::level::TurnLevelOptions,
 }
 
 /// What the replay knows of the load torque.
@@ -73,7 +92,7 @@ impl Default for ReplayOptions {
             timeline_step: TimelineStep::DEFAULT,
             unbalance_baseline: None,
             load: LoadModel::Unknown,
-            turn_level: super::TurnLevelOptions::default(),
+            turn_level: super::winding::level::TurnLevelOptions::default(),
         }
     }
 }
@@ -106,7 +125,7 @@ pub fn monitor_config_for_log(
 
 impl ReplayOptions {
     /// The one check of the options every front end calls (the command line, Python, the
-    /// HMI, the fleet; [`super::Replay::new`] too): the commissioning window as
+    /// HMI, the fleet; [`crate::Replay::new`] too): the commissioning window as
     /// [`CommissionWindow::new`] checks it, `parallel_paths` in [`PARALLEL_PATHS`] (the
     /// time step is positive by construction, [`TimelineStep`]).
     ///
@@ -294,7 +313,7 @@ impl CommissionWindow {
         self.end_s
     }
 
-    /// `(start, end)` [s], as [`super::ReplayOptions::commission`] holds it.
+    /// `(start, end)` [s], as [`ReplayOptions::commission`] holds it.
     pub fn seconds(self) -> (f64, f64) {
         (self.start_s, self.end_s)
     }

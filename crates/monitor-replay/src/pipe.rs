@@ -14,7 +14,10 @@
 
 use super::front::Feeder;
 use super::sequences::{SequenceFront, SequenceStep};
-use super::{sequence_front, Replay, ReplayError, ReplayOptions, SequenceWindow};
+use super::error::ReplayError;
+use super::options::ReplayOptions;
+use super::replay::{sequence_front, Replay};
+use super::sequences::SequenceWindow;
 use monitor_io::log::{Channels, Row};
 use monitor_io::params::ParamFile;
 use std::sync::mpsc::{channel, sync_channel, Receiver, Sender, SyncSender};

@@ -1,9 +1,13 @@
 //! Log rows as core samples ([`LogSampler`]): the host's counterpart of the firmware's ADC
 //! sampler.
 
-use super::{COUNTS_PER_REV, TICK_HZ};
 use monitor_core::{Abc, Sample};
 use monitor_io::log::Row;
+
+/// Timestamp tick rate used for replays [Hz].
+pub const TICK_HZ: f64 = 1.0e6;
+/// Counts per revolution of the synthesised encoder (1024 lines x 4).
+pub const COUNTS_PER_REV: u32 = 4096;
 
 /// The core sample of `row` from `sampler`, its encoder count moved on by `enc_offset`
 /// (counts handed on over a clock reset: [`super::Replay`]'s `enc_offset`).

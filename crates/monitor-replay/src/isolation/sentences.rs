@@ -59,7 +59,7 @@ impl IsolationTracker {
     }
 
     /// The verdict where the last point reads as the friction class with the load an unknown
-    /// input ([`crate::LoadModel::Unknown`]): the load moved.
+    /// input ([`crate::options::LoadModel::Unknown`]): the load moved.
     fn load_moved_sentence(&self) -> String {
         let last = self.events.events().iter().rev().find_map(|e| match e {
             IsolationEvent::LoadMoved { t_s, from_a, to_a } => Some((*t_s, *from_a, *to_a)),

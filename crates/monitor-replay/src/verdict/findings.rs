@@ -5,7 +5,9 @@
 use super::words::fault_text;
 use super::FindingReport;
 use crate::isolation::{FaultCandidate, IsolationBaseline, IsolationName, IsolationReport};
-use crate::{BaselineSource, Replay, UnbalanceReport, MIN_JUDGED_S};
+use super::MIN_JUDGED_S;
+use crate::replay::Replay;
+use crate::winding::{BaselineSource, UnbalanceReport};
 use monitor_core::verdict::{Against, FaultName, FindingSource, NamedFault, Size, State};
 use monitor_core::{MonitorOutput, SensorFlags};
 use monitor_io::log::quality::{DataQuality, MAX_NOT_JUDGED_FRACTION};
@@ -205,7 +207,7 @@ impl Replay {
     /// With the load an unknown input, the lamps' matching only ever named the friction
     /// class (the load term): a load move.
     fn only_load_named(&self) -> bool {
-        self.opts.load == crate::LoadModel::Unknown
+        self.opts.load == crate::options::LoadModel::Unknown
             && !self.detections.is_empty()
             && self
                 .detections
@@ -317,7 +319,7 @@ impl Replay {
         let moves = iso
             .events
             .iter()
-            .filter(|e| matches!(e, crate::IsolationEvent::LoadMoved { .. }))
+            .filter(|e| matches!(e, crate::events::IsolationEvent::LoadMoved { .. }))
             .count();
         let mut said = Vec::new();
         if let Some(note) = self.commission.moved_note(out) {
@@ -458,7 +460,7 @@ pub const WINDING_WATCH_PROBABILITY: f32 = 0.2;
 
 /// The most probable shorted phase and its probability, where it has
 /// [`WINDING_WATCH_PROBABILITY`] or more.
-fn watched_phase(pp: &crate::PhaseProbabilities) -> Option<(monitor_core::Phase, f32)> {
+fn watched_phase(pp: &crate::winding::PhaseProbabilities) -> Option<(monitor_core::Phase, f32)> {
     use monitor_core::Phase;
     [(Phase::A, pp.a), (Phase::B, pp.b), (Phase::C, pp.c)]
         .into_iter()
@@ -471,8 +473,8 @@ fn watched_phase(pp: &crate::PhaseProbabilities) -> Option<(monitor_core::Phase,
 /// `monitor_core::verdict::ROTOR_FAULT_DB`), with the spectrum's confidence; quieter
 /// sidebands ("no sign", and the "watch" band, which practice trends rather than acts on)
 /// are judged clear, with their level; a record the spectrum could not read is unavailable.
-pub(crate) fn rotor_finding(r: &crate::RotorReport) -> FindingReport {
-    use crate::RotorBand;
+pub(crate) fn rotor_finding(r: &crate::rotor::RotorReport) -> FindingReport {
+    use crate::rotor::RotorBand;
     let of = |state, summary: String, brief: String| {
         FindingReport::new(
             FindingSource::Rotor,

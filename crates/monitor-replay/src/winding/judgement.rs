@@ -11,9 +11,10 @@ use super::{
     FULL_LOAD_SLIP_MAX, MAX_SEGMENTS, MEASURED_REFERENCE_UNCERTAINTY_DEG, MIN_SEGMENT_WINDOWS,
     SLIP_MODEL_UNCERTAINTY,
 };
-use crate::report::BaselineSource;
 use crate::sequences::{sensor_phase, SequenceWindow};
-use crate::{Replay, SensorPhaseReport, UnbalanceReport};
+use super::{BaselineSource, UnbalanceReport};
+use crate::replay::Replay;
+use crate::sequences::SensorPhaseReport;
 use monitor_core::sequence::{
     asymmetry_correction_rad, equivalent_impedance, slip_for_current, SinglePhaseGain,
 };

@@ -31,7 +31,7 @@
 //! the judgement.
 
 use super::{abs, Complex32, FULL_LOAD_SLIP_MAX};
-use crate::UnbalanceReport;
+use super::UnbalanceReport;
 use monitor_core::sequence::{equivalent_impedance, slip_for_current};
 use monitor_core::{MotorModel, Phase};
 use serde::{Deserialize, Serialize};
