@@ -2,13 +2,13 @@
 //! ([`diagnose_file`]), the glitch bursts filled or held out, and the observer of every
 //! output (the live HMI's log source).
 
-use super::front::{Direct, Handled, ReplaySink, CLOCK_RESET_GAP_S};
-use super::verdict::findings::data_quality_finding;
 use super::error::ReplayError;
+use super::front::{Direct, Handled, ReplaySink, CLOCK_RESET_GAP_S};
 use super::options::ReplayOptions;
 use super::pipe;
 use super::replay::Replay;
 use super::report::DiagnoseReport;
+use super::verdict::measured::data_quality_finding;
 use monitor_core::MonitorOutput;
 use monitor_io::log::quality::{
     CellLimits, CleanSink, DataQuality, NotJudged, QualityStage, MAX_BRIDGED_GAP_S,
@@ -193,7 +193,7 @@ fn conclude(
         });
     };
     if replay.commissioning_incomplete() && !opts.allow_incomplete {
-        let (window, mut why) = replay.commission.not_learned().unwrap_or_default();
+        let (window, mut why) = replay.lamps.commission.not_learned().unwrap_or_default();
         // What the data-quality stage distrusts is often why nothing was learned (swapped
         // channels, a dead sensor): say it in the same line.
         if !quality.trusted {
@@ -204,8 +204,8 @@ fn conclude(
         }
         return Err(ReplayError::IncompleteCommissioning { window, why });
     }
-    let can_residuals = replay.monitor.is_some();
-    let sensors = replay.output().sensor_fault;
+    let can_residuals = replay.monitor().is_some();
+    let sensors = replay.lamps.output().sensor_fault;
     let mut report = replay.finish();
     describe_actions(&mut quality, can_residuals, handled);
     let dq = data_quality_finding(&quality, sensors);

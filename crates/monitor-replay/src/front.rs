@@ -154,13 +154,13 @@ impl<O: ReplayObserver + ?Sized> Feeder for Direct<'_, O> {
         };
         let out = r.push(row);
         if let Some(o) = self.observer.as_deref_mut() {
-            o.output(&r.with_encoder_offset(row), &out, r);
+            o.output(&r.lamps.with_encoder_offset(row), &out, r);
         }
     }
 
     fn clock_reset(&mut self) {
         if let Some(r) = self.replay.as_mut() {
-            r.clock_reset();
+            r.lamps.clock_reset();
         }
     }
 

@@ -29,6 +29,7 @@ mod events;
 mod front;
 mod isolation;
 mod isolation_name;
+mod lamps;
 mod options;
 mod pipe;
 mod replay;
@@ -64,12 +65,11 @@ pub use isolation::{
     IsolationReport, NameGiven, NOMINAL_UNCERTAINTY,
 };
 pub use options::{
-    angle_source_name, check_parallel_paths, monitor_config_for_log, CommissionWindow, FieldNames, LoadModel,
-    OptionError, OptionField, ReplayOptions, serialize_angle_source, Spelling, TimelineStep, PARALLEL_PATHS,
+    angle_source_name, check_parallel_paths, monitor_config_for_log, serialize_angle_source,
+    CommissionWindow, FieldNames, LoadModel, OptionError, OptionField, ReplayOptions, Spelling,
+    TimelineStep, PARALLEL_PATHS,
 };
-pub use report::{
-    DiagnoseReport, MonitorState, Panel, TimelinePoint,
-};
+pub use report::{DiagnoseReport, MonitorState, Panel, TimelinePoint};
 pub use rotor::{
     band_of, blackman_harris, RotorBand, RotorReport, SlipSource, BLACKMAN_HARRIS_4,
     EDGE_SPREAD_DB, FAULT_EDGE_DB, MAIN_LOBE_HALF_BINS, MAX_SLIP, MAX_STRETCH_S, MIN_BINS,
@@ -84,8 +84,8 @@ pub use winding::level::{
     LabelledRun, LevelBasis, ShortedTurns, TurnCalibration, TurnLevelOptions,
 };
 pub use winding::{
-    describe_against, segments, Against, BaselineSource, OperatingPointSource, UnbalanceReport,
-    PhaseProbabilities, SequenceSegment, BALANCED_RATIO, DEFAULT_SPREAD_CURRENTS,
+    describe_against, segments, Against, BaselineSource, OperatingPointSource, PhaseProbabilities,
+    SequenceSegment, UnbalanceReport, BALANCED_RATIO, DEFAULT_SPREAD_CURRENTS,
     DEFAULT_SPREAD_VOLTAGES, HEALTHY_RUN_DIFFERENCE_CURRENTS, HEALTHY_RUN_DIFFERENCE_VOLTAGES,
     NO_BASELINE_SPREAD, NO_BASELINE_SPREAD_VOLTAGES, WINDING_FAULT_PROBABILITY, WITHIN_LOG_SPREAD,
 };

@@ -12,12 +12,12 @@
 //! synchronously (a configuration the core rejects stops the read at once, as without the
 //! thread).
 
-use super::front::Feeder;
-use super::sequences::{SequenceFront, SequenceStep};
 use super::error::ReplayError;
+use super::front::Feeder;
 use super::options::ReplayOptions;
 use super::replay::{sequence_front, Replay};
 use super::sequences::SequenceWindow;
+use super::sequences::{SequenceFront, SequenceStep};
 use monitor_io::log::{Channels, Row};
 use monitor_io::params::ParamFile;
 use std::sync::mpsc::{channel, sync_channel, Receiver, Sender, SyncSender};
@@ -202,7 +202,7 @@ impl Back<'_> {
                 };
                 match c {
                     Call::Window(w) => r.queue_window(w),
-                    Call::ClockReset => r.clock_reset(),
+                    Call::ClockReset => r.lamps.clock_reset(),
                     Call::End(front) => r.set_sequence_front(*front),
                     Call::Begin(_) | Call::Restart => {}
                 }

@@ -1,24 +1,18 @@
 //! The replay of a log row by row ([`Replay`]): the core's monitor, the sequence analysis,
 //! the isolation and the bookkeeping of the report, fed one row at a time.
 
-use crate::commission::CommissionTracker;
 use crate::error::ReplayError;
-use crate::isolation::chunk::RowFlags;
 use crate::isolation::{self, FaultCandidate, IsolationReport, IsolationTracker, NameGiven};
-use crate::verdict::{findings, glance, Rule, Verdict};
-use crate::winding::UnbalanceReport;
+use crate::lamps::Lamps;
 use crate::options::{monitor_config_for_log, LoadModel, ReplayOptions};
 use crate::report::{
     final_lamps, note_moved_point, signature_candidates, skipped_analyses, DiagnoseReport,
     MonitorState, Panel, TimelinePoint, LOAD_BACK_NOTE, LOAD_MOVED_NOTE,
 };
-use crate::sampler::{sample_of, LogSampler, COUNTS_PER_REV};
 use crate::sequences::{self, SequenceWindow};
-use crate::step::{
-    bands_for, bands_needed, book_detection, lamps_since_moved, note_residuals, timeline_step_due,
-    BlockView, Detection, LastOutput, RestartHold, NO_BANDS,
-};
-use crate::{front, unsettled};
+use crate::step::{lamps_since_moved, timeline_step_due, BlockView, LastOutput};
+use crate::verdict::{findings, glance, Rule, Verdict};
+use crate::winding::{unbalance_report, UnbalanceReport};
 use monitor_core::{CommissioningState, Isolator, Monitor, MonitorOutput};
 use monitor_io::log::quality::DataQuality;
 use monitor_io::log::{Channels, Row};
@@ -66,35 +60,13 @@ pub(crate) fn sequence_front(
 
 /// Streaming replay: feed rows, then [`Replay::finish`].
 pub struct Replay {
-    pub(crate) monitor: Option<Monitor>,
-    pub(crate) sampler: LogSampler,
     pub(crate) opts: ReplayOptions,
     pub(crate) params: ParamFile,
     pub(crate) channels: Channels,
-    pub(crate) commission: CommissionTracker,
-    pub(crate) k_sigma: f32,
     pub(crate) rows: u64,
-    pub(crate) evaluated: bool,
-    /// Seconds of running on which the lamps were judged: evaluated, quasi-steady, on
-    /// thresholds in force ([`MIN_JUDGED_S`] for a healthy verdict).
-    pub(crate) judged_s: f64,
-    /// A detection happened inside the commissioned operating range (or without one).
-    pub(crate) detected_in_range: bool,
-    pub(crate) first_detection: Option<f64>,
-    pub(crate) detections: Vec<Detection>,
-    /// The fault probabilities whose first fault is in `detections` already (NaN: none
-    /// yet; [`step::note_detection`]).
-    pub(crate) top_seen: [f32; monitor_core::FAULT_COUNT],
     pub(crate) timeline: Vec<TimelinePoint>,
     pub(crate) next_point: f64,
     pub(crate) dt_s: f64,
-    pub(crate) max_abs: [f32; 4],
-    /// What the next row needs of the monitor's output after the last row (a copy of the
-    /// whole output per row is what it saves).
-    pub(crate) last: LastOutput,
-    /// What the rows up to the monitor's next revision take from its output
-    /// ([`Replay::block_row`]).
-    pub(crate) view: BlockView,
     pub(crate) t0: Option<f64>,
     pub(crate) isolation: IsolationTracker,
     /// The symmetrical components, sample by sample ([`sequences::SequenceFront`]; on the
@@ -102,17 +74,8 @@ pub struct Replay {
     pub(crate) seq_front: sequences::SequenceFront,
     /// The least-squares windows with the monitor's learning and speed.
     pub(crate) book: sequences::WindowBook,
-    /// The lamps lit now first lit while the operating point had moved (or the load
-    /// explained them), and have not all been dark since: their release after the load came
-    /// back is still the amber state.
-    pub(crate) lamps_since_moved: bool,
-    /// The isolation's wait after a restart of the monitor's estimators.
-    pub(crate) restart: RestartHold,
-    /// The stretch where the quasi-steady gate held the lamps, at the log's end.
-    pub(crate) unsettled: unsettled::Unsettled,
-    /// Added to every row's encoder count after a clock reset: the turn over the bridged
-    /// time ([`Replay::clock_reset`]).
-    pub(crate) enc_offset: i64,
+    /// The lamps: the core's monitor and what the report keeps of its outputs.
+    pub(crate) lamps: Lamps,
 }
 
 impl Replay {
@@ -134,42 +97,20 @@ impl Replay {
             source,
             sample_rate_hz,
         };
-        let can_residuals = channels.voltages && (channels.speed || channels.encoder);
-        let monitor = if can_residuals {
-            Some(Monitor::new(cfg).map_err(config_error)?)
-        } else {
-            cfg.validate().map_err(config_error)?;
-            None
-        };
+        let residuals = channels.voltages && (channels.speed || channels.encoder);
         Ok(Replay {
-            monitor,
-            sampler: LogSampler::default(),
+            lamps: Lamps::new(&cfg, opts.commission, residuals).map_err(config_error)?,
             opts,
             params: *params,
             channels,
-            commission: CommissionTracker::new(opts.commission, &cfg),
-            k_sigma: cfg.thresholds.k_sigma,
             rows: 0,
-            evaluated: false,
-            judged_s: 0.0,
-            detected_in_range: false,
-            first_detection: None,
-            detections: Vec::new(),
-            top_seen: [f32::NAN; monitor_core::FAULT_COUNT],
             timeline: Vec::new(),
             next_point: 0.0,
             dt_s: 1.0 / sample_rate_hz,
-            max_abs: [0.0; 4],
-            last: LastOutput::default(),
-            view: BlockView::default(),
             t0: None,
             isolation: isolation_tracker(params, channels, opts.load, cfg.decimation),
-            lamps_since_moved: false,
             seq_front: sequence_front(params, channels, sample_rate_hz).map_err(config_error)?,
             book: sequences::WindowBook::new(),
-            restart: RestartHold::new(f64::from(cfg.settle_s)),
-            unsettled: unsettled::Unsettled::default(),
-            enc_offset: 0,
         })
     }
 
@@ -179,14 +120,7 @@ impl Replay {
         let step = self.seq_front.track(row, t);
         self.book.take(&mut self.seq_front);
         self.push_step(row, &step);
-        self.output()
-    }
-
-    /// The monitor's last output (the default for a current-only log).
-    pub(crate) fn output(&self) -> MonitorOutput {
-        self.monitor
-            .as_ref()
-            .map_or_else(MonitorOutput::default, |m| *m.output())
+        self.lamps.output()
     }
 
     /// [`Replay::push`] with the sequence analysis' step for the row already taken (by a
@@ -196,15 +130,16 @@ impl Replay {
         self.rows += 1;
         let t0 = *self.t0.get_or_insert(row.t_s);
         let t = row.t_s - t0;
-        let wr = self.monitor.as_ref().map(|_| self.last.wr_rad_s);
-        self.book.row(step, self.last.learning, wr);
-        let Some(mon) = self.monitor.as_mut() else {
+        let wr = self
+            .lamps
+            .monitor
+            .as_ref()
+            .map(|_| self.lamps.last.wr_rad_s);
+        self.book.row(step, self.lamps.last.learning, wr);
+        let Some(fresh) = self.lamps.update(row, t) else {
             return;
         };
-        self.commission.before(mon, t);
-        mon.update(&sample_of(&mut self.sampler, self.enc_offset, row));
-        let fresh = self.revise(t);
-        let Some(mon) = self.monitor.as_ref() else {
+        let Some(mon) = self.lamps.monitor.as_ref() else {
             return;
         };
         // (The output is read where the monitor keeps it: no copy per row.)
@@ -214,9 +149,9 @@ impl Replay {
             judging,
             lamps_lit,
             ..
-        } = self.view;
+        } = self.lamps.view;
         let point = step.point(out.operating.wr_rad_s);
-        let settled = self.restart.settled(t, out);
+        let settled = self.lamps.restart.settled(t, out);
         let usable = flags.with_counts(flags.counts() && settled);
         let (dt_s, tc) = (self.dt_s, row.t_winding_c);
         self.isolation.after(t, dt_s, usable, &point, tc);
@@ -224,104 +159,21 @@ impl Replay {
         // stage's sample clock may put the sample at the step a hair before it).
         let (dt_s, step_s) = (self.dt_s, self.opts.timeline_step.seconds());
         if timeline_step_due(&mut self.next_point, t, dt_s, step_s) {
-            let point = timeline_point(self, t, out, self.view.range_note.clone());
+            let point = timeline_point(self, t, out, self.lamps.view.range_note.clone());
             self.timeline.push(point);
         }
         // The running the lamps were judged on ([`MIN_JUDGED_S`]).
         if judging {
-            self.judged_s += self.dt_s;
+            self.lamps.judged_s += self.dt_s;
         }
-        self.lamps_since_moved = lamps_since_moved(
-            (self.lamps_since_moved, lamps_lit),
+        self.lamps.lamps_since_moved = lamps_since_moved(
+            (self.lamps.lamps_since_moved, lamps_lit),
             out,
-            &self.commission,
+            &self.lamps.commission,
             &self.isolation,
         );
         if fresh {
-            self.last = LastOutput::of(out, flags);
-        }
-    }
-
-    /// Between two of the monitor's revisions ([`Monitor::revision`]) only its speed moves:
-    /// what depends on the rest of the output is done on the revision's first row, in
-    /// [`Replay::block_row`] (whether this row at `t` [s] is one: the answer), every row
-    /// does what depends on its time or its own values ([`Replay::push_step`]).
-    pub(crate) fn revise(&mut self, t: f64) -> bool {
-        let Some(mon) = self.monitor.as_ref() else {
-            return false;
-        };
-        let revision = mon.revision();
-        if self.view.revision == Some(revision) {
-            self.unsettled.tick(t);
-            return false;
-        }
-        let out = mon.output();
-        let range_note = self.commission.after(mon, t, out);
-        let bands = bands_needed(mon, out);
-        let out = *out;
-        self.block_row(t, &out, bands, (revision, range_note));
-        true
-    }
-
-    /// The part of a row that depends on the monitor's output other than its speed, done
-    /// on the first row of each of its revisions ([`Monitor::revision`]; the rows after it
-    /// up to the next would repeat it to the bit): the residuals' extremes, the flags, the
-    /// held stretch, a counted detection, and what the rows up to the next need (`bands`: the
-    /// threshold bands in force, `range_note`: the commissioned range's note now).
-    pub(crate) fn block_row(
-        &mut self,
-        t: f64,
-        out: &MonitorOutput,
-        bands: [(f32, f32); 4],
-        (revision, range_note): (u32, Option<String>),
-    ) {
-        note_residuals(&mut self.evaluated, &mut self.max_abs, out);
-        // With a commissioning window asked for, lamps lit on the fixed thresholds before
-        // the learned ones are in force are not detections: the window says the nominal
-        // parameters are not to be trusted (a sensor fault counts at any time).
-        let trusted = self.commission.thresholds_trusted(out);
-        let flags = RowFlags::of(out, trusted);
-        let counts = flags.counts();
-        let bands = bands_for(bands, out, counts, self.detected_in_range);
-        let held_bands = if out.quasi_steady { NO_BANDS } else { bands };
-        let judged = self.evaluated;
-        self.unsettled
-            .after(t, (out, flags), held_bands, judged, trusted);
-        if out.fault_detected && counts {
-            let first = (&mut self.detected_in_range, &mut self.first_detection);
-            let booked = (&mut self.detections, &mut self.top_seen);
-            book_detection(first, booked, &self.commission, (t, out, bands));
-        }
-        self.view = BlockView {
-            revision: Some(revision),
-            flags,
-            judging: out.evaluating && out.quasi_steady && trusted,
-            lamps_lit: out.lamps.iter().any(|l| *l),
-            range_note,
-        };
-    }
-
-    /// The acquisition clock was reset before the next row (`diagnose` carries the time on
-    /// by [`front::CLOCK_RESET_GAP_S`]): the encoder count handed on goes on by the turn
-    /// over the bridged time at the monitor's speed (the count the data-quality stage hands
-    /// on continues with no step).
-    pub(crate) fn clock_reset(&mut self) {
-        let w = self
-            .monitor
-            .as_ref()
-            .map_or(0.0, |m| f64::from(m.output().speed_rad_s));
-        let turned = w * front::CLOCK_RESET_GAP_S / std::f64::consts::TAU;
-        self.enc_offset = self
-            .enc_offset
-            .wrapping_add((turned * f64::from(COUNTS_PER_REV)).round() as i64);
-    }
-
-    /// `row` with the encoder offset of the clock resets so far ([`Replay::clock_reset`]):
-    /// the row as the monitor sees it.
-    pub(crate) fn with_encoder_offset(&self, row: &Row) -> Row {
-        Row {
-            enc_count: row.enc_count.map(|c| c.wrapping_add(self.enc_offset)),
-            ..*row
+            self.lamps.last = LastOutput::of(out, flags);
         }
     }
 
@@ -339,13 +191,13 @@ impl Replay {
 
     /// The learned calibration (mean and spread of r1..r4), once commissioning is done.
     pub fn calibration(&self) -> Option<monitor_core::Calibration> {
-        self.monitor.as_ref().and_then(|m| m.calibration())
+        self.lamps.monitor.as_ref().and_then(|m| m.calibration())
     }
 
     /// The threshold bands of r1..r4 in force, (centre, half-width)
     /// ([`Monitor::threshold_bands`]); `None` for a current-only log.
     pub fn threshold_bands(&self) -> Option<[(f32, f32); 4]> {
-        self.monitor.as_ref().map(Monitor::threshold_bands)
+        self.lamps.monitor.as_ref().map(Monitor::threshold_bands)
     }
 
     /// Time of `row` since the replay's first row [s] (the timeline's time).
@@ -356,33 +208,8 @@ impl Replay {
     /// What the isolation concludes now, as [`Replay::finish`] would report it (the report
     /// and the candidates listed), for a screen that follows the replay.
     pub fn isolation_now(&self) -> (IsolationReport, Vec<FaultCandidate>) {
-        let detected = self.detected();
+        let detected = self.lamps.detected(&self.isolation, self.opts.load);
         self.isolation.report(detected)
-    }
-
-    /// Whether a fault was detected: a lamp lit or the isolation named a fault, unless the
-    /// isolation ends finding that the windings' heating explains it
-    /// (`monitor_core::isolation`, "Heating is not a fault"), or, with the load an unknown
-    /// input, that the load moved ([`LoadModel::Unknown`]: the lamps' torque residuals see a
-    /// load change as the paper's Bl fault).
-    pub(crate) fn detected(&self) -> bool {
-        // With the load unknown, lamps whose matching only ever named the friction class
-        // (B, Bl: the load term) read a load move, not a fault.
-        let only_load = self.opts.load == LoadModel::Unknown
-            && !self.detections.is_empty()
-            && self
-                .detections
-                .iter()
-                .all(|d| matches!(d.fault, monitor_core::Fault::B | monitor_core::Fault::Bl))
-            && !self.out_sensor_fault_seen();
-        let lamps =
-            self.first_detection.is_some() && !self.isolation.load_explains_lamps() && !only_load;
-        !self.isolation.heating_explains_lamps() && (lamps || self.isolation.named_a_fault())
-    }
-
-    /// A sensor fault was flagged at the end (the lamps' detections then stand).
-    pub(crate) fn out_sensor_fault_seen(&self) -> bool {
-        self.last.sensor_fault
     }
 
     /// Every name the isolation gave so far (a fault or the friction class `b/bl`), each
@@ -398,23 +225,23 @@ impl Replay {
     /// the amber "operating point moved" state: to the paper's model a load change is a Bl
     /// change, so lamps lit there are not a fault unless the isolation names one.
     pub fn operating_point_moved(&self, out: &MonitorOutput) -> Option<String> {
-        self.commission.moved_note(out)
+        self.lamps.commission.moved_note(out)
     }
 
     /// The core monitor (`None` for a current-only log).
     pub fn monitor(&self) -> Option<&Monitor> {
-        self.monitor.as_ref()
+        self.lamps.monitor.as_ref()
     }
 
     /// The core monitor, to start a commissioning run by hand (the live HMI's key); `None`
     /// for a current-only log.
     pub fn monitor_mut(&mut self) -> Option<&mut Monitor> {
-        self.monitor.as_mut()
+        self.lamps.monitor.as_mut()
     }
 
     /// True when a commissioning window was asked for and not learned.
     pub fn commissioning_incomplete(&self) -> bool {
-        self.monitor.is_some() && self.commission.incomplete()
+        self.lamps.monitor.is_some() && self.lamps.commission.incomplete()
     }
 }
 
@@ -456,7 +283,7 @@ impl Replay {
             // Lamps that lit while the load had moved are still releasing (they go out
             // after a second inside their bands): amber until they do, unless the isolation
             // names a fault meanwhile.
-            None if matches!(state, MonitorState::Fault(_)) && self.lamps_since_moved => {
+            None if matches!(state, MonitorState::Fault(_)) && self.lamps.lamps_since_moved => {
                 LOAD_BACK_NOTE.to_string()
             }
             None => return state,
@@ -482,12 +309,12 @@ impl Replay {
         let state = self.state_given(out, own, isolation.as_ref().map(|(r, _)| r));
         // Outside the evaluated points (a transient: the lamps hold) the isolation is
         // asked once here where the rule or the load's note needs it.
-        let asked = (isolation.is_none() && (out.fault_detected || self.lamps_since_moved))
+        let asked = (isolation.is_none() && (out.fault_detected || self.lamps.lamps_since_moved))
             .then(|| self.isolation_now());
         let report = isolation.as_ref().or(asked.as_ref());
         // Lamps held through the transient after a load move are the load's, not a fault,
         // unless the isolation names one.
-        let held_for_load = self.lamps_since_moved
+        let held_for_load = self.lamps.lamps_since_moved
             && !matches!(
                 report.and_then(|(r, _)| r.named),
                 Some(isolation::IsolationName::Fault(_))
@@ -517,7 +344,7 @@ impl Replay {
         signature_candidates: &[FaultCandidate],
     ) -> (IsolationReport, Vec<FaultCandidate>) {
         let (mut isolation, mut isolated) = self.isolation.report(detected);
-        if let Some(note) = self.commission.moved_note(out) {
+        if let Some(note) = self.lamps.commission.moved_note(out) {
             note_moved_point(&mut isolation, &note);
         }
         isolation::refine_single_phase(
@@ -537,17 +364,28 @@ impl Replay {
     /// caller to fill).
     pub fn finish(mut self) -> DiagnoseReport {
         self.isolation.flush();
-        let out = self.output();
+        let out = self.lamps.output();
         self.close_sequences(&out);
         let skipped = skipped_analyses(self.channels);
-        let unbalance = self.unbalance_report();
+        let unbalance = unbalance_report(
+            self.book.windows(),
+            &self.params,
+            self.lamps.monitor.is_some(),
+            self.opts.unbalance_baseline,
+            self.opts.turn_level,
+        );
         let signature_candidates = signature_candidates(&out);
-        let detected = self.detected();
+        let detected = self.lamps.detected(&self.isolation, self.opts.load);
         let (isolation, candidates) =
             self.final_isolation(&out, &unbalance, detected, &signature_candidates);
         let lamps = final_lamps(&out);
         let rotor = super::rotor::rotor_report(self.seq_front.rotor(), &self.params);
-        let found = self.findings(
+        let judged = findings::Judged {
+            lamps: &self.lamps,
+            isolation: &self.isolation,
+            opts: &self.opts,
+        };
+        let found = judged.findings(
             &findings::ResidualInputs {
                 out: &out,
                 isolation: &isolation,
@@ -571,17 +409,17 @@ impl Replay {
             candidates,
             isolation,
             signature_candidates,
-            first_detection_s: self.first_detection,
+            first_detection_s: self.lamps.first_detection,
             unbalance,
             rotor,
-            detections: self.detections,
+            detections: self.lamps.detections,
             skipped,
             angle_source: self.opts.angle_source,
             commission: self.opts.commission,
-            commissioning: self.commission.report(self.k_sigma),
+            commissioning: self.lamps.commission.report(self.lamps.k_sigma),
             data_quality: DataQuality::default(),
             rows: self.rows,
-            max_abs_residual: self.max_abs,
+            max_abs_residual: self.lamps.max_abs,
             timeline: self.timeline,
         };
         report.conclude();
@@ -594,7 +432,7 @@ impl Replay {
         if self.seq_front.finish() {
             self.book.take(&mut self.seq_front);
             self.book
-                .close(self.monitor.as_ref().map(|_| out.operating.wr_rad_s));
+                .close(self.lamps.monitor.as_ref().map(|_| out.operating.wr_rad_s));
         }
     }
 }

@@ -59,7 +59,6 @@ impl MonitorState {
     }
 }
 
-
 /// The amber state's note where the lamps lit for a load that moved inside the commissioned
 /// range, with the load an unknown input (`LoadModel::Unknown`).
 pub const LOAD_MOVED_NOTE: &str =

@@ -34,15 +34,15 @@ use block_pll::BlockPll;
 use lanes::{Demod, FitSums};
 use monitor_core::frames::{clarke, AlphaBeta, SinCos};
 use monitor_core::sequence::{single_phase_gain, Complex32, SinglePhaseGain, ThreePhasors};
-use monitor_core::Phase;
 use monitor_core::Abc;
+use monitor_core::Phase;
 use monitor_core::SteadyPoint as IsolationPoint;
 use monitor_io::log::quality::MAX_BRIDGED_GAP_S;
 use monitor_io::log::Row;
 use monitor_io::params::ParamFile;
 use reference::{RampSums, Reference};
-use slow::SlowFilters;
 use serde::Serialize;
+use slow::SlowFilters;
 use std::collections::VecDeque;
 
 /// Zero sequence (|3 I0|/|I1|) from which one phase's sensor gain error is reported: 0.5 %,

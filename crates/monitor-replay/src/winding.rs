@@ -54,12 +54,13 @@ mod reading;
 mod reasons;
 mod segments;
 
+pub(crate) use judgement::unbalance_report;
 pub use reasons::BALANCED_RATIO;
 pub use segments::segments;
 
-use super::sequences::{SensorPhaseReport, SequenceWindow};
-use super::baseline::{abs, mean, of_pair, pair, pooled_change_sigma, UnbalanceBaseline};
 pub use super::baseline::HealthyReference;
+use super::baseline::{abs, mean, of_pair, pair, pooled_change_sigma, UnbalanceBaseline};
+use super::sequences::{SensorPhaseReport, SequenceWindow};
 use monitor_core::sequence::{Complex32, INHERENT_ASYMMETRY_RATIO};
 use monitor_core::Phase;
 use serde::Serialize;

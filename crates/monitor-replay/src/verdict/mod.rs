@@ -18,6 +18,7 @@
 //!   commissioned.
 
 pub(super) mod findings;
+pub(super) mod measured;
 mod words;
 pub use words::{against_text, fault_text, pct};
 
@@ -186,8 +187,6 @@ pub fn put(findings: &mut Vec<FindingReport>, f: FindingReport) {
 }
 
 use crate::isolation::IsolationReport;
-use crate::replay::Replay;
-use crate::winding::UnbalanceReport;
 use monitor_core::verdict::{FaultName, Glance};
 use monitor_core::MonitorOutput;
 
@@ -203,30 +202,6 @@ pub const MIN_JUDGED_S: f64 = 1.0;
 /// the name and its size.
 pub const MIN_FAULT_CHANGE: f32 = monitor_core::isolation::MIN_FAULT_CHANGE;
 
-impl Replay {
-    /// Every analysis' finding at the end of the replay (the data quality's is added by the
-    /// caller that ran the data-quality stage, `diagnose`): the residuals, the winding, the
-    /// rotor, the operating point, the parameter file's fit, and the sensors' impossible
-    /// readings.
-    pub(crate) fn findings(
-        &self,
-        inp: &findings::ResidualInputs<'_>,
-        unbalance: &UnbalanceReport,
-        rotor: &crate::rotor::RotorReport,
-    ) -> Vec<FindingReport> {
-        let residual = self.residual_finding(inp);
-        let mut found = vec![
-            residual.clone(),
-            findings::winding_finding(unbalance),
-            findings::rotor_finding(rotor),
-            self.operating_point_finding(inp.out, inp.isolation),
-            self.parameter_fit_finding(&residual, inp.isolation),
-        ];
-        found.extend(findings::sensor_flag_finding(inp.out.sensor_fault));
-        found
-    }
-}
-
 /// The moment's evidence as the decision table reads it (the board's
 /// `monitor_core::verdict::Glance`): the lamps, the sensor flags, the isolation's name with
 /// its candidate's probability, its baseline, whether the operating point explains the
@@ -237,12 +212,14 @@ pub(crate) fn glance(
     moved: bool,
 ) -> Glance {
     let named = report.and_then(|(r, c)| findings::isolation_name(r, c));
-    let friction = report.is_some_and(|(r, _)| r.named == Some(crate::isolation::IsolationName::Friction));
+    let friction =
+        report.is_some_and(|(r, _)| r.named == Some(crate::isolation::IsolationName::Friction));
     Glance {
         lamps_lit: out.fault_detected,
         sensor_fault: out.sensor_fault.any(),
         named,
-        commissioned: report.is_some_and(|(r, _)| r.baseline == crate::isolation::IsolationBaseline::Learned),
+        commissioned: report
+            .is_some_and(|(r, _)| r.baseline == crate::isolation::IsolationBaseline::Learned),
         moved: moved || friction,
         // The core's winding phase counts where the lamps are judged (settled, quasi-steady):
         // a start's or a step's transient unbalances the currents for a while.
