@@ -40,24 +40,6 @@ fn isolation_tracker(
     )
 }
 
-/// The sequence analysis of a replay of a log with `channels` at `sample_rate_hz` (the
-/// sample limits the monitor's, [`monitor_config_for_log`]). Errors: the filters' checks
-/// ([`sequences::SequenceFront::new`]).
-pub(crate) fn sequence_front(
-    params: &ParamFile,
-    channels: Channels,
-    sample_rate_hz: f64,
-) -> Result<sequences::SequenceFront, monitor_core::ConfigError> {
-    let cfg = monitor_config_for_log(params, sample_rate_hz, &ReplayOptions::default());
-    sequences::SequenceFront::new(
-        params,
-        channels.voltages,
-        sample_rate_hz,
-        f64::from(cfg.limits.i_max),
-        f64::from(cfg.limits.v_max),
-    )
-}
-
 /// Streaming replay: feed rows, then [`Replay::finish`].
 pub struct Replay {
     pub(crate) opts: ReplayOptions,
@@ -71,7 +53,7 @@ pub struct Replay {
     pub(crate) isolation: IsolationTracker,
     /// The symmetrical components, sample by sample ([`sequences::SequenceFront`]; on the
     /// reading thread in `diagnose`, whose steps come with the rows: [`Replay::push_step`]).
-    pub(crate) seq_front: sequences::SequenceFront,
+    pub(crate) seq_front: Option<sequences::SequenceFront>,
     /// The least-squares windows with the monitor's learning and speed.
     pub(crate) book: sequences::WindowBook,
     /// The lamps: the core's monitor and what the report keeps of its outputs.
@@ -109,7 +91,16 @@ impl Replay {
             dt_s: 1.0 / sample_rate_hz,
             t0: None,
             isolation: isolation_tracker(params, channels, opts.load, cfg.decimation),
-            seq_front: sequence_front(params, channels, sample_rate_hz).map_err(config_error)?,
+            seq_front: Some(
+                sequences::SequenceFront::new(
+                    params,
+                    channels.voltages,
+                    sample_rate_hz,
+                    f64::from(cfg.limits.i_max),
+                    f64::from(cfg.limits.v_max),
+                )
+                .map_err(config_error)?,
+            ),
             book: sequences::WindowBook::new(),
         })
     }
@@ -117,9 +108,11 @@ impl Replay {
     /// Feeds one row; returns the monitor's output (default output for current-only logs).
     pub fn push(&mut self, row: &Row) -> MonitorOutput {
         let t = row.t_s - *self.t0.get_or_insert(row.t_s);
-        let step = self.seq_front.track(row, t);
-        self.book.take(&mut self.seq_front);
-        self.push_step(row, &step);
+        if let Some(front) = self.seq_front.as_mut() {
+            let step = front.track(row, t);
+            self.book.take(front);
+            self.push_step(row, &step);
+        }
         self.lamps.output()
     }
 
@@ -186,7 +179,14 @@ impl Replay {
     /// Takes over the sequence analysis that ran on another thread, once every row was
     /// pushed: its last window is the replay's to close ([`Replay::finish`]).
     pub(crate) fn set_sequence_front(&mut self, front: sequences::SequenceFront) {
-        self.seq_front = front;
+        self.seq_front = Some(front);
+    }
+
+    /// Lends the sequence analysis to the thread that reads the log, which runs it beside
+    /// this replay and gives it back at the end ([`Replay::set_sequence_front`]): the one
+    /// front built with the replay, on the replay's configuration.
+    pub(crate) fn lend_sequence_front(&mut self) -> Option<sequences::SequenceFront> {
+        self.seq_front.take()
     }
 
     /// The learned calibration (mean and spread of r1..r4), once commissioning is done.
@@ -243,9 +243,6 @@ impl Replay {
     pub fn commissioning_incomplete(&self) -> bool {
         self.lamps.monitor.is_some() && self.lamps.commission.incomplete()
     }
-}
-
-impl Replay {
     /// The monitor's state at the replay's output `out` as the panel shows it, the one rule
     /// of the HMI, the demo and `diagnose`'s timeline: [`MonitorState::of`], except that
     /// where the load or the voltage has left the commissioned range
@@ -330,9 +327,6 @@ impl Replay {
             state,
         }
     }
-}
-
-impl Replay {
     /// The isolation's report at the end, with the candidates the report lists (the lamps'
     /// own for a sensor's impossible reading): the moved point's sentence, one phase's
     /// sensor from the zero sequence.
@@ -379,7 +373,11 @@ impl Replay {
         let (isolation, candidates) =
             self.final_isolation(&out, &unbalance, detected, &signature_candidates);
         let lamps = final_lamps(&out);
-        let rotor = super::rotor::rotor_report(self.seq_front.rotor(), &self.params);
+        let rotor = match &self.seq_front {
+            Some(front) => crate::rotor::rotor_report(front.rotor(), &self.params),
+            // (Lent and never given back: a read that ended before its end.)
+            None => crate::rotor::RotorReport::default(),
+        };
         let judged = findings::Judged {
             lamps: &self.lamps,
             isolation: &self.isolation,
@@ -429,8 +427,11 @@ impl Replay {
     /// Closes the sequence analysis' last window (the front's, then the book's, with the
     /// monitor's speed in `out`).
     fn close_sequences(&mut self, out: &MonitorOutput) {
-        if self.seq_front.finish() {
-            self.book.take(&mut self.seq_front);
+        let Some(front) = self.seq_front.as_mut() else {
+            return;
+        };
+        if front.finish() {
+            self.book.take(front);
             self.book
                 .close(self.lamps.monitor.as_ref().map(|_| out.operating.wr_rad_s));
         }

@@ -2,12 +2,12 @@
 //! ([`super::FindingReport`]). Each says what it found and what it was judged against, or
 //! why it could not judge.
 
+use super::measured::{rotor_finding, sensor_flag_finding, winding_finding};
 use super::words::fault_text;
 use super::FindingReport;
 use super::MIN_JUDGED_S;
 use crate::isolation::IsolationTracker;
 use crate::isolation::{FaultCandidate, IsolationBaseline, IsolationName, IsolationReport};
-use super::measured::{rotor_finding, sensor_flag_finding, winding_finding};
 use crate::lamps::Lamps;
 use crate::options::ReplayOptions;
 use crate::winding::UnbalanceReport;
