@@ -3,13 +3,13 @@
 //! output (the live HMI's log source).
 
 use super::error::ReplayError;
-use super::front::{Direct, Handled, ReplaySink, CLOCK_RESET_GAP_S};
+use super::front::{Direct, Handled, ReplaySink};
 use super::options::ReplayOptions;
 use super::pipe;
-use super::replay::Replay;
+use super::replay::{Replay, ReplayObserver};
 use super::report::DiagnoseReport;
+use super::sampler::CLOCK_RESET_GAP_S;
 use super::verdict::measured::data_quality_finding;
-use monitor_core::MonitorOutput;
 use monitor_io::log::quality::{
     CellLimits, CleanSink, DataQuality, NotJudged, QualityStage, MAX_BRIDGED_GAP_S,
 };
@@ -80,17 +80,6 @@ pub fn diagnose_log(
     replay_through_quality(params, file.channels(), file.shown(), opts, |stage| {
         file.for_each_row(progress, stage).map(|_| ())
     })
-}
-
-/// Watches a replay row by row ([`diagnose_file_observed`]): the live HMI's log source.
-pub trait ReplayObserver {
-    /// The monitor's output after `row` (as the data-quality stage passed it on, glitches
-    /// filled in); `replay` for its time base and thresholds ([`Replay::time_of`],
-    /// [`Replay::threshold_bands`]).
-    fn output(&mut self, row: &Row, out: &MonitorOutput, replay: &Replay);
-    /// The replay starts again from the log's first row (the reader's fast path handed
-    /// over to the exact reader): forget every output so far.
-    fn restart(&mut self);
 }
 
 /// [`diagnose_file`] that hands every replayed row's output to `observer` as it goes, the

@@ -1,27 +1,27 @@
-//! The lamps' stage of a replay ([`Lamps`]): the core's monitor fed row by row (exactly the
+//! The lamps' stage of a replay ([`LampStage`]): the core's monitor fed row by row (exactly the
 //! code the firmware runs), commissioning around it, and what the report keeps of its
 //! outputs: the residuals' extremes, the detections, the running judged, the stretch the
 //! quasi-steady gate held, the encoder count carried over a clock reset.
 //!
 //! Between two of the monitor's revisions ([`Monitor::revision`]) only its speed moves:
-//! what depends on the rest of the output is done once per revision ([`Lamps::revise`]).
+//! what depends on the rest of the output is done once per revision ([`LampStage::revise`]).
 
 use crate::commission::CommissionTracker;
 use crate::isolation::chunk::RowFlags;
 use crate::isolation::IsolationTracker;
 use crate::options::LoadModel;
-use crate::sampler::{sample_of, LogSampler, COUNTS_PER_REV};
+use crate::sampler::{sample_of, LogSampler, CLOCK_RESET_GAP_S, COUNTS_PER_REV};
 use crate::step::{
     bands_for, bands_needed, book_detection, note_residuals, BlockView, Detection, LastOutput,
     RestartHold, NO_BANDS,
 };
-use crate::{front, unsettled};
+use crate::unsettled;
 use monitor_core::{ConfigError, Monitor, MonitorConfig, MonitorOutput};
 use monitor_io::log::Row;
 
 /// The lamps' stage: the core's monitor (`None` for a log that cannot feed the residuals:
 /// no voltages or no speed) and its bookkeeping.
-pub(crate) struct Lamps {
+pub(crate) struct LampStage {
     pub(crate) monitor: Option<Monitor>,
     pub(crate) sampler: LogSampler,
     pub(crate) commission: CommissionTracker,
@@ -42,7 +42,7 @@ pub(crate) struct Lamps {
     /// whole output per row is what it saves).
     pub(crate) last: LastOutput,
     /// What the rows up to the monitor's next revision take from its output
-    /// ([`Lamps::block_row`]).
+    /// ([`LampStage::block_row`]).
     pub(crate) view: BlockView,
     /// The lamps lit now first lit while the operating point had moved (or the load
     /// explained them), and have not all been dark since: their release after the load came
@@ -53,11 +53,11 @@ pub(crate) struct Lamps {
     /// The stretch where the quasi-steady gate held the lamps, at the log's end.
     pub(crate) unsettled: unsettled::Unsettled,
     /// Added to every row's encoder count after a clock reset: the turn over the bridged
-    /// time ([`Lamps::clock_reset`]).
+    /// time ([`LampStage::clock_reset`]).
     pub(crate) enc_offset: i64,
 }
 
-impl Lamps {
+impl LampStage {
     /// The stage for a monitor configured by `cfg` (`residuals`: the log can feed them),
     /// commissioning in `commission` [s] where asked for.
     ///
@@ -74,7 +74,7 @@ impl Lamps {
             cfg.validate()?;
             None
         };
-        Ok(Lamps {
+        Ok(LampStage {
             monitor,
             sampler: LogSampler::default(),
             commission: CommissionTracker::new(commission, cfg),
@@ -96,7 +96,7 @@ impl Lamps {
     }
 
     /// Feeds `row` at `t` [s] to the monitor (commissioning's start or end first): whether
-    /// the output is a fresh revision ([`Lamps::revise`]); `None` without a monitor.
+    /// the output is a fresh revision ([`LampStage::revise`]); `None` without a monitor.
     pub(crate) fn update(&mut self, row: &Row, t: f64) -> Option<bool> {
         let mon = self.monitor.as_mut()?;
         self.commission.before(mon, t);
@@ -113,7 +113,7 @@ impl Lamps {
 
     /// Between two of the monitor's revisions ([`Monitor::revision`]) only its speed moves:
     /// what depends on the rest of the output is done on the revision's first row, in
-    /// [`Lamps::block_row`] (whether this row at `t` [s] is one: the answer), every row
+    /// [`LampStage::block_row`] (whether this row at `t` [s] is one: the answer), every row
     /// does what depends on its time or its own values ([`Replay::push_step`]).
     pub(crate) fn revise(&mut self, t: f64) -> bool {
         let Some(mon) = self.monitor.as_ref() else {
@@ -171,7 +171,7 @@ impl Lamps {
     }
 
     /// The acquisition clock was reset before the next row (`diagnose` carries the time on
-    /// by [`front::CLOCK_RESET_GAP_S`]): the encoder count handed on goes on by the turn
+    /// by [`CLOCK_RESET_GAP_S`]): the encoder count handed on goes on by the turn
     /// over the bridged time at the monitor's speed (the count the data-quality stage hands
     /// on continues with no step).
     pub(crate) fn clock_reset(&mut self) {
@@ -179,13 +179,13 @@ impl Lamps {
             .monitor
             .as_ref()
             .map_or(0.0, |m| f64::from(m.output().speed_rad_s));
-        let turned = w * front::CLOCK_RESET_GAP_S / std::f64::consts::TAU;
+        let turned = w * CLOCK_RESET_GAP_S / std::f64::consts::TAU;
         self.enc_offset = self
             .enc_offset
             .wrapping_add((turned * f64::from(COUNTS_PER_REV)).round() as i64);
     }
 
-    /// `row` with the encoder offset of the clock resets so far ([`Lamps::clock_reset`]):
+    /// `row` with the encoder offset of the clock resets so far ([`LampStage::clock_reset`]):
     /// the row as the monitor sees it.
     pub(crate) fn with_encoder_offset(&self, row: &Row) -> Row {
         Row {

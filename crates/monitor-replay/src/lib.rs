@@ -46,7 +46,7 @@ mod winding;
 
 pub use baseline::{HealthyReference, UnbalanceBaseline, BASELINE_I1_TOLERANCE};
 pub use error::ReplayError;
-pub use replay::Replay;
+pub use replay::{Replay, ReplayObserver};
 pub use sampler::{COUNTS_PER_REV, TICK_HZ};
 pub use sequences::{FILLED_SAMPLES, SENSOR_PHASE_MIN_RATIO};
 pub use verdict::{MIN_FAULT_CHANGE, MIN_JUDGED_S};
@@ -55,9 +55,7 @@ pub use commission::{
     grace_s, min_learned_s, CommissioningOutcome, CommissioningReport, QuasiSteadyPoint, RangeNote,
     MIN_LEARNED_S,
 };
-pub use diagnose::{
-    diagnose_file, diagnose_file_observed, diagnose_log, diagnose_rows, Diagnosed, ReplayObserver,
-};
+pub use diagnose::{diagnose_file, diagnose_file_observed, diagnose_log, diagnose_rows, Diagnosed};
 pub use events::{IsolationEvent, LOAD_MOVE_FRACTION, MAX_EVENTS};
 pub use isolation::serialize_state;
 pub use isolation::{

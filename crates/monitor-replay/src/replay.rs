@@ -3,12 +3,13 @@
 
 use crate::error::ReplayError;
 use crate::isolation::{self, FaultCandidate, IsolationReport, IsolationTracker, NameGiven};
-use crate::lamps::Lamps;
+use crate::lamps::LampStage;
 use crate::options::{monitor_config_for_log, LoadModel, ReplayOptions};
 use crate::report::{
     final_lamps, note_moved_point, signature_candidates, skipped_analyses, DiagnoseReport,
     MonitorState, Panel, TimelinePoint, LOAD_BACK_NOTE, LOAD_MOVED_NOTE,
 };
+use crate::rotor::{rotor_report, RotorReport};
 use crate::sequences::{self, SequenceWindow};
 use crate::step::{lamps_since_moved, timeline_step_due, BlockView, LastOutput};
 use crate::verdict::{findings, glance, Rule, Verdict};
@@ -40,6 +41,17 @@ fn isolation_tracker(
     )
 }
 
+/// Watches a replay row by row (`diagnose_file_observed`): the live HMI's log source.
+pub trait ReplayObserver {
+    /// The monitor's output after `row` (as the data-quality stage passed it on, glitches
+    /// filled in); `replay` for its time base and thresholds ([`Replay::time_of`],
+    /// [`Replay::threshold_bands`]).
+    fn output(&mut self, row: &Row, out: &MonitorOutput, replay: &Replay);
+    /// The replay starts again from the log's first row (the reader's fast path handed
+    /// over to the exact reader): forget every output so far.
+    fn restart(&mut self);
+}
+
 /// Streaming replay: feed rows, then [`Replay::finish`].
 pub struct Replay {
     pub(crate) opts: ReplayOptions,
@@ -57,7 +69,7 @@ pub struct Replay {
     /// The least-squares windows with the monitor's learning and speed.
     pub(crate) book: sequences::WindowBook,
     /// The lamps: the core's monitor and what the report keeps of its outputs.
-    pub(crate) lamps: Lamps,
+    pub(crate) lamps: LampStage,
 }
 
 impl Replay {
@@ -81,7 +93,7 @@ impl Replay {
         };
         let residuals = channels.voltages && (channels.speed || channels.encoder);
         Ok(Replay {
-            lamps: Lamps::new(&cfg, opts.commission, residuals).map_err(config_error)?,
+            lamps: LampStage::new(&cfg, opts.commission, residuals).map_err(config_error)?,
             opts,
             params: *params,
             channels,
@@ -354,13 +366,9 @@ impl Replay {
         }
     }
 
-    /// Ends the replay and builds the report (`data_quality` left at its default for the
-    /// caller to fill).
-    pub fn finish(mut self) -> DiagnoseReport {
-        self.isolation.flush();
-        let out = self.lamps.output();
-        self.close_sequences(&out);
-        let skipped = skipped_analyses(self.channels);
+    /// The reports of the sequence analysis' windows and record at the end: the winding's
+    /// negative sequence and the rotor's sidebands.
+    fn sequence_reports(&self) -> (UnbalanceReport, RotorReport) {
         let unbalance = unbalance_report(
             self.book.windows(),
             &self.params,
@@ -368,17 +376,28 @@ impl Replay {
             self.opts.unbalance_baseline,
             self.opts.turn_level,
         );
+        let rotor = match &self.seq_front {
+            Some(front) => rotor_report(front.rotor(), &self.params),
+            // (Lent and never given back: a read that ended before its end.)
+            None => RotorReport::default(),
+        };
+        (unbalance, rotor)
+    }
+
+    /// Ends the replay and builds the report (`data_quality` left at its default for the
+    /// caller to fill).
+    pub fn finish(mut self) -> DiagnoseReport {
+        self.isolation.flush();
+        let out = self.lamps.output();
+        self.close_sequences(&out);
+        let skipped = skipped_analyses(self.channels);
+        let (unbalance, rotor) = self.sequence_reports();
         let signature_candidates = signature_candidates(&out);
         let detected = self.lamps.detected(&self.isolation, self.opts.load);
         let (isolation, candidates) =
             self.final_isolation(&out, &unbalance, detected, &signature_candidates);
         let lamps = final_lamps(&out);
-        let rotor = match &self.seq_front {
-            Some(front) => crate::rotor::rotor_report(front.rotor(), &self.params),
-            // (Lent and never given back: a read that ended before its end.)
-            None => crate::rotor::RotorReport::default(),
-        };
-        let judged = findings::Judged {
+        let judged = findings::Stages {
             lamps: &self.lamps,
             isolation: &self.isolation,
             opts: &self.opts,

@@ -159,12 +159,12 @@ pub struct DiagnoseReport {
     /// Negative-sequence analysis of the currents.
     pub unbalance: UnbalanceReport,
     /// The rotor: broken bars from the current's sidebands (`super::rotor`).
-    pub rotor: super::RotorReport,
+    pub rotor: super::rotor::RotorReport,
     /// Faults ever named while the lamps were lit, with the time first named.
     pub detections: Vec<Detection>,
     /// Analyses skipped for lack of a column, with the reason.
     pub skipped: Vec<String>,
-    /// Angle source used (JSON: its command-line name, [`super::angle_source_name`]).
+    /// Angle source used (JSON: its command-line name, [`super::options::angle_source_name`]).
     #[serde(serialize_with = "serialize_angle_source")]
     pub angle_source: AngleSource,
     /// Commissioning window asked for, if any [s].

@@ -8,7 +8,7 @@ use super::FindingReport;
 use super::MIN_JUDGED_S;
 use crate::isolation::IsolationTracker;
 use crate::isolation::{FaultCandidate, IsolationBaseline, IsolationName, IsolationReport};
-use crate::lamps::Lamps;
+use crate::lamps::LampStage;
 use crate::options::ReplayOptions;
 use crate::winding::UnbalanceReport;
 use monitor_core::verdict::{Against, FaultName, FindingSource, NamedFault, Size, State};
@@ -72,16 +72,16 @@ fn residual_brief(against: Against) -> String {
 
 /// What the findings read of a replay's stages at its end: the lamps, the isolation and
 /// the options asked for.
-pub(crate) struct Judged<'a> {
+pub(crate) struct Stages<'a> {
     /// The lamps' stage.
-    pub lamps: &'a Lamps,
+    pub lamps: &'a LampStage,
     /// The isolation's tracker.
     pub isolation: &'a IsolationTracker,
     /// The replay's options.
     pub opts: &'a ReplayOptions,
 }
 
-impl Judged<'_> {
+impl Stages<'_> {
     /// Every analysis' finding at the end of the replay (the data quality's is added by the
     /// caller that ran the data-quality stage, `diagnose`): the residuals, the winding, the
     /// rotor, the operating point, the parameter file's fit, and the sensors' impossible
