@@ -176,7 +176,10 @@ fn the_root_only_names_its_modules() {
                 }
             }
         }
-        for rel in all.iter().filter(|f| f.starts_with(dir) && f.ends_with(".rs")) {
+        for rel in all
+            .iter()
+            .filter(|f| f.starts_with(dir) && f.ends_with(".rs"))
+        {
             let in_src = &rel[dir.len()..];
             if in_src == "lib.rs" {
                 continue;
