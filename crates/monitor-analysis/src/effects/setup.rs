@@ -358,6 +358,17 @@ impl FitSetup {
         }
     }
 
+    /// Starts the fit from `values` and from nowhere else: the other starting values
+    /// ([`FitSetup::alt_init`]) are dropped too. For an effect already fitted (a ladder's
+    /// nested fit, where the model stood): its valley was chosen when it was fitted. Ignored
+    /// unless there is one value per parameter.
+    pub fn start_only_from(&mut self, values: &[f64]) {
+        if values.len() == self.params.len() {
+            self.start_from(values);
+            self.alt_init.clear();
+        }
+    }
+
     /// The reasons the values `p` are not physically plausible (empty: plausible): one line
     /// per parameter outside its range ([`FitParam::implausible_because`]).
     pub fn implausible(&self, p: &[f64]) -> Vec<String> {

@@ -217,11 +217,6 @@ impl StatMachine<'_> {
     /// Classic RK4 over `h` from `t0` into the sample, with the input at the start,
     /// middle and end.
     fn rk4(&self, x: &StatState, h: f64, v: [C64; 3], t0: f64) -> StatState {
-        let add = |a: &StatState, b: &StatState, s: f64| StatState {
-            i: a.i + b.i * s,
-            psi: a.psi + b.psi * s,
-            wm: a.wm + b.wm * s,
-        };
         // The unequal cage's turn at the start, the middle and the end (one turn of half
         // the step, squared; none without a cage).
         let one = C64::new(1.0, 0.0);
@@ -232,6 +227,18 @@ impl StatMachine<'_> {
             ),
             Some(c) => (one, C64::from_polar(1.0, c.w2 * 0.5 * h)),
             None => (one, one),
+        };
+        self.rk4_turning(x, h, v, r0, r_half)
+    }
+
+    /// [`StatMachine::rk4`] with the unequal cage's turn at the start `r0` and over half
+    /// the step `r_half` given (1 and 1 without a cage).
+    #[inline(always)]
+    fn rk4_turning(&self, x: &StatState, h: f64, v: [C64; 3], r0: C64, r_half: C64) -> StatState {
+        let add = |a: &StatState, b: &StatState, s: f64| StatState {
+            i: a.i + b.i * s,
+            psi: a.psi + b.psi * s,
+            wm: a.wm + b.wm * s,
         };
         let r_mid = r0 * r_half;
         let k1 = self.deriv(x, v[0], r0);
@@ -355,7 +362,7 @@ pub(super) fn simulate_stationary_with(
         wm: x0.wm,
     };
     let mut v = [form.volt.v_at(0), form.volt.v_at(1.min(len - 1))];
-    let mut cage = CageAngle::new(d, t);
+    let cage = CageAngle::new(d, t, volt);
     let lm_guess = std::cell::Cell::new(0.0);
     for k in 0..len {
         let sm = form.machine_at(k, cage.at(d, k), &lm_guess, &mut x);
@@ -496,7 +503,14 @@ impl StatForm<'_> {
             let half = volt.half[k];
             let vm = (v_cur * half + v_next * half.conj()) * 0.5
                 + (vn0 * half.conj() + vn1 * half) * 0.5;
-            sm.rk4(x, dt, [v0, vm, v1], 0.0)
+            // A whole working sample: the cage's half turn is the series' own.
+            let one = C64::new(1.0, 0.0);
+            let r_half = match (&sm.cage, volt.cage_half.get(k)) {
+                (Some(_), Some(&r)) => r,
+                (Some(c), None) => C64::from_polar(1.0, c.w2 * 0.5 * dt),
+                (None, _) => one,
+            };
+            sm.rk4_turning(x, dt, [v0, vm, v1], one, r_half)
         }
     }
 }
@@ -504,37 +518,48 @@ impl StatForm<'_> {
 /// The angle 2 theta_a + phi of the faulty rotor phase for [`CageOverSample`] (`None`
 /// without an unequal cage or without a speed column): Np theta_m integrates the
 /// measured electrical speed (trapezoid) from the analysis frame's angle at the first
-/// sample, as the reduced model's cage terms do, so that `phi` means the same.
+/// sample, as the reduced model's cage terms do, so that `phi` means the same. Its turn
+/// `e^{j (2 theta_a + phi)}` per working sample depends on the series and `phi` alone: the
+/// runs of a fit that leave `phi` where it was share it ([`StatVoltage::cage_turns`]).
 struct CageAngle {
     /// The unequal cage of the terms.
     p: Option<super::CageAsymmetry>,
-    /// 2 Np theta_m at the current sample [rad].
-    th2: f64,
+    /// `e^{j (2 theta_a + phi)}` at each working sample.
+    u: std::sync::Arc<Vec<C64>>,
 }
 
 impl CageAngle {
-    fn new(d: &Prepared, t: &ModelTerms) -> Self {
+    fn new(d: &Prepared, t: &ModelTerms, volt: &StatVoltage) -> Self {
         let ok = d.omega_r.len() == d.len() && !d.is_empty();
+        let p = t.rotor_cage.asymmetry.filter(|_| ok);
         CageAngle {
-            p: t.rotor_cage.asymmetry.filter(|_| ok),
-            th2: d.theta.first().map_or(0.0, |t| 2.0 * t),
+            u: p.map_or_else(Default::default, |c| volt.cage_turns(d, c.phi_rad)),
+            p,
         }
     }
 
-    /// The cage over working sample `k` (call for k = 0, 1, ... in turn).
-    fn at(&mut self, d: &Prepared, k: usize) -> Option<CageOverSample> {
-        let super::CageAsymmetry {
-            delta,
-            phi_rad: phi,
-        } = self.p?;
-        if k > 0 {
-            self.th2 += d.dt_s * (d.omega_r[k] + d.omega_r[k - 1]);
-        }
+    /// The cage over working sample `k`.
+    fn at(&self, d: &Prepared, k: usize) -> Option<CageOverSample> {
+        let super::CageAsymmetry { delta, .. } = self.p?;
         let k1 = (k + 1).min(d.len() - 1);
         Some(CageOverSample {
             d3: delta / 3.0,
-            u0: C64::from_polar(1.0, self.th2 + phi),
+            u0: self.u[k],
             w2: d.omega_r[k] + d.omega_r[k1],
         })
     }
+}
+
+/// `e^{j (2 theta_a + phi)}` at each working sample of `d` ([`CageAngle`]): 2 Np theta_m
+/// from twice the frame's first angle, the trapezoid of the measured electrical speed.
+fn cage_turns_of(d: &Prepared, phi: f64) -> Vec<C64> {
+    let mut th2 = d.theta.first().map_or(0.0, |t| 2.0 * t);
+    (0..d.len())
+        .map(|k| {
+            if k > 0 {
+                th2 += d.dt_s * (d.omega_r[k] + d.omega_r[k - 1]);
+            }
+            C64::from_polar(1.0, th2 + phi)
+        })
+        .collect()
 }

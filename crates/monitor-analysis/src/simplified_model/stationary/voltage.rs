@@ -4,6 +4,7 @@
 use super::{median, phase_step};
 use crate::prep::{self, Prepared, C64};
 use crate::simplified_model::InputNoise;
+use std::sync::Arc;
 
 /// The stationary-frame model's voltage input, per working sample (see
 /// [`super::simulate_stationary`]).
@@ -20,13 +21,45 @@ pub(crate) struct StatVoltage {
     pub(super) step_thr: f64,
     /// `e^{j ph/2}`: half of each working sample's phase step.
     pub(super) half: Vec<C64>,
+    /// An unequal cage's turn over half of each working sample, `e^{j w2 dt/2}`, `w2` the
+    /// sum of the measured electrical speeds at its ends (empty without a speed column):
+    /// the series' alone, so a fit's runs share it ([`super::CageOverSample`]).
+    pub(super) cage_half: Vec<C64>,
+    /// The last few unequal cages' turns ([`StatVoltage::cage_turns`]), by `phi`'s bits.
+    cage_turns: std::sync::Mutex<Vec<(u64, Arc<Vec<C64>>)>>,
 }
+
+/// How many cage angles `phi` [`StatVoltage::cage_turns`] keeps (a Jacobian's columns run
+/// in parallel, one of them with its own `phi`).
+const CAGE_TURNS_KEPT: usize = 4;
 
 impl StatVoltage {
     /// The positive-sequence voltage at sample `k` before the block mean [V].
     #[inline]
     pub(super) fn v_at(&self, k: usize) -> C64 {
         self.v_mean[k] / self.gains[k]
+    }
+
+    /// The unequal cage's turn `e^{j (2 theta_a + phi)}` at each working sample of `d` (the
+    /// series this input was built from), kept for the last few `phi`.
+    pub(super) fn cage_turns(&self, d: &Prepared, phi: f64) -> Arc<Vec<C64>> {
+        let key = phi.to_bits();
+        let found = |kept: &[(u64, Arc<Vec<C64>>)]| {
+            kept.iter().find(|(k, _)| *k == key).map(|(_, u)| u.clone())
+        };
+        if let Some(u) = self.cage_turns.lock().ok().and_then(|kept| found(&kept)) {
+            return u;
+        }
+        let u = Arc::new(super::cage_turns_of(d, phi));
+        if let Ok(mut kept) = self.cage_turns.lock() {
+            if found(&kept).is_none() {
+                if kept.len() >= CAGE_TURNS_KEPT {
+                    kept.remove(0);
+                }
+                kept.push((key, u.clone()));
+            }
+        }
+        u
     }
 
     /// The voltage input of `d` in the stationary frame (`rot_at` the frame rotation),
@@ -73,6 +106,8 @@ impl StatVoltage {
         let step_thr = prep::SUPPLY_STEP_REL.max(10.0 * median(&dev));
         let half = ph.iter().map(|&p| C64::from_polar(1.0, 0.5 * p)).collect();
         StatVoltage {
+            cage_half: cage_half_turns(d),
+            cage_turns: Default::default(),
             v_mean,
             ph,
             gains,
@@ -81,6 +116,21 @@ impl StatVoltage {
             half,
         }
     }
+}
+
+/// [`StatVoltage::cage_half`] of `d`: `e^{j w2 dt/2}` per working sample, `w2` as
+/// [`super::CageAngle::at`] takes it (the same expression, so the same bits).
+fn cage_half_turns(d: &Prepared) -> Vec<C64> {
+    let len = d.len();
+    if d.omega_r.len() != len || len == 0 {
+        return Vec::new();
+    }
+    (0..len)
+        .map(|k| {
+            let w2 = d.omega_r[k] + d.omega_r[(k + 1).min(len - 1)];
+            C64::from_polar(1.0, w2 * 0.5 * d.dt_s)
+        })
+        .collect()
 }
 
 /// Adds `nz`'s white noise (seeded, standard deviation `sigma_v`) to each component of
