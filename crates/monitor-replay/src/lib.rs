@@ -57,7 +57,7 @@ pub use isolation::{
 };
 pub use options::{
     check_parallel_paths, monitor_config_for_log, CommissionWindow, FieldNames, LoadModel,
-    OptionError, OptionField, ReplayOptions, Spelling, TimelineStep, PARALLEL_PATHS,
+    OptionError, OptionField, ReplayOptions, Spelling, TimelineStep, Words, PARALLEL_PATHS,
 };
 pub use report::{
     BaselineSource, Detection, DiagnoseReport, MonitorState, Panel, TimelinePoint, UnbalanceReport,
@@ -192,6 +192,7 @@ fn isolation_tracker(
     params: &ParamFile,
     channels: Channels,
     load: LoadModel,
+    words: Words,
     decimation: u16,
 ) -> IsolationTracker {
     let isolator = Isolator::new(
@@ -203,6 +204,7 @@ fn isolation_tracker(
         isolator.ok(),
         channels.temperature,
         load,
+        words,
         u32::from(decimation),
     )
 }
@@ -308,7 +310,7 @@ impl Replay {
             opts,
             params: *params,
             channels,
-            commission: CommissionTracker::new(opts.commission, &cfg),
+            commission: CommissionTracker::new(opts.commission, opts.words, &cfg),
             k_sigma: cfg.thresholds.k_sigma,
             rows: 0,
             evaluated: false,
@@ -324,7 +326,7 @@ impl Replay {
             last: LastOutput::default(),
             view: BlockView::default(),
             t0: None,
-            isolation: isolation_tracker(params, channels, opts.load, cfg.decimation),
+            isolation: isolation_tracker(params, channels, opts.load, opts.words, cfg.decimation),
             lamps_since_moved: false,
             seq_front: sequence_front(params, channels, sample_rate_hz).map_err(config_error)?,
             book: sequences::WindowBook::new(),

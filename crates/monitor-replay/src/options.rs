@@ -38,6 +38,10 @@ pub struct ReplayOptions {
     /// How the shorted-turn level is sized (the fields `parallel_paths`, 1..=8 as
     /// [`PARALLEL_PATHS`] says, and `turn_calibration`; [`super::winding::level`]).
     pub turn_level: super::TurnLevelOptions,
+    /// The words the report's sentences name a field in (a hint to give `commission`, the
+    /// `load`, a `baseline`): the front end's that asked ([`Words`]; the library's own,
+    /// [`FieldNames`], by default). No part of what is judged: ignored by `==`.
+    pub words: Words,
 }
 
 /// What the replay knows of the load torque.
@@ -74,6 +78,7 @@ impl Default for ReplayOptions {
             unbalance_baseline: None,
             load: LoadModel::Unknown,
             turn_level: super::TurnLevelOptions::default(),
+            words: Words::LIBRARY,
         }
     }
 }
@@ -194,6 +199,57 @@ pub trait Spelling {
     /// front end's words; the library's own name unless a front end says otherwise.
     fn key(&self, name: &str) -> String {
         name.to_string()
+    }
+
+    /// A report's advice to give `field` the value `value` (a placeholder such as
+    /// `START:END`, or a value to copy; empty: the field alone), as its user would type it;
+    /// [`Spelling::option`] unless a front end says otherwise (Python: `commission='2:4'`).
+    fn hint(&self, field: OptionField, value: &str) -> String {
+        self.option(field, value)
+    }
+
+    /// A report's advice to run another command (`diagnose`) with `field`, as its user
+    /// would (the command line: `diagnose --baseline`; the library: `diagnose's baseline`).
+    fn command_with(&self, command: &str, field: OptionField) -> String {
+        format!("{command}'s {}", self.hint(field, ""))
+    }
+}
+
+/// The words a report is spelled in, carried in the options of a request
+/// ([`ReplayOptions::words`], `monitor_analysis::Analysis::words`): a front end's
+/// [`Spelling`] for the whole run (`Words(&CliWords)`). Copy; two are always equal and
+/// print as `Words` (the words are no part of what is judged).
+#[derive(Clone, Copy)]
+pub struct Words(pub &'static (dyn Spelling + Sync));
+
+impl Words {
+    /// The library's own words ([`FieldNames`]).
+    pub const LIBRARY: Words = Words(&FieldNames);
+}
+
+impl Default for Words {
+    fn default() -> Self {
+        Words::LIBRARY
+    }
+}
+
+impl fmt::Debug for Words {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("Words")
+    }
+}
+
+impl PartialEq for Words {
+    fn eq(&self, _: &Words) -> bool {
+        true
+    }
+}
+
+impl std::ops::Deref for Words {
+    type Target = dyn Spelling + Sync;
+
+    fn deref(&self) -> &Self::Target {
+        self.0
     }
 }
 
@@ -455,5 +511,34 @@ mod tests {
         assert!("x".parse::<TimelineStep>().is_err());
         assert!(check_parallel_paths(0).is_err() && check_parallel_paths(9).is_err());
         assert_eq!(check_parallel_paths(8), Ok(8));
+    }
+
+    #[test]
+    fn the_library_words_name_fields_and_two_words_are_equal() {
+        let w = Words::default();
+        assert_eq!(
+            w.hint(OptionField::Commission, "START:END"),
+            "commission = START:END"
+        );
+        assert_eq!(w.hint(OptionField::Baseline, ""), "baseline");
+        assert_eq!(
+            w.command_with("diagnose", OptionField::Baseline),
+            "diagnose's baseline"
+        );
+        // The words are no part of what a replay is asked: options differing only in
+        // them are equal, and print without them.
+        struct Other;
+        impl Spelling for Other {
+            fn option(&self, field: OptionField, _: &str) -> String {
+                format!("<{field}>")
+            }
+        }
+        let other = ReplayOptions {
+            words: Words(&Other),
+            ..ReplayOptions::default()
+        };
+        assert_eq!(other, ReplayOptions::default());
+        assert_eq!(format!("{:?}", other.words), "Words");
+        assert_eq!(other.words.hint(OptionField::Load, "viscous"), "<load>");
     }
 }

@@ -196,7 +196,7 @@ impl Replay {
         match &judged {
             None => report.phase_not_judged = Some(no_stretch_reason(self.params.supply.f_hz)),
             Some(j) => {
-                fill_judgement(&mut report, j, &segs);
+                fill_judgement(&mut report, j, &segs, self.opts.words);
                 let poles = self.params.motor.poles.max(2) as f32 / 2.0;
                 if let Some(o) = &outside {
                     report.least_change_widened = super::reasons::widened(j, &o.ext, poles);
@@ -335,8 +335,13 @@ fn no_stretch_reason(f_hz: f64) -> String {
     )
 }
 
-/// The judged stretch's keys of the report.
-fn fill_judgement(report: &mut UnbalanceReport, j: &PhaseJudged, segs: &[SequenceSegment]) {
+/// The judged stretch's keys of the report (`words`: the sentences' words for a field).
+fn fill_judgement(
+    report: &mut UnbalanceReport,
+    j: &PhaseJudged,
+    segs: &[SequenceSegment],
+    words: crate::Words,
+) {
     let p = j.posterior;
     let named = p.named();
     report.suspect_phase = named.map(|n| n.0);
@@ -361,7 +366,7 @@ fn fill_judgement(report: &mut UnbalanceReport, j: &PhaseJudged, segs: &[Sequenc
     report.judged_against = Some(j.against);
     report.phase_not_judged = segs.get(j.index).and_then(|s| {
         let reference = j.reference.and_then(|k| segs.get(k));
-        super::reasons::not_named(j, s, reference, least)
+        super::reasons::not_named(j, s, reference, least, words)
     });
     report.judged_segment = Some(j.index.min(MAX_SEGMENTS - 1));
     report.reference_segment = j.reference.filter(|&k| k < MAX_SEGMENTS);
