@@ -7,7 +7,9 @@ use monitor_api::{AnalysisRequest, DiagnoseRequest, ParamsSource};
 use std::path::PathBuf;
 
 fn example(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/logs").join(name)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/logs")
+        .join(name)
 }
 
 /// The places `text` names a long flag (`--` then a lowercase letter).
