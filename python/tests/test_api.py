@@ -90,7 +90,8 @@ def test_compare_explain_identify_nameplate(repo, sim_host):
     # The same document; its advice names Python's keyword where the command names its flag.
     cli = cli_json(sim_host, "explain", "--params", MOTULATOR_P, MOTULATOR, "--from", "0.8")
     assert "Add it with effects=['load_torque']" in e.verdict
-    assert e.to_dict() == in_python_words(cli, {"--effects load_torque": "effects=['load_torque']"})
+    assert e.to_dict() == in_python_words(cli, {"--effects load_torque": "effects=['load_torque']",
+                                                "effects or --from)": "effects or from_s=...)"})
     n = dm.params_from_nameplate(2.2, 400, 4.8, 50, 1438, 0.77, 0.863,
                                  columns_from=repo / "examples/params/daq_2p2kw.toml")
     assert n.poles == 4 and "[columns]" in n.toml
