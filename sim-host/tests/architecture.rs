@@ -39,75 +39,10 @@ use architecture_syntax::circles::{circles, reached, ModPath};
 use architecture_syntax::files::{
     crate_sources, files, is_code, is_test_file, packages, parse, read, verdict, workspace,
 };
+use architecture_syntax::layers::INSIDE;
 use architecture_syntax::{module_of, top_module, LongFunctions, Paths};
 
 use syn::visit::Visit;
-
-/// The modules of one crate: (the crate's `src/` folder, its base layer's name, the
-/// modules above the base and their layers, lowest first). A module the table does not
-/// list is in layer 1, the base.
-type Inside = (&'static str, &'static [(&'static str, u8)]);
-
-/// The crates with more than one part, and the order of their modules (rule 1).
-const INSIDE: &[Inside] = &[
-    // The firmware's library: the board's facts and the stored records at the bottom, the
-    // supervisor (`app`) above what it composes, the boot at the top.
-    (
-        "src/",
-        &[
-            ("board", 1),
-            ("flash_record", 1),
-            ("liveness", 1),
-            ("recovery", 1),
-            ("flash_ecc", 2),
-            ("acquisition", 2),
-            ("sampling", 2),
-            ("supply", 2),
-            ("panel", 2),
-            ("commissioning", 2),
-            ("offset_trim", 3),
-            ("reset_record", 3),
-            ("range_watch", 3),
-            ("setup_guard", 4),
-            ("fault_path", 4),
-            ("app", 4),
-            ("motor_source", 5),
-            ("boot", 6),
-        ],
-    ),
-    // The parameter file below the logs and the nameplate estimate.
-    (
-        "crates/monitor-io/src/",
-        &[("params", 1), ("log", 2), ("nameplate", 2)],
-    ),
-    // `identify` on top of the model-vs-measurement analysis, which does not use it.
-    ("crates/monitor-analysis/src/", &[("identify", 2)]),
-    // One simulated scenario through the core, the studies on it, the demo, the bench.
-    (
-        "crates/monitor-studies/src/",
-        &[
-            ("experiment", 1),
-            ("fault_signatures", 2),
-            ("service_profile", 2),
-            ("demo", 3),
-            ("bench", 4),
-        ],
-    ),
-    // The fleet run over the one-call API.
-    ("crates/monitor-api/src/", &[("fleet", 2)]),
-    // The stored row and the store's errors at the bottom, the Parquet mirror above them,
-    // the SQLite store that writes through the mirror on top; the trend reads rows.
-    (
-        "crates/monitor-store/src/",
-        &[
-            ("row", 1),
-            ("error", 1),
-            ("mirror", 2),
-            ("trend", 2),
-            ("store", 3),
-        ],
-    ),
-];
 
 /// The `src/` folders that must be among those checked for import circles (which are
 /// found from the workspace's packages, [`crate_sources`]): every library crate of the
@@ -208,6 +143,63 @@ fn modules_inside_a_crate_point_one_way() {
         }
     }
     verdict("modules inside a crate point one way", bad);
+}
+
+/// The crates whose root (`lib.rs`) is only their table of contents: modules and
+/// re-exports, no item of its own; their modules import from the module that defines a
+/// name, never from the root's re-exports (an import of the root runs back up to the top).
+const ROOT_ONLY_NAMES: [&str; 1] = ["crates/monitor-replay/src/"];
+
+#[test]
+fn the_root_only_names_its_modules() {
+    let mut bad = Vec::new();
+    let all = files();
+    for dir in ROOT_ONLY_NAMES {
+        let root = parse(&format!("{dir}lib.rs"));
+        let mut modules = Vec::new();
+        for item in &root.items {
+            match item {
+                syn::Item::Mod(m) => modules.push(m.ident.to_string()),
+                syn::Item::Use(_) => {}
+                other => {
+                    let name = match other {
+                        syn::Item::Fn(f) => f.sig.ident.to_string(),
+                        syn::Item::Struct(s) => s.ident.to_string(),
+                        syn::Item::Enum(e) => e.ident.to_string(),
+                        syn::Item::Const(c) => c.ident.to_string(),
+                        syn::Item::Impl(_) => "an impl".to_string(),
+                        _ => "an item".to_string(),
+                    };
+                    bad.push(format!(
+                        "{dir}lib.rs: the root holds `{name}` of its own; move it to the module it belongs to"
+                    ));
+                }
+            }
+        }
+        for rel in all
+            .iter()
+            .filter(|f| f.starts_with(dir) && f.ends_with(".rs"))
+        {
+            let in_src = &rel[dir.len()..];
+            if in_src == "lib.rs" {
+                continue;
+            }
+            let module = module_of(in_src);
+            for u in Paths::of(&parse(rel), module) {
+                let Some(target) = top_module(&u) else {
+                    continue;
+                };
+                if !modules.contains(&target) && u.segments.len() > 1 {
+                    bad.push(format!(
+                        "{rel}:{}: `{}` reaches the crate root's re-export; import it from the module that defines it",
+                        u.line,
+                        u.segments.join("::")
+                    ));
+                }
+            }
+        }
+    }
+    verdict("the root only names its modules", bad);
 }
 
 #[test]

@@ -26,7 +26,7 @@
 //! and the 20 % margin, `monitor_core::operating_range::RANGE_MARGIN`) is the core's
 //! `monitor_core::operating_range`, which the firmware's panel uses too.
 
-use crate::options::{OptionField, Words};
+use crate::words::{OptionField, Words};
 use monitor_core::operating_range::{outside, widen};
 use monitor_core::{
     CommissioningState, Monitor, MonitorConfig, MonitorOutput, OperatingPoint, RunStage,

@@ -2,10 +2,14 @@
 //! ([`diagnose_file`]), the glitch bursts filled or held out, and the observer of every
 //! output (the live HMI's log source).
 
-use super::front::{Direct, Handled, ReplaySink, CLOCK_RESET_GAP_S};
-use super::verdict::findings::data_quality_finding;
-use super::{pipe, DiagnoseReport, Replay, ReplayError, ReplayOptions};
-use monitor_core::MonitorOutput;
+use super::error::ReplayError;
+use super::front::{Direct, Handled, ReplaySink};
+use super::options::ReplayOptions;
+use super::pipe;
+use super::replay::{Replay, ReplayObserver};
+use super::report::DiagnoseReport;
+use super::sampler::CLOCK_RESET_GAP_S;
+use super::verdict::measured::data_quality_finding;
 use monitor_io::log::quality::{
     CellLimits, CleanSink, DataQuality, NotJudged, QualityStage, MAX_BRIDGED_GAP_S,
 };
@@ -76,17 +80,6 @@ pub fn diagnose_log(
     replay_through_quality(params, file.channels(), file.shown(), opts, |stage| {
         file.for_each_row(progress, stage).map(|_| ())
     })
-}
-
-/// Watches a replay row by row ([`diagnose_file_observed`]): the live HMI's log source.
-pub trait ReplayObserver {
-    /// The monitor's output after `row` (as the data-quality stage passed it on, glitches
-    /// filled in); `replay` for its time base and thresholds ([`Replay::time_of`],
-    /// [`Replay::threshold_bands`]).
-    fn output(&mut self, row: &Row, out: &MonitorOutput, replay: &Replay);
-    /// The replay starts again from the log's first row (the reader's fast path handed
-    /// over to the exact reader): forget every output so far.
-    fn restart(&mut self);
 }
 
 /// [`diagnose_file`] that hands every replayed row's output to `observer` as it goes, the
@@ -189,7 +182,7 @@ fn conclude(
         });
     };
     if replay.commissioning_incomplete() && !opts.allow_incomplete {
-        let (window, mut why) = replay.commission.not_learned().unwrap_or_default();
+        let (window, mut why) = replay.lamps.commission.not_learned().unwrap_or_default();
         // What the data-quality stage distrusts is often why nothing was learned (swapped
         // channels, a dead sensor): say it in the same line.
         if !quality.trusted {
@@ -200,8 +193,8 @@ fn conclude(
         }
         return Err(ReplayError::IncompleteCommissioning { window, why });
     }
-    let can_residuals = replay.monitor.is_some();
-    let sensors = replay.output().sensor_fault;
+    let can_residuals = replay.monitor().is_some();
+    let sensors = replay.lamps.output().sensor_fault;
     let mut report = replay.finish();
     describe_actions(&mut quality, can_residuals, handled);
     let dq = data_quality_finding(&quality, sensors);

@@ -5,7 +5,10 @@
 //! observer of every output) or the pipe to a replay on a thread of its own
 //! (`super::pipe`).
 
-use super::{Replay, ReplayError, ReplayObserver, ReplayOptions};
+use super::error::ReplayError;
+use super::options::ReplayOptions;
+use super::replay::{Replay, ReplayObserver};
+use super::sampler::CLOCK_RESET_GAP_S;
 use monitor_core::Abc;
 use monitor_io::log::quality::{BadCells, CleanSink, SegmentBreak, TimeBase, MAX_BRIDGED_GAP_S};
 use monitor_io::log::{Channels, Column, Row};
@@ -154,13 +157,13 @@ impl<O: ReplayObserver + ?Sized> Feeder for Direct<'_, O> {
         };
         let out = r.push(row);
         if let Some(o) = self.observer.as_deref_mut() {
-            o.output(&r.with_encoder_offset(row), &out, r);
+            o.output(&r.lamps.with_encoder_offset(row), &out, r);
         }
     }
 
     fn clock_reset(&mut self) {
         if let Some(r) = self.replay.as_mut() {
-            r.clock_reset();
+            r.lamps.clock_reset();
         }
     }
 
@@ -218,9 +221,6 @@ fn encoder_only(bad: BadCells) -> bool {
 /// Samples per supply period below which a segment at another rate is not resampled onto
 /// the monitor's clock (not judged).
 const MIN_RESAMPLE_PER_PERIOD: f64 = 20.0;
-/// Time the replay puts between the segments around a clock reset [s]: a long gap, after
-/// which the monitor restarts its estimators and settles.
-pub(super) const CLOCK_RESET_GAP_S: f64 = 2.0 * MAX_BRIDGED_GAP_S;
 
 impl<F: Feeder> ReplaySink<'_, F> {
     /// Replays one row: after a clock reset its time is moved on to follow the last row's

@@ -22,7 +22,6 @@ pub(super) use report::refine_single_phase;
 use report::{baseline_name, groups, REPORTED_RISE_K};
 pub use report::{
     state_name, DetectionLimit, FaultCandidate, IsolationBaseline, IsolationGroup, IsolationReport,
-    SensorPhaseReport,
 };
 use serde::Serializer;
 
@@ -58,9 +57,9 @@ pub(super) struct IsolationTracker {
     lamps_lit: bool,
     /// The operating points kept since a deviation, and their joint isolation.
     evidence: monitor_core::isolation::Evidence,
-    /// What is known of the load ([`super::LoadModel`]).
-    load: super::LoadModel,
-    words: super::Words,
+    /// What is known of the load ([`super::options::LoadModel`]).
+    load: super::options::LoadModel,
+    words: super::words::Words,
     /// Names and load moves, with times.
     events: super::events::EventLog,
     /// The log's temperature channel (`t_winding_c`), when it has one.
@@ -116,9 +115,9 @@ fn listed_candidates(iso: &Isolation, shown: bool) -> Vec<FaultCandidate> {
 }
 
 /// `n` is the friction class while the load is an unknown input: a load move, not a name
-/// ([`super::LoadModel::Unknown`]).
-fn load_reading(load: super::LoadModel, n: &Named) -> bool {
-    load == super::LoadModel::Unknown && matches!(n, Named::Friction { .. })
+/// ([`super::options::LoadModel::Unknown`]).
+fn load_reading(load: super::options::LoadModel, n: &Named) -> bool {
+    load == super::options::LoadModel::Unknown && matches!(n, Named::Friction { .. })
 }
 
 /// What the report concludes from ([`IsolationTracker::concluded`]).
@@ -147,12 +146,12 @@ impl IsolationTracker {
     pub(super) fn new(
         isolator: Option<Isolator>,
         temperature_column: bool,
-        load: super::LoadModel,
-        words: super::Words,
+        load: super::options::LoadModel,
+        words: super::words::Words,
         chunk_rows: u32,
     ) -> Self {
         let isolator = isolator.map(|mut i| {
-            i.set_load_unknown(load == super::LoadModel::Unknown);
+            i.set_load_unknown(load == super::options::LoadModel::Unknown);
             i
         });
         IsolationTracker {
@@ -404,7 +403,7 @@ impl IsolationTracker {
         if load_moved {
             iso.state = IsolationState::NoDeviation;
         }
-        if self.load == super::LoadModel::Unknown {
+        if self.load == super::options::LoadModel::Unknown {
             without_friction(&mut iso);
         }
         Some(Concluded {
@@ -414,7 +413,7 @@ impl IsolationTracker {
         })
     }
 
-    /// With the load an unknown input ([`super::LoadModel::Unknown`]), the lamps' detections
+    /// With the load an unknown input ([`super::options::LoadModel::Unknown`]), the lamps' detections
     /// are the load's move: the last isolation reads the friction class (the load), the
     /// operating points since name no fault, and no fault was ever named.
     pub(super) fn load_explains_lamps(&self) -> bool {

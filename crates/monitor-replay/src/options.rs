@@ -6,13 +6,33 @@
 //! of it: the command line says it as its flags, Python as its keywords, [`Spelling`]),
 //! and the monitor configuration a replay runs with ([`monitor_config_for_log`]).
 
-use super::{HealthyReference, TICK_HZ};
+use super::baseline::HealthyReference;
+use super::sampler::TICK_HZ;
+pub use super::words::{FieldNames, OptionError, OptionField, Spelling, Words};
 use monitor_core::{AngleSource, MonitorConfig, ResidualForm};
 use monitor_io::params::ParamFile;
 use serde::Serialize;
 use std::fmt;
 use std::ops::RangeInclusive;
 use std::str::FromStr;
+
+/// Serialises an angle source by its command-line name ([`angle_source_name`]), for
+/// `#[serde(serialize_with = "serialize_angle_source")]` on a report's field.
+pub fn serialize_angle_source<S: serde::Serializer>(
+    a: &AngleSource,
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    s.serialize_str(angle_source_name(*a))
+}
+
+/// Name of an angle source as used on the command line.
+pub fn angle_source_name(a: AngleSource) -> &'static str {
+    match a {
+        AngleSource::ZeroCrossing => "zero-crossing",
+        AngleSource::Pll => "pll",
+        AngleSource::RotorFluxCurrentModel => "rotor-flux",
+    }
+}
 
 /// Replay options.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -31,13 +51,13 @@ pub struct ReplayOptions {
     pub timeline_step: TimelineStep,
     /// The healthy machine's negative sequence to judge the winding against (the field
     /// `baseline` of a request: healthy logs); without it, the one learned in the
-    /// commissioning window, else none ([`super::UnbalanceBaseline`]).
+    /// commissioning window, else none ([`super::baseline::UnbalanceBaseline`]).
     pub unbalance_baseline: Option<HealthyReference>,
     /// What is known of the load ([`LoadModel`]; the field `load`).
     pub load: LoadModel,
     /// How the shorted-turn level is sized (the fields `parallel_paths`, 1..=8 as
     /// [`PARALLEL_PATHS`] says, and `turn_calibration`; [`super::winding::level`]).
-    pub turn_level: super::TurnLevelOptions,
+    pub turn_level: super::winding::level::TurnLevelOptions,
     /// The words the report's sentences name a field in (a hint to give `commission`, the
     /// `load`, a `baseline`): the front end's that asked ([`Words`]; the library's own,
     /// [`FieldNames`], by default). No part of what is judged: ignored by `==`.
@@ -77,7 +97,7 @@ impl Default for ReplayOptions {
             timeline_step: TimelineStep::DEFAULT,
             unbalance_baseline: None,
             load: LoadModel::Unknown,
-            turn_level: super::TurnLevelOptions::default(),
+            turn_level: super::winding::level::TurnLevelOptions::default(),
             words: Words::LIBRARY,
         }
     }
@@ -111,7 +131,7 @@ pub fn monitor_config_for_log(
 
 impl ReplayOptions {
     /// The one check of the options every front end calls (the command line, Python, the
-    /// HMI, the fleet; [`super::Replay::new`] too): the commissioning window as
+    /// HMI, the fleet; [`crate::Replay::new`] too): the commissioning window as
     /// [`CommissionWindow::new`] checks it, `parallel_paths` in [`PARALLEL_PATHS`] (the
     /// time step is positive by construction, [`TimelineStep`]).
     ///
@@ -129,172 +149,6 @@ impl ReplayOptions {
 /// The parallel paths per phase a winding may have (the field `parallel_paths`): 1 for a
 /// series star or delta, 2 for a double star, at most 8.
 pub const PARALLEL_PATHS: RangeInclusive<u8> = 1..=8;
-
-/// An option or a request's field, by the name the library gives it (the Python keyword
-/// and the fleet table's key where they have one).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum OptionField {
-    /// The parameter file (`params`).
-    Params,
-    /// The commissioning window (`commission`, [`CommissionWindow`]).
-    Commission,
-    /// Report an incomplete commissioning (`allow_incomplete`).
-    AllowIncomplete,
-    /// The timeline's step (`timeline_step`, [`TimelineStep`]).
-    TimelineStep,
-    /// The winding's parallel paths (`parallel_paths`, [`PARALLEL_PATHS`]).
-    ParallelPaths,
-    /// A calibration of the shorted-turn level (`turn_calibration`).
-    TurnCalibration,
-    /// Healthy logs of the same motor (`baseline`).
-    Baseline,
-    /// What is known of the load (`load`).
-    Load,
-    /// The TDMS group (`group`).
-    Group,
-    /// The analysed window's start (`from_s`).
-    From,
-    /// The analysed window's end (`to_s`).
-    To,
-    /// Effects already in the model (`effects`).
-    Effects,
-    /// The parameter file whose `[columns]` a nameplate estimate carries (`columns_from`).
-    ColumnsFrom,
-}
-
-impl OptionField {
-    /// The field's name (`commission`, `timeline_step`, ...).
-    pub const fn name(self) -> &'static str {
-        match self {
-            OptionField::Params => "params",
-            OptionField::Commission => "commission",
-            OptionField::AllowIncomplete => "allow_incomplete",
-            OptionField::TimelineStep => "timeline_step",
-            OptionField::ParallelPaths => "parallel_paths",
-            OptionField::TurnCalibration => "turn_calibration",
-            OptionField::Baseline => "baseline",
-            OptionField::Load => "load",
-            OptionField::Group => "group",
-            OptionField::From => "from_s",
-            OptionField::To => "to_s",
-            OptionField::Effects => "effects",
-            OptionField::ColumnsFrom => "columns_from",
-        }
-    }
-}
-
-impl fmt::Display for OptionField {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// How a front end names a field given a value, so that its messages speak its words.
-pub trait Spelling {
-    /// `field` given `value` (empty: the field alone, as in a hint) in the front end's
-    /// words.
-    fn option(&self, field: OptionField, value: &str) -> String;
-
-    /// Any other field a message names by its name (a nameplate's `speed_rpm`), in the
-    /// front end's words; the library's own name unless a front end says otherwise.
-    fn key(&self, name: &str) -> String {
-        name.to_string()
-    }
-
-    /// A report's advice to give `field` the value `value` (a placeholder such as
-    /// `START:END`, or a value to copy; empty: the field alone), as its user would type it;
-    /// [`Spelling::option`] unless a front end says otherwise (Python: `commission='2:4'`).
-    fn hint(&self, field: OptionField, value: &str) -> String {
-        self.option(field, value)
-    }
-
-    /// A report's advice to run another command (`diagnose`) with `field`, as its user
-    /// would (the command line: `diagnose --baseline`; the library: `diagnose's baseline`).
-    fn command_with(&self, command: &str, field: OptionField) -> String {
-        format!("{command}'s {}", self.hint(field, ""))
-    }
-}
-
-/// The words a report is spelled in, carried in the options of a request
-/// ([`ReplayOptions::words`], `monitor_analysis::Analysis::words`): a front end's
-/// [`Spelling`] for the whole run (`Words(&CliWords)`). Copy; two are always equal and
-/// print as `Words` (the words are no part of what is judged).
-#[derive(Clone, Copy)]
-pub struct Words(pub &'static (dyn Spelling + Sync));
-
-impl Words {
-    /// The library's own words ([`FieldNames`]).
-    pub const LIBRARY: Words = Words(&FieldNames);
-}
-
-impl Default for Words {
-    fn default() -> Self {
-        Words::LIBRARY
-    }
-}
-
-impl fmt::Debug for Words {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str("Words")
-    }
-}
-
-impl PartialEq for Words {
-    fn eq(&self, _: &Words) -> bool {
-        true
-    }
-}
-
-impl std::ops::Deref for Words {
-    type Target = dyn Spelling + Sync;
-
-    fn deref(&self) -> &Self::Target {
-        self.0
-    }
-}
-
-/// The library's own words: `commission = 4:2` (a fleet table's), the field alone
-/// without a value; what the errors' `Display` says.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct FieldNames;
-
-impl Spelling for FieldNames {
-    fn option(&self, field: OptionField, value: &str) -> String {
-        if value.is_empty() {
-            field.name().to_string()
-        } else {
-            format!("{} = {value}", field.name())
-        }
-    }
-}
-
-/// A value an option does not take: the field, the value as given, and why.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("{}: {why}", FieldNames.option(*field, value))]
-pub struct OptionError {
-    /// The option.
-    pub field: OptionField,
-    /// The value as given (empty where the field alone is meant).
-    pub value: String,
-    /// What is wrong, and what to give instead.
-    pub why: String,
-}
-
-impl OptionError {
-    /// `field` refused `value` because of `why`.
-    pub fn new(field: OptionField, value: impl Into<String>, why: impl Into<String>) -> Self {
-        OptionError {
-            field,
-            value: value.into(),
-            why: why.into(),
-        }
-    }
-
-    /// The message in a front end's words (`spell`).
-    pub fn spelled(&self, spell: &dyn Spelling) -> String {
-        format!("{}: {}", spell.option(self.field, &self.value), self.why)
-    }
-}
 
 /// Checks the winding's parallel paths (the field `parallel_paths`), given as any whole
 /// number.
@@ -350,7 +204,7 @@ impl CommissionWindow {
         self.end_s
     }
 
-    /// `(start, end)` [s], as [`super::ReplayOptions::commission`] holds it.
+    /// `(start, end)` [s], as [`ReplayOptions::commission`] holds it.
     pub fn seconds(self) -> (f64, f64) {
         (self.start_s, self.end_s)
     }

@@ -12,12 +12,19 @@
 //! synchronously (a configuration the core rejects stops the read at once, as without the
 //! thread).
 
+use super::error::ReplayError;
 use super::front::Feeder;
+use super::options::ReplayOptions;
+use super::replay::Replay;
+use super::sequences::SequenceWindow;
 use super::sequences::{SequenceFront, SequenceStep};
-use super::{sequence_front, Replay, ReplayError, ReplayOptions, SequenceWindow};
 use monitor_io::log::{Channels, Row};
 use monitor_io::params::ParamFile;
 use std::sync::mpsc::{channel, sync_channel, Receiver, Sender, SyncSender};
+
+/// The replay's answer to [`Call::Begin`]: its sequence analysis, lent to the reading
+/// thread (`None`: the replay could not be configured).
+type Lent = Option<Box<SequenceFront>>;
 
 /// Rows per batch (about 140 bytes each with its step).
 const BATCH: usize = 4096;
@@ -59,14 +66,12 @@ impl Batch {
 
 /// The reading thread's end: a [`Feeder`] that runs the sequence analysis and batches the
 /// calls (given to the read by [`on_own_thread`]).
-pub(super) struct Pipe<'a> {
-    params: &'a ParamFile,
-    channels: Channels,
+pub(super) struct Pipe {
     tx: SyncSender<Batch>,
     /// Emptied batches coming back (their memory reused).
     back: Receiver<Batch>,
     /// The answer to [`Call::Begin`].
-    began: Receiver<bool>,
+    began: Receiver<Lent>,
     batch: Batch,
     front: Option<SequenceFront>,
     /// The first row's time (the replay's time 0) [s].
@@ -75,7 +80,7 @@ pub(super) struct Pipe<'a> {
     closed: bool,
 }
 
-impl Pipe<'_> {
+impl Pipe {
     /// Sends the batch.
     fn flush(&mut self) {
         if (self.batch.rows.is_empty() && self.batch.calls.is_empty()) || self.closed {
@@ -103,14 +108,18 @@ impl Pipe<'_> {
     }
 }
 
-impl Feeder for Pipe<'_> {
+impl Feeder for Pipe {
     fn begin(&mut self, rate_hz: f64) -> bool {
-        // (A rate the filters refuse is refused by the replay's own start too: `began` is false.)
-        self.front = sequence_front(self.params, self.channels, rate_hz).ok();
+        // (The replay's thread answers with the sequence analysis it built, to run here; a
+        // rate the replay refuses is no answer.)
         self.t0 = None;
         self.push(Call::Begin(rate_hz));
         self.flush();
-        !self.closed && self.began.recv().unwrap_or(false)
+        self.front = None;
+        if !self.closed {
+            self.front = self.began.recv().ok().flatten().map(|f| *f);
+        }
+        self.front.is_some()
     }
 
     fn row(&mut self, row: &Row) {
@@ -179,15 +188,16 @@ struct Back<'a> {
 
 impl Back<'_> {
     /// One call; `began` gets the answer to [`Call::Begin`].
-    fn call(&mut self, c: Call, began: &Sender<bool>) {
+    fn call(&mut self, c: Call, began: &Sender<Lent>) {
         match c {
             Call::Begin(rate) => {
                 match Replay::new(self.params, self.channels, rate, self.opts) {
                     Ok(r) => self.replay = Some(r),
                     Err(e) => self.error = Some(e),
                 }
-                // (The reading thread waits for this answer.)
-                let _ = began.send(self.replay.is_some());
+                // (The reading thread waits for this answer: the sequence analysis to run.)
+                let lent = self.replay.as_mut().and_then(Replay::lend_sequence_front);
+                let _ = began.send(lent.map(Box::new));
             }
             Call::Restart => {
                 self.replay = None;
@@ -199,7 +209,7 @@ impl Back<'_> {
                 };
                 match c {
                     Call::Window(w) => r.queue_window(w),
-                    Call::ClockReset => r.clock_reset(),
+                    Call::ClockReset => r.lamps.clock_reset(),
                     Call::End(front) => r.set_sequence_front(*front),
                     Call::Begin(_) | Call::Restart => {}
                 }
@@ -219,7 +229,7 @@ impl Back<'_> {
 
 /// Receives every batch and hands it to `back` in order (each call after the rows before
 /// it), returning the emptied batches.
-fn receive(back: &mut Back<'_>, rx: Receiver<Batch>, empty: Sender<Batch>, began: Sender<bool>) {
+fn receive(back: &mut Back<'_>, rx: Receiver<Batch>, empty: Sender<Batch>, began: Sender<Lent>) {
     for mut batch in rx {
         let mut from = 0;
         for (at, c) in batch.calls.drain(..) {
@@ -250,7 +260,7 @@ pub(super) fn on_own_thread<R>(
     params: &ParamFile,
     channels: Channels,
     opts: ReplayOptions,
-    read: impl FnOnce(&mut Pipe<'_>) -> R,
+    read: impl FnOnce(&mut Pipe) -> R,
 ) -> (R, Result<Option<Replay>, ReplayError>) {
     let (tx, rx) = sync_channel(IN_FLIGHT);
     let (empty_tx, empty_rx) = channel();
@@ -266,8 +276,6 @@ pub(super) fn on_own_thread<R>(
         let b = &mut back;
         s.spawn(move || receive(b, rx, empty_tx, began_tx));
         let mut pipe = Pipe {
-            params,
-            channels,
             tx,
             back: empty_rx,
             began: began_rx,

@@ -1,9 +1,17 @@
 //! Log rows as core samples ([`LogSampler`]): the host's counterpart of the firmware's ADC
 //! sampler.
 
-use super::{COUNTS_PER_REV, TICK_HZ};
 use monitor_core::{Abc, Sample};
 use monitor_io::log::Row;
+
+/// Timestamp tick rate used for replays [Hz].
+pub const TICK_HZ: f64 = 1.0e6;
+/// Counts per revolution of the synthesised encoder (1024 lines x 4).
+pub const COUNTS_PER_REV: u32 = 4096;
+/// Time the replay puts between the segments around a clock reset [s]: a long gap, after
+/// which the monitor restarts its estimators and settles (the encoder count goes on by the
+/// turn over it).
+pub const CLOCK_RESET_GAP_S: f64 = 2.0 * monitor_io::log::quality::MAX_BRIDGED_GAP_S;
 
 /// The core sample of `row` from `sampler`, its encoder count moved on by `enc_offset`
 /// (counts handed on over a clock reset: [`super::Replay`]'s `enc_offset`).

@@ -4,8 +4,24 @@
 use super::commission::CommissionTracker;
 use super::isolation::chunk::RowFlags;
 use super::isolation::IsolationTracker;
-use super::report::Detection;
-use monitor_core::{Monitor, MonitorOutput, FAULT_COUNT};
+use monitor_core::{Fault, Monitor, MonitorOutput, FAULT_COUNT};
+use serde::{Serialize, Serializer};
+
+/// A fault the lamps named (the top of the signature matching while a lamp was lit), with
+/// the first time it was named [s]. JSON: the pair `[fault, t_s]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Detection {
+    /// The fault.
+    pub fault: Fault,
+    /// When it was first named [s since the log's first row].
+    pub t_s: f64,
+}
+
+impl Serialize for Detection {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        (self.fault, self.t_s).serialize(s)
+    }
+}
 
 /// No bands (centre and half-width 0): what is passed where the bands are not needed.
 pub(super) const NO_BANDS: [(f32, f32); 4] = [(0.0, 0.0); 4];

@@ -54,13 +54,15 @@ mod reading;
 mod reasons;
 mod segments;
 
+pub(crate) use judgement::unbalance_report;
 pub use reasons::BALANCED_RATIO;
 pub use segments::segments;
 
-use super::sequences::SequenceWindow;
-use super::UnbalanceBaseline;
+pub use super::baseline::HealthyReference;
+use super::baseline::{abs, mean, of_pair, pair, pooled_change_sigma, UnbalanceBaseline};
+use super::sequences::{SensorPhaseReport, SequenceWindow};
 use monitor_core::sequence::{Complex32, INHERENT_ASYMMETRY_RATIO};
-use num_complex::Complex64;
+use monitor_core::Phase;
 use serde::Serialize;
 
 /// Fewest least-squares windows a steady stretch holds (0.5 s at 60 Hz).
@@ -255,38 +257,9 @@ fn cdiv(a: Complex32, b: Complex32) -> Complex32 {
     a / b
 }
 
-/// `|a|` (the core's hypotenuse).
-fn abs(a: Complex32) -> f32 {
-    monitor_core::math::fast_hypot(a.re, a.im)
-}
-
 /// `arg a` [deg].
 fn arg_deg(a: Complex32) -> f32 {
     a.im.atan2(a.re).to_degrees()
-}
-
-/// Mean of complex values (summed in double precision).
-fn mean(xs: impl Iterator<Item = Complex32>) -> Complex32 {
-    let (mut s, mut n) = (Complex64::new(0.0, 0.0), 0u32);
-    for x in xs {
-        s += Complex64::new(f64::from(x.re), f64::from(x.im));
-        n += 1;
-    }
-    if n == 0 {
-        return Complex32::new(0.0, 0.0);
-    }
-    let m = s / f64::from(n);
-    Complex32::new(m.re as f32, m.im as f32)
-}
-
-/// A phasor from its JSON pair `[re, im]`.
-fn of_pair(x: [f32; 2]) -> Complex32 {
-    Complex32::new(x[0], x[1])
-}
-
-/// A phasor's JSON pair `[re, im]`.
-fn pair(x: Complex32) -> [f32; 2] {
-    [x.re, x.im]
 }
 
 /// One segment's means.
@@ -338,85 +311,103 @@ pub(super) fn segment_of(ws: &[&SequenceWindow]) -> SequenceSegment {
     }
 }
 
-/// The healthy machine's negative sequence from several runs: their mean, how many, and
-/// their scatter (JSON `unbalance.baseline_runs`, `unbalance.baseline_spread`).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct HealthyReference {
-    /// The runs' mean (`I2/I1`, `V2/I1` where every run has voltages, `|I1|`).
-    pub mean: UnbalanceBaseline,
-    /// How many runs.
-    pub runs: u32,
-    /// `sum |h_i - mean|^2` of the runs' `I2/I1` (0 for one run).
-    pub sum_sq_dev: f32,
+/// Result of the negative-sequence analysis (JSON key `unbalance`).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct UnbalanceReport {
+    /// |I2|/|I1|.
+    pub negative_sequence_ratio: f32,
+    /// The winding's faulty phase (JSON "a", "b", "c"), or null.
+    pub suspect_phase: Option<Phase>,
+    /// The probability that the winding has a short in `suspect_phase` (that there is a
+    /// short, and in that phase), 0..1; 0 without a phase. A phase is named when it is
+    /// more probable than no short; a FAULT needs
+    /// [`WINDING_FAULT_PROBABILITY`]. How it is computed and calibrated:
+    /// `docs/isolation.md`, "The phase's probability".
+    pub phase_confidence: f32,
+    /// The probabilities of no short and of a short in each phase.
+    pub phase_probabilities: PhaseProbabilities,
+    /// Why no phase is judged although the currents are unbalanced, or null: no healthy
+    /// baseline, and the winding part is within a healthy machine's own asymmetry
+    /// (`monitor_core::sequence::INHERENT_ASYMMETRY_RATIO`).
+    pub phase_not_judged: Option<String>,
+    /// arg(I2w/I1) [deg]: the winding's part (the supply's part taken out).
+    pub angle_deg: f32,
+    /// |I2w|/|I1|: the winding's part of the negative sequence.
+    pub winding_ratio: f32,
+    /// |V2/Z2|/|I1|: the part the supply's voltage unbalance drives (0 without voltages).
+    pub supply_ratio: f32,
+    /// |V2|/|V1| (null without voltage columns).
+    pub voltage_negative_sequence_ratio: Option<f32>,
+    /// The reference angle arg Z1 (the power-factor angle, shorted turns) used [deg].
+    pub correction_deg: f32,
+    /// Its uncertainty [deg] (it widens the phase's confidence).
+    pub correction_uncertainty_deg: f32,
+    /// Where the reference angle comes from (null when nothing was judged).
+    pub operating_point: Option<OperatingPointSource>,
+    /// The slip the reference angle was taken at, where one was used.
+    pub slip: Option<f32>,
+    /// The least change of the winding's negative sequence (fraction of |I1|) that names
+    /// a phase at [`WINDING_FAULT_PROBABILITY`] (on its sector's centre, with the
+    /// judged spread and reference angle); 0 when none does.
+    pub least_change: f32,
+    /// Where the reference ran at another operating point than the judged stretch: a
+    /// sentence saying so and how much the least change was widened for it; else null.
+    pub least_change_widened: Option<String>,
+    /// The spread the change is judged with (each component, fraction of |I1|): the
+    /// healthy reference's, the judged stretch's own and, at another operating point,
+    /// what the load moves.
+    pub spread: f32,
+    /// What the change was judged against (null when nothing was judged).
+    pub judged_against: Option<Against>,
+    /// How many healthy runs `--baseline` gave (0: none).
+    pub baseline_runs: u32,
+    /// Their RMS distance from their mean (`|I2/I1|` units), null for fewer than two.
+    pub baseline_spread: Option<f32>,
+    /// Index into `segments` of the one judged (the largest change), null without one.
+    pub judged_segment: Option<usize>,
+    /// Index into `segments` of the stretch it was judged against, when judged within
+    /// the log; else null.
+    pub reference_segment: Option<usize>,
+    /// The log's steady stretches of negative sequence, in time order.
+    pub segments: Vec<SequenceSegment>,
+    /// One phase's current sensor with a gain error, from the zero sequence of the three
+    /// measured currents (zero for a star without neutral, whatever the machine does), or
+    /// null; its part of the negative sequence is taken out before a winding is blamed.
+    pub current_sensor_phase: Option<SensorPhaseReport>,
+    /// The same for the voltage sensors (phase voltages against the star point), or null.
+    pub voltage_sensor_phase: Option<SensorPhaseReport>,
+    /// What was measured, before the baseline is taken out (sensor-corrected): `I2/I1` and
+    /// `V2/I1` (re, im); a healthy log's are the `--baseline` of a later one.
+    pub measured: UnbalanceBaseline,
+    /// The healthy negative sequence the winding is judged against ([`BaselineSource`]),
+    /// or null (none: the supply's part alone is taken out).
+    pub baseline: Option<BaselineSource>,
+    /// How many turns are shorted in the named phase, with its interval and where it comes
+    /// from (`basis`: `physics`, or `calibration` where one was given); null without a
+    /// named phase ([`level`]).
+    pub shorted_turns: Option<level::ShortedTurns>,
+    /// The model's estimate, also where a calibration gave `shorted_turns`; null without a
+    /// named phase.
+    pub shorted_turns_physics: Option<level::ShortedTurns>,
 }
 
-impl From<UnbalanceBaseline> for HealthyReference {
-    fn from(b: UnbalanceBaseline) -> Self {
-        HealthyReference {
-            mean: b,
-            runs: 1,
-            sum_sq_dev: 0.0,
-        }
+impl UnbalanceReport {
+    /// Whether the winding's finding carries a FAULT: a phase named at a probability of
+    /// at least [`WINDING_FAULT_PROBABILITY`].
+    pub fn names_a_short(&self) -> bool {
+        self.suspect_phase.is_some() && self.phase_confidence >= WINDING_FAULT_PROBABILITY
     }
 }
 
-/// [`HealthyReference::change_sigma`] of `runs` runs whose readings' squared distances
-/// from their mean sum to `sum_sq_dev`, with the default spread `s0`.
-pub(crate) fn pooled_change_sigma(s0: f32, runs: u32, sum_sq_dev: f32) -> f32 {
-    let n = runs.max(1) as f32;
-    ((2.0 * s0 * s0 + sum_sq_dev) / (2.0 * n)).sqrt() * (1.0 + 1.0 / n).sqrt()
-}
-
-impl HealthyReference {
-    /// The reference made of several healthy runs (`diagnose --baseline` with several
-    /// logs); `None` for none.
-    pub fn from_runs(runs: &[UnbalanceBaseline]) -> Option<Self> {
-        let n = runs.len();
-        if n == 0 {
-            return None;
-        }
-        let i2 = mean(runs.iter().map(|r| of_pair(r.i2_over_i1)));
-        let v2 = runs
-            .iter()
-            .map(|r| r.v2_over_i1.map(of_pair))
-            .collect::<Option<Vec<_>>>()
-            .map(|v| mean(v.into_iter()));
-        Some(HealthyReference {
-            mean: UnbalanceBaseline {
-                i2_over_i1: pair(i2),
-                v2_over_i1: v2.map(pair),
-                i1_peak_a: runs.iter().map(|r| r.i1_peak_a).sum::<f32>() / n as f32,
-                wr_rad_s: runs
-                    .iter()
-                    .map(|r| r.wr_rad_s)
-                    .collect::<Option<Vec<f32>>>()
-                    .map(|w| w.iter().sum::<f32>() / n as f32),
-            },
-            runs: n as u32,
-            sum_sq_dev: runs
-                .iter()
-                .map(|r| abs(of_pair(r.i2_over_i1) - i2).powi(2))
-                .sum(),
-        })
-    }
-
-    /// The runs' RMS distance from their mean, `sqrt(sum / (n - 1))`; `None` for one run.
-    pub fn measured_spread(&self) -> Option<f32> {
-        (self.runs >= 2).then(|| (self.sum_sq_dev / (self.runs - 1) as f32).sqrt())
-    }
-
-    /// The spread `sigma_run` of one healthy run's reading (each component), with the
-    /// default `s0` counted as one run: `sqrt((2 s0^2 + sum |h_i - mean|^2) / (2 n))`
-    /// (module docs, step 3).
-    pub fn sigma(&self, s0: f32) -> f32 {
-        ((2.0 * s0 * s0 + self.sum_sq_dev) / (2 * self.runs.max(1)) as f32).sqrt()
-    }
-
-    /// The spread of a new healthy reading's change from the runs' mean (each component):
-    /// `sigma_run sqrt(1 + 1/n)`.
-    pub fn change_sigma(&self, s0: f32) -> f32 {
-        pooled_change_sigma(s0, self.runs, self.sum_sq_dev)
-    }
+/// Where the healthy negative sequence the winding is judged against comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BaselineSource {
+    /// Learned in the commissioning window, used while |I1| is within
+    /// [`crate::baseline::BASELINE_I1_TOLERANCE`] of its value there.
+    Commissioning,
+    /// The healthy log given with `--baseline`.
+    File,
 }
 
 /// What was measured: the longest steady segment's `I2/I1`, `V2/I1` and `|I1|` (a

@@ -5,6 +5,7 @@
 
 pub mod circles;
 pub mod files;
+pub mod layers;
 
 use syn::visit::Visit;
 

@@ -3,8 +3,8 @@
 use super::sentences::pct;
 use super::{serialize_state, IsolationName, IsolationTracker, NameGiven, LIST_FROM};
 use crate::events::IsolationEvent;
+use crate::sequences::SensorPhaseReport;
 use monitor_core::isolation::{Candidate, DEFAULT_SPREAD};
-use monitor_core::sequence::SinglePhaseGain;
 use monitor_core::{Fault, Isolation, IsolationState, Phase};
 use serde::Serialize;
 
@@ -29,29 +29,6 @@ impl From<&Candidate> for FaultCandidate {
             probability: c.probability,
             change: Some(c.change),
             phase: None,
-        }
-    }
-}
-
-/// One phase's sensor gain error found from the zero sequence
-/// ([`monitor_core::sequence::single_phase_gain`]; JSON `unbalance.current_sensor_phase`,
-/// `unbalance.voltage_sensor_phase`).
-#[derive(Debug, Clone, Serialize, PartialEq)]
-pub struct SensorPhaseReport {
-    /// The phase (JSON `a`, `b` or `c`).
-    pub phase: Phase,
-    /// The sensor's gain error (0.2: it reads 20 % high).
-    pub gain_error: f32,
-    /// |3 I0| / |I1|: the zero sequence the error leaves in the measured set.
-    pub zero_sequence_ratio: f32,
-}
-
-impl From<&SinglePhaseGain> for SensorPhaseReport {
-    fn from(g: &SinglePhaseGain) -> Self {
-        SensorPhaseReport {
-            phase: g.phase,
-            gain_error: g.gain_error,
-            zero_sequence_ratio: g.zero_sequence_ratio,
         }
     }
 }
@@ -157,9 +134,9 @@ pub struct IsolationReport {
     /// scatter.
     pub heating_explains: bool,
     /// What happened, with times: each name the first time it was given (with its size and
-    /// probability) and each load move ([`IsolationEvent`]), at most [`crate::MAX_EVENTS`].
+    /// probability) and each load move ([`IsolationEvent`]), at most [`crate::events::MAX_EVENTS`].
     pub events: Vec<IsolationEvent>,
-    /// How many events came after [`crate::MAX_EVENTS`] and are not listed.
+    /// How many events came after [`crate::events::MAX_EVENTS`] and are not listed.
     pub events_dropped: usize,
     /// The log's temperature channel (JSON keys `winding_temperature_c`, `measured_rise_k`,
     /// `temperature_channel`, present only for a log with the column).
@@ -196,7 +173,7 @@ impl IsolationTracker {
         Fault::ALL
             .into_iter()
             .filter(|fault| *fault != Fault::B)
-            .filter(|fault| *fault != Fault::Bl || self.load != crate::LoadModel::Unknown)
+            .filter(|fault| *fault != Fault::Bl || self.load != crate::options::LoadModel::Unknown)
             .filter_map(|fault| {
                 iso.detection_limit(&at, fault)
                     .map(|change| DetectionLimit { fault, change })

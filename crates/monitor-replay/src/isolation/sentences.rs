@@ -59,7 +59,7 @@ impl IsolationTracker {
     }
 
     /// The verdict where the last point reads as the friction class with the load an unknown
-    /// input ([`crate::LoadModel::Unknown`]): the load moved.
+    /// input ([`crate::options::LoadModel::Unknown`]): the load moved.
     fn load_moved_sentence(&self) -> String {
         let last = self.events.events().iter().rev().find_map(|e| match e {
             IsolationEvent::LoadMoved { t_s, from_a, to_a } => Some((*t_s, *from_a, *to_a)),
@@ -73,7 +73,7 @@ impl IsolationTracker {
         });
         format!(
             "The load moved{what}: an operating-point change, not a fault; the stator-voltage equations, with the load as an unknown input, fit the machine. (A change of the machine's friction B cannot be told from a load change without a load model: for the paper's fixed viscous load, where a Bl change is a fault, give {}.)",
-            self.words.hint(crate::OptionField::Load, "viscous")
+            self.words.hint(crate::words::OptionField::Load, "viscous")
         )
     }
 

@@ -17,7 +17,7 @@
 //! analysis re-centres it on the supply's own mean frequency per stretch
 //! (`super::spectrum`).
 
-use crate::COUNTS_PER_REV;
+use crate::sampler::COUNTS_PER_REV;
 #[cfg(test)]
 use monitor_core::frames::{AlphaBeta, SinCos};
 use monitor_io::log::{Row, ENC_COUNT_UNREADABLE};

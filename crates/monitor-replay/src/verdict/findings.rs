@@ -2,13 +2,17 @@
 //! ([`super::FindingReport`]). Each says what it found and what it was judged against, or
 //! why it could not judge.
 
+use super::measured::{rotor_finding, sensor_flag_finding, winding_finding};
 use super::words::fault_text;
 use super::FindingReport;
+use super::MIN_JUDGED_S;
+use crate::isolation::IsolationTracker;
 use crate::isolation::{FaultCandidate, IsolationBaseline, IsolationName, IsolationReport};
-use crate::{BaselineSource, Replay, UnbalanceReport, MIN_JUDGED_S};
+use crate::lamps::LampStage;
+use crate::options::ReplayOptions;
+use crate::winding::UnbalanceReport;
 use monitor_core::verdict::{Against, FaultName, FindingSource, NamedFault, Size, State};
-use monitor_core::{MonitorOutput, SensorFlags};
-use monitor_io::log::quality::{DataQuality, MAX_NOT_JUDGED_FRACTION};
+use monitor_core::MonitorOutput;
 
 /// What the residual finding is drawn from, besides the replay's own state: the final output,
 /// the isolation's report and candidates, whether a fault was detected, and the analyses the
@@ -66,11 +70,44 @@ fn residual_brief(against: Against) -> String {
     )
 }
 
-impl Replay {
+/// What the findings read of a replay's stages at its end: the lamps, the isolation and
+/// the options asked for.
+pub(crate) struct Stages<'a> {
+    /// The lamps' stage.
+    pub lamps: &'a LampStage,
+    /// The isolation's tracker.
+    pub isolation: &'a IsolationTracker,
+    /// The replay's options.
+    pub opts: &'a ReplayOptions,
+}
+
+impl Stages<'_> {
+    /// Every analysis' finding at the end of the replay (the data quality's is added by the
+    /// caller that ran the data-quality stage, `diagnose`): the residuals, the winding, the
+    /// rotor, the operating point, the parameter file's fit, and the sensors' impossible
+    /// readings.
+    pub(crate) fn findings(
+        &self,
+        inp: &ResidualInputs<'_>,
+        unbalance: &UnbalanceReport,
+        rotor: &crate::rotor::RotorReport,
+    ) -> Vec<FindingReport> {
+        let residual = self.residual_finding(inp);
+        let mut found = vec![
+            residual.clone(),
+            winding_finding(unbalance),
+            rotor_finding(rotor),
+            self.operating_point_finding(inp.out, inp.isolation),
+            self.parameter_fit_finding(&residual, inp.isolation),
+        ];
+        found.extend(sensor_flag_finding(inp.out.sensor_fault));
+        found
+    }
+
     /// What the residuals are judged against: commissioning where a window was learned (the
     /// lamps' thresholds) or the isolation learned its baseline, else the parameter file.
     fn residuals_against(&self, iso: &IsolationReport) -> Against {
-        if self.commission.learned() || iso.baseline == IsolationBaseline::Learned {
+        if self.lamps.commission.learned() || iso.baseline == IsolationBaseline::Learned {
             Against::Commissioning
         } else {
             Against::ParameterFile
@@ -79,15 +116,15 @@ impl Replay {
 
     /// Why the residuals could not be judged at all, where they could not.
     fn residuals_not_judged(&self, inp: &ResidualInputs<'_>) -> Option<String> {
-        if self.monitor.is_none() {
+        if self.lamps.monitor.is_none() {
             return Some(inp.skipped.first().cloned().unwrap_or_else(|| {
                 "residuals r1..r4: need the voltages and the speed".to_string()
             }));
         }
-        if let Some(why) = self.commission.why_incomplete() {
+        if let Some(why) = self.lamps.commission.why_incomplete() {
             return Some(why);
         }
-        if !self.evaluated && self.first_detection.is_none() {
+        if !self.lamps.evaluated && self.lamps.first_detection.is_none() {
             return Some(
                 "the lamps were never evaluated (the motor never ran settled and quasi-steady with voltage)"
                     .to_string(),
@@ -96,13 +133,13 @@ impl Replay {
         if inp.detected {
             return None;
         }
-        if self.judged_s < MIN_JUDGED_S {
+        if self.lamps.judged_s < MIN_JUDGED_S {
             return Some(format!(
                 "the lamps were judged on only {:.2} s of settled, quasi-steady running ({MIN_JUDGED_S:.1} s needed): the log is all start or transient, or ends too soon after commissioning",
-                self.judged_s
+                self.lamps.judged_s
             ));
         }
-        self.unsettled.withheld()
+        self.lamps.unsettled.withheld()
     }
 
     /// The residual lamps' and the isolation's finding.
@@ -145,7 +182,7 @@ impl Replay {
         if !inp.detected && !lit_end {
             return of(State::Clear, iso.verdict.clone());
         }
-        if let (Some(t), false) = (self.first_detection, self.detected_in_range) {
+        if let (Some(t), false) = (self.lamps.first_detection, self.lamps.detected_in_range) {
             return of(
                 State::OutOfRange,
                 format!(
@@ -161,7 +198,7 @@ impl Replay {
     /// voltages or the speed lacks what they need (unavailable); else the log kept them
     /// from judging (not judged).
     fn residuals_unjudged(&self, against: Against, why: String) -> FindingReport {
-        let state = if self.monitor.is_none() {
+        let state = if self.lamps.monitor.is_none() {
             State::Unavailable
         } else {
             State::NotJudged
@@ -179,7 +216,7 @@ impl Replay {
         lit_end: bool,
     ) -> Option<(String, String)> {
         let iso = inp.isolation;
-        let ever_lit = self.first_detection.is_some() || lit_end;
+        let ever_lit = self.lamps.first_detection.is_some() || lit_end;
         if ever_lit && self.isolation.heating_explains_lamps() {
             let rise = iso
                 .winding_rise_k
@@ -205,9 +242,10 @@ impl Replay {
     /// With the load an unknown input, the lamps' matching only ever named the friction
     /// class (the load term): a load move.
     fn only_load_named(&self) -> bool {
-        self.opts.load == crate::LoadModel::Unknown
-            && !self.detections.is_empty()
+        self.opts.load == crate::options::LoadModel::Unknown
+            && !self.lamps.detections.is_empty()
             && self
+                .lamps
                 .detections
                 .iter()
                 .all(|d| matches!(d.fault, monitor_core::Fault::B | monitor_core::Fault::Bl))
@@ -237,7 +275,7 @@ impl Replay {
                 "commissioned: the residuals are judged against the healthy motor learned in commissioning, not the file's values".to_string(),
             );
         }
-        if self.monitor.is_none() {
+        if self.lamps.monitor.is_none() {
             return of(
                 State::Unavailable,
                 Against::ParameterFile,
@@ -286,7 +324,7 @@ impl Replay {
                 Some(within(fault_text(&n)))
             }
             State::Named(_) => None,
-            _ => self.commission.nominal_misfit(),
+            _ => self.lamps.commission.nominal_misfit(),
         }
     }
 
@@ -308,7 +346,7 @@ impl Replay {
                 brief.clone(),
             )
         };
-        if self.monitor.is_none() {
+        if self.lamps.monitor.is_none() {
             return of(
                 State::Unavailable,
                 "the load and the heating need the voltages and the speed".to_string(),
@@ -317,10 +355,10 @@ impl Replay {
         let moves = iso
             .events
             .iter()
-            .filter(|e| matches!(e, crate::IsolationEvent::LoadMoved { .. }))
+            .filter(|e| matches!(e, crate::events::IsolationEvent::LoadMoved { .. }))
             .count();
         let mut said = Vec::new();
-        if let Some(note) = self.commission.moved_note(out) {
+        if let Some(note) = self.lamps.commission.moved_note(out) {
             said.push(format!("outside the commissioned range at the end: {note}"));
         }
         if moves > 0 {
@@ -339,240 +377,4 @@ impl Replay {
         }
         of(State::Explained, said.join("; "))
     }
-}
-
-/// What the winding was judged against, and the brief phrase (`winding against 2 healthy
-/// runs`).
-fn winding_against(u: &UnbalanceReport) -> (Against, String) {
-    let against = u.judged_against.unwrap_or(match u.baseline {
-        Some(BaselineSource::File) => Against::HealthyRuns,
-        Some(BaselineSource::Commissioning) => Against::Commissioning,
-        None => Against::Nothing,
-    });
-    let brief = if u.baseline_runs > 0 && against == Against::HealthyRuns {
-        format!(
-            "winding against {} healthy run{}",
-            u.baseline_runs,
-            if u.baseline_runs == 1 { "" } else { "s" }
-        )
-    } else {
-        format!(
-            "winding {}",
-            super::words::against_text(FindingSource::Winding, against)
-        )
-    };
-    (against, brief)
-}
-
-/// The winding's finding from the negative-sequence report: shorted turns named with the
-/// phase's calibrated probability where a phase is more probable than no short (a FAULT
-/// from 0.5 on), clear where no short is the more probable, unavailable without a steady
-/// stretch.
-pub(crate) fn winding_finding(u: &UnbalanceReport) -> FindingReport {
-    let (against, brief) = winding_against(u);
-    let of = |state, summary: String| {
-        FindingReport::new(
-            FindingSource::Winding,
-            state,
-            against,
-            summary,
-            brief.clone(),
-        )
-    };
-    let widened = u
-        .least_change_widened
-        .as_ref()
-        .map_or(String::new(), |w| format!("; {w}"));
-    let change = format!(
-        "the negative sequence changed by {:.1} % of I1 (least change {:.1} %){widened}",
-        100.0 * u.winding_ratio,
-        100.0 * u.least_change
-    );
-    let short = |phase, confidence| {
-        State::Named(NamedFault {
-            fault: FaultName::ShortedTurns,
-            size: winding_size(u),
-            phase: Some(phase),
-            confidence,
-        })
-    };
-    if let Some(p) = u.suspect_phase {
-        // With the level where one was sized: "shorted turns in phase c: about 30 % of the
-        // phase's turns (22-38 %), from ...; the negative sequence changed by ...".
-        let said = u.shorted_turns.map_or_else(
-            || format!("shorted turns in phase {}: {change}", p.name()),
-            |t| format!("{}; {change}", t.sentence()),
-        );
-        return of(short(p, u.phase_confidence), said);
-    }
-    if u.judged_segment.is_none() {
-        return winding_unavailable(u, against);
-    }
-    let why = u
-        .phase_not_judged
-        .as_ref()
-        .map_or(String::new(), |w| format!(" ({w})"));
-    if let Some((p, prob)) = watched_phase(&u.phase_probabilities) {
-        // Not named (no short is the most probable), but a short too probable to call the
-        // winding clear: watched, never healthy.
-        return of(
-            short(p, prob),
-            format!(
-                "a short in phase {} is not ruled out (probability {prob:.2}, no short {:.2}): {change}{why}",
-                p.name(),
-                u.phase_probabilities.no_short
-            ),
-        );
-    }
-    of(State::Clear, format!("no shorted turns: {change}{why}"))
-}
-
-/// The winding finding's size: the shorted fraction of the phase's turns where one was
-/// sized (`unbalance.shorted_turns`), else the change of the negative sequence.
-fn winding_size(u: &UnbalanceReport) -> Size {
-    u.shorted_turns
-        .map_or(Size::OfPositiveSequence(u.winding_ratio), |t| {
-            Size::TurnsFraction(t.fraction)
-        })
-}
-
-/// The winding's finding where no steady stretch was judged: unavailable, with the reason.
-fn winding_unavailable(u: &UnbalanceReport, against: Against) -> FindingReport {
-    let why = u
-        .phase_not_judged
-        .clone()
-        .unwrap_or_else(|| "no steady stretch".to_string());
-    let brief = format!("winding: {why}");
-    FindingReport::new(
-        FindingSource::Winding,
-        State::Unavailable,
-        against,
-        why,
-        brief,
-    )
-}
-
-/// The least probability of a short in one phase at which the winding is not clear
-/// ([`winding_finding`]): a short in a phase at 1 in 5 is worth watching.
-pub const WINDING_WATCH_PROBABILITY: f32 = 0.2;
-
-/// The most probable shorted phase and its probability, where it has
-/// [`WINDING_WATCH_PROBABILITY`] or more.
-fn watched_phase(pp: &crate::PhaseProbabilities) -> Option<(monitor_core::Phase, f32)> {
-    use monitor_core::Phase;
-    [(Phase::A, pp.a), (Phase::B, pp.b), (Phase::C, pp.c)]
-        .into_iter()
-        .max_by(|x, y| x.1.total_cmp(&y.1))
-        .filter(|(_, p)| *p >= WINDING_WATCH_PROBABILITY)
-}
-
-/// The rotor's finding from the current spectrum (MCSA): broken bars named from the band "a
-/// cracked bar or a high-resistance joint likely" on (48 dB or less below the supply line,
-/// `monitor_core::verdict::ROTOR_FAULT_DB`), with the spectrum's confidence; quieter
-/// sidebands ("no sign", and the "watch" band, which practice trends rather than acts on)
-/// are judged clear, with their level; a record the spectrum could not read is unavailable.
-pub(crate) fn rotor_finding(r: &crate::RotorReport) -> FindingReport {
-    use crate::RotorBand;
-    let of = |state, summary: String, brief: String| {
-        FindingReport::new(
-            FindingSource::Rotor,
-            state,
-            Against::Nothing,
-            summary,
-            brief,
-        )
-    };
-    let (Some(level), Some(band), true) = (r.level_db, r.band, r.judged) else {
-        let why = r
-            .cannot_judge_because
-            .clone()
-            .unwrap_or_else(|| "the sidebands were not read".to_string());
-        return of(State::Unavailable, why.clone(), format!("rotor: {why}"));
-    };
-    let below = -level as f32;
-    let brief = format!("rotor sidebands {below:.0} dB below the supply line");
-    match band {
-        RotorBand::NoSign | RotorBand::Watch => {
-            let brief = if band == RotorBand::Watch {
-                format!("{brief} (the watch band: trend it)")
-            } else {
-                brief
-            };
-            of(State::Clear, r.sentence.clone(), brief)
-        }
-        _ => {
-            let named = NamedFault {
-                fault: FaultName::BrokenBars,
-                size: Size::DbBelowLine(below),
-                phase: None,
-                confidence: r.confidence.unwrap_or(0.0) as f32,
-            };
-            of(State::Named(named), r.sentence.clone(), brief)
-        }
-    }
-}
-
-/// The data-quality finding: what the stage does not trust, the stretches not judged, and
-/// the sensors' readings no machine gives at the end (`sensors`, the core's flags).
-pub(crate) fn data_quality_finding(q: &DataQuality, sensors: SensorFlags) -> FindingReport {
-    let of = |state, summary: String| {
-        FindingReport::new(
-            FindingSource::DataQuality,
-            state,
-            Against::Nothing,
-            summary,
-            "data quality".to_string(),
-        )
-    };
-    if !q.trusted {
-        return of(
-            State::Unexplained,
-            format!("data quality: {}", q.not_trusted_because.join("; ")),
-        );
-    }
-    let unjudged: f64 = q.not_judged.iter().map(|n| n.to_s - n.from_s).sum();
-    if unjudged > MAX_NOT_JUDGED_FRACTION * q.duration_s.max(f64::MIN_POSITIVE) {
-        return of(
-            State::Unexplained,
-            format!(
-                "{unjudged:.2} s of the {:.2} s log could not be judged (over {:.0} %): {}",
-                q.duration_s,
-                100.0 * MAX_NOT_JUDGED_FRACTION,
-                q.not_judged
-                    .iter()
-                    .map(|n| format!("{:.2}..{:.2} s, {}", n.from_s, n.to_s, n.why))
-                    .collect::<Vec<_>>()
-                    .join("; ")
-            ),
-        );
-    }
-    if let Some(s) = sensor_flag_finding(sensors) {
-        return s;
-    }
-    of(State::Clear, format!("data quality: {}", q.summary()))
-}
-
-/// The core's sensor flags at the end of a replay as a data-quality finding (readings no
-/// machine gives: a sensor or its wiring, not the motor); `None` with no flag set.
-pub(crate) fn sensor_flag_finding(s: SensorFlags) -> Option<FindingReport> {
-    let which: Vec<&str> = [
-        (s.current, "current"),
-        (s.voltage, "voltage"),
-        (s.speed, "speed (encoder)"),
-    ]
-    .into_iter()
-    .filter_map(|(on, w)| on.then_some(w))
-    .collect();
-    (!which.is_empty()).then(|| {
-        FindingReport::new(
-            FindingSource::DataQuality,
-            State::Unexplained,
-            Against::Nothing,
-            format!(
-                "the {} sensor readings at the end of the log are impossible for any machine (not a number, saturated, phases not summing to zero, or an encoder jump): check the sensors and their wiring; the motor cannot be judged from them",
-                which.join(" and ")
-            ),
-            "data quality".to_string(),
-        )
-    })
 }

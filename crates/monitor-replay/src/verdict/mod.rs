@@ -18,6 +18,7 @@
 //!   commissioned.
 
 pub(super) mod findings;
+pub(super) mod measured;
 mod words;
 pub use words::{against_text, fault_text, pct};
 
@@ -185,70 +186,21 @@ pub fn put(findings: &mut Vec<FindingReport>, f: FindingReport) {
     }
 }
 
-use crate::{DiagnoseReport, IsolationReport, Replay, UnbalanceReport};
+use crate::isolation::IsolationReport;
 use monitor_core::verdict::{FaultName, Glance};
 use monitor_core::MonitorOutput;
 
-impl Replay {
-    /// Every analysis' finding at the end of the replay (the data quality's is added by the
-    /// caller that ran the data-quality stage, `diagnose`): the residuals, the winding, the
-    /// rotor, the operating point, the parameter file's fit, and the sensors' impossible
-    /// readings.
-    pub(crate) fn findings(
-        &self,
-        inp: &findings::ResidualInputs<'_>,
-        unbalance: &UnbalanceReport,
-        rotor: &crate::RotorReport,
-    ) -> Vec<FindingReport> {
-        let residual = self.residual_finding(inp);
-        let mut found = vec![
-            residual.clone(),
-            findings::winding_finding(unbalance),
-            findings::rotor_finding(rotor),
-            self.operating_point_finding(inp.out, inp.isolation),
-            self.parameter_fit_finding(&residual, inp.isolation),
-        ];
-        found.extend(findings::sensor_flag_finding(inp.out.sensor_fault));
-        found
-    }
-}
-
-impl DiagnoseReport {
-    /// Decides the verdict from the report's `findings` by the decision table
-    /// ([`conclude`]) and writes it into the verdict's keys. Call again
-    /// after adding or replacing a finding.
-    pub fn conclude(&mut self) {
-        let c = conclude(&self.findings);
-        self.verdict = c.verdict;
-        self.verdict_rule = c.rule;
-        self.verdict_line = c.line;
-        self.verdict_finding = c.finding;
-        self.judged = c.judged;
-        self.not_judged = c.not_judged;
-        self.verdict_withheld_because = c.withheld_because;
-    }
-
-    /// Data that cannot carry a verdict (`why`): every fault-judging finding that judged
-    /// something becomes "not judged", with what it would have said; decided again.
-    pub fn distrust(&mut self, why: &str) {
-        for f in &mut self.findings {
-            if f.source().judges_faults()
-                && f.finding.state != monitor_core::verdict::State::NotJudged
-            {
-                f.summary = format!("not judged ({why}); it read: {}", f.summary);
-                f.brief = format!("{}: {why}", f.source().name());
-                f.finding.state = monitor_core::verdict::State::NotJudged;
-            }
-        }
-        self.conclude();
-    }
-
-    /// Replaces (or adds) the finding of its source and decides again.
-    pub fn put_finding(&mut self, f: FindingReport) {
-        put(&mut self.findings, f);
-        self.conclude();
-    }
-}
+/// The least running, in seconds, on which the lamps must have been judged (evaluated,
+/// quasi-steady, on thresholds in force) for the verdict `healthy`: less is "could not
+/// judge" with how much was judged. One rule for `diagnose`, the HMI's log replay and the
+/// demo (all report through [`Replay::finish`]).
+pub const MIN_JUDGED_S: f64 = 1.0;
+/// The least relative change of a named fault for the verdict `fault`: the core's
+/// ([`monitor_core::isolation::MIN_FAULT_CHANGE`], 5 %), read by the one verdict's decision
+/// table (`monitor_core::verdict`) for `diagnose`, the HMI's log replay, the demo
+/// ([`Replay::finish`]) and the board's FAULT lamp. Below it the verdict is `watching`, with
+/// the name and its size.
+pub const MIN_FAULT_CHANGE: f32 = monitor_core::isolation::MIN_FAULT_CHANGE;
 
 /// The moment's evidence as the decision table reads it (the board's
 /// `monitor_core::verdict::Glance`): the lamps, the sensor flags, the isolation's name with
@@ -256,16 +208,18 @@ impl DiagnoseReport {
 /// lamps (`moved`), and the core's winding phase.
 pub(crate) fn glance(
     out: &MonitorOutput,
-    report: Option<&(IsolationReport, Vec<crate::FaultCandidate>)>,
+    report: Option<&(IsolationReport, Vec<crate::isolation::FaultCandidate>)>,
     moved: bool,
 ) -> Glance {
     let named = report.and_then(|(r, c)| findings::isolation_name(r, c));
-    let friction = report.is_some_and(|(r, _)| r.named == Some(crate::IsolationName::Friction));
+    let friction =
+        report.is_some_and(|(r, _)| r.named == Some(crate::isolation::IsolationName::Friction));
     Glance {
         lamps_lit: out.fault_detected,
         sensor_fault: out.sensor_fault.any(),
         named,
-        commissioned: report.is_some_and(|(r, _)| r.baseline == crate::IsolationBaseline::Learned),
+        commissioned: report
+            .is_some_and(|(r, _)| r.baseline == crate::isolation::IsolationBaseline::Learned),
         moved: moved || friction,
         // The core's winding phase counts where the lamps are judged (settled, quasi-steady):
         // a start's or a step's transient unbalances the currents for a while.

@@ -58,7 +58,7 @@ pub fn fault_text(n: &NamedFault) -> String {
         (FaultName::BrokenBars, size) => {
             let band = match size {
                 Size::DbBelowLine(db) => {
-                    format!(" ({})", crate::band_of(-f64::from(db)).words())
+                    format!(" ({})", crate::rotor::band_of(-f64::from(db)).words())
                 }
                 _ => String::new(),
             };

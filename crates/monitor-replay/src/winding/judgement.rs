@@ -2,6 +2,7 @@
 //! against (module docs of [`super`], steps 2, 3 and 5), and the negative-sequence report
 //! (`unbalance`) built from the judgement.
 
+use super::level::TurnLevelOptions;
 use super::probability::{
     judge_alone, judge_external, judge_within, External, PhaseJudged, PhaseReading,
 };
@@ -11,13 +12,15 @@ use super::{
     FULL_LOAD_SLIP_MAX, MAX_SEGMENTS, MEASURED_REFERENCE_UNCERTAINTY_DEG, MIN_SEGMENT_WINDOWS,
     SLIP_MODEL_UNCERTAINTY,
 };
-use crate::report::BaselineSource;
+use super::{BaselineSource, UnbalanceReport};
+use crate::sequences::SensorPhaseReport;
 use crate::sequences::{sensor_phase, SequenceWindow};
-use crate::{Replay, SensorPhaseReport, UnbalanceReport};
+use crate::words::Words;
 use monitor_core::sequence::{
     asymmetry_correction_rad, equivalent_impedance, slip_for_current, SinglePhaseGain,
 };
 use monitor_core::MotorModel;
+use monitor_io::params::ParamFile;
 
 /// What every stretch is judged with: the model, the nominal supply, and whether the
 /// speed is measured.
@@ -175,90 +178,93 @@ struct Outside {
     ext: External,
 }
 
-impl Replay {
-    /// The negative-sequence report (module docs).
-    pub(crate) fn unbalance_report(&self) -> UnbalanceReport {
-        let windows = self.book.windows();
-        let segs = segments(windows);
-        let judge = Judge {
-            m: self.params.motor.model(),
-            v_nominal: self.params.supply.v_phase_peak() as f32,
-            speed: self.monitor.is_some(),
-        };
-        let we0 = std::f32::consts::TAU * self.params.supply.f_hz as f32;
-        let outside = self
-            .opts
-            .unbalance_baseline
-            .map(|f| from_runs(&judge, &f, we0))
-            .or_else(|| learned_reference(&judge, windows, we0));
-        let judged = judge_stretches(&judge, &segs, outside.as_ref());
-        let mut report = self.report_without_judgement(windows, &segs, outside.as_ref());
-        match &judged {
-            None => report.phase_not_judged = Some(no_stretch_reason(self.params.supply.f_hz)),
-            Some(j) => {
-                fill_judgement(&mut report, j, &segs, self.opts.words);
-                let poles = self.params.motor.poles.max(2) as f32 / 2.0;
-                if let Some(o) = &outside {
-                    report.least_change_widened = super::reasons::widened(j, &o.ext, poles);
-                }
+/// The negative-sequence report (module docs) of the least-squares `windows` of a log of
+/// `params`' machine (`speed`: the log has a speed), judged against `baseline` (the healthy
+/// runs given, else the commissioning window's), with the turns counted by `level`, its
+/// sentences in `words`.
+pub(crate) fn unbalance_report(
+    windows: &[SequenceWindow],
+    params: &ParamFile,
+    speed: bool,
+    baseline: Option<HealthyReference>,
+    level: TurnLevelOptions,
+    words: Words,
+) -> UnbalanceReport {
+    let segs = segments(windows);
+    let judge = Judge {
+        m: params.motor.model(),
+        v_nominal: params.supply.v_phase_peak() as f32,
+        speed,
+    };
+    let we0 = std::f32::consts::TAU * params.supply.f_hz as f32;
+    let outside = baseline
+        .map(|f| from_runs(&judge, &f, we0))
+        .or_else(|| learned_reference(&judge, windows, we0));
+    let judged = judge_stretches(&judge, &segs, outside.as_ref());
+    let mut report = report_without_judgement(windows, &segs, outside.as_ref(), baseline);
+    match &judged {
+        None => report.phase_not_judged = Some(no_stretch_reason(params.supply.f_hz)),
+        Some(j) => {
+            fill_judgement(&mut report, j, &segs, words);
+            let poles = params.motor.poles.max(2) as f32 / 2.0;
+            if let Some(o) = &outside {
+                report.least_change_widened = super::reasons::widened(j, &o.ext, poles);
             }
         }
-        report.segments = listed_segments(segs, judged.map(|j| j.index));
-        let level = self.opts.turn_level;
-        report.shorted_turns_physics =
-            super::level::physics(&report, &judge.m, we0, judge.v_nominal, &level);
-        report.shorted_turns = match level.calibration {
-            Some(cal) => super::level::calibrated(&report, &cal),
-            None => report.shorted_turns_physics,
-        };
-        report
     }
+    report.segments = listed_segments(segs, judged.map(|j| j.index));
+    report.shorted_turns_physics =
+        super::level::physics(&report, &judge.m, we0, judge.v_nominal, &level);
+    report.shorted_turns = match level.calibration {
+        Some(cal) => super::level::calibrated(&report, &cal),
+        None => report.shorted_turns_physics,
+    };
+    report
+}
 
-    /// The report's keys that do not depend on the judgement (`outside`: the healthy
-    /// reference from outside the log, if any).
-    fn report_without_judgement(
-        &self,
-        windows: &[SequenceWindow],
-        segs: &[SequenceSegment],
-        outside: Option<&Outside>,
-    ) -> UnbalanceReport {
-        let (measured, whole_ratio) = measured_of(windows, segs);
-        let file = self.opts.unbalance_baseline;
-        // The sensors at the log's end (as the isolation's candidates are).
-        let (gi, gv) = segs.last().map_or((None, None), sensor_phases);
-        UnbalanceReport {
-            negative_sequence_ratio: whole_ratio,
-            suspect_phase: None,
-            phase_confidence: 0.0,
-            phase_probabilities: PhaseProbabilities::default(),
-            phase_not_judged: None,
-            angle_deg: 0.0,
-            winding_ratio: 0.0,
-            supply_ratio: 0.0,
-            voltage_negative_sequence_ratio: measured_voltage_ratio(windows),
-            correction_deg: 0.0,
-            correction_uncertainty_deg: 0.0,
-            operating_point: None,
-            slip: None,
-            least_change: 0.0,
-            least_change_widened: None,
-            spread: 0.0,
-            judged_against: None,
-            baseline_runs: file.map_or(0, |f| f.runs),
-            baseline_spread: file.and_then(|f| f.measured_spread()),
-            judged_segment: None,
-            reference_segment: None,
-            segments: Vec::new(),
-            current_sensor_phase: gi.as_ref().map(SensorPhaseReport::from),
-            voltage_sensor_phase: gv.as_ref().map(SensorPhaseReport::from),
-            measured,
-            baseline: outside.map(|o| match o.ext.against {
-                Against::Commissioning => BaselineSource::Commissioning,
-                _ => BaselineSource::File,
-            }),
-            shorted_turns: None,
-            shorted_turns_physics: None,
-        }
+/// The report's keys that do not depend on the judgement (`outside`: the healthy
+/// reference from outside the log, if any; `file`: the healthy runs given).
+fn report_without_judgement(
+    windows: &[SequenceWindow],
+    segs: &[SequenceSegment],
+    outside: Option<&Outside>,
+    file: Option<HealthyReference>,
+) -> UnbalanceReport {
+    let (measured, whole_ratio) = measured_of(windows, segs);
+    // The sensors at the log's end (as the isolation's candidates are).
+    let (gi, gv) = segs.last().map_or((None, None), sensor_phases);
+    UnbalanceReport {
+        negative_sequence_ratio: whole_ratio,
+        suspect_phase: None,
+        phase_confidence: 0.0,
+        phase_probabilities: PhaseProbabilities::default(),
+        phase_not_judged: None,
+        angle_deg: 0.0,
+        winding_ratio: 0.0,
+        supply_ratio: 0.0,
+        voltage_negative_sequence_ratio: measured_voltage_ratio(windows),
+        correction_deg: 0.0,
+        correction_uncertainty_deg: 0.0,
+        operating_point: None,
+        slip: None,
+        least_change: 0.0,
+        least_change_widened: None,
+        spread: 0.0,
+        judged_against: None,
+        baseline_runs: file.map_or(0, |f| f.runs),
+        baseline_spread: file.and_then(|f| f.measured_spread()),
+        judged_segment: None,
+        reference_segment: None,
+        segments: Vec::new(),
+        current_sensor_phase: gi.as_ref().map(SensorPhaseReport::from),
+        voltage_sensor_phase: gv.as_ref().map(SensorPhaseReport::from),
+        measured,
+        baseline: outside.map(|o| match o.ext.against {
+            Against::Commissioning => BaselineSource::Commissioning,
+            _ => BaselineSource::File,
+        }),
+        shorted_turns: None,
+        shorted_turns_physics: None,
     }
 }
 
@@ -340,7 +346,7 @@ fn fill_judgement(
     report: &mut UnbalanceReport,
     j: &PhaseJudged,
     segs: &[SequenceSegment],
-    words: crate::Words,
+    words: Words,
 ) {
     let p = j.posterior;
     let named = p.named();

@@ -30,8 +30,8 @@
 //! to the file's, `Z1` over the operating point's range, and `|r|` within two spreads of
 //! the judgement.
 
+use super::UnbalanceReport;
 use super::{abs, Complex32, FULL_LOAD_SLIP_MAX};
-use crate::UnbalanceReport;
 use monitor_core::sequence::{equivalent_impedance, slip_for_current};
 use monitor_core::{MotorModel, Phase};
 use serde::{Deserialize, Serialize};

@@ -19,7 +19,7 @@ pub(super) fn not_named(
     seg: &SequenceSegment,
     reference: Option<&SequenceSegment>,
     least: Option<f32>,
-    words: crate::Words,
+    words: crate::words::Words,
 ) -> Option<String> {
     let p = j.posterior;
     if p.named().is_some() {
@@ -51,7 +51,7 @@ pub(super) fn not_named(
     Some(match j.against {
         Against::Nothing | Against::ParameterFile => format!(
             "cannot judge the phase: the negative sequence ({change:.1} % of I1 at {at}) is within what a healthy machine's own asymmetry may reach ({least}) and there is no healthy baseline (give {} with healthy logs of this motor, or commission)",
-            words.hint(crate::OptionField::Baseline, "")
+            words.hint(crate::words::OptionField::Baseline, "")
         ),
         Against::WithinTheLog => {
             let from = reference.map_or(String::new(), |r| {

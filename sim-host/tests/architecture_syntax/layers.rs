@@ -1,0 +1,95 @@
+//! The order of the modules inside each crate with more than one part (rule 1 of the
+//! architecture test): a module uses only modules of a lower layer of its crate.
+
+/// The modules of one crate: (the crate's `src/` folder, its base layer's name, the
+/// modules above the base and their layers, lowest first). A module the table does not
+/// list is in layer 1, the base.
+pub type Inside = (&'static str, &'static [(&'static str, u8)]);
+
+/// The crates with more than one part, and the order of their modules (rule 1).
+pub const INSIDE: &[Inside] = &[
+    // The firmware's library: the board's facts and the stored records at the bottom, the
+    // supervisor (`app`) above what it composes, the boot at the top.
+    (
+        "src/",
+        &[
+            ("board", 1),
+            ("flash_record", 1),
+            ("liveness", 1),
+            ("recovery", 1),
+            ("flash_ecc", 2),
+            ("acquisition", 2),
+            ("sampling", 2),
+            ("supply", 2),
+            ("panel", 2),
+            ("commissioning", 2),
+            ("offset_trim", 3),
+            ("reset_record", 3),
+            ("range_watch", 3),
+            ("setup_guard", 4),
+            ("fault_path", 4),
+            ("app", 4),
+            ("motor_source", 5),
+            ("boot", 6),
+        ],
+    ),
+    // The parameter file below the logs and the nameplate estimate.
+    (
+        "crates/monitor-io/src/",
+        &[("params", 1), ("log", 2), ("nameplate", 2)],
+    ),
+    // `identify` on top of the model-vs-measurement analysis, which does not use it.
+    ("crates/monitor-analysis/src/", &[("identify", 2)]),
+    // One simulated scenario through the core, the studies on it, the demo, the bench.
+    (
+        "crates/monitor-studies/src/",
+        &[
+            ("experiment", 1),
+            ("fault_signatures", 2),
+            ("service_profile", 2),
+            ("demo", 3),
+            ("bench", 4),
+        ],
+    ),
+    // The replay as stages, from the facts a row needs up to `diagnose`, the front door:
+    // the sample clock, the baseline and the commissioning tracker at the bottom; the rotor's
+    // and the sequences' analyses, the winding's judgement on their windows; the options
+    // (which name the winding's turn count); the isolation; the lamps' stage over the core's
+    // monitor; the findings and the one verdict; the report; the replay that owns the stages;
+    // the data-quality hand-over, the reading thread's pipe and `diagnose` on top.
+    (
+        "crates/monitor-replay/src/",
+        &[
+            ("events", 2),
+            ("rotor", 2),
+            ("sequences", 3),
+            ("winding", 4),
+            ("options", 5),
+            ("error", 6),
+            ("isolation", 6),
+            ("step", 7),
+            ("unsettled", 7),
+            ("lamps", 8),
+            ("verdict", 9),
+            ("report", 10),
+            ("replay", 11),
+            ("front", 12),
+            ("pipe", 13),
+            ("diagnose", 14),
+        ],
+    ),
+    // The fleet run over the one-call API.
+    ("crates/monitor-api/src/", &[("fleet", 2)]),
+    // The stored row and the store's errors at the bottom, the Parquet mirror above them,
+    // the SQLite store that writes through the mirror on top; the trend reads rows.
+    (
+        "crates/monitor-store/src/",
+        &[
+            ("row", 1),
+            ("error", 1),
+            ("mirror", 2),
+            ("trend", 2),
+            ("store", 3),
+        ],
+    ),
+];
