@@ -8,7 +8,7 @@
 
 use super::baseline::HealthyReference;
 use super::sampler::TICK_HZ;
-pub use super::words::{FieldNames, OptionError, OptionField, Spelling, Words};
+pub use super::words::{OptionError, OptionField, Spelling, Words};
 use monitor_core::{AngleSource, MonitorConfig, ResidualForm};
 use monitor_io::params::ParamFile;
 use serde::Serialize;
