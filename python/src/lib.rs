@@ -67,7 +67,37 @@ impl monitor_replay::Spelling for PyWords {
             format!("{} = {value}", field.name())
         }
     }
+
+    /// A report's advice as a keyword argument to type: `commission='START:END'`,
+    /// `load='viscous'`, `baseline=[...]`, `effects=['load_torque']`, `from_s=0.8`.
+    fn hint(&self, field: monitor_replay::OptionField, value: &str) -> String {
+        use monitor_replay::OptionField as F;
+        let name = field.name();
+        let list = |v: &str| {
+            v.split(',')
+                .map(|x| format!("'{}'", x.trim()))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        match (field, value) {
+            (F::Baseline | F::Effects, "") => format!("{name}=[...]"),
+            (_, "") => format!("{name}=..."),
+            (F::Baseline | F::Effects, v) => format!("{name}=[{}]", list(v)),
+            (F::Commission | F::Load | F::Group | F::Params | F::ColumnsFrom, v) => {
+                format!("{name}='{v}'")
+            }
+            (_, v) => format!("{name}={v}"),
+        }
+    }
+
+    /// `diagnose(..., baseline=[...])`.
+    fn command_with(&self, command: &str, field: monitor_replay::OptionField) -> String {
+        format!("{command}(..., {})", self.hint(field, ""))
+    }
 }
+
+/// Python's words, as a request carries them (the reports' advice in keyword arguments).
+const PY: monitor_replay::Words = monitor_replay::Words(&PyWords);
 
 /// The exception of an [`ApiError`], its message in Python's words ([`PyWords`]).
 fn to_py(e: ApiError) -> PyErr {
@@ -232,6 +262,7 @@ fn replay_options(
             parallel_paths,
             calibration: calibration.or(d.turn_level.calibration),
         },
+        words: PY,
     })
 }
 
@@ -302,6 +333,7 @@ fn analysis_request(
         no_fit,
         group,
         rotor_bars,
+        words: PY,
     })
 }
 

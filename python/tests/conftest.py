@@ -36,3 +36,18 @@ def cli_json(sim_host: str, *args: str):
     out = subprocess.run([sim_host, *args, "--json"], capture_output=True, text=True, cwd=REPO)
     assert out.returncode == 0, out.stderr
     return json.loads(out.stdout)
+
+
+def in_python_words(doc, words: dict):
+    """The command's document `doc` with its advice in Python's words: in every string, each
+    of the command line's spellings in `words` (`"--effects load_torque"`) replaced by
+    Python's (`"effects=['load_torque']"`); the rest of the document as the command's."""
+    if isinstance(doc, str):
+        for cli, py in words.items():
+            doc = doc.replace(cli, py)
+        return doc
+    if isinstance(doc, list):
+        return [in_python_words(x, words) for x in doc]
+    if isinstance(doc, dict):
+        return {k: in_python_words(v, words) for k, v in doc.items()}
+    return doc

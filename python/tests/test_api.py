@@ -2,6 +2,7 @@
 memory; every error class with the command's message."""
 
 import json
+import re
 import subprocess
 
 import numpy as np
@@ -10,7 +11,7 @@ import pyarrow as pa
 import pytest
 
 import drive_monitor as dm
-from conftest import cli_json
+from conftest import cli_json, in_python_words
 
 MOTULATOR = "examples/logs/motulator_2p2kw_dol.csv"
 MOTULATOR_P = "examples/logs/motulator_2p2kw_dol.toml"
@@ -86,7 +87,11 @@ def test_compare_explain_identify_nameplate(repo, sim_host):
     assert c.normalized_rms_error < 0.05
     e = dm.explain(repo / MOTULATOR, repo / MOTULATOR_P, from_s=0.8)
     assert e.ranking[0].effect == "load_torque"
-    assert e.to_dict() == cli_json(sim_host, "explain", "--params", MOTULATOR_P, MOTULATOR, "--from", "0.8")
+    # The same document; its advice names Python's keyword where the command names its flag.
+    cli = cli_json(sim_host, "explain", "--params", MOTULATOR_P, MOTULATOR, "--from", "0.8")
+    assert "Add it with effects=['load_torque']" in e.verdict
+    assert e.to_dict() == in_python_words(cli, {"--effects load_torque": "effects=['load_torque']",
+                                                "effects or --from)": "effects or from_s=...)"})
     n = dm.params_from_nameplate(2.2, 400, 4.8, 50, 1438, 0.77, 0.863,
                                  columns_from=repo / "examples/params/daq_2p2kw.toml")
     assert n.poles == 4 and "[columns]" in n.toml
@@ -109,6 +114,18 @@ def test_explain_ladder_matches_the_cli(repo, sim_host):
     frame = lad.ladder_frame
     assert list(frame["step"]) == list(range(len(errors)))
     assert lad.stop in {"noise_floor", "nothing_helps", "library_exhausted"}
+
+
+def test_the_reports_advice_is_in_pythons_words(repo, sim_host):
+    # Without commissioning the report advises it: as the keyword argument to pass, where
+    # the command line names its flag; nothing in the document names a flag.
+    r = dm.diagnose(repo / MOTULATOR, repo / MOTULATOR_P)
+    advice = r.to_dict()["commissioning"]["advice"]
+    assert "commission (commission='START:END')" in advice, advice
+    assert not re.search(r"--[a-z]", json.dumps(r.to_dict())), advice
+    cli = cli_json(sim_host, "diagnose", "--params", MOTULATOR_P, MOTULATOR)
+    assert "commission (--commission START:END)" in cli["commissioning"]["advice"]
+    assert r.to_dict() == in_python_words(cli, {"--commission START:END": "commission='START:END'"})
 
 
 def test_simulate_returns_the_schema(repo):
@@ -172,7 +189,7 @@ def test_the_shorted_turn_level_from_the_model_and_from_a_calibration(repo, sim_
     log, p = repo / ITSC / "SC_A0_B0_C3_001.csv", repo / ITSC / "baldor_0p75hp.toml"
     r = dm.diagnose(log, p, parallel_paths=2)
     cli = cli_json(sim_host, "diagnose", "--params", str(p), str(log), "--parallel-paths", "2")
-    assert r.to_dict() == cli
+    assert r.to_dict() == in_python_words(cli, {"--commission START:END": "commission='START:END'"})
     t = r.shorted_turns
     assert t["phase"] == "c" and t["basis"] == "physics"
     assert t["low"] <= t["fraction"] <= t["high"]

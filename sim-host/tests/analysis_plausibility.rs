@@ -33,10 +33,10 @@ fn a_start_is_named_with_the_dynamics_effects_and_a_from() {
     let from: f64 = c
         .advice
         .iter()
-        .find_map(|a| a.split("--from ").nth(1))
+        .find_map(|a| a.split("from_s = ").nth(1))
         .and_then(|s| s.split(' ').next())
         .and_then(|s| s.parse().ok())
-        .expect("a --from suggestion");
+        .expect("a from_s suggestion (the library's words)");
     assert!(from > 0.1 && from < 1.5, "{from}");
     // Past the suggested start the model fits, its values are plausible, no window is a
     // start, and the error falls by more than 5x.
@@ -367,7 +367,7 @@ fn compare_advice_and_explain_skipped_agree() {
             .advice
             .first()
             .and_then(|a| a.split(": add ").nth(1))
-            .and_then(|s| s.split(" (--effects").next())
+            .and_then(|s| s.split(" (effects = ").next())
             .map(|s| s.split(", ").collect())
             .unwrap_or_default();
         eprintln!("{case}: advice {:#?}\nskipped {skipped:#?}", c.advice);

@@ -159,7 +159,7 @@ impl Analysis {
         let in_model: Vec<EffectKind> = list.iter().map(|e| e.kind()).collect();
         let plan = super::transients::dynamics_plan(span, &self.constants, &in_model);
         let (tags, advice) =
-            super::transients::advice(d, &self.constants, &worst, &in_model, &plan);
+            super::transients::advice(d, &self.constants, &worst, &in_model, &plan, &*self.words);
         for (w, t) in worst.iter_mut().zip(tags) {
             w.transient = t;
         }
@@ -188,9 +188,10 @@ impl Analysis {
                 0,
                 format!(
                     "the model diverged at {t:.3} s (its predicted current left {}x the largest measured): the error \
-                     {:.4} measures nothing; add the effects the advice names, or leave the start out (--from)",
+                     {:.4} measures nothing; add the effects the advice names, or leave the start out ({})",
                     metrics::DIVERGED_CURRENT_RATIO,
-                    m.err.normalized_rms_error
+                    m.err.normalized_rms_error,
+                    self.words.hint(monitor_replay::OptionField::From, "")
                 ),
             );
         }

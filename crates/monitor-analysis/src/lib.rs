@@ -119,6 +119,10 @@ pub struct Analysis {
     pub params: monitor_io::params::ParamFile,
     /// What the data-quality stage found in the log and what the analysis did about it.
     pub quality: monitor_io::log::quality::DataQuality,
+    /// The words the reports' advice names a field in (`--from` on the command line,
+    /// `from_s=...` in Python): the front end's that asked; the library's own
+    /// ([`monitor_replay::FieldNames`]) as loaded.
+    pub words: monitor_replay::Words,
 }
 
 /// Options shared by `compare` and `explain`.
@@ -328,6 +332,7 @@ impl Analysis {
             constants: MachineConstants::from_params(&params),
             params,
             quality,
+            words: monitor_replay::Words::LIBRARY,
         })
     }
 
@@ -531,6 +536,6 @@ fn align(active: &[ActiveEffect<'_>], mut f: FitResult) -> FitResult {
 impl Analysis {
     /// The unbalance / faulty-phase analysis ([`unbalance`]; needs only the currents).
     pub fn unbalance(&self) -> unbalance::UnbalanceAnalysis {
-        unbalance::analyse(&self.data, &self.constants)
+        unbalance::analyse(&self.data, &self.constants, &*self.words)
     }
 }

@@ -10,6 +10,7 @@ use super::metrics::WorstWindow;
 use super::prep::Prepared;
 use super::simplified_model::MachineConstants;
 use monitor_core::EffectKind;
+use monitor_replay::{FieldNames, OptionField, Spelling};
 use serde::Serialize;
 
 /// A relative change of the supply voltage amplitude or frequency larger than this within a
@@ -208,7 +209,7 @@ pub enum NotProposed {
     Requires(Vec<EffectKind>),
     /// Its time constant `tau_s` [s] is shorter than 3 samples of the fit series (period
     /// `dt_s` [s]).
-    #[error("the fit series of this long log ({:.0} Hz) cannot resolve a {:.1} ms time constant; analyse a shorter window with --from/--to", 1.0 / dt_s, 1000.0 * tau_s)]
+    #[error("{}", self.spelled(&FieldNames))]
     Unresolved {
         /// Sample period of the fit series [s].
         dt_s: f64,
@@ -222,6 +223,23 @@ pub enum NotProposed {
         /// The effect's time constant [s].
         tau_s: f64,
     },
+}
+
+impl NotProposed {
+    /// The reason with its advice in a front end's words (`words`: `--from/--to` on the
+    /// command line); `Display` says it in the library's ([`FieldNames`]).
+    pub fn spelled(&self, words: &dyn Spelling) -> String {
+        match self {
+            NotProposed::Unresolved { dt_s, tau_s } => format!(
+                "the fit series of this long log ({:.0} Hz) cannot resolve a {:.1} ms time constant; analyse a shorter window with {}/{}",
+                1.0 / dt_s,
+                1000.0 * tau_s,
+                words.hint(OptionField::From, ""),
+                words.hint(OptionField::To, "")
+            ),
+            other => other.to_string(),
+        }
+    }
 }
 
 /// Effect names, comma separated.
@@ -308,13 +326,15 @@ pub fn dynamics_plan(
 /// The advice `compare` prints when its worst windows are transients: the dynamics effects
 /// not in the model that [`dynamics_plan`] proposes on this span (with the `--effects` that
 /// adds them), each one it does not propose with the reason `explain` gives for skipping it
-/// (`name: why`, the same words), and, after a start, the `--from` past it.
+/// (`name: why`, the same words), and, after a start, the `--from` past it; the fields
+/// named in `words` (the front end's).
 pub fn advice(
     d: &Prepared,
     n: &MachineConstants,
     worst: &[WorstWindow],
     in_model: &[EffectKind],
     plan: &[(EffectKind, Option<NotProposed>)],
+    words: &dyn Spelling,
 ) -> (Vec<Option<Transient>>, Vec<String>) {
     let start = start_end_s(d);
     let look = settling_s(n);
@@ -337,16 +357,17 @@ pub fn advice(
     out.push(format!(
         "the worst windows are transients ({}); {}",
         spans.join("; "),
-        cover(plan, in_model)
+        cover(plan, in_model, words)
     ));
     out.extend(
         plan.iter()
-            .filter_map(|(k, why)| why.as_ref().map(|w| format!("{k}: {w}"))),
+            .filter_map(|(k, why)| why.as_ref().map(|w| format!("{k}: {}", w.spelled(words)))),
     );
     if let Some(te) = start {
         let from = ((te + look) * 10.0).ceil() / 10.0;
         out.push(format!(
-            "or leave the start out: --from {from:.1} (the start ends at about {te:.2} s, plus five rotor time constants)"
+            "or leave the start out: {} (the start ends at about {te:.2} s, plus five rotor time constants)",
+            words.hint(OptionField::From, &format!("{from:.1}"))
         ));
     }
     (tags, out)
@@ -354,7 +375,11 @@ pub fn advice(
 
 /// What the dynamics effects of `plan` do for the transients, in words: those proposed
 /// with the `--effects` that adds them to `in_model`, or why none is.
-fn cover(plan: &[(EffectKind, Option<NotProposed>)], in_model: &[EffectKind]) -> String {
+fn cover(
+    plan: &[(EffectKind, Option<NotProposed>)],
+    in_model: &[EffectKind],
+    words: &dyn Spelling,
+) -> String {
     let proposed: Vec<&str> = plan
         .iter()
         .filter(|(_, why)| why.is_none())
@@ -372,9 +397,9 @@ fn cover(plan: &[(EffectKind, Option<NotProposed>)], in_model: &[EffectKind]) ->
         .chain(proposed.iter().copied())
         .collect();
     format!(
-        "the model's dynamics effects cover a start or a supply step: add {} (--effects {})",
+        "the model's dynamics effects cover a start or a supply step: add {} ({})",
         proposed.join(", "),
-        all.join(",")
+        words.hint(OptionField::Effects, &all.join(","))
     )
 }
 

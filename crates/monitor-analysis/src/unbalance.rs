@@ -15,6 +15,7 @@
 
 use super::prep::{Prepared, C64};
 use super::simplified_model::MachineConstants;
+use monitor_replay::{OptionField, Spelling};
 use serde::Serialize;
 
 /// Unbalance / faulty-phase analysis (JSON key `unbalance` of `compare` and `explain`).
@@ -101,7 +102,8 @@ impl SequenceSums {
 }
 
 /// The analysis of a working series with the machine's constants.
-pub fn analyse(d: &Prepared, n: &MachineConstants) -> UnbalanceAnalysis {
+/// `words`: the words its advice names a field in.
+pub fn analyse(d: &Prepared, n: &MachineConstants, words: &dyn Spelling) -> UnbalanceAnalysis {
     let s = SequenceSums::new(d, d.len() / 10);
     let ratio = (s.i_neg2 / s.i_pos2.max(1e-12)).sqrt();
     let vratio = d
@@ -126,7 +128,7 @@ pub fn analyse(d: &Prepared, n: &MachineConstants) -> UnbalanceAnalysis {
             shorted_fraction: eps,
             phase_rms_a,
         }
-        .in_words(d, suspect),
+        .in_words(d, suspect, words),
     };
     UnbalanceAnalysis {
         negative_sequence_ratio: ratio,
@@ -214,8 +216,14 @@ struct Found {
 }
 
 impl Found {
-    /// The summary sentence, `suspect` the phase named.
-    fn in_words(&self, d: &Prepared, suspect: Option<monitor_core::Phase>) -> String {
+    /// The summary sentence, `suspect` the phase named (`words`: a field's, in advice).
+    fn in_words(
+        &self,
+        d: &Prepared,
+        suspect: Option<monitor_core::Phase>,
+        words: &dyn Spelling,
+    ) -> String {
+        let baseline = || words.command_with("diagnose", OptionField::Baseline);
         let ratio = self.ratio;
         match (suspect, self.supply_explains) {
             (Some(p), _) => {
@@ -237,15 +245,17 @@ impl Found {
                 100.0 * self.vratio.unwrap_or(0.0)
             ),
             (None, false) if d.channels.voltages && ratio >= 0.01 => format!(
-                "negative-sequence current {:.1} % of positive sequence, the winding's part of it {:.1} % (the supply's taken out): within a healthy machine's own asymmetry of {:.0} %, so no winding is named (diagnose --baseline with a healthy run of this motor judges a smaller change)",
+                "negative-sequence current {:.1} % of positive sequence, the winding's part of it {:.1} % (the supply's taken out): within a healthy machine's own asymmetry of {:.0} %, so no winding is named ({} with a healthy run of this motor judges a smaller change)",
                 100.0 * ratio,
                 100.0 * self.winding_ratio,
-                100.0 * NAMED_WINDING_MIN
+                100.0 * NAMED_WINDING_MIN,
+                baseline()
             ),
             (None, false) if !d.channels.voltages && ratio >= 0.01 => format!(
-                "negative sequence {:.1} %: cannot judge the phase (a current-only log: below a healthy machine's own asymmetry of {:.0} % a winding cannot be told from the supply's unbalance or the machine's build; diagnose --baseline with a healthy log judges it)",
+                "negative sequence {:.1} %: cannot judge the phase (a current-only log: below a healthy machine's own asymmetry of {:.0} % a winding cannot be told from the supply's unbalance or the machine's build; {} with a healthy log judges it)",
                 100.0 * ratio,
-                100.0 * monitor_core::sequence::INHERENT_ASYMMETRY_RATIO
+                100.0 * monitor_core::sequence::INHERENT_ASYMMETRY_RATIO,
+                baseline()
             ),
             (None, false) => format!("currents balanced (negative sequence {:.2} %)", 100.0 * ratio),
         }

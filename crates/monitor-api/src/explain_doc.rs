@@ -81,7 +81,7 @@ pub fn explain(
         columns: &columns,
     };
     let a = load_analysis(read, log, req, &mut |_| {})?;
-    let judged = verdict_for_explain(read, log, req.group.clone());
+    let judged = verdict_for_explain(read, log, req.group.clone(), req.words);
     let out = a.explain(&req.options(), &|_| {})?;
     let rotor_asymmetry = mcsa_beside(&a, &out.report, req.rotor_bars);
     let doc = ExplainDocument::new(judged.as_ref(), out.report, rotor_asymmetry);
@@ -105,8 +105,8 @@ pub fn ladder(
 }
 
 /// The verdict `diagnose` gives `log` with its defaults (no commissioning, no baseline; the
-/// TDMS `group`), which `explain` opens with; the error's message where `diagnose` cannot
-/// judge the log at all.
+/// TDMS `group`; its sentences in `words`), which `explain` opens with; the error's message
+/// where `diagnose` cannot judge the log at all.
 ///
 /// # Errors
 /// As [`super::diagnose`].
@@ -114,11 +114,13 @@ pub fn verdict_for_explain(
     params: ParamsSource<'_>,
     log: impl Into<LogSource>,
     group: Option<String>,
+    words: monitor_replay::Words,
 ) -> Result<DiagnoseReport, ApiError> {
-    let req = DiagnoseRequest {
+    let mut req = DiagnoseRequest {
         group,
         ..DiagnoseRequest::default()
     };
+    req.options.words = words;
     diagnose(params, log, &req, &mut |_| {}).map(|d| d.report)
 }
 

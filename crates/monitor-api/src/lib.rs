@@ -16,7 +16,7 @@ use monitor_io::log::OpenOptions;
 use monitor_io::params::{ParamError, ParamFile};
 use monitor_replay::{
     diagnose_log, HealthyReference, OptionError, OptionField, ReplayError, ReplayOptions,
-    UnbalanceBaseline,
+    UnbalanceBaseline, Words,
 };
 use std::path::{Path, PathBuf};
 
@@ -239,18 +239,32 @@ fn baseline_of(
     Ok(d.report.unbalance.measured)
 }
 
-/// `diagnose`: replays `log` through the core with the parameter file `params`; the report
-/// `--json` prints. `progress` gets the fraction of the log read.
+/// What `diagnose` replays a log with, its request resolved ([`plan_diagnose`]): the
+/// parameter file, how the log is opened (its `[columns]`, the TDMS group) and the replay's
+/// options with the healthy reference of the request's `baseline` filled in. The HMI's log
+/// replay runs on it, so that it takes the same request as `diagnose`.
+#[derive(Debug, Clone)]
+pub struct DiagnosePlan {
+    /// The parameter file.
+    pub params: ParamFile,
+    /// How the log (and each baseline log) is opened.
+    pub open: OpenOptions,
+    /// The replay's options (`unbalance_baseline` from the request's `baseline`).
+    pub options: ReplayOptions,
+}
+
+/// Resolves a `diagnose` request on `log`: reads the parameter file, checks the request
+/// ([`DiagnoseRequest::validate`]) and replays its `baseline` logs into the healthy
+/// reference; what [`diagnose`] then replays `log` with.
 ///
 /// # Errors
-/// A bad parameter file, log or option ([`ApiError`]), each a one-line message.
-pub fn diagnose(
+/// A bad parameter file or option ([`ApiError`]), a baseline log that cannot be replayed
+/// or is `log` itself, each a one-line message.
+pub fn plan_diagnose(
     params: ParamsSource<'_>,
-    log: impl Into<LogSource>,
+    log: &LogSource,
     req: &DiagnoseRequest,
-    progress: &mut dyn FnMut(f64),
-) -> Result<monitor_replay::Diagnosed, ApiError> {
-    let log = &log.into();
+) -> Result<DiagnosePlan, ApiError> {
     let (params, columns) = load_params_for(params, log)?;
     let open = OpenOptions {
         group: req.group.clone(),
@@ -272,8 +286,28 @@ pub fn diagnose(
             .collect::<Result<Vec<_>, _>>()?;
         opts.unbalance_baseline = HealthyReference::from_runs(&runs);
     }
-    let file = log.open(&open)?;
-    diagnose_log(&params, &file, opts, progress).map_err(|e| match e {
+    Ok(DiagnosePlan {
+        params,
+        open,
+        options: opts,
+    })
+}
+
+/// `diagnose`: replays `log` through the core with the parameter file `params`; the report
+/// `--json` prints. `progress` gets the fraction of the log read.
+///
+/// # Errors
+/// A bad parameter file, log or option ([`ApiError`]), each a one-line message.
+pub fn diagnose(
+    params: ParamsSource<'_>,
+    log: impl Into<LogSource>,
+    req: &DiagnoseRequest,
+    progress: &mut dyn FnMut(f64),
+) -> Result<monitor_replay::Diagnosed, ApiError> {
+    let log = &log.into();
+    let plan = plan_diagnose(params, log, req)?;
+    let file = log.open(&plan.open)?;
+    diagnose_log(&plan.params, &file, plan.options, progress).map_err(|e| match e {
         // Log errors name the file already; the monitor's configuration does not.
         e @ ReplayError::Config { .. } => ApiError::Config {
             log: log.shown(),
@@ -298,6 +332,9 @@ pub struct AnalysisRequest {
     pub group: Option<String>,
     /// `explain --rotor-bars`.
     pub rotor_bars: Option<u32>,
+    /// The words the reports' advice names a field in (the front end's; the library's
+    /// own by default): [`Analysis::words`].
+    pub words: Words,
 }
 
 /// Supply periods the analysed window of `compare` and `explain` must hold (0.5 s at
@@ -325,7 +362,8 @@ pub fn load_analysis(
         from_s: req.from_s.unwrap_or(f64::NEG_INFINITY),
         to_s: req.to_s.unwrap_or(f64::INFINITY),
     };
-    let a = Analysis::load_file(&file, params, opts, progress)?;
+    let mut a = Analysis::load_file(&file, params, opts, progress)?;
+    a.words = req.words;
     let span = match (a.data.t_s.first(), a.data.t_s.last()) {
         (Some(t0), Some(t1)) => t1 - t0,
         _ => 0.0,

@@ -26,6 +26,7 @@
 //! and the 20 % margin, `monitor_core::operating_range::RANGE_MARGIN`) is the core's
 //! `monitor_core::operating_range`, which the firmware's panel uses too.
 
+use crate::words::{OptionField, Words};
 use monitor_core::operating_range::{outside, widen};
 use monitor_core::{
     CommissioningState, Monitor, MonitorConfig, MonitorOutput, OperatingPoint, RunStage,
@@ -126,6 +127,8 @@ pub(super) struct CommissionTracker {
     noted: u8,
     last_t: f64,
     learned: (u32, u32),
+    /// The words its advice names `commission` in.
+    words: Words,
 }
 
 /// The load and the voltage of `out`, independent of the d-q frame's angle: the active
@@ -140,9 +143,10 @@ pub(super) fn operating_point(out: &MonitorOutput) -> (f32, f32) {
 }
 
 impl CommissionTracker {
-    pub(super) fn new(requested: Option<(f64, f64)>, cfg: &MonitorConfig) -> Self {
+    pub(super) fn new(requested: Option<(f64, f64)>, words: Words, cfg: &MonitorConfig) -> Self {
         CommissionTracker {
             requested,
+            words,
             run_id: None,
             started_at: None,
             ended_at: None,
@@ -336,10 +340,11 @@ impl CommissionTracker {
             .map(|(k, (r, _))| (k, *r))
             .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))?;
         Some(format!(
-            "at the first quasi-steady point ({:.2} s) r{} = {r:+.3} already passes its fixed threshold ({:.3}): the parameter file does not fit this motor, or a fault was there from the start; commission (--commission START:END) on healthy running to tell them apart",
+            "at the first quasi-steady point ({:.2} s) r{} = {r:+.3} already passes its fixed threshold ({:.3}): the parameter file does not fit this motor, or a fault was there from the start; commission ({}) on healthy running to tell them apart",
             p.t_s,
             k + 1,
-            self.fixed[k]
+            self.fixed[k],
+            self.words.hint(OptionField::Commission, "START:END")
         ))
     }
 
@@ -361,7 +366,10 @@ impl CommissionTracker {
     /// with [`CommissionTracker::not_learned`]).
     pub(super) fn why_incomplete(&self) -> Option<String> {
         let (window, why) = self.not_learned()?;
-        Some(format!("--commission {window}: {why}"))
+        Some(format!(
+            "{}: {why}",
+            self.words.option(OptionField::Commission, &window)
+        ))
     }
 
     /// The window asked for (`START:END`) and why it was not learned, where it was not.
@@ -402,10 +410,10 @@ impl CommissionTracker {
             None => (
                 CommissioningOutcome::None,
                 fixed,
-                Some(
-                    "the thresholds are fixed against the parameter file's nominal values; a real motor's parameters differ by 10-30 %, so commission (--commission START:END) over healthy running that covers the whole load and voltage range"
-                        .to_string(),
-                ),
+                Some(format!(
+                    "the thresholds are fixed against the parameter file's nominal values; a real motor's parameters differ by 10-30 %, so commission ({}) over healthy running that covers the whole load and voltage range",
+                    self.words.hint(OptionField::Commission, "START:END")
+                )),
             ),
             Some((a, _)) if self.learned_ok() => (
                 CommissioningOutcome::Learned,

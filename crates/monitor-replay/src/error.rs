@@ -1,7 +1,7 @@
 //! What can go wrong in setting up or running a replay ([`ReplayError`]), in the library's
 //! words and, through [`ReplayError::spelled`], in a front end's.
 
-use crate::options::{FieldNames, OptionError, OptionField, Spelling};
+use crate::words::{FieldNames, OptionError, OptionField, Spelling};
 use monitor_core::ConfigError;
 use monitor_io::log::LogError;
 

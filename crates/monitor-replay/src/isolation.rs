@@ -59,6 +59,7 @@ pub(super) struct IsolationTracker {
     evidence: monitor_core::isolation::Evidence,
     /// What is known of the load ([`super::options::LoadModel`]).
     load: super::options::LoadModel,
+    words: super::words::Words,
     /// Names and load moves, with times.
     events: super::events::EventLog,
     /// The log's temperature channel (`t_winding_c`), when it has one.
@@ -146,6 +147,7 @@ impl IsolationTracker {
         isolator: Option<Isolator>,
         temperature_column: bool,
         load: super::options::LoadModel,
+        words: super::words::Words,
         chunk_rows: u32,
     ) -> Self {
         let isolator = isolator.map(|mut i| {
@@ -163,6 +165,7 @@ impl IsolationTracker {
             lamps_lit: false,
             evidence: monitor_core::isolation::Evidence::default(),
             load,
+            words,
             events: super::events::EventLog::default(),
             temperature: super::temperature::TemperatureChannel::new(temperature_column),
             chunk: chunk::RowChunk::default(),

@@ -16,6 +16,7 @@ use crate::step::{
     RestartHold, NO_BANDS,
 };
 use crate::unsettled;
+use crate::words::Words;
 use monitor_core::{ConfigError, Monitor, MonitorConfig, MonitorOutput};
 use monitor_io::log::Row;
 
@@ -59,13 +60,14 @@ pub(crate) struct LampStage {
 
 impl LampStage {
     /// The stage for a monitor configured by `cfg` (`residuals`: the log can feed them),
-    /// commissioning in `commission` [s] where asked for.
+    /// commissioning in `commission` [s] where asked for (its advice in `words`).
     ///
     /// # Errors
     /// The core's check of `cfg` ([`MonitorConfig::validate`]).
     pub(crate) fn new(
         cfg: &MonitorConfig,
         commission: Option<(f64, f64)>,
+        words: Words,
         residuals: bool,
     ) -> Result<Self, ConfigError> {
         let monitor = if residuals {
@@ -77,7 +79,7 @@ impl LampStage {
         Ok(LampStage {
             monitor,
             sampler: LogSampler::default(),
-            commission: CommissionTracker::new(commission, cfg),
+            commission: CommissionTracker::new(commission, words, cfg),
             k_sigma: cfg.thresholds.k_sigma,
             evaluated: false,
             judged_s: 0.0,

@@ -43,6 +43,7 @@ mod trig;
 mod unsettled;
 pub mod verdict;
 mod winding;
+mod words;
 
 pub use baseline::{HealthyReference, UnbalanceBaseline, BASELINE_I1_TOLERANCE};
 pub use error::ReplayError;
@@ -64,8 +65,7 @@ pub use isolation::{
 };
 pub use options::{
     angle_source_name, check_parallel_paths, monitor_config_for_log, serialize_angle_source,
-    CommissionWindow, FieldNames, LoadModel, OptionError, OptionField, ReplayOptions, Spelling,
-    TimelineStep, PARALLEL_PATHS,
+    CommissionWindow, LoadModel, ReplayOptions, TimelineStep, PARALLEL_PATHS,
 };
 pub use report::{DiagnoseReport, MonitorState, Panel, TimelinePoint};
 pub use rotor::{
@@ -87,3 +87,4 @@ pub use winding::{
     DEFAULT_SPREAD_VOLTAGES, HEALTHY_RUN_DIFFERENCE_CURRENTS, HEALTHY_RUN_DIFFERENCE_VOLTAGES,
     NO_BASELINE_SPREAD, NO_BASELINE_SPREAD_VOLTAGES, WINDING_FAULT_PROBABILITY, WITHIN_LOG_SPREAD,
 };
+pub use words::{FieldNames, OptionError, OptionField, Spelling, Words};

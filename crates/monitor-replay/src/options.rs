@@ -8,6 +8,7 @@
 
 use super::baseline::HealthyReference;
 use super::sampler::TICK_HZ;
+pub use super::words::{OptionError, OptionField, Spelling, Words};
 use monitor_core::{AngleSource, MonitorConfig, ResidualForm};
 use monitor_io::params::ParamFile;
 use serde::Serialize;
@@ -57,6 +58,10 @@ pub struct ReplayOptions {
     /// How the shorted-turn level is sized (the fields `parallel_paths`, 1..=8 as
     /// [`PARALLEL_PATHS`] says, and `turn_calibration`; [`super::winding::level`]).
     pub turn_level: super::winding::level::TurnLevelOptions,
+    /// The words the report's sentences name a field in (a hint to give `commission`, the
+    /// `load`, a `baseline`): the front end's that asked ([`Words`]; the library's own,
+    /// [`FieldNames`], by default). No part of what is judged: ignored by `==`.
+    pub words: Words,
 }
 
 /// What the replay knows of the load torque.
@@ -93,6 +98,7 @@ impl Default for ReplayOptions {
             unbalance_baseline: None,
             load: LoadModel::Unknown,
             turn_level: super::winding::level::TurnLevelOptions::default(),
+            words: Words::LIBRARY,
         }
     }
 }
@@ -143,121 +149,6 @@ impl ReplayOptions {
 /// The parallel paths per phase a winding may have (the field `parallel_paths`): 1 for a
 /// series star or delta, 2 for a double star, at most 8.
 pub const PARALLEL_PATHS: RangeInclusive<u8> = 1..=8;
-
-/// An option or a request's field, by the name the library gives it (the Python keyword
-/// and the fleet table's key where they have one).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum OptionField {
-    /// The parameter file (`params`).
-    Params,
-    /// The commissioning window (`commission`, [`CommissionWindow`]).
-    Commission,
-    /// Report an incomplete commissioning (`allow_incomplete`).
-    AllowIncomplete,
-    /// The timeline's step (`timeline_step`, [`TimelineStep`]).
-    TimelineStep,
-    /// The winding's parallel paths (`parallel_paths`, [`PARALLEL_PATHS`]).
-    ParallelPaths,
-    /// A calibration of the shorted-turn level (`turn_calibration`).
-    TurnCalibration,
-    /// Healthy logs of the same motor (`baseline`).
-    Baseline,
-    /// What is known of the load (`load`).
-    Load,
-    /// The TDMS group (`group`).
-    Group,
-    /// The analysed window's start (`from_s`).
-    From,
-    /// The analysed window's end (`to_s`).
-    To,
-    /// Effects already in the model (`effects`).
-    Effects,
-    /// The parameter file whose `[columns]` a nameplate estimate carries (`columns_from`).
-    ColumnsFrom,
-}
-
-impl OptionField {
-    /// The field's name (`commission`, `timeline_step`, ...).
-    pub const fn name(self) -> &'static str {
-        match self {
-            OptionField::Params => "params",
-            OptionField::Commission => "commission",
-            OptionField::AllowIncomplete => "allow_incomplete",
-            OptionField::TimelineStep => "timeline_step",
-            OptionField::ParallelPaths => "parallel_paths",
-            OptionField::TurnCalibration => "turn_calibration",
-            OptionField::Baseline => "baseline",
-            OptionField::Load => "load",
-            OptionField::Group => "group",
-            OptionField::From => "from_s",
-            OptionField::To => "to_s",
-            OptionField::Effects => "effects",
-            OptionField::ColumnsFrom => "columns_from",
-        }
-    }
-}
-
-impl fmt::Display for OptionField {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// How a front end names a field given a value, so that its messages speak its words.
-pub trait Spelling {
-    /// `field` given `value` (empty: the field alone, as in a hint) in the front end's
-    /// words.
-    fn option(&self, field: OptionField, value: &str) -> String;
-
-    /// Any other field a message names by its name (a nameplate's `speed_rpm`), in the
-    /// front end's words; the library's own name unless a front end says otherwise.
-    fn key(&self, name: &str) -> String {
-        name.to_string()
-    }
-}
-
-/// The library's own words: `commission = 4:2` (a fleet table's), the field alone
-/// without a value; what the errors' `Display` says.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct FieldNames;
-
-impl Spelling for FieldNames {
-    fn option(&self, field: OptionField, value: &str) -> String {
-        if value.is_empty() {
-            field.name().to_string()
-        } else {
-            format!("{} = {value}", field.name())
-        }
-    }
-}
-
-/// A value an option does not take: the field, the value as given, and why.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("{}: {why}", FieldNames.option(*field, value))]
-pub struct OptionError {
-    /// The option.
-    pub field: OptionField,
-    /// The value as given (empty where the field alone is meant).
-    pub value: String,
-    /// What is wrong, and what to give instead.
-    pub why: String,
-}
-
-impl OptionError {
-    /// `field` refused `value` because of `why`.
-    pub fn new(field: OptionField, value: impl Into<String>, why: impl Into<String>) -> Self {
-        OptionError {
-            field,
-            value: value.into(),
-            why: why.into(),
-        }
-    }
-
-    /// The message in a front end's words (`spell`).
-    pub fn spelled(&self, spell: &dyn Spelling) -> String {
-        format!("{}: {}", spell.option(self.field, &self.value), self.why)
-    }
-}
 
 /// Checks the winding's parallel paths (the field `parallel_paths`), given as any whole
 /// number.
@@ -474,5 +365,34 @@ mod tests {
         assert!("x".parse::<TimelineStep>().is_err());
         assert!(check_parallel_paths(0).is_err() && check_parallel_paths(9).is_err());
         assert_eq!(check_parallel_paths(8), Ok(8));
+    }
+
+    #[test]
+    fn the_library_words_name_fields_and_two_words_are_equal() {
+        let w = Words::default();
+        assert_eq!(
+            w.hint(OptionField::Commission, "START:END"),
+            "commission = START:END"
+        );
+        assert_eq!(w.hint(OptionField::Baseline, ""), "baseline");
+        assert_eq!(
+            w.command_with("diagnose", OptionField::Baseline),
+            "diagnose's baseline"
+        );
+        // The words are no part of what a replay is asked: options differing only in
+        // them are equal, and print without them.
+        struct Other;
+        impl Spelling for Other {
+            fn option(&self, field: OptionField, _: &str) -> String {
+                format!("<{field}>")
+            }
+        }
+        let other = ReplayOptions {
+            words: Words(&Other),
+            ..ReplayOptions::default()
+        };
+        assert_eq!(other, ReplayOptions::default());
+        assert_eq!(format!("{:?}", other.words), "Words");
+        assert_eq!(other.words.hint(OptionField::Load, "viscous"), "<load>");
     }
 }

@@ -14,6 +14,7 @@ use crate::sequences::{self, SequenceWindow};
 use crate::step::{lamps_since_moved, timeline_step_due, BlockView, LastOutput};
 use crate::verdict::{findings, glance, Rule, Verdict};
 use crate::winding::{unbalance_report, UnbalanceReport};
+use crate::words::Words;
 use monitor_core::{CommissioningState, Isolator, Monitor, MonitorOutput};
 use monitor_io::log::quality::DataQuality;
 use monitor_io::log::{Channels, Row};
@@ -26,6 +27,7 @@ fn isolation_tracker(
     params: &ParamFile,
     channels: Channels,
     load: LoadModel,
+    words: Words,
     decimation: u16,
 ) -> IsolationTracker {
     let isolator = Isolator::new(
@@ -37,6 +39,7 @@ fn isolation_tracker(
         isolator.ok(),
         channels.temperature,
         load,
+        words,
         u32::from(decimation),
     )
 }
@@ -93,7 +96,8 @@ impl Replay {
         };
         let residuals = channels.voltages && (channels.speed || channels.encoder);
         Ok(Replay {
-            lamps: LampStage::new(&cfg, opts.commission, residuals).map_err(config_error)?,
+            lamps: LampStage::new(&cfg, opts.commission, opts.words, residuals)
+                .map_err(config_error)?,
             opts,
             params: *params,
             channels,
@@ -102,7 +106,7 @@ impl Replay {
             next_point: 0.0,
             dt_s: 1.0 / sample_rate_hz,
             t0: None,
-            isolation: isolation_tracker(params, channels, opts.load, cfg.decimation),
+            isolation: isolation_tracker(params, channels, opts.load, opts.words, cfg.decimation),
             seq_front: Some(
                 sequences::SequenceFront::new(
                     params,
@@ -375,6 +379,7 @@ impl Replay {
             self.lamps.monitor.is_some(),
             self.opts.unbalance_baseline,
             self.opts.turn_level,
+            self.opts.words,
         );
         let rotor = match &self.seq_front {
             Some(front) => rotor_report(front.rotor(), &self.params),

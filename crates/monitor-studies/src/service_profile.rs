@@ -131,6 +131,7 @@ pub fn watch_mismatched(
         unbalance_baseline: None,
         turn_level: Default::default(),
         load: monitor_replay::LoadModel::Unknown,
+        words: monitor_replay::Words::LIBRARY,
     };
     let mut w = ServiceWatch::default();
     let dt = 1.0 / sc.sample_rate_hz;

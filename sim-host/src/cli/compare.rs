@@ -128,6 +128,7 @@ impl Common {
             no_fit: self.no_fit,
             group: self.group.clone(),
             rotor_bars,
+            words: super::words::CLI,
         }
     }
 }
@@ -316,6 +317,7 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
                 },
                 &c.log,
                 c.group.clone(),
+                super::words::CLI,
             )
         });
         let explained = explain_here(args, &params, &columns);

@@ -65,6 +65,28 @@ pub struct DiagnoseArgs {
     pub params: PathBuf,
     /// Measurement log: CSV, TDMS (`.tdms`) or Parquet (`.parquet`), by its extension.
     pub log: PathBuf,
+    /// What the log is replayed with (the same for `hmi LOG`).
+    #[command(flatten)]
+    pub replay: ReplayArgs,
+    /// Report even when the --commission window was not learned (the log ends first, or
+    /// the motor was not quasi-steady long enough); the fixed thresholds are used and the
+    /// verdict is withheld.
+    #[arg(long)]
+    pub allow_incomplete: bool,
+    /// Timeline resolution in the output [s].
+    #[arg(long, default_value_t = defaults().options.timeline_step, allow_negative_numbers = true, value_parser = super::words::parse_timeline_step)]
+    pub timeline_step: monitor_replay::TimelineStep,
+    /// Print one JSON document on stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The options a log is replayed with, the same for `diagnose` and the HMI's log replay
+/// (`hmi LOG`): parsed by the library's parsers ([`super::words`]) and built into one
+/// `monitor_api::DiagnoseRequest` ([`ReplayArgs::request`]), so that both accept and refuse
+/// the same values with the same words.
+#[derive(Debug, Args)]
+pub struct ReplayArgs {
     /// The TDMS group holding the channels (when the file has several).
     #[arg(long, value_name = "NAME")]
     pub group: Option<String>,
@@ -72,11 +94,6 @@ pub struct DiagnoseArgs {
     /// covers the load and voltage range to be monitored).
     #[arg(long, value_name = "START:END", value_parser = super::words::parse_window)]
     pub commission: Option<monitor_replay::CommissionWindow>,
-    /// Report even when the --commission window was not learned (the log ends first, or
-    /// the motor was not quasi-steady long enough); the fixed thresholds are used and the
-    /// verdict is withheld.
-    #[arg(long)]
-    pub allow_incomplete: bool,
     /// Logs of the same motor when healthy (several files, or a folder of them; read
     /// only; the same formats as LOG): the winding is judged against their mean negative
     /// sequence, and their spread sets the least change that names a phase. Give LOG
@@ -94,9 +111,6 @@ pub struct DiagnoseArgs {
     /// change is the fault `b/bl`).
     #[arg(long, value_enum, default_value_t = defaults().options.load.into())]
     pub load: LoadArg,
-    /// Timeline resolution in the output [s].
-    #[arg(long, default_value_t = defaults().options.timeline_step, allow_negative_numbers = true, value_parser = super::words::parse_timeline_step)]
-    pub timeline_step: monitor_replay::TimelineStep,
     /// Parallel paths of each phase of the winding (1 for a series star or delta, 2 for a
     /// double star, as the motor's connection diagram says): the shorted turns lie in one
     /// path, and the shorted-turn level (unbalance.shorted_turns) is sized with that
@@ -109,9 +123,45 @@ pub struct DiagnoseArgs {
     /// unbalance.shorted_turns_physics).
     #[arg(long, value_name = "FILE")]
     pub turn_calibration: Option<PathBuf>,
-    /// Print one JSON document on stdout instead of the table.
-    #[arg(long)]
-    pub json: bool,
+}
+
+impl ReplayArgs {
+    /// The library's request for these options (the rest, `allow_incomplete` and
+    /// `timeline_step`, at their defaults), its report in the command line's words,
+    /// checked as every front end checks one (`DiagnoseRequest::validate`).
+    ///
+    /// # Errors
+    /// A `--turn-calibration` file that cannot be read; a request the library refuses.
+    pub fn request(&self) -> anyhow::Result<monitor_api::DiagnoseRequest> {
+        let req = monitor_api::DiagnoseRequest {
+            options: monitor_replay::ReplayOptions {
+                angle_source: self.angle.into(),
+                residual_form: self.residuals.into(),
+                commission: self
+                    .commission
+                    .map(monitor_replay::CommissionWindow::seconds),
+                load: self.load.into(),
+                turn_level: monitor_replay::TurnLevelOptions {
+                    parallel_paths: self.parallel_paths,
+                    calibration: self
+                        .turn_calibration
+                        .as_ref()
+                        .map(|f| read_calibration(f))
+                        .transpose()?,
+                },
+                words: super::words::CLI,
+                ..defaults().options
+            },
+            baseline: self
+                .baseline
+                .iter()
+                .map(monitor_api::LogSource::from)
+                .collect(),
+            group: self.group.clone(),
+        };
+        req.validate()?;
+        Ok(req)
+    }
 }
 
 /// `diagnose`'s defaults: the API request's, whose one home is the replay's options
@@ -126,33 +176,9 @@ fn defaults() -> monitor_api::DiagnoseRequest {
 /// Bad parameter file or log (one line naming the file, line and column), or a log the
 /// core cannot be configured for.
 pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
-    let req = monitor_api::DiagnoseRequest {
-        options: monitor_replay::ReplayOptions {
-            angle_source: args.angle.into(),
-            residual_form: args.residuals.into(),
-            commission: args
-                .commission
-                .map(monitor_replay::CommissionWindow::seconds),
-            allow_incomplete: args.allow_incomplete,
-            timeline_step: args.timeline_step,
-            unbalance_baseline: None,
-            load: args.load.into(),
-            turn_level: monitor_replay::TurnLevelOptions {
-                parallel_paths: args.parallel_paths,
-                calibration: args
-                    .turn_calibration
-                    .as_ref()
-                    .map(|f| read_calibration(f))
-                    .transpose()?,
-            },
-        },
-        baseline: args
-            .baseline
-            .iter()
-            .map(monitor_api::LogSource::from)
-            .collect(),
-        group: args.group.clone(),
-    };
+    let mut req = args.replay.request()?;
+    req.options.allow_incomplete = args.allow_incomplete;
+    req.options.timeline_step = args.timeline_step;
     req.validate()?;
     let big = std::fs::metadata(&args.log)
         .map(|m| m.len() > 20_000_000)

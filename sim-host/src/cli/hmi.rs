@@ -3,11 +3,10 @@
 //! advance the source by the wall-clock time, draw; or, when stdout is not a terminal,
 //! print one status line every few seconds of the source's time.
 
+use super::diagnose::ReplayArgs;
 use super::render::hmi::render;
-use super::{AngleArg, ResidualArg};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
-use monitor_replay::ReplayOptions;
 use ratatui::crossterm::event::{self, Event, KeyCode, KeyEventKind, KeyModifiers};
 use sim_host::hmi::live::LiveSim;
 use sim_host::hmi::log_replay::LogReplay;
@@ -34,7 +33,12 @@ motor (3 hp reference motor, 12-bit noisy sensors); keys switch each Table 1 fau
 paper's Enable_F_* switches), step the load and the supply, and start commissioning\n  \
 sim-host hmi LOG --params P.toml    replay a log through the data-quality stage and the core, as \
 diagnose does, at --speed 1x, 10x or max, with pause and seek\n  cargo fw-run | sim-host hmi \
---stdin   the firmware's defmt status lines\n\nA first session: start it, wait for 'healthy', press \
+--stdin   the firmware's defmt status lines\n\nA log replay takes diagnose's options, checked by the \
+same code with the same messages: --commission START:END, --load unknown|viscous, --baseline \
+HEALTHY... (healthy logs of the same motor: the verdict's winding is judged against them), --group \
+NAME (TDMS), --angle, --residuals, --parallel-paths, --turn-calibration; a commissioning window \
+the log does not complete is shown, not refused. Example:\n  sim-host hmi today.csv --params \
+motor.toml --baseline healthy_runs/ --load viscous --speed 10x\n\nA first session: start it, wait for 'healthy', press \
 c (commissioning, 3 s), then 6 (load friction Bl +50 %): r2..r4 light and the candidates b/bl \
 appear; 6 again clears it.\n\nWhen stdout is not a terminal (or with --plain) one status line is \
 printed every --every seconds of the source's time instead. Needs an 80x24 terminal at least.",
@@ -55,15 +59,9 @@ pub struct HmiArgs {
     /// Replay speed.
     #[arg(long, value_enum, default_value_t = SpeedArg::X1)]
     pub speed: SpeedArg,
-    /// Replay: learn healthy thresholds over START:END seconds of the log (as diagnose).
-    #[arg(long, value_name = "START:END", value_parser = super::words::parse_window)]
-    pub commission: Option<monitor_replay::CommissionWindow>,
-    /// Replay: frame angle source.
-    #[arg(long, value_enum, default_value_t = AngleArg::RotorFlux)]
-    pub angle: AngleArg,
-    /// Replay: residual form the lamps act on.
-    #[arg(long, value_enum, default_value_t = ResidualArg::Steady)]
-    pub residuals: ResidualArg,
+    /// A log replay's options, diagnose's own (the same request, checked the same way).
+    #[command(flatten, next_help_heading = "Log replay (as diagnose)")]
+    pub replay: ReplayArgs,
     /// Plain text (one status line every --every seconds) even on a terminal.
     #[arg(long)]
     pub plain: bool,
@@ -111,34 +109,26 @@ impl From<SpeedArg> for Speed {
 /// A bad parameter file or log (one line naming it), a terminal that cannot be set up, or
 /// stdout that cannot be written.
 pub fn run(args: &HmiArgs) -> anyhow::Result<()> {
-    // The parameter file with its [columns] mapping (a log replay reads the log's own
-    // channel names and units through it).
-    let loaded = args
-        .params
-        .as_deref()
-        .map(monitor_io::log::mapping::load_params)
-        .transpose()?;
-    let (params, columns) = match loaded {
-        Some((p, c)) => (Some(p), c),
-        None => (None, Default::default()),
-    };
     let plain_text = args.plain || !std::io::stdout().is_terminal();
     let mut source: Box<dyn Source> = if args.stdin && plain_text {
         Box::new(StdinStatus::stdin().one_at_a_time())
     } else if args.stdin {
         Box::new(StdinStatus::stdin())
     } else if let Some(log) = &args.log {
-        let params = params.context("a log replay needs --params P.toml (the log's motor)")?;
-        let opts = ReplayOptions {
-            angle_source: args.angle.into(),
-            residual_form: args.residuals.into(),
-            commission: args
-                .commission
-                .map(monitor_replay::CommissionWindow::seconds),
-            allow_incomplete: true,
-            ..ReplayOptions::default()
-        };
-        opts.validate()?;
+        let params = args
+            .params
+            .as_deref()
+            .context("a log replay needs --params P.toml (the log's motor)")?;
+        // diagnose's request, resolved as diagnose resolves it (the parameter file with its
+        // [columns] mapping, the TDMS group, the baseline's healthy reference); a window
+        // not learned is shown (the fixed thresholds, the verdict withheld), not refused.
+        let mut req = args.replay.request()?;
+        req.options.allow_incomplete = true;
+        let plan = monitor_api::plan_diagnose(
+            monitor_api::ParamsSource::Path(params),
+            &monitor_api::LogSource::from(log.as_path()),
+            &req,
+        )?;
         // Plain text at `max` walks the log at 1x on a clock of its own that does not wait
         // (a status line every --every seconds of the log, none skipped).
         let speed = if plain_text && args.speed == SpeedArg::Max {
@@ -146,12 +136,15 @@ pub fn run(args: &HmiArgs) -> anyhow::Result<()> {
         } else {
             args.speed.into()
         };
-        let open = monitor_io::log::OpenOptions {
-            columns,
-            ..Default::default()
-        };
-        Box::new(LogReplay::start_with(params, log, open, opts, speed)?)
-    } else if let Some(p) = params {
+        // A log that cannot be opened is said as diagnose says it (its fields as flags).
+        let replay = LogReplay::start_with(plan.params, log, plan.open, plan.options, speed)
+            .map_err(|e| match e {
+                monitor_replay::ReplayError::Log(e) => anyhow::Error::new(e),
+                e => anyhow::Error::new(e),
+            })?;
+        Box::new(replay)
+    } else if let Some(p) = &args.params {
+        let (p, _) = monitor_io::log::mapping::load_params(p)?;
         Box::new(LiveSim::new(
             p,
             monitor_studies::fault_signatures::Protocol::default().sample_rate_hz,

@@ -4,12 +4,16 @@
 
 use monitor_api::ApiError;
 use monitor_replay::{
-    check_parallel_paths, CommissionWindow, OptionField, ReplayError, Spelling, TimelineStep,
+    check_parallel_paths, CommissionWindow, OptionField, ReplayError, Spelling, TimelineStep, Words,
 };
 
 /// The command line's spelling of the library's fields: their flags.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct CliWords;
+
+/// The command line's words, as a request carries them (its reports' advice names the
+/// flags: `--commission START:END`, `diagnose --baseline`).
+pub const CLI: Words = Words(&CliWords);
 
 impl Spelling for CliWords {
     fn option(&self, field: OptionField, value: &str) -> String {
@@ -27,6 +31,10 @@ impl Spelling for CliWords {
 
     fn key(&self, name: &str) -> String {
         format!("--{}", name.replace('_', "-"))
+    }
+
+    fn command_with(&self, command: &str, field: OptionField) -> String {
+        format!("{command} {}", self.option(field, ""))
     }
 }
 

@@ -31,6 +31,8 @@ struct ReplayAnalysis {
     done: bool,
     warnings: Vec<String>,
     verdict: Option<String>,
+    /// The verdict's line, as `diagnose` prints it (what it was judged against).
+    verdict_line: Option<String>,
     error: Option<String>,
 }
 
@@ -161,8 +163,9 @@ fn analyse(
                 .ok()
                 .and_then(|v| v.as_str().map(str::to_string));
             a.verdict = v;
+            a.verdict_line = Some(r.verdict_line.clone());
         }
-        Err(e) => a.error = Some(monitor_io::one_line(&e.to_string())),
+        Err(e) => a.error = Some(monitor_io::one_line(&e.spelled(&*opts.words))),
     }
 }
 
@@ -236,6 +239,9 @@ impl Source for LogReplay {
                 None => "log not analysed".to_string(),
             };
             state.event(what);
+            if let Some(line) = &a.verdict_line {
+                state.event(format!("verdict: {line}"));
+            }
         }
         self.show(&a, state);
         state.controls = Controls::Replay(self.controls.clone());

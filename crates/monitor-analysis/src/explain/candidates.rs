@@ -71,8 +71,12 @@ impl Analysis {
         cands
             .iter()
             .filter_map(|c| {
-                self.cannot_rank(*c, base)
-                    .map(|m| format!("{}: {m}", c.kind()))
+                self.cannot_rank(*c, base).map(|m| match m {
+                    NotRanked::NotProposed(p) => {
+                        format!("{}: {}", c.kind(), p.spelled(&*self.words))
+                    }
+                    NotRanked::Setup(s) => format!("{}: {s}", c.kind()),
+                })
             })
             .collect()
     }

@@ -16,6 +16,7 @@ use crate::unbalance::UnbalanceAnalysis;
 use crate::{base_implausible, base_out_of_range, resolve};
 use crate::{Analysis, AnalysisError, Options};
 use monitor_core::EffectKind;
+use monitor_replay::OptionField;
 
 /// What stages 2 to 6 found on a log with voltages: the report's material.
 pub(super) struct ExplainFindings<'a> {
@@ -113,6 +114,7 @@ impl Analysis {
             constants: MachineConstants::from_params(&params),
             params,
             quality: self.quality.clone(),
+            words: self.words,
         };
         let mut out = recentred.explain_once(opts, progress, false)?;
         refit.recentred = true;
@@ -166,13 +168,14 @@ impl Analysis {
     /// implausible fit of the configured model itself.
     fn verdict(&self, found: &ExplainFindings<'_>) -> String {
         let first_plausible = found.ranked.iter().find(|c| c.candidate.plausible);
-        let mut v = verdict(found, first_plausible);
+        let mut v = verdict(found, first_plausible, &*self.words);
         v.push_str(&implausible_note(&found.ranked));
         let base_why = base_implausible(&self.constants, &found.base.fit.base, &self.data);
         if !base_why.is_empty() {
             v.push_str(&format!(
-                ". The configured model's own fit is not plausible ({}): the base parameters absorb an error the model cannot follow; if the log has a start or steps, see compare's advice (dynamics effects or --from)",
-                base_why.join("; ")
+                ". The configured model's own fit is not plausible ({}): the base parameters absorb an error the model cannot follow; if the log has a start or steps, see compare's advice (dynamics effects or {})",
+                base_why.join("; "),
+                self.words.hint(monitor_replay::OptionField::From, "")
             ));
         }
         v
@@ -258,8 +261,12 @@ fn implausible_note(ranked: &[RankedCandidate]) -> String {
     }
 }
 
-/// The conclusion in words, `best` the first plausible candidate.
-fn verdict(found: &ExplainFindings<'_>, best: Option<&RankedCandidate>) -> String {
+/// The conclusion in words, `best` the first plausible candidate (`words`: a field's).
+fn verdict(
+    found: &ExplainFindings<'_>,
+    best: Option<&RankedCandidate>,
+    words: &dyn monitor_replay::Spelling,
+) -> String {
     let (full, o) = (&found.full, found.outcome);
     match best {
         _ if o.near_noise => format!(
@@ -269,19 +276,22 @@ fn verdict(found: &ExplainFindings<'_>, best: Option<&RankedCandidate>) -> Strin
         Some(r) if !o.unexplained => {
             let c = &r.candidate;
             format!(
-                "missing effect: {} explains {:.0} % of the held-back error ({:.4} -> {:.4}); {}. Add it with --effects {}",
+                "missing effect: {} explains {:.0} % of the held-back error ({:.4} -> {:.4}); {}. Add it with {}",
                 c.effect,
                 100.0 * c.explained_fraction,
                 found.base.heldback_error_fit_series,
                 c.validation_normalized_rms_error,
                 c.summary,
-                found
-                    .names
-                    .iter()
-                    .chain([&c.effect])
-                    .map(|e| e.name())
-                    .collect::<Vec<_>>()
-                    .join(",")
+                words.hint(
+                    OptionField::Effects,
+                    &found
+                        .names
+                        .iter()
+                        .chain([&c.effect])
+                        .map(|e| e.name())
+                        .collect::<Vec<_>>()
+                        .join(",")
+                )
             )
         }
         Some(r) if r.candidate.standing == Standing::Candidate => format!(

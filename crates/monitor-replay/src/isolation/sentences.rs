@@ -72,7 +72,8 @@ impl IsolationTracker {
             )
         });
         format!(
-            "The load moved{what}: an operating-point change, not a fault; the stator-voltage equations, with the load as an unknown input, fit the machine. (A change of the machine's friction B cannot be told from a load change without a load model: for the paper's fixed viscous load, where a Bl change is a fault, give --load viscous.)"
+            "The load moved{what}: an operating-point change, not a fault; the stator-voltage equations, with the load as an unknown input, fit the machine. (A change of the machine's friction B cannot be told from a load change without a load model: for the paper's fixed viscous load, where a Bl change is a fault, give {}.)",
+            self.words.hint(crate::words::OptionField::Load, "viscous")
         )
     }
 

@@ -15,6 +15,7 @@ use super::{
 use super::{BaselineSource, UnbalanceReport};
 use crate::sequences::SensorPhaseReport;
 use crate::sequences::{sensor_phase, SequenceWindow};
+use crate::words::Words;
 use monitor_core::sequence::{
     asymmetry_correction_rad, equivalent_impedance, slip_for_current, SinglePhaseGain,
 };
@@ -179,13 +180,15 @@ struct Outside {
 
 /// The negative-sequence report (module docs) of the least-squares `windows` of a log of
 /// `params`' machine (`speed`: the log has a speed), judged against `baseline` (the healthy
-/// runs given, else the commissioning window's), with the turns counted by `level`.
+/// runs given, else the commissioning window's), with the turns counted by `level`, its
+/// sentences in `words`.
 pub(crate) fn unbalance_report(
     windows: &[SequenceWindow],
     params: &ParamFile,
     speed: bool,
     baseline: Option<HealthyReference>,
     level: TurnLevelOptions,
+    words: Words,
 ) -> UnbalanceReport {
     let segs = segments(windows);
     let judge = Judge {
@@ -202,7 +205,7 @@ pub(crate) fn unbalance_report(
     match &judged {
         None => report.phase_not_judged = Some(no_stretch_reason(params.supply.f_hz)),
         Some(j) => {
-            fill_judgement(&mut report, j, &segs);
+            fill_judgement(&mut report, j, &segs, words);
             let poles = params.motor.poles.max(2) as f32 / 2.0;
             if let Some(o) = &outside {
                 report.least_change_widened = super::reasons::widened(j, &o.ext, poles);
@@ -338,8 +341,13 @@ fn no_stretch_reason(f_hz: f64) -> String {
     )
 }
 
-/// The judged stretch's keys of the report.
-fn fill_judgement(report: &mut UnbalanceReport, j: &PhaseJudged, segs: &[SequenceSegment]) {
+/// The judged stretch's keys of the report (`words`: the sentences' words for a field).
+fn fill_judgement(
+    report: &mut UnbalanceReport,
+    j: &PhaseJudged,
+    segs: &[SequenceSegment],
+    words: Words,
+) {
     let p = j.posterior;
     let named = p.named();
     report.suspect_phase = named.map(|n| n.0);
@@ -364,7 +372,7 @@ fn fill_judgement(report: &mut UnbalanceReport, j: &PhaseJudged, segs: &[Sequenc
     report.judged_against = Some(j.against);
     report.phase_not_judged = segs.get(j.index).and_then(|s| {
         let reference = j.reference.and_then(|k| segs.get(k));
-        super::reasons::not_named(j, s, reference, least)
+        super::reasons::not_named(j, s, reference, least, words)
     });
     report.judged_segment = Some(j.index.min(MAX_SEGMENTS - 1));
     report.reference_segment = j.reference.filter(|&k| k < MAX_SEGMENTS);

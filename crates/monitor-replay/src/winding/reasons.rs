@@ -12,12 +12,14 @@ pub const BALANCED_RATIO: f32 = 0.005;
 /// Why the judged stretch names no phase, in a sentence; `None` when it names one, or when
 /// the change is below [`BALANCED_RATIO`] (nothing to judge). `seg` is the judged stretch,
 /// `reference` the stretch it was judged against within the log, `least` the least change
-/// that names a phase (fraction of `|I1|`; `None`: none does).
+/// that names a phase (fraction of `|I1|`; `None`: none does), `words` the words its
+/// advice names a field in.
 pub(super) fn not_named(
     j: &PhaseJudged,
     seg: &SequenceSegment,
     reference: Option<&SequenceSegment>,
     least: Option<f32>,
+    words: crate::words::Words,
 ) -> Option<String> {
     let p = j.posterior;
     if p.named().is_some() {
@@ -48,7 +50,8 @@ pub(super) fn not_named(
     };
     Some(match j.against {
         Against::Nothing | Against::ParameterFile => format!(
-            "cannot judge the phase: the negative sequence ({change:.1} % of I1 at {at}) is within what a healthy machine's own asymmetry may reach ({least}) and there is no healthy baseline (give --baseline with healthy logs of this motor, or commission)"
+            "cannot judge the phase: the negative sequence ({change:.1} % of I1 at {at}) is within what a healthy machine's own asymmetry may reach ({least}) and there is no healthy baseline (give {} with healthy logs of this motor, or commission)",
+            words.hint(crate::words::OptionField::Baseline, "")
         ),
         Against::WithinTheLog => {
             let from = reference.map_or(String::new(), |r| {

@@ -154,7 +154,7 @@ impl Analysis {
             ..sr.span
         };
         if let Some(t) = transients::not_proposed(e, resolvable, &self.constants, &all) {
-            return Some(t.to_string());
+            return Some(t.spelled(&*self.words));
         }
         e.needs()
             .met_by(&self.data)
