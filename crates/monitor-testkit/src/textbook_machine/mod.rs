@@ -164,7 +164,7 @@ impl Machine {
         let ls = lm + self.lls * dn;
         let lr = lm + self.llr * up;
         format!(
-            "# Textbook machine {} (sim-host/tests/textbook_machine)\n[motor]\nrs_ohm = {}\n\
+            "# Textbook machine {} (crates/monitor-testkit/src/textbook_machine)\n[motor]\nrs_ohm = {}\n\
              rr_ohm = {}\nls_h = {}\nlr_h = {}\nlm_h = {}\npoles = {}\nj_kgm2 = {}\n\
              b_nms = {}\nbl_nms = {}\n\n[supply]\nv_ll_rms = {}\nf_hz = {}\n",
             self.name,

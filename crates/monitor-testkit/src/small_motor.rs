@@ -1,5 +1,5 @@
 //! The 0.37 kW machine the tests use beside the two reference motors (the one of
-//! `tests/nameplate.rs`: made for the tests from per-unit values typical of its size, not a
+//! `sim-host/tests/nameplate.rs`: made for the tests from per-unit values typical of its size, not a
 //! published circuit), and the three motors as a list.
 
 use monitor_core::{MotorParameters, SupplyParameters};
@@ -9,7 +9,6 @@ use std::f64::consts::TAU;
 /// The 0.37 kW, 400 V, 50 Hz, 4-pole machine (Rs 30, Rr 24, Xls = Xlr 16, Xm 260 ohm at
 /// 50 Hz), J of a 71-frame motor, the paper's viscous load at its rated torque (2.57 N m
 /// at 1375 rpm).
-#[allow(dead_code)] // (not every test of the motors uses it)
 pub fn small_0p37kw() -> ParamFile {
     let w = TAU * 50.0;
     let (lm, ll) = (260.0 / w, 16.0 / w);
@@ -36,7 +35,6 @@ pub fn small_0p37kw() -> ParamFile {
 }
 
 /// The 3 hp and 2.2 kW reference motors and the 0.37 kW machine, with their names.
-#[allow(dead_code)] // (not every test of the motors uses it)
 pub fn three_motors() -> Vec<(&'static str, ParamFile)> {
     vec![
         ("3 hp", ParamFile::reference_3hp()),
@@ -45,54 +43,11 @@ pub fn three_motors() -> Vec<(&'static str, ParamFile)> {
     ]
 }
 
-/// Replays `sc` on `p` commissioned cold over 1.5-3.5 s, its windings warming from 4 s by
-/// `rise_k` with the thermal time constant `tau_s` (the simulator's `thermal_drift`; no
-/// warming for a rise of 0), with `fault` (kind, time [s], relative change) on top.
-#[allow(dead_code)] // (not every test of the three motors warms them)
-pub fn replay_warming(
-    p: &ParamFile,
-    sc: monitor_sim::Scenario,
-    (rise_k, tau_s): (f64, f64),
-    fault: Option<(monitor_core::Fault, f64, f64)>,
-) -> monitor_replay::DiagnoseReport {
-    replay_warming_from(p, sc, (rise_k, tau_s, 4.0), fault, (1.5, 3.5))
-}
-
-/// [`replay_warming`] with the warming from `at_s` and commissioned over `commission`.
-#[allow(dead_code)] // (not every test of the three motors warms them)
-pub fn replay_warming_from(
-    p: &ParamFile,
-    mut sc: monitor_sim::Scenario,
-    (rise_k, tau_s, at_s): (f64, f64, f64),
-    fault: Option<(monitor_core::Fault, f64, f64)>,
-    commission: (f64, f64),
-) -> monitor_replay::DiagnoseReport {
-    use monitor_sim::{EffectSpec, FaultSpec};
-    if rise_k > 0.0 {
-        let toml = format!(
-            "name = \"thermal_drift\"\nrise_k = {rise_k}\ntau_s = {tau_s}\nat_s = {at_s}\n"
-        );
-        sc.effects
-            .push(toml::from_str::<EffectSpec>(&toml).expect("effect"));
-    }
-    if let Some((f, at_s, change)) = fault {
-        sc.faults.push(FaultSpec::parametric(f, at_s, change));
-    }
-    let opts = monitor_replay::ReplayOptions {
-        commission: Some(commission),
-        ..Default::default()
-    };
-    monitor_studies::experiment::simulate_and_replay(p, p, &sc, opts, |_, _| {})
-        .expect("runs")
-        .finish()
-}
-
 /// Krause, Wasynczuk and Sudhoff's 50 hp, 460 V, 60 Hz, 4-pole machine (Analysis of
 /// Electric Machinery and Drive Systems: Rs 0.087, Rr 0.228, Xls = Xlr 0.302, Xm 13.08
 /// ohm at 60 Hz, J 1.662 kg m^2), in the paper's simplified-model structure (Ls = Lls + Lm,
 /// Lr = Llr + Lm, the viscous load): Bl 0.9 N m s/rad, 160 N m (0.8 of its rated 198 N m)
 /// at 1705 rpm, B a hundredth of it.
-#[allow(dead_code)] // (not every test of the motors uses it)
 pub fn krause_50hp() -> ParamFile {
     let w = TAU * 60.0;
     let (xm, xl) = (13.08, 0.302);

@@ -1,5 +1,5 @@
-//! The textbook machine of `ladder_matrix.rs` (tests/textbook_machine) checked against
-//! physics, so that the ladder's bars rest on a model that can be trusted:
+//! The textbook machine of `sim-host/tests/ladder_matrix.rs` (this crate's
+//! `textbook_machine`) checked against physics, so that the ladder's bars rest on a model that can be trusted:
 //! * its steady state at rated slip equals the T-equivalent circuit's (analytic) torque
 //!   and current, on each of the three machines;
 //! * energy balance over a direct-on-line start with every hidden effect on (and with
@@ -7,7 +7,7 @@
 //!   of stored magnetic and kinetic energy.
 #![allow(missing_docs)]
 
-mod textbook_machine;
+use monitor_testkit::textbook_machine;
 use textbook_machine::{equivalent_circuit, Hidden, Load, Machine, Model, Scenario};
 
 fn machines() -> [Machine; 3] {

@@ -10,7 +10,7 @@ pub const CODE_DIRS: [&str; 5] = ["crates/", "src/", "sim-host/", "tests/", "too
 /// The workspace's root folder.
 pub fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("..")
+        .join("../..")
         .canonicalize()
         .expect("the workspace folder")
 }
@@ -86,6 +86,12 @@ pub fn is_code(rel: &str) -> bool {
 /// A file of tests (`tests/` folders and benches).
 pub fn is_test_file(rel: &str) -> bool {
     rel.starts_with("tests/") || rel.contains("/tests/") || rel.contains("/benches/")
+}
+
+/// A file of the tests' shared scenarios (`crates/monitor-testkit/src/`, a dev-only
+/// crate): test code for the functions' length and the unique type names, code otherwise.
+pub fn is_shared_scenarios(rel: &str) -> bool {
+    rel.starts_with("crates/monitor-testkit/src/")
 }
 
 /// The workspace's packages: (the folder of each tracked `Cargo.toml` with a `[package]`,
