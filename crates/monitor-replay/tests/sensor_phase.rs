@@ -13,7 +13,7 @@ use rayon::prelude::*;
 
 /// The parameter files: (name, file, commissioning window, fault time).
 fn motors() -> Vec<(&'static str, ParamFile, (f64, f64), f64)> {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let eleven = ParamFile::load(&root.join("examples/params/11kw_2pole.toml")).expect("11 kW"); // ok: test
     vec![
         ("3 hp", ParamFile::reference_3hp(), (2.0, 4.0), 4.5),

@@ -21,7 +21,7 @@ use monitor_replay::{
 use std::path::{Path, PathBuf};
 
 fn folder() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/recordings/itsc")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/recordings/itsc")
 }
 
 /// The 13 conditions of one run: `(name, shorted phase index, level 0..4)`.

@@ -10,7 +10,7 @@
 //! phases named at 0.5 or more, at least 95 % are right. The table printed is the one in
 //! `docs/isolation.md`:
 //! ```text
-//! cargo test --release -p sim-host --test winding_reliability -- --nocapture
+//! cargo test --release -p monitor-replay --test winding_reliability -- --nocapture
 //! ```
 //! `MONITOR_FULL_SWEEPS=1` draws four times as many simulated logs.
 
@@ -61,7 +61,7 @@ fn outcome(what: String, u: &UnbalanceReport, shorted: Option<Phase>) -> CaseOut
 // ---------------------------------------------------------------- the ITSC run 002
 
 fn itsc() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/recordings/itsc")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/recordings/itsc")
 }
 
 fn itsc_judge(name: &str, baseline: Option<HealthyReference>) -> UnbalanceReport {

@@ -12,8 +12,7 @@
 //!
 //! Every case runs by default (the 36 broken-bar records take under a second).
 
-#[allow(dead_code)] // (the 0.37 kW machine only)
-mod small_motor;
+use monitor_testkit::small_motor;
 
 use monitor_io::log::{Channels, Row};
 use monitor_io::params::ParamFile;
@@ -552,7 +551,7 @@ fn real_recordings_of_a_healthy_cage_give_no_rotor_fault() {
     // slip only from a pair about the line, which here is the bench's own modulation (the
     // short switched on and off, the supply), never a rotor fault at >= 0.5.
     let folder =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/recordings/itsc");
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/recordings/itsc");
     let (params, columns) =
         monitor_io::log::mapping::load_params(&folder.join("baldor_0p75hp.toml"))
             .expect("parameter file"); // ok: test

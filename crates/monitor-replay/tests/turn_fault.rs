@@ -33,7 +33,7 @@ fn motors() -> [(ParamFile, f64, &'static str); 3] {
     ]
 }
 
-type C = monitor_analysis::prep::C64;
+type C = num_complex::Complex64;
 
 /// The T-equivalent circuit's impedance per phase at slip `s` (textbook).
 fn z_t(p: &ParamFile, we: f64, s: f64) -> C {
