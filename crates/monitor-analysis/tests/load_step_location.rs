@@ -58,7 +58,7 @@ fn segments(a: &Analysis) -> Vec<LoadSegment> {
 /// 14.6 N m +/- 2 %. Up to 2.4 s (the start, no step) no step is placed.
 #[test]
 fn motulator_load_step_is_found_where_it_is() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/logs");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/logs");
     let log = root.join("motulator_2p2kw_dol.csv");
     let p = monitor_io::params::ParamFile::load(&root.join("motulator_2p2kw_dol.toml")).unwrap();
     let a = analyse(&log, &p, f64::NEG_INFINITY);

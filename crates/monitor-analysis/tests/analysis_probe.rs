@@ -135,7 +135,7 @@ fn probe() {
     }
 }
 
-/// Read-speed probe (ignored): `ANALYSIS_BENCH_LOG=... cargo test --test analysis_probe read_speed -- --ignored --nocapture`.
+/// Read-speed probe (ignored): `ANALYSIS_BENCH_LOG=... cargo test -p monitor-analysis --test analysis_probe read_speed -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn read_speed() {

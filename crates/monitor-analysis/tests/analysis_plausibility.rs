@@ -240,7 +240,7 @@ fn assert_standings(case: &str, ex: &ExplainReport) {
 /// prints with a unit "1" (`y_re = 5.00 1` before).
 #[test]
 fn the_motulator_logs_implausible_fits_stand_apart_and_print_no_unit_one() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/logs");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/logs");
     let p = monitor_io::params::ParamFile::load(&root.join("motulator_2p2kw_dol.toml")).unwrap();
     let a = analyse(&root.join("motulator_2p2kw_dol.csv"), &p, 0.0);
     let ex = a.explain(&opts(&[]), &|_| {}).unwrap().report;
@@ -317,7 +317,7 @@ fn out_of_range_values_print_their_unit_and_no_unit_one() {
 #[test]
 fn compare_advice_and_explain_skipped_agree() {
     let dir = tempfile::tempdir().unwrap();
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/logs");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/logs");
     let motulator =
         monitor_io::params::ParamFile::load(&root.join("motulator_2p2kw_dol.toml")).unwrap();
     let p = motor("2p2");

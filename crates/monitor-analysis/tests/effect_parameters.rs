@@ -62,7 +62,7 @@ fn rendered() -> String {
 /// The first table after the heading `### The effects' parameters` in docs/design.md.
 fn documented() -> String {
     let design =
-        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/design.md"))
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/design.md"))
             .expect("docs/design.md");
     let at = design
         .find("### The effects' parameters")

@@ -9,17 +9,16 @@
 //!
 //! The figures (`--nocapture`) are the accuracy table of docs/model-vs-measurement.md:
 //! ```text
-//! MONITOR_FULL_SWEEPS=1 cargo test --release -p sim-host --test noise_floor -- --nocapture
+//! MONITOR_FULL_SWEEPS=1 cargo test --release -p monitor-analysis --test noise_floor -- --nocapture
 //! ```
 //! By default a representative subset runs (each log source once, each rate once); the
 //! thermal-drift logs (40 s) run with `MONITOR_FULL_SWEEPS=1` only (`.ci/run` runs it).
 mod analysis_common;
-#[allow(dead_code)]
-mod small_motor;
 use analysis_common::*;
 use monitor_io::log::{Channels, Log, Row};
 use monitor_io::params::{ParamFile, SensorRanges};
 use monitor_sim::{Scenario, SupplyStep};
+use monitor_testkit::small_motor;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use std::f64::consts::{PI, TAU};
@@ -171,7 +170,7 @@ fn textbook_rows(p: &ParamFile, rate_hz: f64) -> Vec<Row> {
 /// `10 kHz / rate_hz`-th row.
 fn motulator_rows(rate_hz: f64) -> Vec<Row> {
     let path =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/logs/motulator_2p2kw_dol.csv");
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/logs/motulator_2p2kw_dol.csv");
     let text = std::fs::read_to_string(path).expect("motulator log");
     let every = (10_000.0 / rate_hz).round() as usize;
     text.lines()
@@ -197,7 +196,7 @@ fn motulator_rows(rate_hz: f64) -> Vec<Row> {
 /// The motulator log's machine (`examples/logs/motulator_2p2kw_dol.toml`).
 fn motulator_params() -> ParamFile {
     let path =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/logs/motulator_2p2kw_dol.toml");
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/logs/motulator_2p2kw_dol.toml");
     ParamFile::from_toml_str(&std::fs::read_to_string(path).expect("toml"), "motulator")
         .expect("params")
 }

@@ -206,7 +206,7 @@ fn current_only_log_gets_the_unbalance_analysis() {
 
 #[test]
 fn motulator_log_points_at_load_torque() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/logs");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/logs");
     let log = root.join("motulator_2p2kw_dol.csv");
     assert!(log.exists(), "{} is part of the repository", log.display());
     let p = monitor_io::params::ParamFile::load(&root.join("motulator_2p2kw_dol.toml")).unwrap();
