@@ -13,7 +13,7 @@
 //! machines and Krause's 50 hp one. Twenty-four 20 s logs at 4 kHz: about 5 s in the test
 //! profile.
 
-mod small_motor;
+use monitor_testkit::small_motor;
 
 use monitor_io::params::ParamFile;
 use monitor_replay::{DiagnoseReport, IsolationEvent, IsolationName, ReplayOptions};

@@ -123,7 +123,7 @@ fn rise_at(rise_k: f64, tau_s: f64, t_s: f64) -> f64 {
 
 #[test]
 fn a_motor_commissioned_while_it_warms_reads_heating_not_a_fault() {
-    let third = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/params/11kw_2pole.toml");
+    let third = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/params/11kw_2pole.toml");
     let mut four = motors();
     four.push((
         "11 kW",

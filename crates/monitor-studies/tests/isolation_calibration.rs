@@ -29,7 +29,6 @@
 //! 4_880_000.., 48 cases, about 6 s). Print the tables with `-- --nocapture`.
 
 mod calibration_cases;
-mod small_motor;
 
 use calibration_cases::{draw, motors, right_name, run, CaseOutcome, Scored};
 use rayon::prelude::*;

@@ -12,7 +12,7 @@
 //! listed (a 10 % load step moves the active current by a little less than the 10 % a move
 //! needs, so it may be left out). About 4 s in the test profile.
 
-mod small_motor;
+use monitor_testkit::small_motor;
 
 use monitor_io::params::ParamFile;
 use monitor_replay::{IsolationEvent, ReplayOptions};
@@ -65,7 +65,8 @@ fn the_demos_load_steps_are_listed_where_they_began() {
 
 /// The four motors.
 fn motors() -> Vec<(&'static str, ParamFile)> {
-    let eleven = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/params/11kw_2pole.toml");
+    let eleven =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/params/11kw_2pole.toml");
     vec![
         ("3 hp", ParamFile::reference_3hp()),
         ("2.2 kW", ParamFile::reference_2p2kw()),

@@ -2,11 +2,11 @@
 //! from its seed, simulated and replayed (its module docs say what is drawn).
 #![allow(dead_code)]
 
-use super::small_motor;
 use monitor_core::{AngleSource, Fault};
 use monitor_io::params::ParamFile;
 use monitor_replay::{IsolationEvent, IsolationName, ReplayOptions};
 use monitor_sim::{EffectSpec, FaultSpec, LoadSpec, LoadStep, Scenario, SensorSpec};
+use monitor_testkit::small_motor;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
