@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 const SCENARIO: &str = "duration_s = 8.0\nsample_rate_hz = 5000.0\nseed = 5\n[sensors]\nencoder = true\nspeed = false\n";
 
 fn params() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/params/2p2kw.toml")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/params/2p2kw.toml")
 }
 
 /// The log with `enc_count` cells spoilt: 40 bursts from 4.5 s, every 70 ms, of one or

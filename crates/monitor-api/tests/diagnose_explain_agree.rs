@@ -54,7 +54,7 @@ const MOTORS: [&str; 2] = ["3hp.toml", "2p2kw.toml"];
 
 fn params(file: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../examples/params")
+        .join("../../examples/params")
         .join(file)
 }
 
