@@ -19,7 +19,7 @@
 //! its own noise, under `MONITOR_FULL_SWEEPS=1`. Set `MONITOR_MONTH_STORE=PATH` to keep the
 //! month's store (the docs' plot: `sim-host trend --store PATH --plot ...`).
 
-mod small_motor;
+use monitor_testkit::small_motor;
 
 use monitor_io::params::ParamFile;
 use monitor_replay::ReplayOptions;
