@@ -1,5 +1,5 @@
-//! `explain --ladder` on logs of an independent textbook machine (tests/textbook_machine,
-//! Krause's fifth-order model; not `monitor-sim`), over a matrix of three motor sizes,
+//! `explain --ladder` on logs of an independent textbook machine
+//! (`monitor_testkit::textbook_machine`, Krause's fifth-order model; not `monitor-sim`), over a matrix of three motor sizes,
 //! scenarios and hidden effects, single and in pairs, and effect-free controls.
 //!
 //! Bars, over the cases run:
@@ -26,7 +26,7 @@
 #![allow(missing_docs)]
 
 mod analysis_common;
-mod textbook_machine;
+use monitor_testkit::textbook_machine;
 
 use std::collections::BTreeSet;
 use std::path::Path;

@@ -1,0 +1,18 @@
+//! Shared test scenarios of the workspace, a dev-only crate (`publish = false`): the
+//! library crates and the command line take it as a `[dev-dependency]` only, and nothing
+//! ships with it. It sits beside the libraries, above the simulator (it uses
+//! `monitor-core`, `monitor-io` and `monitor-sim` and nothing higher), so the tests of
+//! `monitor-replay`, `monitor-analysis`, `monitor-studies`, `monitor-store` and `sim-host`
+//! can use it without a cycle; `monitor-sim`'s own tests do not.
+//!
+//! * [`analysis_common`]: simulated scenarios and logs of the model-vs-measurement tests.
+//! * [`small_motor`]: the 0.37 kW and 50 hp machines beside the two reference motors.
+//! * [`textbook_machine`]: an independent textbook induction machine (the ladder's logs),
+//!   checked against physics by `tests/textbook_machine_physics.rs`.
+//!
+//! Its own tests also hold the workspace's architecture test (`tests/architecture.rs`),
+//! which reads every crate's sources.
+
+pub mod analysis_common;
+pub mod small_motor;
+pub mod textbook_machine;
