@@ -17,7 +17,7 @@ use arrow_array::types::{
 };
 use arrow_array::{Array, ArrowPrimitiveType, RecordBatchReader};
 use arrow_schema::{DataType, TimeUnit};
-use monitor_io::log::{MemoryLog, MemoryValues};
+use monitor_api::files::{MemoryLog, MemoryValues};
 use pyo3::prelude::*;
 use pyo3::types::{PyCapsule, PyCapsuleMethods};
 

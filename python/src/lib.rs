@@ -59,8 +59,8 @@ create_exception!(
 /// name them (`commission = 4:2`, `load = 'heavy'`).
 struct PyWords;
 
-impl monitor_replay::Spelling for PyWords {
-    fn option(&self, field: monitor_replay::OptionField, value: &str) -> String {
+impl monitor_api::replay::Spelling for PyWords {
+    fn option(&self, field: monitor_api::replay::OptionField, value: &str) -> String {
         if value.is_empty() {
             field.name().to_string()
         } else {
@@ -70,8 +70,8 @@ impl monitor_replay::Spelling for PyWords {
 
     /// A report's advice as a keyword argument to type: `commission='START:END'`,
     /// `load='viscous'`, `baseline=[...]`, `effects=['load_torque']`, `from_s=0.8`.
-    fn hint(&self, field: monitor_replay::OptionField, value: &str) -> String {
-        use monitor_replay::OptionField as F;
+    fn hint(&self, field: monitor_api::replay::OptionField, value: &str) -> String {
+        use monitor_api::replay::OptionField as F;
         let name = field.name();
         let list = |v: &str| {
             v.split(',')
@@ -91,13 +91,13 @@ impl monitor_replay::Spelling for PyWords {
     }
 
     /// `diagnose(..., baseline=[...])`.
-    fn command_with(&self, command: &str, field: monitor_replay::OptionField) -> String {
+    fn command_with(&self, command: &str, field: monitor_api::replay::OptionField) -> String {
         format!("{command}(..., {})", self.hint(field, ""))
     }
 }
 
 /// Python's words, as a request carries them (the reports' advice in keyword arguments).
-const PY: monitor_replay::Words = monitor_replay::Words(&PyWords);
+const PY: monitor_api::replay::Words = monitor_api::replay::Words(&PyWords);
 
 /// The exception of an [`ApiError`], its message in Python's words ([`PyWords`]).
 fn to_py(e: ApiError) -> PyErr {
@@ -153,10 +153,10 @@ fn json<T: serde::Serialize>(v: &T) -> PyResult<String> {
     serde_json::to_string(v).map_err(|e| InternalError::new_err(e.to_string()))
 }
 
-fn load_of(name: &str) -> PyResult<monitor_replay::LoadModel> {
+fn load_of(name: &str) -> PyResult<monitor_api::replay::LoadModel> {
     match name {
-        "unknown" => Ok(monitor_replay::LoadModel::Unknown),
-        "viscous" => Ok(monitor_replay::LoadModel::Viscous),
+        "unknown" => Ok(monitor_api::replay::LoadModel::Unknown),
+        "viscous" => Ok(monitor_api::replay::LoadModel::Viscous),
         other => Err(OptionError::new_err(format!(
             "load = '{other}': give 'unknown' or 'viscous'"
         ))),
@@ -208,10 +208,10 @@ enum CommissionArg {
 
 impl CommissionArg {
     /// The window, by the library's one parser and check.
-    fn window(&self) -> Result<monitor_replay::CommissionWindow, ApiError> {
+    fn window(&self) -> Result<monitor_api::replay::CommissionWindow, ApiError> {
         Ok(match self {
             CommissionArg::Text(s) => s.parse()?,
-            CommissionArg::Pair(a, b) => monitor_replay::CommissionWindow::new(*a, *b)?,
+            CommissionArg::Pair(a, b) => monitor_api::replay::CommissionWindow::new(*a, *b)?,
         })
     }
 }
@@ -228,23 +228,23 @@ fn replay_options(
     timeline_step: Option<f64>,
     parallel_paths: Option<i64>,
     turn_calibration: Option<String>,
-) -> PyResult<monitor_replay::ReplayOptions> {
-    let d = monitor_replay::ReplayOptions::default();
-    // A calibration as its JSON text (`monitor_replay::TurnCalibration`).
+) -> PyResult<monitor_api::replay::ReplayOptions> {
+    let d = monitor_api::replay::ReplayOptions::default();
+    // A calibration as its JSON text (`monitor_api::replay::TurnCalibration`).
     let calibration = turn_calibration
-        .map(|t| serde_json::from_str::<monitor_replay::TurnCalibration>(&t))
+        .map(|t| serde_json::from_str::<monitor_api::replay::TurnCalibration>(&t))
         .transpose()
         .map_err(|e| OptionError::new_err(format!("turn_calibration: not a calibration: {e}")))?;
     let parallel_paths = match parallel_paths {
         None => d.turn_level.parallel_paths,
-        Some(n) => monitor_replay::check_parallel_paths(n).map_err(|e| to_py(e.into()))?,
+        Some(n) => monitor_api::replay::check_parallel_paths(n).map_err(|e| to_py(e.into()))?,
     };
-    Ok(monitor_replay::ReplayOptions {
+    Ok(monitor_api::replay::ReplayOptions {
         commission: commission
             .map(|c| c.window())
             .transpose()
             .map_err(to_py)?
-            .map(monitor_replay::CommissionWindow::seconds),
+            .map(monitor_api::replay::CommissionWindow::seconds),
         allow_incomplete,
         load: load.map(load_of).transpose()?.unwrap_or(d.load),
         angle_source: angle.map(angle_of).transpose()?.unwrap_or(d.angle_source),
@@ -253,12 +253,12 @@ fn replay_options(
             .transpose()?
             .unwrap_or(d.residual_form),
         timeline_step: timeline_step
-            .map(monitor_replay::TimelineStep::new)
+            .map(monitor_api::replay::TimelineStep::new)
             .transpose()
             .map_err(|e| to_py(e.into()))?
             .unwrap_or(d.timeline_step),
         unbalance_baseline: None,
-        turn_level: monitor_replay::TurnLevelOptions {
+        turn_level: monitor_api::replay::TurnLevelOptions {
             parallel_paths,
             calibration: calibration.or(d.turn_level.calibration),
         },
@@ -443,7 +443,7 @@ fn params_from_nameplate(
     nema_design: &str,
     columns_from: Option<PathBuf>,
 ) -> PyResult<String> {
-    use monitor_io::nameplate::{Connection, Nameplate, NemaDesign};
+    use monitor_api::files::{Connection, Nameplate, NemaDesign};
     let connection = match connection {
         "star" => Connection::Star,
         "delta" => Connection::Delta,

@@ -96,5 +96,5 @@ fn one_line_error(e: &anyhow::Error) -> String {
             msg.push_str(&c);
         }
     }
-    monitor_io::one_line(&msg)
+    monitor_api::files::one_line(&msg)
 }

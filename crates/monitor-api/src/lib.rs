@@ -20,10 +20,18 @@ use monitor_replay::{
 };
 use std::path::{Path, PathBuf};
 
+/// Model against measurement for a front end (from `monitor-analysis`).
+pub mod analysis;
 mod error;
 mod explain_doc;
+/// The files a front end reads and writes (from `monitor-io`).
+pub mod files;
 pub mod fleet;
 mod log_source;
+/// The replay of a log for a front end (from `monitor-replay`).
+pub mod replay;
+/// The simulator for a front end (from `monitor-sim`).
+pub mod sim;
 mod turn_calibration;
 pub use error::{ApiError, ErrorKind};
 pub use explain_doc::{

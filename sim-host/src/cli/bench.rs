@@ -96,7 +96,7 @@ fn run_isolation(args: &BenchArgs) -> anyhow::Result<()> {
             .map_err(|e| anyhow::anyhow!("cannot create the plot folder {}: {e}", dir.display()))?;
         let svg = render::plot::confusion_svg(&result.confusion).map_err(anyhow::Error::msg)?;
         let path = dir.join(CONFUSION_SVG);
-        monitor_io::log::write_atomic(&path, svg.as_bytes())
+        monitor_api::files::write_atomic(&path, svg.as_bytes())
             .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
         eprintln!("wrote {}", path.display());
     }

@@ -7,8 +7,8 @@
 use super::output_guard::OutputGuard;
 use anyhow::Context;
 use clap::Args;
+use monitor_api::files::ParamFile;
 use monitor_core::motor_record::MotorRecord;
-use monitor_io::params::ParamFile;
 use std::path::PathBuf;
 
 /// Arguments of `board-record`.
@@ -77,7 +77,7 @@ pub fn run(args: &BoardRecordArgs) -> anyhow::Result<()> {
             args.params.display()
         );
     }
-    monitor_io::log::write_atomic(&args.out, &bytes)
+    monitor_api::files::write_atomic(&args.out, &bytes)
         .with_context(|| format!("writing {}", args.out.display()))?;
     println!("wrote {} ({} bytes)", args.out.display(), bytes.len());
     Ok(())

@@ -3,14 +3,14 @@
 
 use super::output_guard::OutputGuard;
 use super::{progress, render};
-use monitor_analysis::{Analysis, Options};
+use monitor_api::analysis::{Analysis, Options};
 use monitor_core::EffectKind;
 use std::path::PathBuf;
 
 /// A parameter file as read once: its values and its `[columns]` mapping.
 type Params = (
-    monitor_io::params::ParamFile,
-    monitor_io::log::ColumnMapping,
+    monitor_api::files::ParamFile,
+    monitor_api::files::ColumnMapping,
 );
 
 /// Options shared by `compare` and `explain`.
@@ -94,8 +94,8 @@ impl Common {
     /// Reads the log for the model's analysis with the parameter file already read.
     fn load_with(
         &self,
-        params: &monitor_io::params::ParamFile,
-        columns: &monitor_io::log::ColumnMapping,
+        params: &monitor_api::files::ParamFile,
+        columns: &monitor_api::files::ColumnMapping,
     ) -> anyhow::Result<Analysis> {
         let big = std::fs::metadata(&self.log)
             .map(|m| m.len() > 20_000_000)
@@ -257,16 +257,16 @@ pub fn run_compare(args: &CompareArgs) -> anyhow::Result<()> {
 /// so that memory stays at explain's), and the ranking.
 type Explained = (
     Analysis,
-    Option<monitor_analysis::compare::CompareReport>,
-    monitor_analysis::explain::ExplainOutput,
+    Option<monitor_api::analysis::CompareReport>,
+    monitor_api::analysis::ExplainOutput,
 );
 
 /// Reads the log, runs `compare` with `--compare`, and fits the candidates (with a progress
 /// bar on large logs).
 fn explain_here(
     args: &ExplainArgs,
-    params: &monitor_io::params::ParamFile,
-    columns: &monitor_io::log::ColumnMapping,
+    params: &monitor_api::files::ParamFile,
+    columns: &monitor_api::files::ColumnMapping,
 ) -> anyhow::Result<Explained> {
     let c = &args.common;
     let a = c.load_with(params, columns)?;

@@ -1,5 +1,5 @@
 //! `sim-host convert IN OUT`: rewrite a log in another format (CSV, TDMS, Parquet, by the
-//! extensions), through the one reader and the one writer (`monitor_io::log`).
+//! extensions), through the one reader and the one writer (`monitor_api::files::LogFile` and `LogWriter`).
 //!
 //! The rows are copied as the reader hands them over (non-finite cells and times that do
 //! not increase included): judging them stays the data-quality stage's, in the command
@@ -11,7 +11,7 @@ use super::output_guard::OutputGuard;
 use super::render::json::Converted;
 use super::{progress, render, Interruption};
 use clap::Args;
-use monitor_io::log::{Format, LogFile, LogWriter, OpenOptions, Row, RowSink};
+use monitor_api::files::{Format, LogFile, LogWriter, OpenOptions, Row, RowSink};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -52,8 +52,8 @@ pub struct ConvertArgs {
 struct Copy<'a> {
     w: Option<LogWriter>,
     args: &'a ConvertArgs,
-    channels: monitor_io::log::Channels,
-    error: Option<monitor_io::log::LogError>,
+    channels: monitor_api::files::Channels,
+    error: Option<monitor_api::files::LogError>,
     interruption: &'a Interruption,
     rows: u64,
 }
@@ -95,7 +95,7 @@ fn open_input(args: &ConvertArgs) -> anyhow::Result<LogFile> {
     inputs.extend(args.params.as_deref());
     OutputGuard::new(&inputs).check_files(&[&args.output])?;
     let columns = match &args.params {
-        Some(p) => monitor_io::log::mapping::load_params(p)?.1,
+        Some(p) => monitor_api::files::load_params(p)?.1,
         None => Default::default(),
     };
     let opts = OpenOptions {

@@ -1,4 +1,4 @@
-//! `sim-host diagnose`: replay a log through the core ([`monitor_replay::diagnose_file`])
+//! `sim-host diagnose`: replay a log through the core ([`monitor_api::replay::diagnose_file`])
 //! and report lamps, candidates and the negative-sequence analysis.
 
 use super::{progress, render, AngleArg, LoadArg, ResidualArg};
@@ -75,7 +75,7 @@ pub struct DiagnoseArgs {
     pub allow_incomplete: bool,
     /// Timeline resolution in the output [s].
     #[arg(long, default_value_t = defaults().options.timeline_step, allow_negative_numbers = true, value_parser = super::words::parse_timeline_step)]
-    pub timeline_step: monitor_replay::TimelineStep,
+    pub timeline_step: monitor_api::replay::TimelineStep,
     /// Print one JSON document on stdout instead of the table.
     #[arg(long)]
     pub json: bool,
@@ -93,7 +93,7 @@ pub struct ReplayArgs {
     /// Learn healthy thresholds over START:END seconds of the log (healthy running that
     /// covers the load and voltage range to be monitored).
     #[arg(long, value_name = "START:END", value_parser = super::words::parse_window)]
-    pub commission: Option<monitor_replay::CommissionWindow>,
+    pub commission: Option<monitor_api::replay::CommissionWindow>,
     /// Logs of the same motor when healthy (several files, or a folder of them; read
     /// only; the same formats as LOG): the winding is judged against their mean negative
     /// sequence, and their spread sets the least change that names a phase. Give LOG
@@ -118,7 +118,7 @@ pub struct ReplayArgs {
     #[arg(long, default_value_t = defaults().options.turn_level.parallel_paths, value_parser = super::words::parse_parallel_paths)]
     pub parallel_paths: u8,
     /// A calibration of the shorted-turn level learned from labelled runs of the same
-    /// motor (JSON, `monitor_replay::TurnCalibration`): the level is read from it instead
+    /// motor (JSON, `monitor_api::replay::TurnCalibration`): the level is read from it instead
     /// of the model (unbalance.shorted_turns.basis says which; the model's stays in
     /// unbalance.shorted_turns_physics).
     #[arg(long, value_name = "FILE")]
@@ -134,14 +134,14 @@ impl ReplayArgs {
     /// A `--turn-calibration` file that cannot be read; a request the library refuses.
     pub fn request(&self) -> anyhow::Result<monitor_api::DiagnoseRequest> {
         let req = monitor_api::DiagnoseRequest {
-            options: monitor_replay::ReplayOptions {
+            options: monitor_api::replay::ReplayOptions {
                 angle_source: self.angle.into(),
                 residual_form: self.residuals.into(),
                 commission: self
                     .commission
-                    .map(monitor_replay::CommissionWindow::seconds),
+                    .map(monitor_api::replay::CommissionWindow::seconds),
                 load: self.load.into(),
-                turn_level: monitor_replay::TurnLevelOptions {
+                turn_level: monitor_api::replay::TurnLevelOptions {
                     parallel_paths: self.parallel_paths,
                     calibration: self
                         .turn_calibration
@@ -165,7 +165,7 @@ impl ReplayArgs {
 }
 
 /// `diagnose`'s defaults: the API request's, whose one home is the replay's options
-/// (`monitor_replay::ReplayOptions::default`).
+/// (`monitor_api::replay::ReplayOptions::default`).
 fn defaults() -> monitor_api::DiagnoseRequest {
     monitor_api::DiagnoseRequest::default()
 }
@@ -203,7 +203,7 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
 ///
 /// # Errors
 /// A file that cannot be read or is not a calibration, naming the file.
-fn read_calibration(f: &std::path::Path) -> anyhow::Result<monitor_replay::TurnCalibration> {
+fn read_calibration(f: &std::path::Path) -> anyhow::Result<monitor_api::replay::TurnCalibration> {
     let text = std::fs::read_to_string(f)
         .map_err(|e| anyhow::anyhow!("--turn-calibration {}: {e}", f.display()))?;
     serde_json::from_str(&text)

@@ -139,12 +139,12 @@ pub fn run(args: &HmiArgs) -> anyhow::Result<()> {
         // A log that cannot be opened is said as diagnose says it (its fields as flags).
         let replay = LogReplay::start_with(plan.params, log, plan.open, plan.options, speed)
             .map_err(|e| match e {
-                monitor_replay::ReplayError::Log(e) => anyhow::Error::new(e),
+                monitor_api::replay::ReplayError::Log(e) => anyhow::Error::new(e),
                 e => anyhow::Error::new(e),
             })?;
         Box::new(replay)
     } else if let Some(p) = &args.params {
-        let (p, _) = monitor_io::log::mapping::load_params(p)?;
+        let (p, _) = monitor_api::files::load_params(p)?;
         Box::new(LiveSim::new(
             p,
             monitor_studies::fault_signatures::Protocol::default().sample_rate_hz,

@@ -1,11 +1,11 @@
 //! `sim-host identify`: the T-equivalent circuit and the mechanics from a log of the
-//! healthy machine (`monitor_analysis::identify`), starting from a parameter file; the result
+//! healthy machine (`monitor_api::analysis::identify`), starting from a parameter file; the result
 //! written atomically, never over an input, nor over an existing file without `--force`.
 
 use super::output_guard::OutputGuard;
 use super::progress;
 use clap::Args;
-use monitor_analysis::identify::{self, Identification};
+use monitor_api::analysis::{identify, Identification};
 use std::io::Write;
 use std::path::PathBuf;
 

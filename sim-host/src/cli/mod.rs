@@ -155,20 +155,20 @@ pub enum LoadArg {
     Viscous,
 }
 
-impl From<LoadArg> for monitor_replay::LoadModel {
+impl From<LoadArg> for monitor_api::replay::LoadModel {
     fn from(a: LoadArg) -> Self {
         match a {
-            LoadArg::Unknown => monitor_replay::LoadModel::Unknown,
-            LoadArg::Viscous => monitor_replay::LoadModel::Viscous,
+            LoadArg::Unknown => monitor_api::replay::LoadModel::Unknown,
+            LoadArg::Viscous => monitor_api::replay::LoadModel::Viscous,
         }
     }
 }
 
-impl From<monitor_replay::LoadModel> for LoadArg {
-    fn from(a: monitor_replay::LoadModel) -> Self {
+impl From<monitor_api::replay::LoadModel> for LoadArg {
+    fn from(a: monitor_api::replay::LoadModel) -> Self {
         match a {
-            monitor_replay::LoadModel::Unknown => LoadArg::Unknown,
-            monitor_replay::LoadModel::Viscous => LoadArg::Viscous,
+            monitor_api::replay::LoadModel::Unknown => LoadArg::Unknown,
+            monitor_api::replay::LoadModel::Viscous => LoadArg::Viscous,
         }
     }
 }
@@ -210,7 +210,7 @@ pub fn parse_fault(s: &str) -> Result<Fault, String> {
 
 /// Parses an effect name of the library.
 pub fn parse_effect(s: &str) -> Result<EffectKind, String> {
-    monitor_analysis::parse_effect(s.trim()).map_err(|e| e.to_string())
+    monitor_api::analysis::parse_effect(s.trim()).map_err(|e| e.to_string())
 }
 
 /// A time on the command line [s]: a finite number >= 0 (negative values reach this
@@ -240,7 +240,7 @@ pub fn parse_positive_seconds(s: &str) -> Result<f64, String> {
 /// "writing PATH" with the I/O error.
 pub fn write_out(out: Option<&std::path::Path>, bytes: &[u8]) -> anyhow::Result<()> {
     if let Some(out) = out {
-        anyhow::Context::with_context(monitor_io::log::write_atomic(out, bytes), || {
+        anyhow::Context::with_context(monitor_api::files::write_atomic(out, bytes), || {
             format!("writing {}", out.display())
         })?;
     }

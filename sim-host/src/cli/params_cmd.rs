@@ -1,10 +1,10 @@
 //! `sim-host params ...`: commands that make a parameter file. `params from-nameplate`
-//! estimates one from a motor's nameplate (`monitor_io::nameplate`); the output is written
+//! estimates one from a motor's nameplate (the nameplate estimate of `monitor_api::files::Nameplate`); the output is written
 //! atomically and never over an existing file unless `--force`.
 
 use super::output_guard::OutputGuard;
 use clap::{Args, Subcommand, ValueEnum};
-use monitor_io::nameplate::{Connection, Nameplate, NemaDesign};
+use monitor_api::files::{Connection, Nameplate, NemaDesign};
 use std::io::Write;
 use std::path::PathBuf;
 

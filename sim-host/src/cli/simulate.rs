@@ -2,7 +2,7 @@
 //! measurement log (the CSV schema of `docs/design.md`) from a motor parameter file and a scenario
 //! (format: `monitor_sim`).
 //!
-//! The CSV is written atomically (`monitor_io::log::LogWriter`): a failed run, or one stopped by
+//! The CSV is written atomically (`monitor_api::files::LogWriter`): a failed run, or one stopped by
 //! SIGINT (Ctrl-C) or SIGTERM, removes its temporary file and leaves no output (exit status
 //! 130 / 143), and the output may not be one of the inputs. Before anything is written the
 //! run's size is estimated and a run beyond [`MAX_OUTPUT_BYTES`] or [`MAX_STEPS`] is refused
@@ -12,9 +12,9 @@
 use super::output_guard::OutputGuard;
 use super::{progress, render, Interruption};
 use clap::Args;
-use monitor_io::log::LogWriter;
-use monitor_io::params::ParamFile;
-use monitor_sim::{simulate_while, Scenario, Workload};
+use monitor_api::files::LogWriter;
+use monitor_api::files::ParamFile;
+use monitor_api::sim::{simulate_while, Scenario, Workload};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::time::Instant;

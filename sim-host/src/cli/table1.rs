@@ -3,7 +3,7 @@
 
 use super::{progress, render, AngleArg};
 use clap::Args;
-use monitor_io::params::ParamFile;
+use monitor_api::files::ParamFile;
 use monitor_studies::fault_signatures::{run_all, Protocol};
 use std::path::PathBuf;
 

@@ -2,10 +2,10 @@
 //! (`commission` -> `--commission 4:2`), and the library's typed values are parsed by the
 //! library's one parser, their refusals shown as clap shows a bad value.
 
-use monitor_api::ApiError;
-use monitor_replay::{
+use monitor_api::replay::{
     check_parallel_paths, CommissionWindow, OptionField, ReplayError, Spelling, TimelineStep, Words,
 };
+use monitor_api::ApiError;
 
 /// The command line's spelling of the library's fields: their flags.
 #[derive(Debug, Clone, Copy, Default)]
@@ -45,9 +45,9 @@ pub fn error_text(e: &(dyn std::error::Error + 'static)) -> String {
         e.spelled(&CliWords)
     } else if let Some(e) = e.downcast_ref::<ReplayError>() {
         e.spelled(&CliWords)
-    } else if let Some(e) = e.downcast_ref::<monitor_replay::OptionError>() {
+    } else if let Some(e) = e.downcast_ref::<monitor_api::replay::OptionError>() {
         e.spelled(&CliWords)
-    } else if let Some(e) = e.downcast_ref::<monitor_io::log::LogError>() {
+    } else if let Some(e) = e.downcast_ref::<monitor_api::files::LogError>() {
         e.spelled(&|name| CliWords.key(name))
     } else if let Some(monitor_store::HistoryError::Missing(p)) =
         e.downcast_ref::<monitor_store::HistoryError>()
@@ -60,12 +60,14 @@ pub fn error_text(e: &(dyn std::error::Error + 'static)) -> String {
 
 /// `--commission START:END`, by the library's one parser of a window.
 pub fn parse_window(s: &str) -> Result<CommissionWindow, String> {
-    s.parse().map_err(|e: monitor_replay::OptionError| e.why)
+    s.parse()
+        .map_err(|e: monitor_api::replay::OptionError| e.why)
 }
 
 /// `--timeline-step SECONDS`, by the library's one parser of a step (> 0, finite).
 pub fn parse_timeline_step(s: &str) -> Result<TimelineStep, String> {
-    s.parse().map_err(|e: monitor_replay::OptionError| e.why)
+    s.parse()
+        .map_err(|e: monitor_api::replay::OptionError| e.why)
 }
 
 /// `--parallel-paths N`: a whole number in the library's range (1..=8).
@@ -83,7 +85,7 @@ mod tests {
 
     #[test]
     fn fields_are_named_by_their_flags() {
-        let e = monitor_replay::CommissionWindow::new(4.0, 2.0).unwrap_err();
+        let e = monitor_api::replay::CommissionWindow::new(4.0, 2.0).unwrap_err();
         assert_eq!(
             e.spelled(&CliWords),
             "--commission 4:2: the window must be START:END with 0 <= START < END, both finite (seconds)"

@@ -4,16 +4,16 @@
 //! core row by row, with the paper's switches: each Table 1 fault on and off, load and
 //! supply steps, commissioning.
 //!
-//! The simulator ([`monitor_sim::simulate_interactive`]) and the monitor run on a worker
+//! The simulator ([`monitor_api::sim::simulate_interactive`]) and the monitor run on a worker
 //! thread that advances exactly as many rows as [`LiveSim::run_for`] asks and answers
 //! with the readings ([`Snapshot`], every [`SNAPSHOT_EVERY_S`] of simulated time): the
 //! simulation is deterministic whatever the screen's pace, and tests drive it directly.
 
 use super::{quit_key, Controls, HmiState, Key, LiveControls, Snapshot, Source, SNAPSHOT_EVERY_S};
+use monitor_api::files::ParamFile;
+use monitor_api::replay::{Replay, ReplayOptions};
+use monitor_api::sim::{simulate_interactive, FaultSpec, LoadStep, ScenarioEvent, SupplyStep};
 use monitor_core::{CommissioningState, Fault, RunStage};
-use monitor_io::params::ParamFile;
-use monitor_replay::{Replay, ReplayOptions};
-use monitor_sim::{simulate_interactive, FaultSpec, LoadStep, ScenarioEvent, SupplyStep};
 use monitor_studies::fault_signatures::{scenario, Protocol};
 use std::ops::ControlFlow;
 use std::sync::mpsc::{channel, Receiver, Sender};
@@ -55,7 +55,7 @@ pub struct LiveSim {
     sample_rate_hz: f64,
     tx: Option<Sender<LiveCommand>>,
     rx: Receiver<Reply>,
-    worker: Option<JoinHandle<Result<(), monitor_sim::SimError>>>,
+    worker: Option<JoinHandle<Result<(), monitor_api::sim::SimError>>>,
     /// Simulated time [s] so far.
     t_s: f64,
     controls: LiveControls,
@@ -89,14 +89,14 @@ impl LiveSim {
         // The replay's monitor and isolation, fed row by row; its timeline is not kept (a
         // live run has no end), commissioning starts on the `c` key.
         let opts = ReplayOptions {
-            timeline_step: monitor_replay::TimelineStep::NONE,
+            timeline_step: monitor_api::replay::TimelineStep::NONE,
             // The load is an unknown input, as `diagnose` reads it by default: a load step
             // (`+`, `-`, the paper's Bl switch) is the load's move, the amber state, never a
             // FAULT (the simulated load itself is the paper's viscous one).
-            load: monitor_replay::LoadModel::Unknown,
+            load: monitor_api::replay::LoadModel::Unknown,
             ..ReplayOptions::default()
         };
-        let channels = monitor_sim::SensorSpec::default().channels();
+        let channels = monitor_api::sim::SensorSpec::default().channels();
         let replay = Replay::new(&params, channels, sample_rate_hz, opts)?;
         let (tx, cmd_rx) = channel();
         let (reply_tx, rx) = channel();
@@ -308,9 +308,9 @@ struct Worker {
 impl Worker {
     fn run(
         mut self,
-        sc: &monitor_sim::Scenario,
+        sc: &monitor_api::sim::Scenario,
         rx: &Receiver<LiveCommand>,
-    ) -> Result<(), monitor_sim::SimError> {
+    ) -> Result<(), monitor_api::sim::SimError> {
         let params = self.params;
         simulate_interactive(&params, sc, |row, events| {
             if self.wait_for_work(rx, events).is_break() {

@@ -1,6 +1,6 @@
 //! A log replayed on the HMI (`sim-host hmi LOG --params P`): the log goes through the
 //! one reader, the data-quality stage and the core exactly as `diagnose` replays it
-//! ([`monitor_replay::diagnose_file_observed`]), on a worker thread that keeps a reading
+//! ([`monitor_api::replay::diagnose_file_observed`]), on a worker thread that keeps a reading
 //! every [`SNAPSHOT_EVERY_S`] of log time; the screen plays those readings back at 1x,
 //! 10x or as fast as they come, with pause and seek. The data-quality warnings and the
 //! verdict appear when the whole log is analysed.
@@ -9,10 +9,12 @@ use super::{
     quit_key, Controls, HmiState, Key, PlaybackControls, Snapshot, Source, Speed, HISTORY_S,
     SNAPSHOT_EVERY_S,
 };
+use monitor_api::files::ParamFile;
+use monitor_api::files::{LogFile, OpenOptions, Row};
+use monitor_api::replay::{
+    diagnose_file_observed, Replay, ReplayError, ReplayObserver, ReplayOptions,
+};
 use monitor_core::MonitorOutput;
-use monitor_io::log::{LogFile, OpenOptions, Row};
-use monitor_io::params::ParamFile;
-use monitor_replay::{diagnose_file_observed, Replay, ReplayError, ReplayObserver, ReplayOptions};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::thread::JoinHandle;
@@ -165,7 +167,7 @@ fn analyse(
             a.verdict = v;
             a.verdict_line = Some(r.verdict_line.clone());
         }
-        Err(e) => a.error = Some(monitor_io::one_line(&e.spelled(&*opts.words))),
+        Err(e) => a.error = Some(monitor_api::files::one_line(&e.spelled(&*opts.words))),
     }
 }
 

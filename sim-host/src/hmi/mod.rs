@@ -6,7 +6,7 @@
 //!   Table 1 fault on and off (the paper's `Enable_F_*` switches), step the load and the
 //!   supply, and start commissioning;
 //! - [`log_replay::LogReplay`]: a log replayed through the data-quality stage and the core
-//!   ([`monitor_replay::diagnose_file_observed`], the one reader: every format the reader
+//!   ([`monitor_api::replay::diagnose_file_observed`], the one reader: every format the reader
 //!   takes), played back at 1x, 10x or as fast as it is analysed, with pause and seek;
 //! - [`status_line::StdinStatus`]: the firmware's defmt status lines
 //!   (`cargo fw-run | sim-host hmi --stdin`), parsed by [`status_line::parse`].
@@ -23,11 +23,11 @@ pub use keys::{
     fault_key, fault_of_key, key_help, keys, Key, KeyBinding, KeyScope, FAULT_KEY_CHARS,
 };
 
+use monitor_api::files::ParamFile;
+use monitor_api::replay::{FaultCandidate, IsolationName, IsolationReport, Replay};
 use monitor_core::sequence::min_shorted_fraction;
 use monitor_core::verdict::Verdict;
 use monitor_core::{Fault, IsolationState, MonitorOutput, Phase};
-use monitor_io::params::ParamFile;
-use monitor_replay::{FaultCandidate, IsolationName, IsolationReport, Replay};
 use monitor_studies::demo::MonitorState;
 use std::collections::VecDeque;
 
@@ -65,7 +65,7 @@ pub struct Snapshot {
     /// source makes the call.
     pub fault_lamp: bool,
     /// The decision table's verdict at this moment (`monitor_core::verdict`): a replay's
-    /// panel ([`monitor_replay::Replay::panel`]), the board's `call=`; `None` where the source
+    /// panel ([`monitor_api::replay::Replay::panel`]), the board's `call=`; `None` where the source
     /// gives none (the FAULT lamp is then the lamps' detection).
     pub call: Option<Verdict>,
     /// Threshold band of each residual in force, (centre, half-width).
@@ -95,7 +95,7 @@ pub struct Snapshot {
     pub isolation: Option<IsolationView>,
 }
 
-/// The isolation's conclusion as the screen shows it ([`monitor_replay::IsolationReport`]).
+/// The isolation's conclusion as the screen shows it ([`monitor_api::replay::IsolationReport`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct IsolationView {
     /// The conclusion.

@@ -9,10 +9,10 @@
 //! `ERROR`) become events on the screen.
 
 use super::{quit_key, Controls, HmiState, Key, Snapshot, Source, StdinControls};
+use monitor_api::replay::{FaultCandidate, IsolationName};
 use monitor_core::status_line::StatusReading;
 use monitor_core::verdict::Verdict;
 use monitor_core::{Fault, IsolationState};
-use monitor_replay::{FaultCandidate, IsolationName};
 use monitor_studies::demo::MonitorState;
 use std::io::BufRead;
 use std::sync::mpsc::{channel, Receiver, TryRecvError};

@@ -1,8 +1,8 @@
 //! The benchmarks' text tables: `bench`'s figures and detection limits, and
 //! `bench --isolation`'s summaries and confusion matrix.
 
+use monitor_api::replay::{angle_source_name, state_name, IsolationName};
 use monitor_core::Fault;
-use monitor_replay::{angle_source_name, state_name, IsolationName};
 use monitor_studies::bench::isolation::{
     CaseOutcome, CaseResult, IsolationBench, IsolationConfusion,
 };

@@ -1,11 +1,11 @@
 //! The chart sets of `compare` and `explain` (drawn and written by [`super::plot`]).
 
 use super::plot::{self, Chart, Series};
-use monitor_analysis::compare::CompareOutput;
-use monitor_analysis::explain::ladder::{LadderReport, FLOOR_BAND};
-use monitor_analysis::metrics::{self, WorstWindow};
-use monitor_analysis::prep::Prepared;
-use monitor_analysis::simplified_model::Prediction;
+use monitor_api::analysis::CompareOutput;
+use monitor_api::analysis::Prediction;
+use monitor_api::analysis::Prepared;
+use monitor_api::analysis::{metrics, WorstWindow};
+use monitor_api::analysis::{LadderReport, FLOOR_BAND};
 
 /// The charts `compare` writes (file stems; each as `.svg` and `.png`; the zoomed panels
 /// only for a log long enough to be drawn as envelopes, a scatter only where the log spans

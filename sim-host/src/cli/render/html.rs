@@ -5,13 +5,13 @@
 //! the PNG copies sit beside it for slides and tickets. Every file is written atomically.
 
 use super::{charts, plot};
-use monitor_analysis::compare::{CompareOutput, CompareReport};
-use monitor_analysis::explain::ladder::LadderReport;
-use monitor_analysis::simplified_model::Prediction;
-use monitor_analysis::Analysis;
+use monitor_api::analysis::Analysis;
+use monitor_api::analysis::LadderReport;
+use monitor_api::analysis::Prediction;
+use monitor_api::analysis::{CompareOutput, CompareReport};
+use monitor_api::files::DataQuality;
 use monitor_api::ExplainDocument;
 use monitor_core::EffectKind;
-use monitor_io::log::quality::DataQuality;
 use plot::Chart;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -53,7 +53,7 @@ fn write_outputs(
     if let Some(dir) = report {
         let svgs = write_charts(dir, &charts)?;
         let path = dir.join(REPORT_FILE);
-        monitor_io::log::write_atomic(&path, page(&svgs).as_bytes())
+        monitor_api::files::write_atomic(&path, page(&svgs).as_bytes())
             .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
         // Not eprintln!: a closed stderr must not panic after the report is written.
         let _ = std::io::Write::write_all(

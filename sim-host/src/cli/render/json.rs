@@ -1,9 +1,9 @@
 //! The JSON renderer: every command's `--json` document, printed the one way.
 
-use monitor_analysis::compare::CompareReport;
-use monitor_analysis::explain::ExplainReport;
-use monitor_replay::{FaultCandidate, TimelinePoint};
-use monitor_sim::SimSummary;
+use monitor_api::analysis::CompareReport;
+use monitor_api::analysis::ExplainReport;
+use monitor_api::replay::{FaultCandidate, TimelinePoint};
+use monitor_api::sim::SimSummary;
 use monitor_studies::bench::{BenchFigures, DetectionLimitCase};
 use monitor_studies::demo::DemoRun;
 use monitor_studies::fault_signatures::Table1Row;
@@ -35,12 +35,12 @@ pub struct DemoReport<'a> {
     /// Seconds from the fault to the first red FAULT state, null when none came.
     detected_after_s: Option<f64>,
     /// The isolation's events (load moves and names, with times).
-    events: &'a [monitor_replay::IsolationEvent],
-    verdict: monitor_replay::Verdict,
+    events: &'a [monitor_api::replay::IsolationEvent],
+    verdict: monitor_api::replay::Verdict,
     /// The verdict's line, as `diagnose` prints it.
     verdict_line: &'a str,
     /// The finding the verdict rests on.
-    verdict_finding: Option<&'a monitor_replay::FindingReport>,
+    verdict_finding: Option<&'a monitor_api::replay::FindingReport>,
     named: &'a [FaultCandidate],
     correct_fault_among_candidates: bool,
     lamps: &'a BTreeMap<String, bool>,
@@ -107,7 +107,7 @@ impl Table1Report {
         let matches_paper = rows.iter().filter(|r| r.signature == r.paper).count();
         Table1Report {
             motor,
-            angle_source: monitor_replay::angle_source_name(angle).into(),
+            angle_source: monitor_api::replay::angle_source_name(angle).into(),
             rows,
             matches_paper,
         }

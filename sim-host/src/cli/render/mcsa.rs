@@ -2,7 +2,7 @@
 //! the current spectrum around the fundamental with the (1 -/+ 2s) f sidebands marked.
 
 use super::plot::{self, Chart, Series};
-use monitor_analysis::rotor_asymmetry::McsaReport;
+use monitor_api::analysis::McsaReport;
 
 /// File stem of the spectrum chart `explain --plot DIR` writes.
 pub const CHART: &str = "mcsa_spectrum";

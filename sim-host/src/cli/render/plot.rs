@@ -293,7 +293,7 @@ fn png(path: &Path, c: &Chart, text: bool) -> Result<(), String> {
 pub fn write(dir: &Path, c: &Chart) -> Result<(String, Vec<PathBuf>), String> {
     let svg = svg_string(c)?;
     let svg_path = dir.join(format!("{}.svg", c.stem));
-    monitor_io::log::write_atomic(&svg_path, svg.as_bytes())
+    monitor_api::files::write_atomic(&svg_path, svg.as_bytes())
         .map_err(|e| format!("{}: {e}", svg_path.display()))?;
     let png_path = dir.join(format!("{}.png", c.stem));
     let tmp = png_staging_file(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
@@ -305,7 +305,7 @@ pub fn write(dir: &Path, c: &Chart) -> Result<(String, Vec<PathBuf>), String> {
 
 /// The PNG's temporary file in `dir`: a random name created exclusively (it can never be an
 /// existing file, so never an input), the mode of any new file (0o666 less the umask, as
-/// `monitor_io::log::write_atomic` gives the SVG), deleted when drawing fails.
+/// `monitor_api::files::write_atomic` gives the SVG), deleted when drawing fails.
 fn png_staging_file(dir: &Path) -> std::io::Result<tempfile::NamedTempFile> {
     let mut b = tempfile::Builder::new();
     // The image encoder picks the format from the extension.
@@ -373,7 +373,7 @@ fn confusion_panel(
         .caption(
             format!(
                 "isolation bench, angle mode {}",
-                monitor_replay::angle_source_name(m.mode)
+                monitor_api::replay::angle_source_name(m.mode)
             ),
             ("sans-serif", 18),
         )

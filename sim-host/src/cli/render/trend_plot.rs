@@ -93,7 +93,7 @@ pub fn write(path: &Path, motors: &[MotorTrend], opts: &TrendOptions) -> Result<
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
         draw(root, &shown, opts)?;
     }
-    monitor_io::log::write_atomic(path, svg.as_bytes()).map_err(|e| e.to_string())
+    monitor_api::files::write_atomic(path, svg.as_bytes()).map_err(|e| e.to_string())
 }
 
 fn draw<DB: DrawingBackend>(

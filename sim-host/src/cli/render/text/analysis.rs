@@ -2,9 +2,9 @@
 
 use super::diagnose::data_quality;
 use super::number;
-use monitor_analysis::compare::CompareReport;
-use monitor_analysis::explain::ladder::LadderReport;
-use monitor_analysis::explain::{ExplainReport, Standing, EXPLAINS_MIN};
+use monitor_api::analysis::CompareReport;
+use monitor_api::analysis::LadderReport;
+use monitor_api::analysis::{ExplainReport, Standing, EXPLAINS_MIN};
 use monitor_api::ExplainDocument;
 use std::io::Write;
 use std::path::Path;
@@ -295,7 +295,7 @@ pub fn ladder(
 }
 
 /// One step's row of the ladder's table (`k`: its number).
-fn ladder_row(k: usize, s: &monitor_analysis::explain::ladder::LadderStep) -> String {
+fn ladder_row(k: usize, s: &monitor_api::analysis::LadderStep) -> String {
     let fitted: Vec<String> = s
         .fitted
         .iter()
@@ -338,5 +338,5 @@ fn times(r: f64) -> String {
 
 /// A value with four significant digits, in plain or scientific notation by its size.
 fn sig(x: f64) -> String {
-    monitor_analysis::effects::sig(x)
+    monitor_api::analysis::sig(x)
 }

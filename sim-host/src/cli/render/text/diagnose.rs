@@ -2,18 +2,18 @@
 //! commissioning, the data quality and the verdict (also the demo's).
 
 use super::{candidate_list, lamp, panel_text};
-use monitor_core::Phase;
-use monitor_io::log::quality::DataQuality;
-use monitor_replay::{
+use monitor_api::files::DataQuality;
+use monitor_api::replay::{
     angle_source_name, describe_against, Against, CommissioningReport, DiagnoseReport, Diagnosed,
 };
+use monitor_core::Phase;
 use monitor_studies::demo::MonitorState;
 use std::io::Write;
 use std::path::Path;
 
 /// The temperature channel's line (`None` for a log without the column): the reading and
 /// the rise the isolation compensates Rs and Rr with, or why the channel is not used.
-fn temperature_line(t: &monitor_replay::TemperatureReport) -> Option<String> {
+fn temperature_line(t: &monitor_api::replay::TemperatureReport) -> Option<String> {
     let status = t.temperature_channel.as_deref()?;
     let reading = t
         .winding_temperature_c
@@ -45,7 +45,7 @@ fn findings_block(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<
             format!(
                 " (confidence {:.2}; {})",
                 n.confidence,
-                monitor_replay::verdict::against_text(f.source(), f.finding.against)
+                monitor_api::replay::against_text(f.source(), f.finding.against)
             )
         });
         writeln!(
@@ -171,11 +171,11 @@ fn findings(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
 }
 
 /// The healthy verdict's detection limits in a line (none without them).
-fn detection_limits_line(limits: &[monitor_replay::DetectionLimit]) -> Option<String> {
+fn detection_limits_line(limits: &[monitor_api::replay::DetectionLimit]) -> Option<String> {
     (!limits.is_empty()).then(|| {
         format!(
             "  smallest changes the isolation detects at the commissioned point (smaller ones pass as healthy; a FAULT also needs {:.0} %): {}",
-            100.0 * monitor_replay::MIN_FAULT_CHANGE,
+            100.0 * monitor_api::replay::MIN_FAULT_CHANGE,
             limits
                 .iter()
                 .map(|l| format!("{} {}", l.fault.name(), limit_pct(l.change)))
@@ -199,12 +199,12 @@ fn limit_pct(change: f32) -> String {
 }
 
 /// Segments of the negative sequence the text report lists (the JSON has up to
-/// `monitor_replay::winding::MAX_SEGMENTS`).
+/// the replay's own limit of segments).
 const SEGMENTS_LISTED: usize = 8;
 
 /// The negative-sequence analysis: the whole log's ratio and phase, its steady stretches,
 /// and the winding's judgement in a sentence.
-fn unbalance(out: &mut impl Write, u: &monitor_replay::UnbalanceReport) -> anyhow::Result<()> {
+fn unbalance(out: &mut impl Write, u: &monitor_api::replay::UnbalanceReport) -> anyhow::Result<()> {
     writeln!(
         out,
         "unbalance: |I2|/|I1| = {:.2} %, suspect phase: {}",
@@ -261,7 +261,10 @@ fn unbalance(out: &mut impl Write, u: &monitor_replay::UnbalanceReport) -> anyho
 }
 
 /// How many turns are shorted, and the model's own estimate where a calibration gave it.
-fn shorted_turns(out: &mut impl Write, u: &monitor_replay::UnbalanceReport) -> anyhow::Result<()> {
+fn shorted_turns(
+    out: &mut impl Write,
+    u: &monitor_api::replay::UnbalanceReport,
+) -> anyhow::Result<()> {
     if let Some(t) = &u.shorted_turns {
         writeln!(out, "  {}", t.sentence())?;
     }
@@ -275,7 +278,7 @@ fn shorted_turns(out: &mut impl Write, u: &monitor_replay::UnbalanceReport) -> a
 
 /// The steady stretches of the negative sequence (the first [`SEGMENTS_LISTED`]), the
 /// judged one marked.
-fn stretches(out: &mut impl Write, u: &monitor_replay::UnbalanceReport) -> anyhow::Result<()> {
+fn stretches(out: &mut impl Write, u: &monitor_api::replay::UnbalanceReport) -> anyhow::Result<()> {
     writeln!(out, "  steady stretches (least-squares phasors):")?;
     for (k, s) in u.segments.iter().enumerate().take(SEGMENTS_LISTED) {
         writeln!(
@@ -304,13 +307,13 @@ fn stretches(out: &mut impl Write, u: &monitor_replay::UnbalanceReport) -> anyho
 }
 
 /// Most load moves the text report lists (every name is listed; `--json` has up to
-/// [`monitor_replay::MAX_EVENTS`] events).
+/// [`monitor_api::replay::MAX_EVENTS`] events).
 const LOAD_MOVES_LISTED: usize = 10;
 
 /// The isolation's events with their times: every name, and the first
 /// [`LOAD_MOVES_LISTED`] load moves.
-fn events(out: &mut impl Write, iso: &monitor_replay::IsolationReport) -> anyhow::Result<()> {
-    use monitor_replay::IsolationEvent;
+fn events(out: &mut impl Write, iso: &monitor_api::replay::IsolationReport) -> anyhow::Result<()> {
+    use monitor_api::replay::IsolationEvent;
     if iso.events.is_empty() {
         return Ok(());
     }
@@ -355,7 +358,7 @@ pub(super) fn data_quality(out: &mut impl Write, q: &DataQuality) -> anyhow::Res
 /// What `diagnose` did about its thresholds.
 fn commissioning(out: &mut impl Write, c: &CommissioningReport) -> anyhow::Result<()> {
     writeln!(out, "thresholds: {}", c.thresholds)?;
-    if c.state == monitor_replay::CommissioningOutcome::Learned {
+    if c.state == monitor_api::replay::CommissioningOutcome::Learned {
         let span = |s: Option<[f32; 2]>, u: &str| {
             s.map(|[a, b]| format!("{a:.1}..{b:.1} {u}"))
                 .unwrap_or_else(|| "-".into())

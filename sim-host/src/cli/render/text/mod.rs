@@ -10,10 +10,10 @@ pub use diagnose::diagnose;
 
 use super::json::{Converted, Table1Report};
 use diagnose::verdict;
+use monitor_api::files::DataQuality;
+use monitor_api::replay::{state_name, IsolationName, Panel};
+use monitor_api::sim::SimSummary;
 use monitor_core::IsolationState;
-use monitor_io::log::quality::DataQuality;
-use monitor_replay::{state_name, IsolationName, Panel};
-use monitor_sim::SimSummary;
 use monitor_studies::demo::{DemoRun, MonitorState};
 use sim_host::hmi::IsolationView;
 use std::io::Write;
@@ -88,7 +88,7 @@ fn demo_story(out: &mut impl Write, run: &DemoRun) -> anyhow::Result<()> {
 /// the isolation, and a note on the friction class.
 fn demo_conclusion(out: &mut impl Write, run: &DemoRun) -> anyhow::Result<()> {
     for e in &run.report.isolation.events {
-        if matches!(e, monitor_replay::IsolationEvent::LoadMoved { .. }) {
+        if matches!(e, monitor_api::replay::IsolationEvent::LoadMoved { .. }) {
             writeln!(out, "event: {} (not a fault)", e.line().trim())?;
         }
     }
@@ -127,7 +127,7 @@ fn demo_conclusion(out: &mut impl Write, run: &DemoRun) -> anyhow::Result<()> {
 }
 
 /// Candidates as `rr p 0.76 (rr +50 %), speed_sensor p 0.24 (speed_sensor -2 %)`, or `none`.
-fn candidate_list(c: &[monitor_replay::FaultCandidate]) -> String {
+fn candidate_list(c: &[monitor_api::replay::FaultCandidate]) -> String {
     if c.is_empty() {
         return "none".into();
     }

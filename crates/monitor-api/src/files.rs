@@ -1,0 +1,15 @@
+//! The files a front end reads and writes, from `monitor-io`: logs (CSV, TDMS, Parquet;
+//! [`LogFile`], [`LogWriter`], the `[columns]` table [`ColumnMapping`]), parameter files
+//! ([`ParamFile`]), the nameplate estimate ([`Nameplate`]) and the atomic write every output
+//! goes through ([`write_atomic`]). The command line and the HMI reach them here, not in
+//! `monitor-io` itself: this list is what a front end may use.
+
+pub use monitor_io::log::mapping::load_params;
+pub use monitor_io::log::quality::DataQuality;
+pub use monitor_io::log::{
+    write_atomic, Channels, ColumnMapping, Format, LogError, LogFile, LogWriter, MemoryLog,
+    MemoryValues, OpenOptions, Row, RowSink,
+};
+pub use monitor_io::nameplate::{Connection, Nameplate, NemaDesign};
+pub use monitor_io::one_line;
+pub use monitor_io::params::ParamFile;
