@@ -79,6 +79,12 @@ pub struct DiagnoseArgs {
     /// Print one JSON document on stdout instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// Also write the report a crew prints and a planner files: one self-contained HTML
+    /// page (the verdict, the findings, the residuals, lamps and state over time with the
+    /// events marked, the negative sequence, the rotor's sidebands, the data quality),
+    /// written atomically; never over an input.
+    #[arg(long, value_name = "R.html")]
+    pub report: Option<PathBuf>,
 }
 
 /// The options a log is replayed with, the same for `diagnose` and the HMI's log replay
@@ -180,6 +186,12 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
     req.options.allow_incomplete = args.allow_incomplete;
     req.options.timeline_step = args.timeline_step;
     req.validate()?;
+    if let Some(out) = &args.report {
+        let mut inputs = vec![args.params.as_path(), args.log.as_path()];
+        inputs.extend(args.replay.baseline.iter().map(PathBuf::as_path));
+        inputs.extend(args.replay.turn_calibration.as_deref());
+        super::output_guard::OutputGuard::new(&inputs).check_files(&[out])?;
+    }
     let big = std::fs::metadata(&args.log)
         .map(|m| m.len() > 20_000_000)
         .unwrap_or(false);
@@ -192,6 +204,9 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
     )?;
     bar.finish_and_clear();
     render::text::quality_warnings(&d.report.data_quality);
+    if let Some(out) = &args.report {
+        render::diagnose_html::write(out, &args.log, &d)?;
+    }
     if args.json {
         render::json::print(&mut crate::cli::stdout(), &d.report)
     } else {

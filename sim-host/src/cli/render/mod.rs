@@ -1,11 +1,12 @@
 //! One renderer per output format, as a CLI tool keeps its exporters: [`text`] (the human
 //! tables; [`bench_text`] the benchmarks'), [`json`] (one document), [`html`] (the report
-//! page and the chart files), with the chart sets in [`charts`] drawn by [`plot`]; [`hmi`]
+//! page and the chart files; [`diagnose_html`] `diagnose`'s page), with the chart sets in [`charts`] drawn by [`plot`]; [`hmi`]
 //! draws the live HMI's screen. The text and JSON renderers write to the writer they are
 //! given (the commands pass [`crate::cli::stdout`]; a test can pass a `Vec<u8>`).
 
 pub mod bench_text;
 pub mod charts;
+pub mod diagnose_html;
 pub mod hmi;
 pub mod html;
 pub mod json;

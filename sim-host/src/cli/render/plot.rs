@@ -251,25 +251,57 @@ where
                 .legend(move |(x, y)| Circle::new((x + 10, y), 4, col.filled()));
         }
     } else if s.dashed {
+        let mut runs = runs(&s.points, log_y).into_iter();
+        let first = runs.next().unwrap_or_default();
         let a = chart
-            .draw_series(DashedLineSeries::new(pts, 6, 4, col.stroke_width(2)))
+            .draw_series(DashedLineSeries::new(first, 6, 4, col.stroke_width(2)))
             .map_err(e)?;
         if text {
             a.label(s.label.clone()).legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 8, y)], col.stroke_width(2))
             });
         }
+        for r in runs {
+            chart
+                .draw_series(DashedLineSeries::new(r, 6, 4, col.stroke_width(2)))
+                .map_err(e)?;
+        }
     } else {
+        let mut runs = runs(&s.points, log_y).into_iter();
+        let first = runs.next().unwrap_or_default();
         let a = chart
-            .draw_series(LineSeries::new(pts, col.stroke_width(1)))
+            .draw_series(LineSeries::new(first, col.stroke_width(1)))
             .map_err(e)?;
         if text {
             a.label(s.label.clone()).legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2))
             });
         }
+        for r in runs {
+            chart
+                .draw_series(LineSeries::new(r, col.stroke_width(1)))
+                .map_err(e)?;
+        }
     }
     Ok(())
+}
+
+/// The runs of drawable points of a line: a point that is not finite (or not positive on
+/// a logarithmic axis) lifts the pen, so a series can hold several strokes (the event
+/// markers of `diagnose --report`).
+fn runs(points: &[(f64, f64)], log_y: bool) -> Vec<Vec<(f64, f64)>> {
+    let mut out = vec![Vec::new()];
+    for &p in points {
+        if p.0.is_finite() && p.1.is_finite() && (!log_y || p.1 > 0.0) {
+            if let Some(last) = out.last_mut() {
+                last.push(p);
+            }
+        } else if out.last().is_some_and(|r| !r.is_empty()) {
+            out.push(Vec::new());
+        }
+    }
+    out.retain(|r| !r.is_empty());
+    out
 }
 
 /// Renders the chart as SVG text (with labels).

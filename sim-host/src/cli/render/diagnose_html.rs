@@ -1,0 +1,394 @@
+//! `diagnose --report R.html`: the one page a crew prints and a planner files.
+//!
+//! What it holds, top to bottom: the verdict and what it was judged against; the findings
+//! table (one row per analysis, its state and sentence); the residuals and the lamps over
+//! time with the events marked (load moves, faults named, first detections); the negative
+//! sequence over time with the named phase; the rotor's sidebands against the severity
+//! bands; the data quality. Charts are inline SVG drawn with plotters ([`super::plot`]),
+//! so the page is one self-contained file; tables wrap their text, and the page is laid
+//! out for an A4 sheet and a phone's width alike (the charts scale to the page's width).
+//! The file is written atomically ([`monitor_api::files::write_atomic`]).
+
+use super::plot::{self, Chart, Series};
+use monitor_api::replay::{DiagnoseReport, Diagnosed, IsolationEvent, RotorBand};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Writes the report of `d` (the log `log`) to `path`, atomically.
+///
+/// # Errors
+/// A chart that cannot be drawn, or a file that cannot be written (naming it).
+pub fn write(path: &Path, log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
+    let mut svgs = Vec::new();
+    for c in charts(&d.report) {
+        let body = match &c.omitted {
+            Some(why) => format!("<p><i>{}</i></p>", esc(why)),
+            None => plot::svg_string(&c).map_err(anyhow::Error::msg)?,
+        };
+        svgs.push((c.title.to_string(), body));
+    }
+    let html = page(&log.display().to_string(), d, &svgs);
+    monitor_api::files::write_atomic(path, html.as_bytes())
+        .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
+    // Not eprintln!: a closed stderr must not panic after the report is written.
+    let _ = std::io::Write::write_all(
+        &mut std::io::stderr(),
+        format!("report: {}\n", path.display()).as_bytes(),
+    );
+    Ok(())
+}
+
+/// The page's style: readable on paper (A4, 12 mm margins) and on a phone; charts scale to
+/// the width; long words and numbers in tables wrap instead of running off the page.
+const STYLE: &str = "body{font-family:sans-serif;max-width:1000px;margin:1em auto;padding:0 .6em;color:#222;line-height:1.35}\
+h1{font-size:1.4em}h2{font-size:1.15em;margin-top:1.4em;border-bottom:1px solid #ccc}\
+table{border-collapse:collapse;margin:.6em 0;width:100%;table-layout:auto}\
+td,th{border:1px solid #bbb;padding:3px 6px;text-align:left;vertical-align:top;overflow-wrap:anywhere}\
+td.k{overflow-wrap:normal;white-space:nowrap;font-size:.9em}\
+th{background:#eee}svg{max-width:100%;height:auto;display:block}\
+.v{font-size:1.15em;padding:.6em;border-left:6px solid #888;background:#f4f4f4}\
+.fault{border-color:#c22;background:#fbeaea}.watching{border-color:#c90;background:#fbf4e0}\
+.healthy{border-color:#2a2;background:#eaf6ea}.could_not_judge{border-color:#888}\
+code{overflow-wrap:anywhere}ul{padding-left:1.2em}\
+@media print{body{max-width:none;margin:0}h2{break-after:avoid}svg,table,tr{break-inside:avoid}}\
+@page{size:A4;margin:12mm}";
+
+/// The page (module docs), with the charts as (title, inline SVG or why not drawn).
+fn page(log: &str, d: &Diagnosed, charts: &[(String, String)]) -> String {
+    let rep = &d.report;
+    let mut h = String::new();
+    let _ = write!(h, "<!doctype html><html lang=en><head><meta charset=utf-8><meta name=viewport content=\"width=device-width,initial-scale=1\"><title>diagnose: {}</title><style>{STYLE}</style></head><body>", esc(log));
+    let _ = write!(
+        h,
+        "<h1>Drive monitor: diagnosis</h1><p>Log <code>{}</code>: {} rows at {:.0} Hz; frame angle: {}.</p>",
+        esc(log),
+        rep.rows,
+        d.sample_rate_hz,
+        monitor_api::replay::angle_source_name(rep.angle_source)
+    );
+    verdict(&mut h, rep);
+    findings_table(&mut h, rep);
+    for (title, svg) in charts {
+        let _ = write!(h, "<h2>{}</h2>{svg}", esc(title));
+    }
+    events_list(&mut h, rep);
+    winding(&mut h, rep);
+    if rep.rotor.judged {
+        let _ = write!(h, "<h2>Rotor</h2><p>{}</p>", esc(&rep.rotor.sentence));
+    }
+    quality(&mut h, rep);
+    h.push_str("<p><small>Written by <code>sim-host diagnose --report</code>; the same verdict as <code>diagnose</code>'s text and <code>--json</code>.</small></p></body></html>");
+    h
+}
+
+/// The verdict line, what was judged against what, and what was not judged.
+fn verdict(h: &mut String, rep: &DiagnoseReport) {
+    let class = serde_json::to_value(rep.verdict)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_default();
+    let _ = write!(
+        h,
+        "<p class=\"v {}\"><b>verdict: {}</b></p>",
+        esc(&class),
+        esc(&rep.verdict_line)
+    );
+    list(h, "Judged", &rep.judged);
+    list(h, "Not judged", &rep.not_judged);
+    list(h, "Why the verdict is withheld", &rep.verdict_withheld_because);
+}
+
+/// A titled list of sentences (nothing when empty).
+fn list(h: &mut String, title: &str, items: &[String]) {
+    if items.is_empty() {
+        return;
+    }
+    let _ = write!(h, "<p><b>{}</b></p><ul>", esc(title));
+    for s in items {
+        let _ = write!(h, "<li>{}</li>", esc(s));
+    }
+    h.push_str("</ul>");
+}
+
+/// One row per analysis: its name, state and sentence (with the named fault's confidence).
+fn findings_table(h: &mut String, rep: &DiagnoseReport) {
+    h.push_str("<h2>Findings</h2><table><tr><th>analysis</th><th>state</th><th>finding</th></tr>");
+    for f in &rep.findings {
+        let named = f.named().map_or(String::new(), |n| {
+            format!(
+                " (confidence {:.2}; {})",
+                n.confidence,
+                monitor_api::replay::against_text(f.source(), f.finding.against)
+            )
+        });
+        let _ = write!(
+            h,
+            "<tr><td class=k>{}</td><td class=k>{}</td><td>{}{}</td></tr>",
+            esc(f.source().name()),
+            esc(f.state_name()),
+            esc(&f.summary),
+            esc(&named)
+        );
+    }
+    h.push_str("</table>");
+}
+
+/// The isolation's events and the first detections, with their times.
+fn events_list(h: &mut String, rep: &DiagnoseReport) {
+    let mut lines: Vec<(f64, String)> = rep
+        .isolation
+        .events
+        .iter()
+        .map(|e| (e.t_s(), e.line().trim().to_string()))
+        .collect();
+    lines.extend(rep.detections.iter().map(|d| {
+        (
+            d.t_s,
+            format!("{:.2} s  lamps first named {}", d.t_s, d.fault.name()),
+        )
+    }));
+    lines.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let lines: Vec<String> = lines.into_iter().map(|(_, l)| l).collect();
+    list(h, "Events (marked on the charts above)", &lines);
+}
+
+/// The negative sequence: the whole log's ratio, the named phase and its confidence.
+fn winding(h: &mut String, rep: &DiagnoseReport) {
+    let u = &rep.unbalance;
+    let phase = u.suspect_phase.map_or("none".to_string(), |p| {
+        format!("{p:?} (confidence {:.2})", u.phase_confidence)
+    });
+    let _ = write!(
+        h,
+        "<h2>Winding</h2><p>Negative sequence |I2|/|I1| = {:.2} % (least change that names a phase {:.1} %); suspect phase: {}.</p>",
+        100.0 * u.negative_sequence_ratio,
+        100.0 * u.least_change,
+        esc(&phase)
+    );
+    if let Some(why) = &u.phase_not_judged {
+        let _ = write!(h, "<p>{}</p>", esc(why));
+    }
+    let p = &u.phase_probabilities;
+    let _ = write!(
+        h,
+        "<table><tr><th>no short</th><th>short in phase a</th><th>in b</th><th>in c</th></tr><tr><td>{:.2}</td><td>{:.2}</td><td>{:.2}</td><td>{:.2}</td></tr></table>",
+        p.no_short, p.a, p.b, p.c
+    );
+}
+
+/// The data-quality stage's finding and what it did.
+fn quality(h: &mut String, rep: &DiagnoseReport) {
+    let q = &rep.data_quality;
+    let _ = write!(h, "<h2>Data quality</h2><p>{}</p>", esc(&q.summary()));
+    let done: Vec<String> = q.actions.iter().map(|a| format!("done: {a}")).collect();
+    list(h, "What the data-quality stage did", &done);
+    if !q.trusted {
+        list(h, "Not trusted because", &q.not_trusted_because);
+    }
+}
+
+/// The page's charts (module docs).
+fn charts(rep: &DiagnoseReport) -> Vec<Chart<'static>> {
+    vec![
+        residuals_chart(rep),
+        lamps_chart(rep),
+        sequence_chart(rep),
+        rotor_chart(rep),
+    ]
+}
+
+/// The times to mark on the time charts: load moves, faults named, first detections.
+fn event_times(rep: &DiagnoseReport) -> Vec<(f64, bool)> {
+    let mut t: Vec<(f64, bool)> = rep
+        .isolation
+        .events
+        .iter()
+        .map(|e| (e.t_s(), matches!(e, IsolationEvent::LoadMoved { .. })))
+        .collect();
+    t.extend(rep.detections.iter().map(|d| (d.t_s, false)));
+    t
+}
+
+/// Vertical markers at the events between `lo` and `hi` on the y axis: load moves in one
+/// colour, faults named and detections in another.
+fn markers(rep: &DiagnoseReport, lo: f64, hi: f64) -> Vec<Series> {
+    let (moves, named): (Vec<_>, Vec<_>) = event_times(rep).into_iter().partition(|e| e.1);
+    let mut v = Vec::new();
+    for (label, times, color) in [("load moved", moves, 6), ("fault named", named, 3)] {
+        let mut pts = Vec::new();
+        for (t, _) in times {
+            // A vertical stroke per event; a NaN point lifts the pen between strokes.
+            pts.extend([(t, lo), (t, hi), (f64::NAN, f64::NAN)]);
+        }
+        if !pts.is_empty() {
+            v.push(line(label, pts, color, true));
+        }
+    }
+    v
+}
+
+/// One line series.
+fn line(label: &str, points: Vec<(f64, f64)>, color: usize, dashed: bool) -> Series {
+    Series {
+        label: label.to_string(),
+        points,
+        color,
+        scatter: false,
+        dashed,
+    }
+}
+
+/// A time chart, or why it is not drawn when the timeline is empty.
+fn time_chart(
+    rep: &DiagnoseReport,
+    (stem, title, y_label): (&'static str, &'static str, &'static str),
+    series: Vec<Series>,
+) -> Chart<'static> {
+    let omitted = rep.timeline.is_empty().then(|| no_timeline(rep));
+    Chart {
+        stem,
+        title,
+        x_label: "time [s]",
+        y_label,
+        series,
+        log_y: false,
+        omitted,
+    }
+}
+
+/// Why the log has no timeline: the core's monitor did not run (the analyses skipped say
+/// what was missing), or the log is shorter than one step.
+fn no_timeline(rep: &DiagnoseReport) -> String {
+    match rep.skipped.first() {
+        Some(why) => format!("Not drawn: the monitor did not run on this log: {why}"),
+        None => "Not drawn: the log is shorter than one timeline step".to_string(),
+    }
+}
+
+/// The normalised residuals r1..r4 over time, in per cent, with the events marked.
+fn residuals_chart(rep: &DiagnoseReport) -> Chart<'static> {
+    let mut series: Vec<Series> = (0..4)
+        .map(|k| {
+            let pts = rep
+                .timeline
+                .iter()
+                .map(|p| (p.t_s, 100.0 * f64::from(p.residuals.get(k).copied().unwrap_or(0.0))))
+                .collect();
+            line(&format!("r{}", k + 1), pts, k, false)
+        })
+        .collect();
+    let hi = series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.1.abs()))
+        .filter(|y| y.is_finite())
+        .fold(1.0, f64::max);
+    series.extend(markers(rep, -hi, hi));
+    time_chart(
+        rep,
+        ("residuals", "Residuals r1..r4 over time, events marked", "residual [% of nominal]"),
+        series,
+    )
+}
+
+/// The lamps r1..r4 and the monitor's state over time: one row each, high where lit.
+fn lamps_chart(rep: &DiagnoseReport) -> Chart<'static> {
+    let row = |k: usize, on: &dyn Fn(&monitor_api::replay::TimelinePoint) -> bool| {
+        rep.timeline
+            .iter()
+            .map(|p| (p.t_s, k as f64 + if on(p) { 0.7 } else { 0.0 }))
+            .collect::<Vec<_>>()
+    };
+    let mut series: Vec<Series> = (0..4)
+        .map(|k| {
+            let on = move |p: &monitor_api::replay::TimelinePoint| p.lamps.get(k) == Some(&true);
+            line(&format!("r{} lit", k + 1), row(k, &on), k, false)
+        })
+        .collect();
+    series.push(line("evaluating", row(4, &|p| p.evaluating), 4, false));
+    series.push(line("commissioning", row(5, &|p| p.commissioning), 5, false));
+    series.extend(markers(rep, 0.0, 6.0));
+    time_chart(
+        rep,
+        (
+            "lamps",
+            "Lamps and state over time (rows from the bottom: r1..r4, evaluating, commissioning; high = on)",
+            "row",
+        ),
+        series,
+    )
+}
+
+/// The negative-sequence ratio over time, with the steady stretches' values.
+fn sequence_chart(rep: &DiagnoseReport) -> Chart<'static> {
+    let pts = rep
+        .timeline
+        .iter()
+        .map(|p| (p.t_s, 100.0 * f64::from(p.negative_sequence_ratio)))
+        .collect();
+    let mut seg = Vec::new();
+    for s in &rep.unbalance.segments {
+        let y = 100.0 * f64::from(s.negative_sequence_ratio);
+        seg.extend([(s.from_s, y), (s.to_s, y), (f64::NAN, f64::NAN)]);
+    }
+    let mut series = vec![line("|I2|/|I1|", pts, 0, false)];
+    if !seg.is_empty() {
+        series.push(line("steady stretches", seg, 1, true));
+    }
+    let mut chart = time_chart(
+        rep,
+        ("negative_sequence", "Negative sequence of the currents over time", "|I2|/|I1| [%]"),
+        series,
+    );
+    // The steady stretches alone carry the picture on a log with only the currents.
+    if !rep.unbalance.segments.is_empty() {
+        chart.omitted = None;
+    }
+    chart
+}
+
+/// The rotor's sidebands against the severity bands: the line at 0 dB, the `(1 -/+ 2s) f`
+/// sidebands and the noise floor as read, and the upper edges of the severity bands
+/// ([`RotorBand`]). Not drawn when the rotor was not judged.
+fn rotor_chart(rep: &DiagnoseReport) -> Chart<'static> {
+    let r = &rep.rotor;
+    let f = r.supply_hz.unwrap_or(f64::NAN);
+    let omitted = (!r.judged || !f.is_finite() || r.sideband_hz.len() < 2)
+        .then(|| format!("Not drawn: {}", r.sentence));
+    let stem = |x: f64, y: f64| vec![(x, -90.0), (x, y)];
+    let lo = r.sideband_hz.first().copied().unwrap_or(f);
+    let hi = r.sideband_hz.get(1).copied().unwrap_or(f);
+    let span = (lo.min(f) - 1.0, hi.max(f) + 1.0);
+    let level = |l: Option<f64>| l.unwrap_or(-90.0);
+    let mut series = vec![
+        line("supply line (0 dB)", stem(f, 0.0), 0, false),
+        line("(1-2s)f", stem(lo, level(r.level_db)), 3, false),
+        line("(1+2s)f", stem(hi, level(r.upper_sideband_db)), 2, false),
+    ];
+    if let Some(n) = r.noise_floor_db {
+        series.push(line("noise floor", vec![(span.0, n), (span.1, n)], 7, true));
+    }
+    for (k, band) in RotorBand::ALL.iter().enumerate() {
+        let db = band.upper_db();
+        if db.is_finite() {
+            let label = format!("{} dB: below, {}", db, band.words());
+            series.push(line(&label, vec![(span.0, db), (span.1, db)], 8 + k, true));
+        }
+    }
+    Chart {
+        stem: "rotor_sidebands",
+        title: "Rotor: the current's sidebands about the supply line against the severity bands",
+        x_label: "frequency [Hz]",
+        y_label: "level [dB re the line]",
+        series,
+        log_y: false,
+        omitted,
+    }
+}
+
+/// HTML-escapes text.
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
