@@ -6,6 +6,8 @@
 //! can use it without a cycle; `monitor-sim`'s own tests do not.
 //!
 //! * [`analysis_common`]: simulated scenarios and logs of the model-vs-measurement tests.
+//! * [`identify_machines`]: the six machines (0.37 kW to 50 hp) the `identify` tests
+//!   identify, with their nameplates and the start files estimated from them.
 //! * [`small_motor`]: the 0.37 kW and 50 hp machines beside the two reference motors.
 //! * [`textbook_machine`]: an independent textbook induction machine (the ladder's logs),
 //!   checked against physics by `tests/textbook_machine_physics.rs`.
@@ -14,5 +16,6 @@
 //! which reads every crate's sources.
 
 pub mod analysis_common;
+pub mod identify_machines;
 pub mod small_motor;
 pub mod textbook_machine;

@@ -1,5 +1,6 @@
-//! The six machines `tests/identify.rs` identifies, each with its published circuit, its
-//! nameplate (computed from that circuit) and the start file `params from-nameplate`
+//! The six machines the `identify` tests identify (`crates/monitor-analysis/tests/identify.rs`,
+//! the library; `sim-host/tests/identify.rs`, the command), each with its published circuit,
+//! its nameplate (computed from that circuit) and the start file `params from-nameplate`
 //! estimates from it.
 
 use monitor_core::{MotorParameters, SupplyParameters};
@@ -10,17 +11,23 @@ use std::f64::consts::TAU;
 
 /// A machine: name, rated kW, V_ll, Hz, [Rs, Rr, Lls, Llr, Lm] (ohm, H), J [kg m^2].
 pub struct Machine {
+    /// The name the tests print.
     pub name: &'static str,
+    /// Rated shaft power [kW].
     pub p_kw: f64,
+    /// Rated line-to-line voltage [V rms].
     pub v_ll: f64,
+    /// Rated frequency [Hz].
     pub f_hz: f64,
+    /// The T-circuit [Rs, Rr, Lls, Llr, Lm] (ohm, H).
     pub t: [f64; 5],
+    /// Rotor inertia [kg m^2].
     pub j: f64,
 }
 
 /// The six machines (4-pole): a 0.37 kW machine of per-unit values typical of its size
-/// (made for these tests, see `tests/nameplate.rs`); motulator's 2.2 kW (published in
-/// inverse-Gamma form: its leakage all on the stator side);
+/// (made for these tests, see `crates/monitor-io/tests/nameplate.rs`); motulator's
+/// 2.2 kW (published in inverse-Gamma form: its leakage all on the stator side);
 /// Krause, Wasynczuk and Sudhoff's 3 hp and 50 hp (Analysis of Electric Machinery and
 /// Drive Systems, 60 Hz, Xls = Xlr, with their J); MATLAB/Simscape's 4 kW and 15 kW
 /// presets as transcribed by the Modelica Buildings library (Ls = Lr, J of the presets).
