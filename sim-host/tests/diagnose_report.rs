@@ -65,7 +65,10 @@ fn the_page_says_what_the_text_says_with_charts_not_text_blocks() {
     for (name, params, log) in cases() {
         let out = dir.path().join(format!("{name}.html"));
         let (text, stderr) = diagnose_with_report(&params, &log, &out);
-        assert!(stderr.contains("report: "), "{name}: says where the report is");
+        assert!(
+            stderr.contains("report: "),
+            "{name}: says where the report is"
+        );
         let page = std::fs::read_to_string(&out).expect("the report");
         let verdict = text
             .lines()
@@ -129,7 +132,11 @@ fn a_report_over_an_input_is_refused_and_the_input_kept() {
     assert!(!o.status.success());
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("refusing to overwrite the input"), "{err}");
-    assert_eq!(std::fs::read(&copy).expect("read"), before, "the input changed");
+    assert_eq!(
+        std::fs::read(&copy).expect("read"),
+        before,
+        "the input changed"
+    );
 }
 
 /// A script that titles the page `fits`, or `overflows ...` naming what runs past the
@@ -138,20 +145,32 @@ const FIT_CHECK: &str = "<script>window.addEventListener('load',()=>{const v=win
 
 /// Headless Chromium, where installed.
 fn chromium() -> Option<PathBuf> {
-    ["/usr/bin/chromium", "/usr/bin/chromium-browser", "/usr/bin/google-chrome"]
-        .iter()
-        .map(PathBuf::from)
-        .find(|p| p.is_file())
+    [
+        "/usr/bin/chromium",
+        "/usr/bin/chromium-browser",
+        "/usr/bin/google-chrome",
+    ]
+    .iter()
+    .map(PathBuf::from)
+    .find(|p| p.is_file())
 }
 
 /// The title the fit check gives `page` at `width` px.
 fn fit_at(chrome: &Path, page: &Path, width: u32) -> String {
     let html = std::fs::read_to_string(page).expect("page");
     let checked = page.with_extension("check.html");
-    std::fs::write(&checked, html.replace("</body>", &format!("{FIT_CHECK}</body>")))
-        .expect("write");
+    std::fs::write(
+        &checked,
+        html.replace("</body>", &format!("{FIT_CHECK}</body>")),
+    )
+    .expect("write");
     let o = std::process::Command::new(chrome)
-        .args(["--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars"])
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--hide-scrollbars",
+        ])
         .arg(format!("--window-size={width},900"))
         .args(["--virtual-time-budget=3000", "--dump-dom"])
         .arg(format!("file://{}", checked.display()))
@@ -181,7 +200,12 @@ fn nothing_runs_off_the_page_at_a4_or_a_phones_width_in_a_browser() {
             assert_eq!(fit, "fits", "{name} at {width} px");
             let png = shots.join(format!("{name}_{width}.png"));
             let _ = std::process::Command::new(&chrome)
-                .args(["--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars"])
+                .args([
+                    "--headless",
+                    "--no-sandbox",
+                    "--disable-gpu",
+                    "--hide-scrollbars",
+                ])
                 .arg(format!("--window-size={width},2600"))
                 .arg(format!("--screenshot={}", png.display()))
                 .arg(format!("file://{}", out.display()))

@@ -10,7 +10,7 @@ pub use monitor_replay::{
     diagnose_file_observed, state_name, Against, CommissionWindow, CommissioningOutcome,
     CommissioningReport, DetectionLimit, DiagnoseReport, Diagnosed, FaultCandidate, FindingReport,
     IsolationEvent, IsolationName, IsolationReport, LoadModel, OptionError, OptionField, Panel,
-    Replay, ReplayError, ReplayObserver, ReplayOptions, RotorBand, Spelling, TemperatureReport, TimelinePoint,
-    TimelineStep, TurnCalibration, TurnLevelOptions, UnbalanceReport, Verdict, Words, MAX_EVENTS,
-    MIN_FAULT_CHANGE,
+    Replay, ReplayError, ReplayObserver, ReplayOptions, RotorBand, Spelling, TemperatureReport,
+    TimelinePoint, TimelineStep, TurnCalibration, TurnLevelOptions, UnbalanceReport, Verdict,
+    Words, MAX_EVENTS, MIN_FAULT_CHANGE,
 };

@@ -95,7 +95,11 @@ fn verdict(h: &mut String, rep: &DiagnoseReport) {
     );
     list(h, "Judged", &rep.judged);
     list(h, "Not judged", &rep.not_judged);
-    list(h, "Why the verdict is withheld", &rep.verdict_withheld_because);
+    list(
+        h,
+        "Why the verdict is withheld",
+        &rep.verdict_withheld_because,
+    );
 }
 
 /// A titled list of sentences (nothing when empty).
@@ -144,7 +148,11 @@ fn events_list(h: &mut String, rep: &DiagnoseReport) {
     lines.extend(rep.detections.iter().map(|d| {
         (
             d.t_s,
-            format!("{:.2} s  lamps first named {}", d.t_s, d.fault.name()),
+            format!(
+                "{:.2} s  the lamps' signature first matched {} (the verdict above weighs it)",
+                d.t_s,
+                d.fault.name()
+            ),
         )
     }));
     lines.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -214,7 +222,10 @@ fn event_times(rep: &DiagnoseReport) -> Vec<(f64, bool)> {
 fn markers(rep: &DiagnoseReport, lo: f64, hi: f64) -> Vec<Series> {
     let (moves, named): (Vec<_>, Vec<_>) = event_times(rep).into_iter().partition(|e| e.1);
     let mut v = Vec::new();
-    for (label, times, color) in [("load moved", moves, 6), ("fault named", named, 3)] {
+    for (label, times, color) in [
+        ("load moved", moves, 6),
+        ("fault named or signature matched", named, 3),
+    ] {
         let mut pts = Vec::new();
         for (t, _) in times {
             // A vertical stroke per event; a NaN point lifts the pen between strokes.
@@ -272,7 +283,12 @@ fn residuals_chart(rep: &DiagnoseReport) -> Chart<'static> {
             let pts = rep
                 .timeline
                 .iter()
-                .map(|p| (p.t_s, 100.0 * f64::from(p.residuals.get(k).copied().unwrap_or(0.0))))
+                .map(|p| {
+                    (
+                        p.t_s,
+                        100.0 * f64::from(p.residuals.get(k).copied().unwrap_or(0.0)),
+                    )
+                })
                 .collect();
             line(&format!("r{}", k + 1), pts, k, false)
         })
@@ -285,7 +301,11 @@ fn residuals_chart(rep: &DiagnoseReport) -> Chart<'static> {
     series.extend(markers(rep, -hi, hi));
     time_chart(
         rep,
-        ("residuals", "Residuals r1..r4 over time, events marked", "residual [% of nominal]"),
+        (
+            "residuals",
+            "Residuals r1..r4 over time, events marked",
+            "residual [% of nominal]",
+        ),
         series,
     )
 }
@@ -305,7 +325,12 @@ fn lamps_chart(rep: &DiagnoseReport) -> Chart<'static> {
         })
         .collect();
     series.push(line("evaluating", row(4, &|p| p.evaluating), 4, false));
-    series.push(line("commissioning", row(5, &|p| p.commissioning), 5, false));
+    series.push(line(
+        "commissioning",
+        row(5, &|p| p.commissioning),
+        5,
+        false,
+    ));
     series.extend(markers(rep, 0.0, 6.0));
     time_chart(
         rep,
@@ -336,7 +361,11 @@ fn sequence_chart(rep: &DiagnoseReport) -> Chart<'static> {
     }
     let mut chart = time_chart(
         rep,
-        ("negative_sequence", "Negative sequence of the currents over time", "|I2|/|I1| [%]"),
+        (
+            "negative_sequence",
+            "Negative sequence of the currents over time",
+            "|I2|/|I1| [%]",
+        ),
         series,
     );
     // The steady stretches alone carry the picture on a log with only the currents.

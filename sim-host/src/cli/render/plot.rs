@@ -9,6 +9,7 @@
 
 use plotters::coord::ranged1d::{SegmentedCoord, ValueFormatter};
 use plotters::coord::types::RangedCoordi32;
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -251,36 +252,31 @@ where
                 .legend(move |(x, y)| Circle::new((x + 10, y), 4, col.filled()));
         }
     } else if s.dashed {
-        let mut runs = runs(&s.points, log_y).into_iter();
-        let first = runs.next().unwrap_or_default();
+        let style = col.stroke_width(2);
         let a = chart
-            .draw_series(DashedLineSeries::new(first, 6, 4, col.stroke_width(2)))
+            .draw_series(
+                runs(&s.points, log_y)
+                    .into_iter()
+                    .map(move |r| DashedPathElement::new(r, 6, 4, style)),
+            )
             .map_err(e)?;
         if text {
-            a.label(s.label.clone()).legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 8, y)], col.stroke_width(2))
-            });
-        }
-        for r in runs {
-            chart
-                .draw_series(DashedLineSeries::new(r, 6, 4, col.stroke_width(2)))
-                .map_err(e)?;
+            a.label(s.label.clone())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 8, y)], style));
         }
     } else {
-        let mut runs = runs(&s.points, log_y).into_iter();
-        let first = runs.next().unwrap_or_default();
+        let style = col.stroke_width(1);
         let a = chart
-            .draw_series(LineSeries::new(first, col.stroke_width(1)))
+            .draw_series(
+                runs(&s.points, log_y)
+                    .into_iter()
+                    .map(move |r| PathElement::new(r, style)),
+            )
             .map_err(e)?;
         if text {
             a.label(s.label.clone()).legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2))
             });
-        }
-        for r in runs {
-            chart
-                .draw_series(LineSeries::new(r, col.stroke_width(1)))
-                .map_err(e)?;
         }
     }
     Ok(())
