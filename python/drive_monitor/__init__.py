@@ -34,11 +34,21 @@ with ``store=`` it keeps each motor's history, whose trend :func:`trend` reads
 
 from __future__ import annotations
 
-import json
-import os
-import tempfile
-from pathlib import Path
-from typing import TYPE_CHECKING, Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
+# The helpers under underscore names: the package's namespace is its public API
+# (`__all__`), so `dir(drive_monitor)` and completion show no `os`, `json` or `Dict`.
+import json as _json
+import os as _os
+import tempfile as _tempfile
+from pathlib import Path as _Path
+from typing import TYPE_CHECKING as _TYPE_CHECKING
+from typing import Any as _Any
+from typing import Dict as _Dict
+from typing import Iterable as _Iterable
+from typing import List as _List
+from typing import Optional as _Optional
+from typing import Sequence as _Sequence
+from typing import Tuple as _Tuple
+from typing import Union as _Union
 
 from . import _native
 from ._native import (
@@ -60,6 +70,7 @@ from ._results import (
     Result,
 )
 
+#: The public API: everything else in the namespace is a submodule or has an underscore.
 __all__ = [
     "trend",
     "Trend",
@@ -82,27 +93,31 @@ __all__ = [
     "OptionError",
     "AnalysisError",
     "InternalError",
+    "PathLike",
+    "LogLike",
+    "ParamsLike",
+    "CommissionLike",
 ]
 
-if TYPE_CHECKING:  # pragma: no cover
+if _TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
 
-PathLike = Union[str, "os.PathLike[str]"]
+PathLike = _Union[str, "_os.PathLike[str]"]
 #: A log: a path, a pandas DataFrame, a pyarrow Table, a dict of arrays, or any object
 #: with ``__arrow_c_stream__``.
-LogLike = Any
-ParamsLike = Union[PathLike, Dict[str, Any]]
+LogLike = _Any
+ParamsLike = _Union[PathLike, _Dict[str, _Any]]
 #: A commissioning window: ``(start_s, end_s)`` or the command line's ``"START:END"``.
-CommissionLike = Union[Tuple[float, float], Sequence[float], str]
+CommissionLike = _Union[_Tuple[float, float], _Sequence[float], str]
 
 
-def _toml_value(v: Any) -> str:
+def _toml_value(v: _Any) -> str:
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, (int, float)):
         return repr(float(v)) if isinstance(v, float) else str(v)
     if isinstance(v, str):
-        return json.dumps(v)
+        return _json.dumps(v)
     if isinstance(v, dict):
         return "{ " + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + " }"
     if isinstance(v, (list, tuple)):
@@ -110,9 +125,9 @@ def _toml_value(v: Any) -> str:
     raise ParamsError(f"the parameter dict: value {v!r} is not a number, text, table or list")
 
 
-def _params_toml(params: Dict[str, Any]) -> str:
+def _params_toml(params: _Dict[str, _Any]) -> str:
     """The TOML text of a parameter dict (sections of scalars; ``columns`` of tables)."""
-    lines: List[str] = []
+    lines: _List[str] = []
     for section, table in params.items():
         if not isinstance(table, dict):
             raise ParamsError(
@@ -125,18 +140,18 @@ def _params_toml(params: Dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _params(params: ParamsLike) -> Tuple[str, bool]:
+def _params(params: ParamsLike) -> _Tuple[str, bool]:
     """(path or TOML text, is_text) for the native functions."""
     if isinstance(params, dict):
         return _params_toml(params), True
-    return os.fspath(params), False
+    return _os.fspath(params), False
 
 
-def _log(log: LogLike) -> Tuple[Any, Optional[str]]:
+def _log(log: LogLike) -> _Tuple[_Any, _Optional[str]]:
     """(log, origin) for the native functions: a path as it is (origin ``None``), or data
     in memory as an object with ``__arrow_c_stream__`` and the name messages give it."""
-    if isinstance(log, (str, os.PathLike)):
-        return os.fspath(log), None
+    if isinstance(log, (str, _os.PathLike)):
+        return _os.fspath(log), None
     import pyarrow as pa
 
     if isinstance(log, pa.Table):
@@ -163,7 +178,7 @@ def _log(log: LogLike) -> Tuple[Any, Optional[str]]:
     )
 
 
-def _commission(commission: Optional[CommissionLike]) -> Optional[Union[Tuple[float, float], str]]:
+def _commission(commission: _Optional[CommissionLike]) -> _Optional[_Union[_Tuple[float, float], str]]:
     """The window as the library takes it: ``"START:END"`` as given (the library's one
     parser reads it), a pair as ``(start_s, end_s)``; the library checks both."""
     if commission is None or isinstance(commission, str):
@@ -183,16 +198,16 @@ def _commission(commission: Optional[CommissionLike]) -> Optional[Union[Tuple[fl
 def diagnose(
     log: LogLike,
     params: ParamsLike,
-    commission: Optional[CommissionLike] = None,
-    baseline: Optional[Union[LogLike, Sequence[LogLike]]] = None,
-    load: Optional[str] = None,
-    angle: Optional[str] = None,
-    residuals: Optional[str] = None,
+    commission: _Optional[CommissionLike] = None,
+    baseline: _Optional[_Union[LogLike, _Sequence[LogLike]]] = None,
+    load: _Optional[str] = None,
+    angle: _Optional[str] = None,
+    residuals: _Optional[str] = None,
     allow_incomplete: bool = False,
-    timeline_step: Optional[float] = None,
-    group: Optional[str] = None,
-    parallel_paths: Optional[int] = None,
-    turn_calibration: Optional[Union[str, Dict[str, Any]]] = None,
+    timeline_step: _Optional[float] = None,
+    group: _Optional[str] = None,
+    parallel_paths: _Optional[int] = None,
+    turn_calibration: _Optional[_Union[str, _Dict[str, _Any]]] = None,
 ) -> DiagnoseResult:
     """Replay a log through the monitor's core: lamps, the named fault with its size and
     phase, the shorted winding's phase, events, verdict (``sim-host diagnose``).
@@ -207,6 +222,7 @@ def diagnose(
         Learn the healthy thresholds over this window of the log [s] (``(1.5, 2.4)`` or
         the command line's ``"1.5:2.4"``).
     baseline : log or list of logs, optional
+        (One log, a path or data, is a list of one.)
         Healthy logs of the same motor (files, folders, or data): the winding's negative
         sequence is judged against their mean, their spread sets the least change.
     load : {"unknown", "viscous"}, optional
@@ -244,9 +260,7 @@ def diagnose(
     """
     p, is_text = _params(params)
     window = _commission(commission)
-    base = [] if baseline is None else (
-        list(baseline) if isinstance(baseline, (list, tuple)) else [baseline]
-    )
+    base = _items(baseline)
     data, origin = _log(log)
     doc = _native.diagnose(
         data,
@@ -264,27 +278,40 @@ def diagnose(
         parallel_paths=None if parallel_paths is None else int(parallel_paths),
         turn_calibration=_calibration_text(turn_calibration),
     )
-    return DiagnoseResult(json.loads(doc))
+    return DiagnoseResult(_json.loads(doc))
 
 
-def _calibration_text(cal: Optional[Union[str, Dict[str, Any]]]) -> Optional[str]:
+def _calibration_text(cal: _Optional[_Union[str, _Dict[str, _Any]]]) -> _Optional[str]:
     """A shorted-turn calibration as its JSON text: a dict as it is, a path read."""
     if cal is None:
         return None
     if isinstance(cal, dict):
-        return json.dumps(cal)
-    return Path(cal).read_text()
+        return _json.dumps(cal)
+    return _Path(cal).read_text()
+
+
+def _items(value: _Any) -> _List[_Any]:
+    """A list-valued parameter as a list: ``None`` as none, one text, path or data (a
+    ``str``, an ``os.PathLike``, a DataFrame, ...) as one item, any other iterable as its
+    items. ``effects="load_torque"`` is ``["load_torque"]``, never its letters."""
+    if value is None:
+        return []
+    if isinstance(value, (str, bytes, _os.PathLike, dict)) or not isinstance(value, _Iterable):
+        return [value]
+    if hasattr(value, "__arrow_c_stream__") or type(value).__name__ == "DataFrame":
+        return [value]
+    return list(value)
 
 
 def _analysis_kwargs(
-    effects: Optional[Iterable[str]],
-    from_s: Optional[float],
-    to_s: Optional[float],
+    effects: _Optional[_Union[str, _Iterable[str]]],
+    from_s: _Optional[float],
+    to_s: _Optional[float],
     no_fit: bool,
-    group: Optional[str],
-) -> Dict[str, Any]:
+    group: _Optional[str],
+) -> _Dict[str, _Any]:
     return dict(
-        effects=list(effects or []),
+        effects=[str(e) for e in _items(effects)],
         from_s=None if from_s is None else float(from_s),
         to_s=None if to_s is None else float(to_s),
         no_fit=no_fit,
@@ -295,16 +322,18 @@ def _analysis_kwargs(
 def compare(
     log: LogLike,
     params: ParamsLike,
-    effects: Optional[Iterable[str]] = None,
-    from_s: Optional[float] = None,
-    to_s: Optional[float] = None,
+    effects: _Optional[_Union[str, _Iterable[str]]] = None,
+    from_s: _Optional[float] = None,
+    to_s: _Optional[float] = None,
     no_fit: bool = False,
-    group: Optional[str] = None,
+    group: _Optional[str] = None,
 ) -> CompareResult:
     """Compare the paper's simplified model (with ``effects`` added) with the measurement:
     ``normalized_rms_error``, ``channels``, ``worst_windows`` (``sim-host compare``).
 
-    ``from_s``/``to_s`` limit the analysed window [s] (at least 25 supply periods).
+    ``effects`` names the effects already in the model: a list, or one name
+    (``effects="load_torque"`` is ``["load_torque"]``). ``from_s``/``to_s`` limit the
+    analysed window [s] (at least 25 supply periods).
     """
     p, is_text = _params(params)
     data, origin = _log(log)
@@ -315,20 +344,20 @@ def compare(
         params_is_text=is_text,
         **_analysis_kwargs(effects, from_s, to_s, no_fit, group),
     )
-    return CompareResult(json.loads(doc))
+    return CompareResult(_json.loads(doc))
 
 
 def explain(
     log: LogLike,
     params: ParamsLike,
-    effects: Optional[Iterable[str]] = None,
-    from_s: Optional[float] = None,
-    to_s: Optional[float] = None,
+    effects: _Optional[_Union[str, _Iterable[str]]] = None,
+    from_s: _Optional[float] = None,
+    to_s: _Optional[float] = None,
     no_fit: bool = False,
-    group: Optional[str] = None,
-    rotor_bars: Optional[int] = None,
+    group: _Optional[str] = None,
+    rotor_bars: _Optional[int] = None,
     ladder: bool = False,
-) -> Union[ExplainResult, LadderResult]:
+) -> _Union[ExplainResult, LadderResult]:
     """Rank the physical effects missing from the model by how much of its error each
     explains: ``ranking``, ``verdict``, ``unexplained`` (``sim-host explain``).
 
@@ -351,16 +380,16 @@ def explain(
         **_analysis_kwargs(effects, from_s, to_s, no_fit, group),
     )
     if ladder:
-        return LadderResult(json.loads(doc))
-    return ExplainResult(json.loads(doc))
+        return LadderResult(_json.loads(doc))
+    return ExplainResult(_json.loads(doc))
 
 
 def identify(
     log: LogLike,
     params: ParamsLike,
-    from_s: Optional[float] = None,
-    to_s: Optional[float] = None,
-    group: Optional[str] = None,
+    from_s: _Optional[float] = None,
+    to_s: _Optional[float] = None,
+    group: _Optional[str] = None,
 ) -> IdentifyResult:
     """Identify the motor's circuit (Rs, Rr, the leakage, Lm) and J, B + Bl from a log of
     its healthy running, starting from ``params`` (``sim-host identify``).
@@ -381,7 +410,7 @@ def identify(
         to_s=None if to_s is None else float(to_s),
         group=group,
     )
-    return IdentifyResult(json.loads(doc))
+    return IdentifyResult(_json.loads(doc))
 
 
 def params_from_nameplate(
@@ -392,11 +421,11 @@ def params_from_nameplate(
     speed_rpm: float,
     power_factor: float,
     efficiency: float,
-    poles: Optional[int] = None,
+    poles: _Optional[int] = None,
     connection: str = "star",
-    locked_rotor_ratio: Optional[float] = None,
+    locked_rotor_ratio: _Optional[float] = None,
     nema_design: str = "B",
-    columns_from: Optional[PathLike] = None,
+    columns_from: _Optional[PathLike] = None,
 ) -> NameplateResult:
     """A parameter file estimated from a motor's nameplate, each value with its range and
     source (``sim-host params from-nameplate``). ``.toml`` is the file's text, ``.params``
@@ -413,42 +442,54 @@ def params_from_nameplate(
         connection=connection,
         locked_rotor_ratio=locked_rotor_ratio,
         nema_design=nema_design,
-        columns_from=None if columns_from is None else os.fspath(columns_from),
+        columns_from=None if columns_from is None else _os.fspath(columns_from),
     )
-    return NameplateResult(json.loads(doc))
+    return NameplateResult(_json.loads(doc))
 
 
 def simulate(
     params: ParamsLike,
-    scenario: Union[PathLike, str],
-    out: Optional[PathLike] = None,
+    scenario: _Union[PathLike, str],
+    out: _Optional[PathLike] = None,
 ) -> "pd.DataFrame":
     """Simulate the motor of ``params`` through ``scenario`` (a scenario file, or its TOML
     text) with the project's simulator (``sim-host simulate``).
 
     Returns the log as a pandas DataFrame with the schema's columns (``t_s``, ``va_V``, ...,
-    SI units), and writes it to ``out`` too when given (CSV, TDMS or Parquet by extension).
+    SI units), and writes it to ``out`` too when given (CSV, TDMS or Parquet by extension),
+    whole or not at all.
+
+    Raises
+    ------
+    OptionError
+        ``out`` is the parameter file or the scenario file (by any path, ``./`` spelling or
+        link): "refusing to overwrite the input ...", and nothing is written.
+    ParamsError, OptionError
+        A bad parameter file or scenario.
     """
-    import pandas as pd
     import pyarrow.parquet as pq
 
-    text = scenario
-    if isinstance(scenario, os.PathLike) or (
-        isinstance(scenario, str) and "\n" not in scenario and Path(scenario).exists()
-    ):
-        text = Path(scenario).read_text()
+    is_file = isinstance(scenario, _os.PathLike) or (
+        isinstance(scenario, str) and "\n" not in scenario and _Path(scenario).exists()
+    )
     p, is_text = _params(params)
-    if out is not None and not os.fspath(out).endswith(".parquet"):
-        _native.simulate(p, text, os.fspath(out), params_is_text=is_text)
-    fd, tmp = tempfile.mkstemp(suffix=".parquet", prefix="drive_monitor_sim_")
-    os.close(fd)
+    kwargs = dict(params_is_text=is_text, scenario_is_text=not is_file)
+    if out is not None:
+        # The library checks `out` against the parameter file and the scenario file before
+        # anything is written (an OptionError naming both), then writes it atomically.
+        _native.simulate(p, _os.fspath(scenario), _os.fspath(out), **kwargs)
+        if _os.fspath(out).lower().endswith(".parquet"):
+            return pq.read_table(_os.fspath(out)).to_pandas()
+    fd, tmp = _tempfile.mkstemp(suffix=".parquet", prefix="drive_monitor_sim_")
+    _os.close(fd)
     try:
-        _native.simulate(p, text, tmp, params_is_text=is_text)
-        frame = pq.read_table(tmp).to_pandas()
-        if out is not None and os.fspath(out).endswith(".parquet"):
-            os.replace(tmp, os.fspath(out))
-            tmp = None
-        return frame
+        _native.simulate(p, _os.fspath(scenario), tmp, **kwargs)
+        return pq.read_table(tmp).to_pandas()
     finally:
-        if tmp is not None and os.path.exists(tmp):
-            os.remove(tmp)
+        if _os.path.exists(tmp):
+            _os.remove(tmp)
+
+
+# `from __future__ import annotations` binds `annotations` in the namespace; the flag it
+# sets stays with the code compiled above.
+del annotations

@@ -118,6 +118,8 @@ def motor_table_toml(motors: Any, base: Optional[Union[str, "os.PathLike[str]"]]
         for k, v in m.items():
             if v is None or (isinstance(v, float) and v != v):
                 continue
+            if k == "baseline" and isinstance(v, (str, os.PathLike)):
+                v = [v]  # one healthy log (or folder) is a list of one, not its letters
             out.append(f"{k} = {_toml_value(v)}")
     text = "\n".join(out) + "\n"
     _native.fleet_check_table(text, "the motor table (rows)", os.fspath(base or os.getcwd()))
@@ -258,7 +260,7 @@ def diagnose_many(
     Parameters
     ----------
     logs : list of paths/URLs, or a glob (local or any fsspec URL: ``s3://bucket/logs/*.csv``)
-        The logs (CSV, TDMS or Parquet).
+        The logs (CSV, TDMS or Parquet); one path is a list of one.
     motors : path to a motor table (TOML), a DataFrame, or a list of dicts
         Which parameter file, commissioning window, baseline and load belong to which motor,
         and which logs are its (``logs``: a pattern on the file name).
@@ -287,7 +289,9 @@ def diagnose_many(
     ParamsError
         The motor table cannot be read or is not one (naming the file).
     OptionError
-        A glob that matches no file (naming the pattern).
+        A glob that matches no file (naming the pattern); a ``store`` that is one of the
+        files the run reads (the motor table, a parameter file, a baseline, a log), refused
+        before anything is written.
     """
     import pandas as pd
 
@@ -297,6 +301,16 @@ def diagnose_many(
         )
     table = motor_table_toml(motors, base)
     paths = _expand(logs, storage_options)
+    if store is not None:
+        # Before anything is written: the store may not be a file the run reads.
+        local = [p[len("file://"):] if p.startswith("file://") else p for p in paths]
+        _native.fleet_check_outputs(
+            table,
+            os.fspath(base),
+            os.fspath(motors) if _is_path(motors) else None,
+            [p for p in local if not _is_remote(p)],
+            os.fspath(store),
+        )
     own = client is None
     cluster = None
     if own:

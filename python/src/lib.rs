@@ -16,6 +16,7 @@ use pyo3::prelude::*;
 use std::path::PathBuf;
 
 mod arrow_in;
+mod fleet;
 mod store;
 
 create_exception!(
@@ -484,75 +485,34 @@ fn params_from_nameplate(
     })
 }
 
-/// `simulate` into `out` (CSV, TDMS or Parquet by extension); the summary.
+/// `simulate` into `out` (CSV, TDMS or Parquet by extension); the summary. `scenario` is
+/// the scenario's TOML text, or with `scenario_is_text=false` its file's path. `out` is
+/// checked against the parameter file and the scenario file first (the library's one
+/// guard: nothing is written when it is one of them), then written atomically.
+///
+/// # Errors
+/// [`OptionError`] when `out` is an input ("refusing to overwrite the input ..."); as
+/// `monitor_api::simulate_to_file`.
 #[pyfunction]
-#[pyo3(signature = (params, scenario_toml, out, params_is_text=false))]
+#[pyo3(signature = (params, scenario, out, params_is_text=false, scenario_is_text=true))]
 fn simulate(
     py: Python<'_>,
     params: String,
-    scenario_toml: String,
+    scenario: String,
     out: PathBuf,
     params_is_text: bool,
+    scenario_is_text: bool,
 ) -> PyResult<String> {
     run(py, || {
-        let s = api::simulate_to_file(params_source(&params, params_is_text), &scenario_toml, &out)
+        let scenario = if scenario_is_text {
+            api::ScenarioSource::from(scenario.as_str())
+        } else {
+            api::ScenarioSource::Path(std::path::Path::new(&scenario))
+        };
+        let s = api::simulate_to_file(params_source(&params, params_is_text), scenario, &out)
             .map_err(to_py)?;
         json(&s)
     })
-}
-
-/// One log's row of the fleet table (`sim-host fleet`), as JSON: the motor table's text
-/// (`base` its folder, for its relative paths), the log at `log`, shown as `shown`.
-#[pyfunction]
-fn fleet_row(
-    py: Python<'_>,
-    table_toml: String,
-    base: PathBuf,
-    log: PathBuf,
-    shown: String,
-) -> PyResult<String> {
-    run(py, || {
-        let table =
-            monitor_api::fleet::MotorTable::from_toml_str(&table_toml, "the motor table", &base)
-                .map_err(|e| ParamsError::new_err(e.to_string()))?;
-        json(&monitor_api::fleet::row_shown(&table, &log, &shown))
-    })
-}
-
-/// The text of the motor table file at `path`, checked (its relative paths from `base`).
-///
-/// # Errors
-/// [`ParamsError`] naming the file: it cannot be read, or it is not a motor table.
-#[pyfunction]
-fn fleet_read_table(path: PathBuf, base: PathBuf) -> PyResult<String> {
-    let text = std::fs::read_to_string(&path).map_err(|source| {
-        ParamsError::new_err(
-            monitor_api::fleet::FleetError::Io {
-                path: path.display().to_string(),
-                source,
-            }
-            .to_string(),
-        )
-    })?;
-    fleet_check_table(&text, &path.display().to_string(), base)?;
-    Ok(text)
-}
-
-/// Checks a motor table's text (`shown` in messages; relative paths from `base`).
-///
-/// # Errors
-/// [`ParamsError`] naming `shown` and what is wrong.
-#[pyfunction]
-fn fleet_check_table(text: &str, shown: &str, base: PathBuf) -> PyResult<()> {
-    monitor_api::fleet::MotorTable::from_toml_str(text, shown, &base)
-        .map(|_| ())
-        .map_err(|e| ParamsError::new_err(e.to_string()))
-}
-
-/// The fleet table's columns, in order.
-#[pyfunction]
-fn fleet_columns() -> Vec<&'static str> {
-    monitor_api::fleet::COLUMNS.to_vec()
 }
 
 /// The Rust extension of `drive_monitor`.
@@ -571,10 +531,11 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(identify, m)?)?;
     m.add_function(wrap_pyfunction!(params_from_nameplate, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
-    m.add_function(wrap_pyfunction!(fleet_row, m)?)?;
-    m.add_function(wrap_pyfunction!(fleet_columns, m)?)?;
-    m.add_function(wrap_pyfunction!(fleet_read_table, m)?)?;
-    m.add_function(wrap_pyfunction!(fleet_check_table, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet::fleet_row, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet::fleet_columns, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet::fleet_read_table, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet::fleet_check_table, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet::fleet_check_outputs, m)?)?;
     m.add_function(wrap_pyfunction!(store::fleet_store_row, m)?)?;
     m.add_function(wrap_pyfunction!(store::store_append, m)?)?;
     m.add_function(wrap_pyfunction!(store::store_trend, m)?)?;

@@ -92,6 +92,18 @@ pub enum ApiError {
     /// The simulation was interrupted.
     #[error("the simulation was interrupted")]
     Interrupted,
+    /// An output is one of the call's inputs (naming both files and their fields);
+    /// nothing was written.
+    #[error(transparent)]
+    Overwrite(#[from] monitor_io::log::OverwriteError),
+    /// The scenario file cannot be read.
+    #[error("cannot read the scenario {path}: {source}")]
+    ScenarioIo {
+        /// The file.
+        path: String,
+        /// The I/O error.
+        source: std::io::Error,
+    },
 }
 
 /// The kinds of [`ApiError`] (the Python package's exception classes).
@@ -102,7 +114,7 @@ pub enum ErrorKind {
     /// [`ApiError::Log`], and a replay's or an analysis' log error.
     Log,
     /// [`ApiError::Option`] and every refusal of what was asked (a window, a
-    /// configuration, a nameplate, a scenario, labels).
+    /// configuration, a nameplate, a scenario, labels, an output that is an input).
     Option,
     /// [`ApiError::Replay`] and [`ApiError::Analysis`].
     Analysis,
@@ -126,7 +138,9 @@ impl ApiError {
             | ApiError::Labels(_)
             | ApiError::Nameplate(_)
             | ApiError::Simulation(_)
-            | ApiError::Interrupted => ErrorKind::Option,
+            | ApiError::Interrupted
+            | ApiError::Overwrite(_)
+            | ApiError::ScenarioIo { .. } => ErrorKind::Option,
         }
     }
 

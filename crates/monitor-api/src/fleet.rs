@@ -17,8 +17,12 @@
 //!
 //! A log belongs to the first motor whose pattern matches its file name (`*` any text, `?`
 //! one character).
+//!
+//! What a run writes (the history store) may not be a file it reads
+//! ([`check_fleet_outputs`], checked before anything is written).
 
 use crate::{diagnose, ApiError, DiagnoseRequest, LogSource, ParamsSource};
+use monitor_io::log::{check_outputs, NamedFile, OverwriteError};
 use monitor_replay::{DiagnoseReport, IsolationEvent, LoadModel, ReplayOptions};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -362,6 +366,46 @@ pub fn row_for(m: &MotorEntry, log: &Path) -> FleetRow {
         Ok(d) => FleetRow::of_report(&m.name, log, &d.report),
         Err(e) => FleetRow::failed(&m.name, log, one_line_error(&e)),
     }
+}
+
+/// Refuses a fleet run's `outputs` (the history store, a result file) that are one of the
+/// files it reads: the motor table's file `table_file` (when it is one), each motor's
+/// parameter file and baseline logs (or folders), and the `logs`. Call it before anything
+/// is written.
+///
+/// # Errors
+/// [`OverwriteError`] naming the input and the output (and their fields: `motors`,
+/// `params`, `baseline`, `logs`, and the outputs' own).
+pub fn check_fleet_outputs(
+    table_file: Option<&Path>,
+    table: &MotorTable,
+    logs: &[PathBuf],
+    outputs: &[NamedFile<'_>],
+) -> Result<(), OverwriteError> {
+    // The table's file is named `motors` (the Python keyword; the command line's first
+    // argument): the field is left empty where the outputs name none, so that the
+    // command line's message names the paths alone.
+    let named = |field: &'static str| {
+        if outputs.iter().all(|o| o.field.is_empty()) {
+            ""
+        } else {
+            field
+        }
+    };
+    let mut inputs: Vec<NamedFile<'_>> = table_file
+        .map(|t| NamedFile::new(named("motors"), t))
+        .into_iter()
+        .collect();
+    for m in &table.motor {
+        inputs.push(NamedFile::new(named("params"), &m.params));
+        inputs.extend(
+            m.baseline
+                .iter()
+                .map(|b| NamedFile::new(named("baseline"), b)),
+        );
+    }
+    inputs.extend(logs.iter().map(|l| NamedFile::new(named("logs"), l)));
+    check_outputs(&inputs, outputs)
 }
 
 fn one_line_error(e: &ApiError) -> String {

@@ -28,6 +28,7 @@ mod explain_doc;
 pub mod files;
 pub mod fleet;
 mod log_source;
+mod outputs;
 /// The replay of a log for a front end (from `monitor-replay`).
 pub mod replay;
 /// The simulator for a front end (from `monitor-sim`).
@@ -38,6 +39,7 @@ pub use explain_doc::{
     beside_verdict, explain, ladder, mcsa_beside, verdict_for_explain, ExplainDocument,
 };
 pub use log_source::LogSource;
+pub use outputs::{simulate_to_file, ScenarioSource};
 pub use turn_calibration::{learn_turn_calibration, Labelled, Learned};
 
 /// A parameter file: its path, its TOML text, or its values already read (so that a
@@ -532,33 +534,4 @@ pub fn nameplate_document(
         "out": out.map(|p| p.display().to_string()),
         "toml": toml,
     })
-}
-
-/// `simulate` into the log `out` (its format by extension), the scenario given as TOML
-/// text; the run's summary. The log is written whole or not at all.
-///
-/// # Errors
-/// A bad parameter file or scenario ([`ApiError::Simulation`] naming the key), a write
-/// error, [`ApiError::Interrupted`].
-pub fn simulate_to_file(
-    params: ParamsSource<'_>,
-    scenario_toml: &str,
-    out: &Path,
-) -> Result<monitor_sim::SimSummary, ApiError> {
-    let (params, _) = load_params(params)?;
-    let sc = monitor_sim::Scenario::from_toml_str(scenario_toml, "the scenario")?;
-    let mut w = monitor_io::log::LogWriter::create(out, sc.sensors.channels())?;
-    let mut err = None;
-    let summary = monitor_sim::simulate_while(&params, &sc, |r| match w.write_row(r) {
-        Ok(()) => std::ops::ControlFlow::Continue(()),
-        Err(e) => {
-            err = Some(e);
-            std::ops::ControlFlow::Break(())
-        }
-    })?;
-    if let Some(e) = err {
-        return Err(e.into());
-    }
-    w.finish()?;
-    summary.ok_or(ApiError::Interrupted)
 }

@@ -45,10 +45,19 @@ pub struct FleetArgs {
 /// Runs `fleet`.
 ///
 /// # Errors
-/// A motor table that cannot be read, or an error writing to standard output (a log's own
-/// error is its row's).
+/// A motor table that cannot be read, a store that is one of the files the run reads
+/// ("refusing to overwrite the input ..."), or an error writing to standard output (a
+/// log's own error is its row's).
 pub fn run(args: &FleetArgs) -> anyhow::Result<()> {
     let table = monitor_api::fleet::MotorTable::load(&args.motors)?;
+    if let Some(store) = &args.store {
+        monitor_api::fleet::check_fleet_outputs(
+            Some(&args.motors),
+            &table,
+            &args.logs,
+            &[monitor_api::files::NamedFile::path(store)],
+        )?;
+    }
     let rows: Vec<monitor_api::fleet::FleetRow> = match &args.store {
         Some(path) => super::store_run::judge_into(&table, &args.logs, path)?,
         None => args

@@ -1,10 +1,10 @@
-//! The one guard against overwriting an input: a command names its inputs and every file
-//! it will write, and the guard refuses before anything is written.
-//!
-//! Two paths are the same file when their canonical paths are equal (this catches `..`,
-//! `./` and symbolic links) or, when both exist, when they have the same device and inode
-//! (this catches hard links too, which no path comparison can). An output that does not
-//! exist yet cannot be an input.
+//! The command line's side of the one guard against overwriting an input: a command names
+//! its inputs and every file it will write, and the guard refuses before anything is
+//! written. The test itself (the same file by canonical path, or by device and inode, so
+//! that `..`, `./`, symbolic and hard links are all caught) is the library's,
+//! `monitor_api::files::check_outputs`, which the Python package and the fleet run call
+//! too; this adds the command line's own refusal of an existing parameter file without
+//! `--force`.
 //!
 //! What the commands write, for their callers:
 //! - `simulate`: `--out` (through a temporary file beside it with a random name, which is
@@ -15,6 +15,7 @@
 //!   checked with [`OutputGuard::check_folder`]. Their temporary files, too, get random
 //!   names created exclusively.
 
+use monitor_api::files::{check_output_folder, check_outputs, NamedFile};
 use std::path::{Path, PathBuf};
 
 /// The inputs of a command.
@@ -30,26 +31,24 @@ impl OutputGuard {
         }
     }
 
+    /// The inputs as the library's guard takes them: named by their paths alone.
+    fn named(&self) -> Vec<NamedFile<'_>> {
+        self.inputs.iter().map(|p| NamedFile::path(p)).collect()
+    }
+
     /// Refuses when an output file is one of the inputs (the same file by its canonical
-    /// path, or by device and inode: a symbolic or hard link to an input is refused).
+    /// path, or by device and inode: a symbolic or hard link to an input is refused), by
+    /// the library's one guard (`monitor_api::files::check_outputs`).
     ///
     /// # Errors
-    /// "refusing to overwrite the input ..." naming the input and the output.
+    /// "refusing to overwrite the input ..." naming the input (and the output, when it is
+    /// a hard link to it).
     pub fn check_files<P: AsRef<Path>>(&self, outputs: &[P]) -> anyhow::Result<()> {
-        for out in outputs {
-            let out = out.as_ref();
-            if let Some(input) = self.input_at(out) {
-                if same_path(input, out) {
-                    anyhow::bail!("refusing to overwrite the input {}", input.display());
-                }
-                anyhow::bail!(
-                    "refusing to overwrite the input {}: the output {} is the same file",
-                    input.display(),
-                    out.display()
-                );
-            }
-        }
-        Ok(())
+        let outputs: Vec<NamedFile<'_>> = outputs
+            .iter()
+            .map(|o| NamedFile::path(o.as_ref()))
+            .collect();
+        Ok(check_outputs(&self.named(), &outputs)?)
     }
 
     /// Refuses a parameter-file output that is an input, or that exists without `force`
@@ -74,43 +73,12 @@ impl OutputGuard {
     /// # Errors
     /// As [`OutputGuard::check_files`], or "output folder ... is an input file".
     pub fn check_folder(&self, dir: &Path, files: &[String]) -> anyhow::Result<()> {
-        if self.input_at(dir).is_some() {
-            anyhow::bail!("output folder {} is an input file", dir.display());
-        }
-        let paths: Vec<PathBuf> = files.iter().map(|f| dir.join(f)).collect();
-        self.check_files(&paths)
+        Ok(check_output_folder(
+            &self.named(),
+            NamedFile::path(dir),
+            files,
+        )?)
     }
-
-    fn input_at(&self, out: &Path) -> Option<&PathBuf> {
-        self.inputs.iter().find(|i| same_file(i, out))
-    }
-}
-
-/// Whether `a` and `b` are the same existing file: equal canonical paths, or (Unix) equal
-/// device and inode numbers. False when either does not exist.
-pub fn same_file(a: &Path, b: &Path) -> bool {
-    let (Ok(ca), Ok(cb)) = (std::fs::canonicalize(a), std::fs::canonicalize(b)) else {
-        return false;
-    };
-    if ca == cb {
-        return true;
-    }
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        if let (Ok(ma), Ok(mb)) = (std::fs::metadata(&ca), std::fs::metadata(&cb)) {
-            return ma.dev() == mb.dev() && ma.ino() == mb.ino();
-        }
-    }
-    false
-}
-
-/// Whether `a` and `b` name the file by the same canonical path (not through a link).
-fn same_path(a: &Path, b: &Path) -> bool {
-    matches!(
-        (std::fs::canonicalize(a), std::fs::canonicalize(b)),
-        (Ok(x), Ok(y)) if x == y
-    )
 }
 
 #[cfg(test)]

@@ -22,7 +22,9 @@
 //!   interval), and the time base is judged in one place, [`quality::QualityStage`].
 //! - Writing is atomic ([`LogWriter`], [`write_atomic`]): a temporary file beside the
 //!   target, renamed on [`LogWriter::finish`], so an interrupted run never leaves a
-//!   half-written output and never touches an input.
+//!   half-written output; and before it, the one guard against overwriting an input
+//!   ([`check_outputs`]: an output that is an input, by any path or link, is refused
+//!   before anything is written), which every front end calls.
 
 pub mod clipping;
 mod csv_header;
@@ -32,6 +34,7 @@ mod fast;
 mod format;
 pub mod mapping;
 mod memory;
+mod overwrite;
 pub mod parquet;
 pub mod quality;
 mod reader;
@@ -43,6 +46,7 @@ mod writer;
 pub use format::Format;
 pub use mapping::{ChannelUnit, ColumnMapping};
 pub use memory::{MemoryLog, MemoryValues};
+pub use overwrite::{check_output_folder, check_outputs, same_file, NamedFile, OverwriteError};
 pub use reader::{LogFile, RowSink};
 pub use source::OpenOptions;
 pub use writer::{write_atomic, LogWriter};
