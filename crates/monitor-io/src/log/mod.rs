@@ -103,7 +103,8 @@ pub enum LogError {
         /// "holds no finite value", or what its values are instead.
         why: String,
     },
-    /// A cell is not a number.
+    /// A time cell is not a number (text in a measured column is a bad cell, read as
+    /// NaN for the data-quality stage).
     #[error("{path}: line {line}, column '{column}': '{cell}' is not a number")]
     NotNumeric {
         /// The file.
