@@ -13,7 +13,8 @@
 //! - 1: stdout could not be written (a full disk, an I/O error): one line on stderr;
 //! - 2: bad arguments or input, or any other error: one line on stderr;
 //! - 130 / 143: interrupted by SIGINT / SIGTERM (128 + the signal, the shell's
-//!   convention) during a command that cleans up on a signal (`simulate`).
+//!   convention) during a command that catches it (`simulate` and `convert` remove their
+//!   partial output, `diagnose` stops its replay): one line says what was stopped.
 
 mod alloc_tuning;
 mod cli;

@@ -309,9 +309,10 @@ impl Interrupted {
 /// SIGINT and SIGTERM as a flag a long loop checks ([`Interruption::signal`]), from
 /// [`Interruption::catch`] to the end of the process.
 ///
-/// Only the commands that clean up on a signal catch it (`simulate`, around its write
-/// loop); every other command keeps the default action (the process ends at once; its
-/// outputs are written atomically at the end, so it leaves at most a small temporary file).
+/// Only the commands that clean up or report on a signal catch it (`simulate` and
+/// `convert` around their write loops, `diagnose` around its replay); every other
+/// command keeps the default action (the process ends at once; its outputs are written
+/// atomically at the end, so it leaves at most a small temporary file).
 /// A second signal while the first is being handled ends the process at once with
 /// 128 + the signal, as the default action would.
 pub struct Interruption {
