@@ -12,7 +12,12 @@
 use std::path::Path;
 
 /// The workspace crates a front end may list in `[dependencies]`.
-const ALLOWED: [&str; 4] = ["monitor-core", "monitor-api", "monitor-studies", "monitor-store"];
+const ALLOWED: [&str; 4] = [
+    "monitor-core",
+    "monitor-api",
+    "monitor-studies",
+    "monitor-store",
+];
 
 /// The front ends' manifests, from the workspace's root.
 const FRONT_ENDS: [&str; 2] = ["sim-host/Cargo.toml", "python/Cargo.toml"];
@@ -47,5 +52,8 @@ fn the_front_ends_reach_the_library_through_monitor_api() {
 #[test]
 fn the_rule_sees_a_library_below_the_facade() {
     let manifest = "[dependencies]\nmonitor-api.workspace = true\nmonitor-replay.workspace = true\n\n[dev-dependencies]\nmonitor-sim.workspace = true\n";
-    assert_eq!(beside_the_facade(manifest), vec!["monitor-replay".to_string()]);
+    assert_eq!(
+        beside_the_facade(manifest),
+        vec!["monitor-replay".to_string()]
+    );
 }
