@@ -13,7 +13,8 @@
 //! - 1: stdout could not be written (a full disk, an I/O error): one line on stderr;
 //! - 2: bad arguments or input, or any other error: one line on stderr;
 //! - 130 / 143: interrupted by SIGINT / SIGTERM (128 + the signal, the shell's
-//!   convention) during a command that cleans up on a signal (`simulate`).
+//!   convention) during a command that catches it (`simulate` and `convert` remove their
+//!   partial output, `diagnose` stops its replay): one line says what was stopped.
 
 mod alloc_tuning;
 mod cli;
@@ -49,7 +50,7 @@ fn main() -> ExitCode {
             } else {
                 first.join(" ")
             };
-            report(&format!("{first} (see --help)"));
+            report(&format!("{first}{} (see --help)", did_you_mean(&e)));
             return ExitCode::from(2);
         }
     };
@@ -62,6 +63,33 @@ fn main() -> ExitCode {
             }
             ExitCode::from(status)
         }
+    }
+}
+
+/// clap's suggestion for a misspelt command, option or value (`sim-host diagnos`: "; did
+/// you mean 'diagnose'?"), which its usage paragraphs carry and the one line keeps; empty
+/// when clap has none.
+fn did_you_mean(e: &clap::Error) -> String {
+    use clap::error::{ContextKind, ContextValue};
+    let kinds = [
+        ContextKind::SuggestedSubcommand,
+        ContextKind::SuggestedArg,
+        ContextKind::SuggestedValue,
+    ];
+    let names: Vec<String> = kinds
+        .iter()
+        .filter_map(|k| e.get(*k))
+        .flat_map(|v| match v {
+            ContextValue::String(s) => vec![s.clone()],
+            ContextValue::Strings(s) => s.clone(),
+            _ => Vec::new(),
+        })
+        .map(|s| format!("'{s}'"))
+        .collect();
+    if names.is_empty() {
+        String::new()
+    } else {
+        format!("; did you mean {}?", names.join(" or "))
     }
 }
 

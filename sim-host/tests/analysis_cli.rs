@@ -177,7 +177,9 @@ fn bad_input_gives_a_one_line_error() {
     let bad_csv = dir.path().join("bad.csv");
     std::fs::write(&bad_csv, "t_s,ia_A,ib_A\n0,1,2\n").unwrap();
     let bad_num = dir.path().join("badnum.csv");
-    std::fs::write(&bad_num, "t_s,ia_A,ib_A,ic_A\n0,1,2,3\n0.001,1,x,3\n").unwrap();
+    // (Text in a time cell: a row that cannot be placed. Text in a measured column is a
+    // bad cell, held out like NaN.)
+    std::fs::write(&bad_num, "t_s,ia_A,ib_A,ic_A\n0,1,2,3\nx0.001,1,2,3\n").unwrap();
     let cases: Vec<(Vec<std::ffi::OsString>, &str)> = vec![
         (
             vec![

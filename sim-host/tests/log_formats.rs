@@ -536,16 +536,17 @@ fn convert_never_overwrites_its_input_and_names_bad_cells() {
         std::fs::read_to_string(&csv).expect("csv").lines().count(),
         3
     );
-    // A bad cell: the exact reader's line and column, and no output left behind.
+    // A time cell that is not a number: the exact reader's line and column, and no output
+    // left behind. (Text in a measured column is a bad cell, converted as NaN.)
     let bad = dir.path().join("bad.csv");
-    std::fs::write(&bad, "t_s,ia_A,ib_A,ic_A\n0,1,2,-3\n0.001,1,x,-3\n").expect("write");
+    std::fs::write(&bad, "t_s,ia_A,ib_A,ic_A\n0,1,2,-3\n0.001x,1,2,-3\n").expect("write");
     let out = dir.path().join("bad.parquet");
     let e = fails(&[
         "convert",
         bad.to_str().expect("utf8"),
         out.to_str().expect("utf8"),
     ]);
-    assert!(e.contains("line 3") && e.contains("ib_A"), "{e}");
+    assert!(e.contains("line 3") && e.contains("t_s"), "{e}");
     assert!(!out.exists());
     let leftovers = std::fs::read_dir(dir.path())
         .expect("dir")

@@ -95,6 +95,10 @@ pub enum FleetError {
         /// What is wrong.
         message: String,
     },
+    /// A log given as a pattern (`*`, `?` or `[` in its file name) that names no file:
+    /// the same words as the Python package's fleet run.
+    #[error("logs: the pattern '{0}' matches no file")]
+    NoMatch(String),
 }
 
 impl MotorTable {
@@ -143,6 +147,44 @@ impl MotorTable {
         let name = log.file_name()?.to_string_lossy();
         self.motor.iter().find(|m| wildcard(&m.logs, &name))
     }
+}
+
+/// The logs of a fleet run: each path as given, but a path that names no file and holds a
+/// pattern in its file name (`logs/pump_*.csv`, quoted past the shell, or a shell glob that
+/// matched nothing and was passed on as it stands) is expanded to the files of its folder
+/// whose names match it ([`wildcard`]), sorted.
+///
+/// # Errors
+/// [`FleetError::NoMatch`] naming a pattern that matches no file (rather than a row per
+/// pattern blaming the motor table).
+pub fn expand_logs(logs: &[PathBuf]) -> Result<Vec<PathBuf>, FleetError> {
+    let mut out = Vec::with_capacity(logs.len());
+    for log in logs {
+        let name = log.file_name().map(|n| n.to_string_lossy().into_owned());
+        let pattern = name.filter(|n| n.contains(['*', '?', '[']));
+        let Some(pattern) = pattern.filter(|_| !log.exists()) else {
+            out.push(log.clone());
+            continue;
+        };
+        let folder = match log.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let mut found: Vec<PathBuf> = std::fs::read_dir(&folder)
+            .into_iter()
+            .flatten()
+            .flatten()
+            .filter(|e| e.path().is_file())
+            .filter(|e| wildcard(&pattern, &e.file_name().to_string_lossy()))
+            .map(|e| log.with_file_name(e.file_name()))
+            .collect();
+        if found.is_empty() {
+            return Err(FleetError::NoMatch(log.display().to_string()));
+        }
+        found.sort();
+        out.extend(found);
+    }
+    Ok(out)
 }
 
 /// `p` taken from `base` when relative.

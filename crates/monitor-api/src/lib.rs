@@ -423,6 +423,15 @@ pub struct Identified {
     pub toml: String,
 }
 
+impl Identified {
+    /// The identified parameter file's text without the start file's `[columns]` table
+    /// (`sim-host identify` writes this one unless asked to keep the table): it reads logs
+    /// with the standard column names, not only the DAQ's the start file mapped.
+    pub fn toml_without_columns(&self) -> &str {
+        monitor_analysis::identify::without_columns(&self.toml)
+    }
+}
+
 /// `identify`: the circuit and the mechanics of the start file's machine from `log`
 /// (`--from`/`--to` its window), or a refusal naming the likely cause
 /// ([`monitor_analysis::identify::refusal`]).

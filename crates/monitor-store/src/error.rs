@@ -19,6 +19,15 @@ pub enum HistoryError {
         /// What failed.
         message: String,
     },
+    /// The store (or the folder it is to be made in) cannot be written: SQLite's own word
+    /// for it is "unable to open database file".
+    #[error("permission denied: cannot write the store {path} ({why})")]
+    Permission {
+        /// The store's file.
+        path: String,
+        /// Which of the file and its folder is not writable.
+        why: String,
+    },
     /// Reading a store that does not exist.
     #[error("no store at {0} (a fleet run writes one where it is given a store)")]
     Missing(String),

@@ -225,9 +225,52 @@ impl Store {
     }
 }
 
+/// SQLite's error on the store `path`, as [`HistoryError::Permission`] when SQLite cannot
+/// open or write it because the file or its folder is not writable.
 fn sql(path: &Path, e: &rusqlite::Error) -> HistoryError {
+    use rusqlite::ErrorCode;
+    let cannot_open = matches!(
+        e.sqlite_error_code(),
+        Some(ErrorCode::CannotOpen | ErrorCode::ReadOnly | ErrorCode::PermissionDenied)
+    );
+    if let Some(why) = cannot_open.then(|| not_writable(path)).flatten() {
+        return HistoryError::Permission {
+            path: path.display().to_string(),
+            why,
+        };
+    }
     HistoryError::Sqlite {
         path: path.display().to_string(),
         message: e.to_string(),
+    }
+}
+
+/// Why the store `path` cannot be written, if that is so: the file is read-only, or its
+/// folder (where SQLite makes the store and its `-wal` and `-shm` files) is not writable.
+/// Tried, not read from the mode bits, so that a superuser who can write anyway is not
+/// told otherwise.
+fn not_writable(path: &Path) -> Option<String> {
+    let denied = |e: std::io::Error| e.kind() == std::io::ErrorKind::PermissionDenied;
+    if path.exists() {
+        if let Err(e) = std::fs::OpenOptions::new().append(true).open(path) {
+            return denied(e).then(|| "the file is read-only".to_string());
+        }
+    }
+    let folder = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let probe = folder.join(format!(".store-write-test-{}", std::process::id()));
+    match std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&probe)
+    {
+        Ok(_) => {
+            // (A probe left behind would only be a stray empty file.)
+            let _ = std::fs::remove_file(&probe);
+            None
+        }
+        Err(e) => denied(e).then(|| format!("the folder {} is not writable", folder.display())),
     }
 }

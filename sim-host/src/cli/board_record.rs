@@ -18,7 +18,8 @@ use std::path::PathBuf;
     long_about = "Write the firmware's motor record: the parameter file's [motor] and [supply], \
 the sensor full scales and zero offsets, and the encoder's line count, direction and pull-ups, as the \
 132-byte CRC-checked record the firmware reads from flash at boot. The output is written \
-atomically and is never the input.\n\nExample:\n  sim-host board-record P.toml --out motor.bin"
+atomically and is never the input.\n\nOutput: `wrote FILE (132 bytes)`, or with --json one JSON \
+document {out, bytes} on stdout.\n\nExample:\n  sim-host board-record P.toml --out motor.bin"
 )]
 pub struct BoardRecordArgs {
     /// The parameter file ([motor] and [supply]).
@@ -49,6 +50,9 @@ pub struct BoardRecordArgs {
     /// with pull-ups of its own.
     #[arg(long)]
     pub encoder_no_pull_up: bool,
+    /// Print one JSON document on stdout ({out, bytes}) instead of the line.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Runs `board-record`.
@@ -79,6 +83,21 @@ pub fn run(args: &BoardRecordArgs) -> anyhow::Result<()> {
     }
     monitor_api::files::write_atomic(&args.out, &bytes)
         .with_context(|| format!("writing {}", args.out.display()))?;
-    println!("wrote {} ({} bytes)", args.out.display(), bytes.len());
-    Ok(())
+    let mut stdout = super::stdout();
+    if args.json {
+        let doc = serde_json::json!({
+            "out": args.out.display().to_string(),
+            "bytes": bytes.len(),
+        });
+        super::render::json::print(&mut stdout, &doc)
+    } else {
+        use std::io::Write;
+        writeln!(
+            stdout,
+            "wrote {} ({} bytes)",
+            args.out.display(),
+            bytes.len()
+        )?;
+        Ok(())
+    }
 }

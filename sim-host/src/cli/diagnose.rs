@@ -196,12 +196,7 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         .map(|m| m.len() > 20_000_000)
         .unwrap_or(false);
     let bar = progress::bar(progress::FRACTION_STEPS, "reading log", big);
-    let d = monitor_api::diagnose(
-        monitor_api::ParamsSource::Path(&args.params),
-        &args.log,
-        &req,
-        &mut |f| progress::set_fraction(&bar, f),
-    )?;
+    let d = replay_until_signal(args, req, &bar)?;
     bar.finish_and_clear();
     render::text::quality_warnings(&d.report.data_quality);
     if let Some(out) = &args.report {
@@ -211,6 +206,52 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         render::json::print(&mut crate::cli::stdout(), &d.report)
     } else {
         render::text::diagnose(&mut crate::cli::stdout(), &args.log, &d)
+    }
+}
+
+/// The replay of `diagnose`, on a thread of its own, while this one watches for SIGINT and
+/// SIGTERM: a signal stops the command at once with [`super::Interrupted`] ("diagnose of
+/// LOG stopped; nothing was written", status 130 or 143) instead of ending the process
+/// without a word. Nothing is printed before the replay ends, so nothing is half written;
+/// the replay's thread ends with the process.
+///
+/// # Errors
+/// The replay's error, or [`super::Interrupted`].
+fn replay_until_signal(
+    args: &DiagnoseArgs,
+    req: monitor_api::DiagnoseRequest,
+    bar: &indicatif::ProgressBar,
+) -> anyhow::Result<monitor_api::replay::Diagnosed> {
+    use std::sync::mpsc::{channel, RecvTimeoutError};
+    let interruption = super::Interruption::catch()?;
+    let (params, log, worker_bar) = (args.params.clone(), args.log.clone(), bar.clone());
+    let (tx, rx) = channel();
+    std::thread::spawn(move || {
+        let d = monitor_api::diagnose(
+            monitor_api::ParamsSource::Path(&params),
+            &log,
+            &req,
+            &mut |f| progress::set_fraction(&worker_bar, f),
+        );
+        // (The receiver is gone only when a signal already ended the command.)
+        let _ = tx.send(d);
+    });
+    loop {
+        match rx.recv_timeout(std::time::Duration::from_millis(50)) {
+            Ok(d) => return Ok(d?),
+            Err(RecvTimeoutError::Timeout) => {}
+            Err(RecvTimeoutError::Disconnected) => {
+                anyhow::bail!("diagnose of {}: the replay stopped", args.log.display())
+            }
+        }
+        let what = format!(
+            "diagnose of {} stopped; nothing was written",
+            args.log.display()
+        );
+        if let Some(sig) = interruption.signal(&what) {
+            bar.finish_and_clear();
+            return Err(sig.into());
+        }
     }
 }
 

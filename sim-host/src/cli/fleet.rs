@@ -13,7 +13,8 @@ use std::path::PathBuf;
     long_about = "Diagnose many logs of many motors on this machine, in parallel, and print one row \
 per log: motor, file, rows, rate_hz, verdict, fault, size, phase, confidence, \
 first_detection_s, load_moves, data_quality, error. A bad file is a row with its error, never a \
-failed run.\n\nWith --store PATH each judged log is also appended to a store of the motors' \
+failed run; a log pattern that matches no file (`'logs/pump_*.csv'`, or a shell glob that matched \
+nothing) is an error naming the pattern.\n\nWith --store PATH each judged log is also appended to a store of the motors' \
 history (SQLite at PATH, one transaction per log, and a Parquet mirror in PATH.parquet/, \
 partitioned by motor and day): its motor is the table's name for it, its time the file's \
 modification time. A log already stored (the same bytes at the same path) is skipped, not \
@@ -30,7 +31,8 @@ same rows on a Dask cluster (docs/python.md).\n\nExample:\n  sim-host fleet moto
 pub struct FleetArgs {
     /// The motor table (TOML).
     pub motors: PathBuf,
-    /// The logs (CSV, TDMS or Parquet).
+    /// The logs (CSV, TDMS or Parquet); a file name with `*` or `?` that names no file is a
+    /// pattern, expanded in its folder (a pattern that matches no file is an error).
     #[arg(required = true)]
     pub logs: Vec<PathBuf>,
     /// Print one JSON document (a list of rows) instead of CSV.
@@ -50,18 +52,18 @@ pub struct FleetArgs {
 /// log's own error is its row's).
 pub fn run(args: &FleetArgs) -> anyhow::Result<()> {
     let table = monitor_api::fleet::MotorTable::load(&args.motors)?;
+    let logs = monitor_api::fleet::expand_logs(&args.logs)?;
     if let Some(store) = &args.store {
         monitor_api::fleet::check_fleet_outputs(
             Some(&args.motors),
             &table,
-            &args.logs,
+            &logs,
             &[monitor_api::files::NamedFile::path(store)],
         )?;
     }
     let rows: Vec<monitor_api::fleet::FleetRow> = match &args.store {
-        Some(path) => super::store_run::judge_into(&table, &args.logs, path)?,
-        None => args
-            .logs
+        Some(path) => super::store_run::judge_into(&table, &logs, path)?,
+        None => logs
             .par_iter()
             .map(|log| monitor_api::fleet::row(&table, log))
             .collect(),

@@ -36,8 +36,10 @@ A constant load torque is not in the model: B + Bl then absorbs it.\n\n\
 Output: a table (parameter, start, identified, 95 % interval), or --json (one document: \
 estimates [{name, key, unit, start, value, lo, hi, not_identified_because}], inverse_gamma \
 {rs_ohm, r_r_ohm, l_sigma_h, l_m_h}, relative errors, solver, toml). --out writes the parameter file (atomically; never over the log or the start \
-file, nor over another file without --force), each line saying where its value came from; the \
-start file's [columns] table is kept, so the new file reads the same log.\n\n\
+file, nor over another file without --force), each line saying where its value came from. The \
+start file's [columns] table (a DAQ's channel names and units) is left out, so that the new file \
+reads logs with the standard column names; --keep-columns keeps it, for more logs of the same \
+DAQ.\n\n\
 Example (docs/own-motor.md):\n  \
 sim-host params from-nameplate --power-kw 2.2 --voltage-v 400 --current-a 4.8 --frequency-hz 50 \
 --speed-rpm 1438 --power-factor 0.77 --efficiency 0.863 --out nameplate.toml\n  \
@@ -53,6 +55,11 @@ pub struct IdentifyArgs {
     /// Write the identified parameter file here (atomically).
     #[arg(long, value_name = "P.toml")]
     pub out: Option<PathBuf>,
+    /// Keep the start file's [columns] table in the written file (and in --json's toml),
+    /// for more logs of the same DAQ; without it the file reads logs with the standard
+    /// column names.
+    #[arg(long)]
+    pub keep_columns: bool,
     /// Overwrite --out when it exists (never an input).
     #[arg(long)]
     pub force: bool,
@@ -100,10 +107,13 @@ pub fn run(args: &IdentifyArgs) -> anyhow::Result<()> {
         &mut |f| progress::set_fraction(&pb, f),
     );
     pb.finish_and_clear();
-    let monitor_api::Identified {
-        identification: id,
-        toml,
-    } = done?;
+    let done = done?;
+    let toml = if args.keep_columns {
+        done.toml.as_str()
+    } else {
+        done.toml_without_columns()
+    };
+    let id = &done.identification;
     super::write_out(args.out.as_deref(), toml.as_bytes())?;
     let mut stdout = super::stdout();
     if args.json {
@@ -114,7 +124,7 @@ pub fn run(args: &IdentifyArgs) -> anyhow::Result<()> {
         });
         writeln!(stdout, "{}", serde_json::to_string_pretty(&doc)?)?;
     } else {
-        write!(stdout, "{}", table(&id))?;
+        write!(stdout, "{}", table(id))?;
         match &args.out {
             Some(out) => writeln!(stdout, "wrote {}", out.display())?,
             None => writeln!(stdout, "(give --out P.toml to write the parameter file)")?,

@@ -42,7 +42,7 @@ sim-host simulate --params P.toml --scenario S.toml --out D.csv\n  sim-host diag
 D.csv --commission 2:4\n  sim-host compare --params P.toml D.csv\n  sim-host explain --params P.toml \
 D.csv\n  sim-host hmi\n  sim-host convert D.csv D.parquet\n\nYour own motor (docs/own-motor.md):\n  \
 sim-host params from-nameplate --power-kw 2.2 --voltage-v 400 ... --out P.toml\n  \
-sim-host identify --params P.toml LOG --out P2.toml\n  sim-host diagnose --params P2.toml LOG --commission A:B\n\nLogs are CSV, TDMS (.tdms) or Parquet (.parquet), by \
+sim-host identify --params P.toml LOG --out P2.toml --keep-columns\n  sim-host diagnose --params P2.toml LOG --commission A:B\n\nLogs are CSV, TDMS (.tdms) or Parquet (.parquet), by \
 their extension.\n\nEvery command but the interactive hmi takes --json (one JSON document on stdout; progress \
 and logs on stderr)."
 )]
@@ -309,9 +309,10 @@ impl Interrupted {
 /// SIGINT and SIGTERM as a flag a long loop checks ([`Interruption::signal`]), from
 /// [`Interruption::catch`] to the end of the process.
 ///
-/// Only the commands that clean up on a signal catch it (`simulate`, around its write
-/// loop); every other command keeps the default action (the process ends at once; its
-/// outputs are written atomically at the end, so it leaves at most a small temporary file).
+/// Only the commands that clean up or report on a signal catch it (`simulate` and
+/// `convert` around their write loops, `diagnose` around its replay); every other
+/// command keeps the default action (the process ends at once; its outputs are written
+/// atomically at the end, so it leaves at most a small temporary file).
 /// A second signal while the first is being handled ends the process at once with
 /// 128 + the signal, as the default action would.
 pub struct Interruption {

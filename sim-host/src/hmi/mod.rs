@@ -12,11 +12,13 @@
 //!   (`cargo fw-run | sim-host hmi --stdin`), parsed by [`status_line::parse`].
 //!
 //! The keys are one table, [`keys`] (the screen's footer, `--help` and docs/hmi.md use it).
-//! Drawing is the binary's (`src/cli/render/hmi.rs`): a pure function of [`HmiState`].
+//! Drawing is the binary's (`src/cli/render/hmi.rs`): a pure function of [`HmiState`]; the
+//! smallest terminal it fits in, and the note drawn in a smaller one, are [`size`]'s.
 
 mod keys;
 pub mod live;
 pub mod log_replay;
+pub mod size;
 pub mod status_line;
 
 pub use keys::{

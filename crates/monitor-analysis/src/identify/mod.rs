@@ -36,7 +36,7 @@ use model::{CurrentFit, IdentifiedCircuit, N_PARAMS};
 use monitor_io::params::ParamFile;
 use serde::Serialize;
 
-pub use output::{inverse_gamma_line, to_toml};
+pub use output::{inverse_gamma_line, to_toml, without_columns, COLUMNS_COPIED};
 pub use refuse::{refusal, MAX_FIT_ERROR};
 pub use samples::{IdentifyError, Samples, MIN_DURATION_S};
 

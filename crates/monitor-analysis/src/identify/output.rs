@@ -67,8 +67,20 @@ fn source(e: &Estimate) -> String {
     }
 }
 
+/// The line that opens the identified file's copy of the start file's `[columns]` table
+/// ([`to_toml`]; [`without_columns`] cuts the file there).
+pub const COLUMNS_COPIED: &str =
+    "# The start file's [columns] table: the log's channels and units.\n[columns]\n";
+
+/// The identified file's text ([`to_toml`]) without its copy of the start file's
+/// `[columns]` table: a file that reads logs with the standard column names.
+pub fn without_columns(toml: &str) -> &str {
+    toml.find(COLUMNS_COPIED).map_or(toml, |k| &toml[..k])
+}
+
 /// The TOML text of the identified parameter file. `start_text` is the start file's text
-/// (its `[columns]` table is copied), `start_name` and `log_name` name the inputs.
+/// (its `[columns]` table is copied, after [`COLUMNS_COPIED`]), `start_name` and
+/// `log_name` name the inputs.
 pub fn to_toml(id: &Identification, start_text: &str, start_name: &str, log_name: &str) -> String {
     let mut s = format!(
         "# Identified by `sim-host identify` (docs/own-motor.md) from {log_name}, {:.3}..{:.3} s\n\
@@ -101,9 +113,7 @@ pub fn to_toml(id: &Identification, start_text: &str, start_name: &str, log_name
         .map(|(_, c)| c)
         .unwrap_or_default();
     if !columns.is_empty() {
-        s.push_str(
-            "# The start file's [columns] table: the log's channels and units.\n[columns]\n",
-        );
+        s.push_str(COLUMNS_COPIED);
         s.push_str(&monitor_io::params::columns_entries_toml(&columns));
     }
     s

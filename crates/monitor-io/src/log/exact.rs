@@ -2,8 +2,9 @@
 //! slow but with messages that name the line and column. Behind the fast path. Like it, it
 //! hands over non-finite numbers, missing values ([`super::is_missing`], as NaN) and times
 //! that do not increase (the data-quality stage judges them), skips blank lines and counts
-//! them; other text that is not a number is an error. It alone reads a time column of
-//! ISO 8601 text ([`super::mapping`]).
+//! them; other text in a measured column is handed over as NaN too (a bad cell the stage
+//! counts), while text in the time column is an error naming the line and column. It alone
+//! reads a time column of ISO 8601 text ([`super::mapping`]).
 
 use super::mapping::{parse_iso8601, TimeKind};
 use super::source::{row_from_values, ColumnMap, Opened};
@@ -82,14 +83,19 @@ impl ExactRows {
         if super::is_missing(s) {
             return Ok(Some(f64::NAN));
         }
-        s.parse::<f64>()
-            .map(Some)
-            .map_err(|_| LogError::NotNumeric {
+        match s.parse::<f64>() {
+            Ok(x) => Ok(Some(x)),
+            // A measured value that is text (`abc`, a DAQ's `#OVF`) is a bad cell like
+            // NaN: the data-quality stage holds it out and counts it (`bad_cells`).
+            Err(_) if c != Column::Time => Ok(Some(f64::NAN)),
+            // Without its time a row cannot be placed: the file is refused.
+            Err(_) => Err(LogError::NotNumeric {
                 path: self.shown.clone(),
                 line,
                 column: self.columns.name_of_field(col),
                 cell: s.chars().take(40).collect(),
-            })
+            }),
+        }
     }
 
     /// An ISO 8601 time [s since the first row's whole second]; a missing value is NaN.

@@ -370,14 +370,22 @@ mod tests {
             for block in [64, 1 << 20] {
                 assert!(!fast(&path, block).0, "{bad} block {block}");
             }
-            // ... where the exact reader (behind `LogFile::for_each_row`) names the line,
-            // except for the quotes, which it accepts.
+            // ... where the exact reader (behind `LogFile::for_each_row`) names the line of
+            // a wrong field count; it accepts the quotes, and reads text in a measured
+            // column as a bad cell (NaN, for the data-quality stage).
             let log = LogFile::open(&path).unwrap();
             let mut rows: Vec<Row> = Vec::new();
             let res = log.for_each_row(&mut |_| {}, &mut rows);
-            if bad.contains('"') {
+            if bad.contains('"') || bad.contains('x') || bad.contains("zz") {
                 assert_eq!(res.unwrap(), 502);
                 assert_eq!(rows.len(), 502, "the sink was restarted");
+                let r = &rows[500];
+                if bad.contains('x') {
+                    assert!(r.v_abc.is_some_and(|v| v[0].is_nan()), "{bad}: {r:?}");
+                }
+                if bad.contains("zz") {
+                    assert_eq!(r.enc_count, Some(crate::log::ENC_COUNT_UNREADABLE), "{bad}");
+                }
             } else {
                 let e = res.unwrap_err().to_string();
                 assert!(e.contains("line 502"), "{bad}: {e}");

@@ -107,7 +107,8 @@ pub enum LogError {
         /// "holds no finite value", or what its values are instead.
         why: String,
     },
-    /// A cell is not a number.
+    /// A time cell is not a number (text in a measured column is a bad cell, read as
+    /// NaN for the data-quality stage).
     #[error("{path}: line {line}, column '{column}': '{cell}' is not a number")]
     NotNumeric {
         /// The file.
@@ -455,9 +456,14 @@ mod tests {
         let missing = write("t_s,ia_A,ib_A\n0,1,2\n");
         let e = Log::read(missing.path()).unwrap_err().to_string();
         assert!(e.contains("ic_A"), "{e}");
-        let nonnum = write("t_s,ia_A,ib_A,ic_A\n0,1,2,3\n0.1,1,abc,3\n");
+        // Text in a measured column is a bad cell (NaN); in the time column, an error
+        // naming the line and column.
+        let text = write("t_s,ia_A,ib_A,ic_A\n0,1,2,3\n0.1,1,abc,3\n");
+        let rows = Log::read(text.path()).unwrap().rows;
+        assert!(rows.len() == 2 && rows[1].i_abc[1].is_nan(), "{rows:?}");
+        let nonnum = write("t_s,ia_A,ib_A,ic_A\n0,1,2,3\nabc,1,2,3\n");
         let e = Log::read(nonnum.path()).unwrap_err().to_string();
-        assert!(e.contains("ib_A") && e.contains("line 3"), "{e}");
+        assert!(e.contains("t_s") && e.contains("line 3"), "{e}");
         // Times that do not increase are handed over (the data-quality stage judges them).
         let back_in_time = write("t_s,ia_A,ib_A,ic_A\n0,1,2,3\n0,1,2,3\n");
         assert_eq!(Log::read(back_in_time.path()).unwrap().rows.len(), 2);

@@ -22,8 +22,12 @@ use sim_host::hmi::{header_text, keys, Controls, HmiState, KeyScope, Snapshot, H
 /// Colours of r1..r4 (lamps' labels, bars and chart).
 const COLOURS: [Color; 4] = [Color::Cyan, Color::Magenta, Color::Yellow, Color::Green];
 
-/// Draws the whole screen.
+/// Draws the whole screen; in a terminal too small for it, a note that says so and what
+/// size it needs ([`sim_host::hmi::size`]) instead of a panel with rows cut off.
 pub fn render(frame: &mut Frame, state: &HmiState) {
+    if sim_host::hmi::size::draw_if_too_small(frame) {
+        return;
+    }
     let rows = Layout::vertical([
         Constraint::Length(1), // title
         Constraint::Length(2), // lamps and state (the state may take a second line)
