@@ -180,7 +180,7 @@ impl RatedLoadPoint {
         let sync = c.w / c.np;
         let s_b = c.breakdown();
         let excess = |s: f64| c.torque(s) - load * (1.0 - s) * sync;
-        if !(load > 0.0) || excess(s_b) <= 0.0 {
+        if load.is_nan() || load <= 0.0 || excess(s_b) <= 0.0 {
             return None;
         }
         let slip = EquivalentCircuit::root(1e-6, s_b, excess);
@@ -289,7 +289,7 @@ impl RotorLoad {
         let power = 1.5 * m.v1_peak_v * m.i1_peak_a * m.angle_rad.cos();
         let v = m.v1_peak_v / std::f64::consts::SQRT_2;
         let p_at = |s: f64| 3.0 * v * v * (1.0 / c.z(s)).re;
-        if !(power.is_finite() && v > 0.0) || power <= p_at(1e-6) {
+        if !power.is_finite() || v.is_nan() || v <= 0.0 || power <= p_at(1e-6) {
             let mut l = Self::at_slip(p, 0.0, LoadSource::Voltages);
             l.current_peak_a = Some(m.i1_peak_a);
             return l;
@@ -314,7 +314,7 @@ impl RotorLoad {
         let top = r.max_steady_slip(None);
         let lo = (1.0 - u) * r.no_load_current_peak_a;
         let hi = (1.0 + u) * std::f64::consts::SQRT_2 * c.current(top, c.v);
-        if !(i1_peak_a >= lo && i1_peak_a <= hi) {
+        if !(lo..=hi).contains(&i1_peak_a) {
             let mut l = Self::unknown(
                 Some(r),
                 format!(
