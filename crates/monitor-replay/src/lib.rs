@@ -69,9 +69,9 @@ pub use options::{
 };
 pub use report::{DiagnoseReport, MonitorState, Panel, TimelinePoint};
 pub use rotor::{
-    band_of, blackman_harris, RotorBand, RotorReport, SlipSource, BLACKMAN_HARRIS_4,
-    EDGE_SPREAD_DB, FAULT_EDGE_DB, MAIN_LOBE_HALF_BINS, MAX_SLIP, MAX_STRETCH_S, MIN_BINS,
-    MIN_SLIP, SLIP_STEADY,
+    band_of, blackman_harris, LoadSource, MeasuredPoint, RatedLoadPoint, RotorBand, RotorLoad,
+    RotorReport, SlipSource, BLACKMAN_HARRIS_4, EDGE_SPREAD_DB, FAULT_EDGE_DB, MAIN_LOBE_HALF_BINS,
+    MAX_SLIP, MAX_SLIP_OVER_RATED, MAX_STRETCH_S, MCSA_MIN_LOAD, MIN_BINS, MIN_SLIP, SLIP_STEADY,
 };
 pub use sampler::LogSampler;
 pub use sequences::{SensorPhaseReport, SequenceWindow, WINDOW_PERIODS};

@@ -382,7 +382,14 @@ impl Replay {
             self.opts.words,
         );
         let rotor = match &self.seq_front {
-            Some(front) => rotor_report(front.rotor(), &self.params),
+            Some(front) => {
+                let measured: Vec<_> = unbalance
+                    .segments
+                    .iter()
+                    .filter_map(|g| g.measured_point())
+                    .collect();
+                rotor_report(front.rotor(), &self.params, &measured)
+            }
             // (Lent and never given back: a read that ended before its end.)
             None => RotorReport::default(),
         };

@@ -28,7 +28,13 @@
 //!    relative to the line, averaged over the segments. The resolution rule of the
 //!    `explain` analysis holds: the search interval clear of the line's main lobe,
 //!    `2 s f >= MIN_BINS / T`.
-//! 5. The judgement ([`judge`]): the level of the `(1 - 2s) f` sideband in dB below the
+//! 5. Where MCSA applies ([`load`]): the load from the speed, else the voltages' power,
+//!    else the current's magnitude, against the parameter file's rated point; below
+//!    [`MCSA_MIN_LOAD`] of the rated torque the rotor is not judged ("the load is too low
+//!    to judge the rotor"), and a pair about the line whose slip the machine cannot run at
+//!    steadily at that load ([`MAX_SLIP_OVER_RATED`] times its rated slip, or its breakdown
+//!    slip) is not taken for the sidebands.
+//! 6. The judgement ([`judge`]): the level of the `(1 - 2s) f` sideband in dB below the
 //!    line and its band ([`RotorBand`]), the probability of a rotor fault, and, with the
 //!    parameter file's `rotor_bars`, the adjacent broken bars
 //!    (`monitor_core::rotor_cage`, at the torque-producing share of the current the
@@ -62,6 +68,7 @@
 
 mod baseband;
 mod judge;
+mod load;
 mod spectrum;
 mod stretch;
 #[cfg(test)]
@@ -69,6 +76,10 @@ mod tests;
 
 pub use baseband::RotorFront;
 pub use judge::band_of;
+pub use load::{
+    LoadSource, MeasuredPoint, RatedLoadPoint, RotorLoad, CURRENT_MODEL_UNCERTAINTY,
+    MAX_SLIP_OVER_RATED, MCSA_MIN_LOAD,
+};
 pub use spectrum::blackman_harris;
 
 use monitor_io::params::ParamFile;
@@ -254,6 +265,9 @@ pub struct RotorReport {
     pub rotor_bars: Option<u32>,
     /// Adjacent broken bars the sidebands say, null without `rotor_bars`.
     pub broken_bars: Option<f64>,
+    /// The load the rotor was judged at, against the parameter file's rated point
+    /// ([`RotorLoad`]): below [`MCSA_MIN_LOAD`] of the rated torque the rotor is not judged.
+    pub load: Option<RotorLoad>,
 }
 
 /// What the rotor finding needs of the parameter file and the log.

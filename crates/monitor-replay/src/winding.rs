@@ -139,9 +139,7 @@ pub const OPERATING_SPEED_STEP: f32 = 0.003;
 /// The largest slip taken for "full load" where the operating point is not known (rated
 /// slips run from 1 % for large motors to 5 % for small ones).
 pub const FULL_LOAD_SLIP_MAX: f32 = 0.05;
-/// How far a parameter file's current may be off the machine's (for the slip read from the
-/// current's magnitude: its uncertainty).
-pub const CURRENT_MODEL_UNCERTAINTY: f32 = 0.15;
+pub use crate::rotor::CURRENT_MODEL_UNCERTAINTY;
 /// Uncertainty of a reference angle measured as `arg(V1/I1)` [deg]: the sensors' phase
 /// errors and the loop impedance's own angle.
 pub const MEASURED_REFERENCE_UNCERTAINTY_DEG: f32 = 3.0;
@@ -246,6 +244,24 @@ pub struct SequenceSegment {
     wr: Option<f32>,
     #[serde(skip)]
     learning: bool,
+}
+
+impl SequenceSegment {
+    /// The voltages' operating point over the segment (`[from, to]` [s], `|V1|`, `|I1|`,
+    /// `arg(V1/I1)`), where every window had voltages: what the rotor's load estimate reads
+    /// without a speed (`crate::rotor::RotorLoad::from_power`).
+    pub(crate) fn measured_point(&self) -> Option<([f64; 2], crate::rotor::MeasuredPoint)> {
+        let z = self.v1?;
+        let i1 = f64::from(self.i1_peak_a);
+        Some((
+            [self.from_s, self.to_s],
+            crate::rotor::MeasuredPoint {
+                v1_peak_v: f64::from(abs(z)) * i1,
+                i1_peak_a: i1,
+                angle_rad: f64::from(z.im.atan2(z.re)),
+            },
+        ))
+    }
 }
 
 /// `a / b`, 0 for a zero or non-number `|b|`.

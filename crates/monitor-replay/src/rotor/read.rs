@@ -4,6 +4,7 @@
 
 use super::baseband::{Block, RotorFront};
 use super::judge::{band_of, bars_of, fault_probability, noise_max, torque_share};
+use super::load::{MeasuredPoint, RotorLoad, MAX_SLIP_OVER_RATED};
 use super::spectrum::{segments, spectrum, Spectrum, SEGMENT_S};
 use super::stretch::{chunks, longest_run, Chunk};
 use super::{
@@ -34,7 +35,14 @@ struct SidebandReading {
 
 /// The rotor finding of the record `front` of a log of the machine `params` (module docs
 /// of `super`): judged, or "cannot judge" with what was missing.
-pub fn rotor_report(front: &RotorFront, params: &ParamFile) -> RotorReport {
+/// `measured`: the voltages' operating points over the log's steady stretches (`[from, to]`
+/// [s] and the point), where it has voltages; the one holding the rotor's stretch's middle
+/// gives the load where the log has no speed ([`RotorLoad`]).
+pub fn rotor_report(
+    front: &RotorFront,
+    params: &ParamFile,
+    measured: &[([f64; 2], MeasuredPoint)],
+) -> RotorReport {
     let m = RotorMachine::of(params);
     let r = RotorReport {
         rotor_bars: m.bars,
@@ -58,15 +66,24 @@ pub fn rotor_report(front: &RotorFront, params: &ParamFile) -> RotorReport {
         .filter_map(|&k| blocks.get(k).map(|b| b.t_s))
         .collect();
     let stretch = blocks.get(span).unwrap_or(&[]);
-    let mut planner = rustfft::FftPlanner::new();
-    let slip = if by_speed {
+    let speed_slip = by_speed.then(|| {
         let s = ch.get(run).unwrap_or(&[]);
-        Some((
-            s.iter().map(|c| c.slip).sum::<f64>() / s.len().max(1) as f64,
-            SlipSource::Speed,
-        ))
-    } else {
-        slip_from_pairs(&mut r, &mut planner, stretch, bs, &m)
+        s.iter().map(|c| c.slip).sum::<f64>() / s.len().max(1) as f64
+    });
+    let load = load_of(params, stretch, speed_slip, measured);
+    r.load = Some(load.clone());
+    if load.too_low() {
+        let what = if load.fraction.is_some_and(|x| x < NO_LOAD) {
+            "no load"
+        } else {
+            "light load"
+        };
+        return cannot(r, format!("the load is too low to judge the rotor ({what}): {}, below the {:.0} % of the rated torque from which broken-bar sidebands are graded (their level scales with the rotor current; the MCSA severity bands of Thomson and Fenger 2001 are set near full load)", load.words(), 100.0 * load.min_fraction));
+    }
+    let mut planner = rustfft::FftPlanner::new();
+    let slip = match speed_slip {
+        Some(s) => Some((s, SlipSource::Speed)),
+        None => slip_from_pairs(&mut r, &mut planner, stretch, bs, &m, &load),
     };
     let Some((s, source)) = slip else {
         return r;
@@ -74,6 +91,42 @@ pub fn rotor_report(front: &RotorFront, params: &ParamFile) -> RotorReport {
     r.slip = Some(s);
     r.slip_source = Some(source);
     read_and_judge(r, &mut planner, stretch, bs, &m, (by_speed, s))
+}
+
+/// Below this fraction of the rated torque a load too low to judge is "no load" in the
+/// finding's words, above it "light load".
+const NO_LOAD: f64 = 0.1;
+
+/// The load over `stretch` (module docs of [`super::load`]): from the speed's slip where
+/// measured, else from the voltages' operating point holding the stretch's middle, else from
+/// the current's mean magnitude.
+fn load_of(
+    params: &ParamFile,
+    stretch: &[Block],
+    speed_slip: Option<f64>,
+    measured: &[([f64; 2], MeasuredPoint)],
+) -> RotorLoad {
+    if let Some(s) = speed_slip {
+        return RotorLoad::from_speed(params, s);
+    }
+    let mid = match (stretch.first(), stretch.last()) {
+        (Some(a), Some(b)) => 0.5 * (a.t_s + b.t_s),
+        _ => f64::NAN,
+    };
+    if let Some((_, m)) = measured
+        .iter()
+        .find(|(w, _)| (w[0]..=w[1]).contains(&mid))
+        .or_else(|| measured.first())
+    {
+        return RotorLoad::from_power(params, m);
+    }
+    let n = stretch.len().max(1) as f64;
+    let i1 = stretch
+        .iter()
+        .map(|b| f64::from(b.z[0]).hypot(f64::from(b.z[1])))
+        .sum::<f64>()
+        / n;
+    RotorLoad::from_current(params, i1)
 }
 
 /// The blocks of the chunks `run`.
@@ -120,6 +173,7 @@ fn slip_from_pairs(
     stretch: &[Block],
     bs: f64,
     m: &RotorMachine,
+    load: &RotorLoad,
 ) -> Option<(f64, SlipSource)> {
     let fs_min = 2.0 * MIN_SLIP * m.f0;
     let mut avg: Option<Spectrum> = None;
@@ -142,13 +196,21 @@ fn slip_from_pairs(
     // The rotation harmonics first (present in every real machine, and no sign of a fault),
     // then the sidebands; a pair whose refined distance gives a slip outside the range
     // searched is something else.
+    // A slip the machine cannot run at steadily at this load (past 1.5 times its rated
+    // slip, or its breakdown slip: `super::load`) is not the rotor's either.
+    let steady = load.rated.map(|rt| rt.max_steady_slip(load.slip));
     let plausible = |s: f64| (0.0..=MAX_SLIP).contains(&s);
+    let at_load = |s: f64| steady.is_none_or(|top| s <= top);
     let from_rotation = pair(&avg, rot, noise).map(|d| 1.0 - m.np * d / f);
-    if let Some(s) = from_rotation.filter(|s| plausible(*s)) {
+    if let Some(s) = from_rotation.filter(|s| plausible(*s) && at_load(*s)) {
         return Some((s, SlipSource::Eccentricity));
     }
     let from_sidebands = pair(&avg, side.clone(), noise).map(|d| d / (2.0 * f));
     if let Some(s) = from_sidebands.filter(|s| plausible(*s)) {
+        if let Some(top) = steady.filter(|top| s > *top) {
+            *r = cannot(std::mem::take(r), not_sidebands(s, top, load));
+            return None;
+        }
         return Some((s, SlipSource::Sidebands));
     }
     let (_, largest) = avg.peak(-side.end, -side.start);
@@ -163,6 +225,22 @@ fn slip_from_pairs(
         ),
     );
     None
+}
+
+/// Why a pair at slip `s`, above the steady slip `top` the machine can run at at `load`, is
+/// not the rotor's sidebands.
+fn not_sidebands(s: f64, top: f64, load: &RotorLoad) -> String {
+    let (rated, breakdown) = load
+        .rated
+        .map_or((f64::NAN, f64::NAN), |rt| (rt.slip, rt.breakdown_slip));
+    format!(
+        "the pair about the line is not rotor sidebands: slip {:.2} % is implausible at this load (above {:.2} %, {MAX_SLIP_OVER_RATED} times the rated slip {:.2} % of the parameter file's machine, breakdown at {:.1} %; {})",
+        100.0 * s,
+        100.0 * top,
+        100.0 * rated,
+        100.0 * breakdown,
+        load.words()
+    )
 }
 
 /// The Blackman-Harris window's highest sidelobe [dB] (Harris 1978): what a line leaks
@@ -349,8 +427,16 @@ fn sentence(r: &RotorReport, at_noise: bool) -> String {
         Some(SlipSource::Eccentricity) => "the rotation harmonics",
         _ => "the sideband pair",
     };
+    // The probability as the verdict reads it: a named finding's confidence (a cracked bar
+    // or worse), the probability of a fault for a finding the verdict calls clear ("watch",
+    // or a pair not confirmed), nothing for "no sign" (its 0.00 is not a health figure).
+    let p = match r.band {
+        Some(super::RotorBand::NoSign) | None => String::new(),
+        Some(super::RotorBand::Watch) => format!(", probability of a rotor fault {p:.2}"),
+        Some(_) => format!(", confidence {p:.2}"),
+    };
     format!(
-        "rotor: {head}: the (1-2s)f sideband is {level:.1} dB below the supply line{noise} (band {}), confidence {p:.2}{bars}; slip {:.2} % from {source}, {:.1} s read",
+        "rotor: {head}: the (1-2s)f sideband is {level:.1} dB below the supply line{noise} (band {}){p}{bars}; slip {:.2} % from {source}, {:.1} s read",
         r.band.map_or("", |b| b.words()),
         100.0 * r.slip.unwrap_or(f64::NAN),
         r.window_s.last().unwrap_or(&0.0) - r.window_s.first().unwrap_or(&0.0),

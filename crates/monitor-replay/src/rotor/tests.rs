@@ -67,6 +67,7 @@ fn known_sidebands_read_at_their_level() {
         let r = rotor_report(
             &record(rate, dur, s, &sidebands(s, lo, up), true),
             &machine(),
+            &[],
         );
         assert!(r.judged, "{r:?}");
         assert_eq!(r.slip_source, Some(SlipSource::Speed));
@@ -89,6 +90,7 @@ fn without_a_speed_the_slip_comes_from_a_pair_about_the_line() {
     let r = rotor_report(
         &record(2000.0, 4.0, s, &sidebands(s, -42.0, -48.0), false),
         &machine(),
+        &[],
     );
     assert_eq!(r.slip_source, Some(SlipSource::Sidebands), "{r:?}");
     assert!((r.slip.unwrap() - s).abs() < 0.02 * s, "{r:?}");
@@ -100,12 +102,12 @@ fn without_a_speed_the_slip_comes_from_a_pair_about_the_line() {
         (50.0 - fr, 10f64.powf(-50.0 / 20.0)),
         (50.0 + fr, 10f64.powf(-52.0 / 20.0)),
     ];
-    let r = rotor_report(&record(2000.0, 4.0, s, &ecc, false), &machine());
+    let r = rotor_report(&record(2000.0, 4.0, s, &ecc, false), &machine(), &[]);
     assert_eq!(r.slip_source, Some(SlipSource::Eccentricity), "{r:?}");
     assert!((r.slip.unwrap() - s).abs() < 0.05 * s, "{r:?}");
     assert_eq!(r.band, Some(RotorBand::NoSign), "{r:?}");
     // Neither: cannot judge, with the largest component the sidebands could be.
-    let r = rotor_report(&record(2000.0, 4.0, s, &[], false), &machine());
+    let r = rotor_report(&record(2000.0, 4.0, s, &[], false), &machine(), &[]);
     assert!(!r.judged);
     assert!(r.largest_possible_db.unwrap() < -80.0, "{r:?}");
     let why = r.cannot_judge_because.unwrap();
@@ -119,15 +121,20 @@ fn what_is_missing_is_said() {
     let r = rotor_report(
         &record(2000.0, 0.5, s, &sidebands(s, -40.0, -45.0), true),
         &machine(),
+        &[],
     );
     let why = r.cannot_judge_because.unwrap();
     assert!(why.contains("1.67 s are needed"), "{why}");
     // No load.
-    let r = rotor_report(&record(2000.0, 4.0, 0.001, &[], true), &machine());
+    let r = rotor_report(&record(2000.0, 4.0, 0.001, &[], true), &machine(), &[]);
     let why = r.cannot_judge_because.unwrap();
     assert!(why.contains("no load"), "{why}");
     // Nothing at all.
-    let r = rotor_report(&RotorFront::new(2000.0, 50.0, MAX_STRETCH_S), &machine());
+    let r = rotor_report(
+        &RotorFront::new(2000.0, 50.0, MAX_STRETCH_S),
+        &machine(),
+        &[],
+    );
     assert!(r.cannot_judge_because.unwrap().contains("no current"));
 }
 

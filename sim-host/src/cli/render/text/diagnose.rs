@@ -90,11 +90,12 @@ pub fn diagnose(mut out: &mut dyn std::io::Write, log: &Path, d: &Diagnosed) -> 
     verdict(&mut out, rep)
 }
 
-/// The timeline: time, speed, residuals, lamps and the panel's state per point.
+/// The timeline: time [s], the mechanical speed [rad/s] (the units in the header's second
+/// line), residuals, lamps and the panel's state per point.
 fn timeline(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
     writeln!(
         out,
-        "\n  time    speed   r1      r2      r3      r4      lamps     state"
+        "\n  time    speed   r1      r2      r3      r4      lamps     state\n     s    rad/s"
     )?;
     for p in &rep.timeline {
         let lamps: String = p.lamps.iter().map(|l| lamp(*l)).collect();
@@ -138,10 +139,7 @@ fn findings(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
             lit.join(" ")
         }
     )?;
-    match rep.first_detection_s {
-        Some(t) => writeln!(out, "first detection: {t:.2} s")?,
-        None => writeln!(out, "first detection: none")?,
-    }
+    first_detection(out, rep)?;
     writeln!(out, "candidates: {}", candidate_list(&rep.candidates))?;
     writeln!(
         out,
@@ -166,6 +164,29 @@ fn findings(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
                 .join(" / "),
             g.reason
         )?;
+    }
+    Ok(())
+}
+
+/// When the lamps first lit, as the verdict reads it: a detection where the residual finding
+/// is one, else what the lamps lit for (the operating point's load move or heating, the
+/// load outside the commissioned range), which is not a detection of a fault.
+fn first_detection(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
+    use monitor_core::verdict::{FindingSource, State};
+    let of = |s: FindingSource| rep.findings.iter().find(|f| f.source() == s);
+    let residual = of(FindingSource::Residuals).map(|f| f.finding.state);
+    match (rep.first_detection_s, residual) {
+        (None, _) => writeln!(out, "first detection: none")?,
+        (Some(t), Some(State::Explained)) => writeln!(
+            out,
+            "lamps lit: first at {t:.2} s, explained by the operating point ({}), not a fault detection",
+            of(FindingSource::OperatingPoint).map_or("a load move or heating", |f| f.summary.as_str())
+        )?,
+        (Some(t), Some(State::OutOfRange)) => writeln!(
+            out,
+            "lamps lit: first at {t:.2} s, only outside the commissioned load or voltage range, not a fault detection"
+        )?,
+        (Some(t), _) => writeln!(out, "first detection: {t:.2} s")?,
     }
     Ok(())
 }
