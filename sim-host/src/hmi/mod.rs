@@ -523,3 +523,6 @@ pub fn quit_key(key: Key, state: &mut HmiState) -> bool {
     }
     false
 }
+
+#[cfg(test)]
+mod tests;
