@@ -170,6 +170,17 @@ fn the_readme_walkthroughs_print_what_the_readme_shows() {
     assert!(n >= 4, "only {n} walkthroughs found");
 }
 
+/// The walkthroughs of docs/ print what the pages show (the same rules as the README's), so
+/// that the documentation and the program cannot drift apart.
+#[test]
+fn the_docs_walkthroughs_print_what_the_docs_show() {
+    let mut n = 0;
+    for page in ["docs/model-vs-measurement.md", "docs/own-motor.md"] {
+        n += check(page);
+    }
+    assert!(n >= 5, "only {n} walkthroughs found in docs/");
+}
+
 /// The README names every command `sim-host --help` lists (as `` `command``, in its table),
 /// so that a newcomer finds each one.
 #[test]
