@@ -390,12 +390,15 @@ def identify(
     from_s: _Optional[float] = None,
     to_s: _Optional[float] = None,
     group: _Optional[str] = None,
+    keep_columns: bool = False,
 ) -> IdentifyResult:
     """Identify the motor's circuit (Rs, Rr, the leakage, Lm) and J, B + Bl from a log of
     its healthy running, starting from ``params`` (``sim-host identify``).
 
     ``.identification.estimates`` holds each value with its 95 % interval;
-    ``.toml`` is the identified parameter file's text. A log the start file's motor cannot
+    ``.toml`` is the identified parameter file's text, without the start file's
+    ``[columns]`` table unless ``keep_columns=True`` (as ``sim-host identify --keep-columns``:
+    the identified file then reads only the DAQ's logs). A log the start file's motor cannot
     have drawn (a unit), a fit that leaves more than 10 % of the current, or implausible
     values raise :class:`OptionError` naming the likely cause.
     """
@@ -409,6 +412,7 @@ def identify(
         from_s=None if from_s is None else float(from_s),
         to_s=None if to_s is None else float(to_s),
         group=group,
+        keep_columns=bool(keep_columns),
     )
     return IdentifyResult(_json.loads(doc))
 

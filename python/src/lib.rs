@@ -394,7 +394,7 @@ fn explain(
 
 /// `identify --json`: `{"identification": ..., "out": null, "toml": ...}`.
 #[pyfunction]
-#[pyo3(signature = (log, params, log_origin=None, params_is_text=false, from_s=None, to_s=None, group=None))]
+#[pyo3(signature = (log, params, log_origin=None, params_is_text=false, from_s=None, to_s=None, group=None, keep_columns=false))]
 #[allow(clippy::too_many_arguments)]
 fn identify(
     py: Python<'_>,
@@ -405,6 +405,7 @@ fn identify(
     from_s: Option<f64>,
     to_s: Option<f64>,
     group: Option<String>,
+    keep_columns: bool,
 ) -> PyResult<String> {
     let log = log_source(log, log_origin.as_deref())?;
     run(py, || {
@@ -417,10 +418,16 @@ fn identify(
             &mut |_| {},
         )
         .map_err(to_py)?;
+        // As `sim-host identify`: the start file's `[columns]` only when asked for.
+        let toml = if keep_columns {
+            id.toml.as_str()
+        } else {
+            id.toml_without_columns()
+        };
         json(&serde_json::json!({
             "identification": id.identification,
             "out": null,
-            "toml": id.toml,
+            "toml": toml,
         }))
     })
 }

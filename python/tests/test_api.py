@@ -99,6 +99,10 @@ def test_compare_explain_identify_nameplate(repo, sim_host):
     assert i.identification.relative_rms_error < 0.01
     rs = [x for x in i.identification.estimates if x.key == "rs_ohm"][0]
     assert abs(rs.value / 3.7 - 1) < 0.03
+    # As `sim-host identify`: the DAQ's [columns] only when asked to keep them.
+    assert "[columns]" not in i.toml
+    kept = dm.identify(repo / "examples/logs/daq_2p2kw.csv", n.params, keep_columns=True)
+    assert "[columns]" in kept.toml
 
 
 def test_explain_ladder_matches_the_cli(repo, sim_host):
