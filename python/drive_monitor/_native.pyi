@@ -61,6 +61,7 @@ def identify(
     from_s: Optional[float] = ...,
     to_s: Optional[float] = ...,
     group: Optional[str] = ...,
+    keep_columns: bool = ...,
 ) -> str: ...
 def params_from_nameplate(
     power_kw: float,
