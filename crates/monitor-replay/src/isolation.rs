@@ -13,7 +13,10 @@
 
 pub(super) mod chunk;
 mod report;
+mod resistances;
 mod sentences;
+
+pub use resistances::ResistanceReading;
 
 pub use crate::isolation_name::{IsolationName, NameGiven};
 use monitor_core::isolation::{Follower, Named, Step, DEFAULT_SPREAD};
@@ -53,6 +56,8 @@ pub(super) struct IsolationTracker {
     end_t: f64,
     /// The operating point of the last isolation.
     last_point: SteadyPoint,
+    /// Rs and Rr read apart at each isolation's point ([`resistances`]).
+    resistances: resistances::ResistanceSums,
     /// A lamp lit while lamps counted.
     lamps_lit: bool,
     /// The operating points kept since a deviation, and their joint isolation.
@@ -162,6 +167,7 @@ impl IsolationTracker {
             last_t: 0.0,
             end_t: 0.0,
             last_point: SteadyPoint::default(),
+            resistances: resistances::ResistanceSums::default(),
             lamps_lit: false,
             evidence: monitor_core::isolation::Evidence::default(),
             load,
@@ -286,9 +292,12 @@ impl IsolationTracker {
             let lag = follower.measured_rise_k().map(|_| follower.probe_lag_k());
             self.temperature.after_isolation(t, &result, lag);
             self.evidence.after(follower, &result);
-            if let Some((p, _)) = follower.averaged() {
+            let averaged = follower.averaged().map(|(p, _)| p);
+            if let Some(p) = averaged {
                 self.events.point(t, &p);
             }
+            let motor = *follower.isolator().motor();
+            self.resistances.add(&motor, &averaged.unwrap_or(*point));
             if let Some(n) = self.name_of(&result, learned) {
                 self.give_name(t, n);
             }
@@ -495,6 +504,7 @@ impl IsolationTracker {
             first_named: self.first_named,
             events: self.events.events().to_vec(),
             events_dropped: self.events.dropped(),
+            resistances: self.resistances.reading(),
             detection_limits: if learned && iso.state == IsolationState::NoDeviation {
                 self.detection_limits()
             } else {

@@ -61,7 +61,7 @@ pub use events::{IsolationEvent, LOAD_MOVE_FRACTION, MAX_EVENTS};
 pub use isolation::serialize_state;
 pub use isolation::{
     state_name, DetectionLimit, FaultCandidate, IsolationBaseline, IsolationGroup, IsolationName,
-    IsolationReport, NameGiven, NOMINAL_UNCERTAINTY,
+    IsolationReport, NameGiven, ResistanceReading, NOMINAL_UNCERTAINTY,
 };
 pub use options::{
     angle_source_name, check_parallel_paths, monitor_config_for_log, serialize_angle_source,

@@ -36,7 +36,7 @@ const fn c(name: &'static str, kind: Kind, doc: &'static str) -> StoreColumn {
 /// The columns, in order. The first six say which log of which motor and when; every value
 /// after them is one `diagnose --json` reported (the key in brackets); null where the
 /// diagnosis had none (a fault not named, a rotor not judged).
-pub const COLUMNS: [StoreColumn; 34] = [
+pub const COLUMNS: [StoreColumn; 35] = [
     c(
         "log_id",
         Kind::Text,
@@ -186,6 +186,11 @@ pub const COLUMNS: [StoreColumn; 34] = [
         "trusted",
         Kind::Int,
         "1 when the data quality is trusted [data_quality.trusted]",
+    ),
+    c(
+        "stator_excess_pct",
+        Kind::Real,
+        "Rs's change beyond Rr's in %, free of the winding's temperature [isolation.resistances.stator_excess]",
     ),
 ];
 
@@ -412,6 +417,7 @@ fn report_cells(doc: &Value) -> Vec<Cell> {
             .and_then(Value::as_i64)),
         real(num("/data_quality/sample_rate_hz")),
         int(flag("/data_quality/trusted")),
+        real(num("/isolation/resistances/stator_excess").map(|x| 100.0 * x)),
     ]
 }
 

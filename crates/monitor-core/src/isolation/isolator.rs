@@ -78,6 +78,11 @@ impl Isolator {
         })
     }
 
+    /// The machine judged against: the parameter file's (before any heating tracked).
+    pub fn motor(&self) -> &MotorModel {
+        &self.motor
+    }
+
     /// The torque scale of `e_T`: `3/2 Np Lm^2/Lr i_mag^2` with the magnetising current
     /// `i_mag = V_peak / (we Ls)` [N m] (the torque at `I_qs = i_ds`, near rated torque for
     /// common motors).

@@ -207,6 +207,8 @@ pub use outcome::{
     Candidate, Heating, Isolation, IsolationState, Named, HEATING_MAX_MISFIT, HEATING_ONSET_K,
     WARMING_EXPLAINS, WARMING_K,
 };
+mod resistances;
+pub use resistances::{resistance_split, ResistanceSplit, MIN_SPLIT_SLIP};
 mod rule;
 pub use rule::{within_nominal_uncertainty, MIN_FAULT_CHANGE, NOMINAL_UNCERTAINTY};
 

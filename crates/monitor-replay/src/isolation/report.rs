@@ -142,6 +142,10 @@ pub struct IsolationReport {
     /// `temperature_channel`, present only for a log with the column).
     #[serde(flatten)]
     pub temperature: crate::temperature::TemperatureReport,
+    /// Rs and Rr read apart at the isolation's steady points (absent in JSON where no
+    /// point could carry it: no voltage, no speed, too little slip).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub resistances: Option<super::resistances::ResistanceReading>,
     /// Where nothing deviated from a learned baseline: the smallest change of each fault
     /// the isolation would have seen at the commissioned point
     /// ([`monitor_core::Isolator::detection_limit`]), so that "healthy" says how small a
@@ -209,6 +213,7 @@ impl IsolationReport {
             first_named: None,
             events: Vec::new(),
             events_dropped: 0,
+            resistances: None,
             detection_limits: Vec::new(),
         }
     }

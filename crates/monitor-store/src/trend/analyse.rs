@@ -274,10 +274,13 @@ pub fn indicator_trend(
         ind,
         opts,
         end_s / DAY_S,
-        fit.as_ref().map_or(0.0, |f| f.scatter),
+        fit.as_ref().map_or(0.0, |f| f.scatter).max(ind.min_scatter),
     );
     if fit.is_none() && !covs.is_empty() && rows.len() < fit_logs(covs) {
         hold_for_fit(&mut t, rows.len(), fit_logs(covs));
+    }
+    if t.alarm && !ind.alarm_means.is_empty() {
+        t.sentence = format!("{}; {}", t.sentence, ind.alarm_means);
     }
     t
 }

@@ -60,6 +60,13 @@ pub struct Indicator {
     /// The covariates it is normalised on (store columns): sets in order of preference,
     /// the first one the motor's logs have used.
     pub covariates: &'static [&'static [&'static str]],
+    /// What its alarm means to a planner, added to an alarmed indicator's sentence (empty:
+    /// nothing added).
+    pub alarm_means: &'static str,
+    /// The least scatter it is judged with [unit]: what one log can resolve at best, so
+    /// that a line moving by a few hundredths of a per cent on clean simulated data is not
+    /// a trend (0 where the scatter itself is the floor).
+    pub min_scatter: f64,
     /// The store column holding its FAULT level per log (its median over the reference
     /// logs is used), or a fixed level, or none.
     pub fault_level: FaultLevel,
@@ -97,6 +104,8 @@ const fn residual(column: &'static str, label: &'static str) -> Indicator {
         direction: Direction::Either,
         alarms: true,
         covariates: &[&[LOAD, TEMPERATURE], &[LOAD, RISE]],
+        alarm_means: "",
+        min_scatter: 0.0,
         fault_level: FaultLevel::None,
     }
 }
@@ -116,7 +125,13 @@ const fn residual(column: &'static str, label: &'static str) -> Indicator {
 /// - `sideband_db`: the rotor's lower sideband (broken bars grow it), normalised on load;
 ///   its FAULT level is -50 dB below the line ... (the usual MCSA rule of thumb for one
 ///   broken bar, not a project threshold: docs/trend.md).
-pub const INDICATORS: [Indicator; 5] = [
+/// - `stator_excess_pct`: Rs's change beyond Rr's, read apart at the log's steady points
+///   (`monitor_core::isolation::resistance_split`): a warm winding raises both alike and
+///   leaves it, a loosening connection raises Rs alone. Normalised on load (an inductance
+///   of the file that is off moves it with the operating point, not with the
+///   temperature); FAULT level [`STATOR_EXCESS_FAULT_PCT`], judged with at least
+///   [`STATOR_EXCESS_MIN_SCATTER_PCT`] of scatter.
+pub const INDICATORS: [Indicator; 6] = [
     Indicator {
         column: "i2_over_i1",
         label: "|I2w|/|I1|",
@@ -126,6 +141,8 @@ pub const INDICATORS: [Indicator; 5] = [
         direction: Direction::Rising,
         alarms: true,
         covariates: &[&[LOAD]],
+        alarm_means: "a short between turns growing in one phase",
+        min_scatter: 0.0,
         fault_level: FaultLevel::Column("i2_least_change"),
     },
     residual("residual_d", "e_d"),
@@ -140,9 +157,35 @@ pub const INDICATORS: [Indicator; 5] = [
         direction: Direction::Rising,
         alarms: true,
         covariates: &[&[LOAD]],
+        alarm_means: "rotor bars cracking or breaking",
+        min_scatter: 0.0,
         fault_level: FaultLevel::Fixed(-50.0),
     },
+    Indicator {
+        column: "stator_excess_pct",
+        label: "Rs beyond Rr",
+        unit: "%",
+        scale: 1.0,
+        shown_unit: "%",
+        direction: Direction::Rising,
+        alarms: true,
+        covariates: &[&[LOAD]],
+        alarm_means: "Rs beyond Rr: the stator circuit's resistance rises and the rotor's does not, so not heating (a warm winding raises both together): a loosening connection, or, with |I2w|/|I1| rising too, turns shorting in one phase",
+        min_scatter: STATOR_EXCESS_MIN_SCATTER_PCT,
+        fault_level: FaultLevel::Fixed(STATOR_EXCESS_FAULT_PCT),
+    },
 ];
+
+/// The FAULT level of the stator's resistance change beyond the rotor's [%]: the least
+/// change one commissioned log's verdict calls a FAULT (the core's `MIN_FAULT_CHANGE`,
+/// 5 %: what 13 K of heating does to a winding, here with no heating to explain it).
+pub const STATOR_EXCESS_FAULT_PCT: f64 = 5.0;
+
+/// The least scatter of the stator's excess [%]: Rs is read from the part of the voltage in
+/// phase with the current, Rs I being 1-3 % of V, so a DAQ whose voltage-to-current phase
+/// drifts by 0.03 mrad, or whose channels' gain ratio drifts by 0.005 %, from one day to the
+/// next moves it by about 0.2 %; the simulator's logs scatter by 0.01 %.
+pub const STATOR_EXCESS_MIN_SCATTER_PCT: f64 = 0.2;
 
 /// The trend's settings.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
