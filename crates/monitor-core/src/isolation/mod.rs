@@ -208,7 +208,7 @@ pub use outcome::{
     WARMING_EXPLAINS, WARMING_K,
 };
 mod resistances;
-pub use resistances::{resistance_split, ResistanceSplit, MIN_SPLIT_SLIP};
+pub use resistances::{resistance_split, ResistanceSplit, MIN_SPLIT_SLIP, SPLIT_FACTOR_RANGE};
 mod rule;
 pub use rule::{within_nominal_uncertainty, MIN_FAULT_CHANGE, NOMINAL_UNCERTAINTY};
 

@@ -3,9 +3,10 @@
 //!
 //! A warmer winding raises Rs and Rr by the same factor `1 + alpha dT` (copper and the
 //! rotor's aluminium differ by 0.1 %/K in alpha: 0.3 % over 30 K); a connection that
-//! loosens, a corroded lug or a cracked stator conductor raises Rs alone. The ratio of the
-//! two read at the same point, `(Rs/Rs0) / (Rr/Rr0)`, is therefore free of the winding's
-//! temperature, and a rise of it is an Rs change nothing thermal explains.
+//! loosens, a corroded lug or a cracked stator conductor raises Rs alone. The difference of
+//! the two read at the same point, `Rs/Rs0 - Rr/Rr0`, is therefore free of the winding's
+//! temperature (and of a bias in ohms the file's inductances put on both readings, unlike
+//! their ratio), and a rise of it is an Rs change nothing thermal explains.
 //!
 //! # The equations
 //! From the steady state of the T-equivalent machine (the module docs of
@@ -19,9 +20,13 @@
 //!   `Rr^2 = A ws Lr / (we Ls - Im Z) - ws^2 Lr^2`;
 //! - `Rs = Re Z - A Rr / (Rr^2 + ws^2 Lr^2)`.
 //!
-//! Both are exact for the model; an error of the file's inductances moves them by a bias
-//! that depends on the operating point (the trend normalises on load for it), not on the
-//! temperature.
+//! Both are exact for the model. They rest on the file's inductances: `we Ls - Im Z` is a
+//! small difference of two large reactances, so a file whose Lm is 1 % off moves the
+//! excess by 30 % (and 30 K of heating then moves it by 3 %; leakages 5 % off: 4 % and
+//! 1.4 %); a reading outside [`SPLIT_FACTOR_RANGE`] of the file's
+//! values is refused as the file's error, not the machine's. A file identified on the
+//! motor (`sim-host identify`) or one within a few per cent gives a bias that depends on the
+//! operating point (the trend normalises on load for it), not on the temperature.
 
 use super::SteadyPoint;
 use crate::MotorModel;
@@ -30,6 +35,11 @@ use crate::MotorModel;
 /// speed the rotor branch carries almost no current and `Rr^2` is the difference of two
 /// nearly equal terms.
 pub const MIN_SPLIT_SLIP: f64 = 0.002;
+
+/// The range of `Rs/Rs_file` and `Rr/Rr_file` a reading may have: 25 K cooler to 160 K
+/// warmer than the file (the heating range the isolation accepts) with the file 30 % off
+/// either way. Outside it the file's inductances, not the machine, made the reading.
+pub const SPLIT_FACTOR_RANGE: (f64, f64) = (0.6, 2.1);
 
 /// Rs and Rr read from one steady point ([`resistance_split`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -45,10 +55,10 @@ pub struct ResistanceSplit {
 }
 
 impl ResistanceSplit {
-    /// `(Rs/Rs_file) / (Rr/Rr_file) - 1`: the stator's resistance change beyond what the
-    /// rotor's shows, free of the winding's temperature (module docs) [fraction].
+    /// `Rs/Rs_file - Rr/Rr_file`: the stator's resistance change beyond the rotor's, free
+    /// of the winding's temperature (module docs) [fraction of the file's values].
     pub fn stator_excess(&self) -> f64 {
-        self.rs_factor / self.rr_factor - 1.0
+        self.rs_factor - self.rr_factor
     }
 }
 
@@ -57,8 +67,8 @@ impl ResistanceSplit {
 ///
 /// `None` when the point cannot carry it: no voltage or current, a slip below
 /// [`MIN_SPLIT_SLIP`] (or negative: a generating machine), an impedance whose reactance is
-/// not below `we Ls` (the rotor branch must lower it), or a result that is not finite and
-/// positive.
+/// not below `we Ls` (the rotor branch must lower it), or a result outside
+/// [`SPLIT_FACTOR_RANGE`] of the file's values (or not finite).
 pub fn resistance_split(motor: &MotorModel, q: &SteadyPoint) -> Option<ResistanceSplit> {
     let (vd, vq) = (f64::from(q.v.d), f64::from(q.v.q));
     let (id, iq) = (f64::from(q.i.d), f64::from(q.i.q));
@@ -92,9 +102,10 @@ pub fn resistance_split(motor: &MotorModel, q: &SteadyPoint) -> Option<Resistanc
         rs_factor: rs / f64::from(motor.rs_ohm),
         rr_factor: rr / f64::from(motor.rr_ohm),
     };
+    let (lo, hi) = SPLIT_FACTOR_RANGE;
     let ok = [split.rs_factor, split.rr_factor]
         .iter()
-        .all(|k| k.is_finite() && *k > 0.0);
+        .all(|k| (lo..=hi).contains(k));
     ok.then_some(split)
 }
 
@@ -177,6 +188,42 @@ mod tests {
         assert!((loose.stator_excess() - 0.1).abs() < 0.01, "{loose:?}");
     }
 
+    /// Against a file whose leakage inductances are a few per cent off (an identified
+    /// file's) the reading is biased, 30 K of heating moves the bias
+    /// by a fraction of what an Rs +10 % change moves the excess, and that change still
+    /// moves it by about its size.
+    #[test]
+    fn a_file_a_little_off_biases_the_excess_but_not_its_changes() {
+        let m = motor();
+        // (leakage factor, Lm factor)
+        for (dls, dlm) in [(1.05, 1.0), (0.97, 1.0)] {
+            let mut off = m;
+            off.lm_h *= dlm;
+            off.ls_h = off.lm_h + (m.ls_h - m.lm_h) * dls;
+            off.lr_h = off.lm_h + (m.lr_h - m.lm_h) * dls;
+            let at = |rs: f64, rr: f64| {
+                resistance_split(&off, &point(&m, rs, rr, 376.99, 0.03)).map(|s| s.stator_excess())
+            };
+            let warm = 1.0 + 0.00393 * 30.0;
+            let (Some(cold), Some(hot), Some(loose)) = (
+                at(0.435, 0.816),
+                at(0.435 * warm, 0.816 * warm),
+                at(0.435 * 1.1, 0.816),
+            ) else {
+                panic!("no reading with the file off by {dls} {dlm}");
+            };
+            // Measured: at most 1.4 % (leakage 5 % high), against the 10 % of the Rs change.
+            assert!(
+                (hot - cold).abs() < 0.02,
+                "{dls} {dlm}: cold {cold} hot {hot}"
+            );
+            assert!(
+                (loose - cold - 0.1).abs() < 0.03,
+                "{dls} {dlm}: cold {cold} loose {loose}"
+            );
+        }
+    }
+
     #[test]
     fn a_point_that_cannot_carry_it_gives_none() {
         let m = motor();
@@ -187,5 +234,10 @@ mod tests {
         let mut nan = point(&m, 0.435, 0.816, 376.99, 0.03);
         nan.v.d = f32::NAN;
         assert!(resistance_split(&m, &nan).is_none());
+        // A file whose Ls is 40 % high: no rotor branch fits the point, refused.
+        let mut off = m;
+        off.ls_h *= 1.4;
+        let r = resistance_split(&off, &point(&m, 0.435, 0.816, 376.99, 0.03));
+        assert!(r.is_none(), "{r:?}");
     }
 }

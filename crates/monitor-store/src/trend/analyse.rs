@@ -4,7 +4,7 @@
 use super::stats::{least_squares, mad_sigma, median, theil_sen};
 use super::{
     Direction, FaultLevel, Indicator, IndicatorTrend, MotorTrend, TrendOptions, TrendPoint,
-    INDICATORS,
+    INDICATORS, RISE,
 };
 use crate::row::{utc_day, StoredRow};
 
@@ -279,6 +279,9 @@ pub fn indicator_trend(
     if fit.is_none() && !covs.is_empty() && rows.len() < fit_logs(covs) {
         hold_for_fit(&mut t, rows.len(), fit_logs(covs));
     }
+    if covs.contains(&RISE) {
+        hold_without_probe(&mut t);
+    }
     if t.alarm && !ind.alarm_means.is_empty() {
         t.sentence = format!("{}; {}", t.sentence, ind.alarm_means);
     }
@@ -294,6 +297,22 @@ fn hold_for_fit(t: &mut IndicatorTrend, n: usize, needed: usize) {
         t.sentence = t.sentence.replace(
             ": TREND ALARM",
             &format!(": no alarm yet ({n} logs; the operating-point fit needs {needed})"),
+        );
+    }
+}
+
+/// A residual normalised on the rise the isolation read (no temperature channel): shown,
+/// not alarmed. The rise is read from Rs and Rr against the parameter file, so with a file
+/// 10 % off it follows the file's error as much as the season: on a held-out month judged
+/// against such a file every healthy motor's residuals alarmed on the first day the fit
+/// was allowed. The stator's resistance beyond the rotor's (`stator_excess_pct`) needs no
+/// temperature and alarms a loosening connection instead.
+fn hold_without_probe(t: &mut IndicatorTrend) {
+    if t.alarm {
+        t.alarm = false;
+        t.sentence = t.sentence.replace(
+            ": TREND ALARM",
+            ": shown, not alarmed (no temperature channel: normalised on the rise the isolation read)",
         );
     }
 }

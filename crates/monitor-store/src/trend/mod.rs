@@ -90,7 +90,7 @@ const LOAD: &str = "i1_peak_a";
 const TEMPERATURE: &str = "winding_temperature_c";
 /// The temperature covariate without a channel: the rise the isolation read from Rs and Rr
 /// together (a loosening connection's Rs partly reads as heating in it).
-const RISE: &str = "winding_rise_k";
+pub(crate) const RISE: &str = "winding_rise_k";
 
 /// A parity residual as an indicator: either way, per unit, normalised on load and the
 /// windings' temperature (measured, else the isolation's rise), no FAULT level.
