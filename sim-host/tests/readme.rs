@@ -164,6 +164,86 @@ fn check(file: &str) -> usize {
     runs.len()
 }
 
+/// The blocks after a marker `<!-- output: sim-host ARGS -->`: the command's arguments, the
+/// marker's line and the block's lines (a program's output shown without its `$` line).
+fn marked_outputs(md: &str) -> Vec<Walkthrough> {
+    let lines: Vec<&str> = md.lines().collect();
+    let mut out = Vec::new();
+    for (k, l) in lines.iter().enumerate() {
+        let Some(cmd) = l
+            .trim()
+            .strip_prefix("<!-- output: sim-host ")
+            .and_then(|c| c.strip_suffix("-->"))
+        else {
+            continue;
+        };
+        let Some(open) = (k + 1..lines.len()).find(|&j| lines[j].starts_with("```")) else {
+            continue;
+        };
+        let close = (open + 1..lines.len())
+            .find(|&j| lines[j].starts_with("```"))
+            .unwrap_or(lines.len());
+        out.push(Walkthrough {
+            line: k + 1,
+            args: cmd.split_whitespace().map(str::to_string).collect(),
+            shown: lines[open + 1..close]
+                .iter()
+                .map(|l| l.to_string())
+                .collect(),
+        });
+    }
+    out
+}
+
+/// Every marked output block of `file` is printed by its command, line by line in order
+/// (the walkthroughs' rules); the number of blocks.
+fn check_marked(file: &str) -> usize {
+    let md = std::fs::read_to_string(repo().join(file)).expect("read the markdown");
+    let blocks = marked_outputs(&md);
+    let mut failures = Vec::new();
+    for b in &blocks {
+        let o = assert_cmd::Command::cargo_bin("sim-host")
+            .expect("binary")
+            .current_dir(repo())
+            .args(&b.args)
+            .output()
+            .expect("run");
+        let stdout = String::from_utf8_lossy(&o.stdout).to_string();
+        let actual: Vec<&str> = stdout.lines().collect();
+        let mut at = 0;
+        for want in b
+            .shown
+            .iter()
+            .filter(|l| !l.trim().is_empty() && l.trim() != "...")
+        {
+            match actual[at..].iter().position(|a| matches(want, a)) {
+                Some(p) => at += p + 1,
+                None => {
+                    failures.push(format!(
+                        "{file}:{}: `sim-host {}` does not print (in order):\n  {want}\nIt printed:\n{stdout}",
+                        b.line,
+                        b.args.join(" ")
+                    ));
+                    break;
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n\n"));
+    blocks.len()
+}
+
+/// docs/hmi.md's blocks of program output (the keys `hmi --help` lists) are what the
+/// program prints; its screen is checked by the binary's own test
+/// (`cli::render::hmi::doc_tests`).
+#[test]
+fn docs_hmi_output_blocks_are_what_the_program_prints() {
+    assert!(
+        check_marked("docs/hmi.md") >= 1,
+        "no `<!-- output: ... -->` in docs/hmi.md"
+    );
+}
+
 #[test]
 fn the_readme_walkthroughs_print_what_the_readme_shows() {
     let n = check("README.md");
@@ -225,4 +305,9 @@ fn shown_lines_match_with_elisions() {
     assert_eq!(w.len(), 1);
     assert_eq!(w[0].args, ["demo", "--paper"]);
     assert_eq!(w[0].shown, ["line", "..."]);
+    let m = marked_outputs("<!-- output: sim-host hmi --help -->\n\n```\n  q  quit\n```\n");
+    assert_eq!(m.len(), 1);
+    assert_eq!(m[0].line, 1);
+    assert_eq!(m[0].args, ["hmi", "--help"]);
+    assert_eq!(m[0].shown, ["  q  quit"]);
 }

@@ -304,7 +304,8 @@ pub fn plan_diagnose(
 }
 
 /// `diagnose`: replays `log` through the core with the parameter file `params`; the report
-/// `--json` prints. `progress` gets the fraction of the log read.
+/// `--json` prints. `progress` gets the fraction of the work done: forward only, with the
+/// rows replayed, and 1 only once the report is built.
 ///
 /// # Errors
 /// A bad parameter file, log or option ([`ApiError`]), each a one-line message.

@@ -6,6 +6,7 @@ use super::error::ReplayError;
 use super::front::{Direct, Handled, ReplaySink};
 use super::options::ReplayOptions;
 use super::pipe;
+use super::progress::{CountedRows, Forward, READ_SHARE};
 use super::replay::{Replay, ReplayObserver};
 use super::report::DiagnoseReport;
 use super::sampler::CLOCK_RESET_GAP_S;
@@ -49,7 +50,9 @@ pub fn diagnose_rows(
 
 /// Streams a log file through the data-quality stage and the core (`sim-host
 /// diagnose`): the stage's time base configures the monitor, and every row is replayed,
-/// with bounded memory whatever the log's length.
+/// with bounded memory whatever the log's length. `progress` gets the fraction of the work
+/// done, forward only: the rows replayed against the log's estimated rows up to 0.95, and
+/// 1 once the report is built (a progress bar's).
 ///
 /// # Errors
 /// [`ReplayError::Log`] naming the file, line and column, or the stage's time-base
@@ -77,9 +80,27 @@ pub fn diagnose_log(
     opts: ReplayOptions,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Diagnosed, ReplayError> {
-    replay_through_quality(params, file.channels(), file.shown(), opts, |stage| {
-        file.for_each_row(progress, stage).map(|_| ())
-    })
+    let mut bar = Forward::new(progress);
+    let d = replay_through_quality(params, file.channels(), file.shown(), opts, |stage| {
+        read_counted(file, stage, &mut bar)
+    });
+    if d.is_ok() {
+        bar.to(1.0);
+    }
+    d
+}
+
+/// Streams `file` into `stage`, the progress moving with the rows handed over
+/// ([`CountedRows`]), to [`READ_SHARE`] once the read is over.
+fn read_counted(
+    file: &LogFile,
+    stage: &mut dyn RowSink,
+    bar: &mut Forward,
+) -> Result<(), LogError> {
+    let mut counted = CountedRows::new(stage, bar, file.estimated_rows());
+    let read = file.for_each_row(&mut |_| {}, &mut counted).map(|_| ());
+    bar.to(READ_SHARE);
+    read
 }
 
 /// [`diagnose_file`] that hands every replayed row's output to `observer` as it goes, the
@@ -96,14 +117,19 @@ pub fn diagnose_file_observed(
     observer: &mut dyn ReplayObserver,
 ) -> Result<Diagnosed, ReplayError> {
     let file = LogFile::open_with(path, open)?;
-    replay_observed(
+    let mut bar = Forward::new(progress);
+    let d = replay_observed(
         params,
         file.channels(),
         file.shown(),
         opts,
         Some(observer),
-        |stage| file.for_each_row(progress, stage).map(|_| ()),
-    )
+        |stage| read_counted(&file, stage, &mut bar),
+    );
+    if d.is_ok() {
+        bar.to(1.0);
+    }
+    d
 }
 
 /// Runs `feed` into the data-quality stage in front of a replay; builds the report.

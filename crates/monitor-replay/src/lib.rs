@@ -32,6 +32,7 @@ mod isolation_name;
 mod lamps;
 mod options;
 mod pipe;
+mod progress;
 mod replay;
 mod report;
 mod rotor;

@@ -483,3 +483,7 @@ fn keys_line(c: &Controls) -> Line<'static> {
 #[cfg(test)]
 #[path = "hmi_tests.rs"]
 mod tests;
+
+#[cfg(test)]
+#[path = "hmi_doc_tests.rs"]
+mod doc_tests;

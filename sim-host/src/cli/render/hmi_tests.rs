@@ -97,9 +97,6 @@ fn the_screen_after_commissioning_and_after_a_fault_at_80x24() {
     // Every row fits, the footer too.
     assert!(rows.iter().all(|r| r.chars().count() <= 80));
     assert!(rows[23].contains("q quit"), "{}", rows[23]);
-    if let Ok(path) = std::env::var("HMI_SCREEN_CAPTURE") {
-        std::fs::write(&path, rows.join("\n") + "\n").expect("capture written");
-    }
 }
 
 #[test]

@@ -90,25 +90,28 @@ pub fn diagnose(mut out: &mut dyn std::io::Write, log: &Path, d: &Diagnosed) -> 
     verdict(&mut out, rep)
 }
 
-/// The timeline: time [s], the mechanical speed [rad/s] (the units in the header's second
-/// line), residuals, lamps and the panel's state per point.
+/// The timeline's header: each column over its values, the speed with its unit, as the
+/// demo's `speed rpm` (the time's unit is beside each value; the residuals are normalised).
+const TIMELINE_HEADER: &str = "    time speed rad/s  r1      r2      r3      r4       lamps state";
+
+/// A timeline row's time [s], speed [rad/s] and residuals, under [`TIMELINE_HEADER`].
+fn timeline_cells(t_s: f64, speed_rad_s: f32, r: [f32; 4]) -> String {
+    format!(
+        "{t_s:6.2} s {speed_rad_s:11.1}  {:+.4} {:+.4} {:+.4} {:+.4}",
+        r[0], r[1], r[2], r[3]
+    )
+}
+
+/// The timeline: time [s], the mechanical speed [rad/s], residuals, lamps and the panel's
+/// state per point.
 fn timeline(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
-    writeln!(
-        out,
-        "\n  time    speed   r1      r2      r3      r4      lamps     state\n     s    rad/s"
-    )?;
+    writeln!(out, "\n{TIMELINE_HEADER}")?;
     for p in &rep.timeline {
         let lamps: String = p.lamps.iter().map(|l| lamp(*l)).collect();
-        let r = p.residuals;
         writeln!(
             out,
-            "{:6.2} s {:6.1} {:+.4} {:+.4} {:+.4} {:+.4}  {lamps}  {}{}",
-            p.t_s,
-            p.speed_rad_s,
-            r[0],
-            r[1],
-            r[2],
-            r[3],
+            "{}  {lamps}  {}{}",
+            timeline_cells(p.t_s, p.speed_rad_s, p.residuals),
             panel_text(&p.panel),
             p.range_note
                 .as_ref()
@@ -404,4 +407,44 @@ fn commissioning(out: &mut impl Write, c: &CommissioningReport) -> anyhow::Resul
         writeln!(out, "  {a}")?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 65: the speed column says its unit, and every header stands over its column.
+    #[test]
+    fn the_timeline_header_gives_the_speed_its_unit_over_its_column() {
+        let row = format!(
+            "{}  {}  healthy",
+            timeline_cells(12.5, 150.25, [0.0001, -0.0123, 0.5, -0.25]),
+            "○●○○"
+        );
+        let h = TIMELINE_HEADER;
+        assert!(h.contains("speed rad/s"), "{h}");
+        let col = |s: &str, at: &str| s.find(at).unwrap_or(usize::MAX);
+        let chars = |s: &str, at: usize| s[..at].chars().count();
+        // Right-aligned numbers end under their header's end; the rest start under it.
+        assert_eq!(col(h, "time") + 4, col(&row, "12.50 s") + 7, "{h}\n{row}");
+        assert_eq!(col(h, "rad/s") + 5, col(&row, "150.2") + 5, "{h}\n{row}");
+        for (label, value) in [
+            ("r1", "+0.0001"),
+            ("r2", "-0.0123"),
+            ("r3", "+0.5000"),
+            ("r4", "-0.2500"),
+        ] {
+            assert_eq!(col(h, label), col(&row, value), "{label}: {h}\n{row}");
+        }
+        assert_eq!(
+            chars(h, col(h, "lamps")),
+            chars(&row, col(&row, "○●")),
+            "{h}\n{row}"
+        );
+        assert_eq!(
+            chars(h, col(h, "state")),
+            chars(&row, col(&row, "healthy")),
+            "{h}\n{row}"
+        );
+    }
 }
