@@ -63,6 +63,8 @@ pub struct Replay {
     pub(crate) rows: u64,
     pub(crate) timeline: Vec<TimelinePoint>,
     pub(crate) next_point: f64,
+    /// Commissioning was learning at the last output (its end gets a timeline point).
+    pub(crate) was_learning: bool,
     pub(crate) dt_s: f64,
     pub(crate) t0: Option<f64>,
     pub(crate) isolation: IsolationTracker,
@@ -104,6 +106,7 @@ impl Replay {
             rows: 0,
             timeline: Vec::new(),
             next_point: 0.0,
+            was_learning: false,
             dt_s: 1.0 / sample_rate_hz,
             t0: None,
             isolation: isolation_tracker(params, channels, opts.load, opts.words, cfg.decimation),
@@ -166,6 +169,16 @@ impl Replay {
         self.isolation.after(t, dt_s, usable, &point, tc);
         // The sample nearest each timeline step (half a sample early counts: the data-quality
         // stage's sample clock may put the sample at the step a hair before it).
+        // The moment commissioning has learned gets a point of its own ("commissioning
+        // 100 %"): between two steps it would otherwise jump from a part done to healthy.
+        let learning = matches!(out.commissioning, CommissioningState::Learning(_));
+        if self.was_learning && matches!(out.commissioning, CommissioningState::Commissioned) {
+            let mut done = timeline_point(self, t, out, None);
+            done.panel.state = MonitorState::Commissioning(1.0);
+            done.commissioning = true;
+            self.timeline.push(done);
+        }
+        self.was_learning = learning;
         let (dt_s, step_s) = (self.dt_s, self.opts.timeline_step.seconds());
         if timeline_step_due(&mut self.next_point, t, dt_s, step_s) {
             let point = timeline_point(self, t, out, self.lamps.view.range_note.clone());
