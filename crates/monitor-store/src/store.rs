@@ -27,7 +27,9 @@ pub struct Store {
 const TABLE: &str = "logs";
 
 impl Store {
-    /// Opens the store at `path`, creating it (and its table) if it does not exist.
+    /// Opens the store at `path`, creating it (and its table) if it does not exist. A store
+    /// of the version before the `time_source` column gets it (`ALTER TABLE ... ADD
+    /// COLUMN`; null in its rows).
     ///
     /// # Errors
     /// [`HistoryError::Sqlite`] when the file cannot be opened or is not an SQLite store of
@@ -42,7 +44,8 @@ impl Store {
         Ok(s)
     }
 
-    /// Opens an existing store to read it (nothing is created).
+    /// Opens an existing store to read it (nothing is created; a store of the version
+    /// before the `time_source` column gets it, as [`Store::open`]).
     ///
     /// # Errors
     /// [`HistoryError::Missing`] when there is no file at `path`; [`HistoryError::Sqlite`] when
@@ -111,6 +114,16 @@ impl Store {
             .and_then(Iterator::collect)
             .map_err(|e| sql(&self.path, &e))?;
         let want: Vec<&str> = COLUMNS.iter().map(|c| c.name).collect();
+        if let Some((added, older)) = want.split_last() {
+            if names == older {
+                // A store of the version before `time_source`: the column is added (null in
+                // its rows), so that it opens and takes new rows.
+                return self
+                    .conn
+                    .execute_batch(&format!("ALTER TABLE {TABLE} ADD COLUMN {added} TEXT"))
+                    .map_err(|e| sql(&self.path, &e));
+            }
+        }
         if names != want {
             return Err(HistoryError::Sqlite {
                 path: self.path.display().to_string(),
