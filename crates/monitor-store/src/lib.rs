@@ -7,6 +7,8 @@
 //!   and Dask read.
 //! - [`StoredRow`]: one log's row ([`COLUMNS`]), taken from `diagnose --json`'s document
 //!   ([`StoredRow::from_diagnose`]): nothing is analysed again.
+//! - [`one_day_of_modified_times`]: the warning for a motor whose stored logs all took their
+//!   files' modification times on one day (`time_source`).
 //! - [`trend`]: per motor and indicator, Theil-Sen's slope with Sen's interval, against the
 //!   indicator's own scatter, at like operating points; the alarm and the days to FAULT.
 
@@ -14,6 +16,7 @@ mod error;
 pub mod mirror;
 pub mod row;
 mod store;
+mod time_note;
 pub mod trend;
 
 pub use error::HistoryError;
@@ -21,4 +24,5 @@ pub use row::{
     content_hash, parse_day, utc_day, Cell, Kind, LogIdentity, StoreColumn, StoredRow, COLUMNS,
 };
 pub use store::{Appended, Store};
+pub use time_note::one_day_of_modified_times;
 pub use trend::{MotorTrend, TrendOptions};

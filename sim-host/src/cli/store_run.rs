@@ -135,12 +135,23 @@ pub fn judge_into(
         }
         Ok(())
     })?;
+    say_counts(path, [stored, skipped, unstored], table, &times);
+    Ok(rows.into_iter().flatten().collect())
+}
+
+/// The run's counts (stored, skipped, without a report) and what the stored logs' `times`
+/// have to say ([`monitor_api::fleet::time_warnings`]), on stderr.
+fn say_counts(
+    path: &Path,
+    [stored, skipped, unstored]: [usize; 3],
+    table: &MotorTable,
+    times: &[(String, LogTime)],
+) {
     eprintln!(
         "store {}: {stored} log(s) stored, {skipped} already stored (skipped), {unstored} without a report (not stored)",
         path.display()
     );
-    for w in monitor_api::fleet::time_warnings(table, &times) {
+    for w in monitor_api::fleet::time_warnings(table, times) {
         eprintln!("{w}");
     }
-    Ok(rows.into_iter().flatten().collect())
 }
