@@ -263,6 +263,8 @@ def _gather_into_store(
             if stored and out.get("time") is not None:
                 times.append([out["stored"]["motor"], out["time"]])
     for line in _native.fleet_time_warnings(table_toml, base, _json.dumps(times)):
+        if line.startswith("warning: "):
+            line = line[len("warning: "):]
         _warnings.warn(line, UserWarning, stacklevel=3)
     return [r for r in rows if r is not None]
 

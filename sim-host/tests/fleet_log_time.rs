@@ -244,3 +244,38 @@ fn a_timestamp_column_without_one_time_is_an_error_naming_it() {
     let e = rows[0]["error"].as_str().unwrap_or_default();
     assert!(e.contains("column 'Time' holds no time: 'soon'"), "{rows}");
 }
+
+#[test]
+fn a_time_cell_that_is_no_time_is_a_bad_cell_held_out_and_counted() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    setup(
+        d,
+        "[columns]\nt_s = { name = \"Time\", unit = \"timestamp\" }\n",
+        "",
+    );
+    let log = d.join("pump_one_bad.csv");
+    // Row 1000 (t = 0.0999 s) has text for its time; every other row is ISO 8601 text.
+    let bad_at = 999.0e-4;
+    let text = rewritten(&|t| {
+        if (t - bad_at).abs() < 1e-9 {
+            "#VALUE!".to_string()
+        } else {
+            format!("2026-11-03T06:00:{t:09.6}Z")
+        }
+    });
+    std::fs::write(&log, text).expect("write");
+    let out = Command::new(env!("CARGO_BIN_EXE_sim-host"))
+        .args(["diagnose", "--params"])
+        .arg(d.join("p.toml"))
+        .arg(&log)
+        .arg("--json")
+        .output()
+        .expect("sim-host runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let q = &doc["data_quality"];
+    assert_eq!(q["rows_read"], 50_001, "{q}");
+    assert_eq!(q["non_finite_times"], 1, "{q}");
+}

@@ -16,13 +16,11 @@ mod error;
 pub mod mirror;
 pub mod row;
 mod store;
-mod time_note;
 pub mod trend;
 
 pub use error::HistoryError;
 pub use row::{
     content_hash, parse_day, utc_day, Cell, Kind, LogIdentity, StoreColumn, StoredRow, COLUMNS,
 };
-pub use store::{Appended, Store};
-pub use time_note::one_day_of_modified_times;
+pub use store::{one_day_of_modified_times, Appended, Store};
 pub use trend::{MotorTrend, TrendOptions};
