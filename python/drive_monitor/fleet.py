@@ -4,7 +4,7 @@ The motor table says which parameter file, commissioning window, healthy baselin
 belong to which motor, and which logs are its (a pattern on the file name); it is the
 ``sim-host fleet`` command's table (docs/python.md), given as a TOML file or as rows (a
 pandas DataFrame or a list of dicts with the keys ``name``, ``params``, ``logs`` and,
-optionally, ``commission``, ``baseline``, ``load``).
+optionally, ``commission``, ``baseline``, ``load``, ``time_from_name``).
 
 Each log is one Dask task: the worker fetches it (any fsspec URL: ``s3://``, ``gs://``,
 ``abfs://``, ``http(s)://``; local paths as they are), runs the library's diagnosis (the GIL
@@ -19,16 +19,22 @@ transaction per log), skipping logs already stored.
 
 from __future__ import annotations
 
-import json
-import os
-import tempfile
-from pathlib import Path
-from typing import TYPE_CHECKING, Any, Dict, List, Optional, Sequence, Union
+import json as _json
+import os as _os
+import tempfile as _tempfile
+import typing as _typing
+import warnings as _warnings
+from pathlib import Path as _Path
 
 from . import _native
 from ._native import OptionError, ParamsError
 
-if TYPE_CHECKING:  # pragma: no cover
+# The module's namespace holds its own names only (``__all__``, the helpers, the errors):
+# the standard library's modules under private names, the typing names for type checkers
+# alone (the annotations are not evaluated: ``from __future__ import annotations``).
+if _typing.TYPE_CHECKING:  # pragma: no cover
+    from typing import Any, Dict, List, Optional, Sequence, Union
+
     import distributed
     import pandas as pd
 
@@ -43,8 +49,8 @@ def _toml_value(v: Any) -> str:
         return "true" if v else "false"
     if isinstance(v, (int, float)):
         return repr(float(v))
-    if isinstance(v, (str, os.PathLike)):
-        return json.dumps(os.fspath(v))
+    if isinstance(v, (str, _os.PathLike)):
+        return _json.dumps(_os.fspath(v))
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_toml_value(x) for x in v) + "]"
     raise ParamsError(f"the motor table (rows): value {v!r} is not a number, text or list")
@@ -77,15 +83,15 @@ def local_cluster(n_workers: Optional[int] = None) -> "distributed.LocalCluster"
 
     with dask.config.set({"distributed.nanny.pre-spawn-environ": worker_environ()}):
         return LocalCluster(
-            n_workers=n_workers or os.cpu_count() or 1, threads_per_worker=1, processes=True
+            n_workers=n_workers or _os.cpu_count() or 1, threads_per_worker=1, processes=True
         )
 
 
 def _is_path(motors: Any) -> bool:
-    return isinstance(motors, (str, os.PathLike))
+    return isinstance(motors, (str, _os.PathLike))
 
 
-def motor_table_toml(motors: Any, base: Optional[Union[str, "os.PathLike[str]"]] = None) -> str:
+def motor_table_toml(motors: Any, base: Optional[Union[str, "_os.PathLike[str]"]] = None) -> str:
     """The TOML text of a motor table read from a TOML file (a path), or given as rows (a
     DataFrame or a list of dicts), checked by the library (relative paths from ``base``:
     by default the file's folder, or the working directory for rows).
@@ -97,9 +103,9 @@ def motor_table_toml(motors: Any, base: Optional[Union[str, "os.PathLike[str]"]]
         table (an unknown key, a motor without ``params``, no motor at all, ...).
     """
     if _is_path(motors):
-        path = Path(os.fspath(motors))
+        path = _Path(_os.fspath(motors))
         folder = base if base is not None else path.resolve().parent
-        return _native.fleet_read_table(os.fspath(path), os.fspath(folder))
+        return _native.fleet_read_table(_os.fspath(path), _os.fspath(folder))
     try:
         import pandas as pd
 
@@ -118,30 +124,31 @@ def motor_table_toml(motors: Any, base: Optional[Union[str, "os.PathLike[str]"]]
         for k, v in m.items():
             if v is None or (isinstance(v, float) and v != v):
                 continue
-            if k == "baseline" and isinstance(v, (str, os.PathLike)):
+            if k == "baseline" and isinstance(v, (str, _os.PathLike)):
                 v = [v]  # one healthy log (or folder) is a list of one, not its letters
             out.append(f"{k} = {_toml_value(v)}")
     text = "\n".join(out) + "\n"
-    _native.fleet_check_table(text, "the motor table (rows)", os.fspath(base or os.getcwd()))
+    _native.fleet_check_table(text, "the motor table (rows)", _os.fspath(base or _os.getcwd()))
     return text
 
 
 def _expand(logs: Union[str, Sequence[str]], storage_options: Optional[Dict[str, Any]]) -> List[str]:
     """The logs: a list as given, or a glob (local or fsspec URL) expanded."""
-    if isinstance(logs, (str, os.PathLike)):
-        pattern = os.fspath(logs)
+    if isinstance(logs, (str, _os.PathLike)):
+        pattern = _os.fspath(logs)
         if any(c in pattern for c in "*?["):
             import fsspec
 
             fs, _, paths = fsspec.get_fs_token_paths(pattern, storage_options=storage_options or {})
             if not paths:
-                raise OptionError(f"logs: the pattern {pattern!r} matches no file")
+                # The command line's words (monitor_api's FleetError::NoMatch), once.
+                raise OptionError(f"logs: the pattern '{pattern}' matches no file")
             protocol = fs.protocol if isinstance(fs.protocol, str) else fs.protocol[0]
             if protocol in ("file", "local"):
                 return sorted(paths)
             return sorted(f"{protocol}://{p}" for p in paths)
         return [pattern]
-    return [os.fspath(x) for x in logs]
+    return [_os.fspath(x) for x in logs]
 
 
 def _is_remote(log: str) -> bool:
@@ -153,9 +160,9 @@ def _fetch(log: str, storage_options: Optional[Dict[str, Any]]) -> str:
     extension; its path (the caller removes it)."""
     import fsspec
 
-    suffix = Path(log.split("?", 1)[0]).suffix
-    fd, tmp = tempfile.mkstemp(suffix=suffix, prefix="drive_monitor_fleet_")
-    os.close(fd)
+    suffix = _Path(log.split("?", 1)[0]).suffix
+    fd, tmp = _tempfile.mkstemp(suffix=suffix, prefix="drive_monitor_fleet_")
+    _os.close(fd)
     try:
         with fsspec.open(log, "rb", **(storage_options or {})) as src, open(tmp, "wb") as dst:
             while True:
@@ -164,7 +171,7 @@ def _fetch(log: str, storage_options: Optional[Dict[str, Any]]) -> str:
                     break
                 dst.write(chunk)
     except BaseException:
-        os.remove(tmp)
+        _os.remove(tmp)
         raise
     return tmp
 
@@ -178,14 +185,14 @@ def _row(log: str, table_toml: str, base: str, storage_options: Optional[Dict[st
         if _is_remote(log):
             tmp = _fetch(log, storage_options)
             local = tmp
-        return json.loads(_native.fleet_row(table_toml, base, local, shown))
+        return _json.loads(_native.fleet_row(table_toml, base, local, shown))
     except Exception as e:  # a worker's own failure (a fetch) is the row's error too
         row = {c: None for c in COLUMNS}
         row.update(motor="", file=shown, error=f"{type(e).__name__}: {e}")
         return row
     finally:
-        if tmp is not None and os.path.exists(tmp):
-            os.remove(tmp)
+        if tmp is not None and _os.path.exists(tmp):
+            _os.remove(tmp)
 
 
 def _remote_time(log: str, storage_options: Optional[Dict[str, Any]]) -> Optional[int]:
@@ -213,37 +220,52 @@ def _remote_time(log: str, storage_options: Optional[Dict[str, Any]]) -> Optiona
 def _store_row(
     log: str, table_toml: str, base: str, storage_options: Optional[Dict[str, Any]]
 ) -> Dict[str, Any]:
-    """One log's fleet row and store row, on a worker (never raises)."""
+    """One log's fleet row, store row and time, on a worker (never raises): the time from
+    the log itself, else its name (``time_from_name``), else the file's modification time
+    (a remote file's, where its store says one), as ``sim-host fleet --store``."""
     local = log[len("file://"):] if log.startswith("file://") else log
     tmp = None
     try:
-        time_s = None
+        modified_s = None
         if _is_remote(log):
-            time_s = _remote_time(log, storage_options)
+            modified_s = _remote_time(log, storage_options)
             tmp = _fetch(log, storage_options)
             local = tmp
-        return json.loads(_native.fleet_store_row(table_toml, base, local, log, time_s))
+        return _json.loads(
+            _native.fleet_store_row_timed(table_toml, base, local, log, modified_s)
+        )
     except Exception as e:
         row = {c: None for c in COLUMNS}
         row.update(motor="", file=log, error=f"{type(e).__name__}: {e}")
-        return {"row": row, "stored": None}
+        return {"row": row, "stored": None, "time": None}
     finally:
-        if tmp is not None and os.path.exists(tmp):
-            os.remove(tmp)
+        if tmp is not None and _os.path.exists(tmp):
+            _os.remove(tmp)
 
 
-def _gather_into_store(client: Any, futures: List[Any], store: str) -> List[Dict[str, Any]]:
+def _gather_into_store(
+    client: Any, futures: List[Any], store: str, table_toml: str, base: str
+) -> List[Dict[str, Any]]:
     """The workers' rows in the logs' order, each store row appended as its log finishes
-    (here, in the client: the store's one writer)."""
+    (here, in the client: the store's one writer); then a warning (``UserWarning``) for
+    each thing the stored logs' times have to say (times that are files' modification
+    times, names ``time_from_name`` does not read), the command line's lines."""
     from dask.distributed import as_completed
 
     index = {f.key: i for i, f in enumerate(futures)}
     rows: List[Optional[Dict[str, Any]]] = [None] * len(futures)
+    times: List[Any] = []
     for fut in as_completed(futures):
         out = fut.result()
         rows[index[fut.key]] = out["row"]
         if out["stored"] is not None:
-            _native.store_append(store, json.dumps([out["stored"]]))
+            stored, _ = _native.store_append(store, _json.dumps([out["stored"]]))
+            if stored and out.get("time") is not None:
+                times.append([out["stored"]["motor"], out["time"]])
+    for line in _native.fleet_time_warnings(table_toml, base, _json.dumps(times)):
+        if line.startswith("warning: "):
+            line = line[len("warning: "):]
+        _warnings.warn(line, UserWarning, stacklevel=3)
     return [r for r in rows if r is not None]
 
 
@@ -252,8 +274,8 @@ def diagnose_many(
     motors: Any,
     client: Any = None,
     storage_options: Optional[Dict[str, Any]] = None,
-    base: Optional[Union[str, "os.PathLike[str]"]] = None,
-    store: Optional[Union[str, "os.PathLike[str]"]] = None,
+    base: Optional[Union[str, "_os.PathLike[str]"]] = None,
+    store: Optional[Union[str, "_os.PathLike[str]"]] = None,
 ) -> "pd.DataFrame":
     """Diagnose many motors' logs on a Dask cluster; one row per log.
 
@@ -275,8 +297,11 @@ def diagnose_many(
     store : path, optional
         Also append each judged log to this store of the motors' history (SQLite, and its
         Parquet mirror in ``store + ".parquet"``), in the client as the logs finish; a log
-        already stored is not stored twice. Its motor is the table's name, its time the
-        file's modification time (docs/trend.md).
+        already stored is not stored twice. Its motor is the table's name; its time the
+        log's own (a time column of timestamps in the parameter file's ``[columns]``, a
+        TDMS ``wf_start_time``), else the date in its file name by the motor's
+        ``time_from_name`` pattern, else the file's modification time, and a
+        ``UserWarning`` says when times are modification times (docs/trend.md).
 
     Returns
     -------
@@ -297,7 +322,7 @@ def diagnose_many(
 
     if base is None:
         base = (
-            str(Path(os.fspath(motors)).resolve().parent) if _is_path(motors) else os.getcwd()
+            str(_Path(_os.fspath(motors)).resolve().parent) if _is_path(motors) else _os.getcwd()
         )
     table = motor_table_toml(motors, base)
     paths = _expand(logs, storage_options)
@@ -306,10 +331,10 @@ def diagnose_many(
         local = [p[len("file://"):] if p.startswith("file://") else p for p in paths]
         _native.fleet_check_outputs(
             table,
-            os.fspath(base),
-            os.fspath(motors) if _is_path(motors) else None,
+            _os.fspath(base),
+            _os.fspath(motors) if _is_path(motors) else None,
             [p for p in local if not _is_remote(p)],
-            os.fspath(store),
+            _os.fspath(store),
         )
     own = client is None
     cluster = None
@@ -323,14 +348,14 @@ def diagnose_many(
             _row if store is None else _store_row,
             paths,
             table_toml=table,
-            base=os.fspath(base),
+            base=_os.fspath(base),
             storage_options=storage_options,
             pure=False,
         )
         if store is None:
             rows = client.gather(futures)
         else:
-            rows = _gather_into_store(client, futures, os.fspath(store))
+            rows = _gather_into_store(client, futures, _os.fspath(store), table, _os.fspath(base))
     finally:
         if own:
             client.close()

@@ -85,3 +85,73 @@ pub fn fleet_check_outputs(
 pub fn fleet_columns() -> Vec<&'static str> {
     monitor_api::fleet::COLUMNS.to_vec()
 }
+
+/// One log's fleet row, its store row and its time, as JSON `{"row": {...}, "stored":
+/// {...} | null, "time": {"time_s", "source", "name_unmatched"} | null}` (on a worker):
+/// `log` is the local file, `shown` its name in the rows (a URL) and the name its motor
+/// and `time_from_name` read. The time comes from the log itself, else from its name, else
+/// from `modified_s` (a remote file's modification time [s since 1970 UTC]) or the local
+/// file's ([`monitor_api::fleet::log_time`], the order of `sim-host fleet --store`).
+///
+/// # Errors
+/// A motor table that is not one ([`ParamsError`]).
+#[pyfunction]
+#[pyo3(signature = (table_toml, base, log, shown, modified_s=None))]
+pub fn fleet_store_row_timed(
+    py: Python<'_>,
+    table_toml: String,
+    base: PathBuf,
+    log: PathBuf,
+    shown: String,
+    modified_s: Option<i64>,
+) -> PyResult<String> {
+    use monitor_api::fleet::LogTimeSource;
+    run(py, || {
+        let table =
+            monitor_api::fleet::MotorTable::from_toml_str(&table_toml, "the motor table", &base)
+                .map_err(|e| ParamsError::new_err(e.to_string()))?;
+        let (row, doc) = monitor_api::fleet::row_and_report_shown(&table, &log, &shown);
+        let motor = table.motor_of(std::path::Path::new(&shown));
+        let time = motor.and_then(|m| {
+            let mut t = monitor_api::fleet::log_time(m, &log, &shown).ok()?;
+            if let (LogTimeSource::Modified, Some(s)) = (t.source, modified_s) {
+                t.time_s = s;
+            }
+            Some(t)
+        });
+        let stored = motor
+            .zip(time.as_ref())
+            .zip(doc.as_ref())
+            .and_then(|((m, t), d)| {
+                let mut id = monitor_store::LogIdentity::of_file(&m.name, &log).ok()?;
+                id.path = shown.clone();
+                id.time_s = t.time_s;
+                Some(
+                    monitor_store::StoredRow::from_diagnose(&id, d)
+                        .with_time_source(t.source.name()),
+                )
+            });
+        let v = serde_json::json!({ "row": row, "stored": stored, "time": time });
+        Ok(v.to_string())
+    })
+}
+
+/// What a fleet run that stored logs has to say of their times, one line each
+/// ([`monitor_api::fleet::time_warnings`]): `times_json` is a JSON list of `[motor, time]`
+/// (the `time` of [`fleet_store_row_timed`]).
+///
+/// # Errors
+/// [`ParamsError`]: the motor table is not one; [`super::OptionError`]: `times_json` is not
+/// such a list.
+#[pyfunction]
+pub fn fleet_time_warnings(
+    table_toml: &str,
+    base: PathBuf,
+    times_json: &str,
+) -> PyResult<Vec<String>> {
+    let table = monitor_api::fleet::MotorTable::from_toml_str(table_toml, "the motor table", &base)
+        .map_err(|e| ParamsError::new_err(e.to_string()))?;
+    let times: Vec<(String, monitor_api::fleet::LogTime)> = serde_json::from_str(times_json)
+        .map_err(|e| super::OptionError::new_err(format!("fleet times: {e}")))?;
+    Ok(monitor_api::fleet::time_warnings(&table, &times))
+}

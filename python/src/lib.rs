@@ -543,6 +543,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fleet::fleet_read_table, m)?)?;
     m.add_function(wrap_pyfunction!(fleet::fleet_check_table, m)?)?;
     m.add_function(wrap_pyfunction!(fleet::fleet_check_outputs, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet::fleet_store_row_timed, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet::fleet_time_warnings, m)?)?;
     m.add_function(wrap_pyfunction!(store::fleet_store_row, m)?)?;
     m.add_function(wrap_pyfunction!(store::store_append, m)?)?;
     m.add_function(wrap_pyfunction!(store::store_trend, m)?)?;

@@ -110,3 +110,46 @@ def test_a_glob_that_matches_nothing_is_an_error_naming_it(plant, tmp_path):
     with pytest.raises(dm.OptionError) as e:
         fleet.diagnose_many(pattern, table)
     assert pattern in str(e.value) and "matches no file" in str(e.value), str(e.value)
+    # Worded once, in the command line's words.
+    assert str(e.value).count("matches no file") == 1, str(e.value)
+    assert str(e.value) == f"logs: the pattern '{pattern}' matches no file", str(e.value)
+
+
+def test_the_module_exposes_its_own_names_only():
+    for name in ("os", "json", "tempfile", "typing", "Path", "Any", "Dict", "List",
+                 "Optional", "Sequence", "Union", "TYPE_CHECKING"):
+        assert not hasattr(fleet, name), name
+    assert set(fleet.__all__) <= set(vars(fleet))
+
+
+def test_a_stored_logs_time_comes_from_its_name_else_its_modification_time(plant, tmp_path):
+    """Issue 65: the Dask run dates a log as ``sim-host fleet --store`` does: by the motor's
+    ``time_from_name`` where the name has the date (2026-11-03, though the file was written
+    today), else by the file's modification time, and says so."""
+    import shutil
+    import sqlite3
+
+    from dask.distributed import Client, LocalCluster
+
+    d, logs, _table = plant
+    named = tmp_path / "m3hp_20261103_0600.parquet"
+    other = tmp_path / "m3hp_latest.parquet"
+    shutil.copyfile(logs[0], named)
+    shutil.copyfile(logs[0], other)
+    table = tmp_path / "motors.toml"
+    params = open(d / "motors.toml").read().split("[[motor]]")[1]
+    table.write_text("[[motor]]" + params + 'time_from_name = "m3hp_%Y%m%d_%H%M"\n')
+    store = tmp_path / "h.db"
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True) as cluster, Client(cluster) as client:
+        with pytest.warns(UserWarning, match="do not match time_from_name") as said:
+            fleet.diagnose_many([str(named), str(other)], table, client=client, store=store)
+    lines = [str(w.message) for w in said]
+    assert any("modification times" in w for w in lines), lines
+    with sqlite3.connect(store) as c:
+        got = dict(c.execute("SELECT log_path, day || ' ' || time_source FROM logs").fetchall())
+    # 2026-11-03T06:00:00Z (`date -u -d 2026-11-03T06:00:00Z +%s`).
+    assert got[str(named)] == "2026-11-03 file_name", got
+    assert got[str(other)].endswith(" modified") and not got[str(other)].startswith("2026-11-03"), got
+    with sqlite3.connect(store) as c:
+        (t,) = c.execute("SELECT log_time_s FROM logs WHERE log_path = ?", (str(named),)).fetchone()
+    assert t == 1_793_685_600

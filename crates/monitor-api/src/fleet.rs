@@ -13,19 +13,25 @@
 //! commission = [2.0, 4.0]          # optional: --commission START:END
 //! baseline = ["healthy/pump_7"]    # optional: healthy logs or folders (a request's baseline)
 //! load = "unknown"                 # optional: "unknown" (default) or "viscous"
+//! time_from_name = "pump_7_%Y%m%d_%H%M"  # optional: the log's date in its file name
 //! ```
 //!
 //! A log belongs to the first motor whose pattern matches its file name (`*` any text, `?`
-//! one character).
+//! one character). A log's time in the motors' history comes from the log itself where it
+//! can, else from its name by `time_from_name`, else from the file's modification time
+//! ([`time`]: [`log_time`], [`time_from_name`]).
 //!
 //! What a run writes (the history store) may not be a file it reads
 //! ([`check_fleet_outputs`], checked before anything is written).
 
 use crate::{diagnose, ApiError, DiagnoseRequest, LogSource, ParamsSource};
+
+pub mod time;
 use monitor_io::log::{check_outputs, NamedFile, OverwriteError};
 use monitor_replay::{DiagnoseReport, IsolationEvent, LoadModel, ReplayOptions};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+pub use time::{log_time, time_from_name, time_warnings, LogTime, LogTimeSource};
 
 /// One motor of the table.
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
@@ -46,6 +52,13 @@ pub struct MotorEntry {
     /// What is known of its load: `unknown` (default) or `viscous`.
     #[serde(default)]
     pub load: Option<MotorLoad>,
+    /// The date and time in its logs' file names, a chrono strftime pattern
+    /// (`pump_7_%Y%m%d_%H%M`; [`time_from_name`] says what is accepted): a log's time in the
+    /// history where the log itself says none (no time column of timestamps, no TDMS
+    /// `wf_start_time`); a name it does not match falls back to the file's modification
+    /// time, and the run says so ([`time_warnings`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_from_name: Option<String>,
 }
 
 /// What is known of a motor's load (the table's `load`, lower case).
@@ -136,6 +149,16 @@ impl MotorTable {
             request(m)
                 .validate()
                 .map_err(|e| bad(format!("motor {}: {e}", m.name)))?;
+            if let Some(p) = m
+                .time_from_name
+                .as_deref()
+                .filter(|p| !time::time_pattern_ok(p))
+            {
+                return Err(bad(format!(
+                    "motor {}: time_from_name \"{p}\" is not a date pattern: chrono's strftime specifiers with a year and a day (%Y%m%d, %Y-%m-%d_%H%M, ...) or %s",
+                    m.name
+                )));
+            }
             m.params = from_base(base, &m.params);
             m.baseline = m.baseline.iter().map(|p| from_base(base, p)).collect();
         }
@@ -377,16 +400,33 @@ pub fn row_shown(table: &MotorTable, log: &Path, shown: &str) -> FleetRow {
 /// `diagnose --json` prints; `None` where the log gave no report): what a store of the
 /// motor's history keeps (`monitor_store::StoredRow::from_diagnose`).
 pub fn row_and_report(table: &MotorTable, log: &Path) -> (FleetRow, Option<serde_json::Value>) {
-    let Some(m) = table.motor_of(log) else {
-        return (row(table, log), None);
+    row_and_report_shown(table, log, &log.display().to_string())
+}
+
+/// [`row_and_report`] of `log` shown as `shown` (a URL it was fetched from, say): its motor
+/// found by `shown`'s file name, the row's `file` and error naming `shown`.
+pub fn row_and_report_shown(
+    table: &MotorTable,
+    log: &Path,
+    shown: &str,
+) -> (FleetRow, Option<serde_json::Value>) {
+    let Some(m) = table.motor_of(Path::new(shown)) else {
+        return (row_shown(table, log, shown), None);
     };
-    match diagnose(ParamsSource::Path(&m.params), log, &request(m), &mut |_| {}) {
-        Ok(d) => (
-            FleetRow::of_report(&m.name, log, &d.report),
-            serde_json::to_value(&d.report).ok(),
-        ),
-        Err(e) => (FleetRow::failed(&m.name, log, one_line_error(&e)), None),
+    let (mut row, doc) =
+        match diagnose(ParamsSource::Path(&m.params), log, &request(m), &mut |_| {}) {
+            Ok(d) => (
+                FleetRow::of_report(&m.name, log, &d.report),
+                serde_json::to_value(&d.report).ok(),
+            ),
+            Err(e) => (FleetRow::failed(&m.name, log, one_line_error(&e)), None),
+        };
+    let local = log.display().to_string();
+    row.file = shown.to_string();
+    if let Some(e) = &mut row.error {
+        *e = e.replace(&local, shown);
     }
+    (row, doc)
 }
 
 /// The diagnosis request of motor `m`'s logs.

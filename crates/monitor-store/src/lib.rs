@@ -7,6 +7,8 @@
 //!   and Dask read.
 //! - [`StoredRow`]: one log's row ([`COLUMNS`]), taken from `diagnose --json`'s document
 //!   ([`StoredRow::from_diagnose`]): nothing is analysed again.
+//! - [`one_day_of_modified_times`]: the warning for a motor whose stored logs all took their
+//!   files' modification times on one day (`time_source`).
 //! - [`trend`]: per motor and indicator, Theil-Sen's slope with Sen's interval, against the
 //!   indicator's own scatter, at like operating points; the alarm and the days to FAULT.
 
@@ -20,5 +22,5 @@ pub use error::HistoryError;
 pub use row::{
     content_hash, parse_day, utc_day, Cell, Kind, LogIdentity, StoreColumn, StoredRow, COLUMNS,
 };
-pub use store::{Appended, Store};
+pub use store::{one_day_of_modified_times, Appended, Store};
 pub use trend::{MotorTrend, TrendOptions};

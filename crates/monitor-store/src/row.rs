@@ -35,8 +35,10 @@ const fn c(name: &'static str, kind: Kind, doc: &'static str) -> StoreColumn {
 
 /// The columns, in order. The first six say which log of which motor and when; every value
 /// after them is one `diagnose --json` reported (the key in brackets); null where the
-/// diagnosis had none (a fault not named, a rotor not judged).
-pub const COLUMNS: [StoreColumn; 35] = [
+/// diagnosis had none (a fault not named, a rotor not judged); `time_source` says where the
+/// log's time came from. Columns added since the first version come last, so that an older
+/// store takes them with `ALTER TABLE ... ADD COLUMN` ([`Store::open`](crate::Store::open)).
+pub const COLUMNS: [StoreColumn; 36] = [
     c(
         "log_id",
         Kind::Text,
@@ -188,6 +190,11 @@ pub const COLUMNS: [StoreColumn; 35] = [
         "1 when the data quality is trusted [data_quality.trusted]",
     ),
     c(
+        "time_source",
+        Kind::Text,
+        "where log_time_s comes from: log (a time column of timestamps), tdms (wf_start_time), file_name (the motor table's time_from_name), modified (the file's modification time); null in rows stored before it was kept",
+    ),
+    c(
         "stator_excess_pct",
         Kind::Real,
         "Rs's change beyond Rr's in %, free of the winding's temperature [isolation.resistances.stator_excess]",
@@ -254,8 +261,9 @@ pub struct LogIdentity {
 
 impl LogIdentity {
     /// The identity of the log file at `path` as motor `motor`'s: the hash of its bytes
-    /// (read in 1 MiB pieces) and its time, the file's modification time (the log reader
-    /// exposes no absolute start time; docs/trend.md).
+    /// (read in 1 MiB pieces) and its time, the file's modification time: the last resort
+    /// (`monitor_api::fleet::log_time` finds the log's own time first; docs/trend.md) that
+    /// a caller replaces with a better one.
     ///
     /// # Errors
     /// The file cannot be read or has no modification time.
@@ -337,6 +345,15 @@ impl StoredRow {
         cells.extend(report_cells(doc));
         StoredRow { cells }
     }
+
+    /// The row with its `time_source` (`log`, `tdms`, `file_name` or `modified`: where its
+    /// `log_time_s` comes from; null until set).
+    pub fn with_time_source(mut self, source: &str) -> Self {
+        if let Some(c) = column_index("time_source").and_then(|i| self.cells.get_mut(i)) {
+            *c = Cell::Text(source.to_string());
+        }
+        self
+    }
 }
 
 impl StoredRow {
@@ -417,6 +434,8 @@ fn report_cells(doc: &Value) -> Vec<Cell> {
             .and_then(Value::as_i64)),
         real(num("/data_quality/sample_rate_hz")),
         int(flag("/data_quality/trusted")),
+        // time_source: the caller's ([`StoredRow::with_time_source`]).
+        Cell::Null,
         real(num("/isolation/resistances/stator_excess").map(|x| 100.0 * x)),
     ]
 }

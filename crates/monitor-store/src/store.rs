@@ -3,7 +3,7 @@
 
 use crate::error::HistoryError;
 use crate::mirror;
-use crate::row::{Cell, Kind, StoredRow, COLUMNS};
+use crate::row::{utc_day, Cell, Kind, StoredRow, COLUMNS};
 use rusqlite::types::{Value as SqlValue, ValueRef};
 use rusqlite::{params_from_iter, Connection, OpenFlags};
 use std::path::{Path, PathBuf};
@@ -27,7 +27,9 @@ pub struct Store {
 const TABLE: &str = "logs";
 
 impl Store {
-    /// Opens the store at `path`, creating it (and its table) if it does not exist.
+    /// Opens the store at `path`, creating it (and its table) if it does not exist. A store
+    /// of the version before the `time_source` column gets it (`ALTER TABLE ... ADD
+    /// COLUMN`; null in its rows).
     ///
     /// # Errors
     /// [`HistoryError::Sqlite`] when the file cannot be opened or is not an SQLite store of
@@ -42,7 +44,8 @@ impl Store {
         Ok(s)
     }
 
-    /// Opens an existing store to read it (nothing is created).
+    /// Opens an existing store to read it (nothing is created; a store of the version
+    /// before the `time_source` column gets it, as [`Store::open`]).
     ///
     /// # Errors
     /// [`HistoryError::Missing`] when there is no file at `path`; [`HistoryError::Sqlite`] when
@@ -111,6 +114,23 @@ impl Store {
             .and_then(Iterator::collect)
             .map_err(|e| sql(&self.path, &e))?;
         let want: Vec<&str> = COLUMNS.iter().map(|c| c.name).collect();
+        // A store of an earlier version (its columns a prefix of today's: `time_source` and
+        // `stator_excess_pct` came last): the missing columns are added, null in its rows,
+        // so that it opens and takes new rows.
+        if names.len() < want.len() && want.iter().zip(&names).all(|(w, n)| w == n) {
+            let kinds = COLUMNS.iter().skip(names.len());
+            for c in kinds {
+                let kind = match c.kind {
+                    crate::row::Kind::Text => "TEXT",
+                    crate::row::Kind::Int => "INTEGER",
+                    crate::row::Kind::Real => "REAL",
+                };
+                self.conn
+                    .execute_batch(&format!("ALTER TABLE {TABLE} ADD COLUMN {} {kind}", c.name))
+                    .map_err(|e| sql(&self.path, &e))?;
+            }
+            return Ok(());
+        }
         if names != want {
             return Err(HistoryError::Sqlite {
                 path: self.path.display().to_string(),
@@ -272,5 +292,85 @@ fn not_writable(path: &Path) -> Option<String> {
             None
         }
         Err(e) => denied(e).then(|| format!("the folder {} is not writable", folder.display())),
+    }
+}
+
+/// What a motor's stored times say of themselves: a history whose logs all took their
+/// files' modification times on one day is no history (a copy without `cp -p` put them
+/// there), and a reader of the trend is to be told (docs/trend.md).
+/// For each motor of `rows` whose logs (two or more) all have modification times for their
+/// times (`time_source` `modified`, or null: rows stored before the column was kept, whose
+/// times were all modification times) and fall on one UTC day: the one-line warning, in the
+/// motors' order of first appearance.
+pub fn one_day_of_modified_times(rows: &[StoredRow]) -> Vec<String> {
+    let mut motors: Vec<&str> = Vec::new();
+    for r in rows {
+        let m = r.str("motor").unwrap_or_default();
+        if !motors.contains(&m) {
+            motors.push(m);
+        }
+    }
+    let mut out = Vec::new();
+    for m in motors {
+        let own: Vec<&StoredRow> = rows
+            .iter()
+            .filter(|r| r.str("motor").unwrap_or_default() == m)
+            .collect();
+        let modified = own
+            .iter()
+            .all(|r| matches!(r.str("time_source"), None | Some("modified")));
+        let days: std::collections::BTreeSet<String> = own
+            .iter()
+            .map(|r| utc_day(r.f64("log_time_s").unwrap_or(0.0) as i64))
+            .collect();
+        if let (true, true, Some(day)) = (own.len() >= 2 && modified, days.len() == 1, days.first())
+        {
+            out.push(format!(
+                "WARNING: motor {m}: the times of {} logs are their files' modification times and all fall on {day}: copy logs with `cp -p`, give the log a time column, or set `time_from_name` in the motor table (docs/trend.md)",
+                own.len()
+            ));
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::row::LogIdentity;
+
+    fn row(motor: &str, t: i64, source: Option<&str>) -> StoredRow {
+        let id = LogIdentity {
+            motor: motor.into(),
+            path: format!("{motor}{t}"),
+            hash: "00".into(),
+            time_s: t,
+        };
+        let r = StoredRow::from_diagnose(&id, &serde_json::json!({}));
+        match source {
+            Some(s) => r.with_time_source(s),
+            None => r,
+        }
+    }
+
+    #[test]
+    fn one_day_of_modification_times_is_said() {
+        let day = 86_400 * 20_000;
+        let rows = [
+            row("a", day, Some("modified")),
+            row("a", day + 60, None),
+            row("b", day, Some("modified")),
+            row("b", day + 60, Some("log")),
+            row("c", day, Some("modified")),
+            row("c", day + 86_400, Some("modified")),
+            row("d", day, Some("modified")),
+        ];
+        let said = one_day_of_modified_times(&rows);
+        assert_eq!(said.len(), 1, "{said:?}");
+        // Day 20 000 of the Unix epoch: 2024-10-04 (`date -u -d @1728000000 +%F`).
+        assert!(
+            said[0].starts_with("WARNING: motor a: the times of 2 logs are their files' modification times and all fall on 2024-10-04: copy logs with `cp -p`"),
+            "{said:?}"
+        );
     }
 }

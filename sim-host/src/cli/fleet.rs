@@ -16,15 +16,18 @@ first_detection_s, load_moves, data_quality, error. A bad file is a row with its
 failed run; a log pattern that matches no file (`'logs/pump_*.csv'`, or a shell glob that matched \
 nothing) is an error naming the pattern.\n\nWith --store PATH each judged log is also appended to a store of the motors' \
 history (SQLite at PATH, one transaction per log, and a Parquet mirror in PATH.parquet/, \
-partitioned by motor and day): its motor is the table's name for it, its time the file's \
-modification time. A log already stored (the same bytes at the same path) is skipped, not \
+partitioned by motor and day): its motor is the table's name for it, its time the log's own \
+(a time column of timestamps in [columns], a TDMS wf_start_time), else the date in its file \
+name by the motor's time_from_name pattern, else the file's modification time (the run warns \
+of those). A log already stored (the same bytes at the same path) is skipped, not \
 judged again; a run killed mid-way loses no stored row, and the next run finishes it. Read the \
 store with `sim-host trend --store PATH` (docs/trend.md).\n\nThe motor table (TOML) says which parameter file, commissioning window, healthy \
 baseline and load belong to which motor, and which logs are its (a pattern on the file name; \
 paths relative to the table's folder):\n\n  [[motor]]\n  name = \"pump_7\"\n  params = \
 \"params/pump_7.toml\"\n  logs = \"pump_7_*\"\n  commission = [2.0, 4.0]   # optional\n  \
 baseline = [\"healthy/pump_7\"]   # optional: healthy logs or folders\n  load = \"unknown\"   # \
-optional: or \"viscous\"\n\nFor hundreds of motors and many machines, the Python package runs the \
+optional: or \"viscous\"\n  time_from_name = \"pump_7_%Y%m%d_%H%M\"   # optional: the \
+log's date in its file name (chrono's strftime)\n\nFor hundreds of motors and many machines, the Python package runs the \
 same rows on a Dask cluster (docs/python.md).\n\nExample:\n  sim-host fleet motors.toml logs/*.csv \
 --json\n  sim-host fleet motors.toml logs/*.csv --store history.db\n  sim-host trend --store history.db"
 )]

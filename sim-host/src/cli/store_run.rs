@@ -1,16 +1,19 @@
 //! `sim-host fleet --store PATH`: the logs judged in parallel, each judged log appended to
 //! the store by this one thread as it comes (one writer, one transaction per log), so that a
-//! run killed mid-way keeps every log stored before the kill.
+//! run killed mid-way keeps every log stored before the kill. Each log's time comes from the
+//! log where it can ([`monitor_api::fleet::log_time`]); the run warns of times that are
+//! files' modification times ([`monitor_api::fleet::time_warnings`]).
 
-use monitor_api::fleet::{FleetRow, MotorTable};
+use monitor_api::fleet::{FleetRow, LogTime, MotorTable};
 use monitor_store::{Appended, LogIdentity, Store, StoredRow};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// One log's outcome from a worker.
 enum Judged {
-    /// Judged: its fleet row, and the store's row where it gave a report.
-    Row(usize, Box<FleetRow>, Option<StoredRow>),
+    /// Judged: its fleet row, and the store's row where it gave a report (with its motor and
+    /// time).
+    Row(usize, Box<FleetRow>, Option<(StoredRow, String, LogTime)>),
     /// Already in the store: not judged again.
     Stored(PathBuf),
 }
@@ -61,9 +64,16 @@ fn judge_one(table: &MotorTable, log: &Path, id: Option<&LogIdentity>, stored: b
         return Judged::Stored(log.to_path_buf());
     }
     let (row, doc) = monitor_api::fleet::row_and_report(table, log);
-    let kept = id
-        .zip(doc.as_ref())
-        .map(|(id, d)| StoredRow::from_diagnose(id, d));
+    let kept = id.zip(doc.as_ref()).and_then(|(id, d)| {
+        let m = table.motor_of(log)?;
+        let time = monitor_api::fleet::log_time(m, log, &log.display().to_string()).ok()?;
+        let id = LogIdentity {
+            time_s: time.time_s,
+            ..id.clone()
+        };
+        let r = StoredRow::from_diagnose(&id, d).with_time_source(time.source.name());
+        Some((r, id.motor, time))
+    });
     Judged::Row(0, Box::new(row), kept)
 }
 
@@ -82,6 +92,7 @@ pub fn judge_into(
     let (tx, rx) = std::sync::mpsc::channel::<Judged>();
     let mut rows: Vec<Option<FleetRow>> = vec![None; logs.len()];
     let (mut stored, mut skipped, mut unstored) = (0usize, 0usize, 0usize);
+    let mut times: Vec<(String, LogTime)> = Vec::new();
     std::thread::scope(|s| -> anyhow::Result<()> {
         let known = &known;
         s.spawn(move || {
@@ -107,8 +118,11 @@ pub fn judge_into(
                 }
                 Judged::Row(i, row, kept) => {
                     match kept {
-                        Some(r) => match store.append(&r)? {
-                            Appended::Stored => stored += 1,
+                        Some((r, motor, time)) => match store.append(&r)? {
+                            Appended::Stored => {
+                                stored += 1;
+                                times.push((motor, time));
+                            }
                             Appended::AlreadyStored => skipped += 1,
                         },
                         None => unstored += 1,
@@ -121,9 +135,23 @@ pub fn judge_into(
         }
         Ok(())
     })?;
+    say_counts(path, [stored, skipped, unstored], table, &times);
+    Ok(rows.into_iter().flatten().collect())
+}
+
+/// The run's counts (stored, skipped, without a report) and what the stored logs' `times`
+/// have to say ([`monitor_api::fleet::time_warnings`]), on stderr.
+fn say_counts(
+    path: &Path,
+    [stored, skipped, unstored]: [usize; 3],
+    table: &MotorTable,
+    times: &[(String, LogTime)],
+) {
     eprintln!(
         "store {}: {stored} log(s) stored, {skipped} already stored (skipped), {unstored} without a report (not stored)",
         path.display()
     );
-    Ok(rows.into_iter().flatten().collect())
+    for w in monitor_api::fleet::time_warnings(table, times) {
+        eprintln!("{w}");
+    }
 }

@@ -15,7 +15,6 @@
 //! times that do not increase are handed over: the data-quality stage judges them.
 
 use super::csv_line::{parse_block_with, Cols};
-use super::mapping::TimeKind;
 use super::source::row_from_values;
 use super::source::{ColumnMap, Opened};
 use super::{Column, LogError, Row};
@@ -113,7 +112,7 @@ pub(super) fn for_each_row(
     progress: &mut dyn FnMut(f64),
     on_rows: &mut dyn FnMut(&[Row]) -> ControlFlow<usize>,
 ) -> Result<Option<u64>, LogError> {
-    if log.columns().time == TimeKind::Iso8601 {
+    if log.columns().time.is_text() {
         return Ok(None);
     }
     let io = |source| LogError::Io {

@@ -11,9 +11,13 @@
 //!
 //! The units (case as written):
 //! - time (`t_s`): `s`, `ms`, `us` (or `µs`); a timestamp column: `epoch_s`, `epoch_ms`,
-//!   `epoch_us`, `epoch_ns` (seconds ... nanoseconds since 1970-01-01) or `iso8601` (text
-//!   such as `2024-05-01T12:00:00.125Z`, CSV only). A timestamp's time counts from the
-//!   log's first row: `t_s = 0` there.
+//!   `epoch_us`, `epoch_ns` (seconds ... nanoseconds since 1970-01-01), `iso8601` (text
+//!   such as `2024-05-01T12:00:00.125Z`, CSV only) or `timestamp` (either: ISO 8601 text or
+//!   Unix epoch seconds, cell by cell; CSV only, and a Parquet `TIMESTAMP` column). ISO 8601
+//!   text without a zone is UTC. A timestamp's time counts from the log's first row
+//!   (`t_s = 0` there); its first time is the log's start
+//!   ([`super::LogFile::start_time`]). A cell that is no time is a bad cell (NaN, held out
+//!   and counted by the data-quality stage); a column without one time is refused.
 //! - voltages: `V`, `kV`, `mV`; currents: `A`, `mA`;
 //! - speed (`wm_rad_s`, mechanical): `rad/s`, `rpm` (mechanical revolutions per minute,
 //!   times `2 pi / 60`) or `Hz_el` (the electrical frequency of the rotor speed, times
@@ -53,8 +57,11 @@ pub enum ChannelUnit {
     EpochMicroseconds,
     /// Nanoseconds since 1970-01-01.
     EpochNanoseconds,
-    /// ISO 8601 date and time text (`YYYY-MM-DDTHH:MM:SS[.f][Z|+HH:MM]`).
+    /// ISO 8601 date and time text (`YYYY-MM-DDTHH:MM:SS[.f][Z|+HH:MM]`; no zone: UTC).
     Iso8601,
+    /// A timestamp: ISO 8601 text as [`ChannelUnit::Iso8601`] or Unix epoch seconds
+    /// (`1793685600.125`), cell by cell (a Parquet `TIMESTAMP` column: its own unit).
+    Timestamp,
     /// Volts.
     Volts,
     /// Kilovolts.
@@ -92,11 +99,20 @@ pub(super) enum TimeKind {
     Epoch,
     /// ISO 8601 text: counted from the first row.
     Iso8601,
+    /// ISO 8601 text or epoch seconds: counted from the first row.
+    Timestamp,
+}
+
+impl TimeKind {
+    /// True for a time column read as text (the exact reader's).
+    pub(super) fn is_text(self) -> bool {
+        matches!(self, TimeKind::Iso8601 | TimeKind::Timestamp)
+    }
 }
 
 impl ChannelUnit {
     /// Every unit with its spellings (the first is the one written in messages).
-    const SPELLINGS: [(ChannelUnit, &'static [&'static str]); 20] = [
+    const SPELLINGS: [(ChannelUnit, &'static [&'static str]); 21] = [
         (ChannelUnit::Seconds, &["s", "sec", "Seconds"]),
         (ChannelUnit::Milliseconds, &["ms"]),
         (ChannelUnit::Microseconds, &["us", "µs"]),
@@ -105,6 +121,7 @@ impl ChannelUnit {
         (ChannelUnit::EpochMicroseconds, &["epoch_us"]),
         (ChannelUnit::EpochNanoseconds, &["epoch_ns"]),
         (ChannelUnit::Iso8601, &["iso8601"]),
+        (ChannelUnit::Timestamp, &["timestamp"]),
         (ChannelUnit::Volts, &["V", "Volts"]),
         (ChannelUnit::Kilovolts, &["kV"]),
         (ChannelUnit::Millivolts, &["mV"]),
@@ -132,6 +149,7 @@ impl ChannelUnit {
                 U::EpochMicroseconds,
                 U::EpochNanoseconds,
                 U::Iso8601,
+                U::Timestamp,
             ],
             Column::Va | Column::Vb | Column::Vc => &[U::Volts, U::Kilovolts, U::Millivolts],
             Column::Ia | Column::Ib | Column::Ic => &[U::Amperes, U::Milliamperes],
@@ -176,6 +194,7 @@ impl ChannelUnit {
             ChannelUnit::Seconds
             | ChannelUnit::EpochSeconds
             | ChannelUnit::Iso8601
+            | ChannelUnit::Timestamp
             | ChannelUnit::Volts
             | ChannelUnit::Amperes
             | ChannelUnit::RadPerSecond
@@ -214,6 +233,7 @@ impl ChannelUnit {
             | ChannelUnit::EpochMicroseconds
             | ChannelUnit::EpochNanoseconds => TimeKind::Epoch,
             ChannelUnit::Iso8601 => TimeKind::Iso8601,
+            ChannelUnit::Timestamp => TimeKind::Timestamp,
             _ => TimeKind::Plain,
         }
     }
@@ -412,6 +432,8 @@ pub(super) fn resolve_unit(
         why,
     };
     match (ChannelUnit::parse(c, text), declared) {
+        // `timestamp` takes a typed timestamp column in the unit the file records.
+        (Ok(r), Some(ChannelUnit::Timestamp)) if r.time_kind() == TimeKind::Epoch => Ok(Some(r)),
         (Ok(r), Some(d)) if r != d => Err(err(format!(
             "is recorded in '{text}' but the parameter file's [columns] gives {} in '{}'",
             c.name(),

@@ -47,7 +47,7 @@ pub use format::Format;
 pub use mapping::{ChannelUnit, ColumnMapping};
 pub use memory::{MemoryLog, MemoryValues};
 pub use overwrite::{check_output_folder, check_outputs, same_file, NamedFile, OverwriteError};
-pub use reader::{LogFile, RowSink};
+pub use reader::{LogFile, LogStart, LogStartFrom, RowSink};
 pub use source::OpenOptions;
 pub use writer::{write_atomic, LogWriter};
 

@@ -9,6 +9,9 @@ use std::io::{BufRead, BufReader, Read};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
+mod start_time;
+pub use start_time::{LogStart, LogStartFrom};
+
 /// Receives the rows of [`LogFile::for_each_row`].
 pub trait RowSink {
     /// One row, in file order; return false to stop reading.

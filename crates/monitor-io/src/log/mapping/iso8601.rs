@@ -1,112 +1,42 @@
-//! ISO 8601 date and time text (the `iso8601` time unit, CSV only) into seconds since
-//! 1970-01-01 UTC ([`parse_iso8601`]).
+//! ISO 8601 date and time text (the `iso8601` and `timestamp` time units, CSV only) into
+//! seconds since 1970-01-01 UTC ([`parse_iso8601`]), by chrono's parser.
+
+use chrono::format::{parse, Parsed, StrftimeItems};
 
 /// Parses ISO 8601 date and time text, `YYYY-MM-DD` then `T` or a space, `HH:MM:SS`, an
-/// optional fraction (`.` or `,`), an optional zone (`Z`, `+HH:MM`, `-HHMM`), into whole
-/// seconds since 1970-01-01 UTC and the fraction of a second (exact to the digits given).
-/// `None` for anything else.
+/// optional fraction (`.` or `,`), an optional zone (`Z`, `+HH:MM`, `-HHMM`, `+HH`; none:
+/// UTC), into whole seconds since 1970-01-01 UTC and the fraction of a second (to the
+/// nanosecond). A leap second (`:60`) is the next minute's first. `None` for anything else.
 pub(in crate::log) fn parse_iso8601(s: &str) -> Option<(i64, f64)> {
-    let b = s.trim().as_bytes();
-    let [y, mo, d, h, mi, sec] = date_time(b)?;
-    let mut i = 19;
-    let frac = fraction(b, &mut i)?;
-    let offset_s = zone_offset_s(b, i)?;
-    let days = days_from_civil(y, mo, d);
-    Some((days * 86_400 + h * 3600 + mi * 60 + sec - offset_s, frac))
-}
-
-/// The decimal number in bytes `r` of `b`: `None` unless all are digits (and there are
-/// some).
-#[inline]
-fn digits(b: &[u8], r: std::ops::Range<usize>) -> Option<i64> {
-    let t = b.get(r)?;
-    if t.is_empty() || !t.iter().all(u8::is_ascii_digit) {
-        return None;
+    let t = s.trim();
+    // chrono's items take one spelling: `T`, `.`, an offset; the others are brought to it.
+    let mut text = String::with_capacity(t.len() + 6);
+    for (i, ch) in t.char_indices() {
+        text.push(match (i, ch) {
+            (10, ' ' | 't') => 'T',
+            (19, ',') => '.',
+            _ => ch,
+        });
     }
-    std::str::from_utf8(t).ok()?.parse().ok()
-}
-
-/// Year, month, day, hour, minute, second of `YYYY-MM-DDTHH:MM:SS` (`T`, `t` or a space)
-/// at the start of `b`, in their ranges (a leap second, 60, is taken); `None` otherwise.
-#[inline]
-fn date_time(b: &[u8]) -> Option<[i64; 6]> {
-    let (y, mo, d) = (digits(b, 0..4)?, digits(b, 5..7)?, digits(b, 8..10)?);
-    if b.get(4) != Some(&b'-')
-        || b.get(7) != Some(&b'-')
-        || !matches!(b.get(10), Some(b'T' | b't' | b' '))
-    {
-        return None;
-    }
-    let (h, mi, sec) = (digits(b, 11..13)?, digits(b, 14..16)?, digits(b, 17..19)?);
-    if b.get(13) != Some(&b':') || b.get(16) != Some(&b':') {
-        return None;
-    }
-    if !(1..=12).contains(&mo) || !(1..=31).contains(&d) || h > 23 || mi > 59 || sec > 60 {
-        return None;
-    }
-    Some([y, mo, d, h, mi, sec])
-}
-
-/// The fraction of a second at byte `*i` of `b` (`.` or `,` then digits; 0 when there is
-/// none), moving `*i` past it; `None` for a separator without digits.
-#[inline]
-fn fraction(b: &[u8], i: &mut usize) -> Option<f64> {
-    if !matches!(b.get(*i), Some(b'.' | b',')) {
-        return Some(0.0);
-    }
-    let start = *i + 1;
-    *i = start;
-    while b.get(*i).is_some_and(u8::is_ascii_digit) {
-        *i += 1;
-    }
-    if *i == start {
-        return None;
-    }
-    format!("0.{}", std::str::from_utf8(&b[start..*i]).ok()?)
-        .parse()
-        .ok()
-}
-
-/// The zone from byte `i` of `b` to its end as an offset from UTC [s]: none or `Z` is 0,
-/// `+HH:MM`, `+HHMM` or `+HH` (or `-`) ahead of UTC; `None` for anything else.
-#[inline]
-fn zone_offset_s(b: &[u8], i: usize) -> Option<i64> {
-    Some(match b.get(i) {
-        None => 0,
-        Some(b'Z' | b'z') if i + 1 == b.len() => 0,
-        Some(&sign @ (b'+' | b'-')) => {
-            let rest = &b[i + 1..];
-            let (oh, om) = match rest.len() {
-                5 if rest[2] == b':' => (digits(b, i + 1..i + 3)?, digits(b, i + 4..i + 6)?),
-                4 => (digits(b, i + 1..i + 3)?, digits(b, i + 3..i + 5)?),
-                2 => (digits(b, i + 1..i + 3)?, 0),
-                _ => return None,
-            };
-            let o = oh * 3600 + om * 60;
-            if sign == b'+' {
-                o
-            } else {
-                -o
-            }
+    match text.as_bytes().last() {
+        Some(b'Z' | b'z') if text.len() > 19 => {
+            text.pop();
+            text.push_str("+00:00");
         }
-        _ => return None,
-    })
+        Some(b'0'..=b'9') if !has_zone(&text) => text.push_str("+00:00"),
+        _ => {}
+    }
+    let mut p = Parsed::new();
+    parse(&mut p, &text, StrftimeItems::new("%Y-%m-%dT%H:%M:%S%.f%#z")).ok()?;
+    let at = p.to_datetime().ok()?;
+    let nanos = at.timestamp_subsec_nanos();
+    Some((at.timestamp(), f64::from(nanos) * 1e-9))
 }
 
-/// Days since 1970-01-01 of the civil date `y`-`mo`-`d` (Howard Hinnant's algorithm,
-/// proleptic Gregorian).
-#[inline]
-fn days_from_civil(y: i64, mo: i64, d: i64) -> i64 {
-    let (yy, m) = if mo <= 2 {
-        (y - 1, mo + 9)
-    } else {
-        (y, mo - 3)
-    };
-    let era = yy.div_euclid(400);
-    let yoe = yy - era * 400;
-    let doy = (153 * m + 2) / 5 + d - 1;
-    let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
-    era * 146_097 + doe - 719_468
+/// Whether `text` (at least `YYYY-MM-DDTHH:MM:SS`) ends in a zone offset (`+`/`-` after
+/// the seconds).
+fn has_zone(text: &str) -> bool {
+    text.get(19..).is_some_and(|rest| rest.contains(['+', '-']))
 }
 
 #[cfg(test)]
@@ -128,6 +58,14 @@ mod tests {
             parse_iso8601("2024-05-01T10:00:00Z").map(|x| x.0),
             Some(1_714_557_600)
         );
+        // The other spellings: an offset without a colon or minutes, a comma, a `t`.
+        for same in [
+            "2024-05-01T12:00:00+0200",
+            "2024-05-01t07:00:00-03",
+            "2024-05-01 10:00:00,000Z",
+        ] {
+            assert_eq!(parse_iso8601(same), Some((1_714_557_600, 0.0)), "{same}");
+        }
         for bad in [
             "2024-05-01",
             "2024-13-01T00:00:00",

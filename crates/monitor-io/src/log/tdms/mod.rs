@@ -5,7 +5,10 @@
 //! group is the file's only group or the one `--group` names (several groups and none named:
 //! an error listing them). The time is the `t_s` channel, or else the waveform properties
 //! LabVIEW writes on each channel, `wf_start_offset + k * wf_increment` [s] (taken from
-//! `ia_A`). Numeric channels of any width are read as f64. Layouts `tdms-rs` does not read
+//! `ia_A`). The log's start, where LabVIEW wrote it, is a channel's `wf_start_time` (a TDMS
+//! timestamp: seconds since 1904-01-01 UTC and a fraction of 2^-64 s; the time channel's,
+//! else `ia_A`'s, else the first channel's that has one; [`super::LogFile::start_time`]).
+//! Numeric channels of any width are read as f64. Layouts `tdms-rs` does not read
 //! (big-endian, interleaved or DAQmx raw data, incremental metadata, several chunks in one
 //! segment) are refused with one line naming the layout, rather than read wrongly: NI's
 //! "TDMS Defragment" rewrites such a file into the plain layout.
@@ -48,6 +51,32 @@ pub(super) struct TdmsSource {
     group: String,
     time: TimeSource,
     rows: u64,
+    /// The group's `wf_start_time` [s since 1970-01-01 UTC], if a channel has one.
+    start_utc_s: Option<f64>,
+}
+
+/// Seconds from 1904-01-01 (LabVIEW's epoch) to 1970-01-01.
+const LABVIEW_TO_UNIX_S: i64 = 2_082_844_800;
+
+/// A TDMS timestamp property as seconds since 1970-01-01 UTC; `None` for another type and
+/// for the zero timestamp (LabVIEW's "not set").
+fn unix_seconds(p: &PropertyValue) -> Option<f64> {
+    match p {
+        PropertyValue::TimeStamp((secs, frac)) if (*secs, *frac) != (0, 0) => {
+            Some((secs - LABVIEW_TO_UNIX_S) as f64 + *frac as f64 / 18_446_744_073_709_551_616.0)
+        }
+        _ => None,
+    }
+}
+
+/// The `wf_start_time` of group `g`: the time channel's, else `ia_A`'s, else the first
+/// channel's that has one [s since 1970-01-01 UTC].
+fn start_time(g: &tdms_rs::TdmsGroup<'_>, mapping: &super::ColumnMapping) -> Option<f64> {
+    let of = |ch: &tdms_rs::TdmsChannel<'_>| ch.property("wf_start_time").and_then(unix_seconds);
+    [Column::Time, Column::Ia]
+        .iter()
+        .find_map(|c| g.channel(mapping.name_of(*c)).as_ref().and_then(of))
+        .or_else(|| g.channels().find_map(|ch| of(&ch)))
 }
 
 fn not_a_log(shown: &str, why: String) -> LogError {
@@ -426,14 +455,23 @@ impl TdmsSource {
         // (The waveform time is in seconds: wf_increment's unit.)
         columns.set_units(&units, mapping);
         let rows = common_length(&lens, &name, shown)?;
+        let start_utc_s = start_time(&g, mapping);
         Ok((
             TdmsSource {
                 group: name,
                 time,
                 rows: rows as u64,
+                start_utc_s,
             },
             columns,
         ))
+    }
+}
+
+impl TdmsSource {
+    /// The log's start from a channel's `wf_start_time` [s since 1970-01-01 UTC].
+    pub(super) fn start_utc_s(&self) -> Option<f64> {
+        self.start_utc_s
     }
 }
 
