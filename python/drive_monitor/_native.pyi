@@ -101,5 +101,6 @@ def store_trend(
     since: Optional[str] = ...,
     window_days: float = ...,
     k: float = ...,
+    reference_until: Optional[str] = ...,
 ) -> str: ...
 def store_columns() -> List[str]: ...
