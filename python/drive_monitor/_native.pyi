@@ -105,5 +105,6 @@ def store_trend(
     since: Optional[str] = ...,
     window_days: float = ...,
     k: float = ...,
+    reference_until: Optional[str] = ...,
 ) -> str: ...
 def store_columns() -> List[str]: ...

@@ -11,23 +11,27 @@ indicator's own scatter, at like operating points) is the library's, the same as
 
 from __future__ import annotations
 
-import json
-import os
-from typing import TYPE_CHECKING, Any, Dict, List, NamedTuple, Optional, Union
+# The helpers under underscore names, the typing names only for the type checker: the
+# module's namespace is its public API (`__all__`), no `os`, `json` or `Dict`.
+import json as _json
+import os as _os
+import typing as _typing
 
 from . import _native
 
-if TYPE_CHECKING:  # pragma: no cover
+if _typing.TYPE_CHECKING:  # pragma: no cover
+    from typing import Any, Dict, List, Optional, Union
+
     import pandas as pd
 
 __all__ = ["trend", "Trend", "STORE_COLUMNS", "TREND_COLUMNS"]
 
 #: The store's columns, in order (SQLite's ``logs`` table; the Parquet files hold all but
 #: ``motor`` and ``day``, which are the dataset's partitions).
-STORE_COLUMNS: List[str] = list(_native.store_columns())
+STORE_COLUMNS: "List[str]" = list(_native.store_columns())
 
 #: The columns of :attr:`Trend.indicators`, one row per motor and indicator.
-TREND_COLUMNS: List[str] = [
+TREND_COLUMNS: "List[str]" = [
     "motor",
     "indicator",
     "unit",
@@ -42,12 +46,16 @@ TREND_COLUMNS: List[str] = [
     "days_to_fault",
     "days_to_fault_recent",
     "alarm",
+    "alarm_since",
+    "reference_centre",
+    "reference_scatter",
+    "from_reference_scatters",
     "normalisation",
     "sentence",
 ]
 
 
-class Trend(NamedTuple):
+class Trend(_typing.NamedTuple):
     """What :func:`trend` returns."""
 
     #: The stored rows (columns :data:`STORE_COLUMNS`), by motor and time.
@@ -60,11 +68,12 @@ class Trend(NamedTuple):
 
 
 def trend(
-    store: Union[str, "os.PathLike[str]"],
+    store: Union[str, "_os.PathLike[str]"],
     motor: Optional[str] = None,
     since: Optional[str] = None,
     window_days: float = 14.0,
     k: float = 3.0,
+    reference_until: Optional[str] = None,
 ) -> Trend:
     """The store's rows and the trend of each motor's indicators.
 
@@ -80,17 +89,24 @@ def trend(
         The window the slope is taken over, ending at each motor's last log [days].
     k : float
         How many scatters the line must move the indicator over the window to alarm.
+    reference_until : str, optional
+        The baseline: each motor's logs up to the end of this UTC day (``YYYY-MM-DD``) are
+        its reference (the bands, the scatters from the reference, the alarm's clearing),
+        as ``sim-host trend --reference-until``. Default: each motor's first
+        ``window_days`` of logs whose verdict is not FAULT.
 
     Raises
     ------
     LogError
         No store at the path, or not a store.
     OptionError
-        A bad date, window or k.
+        A bad date (``since``, ``reference_until``), window or k.
     """
     import pandas as pd
 
-    doc = json.loads(_native.store_trend(os.fspath(store), motor, since, window_days, k))
+    doc = _json.loads(
+        _native.store_trend(_os.fspath(store), motor, since, window_days, k, reference_until)
+    )
     rows = pd.DataFrame(doc["rows"], columns=STORE_COLUMNS)
     flat = [
         {"motor": m["motor"], **{c: t.get(c) for c in TREND_COLUMNS if c != "motor"}}

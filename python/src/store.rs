@@ -81,8 +81,10 @@ pub fn store_append(py: Python<'_>, store: PathBuf, rows_json: String) -> PyResu
 ///
 /// # Errors
 /// [`LogError`]: no store there, or not a store; [`OptionError`]: a bad date or window.
+/// `reference_until`: the baseline, each motor's logs up to the end of that UTC day
+/// (`sim-host trend --reference-until`).
 #[pyfunction]
-#[pyo3(signature = (store, motor=None, since=None, window_days=14.0, k=3.0))]
+#[pyo3(signature = (store, motor=None, since=None, window_days=14.0, k=3.0, reference_until=None))]
 pub fn store_trend(
     py: Python<'_>,
     store: PathBuf,
@@ -90,6 +92,7 @@ pub fn store_trend(
     since: Option<String>,
     window_days: f64,
     k: f64,
+    reference_until: Option<String>,
 ) -> PyResult<String> {
     run(py, || {
         if !(window_days.is_finite() && window_days > 0.0 && k.is_finite() && k > 0.0) {
@@ -105,11 +108,24 @@ pub fn store_trend(
             })?),
             None => None,
         };
+        let until_s = match &reference_until {
+            Some(d) => Some(
+                monitor_store::parse_day(d)
+                    .ok_or_else(|| {
+                        OptionError::new_err(format!(
+                            "reference_until {d}: not a date; give the UTC day as YYYY-MM-DD"
+                        ))
+                    })?
+                    .saturating_add(86_400),
+            ),
+            None => None,
+        };
         let s = Store::open_existing(&store).map_err(store_err)?;
         let rows = s.rows(motor.as_deref(), since_s).map_err(store_err)?;
         let opts = TrendOptions {
             window_days,
             k_scatter: k,
+            reference_until_s: until_s,
             ..TrendOptions::default()
         };
         let motors = monitor_store::trend::trend(&rows, &opts);

@@ -120,3 +120,23 @@ def test_trend_returns_the_rows_and_each_motors_indicators(month, tmp_path, sim_
         dm.trend(tmp_path / "none.db")
     with pytest.raises(dm.OptionError, match="since"):
         dm.trend(store, since="yesterday")
+
+
+def test_the_history_module_exposes_its_api_only():
+    import drive_monitor.history as h
+
+    public = {n for n in dir(h) if not n.startswith("_")}
+    assert not public & {"os", "json", "typing", "Dict", "List", "Any", "Optional", "Union", "NamedTuple"}, public
+    assert set(h.__all__) <= public
+
+
+def test_trend_takes_a_marked_reference(month, tmp_path, sim_host):
+    d, logs, table = month
+    store = tmp_path / "r.db"
+    subprocess.run([sim_host, "fleet", str(table), *logs, "--store", str(store)], check=True, capture_output=True)
+    first = dm.trend(store).rows.day.min()
+    t = dm.trend(store, reference_until=first)
+    for m in t.motors:
+        assert m["reference"]["marked"] and m["reference"]["last_day"] == first, m["reference"]
+    with pytest.raises(dm.OptionError, match="reference_until"):
+        dm.trend(store, reference_until="soon")

@@ -220,6 +220,14 @@ fn logs_whose_times_all_are_one_days_modification_times_are_warned_of() {
     );
     assert!(err.contains(&loud), "{err}");
     assert_eq!(err.matches("modification times").count(), 1, "{err}");
+    // The trend says it again, before its table.
+    let trend = Command::new(env!("CARGO_BIN_EXE_sim-host"))
+        .args(["trend", "--store"])
+        .arg(d.join("h.db"))
+        .output()
+        .expect("sim-host runs");
+    let said = String::from_utf8_lossy(&trend.stderr);
+    assert!(trend.status.success() && said.contains(&loud), "{said}");
 }
 
 #[test]

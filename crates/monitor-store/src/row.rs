@@ -386,13 +386,7 @@ fn report_cells(doc: &Value) -> Vec<Cell> {
     };
     let text = |p: &str| doc.pointer(p).and_then(Value::as_str).map(str::to_string);
     let flag = |p: &str| doc.pointer(p).and_then(Value::as_bool).map(i64::from);
-    let candidate = |fault: &str| {
-        doc.pointer("/candidates")
-            .and_then(Value::as_array)
-            .and_then(|c| c.iter().find(|x| x["fault"] == fault))
-            .and_then(|x| x["change"].as_f64())
-            .map(|x| 100.0 * x)
-    };
+    let candidate = |fault: &str| candidate_change_pct(doc, fault);
     let named = doc.pointer("/isolation/named").and_then(|v| match v {
         Value::String(s) => Some(s.clone()),
         Value::Null => None,
@@ -438,6 +432,15 @@ fn report_cells(doc: &Value) -> Vec<Cell> {
         Cell::Null,
         real(num("/isolation/resistances/stator_excess").map(|x| 100.0 * x)),
     ]
+}
+
+/// The change in % of the candidate `fault` of the report `doc`, where it lists one.
+fn candidate_change_pct(doc: &Value, fault: &str) -> Option<f64> {
+    doc.pointer("/candidates")
+        .and_then(Value::as_array)
+        .and_then(|c| c.iter().find(|x| x["fault"] == fault))
+        .and_then(|x| x["change"].as_f64())
+        .map(|x| 100.0 * x)
 }
 
 /// The verdict's finding names a fault (a FAULT's or a watched one).

@@ -13,6 +13,10 @@
 //!   verdict is FAULT, on the stator's resistance beyond the rotor's (Rs alone: not heating);
 //! - once raised the alarm holds on every later day;
 //! - the healthy motors raise no alarm on any day;
+//! - every motor's first days (before the connection loosens) lie in the green band of the
+//!   trend taken on day 30 (within `k` reference scatters of its reference) on the
+//!   indicators that alarm here (|I2w|/|I1|, Rs beyond Rr), healthy motors' and the loosening
+//!   one's alike;
 //! - no single log names a fault other than Rs.
 
 use monitor_io::params::ParamFile;
@@ -139,6 +143,42 @@ fn alarms(rows: &[StoredRow], motor: &str) -> Vec<(bool, Vec<String>)> {
         .collect()
 }
 
+/// The points of days 1-10 of `motor` outside the green band of the trend taken on day 30
+/// (more than `k` reference scatters from the reference centre), per indicator.
+fn first_days_out_of_green(rows: &[StoredRow], motor: &str) -> Vec<String> {
+    let mine: Vec<&StoredRow> = rows
+        .iter()
+        .filter(|r| r.str("motor") == Some(motor))
+        .collect();
+    let opts = TrendOptions::default();
+    let t = trend::motor_trend(motor, &mine, &opts);
+    let day10 = (START_S + 10 * 86_400) as f64 / 86_400.0;
+    let mut bad = Vec::new();
+    // The indicators that alarm here: without a temperature channel the residuals are
+    // shown, not alarmed, and their normalisation on the isolation's rise leaves a few of
+    // the first days 3-4 scatters out (printed, not asserted); the sideband is not drawn.
+    let alarming = ["i2_over_i1", "stator_excess_pct"];
+    for i in &t.indicators {
+        let (Some(c), Some(s)) = (i.reference_centre, i.reference_scatter) else {
+            continue;
+        };
+        let out = i
+            .series
+            .iter()
+            .filter(|p| p.t_days < day10 && ((p.normalised - c) / s).abs() > opts.k_scatter)
+            .count();
+        if out > 0 && !alarming.contains(&i.indicator.as_str()) {
+            eprintln!("{motor}: {out} of its first 10 days' {} outside the green band (shown, not alarmed)", i.indicator);
+        } else if out > 0 {
+            bad.push(format!(
+                "{motor}: {out} of its first 10 days' {} outside the green band",
+                i.indicator
+            ));
+        }
+    }
+    bad
+}
+
 /// The month with the loosening connection on machine `loosening`; what broke the bar.
 fn month(loosening: usize, seed: u64) -> Vec<String> {
     let motors = motors(loosening, seed);
@@ -164,6 +204,7 @@ fn month(loosening: usize, seed: u64) -> Vec<String> {
         }
     }
     for m in &motors {
+        bad.extend(first_days_out_of_green(&rows, m.name));
         let days = alarms(&rows, m.name);
         let first_alarm = days.iter().position(|d| d.0).map(|i| i as u32 + 1);
         let first_fault = rows

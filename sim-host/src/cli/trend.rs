@@ -23,7 +23,9 @@ Theil-Sen's slope per day with Sen's 95 % interval, and the indicator's own scat
 line (1.4826 MAD). The TREND ALARM: the interval lies on the fault's side of zero AND the line \
 moves the indicator by more than --k scatters over the window. Where the indicator has a FAULT \
 level (the level a single log's verdict names the fault at), the days until the line reaches \
-it.\n\nWithout --motor: the fleet's motors, alarmed first, then the fastest-moving (the \
+it, where Sen's interval excludes a flat line. Once raised, the alarm holds until the \
+indicator is back within --k scatters of the motor's reference (its first --window-days of logs \
+whose verdict is not FAULT, or its logs up to --reference-until) on two logs in a row.\n\nWithout --motor: the fleet's motors, alarmed first, then the fastest-moving (the \
 indicator that moves most, in scatters over the window).\n\nExamples:\n  sim-host fleet \
 motors.toml logs/*.csv --store history.db\n  sim-host trend --store history.db\n  sim-host \
 trend --store history.db --motor pump_7 --plot pump_7.svg\n  sim-host trend --store history.db \
@@ -46,6 +48,11 @@ pub struct TrendArgs {
     /// How many scatters the line must move over the window to alarm.
     #[arg(long, default_value_t = 3.0, value_name = "K")]
     pub k: f64,
+    /// The baseline: each motor's logs up to the end of this UTC day (YYYY-MM-DD) are its
+    /// reference (the bands, the scatters from the reference, the alarm's clearing).
+    /// Default: each motor's first --window-days of logs whose verdict is not FAULT.
+    #[arg(long, value_name = "DATE")]
+    pub reference_until: Option<String>,
     /// Draw the indicators over time (with the OK / WATCH / FAULT bands) into FILE.svg or
     /// FILE.png.
     #[arg(long, value_name = "FILE")]
@@ -69,7 +76,7 @@ struct TrendReport<'a> {
 /// No store at the path, not a store, a bad date or window, a plot that cannot be written:
 /// one line each.
 pub fn run(args: &TrendArgs) -> anyhow::Result<()> {
-    let since = check(args)?;
+    let (since, reference_until_s) = check(args)?;
     let store = Store::open_existing(&args.store)?;
     let rebuilt = store.sync_mirror()?;
     if rebuilt > 0 {
@@ -85,9 +92,15 @@ pub fn run(args: &TrendArgs) -> anyhow::Result<()> {
             None => anyhow::bail!("the store {} holds no logs", args.store.display()),
         }
     }
+    // A motor whose logs all took the files' modification times on one day has no trend:
+    // said before anything else, on stderr.
+    for warning in monitor_store::one_day_of_modified_times(&rows) {
+        eprintln!("{warning}");
+    }
     let opts = TrendOptions {
         window_days: args.window_days,
         k_scatter: args.k,
+        reference_until_s,
         ..TrendOptions::default()
     };
     let motors = monitor_store::trend::trend(&rows, &opts);
@@ -110,12 +123,13 @@ pub fn run(args: &TrendArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The arguments checked, before anything is read: the window, k, the date (returned as
-/// seconds since 1970-01-01 UTC) and the plot's name.
+/// The arguments checked, before anything is read: the window, k, the dates (returned as
+/// seconds since 1970-01-01 UTC: `--since`'s day's start, `--reference-until`'s day's end)
+/// and the plot's name.
 ///
 /// # Errors
 /// One line naming the option and what it must be.
-fn check(args: &TrendArgs) -> anyhow::Result<Option<i64>> {
+fn check(args: &TrendArgs) -> anyhow::Result<(Option<i64>, Option<i64>)> {
     if !(args.window_days.is_finite() && args.window_days > 0.0) {
         anyhow::bail!(
             "--window-days must be a positive number of days, got {}",
@@ -131,6 +145,18 @@ fn check(args: &TrendArgs) -> anyhow::Result<Option<i64>> {
         })?),
         None => None,
     };
+    let until = match &args.reference_until {
+        Some(d) => Some(
+            monitor_store::parse_day(d)
+                .ok_or_else(|| {
+                    anyhow::anyhow!(
+                        "--reference-until {d}: not a date; give the UTC day as YYYY-MM-DD"
+                    )
+                })?
+                .saturating_add(86_400),
+        ),
+        None => None,
+    };
     if let Some(p) = &args.plot {
         let ext = p.extension().and_then(|e| e.to_str()).unwrap_or_default();
         if !matches!(ext, "svg" | "png") {
@@ -141,10 +167,13 @@ fn check(args: &TrendArgs) -> anyhow::Result<Option<i64>> {
         }
         super::output_guard::OutputGuard::new(&[args.store.as_path()]).check_files(&[p])?;
     }
-    Ok(since)
+    Ok((since, until))
 }
 
-/// The text table: a line per motor (ranked), and per indicator with `detail`.
+/// The text table: a line per motor (ranked), and per indicator with `detail`. `moved`:
+/// the fastest indicator's line's change over the window, in its scatters; `from ref`: the
+/// indicator furthest from the motor's reference, its line at the last log in reference
+/// scatters; `-` where there is none (too few logs: the detail lines say so).
 fn print_table(
     out: &mut impl std::io::Write,
     motors: &[MotorTrend],
@@ -152,47 +181,65 @@ fn print_table(
 ) -> std::io::Result<()> {
     writeln!(
         out,
-        "{:<16} {:>5}  {:<10} {:<10} {:>9}  {:<6} fastest indicator",
-        "motor", "logs", "first", "last", "scatters", "alarm"
+        "{:<16} {:>5}  {:<10} {:<10} {:>6} {:>9}  {:<6} fastest indicator",
+        "motor", "logs", "first", "last", "moved", "from ref", "alarm"
     )?;
+    let abs = |x: Option<f64>| x.map_or(0.0, f64::abs);
     for m in motors {
         let fastest = m
             .indicators
             .iter()
             .filter(|t| t.moves_scatters.is_some())
-            .max_by(|a, b| {
-                let f = |t: &monitor_store::trend::IndicatorTrend| {
-                    t.moves_scatters.map_or(0.0, f64::abs)
-                };
-                f(a).total_cmp(&f(b))
-            });
+            .max_by(|a, b| abs(a.moves_scatters).total_cmp(&abs(b.moves_scatters)));
+        let furthest = m
+            .indicators
+            .iter()
+            .filter_map(|t| t.from_reference_scatters)
+            .max_by(|a, b| a.abs().total_cmp(&b.abs()));
+        let num = |x: Option<f64>| x.map_or("-".to_string(), |x| format!("{x:.1}"));
         writeln!(
             out,
-            "{:<16} {:>5}  {:<10} {:<10} {:>9.1}  {:<6} {}",
+            "{:<16} {:>5}  {:<10} {:<10} {:>6} {:>9}  {:<6} {}",
             m.motor,
             m.logs,
             m.first_day,
             m.last_day,
-            m.fastest_scatters,
+            num(fastest.map(|_| m.fastest_scatters)),
+            num(furthest),
             if m.alarm { "ALARM" } else { "-" },
             fastest.map_or("", |t| t.indicator.as_str())
         )?;
         if detail || m.alarm {
-            for t in &m.indicators {
-                writeln!(out, "    {}", t.sentence)?;
-            }
-            // Each normalisation once, with the indicators it applies to.
-            let mut seen: Vec<(&str, Vec<&str>)> = Vec::new();
-            for t in &m.indicators {
-                match seen.iter_mut().find(|(n, _)| *n == t.normalisation) {
-                    Some((_, v)) => v.push(&t.indicator),
-                    None => seen.push((&t.normalisation, vec![&t.indicator])),
-                }
-            }
-            for (n, v) in seen {
-                writeln!(out, "    {}: {n}", v.join(", "))?;
-            }
+            print_detail(out, m)?;
         }
+    }
+    Ok(())
+}
+
+/// A motor's detail lines: each indicator's sentence, its reference, each normalisation
+/// once with the indicators it applies to.
+fn print_detail(out: &mut impl std::io::Write, m: &MotorTrend) -> std::io::Result<()> {
+    for t in &m.indicators {
+        writeln!(out, "    {}", t.sentence)?;
+    }
+    let r = &m.reference;
+    writeln!(
+        out,
+        "    reference: {} ({} logs, {} to {})",
+        r.how,
+        r.logs,
+        r.first_day.as_deref().unwrap_or("-"),
+        r.last_day.as_deref().unwrap_or("-")
+    )?;
+    let mut seen: Vec<(&str, Vec<&str>)> = Vec::new();
+    for t in &m.indicators {
+        match seen.iter_mut().find(|(n, _)| *n == t.normalisation) {
+            Some((_, v)) => v.push(&t.indicator),
+            None => seen.push((&t.normalisation, vec![&t.indicator])),
+        }
+    }
+    for (n, v) in seen {
+        writeln!(out, "    {}: {n}", v.join(", "))?;
     }
     Ok(())
 }

@@ -1,10 +1,11 @@
 //! The trend's computation (the statistics in [`super::stats`], the rules in the module's
 //! documentation).
 
+use super::reference::{latched, normalisation_note, reference_stats};
 use super::stats::{least_squares, mad_sigma, median, theil_sen};
 use super::{
-    Direction, FaultLevel, Indicator, IndicatorTrend, MotorTrend, TrendOptions, TrendPoint,
-    INDICATORS, RISE,
+    reference_rows, Direction, FaultLevel, Indicator, IndicatorTrend, MotorTrend, TrendOptions,
+    TrendPoint, INDICATORS, RISE,
 };
 use crate::row::{utc_day, StoredRow};
 
@@ -47,7 +48,10 @@ pub fn motor_trend(motor: &str, rows: &[&StoredRow], opts: &TrendOptions) -> Mot
     });
     let indicators: Vec<IndicatorTrend> = INDICATORS
         .iter()
-        .map(|ind| confirmed(indicator_trend(ind, &rows, opts), ind, &rows, opts))
+        .map(|ind| {
+            let judge = |r: &[&StoredRow]| indicator_trend(ind, r, opts);
+            latched(judge(&rows), &rows, opts, &judge)
+        })
         .collect();
     let fastest = indicators
         .iter()
@@ -61,39 +65,9 @@ pub fn motor_trend(motor: &str, rows: &[&StoredRow], opts: &TrendOptions) -> Mot
         last_day: day(rows.last()),
         alarm: indicators.iter().any(|t| t.alarm),
         fastest_scatters: fastest,
+        reference: reference_rows(&rows, opts).1,
         indicators,
     }
-}
-
-/// `t` (the trend as of the last log) with its alarm confirmed: the trend as of the log
-/// before must alarm too ([`TrendOptions::confirm_logs`] logs in a row), so that one
-/// log that happens to tip a marginal slope does not raise it.
-fn confirmed(
-    mut t: IndicatorTrend,
-    ind: &Indicator,
-    rows: &[&StoredRow],
-    opts: &TrendOptions,
-) -> IndicatorTrend {
-    if !t.alarm {
-        return t;
-    }
-    let held = (1..opts.confirm_logs.max(1)).all(|k| {
-        rows.len() > k
-            && rows
-                .get(..rows.len() - k)
-                .is_some_and(|earlier| indicator_trend(ind, earlier, opts).alarm)
-    });
-    if !held {
-        t.alarm = false;
-        t.sentence = t.sentence.replace(
-            ": TREND ALARM",
-            &format!(
-                ": alarm not yet confirmed ({} logs in a row needed)",
-                opts.confirm_logs
-            ),
-        );
-    }
-    t
 }
 
 /// The operating point's fit of one indicator: least-squares coefficients of its
@@ -229,7 +203,8 @@ fn covariates_of(ind: &Indicator, rows: &[&StoredRow]) -> &'static [&'static str
         .unwrap_or_default()
 }
 
-/// One indicator's trend over the window ending at the motor's last row (`rows` by time).
+/// One indicator's trend over the window ending at the motor's last row (`rows` by time),
+/// judged on its own (without the alarm's history: [`motor_trend`] applies it).
 pub fn indicator_trend(
     ind: &Indicator,
     rows: &[&StoredRow],
@@ -237,18 +212,22 @@ pub fn indicator_trend(
 ) -> IndicatorTrend {
     let covs = covariates_of(ind, rows);
     let fit = fit_operating_point(ind, covs, rows);
-    let normalisation = normalisation_of(fit.is_some(), covs, rows.len());
+    let needed = fit_logs(covs);
+    let (normalisation, usable) = normalisation_note(ind, covs, rows, fit.is_some(), needed);
     let end_s = rows
         .last()
         .and_then(|r| r.f64("log_time_s"))
         .unwrap_or_default();
+    let (mask, _) = reference_rows(rows, opts);
     let series = series_of(
         ind,
         covs,
         fit.as_ref(),
-        rows,
+        (rows, &mask),
         end_s - opts.window_days * DAY_S,
     );
+    let floor = fit.as_ref().map_or(0.0, |f| f.scatter).max(ind.min_scatter);
+    let (reference_centre, reference_scatter) = reference_stats(&series, floor, opts.min_logs);
     let mut t = IndicatorTrend {
         indicator: ind.column.to_string(),
         label: ind.label.to_string(),
@@ -265,27 +244,35 @@ pub fn indicator_trend(
         days_to_fault: None,
         days_to_fault_recent: None,
         alarm: false,
+        alarm_since: None,
         normalisation,
+        operating_point_fitted: fit.is_some(),
+        reference_centre,
+        reference_scatter,
+        from_reference_scatters: None,
         sentence: String::new(),
         series,
     };
-    judge(
-        &mut t,
-        ind,
-        opts,
-        end_s / DAY_S,
-        fit.as_ref().map_or(0.0, |f| f.scatter).max(ind.min_scatter),
-    );
-    if fit.is_none() && !covs.is_empty() && rows.len() < fit_logs(covs) {
-        hold_for_fit(&mut t, rows.len(), fit_logs(covs));
+    judge(&mut t, ind, opts, end_s / DAY_S, floor);
+    if let (Some(l), Some(c), Some(s)) = (t.last, reference_centre, reference_scatter) {
+        t.from_reference_scatters = Some((l - c) / s);
     }
+    if fit.is_none() && !covs.is_empty() && usable < needed {
+        hold_for_fit(&mut t, usable, needed);
+    }
+    finish(&mut t, ind, covs);
+    t
+}
+
+/// The last words of `t`: a residual without a temperature channel is not alarmed
+/// ([`hold_without_probe`]); an alarm says what it means.
+fn finish(t: &mut IndicatorTrend, ind: &Indicator, covs: &[&str]) {
     if covs.contains(&RISE) {
-        hold_without_probe(&mut t);
+        hold_without_probe(t);
     }
     if t.alarm && !ind.alarm_means.is_empty() {
         t.sentence = format!("{}; {}", t.sentence, ind.alarm_means);
     }
-    t
 }
 
 /// Too few logs (`n` of the `needed`) to tell a trend from the operating point's moves: no
@@ -317,33 +304,18 @@ fn hold_without_probe(t: &mut IndicatorTrend) {
     }
 }
 
-/// What the report says of the normalisation (`fitted` or not, on `covs`, over `n` logs).
-fn normalisation_of(fitted: bool, covs: &[&str], n: usize) -> String {
-    if fitted {
-        format!(
-            "brought to the median {} (least squares, second order in them, with time, over the motor's {n} logs)",
-            covs.join(" and ")
-        )
-    } else if !covs.is_empty() && n < fit_logs(covs) {
-        format!(
-            "not yet: {n} logs, the operating-point fit needs {}; no alarm until then",
-            fit_logs(covs)
-        )
-    } else {
-        "raw values (an operating point that does not vary)".to_string()
-    }
-}
-
-/// The indicator's points from `start_s` on, normalised with `fit` where there is one.
+/// The indicator's points, normalised with `fit` where there is one: those from `start_s`
+/// on in the window, those of the reference mask (over `rows`) in the reference.
 fn series_of(
     ind: &Indicator,
     covs: &[&str],
     fit: Option<&OperatingFit>,
-    rows: &[&StoredRow],
+    (rows, reference): (&[&StoredRow], &[bool]),
     start_s: f64,
 ) -> Vec<TrendPoint> {
     rows.iter()
-        .filter_map(|r| {
+        .zip(reference)
+        .filter_map(|(r, in_reference)| {
             let t = r.f64("log_time_s")?;
             let value = r.f64(ind.column)?;
             let normalised = match fit {
@@ -358,6 +330,7 @@ fn series_of(
                 value,
                 normalised,
                 in_window: t >= start_s - 1.0,
+                in_reference: *in_reference,
             })
         })
         .collect()
@@ -381,10 +354,11 @@ fn judge(t: &mut IndicatorTrend, ind: &Indicator, opts: &TrendOptions, end_days:
     let window: Vec<&TrendPoint> = t.series.iter().filter(|p| p.in_window).collect();
     if window.len() < opts.min_logs.max(3) {
         t.sentence = format!(
-            "{name}: {} logs in the last {} days, too few for a trend (at least {})",
+            "{name}: {} logs in the last {} days, too few for a trend or a scatter (at least {}){}",
             window.len(),
             opts.window_days,
-            opts.min_logs.max(3)
+            opts.min_logs.max(3),
+            stored_values(&window, ind),
         );
         return;
     }
@@ -424,15 +398,53 @@ fn judge(t: &mut IndicatorTrend, ind: &Indicator, opts: &TrendOptions, end_days:
     t.scatter = Some(scatter);
     t.moves_scatters = Some(moves);
     t.last = Some(last);
-    t.days_to_fault = t.fault_level.and_then(|lvl| days_to(lvl, last, line.slope));
-    t.days_to_fault_recent = t
-        .fault_level
-        .and_then(|lvl| recent_days_to(lvl, &x, &y, end_days - t0, opts.confidence));
+    project(t, &line, (&x, &y), end_days - t0, opts);
     // With a FAULT level, a slope that would take longer than the horizon to reach it is
     // not worth a visit, however significant.
     let soon = t.fault_level.is_none() || t.days_to_fault.is_some_and(|d| d <= opts.horizon_days);
     t.alarm = ind.alarms && significant && big && soon;
     t.sentence = sentence(t, ind, &line, span);
+}
+
+/// The days to the FAULT level of `t` on the window's `line` and on its second half's
+/// (the window's points `(x, y)`, `end` the last log's `x`): only on a slope whose interval
+/// lies on the fault's side of zero (a level is reached by rising), and within the horizon.
+fn project(
+    t: &mut IndicatorTrend,
+    line: &super::stats::SenLine,
+    (x, y): (&[f64], &[f64]),
+    end: f64,
+    opts: &TrendOptions,
+) {
+    let within = |d: &f64| *d <= opts.horizon_days;
+    let last = line.intercept + line.slope * end;
+    t.days_to_fault = t
+        .fault_level
+        .and_then(|lvl| days_to(lvl, last, line.slope, line.low))
+        .filter(within);
+    t.days_to_fault_recent = t
+        .fault_level
+        .and_then(|lvl| recent_days_to(lvl, x, y, end, opts.confidence))
+        .filter(within);
+}
+
+/// "; the stored values 0.0001 to 0.026 pu (first 0.0001, last 0.026)", in the shown unit:
+/// what there is where there is no trend.
+fn stored_values(window: &[&TrendPoint], ind: &Indicator) -> String {
+    let v: Vec<f64> = window.iter().map(|p| p.value * ind.scale).collect();
+    let (Some(first), Some(last)) = (v.first(), v.last()) else {
+        return String::new();
+    };
+    let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    format!(
+        "; the stored values {} to {} {} (first {}, last {})",
+        sig3(lo),
+        sig3(hi),
+        ind.shown_unit,
+        sig3(*first),
+        sig3(*last)
+    )
 }
 
 /// [`IndicatorTrend::days_to_fault_recent`]: the days to `level` on the Theil-Sen line of
@@ -450,17 +462,23 @@ fn recent_days_to(level: f64, x: &[f64], y: &[f64], end: f64, confidence: f64) -
         return None;
     }
     let line = theil_sen(&xr, &yr, confidence)?;
-    days_to(level, line.intercept + line.slope * end, line.slope)
+    days_to(
+        level,
+        line.intercept + line.slope * end,
+        line.slope,
+        line.low,
+    )
 }
 
 /// The days until a line at `last` rising by `slope` a day reaches `level`: 0 at or past
-/// it, none where it does not head there.
-fn days_to(level: f64, last: f64, slope: f64) -> Option<f64> {
+/// it; none where it does not head there or where Sen's interval (its low end `low`) does
+/// not exclude a flat line (a slope that may be zero projects nothing).
+fn days_to(level: f64, last: f64, slope: f64, low: f64) -> Option<f64> {
     if last >= level {
         return Some(0.0);
     }
     let d = (level - last) / slope;
-    (d.is_finite() && slope > 0.0).then_some(d)
+    (d.is_finite() && slope > 0.0 && low > 0.0).then_some(d)
 }
 
 /// "i2_over_i1 rising 0.36 % of I1/week (0.14 to 0.68), 3.3 scatters over 14 days: TREND

@@ -20,11 +20,27 @@
 //!    alone is not enough: a significant slope far inside the noise is not worth a visit,
 //!    and one large scatter is not a trend. The alarm is raised when it holds on
 //!    [`TrendOptions::confirm_logs`] logs in a row (each judged on the logs up to it).
-//! 4. **The projection.** Where the indicator has a FAULT level (the level at which a
-//!    single log's verdict names the fault), the days until the line reaches it; for such
-//!    an indicator the alarm also needs the line to reach it within
-//!    [`TrendOptions::horizon_days`] (a significant drift far below the level is not worth
-//!    a visit).
+//! 4. **The alarm holds once raised** (a hysteresis): it stays raised on the later logs,
+//!    whatever their slope, until the indicator is back at the motor's reference: on
+//!    [`TrendOptions::confirm_logs`] logs in a row, the trend as of the log does not alarm,
+//!    and both the line at the log and the log's own value lie within
+//!    [`TrendOptions::k_scatter`] reference scatters of the reference's centre
+//!    ([`IndicatorTrend::alarm_since`]). Raising and clearing are different tests (a slope,
+//!    a level), so a fault that stops growing stays alarmed, and a repaired motor clears.
+//! 5. **The reference.** Each motor's own healthy start
+//!    ([`MotorTrend::reference`]): its logs up to [`TrendOptions::reference_until_s`]
+//!    where the user marks the baseline, else those of its first
+//!    [`TrendOptions::window_days`] whose stored verdict is not `fault` (at least
+//!    [`TrendOptions::min_logs`] of them). Per indicator its centre (the median of their
+//!    normalised values) and its scatter (1.4826 MAD about it, at least the
+//!    operating-point fit's); the plot's bands and [`IndicatorTrend::from_reference_scatters`]
+//!    are relative to it, and the alarm clears against it.
+//! 6. **The projection.** Where the indicator has a FAULT level (the level at which a
+//!    single log's verdict names the fault), the days until the line reaches it, only where
+//!    Sen's interval lies wholly on the fault's side of zero (a slope that may be zero
+//!    projects nothing) and within [`TrendOptions::horizon_days`]; for such an indicator
+//!    the alarm also needs that projection (a significant drift far below the level is not
+//!    worth a visit).
 
 pub mod stats;
 
@@ -202,8 +218,13 @@ pub struct TrendOptions {
     /// this many days of the last log.
     pub horizon_days: f64,
     /// How many logs in a row (the last and those before it, each judged on the logs up
-    /// to it) must alarm before the alarm is raised.
+    /// to it) must alarm before the alarm is raised, and must be back at the reference
+    /// before a raised alarm clears.
     pub confirm_logs: usize,
+    /// The baseline the user marks: the motor's logs before this time (s since 1970-01-01
+    /// UTC; the command line's `--reference-until DAY` gives the end of that day) are its
+    /// reference. `None`: the motor's first healthy logs ([`MotorTrend::reference`]).
+    pub reference_until_s: Option<i64>,
 }
 
 impl Default for TrendOptions {
@@ -215,6 +236,7 @@ impl Default for TrendOptions {
             min_logs: 6,
             horizon_days: 90.0,
             confirm_logs: 2,
+            reference_until_s: None,
         }
     }
 }
@@ -230,6 +252,8 @@ pub struct TrendPoint {
     pub normalised: f64,
     /// In the window the slope is taken over.
     pub in_window: bool,
+    /// One of the motor's reference logs ([`MotorTrend::reference`]).
+    pub in_reference: bool,
 }
 
 /// One indicator's trend for one motor (JSON: `sim-host trend --json`'s `indicators`).
@@ -266,10 +290,22 @@ pub struct IndicatorTrend {
     /// window, or grows faster as it grows, reaches the level sooner than the whole
     /// window's line says.
     pub days_to_fault_recent: Option<f64>,
-    /// The trend alarm.
+    /// The trend alarm (raised, or held since it was raised: [`Self::alarm_since`]).
     pub alarm: bool,
-    /// How the indicator was normalised for the operating point.
+    /// The day of the log on which the alarm now raised was raised (it holds until the
+    /// indicator is back at the reference; the module's documentation, item 4).
+    pub alarm_since: Option<String>,
+    /// How the indicator was normalised for the operating point, and why not where not.
     pub normalisation: String,
+    /// Whether the operating-point fit was made (else `normalised` is the stored value).
+    pub operating_point_fitted: bool,
+    /// The reference's centre: the median of the reference logs' normalised values [unit].
+    pub reference_centre: Option<f64>,
+    /// The reference's scatter: 1.4826 MAD of those values about their median, at least the
+    /// operating-point fit's [unit]; none with fewer than [`TrendOptions::min_logs`] values.
+    pub reference_scatter: Option<f64>,
+    /// The line at the last log from the reference's centre, in reference scatters (signed).
+    pub from_reference_scatters: Option<f64>,
     /// One sentence: "i2_over_i1 rising 0.21 %/week (0.15-0.30), FAULT level in about 9 days".
     pub sentence: String,
     /// The motor's points, the window's marked.
@@ -292,12 +328,32 @@ pub struct MotorTrend {
     pub last_day: String,
     /// Any indicator's trend alarm.
     pub alarm: bool,
-    /// The fastest indicator's |moves_scatters| (the fleet's ranking key).
+    /// The fastest indicator's |moves_scatters| (the fleet's ranking key; 0 where no
+    /// indicator has a line).
     pub fastest_scatters: f64,
+    /// The logs the indicators are judged against.
+    pub reference: TrendReference,
     /// Per indicator.
     pub indicators: Vec<IndicatorTrend>,
 }
 
+/// A motor's reference: its logs the indicators are judged against (JSON: `reference`).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct TrendReference {
+    /// How many logs.
+    pub logs: usize,
+    /// The first one's day.
+    pub first_day: Option<String>,
+    /// The last one's day.
+    pub last_day: Option<String>,
+    /// Whether the user marked it ([`TrendOptions::reference_until_s`]).
+    pub marked: bool,
+    /// Which logs, in words ("the first 14 days of logs whose verdict is not FAULT").
+    pub how: String,
+}
+
 mod analyse;
+mod reference;
 
 pub use analyse::{day_of, fit_logs, indicator_trend, motor_trend, trend};
+pub use reference::reference_rows;

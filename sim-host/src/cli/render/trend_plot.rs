@@ -5,8 +5,12 @@
 //!   short (the median `unbalance.least_change` of the plotted motors), WATCH from half of
 //!   it, OK below.
 //! - The parity residuals e_d, e_q, e_T in the motor's own scatters from its reference
-//!   (the motor's first logs): OK within ±k scatters, WATCH beyond (they have no FAULT level
-//!   of their own: the isolation names a fault from their direction).
+//!   (its first healthy logs, or the baseline the user marks: `MotorTrend::reference`):
+//!   OK within ±k reference scatters of the reference's centre, WATCH beyond (they have no
+//!   FAULT level of their own: the isolation names a fault from their direction).
+//! - Where a shown motor has too few logs for a reference scatter, the panel draws the
+//!   stored values (in pu, without bands) and its title says so; where an indicator has no
+//!   operating-point fit, its values are the stored ones, and the title says that too.
 //!
 //! At most [`MAX_MOTORS`] motors are drawn: the first of the ranking (alarmed first).
 
@@ -25,36 +29,97 @@ const WATCH: RGBColor = RGBColor(253, 238, 200);
 const FAULT: RGBColor = RGBColor(250, 215, 215);
 
 /// The panels: indicator column, title, and whether it is drawn in scatters.
-const PANELS: [(&str, &str, bool); 4] = [
+const PANELS: [(&str, &str, bool); 5] = [
     (
         "i2_over_i1",
         "|I2w|/|I1| [% of I1] (a short grows it)",
         false,
     ),
-    ("residual_d", "e_d [scatters from the reference]", true),
-    ("residual_q", "e_q [scatters from the reference]", true),
-    ("residual_t", "e_T [scatters from the reference]", true),
+    (
+        "residual_d",
+        "e_d [scatters from the motor's reference]",
+        true,
+    ),
+    (
+        "residual_q",
+        "e_q [scatters from the motor's reference]",
+        true,
+    ),
+    (
+        "residual_t",
+        "e_T [scatters from the motor's reference]",
+        true,
+    ),
+    (
+        "stator_excess_pct",
+        "Rs beyond Rr [scatters from the motor's reference] (a loosening connection raises it)",
+        true,
+    ),
 ];
 
 /// One motor's line in a panel: its name, points (day, value) and palette index.
 type PlotLine = (String, Vec<(f64, f64)>, usize);
 
-/// One motor's points of one panel: (day, value in the panel's unit).
-fn points(t: &IndicatorTrend, in_scatters: bool, t0: f64) -> Vec<(f64, f64)> {
-    let mut refs: Vec<f64> = t.series.iter().map(|p| p.normalised).collect();
-    let centre = monitor_store::trend::stats::median(&mut refs).unwrap_or_default();
-    let scatter = t.scatter.unwrap_or(1.0).max(f64::MIN_POSITIVE);
-    t.series
+/// One motor's points of one panel: (day, value in the panel's unit): in reference
+/// scatters from the reference's centre where `in_scatters` (none without a reference
+/// scatter), else the values (the normalised ones, the stored ones where there was no
+/// operating-point fit) times `scale`.
+pub fn points(
+    t: &IndicatorTrend,
+    in_scatters: bool,
+    scale: f64,
+    t0: f64,
+) -> Option<Vec<(f64, f64)>> {
+    let (centre, scatter) = if in_scatters {
+        (t.reference_centre?, t.reference_scatter?)
+    } else {
+        (0.0, 1.0 / scale)
+    };
+    Some(
+        t.series
+            .iter()
+            .map(|p| (p.t_days - t0, (p.normalised - centre) / scatter))
+            .collect(),
+    )
+}
+
+/// How a panel draws `column` for these motors: in reference scatters (where `in_scatters`
+/// and every shown motor has a reference scatter) or in the stored unit, and its title with
+/// what is drawn where it is not what the panel is for.
+pub fn panel_mode(
+    motors: &[&MotorTrend],
+    opts: &TrendOptions,
+    column: &str,
+    title: &str,
+    in_scatters: bool,
+) -> (bool, String) {
+    let shown: Vec<&IndicatorTrend> = motors
         .iter()
-        .map(|p| {
-            let y = if in_scatters {
-                (p.normalised - centre) / scatter
-            } else {
-                100.0 * p.normalised
-            };
-            (p.t_days - t0, y)
-        })
-        .collect()
+        .filter_map(|m| m.indicators.iter().find(|t| t.indicator == column))
+        .collect();
+    let unfitted = shown.iter().any(|t| !t.operating_point_fitted);
+    let no_scatter: Vec<usize> = shown
+        .iter()
+        .filter(|t| t.reference_scatter.is_none())
+        .map(|t| t.series.iter().filter(|p| p.in_reference).count())
+        .collect();
+    if in_scatters && !no_scatter.is_empty() {
+        let few = no_scatter.iter().copied().min().unwrap_or_default();
+        let label = title.split(" [").next().unwrap_or(title);
+        return (
+            false,
+            format!(
+                "{label} [pu, the stored values: too few reference logs for a scatter ({few} of {})]",
+                opts.min_logs.max(3)
+            ),
+        );
+    }
+    let title = if unfitted {
+        format!("{title}; stored values, no operating-point fit")
+    } else {
+        title.to_string()
+    };
+    (in_scatters, title)
 }
 
 /// Draws the plot into `path` (`.svg` or `.png`, by its extension).
@@ -121,13 +186,15 @@ where
     Ok(())
 }
 
-/// The panel's y range and band levels: (y0, y1, WATCH level, FAULT level).
+/// The panel's y range and band levels: (y0, y1, WATCH level, FAULT level); with `raw`
+/// (the stored values, no bands) the values' own range.
 fn panel_range(
     series: &[PlotLine],
     motors: &[&MotorTrend],
     opts: &TrendOptions,
     column: &str,
     in_scatters: bool,
+    raw: bool,
 ) -> (f64, f64, f64, Option<f64>) {
     let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
     for &(_, y) in series.iter().flat_map(|s| s.1.iter()) {
@@ -150,7 +217,16 @@ fn panel_range(
     if !y0.is_finite() {
         (y0, y1) = (-1.0, 1.0);
     }
-    y1 = y1.max(fault.map_or(watch, |f| 1.15 * f));
+    if raw {
+        let pad = 0.08 * (y1 - y0).max(1e-9 * y1.abs().max(y0.abs()).max(1e-12));
+        return (y0 - pad, y1 + pad, watch, fault);
+    }
+    // No FAULT level (no motor shown has one): no band to make room for (an infinite
+    // WATCH level would make the range infinite, and the axis's labels never end).
+    let top = fault.map_or(watch, |f| 1.15 * f);
+    if top.is_finite() {
+        y1 = y1.max(top);
+    }
     if in_scatters {
         y0 = y0.min(-1.3 * watch);
         y1 = y1.max(1.3 * watch);
@@ -174,19 +250,22 @@ where
     DB::ErrorType: 'static,
 {
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    let (in_scatters, title) = panel_mode(motors, opts, column, title, in_scatters);
+    let scale = if column == "i2_over_i1" { 100.0 } else { 1.0 };
     let series: Vec<PlotLine> = motors
         .iter()
         .enumerate()
         .filter_map(|(i, m)| {
             let t = m.indicators.iter().find(|t| t.indicator == column)?;
-            Some((m.motor.clone(), points(t, in_scatters, t0), i))
+            Some((m.motor.clone(), points(t, in_scatters, scale, t0)?, i))
         })
         .collect();
     let x1 = series
         .iter()
         .flat_map(|s| s.1.iter().map(|p| p.0))
         .fold(1.0f64, f64::max);
-    let (y0, y1, watch, fault) = panel_range(&series, motors, opts, column, in_scatters);
+    let raw = !in_scatters && column != "i2_over_i1";
+    let (y0, y1, watch, fault) = panel_range(&series, motors, opts, column, in_scatters, raw);
     let caption = if k == 0 {
         format!("{title}; days from {}", monitor_store::trend::day_of(t0))
     } else {
@@ -199,16 +278,11 @@ where
         .y_label_area_size(60)
         .build_cartesian_2d(0.0..x1, y0..y1)
         .map_err(e)?;
-    let rect = |lo: f64, hi: f64, c: RGBColor| Rectangle::new([(0.0, lo), (x1, hi)], c.filled());
-    let bands = if in_scatters {
-        [
-            rect(y0, -watch, WATCH),
-            rect(-watch, watch, OK),
-            rect(watch, y1, WATCH),
-        ]
+    let bands = if raw {
+        // The stored values without a reference scatter: no band to draw.
+        Vec::new()
     } else {
-        let (w, f) = (watch.min(y1), fault.unwrap_or(y1).min(y1));
-        [rect(y0, w, OK), rect(w, f, WATCH), rect(f, y1, FAULT)]
+        bands(x1, (y0, y1), watch, fault, in_scatters)
     };
     chart.draw_series(bands).map_err(e)?;
     chart
@@ -218,6 +292,28 @@ where
         .draw()
         .map_err(e)?;
     draw_lines(&mut chart, series, k == 0)
+}
+
+/// The severity bands over `0..x1` and `y0..y1`: in scatters, OK within ±`watch` and
+/// WATCH beyond; else OK below `watch`, WATCH to `fault`, FAULT above.
+fn bands(
+    x1: f64,
+    (y0, y1): (f64, f64),
+    watch: f64,
+    fault: Option<f64>,
+    in_scatters: bool,
+) -> Vec<Rectangle<(f64, f64)>> {
+    let rect = |lo: f64, hi: f64, c: RGBColor| Rectangle::new([(0.0, lo), (x1, hi)], c.filled());
+    if in_scatters {
+        vec![
+            rect(y0, -watch, WATCH),
+            rect(-watch, watch, OK),
+            rect(watch, y1, WATCH),
+        ]
+    } else {
+        let (w, f) = (watch.min(y1), fault.unwrap_or(y1).min(y1));
+        vec![rect(y0, w, OK), rect(w, f, WATCH), rect(f, y1, FAULT)]
+    }
 }
 
 /// Draws the motors' lines (points joined) and, with `legend`, the legend.

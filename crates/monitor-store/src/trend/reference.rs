@@ -1,0 +1,332 @@
+//! The motor's reference (its first healthy logs, or the baseline the user marks), what the
+//! normalisation did and why, and the alarm's hysteresis: raised on the trend, held until
+//! the indicator is back at the reference (the module's documentation, items 4 and 5).
+
+use super::stats::{mad_sigma, median};
+use super::{Indicator, IndicatorTrend, TrendOptions, TrendPoint, TrendReference};
+use crate::row::{utc_day, StoredRow};
+
+/// Seconds per day.
+const DAY_S: f64 = 86_400.0;
+
+/// The motor's reference among `rows` (one motor's, by time): a mask over `rows` and what
+/// it is. With [`TrendOptions::reference_until_s`], the logs before it (all of them: the
+/// user marked them healthy); else the logs of the motor's first
+/// [`TrendOptions::window_days`] whose stored verdict is not `fault`, or its first
+/// [`TrendOptions::min_logs`] such logs where the first days hold fewer; where every log's
+/// verdict is `fault`, its first days' logs whatever their verdict (and `how` says so).
+pub fn reference_rows(rows: &[&StoredRow], opts: &TrendOptions) -> (Vec<bool>, TrendReference) {
+    let time = |r: &StoredRow| r.f64("log_time_s").unwrap_or_default();
+    let healthy = |r: &StoredRow| r.str("verdict") != Some("fault");
+    let marked = opts.reference_until_s.map(|u| u as f64);
+    let (mask, how, is_marked) = match marked {
+        Some(u) if rows.iter().any(|r| time(r) < u) => (
+            rows.iter().map(|r| time(r) < u).collect::<Vec<bool>>(),
+            format!("the logs up to {} (marked)", utc_day(u as i64 - 1)),
+            true,
+        ),
+        _ => {
+            let (mask, how) = first_healthy(rows, opts, &time, &healthy);
+            let how = match marked {
+                Some(u) => format!("no log up to the marked {}: {how}", utc_day(u as i64 - 1)),
+                None => how,
+            };
+            (mask, how, false)
+        }
+    };
+    let picked: Vec<&&StoredRow> = rows
+        .iter()
+        .zip(&mask)
+        .filter(|(_, m)| **m)
+        .map(|(r, _)| r)
+        .collect();
+    let day = |r: Option<&&&StoredRow>| r.and_then(|r| r.str("day")).map(str::to_string);
+    let reference = TrendReference {
+        logs: picked.len(),
+        first_day: day(picked.first()),
+        last_day: day(picked.last()),
+        marked: is_marked,
+        how,
+    };
+    (mask, reference)
+}
+
+/// The default reference: the first days' logs whose verdict is not `fault` (see
+/// [`reference_rows`]).
+fn first_healthy(
+    rows: &[&StoredRow],
+    opts: &TrendOptions,
+    time: &dyn Fn(&StoredRow) -> f64,
+    healthy: &dyn Fn(&StoredRow) -> bool,
+) -> (Vec<bool>, String) {
+    let t0 = rows.first().map_or(0.0, |r| time(r));
+    let early = |r: &StoredRow| time(r) < t0 + opts.window_days * DAY_S;
+    let days = opts.window_days;
+    let mut mask: Vec<bool> = rows.iter().map(|r| early(r) && healthy(r)).collect();
+    if mask.iter().filter(|m| **m).count() >= opts.min_logs {
+        return (
+            mask,
+            format!("the motor's first {days} days of logs whose verdict is not FAULT"),
+        );
+    }
+    let mut taken = 0;
+    for (m, r) in mask.iter_mut().zip(rows) {
+        *m = taken < opts.min_logs && healthy(r);
+        taken += usize::from(*m);
+    }
+    if taken > 0 {
+        return (
+            mask,
+            format!(
+                "the motor's first {} logs whose verdict is not FAULT",
+                opts.min_logs
+            ),
+        );
+    }
+    (
+        rows.iter().map(|r| early(r)).collect(),
+        format!("the motor's first {days} days of logs (every log's verdict is FAULT)"),
+    )
+}
+
+/// The reference's centre and scatter of a series (its points `in_reference`): the median
+/// and 1.4826 MAD about it, the scatter at least `floor` (the operating-point fit's) and
+/// only with at least `min` values.
+pub(super) fn reference_stats(
+    series: &[TrendPoint],
+    floor: f64,
+    min: usize,
+) -> (Option<f64>, Option<f64>) {
+    let mut v: Vec<f64> = series
+        .iter()
+        .filter(|p| p.in_reference)
+        .map(|p| p.normalised)
+        .collect();
+    let scatter = if v.len() >= min.max(3) {
+        let top = v.iter().map(|x| x.abs()).fold(0.0, f64::max);
+        mad_sigma(&v).map(|s| s.max(floor).max(1e-9 * top).max(f64::MIN_POSITIVE))
+    } else {
+        None
+    };
+    (median(&mut v), scatter)
+}
+
+/// A covariate's name and unit in the report's words.
+fn covariate_words(c: &str) -> (&'static str, &'static str) {
+    match c {
+        "i1_peak_a" => ("the load (I1)", "A"),
+        "winding_temperature_c" => ("the windings' temperature", "°C"),
+        "winding_rise_k" => ("the windings' rise", "K"),
+        _ => ("a covariate", ""),
+    }
+}
+
+/// A spread negligible against the covariate's size: below 0.1 % of its largest value
+/// (and below 1e-9 in absolute terms for a covariate about zero).
+fn negligible(lo: f64, hi: f64) -> bool {
+    hi - lo <= 1e-3 * lo.abs().max(hi.abs()).max(1e-6)
+}
+
+/// What the report says of the operating-point normalisation of `ind` on `covs` over
+/// `rows`, `fitted` or not: the fit made, or the actual reason it was not (too few logs
+/// with the covariates, N of M needed; a covariate that does not vary; covariates that
+/// cannot be told apart), with each covariate's range where it is not taken out. Also the
+/// logs the fit could use, and how many it needs.
+pub(super) fn normalisation_note(
+    ind: &Indicator,
+    covs: &[&str],
+    rows: &[&StoredRow],
+    fitted: bool,
+    needed: usize,
+) -> (String, usize) {
+    let usable: Vec<&&StoredRow> = rows
+        .iter()
+        .filter(|r| r.f64(ind.column).is_some() && covs.iter().all(|c| r.f64(c).is_some()))
+        .collect();
+    let n = usable.len();
+    if fitted {
+        let text = format!(
+            "brought to the median {} (least squares, second order in them, with time, over the motor's {n} logs)",
+            covs.join(" and ")
+        );
+        return (text, n);
+    }
+    if covs.is_empty() {
+        return (
+            "raw values (the indicator has no covariates)".to_string(),
+            n,
+        );
+    }
+    let (not_out, flat) = covariate_ranges(covs, rows);
+    if n < needed {
+        let lacking = rows.len().saturating_sub(n);
+        let lack = if lacking > 0 {
+            format!(
+                ", {lacking} of the {} logs lack a covariate or the value",
+                rows.len()
+            )
+        } else {
+            String::new()
+        };
+        let text = format!(
+            "not yet: raw values, too few logs for the operating-point fit ({n} of the {needed} needed{lack}){not_out}; no alarm until then"
+        );
+        return (text, n);
+    }
+    let text = if flat.is_empty() {
+        format!("raw values: the fit on {} could not be made over {n} logs (they move together){not_out}", covs.join(" and "))
+    } else {
+        format!(
+            "raw values: the operating point does not vary ({}){not_out}",
+            flat.join(", ")
+        )
+    };
+    (text, n)
+}
+
+/// The covariates' ranges over `rows` in the report's words: "; the load (I1) varied
+/// 6.400-7.600 A (i1_peak_a) and is not taken out" for those that moved, and "the load
+/// (I1) (i1_peak_a) stays at 7.000 A" for each whose spread is negligible.
+fn covariate_ranges(covs: &[&str], rows: &[&StoredRow]) -> (String, Vec<String>) {
+    let (mut moved, mut flat) = (Vec::new(), Vec::new());
+    for c in covs {
+        let v: Vec<f64> = rows.iter().filter_map(|r| r.f64(c)).collect();
+        let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        if !lo.is_finite() {
+            continue;
+        }
+        let (name, unit) = covariate_words(c);
+        if negligible(lo, hi) {
+            flat.push(format!("{name} ({c}) stays at {lo:.3} {unit}"));
+        } else {
+            moved.push(format!("{name} varied {lo:.3}-{hi:.3} {unit} ({c})"));
+        }
+    }
+    let not_out = match moved.len() {
+        0 => String::new(),
+        1 => format!("; {} and is not taken out", moved.join("")),
+        _ => format!("; {} and are not taken out", moved.join(", ")),
+    };
+    (not_out, flat)
+}
+
+/// The state of one log in the alarm's history: the trend as of it (on the logs up to it)
+/// alarms, or it is back at the reference (no alarm, and the line at it and its value
+/// within [`TrendOptions::k_scatter`] reference scatters of the reference's centre).
+#[derive(Clone, Copy)]
+struct LogState {
+    /// The trend as of the log alarms.
+    alarm: bool,
+    /// The indicator is back at the reference at the log.
+    back: bool,
+}
+
+/// [`LogState`] of a trend as of its last log.
+fn state_of(t: &IndicatorTrend, opts: &TrendOptions) -> LogState {
+    let within = |x: Option<f64>| x.is_some_and(|x| x.abs() <= opts.k_scatter);
+    let value = match (t.series.last(), t.reference_centre, t.reference_scatter) {
+        (Some(p), Some(c), Some(s)) => Some((p.normalised - c) / s),
+        _ => None,
+    };
+    LogState {
+        alarm: t.alarm,
+        back: !t.alarm && within(t.from_reference_scatters) && within(value),
+    }
+}
+
+/// `t` (the trend as of the last of `rows`) with the alarm's hysteresis applied: raised
+/// where the trends as of the last [`TrendOptions::confirm_logs`] logs all alarm, and held
+/// from the log it was raised on until the indicator is back at the reference on
+/// `confirm_logs` logs in a row. The history is walked back from the last log, each log
+/// judged on the logs up to it by `judge`, until a clearing run or the first log.
+pub(super) fn latched(
+    mut t: IndicatorTrend,
+    rows: &[&StoredRow],
+    opts: &TrendOptions,
+    judge: &dyn Fn(&[&StoredRow]) -> IndicatorTrend,
+) -> IndicatorTrend {
+    let c = opts.confirm_logs.max(1);
+    let since = raised_at(rows, opts, state_of(&t, opts), judge);
+    let Some(since) = since else {
+        if t.alarm {
+            t.alarm = false;
+            t.sentence = t.sentence.replace(
+                ": TREND ALARM",
+                &format!(": alarm not yet confirmed ({c} logs in a row needed)"),
+            );
+        }
+        return t;
+    };
+    let day = rows
+        .get(since - 1)
+        .and_then(|r| r.str("day"))
+        .unwrap_or_default()
+        .to_string();
+    if !t.alarm {
+        t.alarm = true;
+        let head = t
+            .sentence
+            .split(": ")
+            .next()
+            .unwrap_or_default()
+            .to_string();
+        let now = t.from_reference_scatters.map_or(String::new(), |x| {
+            format!(", the line {x:+.1} reference scatters from the reference")
+        });
+        t.sentence = format!(
+            "{head}: TREND ALARM held, raised on {day}{now}; it clears when back within {} \
+             reference scatters on {c} logs in a row",
+            opts.k_scatter
+        );
+    }
+    t.alarm_since = Some(day);
+    t
+}
+
+/// The log (1-based, over `rows`) the alarm now standing was raised on, if one stands:
+/// the history walked back from the last log (whose state is `last`), each log judged on
+/// the logs up to it, until [`TrendOptions::confirm_logs`] logs in a row back at the
+/// reference (a clearing: an alarm raised before it no longer stands) or the first log.
+fn raised_at(
+    rows: &[&StoredRow],
+    opts: &TrendOptions,
+    last: LogState,
+    judge: &dyn Fn(&[&StoredRow]) -> IndicatorTrend,
+) -> Option<usize> {
+    let c = opts.confirm_logs.max(1);
+    let n = rows.len();
+    let mut memo: Vec<Option<LogState>> = vec![None; n + 1];
+    if let Some(m) = memo.get_mut(n) {
+        *m = Some(last);
+    }
+    let mut state = |m: usize| -> LogState {
+        if let Some(Some(s)) = memo.get(m) {
+            return *s;
+        }
+        let none = LogState {
+            alarm: false,
+            back: false,
+        };
+        let s = rows.get(..m).map_or(none, |r| state_of(&judge(r), opts));
+        if let Some(slot) = memo.get_mut(m) {
+            *slot = Some(s);
+        }
+        s
+    };
+    let (mut run, mut since) = (0, None);
+    for m in (1..=n).rev() {
+        if state(m).back {
+            run += 1;
+            if run >= c {
+                break;
+            }
+            continue;
+        }
+        run = 0;
+        if m >= c && (m + 1 - c..=m).all(|j| state(j).alarm) {
+            since = Some(m);
+        }
+    }
+    since
+}
