@@ -311,15 +311,37 @@ pub fn not_proposed(
 
 /// Every dynamics effect of the library not in the model (`in_model`), in the library's
 /// order, with why it is not proposed on the span ([`not_proposed`]; `None`: proposed).
+/// What an effect needs first counts as there when the same plan proposes it: the advice
+/// adds them together (`cross_coupling_dynamics` with `d_axis_dynamics`: the full-order
+/// machine, as the ladder's candidate of all the missing dynamics effects at once). Judged
+/// against the model alone, the advice had dropped `cross_coupling_dynamics` ("needs
+/// d_axis_dynamics in the model first") and nothing proposed it later: a hidden supply
+/// unbalance then fell 0.1078 -> 0.0636 where all four dynamics effects took it to 0.0046
+/// (issue 62).
 pub fn dynamics_plan(
     span: Span,
     n: &MachineConstants,
     in_model: &[EffectKind],
 ) -> Vec<(EffectKind, Option<NotProposed>)> {
-    EffectKind::ALL
+    let missing: Vec<EffectKind> = EffectKind::ALL
         .iter()
+        .copied()
         .filter(|k| k.is_dynamics() && !in_model.contains(k))
-        .map(|&k| (k, not_proposed(model_of(k).as_ref(), span, n, in_model)))
+        .collect();
+    // First without what they need: those the span itself allows.
+    let allowed: Vec<EffectKind> = missing
+        .iter()
+        .copied()
+        .filter(|&k| {
+            let model = model_of(k);
+            let all: Vec<EffectKind> = in_model.iter().chain(model.requires()).copied().collect();
+            not_proposed(model.as_ref(), span, n, &all).is_none()
+        })
+        .collect();
+    let with: Vec<EffectKind> = in_model.iter().chain(&allowed).copied().collect();
+    missing
+        .into_iter()
+        .map(|k| (k, not_proposed(model_of(k).as_ref(), span, n, &with)))
         .collect()
 }
 

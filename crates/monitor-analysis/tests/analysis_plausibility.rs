@@ -310,10 +310,14 @@ fn out_of_range_values_print_their_unit_and_no_unit_one() {
 
 /// `compare`'s advice on the dynamics effects and `explain`'s `skipped` come from one rule
 /// (`analysis::transients::not_proposed`): on the same log, every dynamics effect `explain`
-/// skips is in the advice with the same words, every one the advice adds is one `explain`
-/// fitted, and none is both. On the motulator log (a start and a load step), a simulated
-/// start, and a simulated load step without a start (no input transient: the advice adds
-/// nothing and says why, as `explain` does).
+/// skips for what the span lacks is in the advice with the same words; one it skips only
+/// because an effect it needs first is missing from the model is advised together with
+/// that effect (issue 62: `cross_coupling_dynamics` with `d_axis_dynamics`, the full-order
+/// machine; judged against the model alone it was dropped from the advice and nothing
+/// proposed it later); every other one the advice adds is one `explain` fitted. On the
+/// motulator log (a start and a load step), a simulated start, and a simulated load step
+/// without a start (no input transient: the advice adds nothing and says why, as `explain`
+/// does).
 #[test]
 fn compare_advice_and_explain_skipped_agree() {
     let dir = tempfile::tempdir().unwrap();
@@ -375,16 +379,36 @@ fn compare_advice_and_explain_skipped_agree() {
             !c.advice.is_empty(),
             "{case}: the worst windows are transients"
         );
-        assert_eq!(held, skipped, "{case}: the same reasons, word for word");
+        // Skipped only for what it needs first, and advised with it.
+        let with_its_needs = |s: &&&String| {
+            added.iter().any(|k| {
+                s.starts_with(&format!("{k}: needs "))
+                    && s.contains("first")
+                    && added.iter().any(|r| r != k && s.contains(r))
+            })
+        };
+        let for_the_span: Vec<&String> = skipped
+            .iter()
+            .filter(|s| !with_its_needs(s))
+            .copied()
+            .collect();
+        assert_eq!(
+            held, for_the_span,
+            "{case}: the same reasons, word for word"
+        );
         for k in &added {
+            let fitted = ex.ranking.iter().any(|r| r.effect.name() == *k);
+            let needs = skipped
+                .iter()
+                .any(|s| with_its_needs(&s) && s.starts_with(&format!("{k}: ")));
             assert!(
-                ex.ranking.iter().any(|r| r.effect.name() == *k),
-                "{case}: compare adds {k}, explain did not fit it"
+                fitted != needs,
+                "{case}: compare adds {k}: explain must fit it, or skip it only for what the advice adds with it"
             );
-            assert!(
-                !skipped.iter().any(|s| s.starts_with(&format!("{k}: "))),
-                "{case}: {k}"
-            );
+        }
+        if start {
+            // The full-order machine: all four dynamics effects advised on a start.
+            assert_eq!(added.len(), 4, "{case}: {added:?}");
         }
         assert_eq!(!added.is_empty(), start, "{case}: {added:?}");
         if !start {
