@@ -146,8 +146,9 @@ class ExplainResult(Result):
 
     @property
     def ranking_frame(self):
-        """The ranking as a DataFrame (rank, standing, effect, errors, explained fraction,
-        plausibility): ranked candidates first, then ``no_effect``, then ``not_plausible``."""
+        """The ranking as a DataFrame (rank, standing, effect, errors, explained fractions on
+        the held-back windows and the whole log, plausibility): ranked candidates first, then
+        ``no_effect``, then ``not_plausible``."""
         keep = (
             "rank",
             "standing",
@@ -155,6 +156,7 @@ class ExplainResult(Result):
             "normalized_rms_error",
             "validation_normalized_rms_error",
             "explained_fraction",
+            "whole_log_explained_fraction",
             "plausible",
             "summary",
         )

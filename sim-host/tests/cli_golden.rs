@@ -57,7 +57,7 @@ const INTENDED: [(&str, &str, &str); 6] = [
 
 /// Keys added since the golden outputs were taken (issue 8: the data-quality stage's
 /// report, what commissioning did, the verdict, the range note beside a lamp).
-const ADDED: [&str; 66] = [
+const ADDED: [&str; 67] = [
     "rotor", // issue 48: diagnose's rotor finding (broken bars from the sidebands)
     // Issue 40: a healthy verdict's detection limits at the commissioned point.
     "detection_limits",
@@ -148,6 +148,8 @@ const ADDED: [&str; 66] = [
     "temperature_channel",
     // Issue 65: Rs and Rr read apart at the isolation's steady points.
     "resistances",
+    // Issue 62: explain's ranking says the share explained over the whole log too.
+    "whole_log_explained_fraction",
 ];
 
 /// The library effect added since (issue 10, `rotor_asymmetry`): its ranking entries and

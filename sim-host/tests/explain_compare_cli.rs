@@ -133,7 +133,10 @@ fn explains_text_reads_like_its_verdict() {
             .map(|c| c["effect"].as_str().unwrap_or_default().to_string())
             .collect()
     };
-    let table = &lines[ranking + 2..none];
+    // The table's rows end at the line saying what "explained" is (whole log / held-back).
+    let note = at("  (explained: the share of the error beyond the noise floor");
+    assert!(note < none, "{text}");
+    let table = &lines[ranking + 2..note];
     assert_eq!(table.len(), of("candidate").len(), "{text}");
     for bad in of("not_plausible").iter().chain(&of("no_effect")) {
         assert!(

@@ -392,8 +392,8 @@ pub struct ParameterSensitivity {
     pub identified: bool,
 }
 
-/// A 10 % change that moves the model error by less than this (0.4 % normalized error, the
-/// frame estimate's own accuracy, `explain::MIN_MODEL_ERROR`) is not identified.
+/// A 10 % change that moves the model error by less than this (0.4 % normalized error,
+/// about the frame estimate's own accuracy on noise-free data) is not identified.
 pub const IDENTIFIED_MIN: f64 = 0.004;
 
 /// Rank and conditioning of the fit's data Jacobian, and per-parameter sensitivities.

@@ -248,11 +248,14 @@ fn place_of(effect: EffectKind, report: &ExplainReport) -> Place {
 
 /// [`Place`] of a fitted candidate `c`.
 fn placed(c: &EffectCandidate) -> Place {
-    let explained = 100.0 * c.explained_fraction;
+    let (whole, held) = (
+        100.0 * c.whole_log_explained_fraction,
+        100.0 * c.explained_fraction,
+    );
     match (c.standing, c.rank) {
         (Standing::Candidate, Some(k)) => Place {
             words: format!(
-                "{} is rank {k}, explaining {explained:.0} % of the model's held-back error",
+                "{} is rank {k}, explaining {whole:.0} % / {held:.0} % of the model's error beyond the noise floor (whole log / held-back windows)",
                 c.effect
             ),
             agrees: true,
@@ -270,7 +273,7 @@ fn placed(c: &EffectCandidate) -> Place {
         },
         _ => Place {
             words: format!(
-                "{} explains {explained:.0} % of it (no effect on the ranking)",
+                "{} explains {whole:.0} % / {held:.0} % of the error beyond the noise floor (whole log / held-back windows; no effect on the ranking)",
                 c.effect
             ),
             agrees: false,

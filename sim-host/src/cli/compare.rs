@@ -175,7 +175,8 @@ current_dynamics, d_axis_dynamics, cross_coupling_dynamics, rotor_asymmetry) is 
 and fitted together with the base parameters (Ra, Ls, B+Bl, J). The dynamics effects (those \
 with a time constant) are proposed only when the analysed span holds a start or a supply \
 step; with all four the model is the full-order machine. Candidates are ranked by the error \
-on held-back time windows the fit never saw, so an effect that only fits noise does not \
+on held-back time windows the fit never saw (each kind of event the log holds, its start, \
+transients, load moves and steady stretches, falls in both parts), so an effect that only fits noise does not \
 win; a fit outside its physical range is marked plausible: false, is listed apart with its reason \
 and never named, and a plausible fit that explains under 5 % of the held-back error is no \
 candidate (listed apart as no effect). The base \
@@ -183,7 +184,8 @@ parameters refitted to the log are printed with the parameter file's values, and
 log does not identify are named; when the file's values do not fit the log at all (the \
 refit outside their physical range), the model is first recentred on the identified refitted \
 values and the effects are judged against that. When no candidate explains at least 50 % of \
-the held-back error, or the error is already near the noise floor, the answer is \
+the held-back error, or the error is already within 1.12x its noise floor on the whole log \
+and on the held-back windows, the answer is \
 `unexplained: true` rather than a wrong name.\n\n\
 Workflow:\n  sim-host compare --params motor.toml run.csv          # where does the model fail?\n  \
 sim-host explain --params motor.toml run.csv          # which effect is missing?\n  \
@@ -195,7 +197,8 @@ model's error and, where the verdict names a fault, how the ranking relates to i
 JSON (--json): headline, motor_verdict, verdict_finding, beside_verdict, \
 baseline_normalized_rms_error, ranking [{effect, rank, standing (candidate | no_effect | \
 not_plausible), normalized_rms_error, \
-explained_fraction, validation_normalized_rms_error, n_parameters, parameters, summary, \
+explained_fraction (held-back), whole_log_explained_fraction, \
+validation_normalized_rms_error, n_parameters, parameters, summary, \
 plausible, implausible_because, fit {iterations, cost, termination: converged | slow_progress | \
 iteration_limit | stalled | nothing_to_fit}}], \
 no_effect, unexplained, verdict, skipped, unbalance, noise_floor, data_quality, rotor_asymmetry (the \

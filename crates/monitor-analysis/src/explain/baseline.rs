@@ -2,7 +2,7 @@
 //! every candidate is compared with), its base parameters refitted with what the log
 //! identifies of them, and whether its error is structural.
 
-use super::HOLDOUT_WINDOWS;
+use super::ladder::{mask_on, stratified_heldback, weights_for};
 use crate::effects::EffectModel;
 use crate::fit::{self, ActiveEffect, FitResult};
 use crate::metrics::{self, Weights};
@@ -22,14 +22,22 @@ pub(super) struct ExplainBaseline<'a> {
     pub(super) fit_weights: Weights,
     /// Training/held-back split on the working series.
     pub(super) weights: Weights,
-    /// The held-back mask of the working series.
+    /// The held-back mask of the working series, stratified by the log's events as the
+    /// ladder's ([`stratified_heldback`]: the start, transients, load moves and steady
+    /// stretches each fall in both parts).
     pub(super) heldback: Vec<bool>,
-    /// The held-back mask of the fit series.
+    /// The held-back mask of the fit series (the working series' carried over,
+    /// [`mask_on`]).
     pub(super) heldback_fit_series: Vec<bool>,
     /// The configured effects set up on the fit series.
     pub(super) active: Vec<ActiveEffect<'a>>,
     /// Their fit.
     pub(super) fit: FitResult,
+    /// The whole-log error on the fit series (what a candidate's whole-log error is
+    /// compared with; the same as the working series' unless the log was coarsened).
+    pub(super) error_fit_series: f64,
+    /// The whole-log noise floor on the fit series ([`metrics::noise_floor`]).
+    pub(super) noise_fit_series: f64,
     /// The held-back error on the fit series (candidates are ranked there; the same as
     /// the working series' unless the log was coarsened).
     pub(super) heldback_error_fit_series: f64,
@@ -82,13 +90,18 @@ impl Analysis {
         opts: &Options,
     ) -> Result<ExplainBaseline<'a>, AnalysisError> {
         let (fd, m) = self.fit_data();
-        let wf = Weights::new(&fd, HOLDOUT_WINDOWS, MAX_FIT_SAMPLES);
-        let w_full = Weights::new(&self.data, HOLDOUT_WINDOWS, usize::MAX);
-        let heldback: Vec<bool> = w_full.train.iter().map(|t| !t).collect();
+        // The ladder's split: every kind of event the log holds in both parts.
+        let (heldback, _) = stratified_heldback(&self.data, &self.constants);
+        let heldback_fit_series = if m == 1 {
+            heldback.clone()
+        } else {
+            mask_on(&fd, &self.data, &heldback)
+        };
+        let wf = weights_for(&fd, &heldback_fit_series, MAX_FIT_SAMPLES);
+        let w_full = weights_for(&self.data, &heldback, usize::MAX);
         let active = self.setup_all(&fd, configured)?;
         let nominal = BaseParams::nominal(&self.constants);
         let f0 = self.fit_set(&fd, &active, &wf, &nominal, opts.fit_base)?;
-        let heldback_fit_series: Vec<bool> = wf.train.iter().map(|t| !t).collect();
         let span = transients::Span::of(&fd, &self.constants);
         let mut base = ExplainBaseline {
             fit_series: fd,
@@ -99,6 +112,8 @@ impl Analysis {
             heldback_fit_series,
             active,
             fit: f0,
+            error_fit_series: f64::NAN,
+            noise_fit_series: f64::NAN,
             heldback_error_fit_series: f64::NAN,
             heldback_noise_fit_series: f64::NAN,
             span,
@@ -108,7 +123,7 @@ impl Analysis {
         Ok(base)
     }
 
-    /// The baseline's held-back error and noise floor on the fit series: from the
+    /// The baseline's whole-log and held-back errors and noise floors on the fit series: from the
     /// working series' measures when the fit series is the working series (kept in
     /// [`ExplainBaseline::full`]); for a long log (fitted on a coarser series) on that series,
     /// where the candidates are ranked too.
@@ -119,6 +134,8 @@ impl Analysis {
     ) -> Result<(), AnalysisError> {
         if base.coarsening == 1 {
             let full = self.full_series(configured, base)?;
+            base.error_fit_series = full.error;
+            base.noise_fit_series = full.noise;
             base.heldback_error_fit_series = full.heldback_error;
             base.heldback_noise_fit_series = full.heldback_noise;
             base.full = Some(full);
@@ -128,6 +145,9 @@ impl Analysis {
             base.heldback_error_fit_series =
                 metrics::errors(fd, &b, Some(&base.heldback_fit_series)).normalized_rms_error;
             let renoised = self.renoised(fd, &base.active, &base.fit)?;
+            base.error_fit_series = metrics::errors(fd, &b, None).normalized_rms_error;
+            base.noise_fit_series =
+                metrics::noise_floor(fd, &base.fit_weights, Some((&b, &renoised)));
             base.heldback_noise_fit_series =
                 metrics::noise_floor_on(fd, &base.heldback_fit_series, Some((&b, &renoised)));
         }

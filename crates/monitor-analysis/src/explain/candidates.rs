@@ -190,6 +190,11 @@ impl Analysis {
                     heldback_error,
                     base.heldback_noise_fit_series,
                 ),
+                whole_log_explained_fraction: explained_fraction(
+                    base.error_fit_series,
+                    error,
+                    base.noise_fit_series,
+                ),
                 validation_normalized_rms_error: heldback_error,
                 n_parameters,
                 parameters: me.parameters,

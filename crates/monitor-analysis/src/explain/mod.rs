@@ -4,8 +4,10 @@
 //! [`Analysis::explain`] runs eight stages, each a named function:
 //! 1. a log without voltages gets the unbalance analysis only
 //!    (`Analysis::explain_current_only`, `report.rs`);
-//! 2. the baseline: the configured model fitted and measured on the held-back windows
-//!    (`Analysis::baseline`, `baseline.rs`);
+//! 2. the baseline: the configured model fitted and measured on the held-back windows,
+//!    split as the ladder's by the log's events ([`ladder::stratified_heldback`]) so that
+//!    each kind of event the log holds is in both parts (`Analysis::baseline`,
+//!    `baseline.rs`);
 //! 3. its base parameters refitted, with what the log identifies of them
 //!    (`Analysis::base_refit`, [`super::refit`]);
 //! 4. whether its error is structural: the always-present dynamics missing through a
@@ -71,28 +73,18 @@ impl Standing {
         }
     }
 }
-/// A baseline within this factor of the noise floor has nothing left to explain
-/// (1.12 = a model error beyond the noise of half the noise floor).
+
+/// A baseline within this factor of its noise floor on the whole log and on the held-back
+/// windows has nothing left to explain (1.12 = a model error beyond the noise of half the
+/// noise floor). There is no absolute cut-off: an error is only ever judged against its
+/// floor.
 pub const NOISE_MARGIN: f64 = 1.12;
-/// Below this `normalized_rms_error` (0.4 %) the model is as good as the frame estimate and
-/// the working-rate reconstruction allow; nothing is claimed even on noise-free data.
-pub const MIN_MODEL_ERROR: f64 = 0.004;
 /// Ranking penalty per parameter: a candidate's held-back error is multiplied by
 /// `1 + PARAM_PENALTY * n_parameters`, so a richer effect must fit clearly better.
 pub const PARAM_PENALTY: f64 = 0.02;
-/// Interleaved held-back windows for ranking (the log is cut into 2x this many windows).
-///
-/// A fixed interleave can alias with a log's events. With 5 (10 windows), a 3.4 s log's
-/// start and three supply steps all fell in training windows, and thermal drift on an
-/// 11 kW machine, seen mostly in the transients, read as unexplained; with 10, the one
-/// flux peak of a 7 s voltage sweep fell only in held-back windows, and the saturation fit
-/// had to extrapolate past its knee there. 8 serves both (docs/model-vs-measurement.md, "How it works"); a
-/// split stratified by the operating point is the real fix and is not built.
-pub const HOLDOUT_WINDOWS: usize = 8;
-
 /// Fraction of the model error beyond the sensor noise that a candidate removes:
-/// `1 - S_with / S_base`, `S = sqrt(max(E^2 - N^2, 0))` (E the held-back error, N the
-/// noise floor), clamped to 0..1. A candidate that brings the error down to the noise floor
+/// `1 - S_with / S_base`, `S = sqrt(max(E^2 - N^2, 0))` (E the held-back or the whole-log
+/// error, N the noise floor measured the same way), clamped to 0..1. A candidate that brings the error down to the noise floor
 /// explains everything there was to explain. When the baseline's excess `S_base` is below
 /// half the noise floor (the baseline within [`NOISE_MARGIN`] of it) there is nothing to
 /// explain and the fraction is 0: a ratio of two noise-sized numbers means nothing.
@@ -117,9 +109,12 @@ pub struct EffectCandidate {
     pub standing: Standing,
     /// `normalized_rms_error` over the whole log with this effect added.
     pub normalized_rms_error: f64,
-    /// Fraction of the held-back model error beyond the noise floor explained
-    /// (see [`explained_fraction`]).
+    /// Fraction (0..1) of the held-back model error beyond the held-back noise floor the
+    /// effect removes ([`explained_fraction`]); what its standing is judged on.
     pub explained_fraction: f64,
+    /// Fraction (0..1) of the whole-log model error beyond the whole-log noise floor the
+    /// effect removes: [`explained_fraction`] on the whole-log errors and floor.
+    pub whole_log_explained_fraction: f64,
     /// `normalized_rms_error` on the held-back windows.
     pub validation_normalized_rms_error: f64,
     /// Number of parameters the effect adds.

@@ -2,10 +2,7 @@
 //! (nothing left to explain, or nothing explained well enough).
 
 use super::baseline::FullSeries;
-use super::{
-    EffectCandidate, Standing, EXPLAINED_MIN, EXPLAINS_MIN, MIN_MODEL_ERROR, NOISE_MARGIN,
-    PARAM_PENALTY,
-};
+use super::{EffectCandidate, Standing, EXPLAINED_MIN, EXPLAINS_MIN, NOISE_MARGIN, PARAM_PENALTY};
 use crate::effects::{self, EffectEvidence, FitSetup};
 use crate::fit::FitResult;
 use crate::unbalance::UnbalanceAnalysis;
@@ -32,8 +29,9 @@ impl RankedCandidate {
 /// whether no plausible candidate explains enough of it.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct CandidateOutcome {
-    /// The configured model's held-back error is within [`NOISE_MARGIN`] of the noise
-    /// floor, or below [`MIN_MODEL_ERROR`]: nothing to explain.
+    /// The configured model's whole-log error is within [`NOISE_MARGIN`] of the whole-log
+    /// noise floor and its held-back error within [`NOISE_MARGIN`] of the held-back floor:
+    /// nothing to explain. One of the two within the band is not enough.
     pub(super) near_noise: bool,
     /// No plausible candidate first explains [`EXPLAINED_MIN`] of the held-back error (or
     /// there is nothing to explain).
@@ -49,8 +47,8 @@ impl CandidateOutcome {
             .filter(|c| c.candidate.plausible)
             .map(|c| c.candidate.explained_fraction)
             .unwrap_or(0.0);
-        let near_noise =
-            full.heldback_error <= (NOISE_MARGIN * full.heldback_noise).max(MIN_MODEL_ERROR);
+        let near_noise = full.error <= NOISE_MARGIN * full.noise
+            && full.heldback_error <= NOISE_MARGIN * full.heldback_noise;
         CandidateOutcome {
             near_noise,
             unexplained: best < EXPLAINED_MIN || near_noise,
@@ -130,5 +128,36 @@ pub(super) fn stand(ranked: &mut [RankedCandidate]) {
             k += 1;
             k
         });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{CandidateOutcome, FullSeries};
+    use crate::simplified_model::Prediction;
+
+    fn full(error: f64, noise: f64, heldback_error: f64, heldback_noise: f64) -> FullSeries {
+        FullSeries {
+            before: Prediction::default(),
+            error,
+            heldback_error,
+            noise,
+            heldback_noise,
+        }
+    }
+
+    #[test]
+    fn nothing_to_explain_needs_both_errors_within_the_band() {
+        let near = |f: &FullSeries| CandidateOutcome::of(&[], f).near_noise;
+        // Both within 1.12x their floors, however small or large the numbers.
+        assert!(near(&full(0.0021, 0.0020, 0.0023, 0.0022)));
+        assert!(near(&full(0.011, 0.010, 0.020, 0.019)));
+        // The issue-62 example: the whole log 13x its floor, the held-back part near its
+        // own (and under the former 0.004 cut-off): something to explain.
+        assert!(!near(&full(0.0242, 0.0019, 0.0021, 0.0020)));
+        // The held-back error beyond the band, the whole log within it.
+        assert!(!near(&full(0.0021, 0.0020, 0.0030, 0.0022)));
+        // A tiny error far above a tiny floor (a noise-free log) is no floor.
+        assert!(!near(&full(0.0010, 0.0001, 0.0010, 0.0001)));
     }
 }

@@ -4,10 +4,7 @@
 
 use super::baseline::{ExplainBaseline, FullSeries};
 use super::ranking::{CandidateOutcome, RankedCandidate};
-use super::{
-    ExplainOutput, ExplainReport, Standing, EXPLAINED_MIN, EXPLAINS_MIN, MIN_MODEL_ERROR,
-    NOISE_MARGIN,
-};
+use super::{ExplainOutput, ExplainReport, Standing, EXPLAINED_MIN, EXPLAINS_MIN, NOISE_MARGIN};
 use crate::effects::SetupError;
 use crate::fit::{ActiveEffect, FittedModel};
 use crate::refit::BaseRefit;
@@ -269,10 +266,7 @@ fn verdict(
 ) -> String {
     let (full, o) = (&found.full, found.outcome);
     match best {
-        _ if o.near_noise => format!(
-            "nothing to explain: the model's error {:.4} (held-back {:.4}) is within {:.2}x the noise floor {:.4} (held-back {:.4}) or below {:.3}",
-            full.error, full.heldback_error, NOISE_MARGIN, full.noise, full.heldback_noise, MIN_MODEL_ERROR
-        ),
+        _ if o.near_noise => nothing_to_explain(full),
         Some(r) if !o.unexplained => {
             let c = &r.candidate;
             format!(
@@ -306,4 +300,19 @@ fn verdict(
         ),
         None => "unexplained: no candidate could be fitted with physically plausible values".into(),
     }
+}
+
+/// The verdict when the configured model is at its noise floor ([`CandidateOutcome`]),
+/// naming the numbers that decided: the whole-log and the held-back error, each against
+/// its own floor.
+fn nothing_to_explain(full: &FullSeries) -> String {
+    format!(
+        "nothing to explain: the model's error {:.4} is {:.2}x its noise floor {:.4} and the held-back error {:.4} is {:.2}x its floor {:.4} (both within {NOISE_MARGIN}x)",
+        full.error,
+        full.error / full.noise,
+        full.noise,
+        full.heldback_error,
+        full.heldback_error / full.heldback_noise,
+        full.heldback_noise,
+    )
 }

@@ -297,16 +297,16 @@ fn explain_html(log: &str, doc: &ExplainDocument, charts: &[(String, String)]) -
     }
     data_quality(&mut h, &r.data_quality);
     let _ = write!(h, "<p>Error of the model as configured: {:.4} (whole log), {:.4} on the held-back windows the fits never saw; noise floor {:.4}. Each candidate below was added to the model and fitted together with the base parameters; ranking is by the held-back error, so an effect that only fits noise does not win.</p>", r.baseline_normalized_rms_error, r.baseline_validation_normalized_rms_error, r.noise_floor);
-    h.push_str("<table><tr><th>rank</th><th class=l>effect</th><th>error</th><th>held-back error</th><th>explained</th><th>params</th><th class=l>fitted, in words</th></tr>");
+    h.push_str("<table><tr><th>rank</th><th class=l>effect</th><th>error</th><th>held-back error</th><th>explained (whole / held-back)</th><th>params</th><th class=l>fitted, in words</th></tr>");
     // Ranked candidates, then those with no effect, then those not plausible (no rank).
     for c in &r.ranking {
         let rank = c.rank.map_or_else(
             || format!("[{}]", c.standing.name().replace('_', " ")),
             |k| k.to_string(),
         );
-        let _ = write!(h, "<tr><td>{rank}</td><td class=l>{}</td><td>{:.4}</td><td>{:.4}</td><td>{:.0} %</td><td>{}</td><td class=l>{}</td></tr>", c.effect, c.normalized_rms_error, c.validation_normalized_rms_error, 100.0 * c.explained_fraction, c.n_parameters, esc(&c.summary));
+        let _ = write!(h, "<tr><td>{rank}</td><td class=l>{}</td><td>{:.4}</td><td>{:.4}</td><td>{:.0} % / {:.0} %</td><td>{}</td><td class=l>{}</td></tr>", c.effect, c.normalized_rms_error, c.validation_normalized_rms_error, 100.0 * c.whole_log_explained_fraction, 100.0 * c.explained_fraction, c.n_parameters, esc(&c.summary));
     }
-    h.push_str("</table>");
+    h.push_str("</table><p><i>explained: the share of the error beyond the noise floor the effect removes, whole log / held-back windows</i></p>");
     if let Some(c) = r.ranking.first().filter(|c| c.rank.is_some()) {
         let _ = write!(h, "<h2>Before / after</h2><table><tr><th class=l>model</th><th>held-back windows</th><th>whole log</th></tr><tr><td class=l>as configured</td><td>{:.4}</td><td>{:.4}</td></tr><tr><td class=l>+ {}</td><td>{:.4}</td><td>{:.4}</td></tr></table>", r.baseline_validation_normalized_rms_error, r.baseline_normalized_rms_error, c.effect, c.validation_normalized_rms_error, c.normalized_rms_error);
     }

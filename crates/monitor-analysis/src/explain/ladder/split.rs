@@ -163,7 +163,7 @@ fn alternate(
 }
 
 /// The held-back mask of `d`'s coarse copy `fd` (samples at the same times).
-pub(super) fn mask_on(fd: &Prepared, d: &Prepared, held: &[bool]) -> Vec<bool> {
+pub(crate) fn mask_on(fd: &Prepared, d: &Prepared, held: &[bool]) -> Vec<bool> {
     fd.t_s
         .iter()
         .map(|t| {
@@ -177,7 +177,7 @@ pub(super) fn mask_on(fd: &Prepared, d: &Prepared, held: &[bool]) -> Vec<bool> {
 }
 
 /// The weights of a fit on `d` that trains on the samples `held` does not hold back.
-pub(super) fn weights_for(d: &Prepared, held: &[bool], max_fit: usize) -> Weights {
+pub(crate) fn weights_for(d: &Prepared, held: &[bool], max_fit: usize) -> Weights {
     let mut w = Weights::new(d, 0, max_fit);
     w.train = held.iter().map(|h| !h).collect();
     w

@@ -192,20 +192,27 @@ fn ranking(out: &mut impl Write, r: &ExplainReport) -> anyhow::Result<()> {
         )?;
         writeln!(
             out,
-            "  {:<4} {:<18} {:>10} {:>10} {:>10}  fitted",
+            "  {:<4} {:<18} {:>10} {:>10} {:>11}  fitted",
             "rank", "effect", "error", "held-back", "explained"
         )?;
     }
-    for k in ranked {
+    for k in &ranked {
         writeln!(
             out,
-            "  {:<4} {:<18} {:>10} {:>10} {:>9.0}%  {}",
+            "  {:<4} {:<18} {:>10} {:>10} {:>4.0}% / {:>3.0}%  {}",
             k.rank.unwrap_or_default(),
             k.effect.name(),
             number(k.normalized_rms_error),
             number(k.validation_normalized_rms_error),
+            100.0 * k.whole_log_explained_fraction,
             100.0 * k.explained_fraction,
             k.summary
+        )?;
+    }
+    if !ranked.is_empty() {
+        writeln!(
+            out,
+            "  (explained: the share of the error beyond the noise floor the effect removes, whole log / held-back windows)"
         )?;
     }
     apart(out, r)
