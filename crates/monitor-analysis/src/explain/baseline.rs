@@ -2,7 +2,7 @@
 //! every candidate is compared with), its base parameters refitted with what the log
 //! identifies of them, and whether its error is structural.
 
-use super::ladder::{mask_on, stratified_heldback, weights_for};
+use super::HOLDOUT_WINDOWS;
 use crate::effects::EffectModel;
 use crate::fit::{self, ActiveEffect, FitResult};
 use crate::metrics::{self, Weights};
@@ -22,12 +22,9 @@ pub(super) struct ExplainBaseline<'a> {
     pub(super) fit_weights: Weights,
     /// Training/held-back split on the working series.
     pub(super) weights: Weights,
-    /// The held-back mask of the working series, stratified by the log's events as the
-    /// ladder's ([`stratified_heldback`]: the start, transients, load moves and steady
-    /// stretches each fall in both parts).
+    /// The held-back mask of the working series ([`HOLDOUT_WINDOWS`]).
     pub(super) heldback: Vec<bool>,
-    /// The held-back mask of the fit series (the working series' carried over,
-    /// [`mask_on`]).
+    /// The held-back mask of the fit series.
     pub(super) heldback_fit_series: Vec<bool>,
     /// The configured effects set up on the fit series.
     pub(super) active: Vec<ActiveEffect<'a>>,
@@ -90,18 +87,13 @@ impl Analysis {
         opts: &Options,
     ) -> Result<ExplainBaseline<'a>, AnalysisError> {
         let (fd, m) = self.fit_data();
-        // The ladder's split: every kind of event the log holds in both parts.
-        let (heldback, _) = stratified_heldback(&self.data, &self.constants);
-        let heldback_fit_series = if m == 1 {
-            heldback.clone()
-        } else {
-            mask_on(&fd, &self.data, &heldback)
-        };
-        let wf = weights_for(&fd, &heldback_fit_series, MAX_FIT_SAMPLES);
-        let w_full = weights_for(&self.data, &heldback, usize::MAX);
+        let wf = Weights::new(&fd, HOLDOUT_WINDOWS, MAX_FIT_SAMPLES);
+        let w_full = Weights::new(&self.data, HOLDOUT_WINDOWS, usize::MAX);
+        let heldback: Vec<bool> = w_full.train.iter().map(|t| !t).collect();
         let active = self.setup_all(&fd, configured)?;
         let nominal = BaseParams::nominal(&self.constants);
         let f0 = self.fit_set(&fd, &active, &wf, &nominal, opts.fit_base)?;
+        let heldback_fit_series: Vec<bool> = wf.train.iter().map(|t| !t).collect();
         let span = transients::Span::of(&fd, &self.constants);
         let mut base = ExplainBaseline {
             fit_series: fd,
