@@ -46,7 +46,7 @@ use crate::{resolve, transients, Analysis, AnalysisError, Options};
 use monitor_core::EffectKind;
 use round::{pairs_of, LadderSeries, Rung, Starts};
 use serde::Serialize;
-pub(crate) use split::{mask_on, weights_for};
+use split::{mask_on, weights_for};
 use std::collections::BTreeMap;
 
 /// A step must remove at least this share (10 %) of the held-back error beyond the noise
