@@ -34,6 +34,23 @@
 //!   extra drop `dR i_a` on phase a enters the space-vector equation as its
 //!   amplitude-invariant transform `(2/3) dR i_a` along alpha (its zero-sequence third is
 //!   taken up by the star point's shift).
+//! * `rotor_asymmetry`: a rotor cage asymmetry, rotor phase a's resistance `R_r (1 + delta)`
+//!   (broken bars: [`broken_bars_delta`]). In the rotor's own two-axis frame (amplitude
+//!   invariant Clarke of the three rotor phases, star-connected with no zero sequence) the
+//!   extra drop `dR i_ra` on rotor phase a, `dR = delta R_r`, transforms like the stator's:
+//!   `(2/3) dR i_ra` along the rotor's a axis, and `i_ra = e . i_r` with `e` that axis's unit
+//!   vector; the resistance matrix is `R_r I + (2/3) dR e e^T`. Rotated into the stationary
+//!   frame (rotation keeps the form, `e e^T -> e' e'^T`), `e = (cos theta_r, sin theta_r)`
+//!   with `theta_r = int w_r dt` the electrical rotor angle (the state's last element):
+//!   ```text
+//!   d psi_r / dt = -R_r i_r - (2/3) dR (e . i_r) e + j w_r psi_r
+//!   ```
+//!   The extra rotor copper loss is `1.5 (2/3) dR (e . i_r)^2 = dR i_ra^2`, phase a's own.
+//!   Seen from the stator, the asymmetric rotor field has a backward component at
+//!   `-s f` in rotor coordinates, i.e. `(1 - 2 s) f` in the stator: the classic sideband.
+//!   Sized as `n` adjacent broken bars of an `N`-bar cage with the usual approximation
+//!   `delta = 3 n / (N - 3 n)` (the project's `monitor-sim` uses it too; this module only
+//!   shares the formula).
 //!
 //! The energy the model stores is `W = 1.5 (L_ls |i_s|^2 / 2 + L_lr |i_r|^2 / 2 +
 //! int_0^|psi_m| i_m(psi) d psi)` plus `J w_m^2 / 2`; `textbook_machine_physics.rs` checks
@@ -208,6 +225,19 @@ pub struct Hidden {
     pub saturation: Option<f64>,
     /// Extra resistance of stator phase a [ohm].
     pub phase_asymmetry: Option<f64>,
+    /// Rotor phase a's resistance raised to `R_r (1 + delta)`: `delta` (relative).
+    pub rotor_asymmetry: Option<f64>,
+}
+
+/// The rotor asymmetry `delta = 3 n / (N - 3 n)` of `n` adjacent broken bars of an `N`-bar
+/// cage, and back: `n = delta N / (3 (1 + delta))`.
+pub fn broken_bars_delta(n: f64, bars: f64) -> f64 {
+    3.0 * n / (bars - 3.0 * n)
+}
+
+/// The number of adjacent broken bars of an `N`-bar cage for an asymmetry `delta`.
+pub fn broken_bars_of(delta: f64, bars: f64) -> f64 {
+    delta * bars / (3.0 * (1.0 + delta))
 }
 
 /// The supply: a piecewise-linear profile of (t [s], voltage scale, frequency scale);
@@ -294,9 +324,10 @@ impl Scenario {
     }
 }
 
-/// The state: psi_s (alpha, beta), psi_r (alpha, beta), w_m, the supply angle theta and
-/// three energy integrals (input, copper losses, mechanical output incl. friction).
-pub type State = [f64; 9];
+/// The state: psi_s (alpha, beta), psi_r (alpha, beta), w_m, the supply angle theta,
+/// three energy integrals (input, copper losses, mechanical output incl. friction) and the
+/// electrical rotor angle theta_r (used by `rotor_asymmetry` only).
+pub type State = [f64; 10];
 
 /// Everything derived from a state at a time.
 #[derive(Clone, Copy, Debug, Default)]
@@ -314,6 +345,8 @@ pub struct Point {
     pub w_mag: f64,
     pub rs: f64,
     pub rr: f64,
+    /// The rotor asymmetry's extra drop `(2/3) dR (e . i_r) e` (zero without it).
+    pub rotor_drop: [f64; 2],
 }
 
 /// The model's right-hand side.
@@ -420,6 +453,20 @@ impl Model<'_> {
         }
     }
 
+    /// The rotor asymmetry's extra drop `(2/3) dR (e . i_r) e` and its copper loss, written
+    /// as rotor phase a's own `dR i_ra^2` (`i_ra = e . i_r`), not from the drop, so that the
+    /// energy balance checks the drop's `2/3` and sign (both zero without it).
+    fn rotor_drop(&self, x: &State, ir: [f64; 2], rr: f64) -> ([f64; 2], f64) {
+        let Some(delta) = self.s.hidden.rotor_asymmetry else {
+            return ([0.0, 0.0], 0.0);
+        };
+        let dr = delta * rr;
+        let e = [x[9].cos(), x[9].sin()];
+        let ira = e[0] * ir[0] + e[1] * ir[1];
+        let k = 2.0 / 3.0 * dr * ira;
+        ([k * e[0], k * e[1]], dr * ira * ira)
+    }
+
     pub fn point(&self, t: f64, x: &State) -> Point {
         let m = self.m;
         let h = &self.s.hidden;
@@ -441,10 +488,14 @@ impl Model<'_> {
             t_out += k * w * w.abs();
         }
         let dr = h.phase_asymmetry.unwrap_or(0.0) * heat;
+        let (rotor_drop, p_rotor) = self.rotor_drop(x, ir, rr);
         let p_in = 1.5 * (v[0] * is[0] + v[1] * is[1]);
-        let p_cu = 1.5
+        let mut p_cu = 1.5
             * (rs * (is[0] * is[0] + is[1] * is[1]) + rr * (ir[0] * ir[0] + ir[1] * ir[1]))
             + dr * is[0] * is[0];
+        if h.rotor_asymmetry.is_some() {
+            p_cu += p_rotor;
+        }
         let pmn = psi_m[0].hypot(psi_m[1]);
         let w_mag = 1.5
             * (0.5 * m.lls * (is[0] * is[0] + is[1] * is[1])
@@ -462,6 +513,7 @@ impl Model<'_> {
             w_mag,
             rs,
             rr,
+            rotor_drop,
         }
     }
 
@@ -479,19 +531,20 @@ impl Model<'_> {
         [
             p.v[0] - p.rs * p.is[0] - 2.0 / 3.0 * da * p.is[0],
             p.v[1] - p.rs * p.is[1],
-            -p.rr * p.ir[0] - wr * x[3],
-            -p.rr * p.ir[1] + wr * x[2],
+            -p.rr * p.ir[0] - wr * x[3] - p.rotor_drop[0],
+            -p.rr * p.ir[1] + wr * x[2] - p.rotor_drop[1],
             dw,
             2.0 * PI * m.f_hz * fs,
             p.p_in,
             p.p_cu,
             p.t_out * x[4],
+            wr,
         ]
     }
 
     /// The initial state: zero flux, standstill (or the held speed).
     pub fn initial(&self) -> State {
-        let mut x = [0.0; 9];
+        let mut x = [0.0; 10];
         x[4] = self.s.hold_speed.unwrap_or(0.0);
         x
     }
