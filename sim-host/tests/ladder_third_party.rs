@@ -1,0 +1,507 @@
+//! `explain --ladder` on logs of a third-party simulator with the parameter file a user has
+//! (issue 73's guard). The logs are motulator's induction machine (the version in
+//! `tools/motulator-logs/requirements.txt`), made by `tools/motulator-logs/generate.py` into
+//! `tests/data/motulator/`: three machines (motulator's 2.2 kW, a 7.5 kW Simscape preset,
+//! Krause's 50 hp), direct-on-line starts with variac steps and a long V/f log, 12-bit
+//! sensors with noise of about one LSB. Each log's parameter file is what a user derives
+//! from the nameplate, a DC resistance, a no-load and a locked-rotor test (IEEE 112): never
+//! the simulator's values. `manifest.toml` there says, per log, the hidden effects and their
+//! true sizes, the effects the log's physics allows besides them (the dynamics effects on a
+//! start; `load_torque` where the load is a torque) and the effects that are the same term
+//! on that log.
+//!
+//! Bars (issue 73, "Done when"), over the manifest's logs:
+//! * (a) at least 90 % of the hidden effects named: in the ladder's `final_effects` (or a
+//!   same-term equivalent the manifest lists); a warm stator (`warm_stator`, size s) counts
+//!   as named when the ladder reports a base change of `rs` within 5 % of s (+20 %:
+//!   0.19..0.21);
+//! * (b) no effect named that is neither hidden nor allowed on its log;
+//! * (c) the whole-log error never rises along the ladder (base and effect rungs), every log;
+//! * (d) the end within 2x the noise floor or 5x below the start on at least 90 % of the logs;
+//! * (e) no change of `rs` beyond 3 % on the logs whose stator is at the file's temperature.
+//!
+//! The ladder's JSON read here: `start` {error, ...}; `ladder`, the rungs in order, each
+//! with `error` and `ratio_to_floor`; an effect rung with `effect`, `added` and perhaps
+//! `dropped` (earlier effects a later one explains), a base rung with `base` (rs, rr, lls,
+//! llr, lm, j, b), `change` (relative: 0.19 = +19 %) and `interval`; `final_effects`;
+//! `base_changes` (a list of {base, change, interval}). A JSON without base changes counts
+//! a warm stator as missed.
+//!
+//! Part of the full sweeps only: `cargo test` skips it with a note, and
+//! ```text
+//! MONITOR_FULL_SWEEPS=1 cargo test --release -p sim-host --test ladder_third_party -- --nocapture
+//! ```
+//! runs it (about 12 logs, one at a time; the table goes to stderr).
+#![allow(missing_docs)]
+
+use assert_cmd::Command;
+use monitor_testkit::analysis_common::in_this_run;
+use serde::Deserialize;
+use serde_json::Value;
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+/// The folder of the logs, their parameter files and the manifest.
+fn data() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/motulator")
+}
+
+#[derive(Deserialize)]
+struct Manifest {
+    log: Vec<Entry>,
+}
+
+/// One log as the manifest describes it (the fields the bars need).
+#[derive(Deserialize, Clone)]
+struct Entry {
+    name: String,
+    csv: String,
+    /// The CSV's size as the generator wrote it (a hand-edited log is refused).
+    bytes: u64,
+    params: String,
+    hidden: Vec<String>,
+    allowed: Vec<String>,
+    /// (hidden, named, why): on this log `named` is the same term as `hidden`.
+    equivalent: Vec<Vec<String>>,
+    stator_at_file_temperature: bool,
+    /// The stator's resistance over the file's, less one, where it is warm.
+    warm_stator: Option<f64>,
+}
+
+/// The pseudo-effect of a warm stator: a base change of rs, not a library effect.
+const WARM: &str = "warm_stator";
+/// Relative tolerance on a warm stator's base change of rs (its size's 5 %).
+const WARM_TOL: f64 = 0.05;
+/// Largest |rs change| on a log whose stator is at the file's temperature.
+const RS_STILL: f64 = 0.03;
+
+/// A base change: the parameter, its relative change, its interval.
+#[derive(Clone, Debug)]
+struct Base {
+    name: String,
+    change: f64,
+    interval: Option<(f64, f64)>,
+}
+
+/// What the ladder did on one log.
+struct Outcome {
+    entry: Entry,
+    /// Effects in the model at the end (`final_effects`).
+    named: BTreeSet<String>,
+    /// Every effect some rung added, and every effect some rung dropped.
+    added: BTreeSet<String>,
+    dropped: BTreeSet<String>,
+    base: Vec<Base>,
+    /// Whether the JSON carries base changes at all (top-level or as rungs).
+    has_base: bool,
+    /// start.error, then each rung's error.
+    errors: Vec<f64>,
+    end_ratio: f64,
+    /// Each rung: what it did, its error and ratio to the floor.
+    rungs: Vec<(String, f64, f64)>,
+    stop: String,
+    stopped_because: String,
+    seconds: f64,
+    /// The command failed (its stderr).
+    failed: Option<String>,
+}
+
+fn strings(v: &Value) -> Vec<String> {
+    v.as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|s| s.as_str().map(str::to_string))
+        .collect()
+}
+
+fn num(v: &Value) -> f64 {
+    v.as_f64().unwrap_or(f64::NAN)
+}
+
+fn base_of(v: &Value) -> Option<Base> {
+    let name = v["base"].as_str()?.to_string();
+    let i = v["interval"].as_array();
+    let interval = i.filter(|i| i.len() == 2).map(|i| (num(&i[0]), num(&i[1])));
+    Some(Base {
+        name,
+        change: num(&v["change"]),
+        interval,
+    })
+}
+
+fn run(e: &Entry) -> Outcome {
+    let t = std::time::Instant::now();
+    let out = Command::cargo_bin("sim-host")
+        .expect("the sim-host binary")
+        .args(["explain", "--ladder", "--json", "--params"])
+        .arg(data().join(&e.params))
+        .arg(data().join(&e.csv))
+        .output()
+        .expect("run sim-host");
+    let mut o = Outcome {
+        entry: e.clone(),
+        named: BTreeSet::new(),
+        added: BTreeSet::new(),
+        dropped: BTreeSet::new(),
+        base: Vec::new(),
+        has_base: false,
+        errors: Vec::new(),
+        end_ratio: f64::NAN,
+        rungs: Vec::new(),
+        stop: "error".into(),
+        stopped_because: String::new(),
+        seconds: t.elapsed().as_secs_f64(),
+        failed: None,
+    };
+    if !out.status.success() {
+        o.failed = Some(String::from_utf8_lossy(&out.stderr).into_owned());
+        return o;
+    }
+    let j: Value = serde_json::from_slice(&out.stdout).expect("one JSON document");
+    o.errors.push(num(&j["start"]["error"]));
+    o.end_ratio = num(&j["start"]["ratio_to_floor"]);
+    for r in j["ladder"].as_array().into_iter().flatten() {
+        o.errors.push(num(&r["error"]));
+        o.end_ratio = num(&r["ratio_to_floor"]);
+        let what = if let Some(b) = base_of(r) {
+            let w = format!("base {} {:+.1} %", b.name, 100.0 * b.change);
+            o.base.push(b);
+            w
+        } else {
+            let (a, d) = (strings(&r["added"]), strings(&r["dropped"]));
+            o.added.extend(a.iter().cloned());
+            o.dropped.extend(d.iter().cloned());
+            let mut w = format!("+{}", a.join(" +"));
+            if !d.is_empty() {
+                w += &format!(" -{}", d.join(" -"));
+            }
+            w
+        };
+        o.rungs
+            .push((what, num(&r["error"]), num(&r["ratio_to_floor"])));
+    }
+    if let Some(list) = j["base_changes"].as_array() {
+        o.base = list.iter().filter_map(base_of).collect();
+        o.has_base = true;
+    }
+    o.has_base |= !o.base.is_empty();
+    o.named = match j.get("final_effects") {
+        Some(f) => strings(f).into_iter().collect(),
+        None => o.added.difference(&o.dropped).cloned().collect(),
+    };
+    o.stop = j["stop"].as_str().unwrap_or_default().to_string();
+    o.stopped_because = j["stopped_because"]
+        .as_str()
+        .unwrap_or_default()
+        .to_string();
+    o
+}
+
+impl Outcome {
+    /// The change of `rs` the ladder reports (0 when it reports none).
+    fn rs_change(&self) -> f64 {
+        self.base
+            .iter()
+            .find(|b| b.name == "rs")
+            .map_or(0.0, |b| b.change)
+    }
+
+    /// (a) for one hidden item of this log.
+    fn names(&self, hidden: &str) -> bool {
+        if hidden == WARM {
+            let size = self.entry.warm_stator.unwrap_or(f64::NAN);
+            return self
+                .base
+                .iter()
+                .any(|b| b.name == "rs" && (b.change - size).abs() <= WARM_TOL * size.abs());
+        }
+        self.named.contains(hidden)
+            || self
+                .entry
+                .equivalent
+                .iter()
+                .any(|e| e.len() >= 2 && e[0] == hidden && self.named.contains(&e[1]))
+    }
+
+    /// (b): the effects named that are neither hidden, allowed nor a hidden one's equivalent.
+    fn wrong(&self) -> Vec<String> {
+        let e = &self.entry;
+        self.named
+            .iter()
+            .filter(|n| {
+                !e.hidden.contains(n)
+                    && !e.allowed.contains(n)
+                    && !e
+                        .equivalent
+                        .iter()
+                        .any(|q| q.len() >= 2 && &q[1] == *n && e.hidden.contains(&q[0]))
+            })
+            .cloned()
+            .collect()
+    }
+
+    /// (c): the whole-log error never rises (a relative 1e-9 for rounding).
+    fn error_never_rises(&self) -> bool {
+        self.errors.windows(2).all(|w| w[1] <= w[0] * (1.0 + 1e-9))
+    }
+
+    /// (d): ends within 2x the floor or 5x below the start's error.
+    fn ends_low(&self) -> bool {
+        match (self.errors.first(), self.errors.last()) {
+            (Some(f), Some(l)) => self.end_ratio <= 2.0 || l * 5.0 <= *f,
+            _ => false,
+        }
+    }
+
+    fn base_text(&self) -> String {
+        if !self.has_base {
+            return "(none in the JSON)".into();
+        }
+        let b: Vec<String> = self
+            .base
+            .iter()
+            .map(|b| match b.interval {
+                Some((lo, hi)) => format!(
+                    "{} {:+.0}% [{:+.0},{:+.0}]",
+                    b.name,
+                    100.0 * b.change,
+                    100.0 * lo,
+                    100.0 * hi
+                ),
+                None => format!("{} {:+.0}%", b.name, 100.0 * b.change),
+            })
+            .collect();
+        if b.is_empty() {
+            "none".into()
+        } else {
+            b.join(", ")
+        }
+    }
+
+    fn non_dynamics(&self, set: &BTreeSet<String>) -> String {
+        let v: Vec<&str> = set
+            .iter()
+            .map(String::as_str)
+            .filter(|n| !n.ends_with("_dynamics"))
+            .collect();
+        if v.is_empty() {
+            "-".into()
+        } else {
+            v.join(",")
+        }
+    }
+
+    fn details(&self) -> String {
+        match &self.failed {
+            Some(err) => format!("{}: sim-host failed: {err}", self.entry.name),
+            None => {
+                let rungs: Vec<String> = self
+                    .rungs
+                    .iter()
+                    .map(|(w, e, r)| format!("{w} (error {e:.3e}, {r:.2}x floor)"))
+                    .collect();
+                format!(
+                    "{}: start error {:.3e}; rungs: [{}]; base changes: {}; stop {}: {}",
+                    self.entry.name,
+                    self.errors[0],
+                    rungs.join(", "),
+                    self.base_text(),
+                    self.stop,
+                    self.stopped_because
+                )
+            }
+        }
+    }
+}
+
+fn table(outcomes: &[Outcome]) {
+    eprintln!(
+        "{:<22} {:<30} {:<34} {:<28} {:>7} {:>9} {:>9} {:>6}",
+        "log",
+        "hidden",
+        "named (non-dynamics)",
+        "base changes",
+        "end/flr",
+        "start err",
+        "end err",
+        "secs"
+    );
+    for o in outcomes {
+        let e = &o.entry;
+        let mut named = o.non_dynamics(&o.named);
+        let gone = o.non_dynamics(&o.dropped);
+        if gone != "-" {
+            named += &format!(" (dropped {gone})");
+        }
+        eprintln!(
+            "{:<22} {:<30} {:<34} {:<28} {:>7.2} {:>9.3e} {:>9.3e} {:>6.1}",
+            e.name,
+            if e.hidden.is_empty() {
+                "none (control)".to_string()
+            } else {
+                e.hidden.join("+")
+            },
+            named,
+            o.base_text(),
+            o.end_ratio,
+            o.errors.first().copied().unwrap_or(f64::NAN),
+            o.errors.last().copied().unwrap_or(f64::NAN),
+            o.seconds
+        );
+    }
+}
+
+/// Prints a bar's findings; returns the failure, if any.
+fn bar(what: &str, bad: &[String], ok: bool, failure: String) -> Option<String> {
+    eprintln!("{what}");
+    for b in bad {
+        eprintln!("    {b}");
+    }
+    (!ok).then_some(failure)
+}
+
+#[test]
+fn the_ladder_names_the_hidden_effects_of_motulators_logs() {
+    if !in_this_run("ladder_third_party") {
+        return;
+    }
+    let text = std::fs::read_to_string(data().join("manifest.toml")).expect("the manifest");
+    let manifest: Manifest = toml::from_str(&text).expect("a manifest as the generator writes");
+    assert!(manifest.log.len() >= 11, "the manifest lists every log");
+    for e in &manifest.log {
+        let len = std::fs::metadata(data().join(&e.csv)).map_or(0, |m| m.len());
+        assert_eq!(
+            len, e.bytes,
+            "{}: not the generator's file (tools/motulator-logs/generate.py)",
+            e.csv
+        );
+    }
+    let t = std::time::Instant::now();
+    let mut outcomes = Vec::new();
+    for e in &manifest.log {
+        let o = run(e);
+        eprintln!("  done {} ({:.1} s)", e.name, o.seconds);
+        outcomes.push(o);
+    }
+    eprintln!(
+        "{} logs in {:.1} s",
+        outcomes.len(),
+        t.elapsed().as_secs_f64()
+    );
+    table(&outcomes);
+    for o in &outcomes {
+        eprintln!("  {}", o.details());
+    }
+    let mut failures = Vec::new();
+    let crashed: Vec<String> = outcomes
+        .iter()
+        .filter(|o| o.failed.is_some())
+        .map(Outcome::details)
+        .collect();
+    failures.extend(bar(
+        &format!("runs that failed: {}", crashed.len()),
+        &crashed,
+        crashed.is_empty(),
+        format!("sim-host failed on {} logs", crashed.len()),
+    ));
+    // (a)
+    let pairs: Vec<(&Outcome, &str)> = outcomes
+        .iter()
+        .flat_map(|o| o.entry.hidden.iter().map(move |h| (o, h.as_str())))
+        .collect();
+    let missed: Vec<String> = pairs
+        .iter()
+        .filter(|(o, h)| !o.names(h))
+        .map(|(o, h)| match *h {
+            WARM => format!(
+                "{}: warm stator (rs {:+.0} %) missed: base changes {}",
+                o.entry.name,
+                100.0 * o.entry.warm_stator.unwrap_or(f64::NAN),
+                o.base_text()
+            ),
+            _ => format!(
+                "{}: {h} missed; named {}",
+                o.entry.name,
+                o.non_dynamics(&o.named)
+            ),
+        })
+        .collect();
+    let share = 1.0 - missed.len() as f64 / pairs.len().max(1) as f64;
+    failures.extend(bar(
+        &format!(
+            "(a) hidden effects named: {} of {} ({:.0} %; bar 90 %)",
+            pairs.len() - missed.len(),
+            pairs.len(),
+            100.0 * share
+        ),
+        &missed,
+        share >= 0.9,
+        format!("(a) {:.0} % of the hidden effects named", 100.0 * share),
+    ));
+    // (b)
+    let wrong: Vec<String> = outcomes
+        .iter()
+        .filter(|o| !o.wrong().is_empty())
+        .map(|o| format!("{}: {} named", o.entry.name, o.wrong().join(", ")))
+        .collect();
+    failures.extend(bar(
+        &format!(
+            "(b) logs with an effect named that is neither hidden nor allowed: {}",
+            wrong.len()
+        ),
+        &wrong,
+        wrong.is_empty(),
+        format!("(b) a wrong effect named on {} logs", wrong.len()),
+    ));
+    // (c)
+    let rising: Vec<String> = outcomes
+        .iter()
+        .filter(|o| o.failed.is_none() && !o.error_never_rises())
+        .map(|o| format!("errors {:?}: {}", o.errors, o.entry.name))
+        .collect();
+    failures.extend(bar(
+        &format!("(c) logs whose whole-log error rises: {}", rising.len()),
+        &rising,
+        rising.is_empty(),
+        format!("(c) the error rose on {} logs", rising.len()),
+    ));
+    // (d)
+    let high: Vec<String> = outcomes
+        .iter()
+        .filter(|o| !o.ends_low())
+        .map(|o| {
+            format!(
+                "{}: ends at {:.2}x the floor, {:.1}x below the start",
+                o.entry.name,
+                o.end_ratio,
+                o.errors.first().unwrap_or(&f64::NAN) / o.errors.last().unwrap_or(&f64::NAN)
+            )
+        })
+        .collect();
+    let low = 1.0 - high.len() as f64 / outcomes.len().max(1) as f64;
+    failures.extend(bar(
+        &format!(
+            "(d) logs ending within 2x the floor or 5x below the start: {:.0} % (bar 90 %)",
+            100.0 * low
+        ),
+        &high,
+        low >= 0.9,
+        format!("(d) {:.0} % of the logs ended low", 100.0 * low),
+    ));
+    // (e)
+    let moved: Vec<String> = outcomes
+        .iter()
+        .filter(|o| o.entry.stator_at_file_temperature && o.rs_change().abs() > RS_STILL)
+        .map(|o| format!("{}: rs {:+.1} %", o.entry.name, 100.0 * o.rs_change()))
+        .collect();
+    failures.extend(bar(
+        &format!(
+            "(e) logs at the file's stator temperature with rs moved beyond 3 %: {}",
+            moved.len()
+        ),
+        &moved,
+        moved.is_empty(),
+        format!("(e) rs moved beyond 3 % on {} logs", moved.len()),
+    ));
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
