@@ -20,6 +20,8 @@ use super::simplified_model::{
     Prediction, Rotations,
 };
 use nalgebra::DMatrix;
+
+pub mod machine;
 use rayon::prelude::*;
 
 /// An effect set up on the data, with its parameter values.
@@ -48,13 +50,71 @@ pub const PRIOR_WEIGHT: f64 = 0.01;
 /// Number of base parameters.
 pub const N_BASE: usize = 4;
 
+/// Which of the four base parameters a fit frees and how their priors weigh: one prior
+/// standard deviation (15 % of Ra and Ls, 30 % of J, half the B + Bl scale) costs as much
+/// as a normalized error of `prior_weight`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BaseSpec {
+    /// Free parameters, in the order of [`BaseParams`] (Ra, Ls, B + Bl, J).
+    pub free: [bool; N_BASE],
+    /// Free parameters that carry a prior (a parameter without one is held only by its
+    /// bounds).
+    pub prior: [bool; N_BASE],
+    /// The priors' weight (see the type's doc).
+    pub prior_weight: f64,
+}
+
+impl BaseSpec {
+    /// No base parameter free: the start values are kept.
+    pub const FIXED: BaseSpec = BaseSpec {
+        free: [false; N_BASE],
+        prior: [false; N_BASE],
+        prior_weight: PRIOR_WEIGHT,
+    };
+    /// All four free with their priors at [`PRIOR_WEIGHT`] (`compare`'s and `explain`'s
+    /// fit).
+    pub const PAPER: BaseSpec = BaseSpec {
+        free: [true; N_BASE],
+        prior: [true; N_BASE],
+        prior_weight: PRIOR_WEIGHT,
+    };
+
+    /// [`BaseSpec::PAPER`] when `fit_base`, else [`BaseSpec::FIXED`].
+    pub fn paper(fit_base: bool) -> Self {
+        if fit_base {
+            Self::PAPER
+        } else {
+            Self::FIXED
+        }
+    }
+
+    /// The spec for a model with `effects`: an effect that carries a speed-dependent shaft
+    /// torque of its own ([`EffectModel::takes_viscous_part`]: windage, Coulomb friction)
+    /// frees B + Bl without its prior, so that the viscous friction can fall to zero where
+    /// the effect's law carries the whole load (a fan: k w|w| and no viscous load at all).
+    pub fn for_effects(mut self, effects: &[ActiveEffect<'_>]) -> Self {
+        if effects.iter().any(|e| e.effect.takes_viscous_part()) {
+            self.free[2] = true;
+            self.prior[2] = false;
+        }
+        self
+    }
+
+    /// How many prior residuals a fit with this spec has.
+    fn n_priors(&self) -> usize {
+        (0..N_BASE)
+            .filter(|&i| self.free[i] && self.prior[i])
+            .count()
+    }
+}
+
 struct Problem<'a> {
     d: &'a Prepared,
     n: &'a MachineConstants,
     effects: &'a [ActiveEffect<'a>],
     w: &'a Weights,
     btot_scale: f64,
-    fit_base: bool,
+    spec: BaseSpec,
     /// Frame rotations of `d` (the same for every simulation).
     rot: Rotations,
     /// The training samples the residuals use, with their measured channels (fixed).
@@ -74,26 +134,22 @@ impl<'a> Problem<'a> {
     }
 
     /// The problem on `d` (the training samples of `w`, their measured channels fixed);
-    /// with `priors` the base parameters' priors are residuals too.
+    /// the priors of `spec` are residuals too.
     fn new(
         d: &'a Prepared,
         n: &'a MachineConstants,
         effects: &'a [ActiveEffect<'a>],
         w: &'a Weights,
-        priors: bool,
+        spec: BaseSpec,
     ) -> Self {
-        let targets: Vec<(usize, [f64; 5])> = (0..d.len())
-            .step_by(w.stride)
-            .filter(|&k| w.train[k])
-            .map(|k| (k, measured(d, k)))
-            .collect();
+        let targets = training_targets(d, w);
         Problem {
             d,
             n,
             effects,
             w,
             btot_scale: btot_scale(n, d),
-            fit_base: priors,
+            spec,
             rot: rotations(d),
             norm: 1.0 / (targets.len().max(1) as f64).sqrt(),
             targets,
@@ -117,36 +173,26 @@ impl<'a> Problem<'a> {
     /// The residuals of a point the model cannot be run at: 1e3 each (as for a prediction
     /// that ends early).
     fn failed_point(&self) -> Vec<f64> {
-        let priors = if self.fit_base { N_BASE } else { 0 };
-        vec![1e3; self.w.n_channels() * self.targets.len() + priors]
+        vec![1e3; self.w.n_channels() * self.targets.len() + self.spec.n_priors()]
     }
 
     /// The same residuals as [`Weights::residuals`] on the training samples (the measured
     /// side precomputed), plus the priors; `terms` must be [`Problem::terms`] of `x`.
     fn residuals_with(&self, x: &[f64], terms: &ModelTerms) -> Vec<f64> {
         let p = simulate_rot(self.d, &self.rot, self.n, &Self::base(x), terms);
-        let inv = &self.w.inv_rms;
-        let nc = self.w.n_channels();
-        let mut r = Vec::with_capacity(nc * self.targets.len() + N_BASE);
-        for (k, m) in &self.targets {
-            if p.iq.len() <= *k {
-                r.extend(std::iter::repeat_n(1e3, nc));
-                continue;
+        let mut r = data_residuals(self.d, &p, &self.targets, self.w, self.norm, N_BASE);
+        // Weak: with the default weight a 15 % deviation of Ra costs as much as a 0.01
+        // normalized error.
+        let z = [
+            (x[0] - 1.0) / 0.15,
+            (x[1] - 1.0) / 0.15,
+            (x[2] - self.n.btot_nms) / (0.5 * self.btot_scale),
+            (x[3] - 1.0) / 0.3,
+        ];
+        for (i, z) in z.iter().enumerate() {
+            if self.spec.free[i] && self.spec.prior[i] {
+                r.push(self.spec.prior_weight * z);
             }
-            let q = predicted(self.d, &p, *k);
-            for c in 0..5 {
-                if inv[c] > 0.0 {
-                    let e = (q[c] - m[c]) * inv[c] * self.norm;
-                    r.push(if e.is_finite() { e } else { 1e3 });
-                }
-            }
-        }
-        if self.fit_base {
-            // Weak: a 15 % deviation of Ra costs as much as a 0.01 normalized error.
-            r.push(PRIOR_WEIGHT * (x[0] - 1.0) / 0.15);
-            r.push(PRIOR_WEIGHT * (x[1] - 1.0) / 0.15);
-            r.push(PRIOR_WEIGHT * (x[2] - self.n.btot_nms) / (0.5 * self.btot_scale));
-            r.push(PRIOR_WEIGHT * (x[3] - 1.0) / 0.3);
         }
         r
     }
@@ -169,6 +215,47 @@ impl LeastSquares for Problem<'_> {
     fn keeps_cache(&self, i: usize) -> bool {
         i < N_BASE
     }
+}
+
+/// The fit's data residuals of prediction `p` at the training samples `targets` (each with
+/// its measured channels): each channel's error times its weight `1/RMS` and `norm`
+/// (`1/sqrt(number of targets)`), so that their sum of squares is the squared normalized
+/// error; 1e3 where the prediction ended early or is not finite. Room for `extra` more.
+pub(crate) fn data_residuals(
+    d: &Prepared,
+    p: &Prediction,
+    targets: &[(usize, [f64; 5])],
+    w: &Weights,
+    norm: f64,
+    extra: usize,
+) -> Vec<f64> {
+    let inv = &w.inv_rms;
+    let nc = w.n_channels();
+    let mut r = Vec::with_capacity(nc * targets.len() + extra);
+    for (k, m) in targets {
+        if p.iq.len() <= *k {
+            r.extend(std::iter::repeat_n(1e3, nc));
+            continue;
+        }
+        let q = predicted(d, p, *k);
+        for c in 0..5 {
+            if inv[c] > 0.0 {
+                let e = (q[c] - m[c]) * inv[c] * norm;
+                r.push(if e.is_finite() { e } else { 1e3 });
+            }
+        }
+    }
+    r
+}
+
+/// The training samples of `w` on `d` with their measured channels (what
+/// [`data_residuals`] compares with).
+pub(crate) fn training_targets(d: &Prepared, w: &Weights) -> Vec<(usize, [f64; 5])> {
+    (0..d.len())
+        .step_by(w.stride.max(1))
+        .filter(|&k| w.train.get(k).copied().unwrap_or(false))
+        .map(|k| (k, measured(d, k)))
+        .collect()
 }
 
 /// Scale of B+Bl for conditioning and its prior: the larger of the nominal value and the
@@ -225,7 +312,9 @@ fn paired<'e, 'v>(
 }
 
 /// Fits base parameters (unless `fit_base` is false: nominal values are kept) and the
-/// effects' parameters, starting from `start` (base) and each set-up's initial values.
+/// effects' parameters, starting from `start` (base) and each set-up's initial values: the
+/// base parameters as [`BaseSpec::paper`] says, for these effects
+/// ([`BaseSpec::for_effects`]).
 ///
 /// # Errors
 /// [`EffectValuesError`] when an effect refuses its set-up's own values (a set-up whose
@@ -239,7 +328,24 @@ pub fn fit(
     fit_base: bool,
     max_iter: usize,
 ) -> Result<FitResult, EffectValuesError> {
-    let prob = Problem::new(d, n, effects, w, fit_base);
+    let spec = BaseSpec::paper(fit_base).for_effects(effects);
+    fit_spec(d, n, effects, w, start, spec, max_iter)
+}
+
+/// [`fit`] with the base parameters freed and weighed as `spec` says (taken as given).
+///
+/// # Errors
+/// As [`fit`].
+pub fn fit_spec(
+    d: &Prepared,
+    n: &MachineConstants,
+    effects: &[ActiveEffect<'_>],
+    w: &Weights,
+    start: &BaseParams,
+    spec: BaseSpec,
+    max_iter: usize,
+) -> Result<FitResult, EffectValuesError> {
+    let prob = Problem::new(d, n, effects, w, spec);
     let bs = prob.btot_scale;
     let mut x = vec![
         start.ra_scale,
@@ -256,7 +362,9 @@ pub fn fit(
         hi.push(q.hi);
         scale.push(q.scale);
     }
-    let free: Vec<usize> = (0..x.len()).filter(|&i| fit_base || i >= N_BASE).collect();
+    let free: Vec<usize> = (0..x.len())
+        .filter(|&i| i >= N_BASE || spec.free[i])
+        .collect();
     let bounds = lm::Bounds { lo, hi, scale };
     prob.terms(&x)?;
     // From `x`, then from each effect's other starts (`FitSetup::alt_init`, one effect's
@@ -428,7 +536,7 @@ pub fn jacobian(
         return Ok(None);
     }
     // Data residuals only: the priors are not information from the log.
-    let prob = Problem::new(d, n, effects, w, false);
+    let prob = Problem::new(d, n, effects, w, BaseSpec::FIXED);
     let bs = prob.btot_scale;
     let mut x = vec![
         f.base.ra_scale,

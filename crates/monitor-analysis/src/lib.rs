@@ -111,8 +111,9 @@ pub fn parse_effect(name: &str) -> Result<EffectKind, AnalysisError> {
 
 /// A loaded log with its nominal parameters.
 pub struct Analysis {
-    /// Working series.
-    pub data: Prepared,
+    /// Working series (shared: a model recentred on refitted base parameters reads the
+    /// same series, [`Analysis::recentred`]).
+    pub data: std::sync::Arc<Prepared>,
     /// Machine constants from the parameter file.
     pub constants: MachineConstants,
     /// The parameter file.
@@ -123,6 +124,11 @@ pub struct Analysis {
     /// `from_s=...` in Python): the front end's that asked; the library's own
     /// ([`monitor_replay::FieldNames`]) as loaded.
     pub words: monitor_replay::Words,
+    /// The constants the effects are set up with when they are not `constants`: the user's
+    /// file's, for a model the ladder rebased on refitted base parameters
+    /// ([`Analysis::rebased`]), so that an effect's data-dependent set-up (the load
+    /// segments an observer finds, the plausible ranges) is the same on every rung.
+    pub(crate) setup_origin: Option<MachineConstants>,
 }
 
 /// Options shared by `compare` and `explain`.
@@ -328,11 +334,12 @@ impl Analysis {
         let (dec, quality) = prep::decimate_file(log, &params, opts, progress)?;
         let data = prep::voltage_model_flux_frame(&dec, &params);
         Ok(Analysis {
-            data,
+            data: std::sync::Arc::new(data),
             constants: MachineConstants::from_params(&params),
             params,
             quality,
             words: monitor_replay::Words::LIBRARY,
+            setup_origin: None,
         })
     }
 
@@ -416,6 +423,18 @@ impl Analysis {
             fit_base,
             MAX_ITER,
         )
+    }
+
+    /// [`Analysis::fit_set`] with the base parameters as `spec` says.
+    fn fit_spec(
+        &self,
+        fitdata: &Prepared,
+        active: &[ActiveEffect<'_>],
+        w: &Weights,
+        start: &BaseParams,
+        spec: fit::BaseSpec,
+    ) -> Result<FitResult, effects::EffectValuesError> {
+        fit::fit_spec(fitdata, &self.constants, active, w, start, spec, MAX_ITER)
     }
 
     /// The effects `active` with their fitted values in `f`, as the JSON reports them.
@@ -537,5 +556,35 @@ impl Analysis {
     /// The unbalance / faulty-phase analysis ([`unbalance`]; needs only the currents).
     pub fn unbalance(&self) -> unbalance::UnbalanceAnalysis {
         unbalance::analyse(&self.data, &self.constants, &*self.words)
+    }
+}
+
+impl Analysis {
+    /// The same log judged against the parameter file `params` (a model recentred on
+    /// refitted base parameters): the working series is shared, not copied.
+    pub fn recentred(&self, params: monitor_io::params::ParamFile) -> Analysis {
+        Analysis {
+            data: std::sync::Arc::clone(&self.data),
+            constants: MachineConstants::from_params(&params),
+            params,
+            quality: self.quality.clone(),
+            words: self.words,
+            setup_origin: None,
+        }
+    }
+
+    /// [`Analysis::recentred`] with the effects still set up on this analysis' constants
+    /// (the ladder's rungs: an effect's set-up is the same whatever base parameters the
+    /// model has).
+    pub(crate) fn rebased(&self, params: monitor_io::params::ParamFile) -> Analysis {
+        Analysis {
+            setup_origin: Some(*self.setup_constants()),
+            ..self.recentred(params)
+        }
+    }
+
+    /// The constants effects are set up with ([`Analysis::setup_origin`]).
+    pub(crate) fn setup_constants(&self) -> &MachineConstants {
+        self.setup_origin.as_ref().unwrap_or(&self.constants)
     }
 }

@@ -67,6 +67,10 @@ impl EffectModel for CoulombFriction {
     fn about(&self) -> &About {
         &ABOUT
     }
+    /// The friction carries its torque itself: B + Bl is free to fall to zero.
+    fn takes_viscous_part(&self) -> bool {
+        true
+    }
     fn confused_with(&self) -> &'static [Confusion] {
         &[Confusion {
             with: EffectKind::LoadTorque,

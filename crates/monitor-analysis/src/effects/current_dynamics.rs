@@ -49,6 +49,11 @@ impl EffectModel for CurrentDynamics {
     fn about(&self) -> &About {
         &ABOUT
     }
+    /// The machine's own value: followed where the base parameters are refitted as the
+    /// machine's.
+    fn derived_from_machine(&self, n: &MachineConstants) -> Option<Vec<f64>> {
+        Some(vec![n.la_h])
+    }
     fn time_constant_s(&self, n: &MachineConstants) -> Option<f64> {
         Some(n.la_h / n.ra_ohm)
     }

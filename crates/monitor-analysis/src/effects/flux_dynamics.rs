@@ -49,6 +49,11 @@ impl EffectModel for FluxDynamics {
     fn about(&self) -> &About {
         &ABOUT
     }
+    /// The machine's own value: followed where the base parameters are refitted as the
+    /// machine's.
+    fn derived_from_machine(&self, n: &MachineConstants) -> Option<Vec<f64>> {
+        Some(vec![n.lr_h / n.rr_ohm])
+    }
     fn time_constant_s(&self, n: &MachineConstants) -> Option<f64> {
         Some(n.lr_h / n.rr_ohm)
     }

@@ -61,7 +61,7 @@ pub use setup::{
 };
 pub use supply_unbalance::{SupplyUnbalance, SupplyUnbalanceValues};
 pub use switch::StateSwitch;
-pub use thermal_drift::{ThermalDrift, ThermalDriftValues, ALPHA_CU_PER_K};
+pub use thermal_drift::{ThermalDrift, ThermalDriftValues, ALPHA_AL_PER_K, ALPHA_CU_PER_K};
 pub use windage::{Windage, WindageValues};
 
 use super::prep::Prepared;
@@ -208,6 +208,22 @@ pub trait EffectModel: Send + Sync {
     /// Default: none.
     fn requires(&self) -> &'static [EffectKind] {
         &[]
+    }
+    /// True for an effect whose law carries a speed-dependent shaft torque of its own
+    /// (windage, Coulomb friction): fitted with it, the viscous friction B + Bl is free to
+    /// fall to zero, without the prior that holds it near the file's value
+    /// ([`crate::fit::BaseSpec::for_effects`]). Default: false.
+    fn takes_viscous_part(&self) -> bool {
+        false
+    }
+    /// The effect's values as the machine `n` itself has them, for an effect whose
+    /// parameters are the machine's own (the rotor time constant Lr/Rr, the transient
+    /// inductance sigma Ls): where the base parameters are refitted as the machine's
+    /// ([`crate::fit::machine`]) these follow them instead of being fitted beside them, so
+    /// that Rr and the leakages are read through the dynamics they set. Default: `None`
+    /// (the effect's values are its own).
+    fn derived_from_machine(&self, _n: &MachineConstants) -> Option<Vec<f64>> {
+        None
     }
     /// The electrical time constant of the dynamics this effect adds to the model on
     /// machine `n` [s], `None` for an effect that changes the steady state (the default).

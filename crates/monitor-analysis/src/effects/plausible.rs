@@ -81,6 +81,17 @@ pub const DYNAMICS_BASIS: &str = "resistances change -10..+60 % with temperature
 /// Ra relative to nominal: 0.75..1.6 (copper +0.393 %/K, aluminium +0.40 %/K: -20 C to
 /// 155 C is 0.84 to 1.53 times the 20 C value; data-sheet tolerance 10 %).
 pub const RA_RATIO: (f64, f64) = (0.75, 1.6);
+/// Rr relative to the file's (the ladder's base rung): 0.6..2 (aluminium +0.40 %/K over
+/// -20 C to 155 C is 0.84-1.53 x; a locked-rotor test at line frequency reads the skin
+/// effect's Rr, up to about 1.3 x the running value; data-sheet tolerance).
+pub const RR_RATIO: (f64, f64) = (0.6, 2.0);
+/// The leakage inductances relative to the file's (the ladder's base rung): 0.5..2 (the
+/// split of a locked-rotor reactance by design class, IEEE 112, and the leakage paths'
+/// saturation in a locked-rotor test at high current).
+pub const LEAKAGE_RATIO: (f64, f64) = (0.5, 2.0);
+/// Lm relative to the file's (the ladder's base rung): 0.6..1.5 (a no-load test's rated
+/// point against the unsaturated value, and its tolerance).
+pub const LM_RATIO: (f64, f64) = (0.6, 1.5);
 /// Ls relative to nominal: 0.7..1.3 (saturation and data-sheet tolerance).
 pub const LS_RATIO: (f64, f64) = (0.7, 1.3);
 /// J relative to nominal: 0.33..3 (the file's J is rotor plus load; the coupled

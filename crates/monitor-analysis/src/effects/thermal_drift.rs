@@ -8,19 +8,36 @@ use crate::prep::Prepared;
 use crate::simplified_model::{MachineConstants, ModelTerms};
 use monitor_core::EffectKind;
 
-/// Copper temperature coefficient of resistance [1/K] (0.393 %/K at 20 C).
+/// Copper temperature coefficient of resistance [1/K] (0.393 %/K at 20 C): the stator
+/// winding (IEC 60034-1's resistance method of temperature rise uses 235 K + T, the same
+/// slope).
 pub const ALPHA_CU_PER_K: f64 = 0.00393;
+/// Aluminium temperature coefficient of resistance [1/K] (0.403 %/K at 20 C, IEC 60028's
+/// 228 K + T for hard-drawn aluminium): the die-cast rotor cage of a low-voltage motor.
+pub const ALPHA_AL_PER_K: f64 = 0.00403;
 
-/// Winding temperature rise: Rs and Rr follow copper's coefficient.
+/// Winding temperature rise during the log: the stator and the rotor heat apart (the stator
+/// by its copper loss, the cage by its own, with one thermal time constant), each from the
+/// temperature it had when the log began. A motor already warm at the start is a change of
+/// the base parameters (the ladder's base rung reads Rs and Rr against the file), and this
+/// effect is the rise on top of it.
 #[derive(Debug, Clone, Copy)]
 pub struct ThermalDrift;
 
 /// Thermal drift's parameters.
-const PARAMS: [EffectParam; 2] = [
+const PARAMS: [EffectParam; 3] = [
     EffectParam {
-        name: "rise_k",
+        name: "stator_rise_k",
         unit: "K",
-        doc: "final winding temperature rise",
+        doc: "final stator winding temperature rise over the log's start",
+        range: plausible::RISE_K,
+        per: None,
+        basis: plausible::RISE_K_BASIS,
+    },
+    EffectParam {
+        name: "rotor_rise_k",
+        unit: "K",
+        doc: "final rotor cage temperature rise over the log's start",
         range: plausible::RISE_K,
         per: None,
         basis: plausible::RISE_K_BASIS,
@@ -38,8 +55,10 @@ const PARAMS: [EffectParam; 2] = [
 /// Thermal drift's fitted values ([`PARAMS`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ThermalDriftValues {
-    /// The final temperature rise [K] (negative: cooling).
-    pub rise_k: f64,
+    /// The stator's final temperature rise over the log's start [K] (negative: cooling).
+    pub stator_rise_k: f64,
+    /// The rotor's final temperature rise over the log's start [K] (negative: cooling).
+    pub rotor_rise_k: f64,
     /// The thermal time constant [s].
     pub tau_s: f64,
 }
@@ -47,16 +66,28 @@ pub struct ThermalDriftValues {
 impl TryFrom<&[f64]> for ThermalDriftValues {
     type Error = EffectValuesError;
     fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
-        let [rise_k, tau_s] = declared_values(EffectKind::ThermalDrift, &PARAMS, v)?;
-        Ok(ThermalDriftValues { rise_k, tau_s })
+        let [stator_rise_k, rotor_rise_k, tau_s] =
+            declared_values(EffectKind::ThermalDrift, &PARAMS, v)?;
+        Ok(ThermalDriftValues {
+            stator_rise_k,
+            rotor_rise_k,
+            tau_s,
+        })
+    }
+}
+
+impl ThermalDriftValues {
+    /// The rise at `t` [s] after the log's start of a final rise `rise` [K].
+    fn rise_at(&self, rise: f64, t: f64) -> f64 {
+        rise * (1.0 - (-t.max(0.0) / self.tau_s.max(1e-6)).exp())
     }
 }
 
 /// What `ThermalDrift` is ([`About`]).
 const ABOUT: About = About {
     kind: EffectKind::ThermalDrift,
-    description: "The windings heat up with load, so the stator and rotor resistances rise (copper: +0.393 %/K; 20 -> 90 C is +27 %).",
-    equations: "Rs(t), Rr(t) = R (1 + 0.00393 dT(t)), dT(t) = rise_k (1 - exp(-(t - t0)/tau_s)); Ra = Rs + (Ls/Lr) Rr in eq. (28) follows; in the full-order model the rotor time constant Lr/Rr follows too.",
+    description: "The windings heat up with load, the stator and the rotor apart, so their resistances rise (stator copper +0.393 %/K, rotor aluminium +0.403 %/K); a motor already warm when the log starts is a change of the base parameters, this is the rise on top of it.",
+    equations: "Rs(t) = Rs (1 + 0.00393 dTs(t)), Rr(t) = Rr (1 + 0.00403 dTr(t)), dTx(t) = x_rise_k (1 - exp(-(t - t0)/tau_s)) from the log's start t0; Ra = Rs + (Ls/Lr) Rr in eq. (28) follows; in the full-order model the rotor time constant Lr/Rr follows too.",
     parameters: &PARAMS,
 };
 
@@ -66,12 +97,16 @@ impl EffectModel for ThermalDrift {
     }
     fn setup(&self, d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let t = duration(d);
-        let [rise_k, tau_s] = &PARAMS;
+        let [stator, rotor, tau_s] = &PARAMS;
         let params = vec![
-            rise_k.fit(10.0, (-100.0, 400.0), 20.0, 1.0),
+            stator.fit(10.0, (-100.0, 400.0), 20.0, 1.0),
+            rotor.fit(10.0, (-100.0, 400.0), 20.0, 1.0),
             tau_s.fit(t / 3.0, (t / 200.0, 20.0 * t), t / 3.0, 1.0),
         ];
-        Ok(FitSetup::new(*self, params)?)
+        // A rise the log ends in the middle of: also started from a time constant as long
+        // as the log (a drift that is still nearly linear at the end).
+        let alt = vec![vec![20.0, 5.0, t]];
+        Ok(FitSetup::new(*self, params)?.with_alt_init(alt)?)
     }
 }
 
@@ -80,7 +115,8 @@ impl Contribution for ThermalDrift {
     fn values(&self, v: &[f64]) -> Result<ThermalDriftValues, EffectValuesError> {
         ThermalDriftValues::try_from(v)
     }
-    /// The resistance scale 1 + alpha dT(t) per sample (Rs and Rr alike).
+    /// The rotor's scale `1 + alpha_al dTr(t)` on both resistances, and the stator's own
+    /// `(1 + alpha_cu dTs(t)) / (1 + alpha_al dTr(t))` on Rs.
     fn contribute(
         &self,
         p: &ThermalDriftValues,
@@ -88,27 +124,26 @@ impl Contribution for ThermalDrift {
         _n: &MachineConstants,
         t: &mut ModelTerms,
     ) {
-        let ThermalDriftValues { rise_k, tau_s } = *p;
         let t0 = d.t_s.first().copied().unwrap_or(0.0);
-        let tau = tau_s.max(1e-6);
-        t.scale_resistances(
-            d.t_s
-                .iter()
-                .map(|t| 1.0 + ALPHA_CU_PER_K * rise_k * (1.0 - (-(t - t0) / tau).exp())),
-        );
+        let rotor = |t: f64| 1.0 + ALPHA_AL_PER_K * p.rise_at(p.rotor_rise_k, t - t0);
+        let stator = |t: f64| 1.0 + ALPHA_CU_PER_K * p.rise_at(p.stator_rise_k, t - t0);
+        t.scale_resistances(d.t_s.iter().map(|&t| rotor(t)));
+        t.scale_stator_resistance(d.t_s.iter().map(|&t| stator(t) / rotor(t).max(1e-6)));
     }
     fn describe(&self, p: &ThermalDriftValues, d: &Prepared, _n: &MachineConstants) -> String {
-        let ThermalDriftValues { rise_k, tau_s } = *p;
         let t = duration(d);
-        let dt_end = rise_k * (1.0 - (-t / tau_s.max(1e-6)).exp());
+        let (ds, dr) = (p.rise_at(p.stator_rise_k, t), p.rise_at(p.rotor_rise_k, t));
+        let word = |x: f64| if x >= 0.0 { "heats" } else { "cools" };
         format!(
-            "winding resistance {} {:.0} % over the run ({:.0} s), consistent with about {:.0} K of {} (copper 0.393 %/K); thermal time constant about {:.3} s",
-            if dt_end >= 0.0 { "rises" } else { "falls" },
-            (ALPHA_CU_PER_K * dt_end * 100.0).abs(),
+            "the windings' temperatures move over the run ({:.0} s): the stator {} by about {:.0} K (Rs {:+.0} %), the rotor {} by about {:.0} K (Rr {:+.0} %); thermal time constant about {:.3} s",
             t,
-            dt_end.abs(),
-            if dt_end >= 0.0 { "heating" } else { "cooling" },
-            tau_s
+            word(ds),
+            ds.abs(),
+            100.0 * ALPHA_CU_PER_K * ds,
+            word(dr),
+            dr.abs(),
+            100.0 * ALPHA_AL_PER_K * dr,
+            p.tau_s
         )
     }
 }
@@ -129,13 +164,46 @@ mod tests {
         };
         let n = MachineConstants::from_params(&monitor_io::params::ParamFile::reference_2p2kw());
         let s = ThermalDrift.setup(&d, &n).unwrap();
-        let why = s.implausible(&[400.0, 0.01]);
+        let why = s.implausible(&[400.0, 0.0, 0.01]);
         assert_eq!(why.len(), 2, "{why:?}");
-        assert!(why[0].starts_with("rise_k = 400 K"), "{why:?}");
+        assert!(why[0].starts_with("stator_rise_k = 400 K"), "{why:?}");
         assert!(why[1].starts_with("tau_s = 0.0100 s"), "{why:?}");
-        assert!(s.implausible(&[60.0, 600.0]).is_empty());
+        assert!(s.implausible(&[60.0, 40.0, 600.0]).is_empty());
         // Cooling of a log that starts warm is plausible, cooling below ambient is not.
-        assert!(s.implausible(&[-30.0, 600.0]).is_empty());
-        assert_eq!(s.implausible(&[-80.0, 600.0]).len(), 1);
+        assert!(s.implausible(&[-30.0, -20.0, 600.0]).is_empty());
+        assert_eq!(s.implausible(&[-80.0, 0.0, 600.0]).len(), 1);
+    }
+
+    /// The stator and the rotor apart: a stator-only rise moves Rs alone; the rotor's moves
+    /// both resistances' common scale and leaves Rs's own at 1 / (that scale) x its own.
+    #[test]
+    fn the_stator_and_the_rotor_heat_apart() {
+        let d = Prepared {
+            t_s: vec![0.0, 1.0, 1e4],
+            dt_s: 1.0,
+            ..Default::default()
+        };
+        let n = MachineConstants::from_params(&monitor_io::params::ParamFile::reference_2p2kw());
+        let mut t = ModelTerms::default();
+        let p = ThermalDriftValues {
+            stator_rise_k: 70.0,
+            rotor_rise_k: 0.0,
+            tau_s: 3.0,
+        };
+        ThermalDrift.contribute(&p, &d, &n, &mut t);
+        assert!(t.resistance.scale.iter().all(|s| (s - 1.0).abs() < 1e-12));
+        let end = t.resistance.stator_scale[2];
+        assert!((end - (1.0 + 0.00393 * 70.0)).abs() < 1e-9, "{end}");
+        assert_eq!(t.resistance.stator_scale[0], 1.0);
+        let mut t = ModelTerms::default();
+        let p = ThermalDriftValues {
+            stator_rise_k: 50.0,
+            rotor_rise_k: 50.0,
+            tau_s: 3.0,
+        };
+        ThermalDrift.contribute(&p, &d, &n, &mut t);
+        let (r, s) = (t.resistance.scale[2], t.resistance.stator_scale[2]);
+        assert!((r - (1.0 + 0.00403 * 50.0)).abs() < 1e-9);
+        assert!((r * s - (1.0 + 0.00393 * 50.0)).abs() < 1e-9);
     }
 }

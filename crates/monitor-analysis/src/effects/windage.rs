@@ -68,6 +68,10 @@ impl EffectModel for Windage {
     fn about(&self) -> &About {
         &ABOUT
     }
+    /// The drag carries its speed-dependent torque itself: B + Bl is free to fall to zero.
+    fn takes_viscous_part(&self) -> bool {
+        true
+    }
     fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let w = sync_speed_mech(d, n);
         let k = n.torque_scale_nm / (w * w);

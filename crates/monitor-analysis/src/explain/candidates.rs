@@ -224,7 +224,7 @@ impl Analysis {
         f: &FitResult,
     ) -> Result<(f64, f64), AnalysisError> {
         let (series, mask) = if base.coarsening == 1 {
-            (&self.data, &base.heldback)
+            (&*self.data, &base.heldback)
         } else {
             (&base.fit_series, &base.heldback_fit_series)
         };

@@ -8,7 +8,7 @@ use super::{ExplainOutput, ExplainReport, Standing, EXPLAINED_MIN, EXPLAINS_MIN,
 use crate::effects::SetupError;
 use crate::fit::{ActiveEffect, FittedModel};
 use crate::refit::BaseRefit;
-use crate::simplified_model::{MachineConstants, Prediction};
+use crate::simplified_model::Prediction;
 use crate::unbalance::UnbalanceAnalysis;
 use crate::{base_implausible, base_out_of_range, resolve};
 use crate::{Analysis, AnalysisError, Options};
@@ -105,14 +105,7 @@ impl Analysis {
         mut refit: BaseRefit,
         because: Vec<String>,
     ) -> Result<ExplainOutput, AnalysisError> {
-        let params = refit.recentred_params(&self.params);
-        let recentred = Analysis {
-            data: self.data.clone(),
-            constants: MachineConstants::from_params(&params),
-            params,
-            quality: self.quality.clone(),
-            words: self.words,
-        };
+        let recentred = self.recentred(refit.recentred_params(&self.params));
         let mut out = recentred.explain_once(opts, progress, false)?;
         refit.recentred = true;
         refit.because = because;

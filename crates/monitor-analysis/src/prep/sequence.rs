@@ -13,9 +13,13 @@ use super::{hann, C64, SEQ_LPF_HZ};
 /// samples (whole turns) and `P = x_0 - c`: started from the plain mean, each stage would
 /// begin with a transient the size of its ripple, which the next stages pass as a slow
 /// bump (0.15 A on a 9 A current over the first 0.3 s).
-fn lpf3(x: &mut [C64], dt: f64, fc: f64, init_len: usize, omega: f64, backward: bool) {
-    let a = 1.0 - (-2.0 * std::f64::consts::PI * fc * dt).exp();
+///
+/// `fc` is the corner [Hz] at each sample (of the series' own order; [`corner_hz`]).
+fn lpf3(x: &mut [C64], dt: f64, fc: &[f64], init_len: usize, omega: f64, backward: bool) {
+    let gain = |f: f64| 1.0 - (-2.0 * std::f64::consts::PI * f * dt).exp();
     let n = x.len();
+    let fc_at = |k: usize| fc.get(k).copied().unwrap_or(SEQ_LPF_HZ);
+    let a = gain(fc_at(if backward { n.saturating_sub(1) } else { 0 }));
     let at = |k: usize| if backward { n - 1 - k } else { k };
     let m = init_len.clamp(1, n.max(1));
     let (mut sum, mut wsum) = (C64::new(0.0, 0.0), 0.0);
@@ -33,17 +37,34 @@ fn lpf3(x: &mut [C64], dt: f64, fc: f64, init_len: usize, omega: f64, backward: 
         c + h * h * p0 * back,
         c + h * h * h * p0 * back,
     ];
-    let mut stage = |v: &mut C64| {
+    let mut stage = |v: &mut C64, a: f64| {
         s[0] += a * (*v - s[0]);
         s[1] += a * (s[0] - s[1]);
         s[2] += a * (s[1] - s[2]);
         *v = s[2];
     };
     if backward {
-        x.iter_mut().rev().for_each(&mut stage);
+        for (k, v) in x.iter_mut().enumerate().rev() {
+            stage(v, gain(fc_at(k)));
+        }
     } else {
-        x.iter_mut().for_each(&mut stage);
+        for (k, v) in x.iter_mut().enumerate() {
+            stage(v, gain(fc_at(k)));
+        }
     }
+}
+
+/// The sequence separation's corner at a supply frequency of `omega_s` [rad/s]:
+/// [`SEQ_LPF_HZ`], but at most an eighth of the supply frequency, so that the other
+/// sequence, turning at twice the supply frequency in the demodulated signal, is damped
+/// by at least (1/16)^3 = 2.4e-4 whatever the frequency. At 4 Hz fixed, a V/f drive at
+/// 15 Hz left 0.24 % of its positive sequence as an apparent negative sequence, which the
+/// full-order model driven by the positive sequence alone then missed (a balanced
+/// converter's log named a 0.4 % "supply unbalance").
+pub(super) fn corner_hz(omega_s: f64) -> f64 {
+    SEQ_LPF_HZ
+        .min(omega_s.abs() / (2.0 * std::f64::consts::PI) / 8.0)
+        .max(0.05)
 }
 
 /// Relative jump of the supply voltage between two working samples that marks a supply
@@ -110,6 +131,8 @@ pub(super) struct SequenceSeparator {
     omega_2_end: f64,
     /// Working samples where the supply steps ([`supply_steps`]).
     pub(super) steps: Vec<usize>,
+    /// The low-pass corner at each working sample [Hz] ([`corner_hz`]).
+    fc: Vec<f64>,
 }
 
 impl SequenceSeparator {
@@ -142,6 +165,7 @@ impl SequenceSeparator {
             init_len_end,
             omega_2_end,
             steps: Vec::new(),
+            fc: omega_s.iter().map(|&w| corner_hz(w)).collect(),
         }
     }
 
@@ -154,7 +178,7 @@ impl SequenceSeparator {
             lpf3(
                 &mut b,
                 self.dt,
-                SEQ_LPF_HZ,
+                &self.fc,
                 self.init_len_end,
                 -self.omega_2_end,
                 true,
@@ -164,7 +188,7 @@ impl SequenceSeparator {
         lpf3(
             &mut f,
             self.dt,
-            SEQ_LPF_HZ,
+            &self.fc,
             self.init_len,
             self.omega_2,
             false,

@@ -192,8 +192,9 @@ impl FullMachine {
             Some(tau) => rf / tau.max(1e-5),
             None => n.rr_ohm * b.ra_scale * rf / lr,
         };
+        let sf = t.resistance.stator_scale.get(k).copied().unwrap_or(1.0);
         FullMachine {
-            rs: n.rs_ohm * b.ra_scale * rf,
+            rs: n.rs_ohm * b.ra_scale * rf * sf,
             rr: a * l_m,
             l_sigma,
             a,

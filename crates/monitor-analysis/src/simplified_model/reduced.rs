@@ -235,7 +235,7 @@ impl<'a> Reduced<'a> {
         let mf = t.magnetising.lm_scale.get(k).copied().unwrap_or(1.0);
         let lm = n.lm_h * mf;
         AtSample {
-            rs: self.rs0 * rf,
+            rs: self.rs0 * rf * t.resistance.stator_scale.get(k).copied().unwrap_or(1.0),
             rr: self.rr0 * rf * t.resistance.rotor_scale.get(k).copied().unwrap_or(1.0),
             lm,
             ls: self.run.b.ls_scale * (n.lls_h + lm),

@@ -43,6 +43,9 @@ pub struct Resistance {
     /// Multiplies the rotor resistance term of Ra only [-] (the q-q element of an unequal
     /// cage's resistance matrix in the reduced model); composes by multiplication.
     pub rotor_scale: Vec<f64>,
+    /// Multiplies Rs only, on top of `scale` [-] (a stator that heats apart from the
+    /// rotor); composes by multiplication.
+    pub stator_scale: Vec<f64>,
 }
 
 /// The magnetising branch.
@@ -194,6 +197,11 @@ impl ModelTerms {
     /// ([`Resistance::rotor_scale`]).
     pub fn scale_rotor_resistance(&mut self, scale: impl Iterator<Item = f64>) {
         compose(&mut self.resistance.rotor_scale, scale, |a, b| a * b);
+    }
+
+    /// Multiplies Rs alone by `scale` (per sample, on top of [`ModelTerms::scale_resistances`]).
+    pub fn scale_stator_resistance(&mut self, scale: impl Iterator<Item = f64>) {
+        compose(&mut self.resistance.stator_scale, scale, |a, b| a * b);
     }
 
     /// Multiplies Lm by `scale` per sample ([`Magnetising::lm_scale`]).

@@ -2,6 +2,7 @@
 //! confusable ones), the first that passes the step's test ([`STEP_MIN`]) and lowers the
 //! whole-log error kept, the step's report.
 
+use super::base::{base_in_words, BaseChange};
 use super::round::{Fitted, Rung};
 use super::{LadderSeries, LadderStep, RangedValue, Tried, STEP_MIN};
 use crate::effects::{self, EffectModel};
@@ -60,6 +61,7 @@ impl Analysis {
             };
             if let Some(because) = because {
                 tried.push(Tried {
+                    base: c.base.is_some(),
                     added: c.added(before),
                     heldback_error: c.heldback_fit_series,
                     significance: sig,
@@ -98,7 +100,17 @@ impl Analysis {
                 100.0 * STEP_MIN
             )));
         }
-        let next = self.measure_rung(c.models.clone(), c.fit.clone(), sr)?;
+        // The base rung's fit is relative to the file recentred on its factors.
+        let recentred;
+        let an: &Analysis = match c.base {
+            Some(s) => {
+                recentred = self.rebased(s.apply(&sr.file));
+                &recentred
+            }
+            None => self,
+        };
+        let scales = c.base.unwrap_or(rung.scales);
+        let next = an.measure_rung(c.models.clone(), c.fit.clone(), sr, scales)?;
         if !next.error.is_finite() || !next.heldback_error.is_finite() {
             return Ok(Take::Not(
                 "the model with it could not be run through the whole log (it diverged)".into(),
@@ -111,7 +123,12 @@ impl Analysis {
                 effects::sig(next.error)
             )));
         }
-        let step = self.step_of(c, &c.added(rung.models.len()), rung, &next, sig)?;
+        let step = if c.base.is_some() {
+            let changes = an.base_rung_changes(c, sr)?;
+            base_step(changes, rung, &next, sig)
+        } else {
+            self.step_of(c, &c.added(rung.models.len()), rung, &next, sig)?
+        };
         Ok(Take::Kept(Box::new((next, step))))
     }
 
@@ -171,7 +188,7 @@ impl Analysis {
         let mut words = Vec::new();
         for (i, e) in c.models.iter().enumerate().skip(before) {
             let p = c.fit.effect_params.get(i).map_or(&[][..], Vec::as_slice);
-            let Ok(setup) = e.setup(d, &self.constants) else {
+            let Ok(setup) = e.setup(d, self.setup_constants()) else {
                 continue;
             };
             // A long log's coarse copy may have fewer load segments than the working series.
@@ -197,8 +214,10 @@ impl Analysis {
             words.push(setup.describe(p, d, &self.constants)?);
         }
         Ok(LadderStep {
-            effect: added.last().copied().unwrap_or(EffectKind::LoadTorque),
+            effect: added.last().copied(),
             added: added.to_vec(),
+            base: Vec::new(),
+            dropped: Vec::new(),
             fitted,
             summary: words.join("; "),
             error: next.error,
@@ -218,10 +237,54 @@ impl Analysis {
     }
 }
 
+/// The ladder step of a base rung: the changes `changes` took the model from `rung` to
+/// `next` (test statistic `sig`).
+pub(super) fn base_step(
+    changes: Vec<BaseChange>,
+    rung: &Rung<'_>,
+    next: &Rung<'_>,
+    sig: f64,
+) -> LadderStep {
+    let mut fitted = BTreeMap::new();
+    for c in changes.iter().filter(|c| c.changed) {
+        let (lo, hi) = c.interval.map_or((f64::NAN, f64::NAN), |[lo, hi]| (lo, hi));
+        fitted.insert(
+            c.base.name().to_string(),
+            RangedValue {
+                value: c.change,
+                unit: "relative change".into(),
+                low: lo,
+                high: hi,
+            },
+        );
+    }
+    LadderStep {
+        effect: None,
+        added: Vec::new(),
+        base: changes.clone(),
+        dropped: Vec::new(),
+        fitted,
+        summary: base_in_words(&changes),
+        error: next.error,
+        heldback_error: next.heldback_error,
+        noise_floor: next.noise,
+        heldback_noise_floor: next.heldback_noise,
+        ratio_to_floor: next.error / next.noise,
+        heldback_ratio_to_floor: next.heldback_error / next.heldback_noise,
+        significance: sig,
+        explained: explained_fraction(rung.error, next.error, next.noise),
+        heldback_explained: explained_fraction(
+            rung.heldback_error,
+            next.heldback_error,
+            next.heldback_noise,
+        ),
+    }
+}
+
 /// The step's test statistic for candidate `c` on the model of `rung`: the share of the
 /// held-back error beyond the noise floor it removes, its held-back error first raised by
 /// [`PARAM_PENALTY`] per parameter.
-fn significance(rung: &Rung<'_>, c: &Fitted<'_>) -> f64 {
+pub(super) fn significance(rung: &Rung<'_>, c: &Fitted<'_>) -> f64 {
     explained_fraction(
         rung.heldback_fit_series,
         c.score(),

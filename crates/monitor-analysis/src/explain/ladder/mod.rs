@@ -32,19 +32,26 @@
 //! effect-free control logs of the test matrix (a textbook machine written inside the test,
 //! three sizes, starts and steps: under 10 %), doubled (docs/model-vs-measurement.md).
 
+mod base;
 mod choice;
+mod end;
 mod round;
+mod rounds;
 mod split;
+mod stepwise;
 
+pub use base::{base_changes, base_in_words, BaseChange, BASE_CHANGE_MIN};
+pub use end::FinalFit;
 pub use split::stratified_heldback;
 
 use super::{NOISE_MARGIN, PARAM_PENALTY};
 use crate::effects::{self, EffectModel};
+use crate::fit::machine::MachineScales;
 use crate::simplified_model::BaseParams;
 use crate::DataInfo;
 use crate::{resolve, transients, Analysis, AnalysisError, Options};
 use monitor_core::EffectKind;
-use round::{pairs_of, LadderSeries, Rung, Starts};
+use round::{LadderSeries, Rung};
 use serde::Serialize;
 use split::{mask_on, weights_for};
 use std::collections::BTreeMap;
@@ -70,6 +77,11 @@ pub const EVENT_WINDOW_MAX_S: f64 = 0.08;
 /// resolves the stator transient time constant, 3 samples or more of it: the dynamics
 /// effects are refused on a series that does not, [`transients::not_proposed`]).
 pub const LADDER_FIT_SAMPLES: usize = 20_000;
+/// Largest fit copy of a long log whose dynamics need more samples than
+/// [`LADDER_FIT_SAMPLES`] ([`fit_thinning`]): three times as many (a 60 s log at 2 kHz at
+/// 1 kHz), beyond which the copy is thinned to this size and the dynamics effects are
+/// refused as unresolved.
+pub const LADDER_MAX_FIT_SAMPLES: usize = 60_000;
 /// How many single candidates the pair search pairs: those that lowered the training cost
 /// most. With 3 the windage scenario's second step (flux dynamics with a load torque, the
 /// fourth single of its round) is not found and the ladder stops at 65x its floor.
@@ -91,14 +103,24 @@ pub struct RangedValue {
     pub high: f64,
 }
 
-/// One step of the ladder (JSON `ladder[]`).
+/// One step of the ladder (JSON `ladder[]`): an effect added (`effect`), or the base rung
+/// (`base`: the base parameters refitted against the user's file).
 #[derive(Debug, Clone, Serialize)]
 pub struct LadderStep {
-    /// The effect added (for a pair, the one that needed the other).
-    pub effect: EffectKind,
+    /// The effect added (for a pair, the one that needed the other); absent on a base rung.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub effect: Option<EffectKind>,
     /// Every effect the step added: `effect`, and before it one it needs first
-    /// ([`EffectModel::requires`]) when the model lacked it.
+    /// ([`EffectModel::requires`]) when the model lacked it (empty on a base rung).
     pub added: Vec<EffectKind>,
+    /// The base rung's six base parameters against the user's file, each with its change,
+    /// its 95 % interval and whether the rung names it (absent on an effect's step).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub base: Vec<BaseChange>,
+    /// Effects of earlier steps the step removed: the step's effect explains what they stood
+    /// in for (stepwise selection both ways, [`stepwise`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub dropped: Vec<EffectKind>,
     /// The added effects' fitted values with their physical ranges, by parameter name
     /// (prefixed `effect.` when the step added two).
     pub fitted: BTreeMap<String, RangedValue>,
@@ -145,6 +167,9 @@ pub struct LadderStart {
 /// A candidate of the last round that was not kept, and why (JSON `last_round`).
 #[derive(Debug, Clone, Serialize)]
 pub struct Tried {
+    /// True for the base rung (the base parameters refitted; `added` is then empty).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub base: bool,
     /// The effect (with what it needed first, as in [`LadderStep::added`]).
     pub added: Vec<EffectKind>,
     /// Its held-back error.
@@ -174,6 +199,15 @@ pub enum Stop {
 /// The ladder's report (JSON of `explain --ladder`).
 #[derive(Debug, Clone, Serialize)]
 pub struct LadderReport {
+    /// What was found, then why it stopped: the base changes and the effects with their
+    /// sizes, the end against the noise floor, the stop.
+    pub summary: String,
+    /// The base parameters that differ from the user's file, from the chosen model refitted
+    /// on the whole log ([`FinalFit::base`]; only the named changes).
+    pub base_changes: Vec<BaseChange>,
+    /// The chosen model refitted on the whole log: the final figures.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub final_fit: Option<FinalFit>,
     /// The model before the first step.
     pub start: LadderStart,
     /// The steps in order.
@@ -235,6 +269,9 @@ impl Analysis {
         let d = &self.data;
         let (held, strata) = stratified_heldback(d, &self.constants);
         let mut report = LadderReport {
+            summary: String::new(),
+            base_changes: Vec::new(),
+            final_fit: None,
             start: LadderStart {
                 effects: opts.effects.clone(),
                 error: f64::NAN,
@@ -264,16 +301,17 @@ impl Analysis {
         };
         if let Some((stop, why)) = self.refused() {
             report.stop = stop;
-            report.stopped_because = why;
+            report.stopped_because = why.clone();
+            report.summary = why;
             return Ok(report);
         }
-        let sr = self.ladder_series(held);
+        let sr = self.ladder_series(held, opts.fit_base);
         let configured = resolve(&opts.effects);
         let active = self.setup_all(&sr.fd, &configured)?;
         let nominal = BaseParams::nominal(&self.constants);
         let f0 = self.fit_set(&sr.fd, &active, &sr.wf, &nominal, opts.fit_base)?;
         let models: Vec<&dyn EffectModel> = configured.iter().map(|e| e.as_ref()).collect();
-        let rung = self.measure_rung(models, f0, &sr)?;
+        let rung = self.measure_rung(models, f0, &sr, MachineScales::of_file(&self.params))?;
         let lib = effects::library();
         report.start = LadderStart {
             effects: opts.effects.clone(),
@@ -283,7 +321,9 @@ impl Analysis {
             heldback_noise_floor: rung.heldback_noise,
             ratio_to_floor: rung.error / rung.noise,
         };
-        self.walk(&lib, rung, &sr, opts, progress, &mut report)?;
+        let rung = self.walk(&lib, rung, &sr, opts, progress, &mut report)?;
+        let step_no = report.ladder.len() + 1;
+        self.finish(&rung, &sr, &mut report, &|f| progress(step_no, f))?;
         Ok(report)
     }
 
@@ -305,10 +345,23 @@ impl Analysis {
     }
 
     /// The series the ladder's fits run on: a copy of at most [`LADDER_FIT_SAMPLES`] samples
-    /// (a round fits every candidate, and a ladder has several rounds), with the held-back
-    /// mask `held` of the working series carried over.
-    fn ladder_series(&self, held: Vec<bool>) -> LadderSeries {
-        let m = self.data.len().div_ceil(LADDER_FIT_SAMPLES).max(1);
+    /// (a round fits every candidate, and a ladder has several rounds), thinned no further
+    /// than the machine's fastest dynamics allow ([`fit_thinning`]), with the held-back mask
+    /// `held` of the working series carried over.
+    fn ladder_series(&self, held: Vec<bool>, fit_base: bool) -> LadderSeries {
+        let m = fit_thinning(
+            self.data.len(),
+            self.data.dt_s,
+            fastest_dynamics_s(&self.constants),
+        );
+        if std::env::var("LADDER_DEBUG").is_ok() {
+            eprintln!(
+                "fit thinning {m}: len {} dt {} tau {}",
+                self.data.len(),
+                self.data.dt_s,
+                fastest_dynamics_s(&self.constants)
+            );
+        }
         let fd = crate::coarsen(&self.data, m);
         let held_fd = if m == 1 {
             held.clone()
@@ -318,6 +371,8 @@ impl Analysis {
         LadderSeries {
             wf: weights_for(&fd, &held_fd, LADDER_FIT_SAMPLES),
             span: transients::Span::of(&fd, &self.constants),
+            file: self.params,
+            fit_base,
             fd,
             m,
             held,
@@ -326,8 +381,9 @@ impl Analysis {
     }
 
     /// The steps from `rung` until the floor band or nothing helps, into `report`: each
-    /// round fits the candidates of `lib` (then pairs, when no single one passes) and keeps
-    /// at most one.
+    /// round fits the candidates of `lib` and the base rung (then pairs, when no single one
+    /// passes), keeps at most one, and drops the earlier effects it explains better. The
+    /// rung the ladder ended on.
     fn walk<'a>(
         &self,
         lib: &'a [Box<dyn EffectModel>],
@@ -336,45 +392,76 @@ impl Analysis {
         opts: &Options,
         progress: &(dyn Fn(usize, f64) + Sync),
         report: &mut LadderReport,
-    ) -> Result<(), AnalysisError> {
+    ) -> Result<Rung<'a>, AnalysisError> {
         let mut step_no = 0;
+        // The analysis of the rung's model: the file recentred on its base parameters
+        // (`None`: the file itself).
+        let mut recentred: Option<Analysis> = None;
         let (stop, why) = loop {
+            let cur: &Analysis = recentred.as_ref().unwrap_or(self);
             if let Some(why) = at_floor(&rung) {
                 break (Stop::NoiseFloor, why);
             }
             step_no += 1;
-            let (cands, skipped) = self.ladder_candidates(lib, &rung, sr);
-            report.skipped = skipped;
-            if cands.is_empty() {
+            let base_after_base = report.ladder.last().is_some_and(|s| !s.base.is_empty());
+            let round = cur.round(lib, &rung, sr, !base_after_base, &|f| progress(step_no, f))?;
+            report.skipped = round.skipped;
+            report.last_round = round.tried;
+            if round.exhausted {
                 let why = "no effect of the library is left to add on this log";
                 break (Stop::LibraryExhausted, why.to_string());
             }
-            let fitted = self.fit_round(&cands, &rung, sr, opts, Starts::AlsoNominal, &|f| {
-                progress(step_no, 0.7 * f)
-            })?;
-            let pairs = pairs_of(&fitted, rung.models.len());
-            let (mut kept, mut tried) = self.choose(fitted, &rung, sr)?;
-            if kept.is_none() && !pairs.is_empty() {
-                // No single effect passes: two that need each other (a load torque and the
-                // cross coupling of a start, two hidden effects at once) are tried together.
-                let fitted = self.fit_round(&pairs, &rung, sr, opts, Starts::NestedOnly, &|f| {
-                    progress(step_no, 0.7 + 0.3 * f)
-                })?;
-                let (k2, t2) = self.choose(fitted, &rung, sr)?;
-                kept = k2;
-                tried.extend(t2);
-            }
-            report.last_round = tried;
-            let Some((next, step)) = kept else {
-                break (Stop::NothingHelps, nothing_helps(&rung, &report.last_round));
+            let Some((next, step)) = round.kept else {
+                break (
+                    Stop::NothingHelps,
+                    nothing_helps(&rung, &report.last_round, round.base_tried, &report.skipped),
+                );
             };
+            // The step's model is relative to its own base parameters.
+            let moved = next.scales != rung.scales;
+            let next_an = moved.then(|| self.rebased(next.scales.apply(&sr.file)));
+            let an = next_an.as_ref().unwrap_or(cur);
+            let (next, step) = an.drop_stand_ins(next, step, &rung, sr, &opts.effects)?;
             report.ladder.push(step);
             rung = next;
+            if moved {
+                recentred = next_an;
+            }
         };
         report.stop = stop;
         report.stopped_because = why;
         report.final_effects = rung.kinds.clone();
-        Ok(())
+        Ok(rung)
+    }
+}
+
+/// The fastest time constant of the library's dynamics effects on machine `n` [s] (the
+/// stator's transient sigma Ls / Ra: a few ms).
+fn fastest_dynamics_s(n: &crate::simplified_model::MachineConstants) -> f64 {
+    effects::library()
+        .iter()
+        .filter_map(|e| e.time_constant_s(n))
+        .filter(|t| t.is_finite() && *t > 0.0)
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The thinning factor of the fit copy of a working series of `len` samples at `dt_s`: the
+/// factor that brings it to [`LADDER_FIT_SAMPLES`], but never so coarse that the fastest
+/// dynamics time constant `tau_s` has fewer than 3 samples (the rule of
+/// [`transients::not_proposed`]) while the copy stays within [`LADDER_MAX_FIT_SAMPLES`]: a
+/// 24 s log at 2 kHz is fitted at 1 kHz (24 000 samples) where a factor of 3 (667 Hz) left
+/// a 3.6 ms stator transient unresolved and every dynamics effect refused.
+pub fn fit_thinning(len: usize, dt_s: f64, tau_s: f64) -> usize {
+    let budget = len.div_ceil(LADDER_FIT_SAMPLES).max(1);
+    let resolving = if tau_s.is_finite() && dt_s > 0.0 {
+        ((tau_s / (3.0 * dt_s)).floor() as usize).max(1)
+    } else {
+        budget
+    };
+    if budget <= resolving {
+        budget
+    } else {
+        resolving.max(len.div_ceil(LADDER_MAX_FIT_SAMPLES).max(1))
     }
 }
 
@@ -394,8 +481,11 @@ fn at_floor(rung: &Rung<'_>) -> Option<String> {
     })
 }
 
-/// Why no candidate helps, naming the numbers that decided.
-fn nothing_helps(rung: &Rung<'_>, tried: &[Tried]) -> String {
+/// Why no candidate helps, naming the numbers that decided. "Beyond the effect library"
+/// only when the base rung was a candidate of the last round (the effects were tried on a
+/// refitted base) and every effect of the library could be fitted (`skipped` is empty);
+/// otherwise what was not tried.
+fn nothing_helps(rung: &Rung<'_>, tried: &[Tried], base_tried: bool, skipped: &[String]) -> String {
     let r = rung.error / rung.noise;
     let rh = rung.heldback_error / rung.heldback_noise;
     // The plausible candidate that came closest to passing (else the first tried).
@@ -405,21 +495,38 @@ fn nothing_helps(rung: &Rung<'_>, tried: &[Tried]) -> String {
         .max_by(|a, b| a.significance.total_cmp(&b.significance));
     let best = closest
         .or(tried.first())
-        .map(|t| {
-            format!(
-                "{} ({})",
-                t.added
-                    .iter()
-                    .map(|k| k.name())
-                    .collect::<Vec<_>>()
-                    .join("+"),
-                t.because
-            )
-        })
+        .map(|t| format!("{} ({})", tried_name(t), t.because))
         .unwrap_or_else(|| "no candidate could be fitted".into());
+    let what_is_left = if base_tried && skipped.is_empty() {
+        "What is left is beyond the effect library (or below what the log can show)".to_string()
+    } else if !skipped.is_empty() {
+        format!(
+            "What is left is not explained by the effects that could be fitted on this log; not tried: {}",
+            skipped
+                .iter()
+                .map(|s| s.split(':').next().unwrap_or(s))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    } else {
+        "What is left is not explained by the effects of the library on the file's base parameters"
+            .to_string()
+    };
     format!(
-        "no plausible candidate passes the step's test: the whole-log error {} is {r:.2}x its noise floor and the held-back error {} is {rh:.2}x its floor; the best candidate was {best}. What is left is beyond the effect library (or below what the log can show)",
+        "no plausible candidate passes the step's test: the whole-log error {} is {r:.2}x its noise floor and the held-back error {} is {rh:.2}x its floor; the best candidate was {best}. {what_is_left}",
         effects::sig(rung.error),
         effects::sig(rung.heldback_error),
     )
+}
+
+/// A tried candidate's name: its effects joined with `+`, or `base parameters`.
+pub(crate) fn tried_name(t: &Tried) -> String {
+    if t.base {
+        return "the base parameters refitted".to_string();
+    }
+    t.added
+        .iter()
+        .map(|k| k.name())
+        .collect::<Vec<_>>()
+        .join("+")
 }

@@ -5,12 +5,14 @@ use super::split::weights_for;
 use super::PAIR_FROM;
 use crate::effects::{self, EffectModel};
 use crate::explain::PARAM_PENALTY;
-use crate::fit::{self, ActiveEffect, FitResult};
+use crate::fit::machine::MachineScales;
+use crate::fit::{self, ActiveEffect, BaseSpec, FitResult};
 use crate::metrics::{self, Weights};
 use crate::prep::Prepared;
 use crate::simplified_model::{BaseParams, MachineConstants};
-use crate::{align, base_newly_out_of_range, transients, Analysis, AnalysisError, Options};
+use crate::{align, base_newly_out_of_range, transients, Analysis, AnalysisError};
 use monitor_core::EffectKind;
+use monitor_io::params::ParamFile;
 
 /// Where a round's candidates of several effects start their fit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -41,10 +43,18 @@ pub(super) struct LadderSeries {
     pub(super) wf: Weights,
     /// What the fit series offers a dynamics effect.
     pub(super) span: transients::Span,
+    /// The user's parameter file: the base rung's factors are relative to it.
+    pub(super) file: ParamFile,
+    /// Whether the base parameters are refitted at all (the base rung and the final
+    /// refit; `--no-fit-base` keeps the file's).
+    pub(super) fit_base: bool,
 }
 
 /// The model of a ladder step: its effects, their set-ups on the fit series, and the fit.
 pub(super) struct Rung<'a> {
+    /// The base parameters of the model, as factors on the user's file (the analysis the
+    /// rung's fit is relative to is the file with them, [`Analysis::recentred`]).
+    pub(super) scales: MachineScales,
     pub(super) kinds: Vec<EffectKind>,
     pub(super) models: Vec<&'a dyn EffectModel>,
     pub(super) fit: FitResult,
@@ -59,12 +69,16 @@ pub(super) struct Rung<'a> {
 }
 
 /// A candidate fitted in one round.
+#[derive(Clone)]
 pub(super) struct Fitted<'a> {
     pub(super) models: Vec<&'a dyn EffectModel>,
     pub(super) fit: FitResult,
     pub(super) n_parameters: usize,
     pub(super) heldback_fit_series: f64,
     pub(super) implausible: Vec<String>,
+    /// For the base rung: the refitted base parameters (its `fit` is relative to the file
+    /// with them); `None` for an effect candidate.
+    pub(super) base: Option<MachineScales>,
 }
 
 impl Fitted<'_> {
@@ -86,13 +100,14 @@ impl Analysis {
         models: Vec<&'a dyn EffectModel>,
         fit: FitResult,
         sr: &LadderSeries,
+        scales: MachineScales,
     ) -> Result<Rung<'a>, AnalysisError> {
         let (fd, m, held, held_fd) = (&sr.fd, sr.m, &sr.held[..], &sr.held_fd[..]);
         let d = &self.data;
         let active: Vec<ActiveEffect<'a>> = models
             .iter()
             .map(|e| {
-                e.setup(d, &self.constants)
+                e.setup(d, self.setup_constants())
                     .map(|setup| ActiveEffect { effect: *e, setup })
                     .map_err(|source| AnalysisError::Effect {
                         effect: e.kind(),
@@ -119,6 +134,7 @@ impl Analysis {
             )
         };
         Ok(Rung {
+            scales,
             kinds: models.iter().map(|e| e.kind()).collect(),
             models,
             fit,
@@ -132,7 +148,7 @@ impl Analysis {
     }
 
     /// `models` set up on `d`.
-    fn setup_list<'a>(
+    pub(super) fn setup_list<'a>(
         &self,
         d: &Prepared,
         models: &[&'a dyn EffectModel],
@@ -142,7 +158,7 @@ impl Analysis {
             .map(|e| {
                 e.needs()
                     .met_by(d)
-                    .and_then(|()| e.setup(d, &self.constants))
+                    .and_then(|()| e.setup(d, self.setup_constants()))
                     .map(|setup| ActiveEffect { effect: *e, setup })
                     .map_err(|source| AnalysisError::Effect {
                         effect: e.kind(),
@@ -168,12 +184,12 @@ impl Analysis {
             input_transient: true,
             ..sr.span
         };
-        if let Some(t) = transients::not_proposed(e, resolvable, &self.constants, &all) {
+        if let Some(t) = transients::not_proposed(e, resolvable, self.setup_constants(), &all) {
             return Some(t.spelled(&*self.words));
         }
         e.needs()
             .met_by(&self.data)
-            .and_then(|()| e.setup(&sr.fd, &self.constants).map(|_| ()))
+            .and_then(|()| e.setup(&sr.fd, self.setup_constants()).map(|_| ()))
             .err()
             .map(|s| s.to_string())
     }
@@ -220,7 +236,7 @@ impl Analysis {
             set.push(e);
             out.push(set);
         }
-        let dynamics = full_order(lib, &rung.kinds, &self.constants, &fits);
+        let dynamics = full_order(lib, &rung.kinds, self.setup_constants(), &fits);
         if dynamics.len() >= 2 {
             out.push(dynamics);
         }
@@ -236,7 +252,7 @@ impl Analysis {
         cands: &[Vec<&'a dyn EffectModel>],
         rung: &Rung<'a>,
         sr: &LadderSeries,
-        opts: &Options,
+        spec: BaseSpec,
         starts: Starts,
         progress: &(dyn Fn(f64) + Sync),
     ) -> Result<Vec<Fitted<'a>>, AnalysisError> {
@@ -246,7 +262,7 @@ impl Analysis {
         let out: Vec<Option<Fitted<'a>>> = cands
             .par_iter()
             .map(|c| {
-                let r = self.fit_candidate(c, rung, sr, opts, starts);
+                let r = self.fit_candidate(c, rung, sr, spec, starts);
                 let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                 progress(k as f64 / total as f64);
                 r
@@ -256,13 +272,14 @@ impl Analysis {
     }
 
     /// One candidate `c` (effects to add, in order) fitted with the model of `rung`, from
-    /// the `starts` given.
+    /// the `starts` given, the base parameters as `spec` says (for the candidate's effects,
+    /// [`BaseSpec::for_effects`]).
     fn fit_candidate<'a>(
         &self,
         c: &[&'a dyn EffectModel],
         rung: &Rung<'a>,
         sr: &LadderSeries,
-        opts: &Options,
+        spec: BaseSpec,
         starts: Starts,
     ) -> Result<Option<Fitted<'a>>, AnalysisError> {
         let Some(set) = self.nested(c, rung, &sr.fd) else {
@@ -273,16 +290,18 @@ impl Analysis {
             .skip(rung.models.len())
             .map(|a| a.setup.len())
             .sum();
+        let spec = spec.for_effects(&set);
         // Nested: from where the model stood. An effect with what it needs first (or the
         // full-order machine) can trade off against a base parameter (the B + Bl that
-        // absorbed a start's acceleration): it is also fitted from the nominal base
-        // parameters, and the lower training cost wins, so the nested fit's cost is never
-        // exceeded. The two fits are independent and share the cores.
-        let f = if opts.fit_base && c.len() > 1 && starts == Starts::AlsoNominal {
+        // absorbed a start's acceleration): where the fit frees the base parameters it is
+        // also fitted from the nominal ones, and the lower training cost wins, so the nested
+        // fit's cost is never exceeded. The two fits are independent and share the cores.
+        let frees_base = spec.free.iter().any(|f| *f);
+        let f = if frees_base && c.len() > 1 && starts == Starts::AlsoNominal {
             let nominal = BaseParams::nominal(&self.constants);
             let (f, g) = rayon::join(
-                || self.fit_set(&sr.fd, &set, &sr.wf, &rung.fit.base, true),
-                || self.fit_set(&sr.fd, &set, &sr.wf, &nominal, true),
+                || self.fit_spec(&sr.fd, &set, &sr.wf, &rung.fit.base, spec),
+                || self.fit_spec(&sr.fd, &set, &sr.wf, &nominal, spec),
             );
             let (f, g) = (f?, g?);
             if g.report.cost < f.report.cost {
@@ -291,7 +310,7 @@ impl Analysis {
                 f
             }
         } else {
-            self.fit_set(&sr.fd, &set, &sr.wf, &rung.fit.base, opts.fit_base)?
+            self.fit_spec(&sr.fd, &set, &sr.wf, &rung.fit.base, spec)?
         };
         let pred = fit::predict(&sr.fd, &self.constants, &set, &f)?;
         let hb = metrics::errors(&sr.fd, &pred, Some(&sr.held_fd)).normalized_rms_error;
@@ -302,6 +321,7 @@ impl Analysis {
             n_parameters,
             heldback_fit_series: hb,
             implausible: why,
+            base: None,
         }))
     }
 
@@ -313,21 +333,27 @@ impl Analysis {
     /// fitted around it, it ended far above the nested fit on every log measured (the
     /// broken-bar example's last round: 40 iterations each, 30x the cost) and took more than
     /// half the ladder's time (docs/model-vs-measurement.md, "Time").
-    fn nested<'a>(
+    pub(super) fn nested<'a>(
         &self,
         c: &[&'a dyn EffectModel],
         rung: &Rung<'a>,
         fd: &Prepared,
     ) -> Option<Vec<ActiveEffect<'a>>> {
-        let starts = rung.fit.effect_params.iter().map(Some);
+        self.nested_from(&rung.models, &rung.fit.effect_params, c, fd)
+    }
+
+    /// [`Analysis::nested`] for the effects `models` with their values `values`.
+    pub(super) fn nested_from<'a>(
+        &self,
+        models: &[&'a dyn EffectModel],
+        values: &[Vec<f64>],
+        c: &[&'a dyn EffectModel],
+        fd: &Prepared,
+    ) -> Option<Vec<ActiveEffect<'a>>> {
+        let starts = values.iter().map(Some);
         let mut set = Vec::new();
-        for (e, p) in rung
-            .models
-            .iter()
-            .zip(starts)
-            .chain(c.iter().map(|e| (e, None)))
-        {
-            let mut setup = e.setup(fd, &self.constants).ok()?;
+        for (e, p) in models.iter().zip(starts).chain(c.iter().map(|e| (e, None))) {
+            let mut setup = e.setup(fd, self.setup_constants()).ok()?;
             if let Some(p) = p {
                 setup.start_only_from(p);
             }
@@ -355,7 +381,7 @@ impl Analysis {
             // The plausible ranges are those of the working series' set-up (a long log's
             // coarse copy may have fewer load segments: its own set-up then).
             let s_full = (m > 1)
-                .then(|| a.effect.setup(d, &self.constants).ok())
+                .then(|| a.effect.setup(d, self.setup_constants()).ok())
                 .flatten();
             let setup = s_full
                 .as_ref()

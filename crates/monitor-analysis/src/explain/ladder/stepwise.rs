@@ -1,0 +1,160 @@
+//! Stepwise selection both ways: after a step, an effect an earlier step added is dropped
+//! when the model without it loses less than the step's test asks ([`STEP_MIN`]): the later
+//! step explains what it stood in for (iron loss taken for a fan's drag before windage was
+//! in the model). Forward selection alone never undoes a step (Efroymson's stepwise
+//! regression, 1960, removes a term whose partial test fails after each addition; the test
+//! here is the ladder's own, on the held-back windows).
+
+use super::round::{LadderSeries, Rung};
+use super::{LadderStep, STEP_MIN};
+use crate::effects::EffectModel;
+use crate::explain::{explained_fraction, PARAM_PENALTY};
+use crate::fit::{self, BaseSpec, FitResult};
+use crate::metrics;
+use crate::{Analysis, AnalysisError};
+use monitor_core::EffectKind;
+
+/// An effect of the model that may be dropped: added by an earlier step (not configured by
+/// the user, not added by this step), a steady-state effect (the dynamics effects are the
+/// machine's order, not a stand-in), and nothing else in the model needs it.
+fn droppable(
+    models: &[&dyn EffectModel],
+    i: usize,
+    step: &LadderStep,
+    configured: &[EffectKind],
+    an: &Analysis,
+) -> bool {
+    let Some(e) = models.get(i) else {
+        return false;
+    };
+    let k = e.kind();
+    !configured.contains(&k)
+        && !step.added.contains(&k)
+        && e.time_constant_s(&an.constants).is_none()
+        && e.requires().is_empty()
+        && !models.iter().any(|m| m.requires().contains(&k))
+}
+
+/// The model of `next` without its effect `i`, refitted nested (from its values, the base
+/// as the step left it), on the fit series: the fit and its held-back error there.
+struct Without<'a> {
+    i: usize,
+    models: Vec<&'a dyn EffectModel>,
+    fit: FitResult,
+    /// The dropped effect's share of the held-back error beyond the floor (the step's
+    /// statistic for putting it back).
+    significance: f64,
+}
+
+impl Analysis {
+    /// Drops, one at a time, the earlier effects of `next` (the model after `step`, taken
+    /// from `before`) that the model no longer needs: refitted without it, the model loses
+    /// less than [`STEP_MIN`] of its held-back error beyond the floor (each of the effect's
+    /// parameters costing [`PARAM_PENALTY`]), and the whole-log error stays below
+    /// `before`'s (the step as a whole still lowers it). The step records what it dropped.
+    /// `self` is the analysis of `next`'s base parameters.
+    pub(super) fn drop_stand_ins<'a>(
+        &self,
+        mut next: Rung<'a>,
+        mut step: LadderStep,
+        before: &Rung<'a>,
+        sr: &LadderSeries,
+        configured: &[EffectKind],
+    ) -> Result<(Rung<'a>, LadderStep), AnalysisError> {
+        loop {
+            let idx: Vec<usize> = (0..next.models.len())
+                .filter(|&i| droppable(&next.models, i, &step, configured, self))
+                .collect();
+            if idx.is_empty() {
+                break;
+            }
+            let mut best: Option<Without<'a>> = None;
+            for i in idx {
+                let Some(w) = self.without(&next, i, sr)? else {
+                    continue;
+                };
+                if best
+                    .as_ref()
+                    .is_none_or(|b| w.significance < b.significance)
+                {
+                    best = Some(w);
+                }
+            }
+            let Some(w) = best else {
+                break;
+            };
+            if w.significance >= STEP_MIN {
+                break;
+            }
+            let gone = next.kinds[w.i];
+            let rung = self.measure_rung(w.models, w.fit, sr, next.scales)?;
+            if !(rung.error < before.error && rung.error.is_finite()) {
+                break;
+            }
+            step.dropped.push(gone);
+            step.summary = format!(
+                "{}; {gone} removed: the model without it loses {:.0} % of the held-back error beyond the noise floor (a step must earn {:.0} %), this step explains what it stood in for",
+                step.summary,
+                100.0 * w.significance.max(0.0),
+                100.0 * STEP_MIN
+            );
+            step.error = rung.error;
+            step.heldback_error = rung.heldback_error;
+            step.noise_floor = rung.noise;
+            step.heldback_noise_floor = rung.heldback_noise;
+            step.ratio_to_floor = rung.error / rung.noise;
+            step.heldback_ratio_to_floor = rung.heldback_error / rung.heldback_noise;
+            step.explained = explained_fraction(before.error, rung.error, rung.noise);
+            step.heldback_explained = explained_fraction(
+                before.heldback_error,
+                rung.heldback_error,
+                rung.heldback_noise,
+            );
+            next = rung;
+        }
+        Ok((next, step))
+    }
+
+    /// `next`'s model without its effect `i`, refitted nested on the fit series (`None`
+    /// when a set-up refuses the series).
+    fn without<'a>(
+        &self,
+        next: &Rung<'a>,
+        i: usize,
+        sr: &LadderSeries,
+    ) -> Result<Option<Without<'a>>, AnalysisError> {
+        let models: Vec<&'a dyn EffectModel> = next
+            .models
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| *j != i)
+            .map(|(_, m)| *m)
+            .collect();
+        let values: Vec<Vec<f64>> = next
+            .fit
+            .effect_params
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| *j != i)
+            .map(|(_, p)| p.clone())
+            .collect();
+        let Some(set) = self.nested_from(&models, &values, &[], &sr.fd) else {
+            return Ok(None);
+        };
+        let spec = BaseSpec::paper(sr.fit_base).for_effects(&set);
+        let f = self.fit_spec(&sr.fd, &set, &sr.wf, &next.fit.base, spec)?;
+        let pred = fit::predict(&sr.fd, &self.constants, &set, &f)?;
+        let hb = metrics::errors(&sr.fd, &pred, Some(&sr.held_fd)).normalized_rms_error;
+        if !hb.is_finite() {
+            return Ok(None);
+        }
+        let k = next.fit.effect_params.get(i).map_or(0, Vec::len);
+        let with = next.heldback_fit_series * (1.0 + PARAM_PENALTY * k as f64);
+        Ok(Some(Without {
+            i,
+            models,
+            fit: f,
+            significance: explained_fraction(hb, with, next.heldback_noise_fit_series),
+        }))
+    }
+}
