@@ -164,20 +164,50 @@ class ExplainResult(Result):
 
 
 class LadderResult(Result):
-    """``explain --ladder``'s report. Keys: ``start``, ``ladder`` (the steps in order),
-    ``stop``, ``stopped_because``, ``final_effects``, ``last_round``, ``skipped``,
-    ``split``, ``test``, ``data``, ``data_quality``."""
+    """``explain --ladder``'s report. Keys: ``summary`` (what was found, then why it
+    stopped), ``base_changes`` (the base parameters that differ from the file, with their
+    intervals), ``final_fit`` (the chosen model refitted on the whole log), ``start``,
+    ``ladder`` (the steps in order: an effect added, with what it dropped, or the base
+    parameters refitted), ``stop``, ``stopped_because``, ``final_effects``, ``last_round``,
+    ``skipped``, ``split``, ``test``, ``data``, ``data_quality``."""
+
+    @property
+    def base_frame(self):
+        """The six base parameters against the file (from the chosen model refitted on the
+        whole log) as a DataFrame: parameter, relative change, its 95 % interval, the file's
+        and the refitted value, whether the log identifies it and whether the ladder names
+        the change."""
+        rows = []
+        for c in (self._doc.get("final_fit") or {}).get("base", []):
+            interval = c.get("interval") or [None, None]
+            rows.append(
+                {
+                    "base": c.get("base"),
+                    "change": c.get("change"),
+                    "low": interval[0],
+                    "high": interval[1],
+                    "file_value": c.get("file_value"),
+                    "value": c.get("value"),
+                    "unit": c.get("unit"),
+                    "identified": c.get("identified"),
+                    "changed": c.get("changed"),
+                }
+            )
+        return _frame(rows)
 
     @property
     def ladder_frame(self):
-        """The steps as a DataFrame, step 0 the model as configured: step, effects added,
-        whole-log and held-back error, each as a multiple of its noise floor, the test
-        statistic (``significance``) and the shares of the error beyond the floor explained."""
+        """The steps as a DataFrame, step 0 the model as configured: step, effects added
+        (``base`` for the base rung), effects dropped, the base changes it named, whole-log
+        and held-back error, each as a multiple of its noise floor, the test statistic
+        (``significance``) and the shares of the error beyond the floor explained."""
         start = self._doc.get("start", {})
         rows = [
             {
                 "step": 0,
                 "added": "",
+                "dropped": "",
+                "base": "",
                 "error": start.get("error"),
                 "heldback_error": start.get("heldback_error"),
                 "noise_floor": start.get("noise_floor"),
@@ -191,7 +221,13 @@ class LadderResult(Result):
             rows.append(
                 {
                     "step": k,
-                    "added": "+".join(s.get("added", [])),
+                    "added": "+".join(s.get("added", [])) if s.get("effect") else "base",
+                    "dropped": "+".join(s.get("dropped", [])),
+                    "base": ", ".join(
+                        "%s %+.1f %%" % (c["base"], 100.0 * c["change"])
+                        for c in s.get("base", [])
+                        if c.get("changed")
+                    ),
                     "error": s.get("error"),
                     "heldback_error": s.get("heldback_error"),
                     "noise_floor": s.get("noise_floor"),

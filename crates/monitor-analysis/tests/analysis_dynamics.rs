@@ -452,6 +452,7 @@ fn saturated_full_order_model_reproduces_the_simulator() {
                     law: sat.map(|(psi_sat_wb, exponent)| sm::SaturationLaw {
                         psi_sat_wb,
                         exponent,
+                        lm0_over_file: a.constants.lm0_over_file(psi_sat_wb, exponent),
                     }),
                     ..Default::default()
                 },

@@ -7,7 +7,9 @@
 
 pub use monitor_analysis::compare::{CompareOutput, CompareReport};
 pub use monitor_analysis::effects::sig;
-pub use monitor_analysis::explain::ladder::{LadderReport, LadderStep, FLOOR_BAND};
+pub use monitor_analysis::explain::ladder::{
+    tried_name, BaseChange, FinalFit, LadderReport, LadderStep, Tried, FLOOR_BAND,
+};
 pub use monitor_analysis::explain::{ExplainOutput, ExplainReport, Standing, EXPLAINS_MIN};
 pub use monitor_analysis::identify::{self, Identification};
 pub use monitor_analysis::metrics::{self, WorstWindow};

@@ -88,7 +88,9 @@ pub use encoder::EncoderConfig;
 pub use error::{ConfigCheck, ConfigError, ConfigErrorKind};
 pub use frames::{Abc, AlphaBeta, Dq, Phase, Real, SinCos};
 pub use isolation::{Isolation, IsolationState, Isolator, Named, SteadyPoint};
-pub use machine::{reference, MotorModel, MotorParameters, ReferenceMachine, SupplyParameters};
+pub use machine::{
+    reference, LmPoint, MotorModel, MotorParameters, ReferenceMachine, SupplyParameters,
+};
 pub use monitor::{
     CommissioningState, Monitor, MonitorConfig, MonitorOutput, ResidualForm, Sample, SensorFlags,
     SensorLimits,

@@ -154,9 +154,41 @@ pub struct MotorParameters {
         serde(default, skip_serializing_if = "Option::is_none")
     )]
     pub rotor_bars: Option<u32>,
+    /// Which magnetising inductance `lm_h` is (optional key `lm_at`, [`LmPoint`]; absent:
+    /// [`LmPoint::Rated`], what a no-load test or a nameplate gives). Only a saturation law
+    /// (the host's analysis and simulator) reads it; the equations and the board's motor
+    /// record do not.
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "Option::is_none")
+    )]
+    pub lm_at: Option<LmPoint>,
+}
+
+/// Which magnetising inductance a parameter file's `lm_h` holds: the saturation law
+/// `Lm = Lm0 / (1 + (psi_m / psi_sat)^n)` starts from the unsaturated `Lm0`, and a file
+/// from a no-load test at rated voltage holds the rated point's, `Lm0` divided by
+/// `1 + (psi_m,rated / psi_sat)^n`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum LmPoint {
+    /// The value at the rated flux: a no-load test at rated voltage, a nameplate's estimate
+    /// (the default).
+    #[default]
+    Rated,
+    /// The unsaturated value (the linear part of the magnetisation curve): a simulator's
+    /// machine, a design calculation.
+    Unsaturated,
 }
 
 impl MotorParameters {
+    /// Which magnetising inductance `lm_h` is ([`MotorParameters::lm_at`], absent:
+    /// [`LmPoint::Rated`]).
+    pub fn lm_point(&self) -> LmPoint {
+        self.lm_at.unwrap_or_default()
+    }
+
     /// The model the equations use, in `f32` (board) or `f64` (host): the workspace's one
     /// conversion from the parameter file. Pole pairs are `poles / 2` (saturating at 255).
     pub fn model<T: Real>(&self) -> MotorModel<T> {
@@ -254,6 +286,7 @@ pub mod reference {
             b_nms: 0.005,
             bl_nms: 0.0975,
             rotor_bars: None,
+            lm_at: Some(super::LmPoint::Unsaturated),
         },
         supply: SupplyParameters {
             v_ll_rms: 400.0,
@@ -282,6 +315,7 @@ pub mod reference {
             b_nms: 0.002,
             bl_nms: 0.045,
             rotor_bars: None,
+            lm_at: Some(super::LmPoint::Unsaturated),
         },
         supply: SupplyParameters {
             v_ll_rms: 220.0,

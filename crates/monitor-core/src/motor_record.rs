@@ -176,6 +176,7 @@ impl MotorRecord {
             b_nms,
             bl_nms,
             rotor_bars: None,
+            lm_at: None,
         };
         let supply = SupplyParameters {
             v_ll_rms: r.f64()?,

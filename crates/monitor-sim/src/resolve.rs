@@ -23,6 +23,10 @@ pub(super) struct ResolvedEffects {
     pub(super) asym: Option<(usize, f64, Option<f64>)>,
     /// Rotor resistance asymmetry delta (`rotor_asymmetry`), 0 when off.
     pub(super) rotor_delta: f64,
+    /// The saturation law's unsaturated Lm0 over the file's `lm_h`
+    /// ([`monitor_io::params::lm0_over_file`]: above 1 where the file holds the rated
+    /// point's Lm); 0 read as 1 (no saturation).
+    pub(super) lm0_over_file: f64,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -108,10 +112,19 @@ impl ResolvedEffects {
                 psi_sat_ratio,
                 exponent,
             } => {
+                let psi_sat_wb = psi_sat_wb.unwrap_or(psi_sat_ratio * vpk0 / we0);
                 self.sat = Some(SatLaw {
-                    psi_sat_wb: psi_sat_wb.unwrap_or(psi_sat_ratio * vpk0 / we0),
+                    psi_sat_wb,
                     exponent,
-                })
+                });
+                // The file's Lm at the rated point (a no-load test's) is the law's value
+                // there: Lm0 above it.
+                let supply = monitor_core::SupplyParameters {
+                    v_ll_rms: vpk0 * (1.5f64).sqrt(),
+                    f_hz: we0 / (2.0 * PI),
+                };
+                self.lm0_over_file =
+                    monitor_io::params::lm0_over_file(m, &supply, psi_sat_wb, exponent);
             }
             EffectSpec::IronLoss {
                 rfe_ohm,
@@ -248,7 +261,12 @@ impl MachineBuilder<'_> {
         let rr = m.rr_ohm * md.rr * md.th_r;
         let gamma_s = model.lls_h() <= 1e-9 * m.lm_h;
         let gamma_r = model.llr_h() <= 1e-9 * m.lm_h;
-        let mut lm = m.lm_h;
+        let mut lm = m.lm_h
+            * if self.eff.lm0_over_file > 0.0 {
+                self.eff.lm0_over_file
+            } else {
+                1.0
+            };
         if gamma_s {
             lm *= md.lls;
         }

@@ -108,6 +108,7 @@ impl Machine {
                 b_nms: 0.005 * 1000.0 * self.p_kw / (w_rated * w_rated),
                 bl_nms: 1000.0 * self.p_kw / (w_rated * w_rated),
                 rotor_bars: None,
+                lm_at: None,
             },
             supply: SupplyParameters {
                 v_ll_rms: self.v_ll,

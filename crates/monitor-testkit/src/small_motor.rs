@@ -26,6 +26,7 @@ pub fn small_0p37kw() -> ParamFile {
             b_nms: 0.005 * bl,
             bl_nms: bl,
             rotor_bars: None,
+            lm_at: None,
         },
         supply: SupplyParameters {
             v_ll_rms: 400.0,

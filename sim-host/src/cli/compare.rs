@@ -364,18 +364,16 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
 fn run_ladder(c: &Common) -> anyhow::Result<()> {
     c.check(&[render::charts::LADDER])?;
     let (a, _) = c.load()?;
-    let show = a.data.len() > 20_000;
-    let pb = progress::bar(
-        progress::FRACTION_STEPS,
+    // A bar whenever the walk runs longer than 2 s: each step's candidates, then the
+    // chosen model's refit on the whole log.
+    let pb = progress::LateBar::new(
         "ladder step 1: fitting candidates",
-        show,
+        std::time::Duration::from_secs(2),
     );
-    let pbc = pb.clone();
-    let report = a.ladder(&c.options(), &move |step, f| {
-        pbc.set_message(format!("ladder step {step}: fitting candidates"));
-        progress::set_fraction(&pbc, f);
+    let report = a.ladder(&c.options(), &|step, f| {
+        pb.set(Some(format!("ladder step {step}: fitting")), f);
     })?;
-    pb.finish_and_clear();
+    pb.finish();
     render::html::write_ladder(c.plot.as_deref(), c.report.as_deref(), &c.log, &report)?;
     if c.json {
         render::json::print(&mut crate::cli::stdout(), &report)

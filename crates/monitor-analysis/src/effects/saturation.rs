@@ -129,7 +129,7 @@ impl TryFrom<&[f64]> for SaturationValues {
 const ABOUT: About = About {
     kind: EffectKind::Saturation,
     description: "The iron of the main flux path saturates: the magnetising inductance Lm falls as the magnetising current (the flux level) rises.",
-    equations: "Lm(i_f) = Lm0 / (1 + (Lm(i_f) i_f / psi_sat)^n), solved per sample; Ls = Lls + Lm and Kf (Lm^2/Lr) in eqs. (28)-(29) follow. In the full-order model (all dynamics effects in) the same law acts on the model's own magnetising flux |psi_m| = Lm |i_s + i_r|, the fluxes of the T-equivalent circuit being its states.",
+    equations: "Lm(i_f) = Lm0 / (1 + (Lm(i_f) i_f / psi_sat)^n), solved per sample; Lm0 is the file's Lm where the file holds the unsaturated value (lm_at = \"unsaturated\"), else (a no-load test's rated point, the default) the file's Lm times 1 + (psi_m,rated / psi_sat)^n, so that the law gives the file's value at the rated flux; Ls = Lls + Lm and Kf (Lm^2/Lr) in eqs. (28)-(29) follow. In the full-order model (all dynamics effects in) the same law acts on the model's own magnetising flux |psi_m| = Lm |i_s + i_r|, the fluxes of the T-equivalent circuit being its states.",
     parameters: &PARAMS,
 };
 
@@ -170,12 +170,18 @@ impl Contribution for SaturationOnLog {
             psi_sat_wb,
             exponent,
         } = *p;
+        // The law starts from the unsaturated Lm0: the file's Lm where it holds that one,
+        // else the file's rated-point Lm raised by the law's own drop there.
+        let k0 = n.lm0_over_file(psi_sat_wb, exponent);
         t.scale_magnetising_inductance(
-            sat_factors(n.lm_h, &d.i_f, psi_sat_wb, exponent).into_iter(),
+            sat_factors(k0 * n.lm_h, &d.i_f, psi_sat_wb, exponent)
+                .into_iter()
+                .map(|x| k0 * x),
         );
         t.magnetising.law = Some(SaturationLaw {
             psi_sat_wb,
             exponent,
+            lm0_over_file: k0,
         });
     }
     fn describe(&self, p: &SaturationValues, d: &Prepared, n: &MachineConstants) -> String {
@@ -186,16 +192,24 @@ impl Contribution for SaturationOnLog {
             imin = imin.min(i.abs());
             imax = imax.max(i.abs());
         }
+        let k0 = n.lm0_over_file(psi_sat, nexp);
         let (lo, hi) = if imax >= imin {
             (
-                sat_factor(n.lm_h, imax, psi_sat, nexp),
-                sat_factor(n.lm_h, imin, psi_sat, nexp),
+                sat_factor(k0 * n.lm_h, imax, psi_sat, nexp),
+                sat_factor(k0 * n.lm_h, imin, psi_sat, nexp),
             )
         } else {
             (f64::INFINITY, 0.0)
         };
+        let file = match n.lm_point {
+            monitor_core::LmPoint::Rated => format!(
+                "; the file's Lm is the rated point's, {:.0} % of the unsaturated",
+                100.0 / k0
+            ),
+            monitor_core::LmPoint::Unsaturated => String::new(),
+        };
         format!(
-            "magnetising inductance falls with flux: Lm is {:.0} % to {:.0} % of its unsaturated value over this log (saturation flux {:.2} Wb = {:.2} x the rated flux, knee exponent {:.1})",
+            "magnetising inductance falls with flux: Lm is {:.0} % to {:.0} % of its unsaturated value over this log (saturation flux {:.2} Wb = {:.2} x the rated flux, knee exponent {:.1}{file})",
             lo * 100.0,
             hi * 100.0,
             psi_sat,

@@ -275,7 +275,8 @@ impl<'a> FullRun<'a> {
     pub(super) fn machine(&self, k: usize) -> FullMachine {
         let ModelRun { n, b, t, .. } = self.run;
         if self.unsaturated {
-            FullMachine::at_lm(n, b, t, k, 1.0)
+            let lm0 = t.magnetising.law.map_or(1.0, |l| l.lm0_over_file);
+            FullMachine::at_lm(n, b, t, k, lm0)
         } else {
             FullMachine::at(n, b, t, k)
         }

@@ -87,6 +87,26 @@ pub struct MachineConstants {
     pub core_model: monitor_core::MotorModel,
     /// The parameter file's peak phase voltage [V].
     pub v_phase_peak: f64,
+    /// Which magnetising inductance `lm_h` is (the file's `lm_at`): a saturation law takes
+    /// its unsaturated Lm0 from it ([`monitor_io::params::lm0_over_file`]).
+    pub lm_point: monitor_core::LmPoint,
+    /// The rated point's magnetising flux [Wb, peak]
+    /// ([`monitor_io::params::rated_magnetising_flux_wb`]).
+    pub psi_m_rated_wb: f64,
+}
+
+impl MachineConstants {
+    /// The saturation law's unsaturated Lm0 over `lm_h` for a law with `psi_sat_wb` and
+    /// exponent `n` ([`monitor_io::params::lm0_over_file`]: 1 for a file that holds the
+    /// unsaturated value).
+    pub fn lm0_over_file(&self, psi_sat_wb: f64, n: f64) -> f64 {
+        match self.lm_point {
+            monitor_core::LmPoint::Unsaturated => 1.0,
+            monitor_core::LmPoint::Rated => {
+                1.0 + (self.psi_m_rated_wb / psi_sat_wb.max(1e-9)).powf(n)
+            }
+        }
+    }
 }
 
 impl MachineConstants {
@@ -117,6 +137,8 @@ impl MachineConstants {
             torque_scale_nm: t_rated,
             core_model: p.motor.model(),
             v_phase_peak: p.supply.v_phase_peak(),
+            lm_point: p.motor.lm_point(),
+            psi_m_rated_wb: monitor_io::params::rated_magnetising_flux_wb(&p.motor, &p.supply),
         }
     }
 }

@@ -69,6 +69,9 @@ pub struct SaturationLaw {
     pub psi_sat_wb: f64,
     /// Sharpness of the knee, n [-] (about 2 to 14).
     pub exponent: f64,
+    /// Lm0 over the machine's `lm_h` ([`super::MachineConstants::lm0_over_file`]: above
+    /// 1 where the file holds the rated point's Lm).
+    pub lm0_over_file: f64,
 }
 
 /// A shaft torque that depends only on the speed (friction, drag).

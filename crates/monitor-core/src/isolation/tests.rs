@@ -102,6 +102,7 @@ fn motor_11kw() -> MotorParameters {
         b_nms: 0.003,
         bl_nms: 0.11,
         rotor_bars: None,
+        lm_at: None,
     }
 }
 

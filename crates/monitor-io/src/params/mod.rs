@@ -197,6 +197,30 @@ struct FileSections {
     columns: ColumnsTable,
 }
 
+/// The magnetising flux linkage of the rated point [Wb, peak]: the machine at no load on
+/// its rated supply, the stator's resistive drop neglected, `psi_m = (V_phase,peak /
+/// omega_s) Lm / Ls` (the T-equivalent circuit's magnetising branch takes `Lm / Ls` of the
+/// stator flux).
+pub fn rated_magnetising_flux_wb(m: &MotorParameters, s: &SupplyParameters) -> f64 {
+    let ws = s.omega_rad_s().abs().max(1e-9);
+    s.v_phase_peak() / ws * m.lm_h / m.ls_h.max(1e-12)
+}
+
+/// The factor from the file's `lm_h` to the unsaturated Lm0 of the saturation law
+/// `Lm = Lm0 / (1 + (psi_m / psi_sat)^n)`: 1 where the file holds the unsaturated value
+/// ([`monitor_core::LmPoint::Unsaturated`]); where it holds the rated point's (a no-load
+/// test, the default) `1 + (psi_m,rated / psi_sat)^n`, `psi_m,rated` the rated point's
+/// magnetising flux ([`rated_magnetising_flux_wb`]), so that the law gives the file's value
+/// there. The simulator and the analysis take the file's Lm the same way.
+pub fn lm0_over_file(m: &MotorParameters, s: &SupplyParameters, psi_sat_wb: f64, n: f64) -> f64 {
+    match m.lm_point() {
+        monitor_core::LmPoint::Unsaturated => 1.0,
+        monitor_core::LmPoint::Rated => {
+            1.0 + (rated_magnetising_flux_wb(m, s) / psi_sat_wb.max(1e-9)).powf(n)
+        }
+    }
+}
+
 impl ParamFile {
     /// Parses TOML text; `origin` names the source in messages. A `[columns]` table is
     /// left out ([`ParamFile::from_toml_str_with_columns`] returns it).

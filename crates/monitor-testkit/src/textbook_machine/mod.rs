@@ -172,7 +172,8 @@ impl Machine {
         self.v_peak() / (2.0 * PI * self.f_hz)
     }
 
-    /// The parameter file (docs/design.md format) with this machine's true values;
+    /// The parameter file (docs/design.md format) with this machine's true values (its Lm
+    /// the unsaturated one, `lm_at = "unsaturated"`: a saturating machine's law starts there);
     /// `bl_nms` is `bl` (0 for a torque load), every electrical and mechanical value
     /// scaled by `1 + off` with alternating signs when `off` is not 0.
     pub fn params_toml(&self, bl: f64, off: f64) -> String {
@@ -182,7 +183,7 @@ impl Machine {
         let lr = lm + self.llr * up;
         format!(
             "# Textbook machine {} (crates/monitor-testkit/src/textbook_machine)\n[motor]\nrs_ohm = {}\n\
-             rr_ohm = {}\nls_h = {}\nlr_h = {}\nlm_h = {}\npoles = {}\nj_kgm2 = {}\n\
+             rr_ohm = {}\nls_h = {}\nlr_h = {}\nlm_h = {}\nlm_at = \"unsaturated\"\npoles = {}\nj_kgm2 = {}\n\
              b_nms = {}\nbl_nms = {}\n\n[supply]\nv_ll_rms = {}\nf_hz = {}\n",
             self.name,
             self.rs * up,

@@ -62,7 +62,7 @@ pub fn ladder_chart(r: &LadderReport) -> Chart<'static> {
     Chart {
         stem: LADDER,
         title: "The ladder: the model's error after each step, onto the noise floor",
-        x_label: "step (0: the model as configured; each step adds the effect named in the table)",
+        x_label: "step (0: the model as configured; each step adds an effect or refits the base parameters, as the table names)",
         y_label: "normalized RMS error",
         series: vec![
             line("whole log".into(), whole.clone(), 0, false),

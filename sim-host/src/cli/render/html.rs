@@ -132,16 +132,23 @@ fn ladder_html(log: &str, r: &LadderReport, charts: &[(String, String)]) -> Stri
     } else {
         effect_list(&r.start.effects)
     };
-    let _ = write!(h, "<p class=v>{}</p>", esc(&r.stopped_because));
+    let _ = write!(h, "<p class=v>{}</p>", esc(&r.summary));
     for (title, svg) in charts {
         let _ = write!(h, "<h3>{}</h3>{svg}", esc(title));
     }
-    h.push_str("<table><tr><th>step</th><th class=l>effect added</th><th>error</th><th>x floor</th><th>held-back</th><th>x floor</th><th>explained (whole / held-back)</th><th class=l>fitted (physical range)</th></tr>");
+    h.push_str("<table><tr><th>step</th><th class=l>change</th><th>error</th><th>x floor</th><th>held-back</th><th>x floor</th><th>explained (whole / held-back)</th><th class=l>fitted (physical range)</th></tr>");
     let _ = write!(h, "<tr><td>0</td><td class=l>{}</td><td>{:.4}</td><td>{:.1}</td><td>{:.4}</td><td>{:.1}</td><td></td><td></td></tr>", esc(&start), r.start.error, r.start.ratio_to_floor, r.start.heldback_error, r.start.heldback_error / r.start.heldback_noise_floor);
     for (k, s) in r.ladder.iter().enumerate() {
-        let fitted: Vec<String> = s
+        let changed: Vec<String> = s
+            .base
+            .iter()
+            .filter(|c| c.changed)
+            .map(|c| c.spelled())
+            .collect();
+        let mut fitted: Vec<String> = s
             .fitted
             .iter()
+            .filter(|_| s.effect.is_some())
             .map(|(n, v)| {
                 format!(
                     "{n} {:.4} {} ({:.3}..{:.3})",
@@ -149,9 +156,34 @@ fn ladder_html(log: &str, r: &LadderReport, charts: &[(String, String)]) -> Stri
                 )
             })
             .collect();
-        let _ = write!(h, "<tr><td>{}</td><td class=l>{}</td><td>{:.4}</td><td>{:.1}</td><td>{:.4}</td><td>{:.1}</td><td>{:.0} % / {:.0} %</td><td class=l>{}</td></tr>", k + 1, esc(&effect_list(&s.added)), s.error, s.ratio_to_floor, s.heldback_error, s.heldback_ratio_to_floor, 100.0 * s.explained, 100.0 * s.heldback_explained, esc(&fitted.join("; ")));
+        if !changed.is_empty() {
+            fitted.push(format!("base: {}", changed.join(", ")));
+        }
+        let mut name = match s.effect {
+            None => "base parameters refitted".to_string(),
+            Some(_) => effect_list(&s.added),
+        };
+        for d in &s.dropped {
+            name.push_str(&format!(", {d} removed"));
+        }
+        let _ = write!(h, "<tr><td>{}</td><td class=l>{}</td><td>{:.4}</td><td>{:.1}</td><td>{:.4}</td><td>{:.1}</td><td>{:.0} % / {:.0} %</td><td class=l>{}</td></tr>", k + 1, esc(&name), s.error, s.ratio_to_floor, s.heldback_error, s.heldback_ratio_to_floor, 100.0 * s.explained, 100.0 * s.heldback_explained, esc(&fitted.join("; ")));
+    }
+    if let Some(f) = &r.final_fit {
+        let changed: Vec<String> = f
+            .base
+            .iter()
+            .filter(|c| c.changed)
+            .map(|c| c.spelled())
+            .collect();
+        let base = if changed.is_empty() {
+            "base parameters as the file's".to_string()
+        } else {
+            format!("base: {}", changed.join(", "))
+        };
+        let _ = write!(h, "<tr><td>end</td><td class=l>the chosen model refitted on the whole log</td><td>{:.4}</td><td>{:.1}</td><td></td><td></td><td></td><td class=l>{}</td></tr>", f.error, f.ratio_to_floor, esc(&base));
     }
     h.push_str("</table>");
+    let _ = write!(h, "<p>Stopped: {}</p>", esc(&r.stopped_because));
     let _ = write!(h, "<p>The test: {}.</p>", esc(&r.test));
     if !r.last_round.is_empty() {
         h.push_str("<h2>The last round's other candidates</h2><ul>");
@@ -159,7 +191,7 @@ fn ladder_html(log: &str, r: &LadderReport, charts: &[(String, String)]) -> Stri
             let _ = write!(
                 h,
                 "<li>{}: {}</li>",
-                esc(&effect_list(&t.added)),
+                esc(&monitor_api::analysis::tried_name(t)),
                 esc(&t.because)
             );
         }

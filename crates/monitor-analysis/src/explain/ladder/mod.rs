@@ -519,8 +519,9 @@ fn nothing_helps(rung: &Rung<'_>, tried: &[Tried], base_tried: bool, skipped: &[
     )
 }
 
-/// A tried candidate's name: its effects joined with `+`, or `base parameters`.
-pub(crate) fn tried_name(t: &Tried) -> String {
+/// A tried candidate's name: its effects joined with `+`, or `the base parameters
+/// refitted`.
+pub fn tried_name(t: &Tried) -> String {
     if t.base {
         return "the base parameters refitted".to_string();
     }

@@ -3,7 +3,7 @@
 use super::diagnose::data_quality;
 use super::number;
 use monitor_api::analysis::CompareReport;
-use monitor_api::analysis::LadderReport;
+use monitor_api::analysis::{tried_name, LadderReport};
 use monitor_api::analysis::{ExplainReport, Standing, EXPLAINS_MIN};
 use monitor_api::ExplainDocument;
 use std::io::Write;
@@ -252,11 +252,13 @@ fn apart(out: &mut impl Write, r: &ExplainReport) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// `explain --ladder`'s table: the model as configured, one row per step (the effect added,
-/// the whole-log and held-back error each with its multiple of the noise floor, the share of
-/// the error beyond the floor the step removed on each, the fitted values with their
-/// physical ranges), then why it stopped, the test, the last round's other candidates and
-/// what could not be fitted.
+/// `explain --ladder`'s page: first what was found (the summary: the base changes and the
+/// effects with their sizes, the end, why it stopped), then the table: the model as
+/// configured, one row per step (the effect added and what it dropped, or the base rung's
+/// changes; the whole-log and held-back error each with its multiple of the noise floor,
+/// the share of the error beyond the floor the step removed on each, the fitted values with
+/// their physical ranges), the chosen model refitted on the whole log, then why it stopped,
+/// the test, the last round's other candidates and what could not be fitted.
 pub fn ladder(
     mut out: &mut dyn std::io::Write,
     log: &Path,
@@ -264,10 +266,11 @@ pub fn ladder(
 ) -> anyhow::Result<()> {
     writeln!(out, "explain --ladder {}", log.display())?;
     data_quality(&mut out, &r.data_quality)?;
+    writeln!(out, "{}", r.summary)?;
     writeln!(
         out,
         "  {:<4} {:<34} {:>8} {:>7} {:>9} {:>7} {:>11}  fitted (physical range)",
-        "step", "effect added", "error", "x floor", "held-back", "x floor", "explained"
+        "step", "change", "error", "x floor", "held-back", "x floor", "explained"
     )?;
     writeln!(
         out,
@@ -285,6 +288,30 @@ pub fn ladder(
     for (k, s) in r.ladder.iter().enumerate() {
         writeln!(out, "{}", ladder_row(k + 1, s))?;
     }
+    if let Some(f) = &r.final_fit {
+        let changed: Vec<String> = f
+            .base
+            .iter()
+            .filter(|c| c.changed)
+            .map(|c| c.spelled())
+            .collect();
+        writeln!(
+            out,
+            "  {:<4} {:<34} {:>8} {:>7} {:>9} {:>7} {:>11}  {}",
+            "end",
+            "refitted on the whole log",
+            number(f.error),
+            times(f.ratio_to_floor),
+            "",
+            "",
+            "",
+            if changed.is_empty() {
+                "base parameters as the file's".to_string()
+            } else {
+                format!("base: {}", changed.join(", "))
+            }
+        )?;
+    }
     writeln!(
         out,
         "  (explained: the share of the error beyond the noise floor the step removed, whole log / held-back windows)"
@@ -292,8 +319,7 @@ pub fn ladder(
     writeln!(out, "stopped: {}", r.stopped_because)?;
     writeln!(out, "  the test: {}", r.test)?;
     for t in &r.last_round {
-        let names: Vec<&str> = t.added.iter().map(|k| k.name()).collect();
-        writeln!(out, "  not kept: {}: {}", names.join("+"), t.because)?;
+        writeln!(out, "  not kept: {}: {}", tried_name(t), t.because)?;
     }
     for s in &r.skipped {
         writeln!(out, "  not fitted: {s}")?;
@@ -301,25 +327,47 @@ pub fn ladder(
     Ok(())
 }
 
-/// One step's row of the ladder's table (`k`: its number).
+/// One step's row of the ladder's table (`k`: its number): `+ effect` (and `- dropped`), or
+/// `base: Rs +20 % (±1 %), ...` for the base rung.
 fn ladder_row(k: usize, s: &monitor_api::analysis::LadderStep) -> String {
-    let fitted: Vec<String> = s
-        .fitted
+    let changed: Vec<String> = s
+        .base
         .iter()
-        .map(|(n, v)| {
-            format!(
-                "{n} {} {} ({}..{})",
-                sig(v.value),
-                v.unit,
-                sig(v.low),
-                sig(v.high)
-            )
-        })
+        .filter(|c| c.changed)
+        .map(|c| c.spelled())
         .collect();
+    let mut name = if s.effect.is_none() {
+        "base parameters refitted".to_string()
+    } else {
+        model_name(&s.added, "", "+ ", " + ")
+    };
+    for d in &s.dropped {
+        name.push_str(&format!(" - {d}"));
+    }
+    let fitted: Vec<String> = if s.effect.is_none() {
+        changed.clone()
+    } else {
+        s.fitted
+            .iter()
+            .map(|(n, v)| {
+                format!(
+                    "{n} {} {} ({}..{})",
+                    sig(v.value),
+                    v.unit,
+                    sig(v.low),
+                    sig(v.high)
+                )
+            })
+            .chain(
+                (!changed.is_empty())
+                    .then(|| format!("on the refitted base: {}", changed.join(", "))),
+            )
+            .collect()
+    };
     format!(
         "  {:<4} {:<34} {:>8} {:>7} {:>9} {:>7} {:>4.0}% / {:>3.0}%  {}",
         k,
-        model_name(&s.added, "", "+ ", " + "),
+        name,
         number(s.error),
         times(s.ratio_to_floor),
         number(s.heldback_error),
