@@ -62,6 +62,11 @@ pub struct BaseSpec {
     pub prior: [bool; N_BASE],
     /// The priors' weight (see the type's doc).
     pub prior_weight: f64,
+    /// How many of the fit's first effects hold their start values (0: every effect's
+    /// values are free): a screening fit of a candidate added to a model fitted before
+    /// frees only the candidate's values and the base parameters, a few simulations per
+    /// iteration where the whole model's values would take many.
+    pub hold_first: usize,
 }
 
 impl BaseSpec {
@@ -70,6 +75,7 @@ impl BaseSpec {
         free: [false; N_BASE],
         prior: [false; N_BASE],
         prior_weight: PRIOR_WEIGHT,
+        hold_first: 0,
     };
     /// All four free with their priors at [`PRIOR_WEIGHT`] (`compare`'s and `explain`'s
     /// fit).
@@ -77,6 +83,7 @@ impl BaseSpec {
         free: [true; N_BASE],
         prior: [true; N_BASE],
         prior_weight: PRIOR_WEIGHT,
+        hold_first: 0,
     };
 
     /// [`BaseSpec::PAPER`] when `fit_base`, else [`BaseSpec::FIXED`].
@@ -362,8 +369,19 @@ pub fn fit_spec(
         hi.push(q.hi);
         scale.push(q.scale);
     }
+    let held: usize = effects
+        .iter()
+        .take(spec.hold_first)
+        .map(|e| e.setup.len())
+        .sum();
     let free: Vec<usize> = (0..x.len())
-        .filter(|&i| i >= N_BASE || spec.free[i])
+        .filter(|&i| {
+            if i < N_BASE {
+                spec.free[i]
+            } else {
+                i >= N_BASE + held
+            }
+        })
         .collect();
     let bounds = lm::Bounds { lo, hi, scale };
     prob.terms(&x)?;

@@ -434,7 +434,20 @@ impl Analysis {
         start: &BaseParams,
         spec: fit::BaseSpec,
     ) -> Result<FitResult, effects::EffectValuesError> {
-        fit::fit_spec(fitdata, &self.constants, active, w, start, spec, MAX_ITER)
+        self.fit_spec_iter(fitdata, active, w, start, spec, MAX_ITER)
+    }
+
+    /// [`Analysis::fit_spec`] with at most `max_iter` iterations.
+    fn fit_spec_iter(
+        &self,
+        fitdata: &Prepared,
+        active: &[ActiveEffect<'_>],
+        w: &Weights,
+        start: &BaseParams,
+        spec: fit::BaseSpec,
+        max_iter: usize,
+    ) -> Result<FitResult, effects::EffectValuesError> {
+        fit::fit_spec(fitdata, &self.constants, active, w, start, spec, max_iter)
     }
 
     /// The effects `active` with their fitted values in `f`, as the JSON reports them.

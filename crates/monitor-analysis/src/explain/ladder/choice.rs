@@ -44,6 +44,7 @@ impl Analysis {
         });
         let before = rung.models.len();
         self.evidence_decides(&mut fitted, before);
+        whole_machine_first(&mut fitted, rung, before, &self.constants);
         let mut tried = Vec::new();
         let mut kept = None;
         for c in fitted {
@@ -290,4 +291,40 @@ pub(super) fn significance(rung: &Rung<'_>, c: &Fitted<'_>) -> f64 {
         c.score(),
         rung.heldback_noise_fit_series,
     )
+}
+
+/// When the round's first plausible candidate adds dynamics effects only (a part of the
+/// full-order machine: the stator's d axis alone through a start) and a plausible candidate
+/// adding more of the machine's dynamics, and nothing else, passes the step's test too,
+/// that one goes first: the rest of the machine's order is needed as well, and a step that
+/// takes it at once leaves no partial model for the next rounds' effects to be fitted on.
+fn whole_machine_first(
+    fitted: &mut [Fitted<'_>],
+    rung: &Rung<'_>,
+    before: usize,
+    n: &crate::simplified_model::MachineConstants,
+) {
+    let dynamics_only = |c: &Fitted<'_>| {
+        c.models
+            .iter()
+            .skip(before)
+            .all(|m| m.time_constant_s(n).is_some() || !m.requires().is_empty())
+    };
+    let Some(first) = fitted.first() else {
+        return;
+    };
+    if !first.implausible.is_empty() || !dynamics_only(first) || first.base.is_some() {
+        return;
+    }
+    let k = first.models.len();
+    let whole = fitted.iter().position(|c| {
+        c.implausible.is_empty()
+            && c.base.is_none()
+            && c.models.len() > k
+            && dynamics_only(c)
+            && significance(rung, c) >= STEP_MIN
+    });
+    if let Some(i) = whole {
+        fitted[..=i].rotate_right(1);
+    }
 }

@@ -82,6 +82,12 @@ pub const LADDER_FIT_SAMPLES: usize = 20_000;
 /// 1 kHz), beyond which the copy is thinned to this size and the dynamics effects are
 /// refused as unresolved.
 pub const LADDER_MAX_FIT_SAMPLES: usize = 60_000;
+/// Iterations of a round's screening fit of every candidate ([`round`]): enough to rank
+/// them; the [`FINALISTS`] best are then fitted in full.
+pub const SCREEN_ITER: usize = 8;
+/// How many screened candidates of a round are fitted in full (plus the best by held-back
+/// error alone when it is not among them).
+pub const FINALISTS: usize = 3;
 /// How many single candidates the pair search pairs: those that lowered the training cost
 /// most. With 3 the windage scenario's second step (flux dynamics with a load torque, the
 /// fourth single of its round) is not found and the ladder stops at 65x its floor.
@@ -323,7 +329,11 @@ impl Analysis {
         };
         let rung = self.walk(&lib, rung, &sr, opts, progress, &mut report)?;
         let step_no = report.ladder.len() + 1;
+        let t_fin = std::time::Instant::now();
         self.finish(&rung, &sr, &mut report, &|f| progress(step_no, f))?;
+        if std::env::var("LADDER_DEBUG").is_ok() {
+            eprintln!("final: {:.2} s", t_fin.elapsed().as_secs_f64());
+        }
         Ok(report)
     }
 
@@ -404,7 +414,16 @@ impl Analysis {
             }
             step_no += 1;
             let base_after_base = report.ladder.last().is_some_and(|s| !s.base.is_empty());
+            let t_round = std::time::Instant::now();
             let round = cur.round(lib, &rung, sr, !base_after_base, &|f| progress(step_no, f))?;
+            if std::env::var("LADDER_DEBUG").is_ok() {
+                eprintln!(
+                    "round {step_no}: {:.2} s, tried {}, kept {:?}",
+                    t_round.elapsed().as_secs_f64(),
+                    round.tried.len(),
+                    round.kept.as_ref().map(|(r, _)| r.kinds.clone())
+                );
+            }
             report.skipped = round.skipped;
             report.last_round = round.tried;
             if round.exhausted {
@@ -421,7 +440,11 @@ impl Analysis {
             let moved = next.scales != rung.scales;
             let next_an = moved.then(|| self.rebased(next.scales.apply(&sr.file)));
             let an = next_an.as_ref().unwrap_or(cur);
+            let t_drop = std::time::Instant::now();
             let (next, step) = an.drop_stand_ins(next, step, &rung, sr, &opts.effects)?;
+            if std::env::var("LADDER_DEBUG").is_ok() {
+                eprintln!("drops: {:.2} s", t_drop.elapsed().as_secs_f64());
+            }
             report.ladder.push(step);
             rung = next;
             if moved {

@@ -2,7 +2,7 @@
 //! before, and the choice of the one kept (the test of [`super::STEP_MIN`]).
 
 use super::split::weights_for;
-use super::PAIR_FROM;
+use super::{FINALISTS, PAIR_FROM, SCREEN_ITER};
 use crate::effects::{self, EffectModel};
 use crate::explain::PARAM_PENALTY;
 use crate::fit::machine::MachineScales;
@@ -245,8 +245,13 @@ impl Analysis {
 
     /// Every candidate of the round added to the model of `rung`, fitted from its fit on the
     /// fit series `fd` (in parallel), with its held-back error there and what makes it
-    /// implausible. `starts` says whether a candidate of several effects is also fitted
-    /// from the nominal base parameters ([`Starts`]).
+    /// implausible. Three passes: every candidate screened ([`SCREEN_ITER`] iterations, from
+    /// where the model stood, the model's own values held), then the [`FINALISTS`] best
+    /// (plausible first, by their penalised held-back error, and the best of all) fitted to
+    /// convergence from there, and the round's best of them refitted with every value of
+    /// the model free; `starts` says whether that one, of several effects, is also fitted
+    /// from the nominal base parameters ([`Starts`]). The held values cost no simulation
+    /// per iteration: in a late round the model holds a dozen.
     pub(super) fn fit_round<'a>(
         &self,
         cands: &[Vec<&'a dyn EffectModel>],
@@ -258,22 +263,95 @@ impl Analysis {
     ) -> Result<Vec<Fitted<'a>>, AnalysisError> {
         use rayon::prelude::*;
         let done = std::sync::atomic::AtomicUsize::new(0);
-        let total = cands.len().max(1);
-        let out: Vec<Option<Fitted<'a>>> = cands
+        let total = (cands.len() + FINALISTS).max(1);
+        let tick = || {
+            let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            progress(k as f64 / total as f64);
+        };
+        // The screening holds the model's own values: only the candidate's and the base
+        // parameters move.
+        let mut screen = spec;
+        screen.hold_first = rung.models.len();
+        let screened: Vec<Option<Fitted<'a>>> = cands
             .par_iter()
             .map(|c| {
-                let r = self.fit_candidate(c, rung, sr, spec, starts);
-                let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                progress(k as f64 / total as f64);
+                let r =
+                    self.fit_candidate(c, rung, sr, screen, Starts::NestedOnly, SCREEN_ITER, None);
+                tick();
                 r
             })
             .collect::<Result<_, _>>()?;
+        let chosen = finalists(&screened);
+        let full: Vec<(usize, Option<Fitted<'a>>)> = chosen
+            .par_iter()
+            .map(|&i| {
+                let r = self.fit_candidate(
+                    &cands[i],
+                    rung,
+                    sr,
+                    screen,
+                    Starts::NestedOnly,
+                    crate::MAX_ITER,
+                    screened[i].as_ref(),
+                );
+                tick();
+                r.map(|f| (i, f))
+            })
+            .collect::<Result<_, _>>()?;
+        let mut out = screened;
+        for (i, f) in full {
+            if let Some(slot) = out.get_mut(i) {
+                *slot = f;
+            }
+        }
+        // The round's best, refitted with every value of the model free (and, as `starts`
+        // says, also from the nominal base parameters): the best plausible one (what the
+        // step would keep) and the best by held-back error alone (a fit that held the
+        // model's values may have ended at a bound its own values' freedom leaves).
+        let score = |i: &usize| out[*i].as_ref().map_or(f64::INFINITY, Fitted::score);
+        let ran = || {
+            (0..out.len()).filter(|&i| {
+                out[i]
+                    .as_ref()
+                    .is_some_and(|f| f.heldback_fit_series.is_finite())
+            })
+        };
+        let best_plausible = ran()
+            .filter(|&i| out[i].as_ref().is_some_and(|f| f.implausible.is_empty()))
+            .min_by(|a, b| score(a).total_cmp(&score(b)));
+        let best_any = ran().min_by(|a, b| score(a).total_cmp(&score(b)));
+        let mut joint_of: Vec<usize> = best_plausible.into_iter().collect();
+        if let Some(b) = best_any.filter(|b| !joint_of.contains(b)) {
+            joint_of.push(b);
+        }
+        let joint: Vec<(usize, Option<Fitted<'a>>)> = joint_of
+            .par_iter()
+            .map(|&i| {
+                self.fit_candidate(
+                    &cands[i],
+                    rung,
+                    sr,
+                    spec,
+                    starts,
+                    crate::MAX_ITER,
+                    out[i].as_ref(),
+                )
+                .map(|f| (i, f))
+            })
+            .collect::<Result<_, _>>()?;
+        for (i, f) in joint {
+            if let (Some(j), Some(slot)) = (f, out.get_mut(i)) {
+                *slot = Some(j);
+            }
+        }
         Ok(out.into_iter().flatten().collect())
     }
 
     /// One candidate `c` (effects to add, in order) fitted with the model of `rung`, from
     /// the `starts` given, the base parameters as `spec` says (for the candidate's effects,
-    /// [`BaseSpec::for_effects`]).
+    /// [`BaseSpec::for_effects`]), at most `max_iter` iterations; from a screening fit
+    /// `from`'s values where given, else from where the model stood.
+    #[allow(clippy::too_many_arguments)]
     fn fit_candidate<'a>(
         &self,
         c: &[&'a dyn EffectModel],
@@ -281,10 +359,17 @@ impl Analysis {
         sr: &LadderSeries,
         spec: BaseSpec,
         starts: Starts,
+        max_iter: usize,
+        from: Option<&Fitted<'a>>,
     ) -> Result<Option<Fitted<'a>>, AnalysisError> {
-        let Some(set) = self.nested(c, rung, &sr.fd) else {
+        let set = match from {
+            Some(f) => self.nested_from(&f.models, &f.fit.effect_params, &[], &sr.fd),
+            None => self.nested(c, rung, &sr.fd),
+        };
+        let Some(set) = set else {
             return Ok(None);
         };
+        let start = from.map_or(rung.fit.base, |f| f.fit.base);
         let n_parameters = set
             .iter()
             .skip(rung.models.len())
@@ -300,8 +385,8 @@ impl Analysis {
         let f = if frees_base && c.len() > 1 && starts == Starts::AlsoNominal {
             let nominal = BaseParams::nominal(&self.constants);
             let (f, g) = rayon::join(
-                || self.fit_spec(&sr.fd, &set, &sr.wf, &rung.fit.base, spec),
-                || self.fit_spec(&sr.fd, &set, &sr.wf, &nominal, spec),
+                || self.fit_spec_iter(&sr.fd, &set, &sr.wf, &start, spec, max_iter),
+                || self.fit_spec_iter(&sr.fd, &set, &sr.wf, &nominal, spec, max_iter),
             );
             let (f, g) = (f?, g?);
             if g.report.cost < f.report.cost {
@@ -310,7 +395,7 @@ impl Analysis {
                 f
             }
         } else {
-            self.fit_spec(&sr.fd, &set, &sr.wf, &rung.fit.base, spec)?
+            self.fit_spec_iter(&sr.fd, &set, &sr.wf, &start, spec, max_iter)?
         };
         let pred = fit::predict(&sr.fd, &self.constants, &set, &f)?;
         let hb = metrics::errors(&sr.fd, &pred, Some(&sr.held_fd)).normalized_rms_error;
@@ -485,6 +570,54 @@ pub(super) fn pairs_of<'a>(fitted: &[Fitted<'a>], before: usize) -> Vec<Vec<&'a 
                 }
             }
             out.push(set);
+        }
+    }
+    out
+}
+
+/// The screened candidates fitted in full ([`Analysis::fit_round`]): the first
+/// [`FINALISTS`] in the round's order (plausible first, then by penalised held-back
+/// error), and the best by that error alone (a screening fit not yet plausible may end
+/// plausible).
+fn finalists(screened: &[Option<Fitted<'_>>]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..screened.len())
+        .filter(|&i| {
+            screened[i]
+                .as_ref()
+                .is_some_and(|f| f.heldback_fit_series.is_finite())
+        })
+        .collect();
+    let score = |i: usize| screened[i].as_ref().map_or(f64::INFINITY, Fitted::score);
+    let plausible = |i: usize| {
+        screened[i]
+            .as_ref()
+            .is_some_and(|f| f.implausible.is_empty())
+    };
+    order.sort_by(|&a, &b| {
+        plausible(b)
+            .cmp(&plausible(a))
+            .then(score(a).total_cmp(&score(b)))
+    });
+    let mut out: Vec<usize> = order.iter().copied().take(FINALISTS).collect();
+    if let Some(best) = order
+        .iter()
+        .copied()
+        .min_by(|&a, &b| score(a).total_cmp(&score(b)))
+    {
+        if !out.contains(&best) {
+            out.push(best);
+        }
+    }
+    // The full-order machine (the candidate with the most effects) too: the partial
+    // dynamics a screening ranks first are followed by the rest anyway.
+    if let Some(most) = order
+        .iter()
+        .copied()
+        .filter(|&i| screened[i].as_ref().is_some_and(|f| f.models.len() >= 2))
+        .max_by_key(|&i| screened[i].as_ref().map_or(0, |f| f.models.len()))
+    {
+        if !out.contains(&most) {
+            out.push(most);
         }
     }
     out

@@ -43,11 +43,15 @@ impl Analysis {
     ) -> Result<RoundOutcome<'a>, AnalysisError> {
         let (cands, skipped) = self.ladder_candidates(lib, rung, sr);
         progress(0.0);
+        let t0 = std::time::Instant::now();
         let base = if sr.fit_base && with_base {
             self.base_candidate(rung, sr)?
         } else {
             None
         };
+        if std::env::var("LADDER_DEBUG").is_ok() {
+            eprintln!("  base candidate {:.2} s", t0.elapsed().as_secs_f64());
+        }
         let mut out = RoundOutcome {
             kept: None,
             tried: Vec::new(),
@@ -81,6 +85,9 @@ impl Analysis {
         let fitted = an.fit_round(&cands, from, sr, spec, Starts::AlsoNominal, &|f| {
             progress(0.1 + 0.6 * f)
         })?;
+        if std::env::var("LADDER_DEBUG").is_ok() {
+            eprintln!("  singles {:.2} s", t0.elapsed().as_secs_f64());
+        }
         let pairs = pairs_of(&fitted, from.models.len());
         let (mut kept, tried) = an.choose(fitted, from, sr)?;
         out.tried.extend(tried);
