@@ -13,9 +13,9 @@ use crate::simplified_model::BaseParams;
 use crate::{Analysis, AnalysisError, MAX_ITER};
 use serde::Serialize;
 
-/// A refitted value that differs from the file's by less than this (2 %) is not a change
+/// A refitted value that differs from the file's by less than this (3 %) is not a change
 /// the ladder names, whatever its interval.
-pub const BASE_CHANGE_MIN: f64 = 0.02;
+pub const BASE_CHANGE_MIN: f64 = 0.03;
 
 /// One base parameter against the user's file (JSON `ladder[].base[]`, `base_changes[]`).
 #[derive(Debug, Clone, Serialize)]
@@ -47,11 +47,14 @@ impl BaseChange {
             .interval
             .map(|[lo, hi]| 0.5 * (hi - lo))
             .unwrap_or(f64::INFINITY);
-        if self.base == BaseKey::B && self.file_value == 0.0 {
+        if self.base == BaseKey::B && (self.file_value == 0.0 || self.change.abs() > 1.0) {
+            // A viscous load the file does not hold: the value, not a share of the file's
+            // bearing friction.
             return format!(
-                "{} {} N m s/rad (the file has none)",
+                "{} {} N m s/rad (the file's {})",
                 self.base.symbol(),
-                effects::sig(self.value)
+                effects::sig(self.value),
+                effects::sig(self.file_value)
             );
         }
         if half.is_finite() {
@@ -127,38 +130,37 @@ pub fn base_in_words(c: &[BaseChange]) -> String {
     let changed = |k: BaseKey| get(k).is_some_and(|x| x.changed);
     let mut parts: Vec<String> = Vec::new();
     let (rs, rr) = (get(BaseKey::Rs), get(BaseKey::Rr));
+    let spelled = |x: Option<&BaseChange>| x.map_or_else(String::new, BaseChange::spelled);
+    let (a, b) = (rs.map_or(0.0, |x| x.change), rr.map_or(0.0, |x| x.change));
+    let alike = a > 0.0 && b > 0.0 && (a - b).abs() <= 0.3 * a.max(b);
     match (changed(BaseKey::Rs), changed(BaseKey::Rr)) {
-        (true, true) => {
-            let (a, b) = (rs.map_or(0.0, |x| x.change), rr.map_or(0.0, |x| x.change));
-            let reading = if a > 0.0 && b > 0.0 && (a - b).abs() < 0.5 * a.max(b) {
-                format!(
-                    "both windings warmer than the file's values: about {:.0} K (copper 0.393 %/K)",
-                    0.5 * (a + b) / effects::ALPHA_CU_PER_K
-                )
-            } else {
-                "the file's resistances are off (a data sheet's or a test at another temperature)".to_string()
-            };
-            parts.push(format!(
-                "{}, {}: {reading}",
-                rs.map_or_else(String::new, BaseChange::spelled),
-                rr.map_or_else(String::new, BaseChange::spelled)
-            ));
-        }
-        (true, false) => parts.push(format!(
-            "{}, Rr unchanged: {}",
-            rs.map_or_else(String::new, BaseChange::spelled),
-            if rs.is_some_and(|x| x.change > 0.0) {
-                "the file's Rs is cold, or the stator is warm (a loosening connection adds to it too)"
-            } else {
-                "the file's Rs is higher than the winding's (measured warm, or with its leads)"
+        (true, true) if alike => parts.push(format!(
+            "{}, {}: both windings warmer than the file's values, about {:.0} K (copper 0.393 %/K)",
+            spelled(rs),
+            spelled(rr),
+            0.5 * (a + b) / effects::ALPHA_CU_PER_K
+        )),
+        (rs_changed, rr_changed) => {
+            if rs_changed {
+                parts.push(format!(
+                    "{}{}: {}",
+                    spelled(rs),
+                    if rr_changed { "" } else { ", Rr unchanged" },
+                    if a > 0.0 {
+                        "the file's Rs is cold, or the stator is warm (a loosening connection adds to it too)"
+                    } else {
+                        "the file's Rs is higher than the winding's (measured warm, or with its leads)"
+                    }
+                ));
             }
-        )),
-        (false, true) => parts.push(format!(
-            "{}, Rs unchanged: {}",
-            rr.map_or_else(String::new, BaseChange::spelled),
-            "the rotor's resistance differs from the file's (a locked-rotor test at line frequency reads the skin effect's Rr; a warm cage)"
-        )),
-        (false, false) => {}
+            if rr_changed {
+                parts.push(format!(
+                    "{}{}: the rotor's resistance differs from the file's (a locked-rotor test at line frequency reads the skin effect's Rr; a warm cage)",
+                    spelled(rr),
+                    if rs_changed { "" } else { ", Rs unchanged" },
+                ));
+            }
+        }
     }
     let says = |k: BaseKey, why: &str, parts: &mut Vec<String>| {
         if let Some(x) = get(k).filter(|x| x.changed) {
@@ -182,7 +184,7 @@ pub fn base_in_words(c: &[BaseChange]) -> String {
     );
     says(
         BaseKey::B,
-        "the viscous friction differs from the file's (bearings, seals, the load's drag)",
+        "the viscous friction differs from the file's (a viscous load the file leaves out, bearings, seals)",
         &mut parts,
     );
     let unidentified: Vec<&str> = c
@@ -209,6 +211,19 @@ pub fn base_in_words(c: &[BaseChange]) -> String {
         ));
     }
     parts.join("; ")
+}
+
+/// The base parameters' prior weight on a log whose noise floor is `noise` (normalised): the
+/// floor, but not below the model's own accuracy on noise-free data
+/// ([`crate::fit::IDENTIFIED_MIN`], 0.4 %): on a log without noise the priors would weigh
+/// nothing, and the base parameters would take up the model's structural residue (a
+/// noise-free log of another simulator read Rs -4 % against its exact file).
+pub(super) fn prior_weight(noise: f64) -> f64 {
+    if noise.is_finite() {
+        noise.max(crate::fit::IDENTIFIED_MIN)
+    } else {
+        crate::fit::IDENTIFIED_MIN
+    }
 }
 
 /// Why the factors `s` are not a machine's (empty: they are): Rs and Rr within the
@@ -275,16 +290,17 @@ impl Analysis {
         // From where the model stood: the paper fit's base parameters taken into the
         // factors, so the fit can only lower the training cost.
         let start = rung.scales.with_paper(&rung.fit.base);
-        let mf =
-            machine::fit_machine(&sr.fd, &sr.file, &set, &sr.wf, &start, rung.noise, MAX_ITER)?;
+        let mf = machine::fit_machine(
+            &sr.fd,
+            &sr.file,
+            &set,
+            &sr.wf,
+            &start,
+            prior_weight(rung.noise),
+            MAX_ITER,
+        )?;
         let an = self.rebased(mf.params(&sr.file));
         let (fit, hb) = an.base_prediction(&rung.models, &mf, sr)?;
-        if std::env::var("LADDER_DEBUG").is_ok() {
-            eprintln!(
-                "base candidate: {:?} {:?} hb {hb} (rung hb {}) kinds {:?}",
-                mf.scales, mf.report, rung.heldback_fit_series, rung.kinds
-            );
-        }
         let mut why = scales_implausible(&mf.scales);
         for (e, p) in rung.models.iter().zip(&fit.effect_params) {
             if let Ok(s) = e.setup(&self.data, an.setup_constants()) {
@@ -306,6 +322,46 @@ impl Analysis {
             implausible: why,
             base: Some(mf.scales),
         }))
+    }
+
+    /// The candidate `c` (fitted from `rung`'s model) refitted with every value of the
+    /// model free and the six base parameters free beside them ([`machine::fit_machine`],
+    /// from `c`'s values, the paper fit's base parameters taken into the factors): its
+    /// held-back error on the file recentred on the refitted base, and what makes it
+    /// implausible there. It adds two parameters to `c`'s (six base parameters where the
+    /// paper fit had four).
+    pub(super) fn joint_machine<'a>(
+        &self,
+        c: &Fitted<'a>,
+        rung: &Rung<'a>,
+        sr: &LadderSeries,
+    ) -> Result<Fitted<'a>, AnalysisError> {
+        let Some(set) = self.nested_from(&c.models, &c.fit.effect_params, &[], &sr.fd) else {
+            return Ok(c.clone());
+        };
+        let start = rung.scales.with_paper(&c.fit.base);
+        let mf = machine::fit_machine(
+            &sr.fd,
+            &sr.file,
+            &set,
+            &sr.wf,
+            &start,
+            prior_weight(rung.noise),
+            MAX_ITER,
+        )?;
+        let an = self.rebased(mf.params(&sr.file));
+        let (fit, hb) = an.base_prediction(&c.models, &mf, sr)?;
+        let set2 = an.setup_list(&sr.fd, &c.models)?;
+        let mut why = scales_implausible(&mf.scales);
+        why.extend(an.implausible_step(&set2, rung, &fit, sr.m)?);
+        Ok(Fitted {
+            models: c.models.clone(),
+            fit,
+            n_parameters: c.n_parameters + 2,
+            heldback_fit_series: hb,
+            implausible: why,
+            base: Some(mf.scales),
+        })
     }
 
     /// The machine fit `mf` as a fit of the file recentred on it (`self`): the nominal base

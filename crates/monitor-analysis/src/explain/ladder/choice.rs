@@ -124,11 +124,26 @@ impl Analysis {
                 effects::sig(next.error)
             )));
         }
-        let step = if c.base.is_some() {
+        let added = c.added(rung.models.len());
+        let step = if added.is_empty() {
             let changes = an.base_rung_changes(c, sr)?;
             base_step(changes, rung, &next, sig)
         } else {
-            self.step_of(c, &c.added(rung.models.len()), rung, &next, sig)?
+            let mut step = an.step_of(c, &added, rung, &next, sig)?;
+            if c.base.is_some() {
+                // An effect fitted with the base parameters refitted beside it: the changes
+                // it brought.
+                let changes = an.base_rung_changes(c, sr)?;
+                if changes.iter().any(|x| x.changed) {
+                    step.summary = format!(
+                        "{}; on the refitted base: {}",
+                        step.summary,
+                        base_in_words(&changes)
+                    );
+                    step.base = changes;
+                }
+            }
+            step
         };
         Ok(Take::Kept(Box::new((next, step))))
     }

@@ -85,7 +85,7 @@ impl Analysis {
                 &set,
                 &w,
                 &rung.scales.with_paper(&rung.fit.base),
-                rung.noise,
+                super::base::prior_weight(rung.noise),
                 MAX_ITER,
             )?;
             let half = machine::machine_half_widths(&fdata, &sr.file, &set, &w, &mf)?;

@@ -39,6 +39,8 @@ mod round;
 mod rounds;
 mod split;
 mod stepwise;
+#[cfg(test)]
+mod tests;
 
 pub use base::{base_changes, base_in_words, BaseChange, BASE_CHANGE_MIN};
 pub use end::FinalFit;
@@ -84,10 +86,16 @@ pub const LADDER_FIT_SAMPLES: usize = 20_000;
 pub const LADDER_MAX_FIT_SAMPLES: usize = 60_000;
 /// Iterations of a round's screening fit of every candidate ([`round`]): enough to rank
 /// them; the [`FINALISTS`] best are then fitted in full.
-pub const SCREEN_ITER: usize = 8;
+pub const SCREEN_ITER: usize = 6;
 /// How many screened candidates of a round are fitted in full (plus the best by held-back
 /// error alone when it is not among them).
-pub const FINALISTS: usize = 3;
+pub const FINALISTS: usize = 2;
+/// Pairs are tried only while the held-back error is above this multiple (2) of its noise
+/// floor: two effects that need each other leave a large error alone (the windage
+/// scenario's flux dynamics and load torque, 65x the floor without them); near the floor a
+/// pair's test would weigh two effects' worth of parameters against a few per cent of noise,
+/// and the round took 40 % of a ladder's time.
+pub const PAIRS_ABOVE: f64 = 2.0;
 /// How many single candidates the pair search pairs: those that lowered the training cost
 /// most. With 3 the windage scenario's second step (flux dynamics with a load torque, the
 /// fourth single of its round) is not found and the ladder stops at 65x its floor.
@@ -329,11 +337,7 @@ impl Analysis {
         };
         let rung = self.walk(&lib, rung, &sr, opts, progress, &mut report)?;
         let step_no = report.ladder.len() + 1;
-        let t_fin = std::time::Instant::now();
         self.finish(&rung, &sr, &mut report, &|f| progress(step_no, f))?;
-        if std::env::var("LADDER_DEBUG").is_ok() {
-            eprintln!("final: {:.2} s", t_fin.elapsed().as_secs_f64());
-        }
         Ok(report)
     }
 
@@ -364,14 +368,6 @@ impl Analysis {
             self.data.dt_s,
             fastest_dynamics_s(&self.constants),
         );
-        if std::env::var("LADDER_DEBUG").is_ok() {
-            eprintln!(
-                "fit thinning {m}: len {} dt {} tau {}",
-                self.data.len(),
-                self.data.dt_s,
-                fastest_dynamics_s(&self.constants)
-            );
-        }
         let fd = crate::coarsen(&self.data, m);
         let held_fd = if m == 1 {
             held.clone()
@@ -414,16 +410,7 @@ impl Analysis {
             }
             step_no += 1;
             let base_after_base = report.ladder.last().is_some_and(|s| !s.base.is_empty());
-            let t_round = std::time::Instant::now();
             let round = cur.round(lib, &rung, sr, !base_after_base, &|f| progress(step_no, f))?;
-            if std::env::var("LADDER_DEBUG").is_ok() {
-                eprintln!(
-                    "round {step_no}: {:.2} s, tried {}, kept {:?}",
-                    t_round.elapsed().as_secs_f64(),
-                    round.tried.len(),
-                    round.kept.as_ref().map(|(r, _)| r.kinds.clone())
-                );
-            }
             report.skipped = round.skipped;
             report.last_round = round.tried;
             if round.exhausted {
@@ -433,18 +420,19 @@ impl Analysis {
             let Some((next, step)) = round.kept else {
                 break (
                     Stop::NothingHelps,
-                    nothing_helps(&rung, &report.last_round, round.base_tried, &report.skipped),
+                    nothing_helps(
+                        &rung,
+                        &report.last_round,
+                        round.base_tried || base_after_base,
+                        &report.skipped,
+                    ),
                 );
             };
             // The step's model is relative to its own base parameters.
             let moved = next.scales != rung.scales;
             let next_an = moved.then(|| self.rebased(next.scales.apply(&sr.file)));
             let an = next_an.as_ref().unwrap_or(cur);
-            let t_drop = std::time::Instant::now();
             let (next, step) = an.drop_stand_ins(next, step, &rung, sr, &opts.effects)?;
-            if std::env::var("LADDER_DEBUG").is_ok() {
-                eprintln!("drops: {:.2} s", t_drop.elapsed().as_secs_f64());
-            }
             report.ladder.push(step);
             rung = next;
             if moved {

@@ -249,9 +249,11 @@ impl Analysis {
     /// where the model stood, the model's own values held), then the [`FINALISTS`] best
     /// (plausible first, by their penalised held-back error, and the best of all) fitted to
     /// convergence from there, and the round's best of them refitted with every value of
-    /// the model free; `starts` says whether that one, of several effects, is also fitted
-    /// from the nominal base parameters ([`Starts`]). The held values cost no simulation
+    /// the model free (with `machine`, the six physical base parameters free beside them,
+    /// [`Analysis::joint_machine`]); `starts` says whether that one, of several effects, is
+    /// also fitted from the nominal base parameters ([`Starts`]). The held values cost no simulation
     /// per iteration: in a late round the model holds a dozen.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn fit_round<'a>(
         &self,
         cands: &[Vec<&'a dyn EffectModel>],
@@ -259,6 +261,7 @@ impl Analysis {
         sr: &LadderSeries,
         spec: BaseSpec,
         starts: Starts,
+        machine: bool,
         progress: &(dyn Fn(f64) + Sync),
     ) -> Result<Vec<Fitted<'a>>, AnalysisError> {
         use rayon::prelude::*;
@@ -327,16 +330,20 @@ impl Analysis {
         let joint: Vec<(usize, Option<Fitted<'a>>)> = joint_of
             .par_iter()
             .map(|&i| {
-                self.fit_candidate(
-                    &cands[i],
-                    rung,
-                    sr,
-                    spec,
-                    starts,
-                    crate::MAX_ITER,
-                    out[i].as_ref(),
-                )
-                .map(|f| (i, f))
+                let r = match (machine, out[i].as_ref()) {
+                    // With the six base parameters refitted beside it.
+                    (true, Some(f)) => self.joint_machine(f, rung, sr).map(Some),
+                    _ => self.fit_candidate(
+                        &cands[i],
+                        rung,
+                        sr,
+                        spec,
+                        starts,
+                        crate::MAX_ITER,
+                        out[i].as_ref(),
+                    ),
+                };
+                r.map(|f| (i, f))
             })
             .collect::<Result<_, _>>()?;
         for (i, f) in joint {
@@ -452,7 +459,7 @@ impl Analysis {
     /// range, pinned at a bound of its fit, or contradicted by a measurement of the log
     /// ([`EffectModel::contradicted_by`]); a base parameter the fit takes out of range that
     /// the model's own fit had in range.
-    fn implausible_step(
+    pub(super) fn implausible_step(
         &self,
         set: &[ActiveEffect<'_>],
         rung: &Rung<'_>,

@@ -5,10 +5,9 @@
 //! none stands in for them (a warm stator's Rs, the rotor resistance a locked-rotor test
 //! read at line frequency, the viscous load a user's file leaves out).
 
-use super::base::BaseChange;
-use super::choice::{base_step, Kept};
+use super::choice::Kept;
 use super::round::{pairs_of, Fitted, LadderSeries, Rung, Starts};
-use super::{LadderStep, Tried};
+use super::{LadderStep, Tried, PAIRS_ABOVE};
 use crate::effects::EffectModel;
 use crate::explain::explained_fraction;
 use crate::fit::BaseSpec;
@@ -43,15 +42,19 @@ impl Analysis {
     ) -> Result<RoundOutcome<'a>, AnalysisError> {
         let (cands, skipped) = self.ladder_candidates(lib, rung, sr);
         progress(0.0);
-        let t0 = std::time::Instant::now();
-        let base = if sr.fit_base && with_base {
+        // The base parameters are read through a model that can follow the log: on a log
+        // with a start or a supply step, once the machine's dynamics are in (a base refitted
+        // through the paper's steady model takes the transients it cannot follow for Rs,
+        // Lm and J, and every effect fitted on it inherits that).
+        let order_done = !sr.span.input_transient
+            || !cands
+                .iter()
+                .any(|c| c.iter().all(|e| is_dynamics(*e, self)));
+        let base = if sr.fit_base && with_base && order_done {
             self.base_candidate(rung, sr)?
         } else {
             None
         };
-        if std::env::var("LADDER_DEBUG").is_ok() {
-            eprintln!("  base candidate {:.2} s", t0.elapsed().as_secs_f64());
-        }
         let mut out = RoundOutcome {
             kept: None,
             tried: Vec::new(),
@@ -60,7 +63,7 @@ impl Analysis {
             exhausted: cands.is_empty() && base.is_none(),
         };
         // The base rung first: kept when it passes the step's test on its own.
-        let mut on_base = None;
+        let mut judge = None;
         if let Some(b) = base {
             let plausible = b.implausible.is_empty();
             let (kept, tried) = self.choose(vec![b.clone()], rung, sr)?;
@@ -70,40 +73,42 @@ impl Analysis {
                 return Ok(out);
             }
             if plausible {
-                on_base = Some(self.on_base(&b, sr)?);
+                judge = Some(self.judge_of(&b, sr)?);
             }
         }
         if cands.is_empty() {
             return Ok(out);
         }
-        // The effects, on the refitted base where it is physical.
-        let (an, from): (&Analysis, &Rung<'a>) = match &on_base {
-            Some((an, r, _)) => (an, r),
-            None => (self, rung),
-        };
+        // The effects, fitted from where the model stood; once the machine's order is in,
+        // the round's best are refitted with the six base parameters free beside them, and
+        // each is judged against the base refitted alone (where that is physical): no
+        // effect is credited with what the file's own errors explain, and none stands in
+        // for them.
         let spec = BaseSpec::paper(sr.fit_base);
-        let fitted = an.fit_round(&cands, from, sr, spec, Starts::AlsoNominal, &|f| {
-            progress(0.1 + 0.6 * f)
-        })?;
-        if std::env::var("LADDER_DEBUG").is_ok() {
-            eprintln!("  singles {:.2} s", t0.elapsed().as_secs_f64());
-        }
-        let pairs = pairs_of(&fitted, from.models.len());
-        let (mut kept, tried) = an.choose(fitted, from, sr)?;
+        let machine = sr.fit_base && order_done;
+        let from: &Rung<'a> = judge.as_ref().unwrap_or(rung);
+        let fitted =
+            self.fit_round(&cands, rung, sr, spec, Starts::AlsoNominal, machine, &|f| {
+                progress(0.1 + 0.6 * f)
+            })?;
+        let pairs = pairs_of(&fitted, rung.models.len());
+        let (mut kept, tried) = self.choose(fitted, from, sr)?;
         out.tried.extend(tried);
-        if kept.is_none() && !pairs.is_empty() {
+        let far = rung.heldback_error > PAIRS_ABOVE * rung.heldback_noise;
+        if kept.is_none() && !pairs.is_empty() && far {
             // No single effect passes: two that need each other (a load torque and the
             // cross coupling of a start, two hidden effects at once) are tried together.
-            let fitted = an.fit_round(&pairs, from, sr, spec, Starts::NestedOnly, &|f| {
-                progress(0.7 + 0.3 * f)
-            })?;
-            let (k2, t2) = an.choose(fitted, from, sr)?;
+            let fitted =
+                self.fit_round(&pairs, rung, sr, spec, Starts::NestedOnly, machine, &|f| {
+                    progress(0.7 + 0.3 * f)
+                })?;
+            let (k2, t2) = self.choose(fitted, from, sr)?;
             kept = k2;
             out.tried.extend(t2);
         }
-        out.kept = match (kept, on_base) {
-            (Some((next, step)), Some((_, _, changes))) => {
-                let step = with_base_of(step, changes, rung, &next);
+        out.kept = match (kept, &judge) {
+            (Some((next, step)), Some(_)) => {
+                let step = restated(step, rung, &next);
                 Some((next, step))
             }
             (k, _) => k,
@@ -112,38 +117,24 @@ impl Analysis {
         Ok(out)
     }
 
-    /// The base rung `b` (not kept) as the model the effects are fitted on: the analysis of
-    /// its base, its rung, and its changes against the file.
-    fn on_base<'a>(
-        &self,
-        b: &Fitted<'a>,
-        sr: &LadderSeries,
-    ) -> Result<(Analysis, Rung<'a>, Vec<BaseChange>), AnalysisError> {
+    /// The base rung `b` (not kept) as the model the round's effects are judged against:
+    /// its rung on the file recentred on its base parameters.
+    fn judge_of<'a>(&self, b: &Fitted<'a>, sr: &LadderSeries) -> Result<Rung<'a>, AnalysisError> {
         let scales = b
             .base
             .unwrap_or_else(|| crate::fit::machine::MachineScales::of_file(&sr.file));
-        let an = self.rebased(scales.apply(&sr.file));
-        let r = an.measure_rung(b.models.clone(), b.fit.clone(), sr, scales)?;
-        let changes = an.base_rung_changes(b, sr)?;
-        Ok((an, r, changes))
+        self.rebased(scales.apply(&sr.file)).measure_rung(
+            b.models.clone(),
+            b.fit.clone(),
+            sr,
+            scales,
+        )
     }
 }
 
-/// The step `step` of an effect fitted on a refitted base (with its `changes` against the
-/// file), restated against the model `rung` the round started from: the base changes it
-/// brings, and the shares explained from `rung` to `next`.
-fn with_base_of(
-    mut step: LadderStep,
-    changes: Vec<BaseChange>,
-    rung: &Rung<'_>,
-    next: &Rung<'_>,
-) -> LadderStep {
-    let named: Vec<&BaseChange> = changes.iter().filter(|c| c.changed).collect();
-    if !named.is_empty() {
-        let b = base_step(changes.clone(), rung, next, step.significance);
-        step.summary = format!("{}; on the refitted base: {}", step.summary, b.summary);
-        step.base = changes;
-    }
+/// The step `step`, judged against the base refitted alone, restated against the model
+/// `rung` the round started from: the shares explained from `rung` to `next`.
+fn restated(mut step: LadderStep, rung: &Rung<'_>, next: &Rung<'_>) -> LadderStep {
     step.explained = explained_fraction(rung.error, next.error, next.noise);
     step.heldback_explained = explained_fraction(
         rung.heldback_error,
@@ -151,4 +142,8 @@ fn with_base_of(
         next.heldback_noise,
     );
     step
+}
+/// An effect of the machine's order (one with a time constant, or one that needs one first).
+fn is_dynamics(e: &dyn EffectModel, an: &Analysis) -> bool {
+    e.time_constant_s(an.setup_constants()).is_some() || !e.requires().is_empty()
 }

@@ -1,0 +1,183 @@
+//! The ladder's own mechanisms on logs of the textbook machine (monitor-testkit: Krause's
+//! equations, written apart from this crate's model and the project's simulator).
+
+use super::round::Rung;
+use super::*;
+use crate::fit::BaseSpec;
+use crate::prep::ReadOptions;
+use monitor_io::params::ParamFile;
+use monitor_testkit::textbook_machine::{write_log, Machine, Scenario, Supply};
+
+/// The 2.2 kW textbook machine driving a fan (its whole load, no viscous load) through a
+/// start and two voltage steps, 7 s at 4 kHz, with the file's values.
+fn fan_log(dir: &std::path::Path) -> Analysis {
+    let m = Machine::kw2p2();
+    let mut s = Scenario::new(&m, 7.0, 4000.0);
+    s.load = monitor_testkit::textbook_machine::Load::Viscous(0.0);
+    s.hidden.windage = Some(0.6 * m.rated_nm / m.w_sync().powi(2));
+    s.supply = Supply {
+        points: vec![
+            (2.0, 1.0, 1.0),
+            (2.0, 0.85, 1.0),
+            (3.5, 0.85, 1.0),
+            (3.5, 1.1, 1.0),
+            (5.0, 1.1, 1.0),
+            (5.0, 1.0, 1.0),
+        ],
+    };
+    let log = write_log(dir, "fan", &m, &s);
+    let p = ParamFile::from_toml_str(&m.params_toml(0.0, 0.0), "textbook").expect("file");
+    Analysis::load(&log, p, ReadOptions::default(), &mut |_| {}).expect("load")
+}
+
+/// The model of `kinds` fitted nested from `from` (or from scratch) on the ladder's series.
+fn rung_of<'a>(
+    a: &Analysis,
+    lib: &'a [Box<dyn EffectModel>],
+    kinds: &[EffectKind],
+    from: Option<&Rung<'a>>,
+    sr: &LadderSeries,
+) -> Rung<'a> {
+    let models: Vec<&'a dyn EffectModel> = kinds
+        .iter()
+        .filter_map(|k| lib.iter().find(|e| e.kind() == *k).map(|e| e.as_ref()))
+        .collect();
+    let set = match from {
+        Some(r) => {
+            let extra: Vec<&'a dyn EffectModel> = models[r.models.len()..].to_vec();
+            a.nested(&extra, r, &sr.fd).expect("set-up")
+        }
+        None => a.setup_list(&sr.fd, &models).expect("set-up"),
+    };
+    let start = from.map_or(BaseParams::nominal(&a.constants), |r| r.fit.base);
+    let f = a
+        .fit_spec(
+            &sr.fd,
+            &set,
+            &sr.wf,
+            &start,
+            BaseSpec::PAPER.for_effects(&set),
+        )
+        .expect("fit");
+    a.measure_rung(models, f, sr, MachineScales::of_file(&a.params))
+        .expect("measure")
+}
+
+/// Iron loss taken for a fan's drag before windage was in the model is dropped by the step
+/// that adds windage: the model without it loses less than the test's 10 % (stepwise
+/// selection both ways). Without the drop the step keeps it.
+#[test]
+fn a_stand_in_a_later_step_explains_is_dropped() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let a = fan_log(dir.path());
+    let (held, _) = stratified_heldback(&a.data, &a.constants);
+    let sr = a.ladder_series(held, true);
+    let lib = effects::library();
+    let full = [
+        EffectKind::FluxDynamics,
+        EffectKind::CurrentDynamics,
+        EffectKind::DAxisDynamics,
+        EffectKind::CrossCouplingDynamics,
+    ];
+    let with_iron: Vec<EffectKind> = full.iter().copied().chain([EffectKind::IronLoss]).collect();
+    let before = rung_of(&a, &lib, &with_iron, None, &sr);
+    let mut all = with_iron.clone();
+    all.push(EffectKind::Windage);
+    let next = rung_of(&a, &lib, &all, Some(&before), &sr);
+    assert!(next.error < before.error, "{} {}", next.error, before.error);
+    let step = LadderStep {
+        effect: Some(EffectKind::Windage),
+        added: vec![EffectKind::Windage],
+        base: Vec::new(),
+        dropped: Vec::new(),
+        fitted: BTreeMap::new(),
+        summary: String::new(),
+        error: next.error,
+        heldback_error: next.heldback_error,
+        noise_floor: next.noise,
+        heldback_noise_floor: next.heldback_noise,
+        ratio_to_floor: next.error / next.noise,
+        heldback_ratio_to_floor: next.heldback_error / next.heldback_noise,
+        significance: 1.0,
+        explained: 0.0,
+        heldback_explained: 0.0,
+    };
+    let (after, step) = a
+        .drop_stand_ins(next, step, &before, &sr, &[])
+        .expect("drops");
+    assert_eq!(step.dropped, vec![EffectKind::IronLoss], "{}", step.summary);
+    assert!(!after.kinds.contains(&EffectKind::IronLoss));
+    assert!(after.kinds.contains(&EffectKind::Windage));
+    // The step as a whole still lowers the whole-log error.
+    assert!(after.error < before.error);
+    assert!(
+        step.summary.contains("iron_loss removed"),
+        "{}",
+        step.summary
+    );
+}
+
+/// A configured effect (the user's) and the dynamics effects are never dropped, whatever
+/// they explain.
+#[test]
+fn what_the_user_configured_and_the_machine_order_stay() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let a = fan_log(dir.path());
+    let (held, _) = stratified_heldback(&a.data, &a.constants);
+    let sr = a.ladder_series(held, true);
+    let lib = effects::library();
+    let kinds = [
+        EffectKind::FluxDynamics,
+        EffectKind::CurrentDynamics,
+        EffectKind::DAxisDynamics,
+        EffectKind::CrossCouplingDynamics,
+        EffectKind::IronLoss,
+        EffectKind::Windage,
+    ];
+    let before = rung_of(&a, &lib, &kinds[..5], None, &sr);
+    let next = rung_of(&a, &lib, &kinds, Some(&before), &sr);
+    let step = LadderStep {
+        effect: Some(EffectKind::Windage),
+        added: vec![EffectKind::Windage],
+        base: Vec::new(),
+        dropped: Vec::new(),
+        fitted: BTreeMap::new(),
+        summary: String::new(),
+        error: next.error,
+        heldback_error: next.heldback_error,
+        noise_floor: next.noise,
+        heldback_noise_floor: next.heldback_noise,
+        ratio_to_floor: next.error / next.noise,
+        heldback_ratio_to_floor: next.heldback_error / next.heldback_noise,
+        significance: 1.0,
+        explained: 0.0,
+        heldback_explained: 0.0,
+    };
+    let (after, step) = a
+        .drop_stand_ins(next, step, &before, &sr, &[EffectKind::IronLoss])
+        .expect("drops");
+    assert!(step.dropped.is_empty(), "{:?}", step.dropped);
+    assert_eq!(after.kinds, kinds.to_vec());
+}
+
+/// The fit copy of a long log keeps the machine's fastest dynamics resolved: a 22 s log at
+/// 2 kHz (44 000 samples) with a 3.6 ms stator transient is thinned by 2 (1 kHz, 3.6
+/// samples per time constant), where the budget alone (20 000 samples) asked 3 (667 Hz,
+/// 2.4 samples); a 10 s log at 2 kHz is not thinned; a 60 min log is thinned to the copy's
+/// largest size.
+#[test]
+fn a_long_log_is_thinned_no_further_than_its_dynamics_allow() {
+    assert_eq!(fit_thinning(44_000, 5e-4, 3.6e-3), 2);
+    assert_eq!(fit_thinning(44_000, 5e-4, 2.9e-3), 1);
+    assert_eq!(fit_thinning(20_000, 5e-4, 3.6e-3), 1);
+    // A slow machine's log may be thinned as the budget asks.
+    assert_eq!(fit_thinning(80_000, 5e-4, 20e-3), 4);
+    // Beyond the copy's largest size the budget wins (the dynamics are then refused).
+    let m = fit_thinning(7_200_000, 5e-4, 3.6e-3);
+    assert_eq!(m, 7_200_000usize.div_ceil(LADDER_MAX_FIT_SAMPLES));
+    // At least 3 samples per time constant wherever the copy allows it.
+    for (len, tau) in [(44_000, 3.6e-3), (100_000, 5e-3), (30_000, 2e-3)] {
+        let m = fit_thinning(len, 5e-4, tau);
+        assert!(tau / (m as f64 * 5e-4) >= 3.0 || len / m > LADDER_MAX_FIT_SAMPLES);
+    }
+}
