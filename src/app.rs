@@ -45,7 +45,7 @@ pub use lamps::{panel_call, panel_input, PanelIsolation};
 mod sample_path;
 pub use sample_path::{AppError, Command, CommandError, SamplePath};
 mod status_line;
-pub use status_line::status_line;
+pub use status_line::{status_line, BoardCounters};
 
 /// The machine the firmware monitors by default: the "2.2 kW" reference machine
 /// (`monitor_core::reference::MOTOR_2P2KW`: 400 V, 50 Hz, 4 poles, Gamma model, Bl for the
@@ -217,6 +217,12 @@ pub struct MonitorStatus {
     /// ([`RangeWatch::moved`]), false as the sample path hands it ([`panel_input`] shows
     /// the amber state only when no fault is named).
     pub moved: bool,
+    /// Samples since boot with a conversion at the front end's linear limit (clipped,
+    /// held out of the residuals: [`crate::sampling::Clipped`]); wraps.
+    pub clipped: u32,
+    /// Latched encoder counts since boot rejected as a step beyond the maximum speed
+    /// (`acquisition::EncoderCheck`); wraps.
+    pub encoder_rejects: u32,
 }
 
 impl MonitorStatus {
@@ -287,6 +293,8 @@ pub struct Supervisor {
     default_motor: bool,
     /// The clock runs on the HSI: the crystal did not start (the panel marks it).
     clock_fallback: bool,
+    /// The brown-out level is below the goal: records refused (the panel marks it).
+    bor_below_goal: bool,
     /// Sensors whose start-up offset was out of bound ([`Supervisor::set_offset_fault`]).
     offset_fault: SensorFlags,
     /// The ADC's reference, measured at start-up and every second
@@ -325,6 +333,7 @@ impl Supervisor {
             running: false,
             default_motor: false,
             clock_fallback: false,
+            bor_below_goal: false,
             offset_fault: SensorFlags::default(),
             reference: ReferenceWatch::new(REFERENCE_PERIOD_MS),
             range: RangeWatch::new(),
@@ -382,6 +391,13 @@ impl Supervisor {
         self.clock_fallback = fallback;
     }
 
+    /// Whether the brown-out reset level is below the goal (`supply::BorCheck`: records
+    /// refused, a commissioning ends "not stored"): the panel shows it ([`crate::panel`],
+    /// "Brown-out level below the goal"). Off until set.
+    pub fn set_bor_below_goal(&mut self, below: bool) {
+        self.bor_below_goal = below;
+    }
+
     /// The commissioned operating range and the "moved" judgement.
     pub fn range(&self) -> &RangeWatch {
         &self.range
@@ -421,6 +437,7 @@ impl Supervisor {
         let input = PanelInput {
             default_motor: self.default_motor,
             clock_fallback: self.clock_fallback,
+            bor_below_goal: self.bor_below_goal,
             ..panel_input(mode, &self.latest, isolation, failed)
         };
         Tick {

@@ -230,14 +230,17 @@ fn clock_config(source: ClockSource) -> embassy_stm32::Config {
 /// the boot's budget at the fastest LSI). On the registers, before embassy-stm32's `init`
 /// (`firmware/under_the_hal.rs` lists why); `start_watchdog` shortens it once the boot ran.
 fn start_boot_watchdog() {
-    let frozen = debug_halt::FROZEN;
-    pac::DBGMCU.apb2fzr().modify(|w| {
-        w.set_tim1(frozen.trigger);
-        w.set_tim15(frozen.time_base);
+    // The whole registers as `debug_halt` computes them from what they hold (the host
+    // tests run the halt model on these values, not on the constant).
+    let dbg = pac::DBGMCU;
+    let after = debug_halt::FROZEN.registers_after(debug_halt::FreezeRegisters {
+        apb1fzr1: dbg.apb1lfzr().read().0,
+        apb2fzr: dbg.apb2fzr().read().0,
     });
-    pac::DBGMCU
-        .apb1lfzr()
-        .modify(|w| w.set_iwdg(frozen.watchdog));
+    dbg.apb1lfzr()
+        .write_value(pac::dbgmcu::regs::Apb1lfzr(after.apb1fzr1));
+    dbg.apb2fzr()
+        .write_value(pac::dbgmcu::regs::Apb2fzr(after.apb2fzr));
     let setting = watchdog::BOOT_SETTING;
     let iwdg = pac::IWDG;
     // Start (the LSI with it), unlock PR/RLR, the boot's timeout, reload.

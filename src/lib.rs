@@ -34,6 +34,7 @@
 //!   RAM across the reset;
 //! - [`setup_guard`]: the deadline on the ADCs' set-up (a step that does not finish is
 //!   recorded and ends in a reset);
+//! - [`stack`]: the painted stack's high-water mark and an overflow seen at the next boot;
 //! - [`supply`]: the brown-out level in the option bytes and the periodic check of the
 //!   ADC's reference (VDDA through VREFINT);
 //! - [`offset_trim`]: each channel's zero measured at start-up with the motor off, bounded;
@@ -83,6 +84,7 @@ pub mod recovery;
 pub mod reset_record;
 pub mod sampling;
 pub mod setup_guard;
+pub mod stack;
 pub mod supply;
 pub mod under_the_hal;
 pub mod watchdog;

@@ -28,6 +28,37 @@ pub struct RawFrame {
     pub i: [CurrentCode; 3],
     /// TIM4 counter (x4 quadrature, 16 bit, wraps).
     pub encoder_count: u16,
+    /// Which of the sample's channels had a conversion at the front end's linear limit
+    /// (on the board each conversion is checked, `acquisition::sum_half_clipped`, and the
+    /// flag held through the filter's memory, `acquisition::ClipHold`).
+    pub clipped: Clipped,
+    /// The sample's latched encoder counts rejected as a step beyond the maximum speed
+    /// (`acquisition::EncoderCheck`; 0..=8).
+    pub encoder_rejects: u8,
+}
+
+/// Which channels of one sample were clipped: a conversion at or beyond the front end's
+/// linear limit (`acquisition::LinearRange`). A clipped sample is flagged as saturated to
+/// the core, which holds its block out of the filters and the residuals.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Clipped {
+    /// A voltage channel (ADC1).
+    pub voltage: bool,
+    /// A current channel (ADC2).
+    pub current: bool,
+}
+
+impl Clipped {
+    /// No channel clipped.
+    pub const NONE: Clipped = Clipped {
+        voltage: false,
+        current: false,
+    };
+
+    /// Whether any channel clipped.
+    pub const fn any(self) -> bool {
+        self.voltage | self.current
+    }
 }
 
 /// Why a sampling configuration was rejected.
@@ -115,8 +146,8 @@ impl AdcSampler {
             },
             encoder_count: u32::from(raw.encoder_count),
             timestamp_ticks: ts,
-            v_saturated: raw.v.iter().any(|c| is_saturated_code(c.0)),
-            i_saturated: raw.i.iter().any(|c| is_saturated_code(c.0)),
+            v_saturated: raw.clipped.voltage || raw.v.iter().any(|c| is_saturated_code(c.0)),
+            i_saturated: raw.clipped.current || raw.i.iter().any(|c| is_saturated_code(c.0)),
         }
     }
 
@@ -138,6 +169,8 @@ impl AdcSampler {
             ],
             // The hardware counter is 16 bits wide.
             encoder_count: (encoder_count & 0xFFFF) as u16,
+            clipped: Clipped::NONE,
+            encoder_rejects: 0,
         }
     }
 }
@@ -179,5 +212,17 @@ mod tests {
         assert!(s.i_saturated && !s.v_saturated);
         assert_eq!(s.encoder_count, 70_000 & 0xFFFF);
         assert_eq!(b.build(&raw).timestamp_ticks, 49);
+    }
+
+    /// A clip seen in the conversions flags the sample even where the filtered codes are
+    /// inside the range (the mean of eight conversions, two of them clipped).
+    #[test]
+    fn a_clipped_sample_is_flagged_saturated() {
+        let mut b = AdcSampler::new(FrontEnd::DEFAULT, 10_000).unwrap();
+        let mut raw = b.quantize(Abc::default(), Abc::default(), 0);
+        assert!(!b.build(&raw).v_saturated && !b.build(&raw).i_saturated);
+        raw.clipped.current = true;
+        let s = b.build(&raw);
+        assert!(s.i_saturated && !s.v_saturated);
     }
 }

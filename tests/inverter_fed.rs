@@ -110,6 +110,8 @@ fn board_log(rows: &[Row], path: Path) -> Vec<Row> {
                 v: [VoltageCode(va), VoltageCode(vb), VoltageCode(vc)],
                 i: [CurrentCode(ia), CurrentCode(ib), CurrentCode(ic)],
                 encoder_count: 0,
+                clipped: drive_monitor::sampling::Clipped::NONE,
+                encoder_rejects: 0,
             };
             let s = sampler.build(&raw);
             let first = &period[0];

@@ -109,6 +109,7 @@ pub fn panel_input(
         commissioning_failed,
         default_motor: false,
         clock_fallback: false,
+        bor_below_goal: false,
         moved,
     }
 }

@@ -97,6 +97,10 @@ pub struct SamplePath {
     sampler: AdcSampler,
     samples: u32,
     trim: OffsetTrim,
+    /// Clipped samples since boot (wrapping).
+    clipped: u32,
+    /// Rejected encoder counts since boot (wrapping).
+    encoder_rejects: u32,
 }
 
 impl SamplePath {
@@ -114,6 +118,8 @@ impl SamplePath {
             sampler: AdcSampler::new(front_end, sample_rate_hz).map_err(AppError::Sampling)?,
             samples: 0,
             trim: OffsetTrim::new(&front_end),
+            clipped: 0,
+            encoder_rejects: 0,
         })
     }
 
@@ -194,12 +200,19 @@ impl SamplePath {
         self.samples
     }
 
-    /// Process one sample's readings.
+    /// Process one sample's readings: scaled and stamped ([`AdcSampler::build`]; a clipped
+    /// sample goes to the core as saturated, which holds its block out of the residuals)
+    /// into [`Monitor::update`]; the clipped samples and the rejected encoder counts
+    /// counted for the status line.
     #[inline]
     pub fn on_frame(&mut self, raw: &RawFrame) {
         let sample = self.sampler.build(raw);
         self.monitor.update(&sample);
         self.samples = self.samples.wrapping_add(1);
+        self.clipped = self.clipped.wrapping_add(u32::from(raw.clipped.any()));
+        self.encoder_rejects = self
+            .encoder_rejects
+            .wrapping_add(u32::from(raw.encoder_rejects));
     }
 
     /// The status for thread mode, from the latest output.
@@ -241,6 +254,8 @@ impl SamplePath {
             winding_confidence: o.unbalance.phase_confidence,
             vds: o.vds,
             moved: false,
+            clipped: self.clipped,
+            encoder_rejects: self.encoder_rejects,
         }
     }
 }

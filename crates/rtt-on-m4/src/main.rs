@@ -244,7 +244,7 @@ fn log_status(samples: u32, line: u32) {
     let half = [0.006, 0.011, 0.012, 0.007];
     let zc: Option<bool> = None;
     defmt::info!(
-        "r={} lamps={} fault={=bool} call={=str} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32} iqs={=f32}A ids={=f32}A vqs={=f32}V f={=f32}Hz steady={=bool} eval={=bool} sens={=bool},{=bool},{=bool} mid={} half={} iso={=str} iso_change={=f32} iso_p={=f32} wind={=str} wind_i2={=f32} moved={=bool} rise={=f32}K vdda={=f32}V bor={=u8}",
+        "r={} lamps={} fault={=bool} call={=str} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32} iqs={=f32}A ids={=f32}A vqs={=f32}V f={=f32}Hz steady={=bool} eval={=bool} sens={=bool},{=bool},{=bool} mid={} half={} iso={=str} iso_change={=f32} iso_p={=f32} wind={=str} wind_i2={=f32} moved={=bool} rise={=f32}K vdda={=f32}V bor={=u8} clip={=u32} enc_rej={=u32} stack={=u32}B",
         residuals,
         lamps,
         true,
@@ -282,7 +282,10 @@ fn log_status(samples: u32, line: u32) {
         false,
         12.5,
         3.301,
-        4u8
+        4u8,
+        0u32,
+        0u32,
+        2344u32
     );
 }
 
