@@ -69,6 +69,13 @@ pub const VOLT_PER_LSB: f32 = 2.0 * VOLTAGE_FULL_SCALE_V / ADC_MAX_CODE as f32;
 /// Amperes at the motor per ADC code: `2 * 10 A / 4095 LSB = 4.884 mA/LSB`.
 pub const AMP_PER_LSB: f32 = 2.0 * CURRENT_FULL_SCALE_A / ADC_MAX_CODE as f32;
 
+/// The isolated amplifier's output headroom [ADC codes]: its output stage is linear only
+/// up to about 50 mV from its supply rails (a rail-to-rail output stage's swing; check the
+/// part fitted), 62 codes at 3.3 V / 4095. A conversion within it of the record's full
+/// scale counts as clipped (`motor_source::linear_ranges`): an isolated amplifier clips
+/// before the ADC's rail.
+pub const AMPLIFIER_HEADROOM_CODES: f32 = 62.0;
+
 /// Sample (trigger) rate of the six channels by default, hertz.
 pub const DEFAULT_SAMPLE_RATE_HZ: u32 = 10_000;
 /// Encoder lines per mechanical revolution.

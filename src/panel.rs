@@ -280,8 +280,15 @@ pub fn render(input: &PanelInput, t_ms: u32) -> PanelLamps {
     let mark_phase = t_ms % DEFAULT_MOTOR_PERIOD_MS;
     let clock_phase = mark_phase.wrapping_sub(CLOCK_FALLBACK_AT_MS);
     let bor_phase = mark_phase.wrapping_sub(BOR_MARK_AT_MS);
-    let (on, gap) = (DEFAULT_MOTOR_ON_MS, DEFAULT_MOTOR_ON_MS + DEFAULT_MOTOR_GAP_MS);
-    let run = match (input.default_motor, input.bor_below_goal, input.clock_fallback) {
+    let (on, gap) = (
+        DEFAULT_MOTOR_ON_MS,
+        DEFAULT_MOTOR_ON_MS + DEFAULT_MOTOR_GAP_MS,
+    );
+    let run = match (
+        input.default_motor,
+        input.bor_below_goal,
+        input.clock_fallback,
+    ) {
         (true, _, _) if mark_phase < on => true,
         (true, _, _) if mark_phase < gap => false,
         (_, true, _) if bor_phase < on => true,
@@ -449,7 +456,10 @@ mod tests {
             inp.default_motor = true;
             inp.clock_fallback = true;
             for from in [0, 2_500, 5_000] {
-                assert!((0..200u32).all(|k| render(&inp, from + k * 10).run), "{from}");
+                assert!(
+                    (0..200u32).all(|k| render(&inp, from + k * 10).run),
+                    "{from}"
+                );
             }
         }
         // The failed and stalled patterns stay as they are.

@@ -36,7 +36,12 @@ pub const PAINT_MARGIN_BYTES: u32 = 256;
 /// the statics (flip-link: the initial stack pointer `initial_sp` is at or below the first
 /// static's address `first_static`), else cortex-m-rt's `_stack_end` (`stack_end`: the end
 /// of the statics; the default layout, the stack above them).
-pub const fn region_bottom(initial_sp: u32, first_static: u32, ram_start: u32, stack_end: u32) -> u32 {
+pub const fn region_bottom(
+    initial_sp: u32,
+    first_static: u32,
+    ram_start: u32,
+    stack_end: u32,
+) -> u32 {
     if initial_sp <= first_static {
         ram_start
     } else {

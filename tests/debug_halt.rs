@@ -73,7 +73,7 @@ fn a_breakpoint_stops_sampling_cleanly_and_resumes_without_a_recovery() {
         for halt_ms in [1, 100, 2_000, 60_000] {
             assert_eq!(
                 halt(written(read), halt_ms),
-            AfterHalt {
+                AfterHalt {
                     lapped: false,
                     recovered: false,
                     reset: false

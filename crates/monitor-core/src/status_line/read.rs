@@ -311,7 +311,9 @@ mod tests {
         }
         assert!(text.starts_with("r=[0.0123, -0.1, 0.25, -0.004] lamps=[false, true, true, true] fault=true call=fault top=b(0.5) 2nd=bl(0.5) wm=150.5rad/s zc_locked=Some(true) "));
         assert!(
-            text.ends_with(" moved=true rise=54.4K vdda=3.301V bor=4 clip=17 enc_rej=3 stack=2344B"),
+            text.ends_with(
+                " moved=true rise=54.4K vdda=3.301V bor=4 clip=17 enc_rej=3 stack=2344B"
+            ),
             "{text}"
         );
     }
@@ -328,7 +330,10 @@ mod tests {
         let before = "INFO  r=[0.1, 0.2, 0.3, 0.4] lamps=[false, false, false, false] fault=false call=healthy moved=false rise=0.0K vdda=3.3V bor=4";
         let r = parse(before).expect("a status line");
         assert_eq!((r.vdda_v, r.bor), (Some(3.3), Some(4)));
-        assert_eq!((r.clipped, r.encoder_rejects, r.stack_used_bytes), (None, None, None));
+        assert_eq!(
+            (r.clipped, r.encoder_rejects, r.stack_used_bytes),
+            (None, None, None)
+        );
         for other in [
             "INFO  sampling at 10000 Hz",
             "└─ drive_monitor::firmware::log_status @ src/firmware.rs:545",
