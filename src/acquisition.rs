@@ -54,7 +54,8 @@ pub use crate::adc_rules::CHANNELS;
 #[path = "acquisition/checks.rs"]
 mod checks;
 pub use checks::{
-    max_step_per_trigger, sum_half_clipped, ClipHold, EncoderCheck, LinearRange, CLIP_HOLD_SAMPLES,
+    max_step_per_trigger, sum_half_clipped, ClipHold, EncoderCheck, LinearRange, LinearRanges,
+    CLIP_HOLD_SAMPLES,
 };
 
 /// Sequences (triggers) averaged into one sample (module docs).

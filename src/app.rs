@@ -43,7 +43,7 @@ pub use isolation::{board_isolator, isolation_summary};
 mod lamps;
 pub use lamps::{panel_call, panel_input, PanelIsolation};
 mod sample_path;
-pub use sample_path::{AppError, Command, CommandError, SamplePath};
+pub use sample_path::{AppError, Command, CommandError, FrameBuilder, SamplePath};
 mod status_line;
 pub use status_line::{status_line, BoardCounters};
 

@@ -37,7 +37,7 @@ pub struct BootMachine {
     pub encoder: EncoderSetup,
     /// The six channels' linear ranges for the per-conversion clip check
     /// ([`motor_source::linear_ranges`]).
-    pub ranges: motor_source::LinearRanges,
+    pub ranges: crate::acquisition::LinearRanges,
     /// `Ok`: the fault isolation judges against this machine; `Err`: the core's isolation
     /// rejects it ([`Isolator::new`]'s check): the lamps still monitor it, nothing is
     /// isolated.

@@ -4,7 +4,7 @@
 //! board's front end). Host-testable: the firmware reads the page at
 //! [`board::MOTOR_RECORD_FLASH_OFFSET`] and hands the bytes to [`select`].
 
-use crate::acquisition::{self, LinearRange};
+use crate::acquisition::{self, LinearRange, LinearRanges};
 use crate::app::{AppError, SamplePath, DEFAULT_MACHINE};
 use crate::board::{self, ChannelScale, FrontEnd};
 use crate::sampling::TICK_HZ;
@@ -190,16 +190,6 @@ pub fn isolator(rec: &MotorRecord) -> Result<Isolator, ConfigError> {
         rec.supply.v_phase_peak() as f32,
         rec.supply.f_hz as f32,
     )
-}
-
-/// The six channels' linear ranges in ADC codes (the per-conversion clip check,
-/// [`acquisition::sum_half_clipped`]): voltages a, b, c and currents a, b, c.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct LinearRanges {
-    /// The voltage channels' (ADC1).
-    pub voltage: [LinearRange; 3],
-    /// The current channels' (ADC2).
-    pub current: [LinearRange; 3],
 }
 
 /// The front end's linear limit for `rec`, per channel: the record's full scale on either

@@ -67,6 +67,23 @@ pub fn sum_half_clipped(
     ([a, b, c], sequences.len() as u32, clipped)
 }
 
+/// The six channels' linear ranges: voltages a, b, c (ADC1) and currents a, b, c (ADC2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LinearRanges {
+    /// The voltage channels'.
+    pub voltage: [LinearRange; CHANNELS],
+    /// The current channels'.
+    pub current: [LinearRange; CHANNELS],
+}
+
+impl LinearRanges {
+    /// Only the rails clip, on every channel.
+    pub const RAILS: LinearRanges = LinearRanges {
+        voltage: [LinearRange::RAILS; CHANNELS],
+        current: [LinearRange::RAILS; CHANNELS],
+    };
+}
+
 /// Samples a clip stays flagged after the clipped one: [`PwmFilter`]'s memory (its first
 /// stage keeps `(1 - 1/4)^n` of a sample's value after `n` samples: 1 % after 16), so the
 /// clipped conversions' share in the filtered readings after it is held out too.

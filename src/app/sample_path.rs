@@ -3,10 +3,14 @@
 //! [`Command`]s thread mode sends it, applied between two samples.
 
 use super::{board_monitor_config, MonitorStatus};
+use crate::acquisition::{
+    sample_count, sum_half_clipped, ClipHold, EncoderCheck, LinearRanges, PwmFilter,
+};
 use crate::board::FrontEnd;
+use crate::board::{CurrentCode, VoltageCode};
 use crate::flash_record::CalibrationRecord;
 use crate::offset_trim::{OffsetTrim, TrimResult};
-use crate::sampling::{AdcSampler, RawFrame, SamplingError};
+use crate::sampling::{AdcSampler, Clipped, RawFrame, SamplingError};
 use monitor_core::{
     CommissioningError, ConfigError, Fault, Install, Monitor, MonitorConfig, SteadyPoint,
 };
@@ -256,6 +260,66 @@ impl SamplePath {
             moved: false,
             clipped: self.clipped,
             encoder_rejects: self.encoder_rejects,
+        }
+    }
+}
+
+/// One sample's conversions and latched encoder counts -> its [`RawFrame`], as the sample
+/// task builds it: each ADC's oversampled sequences summed with every conversion checked
+/// against its channel's linear range ([`sum_half_clipped`]; a clip held through the
+/// filter's memory, [`ClipHold`]), the inverter's ripple filtered out ([`PwmFilter`]), the
+/// latched counts checked against the maximum speed ([`EncoderCheck`]) and averaged
+/// ([`sample_count`]). No allocation, no panics.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameBuilder {
+    filter: PwmFilter,
+    hold: ClipHold,
+    encoder: EncoderCheck,
+    ranges: LinearRanges,
+}
+
+impl FrameBuilder {
+    /// A builder at `sample_rate_hz` whose filter restores the gain at `supply_hz`, with
+    /// the channels' linear `ranges` (`motor_source::linear_ranges`) and the encoder's
+    /// largest step between two triggers `max_step` (`motor_source::EncoderSetup`).
+    pub fn new(sample_rate_hz: u32, supply_hz: f32, ranges: LinearRanges, max_step: u16) -> Self {
+        Self {
+            filter: PwmFilter::new(sample_rate_hz, supply_hz),
+            hold: ClipHold::default(),
+            encoder: EncoderCheck::new(max_step),
+            ranges,
+        }
+    }
+
+    /// After a gap in the triggers (a recovery, a paused acquisition): the next latched
+    /// count starts the encoder check afresh.
+    pub fn restart(&mut self) {
+        self.encoder.restart();
+    }
+
+    /// A sample that is dropped (`adc_rules::IdleDiscard`): its latched counts still go
+    /// through the encoder check, so the next sample's first step is one trigger long.
+    pub fn skip(&mut self, latched: &mut [u16]) {
+        self.encoder.check_sample(latched);
+    }
+
+    /// One sample: `v` and `i` its sequences of ADC1 and ADC2 (`[a, b, c, a, b, c, ...]`),
+    /// `latched` the encoder counts latched at its triggers (oldest first; corrected in
+    /// place).
+    #[inline]
+    pub fn frame(&mut self, v: &[u16], i: &[u16], latched: &mut [u16]) -> RawFrame {
+        let (vs, n, v_clip) = sum_half_clipped(v, &self.ranges.voltage);
+        let (is, _, i_clip) = sum_half_clipped(i, &self.ranges.current);
+        let [voltage, current] = self.hold.step([v_clip, i_clip]);
+        let encoder_rejects = self.encoder.check_sample(latched);
+        let count = sample_count(latched);
+        let ([va, vb, vc], [ia, ib, ic], encoder_count) = self.filter.step(vs, is, n, count);
+        RawFrame {
+            v: [VoltageCode(va), VoltageCode(vb), VoltageCode(vc)],
+            i: [CurrentCode(ia), CurrentCode(ib), CurrentCode(ic)],
+            encoder_count,
+            clipped: Clipped { voltage, current },
+            encoder_rejects,
         }
     }
 }
