@@ -23,7 +23,7 @@
 
 use crate::board;
 use crate::commissioning::{Action, CommissioningProcedure, RunEnd};
-use crate::flash_record::{self, CalibrationRecord, RecordStore, Stored};
+use crate::flash_record::CalibrationRecord;
 use crate::liveness::{LivenessChange, SampleWatch};
 use crate::offset_trim::TrimResult;
 use crate::panel::{self, blink_code, winding_code, Mode, PanelInput, PanelLamps, NOT_NAMED_CODE};
@@ -46,6 +46,8 @@ mod sample_path;
 pub use sample_path::{AppError, Command, CommandError, FrameBuilder, SamplePath};
 mod status_line;
 pub use status_line::{status_line, BoardCounters};
+mod store;
+pub use store::{carry_out, AcquisitionPause, NoPause};
 
 /// The machine the firmware monitors by default: the "2.2 kW" reference machine
 /// (`monitor_core::reference::MOTOR_2P2KW`: 400 V, 50 Hz, 4 poles, Gamma model, Bl for the
@@ -268,6 +270,10 @@ pub struct Tick {
     pub run_ended: Option<RunEnd>,
     /// The sample path's liveness changed: log it (and write or clear the reset record).
     pub liveness: Option<LivenessChange>,
+    /// A new correction for the ADC's reference to hand the sample task
+    /// ([`Command::ReferenceGain`]: VDDA now over VDDA at commissioning,
+    /// [`crate::supply::ReferenceGain`]).
+    pub reference_gain: Option<f32>,
 }
 
 /// Thread mode's logic: button, commissioning procedure, liveness watch and panel.
@@ -302,6 +308,12 @@ pub struct Supervisor {
     reference: ReferenceWatch,
     /// The commissioned operating range (RAM only) and the "moved" judgement.
     range: RangeWatch,
+    /// The correction of the readings for the reference's drift since commissioning.
+    gain: crate::supply::ReferenceGain,
+    /// VDDA the record being stored holds (in force once the run ends commissioned).
+    pending_vdda: Option<f32>,
+    /// A run ended commissioned in this tick: its VDDA goes into force.
+    gain_on_commissioning: bool,
 }
 
 impl Supervisor {
@@ -337,6 +349,9 @@ impl Supervisor {
             offset_fault: SensorFlags::default(),
             reference: ReferenceWatch::new(REFERENCE_PERIOD_MS),
             range: RangeWatch::new(),
+            gain: crate::supply::ReferenceGain::default(),
+            pending_vdda: None,
+            gain_on_commissioning: false,
         }
     }
 
@@ -428,6 +443,9 @@ impl Supervisor {
         };
         if let Action::Store { record, .. } = &mut action {
             record.isolation = self.run_baseline;
+            // The reference the run learned at: later readings are corrected to it.
+            record.vdda_v = self.reference.in_band_v();
+            self.pending_vdda = record.vdda_v;
         }
         self.expire_failed_show(now_ms);
         let mode = self.mode(watch.stalled);
@@ -448,6 +466,7 @@ impl Supervisor {
             action,
             run_ended,
             liveness: watch.change,
+            reference_gain: self.reference_gain(run_ended),
         }
     }
 
@@ -493,8 +512,34 @@ impl Supervisor {
         }
         if let Some(RunEnd::Commissioned { run }) = run_ended {
             self.range.commit(run);
+            self.gain_on_commissioning = true;
         }
         (action, run_ended)
+    }
+
+    /// The reference's correction at the end of a tick: the VDDA of a run that ended
+    /// commissioned (`run_ended`) goes into force, else the latest measurement against the
+    /// commissioned VDDA ([`crate::supply::ReferenceGain::observe`]); a new gain, if any.
+    fn reference_gain(&mut self, run_ended: Option<RunEnd>) -> Option<f32> {
+        let latest = self.reference.latest();
+        if core::mem::take(&mut self.gain_on_commissioning)
+            && matches!(run_ended, Some(RunEnd::Commissioned { .. }))
+        {
+            return self.gain.commissioned(self.pending_vdda, latest);
+        }
+        latest.and_then(|check| self.gain.observe(check))
+    }
+
+    /// Puts the VDDA of the commissioning `record` loaded at boot into force for the
+    /// reference's correction ([`crate::supply::ReferenceGain`]; a record without it: no
+    /// correction). The gain follows at the next measurement ([`Tick::reference_gain`]).
+    pub fn restore_reference(&mut self, record: &CalibrationRecord) {
+        self.gain.commissioned(record.vdda_v, None);
+    }
+
+    /// The reference's correction in force.
+    pub fn reference_correction(&self) -> &crate::supply::ReferenceGain {
+        &self.gain
     }
 
     /// Ends the boot's "monitor failed" show once `now_ms` has reached its end.
@@ -526,74 +571,5 @@ impl Supervisor {
     }
 }
 
-/// Carries out a commissioning [`Action`]: the command for the sample task, after storing
-/// the calibration in `store` for [`Action::Store`] (erase, write, read back: the command
-/// reports what the store holds, whatever failed). Also returns the storage result.
-pub fn carry_out<S: RecordStore>(
-    action: Action,
-    store: &mut S,
-) -> (Option<Command>, Option<Stored<S::Error>>) {
-    match action {
-        Action::None => (None, None),
-        Action::Start { duration_s } => (Some(Command::StartCommissioning { duration_s }), None),
-        Action::Cancel { run } => (Some(Command::CancelCommissioning { run }), None),
-        Action::Store { run, record } => {
-            let stored = flash_record::store(store, &record);
-            (
-                Some(Command::CalibrationStored {
-                    run,
-                    stored: stored.read_back,
-                }),
-                Some(stored),
-            )
-        }
-    }
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn settings_out_of_range_are_named() {
-        assert_eq!(Settings::DEFAULT.validate(), Ok(()));
-        for rate in [0, 7_000, 10_050, 3_000_000] {
-            let s = Settings {
-                sample_rate_hz: rate,
-                ..Settings::DEFAULT
-            };
-            assert_eq!(s.validate(), Err(SettingsError::SampleRate), "{rate}");
-        }
-        for d in [0.0, -1.0, f32::NAN, f32::INFINITY] {
-            let s = Settings {
-                commissioning_duration_s: d,
-                ..Settings::DEFAULT
-            };
-            assert_eq!(s.validate(), Err(SettingsError::CommissioningDuration));
-        }
-        let s = Settings {
-            commissioning_stall_ms: 0,
-            ..Settings::DEFAULT
-        };
-        assert_eq!(s.validate(), Err(SettingsError::CommissioningStall));
-    }
-
-    #[test]
-    fn board_config_is_valid() {
-        let s = Settings::DEFAULT;
-        assert!(board_monitor_config(s.sample_rate_hz).validate().is_ok());
-        assert!(SamplePath::for_board(s.sample_rate_hz).is_ok());
-        assert_eq!(s.status_every(), 100);
-        // The stall time is shorter than the core's gate timeout (see the procedure).
-        let gate_ms = board_monitor_config(s.sample_rate_hz).gate_timeout_s * 1000.0;
-        assert!((s.commissioning_stall_ms as f32) < gate_ms);
-    }
-
-    #[test]
-    fn another_sample_rate_goes_through_the_same_configuration() {
-        let path = SamplePath::for_board(20_000).unwrap();
-        assert_eq!(path.monitor().config().sample_rate_hz, 20_000.0);
-        assert_eq!(path.sampler().ticks_per_sample(), 50);
-        assert!(SamplePath::for_board(7_000).is_err());
-    }
-}
+mod tests;

@@ -149,6 +149,9 @@ pub fn boot<S: RecordStore>(
     let baseline_restored = calibration
         .as_ref()
         .is_ok_and(|rec| supervisor.restore_isolation(rec));
+    if let Ok(rec) = &calibration {
+        supervisor.restore_reference(rec);
+    }
     Ok(Booted {
         machine,
         path,

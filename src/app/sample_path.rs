@@ -48,6 +48,13 @@ pub enum Command {
     },
     /// Install a calibration read from flash at boot.
     SetCalibration(CalibrationRecord),
+    /// Stop the acquisition until thread mode has erased and written the flash
+    /// ([`super::AcquisitionPause`]); the sample task carries it out on the registers, the
+    /// sample path has nothing to do.
+    PauseAcquisition,
+    /// Correct every reading for the ADC's reference: VDDA now over VDDA at commissioning
+    /// ([`crate::supply::ReferenceGain`]); 1 removes the correction.
+    ReferenceGain(f32),
 }
 
 /// Why the core did not carry out a [`Command`] as asked.
@@ -90,6 +97,8 @@ impl Command {
             Command::CancelCommissioning { .. } => "cancel-commissioning",
             Command::CalibrationStored { .. } => "calibration-stored",
             Command::SetCalibration(_) => "set-calibration",
+            Command::PauseAcquisition => "pause-acquisition",
+            Command::ReferenceGain(_) => "reference-gain",
         }
     }
 }
@@ -105,6 +114,11 @@ pub struct SamplePath {
     clipped: u32,
     /// Rejected encoder counts since boot (wrapping).
     encoder_rejects: u32,
+    /// The front end at the reference of commissioning: the record's scaling with the
+    /// start-up trim's offsets (in codes at that reference).
+    front_end: FrontEnd,
+    /// The reference correction in force: VDDA now over VDDA at commissioning.
+    reference_gain: f32,
 }
 
 impl SamplePath {
@@ -124,6 +138,8 @@ impl SamplePath {
             trim: OffsetTrim::new(&front_end),
             clipped: 0,
             encoder_rejects: 0,
+            front_end,
+            reference_gain: 1.0,
         })
     }
 
@@ -162,6 +178,11 @@ impl SamplePath {
             Command::SetCalibration(rec) => m
                 .set_calibration(rec.into())
                 .map_err(CommandError::Calibration),
+            Command::PauseAcquisition => Ok(()),
+            Command::ReferenceGain(gain) => {
+                self.set_reference_gain(gain);
+                Ok(())
+            }
         }
     }
 
@@ -172,16 +193,49 @@ impl SamplePath {
     /// before and after (then it returns at once).
     pub fn trim_offsets(&mut self, raw: &RawFrame) -> Option<TrimResult> {
         let trim = self.trim.add(raw)?;
-        let mut fe = *self.sampler.front_end();
+        let gain = self.reference_gain;
+        let fe = &mut self.front_end;
         let channels = (fe.voltage.iter_mut().zip(trim.voltage))
             .chain(fe.current.iter_mut().zip(trim.current));
         for (scale, channel) in channels {
             if let Some(offset) = channel.offset() {
-                scale.offset_code = offset;
+                // Measured in codes at today's reference: at commissioning's, x gain.
+                scale.offset_code = offset * gain;
             }
         }
-        self.sampler.set_front_end(fe);
+        self.apply_front_end();
         Some(trim)
+    }
+
+    /// Corrects every reading for the ADC's reference (`Command::ReferenceGain`): `gain`
+    /// = VDDA now over VDDA at commissioning ([`crate::supply::ReferenceGain`]). The front
+    /// end's output is not ratiometric (the isolated amplifiers have references of their
+    /// own), so a code read at VDDA now is `gain` times the code the same input gave at
+    /// commissioning: `x = (gain code - offset) per_lsb = (code - offset / gain) (gain
+    /// per_lsb)`, the front end rescaled once, nothing added per sample. A gain that is
+    /// not finite or outside 0.9..=1.1 (beyond the reference's band, whose readings are
+    /// flagged anyway) is ignored.
+    pub fn set_reference_gain(&mut self, gain: f32) {
+        if gain.is_finite() && (0.9..=1.1).contains(&gain) {
+            self.reference_gain = gain;
+            self.apply_front_end();
+        }
+    }
+
+    /// The reference correction in force (1: none).
+    pub fn reference_gain(&self) -> f32 {
+        self.reference_gain
+    }
+
+    /// The sampler's front end: [`SamplePath::front_end`]'s scaled by the reference gain.
+    fn apply_front_end(&mut self) {
+        let g = self.reference_gain;
+        let mut fe = self.front_end;
+        for scale in fe.voltage.iter_mut().chain(fe.current.iter_mut()) {
+            scale.offset_code /= g;
+            scale.per_lsb *= g;
+        }
+        self.sampler.set_front_end(fe);
     }
 
     /// The ADC sampler (for timestamp resynchronisation after lost samples).
