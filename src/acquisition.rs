@@ -53,6 +53,8 @@ pub use crate::adc_rules::CHANNELS;
 // (the firmware's library, the QEMU program).
 #[path = "acquisition/checks.rs"]
 mod checks;
+// The QEMU program uses a part of them.
+#[allow(unused_imports)]
 pub use checks::{
     max_step_per_trigger, sum_half_clipped, ClipHold, EncoderCheck, LinearRange, LinearRanges,
     CLIP_HOLD_SAMPLES,
@@ -172,14 +174,50 @@ pub const fn sample_period_cycles(sample_rate_hz: u32) -> u32 {
     }
 }
 
-/// Whether a ring of two halves of `samples_per_half` samples tolerates the worst-case
-/// latency at `sample_rate_hz`: the DMA writes into a half again `samples_per_half`
-/// periods after it completed it, so the half must be read, and its samples processed,
-/// within that time.
+/// Cycles per instruction of the **lap case**, x 10: the expected
+/// [`WORST_CYCLES_PER_INSTRUCTION_X10`] (2.1, an assumption no board has measured) plus a
+/// quarter, 2.6. The ring is sized so that it holds even where the assumption is a quarter
+/// too low: at 2.1 a ring of two samples per half would hold (its copy 29 567 cycles after
+/// the request, against 34 000), at 2.6 it is lapped (35 671), and three hold (35 931
+/// against 51 000). `tests/ring_latency.rs` runs the board's events at this case.
+pub const LAP_CYCLES_PER_INSTRUCTION_X10: u32 = 26;
+/// Instructions to copy one sample's 2 x 24 words out of the rings (part of
+/// [`SAMPLE_WORK_INSTRUCTIONS`], done first).
+pub const COPY_INSTRUCTIONS: u32 = 100;
+
+/// `instructions` at [`LAP_CYCLES_PER_INSTRUCTION_X10`] [cycles], rounded up.
+pub const fn lap_cycles(instructions: u32) -> u32 {
+    (instructions * LAP_CYCLES_PER_INSTRUCTION_X10).div_ceil(10)
+}
+
+/// The longest log frame at the lap case's cycles per instruction [CPU cycles]: 31 221
+/// (184 us at 170 MHz).
+pub const LAP_FRAME_CYCLES: u32 = lap_cycles(LOG_FRAME_INSTRUCTIONS);
+
+/// The lap latency [CPU cycles] with `samples_per_half` samples per DMA half: from the
+/// half's interrupt request to the half copied out of the ring (what the DMA must not
+/// overwrite first), every term at its worst at once and the instructions at the lap
+/// case's cycles per instruction: a log frame that masked interrupts just before the
+/// request, the entry, the DMA handler, the other interrupts, the executor, the copy.
+pub const fn lap_latency_cycles(samples_per_half: u32) -> u32 {
+    LAP_FRAME_CYCLES
+        + INTERRUPT_ENTRY_CYCLES
+        + DMA_HANDLER_CYCLES
+        + OTHER_INTERRUPTS_CYCLES
+        + EXECUTOR_CYCLES
+        + samples_per_half * lap_cycles(COPY_INSTRUCTIONS)
+}
+
+/// Whether a ring of two halves of `samples_per_half` samples holds at `sample_rate_hz`:
+/// the DMA writes into a half again `samples_per_half` periods after it completed it, so
+/// the half must be copied out within that time at the lap case
+/// ([`lap_latency_cycles`]), and the task must keep up (a half's work, at the lap case,
+/// within a half's periods).
 pub const fn ring_fits(sample_rate_hz: u32, samples_per_half: u32) -> bool {
+    let slack = samples_per_half * sample_period_cycles(sample_rate_hz);
     samples_per_half > 0
-        && worst_latency_cycles(samples_per_half)
-            <= samples_per_half * sample_period_cycles(sample_rate_hz)
+        && lap_latency_cycles(samples_per_half) <= slack
+        && samples_per_half * lap_cycles(SAMPLE_WORK_INSTRUCTIONS) < slack
 }
 
 /// The smallest number of samples per DMA half (1..=8) that tolerates the worst-case

@@ -48,23 +48,23 @@ pub fn sum_half_clipped(
     ranges: &[LinearRange; CHANNELS],
 ) -> ([u32; CHANNELS], u32, bool) {
     let (sequences, _) = half.as_chunks::<CHANNELS>();
-    let [ra, rb, rc] = *ranges;
-    let (la, lb, lc) = (
-        ra.low.wrapping_add(1),
-        rb.low.wrapping_add(1),
-        rc.low.wrapping_add(1),
-    );
-    let (na, nb, nc) = (ra.inside(), rb.inside(), rc.inside());
+    // Branch-free: with `d = (code - (low + 1)) mod 2^16` (the code's place in the range,
+    // wrapped below it), the code clips when `d >= inside`, that is when
+    // `d + (2^16 - inside)` carries into bit 16: ORed over the conversions, bit 16 says
+    // whether any clipped (an add, a zero-extending add and an OR a conversion).
+    let [ka, kb, kc] = ranges.map(|r| 0x1_0000 - u32::from(r.low.wrapping_add(1)));
+    let [ia, ib, ic] = ranges.map(|r| 0x1_0000 - u32::from(r.inside()));
     let [mut a, mut b, mut c] = [0u32; CHANNELS];
-    let mut clipped = false;
+    let mut carry = 0u32;
     for &[x, y, z] in sequences {
-        a += u32::from(x);
-        b += u32::from(y);
-        c += u32::from(z);
-        clipped |=
-            (x.wrapping_sub(la) >= na) | (y.wrapping_sub(lb) >= nb) | (z.wrapping_sub(lc) >= nc);
+        let (x, y, z) = (u32::from(x), u32::from(y), u32::from(z));
+        a += x;
+        b += y;
+        c += z;
+        carry |=
+            (((x + ka) & 0xFFFF) + ia) | (((y + kb) & 0xFFFF) + ib) | (((z + kc) & 0xFFFF) + ic);
     }
-    ([a, b, c], sequences.len() as u32, clipped)
+    ([a, b, c], sequences.len() as u32, carry & 0x1_0000 != 0)
 }
 
 /// The six channels' linear ranges: voltages a, b, c (ADC1) and currents a, b, c (ADC2).
@@ -183,12 +183,15 @@ impl EncoderCheck {
     /// on each); returns how many were rejected.
     #[inline]
     pub fn check_sample(&mut self, latched: &mut [u16]) -> u8 {
+        // The state in registers for the sample's counts ([`EncoderCheck::check`] on each).
+        let mut s = *self;
         let mut rejected = 0u8;
         for c in latched.iter_mut() {
-            let (corrected, bad) = self.check(*c);
+            let (corrected, bad) = s.check(*c);
             *c = corrected;
             rejected = rejected.saturating_add(u8::from(bad));
         }
+        *self = s;
         rejected
     }
 }

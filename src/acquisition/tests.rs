@@ -17,9 +17,9 @@ fn the_geometry_fits_the_period() {
 /// The ring's depth from the budget, against the sums by hand: one sample's work is
 /// 1 367 instructions, 2 871 cycles at 2.1 (2 870.7 rounded up); the frame 8 960 x
 /// 264 / 197 = 12 007.3, 12 008 instructions, 25 216.8, 25 217 cycles; with 30 + 400 +
-/// 1 500 + 2 000 the worst case is 32 018 cycles for one sample per half (more than its
-/// 17 000 of slack), 34 889 for two (more than 34 000) and 37 760 for three (under
-/// 51 000).
+/// 1 500 + 2 000 a half's samples are processed at worst 32 018, 34 889 and 37 760 cycles
+/// after its request with 1, 2, 3 samples per half (the processing latency). The depth
+/// follows from the lap case, the copy at 2.6 cycles an instruction (below).
 #[test]
 fn the_ring_depth_follows_from_the_latency_budget() {
     assert_eq!(sample_period_cycles(10_000), 17_000);
@@ -28,13 +28,22 @@ fn the_ring_depth_follows_from_the_latency_budget() {
     assert_eq!(worst_latency_cycles(1), 32_018);
     assert_eq!(worst_latency_cycles(2), 34_889);
     assert_eq!(worst_latency_cycles(3), 37_760);
+    // The lap case (2.6 cycles an instruction): the frame 12 008 x 2.6 = 31 220.8, 31 221;
+    // a sample's copy 100 x 2.6 = 260; with 30 + 400 + 1 500 + 2 000 of wake-up the copy
+    // is done 35 411, 35 671 and 35 931 cycles after the request with 1, 2, 3 samples per
+    // half: beyond 17 000 and 34 000, within 51 000.
+    assert_eq!(LAP_FRAME_CYCLES, 31_221);
+    assert_eq!(lap_latency_cycles(1), 35_411);
+    assert_eq!(lap_latency_cycles(2), 35_671);
+    assert_eq!(lap_latency_cycles(3), 35_931);
     assert!(!ring_fits(10_000, 1));
     assert!(!ring_fits(10_000, 2));
     assert!(ring_fits(10_000, 3));
     assert_eq!(SAMPLES_PER_HALF, 3);
     assert_eq!(DMA_HALF_LEN, 72);
-    // A slower rate needs a shallower ring; a faster one a deeper one.
-    assert_eq!(samples_per_half_for(5_000), 1);
+    // A slower rate needs a shallower ring (5 kHz: 34 000 cycles a sample, 35 411 with
+    // one: two); a faster one a deeper one.
+    assert_eq!(samples_per_half_for(5_000), 2);
     assert!(samples_per_half_for(20_000) > 3);
 }
 

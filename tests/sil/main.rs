@@ -17,6 +17,7 @@
 mod boot_composition;
 mod commissioning;
 mod evidence;
+mod flash_pause;
 mod isolation;
 mod liveness;
 mod moved;

@@ -288,10 +288,16 @@ fn count_instructions(cfg: &MonitorConfig, n: usize, ticks_per_instr: f32) {
 
 /// Counts the instructions per sample of the firmware's sampling path (module docs, 4):
 /// each replay sample's six codes as [`acquisition::OVERSAMPLING`] sequences per ADC,
-/// summed (`sum_half`) and filtered (`PwmFilter::step`), and prints
+/// summed with every conversion checked against its channel's linear range
+/// (`sum_half_clipped`, the clip held by `ClipHold`), the eight latched encoder counts
+/// checked against the maximum speed (`EncoderCheck`) and averaged (`sample_count`), and
+/// filtered (`PwmFilter::step`): what `app::FrameBuilder::frame` runs. Prints
 /// `sampling_path`; the loop that builds the halves is measured alone and subtracted.
 fn count_sampling_path(n: usize, ticks_per_instr: f32) {
-    use acquisition::{sum_half, PwmFilter, CHANNELS, HALF_LEN};
+    use acquisition::{
+        sample_count, sum_half_clipped, ClipHold, EncoderCheck, LinearRange, PwmFilter, CHANNELS,
+        HALF_LEN, OVERSAMPLING,
+    };
     let halves = |k: usize| {
         let at = scenario::REPLAY_HEADER + k * scenario::SAMPLE_BYTES;
         let c = |x: usize| scenario::u16_at(REPLAY, at + 2 * x);
@@ -300,7 +306,9 @@ fn count_sampling_path(n: usize, ticks_per_instr: f32) {
             *v = c(j % CHANNELS);
             *i = c(CHANNELS + j % CHANNELS);
         }
-        (v, i, c(6))
+        // The counts latched at the sample's eight triggers: the sample's count, as the
+        // replay's encoder moves at most a few counts a sample.
+        (v, i, [c(6); OVERSAMPLING])
     };
     let base = measure(|| {
         for k in 0..n {
@@ -308,10 +316,21 @@ fn count_sampling_path(n: usize, ticks_per_instr: f32) {
         }
     });
     let mut filter = PwmFilter::new(10_000, 50.0);
+    let mut hold = ClipHold::default();
+    let mut encoder = EncoderCheck::new(4);
+    // The built-in front end's ranges (motor_source::linear_ranges: 62..=4033).
+    let range = [LinearRange {
+        low: 62,
+        high: 4033,
+    }; CHANNELS];
     let t = measure(|| {
         for k in 0..n {
-            let (v, i, count) = halves(black_box(k));
-            let ((vs, m), (is, _)) = (sum_half(black_box(&v)), sum_half(black_box(&i)));
+            let (v, i, mut latched) = halves(black_box(k));
+            let (vs, m, vc) = sum_half_clipped(black_box(&v), &range);
+            let (is, _, ic) = sum_half_clipped(black_box(&i), &range);
+            black_box(hold.step([vc, ic]));
+            black_box(encoder.check_sample(&mut latched));
+            let count = sample_count(&latched);
             black_box(filter.step(vs, is, m, count));
         }
     });
