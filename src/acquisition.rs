@@ -105,18 +105,19 @@ pub fn sample_count(latched: &[u16]) -> u16 {
 /// The sample rate the ring is sized for [Hz] (the firmware's `SETTINGS`, checked there at
 /// compile time with [`ring_fits`]).
 pub const BUDGET_SAMPLE_RATE_HZ: u32 = 10_000;
-/// The status line's bytes as `cargo qemu-rtt` measured them (`bytes_a_reader_finds=195`,
-/// 1 965 B for ten lines: 197 B a line), with the names the QEMU program logs.
-pub const LOG_MEASURED_BYTES: u32 = 197;
+/// The status line's bytes as `cargo qemu-rtt` measured them (2 005 B for ten lines, 200.5 B
+/// a line, rounded up; with issue 74's `clip=`, `enc_rej=` and `stack=`: 197 B before),
+/// with the names the QEMU program logs.
+pub const LOG_MEASURED_BYTES: u32 = 201;
 /// The instructions that line took with interrupts masked under QEMU
-/// (`flood_max_late_instructions=8960`: defmt-rtt holds a critical section for a whole
-/// frame, encoding and copying it byte by byte).
-pub const LOG_MEASURED_INSTRUCTIONS: u32 = 8_960;
+/// (`flood_max_late_instructions=9400`: defmt-rtt holds a critical section for a whole
+/// frame, encoding and copying it byte by byte; 8 960 before issue 74's fields).
+pub const LOG_MEASURED_INSTRUCTIONS: u32 = 9_400;
 /// The longest frame the firmware logs [bytes]: the status line with the longest name in
 /// each of its six name fields, the frame's timestamp and the framing's overhead
 /// (`tests/ring_latency.rs` computes the bound from the names and fails when the line
 /// outgrows it).
-pub const LOG_FRAME_MAX_BYTES: u32 = 264;
+pub const LOG_FRAME_MAX_BYTES: u32 = 268;
 /// The longest frame's instructions, with interrupts masked: the measured line's cost per
 /// byte times [`LOG_FRAME_MAX_BYTES`], rounded up (12 008).
 pub const LOG_FRAME_INSTRUCTIONS: u32 =
@@ -139,17 +140,17 @@ pub const OTHER_INTERRUPTS_CYCLES: u32 = 1_500;
 /// awaits: the poll, the `with_timeout` future and its timer queue entry [cycles].
 pub const EXECUTOR_CYCLES: u32 = 2_000;
 /// One sample's work at its worst [instructions] (`cargo qemu-core`: the sampling path's
-/// 222, the core's fast path 211 and, on every 25th sample, its slow path's 784), plus
-/// copying its 2 x 24 words out of the rings (about 100) and the mean of its 8 latched
-/// encoder counts ([`sample_count`], about 50; not traced).
-pub const SAMPLE_WORK_INSTRUCTIONS: u32 = 222 + 211 + 784 + 100 + 50;
+/// 918, with the per-conversion clip check, the encoder counts' check and their mean; the
+/// core's fast path 211 and, on every 25th sample, its slow path's 784), plus copying its
+/// 2 x 24 words out of the rings ([`COPY_INSTRUCTIONS`]).
+pub const SAMPLE_WORK_INSTRUCTIONS: u32 = 918 + 211 + 784 + COPY_INSTRUCTIONS;
 
 /// `instructions` at [`WORST_CYCLES_PER_INSTRUCTION_X10`] [cycles], rounded up.
 pub const fn worst_cycles(instructions: u32) -> u32 {
     (instructions * WORST_CYCLES_PER_INSTRUCTION_X10).div_ceil(10)
 }
 
-/// The longest critical section a log frame may hold [CPU cycles]: 25 217 (148 us at
+/// The longest critical section a log frame may hold [CPU cycles]: 26 322 (155 us at
 /// 170 MHz).
 pub const LOG_FRAME_CYCLES: u32 = worst_cycles(LOG_FRAME_INSTRUCTIONS);
 
@@ -177,9 +178,10 @@ pub const fn sample_period_cycles(sample_rate_hz: u32) -> u32 {
 /// Cycles per instruction of the **lap case**, x 10: the expected
 /// [`WORST_CYCLES_PER_INSTRUCTION_X10`] (2.1, an assumption no board has measured) plus a
 /// quarter, 2.6. The ring is sized so that it holds even where the assumption is a quarter
-/// too low: at 2.1 a ring of two samples per half would hold (its copy 29 567 cycles after
-/// the request, against 34 000), at 2.6 it is lapped (35 671), and three hold (35 931
-/// against 51 000). `tests/ring_latency.rs` runs the board's events at this case.
+/// too low: at 2.1 a ring of two samples per half would hold (its copy 30 672 cycles after
+/// the request, the DMA back 35 831 after it), at 2.6 it is lapped (37 039), and three
+/// hold (37 299 against 52 831; up to 3.8 cycles an instruction). `tests/ring_latency.rs`
+/// runs the board's events at this case.
 pub const LAP_CYCLES_PER_INSTRUCTION_X10: u32 = 26;
 /// Instructions to copy one sample's 2 x 24 words out of the rings (part of
 /// [`SAMPLE_WORK_INSTRUCTIONS`], done first).
@@ -190,8 +192,8 @@ pub const fn lap_cycles(instructions: u32) -> u32 {
     (instructions * LAP_CYCLES_PER_INSTRUCTION_X10).div_ceil(10)
 }
 
-/// The longest log frame at the lap case's cycles per instruction [CPU cycles]: 31 221
-/// (184 us at 170 MHz).
+/// The longest log frame at the lap case's cycles per instruction [CPU cycles]: 32 589
+/// (192 us at 170 MHz).
 pub const LAP_FRAME_CYCLES: u32 = lap_cycles(LOG_FRAME_INSTRUCTIONS);
 
 /// The lap latency [CPU cycles] with `samples_per_half` samples per DMA half: from the
@@ -208,16 +210,31 @@ pub const fn lap_latency_cycles(samples_per_half: u32) -> u32 {
         + samples_per_half * lap_cycles(COPY_INSTRUCTIONS)
 }
 
+/// One conversion [CPU cycles], rounded down (147 at 170 MHz).
+pub const fn conversion_cycles() -> u32 {
+    (conversion_ns() as u64 * clock::HCLK_HZ as u64 / 1_000_000_000) as u32
+}
+
+/// The time a half's copy has [CPU cycles]: from the half's completion (its last
+/// sequence's last conversion) to the DMA writing its first word again, two halves later:
+/// `(OVERSAMPLING x samples_per_half + 1)` trigger periods less two conversions (18 831,
+/// 35 831 and 52 831 cycles with 1, 2, 3 samples per half at 10 kHz).
+pub const fn lap_slack_cycles(sample_rate_hz: u32, samples_per_half: u32) -> u32 {
+    let trigger = sample_period_cycles(sample_rate_hz) / OVERSAMPLING as u32;
+    ((OVERSAMPLING as u32 * samples_per_half + 1) * trigger)
+        .saturating_sub((CHANNELS as u32 - 1) * conversion_cycles())
+}
+
 /// Whether a ring of two halves of `samples_per_half` samples holds at `sample_rate_hz`:
-/// the DMA writes into a half again `samples_per_half` periods after it completed it, so
-/// the half must be copied out within that time at the lap case
-/// ([`lap_latency_cycles`]), and the task must keep up (a half's work, at the lap case,
-/// within a half's periods).
+/// a half must be copied out before the DMA writes into it again ([`lap_latency_cycles`]
+/// within [`lap_slack_cycles`], at the lap case), and the task must keep up (a half's work,
+/// at the lap case, within a half's periods).
 pub const fn ring_fits(sample_rate_hz: u32, samples_per_half: u32) -> bool {
-    let slack = samples_per_half * sample_period_cycles(sample_rate_hz);
     samples_per_half > 0
-        && lap_latency_cycles(samples_per_half) <= slack
-        && samples_per_half * lap_cycles(SAMPLE_WORK_INSTRUCTIONS) < slack
+        && lap_latency_cycles(samples_per_half)
+            <= lap_slack_cycles(sample_rate_hz, samples_per_half)
+        && samples_per_half * lap_cycles(SAMPLE_WORK_INSTRUCTIONS)
+            < samples_per_half * sample_period_cycles(sample_rate_hz)
 }
 
 /// The smallest number of samples per DMA half (1..=8) that tolerates the worst-case

@@ -15,35 +15,40 @@ fn the_geometry_fits_the_period() {
 }
 
 /// The ring's depth from the budget, against the sums by hand: one sample's work is
-/// 1 367 instructions, 2 871 cycles at 2.1 (2 870.7 rounded up); the frame 8 960 x
-/// 264 / 197 = 12 007.3, 12 008 instructions, 25 216.8, 25 217 cycles; with 30 + 400 +
-/// 1 500 + 2 000 a half's samples are processed at worst 32 018, 34 889 and 37 760 cycles
-/// after its request with 1, 2, 3 samples per half (the processing latency). The depth
-/// follows from the lap case, the copy at 2.6 cycles an instruction (below).
+/// 918 + 211 + 784 + 100 = 2 013 instructions, 4 227.3, 4 228 cycles at 2.1; the frame
+/// 9 400 x 268 / 201 = 12 533.3, 12 534 instructions, 26 321.4, 26 322 cycles; with 30 +
+/// 400 + 1 500 + 2 000 a half's samples are processed at worst 34 480, 38 708 and 42 936
+/// cycles after its request with 1, 2, 3 samples per half (the processing latency). The
+/// depth follows from the lap case, the copy at 2.6 cycles an instruction.
 #[test]
 fn the_ring_depth_follows_from_the_latency_budget() {
     assert_eq!(sample_period_cycles(10_000), 17_000);
-    assert_eq!(LOG_FRAME_INSTRUCTIONS, 12_008);
-    assert_eq!(LOG_FRAME_CYCLES, 25_217);
-    assert_eq!(worst_latency_cycles(1), 32_018);
-    assert_eq!(worst_latency_cycles(2), 34_889);
-    assert_eq!(worst_latency_cycles(3), 37_760);
-    // The lap case (2.6 cycles an instruction): the frame 12 008 x 2.6 = 31 220.8, 31 221;
-    // a sample's copy 100 x 2.6 = 260; with 30 + 400 + 1 500 + 2 000 of wake-up the copy
-    // is done 35 411, 35 671 and 35 931 cycles after the request with 1, 2, 3 samples per
-    // half: beyond 17 000 and 34 000, within 51 000.
-    assert_eq!(LAP_FRAME_CYCLES, 31_221);
-    assert_eq!(lap_latency_cycles(1), 35_411);
-    assert_eq!(lap_latency_cycles(2), 35_671);
-    assert_eq!(lap_latency_cycles(3), 35_931);
+    assert_eq!(LOG_FRAME_INSTRUCTIONS, 12_534);
+    assert_eq!(LOG_FRAME_CYCLES, 26_322);
+    assert_eq!(worst_latency_cycles(1), 34_480);
+    assert_eq!(worst_latency_cycles(2), 38_708);
+    assert_eq!(worst_latency_cycles(3), 42_936);
+    // The lap case (2.6 cycles an instruction): the frame 12 534 x 2.6 = 32 588.4, 32 589;
+    // a sample's copy 100 x 2.6 = 260; with 3 930 of wake-up the copy is done 36 779,
+    // 37 039 and 37 299 cycles after the request with 1, 2, 3 samples per half. The DMA
+    // writes a half's first word again 9, 17, 25 triggers of 2 125 cycles after its start,
+    // less two conversions of 147: 18 831, 35 831, 52 831 cycles after its completion.
+    assert_eq!(LAP_FRAME_CYCLES, 32_589);
+    assert_eq!(lap_latency_cycles(1), 36_779);
+    assert_eq!(lap_latency_cycles(2), 37_039);
+    assert_eq!(lap_latency_cycles(3), 37_299);
+    assert_eq!(conversion_cycles(), 147);
+    assert_eq!(lap_slack_cycles(10_000, 1), 18_831);
+    assert_eq!(lap_slack_cycles(10_000, 2), 35_831);
+    assert_eq!(lap_slack_cycles(10_000, 3), 52_831);
     assert!(!ring_fits(10_000, 1));
     assert!(!ring_fits(10_000, 2));
     assert!(ring_fits(10_000, 3));
     assert_eq!(SAMPLES_PER_HALF, 3);
     assert_eq!(DMA_HALF_LEN, 72);
-    // A slower rate needs a shallower ring (5 kHz: 34 000 cycles a sample, 35 411 with
-    // one: two); a faster one a deeper one.
-    assert_eq!(samples_per_half_for(5_000), 2);
+    // A slower rate needs a shallower ring (5 kHz: 4 250 cycles a trigger, 37 956 of slack
+    // with one sample per half against 36 779); a faster one a deeper one.
+    assert_eq!(samples_per_half_for(5_000), 1);
     assert!(samples_per_half_for(20_000) > 3);
 }
 
