@@ -242,7 +242,7 @@ impl drive_monitor::flash_ecc::RawFlash for TornFlash<'_> {
             let eccr = ECCR_ECCD | ECCR_BK_ECC | (self.torn_at - BANK_SIZE);
             match nmi_action(eccr) {
                 NmiAction::RecordPageEcc(e) => self.latch.latch(e),
-                NmiAction::Fault => return Err(NmiReset),
+                NmiAction::Fault | NmiAction::ClockFailure => return Err(NmiReset),
             }
         }
         Ok(())
