@@ -37,11 +37,12 @@ mod flash;
 mod logs;
 mod reset_ram;
 mod sample_task;
+mod stack;
 mod supply;
 
 use core::sync::atomic::{AtomicU32, Ordering};
 
-use defmt::{error, info};
+use defmt::{error, info, warn};
 use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, Spawner};
 use embassy_stm32::exti::{self, ExtiInput};
@@ -49,6 +50,7 @@ use embassy_stm32::flash::Flash;
 use embassy_stm32::gpio::{Level, Output, Pull, Speed};
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::mode::Async;
+use embassy_stm32::usart::{Config as UsartConfig, UartTx};
 use embassy_stm32::wdg::IndependentWatchdog;
 use embassy_stm32::{bind_interrupts, dma, interrupt, pac, peripherals, Peri};
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
@@ -57,8 +59,8 @@ use embassy_sync::signal::Signal;
 use embassy_time::{with_deadline, with_timeout, Duration, Instant, Timer};
 
 use drive_monitor::app::{
-    carry_out, status_line, Command, MonitorStatus, SamplePath, Settings, Supervisor, Tick,
-    PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
+    carry_out, status_line, AcquisitionPause, BoardCounters, Command, MonitorStatus, SamplePath,
+    Settings, Supervisor, Tick, PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
 };
 use drive_monitor::board::{self, pins::Board, Lamp, LAMP_COUNT};
 use drive_monitor::boot::{self, BootMachine};
@@ -66,7 +68,7 @@ use drive_monitor::clock::{self, ClockSource};
 use drive_monitor::commissioning::Action;
 use drive_monitor::offset_trim::TrimResult;
 use drive_monitor::panel::PanelLamps;
-use drive_monitor::reset_record::{BootPhase, PreviousRun};
+use drive_monitor::reset_record::{BootPhase, PreviousRun, ResetSource};
 use drive_monitor::supply::{BorCheck, BorGate};
 use drive_monitor::{debug_halt, watchdog};
 use monitor_core::Isolation;
@@ -142,6 +144,17 @@ static STATUS: Signal<CriticalSectionRawMutex, Status> = Signal::new();
 static TRIM: Signal<CriticalSectionRawMutex, TrimResult> = Signal::new();
 /// The start-up check of the ADC's reference, from the sample task to thread mode.
 static REFERENCE: Signal<CriticalSectionRawMutex, board::ReferenceCheck> = Signal::new();
+/// The sample task paused the acquisition for a flash erase (`true`: stopped), to thread
+/// mode (`app::AcquisitionPause`).
+static PAUSED: Signal<CriticalSectionRawMutex, bool> = Signal::new();
+/// Thread mode has finished with the flash: the sample task resumes the acquisition.
+static RESUME: Signal<CriticalSectionRawMutex, ()> = Signal::new();
+/// The longest the sample task stays paused for the flash [ms] (an erase takes about
+/// 22 ms, the record's write about 1 ms); it resumes then whatever thread mode says.
+const PAUSE_LIMIT_MS: u32 = 100;
+/// The longest thread mode waits for the sample task to pause [ms] (it pauses between two
+/// halves, 300 us apart).
+const PAUSE_WAIT_MS: u64 = 10;
 static OVERRUNS: AtomicU32 = AtomicU32::new(0);
 static RESTARTS: AtomicU32 = AtomicU32::new(0);
 static EXECUTOR_HIGH: InterruptExecutor = InterruptExecutor::new();
@@ -206,7 +219,7 @@ fn clock_config(source: ClockSource) -> embassy_stm32::Config {
             });
             PllSource::HSE
         }
-        ClockSource::Hsi => PllSource::HSI,
+        ClockSource::Hsi | ClockSource::HsiAfterFailure => PllSource::HSI,
     };
     config.rcc.pll = Some(Pll {
         source: pll_source,
@@ -296,11 +309,21 @@ fn boot_board(
 #[embassy_executor::main]
 async fn main(_spawner: Spawner) {
     start_boot_watchdog();
-    let source = start_crystal();
+    // Before the clock set-up: the previous run's end (a clock failure's record keeps the
+    // crystal out of this run) and the stack (its guard words, then painted).
+    let (previous, reset_source) = logs::read_previous_run();
+    let stack_overflowed = stack::check_and_paint();
+    let source = clock::boot_source(previous.clock_failed(), start_crystal);
     let p = embassy_stm32::init(clock_config(source));
+    if clock::css_on(source) {
+        // The clock security system: a crystal that stops raises an NMI (`failure.rs`)
+        // and the hardware switches to the HSI; embassy-stm32 leaves it off.
+        pac::RCC.cr().modify(|w| w.set_csson(true));
+    }
     info!("drive-monitor {} starting", env!("CARGO_PKG_VERSION"));
     logs::log_clock(source);
-    let previous = logs::previous_run();
+    logs::log_previous_run(previous, reset_source);
+    logs::log_stack(stack_overflowed);
     // The brown-out level of the option bytes: reported, not written (`drive_monitor::supply`).
     let bor = supply::bor_check();
     logs::log_bor(bor);
@@ -322,10 +345,12 @@ async fn main(_spawner: Spawner) {
         log_div: 0,
         bor,
     };
+    report_boot(&mut thread, b.vcp, (previous, reset_source), source);
     let mut button = ExtiInput::new(b.button, b.button_exti, Pull::Down, Irqs);
 
     let (machine, path, mut supervisor) = boot_board(&mut thread.flash.store, previous);
-    supervisor.set_clock_fallback(source == ClockSource::Hsi);
+    supervisor.set_clock_fallback(source != ClockSource::Hse);
+    supervisor.set_bor_below_goal(!bor.allows_flash_writes());
     let boot = Instant::now();
     let hw = SampleHw {
         adc1: b.adc1,
@@ -342,9 +367,63 @@ async fn main(_spawner: Spawner) {
         encoder: machine.encoder,
         syst: cp.SYST,
         supply_hz: machine.record.supply.f_hz as f32,
+        ranges: machine.ranges,
     };
     spawn_sample_task(hw, path);
     thread.run(&mut supervisor, &mut button, boot).await
+}
+
+/// The record a technician reads without a probe: the previous run's end appended to the
+/// reset log in flash (refused below the brown-out goal; before sampling starts, so the
+/// erase holds nothing up), then the boot report and the log's four newest entries as text
+/// on the ST-LINK's virtual COM port (USART2 TX on PA2, 115 200 8N1;
+/// `drive_monitor::reset_record::report`).
+fn report_boot(
+    thread: &mut Thread,
+    (usart, tx): (
+        Peri<'static, peripherals::USART2>,
+        Peri<'static, peripherals::PA2>,
+    ),
+    (previous, reset_source): (PreviousRun, ResetSource),
+    source: ClockSource,
+) {
+    use drive_monitor::reset_record::{log, report};
+    let mut pages = flash::LogPages {
+        flash: &mut thread.flash.store,
+        bor: thread.bor,
+    };
+    let appended = log::Entry::of(&previous)
+        .map(|(ended, record)| log::append(&mut pages, reset_source, ended, record).map(|e| e.seq));
+    logs::log_reset_log(appended);
+    let Ok(mut vcp) = UartTx::new_blocking(usart, tx, UsartConfig::default()) else {
+        error!("virtual COM port: USART2 not configured: no boot report there");
+        return;
+    };
+    let clock = match source {
+        ClockSource::Hse => "24 MHz crystal (HSE)",
+        _ => "internal oscillator (HSI, +-1 %)",
+    };
+    let version = env!("CARGO_PKG_VERSION");
+    let bor = thread.bor.status_number();
+    let mut lines = [
+        report::boot_line(version, reset_source, bor, clock),
+        report::previous_line(&previous),
+    ]
+    .into_iter()
+    .chain(
+        log::newest::<_, 4>(&mut pages)
+            .0
+            .into_iter()
+            .flatten()
+            .map(|e| report::entry_line(&e)),
+    );
+    if lines
+        .try_for_each(|l| vcp.blocking_write(l.as_bytes()))
+        .is_err()
+    {
+        error!("virtual COM port: write failed");
+    }
+    let _ = vcp.blocking_flush();
 }
 
 /// The Cortex-M core peripherals, with the cycle counter running (for the per-sample cost
@@ -452,6 +531,10 @@ impl Thread {
             logs::log_run_end(end);
         }
         self.carry_out(tick.action).await;
+        if let Some(gain) = tick.reference_gain {
+            logs::log_reference_gain(gain);
+            send(Command::ReferenceGain(gain)).await;
+        }
         self.lamps.show(&tick.lamps);
         self.log_div += 1;
         if self.log_div >= 2 {
@@ -465,19 +548,12 @@ impl Thread {
     /// [`COMMAND_SEND_TIMEOUT_MS`] for a slot in the queue (else the command is dropped and
     /// logged).
     async fn carry_out(&mut self, action: Action) {
-        let (command, stored) = carry_out(action, &mut self.flash);
+        let (command, stored) = carry_out(action, &mut self.flash, &mut SampleTaskPause);
         if let Some(stored) = stored {
             logs::log_stored(&stored);
         }
         if let Some(cmd) = command {
-            let sent = with_timeout(
-                Duration::from_millis(COMMAND_SEND_TIMEOUT_MS),
-                COMMANDS.send(cmd),
-            )
-            .await;
-            if sent.is_err() {
-                error!("command queue full: {=str} dropped", cmd.name());
-            }
+            send(cmd).await;
         }
     }
 
@@ -495,6 +571,49 @@ impl Thread {
             self.max_update_cycles,
             (supervisor.reference().vdda_v(), self.bor.status_number()),
         );
+    }
+}
+
+/// Sends `cmd` to the sample task, waiting at most [`COMMAND_SEND_TIMEOUT_MS`] for a slot in
+/// the queue (else the command is dropped and logged).
+async fn send(cmd: Command) {
+    let sent = with_timeout(
+        Duration::from_millis(COMMAND_SEND_TIMEOUT_MS),
+        COMMANDS.send(cmd),
+    )
+    .await;
+    if sent.is_err() {
+        error!("command queue full: {=str} dropped", cmd.name());
+    }
+}
+
+/// The sample task's pause around a flash erase and write (`app::AcquisitionPause`): the
+/// command, then a bounded busy wait in thread mode for the sample task (which preempts
+/// it) to say it paused; the resume by signal.
+struct SampleTaskPause;
+
+impl AcquisitionPause for SampleTaskPause {
+    fn pause(&mut self) -> bool {
+        PAUSED.reset();
+        if COMMANDS.try_send(Command::PauseAcquisition).is_err() {
+            error!("flash: command queue full, the acquisition not paused");
+            return false;
+        }
+        let deadline = Instant::now() + Duration::from_millis(PAUSE_WAIT_MS);
+        while Instant::now() < deadline {
+            if let Some(paused) = PAUSED.try_take() {
+                return paused;
+            }
+        }
+        warn!(
+            "flash: the sample task did not pause within {=u64} ms",
+            PAUSE_WAIT_MS
+        );
+        false
+    }
+
+    fn resume(&mut self) {
+        RESUME.signal(());
     }
 }
 
@@ -530,9 +649,10 @@ fn log_status(
     max_update_cycles: u32,
     supply: (f32, u8),
 ) {
-    let restarts = (
-        OVERRUNS.load(Ordering::Relaxed),
-        RESTARTS.load(Ordering::Relaxed),
-    );
-    status_line(s, iso, rise_k, panel, max_update_cycles, restarts, supply).log_info();
+    let board = BoardCounters {
+        overruns: OVERRUNS.load(Ordering::Relaxed),
+        restarts: RESTARTS.load(Ordering::Relaxed),
+        stack_used_bytes: stack::high_water_bytes(),
+    };
+    status_line(s, iso, rise_k, panel, max_update_cycles, board, supply).log_info();
 }

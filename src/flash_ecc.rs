@@ -21,7 +21,7 @@
 
 use core::sync::atomic::{AtomicU32, Ordering};
 
-use crate::board::{MOTOR_RECORD_FLASH_OFFSET, RECORD_FLASH_OFFSET, RECORD_PAGE_SIZE};
+use crate::board::{RECORD_FLASH_OFFSET, RECORD_PAGE_SIZE, RESET_LOG_FLASH_OFFSET};
 
 /// `FLASH_ECCR.ECCD`: an ECC double error (write 1 to clear).
 pub const ECCR_ECCD: u32 = 1 << 31;
@@ -34,8 +34,9 @@ pub const ECCR_ADDR_MASK: u32 = 0x0007_FFFF;
 /// A bank's size in dual-bank mode (512 KiB device): bank 2 starts at this offset.
 pub const BANK_SIZE: u32 = 256 * 1024;
 
-/// The first flash offset of the record pages (the motor record's page).
-pub const RECORD_PAGES_START: u32 = MOTOR_RECORD_FLASH_OFFSET;
+/// The first flash offset of the record pages (the reset log's first page, below the motor
+/// record's).
+pub const RECORD_PAGES_START: u32 = RESET_LOG_FLASH_OFFSET;
 /// One past the last flash offset of the record pages.
 pub const RECORD_PAGES_END: u32 = RECORD_FLASH_OFFSET + RECORD_PAGE_SIZE;
 

@@ -207,8 +207,11 @@ pub fn linear_ranges(rec: &MotorRecord) -> LinearRanges {
         let low = (offset - half_span).max(0.0) + headroom;
         let high = (offset + half_span).min(top) - headroom;
         LinearRange {
-            low: low.clamp(0.0, top).round() as u16,
-            high: high.clamp(0.0, top).round() as u16,
+            // Rounded to the nearest code (no `f32::round` on the board: + 0.5, truncated;
+            // `max`/`min`, not `f32::clamp`, whose assertion formats floats: 10 KiB of
+            // flash).
+            low: (low.max(0.0).min(top) + 0.5) as u16,
+            high: (high.max(0.0).min(top) + 0.5) as u16,
         }
     };
     LinearRanges {

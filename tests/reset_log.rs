@@ -157,7 +157,8 @@ fn the_boot_report_reads_without_a_probe() {
         previous_line(&PreviousRun::WatchdogReset).as_bytes(),
         b"previous run: watchdog reset with no reason recorded (the firmware hung)\r\n"
     );
-    let fault = ResetRecord::hard_fault(None, 0x0800_1A2C, 0x0800_0F01, 0x0000_0400, 0x4000_0000, 0);
+    let fault =
+        ResetRecord::hard_fault(None, 0x0800_1A2C, 0x0800_0F01, 0x0000_0400, 0x4000_0000, 0);
     let entry = Entry {
         seq: 7,
         source: ResetSource::IndependentWatchdog,

@@ -332,7 +332,7 @@ pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
     loop {
         if let Some(result) = recovery::before_read(&mut acq) {
             RESTARTS.fetch_add(1, Ordering::Relaxed);
-            after_restart(&mut acq, &mut path, &mut counts, result);
+            after_restart(&acq, &mut path, &mut counts, result);
             restarted(&mut discard, &mut frames, &acq, last_data_us);
             continue;
         }
