@@ -43,3 +43,34 @@ fn another_sample_rate_goes_through_the_same_configuration() {
     assert_eq!(path.sampler().ticks_per_sample(), 50);
     assert!(SamplePath::for_board(7_000).is_err());
 }
+
+/// The supervisor hands the brown-out level's mark to the panel: with the level below the
+/// goal the RUN lamp is lit from 2.5 s to 4.5 s of every 10 s (and dark just before), not
+/// without.
+#[test]
+fn the_supervisor_shows_the_brown_out_mark_while_the_level_is_below_the_goal() {
+    let run_lamp = |below: bool| {
+        let mut s = Supervisor::new(
+            &Settings::DEFAULT,
+            PreviousRun::Clean,
+            0,
+            MonitorStatus::default(),
+        );
+        s.set_bor_below_goal(below);
+        (0..200u32)
+            .map(|k| {
+                let status = MonitorStatus {
+                    samples: (k + 1) * 500,
+                    ..MonitorStatus::default()
+                };
+                s.tick(k * PANEL_PERIOD_MS, Some(status), false).lamps.run
+            })
+            .collect::<Vec<bool>>()
+    };
+    let marked = run_lamp(true);
+    let plain = run_lamp(false);
+    // Ticks of 50 ms: 2.5 s .. 4.5 s is ticks 50..90 (and 250..290 ten seconds later).
+    assert!(marked[50..90].iter().all(|on| *on), "{marked:?}");
+    assert!(marked[40..50].iter().all(|on| !on));
+    assert!(!plain[50..90].iter().all(|on| *on));
+}

@@ -16,12 +16,14 @@
 
 mod boot_composition;
 mod commissioning;
+mod conversions;
 mod evidence;
 mod flash_pause;
 mod isolation;
 mod liveness;
 mod moved;
 mod recovery;
+mod reference_gain;
 mod same_state;
 mod startup;
 
