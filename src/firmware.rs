@@ -32,6 +32,7 @@
 //! status, sample task -> thread, 100 Hz), `TRIM` (Signal, the start-up offset trim, once).
 
 mod acquisition;
+mod commands;
 mod failure;
 mod flash;
 mod logs;
@@ -39,10 +40,11 @@ mod reset_ram;
 mod sample_task;
 mod stack;
 mod supply;
+mod vcp;
 
 use core::sync::atomic::{AtomicU32, Ordering};
 
-use defmt::{error, info, warn};
+use defmt::{error, info};
 use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, Spawner};
 use embassy_stm32::exti::{self, ExtiInput};
@@ -50,17 +52,16 @@ use embassy_stm32::flash::Flash;
 use embassy_stm32::gpio::{Level, Output, Pull, Speed};
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::mode::Async;
-use embassy_stm32::usart::{Config as UsartConfig, UartTx};
 use embassy_stm32::wdg::IndependentWatchdog;
 use embassy_stm32::{bind_interrupts, dma, interrupt, pac, peripherals, Peri};
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
-use embassy_time::{with_deadline, with_timeout, Duration, Instant, Timer};
+use embassy_time::{with_deadline, Duration, Instant, Timer};
 
 use drive_monitor::app::{
-    carry_out, status_line, AcquisitionPause, BoardCounters, Command, MonitorStatus, SamplePath,
-    Settings, Supervisor, Tick, PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
+    carry_out, status_line, BoardCounters, Command, MonitorStatus, SamplePath, Settings,
+    Supervisor, Tick, PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
 };
 use drive_monitor::board::{self, pins::Board, Lamp, LAMP_COUNT};
 use drive_monitor::boot::{self, BootMachine};
@@ -68,7 +69,7 @@ use drive_monitor::clock::{self, ClockSource};
 use drive_monitor::commissioning::Action;
 use drive_monitor::offset_trim::TrimResult;
 use drive_monitor::panel::PanelLamps;
-use drive_monitor::reset_record::{BootPhase, PreviousRun, ResetSource};
+use drive_monitor::reset_record::{BootPhase, PreviousRun};
 use drive_monitor::supply::{BorCheck, BorGate};
 use drive_monitor::{debug_halt, watchdog};
 use monitor_core::Isolation;
@@ -332,20 +333,15 @@ async fn main(_spawner: Spawner) {
     let b = Board::take(p);
     let wdg = start_watchdog(b.iwdg);
     let dual_bank = dual_bank_flash();
-    let mut thread = Thread {
-        lamps: PanelPins::new(b.lamps),
-        flash: BorGate {
-            store: BoardFlash(CheckedFlash::new(Driver(
-                dual_bank.then(|| Flash::new_blocking(b.flash)),
-            ))),
-            bor,
-        },
-        wdg,
-        max_update_cycles: 0,
-        log_div: 0,
+    let flash = dual_bank.then(|| Flash::new_blocking(b.flash));
+    let mut thread = Thread::new(PanelPins::new(b.lamps), flash, wdg, bor);
+    vcp::report_boot(
+        &mut thread.flash.store,
         bor,
-    };
-    report_boot(&mut thread, b.vcp, (previous, reset_source), source);
+        b.vcp,
+        (previous, reset_source),
+        source,
+    );
     let mut button = ExtiInput::new(b.button, b.button_exti, Pull::Down, Irqs);
 
     let (machine, path, mut supervisor) = boot_board(&mut thread.flash.store, previous);
@@ -371,59 +367,6 @@ async fn main(_spawner: Spawner) {
     };
     spawn_sample_task(hw, path);
     thread.run(&mut supervisor, &mut button, boot).await
-}
-
-/// The record a technician reads without a probe: the previous run's end appended to the
-/// reset log in flash (refused below the brown-out goal; before sampling starts, so the
-/// erase holds nothing up), then the boot report and the log's four newest entries as text
-/// on the ST-LINK's virtual COM port (USART2 TX on PA2, 115 200 8N1;
-/// `drive_monitor::reset_record::report`).
-fn report_boot(
-    thread: &mut Thread,
-    (usart, tx): (
-        Peri<'static, peripherals::USART2>,
-        Peri<'static, peripherals::PA2>,
-    ),
-    (previous, reset_source): (PreviousRun, ResetSource),
-    source: ClockSource,
-) {
-    use drive_monitor::reset_record::{log, report};
-    let mut pages = flash::LogPages {
-        flash: &mut thread.flash.store,
-        bor: thread.bor,
-    };
-    let appended = log::Entry::of(&previous)
-        .map(|(ended, record)| log::append(&mut pages, reset_source, ended, record).map(|e| e.seq));
-    logs::log_reset_log(appended);
-    let Ok(mut vcp) = UartTx::new_blocking(usart, tx, UsartConfig::default()) else {
-        error!("virtual COM port: USART2 not configured: no boot report there");
-        return;
-    };
-    let clock = match source {
-        ClockSource::Hse => "24 MHz crystal (HSE)",
-        _ => "internal oscillator (HSI, +-1 %)",
-    };
-    let version = env!("CARGO_PKG_VERSION");
-    let bor = thread.bor.status_number();
-    let mut lines = [
-        report::boot_line(version, reset_source, bor, clock),
-        report::previous_line(&previous),
-    ]
-    .into_iter()
-    .chain(
-        log::newest::<_, 4>(&mut pages)
-            .0
-            .into_iter()
-            .flatten()
-            .map(|e| report::entry_line(&e)),
-    );
-    if lines
-        .try_for_each(|l| vcp.blocking_write(l.as_bytes()))
-        .is_err()
-    {
-        error!("virtual COM port: write failed");
-    }
-    let _ = vcp.blocking_flush();
 }
 
 /// The Cortex-M core peripherals, with the cycle counter running (for the per-sample cost
@@ -483,6 +426,28 @@ struct Thread {
 }
 
 impl Thread {
+    /// Thread mode's hardware: the `lamps`, the record pages in `flash` (`None`:
+    /// single-bank option bytes), the watchdog `wdg` and the brown-out level `bor` found at
+    /// boot (records refused below the goal).
+    fn new(
+        lamps: PanelPins,
+        flash: Option<Flash<'static, embassy_stm32::flash::Blocking>>,
+        wdg: IndependentWatchdog<'static, peripherals::IWDG>,
+        bor: BorCheck,
+    ) -> Self {
+        Self {
+            lamps,
+            flash: BorGate {
+                store: BoardFlash(CheckedFlash::new(Driver(flash))),
+                bor,
+            },
+            wdg,
+            max_update_cycles: 0,
+            log_div: 0,
+            bor,
+        }
+    }
+
     /// Thread mode's periods, every [`PANEL_PERIOD_MS`] from boot (`boot`, the clock's
     /// zero): the period's wait is the wait for the `button`, so a press at any time is
     /// seen.
@@ -533,7 +498,7 @@ impl Thread {
         self.carry_out(tick.action).await;
         if let Some(gain) = tick.reference_gain {
             logs::log_reference_gain(gain);
-            send(Command::ReferenceGain(gain)).await;
+            commands::send(Command::ReferenceGain(gain)).await;
         }
         self.lamps.show(&tick.lamps);
         self.log_div += 1;
@@ -548,12 +513,12 @@ impl Thread {
     /// [`COMMAND_SEND_TIMEOUT_MS`] for a slot in the queue (else the command is dropped and
     /// logged).
     async fn carry_out(&mut self, action: Action) {
-        let (command, stored) = carry_out(action, &mut self.flash, &mut SampleTaskPause);
+        let (command, stored) = carry_out(action, &mut self.flash, &mut commands::SampleTaskPause);
         if let Some(stored) = stored {
             logs::log_stored(&stored);
         }
         if let Some(cmd) = command {
-            send(cmd).await;
+            commands::send(cmd).await;
         }
     }
 
@@ -571,49 +536,6 @@ impl Thread {
             self.max_update_cycles,
             (supervisor.reference().vdda_v(), self.bor.status_number()),
         );
-    }
-}
-
-/// Sends `cmd` to the sample task, waiting at most [`COMMAND_SEND_TIMEOUT_MS`] for a slot in
-/// the queue (else the command is dropped and logged).
-async fn send(cmd: Command) {
-    let sent = with_timeout(
-        Duration::from_millis(COMMAND_SEND_TIMEOUT_MS),
-        COMMANDS.send(cmd),
-    )
-    .await;
-    if sent.is_err() {
-        error!("command queue full: {=str} dropped", cmd.name());
-    }
-}
-
-/// The sample task's pause around a flash erase and write (`app::AcquisitionPause`): the
-/// command, then a bounded busy wait in thread mode for the sample task (which preempts
-/// it) to say it paused; the resume by signal.
-struct SampleTaskPause;
-
-impl AcquisitionPause for SampleTaskPause {
-    fn pause(&mut self) -> bool {
-        PAUSED.reset();
-        if COMMANDS.try_send(Command::PauseAcquisition).is_err() {
-            error!("flash: command queue full, the acquisition not paused");
-            return false;
-        }
-        let deadline = Instant::now() + Duration::from_millis(PAUSE_WAIT_MS);
-        while Instant::now() < deadline {
-            if let Some(paused) = PAUSED.try_take() {
-                return paused;
-            }
-        }
-        warn!(
-            "flash: the sample task did not pause within {=u64} ms",
-            PAUSE_WAIT_MS
-        );
-        false
-    }
-
-    fn resume(&mut self) {
-        RESUME.signal(());
     }
 }
 

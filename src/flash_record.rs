@@ -106,7 +106,8 @@ pub struct CalibrationRecord {
     pub isolation: Option<Baseline>,
     /// VDDA, the ADC's reference, when the run learned [V] (`None`: not measured, or a
     /// record before version 4): every later reading is corrected by VDDA now over it
-    /// (`supply::ReferenceGain`); within the reference's band (3.2..3.4 V).
+    /// (`supply::ReferenceGain`); finite and > 0 (a run stores only a measurement in the
+    /// reference's band, 3.2..3.4 V).
     pub vdda_v: Option<f32>,
 }
 
@@ -121,9 +122,7 @@ fn values_ok(rec: &CalibrationRecord) -> bool {
                     .all(|s| s.is_finite() && *s > 0.0)
                 && point_fields(&b.at).iter().all(|x| x.is_finite())
         })
-        && rec.vdda_v.is_none_or(|v| {
-            (crate::board::VDDA_BAND_V.0..=crate::board::VDDA_BAND_V.1).contains(&v)
-        })
+        && rec.vdda_v.is_none_or(|v| v.is_finite() && v > 0.0)
 }
 
 impl From<monitor_core::Calibration> for CalibrationRecord {
@@ -430,10 +429,9 @@ mod tests {
         assert_eq!(new[92..100], [0; 8]);
     }
 
-    /// VDDA at commissioning round trips, and one outside the reference's band (3.2..3.4 V)
-    /// is refused.
+    /// VDDA at commissioning round trips; one that is not finite and positive is refused.
     #[test]
-    fn the_commissioned_vdda_round_trips_and_out_of_band_is_refused() {
+    fn the_commissioned_vdda_round_trips_and_a_bad_one_is_refused() {
         let r = CalibrationRecord {
             vdda_v: Some(3.287),
             ..sample()
@@ -442,11 +440,13 @@ mod tests {
         assert_eq!(bytes[92..96], 3.287f32.to_le_bytes());
         assert_eq!(bytes[88] & 2, 2, "the VDDA flag");
         assert_eq!(CalibrationRecord::decode(&bytes), Ok(r));
-        let out = CalibrationRecord {
-            vdda_v: Some(3.1),
-            ..sample()
-        };
-        assert_eq!(out.encode(), Err(RecordError::Invalid));
+        for bad in [0.0, -3.3, f32::NAN, f32::INFINITY] {
+            let out = CalibrationRecord {
+                vdda_v: Some(bad),
+                ..sample()
+            };
+            assert_eq!(out.encode(), Err(RecordError::Invalid), "{bad}");
+        }
     }
 
     #[test]

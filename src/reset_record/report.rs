@@ -2,7 +2,7 @@
 //! baud 8N1 on the NUCLEO-G474RE): a technician without a probe reads why the board
 //! reset, the brown-out level, the clock and the reset log's newest entries with any
 //! terminal. Built without `core::fmt` (no float or generic formatting pulled into the
-//! firmware): fixed-size lines ([`Line`]) of words and decimal or hexadecimal numbers.
+//! firmware): fixed-size lines ([`ReportLine`]) of words and decimal or hexadecimal numbers.
 
 use super::log::{Ended, Entry};
 use super::{PreviousRun, ResetCause, ResetRecord, ResetSource};
@@ -10,14 +10,14 @@ use super::{PreviousRun, ResetCause, ResetRecord, ResetSource};
 /// Bytes of one line at most (longer text is cut).
 pub const LINE_LEN: usize = 192;
 
-/// One line of text, `\r\n` ended by [`Line::end`].
+/// One line of text, `\r\n` ended by [`ReportLine::end`].
 #[derive(Clone, Copy, Debug)]
-pub struct Line {
+pub struct ReportLine {
     buf: [u8; LINE_LEN],
     len: usize,
 }
 
-impl Default for Line {
+impl Default for ReportLine {
     fn default() -> Self {
         Self {
             buf: [0; LINE_LEN],
@@ -26,7 +26,7 @@ impl Default for Line {
     }
 }
 
-impl Line {
+impl ReportLine {
     /// Appends `s` (what does not fit is cut).
     pub fn push(&mut self, s: &str) -> &mut Self {
         for &b in s.as_bytes() {
@@ -100,7 +100,7 @@ pub fn cause_name(c: ResetCause) -> &'static str {
 }
 
 /// `record`'s cause, message, file and number.
-fn push_record(line: &mut Line, r: &ResetRecord) {
+fn push_record(line: &mut ReportLine, r: &ResetRecord) {
     line.push(cause_name(r.cause()));
     line.push(": ").push(r.message());
     if !r.file().is_empty() {
@@ -118,8 +118,8 @@ fn push_record(line: &mut Line, r: &ResetRecord) {
 
 /// The boot's first line: `drive-monitor VERSION boot: reset by SOURCE, brown-out level N,
 /// clock NAME`.
-pub fn boot_line(version: &str, source: ResetSource, bor: u8, clock: &str) -> Line {
-    let mut l = Line::default();
+pub fn boot_line(version: &str, source: ResetSource, bor: u8, clock: &str) -> ReportLine {
+    let mut l = ReportLine::default();
     l.push("drive-monitor ")
         .push(version)
         .push(" boot: reset by ");
@@ -131,8 +131,8 @@ pub fn boot_line(version: &str, source: ResetSource, bor: u8, clock: &str) -> Li
 }
 
 /// The previous run's end as the boot read it.
-pub fn previous_line(previous: &PreviousRun) -> Line {
-    let mut l = Line::default();
+pub fn previous_line(previous: &PreviousRun) -> ReportLine {
+    let mut l = ReportLine::default();
     l.push("previous run: ");
     match previous {
         PreviousRun::Clean => {
@@ -155,8 +155,8 @@ pub fn previous_line(previous: &PreviousRun) -> Line {
 }
 
 /// One entry of the reset log: `log #SEQ: reset by SOURCE: ...`.
-pub fn entry_line(e: &Entry) -> Line {
-    let mut l = Line::default();
+pub fn entry_line(e: &Entry) -> ReportLine {
+    let mut l = ReportLine::default();
     l.push("log #")
         .number(e.seq)
         .push(": reset by ")

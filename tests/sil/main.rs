@@ -19,6 +19,7 @@ mod commissioning;
 mod conversions;
 mod evidence;
 mod flash_pause;
+mod hal_restart;
 mod isolation;
 mod liveness;
 mod moved;
