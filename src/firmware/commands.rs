@@ -28,6 +28,8 @@ pub(super) struct SampleTaskPause;
 impl AcquisitionPause for SampleTaskPause {
     fn pause(&mut self) -> bool {
         PAUSED.reset();
+        // A resume left from a pause the sample task never took must not end this one.
+        RESUME.reset();
         if COMMANDS.try_send(Command::PauseAcquisition).is_err() {
             error!("flash: command queue full, the acquisition not paused");
             return false;
