@@ -22,6 +22,7 @@
 //! [`Monitor::update`]: monitor_core::Monitor::update
 
 use crate::board;
+use crate::clip_watch::{self, ClipWatch, RangeChange};
 use crate::commissioning::{Action, CommissioningProcedure, RunEnd};
 use crate::flash_record::CalibrationRecord;
 use crate::liveness::{LivenessChange, SampleWatch};
@@ -71,9 +72,10 @@ pub fn default_motor() -> MotorModel {
 
 /// Core configuration for the board: [`DEFAULT_MACHINE`] on its rated supply, sampled at
 /// `sample_rate_hz`, 1 MHz timestamps, a 16-bit x4 encoder counter with
-/// [`board::ENCODER_COUNTS_PER_REV`] counts per revolution, and sensor limits equal to the
-/// front end's full scale (a reading beyond it cannot be real). (The host's configuration
-/// for replaying a log is `monitor_replay::monitor_config_for_log`.)
+/// [`board::ENCODER_COUNTS_PER_REV`] counts per revolution, and sensor limits beyond any
+/// reading the front end gives ([`board::LIMIT_OVER_FULL_SCALE`] times its full scale: a
+/// reading at its edge is a clip, held out and named nothing, not an impossible one). (The
+/// host's configuration for replaying a log is `monitor_replay::monitor_config_for_log`.)
 pub fn board_monitor_config(sample_rate_hz: u32) -> MonitorConfig {
     let supply = DEFAULT_MACHINE.supply;
     let mut cfg = MonitorConfig::new(
@@ -85,8 +87,8 @@ pub fn board_monitor_config(sample_rate_hz: u32) -> MonitorConfig {
     cfg.tick_hz = TICK_HZ as f32;
     cfg.encoder.counter_bits = 16;
     cfg.encoder.counts_per_rev = board::ENCODER_COUNTS_PER_REV;
-    cfg.limits.v_max = board::VOLTAGE_FULL_SCALE_V;
-    cfg.limits.i_max = board::CURRENT_FULL_SCALE_A;
+    cfg.limits.v_max = board::LIMIT_OVER_FULL_SCALE * board::VOLTAGE_FULL_SCALE_V;
+    cfg.limits.i_max = board::LIMIT_OVER_FULL_SCALE * board::CURRENT_FULL_SCALE_A;
     cfg
 }
 
@@ -220,11 +222,20 @@ pub struct MonitorStatus {
     /// the amber state only when no fault is named).
     pub moved: bool,
     /// Samples since boot with a conversion at the front end's linear limit (clipped,
-    /// held out of the residuals: [`crate::sampling::Clipped`]); wraps.
+    /// held out of the residuals, no sensor named: [`crate::sampling::Clipped`]); wraps.
     pub clipped: u32,
+    /// Of those, the samples in which a voltage channel clipped; wraps.
+    pub clipped_voltage: u32,
+    /// Of those, the samples in which a current channel clipped; wraps.
+    pub clipped_current: u32,
     /// Latched encoder counts since boot rejected as a step beyond the maximum speed
     /// (`acquisition::EncoderCheck`); wraps.
     pub encoder_rejects: u32,
+    /// Clipping persists in steady running: the front end's range is too small for this
+    /// motor (the range state: the verdict could not judge, the panel's mark, the status
+    /// line's `clip_range=`). Set by [`Supervisor::tick`] ([`ClipWatch`]), false as the
+    /// sample path hands it.
+    pub clip_range: bool,
 }
 
 impl MonitorStatus {
@@ -237,6 +248,17 @@ impl MonitorStatus {
             self.operating.i_f,
             self.operating.iqs,
         )
+    }
+
+    /// What the clip watch reads of this status ([`ClipWatch`]).
+    pub fn clip_moment(&self) -> clip_watch::Moment {
+        clip_watch::Moment {
+            samples: self.samples,
+            clipped: self.clipped,
+            clipped_voltage: self.clipped_voltage,
+            clipped_current: self.clipped_current,
+            speed_rad_s: self.speed_rad_s,
+        }
     }
 
     /// What the operating-range watch reads of this status.
@@ -274,6 +296,9 @@ pub struct Tick {
     /// ([`Command::ReferenceGain`]: VDDA now over VDDA at commissioning,
     /// [`crate::supply::ReferenceGain`]).
     pub reference_gain: Option<f32>,
+    /// The range state changed (clipping persists in steady running, or no longer:
+    /// [`ClipWatch`]): log it.
+    pub clip_range: Option<RangeChange>,
 }
 
 /// Thread mode's logic: button, commissioning procedure, liveness watch and panel.
@@ -308,6 +333,10 @@ pub struct Supervisor {
     reference: ReferenceWatch,
     /// The commissioned operating range (RAM only) and the "moved" judgement.
     range: RangeWatch,
+    /// Whether clipping persists in steady running (the range state).
+    clips: ClipWatch,
+    /// A change of the range state since the last tick, for its log.
+    clip_change: Option<RangeChange>,
     /// The correction of the readings for the reference's drift since commissioning.
     gain: crate::supply::ReferenceGain,
     /// VDDA the record being stored holds (in force once the run ends commissioned).
@@ -349,6 +378,8 @@ impl Supervisor {
             offset_fault: SensorFlags::default(),
             reference: ReferenceWatch::new(REFERENCE_PERIOD_MS),
             range: RangeWatch::new(),
+            clips: ClipWatch::new(settings.sample_rate_hz),
+            clip_change: None,
             gain: crate::supply::ReferenceGain::default(),
             pending_vdda: None,
             gain_on_commissioning: false,
@@ -451,6 +482,7 @@ impl Supervisor {
         let mode = self.mode(watch.stalled);
         let failed = self.procedure.last_failure().is_some();
         self.latest.moved = self.range.moved(&self.latest.range_moment());
+        self.latest.clip_range = self.clips.too_small();
         let isolation = self.panel_isolation();
         let input = PanelInput {
             default_motor: self.default_motor,
@@ -467,12 +499,13 @@ impl Supervisor {
             run_ended,
             liveness: watch.change,
             reference_gain: self.reference_gain(run_ended),
+            clip_range: self.clip_change.take(),
         }
     }
 
     /// Takes a new status `s` from the sample task as the latest: adds the sensor faults
     /// thread mode knows of (an offset out of bound, a reference out of band), then feeds
-    /// the fault isolation and the operating range with it.
+    /// the fault isolation, the operating range and the clip watch with it.
     fn take_status(&mut self, mut s: MonitorStatus) {
         let reference = self.reference.flags_sensors();
         s.sensor_fault.voltage |= self.offset_fault.voltage || reference;
@@ -481,6 +514,14 @@ impl Supervisor {
         self.latest = s;
         self.follow(&s, previous);
         self.range.observe(&s.range_moment());
+        if let Some(change) = self.clips.observe(&s.clip_moment()) {
+            self.clip_change = Some(change);
+        }
+    }
+
+    /// The clip watch (the range state).
+    pub fn clips(&self) -> &ClipWatch {
+        &self.clips
     }
 
     /// Whether `button` (pressed since the last tick) counts as a press at `now_ms`: not

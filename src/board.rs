@@ -17,8 +17,11 @@
 //! So zero volts / zero amperes sit at mid-scale, code 2047.5, and
 //! `x = (code - offset) * PER_LSB`. The constants below derive the factors from these
 //! ranges; change the ranges here (and only here) for another front end. Codes 0 and
-//! 4095 mean the input is at or beyond the rail: the true value is unknown, so such a
-//! sample is flagged `adc_saturated` and the core does not trust it.
+//! 4095 mean the input is at or beyond the rail: the true value is unknown. Such a code,
+//! or any conversion beyond its channel's linear range, makes the sample **clipped**: the
+//! core holds it out and names no sensor (`acquisition::sum_clipped`,
+//! `crate::sampling::RawFrame::clips`); clipping that persists in steady running is the
+//! range state (`crate::clip_watch`).
 //!
 //! # Pin map (NUCLEO-G474RE, Arduino/Morpho headers)
 //!
@@ -64,6 +67,18 @@ pub const MID_SCALE_CODE: f32 = ADC_MAX_CODE as f32 / 2.0;
 pub const VOLTAGE_FULL_SCALE_V: f32 = 400.0;
 /// Full-scale phase current of the current channels, amperes.
 pub const CURRENT_FULL_SCALE_A: f32 = 10.0;
+
+/// The core's sensor limits on the board (`MonitorConfig::limits`, `v_max` and `i_max`) over
+/// the front end's full scale: 2.5. A reading from a 12-bit code lies at most 4095 codes
+/// from its channel's zero (twice the full scale) times the reference's correction (at most
+/// 1.1, `app::SamplePath::set_reference_gain`): 2.2 times the full scale, so no finite
+/// reading is ever out of the core's range. A reading at or beyond the front end's linear
+/// range is a clip, which the per-conversion check flags and the core holds out without
+/// naming a sensor (`acquisition::sum_clipped`, `crate::clip_watch`); with the limits at the
+/// full scale, a rail code read through a start-up offset trim or the reference's
+/// correction (10.2 A on the 10 A front end) named the current sensor at every
+/// direct-on-line start.
+pub const LIMIT_OVER_FULL_SCALE: f32 = 2.5;
 
 /// Volts at the motor per ADC code: `2 * 400 V / 4095 LSB = 0.195 36 V/LSB`.
 pub const VOLT_PER_LSB: f32 = 2.0 * VOLTAGE_FULL_SCALE_V / ADC_MAX_CODE as f32;

@@ -495,6 +495,9 @@ impl Thread {
         if let Some(end) = tick.run_ended {
             logs::log_run_end(end);
         }
+        if let Some(change) = tick.clip_range {
+            logs::log_clip_range(change);
+        }
         self.carry_out(tick.action).await;
         if let Some(gain) = tick.reference_gain {
             logs::log_reference_gain(gain);

@@ -38,6 +38,8 @@
 //! - [`supply`]: the brown-out level in the option bytes and the periodic check of the
 //!   ADC's reference (VDDA through VREFINT);
 //! - [`offset_trim`]: each channel's zero measured at start-up with the motor off, bounded;
+//! - [`clip_watch`]: whether clipping persists in steady running (the front end's range
+//!   too small for the motor: the range state), in thread mode;
 //! - [`panel`]: lamp patterns and blink codes;
 //! - [`app`]: the glue: settings, the per-sample path, the status it hands thread mode,
 //!   and thread mode's supervisor.
@@ -69,6 +71,7 @@ pub mod adc_rules;
 pub mod app;
 pub mod board;
 pub mod boot;
+pub mod clip_watch;
 pub mod clock;
 pub mod commissioning;
 pub mod debug_halt;

@@ -82,7 +82,8 @@ pub fn select(page: &[u8]) -> (MotorRecord, MachineSource) {
 
 /// The core configuration for `rec` at `sample_rate_hz`: its machine on its supply, 1 MHz
 /// timestamps, a 16-bit x4 encoder counter with `4 x encoder_lines` counts per revolution,
-/// and sensor limits equal to the full scales. For [`default_record`] this is
+/// and sensor limits beyond any reading of the front end ([`board::LIMIT_OVER_FULL_SCALE`]
+/// times the full scales: a reading at its edge is a clip). For [`default_record`] this is
 /// [`crate::app::board_monitor_config`] (a test checks it).
 pub fn monitor_config(rec: &MotorRecord, sample_rate_hz: u32) -> MonitorConfig {
     let mut cfg = MonitorConfig::new(
@@ -94,8 +95,8 @@ pub fn monitor_config(rec: &MotorRecord, sample_rate_hz: u32) -> MonitorConfig {
     cfg.tick_hz = TICK_HZ as f32;
     cfg.encoder.counter_bits = 16;
     cfg.encoder.counts_per_rev = 4 * u32::from(rec.encoder_lines);
-    cfg.limits.v_max = rec.voltage_full_scale_v;
-    cfg.limits.i_max = rec.current_full_scale_a;
+    cfg.limits.v_max = board::LIMIT_OVER_FULL_SCALE * rec.voltage_full_scale_v;
+    cfg.limits.i_max = board::LIMIT_OVER_FULL_SCALE * rec.current_full_scale_a;
     cfg
 }
 

@@ -36,7 +36,7 @@ fn a_valid_record_is_used() {
     assert_eq!(source.describe(), "motor record from flash");
     let cfg = motor_source::monitor_config(&rec, 10_000);
     assert_eq!(cfg.encoder.counts_per_rev, 10_000);
-    assert_eq!(cfg.limits.i_max, 25.0);
+    assert_eq!(cfg.limits.i_max, 2.5 * 25.0);
     let fe = motor_source::front_end(&rec);
     assert_eq!(fe.current[0].offset_code, 2040.0);
     assert_eq!(fe.current[0].per_lsb, 50.0 / 4095.0);
@@ -90,7 +90,7 @@ fn the_boot_builds_the_sample_path_and_isolator_of_the_record() {
     let path = motor_source::sample_path(&rec, 10_000).expect("record path");
     let cfg = path.monitor().config();
     assert_eq!(cfg.encoder.counts_per_rev, 10_000);
-    assert_eq!(cfg.limits.i_max, 25.0);
+    assert_eq!(cfg.limits.i_max, 2.5 * 25.0);
     assert_ne!(cfg, board.monitor().config());
     // The 3 hp machine's torque base is not the 2.2 kW one's: the isolator judges the
     // record's machine.

@@ -50,6 +50,7 @@ fn status() -> MonitorStatus {
         moved: true,
         clipped: 17,
         encoder_rejects: 3,
+        clip_range: true,
         ..MonitorStatus::default()
     }
 }
@@ -108,6 +109,7 @@ fn the_firmwares_line_reads_back_through_the_shared_module() {
         (s.clipped, s.encoder_rejects, s.stack_used_bytes),
         (Some(17), Some(3), Some(2_344))
     );
+    assert_eq!(s.clip_range, Some(true));
 }
 
 #[test]

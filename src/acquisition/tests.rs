@@ -15,28 +15,28 @@ fn the_geometry_fits_the_period() {
 }
 
 /// The ring's depth from the budget, against the sums by hand: one sample's work is
-/// 918 + 211 + 784 + 100 = 2 013 instructions, 4 227.3, 4 228 cycles at 2.1; the frame
-/// 9 400 x 268 / 201 = 12 533.3, 12 534 instructions, 26 321.4, 26 322 cycles; with 30 +
-/// 400 + 1 500 + 2 000 a half's samples are processed at worst 34 480, 38 708 and 42 936
+/// 639 + 213 + 785 + 100 = 1 737 instructions, 3 647.7, 3 648 cycles at 2.1; the frame
+/// 9 440 x 268 / 201 = 12 586.7, 12 587 instructions, 26 432.7, 26 433 cycles; with 30 +
+/// 400 + 1 500 + 2 000 a half's samples are processed at worst 34 011, 37 659 and 41 307
 /// cycles after its request with 1, 2, 3 samples per half (the processing latency). The
 /// depth follows from the lap case, the copy at 2.6 cycles an instruction.
 #[test]
 fn the_ring_depth_follows_from_the_latency_budget() {
     assert_eq!(sample_period_cycles(10_000), 17_000);
-    assert_eq!(LOG_FRAME_INSTRUCTIONS, 12_534);
-    assert_eq!(LOG_FRAME_CYCLES, 26_322);
-    assert_eq!(worst_latency_cycles(1), 34_480);
-    assert_eq!(worst_latency_cycles(2), 38_708);
-    assert_eq!(worst_latency_cycles(3), 42_936);
-    // The lap case (2.6 cycles an instruction): the frame 12 534 x 2.6 = 32 588.4, 32 589;
-    // a sample's copy 100 x 2.6 = 260; with 3 930 of wake-up the copy is done 36 779,
-    // 37 039 and 37 299 cycles after the request with 1, 2, 3 samples per half. The DMA
+    assert_eq!(LOG_FRAME_INSTRUCTIONS, 12_587);
+    assert_eq!(LOG_FRAME_CYCLES, 26_433);
+    assert_eq!(worst_latency_cycles(1), 34_011);
+    assert_eq!(worst_latency_cycles(2), 37_659);
+    assert_eq!(worst_latency_cycles(3), 41_307);
+    // The lap case (2.6 cycles an instruction): the frame 12 587 x 2.6 = 32 726.2, 32 727;
+    // a sample's copy 100 x 2.6 = 260; with 3 930 of wake-up the copy is done 36 917,
+    // 37 177 and 37 437 cycles after the request with 1, 2, 3 samples per half. The DMA
     // writes a half's first word again 9, 17, 25 triggers of 2 125 cycles after its start,
     // less two conversions of 147: 18 831, 35 831, 52 831 cycles after its completion.
-    assert_eq!(LAP_FRAME_CYCLES, 32_589);
-    assert_eq!(lap_latency_cycles(1), 36_779);
-    assert_eq!(lap_latency_cycles(2), 37_039);
-    assert_eq!(lap_latency_cycles(3), 37_299);
+    assert_eq!(LAP_FRAME_CYCLES, 32_727);
+    assert_eq!(lap_latency_cycles(1), 36_917);
+    assert_eq!(lap_latency_cycles(2), 37_177);
+    assert_eq!(lap_latency_cycles(3), 37_437);
     assert_eq!(conversion_cycles(), 147);
     assert_eq!(lap_slack_cycles(10_000, 1), 18_831);
     assert_eq!(lap_slack_cycles(10_000, 2), 35_831);
@@ -47,7 +47,7 @@ fn the_ring_depth_follows_from_the_latency_budget() {
     assert_eq!(SAMPLES_PER_HALF, 3);
     assert_eq!(DMA_HALF_LEN, 72);
     // A slower rate needs a shallower ring (5 kHz: 4 250 cycles a trigger, 37 956 of slack
-    // with one sample per half against 36 779); a faster one a deeper one.
+    // with one sample per half against 36 917); a faster one a deeper one.
     assert_eq!(samples_per_half_for(5_000), 1);
     assert!(samples_per_half_for(20_000) > 3);
 }
@@ -65,10 +65,10 @@ fn a_clip_on_two_of_eight_conversions_is_caught_where_the_mean_is_not() {
     let mean = average_half(&half)[1];
     assert_eq!(mean, 3274, "(2 x 4095 + 6 x 3000) / 8");
     assert!(mean > 0 && mean < 4095, "the mean is no rail code");
-    let rails = [LinearRange::RAILS; CHANNELS];
-    let (sums, n, clipped) = sum_half_clipped(&half, &rails);
+    let rails = ClipLimits::new(&[LinearRange::RAILS; CHANNELS]);
+    let (sums, clipped) = sum_clipped(&half, &rails);
     assert!(clipped);
-    assert_eq!((sums, n), sum_half(&half));
+    assert_eq!((sums, OVERSAMPLING as u32), sum_half(&half));
     // An amplifier that clips 62 codes before the rails: a conversion at 4040 is beyond
     // its linear range though no rail code.
     let amp = LinearRange {
@@ -77,27 +77,66 @@ fn a_clip_on_two_of_eight_conversions_is_caught_where_the_mean_is_not() {
     };
     let mut near = [2048u16; HALF_LEN];
     near[7] = 4040;
-    assert!(!sum_half_clipped(&near, &rails).2);
-    assert!(sum_half_clipped(&near, &[amp; CHANNELS]).2);
-    // Edges: `low` and `high` clip, one code inside does not; on every channel.
-    for ch in 0..CHANNELS {
-        for (code, clips) in [
-            (62, true),
-            (63, false),
-            (4032, false),
-            (4033, true),
-            (0, true),
-        ] {
-            let mut h = [2048u16; HALF_LEN];
-            h[CHANNELS * 5 + ch] = code;
-            assert_eq!(
-                sum_half_clipped(&h, &[amp; CHANNELS]).2,
-                clips,
-                "{ch} {code}"
-            );
-            assert_eq!(amp.clips(code), clips);
+    assert!(!sum_clipped(&near, &rails).1);
+    assert!(sum_clipped(&near, &ClipLimits::new(&[amp; CHANNELS])).1);
+}
+
+/// The check two conversions at a time is [`LinearRange::clips`] of each conversion: every
+/// code 0..=4095 at every one of a sample's 24 places, against channels of three different
+/// ranges (each place's channel its own), the other codes inside; the sums those of the
+/// codes.
+#[test]
+fn the_check_two_at_a_time_is_the_range_test_of_each_conversion() {
+    let ranges = [
+        LinearRange {
+            low: 115,
+            high: 4033,
+        },
+        LinearRange::RAILS,
+        LinearRange { low: 62, high: 63 },
+    ];
+    let limits = ClipLimits::new(&ranges);
+    let inside = [2000u16, 2000, 62];
+    for place in 0..HALF_LEN {
+        let channel = place % CHANNELS;
+        for code in 0..=4095u16 {
+            let mut half = [0u16; HALF_LEN];
+            for (k, c) in half.iter_mut().enumerate() {
+                *c = inside[k % CHANNELS];
+            }
+            // Channel c's range 62..63 has no code inside: every conversion of it clips.
+            let others_clip = channel != 2;
+            half[place] = code;
+            let (sums, clipped) = sum_clipped(&half, &limits);
+            let want = others_clip || ranges[channel].clips(code);
+            assert_eq!(clipped, want, "place {place} code {code}");
+            assert_eq!(sums, sum_half(&half).0, "place {place} code {code}");
         }
     }
+    // And with channel c inside a range of its own, only the code tested clips.
+    let ranges = [ranges[0], ranges[1], LinearRange::RAILS];
+    let limits = ClipLimits::new(&ranges);
+    for place in 0..HALF_LEN {
+        for code in [0u16, 1, 114, 115, 116, 4032, 4033, 4094, 4095] {
+            let mut half = [2000u16; HALF_LEN];
+            half[place] = code;
+            let want = ranges[place % CHANNELS].clips(code);
+            assert_eq!(
+                sum_clipped(&half, &limits).1,
+                want,
+                "place {place} code {code}"
+            );
+        }
+    }
+    // Limits beyond 12 bits: taken as the codes they let through.
+    let wide = ClipLimits::new(
+        &[LinearRange {
+            low: 0,
+            high: u16::MAX,
+        }; CHANNELS],
+    );
+    assert!(!sum_clipped(&[4095; HALF_LEN], &wide).1);
+    assert!(sum_clipped(&[0; HALF_LEN], &wide).1);
 }
 
 /// A clip is held through the filter's memory: the clipped sample and the 16 after it.
@@ -155,6 +194,71 @@ fn encoder_steps_beyond_the_maximum_speed_are_rejected_and_do_not_move_the_count
     assert_eq!(after, [9_500, 9_503]);
 }
 
+/// [`EncoderCheck::sample`] (its fast path and its count by count one) gives what the
+/// count-by-count check and the mean of the corrected counts give, sample after sample:
+/// motion at steady speeds forwards and backwards across the counter's wrap, single-count
+/// spikes, lasting jumps, bursts of noise, restarts; for largest steps from 1 to beyond
+/// [`FAST_MAX_STEP`].
+#[test]
+fn the_encoders_fast_path_is_the_count_by_count_check() {
+    let mut seed = 0x9E37_79B9u32;
+    let mut random = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 17;
+        seed ^= seed << 5;
+        seed
+    };
+    for max_step in [1u16, 2, 4, 9, 100, FAST_MAX_STEP, FAST_MAX_STEP + 1, 5_000] {
+        let mut fast = EncoderCheck::new(max_step);
+        let mut reference = EncoderCheck::new(max_step);
+        let mut count = random() as u16;
+        let (mut fast_samples, mut rejected) = (0u32, 0u32);
+        for k in 0..20_000u32 {
+            // A speed for a stretch of samples: within the largest step, either way.
+            let speed = (k / 500) as i32 % 7 - 3;
+            let step = speed * i32::from(max_step.min(2_000)) / 3;
+            let mut latched = [0u16; OVERSAMPLING];
+            for c in latched.iter_mut() {
+                count = count.wrapping_add(step as u16);
+                *c = count;
+            }
+            match random() % 50 {
+                0 => latched[(random() % 8) as usize] ^= 0x0100,
+                1 => {
+                    let at = (random() % 8) as usize;
+                    let jump = (random() % 2_000) as u16;
+                    for c in &mut latched[at..] {
+                        *c = c.wrapping_add(jump);
+                    }
+                    count = count.wrapping_add(jump);
+                }
+                2 => latched = std::array::from_fn(|_| random() as u16),
+                3 => {
+                    fast.restart();
+                    reference.restart();
+                }
+                _ => {}
+            }
+            let was = fast;
+            let got = fast.sample(&latched);
+            let mut corrected = latched;
+            let rejects = reference.check_sample(&mut corrected);
+            let want = (sample_count(&corrected), rejects);
+            assert_eq!(
+                got, want,
+                "max {max_step}, sample {k}: {latched:?} after {was:?}"
+            );
+            assert_eq!(fast, reference, "max {max_step}, sample {k}");
+            fast_samples += u32::from(was.fast_ready() && got.1 == 0);
+            rejected += u32::from(got.1);
+        }
+        assert!(rejected > 0, "max {max_step}");
+        if max_step <= FAST_MAX_STEP {
+            assert!(fast_samples > 15_000, "max {max_step}: {fast_samples}");
+        }
+    }
+}
+
 /// A sample's count is the mean of its latched counts, across the counter's wrap and
 /// backwards too.
 #[test]
@@ -194,7 +298,7 @@ fn the_filter_keeps_the_fundamental_and_takes_the_ripple_out() {
         let ripple = 300.0 * (std::f64::consts::TAU * 4_000.0 * t).sin();
         let code = |x: f64| ((2048.0 + x) * 8.0).round() as u32;
         let sum = code(fund + ripple);
-        let (v, _, count) = f.step([sum; 3], [code(0.0); 3], 8, k as u16);
+        let (v, _, count) = f.step([sum; 3], [code(0.0); 3], k as u16);
         if k >= 4 {
             assert_eq!(count, (k - 4) as u16);
         }

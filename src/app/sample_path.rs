@@ -3,9 +3,7 @@
 //! [`Command`]s thread mode sends it, applied between two samples.
 
 use super::{board_monitor_config, MonitorStatus};
-use crate::acquisition::{
-    sample_count, sum_half_clipped, ClipHold, EncoderCheck, LinearRanges, PwmFilter,
-};
+use crate::acquisition::{LinearRanges, SampleBuilder, HALF_LEN, OVERSAMPLING};
 use crate::board::FrontEnd;
 use crate::board::{CurrentCode, VoltageCode};
 use crate::flash_record::CalibrationRecord;
@@ -110,8 +108,8 @@ pub struct SamplePath {
     sampler: AdcSampler,
     samples: u32,
     trim: OffsetTrim,
-    /// Clipped samples since boot (wrapping).
-    clipped: u32,
+    /// Clipped samples since boot (wrapping): any front end, the voltages', the currents'.
+    clipped: [u32; 3],
     /// Rejected encoder counts since boot (wrapping).
     encoder_rejects: u32,
     /// The front end at the reference of commissioning: the record's scaling with the
@@ -136,7 +134,7 @@ impl SamplePath {
             sampler: AdcSampler::new(front_end, sample_rate_hz).map_err(AppError::Sampling)?,
             samples: 0,
             trim: OffsetTrim::new(&front_end),
-            clipped: 0,
+            clipped: [0; 3],
             encoder_rejects: 0,
             front_end,
             reference_gain: 1.0,
@@ -259,15 +257,20 @@ impl SamplePath {
     }
 
     /// Process one sample's readings: scaled and stamped ([`AdcSampler::build`]; a clipped
-    /// sample goes to the core as saturated, which holds its block out of the residuals)
-    /// into [`Monitor::update`]; the clipped samples and the rejected encoder counts
-    /// counted for the status line.
+    /// sample goes to the core as clipped, which holds its block out of the residuals and
+    /// names no sensor) into [`Monitor::update`]; the clipped samples (any front end, and
+    /// each) and the rejected encoder counts counted for the status line and thread mode's
+    /// clip watch.
     #[inline]
     pub fn on_frame(&mut self, raw: &RawFrame) {
         let sample = self.sampler.build(raw);
         self.monitor.update(&sample);
         self.samples = self.samples.wrapping_add(1);
-        self.clipped = self.clipped.wrapping_add(u32::from(raw.clipped.any()));
+        let clips = raw.clips();
+        let [any, voltage, current] = &mut self.clipped;
+        *any = any.wrapping_add(u32::from(sample.clipped));
+        *voltage = voltage.wrapping_add(u32::from(clips.voltage));
+        *current = current.wrapping_add(u32::from(clips.current));
         self.encoder_rejects = self
             .encoder_rejects
             .wrapping_add(u32::from(raw.encoder_rejects));
@@ -312,24 +315,24 @@ impl SamplePath {
             winding_confidence: o.unbalance.phase_confidence,
             vds: o.vds,
             moved: false,
-            clipped: self.clipped,
+            clipped: self.clipped[0],
+            clipped_voltage: self.clipped[1],
+            clipped_current: self.clipped[2],
             encoder_rejects: self.encoder_rejects,
+            clip_range: false,
         }
     }
 }
 
 /// One sample's conversions and latched encoder counts -> its [`RawFrame`], as the sample
-/// task builds it: each ADC's oversampled sequences summed with every conversion checked
-/// against its channel's linear range ([`sum_half_clipped`]; a clip held through the
-/// filter's memory, [`ClipHold`]), the inverter's ripple filtered out ([`PwmFilter`]), the
-/// latched counts checked against the maximum speed ([`EncoderCheck`]) and averaged
-/// ([`sample_count`]). No allocation, no panics.
+/// task builds it: [`SampleBuilder`] (each ADC's oversampled sequences summed with every
+/// conversion checked against its channel's linear range, a clip held through the filter's
+/// memory; the latched counts checked against the maximum speed and averaged; the
+/// inverter's ripple filtered out), its result as the frame's codes, count and flags. No
+/// allocation, no panics.
 #[derive(Clone, Copy, Debug)]
 pub struct FrameBuilder {
-    filter: PwmFilter,
-    hold: ClipHold,
-    encoder: EncoderCheck,
-    ranges: LinearRanges,
+    builder: SampleBuilder,
 }
 
 impl FrameBuilder {
@@ -338,42 +341,39 @@ impl FrameBuilder {
     /// largest step between two triggers `max_step` (`motor_source::EncoderSetup`).
     pub fn new(sample_rate_hz: u32, supply_hz: f32, ranges: LinearRanges, max_step: u16) -> Self {
         Self {
-            filter: PwmFilter::new(sample_rate_hz, supply_hz),
-            hold: ClipHold::default(),
-            encoder: EncoderCheck::new(max_step),
-            ranges,
+            builder: SampleBuilder::new(sample_rate_hz, supply_hz, &ranges, max_step),
         }
     }
 
     /// After a gap in the triggers (a recovery, a paused acquisition): the next latched
     /// count starts the encoder check afresh.
     pub fn restart(&mut self) {
-        self.encoder.restart();
+        self.builder.restart();
     }
 
     /// A sample that is dropped (`adc_rules::IdleDiscard`): its latched counts still go
     /// through the encoder check, so the next sample's first step is one trigger long.
-    pub fn skip(&mut self, latched: &mut [u16]) {
-        self.encoder.check_sample(latched);
+    pub fn skip(&mut self, latched: &[u16; OVERSAMPLING]) {
+        self.builder.skip(latched);
     }
 
     /// One sample: `v` and `i` its sequences of ADC1 and ADC2 (`[a, b, c, a, b, c, ...]`),
-    /// `latched` the encoder counts latched at its triggers (oldest first; corrected in
-    /// place).
+    /// `latched` the encoder counts latched at its triggers (oldest first).
     #[inline]
-    pub fn frame(&mut self, v: &[u16], i: &[u16], latched: &mut [u16]) -> RawFrame {
-        let (vs, n, v_clip) = sum_half_clipped(v, &self.ranges.voltage);
-        let (is, _, i_clip) = sum_half_clipped(i, &self.ranges.current);
-        let [voltage, current] = self.hold.step([v_clip, i_clip]);
-        let encoder_rejects = self.encoder.check_sample(latched);
-        let count = sample_count(latched);
-        let ([va, vb, vc], [ia, ib, ic], encoder_count) = self.filter.step(vs, is, n, count);
+    pub fn frame(
+        &mut self,
+        v: &[u16; HALF_LEN],
+        i: &[u16; HALF_LEN],
+        latched: &[u16; OVERSAMPLING],
+    ) -> RawFrame {
+        let b = self.builder.build(v, i, latched);
+        let ([va, vb, vc], [ia, ib, ic], [voltage, current]) = (b.v, b.i, b.clipped);
         RawFrame {
             v: [VoltageCode(va), VoltageCode(vb), VoltageCode(vc)],
             i: [CurrentCode(ia), CurrentCode(ib), CurrentCode(ic)],
-            encoder_count,
+            encoder_count: b.count,
             clipped: Clipped { voltage, current },
-            encoder_rejects,
+            encoder_rejects: b.encoder_rejects,
         }
     }
 }

@@ -57,6 +57,7 @@ pub fn status_line(
         clipped: s.clipped,
         encoder_rejects: s.encoder_rejects,
         stack_used_bytes: board.stack_used_bytes,
+        clip_range: s.clip_range,
     }
 }
 

@@ -7,6 +7,7 @@ use core::sync::atomic::Ordering;
 use defmt::{error, info, warn};
 use drive_monitor::board::{ReferenceCheck, VDDA_BAND_V};
 use drive_monitor::boot::{Booted, CalibrationMissing};
+use drive_monitor::clip_watch::RangeChange;
 use drive_monitor::clock::ClockSource;
 use drive_monitor::commissioning::RunEnd;
 use drive_monitor::flash_record::{self, StoreError};
@@ -261,4 +262,21 @@ pub(super) fn log_reference_gain(gain: f32) {
         "reference: readings corrected by {=f32} (VDDA now over VDDA at commissioning)",
         gain
     );
+}
+
+/// The range state changed (`drive_monitor::clip_watch`): clipping persists in steady
+/// running (the front end's linear range too small for this motor: the verdict could not
+/// judge, the panel's range mark), or no longer; the front ends that clipped in the window
+/// that decided it and its share of clipped samples.
+pub(super) fn log_clip_range(change: RangeChange) {
+    if change.too_small {
+        warn!(
+            "clip: {=u32} per mille of the samples clipped in steady running for 6 s (voltage {=bool}, current {=bool}): the front end's linear range is too small for this motor, not judged",
+            change.permille,
+            change.voltage,
+            change.current
+        );
+    } else {
+        info!("clip: steady running without clipping for 6 s: judged again");
+    }
 }

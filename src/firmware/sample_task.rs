@@ -271,12 +271,16 @@ fn process_half(
     path: &mut SamplePath,
     frames: &mut FrameBuilder,
     (v, i): (&[u16], &[u16]),
-    latched: &mut [u16],
+    latched: &[u16],
     discard: &mut IdleDiscard,
     max_cycles: &mut u32,
 ) {
-    let samples = v.chunks_exact(HALF_LEN).zip(i.chunks_exact(HALF_LEN));
-    for ((v, i), counts) in samples.zip(latched.chunks_exact_mut(geometry::OVERSAMPLING)) {
+    let samples = v
+        .as_chunks::<HALF_LEN>()
+        .0
+        .iter()
+        .zip(i.as_chunks::<HALF_LEN>().0);
+    for ((v, i), counts) in samples.zip(latched.as_chunks::<{ geometry::OVERSAMPLING }>().0) {
         if discard.drop_next() {
             // The first sample after a long idle (errata): dropped, its time skipped; its
             // counts still go through the encoder check.
@@ -359,7 +363,7 @@ pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
             &mut path,
             &mut frames,
             (&half1[..], &half2[..]),
-            &mut latched,
+            &latched,
             &mut discard,
             &mut max_cycles,
         );

@@ -57,7 +57,7 @@ fn a_good_record_is_the_machine_of_the_path_the_isolator_and_the_encoder() {
     assert_eq!(m.encoder, motor_source::encoder_setup(&rec, 10_000));
     let cfg = booted.path.monitor().config();
     assert_eq!(cfg.encoder.counts_per_rev, 10_000);
-    assert_eq!(cfg.limits.i_max, 25.0);
+    assert_eq!(cfg.limits.i_max, 2.5 * 25.0);
     assert_eq!(cfg.motor, MOTOR_3HP.motor.model());
     assert_eq!(
         booted.path.sampler().front_end().current[0].offset_code,

@@ -49,7 +49,7 @@ fn run(
         let (mut v, mut i, mut latched) = conversions(raw, previous);
         previous = raw.encoder_count;
         edit(k, &mut v, &mut i, &mut latched);
-        let frame = builder.frame(&v, &i, &mut latched);
+        let frame = builder.frame(&v, &i, &latched);
         path.on_frame(&frame);
         if k > 15_000 {
             let o = path.monitor().output();
@@ -63,8 +63,9 @@ fn run(
 /// An inrush-like peak clipped on two of one sample's eight current conversions: its mean
 /// (and the filtered code) is far from the rail, the per-conversion check flags it; the
 /// sample and the 16 after it (the filter's memory) are counted, the core holds the block
-/// out (its current sensor flagged for the block, the residuals not fed). The run without
-/// the peak counts only the start's inrush, which clips the 10 A front end too.
+/// out (the filters not fed, the settling time started again: not evaluating 0.2 s later)
+/// and names no sensor. The run without the peak counts only the start's inrush, which
+/// clips the 10 A front end too, and names nothing either.
 #[test]
 fn a_clipped_conversion_is_flagged_counted_and_held_out() {
     let frames = steady_frames(2.0);
@@ -79,10 +80,16 @@ fn a_clipped_conversion_is_flagged_counted_and_held_out() {
     // The start's inrush clips the 10 A front end in both runs; the peak adds its 17.
     assert!(clean.status().clipped > 0);
     assert_eq!(path.status().clipped - clean.status().clipped, 17);
-    // Held out: the block with the clip was flagged and discarded (the sensor hold lasts
-    // a second: still on at the end, 0.2 s later).
-    assert!(path.monitor().output().sensor_fault.current);
-    assert!(!clean.monitor().output().sensor_fault.current);
+    assert_eq!(path.status().clipped_current, path.status().clipped);
+    // Held out: the block with the clip was discarded and the lamps wait for the settling
+    // time; the clean run evaluates by then.
+    assert!(clean.monitor().output().evaluating);
+    assert!(!path.monitor().output().evaluating);
+    // No sensor named, in either run.
+    for p in [&path, &clean] {
+        assert!(!p.monitor().output().sensor_fault.any());
+        assert!(!p.status().sensor_fault.any());
+    }
 }
 
 /// A spike of +300 counts on one latched count, and later edges lost for good (-200 on

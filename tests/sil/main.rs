@@ -15,6 +15,7 @@
 //! the next boot would load) and the panel (the RUN lamp's mode) agree.
 
 mod boot_composition;
+mod clipping;
 mod commissioning;
 mod conversions;
 mod evidence;

@@ -72,6 +72,9 @@ pub struct StatusReading<'a> {
     pub encoder_rejects: Option<u32>,
     /// `stack=` [bytes]: the stack's high-water mark (firmware of issue 74 on).
     pub stack_used_bytes: Option<u32>,
+    /// `clip_range=`: clipping persists in steady running, the front end's range is too
+    /// small for the motor (firmware of issue 74 on).
+    pub clip_range: Option<bool>,
 }
 
 /// The value of field `key` in `line` (`key=` at the start or after a space), up to the
@@ -208,6 +211,7 @@ pub fn parse(line: &str) -> Option<StatusReading<'_>> {
         stack_used_bytes: field(line, "stack")
             .and_then(|v| v.strip_suffix('B'))
             .and_then(|v| v.parse().ok()),
+        clip_range: b("clip_range"),
     })
 }
 
@@ -251,6 +255,7 @@ mod tests {
             clipped: 17,
             encoder_rejects: 3,
             stack_used_bytes: 2_344,
+            clip_range: true,
         }
     }
 
@@ -295,6 +300,7 @@ mod tests {
             (r.clipped, r.encoder_rejects, r.stack_used_bytes),
             (Some(17), Some(3), Some(2_344))
         );
+        assert_eq!(r.clip_range, Some(true));
     }
 
     #[test]
@@ -312,7 +318,7 @@ mod tests {
         assert!(text.starts_with("r=[0.0123, -0.1, 0.25, -0.004] lamps=[false, true, true, true] fault=true call=fault top=b(0.5) 2nd=bl(0.5) wm=150.5rad/s zc_locked=Some(true) "));
         assert!(
             text.ends_with(
-                " moved=true rise=54.4K vdda=3.301V bor=4 clip=17 enc_rej=3 stack=2344B"
+                " moved=true rise=54.4K vdda=3.301V bor=4 clip=17 enc_rej=3 stack=2344B clip_range=true"
             ),
             "{text}"
         );
@@ -331,8 +337,13 @@ mod tests {
         let r = parse(before).expect("a status line");
         assert_eq!((r.vdda_v, r.bor), (Some(3.3), Some(4)));
         assert_eq!(
-            (r.clipped, r.encoder_rejects, r.stack_used_bytes),
-            (None, None, None)
+            (
+                r.clipped,
+                r.encoder_rejects,
+                r.stack_used_bytes,
+                r.clip_range
+            ),
+            (None, None, None, None)
         );
         for other in [
             "INFO  sampling at 10000 Hz",
