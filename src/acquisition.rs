@@ -1,7 +1,8 @@
 //! The acquisition's geometry, written once for the firmware and the host's model of the
 //! ADC and DMA (`tests/sil/recovery.rs`): channels per ADC, oversampling, the DMA ring's
-//! length, the sampling time and the conversion time it gives; and the averaging of the
-//! oversampled sequences into one sample ([`average_half`]).
+//! length, the sampling time and the conversion time it gives; the averaging of the
+//! oversampled sequences into one sample ([`average_half`]); and one sample's frame from its
+//! conversions ([`SampleBuilder`]).
 //!
 //! **Oversampling against the inverter's PWM.** An inverter switches at 2-16 kHz; its
 //! line-to-neutral voltage is a pulse train whose switching components (around multiples
@@ -35,12 +36,18 @@
 //! frame that masked interrupts just before the request ([`LOG_FRAME_CYCLES`], defmt-rtt
 //! holds a critical section for a whole frame, the status line being the longest), the
 //! interrupt's entry, the DMA handler, the other interrupts, the executor and the work on
-//! the half's samples. The ring's depth is the smallest that covers it
-//! ([`samples_per_half_for`]): at 10 kHz and 170 MHz one sample per half (17 000 cycles of
-//! slack) does not, nor do two (34 000 against 34 889), three (51 000) do, with 37 760
-//! cycles worst-case (222 us). The host's model
-//! (`tests/ring_latency.rs`) runs the sample path against that worst case for a simulated
-//! hour and counts no lap.
+//! the half's samples. The ring's depth is the smallest that covers it at the lap case
+//! ([`samples_per_half_for`], [`LAP_CYCLES_PER_INSTRUCTION_X10`]): at 10 kHz and 170 MHz
+//! one sample per half (a copy 36 917 cycles after the request against 18 831 of slack) and
+//! two (37 177 against 35 831) are lapped, three (37 437 against 52 831) are not. The
+//! host's model (`tests/ring_latency.rs`) runs the sample path against that worst case for
+//! a simulated hour and counts no lap.
+//!
+//! **Per sample** ([`SampleBuilder`], what the sample task runs and `cargo qemu-core`
+//! counts): the oversampled sums with every conversion checked against its channel's
+//! linear range ([`sum_clipped`]), the clip held ([`ClipHold`]), the latched encoder counts
+//! checked and averaged ([`EncoderCheck::sample`]), [`PwmFilter`]; the check and the
+//! filter's stages are Thumb-2 kernels on the Cortex-M4 (`acquisition/thumb.rs`).
 
 use crate::clock;
 
@@ -48,6 +55,23 @@ use crate::clock;
 /// [`crate::adc_rules::CHANNELS`], kept there so that the recovery below this module
 /// re-arms the encoder latch with it too).
 pub use crate::adc_rules::CHANNELS;
+// The checks of a sample's conversions (clipping) and of the latched encoder counts (steps
+// beyond the maximum speed): a file of their own, compiled with this one wherever it is
+// (the firmware's library, the QEMU program).
+#[path = "acquisition/checks.rs"]
+mod checks;
+// The sample path's two kernels in Thumb-2 assembly (the per-conversion clip check with the
+// oversampled sums, the filter's stages): on the Cortex-M4 only; the host runs their Rust.
+#[cfg(target_arch = "arm")]
+#[path = "acquisition/thumb.rs"]
+mod thumb;
+// The QEMU program uses a part of them.
+#[allow(unused_imports)]
+pub use checks::{
+    max_step_per_trigger, sum_clipped, sum_clipped_portable, ClipHold, ClipLimits, EncoderCheck,
+    LinearRange, LinearRanges, CLIP_HOLD_SAMPLES, FAST_MAX_STEP,
+};
+
 /// Sequences (triggers) averaged into one sample (module docs).
 pub const OVERSAMPLING: usize = 8;
 /// 16-bit words of one sample's sequences ([`OVERSAMPLING`] x [`CHANNELS`], 24): the unit
@@ -93,20 +117,23 @@ pub fn sample_count(latched: &[u16]) -> u16 {
 /// The sample rate the ring is sized for [Hz] (the firmware's `SETTINGS`, checked there at
 /// compile time with [`ring_fits`]).
 pub const BUDGET_SAMPLE_RATE_HZ: u32 = 10_000;
-/// The status line's bytes as `cargo qemu-rtt` measured them (`bytes_a_reader_finds=195`,
-/// 1 965 B for ten lines: 197 B a line), with the names the QEMU program logs.
-pub const LOG_MEASURED_BYTES: u32 = 197;
+/// The status line's bytes as `cargo qemu-rtt` measured them (2 005 B for ten lines, 200.5 B
+/// a line, rounded up; with issue 74's `clip=`, `enc_rej=`, `stack=` and `clip_range=`:
+/// 197 B before them, the bool packed with the line's others), with the names the QEMU
+/// program logs.
+pub const LOG_MEASURED_BYTES: u32 = 201;
 /// The instructions that line took with interrupts masked under QEMU
-/// (`flood_max_late_instructions=8960`: defmt-rtt holds a critical section for a whole
-/// frame, encoding and copying it byte by byte).
-pub const LOG_MEASURED_INSTRUCTIONS: u32 = 8_960;
+/// (`flood_max_late_instructions=9440`: defmt-rtt holds a critical section for a whole
+/// frame, encoding and copying it byte by byte; 8 960 before issue 74's fields, 9 400
+/// before `clip_range=`).
+pub const LOG_MEASURED_INSTRUCTIONS: u32 = 9_440;
 /// The longest frame the firmware logs [bytes]: the status line with the longest name in
 /// each of its six name fields, the frame's timestamp and the framing's overhead
 /// (`tests/ring_latency.rs` computes the bound from the names and fails when the line
 /// outgrows it).
-pub const LOG_FRAME_MAX_BYTES: u32 = 264;
+pub const LOG_FRAME_MAX_BYTES: u32 = 268;
 /// The longest frame's instructions, with interrupts masked: the measured line's cost per
-/// byte times [`LOG_FRAME_MAX_BYTES`], rounded up (12 008).
+/// byte times [`LOG_FRAME_MAX_BYTES`], rounded up (12 587).
 pub const LOG_FRAME_INSTRUCTIONS: u32 =
     (LOG_MEASURED_INSTRUCTIONS * LOG_FRAME_MAX_BYTES).div_ceil(LOG_MEASURED_BYTES);
 /// CPU cycles per instruction on the worst path, x 10 (an assumption, not measured: the
@@ -127,17 +154,20 @@ pub const OTHER_INTERRUPTS_CYCLES: u32 = 1_500;
 /// awaits: the poll, the `with_timeout` future and its timer queue entry [cycles].
 pub const EXECUTOR_CYCLES: u32 = 2_000;
 /// One sample's work at its worst [instructions] (`cargo qemu-core`: the sampling path's
-/// 222, the core's fast path 211 and, on every 25th sample, its slow path's 784), plus
-/// copying its 2 x 24 words out of the rings (about 100) and the mean of its 8 latched
-/// encoder counts ([`sample_count`], about 50; not traced).
-pub const SAMPLE_WORK_INSTRUCTIONS: u32 = 222 + 211 + 784 + 100 + 50;
+/// 639 when the sample's latched counts go through the encoder check count by count, a
+/// glitch or the first sample after a restart (318 otherwise: the oversampled sums with
+/// the per-conversion clip check, the encoder counts' check and their mean, the filter;
+/// `sampling_path_encoder_rejects` and `sampling_path`); the core's fast path 213 and, on
+/// every 25th sample, its slow path's 785), plus copying its 2 x 24 words out of the rings
+/// ([`COPY_INSTRUCTIONS`]).
+pub const SAMPLE_WORK_INSTRUCTIONS: u32 = 639 + 213 + 785 + COPY_INSTRUCTIONS;
 
 /// `instructions` at [`WORST_CYCLES_PER_INSTRUCTION_X10`] [cycles], rounded up.
 pub const fn worst_cycles(instructions: u32) -> u32 {
     (instructions * WORST_CYCLES_PER_INSTRUCTION_X10).div_ceil(10)
 }
 
-/// The longest critical section a log frame may hold [CPU cycles]: 25 217 (148 us at
+/// The longest critical section a log frame may hold [CPU cycles]: 26 433 (155 us at
 /// 170 MHz).
 pub const LOG_FRAME_CYCLES: u32 = worst_cycles(LOG_FRAME_INSTRUCTIONS);
 
@@ -162,14 +192,66 @@ pub const fn sample_period_cycles(sample_rate_hz: u32) -> u32 {
     }
 }
 
-/// Whether a ring of two halves of `samples_per_half` samples tolerates the worst-case
-/// latency at `sample_rate_hz`: the DMA writes into a half again `samples_per_half`
-/// periods after it completed it, so the half must be read, and its samples processed,
-/// within that time.
+/// Cycles per instruction of the **lap case**, x 10: the expected
+/// [`WORST_CYCLES_PER_INSTRUCTION_X10`] (2.1, an assumption no board has measured) plus a
+/// quarter, 2.6. The ring is sized so that it holds even where the assumption is a quarter
+/// too low: at 2.1 a ring of two samples per half would hold (its copy 30 783 cycles after
+/// the request, the DMA back 35 831 after it), at 2.6 it is lapped (37 177), and three
+/// hold (37 437 against 52 831; up to 3.7 cycles an instruction). `tests/ring_latency.rs`
+/// runs the board's events at this case.
+pub const LAP_CYCLES_PER_INSTRUCTION_X10: u32 = 26;
+/// Instructions to copy one sample's 2 x 24 words out of the rings (part of
+/// [`SAMPLE_WORK_INSTRUCTIONS`], done first).
+pub const COPY_INSTRUCTIONS: u32 = 100;
+
+/// `instructions` at [`LAP_CYCLES_PER_INSTRUCTION_X10`] [cycles], rounded up.
+pub const fn lap_cycles(instructions: u32) -> u32 {
+    (instructions * LAP_CYCLES_PER_INSTRUCTION_X10).div_ceil(10)
+}
+
+/// The longest log frame at the lap case's cycles per instruction [CPU cycles]: 32 727
+/// (193 us at 170 MHz).
+pub const LAP_FRAME_CYCLES: u32 = lap_cycles(LOG_FRAME_INSTRUCTIONS);
+
+/// The lap latency [CPU cycles] with `samples_per_half` samples per DMA half: from the
+/// half's interrupt request to the half copied out of the ring (what the DMA must not
+/// overwrite first), every term at its worst at once and the instructions at the lap
+/// case's cycles per instruction: a log frame that masked interrupts just before the
+/// request, the entry, the DMA handler, the other interrupts, the executor, the copy.
+pub const fn lap_latency_cycles(samples_per_half: u32) -> u32 {
+    LAP_FRAME_CYCLES
+        + INTERRUPT_ENTRY_CYCLES
+        + DMA_HANDLER_CYCLES
+        + OTHER_INTERRUPTS_CYCLES
+        + EXECUTOR_CYCLES
+        + samples_per_half * lap_cycles(COPY_INSTRUCTIONS)
+}
+
+/// One conversion [CPU cycles], rounded down (147 at 170 MHz).
+pub const fn conversion_cycles() -> u32 {
+    (conversion_ns() as u64 * clock::HCLK_HZ as u64 / 1_000_000_000) as u32
+}
+
+/// The time a half's copy has [CPU cycles]: from the half's completion (its last
+/// sequence's last conversion) to the DMA writing its first word again, two halves later:
+/// `(OVERSAMPLING x samples_per_half + 1)` trigger periods less two conversions (18 831,
+/// 35 831 and 52 831 cycles with 1, 2, 3 samples per half at 10 kHz).
+pub const fn lap_slack_cycles(sample_rate_hz: u32, samples_per_half: u32) -> u32 {
+    let trigger = sample_period_cycles(sample_rate_hz) / OVERSAMPLING as u32;
+    ((OVERSAMPLING as u32 * samples_per_half + 1) * trigger)
+        .saturating_sub((CHANNELS as u32 - 1) * conversion_cycles())
+}
+
+/// Whether a ring of two halves of `samples_per_half` samples holds at `sample_rate_hz`:
+/// a half must be copied out before the DMA writes into it again ([`lap_latency_cycles`]
+/// within [`lap_slack_cycles`], at the lap case), and the task must keep up (a half's work,
+/// at the lap case, within a half's periods).
 pub const fn ring_fits(sample_rate_hz: u32, samples_per_half: u32) -> bool {
     samples_per_half > 0
-        && worst_latency_cycles(samples_per_half)
-            <= samples_per_half * sample_period_cycles(sample_rate_hz)
+        && lap_latency_cycles(samples_per_half)
+            <= lap_slack_cycles(sample_rate_hz, samples_per_half)
+        && samples_per_half * lap_cycles(SAMPLE_WORK_INSTRUCTIONS)
+            < samples_per_half * sample_period_cycles(sample_rate_hz)
 }
 
 /// The smallest number of samples per DMA half (1..=8) that tolerates the worst-case
@@ -259,8 +341,9 @@ pub fn sum_half(half: &[u16]) -> ([u32; CHANNELS], u32) {
     ([a, b, c], sequences.len() as u32)
 }
 
-/// Fractional bits of [`PwmFilter`]'s states.
-const FILTER_FRAC_BITS: u32 = 12;
+/// Fractional bits of [`PwmFilter`]'s states (codes x 2^16: a sum of [`OVERSAMPLING`]
+/// 12-bit codes times the input's scale stays below 2^30).
+const FILTER_FRAC_BITS: u32 = 16;
 /// The first stage's coefficient `a = 2^-2` (a one-pole low-pass `y += a (x - y)` at 10 kHz:
 /// -3 dB at 458 Hz).
 const STAGE1_SHIFT: u32 = 2;
@@ -269,25 +352,33 @@ const STAGE2_SHIFT: u32 = 1;
 /// Samples the encoder count is held back, the filters' delay at the fundamental
 /// (`(1 - a) / a`: 3 and 1 samples) so that the shaft angle goes with the readings.
 pub const ENCODER_DELAY_SAMPLES: usize = 4;
+/// Mid-scale in the filter's states (code 2048 x 2^16): the fundamental's gain is restored
+/// about it (the swing, not the offset).
+const FILTER_MID: i32 = 2048 << FILTER_FRAC_BITS;
 
 /// The in-band part of an inverter's ripple taken out of the six channels (module docs):
-/// two one-pole low-passes in integer arithmetic on the oversampled sums ([`sum_half`]),
-/// `a = 1/4` then `a = 1/2` at the sample rate (at 10 kHz: -3 dB at 458 Hz and 1.1 kHz;
-/// gain 0.052 at 4 kHz, 0.12 at 2 kHz, where an 8 kHz carrier's second group lands), and
-/// the fundamental's gain restored (`gain_q15`, from [`PwmFilter::new`]'s supply frequency:
-/// at 50 Hz the two stages pass 0.993). All six channels are filtered alike, so the
-/// machine's equations between the voltages and currents hold through it (a linear filter
-/// commutes with a linear machine's equations in steady state); the encoder count is held
-/// back [`ENCODER_DELAY_SAMPLES`] samples to go with them. No allocation, no panics.
+/// two one-pole low-passes in integer arithmetic on the oversampled sums ([`sum_clipped`],
+/// [`sum_half`]: [`OVERSAMPLING`] sequences), `a = 1/4` then `a = 1/2` at the sample rate
+/// (at 10 kHz: -3 dB at 458 Hz and 1.1 kHz; gain 0.052 at 4 kHz, 0.12 at 2 kHz, where an
+/// 8 kHz carrier's second group lands), and the fundamental's gain restored (from
+/// [`PwmFilter::new`]'s supply frequency: at 50 Hz the two stages pass 0.993), folded into
+/// the input's scale about mid-scale so that a sample costs one multiply-add a channel and
+/// no division. All six channels are filtered alike, so the machine's equations between the
+/// voltages and currents hold through it (a linear filter commutes with a linear machine's
+/// equations in steady state); the encoder count is held back [`ENCODER_DELAY_SAMPLES`]
+/// samples to go with them. No allocation, no panics.
 #[derive(Clone, Copy, Debug)]
 pub struct PwmFilter {
-    /// Each channel's two stages (voltages a, b, c, then currents), in sums x 2^12.
-    stages: [[i32; 2]; 2 * CHANNELS],
-    /// The encoder counts of the last samples, a ring; `at` the oldest.
+    /// Each channel's two stages (voltages a, b, c, then currents), in codes x 2^16 plus
+    /// half a code (the output's rounding, carried through the stages).
+    stages: [[[i32; 2]; CHANNELS]; 2],
+    /// The encoder counts of the last samples, oldest first.
     counts: [u16; ENCODER_DELAY_SAMPLES],
-    at: usize,
-    /// The inverse of the stages' gain at the supply frequency, x 2^15.
-    gain_q15: i32,
+    /// A sum of [`OVERSAMPLING`] codes -> the stages' input: `sum x scale + bias`, the
+    /// mean in codes x 2^16 with the gain restored about mid-scale, plus half a code.
+    scale: i32,
+    /// See `scale`.
+    bias: i32,
     primed: bool,
 }
 
@@ -304,75 +395,226 @@ impl PwmFilter {
             a * a / (re * re + im * im)
         };
         let g2 = gain2(STAGE1_SHIFT) * gain2(STAGE2_SHIFT);
-        let gain_q15 = if g2.is_finite() && g2 > 0.25 && g2 <= 1.0 {
-            (32768.0 * sqrt_near_one(1.0 / g2)) as i32
+        let gain = if g2.is_finite() && g2 > 0.25 && g2 <= 1.0 {
+            sqrt_near_one(1.0 / g2)
         } else {
-            32768
+            1.0
         };
+        // The mean of OVERSAMPLING codes x 2^16 x gain, rounded (gain < 2: below 2^14);
+        // mid-scale kept where it is, exactly.
+        let one = (1i32 << FILTER_FRAC_BITS) / OVERSAMPLING as i32;
+        let scale = (gain * one as f32 + 0.5) as i32;
+        let mid_sum = 2048 * OVERSAMPLING as i32;
+        let bias = FILTER_MID - mid_sum * scale + (1 << (FILTER_FRAC_BITS - 1));
         Self {
-            stages: [[0; 2]; 2 * CHANNELS],
+            stages: [[[0; 2]; CHANNELS]; 2],
             counts: [0; ENCODER_DELAY_SAMPLES],
-            at: 0,
-            gain_q15,
+            scale,
+            bias,
             primed: false,
         }
     }
 
-    /// One sample: the voltages' and currents' sums over `n` sequences (from [`sum_half`])
-    /// and the encoder count read after them; the filtered codes (rounded, within
-    /// 0..=4095) and the encoder count of [`ENCODER_DELAY_SAMPLES`] samples ago. The first
-    /// sample starts the stages at its own value (no run-up from zero).
-    #[inline]
+    /// One sample: the voltages' and currents' sums over [`OVERSAMPLING`] sequences (from
+    /// [`sum_clipped`] or [`sum_half`]) and the encoder count read with them; the filtered
+    /// codes (rounded, within 0..=4095) and the encoder count of
+    /// [`ENCODER_DELAY_SAMPLES`] samples ago. The first sample starts the stages at its own
+    /// value (no run-up from zero).
+    #[inline(always)]
     pub fn step(
         &mut self,
         v: [u32; CHANNELS],
         i: [u32; CHANNELS],
-        n: u32,
         count: u16,
     ) -> ([u16; CHANNELS], [u16; CHANNELS], u16) {
-        let n = n.max(1) as i32;
-        let (primed, gain) = (self.primed, self.gain_q15);
-        let [va, vb, vc] = v;
-        let [ia, ib, ic] = i;
-        let [s0, s1, s2, s3, s4, s5] = &mut self.stages;
-        let v = [
-            filter_channel(s0, va, n, primed, gain),
-            filter_channel(s1, vb, n, primed, gain),
-            filter_channel(s2, vc, n, primed, gain),
-        ];
-        let i = [
-            filter_channel(s3, ia, n, primed, gain),
-            filter_channel(s4, ib, n, primed, gain),
-            filter_channel(s5, ic, n, primed, gain),
-        ];
-        self.primed = true;
-        if !primed {
-            self.counts = [count; ENCODER_DELAY_SAMPLES];
+        self.step_with(v, i, count, filter3)
+    }
+
+    /// [`PwmFilter::step`] in Rust alone on every target (on the Cortex-M4 `step` runs a
+    /// Thumb-2 kernel; `cargo qemu-core` checks the two against each other).
+    pub fn step_portable(
+        &mut self,
+        v: [u32; CHANNELS],
+        i: [u32; CHANNELS],
+        count: u16,
+    ) -> ([u16; CHANNELS], [u16; CHANNELS], u16) {
+        self.step_with(v, i, count, filter3_portable)
+    }
+
+    /// [`PwmFilter::step`] with `filter` for each ADC's three channels.
+    #[inline(always)]
+    fn step_with(
+        &mut self,
+        v: [u32; CHANNELS],
+        i: [u32; CHANNELS],
+        count: u16,
+        filter: Filter3,
+    ) -> ([u16; CHANNELS], [u16; CHANNELS], u16) {
+        if !self.primed {
+            self.prime(v, i, count);
         }
-        let slot = self.counts.get_mut(self.at % ENCODER_DELAY_SAMPLES);
-        let delayed = slot.map_or(count, |c| core::mem::replace(c, count));
-        self.at = (self.at + 1) % ENCODER_DELAY_SAMPLES;
+        let (scale, bias) = (self.scale, self.bias);
+        let [voltages, currents] = &mut self.stages;
+        let v = filter(voltages, v, scale, bias);
+        let i = filter(currents, i, scale, bias);
+        const { assert!(ENCODER_DELAY_SAMPLES == 4) };
+        let [delayed, c1, c2, c3] = self.counts;
+        self.counts = [c1, c2, c3, count];
         (v, i, delayed)
+    }
+
+    /// The first sample: every stage at its own input, the delayed counts at its count.
+    #[cold]
+    #[inline(never)]
+    fn prime(&mut self, v: [u32; CHANNELS], i: [u32; CHANNELS], count: u16) {
+        let (scale, bias) = (self.scale, self.bias);
+        for (st, sum) in self.stages.iter_mut().flatten().zip(v.into_iter().chain(i)) {
+            let x = input(sum, scale, bias);
+            *st = [x, x];
+        }
+        self.counts = [count; ENCODER_DELAY_SAMPLES];
+        self.primed = true;
     }
 }
 
-/// One channel of [`PwmFilter::step`]: the mean of `sum` over `n` sequences in codes x
-/// 2^12 (n <= 8: 4095 x 2^12 < 2^24) through the two stages `st` (started at it when not
-/// `primed`), the gain restored around mid-scale (the swing, not the offset), rounded to
-/// a code within 0..=4095.
+/// Three channels of [`PwmFilter`]: their stages, their sums, the input's scale and bias
+/// -> their codes ([`filter3`], [`filter3_portable`]).
+type Filter3 = fn(&mut [[i32; 2]; CHANNELS], [u32; CHANNELS], i32, i32) -> [u16; CHANNELS];
+
+/// A channel's sum of [`OVERSAMPLING`] codes as [`PwmFilter`]'s input ([`PwmFilter`]'s
+/// `scale` and `bias`).
 #[inline(always)]
-fn filter_channel(st: &mut [i32; 2], sum: u32, n: i32, primed: bool, gain_q15: i32) -> u16 {
-    let x = ((sum as i32) << FILTER_FRAC_BITS) / n;
-    if !primed {
-        *st = [x, x];
-    }
+fn input(sum: u32, scale: i32, bias: i32) -> i32 {
+    (sum as i32).wrapping_mul(scale).wrapping_add(bias)
+}
+
+/// Three channels of [`PwmFilter::step`]: [`filter3_portable`], on the Cortex-M4 as a
+/// Thumb-2 kernel (`acquisition/thumb.rs`, eight instructions a channel; `cargo qemu-core`
+/// checks that the two agree).
+#[inline(always)]
+fn filter3(
+    st: &mut [[i32; 2]; CHANNELS],
+    sums: [u32; CHANNELS],
+    scale: i32,
+    bias: i32,
+) -> [u16; CHANNELS] {
+    #[cfg(target_arch = "arm")]
+    let codes = thumb::filter3(st, sums, scale, bias);
+    #[cfg(not(target_arch = "arm"))]
+    let codes = filter3_portable(st, sums, scale, bias);
+    codes
+}
+
+/// Three channels of [`PwmFilter::step`] in Rust alone ([`filter_channel`] each), on every
+/// target.
+#[inline(always)]
+fn filter3_portable(
+    st: &mut [[i32; 2]; CHANNELS],
+    sums: [u32; CHANNELS],
+    scale: i32,
+    bias: i32,
+) -> [u16; CHANNELS] {
+    let [s0, s1, s2] = st;
+    let [x0, x1, x2] = sums;
+    [
+        filter_channel(s0, x0, scale, bias),
+        filter_channel(s1, x1, scale, bias),
+        filter_channel(s2, x2, scale, bias),
+    ]
+}
+
+/// One channel of [`PwmFilter::step`]: `sum` as the input, through the two stages `st`,
+/// rounded to a code within 0..=4095 (the half code for the rounding is in the states).
+#[inline(always)]
+fn filter_channel(st: &mut [i32; 2], sum: u32, scale: i32, bias: i32) -> u16 {
+    let x = input(sum, scale, bias);
     let [a, b] = st;
-    *a += (x - *a) >> STAGE1_SHIFT;
-    *b += (*a - *b) >> STAGE2_SHIFT;
-    let mid = 2048 << FILTER_FRAC_BITS;
-    let y = mid + ((i64::from(*b - mid) * i64::from(gain_q15)) >> 15) as i32;
-    let code = (y + (1 << (FILTER_FRAC_BITS - 1))) >> FILTER_FRAC_BITS;
-    code.clamp(0, 4095) as u16
+    *a = a.wrapping_add(x.wrapping_sub(*a) >> STAGE1_SHIFT);
+    *b = b.wrapping_add(a.wrapping_sub(*b) >> STAGE2_SHIFT);
+    (*b >> FILTER_FRAC_BITS).clamp(0, 4095) as u16
+}
+
+/// What [`SampleBuilder::build`] makes of one sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BuiltSample {
+    /// The filtered voltage codes a, b, c.
+    pub v: [u16; CHANNELS],
+    /// The filtered current codes a, b, c.
+    pub i: [u16; CHANNELS],
+    /// The encoder count, held back with the filter's delay.
+    pub count: u16,
+    /// `[voltage, current]`: a conversion of the sample, or of the [`CLIP_HOLD_SAMPLES`]
+    /// before it, was clipped ([`sum_clipped`], [`ClipHold`]).
+    pub clipped: [bool; 2],
+    /// The sample's latched counts rejected as a step beyond the maximum speed (0..=8).
+    pub encoder_rejects: u8,
+}
+
+/// One sample's conversions and latched encoder counts -> its filtered codes and count,
+/// with the checks: each ADC's oversampled sequences summed with every conversion checked
+/// against its channel's linear range ([`sum_clipped`], the limits precomputed here; a clip
+/// held through the filter's memory, [`ClipHold`]), the latched counts checked against the
+/// maximum speed and averaged ([`EncoderCheck::sample`]), the inverter's ripple filtered out
+/// ([`PwmFilter`]). What the sample task runs per sample (`app::FrameBuilder`) and what
+/// `cargo qemu-core` counts (`sampling_path`). No allocation, no panics.
+#[derive(Clone, Copy, Debug)]
+pub struct SampleBuilder {
+    filter: PwmFilter,
+    hold: ClipHold,
+    encoder: EncoderCheck,
+    voltage: ClipLimits,
+    current: ClipLimits,
+}
+
+impl SampleBuilder {
+    /// A builder at `sample_rate_hz` whose filter restores the gain at `supply_hz`, with
+    /// the channels' linear `ranges` (`motor_source::linear_ranges`) and the encoder's
+    /// largest step between two triggers `max_step` (`motor_source::EncoderSetup`).
+    pub fn new(sample_rate_hz: u32, supply_hz: f32, ranges: &LinearRanges, max_step: u16) -> Self {
+        Self {
+            filter: PwmFilter::new(sample_rate_hz, supply_hz),
+            hold: ClipHold::default(),
+            encoder: EncoderCheck::new(max_step),
+            voltage: ClipLimits::new(&ranges.voltage),
+            current: ClipLimits::new(&ranges.current),
+        }
+    }
+
+    /// After a gap in the triggers (a recovery, a paused acquisition): the next latched
+    /// count starts the encoder check afresh.
+    pub fn restart(&mut self) {
+        self.encoder.restart();
+    }
+
+    /// A sample that is dropped (`adc_rules::IdleDiscard`): its latched counts still go
+    /// through the encoder check, so the next sample's first step is one trigger long.
+    pub fn skip(&mut self, latched: &[u16; OVERSAMPLING]) {
+        self.encoder.sample(latched);
+    }
+
+    /// One sample: `v` and `i` its sequences of ADC1 and ADC2 (`[a, b, c, a, b, c, ...]`),
+    /// `latched` the encoder counts latched at its triggers (oldest first).
+    #[inline(always)]
+    pub fn build(
+        &mut self,
+        v: &[u16; HALF_LEN],
+        i: &[u16; HALF_LEN],
+        latched: &[u16; OVERSAMPLING],
+    ) -> BuiltSample {
+        // The counts first: the sums go to the filter as soon as they are made.
+        let (count, encoder_rejects) = self.encoder.sample(latched);
+        let (vs, v_clip) = sum_clipped(v, &self.voltage);
+        let (is, i_clip) = sum_clipped(i, &self.current);
+        let (v, i, count) = self.filter.step(vs, is, count);
+        let clipped = self.hold.step([v_clip, i_clip]);
+        BuiltSample {
+            v,
+            i,
+            count,
+            clipped,
+            encoder_rejects,
+        }
+    }
 }
 
 /// `sqrt(x)` for `x` in 1..=4 (the inverse gain squared) by Newton's iteration from `x`:
@@ -399,134 +641,5 @@ fn micro_sin(x: f32) -> f32 {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_geometry_fits_the_period() {
-        assert_eq!(RING_LEN, 144);
-        assert_eq!(HALF_LEN, 24);
-        assert_eq!(conversion_ns(), 870);
-        assert!(sequence_ns() < 12_500);
-        assert_eq!(trigger_rate_hz(10_000), 80_000);
-        assert!(fits(10_000));
-        // 20 kHz: 6.25 us between triggers, less than a sequence held up by VREFINT.
-        assert!(!fits(20_000));
-    }
-
-    /// The ring's depth from the budget, against the sums by hand: one sample's work is
-    /// 1 367 instructions, 2 871 cycles at 2.1 (2 870.7 rounded up); the frame 8 960 x
-    /// 264 / 197 = 12 007.3, 12 008 instructions, 25 216.8, 25 217 cycles; with 30 + 400 +
-    /// 1 500 + 2 000 the worst case is 32 018 cycles for one sample per half (more than its
-    /// 17 000 of slack), 34 889 for two (more than 34 000) and 37 760 for three (under
-    /// 51 000).
-    #[test]
-    fn the_ring_depth_follows_from_the_latency_budget() {
-        assert_eq!(sample_period_cycles(10_000), 17_000);
-        assert_eq!(LOG_FRAME_INSTRUCTIONS, 12_008);
-        assert_eq!(LOG_FRAME_CYCLES, 25_217);
-        assert_eq!(worst_latency_cycles(1), 32_018);
-        assert_eq!(worst_latency_cycles(2), 34_889);
-        assert_eq!(worst_latency_cycles(3), 37_760);
-        assert!(!ring_fits(10_000, 1));
-        assert!(!ring_fits(10_000, 2));
-        assert!(ring_fits(10_000, 3));
-        assert_eq!(SAMPLES_PER_HALF, 3);
-        assert_eq!(DMA_HALF_LEN, 72);
-        // A slower rate needs a shallower ring; a faster one a deeper one.
-        assert_eq!(samples_per_half_for(5_000), 1);
-        assert!(samples_per_half_for(20_000) > 3);
-    }
-
-    /// A sample's count is the mean of its latched counts, across the counter's wrap and
-    /// backwards too.
-    #[test]
-    fn a_samples_count_is_the_mean_of_its_latched_counts() {
-        assert_eq!(sample_count(&[100, 102, 104, 106, 108, 110, 112, 114]), 107);
-        assert_eq!(sample_count(&[65_534, 65_535, 0, 1]), 0);
-        assert_eq!(
-            sample_count(&[3, 2, 1, 0, 65_535, 65_534, 65_533, 65_532]),
-            0
-        );
-        assert_eq!(sample_count(&[7]), 7);
-        assert_eq!(sample_count(&[]), 0);
-    }
-
-    #[test]
-    fn the_average_is_per_channel_and_rounds() {
-        let mut half = [0u16; HALF_LEN];
-        for (k, seq) in half.chunks_exact_mut(CHANNELS).enumerate() {
-            seq.copy_from_slice(&[100 + k as u16, 2000, 4095 - (k as u16 % 2)]);
-        }
-        // a: 100..=107, mean 103.5 -> 104; c: 4095 and 4094 alternating, 4094.5 -> 4095.
-        assert_eq!(average_half(&half), [104, 2000, 4095]);
-        assert_eq!(average_half(&[]), [0, 0, 0]);
-    }
-
-    /// The filter against an independent model: a one-pole cascade in f64 on a 50 Hz
-    /// sinusoid plus a 4 kHz ripple; the 50 Hz amplitude is kept (the gain restored), the
-    /// ripple falls to the cascade's gain, and the encoder count is held back 4 samples.
-    #[test]
-    fn the_filter_keeps_the_fundamental_and_takes_the_ripple_out() {
-        let fs = 10_000.0_f64;
-        let mut f = PwmFilter::new(10_000, 50.0);
-        let (mut out50, mut out_ripple) = (Vec::new(), Vec::new());
-        for k in 0..4_000u32 {
-            let t = f64::from(k) / fs;
-            let fund = 1000.0 * (std::f64::consts::TAU * 50.0 * t).sin();
-            let ripple = 300.0 * (std::f64::consts::TAU * 4_000.0 * t).sin();
-            let code = |x: f64| ((2048.0 + x) * 8.0).round() as u32;
-            let sum = code(fund + ripple);
-            let (v, _, count) = f.step([sum; 3], [code(0.0); 3], 8, k as u16);
-            if k >= 4 {
-                assert_eq!(count, (k - 4) as u16);
-            }
-            if k >= 2_000 {
-                out50.push((t, f64::from(v[0]) - 2048.0));
-                out_ripple.push(f64::from(v[0]) - 2048.0);
-            }
-        }
-        // The 50 Hz amplitude by a DFT over the last 0.2 s (10 periods).
-        let (mut re, mut im) = (0.0, 0.0);
-        for &(t, y) in &out50 {
-            re += 2.0 * y * (std::f64::consts::TAU * 50.0 * t).cos() / out50.len() as f64;
-            im += 2.0 * y * (std::f64::consts::TAU * 50.0 * t).sin() / out50.len() as f64;
-        }
-        let amp = (re * re + im * im).sqrt();
-        assert!((amp - 1000.0).abs() < 2.0, "{amp}");
-        // The ripple left: the cascade's gain at 4 kHz, |a/(1 - (1-a) e^{-jw})| for a =
-        // 1/4 and 1/2 at w = 0.8 pi: 0.150 x 0.348 = 0.052 (x the gain restored, 1.007).
-        let ripple_gain = |a: f64| {
-            let w = std::f64::consts::TAU * 0.4;
-            let (re, im) = (1.0 - (1.0 - a) * w.cos(), (1.0 - a) * w.sin());
-            a / (re * re + im * im).sqrt()
-        };
-        let expected = 300.0 * ripple_gain(0.25) * ripple_gain(0.5);
-        let residual: Vec<f64> = out50
-            .iter()
-            .map(|&(t, y)| y - amp * ((std::f64::consts::TAU * 50.0 * t) + re.atan2(im)).sin())
-            .collect();
-        let peak = residual.iter().fold(0.0f64, |m, r| m.max(r.abs()));
-        assert!(
-            peak < expected * 1.1 + 1.5 && peak > expected * 0.8,
-            "{peak} against {expected}"
-        );
-        assert_eq!(out_ripple.len(), 2_000);
-    }
-
-    /// A sinusoid at a multiple of the sample rate (what folds onto DC and the
-    /// fundamental) averages to nothing; one at 50 Hz passes.
-    #[test]
-    fn the_average_nulls_multiples_of_the_sample_rate() {
-        let ft = 80_000.0_f64;
-        for f in [10_000.0, 20_000.0, 40_000.0] {
-            let mut half = [0u16; HALF_LEN];
-            for (k, seq) in half.chunks_exact_mut(CHANNELS).enumerate() {
-                let x = 2048.0 + 1000.0 * (std::f64::consts::TAU * f * k as f64 / ft + 0.3).sin();
-                seq.fill(x.round() as u16);
-            }
-            let avg = average_half(&half);
-            assert!((i32::from(avg[0]) - 2048).abs() <= 1, "{f} Hz: {avg:?}");
-        }
-    }
-}
+#[path = "acquisition/tests.rs"]
+mod tests;

@@ -22,8 +22,9 @@
 //! [`Monitor::update`]: monitor_core::Monitor::update
 
 use crate::board;
+use crate::clip_watch::{self, ClipWatch, RangeChange};
 use crate::commissioning::{Action, CommissioningProcedure, RunEnd};
-use crate::flash_record::{self, CalibrationRecord, RecordStore, Stored};
+use crate::flash_record::CalibrationRecord;
 use crate::liveness::{LivenessChange, SampleWatch};
 use crate::offset_trim::TrimResult;
 use crate::panel::{self, blink_code, winding_code, Mode, PanelInput, PanelLamps, NOT_NAMED_CODE};
@@ -43,9 +44,11 @@ pub use isolation::{board_isolator, isolation_summary};
 mod lamps;
 pub use lamps::{panel_call, panel_input, PanelIsolation};
 mod sample_path;
-pub use sample_path::{AppError, Command, CommandError, SamplePath};
+pub use sample_path::{AppError, Command, CommandError, FrameBuilder, SamplePath};
 mod status_line;
-pub use status_line::status_line;
+pub use status_line::{status_line, BoardCounters};
+mod store;
+pub use store::{carry_out, AcquisitionPause, NoPause};
 
 /// The machine the firmware monitors by default: the "2.2 kW" reference machine
 /// (`monitor_core::reference::MOTOR_2P2KW`: 400 V, 50 Hz, 4 poles, Gamma model, Bl for the
@@ -69,9 +72,10 @@ pub fn default_motor() -> MotorModel {
 
 /// Core configuration for the board: [`DEFAULT_MACHINE`] on its rated supply, sampled at
 /// `sample_rate_hz`, 1 MHz timestamps, a 16-bit x4 encoder counter with
-/// [`board::ENCODER_COUNTS_PER_REV`] counts per revolution, and sensor limits equal to the
-/// front end's full scale (a reading beyond it cannot be real). (The host's configuration
-/// for replaying a log is `monitor_replay::monitor_config_for_log`.)
+/// [`board::ENCODER_COUNTS_PER_REV`] counts per revolution, and sensor limits beyond any
+/// reading the front end gives ([`board::LIMIT_OVER_FULL_SCALE`] times its full scale: a
+/// reading at its edge is a clip, held out and named nothing, not an impossible one). (The
+/// host's configuration for replaying a log is `monitor_replay::monitor_config_for_log`.)
 pub fn board_monitor_config(sample_rate_hz: u32) -> MonitorConfig {
     let supply = DEFAULT_MACHINE.supply;
     let mut cfg = MonitorConfig::new(
@@ -83,8 +87,8 @@ pub fn board_monitor_config(sample_rate_hz: u32) -> MonitorConfig {
     cfg.tick_hz = TICK_HZ as f32;
     cfg.encoder.counter_bits = 16;
     cfg.encoder.counts_per_rev = board::ENCODER_COUNTS_PER_REV;
-    cfg.limits.v_max = board::VOLTAGE_FULL_SCALE_V;
-    cfg.limits.i_max = board::CURRENT_FULL_SCALE_A;
+    cfg.limits.v_max = board::LIMIT_OVER_FULL_SCALE * board::VOLTAGE_FULL_SCALE_V;
+    cfg.limits.i_max = board::LIMIT_OVER_FULL_SCALE * board::CURRENT_FULL_SCALE_A;
     cfg
 }
 
@@ -217,6 +221,21 @@ pub struct MonitorStatus {
     /// ([`RangeWatch::moved`]), false as the sample path hands it ([`panel_input`] shows
     /// the amber state only when no fault is named).
     pub moved: bool,
+    /// Samples since boot with a conversion at the front end's linear limit (clipped,
+    /// held out of the residuals, no sensor named: [`crate::sampling::Clipped`]); wraps.
+    pub clipped: u32,
+    /// Of those, the samples in which a voltage channel clipped; wraps.
+    pub clipped_voltage: u32,
+    /// Of those, the samples in which a current channel clipped; wraps.
+    pub clipped_current: u32,
+    /// Latched encoder counts since boot rejected as a step beyond the maximum speed
+    /// (`acquisition::EncoderCheck`); wraps.
+    pub encoder_rejects: u32,
+    /// Clipping persists in steady running: the front end's range is too small for this
+    /// motor (the range state: the verdict could not judge, the panel's mark, the status
+    /// line's `clip_range=`). Set by [`Supervisor::tick`] ([`ClipWatch`]), false as the
+    /// sample path hands it.
+    pub clip_range: bool,
 }
 
 impl MonitorStatus {
@@ -229,6 +248,17 @@ impl MonitorStatus {
             self.operating.i_f,
             self.operating.iqs,
         )
+    }
+
+    /// What the clip watch reads of this status ([`ClipWatch`]).
+    pub fn clip_moment(&self) -> clip_watch::Moment {
+        clip_watch::Moment {
+            samples: self.samples,
+            clipped: self.clipped,
+            clipped_voltage: self.clipped_voltage,
+            clipped_current: self.clipped_current,
+            speed_rad_s: self.speed_rad_s,
+        }
     }
 
     /// What the operating-range watch reads of this status.
@@ -262,6 +292,13 @@ pub struct Tick {
     pub run_ended: Option<RunEnd>,
     /// The sample path's liveness changed: log it (and write or clear the reset record).
     pub liveness: Option<LivenessChange>,
+    /// A new correction for the ADC's reference to hand the sample task
+    /// ([`Command::ReferenceGain`]: VDDA now over VDDA at commissioning,
+    /// [`crate::supply::ReferenceGain`]).
+    pub reference_gain: Option<f32>,
+    /// The range state changed (clipping persists in steady running, or no longer:
+    /// [`ClipWatch`]): log it.
+    pub clip_range: Option<RangeChange>,
 }
 
 /// Thread mode's logic: button, commissioning procedure, liveness watch and panel.
@@ -287,6 +324,8 @@ pub struct Supervisor {
     default_motor: bool,
     /// The clock runs on the HSI: the crystal did not start (the panel marks it).
     clock_fallback: bool,
+    /// The brown-out level is below the goal: records refused (the panel marks it).
+    bor_below_goal: bool,
     /// Sensors whose start-up offset was out of bound ([`Supervisor::set_offset_fault`]).
     offset_fault: SensorFlags,
     /// The ADC's reference, measured at start-up and every second
@@ -294,6 +333,16 @@ pub struct Supervisor {
     reference: ReferenceWatch,
     /// The commissioned operating range (RAM only) and the "moved" judgement.
     range: RangeWatch,
+    /// Whether clipping persists in steady running (the range state).
+    clips: ClipWatch,
+    /// A change of the range state since the last tick, for its log.
+    clip_change: Option<RangeChange>,
+    /// The correction of the readings for the reference's drift since commissioning.
+    gain: crate::supply::ReferenceGain,
+    /// VDDA the record being stored holds (in force once the run ends commissioned).
+    pending_vdda: Option<f32>,
+    /// A run ended commissioned in this tick: its VDDA goes into force.
+    gain_on_commissioning: bool,
 }
 
 impl Supervisor {
@@ -325,9 +374,15 @@ impl Supervisor {
             running: false,
             default_motor: false,
             clock_fallback: false,
+            bor_below_goal: false,
             offset_fault: SensorFlags::default(),
             reference: ReferenceWatch::new(REFERENCE_PERIOD_MS),
             range: RangeWatch::new(),
+            clips: ClipWatch::new(settings.sample_rate_hz),
+            clip_change: None,
+            gain: crate::supply::ReferenceGain::default(),
+            pending_vdda: None,
+            gain_on_commissioning: false,
         }
     }
 
@@ -382,6 +437,13 @@ impl Supervisor {
         self.clock_fallback = fallback;
     }
 
+    /// Whether the brown-out reset level is below the goal (`supply::BorCheck`: records
+    /// refused, a commissioning ends "not stored"): the panel shows it ([`crate::panel`],
+    /// "Brown-out level below the goal"). Off until set.
+    pub fn set_bor_below_goal(&mut self, below: bool) {
+        self.bor_below_goal = below;
+    }
+
     /// The commissioned operating range and the "moved" judgement.
     pub fn range(&self) -> &RangeWatch {
         &self.range
@@ -412,15 +474,20 @@ impl Supervisor {
         };
         if let Action::Store { record, .. } = &mut action {
             record.isolation = self.run_baseline;
+            // The reference the run learned at: later readings are corrected to it.
+            record.vdda_v = self.reference.in_band_v();
+            self.pending_vdda = record.vdda_v;
         }
         self.expire_failed_show(now_ms);
         let mode = self.mode(watch.stalled);
         let failed = self.procedure.last_failure().is_some();
         self.latest.moved = self.range.moved(&self.latest.range_moment());
+        self.latest.clip_range = self.clips.too_small();
         let isolation = self.panel_isolation();
         let input = PanelInput {
             default_motor: self.default_motor,
             clock_fallback: self.clock_fallback,
+            bor_below_goal: self.bor_below_goal,
             ..panel_input(mode, &self.latest, isolation, failed)
         };
         Tick {
@@ -431,12 +498,14 @@ impl Supervisor {
             action,
             run_ended,
             liveness: watch.change,
+            reference_gain: self.reference_gain(run_ended),
+            clip_range: self.clip_change.take(),
         }
     }
 
     /// Takes a new status `s` from the sample task as the latest: adds the sensor faults
     /// thread mode knows of (an offset out of bound, a reference out of band), then feeds
-    /// the fault isolation and the operating range with it.
+    /// the fault isolation, the operating range and the clip watch with it.
     fn take_status(&mut self, mut s: MonitorStatus) {
         let reference = self.reference.flags_sensors();
         s.sensor_fault.voltage |= self.offset_fault.voltage || reference;
@@ -445,6 +514,14 @@ impl Supervisor {
         self.latest = s;
         self.follow(&s, previous);
         self.range.observe(&s.range_moment());
+        if let Some(change) = self.clips.observe(&s.clip_moment()) {
+            self.clip_change = Some(change);
+        }
+    }
+
+    /// The clip watch (the range state).
+    pub fn clips(&self) -> &ClipWatch {
+        &self.clips
     }
 
     /// Whether `button` (pressed since the last tick) counts as a press at `now_ms`: not
@@ -476,8 +553,34 @@ impl Supervisor {
         }
         if let Some(RunEnd::Commissioned { run }) = run_ended {
             self.range.commit(run);
+            self.gain_on_commissioning = true;
         }
         (action, run_ended)
+    }
+
+    /// The reference's correction at the end of a tick: the VDDA of a run that ended
+    /// commissioned (`run_ended`) goes into force, else the latest measurement against the
+    /// commissioned VDDA ([`crate::supply::ReferenceGain::observe`]); a new gain, if any.
+    fn reference_gain(&mut self, run_ended: Option<RunEnd>) -> Option<f32> {
+        let latest = self.reference.latest();
+        if core::mem::take(&mut self.gain_on_commissioning)
+            && matches!(run_ended, Some(RunEnd::Commissioned { .. }))
+        {
+            return self.gain.commissioned(self.pending_vdda, latest);
+        }
+        latest.and_then(|check| self.gain.observe(check))
+    }
+
+    /// Puts the VDDA of the commissioning `record` loaded at boot into force for the
+    /// reference's correction ([`crate::supply::ReferenceGain`]; a record without it: no
+    /// correction). The gain follows at the next measurement ([`Tick::reference_gain`]).
+    pub fn restore_reference(&mut self, record: &CalibrationRecord) {
+        self.gain.commissioned(record.vdda_v, None);
+    }
+
+    /// The reference's correction in force.
+    pub fn reference_correction(&self) -> &crate::supply::ReferenceGain {
+        &self.gain
     }
 
     /// Ends the boot's "monitor failed" show once `now_ms` has reached its end.
@@ -509,74 +612,5 @@ impl Supervisor {
     }
 }
 
-/// Carries out a commissioning [`Action`]: the command for the sample task, after storing
-/// the calibration in `store` for [`Action::Store`] (erase, write, read back: the command
-/// reports what the store holds, whatever failed). Also returns the storage result.
-pub fn carry_out<S: RecordStore>(
-    action: Action,
-    store: &mut S,
-) -> (Option<Command>, Option<Stored<S::Error>>) {
-    match action {
-        Action::None => (None, None),
-        Action::Start { duration_s } => (Some(Command::StartCommissioning { duration_s }), None),
-        Action::Cancel { run } => (Some(Command::CancelCommissioning { run }), None),
-        Action::Store { run, record } => {
-            let stored = flash_record::store(store, &record);
-            (
-                Some(Command::CalibrationStored {
-                    run,
-                    stored: stored.read_back,
-                }),
-                Some(stored),
-            )
-        }
-    }
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn settings_out_of_range_are_named() {
-        assert_eq!(Settings::DEFAULT.validate(), Ok(()));
-        for rate in [0, 7_000, 10_050, 3_000_000] {
-            let s = Settings {
-                sample_rate_hz: rate,
-                ..Settings::DEFAULT
-            };
-            assert_eq!(s.validate(), Err(SettingsError::SampleRate), "{rate}");
-        }
-        for d in [0.0, -1.0, f32::NAN, f32::INFINITY] {
-            let s = Settings {
-                commissioning_duration_s: d,
-                ..Settings::DEFAULT
-            };
-            assert_eq!(s.validate(), Err(SettingsError::CommissioningDuration));
-        }
-        let s = Settings {
-            commissioning_stall_ms: 0,
-            ..Settings::DEFAULT
-        };
-        assert_eq!(s.validate(), Err(SettingsError::CommissioningStall));
-    }
-
-    #[test]
-    fn board_config_is_valid() {
-        let s = Settings::DEFAULT;
-        assert!(board_monitor_config(s.sample_rate_hz).validate().is_ok());
-        assert!(SamplePath::for_board(s.sample_rate_hz).is_ok());
-        assert_eq!(s.status_every(), 100);
-        // The stall time is shorter than the core's gate timeout (see the procedure).
-        let gate_ms = board_monitor_config(s.sample_rate_hz).gate_timeout_s * 1000.0;
-        assert!((s.commissioning_stall_ms as f32) < gate_ms);
-    }
-
-    #[test]
-    fn another_sample_rate_goes_through_the_same_configuration() {
-        let path = SamplePath::for_board(20_000).unwrap();
-        assert_eq!(path.monitor().config().sample_rate_hz, 20_000.0);
-        assert_eq!(path.sampler().ticks_per_sample(), 50);
-        assert!(SamplePath::for_board(7_000).is_err());
-    }
-}
+mod tests;

@@ -17,8 +17,11 @@
 //! So zero volts / zero amperes sit at mid-scale, code 2047.5, and
 //! `x = (code - offset) * PER_LSB`. The constants below derive the factors from these
 //! ranges; change the ranges here (and only here) for another front end. Codes 0 and
-//! 4095 mean the input is at or beyond the rail: the true value is unknown, so such a
-//! sample is flagged `adc_saturated` and the core does not trust it.
+//! 4095 mean the input is at or beyond the rail: the true value is unknown. Such a code,
+//! or any conversion beyond its channel's linear range, makes the sample **clipped**: the
+//! core holds it out and names no sensor (`acquisition::sum_clipped`,
+//! `crate::sampling::RawFrame::clips`); clipping that persists in steady running is the
+//! range state (`crate::clip_watch`).
 //!
 //! # Pin map (NUCLEO-G474RE, Arduino/Morpho headers)
 //!
@@ -40,6 +43,7 @@
 //! | FAULT lamp | PB13 | GPIO out | [`Lamp::Fault`], also blinks the top candidate |
 //! | commissioning button | PC13 | B1 (blue, on board), EXTI13 | pressed = high (pull-down) |
 //! | defmt log | SWD (ST-LINK) | RTT | |
+//! | boot report | PA2 | USART2 TX | the ST-LINK's virtual COM port, 115 200 8N1 |
 //!
 //! The lamp rows repeat the lamp table below (`panel_lamps!`, the one definition of each
 //! lamp's pin, label and meaning, from which [`Lamp`], the firmware's lamp pins and the
@@ -64,10 +68,29 @@ pub const VOLTAGE_FULL_SCALE_V: f32 = 400.0;
 /// Full-scale phase current of the current channels, amperes.
 pub const CURRENT_FULL_SCALE_A: f32 = 10.0;
 
+/// The core's sensor limits on the board (`MonitorConfig::limits`, `v_max` and `i_max`) over
+/// the front end's full scale: 2.5. A reading from a 12-bit code lies at most 4095 codes
+/// from its channel's zero (twice the full scale) times the reference's correction (at most
+/// 1.1, `app::SamplePath::set_reference_gain`): 2.2 times the full scale, so no finite
+/// reading is ever out of the core's range. A reading at or beyond the front end's linear
+/// range is a clip, which the per-conversion check flags and the core holds out without
+/// naming a sensor (`acquisition::sum_clipped`, `crate::clip_watch`); with the limits at the
+/// full scale, a rail code read through a start-up offset trim or the reference's
+/// correction (10.2 A on the 10 A front end) named the current sensor at every
+/// direct-on-line start.
+pub const LIMIT_OVER_FULL_SCALE: f32 = 2.5;
+
 /// Volts at the motor per ADC code: `2 * 400 V / 4095 LSB = 0.195 36 V/LSB`.
 pub const VOLT_PER_LSB: f32 = 2.0 * VOLTAGE_FULL_SCALE_V / ADC_MAX_CODE as f32;
 /// Amperes at the motor per ADC code: `2 * 10 A / 4095 LSB = 4.884 mA/LSB`.
 pub const AMP_PER_LSB: f32 = 2.0 * CURRENT_FULL_SCALE_A / ADC_MAX_CODE as f32;
+
+/// The isolated amplifier's output headroom [ADC codes]: its output stage is linear only
+/// up to about 50 mV from its supply rails (a rail-to-rail output stage's swing; check the
+/// part fitted), 62 codes at 3.3 V / 4095. A conversion within it of the record's full
+/// scale counts as clipped (`motor_source::linear_ranges`): an isolated amplifier clips
+/// before the ADC's rail.
+pub const AMPLIFIER_HEADROOM_CODES: f32 = 62.0;
 
 /// Sample (trigger) rate of the six channels by default, hertz.
 pub const DEFAULT_SAMPLE_RATE_HZ: u32 = 10_000;
@@ -117,6 +140,10 @@ pub const RECORD_PAGE_SIZE: u32 = 2048;
 /// board-record`) from the start of flash, bytes: the 2 KiB page before the commissioning
 /// record, `0x0807_F000`, also kept out of the linker's reach by `memory.x`.
 pub const MOTOR_RECORD_FLASH_OFFSET: u32 = RECORD_FLASH_OFFSET - RECORD_PAGE_SIZE;
+/// Offset of the reset log (`reset_record::log`: the last ends of a run, two pages) from
+/// the start of flash, bytes: the two 2 KiB pages before the motor record's, `0x0807_E000`
+/// and `0x0807_E800`, bank 2 like the records (`memory.x` keeps the code in bank 1).
+pub const RESET_LOG_FLASH_OFFSET: u32 = MOTOR_RECORD_FLASH_OFFSET - 2 * RECORD_PAGE_SIZE;
 
 /// A GPIO port of the STM32G474 (`A` = GPIOA, ...).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -406,6 +433,8 @@ pub mod pins {
         pub flash: Peri<'static, p::FLASH>,
         /// Independent watchdog.
         pub iwdg: Peri<'static, p::IWDG>,
+        /// USART2 and its TX pin PA2: the ST-LINK's virtual COM port (the boot report).
+        pub vcp: (Peri<'static, p::USART2>, Peri<'static, p::PA2>),
     }
 
     impl Board {
@@ -436,6 +465,7 @@ pub mod pins {
                 button_exti: p.EXTI13,
                 flash: p.FLASH,
                 iwdg: p.IWDG,
+                vcp: (p.USART2, p.PA2),
             }
         }
     }
@@ -488,100 +518,4 @@ impl ReferenceCheck {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn mid_scale_is_zero_and_rails_are_full_scale() {
-        let v = ChannelScale::VOLTAGE;
-        assert!(v.apply(2047).abs() < 0.2 && v.apply(2048).abs() < 0.2);
-        assert!((v.apply(0) + 400.0).abs() < 1e-3);
-        assert!((v.apply(4095) - 400.0).abs() < 1e-3);
-        let i = ChannelScale::CURRENT;
-        assert!((i.apply(4095) - 10.0).abs() < 1e-4);
-    }
-
-    #[test]
-    fn code_of_inverts_apply_within_half_lsb() {
-        let v = ChannelScale::VOLTAGE;
-        for k in -39..=39 {
-            let x = k as f32 * 10.0;
-            let back = v.apply(v.code_of(x));
-            assert!(
-                (back - x).abs() <= VOLT_PER_LSB / 2.0 + 1e-3,
-                "{x} -> {back}"
-            );
-        }
-        assert_eq!(v.code_of(1e6), ADC_MAX_CODE);
-        assert_eq!(v.code_of(-1e6), 0);
-        assert!(is_saturated_code(0) && is_saturated_code(4095) && !is_saturated_code(1));
-    }
-
-    #[test]
-    fn the_encoder_filter_keeps_a_quarter_of_the_shortest_edge_interval() {
-        // 1024 lines at 50 rev/s: 204 800 edges/s, 4.88 us apart; a quarter is 1.22 us,
-        // 207.5 clocks at 170 MHz: the longest filter within it is fDTS/32 x 6 = 192.
-        assert_eq!(encoder_input_filter(1024, 50.0, 170_000_000), 14);
-        // Twice the speed: 103.8 clocks -> fDTS/16 x 6 = 96 (11).
-        assert_eq!(encoder_input_filter(1024, 100.0, 170_000_000), 11);
-        // A slow encoder gets the longest filter, an impossible one none.
-        assert_eq!(encoder_input_filter(100, 10.0, 170_000_000), 15);
-        assert_eq!(encoder_input_filter(60_000, 1_000.0, 170_000_000), 0);
-        assert_eq!(encoder_input_filter(0, 50.0, 170_000_000), 0);
-        assert_eq!(encoder_input_filter(1024, f32::NAN, 170_000_000), 0);
-        assert!(INPUT_FILTER_CLOCKS.windows(2).all(|w| w[0] < w[1]));
-    }
-
-    #[test]
-    fn pin_names_parse_and_print_back() {
-        let pb12 = GpioPin {
-            port: Port::B,
-            number: 12,
-        };
-        assert_eq!(GpioPin::parse("PB12"), Some(pb12));
-        assert_eq!(pb12.to_string(), "PB12");
-        for bad in ["", "P", "PA", "PB16", "PB20", "PH1", "XA1", "PA1x", "pa1"] {
-            assert_eq!(GpioPin::parse(bad), None, "{bad}");
-        }
-        for port in ['A', 'B', 'C', 'D', 'E', 'F', 'G'] {
-            for n in 0..16 {
-                let name = format!("P{port}{n}");
-                assert_eq!(GpioPin::parse(&name).unwrap().to_string(), name);
-            }
-        }
-    }
-
-    #[test]
-    fn the_lamp_table_has_one_pin_per_lamp_in_panel_order() {
-        for (k, lamp) in Lamp::ALL.into_iter().enumerate() {
-            assert_eq!(lamp as usize, k);
-            assert!(!lamp.label().is_empty() && lamp.meaning().starts_with(lamp.label()));
-            for other in Lamp::ALL.into_iter().skip(k + 1) {
-                assert_ne!(lamp.pin(), other.pin(), "{lamp:?} and {other:?}");
-            }
-        }
-        assert_eq!(Lamp::ALL.first(), Some(&Lamp::Run));
-        assert_eq!(Lamp::ALL.last(), Some(&Lamp::Fault));
-        assert_eq!(Lamp::ALL.get(1..5), Some(&Lamp::RESIDUALS[..]));
-    }
-
-    #[test]
-    fn vdda_from_vrefint_follows_the_reference_manuals_formula() {
-        // A typical calibration word (1.212 V at 3.0 V: 1655 codes) read at 3.3 V.
-        let cal = 1655;
-        let code = (f32::from(cal) * 3.0 / 3.3).round() as u16;
-        let v = vdda_from_vrefint(code, cal).unwrap_or(0.0);
-        assert!((v - 3.3).abs() < 0.005, "{v}");
-        assert_eq!(ReferenceCheck::of(code, cal), ReferenceCheck::InBand(v));
-        // A sagging 3.0 V supply: out of band, readings distrusted.
-        let low = ReferenceCheck::of(cal, cal);
-        assert_eq!(low, ReferenceCheck::OutOfBand(3.0));
-        assert!(low.distrusts_readings());
-        assert_eq!(ReferenceCheck::of(0, cal), ReferenceCheck::Unreadable);
-        assert_eq!(
-            ReferenceCheck::of(ADC_MAX_CODE, cal),
-            ReferenceCheck::Unreadable
-        );
-        assert_eq!(ReferenceCheck::of(1500, 0), ReferenceCheck::Unreadable);
-    }
-}
+mod tests;

@@ -35,6 +35,9 @@ pub struct BootMachine {
     /// The encoder timer's set-up from [`BootMachine::record`] (counts, direction, filter,
     /// pull-ups: [`motor_source::encoder_setup`]).
     pub encoder: EncoderSetup,
+    /// The six channels' linear ranges for the per-conversion clip check
+    /// ([`motor_source::linear_ranges`]).
+    pub ranges: crate::acquisition::LinearRanges,
     /// `Ok`: the fault isolation judges against this machine; `Err`: the core's isolation
     /// rejects it ([`Isolator::new`]'s check): the lamps still monitor it, nothing is
     /// isolated.
@@ -97,7 +100,8 @@ pub fn machine(
     let machine = BootMachine {
         record,
         source,
-        encoder: motor_source::encoder_setup(&record),
+        encoder: motor_source::encoder_setup(&record, sample_rate_hz),
+        ranges: motor_source::linear_ranges(&record),
         isolation: isolator.map(|_| ()),
     };
     Ok((machine, path, isolator.ok()))
@@ -145,6 +149,9 @@ pub fn boot<S: RecordStore>(
     let baseline_restored = calibration
         .as_ref()
         .is_ok_and(|rec| supervisor.restore_isolation(rec));
+    if let Ok(rec) = &calibration {
+        supervisor.restore_reference(rec);
+    }
     Ok(Booted {
         machine,
         path,

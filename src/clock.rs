@@ -40,6 +40,33 @@ pub enum ClockSource {
     Hse,
     /// The internal 16 MHz oscillator ([`HSI_HZ`]): the crystal did not start.
     Hsi,
+    /// The internal 16 MHz oscillator: the crystal failed while running in the previous
+    /// run (the clock security system's record), so it is not tried again
+    /// ([`boot_source`]).
+    HsiAfterFailure,
+}
+
+/// The clock source at boot: the HSI straight away when the previous run ended in a
+/// clock failure (`crystal_failed`: the clock security system saw the crystal stop; an
+/// intermittent crystal would start again and fail again), else the crystal's bounded
+/// start (`start_crystal`: [`ClockSource::Hse`] or, when it does not start, the HSI).
+pub fn boot_source(
+    crystal_failed: bool,
+    start_crystal: impl FnOnce() -> ClockSource,
+) -> ClockSource {
+    if crystal_failed {
+        ClockSource::HsiAfterFailure
+    } else {
+        start_crystal()
+    }
+}
+
+/// Whether the clock security system is switched on for `source` (`RCC_CR.CSSON`, after
+/// the clock set-up): with the crystal clocking the PLL, so that its failure is seen (an
+/// NMI, the hardware's switch to the HSI) instead of stopping the clock or passing
+/// silently; embassy-stm32 0.6 leaves it off.
+pub const fn css_on(source: ClockSource) -> bool {
+    matches!(source, ClockSource::Hse)
 }
 
 impl ClockSource {
@@ -47,7 +74,7 @@ impl ClockSource {
     pub const fn prediv(self) -> u32 {
         match self {
             ClockSource::Hse => HSE_PREDIV,
-            ClockSource::Hsi => PLL_PREDIV,
+            ClockSource::Hsi | ClockSource::HsiAfterFailure => PLL_PREDIV,
         }
     }
 
@@ -55,7 +82,7 @@ impl ClockSource {
     pub const fn hz(self) -> u32 {
         match self {
             ClockSource::Hse => HSE_HZ,
-            ClockSource::Hsi => HSI_HZ,
+            ClockSource::Hsi | ClockSource::HsiAfterFailure => HSI_HZ,
         }
     }
 
@@ -69,7 +96,7 @@ impl ClockSource {
     pub const fn error_ppm(self) -> u32 {
         match self {
             ClockSource::Hse => HSE_ERROR_PPM,
-            ClockSource::Hsi => HSI_ERROR_PPM,
+            ClockSource::Hsi | ClockSource::HsiAfterFailure => HSI_ERROR_PPM,
         }
     }
 
@@ -78,6 +105,9 @@ impl ClockSource {
         match self {
             ClockSource::Hse => "24 MHz crystal (HSE)",
             ClockSource::Hsi => "internal oscillator (HSI, +-1 %): the crystal did not start",
+            ClockSource::HsiAfterFailure => {
+                "internal oscillator (HSI, +-1 %): the crystal failed in the previous run (clock security system)"
+            }
         }
     }
 }
@@ -190,5 +220,6 @@ mod tests {
         assert_eq!(timer_divider(80_000), Some(2_125));
         assert_eq!(timer_divider(30_000), None);
         assert_eq!(timer_divider(0), None);
+        assert_eq!(ClockSource::HsiAfterFailure.sysclk_hz(), 170_000_000);
     }
 }

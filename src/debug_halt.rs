@@ -32,3 +32,43 @@ pub const FROZEN: Freeze = Freeze {
     time_base: true,
     watchdog: true,
 };
+
+/// `DBGMCU_APB2FZR.DBG_TIM1_STOP` (RM0440, "Debug MCU APB2 freeze register"): bit 11.
+pub const DBG_TIM1_STOP: u32 = 1 << 11;
+/// `DBGMCU_APB2FZR.DBG_TIM15_STOP`: bit 16.
+pub const DBG_TIM15_STOP: u32 = 1 << 16;
+/// `DBGMCU_APB1FZR1.DBG_IWDG_STOP` (RM0440, "Debug MCU APB1 freeze register 1"): bit 12.
+pub const DBG_IWDG_STOP: u32 = 1 << 12;
+
+/// The values of `DBGMCU_APB1FZR1` and `DBGMCU_APB2FZR` after the boot's write.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FreezeRegisters {
+    /// `DBGMCU_APB1FZR1`.
+    pub apb1fzr1: u32,
+    /// `DBGMCU_APB2FZR`.
+    pub apb2fzr: u32,
+}
+
+impl Freeze {
+    /// The freeze registers' values the firmware writes at boot for this freeze, from the
+    /// values it read (`read`): each of the three stop bits set or cleared as the freeze
+    /// says, every other bit as read. `src/firmware.rs` writes exactly these values (whole
+    /// registers), so what a halt stops is what this computes.
+    pub const fn registers_after(self, read: FreezeRegisters) -> FreezeRegisters {
+        const fn bit(value: u32, mask: u32, on: bool) -> u32 {
+            if on {
+                value | mask
+            } else {
+                value & !mask
+            }
+        }
+        FreezeRegisters {
+            apb1fzr1: bit(read.apb1fzr1, DBG_IWDG_STOP, self.watchdog),
+            apb2fzr: bit(
+                bit(read.apb2fzr, DBG_TIM1_STOP, self.trigger),
+                DBG_TIM15_STOP,
+                self.time_base,
+            ),
+        }
+    }
+}

@@ -32,12 +32,15 @@
 //! status, sample task -> thread, 100 Hz), `TRIM` (Signal, the start-up offset trim, once).
 
 mod acquisition;
+mod commands;
 mod failure;
 mod flash;
 mod logs;
 mod reset_ram;
 mod sample_task;
+mod stack;
 mod supply;
+mod vcp;
 
 use core::sync::atomic::{AtomicU32, Ordering};
 
@@ -54,11 +57,11 @@ use embassy_stm32::{bind_interrupts, dma, interrupt, pac, peripherals, Peri};
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
-use embassy_time::{with_deadline, with_timeout, Duration, Instant, Timer};
+use embassy_time::{with_deadline, Duration, Instant, Timer};
 
 use drive_monitor::app::{
-    carry_out, status_line, Command, MonitorStatus, SamplePath, Settings, Supervisor, Tick,
-    PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
+    carry_out, status_line, BoardCounters, Command, MonitorStatus, SamplePath, Settings,
+    Supervisor, Tick, PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
 };
 use drive_monitor::board::{self, pins::Board, Lamp, LAMP_COUNT};
 use drive_monitor::boot::{self, BootMachine};
@@ -142,6 +145,17 @@ static STATUS: Signal<CriticalSectionRawMutex, Status> = Signal::new();
 static TRIM: Signal<CriticalSectionRawMutex, TrimResult> = Signal::new();
 /// The start-up check of the ADC's reference, from the sample task to thread mode.
 static REFERENCE: Signal<CriticalSectionRawMutex, board::ReferenceCheck> = Signal::new();
+/// The sample task paused the acquisition for a flash erase (`true`: stopped), to thread
+/// mode (`app::AcquisitionPause`).
+static PAUSED: Signal<CriticalSectionRawMutex, bool> = Signal::new();
+/// Thread mode has finished with the flash: the sample task resumes the acquisition.
+static RESUME: Signal<CriticalSectionRawMutex, ()> = Signal::new();
+/// The longest the sample task stays paused for the flash [ms] (an erase takes about
+/// 22 ms, the record's write about 1 ms); it resumes then whatever thread mode says.
+const PAUSE_LIMIT_MS: u32 = 100;
+/// The longest thread mode waits for the sample task to pause [ms] (it pauses between two
+/// halves, 300 us apart).
+const PAUSE_WAIT_MS: u64 = 10;
 static OVERRUNS: AtomicU32 = AtomicU32::new(0);
 static RESTARTS: AtomicU32 = AtomicU32::new(0);
 static EXECUTOR_HIGH: InterruptExecutor = InterruptExecutor::new();
@@ -206,7 +220,7 @@ fn clock_config(source: ClockSource) -> embassy_stm32::Config {
             });
             PllSource::HSE
         }
-        ClockSource::Hsi => PllSource::HSI,
+        ClockSource::Hsi | ClockSource::HsiAfterFailure => PllSource::HSI,
     };
     config.rcc.pll = Some(Pll {
         source: pll_source,
@@ -230,14 +244,17 @@ fn clock_config(source: ClockSource) -> embassy_stm32::Config {
 /// the boot's budget at the fastest LSI). On the registers, before embassy-stm32's `init`
 /// (`firmware/under_the_hal.rs` lists why); `start_watchdog` shortens it once the boot ran.
 fn start_boot_watchdog() {
-    let frozen = debug_halt::FROZEN;
-    pac::DBGMCU.apb2fzr().modify(|w| {
-        w.set_tim1(frozen.trigger);
-        w.set_tim15(frozen.time_base);
+    // The whole registers as `debug_halt` computes them from what they hold (the host
+    // tests run the halt model on these values, not on the constant).
+    let dbg = pac::DBGMCU;
+    let after = debug_halt::FROZEN.registers_after(debug_halt::FreezeRegisters {
+        apb1fzr1: dbg.apb1lfzr().read().0,
+        apb2fzr: dbg.apb2fzr().read().0,
     });
-    pac::DBGMCU
-        .apb1lfzr()
-        .modify(|w| w.set_iwdg(frozen.watchdog));
+    dbg.apb1lfzr()
+        .write_value(pac::dbgmcu::regs::Apb1lfzr(after.apb1fzr1));
+    dbg.apb2fzr()
+        .write_value(pac::dbgmcu::regs::Apb2fzr(after.apb2fzr));
     let setting = watchdog::BOOT_SETTING;
     let iwdg = pac::IWDG;
     // Start (the LSI with it), unlock PR/RLR, the boot's timeout, reload.
@@ -293,11 +310,21 @@ fn boot_board(
 #[embassy_executor::main]
 async fn main(_spawner: Spawner) {
     start_boot_watchdog();
-    let source = start_crystal();
+    // Before the clock set-up: the previous run's end (a clock failure's record keeps the
+    // crystal out of this run) and the stack (its guard words, then painted).
+    let (previous, reset_source) = logs::read_previous_run();
+    let stack_overflowed = stack::check_and_paint();
+    let source = clock::boot_source(previous.clock_failed(), start_crystal);
     let p = embassy_stm32::init(clock_config(source));
+    if clock::css_on(source) {
+        // The clock security system: a crystal that stops raises an NMI (`failure.rs`)
+        // and the hardware switches to the HSI; embassy-stm32 leaves it off.
+        pac::RCC.cr().modify(|w| w.set_csson(true));
+    }
     info!("drive-monitor {} starting", env!("CARGO_PKG_VERSION"));
     logs::log_clock(source);
-    let previous = logs::previous_run();
+    logs::log_previous_run(previous, reset_source);
+    logs::log_stack(stack_overflowed);
     // The brown-out level of the option bytes: reported, not written (`drive_monitor::supply`).
     let bor = supply::bor_check();
     logs::log_bor(bor);
@@ -306,23 +333,20 @@ async fn main(_spawner: Spawner) {
     let b = Board::take(p);
     let wdg = start_watchdog(b.iwdg);
     let dual_bank = dual_bank_flash();
-    let mut thread = Thread {
-        lamps: PanelPins::new(b.lamps),
-        flash: BorGate {
-            store: BoardFlash(CheckedFlash::new(Driver(
-                dual_bank.then(|| Flash::new_blocking(b.flash)),
-            ))),
-            bor,
-        },
-        wdg,
-        max_update_cycles: 0,
-        log_div: 0,
+    let flash = dual_bank.then(|| Flash::new_blocking(b.flash));
+    let mut thread = Thread::new(PanelPins::new(b.lamps), flash, wdg, bor);
+    vcp::report_boot(
+        &mut thread.flash.store,
         bor,
-    };
+        b.vcp,
+        (previous, reset_source),
+        source,
+    );
     let mut button = ExtiInput::new(b.button, b.button_exti, Pull::Down, Irqs);
 
     let (machine, path, mut supervisor) = boot_board(&mut thread.flash.store, previous);
-    supervisor.set_clock_fallback(source == ClockSource::Hsi);
+    supervisor.set_clock_fallback(source != ClockSource::Hse);
+    supervisor.set_bor_below_goal(!bor.allows_flash_writes());
     let boot = Instant::now();
     let hw = SampleHw {
         adc1: b.adc1,
@@ -339,6 +363,7 @@ async fn main(_spawner: Spawner) {
         encoder: machine.encoder,
         syst: cp.SYST,
         supply_hz: machine.record.supply.f_hz as f32,
+        ranges: machine.ranges,
     };
     spawn_sample_task(hw, path);
     thread.run(&mut supervisor, &mut button, boot).await
@@ -401,6 +426,28 @@ struct Thread {
 }
 
 impl Thread {
+    /// Thread mode's hardware: the `lamps`, the record pages in `flash` (`None`:
+    /// single-bank option bytes), the watchdog `wdg` and the brown-out level `bor` found at
+    /// boot (records refused below the goal).
+    fn new(
+        lamps: PanelPins,
+        flash: Option<Flash<'static, embassy_stm32::flash::Blocking>>,
+        wdg: IndependentWatchdog<'static, peripherals::IWDG>,
+        bor: BorCheck,
+    ) -> Self {
+        Self {
+            lamps,
+            flash: BorGate {
+                store: BoardFlash(CheckedFlash::new(Driver(flash))),
+                bor,
+            },
+            wdg,
+            max_update_cycles: 0,
+            log_div: 0,
+            bor,
+        }
+    }
+
     /// Thread mode's periods, every [`PANEL_PERIOD_MS`] from boot (`boot`, the clock's
     /// zero): the period's wait is the wait for the `button`, so a press at any time is
     /// seen.
@@ -448,7 +495,14 @@ impl Thread {
         if let Some(end) = tick.run_ended {
             logs::log_run_end(end);
         }
+        if let Some(change) = tick.clip_range {
+            logs::log_clip_range(change);
+        }
         self.carry_out(tick.action).await;
+        if let Some(gain) = tick.reference_gain {
+            logs::log_reference_gain(gain);
+            commands::send(Command::ReferenceGain(gain)).await;
+        }
         self.lamps.show(&tick.lamps);
         self.log_div += 1;
         if self.log_div >= 2 {
@@ -462,19 +516,12 @@ impl Thread {
     /// [`COMMAND_SEND_TIMEOUT_MS`] for a slot in the queue (else the command is dropped and
     /// logged).
     async fn carry_out(&mut self, action: Action) {
-        let (command, stored) = carry_out(action, &mut self.flash);
+        let (command, stored) = carry_out(action, &mut self.flash, &mut commands::SampleTaskPause);
         if let Some(stored) = stored {
             logs::log_stored(&stored);
         }
         if let Some(cmd) = command {
-            let sent = with_timeout(
-                Duration::from_millis(COMMAND_SEND_TIMEOUT_MS),
-                COMMANDS.send(cmd),
-            )
-            .await;
-            if sent.is_err() {
-                error!("command queue full: {=str} dropped", cmd.name());
-            }
+            commands::send(cmd).await;
         }
     }
 
@@ -527,9 +574,10 @@ fn log_status(
     max_update_cycles: u32,
     supply: (f32, u8),
 ) {
-    let restarts = (
-        OVERRUNS.load(Ordering::Relaxed),
-        RESTARTS.load(Ordering::Relaxed),
-    );
-    status_line(s, iso, rise_k, panel, max_update_cycles, restarts, supply).log_info();
+    let board = BoardCounters {
+        overruns: OVERRUNS.load(Ordering::Relaxed),
+        restarts: RESTARTS.load(Ordering::Relaxed),
+        stack_used_bytes: stack::high_water_bytes(),
+    };
+    status_line(s, iso, rise_k, panel, max_update_cycles, board, supply).log_info();
 }

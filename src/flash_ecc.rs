@@ -10,8 +10,9 @@
 //! The firmware's NMI handler asks [`nmi_action`]: a double error in one of the record
 //! pages (the motor record, the commissioning record) is latched ([`EccLatch`]),
 //! `ECCD` is cleared and the handler returns, so the read completes (with wrong data);
-//! any other NMI (a double error in the code, the clock security system) goes to the
-//! fault path. Every read of a record page goes through [`CheckedFlash`]: it clears the
+//! a clock failure seen by the clock security system (`RCC_CIFR.CSSF`) is recorded and
+//! resets onto the internal oscillator ([`nmi_cause`]); any other NMI (a double error in
+//! the code) goes to the fault path. Every read of a record page goes through [`CheckedFlash`]: it clears the
 //! latch before the read and looks at it after; a double error makes the read fail
 //! ([`ReadError::Ecc`]) and **marks the page bad** for the rest of the run, so it is not
 //! read again; an erase (the next commissioning's store) clears the mark. The boot then
@@ -20,7 +21,7 @@
 
 use core::sync::atomic::{AtomicU32, Ordering};
 
-use crate::board::{MOTOR_RECORD_FLASH_OFFSET, RECORD_FLASH_OFFSET, RECORD_PAGE_SIZE};
+use crate::board::{RECORD_FLASH_OFFSET, RECORD_PAGE_SIZE, RESET_LOG_FLASH_OFFSET};
 
 /// `FLASH_ECCR.ECCD`: an ECC double error (write 1 to clear).
 pub const ECCR_ECCD: u32 = 1 << 31;
@@ -33,8 +34,9 @@ pub const ECCR_ADDR_MASK: u32 = 0x0007_FFFF;
 /// A bank's size in dual-bank mode (512 KiB device): bank 2 starts at this offset.
 pub const BANK_SIZE: u32 = 256 * 1024;
 
-/// The first flash offset of the record pages (the motor record's page).
-pub const RECORD_PAGES_START: u32 = MOTOR_RECORD_FLASH_OFFSET;
+/// The first flash offset of the record pages (the reset log's first page, below the motor
+/// record's).
+pub const RECORD_PAGES_START: u32 = RESET_LOG_FLASH_OFFSET;
 /// One past the last flash offset of the record pages.
 pub const RECORD_PAGES_END: u32 = RECORD_FLASH_OFFSET + RECORD_PAGE_SIZE;
 
@@ -69,6 +71,25 @@ pub enum NmiAction {
     RecordPageEcc(EccError),
     /// Anything else: the fault path (record, reset).
     Fault,
+    /// The clock security system saw the crystal fail (`RCC_CIFR.CSSF`): the hardware has
+    /// switched SYSCLK to the 16 MHz HSI and stopped the PLL. Clear `CSSF`, record a clock
+    /// failure (`reset_record::ResetCause::ClockFailure`) and reset: the next boot runs
+    /// the PLL from the HSI at 170 MHz and the RUN lamp marks it (`clock::boot_source`).
+    ClockFailure,
+}
+
+/// `RCC_CIFR.CSSF`: the clock security system's flag (RM0440, "Clock interrupt flag
+/// register", bit 8).
+pub const CIFR_CSSF: u32 = 1 << 8;
+
+/// The NMI handler's decision on `RCC_CIFR` (`cifr`) and `FLASH_ECCR` (`eccr`): a clock
+/// failure first (the NMI's other source), else [`nmi_action`].
+pub fn nmi_cause(cifr: u32, eccr: u32) -> NmiAction {
+    if cifr & CIFR_CSSF != 0 {
+        NmiAction::ClockFailure
+    } else {
+        nmi_action(eccr)
+    }
 }
 
 /// The NMI handler's decision on `FLASH_ECCR`'s value `eccr` (module docs).

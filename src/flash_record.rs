@@ -14,27 +14,33 @@
 //! Since version 3 it also stores the operating point that baseline was learned at
 //! ([`Baseline::at`]), so that away from it the isolation allows for the nameplate's error.
 //!
-//! # RecordLayout (little endian, [`RECORD_LEN`] = 96 bytes, a multiple of the G4's 8-byte
-//! flash write unit)
+//! Since version 4 it also stores VDDA, the ADC's reference, measured while the run learned,
+//! so that later readings are corrected by the reference's drift since (`supply`).
+//!
+//! # RecordLayout (little endian, [`RECORD_LEN`] = 104 bytes, a multiple of the G4's
+//! 8-byte flash write unit)
 //!
 //! | bytes | field |
 //! |---|---|
 //! | 0..4 | magic `b"DMCR"` |
 //! | 4..6 | format version, `u16` ([`RECORD_VERSION`]) |
-//! | 6..8 | payload length in bytes, `u16` (= 84) |
+//! | 6..8 | payload length in bytes, `u16` (= 92) |
 //! | 8..24 | `mean[0..4]`, `f32` each |
 //! | 24..40 | `spread[0..4]`, `f32` each |
 //! | 40..52 | isolation baseline `mean[0..3]`, `f32` each (zero when absent) |
 //! | 52..64 | isolation baseline `spread[0..3]`, `f32` each (zero when absent) |
 //! | 64..88 | the learned point: `i_d, i_q` [A], `v_d, v_q` [V], `we, wr` [rad/s], `f32` each (zero when absent) |
-//! | 88..92 | flags, `u32`: bit 0 set when the isolation baseline is present |
-//! | 92..96 | CRC-32/ISO-HDLC of bytes 0..92 ([`monitor_core::record::crc32`]) |
+//! | 88..92 | flags, `u32`: bit 0 set when the isolation baseline is present, bit 1 when VDDA is |
+//! | 92..96 | VDDA at commissioning [V], `f32` (zero when absent) |
+//! | 96..100 | reserved, zero |
+//! | 100..104 | CRC-32/ISO-HDLC of bytes 0..100 ([`monitor_core::record::crc32`]) |
 //!
 //! Header, CRC, reader and writer are the project's one record format
 //! ([`monitor_core::record`], [`FORMAT`]; the length field holds the payload's bytes).
 //!
-//! Version 2 records (72 bytes: as above without the learned point, flags at 64..68, the
-//! CRC at 68..72) are still read, with a baseline that has no learned point; version 1
+//! Version 3 records (96 bytes: as above up to the flags, the CRC at 92..96) are still
+//! read, without VDDA; version 2 records (72 bytes: without the learned point, flags at
+//! 64..68, the CRC at 68..72) too, with a baseline that has no learned point; version 1
 //! records (48 bytes: the lamps' statistics at 8..40, 4 reserved bytes, the CRC at
 //! 44..48) without an isolation baseline.
 //!
@@ -47,14 +53,16 @@ use monitor_core::record::{RecordFormat, RecordLayout, RecordReader, CRC_LEN, HE
 /// Current record format version. Bump it whenever the layout or the meaning of the
 /// stored numbers changes (for example a new normalization in the core): old records
 /// are then rejected instead of misread.
-pub const RECORD_VERSION: u16 = 3;
+pub const RECORD_VERSION: u16 = 4;
 /// Encoded record length in bytes.
-pub const RECORD_LEN: usize = 96;
+pub const RECORD_LEN: usize = 104;
 /// Flag bit: the isolation baseline is present.
 const FLAG_ISOLATION: u32 = 1;
+/// Flag bit: the ADC reference's VDDA at commissioning is present.
+const FLAG_VDDA: u32 = 2;
 
 /// The commissioning record's format: magic `DMCR`, version [`RECORD_VERSION`] of
-/// [`RECORD_LEN`] bytes; versions 2 (72 bytes) and 1 (48 bytes) still read.
+/// [`RECORD_LEN`] bytes; versions 3 (96 bytes), 2 (72 bytes) and 1 (48 bytes) still read.
 pub const FORMAT: RecordFormat = RecordFormat {
     magic: *b"DMCR",
     current: RecordLayout {
@@ -63,6 +71,11 @@ pub const FORMAT: RecordFormat = RecordFormat {
         length: (RECORD_LEN - HEADER_LEN - CRC_LEN) as u16,
     },
     older: &[
+        RecordLayout {
+            version: 3,
+            stored_len: 96,
+            length: 84,
+        },
         RecordLayout {
             version: 2,
             stored_len: 72,
@@ -91,6 +104,11 @@ pub struct CalibrationRecord {
     /// The fault isolation's baseline learned in the same run (`None`: not learned, or a
     /// version 1 record); its spreads > 0.
     pub isolation: Option<Baseline>,
+    /// VDDA, the ADC's reference, when the run learned [V] (`None`: not measured, or a
+    /// record before version 4): every later reading is corrected by VDDA now over it
+    /// (`supply::ReferenceGain`); finite and > 0 (a run stores only a measurement in the
+    /// reference's band, 3.2..3.4 V).
+    pub vdda_v: Option<f32>,
 }
 
 fn values_ok(rec: &CalibrationRecord) -> bool {
@@ -104,6 +122,7 @@ fn values_ok(rec: &CalibrationRecord) -> bool {
                     .all(|s| s.is_finite() && *s > 0.0)
                 && point_fields(&b.at).iter().all(|x| x.is_finite())
         })
+        && rec.vdda_v.is_none_or(|v| v.is_finite() && v > 0.0)
 }
 
 impl From<monitor_core::Calibration> for CalibrationRecord {
@@ -112,6 +131,7 @@ impl From<monitor_core::Calibration> for CalibrationRecord {
             mean: c.mean,
             spread: c.spread,
             isolation: None,
+            vdda_v: None,
         }
     }
 }
@@ -146,11 +166,12 @@ impl CalibrationRecord {
         w.f32s(&iso.mean.to_array());
         w.f32s(&iso.spread.to_array());
         w.f32s(&point_fields(&iso.at));
-        w.u32(if self.isolation.is_some() {
-            FLAG_ISOLATION
-        } else {
-            0
-        });
+        let flag = |present: bool, bit: u32| if present { bit } else { 0 };
+        w.u32(
+            flag(self.isolation.is_some(), FLAG_ISOLATION) | flag(self.vdda_v.is_some(), FLAG_VDDA),
+        );
+        w.f32(self.vdda_v.unwrap_or(0.0));
+        w.u32(0);
         Ok(w.finish())
     }
 
@@ -181,6 +202,7 @@ impl CalibrationRecord {
                 mean,
                 spread,
                 isolation: None,
+                vdda_v: None,
             });
         }
         let mut b = Baseline {
@@ -198,10 +220,17 @@ impl CalibrationRecord {
             };
         }
         let flags = r.u32()?;
+        let mut vdda_v = None;
+        if version >= 4 {
+            let v = r.f32()?;
+            r.take::<4>()?;
+            vdda_v = (flags & FLAG_VDDA != 0).then_some(v);
+        }
         Ok(Self {
             mean,
             spread,
             isolation: (flags & FLAG_ISOLATION != 0).then_some(b),
+            vdda_v,
         })
     }
 }
@@ -308,6 +337,7 @@ mod tests {
                     wr_rad_s: 303.5,
                 },
             }),
+            vdda_v: None,
         }
     }
 
@@ -383,12 +413,40 @@ mod tests {
     const WRITTEN_BEFORE: &str = "444d4352030054000ad7233c0ad7a3bca69b443b00000000cdcc4c3d0ad7233d8fc2753d295c8f3d17b7d13817b751b9a69b443b17b7d13917b7d1396f12833a0000604000008840000000c00080a24300009d4300c0974301000000084965b8";
 
     #[test]
-    fn a_record_written_by_the_former_code_reads_and_is_rewritten_byte_for_byte() {
+    fn a_record_written_by_the_former_code_reads_and_is_rewritten_with_the_same_payload() {
         let old: Vec<u8> = (0..WRITTEN_BEFORE.len() / 2)
             .map(|k| u8::from_str_radix(&WRITTEN_BEFORE[2 * k..2 * k + 2], 16).unwrap())
             .collect();
+        // A version 3 record (96 bytes): read, without VDDA.
+        assert_eq!(old.len(), 96);
         assert_eq!(CalibrationRecord::decode(&old), Ok(sample()));
-        assert_eq!(sample().encode().unwrap().as_slice(), old.as_slice());
+        // Written again as version 4: the same header magic, the same bytes up to the
+        // flags, then VDDA (absent: zero) and the reserved word before the CRC.
+        let new = sample().encode().unwrap();
+        assert_eq!(new[..4], old[..4]);
+        assert_eq!(new[4..8], [4, 0, 92, 0]);
+        assert_eq!(new[8..92], old[8..92]);
+        assert_eq!(new[92..100], [0; 8]);
+    }
+
+    /// VDDA at commissioning round trips; one that is not finite and positive is refused.
+    #[test]
+    fn the_commissioned_vdda_round_trips_and_a_bad_one_is_refused() {
+        let r = CalibrationRecord {
+            vdda_v: Some(3.287),
+            ..sample()
+        };
+        let bytes = r.encode().unwrap();
+        assert_eq!(bytes[92..96], 3.287f32.to_le_bytes());
+        assert_eq!(bytes[88] & 2, 2, "the VDDA flag");
+        assert_eq!(CalibrationRecord::decode(&bytes), Ok(r));
+        for bad in [0.0, -3.3, f32::NAN, f32::INFINITY] {
+            let out = CalibrationRecord {
+                vdda_v: Some(bad),
+                ..sample()
+            };
+            assert_eq!(out.encode(), Err(RecordError::Invalid), "{bad}");
+        }
     }
 
     #[test]

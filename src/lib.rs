@@ -34,9 +34,12 @@
 //!   RAM across the reset;
 //! - [`setup_guard`]: the deadline on the ADCs' set-up (a step that does not finish is
 //!   recorded and ends in a reset);
+//! - [`stack`]: the painted stack's high-water mark and an overflow seen at the next boot;
 //! - [`supply`]: the brown-out level in the option bytes and the periodic check of the
 //!   ADC's reference (VDDA through VREFINT);
 //! - [`offset_trim`]: each channel's zero measured at start-up with the motor off, bounded;
+//! - [`clip_watch`]: whether clipping persists in steady running (the front end's range
+//!   too small for the motor: the range state), in thread mode;
 //! - [`panel`]: lamp patterns and blink codes;
 //! - [`app`]: the glue: settings, the per-sample path, the status it hands thread mode,
 //!   and thread mode's supervisor.
@@ -68,6 +71,7 @@ pub mod adc_rules;
 pub mod app;
 pub mod board;
 pub mod boot;
+pub mod clip_watch;
 pub mod clock;
 pub mod commissioning;
 pub mod debug_halt;
@@ -83,6 +87,7 @@ pub mod recovery;
 pub mod reset_record;
 pub mod sampling;
 pub mod setup_guard;
+pub mod stack;
 pub mod supply;
 pub mod under_the_hal;
 pub mod watchdog;

@@ -4,6 +4,7 @@
 //! board's front end). Host-testable: the firmware reads the page at
 //! [`board::MOTOR_RECORD_FLASH_OFFSET`] and hands the bytes to [`select`].
 
+use crate::acquisition::{self, LinearRange, LinearRanges};
 use crate::app::{AppError, SamplePath, DEFAULT_MACHINE};
 use crate::board::{self, ChannelScale, FrontEnd};
 use crate::sampling::TICK_HZ;
@@ -81,7 +82,8 @@ pub fn select(page: &[u8]) -> (MotorRecord, MachineSource) {
 
 /// The core configuration for `rec` at `sample_rate_hz`: its machine on its supply, 1 MHz
 /// timestamps, a 16-bit x4 encoder counter with `4 x encoder_lines` counts per revolution,
-/// and sensor limits equal to the full scales. For [`default_record`] this is
+/// and sensor limits beyond any reading of the front end ([`board::LIMIT_OVER_FULL_SCALE`]
+/// times the full scales: a reading at its edge is a clip). For [`default_record`] this is
 /// [`crate::app::board_monitor_config`] (a test checks it).
 pub fn monitor_config(rec: &MotorRecord, sample_rate_hz: u32) -> MonitorConfig {
     let mut cfg = MonitorConfig::new(
@@ -93,8 +95,8 @@ pub fn monitor_config(rec: &MotorRecord, sample_rate_hz: u32) -> MonitorConfig {
     cfg.tick_hz = TICK_HZ as f32;
     cfg.encoder.counter_bits = 16;
     cfg.encoder.counts_per_rev = 4 * u32::from(rec.encoder_lines);
-    cfg.limits.v_max = rec.voltage_full_scale_v;
-    cfg.limits.i_max = rec.current_full_scale_a;
+    cfg.limits.v_max = board::LIMIT_OVER_FULL_SCALE * rec.voltage_full_scale_v;
+    cfg.limits.i_max = board::LIMIT_OVER_FULL_SCALE * rec.current_full_scale_a;
     cfg
 }
 
@@ -148,14 +150,26 @@ pub struct EncoderSetup {
     /// an unplugged encoder reads a steady high instead of noise; off for a board with
     /// pull-ups (or a line receiver) of its own.
     pub pull_up: bool,
+    /// The largest step of the count between two latched counts (two triggers) that the
+    /// maximum speed allows [counts]: twice the synchronous speed, the input filter's
+    /// speed too ([`acquisition::max_step_per_trigger`]); a larger step is a glitch,
+    /// rejected by [`acquisition::EncoderCheck`].
+    pub max_step_per_trigger: u16,
 }
 
-/// The encoder setup for `rec` ([`EncoderSetup`]).
-pub fn encoder_setup(rec: &MotorRecord) -> EncoderSetup {
+/// The encoder setup for `rec` at `sample_rate_hz` (the latch's triggers at
+/// [`acquisition::trigger_rate_hz`] of it) ([`EncoderSetup`]).
+pub fn encoder_setup(rec: &MotorRecord, sample_rate_hz: u32) -> EncoderSetup {
     let pole_pairs = (rec.motor.poles / 2).max(1) as f32;
     let max_rev_per_s = 2.0 * rec.supply.f_hz as f32 / pole_pairs;
+    let counts_per_rev = 4 * u32::from(rec.encoder_lines);
     EncoderSetup {
-        counts_per_rev: 4 * u32::from(rec.encoder_lines),
+        max_step_per_trigger: acquisition::max_step_per_trigger(
+            counts_per_rev,
+            max_rev_per_s,
+            acquisition::trigger_rate_hz(sample_rate_hz),
+        ),
+        counts_per_rev,
         invert_a: rec.encoder_reversed,
         input_filter: board::encoder_input_filter(
             rec.encoder_lines,
@@ -177,4 +191,32 @@ pub fn isolator(rec: &MotorRecord) -> Result<Isolator, ConfigError> {
         rec.supply.v_phase_peak() as f32,
         rec.supply.f_hz as f32,
     )
+}
+
+/// The front end's linear limit for `rec`, per channel: the record's full scale on either
+/// side of the channel's zero (`offset +- full_scale / per_lsb` = `offset +- 2047.5` codes,
+/// [`front_end`]), narrowed by the isolated amplifier's output headroom
+/// ([`board::AMPLIFIER_HEADROOM_CODES`]: its output stage is linear only that far from its
+/// supply), within the ADC's rails. The clip levels are the amplifier's, fixed in volts: a
+/// start-up offset trim does not move them. For the built-in default (zero at mid-scale):
+/// 62..=4033, a conversion at or below 62 or at or above 4033 clipped.
+pub fn linear_ranges(rec: &MotorRecord) -> LinearRanges {
+    let half_span = f32::from(board::ADC_MAX_CODE) / 2.0;
+    let headroom = board::AMPLIFIER_HEADROOM_CODES;
+    let top = f32::from(board::ADC_MAX_CODE);
+    let range = |offset: f32| {
+        let low = (offset - half_span).max(0.0) + headroom;
+        let high = (offset + half_span).min(top) - headroom;
+        LinearRange {
+            // Rounded to the nearest code (no `f32::round` on the board: + 0.5, truncated;
+            // `max`/`min`, not `f32::clamp`, whose assertion formats floats: 10 KiB of
+            // flash).
+            low: (low.max(0.0).min(top) + 0.5) as u16,
+            high: (high.max(0.0).min(top) + 0.5) as u16,
+        }
+    };
+    LinearRanges {
+        voltage: rec.voltage_offset_counts.map(range),
+        current: rec.current_offset_counts.map(range),
+    }
 }

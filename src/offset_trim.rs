@@ -170,6 +170,8 @@ mod tests {
             v: v.map(VoltageCode),
             i: i.map(CurrentCode),
             encoder_count: 0,
+            clipped: crate::sampling::Clipped::NONE,
+            encoder_rejects: 0,
         }
     }
 

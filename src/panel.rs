@@ -23,8 +23,15 @@
 //! shows its pattern as above for 7.5 s. **Clock on the internal oscillator**: when the
 //! board's 24 MHz crystal did not start and the clock fell back to the HSI (+-1 %), the RUN
 //! lamp is lit steadily from 5 s to 7 s of every 10 s, then dark for 0.5 s (both marks
-//! show together when both apply). No other state lights the RUN lamp for more than
-//! 500 ms at a time.
+//! show together when both apply). **Brown-out level below the goal**: while the option
+//! bytes' brown-out reset level is below level 4 (the factory's level 0, bring-up step
+//! `cargo fw bor` not done), the flash records are refused and every commissioning ends
+//! "not stored" (the FAULT lamp's flicker): the RUN lamp is dark from 2 s, lit steadily
+//! from 2.5 s to 4.5 s of every 10 s, then dark for 0.5 s, so the panel says why. **Front end's
+//! range too small** (the range state: clipping persists in steady running,
+//! `crate::clip_watch`; the verdict could not judge, the FAULT lamp dark, no sensor named):
+//! the RUN lamp is dark from 7 s, lit steadily from 7.5 s to 9.5 s of every 10 s, then dark
+//! for 0.5 s. No other state lights the RUN lamp for more than 500 ms at a time.
 //!
 //! The RUN lamp is never off for more than 1.7 s while the monitor runs, so "RUN off and
 //! everything else on" cannot be mistaken for a normal state; and only a stalled sample
@@ -47,7 +54,7 @@
 //! | pattern | meaning |
 //! |---|---|
 //! | off | no FAULT: nothing detected, the "operating point moved" state (above), or a detection the one verdict does not call a FAULT (`app::panel_call`, the core's decision table `monitor_core::verdict`: a name below 0.5 probability, under 5 % or the friction class is watched; lamps with nothing named are watched; not commissioned, lamps with no name beyond the file's +-30 % are not judged); the residual lamps still show the core's lamps, the status line's `call=` says which |
-//! | steady on | input invalid: ADC saturated or a sensor fault flagged by the core, no isolation |
+//! | steady on | input invalid: a sensor fault flagged by the core (impossible readings), an offset out of bound or the reference out of band, no isolation; a clipped reading is none of these (held out and counted, `crate::clip_watch`) |
 //! | N blinks (250 ms on / 250 ms off), then 1.5 s dark, repeating | fault detected, blink code N (table below) |
 //! | 10 Hz flicker | the last commissioning failed (no progress, unusable statistics or not stored) and no fault is shown; the RUN lamp says which thresholds are in force; press the button to retry |
 //!
@@ -165,7 +172,8 @@ pub struct PanelInput {
     pub residual_lamps: [bool; 4],
     /// The core detected a fault.
     pub fault_detected: bool,
-    /// Input invalid (ADC saturated / sensor fault flag).
+    /// Input invalid: a sensor fault flagged (the core's impossible readings, an offset out
+    /// of bound, the reference out of band); a clip is not one.
     pub input_invalid: bool,
     /// Blink code of the fault shown: 1..=9 ([`blink_code`] of the isolated fault; 5 for
     /// the friction class), [`NOT_NAMED_CODE`] (10), or 11..=13 for shorted turns
@@ -179,10 +187,19 @@ pub struct PanelInput {
     /// The crystal (HSE) did not start and the clock runs on the internal oscillator
     /// (HSI, +-1 %): the RUN lamp's steady 2 s from 5 s of every 10 s (module docs).
     pub clock_fallback: bool,
+    /// The brown-out reset level in the option bytes is below the goal (level 4), so the
+    /// flash records are refused and a commissioning ends "not stored": the RUN lamp's
+    /// steady 2 s from 2.5 s of every 10 s (module docs).
+    pub bor_below_goal: bool,
     /// Commissioned, and the operating point (load or voltage) has left the commissioned
     /// range with no fault named: the RUN lamp's triple flash, the "amber" state (module
     /// docs). The application clears `fault_detected` for the lamps' detection then.
     pub moved: bool,
+    /// The range state: clipping persists in steady running, the front end's linear range
+    /// is too small for this motor (`crate::clip_watch`): the RUN lamp's steady 2 s from
+    /// 7.5 s of every 10 s (module docs). The application's verdict is "could not judge"
+    /// then (no FAULT).
+    pub clip_range: bool,
 }
 
 /// Blink code of a fault detected that the isolation did not name (module docs): the one
@@ -226,6 +243,12 @@ const DEFAULT_MOTOR_GAP_MS: u32 = 500;
 /// Where the "clock on the internal oscillator" mark starts in the same 10 s period, ms:
 /// the same 2 s steady and 0.5 s dark, apart from the default motor's.
 const CLOCK_FALLBACK_AT_MS: u32 = 5_000;
+/// Where the "brown-out level below the goal" mark starts in the same 10 s period, ms:
+/// between the default motor's mark and the clock's, 2 s steady and 0.5 s dark.
+const BOR_MARK_AT_MS: u32 = 2_500;
+/// Where the "front end's range too small" mark starts in the same 10 s period, ms: after
+/// the clock's, 2 s steady and 0.5 s dark, ending with the period.
+const CLIP_RANGE_AT_MS: u32 = 7_500;
 
 /// Fault lamp state at `t_ms` for blink code `n` (>= 1): `n` pulses of 250 ms in 500 ms
 /// slots, then 1.5 s dark; period `n * 500 + 1500` ms.
@@ -268,11 +291,30 @@ pub fn render(input: &PanelInput, t_ms: u32) -> PanelLamps {
     let learning = input.mode == Mode::Commissioning;
     let mark_phase = t_ms % DEFAULT_MOTOR_PERIOD_MS;
     let clock_phase = mark_phase.wrapping_sub(CLOCK_FALLBACK_AT_MS);
-    let run = match (input.default_motor, input.clock_fallback) {
-        (true, _) if mark_phase < DEFAULT_MOTOR_ON_MS => true,
-        (true, _) if mark_phase < DEFAULT_MOTOR_ON_MS + DEFAULT_MOTOR_GAP_MS => false,
-        (_, true) if clock_phase < DEFAULT_MOTOR_ON_MS => true,
-        (_, true) if clock_phase < DEFAULT_MOTOR_ON_MS + DEFAULT_MOTOR_GAP_MS => false,
+    let bor_phase = mark_phase.wrapping_sub(BOR_MARK_AT_MS);
+    let clip_phase = mark_phase.wrapping_sub(CLIP_RANGE_AT_MS);
+    let (on, gap) = (
+        DEFAULT_MOTOR_ON_MS,
+        DEFAULT_MOTOR_ON_MS + DEFAULT_MOTOR_GAP_MS,
+    );
+    // The gap before the range mark: after the clock's mark (5 s + 2 s) up to 7.5 s.
+    let before_clip = (CLOCK_FALLBACK_AT_MS + on..CLIP_RANGE_AT_MS).contains(&mark_phase);
+    let run = match (
+        input.default_motor,
+        input.bor_below_goal,
+        input.clock_fallback,
+        input.clip_range,
+    ) {
+        (true, _, _, _) if mark_phase < on => true,
+        (true, _, _, _) if mark_phase < gap => false,
+        (_, true, _, _) if bor_phase < on => true,
+        // Dark for 0.5 s on both sides, so no pattern's flash runs into it.
+        (_, true, _, _) if bor_phase < gap || (on..BOR_MARK_AT_MS).contains(&mark_phase) => false,
+        (_, _, true, _) if clock_phase < on => true,
+        (_, _, true, _) if clock_phase < gap => false,
+        (_, _, _, true) if clip_phase < on => true,
+        // Dark for 0.5 s on both sides (its gap after it ends the period).
+        (_, _, _, true) if clip_phase < gap || before_clip => false,
         _ if input.moved && input.mode == Mode::Commissioned => moved_run_lamp(t_ms),
         _ => run_lamp(input.mode, t_ms),
     };
@@ -345,7 +387,9 @@ mod tests {
             commissioning_failed: false,
             default_motor: false,
             clock_fallback: false,
+            bor_below_goal: false,
             moved: false,
+            clip_range: false,
         }
     }
 
@@ -412,6 +456,73 @@ mod tests {
             inp.default_motor = true;
             assert!((0..200u32).all(|k| render(&inp, k * 10).run));
             assert!((0..200u32).all(|k| render(&inp, 5_000 + k * 10).run));
+        }
+    }
+
+    /// The brown-out mark: the RUN lamp steady from 2.5 s to 4.5 s of every 10 s, the
+    /// mode's pattern elsewhere; apart from (and together with) the other two marks.
+    #[test]
+    fn a_brown_out_level_below_the_goal_lights_the_run_lamp_for_2_s_from_2_5_s_in_10() {
+        for mode in NORMAL {
+            let mut inp = input(mode);
+            inp.bor_below_goal = true;
+            assert_eq!(longest_run_on_ms(&inp), 2_000, "{mode:?}");
+            assert!((0..200u32).all(|k| render(&inp, 12_500 + k * 10).run));
+            assert!((0..50u32).all(|k| !render(&inp, 14_500 + k * 10).run));
+            let own = |t: u32| render(&input(mode), t).run;
+            assert!((0..200u32).all(|k| render(&inp, k * 10).run == own(k * 10)));
+            assert!((200..250u32).all(|k| !render(&inp, k * 10).run));
+            assert!((500..1000u32).all(|k| render(&inp, k * 10).run == own(k * 10)));
+            inp.default_motor = true;
+            inp.clock_fallback = true;
+            for from in [0, 2_500, 5_000] {
+                assert!(
+                    (0..200u32).all(|k| render(&inp, from + k * 10).run),
+                    "{from}"
+                );
+            }
+        }
+        // The failed and stalled patterns stay as they are.
+        for mode in [Mode::Failed, Mode::SamplingStalled] {
+            let mut inp = input(mode);
+            inp.bor_below_goal = true;
+            assert!(longest_run_on_ms(&inp) <= 250, "{mode:?}");
+        }
+    }
+
+    /// The range state's mark: the RUN lamp steady from 7.5 s to 9.5 s of every 10 s, dark
+    /// 0.5 s either side, the mode's pattern elsewhere; apart from (and together with) the
+    /// other three marks; the FAULT and residual lamps as they are.
+    #[test]
+    fn the_range_state_lights_the_run_lamp_for_2_s_from_7_5_s_in_10() {
+        for mode in NORMAL {
+            let mut inp = input(mode);
+            inp.clip_range = true;
+            assert_eq!(longest_run_on_ms(&inp), 2_000, "{mode:?}");
+            assert!((0..200u32).all(|k| render(&inp, 17_500 + k * 10).run));
+            assert!((0..50u32).all(|k| !render(&inp, 17_000 + k * 10).run));
+            assert!((0..50u32).all(|k| !render(&inp, 19_500 + k * 10).run));
+            let own = |t: u32| render(&input(mode), t).run;
+            assert!((0..700u32).all(|k| render(&inp, k * 10).run == own(k * 10)));
+            let (plain, marked) = (render(&input(mode), 8_000), render(&inp, 8_000));
+            assert_eq!(
+                (plain.residuals, plain.fault),
+                (marked.residuals, marked.fault)
+            );
+            inp.default_motor = true;
+            inp.bor_below_goal = true;
+            inp.clock_fallback = true;
+            for from in [0, 2_500, 5_000, 7_500] {
+                assert!(
+                    (0..200u32).all(|k| render(&inp, from + k * 10).run),
+                    "{from}"
+                );
+            }
+        }
+        for mode in [Mode::Failed, Mode::SamplingStalled] {
+            let mut inp = input(mode);
+            inp.clip_range = true;
+            assert!(longest_run_on_ms(&inp) <= 250, "{mode:?}");
         }
     }
 

@@ -21,9 +21,9 @@
 //! |---|---|---|
 //! | [`RecoveryStep::StopTrigger`] | TIM1 counter off | no new conversion starts |
 //! | [`RecoveryStep::StopAdc`] | `ADSTP` (written alone: `adc_rules::cr_setting`), then wait for `ADSTART = 0` and `JADSTART = 0` (bounded) | a conversion in flight ends before the DMA stops (else it would set `OVR` itself); `DMAEN` may change only with no regular and no injected conversion ongoing |
-//! | [`RecoveryStep::PauseDma`] | `DMAEN = 0` in `ADC_CFGR`, then the channels' `EN = 0` (the encoder latch's too) and a wait for them (bounded) | the ADC withdraws its DMA request (a request latched while the channel was off, after a transfer error, would otherwise move one stale word at the re-arm and shift the channels in the ring for good); `CNDTR` may only be written with the channel off |
+//! | [`RecoveryStep::PauseDma`] | `DMAEN = 0` in `ADC_CFGR`, then the channels' `EN = 0`, `CC3DE = 0` and the encoder latch's `EN = 0`, and a wait for them (bounded) | the ADC withdraws its DMA request (a request latched while the channel was off, after a transfer error, would otherwise move one stale word at the re-arm and shift the channels in the ring for good); `CNDTR` may only be written with the channel off |
 //! | [`RecoveryStep::ClearFlags`] | `OVR`, `EOC`, `EOS` (write 1), `TEIF`/`HTIF`/`TCIF` (`DMA_IFCR`) | a latched `OVR` blocks the DMA requests; an `EOC` left set (the data register unread since the overrun) sets `OVR` again at the next conversion |
-//! | [`RecoveryStep::RearmDma`] | `CNDTR` = ring length, ring indices reset (the encoder latch's ring too), `DMAEN`/`DMACFG` circular, `EN = 1` | the DMA is ready before the ADC asks |
+//! | [`RecoveryStep::RearmDma`] | `CNDTR` = ring length, ring indices reset (the encoder latch's ring too, its `EN = 1`, then `CC3DE = 1`), `DMAEN`/`DMACFG` circular, `EN = 1` | the DMA is ready before the ADC (and the timer) asks |
 //! | [`RecoveryStep::StartAdc`] | `ADSTART = 1`, written alone (waits for the next trigger) | both ADCs armed before the trigger |
 //! | [`RecoveryStep::StartTrigger`] | TIM1 counter on, timestamps continue from now | ADC1 and ADC2 start on the same trigger |
 //!
@@ -153,15 +153,51 @@ pub trait Acquisition {
 /// # Errors
 /// [`StepTimeout`] when a bounded wait ran out (the sequence stops there).
 pub fn recover<A: Acquisition>(acq: &mut A) -> Result<Faults, StepTimeout> {
+    let faults = pause(acq)?;
+    resume(acq);
+    Ok(faults)
+}
+
+/// The recovery's first half: the faults latched now, then the trigger, the ADCs and the
+/// DMA stopped ([`RecoveryStep::StopTrigger`], [`RecoveryStep::StopAdc`],
+/// [`RecoveryStep::PauseDma`]). Also what the sample task does before a flash erase
+/// (`app::carry_out`'s store): nothing converts, nothing moves, so nothing can lap while
+/// the flash is busy; [`resume`] starts it again.
+///
+/// # Errors
+/// [`StepTimeout`] when a bounded wait ran out (the sequence stops there).
+pub fn pause<A: Acquisition>(acq: &mut A) -> Result<Faults, StepTimeout> {
     let faults = acq.faults();
     acq.stop_trigger();
     acq.stop_adc()?;
     acq.pause_dma()?;
+    Ok(faults)
+}
+
+/// The recovery's second half, after [`pause`]: the flags cleared, the DMA re-armed from
+/// the rings' starts, the ADCs and the trigger started ([`RecoveryStep::ClearFlags`] ..
+/// [`RecoveryStep::StartTrigger`]).
+pub fn resume<A: Acquisition>(acq: &mut A) {
     acq.clear_flags();
     acq.rearm_dma();
     acq.start_adc();
     acq.start_trigger();
-    Ok(faults)
+}
+
+/// Before the sample task reads the rings: when a channel of the acquisition is off (a DMA
+/// transfer error cleared its `EN` since the last read), the recovery runs now and its
+/// result is returned. Embassy-stm32 0.6's `RingBufferedAdc::read` would otherwise restart
+/// a ring it finds off with its own `start()`: the DMA channel enabled again without the
+/// flags cleared or `CNDTR` reloaded, and `ADC_CR` written by read-modify-write (`ADEN`
+/// written back with `ADSTART`, against [`crate::adc_rules`]). `None`: every channel runs.
+pub fn before_read<R: AcqRegisters>(
+    acq: &mut RegisterAcquisition<R>,
+) -> Option<Result<Faults, StepTimeout>> {
+    if acq.running() {
+        None
+    } else {
+        Some(recover(acq))
+    }
 }
 
 /// An ADC's status flags of `ADC_ISR` that the recovery reads and clears (RM0440): `OVR`,
@@ -224,6 +260,11 @@ pub trait AcqRegisters {
     fn dma_reload(&mut self, i: usize, transfers: u16);
     /// Enables DMA channel `i` (`EN = 1`).
     fn dma_enable(&mut self, i: usize);
+    /// The encoder timer's capture DMA request (`TIM4_DIER.CC3DE`): off, the timer raises
+    /// no request and withdraws one it raised (a capture made while the latch's channel
+    /// was off, which the re-armed channel would otherwise serve first: one stale count at
+    /// the ring's start, every later count one trigger late); on, each capture raises one.
+    fn latch_request(&mut self, on: bool);
     /// Disables the encoder latch's DMA channel (`EN = 0`): the channel that copies the
     /// encoder timer's captured count at every trigger into its ring
     /// (`acquisition::LATCH_LEN`).
@@ -294,6 +335,8 @@ impl<R: AcqRegisters> Acquisition for RegisterAcquisition<R> {
         for i in CHANNELS {
             self.regs.dma_disable(i);
         }
+        // The capture's request withdrawn before its channel stops, as DMAEN for the ADCs.
+        self.regs.latch_request(false);
         self.regs.latch_disable();
         let regs = &mut self.regs;
         poll_until(RecoveryStep::PauseDma, POLL_LIMIT, || {
@@ -319,6 +362,7 @@ impl<R: AcqRegisters> Acquisition for RegisterAcquisition<R> {
         let channels = adc_rules::CHANNELS as u16;
         self.regs.latch_reload(self.ring_len / channels);
         self.regs.latch_enable();
+        self.regs.latch_request(true);
         for i in CHANNELS {
             // ADSTART = 0 here, so DMAEN/DMACFG are writable.
             self.regs.adc_dma_circular(i);
@@ -337,6 +381,14 @@ impl<R: AcqRegisters> Acquisition for RegisterAcquisition<R> {
 
     fn start_trigger(&mut self) {
         self.regs.trigger_start();
+    }
+}
+
+impl<R: AcqRegisters> RegisterAcquisition<R> {
+    /// Whether every channel of the acquisition runs: both ADC rings' DMA channels and the
+    /// encoder latch's have `EN` set ([`before_read`]).
+    pub fn running(&mut self) -> bool {
+        CHANNELS.iter().all(|&i| self.regs.dma_enabled(i)) && self.regs.latch_enabled()
     }
 }
 

@@ -31,7 +31,7 @@
 //! | 0..4 | magic `b"DMRR"` |
 //! | 4..6 | version, `u16` (2) |
 //! | 6..8 | payload length, `u16` (116) |
-//! | 8 | cause: 1 = panic, 2 = sample path stalled, 3 = a set-up step did not finish, 4 = a `defmt` panic, 5 = a HardFault or an unhandled exception, 6 = a set-up step overran its deadline |
+//! | 8 | cause: 1 = panic, 2 = sample path stalled, 3 = a set-up step did not finish, 4 = a `defmt` panic, 5 = a HardFault or an unhandled exception, 6 = a set-up step overran its deadline, 7 = the crystal failed (clock security system) |
 //! | 9 | message length (0..=[`MESSAGE_LEN`]) |
 //! | 10 | file length (0..=[`FILE_LEN`]) |
 //! | 11 | the brown-out reset level in force when the record was written (`FLASH_OPTR.BOR_LEV`, 0..=4; 255 = not recorded; [`crate::supply::BorLevel`]) |
@@ -94,6 +94,11 @@ pub enum ResetCause {
     /// into the message and the deadline into the number, then reset the MCU by software
     /// ([`ResetRecord::setup_deadline`]).
     SetupDeadline,
+    /// The clock security system saw the crystal (HSE) fail while it clocked the PLL: the
+    /// hardware switched to the 16 MHz HSI, the NMI handler wrote this record and the
+    /// watchdog reset the MCU; the next boot runs on the HSI without trying the crystal
+    /// ([`PreviousRun::clock_failed`]).
+    ClockFailure,
 }
 
 impl ResetCause {
@@ -106,6 +111,7 @@ impl ResetCause {
             ResetCause::DefmtPanic => 4,
             ResetCause::HardFault => 5,
             ResetCause::SetupDeadline => 6,
+            ResetCause::ClockFailure => 7,
         }
     }
 
@@ -118,6 +124,7 @@ impl ResetCause {
             4 => Some(ResetCause::DefmtPanic),
             5 => Some(ResetCause::HardFault),
             6 => Some(ResetCause::SetupDeadline),
+            7 => Some(ResetCause::ClockFailure),
             _ => None,
         }
     }
@@ -424,6 +431,17 @@ impl ResetRecord {
         }
     }
 
+    /// The crystal failed while it clocked the PLL (the clock security system's NMI).
+    pub fn clock_failure() -> Self {
+        Self {
+            cause: ResetCause::ClockFailure,
+            bor: NO_BOR_LEVEL,
+            number: 0,
+            message: Text::new("crystal failed (clock security system)", false),
+            file: Text::new("", true),
+        }
+    }
+
     /// A stalled sample path, `stalled_ms` without samples when recorded.
     pub fn sample_stall(stalled_ms: u32) -> Self {
         Self {
@@ -555,6 +573,12 @@ impl PreviousRun {
         }
     }
 
+    /// The previous run ended in a clock failure (the clock security system's record):
+    /// the boot runs on the HSI without trying the crystal again.
+    pub fn clock_failed(&self) -> bool {
+        matches!(self, PreviousRun::Recorded(r) if r.cause() == ResetCause::ClockFailure)
+    }
+
     /// The previous run failed (the panel shows "monitor failed" for a while): a record or
     /// a watchdog reset; a stall cut short by another reset counts too (it was seen).
     pub fn failed(&self) -> bool {
@@ -562,5 +586,7 @@ impl PreviousRun {
     }
 }
 
+pub mod log;
+pub mod report;
 #[cfg(test)]
 mod tests;

@@ -2,9 +2,11 @@
 //!
 //! The ADCs deliver, per trigger, three voltage codes (ADC1) and three current codes
 //! (ADC2); the encoder timer delivers its 16-bit counter. [`AdcSampler`] scales the
-//! codes with the board's [`FrontEnd`], flags rail codes as saturated, passes the raw
-//! counter on (the core unwraps it, `EncoderConfig::counter_bits = 16`) and stamps the
-//! sample with a free-running timestamp in ticks of [`TICK_HZ`].
+//! codes with the board's [`FrontEnd`], marks a clipped sample (a conversion beyond its
+//! channel's linear range, or a code on a rail) as clipped for the core, which holds it out
+//! and names no sensor, passes the raw counter on (the core unwraps it,
+//! `EncoderConfig::counter_bits = 16`) and stamps the sample with a free-running timestamp
+//! in ticks of [`TICK_HZ`].
 //!
 //! Timestamps: samples are taken by a hardware timer at an exact rate, so the timestamp of
 //! sample `n` is `n * ticks_per_sample` (wrapping `u32`). When samples were lost (a DMA
@@ -28,6 +30,53 @@ pub struct RawFrame {
     pub i: [CurrentCode; 3],
     /// TIM4 counter (x4 quadrature, 16 bit, wraps).
     pub encoder_count: u16,
+    /// Which of the sample's channels had a conversion at the front end's linear limit
+    /// (on the board each conversion is checked, `acquisition::sum_clipped`, and the
+    /// flag held through the filter's memory, `acquisition::ClipHold`).
+    pub clipped: Clipped,
+    /// The sample's latched encoder counts rejected as a step beyond the maximum speed
+    /// (`acquisition::EncoderCheck`; 0..=8).
+    pub encoder_rejects: u8,
+}
+
+/// Which channels of one sample were clipped: a conversion at or beyond the front end's
+/// linear limit (`acquisition::LinearRange`). A clipped sample goes to the core as clipped
+/// (`Sample::clipped`): its block is held out of the filters and the residuals, and no
+/// sensor is named (a DOL start's inrush clips a current front end sized for the running
+/// current); the sample path counts it, and thread mode judges whether clipping persists
+/// in steady running (`crate::clip_watch`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Clipped {
+    /// A voltage channel (ADC1).
+    pub voltage: bool,
+    /// A current channel (ADC2).
+    pub current: bool,
+}
+
+impl Clipped {
+    /// No channel clipped.
+    pub const NONE: Clipped = Clipped {
+        voltage: false,
+        current: false,
+    };
+
+    /// Whether any channel clipped.
+    pub const fn any(self) -> bool {
+        self.voltage | self.current
+    }
+}
+
+impl RawFrame {
+    /// Which front ends clipped in this frame: its flags (the per-conversion check), or a
+    /// code on a rail (a frame built without the check: the mean of eight conversions on the
+    /// rail clipped them all).
+    #[inline]
+    pub fn clips(&self) -> Clipped {
+        Clipped {
+            voltage: self.clipped.voltage || self.v.iter().any(|c| is_saturated_code(c.0)),
+            current: self.clipped.current || self.i.iter().any(|c| is_saturated_code(c.0)),
+        }
+    }
 }
 
 /// Why a sampling configuration was rejected.
@@ -93,7 +142,10 @@ impl AdcSampler {
         self.next_ticks = now_ticks;
     }
 
-    /// Scale one frame and stamp it.
+    /// Scale one frame and stamp it; a frame that clipped ([`RawFrame::clips`]) goes to the
+    /// core as clipped. The board never flags an ADC as saturated: a code on a rail is the
+    /// front end's clip (held out, no sensor named), and what a sensor's impossible
+    /// readings look like the core finds from the values (out of range, the sums).
     #[inline]
     pub fn build(&mut self, raw: &RawFrame) -> Sample {
         let [va, vb, vc] = raw.v;
@@ -115,13 +167,15 @@ impl AdcSampler {
             },
             encoder_count: u32::from(raw.encoder_count),
             timestamp_ticks: ts,
-            v_saturated: raw.v.iter().any(|c| is_saturated_code(c.0)),
-            i_saturated: raw.i.iter().any(|c| is_saturated_code(c.0)),
+            v_saturated: false,
+            i_saturated: false,
+            clipped: raw.clips().any(),
         }
     }
 
     /// The inverse used by simulations: quantize physical values to the codes this front
-    /// end would produce (clamped to the 12-bit range, so out-of-range values saturate).
+    /// end would produce (clamped to the 12-bit range: out-of-range values sit on a rail,
+    /// which [`RawFrame::clips`] reads as clipped).
     pub fn quantize(&self, v_abc: Abc, i_abc: Abc, encoder_count: u32) -> RawFrame {
         let [sva, svb, svc] = self.front_end.voltage;
         let [sia, sib, sic] = self.front_end.current;
@@ -138,6 +192,8 @@ impl AdcSampler {
             ],
             // The hardware counter is 16 bits wide.
             encoder_count: (encoder_count & 0xFFFF) as u16,
+            clipped: Clipped::NONE,
+            encoder_rejects: 0,
         }
     }
 }
@@ -176,8 +232,29 @@ mod tests {
         let s = b.build(&raw);
         assert_eq!(s.timestamp_ticks, u32::MAX - 50);
         assert!((s.v_abc.a - 100.0).abs() < 0.1);
-        assert!(s.i_saturated && !s.v_saturated);
+        // 20 A on the 10 A front end: on the rail, clipped, no ADC flagged saturated.
+        assert!(s.clipped && !s.i_saturated && !s.v_saturated);
+        assert_eq!(
+            raw.clips(),
+            Clipped {
+                voltage: false,
+                current: true
+            }
+        );
         assert_eq!(s.encoder_count, 70_000 & 0xFFFF);
         assert_eq!(b.build(&raw).timestamp_ticks, 49);
+    }
+
+    /// A clip seen in the conversions marks the sample clipped even where the filtered
+    /// codes are inside the range (the mean of eight conversions, two of them clipped); it
+    /// is never flagged saturated (which would name the sensor).
+    #[test]
+    fn a_clipped_sample_goes_to_the_core_clipped_not_saturated() {
+        let mut b = AdcSampler::new(FrontEnd::DEFAULT, 10_000).unwrap();
+        let mut raw = b.quantize(Abc::default(), Abc::default(), 0);
+        assert!(!b.build(&raw).clipped);
+        raw.clipped.current = true;
+        let s = b.build(&raw);
+        assert!(s.clipped && !s.i_saturated && !s.v_saturated);
     }
 }

@@ -168,6 +168,81 @@ where
     }
 }
 
+/// The correction of the readings for the ADC's reference: VDDA at commissioning is kept in
+/// the commissioning record (`flash_record::CalibrationRecord::vdda_v`); every measurement
+/// in band afterwards gives the gain `VDDA now / VDDA at commissioning` by which every code
+/// is scaled back (`SamplePath::set_reference_gain`). A 3 % drift within the band no longer
+/// moves every reading by 3 %. New gains are handed to the sample task only when they differ
+/// from the one in force by more than [`ReferenceGain::DEADBAND`] (a VREFINT conversion's
+/// own noise, a code or two of about 1 500, does not toggle it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReferenceGain {
+    /// VDDA when the record in force was commissioned [V] (`None`: no record with it; no
+    /// correction).
+    commissioned_v: Option<f32>,
+    /// The gain in force.
+    in_force: f32,
+}
+
+impl Default for ReferenceGain {
+    fn default() -> Self {
+        Self {
+            commissioned_v: None,
+            in_force: 1.0,
+        }
+    }
+}
+
+impl ReferenceGain {
+    /// The smallest change of the gain handed on (0.2 %).
+    pub const DEADBAND: f32 = 0.002;
+
+    /// The commissioned VDDA (`None`: no correction from now on: the gain goes back to 1);
+    /// returns the gain to put into force if it changed.
+    pub fn commissioned(
+        &mut self,
+        vdda_v: Option<f32>,
+        latest: Option<ReferenceCheck>,
+    ) -> Option<f32> {
+        self.commissioned_v = vdda_v;
+        match (vdda_v, latest) {
+            (Some(_), Some(check)) => self.observe(check),
+            _ => self.set(1.0),
+        }
+    }
+
+    /// A measurement `check`: the gain to put into force when it moved by more than
+    /// [`ReferenceGain::DEADBAND`] (measurements out of band or unreadable change nothing:
+    /// the sensors are flagged then).
+    pub fn observe(&mut self, check: ReferenceCheck) -> Option<f32> {
+        let (Some(at), ReferenceCheck::InBand(now)) = (self.commissioned_v, check) else {
+            return None;
+        };
+        let gain = now / at;
+        if (gain - self.in_force).abs() > Self::DEADBAND {
+            self.set(gain)
+        } else {
+            None
+        }
+    }
+
+    /// The gain in force.
+    pub fn in_force(&self) -> f32 {
+        self.in_force
+    }
+
+    /// The VDDA of commissioning, when known [V].
+    pub fn commissioned_v(&self) -> Option<f32> {
+        self.commissioned_v
+    }
+
+    fn set(&mut self, gain: f32) -> Option<f32> {
+        let changed = gain != self.in_force;
+        self.in_force = gain;
+        changed.then_some(gain)
+    }
+}
+
 /// How often thread mode measures VREFINT while the monitor runs [ms]: fast enough that a
 /// sagging supply is flagged within a second, rare enough that the injected conversion's
 /// 6 us delay of ADC1's regular sequence (once per second, on one sample) does not matter.
@@ -283,6 +358,14 @@ impl ReferenceWatch {
     /// The latest measurement (`None` before the start-up check).
     pub fn latest(&self) -> Option<ReferenceCheck> {
         self.latest
+    }
+
+    /// The latest VDDA when it is in band [V] (what a commissioning run stores).
+    pub fn in_band_v(&self) -> Option<f32> {
+        match self.latest {
+            Some(ReferenceCheck::InBand(v)) => Some(v),
+            _ => None,
+        }
     }
 
     /// A measurement's result at `now_ms` (the start-up check, or a periodic one): the

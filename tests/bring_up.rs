@@ -58,8 +58,29 @@ fn the_bring_up_list_runs_record_brown_out_handlers_boot_report() {
         at("brown-out"),
         at("handlers visible"),
         at("boot report"),
+        at("virtual com port"),
+        at("offset trim"),
+        at("status line"),
+        at("commission"),
     ];
     assert!(order.windows(2).all(|w| w[0] < w[1]), "{titles:?}");
     // The brown-out step names the command that programs it.
     assert!(list.contains("cargo fw bor"));
+    // Issue 74's checks are in the list: flip-link before the first run, the counters on
+    // the status line, the stored reference, the clock security system, the panel's marks,
+    // the range state (clipping that persists in steady running).
+    for needle in [
+        "cargo\n   install flip-link --locked",
+        "`clip=`",
+        "`enc_rej=`",
+        "`stack=`",
+        "readings corrected by",
+        "clock security system",
+        "from 2.5 s to 4.5 s",
+        "115 200 baud",
+        "`clip_range=false`",
+        "from 7.5 s to 9.5 s",
+    ] {
+        assert!(list.contains(needle), "the checklist lacks {needle:?}");
+    }
 }

@@ -8,7 +8,7 @@
 
 use drive_monitor::acquisition::SAMPLES_PER_HALF;
 use drive_monitor::app::WATCHDOG_TIMEOUT_MS;
-use drive_monitor::debug_halt::{Freeze, FROZEN};
+use drive_monitor::debug_halt::{Freeze, FreezeRegisters, FROZEN};
 use drive_monitor::liveness::AdcWait;
 
 const FS: u32 = 10_000;
@@ -40,18 +40,47 @@ fn halt(freeze: Freeze, halt_ms: u32) -> AfterHalt {
     }
 }
 
+/// What a halt stops, read from the values the boot writes into `DBGMCU_APB1FZR1` and
+/// `DBGMCU_APB2FZR` (`Freeze::registers_after` on registers that held `read`), decoded with
+/// RM0440's bit positions written out here: TIM1 bit 11 and TIM15 bit 16 of `APB2FZR`, the
+/// IWDG bit 12 of `APB1FZR1`.
+fn written(read: FreezeRegisters) -> Freeze {
+    let after = FROZEN.registers_after(read);
+    Freeze {
+        trigger: after.apb2fzr & (1 << 11) != 0,
+        time_base: after.apb2fzr & (1 << 16) != 0,
+        watchdog: after.apb1fzr1 & (1 << 12) != 0,
+    }
+}
+
 #[test]
 fn a_breakpoint_stops_sampling_cleanly_and_resumes_without_a_recovery() {
-    for halt_ms in [1, 100, 2_000, 60_000] {
-        assert_eq!(
-            halt(FROZEN, halt_ms),
-            AfterHalt {
-                lapped: false,
-                recovered: false,
-                reset: false
-            },
-            "{halt_ms} ms"
-        );
+    // From the reset values (0) and from registers a debugger left with other bits set.
+    let reset = FreezeRegisters {
+        apb1fzr1: 0,
+        apb2fzr: 0,
+    };
+    let other = FreezeRegisters {
+        apb1fzr1: 0x0000_0004,
+        apb2fzr: 0x0004_0000,
+    };
+    assert_eq!(
+        FROZEN.registers_after(other).apb1fzr1 & 0x4,
+        0x4,
+        "the other stop bits are left as read"
+    );
+    for read in [reset, other] {
+        for halt_ms in [1, 100, 2_000, 60_000] {
+            assert_eq!(
+                halt(written(read), halt_ms),
+                AfterHalt {
+                    lapped: false,
+                    recovered: false,
+                    reset: false
+                },
+                "{halt_ms} ms"
+            );
+        }
     }
     // Each part of the freeze is needed: without it the halt laps the ring, times the
     // wait out or resets the MCU.
@@ -90,9 +119,9 @@ fn the_watchdog_and_the_freeze_come_first_in_main() {
     let body = &body[..body.find("\n}\n").expect("its end")];
     for needle in [
         "debug_halt::FROZEN",
-        "set_tim1(",
-        "set_tim15(",
-        "set_iwdg(",
+        "registers_after(",
+        "apb1lfzr()",
+        "apb2fzr()",
         "Key::START",
     ] {
         assert!(body.contains(needle), "start_boot_watchdog lacks {needle}");

@@ -23,6 +23,7 @@ fn record() -> CalibrationRecord {
                 wr_rad_s: 303.5,
             },
         }),
+        vdda_v: None,
     }
 }
 
@@ -79,6 +80,7 @@ fn values_out_of_the_cores_range_are_not_applied() {
         mean: [5.0, 0.0, 0.0, 0.0],
         spread: [0.1; 4],
         isolation: None,
+        vdda_v: None,
     };
     let bytes = rec.encode().unwrap();
     let decoded = CalibrationRecord::decode(&bytes).unwrap();

@@ -97,11 +97,12 @@ fn board_log(rows: &[Row], path: Path) -> Vec<Row> {
                 }
             }
             let n = take * CHANNELS;
-            let (vs, count) = sum_half(&v[..n]);
+            // The firmware's path sums all eight sequences (the filter's input).
+            let (vs, _) = sum_half(&v[..n]);
             let (is, _) = sum_half(&i[..n]);
             let ([va, vb, vc], [ia, ib, ic]) = match path {
                 Path::Firmware => {
-                    let (v, i, _) = filter.step(vs, is, count, 0);
+                    let (v, i, _) = filter.step(vs, is, 0);
                     (v, i)
                 }
                 Path::OneTrigger => (vs.map(|x| x as u16), is.map(|x| x as u16)),
@@ -110,6 +111,8 @@ fn board_log(rows: &[Row], path: Path) -> Vec<Row> {
                 v: [VoltageCode(va), VoltageCode(vb), VoltageCode(vc)],
                 i: [CurrentCode(ia), CurrentCode(ib), CurrentCode(ic)],
                 encoder_count: 0,
+                clipped: drive_monitor::sampling::Clipped::NONE,
+                encoder_rejects: 0,
             };
             let s = sampler.build(&raw);
             let first = &period[0];

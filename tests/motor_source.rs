@@ -36,7 +36,7 @@ fn a_valid_record_is_used() {
     assert_eq!(source.describe(), "motor record from flash");
     let cfg = motor_source::monitor_config(&rec, 10_000);
     assert_eq!(cfg.encoder.counts_per_rev, 10_000);
-    assert_eq!(cfg.limits.i_max, 25.0);
+    assert_eq!(cfg.limits.i_max, 2.5 * 25.0);
     let fe = motor_source::front_end(&rec);
     assert_eq!(fe.current[0].offset_code, 2040.0);
     assert_eq!(fe.current[0].per_lsb, 50.0 / 4095.0);
@@ -90,7 +90,7 @@ fn the_boot_builds_the_sample_path_and_isolator_of_the_record() {
     let path = motor_source::sample_path(&rec, 10_000).expect("record path");
     let cfg = path.monitor().config();
     assert_eq!(cfg.encoder.counts_per_rev, 10_000);
-    assert_eq!(cfg.limits.i_max, 25.0);
+    assert_eq!(cfg.limits.i_max, 2.5 * 25.0);
     assert_ne!(cfg, board.monitor().config());
     // The 3 hp machine's torque base is not the 2.2 kW one's: the isolator judges the
     // record's machine.
@@ -103,30 +103,34 @@ fn the_boot_builds_the_sample_path_and_isolator_of_the_record() {
 fn the_encoder_timer_is_set_up_from_the_record() {
     use drive_monitor::motor_source::EncoderSetup;
     // The default: 1024 lines counting up, 4 poles at 50 Hz (up to 50 rev/s with the
-    // margin): a quarter edge interval of 207 clocks, filter fDTS/32 x 6 (192 clocks, 14).
+    // margin): a quarter edge interval of 207 clocks, filter fDTS/32 x 6 (192 clocks, 14);
+    // 4096 x 50 / 80 000 = 2.56 counts between two triggers: 3, + 1 = 4.
     assert_eq!(
-        motor_source::encoder_setup(&motor_source::default_record()),
+        motor_source::encoder_setup(&motor_source::default_record(), 10_000),
         EncoderSetup {
             counts_per_rev: 4096,
             invert_a: false,
             input_filter: 14,
-            pull_up: true
+            pull_up: true,
+            max_step_per_trigger: 4,
         }
     );
     // The 3 hp record, reversed: 2500 lines at up to 60 rev/s, 70.8 clocks: fDTS/8 x 8
-    // (64 clocks, 9); the direction inverted in the timer, the line count the core's too.
+    // (64 clocks, 9); the direction inverted in the timer, the line count the core's too;
+    // 10 000 x 60 / 80 000 = 7.5 counts between two triggers: 8, + 1 = 9.
     let rec = MotorRecord {
         encoder_reversed: true,
         ..other_motor()
     };
-    let setup = motor_source::encoder_setup(&rec);
+    let setup = motor_source::encoder_setup(&rec, 10_000);
     assert_eq!(
         setup,
         EncoderSetup {
             counts_per_rev: 10_000,
             invert_a: true,
             input_filter: 9,
-            pull_up: true
+            pull_up: true,
+            max_step_per_trigger: 9,
         }
     );
     assert_eq!(
@@ -142,5 +146,41 @@ fn the_encoder_timer_is_set_up_from_the_record() {
     };
     let (read, source) = motor_source::select(&page_with(&rec.to_bytes()));
     assert_eq!(source, MachineSource::Flash);
-    assert!(!motor_source::encoder_setup(&read).pull_up);
+    assert!(!motor_source::encoder_setup(&read, 10_000).pull_up);
+}
+
+/// The front end's linear limit per channel from the record: its full scale about the
+/// channel's zero, 62 codes of the amplifier's headroom inside, within the rails.
+#[test]
+fn the_linear_ranges_follow_the_records_offsets() {
+    use drive_monitor::acquisition::LinearRange;
+    let r = motor_source::linear_ranges(&motor_source::default_record());
+    // Zero at 2047.5: 0 + 62 and 4095 - 62.
+    let mid = LinearRange {
+        low: 62,
+        high: 4033,
+    };
+    assert_eq!((r.voltage, r.current), ([mid; 3], [mid; 3]));
+    // A current channel whose zero is at 2100: its negative full scale at 52.5 codes,
+    // + 62 = 114.5 -> 115 (rounded); its positive one beyond the rail, 4095 - 62.
+    let rec = MotorRecord {
+        current_offset_counts: [2100.0, 2047.5, 1990.0],
+        ..motor_source::default_record()
+    };
+    let r = motor_source::linear_ranges(&rec);
+    assert_eq!(
+        r.current[0],
+        LinearRange {
+            low: 115,
+            high: 4033
+        }
+    );
+    // A zero at 1990: low 62, high 1990 + 2047.5 - 62 = 3975.5 -> 3976.
+    assert_eq!(
+        r.current[2],
+        LinearRange {
+            low: 62,
+            high: 3976
+        }
+    );
 }

@@ -3,7 +3,7 @@
 //! firmware builds from a status (`drive_monitor::app::status_line`) reads back with every
 //! value in place, and docs/firmware.md's "The status line" documents every field.
 
-use drive_monitor::app::{status_line, MonitorStatus};
+use drive_monitor::app::{status_line, BoardCounters, MonitorStatus};
 use monitor_core::status_line::{parse, FORMAT};
 use monitor_core::verdict::Verdict;
 use monitor_core::{CommissioningRun, Fault, Operating, Phase, SensorFlags};
@@ -48,6 +48,9 @@ fn status() -> MonitorStatus {
         bands: [(0.001, 0.006), (-0.01, 0.011), (0.009, 0.012), (0.0, 0.007)],
         winding: Some((Phase::B, 0.041)),
         moved: true,
+        clipped: 17,
+        encoder_rejects: 3,
+        clip_range: true,
         ..MonitorStatus::default()
     }
 }
@@ -60,7 +63,11 @@ fn the_firmwares_line_reads_back_through_the_shared_module() {
         54.4,
         ("commissioned", Verdict::Fault.name()),
         2310,
-        (3, 1),
+        BoardCounters {
+            overruns: 3,
+            restarts: 1,
+            stack_used_bytes: 2_344,
+        },
         (3.301, 4),
     );
     // As probe-rs prints it: the level before, the location on the next line.
@@ -98,6 +105,11 @@ fn the_firmwares_line_reads_back_through_the_shared_module() {
     assert_eq!(s.moved, Some(true));
     assert_eq!(s.winding_rise_k, Some(54.4));
     assert_eq!((s.vdda_v, s.bor), (Some(3.301), Some(4)));
+    assert_eq!(
+        (s.clipped, s.encoder_rejects, s.stack_used_bytes),
+        (Some(17), Some(3), Some(2_344))
+    );
+    assert_eq!(s.clip_range, Some(true));
 }
 
 #[test]

@@ -36,7 +36,21 @@ impl PanelIsolation<'_> {
 /// and shorted turns with the core's phase confidence. The board knows no load model: as the
 /// host's `diagnose` by default, it reads the load as an unknown input, so the friction
 /// class is the load's move (the operating point "moved"), not a name.
+///
+/// In the range state (`status.clip_range`: clipping persists in steady running,
+/// [`crate::clip_watch`]) the data cannot carry a verdict: the blocks the monitor judges
+/// are the few that did not clip, at the operating points where the readings stayed inside
+/// the front end. The glance is then the data's quality alone (untrusted, the decision
+/// table's "could not judge"), nothing detected or named, so the FAULT lamp stays dark; the
+/// panel's residual lamps still show the core's.
 pub fn panel_glance(status: &MonitorStatus, isolation: PanelIsolation<'_>) -> Glance {
+    if status.clip_range {
+        return Glance {
+            sensor_fault: true,
+            commissioned: status.commissioned,
+            ..Glance::default()
+        };
+    }
     let named = isolation.named(status.commissioned);
     let friction = matches!(named, Some(Named::Friction { .. }));
     Glance {
@@ -87,7 +101,8 @@ fn fault_code(glance: &Glance, d: Decision) -> Option<u8> {
 /// least 0.5; not for a name below 5 %, watched, nor, not commissioned, for lamps whose
 /// isolation names nothing beyond the file's +-30 %), with the blink code of what it names;
 /// "input invalid" when a sensor fault is flagged with no residual lamp lit; the amber
-/// "operating point moved" state (the panel's module docs).
+/// "operating point moved" state; the range state's mark (`status.clip_range`, the panel's
+/// module docs).
 pub fn panel_input(
     mode: Mode,
     status: &MonitorStatus,
@@ -109,7 +124,9 @@ pub fn panel_input(
         commissioning_failed,
         default_motor: false,
         clock_fallback: false,
+        bor_below_goal: false,
         moved,
+        clip_range: status.clip_range,
     }
 }
 
@@ -255,6 +272,29 @@ mod tests {
             panel_call(&status, learned(&iso)).verdict,
             Verdict::CouldNotJudge
         );
+    }
+
+    /// The range state (clipping persists in steady running): could not judge, whatever the
+    /// lamps and the isolation say; the FAULT lamp dark (no blink code, no steady "input
+    /// invalid"), no amber state, the RUN lamp's range mark; the residual lamps as the core's.
+    #[test]
+    fn the_range_state_could_not_judge_and_lights_no_fault() {
+        let mut status = commissioned();
+        status.residual_lamps = [false, true, true, true];
+        status.fault_detected = true;
+        status.moved = true;
+        let rr = isolation(Fault::Rr, 0.9, 0.3);
+        let inp = panel_input(Mode::Commissioned, &status, learned(&rr), false);
+        assert_eq!(code(&inp), Some(2), "the control: a FAULT named");
+        status.clip_range = true;
+        let inp = panel_input(Mode::Commissioned, &status, learned(&rr), false);
+        assert!(dark(&inp) && !inp.input_invalid && !inp.moved && inp.clip_range);
+        assert_eq!(inp.residual_lamps, [false, true, true, true]);
+        assert_eq!(
+            panel_call(&status, learned(&rr)).verdict,
+            Verdict::CouldNotJudge
+        );
+        assert!(render(&inp, 8_000).is_on(Lamp::Run) && !render(&inp, 9_700).is_on(Lamp::Run));
     }
 
     /// Not commissioned, lamps lit against the motor record's nominal values are a FAULT

@@ -3,10 +3,12 @@
 //! [`Command`]s thread mode sends it, applied between two samples.
 
 use super::{board_monitor_config, MonitorStatus};
+use crate::acquisition::{LinearRanges, SampleBuilder, HALF_LEN, OVERSAMPLING};
 use crate::board::FrontEnd;
+use crate::board::{CurrentCode, VoltageCode};
 use crate::flash_record::CalibrationRecord;
 use crate::offset_trim::{OffsetTrim, TrimResult};
-use crate::sampling::{AdcSampler, RawFrame, SamplingError};
+use crate::sampling::{AdcSampler, Clipped, RawFrame, SamplingError};
 use monitor_core::{
     CommissioningError, ConfigError, Fault, Install, Monitor, MonitorConfig, SteadyPoint,
 };
@@ -44,6 +46,13 @@ pub enum Command {
     },
     /// Install a calibration read from flash at boot.
     SetCalibration(CalibrationRecord),
+    /// Stop the acquisition until thread mode has erased and written the flash
+    /// ([`super::AcquisitionPause`]); the sample task carries it out on the registers, the
+    /// sample path has nothing to do.
+    PauseAcquisition,
+    /// Correct every reading for the ADC's reference: VDDA now over VDDA at commissioning
+    /// ([`crate::supply::ReferenceGain`]); 1 removes the correction.
+    ReferenceGain(f32),
 }
 
 /// Why the core did not carry out a [`Command`] as asked.
@@ -86,6 +95,8 @@ impl Command {
             Command::CancelCommissioning { .. } => "cancel-commissioning",
             Command::CalibrationStored { .. } => "calibration-stored",
             Command::SetCalibration(_) => "set-calibration",
+            Command::PauseAcquisition => "pause-acquisition",
+            Command::ReferenceGain(_) => "reference-gain",
         }
     }
 }
@@ -97,6 +108,15 @@ pub struct SamplePath {
     sampler: AdcSampler,
     samples: u32,
     trim: OffsetTrim,
+    /// Clipped samples since boot (wrapping): any front end, the voltages', the currents'.
+    clipped: [u32; 3],
+    /// Rejected encoder counts since boot (wrapping).
+    encoder_rejects: u32,
+    /// The front end at the reference of commissioning: the record's scaling with the
+    /// start-up trim's offsets (in codes at that reference).
+    front_end: FrontEnd,
+    /// The reference correction in force: VDDA now over VDDA at commissioning.
+    reference_gain: f32,
 }
 
 impl SamplePath {
@@ -114,6 +134,10 @@ impl SamplePath {
             sampler: AdcSampler::new(front_end, sample_rate_hz).map_err(AppError::Sampling)?,
             samples: 0,
             trim: OffsetTrim::new(&front_end),
+            clipped: [0; 3],
+            encoder_rejects: 0,
+            front_end,
+            reference_gain: 1.0,
         })
     }
 
@@ -152,6 +176,11 @@ impl SamplePath {
             Command::SetCalibration(rec) => m
                 .set_calibration(rec.into())
                 .map_err(CommandError::Calibration),
+            Command::PauseAcquisition => Ok(()),
+            Command::ReferenceGain(gain) => {
+                self.set_reference_gain(gain);
+                Ok(())
+            }
         }
     }
 
@@ -162,16 +191,49 @@ impl SamplePath {
     /// before and after (then it returns at once).
     pub fn trim_offsets(&mut self, raw: &RawFrame) -> Option<TrimResult> {
         let trim = self.trim.add(raw)?;
-        let mut fe = *self.sampler.front_end();
+        let gain = self.reference_gain;
+        let fe = &mut self.front_end;
         let channels = (fe.voltage.iter_mut().zip(trim.voltage))
             .chain(fe.current.iter_mut().zip(trim.current));
         for (scale, channel) in channels {
             if let Some(offset) = channel.offset() {
-                scale.offset_code = offset;
+                // Measured in codes at today's reference: at commissioning's, x gain.
+                scale.offset_code = offset * gain;
             }
         }
-        self.sampler.set_front_end(fe);
+        self.apply_front_end();
         Some(trim)
+    }
+
+    /// Corrects every reading for the ADC's reference (`Command::ReferenceGain`): `gain`
+    /// = VDDA now over VDDA at commissioning ([`crate::supply::ReferenceGain`]). The front
+    /// end's output is not ratiometric (the isolated amplifiers have references of their
+    /// own), so a code read at VDDA now is `gain` times the code the same input gave at
+    /// commissioning: `x = (gain code - offset) per_lsb = (code - offset / gain) (gain
+    /// per_lsb)`, the front end rescaled once, nothing added per sample. A gain that is
+    /// not finite or outside 0.9..=1.1 (beyond the reference's band, whose readings are
+    /// flagged anyway) is ignored.
+    pub fn set_reference_gain(&mut self, gain: f32) {
+        if gain.is_finite() && (0.9..=1.1).contains(&gain) {
+            self.reference_gain = gain;
+            self.apply_front_end();
+        }
+    }
+
+    /// The reference correction in force (1: none).
+    pub fn reference_gain(&self) -> f32 {
+        self.reference_gain
+    }
+
+    /// The sampler's front end: [`SamplePath::front_end`]'s scaled by the reference gain.
+    fn apply_front_end(&mut self) {
+        let g = self.reference_gain;
+        let mut fe = self.front_end;
+        for scale in fe.voltage.iter_mut().chain(fe.current.iter_mut()) {
+            scale.offset_code /= g;
+            scale.per_lsb *= g;
+        }
+        self.sampler.set_front_end(fe);
     }
 
     /// The ADC sampler (for timestamp resynchronisation after lost samples).
@@ -194,12 +256,24 @@ impl SamplePath {
         self.samples
     }
 
-    /// Process one sample's readings.
+    /// Process one sample's readings: scaled and stamped ([`AdcSampler::build`]; a clipped
+    /// sample goes to the core as clipped, which holds its block out of the residuals and
+    /// names no sensor) into [`Monitor::update`]; the clipped samples (any front end, and
+    /// each) and the rejected encoder counts counted for the status line and thread mode's
+    /// clip watch.
     #[inline]
     pub fn on_frame(&mut self, raw: &RawFrame) {
         let sample = self.sampler.build(raw);
         self.monitor.update(&sample);
         self.samples = self.samples.wrapping_add(1);
+        let clips = raw.clips();
+        let [any, voltage, current] = &mut self.clipped;
+        *any = any.wrapping_add(u32::from(sample.clipped));
+        *voltage = voltage.wrapping_add(u32::from(clips.voltage));
+        *current = current.wrapping_add(u32::from(clips.current));
+        self.encoder_rejects = self
+            .encoder_rejects
+            .wrapping_add(u32::from(raw.encoder_rejects));
     }
 
     /// The status for thread mode, from the latest output.
@@ -241,6 +315,65 @@ impl SamplePath {
             winding_confidence: o.unbalance.phase_confidence,
             vds: o.vds,
             moved: false,
+            clipped: self.clipped[0],
+            clipped_voltage: self.clipped[1],
+            clipped_current: self.clipped[2],
+            encoder_rejects: self.encoder_rejects,
+            clip_range: false,
+        }
+    }
+}
+
+/// One sample's conversions and latched encoder counts -> its [`RawFrame`], as the sample
+/// task builds it: [`SampleBuilder`] (each ADC's oversampled sequences summed with every
+/// conversion checked against its channel's linear range, a clip held through the filter's
+/// memory; the latched counts checked against the maximum speed and averaged; the
+/// inverter's ripple filtered out), its result as the frame's codes, count and flags. No
+/// allocation, no panics.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameBuilder {
+    builder: SampleBuilder,
+}
+
+impl FrameBuilder {
+    /// A builder at `sample_rate_hz` whose filter restores the gain at `supply_hz`, with
+    /// the channels' linear `ranges` (`motor_source::linear_ranges`) and the encoder's
+    /// largest step between two triggers `max_step` (`motor_source::EncoderSetup`).
+    pub fn new(sample_rate_hz: u32, supply_hz: f32, ranges: LinearRanges, max_step: u16) -> Self {
+        Self {
+            builder: SampleBuilder::new(sample_rate_hz, supply_hz, &ranges, max_step),
+        }
+    }
+
+    /// After a gap in the triggers (a recovery, a paused acquisition): the next latched
+    /// count starts the encoder check afresh.
+    pub fn restart(&mut self) {
+        self.builder.restart();
+    }
+
+    /// A sample that is dropped (`adc_rules::IdleDiscard`): its latched counts still go
+    /// through the encoder check, so the next sample's first step is one trigger long.
+    pub fn skip(&mut self, latched: &[u16; OVERSAMPLING]) {
+        self.builder.skip(latched);
+    }
+
+    /// One sample: `v` and `i` its sequences of ADC1 and ADC2 (`[a, b, c, a, b, c, ...]`),
+    /// `latched` the encoder counts latched at its triggers (oldest first).
+    #[inline]
+    pub fn frame(
+        &mut self,
+        v: &[u16; HALF_LEN],
+        i: &[u16; HALF_LEN],
+        latched: &[u16; OVERSAMPLING],
+    ) -> RawFrame {
+        let b = self.builder.build(v, i, latched);
+        let ([va, vb, vc], [ia, ib, ic], [voltage, current]) = (b.v, b.i, b.clipped);
+        RawFrame {
+            v: [VoltageCode(va), VoltageCode(vb), VoltageCode(vc)],
+            i: [CurrentCode(ia), CurrentCode(ib), CurrentCode(ic)],
+            encoder_count: b.count,
+            clipped: Clipped { voltage, current },
+            encoder_rejects: b.encoder_rejects,
         }
     }
 }

@@ -8,16 +8,17 @@ use monitor_core::status_line::StatusLine;
 /// probability: [`isolation_summary`]) and the winding temperature rise the isolation
 /// tracks since commissioning (`rise_k` [K]); `panel`: the panel's mode and the one
 /// verdict on the lamps ([`Mode::name`], [`Verdict::name`] of [`panel_call`]);
-/// `max_update_cycles`: the longest `Monitor::update` [CPU cycles]; `restarts`: the ADC
-/// DMA overruns and the sampling restarts since boot; `supply`: the latest VDDA [V] (0
-/// before the first reading or when unreadable) and the brown-out level (255: reserved).
+/// `max_update_cycles`: the longest `Monitor::update` [CPU cycles]; `board`: the counters
+/// the firmware keeps outside the sample path's status (overruns, restarts, the stack's
+/// high-water mark); `supply`: the latest VDDA [V] (0 before the first reading or when
+/// unreadable) and the brown-out level (255: reserved).
 pub fn status_line(
     s: &MonitorStatus,
     iso: Option<&Isolation>,
     rise_k: f32,
     panel: (&'static str, &'static str),
     max_update_cycles: u32,
-    restarts: (u32, u32),
+    board: BoardCounters,
     supply: (f32, u8),
 ) -> StatusLine<'static> {
     let (mode, call) = panel;
@@ -34,8 +35,8 @@ pub fn status_line(
         zero_crossing_locked: s.zero_crossing_locked,
         mode,
         run: (s.run.id, s.run.blocks_learned, s.run.blocks_needed),
-        overruns: restarts.0,
-        restarts: restarts.1,
+        overruns: board.overruns,
+        restarts: board.restarts,
         samples: s.samples,
         max_update_cycles,
         iqs_a: s.operating.iqs,
@@ -53,5 +54,20 @@ pub fn status_line(
         winding_rise_k: rise_k,
         vdda_v: supply.0,
         bor: supply.1,
+        clipped: s.clipped,
+        encoder_rejects: s.encoder_rejects,
+        stack_used_bytes: board.stack_used_bytes,
+        clip_range: s.clip_range,
     }
+}
+
+/// The counters the status line takes from the firmware besides the sample path's status.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BoardCounters {
+    /// `overruns=`: the ADC DMA rings lapped since boot.
+    pub overruns: u32,
+    /// `restarts=`: the acquisition's recoveries since boot.
+    pub restarts: u32,
+    /// `stack=`: the stack's high-water mark since boot [bytes] (`crate::stack`).
+    pub stack_used_bytes: u32,
 }

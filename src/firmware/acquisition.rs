@@ -218,6 +218,11 @@ impl AcqRegisters for HwRegisters {
         pac::DMA1.ch(dma(i)).cr().modify(|w| w.set_en(true));
     }
 
+    fn latch_request(&mut self, on: bool) {
+        // TIM4's capture DMA request on channel 3 (withdrawn when cleared).
+        pac::TIM4.dier().modify(|w| w.set_ccde(2, on));
+    }
+
     fn latch_disable(&mut self) {
         self.latch.request_pause();
     }

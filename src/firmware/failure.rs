@@ -95,10 +95,11 @@ unsafe fn HardFault(frame: &cortex_m_rt::ExceptionFrame) -> ! {
     ))
 }
 
-/// The NMI: a double ECC error in a record page (`FLASH_ECCR.ECCD` with the page's
-/// address) is latched and cleared, and the handler returns: the read completes, the
-/// checked read rejects it and the boot falls back (`drive_monitor::flash_ecc`). Any other
-/// NMI is a fault.
+/// The NMI: a clock failure (the clock security system's `RCC_CIFR.CSSF`) is recorded and
+/// ends in a reset onto the HSI; a double ECC error in a record page (`FLASH_ECCR.ECCD`
+/// with the page's address) is latched and cleared, and the handler returns: the read
+/// completes, the checked read rejects it and the boot falls back
+/// (`drive_monitor::flash_ecc::nmi_cause`). Any other NMI is a fault.
 #[cortex_m_rt::exception]
 #[allow(unsafe_code)]
 unsafe fn NonMaskableInt() {
@@ -106,7 +107,18 @@ unsafe fn NonMaskableInt() {
     // critical section): the handler touches only `FLASH_ECCR`, the `ECC` latch (an
     // atomic) and, for a fault, the fault path, which never returns.
     let eccr = pac::FLASH.eccr().read();
-    match flash_ecc::nmi_action(eccr.0) {
+    match flash_ecc::nmi_cause(pac::RCC.cifr().read().0, eccr.0) {
+        NmiAction::ClockFailure => {
+            // The hardware runs SYSCLK from the HSI now. Clear CSSF (the NMI would pend
+            // again), record the failure, reset: the next boot runs the PLL from the HSI.
+            pac::RCC.cicr().write(|w| w.set_cssc(true));
+            cortex_m::interrupt::disable();
+            end(fault_path::on_fault(
+                &GUARD,
+                &mut Registers,
+                ResetRecord::clock_failure(),
+            ))
+        }
         NmiAction::RecordPageEcc(e) => {
             ECC.latch(e);
             // Write 1 to clear ECCD (and ECCC); the other bits are read-only or enables.

@@ -111,3 +111,50 @@ pub(super) fn read_motor_page(flash: &mut BoardFlash) -> [u8; MOTOR_RECORD_LEN] 
     }
     page
 }
+
+/// The reset log's two pages (`drive_monitor::reset_record::log`) in bank 2 at
+/// `board::RESET_LOG_FLASH_OFFSET`: reads checked for ECC double errors, erases and writes
+/// refused below the brown-out goal (as the records'; the boot appends before sampling
+/// starts, so nothing is running that an erase could hold up).
+pub(super) struct LogPages<'a> {
+    pub(super) flash: &'a mut BoardFlash,
+    pub(super) bor: BorCheck,
+}
+
+impl LogPages<'_> {
+    fn offset(page: usize, offset: usize) -> u32 {
+        board::RESET_LOG_FLASH_OFFSET + page as u32 * board::RECORD_PAGE_SIZE + offset as u32
+    }
+}
+
+impl drive_monitor::reset_record::log::LogFlash for LogPages<'_> {
+    type Error = FlashError;
+    fn read(&mut self, page: usize, offset: usize, buf: &mut [u8]) -> Result<(), FlashError> {
+        self.flash.read_at(Self::offset(page, offset), buf)
+    }
+    fn erase(&mut self, page: usize) -> Result<(), FlashError> {
+        if !self.bor.allows_flash_writes() {
+            return Err(FlashError::bor_refused(self.bor));
+        }
+        let from = Self::offset(page, 0);
+        self.flash
+            .0
+            .raw
+            .get()?
+            .blocking_erase(from, from + board::RECORD_PAGE_SIZE)
+            .map_err(FlashError::Driver)?;
+        self.flash.0.erased(from);
+        Ok(())
+    }
+    fn write(&mut self, page: usize, offset: usize, bytes: &[u8]) -> Result<(), FlashError> {
+        if !self.bor.allows_flash_writes() {
+            return Err(FlashError::bor_refused(self.bor));
+        }
+        self.flash
+            .0
+            .raw
+            .get()?
+            .blocking_write(Self::offset(page, offset), bytes)
+            .map_err(FlashError::Driver)
+    }
+}

@@ -7,6 +7,7 @@ use core::sync::atomic::Ordering;
 use defmt::{error, info, warn};
 use drive_monitor::board::{ReferenceCheck, VDDA_BAND_V};
 use drive_monitor::boot::{Booted, CalibrationMissing};
+use drive_monitor::clip_watch::RangeChange;
 use drive_monitor::clock::ClockSource;
 use drive_monitor::commissioning::RunEnd;
 use drive_monitor::flash_record::{self, StoreError};
@@ -54,7 +55,7 @@ pub(super) fn log_clock(source: ClockSource) {
             source.name(),
             source.error_ppm()
         ),
-        ClockSource::Hsi => warn!(
+        ClockSource::Hsi | ClockSource::HsiAfterFailure => warn!(
             "clock: {=str}; frequencies, speeds and time constants are known to +-{=u32} ppm only (the RUN lamp's steady 2 s from 5 s of every 10 s)",
             source.name(),
             source.error_ppm()
@@ -83,12 +84,18 @@ pub(super) fn log_reference(change: ReferenceChange) {
 }
 
 /// Why the previous run ended: the reset record (then erased) and the reset flags (then
-/// cleared), logged.
-pub(super) fn previous_run() -> PreviousRun {
+/// cleared), read before the clock set-up (a clock failure's record decides the clock
+/// source) and logged later ([`log_previous_run`]).
+pub(super) fn read_previous_run() -> (PreviousRun, ResetSource) {
     let source = ResetSource::from_csr(pac::RCC.csr().read().0);
     pac::RCC.csr().modify(|w| w.set_rmvf(true));
     let previous = PreviousRun::at_boot(&read_reset_record(), source);
     write_reset_record(&[0; RESET_RECORD_LEN]);
+    (previous, source)
+}
+
+/// The previous run's end ([`read_previous_run`]) in the log.
+pub(super) fn log_previous_run(previous: PreviousRun, source: ResetSource) {
     info!("reset by {=str}", source.name());
     match previous {
         PreviousRun::Clean => {}
@@ -103,7 +110,6 @@ pub(super) fn previous_run() -> PreviousRun {
         ),
         PreviousRun::Recorded(rec) => log_record(&rec),
     }
-    previous
 }
 
 fn log_record(rec: &ResetRecord) {
@@ -137,6 +143,9 @@ fn log_record(rec: &ResetRecord) {
         ResetCause::SampleStall => error!(
             "previous run ended in a watchdog reset: the sample path had stalled (no samples for {=u32} ms when recorded; recoveries did not help)",
             rec.line_or_ms()
+        ),
+        ResetCause::ClockFailure => error!(
+            "previous run ended in a clock failure: the crystal stopped and the clock security system switched to the HSI; running on the HSI (+-1 %), the crystal not tried again until the next reset"
         ),
     }
 }
@@ -226,5 +235,48 @@ pub(super) fn log_stored<E: defmt::Format>(stored: &flash_record::Stored<E>) {
         }
         Err(StoreError::Erase(e)) => error!("flash erase failed: {}", e),
         Err(StoreError::Write(e)) => error!("flash write failed: {}", e),
+    }
+}
+
+/// The stack: an overflow in the previous run (its guard words written; the previous run
+/// then ended in a fault or a lock-up), and the region's size.
+pub(super) fn log_stack(overflowed: bool) {
+    if overflowed {
+        error!("previous run: the stack reached the bottom of RAM (a stack overflow; flip-link made it fault instead of overwriting the statics)");
+    }
+}
+
+/// The reset log's entry appended for the previous run, or why not.
+pub(super) fn log_reset_log<E: defmt::Format>(appended: Option<Result<u32, E>>) {
+    match appended {
+        None => {}
+        Some(Ok(seq)) => info!("reset log: entry #{=u32} written to flash", seq),
+        Some(Err(e)) => warn!("reset log: not written: {}", e),
+    }
+}
+
+/// A new correction of the readings for the ADC's reference (VDDA now over VDDA at
+/// commissioning, `drive_monitor::supply::ReferenceGain`).
+pub(super) fn log_reference_gain(gain: f32) {
+    info!(
+        "reference: readings corrected by {=f32} (VDDA now over VDDA at commissioning)",
+        gain
+    );
+}
+
+/// The range state changed (`drive_monitor::clip_watch`): clipping persists in steady
+/// running (the front end's linear range too small for this motor: the verdict could not
+/// judge, the panel's range mark), or no longer; the front ends that clipped in the window
+/// that decided it and its share of clipped samples.
+pub(super) fn log_clip_range(change: RangeChange) {
+    if change.too_small {
+        warn!(
+            "clip: {=u32} per mille of the samples clipped in steady running for 6 s (voltage {=bool}, current {=bool}): the front end's linear range is too small for this motor, not judged",
+            change.permille,
+            change.voltage,
+            change.current
+        );
+    } else {
+        info!("clip: steady running without clipping for 6 s: judged again");
     }
 }

@@ -10,14 +10,13 @@ use core::sync::atomic::Ordering;
 use defmt::{error, info, warn};
 use drive_monitor::acquisition::{self as geometry, DMA_HALF_LEN, HALF_LEN, RING_LEN};
 use drive_monitor::adc_rules::{self, IdleDiscard, PairError};
-use drive_monitor::app::SamplePath;
-use drive_monitor::board::{self, CurrentCode, VoltageCode};
+use drive_monitor::app::{Command, FrameBuilder, SamplePath};
+use drive_monitor::board;
 use drive_monitor::clock;
 use drive_monitor::liveness::AdcWait;
 use drive_monitor::motor_source::EncoderSetup;
 use drive_monitor::recovery::{self, RecoveryCounts, StepTimeout};
 use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
-use drive_monitor::sampling::RawFrame;
 use drive_monitor::setup_guard::SetupStep;
 use embassy_stm32::adc::{Adc, AdcChannel, Exten, RingBufferedAdc, SampleTime};
 use embassy_stm32::dma::{self, ReadableRingBuffer, TransferOptions};
@@ -31,7 +30,10 @@ use embassy_time::{with_timeout, Duration, TimeoutError};
 use super::acquisition::{self, HwAcquisition};
 use super::reset_ram::{set_phase, write_reset_record};
 use super::supply;
-use super::{Irqs, Status, COMMANDS, OVERRUNS, REFERENCE, RESTARTS, SETTINGS, STATUS, TRIM};
+use super::{
+    Irqs, Status, COMMANDS, OVERRUNS, PAUSED, PAUSE_LIMIT_MS, REFERENCE, RESTARTS, RESUME,
+    SETTINGS, STATUS, TRIM,
+};
 
 /// Everything the sample task owns.
 pub(super) struct SampleHw {
@@ -54,6 +56,8 @@ pub(super) struct SampleHw {
     /// The supply frequency of the machine monitored [Hz] (the filter's gain is restored
     /// there: `geometry::PwmFilter`).
     pub(super) supply_hz: f32,
+    /// The six channels' linear ranges from the motor record (the clip check).
+    pub(super) ranges: geometry::LinearRanges,
 }
 
 /// The encoder: TIM4 in quadrature mode on PB6/PB7 with the motor record's pull-ups,
@@ -256,42 +260,41 @@ fn start_acquisition(
 }
 
 /// Runs the sample path on the readings of one DMA half (`v` from ADC1, `i` from ADC2:
-/// [`geometry::SAMPLES_PER_HALF`] samples of [`geometry::OVERSAMPLING`] sequences, each
-/// sample summed and filtered by `filter`, `geometry::PwmFilter`: the inverter's in-band
-/// ripple out, the encoder count held back with it) with the encoder counts of its samples
-/// (`counts`: each the mean of the counts TIM4 latched at the sample's triggers,
-/// `geometry::sample_count`); hands thread mode a status every `status_every` samples. `max_cycles`: the
-/// longest oversampling, filter and `on_frame` of one sample so far, in CPU cycles.
+/// [`geometry::SAMPLES_PER_HALF`] samples of [`geometry::OVERSAMPLING`] sequences) and the
+/// encoder counts latched at the same triggers (`latched`): each sample's frame built by
+/// `frames` (`app::FrameBuilder`: the sequences summed with every conversion checked for
+/// clipping, the inverter's ripple filtered, the latched counts checked against the
+/// maximum speed and averaged), then `SamplePath::on_frame`; hands thread mode a status
+/// every `status_every` samples. `max_cycles`: the longest frame and `on_frame` of one
+/// sample so far, in CPU cycles.
 fn process_half(
     path: &mut SamplePath,
-    filter: &mut geometry::PwmFilter,
+    frames: &mut FrameBuilder,
     (v, i): (&[u16], &[u16]),
-    counts: [u16; geometry::SAMPLES_PER_HALF],
+    latched: &[u16],
     discard: &mut IdleDiscard,
     max_cycles: &mut u32,
 ) {
-    let samples = v.chunks_exact(HALF_LEN).zip(i.chunks_exact(HALF_LEN));
-    for ((v, i), encoder_count) in samples.zip(counts) {
+    let samples = v
+        .as_chunks::<HALF_LEN>()
+        .0
+        .iter()
+        .zip(i.as_chunks::<HALF_LEN>().0);
+    for ((v, i), counts) in samples.zip(latched.as_chunks::<{ geometry::OVERSAMPLING }>().0) {
         if discard.drop_next() {
-            // The first sample after a long idle (errata): dropped, its time skipped.
+            // The first sample after a long idle (errata): dropped, its time skipped; its
+            // counts still go through the encoder check.
+            frames.skip(counts);
             path.sampler_mut().skip();
             continue;
         }
         let t0 = cortex_m::peripheral::DWT::cycle_count();
-        let ((vs, n), (is, _)) = (geometry::sum_half(v), geometry::sum_half(i));
-        let ([va, vb, vc], [ia, ib, ic], encoder_count) = filter.step(vs, is, n, encoder_count);
-        let filtering = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t0);
-        let raw = RawFrame {
-            v: [VoltageCode(va), VoltageCode(vb), VoltageCode(vc)],
-            i: [CurrentCode(ia), CurrentCode(ib), CurrentCode(ic)],
-            encoder_count,
-        };
+        let raw = frames.frame(v, i, counts);
         if let Some(trim) = path.trim_offsets(&raw) {
             TRIM.signal(trim);
         }
-        let t1 = cortex_m::peripheral::DWT::cycle_count();
         path.on_frame(&raw);
-        let dt = filtering + cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t1);
+        let dt = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t0);
         *max_cycles = (*max_cycles).max(dt);
         if path.samples().is_multiple_of(SETTINGS.status_every()) {
             STATUS.signal(Status {
@@ -303,13 +306,20 @@ fn process_half(
 }
 
 /// The sample task: sets up the acquisition, then per DMA half (`SAMPLES_PER_HALF`
-/// samples, the ring's depth from the latency budget) waits for both
-/// ADCs' data, bounded by [`AdcWait`]'s timeout; recovers the acquisition when no data came
-/// or the DMA lapped the reader, else applies thread mode's commands and runs the sample
-/// path on the half.
+/// samples, the ring's depth from the latency budget) checks that every ring runs (a DMA
+/// error since the last read: the recovery now, not the HAL's restart inside `read`,
+/// `recovery::before_read`), waits for both ADCs' data, bounded by [`AdcWait`]'s timeout;
+/// recovers the acquisition when no data came or the DMA lapped the reader, else applies
+/// thread mode's commands (a pause for a flash erase among them) and runs the sample path
+/// on the half.
 #[embassy_executor::task]
 pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
-    let mut filter = geometry::PwmFilter::new(SETTINGS.sample_rate_hz, hw.supply_hz);
+    let mut frames = FrameBuilder::new(
+        SETTINGS.sample_rate_hz,
+        hw.supply_hz,
+        hw.ranges,
+        hw.encoder.max_step_per_trigger,
+    );
     // The encoder driver is kept (its timer counts); the count is read from the latch.
     let (_qei, mut acq) = set_up_acquisition(hw, &mut path);
     let mut wait = AdcWait::new(SETTINGS.sample_rate_hz);
@@ -324,6 +334,12 @@ pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
     let mut max_cycles: u32 = 0;
     let mut counts = RecoveryCounts::default();
     loop {
+        if let Some(result) = recovery::before_read(&mut acq) {
+            RESTARTS.fetch_add(1, Ordering::Relaxed);
+            after_restart(&acq, &mut path, &mut counts, result);
+            restarted(&mut discard, &mut frames, &acq, last_data_us);
+            continue;
+        }
         let read = with_timeout(timeout, async {
             let r1 = acq.regs.adc1.read(&mut half1).await;
             let r2 = acq.regs.adc2.read(&mut half2).await;
@@ -335,24 +351,36 @@ pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
         .await;
         if needs_recovery(read, &mut wait) {
             recover_acquisition(&mut acq, &mut path, &mut counts);
-            discard.on_start(acq.regs.started_us.wrapping_sub(last_data_us));
+            restarted(&mut discard, &mut frames, &acq, last_data_us);
             continue;
         }
-        apply_commands(&mut path);
-        let halves = (&half1[..], &half2[..]);
-        let mut sequences = latched.chunks_exact(geometry::OVERSAMPLING);
-        let counts: [u16; geometry::SAMPLES_PER_HALF] =
-            core::array::from_fn(|_| sequences.next().map_or(0, geometry::sample_count));
+        if apply_commands(&mut path, &mut acq).await {
+            restarted(&mut discard, &mut frames, &acq, last_data_us);
+            continue;
+        }
         last_data_us = embassy_time::Instant::now().as_micros() as u32;
         process_half(
             &mut path,
-            &mut filter,
-            halves,
-            counts,
+            &mut frames,
+            (&half1[..], &half2[..]),
+            &latched,
             &mut discard,
             &mut max_cycles,
         );
     }
+}
+
+/// After the acquisition restarted (a recovery, or a pause for a flash erase): the first
+/// sample is dropped if the ADCs idled more than 1 ms since `last_data_us` (errata), and the
+/// encoder check starts afresh (the shaft moved during the gap).
+fn restarted(
+    discard: &mut IdleDiscard,
+    frames: &mut FrameBuilder,
+    acq: &HwAcquisition,
+    last_data_us: u32,
+) {
+    discard.on_start(acq.regs.started_us.wrapping_sub(last_data_us));
+    frames.restart();
 }
 
 /// [`start_acquisition`] under the reset record: the HAL's ADC set-up waits on registers
@@ -419,6 +447,17 @@ fn recover_acquisition(
 ) {
     set_phase(BootPhase::Recovery);
     let result = recovery::recover(acq);
+    after_restart(acq, path, counts, result);
+}
+
+/// After a recovery's `result`: the timestamps continue from the restart, the result
+/// counted in `counts` and logged.
+fn after_restart(
+    acq: &HwAcquisition,
+    path: &mut SamplePath,
+    counts: &mut RecoveryCounts,
+    result: Result<recovery::Faults, StepTimeout>,
+) {
     path.sampler_mut().resync(acq.regs.started_us);
     set_phase(BootPhase::Sampling);
     counts.count(result);
@@ -439,12 +478,40 @@ fn recover_acquisition(
 }
 
 /// Applies thread mode's queued commands to the sample path (between two samples); a
-/// refused one is logged.
-#[inline]
-fn apply_commands(path: &mut SamplePath) {
+/// refused one is logged. A pause (`Command::PauseAcquisition`, before a flash erase) stops
+/// the acquisition (`recovery::pause`), tells thread mode (`PAUSED`) and waits for its
+/// resume (`RESUME`, at most `PAUSE_LIMIT_MS`), then starts it again (`recovery::resume`);
+/// returns whether it did.
+async fn apply_commands(path: &mut SamplePath, acq: &mut HwAcquisition) -> bool {
+    let mut paused = false;
     while let Ok(cmd) = COMMANDS.try_receive() {
+        if cmd == Command::PauseAcquisition {
+            pause_for_flash(acq, path).await;
+            paused = true;
+            continue;
+        }
         if let Err(e) = path.command(cmd) {
             warn!("core refused a command: {=str}", e.describe());
         }
     }
+    paused
+}
+
+/// The acquisition paused while thread mode erases and writes the flash (module docs of
+/// `drive_monitor::recovery`, `pause`): nothing converts or moves, so nothing laps;
+/// resumed when thread mode says so, or after [`PAUSE_LIMIT_MS`] whatever it says.
+async fn pause_for_flash(acq: &mut HwAcquisition, path: &mut SamplePath) {
+    set_phase(BootPhase::Recovery);
+    let paused = recovery::pause(acq);
+    PAUSED.signal(paused.is_ok());
+    let limit = Duration::from_millis(u64::from(PAUSE_LIMIT_MS));
+    if with_timeout(limit, RESUME.wait()).await.is_err() {
+        warn!(
+            "flash: no resume within {=u32} ms: sampling restarted",
+            PAUSE_LIMIT_MS
+        );
+    }
+    recovery::resume(acq);
+    path.sampler_mut().resync(acq.regs.started_us);
+    set_phase(BootPhase::Sampling);
 }

@@ -54,10 +54,10 @@ fn a_good_record_is_the_machine_of_the_path_the_isolator_and_the_encoder() {
     assert_eq!(m.source, MachineSource::Flash);
     assert_eq!(m.record, rec);
     assert_eq!(m.isolation, Ok(()));
-    assert_eq!(m.encoder, motor_source::encoder_setup(&rec));
+    assert_eq!(m.encoder, motor_source::encoder_setup(&rec, 10_000));
     let cfg = booted.path.monitor().config();
     assert_eq!(cfg.encoder.counts_per_rev, 10_000);
-    assert_eq!(cfg.limits.i_max, 25.0);
+    assert_eq!(cfg.limits.i_max, 2.5 * 25.0);
     assert_eq!(cfg.motor, MOTOR_3HP.motor.model());
     assert_eq!(
         booted.path.sampler().front_end().current[0].offset_code,
@@ -165,6 +165,7 @@ fn the_encoder_settings_of_the_record_are_applied() {
             invert_a: true,
             input_filter: 9,
             pull_up: false,
+            max_step_per_trigger: 9,
         }
     );
     // The built-in default's: 1024 lines counting up, pull-ups on.
@@ -176,6 +177,7 @@ fn the_encoder_settings_of_the_record_are_applied() {
             invert_a: false,
             input_filter: 14,
             pull_up: true,
+            max_step_per_trigger: 4,
         }
     );
 }
@@ -240,7 +242,7 @@ impl drive_monitor::flash_ecc::RawFlash for TornFlash<'_> {
             let eccr = ECCR_ECCD | ECCR_BK_ECC | (self.torn_at - BANK_SIZE);
             match nmi_action(eccr) {
                 NmiAction::RecordPageEcc(e) => self.latch.latch(e),
-                NmiAction::Fault => return Err(NmiReset),
+                NmiAction::Fault | NmiAction::ClockFailure => return Err(NmiReset),
             }
         }
         Ok(())

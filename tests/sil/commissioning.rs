@@ -274,6 +274,7 @@ fn a_corrupt_or_unusable_record_at_boot_means_not_commissioned_everywhere() {
         mean: [5.0, 0.0, 0.0, 0.0],
         spread: [0.1; 4],
         isolation: None,
+        vdda_v: None,
     });
     for flash in [flipped, unusable, FakeFlash::erased()] {
         let mut rig = Rig::boot(Survivors::power_on(flash));

@@ -15,18 +15,23 @@
 //! the next boot would load) and the panel (the RUN lamp's mode) agree.
 
 mod boot_composition;
+mod clipping;
 mod commissioning;
+mod conversions;
 mod evidence;
+mod flash_pause;
+mod hal_restart;
 mod isolation;
 mod liveness;
 mod moved;
 mod recovery;
+mod reference_gain;
 mod same_state;
 mod startup;
 
 use drive_monitor::app::{
-    carry_out, panel_input, MonitorStatus, SamplePath, Settings, Supervisor, Tick, PANEL_PERIOD_MS,
-    WATCHDOG_TIMEOUT_MS,
+    carry_out, panel_input, AcquisitionPause, Command, MonitorStatus, SamplePath, Settings,
+    Supervisor, Tick, PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
 };
 use drive_monitor::board::Lamp;
 use drive_monitor::board::{self, RECORD_PAGE_SIZE};
@@ -224,6 +229,25 @@ struct Rig {
     reference: Option<startup::FakeReference>,
     /// The reference verdict's changes, with the tick's time [ms].
     reference_changes: Vec<(u32, drive_monitor::supply::ReferenceChange)>,
+    /// The flash stores that paused the acquisition (`app::carry_out`).
+    paused_for_flash: u32,
+}
+
+/// The sample task's pause around a flash store on the rig: the firmware's
+/// `recovery::pause` and `recovery::resume` on the register model.
+struct ModelPause<'a> {
+    acq: &'a mut recovery::ModelAcq,
+    paused: &'a mut u32,
+}
+
+impl AcquisitionPause for ModelPause<'_> {
+    fn pause(&mut self) -> bool {
+        *self.paused += 1;
+        drive_monitor::recovery::pause(self.acq).is_ok()
+    }
+    fn resume(&mut self) {
+        drive_monitor::recovery::resume(self.acq);
+    }
 }
 
 impl Rig {
@@ -271,6 +295,7 @@ impl Rig {
             ended: Vec::new(),
             reference: None,
             reference_changes: Vec::new(),
+            paused_for_flash: 0,
         }
     }
 
@@ -362,7 +387,15 @@ impl Rig {
             }
             _ => {}
         }
-        let (command, _stored) = carry_out(tick.action, &mut self.survivors.flash);
+        if let Some(gain) = tick.reference_gain {
+            // Handed to the sample task on the board (a command between two samples).
+            let _ = self.path.command(Command::ReferenceGain(gain));
+        }
+        let mut pause = ModelPause {
+            acq: &mut self.acq,
+            paused: &mut self.paused_for_flash,
+        };
+        let (command, _stored) = carry_out(tick.action, &mut self.survivors.flash, &mut pause);
         if self.survivors.flash.power_lost {
             self.survivors.reset_source = ResetSource::PowerOnOrBrownOut;
             return Err(Reset::PowerLoss);
@@ -492,6 +525,7 @@ fn old_record() -> CalibrationRecord {
         mean: [0.0, 0.001, -0.001, 0.0],
         spread: [0.004; 4],
         isolation: None,
+        vdda_v: None,
     }
 }
 

@@ -34,7 +34,7 @@ pub(super) use model::{AdcDmaModel, ModelAcq, RING_LEN};
 
 /// What a weakened sequence leaves out.
 #[derive(Clone, Copy, PartialEq, Eq)]
-enum Without {
+pub(super) enum Without {
     /// The `EOC`/`EOS` clear: only `OVR` cleared in `ADC_ISR` (the sequence before the
     /// `EOC` clear).
     EocClear,
@@ -46,6 +46,8 @@ enum Without {
     SetOnlyMask,
     /// The encoder latch's reload with the ADCs' rings.
     LatchReload,
+    /// The capture request's toggle (`CC3DE` off in the pause, on after the re-arm).
+    Cc3deToggle,
 }
 
 /// The firmware's sequence with one access left out ([`Without`]): every other register
@@ -125,6 +127,11 @@ impl AcqRegisters for Weakened<'_> {
     fn latch_enable(&mut self) {
         self.0.latch_enable();
     }
+    fn latch_request(&mut self, on: bool) {
+        if self.1 != Without::Cc3deToggle {
+            self.0.latch_request(on);
+        }
+    }
     fn trigger_stop(&mut self) {
         self.0.trigger_stop();
     }
@@ -134,7 +141,10 @@ impl AcqRegisters for Weakened<'_> {
 }
 
 /// The recovery without `without` ([`Weakened`]).
-fn recover_weakened(acq: &mut ModelAcq, without: Without) -> Result<Faults, StepTimeout> {
+pub(super) fn recover_weakened(
+    acq: &mut ModelAcq,
+    without: Without,
+) -> Result<Faults, StepTimeout> {
     let mut weak = RegisterAcquisition {
         regs: Weakened(&mut acq.regs, without),
         ring_len: acq.ring_len,

@@ -102,6 +102,7 @@ pub fn sample(replay: &[u8], k: usize) -> Sample {
         timestamp_ticks: (k as u32).wrapping_mul(TICKS_PER_SAMPLE),
         v_saturated: sat(0) || sat(1) || sat(2),
         i_saturated: sat(3) || sat(4) || sat(5),
+        clipped: false,
     }
 }
 

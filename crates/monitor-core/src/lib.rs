@@ -139,6 +139,7 @@ pub(crate) mod testing {
             timestamp_ticks: (t * 1e6) as u32,
             v_saturated: false,
             i_saturated: false,
+            clipped: false,
         }
     }
 }

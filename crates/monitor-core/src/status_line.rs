@@ -10,6 +10,7 @@
 //! wm=Xrad/s zc_locked=.. mode=MODE run=ID:LEARNED/NEEDED overruns=N restarts=N samples=N
 //! max_cyc=N iqs=XA ids=XA vqs=XV f=XHz steady=B eval=B sens=B,B,B mid=[..] half=[..]
 //! iso=NAME iso_change=X iso_p=P wind=PHASE wind_i2=X moved=B rise=XK vdda=XV bor=N
+//! clip=N enc_rej=N stack=NB clip_range=B
 //! ```
 //!
 //! - **The format** is one literal ([`FORMAT`]) with its arguments, the fields of a
@@ -36,7 +37,7 @@ use crate::{verdict::Verdict, Fault, Phase};
 macro_rules! with_status_line {
     ($then:ident, $s:ident) => {
         $then!(
-            "r={} lamps={} fault={=bool} call={=str} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32} iqs={=f32}A ids={=f32}A vqs={=f32}V f={=f32}Hz steady={=bool} eval={=bool} sens={=bool},{=bool},{=bool} mid={} half={} iso={=str} iso_change={=f32} iso_p={=f32} wind={=str} wind_i2={=f32} moved={=bool} rise={=f32}K vdda={=f32}V bor={=u8}",
+            "r={} lamps={} fault={=bool} call={=str} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32} iqs={=f32}A ids={=f32}A vqs={=f32}V f={=f32}Hz steady={=bool} eval={=bool} sens={=bool},{=bool},{=bool} mid={} half={} iso={=str} iso_change={=f32} iso_p={=f32} wind={=str} wind_i2={=f32} moved={=bool} rise={=f32}K vdda={=f32}V bor={=u8} clip={=u32} enc_rej={=u32} stack={=u32}B clip_range={=bool}",
             $s.residuals,
             $s.lamps,
             $s.fault,
@@ -74,7 +75,11 @@ macro_rules! with_status_line {
             $s.moved,
             $s.winding_rise_k,
             $s.vdda_v,
-            $s.bor
+            $s.bor,
+            $s.clipped,
+            $s.encoder_rejects,
+            $s.stack_used_bytes,
+            $s.clip_range
         )
     };
 }
@@ -155,6 +160,17 @@ pub struct StatusLine<'a> {
     pub vdda_v: f32,
     /// `bor=`: the brown-out reset level (255: a reserved value).
     pub bor: u8,
+    /// `clip=`: samples since boot with a conversion at the front end's linear limit
+    /// (held out of the residuals, no sensor named; the board's per-conversion clip check).
+    pub clipped: u32,
+    /// `enc_rej=`: latched encoder counts since boot rejected as a step beyond the
+    /// maximum speed (a glitch, not motion).
+    pub encoder_rejects: u32,
+    /// `stack=`: the stack's high-water mark since boot [bytes] (the painted stack).
+    pub stack_used_bytes: u32,
+    /// `clip_range=`: clipping persists in steady running, so the front end's linear range
+    /// is too small for this motor (the board's range state; its verdict could not judge).
+    pub clip_range: bool,
 }
 
 #[cfg(feature = "defmt")]

@@ -51,6 +51,7 @@ impl Healthy {
             timestamp_ticks: ticks,
             v_saturated: false,
             i_saturated: false,
+            clipped: false,
         }
     }
 }

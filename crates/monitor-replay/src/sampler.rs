@@ -96,6 +96,7 @@ impl LogSampler {
             timestamp_ticks: round_i64(row.t_s * TICK_HZ) as u32,
             v_saturated: false,
             i_saturated: false,
+            clipped: false,
         }
     }
 }

@@ -11,8 +11,9 @@
 //! - the sample path is the SysTick exception every [`INSTRUCTIONS_PER_SAMPLE`] = 17 000
 //!   instructions (QEMU's `-icount shift=0` runs one instruction per virtual nanosecond;
 //!   17 000 are the G474's cycles in 100 us at 170 MHz, counted as one instruction each),
-//!   its work a loop of 464 instructions (per sample on the board, `cargo qemu-core`: the
-//!   core's 242 and the sampling path's 222 ahead of it);
+//!   its work a loop of 562 instructions (per sample on the board, `cargo qemu-core`:
+//!   the core's 244 and the sampling path's 318 ahead of it, with the clip and encoder
+//!   checks);
 //! - thread mode logs the firmware's status line with its format string (the core's
 //!   `monitor_core::status_line::FORMAT`; `tests/logging_never_blocks.rs` checks that the two
 //!   are the same).
@@ -61,8 +62,8 @@ const SAMPLES_PER_PHASE: u32 = 10_000;
 /// The firmware's status line: every 100 ms (its thread mode's period 50 ms, every second
 /// period), 1 000 samples.
 const STATUS_EVERY: u32 = 1_000;
-/// Iterations of the sample path's stand-in loop (two instructions each: 464 in all).
-const PATH_LOOP: u32 = 232;
+/// Iterations of the sample path's stand-in loop (two instructions each: 562 in all).
+const PATH_LOOP: u32 = 281;
 /// The watchdog's NMI after this many TIMER0 ticks (0.6 s of QEMU's virtual time at 25 MHz,
 /// about 3.5 s of the board's: both phases take 2 s).
 const WATCHDOG_TICKS: u32 = 15_000_000;
@@ -82,7 +83,7 @@ static DONE: AtomicBool = AtomicBool::new(false);
 /// Which phase runs (for the watchdog's report).
 static PHASE: AtomicU32 = AtomicU32::new(0);
 
-/// The sample path: one sample per SysTick, its lateness against TIMER0, 464 instructions
+/// The sample path: one sample per SysTick, its lateness against TIMER0, 562 instructions
 /// of work; the last sample of the phase stops SysTick.
 #[exception]
 fn SysTick() {
@@ -244,7 +245,7 @@ fn log_status(samples: u32, line: u32) {
     let half = [0.006, 0.011, 0.012, 0.007];
     let zc: Option<bool> = None;
     defmt::info!(
-        "r={} lamps={} fault={=bool} call={=str} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32} iqs={=f32}A ids={=f32}A vqs={=f32}V f={=f32}Hz steady={=bool} eval={=bool} sens={=bool},{=bool},{=bool} mid={} half={} iso={=str} iso_change={=f32} iso_p={=f32} wind={=str} wind_i2={=f32} moved={=bool} rise={=f32}K vdda={=f32}V bor={=u8}",
+        "r={} lamps={} fault={=bool} call={=str} top={=str}({=f32}) 2nd={=str}({=f32}) wm={=f32}rad/s zc_locked={} mode={=str} run={=u16}:{=u32}/{=u32} overruns={=u32} restarts={=u32} samples={=u32} max_cyc={=u32} iqs={=f32}A ids={=f32}A vqs={=f32}V f={=f32}Hz steady={=bool} eval={=bool} sens={=bool},{=bool},{=bool} mid={} half={} iso={=str} iso_change={=f32} iso_p={=f32} wind={=str} wind_i2={=f32} moved={=bool} rise={=f32}K vdda={=f32}V bor={=u8} clip={=u32} enc_rej={=u32} stack={=u32}B clip_range={=bool}",
         residuals,
         lamps,
         true,
@@ -282,7 +283,11 @@ fn log_status(samples: u32, line: u32) {
         false,
         12.5,
         3.301,
-        4u8
+        4u8,
+        0u32,
+        0u32,
+        2344u32,
+        false
     );
 }
 

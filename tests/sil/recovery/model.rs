@@ -79,6 +79,10 @@ pub(crate) struct DmaModel {
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct LatchModel {
     pub(crate) en: bool,
+    /// `TIM4_DIER.CC3DE`: each capture raises a DMA request.
+    pub(crate) cc3de: bool,
+    /// A capture's DMA request not served yet, and the trigger it captured at.
+    pub(crate) request: Option<u64>,
     pub(crate) cndtr: u16,
     /// The trigger each ring position's count was captured at.
     pub(crate) ids: [u64; LATCH_LEN],
@@ -137,6 +141,8 @@ impl AdcDmaModel {
                 triggers: 0,
                 latch: LatchModel {
                     en: true,
+                    cc3de: true,
+                    request: None,
                     cndtr: LATCH_LEN as u16,
                     ids: [0; LATCH_LEN],
                 },
@@ -197,6 +203,41 @@ impl AdcDmaModel {
         }
     }
 
+    /// The latch's DMA channel serves the capture's request: the captured count into the
+    /// latch's ring.
+    fn serve_latch(&mut self) {
+        let l = &mut self.latch;
+        let Some(id) = l.request.filter(|_| l.en) else {
+            return;
+        };
+        l.request = None;
+        let at = LATCH_LEN - usize::from(l.cndtr);
+        l.ids[at] = id;
+        l.cndtr = if l.cndtr <= 1 {
+            LATCH_LEN as u16
+        } else {
+            l.cndtr - 1
+        };
+    }
+
+    /// A DMA transfer error on the latch's channel: the hardware clears its `EN`.
+    pub(crate) fn inject_latch_dma_error(&mut self) {
+        self.latch.en = false;
+    }
+
+    /// Embassy-stm32 0.6's `RingBufferedAdc::read` on ADC `i` as it begins: a ring whose
+    /// DMA channel is off is restarted by the HAL's own `start()`: the channel enabled
+    /// (no flag cleared, no `CNDTR` reloaded) and `ADC_CR` written by read-modify-write
+    /// with `ADSTART` (`ADEN` written back: a violation of the register rules).
+    pub(crate) fn hal_read(&mut self, i: usize) {
+        if self.dma[i].en {
+            return;
+        }
+        self.dma_enable(i);
+        let cr = self.adc_cr(i);
+        self.adc_cr_write(i, cr | CR_ADSTART);
+    }
+
     /// One trigger: each converting ADC runs its sequence of [`CHANNELS`] conversions
     /// (each ends an 870 ns conversion: an overrun if `EOC` is still set, else a result
     /// and a DMA request), the DMA serving the requests; then the clock runs to the next
@@ -206,17 +247,12 @@ impl AdcDmaModel {
         let t0 = self.now_ns;
         if self.trigger_on {
             self.conversions += 1;
-            // TIM4 captures its count at the trigger; the capture's DMA request moves it.
-            let l = &mut self.latch;
-            if l.en {
-                let at = LATCH_LEN - usize::from(l.cndtr);
-                l.ids[at] = self.triggers;
-                l.cndtr = if l.cndtr <= 1 {
-                    LATCH_LEN as u16
-                } else {
-                    l.cndtr - 1
-                };
+            // TIM4 captures its count at the trigger; the capture's DMA request moves it
+            // (held while the channel is off: the latest capture's, CCR3 overwritten).
+            if self.latch.cc3de {
+                self.latch.request = Some(self.triggers);
             }
+            self.serve_latch();
             self.triggers += 1;
             for rank in 0..CHANNELS {
                 let end = t0 + (rank as u64 + 1) * u64::from(conversion_ns());
@@ -421,6 +457,15 @@ impl AcqRegisters for AdcDmaModel {
     }
     fn latch_enable(&mut self) {
         self.latch.en = true;
+        // A capture's request raised while the channel was off is served now.
+        self.serve_latch();
+    }
+    fn latch_request(&mut self, on: bool) {
+        self.latch.cc3de = on;
+        if !on {
+            // Clearing CC3DE withdraws the timer's pending request.
+            self.latch.request = None;
+        }
     }
     fn trigger_stop(&mut self) {
         self.trigger_on = false;

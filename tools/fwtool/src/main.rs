@@ -3,7 +3,8 @@
 //! - `fw [--check]`: build the firmware ELF (the workspace's `firmware` profile: fat LTO,
 //!   one codegen unit, debug info) for `thumbv7em-none-eabihf`, then
 //!   read its section table and print flash and static RAM use against the goals
-//!   (128 KiB flash, 32 KiB RAM: the smallest STM32G4 part with the same peripherals).
+//!   (128 KiB flash, 32 KiB RAM: the smallest STM32G4 part with the same peripherals), and
+//!   whether the stack lies below the statics (flip-link; `--check` fails otherwise).
 //!   `--check` exits 1 when a goal is missed.
 //! - `qemu-core`: build `crates/core-on-m4` for `thumbv7em-none-eabihf`, check that its
 //!   vector table is at 0x0 (the mps2-an386 layout, not the G474's), and run it on
@@ -133,6 +134,9 @@ fn fw(check: bool) -> Result<(), String> {
         .join("firmware/drive-monitor");
     let elf = std::fs::read(&elf_path).map_err(|e| format!("{}: {e}", elf_path.display()))?;
     let (mut flash, mut ram) = (0u64, 0u64);
+    // The lowest address of a static in RAM: with flip-link the stack lies below the
+    // statics, from the start of RAM (docs/firmware.md, "The stack").
+    let mut first_static = u64::MAX;
     println!("{:<16} {:>8} {:>10}", "section", "bytes", "address");
     for Section {
         name,
@@ -149,6 +153,7 @@ fn fw(check: bool) -> Result<(), String> {
         let in_ram = (0x2000_0000..0x2002_0000).contains(&addr);
         if in_ram {
             ram += u64::from(size);
+            first_static = first_static.min(u64::from(addr));
             if ty != SHT_NOBITS {
                 flash += u64::from(size); // .data: initial values are stored in flash
             }
@@ -170,8 +175,27 @@ fn fw(check: bool) -> Result<(), String> {
         RAM_GOAL / 1024,
         verdict(ram, RAM_GOAL)
     );
+    let stack_below = first_static != u64::MAX && first_static > 0x2000_0000;
+    println!(
+        "stack={} ({:#010x}..{:#010x} below the statics: {})",
+        if stack_below {
+            "at the bottom of RAM"
+        } else {
+            "above the statics"
+        },
+        0x2000_0000u32,
+        first_static.min(0x2000_0000 + 128 * 1024),
+        if stack_below {
+            "flip-link: ok"
+        } else {
+            "NOT flip-link"
+        }
+    );
     if check && (flash > FLASH_GOAL || ram > RAM_GOAL) {
         return Err("size goal missed".into());
+    }
+    if check && !stack_below {
+        return Err("the statics start at the bottom of RAM: the firmware was not linked with flip-link (.cargo/config.toml)".into());
     }
     Ok(())
 }

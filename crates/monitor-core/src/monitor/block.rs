@@ -106,7 +106,8 @@ impl Derived {
 /// check at the block's end (one check per block instead of one per sample).
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct BlockExtremes {
-    /// Bit 0: a current channel saturated; bit 1: a voltage channel.
+    /// Bit 0: a current channel saturated; bit 1: a voltage channel; bit 2: a reading
+    /// clipped ([`Sample::clipped`]: held out, no sensor named).
     saturated: u8,
     /// The largest |phase voltage| as bit pattern (the sign bit cleared).
     v_bits: u32,
@@ -118,7 +119,8 @@ impl BlockExtremes {
     /// Adds one sample's readings.
     #[inline(always)]
     pub(super) fn add(&mut self, s: &Sample) {
-        self.saturated |= u8::from(s.i_saturated) | (u8::from(s.v_saturated) << 1);
+        self.saturated |=
+            u8::from(s.i_saturated) | (u8::from(s.v_saturated) << 1) | (u8::from(s.clipped) << 2);
         let m = 0x7fff_ffffu32;
         let vb = (s.v_abc.a.to_bits() & m)
             .max(s.v_abc.b.to_bits() & m)
@@ -131,17 +133,19 @@ impl BlockExtremes {
     }
 
     /// Ends the block: the sensors whose readings were impossible (saturated, out of range,
-    /// not finite) against the limits as bit patterns ([`Derived::v_max_bits`]), and the
-    /// extremes cleared for the next block.
+    /// not finite) against the limits as bit patterns ([`Derived::v_max_bits`]), whether a
+    /// reading was clipped (the block held out, no sensor named), and the extremes cleared
+    /// for the next block.
     #[inline(always)]
-    pub(super) fn take_verdict(&mut self, k: &Derived) -> SensorFlags {
+    pub(super) fn take_verdict(&mut self, k: &Derived) -> (SensorFlags, bool) {
         let bad = SensorFlags {
             current: (self.saturated & 1 != 0) | (self.i_bits > k.i_max_bits),
             voltage: (self.saturated & 2 != 0) | (self.v_bits > k.v_max_bits),
             speed: false,
         };
+        let clipped = self.saturated & 4 != 0;
         *self = BlockExtremes::default();
-        bad
+        (bad, clipped)
     }
 }
 

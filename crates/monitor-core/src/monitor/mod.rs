@@ -56,6 +56,14 @@ pub struct Sample {
     pub v_saturated: bool,
     /// A current channel's ADC was at its end stop.
     pub i_saturated: bool,
+    /// A reading was at or beyond its front end's linear range (an analog clip: a DOL
+    /// start's inrush on a current front end sized for the running current; the firmware's
+    /// per-conversion check). The sample's block is held out of the filters and the
+    /// residuals, as a saturated one is, but no sensor is flagged: a clip says the front
+    /// end's range was exceeded, not that a sensor gives readings no machine gives. (Whether
+    /// clipping persists, and what that says of the front end's range, is the caller's to
+    /// judge; the firmware's `clip_watch`.)
+    pub clipped: bool,
 }
 
 /// The drive monitor. Construction validates the configuration; [`Monitor::update`] never
@@ -185,7 +193,8 @@ impl Monitor {
     }
 
     /// Processes one sample and returns the updated output. Never panics: a non-finite,
-    /// out-of-range or saturated reading is held out of the estimators and flags its sensor.
+    /// out-of-range or saturated reading is held out of the estimators and flags its sensor;
+    /// a clipped one ([`Sample::clipped`]) is held out and flags nothing.
     pub fn update(&mut self, s: &Sample) -> &MonitorOutput {
         // Plausibility is checked once per block (slow path): the ADC flags and the
         // readings' extremes are collected here, their range and finiteness are checked

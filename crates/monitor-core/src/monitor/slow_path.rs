@@ -78,10 +78,15 @@ impl Monitor {
     #[inline(always)]
     fn block_end(&mut self, s: &Sample, wr_rad_s: f32, sc: SinCos) {
         let off_time = self.block_timing(s.timestamp_ticks);
-        // Plausibility of the block: saturation flags, range (NaN and inf fail, see update).
-        let bad = self.extremes.take_verdict(&self.derived);
+        // Plausibility of the block: saturation flags, range (NaN and inf fail, see update);
+        // a clipped reading holds the block out too, naming no sensor.
+        let (bad, clipped) = self.extremes.take_verdict(&self.derived);
         if bad.current | bad.voltage {
             self.flag(bad);
+            self.discard_block();
+            return;
+        }
+        if clipped {
             self.discard_block();
             return;
         }

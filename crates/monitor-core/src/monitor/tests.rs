@@ -93,6 +93,51 @@ fn nan_current_names_the_current_sensor() {
     assert_eq!(m.output().top(), Some((Fault::VoltageSensor, 1.0)));
 }
 
+/// A clipped reading (`Sample::clipped`: beyond the front end's linear range) holds its
+/// block out of the filters and the residuals, as a saturated one does, but flags no sensor
+/// (the synthetic machine's lamps are lit from the start: its fault candidates stay the
+/// lamps' own); the same reading flagged saturated names the current sensor.
+#[test]
+fn a_clipped_sample_is_held_out_and_names_no_sensor() {
+    let run = |mark: fn(&mut Sample)| {
+        let mut m = monitor(AngleSource::RotorFluxCurrentModel);
+        for k in 0..20_000 {
+            m.update(&healthy(k));
+        }
+        let before = *m.output();
+        assert!(before.evaluating && !before.sensor_fault.any());
+        // One sample of the next block marked, the rest of the block healthy.
+        let mut s = healthy(20_000);
+        s.i_abc.a *= 1.3;
+        mark(&mut s);
+        m.update(&s);
+        for k in 20_001..20_025 {
+            m.update(&healthy(k));
+        }
+        let after = *m.output();
+        // The next block, healthy: evaluated unless the settling time started again.
+        for k in 20_025..20_050 {
+            m.update(&healthy(k));
+        }
+        (before, after, m.output().evaluating)
+    };
+    let (before, after, evaluating) = run(|s| s.clipped = true);
+    assert!(!after.sensor_fault.any());
+    assert_eq!(after.top(), before.top());
+    assert!(!matches!(after.top(), Some((Fault::CurrentSensor, _))));
+    // Held out: the filters did not take the block, and the lamps wait for the settling time.
+    assert_eq!(after.operating, before.operating);
+    assert!(!evaluating);
+    // A healthy block moves the filters (the control).
+    let (before, after, evaluating) = run(|_| {});
+    assert_ne!(after.operating, before.operating);
+    assert!(evaluating);
+    // Saturated, the same reading names the current sensor.
+    let (_, after, _) = run(|s| s.i_saturated = true);
+    assert!(after.sensor_fault.current);
+    assert_eq!(after.top(), Some((Fault::CurrentSensor, 1.0)));
+}
+
 #[test]
 fn encoder_jump_names_the_speed_sensor() {
     let mut m = monitor(AngleSource::RotorFluxCurrentModel);
@@ -130,6 +175,7 @@ proptest! {
                     timestamp_ticks: k.wrapping_mul(100),
                     v_saturated: k % 7 == 0,
                     i_saturated: false,
+                    clipped: k % 11 == 0,
                 }
             } else {
                 healthy(k)

@@ -66,6 +66,15 @@ pub struct StatusReading<'a> {
     pub vdda_v: Option<f32>,
     /// `bor=`.
     pub bor: Option<u8>,
+    /// `clip=`: clipped samples since boot (firmware of issue 74 on).
+    pub clipped: Option<u32>,
+    /// `enc_rej=`: rejected encoder counts since boot (firmware of issue 74 on).
+    pub encoder_rejects: Option<u32>,
+    /// `stack=` [bytes]: the stack's high-water mark (firmware of issue 74 on).
+    pub stack_used_bytes: Option<u32>,
+    /// `clip_range=`: clipping persists in steady running, the front end's range is too
+    /// small for the motor (firmware of issue 74 on).
+    pub clip_range: Option<bool>,
 }
 
 /// The value of field `key` in `line` (`key=` at the start or after a space), up to the
@@ -197,6 +206,12 @@ pub fn parse(line: &str) -> Option<StatusReading<'_>> {
         winding_rise_k: f("rise"),
         vdda_v: f("vdda"),
         bor: field(line, "bor").and_then(|v| v.parse().ok()),
+        clipped: u("clip"),
+        encoder_rejects: u("enc_rej"),
+        stack_used_bytes: field(line, "stack")
+            .and_then(|v| v.strip_suffix('B'))
+            .and_then(|v| v.parse().ok()),
+        clip_range: b("clip_range"),
     })
 }
 
@@ -237,6 +252,10 @@ mod tests {
             winding_rise_k: 54.4,
             vdda_v: 3.301,
             bor: 4,
+            clipped: 17,
+            encoder_rejects: 3,
+            stack_used_bytes: 2_344,
+            clip_range: true,
         }
     }
 
@@ -277,6 +296,11 @@ mod tests {
         assert_eq!(r.winding, Some((Phase::B, 0.041)));
         assert_eq!((r.moved, r.winding_rise_k), (Some(true), Some(54.4)));
         assert_eq!((r.vdda_v, r.bor), (Some(3.301), Some(4)));
+        assert_eq!(
+            (r.clipped, r.encoder_rejects, r.stack_used_bytes),
+            (Some(17), Some(3), Some(2_344))
+        );
+        assert_eq!(r.clip_range, Some(true));
     }
 
     #[test]
@@ -293,7 +317,9 @@ mod tests {
         }
         assert!(text.starts_with("r=[0.0123, -0.1, 0.25, -0.004] lamps=[false, true, true, true] fault=true call=fault top=b(0.5) 2nd=bl(0.5) wm=150.5rad/s zc_locked=Some(true) "));
         assert!(
-            text.ends_with(" moved=true rise=54.4K vdda=3.301V bor=4"),
+            text.ends_with(
+                " moved=true rise=54.4K vdda=3.301V bor=4 clip=17 enc_rej=3 stack=2344B clip_range=true"
+            ),
             "{text}"
         );
     }
@@ -306,6 +332,19 @@ mod tests {
         assert_eq!(r.candidates, [None, None]);
         assert_eq!((r.iqs_a, r.band, r.isolation), (None, None, None));
         assert_eq!(r.call, Some(Verdict::Healthy));
+        // A line of the firmware before issue 74: its new fields absent, the rest read.
+        let before = "INFO  r=[0.1, 0.2, 0.3, 0.4] lamps=[false, false, false, false] fault=false call=healthy moved=false rise=0.0K vdda=3.3V bor=4";
+        let r = parse(before).expect("a status line");
+        assert_eq!((r.vdda_v, r.bor), (Some(3.3), Some(4)));
+        assert_eq!(
+            (
+                r.clipped,
+                r.encoder_rejects,
+                r.stack_used_bytes,
+                r.clip_range
+            ),
+            (None, None, None, None)
+        );
         for other in [
             "INFO  sampling at 10000 Hz",
             "└─ drive_monitor::firmware::log_status @ src/firmware.rs:545",

@@ -1,0 +1,182 @@
+//! The sample path's two kernels in Thumb-2 assembly, for the Cortex-M4 (the board and
+//! the QEMU program): [`sum_clipped_words`] (the oversampled sums and the per-conversion clip
+//! check, `acquisition::sum_clipped`) and [`filter3`] (three channels of
+//! `acquisition::PwmFilter`). Each does exactly the arithmetic of its Rust counterpart,
+//! `sum_clipped_portable` and `filter3_portable`, which the host runs; `cargo qemu-core`
+//! runs both on the replay and on clipped and edge cases and fails unless they agree.
+//!
+//! Why assembly: the firmware is built for size, and the compiler, given the sums and the
+//! range tests of an ADC's twelve words, computes the sums first and keeps the words live
+//! for the tests, spilling them to the stack (about 100 instructions an ADC where these
+//! take 72); its filter reloads the sums it spilled. No loop, no branch, no stack. These two
+//! functions are the library's only `unsafe` (`asm!`; the workspace denies `unsafe_code`,
+//! allowed here item by item as in the firmware's register files), built for ARM only.
+
+use super::checks::ClipLimits;
+use super::{CHANNELS, HALF_LEN};
+
+/// The word sums of the word positions `(a, b)`, `(c, a)`, `(b, c)` of one ADC's sample and
+/// the test words ORed: `checks::sum_clipped_words`' arithmetic, word by word in the same
+/// order. Per word position its `(above, below)` pair is loaded once (`ClipLimits` is
+/// `repr(C)`: three such pairs), then per word a load, an add into the sum, `word + above`
+/// and `below - word` ORed into the flags: six instructions a word.
+#[inline(always)]
+#[allow(unsafe_code)]
+pub(super) fn sum_clipped_words(
+    conversions: &[u16; HALF_LEN],
+    limits: &ClipLimits,
+) -> (u32, u32, u32, u32) {
+    let (ab, ca, bc, flags): (u32, u32, u32, u32);
+    // SAFETY: the loads read the 48 bytes of `conversions` (words at byte offsets 0 to
+    // 44; the Cortex-M4 loads a word at a halfword boundary, `CCR.UNALIGN_TRP` is never
+    // set) and the 24 bytes of `limits` (`repr(C)`, word-aligned: `ldrd`), both through
+    // live shared references; the block writes only its own output and scratch
+    // registers, touches no other memory and no stack, and sets no condition flags.
+    unsafe {
+        core::arch::asm!(
+            // (a, b): words 0, 3, 6, 9 (byte offsets 0, 12, 24, 36).
+            "ldrd {a}, {b}, [{lim}]",
+            "ldr {ab}, [{p}]",
+            "add {t}, {ab}, {a}",
+            "sub {f}, {b}, {ab}",
+            "orr {f}, {f}, {t}",
+            "ldr {w}, [{p}, #12]",
+            "add {ab}, {ab}, {w}",
+            "add {t}, {w}, {a}",
+            "orr {f}, {f}, {t}",
+            "sub {t}, {b}, {w}",
+            "orr {f}, {f}, {t}",
+            "ldr {w}, [{p}, #24]",
+            "add {ab}, {ab}, {w}",
+            "add {t}, {w}, {a}",
+            "orr {f}, {f}, {t}",
+            "sub {t}, {b}, {w}",
+            "orr {f}, {f}, {t}",
+            "ldr {w}, [{p}, #36]",
+            "add {ab}, {ab}, {w}",
+            "add {t}, {w}, {a}",
+            "orr {f}, {f}, {t}",
+            "sub {t}, {b}, {w}",
+            "orr {f}, {f}, {t}",
+            // (c, a): words 1, 4, 7, 10.
+            "ldrd {a}, {b}, [{lim}, #8]",
+            "ldr {ca}, [{p}, #4]",
+            "add {t}, {ca}, {a}",
+            "orr {f}, {f}, {t}",
+            "sub {t}, {b}, {ca}",
+            "orr {f}, {f}, {t}",
+            "ldr {w}, [{p}, #16]",
+            "add {ca}, {ca}, {w}",
+            "add {t}, {w}, {a}",
+            "orr {f}, {f}, {t}",
+            "sub {t}, {b}, {w}",
+            "orr {f}, {f}, {t}",
+            "ldr {w}, [{p}, #28]",
+            "add {ca}, {ca}, {w}",
+            "add {t}, {w}, {a}",
+            "orr {f}, {f}, {t}",
+            "sub {t}, {b}, {w}",
+            "orr {f}, {f}, {t}",
+            "ldr {w}, [{p}, #40]",
+            "add {ca}, {ca}, {w}",
+            "add {t}, {w}, {a}",
+            "orr {f}, {f}, {t}",
+            "sub {t}, {b}, {w}",
+            "orr {f}, {f}, {t}",
+            // (b, c): words 2, 5, 8, 11.
+            "ldrd {a}, {b}, [{lim}, #16]",
+            "ldr {bc}, [{p}, #8]",
+            "add {t}, {bc}, {a}",
+            "orr {f}, {f}, {t}",
+            "sub {t}, {b}, {bc}",
+            "orr {f}, {f}, {t}",
+            "ldr {w}, [{p}, #20]",
+            "add {bc}, {bc}, {w}",
+            "add {t}, {w}, {a}",
+            "orr {f}, {f}, {t}",
+            "sub {t}, {b}, {w}",
+            "orr {f}, {f}, {t}",
+            "ldr {w}, [{p}, #32]",
+            "add {bc}, {bc}, {w}",
+            "add {t}, {w}, {a}",
+            "orr {f}, {f}, {t}",
+            "sub {t}, {b}, {w}",
+            "orr {f}, {f}, {t}",
+            "ldr {w}, [{p}, #44]",
+            "add {bc}, {bc}, {w}",
+            "add {t}, {w}, {a}",
+            "orr {f}, {f}, {t}",
+            "sub {t}, {b}, {w}",
+            "orr {f}, {f}, {t}",
+            p = in(reg) conversions.as_ptr(),
+            lim = in(reg) limits as *const ClipLimits,
+            ab = out(reg) ab,
+            ca = out(reg) ca,
+            bc = out(reg) bc,
+            f = out(reg) flags,
+            a = out(reg) _,
+            b = out(reg) _,
+            t = out(reg) _,
+            w = out(reg) _,
+            options(pure, readonly, nostack, preserves_flags),
+        );
+    }
+    (ab, ca, bc, flags)
+}
+
+/// Three channels of `PwmFilter` (`filter3_portable`'s arithmetic): per channel its two
+/// stages loaded, the input `sum x scale + bias` (`mla`), the stages `a += (x - a) >> 2`,
+/// `b += (a - b) >> 1` (arithmetic shifts, wrapping), the stages stored, the code `b >> 16`
+/// saturated to 0..=4095 (`usat`): eight instructions a channel.
+#[inline(always)]
+#[allow(unsafe_code)]
+pub(super) fn filter3(
+    st: &mut [[i32; 2]; CHANNELS],
+    sums: [u32; CHANNELS],
+    scale: i32,
+    bias: i32,
+) -> [u16; CHANNELS] {
+    let [mut x0, mut x1, mut x2] = sums;
+    // SAFETY: `ldrd`/`strd` read and write the 24 bytes of `st` (word-aligned `i32`s)
+    // through the live exclusive reference; nothing else is touched, no stack.
+    unsafe {
+        core::arch::asm!(
+            "ldrd {a}, {b}, [{st}]",
+            "mla {x0}, {x0}, {scale}, {bias}",
+            "sub {t}, {x0}, {a}",
+            "add {a}, {a}, {t}, asr #2",
+            "sub {t}, {a}, {b}",
+            "add {b}, {b}, {t}, asr #1",
+            "strd {a}, {b}, [{st}]",
+            "usat {x0}, #12, {b}, asr #16",
+            "ldrd {a}, {b}, [{st}, #8]",
+            "mla {x1}, {x1}, {scale}, {bias}",
+            "sub {t}, {x1}, {a}",
+            "add {a}, {a}, {t}, asr #2",
+            "sub {t}, {a}, {b}",
+            "add {b}, {b}, {t}, asr #1",
+            "strd {a}, {b}, [{st}, #8]",
+            "usat {x1}, #12, {b}, asr #16",
+            "ldrd {a}, {b}, [{st}, #16]",
+            "mla {x2}, {x2}, {scale}, {bias}",
+            "sub {t}, {x2}, {a}",
+            "add {a}, {a}, {t}, asr #2",
+            "sub {t}, {a}, {b}",
+            "add {b}, {b}, {t}, asr #1",
+            "strd {a}, {b}, [{st}, #16]",
+            "usat {x2}, #12, {b}, asr #16",
+            st = in(reg) st.as_mut_ptr(),
+            scale = in(reg) scale,
+            bias = in(reg) bias,
+            x0 = inout(reg) x0,
+            x1 = inout(reg) x1,
+            x2 = inout(reg) x2,
+            a = out(reg) _,
+            b = out(reg) _,
+            t = out(reg) _,
+            // `usat` sets the sticky Q flag when it saturates.
+            options(nostack),
+        );
+    }
+    [x0 as u16, x1 as u16, x2 as u16]
+}

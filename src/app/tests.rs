@@ -1,0 +1,76 @@
+//! The application's settings and the board's configuration.
+use super::*;
+
+#[test]
+fn settings_out_of_range_are_named() {
+    assert_eq!(Settings::DEFAULT.validate(), Ok(()));
+    for rate in [0, 7_000, 10_050, 3_000_000] {
+        let s = Settings {
+            sample_rate_hz: rate,
+            ..Settings::DEFAULT
+        };
+        assert_eq!(s.validate(), Err(SettingsError::SampleRate), "{rate}");
+    }
+    for d in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+        let s = Settings {
+            commissioning_duration_s: d,
+            ..Settings::DEFAULT
+        };
+        assert_eq!(s.validate(), Err(SettingsError::CommissioningDuration));
+    }
+    let s = Settings {
+        commissioning_stall_ms: 0,
+        ..Settings::DEFAULT
+    };
+    assert_eq!(s.validate(), Err(SettingsError::CommissioningStall));
+}
+
+#[test]
+fn board_config_is_valid() {
+    let s = Settings::DEFAULT;
+    assert!(board_monitor_config(s.sample_rate_hz).validate().is_ok());
+    assert!(SamplePath::for_board(s.sample_rate_hz).is_ok());
+    assert_eq!(s.status_every(), 100);
+    // The stall time is shorter than the core's gate timeout (see the procedure).
+    let gate_ms = board_monitor_config(s.sample_rate_hz).gate_timeout_s * 1000.0;
+    assert!((s.commissioning_stall_ms as f32) < gate_ms);
+}
+
+#[test]
+fn another_sample_rate_goes_through_the_same_configuration() {
+    let path = SamplePath::for_board(20_000).unwrap();
+    assert_eq!(path.monitor().config().sample_rate_hz, 20_000.0);
+    assert_eq!(path.sampler().ticks_per_sample(), 50);
+    assert!(SamplePath::for_board(7_000).is_err());
+}
+
+/// The supervisor hands the brown-out level's mark to the panel: with the level below the
+/// goal the RUN lamp is lit from 2.5 s to 4.5 s of every 10 s (and dark just before), not
+/// without.
+#[test]
+fn the_supervisor_shows_the_brown_out_mark_while_the_level_is_below_the_goal() {
+    let run_lamp = |below: bool| {
+        let mut s = Supervisor::new(
+            &Settings::DEFAULT,
+            PreviousRun::Clean,
+            0,
+            MonitorStatus::default(),
+        );
+        s.set_bor_below_goal(below);
+        (0..200u32)
+            .map(|k| {
+                let status = MonitorStatus {
+                    samples: (k + 1) * 500,
+                    ..MonitorStatus::default()
+                };
+                s.tick(k * PANEL_PERIOD_MS, Some(status), false).lamps.run
+            })
+            .collect::<Vec<bool>>()
+    };
+    let marked = run_lamp(true);
+    let plain = run_lamp(false);
+    // Ticks of 50 ms: 2.5 s .. 4.5 s is ticks 50..90 (and 250..290 ten seconds later).
+    assert!(marked[50..90].iter().all(|on| *on), "{marked:?}");
+    assert!(marked[40..50].iter().all(|on| !on));
+    assert!(!plain[50..90].iter().all(|on| *on));
+}

@@ -1,0 +1,177 @@
+//! The boot report as plain text for the ST-LINK's virtual COM port (USART2, PA2, 115 200
+//! baud 8N1 on the NUCLEO-G474RE): a technician without a probe reads why the board
+//! reset, the brown-out level, the clock and the reset log's newest entries with any
+//! terminal. Built without `core::fmt` (no float or generic formatting pulled into the
+//! firmware): fixed-size lines ([`ReportLine`]) of words and decimal or hexadecimal numbers.
+
+use super::log::{Ended, Entry};
+use super::{PreviousRun, ResetCause, ResetRecord, ResetSource};
+
+/// Bytes of one line at most (longer text is cut).
+pub const LINE_LEN: usize = 192;
+
+/// One line of text, `\r\n` ended by [`ReportLine::end`].
+#[derive(Clone, Copy, Debug)]
+pub struct ReportLine {
+    buf: [u8; LINE_LEN],
+    len: usize,
+}
+
+impl Default for ReportLine {
+    fn default() -> Self {
+        Self {
+            buf: [0; LINE_LEN],
+            len: 0,
+        }
+    }
+}
+
+impl ReportLine {
+    /// Appends `s` (what does not fit is cut).
+    pub fn push(&mut self, s: &str) -> &mut Self {
+        for &b in s.as_bytes() {
+            if let Some(slot) = self.buf.get_mut(self.len) {
+                *slot = b;
+                self.len += 1;
+            }
+        }
+        self
+    }
+
+    /// Appends `v` in decimal.
+    pub fn number(&mut self, v: u32) -> &mut Self {
+        let mut digits = [0u8; 10];
+        let mut n = 0;
+        let mut x = v;
+        loop {
+            if let Some(d) = digits.get_mut(n) {
+                *d = b'0' + (x % 10) as u8;
+            }
+            n += 1;
+            x /= 10;
+            if x == 0 {
+                break;
+            }
+        }
+        for k in (0..n).rev() {
+            let d = digits.get(k).copied().unwrap_or(b'0');
+            self.push(core::str::from_utf8(&[d]).unwrap_or("?"));
+        }
+        self
+    }
+
+    /// Appends `v` as `0x` and eight hexadecimal digits.
+    pub fn hex(&mut self, v: u32) -> &mut Self {
+        self.push("0x");
+        for k in 0..8 {
+            let nibble = ((v >> (28 - 4 * k)) & 0xF) as u8;
+            let d = if nibble < 10 {
+                b'0' + nibble
+            } else {
+                b'A' + nibble - 10
+            };
+            self.push(core::str::from_utf8(&[d]).unwrap_or("?"));
+        }
+        self
+    }
+
+    /// Ends the line (`\r\n`, as a terminal wants it).
+    pub fn end(&mut self) -> &mut Self {
+        self.push("\r\n")
+    }
+
+    /// The text so far.
+    pub fn as_bytes(&self) -> &[u8] {
+        self.buf.get(..self.len).unwrap_or(&[])
+    }
+}
+
+/// A cause's words.
+pub fn cause_name(c: ResetCause) -> &'static str {
+    match c {
+        ResetCause::Panic => "a panic",
+        ResetCause::SampleStall => "a stalled sample path",
+        ResetCause::SetupTimeout => "a set-up that did not finish",
+        ResetCause::DefmtPanic => "a defmt panic",
+        ResetCause::HardFault => "a hard fault",
+        ResetCause::SetupDeadline => "a set-up step past its deadline",
+        ResetCause::ClockFailure => "a clock failure",
+    }
+}
+
+/// `record`'s cause, message, file and number.
+fn push_record(line: &mut ReportLine, r: &ResetRecord) {
+    line.push(cause_name(r.cause()));
+    line.push(": ").push(r.message());
+    if !r.file().is_empty() {
+        line.push(" ").push(r.file());
+    }
+    match r.cause() {
+        ResetCause::HardFault | ResetCause::DefmtPanic => {
+            line.push(" at ").hex(r.line_or_ms());
+        }
+        _ => {
+            line.push(" (").number(r.line_or_ms()).push(")");
+        }
+    }
+}
+
+/// The boot's first line: `drive-monitor VERSION boot: reset by SOURCE, brown-out level N,
+/// clock NAME`.
+pub fn boot_line(version: &str, source: ResetSource, bor: u8, clock: &str) -> ReportLine {
+    let mut l = ReportLine::default();
+    l.push("drive-monitor ")
+        .push(version)
+        .push(" boot: reset by ");
+    l.push(source.name())
+        .push(", brown-out level ")
+        .number(u32::from(bor));
+    l.push(", clock ").push(clock).end();
+    l
+}
+
+/// The previous run's end as the boot read it.
+pub fn previous_line(previous: &PreviousRun) -> ReportLine {
+    let mut l = ReportLine::default();
+    l.push("previous run: ");
+    match previous {
+        PreviousRun::Clean => {
+            l.push("no failure recorded");
+        }
+        PreviousRun::WatchdogReset => {
+            l.push("watchdog reset with no reason recorded (the firmware hung)");
+        }
+        PreviousRun::Recorded(r) => {
+            l.push("ended in ");
+            push_record(&mut l, r);
+        }
+        PreviousRun::ResetDuring { record, source } => {
+            push_record(&mut l, record);
+            l.push(", then a ").push(source.name()).push(" reset");
+        }
+    }
+    l.end();
+    l
+}
+
+/// One entry of the reset log: `log #SEQ: reset by SOURCE: ...`.
+pub fn entry_line(e: &Entry) -> ReportLine {
+    let mut l = ReportLine::default();
+    l.push("log #")
+        .number(e.seq)
+        .push(": reset by ")
+        .push(e.source.name())
+        .push(": ");
+    match (e.ended, &e.record) {
+        (Ended::WatchdogReset, _) | (_, None) => {
+            l.push("watchdog reset with no reason recorded");
+        }
+        (Ended::Recorded, Some(r)) => push_record(&mut l, r),
+        (Ended::ResetDuring, Some(r)) => {
+            push_record(&mut l, r);
+            l.push(", another reset came first");
+        }
+    }
+    l.end();
+    l
+}
