@@ -86,6 +86,19 @@ fn judge(which: &str, name: &str, error: &str) -> (Vec<String>, BaseRefit) {
         "{which} {name:<17} file {error:<12} top {top:<17} unexplained {} | {words}",
         ex.unexplained
     );
+    for c in ex.ranking.iter().take(4) {
+        eprintln!(
+            "    ranked {} {:.3} plausible {} {:?} {}",
+            c.effect,
+            c.explained_fraction,
+            c.plausible,
+            c.parameters
+                .iter()
+                .map(|(k, v)| (k.clone(), v.value))
+                .collect::<Vec<_>>(),
+            c.implausible_because.join("; ")
+        );
+    }
     for r in &refit.parameters {
         eprintln!(
             "    {:<14} file {:.5} refitted {:.5} true {:.5} identified {}",

@@ -61,7 +61,9 @@ pub use setup::{
 };
 pub use supply_unbalance::{SupplyUnbalance, SupplyUnbalanceValues};
 pub use switch::StateSwitch;
-pub use thermal_drift::{ThermalDrift, ThermalDriftValues, ALPHA_AL_PER_K, ALPHA_CU_PER_K};
+pub use thermal_drift::{
+    ThermalDrift, ThermalDriftValues, Windings, ALPHA_AL_PER_K, ALPHA_CU_PER_K,
+};
 pub use windage::{Windage, WindageValues};
 
 use super::prep::Prepared;
@@ -327,7 +329,7 @@ pub fn sync_speed_mech(d: &Prepared, n: &MachineConstants) -> f64 {
 /// The model of an effect of the library.
 pub fn model_of(kind: EffectKind) -> Box<dyn EffectModel> {
     match kind {
-        EffectKind::ThermalDrift => Box::new(ThermalDrift),
+        EffectKind::ThermalDrift => Box::new(ThermalDrift::TOGETHER),
         EffectKind::Saturation => Box::new(Saturation),
         EffectKind::IronLoss => Box::new(IronLoss),
         EffectKind::CoulombFriction => Box::new(CoulombFriction),
@@ -346,6 +348,19 @@ pub fn model_of(kind: EffectKind) -> Box<dyn EffectModel> {
 /// The whole library, in the order of [`EffectKind::ALL`].
 pub fn library() -> Vec<Box<dyn EffectModel>> {
     EffectKind::ALL.into_iter().map(model_of).collect()
+}
+
+/// The ladder's library: [`library`] with the windings' temperatures fitted apart
+/// ([`ThermalDrift::APART`]: the ladder reads Rs and Rr apart in its base rung, so a stator
+/// heating alone is not taken for both windings).
+pub fn ladder_library() -> Vec<Box<dyn EffectModel>> {
+    EffectKind::ALL
+        .into_iter()
+        .map(|k| match k {
+            EffectKind::ThermalDrift => Box::new(ThermalDrift::APART) as Box<dyn EffectModel>,
+            k => model_of(k),
+        })
+        .collect()
 }
 
 #[cfg(test)]

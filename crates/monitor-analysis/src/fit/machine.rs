@@ -541,8 +541,15 @@ mod tests {
     #[test]
     fn correlated_residuals_inflate_the_variance() {
         // White: about 1. A slow sine sampled finely: large.
+        // A 64-bit linear congruential generator's top bits (Knuth's MMIX constants).
+        let mut x: u64 = 1;
         let white: Vec<f64> = (0..4000)
-            .map(|k| ((k as f64 * 12.9898).sin() * 43758.5453).fract() - 0.5)
+            .map(|_| {
+                x = x
+                    .wrapping_mul(6_364_136_223_846_793_005)
+                    .wrapping_add(1_442_695_040_888_963_407);
+                (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            })
             .collect();
         assert!(inflation(&white, 1) < 1.2, "{}", inflation(&white, 1));
         let slow: Vec<f64> = (0..4000).map(|k| (k as f64 * 0.01).sin()).collect();

@@ -89,7 +89,7 @@ pub const LADDER_MAX_FIT_SAMPLES: usize = 60_000;
 pub const SCREEN_ITER: usize = 6;
 /// How many screened candidates of a round are fitted in full (plus the best by held-back
 /// error alone when it is not among them).
-pub const FINALISTS: usize = 2;
+pub const FINALISTS: usize = 3;
 /// Pairs are tried only while the held-back error is above this multiple (2) of its noise
 /// floor: two effects that need each other leave a large error alone (the windage
 /// scenario's flux dynamics and load torque, 65x the floor without them); near the floor a
@@ -326,7 +326,7 @@ impl Analysis {
         let f0 = self.fit_set(&sr.fd, &active, &sr.wf, &nominal, opts.fit_base)?;
         let models: Vec<&dyn EffectModel> = configured.iter().map(|e| e.as_ref()).collect();
         let rung = self.measure_rung(models, f0, &sr, MachineScales::of_file(&self.params))?;
-        let lib = effects::library();
+        let lib = effects::ladder_library();
         report.start = LadderStart {
             effects: opts.effects.clone(),
             error: rung.error,

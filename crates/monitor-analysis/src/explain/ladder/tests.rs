@@ -72,7 +72,7 @@ fn a_stand_in_a_later_step_explains_is_dropped() {
     let a = fan_log(dir.path());
     let (held, _) = stratified_heldback(&a.data, &a.constants);
     let sr = a.ladder_series(held, true);
-    let lib = effects::library();
+    let lib = effects::ladder_library();
     let full = [
         EffectKind::FluxDynamics,
         EffectKind::CurrentDynamics,
@@ -125,7 +125,7 @@ fn what_the_user_configured_and_the_machine_order_stay() {
     let a = fan_log(dir.path());
     let (held, _) = stratified_heldback(&a.data, &a.constants);
     let sr = a.ladder_series(held, true);
-    let lib = effects::library();
+    let lib = effects::ladder_library();
     let kinds = [
         EffectKind::FluxDynamics,
         EffectKind::CurrentDynamics,
