@@ -284,7 +284,22 @@ impl Analysis {
                 r
             })
             .collect::<Result<_, _>>()?;
-        let chosen = finalists(&screened);
+        // A candidate confusable with an effect of the model (Coulomb friction beside a load
+        // torque: the same term where the speed never reverses) can only show what it adds
+        // by trading values with it: it is a finalist with every value free.
+        let trades = |c: &[&dyn EffectModel]| {
+            c.iter().any(|e| {
+                e.confused_with()
+                    .iter()
+                    .any(|x| rung.kinds.contains(&x.with))
+            })
+        };
+        let mut chosen = finalists(&screened);
+        for (i, c) in cands.iter().enumerate() {
+            if trades(c) && screened[i].is_some() && !chosen.contains(&i) {
+                chosen.push(i);
+            }
+        }
         let full: Vec<(usize, Option<Fitted<'a>>)> = chosen
             .par_iter()
             .map(|&i| {
@@ -292,7 +307,7 @@ impl Analysis {
                     &cands[i],
                     rung,
                     sr,
-                    screen,
+                    if trades(&cands[i]) { spec } else { screen },
                     Starts::NestedOnly,
                     crate::MAX_ITER,
                     screened[i].as_ref(),
