@@ -10,7 +10,12 @@ use monitor_core::reference::MOTOR_3HP;
 
 fn other_motor() -> MotorRecord {
     MotorRecord {
-        motor: MOTOR_3HP.motor,
+        // The record carries the equations' values; which Lm the file holds (`lm_at`)
+        // is the host's saturation law's alone and not in it.
+        motor: monitor_core::MotorParameters {
+            lm_at: None,
+            ..MOTOR_3HP.motor
+        },
         supply: MOTOR_3HP.supply,
         current_full_scale_a: 25.0,
         voltage_full_scale_v: 600.0,
@@ -32,7 +37,7 @@ fn page_with(bytes: &[u8]) -> [u8; 2048] {
 fn a_valid_record_is_used() {
     let (rec, source) = motor_source::select(&page_with(&other_motor().to_bytes()));
     assert_eq!(source, MachineSource::Flash);
-    assert_eq!(rec.motor, MOTOR_3HP.motor);
+    assert_eq!(rec.motor, other_motor().motor);
     assert_eq!(source.describe(), "motor record from flash");
     let cfg = motor_source::monitor_config(&rec, 10_000);
     assert_eq!(cfg.encoder.counts_per_rev, 10_000);

@@ -11,6 +11,7 @@
 //! average (a wall time on a shared machine means little without it).
 //! `LADDER_BENCH_REPEAT` runs the ladder that many times (default 1) and prints each.
 
+#[allow(dead_code)] // each benchmark uses part of what the benchmarks share
 mod common;
 
 use monitor_analysis::{prep::ReadOptions, Analysis, Options};

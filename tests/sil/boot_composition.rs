@@ -17,7 +17,12 @@ use monitor_core::ConfigCheck;
 /// 2500-line encoder.
 fn record_3hp() -> MotorRecord {
     MotorRecord {
-        motor: MOTOR_3HP.motor,
+        // The record carries the equations' values; which Lm the file holds (`lm_at`)
+        // is the host's saturation law's alone and not in it.
+        motor: monitor_core::MotorParameters {
+            lm_at: None,
+            ..MOTOR_3HP.motor
+        },
         supply: MOTOR_3HP.supply,
         current_full_scale_a: 25.0,
         voltage_full_scale_v: board::VOLTAGE_FULL_SCALE_V,

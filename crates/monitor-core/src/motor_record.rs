@@ -213,7 +213,12 @@ mod tests {
 
     fn sample() -> MotorRecord {
         MotorRecord {
-            motor: MOTOR_2P2KW.motor,
+            // The record holds the equations' values; which Lm a file holds (`lm_at`) is
+            // the host's saturation law's alone and not in it.
+            motor: MotorParameters {
+                lm_at: None,
+                ..MOTOR_2P2KW.motor
+            },
             supply: MOTOR_2P2KW.supply,
             current_full_scale_a: 20.0,
             voltage_full_scale_v: 500.0,

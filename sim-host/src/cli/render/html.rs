@@ -6,9 +6,9 @@
 
 use super::{charts, plot};
 use monitor_api::analysis::Analysis;
-use monitor_api::analysis::LadderReport;
 use monitor_api::analysis::Prediction;
 use monitor_api::analysis::{CompareOutput, CompareReport};
+use monitor_api::analysis::{FinalFit, LadderReport, LadderStep};
 use monitor_api::files::DataQuality;
 use monitor_api::ExplainDocument;
 use monitor_core::EffectKind;
@@ -139,48 +139,10 @@ fn ladder_html(log: &str, r: &LadderReport, charts: &[(String, String)]) -> Stri
     h.push_str("<table><tr><th>step</th><th class=l>change</th><th>error</th><th>x floor</th><th>held-back</th><th>x floor</th><th>explained (whole / held-back)</th><th class=l>fitted (physical range)</th></tr>");
     let _ = write!(h, "<tr><td>0</td><td class=l>{}</td><td>{:.4}</td><td>{:.1}</td><td>{:.4}</td><td>{:.1}</td><td></td><td></td></tr>", esc(&start), r.start.error, r.start.ratio_to_floor, r.start.heldback_error, r.start.heldback_error / r.start.heldback_noise_floor);
     for (k, s) in r.ladder.iter().enumerate() {
-        let changed: Vec<String> = s
-            .base
-            .iter()
-            .filter(|c| c.changed)
-            .map(|c| c.spelled())
-            .collect();
-        let mut fitted: Vec<String> = s
-            .fitted
-            .iter()
-            .filter(|_| s.effect.is_some())
-            .map(|(n, v)| {
-                format!(
-                    "{n} {:.4} {} ({:.3}..{:.3})",
-                    v.value, v.unit, v.low, v.high
-                )
-            })
-            .collect();
-        if !changed.is_empty() {
-            fitted.push(format!("base: {}", changed.join(", ")));
-        }
-        let mut name = match s.effect {
-            None => "base parameters refitted".to_string(),
-            Some(_) => effect_list(&s.added),
-        };
-        for d in &s.dropped {
-            name.push_str(&format!(", {d} removed"));
-        }
-        let _ = write!(h, "<tr><td>{}</td><td class=l>{}</td><td>{:.4}</td><td>{:.1}</td><td>{:.4}</td><td>{:.1}</td><td>{:.0} % / {:.0} %</td><td class=l>{}</td></tr>", k + 1, esc(&name), s.error, s.ratio_to_floor, s.heldback_error, s.heldback_ratio_to_floor, 100.0 * s.explained, 100.0 * s.heldback_explained, esc(&fitted.join("; ")));
+        ladder_row(&mut h, k + 1, s);
     }
     if let Some(f) = &r.final_fit {
-        let changed: Vec<String> = f
-            .base
-            .iter()
-            .filter(|c| c.changed)
-            .map(|c| c.spelled())
-            .collect();
-        let base = if changed.is_empty() {
-            "base parameters as the file's".to_string()
-        } else {
-            format!("base: {}", changed.join(", "))
-        };
-        let _ = write!(h, "<tr><td>end</td><td class=l>the chosen model refitted on the whole log</td><td>{:.4}</td><td>{:.1}</td><td></td><td></td><td></td><td class=l>{}</td></tr>", f.error, f.ratio_to_floor, esc(&base));
+        ladder_end_row(&mut h, f);
     }
     h.push_str("</table>");
     let _ = write!(h, "<p>Stopped: {}</p>", esc(&r.stopped_because));
@@ -206,6 +168,44 @@ fn ladder_html(log: &str, r: &LadderReport, charts: &[(String, String)]) -> Stri
     }
     h.push_str("</body></html>");
     h
+}
+
+/// The table row of the ladder's step `s` (number `k`): what it added, changed or
+/// dropped, its errors, the shares it explained and its fitted values.
+fn ladder_row(h: &mut String, k: usize, s: &LadderStep) {
+    let changed: Vec<String> = s
+        .base
+        .iter()
+        .filter(|c| c.changed)
+        .map(|c| c.spelled())
+        .collect();
+    let mut fitted: Vec<String> = s
+        .fitted
+        .iter()
+        .filter(|_| s.effect.is_some())
+        .map(|(n, v)| {
+            format!(
+                "{n} {:.4} {} ({:.3}..{:.3})",
+                v.value, v.unit, v.low, v.high
+            )
+        })
+        .collect();
+    if !changed.is_empty() {
+        fitted.push(format!("base: {}", changed.join(", ")));
+    }
+    let mut name = match s.effect {
+        None => "base parameters refitted".to_string(),
+        Some(_) => effect_list(&s.added),
+    };
+    for d in &s.dropped {
+        name.push_str(&format!(", {d} removed"));
+    }
+    let _ = write!(h, "<tr><td>{}</td><td class=l>{}</td><td>{:.4}</td><td>{:.1}</td><td>{:.4}</td><td>{:.1}</td><td>{:.0} % / {:.0} %</td><td class=l>{}</td></tr>", k, esc(&name), s.error, s.ratio_to_floor, s.heldback_error, s.heldback_ratio_to_floor, 100.0 * s.explained, 100.0 * s.heldback_explained, esc(&fitted.join("; ")));
+}
+
+/// The table row of the chosen model refitted on the whole log.
+fn ladder_end_row(h: &mut String, f: &FinalFit) {
+    let _ = write!(h, "<tr><td>end</td><td class=l>the chosen model refitted on the whole log</td><td>{:.4}</td><td>{:.1}</td><td></td><td></td><td></td><td class=l>{}</td></tr>", f.error, f.ratio_to_floor, esc(&super::end_base(f)));
 }
 
 fn esc(s: &str) -> String {

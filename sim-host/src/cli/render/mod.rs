@@ -14,3 +14,19 @@ pub mod mcsa;
 pub mod plot;
 pub mod text;
 pub mod trend_plot;
+
+/// The base parameters of the ladder's end (`f`, the chosen model refitted on the whole
+/// log) in a table cell: the changes named, or "base parameters as the file's".
+pub fn end_base(f: &monitor_api::analysis::FinalFit) -> String {
+    let changed: Vec<String> = f
+        .base
+        .iter()
+        .filter(|c| c.changed)
+        .map(|c| c.spelled())
+        .collect();
+    if changed.is_empty() {
+        "base parameters as the file's".to_string()
+    } else {
+        format!("base: {}", changed.join(", "))
+    }
+}

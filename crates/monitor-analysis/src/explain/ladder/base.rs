@@ -126,67 +126,12 @@ pub fn base_changes(
 /// What the changes `c` mean, in a drive engineer's words: each named change with its
 /// interval and its likely reading, then the parameters the log does not identify.
 pub fn base_in_words(c: &[BaseChange]) -> String {
-    let get = |k: BaseKey| c.iter().find(|x| x.base == k);
-    let changed = |k: BaseKey| get(k).is_some_and(|x| x.changed);
-    let mut parts: Vec<String> = Vec::new();
-    let (rs, rr) = (get(BaseKey::Rs), get(BaseKey::Rr));
-    let spelled = |x: Option<&BaseChange>| x.map_or_else(String::new, BaseChange::spelled);
-    let (a, b) = (rs.map_or(0.0, |x| x.change), rr.map_or(0.0, |x| x.change));
-    let alike = a > 0.0 && b > 0.0 && (a - b).abs() <= 0.3 * a.max(b);
-    match (changed(BaseKey::Rs), changed(BaseKey::Rr)) {
-        (true, true) if alike => parts.push(format!(
-            "{}, {}: both windings warmer than the file's values, about {:.0} K (copper 0.393 %/K)",
-            spelled(rs),
-            spelled(rr),
-            0.5 * (a + b) / effects::ALPHA_CU_PER_K
-        )),
-        (rs_changed, rr_changed) => {
-            if rs_changed {
-                parts.push(format!(
-                    "{}{}: {}",
-                    spelled(rs),
-                    if rr_changed { "" } else { ", Rr unchanged" },
-                    if a > 0.0 {
-                        "the file's Rs is cold, or the stator is warm (a loosening connection adds to it too)"
-                    } else {
-                        "the file's Rs is higher than the winding's (measured warm, or with its leads)"
-                    }
-                ));
-            }
-            if rr_changed {
-                parts.push(format!(
-                    "{}{}: the rotor's resistance differs from the file's (a locked-rotor test at line frequency reads the skin effect's Rr; a warm cage)",
-                    spelled(rr),
-                    if rs_changed { "" } else { ", Rs unchanged" },
-                ));
-            }
-        }
-    }
-    let says = |k: BaseKey, why: &str, parts: &mut Vec<String>| {
-        if let Some(x) = get(k).filter(|x| x.changed) {
+    let mut parts = resistances_in_words(c);
+    for (k, why) in OTHER_READINGS {
+        if let Some(x) = c.iter().find(|x| x.base == k && x.changed) {
             parts.push(format!("{}: {why}", x.spelled()));
         }
-    };
-    says(
-        BaseKey::Lm,
-        "the magnetising inductance differs from the file's (a no-load test at another voltage, or saturation)",
-        &mut parts,
-    );
-    says(
-        BaseKey::Leakage,
-        "the leakage inductances differ from the file's (a locked-rotor test's split or its saturated leakage paths)",
-        &mut parts,
-    );
-    says(
-        BaseKey::J,
-        "the inertia differs from the file's (the coupled load's)",
-        &mut parts,
-    );
-    says(
-        BaseKey::B,
-        "the viscous friction differs from the file's (a viscous load the file leaves out, bearings, seals)",
-        &mut parts,
-    );
+    }
     let unidentified: Vec<&str> = c
         .iter()
         .filter(|x| !x.identified)
@@ -211,6 +156,67 @@ pub fn base_in_words(c: &[BaseChange]) -> String {
         ));
     }
     parts.join("; ")
+}
+
+/// The likely reading of a change of each base parameter other than the resistances.
+const OTHER_READINGS: [(BaseKey, &str); 4] = [
+    (
+        BaseKey::Lm,
+        "the magnetising inductance differs from the file's (a no-load test at another voltage, or saturation)",
+    ),
+    (
+        BaseKey::Leakage,
+        "the leakage inductances differ from the file's (a locked-rotor test's split or its saturated leakage paths)",
+    ),
+    (
+        BaseKey::J,
+        "the inertia differs from the file's (the coupled load's)",
+    ),
+    (
+        BaseKey::B,
+        "the viscous friction differs from the file's (a viscous load the file leaves out, bearings, seals)",
+    ),
+];
+
+/// The changes of Rs and Rr in `c` in words: both risen alike read as a warm machine (its
+/// rise in K at copper's 0.393 %/K), else each with its likely reading.
+fn resistances_in_words(c: &[BaseChange]) -> Vec<String> {
+    let get = |k: BaseKey| c.iter().find(|x| x.base == k);
+    let changed = |k: BaseKey| get(k).is_some_and(|x| x.changed);
+    let (rs, rr) = (get(BaseKey::Rs), get(BaseKey::Rr));
+    let spelled = |x: Option<&BaseChange>| x.map_or_else(String::new, BaseChange::spelled);
+    let (a, b) = (rs.map_or(0.0, |x| x.change), rr.map_or(0.0, |x| x.change));
+    let alike = a > 0.0 && b > 0.0 && (a - b).abs() <= 0.3 * a.max(b);
+    let (rs_changed, rr_changed) = (changed(BaseKey::Rs), changed(BaseKey::Rr));
+    if rs_changed && rr_changed && alike {
+        return vec![format!(
+            "{}, {}: both windings warmer than the file's values, about {:.0} K (copper 0.393 %/K)",
+            spelled(rs),
+            spelled(rr),
+            0.5 * (a + b) / effects::ALPHA_CU_PER_K
+        )];
+    }
+    let mut parts = Vec::new();
+    if rs_changed {
+        parts.push(format!(
+            "{}{}: {}",
+            spelled(rs),
+            if rr_changed { "" } else { ", Rr unchanged" },
+            if a > 0.0 {
+                "the file's Rs is cold, or the stator is warm (a loosening connection adds to it too)"
+            } else {
+                "the file's Rs is higher than the winding's (measured warm, or with its leads)"
+            }
+        ));
+    }
+    if rr_changed {
+        parts.push(format!(
+            "{}{}: the rotor's resistance differs from the file's (a locked-rotor test at line frequency reads the skin effect's Rr; a warm cage)",
+            spelled(rr),
+            if rs_changed { "" } else { ", Rs unchanged" },
+        ));
+    }
+    parts
 }
 
 /// The base parameters' prior weight on a log whose noise floor is `noise` (normalised): the

@@ -83,23 +83,8 @@ impl Analysis {
         sr: &LadderSeries,
         sig: f64,
     ) -> Result<Take<'a>, AnalysisError> {
-        if !(c.heldback_fit_series.is_finite() && c.heldback_fit_series > 0.0) {
-            return Ok(Take::Not(
-                "the model with it could not be run through the log (it diverged)".into(),
-            ));
-        }
-        if !c.implausible.is_empty() {
-            return Ok(Take::Not(format!(
-                "not physical: {}",
-                c.implausible.join("; ")
-            )));
-        }
-        if sig < STEP_MIN {
-            return Ok(Take::Not(format!(
-                "removes {:.0} % of the held-back error beyond the noise floor (the test asks {:.0} %)",
-                100.0 * sig,
-                100.0 * STEP_MIN
-            )));
+        if let Some(why) = refused(c, sig) {
+            return Ok(Take::Not(why));
         }
         // The base rung's fit is relative to the file recentred on its factors.
         let recentred;
@@ -124,28 +109,39 @@ impl Analysis {
                 effects::sig(next.error)
             )));
         }
-        let added = c.added(rung.models.len());
-        let step = if added.is_empty() {
-            let changes = an.base_rung_changes(c, sr)?;
-            base_step(changes, rung, &next, sig)
-        } else {
-            let mut step = an.step_of(c, &added, rung, &next, sig)?;
-            if c.base.is_some() {
-                // An effect fitted with the base parameters refitted beside it: the changes
-                // it brought.
-                let changes = an.base_rung_changes(c, sr)?;
-                if changes.iter().any(|x| x.changed) {
-                    step.summary = format!(
-                        "{}; on the refitted base: {}",
-                        step.summary,
-                        base_in_words(&changes)
-                    );
-                    step.base = changes;
-                }
-            }
-            step
-        };
+        let step = an.step_taken(c, rung, &next, sr, sig)?;
         Ok(Take::Kept(Box::new((next, step))))
+    }
+
+    /// The step from `rung` to `next` that candidate `c` (its statistic `sig`) makes, with
+    /// the base changes it brought: a base rung's step, or an effect's (fitted with the
+    /// base parameters refitted beside it: their changes too, where any is named).
+    fn step_taken<'a>(
+        &self,
+        c: &Fitted<'a>,
+        rung: &Rung<'a>,
+        next: &Rung<'a>,
+        sr: &LadderSeries,
+        sig: f64,
+    ) -> Result<LadderStep, AnalysisError> {
+        let added = c.added(rung.models.len());
+        if added.is_empty() {
+            let changes = self.base_rung_changes(c, sr)?;
+            return Ok(base_step(changes, rung, next, sig));
+        }
+        let mut step = self.step_of(c, &added, rung, next, sig)?;
+        if c.base.is_some() {
+            let changes = self.base_rung_changes(c, sr)?;
+            if changes.iter().any(|x| x.changed) {
+                step.summary = format!(
+                    "{}; on the refitted base: {}",
+                    step.summary,
+                    base_in_words(&changes)
+                );
+                step.base = changes;
+            }
+        }
+        Ok(step)
     }
 
     /// When the first two plausible single candidates of `fitted` (in the round's order)
@@ -232,23 +228,9 @@ impl Analysis {
         Ok(LadderStep {
             effect: added.last().copied(),
             added: added.to_vec(),
-            base: Vec::new(),
-            dropped: Vec::new(),
             fitted,
             summary: words.join("; "),
-            error: next.error,
-            heldback_error: next.heldback_error,
-            noise_floor: next.noise,
-            heldback_noise_floor: next.heldback_noise,
-            ratio_to_floor: next.error / next.noise,
-            heldback_ratio_to_floor: next.heldback_error / next.heldback_noise,
-            significance: sig,
-            explained: explained_fraction(rung.error, next.error, next.noise),
-            heldback_explained: explained_fraction(
-                rung.heldback_error,
-                next.heldback_error,
-                next.heldback_noise,
-            ),
+            ..step_between(rung, next, sig)
         })
     }
 }
@@ -275,12 +257,23 @@ pub(super) fn base_step(
         );
     }
     LadderStep {
+        summary: base_in_words(&changes),
+        base: changes,
+        fitted,
+        ..step_between(rung, next, sig)
+    }
+}
+
+/// The step from `rung` to `next` (test statistic `sig`) with its errors, floors and
+/// shares explained, and nothing added, changed or dropped yet.
+fn step_between(rung: &Rung<'_>, next: &Rung<'_>, sig: f64) -> LadderStep {
+    LadderStep {
         effect: None,
         added: Vec::new(),
-        base: changes.clone(),
+        base: Vec::new(),
         dropped: Vec::new(),
-        fitted,
-        summary: base_in_words(&changes),
+        fitted: BTreeMap::new(),
+        summary: String::new(),
         error: next.error,
         heldback_error: next.heldback_error,
         noise_floor: next.noise,
@@ -342,4 +335,24 @@ fn whole_machine_first(
     if let Some(i) = whole {
         fitted[..=i].rotate_right(1);
     }
+}
+
+/// Why candidate `c` (its test statistic `sig`) cannot be a step whatever the whole log
+/// says: its model diverged on the held-back windows, its values are not physical, or it
+/// removes less than the test's [`STEP_MIN`] of the held-back error beyond the floor.
+fn refused(c: &Fitted<'_>, sig: f64) -> Option<String> {
+    if !(c.heldback_fit_series.is_finite() && c.heldback_fit_series > 0.0) {
+        return Some("the model with it could not be run through the log (it diverged)".into());
+    }
+    if !c.implausible.is_empty() {
+        return Some(format!("not physical: {}", c.implausible.join("; ")));
+    }
+    if sig < STEP_MIN {
+        return Some(format!(
+            "removes {:.0} % of the held-back error beyond the noise floor (the test asks {:.0} %)",
+            100.0 * sig,
+            100.0 * STEP_MIN
+        ));
+    }
+    None
 }

@@ -14,8 +14,9 @@ use super::round::{LadderSeries, Rung};
 use super::LadderReport;
 use crate::effects::{self, EffectModel};
 use crate::fit::machine::{self, MachineFit};
-use crate::fit::{BaseSpec, FitResult};
+use crate::fit::{ActiveEffect, BaseSpec, FitResult};
 use crate::metrics::{self, Weights};
+use crate::prep::Prepared;
 use crate::simplified_model::BaseParams;
 use crate::{align, Analysis, AnalysisError, FittedEffect, MAX_ITER};
 use monitor_core::EffectKind;
@@ -77,34 +78,7 @@ impl Analysis {
         let Some(set) = an.nested_from(&rung.models, &rung.fit.effect_params, &[], &fdata) else {
             return Ok(None);
         };
-        let w = Weights::new(&fdata, 0, usize::MAX);
-        let (mf, half) = if sr.fit_base {
-            let mf = machine::fit_machine(
-                &fdata,
-                &sr.file,
-                &set,
-                &w,
-                &rung.scales.with_paper(&rung.fit.base),
-                super::base::prior_weight(rung.noise),
-                MAX_ITER,
-            )?;
-            let half = machine::machine_half_widths(&fdata, &sr.file, &set, &w, &mf)?;
-            (mf, half)
-        } else {
-            let f = an.fit_spec(
-                &fdata,
-                &set,
-                &w,
-                &rung.fit.base,
-                BaseSpec::FIXED.for_effects(&set),
-            )?;
-            let mf = MachineFit {
-                scales: rung.scales,
-                effect_params: f.effect_params,
-                report: f.report,
-            };
-            (mf, [None; 6])
-        };
+        let (mf, half) = an.machine_on(&fdata, rung, sr, &set)?;
         let fin = self.rebased(mf.params(&sr.file));
         let models: Vec<&dyn EffectModel> = rung.models.clone();
         let active = fin.setup_list(&self.data, &models)?;
@@ -131,6 +105,48 @@ impl Analysis {
             fitted,
             fit_samples: fdata.len(),
         }))
+    }
+}
+
+impl Analysis {
+    /// The model of `rung` (its effects set up as `set`) fitted on `fdata` from the last
+    /// step's values: with the six base parameters free beside its effects
+    /// ([`machine::fit_machine`], their 95 % half-widths), or, where the log cannot refit the
+    /// base parameters, its effects alone on the rung's base (no half-widths).
+    fn machine_on(
+        &self,
+        fdata: &Prepared,
+        rung: &Rung<'_>,
+        sr: &LadderSeries,
+        set: &[ActiveEffect<'_>],
+    ) -> Result<(MachineFit, [Option<f64>; 6]), AnalysisError> {
+        let w = Weights::new(fdata, 0, usize::MAX);
+        if sr.fit_base {
+            let mf = machine::fit_machine(
+                fdata,
+                &sr.file,
+                set,
+                &w,
+                &rung.scales.with_paper(&rung.fit.base),
+                super::base::prior_weight(rung.noise),
+                MAX_ITER,
+            )?;
+            let half = machine::machine_half_widths(fdata, &sr.file, set, &w, &mf)?;
+            return Ok((mf, half));
+        }
+        let f = self.fit_spec(
+            fdata,
+            set,
+            &w,
+            &rung.fit.base,
+            BaseSpec::FIXED.for_effects(set),
+        )?;
+        let mf = MachineFit {
+            scales: rung.scales,
+            effect_params: f.effect_params,
+            report: f.report,
+        };
+        Ok((mf, [None; 6]))
     }
 }
 

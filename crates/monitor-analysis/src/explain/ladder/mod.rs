@@ -35,6 +35,7 @@
 mod base;
 mod choice;
 mod end;
+mod passes;
 mod round;
 mod rounds;
 mod split;
@@ -280,39 +281,8 @@ impl Analysis {
         opts: &Options,
         progress: &(dyn Fn(usize, f64) + Sync),
     ) -> Result<LadderReport, AnalysisError> {
-        let d = &self.data;
-        let (held, strata) = stratified_heldback(d, &self.constants);
-        let mut report = LadderReport {
-            summary: String::new(),
-            base_changes: Vec::new(),
-            final_fit: None,
-            start: LadderStart {
-                effects: opts.effects.clone(),
-                error: f64::NAN,
-                heldback_error: f64::NAN,
-                noise_floor: f64::NAN,
-                heldback_noise_floor: f64::NAN,
-                ratio_to_floor: f64::NAN,
-            },
-            ladder: Vec::new(),
-            stop: Stop::NoModel,
-            stopped_because: String::new(),
-            final_effects: opts.effects.clone(),
-            last_round: Vec::new(),
-            skipped: Vec::new(),
-            split: SplitInfo {
-                heldback_share: held.iter().filter(|h| **h).count() as f64
-                    / d.len().max(1) as f64,
-                strata,
-            },
-            test: format!(
-                "a step is kept when it removes at least {:.0} % of the held-back error beyond the noise floor (each parameter costing {:.0} % of the held-back error) and lowers the whole-log error; the ladder stops within {FLOOR_BAND}x the noise floor on the whole log and the held-back part",
-                100.0 * STEP_MIN,
-                100.0 * PARAM_PENALTY
-            ),
-            data: self.info(),
-            data_quality: self.quality.clone(),
-        };
+        let (held, strata) = stratified_heldback(&self.data, &self.constants);
+        let mut report = self.report_before(opts, &held, strata);
         if let Some((stop, why)) = self.refused() {
             report.stop = stop;
             report.stopped_because = why.clone();
@@ -339,6 +309,42 @@ impl Analysis {
         let step_no = report.ladder.len() + 1;
         self.finish(&rung, &sr, &mut report, &|f| progress(step_no, f))?;
         Ok(report)
+    }
+
+    /// The ladder's report before its first step: the split (`held`, `strata`), the test,
+    /// the data, no steps.
+    fn report_before(&self, opts: &Options, held: &[bool], strata: Vec<Stratum>) -> LadderReport {
+        LadderReport {
+            summary: String::new(),
+            base_changes: Vec::new(),
+            final_fit: None,
+            start: LadderStart {
+                effects: opts.effects.clone(),
+                error: f64::NAN,
+                heldback_error: f64::NAN,
+                noise_floor: f64::NAN,
+                heldback_noise_floor: f64::NAN,
+                ratio_to_floor: f64::NAN,
+            },
+            ladder: Vec::new(),
+            stop: Stop::NoModel,
+            stopped_because: String::new(),
+            final_effects: opts.effects.clone(),
+            last_round: Vec::new(),
+            skipped: Vec::new(),
+            split: SplitInfo {
+                heldback_share: held.iter().filter(|h| **h).count() as f64
+                    / self.data.len().max(1) as f64,
+                strata,
+            },
+            test: format!(
+                "a step is kept when it removes at least {:.0} % of the held-back error beyond the noise floor (each parameter costing {:.0} % of the held-back error) and lowers the whole-log error; the ladder stops within {FLOOR_BAND}x the noise floor on the whole log and the held-back part",
+                100.0 * STEP_MIN,
+                100.0 * PARAM_PENALTY
+            ),
+            data: self.info(),
+            data_quality: self.quality.clone(),
+        }
     }
 
     /// Why the ladder cannot start on this log, if it cannot: no voltages (the model cannot

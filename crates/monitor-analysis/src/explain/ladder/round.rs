@@ -2,7 +2,7 @@
 //! before, and the choice of the one kept (the test of [`super::STEP_MIN`]).
 
 use super::split::weights_for;
-use super::{FINALISTS, PAIR_FROM, SCREEN_ITER};
+use super::PAIR_FROM;
 use crate::effects::{self, EffectModel};
 use crate::explain::PARAM_PENALTY;
 use crate::fit::machine::MachineScales;
@@ -243,138 +243,12 @@ impl Analysis {
         (out, skipped)
     }
 
-    /// Every candidate of the round added to the model of `rung`, fitted from its fit on the
-    /// fit series `fd` (in parallel), with its held-back error there and what makes it
-    /// implausible. Three passes: every candidate screened ([`SCREEN_ITER`] iterations, from
-    /// where the model stood, the model's own values held), then the [`FINALISTS`] best
-    /// (plausible first, by their penalised held-back error, and the best of all) fitted to
-    /// convergence from there, and the round's best of them refitted with every value of
-    /// the model free (with `machine`, the six physical base parameters free beside them,
-    /// [`Analysis::joint_machine`]); `starts` says whether that one, of several effects, is
-    /// also fitted from the nominal base parameters ([`Starts`]). The held values cost no simulation
-    /// per iteration: in a late round the model holds a dozen.
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn fit_round<'a>(
-        &self,
-        cands: &[Vec<&'a dyn EffectModel>],
-        rung: &Rung<'a>,
-        sr: &LadderSeries,
-        spec: BaseSpec,
-        starts: Starts,
-        machine: bool,
-        progress: &(dyn Fn(f64) + Sync),
-    ) -> Result<Vec<Fitted<'a>>, AnalysisError> {
-        use rayon::prelude::*;
-        let done = std::sync::atomic::AtomicUsize::new(0);
-        let total = (cands.len() + FINALISTS).max(1);
-        let tick = || {
-            let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            progress(k as f64 / total as f64);
-        };
-        // The screening holds the model's own values: only the candidate's and the base
-        // parameters move.
-        let mut screen = spec;
-        screen.hold_first = rung.models.len();
-        let screened: Vec<Option<Fitted<'a>>> = cands
-            .par_iter()
-            .map(|c| {
-                let r =
-                    self.fit_candidate(c, rung, sr, screen, Starts::NestedOnly, SCREEN_ITER, None);
-                tick();
-                r
-            })
-            .collect::<Result<_, _>>()?;
-        // A candidate confusable with an effect of the model (Coulomb friction beside a load
-        // torque: the same term where the speed never reverses) can only show what it adds
-        // by trading values with it: it is a finalist with every value free.
-        let trades = |c: &[&dyn EffectModel]| {
-            c.iter().any(|e| {
-                e.confused_with()
-                    .iter()
-                    .any(|x| rung.kinds.contains(&x.with))
-            })
-        };
-        let mut chosen = finalists(&screened);
-        for (i, c) in cands.iter().enumerate() {
-            if trades(c) && screened[i].is_some() && !chosen.contains(&i) {
-                chosen.push(i);
-            }
-        }
-        let full: Vec<(usize, Option<Fitted<'a>>)> = chosen
-            .par_iter()
-            .map(|&i| {
-                let r = self.fit_candidate(
-                    &cands[i],
-                    rung,
-                    sr,
-                    if trades(&cands[i]) { spec } else { screen },
-                    Starts::NestedOnly,
-                    crate::MAX_ITER,
-                    screened[i].as_ref(),
-                );
-                tick();
-                r.map(|f| (i, f))
-            })
-            .collect::<Result<_, _>>()?;
-        let mut out = screened;
-        for (i, f) in full {
-            if let Some(slot) = out.get_mut(i) {
-                *slot = f;
-            }
-        }
-        // The round's best, refitted with every value of the model free (and, as `starts`
-        // says, also from the nominal base parameters): the best plausible one (what the
-        // step would keep) and the best by held-back error alone (a fit that held the
-        // model's values may have ended at a bound its own values' freedom leaves).
-        let score = |i: &usize| out[*i].as_ref().map_or(f64::INFINITY, Fitted::score);
-        let ran = || {
-            (0..out.len()).filter(|&i| {
-                out[i]
-                    .as_ref()
-                    .is_some_and(|f| f.heldback_fit_series.is_finite())
-            })
-        };
-        let best_plausible = ran()
-            .filter(|&i| out[i].as_ref().is_some_and(|f| f.implausible.is_empty()))
-            .min_by(|a, b| score(a).total_cmp(&score(b)));
-        let best_any = ran().min_by(|a, b| score(a).total_cmp(&score(b)));
-        let mut joint_of: Vec<usize> = best_plausible.into_iter().collect();
-        if let Some(b) = best_any.filter(|b| !joint_of.contains(b)) {
-            joint_of.push(b);
-        }
-        let joint: Vec<(usize, Option<Fitted<'a>>)> = joint_of
-            .par_iter()
-            .map(|&i| {
-                let r = match (machine, out[i].as_ref()) {
-                    // With the six base parameters refitted beside it.
-                    (true, Some(f)) => self.joint_machine(f, rung, sr).map(Some),
-                    _ => self.fit_candidate(
-                        &cands[i],
-                        rung,
-                        sr,
-                        spec,
-                        starts,
-                        crate::MAX_ITER,
-                        out[i].as_ref(),
-                    ),
-                };
-                r.map(|f| (i, f))
-            })
-            .collect::<Result<_, _>>()?;
-        for (i, f) in joint {
-            if let (Some(j), Some(slot)) = (f, out.get_mut(i)) {
-                *slot = Some(j);
-            }
-        }
-        Ok(out.into_iter().flatten().collect())
-    }
-
     /// One candidate `c` (effects to add, in order) fitted with the model of `rung`, from
     /// the `starts` given, the base parameters as `spec` says (for the candidate's effects,
     /// [`BaseSpec::for_effects`]), at most `max_iter` iterations; from a screening fit
     /// `from`'s values where given, else from where the model stood.
     #[allow(clippy::too_many_arguments)]
-    fn fit_candidate<'a>(
+    pub(super) fn fit_candidate<'a>(
         &self,
         c: &[&'a dyn EffectModel],
         rung: &Rung<'a>,
@@ -592,54 +466,6 @@ pub(super) fn pairs_of<'a>(fitted: &[Fitted<'a>], before: usize) -> Vec<Vec<&'a 
                 }
             }
             out.push(set);
-        }
-    }
-    out
-}
-
-/// The screened candidates fitted in full ([`Analysis::fit_round`]): the first
-/// [`FINALISTS`] in the round's order (plausible first, then by penalised held-back
-/// error), and the best by that error alone (a screening fit not yet plausible may end
-/// plausible).
-fn finalists(screened: &[Option<Fitted<'_>>]) -> Vec<usize> {
-    let mut order: Vec<usize> = (0..screened.len())
-        .filter(|&i| {
-            screened[i]
-                .as_ref()
-                .is_some_and(|f| f.heldback_fit_series.is_finite())
-        })
-        .collect();
-    let score = |i: usize| screened[i].as_ref().map_or(f64::INFINITY, Fitted::score);
-    let plausible = |i: usize| {
-        screened[i]
-            .as_ref()
-            .is_some_and(|f| f.implausible.is_empty())
-    };
-    order.sort_by(|&a, &b| {
-        plausible(b)
-            .cmp(&plausible(a))
-            .then(score(a).total_cmp(&score(b)))
-    });
-    let mut out: Vec<usize> = order.iter().copied().take(FINALISTS).collect();
-    if let Some(best) = order
-        .iter()
-        .copied()
-        .min_by(|&a, &b| score(a).total_cmp(&score(b)))
-    {
-        if !out.contains(&best) {
-            out.push(best);
-        }
-    }
-    // The full-order machine (the candidate with the most effects) too: the partial
-    // dynamics a screening ranks first are followed by the rest anyway.
-    if let Some(most) = order
-        .iter()
-        .copied()
-        .filter(|&i| screened[i].as_ref().is_some_and(|f| f.models.len() >= 2))
-        .max_by_key(|&i| screened[i].as_ref().map_or(0, |f| f.models.len()))
-    {
-        if !out.contains(&most) {
-            out.push(most);
         }
     }
     out

@@ -6,6 +6,7 @@
 //! read at line frequency, the viscous load a user's file leaves out).
 
 use super::choice::Kept;
+use super::passes::Round;
 use super::round::{pairs_of, Fitted, LadderSeries, Rung, Starts};
 use super::{LadderStep, Tried, PAIRS_ABOVE};
 use crate::effects::EffectModel;
@@ -62,21 +63,8 @@ impl Analysis {
             base_tried: base.is_some(),
             exhausted: cands.is_empty() && base.is_none(),
         };
-        // The base rung first: kept when it passes the step's test on its own.
-        let mut judge = None;
-        if let Some(b) = base {
-            let plausible = b.implausible.is_empty();
-            let (kept, tried) = self.choose(vec![b.clone()], rung, sr)?;
-            out.tried.extend(tried);
-            if kept.is_some() {
-                out.kept = kept;
-                return Ok(out);
-            }
-            if plausible {
-                judge = Some(self.judge_of(&b, sr)?);
-            }
-        }
-        if cands.is_empty() {
+        let judge = self.base_first(base, rung, sr, &mut out)?;
+        if out.kept.is_some() || cands.is_empty() {
             return Ok(out);
         }
         // The effects, fitted from where the model stood; once the machine's order is in,
@@ -84,28 +72,16 @@ impl Analysis {
         // each is judged against the base refitted alone (where that is physical): no
         // effect is credited with what the file's own errors explain, and none stands in
         // for them.
-        let spec = BaseSpec::paper(sr.fit_base);
-        let machine = sr.fit_base && order_done;
+        let round = Round {
+            cands: &cands,
+            rung,
+            sr,
+            spec: BaseSpec::paper(sr.fit_base),
+            starts: Starts::AlsoNominal,
+            machine: sr.fit_base && order_done,
+        };
         let from: &Rung<'a> = judge.as_ref().unwrap_or(rung);
-        let fitted =
-            self.fit_round(&cands, rung, sr, spec, Starts::AlsoNominal, machine, &|f| {
-                progress(0.1 + 0.6 * f)
-            })?;
-        let pairs = pairs_of(&fitted, rung.models.len());
-        let (mut kept, tried) = self.choose(fitted, from, sr)?;
-        out.tried.extend(tried);
-        let far = rung.heldback_error > PAIRS_ABOVE * rung.heldback_noise;
-        if kept.is_none() && !pairs.is_empty() && far {
-            // No single effect passes: two that need each other (a load torque and the
-            // cross coupling of a start, two hidden effects at once) are tried together.
-            let fitted =
-                self.fit_round(&pairs, rung, sr, spec, Starts::NestedOnly, machine, &|f| {
-                    progress(0.7 + 0.3 * f)
-                })?;
-            let (k2, t2) = self.choose(fitted, from, sr)?;
-            kept = k2;
-            out.tried.extend(t2);
-        }
+        let kept = self.effects_round(&round, from, &mut out.tried, progress)?;
         out.kept = match (kept, &judge) {
             (Some((next, step)), Some(_)) => {
                 let step = restated(step, rung, &next);
@@ -115,6 +91,65 @@ impl Analysis {
         };
         progress(1.0);
         Ok(out)
+    }
+
+    /// The base rung `base` of the round, if any, tried first: kept in `out` when it passes
+    /// the step's test on its own; else, where its values are plausible, the model the
+    /// round's effects are judged against ([`Analysis::judge_of`]).
+    fn base_first<'a>(
+        &self,
+        base: Option<Fitted<'a>>,
+        rung: &Rung<'a>,
+        sr: &LadderSeries,
+        out: &mut RoundOutcome<'a>,
+    ) -> Result<Option<Rung<'a>>, AnalysisError> {
+        let Some(b) = base else {
+            return Ok(None);
+        };
+        let plausible = b.implausible.is_empty();
+        let (kept, tried) = self.choose(vec![b.clone()], rung, sr)?;
+        out.tried.extend(tried);
+        if kept.is_some() {
+            out.kept = kept;
+            return Ok(None);
+        }
+        if plausible {
+            return self.judge_of(&b, sr).map(Some);
+        }
+        Ok(None)
+    }
+
+    /// The effects of `round`, each judged against `from`: the singles, then, when none
+    /// passes and the model is still far from its floor ([`PAIRS_ABOVE`]), the pairs of
+    /// the singles that lowered the training error most. The candidates not kept go to
+    /// `tried`; `progress` gets the round's fraction done.
+    fn effects_round<'a>(
+        &self,
+        round: &Round<'_, 'a>,
+        from: &Rung<'a>,
+        tried: &mut Vec<Tried>,
+        progress: &(dyn Fn(f64) + Sync),
+    ) -> Result<Option<Kept<'a>>, AnalysisError> {
+        let (rung, sr) = (round.rung, round.sr);
+        let fitted = self.fit_round(round, &|f| progress(0.1 + 0.6 * f))?;
+        let pairs = pairs_of(&fitted, rung.models.len());
+        let (kept, t) = self.choose(fitted, from, sr)?;
+        tried.extend(t);
+        let far = rung.heldback_error > PAIRS_ABOVE * rung.heldback_noise;
+        if kept.is_some() || pairs.is_empty() || !far {
+            return Ok(kept);
+        }
+        // No single effect passes: two that need each other (a load torque and the cross
+        // coupling of a start, two hidden effects at once) are tried together.
+        let of_pairs = Round {
+            cands: &pairs,
+            starts: Starts::NestedOnly,
+            ..*round
+        };
+        let fitted = self.fit_round(&of_pairs, &|f| progress(0.7 + 0.3 * f))?;
+        let (kept, t) = self.choose(fitted, from, sr)?;
+        tried.extend(t);
+        Ok(kept)
     }
 
     /// The base rung `b` (not kept) as the model the round's effects are judged against:

@@ -68,19 +68,7 @@ impl Analysis {
             if idx.is_empty() {
                 break;
             }
-            let mut best: Option<Without<'a>> = None;
-            for i in idx {
-                let Some(w) = self.without(&next, i, sr)? else {
-                    continue;
-                };
-                if best
-                    .as_ref()
-                    .is_none_or(|b| w.significance < b.significance)
-                {
-                    best = Some(w);
-                }
-            }
-            let Some(w) = best else {
+            let Some(w) = self.least_needed(&next, idx, sr)? else {
                 break;
             };
             if w.significance >= STEP_MIN {
@@ -113,6 +101,29 @@ impl Analysis {
             next = rung;
         }
         Ok((next, step))
+    }
+
+    /// Of `next`'s effects at `idx`, the one whose removal costs the least held-back
+    /// error, refitted without it (`None` when no refit could run).
+    fn least_needed<'a>(
+        &self,
+        next: &Rung<'a>,
+        idx: Vec<usize>,
+        sr: &LadderSeries,
+    ) -> Result<Option<Without<'a>>, AnalysisError> {
+        let mut best: Option<Without<'a>> = None;
+        for i in idx {
+            let Some(w) = self.without(next, i, sr)? else {
+                continue;
+            };
+            if best
+                .as_ref()
+                .is_none_or(|b| w.significance < b.significance)
+            {
+                best = Some(w);
+            }
+        }
+        Ok(best)
     }
 
     /// `next`'s model without its effect `i`, refitted nested on the fit series (`None`

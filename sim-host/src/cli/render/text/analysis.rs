@@ -289,12 +289,6 @@ pub fn ladder(
         writeln!(out, "{}", ladder_row(k + 1, s))?;
     }
     if let Some(f) = &r.final_fit {
-        let changed: Vec<String> = f
-            .base
-            .iter()
-            .filter(|c| c.changed)
-            .map(|c| c.spelled())
-            .collect();
         writeln!(
             out,
             "  {:<4} {:<34} {:>8} {:>7} {:>9} {:>7} {:>11}  {}",
@@ -305,11 +299,7 @@ pub fn ladder(
             "",
             "",
             "",
-            if changed.is_empty() {
-                "base parameters as the file's".to_string()
-            } else {
-                format!("base: {}", changed.join(", "))
-            }
+            super::super::end_base(f)
         )?;
     }
     writeln!(

@@ -1,0 +1,261 @@
+//! A round's three passes over its candidates: every one screened, the finalists fitted to
+//! convergence, the round's best refitted with every value of the model free.
+
+use super::round::{Fitted, LadderSeries, Rung, Starts};
+use super::{FINALISTS, SCREEN_ITER};
+use crate::effects::EffectModel;
+use crate::fit::BaseSpec;
+use crate::{Analysis, AnalysisError};
+use rayon::prelude::*;
+
+/// One slot per candidate of the round: its latest fit, or none where it could not run.
+type Slots<'a> = Vec<Option<Fitted<'a>>>;
+
+/// What a round's passes share: the candidates, the model they join and the fit series.
+pub(super) struct Round<'r, 'a> {
+    /// The candidates (effects to add, in order).
+    pub(super) cands: &'r [Vec<&'a dyn EffectModel>],
+    /// The model they are added to.
+    pub(super) rung: &'r Rung<'a>,
+    /// The fit series with its held-back split.
+    pub(super) sr: &'r LadderSeries,
+    /// The base parameters' freedom for the candidates' fits.
+    pub(super) spec: BaseSpec,
+    /// Where a best candidate of several effects starts its last fit.
+    pub(super) starts: Starts,
+    /// Whether the round's best is refitted with the six physical base parameters free.
+    pub(super) machine: bool,
+}
+
+impl Round<'_, '_> {
+    /// The screening's base specification: the model's own values held, only the
+    /// candidate's and the base parameters move.
+    fn screen_spec(&self) -> BaseSpec {
+        let mut screen = self.spec;
+        screen.hold_first = self.rung.models.len();
+        screen
+    }
+
+    /// Whether candidate `c` is confusable with an effect of the model (Coulomb friction
+    /// beside a load torque: the same term where the speed never reverses): it can only
+    /// show what it adds by trading values with it, so it is a finalist with every value
+    /// free.
+    fn trades(&self, c: &[&dyn EffectModel]) -> bool {
+        c.iter().any(|e| {
+            e.confused_with()
+                .iter()
+                .any(|x| self.rung.kinds.contains(&x.with))
+        })
+    }
+}
+
+impl Analysis {
+    /// Every candidate of `round` added to the model of its rung, fitted from its fit on
+    /// the fit series (in parallel), with its held-back error there and what makes it
+    /// implausible. Three passes: every candidate screened ([`SCREEN_ITER`] iterations,
+    /// from where the model stood, the model's own values held), then the [`FINALISTS`]
+    /// best (plausible first, by their penalised held-back error, and the best of all)
+    /// fitted to convergence from there, and the round's best of them refitted with every
+    /// value of the model free (with `machine`, the six physical base parameters free
+    /// beside them, [`Analysis::joint_machine`]); `starts` says whether that one, of
+    /// several effects, is also fitted from the nominal base parameters ([`Starts`]). The
+    /// held values cost no simulation per iteration: in a late round the model holds a
+    /// dozen. `progress` is handed the share of the round done.
+    pub(super) fn fit_round<'a>(
+        &self,
+        round: &Round<'_, 'a>,
+        progress: &(dyn Fn(f64) + Sync),
+    ) -> Result<Vec<Fitted<'a>>, AnalysisError> {
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        let total = (round.cands.len() + FINALISTS).max(1);
+        let tick = || {
+            let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            progress(k as f64 / total as f64);
+        };
+        let screened = self.screen_pass(round, &tick)?;
+        let out = self.final_pass(round, screened, &tick)?;
+        let out = self.joint_pass(round, out)?;
+        Ok(out.into_iter().flatten().collect())
+    }
+
+    /// The first pass: every candidate fitted [`SCREEN_ITER`] iterations with the model's
+    /// own values held.
+    fn screen_pass<'a>(
+        &self,
+        round: &Round<'_, 'a>,
+        tick: &(dyn Fn() + Sync),
+    ) -> Result<Slots<'a>, AnalysisError> {
+        let screen = round.screen_spec();
+        round
+            .cands
+            .par_iter()
+            .map(|c| {
+                let r = self.fit_candidate(
+                    c,
+                    round.rung,
+                    round.sr,
+                    screen,
+                    Starts::NestedOnly,
+                    SCREEN_ITER,
+                    None,
+                );
+                tick();
+                r
+            })
+            .collect()
+    }
+
+    /// The second pass: the finalists ([`finalists`], and every candidate that trades
+    /// values with an effect of the model) fitted to convergence from their screening.
+    fn final_pass<'a>(
+        &self,
+        round: &Round<'_, 'a>,
+        screened: Slots<'a>,
+        tick: &(dyn Fn() + Sync),
+    ) -> Result<Slots<'a>, AnalysisError> {
+        let screen = round.screen_spec();
+        let mut chosen = finalists(&screened);
+        for (i, c) in round.cands.iter().enumerate() {
+            if round.trades(c) && screened[i].is_some() && !chosen.contains(&i) {
+                chosen.push(i);
+            }
+        }
+        let full: Vec<(usize, Option<Fitted<'a>>)> = chosen
+            .par_iter()
+            .map(|&i| {
+                let c = &round.cands[i];
+                let spec = if round.trades(c) { round.spec } else { screen };
+                let r = self.fit_candidate(
+                    c,
+                    round.rung,
+                    round.sr,
+                    spec,
+                    Starts::NestedOnly,
+                    crate::MAX_ITER,
+                    screened[i].as_ref(),
+                );
+                tick();
+                r.map(|f| (i, f))
+            })
+            .collect::<Result<_, _>>()?;
+        // A finalist whose full fit could not run leaves the round.
+        let mut out = screened;
+        for (i, f) in full {
+            if let Some(slot) = out.get_mut(i) {
+                *slot = f;
+            }
+        }
+        Ok(out)
+    }
+
+    /// The third pass: the round's best plausible candidate (what the step would keep) and
+    /// the best by held-back error alone (a fit that held the model's values may have
+    /// ended at a bound its own values' freedom leaves), refitted with every value of the
+    /// model free: with the six base parameters beside them where the round's `machine`
+    /// says so, else from the round's `starts`.
+    fn joint_pass<'a>(
+        &self,
+        round: &Round<'_, 'a>,
+        out: Slots<'a>,
+    ) -> Result<Slots<'a>, AnalysisError> {
+        let joint: Vec<(usize, Option<Fitted<'a>>)> = best_two(&out)
+            .par_iter()
+            .map(|&i| {
+                let r = match (round.machine, out[i].as_ref()) {
+                    (true, Some(f)) => self.joint_machine(f, round.rung, round.sr).map(Some),
+                    _ => self.fit_candidate(
+                        &round.cands[i],
+                        round.rung,
+                        round.sr,
+                        round.spec,
+                        round.starts,
+                        crate::MAX_ITER,
+                        out[i].as_ref(),
+                    ),
+                };
+                r.map(|f| (i, f))
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(replace(out, joint))
+    }
+}
+
+/// `slots` with each refit of `new` in its candidate's slot (a refit that could not run
+/// leaves the fit before it in place).
+fn replace<'a>(mut slots: Slots<'a>, new: Vec<(usize, Option<Fitted<'a>>)>) -> Slots<'a> {
+    for (i, f) in new {
+        if let (Some(f), Some(slot)) = (f, slots.get_mut(i)) {
+            *slot = Some(f);
+        }
+    }
+    slots
+}
+
+/// The indices of the best plausible candidate and of the best by penalised held-back
+/// error alone (one index when they are the same).
+fn best_two(out: &[Option<Fitted<'_>>]) -> Vec<usize> {
+    let score = |i: &usize| out[*i].as_ref().map_or(f64::INFINITY, Fitted::score);
+    let ran = || {
+        (0..out.len()).filter(|&i| {
+            out[i]
+                .as_ref()
+                .is_some_and(|f| f.heldback_fit_series.is_finite())
+        })
+    };
+    let best_plausible = ran()
+        .filter(|&i| out[i].as_ref().is_some_and(|f| f.implausible.is_empty()))
+        .min_by(|a, b| score(a).total_cmp(&score(b)));
+    let best_any = ran().min_by(|a, b| score(a).total_cmp(&score(b)));
+    let mut joint_of: Vec<usize> = best_plausible.into_iter().collect();
+    if let Some(b) = best_any.filter(|b| !joint_of.contains(b)) {
+        joint_of.push(b);
+    }
+    joint_of
+}
+/// The screened candidates fitted in full ([`Analysis::fit_round`]): the first
+/// [`FINALISTS`] in the round's order (plausible first, then by penalised held-back
+/// error), and the best by that error alone (a screening fit not yet plausible may end
+/// plausible).
+fn finalists(screened: &[Option<Fitted<'_>>]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..screened.len())
+        .filter(|&i| {
+            screened[i]
+                .as_ref()
+                .is_some_and(|f| f.heldback_fit_series.is_finite())
+        })
+        .collect();
+    let score = |i: usize| screened[i].as_ref().map_or(f64::INFINITY, Fitted::score);
+    let plausible = |i: usize| {
+        screened[i]
+            .as_ref()
+            .is_some_and(|f| f.implausible.is_empty())
+    };
+    order.sort_by(|&a, &b| {
+        plausible(b)
+            .cmp(&plausible(a))
+            .then(score(a).total_cmp(&score(b)))
+    });
+    let mut out: Vec<usize> = order.iter().copied().take(FINALISTS).collect();
+    if let Some(best) = order
+        .iter()
+        .copied()
+        .min_by(|&a, &b| score(a).total_cmp(&score(b)))
+    {
+        if !out.contains(&best) {
+            out.push(best);
+        }
+    }
+    // The full-order machine (the candidate with the most effects) too: the partial
+    // dynamics a screening ranks first are followed by the rest anyway.
+    if let Some(most) = order
+        .iter()
+        .copied()
+        .filter(|&i| screened[i].as_ref().is_some_and(|f| f.models.len() >= 2))
+        .max_by_key(|&i| screened[i].as_ref().map_or(0, |f| f.models.len()))
+    {
+        if !out.contains(&most) {
+            out.push(most);
+        }
+    }
+    out
+}
