@@ -1,9 +1,11 @@
 //! `compare`: the configured model's errors against the log, and where it fails.
 
+use super::analysis::{
+    align, resolve, Analysis, AnalysisError, DataInfo, FittedEffect, Options, ParamValue,
+};
 use super::metrics::{self, ErrorSummary, Weights, WorstWindow};
 use super::simplified_model::{BaseParams, Prediction};
 use super::unbalance::UnbalanceAnalysis;
-use super::{align, resolve, Analysis, AnalysisError, DataInfo, FittedEffect, Options, ParamValue};
 use monitor_core::EffectKind;
 use serde::Serialize;
 

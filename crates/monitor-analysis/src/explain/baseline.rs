@@ -3,13 +3,14 @@
 //! identifies of them, and whether its error is structural.
 
 use super::HOLDOUT_WINDOWS;
+use crate::analysis::{align, Analysis, AnalysisError, Options, MAX_FIT_SAMPLES};
 use crate::effects::EffectModel;
 use crate::fit::{self, ActiveEffect, FitResult};
 use crate::metrics::{self, Weights};
 use crate::prep::Prepared;
 use crate::refit::BaseRefit;
 use crate::simplified_model::{BaseParams, Prediction};
-use crate::{align, transients, Analysis, AnalysisError, Options, MAX_FIT_SAMPLES};
+use crate::transients;
 use monitor_core::EffectKind;
 
 /// The configured model fitted and measured: what every candidate is compared with.

@@ -5,10 +5,11 @@
 use super::baseline::{ExplainBaseline, FullSeries};
 use super::ranking::RankedCandidate;
 use super::{explained_fraction, EffectCandidate, Standing};
+use crate::analysis::{align, Analysis, AnalysisError, FittedEffect, Options};
+use crate::base_range::base_newly_out_of_range;
 use crate::effects::{self, EffectModel, SetupError};
 use crate::fit::{self, ActiveEffect, FitResult};
-use crate::{align, base_newly_out_of_range, metrics, transients};
-use crate::{Analysis, AnalysisError, FittedEffect, Options};
+use crate::{metrics, transients};
 use monitor_core::EffectKind;
 
 /// Stage 5: the effects of the library `lib` that are not in the model (`names`), the

@@ -27,11 +27,11 @@ pub mod ladder;
 mod ranking;
 mod report;
 
+use super::analysis::{resolve, Analysis, AnalysisError, DataInfo, Options, ParamValue};
 use super::effects;
 use super::refit::BaseRefit;
 use super::simplified_model::Prediction;
 use super::unbalance::UnbalanceAnalysis;
-use super::{resolve, Analysis, AnalysisError, DataInfo, Options, ParamValue};
 use baseline::structural_error;
 use candidates::candidates;
 use monitor_core::EffectKind;

@@ -5,13 +5,13 @@
 use super::baseline::{ExplainBaseline, FullSeries};
 use super::ranking::{CandidateOutcome, RankedCandidate};
 use super::{ExplainOutput, ExplainReport, Standing, EXPLAINED_MIN, EXPLAINS_MIN, NOISE_MARGIN};
+use crate::analysis::{resolve, Analysis, AnalysisError, Options};
+use crate::base_range::{base_implausible, base_out_of_range};
 use crate::effects::SetupError;
 use crate::fit::{ActiveEffect, FittedModel};
 use crate::refit::BaseRefit;
 use crate::simplified_model::Prediction;
 use crate::unbalance::UnbalanceAnalysis;
-use crate::{base_implausible, base_out_of_range, resolve};
-use crate::{Analysis, AnalysisError, Options};
 use monitor_core::EffectKind;
 use monitor_replay::OptionField;
 
