@@ -364,10 +364,13 @@ def explain(
     With ``ladder=True``, walk the ladder instead (``sim-host explain --ladder``): add the
     effect that lowers the held-back error most, keep it when the step passes its test, and
     go on until the error is within the noise-floor band or nothing plausible helps. The
-    result (:class:`LadderResult`) has ``start``, ``ladder`` (one step each: ``effect``,
-    ``added``, ``fitted``, ``error``, ``heldback_error``, ``noise_floor``,
-    ``ratio_to_floor``, ``significance``, ...), ``stop`` and ``stopped_because``;
-    ``.ladder_frame`` is the steps as a DataFrame."""
+    result (:class:`LadderResult`) has ``summary`` (what was found, where it ended, why it
+    stopped), ``start``, ``ladder`` (one step each: ``effect`` (absent on the base rung),
+    ``added``, ``base`` (the base parameters' changes), ``dropped``, ``fitted``, ``error``,
+    ``heldback_error``, ``noise_floor``, ``ratio_to_floor``, ``significance``, ...),
+    ``base_changes``, ``final_fit`` (the chosen model refitted on the whole log), ``stop``
+    and ``stopped_because``; ``.ladder_frame`` is the steps as a DataFrame, ``.base_frame``
+    the six base parameters against the file."""
     p, is_text = _params(params)
     data, origin = _log(log)
     doc = _native.explain(

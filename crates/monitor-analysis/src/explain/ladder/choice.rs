@@ -62,7 +62,7 @@ impl Analysis {
             };
             if let Some(because) = because {
                 tried.push(Tried {
-                    base: c.base.is_some(),
+                    base: c.base.is_some() && c.added(before).is_empty(),
                     added: c.added(before),
                     heldback_error: c.heldback_fit_series,
                     significance: sig,

@@ -539,7 +539,8 @@ fn nothing_helps(rung: &Rung<'_>, tried: &[Tried], base_tried: bool, skipped: &[
 /// A tried candidate's name: its effects joined with `+`, or `the base parameters
 /// refitted`.
 pub fn tried_name(t: &Tried) -> String {
-    if t.base {
+    // An effect fitted with the base parameters refitted beside it is named by its effects.
+    if t.added.is_empty() {
         return "the base parameters refitted".to_string();
     }
     t.added
