@@ -12,14 +12,55 @@
 //! functions are the library's only `unsafe` (`asm!`; the workspace denies `unsafe_code`,
 //! allowed here item by item as in the firmware's register files), built for ARM only.
 
-use super::checks::ClipLimits;
+use super::limits::ClipLimits;
 use super::{CHANNELS, HALF_LEN};
+
+/// The template of one word of [`sum_clipped_words`] after its position's first: the word
+/// at byte offset `$offset` loaded into `{w}`, added into the position's sum `{$sum}`, and
+/// `word + above` and `below - word` ORed into the flags `{f}` (six instructions).
+macro_rules! clip_word {
+    ($sum:literal, $offset:literal) => {
+        concat!(
+            "ldr {w}, [{p}, #",
+            $offset,
+            "]\n",
+            "add {",
+            $sum,
+            "}, {",
+            $sum,
+            "}, {w}\n",
+            "add {t}, {w}, {a}\n",
+            "orr {f}, {f}, {t}\n",
+            "sub {t}, {b}, {w}\n",
+            "orr {f}, {f}, {t}",
+        )
+    };
+}
+
+/// The template of one word position of [`sum_clipped_words`] after the first: its
+/// `(above, below)` pair loaded from byte offset `$pair` of the limits into `{a}`, `{b}`;
+/// its first word (byte offset `$first`) loaded as the sum `{$sum}`, its tests ORed into the
+/// flags `{f}`; then the other three words ([`clip_word`], byte offsets `$rest`).
+macro_rules! clip_position {
+    ($sum:literal, $pair:literal, $first:literal, $($rest:literal),+) => {
+        concat!(
+            "ldrd {a}, {b}, [{lim}, #", $pair, "]\n",
+            "ldr {", $sum, "}, [{p}, #", $first, "]\n",
+            "add {t}, {", $sum, "}, {a}\n",
+            "orr {f}, {f}, {t}\n",
+            "sub {t}, {b}, {", $sum, "}\n",
+            "orr {f}, {f}, {t}",
+            $("\n", clip_word!($sum, $rest)),+
+        )
+    };
+}
 
 /// The word sums of the word positions `(a, b)`, `(c, a)`, `(b, c)` of one ADC's sample and
 /// the test words ORed: `checks::sum_clipped_words`' arithmetic, word by word in the same
 /// order. Per word position its `(above, below)` pair is loaded once (`ClipLimits` is
 /// `repr(C)`: three such pairs), then per word a load, an add into the sum, `word + above`
-/// and `below - word` ORed into the flags: six instructions a word.
+/// and `below - word` ORed into the flags: six instructions a word. One block of assembly,
+/// its template written a word position at a time ([`clip_position`], [`clip_word`]).
 #[inline(always)]
 #[allow(unsafe_code)]
 pub(super) fn sum_clipped_words(
@@ -34,80 +75,20 @@ pub(super) fn sum_clipped_words(
     // registers, touches no other memory and no stack, and sets no condition flags.
     unsafe {
         core::arch::asm!(
-            // (a, b): words 0, 3, 6, 9 (byte offsets 0, 12, 24, 36).
+            // (a, b): words 0, 3, 6, 9 (byte offsets 0, 12, 24, 36); its first word starts
+            // the flags.
             "ldrd {a}, {b}, [{lim}]",
             "ldr {ab}, [{p}]",
             "add {t}, {ab}, {a}",
             "sub {f}, {b}, {ab}",
             "orr {f}, {f}, {t}",
-            "ldr {w}, [{p}, #12]",
-            "add {ab}, {ab}, {w}",
-            "add {t}, {w}, {a}",
-            "orr {f}, {f}, {t}",
-            "sub {t}, {b}, {w}",
-            "orr {f}, {f}, {t}",
-            "ldr {w}, [{p}, #24]",
-            "add {ab}, {ab}, {w}",
-            "add {t}, {w}, {a}",
-            "orr {f}, {f}, {t}",
-            "sub {t}, {b}, {w}",
-            "orr {f}, {f}, {t}",
-            "ldr {w}, [{p}, #36]",
-            "add {ab}, {ab}, {w}",
-            "add {t}, {w}, {a}",
-            "orr {f}, {f}, {t}",
-            "sub {t}, {b}, {w}",
-            "orr {f}, {f}, {t}",
+            clip_word!("ab", 12),
+            clip_word!("ab", 24),
+            clip_word!("ab", 36),
             // (c, a): words 1, 4, 7, 10.
-            "ldrd {a}, {b}, [{lim}, #8]",
-            "ldr {ca}, [{p}, #4]",
-            "add {t}, {ca}, {a}",
-            "orr {f}, {f}, {t}",
-            "sub {t}, {b}, {ca}",
-            "orr {f}, {f}, {t}",
-            "ldr {w}, [{p}, #16]",
-            "add {ca}, {ca}, {w}",
-            "add {t}, {w}, {a}",
-            "orr {f}, {f}, {t}",
-            "sub {t}, {b}, {w}",
-            "orr {f}, {f}, {t}",
-            "ldr {w}, [{p}, #28]",
-            "add {ca}, {ca}, {w}",
-            "add {t}, {w}, {a}",
-            "orr {f}, {f}, {t}",
-            "sub {t}, {b}, {w}",
-            "orr {f}, {f}, {t}",
-            "ldr {w}, [{p}, #40]",
-            "add {ca}, {ca}, {w}",
-            "add {t}, {w}, {a}",
-            "orr {f}, {f}, {t}",
-            "sub {t}, {b}, {w}",
-            "orr {f}, {f}, {t}",
+            clip_position!("ca", 8, 4, 16, 28, 40),
             // (b, c): words 2, 5, 8, 11.
-            "ldrd {a}, {b}, [{lim}, #16]",
-            "ldr {bc}, [{p}, #8]",
-            "add {t}, {bc}, {a}",
-            "orr {f}, {f}, {t}",
-            "sub {t}, {b}, {bc}",
-            "orr {f}, {f}, {t}",
-            "ldr {w}, [{p}, #20]",
-            "add {bc}, {bc}, {w}",
-            "add {t}, {w}, {a}",
-            "orr {f}, {f}, {t}",
-            "sub {t}, {b}, {w}",
-            "orr {f}, {f}, {t}",
-            "ldr {w}, [{p}, #32]",
-            "add {bc}, {bc}, {w}",
-            "add {t}, {w}, {a}",
-            "orr {f}, {f}, {t}",
-            "sub {t}, {b}, {w}",
-            "orr {f}, {f}, {t}",
-            "ldr {w}, [{p}, #44]",
-            "add {bc}, {bc}, {w}",
-            "add {t}, {w}, {a}",
-            "orr {f}, {f}, {t}",
-            "sub {t}, {b}, {w}",
-            "orr {f}, {f}, {t}",
+            clip_position!("bc", 16, 8, 20, 32, 44),
             p = in(reg) conversions.as_ptr(),
             lim = in(reg) limits as *const ClipLimits,
             ab = out(reg) ab,
