@@ -53,7 +53,7 @@ pub const STEADY_SPREAD: f32 = 0.05;
 
 /// What the watch reads of one status (`app::MonitorStatus::clip_moment`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Moment {
+pub struct ClipMoment {
     /// Samples since boot (wrapping).
     pub samples: u32,
     /// Clipped samples since boot (wrapping): any front end.
@@ -82,9 +82,35 @@ pub struct RangeChange {
 /// The window being measured: the counts at its start and the speed's extremes so far.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Window {
-    start: Moment,
+    start: ClipMoment,
     slowest: f32,
     fastest: f32,
+}
+
+impl Window {
+    /// A window that starts at `m`, its speed's extremes at `m`'s speed.
+    fn starting_at(m: &ClipMoment) -> Self {
+        Self {
+            start: *m,
+            slowest: m.speed_rad_s,
+            fastest: m.speed_rad_s,
+        }
+    }
+
+    /// Widens the speed's extremes by `speed` [rad/s]. NaN is neither: a speed that is
+    /// not a number makes the window not steady ([`steady`]).
+    fn track(&mut self, speed: f32) {
+        self.slowest = if speed < self.slowest || speed.is_nan() {
+            speed
+        } else {
+            self.slowest
+        };
+        self.fastest = if speed > self.fastest || speed.is_nan() {
+            speed
+        } else {
+            self.fastest
+        };
+    }
 }
 
 /// The clip watch (module docs).
@@ -118,36 +144,18 @@ impl ClipWatch {
 
     /// Feeds one status; at the end of a window applies the rule and returns a change of
     /// the range state, if any.
-    pub fn observe(&mut self, m: &Moment) -> Option<RangeChange> {
+    pub fn observe(&mut self, m: &ClipMoment) -> Option<RangeChange> {
         let Some(w) = &mut self.window else {
-            self.window = Some(Window {
-                start: *m,
-                slowest: m.speed_rad_s,
-                fastest: m.speed_rad_s,
-            });
+            self.window = Some(Window::starting_at(m));
             return None;
         };
-        // NaN is neither: a speed that is not a number makes the window not steady below.
-        w.slowest = if m.speed_rad_s < w.slowest || m.speed_rad_s.is_nan() {
-            m.speed_rad_s
-        } else {
-            w.slowest
-        };
-        w.fastest = if m.speed_rad_s > w.fastest || m.speed_rad_s.is_nan() {
-            m.speed_rad_s
-        } else {
-            w.fastest
-        };
+        w.track(m.speed_rad_s);
         let samples = m.samples.wrapping_sub(w.start.samples);
         if samples < self.window_samples.max(1) {
             return None;
         }
         let w = *w;
-        self.window = Some(Window {
-            start: *m,
-            slowest: m.speed_rad_s,
-            fastest: m.speed_rad_s,
-        });
+        self.window = Some(Window::starting_at(m));
         let clipped = m.clipped.wrapping_sub(w.start.clipped);
         let permille_x = |n: u32| u64::from(n) * 1_000;
         let share = (permille_x(clipped) / u64::from(samples)) as u32;
@@ -205,7 +213,7 @@ mod tests {
     /// end), the speed `speed(t)`; the changes seen.
     fn run(
         watch: &mut ClipWatch,
-        at: &mut Moment,
+        at: &mut ClipMoment,
         seconds: f32,
         per_s: u32,
         speed: impl Fn(f32) -> f32,
@@ -226,9 +234,9 @@ mod tests {
     #[test]
     fn clipping_that_persists_in_steady_running_sets_the_range_state_and_a_start_does_not() {
         let mut w = ClipWatch::new(FS);
-        let mut at = Moment {
+        let mut at = ClipMoment {
             samples: u32::MAX - 3_000,
-            ..Moment::default()
+            ..ClipMoment::default()
         };
         // A start: 60 % clipped through the first 0.5 s while the shaft accelerates, none
         // after (10 s in all: five windows).
@@ -263,7 +271,7 @@ mod tests {
     fn isolated_clips_a_stall_and_an_interrupted_clip_set_nothing() {
         // A clip a second (17 samples with the hold: 0.085 %), steady: nothing.
         let mut w = ClipWatch::new(FS);
-        let mut at = Moment::default();
+        let mut at = ClipMoment::default();
         assert!(run(&mut w, &mut at, 30.0, 17, |_| 150.0).is_empty());
         // A stalled rotor clipping every sample: not running, nothing.
         assert!(run(&mut w, &mut at, 30.0, 10_000, |_| 0.3).is_empty());
@@ -273,7 +281,7 @@ mod tests {
         // Clipped steady running interrupted by a restart every 4 s: never three steady
         // windows clipped in a row.
         let mut w = ClipWatch::new(FS);
-        let mut at = Moment::default();
+        let mut at = ClipMoment::default();
         for _ in 0..5 {
             assert!(run(&mut w, &mut at, 4.0, 5_000, |_| 150.0).is_empty());
             assert!(run(&mut w, &mut at, 2.0, 5_000, |t| 20.0 + 60.0 * t).is_empty());

@@ -90,6 +90,11 @@
 
 use crate::board::Lamp;
 
+mod blink;
+pub use blink::{
+    blink_code, blink_code_lamp, read_blink_code, winding_code, NOT_NAMED_CODE, WINDING_CODE_A,
+};
+
 /// State of the six lamps (`true` = lit), one field per lamp.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct PanelLamps {
@@ -202,37 +207,6 @@ pub struct PanelInput {
     pub clip_range: bool,
 }
 
-/// Blink code of a fault detected that the isolation did not name (module docs): the one
-/// after the last fault's ([`blink_code`] of the core's fault list, `monitor_core::FAULTS`),
-/// 10 with Table 1's nine faults, so a fault added to the list cannot collide with it.
-pub const NOT_NAMED_CODE: u8 = blink_code(FAULT_CODES);
-
-/// Blink code of shorted turns in phase a; b and c follow (module docs): after
-/// [`NOT_NAMED_CODE`] (11, 12, 13 with Table 1's nine faults).
-pub const WINDING_CODE_A: u8 = NOT_NAMED_CODE + 1;
-
-/// The number of faults with a blink code: the core's fault list's length (at most 240,
-/// so the winding codes after them fit a `u8`).
-const FAULT_CODES: u8 = {
-    assert!(monitor_core::FAULT_COUNT <= 240, "blink codes are one byte");
-    monitor_core::FAULT_COUNT as u8
-};
-
-/// Blink code of shorted turns in the phase of index `phase_index` (0, 1, 2 for a, b, c):
-/// 11, 12, 13.
-pub const fn winding_code(phase_index: u8) -> u8 {
-    WINDING_CODE_A.saturating_add(phase_index)
-}
-
-/// Blink code of a candidate index (`monitor_core::Fault::index`): `index + 1` (1..=9 for
-/// Table 1's nine faults).
-pub const fn blink_code(candidate_index: u8) -> u8 {
-    candidate_index.saturating_add(1)
-}
-
-const BLINK_ON_MS: u32 = 250;
-const BLINK_SLOT_MS: u32 = 500;
-const BLINK_GAP_MS: u32 = 1500;
 /// Half period of the "sampling stalled" flash, ms (2 Hz).
 const STALLED_HALF_PERIOD_MS: u32 = 250;
 /// Period of the "built-in default motor" mark and its steady part, ms.
@@ -249,17 +223,6 @@ const BOR_MARK_AT_MS: u32 = 2_500;
 /// Where the "front end's range too small" mark starts in the same 10 s period, ms: after
 /// the clock's, 2 s steady and 0.5 s dark, ending with the period.
 const CLIP_RANGE_AT_MS: u32 = 7_500;
-
-/// Fault lamp state at `t_ms` for blink code `n` (>= 1): `n` pulses of 250 ms in 500 ms
-/// slots, then 1.5 s dark; period `n * 500 + 1500` ms.
-pub fn blink_code_lamp(n: u8, t_ms: u32) -> bool {
-    if n == 0 {
-        return false;
-    }
-    let period = u32::from(n) * BLINK_SLOT_MS + BLINK_GAP_MS;
-    let phase = t_ms % period;
-    phase < u32::from(n) * BLINK_SLOT_MS && phase % BLINK_SLOT_MS < BLINK_ON_MS
-}
 
 fn run_lamp(mode: Mode, t_ms: u32) -> bool {
     match mode {
@@ -335,42 +298,6 @@ pub fn render(input: &PanelInput, t_ms: u32) -> PanelLamps {
             input.commissioning_failed && t_ms % 100 < 50
         },
     }
-}
-
-/// Decode a blink code from a recorded fault-lamp trace sampled every `step_ms`
-/// (counts the pulses of the first complete group). For tests and for users who log
-/// the pin; returns `None` if no complete group is seen.
-pub fn read_blink_code(trace: &[bool], step_ms: u32) -> Option<u8> {
-    let gap_steps = (BLINK_GAP_MS / step_ms.max(1)) as usize;
-    // find the end of a dark gap, then count rising edges until the next gap
-    let mut dark = 0usize;
-    let mut start = None;
-    for (k, &on) in trace.iter().enumerate() {
-        if on {
-            if dark >= gap_steps.saturating_sub(1) {
-                start = Some(k);
-                break;
-            }
-            dark = 0;
-        } else {
-            dark += 1;
-        }
-    }
-    let start = start?;
-    let mut pulses = 0u8;
-    let mut prev = false;
-    let mut dark = 0usize;
-    for &on in trace.get(start..)? {
-        if on && !prev {
-            pulses = pulses.saturating_add(1);
-        }
-        dark = if on { 0 } else { dark + 1 };
-        if dark >= gap_steps.saturating_sub(1) {
-            return Some(pulses);
-        }
-        prev = on;
-    }
-    None
 }
 
 #[cfg(test)]

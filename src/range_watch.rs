@@ -21,7 +21,7 @@ use monitor_core::{OperatingPoint, OperatingRange, RunStage};
 /// What the watch reads of one status the sample task hands over (the app builds it,
 /// `MonitorStatus::range_moment`; this module knows nothing of the app).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Moment {
+pub struct RangeMoment {
     /// The status's operating point ([`OperatingPoint::from_dq`] of its `V_ds`, `V_qs`,
     /// `i_ds`, `I_qs`).
     pub point: OperatingPoint,
@@ -57,7 +57,7 @@ impl RangeWatch {
 
     /// Feeds a status: while its run learns and the quasi-steady gate is open, widens that
     /// run's range (a new run starts from nothing).
-    pub fn observe(&mut self, s: &Moment) {
+    pub fn observe(&mut self, s: &RangeMoment) {
         if s.stage != RunStage::Learning || !s.quasi_steady {
             return;
         }
@@ -86,7 +86,7 @@ impl RangeWatch {
 
     /// The status's operating point has left the commissioned range (beyond the core's
     /// margin) while the learned thresholds are in force and the lamps are evaluated.
-    pub fn moved(&self, s: &Moment) -> bool {
+    pub fn moved(&self, s: &RangeMoment) -> bool {
         s.commissioned && s.evaluating && !s.stage.is_active() && self.commissioned.moved(s.point)
     }
 }
