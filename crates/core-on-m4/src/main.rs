@@ -376,25 +376,9 @@ fn count_sampling_path(n: usize, ticks_per_instr: f32) -> f32 {
 /// built-in ranges, the rails alone, channels of different ranges and a narrow range that
 /// clips most conversions. Prints `kernels=pass` or the mismatches; `false` on any.
 fn check_kernels(n: usize) -> bool {
-    use acquisition::{
-        sum_clipped, sum_clipped_portable, ClipLimits, LinearRange, PwmFilter, HALF_LEN,
-    };
-    let r = |low, high| LinearRange { low, high };
-    let ranges = [
-        [r(62, 4033); 3],
-        [LinearRange::RAILS; 3],
-        [r(115, 4033), r(62, 4033), r(62, 3976)],
-        [r(1500, 2600), r(0, 2048), r(2047, 4095)],
-    ];
-    let limits = ranges.map(|r| ClipLimits::new(&r));
-    let edges: [u16; 12] = [0, 1, 61, 62, 63, 114, 115, 116, 3976, 4032, 4033, 4095];
+    use acquisition::{sum_clipped, sum_clipped_portable, PwmFilter, HALF_LEN};
+    let limits = KERNEL_RANGES.map(|r| acquisition::ClipLimits::new(&r));
     let mut seed = 0x2545_F491u32;
-    let mut random = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 17;
-        seed ^= seed << 5;
-        seed
-    };
     let mut buf = (
         [0u16; HALF_LEN],
         [0u16; HALF_LEN],
@@ -407,12 +391,7 @@ fn check_kernels(n: usize) -> bool {
             fill(k, &mut buf);
         } else {
             for code in buf.0.iter_mut().chain(buf.1.iter_mut()) {
-                let x = random();
-                *code = if x % 10 == 0 {
-                    edges[(x / 10) as usize % edges.len()]
-                } else {
-                    (x >> 8) as u16 & 0x0FFF
-                };
+                *code = random_code(&mut seed);
             }
         }
         for lim in &limits {
@@ -450,6 +429,42 @@ fn check_kernels(n: usize) -> bool {
             }
         }
     }
+    kernel_verdict(checked, clipped, mismatches)
+}
+
+/// [`check_kernels`]' ranges: the built-in ones, the rails alone, channels of different
+/// ranges, and a narrow range that clips most conversions.
+const KERNEL_RANGES: [[acquisition::LinearRange; 3]; 4] = {
+    use acquisition::LinearRange;
+    const fn r(low: u16, high: u16) -> LinearRange {
+        LinearRange { low, high }
+    }
+    [
+        [r(62, 4033); 3],
+        [LinearRange::RAILS; 3],
+        [r(115, 4033), r(62, 4033), r(62, 3976)],
+        [r(1500, 2600), r(0, 2048), r(2047, 4095)],
+    ]
+};
+
+/// [`check_kernels`]' next pseudo-random code from `seed` (xorshift32): anywhere in
+/// 0..=4095, a tenth of them on a range's edges.
+fn random_code(seed: &mut u32) -> u16 {
+    const EDGES: [u16; 12] = [0, 1, 61, 62, 63, 114, 115, 116, 3976, 4032, 4033, 4095];
+    *seed ^= *seed << 13;
+    *seed ^= *seed >> 17;
+    *seed ^= *seed << 5;
+    let x = *seed;
+    if x % 10 == 0 {
+        EDGES[(x / 10) as usize % EDGES.len()]
+    } else {
+        (x >> 8) as u16 & 0x0FFF
+    }
+}
+
+/// Prints [`check_kernels`]' counts and `kernels=pass` or `FAIL`: whether the kernels
+/// passed (no mismatch, and some of the `checked` clip checks `clipped` but not all).
+fn kernel_verdict(checked: u32, clipped: u32, mismatches: u32) -> bool {
     println!(
         "kernel_checks={} kernel_checks_clipped={}",
         checked, clipped

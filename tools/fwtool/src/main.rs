@@ -118,21 +118,19 @@ fn sections(elf: &[u8]) -> Result<Vec<Section>, String> {
 const SHF_ALLOC: u32 = 2;
 const SHT_NOBITS: u32 = 8;
 
-fn fw(check: bool) -> Result<(), String> {
-    let root = root();
-    run(cargo().current_dir(&root).args([
-        "build",
-        "--profile",
-        "firmware",
-        "--target",
-        TARGET,
-        "-p",
-        "drive-monitor",
-    ]))?;
-    let elf_path = target_dir(&root)
-        .join(TARGET)
-        .join("firmware/drive-monitor");
-    let elf = std::fs::read(&elf_path).map_err(|e| format!("{}: {e}", elf_path.display()))?;
+/// What the firmware's ELF takes of the chip ([`usage`]).
+struct Usage {
+    /// Flash [bytes]: the allocated sections outside RAM and the initial values of `.data`.
+    flash: u64,
+    /// Static RAM [bytes] (the stack not included).
+    ram: u64,
+    /// The lowest address of a static in RAM (`u64::MAX` without one).
+    first_static: u64,
+}
+
+/// Prints the ELF's allocated sections (name, bytes, address) and adds up what they take
+/// of the flash and the RAM.
+fn usage(elf: &[u8]) -> Result<Usage, String> {
     let (mut flash, mut ram) = (0u64, 0u64);
     // The lowest address of a static in RAM: with flip-link the stack lies below the
     // statics, from the start of RAM (docs/firmware.md, "The stack").
@@ -144,7 +142,7 @@ fn fw(check: bool) -> Result<(), String> {
         flags,
         addr,
         size,
-    } in sections(&elf)?
+    } in sections(elf)?
     {
         if flags & SHF_ALLOC == 0 || size == 0 {
             continue;
@@ -161,6 +159,33 @@ fn fw(check: bool) -> Result<(), String> {
             flash += u64::from(size);
         }
     }
+    Ok(Usage {
+        flash,
+        ram,
+        first_static,
+    })
+}
+
+fn fw(check: bool) -> Result<(), String> {
+    let root = root();
+    run(cargo().current_dir(&root).args([
+        "build",
+        "--profile",
+        "firmware",
+        "--target",
+        TARGET,
+        "-p",
+        "drive-monitor",
+    ]))?;
+    let elf_path = target_dir(&root)
+        .join(TARGET)
+        .join("firmware/drive-monitor");
+    let elf = std::fs::read(&elf_path).map_err(|e| format!("{}: {e}", elf_path.display()))?;
+    let Usage {
+        flash,
+        ram,
+        first_static,
+    } = usage(&elf)?;
     println!("ELF: {}", elf_path.display());
     let verdict = |used: u64, goal: u64| if used <= goal { "ok" } else { "OVER GOAL" };
     println!(
