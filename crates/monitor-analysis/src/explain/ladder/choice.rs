@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 pub(super) type Kept<'a> = (Rung<'a>, LadderStep);
 
 /// What a round found: the step kept (if any) and the candidates not kept, with why.
-pub(super) type Round<'a> = (Option<Kept<'a>>, Vec<Tried>);
+pub(super) type Choice<'a> = (Option<Kept<'a>>, Vec<Tried>);
 
 /// A candidate taken as a round's step, or why it is not kept.
 enum Take<'a> {
@@ -34,7 +34,7 @@ impl Analysis {
         mut fitted: Vec<Fitted<'a>>,
         rung: &Rung<'a>,
         sr: &LadderSeries,
-    ) -> Result<Round<'a>, AnalysisError> {
+    ) -> Result<Choice<'a>, AnalysisError> {
         fitted.sort_by(|a, b| {
             a.implausible
                 .is_empty()
