@@ -112,7 +112,7 @@ pub struct RangeNote {
 
 /// Follows a replay's commissioning (see the module documentation).
 #[derive(Debug, Clone)]
-pub(super) struct CommissionTracker {
+pub(crate) struct CommissionTracker {
     requested: Option<(f64, f64)>,
     run_id: Option<u16>,
     started_at: Option<f64>,
@@ -136,14 +136,14 @@ pub(super) struct CommissionTracker {
 /// `|V| = sqrt(V_ds^2 + V_qs^2)` [V] (module docs; the rule is the core's
 /// [`OperatingPoint`], `|V|` by the standard library's `hypot`); `I_active` is NaN without
 /// voltage.
-pub(super) fn operating_point(out: &MonitorOutput) -> (f32, f32) {
+pub(crate) fn operating_point(out: &MonitorOutput) -> (f32, f32) {
     let o = &out.operating;
     let p = OperatingPoint::with_magnitude(out.vds, o.vqs, o.i_f, o.iqs, out.vds.hypot(o.vqs));
     (p.load_a, p.voltage_v)
 }
 
 impl CommissionTracker {
-    pub(super) fn new(requested: Option<(f64, f64)>, words: Words, cfg: &MonitorConfig) -> Self {
+    pub(crate) fn new(requested: Option<(f64, f64)>, words: Words, cfg: &MonitorConfig) -> Self {
         CommissionTracker {
             requested,
             words,
@@ -165,7 +165,7 @@ impl CommissionTracker {
 
     /// Before the sample at `t` [s since the log's start]: starts the run at the window's
     /// start, cancels it when it is still learning past the grace time.
-    pub(super) fn before(&mut self, mon: &mut Monitor, t: f64) {
+    pub(crate) fn before(&mut self, mon: &mut Monitor, t: f64) {
         self.last_t = t;
         let Some((a, b)) = self.requested else {
             return;
@@ -199,7 +199,7 @@ impl CommissionTracker {
     /// After the sample: records the learning range, the run's end, the first
     /// quasi-steady point; returns a note when a lit r2..r4 lamp meets an operating point
     /// outside the learned range.
-    pub(super) fn after(&mut self, mon: &Monitor, t: f64, out: &MonitorOutput) -> Option<String> {
+    pub(crate) fn after(&mut self, mon: &Monitor, t: f64, out: &MonitorOutput) -> Option<String> {
         // (The run is read only where this replay started one.)
         if let Some(id) = self.run_id {
             let run = mon.commissioning();
@@ -274,7 +274,7 @@ impl CommissionTracker {
     /// left the span seen while learning (beyond the reporting margin): the note, as the
     /// timeline's `range_note` words it, whether or not a lamp is lit. `None` inside the
     /// range or without a learned window.
-    pub(super) fn moved_note(&self, out: &MonitorOutput) -> Option<String> {
+    pub(crate) fn moved_note(&self, out: &MonitorOutput) -> Option<String> {
         if out.commissioning != CommissioningState::Commissioned {
             return None;
         }
@@ -302,7 +302,7 @@ impl CommissionTracker {
     /// is outside the span seen while learning (beyond the reporting margin).
     /// (The same test as [`CommissionTracker::moved_note`]'s, without its words.)
     #[inline]
-    pub(super) fn outside_learned_range(&self, out: &MonitorOutput) -> bool {
+    pub(crate) fn outside_learned_range(&self, out: &MonitorOutput) -> bool {
         out.commissioning == CommissioningState::Commissioned && self.outside_span(out)
     }
 
@@ -319,7 +319,7 @@ impl CommissionTracker {
     /// window (the fixed thresholds are what the user chose), with one once the learned
     /// thresholds are in force, or once an incomplete run was given up (then the fixed
     /// thresholds are what `--allow-incomplete` reports with); never before.
-    pub(super) fn thresholds_trusted(&self, out: &MonitorOutput) -> bool {
+    pub(crate) fn thresholds_trusted(&self, out: &MonitorOutput) -> bool {
         self.requested.is_none()
             || self.cancelled
             || out.commissioning == CommissioningState::Commissioned
@@ -329,7 +329,7 @@ impl CommissionTracker {
     /// residuals already pass them at the first quasi-steady point. Wrong nominal
     /// parameters (a nameplate 10-30 % off) and a fault present from the start then look
     /// the same; only commissioning on healthy running tells them apart.
-    pub(super) fn nominal_misfit(&self) -> Option<String> {
+    pub(crate) fn nominal_misfit(&self) -> Option<String> {
         let p = self.first_steady.filter(|_| self.requested.is_none())?;
         let (k, r) = p
             .residuals
@@ -349,12 +349,12 @@ impl CommissionTracker {
     }
 
     /// True when a window was asked for and not learned.
-    pub(super) fn incomplete(&self) -> bool {
+    pub(crate) fn incomplete(&self) -> bool {
         self.requested.is_some() && !self.learned_ok()
     }
 
     /// A window was asked for and learned: the lamps' thresholds are the motor's own.
-    pub(super) fn learned(&self) -> bool {
+    pub(crate) fn learned(&self) -> bool {
         self.requested.is_some() && self.learned_ok()
     }
 
@@ -364,7 +364,7 @@ impl CommissionTracker {
 
     /// Why the window is incomplete, in one line (for the report; the error says it
     /// with [`CommissionTracker::not_learned`]).
-    pub(super) fn why_incomplete(&self) -> Option<String> {
+    pub(crate) fn why_incomplete(&self) -> Option<String> {
         let (window, why) = self.not_learned()?;
         Some(format!(
             "{}: {why}",
@@ -373,7 +373,7 @@ impl CommissionTracker {
     }
 
     /// The window asked for (`START:END`) and why it was not learned, where it was not.
-    pub(super) fn not_learned(&self) -> Option<(String, String)> {
+    pub(crate) fn not_learned(&self) -> Option<(String, String)> {
         let (a, b) = self.requested?;
         if self.learned_ok() {
             return None;
@@ -400,8 +400,13 @@ impl CommissionTracker {
         f64::from(blocks) / self.slow_hz.max(1e-9)
     }
 
+    /// The commissioning window asked for [s], if any.
+    pub(crate) fn requested(&self) -> Option<(f64, f64)> {
+        self.requested
+    }
+
     /// The report at the end of the replay.
-    pub(super) fn report(&self, k_sigma: f32) -> CommissioningReport {
+    pub(crate) fn report(&self, k_sigma: f32) -> CommissioningReport {
         let fixed = format!(
             "fixed: |r| > {:.1} % against the nominal parameters",
             100.0 * self.fixed[0]

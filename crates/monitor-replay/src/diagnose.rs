@@ -2,15 +2,19 @@
 //! ([`diagnose_file`]), the glitch bursts filled or held out, and the observer of every
 //! output (the live HMI's log source).
 
-use super::error::ReplayError;
-use super::front::{Direct, Handled, ReplaySink};
-use super::options::ReplayOptions;
-use super::pipe;
-use super::progress::{CountedRows, Forward, READ_SHARE};
-use super::replay::{Replay, ReplayObserver};
-use super::report::DiagnoseReport;
-use super::sampler::CLOCK_RESET_GAP_S;
-use super::verdict::measured::data_quality_finding;
+mod front;
+mod pipe;
+
+use crate::error::ReplayError;
+use crate::options::ReplayOptions;
+use crate::progress::{CountedRows, Forward, READ_SHARE};
+use crate::quality::DataQualityStage;
+use crate::replay::{Replay, ReplayObserver};
+use crate::report::DiagnoseReport;
+use crate::sampler::CLOCK_RESET_GAP_S;
+use crate::stage::Finish;
+use front::{Direct, Handled, ReplaySink};
+use monitor_core::SensorFlags;
 use monitor_io::log::quality::{
     CellLimits, CleanSink, DataQuality, NotJudged, QualityStage, MAX_BRIDGED_GAP_S,
 };
@@ -208,7 +212,7 @@ fn conclude(
         });
     };
     if replay.commissioning_incomplete() && !opts.allow_incomplete {
-        let (window, mut why) = replay.lamps.commission.not_learned().unwrap_or_default();
+        let (window, mut why) = replay.commissioning_not_learned().unwrap_or_default();
         // What the data-quality stage distrusts is often why nothing was learned (swapped
         // channels, a dead sensor): say it in the same line.
         if !quality.trusted {
@@ -220,17 +224,20 @@ fn conclude(
         return Err(ReplayError::IncompleteCommissioning { window, why });
     }
     let can_residuals = replay.monitor().is_some();
-    let sensors = replay.lamps.output().sensor_fault;
-    let mut report = replay.finish();
+    let sensors = replay
+        .monitor()
+        .map_or_else(SensorFlags::default, |m| m.output().sensor_fault);
+    let mut report = replay.end();
     describe_actions(&mut quality, can_residuals, handled);
-    let dq = data_quality_finding(&quality, sensors);
+    let dq = DataQualityStage::new(quality).finish(sensors);
     // Data the stage does not trust carry no finding (the sensors' impossible readings at
     // the end are the core's own finding: a sensor the isolation names with its size stands).
-    if !quality.trusted || dq_unjudged(&quality) {
-        report.distrust(&dq.summary);
+    if let Some(why) = &dq.distrusts {
+        report.distrust(why);
     }
-    report.put_finding(dq);
-    report.data_quality = quality;
+    report.put_finding(dq.finding);
+    report.data_quality = dq.quality;
+    report.conclude();
     Ok(Diagnosed {
         report,
         sample_rate_hz: handled.rate_hz,
@@ -298,10 +305,97 @@ fn describe_actions(q: &mut DataQuality, monitor: bool, sink: &Handled) {
     }
 }
 
-/// More of the log could not be judged than a verdict allows
-/// ([`monitor_io::log::quality::MAX_NOT_JUDGED_FRACTION`]).
-fn dq_unjudged(q: &DataQuality) -> bool {
-    let unjudged: f64 = q.not_judged.iter().map(|n| n.to_s - n.from_s).sum();
-    unjudged
-        > monitor_io::log::quality::MAX_NOT_JUDGED_FRACTION * q.duration_s.max(f64::MIN_POSITIVE)
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::verdict::{decided_on_this_thread, Verdict};
+    use monitor_sim::{simulate_to_vec, Scenario};
+
+    /// A 4 s log of the 2.2 kW reference machine at 2 kHz, an encoder logged.
+    fn log() -> Vec<Row> {
+        let text =
+            "duration_s = 4.0\nsample_rate_hz = 2000.0\nseed = 5\n[sensors]\nencoder = true\n";
+        let sc = Scenario::from_toml_str(text, "verdict-once").expect("scenario"); // ok: test
+        simulate_to_vec(&ParamFile::reference_2p2kw(), &sc).expect("simulate") // ok: test
+    }
+
+    /// The verdicts one `diagnose` decides: `monitor_core::verdict::decide` through
+    /// `verdict::conclude`, counted on this thread (the replay runs on a thread of its own;
+    /// the report is concluded here).
+    fn decided_by(channels: Channels, rows: &[Row], opts: ReplayOptions) -> (u32, DiagnoseReport) {
+        let before = decided_on_this_thread();
+        let report =
+            diagnose_rows(&ParamFile::reference_2p2kw(), channels, rows, opts).expect("diagnose"); // ok: test
+        (decided_on_this_thread() - before, report)
+    }
+
+    #[test]
+    fn a_diagnosis_decides_its_verdict_once() {
+        let rows = log();
+        let all = Channels {
+            voltages: true,
+            speed: true,
+            encoder: true,
+            temperature: false,
+        };
+        let commissioned = ReplayOptions {
+            commission: Some((1.0, 2.5)),
+            allow_incomplete: true,
+            ..ReplayOptions::default()
+        };
+        let current_only = Channels {
+            voltages: false,
+            speed: false,
+            encoder: false,
+            temperature: false,
+        };
+        // Every row's time repeated: the data-quality stage drops them and does not trust
+        // the log, so its finding makes every other finding "not judged" first.
+        let doubled: Vec<Row> = rows.iter().flat_map(|r| [*r, *r]).collect();
+        for (what, channels, rows, opts) in [
+            ("file", all, &rows, ReplayOptions::default()),
+            ("commissioned", all, &rows, commissioned),
+            (
+                "currents only",
+                current_only,
+                &rows,
+                ReplayOptions::default(),
+            ),
+            ("rows repeated", all, &doubled, ReplayOptions::default()),
+        ] {
+            let (n, report) = decided_by(channels, rows, opts);
+            assert_eq!(n, 1, "{what}: the verdict was decided {n} times");
+            // The decision stands in the report: its line is the verdict's.
+            assert!(!report.verdict_line.is_empty(), "{what}: no verdict line");
+            // (The repeated rows take the distrusting path: untrusted data, could not judge.)
+            let repeated = what == "rows repeated";
+            assert_eq!(report.data_quality.trusted, !repeated, "{what}");
+            assert_eq!(report.verdict == Verdict::CouldNotJudge, repeated, "{what}");
+        }
+    }
+
+    #[test]
+    fn a_replay_finished_decides_once() {
+        let rows = log();
+        let all = Channels {
+            voltages: true,
+            speed: true,
+            encoder: true,
+            temperature: false,
+        };
+        let mut replay = Replay::new(
+            &ParamFile::reference_2p2kw(),
+            all,
+            2000.0,
+            ReplayOptions::default(),
+        )
+        .expect("replay"); // ok: test
+        for r in &rows {
+            replay.push(r);
+        }
+        let before = decided_on_this_thread();
+        let report = replay.finish();
+        assert_eq!(decided_on_this_thread() - before, 1);
+        assert_eq!(report.rows, rows.len() as u64);
+    }
 }

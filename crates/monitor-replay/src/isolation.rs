@@ -11,17 +11,20 @@
 //! ([`monitor_core::isolation::Follower`]: the same code the firmware runs; the firmware
 //! feeds it the monitor's own outputs, [`SteadyPoint::from_output`]).
 
-pub(super) mod chunk;
+mod chunk;
 mod report;
 mod resistances;
 mod sentences;
+mod stage;
 
 pub use resistances::ResistanceReading;
+pub(crate) use stage::{IsolationClosing, IsolationFinding, IsolationInput};
 
 pub use crate::isolation_name::{IsolationName, NameGiven};
+use crate::stage::RowFlags;
 use monitor_core::isolation::{Follower, Named, Step, DEFAULT_SPREAD};
 use monitor_core::{Fault, Isolation, IsolationState, Isolator, SteadyPoint};
-pub(super) use report::refine_single_phase;
+use report::refine_single_phase;
 use report::{baseline_name, groups, REPORTED_RISE_K};
 pub use report::{
     state_name, DetectionLimit, FaultCandidate, IsolationBaseline, IsolationGroup, IsolationReport,
@@ -56,6 +59,8 @@ pub(super) struct IsolationTracker {
     end_t: f64,
     /// The operating point of the last isolation.
     last_point: SteadyPoint,
+    /// The sample interval [s].
+    dt_s: f64,
     /// Rs and Rr read apart at each isolation's point ([`resistances`]).
     resistances: resistances::ResistanceSums,
     /// A lamp lit while lamps counted.
@@ -148,12 +153,12 @@ impl IsolationTracker {
     /// (`temperature_column`) or without; `load`: what is known of the load.
     /// `chunk_rows`: the most rows whose points are handed on together (the core's block of
     /// `decimation` samples, [`chunk`]; at least 1).
-    pub(super) fn new(
+    pub(crate) fn new(
         isolator: Option<Isolator>,
         temperature_column: bool,
         load: super::options::LoadModel,
         words: super::words::Words,
-        chunk_rows: u32,
+        (dt_s, chunk_rows): (f64, u32),
     ) -> Self {
         let isolator = isolator.map(|mut i| {
             i.set_load_unknown(load == super::options::LoadModel::Unknown);
@@ -167,6 +172,7 @@ impl IsolationTracker {
             last_t: 0.0,
             end_t: 0.0,
             last_point: SteadyPoint::default(),
+            dt_s,
             resistances: resistances::ResistanceSums::default(),
             lamps_lit: false,
             evidence: monitor_core::isolation::Evidence::default(),
@@ -183,20 +189,13 @@ impl IsolationTracker {
     }
 
     /// After the monitor's output for the sample at `t` (`dt_s` after the previous one);
-    /// `flags`: the output's flags ([`chunk::RowFlags`]), their `counts` whether the lamps and
+    /// `flags`: the output's flags ([`RowFlags`]), their `counts` whether the lamps and
     /// detections count now (the learned thresholds are in force, or none were asked for)
     /// and the monitor has settled after a restart; `point`: the steady-state vectors at
     /// this sample (module docs); `temperature_c`: the log's temperature reading, if it has the column. The point goes
     /// into the chunk of rows handed on together ([`chunk`]; [`IsolationTracker::flush`]).
     #[inline]
-    pub(super) fn after(
-        &mut self,
-        t: f64,
-        dt_s: f64,
-        flags: chunk::RowFlags,
-        point: &SteadyPoint,
-        temperature_c: Option<f64>,
-    ) {
+    fn after(&mut self, t: f64, flags: RowFlags, point: &SteadyPoint, temperature_c: Option<f64>) {
         self.end_t = t;
         if self.follower.is_none() {
             return;
@@ -219,7 +218,7 @@ impl IsolationTracker {
         if alone {
             self.flush();
         }
-        let rows = self.chunk.add(t, dt_s, point, flags);
+        let rows = self.chunk.add(t, self.dt_s, point, flags);
         if rows >= self.chunk_rows || alone || self.chunk.span_s() >= self.block_left_s {
             self.flush();
         }
@@ -250,7 +249,7 @@ impl IsolationTracker {
     /// Whether a point with `flags` is usable by the follower: the monitor runs (now or
     /// before), no sensor fault, and commissioning learns or the lamps count.
     #[inline]
-    fn usable_with(&self, flags: chunk::RowFlags) -> bool {
+    fn usable_with(&self, flags: RowFlags) -> bool {
         let running = self.running || flags.evaluating() || flags.learned_blocks();
         running && !flags.sensor_fault() && (flags.learning() || flags.counts())
     }
@@ -258,7 +257,7 @@ impl IsolationTracker {
     /// Hands the rows of the chunk to the events' history and the follower (their mean
     /// point, the chunk's length; [`chunk`]), and books what the follower isolated; at the
     /// end of the log, what is left.
-    pub(super) fn flush(&mut self) {
+    pub(crate) fn flush(&mut self) {
         let Some(c) = self.chunk.close() else {
             return;
         };
@@ -350,14 +349,14 @@ impl IsolationTracker {
 
     /// Every name the isolation gave so far (a fault or the friction class), each with the
     /// first time it was given [s], in that order.
-    pub(super) fn names(&self) -> &[NameGiven] {
+    pub(crate) fn names(&self) -> &[NameGiven] {
         &self.names
     }
 
     /// The isolation named a fault other than the friction class at some point (a load
     /// change is, to the paper's model, a Bl change: that is left to the lamps and the
     /// commissioned range).
-    pub(super) fn named_a_fault(&self) -> bool {
+    pub(crate) fn named_a_fault(&self) -> bool {
         self.first_named
             .is_some_and(|g| g.name != IsolationName::Friction)
     }
@@ -367,7 +366,7 @@ impl IsolationTracker {
     /// learned baseline or its point.
     /// The tracked winding temperature rise [K] when a learned baseline is in force and it
     /// is at least [`report::REPORTED_RISE_K`] either way.
-    pub(super) fn winding_rise_k(&self) -> Option<f32> {
+    pub(crate) fn winding_rise_k(&self) -> Option<f32> {
         let f = self.follower.as_ref().filter(|f| f.learned())?;
         let rise = f.isolator().winding_rise_k();
         (rise.abs() >= REPORTED_RISE_K).then_some(rise)
@@ -393,7 +392,7 @@ impl IsolationTracker {
     /// winding's heating: the last isolation found no deviation from the machine at its
     /// tracked (warmer) temperature, which has risen by at least [`report::REPORTED_RISE_K`] (a
     /// name given while the tracking lagged a fast warming was withdrawn since).
-    pub(super) fn heating_explains_lamps(&self) -> bool {
+    pub(crate) fn heating_explains_lamps(&self) -> bool {
         self.winding_rise_k().is_some_and(|r| r > 0.0)
             && self
                 .concluded()
@@ -425,7 +424,7 @@ impl IsolationTracker {
     /// With the load an unknown input ([`super::options::LoadModel::Unknown`]), the lamps' detections
     /// are the load's move: the last isolation reads the friction class (the load), the
     /// operating points since name no fault, and no fault was ever named.
-    pub(super) fn load_explains_lamps(&self) -> bool {
+    pub(crate) fn load_explains_lamps(&self) -> bool {
         self.load_explains
     }
 
@@ -455,7 +454,7 @@ impl IsolationTracker {
     /// The report, and the candidates for `diagnose` (most probable first, those from
     /// [`LIST_FROM`] on) when `detected` (a lamp lit or a sensor fault was seen) or the
     /// isolation deviates from a learned baseline.
-    pub(super) fn report(&self, detected: bool) -> (IsolationReport, Vec<FaultCandidate>) {
+    pub(crate) fn report(&self, detected: bool) -> (IsolationReport, Vec<FaultCandidate>) {
         let learned = self.follower.as_ref().is_some_and(Follower::learned);
         let Some(concluded) = self.concluded() else {
             let why = if self.follower.is_none() {

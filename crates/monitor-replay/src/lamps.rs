@@ -5,71 +5,140 @@
 //!
 //! Between two of the monitor's revisions ([`Monitor::revision`]) only its speed moves:
 //! what depends on the rest of the output is done once per revision ([`LampStage::revise`]).
+//!
+//! Per row ([`Stage::update`]) it takes the row's time and hands on [`LampsRow`]: the
+//! output's flags as the isolation reads them and what the monitor said after the row
+//! before (the winding's windows take the learning and the speed from it). At the end
+//! ([`Finish::finish`]) it gives [`LampsFinding`].
+
+mod step;
+mod unsettled;
+
+pub use step::Detection;
 
 use crate::commission::CommissionTracker;
-use crate::isolation::chunk::RowFlags;
-use crate::isolation::IsolationTracker;
-use crate::options::LoadModel;
+use crate::options::{LoadModel, ReplayOptions};
 use crate::sampler::{sample_of, LogSampler, CLOCK_RESET_GAP_S, COUNTS_PER_REV};
-use crate::step::{
-    bands_for, bands_needed, book_detection, note_residuals, BlockView, Detection, LastOutput,
-    RestartHold, NO_BANDS,
+use crate::stage::{Finish, LampsSeen, RowFlags, Stage};
+use monitor_core::{AngleSource, ConfigError, Monitor, MonitorConfig, MonitorOutput};
+use monitor_io::log::{Channels, Row};
+pub(crate) use step::LastOutput;
+use step::{
+    bands_for, bands_needed, book_detection, note_residuals, BlockView, RestartHold, NO_BANDS,
 };
-use crate::unsettled;
-use crate::words::Words;
-use monitor_core::{ConfigError, Monitor, MonitorConfig, MonitorOutput};
-use monitor_io::log::Row;
 
 /// The lamps' stage: the core's monitor (`None` for a log that cannot feed the residuals:
 /// no voltages or no speed) and its bookkeeping.
 pub(crate) struct LampStage {
-    pub(crate) monitor: Option<Monitor>,
-    pub(crate) sampler: LogSampler,
-    pub(crate) commission: CommissionTracker,
-    pub(crate) k_sigma: f32,
-    pub(crate) evaluated: bool,
+    monitor: Option<Monitor>,
+    sampler: LogSampler,
+    commission: CommissionTracker,
+    k_sigma: f32,
+    /// The sample interval [s] (the running judged is counted in it).
+    dt_s: f64,
+    /// What is known of the load ([`LampStage::seen`]: with the load unknown, lamps that
+    /// only named the load term read a load move).
+    load: LoadModel,
+    /// The monitor's angle source (the report's).
+    angle_source: AngleSource,
+    /// The analyses the log's columns cannot feed (the report's `skipped`).
+    skipped: Vec<String>,
+    evaluated: bool,
     /// Seconds of running on which the lamps were judged: evaluated, quasi-steady, on
-    /// thresholds in force ([`MIN_JUDGED_S`] for a healthy verdict).
+    /// thresholds in force (`MIN_JUDGED_S` for a healthy verdict).
+    judged_s: f64,
+    /// A detection happened inside the commissioned operating range (or without one).
+    detected_in_range: bool,
+    first_detection: Option<f64>,
+    detections: Vec<Detection>,
+    /// The fault probabilities whose first fault is in `detections` already (NaN: none
+    /// yet; `step::note_detection`).
+    top_seen: [f32; monitor_core::FAULT_COUNT],
+    max_abs: [f32; 4],
+    /// What the next row needs of the monitor's output after the last row (a copy of the
+    /// whole output per row is what it saves).
+    last: LastOutput,
+    /// What the rows up to the monitor's next revision take from its output
+    /// ([`LampStage::block_row`]).
+    view: BlockView,
+    /// The isolation's wait after a restart of the monitor's estimators.
+    restart: RestartHold,
+    /// The stretch where the quasi-steady gate held the lamps, at the log's end.
+    unsettled: unsettled::Unsettled,
+    /// Added to every row's encoder count after a clock reset: the turn over the bridged
+    /// time ([`LampStage::clock_reset`]).
+    enc_offset: i64,
+}
+
+/// What the lamps hand on for one row.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct LampsRow {
+    /// What the monitor's output was after the row before (the default for a current-only
+    /// log): the windows' learning and speed, and the sensor flag the isolation's report
+    /// read during this row.
+    pub(crate) before: LastOutput,
+    /// The row fed a monitor (false for a current-only log: the stages after it that read
+    /// the monitor's output skip the row).
+    pub(crate) fed: bool,
+    /// The output's flags with `counts` the isolation's: the lamps count and the monitor
+    /// has settled after a restart of its estimators.
+    pub(crate) usable: RowFlags,
+    /// A lamp is lit.
+    pub(crate) lamps_lit: bool,
+}
+
+/// What the lamps found over the log ([`Finish::finish`]): the monitor's last output and
+/// what the report and the residual finding read.
+#[derive(Debug, Clone)]
+pub(crate) struct LampsFinding {
+    /// The log fed a monitor (voltages and a speed).
+    pub(crate) monitor: bool,
+    /// The monitor's last output (the default for a current-only log).
+    pub(crate) out: MonitorOutput,
+    /// The lamps were evaluated at some time.
+    pub(crate) evaluated: bool,
+    /// Seconds of running on which the lamps were judged.
     pub(crate) judged_s: f64,
     /// A detection happened inside the commissioned operating range (or without one).
     pub(crate) detected_in_range: bool,
+    /// The first detection's time [s].
     pub(crate) first_detection: Option<f64>,
+    /// The faults named while a lamp was lit, each with its first time.
     pub(crate) detections: Vec<Detection>,
-    /// The fault probabilities whose first fault is in `detections` already (NaN: none
-    /// yet; [`step::note_detection`]).
-    pub(crate) top_seen: [f32; monitor_core::FAULT_COUNT],
+    /// The largest |residual| of each while evaluating.
     pub(crate) max_abs: [f32; 4],
-    /// What the next row needs of the monitor's output after the last row (a copy of the
-    /// whole output per row is what it saves).
-    pub(crate) last: LastOutput,
-    /// What the rows up to the monitor's next revision take from its output
-    /// ([`LampStage::block_row`]).
-    pub(crate) view: BlockView,
-    /// The lamps lit now first lit while the operating point had moved (or the load
-    /// explained them), and have not all been dark since: their release after the load came
-    /// back is still the amber state.
-    pub(crate) lamps_since_moved: bool,
-    /// The isolation's wait after a restart of the monitor's estimators.
-    pub(crate) restart: RestartHold,
-    /// The stretch where the quasi-steady gate held the lamps, at the log's end.
-    pub(crate) unsettled: unsettled::Unsettled,
-    /// Added to every row's encoder count after a clock reset: the turn over the bridged
-    /// time ([`LampStage::clock_reset`]).
-    pub(crate) enc_offset: i64,
+    /// Commissioning as it ended.
+    pub(crate) commission: CommissionTracker,
+    /// The thresholds' spreads.
+    pub(crate) k_sigma: f32,
+    /// Why the log's end withholds the verdict (the quasi-steady gate held the lamps far
+    /// outside their bands), where it does.
+    pub(crate) withheld: Option<String>,
+    /// What the lamps say at the end about a fault ([`LampsSeen`]).
+    pub(crate) seen: LampsSeen,
+    /// With the load an unknown input, the lamps' matching only ever named the friction
+    /// class (the load term).
+    pub(crate) only_load_named: bool,
+    /// The monitor's angle source.
+    pub(crate) angle_source: AngleSource,
+    /// The analyses the log's columns cannot feed, with the column they need.
+    pub(crate) skipped: Vec<String>,
 }
 
 impl LampStage {
-    /// The stage for a monitor configured by `cfg` (`residuals`: the log can feed them),
-    /// commissioning in `commission` [s] where asked for (its advice in `words`).
+    /// The stage for a monitor configured by `cfg` from `opts` (commissioning, the load,
+    /// the words of its advice), on a log with `channels` (a monitor where they feed the
+    /// residuals: voltages and a speed), rows `dt_s` apart [s].
     ///
     /// # Errors
     /// The core's check of `cfg` ([`MonitorConfig::validate`]).
     pub(crate) fn new(
         cfg: &MonitorConfig,
-        commission: Option<(f64, f64)>,
-        words: Words,
-        residuals: bool,
+        opts: &ReplayOptions,
+        channels: Channels,
+        dt_s: f64,
     ) -> Result<Self, ConfigError> {
+        let residuals = channels.voltages && (channels.speed || channels.encoder);
         let monitor = if residuals {
             Some(Monitor::new(*cfg)?)
         } else {
@@ -79,8 +148,12 @@ impl LampStage {
         Ok(LampStage {
             monitor,
             sampler: LogSampler::default(),
-            commission: CommissionTracker::new(commission, words, cfg),
+            commission: CommissionTracker::new(opts.commission, opts.words, cfg),
             k_sigma: cfg.thresholds.k_sigma,
+            dt_s,
+            load: opts.load,
+            angle_source: opts.angle_source,
+            skipped: skipped_analyses(channels),
             evaluated: false,
             judged_s: 0.0,
             detected_in_range: false,
@@ -90,20 +163,25 @@ impl LampStage {
             max_abs: [0.0; 4],
             last: LastOutput::default(),
             view: BlockView::default(),
-            lamps_since_moved: false,
             restart: RestartHold::new(f64::from(cfg.settle_s)),
             unsettled: unsettled::Unsettled::default(),
             enc_offset: 0,
         })
     }
 
-    /// Feeds `row` at `t` [s] to the monitor (commissioning's start or end first): whether
-    /// the output is a fresh revision ([`LampStage::revise`]); `None` without a monitor.
-    pub(crate) fn update(&mut self, row: &Row, t: f64) -> Option<bool> {
-        let mon = self.monitor.as_mut()?;
-        self.commission.before(mon, t);
-        mon.update(&sample_of(&mut self.sampler, self.enc_offset, row));
-        Some(self.revise(t))
+    /// The core monitor (`None` for a current-only log).
+    pub(crate) fn monitor(&self) -> Option<&Monitor> {
+        self.monitor.as_ref()
+    }
+
+    /// The core monitor, to start a commissioning run by hand.
+    pub(crate) fn monitor_mut(&mut self) -> Option<&mut Monitor> {
+        self.monitor.as_mut()
+    }
+
+    /// Commissioning as it stands (its range, its notes).
+    pub(crate) fn commission(&self) -> &CommissionTracker {
+        &self.commission
     }
 
     /// The monitor's last output (the default for a current-only log).
@@ -113,11 +191,44 @@ impl LampStage {
             .map_or_else(MonitorOutput::default, |m| *m.output())
     }
 
+    /// The note on the commissioned range at the monitor's last revision (the timeline's).
+    pub(crate) fn range_note(&self) -> Option<&String> {
+        self.view.range_note.as_ref()
+    }
+
+    /// What the lamps say about a fault now, `sensor_fault_seen` whether a sensor fault
+    /// stood at the monitor's last revision before ([`LampsSeen`]).
+    pub(crate) fn seen(&self, sensor_fault_seen: bool) -> LampsSeen {
+        // With the load unknown, lamps whose matching only ever named the friction class
+        // (B, Bl: the load term) read a load move, not a fault.
+        let only_load = self.only_load_named() && !sensor_fault_seen;
+        LampsSeen {
+            detected: self.first_detection.is_some(),
+            only_load,
+        }
+    }
+
+    /// With the load an unknown input, the lamps' matching only ever named the friction
+    /// class (the load term): a load move.
+    fn only_load_named(&self) -> bool {
+        self.load == LoadModel::Unknown
+            && !self.detections.is_empty()
+            && self
+                .detections
+                .iter()
+                .all(|d| matches!(d.fault, monitor_core::Fault::B | monitor_core::Fault::Bl))
+    }
+
+    /// What the lamps say about a fault after the last row.
+    pub(crate) fn seen_now(&self) -> LampsSeen {
+        self.seen(self.last.sensor_fault)
+    }
+
     /// Between two of the monitor's revisions ([`Monitor::revision`]) only its speed moves:
     /// what depends on the rest of the output is done on the revision's first row, in
     /// [`LampStage::block_row`] (whether this row at `t` [s] is one: the answer), every row
-    /// does what depends on its time or its own values ([`Replay::push_step`]).
-    pub(crate) fn revise(&mut self, t: f64) -> bool {
+    /// does what depends on its time or its own values ([`LampStage::update`]).
+    fn revise(&mut self, t: f64) -> bool {
         let Some(mon) = self.monitor.as_ref() else {
             return false;
         };
@@ -139,7 +250,7 @@ impl LampStage {
     /// up to the next would repeat it to the bit): the residuals' extremes, the flags, the
     /// held stretch, a counted detection, and what the rows up to the next need (`bands`: the
     /// threshold bands in force, `range_note`: the commissioned range's note now).
-    pub(crate) fn block_row(
+    fn block_row(
         &mut self,
         t: f64,
         out: &MonitorOutput,
@@ -195,29 +306,94 @@ impl LampStage {
             ..*row
         }
     }
+}
 
-    /// Whether a fault was detected: a lamp lit or the isolation named a fault, unless the
-    /// isolation ends finding that the windings' heating explains it
-    /// (`monitor_core::isolation`, "Heating is not a fault"), or, with the load an unknown
-    /// input, that the load moved ([`LoadModel::Unknown`]: the lamps' torque residuals see a
-    /// load change as the paper's Bl fault).
-    pub(crate) fn detected(&self, isolation: &IsolationTracker, load: LoadModel) -> bool {
-        // With the load unknown, lamps whose matching only ever named the friction class
-        // (B, Bl: the load term) read a load move, not a fault.
-        let only_load = load == LoadModel::Unknown
-            && !self.detections.is_empty()
-            && self
-                .detections
-                .iter()
-                .all(|d| matches!(d.fault, monitor_core::Fault::B | monitor_core::Fault::Bl))
-            && !self.out_sensor_fault_seen();
-        let lamps =
-            self.first_detection.is_some() && !isolation.load_explains_lamps() && !only_load;
-        !isolation.heating_explains_lamps() && (lamps || isolation.named_a_fault())
-    }
+impl Stage for LampStage {
+    /// The row's time since the first row [s].
+    type Input<'a> = f64;
+    type Output = LampsRow;
 
-    /// A sensor fault was flagged at the end (the lamps' detections then stand).
-    pub(crate) fn out_sensor_fault_seen(&self) -> bool {
-        self.last.sensor_fault
+    /// Feeds `row` at `t` [s] to the monitor (commissioning's start or end first); the
+    /// monitor's output is then [`LampStage::monitor`]'s.
+    #[inline]
+    fn update(&mut self, row: &Row, t: f64) -> LampsRow {
+        let before = self.last;
+        let Some(mon) = self.monitor.as_mut() else {
+            return LampsRow {
+                before,
+                ..LampsRow::default()
+            };
+        };
+        self.commission.before(mon, t);
+        mon.update(&sample_of(&mut self.sampler, self.enc_offset, row));
+        let fresh = self.revise(t);
+        let Some(mon) = self.monitor.as_ref() else {
+            return LampsRow::default();
+        };
+        // (The output is read where the monitor keeps it: no copy per row.)
+        let out = mon.output();
+        let BlockView {
+            flags,
+            judging,
+            lamps_lit,
+            ..
+        } = self.view;
+        let settled = self.restart.settled(t, out);
+        // The running the lamps were judged on (`MIN_JUDGED_S`).
+        if judging {
+            self.judged_s += self.dt_s;
+        }
+        if fresh {
+            self.last = LastOutput::of(out, flags);
+        }
+        LampsRow {
+            before,
+            fed: true,
+            usable: flags.with_counts(flags.counts() && settled),
+            lamps_lit,
+        }
     }
+}
+
+impl Finish for LampStage {
+    type Closing<'a> = ();
+    type Finding = LampsFinding;
+
+    fn finish(self, (): ()) -> LampsFinding {
+        LampsFinding {
+            monitor: self.monitor.is_some(),
+            out: self.output(),
+            evaluated: self.evaluated,
+            judged_s: self.judged_s,
+            detected_in_range: self.detected_in_range,
+            seen: self.seen_now(),
+            only_load_named: self.only_load_named(),
+            angle_source: self.angle_source,
+            skipped: self.skipped,
+            first_detection: self.first_detection,
+            detections: self.detections,
+            max_abs: self.max_abs,
+            commission: self.commission,
+            k_sigma: self.k_sigma,
+            withheld: self.unsettled.withheld(),
+        }
+    }
+}
+
+/// The analyses a log with `channels` cannot feed, with the column they need (the report's
+/// `skipped`).
+fn skipped_analyses(channels: Channels) -> Vec<String> {
+    let mut skipped = Vec::new();
+    if !channels.voltages {
+        skipped.push(
+            "residuals r1..r4 and fault signatures: need the voltages va_V, vb_V, vc_V (Vqs)"
+                .to_string(),
+        );
+    } else if !(channels.speed || channels.encoder) {
+        skipped.push(
+            "residuals r1..r4 and fault signatures: need the speed (wm_rad_s or enc_count)"
+                .to_string(),
+        );
+    }
+    skipped
 }

@@ -26,32 +26,34 @@ mod commission;
 mod diagnose;
 mod error;
 mod events;
-mod front;
 mod isolation;
 mod isolation_name;
 mod lamps;
 mod options;
-mod pipe;
 mod progress;
+mod quality;
 mod replay;
 mod report;
 mod rotor;
 mod sampler;
 mod sequences;
-mod step;
+mod stage;
 mod temperature;
+mod timeline;
 mod trig;
-mod unsettled;
+mod turn_calibration;
 pub mod verdict;
 mod winding;
+mod windows;
 mod words;
 
 pub use baseline::{HealthyReference, UnbalanceBaseline, BASELINE_I1_TOLERANCE};
 pub use error::ReplayError;
 pub use replay::{Replay, ReplayObserver};
 pub use sampler::{COUNTS_PER_REV, TICK_HZ};
-pub use sequences::{FILLED_SAMPLES, SENSOR_PHASE_MIN_RATIO};
+pub use sequences::FILLED_SAMPLES;
 pub use verdict::{MIN_FAULT_CHANGE, MIN_JUDGED_S};
+pub use windows::SENSOR_PHASE_MIN_RATIO;
 
 pub use commission::{
     grace_s, min_learned_s, CommissioningOutcome, CommissioningReport, QuasiSteadyPoint, RangeNote,
@@ -64,20 +66,20 @@ pub use isolation::{
     state_name, DetectionLimit, FaultCandidate, IsolationBaseline, IsolationGroup, IsolationName,
     IsolationReport, NameGiven, ResistanceReading, NOMINAL_UNCERTAINTY,
 };
+pub use lamps::Detection;
 pub use options::{
     angle_source_name, check_parallel_paths, monitor_config_for_log, serialize_angle_source,
     CommissionWindow, LoadModel, ReplayOptions, TimelineStep, PARALLEL_PATHS,
 };
-pub use report::{DiagnoseReport, MonitorState, Panel, TimelinePoint};
+pub use report::DiagnoseReport;
 pub use rotor::{
     band_of, blackman_harris, LoadSource, MeasuredPoint, RatedLoadPoint, RotorBand, RotorLoad,
     RotorReport, SlipSource, BLACKMAN_HARRIS_4, EDGE_SPREAD_DB, FAULT_EDGE_DB, MAIN_LOBE_HALF_BINS,
     MAX_SLIP, MAX_SLIP_OVER_RATED, MAX_STRETCH_S, MCSA_MIN_LOAD, MIN_BINS, MIN_SLIP, SLIP_STEADY,
 };
 pub use sampler::LogSampler;
-pub use sequences::{SensorPhaseReport, SequenceWindow, WINDOW_PERIODS};
-pub use step::Detection;
 pub use temperature::TemperatureReport;
+pub use timeline::{MonitorState, Panel, TimelinePoint};
 pub use verdict::{FindingReport, Rule, Verdict};
 pub use winding::level::{
     LabelledRun, LevelBasis, ShortedTurns, TurnCalibration, TurnLevelOptions,
@@ -88,4 +90,5 @@ pub use winding::{
     DEFAULT_SPREAD_VOLTAGES, HEALTHY_RUN_DIFFERENCE_CURRENTS, HEALTHY_RUN_DIFFERENCE_VOLTAGES,
     NO_BASELINE_SPREAD, NO_BASELINE_SPREAD_VOLTAGES, WINDING_FAULT_PROBABILITY, WITHIN_LOG_SPREAD,
 };
+pub use windows::{SensorPhaseReport, SequenceWindow, WINDOW_PERIODS};
 pub use words::{FieldNames, OptionError, OptionField, Spelling, Words};

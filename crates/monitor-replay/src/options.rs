@@ -56,8 +56,8 @@ pub struct ReplayOptions {
     /// What is known of the load ([`LoadModel`]; the field `load`).
     pub load: LoadModel,
     /// How the shorted-turn level is sized (the fields `parallel_paths`, 1..=8 as
-    /// [`PARALLEL_PATHS`] says, and `turn_calibration`; [`super::winding::level`]).
-    pub turn_level: super::winding::level::TurnLevelOptions,
+    /// [`PARALLEL_PATHS`] says, and `turn_calibration`; `winding::level`).
+    pub turn_level: crate::turn_calibration::TurnLevelOptions,
     /// The words the report's sentences name a field in (a hint to give `commission`, the
     /// `load`, a `baseline`): the front end's that asked ([`Words`]; the library's own,
     /// [`FieldNames`], by default). No part of what is judged: ignored by `==`.
@@ -97,7 +97,7 @@ impl Default for ReplayOptions {
             timeline_step: TimelineStep::DEFAULT,
             unbalance_baseline: None,
             load: LoadModel::Unknown,
-            turn_level: super::winding::level::TurnLevelOptions::default(),
+            turn_level: crate::turn_calibration::TurnLevelOptions::default(),
             words: Words::LIBRARY,
         }
     }

@@ -77,8 +77,7 @@ mod tests;
 pub use baseband::RotorFront;
 pub use judge::band_of;
 pub use load::{
-    LoadSource, MeasuredPoint, RatedLoadPoint, RotorLoad, CURRENT_MODEL_UNCERTAINTY,
-    MAX_SLIP_OVER_RATED, MCSA_MIN_LOAD,
+    LoadSource, MeasuredPoint, RatedLoadPoint, RotorLoad, MAX_SLIP_OVER_RATED, MCSA_MIN_LOAD,
 };
 pub use spectrum::blackman_harris;
 
@@ -297,3 +296,37 @@ impl RotorMachine {
 
 mod read;
 pub use read::rotor_report;
+
+/// The rotor stage: its rows reach it inside the sequence stage (the demodulator runs on
+/// the sequence stage's reference angle, [`RotorFront`]); at the end it reads the record
+/// with the operating points the winding measured ([`RotorClosing`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct RotorStage {
+    params: ParamFile,
+}
+
+/// What the chain hands the rotor at the end.
+pub(crate) struct RotorClosing<'a> {
+    /// The demodulator's record (`None`: the sequence stage was lent and never given back).
+    pub(crate) front: Option<&'a RotorFront>,
+    /// The steady operating points the winding measured, with their stretches [s].
+    pub(crate) measured: &'a [([f64; 2], MeasuredPoint)],
+}
+
+impl RotorStage {
+    /// The stage for `params`' machine.
+    pub(crate) fn new(params: &ParamFile) -> Self {
+        RotorStage { params: *params }
+    }
+}
+
+impl crate::stage::Finish for RotorStage {
+    type Closing<'a> = RotorClosing<'a>;
+    type Finding = RotorReport;
+
+    fn finish(self, c: RotorClosing<'_>) -> RotorReport {
+        c.front.map_or_else(RotorReport::default, |f| {
+            rotor_report(f, &self.params, c.measured)
+        })
+    }
+}

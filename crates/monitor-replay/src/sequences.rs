@@ -30,33 +30,23 @@ mod lanes;
 mod reference;
 mod slow;
 
+use crate::stage::{Finish, Stage};
+use crate::windows::{SequenceWindow, WindowRow, MIN_WINDOW_FILL, WINDOW_PERIODS};
 use block_pll::BlockPll;
 use lanes::{Demod, FitSums};
 use monitor_core::frames::{clarke, AlphaBeta, SinCos};
-use monitor_core::sequence::{single_phase_gain, Complex32, SinglePhaseGain, ThreePhasors};
 use monitor_core::Abc;
-use monitor_core::Phase;
 use monitor_core::SteadyPoint as IsolationPoint;
 use monitor_io::log::quality::MAX_BRIDGED_GAP_S;
 use monitor_io::log::Row;
 use monitor_io::params::ParamFile;
 use reference::{RampSums, Reference};
-use serde::Serialize;
 use slow::SlowFilters;
 use std::collections::VecDeque;
 
-/// Zero sequence (|3 I0|/|I1|) from which one phase's sensor gain error is reported: 0.5 %,
-/// about ten times what 12-bit sensors with 0.1 % noise and 0.2 % gain mismatch leave after
-/// the sequence analysis' 2 Hz filters (a one-phase gain error `g` gives about `g`).
-pub const SENSOR_PHASE_MIN_RATIO: f32 = 0.005;
 /// Missing samples up to this many in a row are filled for the sequence analysis (the
 /// vectors turned back at the supply frequency); longer gaps only advance the angle.
 pub const FILLED_SAMPLES: usize = 50;
-
-/// Supply periods per least-squares window (at the nominal frequency): 0.17 s at 60 Hz,
-/// 0.2 s at 50 Hz. Short enough to see a fault switched on and off within a few seconds,
-/// long enough that harmonics and noise average out.
-pub const WINDOW_PERIODS: f64 = 10.0;
 
 /// Corner of the low-pass on the PLL's frequency that the least-squares reference turns at
 /// [Hz]: a second-order filter that passes `2f` wobble at `(1/(2f))^2` (7e-5 at 60 Hz).
@@ -66,37 +56,6 @@ pub const REFERENCE_FC_HZ: f32 = 1.0;
 /// steady (a fraction of its mean): above it the supply frequency moved (a run-up, a
 /// drive's ramp) or the PLL was still locking.
 pub const STEADY_FREQUENCY_RANGE: f32 = 0.005;
-
-/// Least share of a window's samples the fit must have used (bad samples are held out).
-pub const MIN_WINDOW_FILL: f64 = 0.8;
-
-/// One window of the least-squares analysis.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SequenceWindow {
-    /// Time of the window's first and last sample [s since the log's first row].
-    pub from_s: f64,
-    /// See `from_s`.
-    pub to_s: f64,
-    /// The currents' phase phasors.
-    pub i: ThreePhasors,
-    /// The voltages' phase phasors, where logged and good in the whole window.
-    pub v: Option<ThreePhasors>,
-    /// Mean supply angular frequency over the window [rad/s].
-    pub we_rad_s: f32,
-    /// Mean over the window of the reference angle less `w0 t` (the nominal frequency's
-    /// angle), unwrapped [rad]: how far the reference turned from a fixed-frequency frame,
-    /// so that windows can be put into one frame ([`SequenceWindow::offset_rad`]).
-    pub offset_rad: f64,
-    /// The monitor's electrical rotor speed at the window's end [rad/s], where the log
-    /// has a speed (encoder or speed column).
-    pub wr_rad_s: Option<f32>,
-    /// The fit used at least [`MIN_WINDOW_FILL`] of the window's samples.
-    pub complete: bool,
-    /// Complete, and the supply frequency held still.
-    pub steady: bool,
-    /// The window lies in the commissioning window's learning.
-    pub learning: bool,
-}
 
 /// The window being filled.
 #[derive(Debug, Clone, Copy)]
@@ -176,6 +135,19 @@ pub(super) struct SequenceStep {
 }
 
 impl SequenceStep {
+    /// What the winding's windows take of the step: whether the open window was closed
+    /// before the row's sample and after it, with the monitor's learning and speed after
+    /// the row before.
+    #[inline]
+    pub fn window_row(&self, learning: bool, wr_rad_s: Option<f32>) -> WindowRow {
+        WindowRow {
+            closed_before: self.closed_before,
+            closed_after: self.closed_after,
+            learning,
+            wr_rad_s,
+        }
+    }
+
     /// The steady-state vectors for the isolation: the positive sequences of voltage and
     /// current on the PLL's angle, its frequency, and the monitor's electrical speed
     /// `wr_rad_s` (encoder, filtered).
@@ -192,66 +164,6 @@ impl SequenceStep {
             we_rad_s: self.we_rad_s,
             wr_rad_s,
         }
-    }
-}
-
-/// The least-squares windows with what the monitor adds to them: whether the commissioning
-/// window's learning covered every sample, and the monitor's speed where the window closed.
-#[derive(Debug, Clone, Default)]
-pub(super) struct WindowBook {
-    /// The open window's samples were all offered while learning.
-    learning: bool,
-    /// Windows closed by the front, not yet booked.
-    queue: VecDeque<Option<SequenceWindow>>,
-    windows: Vec<SequenceWindow>,
-}
-
-impl WindowBook {
-    /// An empty book.
-    pub fn new() -> Self {
-        WindowBook {
-            learning: true,
-            ..WindowBook::default()
-        }
-    }
-
-    /// Takes the windows the front closed (in order).
-    pub fn take(&mut self, front: &mut SequenceFront) {
-        self.queue.extend(front.closed.drain(..));
-    }
-
-    /// Queues one window the front closed (the other thread's end of [`WindowBook::take`]).
-    pub fn queue(&mut self, w: Option<SequenceWindow>) {
-        self.queue.push_back(w);
-    }
-
-    /// Books one row's step: `learning` whether the monitor was learning its commissioning
-    /// window, `wr_rad_s` its electrical speed, both at the row before (where the log has a
-    /// speed).
-    #[inline]
-    pub fn row(&mut self, step: &SequenceStep, learning: bool, wr_rad_s: Option<f32>) {
-        if step.closed_before {
-            self.close(wr_rad_s);
-        }
-        self.learning &= learning;
-        if step.closed_after {
-            self.close(wr_rad_s);
-        }
-    }
-
-    /// Ends the open window (the front closed it).
-    pub fn close(&mut self, wr_rad_s: Option<f32>) {
-        if let Some(mut w) = self.queue.pop_front().flatten() {
-            w.learning = self.learning;
-            w.wr_rad_s = wr_rad_s;
-            self.windows.push(w);
-        }
-        self.learning = true;
-    }
-
-    /// The least-squares windows so far (the open one left out).
-    pub fn windows(&self) -> &[SequenceWindow] {
-        &self.windows
     }
 }
 
@@ -498,13 +410,6 @@ impl SequenceFront {
     }
 }
 
-/// One phase's sensor gain error in a set of phasors (the zero sequence,
-/// [`single_phase_gain`]), evidence from [`SENSOR_PHASE_MIN_RATIO`] on: `p`, `n`, `z` the
-/// positive, negative and zero sequences with one rotation.
-pub(super) fn sensor_phase(p: Complex32, n: Complex32, z: Complex32) -> Option<SinglePhaseGain> {
-    single_phase_gain(p, n, z, SENSOR_PHASE_MIN_RATIO)
-}
-
 /// The current vector of the phase values `[a, b, c, _]` ([`clarke`]).
 #[inline]
 fn clarke_of(x: [f32; 4]) -> AlphaBeta {
@@ -515,25 +420,84 @@ fn clarke_of(x: [f32; 4]) -> AlphaBeta {
     })
 }
 
-/// One phase's sensor gain error found from the zero sequence
-/// ([`monitor_core::sequence::single_phase_gain`]; JSON `unbalance.current_sensor_phase`,
-/// `unbalance.voltage_sensor_phase`).
-#[derive(Debug, Clone, Serialize, PartialEq)]
-pub struct SensorPhaseReport {
-    /// The phase (JSON `a`, `b` or `c`).
-    pub phase: Phase,
-    /// The sensor's gain error (0.2: it reads 20 % high).
-    pub gain_error: f32,
-    /// |3 I0| / |I1|: the zero sequence the error leaves in the measured set.
-    pub zero_sequence_ratio: f32,
+/// The sequence stage: the front ([`SequenceFront`]) the chain runs on each row, or lent to
+/// the thread that reads the log (`diagnose`, `pipe.rs`), which runs it beside the chain
+/// and gives it back at the end. It hands on each row's [`SequenceStep`], and the windows
+/// it closes go to the winding in order ([`SequenceStage::closed`]).
+#[derive(Debug)]
+pub(super) struct SequenceStage {
+    front: Option<SequenceFront>,
 }
 
-impl From<&SinglePhaseGain> for SensorPhaseReport {
-    fn from(g: &SinglePhaseGain) -> Self {
-        SensorPhaseReport {
-            phase: g.phase,
-            gain_error: g.gain_error,
-            zero_sequence_ratio: g.zero_sequence_ratio,
+/// What the sequence stage leaves at the end: the windows it closed and not yet handed on
+/// (the last one among them), and the front with the rotor's record (`None`: lent and
+/// never given back, a read that ended before its end).
+#[derive(Debug)]
+pub(super) struct SequencesEnd {
+    /// The last window was closed at the end (the monitor's speed then goes with it).
+    pub(super) closed_last: bool,
+    /// The windows closed and not yet handed on, in order.
+    pub(super) closed: Vec<Option<SequenceWindow>>,
+    /// The front as it ended.
+    pub(super) front: Option<SequenceFront>,
+}
+
+impl SequenceStage {
+    /// The stage over `front`.
+    pub(super) fn new(front: SequenceFront) -> Self {
+        SequenceStage { front: Some(front) }
+    }
+
+    /// The windows closed and not yet handed on (in order; `None` for one without a
+    /// solution).
+    #[inline]
+    pub(super) fn closed(&mut self) -> impl Iterator<Item = Option<SequenceWindow>> + '_ {
+        self.front.iter_mut().flat_map(|f| f.closed.drain(..))
+    }
+
+    /// Lends the front to the thread that reads the log ([`SequenceStage::give_back`]).
+    pub(super) fn lend(&mut self) -> Option<SequenceFront> {
+        self.front.take()
+    }
+
+    /// Takes the front back once every row was pushed: its last window is the stage's to
+    /// close ([`Finish::finish`]).
+    pub(super) fn give_back(&mut self, front: SequenceFront) {
+        self.front = Some(front);
+    }
+
+    /// The front is here (not lent).
+    pub(super) fn present(&self) -> bool {
+        self.front.is_some()
+    }
+}
+
+impl Stage for SequenceStage {
+    /// The row's time since the first row [s].
+    type Input<'a> = f64;
+    type Output = SequenceStep;
+
+    /// The row's step (the default while the front is lent: the chain is then handed the
+    /// steps the other thread took).
+    #[inline]
+    fn update(&mut self, row: &Row, t: f64) -> SequenceStep {
+        self.front
+            .as_mut()
+            .map_or_else(SequenceStep::default, |f| f.track(row, t))
+    }
+}
+
+impl Finish for SequenceStage {
+    type Closing<'a> = ();
+    type Finding = SequencesEnd;
+
+    fn finish(mut self, (): ()) -> SequencesEnd {
+        let closed_last = self.front.as_mut().is_some_and(SequenceFront::finish);
+        let closed = self.closed().collect();
+        SequencesEnd {
+            closed_last,
+            closed,
+            front: self.front,
         }
     }
 }

@@ -53,14 +53,15 @@ mod probability;
 mod reading;
 mod reasons;
 mod segments;
+mod stage;
 
-pub(crate) use judgement::unbalance_report;
 pub use reasons::BALANCED_RATIO;
 pub use segments::segments;
+pub(crate) use stage::{WindingClosing, WindingStage};
 
 pub use super::baseline::HealthyReference;
 use super::baseline::{abs, mean, of_pair, pair, pooled_change_sigma, UnbalanceBaseline};
-use super::sequences::{SensorPhaseReport, SequenceWindow};
+use crate::windows::{SensorPhaseReport, SequenceWindow};
 use monitor_core::sequence::{Complex32, INHERENT_ASYMMETRY_RATIO};
 use monitor_core::Phase;
 use serde::Serialize;
@@ -139,7 +140,7 @@ pub const OPERATING_SPEED_STEP: f32 = 0.003;
 /// The largest slip taken for "full load" where the operating point is not known (rated
 /// slips run from 1 % for large motors to 5 % for small ones).
 pub const FULL_LOAD_SLIP_MAX: f32 = 0.05;
-pub use crate::rotor::CURRENT_MODEL_UNCERTAINTY;
+pub use crate::windows::CURRENT_MODEL_UNCERTAINTY;
 /// Uncertainty of a reference angle measured as `arg(V1/I1)` [deg]: the sensors' phase
 /// errors and the loop impedance's own angle.
 pub const MEASURED_REFERENCE_UNCERTAINTY_DEG: f32 = 3.0;
@@ -250,12 +251,12 @@ impl SequenceSegment {
     /// The voltages' operating point over the segment (`[from, to]` [s], `|V1|`, `|I1|`,
     /// `arg(V1/I1)`), where every window had voltages: what the rotor's load estimate reads
     /// without a speed (`crate::rotor::RotorLoad::from_power`).
-    pub(crate) fn measured_point(&self) -> Option<([f64; 2], crate::rotor::MeasuredPoint)> {
+    pub(crate) fn measured_point(&self) -> Option<([f64; 2], crate::windows::MeasuredPoint)> {
         let z = self.v1?;
         let i1 = f64::from(self.i1_peak_a);
         Some((
             [self.from_s, self.to_s],
-            crate::rotor::MeasuredPoint {
+            crate::windows::MeasuredPoint {
                 v1_peak_v: f64::from(abs(z)) * i1,
                 i1_peak_a: i1,
                 angle_rad: f64::from(z.im.atan2(z.re)),

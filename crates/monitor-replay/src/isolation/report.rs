@@ -3,7 +3,7 @@
 use super::sentences::pct;
 use super::{serialize_state, IsolationName, IsolationTracker, NameGiven, LIST_FROM};
 use crate::events::IsolationEvent;
-use crate::sequences::SensorPhaseReport;
+use crate::windows::SensorPhaseReport;
 use monitor_core::isolation::{Candidate, DEFAULT_SPREAD};
 use monitor_core::{Fault, Isolation, IsolationState, Phase};
 use serde::Serialize;

@@ -41,6 +41,7 @@
 //! full-load level, a band and a third of the bands' 6 dB; below it the bands no longer
 //! grade the cage, and the finding says the load is too low.
 
+pub use crate::windows::{MeasuredPoint, CURRENT_MODEL_UNCERTAINTY};
 use monitor_core::sequence::slip_for_current;
 use monitor_io::params::ParamFile;
 use num_complex::Complex64;
@@ -58,10 +59,6 @@ pub const MCSA_MIN_LOAD: f64 = 0.4;
 /// overload protection does not let run. A pair about the line that gives a larger slip is
 /// not the rotor's sidebands.
 pub const MAX_SLIP_OVER_RATED: f64 = 1.5;
-/// How far a parameter file's current may be off the machine's (for the slip read from the
-/// current's magnitude: its uncertainty); also the winding's reference angle's
-/// (`crate::winding`).
-pub const CURRENT_MODEL_UNCERTAINTY: f32 = 0.15;
 
 /// The rated point of a parameter file's machine (module docs, "The rated point").
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -232,19 +229,6 @@ pub struct RotorLoad {
     pub unknown_because: Option<String>,
     /// The measured current [A, phase peak] where it was read.
     pub current_peak_a: Option<f64>,
-}
-
-/// What the log measured of the operating point beyond the rotor's own record: the
-/// positive-sequence voltage and current phasors over a steady stretch (peak), where the log
-/// has voltages.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MeasuredPoint {
-    /// `|V1|` [V, phase peak].
-    pub v1_peak_v: f64,
-    /// `|I1|` [A, phase peak].
-    pub i1_peak_a: f64,
-    /// The power factor angle `arg(V1 / I1)` [rad].
-    pub angle_rad: f64,
 }
 
 impl RotorLoad {

@@ -6,17 +6,15 @@ use super::measured::{rotor_finding, sensor_flag_finding, winding_finding};
 use super::words::fault_text;
 use super::FindingReport;
 use super::MIN_JUDGED_S;
-use crate::isolation::IsolationTracker;
+use crate::isolation::IsolationFinding;
 use crate::isolation::{FaultCandidate, IsolationBaseline, IsolationName, IsolationReport};
-use crate::lamps::LampStage;
-use crate::options::ReplayOptions;
+use crate::lamps::LampsFinding;
 use crate::winding::UnbalanceReport;
 use monitor_core::verdict::{Against, FaultName, FindingSource, NamedFault, Size, State};
 use monitor_core::MonitorOutput;
 
-/// What the residual finding is drawn from, besides the replay's own state: the final output,
-/// the isolation's report and candidates, whether a fault was detected, and the analyses the
-/// log could not feed.
+/// What the residual finding is drawn from: the lamps' final output, the isolation's report
+/// and candidates, whether a fault was detected, and the analyses the log could not feed.
 pub(crate) struct ResidualInputs<'a> {
     /// The monitor's last output.
     pub out: &'a MonitorOutput,
@@ -70,15 +68,13 @@ fn residual_brief(against: Against) -> String {
     )
 }
 
-/// What the findings read of a replay's stages at its end: the lamps, the isolation and
-/// the options asked for.
+/// What the findings read of a replay's stages at its end: the lamps' and the isolation's
+/// findings.
 pub(crate) struct Stages<'a> {
-    /// The lamps' stage.
-    pub lamps: &'a LampStage,
-    /// The isolation's tracker.
-    pub isolation: &'a IsolationTracker,
-    /// The replay's options.
-    pub opts: &'a ReplayOptions,
+    /// The lamps' finding.
+    pub lamps: &'a LampsFinding,
+    /// The isolation's finding.
+    pub isolation: &'a IsolationFinding,
 }
 
 impl Stages<'_> {
@@ -88,10 +84,16 @@ impl Stages<'_> {
     /// readings.
     pub(crate) fn findings(
         &self,
-        inp: &ResidualInputs<'_>,
         unbalance: &UnbalanceReport,
         rotor: &crate::rotor::RotorReport,
     ) -> Vec<FindingReport> {
+        let inp = &ResidualInputs {
+            out: &self.lamps.out,
+            isolation: &self.isolation.report,
+            candidates: &self.isolation.candidates,
+            detected: self.isolation.detected,
+            skipped: &self.lamps.skipped,
+        };
         let residual = self.residual_finding(inp);
         let mut found = vec![
             residual.clone(),
@@ -116,7 +118,7 @@ impl Stages<'_> {
 
     /// Why the residuals could not be judged at all, where they could not.
     fn residuals_not_judged(&self, inp: &ResidualInputs<'_>) -> Option<String> {
-        if self.lamps.monitor.is_none() {
+        if !self.lamps.monitor {
             return Some(inp.skipped.first().cloned().unwrap_or_else(|| {
                 "residuals r1..r4: need the voltages and the speed".to_string()
             }));
@@ -139,7 +141,7 @@ impl Stages<'_> {
                 self.lamps.judged_s
             ));
         }
-        self.lamps.unsettled.withheld()
+        self.lamps.withheld.clone()
     }
 
     /// The residual lamps' and the isolation's finding.
@@ -198,7 +200,7 @@ impl Stages<'_> {
     /// voltages or the speed lacks what they need (unavailable); else the log kept them
     /// from judging (not judged).
     fn residuals_unjudged(&self, against: Against, why: String) -> FindingReport {
-        let state = if self.lamps.monitor.is_none() {
+        let state = if !self.lamps.monitor {
             State::Unavailable
         } else {
             State::NotJudged
@@ -217,7 +219,7 @@ impl Stages<'_> {
     ) -> Option<(String, String)> {
         let iso = inp.isolation;
         let ever_lit = self.lamps.first_detection.is_some() || lit_end;
-        if ever_lit && self.isolation.heating_explains_lamps() {
+        if ever_lit && self.isolation.heating_explains_lamps {
             let rise = iso
                 .winding_rise_k
                 .map_or("heating".to_string(), |k| format!("{k:.0} K of heating"));
@@ -226,8 +228,8 @@ impl Stages<'_> {
         // The lamps' matching read only the load term: a load move, unless the isolation's
         // steady-state equations find a change no single fault (nor the load) explains.
         let lamps_read_load =
-            self.only_load_named() && iso.state != monitor_core::IsolationState::Unknown;
-        if ever_lit && (self.isolation.load_explains_lamps() || lamps_read_load) {
+            self.lamps.only_load_named && iso.state != monitor_core::IsolationState::Unknown;
+        if ever_lit && (self.isolation.load_explains_lamps || lamps_read_load) {
             return Some((
                 format!(
                     "the lamps lit for a load move (to the paper's model a load change is a Bl change): {}",
@@ -237,18 +239,6 @@ impl Stages<'_> {
             ));
         }
         None
-    }
-
-    /// With the load an unknown input, the lamps' matching only ever named the friction
-    /// class (the load term): a load move.
-    fn only_load_named(&self) -> bool {
-        self.opts.load == crate::options::LoadModel::Unknown
-            && !self.lamps.detections.is_empty()
-            && self
-                .lamps
-                .detections
-                .iter()
-                .all(|d| matches!(d.fault, monitor_core::Fault::B | monitor_core::Fault::Bl))
     }
 
     /// Whether the parameter file fits the log where nothing was commissioned: judged from
@@ -275,7 +265,7 @@ impl Stages<'_> {
                 "commissioned: the residuals are judged against the healthy motor learned in commissioning, not the file's values".to_string(),
             );
         }
-        if self.lamps.monitor.is_none() {
+        if !self.lamps.monitor {
             return of(
                 State::Unavailable,
                 Against::ParameterFile,
@@ -346,7 +336,7 @@ impl Stages<'_> {
                 brief.clone(),
             )
         };
-        if self.lamps.monitor.is_none() {
+        if !self.lamps.monitor {
             return of(
                 State::Unavailable,
                 "the load and the heating need the voltages and the speed".to_string(),

@@ -153,6 +153,8 @@ pub struct Conclusion {
 
 /// The verdict of `findings` by the core's decision table, with its line and lists.
 pub fn conclude(findings: &[FindingReport]) -> Conclusion {
+    #[cfg(test)]
+    DECIDED.with(|d| d.set(d.get() + 1));
     let core: Vec<Finding> = findings.iter().map(|f| f.finding).collect();
     let d = decide(&core);
     let finding = d.by.and_then(|k| findings.get(k)).cloned();
@@ -176,6 +178,19 @@ pub fn conclude(findings: &[FindingReport]) -> Conclusion {
         not_judged,
         withheld_because,
     }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// How many verdicts [`conclude`] decided on this thread (the test that a diagnosis
+    /// decides once).
+    static DECIDED: std::cell::Cell<u32> = const { std::cell::Cell::new(0) };
+}
+
+/// How many verdicts [`conclude`] decided on this thread so far.
+#[cfg(test)]
+pub(crate) fn decided_on_this_thread() -> u32 {
+    DECIDED.with(std::cell::Cell::get)
 }
 
 /// Replaces the finding of `source` in `findings` (or adds it).

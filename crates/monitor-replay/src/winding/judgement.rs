@@ -13,8 +13,8 @@ use super::{
     SLIP_MODEL_UNCERTAINTY,
 };
 use super::{BaselineSource, UnbalanceReport};
-use crate::sequences::SensorPhaseReport;
-use crate::sequences::{sensor_phase, SequenceWindow};
+use crate::windows::SensorPhaseReport;
+use crate::windows::{sensor_phase, SequenceWindow};
 use crate::words::Words;
 use monitor_core::sequence::{
     asymmetry_correction_rad, equivalent_impedance, slip_for_current, SinglePhaseGain,
@@ -337,7 +337,7 @@ fn no_stretch_reason(f_hz: f64) -> String {
     format!(
         "cannot judge the phase: no steady stretch of at least {} least-squares windows ({:.2} s): the log is too short or its operating point never settled",
         MIN_SEGMENT_WINDOWS,
-        MIN_SEGMENT_WINDOWS as f64 * crate::sequences::WINDOW_PERIODS / f_hz
+        MIN_SEGMENT_WINDOWS as f64 * crate::windows::WINDOW_PERIODS / f_hz
     )
 }
 

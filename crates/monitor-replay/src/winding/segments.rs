@@ -8,7 +8,7 @@ use super::{
     abs, cdiv, Complex32, SequenceSegment, MAX_UNSTEADY_INSIDE, MIN_SEGMENT_WINDOWS,
     SEGMENT_I1_STEP, SEGMENT_STEP_MIN, SEGMENT_STEP_REL, SEGMENT_VOLTAGE_STEP_MIN,
 };
-use crate::sequences::SequenceWindow;
+use crate::windows::SequenceWindow;
 use num_complex::Complex64;
 
 /// A window's features that a segment holds still: `I2/I1`, `I0/I1` and, with voltages,

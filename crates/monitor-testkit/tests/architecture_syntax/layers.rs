@@ -51,31 +51,32 @@ pub const INSIDE: &[Inside] = &[
             ("bench", 4),
         ],
     ),
-    // The replay as stages, from the facts a row needs up to `diagnose`, the front door:
-    // the sample clock, the baseline and the commissioning tracker at the bottom; the rotor's
-    // and the sequences' analyses, the winding's judgement on their windows; the options
-    // (which name the winding's turn count); the isolation; the lamps' stage over the core's
-    // monitor; the findings and the one verdict; the report; the replay that owns the stages;
-    // the data-quality hand-over, the reading thread's pipe and `diagnose` on top.
+    // The replay as a chain of stages of one shape (`stage`), from the facts a row needs up
+    // to `diagnose`, the front door: the stage trait, the sample clock, the windows the
+    // sequence stage hands on, the baseline at the bottom; the options, the commissioning
+    // tracker, the events; the rotor's demodulator, which runs inside the sequence stage;
+    // the stages side by side (no stage uses another: same layer); the timeline and the
+    // findings with the one verdict; the report and the data-quality stage's end; the
+    // replay that holds the chain; `diagnose` (the reading thread's pipe, the data-quality
+    // hand-over) on top.
     (
         "crates/monitor-replay/src/",
         &[
             ("events", 2),
-            ("rotor", 2),
-            ("sequences", 3),
+            ("commission", 2),
+            ("error", 2),
+            ("options", 2),
+            ("rotor", 3),
+            ("sequences", 4),
+            ("lamps", 4),
             ("winding", 4),
-            ("options", 5),
-            ("error", 6),
-            ("isolation", 6),
-            ("step", 7),
-            ("unsettled", 7),
-            ("lamps", 8),
-            ("verdict", 9),
-            ("report", 10),
-            ("replay", 11),
-            ("front", 12),
-            ("pipe", 13),
-            ("diagnose", 14),
+            ("isolation", 4),
+            ("timeline", 5),
+            ("verdict", 5),
+            ("report", 6),
+            ("quality", 6),
+            ("replay", 7),
+            ("diagnose", 8),
         ],
     ),
     // The fleet run over the one-call API.

@@ -12,12 +12,12 @@
 //! synchronously (a configuration the core rejects stops the read at once, as without the
 //! thread).
 
-use super::error::ReplayError;
 use super::front::Feeder;
-use super::options::ReplayOptions;
-use super::replay::Replay;
-use super::sequences::SequenceWindow;
-use super::sequences::{SequenceFront, SequenceStep};
+use crate::error::ReplayError;
+use crate::options::ReplayOptions;
+use crate::replay::Replay;
+use crate::sequences::{SequenceFront, SequenceStep};
+use crate::windows::SequenceWindow;
 use monitor_io::log::{Channels, Row};
 use monitor_io::params::ParamFile;
 use std::sync::mpsc::{channel, sync_channel, Receiver, Sender, SyncSender};
@@ -209,7 +209,7 @@ impl Back<'_> {
                 };
                 match c {
                     Call::Window(w) => r.queue_window(w),
-                    Call::ClockReset => r.lamps.clock_reset(),
+                    Call::ClockReset => r.clock_reset(),
                     Call::End(front) => r.set_sequence_front(*front),
                     Call::Begin(_) | Call::Restart => {}
                 }

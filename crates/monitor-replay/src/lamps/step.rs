@@ -1,9 +1,8 @@
-//! The replay's per-row steps after the monitor's output ([`super::Replay::push_step`]):
-//! each reads the output by reference and updates the fields it is given.
+//! The lamps' per-row steps after the monitor's output ([`super::LampStage::update`]): each
+//! reads the output by reference and updates the fields it is given.
 
-use super::commission::CommissionTracker;
-use super::isolation::chunk::RowFlags;
-use super::isolation::IsolationTracker;
+use crate::commission::CommissionTracker;
+use crate::stage::RowFlags;
 use monitor_core::{Fault, Monitor, MonitorOutput, FAULT_COUNT};
 use serde::{Serialize, Serializer};
 
@@ -24,12 +23,12 @@ impl Serialize for Detection {
 }
 
 /// No bands (centre and half-width 0): what is passed where the bands are not needed.
-pub(super) const NO_BANDS: [(f32, f32); 4] = [(0.0, 0.0); 4];
+pub(crate) const NO_BANDS: [(f32, f32); 4] = [(0.0, 0.0); 4];
 
 /// Books the residuals of `out`: whether the lamps were ever evaluated, and the largest
 /// |residual| of each while evaluating.
 #[inline]
-pub(super) fn note_residuals(evaluated: &mut bool, max_abs: &mut [f32; 4], out: &MonitorOutput) {
+pub(crate) fn note_residuals(evaluated: &mut bool, max_abs: &mut [f32; 4], out: &MonitorOutput) {
     *evaluated |= out.evaluating;
     if out.evaluating {
         for (m, r) in max_abs.iter_mut().zip(out.residuals) {
@@ -41,7 +40,7 @@ pub(super) fn note_residuals(evaluated: &mut bool, max_abs: &mut [f32; 4], out: 
 /// The threshold bands in force: they only matter (and are only looked up) while the gate
 /// holds the lamps or a lamp is lit ([`NO_BANDS`] otherwise).
 #[inline]
-pub(super) fn bands_needed(mon: &Monitor, out: &MonitorOutput) -> [(f32, f32); 4] {
+pub(crate) fn bands_needed(mon: &Monitor, out: &MonitorOutput) -> [(f32, f32); 4] {
     if out.quasi_steady && !out.fault_detected {
         NO_BANDS
     } else {
@@ -54,7 +53,7 @@ pub(super) fn bands_needed(mon: &Monitor, out: &MonitorOutput) -> [(f32, f32); 4
 /// first look inside the range (`detected`: one was found already, and that stays), else
 /// [`NO_BANDS`].
 #[inline]
-pub(super) fn bands_for(
+pub(crate) fn bands_for(
     needed: [(f32, f32); 4],
     out: &MonitorOutput,
     counts: bool,
@@ -72,7 +71,7 @@ pub(super) fn bands_for(
 /// [`detected_in_range`]), the first one's time, and each fault the output ranks first
 /// ([`note_detection`]).
 #[inline]
-pub(super) fn book_detection(
+pub(crate) fn book_detection(
     (in_range, first): (&mut bool, &mut Option<f64>),
     booked: (&mut Vec<Detection>, &mut [f32; FAULT_COUNT]),
     commission: &CommissionTracker,
@@ -86,7 +85,7 @@ pub(super) fn book_detection(
 /// waits out the monitor's settling time too: the restarted frame's vectors look steady
 /// before they are right.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct RestartHold {
+pub(crate) struct RestartHold {
     /// The monitor's count of timing faults (estimator restarts) at the last row.
     timing_faults_seen: u32,
     /// The isolation ignores points until this time [s].
@@ -97,7 +96,7 @@ pub(super) struct RestartHold {
 
 impl RestartHold {
     /// No restart yet; `settle_s`: the monitor's settling time [s].
-    pub(super) fn new(settle_s: f64) -> Self {
+    pub(crate) fn new(settle_s: f64) -> Self {
         RestartHold {
             timing_faults_seen: 0,
             hold_until: f64::NEG_INFINITY,
@@ -108,7 +107,7 @@ impl RestartHold {
     /// Whether the isolation may use the point at `t` [s] (a restart counted in `out`
     /// starts a new hold).
     #[inline]
-    pub(super) fn settled(&mut self, t: f64, out: &MonitorOutput) -> bool {
+    pub(crate) fn settled(&mut self, t: f64, out: &MonitorOutput) -> bool {
         if out.timing.timing_faults != self.timing_faults_seen {
             self.timing_faults_seen = out.timing.timing_faults;
             self.hold_until = t + self.settle_s;
@@ -122,7 +121,7 @@ impl RestartHold {
 /// (`bands`) inside the learned range. A lamp held through a transient, or after its
 /// residual came back (the load returned into the range), detects nothing new there.
 #[inline]
-pub(super) fn detected_in_range(
+pub(crate) fn detected_in_range(
     commission: &CommissionTracker,
     out: &MonitorOutput,
     bands: [(f32, f32); 4],
@@ -136,7 +135,7 @@ pub(super) fn detected_in_range(
 /// booked already (the diagnosis changes only with the lamps: the same one is not ranked
 /// again).
 #[inline]
-pub(super) fn note_detection(
+pub(crate) fn note_detection(
     first: &mut Option<f64>,
     (detections, seen): (&mut Vec<Detection>, &mut [f32; FAULT_COUNT]),
     t: f64,
@@ -167,71 +166,38 @@ fn same_bits(a: &[f32; FAULT_COUNT], b: &[f32; FAULT_COUNT]) -> bool {
         == 0
 }
 
-/// Whether the sample at `t` [s] (interval `dt_s`) is the one nearest the timeline step
-/// `next` (half a sample early counts); if so, `next` moves on by `step_s`, past `t` after a
-/// gap (one point for the gap, not one per step missed).
-#[inline]
-pub(super) fn timeline_step_due(next: &mut f64, t: f64, dt_s: f64, step_s: f64) -> bool {
-    if t + 0.5 * dt_s < *next {
-        return false;
-    }
-    *next += step_s;
-    if *next <= t {
-        *next += (((t - *next) / step_s).floor() + 1.0) * step_s;
-    }
-    true
-}
-
-/// Whether the lamps lit now (`lit`: a lamp of `out` is lit) first lit while the load had
-/// moved (or the load explained them), `was` the answer at the last row: false once every
-/// lamp is dark. (Once true it stays true while a lamp is lit: the load's checks are made
-/// only while it is false.)
-#[inline]
-pub(super) fn lamps_since_moved(
-    (was, lit): (bool, bool),
-    out: &MonitorOutput,
-    commission: &CommissionTracker,
-    isolation: &IsolationTracker,
-) -> bool {
-    if !lit {
-        false
-    } else {
-        was || isolation.load_explains_lamps() || commission.outside_learned_range(out)
-    }
-}
-
 /// What the rows up to the monitor's next revision ([`Monitor::revision`]) take from its
 /// output, as the revision's first row found it.
 #[derive(Debug, Clone, Default)]
-pub(super) struct BlockView {
+pub(crate) struct BlockView {
     /// The revision it was taken at (`None`: none yet).
-    pub(super) revision: Option<u32>,
+    pub(crate) revision: Option<u32>,
     /// The output's flags.
-    pub(super) flags: RowFlags,
+    pub(crate) flags: RowFlags,
     /// The lamps are judged: evaluated, quasi-steady, on thresholds that count
-    /// ([`super::MIN_JUDGED_S`]).
-    pub(super) judging: bool,
+    /// (`MIN_JUDGED_S`).
+    pub(crate) judging: bool,
     /// A lamp is lit.
-    pub(super) lamps_lit: bool,
+    pub(crate) lamps_lit: bool,
     /// The note on the commissioned range for the timeline.
-    pub(super) range_note: Option<String>,
+    pub(crate) range_note: Option<String>,
 }
 
 /// What a replay keeps of the monitor's output after a row for the next one.
 #[derive(Debug, Clone, Copy, Default)]
-pub(super) struct LastOutput {
+pub(crate) struct LastOutput {
     /// The commissioning window is being learned.
-    pub(super) learning: bool,
+    pub(crate) learning: bool,
     /// The electrical rotor speed [rad/s].
-    pub(super) wr_rad_s: f32,
+    pub(crate) wr_rad_s: f32,
     /// A sensor fault is flagged.
-    pub(super) sensor_fault: bool,
+    pub(crate) sensor_fault: bool,
 }
 
 impl LastOutput {
     /// What the next row needs of `out` (with its `flags`).
     #[inline]
-    pub(super) fn of(out: &MonitorOutput, flags: RowFlags) -> Self {
+    pub(crate) fn of(out: &MonitorOutput, flags: RowFlags) -> Self {
         LastOutput {
             learning: flags.learning(),
             wr_rad_s: out.operating.wr_rad_s,
@@ -242,7 +208,7 @@ impl LastOutput {
 
 /// Whether a lit lamp's residual lies outside its band `(centre, half-width)` now.
 #[inline]
-pub(super) fn lit_outside_band(out: &MonitorOutput, bands: [(f32, f32); 4]) -> bool {
+pub(crate) fn lit_outside_band(out: &MonitorOutput, bands: [(f32, f32); 4]) -> bool {
     out.lamps
         .iter()
         .zip(out.residuals)

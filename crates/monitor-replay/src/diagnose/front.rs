@@ -5,10 +5,10 @@
 //! observer of every output) or the pipe to a replay on a thread of its own
 //! (`super::pipe`).
 
-use super::error::ReplayError;
-use super::options::ReplayOptions;
-use super::replay::{Replay, ReplayObserver};
-use super::sampler::CLOCK_RESET_GAP_S;
+use crate::error::ReplayError;
+use crate::options::ReplayOptions;
+use crate::replay::{Replay, ReplayObserver};
+use crate::sampler::CLOCK_RESET_GAP_S;
 use monitor_core::Abc;
 use monitor_io::log::quality::{BadCells, CleanSink, SegmentBreak, TimeBase, MAX_BRIDGED_GAP_S};
 use monitor_io::log::{Channels, Column, Row};
@@ -157,13 +157,13 @@ impl<O: ReplayObserver + ?Sized> Feeder for Direct<'_, O> {
         };
         let out = r.push(row);
         if let Some(o) = self.observer.as_deref_mut() {
-            o.output(&r.lamps.with_encoder_offset(row), &out, r);
+            o.output(&r.as_monitor_sees(row), &out, r);
         }
     }
 
     fn clock_reset(&mut self) {
         if let Some(r) = self.replay.as_mut() {
-            r.lamps.clock_reset();
+            r.clock_reset();
         }
     }
 

@@ -8,7 +8,7 @@
 //! nobody judged; when they sit at many times their bands, "healthy" would hide a fault,
 //! so `diagnose` says it could not judge instead ([`Unsettled::withheld`]).
 
-use super::isolation::chunk::RowFlags;
+use crate::stage::RowFlags;
 use monitor_core::MonitorOutput;
 
 /// How far outside its band a residual must sit, in half-widths, for a held stretch to
