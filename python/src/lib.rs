@@ -238,14 +238,10 @@ fn replay_options(
         .map_err(|e| OptionError::new_err(format!("turn_calibration: not a calibration: {e}")))?;
     let parallel_paths = match parallel_paths {
         None => d.turn_level.parallel_paths,
-        Some(n) => monitor_api::replay::check_parallel_paths(n).map_err(|e| to_py(e.into()))?,
+        Some(n) => monitor_api::replay::ParallelPaths::new(n).map_err(|e| to_py(e.into()))?,
     };
     Ok(monitor_api::replay::ReplayOptions {
-        commission: commission
-            .map(|c| c.window())
-            .transpose()
-            .map_err(to_py)?
-            .map(monitor_api::replay::CommissionWindow::seconds),
+        commission: commission.map(|c| c.window()).transpose().map_err(to_py)?,
         allow_incomplete,
         load: load.map(load_of).transpose()?.unwrap_or(d.load),
         angle_source: angle.map(angle_of).transpose()?.unwrap_or(d.angle_source),
@@ -305,7 +301,6 @@ fn diagnose(
             .collect::<PyResult<_>>()?,
         group,
     };
-    req.validate().map_err(to_py)?;
     let log = log_source(log, log_origin.as_deref())?;
     run(py, || {
         let d = api::diagnose(

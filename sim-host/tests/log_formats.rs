@@ -107,7 +107,7 @@ fn every_format_gives_the_same_rows_verdicts_and_figures() {
 
     // diagnose: the same report (lamps, candidates, times, data quality) from each.
     let opts = ReplayOptions {
-        commission: Some((2.0, 4.0)),
+        commission: Some(monitor_replay::CommissionWindow::of(2.0, 4.0)),
         ..Default::default()
     };
     let p = params();

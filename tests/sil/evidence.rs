@@ -67,7 +67,7 @@ fn board_run(sc: &Scenario) -> Rig {
 fn host_named(sc: &Scenario) -> (Option<IsolationName>, Option<f32>) {
     let p = ParamFile::reference_3hp();
     let opts = ReplayOptions {
-        commission: Some((1.5, 3.5)),
+        commission: Some(monitor_replay::CommissionWindow::of(1.5, 3.5)),
         ..Default::default()
     };
     let r = simulate_and_replay(&p, &p, sc, opts, |_, _| {})

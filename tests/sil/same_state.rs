@@ -51,7 +51,7 @@ fn the_board_and_the_host_show_the_same_state_for_the_same_log() {
     let params = ParamFile::reference_2p2kw();
     let rows = simulate_to_vec(&params, &scenario).expect("simulation"); // ok: test
     let opts = ReplayOptions {
-        commission: Some((1.5, learned_until)),
+        commission: Some(monitor_replay::CommissionWindow::of(1.5, learned_until)),
         timeline_step: monitor_replay::TimelineStep::of(0.05),
         ..ReplayOptions::default()
     };

@@ -292,7 +292,7 @@ fn a_healthy_baseline_takes_the_motors_own_asymmetry_out() {
         let commissioned = replay(
             &healthy,
             ReplayOptions {
-                commission: Some((2.0, 4.0)),
+                commission: Some(monitor_replay::CommissionWindow::of(2.0, 4.0)),
                 ..ReplayOptions::default()
             },
         );

@@ -28,7 +28,7 @@ use crate::{diagnose, ApiError, DiagnoseRequest, LogSource, ParamsSource};
 
 pub mod time;
 use monitor_io::log::{check_outputs, NamedFile, OverwriteError};
-use monitor_replay::{DiagnoseReport, IsolationEvent, LoadModel, ReplayOptions};
+use monitor_replay::{CommissionWindow, DiagnoseReport, IsolationEvent, LoadModel, ReplayOptions};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 pub use time::{log_time, time_from_name, time_warnings, LogTime, LogTimeSource};
@@ -43,9 +43,10 @@ pub struct MotorEntry {
     pub params: PathBuf,
     /// The pattern its logs' file names match.
     pub logs: String,
-    /// Its commissioning window [s], if the logs are judged against one.
+    /// Its commissioning window [s], if the logs are judged against one (checked as the
+    /// table is read: `[2.0, 1.0]` is refused there).
     #[serde(default)]
-    pub commission: Option<[f64; 2]>,
+    pub commission: Option<CommissionWindow>,
     /// Healthy logs of it (files or folders).
     #[serde(default)]
     pub baseline: Vec<PathBuf>,
@@ -145,10 +146,7 @@ impl MotorTable {
             return Err(bad("no [[motor]] in it".into()));
         }
         for m in &mut t.motor {
-            // The one check of a request, as every front end's.
-            request(m)
-                .validate()
-                .map_err(|e| bad(format!("motor {}: {e}", m.name)))?;
+            // (Its commissioning window was checked as it was read.)
             if let Some(p) = m
                 .time_from_name
                 .as_deref()
@@ -433,7 +431,7 @@ pub fn row_and_report_shown(
 fn request(m: &MotorEntry) -> DiagnoseRequest {
     DiagnoseRequest {
         options: ReplayOptions {
-            commission: m.commission.map(|[a, b]| (a, b)),
+            commission: m.commission,
             load: m.load.map_or(LoadModel::Unknown, MotorLoad::model),
             ..ReplayOptions::default()
         },

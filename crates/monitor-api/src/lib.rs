@@ -161,17 +161,6 @@ pub struct DiagnoseRequest {
     pub group: Option<String>,
 }
 
-impl DiagnoseRequest {
-    /// The one check of a request, the same for every front end: the options as
-    /// [`ReplayOptions::validate`] checks them.
-    ///
-    /// # Errors
-    /// [`ApiError::Option`] naming the field (`commission`, `parallel_paths`).
-    pub fn validate(&self) -> Result<(), ApiError> {
-        Ok(self.options.validate()?)
-    }
-}
-
 /// The logs of a request's `baseline`: each file and each data as given, each folder's log files
 /// (CSV, TDMS, Parquet, by extension) in name order.
 ///
@@ -280,7 +269,6 @@ pub fn plan_diagnose(
         group: req.group.clone(),
         columns,
     };
-    req.validate()?;
     let mut opts = req.options;
     if !req.baseline.is_empty() {
         let files = baseline_files(&req.baseline)?;

@@ -6,11 +6,11 @@
 
 pub use monitor_replay::verdict::against_text;
 pub use monitor_replay::{
-    angle_source_name, check_parallel_paths, describe_against, diagnose_file,
-    diagnose_file_observed, state_name, Against, CommissionWindow, CommissioningOutcome,
-    CommissioningReport, DetectionLimit, DiagnoseReport, Diagnosed, FaultCandidate, FindingReport,
-    IsolationEvent, IsolationName, IsolationReport, LoadModel, OptionError, OptionField, Panel,
-    Replay, ReplayError, ReplayObserver, ReplayOptions, RotorBand, Spelling, TemperatureReport,
+    angle_source_name, describe_against, diagnose_file, diagnose_file_observed, state_name,
+    Against, CommissionWindow, CommissioningOutcome, CommissioningReport, DetectionLimit,
+    DiagnoseReport, Diagnosed, FaultCandidate, FindingReport, IsolationEvent, IsolationName,
+    IsolationReport, LoadModel, OptionError, OptionField, Panel, ParallelPaths, Replay,
+    ReplayError, ReplayObserver, ReplayOptions, RotorBand, Spelling, TemperatureReport,
     TimelinePoint, TimelineStep, TurnCalibration, TurnLevelOptions, UnbalanceReport, Verdict,
     Words, MAX_EVENTS, MIN_FAULT_CHANGE,
 };

@@ -118,7 +118,7 @@ fn bad_encoder_cells_do_not_make_a_speed_sensor_fault() {
     }
     let req = DiagnoseRequest {
         options: monitor_replay::ReplayOptions {
-            commission: Some((2.0, 4.0)),
+            commission: Some(monitor_replay::CommissionWindow::of(2.0, 4.0)),
             ..Default::default()
         },
         ..Default::default()

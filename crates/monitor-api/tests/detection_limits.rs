@@ -25,7 +25,7 @@ fn run(dir: &std::path::Path, change: f64) -> DiagnoseReport {
     api::simulate_to_file(source(), &scenario, &log).expect("simulates");
     let req = DiagnoseRequest {
         options: monitor_replay::ReplayOptions {
-            commission: Some((3.0, 4.5)),
+            commission: Some(monitor_replay::CommissionWindow::of(3.0, 4.5)),
             ..Default::default()
         },
         ..Default::default()

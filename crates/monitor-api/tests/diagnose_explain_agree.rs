@@ -87,7 +87,7 @@ fn diagnose_and_explain_agree_on_twenty_logs() {
             let p = params(motor);
             let req = DiagnoseRequest {
                 options: monitor_replay::ReplayOptions {
-                    commission: Some((2.0, 4.0)),
+                    commission: Some(monitor_replay::CommissionWindow::of(2.0, 4.0)),
                     ..Default::default()
                 },
                 ..Default::default()

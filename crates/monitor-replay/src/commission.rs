@@ -26,6 +26,7 @@
 //! and the 20 % margin, `monitor_core::operating_range::RANGE_MARGIN`) is the core's
 //! `monitor_core::operating_range`, which the firmware's panel uses too.
 
+use crate::options::CommissionWindow;
 use crate::words::{OptionField, Words};
 use monitor_core::operating_range::{outside, widen};
 use monitor_core::{
@@ -69,7 +70,7 @@ pub struct CommissioningReport {
     /// `learned`, `incomplete` or `none`.
     pub state: CommissioningOutcome,
     /// The window asked for, `[START, END]` [s], if any.
-    pub requested: Option<[f64; 2]>,
+    pub requested: Option<CommissionWindow>,
     /// The part of the log the run actually spanned, from its start to its end (or to
     /// where it was cancelled, or to the end of the log) [s]; null if it never started.
     pub window: Option<[f64; 2]>,
@@ -113,7 +114,7 @@ pub struct RangeNote {
 /// Follows a replay's commissioning (see the module documentation).
 #[derive(Debug, Clone)]
 pub(crate) struct CommissionTracker {
-    requested: Option<(f64, f64)>,
+    requested: Option<CommissionWindow>,
     run_id: Option<u16>,
     started_at: Option<f64>,
     ended_at: Option<f64>,
@@ -143,7 +144,11 @@ pub(crate) fn operating_point(out: &MonitorOutput) -> (f32, f32) {
 }
 
 impl CommissionTracker {
-    pub(crate) fn new(requested: Option<(f64, f64)>, words: Words, cfg: &MonitorConfig) -> Self {
+    pub(crate) fn new(
+        requested: Option<CommissionWindow>,
+        words: Words,
+        cfg: &MonitorConfig,
+    ) -> Self {
         CommissionTracker {
             requested,
             words,
@@ -167,7 +172,7 @@ impl CommissionTracker {
     /// start, cancels it when it is still learning past the grace time.
     pub(crate) fn before(&mut self, mon: &mut Monitor, t: f64) {
         self.last_t = t;
-        let Some((a, b)) = self.requested else {
+        let Some((a, b)) = self.requested.map(CommissionWindow::seconds) else {
             return;
         };
         if self.started_at.is_none() && t >= a {
@@ -374,7 +379,7 @@ impl CommissionTracker {
 
     /// The window asked for (`START:END`) and why it was not learned, where it was not.
     pub(crate) fn not_learned(&self) -> Option<(String, String)> {
-        let (a, b) = self.requested?;
+        let (a, b) = self.requested?.seconds();
         if self.learned_ok() {
             return None;
         }
@@ -401,7 +406,7 @@ impl CommissionTracker {
     }
 
     /// The commissioning window asked for [s], if any.
-    pub(crate) fn requested(&self) -> Option<(f64, f64)> {
+    pub(crate) fn requested(&self) -> Option<CommissionWindow> {
         self.requested
     }
 
@@ -411,7 +416,7 @@ impl CommissionTracker {
             "fixed: |r| > {:.1} % against the nominal parameters",
             100.0 * self.fixed[0]
         );
-        let (state, thresholds, advice) = match self.requested {
+        let (state, thresholds, advice) = match self.requested.map(CommissionWindow::seconds) {
             None => (
                 CommissioningOutcome::None,
                 fixed,
@@ -436,12 +441,12 @@ impl CommissionTracker {
         };
         CommissioningReport {
             state,
-            requested: self.requested.map(|(a, b)| [a, b]),
+            requested: self.requested,
             window: self
                 .started_at
                 .map(|s| [s, self.ended_at.unwrap_or(self.last_t)]),
             seconds_evaluated: self.seconds(self.learned.0),
-            seconds_needed: self.requested.map_or(0.0, |(a, b)| b - a),
+            seconds_needed: self.requested.map_or(0.0, |w| w.end_s() - w.start_s()),
             load_current_a: self.iqs,
             voltage_v: self.vqs,
             thresholds,

@@ -68,8 +68,8 @@ pub use isolation::{
 };
 pub use lamps::Detection;
 pub use options::{
-    angle_source_name, check_parallel_paths, monitor_config_for_log, serialize_angle_source,
-    CommissionWindow, LoadModel, ReplayOptions, TimelineStep, PARALLEL_PATHS,
+    angle_source_name, monitor_config_for_log, serialize_angle_source, CommissionWindow, LoadModel,
+    ParallelPaths, ReplayOptions, TimelineStep, TurnLevelOptions, PARALLEL_PATHS,
 };
 pub use report::DiagnoseReport;
 pub use rotor::{
@@ -81,9 +81,7 @@ pub use sampler::LogSampler;
 pub use temperature::TemperatureReport;
 pub use timeline::{MonitorState, Panel, TimelinePoint};
 pub use verdict::{FindingReport, Rule, Verdict};
-pub use winding::level::{
-    LabelledRun, LevelBasis, ShortedTurns, TurnCalibration, TurnLevelOptions,
-};
+pub use winding::level::{LabelledRun, LevelBasis, ShortedTurns, TurnCalibration};
 pub use winding::{
     describe_against, segments, Against, BaselineSource, OperatingPointSource, PhaseProbabilities,
     SequenceSegment, UnbalanceReport, BALANCED_RATIO, DEFAULT_SPREAD_CURRENTS,

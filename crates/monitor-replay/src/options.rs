@@ -1,14 +1,15 @@
 //! What a replay is asked to do ([`ReplayOptions`], [`LoadModel`]), the typed values a
-//! front end parses its words into, each parsed and checked in one place
-//! ([`CommissionWindow`], `START:END` seconds; [`TimelineStep`], positive by construction;
-//! [`PARALLEL_PATHS`]), the one check of them all ([`ReplayOptions::validate`]) and its
-//! error ([`OptionError`], naming the field, [`OptionField`], never a front end's spelling
+//! front end parses its words into, each checked once, where it is made, and valid from
+//! then on ([`CommissionWindow`], `START:END` seconds; [`TimelineStep`], positive;
+//! [`ParallelPaths`], in [`PARALLEL_PATHS`]), their error ([`OptionError`], naming the
+//! field, [`OptionField`], never a front end's spelling
 //! of it: the command line says it as its flags, Python as its keywords, [`Spelling`]),
 //! and the monitor configuration a replay runs with ([`monitor_config_for_log`]).
 
 use super::baseline::HealthyReference;
 use super::sampler::TICK_HZ;
 pub use super::words::{OptionError, OptionField, Spelling, Words};
+use crate::turn_calibration::TurnCalibration;
 use monitor_core::{AngleSource, MonitorConfig, ResidualForm};
 use monitor_io::params::ParamFile;
 use serde::Serialize;
@@ -41,9 +42,9 @@ pub struct ReplayOptions {
     pub angle_source: AngleSource,
     /// Residual form for the lamps.
     pub residual_form: ResidualForm,
-    /// Commissioning window [start, end) in log seconds; None = fixed thresholds. Checked
-    /// by [`ReplayOptions::validate`] as [`CommissionWindow::new`] checks it.
-    pub commission: Option<(f64, f64)>,
+    /// Commissioning window [start, end) in log seconds, valid by construction
+    /// ([`CommissionWindow::new`], the one check); None = fixed thresholds.
+    pub commission: Option<CommissionWindow>,
     /// Report a commissioning window that was not learned instead of refusing.
     pub allow_incomplete: bool,
     /// Timeline resolution (one point per interval; default 0.5 s, the one default of
@@ -57,7 +58,7 @@ pub struct ReplayOptions {
     pub load: LoadModel,
     /// How the shorted-turn level is sized (the fields `parallel_paths`, 1..=8 as
     /// [`PARALLEL_PATHS`] says, and `turn_calibration`; `winding::level`).
-    pub turn_level: crate::turn_calibration::TurnLevelOptions,
+    pub turn_level: TurnLevelOptions,
     /// The words the report's sentences name a field in (a hint to give `commission`, the
     /// `load`, a `baseline`): the front end's that asked ([`Words`]; the library's own,
     /// [`FieldNames`], by default). No part of what is judged: ignored by `==`.
@@ -84,6 +85,28 @@ pub enum LoadModel {
     Viscous,
 }
 
+/// What the level is computed with (`ReplayOptions::turn_level`; `diagnose
+/// --parallel-paths`, `--turn-calibration`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TurnLevelOptions {
+    /// Parallel paths of each phase (1 for a series star or delta, 2 for a double star;
+    /// 1..=8, [`PARALLEL_PATHS`], by construction).
+    pub parallel_paths: ParallelPaths,
+    /// A calibration learned from labelled runs of the same motor, used instead of the
+    /// model where given (the model's estimate is still reported).
+    pub calibration: Option<TurnCalibration>,
+}
+
+/// One path, no calibration (the model's level).
+impl Default for TurnLevelOptions {
+    fn default() -> Self {
+        TurnLevelOptions {
+            parallel_paths: ParallelPaths::ONE,
+            calibration: None,
+        }
+    }
+}
+
 /// The one home of `diagnose`'s defaults: the command line, the API
 /// (`monitor_api::DiagnoseRequest`), the fleet run and the Python package take theirs from
 /// here.
@@ -97,7 +120,7 @@ impl Default for ReplayOptions {
             timeline_step: TimelineStep::DEFAULT,
             unbalance_baseline: None,
             load: LoadModel::Unknown,
-            turn_level: crate::turn_calibration::TurnLevelOptions::default(),
+            turn_level: TurnLevelOptions::default(),
             words: Words::LIBRARY,
         }
     }
@@ -129,42 +152,52 @@ pub fn monitor_config_for_log(
     cfg
 }
 
-impl ReplayOptions {
-    /// The one check of the options every front end calls (the command line, Python, the
-    /// HMI, the fleet; [`crate::Replay::new`] too): the commissioning window as
-    /// [`CommissionWindow::new`] checks it, `parallel_paths` in [`PARALLEL_PATHS`] (the
-    /// time step is positive by construction, [`TimelineStep`]).
-    ///
-    /// # Errors
-    /// [`OptionError`] naming the field (`commission`, `parallel_paths`).
-    pub fn validate(&self) -> Result<(), OptionError> {
-        if let Some((a, b)) = self.commission {
-            CommissionWindow::new(a, b)?;
-        }
-        check_parallel_paths(i64::from(self.turn_level.parallel_paths))?;
-        Ok(())
-    }
-}
-
 /// The parallel paths per phase a winding may have (the field `parallel_paths`): 1 for a
 /// series star or delta, 2 for a double star, at most 8.
 pub const PARALLEL_PATHS: RangeInclusive<u8> = 1..=8;
 
-/// Checks the winding's parallel paths (the field `parallel_paths`), given as any whole
-/// number.
-///
-/// # Errors
-/// [`OptionError`] for a count outside [`PARALLEL_PATHS`].
-pub fn check_parallel_paths(n: i64) -> Result<u8, OptionError> {
-    match u8::try_from(n) {
-        Ok(p) if PARALLEL_PATHS.contains(&p) => Ok(p),
-        _ => {
-        Err(OptionError::new(
-            OptionField::ParallelPaths,
-            n.to_string(),
-            "give the parallel paths of each phase, 1..=8 (1 for a series star or delta, 2 for a double star)",
-        ))
+/// The winding's parallel paths per phase (the field `parallel_paths`): in
+/// [`PARALLEL_PATHS`] by construction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct ParallelPaths(u8);
+
+impl ParallelPaths {
+    /// One path (a series star or delta): the default.
+    pub const ONE: ParallelPaths = ParallelPaths(1);
+
+    /// The paths `n`, given as any whole number.
+    ///
+    /// # Errors
+    /// [`OptionError`] naming `parallel_paths` for a count outside [`PARALLEL_PATHS`].
+    pub fn new(n: i64) -> Result<Self, OptionError> {
+        match u8::try_from(n) {
+            Ok(p) if PARALLEL_PATHS.contains(&p) => Ok(ParallelPaths(p)),
+            _ => Err(OptionError::new(
+                OptionField::ParallelPaths,
+                n.to_string(),
+                "give the parallel paths of each phase, 1..=8 (1 for a series star or delta, 2 for a double star)",
+            )),
         }
+    }
+
+    /// Paths known valid where they are written (a constant).
+    ///
+    /// # Panics
+    /// Outside [`PARALLEL_PATHS`].
+    pub const fn of(n: u8) -> Self {
+        assert!(n >= 1 && n <= 8, "parallel paths 1..=8");
+        ParallelPaths(n)
+    }
+
+    /// The paths (1..=8).
+    pub fn get(self) -> u8 {
+        self.0
+    }
+}
+
+impl fmt::Display for ParallelPaths {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.0)
     }
 }
 
@@ -194,6 +227,19 @@ impl CommissionWindow {
         }
     }
 
+    /// A window known valid where it is written (a constant: use it in a `const` so that a
+    /// bad one fails the build).
+    ///
+    /// # Panics
+    /// Unless `0 <= start_s < end_s`, both finite.
+    pub const fn of(start_s: f64, end_s: f64) -> Self {
+        assert!(
+            end_s > start_s && start_s >= 0.0 && end_s.is_finite(),
+            "a commissioning window 0 <= START < END, both finite"
+        );
+        CommissionWindow { start_s, end_s }
+    }
+
     /// The start [s].
     pub fn start_s(self) -> f64 {
         self.start_s
@@ -204,7 +250,7 @@ impl CommissionWindow {
         self.end_s
     }
 
-    /// `(start, end)` [s], as [`ReplayOptions::commission`] holds it.
+    /// `(start, end)` [s].
     pub fn seconds(self) -> (f64, f64) {
         (self.start_s, self.end_s)
     }
@@ -219,6 +265,15 @@ impl fmt::Display for CommissionWindow {
 impl Serialize for CommissionWindow {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         [self.start_s, self.end_s].serialize(s)
+    }
+}
+
+/// A window from `[start, end]` (a fleet table's `commission = [2.0, 4.0]`), checked as it is
+/// read ([`CommissionWindow::new`]).
+impl<'de> serde::Deserialize<'de> for CommissionWindow {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let [a, b] = <[f64; 2]>::deserialize(d)?;
+        CommissionWindow::new(a, b).map_err(serde::de::Error::custom)
     }
 }
 
@@ -363,8 +418,8 @@ mod tests {
             assert_eq!(e.field, OptionField::TimelineStep);
         }
         assert!("x".parse::<TimelineStep>().is_err());
-        assert!(check_parallel_paths(0).is_err() && check_parallel_paths(9).is_err());
-        assert_eq!(check_parallel_paths(8), Ok(8));
+        assert!(ParallelPaths::new(0).is_err() && ParallelPaths::new(9).is_err());
+        assert_eq!(ParallelPaths::new(8).map(ParallelPaths::get), Ok(8));
     }
 
     #[test]

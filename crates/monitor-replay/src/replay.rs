@@ -65,15 +65,13 @@ impl Replay {
     ///
     /// # Errors
     /// [`ReplayError::Config`] when the core rejects the configuration (e.g. a sample rate
-    /// below 8x the supply frequency); [`ReplayError::Option`] for options
-    /// [`ReplayOptions::validate`] refuses.
+    /// below 8x the supply frequency). (The options are valid by construction.)
     pub fn new(
         params: &ParamFile,
         channels: Channels,
         sample_rate_hz: f64,
         opts: ReplayOptions,
     ) -> Result<Self, ReplayError> {
-        opts.validate()?;
         let cfg = monitor_config_for_log(params, sample_rate_hz, &opts);
         let config_error = |source| ReplayError::Config {
             source,

@@ -5,7 +5,7 @@
 use crate::commission::CommissioningReport;
 use crate::isolation::{FaultCandidate, IsolationFinding, IsolationReport};
 use crate::lamps::{Detection, LampsFinding};
-use crate::options::serialize_angle_source;
+use crate::options::{serialize_angle_source, CommissionWindow};
 use crate::rotor::RotorReport;
 use crate::timeline::TimelinePoint;
 use crate::verdict::findings::Stages;
@@ -67,7 +67,7 @@ pub struct DiagnoseReport {
     #[serde(serialize_with = "serialize_angle_source")]
     pub angle_source: AngleSource,
     /// Commissioning window asked for, if any [s].
-    pub commission: Option<(f64, f64)>,
+    pub commission: Option<CommissionWindow>,
     /// What commissioning did (state, window used, range covered).
     pub commissioning: CommissioningReport,
     /// What the data-quality stage found and did.

@@ -1,35 +1,12 @@
-//! What a shorted turn's level is computed with ([`TurnLevelOptions`], `ReplayOptions::turn_level`):
-//! the winding's parallel paths and a calibration learned from labelled runs of the same
-//! motor ([`TurnCalibration`]). The winding stage reads them (`winding::level`).
+//! A calibration of a shorted turn's level learned from labelled runs of the same motor
+//! ([`TurnCalibration`]): one of the options the winding stage reads (`ReplayOptions::
+//! turn_level`, `winding::level`).
 
 use monitor_core::Phase;
 use serde::{Deserialize, Serialize};
 
 /// Most levels a calibration keeps per phase.
 pub const MAX_CALIBRATION_LEVELS: usize = 8;
-
-/// What the level is computed with (`ReplayOptions::turn_level`; `diagnose
-/// --parallel-paths`, `--turn-calibration`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TurnLevelOptions {
-    /// Parallel paths of each phase (1 for a series star or delta, 2 for a double star;
-    /// 1..=8, [`crate::PARALLEL_PATHS`], as [`crate::ReplayOptions::validate`] checks;
-    /// 0 is taken as 1 by a replay that was not validated).
-    pub parallel_paths: u8,
-    /// A calibration learned from labelled runs of the same motor, used instead of the
-    /// model where given (the model's estimate is still reported).
-    pub calibration: Option<TurnCalibration>,
-}
-
-/// One path, no calibration (the model's level).
-impl Default for TurnLevelOptions {
-    fn default() -> Self {
-        TurnLevelOptions {
-            parallel_paths: 1,
-            calibration: None,
-        }
-    }
-}
 
 /// A calibration of the loop ratio `|r|` against the shorted fraction, learned from
 /// labelled runs of one motor: per phase, the mean `|r|` of each labelled level; a reading

@@ -37,7 +37,7 @@ fn a_window_with_supply_steps_inside_is_learned_and_the_log_stays_healthy() {
     for p in [ParamFile::reference_2p2kw(), ParamFile::reference_3hp()] {
         let rows = supply_steps_log(&p, 4);
         let opts = ReplayOptions {
-            commission: Some((3.0, 6.5)),
+            commission: Some(monitor_replay::CommissionWindow::of(3.0, 6.5)),
             ..ReplayOptions::default()
         };
         let r = diagnose_rows(&p, channels(), &rows, opts).expect("learned"); // ok: test
@@ -69,7 +69,7 @@ fn a_window_with_too_little_steady_running_says_how_much_it_found() {
     let rows = supply_steps_log(&p, 5);
     // 0.6 s from 0.3 s: the start, never quasi-steady.
     let opts = ReplayOptions {
-        commission: Some((0.1, 0.7)),
+        commission: Some(monitor_replay::CommissionWindow::of(0.1, 0.7)),
         ..ReplayOptions::default()
     };
     match diagnose_rows(&p, channels(), &rows, opts) {

@@ -44,7 +44,7 @@ fn diagnose(rows: &[Row], speed: bool) -> Result<DiagnoseReport, String> {
         })
         .collect();
     let opts = ReplayOptions {
-        commission: Some((2.0, 4.0)),
+        commission: Some(monitor_replay::CommissionWindow::of(2.0, 4.0)),
         ..ReplayOptions::default()
     };
     diagnose_rows(&ParamFile::reference_2p2kw(), channels, &rows, opts).map_err(|e| e.to_string())

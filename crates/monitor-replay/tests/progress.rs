@@ -35,7 +35,7 @@ fn the_fraction_moves_through_the_whole_work_and_reaches_one_at_the_end() {
     ));
     write_log(&p, &path);
     let opts = ReplayOptions {
-        commission: Some((2.0, 4.0)),
+        commission: Some(monitor_replay::CommissionWindow::of(2.0, 4.0)),
         ..ReplayOptions::default()
     };
     let mut seen: Vec<f64> = Vec::new();

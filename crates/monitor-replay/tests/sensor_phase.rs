@@ -25,7 +25,7 @@ fn motors() -> Vec<(&'static str, ParamFile, (f64, f64), f64)> {
 fn diagnose(p: &ParamFile, sc: &Scenario, commission: Option<(f64, f64)>) -> DiagnoseReport {
     let rows = simulate_to_vec(p, sc).expect("simulate"); // ok: test
     let opts = ReplayOptions {
-        commission,
+        commission: commission.map(|(a, b)| monitor_replay::CommissionWindow::of(a, b)),
         ..ReplayOptions::default()
     };
     diagnose_rows(p, sc.sensors.channels(), &rows, opts).expect("replay") // ok: test

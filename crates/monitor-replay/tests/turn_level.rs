@@ -64,7 +64,7 @@ fn judge(name: &str, turn_level: TurnLevelOptions) -> UnbalanceReport {
 
 fn double_star() -> TurnLevelOptions {
     TurnLevelOptions {
-        parallel_paths: 2,
+        parallel_paths: monitor_replay::ParallelPaths::of(2),
         calibration: None,
     }
 }
@@ -132,7 +132,7 @@ fn a_calibration_from_run_001_names_phase_and_level_of_run_002() {
     assert_eq!(learned.len(), 12, "every labelled fault run read");
     let cal = TurnCalibration::learn(&learned).expect("a calibration"); // ok: test
     let with_cal = TurnLevelOptions {
-        parallel_paths: 2,
+        parallel_paths: monitor_replay::ParallelPaths::of(2),
         calibration: Some(cal),
     };
     let mut right = 0;

@@ -13,7 +13,9 @@
 use crate::experiment::{simulate_and_replay, ExperimentError};
 use monitor_core::{AngleSource, Fault, IsolationState};
 use monitor_io::params::ParamFile;
-use monitor_replay::{serialize_state, FaultCandidate, IsolationName, NameGiven, ReplayOptions};
+use monitor_replay::{
+    serialize_state, CommissionWindow, FaultCandidate, IsolationName, NameGiven, ReplayOptions,
+};
 use monitor_sim::{FaultSpec, LoadStep, Scenario, SensorSpec};
 use serde::{Serialize, Serializer};
 
@@ -25,7 +27,7 @@ pub const RESIDUAL_MEAN_S: f64 = 0.1;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Protocol {
     /// Commissioning window [s].
-    pub commission: (f64, f64),
+    pub commission: CommissionWindow,
     /// Fault switch-on time [s].
     pub fault_at_s: f64,
     /// End of the run [s].
@@ -48,7 +50,7 @@ pub struct Protocol {
 impl Default for Protocol {
     fn default() -> Self {
         Protocol {
-            commission: (2.0, 4.0),
+            commission: CommissionWindow::of(2.0, 4.0),
             fault_at_s: 4.5,
             duration_s: 7.5,
             sample_rate_hz: 10_000.0,

@@ -10,14 +10,14 @@
 use crate::experiment::{simulate_and_replay, ExperimentError};
 use monitor_core::{AngleSource, ResidualForm};
 use monitor_io::params::ParamFile;
-use monitor_replay::{NameGiven, ReplayOptions};
+use monitor_replay::{CommissionWindow, NameGiven, ReplayOptions};
 use monitor_sim::{FaultSpec, LoadSpec, LoadStep, Scenario, SensorSpec, SupplyStep};
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 /// Commissioning window of the profile [s].
-pub const COMMISSION: (f64, f64) = (2.0, 30.0);
+pub const COMMISSION: CommissionWindow = CommissionWindow::of(2.0, 30.0);
 
 /// The healthy service scenario, `duration_s` long (steps past the end are ignored).
 pub fn healthy_service(params: &ParamFile, seed: u64, duration_s: f64) -> Scenario {
@@ -136,7 +136,7 @@ pub fn watch_mismatched(
     let mut w = ServiceWatch::default();
     let dt = 1.0 / sc.sample_rate_hz;
     let replay = simulate_and_replay(truth, params, &sc, opts, |row, o| {
-        if row.t_s > COMMISSION.1 {
+        if row.t_s > COMMISSION.end_s() {
             if o.evaluating {
                 w.evaluated_s += dt;
             }
@@ -201,4 +201,4 @@ pub const MOVING_PERIOD_S: f64 = 4.0;
 
 /// The commissioning window of [`moving_load`] [s]: from the end of the start (a 37 kW
 /// machine's run-up takes about a second and a half) over the five first load levels.
-pub const MOVING_COMMISSION: (f64, f64) = (2.0, 24.0);
+pub const MOVING_COMMISSION: CommissionWindow = CommissionWindow::of(2.0, 24.0);

@@ -424,7 +424,7 @@ at_s = 3.0
         .par_iter()
         .filter_map(|(name, truth, file)| {
             let opts = monitor_replay::ReplayOptions {
-                commission: Some((2.0, 8.0)),
+                commission: Some(monitor_replay::CommissionWindow::of(2.0, 8.0)),
                 ..Default::default()
             };
             let r =

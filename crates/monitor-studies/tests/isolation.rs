@@ -84,7 +84,10 @@ fn run(m: usize, f: Fault, change: f64) -> Table1Row {
     let late = *name == "11 kW";
     let proto = Protocol {
         sample_rate_hz: 5000.0,
-        commission: if late { (3.0, 5.0) } else { (2.0, 4.0) },
+        commission: monitor_replay::CommissionWindow::of(
+            if late { 3.0 } else { 2.0 },
+            if late { 5.0 } else { 4.0 },
+        ),
         fault_at_s: if late { 5.5 } else { 4.5 },
         duration_s: if late { 10.5 } else { 9.5 },
         ..Protocol::default()

@@ -100,7 +100,7 @@ fn replay_steps(p: &ParamFile, change: f64, commission: Option<(f64, f64)>) -> V
         ..LoadSpec::default()
     };
     let opts = ReplayOptions {
-        commission,
+        commission: commission.map(|(a, b)| monitor_replay::CommissionWindow::of(a, b)),
         ..Default::default()
     };
     let r = monitor_studies::experiment::simulate_and_replay(p, p, &sc, opts, |_, _| {})

@@ -34,7 +34,7 @@ fn run(fault: Option<(Fault, f64)>, steps: bool) -> DiagnoseReport {
         sc.faults.push(FaultSpec::at_change(f, 4.5, change));
     }
     let opts = ReplayOptions {
-        commission: Some((2.0, 4.0)),
+        commission: Some(monitor_replay::CommissionWindow::of(2.0, 4.0)),
         ..Default::default()
     };
     simulate_and_replay(&p, &p, &sc, opts, |_, _| {})

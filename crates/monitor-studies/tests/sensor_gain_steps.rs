@@ -33,7 +33,7 @@ fn run(p: &ParamFile, fault: Option<(Fault, f64)>) -> DiagnoseReport {
         sc.faults.push(FaultSpec::sensor_gain(f, 5.0, change));
     }
     let opts = ReplayOptions {
-        commission: Some((1.5, 4.0)),
+        commission: Some(monitor_replay::CommissionWindow::of(1.5, 4.0)),
         ..Default::default()
     };
     simulate_and_replay(p, p, &sc, opts, |_, _| {})

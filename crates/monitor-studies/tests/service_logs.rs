@@ -353,7 +353,7 @@ fn an_hour_with_load_steps_and_a_rotor_fault_at_50_min() {
         .to_vec();
     sc.faults.push(FaultSpec::at_change(Fault::Rr, 3000.0, 0.2));
     let opts = ReplayOptions {
-        commission: Some((60.0, 500.0)),
+        commission: Some(monitor_replay::CommissionWindow::of(60.0, 500.0)),
         ..Default::default()
     };
     let replay = simulate_and_replay(&p, &p, &sc, opts, |_, _| {}).expect("runs");

@@ -30,8 +30,8 @@ pub struct CalibrateTurnsArgs {
     #[arg(required = true, value_name = "LOG=PHASE:PERCENT", value_parser = parse_labelled)]
     pub labelled: Vec<(PathBuf, Phase, f32)>,
     /// Parallel paths of each phase of the winding (as for diagnose).
-    #[arg(long, default_value_t = 1, value_parser = super::words::parse_parallel_paths)]
-    pub parallel_paths: u8,
+    #[arg(long, default_value_t = monitor_api::replay::ParallelPaths::ONE, value_parser = super::words::parse_parallel_paths)]
+    pub parallel_paths: monitor_api::replay::ParallelPaths,
     /// Healthy logs of the same motor (as for diagnose); without, each run is judged
     /// within itself.
     #[arg(long, value_name = "HEALTHY", num_args = 1.., action = clap::ArgAction::Append)]
@@ -74,7 +74,6 @@ pub fn run(args: &CalibrateTurnsArgs) -> anyhow::Result<()> {
         .iter()
         .map(monitor_api::LogSource::from)
         .collect();
-    req.validate()?;
     let labelled: Vec<monitor_api::Labelled> = args
         .labelled
         .iter()

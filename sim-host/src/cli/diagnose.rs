@@ -122,7 +122,7 @@ pub struct ReplayArgs {
     /// path, and the shorted-turn level (unbalance.shorted_turns) is sized with that
     /// path's resistance.
     #[arg(long, default_value_t = defaults().options.turn_level.parallel_paths, value_parser = super::words::parse_parallel_paths)]
-    pub parallel_paths: u8,
+    pub parallel_paths: monitor_api::replay::ParallelPaths,
     /// A calibration of the shorted-turn level learned from labelled runs of the same
     /// motor (JSON, `monitor_api::replay::TurnCalibration`): the level is read from it instead
     /// of the model (unbalance.shorted_turns.basis says which; the model's stays in
@@ -143,9 +143,7 @@ impl ReplayArgs {
             options: monitor_api::replay::ReplayOptions {
                 angle_source: self.angle.into(),
                 residual_form: self.residuals.into(),
-                commission: self
-                    .commission
-                    .map(monitor_api::replay::CommissionWindow::seconds),
+                commission: self.commission,
                 load: self.load.into(),
                 turn_level: monitor_api::replay::TurnLevelOptions {
                     parallel_paths: self.parallel_paths,
@@ -165,7 +163,6 @@ impl ReplayArgs {
                 .collect(),
             group: self.group.clone(),
         };
-        req.validate()?;
         Ok(req)
     }
 }
@@ -185,7 +182,6 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
     let mut req = args.replay.request()?;
     req.options.allow_incomplete = args.allow_incomplete;
     req.options.timeline_step = args.timeline_step;
-    req.validate()?;
     if let Some(out) = &args.report {
         let mut inputs = vec![args.params.as_path(), args.log.as_path()];
         inputs.extend(args.replay.baseline.iter().map(PathBuf::as_path));

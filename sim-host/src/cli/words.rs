@@ -3,7 +3,7 @@
 //! library's one parser, their refusals shown as clap shows a bad value.
 
 use monitor_api::replay::{
-    check_parallel_paths, CommissionWindow, OptionField, ReplayError, Spelling, TimelineStep, Words,
+    CommissionWindow, OptionField, ParallelPaths, ReplayError, Spelling, TimelineStep, Words,
 };
 use monitor_api::ApiError;
 
@@ -71,12 +71,12 @@ pub fn parse_timeline_step(s: &str) -> Result<TimelineStep, String> {
 }
 
 /// `--parallel-paths N`: a whole number in the library's range (1..=8).
-pub fn parse_parallel_paths(s: &str) -> Result<u8, String> {
+pub fn parse_parallel_paths(s: &str) -> Result<ParallelPaths, String> {
     let n = s
         .trim()
         .parse::<i64>()
         .map_err(|_| format!("'{s}' is not a whole number of paths (1..=8)"))?;
-    check_parallel_paths(n).map_err(|e| e.why)
+    ParallelPaths::new(n).map_err(|e| e.why)
 }
 
 #[cfg(test)]

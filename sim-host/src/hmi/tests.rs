@@ -211,7 +211,7 @@ fn a_simulated_log_replays_with_speed_pause_and_seek() {
     let path = dir.path().join("lr.csv");
     log.write(&path).expect("write");
     let opts = ReplayOptions {
-        commission: Some((2.0, 4.0)),
+        commission: Some(monitor_replay::CommissionWindow::of(2.0, 4.0)),
         ..ReplayOptions::default()
     };
     let mut replay = LogReplay::start(params, &path, opts, Speed::X1).expect("log opens");

@@ -32,7 +32,8 @@
 
 use super::UnbalanceReport;
 use super::{abs, Complex32, FULL_LOAD_SLIP_MAX};
-pub use crate::turn_calibration::{LabelledRun, TurnCalibration, TurnLevelOptions};
+pub use crate::options::TurnLevelOptions;
+pub use crate::turn_calibration::{LabelledRun, TurnCalibration};
 use monitor_core::sequence::{equivalent_impedance, slip_for_current};
 use monitor_core::{MotorModel, Phase};
 use serde::Serialize;
@@ -188,7 +189,7 @@ pub fn physics(
     opts: &TurnLevelOptions,
 ) -> Option<ShortedTurns> {
     let (phase, r, dr) = loop_ratio(u)?;
-    let paths = f32::from(opts.parallel_paths.max(1));
+    let paths = f32::from(opts.parallel_paths.get());
     let z1s = z1_range(u, m, we, v_peak, r);
     let x_lls = we * (m.ls_h - m.lm_h);
     let rs = m.rs_ohm;

@@ -24,7 +24,9 @@ use crate::experiment::ExperimentError;
 use crate::fault_signatures::{run_case, Protocol, Table1Row};
 use monitor_core::{AngleSource, Fault, IsolationState};
 use monitor_io::params::{ParamError, ParamFile};
-use monitor_replay::{serialize_angle_source, serialize_state, FaultCandidate, IsolationName};
+use monitor_replay::{
+    serialize_angle_source, serialize_state, CommissionWindow, FaultCandidate, IsolationName,
+};
 use serde::{Serialize, Serializer};
 use std::fmt;
 
@@ -103,7 +105,7 @@ pub struct BenchMotor {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Timing {
     /// Commissioning window [start, end).
-    pub commission: (f64, f64),
+    pub commission: CommissionWindow,
     /// Fault switch-on.
     pub fault_at_s: f64,
     /// End of the run.
@@ -146,7 +148,7 @@ impl BenchMotor {
 /// The embedded 11 kW parameter file does not parse (a test reads it).
 pub fn motors() -> Result<Vec<BenchMotor>, ParamError> {
     let early = Timing {
-        commission: (2.0, 4.0),
+        commission: CommissionWindow::of(2.0, 4.0),
         fault_at_s: 4.5,
         duration_s: 9.5,
     };
@@ -165,7 +167,7 @@ pub fn motors() -> Result<Vec<BenchMotor>, ParamError> {
             name: "11 kW",
             params: ParamFile::from_toml_str(MOTOR_11KW, "examples/params/11kw_2pole.toml")?,
             timing: Timing {
-                commission: (3.0, 5.0),
+                commission: CommissionWindow::of(3.0, 5.0),
                 fault_at_s: 5.5,
                 duration_s: 10.5,
             },

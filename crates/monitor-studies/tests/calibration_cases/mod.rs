@@ -188,7 +188,9 @@ pub fn setup(c: &Case) -> (ParamFile, ParamFile, Scenario, ReplayOptions) {
     let (sc, window) = scenario(c, &truth);
     let opts = ReplayOptions {
         angle_source: c.angle,
-        commission: c.commissioned.then_some(window),
+        commission: c
+            .commissioned
+            .then_some(monitor_replay::CommissionWindow::of(window.0, window.1)),
         allow_incomplete: true,
         ..Default::default()
     };

@@ -39,7 +39,10 @@ pub fn replay_warming_from(
         sc.faults.push(FaultSpec::parametric(f, at_s, change));
     }
     let opts = monitor_replay::ReplayOptions {
-        commission: Some(commission),
+        commission: Some(monitor_replay::CommissionWindow::of(
+            commission.0,
+            commission.1,
+        )),
         ..Default::default()
     };
     monitor_studies::experiment::simulate_and_replay(p, p, &sc, opts, |_, _| {})

@@ -63,7 +63,7 @@ pub const INSIDE: &[Inside] = &[
         "crates/monitor-replay/src/",
         &[
             ("events", 2),
-            ("commission", 2),
+            ("commission", 3),
             ("error", 2),
             ("options", 2),
             ("rotor", 3),
