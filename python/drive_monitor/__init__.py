@@ -36,9 +36,12 @@ from __future__ import annotations
 
 # The helpers under underscore names: the package's namespace is its public API
 # (`__all__`), so `dir(drive_monitor)` and completion show no `os`, `json` or `Dict`.
+import ast as _ast
+import inspect as _inspect
 import json as _json
 import os as _os
 import tempfile as _tempfile
+import textwrap as _textwrap
 from pathlib import Path as _Path
 from typing import TYPE_CHECKING as _TYPE_CHECKING
 from typing import Any as _Any
@@ -178,36 +181,12 @@ def _log(log: LogLike) -> _Tuple[_Any, _Optional[str]]:
     )
 
 
-def _commission(commission: _Optional[CommissionLike]) -> _Optional[_Union[_Tuple[float, float], str]]:
-    """The window as the library takes it: ``"START:END"`` as given (the library's one
-    parser reads it), a pair as ``(start_s, end_s)``; the library checks both."""
-    if commission is None or isinstance(commission, str):
-        return commission
-    how = "give (start_s, end_s) or 'START:END' in seconds, e.g. (1.5, 2.4) or '1.5:2.4'"
-    if not isinstance(commission, (tuple, list)):
-        raise OptionError(f"commission = {commission!r}: {how}")
-    if len(commission) != 2:
-        raise OptionError(f"commission = {commission!r}: two values, the start and the end; {how}")
-    try:
-        a, b = (float(x) for x in commission)
-    except (TypeError, ValueError):
-        raise OptionError(f"commission = {commission!r}: not numbers; {how}") from None
-    return a, b
-
-
 def diagnose(
     log: LogLike,
     params: ParamsLike,
-    commission: _Optional[CommissionLike] = None,
     baseline: _Optional[_Union[LogLike, _Sequence[LogLike]]] = None,
-    load: _Optional[str] = None,
-    angle: _Optional[str] = None,
-    residuals: _Optional[str] = None,
-    allow_incomplete: bool = False,
-    timeline_step: _Optional[float] = None,
     group: _Optional[str] = None,
-    parallel_paths: _Optional[int] = None,
-    turn_calibration: _Optional[_Union[str, _Dict[str, _Any]]] = None,
+    **options: _Any,
 ) -> DiagnoseResult:
     """Replay a log through the monitor's core: lamps, the named fault with its size and
     phase, the shorted winding's phase, events, verdict (``sim-host diagnose``).
@@ -218,35 +197,13 @@ def diagnose(
         The measurement (see the module's doc for the columns).
     params : path or dict
         The motor's parameter file.
-    commission : (start_s, end_s) or "START:END", optional
-        Learn the healthy thresholds over this window of the log [s] (``(1.5, 2.4)`` or
-        the command line's ``"1.5:2.4"``).
     baseline : log or list of logs, optional
         (One log, a path or data, is a list of one.)
         Healthy logs of the same motor (files, folders, or data): the winding's negative
         sequence is judged against their mean, their spread sets the least change.
-    load : {"unknown", "viscous"}, optional
-        What is known of the load ("unknown", the default: a load change is a load move,
-        never a fault).
-    angle : {"rotor-flux", "pll", "zero-crossing"}, optional
-        The frame's angle source (default "rotor-flux").
-    residuals : {"steady", "full"}, optional
-        The residual form the lamps act on (eq. 37, the default, or eq. 36).
-    allow_incomplete : bool
-        Report even when the commissioning window was not learned.
-    timeline_step : float, optional
-        Timeline resolution [s] (default: the command line's, 0.5 s); finite and > 0, a
-        step of 0 is refused (``OptionError``) as on the command line.
     group : str, optional
         The TDMS group holding the channels.
-    parallel_paths : int, optional
-        Parallel paths of each phase of the winding, 1..8 (1, the default; 2 for a double star):
-        the shorted-turn level is sized with one path's resistance.
-    turn_calibration : path or dict, optional
-        A calibration of the shorted-turn level learned from labelled runs of the same
-        motor (the JSON of ``sim-host diagnose --turn-calibration``): the level is read from
-        it instead of the model (``.shorted_turns["basis"]`` says which).
-
+    {options}
     Returns
     -------
     DiagnoseResult
@@ -259,7 +216,6 @@ def diagnose(
     ParamsError, LogError, OptionError, AnalysisError
     """
     p, is_text = _params(params)
-    window = _commission(commission)
     base = _items(baseline)
     data, origin = _log(log)
     doc = _native.diagnose(
@@ -267,27 +223,33 @@ def diagnose(
         p,
         log_origin=origin,
         params_is_text=is_text,
-        commission=window,
         baseline=[_log(b) for b in base],
-        load=load,
-        angle=angle,
-        residuals=residuals,
-        allow_incomplete=allow_incomplete,
-        timeline_step=None if timeline_step is None else float(timeline_step),
         group=group,
-        parallel_paths=None if parallel_paths is None else int(parallel_paths),
-        turn_calibration=_calibration_text(turn_calibration),
+        **options,
     )
     return DiagnoseResult(_json.loads(doc))
 
 
-def _calibration_text(cal: _Optional[_Union[str, _Dict[str, _Any]]]) -> _Optional[str]:
-    """A shorted-turn calibration as its JSON text: a dict as it is, a path read."""
-    if cal is None:
-        return None
-    if isinstance(cal, dict):
-        return _json.dumps(cal)
-    return _Path(cal).read_text()
+def _with_options(f: _Any, described: _List[_Tuple[str, str, str, str]]) -> _Any:
+    """``f`` with the options of the library's one description (``_native.diagnose_options``:
+    name, annotation, default, doc) in its signature, as keyword-only parameters in place of
+    ``**options``, and in its docstring's parameters (where ``{options}`` stands)."""
+    sig = _inspect.signature(f)
+    kept = [p for p in sig.parameters.values() if p.kind is not p.VAR_KEYWORD]
+    named = [
+        _inspect.Parameter(name, _inspect.Parameter.KEYWORD_ONLY, default=_ast.literal_eval(default), annotation=ann)
+        for name, ann, default, _doc in described
+    ]
+    f.__signature__ = sig.replace(parameters=kept + named)
+    lines = []
+    for name, ann, default, doc in described:
+        lines.append(f"{name} : {ann}, default {default}")
+        lines.extend("    " + w for w in _textwrap.wrap(doc, 80))
+    f.__doc__ = (f.__doc__ or "").replace("{options}", "\n    ".join(lines) + "\n")
+    return f
+
+
+_with_options(diagnose, _native.diagnose_options())
 
 
 def _items(value: _Any) -> _List[_Any]:

@@ -18,17 +18,11 @@ def diagnose(
     params: str,
     log_origin: Optional[str] = ...,
     params_is_text: bool = ...,
-    commission: Optional[Union[Tuple[float, float], str]] = ...,
     baseline: List[Tuple[Any, Optional[str]]] = ...,
-    load: Optional[str] = ...,
-    angle: Optional[str] = ...,
-    residuals: Optional[str] = ...,
-    allow_incomplete: bool = ...,
-    timeline_step: Optional[float] = ...,
     group: Optional[str] = ...,
-    parallel_paths: Optional[int] = ...,
-    turn_calibration: Optional[str] = ...,
+    **options: Any,
 ) -> str: ...
+def diagnose_options() -> List[Tuple[str, str, str, str]]: ...
 def compare(
     log: Any,
     params: str,

@@ -9,10 +9,12 @@
 //! an `InternalError`); errors are the exception classes below, carrying the command line's
 //! one-line message.
 
+use monitor_api::replay::{self, OptionSpec, OptionValue, Takes, DIAGNOSE_OPTIONS};
 use monitor_api::{self as api, ApiError, ErrorKind, LogSource, ParamsSource};
 use pyo3::create_exception;
-use pyo3::exceptions::PyException;
+use pyo3::exceptions::{PyException, PyTypeError};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use std::path::PathBuf;
 
 mod arrow_in;
@@ -154,37 +156,6 @@ fn json<T: serde::Serialize>(v: &T) -> PyResult<String> {
     serde_json::to_string(v).map_err(|e| InternalError::new_err(e.to_string()))
 }
 
-fn load_of(name: &str) -> PyResult<monitor_api::replay::LoadModel> {
-    match name {
-        "unknown" => Ok(monitor_api::replay::LoadModel::Unknown),
-        "viscous" => Ok(monitor_api::replay::LoadModel::Viscous),
-        other => Err(OptionError::new_err(format!(
-            "load = '{other}': give 'unknown' or 'viscous'"
-        ))),
-    }
-}
-
-fn angle_of(name: &str) -> PyResult<monitor_core::AngleSource> {
-    match name {
-        "rotor-flux" => Ok(monitor_core::AngleSource::RotorFluxCurrentModel),
-        "pll" => Ok(monitor_core::AngleSource::Pll),
-        "zero-crossing" => Ok(monitor_core::AngleSource::ZeroCrossing),
-        other => Err(OptionError::new_err(format!(
-            "angle = '{other}': give 'rotor-flux', 'pll' or 'zero-crossing'"
-        ))),
-    }
-}
-
-fn residuals_of(name: &str) -> PyResult<monitor_core::ResidualForm> {
-    match name {
-        "steady" => Ok(monitor_core::ResidualForm::Steady),
-        "full" => Ok(monitor_core::ResidualForm::Full),
-        other => Err(OptionError::new_err(format!(
-            "residuals = '{other}': give 'steady' or 'full'"
-        ))),
-    }
-}
-
 fn effects_of(names: &[String]) -> PyResult<Vec<monitor_core::EffectKind>> {
     names
         .iter()
@@ -198,74 +169,103 @@ fn effects_of(names: &[String]) -> PyResult<Vec<monitor_core::EffectKind>> {
         .collect()
 }
 
-/// A commissioning window as Python gives it: `"START:END"` or `(start_s, end_s)`.
-#[derive(FromPyObject)]
-enum CommissionArg {
-    /// `"START:END"` [s].
-    Text(String),
-    /// `(start_s, end_s)` [s].
-    Pair(f64, f64),
-}
-
-impl CommissionArg {
-    /// The window, by the library's one parser and check.
-    fn window(&self) -> Result<monitor_api::replay::CommissionWindow, ApiError> {
-        Ok(match self {
-            CommissionArg::Text(s) => s.parse()?,
-            CommissionArg::Pair(a, b) => monitor_api::replay::CommissionWindow::new(*a, *b)?,
-        })
-    }
-}
-
-/// The request's replay options from Python's keywords (an option not given keeps the one
-/// default, `ReplayOptions::default`, the command line's too).
-#[allow(clippy::too_many_arguments)]
-fn replay_options(
-    commission: Option<CommissionArg>,
-    load: Option<&str>,
-    angle: Option<&str>,
-    residuals: Option<&str>,
-    allow_incomplete: bool,
-    timeline_step: Option<f64>,
-    parallel_paths: Option<i64>,
-    turn_calibration: Option<String>,
-) -> PyResult<monitor_api::replay::ReplayOptions> {
-    let d = monitor_api::replay::ReplayOptions::default();
-    // A calibration as its JSON text (`monitor_api::replay::TurnCalibration`).
-    let calibration = turn_calibration
-        .map(|t| serde_json::from_str::<monitor_api::replay::TurnCalibration>(&t))
-        .transpose()
-        .map_err(|e| OptionError::new_err(format!("turn_calibration: not a calibration: {e}")))?;
-    let parallel_paths = match parallel_paths {
-        None => d.turn_level.parallel_paths,
-        Some(n) => monitor_api::replay::ParallelPaths::new(n).map_err(|e| to_py(e.into()))?,
-    };
-    Ok(monitor_api::replay::ReplayOptions {
-        commission: commission.map(|c| c.window()).transpose().map_err(to_py)?,
-        allow_incomplete,
-        load: load.map(load_of).transpose()?.unwrap_or(d.load),
-        angle_source: angle.map(angle_of).transpose()?.unwrap_or(d.angle_source),
-        residual_form: residuals
-            .map(residuals_of)
-            .transpose()?
-            .unwrap_or(d.residual_form),
-        timeline_step: timeline_step
-            .map(monitor_api::replay::TimelineStep::new)
-            .transpose()
-            .map_err(|e| to_py(e.into()))?
-            .unwrap_or(d.timeline_step),
-        unbalance_baseline: None,
-        turn_level: monitor_api::replay::TurnLevelOptions {
-            parallel_paths,
-            calibration: calibration.or(d.turn_level.calibration),
-        },
-        words: PY,
+/// A keyword's value as the option of `spec` takes it ([`Takes`]): a window as
+/// `"START:END"` or a pair of numbers, a name, a number, a whole number, a flag, or a JSON
+/// file as its path or its dict (read here); refused in the option's words otherwise.
+fn option_value(spec: &OptionSpec, v: &Bound<'_, PyAny>) -> PyResult<OptionValue> {
+    let shown = v.repr().map_or_else(|_| "?".to_string(), |r| r.to_string());
+    let bad = |why: &str| to_py(replay::OptionError::new(spec.field, shown.clone(), why).into());
+    Ok(match spec.takes {
+        Takes::Window => {
+            if let Ok(s) = v.extract::<String>() {
+                return Ok(OptionValue::Text(s));
+            }
+            let how =
+                "give (start_s, end_s) or 'START:END' in seconds, e.g. (1.5, 2.4) or '1.5:2.4'";
+            let pair: Vec<Bound<'_, PyAny>> = v.extract().map_err(|_| bad(how))?;
+            let [a, b] = pair.as_slice() else {
+                return Err(bad(&format!("two values, the start and the end; {how}")));
+            };
+            match (a.extract::<f64>(), b.extract::<f64>()) {
+                (Ok(a), Ok(b)) => OptionValue::Pair(a, b),
+                _ => return Err(bad(&format!("not numbers; {how}"))),
+            }
+        }
+        Takes::Choice(names) => OptionValue::Text(
+            v.extract()
+                .map_err(|_| bad(&format!("give one of {}", names.join(", "))))?,
+        ),
+        Takes::Seconds => OptionValue::Number(v.extract().map_err(|_| bad("give seconds"))?),
+        Takes::Count => OptionValue::Whole(v.extract().map_err(|_| bad("give a whole number"))?),
+        Takes::Flag => OptionValue::Flag(v.extract().map_err(|_| bad("give True or False"))?),
+        Takes::JsonFile => {
+            if v.is_instance_of::<PyDict>() {
+                let text = v.py().import("json")?.call_method1("dumps", (v,))?;
+                OptionValue::Text(text.extract()?)
+            } else {
+                let path: PathBuf = v.extract().map_err(|_| bad("give a path or a dict"))?;
+                let text = std::fs::read_to_string(&path)
+                    .map_err(|e| bad(&format!("cannot read {}: {e}", path.display())))?;
+                OptionValue::Text(text)
+            }
+        }
     })
 }
 
-/// `diagnose --json` of the log at `log` with the parameter file `params`.
+/// The request's replay options from Python's keywords, each by the library's one
+/// description ([`DIAGNOSE_OPTIONS`], [`ReplayOptions::set`](replay::ReplayOptions::set)):
+/// an option not given, or given as `None`, keeps the one default
+/// (`ReplayOptions::default`, the command line's too).
+fn replay_options(options: Option<&Bound<'_, PyDict>>) -> PyResult<replay::ReplayOptions> {
+    let mut opts = replay::ReplayOptions {
+        words: PY,
+        ..replay::ReplayOptions::default()
+    };
+    for (k, v) in options.into_iter().flat_map(|d| d.iter()) {
+        let name: String = k.extract()?;
+        let Some(spec) = DIAGNOSE_OPTIONS.iter().find(|s| s.field.name() == name) else {
+            return Err(PyTypeError::new_err(format!(
+                "diagnose() got an unexpected keyword argument '{name}'"
+            )));
+        };
+        if !v.is_none() {
+            let value = option_value(spec, &v)?;
+            opts.set(spec.field, value).map_err(|e| to_py(e.into()))?;
+        }
+    }
+    Ok(opts)
+}
+
+/// The options `diagnose` takes by name, from the library's one description
+/// ([`DIAGNOSE_OPTIONS`]): `(name, annotation, default, doc)` each, in order; the package
+/// builds `drive_monitor.diagnose`'s signature and docs from them.
 #[pyfunction]
-#[pyo3(signature = (log, params, log_origin=None, params_is_text=false, commission=None, baseline=Vec::new(), load=None, angle=None, residuals=None, allow_incomplete=false, timeline_step=None, group=None, parallel_paths=None, turn_calibration=None))]
+fn diagnose_options() -> Vec<(String, String, String, String)> {
+    DIAGNOSE_OPTIONS
+        .iter()
+        .map(|s| {
+            let annotation = match s.takes {
+                Takes::Window => "Optional[Union[Tuple[float, float], str]]",
+                Takes::Choice(_) => "Optional[str]",
+                Takes::Seconds => "Optional[float]",
+                Takes::Count => "Optional[int]",
+                Takes::Flag => "bool",
+                Takes::JsonFile => "Optional[Union[str, os.PathLike, Dict[str, Any]]]",
+            };
+            (
+                s.field.name().to_string(),
+                annotation.to_string(),
+                s.default.to_string(),
+                s.doc.split_whitespace().collect::<Vec<_>>().join(" "),
+            )
+        })
+        .collect()
+}
+
+/// `diagnose --json` of the log at `log` with the parameter file `params`; its options by
+/// name (`**options`: [`diagnose_options`]).
+#[pyfunction]
+#[pyo3(signature = (log, params, log_origin=None, params_is_text=false, baseline=Vec::new(), group=None, **options))]
 #[allow(clippy::too_many_arguments)]
 fn diagnose(
     py: Python<'_>,
@@ -273,28 +273,12 @@ fn diagnose(
     params: String,
     log_origin: Option<String>,
     params_is_text: bool,
-    commission: Option<CommissionArg>,
     baseline: Vec<(Bound<'_, PyAny>, Option<String>)>,
-    load: Option<&str>,
-    angle: Option<&str>,
-    residuals: Option<&str>,
-    allow_incomplete: bool,
-    timeline_step: Option<f64>,
     group: Option<String>,
-    parallel_paths: Option<i64>,
-    turn_calibration: Option<String>,
+    options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<String> {
     let req = api::DiagnoseRequest {
-        options: replay_options(
-            commission,
-            load,
-            angle,
-            residuals,
-            allow_incomplete,
-            timeline_step,
-            parallel_paths,
-            turn_calibration,
-        )?,
+        options: replay_options(options)?,
         baseline: baseline
             .iter()
             .map(|(b, origin)| log_source(b, origin.as_deref()))
@@ -528,6 +512,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("AnalysisError", py.get_type::<AnalysisError>())?;
     m.add("InternalError", py.get_type::<InternalError>())?;
     m.add_function(wrap_pyfunction!(diagnose, m)?)?;
+    m.add_function(wrap_pyfunction!(diagnose_options, m)?)?;
     m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add_function(wrap_pyfunction!(explain, m)?)?;
     m.add_function(wrap_pyfunction!(identify, m)?)?;

@@ -14,7 +14,9 @@ PKG = Path(dm.__file__).resolve().parent
 def stub_functions():
     tree = ast.parse((PKG / "_native.pyi").read_text())
     return {
-        n.name: [a.arg for a in n.args.args] for n in tree.body if isinstance(n, ast.FunctionDef)
+        n.name: [a.arg for a in n.args.args] + ([n.args.kwarg.arg] if n.args.kwarg else [])
+        for n in tree.body
+        if isinstance(n, ast.FunctionDef)
     }
 
 
@@ -37,3 +39,18 @@ def test_the_package_is_annotated_in_place():
             assert sig.return_annotation is not inspect.Signature.empty, name
             for p in sig.parameters.values():
                 assert p.annotation is not inspect.Parameter.empty, (name, p.name)
+
+
+def test_diagnose_takes_every_described_option_by_name():
+    # One description (the library's DIAGNOSE_OPTIONS): the signature and the docs of
+    # drive_monitor.diagnose are made from it, so a new option needs no line here.
+    described = _native.diagnose_options()
+    names = [d[0] for d in described]
+    assert "commission" in names and "timeline_step" in names, names
+    sig = inspect.signature(dm.diagnose)
+    for name, annotation, default, doc in described:
+        p = sig.parameters[name]
+        assert p.kind is inspect.Parameter.KEYWORD_ONLY, name
+        assert p.annotation == annotation and doc, name
+        assert f"{name} : {annotation}" in dm.diagnose.__doc__, name
+    assert "{options}" not in dm.diagnose.__doc__

@@ -146,9 +146,9 @@ fn swapped(source: ParamsSource<'_>, log: &LogSource) -> Option<ApiError> {
 }
 
 /// What `diagnose` is asked: the replay's options and the few fields of a request alone.
-/// Every default is [`ReplayOptions`]'s (no baseline, no TDMS group); every front end (the
-/// command line, Python, the HMI, the fleet) checks a request with
-/// [`DiagnoseRequest::validate`] ([`diagnose`] does too).
+/// Every default is [`ReplayOptions`]'s (no baseline, no TDMS group); its options are valid
+/// by construction (each front end makes their typed values with the library's one
+/// constructor: `CommissionWindow`, `TimelineStep`, `ParallelPaths`).
 #[derive(Debug, Clone, Default)]
 pub struct DiagnoseRequest {
     /// The replay's options (the healthy reference, `unbalance_baseline`, is filled from
@@ -252,9 +252,8 @@ pub struct DiagnosePlan {
     pub options: ReplayOptions,
 }
 
-/// Resolves a `diagnose` request on `log`: reads the parameter file, checks the request
-/// ([`DiagnoseRequest::validate`]) and replays its `baseline` logs into the healthy
-/// reference; what [`diagnose`] then replays `log` with.
+/// Resolves a `diagnose` request on `log`: reads the parameter file and replays its
+/// `baseline` logs into the healthy reference; what [`diagnose`] then replays `log` with.
 ///
 /// # Errors
 /// A bad parameter file or option ([`ApiError`]), a baseline log that cannot be replayed

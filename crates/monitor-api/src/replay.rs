@@ -9,8 +9,8 @@ pub use monitor_replay::{
     angle_source_name, describe_against, diagnose_file, diagnose_file_observed, state_name,
     Against, CommissionWindow, CommissioningOutcome, CommissioningReport, DetectionLimit,
     DiagnoseReport, Diagnosed, FaultCandidate, FindingReport, IsolationEvent, IsolationName,
-    IsolationReport, LoadModel, OptionError, OptionField, Panel, ParallelPaths, Replay,
-    ReplayError, ReplayObserver, ReplayOptions, RotorBand, Spelling, TemperatureReport,
-    TimelinePoint, TimelineStep, TurnCalibration, TurnLevelOptions, UnbalanceReport, Verdict,
-    Words, MAX_EVENTS, MIN_FAULT_CHANGE,
+    IsolationReport, LoadModel, OptionError, OptionField, OptionSpec, OptionValue, Panel,
+    ParallelPaths, Replay, ReplayError, ReplayObserver, ReplayOptions, RotorBand, Spelling, Takes,
+    TemperatureReport, TimelinePoint, TimelineStep, TurnCalibration, TurnLevelOptions,
+    UnbalanceReport, Verdict, Words, DIAGNOSE_OPTIONS, MAX_EVENTS, MIN_FAULT_CHANGE,
 };

@@ -339,7 +339,7 @@ mod tests {
             temperature: false,
         };
         let commissioned = ReplayOptions {
-            commission: Some(crate::CommissionWindow::of(1.0, 2.5)),
+            commission: Some(crate::options::CommissionWindow::of(1.0, 2.5)),
             allow_incomplete: true,
             ..ReplayOptions::default()
         };

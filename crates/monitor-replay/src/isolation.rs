@@ -150,16 +150,17 @@ pub use monitor_core::isolation::NOMINAL_UNCERTAINTY;
 impl IsolationTracker {
     /// A tracker for the nominal machine (`None`: a machine the isolator rejects, then
     /// nothing is isolated and the report says so), of a log with a temperature column
-    /// (`temperature_column`) or without; `load`: what is known of the load.
+    /// (`temperature_column`) or without, as `opts` ask (what is known of the load, the
+    /// words of its sentences).
     /// `chunk_rows`: the most rows whose points are handed on together (the core's block of
     /// `decimation` samples, [`chunk`]; at least 1).
     pub(crate) fn new(
         isolator: Option<Isolator>,
         temperature_column: bool,
-        load: super::options::LoadModel,
-        words: super::words::Words,
+        opts: &super::options::ReplayOptions,
         (dt_s, chunk_rows): (f64, u32),
     ) -> Self {
+        let (load, words) = (opts.load, opts.words);
         let isolator = isolator.map(|mut i| {
             i.set_load_unknown(load == super::options::LoadModel::Unknown);
             i

@@ -89,4 +89,7 @@ pub use winding::{
     NO_BASELINE_SPREAD, NO_BASELINE_SPREAD_VOLTAGES, WINDING_FAULT_PROBABILITY, WITHIN_LOG_SPREAD,
 };
 pub use windows::{SensorPhaseReport, SequenceWindow, WINDOW_PERIODS};
-pub use words::{FieldNames, OptionError, OptionField, Spelling, Words};
+pub use words::{
+    FieldNames, OptionError, OptionField, OptionSpec, OptionValue, Spelling, Takes, Words,
+    DIAGNOSE_OPTIONS,
+};

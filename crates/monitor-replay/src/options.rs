@@ -8,7 +8,7 @@
 
 use super::baseline::HealthyReference;
 use super::sampler::TICK_HZ;
-pub use super::words::{OptionError, OptionField, Spelling, Words};
+pub use super::words::{OptionError, OptionField, OptionValue, Spelling, Words};
 use crate::turn_calibration::TurnCalibration;
 use monitor_core::{AngleSource, MonitorConfig, ResidualForm};
 use monitor_io::params::ParamFile;
@@ -150,6 +150,62 @@ pub fn monitor_config_for_log(
     cfg.limits.i_max = limits.i_max_a;
     cfg.limits.max_speed_rad_s = limits.wm_max_rad_s;
     cfg
+}
+
+impl ReplayOptions {
+    /// Sets the option `field` from `value` as a front end hands it by name
+    /// ([`crate::DIAGNOSE_OPTIONS`]), each value checked by its type's one constructor.
+    ///
+    /// # Errors
+    /// [`OptionError`] naming the field, for a value it does not take (or a field that is
+    /// no option of `diagnose`).
+    pub fn set(&mut self, field: OptionField, value: OptionValue) -> Result<(), OptionError> {
+        let bad = |why: &str| OptionError::new(field, value.shown(), why);
+        match (field, &value) {
+            (OptionField::Commission, OptionValue::Text(s)) => self.commission = Some(s.parse()?),
+            (OptionField::Commission, OptionValue::Pair(a, b)) => {
+                self.commission = Some(CommissionWindow::new(*a, *b)?);
+            }
+            (OptionField::AllowIncomplete, OptionValue::Flag(b)) => self.allow_incomplete = *b,
+            (OptionField::Load, OptionValue::Text(s)) => {
+                self.load = match s.as_str() {
+                    "unknown" => LoadModel::Unknown,
+                    "viscous" => LoadModel::Viscous,
+                    _ => return Err(bad("give 'unknown' or 'viscous'")),
+                };
+            }
+            (OptionField::Angle, OptionValue::Text(s)) => {
+                self.angle_source = [
+                    AngleSource::RotorFluxCurrentModel,
+                    AngleSource::Pll,
+                    AngleSource::ZeroCrossing,
+                ]
+                .into_iter()
+                .find(|a| angle_source_name(*a) == s)
+                .ok_or_else(|| bad("give 'rotor-flux', 'pll' or 'zero-crossing'"))?;
+            }
+            (OptionField::Residuals, OptionValue::Text(s)) => {
+                self.residual_form = match s.as_str() {
+                    "steady" => ResidualForm::Steady,
+                    "full" => ResidualForm::Full,
+                    _ => return Err(bad("give 'steady' or 'full'")),
+                };
+            }
+            (OptionField::TimelineStep, OptionValue::Number(x)) => {
+                self.timeline_step = TimelineStep::new(*x)?;
+            }
+            (OptionField::ParallelPaths, OptionValue::Whole(n)) => {
+                self.turn_level.parallel_paths = ParallelPaths::new(*n)?;
+            }
+            (OptionField::TurnCalibration, OptionValue::Text(json)) => {
+                let cal = serde_json::from_str::<TurnCalibration>(json)
+                    .map_err(|e| OptionError::new(field, "", format!("not a calibration: {e}")))?;
+                self.turn_level.calibration = Some(cal);
+            }
+            _ => return Err(bad("not a value this option takes")),
+        }
+        Ok(())
+    }
 }
 
 /// The parallel paths per phase a winding may have (the field `parallel_paths`): 1 for a
@@ -372,7 +428,50 @@ impl FromStr for TimelineStep {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::words::{Takes, DIAGNOSE_OPTIONS};
     use monitor_io::log::quality::CellLimits;
+
+    /// A value of the kind `takes` that is no option's default.
+    fn sample(takes: Takes) -> OptionValue {
+        match takes {
+            Takes::Window => OptionValue::Text("1:2".into()),
+            Takes::Choice(names) => OptionValue::Text(names.last().copied().unwrap_or("").into()),
+            Takes::Seconds => OptionValue::Number(0.25),
+            Takes::Count => OptionValue::Whole(2),
+            Takes::Flag => OptionValue::Flag(true),
+            Takes::JsonFile => {
+                let run = crate::turn_calibration::LabelledRun {
+                    phase: monitor_core::Phase::A,
+                    fraction: 0.05,
+                    loop_ratio: 0.02,
+                };
+                let cal = TurnCalibration::learn(&[run]).expect("one run"); // ok: test
+                OptionValue::Text(serde_json::to_string(&cal).expect("JSON")) // ok: test
+            }
+        }
+    }
+
+    #[test]
+    fn every_described_option_is_set_by_its_name() {
+        for spec in DIAGNOSE_OPTIONS {
+            let mut opts = ReplayOptions::default();
+            opts.set(spec.field, sample(spec.takes))
+                .unwrap_or_else(|e| panic!("{}: {e}", spec.field)); // ok: test
+            assert_ne!(opts, ReplayOptions::default(), "{} set nothing", spec.field);
+        }
+        // A value of another kind, or a field that is no option, is refused by name.
+        let mut opts = ReplayOptions::default();
+        let e = opts.set(OptionField::TimelineStep, OptionValue::Text("x".into()));
+        assert_eq!(e.map_err(|e| e.field), Err(OptionField::TimelineStep));
+        assert!(opts
+            .set(OptionField::Params, OptionValue::Flag(true))
+            .is_err());
+        let e = opts.set(OptionField::Load, OptionValue::Text("heavy".into()));
+        assert_eq!(
+            e.map_err(|e| e.to_string()),
+            Err("load = heavy: give 'unknown' or 'viscous'".to_string())
+        );
+    }
 
     #[test]
     fn the_monitor_and_the_quality_stage_judge_a_log_by_the_same_limits() {

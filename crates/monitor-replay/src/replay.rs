@@ -93,21 +93,14 @@ impl Replay {
             params.supply.f_hz as f32,
         );
         Ok(Replay {
-            winding: WindingStage::new(
-                params,
-                lamps.monitor().is_some(),
-                opts.unbalance_baseline,
-                opts.turn_level,
-                opts.words,
-            ),
+            winding: WindingStage::new(params, lamps.monitor().is_some(), &opts),
             isolation: IsolationTracker::new(
                 isolator.ok(),
                 channels.temperature,
-                opts.load,
-                opts.words,
+                &opts,
                 (clock.dt_s(), u32::from(cfg.decimation)),
             ),
-            timeline: TimelineStage::new(clock.dt_s(), opts.timeline_step.seconds()),
+            timeline: TimelineStage::new(clock.dt_s(), &opts),
             rotor: RotorStage::new(params),
             sequences: SequenceStage::new(front),
             lamps,

@@ -6,6 +6,7 @@
 //! it ([`TimelineInput`]); at the end it gives its points.
 
 use crate::isolation::{FaultCandidate, IsolationReport};
+use crate::options::ReplayOptions;
 use crate::stage::{Finish, Stage};
 use monitor_core::{CommissioningState, Fault, MonitorOutput};
 use monitor_io::log::Row;
@@ -153,14 +154,15 @@ pub(crate) struct TimelineInput<'a> {
 }
 
 impl TimelineStage {
-    /// A timeline of a log sampled every `dt_s` [s], one point every `step_s` [s].
-    pub(crate) fn new(dt_s: f64, step_s: f64) -> Self {
+    /// A timeline of a log sampled every `dt_s` [s], as `opts` ask (one point every
+    /// `timeline_step`).
+    pub(crate) fn new(dt_s: f64, opts: &ReplayOptions) -> Self {
         TimelineStage {
             points: Vec::new(),
             next_point: 0.0,
             was_learning: false,
             dt_s,
-            step_s,
+            step_s: opts.timeline_step.seconds(),
             since_moved: false,
         }
     }

@@ -133,8 +133,8 @@ pub struct ReplayArgs {
 
 impl ReplayArgs {
     /// The library's request for these options (the rest, `allow_incomplete` and
-    /// `timeline_step`, at their defaults), its report in the command line's words,
-    /// checked as every front end checks one (`DiagnoseRequest::validate`).
+    /// `timeline_step`, at their defaults), its report in the command line's words (each
+    /// value checked once, by its parser, `super::words`).
     ///
     /// # Errors
     /// A `--turn-calibration` file that cannot be read; a request the library refuses.
@@ -260,4 +260,28 @@ fn read_calibration(f: &std::path::Path) -> anyhow::Result<monitor_api::replay::
         .map_err(|e| anyhow::anyhow!("--turn-calibration {}: {e}", f.display()))?;
     serde_json::from_str(&text)
         .map_err(|e| anyhow::anyhow!("--turn-calibration {}: not a calibration: {e}", f.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory;
+
+    /// Every option the library describes by name (`DIAGNOSE_OPTIONS`, Python's keywords)
+    /// is a flag of `diagnose` here, spelled as the command line spells its field.
+    #[test]
+    fn every_described_option_is_a_flag() {
+        let cli = super::super::Cli::command();
+        let diagnose = cli.find_subcommand("diagnose").expect("diagnose"); // ok: test
+        let flags: Vec<&str> = diagnose
+            .get_arguments()
+            .filter_map(|a| a.get_long())
+            .collect();
+        for spec in monitor_api::replay::DIAGNOSE_OPTIONS {
+            let flag = spec.field.name().replace('_', "-");
+            assert!(
+                flags.contains(&flag.as_str()),
+                "--{flag} is not a flag of diagnose"
+            );
+        }
+    }
 }

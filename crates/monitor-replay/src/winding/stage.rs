@@ -6,6 +6,7 @@
 use super::judgement::unbalance_report;
 use super::level::TurnLevelOptions;
 use super::{HealthyReference, UnbalanceReport};
+use crate::options::ReplayOptions;
 use crate::stage::{Finish, Stage};
 use crate::windows::{SequenceWindow, WindowRow};
 use crate::words::Words;
@@ -92,22 +93,17 @@ pub(crate) struct WindingClosing {
 }
 
 impl WindingStage {
-    /// The stage for `params`' machine (`speed`: the log has a speed for the monitor),
-    /// judged against `baseline` where given, the level with `level`, its advice in `words`.
-    pub(crate) fn new(
-        params: &ParamFile,
-        speed: bool,
-        baseline: Option<HealthyReference>,
-        level: TurnLevelOptions,
-        words: Words,
-    ) -> Self {
+    /// The stage for `params`' machine (`speed`: the log has a speed for the monitor), as
+    /// `opts` ask: judged against their healthy baseline where given, the level with their
+    /// turn level, its advice in their words.
+    pub(crate) fn new(params: &ParamFile, speed: bool, opts: &ReplayOptions) -> Self {
         WindingStage {
             book: WindowBook::new(),
             params: *params,
             speed,
-            baseline,
-            level,
-            words,
+            baseline: opts.unbalance_baseline,
+            level: opts.turn_level,
+            words: opts.words,
         }
     }
 
