@@ -129,9 +129,8 @@ pub fn watch_mismatched(
         allow_incomplete: false,
         timeline_step: const { monitor_replay::TimelineStep::of(1.0) },
         unbalance_baseline: None,
-        turn_level: Default::default(),
         load: monitor_replay::LoadModel::Unknown,
-        words: monitor_replay::Words::LIBRARY,
+        ..ReplayOptions::default()
     };
     let mut w = ServiceWatch::default();
     let dt = 1.0 / sc.sample_rate_hz;
