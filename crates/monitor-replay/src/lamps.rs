@@ -11,15 +11,16 @@
 //! before (the winding's windows take the learning and the speed from it). At the end
 //! ([`Finish::finish`]) it gives [`LampsFinding`].
 
+pub(crate) mod commission;
 mod step;
 mod unsettled;
 
 pub use step::Detection;
 
-use crate::commission::CommissionTracker;
 use crate::options::{LoadModel, ReplayOptions};
 use crate::sampler::{sample_of, LogSampler, CLOCK_RESET_GAP_S, COUNTS_PER_REV};
 use crate::stage::{Finish, LampsSeen, RowFlags, Stage};
+use commission::CommissionTracker;
 use monitor_core::{AngleSource, ConfigError, Monitor, MonitorConfig, MonitorOutput};
 use monitor_io::log::{Channels, Row};
 pub(crate) use step::LastOutput;

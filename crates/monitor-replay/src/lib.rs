@@ -22,7 +22,6 @@
 //! `data_quality`; what commissioning did is its `commissioning` ([`commission`]).
 
 mod baseline;
-mod commission;
 mod diagnose;
 mod error;
 mod events;
@@ -55,16 +54,16 @@ pub use sequences::FILLED_SAMPLES;
 pub use verdict::{MIN_FAULT_CHANGE, MIN_JUDGED_S};
 pub use windows::SENSOR_PHASE_MIN_RATIO;
 
-pub use commission::{
-    grace_s, min_learned_s, CommissioningOutcome, CommissioningReport, QuasiSteadyPoint, RangeNote,
-    MIN_LEARNED_S,
-};
 pub use diagnose::{diagnose_file, diagnose_file_observed, diagnose_log, diagnose_rows, Diagnosed};
 pub use events::{IsolationEvent, LOAD_MOVE_FRACTION, MAX_EVENTS};
 pub use isolation::serialize_state;
 pub use isolation::{
     state_name, DetectionLimit, FaultCandidate, IsolationBaseline, IsolationGroup, IsolationName,
     IsolationReport, NameGiven, ResistanceReading, NOMINAL_UNCERTAINTY,
+};
+pub use lamps::commission::{
+    grace_s, min_learned_s, CommissioningOutcome, CommissioningReport, QuasiSteadyPoint, RangeNote,
+    MIN_LEARNED_S,
 };
 pub use lamps::Detection;
 pub use options::{

@@ -2,8 +2,8 @@
 //! timeline, and the verdict decided once from the findings ([`DiagnoseReport::conclude`]),
 //! built by [`crate::Replay::finish`].
 
-use crate::commission::CommissioningReport;
 use crate::isolation::{FaultCandidate, IsolationFinding, IsolationReport};
+use crate::lamps::commission::CommissioningReport;
 use crate::lamps::{Detection, LampsFinding};
 use crate::options::{serialize_angle_source, CommissionWindow};
 use crate::rotor::RotorReport;

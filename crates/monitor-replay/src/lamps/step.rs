@@ -1,7 +1,7 @@
 //! The lamps' per-row steps after the monitor's output ([`super::LampStage::update`]): each
 //! reads the output by reference and updates the fields it is given.
 
-use crate::commission::CommissionTracker;
+use super::commission::CommissionTracker;
 use crate::stage::RowFlags;
 use monitor_core::{Fault, Monitor, MonitorOutput, FAULT_COUNT};
 use serde::{Serialize, Serializer};

@@ -53,9 +53,9 @@ pub const INSIDE: &[Inside] = &[
     ),
     // The replay as a chain of stages of one shape (`stage`), from the facts a row needs up
     // to `diagnose`, the front door: the stage trait, the sample clock, the windows the
-    // sequence stage hands on, the baseline at the bottom; the options, the commissioning
-    // tracker, the events; the rotor's demodulator, which runs inside the sequence stage;
-    // the stages side by side (no stage uses another: same layer); the timeline and the
+    // sequence stage hands on, the baseline at the bottom; the options, the events, the
+    // rotor's demodulator, which runs inside the sequence stage; the stages side by side
+    // (no stage uses another: same layer; the commissioning tracker is the lamps' own); the timeline and the
     // findings with the one verdict; the report and the data-quality stage's end; the
     // replay that holds the chain; `diagnose` (the reading thread's pipe, the data-quality
     // hand-over) on top.
@@ -63,20 +63,19 @@ pub const INSIDE: &[Inside] = &[
         "crates/monitor-replay/src/",
         &[
             ("events", 2),
-            ("commission", 3),
             ("error", 2),
             ("options", 2),
-            ("rotor", 3),
-            ("sequences", 4),
-            ("lamps", 4),
-            ("winding", 4),
-            ("isolation", 4),
-            ("timeline", 5),
-            ("verdict", 5),
-            ("report", 6),
-            ("quality", 6),
-            ("replay", 7),
-            ("diagnose", 8),
+            ("rotor", 2),
+            ("sequences", 3),
+            ("lamps", 3),
+            ("winding", 3),
+            ("isolation", 3),
+            ("timeline", 4),
+            ("verdict", 4),
+            ("report", 5),
+            ("quality", 5),
+            ("replay", 6),
+            ("diagnose", 7),
         ],
     ),
     // The fleet run over the one-call API.
