@@ -200,7 +200,7 @@ pub enum Takes {
 /// One option of `diagnose` by name: the field (its name is Python's keyword; the command
 /// line's flag is the name in kebab case), what it takes, its default as a front end shows
 /// it, and its documentation (one paragraph). The command line writes its flag by hand,
-/// beside this (a test holds the two together, `sim-host/src/cli/diagnose.rs`).
+/// beside this (a test holds the two together, `sim-host/src/cli/mod.rs`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct OptionSpec {
     /// The field.

@@ -70,14 +70,14 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     };
     if args.json {
         render::json::print(
-            &mut crate::cli::stdout(),
+            &mut crate::cli::out::stdout(),
             &render::json::BenchReport {
                 figures: &figures,
                 detection_limits: limits.as_deref(),
             },
         )
     } else {
-        render::bench_text::bench(&mut crate::cli::stdout(), &figures, limits.as_deref())
+        render::bench_text::bench(&mut crate::cli::out::stdout(), &figures, limits.as_deref())
     }
 }
 
@@ -101,8 +101,8 @@ fn run_isolation(args: &BenchArgs) -> anyhow::Result<()> {
         eprintln!("wrote {}", path.display());
     }
     if args.json {
-        render::json::print(&mut crate::cli::stdout(), &result)
+        render::json::print(&mut crate::cli::out::stdout(), &result)
     } else {
-        render::bench_text::isolation_bench(&mut crate::cli::stdout(), &result)
+        render::bench_text::isolation_bench(&mut crate::cli::out::stdout(), &result)
     }
 }

@@ -83,7 +83,7 @@ pub fn run(args: &BoardRecordArgs) -> anyhow::Result<()> {
     }
     monitor_api::files::write_atomic(&args.out, &bytes)
         .with_context(|| format!("writing {}", args.out.display()))?;
-    let mut stdout = super::stdout();
+    let mut stdout = super::out::stdout();
     if args.json {
         let doc = serde_json::json!({
             "out": args.out.display().to_string(),

@@ -26,7 +26,7 @@ pub struct Common {
     #[arg(long, value_name = "NAME")]
     pub group: Option<String>,
     /// Effects already in the model, comma separated (e.g. `thermal_drift,load_torque`).
-    #[arg(long, value_delimiter = ',', value_parser = super::parse_effect)]
+    #[arg(long, value_delimiter = ',', value_parser = super::args::parse_effect)]
     pub effects: Vec<EffectKind>,
     /// Print one JSON document on stdout instead of the table.
     #[arg(long)]
@@ -39,10 +39,10 @@ pub struct Common {
     #[arg(long, value_name = "DIR")]
     pub report: Option<PathBuf>,
     /// Analyse from this time on [s] (e.g. to leave a start-up out).
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = super::parse_seconds)]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = super::args::parse_seconds)]
     pub from: Option<f64>,
     /// Analyse up to this time [s].
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = super::parse_positive_seconds)]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = super::args::parse_positive_seconds)]
     pub to: Option<f64>,
     /// Keep the nominal base parameters (do not refit Ra, Ls, B+Bl, J).
     #[arg(long)]
@@ -249,9 +249,9 @@ pub fn run_compare(args: &CompareArgs) -> anyhow::Result<()> {
     let out = a.compare(&c.options())?;
     render::html::write_compare(c.plot.as_deref(), c.report.as_deref(), &c.log, &a, &out)?;
     if c.json {
-        render::json::print(&mut crate::cli::stdout(), &out.report)
+        render::json::print(&mut crate::cli::out::stdout(), &out.report)
     } else {
-        render::text::compare(&mut crate::cli::stdout(), &c.log, &out.report)
+        render::text::compare(&mut crate::cli::out::stdout(), &c.log, &out.report)
     }
 }
 
@@ -277,7 +277,7 @@ fn explain_here(
     let compared = if args.compare {
         let out = a.compare(&opts)?;
         if !c.json {
-            render::text::compare(&mut crate::cli::stdout(), &c.log, &out.report)?;
+            render::text::compare(&mut crate::cli::out::stdout(), &c.log, &out.report)?;
         }
         Some(out.report)
     } else {
@@ -344,14 +344,14 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
     )?;
     match (c.json, compared) {
         (true, Some(cmp)) => render::json::print(
-            &mut crate::cli::stdout(),
+            &mut crate::cli::out::stdout(),
             &render::json::ExplainWithCompare {
                 compare: &cmp,
                 explain: &doc,
             },
         ),
-        (true, None) => render::json::print(&mut crate::cli::stdout(), &doc),
-        (false, _) => render::text::explain(&mut crate::cli::stdout(), &c.log, &doc),
+        (true, None) => render::json::print(&mut crate::cli::out::stdout(), &doc),
+        (false, _) => render::text::explain(&mut crate::cli::out::stdout(), &c.log, &doc),
     }
 }
 
@@ -376,8 +376,8 @@ fn run_ladder(c: &Common) -> anyhow::Result<()> {
     pb.finish();
     render::html::write_ladder(c.plot.as_deref(), c.report.as_deref(), &c.log, &report)?;
     if c.json {
-        render::json::print(&mut crate::cli::stdout(), &report)
+        render::json::print(&mut crate::cli::out::stdout(), &report)
     } else {
-        render::text::ladder(&mut crate::cli::stdout(), &c.log, &report)
+        render::text::ladder(&mut crate::cli::out::stdout(), &c.log, &report)
     }
 }

@@ -7,9 +7,10 @@
 //! SIGINT/SIGTERM remove the temporary file (exit status 130 / 143). A progress bar goes to
 //! stderr for inputs above 20 MB when it is a terminal.
 
+use super::out::Interruption;
 use super::output_guard::OutputGuard;
 use super::render::json::Converted;
-use super::{progress, render, Interruption};
+use super::{progress, render};
 use clap::Args;
 use monitor_api::files::{Format, LogFile, LogWriter, OpenOptions, Row, RowSink};
 use std::path::PathBuf;
@@ -109,7 +110,7 @@ fn open_input(args: &ConvertArgs) -> anyhow::Result<LogFile> {
 ///
 /// # Errors
 /// An output that is the input, an unreadable or malformed input (one line naming the
-/// file, line and column), an I/O error writing the output, or [`super::Interrupted`].
+/// file, line and column), an I/O error writing the output, or [`super::out::Interrupted`].
 pub fn run(args: &ConvertArgs) -> anyhow::Result<()> {
     let file = open_input(args)?;
     let start = Instant::now();
@@ -155,8 +156,8 @@ pub fn run(args: &ConvertArgs) -> anyhow::Result<()> {
         wall_s: start.elapsed().as_secs_f64(),
     };
     if args.json {
-        render::json::print(&mut crate::cli::stdout(), &done)
+        render::json::print(&mut crate::cli::out::stdout(), &done)
     } else {
-        render::text::convert(&mut crate::cli::stdout(), &done)
+        render::text::convert(&mut crate::cli::out::stdout(), &done)
     }
 }

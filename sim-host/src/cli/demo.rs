@@ -23,7 +23,7 @@ sim-host demo --paper"
 pub struct DemoArgs {
     /// Fault to inject: rs, rr, ls, lr, b, bl, current_sensor, voltage_sensor, speed_sensor
     /// (default: rs; with --paper: bl).
-    #[arg(long, value_parser = super::parse_fault)]
+    #[arg(long, value_parser = super::args::parse_fault)]
     pub fault: Option<Fault>,
     /// Relative change, -0.95..5 (0.5 = +50 %; sensor faults: gain error).
     #[arg(long, default_value_t = 0.5, allow_negative_numbers = true, value_parser = parse_change)]
@@ -67,8 +67,8 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     };
     let run = monitor_studies::demo::run(story)?;
     if args.json {
-        render::json::print(&mut crate::cli::stdout(), &render::json::demo(&run))
+        render::json::print(&mut crate::cli::out::stdout(), &render::json::demo(&run))
     } else {
-        render::text::demo(&mut crate::cli::stdout(), &run)
+        render::text::demo(&mut crate::cli::out::stdout(), &run)
     }
 }

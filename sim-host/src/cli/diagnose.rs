@@ -1,7 +1,8 @@
 //! `sim-host diagnose`: replay a log through the core ([`monitor_api::replay::diagnose_file`])
 //! and report lamps, candidates and the negative-sequence analysis.
 
-use super::{progress, render, AngleArg, LoadArg, ResidualArg};
+use super::args::{AngleArg, LoadArg, ResidualArg};
+use super::{progress, render};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -199,27 +200,27 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         render::diagnose_html::write(out, &args.log, &d)?;
     }
     if args.json {
-        render::json::print(&mut crate::cli::stdout(), &d.report)
+        render::json::print(&mut crate::cli::out::stdout(), &d.report)
     } else {
-        render::text::diagnose(&mut crate::cli::stdout(), &args.log, &d)
+        render::text::diagnose(&mut crate::cli::out::stdout(), &args.log, &d)
     }
 }
 
 /// The replay of `diagnose`, on a thread of its own, while this one watches for SIGINT and
-/// SIGTERM: a signal stops the command at once with [`super::Interrupted`] ("diagnose of
+/// SIGTERM: a signal stops the command at once with [`super::out::Interrupted`] ("diagnose of
 /// LOG stopped; nothing was written", status 130 or 143) instead of ending the process
 /// without a word. Nothing is printed before the replay ends, so nothing is half written;
 /// the replay's thread ends with the process.
 ///
 /// # Errors
-/// The replay's error, or [`super::Interrupted`].
+/// The replay's error, or [`super::out::Interrupted`].
 fn replay_until_signal(
     args: &DiagnoseArgs,
     req: monitor_api::DiagnoseRequest,
     bar: &indicatif::ProgressBar,
 ) -> anyhow::Result<monitor_api::replay::Diagnosed> {
     use std::sync::mpsc::{channel, RecvTimeoutError};
-    let interruption = super::Interruption::catch()?;
+    let interruption = super::out::Interruption::catch()?;
     let (params, log, worker_bar) = (args.params.clone(), args.log.clone(), bar.clone());
     let (tx, rx) = channel();
     std::thread::spawn(move || {
@@ -260,28 +261,4 @@ fn read_calibration(f: &std::path::Path) -> anyhow::Result<monitor_api::replay::
         .map_err(|e| anyhow::anyhow!("--turn-calibration {}: {e}", f.display()))?;
     serde_json::from_str(&text)
         .map_err(|e| anyhow::anyhow!("--turn-calibration {}: not a calibration: {e}", f.display()))
-}
-
-#[cfg(test)]
-mod tests {
-    use clap::CommandFactory;
-
-    /// Every option the library describes by name (`DIAGNOSE_OPTIONS`, Python's keywords)
-    /// is a flag of `diagnose` here, spelled as the command line spells its field.
-    #[test]
-    fn every_described_option_is_a_flag() {
-        let cli = super::super::Cli::command();
-        let diagnose = cli.find_subcommand("diagnose").expect("diagnose"); // ok: test
-        let flags: Vec<&str> = diagnose
-            .get_arguments()
-            .filter_map(|a| a.get_long())
-            .collect();
-        for spec in monitor_api::replay::DIAGNOSE_OPTIONS {
-            let flag = spec.field.name().replace('_', "-");
-            assert!(
-                flags.contains(&flag.as_str()),
-                "--{flag} is not a flag of diagnose"
-            );
-        }
-    }
 }

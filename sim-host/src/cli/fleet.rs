@@ -72,10 +72,10 @@ pub fn run(args: &FleetArgs) -> anyhow::Result<()> {
             .collect(),
     };
     if args.json {
-        return render::json::print(&mut crate::cli::stdout(), &rows);
+        return render::json::print(&mut crate::cli::out::stdout(), &rows);
     }
     // (The header comes from the rows' field names: monitor_api::fleet::COLUMNS.)
-    let mut w = csv::Writer::from_writer(super::stdout());
+    let mut w = csv::Writer::from_writer(super::out::stdout());
     for r in &rows {
         w.serialize(r)?;
     }

@@ -69,7 +69,7 @@ pub struct HmiArgs {
     #[arg(long, default_value_t = 1.0, value_parser = parse_every)]
     pub every: f64,
     /// Stop after this many seconds of wall-clock time (scripts, tests).
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = super::parse_positive_seconds)]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = super::args::parse_positive_seconds)]
     pub duration: Option<f64>,
 }
 
@@ -177,7 +177,7 @@ impl Drop for Restore {
 /// The full-screen HMI.
 fn screen(source: &mut dyn Source, deadline: Option<Instant>) -> anyhow::Result<()> {
     // SIGTERM (and SIGINT from outside: in raw mode Ctrl-C is a key) ends the loop cleanly.
-    let signals = super::Interruption::catch()?;
+    let signals = super::out::Interruption::catch()?;
     let mut terminal = ratatui::try_init().context("cannot set up the terminal")?;
     let _restore = Restore;
     let mut state = source.initial_state();
@@ -234,7 +234,7 @@ fn plain(
     fast: bool,
     deadline: Option<Instant>,
 ) -> anyhow::Result<()> {
-    let mut out = super::stdout();
+    let mut out = super::out::stdout();
     let mut state = source.initial_state();
     writeln!(out, "{}", state.title)?;
     let (mut printed, mut warnings) = (0u64, 0usize);

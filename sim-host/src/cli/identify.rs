@@ -67,10 +67,10 @@ pub struct IdentifyArgs {
     #[arg(long)]
     pub json: bool,
     /// Use the log from this time on [s].
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = super::parse_seconds)]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = super::args::parse_seconds)]
     pub from: Option<f64>,
     /// Use the log up to this time [s].
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = super::parse_seconds)]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = super::args::parse_seconds)]
     pub to: Option<f64>,
     /// The TDMS group holding the channels (when the log has several).
     #[arg(long, value_name = "NAME")]
@@ -114,8 +114,8 @@ pub fn run(args: &IdentifyArgs) -> anyhow::Result<()> {
         done.toml_without_columns()
     };
     let id = &done.identification;
-    super::write_out(args.out.as_deref(), toml.as_bytes())?;
-    let mut stdout = super::stdout();
+    super::out::write_out(args.out.as_deref(), toml.as_bytes())?;
+    let mut stdout = super::out::stdout();
     if args.json {
         let doc = serde_json::json!({
             "identification": id,

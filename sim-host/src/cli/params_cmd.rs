@@ -182,8 +182,8 @@ pub fn run_from_nameplate(args: &FromNameplateArgs) -> anyhow::Result<()> {
     }
     let (estimate, toml) =
         monitor_api::params_from_nameplate(&args.nameplate(), args.columns_from.as_deref())?;
-    super::write_out(args.out.as_deref(), toml.as_bytes())?;
-    let mut stdout = super::stdout();
+    super::out::write_out(args.out.as_deref(), toml.as_bytes())?;
+    let mut stdout = super::out::stdout();
     if args.json {
         let doc = monitor_api::nameplate_document(&estimate, &toml, args.out.as_deref());
         writeln!(stdout, "{}", serde_json::to_string_pretty(&doc)?)?;

@@ -9,8 +9,9 @@
 //! unless `--force`. A progress bar goes to stderr when it is a terminal and the run is
 //! expected to take more than [`PROGRESS_AFTER_S`].
 
+use super::out::Interruption;
 use super::output_guard::OutputGuard;
-use super::{progress, render, Interruption};
+use super::{progress, render};
 use clap::Args;
 use monitor_api::files::LogWriter;
 use monitor_api::files::ParamFile;
@@ -83,7 +84,7 @@ pub struct SimulateArgs {
 /// # Errors
 /// Unreadable or invalid inputs (one line naming the file and key), an output that is an
 /// input, a run too large without `--force`, an I/O error writing the output, or
-/// [`super::Interrupted`] after SIGINT/SIGTERM (the partial output removed).
+/// [`super::out::Interrupted`] after SIGINT/SIGTERM (the partial output removed).
 pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     OutputGuard::new(&[&args.params, &args.scenario]).check_files(&[&args.out])?;
     let params = ParamFile::load(&args.params)?;
@@ -136,7 +137,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     };
     w.finish()?;
     let wall_s = start.elapsed().as_secs_f64();
-    let out = &mut crate::cli::stdout();
+    let out = &mut crate::cli::out::stdout();
     if args.json {
         render::json::print(out, &render::json::simulate(&args.out, wall_s, &summary))
     } else {

@@ -1,7 +1,8 @@
 //! `sim-host table1`: reproduce the paper's Table 1 end to end
 //! ([`monitor_studies::fault_signatures`]).
 
-use super::{progress, render, AngleArg};
+use super::args::AngleArg;
+use super::{progress, render};
 use clap::Args;
 use monitor_api::files::ParamFile;
 use monitor_studies::fault_signatures::{run_all, Protocol};
@@ -50,8 +51,8 @@ pub fn run(args: &Table1Args) -> anyhow::Result<()> {
     bar.finish_and_clear();
     let table = render::json::Table1Report::new(name, proto.angle_source, rows);
     if args.json {
-        render::json::print(&mut crate::cli::stdout(), &table)
+        render::json::print(&mut crate::cli::out::stdout(), &table)
     } else {
-        render::text::table1(&mut crate::cli::stdout(), &table)
+        render::text::table1(&mut crate::cli::out::stdout(), &table)
     }
 }

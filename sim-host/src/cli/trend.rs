@@ -110,7 +110,7 @@ pub fn run(args: &TrendArgs) -> anyhow::Result<()> {
     }
     if args.json {
         return render::json::print(
-            &mut crate::cli::stdout(),
+            &mut crate::cli::out::stdout(),
             &TrendReport {
                 store: args.store.display().to_string(),
                 options: opts,
@@ -118,7 +118,7 @@ pub fn run(args: &TrendArgs) -> anyhow::Result<()> {
             },
         );
     }
-    let mut out = super::stdout();
+    let mut out = super::out::stdout();
     print_table(&mut out, &motors, args.motor.is_some())?;
     Ok(())
 }

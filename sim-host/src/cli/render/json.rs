@@ -11,7 +11,7 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// Prints `v` as one pretty JSON document on stdout ([`crate::cli::stdout`]). The document is
+/// Prints `v` as one pretty JSON document on stdout ([`crate::cli::out::stdout`]). The document is
 /// serialised first, so a failed write is the stdout error `main` recognises.
 ///
 /// # Errors

@@ -2,7 +2,7 @@
 //! tables; [`bench_text`] the benchmarks'), [`json`] (one document), [`html`] (the report
 //! page and the chart files; [`diagnose_html`] `diagnose`'s page), with the chart sets in [`charts`] drawn by [`plot`]; [`hmi`]
 //! draws the live HMI's screen. The text and JSON renderers write to the writer they are
-//! given (the commands pass [`crate::cli::stdout`]; a test can pass a `Vec<u8>`).
+//! given (the commands pass [`crate::cli::out::stdout`]; a test can pass a `Vec<u8>`).
 
 pub mod bench_text;
 pub mod charts;

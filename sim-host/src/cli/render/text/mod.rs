@@ -1,5 +1,5 @@
 //! The text renderer: the human tables of every command, written to stdout through
-//! [`crate::cli::stdout`] (a closed pipe or a full disk is an error that `main` recognises, not
+//! [`crate::cli::out::stdout`] (a closed pipe or a full disk is an error that `main` recognises, not
 //! a panic).
 
 mod analysis;
