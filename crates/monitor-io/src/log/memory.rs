@@ -127,14 +127,8 @@ impl MemorySource {
                 },
             })
             .collect();
-        let mut columns = ColumnMap::locate(&found, mapping, shown)?;
-        let numbers = "floats or integers";
-        let units = super::typed::column_units(&types, &columns, &found, mapping, shown, numbers)?;
-        columns.set_units(&units, mapping);
-        super::typed::check_unmapped_timestamp(
-            &types, &columns, &found, mapping, shown, "the data",
-        )?;
-        super::source::check_columns(&columns, shown, true, mapping, &found)?;
+        let held = ("floats or integers", "the data");
+        let columns = super::typed::typed_columns(&found, &types, mapping, shown, held)?;
         Ok((MemorySource { log }, columns))
     }
 }

@@ -15,7 +15,7 @@
 //! group.
 
 use super::mapping::ColumnMapping;
-use super::source::{BinarySource, ColumnMap, Opened};
+use super::source::{not_a_log, BinarySource, ColumnMap, Opened};
 use super::typed::FieldType;
 use super::{Channels, Column, LogError, Row, RowSink};
 use parquet::basic::{Compression, Encoding, LogicalType, TimeUnit, Type as PhysicalType};
@@ -40,13 +40,6 @@ pub const ROW_GROUP_ROWS: usize = 1 << 18;
 #[derive(Debug, Clone)]
 pub(super) struct ParquetSource {
     groups: Vec<u64>,
-}
-
-fn not_a_log(shown: &str, why: String) -> LogError {
-    LogError::NotALog {
-        path: shown.to_string(),
-        why,
-    }
 }
 
 fn pq_error(shown: &str, e: &ParquetError) -> LogError {
@@ -149,21 +142,9 @@ impl ParquetSource {
         let found: Vec<String> = (0..schema.num_columns())
             .map(|j| schema.column(j).path().string())
             .collect();
-        let mut columns = ColumnMap::locate(&found, mapping, shown)?;
-        let types = field_types(schema);
-        let units = super::typed::column_units(
-            &types,
-            &columns,
-            &found,
-            mapping,
-            shown,
-            "DOUBLE, FLOAT, INT32 or INT64",
-        )?;
-        columns.set_units(&units, mapping);
-        super::typed::check_unmapped_timestamp(
-            &types, &columns, &found, mapping, shown, "the file",
-        )?;
-        super::source::check_columns(&columns, shown, true, mapping, &found)?;
+        let held = ("DOUBLE, FLOAT, INT32 or INT64", "the file");
+        let columns =
+            super::typed::typed_columns(&found, &field_types(schema), mapping, shown, held)?;
         check_codecs(meta, &columns.field, shown)?;
         let groups = meta
             .row_groups()

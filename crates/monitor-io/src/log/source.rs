@@ -276,3 +276,12 @@ pub(super) fn row_from_values(v: &[f64; Column::COUNT], columns: &ColumnMap) -> 
         t_winding_c,
     }
 }
+
+/// A file (or data, `shown`) that cannot be read as a log, and why: [`LogError::NotALog`],
+/// the one constructor of every reader.
+pub(super) fn not_a_log(shown: &str, why: String) -> LogError {
+    LogError::NotALog {
+        path: shown.to_string(),
+        why,
+    }
+}

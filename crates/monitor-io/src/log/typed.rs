@@ -83,3 +83,26 @@ pub(super) fn check_unmapped_timestamp(
         ),
     ))
 }
+
+/// The columns of a typed log: the mapping's columns located among `found`, their units
+/// resolved against their types ([`column_units`]), a timestamp left unmapped refused
+/// ([`check_unmapped_timestamp`]) and the columns every log needs checked
+/// ([`super::source::check_columns`]), in that order, the same for every typed format.
+/// `numbers`: the number types the format reads; `held_in`: "the file" or "the data".
+///
+/// # Errors
+/// As the checks named above.
+pub(super) fn typed_columns(
+    found: &[String],
+    types: &[FieldType],
+    mapping: &ColumnMapping,
+    shown: &str,
+    (numbers, held_in): (&str, &str),
+) -> Result<ColumnMap, LogError> {
+    let mut columns = ColumnMap::locate(found, mapping, shown)?;
+    let units = column_units(types, &columns, found, mapping, shown, numbers)?;
+    columns.set_units(&units, mapping);
+    check_unmapped_timestamp(types, &columns, found, mapping, shown, held_in)?;
+    super::source::check_columns(&columns, shown, true, mapping, found)?;
+    Ok(columns)
+}

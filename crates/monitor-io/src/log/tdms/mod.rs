@@ -19,7 +19,7 @@
 //! as I64. Every channel carries `wf_increment` and `wf_start_offset` (from the first
 //! segment's times), so LabVIEW and DIAdem show a time axis.
 
-use super::source::{BinarySource, ColumnMap, OpenOptions, Opened};
+use super::source::{not_a_log, BinarySource, ColumnMap, OpenOptions, Opened};
 use super::{Column, LogError, Row};
 use std::fs::File;
 use std::io::{Read, Seek, SeekFrom};
@@ -77,13 +77,6 @@ fn start_time(g: &tdms_rs::TdmsGroup<'_>, mapping: &super::ColumnMapping) -> Opt
         .iter()
         .find_map(|c| g.channel(mapping.name_of(*c)).as_ref().and_then(of))
         .or_else(|| g.channels().find_map(|ch| of(&ch)))
-}
-
-fn not_a_log(shown: &str, why: String) -> LogError {
-    LogError::NotALog {
-        path: shown.to_string(),
-        why,
-    }
 }
 
 fn tdms_error(shown: &str, e: &tdms_rs::TdmsError) -> LogError {
