@@ -24,10 +24,12 @@ const FULL: [&str; 4] = [
 
 /// A made-up 11 kW, 400 V, 50 Hz, 4-pole machine with textbook per-unit values
 /// (Z_base = 14.5 ohm: Rs 0.026 pu, Rr 0.024 pu, leakages 0.076 pu each, Xm 1.95 pu,
-/// sigma 0.07, Lr/Rr 0.27 s, inertia constant about 0.2 s with a coupled load).
+/// sigma 0.07, Lr/Rr 0.27 s, inertia constant about 0.2 s with a coupled load). A
+/// simulator's machine: its Lm is the unsaturated one (`lm_at`), as the simulator's
+/// reference machines'.
 fn motor_11kw() -> ParamFile {
     ParamFile::from_toml_str(
-        "[motor]\nrs_ohm = 0.38\nrr_ohm = 0.35\nls_h = 0.0935\nlr_h = 0.0935\nlm_h = 0.09\npoles = 4\nj_kgm2 = 0.09\nb_nms = 0.01\nbl_nms = 0.45\n[supply]\nv_ll_rms = 400.0\nf_hz = 50.0\n",
+        "[motor]\nrs_ohm = 0.38\nrr_ohm = 0.35\nls_h = 0.0935\nlr_h = 0.0935\nlm_h = 0.09\npoles = 4\nj_kgm2 = 0.09\nb_nms = 0.01\nbl_nms = 0.45\nlm_at = \"unsaturated\"\n[supply]\nv_ll_rms = 400.0\nf_hz = 50.0\n",
         "11 kW test machine",
     )
     .expect("11 kW parameters")
