@@ -24,10 +24,9 @@ fn a_type(v: &Bound<'_, PyAny>) -> String {
 }
 
 /// A keyword's value as the option of `spec` takes it ([`Takes`]): a window as
-/// `"START:END"` or a pair of numbers, a name (`str`), a number (an `int` or a `float`, numpy's
-/// too), a whole
-/// number (an `int`, or any integer with `__index__` but a bool), a flag (`bool`), or a JSON file as its path or its dict (read here).
-/// Anything else is refused in the option's words, naming the type given and the one
+/// `"START:END"` or a pair of numbers, a name (`str`), a number (an `int` or a `float`,
+/// numpy's too), a whole number (an `int`, or any integer with `__index__` but a bool), a
+/// flag (`bool`), or a JSON file as its path or its dict (read here). Anything else is refused in the option's words, naming the type given and the one
 /// expected (`parallel_paths = 2.5: a float, not an int (a whole number)`): never rounded,
 /// parsed from text or read as a bool. Every option of [`DIAGNOSE_OPTIONS`] goes through
 /// here, so a new one is checked by its [`Takes`] alone.
