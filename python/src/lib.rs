@@ -9,7 +9,7 @@
 //! an `InternalError`); errors are the exception classes below, carrying the command line's
 //! one-line message.
 
-use monitor_api::replay::{self, Takes, DIAGNOSE_OPTIONS};
+use monitor_api::replay::{Takes, DIAGNOSE_OPTIONS};
 use monitor_api::{self as api, ApiError, ErrorKind, LogSource, ParamsSource};
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;
