@@ -76,27 +76,31 @@ fn option_value(spec: &OptionSpec, v: &Bound<'_, PyAny>) -> PyResult<OptionValue
         Takes::Count => return Err(wrong("an int (a whole number)")),
         Takes::Flag if is_bool => OptionValue::Flag(v.extract()?),
         Takes::Flag => return Err(wrong("a bool: give True or False")),
-        Takes::JsonFile => json_file(v).map_err(|why| bad(&why))?,
+        Takes::JsonFile => json_file(v, bad)?,
     })
 }
 
-/// A JSON option's value: its dict (as JSON text), or the path of its file (read here).
-fn json_file(v: &Bound<'_, PyAny>) -> Result<OptionValue, String> {
+/// A JSON option's value: its dict (as JSON text), or the path of its file (read here);
+/// refused by `bad` (the option's words) otherwise.
+fn json_file(v: &Bound<'_, PyAny>, bad: impl Fn(&str) -> PyErr) -> PyResult<OptionValue> {
     if v.is_instance_of::<PyDict>() {
         let text = v
             .py()
             .import("json")
             .and_then(|j| j.call_method1("dumps", (v,)))
             .and_then(|t| t.extract::<String>())
-            .map_err(|e| format!("not JSON: {e}"))?;
+            .map_err(|e| bad(&format!("not JSON: {e}")))?;
         return Ok(OptionValue::Text(text));
     }
-    let path: PathBuf = v
-        .extract()
-        .map_err(|_| format!("{}, not a path (str or os.PathLike) or a dict", a_type(v)))?;
+    let path: PathBuf = v.extract().map_err(|_| {
+        bad(&format!(
+            "{}, not a path (str or os.PathLike) or a dict",
+            a_type(v)
+        ))
+    })?;
     std::fs::read_to_string(&path)
         .map(OptionValue::Text)
-        .map_err(|e| format!("cannot read {}: {e}", path.display()))
+        .map_err(|e| bad(&format!("cannot read {}: {e}", path.display())))
 }
 
 /// The request's replay options from Python's keywords, each by the library's one
