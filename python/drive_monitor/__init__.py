@@ -73,6 +73,9 @@ from ._results import (
     Result,
 )
 
+#: The package's version: the library's (its Cargo version, the wheel's too).
+__version__: str = _native.__version__
+
 #: The public API: everything else in the namespace is a submodule or has an underscore.
 __all__ = [
     "trend",

@@ -6,6 +6,9 @@ string; the package's Python layer wraps it. A ``log`` is a path when ``log_orig
 
 from typing import Any, List, Optional, Tuple, Union
 
+#: The library's Cargo version (``drive_monitor.__version__``).
+__version__: str
+
 class DriveMonitorError(Exception): ...
 class ParamsError(DriveMonitorError): ...
 class LogError(DriveMonitorError): ...

@@ -9,16 +9,17 @@
 //! an `InternalError`); errors are the exception classes below, carrying the command line's
 //! one-line message.
 
-use monitor_api::replay::{self, OptionSpec, OptionValue, Takes, DIAGNOSE_OPTIONS};
+use monitor_api::replay::{Takes, DIAGNOSE_OPTIONS};
 use monitor_api::{self as api, ApiError, ErrorKind, LogSource, ParamsSource};
 use pyo3::create_exception;
-use pyo3::exceptions::{PyException, PyTypeError};
+use pyo3::exceptions::PyException;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
 
 mod arrow_in;
 mod fleet;
+mod options;
 mod store;
 
 create_exception!(
@@ -156,84 +157,42 @@ fn json<T: serde::Serialize>(v: &T) -> PyResult<String> {
     serde_json::to_string(v).map_err(|e| InternalError::new_err(e.to_string()))
 }
 
+/// The effects named, each by the library's list ([`monitor_core::EffectKind::ALL`]); an
+/// unknown name is refused with its near matches ([`api::files::near_names`]) and the list.
 fn effects_of(names: &[String]) -> PyResult<Vec<monitor_core::EffectKind>> {
+    let known: Vec<&str> = monitor_core::EffectKind::ALL
+        .iter()
+        .map(|e| e.name())
+        .collect();
     names
         .iter()
         .map(|n| {
-            monitor_core::EffectKind::ALL
-                .iter()
-                .find(|e| e.name() == n.as_str())
-                .copied()
-                .ok_or_else(|| OptionError::new_err(format!("effect '{n}' is not in the library")))
+            monitor_core::EffectKind::from_name(n)
+                .ok_or_else(|| OptionError::new_err(not_in_library("effect", n, &known)))
         })
         .collect()
 }
 
-/// A keyword's value as the option of `spec` takes it ([`Takes`]): a window as
-/// `"START:END"` or a pair of numbers, a name, a number, a whole number, a flag, or a JSON
-/// file as its path or its dict (read here); refused in the option's words otherwise.
-fn option_value(spec: &OptionSpec, v: &Bound<'_, PyAny>) -> PyResult<OptionValue> {
-    let shown = v.repr().map_or_else(|_| "?".to_string(), |r| r.to_string());
-    let bad = |why: &str| to_py(replay::OptionError::new(spec.field, shown.clone(), why).into());
-    Ok(match spec.takes {
-        Takes::Window => {
-            if let Ok(s) = v.extract::<String>() {
-                return Ok(OptionValue::Text(s));
-            }
-            let how =
-                "give (start_s, end_s) or 'START:END' in seconds, e.g. (1.5, 2.4) or '1.5:2.4'";
-            let pair: Vec<Bound<'_, PyAny>> = v.extract().map_err(|_| bad(how))?;
-            let [a, b] = pair.as_slice() else {
-                return Err(bad(&format!("two values, the start and the end; {how}")));
-            };
-            match (a.extract::<f64>(), b.extract::<f64>()) {
-                (Ok(a), Ok(b)) => OptionValue::Pair(a, b),
-                _ => return Err(bad(&format!("not numbers; {how}"))),
-            }
-        }
-        Takes::Choice(names) => OptionValue::Text(
-            v.extract()
-                .map_err(|_| bad(&format!("give one of {}", names.join(", "))))?,
+/// `effect 'load_torq' is not in the library; did you mean 'load_torque'? (the library's
+/// effects: ...)`: the message for a name of `what` not among `known`.
+fn not_in_library(what: &str, name: &str, known: &[&str]) -> String {
+    let near = api::files::near_names(name, known);
+    let meant = match near.as_slice() {
+        [] => String::new(),
+        names => format!(
+            "; did you mean {}?",
+            names
+                .iter()
+                .take(3)
+                .map(|n| format!("'{n}'"))
+                .collect::<Vec<_>>()
+                .join(" or ")
         ),
-        Takes::Seconds => OptionValue::Number(v.extract().map_err(|_| bad("give seconds"))?),
-        Takes::Count => OptionValue::Whole(v.extract().map_err(|_| bad("give a whole number"))?),
-        Takes::Flag => OptionValue::Flag(v.extract().map_err(|_| bad("give True or False"))?),
-        Takes::JsonFile => {
-            if v.is_instance_of::<PyDict>() {
-                let text = v.py().import("json")?.call_method1("dumps", (v,))?;
-                OptionValue::Text(text.extract()?)
-            } else {
-                let path: PathBuf = v.extract().map_err(|_| bad("give a path or a dict"))?;
-                let text = std::fs::read_to_string(&path)
-                    .map_err(|e| bad(&format!("cannot read {}: {e}", path.display())))?;
-                OptionValue::Text(text)
-            }
-        }
-    })
-}
-
-/// The request's replay options from Python's keywords, each by the library's one
-/// description ([`DIAGNOSE_OPTIONS`], [`ReplayOptions::set`](replay::ReplayOptions::set)):
-/// an option not given, or given as `None`, keeps the one default
-/// (`ReplayOptions::default`, the command line's too).
-fn replay_options(options: Option<&Bound<'_, PyDict>>) -> PyResult<replay::ReplayOptions> {
-    let mut opts = replay::ReplayOptions {
-        words: PY,
-        ..replay::ReplayOptions::default()
     };
-    for (k, v) in options.into_iter().flat_map(|d| d.iter()) {
-        let name: String = k.extract()?;
-        let Some(spec) = DIAGNOSE_OPTIONS.iter().find(|s| s.field.name() == name) else {
-            return Err(PyTypeError::new_err(format!(
-                "diagnose() got an unexpected keyword argument '{name}'"
-            )));
-        };
-        if !v.is_none() {
-            let value = option_value(spec, &v)?;
-            opts.set(spec.field, value).map_err(|e| to_py(e.into()))?;
-        }
-    }
-    Ok(opts)
+    format!(
+        "{what} '{name}' is not in the library{meant} (the library's {what}s: {})",
+        known.join(", ")
+    )
 }
 
 /// The options `diagnose` takes by name, from the library's one description
@@ -278,7 +237,7 @@ fn diagnose(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<String> {
     let req = api::DiagnoseRequest {
-        options: replay_options(options)?,
+        options: options::replay_options(options)?,
         baseline: baseline
             .iter()
             .map(|(b, origin)| log_source(b, origin.as_deref()))
@@ -505,6 +464,7 @@ fn simulate(
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("DriveMonitorError", py.get_type::<DriveMonitorError>())?;
     m.add("ParamsError", py.get_type::<ParamsError>())?;
     m.add("LogError", py.get_type::<LogError>())?;

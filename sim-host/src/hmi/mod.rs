@@ -424,16 +424,19 @@ impl HmiState {
     }
 }
 
-/// The screen's header: the isolated fault with its size first (`rs +50 % | sig. rs p
-/// 0.33 / ls p 0.33`; the FAULT lamp stands beside it), then the lamps' signature candidates; without a
-/// named fault, the monitor's state in words ([`state_text`]).
+/// The screen's header: the isolated fault with its size alone (`rs +50 %`; the FAULT lamp
+/// stands beside it), as the verdict names it; without a named fault, the monitor's state in
+/// words ([`state_text`], the lamps' signature candidates).
 pub fn header_text(s: &Snapshot) -> String {
     header_of(&s.state, &s.candidates, s.isolation.as_ref())
 }
 
 /// [`header_text`] of a state, the lamps' signature candidates (most probable first) and
 /// the isolation's conclusion: the one wording of the HMI, the demo and `diagnose`'s
-/// timeline.
+/// timeline. A fault is named only where the isolation names it alone, as the verdict
+/// (`monitor_core::verdict`) names it: beside a named fault the lamps' signature is not
+/// shown (its tie, `sig. rs p 0.33 / ls p 0.33 / voltage_sensor p 0.33`, would name two
+/// faults the isolation ruled out; the lamps' candidates have their own line and panel).
 pub fn header_of(
     state: &MonitorState,
     candidates: &[(Fault, f32)],
@@ -441,13 +444,7 @@ pub fn header_of(
 ) -> String {
     let named = isolation.filter(|i| i.named.is_some());
     match (named, state) {
-        (Some(iso), MonitorState::Fault(_)) => format!(
-            "{} | {}",
-            iso.text(),
-            monitor_studies::fault_signatures::signature_text(
-                candidates.iter().map(|(f, p)| (*f, *p))
-            )
-        ),
+        (Some(iso), MonitorState::Fault(_)) => iso.text(),
         (Some(iso), MonitorState::Moved(note)) => format!("moved: {} | {note}", iso.text()),
         (Some(iso), _) => format!("{} | named: {}", state_text(state, candidates), iso.text()),
         (None, _) => state_text(state, candidates),

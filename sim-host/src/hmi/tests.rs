@@ -432,3 +432,49 @@ fn the_firmwares_full_line_on_the_screen() {
         assert_eq!(lamp, word);
     }
 }
+
+/// Issue 76: the state column names a fault only where the isolation names it alone, as the
+/// verdict does: beside the named `rs +50 %` the lamps' three-way tie (which names `ls` and
+/// `voltage_sensor` too) is not spelled; without a name the tie is the state.
+#[test]
+fn a_named_fault_stands_alone_in_the_state() {
+    use monitor_api::replay::{FaultCandidate, IsolationName};
+    use monitor_core::verdict::Verdict;
+    let tie = vec![
+        (Fault::Rs, 1.0 / 3.0),
+        (Fault::Ls, 1.0 / 3.0),
+        (Fault::VoltageSensor, 1.0 / 3.0),
+    ];
+    let named = crate::hmi::IsolationView {
+        state: monitor_core::IsolationState::Isolated,
+        named: Some(IsolationName::Fault(Fault::Rs)),
+        change: Some(0.5),
+        candidates: vec![FaultCandidate {
+            fault: Fault::Rs,
+            probability: 1.0,
+            change: Some(0.5),
+            phase: None,
+        }],
+        winding_rise_k: None,
+    };
+    let state = MonitorState::Fault(tie.clone());
+    let header = |iso: Option<&crate::hmi::IsolationView>, call| {
+        crate::hmi::lamp_and_header(&state, call == Verdict::Fault, Some(call), &tie, iso)
+    };
+    assert_eq!(
+        header(Some(&named), Verdict::Fault),
+        ("FAULT", "rs +50 %".to_string())
+    );
+    let unnamed = crate::hmi::IsolationView {
+        named: None,
+        change: None,
+        ..named.clone()
+    };
+    assert_eq!(
+        header(Some(&unnamed), Verdict::Watching),
+        (
+            "WATCHING",
+            "(sig. rs p 0.33 / ls p 0.33 / voltage_sensor p 0.33)".to_string()
+        )
+    );
+}

@@ -37,7 +37,7 @@ pub use columns_error::ColumnsError;
 mod iso8601;
 mod suggest;
 pub(super) use iso8601::parse_iso8601;
-pub use suggest::{channel_list, closest};
+pub use suggest::{channel_list, closest, near_names};
 pub(super) use suggest::{missing_column, missing_column_with};
 
 /// The unit a log's channel is recorded in; see the module documentation for the list.

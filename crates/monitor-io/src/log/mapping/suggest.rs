@@ -64,6 +64,26 @@ pub fn closest<'a>(c: Column, wanted: &str, found: &'a [String]) -> Option<&'a s
         .map(|(_, f)| f.as_str())
 }
 
+/// The names of `known` near the misspelt `wanted`, nearest first: an edit distance (letters
+/// and digits only, case folded) of at most a third of the longer name (1 to 3), or one
+/// name the start of the other (`load_torq` -> `load_torque`). For the messages that refuse
+/// an unknown name of a list (an effect, a fault) and say what was meant.
+pub fn near_names<'a>(wanted: &str, known: &[&'a str]) -> Vec<&'a str> {
+    let w = folded(wanted);
+    let mut near: Vec<(usize, &'a str)> = known
+        .iter()
+        .filter_map(|k| {
+            let kf = folded(k);
+            let d = edit_distance(&w, &kf);
+            let limit = (w.chars().count().max(kf.chars().count()) / 3).clamp(1, 3);
+            let prefix = !w.is_empty() && (kf.starts_with(&w) || w.starts_with(&kf));
+            (d <= limit || prefix).then_some((d, *k))
+        })
+        .collect();
+    near.sort_by_key(|(d, _)| *d);
+    near.into_iter().map(|(_, k)| k).collect()
+}
+
 /// The channels of a log as a list for a message (at most 24 names, then how many more).
 pub fn channel_list(found: &[String]) -> String {
     if found.is_empty() {

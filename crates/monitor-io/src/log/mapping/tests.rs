@@ -99,3 +99,12 @@ fn the_closest_channel() {
     let other: Vec<String> = vec!["Time".into(), "Strom 1".into()];
     assert_eq!(closest(Column::Time, "t_s", &other), Some("Time"));
 }
+
+#[test]
+fn the_near_names_of_a_misspelt_one() {
+    let known = ["load_torque", "core_loss", "saturation", "rs_temperature"];
+    assert_eq!(near_names("load_torq", &known), ["load_torque"]);
+    assert_eq!(near_names("Load-Torque", &known), ["load_torque"]);
+    assert_eq!(near_names("satration", &known), ["saturation"]);
+    assert!(near_names("xyz", &known).is_empty());
+}
