@@ -1,0 +1,21 @@
+//! The one door: every sentence a crew reads is spelled here, and only here.
+//!
+//! The engines (the replay's stages and its verdict, the analyses and the ladder, the
+//! trend) return typed values: findings with their numbers and typed reasons (enums with
+//! the numbers that decided, such as a ladder refusal `Diverged` or a trend alarm
+//! `FaultLevelInARow { logs }`). They never build a sentence, and nothing is decided by
+//! reading one back. This crate turns those values into the words of every front end:
+//! the command line's text, its HTML report, the terminal HMI, the trend's table and
+//! Python's results all take their lines from the functions here, so two lines about one
+//! log cannot disagree.
+//!
+//! A front end says how it names the library's options (the command line by its flags,
+//! Python by its keywords) by passing its [`Spelling`](monitor_replay::Spelling) to the
+//! function that spells; no options type carries words.
+//!
+//! Modules, one per engine:
+//! - [`trend`]: a motor's trend (`sim-host trend`, Python's `trend`).
+
+#![forbid(unsafe_code)]
+
+pub mod trend;
