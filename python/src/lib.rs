@@ -63,7 +63,7 @@ create_exception!(
 /// name them (`commission = 4:2`, `load = 'heavy'`).
 struct PyWords;
 
-impl monitor_api::replay::Spelling for PyWords {
+impl monitor_api::words::Spelling for PyWords {
     fn option(&self, field: monitor_api::replay::OptionField, value: &str) -> String {
         if value.is_empty() {
             field.name().to_string()
@@ -100,8 +100,26 @@ impl monitor_api::replay::Spelling for PyWords {
     }
 }
 
-/// Python's words, as a request carries them (the reports' advice in keyword arguments).
-const PY: monitor_api::replay::Words = monitor_api::replay::Words(&PyWords);
+/// Python's words for the analyses' advice (until the analyses return typed advice the door
+/// spells).
+pub(crate) const PY: monitor_api::analysis::Words = monitor_api::analysis::Words(&PyWordsShim);
+
+/// Python's keywords for the analyses' advice (the same as [`PyWords`]).
+struct PyWordsShim;
+
+impl monitor_api::analysis::Spelling for PyWordsShim {
+    fn option(&self, field: monitor_api::replay::OptionField, value: &str) -> String {
+        monitor_api::words::Spelling::option(&PyWords, field, value)
+    }
+
+    fn hint(&self, field: monitor_api::replay::OptionField, value: &str) -> String {
+        monitor_api::words::Spelling::hint(&PyWords, field, value)
+    }
+
+    fn command_with(&self, command: &str, field: monitor_api::replay::OptionField) -> String {
+        monitor_api::words::Spelling::command_with(&PyWords, command, field)
+    }
+}
 
 /// The exception of an [`ApiError`], its message in Python's words ([`PyWords`]).
 fn to_py(e: ApiError) -> PyErr {
@@ -253,7 +271,7 @@ fn diagnose(
             &mut |_| {},
         )
         .map_err(to_py)?;
-        json(&d.report)
+        json(&monitor_api::words::diagnose::document(&d.report, &PyWords))
     })
 }
 
@@ -324,7 +342,7 @@ fn explain(
         let doc = if ladder {
             api::ladder(params, log, &req)
         } else {
-            api::explain(params, log, &req)
+            api::explain(params, log, &req, &PyWords)
         };
         json(&doc.map_err(to_py)?)
     })

@@ -2,7 +2,7 @@
 //! library's one description takes ([`DIAGNOSE_OPTIONS`], [`Takes`]): a value of the wrong
 //! type is refused naming the keyword, the type given and the one expected.
 
-use crate::{to_py, PY};
+use crate::to_py;
 use monitor_api::replay::{self, OptionSpec, OptionValue, Takes, DIAGNOSE_OPTIONS};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -110,10 +110,7 @@ fn json_file(v: &Bound<'_, PyAny>, bad: impl Fn(&str) -> PyErr) -> PyResult<Opti
 pub(crate) fn replay_options(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<replay::ReplayOptions> {
-    let mut opts = replay::ReplayOptions {
-        words: PY,
-        ..replay::ReplayOptions::default()
-    };
+    let mut opts = replay::ReplayOptions::default();
     for (k, v) in options.into_iter().flat_map(|d| d.iter()) {
         let name: String = k.extract()?;
         let Some(spec) = DIAGNOSE_OPTIONS.iter().find(|s| s.field.name() == name) else {

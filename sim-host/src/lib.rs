@@ -3,4 +3,5 @@
 //! The commands themselves are the binary (`src/main.rs`, `src/cli/`); the libraries they
 //! call are the workspace's crates in `crates/` (`docs/architecture.md`).
 
+pub mod flags;
 pub mod hmi;

@@ -57,7 +57,7 @@ const INTENDED: [(&str, &str, &str); 6] = [
 
 /// Keys added since the golden outputs were taken (issue 8: the data-quality stage's
 /// report, what commissioning did, the verdict, the range note beside a lamp).
-const ADDED: [&str; 67] = [
+const ADDED: [&str; 82] = [
     "rotor", // issue 48: diagnose's rotor finding (broken bars from the sidebands)
     // Issue 40: a healthy verdict's detection limits at the commissioned point.
     "detection_limits",
@@ -150,6 +150,23 @@ const ADDED: [&str; 67] = [
     "resistances",
     // Issue 62: explain's ranking says the share explained over the whole log too.
     "whole_log_explained_fraction",
+    // Issue 79: every sentence spelled at one door, from a typed reason the JSON gives
+    // beside it (its key beside the sentence's), and the winding's reach in turns.
+    "reason",
+    "skipped_reasons",
+    "said",
+    "phase_not_judged_reason",
+    "least_change_widened_by",
+    "cannot_judge_reason",
+    "at_noise",
+    "thresholds_in_force",
+    "advice_given",
+    "range_departures",
+    "temperature_channel_state",
+    "unknown_reason",
+    "shorted_turns_reach",
+    "why",
+    "departures",
 ];
 
 /// The library effect added since (issue 10, `rotor_asymmetry`): its ranking entries and

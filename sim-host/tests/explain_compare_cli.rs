@@ -260,8 +260,7 @@ fn the_ranking_reads_beside_the_verdicts_fault() {
             source,
             State::Named(n),
             Against::Nothing,
-            "x".into(),
-            "y".into(),
+            monitor_replay::Detail::Rotor,
         )
     };
     let bars = named(
@@ -315,8 +314,7 @@ fn the_ranking_reads_beside_the_verdicts_fault() {
         FindingSource::Rotor,
         State::Clear,
         Against::Nothing,
-        "x".into(),
-        "y".into(),
+        monitor_replay::Detail::Rotor,
     );
     assert_eq!(monitor_api::beside_verdict(&healthy, &report, &mcsa), None);
     // A log without voltages: no model, no ranking; the sentence says so.

@@ -291,6 +291,76 @@ fn contradictions(d: &Value, text: &str) -> Vec<String> {
     bad
 }
 
+/// The text's lines about one analysis that tell another story than its finding (issue
+/// "One story, spelled at one door"): the winding's `suspect phase` and `winding:` lines
+/// against the winding finding, advice to commission residuals that never ran, and the
+/// timeline's last state against the verdict.
+fn other_stories(d: &Value, text: &str) -> Vec<String> {
+    let mut bad = Vec::new();
+    let findings = d["findings"].as_array().cloned().unwrap_or_default();
+    let of = |source: &str| findings.iter().find(|f| f["source"] == source);
+    // The winding: the unbalance line's suspect phase and the winding's sentence.
+    if let Some(w) = of("winding") {
+        let state = w["state"].as_str().unwrap_or("");
+        let confidence = w["confidence"].as_f64().unwrap_or(0.0);
+        let suspect = text
+            .lines()
+            .find_map(|l| {
+                l.strip_prefix("unbalance: ")
+                    .and_then(|l| l.split_once("suspect phase: "))
+            })
+            .map(|(_, p)| p.to_string());
+        if let Some(p) = suspect {
+            let phase = w["phase"].as_str().unwrap_or("?");
+            let agrees = match state {
+                "named" if confidence >= 0.5 => p.starts_with(phase) && !p.contains("watched"),
+                "named" => p.starts_with(phase) && p.contains("watched"),
+                _ => p == "none",
+            };
+            if !agrees {
+                bad.push(format!(
+                    "suspect phase: {p} beside the winding finding {state} {phase} at {confidence}"
+                ));
+            }
+        }
+        for l in text.lines().filter(|l| l.starts_with("winding: ")) {
+            let judged = matches!(state, "clear" | "named");
+            if judged && l.contains("cannot judge") {
+                bad.push(format!("{l:?} beside the winding finding {state}"));
+            }
+            if state == "clear" && !l.starts_with("winding: no short") {
+                bad.push(format!("{l:?} beside a clear winding"));
+            }
+        }
+    }
+    // Advice only for what was judged: no thresholds or commissioning advice where the
+    // residuals never ran.
+    if of("residuals").is_some_and(|f| f["state"] == "unavailable") {
+        if let Some(l) = text.lines().find(|l| l.starts_with("thresholds:")) {
+            bad.push(format!("{l:?} where the residuals never ran"));
+        }
+        if !d["commissioning"]["advice"].is_null() {
+            bad.push(format!(
+                "advice {} where the residuals never ran",
+                d["commissioning"]["advice"]
+            ));
+        }
+    }
+    // The timeline's last state: no red FAULT at the end of a log judged healthy.
+    let last_row = text
+        .lines()
+        .skip_while(|l| !l.trim_start().starts_with("time speed"))
+        .skip(1)
+        .take_while(|l| !l.trim().is_empty())
+        .last();
+    if let Some(row) = last_row {
+        if d["verdict"] == "healthy" && row.contains(" FAULT ") {
+            bad.push(format!("the timeline ends {row:?} under a healthy verdict"));
+        }
+    }
+    bad
+}
+
 /// The fleet's row of a report agrees with its verdict (the same fault, phase and
 /// confidence).
 fn fleet_row_disagrees(case: &Case) -> Option<String> {
@@ -317,7 +387,7 @@ fn fleet_row_disagrees(case: &Case) -> Option<String> {
         && row.fault.as_deref() == named.map(|n| n.fault.name())
         && row.phase.as_deref() == named.and_then(|n| n.phase).map(|p| p.name())
         && row.confidence.is_some() == named.is_some();
-    (!same).then(|| format!("fleet row {row:?} against {:?}", report.verdict_line))
+    (!same).then(|| format!("fleet row {row:?} against {:?}", report.verdict))
 }
 
 #[test]
@@ -339,6 +409,7 @@ fn no_shipped_log_gets_a_verdict_that_contradicts_its_report() {
             let t = run(&c.args(false));
             let text = String::from_utf8_lossy(&t.stdout).to_string();
             let mut bad = contradictions(&d, &text);
+            bad.extend(other_stories(&d, &text));
             if c.extra.is_empty() {
                 bad.extend(fleet_row_disagrees(c));
             }
@@ -397,4 +468,39 @@ fn the_checks_catch_the_contradictions_the_issue_measured() {
     });
     assert!(!contradictions(&other_line, "verdict: healthy").is_empty());
     assert!(contradictions(&other_line, "verdict: healthy: residuals").is_empty());
+    // The three stories of the issue: a clear winding that "cannot judge", a watched
+    // phase with "suspect phase: none", thresholds advised on a current-only log.
+    let clear = serde_json::json!({
+        "verdict": "healthy", "commissioning": {"advice": null},
+        "findings": [{"source": "winding", "state": "clear"}],
+    });
+    let said = "unbalance: |I2|/|I1| = 3.10 %, suspect phase: none\nwinding: cannot judge the phase: the negative sequence (3.1 % of I1) is within (least change 12.7 %)\n";
+    assert_eq!(other_stories(&clear, said).len(), 2, "{said}");
+    let one = "unbalance: |I2|/|I1| = 3.10 %, suspect phase: none\nwinding: no short of more than 35 % of the turns: ...\n";
+    assert!(other_stories(&clear, one).is_empty());
+    let watched = serde_json::json!({
+        "verdict": "watching", "commissioning": {"advice": null},
+        "findings": [{"source": "winding", "state": "named", "phase": "c", "confidence": 0.39}],
+    });
+    assert_eq!(
+        other_stories(
+            &watched,
+            "unbalance: |I2|/|I1| = 9 %, suspect phase: none\n"
+        )
+        .len(),
+        1
+    );
+    assert!(other_stories(
+        &watched,
+        "unbalance: |I2|/|I1| = 9 %, suspect phase: c, watched (probability 0.39)\n"
+    )
+    .is_empty());
+    let current_only = serde_json::json!({
+        "verdict": "healthy", "commissioning": {"advice": "commission (--commission START:END)"},
+        "findings": [{"source": "residuals", "state": "unavailable"}],
+    });
+    assert_eq!(
+        other_stories(&current_only, "thresholds: fixed: |r| > 3.0 %\n").len(),
+        2
+    );
 }

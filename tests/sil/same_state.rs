@@ -114,5 +114,5 @@ fn the_board_and_the_host_show_the_same_state_for_the_same_log() {
     // The fault is named on both: a FAULT at the end.
     let end = rig.last();
     assert_eq!(end.tick.call, Verdict::Fault, "board at the end");
-    assert_eq!(host.verdict, Verdict::Fault, "{}", host.verdict_line);
+    assert_eq!(host.verdict, Verdict::Fault, "{:?}", host.verdict_finding);
 }

@@ -71,8 +71,8 @@ pub struct Analysis {
     pub quality: monitor_io::log::quality::DataQuality,
     /// The words the reports' advice names a field in (`--from` on the command line,
     /// `from_s=...` in Python): the front end's that asked; the library's own
-    /// ([`monitor_replay::FieldNames`]) as loaded.
-    pub words: monitor_replay::Words,
+    /// ([`crate::words_shim::FieldNames`]) as loaded.
+    pub words: crate::words_shim::Words,
     /// The constants the effects are set up with when they are not `constants`: the user's
     /// file's, for a model the ladder rebased on refitted base parameters
     /// ([`Analysis::rebased`]), so that an effect's data-dependent set-up (the load
@@ -291,7 +291,7 @@ impl Analysis {
             constants: MachineConstants::from_params(&params),
             params,
             quality,
-            words: monitor_replay::Words::LIBRARY,
+            words: crate::words_shim::Words::LIBRARY,
             setup_origin: None,
         })
     }

@@ -52,6 +52,7 @@ pub mod rotor_asymmetry;
 pub mod simplified_model;
 pub mod transients;
 pub mod unbalance;
+pub mod words_shim;
 
 pub use analysis::{
     known_effects, parse_effect, Analysis, AnalysisError, AnalysisFrame, DataInfo, FittedEffect,

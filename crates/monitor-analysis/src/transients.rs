@@ -9,8 +9,9 @@ use super::effects::{model_of, EffectModel};
 use super::metrics::WorstWindow;
 use super::prep::Prepared;
 use super::simplified_model::MachineConstants;
+use crate::words_shim::{FieldNames, Spelling};
 use monitor_core::EffectKind;
-use monitor_replay::{FieldNames, OptionField, Spelling};
+use monitor_replay::OptionField;
 use serde::Serialize;
 
 /// A relative change of the supply voltage amplitude or frequency larger than this within a

@@ -15,7 +15,8 @@
 
 use super::prep::{Prepared, C64};
 use super::simplified_model::MachineConstants;
-use monitor_replay::{OptionField, Spelling};
+use crate::words_shim::Spelling;
+use monitor_replay::OptionField;
 use serde::Serialize;
 
 /// Unbalance / faulty-phase analysis (JSON key `unbalance` of `compare` and `explain`).

@@ -14,7 +14,7 @@ fn run(
     load_nm: f64,
     phase: Phase,
     fraction: f64,
-) -> (Option<String>, f32, Option<String>) {
+) -> (Option<String>, f32, Option<monitor_replay::PhaseNotJudged>) {
     let mut sc = Scenario::steady(4.0, 10_000.0);
     sc.sensors = SensorSpec::default();
     sc.load = LoadSpec {

@@ -16,4 +16,5 @@ pub use monitor_analysis::metrics::{self, WorstWindow};
 pub use monitor_analysis::prep::Prepared;
 pub use monitor_analysis::rotor_asymmetry::McsaReport;
 pub use monitor_analysis::simplified_model::Prediction;
+pub use monitor_analysis::words_shim::{Spelling, Words};
 pub use monitor_analysis::{parse_effect, Analysis, Options};

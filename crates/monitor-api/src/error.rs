@@ -6,7 +6,8 @@
 use monitor_analysis::AnalysisError;
 use monitor_io::log::LogError;
 use monitor_io::params::ParamError;
-use monitor_replay::{FieldNames, OptionError, OptionField, ReplayError, Spelling};
+use monitor_replay::{OptionError, OptionField, ReplayError};
+use monitor_words::{FieldNames, Spelling};
 
 /// A failed call: one line naming the file, the field or the option, and its kind.
 #[derive(Debug, thiserror::Error)]
@@ -149,11 +150,11 @@ impl ApiError {
     /// `commission = 4:2`); the library's own is `Display`'s ([`FieldNames`]).
     pub fn spelled(&self, spell: &dyn Spelling) -> String {
         match self {
-            ApiError::Option(e) => e.spelled(spell),
+            ApiError::Option(e) => monitor_words::option_error(e, spell),
             ApiError::Log(e)
             | ApiError::Replay(ReplayError::Log(e))
             | ApiError::Analysis(AnalysisError::Log(e)) => e.spelled(&|name| spell.key(name)),
-            ApiError::Replay(e) => e.spelled(spell),
+            ApiError::Replay(e) => monitor_words::replay_error(e, spell),
             ApiError::Nameplate(e) => e.spelled(&|name| spell.key(name)),
             ApiError::Swapped { params, also } => format!(
                 "{} is a log, not a parameter file{also}: the arguments look swapped (give {} LOG)",

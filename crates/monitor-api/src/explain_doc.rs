@@ -20,8 +20,9 @@ use monitor_analysis::rotor_asymmetry::{self, McsaReport};
 use monitor_analysis::Analysis;
 use monitor_core::verdict::FaultName;
 use monitor_core::EffectKind;
-use monitor_replay::verdict::fault_text;
 use monitor_replay::{DiagnoseReport, FindingReport, Verdict};
+use monitor_words::diagnose::fault_text;
+use monitor_words::Spelling;
 
 /// `explain`'s JSON document: the one verdict's headline, the report, how the ranking
 /// relates to the verdict's finding, and the motor current signature analysis.
@@ -72,6 +73,7 @@ pub fn explain(
     params: ParamsSource<'_>,
     log: impl Into<LogSource>,
     req: &AnalysisRequest,
+    sp: &dyn Spelling,
 ) -> Result<serde_json::Value, ApiError> {
     let log = &log.into();
     // The parameter file read once for both calls.
@@ -81,11 +83,11 @@ pub fn explain(
         columns: &columns,
     };
     let a = load_analysis(read, log, req, &mut |_| {})?;
-    let judged = verdict_for_explain(read, log, req.group.clone(), req.words);
+    let judged = verdict_for_explain(read, log, req.group.clone());
     let out = a.explain(&req.options(), &|_| {})?;
     let rotor_asymmetry = mcsa_beside(&a, &out.report, req.rotor_bars);
-    let doc = ExplainDocument::new(judged.as_ref(), out.report, rotor_asymmetry);
-    Ok(serde_json::to_value(&doc).unwrap_or_default())
+    let doc = ExplainDocument::new(judged.as_ref(), out.report, rotor_asymmetry, sp);
+    Ok(doc.json(judged.as_ref().ok(), sp))
 }
 
 /// `explain --ladder --json`'s document ([`monitor_analysis::explain::ladder`]): the
@@ -105,8 +107,8 @@ pub fn ladder(
 }
 
 /// The verdict `diagnose` gives `log` with its defaults (no commissioning, no baseline; the
-/// TDMS `group`; its sentences in `words`), which `explain` opens with; the error's message
-/// where `diagnose` cannot judge the log at all.
+/// TDMS `group`), which `explain` opens with; the error where `diagnose` cannot judge the
+/// log at all.
 ///
 /// # Errors
 /// As [`super::diagnose`].
@@ -114,32 +116,31 @@ pub fn verdict_for_explain(
     params: ParamsSource<'_>,
     log: impl Into<LogSource>,
     group: Option<String>,
-    words: monitor_replay::Words,
 ) -> Result<DiagnoseReport, ApiError> {
-    let mut req = DiagnoseRequest {
+    let req = DiagnoseRequest {
         group,
         ..DiagnoseRequest::default()
     };
-    req.options.words = words;
     diagnose(params, log, &req, &mut |_| {}).map(|d| d.report)
 }
 
 impl ExplainDocument {
     /// The document of an `explain` report beside the verdict `diagnose` gave the same log
-    /// (`judged`; its error where it gave none).
+    /// (`judged`; its error where it gave none), its headline in `sp`'s words.
     pub fn new(
         judged: Result<&DiagnoseReport, &ApiError>,
         report: ExplainReport,
         rotor_asymmetry: McsaReport,
+        sp: &dyn Spelling,
     ) -> Self {
         let (headline, motor_verdict, verdict_finding) = match judged {
             Ok(j) => (
-                format!("verdict: {}", j.verdict_line),
+                format!("verdict: {}", monitor_words::diagnose::verdict_line(j, sp)),
                 j.verdict,
                 j.verdict_finding.clone(),
             ),
             Err(e) => (
-                format!("verdict: could not judge: {e}"),
+                format!("verdict: could not judge: {}", e.spelled(sp)),
                 Verdict::CouldNotJudge,
                 None,
             ),
@@ -155,6 +156,25 @@ impl ExplainDocument {
             report,
             rotor_asymmetry,
         }
+    }
+}
+
+impl ExplainDocument {
+    /// The JSON document, the verdict's finding with its sentence (`judged`: the report it
+    /// comes from).
+    pub fn json(&self, judged: Option<&DiagnoseReport>, sp: &dyn Spelling) -> serde_json::Value {
+        let mut v = serde_json::to_value(self).unwrap_or_default();
+        if let (Some(j), Some(f), Some(vf)) = (
+            judged,
+            self.verdict_finding.as_ref(),
+            v.get_mut("verdict_finding").and_then(|x| x.as_object_mut()),
+        ) {
+            vf.insert(
+                "summary".into(),
+                monitor_words::diagnose::summary(f, j, sp).into(),
+            );
+        }
+        v
     }
 }
 

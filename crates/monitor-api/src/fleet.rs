@@ -415,7 +415,10 @@ pub fn row_and_report_shown(
         match diagnose(ParamsSource::Path(&m.params), log, &request(m), &mut |_| {}) {
             Ok(d) => (
                 FleetRow::of_report(&m.name, log, &d.report),
-                serde_json::to_value(&d.report).ok(),
+                Some(monitor_words::diagnose::document(
+                    &d.report,
+                    &monitor_words::FieldNames,
+                )),
             ),
             Err(e) => (FleetRow::failed(&m.name, log, one_line_error(&e)), None),
         };

@@ -9,6 +9,7 @@
 //! file, a bad log, a bad option, or an analysis that cannot run on this log.
 
 use monitor_analysis::prep::ReadOptions;
+use monitor_analysis::words_shim::Words;
 use monitor_analysis::{Analysis, Options};
 use monitor_core::EffectKind;
 use monitor_io::log::mapping::ColumnMapping;
@@ -16,7 +17,7 @@ use monitor_io::log::OpenOptions;
 use monitor_io::params::{ParamError, ParamFile};
 use monitor_replay::{
     diagnose_log, HealthyReference, OptionError, OptionField, ReplayError, ReplayOptions,
-    UnbalanceBaseline, Words,
+    UnbalanceBaseline,
 };
 use std::path::{Path, PathBuf};
 
@@ -34,14 +35,14 @@ pub mod replay;
 /// The simulator for a front end (from `monitor-sim`).
 pub mod sim;
 mod turn_calibration;
-/// The one door: every sentence a crew reads, spelled from the engines' typed values (from
-/// `monitor-words`).
-pub use monitor_words as words;
 pub use error::{ApiError, ErrorKind};
 pub use explain_doc::{
     beside_verdict, explain, ladder, mcsa_beside, verdict_for_explain, ExplainDocument,
 };
 pub use log_source::LogSource;
+/// The one door: every sentence a crew reads, spelled from the engines' typed values (from
+/// `monitor-words`).
+pub use monitor_words as words;
 pub use outputs::{simulate_to_file, ScenarioSource};
 pub use turn_calibration::{learn_turn_calibration, Labelled, Learned};
 

@@ -34,9 +34,13 @@ fn no_sentence_of_a_report_in_the_librarys_words_names_a_flag() {
     // diagnose without commissioning: the report advises it.
     let d = monitor_api::diagnose(p, &log, &DiagnoseRequest::default(), &mut |_| {})
         .expect("diagnoses");
-    let text = serde_json::to_string(&d.report).expect("json");
+    let doc = monitor_api::words::diagnose::document(&d.report, &monitor_api::words::FieldNames);
+    let text = doc.to_string();
     assert!(flags(&text).is_empty(), "{:#?}", flags(&text));
-    let advice = d.report.commissioning.advice.clone().unwrap_or_default();
+    let advice = doc["commissioning"]["advice"]
+        .as_str()
+        .unwrap_or_default()
+        .to_string();
     assert!(
         advice.contains("commission (commission = START:END)"),
         "{advice}"
@@ -51,7 +55,7 @@ fn no_sentence_of_a_report_in_the_librarys_words_names_a_flag() {
         from_s: Some(0.8),
         ..AnalysisRequest::default()
     };
-    let e = monitor_api::explain(p, &log, &req).expect("explains");
+    let e = monitor_api::explain(p, &log, &req, &monitor_api::words::FieldNames).expect("explains");
     let text = e.to_string();
     assert!(flags(&text).is_empty(), "{:#?}", flags(&text));
     let verdict = e["verdict"].as_str().unwrap_or_default();

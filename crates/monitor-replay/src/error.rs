@@ -1,7 +1,8 @@
 //! What can go wrong in setting up or running a replay ([`ReplayError`]), in the library's
-//! words and, through [`ReplayError::spelled`], in a front end's.
+//! names (a front end's own words for the fields are the door's, `monitor_words`).
 
-use crate::words::{FieldNames, OptionError, OptionField, Spelling};
+use crate::fields::OptionError;
+use crate::lamps::commission::NotLearned;
 use monitor_core::ConfigError;
 use monitor_io::log::LogError;
 
@@ -26,29 +27,15 @@ pub enum ReplayError {
         log: String,
     },
     /// The commissioning window was not learned (and `allow_incomplete` was not asked).
-    #[error("{}", self.spelled(&FieldNames))]
+    #[error("commission = {}: the window was not learned", not_learned.window)]
     IncompleteCommissioning {
-        /// The window asked for (`START:END`).
-        window: String,
-        /// What happened.
-        why: String,
+        /// The window asked for and why it was not learned.
+        not_learned: NotLearned,
+        /// What the data-quality stage does not trust, often why nothing was learned
+        /// (swapped channels, a dead sensor): its words.
+        data_quality: Vec<String>,
     },
     /// Reading the log failed.
     #[error(transparent)]
     Log(#[from] LogError),
-}
-
-impl ReplayError {
-    /// The message in a front end's words (`spell` names the options it refers to).
-    pub fn spelled(&self, spell: &dyn Spelling) -> String {
-        match self {
-            ReplayError::Option(e) => e.spelled(spell),
-            ReplayError::IncompleteCommissioning { window, why } => format!(
-                "{}: {why}: give a window inside the log's healthy running, or {} to report with the fixed thresholds",
-                spell.option(OptionField::Commission, window),
-                spell.option(OptionField::AllowIncomplete, "")
-            ),
-            e => e.to_string(),
-        }
-    }
 }

@@ -74,30 +74,6 @@ impl IsolationEvent {
             IsolationEvent::Named { t_s, .. } | IsolationEvent::LoadMoved { t_s, .. } => *t_s,
         }
     }
-
-    /// One line for the text report, e.g. `  601.70 s  load moved: active current 6.21 ->
-    /// 4.36 A (-30 %)` or `3000.50 s  named rr +20 % (p 0.99)`.
-    pub fn line(&self) -> String {
-        match self {
-            IsolationEvent::Named {
-                t_s,
-                name,
-                change,
-                probability,
-            } => {
-                // A size under 10 % to a tenth of a per cent: "+0 %" says nothing.
-                let digits = usize::from(change.abs() < 0.095);
-                format!(
-                    "{t_s:9.2} s  named {name} {:+.digits$} % (p {probability:.2})",
-                    100.0 * change
-                )
-            }
-            IsolationEvent::LoadMoved { t_s, from_a, to_a } => format!(
-                "{t_s:9.2} s  load moved: active current {from_a:.2} -> {to_a:.2} A ({:+.0} %), an operating-point change",
-                100.0 * (to_a / from_a - 1.0)
-            ),
-        }
-    }
 }
 
 /// The events of a replay, in time order.
@@ -327,7 +303,6 @@ mod tests {
             }
             other => panic!("{other:?}"),
         }
-        assert!(moves[0].line().contains("(-30 %)"), "{}", moves[0].line());
     }
 
     /// A step of the active current from 6 A to `to` A at `step_s` seen through a 2 Hz

@@ -14,7 +14,7 @@
 mod chunk;
 mod report;
 mod resistances;
-mod sentences;
+pub mod said;
 mod stage;
 
 pub use resistances::ResistanceReading;
@@ -27,7 +27,8 @@ use monitor_core::{Fault, Isolation, IsolationState, Isolator, SteadyPoint};
 use report::refine_single_phase;
 use report::{baseline_name, groups, REPORTED_RISE_K};
 pub use report::{
-    state_name, DetectionLimit, FaultCandidate, IsolationBaseline, IsolationGroup, IsolationReport,
+    state_name, DetectionLimit, FaultCandidate, GroupWhy, IsolationBaseline, IsolationGroup,
+    IsolationReport,
 };
 use serde::Serializer;
 
@@ -69,7 +70,6 @@ pub(super) struct IsolationTracker {
     evidence: monitor_core::isolation::Evidence,
     /// What is known of the load ([`super::options::LoadModel`]).
     load: super::options::LoadModel,
-    words: super::words::Words,
     /// Names and load moves, with times.
     events: super::events::EventLog,
     /// The log's temperature channel (`t_winding_c`), when it has one.
@@ -150,8 +150,7 @@ pub use monitor_core::isolation::NOMINAL_UNCERTAINTY;
 impl IsolationTracker {
     /// A tracker for the nominal machine (`None`: a machine the isolator rejects, then
     /// nothing is isolated and the report says so), of a log with a temperature column
-    /// (`temperature_column`) or without, as `opts` ask (what is known of the load, the
-    /// words of its sentences).
+    /// (`temperature_column`) or without, as `opts` ask (what is known of the load).
     /// `chunk_rows`: the most rows whose points are handed on together (the core's block of
     /// `decimation` samples, [`chunk`]; at least 1).
     pub(crate) fn new(
@@ -160,7 +159,7 @@ impl IsolationTracker {
         opts: &super::options::ReplayOptions,
         (dt_s, chunk_rows): (f64, u32),
     ) -> Self {
-        let (load, words) = (opts.load, opts.words);
+        let load = opts.load;
         let isolator = isolator.map(|mut i| {
             i.set_load_unknown(load == super::options::LoadModel::Unknown);
             i
@@ -178,7 +177,6 @@ impl IsolationTracker {
             lamps_lit: false,
             evidence: monitor_core::isolation::Evidence::default(),
             load,
-            words,
             events: super::events::EventLog::default(),
             temperature: super::temperature::TemperatureChannel::new(temperature_column),
             chunk: chunk::RowChunk::default(),
@@ -459,9 +457,9 @@ impl IsolationTracker {
         let learned = self.follower.as_ref().is_some_and(Follower::learned);
         let Some(concluded) = self.concluded() else {
             let why = if self.follower.is_none() {
-                "the parameter file's machine cannot be used by the isolation"
+                said::NotIsolatedWhy::MachineUnusable
             } else {
-                "no settled, quasi-steady operating point with voltage was evaluated"
+                said::NotIsolatedWhy::NoSteadyPoint
             };
             return (IsolationReport::not_judged(why, learned), Vec::new());
         };
@@ -480,7 +478,7 @@ impl IsolationTracker {
             named: named.map(|n| IsolationName::of(&n)),
             named_change: named.map(|n| n.change()),
             named_probability: named.map(|n| n.probability()),
-            verdict: self.verdict(&concluded, in_file_error, detected, moved),
+            said: self.said(&concluded, in_file_error, detected, moved),
             moved_from_learned: moved,
             winding_rise_k: if learned {
                 self.winding_rise_k()

@@ -16,6 +16,17 @@ mod step;
 mod unsettled;
 
 pub use step::Detection;
+pub use unsettled::HeldUnsettled;
+
+/// Why the residuals were skipped: the column the log lacks (the report's `skipped`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Skipped {
+    /// The residuals need the voltages `va_V, vb_V, vc_V`.
+    ResidualsNeedVoltages,
+    /// The residuals need the speed (`wm_rad_s` or `enc_count`).
+    ResidualsNeedSpeed,
+}
 
 use crate::options::{LoadModel, ReplayOptions};
 use crate::sampler::{sample_of, LogSampler, CLOCK_RESET_GAP_S, COUNTS_PER_REV};
@@ -43,7 +54,7 @@ pub(crate) struct LampStage {
     /// The monitor's angle source (the report's).
     angle_source: AngleSource,
     /// The analyses the log's columns cannot feed (the report's `skipped`).
-    skipped: Vec<String>,
+    skipped: Vec<Skipped>,
     evaluated: bool,
     /// Seconds of running on which the lamps were judged: evaluated, quasi-steady, on
     /// thresholds in force (`MIN_JUDGED_S` for a healthy verdict).
@@ -114,7 +125,7 @@ pub(crate) struct LampsFinding {
     pub(crate) k_sigma: f32,
     /// Why the log's end withholds the verdict (the quasi-steady gate held the lamps far
     /// outside their bands), where it does.
-    pub(crate) withheld: Option<String>,
+    pub(crate) withheld: Option<HeldUnsettled>,
     /// What the lamps say at the end about a fault ([`LampsSeen`]).
     pub(crate) seen: LampsSeen,
     /// With the load an unknown input, the lamps' matching only ever named the friction
@@ -123,12 +134,12 @@ pub(crate) struct LampsFinding {
     /// The monitor's angle source.
     pub(crate) angle_source: AngleSource,
     /// The analyses the log's columns cannot feed, with the column they need.
-    pub(crate) skipped: Vec<String>,
+    pub(crate) skipped: Vec<Skipped>,
 }
 
 impl LampStage {
-    /// The stage for a monitor configured by `cfg` from `opts` (commissioning, the load,
-    /// the words of its advice), on a log with `channels` (a monitor where they feed the
+    /// The stage for a monitor configured by `cfg` from `opts` (commissioning, the load), on
+    /// a log with `channels` (a monitor where they feed the
     /// residuals: voltages and a speed), rows `dt_s` apart [s].
     ///
     /// # Errors
@@ -149,7 +160,7 @@ impl LampStage {
         Ok(LampStage {
             monitor,
             sampler: LogSampler::default(),
-            commission: CommissionTracker::new(opts.commission, opts.words, cfg),
+            commission: CommissionTracker::new(opts.commission, cfg),
             k_sigma: cfg.thresholds.k_sigma,
             dt_s,
             load: opts.load,
@@ -193,7 +204,7 @@ impl LampStage {
     }
 
     /// The note on the commissioned range at the monitor's last revision (the timeline's).
-    pub(crate) fn range_note(&self) -> Option<&String> {
+    pub(crate) fn range_note(&self) -> Option<&Vec<commission::RangeDeparture>> {
         self.view.range_note.as_ref()
     }
 
@@ -256,7 +267,7 @@ impl LampStage {
         t: f64,
         out: &MonitorOutput,
         bands: [(f32, f32); 4],
-        (revision, range_note): (u32, Option<String>),
+        (revision, range_note): (u32, Option<Vec<commission::RangeDeparture>>),
     ) {
         note_residuals(&mut self.evaluated, &mut self.max_abs, out);
         // With a commissioning window asked for, lamps lit on the fixed thresholds before
@@ -383,18 +394,12 @@ impl Finish for LampStage {
 
 /// The analyses a log with `channels` cannot feed, with the column they need (the report's
 /// `skipped`).
-fn skipped_analyses(channels: Channels) -> Vec<String> {
-    let mut skipped = Vec::new();
+fn skipped_analyses(channels: Channels) -> Vec<Skipped> {
     if !channels.voltages {
-        skipped.push(
-            "residuals r1..r4 and fault signatures: need the voltages va_V, vb_V, vc_V (Vqs)"
-                .to_string(),
-        );
+        vec![Skipped::ResidualsNeedVoltages]
     } else if !(channels.speed || channels.encoder) {
-        skipped.push(
-            "residuals r1..r4 and fault signatures: need the speed (wm_rad_s or enc_count)"
-                .to_string(),
-        );
+        vec![Skipped::ResidualsNeedSpeed]
+    } else {
+        Vec::new()
     }
-    skipped
 }

@@ -3,12 +3,13 @@
 //! then on ([`CommissionWindow`], `START:END` seconds; [`TimelineStep`], positive;
 //! [`ParallelPaths`], in [`PARALLEL_PATHS`]), their error ([`OptionError`], naming the
 //! field, [`OptionField`], never a front end's spelling
-//! of it: the command line says it as its flags, Python as its keywords, [`Spelling`]),
-//! and the monitor configuration a replay runs with ([`monitor_config_for_log`]).
+//! of it: the door, `monitor_words`, says it in the command line's flags or Python's
+//! keywords), and the monitor configuration a replay runs with ([`monitor_config_for_log`]).
+//! No option carries words.
 
 use super::baseline::HealthyReference;
+pub use super::fields::{OptionError, OptionField, OptionValue};
 use super::sampler::TICK_HZ;
-pub use super::words::{OptionError, OptionField, OptionValue, Spelling, Words};
 use crate::turn_calibration::TurnCalibration;
 use monitor_core::{AngleSource, MonitorConfig, ResidualForm};
 use monitor_io::params::ParamFile;
@@ -59,10 +60,6 @@ pub struct ReplayOptions {
     /// How the shorted-turn level is sized (the fields `parallel_paths`, 1..=8 as
     /// [`PARALLEL_PATHS`] says, and `turn_calibration`; `winding::level`).
     pub turn_level: TurnLevelOptions,
-    /// The words the report's sentences name a field in (a hint to give `commission`, the
-    /// `load`, a `baseline`): the front end's that asked ([`Words`]; the library's own,
-    /// [`FieldNames`], by default). No part of what is judged: ignored by `==`.
-    pub words: Words,
 }
 
 /// What the replay knows of the load torque.
@@ -121,7 +118,6 @@ impl Default for ReplayOptions {
             unbalance_baseline: None,
             load: LoadModel::Unknown,
             turn_level: TurnLevelOptions::default(),
-            words: Words::LIBRARY,
         }
     }
 }
@@ -428,7 +424,7 @@ impl FromStr for TimelineStep {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::words::{Takes, DIAGNOSE_OPTIONS};
+    use crate::fields::{Takes, DIAGNOSE_OPTIONS};
     use monitor_io::log::quality::CellLimits;
 
     /// A value of the kind `takes` that is no option's default.
@@ -519,34 +515,5 @@ mod tests {
         assert!("x".parse::<TimelineStep>().is_err());
         assert!(ParallelPaths::new(0).is_err() && ParallelPaths::new(9).is_err());
         assert_eq!(ParallelPaths::new(8).map(ParallelPaths::get), Ok(8));
-    }
-
-    #[test]
-    fn the_library_words_name_fields_and_two_words_are_equal() {
-        let w = Words::default();
-        assert_eq!(
-            w.hint(OptionField::Commission, "START:END"),
-            "commission = START:END"
-        );
-        assert_eq!(w.hint(OptionField::Baseline, ""), "baseline");
-        assert_eq!(
-            w.command_with("diagnose", OptionField::Baseline),
-            "diagnose's baseline"
-        );
-        // The words are no part of what a replay is asked: options differing only in
-        // them are equal, and print without them.
-        struct Other;
-        impl Spelling for Other {
-            fn option(&self, field: OptionField, _: &str) -> String {
-                format!("<{field}>")
-            }
-        }
-        let other = ReplayOptions {
-            words: Words(&Other),
-            ..ReplayOptions::default()
-        };
-        assert_eq!(other, ReplayOptions::default());
-        assert_eq!(format!("{:?}", other.words), "Words");
-        assert_eq!(other.words.hint(OptionField::Load, "viscous"), "<load>");
     }
 }

@@ -24,7 +24,7 @@ pub(crate) struct QualityFinding {
     /// Why the data cannot carry a verdict, where they cannot: the stage does not trust
     /// them, or more of the log could not be judged than a verdict allows
     /// ([`MAX_NOT_JUDGED_FRACTION`]). Every fault-judging finding is then not judged.
-    pub(crate) distrusts: Option<String>,
+    pub(crate) distrusts: Option<crate::verdict::Detail>,
 }
 
 impl DataQualityStage {
@@ -42,7 +42,7 @@ impl Finish for DataQualityStage {
     fn finish(self, sensors: SensorFlags) -> QualityFinding {
         let finding = data_quality_finding(&self.quality, sensors);
         let distrusts =
-            (!self.quality.trusted || unjudged(&self.quality)).then(|| finding.summary.clone());
+            (!self.quality.trusted || unjudged(&self.quality)).then(|| finding.detail.clone());
         QualityFinding {
             quality: self.quality,
             finding,

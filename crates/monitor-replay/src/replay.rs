@@ -26,8 +26,8 @@ use crate::report::{signature_candidates, DiagnoseReport};
 use crate::rotor::{RotorClosing, RotorStage};
 use crate::sequences::{SequenceFront, SequenceStage, SequenceStep};
 use crate::stage::{Clock, Finish, LampsSeen, Stage};
+use crate::timeline::MovedWhy;
 use crate::timeline::{MonitorState, Panel, TimelineInput, TimelineStage};
-use crate::timeline::{LOAD_BACK_NOTE, LOAD_MOVED_NOTE};
 use crate::verdict::{glance, Verdict};
 use crate::winding::{WindingClosing, WindingStage};
 use crate::windows::SequenceWindow;
@@ -232,7 +232,10 @@ impl Replay {
     /// 6.47..6.48"); `None` inside it or without a learned window. The HMI shows this as
     /// the amber "operating point moved" state: to the paper's model a load change is a Bl
     /// change, so lamps lit there are not a fault unless the isolation names one.
-    pub fn operating_point_moved(&self, out: &MonitorOutput) -> Option<String> {
+    pub fn operating_point_moved(
+        &self,
+        out: &MonitorOutput,
+    ) -> Option<Vec<crate::lamps::commission::RangeDeparture>> {
         self.lamps.commission().moved_note(out)
     }
 
@@ -253,7 +256,7 @@ impl Replay {
     }
 
     /// The commissioning window asked for and why it was not learned, where it was not.
-    pub(crate) fn commissioning_not_learned(&self) -> Option<(String, String)> {
+    pub(crate) fn commissioning_not_learned(&self) -> Option<crate::lamps::commission::NotLearned> {
         self.lamps.commission().not_learned()
     }
 
@@ -353,18 +356,16 @@ fn state_given(
         return state;
     }
     let note = match lamps.commission().moved_note(out) {
-        Some(note) => note,
+        Some(departures) => MovedWhy::OutsideRange { departures },
         // With the load an unknown input, lamps lit for a load that moved inside the
         // commissioned range are the amber state too (`LoadModel::Unknown`).
         None if matches!(state, MonitorState::Fault(_)) && isolation.load_explains_lamps() => {
-            LOAD_MOVED_NOTE.to_string()
+            MovedWhy::LoadMovedInside
         }
         // Lamps that lit while the load had moved are still releasing (they go out
         // after a second inside their bands): amber until they do, unless the isolation
         // names a fault meanwhile.
-        None if matches!(state, MonitorState::Fault(_)) && since_moved => {
-            LOAD_BACK_NOTE.to_string()
-        }
+        None if matches!(state, MonitorState::Fault(_)) && since_moved => MovedWhy::LoadCameBack,
         None => return state,
     };
     let named = match report {

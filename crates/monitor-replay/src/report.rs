@@ -24,23 +24,16 @@ pub struct DiagnoseReport {
     /// The one verdict (`fault`, `watching`, `healthy`, `could_not_judge`): the decision
     /// table over `findings` ([`crate::verdict`]).
     pub verdict: Verdict,
-    /// The verdict's line as `diagnose` prints it after `verdict: `.
-    pub verdict_line: String,
     /// The row of the decision table that decided (`named`, `data_untrusted`, `file_misfit`,
     /// `watching`, `unexplained`, `out_of_range`, `healthy`, `nothing_judged`).
     pub verdict_rule: Rule,
     /// The finding the verdict rests on (null for healthy and for nothing judged).
     pub verdict_finding: Option<FindingReport>,
     /// Every analysis' finding: residuals, winding, rotor, operating point, data quality,
-    /// parameter fit.
+    /// parameter fit. (The door, `monitor_words`, spells the verdict's line and the lists
+    /// of what was and was not judged from them: JSON `verdict_line`, `judged`,
+    /// `not_judged`, `verdict_withheld_because`.)
     pub findings: Vec<FindingReport>,
-    /// What was judged, against what (`residuals against commissioning`, ...).
-    pub judged: Vec<String>,
-    /// What could not be judged, and why.
-    pub not_judged: Vec<String>,
-    /// Why the verdict is not a FAULT or healthy (empty for those): the deciding finding,
-    /// then what could not be judged.
-    pub verdict_withheld_because: Vec<String>,
     /// Final lamps `{"r1":bool,..}`.
     pub lamps: std::collections::BTreeMap<String, bool>,
     /// Final fault candidates, most probable first, with their estimated size: from the
@@ -61,8 +54,10 @@ pub struct DiagnoseReport {
     pub rotor: RotorReport,
     /// Faults ever named while the lamps were lit, with the time first named.
     pub detections: Vec<Detection>,
-    /// Analyses skipped for lack of a column, with the reason.
-    pub skipped: Vec<String>,
+    /// Analyses skipped for lack of a column, with the column (JSON `skipped_reasons`; the
+    /// door spells them as `skipped`).
+    #[serde(rename = "skipped_reasons")]
+    pub skipped: Vec<crate::verdict::Skipped>,
     /// Angle source used (JSON: its command-line name, [`crate::angle_source_name`]).
     #[serde(serialize_with = "serialize_angle_source")]
     pub angle_source: AngleSource,
@@ -129,13 +124,9 @@ impl DiagnoseReport {
         let findings = stages.findings(&unbalance, &rotor);
         DiagnoseReport {
             verdict: Verdict::CouldNotJudge,
-            verdict_line: String::new(),
             verdict_rule: Rule::NothingJudged,
             verdict_finding: None,
             findings,
-            judged: Vec::new(),
-            not_judged: Vec::new(),
-            verdict_withheld_because: Vec::new(),
             lamps: final_lamps(&lamps.out),
             candidates: isolation.candidates,
             isolation: isolation.report,
@@ -147,7 +138,7 @@ impl DiagnoseReport {
             skipped: lamps.skipped,
             angle_source: lamps.angle_source,
             commission: lamps.commission.requested(),
-            commissioning: lamps.commission.report(lamps.k_sigma),
+            commissioning: lamps.commission.report(lamps.k_sigma, lamps.monitor),
             data_quality: DataQuality::default(),
             rows,
             max_abs_residual: lamps.max_abs,
@@ -162,23 +153,22 @@ impl DiagnoseReport {
         let c = conclude(&self.findings);
         self.verdict = c.verdict;
         self.verdict_rule = c.rule;
-        self.verdict_line = c.line;
         self.verdict_finding = c.finding;
-        self.judged = c.judged;
-        self.not_judged = c.not_judged;
-        self.verdict_withheld_because = c.withheld_because;
     }
 
     /// Data that cannot carry a verdict (`why`): every fault-judging finding that judged
     /// something becomes "not judged", with what it would have said (the verdict is decided
     /// after, [`DiagnoseReport::conclude`]).
-    pub(crate) fn distrust(&mut self, why: &str) {
+    pub(crate) fn distrust(&mut self, why: &crate::verdict::Detail) {
         for f in &mut self.findings {
             if f.source().judges_faults()
                 && f.finding.state != monitor_core::verdict::State::NotJudged
             {
-                f.summary = format!("not judged ({why}); it read: {}", f.summary);
-                f.brief = format!("{}: {why}", f.source().name());
+                let read = std::mem::replace(&mut f.detail, crate::verdict::Detail::DataClean);
+                f.detail = crate::verdict::Detail::Distrusted {
+                    why: Box::new(why.clone()),
+                    read: Box::new(read),
+                };
                 f.finding.state = monitor_core::verdict::State::NotJudged;
             }
         }

@@ -77,7 +77,8 @@ mod tests;
 pub use baseband::RotorFront;
 pub use judge::band_of;
 pub use load::{
-    LoadSource, MeasuredPoint, RatedLoadPoint, RotorLoad, MAX_SLIP_OVER_RATED, MCSA_MIN_LOAD,
+    LoadSource, LoadUnknown, MeasuredPoint, RatedLoadPoint, RotorLoad, MAX_SLIP_OVER_RATED,
+    MCSA_MIN_LOAD,
 };
 pub use spectrum::blackman_harris;
 
@@ -173,31 +174,6 @@ impl RotorBand {
             RotorBand::SeveralBrokenBars => f64::INFINITY,
         }
     }
-
-    /// What the band says, in the practice's words, with its range.
-    pub fn words(self) -> &'static str {
-        match self {
-            RotorBand::NoSign => "more than 54 dB below: no sign",
-            RotorBand::Watch => "48-54 dB below: a developing problem may be starting",
-            RotorBand::CrackedBarOrJoint => {
-                "42-48 dB below: a cracked bar or a high-resistance joint likely"
-            }
-            RotorBand::BrokenBars => "36-42 dB below: two or more broken bars likely",
-            RotorBand::SeveralBrokenBars => {
-                "less than 36 dB below: several broken bars and end-ring problems"
-            }
-        }
-    }
-
-    /// The finding's name in the report's sentence.
-    pub fn finding(self) -> &'static str {
-        match self {
-            RotorBand::NoSign => "no sign of broken bars",
-            RotorBand::Watch => "watch the rotor",
-            RotorBand::CrackedBarOrJoint => "rotor bar damage",
-            RotorBand::BrokenBars | RotorBand::SeveralBrokenBars => "broken rotor bars",
-        }
-    }
 }
 
 /// Where the slip the sidebands are read at comes from.
@@ -212,15 +188,76 @@ pub enum SlipSource {
     Sidebands,
 }
 
+/// Why the rotor could not be judged (JSON `rotor.cannot_judge_reason`, `{"kind": ..}`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum RotorCannot {
+    /// Less than two supply periods of good current samples.
+    NoCurrent,
+    /// No steady stretch of 0.2 s chunks (of the slip where the log has a speed, else of
+    /// the current).
+    NotSteady {
+        /// The slip was followed (the log has a speed).
+        by_speed: bool,
+    },
+    /// The load is below [`MCSA_MIN_LOAD`] of the rated torque.
+    LoadTooLow {
+        /// Below a tenth of the rated torque ("no load"), else "light load".
+        no_load: bool,
+    },
+    /// A pair about the line at a slip the machine cannot run at steadily at this load.
+    NotSidebands {
+        /// The pair's slip.
+        slip: f64,
+        /// The steady slip the machine reaches at this load.
+        top: f64,
+    },
+    /// No speed, and no pair of sidebands nor of rotation harmonics stands above the noise.
+    SlipUnknown {
+        /// The largest component where the lower sideband could be [dB below the line].
+        largest_db_below: f64,
+    },
+    /// The slip is below [`MIN_SLIP`] (no load).
+    SlipBelow {
+        /// The slip.
+        slip: f64,
+    },
+    /// The slip is above [`MAX_SLIP`] (a start or an overload).
+    SlipAbove {
+        /// The slip.
+        slip: f64,
+    },
+    /// The steady stretch is too short to resolve the sidebands.
+    TooShort {
+        /// Its length [s].
+        stretch_s: f64,
+        /// The length needed [s].
+        needed_s: f64,
+        /// The sidebands' distance from the line `2 s f` [Hz].
+        offset_hz: f64,
+    },
+    /// No supply line in the current's spectrum.
+    NoLine,
+    /// The current's noise, where the sideband is read, is above what a healthy cage is told
+    /// at.
+    Noisy {
+        /// The noise [dB below the line].
+        floor_db_below: f64,
+    },
+}
+
 /// What `diagnose` found of the rotor (JSON `rotor`; module docs).
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct RotorReport {
     /// True when the sidebands were read and judged.
     pub judged: bool,
-    /// Why not ("cannot judge: ..."), null when judged.
-    pub cannot_judge_because: Option<String>,
-    /// One sentence: the finding, or why there is none.
-    pub sentence: String,
+    /// Why not, null when judged (JSON `cannot_judge_reason`, `{"kind": ..}` with its
+    /// numbers; the door spells it as `cannot_judge_because`, and the report's one
+    /// `sentence`).
+    #[serde(rename = "cannot_judge_reason")]
+    pub cannot_judge_because: Option<RotorCannot>,
+    /// The sideband was read at the current's noise (a judgement of "below the noise").
+    pub at_noise: bool,
     /// The `(1 - 2s) f` sideband relative to the supply line [dB] (negative: -45.0 is
     /// 45 dB below the line).
     pub level_db: Option<f64>,
@@ -232,10 +269,9 @@ pub struct RotorReport {
     /// Without a slip: the largest component anywhere the lower sideband could be (slips
     /// [`MIN_SLIP`]..[`MAX_SLIP`]) relative to the line [dB]; an upper bound of the level.
     pub largest_possible_db: Option<f64>,
-    /// The level's severity band ([`RotorBand`]).
+    /// The level's severity band ([`RotorBand`]; the door spells its meaning as
+    /// `band_meaning`).
     pub band: Option<RotorBand>,
-    /// The band in words.
-    pub band_meaning: Option<String>,
     /// Probability that the rotor has a fault (module docs, "Confidence"); below one half
     /// for the "watch" band and quieter.
     pub confidence: Option<f64>,

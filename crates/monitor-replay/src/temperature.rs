@@ -39,10 +39,72 @@ pub struct TemperatureReport {
     /// (`1 + 0.00393 rise`) instead of tracked from the residuals.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub measured_rise_k: Option<f32>,
-    /// `used`, or `not used: <why>` (the isolation then tracks the heating from the
-    /// resistances).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub temperature_channel: Option<String>,
+    /// Whether the channel is used, or why not (JSON `temperature_channel_state`; the door
+    /// spells it as `temperature_channel`: `used`, or `not used: <why>`; the isolation then
+    /// tracks the heating from the resistances).
+    #[serde(
+        rename = "temperature_channel_state",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub temperature_channel: Option<ChannelUse>,
+}
+
+/// Whether the log's temperature channel is used (JSON `{"kind": ..}`).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum ChannelUse {
+    /// Used: Rs and Rr are compensated with its rise.
+    Used,
+    /// Not used, and why.
+    NotUsed {
+        /// Why.
+        why: ChannelDropped,
+    },
+}
+
+/// Why the temperature channel is not used (JSON `{"kind": ..}` with its numbers).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum ChannelDropped {
+    /// No plausible reading (inside [`PLAUSIBLE_C`]) for [`GAP_S`] from `since_s`.
+    NoReading {
+        /// The last plausible reading's time [s].
+        since_s: f64,
+    },
+    /// No plausible reading while commissioning learned.
+    NoneWhileCommissioning,
+    /// One value for [`STUCK_S`] from `since_s`.
+    Stuck {
+        /// The value [degC].
+        value_c: f64,
+        /// Since when [s].
+        since_s: f64,
+    },
+    /// A jump faster than a winding heats ([`MAX_HEATING_K_PER_S`]).
+    Jumped {
+        /// The reading before [degC].
+        from_c: f64,
+        /// The reading after [degC].
+        to_c: f64,
+        /// Between the two [s].
+        dt_s: f64,
+        /// When [s].
+        at_s: f64,
+    },
+    /// The resistances disagree with the channel by more than [`DISAGREE_K`].
+    Disagrees {
+        /// The resistances' winding minus the channel's reading [K].
+        off_k: f32,
+        /// Since when [s].
+        since_s: f64,
+    },
+    /// A rise the core refuses (beyond what a winding reaches in service).
+    BeyondService {
+        /// The rise [K].
+        rise_k: f32,
+    },
+    /// No commissioning: the rise counts from the temperature commissioning saw.
+    NoCommissioning,
 }
 
 /// The plausible range of a winding or frame temperature [degC]: from an unheated machine
@@ -82,7 +144,7 @@ pub(super) struct TemperatureChannel {
     /// Since when the resistances disagree with the channel [s].
     disagree_since_s: Option<f64>,
     /// Why the channel is not used (from then on).
-    not_used: Option<String>,
+    not_used: Option<ChannelDropped>,
     /// When the first reading came [s] (the gap counts from it).
     first_s: Option<f64>,
 }
@@ -136,23 +198,20 @@ impl TemperatureChannel {
         }
         let since = self.last.map_or(first, |(s, _)| s);
         if t - since > GAP_S {
-            self.drop_channel(format!(
-                "no reading inside {:.0}..{:.0} degC for {GAP_S:.0} s from {since:.1} s (NaN, empty or out of range)",
-                PLAUSIBLE_C.0, PLAUSIBLE_C.1
-            ));
+            self.drop_channel(ChannelDropped::NoReading { since_s: since });
         }
         if learned && !learning && self.commissioned_c.is_none() {
             if self.learn_n == 0 {
-                self.drop_channel("no plausible reading during commissioning".into());
+                self.drop_channel(ChannelDropped::NoneWhileCommissioning);
             }
             self.commissioned_c = Some(self.learn_sum / self.learn_n.max(1) as f64);
         }
         if learned && t - self.changed_at_s > STUCK_S {
             let v = self.last.map_or(f64::NAN, |l| l.1);
-            self.drop_channel(format!(
-                "stuck at {v:.1} degC from {:.1} s ({STUCK_S:.0} s without a change)",
-                self.changed_at_s
-            ));
+            self.drop_channel(ChannelDropped::Stuck {
+                value_c: v,
+                since_s: self.changed_at_s,
+            });
         }
         if self.not_used.is_some() || !learned {
             return None;
@@ -169,10 +228,12 @@ impl TemperatureChannel {
         };
         let allowed = MAX_HEATING_K_PER_S * (t - t0) + JUMP_SLACK_K;
         if (x - x0).abs() > allowed {
-            self.drop_channel(format!(
-                "jumped from {x0:.1} to {x:.1} degC in {:.2} s at {t:.1} s (a winding heats by at most {MAX_HEATING_K_PER_S:.0} K/s)",
-                t - t0
-            ));
+            self.drop_channel(ChannelDropped::Jumped {
+                from_c: x0,
+                to_c: x,
+                dt_s: t - t0,
+                at_s: t,
+            });
         }
     }
 
@@ -190,9 +251,10 @@ impl TemperatureChannel {
         if iso.heating_explains() && off_k.abs() > DISAGREE_K {
             let since = *self.disagree_since_s.get_or_insert(t);
             if t - since >= DISAGREE_S {
-                self.drop_channel(format!(
-                    "the resistances say the winding is {off_k:+.0} K from the channel's reading since {since:.1} s"
-                ));
+                self.drop_channel(ChannelDropped::Disagrees {
+                    off_k,
+                    since_s: since,
+                });
             }
         } else {
             self.disagree_since_s = None;
@@ -214,10 +276,9 @@ impl TemperatureChannel {
         }
         let rise = self.observe(t, reading, learning, follower.learned());
         if !follower.set_measured_rise_k(rise) {
-            self.drop_channel(format!(
-                "a rise of {:.0} K since commissioning is beyond what a winding reaches in service",
-                rise.unwrap_or(f32::NAN)
-            ));
+            self.drop_channel(ChannelDropped::BeyondService {
+                rise_k: rise.unwrap_or(f32::NAN),
+            });
             follower.set_measured_rise_k(None);
         }
     }
@@ -231,22 +292,22 @@ impl TemperatureChannel {
             winding_temperature_c: self.last_c().map(|x| x as f32),
             measured_rise_k: self.rise_k().map(|x| x as f32),
             temperature_channel: Some(match self.not_used() {
-                Some(why) => format!("not used: {why}"),
-                None if self.commissioned_c.is_none() => {
-                    "not used: no commissioning (the rise counts from the temperature commissioning saw)".into()
-                }
-                None => "used".into(),
+                Some(why) => ChannelUse::NotUsed { why },
+                None if self.commissioned_c.is_none() => ChannelUse::NotUsed {
+                    why: ChannelDropped::NoCommissioning,
+                },
+                None => ChannelUse::Used,
             }),
         }
     }
 
-    fn drop_channel(&mut self, why: String) {
+    fn drop_channel(&mut self, why: ChannelDropped) {
         self.not_used.get_or_insert(why);
     }
 
     /// Why the channel is not used, if it is not.
-    pub fn not_used(&self) -> Option<&str> {
-        self.not_used.as_deref()
+    pub fn not_used(&self) -> Option<ChannelDropped> {
+        self.not_used
     }
 
     /// The last plausible reading [degC].
@@ -289,13 +350,22 @@ mod tests {
         let rise = warm.rise_k().unwrap();
         assert!((rise - 37.0).abs() < 0.5, "{rise}");
         let nan = run(40.0, |t| if t > 10.0 { f64::NAN } else { 20.0 + noise(t) });
-        assert!(nan.not_used().unwrap().contains("no reading"), "{nan:?}");
+        assert!(
+            matches!(nan.not_used(), Some(ChannelDropped::NoReading { since_s }) if (since_s - 10.0).abs() < 0.05),
+            "{nan:?}"
+        );
         let jump = run(40.0, |t| {
             20.0 + noise(t) + if t > 10.0 { 60.0 } else { 0.0 }
         });
-        assert!(jump.not_used().unwrap().contains("jumped"), "{jump:?}");
+        assert!(
+            matches!(jump.not_used(), Some(ChannelDropped::Jumped { to_c, .. }) if to_c > 75.0),
+            "{jump:?}"
+        );
         let stuck = run(60.0, |t| if t > 10.0 { 21.0 } else { 20.0 + noise(t) });
-        assert!(stuck.not_used().unwrap().contains("stuck"), "{stuck:?}");
+        assert!(
+            matches!(stuck.not_used(), Some(ChannelDropped::Stuck { value_c, .. }) if value_c == 21.0),
+            "{stuck:?}"
+        );
         let hot = run(40.0, |t| if t > 10.0 { 400.0 } else { 20.0 + noise(t) });
         assert!(hot.not_used().is_some(), "{hot:?}");
         // A log without the column: nothing, and nothing to say.

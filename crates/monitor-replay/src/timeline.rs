@@ -6,6 +6,7 @@
 //! it ([`TimelineInput`]); at the end it gives its points.
 
 use crate::isolation::{FaultCandidate, IsolationReport};
+use crate::lamps::commission::RangeDeparture;
 use crate::options::ReplayOptions;
 use crate::stage::{Finish, Stage};
 use monitor_core::{CommissioningState, Fault, MonitorOutput};
@@ -28,9 +29,9 @@ pub enum MonitorState {
     /// Lamps lit: the candidates with their probabilities.
     Fault(Vec<(Fault, f32)>),
     /// The load or the voltage has left the commissioned range and no fault is named (the
-    /// amber state): lamps may light, the FAULT lamp stays off; the note says where the
-    /// operating point went ([`crate::Replay::operating_point_moved`]).
-    Moved(String),
+    /// amber state): lamps may light, the FAULT lamp stays off; why the operating point
+    /// counts as moved ([`crate::Replay::operating_point_moved`]).
+    Moved(MovedWhy),
 }
 
 impl MonitorState {
@@ -59,15 +60,25 @@ impl MonitorState {
     }
 }
 
-/// The amber state's note where the lamps lit for a load that moved inside the commissioned
-/// range, with the load an unknown input (`LoadModel::Unknown`).
-pub const LOAD_MOVED_NOTE: &str =
-    "load moved inside the commissioned range; the stator-voltage equations fit (the torque residuals read it as Bl)";
-
-/// The amber state's note while lamps that lit for a load move go out after the load came
-/// back into the commissioned range.
-pub const LOAD_BACK_NOTE: &str =
-    "the load came back; the lamps that lit while it had moved are going out";
+/// Why the operating point counts as moved (the amber state).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum MovedWhy {
+    /// The load or the voltage has left the commissioned range.
+    OutsideRange {
+        /// What left it.
+        departures: Vec<RangeDeparture>,
+    },
+    /// The lamps lit for a load that moved inside the commissioned range, with the load an
+    /// unknown input (`LoadModel::Unknown`): the stator-voltage equations fit.
+    LoadMovedInside,
+    /// The load came back into the commissioned range; the lamps that lit while it had
+    /// moved are going out.
+    LoadCameBack,
+    /// The board's status line says the load or the voltage left the commissioned range
+    /// (it does not say which, nor by how much).
+    BoardSays,
+}
 
 /// One point of the diagnosis timeline.
 #[derive(Debug, Clone, Serialize)]
@@ -92,9 +103,10 @@ pub struct TimelinePoint {
     pub quasi_steady: bool,
     /// |I2|/|I1|.
     pub negative_sequence_ratio: f32,
-    /// Beside a lit r2..r4 lamp: the operating point has left the commissioned range.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub range_note: Option<String>,
+    /// Beside a lit r2..r4 lamp: the operating point has left the commissioned range, and
+    /// how (JSON `range_departures`; the door spells it as `range_note`).
+    #[serde(rename = "range_departures", skip_serializing_if = "Option::is_none")]
+    pub range_note: Option<Vec<RangeDeparture>>,
     /// What the panel shows ([`crate::Replay::panel`]; not in the JSON, whose keys above carry
     /// it).
     #[serde(skip)]
@@ -144,7 +156,7 @@ pub(crate) struct TimelineInput<'a> {
     /// A lamp is lit.
     pub(crate) lamps_lit: bool,
     /// The commissioned range's note at the monitor's last revision.
-    pub(crate) range_note: Option<&'a String>,
+    pub(crate) range_note: Option<&'a Vec<RangeDeparture>>,
     /// Whether the operating point has moved now: the load explains the lamps, or the
     /// point is outside the commissioned range (asked only while a lamp is lit and the
     /// amber memory is off).
@@ -174,7 +186,12 @@ impl TimelineStage {
 }
 
 /// The timeline point of an output at `t` with what the panel shows there.
-fn point(t: f64, out: &MonitorOutput, range_note: Option<String>, panel: Panel) -> TimelinePoint {
+fn point(
+    t: f64,
+    out: &MonitorOutput,
+    range_note: Option<Vec<RangeDeparture>>,
+    panel: Panel,
+) -> TimelinePoint {
     let top = out.top();
     TimelinePoint {
         t_s: t,

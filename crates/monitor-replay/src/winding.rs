@@ -55,7 +55,7 @@ mod reasons;
 mod segments;
 mod stage;
 
-pub use reasons::BALANCED_RATIO;
+pub use reasons::{PhaseNotJudged, Widened, BALANCED_RATIO};
 pub use segments::segments;
 pub(crate) use stage::{WindingClosing, WindingStage};
 
@@ -165,34 +165,10 @@ pub enum OperatingPointSource {
     AssumedRange,
 }
 
-impl OperatingPointSource {
-    /// In words, for the text report.
-    pub fn describe(self) -> &'static str {
-        match self {
-            OperatingPointSource::Voltages => "measured from the voltages",
-            OperatingPointSource::Speed => "the model's at the measured speed",
-            OperatingPointSource::CurrentMagnitude => "the model's at the current's magnitude",
-            OperatingPointSource::AssumedRange => {
-                "unknown operating point: no load to full load (the current's magnitude does not fit the parameter file)"
-            }
-        }
-    }
-}
-
 /// What the winding's change was judged against (JSON `unbalance.judged_against`): the
 /// verdict's own vocabulary (`monitor_core::verdict::Against`: `commissioning`,
 /// `healthy_runs`, `within_the_log`, `nothing`).
 pub use monitor_core::verdict::Against;
-
-/// What a winding judgement's reference is, in words, for the text report.
-pub fn describe_against(a: Against) -> &'static str {
-    match a {
-        Against::Commissioning => "against the commissioning window",
-        Against::HealthyRuns => "against the healthy runs",
-        Against::WithinTheLog => "against another stretch of the log",
-        Against::ParameterFile | Against::Nothing => "with no healthy baseline",
-    }
-}
 
 /// The probabilities of no short and of a short in each phase (JSON
 /// `unbalance.phase_probabilities`; they sum to 1).
@@ -343,10 +319,11 @@ pub struct UnbalanceReport {
     pub phase_confidence: f32,
     /// The probabilities of no short and of a short in each phase.
     pub phase_probabilities: PhaseProbabilities,
-    /// Why no phase is judged although the currents are unbalanced, or null: no healthy
-    /// baseline, and the winding part is within a healthy machine's own asymmetry
-    /// (`monitor_core::sequence::INHERENT_ASYMMETRY_RATIO`).
-    pub phase_not_judged: Option<String>,
+    /// Why no phase is named although the currents are unbalanced, or null (JSON
+    /// `phase_not_judged_reason`, `{"kind": ..}` with its numbers; the door spells it as
+    /// `phase_not_judged`).
+    #[serde(rename = "phase_not_judged_reason")]
+    pub phase_not_judged: Option<PhaseNotJudged>,
     /// arg(I2w/I1) [deg]: the winding's part (the supply's part taken out).
     pub angle_deg: f32,
     /// |I2w|/|I1|: the winding's part of the negative sequence.
@@ -367,9 +344,11 @@ pub struct UnbalanceReport {
     /// a phase at [`WINDING_FAULT_PROBABILITY`] (on its sector's centre, with the
     /// judged spread and reference angle); 0 when none does.
     pub least_change: f32,
-    /// Where the reference ran at another operating point than the judged stretch: a
-    /// sentence saying so and how much the least change was widened for it; else null.
-    pub least_change_widened: Option<String>,
+    /// Where the reference ran at another operating point than the judged stretch: how it
+    /// differed and how much the least change was widened for it; else null (JSON
+    /// `least_change_widened_by`; the door spells it as `least_change_widened`).
+    #[serde(rename = "least_change_widened_by")]
+    pub least_change_widened: Option<reasons::Widened>,
     /// The spread the change is judged with (each component, fraction of |I1|): the
     /// healthy reference's, the judged stretch's own and, at another operating point,
     /// what the load moves.
@@ -406,6 +385,10 @@ pub struct UnbalanceReport {
     /// The model's estimate, also where a calibration gave `shorted_turns`; null without a
     /// named phase.
     pub shorted_turns_physics: Option<level::ShortedTurns>,
+    /// Where no phase is named: how large a short this log could hide, in the fraction of a
+    /// phase's turns whose loop draws the least change ([`level::TurnReach`]); null where
+    /// a phase is named or nothing was judged.
+    pub shorted_turns_reach: Option<level::TurnReach>,
 }
 
 impl UnbalanceReport {

@@ -233,7 +233,9 @@ fn tally(baseline: Option<HealthyReference>, mode: &str) -> Tally {
             u.judged_against,
             u.correction_deg,
             u.correction_uncertainty_deg,
-            u.phase_not_judged.as_deref().map(|w| format!(" ({w})")).unwrap_or_default()
+            u.phase_not_judged
+                .map(|w| format!(" ({w:?})"))
+                .unwrap_or_default()
         );
         match (got, u.names_a_short()) {
             (Some(g), true) if g == phase => t.right += 1,

@@ -154,7 +154,7 @@ fn broken_bars_are_named_with_their_level_and_band() {
         let fs = 2.0 * s * p.supply.f_hz;
         let case =
             format!("{which} load {load} {broken} bars {record_s} s {rate} Hz noise {noisy}");
-        eprintln!("{case}: {}", r.sentence);
+        eprintln!("{case}: {}", said(&r));
         if rep.unbalance.suspect_phase.is_some() && rep.unbalance.phase_confidence >= 0.5 {
             failures.push(format!(
                 "{case}: the winding names phase {:?} at {:.2}",
@@ -163,7 +163,7 @@ fn broken_bars_are_named_with_their_level_and_band() {
         }
         // The resolution rule: 5 bins of 1/T between the line and 2sf.
         if record_s < 5.0 / fs + 0.05 {
-            let why = r.cannot_judge_because.clone().unwrap_or_default();
+            let why = monitor_words::diagnose::Story::rotor_sentence(r);
             if !why.contains("s are needed") || r.judged {
                 failures.push(format!(
                     "{case}: 2sf = {fs:.2} Hz needs {:.2} s: {why}",
@@ -181,10 +181,10 @@ fn broken_bars_are_named_with_their_level_and_band() {
         // Named as broken bars, with the level and a band past "watch".
         let named = r.judged
             && p_fault >= 0.5
-            && r.sentence.contains("broken rotor bars")
-            && r.sentence.contains(&format!("{:.1} dB below", -level));
+            && said(&r).contains("broken rotor bars")
+            && said(&r).contains(&format!("{:.1} dB below", -level));
         if !named || matches!(r.band, Some(RotorBand::NoSign | RotorBand::Watch) | None) {
-            failures.push(format!("{case}: not named: {}", r.sentence));
+            failures.push(format!("{case}: not named: {}", said(&r)));
         }
         // The textbook's sum of the two sidebands, within 2 dB.
         let sum = 10f64.powf(level / 20.0) + 10f64.powf(upper / 20.0);
@@ -217,12 +217,12 @@ fn healthy_motors_of_three_sizes_give_no_rotor_finding() {
             let rows = record(which, load, 0.0, record_s, rate, noisy);
             let r = diagnose(&p, &rows, true, true).rotor;
             let case = format!("healthy {which} load {load} {record_s} s {rate} Hz noise {noisy}");
-            eprintln!("{case}: {}", r.sentence);
+            eprintln!("{case}: {}", said(&r));
             let fs = 2.0 * slip_of(&p, &rows) * p.supply.f_hz;
             if record_s < 5.0 / fs + 0.05 {
                 // Too short for this slip: said so, and no finding.
-                if r.judged || !r.sentence.contains("s are needed") {
-                    failures.push(format!("{case}: {}", r.sentence));
+                if r.judged || !said(&r).contains("s are needed") {
+                    failures.push(format!("{case}: {}", said(&r)));
                 }
                 continue;
             }
@@ -231,9 +231,9 @@ fn healthy_motors_of_three_sizes_give_no_rotor_finding() {
                 && r.confidence.is_some_and(|c| c < 0.01);
             // "no sign" names no fault: no confidence or probability beside it (issue 65:
             // "confidence 0.00" read as "not sure").
-            let no_number = !r.sentence.contains("confidence") && !r.sentence.contains("probab");
-            if !quiet || !r.sentence.contains("no sign of broken bars") || !no_number {
-                failures.push(format!("{case}: {}", r.sentence));
+            let no_number = !said(&r).contains("confidence") && !said(&r).contains("probab");
+            if !quiet || !said(&r).contains("no sign of broken bars") || !no_number {
+                failures.push(format!("{case}: {}", said(&r)));
             }
         }
     }
@@ -319,15 +319,15 @@ fn synthetic_sidebands_are_read_at_their_level_through_noise_and_a_speed_wobble(
         (0.02, -30.0, -33.0, 0.01, 0.004, 6.0),
     ] {
         let r = diagnose_synthetic(&synthetic(s, lo, up, noise, wobble, dur, &mut g));
-        eprintln!("{lo} dB, noise {noise}, wobble {wobble}: {}", r.sentence);
-        assert!(r.judged, "{}", r.sentence);
+        eprintln!("{lo} dB, noise {noise}, wobble {wobble}: {}", said(&r));
+        assert!(r.judged, "{}", said(&r));
         assert_eq!(r.slip_source, Some(SlipSource::Speed));
         let level = r.level_db.unwrap();
-        assert!((level - lo).abs() < 0.5, "{lo}: {}", r.sentence);
+        assert!((level - lo).abs() < 0.5, "{lo}: {}", said(&r));
         assert!(
             (r.upper_sideband_db.unwrap() - up).abs() < 0.7,
             "{up}: {}",
-            r.sentence
+            said(&r)
         );
         let band = match lo {
             x if x < -54.0 => RotorBand::NoSign,
@@ -336,10 +336,10 @@ fn synthetic_sidebands_are_read_at_their_level_through_noise_and_a_speed_wobble(
             x if x < -36.0 => RotorBand::BrokenBars,
             _ => RotorBand::SeveralBrokenBars,
         };
-        assert_eq!(r.band, Some(band), "{}", r.sentence);
+        assert_eq!(r.band, Some(band), "{}", said(&r));
         // "watch" is a finding below one half, a cracked bar or worse above.
         let p = r.confidence.unwrap();
-        assert_eq!(p >= 0.5, lo > -48.0, "{}", r.sentence);
+        assert_eq!(p >= 0.5, lo > -48.0, "{}", said(&r));
     }
 }
 
@@ -376,7 +376,7 @@ fn the_confidence_is_calibrated_on_records_of_known_sidebands() {
         let Some(p) = r.confidence else {
             panic!(
                 "no confidence at {level:.1} dB, noise {noise}: {}",
-                r.sentence
+                said(&r)
             ); // ok: test
         };
         rows.push((p, level > edge));
@@ -439,25 +439,21 @@ fn what_is_missing_is_said() {
     let rows = record("3hp", 1.0, 1.0, 0.6, 2000.0, false);
     let r = diagnose(&p, &rows, true, true).rotor;
     assert!(
-        !r.judged && r.sentence.contains("s are needed"),
+        !r.judged && said(&r).contains("s are needed"),
         "{}",
-        r.sentence
+        said(&r)
     );
     // No load.
     let rows = record("3hp", 0.0, 1.0, 4.0, 2000.0, false);
     let r = diagnose(&p, &rows, true, true).rotor;
-    assert!(
-        !r.judged && r.sentence.contains("(no load)"),
-        "{}",
-        r.sentence
-    );
+    assert!(!r.judged && said(&r).contains("(no load)"), "{}", said(&r));
     // No speed and a healthy cage: the slip is unknown; the bound is given.
     let rows = record("3hp", 1.0, 0.0, 4.0, 2000.0, false);
     let r = diagnose(&p, &rows, true, false).rotor;
     assert!(
-        !r.judged && r.sentence.contains("the slip is unknown"),
+        !r.judged && said(&r).contains("the slip is unknown"),
         "{}",
-        r.sentence
+        said(&r)
     );
     assert!(r.largest_possible_db.is_some_and(|x| x < -54.0), "{r:?}");
     assert_eq!(r.confidence, None);
@@ -465,14 +461,14 @@ fn what_is_missing_is_said() {
     // a pair taken for the rotor's by assumption stays a finding below one half.
     let rows = record("3hp", 1.0, 1.0, 4.0, 2000.0, false);
     let r = diagnose(&p, &rows, false, false).rotor;
-    assert_eq!(r.slip_source, Some(SlipSource::Sidebands), "{}", r.sentence);
+    assert_eq!(r.slip_source, Some(SlipSource::Sidebands), "{}", said(&r));
     assert!(
         (r.slip.unwrap() - slip_of(&p, &rows)).abs() < 0.002,
         "{}",
-        r.sentence
+        said(&r)
     );
-    assert_eq!(r.band, Some(RotorBand::SeveralBrokenBars), "{}", r.sentence);
-    assert!(r.confidence.unwrap() < 0.5, "{}", r.sentence);
+    assert_eq!(r.band, Some(RotorBand::SeveralBrokenBars), "{}", said(&r));
+    assert!(r.confidence.unwrap() < 0.5, "{}", said(&r));
 }
 
 /// A record of `which` at 70 % of its rated torque with `broken` bars, the load stepping to
@@ -524,9 +520,9 @@ fn the_lamps_are_evaluated_on_a_steady_broken_bar_record_and_a_load_step_still_h
         );
         let first = rep.timeline.iter().find(|t| t.evaluating).map(|t| t.t_s);
         let never = rep
-            .verdict_withheld_because
+            .findings
             .iter()
-            .any(|w| w.contains("never evaluated"));
+            .any(|f| f.detail == monitor_replay::Detail::ResidualsNeverEvaluated);
         eprintln!("{which} {broken} bars: first evaluated at {first:?} s of a 5 s record");
         if first.is_none_or(|t| t > 3.5) || never {
             failures.push(format!(
@@ -577,10 +573,15 @@ fn real_recordings_of_a_healthy_cage_give_no_rotor_fault() {
                 .expect("diagnose") // ok: test
                 .report;
         let r = rep.rotor;
-        eprintln!("{}: {}", path.display(), r.sentence);
+        eprintln!("{}: {}", path.display(), said(&r));
         if r.confidence.is_some_and(|c| c >= 0.5) {
-            failures.push(format!("{}: {}", path.display(), r.sentence));
+            failures.push(format!("{}: {}", path.display(), said(&r)));
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The rotor's one sentence, as the door spells it for a crew.
+fn said(r: &monitor_replay::RotorReport) -> String {
+    monitor_words::diagnose::Story::rotor_sentence(r)
 }

@@ -11,7 +11,8 @@ use monitor_core::verdict::{FindingSource, State};
 use monitor_io::log::{Channels, Row};
 use monitor_io::params::ParamFile;
 use monitor_replay::{
-    diagnose_rows, DiagnoseReport, LoadSource, ReplayOptions, RotorBand, Verdict, MCSA_MIN_LOAD,
+    diagnose_rows, DiagnoseReport, LoadSource, ReplayOptions, RotorBand, RotorCannot, Verdict,
+    MCSA_MIN_LOAD,
 };
 use monitor_sim::{
     simulate_to_vec, EffectSpec, LoadKind, LoadSpec, LoadStep, Scenario, SensorSpec,
@@ -43,28 +44,15 @@ fn healthy_real_motor_at_no_load_gets_no_rotor_finding_in_its_verdict() {
     for name in ["SC_HLT_001.csv", "SC_HLT_002.csv"] {
         let rep = itsc(name);
         let r = &rep.rotor;
-        eprintln!("{name}: {}\n  verdict: {}", r.sentence, rep.verdict_line);
-        assert_eq!(
-            rep.verdict,
-            Verdict::Healthy,
-            "{name}: {}",
-            rep.verdict_line
+        eprintln!(
+            "{name}: {:?}\n  verdict: {:?}",
+            r.cannot_judge_because, rep.verdict
         );
-        // Nothing of the rotor among what the verdict judged: no level, no watch band.
-        let judged = rep.verdict_line.split("not judged:").next().unwrap_or("");
-        assert!(!judged.contains("rotor"), "{name}: {}", rep.verdict_line);
-        assert!(
-            !rep.verdict_line.contains("watch band"),
-            "{name}: {}",
-            rep.verdict_line
-        );
-        assert!(
-            rep.judged.iter().all(|j| !j.contains("rotor")),
-            "{:?}",
-            rep.judged
-        );
+        assert_eq!(rep.verdict, Verdict::Healthy, "{name}: {:?}", rep.findings);
         // The rotor finding: not judged, saying why (the load, or a pair that cannot be the
-        // sidebands at a slip a machine at no load does not have).
+        // sidebands at a slip a machine at no load does not have); nothing of the rotor is
+        // then among what the verdict judged (no level, no watch band: the verdict's lists
+        // hold the judged findings only).
         let f = rep
             .findings
             .iter()
@@ -72,15 +60,18 @@ fn healthy_real_motor_at_no_load_gets_no_rotor_finding_in_its_verdict() {
             .expect("a rotor finding"); // ok: test
         assert!(
             matches!(f.finding.state, State::Unavailable | State::NotJudged),
-            "{name}: {:?} {}",
+            "{name}: {:?} {:?}",
             f.finding.state,
-            f.summary
+            f.detail
         );
-        assert!(!r.judged && r.band.is_none(), "{name}: {}", r.sentence);
+        assert!(!r.judged && r.band.is_none(), "{name}: {r:?}");
         assert!(
-            r.sentence.contains("not rotor sidebands") || r.sentence.contains("too low"),
-            "{name}: {}",
-            r.sentence
+            matches!(
+                r.cannot_judge_because,
+                Some(RotorCannot::NotSidebands { .. } | RotorCannot::LoadTooLow { .. })
+            ),
+            "{name}: {:?}",
+            r.cannot_judge_because
         );
     }
 }
@@ -200,7 +191,7 @@ fn broken_bars_are_judged_at_load_and_said_too_lightly_loaded_below_it() {
         let rep = diagnose(&p, &rows, voltages, speed);
         let r = &rep.rotor;
         let case = format!("load {x}, voltages {voltages}, speed {speed}");
-        eprintln!("{case}: {}", r.sentence);
+        eprintln!("{case}: {:?} {:?}", r.band, r.cannot_judge_because);
         // The load the report estimates, against the set torque (plus the file's friction
         // B w_m, which the machine carries too) over the textbook's rated torque.
         let est = r.load.as_ref().and_then(|l| l.fraction);
@@ -225,13 +216,12 @@ fn broken_bars_are_judged_at_load_and_said_too_lightly_loaded_below_it() {
         if x < MCSA_MIN_LOAD {
             // Too lightly loaded: not judged, the estimate and the threshold named, nothing
             // named in the verdict.
-            let said = r
-                .sentence
-                .contains("the load is too low to judge the rotor")
-                && r.sentence
-                    .contains(&format!("{:.0} %", 100.0 * MCSA_MIN_LOAD));
+            let said = matches!(r.cannot_judge_because, Some(RotorCannot::LoadTooLow { .. }))
+                && r.load
+                    .as_ref()
+                    .is_some_and(|l| l.min_fraction == MCSA_MIN_LOAD);
             if r.judged || !said || !matches!(rotor, Some(State::Unavailable)) {
-                failures.push(format!("{case}: {rotor:?} {}", r.sentence));
+                failures.push(format!("{case}: {rotor:?} {:?}", r.cannot_judge_because));
             }
         } else if speed {
             // At load with the speed: broken bars named, as before the gate.
@@ -240,12 +230,12 @@ fn broken_bars_are_judged_at_load_and_said_too_lightly_loaded_below_it() {
                 && !matches!(r.band, Some(RotorBand::NoSign | RotorBand::Watch) | None)
                 && matches!(rotor, Some(State::Named(_)));
             if !named {
-                failures.push(format!("{case}: not named: {}", r.sentence));
+                failures.push(format!("{case}: not named: {r:?}"));
             }
         } else if !r.judged || matches!(r.band, Some(RotorBand::NoSign) | None) {
             // At load without the speed: the pair read, its slip plausible at the load the
             // voltages say; unconfirmed, but judged.
-            failures.push(format!("{case}: not read: {}", r.sentence));
+            failures.push(format!("{case}: not read: {r:?}"));
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));

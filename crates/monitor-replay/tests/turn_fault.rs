@@ -284,7 +284,9 @@ fn the_shorted_phase_is_named_against_a_healthy_recording() {
             u.correction_deg,
             u.correction_uncertainty_deg,
             u.operating_point,
-            u.phase_not_judged.as_deref().map(|w| format!(": {w}")).unwrap_or_default()
+            u.phase_not_judged
+                .map(|w| format!(": {w:?}"))
+                .unwrap_or_default()
         );
         match short {
             Some((phase, _, _)) => {

@@ -50,13 +50,20 @@ fn a_clipped_voltage_sensor_withholds_the_verdict_and_headroom_gives_the_size() 
     }
     assert!(!q.trusted);
     assert_eq!(clipped.verdict, Verdict::CouldNotJudge);
+    // The verdict rests on the data-quality finding, which does not trust the clipping
+    // voltage channel.
     assert!(
-        clipped
-            .verdict_withheld_because
+        q.not_trusted_because
             .iter()
             .any(|w| w.contains("va_V clips")),
         "{:?}",
-        clipped.verdict_withheld_because
+        q.not_trusted_because
+    );
+    assert_eq!(
+        clipped.verdict_finding.as_ref().map(|f| &f.detail),
+        Some(&monitor_replay::Detail::DataNotTrusted),
+        "{:?}",
+        clipped.verdict_finding
     );
 
     let room = diagnose(&p, Some((Fault::VoltageSensor, 0.5)), Some(600.0));

@@ -256,7 +256,7 @@ fn a_50hp_motor_warming_fast_is_heating_and_names_nothing() {
                 .events
                 .iter()
                 .filter(|e| matches!(e, monitor_replay::IsolationEvent::Named { .. }))
-                .map(|e| e.line())
+                .map(monitor_words::diagnose::event_line)
                 .collect();
             let strong = r.candidates.iter().find(|c| c.probability >= 0.5);
             let seen = r.isolation.winding_rise_k;
@@ -330,7 +330,8 @@ fn an_uncommissioned_motor_that_warms_is_not_judged_a_fault() {
         .flat_map(|(name, p)| {
             let mut bad = Vec::new();
             let warm = replay(p, 60.0, None);
-            let why = warm.verdict_withheld_because.join("; ");
+            let why = monitor_words::diagnose::withheld_because(&warm, &monitor_words::FieldNames)
+                .join("; ");
             eprintln!(
                 "{name} warming 60 K, not commissioned: {:?}: {why}",
                 warm.verdict

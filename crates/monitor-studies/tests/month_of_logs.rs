@@ -118,7 +118,7 @@ fn a_month_of_warm_logs_reads_heating_and_a_loosening_connection_as_rs() {
             let r = replay(&p, &day_log(&p, day, change, seed));
             let given = names(&r);
             let line = format!(
-                "{name} day {day} ({:.0} K warm{}): {:?}, named {given:?}, heating explains {}, {}",
+                "{name} day {day} ({:.0} K warm{}): {:?}, named {given:?}, heating explains {}, {:?}",
                 season_rise_k(day),
                 if change > 0.0 {
                     format!(", Rs +{:.1} %", 100.0 * change)
@@ -127,7 +127,7 @@ fn a_month_of_warm_logs_reads_heating_and_a_loosening_connection_as_rs() {
                 },
                 r.verdict,
                 r.isolation.heating_explains,
-                r.isolation.verdict
+                r.isolation.said
             );
             eprintln!("{line}");
             let rs = IsolationName::Fault(monitor_core::Fault::Rs);

@@ -51,11 +51,11 @@ fn ls_on_the_3hp_motor_is_named_once_the_load_has_moved() {
             let one = run(Some((Fault::Ls, change)), false);
             let many = run(Some((Fault::Ls, change)), true);
             eprintln!(
-                "ls {change:+}: one load level: named {:?}; three: named {:?} {:?}: {} rise {:?}, candidates {:?}",
+                "ls {change:+}: one load level: named {:?}; three: named {:?} {:?}: {:?} rise {:?}, candidates {:?}",
                 one.isolation.named,
                 many.isolation.named,
                 many.isolation.named_change,
-                many.isolation.verdict,
+                many.isolation.said,
                 many.isolation.winding_rise_k,
                 many.candidates
                     .iter()

@@ -102,11 +102,11 @@ fn a_sensor_gain_step_never_ends_healthy() {
 fn a_speed_sensor_step_is_not_called_a_load_or_voltage_change() {
     for (name, p) in motors() {
         let r = run(&p, Some((Fault::SpeedSensor, 0.1)));
-        let notes: Vec<&str> = r
+        let notes: Vec<String> = r
             .commissioning
             .outside_range
             .iter()
-            .map(|n| n.note.as_str())
+            .map(monitor_words::diagnose::note)
             .collect();
         eprintln!("{name}: {:?}, notes {notes:?}", r.verdict);
         assert!(
@@ -125,7 +125,7 @@ fn healthy_logs_stay_healthy() {
             r.verdict,
             Verdict::Healthy,
             "{name}: {:?}",
-            r.verdict_withheld_because
+            r.verdict_finding
         );
         assert!(r.isolation.named.is_none(), "{name}: {:?}", r.isolation);
     }

@@ -218,7 +218,10 @@ fn run_with(
         named: r.isolation.named,
         size: r.isolation.named_change,
         given,
-        verdict: r.isolation.verdict.chars().take(110).collect(),
+        verdict: format!("{:?}", r.isolation.said)
+            .chars()
+            .take(110)
+            .collect(),
         spread: r.isolation.spread,
     }
 }
@@ -360,10 +363,10 @@ fn an_hour_with_load_steps_and_a_rotor_fault_at_50_min() {
     let given = replay.isolation_names().to_vec();
     let r = replay.finish();
     eprintln!(
-        "names given: {given:?}\nnamed at the end: {:?} {:?}\nverdict: {}\n{}",
+        "names given: {given:?}\nnamed at the end: {:?} {:?}\nverdict: {:?}\n{}",
         r.isolation.named,
         r.isolation.named_change,
-        r.isolation.verdict,
+        r.isolation.said,
         serde_json::to_string(&r.verdict).unwrap_or_default()
     );
     // The load is an unknown input (the replay's default): the load steps are load moves,

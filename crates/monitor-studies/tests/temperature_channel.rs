@@ -96,7 +96,7 @@ fn warming_with_a_temperature_channel_is_a_measured_rise_not_a_fault() {
             let t = &r.isolation.temperature;
             let ok = r.verdict != Verdict::Fault
                 && r.isolation.named.is_none()
-                && t.temperature_channel.as_deref() == Some("used")
+                && t.temperature_channel == Some(monitor_replay::ChannelUse::Used)
                 && t
                     .measured_rise_k
                     .is_some_and(|m| (f64::from(m) - truth).abs() <= 5.0)
@@ -194,8 +194,7 @@ fn a_channel_that_lies_is_not_used_and_does_no_harm() {
                         .isolation
                         .temperature
                         .temperature_channel
-                        .as_deref()
-                        .is_some_and(|s| s.starts_with("not used: "));
+                        .is_some_and(|s| matches!(s, monitor_replay::ChannelUse::NotUsed { .. }));
                     // No worse: no fault named where the run without the channel names
                     // none, no FAULT verdict where it has none, and the rise the
                     // resistances track within 15 K of the truth where it is.
@@ -244,8 +243,8 @@ fn a_frame_probe_offset_by_a_constant_gives_the_same_verdict() {
     assert_eq!(frame.verdict, winding.verdict);
     assert_eq!(frame.isolation.named, winding.isolation.named);
     assert_eq!(
-        frame.isolation.temperature.temperature_channel.as_deref(),
-        Some("used")
+        frame.isolation.temperature.temperature_channel,
+        Some(monitor_replay::ChannelUse::Used)
     );
     let rise =
         |r: &DiagnoseReport| f64::from(r.isolation.temperature.measured_rise_k.expect("rise"));

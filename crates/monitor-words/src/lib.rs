@@ -2,20 +2,29 @@
 //!
 //! The engines (the replay's stages and its verdict, the analyses and the ladder, the
 //! trend) return typed values: findings with their numbers and typed reasons (enums with
-//! the numbers that decided, such as a ladder refusal `Diverged` or a trend alarm
-//! `FaultLevelInARow { logs }`). They never build a sentence, and nothing is decided by
-//! reading one back. This crate turns those values into the words of every front end:
-//! the command line's text, its HTML report, the terminal HMI, the trend's table and
-//! Python's results all take their lines from the functions here, so two lines about one
-//! log cannot disagree.
+//! the numbers that decided, such as a rotor that cannot be judged,
+//! `RotorCannot::TooShort { stretch_s, needed_s, .. }`). They never build a sentence, and
+//! nothing is decided by reading one back. This crate turns those values into the words of
+//! every front end: the command line's text, its HTML report, the terminal HMI, the
+//! trend's table and Python's results all take their lines from the functions here, so two
+//! lines about one log cannot disagree.
 //!
 //! A front end says how it names the library's options (the command line by its flags,
-//! Python by its keywords) by passing its [`Spelling`](monitor_replay::Spelling) to the
-//! function that spells; no options type carries words.
+//! Python by its keywords) by passing its [`Spelling`] to the function that spells; no
+//! options type carries words.
 //!
 //! Modules, one per engine:
+//! - [`diagnose`]: one log's report (`sim-host diagnose`, the demo, the HMI, Python's
+//!   `diagnose`), its [`diagnose::Story`] and its JSON document;
 //! - [`trend`]: a motor's trend (`sim-host trend`, Python's `trend`).
 
 #![forbid(unsafe_code)]
 
+pub mod diagnose;
+mod errors;
+mod spelling;
 pub mod trend;
+
+pub use errors::{option_error, replay_error};
+pub use monitor_replay::OptionField;
+pub use spelling::{FieldNames, Spelling};

@@ -320,7 +320,6 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
                 },
                 &c.log,
                 c.group.clone(),
-                super::words::CLI,
             )
         });
         let explained = explain_here(args, &params, &columns);
@@ -333,7 +332,12 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
     let judged = judged?;
     // The motor current signature analysis, with the fitted rotor_asymmetry's delta.
     let mcsa = monitor_api::mcsa_beside(&a, &out.report, args.rotor_bars);
-    let doc = monitor_api::ExplainDocument::new(judged.as_ref(), out.report, mcsa);
+    let doc = monitor_api::ExplainDocument::new(
+        judged.as_ref(),
+        out.report,
+        mcsa,
+        &super::words::CliWords,
+    );
     render::html::write_explain(
         c.plot.as_deref(),
         c.report.as_deref(),
@@ -342,16 +346,28 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
         (&out.before, out.after.as_ref()),
         &doc,
     )?;
-    match (c.json, compared) {
-        (true, Some(cmp)) => render::json::print(
+    print_explain(c, &doc, judged.as_ref().ok(), compared.as_ref())
+}
+
+/// `explain`'s document on standard output: its JSON (after `compare`'s with `--compare`),
+/// or its text.
+fn print_explain(
+    c: &Common,
+    doc: &monitor_api::ExplainDocument,
+    judged: Option<&monitor_api::replay::DiagnoseReport>,
+    compared: Option<&monitor_api::analysis::CompareReport>,
+) -> anyhow::Result<()> {
+    let json = c.json.then(|| doc.json(judged, &super::words::CliWords));
+    match (json, compared) {
+        (Some(explain), Some(cmp)) => render::json::print(
             &mut crate::cli::out::stdout(),
             &render::json::ExplainWithCompare {
-                compare: &cmp,
-                explain: &doc,
+                compare: cmp,
+                explain: &explain,
             },
         ),
-        (true, None) => render::json::print(&mut crate::cli::out::stdout(), &doc),
-        (false, _) => render::text::explain(&mut crate::cli::out::stdout(), &c.log, &doc),
+        (Some(explain), None) => render::json::print(&mut crate::cli::out::stdout(), &explain),
+        (None, _) => render::text::explain(&mut crate::cli::out::stdout(), &c.log, doc),
     }
 }
 

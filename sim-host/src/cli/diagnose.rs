@@ -154,7 +154,6 @@ impl ReplayArgs {
                         .map(|f| read_calibration(f))
                         .transpose()?,
                 },
-                words: super::words::CLI,
                 ..defaults().options
             },
             baseline: self
@@ -200,7 +199,10 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         render::diagnose_html::write(out, &args.log, &d)?;
     }
     if args.json {
-        render::json::print(&mut crate::cli::out::stdout(), &d.report)
+        render::json::print(
+            &mut crate::cli::out::stdout(),
+            &monitor_api::words::diagnose::document(&d.report, &super::words::CliWords),
+        )
     } else {
         render::text::diagnose(&mut crate::cli::out::stdout(), &args.log, &d)
     }

@@ -3,38 +3,27 @@
 //! library's one parser, their refusals shown as clap shows a bad value.
 
 use monitor_api::replay::{
-    CommissionWindow, OptionField, ParallelPaths, ReplayError, Spelling, TimelineStep, Words,
+    CommissionWindow, OptionField, ParallelPaths, ReplayError, TimelineStep,
 };
+use monitor_api::words::Spelling;
 use monitor_api::ApiError;
+pub use sim_host::flags::CliWords;
 
-/// The command line's spelling of the library's fields: their flags.
+/// The command line's words for the analyses' advice (until the analyses return typed
+/// advice the door spells).
+pub const CLI: monitor_api::analysis::Words = monitor_api::analysis::Words(&CliWordsShim);
+
+/// The command line's flags for the analyses' advice (the same names as [`CliWords`]).
 #[derive(Debug, Clone, Copy, Default)]
-pub struct CliWords;
+pub struct CliWordsShim;
 
-/// The command line's words, as a request carries them (its reports' advice names the
-/// flags: `--commission START:END`, `diagnose --baseline`).
-pub const CLI: Words = Words(&CliWords);
-
-impl Spelling for CliWords {
+impl monitor_api::analysis::Spelling for CliWordsShim {
     fn option(&self, field: OptionField, value: &str) -> String {
-        let flag = match field {
-            OptionField::From => "from".to_string(),
-            OptionField::To => "to".to_string(),
-            f => f.name().replace('_', "-"),
-        };
-        if value.is_empty() {
-            format!("--{flag}")
-        } else {
-            format!("--{flag} {value}")
-        }
-    }
-
-    fn key(&self, name: &str) -> String {
-        format!("--{}", name.replace('_', "-"))
+        CliWords.option(field, value)
     }
 
     fn command_with(&self, command: &str, field: OptionField) -> String {
-        format!("{command} {}", self.option(field, ""))
+        CliWords.command_with(command, field)
     }
 }
 
@@ -44,9 +33,9 @@ pub fn error_text(e: &(dyn std::error::Error + 'static)) -> String {
     if let Some(e) = e.downcast_ref::<ApiError>() {
         e.spelled(&CliWords)
     } else if let Some(e) = e.downcast_ref::<ReplayError>() {
-        e.spelled(&CliWords)
+        monitor_api::words::replay_error(e, &CliWords)
     } else if let Some(e) = e.downcast_ref::<monitor_api::replay::OptionError>() {
-        e.spelled(&CliWords)
+        monitor_api::words::option_error(e, &CliWords)
     } else if let Some(e) = e.downcast_ref::<monitor_api::files::LogError>() {
         e.spelled(&|name| CliWords.key(name))
     } else if let Some(monitor_store::HistoryError::Missing(p)) =
@@ -87,7 +76,7 @@ mod tests {
     fn fields_are_named_by_their_flags() {
         let e = monitor_api::replay::CommissionWindow::new(4.0, 2.0).unwrap_err();
         assert_eq!(
-            e.spelled(&CliWords),
+            monitor_api::words::option_error(&e, &CliWords),
             "--commission 4:2: the window must be START:END with 0 <= START < END, both finite (seconds)"
         );
         assert_eq!(CliWords.option(OptionField::From, ""), "--from");

@@ -2,7 +2,8 @@
 //! one reader, the data-quality stage and the core exactly as `diagnose` replays it
 //! ([`monitor_api::replay::diagnose_file_observed`]), on a worker thread that keeps a reading
 //! every [`SNAPSHOT_EVERY_S`] of log time; the screen plays those readings back at 1x,
-//! 10x or as fast as they come, with pause and seek. The data-quality warnings and the
+//! 10x or as fast as they come, with pause
+//! and seek. The data-quality warnings and the
 //! verdict appear when the whole log is analysed.
 
 use super::{
@@ -158,16 +159,20 @@ fn analyse(
     match result {
         Ok(d) => {
             let r = d.report;
+            let story = monitor_api::words::diagnose::Story::of(&r, &crate::flags::CliWords);
             a.warnings.extend(r.data_quality.warnings.iter().cloned());
-            a.warnings
-                .extend(r.verdict_withheld_because.iter().cloned());
+            a.warnings.extend(story.withheld_because);
             let v = serde_json::to_value(r.verdict)
                 .ok()
                 .and_then(|v| v.as_str().map(str::to_string));
             a.verdict = v;
-            a.verdict_line = Some(r.verdict_line.clone());
+            a.verdict_line = Some(story.verdict_line);
         }
-        Err(e) => a.error = Some(monitor_api::files::one_line(&e.spelled(&*opts.words))),
+        Err(e) => {
+            a.error = Some(monitor_api::files::one_line(
+                &monitor_api::words::replay_error(&e, &crate::flags::CliWords),
+            ))
+        }
     }
 }
 

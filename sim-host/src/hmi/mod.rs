@@ -445,7 +445,11 @@ pub fn header_of(
     let named = isolation.filter(|i| i.named.is_some());
     match (named, state) {
         (Some(iso), MonitorState::Fault(_)) => iso.text(),
-        (Some(iso), MonitorState::Moved(note)) => format!("moved: {} | {note}", iso.text()),
+        (Some(iso), MonitorState::Moved(note)) => format!(
+            "moved: {} | {}",
+            iso.text(),
+            monitor_api::words::diagnose::moved_why(note)
+        ),
         (Some(iso), _) => format!("{} | named: {}", state_text(state, candidates), iso.text()),
         (None, _) => state_text(state, candidates),
     }
@@ -498,7 +502,10 @@ pub fn state_text(state: &MonitorState, candidates: &[(Fault, f32)]) -> String {
             );
             format!("FAULT ({sig})")
         }
-        MonitorState::Moved(note) => format!("operating point moved: {note}"),
+        MonitorState::Moved(note) => format!(
+            "operating point moved: {}",
+            monitor_api::words::diagnose::moved_why(note)
+        ),
     }
 }
 

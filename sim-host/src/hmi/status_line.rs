@@ -220,10 +220,7 @@ impl FirmwareStatus {
             MonitorState::Healthy | MonitorState::Fault(_)
                 if self.moved == Some(true) && !named_fault && !sensor =>
             {
-                MonitorState::Moved(
-                    "the board says the load or the voltage left the commissioned range"
-                        .to_string(),
-                )
+                MonitorState::Moved(monitor_api::replay::MovedWhy::BoardSays)
             }
             other => other,
         }

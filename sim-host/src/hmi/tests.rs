@@ -94,7 +94,11 @@ fn live_simulation_commissions_and_a_key_injects_a_fault() {
     let n = names(&state);
     assert!(n.contains(&Fault::Bl) && n.contains(&Fault::B), "{n:?}");
     assert!(
-        matches!(&s.state, MonitorState::Moved(note) if note.contains("load (active current)")),
+        matches!(
+            &s.state,
+            MonitorState::Moved(monitor_api::replay::MovedWhy::OutsideRange { departures })
+                if departures.iter().any(|d| d.quantity == monitor_api::replay::RangeQuantity::Load)
+        ),
         "{:?}",
         s.state
     );

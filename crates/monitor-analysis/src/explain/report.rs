@@ -255,7 +255,7 @@ fn implausible_note(ranked: &[RankedCandidate]) -> String {
 fn verdict(
     found: &ExplainFindings<'_>,
     best: Option<&RankedCandidate>,
-    words: &dyn monitor_replay::Spelling,
+    words: &dyn crate::words_shim::Spelling,
 ) -> String {
     let (full, o) = (&found.full, found.outcome);
     match best {

@@ -1,6 +1,6 @@
 //! What `diagnose` reports of the isolation (JSON `isolation`, the candidates).
 
-use super::sentences::pct;
+use super::said::{IsolationSaid, NotIsolatedWhy, SensorKind};
 use super::{serialize_state, IsolationName, IsolationTracker, NameGiven, LIST_FROM};
 use crate::events::IsolationEvent;
 use crate::windows::SensorPhaseReport;
@@ -44,8 +44,8 @@ pub(crate) fn refine_single_phase(
     voltage: Option<&SensorPhaseReport>,
 ) {
     let of = |fault: Fault| match fault {
-        Fault::CurrentSensor => current.map(|g| (g, "current")),
-        Fault::VoltageSensor => voltage.map(|g| (g, "voltage")),
+        Fault::CurrentSensor => current.map(|g| (g, SensorKind::Current)),
+        Fault::VoltageSensor => voltage.map(|g| (g, SensorKind::Voltage)),
         _ => None,
     };
     for c in candidates.iter_mut() {
@@ -54,22 +54,23 @@ pub(crate) fn refine_single_phase(
             c.phase = Some(g.phase);
         }
     }
-    let Some((g, what)) = (match report.named {
+    let Some((g, sensor)) = (match report.named {
         Some(IsolationName::Fault(f)) => of(f),
         _ => None,
     }) else {
         return;
     };
     report.named_change = Some(g.gain_error);
-    report.verdict = format!(
-        "The phase {} {what} sensor's gain changed by {} (the zero sequence of the three readings names it; one phase's error is a third of that on the three-phase vector){}",
-        g.phase.name(),
-        pct(g.gain_error),
-        report
-            .verdict
-            .find(" (judged at")
-            .map_or(".".to_string(), |k| report.verdict[k..].to_string())
-    );
+    let stale = match &report.said {
+        IsolationSaid::Stale { stale, .. } => Some(*stale),
+        _ => None,
+    };
+    report.said = IsolationSaid::SensorPhase {
+        sensor,
+        phase: g.phase,
+        gain_error: g.gain_error,
+        stale,
+    };
 }
 
 /// Faults that cannot be separated here, and why (JSON `isolation.groups`).
@@ -77,8 +78,32 @@ pub(crate) fn refine_single_phase(
 pub struct IsolationGroup {
     /// The faults (JSON: their names).
     pub faults: Vec<Fault>,
-    /// Why they cannot be separated.
-    pub reason: String,
+    /// Why they cannot be separated (JSON `why`; the door spells it as `reason`).
+    #[serde(rename = "why")]
+    pub reason: GroupWhy,
+}
+
+/// Why a group of candidates cannot be separated (JSON `{"kind": ..}`).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum GroupWhy {
+    /// B and Bl scale the same load term of the torque balance.
+    FrictionClass,
+    /// Rr and a speed-sensor gain error change the steady-state currents alike.
+    RotorResistanceAndSpeedSensor {
+        /// The directions' angle [deg].
+        separation_deg: f32,
+    },
+    /// The current and voltage sensors both scale the measured impedance.
+    CurrentAndVoltageSensors {
+        /// The directions' angle [deg].
+        separation_deg: f32,
+    },
+    /// Their directions in the residual space are this close at this point.
+    CloseDirections {
+        /// The directions' angle [deg].
+        separation_deg: f32,
+    },
 }
 
 /// What the isolation concluded (`diagnose --json` key `isolation`).
@@ -94,8 +119,9 @@ pub struct IsolationReport {
     /// The probability that the named fault is the fault (for `b/bl`: the class's), or
     /// null: a calibrated probability (docs/isolation.md, "How often a name is right").
     pub named_probability: Option<f32>,
-    /// One sentence.
-    pub verdict: String,
+    /// What it concluded, with its numbers (JSON `said`; the door spells it as `verdict`).
+    #[serde(rename = "said")]
+    pub said: IsolationSaid,
     /// Candidates that cannot be separated at the last operating point, with the reason.
     pub groups: Vec<IsolationGroup>,
     /// The change from the baseline in standard deviations.
@@ -191,13 +217,13 @@ impl IsolationTracker {
 pub const REPORTED_RISE_K: f32 = 5.0;
 
 impl IsolationReport {
-    pub(super) fn not_judged(why: &str, learned: bool) -> Self {
+    pub(super) fn not_judged(why: NotIsolatedWhy, learned: bool) -> Self {
         IsolationReport {
             state: IsolationState::NotJudged,
             named: None,
             named_change: None,
             named_probability: None,
-            verdict: format!("The fault could not be isolated: {why}."),
+            said: IsolationSaid::NotIsolated { why },
             groups: Vec::new(),
             deviation_sigma: 0.0,
             unknown_probability: 0.0,
@@ -266,7 +292,7 @@ pub(super) fn groups(iso: &Isolation) -> Vec<IsolationGroup> {
     if listed(Fault::B) || listed(Fault::Bl) {
         out.push(IsolationGroup {
             faults: vec![Fault::B, Fault::Bl],
-            reason: "both scale the load term (B + Bl) wr of the torque balance: one friction class at every operating point".into(),
+            reason: GroupWhy::FrictionClass,
         });
     }
     if let [a, b, ..] = &iso.candidates[..] {
@@ -282,13 +308,13 @@ pub(super) fn groups(iso: &Isolation) -> Vec<IsolationGroup> {
     out
 }
 
-fn pair_reason(a: Fault, b: Fault, sep_deg: f32) -> String {
+fn pair_reason(a: Fault, b: Fault, separation_deg: f32) -> GroupWhy {
     let pair = |x: Fault, y: Fault| (a == x && b == y) || (a == y && b == x);
     if pair(Fault::Rr, Fault::SpeedSensor) {
-        format!("in steady state the rotor circuit depends on Rr/slip only, so an Rr change and a small speed-sensor gain error change the currents alike (directions {sep_deg:.1} deg apart); only the torque balance with the assumed viscous load, a speed transient, or a load change of 20 % or more (the isolation then fits the operating points together) tells them apart")
+        GroupWhy::RotorResistanceAndSpeedSensor { separation_deg }
     } else if pair(Fault::CurrentSensor, Fault::VoltageSensor) {
-        format!("both scale the measured impedance V/I; only the torque balance separates them, and it is weak at light load (directions {sep_deg:.1} deg apart)")
+        GroupWhy::CurrentAndVoltageSensors { separation_deg }
     } else {
-        format!("their directions in the residual space are {sep_deg:.1} deg apart at this operating point; a load change of 20 % or more may separate them (the isolation then fits the operating points together)")
+        GroupWhy::CloseDirections { separation_deg }
     }
 }

@@ -3,6 +3,7 @@
 //! ([`IsolationClosing`], [`IsolationFinding`]).
 
 use super::{refine_single_phase, FaultCandidate, IsolationReport, IsolationTracker};
+use crate::range::RangeDeparture;
 use crate::stage::{Finish, LampsSeen, RowFlags, Stage};
 use crate::windows::SensorPhaseReport;
 use monitor_core::{MonitorOutput, SteadyPoint};
@@ -27,8 +28,9 @@ pub(crate) struct IsolationClosing<'a> {
     pub(crate) seen: LampsSeen,
     /// The monitor's last output.
     pub(crate) out: &'a MonitorOutput,
-    /// Where the operating point was outside the commissioned range at the end: the note.
-    pub(crate) moved_note: Option<&'a str>,
+    /// Where the operating point was outside the commissioned range at the end: what left
+    /// it.
+    pub(crate) moved_note: Option<&'a [RangeDeparture]>,
     /// One phase's current and voltage sensor read from the zero sequence (the winding's).
     pub(crate) current_sensor: Option<&'a SensorPhaseReport>,
     /// See `current_sensor`.
@@ -118,11 +120,11 @@ impl Finish for IsolationTracker {
 /// Outside the commissioned range at the end (`note`: where the point moved), a deviation no
 /// single fault explains is the new operating point's, said calmly (the verdict withholds a
 /// judgement).
-fn note_moved_point(isolation: &mut IsolationReport, note: &str) {
+fn note_moved_point(isolation: &mut IsolationReport, note: &[RangeDeparture]) {
     if isolation.state == monitor_core::IsolationState::Unknown {
-        isolation.verdict = format!(
-            "Not judged as a fault: the operating point moved outside the commissioned range ({note}), where the healthy baseline does not hold; the deviation there ({:.0} standard deviations) fits no single fault, as a new load would not. Commission over this load to judge it.",
-            isolation.deviation_sigma
-        );
+        isolation.said = super::said::IsolationSaid::OutsideRange {
+            departures: note.to_vec(),
+            deviation: isolation.deviation_sigma,
+        };
     }
 }

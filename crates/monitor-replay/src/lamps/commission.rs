@@ -27,7 +27,7 @@
 //! `monitor_core::operating_range`, which the firmware's panel uses too.
 
 use crate::options::CommissionWindow;
-use crate::words::{OptionField, Words};
+pub use crate::range::{RangeDeparture, RangeQuantity};
 use monitor_core::operating_range::{outside, widen};
 use monitor_core::{
     CommissioningState, Monitor, MonitorConfig, MonitorOutput, OperatingPoint, RunStage,
@@ -83,14 +83,88 @@ pub struct CommissioningReport {
     pub load_current_a: Option<[f32; 2]>,
     /// Span of the voltage magnitude |V| while learning, `[min, max]` [V peak, phase].
     pub voltage_v: Option<[f32; 2]>,
-    /// Which thresholds the lamps used, in words.
-    pub thresholds: String,
+    /// Which thresholds the lamps used (JSON `thresholds_in_force`; the door spells it as
+    /// `thresholds`).
+    #[serde(rename = "thresholds_in_force")]
+    pub thresholds: Thresholds,
     /// Without commissioning: the first quasi-steady point and the residuals there.
     pub first_quasi_steady: Option<QuasiSteadyPoint>,
     /// Times a lit r2/r3/r4 lamp met an operating point outside the learned range.
     pub outside_range: Vec<RangeNote>,
-    /// What the user should do or know, if anything.
-    pub advice: Option<String>,
+    /// What the user should do, if anything (JSON `advice_given`; the door spells it as
+    /// `advice`): given only where the residuals ran.
+    #[serde(rename = "advice_given")]
+    pub advice: Option<CommissionAdvice>,
+}
+
+/// The thresholds the lamps acted on (JSON `{"kind": ..}`).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Thresholds {
+    /// The fixed thresholds against the nominal parameters: `|r| > fixed` (a fraction).
+    Fixed {
+        /// The fixed threshold on `|r|` (0.03: 3 %).
+        fixed: f32,
+    },
+    /// Learned over `[from_s, to_s]`: the healthy mean +/- `k_sigma` spreads.
+    Learned {
+        /// Where learning began [s].
+        from_s: f64,
+        /// Where it ended [s].
+        to_s: f64,
+        /// How many spreads a lamp's band is wide.
+        k_sigma: f32,
+    },
+    /// A window was asked for and not learned: the fixed thresholds stayed in force.
+    FixedIncomplete {
+        /// The fixed threshold on `|r|`.
+        fixed: f32,
+    },
+    /// No residual ran (the log lacks the voltages or the speed): no threshold was used.
+    NotUsed,
+}
+
+/// What the user should do about commissioning (JSON `{"kind": ..}`).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum CommissionAdvice {
+    /// The thresholds are fixed against the file's nominal values: commission over healthy
+    /// running that covers the whole load and voltage range.
+    CommissionOverRange,
+    /// The window asked for was not learned, and why.
+    NotLearned(NotLearned),
+}
+
+/// A commissioning window that was not learned, and why.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct NotLearned {
+    /// The window asked for.
+    pub window: CommissionWindow,
+    /// Why it was not learned.
+    pub why: NotLearnedWhy,
+}
+
+/// Why a commissioning window was not learned (JSON `{"kind": ..}`).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum NotLearnedWhy {
+    /// The log ends at `end_s`, before the window starts.
+    EndsBeforeWindow {
+        /// The log's last time [s].
+        end_s: f64,
+    },
+    /// Too little evaluated running was learned.
+    TooLittle {
+        /// Seconds of evaluated running learned.
+        learned_s: f64,
+        /// By when [s].
+        by_s: f64,
+        /// Seconds needed at least ([`min_learned_s`]).
+        needed_s: f64,
+        /// The run was given up (the window held too little quasi-steady running with
+        /// usable data); else the log ended first.
+        cancelled: bool,
+    },
 }
 
 /// The residuals at one time.
@@ -107,8 +181,21 @@ pub struct QuasiSteadyPoint {
 pub struct RangeNote {
     /// First time [s].
     pub t_s: f64,
-    /// What left the range, by how much, and what it means.
-    pub note: String,
+    /// What left the range, by how much (the door spells it as `note`).
+    pub departures: Vec<RangeDeparture>,
+}
+
+/// Why the first quasi-steady point already passes a fixed threshold without commissioning.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct FirstPointMisfit {
+    /// The first quasi-steady point [s].
+    pub t_s: f64,
+    /// Which residual (0 for r1).
+    pub residual: usize,
+    /// Its value.
+    pub value: f32,
+    /// Its fixed threshold.
+    pub threshold: f32,
 }
 
 /// Follows a replay's commissioning (see the module documentation).
@@ -128,8 +215,6 @@ pub(crate) struct CommissionTracker {
     noted: u8,
     last_t: f64,
     learned: (u32, u32),
-    /// The words its advice names `commission` in.
-    words: Words,
 }
 
 /// The load and the voltage of `out`, independent of the d-q frame's angle: the active
@@ -144,14 +229,9 @@ pub(crate) fn operating_point(out: &MonitorOutput) -> (f32, f32) {
 }
 
 impl CommissionTracker {
-    pub(crate) fn new(
-        requested: Option<CommissionWindow>,
-        words: Words,
-        cfg: &MonitorConfig,
-    ) -> Self {
+    pub(crate) fn new(requested: Option<CommissionWindow>, cfg: &MonitorConfig) -> Self {
         CommissionTracker {
             requested,
-            words,
             run_id: None,
             started_at: None,
             ended_at: None,
@@ -204,7 +284,12 @@ impl CommissionTracker {
     /// After the sample: records the learning range, the run's end, the first
     /// quasi-steady point; returns a note when a lit r2..r4 lamp meets an operating point
     /// outside the learned range.
-    pub(crate) fn after(&mut self, mon: &Monitor, t: f64, out: &MonitorOutput) -> Option<String> {
+    pub(crate) fn after(
+        &mut self,
+        mon: &Monitor,
+        t: f64,
+        out: &MonitorOutput,
+    ) -> Option<Vec<RangeDeparture>> {
         // (The run is read only where this replay started one.)
         if let Some(id) = self.run_id {
             let run = mon.commissioning();
@@ -233,74 +318,56 @@ impl CommissionTracker {
         self.range_note(t, out)
     }
 
-    fn range_note(&mut self, t: f64, out: &MonitorOutput) -> Option<String> {
-        let mut said = Vec::new();
-        let (i_active, v) = operating_point(out);
-        let checks = [
-            (
-                self.iqs,
-                i_active,
-                "load (active current)",
-                "to the paper's model a load change is a Bl change",
-            ),
-            (
-                self.vqs,
-                v,
-                "voltage (|V|)",
-                "the learned healthy means hold only at the voltage they were learned at",
-            ),
-        ];
-        for (k, (span, x, what, meaning)) in checks.into_iter().enumerate() {
-            let Some(f) = span.and_then(|s| outside(s, x)) else {
-                continue;
+    fn range_note(&mut self, t: f64, out: &MonitorOutput) -> Option<Vec<RangeDeparture>> {
+        let said = self.departures(out);
+        for d in &said {
+            let k = match d.quantity {
+                RangeQuantity::Load => 0,
+                RangeQuantity::Voltage => 1,
             };
-            let dir = if f > 0.0 { "above" } else { "below" };
-            let s = span.unwrap_or_default();
-            let note = format!(
-                "{what} {x:.2} is {:.0} % {dir} the commissioned range {:.2}..{:.2}: {meaning}",
-                100.0 * f.abs(),
-                s[0],
-                s[1]
-            );
-            let bit = 1u8 << (2 * k + usize::from(f > 0.0));
+            let bit = 1u8 << (2 * k + usize::from(d.fraction > 0.0));
             if self.noted & bit == 0 {
                 self.noted |= bit;
                 self.notes.push(RangeNote {
                     t_s: t,
-                    note: note.clone(),
+                    departures: vec![*d],
                 });
             }
-            said.push(note);
         }
-        (!said.is_empty()).then(|| said.join("; "))
+        (!said.is_empty()).then_some(said)
+    }
+
+    /// The quantities of `out` outside the span learned while commissioning (beyond the
+    /// reporting margin), whether or not the learned thresholds are in force.
+    fn departures(&self, out: &MonitorOutput) -> Vec<RangeDeparture> {
+        let (i_active, v) = operating_point(out);
+        [
+            (self.iqs, i_active, RangeQuantity::Load),
+            (self.vqs, v, RangeQuantity::Voltage),
+        ]
+        .into_iter()
+        .filter_map(|(span, value, quantity)| {
+            let span = span?;
+            outside(span, value).map(|fraction| RangeDeparture {
+                quantity,
+                value,
+                fraction,
+                span,
+            })
+        })
+        .collect()
     }
 
     /// Where the learned thresholds are in force and the load current or the voltage has
-    /// left the span seen while learning (beyond the reporting margin): the note, as the
-    /// timeline's `range_note` words it, whether or not a lamp is lit. `None` inside the
+    /// left the span seen while learning (beyond the reporting margin): what left it, as
+    /// the timeline's `range_note` has it, whether or not a lamp is lit. `None` inside the
     /// range or without a learned window.
-    pub(crate) fn moved_note(&self, out: &MonitorOutput) -> Option<String> {
+    pub(crate) fn moved_note(&self, out: &MonitorOutput) -> Option<Vec<RangeDeparture>> {
         if out.commissioning != CommissioningState::Commissioned {
             return None;
         }
-        let mut said = Vec::new();
-        let (i_active, v) = operating_point(out);
-        for (span, x, what) in [
-            (self.iqs, i_active, "load (active current)"),
-            (self.vqs, v, "voltage (|V|)"),
-        ] {
-            if let Some(f) = span.and_then(|s| outside(s, x)) {
-                let s = span.unwrap_or_default();
-                said.push(format!(
-                    "{what} {x:.2} is {:.0} % {} the commissioned {:.2}..{:.2}",
-                    100.0 * f.abs(),
-                    if f > 0.0 { "above" } else { "below" },
-                    s[0],
-                    s[1]
-                ));
-            }
-        }
-        (!said.is_empty()).then(|| said.join("; "))
+        let said = self.departures(out);
+        (!said.is_empty()).then_some(said)
     }
 
     /// True when the learned thresholds are in force and the load current or the voltage
@@ -334,7 +401,7 @@ impl CommissionTracker {
     /// residuals already pass them at the first quasi-steady point. Wrong nominal
     /// parameters (a nameplate 10-30 % off) and a fault present from the start then look
     /// the same; only commissioning on healthy running tells them apart.
-    pub(crate) fn nominal_misfit(&self) -> Option<String> {
+    pub(crate) fn nominal_misfit(&self) -> Option<FirstPointMisfit> {
         let p = self.first_steady.filter(|_| self.requested.is_none())?;
         let (k, r) = p
             .residuals
@@ -344,13 +411,12 @@ impl CommissionTracker {
             .filter(|(_, (r, f))| r.abs() > *f)
             .map(|(k, (r, _))| (k, *r))
             .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))?;
-        Some(format!(
-            "at the first quasi-steady point ({:.2} s) r{} = {r:+.3} already passes its fixed threshold ({:.3}): the parameter file does not fit this motor, or a fault was there from the start; commission ({}) on healthy running to tell them apart",
-            p.t_s,
-            k + 1,
-            self.fixed[k],
-            self.words.hint(OptionField::Commission, "START:END")
-        ))
+        Some(FirstPointMisfit {
+            t_s: p.t_s,
+            residual: k,
+            value: r,
+            threshold: self.fixed.get(k).copied().unwrap_or(0.0),
+        })
     }
 
     /// True when a window was asked for and not learned.
@@ -367,38 +433,24 @@ impl CommissionTracker {
         !self.cancelled && self.ended_at.is_some() && self.learned.0 >= self.learned.1
     }
 
-    /// Why the window is incomplete, in one line (for the report; the error says it
-    /// with [`CommissionTracker::not_learned`]).
-    pub(crate) fn why_incomplete(&self) -> Option<String> {
-        let (window, why) = self.not_learned()?;
-        Some(format!(
-            "{}: {why}",
-            self.words.option(OptionField::Commission, &window)
-        ))
-    }
-
-    /// The window asked for (`START:END`) and why it was not learned, where it was not.
-    pub(crate) fn not_learned(&self) -> Option<(String, String)> {
-        let (a, b) = self.requested?.seconds();
+    /// The window asked for and why it was not learned, where it was not.
+    pub(crate) fn not_learned(&self) -> Option<NotLearned> {
+        let window = self.requested?;
+        let (a, b) = window.seconds();
         if self.learned_ok() {
             return None;
         }
         let end = self.last_t;
         let why = match self.started_at {
-            None => format!("the log ends at {end:.2} s, before the window starts"),
-            Some(_) => format!(
-                "learned {:.2} s of evaluated running by {:.2} s, {:.2} s at least needed ({}); the lamps were off while learning",
-                self.seconds(self.learned.0),
-                self.ended_at.unwrap_or(end),
-                min_learned_s(a, b),
-                if self.cancelled {
-                    "the window held too little quasi-steady running with usable data"
-                } else {
-                    "the log ended first"
-                }
-            ),
+            None => NotLearnedWhy::EndsBeforeWindow { end_s: end },
+            Some(_) => NotLearnedWhy::TooLittle {
+                learned_s: self.seconds(self.learned.0),
+                by_s: self.ended_at.unwrap_or(end),
+                needed_s: min_learned_s(a, b),
+                cancelled: self.cancelled,
+            },
         };
-        Some((format!("{a}:{b}"), why))
+        Some(NotLearned { window, why })
     }
 
     fn seconds(&self, blocks: u32) -> f64 {
@@ -410,33 +462,31 @@ impl CommissionTracker {
         self.requested
     }
 
-    /// The report at the end of the replay.
-    pub(crate) fn report(&self, k_sigma: f32) -> CommissioningReport {
-        let fixed = format!(
-            "fixed: |r| > {:.1} % against the nominal parameters",
-            100.0 * self.fixed[0]
-        );
+    /// The report at the end of the replay (`monitor`: the residuals ran; without them no
+    /// threshold was used and no advice is given).
+    pub(crate) fn report(&self, k_sigma: f32, monitor: bool) -> CommissioningReport {
+        let fixed = self.fixed[0];
         let (state, thresholds, advice) = match self.requested.map(CommissionWindow::seconds) {
+            None if !monitor => (CommissioningOutcome::None, Thresholds::NotUsed, None),
             None => (
                 CommissioningOutcome::None,
-                fixed,
-                Some(format!(
-                    "the thresholds are fixed against the parameter file's nominal values; a real motor's parameters differ by 10-30 %, so commission ({}) over healthy running that covers the whole load and voltage range",
-                    self.words.hint(OptionField::Commission, "START:END")
-                )),
+                Thresholds::Fixed { fixed },
+                Some(CommissionAdvice::CommissionOverRange),
             ),
             Some((a, _)) if self.learned_ok() => (
                 CommissioningOutcome::Learned,
-                format!(
-                    "learned over {a}..{:.2} s: mean +/- {k_sigma} spreads",
-                    self.ended_at.unwrap_or(self.last_t)
-                ),
+                Thresholds::Learned {
+                    from_s: a,
+                    to_s: self.ended_at.unwrap_or(self.last_t),
+                    k_sigma,
+                },
                 None,
             ),
+            Some(_) if !monitor => (CommissioningOutcome::Incomplete, Thresholds::NotUsed, None),
             Some(_) => (
                 CommissioningOutcome::Incomplete,
-                format!("{fixed} (commissioning incomplete)"),
-                self.why_incomplete(),
+                Thresholds::FixedIncomplete { fixed },
+                self.not_learned().map(CommissionAdvice::NotLearned),
             ),
         };
         CommissioningReport {

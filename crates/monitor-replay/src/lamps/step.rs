@@ -180,7 +180,7 @@ pub(crate) struct BlockView {
     /// A lamp is lit.
     pub(crate) lamps_lit: bool,
     /// The note on the commissioned range for the timeline.
-    pub(crate) range_note: Option<String>,
+    pub(crate) range_note: Option<Vec<super::commission::RangeDeparture>>,
 }
 
 /// What a replay keeps of the monitor's output after a row for the next one.

@@ -70,17 +70,26 @@ impl Unsettled {
     /// Why no verdict can be given when the log ended inside a held stretch of at least
     /// [`MIN_HELD_S`] with a residual at [`WORST_BANDS`] or more of its band; `None`
     /// otherwise.
-    pub(super) fn withheld(&self) -> Option<String> {
+    pub(super) fn withheld(&self) -> Option<HeldUnsettled> {
         let since = self.since_s?;
         let held = self.last_s - since;
-        (held >= MIN_HELD_S && self.worst >= WORST_BANDS).then(|| {
-            format!(
-                "the operating point had not settled over the last {held:.2} s of the log (from {since:.2} s) \
-                 while a residual sat at {:.0} times its band: the quasi-steady gate held the lamps there, \
-                 so a fault cannot be ruled out (the monitor evaluates the lamps regardless once the gate has \
-                 been closed for its timeout; a longer log, or a steady stretch, is needed to judge)",
-                self.worst
-            )
+        (held >= MIN_HELD_S && self.worst >= WORST_BANDS).then_some(HeldUnsettled {
+            held_s: held,
+            since_s: since,
+            worst_bands: self.worst,
         })
     }
+}
+
+/// The log ended inside a held, unsettled stretch (the quasi-steady gate held the lamps)
+/// while a residual sat far outside its band: a fault cannot be ruled out (JSON
+/// `{"held_s", "since_s", "worst_bands"}`).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct HeldUnsettled {
+    /// How long the stretch lasted to the log's end [s].
+    pub held_s: f64,
+    /// From when [s].
+    pub since_s: f64,
+    /// The worst residual, in its bands.
+    pub worst_bands: f32,
 }

@@ -212,6 +212,26 @@ pub enum LoadSource {
     Current,
 }
 
+/// Why the load is unknown (JSON `{"kind": ..}`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum LoadUnknown {
+    /// The parameter file has no rated load (B + Bl).
+    NoRatedLoad,
+    /// The current is outside what the file draws between no load and `top_slip`: a scale
+    /// the file does not know, and the log has no speed or voltages.
+    CurrentOutOfScale {
+        /// The current [A, peak].
+        current_peak_a: f64,
+        /// The steady slip the range reaches.
+        top_slip: f64,
+        /// The range `[low, high]` [A, peak] with its uncertainty.
+        range_a: [f64; 2],
+        /// The uncertainty (fraction).
+        uncertainty: f64,
+    },
+}
+
 /// The load the rotor is judged at (JSON `rotor.load`; module docs).
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct RotorLoad {
@@ -225,8 +245,10 @@ pub struct RotorLoad {
     pub min_fraction: f64,
     /// The file's rated point; null where the file gives none.
     pub rated: Option<RatedLoadPoint>,
-    /// Why the load is unknown, where it is.
-    pub unknown_because: Option<String>,
+    /// Why the load is unknown, where it is (JSON `unknown_reason`; the door spells it as
+    /// `unknown_because`).
+    #[serde(rename = "unknown_reason")]
+    pub unknown_because: Option<LoadUnknown>,
     /// The measured current [A, phase peak] where it was read.
     pub current_peak_a: Option<f64>,
 }
@@ -249,12 +271,12 @@ impl RotorLoad {
                 rated: Some(r),
                 ..RotorLoad::default()
             },
-            None => Self::unknown(None, "the parameter file has no rated load (B + Bl)".into()),
+            None => Self::unknown(None, LoadUnknown::NoRatedLoad),
         }
     }
 
     /// An unknown load, with why.
-    fn unknown(rated: Option<RatedLoadPoint>, why: String) -> Self {
+    fn unknown(rated: Option<RatedLoadPoint>, why: LoadUnknown) -> Self {
         RotorLoad {
             min_fraction: MCSA_MIN_LOAD,
             rated,
@@ -268,7 +290,7 @@ impl RotorLoad {
     pub fn from_power(p: &ParamFile, m: &MeasuredPoint) -> Self {
         let c = EquivalentCircuit::of(p);
         let Some(r) = RatedLoadPoint::of(p) else {
-            return Self::unknown(None, "the parameter file has no rated load (B + Bl)".into());
+            return Self::unknown(None, LoadUnknown::NoRatedLoad);
         };
         let power = 1.5 * m.v1_peak_v * m.i1_peak_a * m.angle_rad.cos();
         let v = m.v1_peak_v / std::f64::consts::SQRT_2;
@@ -291,7 +313,7 @@ impl RotorLoad {
     /// docs): unknown where the file cannot draw it.
     pub fn from_current(p: &ParamFile, i1_peak_a: f64) -> Self {
         let Some(r) = RatedLoadPoint::of(p) else {
-            return Self::unknown(None, "the parameter file has no rated load (B + Bl)".into());
+            return Self::unknown(None, LoadUnknown::NoRatedLoad);
         };
         let c = EquivalentCircuit::of(p);
         let u = f64::from(CURRENT_MODEL_UNCERTAINTY);
@@ -301,11 +323,12 @@ impl RotorLoad {
         if !(lo..=hi).contains(&i1_peak_a) {
             let mut l = Self::unknown(
                 Some(r),
-                format!(
-                    "the current {i1_peak_a:.2} A (peak) is outside what the parameter file draws between no load and {:.1} % slip ({lo:.2}..{hi:.2} A with its {:.0} % uncertainty): a scale the file does not know (a DAQ's own units, a CT ratio), and the log has no speed or voltages",
-                    100.0 * top,
-                    100.0 * u
-                ),
+                LoadUnknown::CurrentOutOfScale {
+                    current_peak_a: i1_peak_a,
+                    top_slip: top,
+                    range_a: [lo, hi],
+                    uncertainty: u,
+                },
             );
             l.current_peak_a = Some(i1_peak_a);
             return l;
@@ -329,37 +352,6 @@ impl RotorLoad {
     /// Whether the load is known and below [`MCSA_MIN_LOAD`].
     pub fn too_low(&self) -> bool {
         self.fraction.is_some_and(|x| x < self.min_fraction)
-    }
-
-    /// The estimate in words: `about 3 % of the rated torque (from the speed: slip 0.12 %,
-    /// rated 4.17 %)`, or why it is unknown.
-    pub fn words(&self) -> String {
-        let (Some(x), Some(r)) = (self.fraction, self.rated) else {
-            return format!(
-                "the load is unknown: {}",
-                self.unknown_because.as_deref().unwrap_or("no estimate")
-            );
-        };
-        let slip = self.slip.unwrap_or(0.0);
-        let from = match self.source {
-            Some(LoadSource::Speed) => format!(
-                "from the speed: slip {:.2} %, rated {:.2} %",
-                100.0 * slip,
-                100.0 * r.slip
-            ),
-            Some(LoadSource::Voltages) => format!(
-                "from the voltages' power: slip {:.2} % in the file's circuit, rated {:.2} %",
-                100.0 * slip,
-                100.0 * r.slip
-            ),
-            _ => format!(
-                "from the current {:.2} A against the file's no-load {:.2} A and rated {:.2} A (peak)",
-                self.current_peak_a.unwrap_or(f64::NAN),
-                r.no_load_current_peak_a,
-                r.current_peak_a
-            ),
-        };
-        format!("about {:.0} % of the rated torque ({from})", 100.0 * x)
     }
 }
 
@@ -388,18 +380,21 @@ mod tests {
         // The current alone: the no-load current is no load, the rated current full load,
         // five times the rated current a scale the file does not know.
         let idle = RotorLoad::from_current(&p, r.no_load_current_peak_a);
-        assert!(idle.too_low(), "{}", idle.words());
+        assert!(idle.too_low(), "{idle:?}");
         let rated = RotorLoad::from_current(&p, r.current_peak_a);
         assert!(
             (rated.fraction.unwrap_or(0.0) - 1.0).abs() < 0.02,
-            "{}",
-            rated.words()
+            "{rated:?}"
         );
         let scaled = RotorLoad::from_current(&p, 5.0 * r.current_peak_a);
         assert!(
-            scaled.fraction.is_none() && !scaled.too_low(),
-            "{}",
-            scaled.words()
+            scaled.fraction.is_none()
+                && !scaled.too_low()
+                && matches!(
+                    scaled.unknown_because,
+                    Some(LoadUnknown::CurrentOutOfScale { .. })
+                ),
+            "{scaled:?}"
         );
     }
 }

@@ -4,12 +4,12 @@
 
 use super::baseband::{Block, RotorFront};
 use super::judge::{band_of, bars_of, fault_probability, noise_max, torque_share};
-use super::load::{MeasuredPoint, RotorLoad, MAX_SLIP_OVER_RATED};
+use super::load::{MeasuredPoint, RotorLoad};
 use super::spectrum::{segments, spectrum, Spectrum, SEGMENT_S};
 use super::stretch::{chunks, longest_run, Chunk};
 use super::{
-    RotorMachine, RotorReport, SlipSource, MAIN_LOBE_HALF_BINS, MAX_SLIP, MIN_BINS, MIN_SLIP,
-    PAIR_SNR_DB, SLIP_STEADY,
+    RotorCannot, RotorMachine, RotorReport, SlipSource, MAIN_LOBE_HALF_BINS, MAX_SLIP, MIN_BINS,
+    MIN_SLIP, PAIR_SNR_DB, SLIP_STEADY,
 };
 use monitor_io::params::ParamFile;
 use std::f64::consts::TAU;
@@ -51,13 +51,12 @@ pub fn rotor_report(
     let blocks: Vec<Block> = front.blocks().iter().copied().collect();
     let bs = front.block_s();
     if blocks.len() < 16 {
-        return cannot(r, "no current to read: the log holds less than two supply periods of good current samples".into());
+        return cannot(r, RotorCannot::NoCurrent);
     }
     let by_speed = blocks.iter().any(|b| b.wm.is_finite());
     let ch = chunks(&blocks, bs, m.np);
     let Some(run) = longest_run(&ch, by_speed) else {
-        let what = if by_speed { "the slip" } else { "the current" };
-        return cannot(r, format!("{what} is steady in no stretch of 0.2 s chunks"));
+        return cannot(r, RotorCannot::NotSteady { by_speed });
     };
     let span = span_of(&ch, run.clone());
     let mut r = r;
@@ -73,12 +72,8 @@ pub fn rotor_report(
     let load = load_of(params, stretch, speed_slip, measured);
     r.load = Some(load.clone());
     if load.too_low() {
-        let what = if load.fraction.is_some_and(|x| x < NO_LOAD) {
-            "no load"
-        } else {
-            "light load"
-        };
-        return cannot(r, format!("the load is too low to judge the rotor ({what}): {}, below the {:.0} % of the rated torque from which broken-bar sidebands are graded (their level scales with the rotor current; the MCSA severity bands of Thomson and Fenger 2001 are set near full load)", load.words(), 100.0 * load.min_fraction));
+        let no_load = load.fraction.is_some_and(|x| x < NO_LOAD);
+        return cannot(r, RotorCannot::LoadTooLow { no_load });
     }
     let mut planner = rustfft::FftPlanner::new();
     let slip = match speed_slip {
@@ -137,10 +132,9 @@ fn span_of(ch: &[Chunk], run: Range<usize>) -> Range<usize> {
 }
 
 /// `r` with the reason it cannot judge.
-fn cannot(mut r: RotorReport, why: String) -> RotorReport {
+fn cannot(mut r: RotorReport, why: RotorCannot) -> RotorReport {
     r.judged = false;
-    r.sentence = format!("rotor: cannot judge: {why}");
-    r.cannot_judge_because = Some(format!("cannot judge: {why}"));
+    r.cannot_judge_because = Some(why);
     r
 }
 
@@ -208,7 +202,10 @@ fn slip_from_pairs(
     let from_sidebands = pair(&avg, side.clone(), noise).map(|d| d / (2.0 * f));
     if let Some(s) = from_sidebands.filter(|s| plausible(*s)) {
         if let Some(top) = steady.filter(|top| s > *top) {
-            *r = cannot(std::mem::take(r), not_sidebands(s, top, load));
+            *r = cannot(
+                std::mem::take(r),
+                RotorCannot::NotSidebands { slip: s, top },
+            );
             return None;
         }
         return Some((s, SlipSource::Sidebands));
@@ -217,30 +214,11 @@ fn slip_from_pairs(
     r.largest_possible_db = Some(10.0 * largest.max(1e-30).log10());
     *r = cannot(
         std::mem::take(r),
-        format!(
-            "the slip is unknown: the log has no speed (wm_rad_s or enc_count), and no pair of sidebands (1 -/+ 2s) f nor of rotation harmonics f -/+ f_r stands {PAIR_SNR_DB:.0} dB above the current's noise; the largest component where the lower sideband could be (slips {:.1}..{:.0} %) is {:.1} dB below the line",
-            100.0 * MIN_SLIP,
-            100.0 * MAX_SLIP,
-            -10.0 * largest.max(1e-30).log10()
-        ),
+        RotorCannot::SlipUnknown {
+            largest_db_below: -10.0 * largest.max(1e-30).log10(),
+        },
     );
     None
-}
-
-/// Why a pair at slip `s`, above the steady slip `top` the machine can run at at `load`, is
-/// not the rotor's sidebands.
-fn not_sidebands(s: f64, top: f64, load: &RotorLoad) -> String {
-    let (rated, breakdown) = load
-        .rated
-        .map_or((f64::NAN, f64::NAN), |rt| (rt.slip, rt.breakdown_slip));
-    format!(
-        "the pair about the line is not rotor sidebands: slip {:.2} % is implausible at this load (above {:.2} %, {MAX_SLIP_OVER_RATED} times the rated slip {:.2} % of the parameter file's machine, breakdown at {:.1} %; {})",
-        100.0 * s,
-        100.0 * top,
-        100.0 * rated,
-        100.0 * breakdown,
-        load.words()
-    )
 }
 
 /// The Blackman-Harris window's highest sidelobe [dB] (Harris 1978): what a line leaks
@@ -283,15 +261,22 @@ fn read_and_judge(
     let fs = 2.0 * s.abs() * f;
     r.resolution_needed_hz = Some(fs / MIN_BINS);
     if s < MIN_SLIP {
-        return cannot(r, format!("the slip {:.2} % is below {:.1} % (no load): the sidebands sit on the line, and a cage carries too little current for a broken bar to show", 100.0 * s, 100.0 * MIN_SLIP));
+        return cannot(r, RotorCannot::SlipBelow { slip: s });
     }
     if s > MAX_SLIP {
-        return cannot(r, format!("the slip {:.1} % is above {:.0} %: a start or an overload, not a steady running point the severity bands grade", 100.0 * s, 100.0 * MAX_SLIP));
+        return cannot(r, RotorCannot::SlipAbove { slip: s });
     }
     let t = stretch.len() as f64 * bs;
     if t < MIN_BINS / fs {
         r.resolution_hz = Some(1.0 / t.max(bs));
-        return cannot(r, format!("the steady stretch is {t:.2} s; {:.2} s are needed to resolve sidebands 2sf = {fs:.2} Hz from the line ({MIN_BINS} bins of a Blackman-Harris window)", MIN_BINS / fs));
+        return cannot(
+            r,
+            RotorCannot::TooShort {
+                stretch_s: t,
+                needed_s: MIN_BINS / fs,
+                offset_hz: fs,
+            },
+        );
     }
     let mut sum = SidebandReading::default();
     for sp in spectra(planner, stretch, bs, m, segment_blocks(fs, bs)) {
@@ -301,7 +286,7 @@ fn read_and_judge(
         }
     }
     if sum.k == 0 {
-        return cannot(r, "no supply line in the current's spectrum".into());
+        return cannot(r, RotorCannot::NoLine);
     }
     let k = sum.k as f64;
     for x in [
@@ -393,52 +378,15 @@ fn judge(mut r: RotorReport, x: &SidebandReading, m: &RotorMachine) -> RotorRepo
     // below what a healthy cage reads, none above it.
     let at_noise = x.lower < 2.0 * floor;
     if at_noise && db(floor) > super::RotorBand::NoSign.upper_db() {
-        return cannot(r, format!("the current's noise reads {:.1} dB below the line where the (1 - 2s) f sideband is read, above the 54 dB a healthy cage is told at: a longer steady record or quieter current sensors lower it", -db(floor)));
+        return cannot(
+            r,
+            RotorCannot::Noisy {
+                floor_db_below: -db(floor),
+            },
+        );
     }
-    let band = band_of(level);
-    r.band = Some(band);
-    r.band_meaning = Some(band.words().to_string());
+    r.band = Some(band_of(level));
     r.judged = true;
-    r.sentence = sentence(&r, at_noise);
+    r.at_noise = at_noise;
     r
-}
-
-/// The report's one sentence.
-fn sentence(r: &RotorReport, at_noise: bool) -> String {
-    let level = -r.level_db.unwrap_or(f64::NAN);
-    let p = r.confidence.unwrap_or(0.0);
-    let head = match (r.slip_source, r.band) {
-        (Some(SlipSource::Sidebands), Some(b)) if b != super::RotorBand::NoSign => {
-            "unconfirmed: a pair about the line taken for the sidebands (no speed to confirm the slip)"
-        }
-        (_, b) => b.map_or("", |b| b.finding()),
-    };
-    let noise = if at_noise {
-        " (at the current's noise)"
-    } else {
-        ""
-    };
-    let bars = match (r.broken_bars, r.rotor_bars) {
-        (Some(n), Some(nb)) if p >= 0.5 => format!("; about {n:.1} adjacent broken bars of {nb}"),
-        _ => String::new(),
-    };
-    let source = match r.slip_source {
-        Some(SlipSource::Speed) => "the speed",
-        Some(SlipSource::Eccentricity) => "the rotation harmonics",
-        _ => "the sideband pair",
-    };
-    // The probability as the verdict reads it: a named finding's confidence (a cracked bar
-    // or worse), the probability of a fault for a finding the verdict calls clear ("watch",
-    // or a pair not confirmed), nothing for "no sign" (its 0.00 is not a health figure).
-    let p = match r.band {
-        Some(super::RotorBand::NoSign) | None => String::new(),
-        Some(super::RotorBand::Watch) => format!(", probability of a rotor fault {p:.2}"),
-        Some(_) => format!(", confidence {p:.2}"),
-    };
-    format!(
-        "rotor: {head}: the (1-2s)f sideband is {level:.1} dB below the supply line{noise} (band {}){p}{bars}; slip {:.2} % from {source}, {:.1} s read",
-        r.band.map_or("", |b| b.words()),
-        100.0 * r.slip.unwrap_or(f64::NAN),
-        r.window_s.last().unwrap_or(&0.0) - r.window_s.first().unwrap_or(&0.0),
-    )
 }

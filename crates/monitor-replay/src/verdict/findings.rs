@@ -3,11 +3,11 @@
 //! why it could not judge.
 
 use super::measured::{rotor_finding, sensor_flag_finding, winding_finding};
-use super::words::fault_text;
-use super::FindingReport;
 use super::MIN_JUDGED_S;
+use super::{Detail, FindingReport, Skipped};
 use crate::isolation::IsolationFinding;
 use crate::isolation::{FaultCandidate, IsolationBaseline, IsolationName, IsolationReport};
+use crate::lamps::commission::FirstPointMisfit;
 use crate::lamps::LampsFinding;
 use crate::winding::UnbalanceReport;
 use monitor_core::verdict::{Against, FaultName, FindingSource, NamedFault, Size, State};
@@ -25,7 +25,7 @@ pub(crate) struct ResidualInputs<'a> {
     /// A lamp or the isolation detected a fault (after heating and load moves).
     pub detected: bool,
     /// The analyses the log could not feed (the report's `skipped`).
-    pub skipped: &'a [String],
+    pub skipped: &'a [Skipped],
 }
 
 /// What the isolation names, as the verdict reads it: a Table 1 fault with its candidate's
@@ -60,12 +60,20 @@ pub(crate) fn isolation_name(
     }
 }
 
-/// The residuals' brief phrase (`residuals against commissioning`).
-fn residual_brief(against: Against) -> String {
-    format!(
-        "residuals {}",
-        super::words::against_text(FindingSource::Residuals, against)
-    )
+/// Why the parameter file does not fit the log (JSON `{"kind": ..}`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum FileMisfit {
+    /// The nearest single fault is within the file's own uncertainty.
+    NearestWithinFile {
+        /// The fault, with its size.
+        #[serde(serialize_with = "super::serialize_named")]
+        named: NamedFault,
+    },
+    /// What the isolation concluded (the report's `isolation.said`).
+    Isolation,
+    /// The first quasi-steady point already passes a fixed threshold.
+    FirstPoint(FirstPointMisfit),
 }
 
 /// What the findings read of a replay's stages at its end: the lamps' and the isolation's
@@ -117,48 +125,42 @@ impl Stages<'_> {
     }
 
     /// Why the residuals could not be judged at all, where they could not.
-    fn residuals_not_judged(&self, inp: &ResidualInputs<'_>) -> Option<String> {
+    fn residuals_not_judged(&self, inp: &ResidualInputs<'_>) -> Option<Detail> {
         if !self.lamps.monitor {
-            return Some(inp.skipped.first().cloned().unwrap_or_else(|| {
-                "residuals r1..r4: need the voltages and the speed".to_string()
-            }));
+            return Some(Detail::ResidualsSkipped {
+                need: inp.skipped.first().copied(),
+            });
         }
-        if let Some(why) = self.lamps.commission.why_incomplete() {
-            return Some(why);
+        if let Some(n) = self.lamps.commission.not_learned() {
+            return Some(Detail::ResidualsNotLearned(n));
         }
         if !self.lamps.evaluated && self.lamps.first_detection.is_none() {
-            return Some(
-                "the lamps were never evaluated (the motor never ran settled and quasi-steady with voltage)"
-                    .to_string(),
-            );
+            return Some(Detail::ResidualsNeverEvaluated);
         }
         if inp.detected {
             return None;
         }
         if self.lamps.judged_s < MIN_JUDGED_S {
-            return Some(format!(
-                "the lamps were judged on only {:.2} s of settled, quasi-steady running ({MIN_JUDGED_S:.1} s needed): the log is all start or transient, or ends too soon after commissioning",
-                self.lamps.judged_s
-            ));
+            return Some(Detail::ResidualsTooLittle {
+                judged_s: self.lamps.judged_s,
+                needed_s: MIN_JUDGED_S,
+            });
         }
-        self.lamps.withheld.clone()
+        self.lamps.withheld.map(Detail::ResidualsUnsettled)
     }
 
     /// The residual lamps' and the isolation's finding.
     pub(crate) fn residual_finding(&self, inp: &ResidualInputs<'_>) -> FindingReport {
         let against = self.residuals_against(inp.isolation);
-        let brief = residual_brief(against);
-        let of = |state, summary: String| {
-            FindingReport::new(
-                FindingSource::Residuals,
-                state,
-                against,
-                summary,
-                brief.clone(),
-            )
-        };
+        let of =
+            |state, detail| FindingReport::new(FindingSource::Residuals, state, against, detail);
         if let Some(why) = self.residuals_not_judged(inp) {
-            return self.residuals_unjudged(against, why);
+            let state = if !self.lamps.monitor {
+                State::Unavailable
+            } else {
+                State::NotJudged
+            };
+            return of(state, why);
         }
         let iso = inp.isolation;
         if let Some(named) = isolation_name(iso, inp.candidates).filter(|_| inp.detected) {
@@ -173,70 +175,37 @@ impl Stages<'_> {
             } else {
                 State::Named(named)
             };
-            return of(state, iso.verdict.clone());
+            return of(state, Detail::Isolation);
         }
         let lit_end = inp.out.lamps.iter().any(|l| *l);
-        if let Some((why, what)) = self.operating_point_explains(inp, lit_end) {
-            let mut f = of(State::Explained, why);
-            f.brief = format!("{brief} (the lamps lit for {what}, not a fault)");
-            return f;
+        if let Some(why) = self.operating_point_explains(inp, lit_end) {
+            return of(State::Explained, why);
         }
         if !inp.detected && !lit_end {
-            return of(State::Clear, iso.verdict.clone());
+            return of(State::Clear, Detail::Isolation);
         }
         if let (Some(t), false) = (self.lamps.first_detection, self.lamps.detected_in_range) {
-            return of(
-                State::OutOfRange,
-                format!(
-                    "the lamps lit (first at {t:.2} s) only while the load or the voltage was outside the range commissioned: the learned means hold only where they were learned; commission over the whole load and voltage range ({})",
-                    iso.verdict
-                ),
-            );
+            return of(State::OutOfRange, Detail::LampsOutOfRange { first_s: t });
         }
-        of(State::Unexplained, iso.verdict.clone())
-    }
-
-    /// The residual finding where they could not be judged (`why`): a log without the
-    /// voltages or the speed lacks what they need (unavailable); else the log kept them
-    /// from judging (not judged).
-    fn residuals_unjudged(&self, against: Against, why: String) -> FindingReport {
-        let state = if !self.lamps.monitor {
-            State::Unavailable
-        } else {
-            State::NotJudged
-        };
-        let brief = format!("residuals: {why}");
-        FindingReport::new(FindingSource::Residuals, state, against, why, brief)
+        of(State::Unexplained, Detail::Isolation)
     }
 
     /// Why the lamps that lit are the operating point's (heating, a load move), where they
-    /// are: the sentence, and a short phrase
-    /// (`62 K of heating`); `lit_end` whether a lamp is lit at the end.
-    fn operating_point_explains(
-        &self,
-        inp: &ResidualInputs<'_>,
-        lit_end: bool,
-    ) -> Option<(String, String)> {
+    /// are; `lit_end` whether a lamp is lit at the end.
+    fn operating_point_explains(&self, inp: &ResidualInputs<'_>, lit_end: bool) -> Option<Detail> {
         let iso = inp.isolation;
         let ever_lit = self.lamps.first_detection.is_some() || lit_end;
         if ever_lit && self.isolation.heating_explains_lamps {
-            let rise = iso
-                .winding_rise_k
-                .map_or("heating".to_string(), |k| format!("{k:.0} K of heating"));
-            return Some((iso.verdict.clone(), rise));
+            return Some(Detail::LampsForHeating {
+                rise_k: iso.winding_rise_k,
+            });
         }
         // The lamps' matching read only the load term: a load move, unless the isolation's
         // steady-state equations find a change no single fault (nor the load) explains.
         let lamps_read_load =
             self.lamps.only_load_named && iso.state != monitor_core::IsolationState::Unknown;
         if ever_lit && (self.isolation.load_explains_lamps || lamps_read_load) {
-            return Some((
-                format!(
-                    "the lamps lit for a load move (to the paper's model a load change is a Bl change): {}",
-                    iso.verdict
-                ),
-                "a load move".to_string(),
-            ));
+            return Some(Detail::LampsForLoadMove);
         }
         None
     }
@@ -248,73 +217,55 @@ impl Stages<'_> {
         residual: &FindingReport,
         iso: &IsolationReport,
     ) -> FindingReport {
-        let brief = "parameter file".to_string();
-        let of = |state, against, summary: String| {
-            FindingReport::new(
-                FindingSource::ParameterFit,
-                state,
-                against,
-                summary,
-                brief.clone(),
-            )
+        let of = |state, against, detail| {
+            FindingReport::new(FindingSource::ParameterFit, state, against, detail)
         };
         if self.residuals_against(iso) == Against::Commissioning {
-            return of(
-                State::Clear,
-                Against::Commissioning,
-                "commissioned: the residuals are judged against the healthy motor learned in commissioning, not the file's values".to_string(),
-            );
+            return of(State::Clear, Against::Commissioning, Detail::Commissioned);
         }
         if !self.lamps.monitor {
             return of(
                 State::Unavailable,
                 Against::ParameterFile,
-                "the residuals against the file need the voltages and the speed".to_string(),
+                Detail::ParameterFitUnavailable,
             );
         }
-        let misfit = |why: String| {
-            of(
+        if let Some(why) = self.file_misfit(residual, iso) {
+            return of(
                 State::Unexplained,
                 Against::ParameterFile,
-                format!(
-                    "the parameter file does not fit this log (commission on the healthy motor, or identify it: sim-host identify): {why}"
-                ),
-            )
-        };
-        if let Some(why) = self.file_misfit(residual, iso) {
-            return misfit(why);
+                Detail::FileMisfit(why),
+            );
         }
-        of(
-            State::Clear,
-            Against::ParameterFile,
-            "the residuals against the file's nominal values stay within their fixed thresholds"
-                .to_string(),
-        )
+        of(State::Clear, Against::ParameterFile, Detail::FileFits)
     }
 
     /// Why the parameter file does not fit the log, judged against its nominal values from
     /// the residual finding: a change no single fault explains, a name within the file's own
     /// uncertainty, or the first quasi-steady point already past the fixed thresholds.
-    fn file_misfit(&self, residual: &FindingReport, iso: &IsolationReport) -> Option<String> {
-        let within = |what: String| {
-            format!(
-                "the nearest single fault, {what}, is within the file's own uncertainty (+/-{:.0} %); a file 10-30 % off the machine, or windings 60 K warmer than the file assumes, move the residuals this much",
-                100.0 * monitor_core::isolation::NOMINAL_UNCERTAINTY
-            )
-        };
+    fn file_misfit(&self, residual: &FindingReport, iso: &IsolationReport) -> Option<FileMisfit> {
         match residual.finding.state {
             State::Unexplained => Some(match (iso.named, iso.named_change) {
-                (Some(IsolationName::Fault(f)), Some(c)) => {
-                    within(format!("{} {}", f.name(), super::words::pct(c)))
-                }
-                _ => iso.verdict.clone(),
+                (Some(IsolationName::Fault(f)), Some(c)) => FileMisfit::NearestWithinFile {
+                    named: NamedFault {
+                        fault: FaultName::Table1(f),
+                        size: Size::Relative(c),
+                        phase: None,
+                        confidence: iso.named_probability.unwrap_or(0.0),
+                    },
+                },
+                _ => FileMisfit::Isolation,
             }),
-            State::OutOfRange => Some(iso.verdict.clone()),
+            State::OutOfRange => Some(FileMisfit::Isolation),
             State::Named(n) if !n.stands_clear(Against::ParameterFile) => {
-                Some(within(fault_text(&n)))
+                Some(FileMisfit::NearestWithinFile { named: n })
             }
             State::Named(_) => None,
-            _ => self.lamps.commission.nominal_misfit(),
+            _ => self
+                .lamps
+                .commission
+                .nominal_misfit()
+                .map(FileMisfit::FirstPoint),
         }
     }
 
@@ -325,46 +276,30 @@ impl Stages<'_> {
         out: &MonitorOutput,
         iso: &IsolationReport,
     ) -> FindingReport {
-        let brief = "operating point".to_string();
         let against = self.residuals_against(iso);
-        let of = |state, summary: String| {
-            FindingReport::new(
-                FindingSource::OperatingPoint,
-                state,
-                against,
-                summary,
-                brief.clone(),
-            )
+        let of = |state, detail| {
+            FindingReport::new(FindingSource::OperatingPoint, state, against, detail)
         };
         if !self.lamps.monitor {
-            return of(
-                State::Unavailable,
-                "the load and the heating need the voltages and the speed".to_string(),
-            );
+            return of(State::Unavailable, Detail::OperatingPointUnavailable);
         }
-        let moves = iso
+        let load_moves = iso
             .events
             .iter()
             .filter(|e| matches!(e, crate::events::IsolationEvent::LoadMoved { .. }))
             .count();
-        let mut said = Vec::new();
-        if let Some(note) = self.lamps.commission.moved_note(out) {
-            said.push(format!("outside the commissioned range at the end: {note}"));
+        let outside = self.lamps.commission.moved_note(out);
+        let rise_k = iso.winding_rise_k;
+        if outside.is_none() && load_moves == 0 && rise_k.is_none() {
+            return of(State::Clear, Detail::Steady);
         }
-        if moves > 0 {
-            said.push(format!(
-                "the load moved {moves} time{}",
-                if moves == 1 { "" } else { "s" }
-            ));
-        }
-        if let Some(rise) = iso.winding_rise_k {
-            said.push(format!(
-                "the windings warmed by {rise:.0} K since commissioning"
-            ));
-        }
-        if said.is_empty() {
-            return of(State::Clear, "steady: no load move, no heating".to_string());
-        }
-        of(State::Explained, said.join("; "))
+        of(
+            State::Explained,
+            Detail::OperatingPointMoved {
+                outside,
+                load_moves,
+                rise_k,
+            },
+        )
     }
 }

@@ -19,42 +19,129 @@
 
 pub(super) mod findings;
 pub(super) mod measured;
-mod words;
-pub use words::{against_text, fault_text, pct};
 
 use monitor_core::verdict::{decide, Finding, NamedFault, Size, State};
 pub use monitor_core::verdict::{Against, FindingSource, Rule, Verdict};
 use monitor_core::Phase;
 use serde::{Serialize, Serializer};
 
+pub use findings::FileMisfit;
+
 /// One finding as the report gives it (JSON `findings[]`, `verdict_finding`): the core's
-/// [`Finding`] and a sentence.
+/// [`Finding`] and what it rests on ([`Detail`]), from which the door (`monitor_words`)
+/// spells its sentence (`summary`) and its brief phrase.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FindingReport {
     /// What the decision table reads.
     pub finding: Finding,
-    /// One sentence: what was found, or why nothing could be judged.
-    pub summary: String,
-    /// A short phrase for the verdict's lists: what was judged and against what
-    /// (`residuals against commissioning`, `rotor sidebands 58 dB below the supply line`), or
-    /// for a finding not judged, why (`rotor: the slip is below 0.003 (no load)`).
-    pub brief: String,
+    /// What was found, or why nothing could be judged, with its numbers.
+    pub detail: Detail,
+}
+
+pub use crate::lamps::Skipped;
+
+/// What a finding rests on, with its numbers (JSON `findings[].reason`, `{"kind": ..}`).
+/// The winding's, the rotor's and the isolation's own reports carry theirs (the report's
+/// `unbalance`, `rotor` and `isolation`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Detail {
+    /// The residuals were skipped: the log lacks a column (`None`: the voltages and the
+    /// speed both).
+    ResidualsSkipped {
+        /// Which column.
+        need: Option<Skipped>,
+    },
+    /// The commissioning window asked for was not learned.
+    ResidualsNotLearned(crate::lamps::commission::NotLearned),
+    /// The lamps were never evaluated: the motor never ran settled and quasi-steady with
+    /// voltage.
+    ResidualsNeverEvaluated,
+    /// The lamps were judged on too little settled, quasi-steady running.
+    ResidualsTooLittle {
+        /// Seconds judged.
+        judged_s: f64,
+        /// Seconds needed ([`MIN_JUDGED_S`]).
+        needed_s: f64,
+    },
+    /// The log ended inside a held, unsettled stretch with a residual far outside its band.
+    ResidualsUnsettled(crate::lamps::HeldUnsettled),
+    /// The isolation's conclusion (the report's `isolation.said`).
+    Isolation,
+    /// The lamps lit for the windings' heating (the tracked rise [K], where known).
+    LampsForHeating {
+        /// The rise [K].
+        rise_k: Option<f32>,
+    },
+    /// The lamps lit for a load move (to the paper's model a load change is a Bl change).
+    LampsForLoadMove,
+    /// The lamps lit only while the load or the voltage was outside the commissioned range.
+    LampsOutOfRange {
+        /// First lit [s].
+        first_s: f64,
+    },
+    /// The winding's negative sequence (the report's `unbalance`).
+    Winding,
+    /// The rotor's sidebands (the report's `rotor`).
+    Rotor,
+    /// The load and the heating need the voltages and the speed.
+    OperatingPointUnavailable,
+    /// Steady: no load move, no heating.
+    Steady,
+    /// The operating point moved.
+    OperatingPointMoved {
+        /// Outside the commissioned range at the end: what left it.
+        outside: Option<Vec<crate::lamps::commission::RangeDeparture>>,
+        /// How many times the load moved.
+        load_moves: usize,
+        /// How much the windings warmed since commissioning [K].
+        rise_k: Option<f32>,
+    },
+    /// Commissioned: the residuals are judged against the healthy motor learned.
+    Commissioned,
+    /// The residuals against the file need the voltages and the speed.
+    ParameterFitUnavailable,
+    /// The residuals against the file's nominal values stay within their fixed thresholds.
+    FileFits,
+    /// The parameter file does not fit this log, and why.
+    FileMisfit(FileMisfit),
+    /// The data-quality stage does not trust the data (the report's
+    /// `data_quality.not_trusted_because`).
+    DataNotTrusted,
+    /// Too much of the log could not be judged (the report's `data_quality.not_judged`).
+    DataNotJudged {
+        /// Seconds not judged.
+        unjudged_s: f64,
+        /// The log's length [s].
+        duration_s: f64,
+    },
+    /// The data are clean (the report's `data_quality`).
+    DataClean,
+    /// Sensor readings no machine gives at the end of the log.
+    ImpossibleReadings {
+        /// The current sensors.
+        current: bool,
+        /// The voltage sensors.
+        voltage: bool,
+        /// The speed sensor (encoder).
+        speed: bool,
+    },
+    /// The data-quality stage does not trust the data: nothing is judged, and what the
+    /// analysis read.
+    Distrusted {
+        /// Why the data are not trusted: the data-quality finding's own detail.
+        why: Box<Detail>,
+        /// What the analysis read.
+        read: Box<Detail>,
+    },
 }
 
 impl FindingReport {
-    /// A finding of `source` in `state` against `against`, with its sentence and its brief
-    /// phrase.
-    pub fn new(
-        source: FindingSource,
-        state: State,
-        against: Against,
-        summary: String,
-        brief: String,
-    ) -> Self {
+    /// A finding of `source` in `state` against `against`, resting on `detail`.
+    pub fn new(source: FindingSource, state: State, against: Against, detail: Detail) -> Self {
         FindingReport {
             finding: Finding::new(source, state, against),
-            summary,
-            brief,
+            detail,
         }
     }
 
@@ -82,12 +169,18 @@ impl FindingReport {
             State::OutOfRange => "out_of_range",
         }
     }
+
+    /// Whether the finding judged nothing: not judged, or unavailable.
+    pub fn judged_nothing(&self) -> bool {
+        matches!(self.finding.state, State::NotJudged | State::Unavailable)
+    }
 }
 
 /// The JSON form of a [`FindingReport`]: `source`, `state`, `fault`, `size`, `size_unit`
 /// (`relative`: 0.5 is +50 %; `of_i1`: a fraction of the positive-sequence current;
 /// `turns_fraction`: of the phase's turns; `db_below_line`: dB below the supply line),
-/// `phase`, `confidence` (null without a name), `against`, `summary`.
+/// `phase`, `confidence` (null without a name), `against`, `reason` (the door adds
+/// `summary`, its sentence).
 #[derive(Serialize)]
 struct FindingJson<'a> {
     source: FindingSource,
@@ -98,7 +191,29 @@ struct FindingJson<'a> {
     phase: Option<Phase>,
     confidence: Option<f32>,
     against: Against,
-    summary: &'a str,
+    reason: &'a Detail,
+}
+
+/// A named fault as the JSON gives it: `{fault, size, size_unit, phase, confidence}`, for
+/// `#[serde(serialize_with = "serialize_named")]`.
+pub fn serialize_named<S: Serializer>(n: &NamedFault, s: S) -> Result<S::Ok, S::Error> {
+    #[derive(Serialize)]
+    struct NamedJson {
+        fault: &'static str,
+        size: f32,
+        size_unit: &'static str,
+        phase: Option<Phase>,
+        confidence: f32,
+    }
+    let (size, size_unit) = size_parts(n.size);
+    NamedJson {
+        fault: n.fault.name(),
+        size,
+        size_unit,
+        phase: n.phase,
+        confidence: n.confidence,
+    }
+    .serialize(s)
 }
 
 /// A size's value and the JSON name of its unit.
@@ -124,13 +239,13 @@ impl Serialize for FindingReport {
             phase: n.and_then(|n| n.phase),
             confidence: n.map(|n| n.confidence),
             against: self.finding.against,
-            summary: &self.summary,
+            reason: &self.detail,
         }
         .serialize(s)
     }
 }
 
-/// What the decision table concluded, in the report's words.
+/// What the decision table concluded.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Conclusion {
     /// The verdict.
@@ -139,44 +254,18 @@ pub struct Conclusion {
     pub rule: Rule,
     /// The finding it rests on, where one decided.
     pub finding: Option<FindingReport>,
-    /// The verdict's line as printed after `verdict: ` (`FAULT rs +50 % (confidence 1.00;
-    /// residuals against commissioning)`, `healthy: residuals against commissioning; ...`).
-    pub line: String,
-    /// What was judged, one phrase per analysis (`residuals against commissioning`).
-    pub judged: Vec<String>,
-    /// What could not be judged, and why (`rotor: ...`).
-    pub not_judged: Vec<String>,
-    /// Why the verdict is not a FAULT or healthy, where it is not (watching, could not
-    /// judge): the deciding finding's sentence, then what could not be judged.
-    pub withheld_because: Vec<String>,
 }
 
-/// The verdict of `findings` by the core's decision table, with its line and lists.
+/// The verdict of `findings` by the core's decision table.
 pub fn conclude(findings: &[FindingReport]) -> Conclusion {
     #[cfg(test)]
     DECIDED.with(|d| d.set(d.get() + 1));
     let core: Vec<Finding> = findings.iter().map(|f| f.finding).collect();
     let d = decide(&core);
-    let finding = d.by.and_then(|k| findings.get(k)).cloned();
-    let judged = words::judged(findings);
-    let not_judged = words::not_judged(findings);
-    let line = words::line(d, finding.as_ref(), findings, &judged, &not_judged);
-    let withheld_because = match d.verdict {
-        Verdict::Fault | Verdict::Healthy => Vec::new(),
-        Verdict::Watching | Verdict::CouldNotJudge => finding
-            .iter()
-            .map(|f| f.summary.clone())
-            .chain(not_judged.iter().cloned())
-            .collect(),
-    };
     Conclusion {
         verdict: d.verdict,
         rule: d.rule,
-        finding,
-        line,
-        judged,
-        not_judged,
-        withheld_because,
+        finding: d.by.and_then(|k| findings.get(k)).cloned(),
     }
 }
 
@@ -254,6 +343,3 @@ fn steady_phase(out: &MonitorOutput) -> Option<Phase> {
         .suspect_phase
         .filter(|_| out.evaluating && out.quasi_steady)
 }
-
-#[cfg(test)]
-mod tests;

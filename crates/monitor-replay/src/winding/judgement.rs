@@ -15,7 +15,6 @@ use super::{
 use super::{BaselineSource, UnbalanceReport};
 use crate::windows::SensorPhaseReport;
 use crate::windows::{sensor_phase, SequenceWindow};
-use crate::words::Words;
 use monitor_core::sequence::{
     asymmetry_correction_rad, equivalent_impedance, slip_for_current, SinglePhaseGain,
 };
@@ -180,15 +179,13 @@ struct Outside {
 
 /// The negative-sequence report (module docs) of the least-squares `windows` of a log of
 /// `params`' machine (`speed`: the log has a speed), judged against `baseline` (the healthy
-/// runs given, else the commissioning window's), with the turns counted by `level`, its
-/// sentences in `words`.
+/// runs given, else the commissioning window's), with the turns counted by `level`.
 pub(crate) fn unbalance_report(
     windows: &[SequenceWindow],
     params: &ParamFile,
     speed: bool,
     baseline: Option<HealthyReference>,
     level: TurnLevelOptions,
-    words: Words,
 ) -> UnbalanceReport {
     let segs = segments(windows);
     let judge = Judge {
@@ -205,7 +202,7 @@ pub(crate) fn unbalance_report(
     match &judged {
         None => report.phase_not_judged = Some(no_stretch_reason(params.supply.f_hz)),
         Some(j) => {
-            fill_judgement(&mut report, j, &segs, words);
+            fill_judgement(&mut report, j, &segs);
             let poles = params.motor.poles.max(2) as f32 / 2.0;
             if let Some(o) = &outside {
                 report.least_change_widened = super::reasons::widened(j, &o.ext, poles);
@@ -219,6 +216,10 @@ pub(crate) fn unbalance_report(
         Some(cal) => super::level::calibrated(&report, &cal),
         None => report.shorted_turns_physics,
     };
+    if report.suspect_phase.is_none() {
+        report.shorted_turns_reach =
+            super::level::reach(&report, &judge.m, we0, judge.v_nominal, &level);
+    }
     report
 }
 
@@ -265,6 +266,7 @@ fn report_without_judgement(
         }),
         shorted_turns: None,
         shorted_turns_physics: None,
+        shorted_turns_reach: None,
     }
 }
 
@@ -333,21 +335,15 @@ fn learned_reference(judge: &Judge, windows: &[SequenceWindow], we0: f32) -> Opt
 
 /// Why the phase is not judged when no stretch is steady long enough (`f_hz`: the supply
 /// frequency).
-fn no_stretch_reason(f_hz: f64) -> String {
-    format!(
-        "cannot judge the phase: no steady stretch of at least {} least-squares windows ({:.2} s): the log is too short or its operating point never settled",
-        MIN_SEGMENT_WINDOWS,
-        MIN_SEGMENT_WINDOWS as f64 * crate::windows::WINDOW_PERIODS / f_hz
-    )
+fn no_stretch_reason(f_hz: f64) -> super::PhaseNotJudged {
+    super::PhaseNotJudged::NoSteadyStretch {
+        windows: MIN_SEGMENT_WINDOWS,
+        seconds: MIN_SEGMENT_WINDOWS as f64 * crate::windows::WINDOW_PERIODS / f_hz,
+    }
 }
 
-/// The judged stretch's keys of the report (`words`: the sentences' words for a field).
-fn fill_judgement(
-    report: &mut UnbalanceReport,
-    j: &PhaseJudged,
-    segs: &[SequenceSegment],
-    words: Words,
-) {
+/// The judged stretch's keys of the report.
+fn fill_judgement(report: &mut UnbalanceReport, j: &PhaseJudged, segs: &[SequenceSegment]) {
     let p = j.posterior;
     let named = p.named();
     report.suspect_phase = named.map(|n| n.0);
@@ -372,7 +368,7 @@ fn fill_judgement(
     report.judged_against = Some(j.against);
     report.phase_not_judged = segs.get(j.index).and_then(|s| {
         let reference = j.reference.and_then(|k| segs.get(k));
-        super::reasons::not_named(j, s, reference, least, words)
+        super::reasons::not_named(j, s, reference, least)
     });
     report.judged_segment = Some(j.index.min(MAX_SEGMENTS - 1));
     report.reference_segment = j.reference.filter(|&k| k < MAX_SEGMENTS);

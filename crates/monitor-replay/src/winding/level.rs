@@ -216,6 +216,88 @@ pub fn physics(
     })
 }
 
+/// How large a short the judged stretch could hide: the fraction of a phase's turns whose
+/// loop draws the least change that names a phase (JSON `unbalance.shorted_turns_reach`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TurnReach {
+    /// The fraction with the file's winding and the default fault resistance (0..1).
+    pub fraction: f32,
+    /// The largest over the operating point's, the winding resistance's and the fault
+    /// resistance's ranges: no short of more than this stays below the least change.
+    pub high: f32,
+    /// Where it comes from.
+    pub basis: LevelBasis,
+    /// The least change it is read from (fraction of `|I1|`).
+    pub least_change: f32,
+}
+
+/// The loop ratio a change of `least` (fraction of `|I1|`) of the judged stretch reads as,
+/// in the phase where it reads largest (`r = c a^-k / (1 - M a^-k)`, module docs step 1):
+/// `None` without a judged stretch or a least change.
+fn least_loop_ratio(u: &UnbalanceReport, least: f32) -> Option<f32> {
+    let seg = u.segments.get(u.judged_segment?)?;
+    if !(least.is_finite() && least > 0.0) {
+        return None;
+    }
+    let m = Complex32::from_polar(seg.negative_sequence_ratio, seg.angle_deg.to_radians());
+    Phase::ALL
+        .iter()
+        .map(|p| {
+            let turn =
+                Complex32::from_polar(1.0, -(p.index() as f32) * std::f32::consts::TAU / 3.0);
+            least / abs(Complex32::new(1.0, 0.0) - m * turn).max(1e-3)
+        })
+        .reduce(f32::max)
+}
+
+/// How large a short this log could hide ([`TurnReach`]): the model's fraction for the least
+/// change that names a phase (`None` without a judged stretch, or where no change names one).
+pub fn reach(
+    u: &UnbalanceReport,
+    m: &MotorModel,
+    we: f32,
+    v_peak: f32,
+    opts: &TurnLevelOptions,
+) -> Option<TurnReach> {
+    let x = least_loop_ratio(u, u.least_change)?;
+    if let Some(cal) = &opts.calibration {
+        let f = |x: f32| {
+            Phase::ALL
+                .iter()
+                .filter_map(|p| cal.fraction(*p, x))
+                .map(|v| v.clamp(0.0, 1.0))
+                .reduce(f32::max)
+        };
+        let fraction = f(x)?;
+        return Some(TurnReach {
+            fraction,
+            high: f(x + 2.0 * cal.scatter).unwrap_or(fraction).max(fraction),
+            basis: LevelBasis::Calibration,
+            least_change: u.least_change,
+        });
+    }
+    let paths = f32::from(opts.parallel_paths.get());
+    let r = Complex32::new(x, 0.0);
+    let z1s = z1_range(u, m, we, v_peak, r);
+    let x_lls = we * (m.ls_h - m.lm_h);
+    let rs = m.rs_ohm;
+    let at =
+        |z1: f32, rw: f32, rf_of_rs: f32| fraction_for_loop(x, z1, rw, rf_of_rs * rs, x_lls, paths);
+    let fraction = at(z1s[0], rs, FAULT_RESISTANCE_OF_RS);
+    let mut high = fraction;
+    for z1 in z1s {
+        for rw in [WINDING_RESISTANCE_LOW * rs, rs] {
+            high = high.max(at(z1, rw, FAULT_RESISTANCE_RANGE.1));
+        }
+    }
+    Some(TurnReach {
+        fraction,
+        high,
+        basis: LevelBasis::Physics,
+        least_change: u.least_change,
+    })
+}
+
 /// The calibration's estimate for the same reading (`None` without a named phase);
 /// the interval is the calibration's scatter and the judgement's two spreads on `|r|`.
 pub fn calibrated(u: &UnbalanceReport, cal: &TurnCalibration) -> Option<ShortedTurns> {

@@ -1,69 +1,138 @@
-//! The winding judgement's sentences: why no phase is named, and that a baseline ran at
-//! another operating point (the least change widened for it).
+//! Why the winding judgement names no phase ([`PhaseNotJudged`]), and that a baseline ran at
+//! another operating point (the least change widened for it, [`Widened`]): typed values,
+//! spelled at the door (`monitor_words`).
 
 use super::probability::{External, PhaseJudged};
-use super::{abs, Against, SequenceSegment, OPERATING_SPEED_STEP, SEGMENT_I1_STEP};
+use super::{
+    abs, Against, OperatingPointSource, SequenceSegment, OPERATING_SPEED_STEP, SEGMENT_I1_STEP,
+};
 use monitor_core::Phase;
+use serde::Serialize;
 
 /// A change of `I2/I1` below this is no asymmetry to speak of (the noise of 12-bit sensors):
 /// no reason is given for naming no phase.
 pub const BALANCED_RATIO: f32 = 0.005;
 
-/// Why the judged stretch names no phase, in a sentence; `None` when it names one, or when
-/// the change is below [`BALANCED_RATIO`] (nothing to judge). `seg` is the judged stretch,
-/// `reference` the stretch it was judged against within the log, `least` the least change
-/// that names a phase (fraction of `|I1|`; `None`: none does), `words` the words its
-/// advice names a field in.
+/// Why no phase is named (JSON `unbalance.phase_not_judged_reason`, `{"kind": ..}`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum PhaseNotJudged {
+    /// No steady stretch of at least `windows` least-squares windows (`seconds`): the log
+    /// is too short or its operating point never settled.
+    NoSteadyStretch {
+        /// The least windows a stretch holds.
+        windows: usize,
+        /// Their length [s].
+        seconds: f64,
+    },
+    /// A short is the more probable, but no one phase is: the change points between two
+    /// phases' centres and its angle is uncertain.
+    BetweenPhases {
+        /// The change (fraction of `|I1|`).
+        change: f32,
+        /// The judged stretch `[from, to]` [s].
+        at_s: [f64; 2],
+        /// The probability of a short.
+        short: f32,
+        /// The most probable phase, and its probability.
+        phase: Phase,
+        /// See `phase`.
+        phase_probability: f32,
+        /// How far the change points from that phase's centre [deg].
+        deviation_deg: f32,
+        /// The phase it leans towards.
+        towards: Phase,
+        /// The change's angle uncertainty [deg].
+        angle_sd_deg: f32,
+        /// The reference angle's uncertainty [deg], and where it comes from.
+        reference_sd_deg: f32,
+        /// See `reference_sd_deg`.
+        reference: OperatingPointSource,
+    },
+    /// The change is within what a healthy machine's own asymmetry may reach, and there is
+    /// no healthy baseline.
+    NoBaseline {
+        /// The change (fraction of `|I1|`).
+        change: f32,
+        /// The judged stretch `[from, to]` [s].
+        at_s: [f64; 2],
+        /// The least change that names a phase (`None`: none does with this spread).
+        least: Option<f32>,
+    },
+    /// Within what stretches of one healthy log differ by.
+    WithinTheLog {
+        /// The change (fraction of `|I1|`).
+        change: f32,
+        /// The judged stretch `[from, to]` [s].
+        at_s: [f64; 2],
+        /// The stretch it was judged against `[from, to]` [s].
+        reference_s: Option<[f64; 2]>,
+        /// The least change that names a phase.
+        least: Option<f32>,
+    },
+    /// Within what healthy runs (or the commissioning window) differ by.
+    WithinHealthyRuns {
+        /// The change (fraction of `|I1|`).
+        change: f32,
+        /// The judged stretch `[from, to]` [s].
+        at_s: [f64; 2],
+        /// The least change that names a phase.
+        least: Option<f32>,
+    },
+}
+
+/// Why the judged stretch names no phase; `None` when it names one, or when the change is
+/// below [`BALANCED_RATIO`] (nothing to judge). `seg` is the judged stretch, `reference`
+/// the stretch it was judged against within the log, `least` the least change that names a
+/// phase (fraction of `|I1|`; `None`: none does).
 pub(super) fn not_named(
     j: &PhaseJudged,
     seg: &SequenceSegment,
     reference: Option<&SequenceSegment>,
     least: Option<f32>,
-    words: crate::words::Words,
-) -> Option<String> {
+) -> Option<PhaseNotJudged> {
     let p = j.posterior;
     if p.named().is_some() {
         return None;
     }
-    let change = 100.0 * abs(j.change);
-    let at = format!("{:.1}..{:.1} s", seg.from_s, seg.to_s);
+    let change = abs(j.change);
+    let at_s = [seg.from_s, seg.to_s];
     let (phase, best) = p.most_probable();
-    if p.short() > p.no_short && least.is_none_or(|l| abs(j.change) >= l) {
+    if p.short() > p.no_short && least.is_none_or(|l| change >= l) {
         // A short is the more probable, but no one phase is.
-        let dev = deviation_deg(j, phase);
-        let u = j.reading.model().angle_sd_rad.to_degrees();
-        return Some(format!(
-            "cannot judge the phase: the change ({change:.1} % of I1 at {at}) is likely a short ({:.2}) but points {dev:.0} deg from phase {}'s centre (probability {best:.2}), towards phase {}, and its angle is uncertain by {u:.0} deg (reference angle +/-{:.0} deg, {}, and the shorted loop's own)",
-            p.short(),
-            phase.name(),
-            neighbour(j, phase).name(),
-            j.reading.op.1.to_degrees(),
-            j.reading.op.3.describe()
-        ));
+        return Some(PhaseNotJudged::BetweenPhases {
+            change,
+            at_s,
+            short: p.short(),
+            phase,
+            phase_probability: best,
+            deviation_deg: deviation_deg(j, phase),
+            towards: neighbour(j, phase),
+            angle_sd_deg: j.reading.model().angle_sd_rad.to_degrees(),
+            reference_sd_deg: j.reading.op.1.to_degrees(),
+            reference: j.reading.op.3,
+        });
     }
-    if abs(j.change) < BALANCED_RATIO {
+    if change < BALANCED_RATIO {
         return None;
     }
-    let least = match least {
-        Some(l) => format!("least change {:.1} %", 100.0 * l),
-        None => "no change names a phase with this spread".to_string(),
-    };
     Some(match j.against {
-        Against::Nothing | Against::ParameterFile => format!(
-            "cannot judge the phase: the negative sequence ({change:.1} % of I1 at {at}) is within what a healthy machine's own asymmetry may reach ({least}) and there is no healthy baseline (give {} with healthy logs of this motor, or commission)",
-            words.hint(crate::words::OptionField::Baseline, "")
-        ),
-        Against::WithinTheLog => {
-            let from = reference.map_or(String::new(), |r| {
-                format!(" from the stretch at {:.1}..{:.1} s", r.from_s, r.to_s)
-            });
-            format!(
-                "no phase: the negative sequence changed by {change:.1} % of I1 at {at}{from}, within what stretches of one healthy log differ by at their loads ({least}), and neither stands clear of a healthy machine's own asymmetry"
-            )
-        }
-        Against::HealthyRuns | Against::Commissioning => format!(
-            "no phase: the change of the negative sequence ({change:.1} % of I1 at {at}) is within what healthy runs differ by ({least})"
-        ),
+        Against::Nothing | Against::ParameterFile => PhaseNotJudged::NoBaseline {
+            change,
+            at_s,
+            least,
+        },
+        Against::WithinTheLog => PhaseNotJudged::WithinTheLog {
+            change,
+            at_s,
+            reference_s: reference.map(|r| [r.from_s, r.to_s]),
+            least,
+        },
+        Against::HealthyRuns | Against::Commissioning => PhaseNotJudged::WithinHealthyRuns {
+            change,
+            at_s,
+            least,
+        },
     })
 }
 
@@ -86,12 +155,28 @@ fn neighbour(j: &PhaseJudged, phase: Phase) -> Phase {
     Phase::from_turns(phase.index() as i32 + if side > 0.0 { 1 } else { -1 })
 }
 
-/// The sentence that the outside reference `ext` ran at another operating point than the
-/// judged stretch (`|I1|`, the named short's own share taken out, beyond
-/// [`SEGMENT_I1_STEP`], or the speed beyond [`OPERATING_SPEED_STEP`]) and the least change
-/// was widened for it; `None` at the same point. `pole_pairs` turns the electrical speed
-/// into the shaft's.
-pub(super) fn widened(j: &PhaseJudged, ext: &External, pole_pairs: f32) -> Option<String> {
+/// That the outside reference ran at another operating point than the judged stretch, and
+/// the least change was widened for it (JSON `unbalance.least_change_widened_by`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Widened {
+    /// What the reference is (`commissioning`, or `healthy_runs`: the baseline).
+    pub reference: Against,
+    /// `|I1|`'s relative change from the reference (the named short's own share taken out
+    /// where `beyond_short`).
+    pub i1_change: Option<f32>,
+    /// A phase was named: `i1_change` is beyond the short's own share.
+    pub beyond_short: bool,
+    /// The shaft speed's change from the reference [rad/s, mechanical].
+    pub speed_change_rad_s: Option<f32>,
+    /// The least change at one operating point and as widened [%] (infinite: none).
+    pub least_pct: [f32; 2],
+}
+
+/// That the outside reference `ext` ran at another operating point than the judged stretch
+/// (`|I1|`, the named short's own share taken out, beyond [`SEGMENT_I1_STEP`], or the speed
+/// beyond [`OPERATING_SPEED_STEP`]) and the least change was widened for it; `None` at the
+/// same point. `pole_pairs` turns the electrical speed into the shaft's.
+pub(super) fn widened(j: &PhaseJudged, ext: &External, pole_pairs: f32) -> Option<Widened> {
     let rd = &j.reading;
     let i1 = j.load_i1_change.filter(|d| d.is_finite());
     let speed = rd.wr.zip(ext.wr).map(|(a, b)| a - b);
@@ -100,42 +185,12 @@ pub(super) fn widened(j: &PhaseJudged, ext: &External, pole_pairs: f32) -> Optio
     if i1_moved.is_none() && speed_moved.is_none() {
         return None;
     }
-    let mut how = Vec::new();
-    if let Some(d) = i1 {
-        how.push(format!(
-            "|I1| {:.0} % {}{}",
-            100.0 * d.abs(),
-            if d > 0.0 { "higher" } else { "lower" },
-            if j.posterior.named().is_some() {
-                " beyond the short's own share"
-            } else {
-                ""
-            }
-        ));
-    }
-    if let Some(d) = speed {
-        how.push(format!(
-            "speed {:.1} rad/s {}",
-            d.abs() / pole_pairs,
-            if d > 0.0 { "higher" } else { "lower" }
-        ));
-    }
-    let what = match ext.against {
-        Against::Commissioning => "the commissioning window",
-        _ => "the baseline",
-    };
     let pct = |s: f32| j.least_change_at(s).map_or(f32::INFINITY, |l| 100.0 * l);
-    let (from, to) = (pct(j.sigma_same_point), pct(j.sigma));
-    // Two decimals where one would not show the widening; none worth a word at two.
-    let digits = if (to - from) < 0.05 { 2 } else { 1 };
-    if (to - from).is_nan() || to - from < 0.005 {
-        return Some(format!(
-            "{what} ran at another operating point than the judged stretch ({}), which the least change {from:.digits$} % already covers",
-            how.join(", "),
-        ));
-    }
-    Some(format!(
-        "{what} ran at another operating point than the judged stretch ({}): the least change widened from {from:.digits$} % to {to:.digits$} % (the negative sequence a healthy motor has moves with the load)",
-        how.join(", "),
-    ))
+    Some(Widened {
+        reference: ext.against,
+        i1_change: i1,
+        beyond_short: j.posterior.named().is_some(),
+        speed_change_rad_s: speed.map(|d| d / pole_pairs),
+        least_pct: [pct(j.sigma_same_point), pct(j.sigma)],
+    })
 }

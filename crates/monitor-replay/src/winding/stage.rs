@@ -9,7 +9,6 @@ use super::{HealthyReference, UnbalanceReport};
 use crate::options::ReplayOptions;
 use crate::stage::{Finish, Stage};
 use crate::windows::{SequenceWindow, WindowRow};
-use crate::words::Words;
 use monitor_io::log::Row;
 use monitor_io::params::ParamFile;
 use std::collections::VecDeque;
@@ -78,7 +77,6 @@ pub(crate) struct WindingStage {
     speed: bool,
     baseline: Option<HealthyReference>,
     level: TurnLevelOptions,
-    words: Words,
 }
 
 /// What the chain hands the winding at the end: whether the sequence stage closed its last
@@ -95,7 +93,7 @@ pub(crate) struct WindingClosing {
 impl WindingStage {
     /// The stage for `params`' machine (`speed`: the log has a speed for the monitor), as
     /// `opts` ask: judged against their healthy baseline where given, the level with their
-    /// turn level, its advice in their words.
+    /// turn level.
     pub(crate) fn new(params: &ParamFile, speed: bool, opts: &ReplayOptions) -> Self {
         WindingStage {
             book: WindowBook::new(),
@@ -103,7 +101,6 @@ impl WindingStage {
             speed,
             baseline: opts.unbalance_baseline,
             level: opts.turn_level,
-            words: opts.words,
         }
     }
 
@@ -142,7 +139,6 @@ impl Finish for WindingStage {
             self.speed,
             self.baseline,
             self.level,
-            self.words,
         )
     }
 }

@@ -63,7 +63,7 @@ pub const INSIDE: &[Inside] = &[
         "crates/monitor-replay/src/",
         &[
             ("events", 2),
-            ("error", 2),
+            ("error", 5),
             ("options", 2),
             ("rotor", 2),
             ("sequences", 3),
@@ -77,6 +77,12 @@ pub const INSIDE: &[Inside] = &[
             ("replay", 6),
             ("diagnose", 7),
         ],
+    ),
+    // The door: the front ends' spelling of the fields at the bottom, the engines' words
+    // above it, the errors' words (which read a report's words) on top.
+    (
+        "crates/monitor-words/src/",
+        &[("diagnose", 2), ("trend", 2), ("errors", 3)],
     ),
     // The fleet run over the one-call API.
     ("crates/monitor-api/src/", &[("fleet", 2)]),

@@ -10,7 +10,9 @@
 //! The file is written atomically ([`monitor_api::files::write_atomic`]).
 
 use super::plot::{self, Chart, Series};
+use crate::cli::words::CliWords;
 use monitor_api::replay::{DiagnoseReport, Diagnosed, IsolationEvent, RotorBand};
+use monitor_api::words::diagnose::{self as words, Story};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -56,6 +58,7 @@ code{overflow-wrap:anywhere}ul{padding-left:1.2em}\
 /// The page (module docs), with the charts as (title, inline SVG or why not drawn).
 fn page(log: &str, d: &Diagnosed, charts: &[(String, String)]) -> String {
     let rep = &d.report;
+    let story = Story::of(rep, &CliWords);
     let mut h = String::new();
     let _ = write!(h, "<!doctype html><html lang=en><head><meta charset=utf-8><meta name=viewport content=\"width=device-width,initial-scale=1\"><title>diagnose: {}</title><style>{STYLE}</style></head><body>", esc(log));
     let _ = write!(
@@ -66,15 +69,15 @@ fn page(log: &str, d: &Diagnosed, charts: &[(String, String)]) -> String {
         d.sample_rate_hz,
         monitor_api::replay::angle_source_name(rep.angle_source)
     );
-    verdict(&mut h, rep);
-    findings_table(&mut h, rep);
+    verdict(&mut h, rep, &story);
+    findings_table(&mut h, rep, &story);
     for (title, svg) in charts {
         let _ = write!(h, "<h2>{}</h2>{svg}", esc(title));
     }
     events_list(&mut h, rep);
-    winding(&mut h, rep);
+    winding(&mut h, rep, &story);
     if rep.rotor.judged {
-        let _ = write!(h, "<h2>Rotor</h2><p>{}</p>", esc(&rep.rotor.sentence));
+        let _ = write!(h, "<h2>Rotor</h2><p>{}</p>", esc(&story.rotor));
     }
     quality(&mut h, rep);
     h.push_str("<p><small>Written by <code>sim-host diagnose --report</code>; the same verdict as <code>diagnose</code>'s text and <code>--json</code>.</small></p></body></html>");
@@ -82,7 +85,7 @@ fn page(log: &str, d: &Diagnosed, charts: &[(String, String)]) -> String {
 }
 
 /// The verdict line, what was judged against what, and what was not judged.
-fn verdict(h: &mut String, rep: &DiagnoseReport) {
+fn verdict(h: &mut String, rep: &DiagnoseReport, story: &Story) {
     let class = serde_json::to_value(rep.verdict)
         .ok()
         .and_then(|v| v.as_str().map(str::to_string))
@@ -91,15 +94,11 @@ fn verdict(h: &mut String, rep: &DiagnoseReport) {
         h,
         "<p class=\"v {}\"><b>verdict: {}</b></p>",
         esc(&class),
-        esc(&rep.verdict_line)
+        esc(&story.verdict_line)
     );
-    list(h, "Judged", &rep.judged);
-    list(h, "Not judged", &rep.not_judged);
-    list(
-        h,
-        "Why the verdict is withheld",
-        &rep.verdict_withheld_because,
-    );
+    list(h, "Judged", &story.judged);
+    list(h, "Not judged", &story.not_judged);
+    list(h, "Why the verdict is withheld", &story.withheld_because);
 }
 
 /// A titled list of sentences (nothing when empty).
@@ -115,14 +114,14 @@ fn list(h: &mut String, title: &str, items: &[String]) {
 }
 
 /// One row per analysis: its name, state and sentence (with the named fault's confidence).
-fn findings_table(h: &mut String, rep: &DiagnoseReport) {
+fn findings_table(h: &mut String, rep: &DiagnoseReport, story: &Story) {
     h.push_str("<h2>Findings</h2><table><tr><th>analysis</th><th>state</th><th>finding</th></tr>");
-    for f in &rep.findings {
+    for (f, (summary, _)) in rep.findings.iter().zip(&story.findings) {
         let named = f.named().map_or(String::new(), |n| {
             format!(
                 " (confidence {:.2}; {})",
                 n.confidence,
-                monitor_api::replay::against_text(f.source(), f.finding.against)
+                words::against_text(f.source(), f.finding.against)
             )
         });
         let _ = write!(
@@ -130,7 +129,7 @@ fn findings_table(h: &mut String, rep: &DiagnoseReport) {
             "<tr><td class=k>{}</td><td class=k>{}</td><td>{}{}</td></tr>",
             esc(f.source().name()),
             esc(f.state_name()),
-            esc(&f.summary),
+            esc(summary),
             esc(&named)
         );
     }
@@ -143,7 +142,7 @@ fn events_list(h: &mut String, rep: &DiagnoseReport) {
         .isolation
         .events
         .iter()
-        .map(|e| (e.t_s(), e.line().trim().to_string()))
+        .map(|e| (e.t_s(), words::event_line(e).trim().to_string()))
         .collect();
     lines.extend(rep.detections.iter().map(|d| {
         (
@@ -161,11 +160,9 @@ fn events_list(h: &mut String, rep: &DiagnoseReport) {
 }
 
 /// The negative sequence: the whole log's ratio, the named phase and its confidence.
-fn winding(h: &mut String, rep: &DiagnoseReport) {
+fn winding(h: &mut String, rep: &DiagnoseReport, story: &Story) {
     let u = &rep.unbalance;
-    let phase = u.suspect_phase.map_or("none".to_string(), |p| {
-        format!("{p:?} (confidence {:.2})", u.phase_confidence)
-    });
+    let phase = words::suspect(u);
     let _ = write!(
         h,
         "<h2>Winding</h2><p>Negative sequence |I2|/|I1| = {:.2} % (least change that names a phase {:.1} %); suspect phase: {}.</p>",
@@ -173,8 +170,8 @@ fn winding(h: &mut String, rep: &DiagnoseReport) {
         100.0 * u.least_change,
         esc(&phase)
     );
-    if let Some(why) = &u.phase_not_judged {
-        let _ = write!(h, "<p>{}</p>", esc(why));
+    if let Some(line) = words::winding_line(u, &CliWords) {
+        let _ = write!(h, "<p>{}</p>", esc(&line));
     }
     let p = &u.phase_probabilities;
     let _ = write!(
@@ -271,7 +268,10 @@ fn time_chart(
 /// what was missing), or the log is shorter than one step.
 fn no_timeline(rep: &DiagnoseReport) -> String {
     match rep.skipped.first() {
-        Some(why) => format!("Not drawn: the monitor did not run on this log: {why}"),
+        Some(why) => format!(
+            "Not drawn: the monitor did not run on this log: {}",
+            words::skipped(*why)
+        ),
         None => "Not drawn: the log is shorter than one timeline step".to_string(),
     }
 }
@@ -382,7 +382,7 @@ fn rotor_chart(rep: &DiagnoseReport) -> Chart<'static> {
     let r = &rep.rotor;
     let f = r.supply_hz.unwrap_or(f64::NAN);
     let omitted = (!r.judged || !f.is_finite() || r.sideband_hz.len() < 2)
-        .then(|| format!("Not drawn: {}", r.sentence));
+        .then(|| format!("Not drawn: {}", words::Story::rotor_sentence(r)));
     let stem = |x: f64, y: f64| vec![(x, -90.0), (x, y)];
     let lo = r.sideband_hz.first().copied().unwrap_or(f);
     let hi = r.sideband_hz.get(1).copied().unwrap_or(f);
@@ -399,7 +399,7 @@ fn rotor_chart(rep: &DiagnoseReport) -> Chart<'static> {
     for (k, band) in RotorBand::ALL.iter().enumerate() {
         let db = band.upper_db();
         if db.is_finite() {
-            let label = format!("{} dB: below, {}", db, band.words());
+            let label = format!("{} dB: below, {}", db, words::band_words(*band));
             series.push(line(&label, vec![(span.0, db), (span.1, db)], 8 + k, true));
         }
     }

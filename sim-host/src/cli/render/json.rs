@@ -38,9 +38,9 @@ pub struct DemoReport<'a> {
     events: &'a [monitor_api::replay::IsolationEvent],
     verdict: monitor_api::replay::Verdict,
     /// The verdict's line, as `diagnose` prints it.
-    verdict_line: &'a str,
-    /// The finding the verdict rests on.
-    verdict_finding: Option<&'a monitor_api::replay::FindingReport>,
+    verdict_line: String,
+    /// The finding the verdict rests on (as `diagnose --json` gives it, with its sentence).
+    verdict_finding: serde_json::Value,
     named: &'a [FaultCandidate],
     correct_fault_among_candidates: bool,
     lamps: &'a BTreeMap<String, bool>,
@@ -49,6 +49,8 @@ pub struct DemoReport<'a> {
 
 /// The `demo --json` document of a run.
 pub fn demo(run: &DemoRun) -> DemoReport<'_> {
+    let sp = &crate::cli::words::CliWords;
+    let doc = monitor_api::words::diagnose::document(&run.report, sp);
     DemoReport {
         story: match run.story {
             monitor_studies::demo::Story::Service { .. } => "service",
@@ -61,8 +63,11 @@ pub fn demo(run: &DemoRun) -> DemoReport<'_> {
         detected_after_s: run.detected_after_s(),
         events: &run.report.isolation.events,
         verdict: run.report.verdict,
-        verdict_line: &run.report.verdict_line,
-        verdict_finding: run.report.verdict_finding.as_ref(),
+        verdict_line: monitor_api::words::diagnose::verdict_line(&run.report, sp),
+        verdict_finding: doc
+            .get("verdict_finding")
+            .cloned()
+            .unwrap_or(serde_json::Value::Null),
         named: &run.report.candidates,
         correct_fault_among_candidates: run.correct_fault_named(),
         lamps: &run.report.lamps,

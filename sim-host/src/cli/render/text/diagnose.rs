@@ -2,11 +2,12 @@
 //! commissioning, the data quality and the verdict (also the demo's).
 
 use super::{candidate_list, lamp, panel_text};
+use crate::cli::words::CliWords;
 use monitor_api::files::DataQuality;
 use monitor_api::replay::{
-    angle_source_name, describe_against, Against, CommissioningReport, DiagnoseReport, Diagnosed,
+    angle_source_name, Against, CommissioningReport, DiagnoseReport, Diagnosed,
 };
-use monitor_core::Phase;
+use monitor_api::words::diagnose::{self as words, Story};
 use monitor_studies::demo::MonitorState;
 use std::io::Write;
 use std::path::Path;
@@ -14,11 +15,16 @@ use std::path::Path;
 /// The temperature channel's line (`None` for a log without the column): the reading and
 /// the rise the isolation compensates Rs and Rr with, or why the channel is not used.
 fn temperature_line(t: &monitor_api::replay::TemperatureReport) -> Option<String> {
-    let status = t.temperature_channel.as_deref()?;
+    use monitor_api::replay::ChannelUse;
+    let status = t.temperature_channel.as_ref()?;
     let reading = t
         .winding_temperature_c
         .map_or("no reading".to_string(), |c| format!("{c:.1} degC"));
-    Some(match (status.strip_prefix("not used: "), t.measured_rise_k) {
+    let not_used = match status {
+        ChannelUse::NotUsed { why } => Some(words::channel_dropped(why)),
+        ChannelUse::Used => None,
+    };
+    Some(match (not_used, t.measured_rise_k) {
         (Some(why), _) => format!(
             "temperature channel not used: {why}; heating tracked from the resistances (last reading {reading})"
         ),
@@ -29,31 +35,30 @@ fn temperature_line(t: &monitor_api::replay::TemperatureReport) -> Option<String
     })
 }
 
-/// The verdict line of `diagnose` and the demo: the decision table's line
-/// (`DiagnoseReport::verdict_line`), as the JSON and Python give it.
+/// The verdict line of `diagnose` and the demo: the decision table's line, as the door
+/// spells it for the JSON and Python too.
 pub(super) fn verdict(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
-    writeln!(out, "verdict: {}", rep.verdict_line)?;
+    writeln!(out, "verdict: {}", words::verdict_line(rep, &CliWords))?;
     Ok(())
 }
 
 /// Every analysis' finding, one line each: its source, what it concluded and against what,
 /// and its sentence (the evidence the verdict's decision table read).
-fn findings_block(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
+fn findings_block(out: &mut impl Write, rep: &DiagnoseReport, story: &Story) -> anyhow::Result<()> {
     writeln!(out, "findings:")?;
-    for f in &rep.findings {
+    for (f, (summary, _)) in rep.findings.iter().zip(&story.findings) {
         let named = f.named().map_or(String::new(), |n| {
             format!(
                 " (confidence {:.2}; {})",
                 n.confidence,
-                monitor_api::replay::against_text(f.source(), f.finding.against)
+                words::against_text(f.source(), f.finding.against)
             )
         });
         writeln!(
             out,
-            "  {:<16} {:<12} {}{named}",
+            "  {:<16} {:<12} {summary}{named}",
             f.source().name(),
             f.state_name(),
-            f.summary
         )?;
     }
     Ok(())
@@ -62,6 +67,7 @@ fn findings_block(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<
 /// `diagnose`'s timeline, lamps, candidates, unbalance and rotor.
 pub fn diagnose(mut out: &mut dyn std::io::Write, log: &Path, d: &Diagnosed) -> anyhow::Result<()> {
     let rep = &d.report;
+    let story = Story::of(rep, &CliWords);
     writeln!(
         out,
         "diagnose {} ({} rows, {:.0} Hz, angle: {})",
@@ -71,23 +77,29 @@ pub fn diagnose(mut out: &mut dyn std::io::Write, log: &Path, d: &Diagnosed) -> 
         angle_source_name(rep.angle_source)
     )?;
     data_quality(&mut out, &rep.data_quality)?;
-    commissioning(&mut out, &rep.commissioning)?;
-    for s in &rep.skipped {
+    commissioning(&mut out, &rep.commissioning, &story)?;
+    for s in &story.skipped {
         writeln!(out, "skipped: {s}")?;
     }
     if rep.skipped.is_empty() {
-        timeline(&mut out, rep)?;
-        findings(&mut out, rep)?;
+        timeline(&mut out, rep, &story)?;
+        findings(&mut out, rep, &story)?;
         events(&mut out, &rep.isolation)?;
     }
-    unbalance(&mut out, &rep.unbalance)?;
+    unbalance(&mut out, &rep.unbalance, &story)?;
     // The rotor's finding or why there is none, in one line ("rotor: ...").
-    writeln!(out, "{}", rep.rotor.sentence)?;
-    for n in &rep.commissioning.outside_range {
-        writeln!(out, "note at {:.2} s: {}", n.t_s, n.note)?;
+    writeln!(out, "{}", story.rotor)?;
+    for (n, note) in rep
+        .commissioning
+        .outside_range
+        .iter()
+        .zip(&story.outside_range)
+    {
+        writeln!(out, "note at {:.2} s: {note}", n.t_s)?;
     }
-    findings_block(&mut out, rep)?;
-    verdict(&mut out, rep)
+    findings_block(&mut out, rep, &story)?;
+    writeln!(out, "verdict: {}", story.verdict_line)?;
+    Ok(())
 }
 
 /// The timeline's header: each column over its values, the speed with its unit, as the
@@ -104,17 +116,16 @@ fn timeline_cells(t_s: f64, speed_rad_s: f32, r: [f32; 4]) -> String {
 
 /// The timeline: time [s], the mechanical speed [rad/s], residuals, lamps and the panel's
 /// state per point.
-fn timeline(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
+fn timeline(out: &mut impl Write, rep: &DiagnoseReport, story: &Story) -> anyhow::Result<()> {
     writeln!(out, "\n{TIMELINE_HEADER}")?;
-    for p in &rep.timeline {
+    for (p, note) in rep.timeline.iter().zip(&story.timeline_notes) {
         let lamps: String = p.lamps.iter().map(|l| lamp(*l)).collect();
         writeln!(
             out,
             "{}  {lamps}  {}{}",
             timeline_cells(p.t_s, p.speed_rad_s, p.residuals),
             panel_text(&p.panel),
-            p.range_note
-                .as_ref()
+            note.as_ref()
                 .filter(|_| !matches!(p.panel.state, MonitorState::Moved(_)))
                 .map(|n| format!("  [{n}]"))
                 .unwrap_or_default()
@@ -126,7 +137,7 @@ fn timeline(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
 /// What the run found: the final lamps, the first detection, the candidates, the
 /// isolation's verdict with its detection limits, the temperature, what cannot be
 /// separated.
-fn findings(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
+fn findings(out: &mut impl Write, rep: &DiagnoseReport, story: &Story) -> anyhow::Result<()> {
     let lit: Vec<&str> = rep
         .lamps
         .iter()
@@ -142,30 +153,29 @@ fn findings(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
             lit.join(" ")
         }
     )?;
-    first_detection(out, rep)?;
+    first_detection(out, rep, story)?;
     writeln!(out, "candidates: {}", candidate_list(&rep.candidates))?;
     writeln!(
         out,
         "lamps' candidates (signature matching): {}",
         candidate_list(&rep.signature_candidates)
     )?;
-    writeln!(out, "isolation: {}", rep.isolation.verdict)?;
+    writeln!(out, "isolation: {}", story.isolation)?;
     if let Some(line) = detection_limits_line(&rep.isolation.detection_limits) {
         writeln!(out, "{line}")?;
     }
     if let Some(line) = temperature_line(&rep.isolation.temperature) {
         writeln!(out, "{line}")?;
     }
-    for g in &rep.isolation.groups {
+    for (g, reason) in rep.isolation.groups.iter().zip(&story.groups) {
         writeln!(
             out,
-            "  cannot be separated: {} ({})",
+            "  cannot be separated: {} ({reason})",
             g.faults
                 .iter()
                 .map(|f| f.name())
                 .collect::<Vec<_>>()
                 .join(" / "),
-            g.reason
         )?;
     }
     Ok(())
@@ -174,16 +184,27 @@ fn findings(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
 /// When the lamps first lit, as the verdict reads it: a detection where the residual finding
 /// is one, else what the lamps lit for (the operating point's load move or heating, the
 /// load outside the commissioned range), which is not a detection of a fault.
-fn first_detection(out: &mut impl Write, rep: &DiagnoseReport) -> anyhow::Result<()> {
+fn first_detection(
+    out: &mut impl Write,
+    rep: &DiagnoseReport,
+    story: &Story,
+) -> anyhow::Result<()> {
     use monitor_core::verdict::{FindingSource, State};
     let of = |s: FindingSource| rep.findings.iter().find(|f| f.source() == s);
+    let summary_of = |s: FindingSource| {
+        rep.findings
+            .iter()
+            .position(|f| f.source() == s)
+            .and_then(|k| story.findings.get(k))
+            .map(|(summary, _)| summary.as_str())
+    };
     let residual = of(FindingSource::Residuals).map(|f| f.finding.state);
     match (rep.first_detection_s, residual) {
         (None, _) => writeln!(out, "first detection: none")?,
         (Some(t), Some(State::Explained)) => writeln!(
             out,
             "lamps lit: first at {t:.2} s, explained by the operating point ({}), not a fault detection",
-            of(FindingSource::OperatingPoint).map_or("a load move or heating", |f| f.summary.as_str())
+            summary_of(FindingSource::OperatingPoint).unwrap_or("a load move or heating")
         )?,
         (Some(t), Some(State::OutOfRange)) => writeln!(
             out,
@@ -228,57 +249,26 @@ const SEGMENTS_LISTED: usize = 8;
 
 /// The negative-sequence analysis: the whole log's ratio and phase, its steady stretches,
 /// and the winding's judgement in a sentence.
-fn unbalance(out: &mut impl Write, u: &monitor_api::replay::UnbalanceReport) -> anyhow::Result<()> {
+fn unbalance(
+    out: &mut impl Write,
+    u: &monitor_api::replay::UnbalanceReport,
+    story: &Story,
+) -> anyhow::Result<()> {
     writeln!(
         out,
         "unbalance: |I2|/|I1| = {:.2} %, suspect phase: {}",
         100.0 * u.negative_sequence_ratio,
-        u.suspect_phase.map_or("none", Phase::name)
+        words::suspect(u)
     )?;
     if u.segments.len() > 1 {
         stretches(out, u)?;
     }
-    let against = match (u.judged_against, u.baseline_runs) {
-        (Some(Against::HealthyRuns), 1) => "against 1 healthy run".to_string(),
-        (Some(Against::HealthyRuns), n) => format!(
-            "against the mean of {n} healthy runs (their spread {:.1} %)",
-            100.0 * u.baseline_spread.unwrap_or(0.0)
-        ),
-        (Some(Against::WithinTheLog), _) => {
-            match u.reference_segment.and_then(|k| u.segments.get(k)) {
-                Some(r) => format!(
-                    "against the stretch at {:.1}..{:.1} s of the log",
-                    r.from_s, r.to_s
-                ),
-                None => describe_against(Against::WithinTheLog).to_string(),
-            }
-        }
-        (Some(a), _) => describe_against(a).to_string(),
-        (None, _) => "with no healthy baseline".to_string(),
-    };
-    let reference = u.operating_point.map(|o| {
-        format!(
-            "reference angle {:.0} +/- {:.0} deg, {}",
-            u.correction_deg,
-            u.correction_uncertainty_deg,
-            o.describe()
-        )
-    });
-    match (u.suspect_phase, &u.phase_not_judged) {
-        (Some(p), _) => writeln!(
-            out,
-            "winding: shorted turns in phase {} (probability {:.2}): the negative sequence changed by {:.1} % of I1 {against}, least change {:.1} %; {}",
-            p.name(),
-            u.phase_confidence,
-            100.0 * u.winding_ratio,
-            100.0 * u.least_change,
-            reference.unwrap_or_default()
-        )?,
-        (None, Some(why)) => writeln!(out, "winding: {why}")?,
-        (None, None) => {}
+    if let Some(line) = words::winding_line(u, &CliWords) {
+        writeln!(out, "winding: {line}")?;
     }
     shorted_turns(out, u)?;
-    if let Some(w) = &u.least_change_widened {
+    // (Where no phase is named the winding's sentence above says it already.)
+    if let (Some(w), Some(_)) = (&story.least_change_widened, u.suspect_phase) {
         writeln!(out, "  {w}")?;
     }
     Ok(())
@@ -290,11 +280,11 @@ fn shorted_turns(
     u: &monitor_api::replay::UnbalanceReport,
 ) -> anyhow::Result<()> {
     if let Some(t) = &u.shorted_turns {
-        writeln!(out, "  {}", t.sentence())?;
+        writeln!(out, "  {}", words::shorted_turns(t))?;
     }
     if let (Some(c), Some(p)) = (&u.shorted_turns, &u.shorted_turns_physics) {
         if c.basis != p.basis {
-            writeln!(out, "  (the model alone: {})", p.sentence())?;
+            writeln!(out, "  (the model alone: {})", words::shorted_turns(p))?;
         }
     }
     Ok(())
@@ -355,7 +345,7 @@ fn events(out: &mut impl Write, iso: &monitor_api::replay::IsolationReport) -> a
                 continue;
             }
         }
-        writeln!(out, "  {}", e.line())?;
+        writeln!(out, "  {}", words::event_line(e))?;
     }
     let more = moves.saturating_sub(LOAD_MOVES_LISTED) + iso.events_dropped;
     if more > 0 {
@@ -380,8 +370,15 @@ pub(super) fn data_quality(out: &mut impl Write, q: &DataQuality) -> anyhow::Res
 }
 
 /// What `diagnose` did about its thresholds.
-fn commissioning(out: &mut impl Write, c: &CommissioningReport) -> anyhow::Result<()> {
-    writeln!(out, "thresholds: {}", c.thresholds)?;
+fn commissioning(
+    out: &mut impl Write,
+    c: &CommissioningReport,
+    story: &Story,
+) -> anyhow::Result<()> {
+    // (Where the residuals never ran the log's `skipped:` line says why, once.)
+    if c.thresholds != monitor_api::replay::Thresholds::NotUsed {
+        writeln!(out, "thresholds: {}", story.thresholds)?;
+    }
     if c.state == monitor_api::replay::CommissioningOutcome::Learned {
         let span = |s: Option<[f32; 2]>, u: &str| {
             s.map(|[a, b]| format!("{a:.1}..{b:.1} {u}"))
@@ -403,7 +400,7 @@ fn commissioning(out: &mut impl Write, c: &CommissioningReport) -> anyhow::Resul
             p.t_s, r[0], r[1], r[2], r[3]
         )?;
     }
-    if let Some(a) = &c.advice {
+    if let Some(a) = &story.advice {
         writeln!(out, "  {a}")?;
     }
     Ok(())

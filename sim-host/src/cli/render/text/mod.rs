@@ -89,7 +89,11 @@ fn demo_story(out: &mut impl Write, run: &DemoRun) -> anyhow::Result<()> {
 fn demo_conclusion(out: &mut impl Write, run: &DemoRun) -> anyhow::Result<()> {
     for e in &run.report.isolation.events {
         if matches!(e, monitor_api::replay::IsolationEvent::LoadMoved { .. }) {
-            writeln!(out, "event: {} (not a fault)", e.line().trim())?;
+            writeln!(
+                out,
+                "event: {} (not a fault)",
+                monitor_api::words::diagnose::event_line(e).trim()
+            )?;
         }
     }
     match run.detected_after_s() {
@@ -114,7 +118,14 @@ fn demo_conclusion(out: &mut impl Write, run: &DemoRun) -> anyhow::Result<()> {
             ""
         }
     )?;
-    writeln!(out, "isolation: {}", run.report.isolation.verdict)?;
+    writeln!(
+        out,
+        "isolation: {}",
+        monitor_api::words::diagnose::said(
+            &run.report.isolation.said,
+            &crate::cli::words::CliWords
+        )
+    )?;
     if matches!(run.fault, monitor_core::Fault::B | monitor_core::Fault::Bl) {
         writeln!(
             out,

@@ -1,9 +1,8 @@
-//! The library's words for its options and fields ([`OptionField`]) and how a front end
-//! says them ([`Spelling`]: the command line as its flags, Python as its keywords, the
-//! library as the field's name, [`FieldNames`]); the words a replay's sentences are spelled
-//! in ([`Words`]) and the error that names a field ([`OptionError`]); and the one
-//! description of `diagnose`'s options ([`DIAGNOSE_OPTIONS`]) that a front end which takes
-//! them by name (Python) builds its signature, its stub's and its docs from.
+//! The library's options and fields by name ([`OptionField`]; a front end says them in its
+//! own words at the door, `monitor_words`: the command line as its flags, Python as its
+//! keywords), the error that names a field ([`OptionError`]), and the one description of
+//! `diagnose`'s options ([`DIAGNOSE_OPTIONS`]) that a front end which takes them by name
+//! (Python) builds its signature, its stub's and its docs from.
 
 use std::fmt;
 
@@ -72,88 +71,11 @@ impl fmt::Display for OptionField {
     }
 }
 
-/// How a front end names a field given a value, so that its messages speak its words.
-pub trait Spelling {
-    /// `field` given `value` (empty: the field alone, as in a hint) in the front end's
-    /// words.
-    fn option(&self, field: OptionField, value: &str) -> String;
-
-    /// Any other field a message names by its name (a nameplate's `speed_rpm`), in the
-    /// front end's words; the library's own name unless a front end says otherwise.
-    fn key(&self, name: &str) -> String {
-        name.to_string()
-    }
-
-    /// A report's advice to give `field` the value `value` (a placeholder such as
-    /// `START:END`, or a value to copy; empty: the field alone), as its user would type it;
-    /// [`Spelling::option`] unless a front end says otherwise (Python: `commission='2:4'`).
-    fn hint(&self, field: OptionField, value: &str) -> String {
-        self.option(field, value)
-    }
-
-    /// A report's advice to run another command (`diagnose`) with `field`, as its user
-    /// would (the command line: `diagnose --baseline`; the library: `diagnose's baseline`).
-    fn command_with(&self, command: &str, field: OptionField) -> String {
-        format!("{command}'s {}", self.hint(field, ""))
-    }
-}
-
-/// The words a report is spelled in, carried in the options of a request
-/// ([`ReplayOptions::words`], `monitor_analysis::Analysis::words`): a front end's
-/// [`Spelling`] for the whole run (`Words(&CliWords)`). Copy; two are always equal and
-/// print as `Words` (the words are no part of what is judged).
-#[derive(Clone, Copy)]
-pub struct Words(pub &'static (dyn Spelling + Sync));
-
-impl Words {
-    /// The library's own words ([`FieldNames`]).
-    pub const LIBRARY: Words = Words(&FieldNames);
-}
-
-impl Default for Words {
-    fn default() -> Self {
-        Words::LIBRARY
-    }
-}
-
-impl fmt::Debug for Words {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str("Words")
-    }
-}
-
-impl PartialEq for Words {
-    fn eq(&self, _: &Words) -> bool {
-        true
-    }
-}
-
-impl std::ops::Deref for Words {
-    type Target = dyn Spelling + Sync;
-
-    fn deref(&self) -> &Self::Target {
-        self.0
-    }
-}
-
-/// The library's own words: `commission = 4:2` (a fleet table's), the field alone
-/// without a value; what the errors' `Display` says.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct FieldNames;
-
-impl Spelling for FieldNames {
-    fn option(&self, field: OptionField, value: &str) -> String {
-        if value.is_empty() {
-            field.name().to_string()
-        } else {
-            format!("{} = {value}", field.name())
-        }
-    }
-}
-
-/// A value an option does not take: the field, the value as given, and why.
+/// A value an option does not take: the field, the value as given, and why (`Display`:
+/// `commission = 4:2: why`, the library's names; a front end names the field in its own
+/// words at the door, `monitor_words`).
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("{}: {why}", FieldNames.option(*field, value))]
+#[error("{}: {why}", field_given(*field, value))]
 pub struct OptionError {
     /// The option.
     pub field: OptionField,
@@ -172,10 +94,14 @@ impl OptionError {
             why: why.into(),
         }
     }
+}
 
-    /// The message in a front end's words (`spell`).
-    pub fn spelled(&self, spell: &dyn Spelling) -> String {
-        format!("{}: {}", spell.option(self.field, &self.value), self.why)
+/// `field = value` in the library's names, the field alone for an empty value.
+pub fn field_given(field: OptionField, value: &str) -> String {
+    if value.is_empty() {
+        field.name().to_string()
+    } else {
+        format!("{} = {value}", field.name())
     }
 }
 

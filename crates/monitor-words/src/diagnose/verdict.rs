@@ -1,34 +1,14 @@
-//! The verdict in words: its line, and the lists of what was and was not judged.
+//! The verdict in words: its line, the lists of what was and was not judged, a named
+//! fault with its size and phase.
 
-use super::FindingReport;
+use super::findings::{brief, summary};
 use monitor_core::isolation::{MIN_FAULT_CHANGE, NOMINAL_UNCERTAINTY};
 use monitor_core::verdict::{
-    Against, Decision, FaultName, FindingSource, NamedFault, Rule, Size, State, Verdict,
-    FAULT_CONFIDENCE,
+    Against, FaultName, FindingSource, NamedFault, Rule, Size, Verdict, FAULT_CONFIDENCE,
 };
+use monitor_replay::{DiagnoseReport, FindingReport};
 
-/// The fault-judging findings that were judged, as their brief phrases.
-pub(super) fn judged(findings: &[FindingReport]) -> Vec<String> {
-    findings
-        .iter()
-        .filter(|f| f.source().judges_faults() && !not_judged_state(&f.finding.state))
-        .map(|f| f.brief.clone())
-        .collect()
-}
-
-/// The fault-judging findings that could not be judged, with why.
-pub(super) fn not_judged(findings: &[FindingReport]) -> Vec<String> {
-    findings
-        .iter()
-        .filter(|f| f.source().judges_faults() && not_judged_state(&f.finding.state))
-        .map(|f| f.brief.clone())
-        .collect()
-}
-
-/// A state that judged nothing: not judged, or unavailable.
-fn not_judged_state(s: &State) -> bool {
-    matches!(s, State::NotJudged | State::Unavailable)
-}
+use crate::spelling::Spelling;
 
 /// A relative change as the reports print it: `+50 %`, to a tenth of a per cent under 10 %.
 pub fn pct(x: f32) -> String {
@@ -57,9 +37,10 @@ pub fn fault_text(n: &NamedFault) -> String {
         }
         (FaultName::BrokenBars, size) => {
             let band = match size {
-                Size::DbBelowLine(db) => {
-                    format!(" ({})", crate::rotor::band_of(-f64::from(db)).words())
-                }
+                Size::DbBelowLine(db) => format!(
+                    " ({})",
+                    super::rotor::band_words(monitor_replay::band_of(-f64::from(db)))
+                ),
                 _ => String::new(),
             };
             format!("broken rotor bars: {}{band}", size_text(size))
@@ -158,21 +139,115 @@ fn also(decided: Option<&FindingReport>, findings: &[FindingReport]) -> String {
     }
 }
 
-/// The verdict's line (after `verdict: `).
-pub(super) fn line(
-    d: Decision,
-    by: Option<&FindingReport>,
+/// How the verdict's words read a finding: its sentence and its brief phrase.
+pub(super) struct Spelled<'a> {
+    /// The finding's sentence.
+    pub summary: &'a dyn Fn(&FindingReport) -> String,
+    /// Its brief phrase.
+    pub brief: &'a dyn Fn(&FindingReport) -> String,
+}
+
+/// The report's findings as `sp` spells them.
+fn spelled_by<'a>(
+    rep: &'a DiagnoseReport,
+    sp: &'a dyn Spelling,
+) -> (
+    impl Fn(&FindingReport) -> String + 'a,
+    impl Fn(&FindingReport) -> String + 'a,
+) {
+    (
+        move |f: &FindingReport| summary(f, rep, sp),
+        move |f: &FindingReport| brief(f, rep, sp),
+    )
+}
+
+/// The fault-judging findings that were judged, as their brief phrases.
+pub fn judged(rep: &DiagnoseReport, sp: &dyn Spelling) -> Vec<String> {
+    let (_, b) = spelled_by(rep, sp);
+    judged_of(&rep.findings, &b)
+}
+
+fn judged_of(findings: &[FindingReport], brief: &dyn Fn(&FindingReport) -> String) -> Vec<String> {
+    findings
+        .iter()
+        .filter(|f| f.source().judges_faults() && !f.judged_nothing())
+        .map(brief)
+        .collect()
+}
+
+/// The fault-judging findings that could not be judged, with why.
+pub fn not_judged(rep: &DiagnoseReport, sp: &dyn Spelling) -> Vec<String> {
+    let (_, b) = spelled_by(rep, sp);
+    not_judged_of(&rep.findings, &b)
+}
+
+fn not_judged_of(
     findings: &[FindingReport],
-    judged: &[String],
-    not_judged: &[String],
-) -> String {
+    brief: &dyn Fn(&FindingReport) -> String,
+) -> Vec<String> {
+    findings
+        .iter()
+        .filter(|f| f.source().judges_faults() && f.judged_nothing())
+        .map(brief)
+        .collect()
+}
+
+/// Why the verdict is not a FAULT or healthy (empty for those): the deciding finding's
+/// sentence, then what could not be judged.
+pub fn withheld_because(rep: &DiagnoseReport, sp: &dyn Spelling) -> Vec<String> {
+    let (s, b) = spelled_by(rep, sp);
+    let words = Spelled {
+        summary: &s,
+        brief: &b,
+    };
+    withheld_of(&decided(rep), &rep.findings, &words)
+}
+
+/// What the decision table concluded: the verdict, its rule, the finding it rests on.
+pub(super) type Decided<'a> = (Verdict, Rule, Option<&'a FindingReport>);
+
+/// The report's decision.
+fn decided(rep: &DiagnoseReport) -> Decided<'_> {
+    (rep.verdict, rep.verdict_rule, rep.verdict_finding.as_ref())
+}
+
+pub(super) fn withheld_of(
+    d: &Decided<'_>,
+    findings: &[FindingReport],
+    w: &Spelled<'_>,
+) -> Vec<String> {
+    match d.0 {
+        Verdict::Fault | Verdict::Healthy => Vec::new(),
+        Verdict::Watching | Verdict::CouldNotJudge => {
+            d.2.iter()
+                .map(|f| (w.summary)(f))
+                .chain(not_judged_of(findings, w.brief))
+                .collect()
+        }
+    }
+}
+
+/// The verdict's line (after `verdict: `).
+pub fn line(rep: &DiagnoseReport, sp: &dyn Spelling) -> String {
+    let (s, b) = spelled_by(rep, sp);
+    let words = Spelled {
+        summary: &s,
+        brief: &b,
+    };
+    line_of(&decided(rep), &rep.findings, &words)
+}
+
+/// The line of the decision `d` over `findings`, their words `w`.
+pub(super) fn line_of(d: &Decided<'_>, findings: &[FindingReport], w: &Spelled<'_>) -> String {
+    let (verdict, rule, by) = *d;
     let named = by.and_then(|f| f.named().map(|n| (f, n)));
+    let not_judged = not_judged_of(findings, w.brief);
     let not = if not_judged.is_empty() {
         String::new()
     } else {
         format!("; not judged: {}", not_judged.join("; "))
     };
-    match (d.verdict, d.rule, named) {
+    match (verdict, rule, named) {
         (Verdict::Fault, _, Some((f, n))) => format!(
             "FAULT {} (confidence {:.2}; {} {}){}",
             fault_text(n),
@@ -191,16 +266,15 @@ pub(super) fn line(
         ),
         (Verdict::Watching, _, _) => format!(
             "WATCHING: {}{}",
-            by.map_or("a change no single fault explains", |f| f.summary.as_str()),
+            by.map_or("a change no single fault explains".to_string(), w.summary),
             also(by, findings)
         ),
-        (Verdict::Healthy, _, _) => format!("healthy: {}{not}", judged.join("; ")),
+        (Verdict::Healthy, _, _) => {
+            format!("healthy: {}{not}", judged_of(findings, w.brief).join("; "))
+        }
         (Verdict::CouldNotJudge, Rule::NothingJudged, _) => {
             format!("could not judge: {}", not_judged.join("; "))
         }
-        (_, _, _) => format!(
-            "could not judge: {}",
-            by.map_or(String::new(), |f| f.summary.clone())
-        ),
+        (_, _, _) => format!("could not judge: {}", by.map_or(String::new(), w.summary)),
     }
 }

@@ -1,0 +1,251 @@
+//! `diagnose` in words: every line a crew reads of one log's report (the text, the HTML
+//! report, the JSON document, the HMI, Python) spelled from the report's typed findings, in
+//! one place, so that no two lines disagree.
+//!
+//! [`Story`] spells a report once; [`document`] is `diagnose --json`'s document: the
+//! report's typed values (the findings with their `reason`, the isolation's `said`, the
+//! winding's `phase_not_judged_reason`, the rotor's `cannot_judge_reason`, ...) and beside
+//! each its sentence under the key it has always had (`summary`, `verdict`,
+//! `phase_not_judged`, `cannot_judge_because`, ...).
+
+mod commissioning;
+mod findings;
+mod isolation;
+mod rotor;
+mod verdict;
+mod winding;
+
+pub use commissioning::{
+    advice, first_point_misfit, not_learned, not_learned_why, note, quantity, range_note, skipped,
+    thresholds,
+};
+pub use findings::{brief, summary};
+pub use isolation::{channel_dropped, channel_use, event_line, group_reason, moved_note, said};
+pub use rotor::{band_words, load_unknown, load_words};
+pub use verdict::{
+    against_text, fault_text, judged, line as verdict_line, not_judged, pct, withheld_because,
+};
+pub use winding::{
+    describe_against, line as winding_line, operating_point_source, phase_not_judged, reach,
+    shorted_turns, summary as winding_summary, suspect, widened, CREW_SHORT,
+};
+
+use monitor_replay::{DiagnoseReport, MonitorState, MovedWhy};
+use serde_json::Value;
+
+use crate::spelling::Spelling;
+
+/// Every sentence of one report, spelled once from its findings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Story {
+    /// The verdict's line, after `verdict: `.
+    pub verdict_line: String,
+    /// What was judged, against what (`residuals against commissioning`).
+    pub judged: Vec<String>,
+    /// What could not be judged, and why.
+    pub not_judged: Vec<String>,
+    /// Why the verdict is not a FAULT or healthy (empty for those).
+    pub withheld_because: Vec<String>,
+    /// Each finding's sentence and brief phrase, in the report's order.
+    pub findings: Vec<(String, String)>,
+    /// The analyses the log could not feed.
+    pub skipped: Vec<String>,
+    /// The thresholds in force and the advice on commissioning.
+    pub thresholds: String,
+    /// See `thresholds`.
+    pub advice: Option<String>,
+    /// Where a lit lamp met the operating point outside the commissioned range.
+    pub outside_range: Vec<String>,
+    /// The isolation's verdict.
+    pub isolation: String,
+    /// Why each group of candidates cannot be separated.
+    pub groups: Vec<String>,
+    /// The temperature channel's use, for a log with the column.
+    pub temperature_channel: Option<String>,
+    /// Why the winding names no phase, and a baseline at another operating point.
+    pub phase_not_judged: Option<String>,
+    /// See `phase_not_judged`.
+    pub least_change_widened: Option<String>,
+    /// The rotor's one sentence, and why it was not judged.
+    pub rotor: String,
+    /// See `rotor`.
+    pub rotor_cannot: Option<String>,
+    /// The rotor band's meaning.
+    pub rotor_band: Option<String>,
+    /// Why the rotor's load is unknown.
+    pub rotor_load_unknown: Option<String>,
+    /// The timeline's notes, one per point (`None` where a point has none).
+    pub timeline_notes: Vec<Option<String>>,
+    /// The events, one line each.
+    pub events: Vec<String>,
+}
+
+impl Story {
+    /// The rotor's one sentence (the report's `rotor.sentence`).
+    pub fn rotor_sentence(r: &monitor_replay::RotorReport) -> String {
+        rotor::sentence(r)
+    }
+
+    /// The report's sentences, in `sp`'s words for the options its advice names.
+    pub fn of(rep: &DiagnoseReport, sp: &dyn Spelling) -> Self {
+        let (thresholds, advice) = commissioning::report_words(&rep.commissioning, sp);
+        Story {
+            verdict_line: verdict::line(rep, sp),
+            judged: verdict::judged(rep, sp),
+            not_judged: verdict::not_judged(rep, sp),
+            withheld_because: verdict::withheld_because(rep, sp),
+            findings: rep
+                .findings
+                .iter()
+                .map(|f| (summary(f, rep, sp), brief(f, rep, sp)))
+                .collect(),
+            skipped: rep
+                .skipped
+                .iter()
+                .map(|s| skipped(*s).to_string())
+                .collect(),
+            thresholds,
+            advice,
+            outside_range: rep.commissioning.outside_range.iter().map(note).collect(),
+            isolation: said(&rep.isolation.said, sp),
+            groups: rep
+                .isolation
+                .groups
+                .iter()
+                .map(|g| group_reason(&g.reason))
+                .collect(),
+            temperature_channel: rep
+                .isolation
+                .temperature
+                .temperature_channel
+                .as_ref()
+                .map(channel_use),
+            phase_not_judged: rep
+                .unbalance
+                .phase_not_judged
+                .as_ref()
+                .map(|w| phase_not_judged(w, sp)),
+            least_change_widened: rep.unbalance.least_change_widened.as_ref().map(widened),
+            rotor: rotor::sentence(&rep.rotor),
+            rotor_cannot: rotor::cannot_judge_because(&rep.rotor),
+            rotor_band: rep.rotor.band.map(|b| band_words(b).to_string()),
+            rotor_load_unknown: rep
+                .rotor
+                .load
+                .as_ref()
+                .and_then(|l| l.unknown_because.as_ref())
+                .map(load_unknown),
+            timeline_notes: rep
+                .timeline
+                .iter()
+                .map(|p| p.range_note.as_deref().map(range_note))
+                .collect(),
+            events: rep.isolation.events.iter().map(event_line).collect(),
+        }
+    }
+}
+
+/// The amber state's note: why the operating point counts as moved.
+pub fn moved_why(m: &MovedWhy) -> String {
+    match m {
+        MovedWhy::OutsideRange { departures } => moved_note(departures),
+        MovedWhy::LoadMovedInside => "load moved inside the commissioned range; the stator-voltage equations fit (the torque residuals read it as Bl)".into(),
+        MovedWhy::LoadCameBack => {
+            "the load came back; the lamps that lit while it had moved are going out".into()
+        }
+        MovedWhy::BoardSays => {
+            "the board says the load or the voltage left the commissioned range".into()
+        }
+    }
+}
+
+/// The note of a panel's state, where it has one (the amber state's).
+pub fn state_note(s: &MonitorState) -> Option<String> {
+    match s {
+        MonitorState::Moved(m) => Some(moved_why(m)),
+        _ => None,
+    }
+}
+
+/// Puts `value` at `key` of the object `v` (nothing where `v` is not an object).
+fn put(v: &mut Value, key: &str, value: impl Into<Value>) {
+    if let Some(m) = v.as_object_mut() {
+        m.insert(key.to_string(), value.into());
+    }
+}
+
+/// `diagnose --json`'s document of `rep`: its typed values, and beside each its sentence
+/// under the key the document has always had, in `sp`'s words.
+pub fn document(rep: &DiagnoseReport, sp: &dyn Spelling) -> Value {
+    let story = Story::of(rep, sp);
+    let mut v = serde_json::to_value(rep).unwrap_or_default();
+    put_story(&mut v, rep, &story, sp);
+    v
+}
+
+/// The sentences of `story` put into the document `v` of `rep`.
+fn put_story(v: &mut Value, rep: &DiagnoseReport, story: &Story, sp: &dyn Spelling) {
+    put(v, "verdict_line", story.verdict_line.clone());
+    put(v, "judged", story.judged.clone());
+    put(v, "not_judged", story.not_judged.clone());
+    put(
+        v,
+        "verdict_withheld_because",
+        story.withheld_because.clone(),
+    );
+    put(v, "skipped", story.skipped.clone());
+    if let Some(fs) = v.get_mut("findings").and_then(Value::as_array_mut) {
+        for (f, (s, _)) in fs.iter_mut().zip(&story.findings) {
+            put(f, "summary", s.clone());
+        }
+    }
+    if let (Some(f), Some(vf)) = (rep.verdict_finding.as_ref(), v.get_mut("verdict_finding")) {
+        put(vf, "summary", summary(f, rep, sp));
+    }
+    if let Some(c) = v.get_mut("commissioning") {
+        put(c, "thresholds", story.thresholds.clone());
+        put(c, "advice", story.advice.clone());
+        if let Some(notes) = c.get_mut("outside_range").and_then(Value::as_array_mut) {
+            for (n, s) in notes.iter_mut().zip(&story.outside_range) {
+                put(n, "note", s.clone());
+            }
+        }
+    }
+    if let Some(i) = v.get_mut("isolation") {
+        put(i, "verdict", story.isolation.clone());
+        if let Some(t) = &story.temperature_channel {
+            put(i, "temperature_channel", t.clone());
+        }
+        if let Some(gs) = i.get_mut("groups").and_then(Value::as_array_mut) {
+            for (g, s) in gs.iter_mut().zip(&story.groups) {
+                put(g, "reason", s.clone());
+            }
+        }
+    }
+    if let Some(u) = v.get_mut("unbalance") {
+        put(u, "phase_not_judged", story.phase_not_judged.clone());
+        put(
+            u,
+            "least_change_widened",
+            story.least_change_widened.clone(),
+        );
+    }
+    if let Some(r) = v.get_mut("rotor") {
+        put(r, "sentence", story.rotor.clone());
+        put(r, "cannot_judge_because", story.rotor_cannot.clone());
+        put(r, "band_meaning", story.rotor_band.clone());
+        if let Some(l) = r.get_mut("load").filter(|l| l.is_object()) {
+            put(l, "unknown_because", story.rotor_load_unknown.clone());
+        }
+    }
+    if let Some(ps) = v.get_mut("timeline").and_then(Value::as_array_mut) {
+        for (p, n) in ps.iter_mut().zip(&story.timeline_notes) {
+            if let Some(n) = n {
+                put(p, "range_note", n.clone());
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;
