@@ -263,7 +263,9 @@ fn unbalance(
     if u.segments.len() > 1 {
         stretches(out, u)?;
     }
-    if let Some(line) = words::winding_line(u, &CliWords) {
+    // A named phase with its reference; else the findings below say the winding's
+    // sentence, once.
+    if let Some(line) = words::winding_line(u, &CliWords).filter(|_| u.suspect_phase.is_some()) {
         writeln!(out, "winding: {line}")?;
     }
     shorted_turns(out, u)?;
