@@ -64,9 +64,20 @@ fn at_text(at: [f64; 2]) -> String {
 
 /// Why no phase is named (JSON `unbalance.phase_not_judged`).
 pub fn phase_not_judged(w: &PhaseNotJudged, sp: &dyn Spelling) -> String {
+    let head = match w {
+        PhaseNotJudged::NoSteadyStretch { .. } => "cannot judge the phase",
+        PhaseNotJudged::BetweenPhases { .. } => "which phase is uncertain",
+        _ => "no phase",
+    };
+    format!("{head}: {}", reason_body(w, sp))
+}
+
+/// Why no phase is named, without its head (`no phase: `): the change, where it was read,
+/// and what it is within.
+fn reason_body(w: &PhaseNotJudged, sp: &dyn Spelling) -> String {
     match *w {
         PhaseNotJudged::NoSteadyStretch { windows, seconds } => format!(
-            "cannot judge the phase: no steady stretch of at least {windows} least-squares windows ({seconds:.2} s): the log is too short or its operating point never settled"
+            "no steady stretch of at least {windows} least-squares windows ({seconds:.2} s): the log is too short or its operating point never settled"
         ),
         PhaseNotJudged::BetweenPhases {
             change,
@@ -80,7 +91,7 @@ pub fn phase_not_judged(w: &PhaseNotJudged, sp: &dyn Spelling) -> String {
             reference_sd_deg,
             reference,
         } => format!(
-            "which phase is uncertain: the change ({:.1} % of I1 at {}) is likely a short ({short:.2}) but points {deviation_deg:.0} deg from phase {}'s centre (probability {phase_probability:.2}), towards phase {}, and its angle is uncertain by {angle_sd_deg:.0} deg (reference angle +/-{reference_sd_deg:.0} deg, {}, and the shorted loop's own)",
+            "the change ({:.1} % of I1 at {}) is likely a short ({short:.2}) but points {deviation_deg:.0} deg from phase {}'s centre (probability {phase_probability:.2}), towards phase {}, and its angle is uncertain by {angle_sd_deg:.0} deg (reference angle +/-{reference_sd_deg:.0} deg, {}, and the shorted loop's own)",
             100.0 * change,
             at_text(at_s),
             phase.name(),
@@ -88,7 +99,7 @@ pub fn phase_not_judged(w: &PhaseNotJudged, sp: &dyn Spelling) -> String {
             operating_point_source(reference)
         ),
         PhaseNotJudged::NoBaseline { change, at_s, least } => format!(
-            "no phase: the negative sequence ({:.1} % of I1 at {}) is within what a healthy machine's own asymmetry may reach ({}) and there is no healthy baseline (give {} with healthy logs of this motor, or commission, to see smaller shorts)",
+            "the negative sequence ({:.1} % of I1 at {}) is within what a healthy machine's own asymmetry may reach ({}) and there is no healthy baseline (give {} with healthy logs of this motor, or commission, to see smaller shorts)",
             100.0 * change,
             at_text(at_s),
             least_text(least),
@@ -100,7 +111,7 @@ pub fn phase_not_judged(w: &PhaseNotJudged, sp: &dyn Spelling) -> String {
             reference_s,
             least,
         } => format!(
-            "no phase: the negative sequence changed by {:.1} % of I1 at {}{}, within what stretches of one healthy log differ by at their loads ({}), and neither stands clear of a healthy machine's own asymmetry",
+            "the negative sequence changed by {:.1} % of I1 at {}{}, within what stretches of one healthy log differ by at their loads ({}), and neither stands clear of a healthy machine's own asymmetry",
             100.0 * change,
             at_text(at_s),
             reference_s.map_or(String::new(), |r| format!(
@@ -110,7 +121,7 @@ pub fn phase_not_judged(w: &PhaseNotJudged, sp: &dyn Spelling) -> String {
             least_text(least)
         ),
         PhaseNotJudged::WithinHealthyRuns { change, at_s, least } => format!(
-            "no phase: the change of the negative sequence ({:.1} % of I1 at {}) is within what healthy runs differ by ({})",
+            "the change of the negative sequence ({:.1} % of I1 at {}) is within what healthy runs differ by ({})",
             100.0 * change,
             at_text(at_s),
             least_text(least)
@@ -273,9 +284,21 @@ pub fn summary(u: &UnbalanceReport, sp: &dyn Spelling) -> String {
             u.phase_probabilities.no_short
         );
     }
+    // Clear: the reach, then why no phase is named (the change and the least change that
+    // would name one), each said once.
+    let said = match &u.phase_not_judged {
+        Some(w) => {
+            let widened = u
+                .least_change_widened
+                .as_ref()
+                .map_or(String::new(), |w| format!("; {}", widened(w)));
+            format!("{}{widened}", reason_body(w, sp))
+        }
+        None => change,
+    };
     match &u.shorted_turns_reach {
-        Some(r) => format!("{}: {change}{why}", reach(r)),
-        None => format!("no shorted turns seen: {change}{why}"),
+        Some(r) => format!("{}: {said}", reach(r)),
+        None => format!("no shorted turns seen: {said}"),
     }
 }
 
