@@ -6,13 +6,16 @@
 //! and 78 % of its rated torque (an unknown input), one 12 s log a day at 2 kHz, each judged against the parameter file as the
 //! trend's month judges its logs (`diagnose`'s defaults, no commissioning).
 //!
-//! Before (issue 79): days 29 and 30 ended `FAULT ls +35 %` and `+38 %` where a reviewer ran
-//! it; the stator leakage and the windings' heating move this machine's residuals almost
-//! alike at light load, and where the heating alone no longer explained the change (the
-//! loosening on top of it), `ls` was the single fault nearest. Now a fault on a winding of
-//! unknown temperature is fitted at any temperature of the heating range: the loosening
-//! reads Rs beyond Rr, which no single log tells from Rr falling on a warmer winding, so
-//! no fault is named (a FAULT is Rs or nothing), never another.
+//! Before (issue 79; a reviewer's month read `FAULT ls +35 %` and `+38 %` on days 29 and 30):
+//! `FAULT ls +49..60 %` on days 22 and 27-29 of the simulator's month and on days 27-29 of
+//! the textbook machine's, `ls` named on the way on every other day from day 22. The stator
+//! leakage and the windings' heating move this machine's residuals almost alike at light
+//! load, and with the loosening on top of the heating `ls` at the file's temperature was the
+//! single fault nearest. Now, against the file, a fault is fitted at any temperature of the
+//! heating range and ranked only for what it explains beyond the heating: no day names a
+//! fault (each is "could not judge: the parameter file does not fit this log", its
+//! isolation reading heating); the loosening is Rs beyond Rr, which no single log tells from
+//! Rr falling on a warmer winding, and the trend alarms it. A FAULT is Rs or nothing.
 //!
 //! Held on two models of the machine: this project's simulator (`monitor-sim`) and the
 //! independent textbook machine (`monitor_testkit::textbook_machine`, Krause's equations,
