@@ -13,7 +13,7 @@ pub use search::SearchHints;
 use super::*;
 use crate::error::{ensure, ConfigCheck, ConfigError};
 use crate::{FaultTarget, SensorChannel};
-use search::{fit_factor, rank};
+use search::{fit_factor, rank, ALL_SEEN};
 
 /// A measured point with the magnitudes of its voltage and current vectors
 /// ([`fast_hypot`](crate::math::fast_hypot)), computed once for the many hypotheses a
@@ -423,14 +423,28 @@ impl Isolator {
         }
         let heat = self.fit_heating(&r, &w);
         let eps = self.direction_uncertainty();
-        rank(&mut out, &mut fits, heat, (chi0, 3.0), eps);
-        // On a warm machine a fault is judged with the tracked temperature's lag allowed
-        // for (heating itself is decided on the single fits above).
-        if !out.heating_explains() {
-            for (fit, f) in fits.iter_mut().zip(Fault::ALL) {
-                *fit = self.fit_on_warm(&r, f, &w, (*fit, hints.get(f, use_hints)));
+        if self.temperature_unknown() {
+            // A winding of unknown temperature (module docs, "The temperature unknown"):
+            // each fault at any temperature of the heating range, and named only for what
+            // it explains beyond the heating.
+            let seen = self.fits_beyond_heating(
+                &mut fits,
+                heat,
+                |iso, f, k| iso.chi2_at(&r, Some((f, k)), &w),
+                (hints, use_hints),
+            );
+            rank(&mut out, &mut fits, heat, (chi0, 3.0), eps, &seen);
+            heating_not_unknown(&mut out);
+        } else {
+            rank(&mut out, &mut fits, heat, (chi0, 3.0), eps, &ALL_SEEN);
+            // On a warm machine a fault is judged with the tracked temperature's lag
+            // allowed for (heating itself is decided on the single fits above).
+            if !out.heating_explains() {
+                for (fit, f) in fits.iter_mut().zip(Fault::ALL) {
+                    *fit = self.fit_on_warm(&r, f, &w, (*fit, hints.get(f, use_hints)));
+                }
+                rank(&mut out, &mut fits, heat, (chi0, 3.0), eps, &ALL_SEEN);
             }
-            rank(&mut out, &mut fits, heat, (chi0, 3.0), eps);
         }
         out.separation_deg = self.separation(p, &e0, &out.candidates);
         out
@@ -552,5 +566,14 @@ impl Isolator {
             np: m.np(),
             b_total: m.b_nms + m.bl_nms,
         }
+    }
+}
+
+/// On a winding of unknown temperature, a deviation the heating explains better than the
+/// unknown fault is not an unknown fault, though no fault is more probable (the faults
+/// that explain nothing beyond the heating take no part in the ranking).
+pub(super) fn heating_not_unknown(out: &mut Isolation) {
+    if out.state == IsolationState::Unknown && out.heating.probability > out.unknown_probability {
+        out.state = IsolationState::Isolated;
     }
 }

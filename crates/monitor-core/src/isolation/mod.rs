@@ -108,6 +108,26 @@
 //! winding beginning to warm ([`Isolation::heating_begins`]): a deviation that grew from
 //! nothing is a warming, a step fault appears at its full size.
 //!
+//! # The temperature unknown
+//! Against the parameter file's nominal values (no learned baseline, so no measured rise
+//! either) the winding's temperature is not known: a motor in service runs 20-100 K above
+//! the file's, and Rs and Rr follow it. A fault is then fitted on a winding at any
+//! temperature of the heating range (its size and the heating factor together,
+//! `Isolator::fit_at_any_temperature`), and takes part in the ranking only for what it
+//! explains beyond the heating: where it lowers the heating hypothesis' misfit by at least
+//! [`DETECT_CHI2`] (a change beyond the heated machine detected, as any deviation is). The
+//! others explain nothing the heating does not, and their probability is 0. Where Rs is
+//! large against the reactances (a small motor) and the load light, the heating and a
+//! stator-leakage change move the residuals almost alike, and a fault fitted at the file's
+//! temperature named the leakage for a loosening connection on a warm winding (issue 79:
+//! `ls +35 %` at p 0.90 for Rs +10 % on a winding 20 K warm at 42 % of the rated torque).
+//! Fitted at any temperature, one point's
+//! two stator-voltage equations no longer tell a fault from another (two unknowns, two
+//! equations): nothing is named from one point with the load unknown; over two load levels
+//! or more (the joint fit, [`Evidence`]) or with the torque balance, a fault on a warm
+//! winding parts from another. Rs beyond Rr stays what it is: an Rs rise, or an Rr fall on
+//! a winding warmer still, which no log without a temperature tells apart.
+//!
 //! # Heating during commissioning
 //! A motor commissioned soon after its start warms while the baseline is learned. Its
 //! residuals then drift along the heating direction `h = de/dk` over the window, and a

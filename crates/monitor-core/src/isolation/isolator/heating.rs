@@ -4,7 +4,7 @@
 //! direction.
 
 use super::*;
-use search::golden;
+use search::{fit_factor, golden};
 
 impl Isolator {
     /// How far the winding's temperature can have moved since it was last judged (a point
@@ -114,6 +114,77 @@ impl Isolator {
         best
     }
 
+    /// The winding's temperature is not known: no learned baseline is in force, so the
+    /// machine is judged against the parameter file's values, whose temperature the
+    /// winding need not have (a motor in service runs 20-100 K above it), and no channel
+    /// measures it (a measured rise is in force only after commissioning). Then a fault is
+    /// fitted on a machine at any temperature of the heating range
+    /// ([`Isolator::fits_beyond_heating`]; module docs, "The temperature unknown").
+    pub(super) fn temperature_unknown(&self) -> bool {
+        !self.learned_point()
+    }
+
+    /// Fault `f`'s fit on a winding of unknown temperature (module docs of
+    /// [`crate::isolation`], "The temperature unknown"): the size `k` and the heating factor
+    /// (Rs and Rr both times it, within [`Isolator::heating_range`]) fitted together, the
+    /// misfit of hypothesis `(f, k)` on the isolator `warm` given by `misfit(warm, f, k)`.
+    /// Golden section over the heating factor ([`FREE_STEPS`]) of the size's best fit
+    /// ([`fit_factor`], each started from the last one's grid point); returns `(chi2, k)`
+    /// and the hint for the next search. `hint`: where the size search starts.
+    #[inline(never)]
+    pub(super) fn fit_at_any_temperature(
+        &self,
+        f: Fault,
+        misfit: impl Fn(&Isolator, Fault, f32) -> f32,
+        hint: u8,
+    ) -> ((f32, f32), u8) {
+        let (lo, hi) = self.heating_range();
+        let best = core::cell::Cell::new((f32::INFINITY, 1.0f32));
+        let next = core::cell::Cell::new(hint);
+        let _ = golden(
+            |kh| {
+                let warm = self.warmer(kh);
+                let (found, h) = fit_factor(|k| misfit(&warm, f, k), next.get());
+                next.set(h);
+                if found.0 < best.get().0 {
+                    best.set(found);
+                }
+                found.0
+            },
+            lo,
+            hi,
+            FREE_STEPS,
+        );
+        (best.get(), next.get())
+    }
+
+    /// The faults' fits on a winding of unknown temperature (module docs of
+    /// [`crate::isolation`], "The temperature unknown"): each fault's `fits` (its fit at the
+    /// tracked temperature, replaced by [`Isolator::fit_at_any_temperature`]'s where that is
+    /// better), and which of them are seen beyond the heating: where the fault on top of
+    /// the winding's best heating `heat` lowers the misfit by at least [`DETECT_CHI2`] (a
+    /// change beyond the heated machine detected, as a deviation from the healthy one is).
+    /// The others explain nothing the heating alone does not, and take no part in the
+    /// ranking. `misfit(warm, f, k)`: the misfit of `(f, k)` on the isolator `warm`;
+    /// `hints`: where the size searches start, and whether they are used.
+    pub(super) fn fits_beyond_heating(
+        &self,
+        fits: &mut [(f32, f32); FAULT_COUNT],
+        heat: (f32, f32),
+        misfit: impl Fn(&Isolator, Fault, f32) -> f32,
+        (hints, use_hints): (&SearchHints, bool),
+    ) -> [bool; FAULT_COUNT] {
+        let mut seen = [false; FAULT_COUNT];
+        for ((fit, f), s) in fits.iter_mut().zip(Fault::ALL).zip(seen.iter_mut()) {
+            let (free, _) = self.fit_at_any_temperature(f, &misfit, hints.get(f, use_hints));
+            if free.0 < fit.0 {
+                *fit = free;
+            }
+            *s = heat.0 - fit.0 >= DETECT_CHI2;
+        }
+        seen
+    }
+
     /// The residuals at `newer` differ from those at `older` (two means of the same
     /// operating point's blocks, each's spreads the baseline's times `spread_scale`) by more
     /// than the healthy scatter allows: the difference, less a warming of at most
@@ -169,3 +240,7 @@ const HEATING_LAG_K: f32 = 3.0;
 pub const HEATING_LAG_SIGMA_K: f32 = 3.0;
 /// Golden-section steps of the lag's fit: +-10 K shrunk by 0.618^12, to 0.07 K.
 const LAG_STEPS: usize = 12;
+/// Golden-section steps of the heating factor in a fault's fit on a winding of unknown
+/// temperature ([`Isolator::fit_at_any_temperature`]): the heating range (0.90..1.63 of the
+/// file's resistances) shrunk by 0.618^14, to 1e-3 of the factor (0.3 K).
+const FREE_STEPS: usize = 14;

@@ -3,7 +3,7 @@
 //! torque compared with the load known at an anchor.
 
 use super::heating::HEATING_STEPS;
-use super::search::{fit_factor, golden, rank};
+use super::search::{fit_factor, golden, rank, ALL_SEEN};
 use super::*;
 
 impl Isolator {
@@ -92,6 +92,20 @@ impl Isolator {
             hi,
             HEATING_STEPS,
         );
+        // A winding of unknown temperature (module docs, "The temperature unknown"): each
+        // fault at any temperature of the heating range, named only for what it explains
+        // beyond the heating; over two load levels or more a fault on a warm winding parts
+        // from another on a winding warmed differently.
+        let seen = if self.temperature_unknown() {
+            self.fits_beyond_heating(
+                &mut fits,
+                heat,
+                |iso, f, k| iso.chi2_points(used, load, Some((f, k))),
+                (hints, use_hints),
+            )
+        } else {
+            ALL_SEEN
+        };
         let dims = 2.0 * n as f32 + if load.is_some() { 1.0 } else { 0.0 };
         rank(
             &mut out,
@@ -99,7 +113,11 @@ impl Isolator {
             heat,
             (chi0, dims),
             self.direction_uncertainty(),
+            &seen,
         );
+        if self.temperature_unknown() {
+            super::heating_not_unknown(&mut out);
+        }
         if let Some(e0) = self.residuals(&first, None) {
             out.separation_deg = self.separation(&first, &e0, &out.candidates);
         }

@@ -35,13 +35,15 @@ pub(super) fn golden(chi: impl Fn(f32) -> f32, lo: f32, hi: f32, steps: usize) -
 /// `out` (candidates, probabilities, state), for a deviation of misfit `chi0` over `dims`
 /// equations, with the fault directions known to a relative `eps` (module docs,
 /// "How sure a name is"). B and Bl scale the same load term: one friction class with one
-/// misfit (each keeps the size it needs on its own).
+/// misfit (each keeps the size it needs on its own). A fault not `seen` takes no part (its
+/// probability is 0; [`ALL_SEEN`]: every fault takes part).
 pub(super) fn rank(
     out: &mut Isolation,
     fits: &mut [(f32, f32); FAULT_COUNT],
     heat: (f32, f32),
     (chi0, dims): (f32, f32),
     eps: f32,
+    seen: &[bool; FAULT_COUNT],
 ) {
     let friction = [Fault::B.index(), Fault::Bl.index()];
     let chi_friction = friction
@@ -57,16 +59,17 @@ pub(super) fn rank(
     // within HEATING_MAX_MISFIT): elsewhere the faults rank among themselves as without it.
     let (chi_heat, k_heat) = heat;
     let heat_in = crate::math::sqrt(chi_heat) <= HEATING_MAX_MISFIT;
-    let chi_min = fits.iter().fold(
+    let chi_min = fits.iter().zip(seen).filter(|(_, s)| **s).fold(
         if heat_in { chi_heat } else { f32::INFINITY },
-        |a, (c, _)| crate::math::minf(a, *c),
+        |a, ((c, _), _)| crate::math::minf(a, *c),
     );
     let chi_unknown = crate::math::maxf(UNKNOWN_CHI2, 0.1 * chi0);
     let t = temperature(chi_min, (chi0, dims), eps);
     let w = |c: f32| F32Ext::exp(-(c - chi_min) / (2.0 * t));
+    let w_fault = |c: f32, seen: bool| if seen { w(c) } else { 0.0 };
     let mut total = w(chi_unknown);
-    for (c, _) in fits.iter() {
-        total += w(*c);
+    for ((c, _), s) in fits.iter().zip(seen) {
+        total += w_fault(*c, *s);
     }
     if heat_in {
         total += w(chi_heat);
@@ -76,10 +79,16 @@ pub(super) fn rank(
         factor: k_heat,
         misfit: crate::math::sqrt(chi_heat),
     };
-    for ((cand, (c, k)), f) in out.candidates.iter_mut().zip(*fits).zip(Fault::ALL) {
+    for (((cand, (c, k)), f), s) in out
+        .candidates
+        .iter_mut()
+        .zip(*fits)
+        .zip(Fault::ALL)
+        .zip(seen)
+    {
         *cand = Candidate {
             fault: f,
-            probability: w(c) / total,
+            probability: w_fault(c, *s) / total,
             change: k - 1.0,
             misfit: crate::math::sqrt(c),
             at_limit: k <= K_MIN * 1.001 || k >= K_MAX * 0.999,
@@ -94,6 +103,9 @@ pub(super) fn rank(
         IsolationState::Isolated
     };
 }
+
+/// Every fault takes part in the ranking ([`rank`]).
+pub(super) const ALL_SEEN: [bool; FAULT_COUNT] = [true; FAULT_COUNT];
 
 /// The ranking's temperature (module docs of [`crate::isolation`], "How sure a name is"):
 /// the directions' own uncertainty (a model error of `eps` times the deviation of misfit
