@@ -30,7 +30,12 @@ __all__ = ["trend", "Trend", "STORE_COLUMNS", "TREND_COLUMNS"]
 #: ``motor`` and ``day``, which are the dataset's partitions).
 STORE_COLUMNS: "List[str]" = list(_native.store_columns())
 
-#: The columns of :attr:`Trend.indicators`, one row per motor and indicator.
+#: The columns of :attr:`Trend.indicators`, one row per motor and the indicators its logs
+#: measured (an indicator no log of the motor measured, such as the parity residuals of
+#: logs without voltages, has no row: absent, not zero). ``sentence`` is the indicator's
+#: line as ``sim-host trend`` prints it; ``reason`` the typed reason beside it, a dict with
+#: its ``kind`` (``fault_level_in_a_row``, ``slope``, ``held``, ``not_yet``, ``no_alarm``,
+#: ...) and the numbers that decided.
 TREND_COLUMNS: "List[str]" = [
     "motor",
     "indicator",
@@ -52,6 +57,7 @@ TREND_COLUMNS: "List[str]" = [
     "from_reference_scatters",
     "normalisation",
     "sentence",
+    "reason",
 ]
 
 

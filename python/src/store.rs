@@ -77,7 +77,8 @@ pub fn store_append(py: Python<'_>, store: PathBuf, rows_json: String) -> PyResu
     })
 }
 
-/// The store's rows and their trend, as JSON `{"rows": [...], "motors": [...]}`.
+/// The store's rows and their trend, as JSON `{"rows": [...], "motors": [...]}` (`motors`
+/// spelled by `monitor_words::trend`, as `sim-host trend --json`'s).
 ///
 /// # Errors
 /// [`LogError`]: no store there, or not a store; [`OptionError`]: a bad date or window.
@@ -129,6 +130,8 @@ pub fn store_trend(
             ..TrendOptions::default()
         };
         let motors = monitor_store::trend::trend(&rows, &opts);
+        // The sentences are the words door's, beside the engine's typed reasons.
+        let motors = monitor_api::words::trend::spelled(&motors);
         Ok(serde_json::json!({ "rows": rows, "motors": motors }).to_string())
     })
 }

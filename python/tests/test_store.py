@@ -140,3 +140,44 @@ def test_trend_takes_a_marked_reference(month, tmp_path, sim_host):
         assert m["reference"]["marked"] and m["reference"]["last_day"] == first, m["reference"]
     with pytest.raises(dm.OptionError, match="reference_until"):
         dm.trend(store, reference_until="soon")
+
+
+ITSC = (
+    ["SC_HLT_001", "SC_HLT_002", "SC_HLT_001", "SC_HLT_002"]
+    + ["SC_A0_B0_C1_001", "SC_A0_B0_C1_002", "SC_A0_B0_C2_001", "SC_A0_B0_C2_002"]
+    + ["SC_A0_B0_C3_001", "SC_A0_B0_C4_001"]
+)
+UNMEASURED = ["residual_d", "residual_q", "residual_t", "stator_excess_pct"]
+
+
+def test_a_current_only_bench_alarms_on_its_fault_logs_and_drops_what_it_cannot_measure(repo, tmp_path, sim_host):
+    """Issue 79: ten dated copies of the real ITSC bench's logs (currents only; four healthy,
+    then shorts from 10 % to 40 %): the trend alarms on the FAULT level of two logs in a row,
+    and the residuals and Rs beyond Rr, which these logs cannot measure, are absent from the
+    trend's frame and null in the rows (SQLite and Parquet), not zeros."""
+    import shutil
+
+    itsc = repo / "examples" / "recordings" / "itsc"
+    logs = []
+    for k, name in enumerate(ITSC):
+        to = tmp_path / f"bench_202611{k + 1:02d}.csv"
+        shutil.copy(itsc / f"{name}.csv", to)
+        logs.append(str(to))
+    table = tmp_path / "motors.toml"
+    table.write_text(
+        f'[[motor]]\nname = "bench"\nparams = "{itsc / "baldor_0p75hp.toml"}"\nlogs = "bench_*"\n'
+        'time_from_name = "bench_%Y%m%d"\n'
+    )
+    store = tmp_path / "bench.db"
+    subprocess.run([sim_host, "fleet", str(table), *logs, "--store", str(store)], check=True, capture_output=True)
+    t = dm.trend(store)
+    assert set(t.indicators.indicator).isdisjoint(UNMEASURED), t.indicators.indicator.tolist()
+    i2 = t.indicators.set_index("indicator").loc["i2_over_i1"]
+    assert i2.alarm, i2.sentence
+    assert i2.reason["kind"] == "fault_level_in_a_row" and i2.reason["logs"] == 6, i2.reason
+    assert "TREND ALARM" in i2.sentence
+    for frame in (t.rows, read_sqlite(store), read_mirror(store)):
+        assert len(frame) == len(ITSC)
+        for c in UNMEASURED + ["deviation_sigma"]:
+            assert frame[c].isna().all(), (c, frame[c].tolist())
+        assert frame["i2_over_i1"].notna().all()

@@ -84,18 +84,16 @@ fn four_logs_are_drawn_as_their_stored_values_not_flat_lines() {
         String::from_utf8_lossy(&out.stderr)
     );
     let svg = std::fs::read_to_string(&svg_path).expect("svg");
-    // The panels are 260 px high, one under the other: e_d's is the second (260-520),
-    // e_q's the third (520-780). A motor's line has its four points.
+    // The panels are 260 px high, one under the other, one per indicator the logs measured
+    // (no |I2w|/|I1| here: issue 79): e_d's is the first (0-260), e_q's the second
+    // (260-520). A motor's line has its four points.
     let line_in = |lo: f64, hi: f64| {
         polylines(&svg)
             .into_iter()
             .find(|l| l.len() == 4 && l.iter().all(|p| p.1 > lo && p.1 < hi))
             .unwrap_or_else(|| panic!("no line of 4 points in {lo}-{hi} px"))
     };
-    for (panel, (lo, hi), rising) in [
-        ("e_d", (260.0, 520.0), true),
-        ("e_q", (520.0, 780.0), false),
-    ] {
+    for (panel, (lo, hi), rising) in [("e_d", (0.0, 260.0), true), ("e_q", (260.0, 520.0), false)] {
         let ys: Vec<f64> = line_in(lo, hi).iter().map(|p| p.1).collect();
         let spread = ys.iter().copied().fold(f64::MIN, f64::max)
             - ys.iter().copied().fold(f64::MAX, f64::min);
@@ -143,7 +141,8 @@ fn reference_until_marks_the_baseline() {
     assert_eq!(r["marked"], true, "{r}");
     assert_eq!(r["logs"], 2, "{r}");
     assert_eq!(r["last_day"], "2026-11-02", "{r}");
-    let e_d = &doc["motors"][0]["indicators"][1];
+    // The first indicator the logs measured (they have no |I2w|/|I1|: absent, issue 79).
+    let e_d = &doc["motors"][0]["indicators"][0];
     assert_eq!(e_d["indicator"], "residual_d");
     let marked: Vec<bool> = e_d["series"]
         .as_array()

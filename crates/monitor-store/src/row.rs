@@ -125,17 +125,17 @@ pub const COLUMNS: [StoreColumn; 36] = [
     c(
         "residual_d",
         Kind::Real,
-        "parity residual e_d minus the baseline [isolation.residuals[0]]",
+        "parity residual e_d minus the baseline [isolation.residuals[0]]; null where the isolation judged no point (no voltages)",
     ),
     c(
         "residual_q",
         Kind::Real,
-        "parity residual e_q minus the baseline [isolation.residuals[1]]",
+        "parity residual e_q minus the baseline [isolation.residuals[1]]; null where the isolation judged no point (no voltages)",
     ),
     c(
         "residual_t",
         Kind::Real,
-        "parity residual e_T minus the baseline [isolation.residuals[2]]",
+        "parity residual e_T minus the baseline [isolation.residuals[2]]; null where the isolation judged no point (no voltages)",
     ),
     c(
         "deviation_sigma",
@@ -393,6 +393,11 @@ fn report_cells(doc: &Value) -> Vec<Cell> {
         other => Some(other.to_string()),
     });
     let judged = doc.pointer("/rotor/judged") == Some(&Value::Bool(true));
+    // The isolation's residuals, their deviation and its heating flag are measured only
+    // where it judged an operating point (a log without voltages reports them as zeros
+    // with the state `not_judged`): null there, never a 0 that reads as healthy.
+    let isolated = doc.pointer("/isolation/state").and_then(Value::as_str) != Some("not_judged");
+    let iso = |x: Option<f64>| x.filter(|_| isolated);
     let finding = is_named(doc);
     let real = |x: Option<f64>| x.map_or(Cell::Null, Cell::Real);
     let txt = |x: Option<String>| x.map_or(Cell::Null, Cell::Text);
@@ -409,12 +414,12 @@ fn report_cells(doc: &Value) -> Vec<Cell> {
         real(candidate("rs")),
         real(candidate("rr")),
         real(num("/isolation/winding_rise_k")),
-        int(flag("/isolation/heating_explains")),
+        int(flag("/isolation/heating_explains").filter(|_| isolated)),
         real(num("/isolation/winding_temperature_c")),
-        real(num("/isolation/residuals/0")),
-        real(num("/isolation/residuals/1")),
-        real(num("/isolation/residuals/2")),
-        real(num("/isolation/deviation_sigma")),
+        real(iso(num("/isolation/residuals/0"))),
+        real(iso(num("/isolation/residuals/1"))),
+        real(iso(num("/isolation/residuals/2"))),
+        real(iso(num("/isolation/deviation_sigma"))),
         real(num("/unbalance/winding_ratio")),
         real(num("/unbalance/angle_deg")),
         real(num("/unbalance/least_change")),
@@ -552,5 +557,41 @@ mod tests {
         let back = StoredRow::from_json(&serde_json::to_value(&r).unwrap()).unwrap();
         assert_eq!(back, r);
         assert!(StoredRow::from_json(&serde_json::json!({"log_id": 3})).is_none());
+    }
+
+    #[test]
+    fn what_a_log_without_voltages_cannot_measure_is_null_not_zero() {
+        // `diagnose --json` of a current-only log: the isolation judged no point and
+        // reports its residuals as zeros.
+        let doc = serde_json::json!({
+            "verdict": "healthy",
+            "isolation": {"state": "not_judged", "residuals": [0.0, 0.0, 0.0],
+                "deviation_sigma": 0.0, "heating_explains": false},
+            "unbalance": {"winding_ratio": 0.03, "measured": {"i1_peak_a": 7.5}}
+        });
+        let id = LogIdentity {
+            motor: "m1".into(),
+            path: "/x/m1.csv".into(),
+            hash: "00ff".into(),
+            time_s: 0,
+        };
+        let r = StoredRow::from_diagnose(&id, &doc);
+        for c in [
+            "residual_d",
+            "residual_q",
+            "residual_t",
+            "deviation_sigma",
+            "heating_explains",
+            "stator_excess_pct",
+        ] {
+            assert_eq!(r.get(c), &Cell::Null, "{c}");
+        }
+        assert_eq!(r.f64("i2_over_i1"), Some(0.03));
+        // Judged (no deviation): its zeros are measured values.
+        let mut judged = doc.clone();
+        judged["isolation"]["state"] = "no_deviation".into();
+        let r = StoredRow::from_diagnose(&id, &judged);
+        assert_eq!(r.f64("residual_d"), Some(0.0));
+        assert_eq!(r.f64("heating_explains"), Some(0.0));
     }
 }

@@ -126,7 +126,7 @@ fn judge(m: &Motor, day: u32, seed: u64) -> StoredRow {
 }
 
 /// Per day 1..=30: whether the trend of the motor's logs up to that day alarms, and the
-/// alarmed indicators' sentences.
+/// alarmed indicators with their reasons ("stator_excess_pct: Slope { .. }").
 fn alarms(rows: &[StoredRow], motor: &str) -> Vec<(bool, Vec<String>)> {
     (1..=DAYS)
         .map(|day| {
@@ -138,7 +138,8 @@ fn alarms(rows: &[StoredRow], motor: &str) -> Vec<(bool, Vec<String>)> {
                 .collect();
             let t = trend::motor_trend(motor, &upto, &TrendOptions::default());
             let said = t.indicators.iter().filter(|i| i.alarm);
-            (t.alarm, said.map(|i| i.sentence.clone()).collect())
+            let said = said.map(|i| format!("{}: {:?}", i.indicator, i.reason));
+            (t.alarm, said.collect())
         })
         .collect()
 }
@@ -255,7 +256,7 @@ fn month(loosening: usize, seed: u64) -> Vec<String> {
         if !days[a as usize - 1]
             .1
             .iter()
-            .any(|s| s.contains("Rs beyond Rr"))
+            .any(|s| s.starts_with("stator_excess_pct:"))
         {
             bad.push(format!(
                 "{}: alarmed, but not on Rs beyond Rr: {:?}",

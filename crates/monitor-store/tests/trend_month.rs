@@ -157,7 +157,7 @@ fn first_alarm(rows: &[StoredRow], motor: &str) -> Option<(u32, Vec<String>)> {
                 t.indicators
                     .iter()
                     .filter(|i| i.alarm)
-                    .map(|i| i.sentence.clone())
+                    .map(|i| format!("{}: {:?}", i.indicator, i.reason))
                     .collect(),
             )
         })

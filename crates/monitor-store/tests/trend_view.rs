@@ -1,14 +1,16 @@
 //! A trend a planner can trust (issue 65): the alarm holds once raised until the indicator
 //! is back at the motor's reference; the reference is the motor's own first healthy logs
 //! (or the baseline the user marks), not all its logs; with few logs the stored values are
-//! what is shown, and the report says why; the normalisation's sentence gives the actual
-//! reason; no days to FAULT on a slope that may be flat.
+//! what is shown, and the report says why; the normalisation gives the actual reason; no
+//! days to FAULT on a slope that may be flat. (Their words: crates/monitor-words/tests.)
 //!
 //! Every row is built here with values chosen in the test (`StoredRow` cells set by
 //! column), and every expected value is the test's own.
 
 use monitor_store::row::column_index;
-use monitor_store::trend::{self, IndicatorTrend, MotorTrend, TrendOptions};
+use monitor_store::trend::{
+    self, CovariateRange, IndicatorTrend, MotorTrend, Normalisation, TrendOptions, TrendReason,
+};
 use monitor_store::{Cell, LogIdentity, StoredRow};
 
 /// 2026-11-01 06:00 UTC: day 1's log.
@@ -94,11 +96,15 @@ fn the_alarm_holds_once_raised_until_the_indicator_is_back_at_its_reference() {
         i2.alarm_since.as_deref(),
         Some(monitor_store::utc_day(START_S + (raised - 1) * 86_400).as_str())
     );
-    assert!(i2.sentence.contains("TREND ALARM"), "{}", i2.sentence);
+    assert!(
+        matches!(i2.reason, TrendReason::Held { ref since, .. } if Some(since) == i2.alarm_since.as_ref()),
+        "{:?}",
+        i2.reason
+    );
     // Repaired on day 51: the values are back at once, the 14-day line within two weeks.
     for day in 66..=75 {
         let i2 = ind(&motor(&rows, day, &opts), "i2_over_i1").clone();
-        assert!(!i2.alarm, "day {day}: {}", i2.sentence);
+        assert!(!i2.alarm, "day {day}: {:?}", i2.reason);
         assert_eq!(i2.alarm_since, None);
     }
 }
@@ -231,14 +237,33 @@ fn four_logs_show_their_stored_values_and_say_why_there_is_no_trend() {
     assert!(!e_d.operating_point_fitted);
     assert_eq!(e_d.scatter, None);
     assert_eq!(e_d.reference_scatter, None);
-    let s = &e_d.sentence;
-    assert!(s.contains("too few"), "{s}");
-    assert!(s.contains("0.0260"), "{s}");
+    match &e_d.reason {
+        TrendReason::TooFewLogs {
+            logs: 4,
+            needed: 6,
+            values: Some(v),
+            ..
+        } => assert_eq!(
+            (v.low, v.high, v.first, v.last),
+            (0.0001, 0.026, 0.0001, 0.026)
+        ),
+        other => panic!("{other:?}"),
+    }
     // The reason for the raw values: too few logs, 4 of 28, while the load moved.
-    let n = &e_d.normalisation;
-    assert!(n.contains("4 of the 28"), "{n}");
-    assert!(n.contains("6.400-7.600 A"), "{n}");
-    assert!(!n.contains("does not vary"), "{n}");
+    match &e_d.normalisation {
+        Normalisation::TooFewLogs {
+            logs: 4,
+            needed: 28,
+            lacking: 0,
+            total: 4,
+            moved,
+        } => {
+            // The load moved; the rise (10 K on every log) did not.
+            assert_eq!(moved.len(), 1, "{moved:?}");
+            near(&moved[0], "i1_peak_a", 6.4, 7.6);
+        }
+        other => panic!("{other:?}"),
+    }
 }
 
 #[test]
@@ -258,9 +283,16 @@ fn raw_values_say_the_actual_reason() {
     let n = ind(&motor(&rows, 30, &TrendOptions::default()), "residual_d")
         .normalisation
         .clone();
-    assert!(n.contains("10 of the 28"), "{n}");
-    assert!(n.contains("6.400-7.600 A"), "{n}");
-    assert!(!n.contains("does not vary"), "{n}");
+    match n {
+        Normalisation::TooFewLogs {
+            logs: 10,
+            needed: 28,
+            lacking: 20,
+            total: 30,
+            moved,
+        } => near(&moved[0], "i1_peak_a", 6.4, 7.6),
+        other => panic!("{other:?}"),
+    }
 
     // 30 logs at one load (7.0 A) with a temperature that moves: the load really does
     // not vary, the temperature does.
@@ -277,9 +309,23 @@ fn raw_values_say_the_actual_reason() {
     let n = ind(&motor(&rows, 30, &TrendOptions::default()), "residual_d")
         .normalisation
         .clone();
-    assert!(n.contains("does not vary"), "{n}");
-    assert!(n.contains("i1_peak_a"), "{n}");
-    assert!(n.contains("30.000-36.000"), "{n}");
+    match n {
+        Normalisation::Flat { flat, moved } => {
+            assert_eq!((flat.len(), moved.len()), (1, 1), "{flat:?} {moved:?}");
+            near(&flat[0], "i1_peak_a", 7.0, 7.0);
+            near(&moved[0], "winding_temperature_c", 30.0, 36.0);
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+/// `r` is covariate `column`'s range `low`-`high` (to 1e-9).
+fn near(r: &CovariateRange, column: &str, low: f64, high: f64) {
+    assert_eq!(r.column, column, "{r:?}");
+    assert!(
+        (r.low - low).abs() < 1e-9 && (r.high - high).abs() < 1e-9,
+        "{r:?}"
+    );
 }
 
 #[test]
@@ -306,8 +352,13 @@ fn a_slope_that_may_be_flat_projects_no_days_to_fault() {
     let (slope, low) = (i2.slope_per_day.expect("slope"), i2.slope_low.expect("low"));
     // The premise: a rising median slope whose interval takes in zero.
     assert!(slope > 0.0 && low <= 0.0, "slope {slope}, low {low}");
-    assert_eq!(i2.days_to_fault, None, "{}", i2.sentence);
-    assert_eq!(i2.days_to_fault_recent, None, "{}", i2.sentence);
-    assert!(!i2.sentence.contains("FAULT level in"), "{}", i2.sentence);
+    assert_eq!(i2.days_to_fault, None, "{:?}", i2.reason);
+    assert_eq!(i2.days_to_fault_recent, None, "{:?}", i2.reason);
+    assert_eq!(
+        i2.reason,
+        TrendReason::NoAlarm {
+            days_to_fault: None
+        }
+    );
     assert!(!i2.alarm);
 }

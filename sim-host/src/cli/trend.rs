@@ -3,7 +3,8 @@
 
 use super::render;
 use clap::Args;
-use monitor_store::trend::{MotorTrend, TrendOptions};
+use monitor_api::words::trend as words;
+use monitor_store::trend::{MotorTrend, Normalisation, TrendOptions};
 use monitor_store::Store;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -15,13 +16,16 @@ use std::path::PathBuf;
     long_about = "Read the store `sim-host fleet --store PATH` writes and trend each motor's \
 indicators over the last --window-days of its logs: the winding's negative-sequence change \
 |I2w|/|I1| (a short grows it), the isolation's parity residuals e_d, e_q, e_T (a resistance, \
-inductance or load change moves them) and the rotor's sideband (broken bars).\n\nEach indicator \
+inductance or load change moves them) and the rotor's sideband (broken bars). An indicator none \
+of a motor's logs measured (the residuals of logs without voltages) is left out of its table, \
+JSON and plot, never drawn as zero.\n\nEach indicator \
 is first brought to the motor's usual operating point: a least-squares fit on the load (the \
 current I1) and the windings' temperature rise, made on the motor's first logs, is removed, so \
 a load that moves from day to day or a season that warms the windings is not a trend. Then \
 Theil-Sen's slope per day with Sen's 95 % interval, and the indicator's own scatter about the \
-line (1.4826 MAD). The TREND ALARM: the interval lies on the fault's side of zero AND the line \
-moves the indicator by more than --k scatters over the window. Where the indicator has a FAULT \
+line (1.4826 MAD). The TREND ALARM: the indicator's stored value at its FAULT level on two logs \
+in a row (what the logs show, whatever the fit still needs), or the interval lies on the fault's \
+side of zero AND the line moves the indicator by more than --k scatters over the window. Where the indicator has a FAULT \
 level (the level a single log's verdict names the fault at), the days until the line reaches \
 it, where Sen's interval excludes a flat line. Once raised, the alarm holds until the \
 indicator is back within --k scatters of the motor's reference (its first --window-days of logs \
@@ -67,7 +71,7 @@ pub struct TrendArgs {
 struct TrendReport<'a> {
     store: String,
     options: TrendOptions,
-    motors: &'a [MotorTrend],
+    motors: Vec<words::SpelledMotor<'a>>,
 }
 
 /// Runs `trend`.
@@ -114,7 +118,7 @@ pub fn run(args: &TrendArgs) -> anyhow::Result<()> {
             &TrendReport {
                 store: args.store.display().to_string(),
                 options: opts,
-                motors: &motors,
+                motors: words::spelled(&motors),
             },
         );
     }
@@ -220,26 +224,26 @@ fn print_table(
 /// once with the indicators it applies to.
 fn print_detail(out: &mut impl std::io::Write, m: &MotorTrend) -> std::io::Result<()> {
     for t in &m.indicators {
-        writeln!(out, "    {}", t.sentence)?;
+        writeln!(out, "    {}", words::sentence(t))?;
     }
     let r = &m.reference;
     writeln!(
         out,
         "    reference: {} ({} logs, {} to {})",
-        r.how,
+        words::reference_how(r),
         r.logs,
         r.first_day.as_deref().unwrap_or("-"),
         r.last_day.as_deref().unwrap_or("-")
     )?;
-    let mut seen: Vec<(&str, Vec<&str>)> = Vec::new();
+    let mut seen: Vec<(&Normalisation, Vec<&str>)> = Vec::new();
     for t in &m.indicators {
-        match seen.iter_mut().find(|(n, _)| *n == t.normalisation) {
+        match seen.iter_mut().find(|(n, _)| **n == t.normalisation) {
             Some((_, v)) => v.push(&t.indicator),
             None => seen.push((&t.normalisation, vec![&t.indicator])),
         }
     }
     for (n, v) in seen {
-        writeln!(out, "    {}: {n}", v.join(", "))?;
+        writeln!(out, "    {}: {}", v.join(", "), words::normalisation(n))?;
     }
     Ok(())
 }

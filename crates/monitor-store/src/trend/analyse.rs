@@ -5,7 +5,7 @@ use super::reference::{latched, normalisation_note, reference_stats};
 use super::stats::{least_squares, mad_sigma, median, theil_sen};
 use super::{
     reference_rows, Direction, FaultLevel, Indicator, IndicatorTrend, MotorTrend, TrendOptions,
-    TrendPoint, INDICATORS, RISE,
+    TrendPoint, TrendReason, ValueRange, INDICATORS, RISE,
 };
 use crate::row::{utc_day, StoredRow};
 
@@ -46,11 +46,14 @@ pub fn motor_trend(motor: &str, rows: &[&StoredRow], opts: &TrendOptions) -> Mot
             .unwrap_or_default()
             .total_cmp(&b.f64("log_time_s").unwrap_or_default())
     });
+    // An indicator none of the motor's logs measured (a log without voltages has no parity
+    // residual, no Rs beyond Rr) is absent, not a flat line at zero.
     let indicators: Vec<IndicatorTrend> = INDICATORS
         .iter()
+        .filter(|ind| rows.iter().any(|r| r.f64(ind.column).is_some()))
         .map(|ind| {
             let judge = |r: &[&StoredRow]| indicator_trend(ind, r, opts);
-            latched(judge(&rows), &rows, opts, &judge)
+            latched(judge(&rows), ind, &rows, opts, &judge)
         })
         .collect();
     let fastest = indicators
@@ -245,63 +248,80 @@ pub fn indicator_trend(
         days_to_fault_recent: None,
         alarm: false,
         alarm_since: None,
+        span_days: None,
         normalisation,
         operating_point_fitted: fit.is_some(),
         reference_centre,
         reference_scatter,
         from_reference_scatters: None,
-        sentence: String::new(),
+        reason: TrendReason::OneTime,
+        fault_level_logs: fault_level_run(ind, rows).map_or(0, |r| r.logs),
         series,
     };
     judge(&mut t, ind, opts, end_s / DAY_S, floor);
     if let (Some(l), Some(c), Some(s)) = (t.last, reference_centre, reference_scatter) {
         t.from_reference_scatters = Some((l - c) / s);
     }
-    if fit.is_none() && !covs.is_empty() && usable < needed {
-        hold_for_fit(&mut t, usable, needed);
+    if t.alarm && fit.is_none() && !covs.is_empty() && usable < needed {
+        // Too few logs to tell a trend from the operating point's moves: the slope does
+        // not alarm yet (the FAULT level on logs in a row still does: [`latched`]).
+        t.alarm = false;
+        t.reason = TrendReason::NotYet {
+            logs: usable,
+            needed,
+        };
     }
-    finish(&mut t, ind, covs);
+    if t.alarm && covs.contains(&RISE) {
+        // A residual normalised on the rise the isolation read (no temperature channel):
+        // shown, not alarmed. The rise is read from Rs and Rr against the parameter file,
+        // so with a file 10 % off it follows the file's error as much as the season: on a
+        // held-out month judged against such a file every healthy motor's residuals
+        // alarmed on the first day the fit was allowed. The stator's resistance beyond the
+        // rotor's (`stator_excess_pct`) needs no temperature and alarms a loosening
+        // connection instead.
+        t.alarm = false;
+        t.reason = TrendReason::NoTemperatureChannel;
+    }
     t
 }
 
-/// The last words of `t`: a residual without a temperature channel is not alarmed
-/// ([`hold_without_probe`]); an alarm says what it means.
-fn finish(t: &mut IndicatorTrend, ind: &Indicator, covs: &[&str]) {
-    if covs.contains(&RISE) {
-        hold_without_probe(t);
-    }
-    if t.alarm && !ind.alarm_means.is_empty() {
-        t.sentence = format!("{}; {}", t.sentence, ind.alarm_means);
-    }
+/// The motor's last logs in a row at an indicator's FAULT level
+/// ([`TrendReason::FaultLevelInARow`]).
+pub(super) struct LevelRun {
+    /// How many (at least 1).
+    pub logs: usize,
+    /// The first one's UTC day.
+    pub first_day: String,
+    /// The last log's stored value.
+    pub value: f64,
+    /// Its FAULT level.
+    pub level: f64,
 }
 
-/// Too few logs (`n` of the `needed`) to tell a trend from the operating point's moves: no
-/// alarm, and the sentence says so (it never says TREND ALARM where the alarm is not
-/// raised).
-fn hold_for_fit(t: &mut IndicatorTrend, n: usize, needed: usize) {
-    if t.alarm {
-        t.alarm = false;
-        t.sentence = t.sentence.replace(
-            ": TREND ALARM",
-            &format!(": no alarm yet ({n} logs; the operating-point fit needs {needed})"),
-        );
-    }
-}
-
-/// A residual normalised on the rise the isolation read (no temperature channel): shown,
-/// not alarmed. The rise is read from Rs and Rr against the parameter file, so with a file
-/// 10 % off it follows the file's error as much as the season: on a held-out month judged
-/// against such a file every healthy motor's residuals alarmed on the first day the fit
-/// was allowed. The stator's resistance beyond the rotor's (`stator_excess_pct`) needs no
-/// temperature and alarms a loosening connection instead.
-fn hold_without_probe(t: &mut IndicatorTrend) {
-    if t.alarm {
-        t.alarm = false;
-        t.sentence = t.sentence.replace(
-            ": TREND ALARM",
-            ": shown, not alarmed (no temperature channel: normalised on the rise the isolation read)",
-        );
-    }
+/// The run of logs at the FAULT level of `ind` that ends at the last of `rows` (by time):
+/// each log's stored value at or beyond its own level (a level column's value in the log,
+/// else the indicator's level over `rows`); a log without the value, or below its level,
+/// ends the run. `None` where the last log is not at the level or `ind` has none.
+pub(super) fn fault_level_run(ind: &Indicator, rows: &[&StoredRow]) -> Option<LevelRun> {
+    let common = fault_level_of(ind, rows);
+    let level_of = |r: &StoredRow| match ind.fault_level {
+        FaultLevel::Column(c) => r.f64(c).filter(|x| *x > 0.0).or(common),
+        _ => common,
+    };
+    let at = |r: &StoredRow| match (r.f64(ind.column), level_of(r)) {
+        (Some(v), Some(l)) if v.is_finite() && v >= l => Some((v, l)),
+        _ => None,
+    };
+    let last = rows.last()?;
+    let (value, level) = at(last)?;
+    let logs = rows.iter().rev().take_while(|r| at(r).is_some()).count();
+    let first = rows.get(rows.len() - logs)?;
+    Some(LevelRun {
+        logs,
+        first_day: first.str("day").unwrap_or_default().to_string(),
+        value,
+        level,
+    })
 }
 
 /// The indicator's points, normalised with `fit` where there is one: those from `start_s`
@@ -348,18 +368,16 @@ fn fault_level_of(ind: &Indicator, rows: &[&StoredRow]) -> Option<f64> {
     }
 }
 
-/// The slope, scatter, alarm, projection and sentence of `t` from its series.
+/// The slope, scatter, alarm, projection and reason of `t` from its series.
 fn judge(t: &mut IndicatorTrend, ind: &Indicator, opts: &TrendOptions, end_days: f64, floor: f64) {
-    let name = ind.column;
     let window: Vec<&TrendPoint> = t.series.iter().filter(|p| p.in_window).collect();
     if window.len() < opts.min_logs.max(3) {
-        t.sentence = format!(
-            "{name}: {} logs in the last {} days, too few for a trend or a scatter (at least {}){}",
-            window.len(),
-            opts.window_days,
-            opts.min_logs.max(3),
-            stored_values(&window, ind),
-        );
+        t.reason = TrendReason::TooFewLogs {
+            logs: window.len(),
+            needed: opts.min_logs.max(3),
+            window_days: opts.window_days,
+            values: stored_values(&window),
+        };
         return;
     }
     // Days from the window's first point (the slope's scale does not depend on it).
@@ -367,7 +385,7 @@ fn judge(t: &mut IndicatorTrend, ind: &Indicator, opts: &TrendOptions, end_days:
     let x: Vec<f64> = window.iter().map(|p| p.t_days - t0).collect();
     let y: Vec<f64> = window.iter().map(|p| p.normalised).collect();
     let Some(line) = theil_sen(&x, &y, opts.confidence) else {
-        t.sentence = format!("{name}: all logs at one time, no slope");
+        t.reason = TrendReason::OneTime;
         return;
     };
     let resid: Vec<f64> = x
@@ -398,12 +416,24 @@ fn judge(t: &mut IndicatorTrend, ind: &Indicator, opts: &TrendOptions, end_days:
     t.scatter = Some(scatter);
     t.moves_scatters = Some(moves);
     t.last = Some(last);
+    t.span_days = Some(span);
     project(t, &line, (&x, &y), end_days - t0, opts);
     // With a FAULT level, a slope that would take longer than the horizon to reach it is
     // not worth a visit, however significant.
     let soon = t.fault_level.is_none() || t.days_to_fault.is_some_and(|d| d <= opts.horizon_days);
     t.alarm = ind.alarms && significant && big && soon;
-    t.sentence = sentence(t, ind, &line, span);
+    t.reason = if t.alarm {
+        TrendReason::Slope {
+            days_to_fault: t.days_to_fault,
+            days_to_fault_recent: t.days_to_fault_recent,
+        }
+    } else if !ind.alarms {
+        TrendReason::ShownOnly
+    } else {
+        TrendReason::NoAlarm {
+            days_to_fault: t.days_to_fault,
+        }
+    };
 }
 
 /// The days to the FAULT level of `t` on the window's `line` and on its second half's
@@ -428,23 +458,18 @@ fn project(
         .filter(within);
 }
 
-/// "; the stored values 0.0001 to 0.026 pu (first 0.0001, last 0.026)", in the shown unit:
-/// what there is where there is no trend.
-fn stored_values(window: &[&TrendPoint], ind: &Indicator) -> String {
-    let v: Vec<f64> = window.iter().map(|p| p.value * ind.scale).collect();
-    let (Some(first), Some(last)) = (v.first(), v.last()) else {
-        return String::new();
-    };
-    let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    format!(
-        "; the stored values {} to {} {} (first {}, last {})",
-        sig3(lo),
-        sig3(hi),
-        ind.shown_unit,
-        sig3(*first),
-        sig3(*last)
-    )
+/// The stored values of the window's points (none without a point): what there is where
+/// there is no trend.
+fn stored_values(window: &[&TrendPoint]) -> Option<ValueRange> {
+    let first = window.first()?.value;
+    let last = window.last()?.value;
+    let v = window.iter().map(|p| p.value);
+    Some(ValueRange {
+        low: v.clone().fold(f64::INFINITY, f64::min),
+        high: v.fold(f64::NEG_INFINITY, f64::max),
+        first,
+        last,
+    })
 }
 
 /// [`IndicatorTrend::days_to_fault_recent`]: the days to `level` on the Theil-Sen line of
@@ -479,68 +504,6 @@ fn days_to(level: f64, last: f64, slope: f64, low: f64) -> Option<f64> {
     }
     let d = (level - last) / slope;
     (d.is_finite() && slope > 0.0 && low > 0.0).then_some(d)
-}
-
-/// "i2_over_i1 rising 0.36 % of I1/week (0.14 to 0.68), 3.3 scatters over 14 days: TREND
-/// ALARM, FAULT level in about 38 days", in the indicator's shown unit.
-fn sentence(
-    t: &IndicatorTrend,
-    ind: &Indicator,
-    line: &super::stats::SenLine,
-    span: f64,
-) -> String {
-    let week = |v: f64| 7.0 * v * ind.scale;
-    let dir = if line.slope >= 0.0 {
-        "rising"
-    } else {
-        "falling"
-    };
-    let mut s = format!(
-        "{} {dir} {} {}/week ({} to {}), {:.1} scatters over {span:.0} days",
-        ind.column,
-        sig3(week(line.slope)),
-        ind.shown_unit,
-        sig3(week(line.low)),
-        sig3(week(line.high)),
-        t.moves_scatters.unwrap_or_default(),
-    );
-    match (t.alarm, t.days_to_fault) {
-        (true, Some(d)) if d < 0.5 => s.push_str(": TREND ALARM, at the FAULT level already"),
-        (true, Some(d)) => {
-            s.push_str(&format!(": TREND ALARM, FAULT level in about {d:.0} days"));
-            s.push_str(&sooner(t.days_to_fault_recent, d, span));
-        }
-        (true, None) => s.push_str(": TREND ALARM"),
-        (false, Some(d)) if d < 365.0 => s.push_str(&format!(
-            ": no alarm (FAULT level in about {d:.0} days at this slope)"
-        )),
-        (false, _) if !ind.alarms => s.push_str(": shown, not alarmed"),
-        (false, _) => s.push_str(": no alarm"),
-    }
-    s
-}
-
-/// " (about 7 at the last 7 days' slope)" where the window's second half projects the FAULT
-/// level well sooner (under 0.8 of) the whole window's `d` days; else nothing.
-fn sooner(recent: Option<f64>, d: f64, span: f64) -> String {
-    match recent {
-        Some(r) if r < 0.8 * d => format!(
-            " (about {:.0} at the last {:.0} days' slope)",
-            r.max(0.0),
-            0.5 * span
-        ),
-        _ => String::new(),
-    }
-}
-
-/// `v` with three significant digits, in plain notation where that is short.
-fn sig3(v: f64) -> String {
-    let a = v.abs();
-    if a == 0.0 || !(1e-3..1e4).contains(&a) {
-        return format!("{v:.2e}");
-    }
-    let decimals = (2 - a.log10().floor() as i32).max(0) as usize;
-    format!("{v:.decimals$}")
 }
 
 /// The UTC day of `t_days` days since 1970-01-01.

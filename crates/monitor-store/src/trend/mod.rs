@@ -1,4 +1,6 @@
-//! The trend of a motor's indicators across its stored logs, and the alarm on it.
+//! The trend of a motor's indicators across its stored logs, and the alarm on it: typed
+//! values and typed reasons ([`TrendReason`], [`Normalisation`], [`ReferenceBasis`]), no
+//! sentence (`monitor_words::trend` spells them).
 //!
 //! Per indicator, over the last [`TrendOptions::window_days`] of the motor's logs:
 //!
@@ -14,12 +16,23 @@
 //! 2. **A robust slope.** Theil-Sen's slope per day with Sen's interval
 //!    ([`stats::theil_sen`]), and the indicator's own scatter, 1.4826 x the median absolute
 //!    deviation of the values about the line ([`stats::mad_sigma`]).
-//! 3. **The alarm.** The interval lies wholly on the indicator's bad side of zero (above it
-//!    for a rising indicator; either side for a two-sided one) *and* the line moves the
-//!    indicator by more than [`TrendOptions::k_scatter`] scatters over the window. Either
-//!    alone is not enough: a significant slope far inside the noise is not worth a visit,
-//!    and one large scatter is not a trend. The alarm is raised when it holds on
-//!    [`TrendOptions::confirm_logs`] logs in a row (each judged on the logs up to it).
+//! 3. **The alarm.** On [`TrendOptions::confirm_logs`] logs in a row (each judged on the
+//!    logs up to it), either of:
+//!    - **the FAULT level**: the log's stored value is at or beyond the indicator's FAULT
+//!      level (the log's own level where the level is a column, as its verdict used it).
+//!      What the logs show raises the alarm whatever the operating-point fit still needs:
+//!      the fit refines the slope, it never silences the logs
+//!      ([`TrendReason::FaultLevelInARow`]); one log at the level alone does not
+//!      ([`TrendReason::FaultLevelNotConfirmed`]);
+//!    - **the slope**: the interval lies wholly on the indicator's bad side of zero (above
+//!      it for a rising indicator; either side for a two-sided one) *and* the line moves
+//!      the indicator by more than [`TrendOptions::k_scatter`] scatters over the window.
+//!      Either alone is not enough: a significant slope far inside the noise is not worth
+//!      a visit, and one large scatter is not a trend ([`TrendReason::Slope`]).
+//!
+//!    An indicator none of the motor's logs measured (a log without voltages has no parity
+//!    residual and no Rs beyond Rr: null in the store) is absent from
+//!    [`MotorTrend::indicators`], not a flat line at zero.
 //! 4. **The alarm holds once raised** (a hysteresis): it stays raised on the later logs,
 //!    whatever their slope, until the indicator is back at the motor's reference: on
 //!    [`TrendOptions::confirm_logs`] logs in a row, the trend as of the log does not alarm,
@@ -76,15 +89,13 @@ pub struct Indicator {
     /// The covariates it is normalised on (store columns): sets in order of preference,
     /// the first one the motor's logs have used.
     pub covariates: &'static [&'static [&'static str]],
-    /// What its alarm means to a planner, added to an alarmed indicator's sentence (empty:
-    /// nothing added).
-    pub alarm_means: &'static str,
     /// The least scatter it is judged with [unit]: what one log can resolve at best, so
     /// that a line moving by a few hundredths of a per cent on clean simulated data is not
     /// a trend (0 where the scatter itself is the floor).
     pub min_scatter: f64,
-    /// The store column holding its FAULT level per log (its median over the reference
-    /// logs is used), or a fixed level, or none.
+    /// The store column holding its FAULT level per log (each log is at the FAULT level
+    /// against its own; the trend's line against their median over the motor's logs), or a
+    /// fixed level, or none.
     pub fault_level: FaultLevel,
 }
 
@@ -93,7 +104,8 @@ pub struct Indicator {
 pub enum FaultLevel {
     /// No level: the trend alarms, nothing is projected.
     None,
-    /// A store column's value per log (the median over the motor's logs).
+    /// A store column's value per log (a log against its own, the line against the median
+    /// over the motor's logs).
     Column(&'static str),
     /// A fixed level in the indicator's unit.
     Fixed(f64),
@@ -120,7 +132,6 @@ const fn residual(column: &'static str, label: &'static str) -> Indicator {
         direction: Direction::Either,
         alarms: true,
         covariates: &[&[LOAD, TEMPERATURE], &[LOAD, RISE]],
-        alarm_means: "",
         min_scatter: 0.0,
         fault_level: FaultLevel::None,
     }
@@ -157,7 +168,6 @@ pub const INDICATORS: [Indicator; 6] = [
         direction: Direction::Rising,
         alarms: true,
         covariates: &[&[LOAD]],
-        alarm_means: "a short between turns growing in one phase",
         min_scatter: 0.0,
         fault_level: FaultLevel::Column("i2_least_change"),
     },
@@ -173,7 +183,6 @@ pub const INDICATORS: [Indicator; 6] = [
         direction: Direction::Rising,
         alarms: true,
         covariates: &[&[LOAD]],
-        alarm_means: "rotor bars cracking or breaking",
         min_scatter: 0.0,
         fault_level: FaultLevel::Fixed(-50.0),
     },
@@ -186,7 +195,6 @@ pub const INDICATORS: [Indicator; 6] = [
         direction: Direction::Rising,
         alarms: true,
         covariates: &[&[LOAD]],
-        alarm_means: "Rs beyond Rr: the stator circuit's resistance rises and the rotor's does not, so not heating (a warm winding raises both together): a loosening connection, or, with |I2w|/|I1| rising too, turns shorting in one phase",
         min_scatter: STATOR_EXCESS_MIN_SCATTER_PCT,
         fault_level: FaultLevel::Fixed(STATOR_EXCESS_FAULT_PCT),
     },
@@ -295,8 +303,13 @@ pub struct IndicatorTrend {
     /// The day of the log on which the alarm now raised was raised (it holds until the
     /// indicator is back at the reference; the module's documentation, item 4).
     pub alarm_since: Option<String>,
-    /// How the indicator was normalised for the operating point, and why not where not.
-    pub normalisation: String,
+    /// The days the window's line spans, from its first log to its last (null without a
+    /// line).
+    pub span_days: Option<f64>,
+    /// How the indicator was normalised for the operating point, and why not where not
+    /// (JSON `normalisation_reason`; its words, `normalisation`, are the front end's).
+    #[serde(rename = "normalisation_reason")]
+    pub normalisation: Normalisation,
     /// Whether the operating-point fit was made (else `normalised` is the stored value).
     pub operating_point_fitted: bool,
     /// The reference's centre: the median of the reference logs' normalised values [unit].
@@ -306,8 +319,12 @@ pub struct IndicatorTrend {
     pub reference_scatter: Option<f64>,
     /// The line at the last log from the reference's centre, in reference scatters (signed).
     pub from_reference_scatters: Option<f64>,
-    /// One sentence: "i2_over_i1 rising 0.21 %/week (0.15-0.30), FAULT level in about 9 days".
-    pub sentence: String,
+    /// Why it alarms or does not, with the numbers that decided (its words, the JSON's
+    /// `sentence`, are the front end's: `monitor_words::trend`).
+    pub reason: TrendReason,
+    /// The logs in a row, ending at the last log with a value, whose stored value is at the
+    /// indicator's FAULT level (0 without a level).
+    pub fault_level_logs: usize,
     /// The motor's points, the window's marked.
     pub series: Vec<TrendPoint>,
 }
@@ -333,7 +350,7 @@ pub struct MotorTrend {
     pub fastest_scatters: f64,
     /// The logs the indicators are judged against.
     pub reference: TrendReference,
-    /// Per indicator.
+    /// Per indicator the motor's logs measured (one none of them measured is absent).
     pub indicators: Vec<IndicatorTrend>,
 }
 
@@ -348,12 +365,17 @@ pub struct TrendReference {
     pub last_day: Option<String>,
     /// Whether the user marked it ([`TrendOptions::reference_until_s`]).
     pub marked: bool,
-    /// Which logs, in words ("the first 14 days of logs whose verdict is not FAULT").
-    pub how: String,
+    /// Which logs (its words, the JSON's `how`, are the front end's).
+    pub basis: ReferenceBasis,
+    /// The day the user marked where no log lies up to it (the reference is then the
+    /// default one, `basis`).
+    pub mark_without_logs: Option<String>,
 }
 
 mod analyse;
+mod reason;
 mod reference;
 
 pub use analyse::{day_of, fit_logs, indicator_trend, motor_trend, trend};
+pub use reason::{CovariateRange, Normalisation, ReferenceBasis, TrendReason, ValueRange};
 pub use reference::reference_rows;

@@ -2,8 +2,12 @@
 //! normalisation did and why, and the alarm's hysteresis: raised on the trend, held until
 //! the indicator is back at the reference (the module's documentation, items 4 and 5).
 
+use super::analyse::fault_level_run;
 use super::stats::{mad_sigma, median};
-use super::{Indicator, IndicatorTrend, TrendOptions, TrendPoint, TrendReference};
+use super::{
+    CovariateRange, Indicator, IndicatorTrend, Normalisation, ReferenceBasis, TrendOptions,
+    TrendPoint, TrendReason, TrendReference,
+};
 use crate::row::{utc_day, StoredRow};
 
 /// Seconds per day.
@@ -14,24 +18,24 @@ const DAY_S: f64 = 86_400.0;
 /// user marked them healthy); else the logs of the motor's first
 /// [`TrendOptions::window_days`] whose stored verdict is not `fault`, or its first
 /// [`TrendOptions::min_logs`] such logs where the first days hold fewer; where every log's
-/// verdict is `fault`, its first days' logs whatever their verdict (and `how` says so).
+/// verdict is `fault`, its first days' logs whatever their verdict (and [`TrendReference::basis`] says so).
 pub fn reference_rows(rows: &[&StoredRow], opts: &TrendOptions) -> (Vec<bool>, TrendReference) {
     let time = |r: &StoredRow| r.f64("log_time_s").unwrap_or_default();
     let healthy = |r: &StoredRow| r.str("verdict") != Some("fault");
     let marked = opts.reference_until_s.map(|u| u as f64);
-    let (mask, how, is_marked) = match marked {
+    let marked_day = |u: f64| utc_day(u as i64 - 1);
+    let (mask, basis, is_marked, mark_without_logs) = match marked {
         Some(u) if rows.iter().any(|r| time(r) < u) => (
             rows.iter().map(|r| time(r) < u).collect::<Vec<bool>>(),
-            format!("the logs up to {} (marked)", utc_day(u as i64 - 1)),
+            ReferenceBasis::Marked {
+                until_day: marked_day(u),
+            },
             true,
+            None,
         ),
         _ => {
-            let (mask, how) = first_healthy(rows, opts, &time, &healthy);
-            let how = match marked {
-                Some(u) => format!("no log up to the marked {}: {how}", utc_day(u as i64 - 1)),
-                None => how,
-            };
-            (mask, how, false)
+            let (mask, basis) = first_healthy(rows, opts, &time, &healthy);
+            (mask, basis, false, marked.map(marked_day))
         }
     };
     let picked: Vec<&&StoredRow> = rows
@@ -46,7 +50,8 @@ pub fn reference_rows(rows: &[&StoredRow], opts: &TrendOptions) -> (Vec<bool>, T
         first_day: day(picked.first()),
         last_day: day(picked.last()),
         marked: is_marked,
-        how,
+        basis,
+        mark_without_logs,
     };
     (mask, reference)
 }
@@ -58,16 +63,13 @@ fn first_healthy(
     opts: &TrendOptions,
     time: &dyn Fn(&StoredRow) -> f64,
     healthy: &dyn Fn(&StoredRow) -> bool,
-) -> (Vec<bool>, String) {
+) -> (Vec<bool>, ReferenceBasis) {
     let t0 = rows.first().map_or(0.0, |r| time(r));
     let early = |r: &StoredRow| time(r) < t0 + opts.window_days * DAY_S;
     let days = opts.window_days;
     let mut mask: Vec<bool> = rows.iter().map(|r| early(r) && healthy(r)).collect();
     if mask.iter().filter(|m| **m).count() >= opts.min_logs {
-        return (
-            mask,
-            format!("the motor's first {days} days of logs whose verdict is not FAULT"),
-        );
+        return (mask, ReferenceBasis::FirstHealthyDays { days });
     }
     let mut taken = 0;
     for (m, r) in mask.iter_mut().zip(rows) {
@@ -77,15 +79,14 @@ fn first_healthy(
     if taken > 0 {
         return (
             mask,
-            format!(
-                "the motor's first {} logs whose verdict is not FAULT",
-                opts.min_logs
-            ),
+            ReferenceBasis::FirstHealthyLogs {
+                logs: opts.min_logs,
+            },
         );
     }
     (
         rows.iter().map(|r| early(r)).collect(),
-        format!("the motor's first {days} days of logs (every log's verdict is FAULT)"),
+        ReferenceBasis::FirstDaysAllFault { days },
     )
 }
 
@@ -111,112 +112,97 @@ pub(super) fn reference_stats(
     (median(&mut v), scatter)
 }
 
-/// A covariate's name and unit in the report's words.
-fn covariate_words(c: &str) -> (&'static str, &'static str) {
-    match c {
-        "i1_peak_a" => ("the load (I1)", "A"),
-        "winding_temperature_c" => ("the windings' temperature", "°C"),
-        "winding_rise_k" => ("the windings' rise", "K"),
-        _ => ("a covariate", ""),
-    }
-}
-
 /// A spread negligible against the covariate's size: below 0.1 % of its largest value
 /// (and below 1e-9 in absolute terms for a covariate about zero).
 fn negligible(lo: f64, hi: f64) -> bool {
     hi - lo <= 1e-3 * lo.abs().max(hi.abs()).max(1e-6)
 }
 
-/// What the report says of the operating-point normalisation of `ind` on `covs` over
-/// `rows`, `fitted` or not: the fit made, or the actual reason it was not (too few logs
-/// with the covariates, N of M needed; a covariate that does not vary; covariates that
-/// cannot be told apart), with each covariate's range where it is not taken out. Also the
-/// logs the fit could use, and how many it needs.
+/// The operating-point normalisation of `ind` on `covs` over `rows`, `fitted` or not: the
+/// fit made, or the actual reason it was not (too few logs with the covariates, N of M
+/// needed; a covariate that does not vary; covariates that cannot be told apart), with
+/// each covariate's range where it is not taken out. Also the logs the fit could use.
 pub(super) fn normalisation_note(
     ind: &Indicator,
     covs: &[&str],
     rows: &[&StoredRow],
     fitted: bool,
     needed: usize,
-) -> (String, usize) {
-    let usable: Vec<&&StoredRow> = rows
+) -> (Normalisation, usize) {
+    let n = rows
         .iter()
         .filter(|r| r.f64(ind.column).is_some() && covs.iter().all(|c| r.f64(c).is_some()))
-        .collect();
-    let n = usable.len();
+        .count();
+    let covariates = || covs.iter().map(|c| c.to_string()).collect();
     if fitted {
-        let text = format!(
-            "brought to the median {} (least squares, second order in them, with time, over the motor's {n} logs)",
-            covs.join(" and ")
-        );
-        return (text, n);
-    }
-    if covs.is_empty() {
+        let covariates = covariates();
         return (
-            "raw values (the indicator has no covariates)".to_string(),
+            Normalisation::Fitted {
+                covariates,
+                logs: n,
+            },
             n,
         );
     }
-    let (not_out, flat) = covariate_ranges(covs, rows);
-    if n < needed {
-        let lacking = rows.len().saturating_sub(n);
-        let lack = if lacking > 0 {
-            format!(
-                ", {lacking} of the {} logs lack a covariate or the value",
-                rows.len()
-            )
-        } else {
-            String::new()
-        };
-        let text = format!(
-            "not yet: raw values, too few logs for the operating-point fit ({n} of the {needed} needed{lack}){not_out}; no alarm until then"
-        );
-        return (text, n);
+    if covs.is_empty() {
+        return (Normalisation::NoCovariates, n);
     }
-    let text = if flat.is_empty() {
-        format!("raw values: the fit on {} could not be made over {n} logs (they move together){not_out}", covs.join(" and "))
+    let (moved, flat) = covariate_ranges(covs, rows);
+    let note = if n < needed {
+        Normalisation::TooFewLogs {
+            logs: n,
+            needed,
+            lacking: rows.len().saturating_sub(n),
+            total: rows.len(),
+            moved,
+        }
+    } else if flat.is_empty() {
+        Normalisation::Collinear {
+            covariates: covariates(),
+            logs: n,
+            moved,
+        }
     } else {
-        format!(
-            "raw values: the operating point does not vary ({}){not_out}",
-            flat.join(", ")
-        )
+        Normalisation::Flat { flat, moved }
     };
-    (text, n)
+    (note, n)
 }
 
-/// The covariates' ranges over `rows` in the report's words: "; the load (I1) varied
-/// 6.400-7.600 A (i1_peak_a) and is not taken out" for those that moved, and "the load
-/// (I1) (i1_peak_a) stays at 7.000 A" for each whose spread is negligible.
-fn covariate_ranges(covs: &[&str], rows: &[&StoredRow]) -> (String, Vec<String>) {
+/// The covariates' ranges over `rows`: those that moved, and those whose spread is
+/// negligible.
+fn covariate_ranges(
+    covs: &[&str],
+    rows: &[&StoredRow],
+) -> (Vec<CovariateRange>, Vec<CovariateRange>) {
     let (mut moved, mut flat) = (Vec::new(), Vec::new());
     for c in covs {
         let v: Vec<f64> = rows.iter().filter_map(|r| r.f64(c)).collect();
-        let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        if !lo.is_finite() {
+        let low = v.iter().copied().fold(f64::INFINITY, f64::min);
+        let high = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        if !low.is_finite() {
             continue;
         }
-        let (name, unit) = covariate_words(c);
-        if negligible(lo, hi) {
-            flat.push(format!("{name} ({c}) stays at {lo:.3} {unit}"));
+        let range = CovariateRange {
+            column: c.to_string(),
+            low,
+            high,
+        };
+        if negligible(low, high) {
+            flat.push(range);
         } else {
-            moved.push(format!("{name} varied {lo:.3}-{hi:.3} {unit} ({c})"));
+            moved.push(range);
         }
     }
-    let not_out = match moved.len() {
-        0 => String::new(),
-        1 => format!("; {} and is not taken out", moved.join("")),
-        _ => format!("; {} and are not taken out", moved.join(", ")),
-    };
-    (not_out, flat)
+    (moved, flat)
 }
 
 /// The state of one log in the alarm's history: the trend as of it (on the logs up to it)
-/// alarms, or it is back at the reference (no alarm, and the line at it and its value
-/// within [`TrendOptions::k_scatter`] reference scatters of the reference's centre).
+/// alarms or the log is at the FAULT level, or it is back at the reference (neither, and
+/// the line at it and its value within [`TrendOptions::k_scatter`] reference scatters of
+/// the reference's centre).
 #[derive(Clone, Copy)]
 struct LogState {
-    /// The trend as of the log alarms.
+    /// The trend as of the log alarms, or the log's value is at the FAULT level.
     alarm: bool,
     /// The indicator is back at the reference at the log.
     back: bool,
@@ -229,32 +215,42 @@ fn state_of(t: &IndicatorTrend, opts: &TrendOptions) -> LogState {
         (Some(p), Some(c), Some(s)) => Some((p.normalised - c) / s),
         _ => None,
     };
+    let alarm = t.alarm || t.fault_level_logs > 0;
     LogState {
-        alarm: t.alarm,
-        back: !t.alarm && within(t.from_reference_scatters) && within(value),
+        alarm,
+        back: !alarm && within(t.from_reference_scatters) && within(value),
     }
 }
 
-/// `t` (the trend as of the last of `rows`) with the alarm's hysteresis applied: raised
-/// where the trends as of the last [`TrendOptions::confirm_logs`] logs all alarm, and held
-/// from the log it was raised on until the indicator is back at the reference on
-/// `confirm_logs` logs in a row. The history is walked back from the last log, each log
-/// judged on the logs up to it by `judge`, until a clearing run or the first log.
+/// `t` (the trend of `ind` as of the last of `rows`) with the alarm's hysteresis applied:
+/// raised where the last [`TrendOptions::confirm_logs`] logs all alarm (the trend as of
+/// each, or its value at the FAULT level), and held from the log it was raised on until the
+/// indicator is back at the reference on `confirm_logs` logs in a row. The history is
+/// walked back from the last log, each log judged on the logs up to it by `judge`, until
+/// a clearing run or the first log. The reason: the FAULT level on the last logs in a row
+/// first (what the logs show, whatever the operating-point fit needs), then the slope,
+/// then the alarm held.
 pub(super) fn latched(
     mut t: IndicatorTrend,
+    ind: &Indicator,
     rows: &[&StoredRow],
     opts: &TrendOptions,
     judge: &dyn Fn(&[&StoredRow]) -> IndicatorTrend,
 ) -> IndicatorTrend {
     let c = opts.confirm_logs.max(1);
+    let run = fault_level_run(ind, rows);
     let since = raised_at(rows, opts, state_of(&t, opts), judge);
     let Some(since) = since else {
         if t.alarm {
             t.alarm = false;
-            t.sentence = t.sentence.replace(
-                ": TREND ALARM",
-                &format!(": alarm not yet confirmed ({c} logs in a row needed)"),
-            );
+            t.reason = TrendReason::NotConfirmed { confirm_logs: c };
+        } else if let Some(r) = run {
+            t.reason = TrendReason::FaultLevelNotConfirmed {
+                logs: r.logs,
+                confirm_logs: c,
+                value: r.value,
+                level: r.level,
+            };
         }
         return t;
     };
@@ -263,23 +259,26 @@ pub(super) fn latched(
         .and_then(|r| r.str("day"))
         .unwrap_or_default()
         .to_string();
-    if !t.alarm {
-        t.alarm = true;
-        let head = t
-            .sentence
-            .split(": ")
-            .next()
-            .unwrap_or_default()
-            .to_string();
-        let now = t.from_reference_scatters.map_or(String::new(), |x| {
-            format!(", the line {x:+.1} reference scatters from the reference")
-        });
-        t.sentence = format!(
-            "{head}: TREND ALARM held, raised on {day}{now}; it clears when back within {} \
-             reference scatters on {c} logs in a row",
-            opts.k_scatter
-        );
+    match run.filter(|r| r.logs >= c) {
+        Some(r) => {
+            t.reason = TrendReason::FaultLevelInARow {
+                logs: r.logs,
+                first_day: r.first_day,
+                value: r.value,
+                level: r.level,
+            };
+        }
+        None if !t.alarm => {
+            t.reason = TrendReason::Held {
+                since: day.clone(),
+                from_reference_scatters: t.from_reference_scatters,
+                k_scatter: opts.k_scatter,
+                confirm_logs: c,
+            };
+        }
+        None => {}
     }
+    t.alarm = true;
     t.alarm_since = Some(day);
     t
 }

@@ -12,6 +12,9 @@
 //!   stored values (in pu, without bands) and its title says so; where an indicator has no
 //!   operating-point fit, its values are the stored ones, and the title says that too.
 //!
+//! - An indicator none of the shown motors' logs measured (the residuals and Rs beyond Rr
+//!   of logs without voltages) has no panel: it is absent, not a flat line at zero.
+//!
 //! At most [`MAX_MOTORS`] motors are drawn: the first of the ranking (alarmed first).
 
 use monitor_store::trend::{IndicatorTrend, MotorTrend, TrendOptions};
@@ -28,8 +31,11 @@ const OK: RGBColor = RGBColor(220, 242, 220);
 const WATCH: RGBColor = RGBColor(253, 238, 200);
 const FAULT: RGBColor = RGBColor(250, 215, 215);
 
+/// One panel: indicator column, title, and whether it is drawn in scatters.
+pub type TrendPanel = (&'static str, &'static str, bool);
+
 /// The panels: indicator column, title, and whether it is drawn in scatters.
-const PANELS: [(&str, &str, bool); 5] = [
+const PANELS: [TrendPanel; 5] = [
     (
         "i2_over_i1",
         "|I2w|/|I1| [% of I1] (a short grows it)",
@@ -122,13 +128,30 @@ pub fn panel_mode(
     (in_scatters, title)
 }
 
+/// The panels of the indicators some of `motors` has (an indicator no log measured is left
+/// out of the motor's trend); the first panel where none has any.
+pub fn panels_of(motors: &[&MotorTrend]) -> Vec<TrendPanel> {
+    let has = |column: &str| {
+        motors
+            .iter()
+            .any(|m| m.indicators.iter().any(|t| t.indicator == column))
+    };
+    let panels: Vec<TrendPanel> = PANELS.iter().copied().filter(|p| has(p.0)).collect();
+    if panels.is_empty() {
+        PANELS.iter().take(1).copied().collect()
+    } else {
+        panels
+    }
+}
+
 /// Draws the plot into `path` (`.svg` or `.png`, by its extension).
 ///
 /// # Errors
 /// A drawing or writing error, as one line.
 pub fn write(path: &Path, motors: &[MotorTrend], opts: &TrendOptions) -> Result<(), String> {
     let shown: Vec<&MotorTrend> = motors.iter().take(MAX_MOTORS).collect();
-    let size = (900u32, 260u32 * PANELS.len() as u32);
+    let panels = panels_of(&shown);
+    let size = (900u32, 260u32 * panels.len() as u32);
     let png = path.extension().and_then(|e| e.to_str()) == Some("png");
     if png {
         let dir = path
@@ -148,7 +171,7 @@ pub fn write(path: &Path, motors: &[MotorTrend], opts: &TrendOptions) -> Result<
             .map_err(|e| format!("{}: {e}", dir.display()))?;
         {
             let root = BitMapBackend::new(tmp.path(), size).into_drawing_area();
-            draw(root, &shown, opts)?;
+            draw(root, &shown, &panels, opts)?;
         }
         tmp.persist(path).map_err(|e| e.error.to_string())?;
         return Ok(());
@@ -156,7 +179,7 @@ pub fn write(path: &Path, motors: &[MotorTrend], opts: &TrendOptions) -> Result<
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-        draw(root, &shown, opts)?;
+        draw(root, &shown, &panels, opts)?;
     }
     monitor_api::files::write_atomic(path, svg.as_bytes()).map_err(|e| e.to_string())
 }
@@ -164,6 +187,7 @@ pub fn write(path: &Path, motors: &[MotorTrend], opts: &TrendOptions) -> Result<
 fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     motors: &[&MotorTrend],
+    panels: &[TrendPanel],
     opts: &TrendOptions,
 ) -> Result<(), String>
 where
@@ -178,9 +202,10 @@ where
         .filter_map(|t| t.series.first().map(|p| p.t_days.floor()))
         .fold(f64::INFINITY, f64::min);
     let t0 = if t0.is_finite() { t0 } else { 0.0 };
-    let panels = root.split_evenly((PANELS.len(), 1));
-    for (k, (panel, area)) in PANELS.iter().zip(&panels).enumerate() {
-        draw_panel(area, motors, opts, panel, k, t0)?;
+    let areas = root.split_evenly((panels.len(), 1));
+    for (k, (panel, area)) in panels.iter().zip(&areas).enumerate() {
+        let last = k + 1 == panels.len();
+        draw_panel(area, motors, opts, panel, (k, last), t0)?;
     }
     root.present().map_err(e)?;
     Ok(())
@@ -242,8 +267,8 @@ fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     motors: &[&MotorTrend],
     opts: &TrendOptions,
-    &(column, title, in_scatters): &(&str, &str, bool),
-    k: usize,
+    &(column, title, in_scatters): &TrendPanel,
+    (k, last): (usize, bool),
     t0: f64,
 ) -> Result<(), String>
 where
@@ -287,7 +312,7 @@ where
     chart.draw_series(bands).map_err(e)?;
     chart
         .configure_mesh()
-        .x_desc(if k + 1 == PANELS.len() { "day" } else { "" })
+        .x_desc(if last { "day" } else { "" })
         .light_line_style(WHITE.mix(0.0))
         .draw()
         .map_err(e)?;

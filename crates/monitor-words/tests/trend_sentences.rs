@@ -5,6 +5,7 @@
 
 use monitor_store::trend::{self, fit_logs, TrendOptions, INDICATORS};
 use monitor_store::{LogIdentity, StoredRow};
+use monitor_words::trend::sentence;
 
 /// Day `day`'s log of a motor whose negative sequence grows 1 % of I1 a day while its load
 /// moves (I1 between 9 and 11 A).
@@ -30,13 +31,9 @@ fn row(day: i64) -> StoredRow {
 
 fn consistent(t: &trend::MotorTrend) {
     for i in &t.indicators {
-        assert_eq!(
-            i.sentence.contains("TREND ALARM"),
-            i.alarm,
-            "{}: {}",
-            i.indicator,
-            i.sentence
-        );
+        let s = sentence(i);
+        assert_eq!(s.contains("TREND ALARM"), i.alarm, "{}: {s}", i.indicator);
+        assert_eq!(i.reason.alarms(), i.alarm, "{}: {s}", i.indicator);
     }
     assert_eq!(t.alarm, t.indicators.iter().any(|i| i.alarm));
 }
@@ -54,12 +51,12 @@ fn a_steep_rise_on_too_few_logs_is_reported_as_no_alarm_yet_and_alarmed_once_the
     let refs: Vec<&StoredRow> = few.iter().collect();
     let t = trend::motor_trend("m1", &refs, &opts);
     consistent(&t);
-    let s = &t
-        .indicators
-        .iter()
-        .find(|i| i.indicator == "i2_over_i1")
-        .expect("trended")
-        .sentence;
+    let s = &sentence(
+        t.indicators
+            .iter()
+            .find(|i| i.indicator == "i2_over_i1")
+            .expect("trended"),
+    );
     assert!(!t.alarm, "{s}");
     assert!(s.contains("no alarm yet"), "{s}");
 
@@ -72,7 +69,7 @@ fn a_steep_rise_on_too_few_logs_is_reported_as_no_alarm_yet_and_alarmed_once_the
             .iter()
             .any(|i| i.indicator == "i2_over_i1" && i.alarm),
         "{:#?}",
-        t.indicators.iter().map(|i| &i.sentence).collect::<Vec<_>>()
+        t.indicators.iter().map(sentence).collect::<Vec<_>>()
     );
 }
 
