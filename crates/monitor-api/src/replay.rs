@@ -4,7 +4,7 @@
 //! words a front end spells fields in ([`Spelling`], [`Words`]) and the step-by-step
 //! [`Replay`] the HMI watches. This list is what a front end may use.
 
-pub use monitor_replay::verdict::against_text;
+pub use monitor_replay::verdict::{against_text, fault_text, why_watched};
 pub use monitor_replay::{
     angle_source_name, describe_against, diagnose_file, diagnose_file_observed, state_name,
     Against, CommissionWindow, CommissioningOutcome, CommissioningReport, DetectionLimit,

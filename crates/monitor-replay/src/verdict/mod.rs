@@ -20,7 +20,7 @@
 pub(super) mod findings;
 pub(super) mod measured;
 mod words;
-pub use words::{against_text, fault_text, pct};
+pub use words::{against_text, fault_text, pct, why_watched};
 
 use monitor_core::verdict::{decide, Finding, NamedFault, Size, State};
 pub use monitor_core::verdict::{Against, FindingSource, Rule, Verdict};
