@@ -264,6 +264,7 @@ fn time_chart(
         series,
         log_y: false,
         omitted,
+        x_names: Vec::new(),
     }
 }
 
@@ -411,6 +412,7 @@ fn rotor_chart(rep: &DiagnoseReport) -> Chart<'static> {
         series,
         log_y: false,
         omitted,
+        x_names: Vec::new(),
     }
 }
 
