@@ -24,7 +24,12 @@ Errors
     dict, a fleet's motor table), :class:`LogError`, :class:`OptionError`,
     :class:`AnalysisError` (and :class:`InternalError` for a bug), each carrying the
     command line's one-line message; the class is the library error's kind, never read
-    from the message. No Rust panic crosses into Python.
+    from the message. As Python's convention asks (numpy and pandas follow it), a bad value
+    is also a ``ValueError`` and a value of the wrong type a ``TypeError``
+    (:class:`OptionTypeError`, :class:`ParamsTypeError`, :class:`LogTypeError`:
+    ``parallel_paths=2.5``, ``from_s="1.5"``), so ``except ValueError`` and ``except
+    TypeError`` catch them; a bug is also a ``RuntimeError``. No Rust panic crosses into
+    Python.
     The GIL is released while the library runs, so threads (and Dask) run in parallel.
 
 The fleet run over many motors' logs on Dask is :func:`drive_monitor.fleet.diagnose_many`;
@@ -39,6 +44,7 @@ from __future__ import annotations
 import ast as _ast
 import inspect as _inspect
 import json as _json
+import numbers as _numbers
 import os as _os
 import tempfile as _tempfile
 import textwrap as _textwrap
@@ -54,13 +60,16 @@ from typing import Tuple as _Tuple
 from typing import Union as _Union
 
 from . import _native
-from ._native import (
+from ._errors import (
     AnalysisError,
     DriveMonitorError,
     InternalError,
     LogError,
+    LogTypeError,
     OptionError,
+    OptionTypeError,
     ParamsError,
+    ParamsTypeError,
 )
 from .history import Trend, trend
 from ._results import (
@@ -95,8 +104,11 @@ __all__ = [
     "NameplateResult",
     "DriveMonitorError",
     "ParamsError",
+    "ParamsTypeError",
     "LogError",
+    "LogTypeError",
     "OptionError",
+    "OptionTypeError",
     "AnalysisError",
     "InternalError",
     "PathLike",
@@ -128,7 +140,7 @@ def _toml_value(v: _Any) -> str:
         return "{ " + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + " }"
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_toml_value(x) for x in v) + "]"
-    raise ParamsError(f"the parameter dict: value {v!r} is not a number, text, table or list")
+    raise ParamsTypeError(f"the parameter dict: value {v!r} is not a number, text, table or list")
 
 
 def _params_toml(params: _Dict[str, _Any]) -> str:
@@ -136,7 +148,7 @@ def _params_toml(params: _Dict[str, _Any]) -> str:
     lines: _List[str] = []
     for section, table in params.items():
         if not isinstance(table, dict):
-            raise ParamsError(
+            raise ParamsTypeError(
                 f"the parameter dict: section {section!r} is {table!r}, not a table of keys "
                 f"(e.g. {{{section!r}: {{...}}}})"
             )
@@ -150,7 +162,44 @@ def _params(params: ParamsLike) -> _Tuple[str, bool]:
     """(path or TOML text, is_text) for the native functions."""
     if isinstance(params, dict):
         return _params_toml(params), True
+    if not isinstance(params, (str, _os.PathLike)):
+        raise ParamsTypeError(
+            f"params: a path (str or os.PathLike) or a dict of sections, not {_a_type(params)}"
+        )
     return _os.fspath(params), False
+
+
+def _a_type(v: _Any) -> str:
+    """The type of ``v`` as a message names it, with its article (``a float``, ``an int``),
+    as the extension's messages do."""
+    name = type(v).__name__
+    return f"{'an' if name[:1] in 'aeiou' else 'a'} {name}"
+
+
+def _number(name: str, v: _Any) -> _Optional[float]:
+    """A keyword that takes a number (an int or a float, numpy's too) as a float; ``None``
+    as ``None``. A bool, a str or anything else is refused as the extension refuses
+    ``diagnose``'s options: an :class:`OptionTypeError` naming the keyword, the type given
+    and the one expected, never parsed from text."""
+    if v is None:
+        return None
+    if isinstance(v, bool) or not isinstance(v, _numbers.Real):
+        raise OptionTypeError(f"{name} = {v!r}: {_a_type(v)}, not a number (an int or a float)")
+    return float(v)
+
+
+def _count(name: str, v: _Any) -> _Optional[int]:
+    """A keyword that takes a whole number (an int, numpy's too; never a bool or a float) of
+    0 to 4294967295 (the library's ``u32``); ``None`` as ``None``. The wrong type is an
+    :class:`OptionTypeError`, a number out of the range an :class:`OptionError` (a
+    ``ValueError``), each naming the keyword."""
+    if v is None:
+        return None
+    if isinstance(v, bool) or not isinstance(v, _numbers.Integral):
+        raise OptionTypeError(f"{name} = {v!r}: {_a_type(v)}, not an int (a whole number)")
+    if not 0 <= int(v) <= 0xFFFF_FFFF:
+        raise OptionError(f"{name} = {v!r}: not a count (0 to 4294967295)")
+    return int(v)
 
 
 def _log(log: LogLike) -> _Tuple[_Any, _Optional[str]]:
@@ -178,7 +227,7 @@ def _log(log: LogLike) -> _Tuple[_Any, _Optional[str]]:
             raise LogError(f"dict: not a table of columns of one length ({e})") from None
     if hasattr(log, "__arrow_c_stream__"):
         return log, type(log).__name__
-    raise LogError(
+    raise LogTypeError(
         "log: a path, a pandas DataFrame, a pyarrow Table, a dict of arrays or an object with "
         f"__arrow_c_stream__, not {type(log).__name__}"
     )
@@ -217,6 +266,9 @@ def diagnose(
     Raises
     ------
     ParamsError, LogError, OptionError, AnalysisError
+        A bad value (each also a ``ValueError``).
+    OptionTypeError, ParamsTypeError, LogTypeError
+        A value of the wrong type (each also a ``TypeError``): ``parallel_paths=2.5``.
     """
     p, is_text = _params(params)
     base = _items(baseline)
@@ -275,10 +327,14 @@ def _analysis_kwargs(
     no_fit: bool,
     group: _Optional[str],
 ) -> _Dict[str, _Any]:
+    names = _items(effects)
+    for e in names:
+        if not isinstance(e, str):
+            raise OptionTypeError(f"effects = {effects!r}: {_a_type(e)}, not a str: give the effects' names")
     return dict(
-        effects=[str(e) for e in _items(effects)],
-        from_s=None if from_s is None else float(from_s),
-        to_s=None if to_s is None else float(to_s),
+        effects=names,
+        from_s=_number("from_s", from_s),
+        to_s=_number("to_s", to_s),
         no_fit=no_fit,
         group=group,
     )
@@ -343,7 +399,7 @@ def explain(
         p,
         log_origin=origin,
         params_is_text=is_text,
-        rotor_bars=rotor_bars,
+        rotor_bars=_count("rotor_bars", rotor_bars),
         ladder=ladder,
         **_analysis_kwargs(effects, from_s, to_s, no_fit, group),
     )
@@ -377,8 +433,8 @@ def identify(
         p,
         log_origin=origin,
         params_is_text=is_text,
-        from_s=None if from_s is None else float(from_s),
-        to_s=None if to_s is None else float(to_s),
+        from_s=_number("from_s", from_s),
+        to_s=_number("to_s", to_s),
         group=group,
         keep_columns=bool(keep_columns),
     )
@@ -403,16 +459,16 @@ def params_from_nameplate(
     source (``sim-host params from-nameplate``). ``.toml`` is the file's text, ``.params``
     the file as a dict (usable as ``params`` by the other functions)."""
     doc = _native.params_from_nameplate(
-        float(power_kw),
-        float(voltage_v),
-        float(current_a),
-        float(frequency_hz),
-        float(speed_rpm),
-        float(power_factor),
-        float(efficiency),
-        poles=poles,
+        _number("power_kw", power_kw),
+        _number("voltage_v", voltage_v),
+        _number("current_a", current_a),
+        _number("frequency_hz", frequency_hz),
+        _number("speed_rpm", speed_rpm),
+        _number("power_factor", power_factor),
+        _number("efficiency", efficiency),
+        poles=_count("poles", poles),
         connection=connection,
-        locked_rotor_ratio=locked_rotor_ratio,
+        locked_rotor_ratio=_number("locked_rotor_ratio", locked_rotor_ratio),
         nema_design=nema_design,
         columns_from=None if columns_from is None else _os.fspath(columns_from),
     )

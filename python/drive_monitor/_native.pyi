@@ -9,12 +9,17 @@ from typing import Any, List, Optional, Tuple, Union
 #: The library's Cargo version (``drive_monitor.__version__``).
 __version__: str
 
-class DriveMonitorError(Exception): ...
-class ParamsError(DriveMonitorError): ...
-class LogError(DriveMonitorError): ...
-class OptionError(DriveMonitorError): ...
-class AnalysisError(DriveMonitorError): ...
-class InternalError(DriveMonitorError): ...
+# The package's exception classes (defined in _errors.py, raised and exported by the
+# extension).
+from ._errors import AnalysisError as AnalysisError
+from ._errors import DriveMonitorError as DriveMonitorError
+from ._errors import InternalError as InternalError
+from ._errors import LogError as LogError
+from ._errors import LogTypeError as LogTypeError
+from ._errors import OptionError as OptionError
+from ._errors import OptionTypeError as OptionTypeError
+from ._errors import ParamsError as ParamsError
+from ._errors import ParamsTypeError as ParamsTypeError
 
 def diagnose(
     log: Any,

@@ -27,7 +27,7 @@ import warnings as _warnings
 from pathlib import Path as _Path
 
 from . import _native
-from ._native import OptionError, ParamsError
+from ._errors import OptionError, ParamsError, ParamsTypeError
 
 # The module's namespace holds its own names only (``__all__``, the helpers, the errors):
 # the standard library's modules under private names, the typing names for type checkers
@@ -53,7 +53,7 @@ def _toml_value(v: Any) -> str:
         return _json.dumps(_os.fspath(v))
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_toml_value(x) for x in v) + "]"
-    raise ParamsError(f"the motor table (rows): value {v!r} is not a number, text or list")
+    raise ParamsTypeError(f"the motor table (rows): value {v!r} is not a number, text or list")
 
 
 def worker_environ() -> Dict[str, str]:
@@ -114,7 +114,7 @@ def motor_table_toml(motors: Any, base: Optional[Union[str, "_os.PathLike[str]"]
     except ImportError:  # pragma: no cover
         pass
     if not isinstance(motors, (list, tuple)) or not all(isinstance(m, dict) for m in motors):
-        raise ParamsError(
+        raise ParamsTypeError(
             "the motor table: give a TOML file's path, a DataFrame or a list of dicts "
             f"(name, params, logs, ...), not {type(motors).__name__}"
         )

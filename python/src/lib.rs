@@ -6,13 +6,12 @@
 //! key for key.
 //!
 //! The GIL is released while the Rust code runs; a panic never crosses into Python (it is
-//! an `InternalError`); errors are the exception classes below, carrying the command line's
-//! one-line message.
+//! an `InternalError`); errors are the package's exception classes (imported below from
+//! `drive_monitor/_errors.py`: a bad value a `ValueError`, a wrong type a `TypeError`),
+//! carrying the command line's one-line message.
 
 use monitor_api::replay::{Takes, DIAGNOSE_OPTIONS};
 use monitor_api::{self as api, ApiError, ErrorKind, LogSource, ParamsSource};
-use pyo3::create_exception;
-use pyo3::exceptions::PyException;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
@@ -22,42 +21,28 @@ mod fleet;
 mod options;
 mod store;
 
-create_exception!(
-    _native,
-    DriveMonitorError,
-    PyException,
-    "Base of every drive_monitor error."
-);
-create_exception!(
-    _native,
-    ParamsError,
-    DriveMonitorError,
-    "The parameter file cannot be read, or is not one."
-);
-create_exception!(
-    _native,
-    LogError,
-    DriveMonitorError,
-    "The log cannot be read, or is not one."
-);
-create_exception!(
-    _native,
-    OptionError,
-    DriveMonitorError,
-    "An option is wrong (a window, a baseline, a name), or the analysis refused the data."
-);
-create_exception!(
-    _native,
-    AnalysisError,
-    DriveMonitorError,
-    "The analysis could not run on this log."
-);
-create_exception!(
-    _native,
-    InternalError,
-    DriveMonitorError,
-    "A bug: the library panicked (please report it with the call)."
-);
+// The package's exception classes are Python classes (`drive_monitor/_errors.py`), so that
+// each derives from the built-in class Python's convention asks for: a bad value is a
+// `ValueError` (`ParamsError`, `LogError`, `OptionError`, `AnalysisError`), a value of the
+// wrong type a `TypeError` (`OptionTypeError`, a subclass of `OptionError`), a bug a
+// `RuntimeError` (`InternalError`); all derive from `DriveMonitorError`. PyO3's own classes
+// (`create_exception!`) take one base, and these need two.
+pyo3::import_exception!(drive_monitor._errors, DriveMonitorError);
+pyo3::import_exception!(drive_monitor._errors, ParamsError);
+pyo3::import_exception!(drive_monitor._errors, ParamsTypeError);
+pyo3::import_exception!(drive_monitor._errors, LogError);
+pyo3::import_exception!(drive_monitor._errors, LogTypeError);
+pyo3::import_exception!(drive_monitor._errors, OptionError);
+pyo3::import_exception!(drive_monitor._errors, OptionTypeError);
+pyo3::import_exception!(drive_monitor._errors, AnalysisError);
+pyo3::import_exception!(drive_monitor._errors, InternalError);
+
+/// The error `e` (an [`OptionError`] of an option given a value of the wrong type) as an
+/// [`OptionTypeError`] with the same message: `except TypeError` catches it, and `except
+/// OptionError` still does.
+fn wrong_type(py: Python<'_>, e: PyErr) -> PyErr {
+    OptionTypeError::new_err(e.value(py).to_string())
+}
 
 /// Python's spelling of the library's fields: its keyword arguments, as its other messages
 /// name them (`commission = 4:2`, `load = 'heavy'`).
@@ -485,8 +470,11 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("DriveMonitorError", py.get_type::<DriveMonitorError>())?;
     m.add("ParamsError", py.get_type::<ParamsError>())?;
+    m.add("ParamsTypeError", py.get_type::<ParamsTypeError>())?;
     m.add("LogError", py.get_type::<LogError>())?;
+    m.add("LogTypeError", py.get_type::<LogTypeError>())?;
     m.add("OptionError", py.get_type::<OptionError>())?;
+    m.add("OptionTypeError", py.get_type::<OptionTypeError>())?;
     m.add("AnalysisError", py.get_type::<AnalysisError>())?;
     m.add("InternalError", py.get_type::<InternalError>())?;
     m.add_function(wrap_pyfunction!(diagnose, m)?)?;

@@ -2,7 +2,7 @@
 //! library's one description takes ([`DIAGNOSE_OPTIONS`], [`Takes`]): a value of the wrong
 //! type is refused naming the keyword, the type given and the one expected.
 
-use crate::to_py;
+use crate::{to_py, wrong_type};
 use monitor_api::replay::{self, OptionSpec, OptionValue, Takes, DIAGNOSE_OPTIONS};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -26,15 +26,20 @@ fn a_type(v: &Bound<'_, PyAny>) -> String {
 /// A keyword's value as the option of `spec` takes it ([`Takes`]): a window as
 /// `"START:END"` or a pair of numbers, a name (`str`), a number (an `int` or a `float`,
 /// numpy's too), a whole number (an `int`, or any integer with `__index__` but a bool), a
-/// flag (`bool`), or a JSON file as its path or its dict (read here). Anything else is refused in the option's words, naming the type given and the one
-/// expected (`parallel_paths = 2.5: a float, not an int (a whole number)`): never rounded,
+/// flag (`bool`), or a JSON file as its path or its dict (read here). A value of another
+/// type is refused in the option's words as an `OptionTypeError` (a `TypeError`), naming
+/// the type given and the one expected (`parallel_paths = 2.5: a float, not an int (a whole
+/// number)`); a value of the right type that is not one the option takes (a window of three
+/// values, a file that is not JSON) as an `OptionError` (a `ValueError`): never rounded,
 /// parsed from text or read as a bool. Every option of [`DIAGNOSE_OPTIONS`] goes through
 /// here, so a new one is checked by its [`Takes`] alone.
 fn option_value(spec: &OptionSpec, v: &Bound<'_, PyAny>) -> PyResult<OptionValue> {
     let shown = v.repr().map_or_else(|_| "?".to_string(), |r| r.to_string());
     let bad = |why: &str| to_py(replay::OptionError::new(spec.field, shown.clone(), why).into());
+    // A value of the wrong type: the same message, an `OptionTypeError` (a `TypeError`).
+    let bad_type = |why: &str| wrong_type(v.py(), bad(why));
     let got = a_type(v);
-    let wrong = |expected: &str| bad(&format!("{got}, not {expected}"));
+    let wrong = |expected: &str| bad_type(&format!("{got}, not {expected}"));
     // A bool is an int to Python, and a float has `__int__`: neither is taken for a count.
     let is_bool = v.is_instance_of::<PyBool>();
     let has = |a: &str| v.hasattr(a).unwrap_or(false);
@@ -49,7 +54,7 @@ fn option_value(spec: &OptionSpec, v: &Bound<'_, PyAny>) -> PyResult<OptionValue
                 "give (start_s, end_s) or 'START:END' in seconds, e.g. (1.5, 2.4) or '1.5:2.4'";
             let pair: Vec<Bound<'_, PyAny>> = v
                 .extract()
-                .map_err(|_| bad(&format!("{got}, not a pair of numbers or a str; {how}")))?;
+                .map_err(|_| bad_type(&format!("{got}, not a pair of numbers or a str; {how}")))?;
             let [a, b] = pair.as_slice() else {
                 return Err(bad(&format!("two values, the start and the end; {how}")));
             };
@@ -60,7 +65,7 @@ fn option_value(spec: &OptionSpec, v: &Bound<'_, PyAny>) -> PyResult<OptionValue
             };
             match (number(a), number(b)) {
                 (Some(a), Some(b)) => OptionValue::Pair(a, b),
-                _ => return Err(bad(&format!("not numbers; {how}"))),
+                _ => return Err(bad_type(&format!("not numbers; {how}"))),
             }
         }
         Takes::Choice(_) if v.is_instance_of::<PyString>() => OptionValue::Text(v.extract()?),
@@ -76,13 +81,18 @@ fn option_value(spec: &OptionSpec, v: &Bound<'_, PyAny>) -> PyResult<OptionValue
         Takes::Count => return Err(wrong("an int (a whole number)")),
         Takes::Flag if is_bool => OptionValue::Flag(v.extract()?),
         Takes::Flag => return Err(wrong("a bool: give True or False")),
-        Takes::JsonFile => json_file(v, bad)?,
+        Takes::JsonFile => json_file(v, bad, bad_type)?,
     })
 }
 
 /// A JSON option's value: its dict (as JSON text), or the path of its file (read here);
-/// refused by `bad` (the option's words) otherwise.
-fn json_file(v: &Bound<'_, PyAny>, bad: impl Fn(&str) -> PyErr) -> PyResult<OptionValue> {
+/// refused in the option's words otherwise: by `bad_type` when it is neither a dict nor a
+/// path, by `bad` when it cannot be read or is not JSON.
+fn json_file(
+    v: &Bound<'_, PyAny>,
+    bad: impl Fn(&str) -> PyErr,
+    bad_type: impl Fn(&str) -> PyErr,
+) -> PyResult<OptionValue> {
     if v.is_instance_of::<PyDict>() {
         let text = v
             .py()
@@ -93,7 +103,7 @@ fn json_file(v: &Bound<'_, PyAny>, bad: impl Fn(&str) -> PyErr) -> PyResult<Opti
         return Ok(OptionValue::Text(text));
     }
     let path: PathBuf = v.extract().map_err(|_| {
-        bad(&format!(
+        bad_type(&format!(
             "{}, not a path (str or os.PathLike) or a dict",
             a_type(v)
         ))

@@ -37,6 +37,8 @@ def test_a_wrong_type_names_the_argument_and_the_type_expected(repo, option, val
         dm.diagnose(repo / MOTULATOR, repo / MOTULATOR_P, **{option: value})
     msg = str(e.value)
     assert says in msg and "\n" not in msg, msg
+    # Python's convention (issue 79): a wrong type is a TypeError.
+    assert isinstance(e.value, TypeError) and isinstance(e.value, dm.OptionTypeError), type(e.value)
 
 
 def test_the_right_types_are_taken(repo):

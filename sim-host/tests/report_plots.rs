@@ -2,7 +2,12 @@
 //! a solid band (fewer than 2 drawn points per pixel column: envelopes over the long span,
 //! zoomed panels of a few supply periods), the model "before" is dashed and drawn after
 //! the other lines, one unit per error chart, a scatter over one operating point is
-//! replaced by a sentence, and the headings are words, not file names.
+//! replaced by a sentence, and the headings are words, not file names. Every chart draws
+//! what its legend names (issue 79): each entry has points drawn, no two look alike, an
+//! error drawn per supply period is its RMS and says so, and the ladder's steps are whole
+//! ticks named by what each step added.
+
+mod chart_legend;
 
 use assert_cmd::Command;
 use std::path::{Path, PathBuf};
@@ -112,7 +117,22 @@ fn headings(html: &str) -> Vec<String> {
         .collect()
 }
 
+/// Every SVG chart in `dir` held to [`chart_legend::check`]; how many there were.
+fn legends_drawn(dir: &Path) -> usize {
+    let mut n = 0;
+    for e in std::fs::read_dir(dir).expect("dir") {
+        let path = e.expect("entry").path();
+        if path.extension().is_some_and(|x| x == "svg") {
+            let svg = std::fs::read_to_string(&path).expect("svg");
+            chart_legend::check(&svg, &path.display().to_string());
+            n += 1;
+        }
+    }
+    n
+}
+
 fn check_dir(dir: &Path, stems: &[&str]) -> String {
+    assert!(legends_drawn(dir) >= stems.len());
     for stem in stems {
         let path = dir.join(format!("{stem}.svg"));
         let svg =
@@ -156,6 +176,26 @@ fn compare_report_draws_envelopes_zooms_and_one_unit_per_axis() {
     // One unit per error chart.
     let e = std::fs::read_to_string(dir.join("error_time.svg")).expect("svg");
     assert!(e.contains("[A]") && !e.contains("rad/s"));
+    // The error over the 5 s log is drawn per supply period as its RMS, and named so: no
+    // value below zero (the signed envelope drew down to -25 A under an "RMS" label); the
+    // currents themselves are drawn as the periods' means, signed.
+    for stem in ["error_time", "error_time_omega_r"] {
+        let svg = std::fs::read_to_string(dir.join(format!("{stem}.svg"))).expect("svg");
+        let legend = chart_legend::legend(&svg).expect("legend");
+        assert!(
+            legend[0].label.ends_with("(RMS per supply period)"),
+            "{legend:?}"
+        );
+        let (lo, hi) = legend[0].y_range.expect("drawn");
+        assert!(lo >= 0.0 && hi > lo, "{stem}: {lo}..{hi}");
+    }
+    let o = std::fs::read_to_string(dir.join("overlay_iqs.svg")).expect("svg");
+    for entry in chart_legend::legend(&o).expect("legend") {
+        assert!(
+            entry.label.ends_with("(mean per supply period)"),
+            "{entry:?}"
+        );
+    }
     let w = std::fs::read_to_string(dir.join("error_time_omega_r.svg")).expect("svg");
     assert!(w.contains("[rad/s]") && !w.contains("[A]"));
     // The motulator log runs at one supply voltage: no scatter against it, a sentence.
@@ -275,4 +315,78 @@ fn compare_report_holds_the_advice_flags_and_identifiability() {
     // The data-quality stage's line and the worst windows' transients, as the text has them.
     assert!(html.contains("Data quality: clean"));
     assert!(html.contains("transient (start): the direct-on-line start"));
+}
+
+/// `explain --ladder --report`: the chart's x axis has one tick per step, named by what the
+/// step added (the table's numbers), on one line below the plot, and no other tick there
+/// (it numbered them 0.0, 0.2, ... 2.0 and named none).
+#[test]
+fn the_ladders_chart_names_each_step_on_a_whole_tick() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let dir = tmp.path().join("l");
+    run(&[
+        "explain",
+        "--ladder",
+        "--from",
+        "0.8",
+        "--to",
+        "3.5",
+        "--report",
+        dir.to_str().expect("utf8"),
+    ]);
+    legends_drawn(&dir);
+    let svg = std::fs::read_to_string(dir.join("ladder.svg")).expect("svg");
+    // The texts of the SVG: (x, y, text).
+    let texts: Vec<(f64, f64, String)> = svg
+        .split("<text")
+        .skip(1)
+        .filter_map(|t| {
+            let (head, rest) = t.split_once('>')?;
+            let attr = |a: &str| -> Option<f64> {
+                head.split(&format!(" {a}=\""))
+                    .nth(1)?
+                    .split('"')
+                    .next()?
+                    .parse()
+                    .ok()
+            };
+            let text = rest.split("</text>").next()?.trim().to_string();
+            Some((attr("x")?, attr("y")?, text))
+        })
+        .filter(|t| !t.2.is_empty())
+        .collect();
+    let steps: Vec<&(f64, f64, String)> = texts
+        .iter()
+        .filter(|t| {
+            t.2.split(':')
+                .next()
+                .is_some_and(|k| k.parse::<usize>().is_ok())
+        })
+        .collect();
+    assert!(steps.len() >= 2, "{texts:?}");
+    assert_eq!(steps[0].2, "0: as configured");
+    assert_eq!(steps[1].2, "1: +load_torque");
+    for (k, t) in steps.iter().enumerate() {
+        assert!(
+            t.2.starts_with(&format!("{k}: ")),
+            "step {k} named {:?}",
+            t.2
+        );
+        assert!(
+            k == 0 || t.0 > steps[k - 1].0,
+            "the steps run left to right: {steps:?}"
+        );
+    }
+    // Every text on the ticks' line is a step's name.
+    let line = steps[0].1;
+    let on_line: Vec<&String> = texts
+        .iter()
+        .filter(|t| (t.1 - line).abs() < 1.0)
+        .map(|t| &t.2)
+        .collect();
+    assert_eq!(
+        on_line.len(),
+        steps.len(),
+        "other ticks beside the steps: {on_line:?}"
+    );
 }

@@ -6,6 +6,8 @@
 //! The store is built here: four logs of one motor (Rs 0/+10/+20/+40 %, each a FAULT
 //! verdict) with the residuals and the load the test sets.
 
+mod chart_legend;
+
 use assert_cmd::Command;
 use monitor_store::row::column_index;
 use monitor_store::{Cell, LogIdentity, Store, StoredRow};
@@ -107,6 +109,11 @@ fn four_logs_are_drawn_as_their_stored_values_not_flat_lines() {
         svg.contains("the stored values"),
         "the title says what is drawn"
     );
+    // The motor is named beside a line of its own: these logs hold no |I2w|/|I1|, so the
+    // legend is on the first panel the motor has a point on (issue 79).
+    let legend = chart_legend::check(&svg, "trend --plot");
+    assert_eq!(legend.len(), 1, "{legend:?}");
+    assert_eq!(legend[0].label, "bench");
     // The table: no trend, and why, with the values.
     assert!(stdout.contains("too few for a trend"), "{stdout}");
     assert!(stdout.contains("0.0260"), "{stdout}");

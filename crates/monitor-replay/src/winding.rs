@@ -366,6 +366,13 @@ pub struct UnbalanceReport {
     pub reference_segment: Option<usize>,
     /// The log's steady stretches of negative sequence, in time order.
     pub segments: Vec<SequenceSegment>,
+    /// The negative sequence over the log: `(t, |I2|/|I1|)` of each complete least-squares
+    /// window ([`crate::windows::WINDOW_PERIODS`] supply periods; `t` its middle [s since
+    /// the log's first row]), in time order, as measured (before the sensors' and the
+    /// baseline's parts are taken out). What `diagnose --report` draws where the monitor's
+    /// timeline has none (a log with the currents only). Not in the JSON (`segments` are).
+    #[serde(skip)]
+    pub ratio_over_time: Vec<(f64, f32)>,
     /// One phase's current sensor with a gain error, from the zero sequence of the three
     /// measured currents (zero for a star without neutral, whatever the machine does), or
     /// null; its part of the negative sequence is taken out before a winding is blamed.

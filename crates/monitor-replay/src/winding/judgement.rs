@@ -257,6 +257,14 @@ fn report_without_judgement(
         judged_segment: None,
         reference_segment: None,
         segments: Vec::new(),
+        ratio_over_time: windows
+            .iter()
+            .filter(|w| w.complete)
+            .map(|w| {
+                let r = abs(cdiv(w.i.negative(), w.i.positive()));
+                (0.5 * (w.from_s + w.to_s), r)
+            })
+            .collect(),
         current_sensor_phase: gi.as_ref().map(SensorPhaseReport::from),
         voltage_sensor_phase: gv.as_ref().map(SensorPhaseReport::from),
         measured,

@@ -81,8 +81,9 @@ pub fn against_text(source: FindingSource, a: Against) -> &'static str {
     }
 }
 
-/// Why a name is watched rather than a FAULT.
-fn why_watched(n: &NamedFault, against: Against) -> String {
+/// Why a name is watched rather than a FAULT (`confidence 0.39, below the 0.60 a FAULT
+/// needs`): the verdict line's words, which `diagnose --report`'s banner says too.
+pub fn why_watched(n: &NamedFault, against: Against) -> String {
     // (A confidence that is not a number is below it.)
     if n.confidence
         .partial_cmp(&FAULT_CONFIDENCE)

@@ -5,7 +5,7 @@ use monitor_api::analysis::CompareOutput;
 use monitor_api::analysis::Prediction;
 use monitor_api::analysis::Prepared;
 use monitor_api::analysis::{metrics, WorstWindow};
-use monitor_api::analysis::{LadderReport, FLOOR_BAND};
+use monitor_api::analysis::{LadderReport, LadderStep, FLOOR_BAND};
 
 /// The charts `compare` writes (file stems; each as `.svg` and `.png`; the zoomed panels
 /// only for a log long enough to be drawn as envelopes, a scatter only where the log spans
@@ -37,9 +37,29 @@ pub const EXPLAIN: [&str; 5] = [
 /// The chart `explain --ladder` writes: the error after each step onto the floor band.
 pub const LADDER: &str = "ladder";
 
+/// The ladder chart's name of step `k` (`s`), as its tick reads: its number (the table's)
+/// and what it added (`1: +load_torque`), refitted (`2: base refit`) or removed
+/// (`3: +saturation -load_torque`).
+fn step_name(k: usize, s: &LadderStep) -> String {
+    let mut name = match s.effect {
+        None => "base refit".to_string(),
+        Some(_) => s
+            .added
+            .iter()
+            .map(|e| format!("+{}", e.name()))
+            .collect::<Vec<_>>()
+            .join(" "),
+    };
+    for d in &s.dropped {
+        name.push_str(&format!(" -{}", d.name()));
+    }
+    format!("{k}: {name}")
+}
+
 /// `explain --ladder`'s chart: the whole-log and the held-back error after each step (step 0:
 /// the model as configured) on a logarithmic axis, with the noise floor and the band's top
-/// ([`FLOOR_BAND`] times it) as lines: the error falls step by step onto the band.
+/// ([`FLOOR_BAND`] times it) as lines: the error falls step by step onto the band. The x
+/// axis has one tick per step, named by what the step added ([`step_name`]).
 pub fn ladder_chart(r: &LadderReport) -> Chart<'static> {
     let mut whole = vec![(0.0, r.start.error)];
     let mut held = vec![(0.0, r.start.heldback_error)];
@@ -62,7 +82,7 @@ pub fn ladder_chart(r: &LadderReport) -> Chart<'static> {
     Chart {
         stem: LADDER,
         title: "The ladder: the model's error after each step, onto the noise floor",
-        x_label: "step (0: the model as configured; each step adds an effect or refits the base parameters, as the table names)",
+        x_label: "step: what it added (+ an effect, or the base parameters refitted), as the table numbers it",
         y_label: "normalized RMS error",
         series: vec![
             line("whole log".into(), whole.clone(), 0, false),
@@ -84,6 +104,9 @@ pub fn ladder_chart(r: &LadderReport) -> Chart<'static> {
         ],
         log_y: true,
         omitted,
+        x_names: std::iter::once("0: as configured".to_string())
+            .chain(r.ladder.iter().enumerate().map(|(k, s)| step_name(k + 1, s)))
+            .collect(),
     }
 }
 
@@ -98,8 +121,8 @@ pub fn file_names(stems: &[&str]) -> Vec<String> {
 /// Points a line over a short span keeps (min/max pairs): under one per pixel column of a
 /// [`plot::WIDTH_PX`] chart.
 const MAX_POINTS: usize = 800;
-/// A line over more supply periods than this is drawn as its envelope (RMS per supply
-/// period): sample by sample it would be a solid band.
+/// A line over more supply periods than this is drawn per supply period ([`Per`]): sample
+/// by sample it would be a solid band.
 const ENVELOPE_FROM_PERIODS: usize = 40;
 /// Supply periods a zoomed panel shows.
 const ZOOM_PERIODS: usize = 4;
@@ -134,32 +157,51 @@ fn period_samples(d: &Prepared) -> usize {
     ((1.0 / (f_hz * d.dt_s)).round() as usize).max(1)
 }
 
-/// The envelope of `y`: per supply period of `per` samples, (mid time, RMS with the sign
-/// of the period's mean).
-fn envelope(t: &[f64], y: &[f64], per: usize) -> Vec<(f64, f64)> {
+/// What a long line draws per supply period ([`envelope`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Per {
+    /// The period's mean, signed: a quantity of the rotating frame (I_qs, the speed), whose
+    /// value is its mean and whose sign matters (motoring or braking).
+    Mean,
+    /// The period's RMS, never negative: the size of an error.
+    Rms,
+}
+
+impl Per {
+    /// How the legend names it.
+    fn label(self) -> &'static str {
+        match self {
+            Per::Mean => "mean per supply period",
+            Per::Rms => "RMS per supply period",
+        }
+    }
+}
+
+/// The envelope of `y`: per supply period of `per` samples, (mid time, the period's mean or
+/// RMS as `what` says).
+fn envelope(t: &[f64], y: &[f64], per: usize, what: Per) -> Vec<(f64, f64)> {
     t.chunks(per)
         .zip(y.chunks(per))
         .filter_map(|(tc, yc)| {
             let (first, last) = (tc.first()?, tc.last()?);
             let n = yc.len().max(1) as f64;
-            let rms = (yc.iter().map(|v| v * v).sum::<f64>() / n).sqrt();
-            let sign = if yc.iter().sum::<f64>() < 0.0 {
-                -1.0
-            } else {
-                1.0
+            let v = match what {
+                Per::Mean => yc.iter().sum::<f64>() / n,
+                Per::Rms => (yc.iter().map(|v| v * v).sum::<f64>() / n).sqrt(),
             };
-            Some((0.5 * (first + last), sign * rms))
+            Some((0.5 * (first + last), v))
         })
         .collect()
 }
 
 /// A line of `y` over `t`: sample by sample over a short span, its envelope
-/// ([`envelope`], the label says so) over more than [`ENVELOPE_FROM_PERIODS`] periods.
-fn trace(label: &str, t: &[f64], y: &[f64], per: usize, color: usize) -> Series {
+/// ([`envelope`], `what` per period, the label says which) over more than
+/// [`ENVELOPE_FROM_PERIODS`] periods.
+fn trace(label: &str, t: &[f64], y: &[f64], per: usize, color: usize, what: Per) -> Series {
     if t.len() > ENVELOPE_FROM_PERIODS * per {
         Series {
-            label: format!("{label} (RMS per supply period)"),
-            points: envelope(t, y, per),
+            label: format!("{label} ({})", what.label()),
+            points: envelope(t, y, per, what),
             color,
             scatter: false,
             dashed: false,
@@ -247,6 +289,7 @@ fn over_time(
         series,
         log_y: false,
         omitted: None,
+        x_names: Vec::new(),
     }
 }
 
@@ -291,6 +334,7 @@ pub fn compare_charts(d: &Prepared, out: &CompareOutput) -> Vec<Chart<'static>> 
         }],
         log_y: true,
         omitted: None,
+        x_names: Vec::new(),
     });
     v
 }
@@ -310,8 +354,8 @@ fn overlays(
         "q-axis current I_qs: measured vs model",
         "I_qs [A]",
         vec![
-            trace("measured", t, &d.iq, per, 0),
-            trace("model", t, &p.iq, per, 1),
+            trace("measured", t, &d.iq, per, 0, Per::Mean),
+            trace("model", t, &p.iq, per, 1, Per::Mean),
         ],
     )];
     if d.channels.speed {
@@ -320,8 +364,8 @@ fn overlays(
             "Rotor speed omega_r (electrical): measured vs model",
             "omega_r [rad/s]",
             vec![
-                trace("measured", t, &d.omega_r, per, 0),
-                trace("model", t, &p.omega_r, per, 1),
+                trace("measured", t, &d.omega_r, per, 0, Per::Mean),
+                trace("model", t, &p.omega_r, per, 1, Per::Mean),
             ],
         ));
     }
@@ -366,7 +410,7 @@ fn errors_over_time(d: &Prepared, p: &Prediction, eiq: &[f64]) -> Vec<Chart<'sta
         "error_time",
         "Error of the q-axis current vs time (model - measured)",
         "I_qs error [A]",
-        vec![trace("I_qs error", t, eiq, per, 1)],
+        vec![trace("I_qs error", t, eiq, per, 1, Per::Rms)],
     )];
     if d.channels.speed {
         let e: Vec<f64> = p
@@ -379,7 +423,7 @@ fn errors_over_time(d: &Prepared, p: &Prediction, eiq: &[f64]) -> Vec<Chart<'sta
             "error_time_omega_r",
             "Error of the rotor speed vs time (model - measured)",
             "omega_r error [rad/s]",
-            vec![trace("omega_r error", t, &e, per, 2)],
+            vec![trace("omega_r error", t, &e, per, 2, Per::Rms)],
         ));
     }
     v
@@ -449,6 +493,7 @@ fn condition_charts(d: &Prepared, all: &[WorstWindow]) -> Vec<Chart<'static>> {
             x_label: xl,
             y_label: "normalized RMS error",
             omitted: one_operating_point(xl, &points),
+            x_names: Vec::new(),
             series: vec![Series {
                 label: "window".into(),
                 points,
@@ -476,11 +521,25 @@ pub fn explain_charts(
     let t = &d.t_s;
     let per = period_samples(d);
     let overlay = |measured: &[f64], pick: &dyn Fn(&Prediction) -> &[f64]| {
-        let mut s = vec![trace("measured", t, measured, per, 0)];
+        let mut s = vec![trace("measured", t, measured, per, 0, Per::Mean)];
         if let Some((name, p)) = after {
-            s.push(trace(&format!("model + {name}"), t, pick(p), per, 2));
+            s.push(trace(
+                &format!("model + {name}"),
+                t,
+                pick(p),
+                per,
+                2,
+                Per::Mean,
+            ));
         }
-        s.push(before(trace("model before", t, pick(before_p), per, 1)));
+        s.push(before(trace(
+            "model before",
+            t,
+            pick(before_p),
+            per,
+            1,
+            Per::Mean,
+        )));
         s
     };
     v.push(over_time(
@@ -535,9 +594,23 @@ fn before_after_errors(
     );
     let mut s = Vec::new();
     if let Some((name, p)) = after {
-        s.push(trace(&format!("error with {name}"), t, &error(p), per, 2));
+        s.push(trace(
+            &format!("error with {name}"),
+            t,
+            &error(p),
+            per,
+            2,
+            Per::Rms,
+        ));
     }
-    s.push(before(trace("error before", t, &e_before, per, 1)));
+    s.push(before(trace(
+        "error before",
+        t,
+        &e_before,
+        per,
+        1,
+        Per::Rms,
+    )));
     v.push(over_time(
         "before_after_error",
         "Error of the q-axis current before (dashed) and after adding the top effect",
@@ -545,4 +618,43 @@ fn before_after_errors(
         s,
     ));
     v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A supply current's q-axis part over 50 periods of 20 samples: `offset` plus a ripple
+    /// of amplitude `a` at the supply frequency.
+    fn rippled(offset: f64, a: f64) -> (Vec<f64>, Vec<f64>) {
+        let n = 50 * 20;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 0.001).collect();
+        let y = (0..n)
+            .map(|k| offset + a * (std::f64::consts::TAU * k as f64 / 20.0).sin())
+            .collect();
+        (t, y)
+    }
+
+    #[test]
+    fn an_error_is_drawn_as_its_rms_a_quantity_as_its_mean_each_named_so() {
+        // An error of -3 A with a 2 A ripple: its RMS per period is sqrt(9 + 2) A, never
+        // negative; the signed envelope drew -3.3 A under the label "RMS".
+        let (t, y) = rippled(-3.0, 2.0);
+        let e = trace("I_qs error", &t, &y, 20, 1, Per::Rms);
+        assert_eq!(e.label, "I_qs error (RMS per supply period)");
+        assert_eq!(e.points.len(), 50);
+        for &(_, v) in &e.points {
+            assert!((v - 11f64.sqrt()).abs() < 1e-9, "{v}");
+        }
+        // A current is drawn as the period's mean: its sign (braking) kept, the ripple out.
+        let m = trace("measured", &t, &y, 20, 0, Per::Mean);
+        assert_eq!(m.label, "measured (mean per supply period)");
+        for &(_, v) in &m.points {
+            assert!((v + 3.0).abs() < 1e-9, "{v}");
+        }
+        // A short span is drawn sample by sample, and named plainly.
+        let short = trace("I_qs error", &t[..200], &y[..200], 20, 1, Per::Rms);
+        assert_eq!(short.label, "I_qs error");
+        assert!(short.points.iter().any(|p| p.1 < 0.0));
+    }
 }

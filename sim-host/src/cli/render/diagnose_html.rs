@@ -1,7 +1,9 @@
 //! `diagnose --report R.html`: the one page a crew prints and a planner files.
 //!
-//! What it holds, top to bottom: the verdict and what it was judged against; the findings
-//! table (one row per analysis, its state and sentence); the residuals and the lamps over
+//! What it holds, top to bottom: the verdict's banner (at most two lines: the verdict with
+//! the fault it names, then which analyses were judged and which could not be); the
+//! findings table right below it (one row per analysis, its state and sentence: each
+//! reason once, the row the verdict rests on marked); the residuals and the lamps over
 //! time with the events marked (load moves, faults named, first detections); the negative
 //! sequence over time with the named phase; the rotor's sidebands against the severity
 //! bands; the data quality. Charts are inline SVG drawn with plotters ([`super::plot`]),
@@ -11,8 +13,10 @@
 
 use super::plot::{self, Chart, Series};
 use crate::cli::words::CliWords;
-use monitor_api::replay::{DiagnoseReport, Diagnosed, IsolationEvent, RotorBand};
+use monitor_api::replay::{DiagnoseReport, Diagnosed, FindingReport, IsolationEvent, RotorBand};
+use monitor_api::replay::Verdict;
 use monitor_api::words::diagnose::{self as words, Story};
+use monitor_core::verdict::State;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -51,6 +55,7 @@ th{background:#eee}svg{max-width:100%;height:auto;display:block}\
 .v{font-size:1.15em;padding:.6em;border-left:6px solid #888;background:#f4f4f4}\
 .fault{border-color:#c22;background:#fbeaea}.watching{border-color:#c90;background:#fbf4e0}\
 .healthy{border-color:#2a2;background:#eaf6ea}.could_not_judge{border-color:#888}\
+.v small{display:block;font-size:.75em;margin-top:.2em}tr.by td{font-weight:bold;background:#f4f4f4}td.k small{display:block;white-space:normal}\
 code{overflow-wrap:anywhere}ul{padding-left:1.2em}\
 @media print{body{max-width:none;margin:0}h2{break-after:avoid}svg,table,tr{break-inside:avoid}}\
 @page{size:A4;margin:12mm}";
@@ -69,36 +74,76 @@ fn page(log: &str, d: &Diagnosed, charts: &[(String, String)]) -> String {
         d.sample_rate_hz,
         monitor_api::replay::angle_source_name(rep.angle_source)
     );
-    verdict(&mut h, rep, &story);
+    verdict(&mut h, rep);
     findings_table(&mut h, rep, &story);
     for (title, svg) in charts {
         let _ = write!(h, "<h2>{}</h2>{svg}", esc(title));
     }
     events_list(&mut h, rep);
-    winding(&mut h, rep, &story);
-    if rep.rotor.judged {
-        let _ = write!(h, "<h2>Rotor</h2><p>{}</p>", esc(&story.rotor));
-    }
+    // The rotor's sentence is its finding's, in the table above: said once.
+    winding(&mut h, rep);
     quality(&mut h, rep);
     h.push_str("<p><small>Written by <code>sim-host diagnose --report</code>; the same verdict as <code>diagnose</code>'s text and <code>--json</code>.</small></p></body></html>");
     h
 }
 
-/// The verdict line, what was judged against what, and what was not judged.
-fn verdict(h: &mut String, rep: &DiagnoseReport, story: &Story) {
+/// Whether a finding judged nothing (not judged, or unavailable on this log).
+fn judged_nothing(f: &FindingReport) -> bool {
+    matches!(f.finding.state, State::NotJudged | State::Unavailable)
+}
+
+/// The verdict with the fault it names, as the banner's first line (`FAULT shorted turns in
+/// phase c: about 10 % of the phase's turns`, `healthy`); its confidence is the second
+/// line's, why and against what the findings table's (its marked row).
+fn verdict_head(rep: &DiagnoseReport) -> String {
+    let named = rep.verdict_finding.as_ref().and_then(FindingReport::named);
+    match (rep.verdict, named) {
+        (Verdict::Fault, Some(n)) => format!("FAULT {}", words::fault_text(n)),
+        (Verdict::Watching, Some(n)) => format!("WATCHING {}", words::fault_text(n)),
+        (Verdict::Fault, None) => "FAULT".to_string(),
+        (Verdict::Watching, None) => "WATCHING".to_string(),
+        (Verdict::Healthy, _) => "healthy".to_string(),
+        (Verdict::CouldNotJudge, _) => "could not judge".to_string(),
+    }
+}
+
+/// The verdict's banner, at most two lines: the verdict ([`verdict_head`]), then the named
+/// fault's confidence (a watched one's with why it is watched rather than a FAULT, in the
+/// verdict line's words) and the analyses judged and those that could not judge, by name.
+/// Each one's reason is said once, in the findings table right below.
+fn verdict(h: &mut String, rep: &DiagnoseReport) {
     let class = serde_json::to_value(rep.verdict)
         .ok()
         .and_then(|v| v.as_str().map(str::to_string))
         .unwrap_or_default();
+    let names = |nothing: bool| {
+        let v: Vec<&str> = rep
+            .findings
+            .iter()
+            .filter(|f| f.source().judges_faults() && judged_nothing(f) == nothing)
+            .map(|f| f.source().name())
+            .collect();
+        if v.is_empty() {
+            "none".to_string()
+        } else {
+            v.join(", ")
+        }
+    };
+    // A FAULT's confidence; a watched name's, with why it is watched, not a FAULT.
+    let by = rep.verdict_finding.as_ref();
+    let confidence = match (rep.verdict, by.and_then(|f| f.named().map(|n| (f, n)))) {
+        (Verdict::Watching, Some((f, n))) => format!("{}; ", words::why_watched(n, f.finding.against)),
+        (_, Some((_, n))) => format!("confidence {:.2}; ", n.confidence),
+        (_, None) => String::new(),
+    };
     let _ = write!(
         h,
-        "<p class=\"v {}\"><b>verdict: {}</b></p>",
+        "<p class=\"v {}\"><b>verdict: {}</b><small>{confidence}judged: {}; not judged: {}. Why, for each, in the findings below.</small></p>",
         esc(&class),
-        esc(&story.verdict_line)
+        esc(&verdict_head(rep)),
+        esc(&names(false)),
+        esc(&names(true))
     );
-    list(h, "Judged", &story.judged);
-    list(h, "Not judged", &story.not_judged);
-    list(h, "Why the verdict is withheld", &story.withheld_because);
 }
 
 /// A titled list of sentences (nothing when empty).
@@ -113,24 +158,30 @@ fn list(h: &mut String, title: &str, items: &[String]) {
     h.push_str("</ul>");
 }
 
-/// One row per analysis: its name, state and sentence (with the named fault's confidence).
+/// One row per analysis: its name, state and sentence, with what a judged analysis was
+/// judged against (and a named fault's confidence); the row the verdict rests on is marked.
 fn findings_table(h: &mut String, rep: &DiagnoseReport, story: &Story) {
     h.push_str("<h2>Findings</h2><table><tr><th>analysis</th><th>state</th><th>finding</th></tr>");
+    let by = rep.verdict_finding.as_ref().map(FindingReport::source);
     for (f, (summary, _)) in rep.findings.iter().zip(&story.findings) {
-        let named = f.named().map_or(String::new(), |n| {
-            format!(
-                " (confidence {:.2}; {})",
-                n.confidence,
-                words::against_text(f.source(), f.finding.against)
-            )
-        });
+        let against = words::against_text(f.source(), f.finding.against);
+        let judged = match f.named() {
+            Some(n) => format!(" (confidence {:.2}; {against})", n.confidence),
+            None if f.source().judges_faults() && !judged_nothing(f) => format!(" ({against})"),
+            None => String::new(),
+        };
+        let (row, mark) = if by == Some(f.source()) {
+            (" class=by", "<br><small>the verdict rests on it</small>")
+        } else {
+            ("", "")
+        };
         let _ = write!(
             h,
-            "<tr><td class=k>{}</td><td class=k>{}</td><td>{}{}</td></tr>",
+            "<tr{row}><td class=k>{}</td><td class=k>{}{mark}</td><td>{}{}</td></tr>",
             esc(f.source().name()),
             esc(f.state_name()),
             esc(summary),
-            esc(&named)
+            esc(&judged)
         );
     }
     h.push_str("</table>");
@@ -160,7 +211,7 @@ fn events_list(h: &mut String, rep: &DiagnoseReport) {
 }
 
 /// The negative sequence: the whole log's ratio, the named phase and its confidence.
-fn winding(h: &mut String, rep: &DiagnoseReport, story: &Story) {
+fn winding(h: &mut String, rep: &DiagnoseReport) {
     let u = &rep.unbalance;
     let phase = words::suspect(u);
     let _ = write!(
@@ -170,9 +221,7 @@ fn winding(h: &mut String, rep: &DiagnoseReport, story: &Story) {
         100.0 * u.least_change,
         esc(&phase)
     );
-    if let Some(line) = words::winding_line(u, &CliWords) {
-        let _ = write!(h, "<p>{}</p>", esc(&line));
-    }
+    // Why no phase was judged is the winding finding's sentence, in the table above.
     let p = &u.phase_probabilities;
     let _ = write!(
         h,
@@ -181,25 +230,31 @@ fn winding(h: &mut String, rep: &DiagnoseReport, story: &Story) {
     );
 }
 
-/// The data-quality stage's finding and what it did.
+/// What the data-quality stage did (what it found, and what it does not trust, is its
+/// finding's, in the table above: said once).
 fn quality(h: &mut String, rep: &DiagnoseReport) {
     let q = &rep.data_quality;
-    let _ = write!(h, "<h2>Data quality</h2><p>{}</p>", esc(&q.summary()));
+    h.push_str("<h2>Data quality</h2>");
+    if q.actions.is_empty() {
+        h.push_str(
+            "<p>The data-quality stage changed nothing; its finding is in the table above.</p>",
+        );
+    }
     let done: Vec<String> = q.actions.iter().map(|a| format!("done: {a}")).collect();
     list(h, "What the data-quality stage did", &done);
-    if !q.trusted {
-        list(h, "Not trusted because", &q.not_trusted_because);
-    }
 }
 
-/// The page's charts (module docs).
+/// The page's charts (module docs). Without a timeline the residuals and the lamps are one
+/// place that says, once, why neither is drawn.
 fn charts(rep: &DiagnoseReport) -> Vec<Chart<'static>> {
-    vec![
-        residuals_chart(rep),
-        lamps_chart(rep),
-        sequence_chart(rep),
-        rotor_chart(rep),
-    ]
+    let mut v = vec![residuals_chart(rep)];
+    if rep.timeline.is_empty() {
+        v[0].title = "Residuals r1..r4 and the lamps over time";
+    } else {
+        v.push(lamps_chart(rep));
+    }
+    v.extend([sequence_chart(rep), rotor_chart(rep)]);
+    v
 }
 
 /// The times to mark on the time charts: load moves, faults named, first detections.
@@ -219,9 +274,10 @@ fn event_times(rep: &DiagnoseReport) -> Vec<(f64, bool)> {
 fn markers(rep: &DiagnoseReport, lo: f64, hi: f64) -> Vec<Series> {
     let (moves, named): (Vec<_>, Vec<_>) = event_times(rep).into_iter().partition(|e| e.1);
     let mut v = Vec::new();
+    // Colours of their own (the palette's brown and pink): not a residual's or a lamp's.
     for (label, times, color) in [
         ("load moved", moves, 6),
-        ("fault named or signature matched", named, 3),
+        ("fault named or signature matched", named, 7),
     ] {
         let mut pts = Vec::new();
         for (t, _) in times {
@@ -261,18 +317,18 @@ fn time_chart(
         series,
         log_y: false,
         omitted,
+        x_names: Vec::new(),
     }
 }
 
-/// Why the log has no timeline: the core's monitor did not run (the analyses skipped say
-/// what was missing), or the log is shorter than one step.
+/// Why the log has no timeline: the core's monitor did not run (what was missing is the
+/// residuals' finding, in the table: not said again), or the log is shorter than one step.
 fn no_timeline(rep: &DiagnoseReport) -> String {
-    match rep.skipped.first() {
-        Some(why) => format!(
-            "Not drawn: the monitor did not run on this log: {}",
-            words::skipped(*why)
-        ),
-        None => "Not drawn: the log is shorter than one timeline step".to_string(),
+    if rep.skipped.is_empty() {
+        "Not drawn: the log is shorter than one timeline step.".to_string()
+    } else {
+        "Not drawn: the monitor did not run on this log (the residuals' finding above says why)."
+            .to_string()
     }
 }
 
@@ -343,19 +399,40 @@ fn lamps_chart(rep: &DiagnoseReport) -> Chart<'static> {
     )
 }
 
-/// The negative-sequence ratio over time, with the steady stretches' values.
+/// The negative-sequence ratio over time, with the steady stretches' values: the monitor's
+/// timeline where it ran, else (a log with the currents only) the least-squares windows'
+/// ratio (`unbalance.ratio_over_time`, the legend says each window's length). Drawn
+/// whenever either has a point; a series without one is left out, so every legend entry
+/// is a curve.
 fn sequence_chart(rep: &DiagnoseReport) -> Chart<'static> {
-    let pts = rep
-        .timeline
-        .iter()
-        .map(|p| (p.t_s, 100.0 * f64::from(p.negative_sequence_ratio)))
-        .collect();
+    let (pts, label): (Vec<(f64, f64)>, String) = if rep.timeline.is_empty() {
+        let w = &rep.unbalance.ratio_over_time;
+        let pts = w.iter().map(|&(t, r)| (t, 100.0 * f64::from(r))).collect();
+        let mut steps: Vec<f64> = w.windows(2).map(|p| p[1].0 - p[0].0).collect();
+        steps.sort_by(f64::total_cmp);
+        let label = match steps.get(steps.len() / 2) {
+            Some(dt) => format!("|I2|/|I1| (each {dt:.2} s window)"),
+            None => "|I2|/|I1| (one window)".to_string(),
+        };
+        (pts, label)
+    } else {
+        let pts = rep
+            .timeline
+            .iter()
+            .map(|p| (p.t_s, 100.0 * f64::from(p.negative_sequence_ratio)))
+            .collect();
+        (pts, "|I2|/|I1|".to_string())
+    };
     let mut seg = Vec::new();
     for s in &rep.unbalance.segments {
         let y = 100.0 * f64::from(s.negative_sequence_ratio);
         seg.extend([(s.from_s, y), (s.to_s, y), (f64::NAN, f64::NAN)]);
     }
-    let mut series = vec![line("|I2|/|I1|", pts, 0, false)];
+    let drawn = !pts.is_empty() || !seg.is_empty();
+    let mut series = Vec::new();
+    if !pts.is_empty() {
+        series.push(line(&label, pts, 0, false));
+    }
     if !seg.is_empty() {
         series.push(line("steady stretches", seg, 1, true));
     }
@@ -368,8 +445,7 @@ fn sequence_chart(rep: &DiagnoseReport) -> Chart<'static> {
         ),
         series,
     );
-    // The steady stretches alone carry the picture on a log with only the currents.
-    if !rep.unbalance.segments.is_empty() {
+    if drawn {
         chart.omitted = None;
     }
     chart
@@ -381,8 +457,9 @@ fn sequence_chart(rep: &DiagnoseReport) -> Chart<'static> {
 fn rotor_chart(rep: &DiagnoseReport) -> Chart<'static> {
     let r = &rep.rotor;
     let f = r.supply_hz.unwrap_or(f64::NAN);
-    let omitted = (!r.judged || !f.is_finite() || r.sideband_hz.len() < 2)
-        .then(|| format!("Not drawn: {}", words::Story::rotor_sentence(r)));
+    let omitted = (!r.judged || !f.is_finite() || r.sideband_hz.len() < 2).then(|| {
+        "Not drawn: the sidebands were not read (the rotor's finding above says why).".to_string()
+    });
     let stem = |x: f64, y: f64| vec![(x, -90.0), (x, y)];
     let lo = r.sideband_hz.first().copied().unwrap_or(f);
     let hi = r.sideband_hz.get(1).copied().unwrap_or(f);
@@ -394,13 +471,16 @@ fn rotor_chart(rep: &DiagnoseReport) -> Chart<'static> {
         line("(1+2s)f", stem(hi, level(r.upper_sideband_db)), 2, false),
     ];
     if let Some(n) = r.noise_floor_db {
-        series.push(line("noise floor", vec![(span.0, n), (span.1, n)], 7, true));
+        series.push(line("noise floor", vec![(span.0, n), (span.1, n)], 5, true));
     }
-    for (k, band) in RotorBand::ALL.iter().enumerate() {
+    // The bands' edges from the mildest up (cyan, olive, brown, red, purple): no colour
+    // another entry of the chart has.
+    const BAND_COLOURS: [usize; 5] = [9, 8, 6, 1, 4];
+    for (band, color) in RotorBand::ALL.iter().zip(BAND_COLOURS) {
         let db = band.upper_db();
         if db.is_finite() {
             let label = format!("{} dB: below, {}", db, words::band_words(*band));
-            series.push(line(&label, vec![(span.0, db), (span.1, db)], 8 + k, true));
+            series.push(line(&label, vec![(span.0, db), (span.1, db)], color, true));
         }
     }
     Chart {
@@ -411,6 +491,7 @@ fn rotor_chart(rep: &DiagnoseReport) -> Chart<'static> {
         series,
         log_y: false,
         omitted,
+        x_names: Vec::new(),
     }
 }
 

@@ -107,5 +107,6 @@ pub fn chart(r: &McsaReport) -> Option<Chart<'static>> {
         ],
         log_y: false,
         omitted: None,
+        x_names: Vec::new(),
     })
 }

@@ -6,6 +6,11 @@
 //! "sans-serif" before the first chart is drawn ([`FONT`]), so no system font package is
 //! needed, in CI or on a user's machine. Outputs are written atomically (temporary file,
 //! then rename).
+//!
+//! A chart draws what it names: every legend entry is a series, and the SVG carries, for
+//! the reader that cannot see it (a screen reader, a test), its title and each legend
+//! entry with the points drawn ([`legend`], in the SVG's `<desc>`): a test over every chart
+//! the tool writes holds each entry to at least one point drawn.
 
 use plotters::coord::ranged1d::{SegmentedCoord, ValueFormatter};
 use plotters::coord::types::RangedCoordi32;
@@ -43,12 +48,213 @@ pub struct Chart<'a> {
     pub log_y: bool,
     /// Why the chart is not drawn (a sentence for the report in its place), or `None`.
     pub omitted: Option<String>,
+    /// The names of the x axis' whole positions `0, 1, ..`: each gets a tick with its name
+    /// (the ladder's steps); empty for a numeric axis.
+    pub x_names: Vec<String>,
+}
+
+/// A legend entry and what was drawn of it ([`legend`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LegendEntry {
+    /// The label the legend shows.
+    pub label: String,
+    /// How it is drawn: its colour and stroke (`#1F77B4 line`, `#D62728 dashed line`,
+    /// `#FF7F0E points`); no two entries of a chart look alike.
+    pub look: String,
+    /// Points drawn (finite, and above 0 on a logarithmic axis).
+    pub points: usize,
+    /// The lowest and the highest value drawn (y), `None` without a point.
+    pub y_range: Option<(f64, f64)>,
+}
+
+/// The points of `points` a chart draws: finite, and above 0 on a logarithmic axis.
+fn drawable(p: &(f64, f64), log_y: bool) -> bool {
+    p.0.is_finite() && p.1.is_finite() && (!log_y || p.1 > 0.0)
+}
+
+/// How a series of palette colour `color` is drawn, as [`LegendEntry::look`] says it.
+pub(crate) fn look(color: usize, dashed: bool, scatter: bool) -> String {
+    let RGBColor(r, g, b) = PALETTE[color % PALETTE.len()];
+    let stroke = match (scatter, dashed) {
+        (true, _) => "points",
+        (false, true) => "dashed line",
+        (false, false) => "line",
+    };
+    format!("#{r:02X}{g:02X}{b:02X} {stroke}")
+}
+
+/// The legend of chart `c` as drawn: each series' label with the points drawn of it (the
+/// same filter the drawing uses), in the legend's order.
+pub fn legend(c: &Chart) -> Vec<LegendEntry> {
+    c.series
+        .iter()
+        .map(|s| {
+            let ys: Vec<f64> = s
+                .points
+                .iter()
+                .filter(|p| drawable(p, c.log_y))
+                .map(|p| p.1)
+                .collect();
+            let lo = ys.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = ys.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            LegendEntry {
+                label: s.label.clone(),
+                look: look(s.color, s.dashed, s.scatter),
+                points: ys.len(),
+                y_range: (!ys.is_empty()).then_some((lo, hi)),
+            }
+        })
+        .collect()
+}
+
+/// `svg` with its `<title>` and `<desc>` (inserted as the root's first children): the
+/// chart's `title`, and its legend as drawn (`entries`), one line per entry with its look,
+/// its points and the range of their values (`measured [#1F77B4 line]: 812 points, y from
+/// -0.5 to 12`, `model [#D62728 line]: 0 points`) after a first line `legend:`.
+pub fn described(svg: String, title: &str, entries: &[LegendEntry]) -> String {
+    let lines: Vec<String> = entries
+        .iter()
+        .map(|e| match e.y_range {
+            Some((lo, hi)) => format!(
+                "{} [{}]: {} points, y from {lo} to {hi}",
+                e.label, e.look, e.points
+            ),
+            None => format!("{} [{}]: 0 points", e.label, e.look),
+        })
+        .collect();
+    let extra = format!(
+        "<title>{}</title><desc>legend:\n{}</desc>",
+        xml_escape(title),
+        xml_escape(&lines.join("\n"))
+    );
+    match svg
+        .find("<svg")
+        .and_then(|a| svg[a..].find('>').map(|b| a + b + 1))
+    {
+        Some(k) => format!("{}{extra}{}", &svg[..k], &svg[k..]),
+        None => svg,
+    }
+}
+
+/// Text escaped for XML.
+fn xml_escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
 }
 
 /// Width of every chart [px].
 pub const WIDTH_PX: u32 = 900;
-/// Height of every chart [px].
+/// Height of every chart [px] (a named axis' upright names add theirs, [`height`]).
 const HEIGHT_PX: u32 = 420;
+/// Width a character of a tick label takes, about (DejaVu Sans at the mesh's 12 px) [px].
+const LABEL_CHAR_PX: u32 = 6;
+
+/// The longest name of a named axis, in label pixels ([`LABEL_CHAR_PX`]), when the names
+/// stand upright (rotated a quarter turn) because one would not fit its step's width on
+/// the line; 0 when they lie on one line (or the axis is numeric).
+fn upright_names_px(c: &Chart) -> u32 {
+    let n = c.x_names.len().max(1) as u32;
+    let longest = c
+        .x_names
+        .iter()
+        .map(|s| s.chars().count())
+        .max()
+        .unwrap_or(0) as u32;
+    let px = longest * LABEL_CHAR_PX;
+    // The plot is the chart less the y labels' area and the margins.
+    if px > (WIDTH_PX - 100) / n {
+        px
+    } else {
+        0
+    }
+}
+
+/// The chart's height [px]: [`HEIGHT_PX`], and room for upright names below the plot.
+fn height(c: &Chart) -> u32 {
+    HEIGHT_PX + upright_names_px(c)
+}
+
+/// A tick label of a logarithmic axis: a power of ten as a number where it is short
+/// (`0.001`, `100`), else as `1e-5`; any other value with two digits (`2.5e-5`). (The axis'
+/// own formatting printed 1e-4 as `9.999999999e-5`.)
+fn log_tick(v: &f64) -> String {
+    if !(v.is_finite() && *v > 0.0) {
+        return String::new();
+    }
+    let e = v.log10().round();
+    let m = v / 10f64.powf(e);
+    if (m - 1.0).abs() < 1e-6 {
+        if (-3.0..=3.0).contains(&e) {
+            format!("{}", 10f64.powi(e as i32))
+        } else {
+            format!("1e{e}")
+        }
+    } else {
+        format!("{v:.1e}")
+    }
+}
+
+/// Where the legend goes: the corner of the plot (or the right's middle) the series cross
+/// least, counted on their points and, for lines, on points along their segments, in the
+/// plot's own scale (`log_y`: the logarithm's) within `ranges`.
+fn legend_position(
+    c: &Chart,
+    ((x0, x1), (y0, y1)): ((f64, f64), (f64, f64)),
+) -> SeriesLabelPosition {
+    let ty = |y: f64| {
+        if c.log_y {
+            y.max(f64::MIN_POSITIVE).log10()
+        } else {
+            y
+        }
+    };
+    let (ly0, ly1) = (ty(y0), ty(y1));
+    let (w, hgt) = (
+        (x1 - x0).max(f64::MIN_POSITIVE),
+        (ly1 - ly0).max(f64::MIN_POSITIVE),
+    );
+    // The candidates' boxes as shares of the plot: (x from, x to, y from, y to), y upwards.
+    let boxes = [
+        (SeriesLabelPosition::UpperRight, (0.6, 1.0, 0.65, 1.0)),
+        (SeriesLabelPosition::UpperLeft, (0.0, 0.4, 0.65, 1.0)),
+        (SeriesLabelPosition::LowerRight, (0.6, 1.0, 0.0, 0.35)),
+        (SeriesLabelPosition::LowerLeft, (0.0, 0.4, 0.0, 0.35)),
+        (SeriesLabelPosition::MiddleRight, (0.6, 1.0, 0.33, 0.67)),
+    ];
+    let mut counts = [0usize; 5];
+    for s in &c.series {
+        let pts: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .filter(|p| drawable(p, c.log_y))
+            .map(|&(x, y)| ((x - x0) / w, (ty(y) - ly0) / hgt))
+            .collect();
+        let along = !s.scatter && pts.len() < 400;
+        let mut visit = |(x, y): (f64, f64)| {
+            for (k, (_, (a, b, lo, hi))) in boxes.iter().enumerate() {
+                if (*a..=*b).contains(&x) && (*lo..=*hi).contains(&y) {
+                    counts[k] += 1;
+                }
+            }
+        };
+        for (k, &p) in pts.iter().enumerate() {
+            visit(p);
+            if along && k > 0 {
+                let q = pts[k - 1];
+                for j in 1..10 {
+                    let f = f64::from(j) / 10.0;
+                    visit((q.0 + f * (p.0 - q.0), q.1 + f * (p.1 - q.1)));
+                }
+            }
+        }
+    }
+    let best = (0..boxes.len()).min_by_key(|&k| counts[k]).unwrap_or(0);
+    boxes
+        .into_iter()
+        .nth(best)
+        .map_or(SeriesLabelPosition::UpperRight, |b| b.0)
+}
 
 /// DejaVu Sans 2.37 (Bitstream Vera licence: `assets/fonts/LICENSE-DejaVu.txt`), the PNG
 /// charts' font.
@@ -67,14 +273,19 @@ pub fn register_font() -> Result<(), String> {
     .clone()
 }
 
-/// The series colours of every chart (matplotlib's first five and a grey), in order.
-pub(crate) const PALETTE: [RGBColor; 6] = [
+/// The series colours of every chart (matplotlib's first five, a grey, then matplotlib's
+/// brown, pink, olive and cyan), in order: ten, so that no chart's entries share a colour.
+pub(crate) const PALETTE: [RGBColor; 10] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
     RGBColor(255, 127, 14),
     RGBColor(148, 103, 189),
     RGBColor(90, 90, 90),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
 ];
 
 /// Keeps at most `max` points, preserving each bucket's min and max (so spikes survive).
@@ -124,6 +335,10 @@ fn ranges(c: &Chart) -> ((f64, f64), (f64, f64)) {
             }
         }
     }
+    if !c.x_names.is_empty() {
+        // Whole positions 0..n, each with room beside it.
+        (x0, x1) = (-0.4, c.x_names.len() as f64 - 0.6);
+    }
     if !x0.is_finite() {
         return ((0.0, 1.0), (0.0, 1.0));
     }
@@ -163,23 +378,47 @@ where
     b.margin(12);
     if text {
         b.caption(c.title, ("sans-serif", 20))
-            .x_label_area_size(40)
+            .x_label_area_size(40 + upright_names_px(c))
             .y_label_area_size(70);
     }
-    if c.log_y {
+    let corner = legend_position(c, ((x0, x1), (y0, y1)));
+    let ticks = if c.log_y {
         let chart = b
             .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
             .map_err(e)?;
-        draw_plot(chart, c, text)?;
+        draw_plot(chart, c, text, corner)?
     } else {
-        draw_plot(b.build_cartesian_2d(x0..x1, y0..y1).map_err(e)?, c, text)?;
+        let chart = b.build_cartesian_2d(x0..x1, y0..y1).map_err(e)?;
+        draw_plot(chart, c, text, corner)?
+    };
+    if text {
+        // A named axis: a tick at each whole position and its name below it, on one line,
+        // or upright, each reading down from its tick, where one would not fit its step
+        // (the mesh's own labels fall where its key points do, and it centres a label on
+        // its tick, which would stand a turned name half inside the plot).
+        use plotters::style::text_anchor::{HPos, Pos, VPos};
+        let font = ("sans-serif", 12).into_font();
+        let style = if upright_names_px(c) > 0 {
+            font.transform(FontTransform::Rotate90)
+                .color(&BLACK)
+                .pos(Pos::new(HPos::Left, VPos::Center))
+        } else {
+            font.color(&BLACK).pos(Pos::new(HPos::Center, VPos::Top))
+        };
+        for (name, (x, y)) in c.x_names.iter().zip(ticks) {
+            root.draw(&PathElement::new(vec![(x, y), (x, y + 5)], BLACK))
+                .map_err(e)?;
+            root.draw(&Text::new(name.as_str(), (x, y + 8), style.clone()))
+                .map_err(e)?;
+        }
     }
     root.present().map_err(e)?;
     Ok(())
 }
 
 /// Draws the mesh, every series of `c` and (with `text`) the axis descriptions and the
-/// legend into the built `chart` (linear or logarithmic y axis).
+/// legend (at `corner`) into the built `chart` (linear or logarithmic y axis); returns the
+/// pixels of a named axis' ticks (where each whole position meets the x axis).
 ///
 /// # Errors
 /// Drawing errors of the backend.
@@ -187,7 +426,8 @@ fn draw_plot<'a, DB, X, Y>(
     mut chart: ChartContext<'a, DB, Cartesian2d<X, Y>>,
     c: &Chart,
     text: bool,
-) -> Result<(), String>
+    corner: SeriesLabelPosition,
+) -> Result<Vec<(i32, i32)>, String>
 where
     DB: DrawingBackend + 'a,
     DB::ErrorType: 'static,
@@ -202,6 +442,13 @@ where
         } else {
             mesh.x_labels(0).y_labels(0);
         }
+        if !c.x_names.is_empty() {
+            // A named axis' ticks and names are drawn beside the mesh ([`draw`]).
+            mesh.x_labels(0).disable_x_mesh();
+        }
+        if text && c.log_y {
+            mesh.y_label_formatter(&log_tick);
+        }
         mesh.draw().map_err(e)?;
     }
     for s in &c.series {
@@ -210,12 +457,16 @@ where
     if text {
         chart
             .configure_series_labels()
+            .position(corner)
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .draw()
             .map_err(e)?;
     }
-    Ok(())
+    let bottom = chart.y_range().start;
+    Ok((0..c.x_names.len())
+        .map(|k| chart.backend_coord(&(k as f64, bottom)))
+        .collect())
 }
 
 /// Draws one series (points, dashed or solid line) and, with `text`, its legend entry;
@@ -241,7 +492,7 @@ where
         .points
         .iter()
         .copied()
-        .filter(|p| p.0.is_finite() && p.1.is_finite() && (!log_y || p.1 > 0.0))
+        .filter(|p| drawable(p, log_y))
         .collect();
     if s.scatter {
         let a = chart
@@ -288,7 +539,7 @@ where
 fn runs(points: &[(f64, f64)], log_y: bool) -> Vec<Vec<(f64, f64)>> {
     let mut out = vec![Vec::new()];
     for &p in points {
-        if p.0.is_finite() && p.1.is_finite() && (!log_y || p.1 > 0.0) {
+        if drawable(&p, log_y) {
             if let Some(last) = out.last_mut() {
                 last.push(p);
             }
@@ -300,19 +551,19 @@ fn runs(points: &[(f64, f64)], log_y: bool) -> Vec<Vec<(f64, f64)>> {
     out
 }
 
-/// Renders the chart as SVG text (with labels).
+/// Renders the chart as SVG text (with labels, and its legend as drawn in its `<desc>`).
 pub fn svg_string(c: &Chart) -> Result<String, String> {
     let mut s = String::new();
     {
-        let root = SVGBackend::with_string(&mut s, (WIDTH_PX, HEIGHT_PX)).into_drawing_area();
+        let root = SVGBackend::with_string(&mut s, (WIDTH_PX, height(c))).into_drawing_area();
         draw(root, c, true)?;
     }
-    Ok(s)
+    Ok(described(s, c.title, &legend(c)))
 }
 
 /// Draws the chart as a PNG into `path` (`text`: with title, labels and legend).
 fn png(path: &Path, c: &Chart, text: bool) -> Result<(), String> {
-    let root = BitMapBackend::new(path, (WIDTH_PX, HEIGHT_PX)).into_drawing_area();
+    let root = BitMapBackend::new(path, (WIDTH_PX, height(c))).into_drawing_area();
     draw(root, c, text)
 }
 
@@ -506,6 +757,7 @@ mod tests {
             }],
             log_y: false,
             omitted: None,
+            x_names: Vec::new(),
         }
     }
 
@@ -550,5 +802,76 @@ mod tests {
         let (_, paths) = write(dir.path(), &chart("Title")).expect("write");
         let bytes = std::fs::read(&paths[1]).expect("png");
         assert_eq!(&bytes[1..4], b"PNG");
+    }
+
+    /// The `<desc>` of an SVG: its legend lines.
+    fn desc_lines(svg: &str) -> Vec<String> {
+        let d = svg
+            .split("<desc>legend:\n")
+            .nth(1)
+            .and_then(|d| d.split("</desc>").next())
+            .expect("a legend record");
+        d.lines().map(str::to_string).collect()
+    }
+
+    #[test]
+    fn the_svg_records_each_legend_entry_with_the_points_drawn() {
+        let mut c = chart("Residuals");
+        // A series of holes and one of values at or below 0 on a log axis draw nothing;
+        // the record says so (0 points), as the test over every chart reads it.
+        c.series.push(Series {
+            label: "holes".into(),
+            points: vec![(0.0, f64::NAN), (f64::INFINITY, 1.0)],
+            color: 1,
+            scatter: false,
+            dashed: true,
+        });
+        let svg = svg_string(&c).expect("svg");
+        assert!(svg.contains("<title>Residuals</title>"), "{svg}");
+        let lines = desc_lines(&svg);
+        assert_eq!(lines.len(), 2, "{lines:?}");
+        assert!(
+            lines[0].starts_with("measured [#1F77B4 line]: 200 points, y from -"),
+            "{lines:?}"
+        );
+        assert_eq!(lines[1], "holes [#D62728 dashed line]: 0 points");
+        // On a logarithmic axis, values not above 0 are not drawn, and not counted.
+        c.log_y = true;
+        let e = legend(&c);
+        let positive = c.series[0].points.iter().filter(|p| p.1 > 0.0).count();
+        assert_eq!(e[0].points, positive);
+        assert!(e[0].y_range.is_some_and(|(lo, _)| lo > 0.0), "{e:?}");
+        // The record is the SVG's first child, so the picture is unchanged below it.
+        let at = svg.find("<title>").expect("title");
+        assert_eq!(svg[..at].matches('<').count(), 1, "{}", &svg[..at]);
+    }
+
+    #[test]
+    fn a_named_axis_has_one_tick_per_whole_position_with_its_name() {
+        for n in [1usize, 2, 3, 7, 12] {
+            let mut c = chart("The ladder");
+            c.x_names = (0..n).map(|k| format!("{k}: step")).collect();
+            c.series[0].points = (0..n).map(|k| (k as f64, 1.0 / (1.0 + k as f64))).collect();
+            let svg = svg_string(&c).expect("svg");
+            // The SVG's texts: (y, text).
+            let texts: Vec<(String, String)> = svg
+                .split("<text")
+                .skip(1)
+                .filter_map(|t| {
+                    let (head, rest) = t.split_once('>')?;
+                    let y = head.split(" y=\"").nth(1)?.split('"').next()?;
+                    let text = rest.split("</text>").next()?.trim();
+                    (!text.is_empty()).then(|| (y.to_string(), text.to_string()))
+                })
+                .collect();
+            for name in &c.x_names {
+                let k = texts.iter().filter(|t| &t.1 == name).count();
+                assert_eq!(k, 1, "{n}: {name}: {texts:?}");
+            }
+            // No other tick on the names' line (a fractional step's number, 0.2, 0.5).
+            let line = texts.iter().find(|t| t.1.ends_with(": step")).map(|t| &t.0);
+            let ticks_on_that_line = texts.iter().filter(|t| Some(&t.0) == line).count();
+            assert_eq!(ticks_on_that_line, n, "{n} steps");
+        }
     }
 }

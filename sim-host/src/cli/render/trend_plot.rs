@@ -22,7 +22,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::path::Path;
 
-use super::plot::PALETTE;
+use super::plot::{LegendEntry, PALETTE};
 
 /// The most motors one plot draws.
 pub const MAX_MOTORS: usize = 6;
@@ -177,19 +177,22 @@ pub fn write(path: &Path, motors: &[MotorTrend], opts: &TrendOptions) -> Result<
         return Ok(());
     }
     let mut svg = String::new();
-    {
+    let legend = {
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-        draw(root, &shown, &panels, opts)?;
-    }
+        draw(root, &shown, &panels, opts)?
+    };
+    let svg = super::plot::described(svg, "The motors' indicators over time", &legend);
     monitor_api::files::write_atomic(path, svg.as_bytes()).map_err(|e| e.to_string())
 }
 
+/// Draws every panel into `root`; returns the legend as drawn: each motor named once, on
+/// the first panel where it has a point ([`draw_lines`]).
 fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     motors: &[&MotorTrend],
     panels: &[TrendPanel],
     opts: &TrendOptions,
-) -> Result<(), String>
+) -> Result<Vec<LegendEntry>, String>
 where
     DB::ErrorType: 'static,
 {
@@ -203,12 +206,13 @@ where
         .fold(f64::INFINITY, f64::min);
     let t0 = if t0.is_finite() { t0 } else { 0.0 };
     let areas = root.split_evenly((panels.len(), 1));
+    let mut legend = Vec::new();
     for (k, (panel, area)) in panels.iter().zip(&areas).enumerate() {
         let last = k + 1 == panels.len();
-        draw_panel(area, motors, opts, panel, (k, last), t0)?;
+        draw_panel(area, motors, opts, panel, (k, last, t0), &mut legend)?;
     }
     root.present().map_err(e)?;
-    Ok(())
+    Ok(legend)
 }
 
 /// The panel's y range and band levels: (y0, y1, WATCH level, FAULT level); with `raw`
@@ -262,14 +266,15 @@ fn panel_range(
     (y0 - pad, y1 + pad, watch, fault)
 }
 
-/// Draws panel `k` (indicator `panel`) of the motors' lines with its bands.
+/// Draws panel `k` (indicator `panel`, days from `t0`) of the motors' lines with its bands,
+/// naming in its legend the motors not yet in `legend` ([`draw_lines`]).
 fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     motors: &[&MotorTrend],
     opts: &TrendOptions,
     &(column, title, in_scatters): &TrendPanel,
-    (k, last): (usize, bool),
-    t0: f64,
+    (k, last, t0): (usize, bool, f64),
+    legend: &mut Vec<LegendEntry>,
 ) -> Result<(), String>
 where
     DB::ErrorType: 'static,
@@ -316,7 +321,7 @@ where
         .light_line_style(WHITE.mix(0.0))
         .draw()
         .map_err(e)?;
-    draw_lines(&mut chart, series, k == 0)
+    draw_lines(&mut chart, series, legend)
 }
 
 /// The severity bands over `0..x1` and `y0..y1`: in scatters, OK within ±`watch` and
@@ -341,31 +346,55 @@ fn bands(
     }
 }
 
-/// Draws the motors' lines (points joined) and, with `legend`, the legend.
+/// Draws the motors' lines (points joined), and a legend naming each motor drawn here with
+/// at least one point that `legend` (the entries of the panels above) does not name yet:
+/// every motor is named once, beside a line of its own (a motor with nothing to draw on the
+/// first panel is named on the next one where it has a point).
 fn draw_lines<'a, DB: DrawingBackend + 'a>(
     chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     series: Vec<PlotLine>,
-    legend: bool,
+    legend: &mut Vec<LegendEntry>,
 ) -> Result<(), String>
 where
     DB::ErrorType: 'static,
 {
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    let mut named_here = false;
     for (name, pts, i) in series {
         let col = PALETTE[i % PALETTE.len()];
+        let ys: Vec<f64> = pts
+            .iter()
+            .filter(|p| p.0.is_finite() && p.1.is_finite())
+            .map(|p| p.1)
+            .collect();
+        let name_it = !ys.is_empty() && legend.iter().all(|l| l.label != name);
+        if name_it {
+            legend.push(LegendEntry {
+                label: name.clone(),
+                look: super::plot::look(i, false, false),
+                points: ys.len(),
+                y_range: (!ys.is_empty()).then(|| {
+                    (
+                        ys.iter().copied().fold(f64::INFINITY, f64::min),
+                        ys.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                    )
+                }),
+            });
+        }
         chart
             .draw_series(pts.iter().map(|&p| Circle::new(p, 2, col.filled())))
             .map_err(e)?;
         let a = chart
             .draw_series(LineSeries::new(pts, col.stroke_width(2)))
             .map_err(e)?;
-        if legend {
+        if name_it {
+            named_here = true;
             a.label(name).legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 16, y)], col.stroke_width(2))
             });
         }
     }
-    if legend {
+    if named_here {
         chart
             .configure_series_labels()
             .position(SeriesLabelPosition::UpperLeft)
