@@ -227,7 +227,7 @@ fn boot_board(flash: &mut BoardFlash, facts: &BootFacts) -> (BootMachine, Sample
 /// executor and thread mode's periods ([`Thread::run`]).
 #[embassy_executor::main]
 async fn main(_spawner: Spawner) {
-    let (p, facts) = startup::start(&mut startup_hw::Registers);
+    let (p, facts) = startup::start(&mut startup_hw::StartRegisters);
     reset_ram::FINDINGS.store(facts.findings.0, Ordering::Relaxed);
     info!("drive-monitor {} starting", env!("CARGO_PKG_VERSION"));
     logs::log_facts(&facts);
@@ -342,7 +342,7 @@ impl ThreadHw for ThreadBoard {
 
     fn write_record(&mut self, record: Option<ResetRecord>) {
         match record {
-            Some(r) => reset_ram::record(r),
+            Some(r) => reset_ram::record(r, supply::bor_level()),
             None => reset_ram::write_reset_record(&[0; RESET_RECORD_LEN]),
         }
     }

@@ -16,7 +16,7 @@ use crate::clock::{ClockSource, ADC_PRESC};
 use crate::supply::BOR_GOAL;
 
 pub mod registers;
-pub use registers::{Check, CheckId, Expectation};
+pub use registers::{CheckId, Expectation, RegisterCheck};
 
 /// A finding's bit: the crystal did not start within `clock::HSE_STARTUP_TIMEOUT_MS` (the
 /// HSI clocks the PLL instead).

@@ -10,8 +10,7 @@ use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 
 use drive_monitor::boot_block::{BootBlock, BOOT_BLOCK_LEN};
 use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
-
-use super::supply::bor_level;
+use drive_monitor::supply::BorLevel;
 
 /// What the firmware is doing ([`BootPhase::number`]), for the record of a `defmt` panic.
 pub(super) static PHASE: AtomicU8 = AtomicU8::new(0);
@@ -47,11 +46,11 @@ pub(super) fn mark_up(long: bool) {
     });
 }
 
-/// Writes `record` into the reset record with the brown-out level in force and the run's
-/// self-check findings.
-pub(super) fn record(record: ResetRecord) {
+/// Writes `record` into the reset record with the brown-out level in force (`bor`,
+/// `supply::bor_level`) and the run's self-check findings.
+pub(super) fn record(record: ResetRecord, bor: Option<BorLevel>) {
     let record = record
-        .with_bor_level(bor_level())
+        .with_bor_level(bor)
         .with_findings(FINDINGS.load(Ordering::Relaxed));
     write_reset_record(&record.encode());
 }

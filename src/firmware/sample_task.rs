@@ -393,7 +393,7 @@ fn set_up_acquisition(
     path: &mut SamplePath,
 ) -> (Qei<'static, peripherals::TIM4>, HwAcquisition) {
     mark_phase(BootPhase::AdcSetup);
-    reset_ram::record(ResetRecord::setup(BootPhase::AdcSetup));
+    reset_ram::record(ResetRecord::setup(BootPhase::AdcSetup), supply::bor_level());
     let expected = EncoderExpected {
         filter: hw.encoder.input_filter,
         invert_a: hw.encoder.invert_a,

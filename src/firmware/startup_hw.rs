@@ -15,7 +15,7 @@ use super::reset_ram;
 use super::stack;
 
 /// The registers before `init` (and the peripherals it hands back).
-pub(super) struct Registers;
+pub(super) struct StartRegisters;
 
 /// embassy-stm32's configuration for the PLL from `source` at 170 MHz: 24 MHz HSE / 6 (or
 /// 16 MHz HSI / 4) x 85 / 2, boost mode, the ADC12 clock from SYSCLK (the settings of
@@ -53,7 +53,7 @@ fn clock_config(source: Option<ClockSource>) -> embassy_stm32::Config {
     config
 }
 
-impl StartupHw for Registers {
+impl StartupHw for StartRegisters {
     type Peripherals = embassy_stm32::Peripherals;
 
     fn read_freeze(&mut self) -> FreezeRegisters {

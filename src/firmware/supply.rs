@@ -61,7 +61,7 @@ impl SetupGuard {
 #[cortex_m_rt::exception]
 fn SysTick() {
     if let Some(record) = setup_guard::on_deadline(SETUP_STEP.load(Ordering::SeqCst)) {
-        reset_ram::record(record);
+        reset_ram::record(record, bor_level());
         cortex_m::peripheral::SCB::sys_reset();
     }
 }

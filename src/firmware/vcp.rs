@@ -43,6 +43,27 @@ pub(super) fn report_boot(
         error!("virtual COM port: USART2 not configured: no boot report there");
         return;
     };
+    let head = head_lines(facts);
+    let totals = report::totals_line(&log::totals(&mut pages));
+    let mut lines = head.into_iter().flatten().chain([totals]).chain(
+        log::newest::<_, 4>(&mut pages)
+            .0
+            .into_iter()
+            .flatten()
+            .map(|e| report::entry_line(&e)),
+    );
+    if lines
+        .try_for_each(|l| vcp.blocking_write(l.as_bytes()))
+        .is_err()
+    {
+        error!("virtual COM port: write failed");
+    }
+    let _ = vcp.blocking_flush();
+}
+
+/// The report's first lines: the boot line, the previous run's end, the self-check's
+/// findings and the safe mode (when there are any).
+fn head_lines(facts: &BootFacts) -> [Option<report::ReportLine>; 4] {
     let clock = match facts.clock {
         Some(ClockSource::Hse) => "24 MHz crystal (HSE)",
         Some(_) => "internal oscillator (HSI, +-1 %)",
@@ -61,25 +82,10 @@ pub(super) fn report_boot(
         };
         report::safe_mode_line(reason.code(), why)
     });
-    let head = [
+    [
         Some(report::boot_line(version, facts.reset_source, bor, clock)),
         Some(report::previous_line(&facts.previous)),
         findings,
         safe,
-        Some(report::totals_line(&log::totals(&mut pages))),
-    ];
-    let mut lines = head.into_iter().flatten().chain(
-        log::newest::<_, 4>(&mut pages)
-            .0
-            .into_iter()
-            .flatten()
-            .map(|e| report::entry_line(&e)),
-    );
-    if lines
-        .try_for_each(|l| vcp.blocking_write(l.as_bytes()))
-        .is_err()
-    {
-        error!("virtual COM port: write failed");
-    }
-    let _ = vcp.blocking_flush();
+    ]
 }

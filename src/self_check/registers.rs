@@ -10,7 +10,7 @@
 
 /// One check: the register at `address`, its bits in `mask` against `expected`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Check {
+pub struct RegisterCheck {
     /// What is checked (its bit in the mismatch mask: [`CheckId::bit`]).
     pub id: CheckId,
     /// The register's address.
@@ -21,7 +21,7 @@ pub struct Check {
     pub expected: u32,
 }
 
-impl Check {
+impl RegisterCheck {
     /// Whether a read `value` of the register holds the expected bits.
     pub const fn holds(&self, value: u32) -> bool {
         value & self.mask == self.expected
@@ -216,7 +216,7 @@ impl Expectation {
     };
 
     /// The check `id` against this expectation.
-    pub const fn check(&self, id: CheckId) -> Check {
+    pub const fn check(&self, id: CheckId) -> RegisterCheck {
         let (address, mask, expected) = match id {
             CheckId::FreezeWatchdog => (DBGMCU_APB1FZR1, 1 << 12, 1 << 12),
             CheckId::FreezeTimers => (DBGMCU_APB2FZR, (1 << 11) | (1 << 16), (1 << 11) | (1 << 16)),
@@ -251,7 +251,7 @@ impl Expectation {
                 ((self.adc_presc & 0xF) << 18) | (1 << 22),
             ),
         };
-        Check {
+        RegisterCheck {
             id,
             address,
             mask,

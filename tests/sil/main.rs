@@ -29,10 +29,11 @@ mod recovery;
 mod reference_gain;
 mod same_state;
 mod startup;
+mod thread;
 
 use drive_monitor::app::{
     panel_input, period, AcquisitionPause, Command, MonitorStatus, PeriodInput, SamplePath,
-    Settings, Supervisor, ThreadHw, ThreadState, Tick, PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
+    Settings, Supervisor, ThreadState, Tick, PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
 };
 use drive_monitor::board::Lamp;
 use drive_monitor::board::{self, RECORD_PAGE_SIZE};
@@ -54,6 +55,7 @@ use drive_monitor::supply::BorCheck;
 use monitor_core::{Abc, Calibration, CommissioningFailure, Fault, RunStage};
 use monitor_io::params::ParamFile;
 use monitor_sim::{simulate_to_vec, FaultSpec, LoadStep, Scenario};
+use thread::RigThread;
 
 const FS: u32 = board::DEFAULT_SAMPLE_RATE_HZ;
 const PERIODS_PER_MS: u64 = FS as u64 / 1000;
@@ -252,41 +254,6 @@ struct Rig {
     pending_trim: Option<TrimResult>,
     /// The runs marked up (`false`) and long up (`true`), in order.
     marked_up: Vec<bool>,
-}
-
-/// Thread mode's hardware on the rig (`app::ThreadHw`): the survivors' flash and reset
-/// record, the acquisition's pause on the register model, the watchdog's last pet, the
-/// reference when the test gives one.
-struct RigThread<'a> {
-    now_ms: u32,
-    flash: &'a mut FakeFlash,
-    reset_ram: &'a mut [u8; RESET_RECORD_LEN],
-    pause: ModelPause<'a>,
-    reference: Option<&'a mut startup::FakeReference>,
-    last_pet_ms: &'a mut u32,
-    marked_up: &'a mut Vec<bool>,
-}
-
-impl<'a> ThreadHw for RigThread<'a> {
-    type Store = FakeFlash;
-    type Pause = ModelPause<'a>;
-    type Reference = startup::FakeReference;
-    fn pet_watchdog(&mut self) {
-        *self.last_pet_ms = self.now_ms;
-    }
-    fn store_and_pause(&mut self) -> (&mut FakeFlash, &mut ModelPause<'a>) {
-        (&mut *self.flash, &mut self.pause)
-    }
-    fn reference(&mut self) -> Option<&mut startup::FakeReference> {
-        self.reference.as_deref_mut()
-    }
-    fn show(&mut self, _lamps: &drive_monitor::panel::PanelLamps) {}
-    fn write_record(&mut self, record: Option<ResetRecord>) {
-        *self.reset_ram = record.map_or([0; RESET_RECORD_LEN], |r| r.encode());
-    }
-    fn mark_up(&mut self, long: bool) {
-        self.marked_up.push(long);
-    }
 }
 
 /// The sample task's pause around a flash store on the rig: the firmware's

@@ -210,6 +210,30 @@ fn fw(check: bool) -> Result<(), String> {
     } = usage(&elf)?;
     println!("ELF: {}", elf_path.display());
     let verdict = budget.verdict(flash);
+    let in_bank1 = flash_end <= BANK2_START;
+    let stack_below = first_static != u64::MAX && first_static > 0x2000_0000;
+    print_usage(&budget, verdict, (flash, ram), (flash_end, first_static));
+    if check && (verdict == Verdict::Over || ram > RAM_GOAL) {
+        return Err("size budget missed".into());
+    }
+    if check && !in_bank1 {
+        return Err("a section lies in bank 2, the records' pages (memory.x)".into());
+    }
+    if check && !stack_below {
+        return Err("the statics start at the bottom of RAM: the firmware was not linked with flip-link (.cargo/config.toml)".into());
+    }
+    Ok(())
+}
+
+/// Prints the flash use against the `budget` (its `verdict`), the static RAM against its
+/// goal, where the code ends (`flash_end`: bank 1 or not) and where the stack lies (below
+/// the first static, `first_static`: flip-link).
+fn print_usage(
+    budget: &Budget,
+    verdict: Verdict,
+    (flash, ram): (u64, u64),
+    (flash_end, first_static): (u64, u64),
+) {
     println!(
         "flash={flash} bytes ({:.1} KiB of bank 1's {} KiB in memory.x: {}; warn above {} KiB, fail above {} KiB)",
         flash as f64 / 1024.0,
@@ -228,10 +252,9 @@ fn fw(check: bool) -> Result<(), String> {
         RAM_GOAL / 1024,
         if ram <= RAM_GOAL { "ok" } else { "OVER GOAL" }
     );
-    let in_bank1 = flash_end <= BANK2_START;
     println!(
         "code and constants end at {flash_end:#010x}: {}",
-        if in_bank1 {
+        if flash_end <= BANK2_START {
             "bank 1 (bank 2, from 0x08040000, is the records')"
         } else {
             "IN BANK 2"
@@ -253,16 +276,6 @@ fn fw(check: bool) -> Result<(), String> {
             "NOT flip-link"
         }
     );
-    if check && (verdict == Verdict::Over || ram > RAM_GOAL) {
-        return Err("size budget missed".into());
-    }
-    if check && !in_bank1 {
-        return Err("a section lies in bank 2, the records' pages (memory.x)".into());
-    }
-    if check && !stack_below {
-        return Err("the statics start at the bottom of RAM: the firmware was not linked with flip-link (.cargo/config.toml)".into());
-    }
-    Ok(())
 }
 
 /// `fw bring-up` (`bring_up`): the firmware built, flashed (unless `--no-flash`) and its
