@@ -1,6 +1,6 @@
 //! The clock tree, written once: the PLL's settings that the firmware's clock
-//! configuration (`clock_config` in `src/firmware.rs`) hands embassy-stm32, and every rate
-//! and cycle count derived from them (the fault path's wait, the set-up deadline's SysTick
+//! configuration (`clock_config` in `src/firmware/startup_hw.rs`) hands embassy-stm32, and
+//! every rate and cycle count derived from them (the fault path's wait, the set-up deadline's SysTick
 //! reload, the encoder timer's clock, the sample trigger's and the ADC's rates).
 //!
 //! The source is the NUCLEO-G474RE's 24 MHz crystal (HSE, [`ClockSource::Hse`]): 24 MHz /
