@@ -183,8 +183,9 @@ mod tests {
         assert_eq!(BootBlock::decode(&b.encode()), Some(b));
         assert_eq!(BootBlock::decode(&[0x5A; BOOT_BLOCK_LEN]), None);
         assert_eq!(BootBlock::decode(&[0; BOOT_BLOCK_LEN]), None);
-        assert_eq!(&b.encode()[..4], b"DMBB");
-        assert_eq!(b.encode()[8], BootPhase::Clock.number());
+        // The header the module docs give: magic, version 1, a payload of 4 bytes.
+        assert_eq!(b.encode()[..8], *b"DMBB\x01\x00\x04\x00");
+        assert_eq!(b.encode()[8..12], [BootPhase::Clock.number(), 3, 2, 0]);
     }
 
     /// Five runs that fail before they are up: the sixth boot is the safe mode's. A run

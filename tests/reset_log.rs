@@ -131,6 +131,17 @@ fn every_reset_is_counted_and_failed_runs_are_entered() {
         log::record_boot(&mut flash, &failed(7)),
         Ok(Written::Entry(1))
     );
+    // The layouts of the module docs: the page's header (magic `DMLP`, version 1, a payload
+    // of 52 bytes), four counts of 8 bytes (`C`, the kind's index, the count, the check),
+    // then the entry (magic `DMRL`, version 2, a payload of 140 bytes).
+    let page = &flash.pages[0];
+    assert_eq!(page[..8], *b"DMLP\x01\x00\x34\x00");
+    let power_on = [b'C', 0, 1, 0];
+    let check = (!u32::from_le_bytes(power_on)).to_le_bytes();
+    assert_eq!(page[64..68], power_on);
+    assert_eq!(page[68..72], check);
+    assert_eq!(page[72..76], [b'C', 2, 1, 0], "the reset button's count");
+    assert_eq!(page[96..104], *b"DMRL\x02\x00\x8c\x00");
     let t = log::totals(&mut flash);
     assert_eq!(t.resets(ResetKind::PowerOn), 2);
     assert_eq!(t.resets(ResetKind::Pin), 1);
