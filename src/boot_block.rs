@@ -186,6 +186,21 @@ mod tests {
         // The header the module docs give: magic, version 1, a payload of 4 bytes.
         assert_eq!(b.encode()[..8], *b"DMBB\x01\x00\x04\x00");
         assert_eq!(b.encode()[8..12], [BootPhase::Clock.number(), 3, 2, 0]);
+        // Every flag alone round trips.
+        for (up, long_up) in [(false, false), (true, false), (false, true), (true, true)] {
+            let b = BootBlock {
+                up,
+                long_up,
+                ..BootBlock::default()
+            };
+            assert_eq!(BootBlock::decode(&b.encode()), Some(b));
+        }
+        // Marked up: the failed boots in a row end there.
+        let marked = b.marked_up(false);
+        assert_eq!(
+            (marked.failed_boots, marked.up, marked.long_up),
+            (0, true, true)
+        );
     }
 
     /// Five runs that fail before they are up: the sixth boot is the safe mode's. A run

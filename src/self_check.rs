@@ -145,6 +145,131 @@ mod tests {
             CheckId::BOOT.len() + CheckId::ACQUISITION.len(),
             CheckId::ALL.len()
         );
+        // Each check names its register and field, as the log and `cargo fw bring-up` print
+        // them; no two alike.
+        let names: Vec<&str> = CheckId::ALL.iter().map(|c| c.name()).collect();
+        for (id, name) in CheckId::ALL.iter().zip(&names) {
+            let register = match e.check(*id).address {
+                0xE004_2008 => "DBGMCU_APB1FZR1.",
+                0xE004_2010 => "DBGMCU_APB2FZR.",
+                0x4002_1000 => "RCC_CR.",
+                0x4002_2020 => "FLASH_OPTR.",
+                0x4000_0808 => "TIM4_SMCR.",
+                0x4000_0818 => "TIM4_CCMR1.",
+                0x4000_081C => "TIM4_CCMR2.",
+                0x4000_0820 => "TIM4_CCER.",
+                0x4000_080C => "TIM4_DIER.",
+                0x5000_0308 => "ADC12_CCR.",
+                other => panic!("{id:?} at {other:#x}, an address not in RM0440's list"),
+            };
+            assert!(name.starts_with(register), "{id:?}: {name}");
+        }
+        let mut sorted = names.clone();
+        sorted.sort_unstable();
+        sorted.dedup();
+        assert_eq!(sorted.len(), names.len());
+    }
+
+    /// Every check's register, mask and expected bits, RM0440's fields written out as
+    /// numbers (the board's run: the crystal, the encoder's filter 6 with input A inverted).
+    #[test]
+    fn every_check_reads_the_bits_rm0440_gives() {
+        let setup = EncoderExpected {
+            filter: 6,
+            invert_a: true,
+        };
+        let e = expectation(ClockSource::Hse, Some(setup));
+        let table = [
+            (
+                CheckId::FreezeWatchdog,
+                0xE004_2008,
+                0x0000_1000,
+                0x0000_1000,
+            ),
+            (CheckId::FreezeTimers, 0xE004_2010, 0x0001_0800, 0x0001_0800),
+            (
+                CheckId::ClockSecurity,
+                0x4002_1000,
+                0x0008_0000,
+                0x0008_0000,
+            ),
+            (CheckId::CcmSramKept, 0x4002_2020, 0x0200_0000, 0x0200_0000),
+            (
+                CheckId::SramParityOff,
+                0x4002_2020,
+                0x0100_0000,
+                0x0100_0000,
+            ),
+            (
+                CheckId::BootFromFlash,
+                0x4002_2020,
+                0x0800_0000,
+                0x0800_0000,
+            ),
+            (
+                CheckId::WatchdogBySoftware,
+                0x4002_2020,
+                0x0001_0000,
+                0x0001_0000,
+            ),
+            (CheckId::BootBank1, 0x4002_2020, 0x0010_0000, 0),
+            (CheckId::DualBank, 0x4002_2020, 0x0040_0000, 0x0040_0000),
+            (
+                CheckId::BrownOutLevel,
+                0x4002_2020,
+                0x0000_0700,
+                0x0000_0400,
+            ),
+            (CheckId::EncoderMode, 0x4000_0808, 0x0031_0077, 0x0000_0003),
+            (
+                CheckId::EncoderInputs,
+                0x4000_0818,
+                0x0000_F3F3,
+                0x0000_6161,
+            ),
+            (CheckId::EncoderLatch, 0x4000_081C, 0x0000_0003, 0x0000_0003),
+            (
+                CheckId::EncoderEnables,
+                0x4000_0820,
+                0x0000_0333,
+                0x0000_0113,
+            ),
+            (CheckId::LatchDma, 0x4000_080C, 0x0000_0800, 0x0000_0800),
+            (CheckId::AdcCommon, 0x5000_0308, 0x007F_001F, 0x0048_0000),
+        ];
+        for (id, address, mask, expected) in table {
+            assert_eq!(
+                e.check(id),
+                RegisterCheck {
+                    id,
+                    address,
+                    mask,
+                    expected
+                },
+                "{id:?}"
+            );
+        }
+        // Not knowing the record: the filter's and the direction's bits left out.
+        let b = Expectation::BRING_UP;
+        assert_eq!(b.check(CheckId::EncoderInputs).mask, 0x0303);
+        assert_eq!(b.check(CheckId::EncoderEnables).mask, 0x0331);
+    }
+
+    /// The findings: clean only without a bit; a finding found twice stays found.
+    #[test]
+    fn findings_add_up_and_a_check_listed_twice_is_found_once() {
+        assert!(Findings::NONE.is_clean());
+        let f = Findings(CheckId::DualBank.bit());
+        assert!(!f.is_clean());
+        assert_eq!(f.with(CheckId::DualBank.bit()), f);
+        assert_eq!(
+            f.with(PLL_DID_NOT_LOCK).0,
+            CheckId::DualBank.bit() | PLL_DID_NOT_LOCK
+        );
+        assert!(f.with(PLL_DID_NOT_LOCK).pll_did_not_lock());
+        let e = expectation(ClockSource::Hse, None);
+        let twice = [CheckId::DualBank, CheckId::DualBank];
+        assert_eq!(run(&twice, &e, |_| 0), f);
     }
 
     /// The G474's factory option bytes (0xFFEF_F8AA, RM0440) hold everything the firmware

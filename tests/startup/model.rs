@@ -25,6 +25,9 @@ pub const IWDGRSTF: u32 = 1 << 29;
 pub const PINRSTF: u32 = 1 << 26;
 pub const BORRSTF: u32 = 1 << 27;
 
+/// `PLLRDY` clears this long after `PLLON` is cleared [us].
+pub const PLL_OFF_US: u64 = 20;
+
 /// One step the model saw, in order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Op {
@@ -45,6 +48,13 @@ pub struct Iwdg {
     pub reloads: u32,
     /// Writes of `PR`/`RLR` while locked (ignored by the hardware).
     pub locked_writes: u32,
+    /// Polls of `SR` a new `PR`/`RLR` takes to reach the LSI domain (`PVU`/`RVU` set).
+    pub update_polls: u32,
+    /// `SR` polls while the update was on its way, and in all.
+    pub polls_updating: u32,
+    pub polls: u32,
+    /// A reload key written while the update was still on its way.
+    pub reloads_while_updating: u32,
 }
 
 /// The board (module docs).
@@ -70,6 +80,12 @@ pub struct Board {
     pub pll_on_at_us: Option<u64>,
     /// `CSSON` writes have no effect (a remedy that did not take).
     pub css_stuck_off: bool,
+    /// `SR` polls a new watchdog setting takes to reach the LSI domain.
+    pub iwdg_update_polls: u32,
+    /// When the PLL was switched off [us] (`PLLRDY` clears [`PLL_OFF_US`] later).
+    pub pll_off_at_us: Option<u64>,
+    /// `PLLRDY` was still set when `init` was called.
+    pub pll_ready_at_init: bool,
     pub now_us: u64,
     pub ops: Vec<Op>,
     pub init_with: Option<Option<ClockSource>>,
@@ -97,6 +113,9 @@ impl Board {
             pllcfgr: 0,
             pll_on_at_us: None,
             css_stuck_off: false,
+            iwdg_update_polls: 3,
+            pll_off_at_us: None,
+            pll_ready_at_init: false,
             now_us: 0,
             ops: Vec::new(),
             init_with: None,
@@ -114,6 +133,7 @@ impl Board {
         next.crystal_ready_after_us = self.crystal_ready_after_us;
         next.pll_from_hse_us = self.pll_from_hse_us;
         next.pll_from_hsi_us = self.pll_from_hsi_us;
+        next.iwdg_update_polls = self.iwdg_update_polls;
         next
     }
 
@@ -130,6 +150,20 @@ impl Board {
 
     fn pll_source(&self) -> u32 {
         self.pllcfgr & 0b11
+    }
+
+    /// The PLL runs and has locked from its source.
+    fn pll_locked(&self) -> bool {
+        let Some(t0) = self.pll_on_at_us else {
+            return false;
+        };
+        // PLLSRC: 3 the crystal (which must run), 2 the HSI16.
+        let lock = match self.pll_source() {
+            3 if self.crystal_runs() => self.pll_from_hse_us,
+            2 => self.pll_from_hsi_us,
+            _ => None,
+        };
+        lock.is_some_and(|after| self.now_us >= t0 + after)
     }
 
     fn crystal_runs(&self) -> bool {
@@ -165,6 +199,9 @@ impl StartupHw for Board {
             0x5555 => self.iwdg.unlocked = true,
             0xAAAA => {
                 self.iwdg.reloads += 1;
+                if self.iwdg.update_polls > 0 {
+                    self.iwdg.reloads_while_updating += 1;
+                }
                 self.iwdg.unlocked = false;
             }
             _ => self.iwdg.unlocked = false,
@@ -173,12 +210,19 @@ impl StartupHw for Board {
     fn iwdg_setting(&mut self, setting: IwdgSetting) {
         if self.iwdg.unlocked {
             self.iwdg.setting = Some(setting);
+            self.iwdg.update_polls = self.iwdg_update_polls;
         } else {
             self.iwdg.locked_writes += 1;
         }
     }
     fn iwdg_updating(&mut self) -> bool {
-        false
+        self.iwdg.polls += 1;
+        let updating = self.iwdg.update_polls > 0;
+        if updating {
+            self.iwdg.polls_updating += 1;
+            self.iwdg.update_polls -= 1;
+        }
+        updating
     }
     fn reset_flags(&mut self) -> u32 {
         self.csr
@@ -216,24 +260,25 @@ impl StartupHw for Board {
         self.pllcfgr = pllcfgr;
     }
     fn pll_on(&mut self, on: bool) {
+        if !on && self.pll_locked() {
+            self.pll_off_at_us = Some(self.now_us);
+        }
         self.pll_on_at_us = on.then_some(self.now_us);
     }
     fn pll_ready(&mut self) -> bool {
-        let Some(t0) = self.pll_on_at_us else {
-            return false;
-        };
-        // PLLSRC: 3 the crystal (which must run), 2 the HSI16.
-        let lock = match self.pll_source() {
-            3 if self.crystal_runs() => self.pll_from_hse_us,
-            2 => self.pll_from_hsi_us,
-            _ => None,
-        };
-        lock.is_some_and(|after| self.now_us >= t0 + after)
+        if self.pll_on_at_us.is_none() {
+            // Switched off: PLLRDY clears a little later.
+            return self
+                .pll_off_at_us
+                .is_some_and(|t| self.now_us < t + PLL_OFF_US);
+        }
+        self.pll_locked()
     }
     fn delay_us(&mut self, us: u32) {
         self.now_us += u64::from(us);
     }
     fn init(&mut self, clock: Option<ClockSource>) {
+        self.pll_ready_at_init = self.pll_ready();
         self.block_at_init = Some(self.boot_block);
         self.init_with = Some(clock);
         self.ops.push(Op::Init);

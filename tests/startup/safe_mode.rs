@@ -7,7 +7,7 @@ use super::model::{Board, BORRSTF, IWDGRSTF, PINRSTF};
 use drive_monitor::boot_block::{BootBlock, ResetKind, SAFE_MODE_AFTER};
 use drive_monitor::panel::{read_blink_code, PanelLamps};
 use drive_monitor::reset_record::PreviousRun;
-use drive_monitor::startup::SafeModeReason;
+use drive_monitor::startup::{BootNote, SafeModeReason};
 
 /// The run after each boot hangs before it is up (the watchdog resets the MCU).
 #[test]
@@ -17,6 +17,13 @@ fn five_failed_boots_in_a_row_enter_the_safe_mode_and_the_reset_button_ends_it()
     for _ in 0..=SAFE_MODE_AFTER {
         let facts = boot(&mut board);
         seen.push((facts.history.failed_boots, facts.safe_mode.is_some()));
+        // The boot's log counts the failed boots from the second on.
+        let n = facts.history.failed_boots;
+        assert_eq!(
+            facts.notes().any(|note| note == BootNote::FailedBoots(n)),
+            n > 1,
+            "{n}"
+        );
         if facts.safe_mode.is_some() {
             assert_eq!(
                 facts.safe_mode,
