@@ -51,6 +51,8 @@ mod status_line;
 pub use status_line::{status_line, BoardCounters};
 mod store;
 pub use store::{carry_out, AcquisitionPause, NoPause};
+mod period;
+pub use period::{period, PeriodInput, PeriodOutput, ThreadHw, ThreadState};
 
 /// The machine the firmware monitors by default: the "2.2 kW" reference machine
 /// (`monitor_core::reference::MOTOR_2P2KW`: 400 V, 50 Hz, 4 poles, Gamma model, Bl for the

@@ -129,10 +129,10 @@ pub fn encoder_input_filter(lines: u16, max_rev_per_s: f32, timer_hz: u32) -> u8
         .map_or(0, |k| k as u8)
 }
 
-/// Offset of the commissioning record from the start of flash (0x0800_0000), bytes:
-/// the last 2 KiB page of bank 2 (dual-bank mode), `0x0807_F800`. `memory.x` keeps the
-/// last 4 KiB out of the linker's reach so code can never land there. Writing bank 2
-/// while code runs from bank 1 does not stall instruction fetches.
+/// Offset of the commissioning record's first page from the start of flash (0x0800_0000),
+/// bytes: the last 2 KiB page of bank 2 (dual-bank mode), `0x0807_F800`. `memory.x` gives
+/// the linker bank 1 alone, so code can never land in bank 2, and writing bank 2 while
+/// code runs from bank 1 does not stall instruction fetches.
 pub const RECORD_FLASH_OFFSET: u32 = 0x0007_F800;
 /// Size of the flash page that holds the record (erase granularity, dual-bank mode).
 pub const RECORD_PAGE_SIZE: u32 = 2048;
@@ -140,10 +140,17 @@ pub const RECORD_PAGE_SIZE: u32 = 2048;
 /// board-record`) from the start of flash, bytes: the 2 KiB page before the commissioning
 /// record, `0x0807_F000`, also kept out of the linker's reach by `memory.x`.
 pub const MOTOR_RECORD_FLASH_OFFSET: u32 = RECORD_FLASH_OFFSET - RECORD_PAGE_SIZE;
-/// Offset of the reset log (`reset_record::log`: the last ends of a run, two pages) from
-/// the start of flash, bytes: the two 2 KiB pages before the motor record's, `0x0807_E000`
-/// and `0x0807_E800`, bank 2 like the records (`memory.x` keeps the code in bank 1).
-pub const RESET_LOG_FLASH_OFFSET: u32 = MOTOR_RECORD_FLASH_OFFSET - 2 * RECORD_PAGE_SIZE;
+/// Offset of the commissioning record's second page (`flash_record::RecordPage::B`: the
+/// two copies in turn), bytes: the page before the motor record's, `0x0807_E800`.
+pub const RECORD_B_FLASH_OFFSET: u32 = MOTOR_RECORD_FLASH_OFFSET - RECORD_PAGE_SIZE;
+/// Offset of the reset log (`reset_record::log`: the counts and the last ends of a run,
+/// `reset_record::log::PAGES` pages of 2 KiB) from the start of flash, bytes: the 16 pages
+/// before the record's second, `0x0807_6800`..`0x0807_E800`, bank 2 like the records.
+pub const RESET_LOG_FLASH_OFFSET: u32 = RECORD_B_FLASH_OFFSET - 16 * RECORD_PAGE_SIZE;
+/// The start of bank 2 (dual-bank mode) from the start of flash, bytes: `0x0804_0000`.
+/// Everything from here on is data (the records, the reset log), never code.
+pub const BANK2_OFFSET: u32 = 0x0004_0000;
+const _: () = assert!(RESET_LOG_FLASH_OFFSET >= BANK2_OFFSET);
 
 /// A GPIO port of the STM32G474 (`A` = GPIOA, ...).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -470,6 +477,28 @@ pub mod pins {
         }
     }
 }
+
+/// Where a front end's zero (0 V, 0 A) is biased, which decides how a drift of VDDA, the
+/// ADC's reference, moves its codes (`app::SamplePath::set_reference_gain`). The signal's
+/// swing is the amplifier's own (volts per volt or per ampere, not a share of VDDA) in
+/// both: a code is `zero + x / (per_lsb at commissioning) x (VDDA at commissioning / VDDA
+/// now)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ZeroBias {
+    /// The zero is a voltage of its own (an amplifier's reference pin): its code moves
+    /// with VDDA too, `zero x VDDA at commissioning / VDDA now`.
+    Absolute,
+    /// The zero is VDDA / 2 (a divider from VDDA, a mid-supply buffer): its code stays at
+    /// the same share of the range whatever VDDA does; only the swing around it scales.
+    /// Corrected as an absolute zero, it would move by `zero x drift`: 57 codes (11 V on the
+    /// voltage channels) at a 2.8 % drift.
+    HalfVdda,
+}
+
+/// The board's front end: the zero at VDDA / 2 (the isolated amplifiers' outputs level
+/// shifted onto a mid-supply reference from VDDA). A front end whose zero comes from a
+/// reference of its own is [`ZeroBias::Absolute`]: change it here.
+pub const ZERO_BIAS: ZeroBias = ZeroBias::HalfVdda;
 
 /// VDDA at which the factory measured `VREFINT_CAL` (STM32G474 datasheet: 3.0 V, 30 degC; the
 /// calibration word is at 0x1FFF_75AA).

@@ -1,6 +1,6 @@
 //! The clock tree, written once: the PLL's settings that the firmware's clock
-//! configuration (`clock_config` in `src/firmware.rs`) hands embassy-stm32, and every rate
-//! and cycle count derived from them (the fault path's wait, the set-up deadline's SysTick
+//! configuration (`clock_config` in `src/firmware/startup_hw.rs`) hands embassy-stm32, and
+//! every rate and cycle count derived from them (the fault path's wait, the set-up deadline's SysTick
 //! reload, the encoder timer's clock, the sample trigger's and the ADC's rates).
 //!
 //! The source is the NUCLEO-G474RE's 24 MHz crystal (HSE, [`ClockSource::Hse`]): 24 MHz /
@@ -111,6 +111,19 @@ impl ClockSource {
         }
     }
 }
+/// `RCC_PLLCFGR` for the PLL from `source` (RM0440, "PLL configuration register"), as
+/// embassy-stm32's `init` writes it from the firmware's clock configuration: `PLLSRC`
+/// (bits 1:0; 2 the HSI16, 3 the HSE), `PLLM - 1` (bits 7:4), `PLLN` (bits 14:8), `PLLREN`
+/// (bit 24) and `PLLR` = /2 (bits 26:25, `PLLR / 2 - 1`); the P and Q outputs off. The boot
+/// writes it for the PLL's bounded lock before `init` (`crate::startup::pll_locks`).
+pub const fn pll_cfgr(source: ClockSource) -> u32 {
+    let src = match source {
+        ClockSource::Hse => 3,
+        ClockSource::Hsi | ClockSource::HsiAfterFailure => 2,
+    };
+    src | ((source.prediv() - 1) << 4) | (PLL_MUL << 8) | (1 << 24) | ((PLL_RDIV / 2 - 1) << 25)
+}
+
 /// The PLL's multiplier `PLLN` (8..=127).
 pub const PLL_MUL: u32 = 85;
 /// The PLL's `R` output divider (2, 4, 6 or 8): SYSCLK.
@@ -221,5 +234,13 @@ mod tests {
         assert_eq!(timer_divider(30_000), None);
         assert_eq!(timer_divider(0), None);
         assert_eq!(ClockSource::HsiAfterFailure.sysclk_hz(), 170_000_000);
+        // RM0440's fields written out: HSE (3), M = 6 (5), N = 85, R enabled, R = /2 (0).
+        assert_eq!(pll_cfgr(ClockSource::Hse), 3 | 5 << 4 | 85 << 8 | 1 << 24);
+        // HSI16 (2), M = 4 (3).
+        assert_eq!(pll_cfgr(ClockSource::Hsi), 2 | 3 << 4 | 85 << 8 | 1 << 24);
+        assert_eq!(
+            pll_cfgr(ClockSource::HsiAfterFailure),
+            pll_cfgr(ClockSource::Hsi)
+        );
     }
 }

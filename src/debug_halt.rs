@@ -72,3 +72,43 @@ impl Freeze {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each stop bit set or cleared as the freeze says, from either value it held, every
+    /// other bit as read.
+    #[test]
+    fn each_stop_bit_follows_the_freeze_whatever_it_held() {
+        let all = FreezeRegisters {
+            apb1fzr1: u32::MAX,
+            apb2fzr: u32::MAX,
+        };
+        let none = FreezeRegisters {
+            apb1fzr1: 0,
+            apb2fzr: 0,
+        };
+        let off = Freeze {
+            trigger: false,
+            time_base: false,
+            watchdog: false,
+        };
+        assert_eq!(FROZEN.registers_after(all), all, "set stays set");
+        assert_eq!(
+            off.registers_after(all),
+            FreezeRegisters {
+                apb1fzr1: !DBG_IWDG_STOP,
+                apb2fzr: !(DBG_TIM1_STOP | DBG_TIM15_STOP),
+            }
+        );
+        assert_eq!(off.registers_after(none), none);
+        assert_eq!(
+            FROZEN.registers_after(none),
+            FreezeRegisters {
+                apb1fzr1: DBG_IWDG_STOP,
+                apb2fzr: DBG_TIM1_STOP | DBG_TIM15_STOP,
+            }
+        );
+    }
+}

@@ -8,7 +8,7 @@
 //!    reentrantly" when the first fault hit inside a log frame) finds it taken and goes
 //!    straight to the reset ([`FaultEnd::Reentered`]), the first record kept.
 //! 2. **The record next**, before anything else: the reset record (RAM that survives the
-//!    reset) with the brown-out level in force.
+//!    reset) with the brown-out level in force and the run's self-check findings.
 //! 3. **Then the panel's "monitor failed" pattern** on the lamp pins.
 //! 4. **No log.** The fault may have hit while a `defmt` frame was open (`defmt-rtt` holds
 //!    a critical section and a "taken" flag for a frame): any `defmt` call from here could
@@ -56,6 +56,9 @@ impl Default for FaultGuard {
 pub trait FaultBoard {
     /// The brown-out level in force (`None`: a reserved value).
     fn bor_level(&mut self) -> Option<BorLevel>;
+    /// The run's self-check findings (`crate::self_check::Findings`' bits), which the record
+    /// carries.
+    fn findings(&mut self) -> u32;
     /// Overwrites the reset record.
     fn write_record(&mut self, bytes: &[u8; RESET_RECORD_LEN]);
     /// Shows the panel's "monitor failed" pattern on the lamp pins (plain register
@@ -82,7 +85,13 @@ pub fn on_fault(guard: &FaultGuard, board: &mut impl FaultBoard, record: ResetRe
         return FaultEnd::Reentered;
     }
     let level = board.bor_level();
-    board.write_record(&record.with_bor_level(level).encode());
+    let findings = board.findings();
+    board.write_record(
+        &record
+            .with_bor_level(level)
+            .with_findings(findings)
+            .encode(),
+    );
     board.show_failed();
     FaultEnd::Recorded
 }

@@ -16,11 +16,14 @@
 //!   `EOC`, `EOS` and `TEIF` cleared, DMA re-armed, ADCs and trigger restarted, in the
 //!   reference manual's order. Every `status_every` samples the task hands thread mode a
 //!   small `MonitorStatus`.
-//! - `main` in thread mode: boot (clocks, watchdog, why the previous run ended, flash
-//!   record), then every 50 ms `Supervisor::tick`: button, commissioning procedure, the
-//!   watch on the sample counter (the watchdog is petted only while samples flow), panel;
-//!   it carries out the commissioning action (storing the record in flash) and logs a
-//!   status line every 100 ms.
+//! - `main` in thread mode: the start (`drive_monitor::startup::start` on the registers of
+//!   `firmware/startup_hw.rs`: the freeze, the watchdog, why the previous run ended, the
+//!   clock with its bounded waits, the self-check; the safe mode, `firmware/safe_mode.rs`,
+//!   when the boot gave up), the flash records, then every 50 ms thread mode's period
+//!   (`drive_monitor::app::period`: button, commissioning procedure, the watch on the sample
+//!   counter, the watchdog petted only while samples flow, the run marked up, panel, the
+//!   commissioning action carried out), its commands sent to the sample task, and a status
+//!   line every 100 ms.
 //! - The fault path (`firmware/failure.rs`: the panic handlers, `core`'s and defmt's, the
 //!   HardFault, NMI and default handlers; `drive_monitor::fault_path`): a guard, the reason
 //!   into the reset record (RAM that survives the reset), "monitor failed" on the panel, no
@@ -37,8 +40,10 @@ mod failure;
 mod flash;
 mod logs;
 mod reset_ram;
+mod safe_mode;
 mod sample_task;
 mod stack;
+mod startup_hw;
 mod supply;
 mod vcp;
 
@@ -60,20 +65,18 @@ use embassy_sync::signal::Signal;
 use embassy_time::{with_deadline, Duration, Instant, Timer};
 
 use drive_monitor::app::{
-    carry_out, status_line, BoardCounters, Command, MonitorStatus, SamplePath, Settings,
-    Supervisor, Tick, PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
+    period, status_line, BoardCounters, Command, MonitorStatus, PeriodInput, SamplePath, Settings,
+    Supervisor, ThreadHw, ThreadState, Tick, PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
 };
 use drive_monitor::board::{self, pins::Board, Lamp, LAMP_COUNT};
-use drive_monitor::boot::{self, BootMachine};
-use drive_monitor::clock::{self, ClockSource};
-use drive_monitor::commissioning::Action;
+use drive_monitor::boot::BootMachine;
 use drive_monitor::offset_trim::TrimResult;
 use drive_monitor::panel::PanelLamps;
-use drive_monitor::reset_record::{BootPhase, PreviousRun};
+use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
+use drive_monitor::startup::{self, BootFacts};
 use drive_monitor::supply::{BorCheck, BorGate};
-use drive_monitor::{debug_halt, watchdog};
 use monitor_core::Isolation;
-use reset_ram::set_phase;
+use reset_ram::{mark_phase, set_phase};
 
 use drive_monitor::flash_ecc::CheckedFlash;
 use flash::{read_motor_page, BoardFlash, Driver};
@@ -186,93 +189,9 @@ impl PanelPins {
     }
 }
 
-/// Starts the board's 24 MHz crystal (HSE) on the registers and waits for it at most
-/// `clock::HSE_STARTUP_TIMEOUT_MS` (the core runs on the 16 MHz HSI after reset: 16 000
-/// cycles a millisecond): embassy-stm32's clock set-up waits for `HSERDY` without a bound,
-/// so it is handed the crystal only once it runs. A crystal that did not start is
-/// switched off again and the clock falls back to the HSI (`ClockSource::Hsi`).
-fn start_crystal() -> ClockSource {
-    pac::RCC.cr().modify(|w| w.set_hseon(true));
-    for _ in 0..clock::HSE_STARTUP_TIMEOUT_MS {
-        if pac::RCC.cr().read().hserdy() {
-            return ClockSource::Hse;
-        }
-        cortex_m::asm::delay(clock::HSI_HZ / 1_000);
-    }
-    if pac::RCC.cr().read().hserdy() {
-        return ClockSource::Hse;
-    }
-    pac::RCC.cr().modify(|w| w.set_hseon(false));
-    ClockSource::Hsi
-}
-
-fn clock_config(source: ClockSource) -> embassy_stm32::Config {
-    use embassy_stm32::rcc::*;
-    let mut config = embassy_stm32::Config::default();
-    // 24 MHz HSE / 6 (or 16 MHz HSI / 4) * 85 / 2 = 170 MHz SYSCLK (the G474's maximum,
-    // needs boost mode): the settings of `drive_monitor::clock`, from which every rate and
-    // cycle count is derived (the registers' encodings: PLLM - 1, PLLN, PLLR / 2 - 1).
-    let pll_source = match source {
-        ClockSource::Hse => {
-            config.rcc.hse = Some(Hse {
-                freq: embassy_stm32::time::Hertz(clock::HSE_HZ),
-                mode: HseMode::Oscillator,
-            });
-            PllSource::HSE
-        }
-        ClockSource::Hsi | ClockSource::HsiAfterFailure => PllSource::HSI,
-    };
-    config.rcc.pll = Some(Pll {
-        source: pll_source,
-        prediv: PllPreDiv::from_bits((source.prediv() - 1) as u8),
-        mul: PllMul::from_bits(clock::PLL_MUL as u8),
-        divp: None,
-        divq: None,
-        divr: Some(PllRDiv::from_bits((clock::PLL_RDIV / 2 - 1) as u8)),
-    });
-    config.rcc.sys = Sysclk::PLL1_R;
-    config.rcc.boost = true;
-    // The ADC12 kernel clock mux defaults to "no clock" (Adc::new would panic).
-    config.rcc.mux.adc12sel = mux::Adcsel::SYS;
-    config
-}
-
-/// The first thing `main` does, before the clock set-up (which waits for the crystal and
-/// the PLL): what a debugger's halt freezes (`drive_monitor::debug_halt::FROZEN`: TIM1, the
-/// sample trigger; TIM15, embassy-time's clock; the IWDG), then the independent watchdog
-/// started with the boot's timeout (`drive_monitor::watchdog::BOOT_SETTING`, 1 s, covering
-/// the boot's budget at the fastest LSI). On the registers, before embassy-stm32's `init`
-/// (`firmware/under_the_hal.rs` lists why); `start_watchdog` shortens it once the boot ran.
-fn start_boot_watchdog() {
-    // The whole registers as `debug_halt` computes them from what they hold (the host
-    // tests run the halt model on these values, not on the constant).
-    let dbg = pac::DBGMCU;
-    let after = debug_halt::FROZEN.registers_after(debug_halt::FreezeRegisters {
-        apb1fzr1: dbg.apb1lfzr().read().0,
-        apb2fzr: dbg.apb2fzr().read().0,
-    });
-    dbg.apb1lfzr()
-        .write_value(pac::dbgmcu::regs::Apb1lfzr(after.apb1fzr1));
-    dbg.apb2fzr()
-        .write_value(pac::dbgmcu::regs::Apb2fzr(after.apb2fzr));
-    let setting = watchdog::BOOT_SETTING;
-    let iwdg = pac::IWDG;
-    // Start (the LSI with it), unlock PR/RLR, the boot's timeout, reload.
-    iwdg.kr().write(|w| w.set_key(pac::iwdg::vals::Key::START));
-    iwdg.kr().write(|w| w.set_key(pac::iwdg::vals::Key::ENABLE));
-    iwdg.pr()
-        .write(|w| w.set_pr(pac::iwdg::vals::Pr::from_bits(setting.pr)));
-    iwdg.rlr().write(|w| w.set_rl(setting.rlr));
-    // The new values reach the LSI domain within a few LSI periods (bounded: 48 us each).
-    let mut polls = 0u32;
-    while (iwdg.sr().read().pvu() || iwdg.sr().read().rvu()) && polls < 100_000 {
-        polls += 1;
-    }
-    iwdg.kr().write(|w| w.set_key(pac::iwdg::vals::Key::RESET));
-}
-
 /// The independent watchdog at its running timeout (`WATCHDOG_TIMEOUT_MS`, 500 ms): it
-/// runs since [`start_boot_watchdog`]; embassy's driver writes the shorter timeout.
+/// runs since the start (`drive_monitor::startup`, the boot's 1 s); embassy's driver writes
+/// the shorter timeout.
 fn start_watchdog(
     iwdg: Peri<'static, peripherals::IWDG>,
 ) -> IndependentWatchdog<'static, peripherals::IWDG> {
@@ -282,17 +201,15 @@ fn start_watchdog(
     wdg
 }
 
-/// The boot composition (`drive_monitor::boot`, the function the host's SIL rig boots
-/// through) on the flash's two record pages: the machine, its sample path, isolator and
-/// encoder set-up, the stored calibration and the supervisor, each failure with its
-/// fallback, logged. A plain function, so that what it builds on its way is on the stack,
-/// not kept in the main task's future.
-fn boot_board(
-    flash: &mut BoardFlash,
-    previous: PreviousRun,
-) -> (BootMachine, SamplePath, Supervisor) {
+/// The boot composition (`drive_monitor::startup::boot_board`, the function the host's SIL
+/// rig boots through) on the flash's record pages with what the start found (`facts`): the
+/// machine, its sample path, isolator and encoder set-up, the stored calibration and the
+/// supervisor with the panel's marks, each failure with its fallback, logged. A plain
+/// function, so that what it builds on its way is on the stack, not kept in the main
+/// task's future.
+fn boot_board(flash: &mut BoardFlash, facts: &BootFacts) -> (BootMachine, SamplePath, Supervisor) {
     let page = read_motor_page(flash);
-    let booted = match boot::boot(&page, flash, &SETTINGS, previous, 0) {
+    let booted = match startup::boot_board(facts, &page, flash, &SETTINGS) {
         Ok(b) => b,
         // The built-in default at the constant sample rate: a host test (`app::tests`)
         // builds the same path, so this cannot happen, and if it did nothing could be
@@ -304,49 +221,29 @@ fn boot_board(
     (booted.machine, booted.path, booted.supervisor)
 }
 
-/// Boot in thread mode (clocks, the reason the previous run ended, the brown-out level,
-/// the watchdog, the flash records), then the sample task on the high-priority executor and
-/// thread mode's periods ([`Thread::run`]).
+/// The start (`drive_monitor::startup::start`: the freeze, the watchdog, why the previous
+/// run ended, the stack, the clock with its bounded waits, the self-check; or the safe
+/// mode), the flash records and the boot report, then the sample task on the high-priority
+/// executor and thread mode's periods ([`Thread::run`]).
 #[embassy_executor::main]
 async fn main(_spawner: Spawner) {
-    start_boot_watchdog();
-    // Before the clock set-up: the previous run's end (a clock failure's record keeps the
-    // crystal out of this run) and the stack (its guard words, then painted).
-    let (previous, reset_source) = logs::read_previous_run();
-    let stack_overflowed = stack::check_and_paint();
-    let source = clock::boot_source(previous.clock_failed(), start_crystal);
-    let p = embassy_stm32::init(clock_config(source));
-    if clock::css_on(source) {
-        // The clock security system: a crystal that stops raises an NMI (`failure.rs`)
-        // and the hardware switches to the HSI; embassy-stm32 leaves it off.
-        pac::RCC.cr().modify(|w| w.set_csson(true));
-    }
+    let (p, facts) = startup::start(&mut startup_hw::StartRegisters);
+    reset_ram::FINDINGS.store(facts.findings.0, Ordering::Relaxed);
     info!("drive-monitor {} starting", env!("CARGO_PKG_VERSION"));
-    logs::log_clock(source);
-    logs::log_previous_run(previous, reset_source);
-    logs::log_stack(stack_overflowed);
-    // The brown-out level of the option bytes: reported, not written (`drive_monitor::supply`).
-    let bor = supply::bor_check();
-    logs::log_bor(bor);
+    logs::log_facts(&facts);
+    if let Some(reason) = facts.safe_mode {
+        safe_mode::run(p, &facts, reason).await
+    }
     let cp = core_peripherals();
-
     let b = Board::take(p);
     let wdg = start_watchdog(b.iwdg);
     let dual_bank = dual_bank_flash();
     let flash = dual_bank.then(|| Flash::new_blocking(b.flash));
-    let mut thread = Thread::new(PanelPins::new(b.lamps), flash, wdg, bor);
-    vcp::report_boot(
-        &mut thread.flash.store,
-        bor,
-        b.vcp,
-        (previous, reset_source),
-        source,
-    );
+    let mut thread = Thread::new(PanelPins::new(b.lamps), flash, wdg, facts.bor);
+    vcp::report_boot(&mut thread.hw.flash.store, b.vcp, &facts);
     let mut button = ExtiInput::new(b.button, b.button_exti, Pull::Down, Irqs);
 
-    let (machine, path, mut supervisor) = boot_board(&mut thread.flash.store, previous);
-    supervisor.set_clock_fallback(source != ClockSource::Hse);
-    supervisor.set_bor_below_goal(!bor.allows_flash_writes());
+    let (machine, path, mut supervisor) = boot_board(&mut thread.hw.flash.store, &facts);
     let boot = Instant::now();
     let hw = SampleHw {
         adc1: b.adc1,
@@ -364,6 +261,7 @@ async fn main(_spawner: Spawner) {
         syst: cp.SYST,
         supply_hz: machine.record.supply.f_hz as f32,
         ranges: machine.ranges,
+        clock: facts.clock,
     };
     spawn_sample_task(hw, path);
     thread.run(&mut supervisor, &mut button, boot).await
@@ -388,7 +286,7 @@ fn core_peripherals() -> cortex_m::Peripherals {
 /// first and runs without the records instead (the built-in motor, not commissioned),
 /// saying so in the log.
 fn dual_bank_flash() -> bool {
-    set_phase(BootPhase::Flash);
+    mark_phase(BootPhase::Flash);
     let dual_bank = pac::FLASH.optr().read().dbank();
     if !dual_bank {
         error!("option bytes: single-bank flash (DBANK = 0); the records need dual-bank: set DBANK with STM32CubeProgrammer. Running with the built-in motor, not commissioned");
@@ -410,17 +308,57 @@ fn spawn_sample_task(hw: SampleHw, path: SamplePath) {
     }
 }
 
-/// What thread mode owns besides the supervisor: the lamps, the flash, the watchdog and
-/// the log's state.
-struct Thread {
+/// Thread mode's hardware (`drive_monitor::app::ThreadHw`): the lamps, the record pages
+/// behind the brown-out gate, the acquisition's pause, the watchdog, VREFINT.
+struct ThreadBoard {
     lamps: PanelPins,
     /// The record pages, erases and writes refused below the brown-out goal.
     flash: BorGate<BoardFlash>,
+    pause: commands::SampleTaskPause,
     wdg: IndependentWatchdog<'static, peripherals::IWDG>,
+    reference: supply::HwReference,
+}
+
+impl ThreadHw for ThreadBoard {
+    type Store = BorGate<BoardFlash>;
+    type Pause = commands::SampleTaskPause;
+    type Reference = supply::HwReference;
+
+    fn pet_watchdog(&mut self) {
+        self.wdg.pet();
+    }
+
+    fn store_and_pause(&mut self) -> (&mut Self::Store, &mut Self::Pause) {
+        (&mut self.flash, &mut self.pause)
+    }
+
+    fn reference(&mut self) -> Option<&mut Self::Reference> {
+        Some(&mut self.reference)
+    }
+
+    fn show(&mut self, lamps: &PanelLamps) {
+        self.lamps.show(lamps);
+    }
+
+    fn write_record(&mut self, record: Option<ResetRecord>) {
+        match record {
+            Some(r) => reset_ram::record(r, supply::bor_level()),
+            None => reset_ram::write_reset_record(&[0; RESET_RECORD_LEN]),
+        }
+    }
+
+    fn mark_up(&mut self, long: bool) {
+        reset_ram::mark_up(long);
+    }
+}
+
+/// What thread mode owns besides the supervisor: its hardware, its state across periods
+/// and the log's.
+struct Thread {
+    hw: ThreadBoard,
+    state: ThreadState,
     /// The sample task's longest `Monitor::update` so far, in CPU cycles (from its status).
     max_update_cycles: u32,
-    /// Periods since the last status line (one every second period: 100 ms).
-    log_div: u32,
     /// The brown-out level found at boot (the status line's `bor=`).
     bor: BorCheck,
 }
@@ -436,14 +374,18 @@ impl Thread {
         bor: BorCheck,
     ) -> Self {
         Self {
-            lamps,
-            flash: BorGate {
-                store: BoardFlash(CheckedFlash::new(Driver(flash))),
-                bor,
+            hw: ThreadBoard {
+                lamps,
+                flash: BorGate {
+                    store: BoardFlash(CheckedFlash::new(Driver(flash))),
+                    bor,
+                },
+                pause: commands::SampleTaskPause,
+                wdg,
+                reference: supply::HwReference,
             },
-            wdg,
+            state: ThreadState::default(),
             max_update_cycles: 0,
-            log_div: 0,
             bor,
         }
     }
@@ -472,56 +414,33 @@ impl Thread {
         }
     }
 
-    /// One period at `now_ms`: the supervisor's tick on the latest status and the button,
-    /// then its consequences (watchdog, logs, the commissioning action with its command
-    /// to the sample task, the lamps) and every second period the status line.
+    /// One period at `now_ms` (`drive_monitor::app::period` on what the sample task handed
+    /// over): its events logged, its commands sent to the sample task in order (each waiting
+    /// at most [`COMMAND_SEND_TIMEOUT_MS`] for a slot in the queue, else dropped and
+    /// logged), and every second period the status line.
     async fn period(&mut self, supervisor: &mut Supervisor, now_ms: u32, pressed: bool) {
         let status = STATUS.try_take();
         if let Some(s) = status {
             self.max_update_cycles = s.max_update_cycles;
         }
-        if let Some(trim) = TRIM.try_take() {
-            supervisor.set_offset_fault(&trim);
-            logs::log_trim(&trim);
+        let reference = REFERENCE.try_take();
+        if let Some(board::ReferenceCheck::InBand(v)) = reference {
+            info!("reference: VDDA {=f32} V", v);
         }
-        check_reference(supervisor, now_ms);
-        let tick = supervisor.tick(now_ms, status.map(|s| s.monitor), pressed);
-        if tick.pet_watchdog {
-            self.wdg.pet();
-        }
-        if let Some(change) = tick.liveness {
-            logs::on_liveness(change);
-        }
-        if let Some(end) = tick.run_ended {
-            logs::log_run_end(end);
-        }
-        if let Some(change) = tick.clip_range {
-            logs::log_clip_range(change);
-        }
-        self.carry_out(tick.action).await;
-        if let Some(gain) = tick.reference_gain {
-            logs::log_reference_gain(gain);
-            commands::send(Command::ReferenceGain(gain)).await;
-        }
-        self.lamps.show(&tick.lamps);
-        self.log_div += 1;
-        if self.log_div >= 2 {
-            self.log_div = 0;
-            self.status_line(supervisor, &tick);
-        }
-    }
-
-    /// Carries out the commissioning `action` ([`carry_out`]: the record stored in flash
-    /// first, logged) and sends its command to the sample task, waiting at most
-    /// [`COMMAND_SEND_TIMEOUT_MS`] for a slot in the queue (else the command is dropped and
-    /// logged).
-    async fn carry_out(&mut self, action: Action) {
-        let (command, stored) = carry_out(action, &mut self.flash, &mut commands::SampleTaskPause);
-        if let Some(stored) = stored {
-            logs::log_stored(&stored);
-        }
-        if let Some(cmd) = command {
+        let input = PeriodInput {
+            now_ms,
+            status: status.map(|s| s.monitor),
+            pressed,
+            trim: TRIM.try_take(),
+            reference,
+        };
+        let out = period(supervisor, &mut self.state, input, &mut self.hw);
+        logs::log_period(&out);
+        for cmd in out.commands.into_iter().flatten() {
             commands::send(cmd).await;
+        }
+        if out.status_line {
+            self.status_line(supervisor, &out.tick);
         }
     }
 
@@ -539,23 +458,6 @@ impl Thread {
             self.max_update_cycles,
             (supervisor.reference().vdda_v(), self.bor.status_number()),
         );
-    }
-}
-
-/// The checks of the ADC's reference at `now_ms`: the start-up one from the sample task
-/// (`REFERENCE`, once, its VDDA logged) and the periodic one on ADC1's injected channel,
-/// observed by the `supervisor`; a change of the verdict is logged.
-fn check_reference(supervisor: &mut Supervisor, now_ms: u32) {
-    if let Some(check) = REFERENCE.try_take() {
-        if let board::ReferenceCheck::InBand(v) = check {
-            info!("reference: VDDA {=f32} V", v);
-        }
-        if let Some(change) = supervisor.observe_reference(check, now_ms) {
-            logs::log_reference(change);
-        }
-    }
-    if let Some(change) = supervisor.poll_reference(now_ms, &mut supply::HwReference) {
-        logs::log_reference(change);
     }
 }
 

@@ -34,8 +34,8 @@ pub const ECCR_ADDR_MASK: u32 = 0x0007_FFFF;
 /// A bank's size in dual-bank mode (512 KiB device): bank 2 starts at this offset.
 pub const BANK_SIZE: u32 = 256 * 1024;
 
-/// The first flash offset of the record pages (the reset log's first page, below the motor
-/// record's).
+/// The first flash offset of the record pages (the reset log's first page, below the
+/// commissioning record's second page and the motor record's).
 pub const RECORD_PAGES_START: u32 = RESET_LOG_FLASH_OFFSET;
 /// One past the last flash offset of the record pages.
 pub const RECORD_PAGES_END: u32 = RECORD_FLASH_OFFSET + RECORD_PAGE_SIZE;
@@ -159,43 +159,64 @@ pub enum ReadError<E> {
 }
 
 /// The record pages' reads with their ECC errors handled (module docs): `raw` and the
-/// pages marked bad in this run (the two record pages).
+/// pages marked bad in this run (a bit for each 2 KiB page from [`RECORD_PAGES_START`]).
 #[derive(Debug)]
 pub struct CheckedFlash<F> {
     /// The driver.
     pub raw: F,
-    bad: [bool; 2],
+    bad: u32,
 }
 
-/// Which record page `offset` is in (0: the motor record's, 1: the commissioning
-/// record's).
-fn page_index(offset: u32) -> Option<usize> {
-    if (RECORD_PAGES_START..RECORD_FLASH_OFFSET).contains(&offset) {
-        Some(0)
-    } else if (RECORD_FLASH_OFFSET..RECORD_PAGES_END).contains(&offset) {
-        Some(1)
+/// The bit of the record page `offset` is in (each 2 KiB page from [`RECORD_PAGES_START`]
+/// its own: a torn double word in a reset log page marks that page, not the motor
+/// record's beside it).
+fn page_bit(offset: u32) -> Option<u32> {
+    if (RECORD_PAGES_START..RECORD_PAGES_END).contains(&offset) {
+        Some(1 << ((offset - RECORD_PAGES_START) / RECORD_PAGE_SIZE))
     } else {
         None
     }
 }
+const _: () = assert!((RECORD_PAGES_END - RECORD_PAGES_START) / RECORD_PAGE_SIZE <= 32);
 
 impl<F: RawFlash> CheckedFlash<F> {
     /// `raw` with no page marked bad.
     pub fn new(raw: F) -> Self {
-        Self {
-            raw,
-            bad: [false; 2],
-        }
+        Self { raw, bad: 0 }
     }
 
     /// Whether the record page holding `offset` is marked bad.
     pub fn is_bad(&self, offset: u32) -> bool {
-        page_index(offset).and_then(|i| self.bad.get(i)).copied() == Some(true)
+        page_bit(offset).is_some_and(|b| self.bad & b != 0)
     }
 
     fn set_bad(&mut self, offset: u32, bad: bool) {
-        if let Some(b) = page_index(offset).and_then(|i| self.bad.get_mut(i)) {
-            *b = bad;
+        if let Some(b) = page_bit(offset) {
+            if bad {
+                self.bad |= b;
+            } else {
+                self.bad &= !b;
+            }
+        }
+    }
+
+    /// Reads `buf.len()` bytes at `offset` with the NMI handler's `latch` looked at after
+    /// the read, without marking the page: the reset log's reads, which treat a page as
+    /// full from a double error on and read it again in the same boot.
+    ///
+    /// # Errors
+    /// [`ReadError::Driver`]; [`ReadError::Ecc`] when the read raised a double error.
+    pub fn read_unmarked(
+        &mut self,
+        latch: &EccLatch,
+        offset: u32,
+        buf: &mut [u8],
+    ) -> Result<(), ReadError<F::Error>> {
+        let _stale = latch.take();
+        self.raw.read_raw(offset, buf).map_err(ReadError::Driver)?;
+        match latch.take() {
+            Some(e) => Err(ReadError::Ecc(e)),
+            None => Ok(()),
         }
     }
 

@@ -1,10 +1,18 @@
 //! The commissioning record kept in flash: encode, decode, version and checksum.
 //!
 //! The record stores the healthy-residual statistics learned during commissioning
-//! (per residual r1..r4: mean and spread, in the core's normalized units). It is written
-//! to the page at [`crate::board::RECORD_FLASH_OFFSET`] and read back at boot. Anything
+//! (per residual r1..r4: mean and spread, in the core's normalized units). Anything
 //! that is not a complete, current-version record with a matching CRC and sane values
 //! is rejected with a [`RecordError`], and the firmware then runs "not commissioned".
+//!
+//! **Two pages, in turn.** The record is kept in two flash pages ([`RecordPage`]:
+//! [`crate::board::RECORD_FLASH_OFFSET`] and [`crate::board::RECORD_B_FLASH_OFFSET`]), each
+//! copy with a sequence number. The boot reads both and puts the newer valid one into force
+//! ([`load`]); a store erases and writes the *other* page, with the next number ([`store`]).
+//! A power cut at any step of a store (during the erase, during the write) leaves the
+//! page in force untouched: the next boot finds the old record or the new one, never none
+//! (the erase and the write of one page took about 25 ms, and a cut there lost the only
+//! copy).
 //!
 //! Since version 2 it also stores the fault isolation's healthy baseline
 //! ([`monitor_core::isolation::Baseline`]: the mean and spread of its three parity
@@ -32,7 +40,7 @@
 //! | 64..88 | the learned point: `i_d, i_q` [A], `v_d, v_q` [V], `we, wr` [rad/s], `f32` each (zero when absent) |
 //! | 88..92 | flags, `u32`: bit 0 set when the isolation baseline is present, bit 1 when VDDA is |
 //! | 92..96 | VDDA at commissioning [V], `f32` (zero when absent) |
-//! | 96..100 | reserved, zero |
+//! | 96..100 | the copy's sequence number, `u32` ([`store`]: the newer of the two pages has the higher; 0 in records written before the two pages) |
 //! | 100..104 | CRC-32/ISO-HDLC of bytes 0..100 ([`monitor_core::record::crc32`]) |
 //!
 //! Header, CRC, reader and writer are the project's one record format
@@ -146,12 +154,20 @@ impl From<CalibrationRecord> for monitor_core::Calibration {
 }
 
 impl CalibrationRecord {
-    /// Encode into the flash layout described in the module docs.
+    /// Encode into the flash layout described in the module docs, sequence number 0.
     ///
     /// # Errors
     /// [`RecordError::Invalid`] if a value is non-finite or a spread is negative (such a
     /// record would be rejected at the next boot anyway).
     pub fn encode(&self) -> Result<[u8; RECORD_LEN], RecordError> {
+        self.encode_copy(0)
+    }
+
+    /// Encode as the copy numbered `seq` (the module docs' two pages).
+    ///
+    /// # Errors
+    /// As [`CalibrationRecord::encode`].
+    pub fn encode_copy(&self, seq: u32) -> Result<[u8; RECORD_LEN], RecordError> {
         if !values_ok(self) {
             return Err(RecordError::Invalid);
         }
@@ -171,7 +187,7 @@ impl CalibrationRecord {
             flag(self.isolation.is_some(), FLAG_ISOLATION) | flag(self.vdda_v.is_some(), FLAG_VDDA),
         );
         w.f32(self.vdda_v.unwrap_or(0.0));
-        w.u32(0);
+        w.u32(seq);
         Ok(w.finish())
     }
 
@@ -182,28 +198,38 @@ impl CalibrationRecord {
     /// The record module's checks ([`RecordFormat::open`]: truncated, erased, magic, version,
     /// length, checksum), then [`RecordError::Invalid`] for unusable values.
     pub fn decode(bytes: &[u8]) -> Result<Self, RecordError> {
+        Self::decode_copy(bytes).map(|(rec, _)| rec)
+    }
+
+    /// Decode a copy: the record and its sequence number (0 before version 4).
+    ///
+    /// # Errors
+    /// As [`CalibrationRecord::decode`].
+    pub fn decode_copy(bytes: &[u8]) -> Result<(Self, u32), RecordError> {
         let mut r = FORMAT.open(bytes)?;
         let out = Self::fields(&mut r)?;
-        if !values_ok(&out) {
+        if !values_ok(&out.0) {
             return Err(RecordError::Invalid);
         }
         Ok(out)
     }
 
-    /// The payload's fields as the record's version lays them out (module docs).
-    fn fields(r: &mut RecordReader<'_>) -> Result<Self, RecordError> {
+    /// The payload's fields as the record's version lays them out (module docs), and the
+    /// copy's sequence number.
+    fn fields(r: &mut RecordReader<'_>) -> Result<(Self, u32), RecordError> {
         let version = r.version();
         let mean = r.f32s::<4>()?;
         let spread = r.f32s::<4>()?;
         if version < 2 {
             // Version 1: 4 reserved bytes, no isolation baseline.
             r.take::<4>()?;
-            return Ok(Self {
+            let rec = Self {
                 mean,
                 spread,
                 isolation: None,
                 vdda_v: None,
-            });
+            };
+            return Ok((rec, 0));
         }
         let mut b = Baseline {
             mean: ParityResiduals::from_array(r.f32s::<3>()?),
@@ -221,17 +247,19 @@ impl CalibrationRecord {
         }
         let flags = r.u32()?;
         let mut vdda_v = None;
+        let mut seq = 0;
         if version >= 4 {
             let v = r.f32()?;
-            r.take::<4>()?;
+            seq = r.u32()?;
             vdda_v = (flags & FLAG_VDDA != 0).then_some(v);
         }
-        Ok(Self {
+        let rec = Self {
             mean,
             spread,
             isolation: (flags & FLAG_ISOLATION != 0).then_some(b),
             vdda_v,
-        })
+        };
+        Ok((rec, seq))
     }
 }
 
@@ -240,45 +268,108 @@ fn point_fields(p: &SteadyPoint) -> [f32; 6] {
     [p.i.d, p.i.q, p.v.d, p.v.q, p.we_rad_s, p.wr_rad_s]
 }
 
-/// Where the record is kept: the flash page on the board, a byte array in the host tests
-/// (the software-in-the-loop rig). Erase, write and read of the one record.
+/// One of the record's two pages (module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RecordPage {
+    /// The first page ([`crate::board::RECORD_FLASH_OFFSET`]).
+    A,
+    /// The second page ([`crate::board::RECORD_B_FLASH_OFFSET`]).
+    B,
+}
+
+impl RecordPage {
+    /// Both pages.
+    pub const BOTH: [RecordPage; 2] = [RecordPage::A, RecordPage::B];
+
+    /// The other page.
+    pub const fn other(self) -> RecordPage {
+        match self {
+            RecordPage::A => RecordPage::B,
+            RecordPage::B => RecordPage::A,
+        }
+    }
+}
+
+/// Where the record is kept: the two flash pages on the board, byte arrays in the host
+/// tests (the software-in-the-loop rig). Erase, write and read of one page.
 pub trait RecordStore {
     /// What a failed flash operation reports.
     type Error;
-    /// Reads the first [`RECORD_LEN`] bytes of the record page.
+    /// Reads the first [`RECORD_LEN`] bytes of `page`.
     ///
     /// # Errors
     /// When the page cannot be read.
-    fn read(&mut self, buf: &mut [u8; RECORD_LEN]) -> Result<(), Self::Error>;
-    /// Erases the record page (every byte `0xFF`).
+    fn read(&mut self, page: RecordPage, buf: &mut [u8; RECORD_LEN]) -> Result<(), Self::Error>;
+    /// Erases `page` (every byte `0xFF`).
     ///
     /// # Errors
     /// When the erase fails.
-    fn erase(&mut self) -> Result<(), Self::Error>;
-    /// Writes `bytes` at the start of the (erased) record page.
+    fn erase(&mut self, page: RecordPage) -> Result<(), Self::Error>;
+    /// Writes `bytes` at the start of the (erased) `page`.
     ///
     /// # Errors
     /// When the write fails.
-    fn write(&mut self, bytes: &[u8; RECORD_LEN]) -> Result<(), Self::Error>;
+    fn write(&mut self, page: RecordPage, bytes: &[u8; RECORD_LEN]) -> Result<(), Self::Error>;
 }
 
 /// Why no record could be loaded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LoadError<E> {
-    /// The store could not be read.
+    /// Neither page could be read (the first page's error).
     Read(E),
-    /// The bytes are not a valid record.
+    /// No page holds a valid record (the first page's reason, or the second's when the
+    /// first is erased or unreadable).
     Record(RecordError),
 }
 
-/// Reads and validates the stored record.
+/// The newer valid copy of the two pages: its page, the record and its sequence number.
 ///
 /// # Errors
-/// [`LoadError`]: the read failed, or the bytes are not a valid record.
+/// [`LoadError`]: no page read, or no valid record in either.
+pub fn newest<S: RecordStore>(
+    store: &mut S,
+) -> Result<(RecordPage, CalibrationRecord, u32), LoadError<S::Error>> {
+    let mut best: Option<(RecordPage, CalibrationRecord, u32)> = None;
+    let mut why: Option<LoadError<S::Error>> = None;
+    for page in RecordPage::BOTH {
+        let mut buf = [0u8; RECORD_LEN];
+        match store.read(page, &mut buf) {
+            Err(e) => {
+                why.get_or_insert(LoadError::Read(e));
+            }
+            Ok(()) => match CalibrationRecord::decode_copy(&buf) {
+                Ok((rec, seq)) => {
+                    // The newer copy; the sequence numbers wrap, so "newer" is the nearer
+                    // one ahead.
+                    if best.is_none_or(|(_, _, b)| seq.wrapping_sub(b) as i32 > 0) {
+                        best = Some((page, rec, seq));
+                    }
+                }
+                Err(e) => {
+                    let replace = match why {
+                        None | Some(LoadError::Read(_)) => true,
+                        Some(LoadError::Record(old)) => old == RecordError::Erased,
+                    };
+                    if replace {
+                        why = Some(LoadError::Record(e));
+                    }
+                }
+            },
+        }
+    }
+    match (best, why) {
+        (Some(b), _) => Ok(b),
+        (None, Some(w)) => Err(w),
+        (None, None) => Err(LoadError::Record(RecordError::Erased)),
+    }
+}
+
+/// Reads both pages and returns the newer valid record (module docs).
+///
+/// # Errors
+/// [`LoadError`]: no page read, or no valid record in either.
 pub fn load<S: RecordStore>(store: &mut S) -> Result<CalibrationRecord, LoadError<S::Error>> {
-    let mut buf = [0u8; RECORD_LEN];
-    store.read(&mut buf).map_err(LoadError::Read)?;
-    CalibrationRecord::decode(&buf).map_err(LoadError::Record)
+    newest(store).map(|(_, rec, _)| rec)
 }
 
 /// The result of [`store`]: what went wrong, if anything, and what the store holds now.
@@ -286,8 +377,9 @@ pub fn load<S: RecordStore>(store: &mut S) -> Result<CalibrationRecord, LoadErro
 pub struct Stored<E> {
     /// The first failure of encode, erase or write (`Ok` when all three worked).
     pub written: Result<(), StoreError<E>>,
-    /// The record read back after the attempt (`None`: no valid record); this, not what
-    /// was meant to be written, is what the monitor must use.
+    /// The record read back after the attempt (the newer valid copy; `None`: no valid
+    /// record): this, not what was meant to be written, is what the monitor must use. After
+    /// a failed erase or write it is the copy that was in force before.
     pub read_back: Option<CalibrationRecord>,
 }
 
@@ -302,15 +394,20 @@ pub enum StoreError<E> {
     Write(E),
 }
 
-/// Erases the page, writes `rec` and reads the page back. Whatever fails, the result says
-/// what the store holds afterwards ([`Stored::read_back`]), so the caller can make the
-/// monitor use exactly that.
+/// Writes `rec` as the next copy into the page not in force (erase, write; the copy in
+/// force untouched), then reads both pages back. Whatever fails, the result says what the
+/// store holds afterwards ([`Stored::read_back`]), so the caller can make the monitor use
+/// exactly that.
 pub fn store<S: RecordStore>(store: &mut S, rec: &CalibrationRecord) -> Stored<S::Error> {
-    let written = match rec.encode() {
+    let (page, seq) = match newest(store) {
+        Ok((page, _, seq)) => (page.other(), seq.wrapping_add(1)),
+        Err(_) => (RecordPage::A, 1),
+    };
+    let written = match rec.encode_copy(seq) {
         Err(e) => Err(StoreError::Encode(e)),
-        Ok(bytes) => match store.erase() {
+        Ok(bytes) => match store.erase(page) {
             Err(e) => Err(StoreError::Erase(e)),
-            Ok(()) => store.write(&bytes).map_err(StoreError::Write),
+            Ok(()) => store.write(page, &bytes).map_err(StoreError::Write),
         },
     };
     Stored {

@@ -30,6 +30,8 @@
 //!   the watchdog;
 //! - [`recovery`]: the acquisition's recovery after an ADC overrun or a DMA error (the
 //!   register sequence in the reference manual's order, over a trait the host rig fakes);
+//! - [`ring_read`]: the sample task's read of one DMA half, every ring's channel checked
+//!   before each read (the HAL's `read` never restarts a ring itself);
 //! - [`reset_record`]: why the previous run ended (panic, stalled sample path), kept in
 //!   RAM across the reset;
 //! - [`setup_guard`]: the deadline on the ADCs' set-up (a step that does not finish is
@@ -40,6 +42,13 @@
 //! - [`offset_trim`]: each channel's zero measured at start-up with the motor off, bounded;
 //! - [`clip_watch`]: whether clipping persists in steady running (the front end's range
 //!   too small for the motor: the range state), in thread mode;
+//! - [`boot_block`]: what the boot keeps in RAM across a reset besides the reset record
+//!   (the phase mark, the failed boots in a row that lead to the safe mode);
+//! - [`self_check`]: the boot's read-back of what the firmware wrote (the freeze, the clock
+//!   security system, the option bytes, the encoder's timer, the ADCs' common register);
+//! - [`startup`]: the start of every run on the registers (freeze, watchdog, the previous
+//!   run, the stack, the clock with its bounded waits, the safe mode, the self-check), over
+//!   a trait the host tests drive with a register model;
 //! - [`panel`]: lamp patterns and blink codes;
 //! - [`app`]: the glue: settings, the per-sample path, the status it hands thread mode,
 //!   and thread mode's supervisor.
@@ -71,6 +80,7 @@ pub mod adc_rules;
 pub mod app;
 pub mod board;
 pub mod boot;
+pub mod boot_block;
 pub mod clip_watch;
 pub mod clock;
 pub mod commissioning;
@@ -85,9 +95,12 @@ pub mod panel;
 pub mod range_watch;
 pub mod recovery;
 pub mod reset_record;
+pub mod ring_read;
 pub mod sampling;
+pub mod self_check;
 pub mod setup_guard;
 pub mod stack;
+pub mod startup;
 pub mod supply;
 pub mod under_the_hal;
 pub mod watchdog;

@@ -23,6 +23,13 @@
 //!                 still none at 500 ms after the last pet ─► watchdog reset ─► boot reports it
 //! ```
 
+/// A run is **up** once samples have flowed, with the watchdog petted, this long [ms]: its
+/// failed boots in a row end (`crate::boot_block`, the safe mode's count).
+pub const UP_AFTER_MS: u32 = 10_000;
+/// A run is **long up** after this long [ms] (10 minutes): the next boot writes the reset
+/// log's "up" mark, which gives the log's rate limit its full entries back.
+pub const LONG_UP_AFTER_MS: u32 = 600_000;
+
 /// Time without samples after which the sample path counts as stalled, ms.
 pub const STALL_AFTER_MS: u32 = 100;
 /// Time without samples after which the stall is written to the reset record, ms (before

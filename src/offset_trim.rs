@@ -1,12 +1,12 @@
-//! Offset trim at start-up: the zero of each of the six analog channels measured while the
-//! motor is off.
+//! Offset trim: the zero of each of the six analog channels measured while the motor is
+//! off, at start-up and again whenever the shaft stands and the currents are zero.
 //!
 //! The front end's zero (0 V, 0 A) is nominally at mid-scale (code 2047.5) or at the motor
 //! record's offsets; amplifier offsets and reference tolerances move it by a few codes,
-//! which the residuals read as a small steady error. For the first [`TRIM_SAMPLES`] samples
-//! after boot the sample task adds every trigger's codes to an [`OffsetTrim`] (the monitor
-//! runs as usual meanwhile); then each channel's mean and spread decide
-//! ([`ChannelTrim`]):
+//! which the residuals read as a small steady error, and it drifts with temperature and
+//! the supply over a year. For the first [`TRIM_SAMPLES`] samples after boot the sample
+//! task adds every trigger's codes to an [`OffsetTrim`] (the monitor runs as usual
+//! meanwhile); then each channel's mean and spread decide ([`ChannelTrim`]):
 //! - **quiet** (spread <= [`QUIET_SPREAD_CODES`]: the motor is off, no supply on the voltage
 //!   inputs) and within [`MAX_OFFSET_CODES`] of the zero in force (the motor record's
 //!   offset, mid-scale for the built-in default): the mean is the channel's new
@@ -19,8 +19,18 @@
 //! - **not quiet** (the motor was running, or mains on the voltage inputs): nothing is
 //!   measured, the record's offsets stay.
 //!
-//! Bounded work: six additions and six multiply-adds per sample for [`TRIM_SAMPLES`]
-//! samples, then nothing.
+//! **The re-trim** ([`TrimKind::Retrim`]). After the start-up trim the accumulator runs on:
+//! every window of [`TRIM_SAMPLES`] samples in which the shaft stood (the encoder's count
+//! within [`STANDSTILL_COUNTS`] of the window's first; a turn starts the window again) is
+//! judged again, but only when all three currents are zero (each current channel quiet and
+//! within [`RETRIM_STEP_CODES`] of its zero in force: a standing motor that carries a
+//! current, DC braking or a held load, is no zero): then every quiet channel within that
+//! step of its zero in force is trimmed again (the voltages too, when no supply is on them).
+//! A zero that moved further is [`ChannelTrim::TooFar`]: not used, not flagged (only the
+//! start-up trim flags a sensor). The zeros follow a slow drift in steps of at most
+//! [`RETRIM_STEP_CODES`].
+//!
+//! Bounded work: six additions, six multiply-adds and a count's comparison per sample.
 
 use crate::board::{FrontEnd, MID_SCALE_CODE};
 use crate::sampling::RawFrame;
@@ -35,6 +45,15 @@ pub const QUIET_SPREAD_CODES: f32 = 8.0;
 /// mid-scale by default), ADC codes (100 codes: 2.4 % of the range, about 10 V or 0.24 A
 /// with the default front end); beyond it the sensor is flagged instead.
 pub const MAX_OFFSET_CODES: f32 = 100.0;
+/// Largest step of a re-trim from the zero in force [codes]: 20 codes (about 4 V, 0.1 A with
+/// the default front end), far beyond a drift between two standstills, far below a current
+/// a standing motor may carry.
+pub const RETRIM_STEP_CODES: f32 = 20.0;
+/// The encoder's count may move this many counts in a window and the shaft still stands
+/// (one count of jitter at an edge).
+pub const STANDSTILL_COUNTS: u16 = 1;
+/// A re-trim that moves no zero by this much [codes] is not reported (nothing to log).
+pub const REPORT_STEP_CODES: f32 = 0.5;
 
 /// What the trim found for one channel.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,6 +65,9 @@ pub enum ChannelTrim {
     OutOfBound(f32),
     /// Not quiet: the measured spread, codes (nothing trimmed).
     NotQuiet(f32),
+    /// A re-trim: quiet, but farther than [`RETRIM_STEP_CODES`] from the zero in force: the
+    /// measured zero, codes (not used, not flagged).
+    TooFar(f32),
 }
 
 impl ChannelTrim {
@@ -63,9 +85,20 @@ impl ChannelTrim {
     }
 }
 
+/// Which trim a result is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TrimKind {
+    /// The first window after boot (a channel out of bound is flagged).
+    StartUp,
+    /// A later window, the shaft standing and the currents zero.
+    Retrim,
+}
+
 /// The trim of the six channels.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TrimResult {
+    /// The start-up trim or a re-trim.
+    pub kind: TrimKind,
     /// Voltage channels a, b, c.
     pub voltage: [ChannelTrim; 3],
     /// Current channels a, b, c.
@@ -84,14 +117,18 @@ impl TrimResult {
     }
 }
 
-/// The accumulator: sums and sums of squares of the six channels' codes (exact integers).
+/// The accumulator: sums and sums of squares of the six channels' codes (exact integers)
+/// over the current window.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OffsetTrim {
     sum: [u32; 6],
     sum_sq: [u64; 6],
     n: u32,
-    done: bool,
-    /// The zeros in force, codes: va, vb, vc, ia, ib, ic.
+    /// The start-up trim is done: the windows are re-trims.
+    started: bool,
+    /// The window's first encoder count (re-trims: the shaft must stand).
+    first_count: Option<u16>,
+    /// The zeros in force, codes: va, vb, vc, ia, ib, ic (the record's, then the trims').
     nominal: [f32; 6],
 }
 
@@ -104,16 +141,31 @@ impl OffsetTrim {
             sum: [0; 6],
             sum_sq: [0; 6],
             n: 0,
-            done: false,
+            started: false,
+            first_count: None,
             nominal: [va, vb, vc, ia, ib, ic].map(|c| c.offset_code),
         }
     }
 
-    /// Adds one trigger's codes; returns the result at the [`TRIM_SAMPLES`]th call, `None`
-    /// before and after.
+    /// Starts a new window.
+    fn restart(&mut self) {
+        self.sum = [0; 6];
+        self.sum_sq = [0; 6];
+        self.n = 0;
+        self.first_count = None;
+    }
+
+    /// Adds one sample's codes; returns the start-up trim at the [`TRIM_SAMPLES`]th call,
+    /// then a re-trim at the end of each window in which the shaft stood and the currents
+    /// were zero (module docs); `None` otherwise.
     pub fn add(&mut self, raw: &RawFrame) -> Option<TrimResult> {
-        if self.done {
-            return None;
+        if self.started {
+            let first = *self.first_count.get_or_insert(raw.encoder_count);
+            let moved = (raw.encoder_count.wrapping_sub(first) as i16).unsigned_abs();
+            if moved > STANDSTILL_COUNTS {
+                self.restart();
+                self.first_count = Some(raw.encoder_count);
+            }
         }
         let codes = [
             raw.v[0].0, raw.v[1].0, raw.v[2].0, raw.i[0].0, raw.i[1].0, raw.i[2].0,
@@ -126,34 +178,57 @@ impl OffsetTrim {
         if self.n < TRIM_SAMPLES {
             return None;
         }
-        self.done = true;
+        let kind = if self.started {
+            TrimKind::Retrim
+        } else {
+            TrimKind::StartUp
+        };
         let ch = |k: usize| {
             let (s, q, zero) = (
                 self.sum.get(k).copied().unwrap_or(0),
                 self.sum_sq.get(k).copied().unwrap_or(0),
                 self.nominal.get(k).copied().unwrap_or(MID_SCALE_CODE),
             );
-            judge(s, q, self.n, zero)
+            judge(s, q, self.n, zero, kind)
         };
-        Some(TrimResult {
+        let result = TrimResult {
+            kind,
             voltage: [ch(0), ch(1), ch(2)],
             current: [ch(3), ch(4), ch(5)],
-        })
+        };
+        self.started = true;
+        self.restart();
+        // A re-trim only where the currents are zero.
+        let currents_zero = result.current.iter().all(|c| c.offset().is_some());
+        if kind == TrimKind::Retrim && !currents_zero {
+            return None;
+        }
+        let channels = result.voltage.iter().chain(result.current.iter());
+        for (zero, channel) in self.nominal.iter_mut().zip(channels) {
+            if let Some(x) = channel.offset() {
+                *zero = x;
+            }
+        }
+        Some(result)
     }
 }
 
 /// One channel from its sum, sum of squares and count (`n > 0`): mean and spread in codes,
-/// then the bounds around `zero`, the zero in force.
-fn judge(sum: u32, sum_sq: u64, n: u32, zero: f32) -> ChannelTrim {
+/// then the bounds around `zero`, the zero in force: [`MAX_OFFSET_CODES`] at start-up,
+/// [`RETRIM_STEP_CODES`] for a re-trim.
+fn judge(sum: u32, sum_sq: u64, n: u32, zero: f32, kind: TrimKind) -> ChannelTrim {
     let n64 = u64::from(n.max(1));
     let s = u64::from(sum);
     // n^2 var = n sum_sq - sum^2, exact in integers (>= 0 for any real data).
     let n2_var = n64.saturating_mul(sum_sq).saturating_sub(s * s);
     let spread = monitor_core::math::sqrt(n2_var as f32) / n64 as f32;
     let mean = sum as f32 / n64 as f32;
+    let distance = (mean - zero).abs();
     if spread > QUIET_SPREAD_CODES {
         ChannelTrim::NotQuiet(spread)
-    } else if (mean - zero).abs() > MAX_OFFSET_CODES {
+    } else if kind == TrimKind::Retrim && distance > RETRIM_STEP_CODES {
+        ChannelTrim::TooFar(mean)
+    } else if distance > MAX_OFFSET_CODES {
         ChannelTrim::OutOfBound(mean)
     } else {
         ChannelTrim::Trimmed(mean)
@@ -166,10 +241,14 @@ mod tests {
     use crate::board::{CurrentCode, VoltageCode};
 
     fn frame(v: [u16; 3], i: [u16; 3]) -> RawFrame {
+        frame_at(v, i, 0)
+    }
+
+    fn frame_at(v: [u16; 3], i: [u16; 3], encoder_count: u16) -> RawFrame {
         RawFrame {
             v: v.map(VoltageCode),
             i: i.map(CurrentCode),
-            encoder_count: 0,
+            encoder_count,
             clipped: crate::sampling::Clipped::NONE,
             encoder_rejects: 0,
         }
@@ -203,15 +282,75 @@ mod tests {
         assert!(r.current_fault() && !r.voltage_fault());
         assert_eq!(r.voltage[2].offset(), None);
         assert_eq!(r.current[1].offset(), None);
-        // Done once.
+        assert_eq!(r.kind, TrimKind::StartUp);
+        // Then a re-trim, not another start-up trim.
         assert_eq!(trim.add(&frame([2047; 3], [2047; 3])), None);
+    }
+
+    /// The zero drifts by 30 codes over the first hour; the shaft stands now and then with
+    /// the currents zero: every standstill re-trims, in steps of at most 20 codes, and the
+    /// zeros follow. A window in which the shaft turns, or a current flows, re-trims nothing.
+    #[test]
+    fn the_zeros_are_re_trimmed_whenever_the_shaft_stands_and_the_currents_are_zero() {
+        let mut trim = OffsetTrim::new(&FrontEnd::DEFAULT);
+        let at = |zero: u16, count: u16| frame_at([zero; 3], [zero; 3], count);
+        let mut last = None;
+        for _ in 0..TRIM_SAMPLES {
+            last = last.or(trim.add(&at(2048, 0)));
+        }
+        assert_eq!(last.map(|r| r.kind), Some(TrimKind::StartUp));
+        // Standstills at a zero 15, then 30 codes away.
+        for zero in [2063u16, 2078] {
+            let mut got = None;
+            for _ in 0..TRIM_SAMPLES {
+                got = got.or(trim.add(&at(zero, 500)));
+            }
+            let r = got.expect("a re-trim at standstill");
+            assert_eq!(r.kind, TrimKind::Retrim);
+            assert!(
+                r.voltage
+                    .iter()
+                    .chain(r.current.iter())
+                    .all(|c| *c == ChannelTrim::Trimmed(f32::from(zero))),
+                "{r:?}"
+            );
+        }
+        // The shaft turns: the window starts again at every step, nothing judged.
+        for k in 0..3 * TRIM_SAMPLES {
+            assert_eq!(trim.add(&at(2078, (k * 7) as u16)), None);
+        }
+        // A current of 30 codes (0.15 A) through a standing motor: no re-trim.
+        let mut got = None;
+        for _ in 0..2 * TRIM_SAMPLES {
+            got = got.or(trim.add(&frame_at([2078; 3], [2108, 2048, 2078], 900)));
+        }
+        assert_eq!(got, None);
+        // A zero that jumped 40 codes: too far for one step, not flagged.
+        let mut got = None;
+        for _ in 0..TRIM_SAMPLES {
+            got = got.or(trim.add(&frame_at([2118; 3], [2078; 3], 900)));
+        }
+        let r = got.unwrap();
+        assert_eq!(r.voltage[0], ChannelTrim::TooFar(2118.0));
+        assert!(!r.voltage_fault() && !r.current_fault());
     }
 
     #[test]
     fn the_bounds_are_inclusive_and_a_rail_is_out_of_bound() {
         let half = MID_SCALE_CODE;
-        assert!(matches!(judge(0, 0, 10, half), ChannelTrim::OutOfBound(_)));
-        let at = |code: u32| judge(code * 10, u64::from(code * code) * 10, 10, half);
+        assert!(matches!(
+            judge(0, 0, 10, half, TrimKind::StartUp),
+            ChannelTrim::OutOfBound(_)
+        ));
+        let at = |code: u32| {
+            judge(
+                code * 10,
+                u64::from(code * code) * 10,
+                10,
+                half,
+                TrimKind::StartUp,
+            )
+        };
         assert!(matches!(
             at((half + MAX_OFFSET_CODES - 0.5) as u32),
             ChannelTrim::Trimmed(_)
@@ -222,7 +361,15 @@ mod tests {
         ));
         assert!(matches!(at(4095), ChannelTrim::OutOfBound(_)));
         // The bound is around the zero in force (a record's offset), not mid-scale.
-        let at_500 = |code: u32| judge(code * 10, u64::from(code * code) * 10, 10, 500.0);
+        let at_500 = |code: u32| {
+            judge(
+                code * 10,
+                u64::from(code * code) * 10,
+                10,
+                500.0,
+                TrimKind::StartUp,
+            )
+        };
         assert_eq!(at_500(560), ChannelTrim::Trimmed(560.0));
         assert_eq!(at_500(2048), ChannelTrim::OutOfBound(2048.0));
     }

@@ -115,6 +115,18 @@ impl PanelLamps {
         fault: true,
     };
 
+    /// The safe mode's pattern at `t_ms` (the boot gave up after failed boots in a row, or
+    /// the PLL did not lock: `crate::startup::SafeModeReason::code`): r1 and r4 lit, RUN, r2
+    /// and r3 dark, the FAULT lamp blinking `code` ([`blink_code_lamp`]): like no other
+    /// pattern, so a board in the safe mode is told from a failed or stalled one.
+    pub fn safe_mode(code: u8, t_ms: u32) -> Self {
+        Self {
+            run: false,
+            residuals: [true, false, false, true],
+            fault: blink_code_lamp(code, t_ms),
+        }
+    }
+
     /// Every lamp lit (`true`) or dark.
     pub const fn all(on: bool) -> Self {
         Self {

@@ -21,7 +21,7 @@
 //! defmt log); their record names the firmware's [`BootPhase`] at the time and the address
 //! the handler was called from ([`ResetRecord::defmt_panic`]).
 //!
-//! # RecordLayout ([`RESET_RECORD_LEN`] = 128 bytes, little endian, version 2)
+//! # RecordLayout ([`RESET_RECORD_LEN`] = 128 bytes, little endian, version 3)
 //!
 //! Header, CRC, reader and writer are the project's one record format
 //! ([`monitor_core::record`], [`FORMAT`]); the length field holds the payload's bytes (116).
@@ -36,14 +36,16 @@
 //! | 10 | file length (0..=[`FILE_LEN`]) |
 //! | 11 | the brown-out reset level in force when the record was written (`FLASH_OPTR.BOR_LEV`, 0..=4; 255 = not recorded; [`crate::supply::BorLevel`]) |
 //! | 12..16 | line (panic), stall time in ms (stall), phase (set-up), return address (`defmt` panic), stacked PC (HardFault), deadline in ms (set-up deadline), `u32` |
-//! | 16..80 | message, UTF-8, zero padded |
-//! | 80..124 | file (the end of the path), UTF-8, zero padded |
+//! | 16..20 | the run's self-check findings (`crate::self_check::Findings`: a bit for each register that did not hold what the firmware wrote, and for a clock that fell back), `u32` |
+//! | 20..84 | message, UTF-8, zero padded |
+//! | 84..124 | file (the end of the path), UTF-8, zero padded |
 //! | 124..128 | CRC-32/ISO-HDLC of bytes 0..124 ([`monitor_core::record::crc32`]) |
 //!
-//! Version 1 (no version and length fields, the cause at byte 4, a 48-byte file) is not
-//! read: the record lives in RAM across one reset of the same firmware, so a record of
-//! the former layout can only be met once, right after flashing this one, and then reads as
-//! "no reason recorded" (its header is not this format's).
+//! Versions 1 (no version and length fields, the cause at byte 4, a 48-byte file) and 2
+//! (no findings, a 44-byte file) are not read: the record lives in RAM across one reset of
+//! the same firmware, so a record of a former layout can only be met once, right after
+//! flashing this one, and then reads as "no reason recorded" (its header is not this
+//! format's).
 
 use crate::supply::BorLevel;
 use monitor_core::record::{RecordFormat, RecordLayout, CRC_LEN, HEADER_LEN};
@@ -53,22 +55,23 @@ pub const RESET_RECORD_LEN: usize = 128;
 /// Longest message kept, bytes (longer ones are cut at a character boundary).
 pub const MESSAGE_LEN: usize = 64;
 /// Longest file path kept, bytes (longer paths keep their end: the file name).
-pub const FILE_LEN: usize = 44;
+pub const FILE_LEN: usize = 40;
 /// The byte of a record that holds no brown-out level.
 const NO_BOR_LEVEL: u8 = 0xFF;
 
-/// The reset record's format: magic `DMRR`, version 2, [`RESET_RECORD_LEN`] bytes.
+/// The reset record's format: magic `DMRR`, version 3, [`RESET_RECORD_LEN`] bytes.
 pub const FORMAT: RecordFormat = RecordFormat {
     magic: *b"DMRR",
     current: RecordLayout {
-        version: 2,
+        version: 3,
         stored_len: RESET_RECORD_LEN,
         length: (RESET_RECORD_LEN - HEADER_LEN - CRC_LEN) as u16,
     },
     older: &[],
 };
-// The fields fill the payload: 4 bytes of cause and lengths, the number, the texts.
-const _: () = assert!(HEADER_LEN + 8 + MESSAGE_LEN + FILE_LEN + CRC_LEN == RESET_RECORD_LEN);
+// The fields fill the payload: 4 bytes of cause and lengths, the number, the findings,
+// the texts.
+const _: () = assert!(HEADER_LEN + 12 + MESSAGE_LEN + FILE_LEN + CRC_LEN == RESET_RECORD_LEN);
 
 /// What ended the previous run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -149,16 +152,20 @@ pub enum BootPhase {
     Sampling,
     /// The acquisition's recovery after an overrun or a DMA error.
     Recovery,
+    /// The clock set-up: the crystal's and the PLL's bounded starts, then embassy-stm32's
+    /// `init` (whose own waits have no bound).
+    Clock,
 }
 
 impl BootPhase {
     /// All phases.
-    pub const ALL: [BootPhase; 5] = [
+    pub const ALL: [BootPhase; 6] = [
         BootPhase::Boot,
         BootPhase::Flash,
         BootPhase::AdcSetup,
         BootPhase::Sampling,
         BootPhase::Recovery,
+        BootPhase::Clock,
     ];
 
     /// The phase's name in logs and records.
@@ -169,6 +176,7 @@ impl BootPhase {
             BootPhase::AdcSetup => "adc-setup",
             BootPhase::Sampling => "sampling",
             BootPhase::Recovery => "recovery",
+            BootPhase::Clock => "clock",
         }
     }
 
@@ -183,68 +191,6 @@ impl BootPhase {
     }
 }
 
-/// What reset the MCU, from the reset flags of `RCC_CSR` (STM32G4 reference manual RM0440,
-/// "RCC control/status register"). Every reset also pulses the NRST pin, so the pin flag
-/// means the button (or an external reset) only when no other flag is set.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ResetSource {
-    /// The independent watchdog (`IWDGRSTF`, bit 29).
-    IndependentWatchdog,
-    /// The window watchdog (`WWDGRSTF`, bit 30; not used by the firmware).
-    WindowWatchdog,
-    /// A software reset (`SFTRSTF`, bit 28): the panic handler's, before the watchdog runs.
-    Software,
-    /// Loading the option bytes (`OBLRSTF`, bit 25).
-    OptionBytes,
-    /// An illegal low-power entry (`LPWRRSTF`, bit 31).
-    LowPower,
-    /// A power-on or a brown-out (`BORRSTF`, bit 27).
-    PowerOnOrBrownOut,
-    /// The reset button (NRST, `PINRSTF`, bit 26) or a debugger's reset.
-    Pin,
-    /// No flag set (the flags were cleared and nothing reset since).
-    Unknown,
-}
-
-impl ResetSource {
-    /// The source named by the reset flags of `RCC_CSR`'s value `csr`, most specific
-    /// first (watchdogs, software, option bytes, low power, power/brown-out, the pin).
-    pub fn from_csr(csr: u32) -> Self {
-        let bit = |n: u32| csr & (1 << n) != 0;
-        if bit(29) {
-            ResetSource::IndependentWatchdog
-        } else if bit(30) {
-            ResetSource::WindowWatchdog
-        } else if bit(28) {
-            ResetSource::Software
-        } else if bit(25) {
-            ResetSource::OptionBytes
-        } else if bit(31) {
-            ResetSource::LowPower
-        } else if bit(27) {
-            ResetSource::PowerOnOrBrownOut
-        } else if bit(26) {
-            ResetSource::Pin
-        } else {
-            ResetSource::Unknown
-        }
-    }
-
-    /// A short name for logs.
-    pub const fn name(self) -> &'static str {
-        match self {
-            ResetSource::IndependentWatchdog => "watchdog",
-            ResetSource::WindowWatchdog => "window watchdog",
-            ResetSource::Software => "software",
-            ResetSource::OptionBytes => "option-byte load",
-            ResetSource::LowPower => "low-power",
-            ResetSource::PowerOnOrBrownOut => "power-on or brown-out",
-            ResetSource::Pin => "reset button",
-            ResetSource::Unknown => "unknown",
-        }
-    }
-}
-
 /// The record: the cause, a message, and a location (panic) or a duration (stall).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ResetRecord {
@@ -252,6 +198,8 @@ pub struct ResetRecord {
     /// `FLASH_OPTR.BOR_LEV` when written ([`NO_BOR_LEVEL`]: not recorded).
     bor: u8,
     number: u32,
+    /// The run's self-check findings (`crate::self_check::Findings`'s bits).
+    findings: u32,
     message: Text<MESSAGE_LEN>,
     file: Text<FILE_LEN>,
 }
@@ -314,6 +262,7 @@ impl ResetRecord {
         Self {
             cause: ResetCause::Panic,
             bor: NO_BOR_LEVEL,
+            findings: 0,
             number: line,
             message: Text::new(message, false),
             file: Text::new(file, true),
@@ -335,6 +284,7 @@ impl ResetRecord {
         Self {
             cause: ResetCause::DefmtPanic,
             bor: NO_BOR_LEVEL,
+            findings: 0,
             number: return_address,
             message: Text::new(phase.name(), false),
             file: Text::new("", true),
@@ -399,6 +349,7 @@ impl ResetRecord {
         Self {
             cause: ResetCause::HardFault,
             bor: NO_BOR_LEVEL,
+            findings: 0,
             number: pc,
             message: Text::new(message, false),
             file: Text::new(file, true),
@@ -412,6 +363,7 @@ impl ResetRecord {
         Self {
             cause: ResetCause::SetupTimeout,
             bor: NO_BOR_LEVEL,
+            findings: 0,
             number: u32::from(phase.number()),
             message: Text::new(phase.name(), false),
             file: Text::new("", true),
@@ -425,6 +377,7 @@ impl ResetRecord {
         Self {
             cause: ResetCause::SetupDeadline,
             bor: NO_BOR_LEVEL,
+            findings: 0,
             number: deadline_ms,
             message: Text::new(step, false),
             file: Text::new("", true),
@@ -436,6 +389,7 @@ impl ResetRecord {
         Self {
             cause: ResetCause::ClockFailure,
             bor: NO_BOR_LEVEL,
+            findings: 0,
             number: 0,
             message: Text::new("crystal failed (clock security system)", false),
             file: Text::new("", true),
@@ -447,6 +401,7 @@ impl ResetRecord {
         Self {
             cause: ResetCause::SampleStall,
             bor: NO_BOR_LEVEL,
+            findings: 0,
             number: stalled_ms,
             message: Text::new("sample path stalled", false),
             file: Text::new("", true),
@@ -483,6 +438,20 @@ impl ResetRecord {
         self
     }
 
+    /// The record with the run's self-check findings (`crate::self_check::Findings`'s
+    /// bits: the registers that did not hold what the firmware wrote, a clock that fell
+    /// back), so that the next boot and the reset log say which remedy did not take.
+    #[must_use]
+    pub fn with_findings(mut self, findings: u32) -> Self {
+        self.findings = findings;
+        self
+    }
+
+    /// The run's self-check findings when the record was written (0: none).
+    pub fn findings(&self) -> u32 {
+        self.findings
+    }
+
     /// The brown-out reset level in force when the record was written (`None`: not
     /// recorded).
     pub fn bor_level(&self) -> Option<BorLevel> {
@@ -494,6 +463,7 @@ impl ResetRecord {
         let mut w = FORMAT.writer::<RESET_RECORD_LEN>();
         w.bytes(&[self.cause.code(), self.message.len, self.file.len, self.bor]);
         w.u32(self.number);
+        w.u32(self.findings);
         w.bytes(&self.message.bytes);
         w.bytes(&self.file.bytes);
         w.finish()
@@ -510,12 +480,14 @@ impl ResetRecord {
             return None;
         }
         let number = r.u32().ok()?;
+        let findings = r.u32().ok()?;
         let message = r.take::<MESSAGE_LEN>().ok()?;
         let file = r.take::<FILE_LEN>().ok()?;
         Some(Self {
             cause,
             bor,
             number,
+            findings,
             message: Text::from_bytes(&message, message_len)?,
             file: Text::from_bytes(&file, file_len)?,
         })
@@ -544,7 +516,12 @@ pub enum PreviousRun {
     /// A record says why (a panic, a stalled sample path, a set-up that did not finish).
     Recorded(ResetRecord),
     /// The watchdog reset the MCU and nothing recorded why: the firmware hung.
-    WatchdogReset,
+    WatchdogReset {
+        /// The boot phase the run had marked last (the phase mark that survives the reset,
+        /// `crate::boot_block`; `None`: not known): a hang in the clock set-up says
+        /// `Some(BootPhase::Clock)`.
+        phase: Option<BootPhase>,
+    },
     /// A record of a stall or an unfinished set-up was written, but `source`, not the
     /// watchdog, reset the MCU before it would have: the condition was seen, it is not
     /// known whether it would have cleared.
@@ -568,8 +545,18 @@ impl PreviousRun {
                 }
             }
             Some(rec) => PreviousRun::Recorded(rec),
-            None if watchdog => PreviousRun::WatchdogReset,
+            None if watchdog => PreviousRun::WatchdogReset { phase: None },
             None => PreviousRun::Clean,
+        }
+    }
+
+    /// The same, a watchdog reset with no record placed in `phase` (the phase mark the run
+    /// left, `None`: not known).
+    #[must_use]
+    pub fn hung_in(self, phase: Option<BootPhase>) -> Self {
+        match self {
+            PreviousRun::WatchdogReset { .. } => PreviousRun::WatchdogReset { phase },
+            other => other,
         }
     }
 
@@ -588,5 +575,7 @@ impl PreviousRun {
 
 pub mod log;
 pub mod report;
+mod source;
+pub use source::{ResetKind, ResetSource};
 #[cfg(test)]
 mod tests;

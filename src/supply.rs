@@ -23,6 +23,7 @@
 //! measurement is in band again.
 
 use crate::board::ReferenceCheck;
+use crate::flash_record::RecordPage;
 
 /// A brown-out reset level of `FLASH_OPTR.BOR_LEV` (RM0440, "FLASH option register";
 /// the thresholds are the reference manual's approximate falling-edge values).
@@ -151,20 +152,28 @@ where
     S::Error: FromBorRefusal,
 {
     type Error = S::Error;
-    fn read(&mut self, buf: &mut [u8; crate::flash_record::RECORD_LEN]) -> Result<(), S::Error> {
-        self.store.read(buf)
+    fn read(
+        &mut self,
+        page: RecordPage,
+        buf: &mut [u8; crate::flash_record::RECORD_LEN],
+    ) -> Result<(), S::Error> {
+        self.store.read(page, buf)
     }
-    fn erase(&mut self) -> Result<(), S::Error> {
+    fn erase(&mut self, page: RecordPage) -> Result<(), S::Error> {
         if !self.bor.allows_flash_writes() {
             return Err(S::Error::bor_refused(self.bor));
         }
-        self.store.erase()
+        self.store.erase(page)
     }
-    fn write(&mut self, bytes: &[u8; crate::flash_record::RECORD_LEN]) -> Result<(), S::Error> {
+    fn write(
+        &mut self,
+        page: RecordPage,
+        bytes: &[u8; crate::flash_record::RECORD_LEN],
+    ) -> Result<(), S::Error> {
         if !self.bor.allows_flash_writes() {
             return Err(S::Error::bor_refused(self.bor));
         }
-        self.store.write(bytes)
+        self.store.write(page, bytes)
     }
 }
 

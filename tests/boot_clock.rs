@@ -1,46 +1,12 @@
-//! The clock's source at boot (`src/firmware.rs`, `drive_monitor::clock::ClockSource`): the
-//! 24 MHz crystal started on the registers with a bounded wait before embassy-stm32's
-//! `init` (whose own wait for `HSERDY` has no bound), the PLL fed from it, the HSI as the
-//! fallback, said in the boot report and on the panel. The firmware does not run on the
-//! host; these checks read its source, so that taking a remedy out fails here.
+//! The clock at boot (`drive_monitor::clock::ClockSource`): a clock failure's record makes
+//! the next boot run on the HSI without trying the crystal; the log's timestamps. The
+//! crystal's and the PLL's bounded starts before embassy-stm32's `init`, the fallback and
+//! the clock security system's register are run on a register model in
+//! `tests/startup/`.
 
 fn firmware(file: &str) -> String {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
     std::fs::read_to_string(path).unwrap()
-}
-
-fn body<'a>(src: &'a str, signature: &str) -> &'a str {
-    let from = &src[src.find(signature).unwrap_or_else(|| panic!("{signature}"))..];
-    &from[..from.find("\n}\n").expect("its end")]
-}
-
-#[test]
-fn the_crystal_is_started_with_a_bound_before_init_and_the_hsi_is_the_fallback() {
-    let src = firmware("src/firmware.rs");
-    let main = body(&src, "async fn main(");
-    let crystal = main.find("start_crystal").expect("start_crystal in main");
-    let init = main
-        .find("embassy_stm32::init(clock_config(source))")
-        .expect("init");
-    assert!(crystal < init);
-    assert!(main.contains("set_clock_fallback(source != ClockSource::Hse)"));
-    assert!(main.contains("clock::boot_source(previous.clock_failed(), start_crystal)"));
-    assert!(main.contains("clock::css_on(source)"));
-    assert!(main.contains("logs::log_clock(source)"));
-    let start = body(&src, "fn start_crystal()");
-    for needle in [
-        "set_hseon(true)",
-        "clock::HSE_STARTUP_TIMEOUT_MS",
-        "hserdy()",
-        "set_hseon(false)",
-        "ClockSource::Hsi",
-    ] {
-        assert!(start.contains(needle), "start_crystal lacks {needle}");
-    }
-    let config = body(&src, "fn clock_config(");
-    for needle in ["PllSource::HSE", "clock::HSE_HZ", "source.prediv()"] {
-        assert!(config.contains(needle), "clock_config lacks {needle}");
-    }
 }
 
 /// Every defmt frame has a timestamp (the time since boot in us, embassy-time's clock).
@@ -84,6 +50,9 @@ fn a_clock_failure_is_recorded_and_the_next_boot_runs_on_the_hsi() {
         fn bor_level(&mut self) -> Option<BorLevel> {
             Some(BorLevel::Level4)
         }
+        fn findings(&mut self) -> u32 {
+            drive_monitor::self_check::CRYSTAL_DID_NOT_START
+        }
         fn write_record(&mut self, bytes: &[u8; RESET_RECORD_LEN]) {
             self.0 = *bytes;
         }
@@ -99,6 +68,11 @@ fn a_clock_failure_is_recorded_and_the_next_boot_runs_on_the_hsi() {
         panic!("{previous:?}");
     };
     assert_eq!(rec.cause(), ResetCause::ClockFailure);
+    // The run's self-check findings go with the record.
+    assert_eq!(
+        rec.findings(),
+        drive_monitor::self_check::CRYSTAL_DID_NOT_START
+    );
     assert!(previous.clock_failed());
     let mut tried = false;
     let source = boot_source(previous.clock_failed(), || {

@@ -1,8 +1,10 @@
 //! The bring-up a first board gets (issue 51): `cargo fw-run`'s runner lets the firmware's
 //! own handlers run (probe-rs catches neither the reset nor the HardFault), and
 //! docs/firmware.md's bring-up checklist puts the steps in the order a board needs them:
-//! the motor record into flash, the crystal, the debugger, the brown-out level, the run
-//! with the handlers visible, the boot report.
+//! the probe and the part's revision, the motor record into flash, the crystal, the
+//! debugger, the brown-out level, the run with the handlers visible, the registers read
+//! back (`cargo fw bring-up`), the boot report, ..., an hour without an overrun, the fault
+//! injections.
 
 use std::path::Path;
 
@@ -52,16 +54,21 @@ fn the_bring_up_list_runs_record_brown_out_handlers_boot_report() {
             .unwrap_or_else(|| panic!("no step {what:?} in {titles:?}"))
     };
     let order = [
+        at("probe and the part"),
         at("motor record"),
         at("crystal"),
         at("debugger"),
         at("brown-out"),
         at("handlers visible"),
+        at("cargo fw bring-up"),
         at("boot report"),
         at("virtual com port"),
         at("offset trim"),
         at("status line"),
         at("commission"),
+        at("an hour"),
+        at("fault injections"),
+        at("faults that recover"),
     ];
     assert!(order.windows(2).all(|w| w[0] < w[1]), "{titles:?}");
     // The brown-out step names the command that programs it.
@@ -80,6 +87,19 @@ fn the_bring_up_list_runs_record_brown_out_handlers_boot_report() {
         "115 200 baud",
         "`clip_range=false`",
         "from 7.5 s to 9.5 s",
+        // Issue 82's: the part's revision, the registers read back, the hour, the injections.
+        "REV_ID",
+        "ES0430",
+        "`overruns=0`",
+        "*a breakpoint*",
+        "*the encoder unplugged*",
+        "*an input at the rail*",
+        "*a stopped crystal*",
+        "*a stack-overflow build*",
+        "*power cuts*",
+        "*a supply ramp through 2.8 V*",
+        "*a forced reset loop*",
+        "SAFE MODE (code 1)",
     ] {
         assert!(list.contains(needle), "the checklist lacks {needle:?}");
     }

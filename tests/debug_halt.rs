@@ -4,7 +4,8 @@
 //! timeout) and the IWDG runs on unless frozen. After the halt the model says whether the
 //! DMA lapped the ring (it wrote more samples than the ring holds beyond the unread ones),
 //! whether the sample task's wait timed out (a recovery) and whether the watchdog reset
-//! the MCU. And the boot starts the watchdog, and sets the freeze, before anything else.
+//! the MCU. That the start sets the freeze and starts the watchdog before anything else is
+//! run on a register model in `tests/startup/`.
 
 use drive_monitor::acquisition::SAMPLES_PER_HALF;
 use drive_monitor::app::WATCHDOG_TIMEOUT_MS;
@@ -99,31 +100,4 @@ fn a_breakpoint_stops_sampling_cleanly_and_resumes_without_a_recovery() {
         ..FROZEN
     };
     assert!(halt(without_watchdog, 2_000).reset);
-}
-
-/// `main` starts the watchdog (with the freeze) before embassy-stm32's `init`, whose clock
-/// set-up waits for the crystal and the PLL.
-#[test]
-fn the_watchdog_and_the_freeze_come_first_in_main() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/firmware.rs");
-    let src = std::fs::read_to_string(path).unwrap();
-    let main = &src[src.find("async fn main(").expect("main")..];
-    let first = main
-        .find("start_boot_watchdog();")
-        .expect("the boot watchdog in main");
-    let init = main.find("embassy_stm32::init(").expect("init in main");
-    assert!(first < init, "the watchdog starts after init");
-    let body = &src[src
-        .find("fn start_boot_watchdog()")
-        .expect("its definition")..];
-    let body = &body[..body.find("\n}\n").expect("its end")];
-    for needle in [
-        "debug_halt::FROZEN",
-        "registers_after(",
-        "apb1lfzr()",
-        "apb2fzr()",
-        "Key::START",
-    ] {
-        assert!(body.contains(needle), "start_boot_watchdog lacks {needle}");
-    }
 }

@@ -1,10 +1,13 @@
 //! A stored commissioning record that is not exactly what the firmware wrote is never
 //! used: every single-bit flip, a wrong version, a truncated record, an erased page and
-//! values the core would reject all come back as errors.
+//! values the core would reject all come back as errors. And a power cut at any step of a
+//! store (the erase, each double word of the write) leaves the old record or the new one in
+//! force, never none: the two pages in turn.
 
 use drive_monitor::app::{Command, SamplePath};
 use drive_monitor::flash_record::{
-    crc32, CalibrationRecord, RecordError, RECORD_LEN, RECORD_VERSION,
+    crc32, load, store, CalibrationRecord, LoadError, RecordError, RecordPage, RecordStore,
+    RECORD_LEN, RECORD_VERSION,
 };
 use monitor_core::isolation::{Baseline, ParityResiduals};
 
@@ -97,7 +100,7 @@ fn values_out_of_the_cores_range_are_not_applied() {
 /// keeps the old record, and the store says why); at level 4 it is stored.
 #[test]
 fn records_are_refused_while_the_brown_out_level_is_below_the_goal() {
-    use drive_monitor::flash_record::{store, RecordStore, StoreError};
+    use drive_monitor::flash_record::StoreError;
     use drive_monitor::supply::{BorCheck, BorGate, BorLevel, FromBorRefusal};
 
     #[derive(Debug, PartialEq)]
@@ -109,44 +112,210 @@ fn records_are_refused_while_the_brown_out_level_is_below_the_goal() {
             E::Bor(check)
         }
     }
-    struct Page([u8; RECORD_LEN], u32);
+    /// The two pages and the erases and writes they took.
+    struct Page([u8; RECORD_LEN], [u8; RECORD_LEN], u32);
     impl RecordStore for Page {
         type Error = E;
-        fn read(&mut self, buf: &mut [u8; RECORD_LEN]) -> Result<(), E> {
-            *buf = self.0;
+        fn read(&mut self, page: RecordPage, buf: &mut [u8; RECORD_LEN]) -> Result<(), E> {
+            *buf = if page == RecordPage::A {
+                self.0
+            } else {
+                self.1
+            };
             Ok(())
         }
-        fn erase(&mut self) -> Result<(), E> {
-            self.0 = [0xFF; RECORD_LEN];
-            self.1 += 1;
-            Ok(())
+        fn erase(&mut self, page: RecordPage) -> Result<(), E> {
+            self.write(page, &[0xFF; RECORD_LEN])
         }
-        fn write(&mut self, bytes: &[u8; RECORD_LEN]) -> Result<(), E> {
-            self.0 = *bytes;
-            self.1 += 1;
+        fn write(&mut self, page: RecordPage, bytes: &[u8; RECORD_LEN]) -> Result<(), E> {
+            match page {
+                RecordPage::A => self.0 = *bytes,
+                RecordPage::B => self.1 = *bytes,
+            }
+            self.2 += 1;
             Ok(())
         }
     }
     let old = record().encode().unwrap();
+    let erased = [0xFF; RECORD_LEN];
     let mut new = record();
     new.mean[0] = 0.02;
     let factory = BorCheck::of_optr(0xFFEF_F8AA);
     assert_eq!(factory, BorCheck::BelowGoal(BorLevel::Level0));
     let mut gate = BorGate {
-        store: Page(old, 0),
+        store: Page(old, erased, 0),
         bor: factory,
     };
     let stored = store(&mut gate, &new);
     assert_eq!(stored.written, Err(StoreError::Erase(E::Bor(factory))));
-    assert_eq!((gate.store.0, gate.store.1), (old, 0));
+    assert_eq!((gate.store.0, gate.store.1, gate.store.2), (old, erased, 0));
     assert_eq!(stored.read_back, Some(record()));
 
     let at_goal = BorCheck::of_optr((0xFFEF_F8AA & !(0b111 << 8)) | (4 << 8));
     let mut gate = BorGate {
-        store: Page(old, 0),
+        store: Page(old, erased, 0),
         bor: at_goal,
     };
     let stored = store(&mut gate, &new);
     assert_eq!(stored.written, Ok(()));
     assert_eq!(stored.read_back, Some(new));
+    // The new copy went to the other page; the old one is still there.
+    assert_eq!(gate.store.0, old);
+    assert_eq!(CalibrationRecord::decode_copy(&gate.store.1), Ok((new, 1)));
+}
+
+/// The record's two pages at the level of the flash: an erase, and writes of 8-byte double
+/// words (the G4's unit, each with its ECC), and a power cut after `cut_after` more steps
+/// (an erase, or one double word): the erase it cuts leaves the page neither erased nor
+/// written (its reads fail: an ECC double error), the double word it cuts is torn (its
+/// read fails), the later ones never written.
+#[derive(Clone)]
+struct Cuttable {
+    pages: [[u8; RECORD_LEN]; 2],
+    /// A read of the page fails (an ECC error in it).
+    unreadable: [bool; 2],
+    cut_after: Option<u32>,
+    powered: bool,
+}
+
+#[derive(Debug, PartialEq)]
+struct PowerCut;
+
+impl Cuttable {
+    fn index(page: RecordPage) -> usize {
+        usize::from(page == RecordPage::B)
+    }
+
+    /// One step; `false`: the power went during it.
+    fn step(&mut self) -> bool {
+        if !self.powered {
+            return false;
+        }
+        match self.cut_after.as_mut() {
+            Some(0) => {
+                self.powered = false;
+                false
+            }
+            Some(n) => {
+                *n -= 1;
+                true
+            }
+            None => true,
+        }
+    }
+}
+
+impl RecordStore for Cuttable {
+    type Error = PowerCut;
+    fn read(&mut self, page: RecordPage, buf: &mut [u8; RECORD_LEN]) -> Result<(), PowerCut> {
+        let k = Self::index(page);
+        if !self.powered || self.unreadable[k] {
+            return Err(PowerCut);
+        }
+        *buf = self.pages[k];
+        Ok(())
+    }
+    fn erase(&mut self, page: RecordPage) -> Result<(), PowerCut> {
+        let k = Self::index(page);
+        if !self.step() {
+            // Half erased: neither the old bytes nor all 0xFF, an ECC error to read.
+            for b in self.pages[k].iter_mut().step_by(2) {
+                *b = 0xFF;
+            }
+            self.unreadable[k] = true;
+            return Err(PowerCut);
+        }
+        self.pages[k] = [0xFF; RECORD_LEN];
+        self.unreadable[k] = false;
+        Ok(())
+    }
+    fn write(&mut self, page: RecordPage, bytes: &[u8; RECORD_LEN]) -> Result<(), PowerCut> {
+        let k = Self::index(page);
+        for (dw, chunk) in bytes.chunks(8).enumerate() {
+            if !self.step() {
+                // The double word being written is torn: its ECC does not match.
+                self.pages[k][dw * 8] = chunk[0];
+                self.unreadable[k] = true;
+                return Err(PowerCut);
+            }
+            self.pages[k][dw * 8..dw * 8 + chunk.len()].copy_from_slice(chunk);
+        }
+        Ok(())
+    }
+}
+
+/// A power cut at every step of a store (the erase, each of the 13 double words), from
+/// every starting point (no record, the record in either page): the next boot finds the
+/// old record or the new one, never none (and the new one only once its write completed);
+/// the next store after the cut succeeds.
+#[test]
+fn a_power_cut_at_any_step_of_a_store_keeps_the_old_or_the_new_record() {
+    let old = record();
+    let mut new = record();
+    new.mean[0] = 0.02;
+    let mut newer = record();
+    newer.mean[1] = 0.03;
+    let steps = 1 + (RECORD_LEN / 8) as u32;
+    assert_eq!(steps, 14);
+    let erased = [0xFF; RECORD_LEN];
+    let starts = [
+        ("the old copy in A", [old.encode_copy(7).unwrap(), erased]),
+        ("the old copy in B", [erased, old.encode_copy(8).unwrap()]),
+        (
+            "the old copy in B, an older in A",
+            [
+                record().encode_copy(3).unwrap(),
+                old.encode_copy(4).unwrap(),
+            ],
+        ),
+        (
+            "a record written before the two pages",
+            [old.encode().unwrap(), erased],
+        ),
+    ];
+    for (what, pages) in starts {
+        for cut in 0..=steps {
+            let mut flash = Cuttable {
+                pages,
+                unreadable: [false; 2],
+                cut_after: Some(cut),
+                powered: true,
+            };
+            let stored = store(&mut flash, &new);
+            // Power back.
+            flash.powered = true;
+            flash.cut_after = None;
+            let found = load(&mut flash);
+            if cut == steps {
+                assert_eq!(stored.written, Ok(()), "{what}");
+                assert_eq!(found, Ok(new), "{what}: the complete store");
+            } else {
+                assert!(stored.written.is_err(), "{what}, cut {cut}");
+                assert_eq!(found, Ok(old), "{what}: cut after {cut} steps");
+            }
+            // The next commissioning stores over the torn page, never over the one in force.
+            let again = store(&mut flash, &newer);
+            assert_eq!(
+                (again.written, again.read_back),
+                (Ok(()), Some(newer)),
+                "{what}"
+            );
+            assert_eq!(load(&mut flash), Ok(newer));
+        }
+    }
+    // With no record at all, a cut leaves none, and never a torn one in force.
+    for cut in 0..steps {
+        let mut flash = Cuttable {
+            pages: [erased; 2],
+            unreadable: [false; 2],
+            cut_after: Some(cut),
+            powered: true,
+        };
+        let _ = store(&mut flash, &new);
+        flash.powered = true;
+        assert!(matches!(
+            load(&mut flash),
+            Err(LoadError::Record(_) | LoadError::Read(_))
+        ));
+    }
 }

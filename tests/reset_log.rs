@@ -1,19 +1,25 @@
 //! The reset log in flash (`drive_monitor::reset_record::log`) and the boot report on the
-//! virtual COM port (`reset_record::report`): the last ends of a run survive a power loss
-//! and a torn write; the text a technician reads without a probe.
+//! virtual COM port (`reset_record::report`): every reset counted, the ends of failed runs
+//! kept across a power loss and a torn write, the rate limit that bounds the wear to more
+//! than a year of a boot every second, and the text a technician reads without a probe.
 
-use drive_monitor::reset_record::log::{self, Ended, Entry, LogFlash, ENTRY_LEN, PAGE_LEN};
-use drive_monitor::reset_record::report::{boot_line, entry_line, previous_line};
-use drive_monitor::reset_record::{PreviousRun, ResetRecord, ResetSource};
+use drive_monitor::reset_record::log::{
+    self, BootRecord, Ended, Entry, LogFlash, Written, ENTRY_LEN, FULL_ENTRIES, MARKS_PER_PAGE,
+    PAGES, PAGE_LEN,
+};
+use drive_monitor::reset_record::report::{
+    boot_line, entry_line, list_line, previous_line, safe_mode_line, totals_line,
+};
+use drive_monitor::reset_record::{BootPhase, PreviousRun, ResetKind, ResetRecord, ResetSource};
 
-/// The log's two pages, with a power loss after `cut` bytes of the next write, and slots
-/// whose reads fail (an ECC double error).
+/// The log's pages, with a power loss after `cut` bytes of the next write, a double word
+/// whose reads fail (an ECC double error) and each page's erases counted.
 #[derive(Clone)]
 struct Pages {
-    pages: [Vec<u8>; 2],
+    pages: Vec<Vec<u8>>,
     cut: Option<usize>,
     unreadable: Option<(usize, usize)>,
-    erases: u32,
+    erases: Vec<u32>,
 }
 
 #[derive(Debug, PartialEq)]
@@ -22,10 +28,10 @@ struct Lost;
 impl Pages {
     fn erased() -> Self {
         Self {
-            pages: [vec![0xFF; PAGE_LEN], vec![0xFF; PAGE_LEN]],
+            pages: vec![vec![0xFF; PAGE_LEN]; PAGES],
             cut: None,
             unreadable: None,
-            erases: 0,
+            erases: vec![0; PAGES],
         }
     }
 }
@@ -43,16 +49,20 @@ impl LogFlash for Pages {
         Ok(())
     }
     fn erase(&mut self, page: usize) -> Result<(), Lost> {
-        self.erases += 1;
+        self.erases[page] += 1;
         self.pages[page].fill(0xFF);
+        if self.unreadable.is_some_and(|(p, _)| p == page) {
+            self.unreadable = None;
+        }
         Ok(())
     }
     fn write(&mut self, page: usize, offset: usize, bytes: &[u8]) -> Result<(), Lost> {
+        assert_eq!(offset % 8, 0, "items are 8-byte aligned");
         assert!(
             self.pages[page][offset..offset + bytes.len()]
                 .iter()
                 .all(|b| *b == 0xFF),
-            "a write over a slot that is not erased"
+            "a write over bytes that are not erased"
         );
         let n = self.cut.take().unwrap_or(bytes.len());
         self.pages[page][offset..offset + n].copy_from_slice(&bytes[..n]);
@@ -67,13 +77,33 @@ fn panic_at(line: u32) -> ResetRecord {
     ResetRecord::panic("index out of bounds", "src/app.rs", line)
 }
 
-fn append(flash: &mut Pages, line: u32) -> Result<Entry, Lost> {
-    log::append(
-        flash,
-        ResetSource::IndependentWatchdog,
-        Ended::Recorded,
-        Some(panic_at(line)),
-    )
+/// A boot after a run that ended in a panic at `line` (the watchdog's reset).
+fn failed(line: u32) -> BootRecord {
+    BootRecord {
+        previous: PreviousRun::Recorded(panic_at(line)),
+        source: ResetSource::IndependentWatchdog,
+        kind: ResetKind::Watchdog,
+        previous_long_up: false,
+        safe_mode: false,
+    }
+}
+
+/// A boot after a clean run reset by `kind`'s source.
+fn clean(kind: ResetKind) -> BootRecord {
+    let source = match kind {
+        ResetKind::PowerOn | ResetKind::BrownOut => ResetSource::PowerOnOrBrownOut,
+        ResetKind::Pin => ResetSource::Pin,
+        ResetKind::Watchdog => ResetSource::IndependentWatchdog,
+        ResetKind::Software => ResetSource::Software,
+        ResetKind::Other => ResetSource::Unknown,
+    };
+    BootRecord {
+        previous: PreviousRun::Clean,
+        source,
+        kind,
+        previous_long_up: false,
+        safe_mode: false,
+    }
 }
 
 fn newest(flash: &mut Pages) -> Vec<u32> {
@@ -81,58 +111,186 @@ fn newest(flash: &mut Pages) -> Vec<u32> {
     entries.iter().take(n).flatten().map(|e| e.seq).collect()
 }
 
-/// 13 entries a page; the 14th goes to the other page; the 27th erases the older page:
-/// the newer page's 13 and the new one stay, newest first.
+/// Every boot writes one item: an entry for a failed run, a count for the rest; the counts
+/// by kind add up, power-ons told from brown-outs.
 #[test]
-fn the_log_keeps_the_newest_entries_across_both_pages() {
-    assert_eq!(log::SLOTS_PER_PAGE, 13);
-    assert_eq!(ENTRY_LEN % 8, 0);
+fn every_reset_is_counted_and_failed_runs_are_entered() {
     let mut flash = Pages::erased();
-    for k in 1..=27 {
-        let e = append(&mut flash, 100 + k).unwrap();
-        assert_eq!(e.seq, k);
+    for kind in [
+        ResetKind::PowerOn,
+        ResetKind::Pin,
+        ResetKind::BrownOut,
+        ResetKind::PowerOn,
+    ] {
+        assert_eq!(
+            log::record_boot(&mut flash, &clean(kind)),
+            Ok(Written::Counted { failed: false })
+        );
     }
-    assert_eq!(flash.erases, 2);
-    assert_eq!(newest(&mut flash), (14..=27).rev().collect::<Vec<u32>>());
+    assert_eq!(
+        log::record_boot(&mut flash, &failed(7)),
+        Ok(Written::Entry(1))
+    );
+    // The layouts of the module docs: the page's header (magic `DMLP`, version 1, a payload
+    // of 52 bytes), four counts of 8 bytes (`C`, the kind's index, the count, the check),
+    // then the entry (magic `DMRL`, version 2, a payload of 140 bytes).
+    let page = &flash.pages[0];
+    assert_eq!(page[..8], *b"DMLP\x01\x00\x34\x00");
+    let power_on = [b'C', 0, 1, 0];
+    let check = (!u32::from_le_bytes(power_on)).to_le_bytes();
+    assert_eq!(page[64..68], power_on);
+    assert_eq!(page[68..72], check);
+    assert_eq!(page[72..76], [b'C', 2, 1, 0], "the reset button's count");
+    assert_eq!(page[96..104], *b"DMRL\x02\x00\x8c\x00");
+    let t = log::totals(&mut flash);
+    assert_eq!(t.resets(ResetKind::PowerOn), 2);
+    assert_eq!(t.resets(ResetKind::Pin), 1);
+    assert_eq!(t.resets(ResetKind::BrownOut), 1);
+    assert_eq!(t.resets(ResetKind::Watchdog), 1);
+    assert_eq!(
+        (t.entries_since_up, t.last_entry, t.failed_not_entered),
+        (1, 1, 0)
+    );
     let (four, n) = log::newest::<_, 4>(&mut flash);
-    assert_eq!(n, 4);
-    let first = four[0].unwrap();
-    assert_eq!((first.seq, first.record), (27, Some(panic_at(127))));
-    assert_eq!(first.source, ResetSource::IndependentWatchdog);
+    assert_eq!(n, 1);
+    let e = four[0].unwrap();
+    assert_eq!(
+        (e.seq, e.record, e.kind),
+        (1, Some(panic_at(7)), ResetKind::Watchdog)
+    );
 }
 
-/// A power loss in the middle of an entry's write: the torn slot is no entry, the ones
-/// before it stay, and the next boot writes after it (never over it).
+/// The rate limit: a loop of 1 000 failed runs gets four full entries; the other 996 are
+/// counted as failed (8 bytes each), none lost. A run that was up for 10 minutes (the next
+/// boot's "up" mark) gives the entries back.
 #[test]
-fn a_torn_write_loses_only_its_own_entry() {
+fn the_rate_limit_enters_four_failed_runs_between_ups_and_counts_the_rest() {
+    let mut flash = Pages::erased();
+    let mut entered = 0;
+    for k in 0..1_000 {
+        match log::record_boot(&mut flash, &failed(k)).unwrap() {
+            Written::Entry(_) => entered += 1,
+            Written::Counted { failed } => assert!(failed),
+        }
+    }
+    assert_eq!(entered, FULL_ENTRIES);
+    let t = log::totals(&mut flash);
+    assert_eq!(t.resets(ResetKind::Watchdog), 1_000);
+    assert_eq!(t.failed_not_entered, 1_000 - FULL_ENTRIES);
+    assert_eq!(newest(&mut flash), [4, 3, 2, 1]);
+    // 4 entries (608 B) and 996 counts (7 968 B) on 2 048-byte pages: 5 pages, 5 erases.
+    assert_eq!(flash.erases.iter().sum::<u32>(), 5);
+    // Up for 10 minutes, then a failure: entered again (after the "up" mark).
+    let mut after_up = failed(2_000);
+    after_up.previous_long_up = true;
+    assert_eq!(
+        log::record_boot(&mut flash, &after_up),
+        Ok(Written::Entry(5))
+    );
+    let t = log::totals(&mut flash);
+    assert_eq!((t.ups(), t.entries_since_up), (1, 1));
+}
+
+/// A boot every second for a year, the worst case (RAM lost at every boot: nothing but
+/// flash remembers): one count of 8 bytes a boot, 248 a page, 16 pages in turn. Run for
+/// 40 000 boots and scaled to 31 536 000: every page's erases stay below the 10 000 cycles
+/// a page survives (DS12288), and not one boot is lost from the counts.
+#[test]
+fn a_boot_every_second_for_a_year_wears_no_page_out() {
+    let mut flash = Pages::erased();
+    let boots = 40_000u32;
+    for k in 0..boots {
+        let kind = if k % 3 == 0 {
+            ResetKind::BrownOut
+        } else {
+            ResetKind::PowerOn
+        };
+        log::record_boot(&mut flash, &clean(kind)).unwrap();
+    }
+    let t = log::totals(&mut flash);
+    assert_eq!(
+        t.resets(ResetKind::PowerOn) + t.resets(ResetKind::BrownOut),
+        boots
+    );
+    let most = *flash.erases.iter().max().unwrap();
+    let least = *flash.erases.iter().min().unwrap();
+    assert!(most - least <= 1, "{:?}", flash.erases);
+    let year = 365 * 24 * 3_600u64;
+    let per_page_year = u64::from(most) * year / u64::from(boots);
+    assert!(
+        per_page_year < 10_000,
+        "{per_page_year} erases a page a year"
+    );
+    // The arithmetic of the docs: 31 536 000 / 248 / 16 = 7 948.
+    assert_eq!(MARKS_PER_PAGE, 248);
+    assert_eq!(year / MARKS_PER_PAGE as u64 / PAGES as u64, 7_947);
+    // A loop of failed runs costs the same (four entries, then counts).
+    let mut flash = Pages::erased();
+    for k in 0..10_000 {
+        log::record_boot(&mut flash, &failed(k)).unwrap();
+    }
+    assert_eq!(flash.erases.iter().sum::<u32>(), 41);
+}
+
+/// A power loss in the middle of an entry's write, of a count's, of a new page's header:
+/// the torn item is nothing, the items before it stay, the next boot writes after it.
+#[test]
+fn a_torn_write_loses_only_its_own_item() {
     let mut flash = Pages::erased();
     for k in 1..=3 {
-        append(&mut flash, k).unwrap();
+        log::record_boot(&mut flash, &failed(k)).unwrap();
     }
     flash.cut = Some(60);
-    assert_eq!(append(&mut flash, 4), Err(Lost));
+    assert_eq!(log::record_boot(&mut flash, &failed(4)), Err(Lost));
     assert_eq!(newest(&mut flash), [3, 2, 1]);
-    // The next boot: after the torn slot (the writer asserts it writes only erased bytes).
-    let e = append(&mut flash, 5).unwrap();
-    assert_eq!(e.seq, 4);
+    // The next boot: after the torn entry (the model asserts it writes only erased bytes).
+    assert_eq!(
+        log::record_boot(&mut flash, &failed(5)),
+        Ok(Written::Entry(4))
+    );
     assert_eq!(newest(&mut flash), [4, 3, 2, 1]);
-    let torn = &flash.pages[0][3 * ENTRY_LEN..4 * ENTRY_LEN];
-    assert!(torn.iter().any(|b| *b != 0xFF) && Entry::decode(torn).is_none());
+    // A torn count.
+    flash.cut = Some(3);
+    assert_eq!(
+        log::record_boot(&mut flash, &clean(ResetKind::Pin)),
+        Err(Lost)
+    );
+    log::record_boot(&mut flash, &clean(ResetKind::Pin)).unwrap();
+    assert_eq!(log::totals(&mut flash).resets(ResetKind::Pin), 1);
+    // Fill the page; the next page's header torn: the counts so far stay (the full page is
+    // still the one in use), the next boot erases that page again.
+    let mut flash = Pages::erased();
+    for _ in 0..MARKS_PER_PAGE {
+        log::record_boot(&mut flash, &clean(ResetKind::PowerOn)).unwrap();
+    }
+    flash.cut = Some(20);
+    assert_eq!(
+        log::record_boot(&mut flash, &clean(ResetKind::PowerOn)),
+        Err(Lost)
+    );
+    assert_eq!(log::totals(&mut flash).resets(ResetKind::PowerOn), 248);
+    log::record_boot(&mut flash, &clean(ResetKind::PowerOn)).unwrap();
+    assert_eq!(log::totals(&mut flash).resets(ResetKind::PowerOn), 249);
+    assert_eq!(flash.erases[1], 2);
 }
 
-/// A slot whose read fails (an ECC double error in a torn double word): its page counts as
-/// full from there, the next entry goes to the other page, the readable entries stay.
+/// A double word whose read fails (an ECC double error in a torn double word): its page is
+/// full from there, the next item starts the next page, the counts before it stay.
 #[test]
-fn an_unreadable_slot_sends_the_next_entry_to_the_other_page() {
+fn an_unreadable_double_word_ends_its_page() {
     let mut flash = Pages::erased();
-    for k in 1..=5 {
-        append(&mut flash, k).unwrap();
+    for k in 1..=3 {
+        log::record_boot(&mut flash, &failed(k)).unwrap();
     }
-    flash.unreadable = Some((0, 3 * ENTRY_LEN + 16));
-    assert_eq!(newest(&mut flash), [3, 2, 1]);
-    let e = append(&mut flash, 6).unwrap();
-    assert_eq!(e.seq, 4);
-    assert_eq!(Entry::decode(&flash.pages[1][..ENTRY_LEN]), Some(e));
+    flash.unreadable = Some((0, 64 + 2 * ENTRY_LEN + 16));
+    assert_eq!(newest(&mut flash), [2, 1]);
+    let e = log::record_boot(&mut flash, &failed(4)).unwrap();
+    assert_eq!(e, Written::Entry(3));
+    assert_eq!(
+        Entry::decode(&flash.pages[1][64..64 + ENTRY_LEN]).map(|e| e.seq),
+        Some(3)
+    );
+    assert_eq!(log::totals(&mut flash).resets(ResetKind::Watchdog), 3);
 }
 
 /// What the boot writes on USART2, word for word.
@@ -154,29 +312,61 @@ fn the_boot_report_reads_without_a_probe() {
         b"previous run: ended in a panic: index out of bounds src/app.rs (42)\r\n"
     );
     assert_eq!(
-        previous_line(&PreviousRun::WatchdogReset).as_bytes(),
+        previous_line(&PreviousRun::WatchdogReset { phase: None }).as_bytes(),
         b"previous run: watchdog reset with no reason recorded (the firmware hung)\r\n"
+    );
+    assert_eq!(
+        previous_line(&PreviousRun::WatchdogReset {
+            phase: Some(BootPhase::Clock)
+        })
+        .as_bytes(),
+        b"previous run: watchdog reset with no reason recorded (the firmware hung in its clock phase)\r\n"
     );
     let fault =
         ResetRecord::hard_fault(None, 0x0800_1A2C, 0x0800_0F01, 0x0000_0400, 0x4000_0000, 0);
     let entry = Entry {
         seq: 7,
         source: ResetSource::IndependentWatchdog,
+        kind: ResetKind::Watchdog,
         ended: Ended::Recorded,
+        phase: None,
+        safe_mode: false,
         record: Some(fault),
     };
     assert_eq!(
         entry_line(&entry).as_bytes(),
         b"log #7: reset by watchdog: a hard fault: lr=0x08000F01 cfsr=0x00000400 hfsr=0x40000000 bfar=0x00000000 hard fault at 0x08001A2C\r\n"
     );
-    let clock = Entry {
+    let hung = Entry {
         seq: 8,
-        source: ResetSource::IndependentWatchdog,
-        ended: Ended::Recorded,
-        record: Some(ResetRecord::clock_failure()),
+        ended: Ended::WatchdogReset,
+        phase: Some(BootPhase::Clock),
+        safe_mode: true,
+        record: None,
+        ..entry
     };
     assert_eq!(
-        entry_line(&clock).as_bytes(),
-        b"log #8: reset by watchdog: a clock failure: crystal failed (clock security system) (0)\r\n"
+        entry_line(&hung).as_bytes(),
+        b"log #8: reset by watchdog: watchdog reset with no reason recorded (hung in its clock phase); safe mode\r\n"
+    );
+    let mut flash = Pages::erased();
+    log::record_boot(&mut flash, &clean(ResetKind::PowerOn)).unwrap();
+    log::record_boot(&mut flash, &failed(1)).unwrap();
+    assert_eq!(
+        totals_line(&log::totals(&mut flash)).as_bytes(),
+        b"resets: power-on 1, brown-out 0, reset button 0, watchdog 1, software 0, other 0; up 10 min 0; failed runs counted, not entered 0; safe mode 0\r\n"
+    );
+    let found = list_line(
+        "self-check: did not take: ",
+        ["RCC_CR.CSSON", "FLASH_OPTR.BOR_LEV"].into_iter(),
+    );
+    assert_eq!(
+        found.unwrap().as_bytes(),
+        b"self-check: did not take: RCC_CR.CSSON, FLASH_OPTR.BOR_LEV\r\n"
+    );
+    assert!(list_line("self-check: did not take: ", [].into_iter()).is_none());
+    assert_eq!(
+        safe_mode_line(1, "boots in a row failed before the monitor was up").as_bytes(),
+        b"SAFE MODE (code 1): boots in a row failed before the monitor was up; not monitoring; press the reset button to try again\r\n"
     );
 }

@@ -4,10 +4,10 @@
 
 use super::{board_monitor_config, MonitorStatus};
 use crate::acquisition::{LinearRanges, SampleBuilder, HALF_LEN, OVERSAMPLING};
-use crate::board::FrontEnd;
 use crate::board::{CurrentCode, VoltageCode};
+use crate::board::{FrontEnd, ZeroBias, ZERO_BIAS};
 use crate::flash_record::CalibrationRecord;
-use crate::offset_trim::{OffsetTrim, TrimResult};
+use crate::offset_trim::{OffsetTrim, TrimKind, TrimResult, REPORT_STEP_CODES};
 use crate::sampling::{AdcSampler, Clipped, RawFrame, SamplingError};
 use monitor_core::{
     CommissioningError, ConfigError, Fault, Install, Monitor, MonitorConfig, SteadyPoint,
@@ -117,6 +117,8 @@ pub struct SamplePath {
     front_end: FrontEnd,
     /// The reference correction in force: VDDA now over VDDA at commissioning.
     reference_gain: f32,
+    /// Where the front end's zero is biased ([`ZERO_BIAS`]): how the correction moves it.
+    zero_bias: ZeroBias,
 }
 
 impl SamplePath {
@@ -138,6 +140,7 @@ impl SamplePath {
             encoder_rejects: 0,
             front_end,
             reference_gain: 1.0,
+            zero_bias: ZERO_BIAS,
         })
     }
 
@@ -184,35 +187,54 @@ impl SamplePath {
         }
     }
 
-    /// The start-up offset trim ([`crate::offset_trim`]): adds `raw` (the frame also given
-    /// to [`SamplePath::on_frame`]) and, at the [`crate::offset_trim::TRIM_SAMPLES`]th
-    /// frame, puts the trimmed channels' offsets into force in the front end and returns the
-    /// result (the out-of-bound channels go to [`Supervisor::set_offset_fault`](super::Supervisor::set_offset_fault)). `None`
-    /// before and after (then it returns at once).
+    /// The offset trim ([`crate::offset_trim`]): adds `raw` (the frame also given to
+    /// [`SamplePath::on_frame`]); at the end of the start-up window, and of each later
+    /// window in which the shaft stood and the currents were zero, puts the trimmed
+    /// channels' offsets into force in the front end. Returns the start-up trim (its
+    /// out-of-bound channels go to [`Supervisor::set_offset_fault`](super::Supervisor::set_offset_fault))
+    /// and the re-trims that moved a zero by [`REPORT_STEP_CODES`] or more (to log); `None`
+    /// otherwise.
     pub fn trim_offsets(&mut self, raw: &RawFrame) -> Option<TrimResult> {
         let trim = self.trim.add(raw)?;
         let gain = self.reference_gain;
+        let bias = self.zero_bias;
         let fe = &mut self.front_end;
         let channels = (fe.voltage.iter_mut().zip(trim.voltage))
             .chain(fe.current.iter_mut().zip(trim.current));
+        let mut moved = false;
         for (scale, channel) in channels {
             if let Some(offset) = channel.offset() {
-                // Measured in codes at today's reference: at commissioning's, x gain.
-                scale.offset_code = offset * gain;
+                // Measured in codes at today's reference; the front end keeps them at
+                // commissioning's: an absolute zero's code x gain, a zero at VDDA / 2's as
+                // it is.
+                let at_commissioning = match bias {
+                    ZeroBias::Absolute => offset * gain,
+                    ZeroBias::HalfVdda => offset,
+                };
+                moved |= (at_commissioning - scale.offset_code).abs() >= REPORT_STEP_CODES;
+                scale.offset_code = at_commissioning;
             }
         }
         self.apply_front_end();
-        Some(trim)
+        (trim.kind == TrimKind::StartUp || moved).then_some(trim)
+    }
+
+    /// Where the front end's zero is biased (the board's [`ZERO_BIAS`] unless set).
+    pub fn set_zero_bias(&mut self, bias: ZeroBias) {
+        self.zero_bias = bias;
+        self.apply_front_end();
     }
 
     /// Corrects every reading for the ADC's reference (`Command::ReferenceGain`): `gain`
     /// = VDDA now over VDDA at commissioning ([`crate::supply::ReferenceGain`]). The front
-    /// end's output is not ratiometric (the isolated amplifiers have references of their
-    /// own), so a code read at VDDA now is `gain` times the code the same input gave at
-    /// commissioning: `x = (gain code - offset) per_lsb = (code - offset / gain) (gain
-    /// per_lsb)`, the front end rescaled once, nothing added per sample. A gain that is
-    /// not finite or outside 0.9..=1.1 (beyond the reference's band, whose readings are
-    /// flagged anyway) is ignored.
+    /// end's swing is not ratiometric (the isolated amplifiers' gain is theirs), so the
+    /// swing around the zero read at VDDA now is `1 / gain` times the swing the same input
+    /// gave at commissioning: `x = (code - zero now) (gain per_lsb)`. The zero's code now
+    /// depends on its bias ([`crate::board::ZeroBias`]): a zero at VDDA / 2 stays where it
+    /// was (`zero now = offset`); an absolute one moves with the swing (`zero now = offset /
+    /// gain`). The front end rescaled once, nothing added per sample. A gain that is not
+    /// finite or outside 0.9..=1.1 (beyond the reference's band, whose readings are flagged
+    /// anyway) is ignored.
     pub fn set_reference_gain(&mut self, gain: f32) {
         if gain.is_finite() && (0.9..=1.1).contains(&gain) {
             self.reference_gain = gain;
@@ -228,9 +250,12 @@ impl SamplePath {
     /// The sampler's front end: [`SamplePath::front_end`]'s scaled by the reference gain.
     fn apply_front_end(&mut self) {
         let g = self.reference_gain;
+        let absolute = self.zero_bias == ZeroBias::Absolute;
         let mut fe = self.front_end;
         for scale in fe.voltage.iter_mut().chain(fe.current.iter_mut()) {
-            scale.offset_code /= g;
+            if absolute {
+                scale.offset_code /= g;
+            }
             scale.per_lsb *= g;
         }
         self.sampler.set_front_end(fe);

@@ -9,8 +9,10 @@
 
 use core::marker::PhantomData;
 
+use drive_monitor::acquisition::{DMA_HALF_LEN, LATCH_HALF_LEN};
 use drive_monitor::adc_rules::AdcPairSetup;
 use drive_monitor::recovery::{AcqRegisters, Acquisition, AdcFlags, RegisterAcquisition};
+use drive_monitor::ring_read::{RingRead, RingReads};
 use embassy_stm32::adc::RingBufferedAdc;
 use embassy_stm32::adc::{Adc, AdcConfig};
 use embassy_stm32::dma::{self, ReadableRingBuffer};
@@ -19,7 +21,7 @@ use embassy_stm32::pac;
 use embassy_stm32::pac::adc::vals::{Dmacfg, Dmaen};
 use embassy_stm32::timer::low_level::Timer as HwTimer;
 use embassy_stm32::{peripherals, Peri};
-use embassy_time::Instant;
+use embassy_time::{with_deadline, Duration, Instant};
 
 /// The two ADCs' registers, ADC1 (voltages) then ADC2 (currents).
 const ADCS: [pac::adc::Adc; 2] = [pac::ADC1, pac::ADC2];
@@ -41,6 +43,10 @@ pub(super) struct HwRegisters {
     pub(super) latch: ReadableRingBuffer<'static, u16>,
     /// When the trigger was last started, us (the timestamps continue from there).
     pub(super) started_us: u32,
+    /// The wait for one half at most (`liveness::AdcWait::timeout_us`).
+    pub(super) timeout: Duration,
+    /// The current half's deadline ([`RingReads::start_wait`]).
+    pub(super) deadline: Instant,
 }
 
 fn now_us() -> u32 {
@@ -57,7 +63,7 @@ pub(super) fn new_acquisition(
     adc1: RingBufferedAdc<'static, peripherals::ADC1>,
     adc2: RingBufferedAdc<'static, peripherals::ADC2>,
     latch: ReadableRingBuffer<'static, u16>,
-    ring_len: u16,
+    (ring_len, timeout): (u16, Duration),
 ) -> HwAcquisition {
     for n in DMA_CHANNELS.into_iter().chain([LATCH_CHANNEL]) {
         pac::DMA1.ch(n).cr().modify(|w| w.set_teie(false));
@@ -69,6 +75,8 @@ pub(super) fn new_acquisition(
             adc2,
             latch,
             started_us: 0,
+            timeout,
+            deadline: Instant::now(),
         },
         ring_len,
     }
@@ -259,6 +267,33 @@ impl AcqRegisters for HwRegisters {
     fn trigger_start(&mut self) {
         self.started_us = now_us();
         self.trigger.start();
+    }
+}
+
+impl RingReads for HwRegisters {
+    fn start_wait(&mut self) {
+        self.deadline = Instant::now() + self.timeout;
+    }
+
+    async fn read_adc(&mut self, i: usize, buf: &mut [u16; DMA_HALF_LEN]) -> RingRead {
+        let read = if i == 0 {
+            with_deadline(self.deadline, self.adc1.read(buf)).await
+        } else {
+            with_deadline(self.deadline, self.adc2.read(buf)).await
+        };
+        match read {
+            Err(_) => RingRead::TimedOut,
+            Ok(Ok(_)) => RingRead::Data,
+            Ok(Err(_)) => RingRead::Lapped,
+        }
+    }
+
+    async fn read_latch(&mut self, buf: &mut [u16; LATCH_HALF_LEN]) -> RingRead {
+        match with_deadline(self.deadline, self.latch.read_exact(buf)).await {
+            Err(_) => RingRead::TimedOut,
+            Ok(Ok(_)) => RingRead::Data,
+            Ok(Err(_)) => RingRead::Lapped,
+        }
     }
 }
 

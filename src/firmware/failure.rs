@@ -18,7 +18,7 @@ use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
 use drive_monitor::supply::BorLevel;
 use embassy_stm32::pac;
 
-use super::reset_ram::{write_reset_record, PHASE};
+use super::reset_ram::{write_reset_record, FINDINGS, PHASE};
 use super::supply::bor_level;
 
 /// Taken by the first fault of the run (`fault_path`): a second goes straight to reset.
@@ -32,6 +32,10 @@ struct Registers;
 impl FaultBoard for Registers {
     fn bor_level(&mut self) -> Option<BorLevel> {
         bor_level()
+    }
+
+    fn findings(&mut self) -> u32 {
+        FINDINGS.load(Ordering::Relaxed)
     }
 
     fn write_record(&mut self, bytes: &[u8; RESET_RECORD_LEN]) {

@@ -6,7 +6,7 @@
 use defmt::warn;
 use drive_monitor::board;
 use drive_monitor::flash_ecc::{CheckedFlash, RawFlash, ReadError};
-use drive_monitor::flash_record::{RecordStore, RECORD_LEN};
+use drive_monitor::flash_record::{RecordPage, RecordStore, RECORD_LEN};
 use drive_monitor::supply::{BorCheck, FromBorRefusal};
 use embassy_stm32::flash::{Blocking, Flash};
 use monitor_core::motor_record::STORED_LEN as MOTOR_RECORD_LEN;
@@ -75,13 +75,21 @@ impl BoardFlash {
     }
 }
 
+/// A commissioning record page's offset from the start of flash.
+fn record_offset(page: RecordPage) -> u32 {
+    match page {
+        RecordPage::A => board::RECORD_FLASH_OFFSET,
+        RecordPage::B => board::RECORD_B_FLASH_OFFSET,
+    }
+}
+
 impl RecordStore for BoardFlash {
     type Error = FlashError;
-    fn read(&mut self, buf: &mut [u8; RECORD_LEN]) -> Result<(), Self::Error> {
-        self.read_at(board::RECORD_FLASH_OFFSET, buf)
+    fn read(&mut self, page: RecordPage, buf: &mut [u8; RECORD_LEN]) -> Result<(), Self::Error> {
+        self.read_at(record_offset(page), buf)
     }
-    fn erase(&mut self) -> Result<(), Self::Error> {
-        let from = board::RECORD_FLASH_OFFSET;
+    fn erase(&mut self, page: RecordPage) -> Result<(), Self::Error> {
+        let from = record_offset(page);
         self.0
             .raw
             .get()?
@@ -90,11 +98,11 @@ impl RecordStore for BoardFlash {
         self.0.erased(from);
         Ok(())
     }
-    fn write(&mut self, bytes: &[u8; RECORD_LEN]) -> Result<(), Self::Error> {
+    fn write(&mut self, page: RecordPage, bytes: &[u8; RECORD_LEN]) -> Result<(), Self::Error> {
         self.0
             .raw
             .get()?
-            .blocking_write(board::RECORD_FLASH_OFFSET, bytes)
+            .blocking_write(record_offset(page), bytes)
             .map_err(FlashError::Driver)
     }
 }
@@ -112,7 +120,7 @@ pub(super) fn read_motor_page(flash: &mut BoardFlash) -> [u8; MOTOR_RECORD_LEN] 
     page
 }
 
-/// The reset log's two pages (`drive_monitor::reset_record::log`) in bank 2 at
+/// The reset log's pages (`drive_monitor::reset_record::log`) in bank 2 from
 /// `board::RESET_LOG_FLASH_OFFSET`: reads checked for ECC double errors, erases and writes
 /// refused below the brown-out goal (as the records'; the boot appends before sampling
 /// starts, so nothing is running that an erase could hold up).
@@ -130,7 +138,10 @@ impl LogPages<'_> {
 impl drive_monitor::reset_record::log::LogFlash for LogPages<'_> {
     type Error = FlashError;
     fn read(&mut self, page: usize, offset: usize, buf: &mut [u8]) -> Result<(), FlashError> {
-        self.flash.read_at(Self::offset(page, offset), buf)
+        self.flash
+            .0
+            .read_unmarked(&failure::ECC, Self::offset(page, offset), buf)
+            .map_err(flash_error)
     }
     fn erase(&mut self, page: usize) -> Result<(), FlashError> {
         if !self.bor.allows_flash_writes() {

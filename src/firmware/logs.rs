@@ -1,10 +1,15 @@
-//! The firmware's log lines for events: why the previous run ended, what the boot put into
-//! force, the start-up checks (offset trim, reference, brown-out level), liveness changes and the commissioning's
-//! ends. The status line is `log_status` in `src/firmware.rs`.
+//! The firmware's log lines for events, each spelled from a typed value of the library:
+//! what the start found (`drive_monitor::startup::BootNote`: the clock, why the previous
+//! run ended, the stack, the self-check's findings, the brown-out level, the safe mode),
+//! what the boot put into force, and what thread mode's period did
+//! (`drive_monitor::app::PeriodOutput`: the offset trim, the reference, liveness changes,
+//! the commissioning's ends and store, the range state). The status line is `log_status`
+//! in `src/firmware.rs`.
 
 use core::sync::atomic::Ordering;
 
 use defmt::{error, info, warn};
+use drive_monitor::app::PeriodOutput;
 use drive_monitor::board::{ReferenceCheck, VDDA_BAND_V};
 use drive_monitor::boot::{Booted, CalibrationMissing};
 use drive_monitor::clip_watch::RangeChange;
@@ -12,20 +17,20 @@ use drive_monitor::clock::ClockSource;
 use drive_monitor::commissioning::RunEnd;
 use drive_monitor::flash_record::{self, StoreError};
 use drive_monitor::liveness::LivenessChange;
-use drive_monitor::offset_trim::{ChannelTrim, TrimResult, MAX_OFFSET_CODES};
-use drive_monitor::reset_record::{
-    PreviousRun, ResetCause, ResetRecord, ResetSource, RESET_RECORD_LEN,
+use drive_monitor::offset_trim::{
+    ChannelTrim, TrimKind, TrimResult, MAX_OFFSET_CODES, RETRIM_STEP_CODES,
 };
+use drive_monitor::reset_record::{log, PreviousRun, ResetCause, ResetRecord, ResetSource};
+use drive_monitor::self_check::CheckId;
+use drive_monitor::startup::{BootFacts, BootNote, SafeModeReason};
 use drive_monitor::supply::{BorCheck, ReferenceChange, BOR_GOAL};
-use embassy_stm32::pac;
 
-use super::reset_ram::{read_reset_record, write_reset_record};
-use super::supply::bor_level;
+use super::flash::FlashError;
 use super::RESTARTS;
 
 /// The boot's brown-out check: the level in force, and below [`BOR_GOAL`] how to raise it
 /// (docs/firmware.md, "Brown-out level"); the firmware does not write the option bytes.
-pub(super) fn log_bor(check: BorCheck) {
+fn log_bor(check: BorCheck) {
     match check {
         BorCheck::AtGoal(l) => info!(
             "brown-out reset level {=u8} (about {=f32} V)",
@@ -46,9 +51,60 @@ pub(super) fn log_bor(check: BorCheck) {
     }
 }
 
+/// What the start found (`BootFacts::notes`), in order.
+pub(super) fn log_facts(facts: &BootFacts) {
+    for note in facts.notes() {
+        match note {
+            BootNote::Clock(Some(source)) => log_clock(source),
+            BootNote::Clock(None) => {
+                warn!("clock: the 16 MHz reset clock (HSI, no PLL): safe mode")
+            }
+            BootNote::PreviousRun(source, previous) => log_previous_run(previous, source),
+            BootNote::StackOverflowed => log_stack(),
+            BootNote::FailedBoots(n) => warn!(
+                "{=u8} boots in a row failed before the monitor was up (the safe mode after {=u8})",
+                n,
+                drive_monitor::boot_block::SAFE_MODE_AFTER
+            ),
+            BootNote::Mismatch(id) => log_mismatch(id),
+            BootNote::BrownOut(check) => log_bor(check),
+            BootNote::SafeMode(reason) => log_safe_mode(reason),
+        }
+    }
+    if facts.findings.crystal_did_not_start() {
+        warn!("self-check: the crystal did not start within its bound");
+    }
+    if facts.findings.pll_did_not_lock() {
+        error!("self-check: the PLL did not lock from the crystal: running on the HSI");
+    }
+}
+
+/// A register that did not hold what the firmware wrote (the self-check).
+pub(super) fn log_mismatch(id: CheckId) {
+    error!(
+        "self-check: {=str} does not hold what the firmware wrote or expects (docs/firmware.md, \"The self-check\")",
+        id.name()
+    );
+}
+
+/// The safe mode's reason.
+fn log_safe_mode(reason: SafeModeReason) {
+    match reason {
+        SafeModeReason::BootLoop { failed_boots } => error!(
+            "SAFE MODE: {=u8} boots in a row failed before the monitor was up; not monitoring. The FAULT lamp blinks code {=u8}; press the reset button to try again",
+            failed_boots,
+            reason.code()
+        ),
+        SafeModeReason::PllDidNotLock => error!(
+            "SAFE MODE: the PLL locked neither from the crystal nor from the HSI; not monitoring. The FAULT lamp blinks code {=u8}",
+            reason.code()
+        ),
+    }
+}
+
 /// The clock's source (`drive_monitor::clock::ClockSource`) and the time base's error it
 /// implies.
-pub(super) fn log_clock(source: ClockSource) {
+fn log_clock(source: ClockSource) {
     match source {
         ClockSource::Hse => info!(
             "clock: {=str}, time base within +-{=u32} ppm",
@@ -65,7 +121,7 @@ pub(super) fn log_clock(source: ClockSource) {
 
 /// A change of the reference's verdict (`Supervisor::observe_reference`,
 /// `Supervisor::poll_reference`): why the sensors are flagged, or that they are not any more.
-pub(super) fn log_reference(change: ReferenceChange) {
+fn log_reference(change: ReferenceChange) {
     match change {
         ReferenceChange::Flagged(ReferenceCheck::OutOfBand(v)) => error!(
             "reference: VDDA {=f32} V outside {=f32}..{=f32} V: every reading is off by that ratio; the sensors are flagged until it returns",
@@ -83,25 +139,18 @@ pub(super) fn log_reference(change: ReferenceChange) {
     }
 }
 
-/// Why the previous run ended: the reset record (then erased) and the reset flags (then
-/// cleared), read before the clock set-up (a clock failure's record decides the clock
-/// source) and logged later ([`log_previous_run`]).
-pub(super) fn read_previous_run() -> (PreviousRun, ResetSource) {
-    let source = ResetSource::from_csr(pac::RCC.csr().read().0);
-    pac::RCC.csr().modify(|w| w.set_rmvf(true));
-    let previous = PreviousRun::at_boot(&read_reset_record(), source);
-    write_reset_record(&[0; RESET_RECORD_LEN]);
-    (previous, source)
-}
-
-/// The previous run's end ([`read_previous_run`]) in the log.
-pub(super) fn log_previous_run(previous: PreviousRun, source: ResetSource) {
+/// The previous run's end (`drive_monitor::startup`) in the log.
+fn log_previous_run(previous: PreviousRun, source: ResetSource) {
     info!("reset by {=str}", source.name());
     match previous {
         PreviousRun::Clean => {}
-        PreviousRun::WatchdogReset => {
+        PreviousRun::WatchdogReset { phase: None } => {
             error!("previous run ended in a watchdog reset with no reason recorded: the firmware hung")
         }
+        PreviousRun::WatchdogReset { phase: Some(p) } => error!(
+            "previous run ended in a watchdog reset with no reason recorded: the firmware hung in its {=str} phase",
+            p.name()
+        ),
         PreviousRun::ResetDuring { record, source } => warn!(
             "previous run: {=str} recorded ({=u32}), then a {=str} reset came before the watchdog's",
             record.message(),
@@ -172,26 +221,59 @@ pub(super) fn log_boot<E: defmt::Format>(booted: &Booted<E>) {
     }
 }
 
-pub(super) fn on_liveness(change: LivenessChange) {
+/// What one thread-mode period did (`drive_monitor::app::period`), in the log.
+pub(super) fn log_period(out: &PeriodOutput<FlashError>) {
+    if let Some(trim) = &out.trim {
+        log_trim(trim);
+    }
+    for change in out.reference_changes.into_iter().flatten() {
+        log_reference(change);
+    }
+    if let Some(change) = out.tick.liveness {
+        on_liveness(change);
+    }
+    if let Some(end) = out.tick.run_ended {
+        log_run_end(end);
+    }
+    if let Some(change) = out.tick.clip_range {
+        log_clip_range(change);
+    }
+    if let Some(stored) = &out.stored {
+        log_stored(stored);
+    }
+    if let Some(gain) = out.tick.reference_gain {
+        log_reference_gain(gain);
+    }
+    match out.marked_up {
+        Some(false) => info!(
+            "up: samples flowed for {=u32} s: the failed boots in a row end",
+            drive_monitor::boot_block::UP_AFTER_MS / 1_000
+        ),
+        Some(true) => info!("up for 10 minutes: the reset log's entries are given back"),
+        None => {}
+    }
+}
+
+fn on_liveness(change: LivenessChange) {
     match change {
         LivenessChange::Stalled { for_ms } => error!(
             "SAMPLE PATH STALLED: no samples for {=u32} ms (restarts so far {=u32}); watchdog not petted",
             for_ms,
             RESTARTS.load(Ordering::Relaxed)
         ),
-        LivenessChange::RecordStall { for_ms } => {
-            let record = ResetRecord::sample_stall(for_ms).with_bor_level(bor_level());
-            write_reset_record(&record.encode());
-        }
+        LivenessChange::RecordStall { .. } => {}
         LivenessChange::Recovered { after_ms } => {
-            write_reset_record(&[0; RESET_RECORD_LEN]);
             warn!("sample path recovered after {=u32} ms", after_ms);
         }
     }
 }
 
-/// The start-up offset trim, channel by channel (`drive_monitor::offset_trim`).
-pub(super) fn log_trim(trim: &TrimResult) {
+/// The offset trim, channel by channel (`drive_monitor::offset_trim`): the start-up trim,
+/// or a re-trim at standstill that moved a zero.
+fn log_trim(trim: &TrimResult) {
+    if trim.kind == TrimKind::Retrim {
+        info!("offset re-trim: the shaft stands, the currents are zero");
+    }
     let names = ["va", "vb", "vc", "ia", "ib", "ic"];
     let channels = trim.voltage.iter().chain(trim.current.iter());
     for (name, channel) in names.into_iter().zip(channels) {
@@ -208,11 +290,17 @@ pub(super) fn log_trim(trim: &TrimResult) {
                 name,
                 spread
             ),
+            ChannelTrim::TooFar(code) => warn!(
+                "offset re-trim {=str}: zero at {=f32} codes, more than {=f32} from the zero in force: not used",
+                name,
+                code,
+                RETRIM_STEP_CODES
+            ),
         }
     }
 }
 
-pub(super) fn log_run_end(end: RunEnd) {
+fn log_run_end(end: RunEnd) {
     match end {
         RunEnd::Commissioned { run } => info!("commissioning run {=u16}: stored and in force", run),
         RunEnd::CancelledByUser { run } => info!("commissioning run {=u16}: cancelled", run),
@@ -224,7 +312,7 @@ pub(super) fn log_run_end(end: RunEnd) {
     }
 }
 
-pub(super) fn log_stored<E: defmt::Format>(stored: &flash_record::Stored<E>) {
+fn log_stored<E: defmt::Format>(stored: &flash_record::Stored<E>) {
     match &stored.written {
         Ok(()) => info!(
             "commissioning record written, read back: {}",
@@ -239,25 +327,27 @@ pub(super) fn log_stored<E: defmt::Format>(stored: &flash_record::Stored<E>) {
 }
 
 /// The stack: an overflow in the previous run (its guard words written; the previous run
-/// then ended in a fault or a lock-up), and the region's size.
-pub(super) fn log_stack(overflowed: bool) {
-    if overflowed {
-        error!("previous run: the stack reached the bottom of RAM (a stack overflow; flip-link made it fault instead of overwriting the statics)");
-    }
+/// then ended in a fault or a lock-up).
+fn log_stack() {
+    error!("previous run: the stack reached the bottom of RAM (a stack overflow; flip-link made it fault instead of overwriting the statics)");
 }
 
-/// The reset log's entry appended for the previous run, or why not.
-pub(super) fn log_reset_log<E: defmt::Format>(appended: Option<Result<u32, E>>) {
-    match appended {
-        None => {}
-        Some(Ok(seq)) => info!("reset log: entry #{=u32} written to flash", seq),
-        Some(Err(e)) => warn!("reset log: not written: {}", e),
+/// What the boot wrote to the reset log (`log::record_boot`), or why not.
+pub(super) fn log_reset_log(written: Result<log::Written, FlashError>) {
+    match written {
+        Ok(log::Written::Entry(seq)) => info!("reset log: entry #{=u32} written to flash", seq),
+        Ok(log::Written::Counted { failed: true }) => warn!(
+            "reset log: the failed run counted, not entered ({=u32} entries between two runs up for 10 minutes: the log's rate limit)",
+            log::FULL_ENTRIES
+        ),
+        Ok(log::Written::Counted { failed: false }) => {}
+        Err(e) => warn!("reset log: not written: {}", e),
     }
 }
 
 /// A new correction of the readings for the ADC's reference (VDDA now over VDDA at
 /// commissioning, `drive_monitor::supply::ReferenceGain`).
-pub(super) fn log_reference_gain(gain: f32) {
+fn log_reference_gain(gain: f32) {
     info!(
         "reference: readings corrected by {=f32} (VDDA now over VDDA at commissioning)",
         gain
@@ -268,7 +358,7 @@ pub(super) fn log_reference_gain(gain: f32) {
 /// running (the front end's linear range too small for this motor: the verdict could not
 /// judge, the panel's range mark), or no longer; the front ends that clipped in the window
 /// that decided it and its share of clipped samples.
-pub(super) fn log_clip_range(change: RangeChange) {
+fn log_clip_range(change: RangeChange) {
     if change.too_small {
         warn!(
             "clip: {=u32} per mille of the samples clipped in steady running for 6 s (voltage {=bool}, current {=bool}): the front end's linear range is too small for this motor, not judged",

@@ -1,20 +1,84 @@
 //! What survives a reset in RAM: the reset record (`drive_monitor::reset_record`: why the
-//! previous run ended) in cortex-m-rt's `.uninit` section, and the phase the firmware is
-//! in ([`PHASE`]), which the fault path writes into the record. The boot reads the record
-//! (`logs::previous_run`); the sample task, the brown-out check and the fault path
-//! (`failure.rs`) write it.
+//! previous run ended) and the boot block (`drive_monitor::boot_block`: the phase mark,
+//! the failed boots in a row) in cortex-m-rt's `.uninit` section, and the phase the
+//! firmware is in ([`PHASE`]), which the fault path writes into the record. The boot reads
+//! both (`drive_monitor::startup`); the sample task, thread mode and the fault path
+//! (`failure.rs`) write them.
 
 use core::mem::MaybeUninit;
-use core::sync::atomic::{AtomicU8, Ordering};
+use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 
-use drive_monitor::reset_record::{BootPhase, RESET_RECORD_LEN};
+use drive_monitor::boot_block::{BootBlock, BOOT_BLOCK_LEN};
+use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
+use drive_monitor::supply::BorLevel;
 
 /// What the firmware is doing ([`BootPhase::number`]), for the record of a `defmt` panic.
 pub(super) static PHASE: AtomicU8 = AtomicU8::new(0);
 
+/// The run's self-check findings (`drive_monitor::self_check::Findings`), which every
+/// reset record of the run carries ([`record`]).
+pub(super) static FINDINGS: AtomicU32 = AtomicU32::new(0);
+
 /// Records `phase` as what the firmware is doing now ([`PHASE`]).
 pub(super) fn set_phase(phase: BootPhase) {
     PHASE.store(phase.number(), Ordering::Relaxed);
+}
+
+/// Records `phase` ([`set_phase`]) and marks it in the boot block, which survives a
+/// reset: a hang from here on is placed by the next boot. In a critical section (thread
+/// mode and the sample task both mark).
+pub(super) fn mark_phase(phase: BootPhase) {
+    set_phase(phase);
+    cortex_m::interrupt::free(|_| {
+        if let Some(block) = BootBlock::decode(&read_boot_block()) {
+            write_boot_block(&block.in_phase(phase).encode());
+        }
+    });
+}
+
+/// Marks the run up in the boot block (the failed boots in a row end; `long`: up for the
+/// reset log's "up" mark), in a critical section.
+pub(super) fn mark_up(long: bool) {
+    cortex_m::interrupt::free(|_| {
+        if let Some(block) = BootBlock::decode(&read_boot_block()) {
+            write_boot_block(&block.marked_up(long).encode());
+        }
+    });
+}
+
+/// Writes `record` into the reset record with the brown-out level in force (`bor`,
+/// `supply::bor_level`) and the run's self-check findings.
+pub(super) fn record(record: ResetRecord, bor: Option<BorLevel>) {
+    let record = record
+        .with_bor_level(bor)
+        .with_findings(FINDINGS.load(Ordering::Relaxed));
+    write_reset_record(&record.encode());
+}
+
+/// The boot block: RAM in `.uninit`, as the reset record.
+#[allow(unsafe_code)]
+#[link_section = ".uninit.BOOT_BLOCK"]
+static mut BOOT_BLOCK: MaybeUninit<[u8; BOOT_BLOCK_LEN]> = MaybeUninit::uninit();
+
+/// The boot block's bytes (whatever they are: power-on garbage fails its check).
+#[allow(unsafe_code)]
+pub(super) fn read_boot_block() -> [u8; BOOT_BLOCK_LEN] {
+    // SAFETY: as `read_reset_record`: a byte array read volatile through a raw pointer;
+    // the writers are the boot, thread mode and the sample task, each in a critical
+    // section ([`mark_phase`], [`mark_up`]) or before the tasks run.
+    unsafe { core::ptr::read_volatile(core::ptr::addr_of!(BOOT_BLOCK).cast()) }
+}
+
+/// Overwrites the boot block.
+#[allow(unsafe_code)]
+pub(super) fn write_boot_block(bytes: &[u8; BOOT_BLOCK_LEN]) {
+    // SAFETY: as `read_boot_block`.
+    unsafe {
+        core::ptr::write_volatile(
+            core::ptr::addr_of_mut!(BOOT_BLOCK).cast::<[u8; BOOT_BLOCK_LEN]>(),
+            *bytes,
+        )
+    }
 }
 
 /// The reset record: RAM in cortex-m-rt's `.uninit` section, which the start-up code

@@ -8,15 +8,18 @@
 use core::sync::atomic::Ordering;
 
 use defmt::{error, info, warn};
-use drive_monitor::acquisition::{self as geometry, DMA_HALF_LEN, HALF_LEN, RING_LEN};
+use drive_monitor::acquisition::{self as geometry, HALF_LEN, RING_LEN};
 use drive_monitor::adc_rules::{self, IdleDiscard, PairError};
 use drive_monitor::app::{Command, FrameBuilder, SamplePath};
 use drive_monitor::board;
 use drive_monitor::clock;
+use drive_monitor::clock::ClockSource;
 use drive_monitor::liveness::AdcWait;
 use drive_monitor::motor_source::EncoderSetup;
 use drive_monitor::recovery::{self, RecoveryCounts, StepTimeout};
 use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
+use drive_monitor::ring_read::{self, Half, HalfBuffers};
+use drive_monitor::self_check::{self, CheckId, EncoderExpected};
 use drive_monitor::setup_guard::SetupStep;
 use embassy_stm32::adc::{Adc, AdcChannel, Exten, RingBufferedAdc, SampleTime};
 use embassy_stm32::dma::{self, ReadableRingBuffer, TransferOptions};
@@ -25,11 +28,12 @@ use embassy_stm32::time::Hertz;
 use embassy_stm32::timer::low_level::{MasterMode, RoundTo, Timer as HwTimer};
 use embassy_stm32::timer::qei::{Config as QeiConfig, Qei};
 use embassy_stm32::{pac, peripherals, triggers, Peri};
-use embassy_time::{with_timeout, Duration, TimeoutError};
+use embassy_time::{with_timeout, Duration};
 
 use super::acquisition::{self, HwAcquisition};
-use super::reset_ram::{set_phase, write_reset_record};
+use super::reset_ram::{self, mark_phase, set_phase, write_reset_record};
 use super::supply;
+use super::{logs, startup_hw};
 use super::{
     Irqs, Status, COMMANDS, OVERRUNS, PAUSED, PAUSE_LIMIT_MS, REFERENCE, RESTARTS, RESUME,
     SETTINGS, STATUS, TRIM,
@@ -58,6 +62,8 @@ pub(super) struct SampleHw {
     pub(super) supply_hz: f32,
     /// The six channels' linear ranges from the motor record (the clip check).
     pub(super) ranges: geometry::LinearRanges,
+    /// The clock the start chose (the self-check's expectation).
+    pub(super) clock: Option<ClockSource>,
 }
 
 /// The encoder: TIM4 in quadrature mode on PB6/PB7 with the motor record's pull-ups,
@@ -252,7 +258,11 @@ fn start_acquisition(
     guard.step(SetupStep::Ring2);
     let adc2 = ring_currents(adc2, hw.dma2, hw.i, ring2);
     guard.step(SetupStep::Start);
-    let mut acq = acquisition::new_acquisition(trigger, adc1, adc2, latch, RING_LEN as u16);
+    let timeout = Duration::from_micros(u64::from(
+        AdcWait::new(SETTINGS.sample_rate_hz).timeout_us(),
+    ));
+    let mut acq =
+        acquisition::new_acquisition(trigger, adc1, adc2, latch, (RING_LEN as u16, timeout));
     acquisition::start(&mut acq);
     guard.disarm();
     path.sampler_mut().resync(acq.regs.started_us);
@@ -323,10 +333,7 @@ pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
     // The encoder driver is kept (its timer counts); the count is read from the latch.
     let (_qei, mut acq) = set_up_acquisition(hw, &mut path);
     let mut wait = AdcWait::new(SETTINGS.sample_rate_hz);
-    let timeout = Duration::from_micros(u64::from(wait.timeout_us()));
-    let mut half1 = [0u16; DMA_HALF_LEN];
-    let mut half2 = [0u16; DMA_HALF_LEN];
-    let mut latched = [0u16; geometry::LATCH_HALF_LEN];
+    let mut bufs = HalfBuffers::default();
     // The ADCs idled since their set-up: the first sample is dropped (errata).
     let mut discard = IdleDiscard::default();
     discard.on_start(u32::MAX);
@@ -334,25 +341,20 @@ pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
     let mut max_cycles: u32 = 0;
     let mut counts = RecoveryCounts::default();
     loop {
-        if let Some(result) = recovery::before_read(&mut acq) {
-            RESTARTS.fetch_add(1, Ordering::Relaxed);
-            after_restart(&acq, &mut path, &mut counts, result);
-            restarted(&mut discard, &mut frames, &acq, last_data_us);
-            continue;
-        }
-        let read = with_timeout(timeout, async {
-            let r1 = acq.regs.adc1.read(&mut half1).await;
-            let r2 = acq.regs.adc2.read(&mut half2).await;
-            // The counts latched at the same triggers (the latch's half is complete at the
-            // last trigger, before the conversions it started).
-            let r3 = acq.regs.latch.read_exact(&mut latched).await;
-            (r1.is_ok(), r2.is_ok() && r3.is_ok())
-        })
-        .await;
-        if needs_recovery(read, &mut wait) {
-            recover_acquisition(&mut acq, &mut path, &mut counts);
-            restarted(&mut discard, &mut frames, &acq, last_data_us);
-            continue;
+        match ring_read::read_half(&mut acq, &mut bufs).await {
+            Half::Recovered(result) => {
+                RESTARTS.fetch_add(1, Ordering::Relaxed);
+                after_restart(&acq, &mut path, &mut counts, result);
+                restarted(&mut discard, &mut frames, &acq, last_data_us);
+                continue;
+            }
+            half => {
+                if needs_recovery(half, &mut wait) {
+                    recover_acquisition(&mut acq, &mut path, &mut counts);
+                    restarted(&mut discard, &mut frames, &acq, last_data_us);
+                    continue;
+                }
+            }
         }
         if apply_commands(&mut path, &mut acq).await {
             restarted(&mut discard, &mut frames, &acq, last_data_us);
@@ -362,8 +364,8 @@ pub(super) async fn sample_task(hw: SampleHw, mut path: SamplePath) {
         process_half(
             &mut path,
             &mut frames,
-            (&half1[..], &half2[..]),
-            &latched,
+            (&bufs.v[..], &bufs.i[..]),
+            &bufs.latched,
             &mut discard,
             &mut max_cycles,
         );
@@ -390,38 +392,45 @@ fn set_up_acquisition(
     hw: SampleHw,
     path: &mut SamplePath,
 ) -> (Qei<'static, peripherals::TIM4>, HwAcquisition) {
-    set_phase(BootPhase::AdcSetup);
-    let setup = ResetRecord::setup(BootPhase::AdcSetup).with_bor_level(supply::bor_level());
-    write_reset_record(&setup.encode());
+    mark_phase(BootPhase::AdcSetup);
+    reset_ram::record(ResetRecord::setup(BootPhase::AdcSetup), supply::bor_level());
+    let expected = EncoderExpected {
+        filter: hw.encoder.input_filter,
+        invert_a: hw.encoder.invert_a,
+    };
+    let clock = hw.clock.unwrap_or(ClockSource::Hsi);
     let started = start_acquisition(hw, path);
     write_reset_record(&[0; RESET_RECORD_LEN]);
-    set_phase(BootPhase::Sampling);
+    mark_phase(BootPhase::Sampling);
     info!("sampling at {=u32} Hz", SETTINGS.sample_rate_hz);
+    // The acquisition's registers read back (the encoder's timer, the ADCs' common
+    // register): each mismatch logged and carried by every later reset record.
+    let expectation = self_check::expectation(clock, Some(expected));
+    let findings = self_check::run(&CheckId::ACQUISITION, &expectation, startup_hw::read_word);
+    reset_ram::FINDINGS.fetch_or(findings.0, Ordering::Relaxed);
+    findings.mismatched().for_each(logs::log_mismatch);
     started
 }
 
-/// Whether the acquisition needs the recovery after the wait for one half: `read` is both
-/// ADCs' read result (`true`: read, `false`: the DMA lapped the reader and samples were
-/// lost), or the timeout's error when no data came within it (an ADC overrun, a DMA error,
-/// or a stopped trigger: thread mode shows a stall and stops petting the watchdog until
-/// samples flow again). Counts and logs each cause on `wait` and the counters.
+/// Whether the acquisition needs the recovery after the wait for one `half`
+/// (`ring_read::read_half`): read (`lapped`: the DMA lapped the reader and samples were
+/// lost), or no data within the timeout (an ADC overrun, a stopped trigger: thread mode
+/// shows a stall and stops petting the watchdog until samples flow again). Counts and logs
+/// each cause on `wait` and the counters.
 #[inline]
-fn needs_recovery(read: Result<(bool, bool), TimeoutError>, wait: &mut AdcWait) -> bool {
-    match read {
-        Ok((ok1, ok2)) => {
+fn needs_recovery(half: Half, wait: &mut AdcWait) -> bool {
+    match half {
+        Half::Read { lapped: [l1, l2] } => {
             if let Some(n) = wait.data() {
                 warn!("sampling resumed after {=u32} recoveries", n);
             }
-            if !(ok1 && ok2) {
+            if l1 || l2 {
                 let n = OVERRUNS.fetch_add(1, Ordering::Relaxed) + 1;
-                warn!(
-                    "ADC DMA ring lapped #{=u32} (adc1 {} adc2 {})",
-                    n, !ok1, !ok2
-                );
+                warn!("ADC DMA ring lapped #{=u32} (adc1 {} adc2 {})", n, l1, l2);
             }
-            !(ok1 && ok2)
+            l1 || l2
         }
-        Err(_) => {
+        Half::TimedOut | Half::Recovered(_) => {
             let restart = wait.timed_out();
             RESTARTS.fetch_add(1, Ordering::Relaxed);
             if restart.log {

@@ -7,12 +7,12 @@ use core::sync::atomic::{AtomicU8, Ordering};
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 use drive_monitor::setup_guard::{self, SetupStep, SETUP_DEADLINE_MS};
-use drive_monitor::supply::{BorCheck, BorLevel, ReferenceAdc};
+use drive_monitor::supply::{BorLevel, ReferenceAdc};
 use drive_monitor::{adc_rules, clock};
 use embassy_stm32::pac;
 use embassy_stm32::pac::adc::vals::{Exten, SampleTime};
 
-use super::reset_ram::write_reset_record;
+use super::reset_ram;
 
 /// The set-up step running (`SetupStep::number`), 0 when no set-up runs: what the SysTick
 /// exception reads when the deadline runs out.
@@ -61,7 +61,7 @@ impl SetupGuard {
 #[cortex_m_rt::exception]
 fn SysTick() {
     if let Some(record) = setup_guard::on_deadline(SETUP_STEP.load(Ordering::SeqCst)) {
-        write_reset_record(&record.with_bor_level(bor_level()).encode());
+        reset_ram::record(record, bor_level());
         cortex_m::peripheral::SCB::sys_reset();
     }
 }
@@ -69,11 +69,6 @@ fn SysTick() {
 /// The brown-out level in force (`FLASH_OPTR.BOR_LEV`; `None` for a reserved value).
 pub(super) fn bor_level() -> Option<BorLevel> {
     BorLevel::from_optr(pac::FLASH.optr().read().0)
-}
-
-/// The boot's brown-out check ([`BorCheck::of_optr`]).
-pub(super) fn bor_check() -> BorCheck {
-    BorCheck::of_optr(pac::FLASH.optr().read().0)
 }
 
 /// ADC1's VREFINT channel (RM0440, "ADC1 connectivity": ADC1_IN18).

@@ -4,49 +4,48 @@
 
 use defmt::error;
 use drive_monitor::clock::ClockSource;
-use drive_monitor::reset_record::{log, report, PreviousRun, ResetSource};
-use drive_monitor::supply::BorCheck;
+use drive_monitor::reset_record::{log, report};
+use drive_monitor::self_check::CheckId;
+use drive_monitor::startup::{BootFacts, SafeModeReason};
 use embassy_stm32::usart::{Config as UsartConfig, UartTx};
 use embassy_stm32::{peripherals, Peri};
 
 use super::flash::{BoardFlash, LogPages};
 use super::logs;
 
-/// The record a technician reads without a probe: the previous run's end appended to the
-/// reset log in flash (refused below the brown-out goal; before sampling starts, so the
-/// erase holds nothing up), then the boot report and the log's four newest entries as text
-/// on the ST-LINK's virtual COM port (USART2 TX on PA2, 115 200 8N1;
-/// `drive_monitor::reset_record::report`).
+/// The record a technician reads without a probe: the boot's item in the reset log in flash
+/// (`log::record_boot`: a full entry for a failed run within the rate limit, else a count;
+/// refused below the brown-out goal; before sampling starts, so an erase holds nothing up),
+/// then the boot report, the self-check's findings, the safe mode, the log's counts and its
+/// four newest entries as text on the ST-LINK's virtual COM port (USART2 TX on PA2,
+/// 115 200 8N1; `drive_monitor::reset_record::report`).
 pub(super) fn report_boot(
     flash: &mut BoardFlash,
-    bor: BorCheck,
     (usart, tx): (
         Peri<'static, peripherals::USART2>,
         Peri<'static, peripherals::PA2>,
     ),
-    (previous, reset_source): (PreviousRun, ResetSource),
-    source: ClockSource,
+    facts: &BootFacts,
 ) {
-    let mut pages = LogPages { flash, bor };
-    let appended = log::Entry::of(&previous)
-        .map(|(ended, record)| log::append(&mut pages, reset_source, ended, record).map(|e| e.seq));
-    logs::log_reset_log(appended);
+    let mut pages = LogPages {
+        flash,
+        bor: facts.bor,
+    };
+    let boot = log::BootRecord {
+        previous: facts.previous,
+        source: facts.reset_source,
+        kind: facts.history.kind,
+        previous_long_up: facts.history.previous_long_up,
+        safe_mode: facts.safe_mode.is_some(),
+    };
+    logs::log_reset_log(log::record_boot(&mut pages, &boot));
     let Ok(mut vcp) = UartTx::new_blocking(usart, tx, UsartConfig::default()) else {
         error!("virtual COM port: USART2 not configured: no boot report there");
         return;
     };
-    let clock = match source {
-        ClockSource::Hse => "24 MHz crystal (HSE)",
-        _ => "internal oscillator (HSI, +-1 %)",
-    };
-    let version = env!("CARGO_PKG_VERSION");
-    let bor = bor.status_number();
-    let mut lines = [
-        report::boot_line(version, reset_source, bor, clock),
-        report::previous_line(&previous),
-    ]
-    .into_iter()
-    .chain(
+    let head = head_lines(facts);
+    let totals = report::totals_line(&log::totals(&mut pages));
+    let mut lines = head.into_iter().flatten().chain([totals]).chain(
         log::newest::<_, 4>(&mut pages)
             .0
             .into_iter()
@@ -60,4 +59,33 @@ pub(super) fn report_boot(
         error!("virtual COM port: write failed");
     }
     let _ = vcp.blocking_flush();
+}
+
+/// The report's first lines: the boot line, the previous run's end, the self-check's
+/// findings and the safe mode (when there are any).
+fn head_lines(facts: &BootFacts) -> [Option<report::ReportLine>; 4] {
+    let clock = match facts.clock {
+        Some(ClockSource::Hse) => "24 MHz crystal (HSE)",
+        Some(_) => "internal oscillator (HSI, +-1 %)",
+        None => "16 MHz reset clock (safe mode)",
+    };
+    let version = env!("CARGO_PKG_VERSION");
+    let bor = facts.bor.status_number();
+    let findings = report::list_line(
+        "self-check: did not take: ",
+        facts.findings.mismatched().map(CheckId::name),
+    );
+    let safe = facts.safe_mode.map(|reason| {
+        let why = match reason {
+            SafeModeReason::BootLoop { .. } => "boots in a row failed before the monitor was up",
+            SafeModeReason::PllDidNotLock => "the PLL did not lock",
+        };
+        report::safe_mode_line(reason.code(), why)
+    });
+    [
+        Some(report::boot_line(version, facts.reset_source, bor, clock)),
+        Some(report::previous_line(&facts.previous)),
+        findings,
+        safe,
+    ]
 }

@@ -1,45 +1,96 @@
-//! The reset log: the last reset records in flash, for a board nobody watched with a
-//! probe. The reset record lives in RAM ([`super::ResetRecord`]) and is lost with the
-//! supply; at every boot after a failed run (a record, or a watchdog reset with none) the
-//! firmware appends what the boot read to this log, two 2 KiB pages of bank 2 below the
-//! motor record's (`board::RESET_LOG_FLASH_OFFSET`), 13 entries a page, so the last 13 to
-//! 26 ends of a run survive a power loss; the boot prints the newest on the ST-LINK's
-//! virtual COM port ([`super::report`]).
+//! The reset log: every reset counted and the ends of failed runs kept in flash, for a
+//! board nobody watched with a probe, with its wear bounded for a year of a boot every
+//! second.
 //!
-//! **An entry** ([`ENTRY_LEN`] = 152 bytes, a multiple of the G4's 8-byte write unit) is
-//! a format of the core's one record module ([`monitor_core::record`]: magic `DMRL`,
-//! version 1, length, CRC-32): a sequence number, the reset's source, what the boot
-//! concluded ([`Ended`]) and the 128-byte reset record as it was in RAM.
+//! The reset record lives in RAM ([`super::ResetRecord`]) and is lost with the supply. At
+//! every boot the firmware writes one item to this log ([`record_boot`]): a **full entry**
+//! (152 bytes: a sequence number, the reset's source and kind, how the previous run ended,
+//! the 128-byte reset record) for a failed run, or a **count mark** (8 bytes: the reset's
+//! kind, a count) for everything else: a power-on, a brown-out, the reset button, and a
+//! failed run beyond the rate limit. The boot prints the newest entries and the totals on
+//! the ST-LINK's virtual COM port ([`super::report`]).
 //!
-//! **Torn writes.** A slot is erased (every byte `0xFF`), valid (its CRC holds) or torn (a
-//! write a power loss cut short: neither). The writer appends after the last slot that is
-//! not erased, so a torn slot is never written over and never read as an entry; a page
-//! whose read fails (an ECC double error in a torn double word, which the checked reads
-//! report) counts as full. When the page in use is full, the other page (the older
-//! entries) is erased and written from its first slot: the newer page's entries stay.
+//! **The rate limit.** Between two "up" marks (a run that sampled for 10 minutes,
+//! `crate::liveness::LONG_UP_AFTER_MS`; the next boot writes the mark) at most
+//! [`FULL_ENTRIES`] failed runs get a full entry; later ones are counted as marks (their
+//! kind, flagged failed). A boot loop therefore writes 8 bytes a boot, whatever fails.
+//!
+//! **Pages.** [`PAGES`] pages of bank 2 (`board::RESET_LOG_FLASH_OFFSET`), used in turn: a
+//! page starts with a header ([`HEADER_LEN`] bytes: its sequence number, the totals of every
+//! count and the entries since the last "up" so far, the entry numbering), then items
+//! follow, 8-byte aligned. When the page in use is full, the next page in turn is erased and
+//! starts with the totals carried over: the counts are never lost with an erased page, the
+//! oldest entries are.
+//!
+//! **Wear.** A page holds [`MARKS_PER_PAGE`] (248) marks. A boot every second for a year is
+//! 31 536 000 boots: at most 31 536 000 marks (plus [`FULL_ENTRIES`] entries for each 10
+//! minutes a run was up, which a boot every second never is), 127 162 page fills, spread
+//! over 16 pages: 7 948 erases a page, within the 10 000 cycles a page survives (DS12288).
+//! A boot every second lasts 1.26 years; a board that boots once a day, thousands of years.
+//!
+//! **Torn writes.** An item is 8-byte aligned and written once; a write a power loss cut
+//! short leaves a torn item (neither erased nor valid): it is skipped, never read as an
+//! entry or a count, never written over; a read that fails (an ECC double error in a torn
+//! double word, which the checked reads report) ends the page (full from there). A page
+//! whose header is torn or erased is not in use; the next page fill erases it again.
 
-use super::{PreviousRun, ResetRecord, ResetSource, RESET_RECORD_LEN};
+use super::{BootPhase, PreviousRun, ResetKind, ResetRecord, ResetSource, RESET_RECORD_LEN};
 use monitor_core::record::{RecordFormat, RecordLayout};
 
 /// Bytes of one entry (header, payload, CRC; a multiple of 8).
 pub const ENTRY_LEN: usize = 152;
+/// Bytes of a count mark.
+pub const MARK_LEN: usize = 8;
+/// Bytes of a page's header.
+pub const HEADER_LEN: usize = 64;
 /// Bytes of a log page (the G4's page in dual-bank mode).
 pub const PAGE_LEN: usize = 2048;
-/// Entries a page holds.
-pub const SLOTS_PER_PAGE: usize = PAGE_LEN / ENTRY_LEN;
 /// Pages of the log.
-pub const PAGES: usize = 2;
+pub const PAGES: usize = 16;
+/// Count marks a page holds.
+pub const MARKS_PER_PAGE: usize = (PAGE_LEN - HEADER_LEN) / MARK_LEN;
+/// Full entries a page holds.
+pub const ENTRIES_PER_PAGE: usize = (PAGE_LEN - HEADER_LEN) / ENTRY_LEN;
+/// Failed runs that get a full entry between two "up" marks (module docs).
+pub const FULL_ENTRIES: u32 = 4;
+/// Counts the log keeps: one for each [`ResetKind`], then the "up" marks.
+pub const COUNTS: usize = 7;
+/// The count of "up" marks in [`Totals::counts`].
+const UP: usize = 6;
 
-/// The entry's format: magic `DMRL`, version 1, [`ENTRY_LEN`] bytes.
+/// The entry's format: magic `DMRL`, version 2, [`ENTRY_LEN`] bytes.
 pub const FORMAT: RecordFormat = RecordFormat {
     magic: *b"DMRL",
     current: RecordLayout {
-        version: 1,
+        version: 2,
         stored_len: ENTRY_LEN,
         length: (ENTRY_LEN - 12) as u16,
     },
     older: &[],
 };
+
+/// A page header's format: magic `DMLP`, version 1, [`HEADER_LEN`] bytes.
+pub const HEADER_FORMAT: RecordFormat = RecordFormat {
+    magic: *b"DMLP",
+    current: RecordLayout {
+        version: 1,
+        stored_len: HEADER_LEN,
+        length: (HEADER_LEN - 12) as u16,
+    },
+    older: &[],
+};
+
+/// A count mark's tag byte.
+const MARK_TAG: u8 = b'C';
+/// A mark's flag: the boot entered the safe mode.
+const MARK_SAFE_MODE: u8 = 0x80;
+/// A mark's flag: the run it counts failed (counted, not entered: the rate limit).
+const MARK_FAILED: u8 = 0x40;
+
+// Items stay 8-byte aligned; a page holds the header and 13 entries.
+const _: () = assert!(ENTRY_LEN.is_multiple_of(8) && HEADER_LEN.is_multiple_of(8) && MARK_LEN == 8);
+const _: () = assert!(ENTRIES_PER_PAGE == 13 && MARKS_PER_PAGE == 248);
+const _: () = assert!(COUNTS == ResetKind::ALL.len() + 1);
 
 /// How the previous run ended, as the boot concluded ([`PreviousRun`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -59,21 +110,29 @@ pub struct Entry {
     pub seq: u32,
     /// What reset the MCU.
     pub source: ResetSource,
+    /// The reset's kind (a power-on told from a brown-out).
+    pub kind: ResetKind,
     /// How the run ended.
     pub ended: Ended,
+    /// The phase a run that hung had marked last (`None`: not known, or no hang).
+    pub phase: Option<BootPhase>,
+    /// The boot that wrote it entered the safe mode.
+    pub safe_mode: bool,
     /// The reset record (`None` for a watchdog reset with no record).
     pub record: Option<ResetRecord>,
 }
 
 impl Entry {
     /// What the log keeps of the previous run as the boot read it (`None` for a clean one,
-    /// which is not logged).
-    pub fn of(previous: &PreviousRun) -> Option<(Ended, Option<ResetRecord>)> {
+    /// which is counted, not entered): how it ended, its record, the phase of a hang.
+    pub fn of(previous: &PreviousRun) -> Option<(Ended, Option<ResetRecord>, Option<BootPhase>)> {
         match *previous {
             PreviousRun::Clean => None,
-            PreviousRun::Recorded(r) => Some((Ended::Recorded, Some(r))),
-            PreviousRun::WatchdogReset => Some((Ended::WatchdogReset, None)),
-            PreviousRun::ResetDuring { record, .. } => Some((Ended::ResetDuring, Some(record))),
+            PreviousRun::Recorded(r) => Some((Ended::Recorded, Some(r), None)),
+            PreviousRun::WatchdogReset { phase } => Some((Ended::WatchdogReset, None, phase)),
+            PreviousRun::ResetDuring { record, .. } => {
+                Some((Ended::ResetDuring, Some(record), None))
+            }
         }
     }
 
@@ -87,7 +146,8 @@ impl Entry {
             Ended::WatchdogReset => 2,
             Ended::ResetDuring => 3,
         });
-        w.bytes(&[0; 2]);
+        w.u8(self.kind.index() as u8 | if self.safe_mode { MARK_SAFE_MODE } else { 0 });
+        w.u8(self.phase.map_or(0xFF, BootPhase::number));
         w.bytes(&self.record.map_or([0; RESET_RECORD_LEN], |r| r.encode()));
         w.bytes(&[0; 4]);
         w.finish()
@@ -104,12 +164,16 @@ impl Entry {
             3 => Ended::ResetDuring,
             _ => return None,
         };
-        r.take::<2>().ok()?;
+        let kind = r.u8().ok()?;
+        let phase = BootPhase::from_number(r.u8().ok()?);
         let record = ResetRecord::decode(&r.take::<RESET_RECORD_LEN>().ok()?);
         Some(Entry {
             seq,
             source,
+            kind: *ResetKind::ALL.get(usize::from(kind & 0x0F))?,
             ended,
+            phase,
+            safe_mode: kind & MARK_SAFE_MODE != 0,
             record,
         })
     }
@@ -143,12 +207,132 @@ fn source_of(code: u8) -> ResetSource {
     }
 }
 
-/// The log's two flash pages: the board's flash (checked reads, erases and writes refused
-/// below the brown-out goal), a byte array in the host tests.
+/// A count mark: `count` more of `what` (a [`ResetKind`]'s index, or [`UP`]) with its
+/// flags.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Mark {
+    what: usize,
+    count: u16,
+    failed: bool,
+    safe_mode: bool,
+}
+
+impl Mark {
+    fn encode(&self) -> [u8; MARK_LEN] {
+        let flags =
+            (u8::from(self.failed) * MARK_FAILED) | (u8::from(self.safe_mode) * MARK_SAFE_MODE);
+        let [c0, c1] = self.count.to_le_bytes();
+        let head = [MARK_TAG, self.what as u8 | flags, c0, c1];
+        let [k0, k1, k2, k3] = (!u32::from_le_bytes(head)).to_le_bytes();
+        let [h0, h1, h2, h3] = head;
+        [h0, h1, h2, h3, k0, k1, k2, k3]
+    }
+
+    fn decode(bytes: &[u8; MARK_LEN]) -> Option<Mark> {
+        let [h0, h1, h2, h3, k0, k1, k2, k3] = *bytes;
+        let head = u32::from_le_bytes([h0, h1, h2, h3]);
+        if h0 != MARK_TAG || !head != u32::from_le_bytes([k0, k1, k2, k3]) {
+            return None;
+        }
+        let what = usize::from(h1 & 0x0F);
+        (what < COUNTS).then_some(Mark {
+            what,
+            count: u16::from_le_bytes([h2, h3]),
+            failed: h1 & MARK_FAILED != 0,
+            safe_mode: h1 & MARK_SAFE_MODE != 0,
+        })
+    }
+}
+
+/// Everything the log has counted since it was first written.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Totals {
+    /// Resets by kind ([`ResetKind::index`]) and, last, the runs that were up for 10 minutes.
+    pub counts: [u32; COUNTS],
+    /// Failed runs counted but not entered (beyond the rate limit).
+    pub failed_not_entered: u32,
+    /// Boots that entered the safe mode.
+    pub safe_modes: u32,
+    /// Full entries written since the last "up" mark (the rate limit's count).
+    pub entries_since_up: u32,
+    /// The newest entry's sequence number (0: none yet).
+    pub last_entry: u32,
+}
+
+impl Totals {
+    /// Resets of `kind` counted.
+    pub fn resets(&self, kind: ResetKind) -> u32 {
+        self.counts.get(kind.index()).copied().unwrap_or(0)
+    }
+
+    /// Runs that were up for 10 minutes.
+    pub fn ups(&self) -> u32 {
+        self.counts.get(UP).copied().unwrap_or(0)
+    }
+
+    fn add_mark(&mut self, m: &Mark) {
+        if let Some(c) = self.counts.get_mut(m.what) {
+            *c = c.wrapping_add(u32::from(m.count));
+        }
+        if m.what == UP {
+            self.entries_since_up = 0;
+        }
+        if m.failed {
+            self.failed_not_entered = self.failed_not_entered.wrapping_add(u32::from(m.count));
+        }
+        if m.safe_mode {
+            self.safe_modes = self.safe_modes.wrapping_add(u32::from(m.count));
+        }
+    }
+
+    fn add_entry(&mut self, e: &Entry) {
+        if let Some(c) = self.counts.get_mut(e.kind.index()) {
+            *c = c.wrapping_add(1);
+        }
+        self.entries_since_up = self.entries_since_up.saturating_add(1);
+        self.last_entry = self.last_entry.max(e.seq);
+        if e.safe_mode {
+            self.safe_modes = self.safe_modes.wrapping_add(1);
+        }
+    }
+
+    fn encode_header(&self, page_seq: u32) -> [u8; HEADER_LEN] {
+        let mut w = HEADER_FORMAT.writer::<HEADER_LEN>();
+        w.u32(page_seq);
+        w.u32(self.entries_since_up);
+        w.u32(self.last_entry);
+        w.u32(self.failed_not_entered);
+        w.u32(self.safe_modes);
+        for c in self.counts {
+            w.u32(c);
+        }
+        w.bytes(&[0; 4]);
+        w.finish()
+    }
+
+    fn decode_header(bytes: &[u8]) -> Option<(u32, Totals)> {
+        let mut r = HEADER_FORMAT.open(bytes).ok()?;
+        let page_seq = r.u32().ok()?;
+        let mut t = Totals {
+            entries_since_up: r.u32().ok()?,
+            last_entry: r.u32().ok()?,
+            failed_not_entered: r.u32().ok()?,
+            safe_modes: r.u32().ok()?,
+            ..Totals::default()
+        };
+        for c in t.counts.iter_mut() {
+            *c = r.u32().ok()?;
+        }
+        Some((page_seq, t))
+    }
+}
+
+/// The log's pages: the board's flash (checked reads, erases and writes refused below the
+/// brown-out goal), byte arrays in the host tests.
 pub trait LogFlash {
     /// A failed read, erase or write.
     type Error;
-    /// Reads `buf.len()` bytes at `offset` of page `page` (0 or 1).
+    /// Reads `buf.len()` bytes at `offset` of page `page` (0..[`PAGES`]).
     ///
     /// # Errors
     /// When the read fails (an ECC double error in a torn double word among others).
@@ -165,93 +349,5 @@ pub trait LogFlash {
     fn write(&mut self, page: usize, offset: usize, bytes: &[u8]) -> Result<(), Self::Error>;
 }
 
-/// What a page holds: its valid entries' newest sequence number and the first slot after
-/// its last written one (`SLOTS_PER_PAGE`: full, or unreadable from there).
-#[derive(Clone, Copy, Debug, Default)]
-struct PageScan {
-    newest: Option<u32>,
-    next_free: usize,
-}
-
-/// Scans page `page`, calling `each` on its valid entries.
-fn scan<F: LogFlash>(flash: &mut F, page: usize, mut each: impl FnMut(Entry)) -> PageScan {
-    let mut out = PageScan::default();
-    for slot in 0..SLOTS_PER_PAGE {
-        let mut buf = [0u8; ENTRY_LEN];
-        if flash.read(page, slot * ENTRY_LEN, &mut buf).is_err() {
-            // Unreadable from here (a torn double word's ECC error): the page is full.
-            out.next_free = SLOTS_PER_PAGE;
-            return out;
-        }
-        if buf.iter().all(|b| *b == 0xFF) {
-            continue;
-        }
-        out.next_free = slot + 1;
-        if let Some(e) = Entry::decode(&buf) {
-            out.newest = out.newest.max(Some(e.seq));
-            each(e);
-        }
-    }
-    out
-}
-
-/// Appends the previous run's end (`ended`, `record`) after a reset by `source` to the log
-/// in `flash` (module docs: after the newest entry's slot, or in the other page, erased,
-/// when that page is full). Returns the entry written.
-///
-/// # Errors
-/// The flash's error when the erase or the write failed (or was refused).
-pub fn append<F: LogFlash>(
-    flash: &mut F,
-    source: ResetSource,
-    ended: Ended,
-    record: Option<ResetRecord>,
-) -> Result<Entry, F::Error> {
-    let pages = [scan(flash, 0, |_| {}), scan(flash, 1, |_| {})];
-    let [p0, p1] = pages;
-    // The page in use holds the newest entry (page 0 on an empty log).
-    let current = usize::from(p1.newest > p0.newest);
-    let newest = p0.newest.max(p1.newest).unwrap_or(0);
-    let at = if current == 0 { p0 } else { p1 };
-    let (page, slot) = if at.next_free < SLOTS_PER_PAGE {
-        (current, at.next_free)
-    } else {
-        let other = 1 - current;
-        flash.erase(other)?;
-        (other, 0)
-    };
-    let entry = Entry {
-        seq: newest.wrapping_add(1),
-        source,
-        ended,
-        record,
-    };
-    flash.write(page, slot * ENTRY_LEN, &entry.encode())?;
-    Ok(entry)
-}
-
-/// The newest `N` entries of the log, newest first (fewer when the log holds fewer).
-pub fn newest<F: LogFlash, const N: usize>(flash: &mut F) -> ([Option<Entry>; N], usize) {
-    let mut out: [Option<Entry>; N] = [None; N];
-    for page in 0..PAGES {
-        scan(flash, page, |e| {
-            // Insert keeping the newest first, the oldest dropped.
-            let mut carry = Some(e);
-            for slot in out.iter_mut() {
-                match (carry, *slot) {
-                    (Some(c), Some(s)) if c.seq > s.seq => {
-                        *slot = Some(c);
-                        carry = Some(s);
-                    }
-                    (Some(c), None) => {
-                        *slot = Some(c);
-                        carry = None;
-                    }
-                    _ => {}
-                }
-            }
-        });
-    }
-    let n = out.iter().filter(|e| e.is_some()).count();
-    (out, n)
-}
+mod pages;
+pub use pages::{newest, record_boot, totals, BootRecord, Written};

@@ -4,8 +4,8 @@
 //! terminal. Built without `core::fmt` (no float or generic formatting pulled into the
 //! firmware): fixed-size lines ([`ReportLine`]) of words and decimal or hexadecimal numbers.
 
-use super::log::{Ended, Entry};
-use super::{PreviousRun, ResetCause, ResetRecord, ResetSource};
+use super::log::{Ended, Entry, Totals};
+use super::{PreviousRun, ResetCause, ResetKind, ResetRecord, ResetSource};
 
 /// Bytes of one line at most (longer text is cut).
 pub const LINE_LEN: usize = 192;
@@ -138,8 +138,12 @@ pub fn previous_line(previous: &PreviousRun) -> ReportLine {
         PreviousRun::Clean => {
             l.push("no failure recorded");
         }
-        PreviousRun::WatchdogReset => {
-            l.push("watchdog reset with no reason recorded (the firmware hung)");
+        PreviousRun::WatchdogReset { phase } => {
+            l.push("watchdog reset with no reason recorded (the firmware hung");
+            if let Some(p) = phase {
+                l.push(" in its ").push(p.name()).push(" phase");
+            }
+            l.push(")");
         }
         PreviousRun::Recorded(r) => {
             l.push("ended in ");
@@ -165,6 +169,9 @@ pub fn entry_line(e: &Entry) -> ReportLine {
     match (e.ended, &e.record) {
         (Ended::WatchdogReset, _) | (_, None) => {
             l.push("watchdog reset with no reason recorded");
+            if let Some(p) = e.phase {
+                l.push(" (hung in its ").push(p.name()).push(" phase)");
+            }
         }
         (Ended::Recorded, Some(r)) => push_record(&mut l, r),
         (Ended::ResetDuring, Some(r)) => {
@@ -172,6 +179,57 @@ pub fn entry_line(e: &Entry) -> ReportLine {
             l.push(", another reset came first");
         }
     }
+    if e.safe_mode {
+        l.push("; safe mode");
+    }
     l.end();
+    l
+}
+
+/// The log's counts: `resets: power-on N, brown-out N, reset button N, watchdog N, software
+/// N, other N; up 10 min N; failed runs counted, not entered N; safe mode N`.
+pub fn totals_line(t: &Totals) -> ReportLine {
+    let mut l = ReportLine::default();
+    l.push("resets:");
+    for (k, kind) in ResetKind::ALL.iter().enumerate() {
+        l.push(if k == 0 { " " } else { ", " })
+            .push(kind.name())
+            .push(" ")
+            .number(t.resets(*kind));
+    }
+    l.push("; up 10 min ").number(t.ups());
+    l.push("; failed runs counted, not entered ")
+        .number(t.failed_not_entered);
+    l.push("; safe mode ").number(t.safe_modes).end();
+    l
+}
+
+/// `head` and the `items`, comma separated (the self-check's findings: `self-check: did not
+/// take: RCC_CR.CSSON, FLASH_OPTR.BOR_LEV`); `None` without items.
+pub fn list_line<'a>(head: &str, items: impl Iterator<Item = &'a str>) -> Option<ReportLine> {
+    let mut l = ReportLine::default();
+    l.push(head);
+    let mut any = false;
+    for item in items {
+        if any {
+            l.push(", ");
+        }
+        l.push(item);
+        any = true;
+    }
+    l.end();
+    any.then_some(l)
+}
+
+/// The safe mode's line: `SAFE MODE (code N): WHY; not monitoring; press the reset button to
+/// try again`.
+pub fn safe_mode_line(code: u8, why: &str) -> ReportLine {
+    let mut l = ReportLine::default();
+    l.push("SAFE MODE (code ")
+        .number(u32::from(code))
+        .push("): ")
+        .push(why)
+        .push("; not monitoring; press the reset button to try again")
+        .end();
     l
 }

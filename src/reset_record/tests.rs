@@ -37,7 +37,7 @@ fn anything_but_an_intact_record_reads_as_none() {
     let wd = ResetSource::IndependentWatchdog;
     assert_eq!(
         PreviousRun::at_boot(&[0; RESET_RECORD_LEN], wd),
-        PreviousRun::WatchdogReset
+        PreviousRun::WatchdogReset { phase: None }
     );
     assert_eq!(
         PreviousRun::at_boot(&[0; RESET_RECORD_LEN], ResetSource::Pin),
@@ -181,7 +181,7 @@ const WRITTEN_BEFORE: &str = "444d525201130a002a000000696e646578206f7574206f6620
 fn the_header_is_the_record_modules_and_the_former_layout_reads_as_no_record() {
     let rec = ResetRecord::panic("index out of bounds", "src/app.rs", 42);
     let bytes = rec.encode();
-    assert_eq!(&bytes[..8], &[b'D', b'M', b'R', b'R', 2, 0, 116, 0]);
+    assert_eq!(&bytes[..8], &[b'D', b'M', b'R', b'R', 3, 0, 116, 0]);
     assert_eq!(FORMAT.open(&bytes).map(|r| r.remaining()), Ok(116));
     let old: Vec<u8> = (0..WRITTEN_BEFORE.len() / 2)
         .map(|k| u8::from_str_radix(&WRITTEN_BEFORE[2 * k..2 * k + 2], 16).unwrap())

@@ -203,11 +203,14 @@ fn the_button_cancels_a_learning_run() {
     );
 }
 
+/// A power loss during the store's write: the new copy in the other page is torn, the old
+/// record in its page untouched (the two pages in turn, `flash_record`). Power back: RAM,
+/// flash and panel say "commissioned" with the old record.
 #[test]
-fn power_loss_during_the_flash_write_leaves_no_record_anywhere() {
+fn power_loss_during_the_flash_write_keeps_the_old_record() {
     let frames = steady_frames(3.0);
     let mut flash = FakeFlash::holding(&old_record());
-    // The record page was erased and 16 of the 48 bytes written when the power went.
+    // The other page was erased and 16 of the 104 bytes written when the power went.
     flash.fault = Some(FlashFault::PowerLossAfter(16));
     let mut rig = Rig::boot(Survivors::power_on(flash));
     let reset = rig.run(&frames, |rig, k| {
@@ -216,18 +219,23 @@ fn power_loss_during_the_flash_write_leaves_no_record_anywhere() {
         }
     });
     assert_eq!(reset, Err(Reset::PowerLoss));
-    // Power back: the torn record is rejected; RAM, flash and panel say "not commissioned".
+    // Power back: the torn copy is rejected, the old one is in force everywhere.
     let survivors = Survivors::power_on(rig.survivors.flash.clone());
     assert_eq!(
-        CalibrationRecord::decode(&survivors.flash.page),
+        CalibrationRecord::decode(&survivors.flash.page_b),
         Err(flash_record::RecordError::Crc)
+    );
+    assert_eq!(
+        CalibrationRecord::decode(&survivors.flash.page),
+        Ok(old_record())
     );
     let mut rig = Rig::boot(survivors);
     assert_eq!(rig.previous, PreviousRun::Clean);
     rig.run(&frames[..5_000], |_, _| {}).unwrap();
-    assert_eq!(rig.path.monitor().calibration(), None);
-    assert_eq!(rig.survivors.flash.usable(), None);
-    assert_eq!(rig.mode(), Mode::NotCommissioned);
+    let old = Some(Calibration::from(old_record()));
+    assert_eq!(rig.path.monitor().calibration(), old);
+    assert_eq!(rig.survivors.flash.usable(), old);
+    assert_eq!(rig.mode(), Mode::Commissioned);
 }
 
 #[test]
@@ -242,7 +250,8 @@ fn a_failed_flash_write_puts_what_the_flash_holds_into_force() {
         }
     })
     .unwrap();
-    // The page was erased, the write failed: nothing in flash, nothing in RAM.
+    // The other page was erased, the write failed: the old record in flash, in RAM and on
+    // the panel; the run did not store what it learned.
     assert_eq!(
         rig.ended,
         [RunEnd::Failed {
@@ -250,9 +259,10 @@ fn a_failed_flash_write_puts_what_the_flash_holds_into_force() {
             why: Failure::Core(CommissioningFailure::NotStored)
         }]
     );
-    assert_eq!(rig.path.monitor().calibration(), None);
-    assert_eq!(rig.survivors.flash.usable(), None);
-    assert_eq!(rig.mode(), Mode::NotCommissioned);
+    let old = Some(Calibration::from(old_record()));
+    assert_eq!(rig.path.monitor().calibration(), old);
+    assert_eq!(rig.survivors.flash.usable(), old);
+    assert_eq!(rig.mode(), Mode::Commissioned);
     // The FAULT lamp flickers at 10 Hz (on in the first half of every 100 ms; the rig's
     // ticks fall on both halves).
     let last_second: Vec<&Seen> = rig.seen.iter().rev().take(20).collect();

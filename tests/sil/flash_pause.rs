@@ -16,7 +16,7 @@ use super::{old_record, FakeFlash, FlashError};
 use drive_monitor::acquisition::trigger_rate_hz;
 use drive_monitor::app::{carry_out, AcquisitionPause, NoPause};
 use drive_monitor::commissioning::Action;
-use drive_monitor::flash_record::{RecordStore, RECORD_LEN};
+use drive_monitor::flash_record::{RecordPage, RecordStore, RECORD_LEN};
 
 /// A G4 page erase [ms] (datasheet `t_ERASE`, about 22 ms).
 const ERASE_MS: u64 = 22;
@@ -33,20 +33,20 @@ struct ErasingFlash {
 
 impl RecordStore for ErasingFlash {
     type Error = FlashError;
-    fn read(&mut self, buf: &mut [u8; RECORD_LEN]) -> Result<(), FlashError> {
-        self.page.read(buf)
+    fn read(&mut self, page: RecordPage, buf: &mut [u8; RECORD_LEN]) -> Result<(), FlashError> {
+        self.page.read(page, buf)
     }
-    fn erase(&mut self) -> Result<(), FlashError> {
+    fn erase(&mut self, page: RecordPage) -> Result<(), FlashError> {
         let mut acq = self.acq.borrow_mut();
         let triggers = ERASE_MS * u64::from(trigger_rate_hz(super::FS)) / 1_000;
         for _ in 0..triggers {
             acq.regs.trigger();
         }
         self.halves_during_erase = acq.regs.dma[0].halves;
-        self.page.erase()
+        self.page.erase(page)
     }
-    fn write(&mut self, bytes: &[u8; RECORD_LEN]) -> Result<(), FlashError> {
-        self.page.write(bytes)
+    fn write(&mut self, page: RecordPage, bytes: &[u8; RECORD_LEN]) -> Result<(), FlashError> {
+        self.page.write(page, bytes)
     }
 }
 

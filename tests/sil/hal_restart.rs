@@ -3,6 +3,19 @@
 
 use super::recovery::{recover_weakened, AdcDmaModel, Without};
 use drive_monitor::recovery;
+use drive_monitor::ring_read::{read_half, Half, HalfBuffers};
+use std::future::Future;
+use std::pin::pin;
+use std::task::{Context, Poll, Waker};
+
+/// Runs a future the model completes at once (no executor needed).
+fn now<F: Future>(f: F) -> F::Output {
+    let mut f = pin!(f);
+    match f.as_mut().poll(&mut Context::from_waker(Waker::noop())) {
+        Poll::Ready(out) => out,
+        Poll::Pending => panic!("the model's reads complete at once"),
+    }
+}
 
 /// A DMA transfer error on the encoder latch's channel leaves TIM4's capture request
 /// pending (the timer keeps requesting while the channel is off). The firmware's recovery
@@ -86,5 +99,50 @@ fn a_dma_error_between_two_reads_is_recovered_before_the_hals_read_restarts_the_
                 acq.regs.violations
             );
         }
+    }
+}
+
+/// The sample task's read of a half (`ring_read::read_half`, what `src/firmware/
+/// sample_task.rs` awaits): a DMA transfer error on ADC2's channel (or ADC1's, or both)
+/// while the task awaits ADC1's half is recovered before ADC2's read, so the HAL's read
+/// never restarts a ring itself; an error between two halves is recovered before the first
+/// read. Every later half reads, no register rule broken.
+#[test]
+fn a_dma_error_during_the_wait_for_adc1_is_recovered_before_adc2s_read() {
+    for error in [None, Some((0, 1)), Some((0, 0))] {
+        let mut acq = AdcDmaModel::running();
+        let mut bufs = HalfBuffers::default();
+        for _ in 0..10 {
+            assert!(acq.regs.sample());
+        }
+        match error {
+            Some(e) => acq.regs.error_on_read = Some(e),
+            // Between two halves: the error is there before the first read.
+            None => acq.regs.inject_dma_error(),
+        }
+        let half = now(read_half(&mut acq, &mut bufs));
+        assert!(
+            matches!(half, Half::Recovered(Ok(f)) if f.dma_error),
+            "{error:?}: {half:?}"
+        );
+        assert_eq!(
+            acq.regs.reads[1], 0,
+            "{error:?}: ADC2's ring read while off"
+        );
+        for _ in 0..5 {
+            acq.regs.sample();
+            assert_eq!(
+                now(read_half(&mut acq, &mut bufs)),
+                Half::Read { lapped: [false; 2] }
+            );
+        }
+        assert!(
+            acq.regs.violations.is_empty(),
+            "{error:?}: {:?}",
+            acq.regs.violations
+        );
+        let delivered = (0..100).filter(|_| acq.regs.sample()).count();
+        assert!(delivered >= 99, "{delivered}");
+        assert_eq!(acq.regs.misaligned_halves, 0);
     }
 }

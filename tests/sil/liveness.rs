@@ -162,7 +162,10 @@ fn a_panic_reason_survives_the_reset() {
     );
     // ...and a watchdog reset with no record is a hang.
     survivors.reset_ram = [0; RESET_RECORD_LEN];
-    assert_eq!(Rig::boot(survivors).previous, PreviousRun::WatchdogReset);
+    assert_eq!(
+        Rig::boot(survivors).previous,
+        PreviousRun::WatchdogReset { phase: None }
+    );
 }
 
 /// A current front end on its rails at every peak (20 A peaks on the +-10 A front end, the
@@ -218,6 +221,9 @@ struct FakeFaultBoard<'a> {
 impl drive_monitor::fault_path::FaultBoard for FakeFaultBoard<'_> {
     fn bor_level(&mut self) -> Option<drive_monitor::supply::BorLevel> {
         Some(drive_monitor::supply::BorLevel::Level4)
+    }
+    fn findings(&mut self) -> u32 {
+        0
     }
     fn write_record(&mut self, bytes: &[u8; RESET_RECORD_LEN]) {
         *self.reset_ram = *bytes;

@@ -18,6 +18,7 @@ mod boot_composition;
 mod clipping;
 mod commissioning;
 mod conversions;
+mod drift;
 mod evidence;
 mod flash_pause;
 mod hal_restart;
@@ -28,16 +29,18 @@ mod recovery;
 mod reference_gain;
 mod same_state;
 mod startup;
+mod thread;
 
 use drive_monitor::app::{
-    carry_out, panel_input, AcquisitionPause, Command, MonitorStatus, SamplePath, Settings,
-    Supervisor, Tick, PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
+    panel_input, period, AcquisitionPause, Command, MonitorStatus, PeriodInput, SamplePath,
+    Settings, Supervisor, ThreadState, Tick, PANEL_PERIOD_MS, WATCHDOG_TIMEOUT_MS,
 };
 use drive_monitor::board::Lamp;
 use drive_monitor::board::{self, RECORD_PAGE_SIZE};
-use drive_monitor::boot;
+use drive_monitor::boot_block::BootHistory;
+use drive_monitor::clock::ClockSource;
 use drive_monitor::commissioning::{Failure, RunEnd};
-use drive_monitor::flash_record::{self, CalibrationRecord, RecordStore, RECORD_LEN};
+use drive_monitor::flash_record::{self, CalibrationRecord, RecordPage, RecordStore, RECORD_LEN};
 use drive_monitor::liveness::AdcWait;
 use drive_monitor::offset_trim::TrimResult;
 use drive_monitor::panel::{self, Mode, PanelLamps};
@@ -46,9 +49,13 @@ use drive_monitor::reset_record::{
     PreviousRun, ResetCause, ResetRecord, ResetSource, RESET_RECORD_LEN,
 };
 use drive_monitor::sampling::RawFrame;
+use drive_monitor::self_check::Findings;
+use drive_monitor::startup::{boot_board, BootFacts};
+use drive_monitor::supply::BorCheck;
 use monitor_core::{Abc, Calibration, CommissioningFailure, Fault, RunStage};
 use monitor_io::params::ParamFile;
 use monitor_sim::{simulate_to_vec, FaultSpec, LoadStep, Scenario};
+use thread::RigThread;
 
 const FS: u32 = board::DEFAULT_SAMPLE_RATE_HZ;
 const PERIODS_PER_MS: u64 = FS as u64 / 1000;
@@ -67,10 +74,12 @@ enum FlashFault {
     WriteFails,
 }
 
-/// The record page, with fault injection.
+/// The commissioning record's two pages (`page`: the first, `page_b`: the second), with
+/// fault injection.
 #[derive(Clone, Debug)]
 struct FakeFlash {
     page: Vec<u8>,
+    page_b: Vec<u8>,
     fault: Option<FlashFault>,
     power_lost: bool,
     writes: u32,
@@ -83,9 +92,17 @@ impl FakeFlash {
     fn erased() -> Self {
         Self {
             page: vec![0xFF; RECORD_PAGE_SIZE as usize],
+            page_b: vec![0xFF; RECORD_PAGE_SIZE as usize],
             fault: None,
             power_lost: false,
             writes: 0,
+        }
+    }
+
+    fn page_mut(&mut self, page: RecordPage) -> &mut Vec<u8> {
+        match page {
+            RecordPage::A => &mut self.page,
+            RecordPage::B => &mut self.page_b,
         }
     }
 
@@ -98,7 +115,7 @@ impl FakeFlash {
     /// The calibration the next boot would put into force (a valid record the core
     /// accepts), the flash side of "RAM, flash and panel agree".
     fn usable(&self) -> Option<Calibration> {
-        CalibrationRecord::decode(&self.page)
+        flash_record::load(&mut self.clone())
             .ok()
             .map(Calibration::from)
             .filter(Calibration::is_valid)
@@ -107,32 +124,32 @@ impl FakeFlash {
 
 impl RecordStore for FakeFlash {
     type Error = FlashError;
-    fn read(&mut self, buf: &mut [u8; RECORD_LEN]) -> Result<(), FlashError> {
+    fn read(&mut self, page: RecordPage, buf: &mut [u8; RECORD_LEN]) -> Result<(), FlashError> {
         if self.power_lost {
             return Err(FlashError);
         }
-        buf.copy_from_slice(&self.page[..RECORD_LEN]);
+        buf.copy_from_slice(&self.page_mut(page)[..RECORD_LEN]);
         Ok(())
     }
-    fn erase(&mut self) -> Result<(), FlashError> {
+    fn erase(&mut self, page: RecordPage) -> Result<(), FlashError> {
         if self.power_lost {
             return Err(FlashError);
         }
-        self.page.fill(0xFF);
+        self.page_mut(page).fill(0xFF);
         Ok(())
     }
-    fn write(&mut self, bytes: &[u8; RECORD_LEN]) -> Result<(), FlashError> {
+    fn write(&mut self, page: RecordPage, bytes: &[u8; RECORD_LEN]) -> Result<(), FlashError> {
         if self.power_lost {
             return Err(FlashError);
         }
         self.writes += 1;
         match self.fault.take() {
             None => {
-                self.page[..RECORD_LEN].copy_from_slice(bytes);
+                self.page_mut(page)[..RECORD_LEN].copy_from_slice(bytes);
                 Ok(())
             }
             Some(FlashFault::PowerLossAfter(n)) => {
-                self.page[..n].copy_from_slice(&bytes[..n]);
+                self.page_mut(page)[..n].copy_from_slice(&bytes[..n]);
                 self.power_lost = true;
                 Err(FlashError)
             }
@@ -231,6 +248,12 @@ struct Rig {
     reference_changes: Vec<(u32, drive_monitor::supply::ReferenceChange)>,
     /// The flash stores that paused the acquisition (`app::carry_out`).
     paused_for_flash: u32,
+    /// Thread mode's state across periods (`app::period`).
+    thread: ThreadState,
+    /// The offset trim's result, handed to thread mode at its next period.
+    pending_trim: Option<TrimResult>,
+    /// The runs marked up (`false`) and long up (`true`), in order.
+    marked_up: Vec<bool>,
 }
 
 /// The sample task's pause around a flash store on the rig: the firmware's
@@ -257,6 +280,19 @@ impl Rig {
 
     fn boot_with(settings: Settings, mut survivors: Survivors) -> Self {
         let previous = PreviousRun::at_boot(&survivors.reset_ram, survivors.reset_source);
+        // What the start (`drive_monitor::startup::start`, run on its own register model
+        // in `tests/startup/`) hands the boot: the crystal, the brown-out level at its goal,
+        // nothing found.
+        let facts = BootFacts {
+            previous,
+            reset_source: survivors.reset_source,
+            history: BootHistory::of(None, survivors.reset_source, &previous),
+            stack_overflowed: false,
+            clock: Some(ClockSource::Hse),
+            findings: Findings::NONE,
+            bor: BorCheck::of_optr(0xFFEF_F8AA | 4 << 8),
+            safe_mode: None,
+        };
         survivors.reset_ram = [0; RESET_RECORD_LEN];
         // The flags are cleared at boot; a boot of the rig without a reset event is the
         // reset button's.
@@ -264,13 +300,12 @@ impl Rig {
         survivors.flash.power_lost = false;
         // The firmware's boot composition: the machine, its sample path and isolator, the
         // stored calibration (a record the core rejects leaves the default thresholds) and
-        // the supervisor.
-        let booted = boot::boot(
+        // the supervisor with the panel's marks.
+        let booted = boot_board(
+            &facts,
             &survivors.motor_page,
             &mut survivors.flash,
             &settings,
-            previous,
-            0,
         )
         .unwrap();
         let (path, supervisor) = (booted.path, booted.supervisor);
@@ -296,6 +331,9 @@ impl Rig {
             reference: None,
             reference_changes: Vec::new(),
             paused_for_flash: 0,
+            thread: ThreadState::default(),
+            pending_trim: None,
+            marked_up: Vec::new(),
         }
     }
 
@@ -315,8 +353,8 @@ impl Rig {
                 self.waited_us = 0;
                 self.adc.data();
                 if let Some(trim) = self.path.trim_offsets(raw) {
-                    // Handed to thread mode on the board (logged, the sensor flags).
-                    self.supervisor.set_offset_fault(&trim);
+                    // Handed to thread mode (logged, the sensor flags).
+                    self.pending_trim = Some(trim);
                     self.trims.push(trim);
                 }
                 self.path.on_frame(raw);
@@ -357,16 +395,32 @@ impl Rig {
         Ok(())
     }
 
+    /// Thread mode's period: the firmware's own (`app::period`) on the rig's hardware.
     fn thread_tick(&mut self, now_ms: u32) -> Result<(), Reset> {
-        let status = self.pending_status.take();
-        let button = std::mem::take(&mut self.button);
-        if let Some(adc) = self.reference.as_mut() {
-            if let Some(change) = self.supervisor.poll_reference(now_ms, adc) {
-                self.reference_changes.push((now_ms, change));
-            }
-        }
-        let tick = self.supervisor.tick(now_ms, status, button);
+        let input = PeriodInput {
+            now_ms,
+            status: self.pending_status.take(),
+            pressed: std::mem::take(&mut self.button),
+            trim: self.pending_trim.take(),
+            reference: None,
+        };
+        let mut hw = RigThread {
+            now_ms,
+            flash: &mut self.survivors.flash,
+            reset_ram: &mut self.survivors.reset_ram,
+            pause: ModelPause {
+                acq: &mut self.acq,
+                paused: &mut self.paused_for_flash,
+            },
+            reference: self.reference.as_mut(),
+            last_pet_ms: &mut self.last_pet_ms,
+            marked_up: &mut self.marked_up,
+        };
+        let out = period(&mut self.supervisor, &mut self.thread, input, &mut hw);
+        let tick = out.tick;
         let used = *self.supervisor.latest();
+        // Before the commands reach the sample path: a store's record is in flash, the core
+        // still awaits it.
         self.check_agreement(now_ms, &tick, &used);
         self.seen.push(Seen {
             t_ms: now_ms,
@@ -374,33 +428,15 @@ impl Rig {
             status: used,
             quasi_steady: self.path.monitor().output().quasi_steady,
         });
-        if tick.pet_watchdog {
-            self.last_pet_ms = now_ms;
-        }
         self.ended.extend(tick.run_ended);
-        match tick.liveness {
-            Some(drive_monitor::liveness::LivenessChange::RecordStall { for_ms }) => {
-                self.survivors.reset_ram = ResetRecord::sample_stall(for_ms).encode();
-            }
-            Some(drive_monitor::liveness::LivenessChange::Recovered { .. }) => {
-                self.survivors.reset_ram = [0; RESET_RECORD_LEN];
-            }
-            _ => {}
+        for change in out.reference_changes.into_iter().flatten() {
+            self.reference_changes.push((now_ms, change));
         }
-        if let Some(gain) = tick.reference_gain {
-            // Handed to the sample task on the board (a command between two samples).
-            let _ = self.path.command(Command::ReferenceGain(gain));
-        }
-        let mut pause = ModelPause {
-            acq: &mut self.acq,
-            paused: &mut self.paused_for_flash,
-        };
-        let (command, _stored) = carry_out(tick.action, &mut self.survivors.flash, &mut pause);
         if self.survivors.flash.power_lost {
             self.survivors.reset_source = ResetSource::PowerOnOrBrownOut;
             return Err(Reset::PowerLoss);
         }
-        if let Some(cmd) = command {
+        for cmd in out.commands.into_iter().flatten() {
             // The sample task applies commands between two samples; a refused one is
             // logged on the board.
             let _ = self.path.command(cmd);

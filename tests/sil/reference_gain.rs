@@ -14,9 +14,15 @@ const DRIFTED: f32 = 3.21;
 const DRIFT_AT: usize = 15_000;
 
 /// The frames an ADC whose reference has drifted from 3.30 V to 3.21 V reads: the same
-/// input, every code `3.30 / 3.21` larger (the front end's output is not ratiometric).
+/// input, the swing around the zero `3.30 / 3.21` larger (the front end's swing is not
+/// ratiometric), the zero where it was (the board's front end biases it at VDDA / 2,
+/// `board::ZERO_BIAS`).
 fn drifted(raw: &RawFrame) -> RawFrame {
-    let scale = |c: u16| ((f32::from(c) * AT_COMMISSIONING / DRIFTED).round() as u16).min(4095);
+    let zero = drive_monitor::board::MID_SCALE_CODE;
+    let scale = |c: u16| {
+        let swing = (f32::from(c) - zero) * AT_COMMISSIONING / DRIFTED;
+        (zero + swing).round().clamp(0.0, 4095.0) as u16
+    };
     let mut out = *raw;
     for c in out.v.iter_mut() {
         c.0 = scale(c.0);

@@ -6,7 +6,9 @@ use drive_monitor::acquisition::{
     conversion_ns, trigger_rate_hz, CHANNELS, HALF_LEN, LATCH_LEN, OVERSAMPLING,
     RING_LEN as FW_RING_LEN,
 };
+use drive_monitor::acquisition::{DMA_HALF_LEN, LATCH_HALF_LEN};
 use drive_monitor::recovery::{AcqRegisters, AdcFlags, RegisterAcquisition};
+use drive_monitor::ring_read::{RingRead, RingReads};
 
 /// The ring's length in DMA transfers: the firmware's.
 pub(crate) const RING_LEN: u16 = FW_RING_LEN as u16;
@@ -113,6 +115,11 @@ pub(crate) struct AdcDmaModel {
     /// Whether the last sample block completed on each channel held a word the errata
     /// make wrong (the first conversion after more than 1 ms idle).
     pub(crate) last_block_bad: [bool; 2],
+    /// A DMA transfer error on channel `.1` while the sample task awaits ring `.0`'s half
+    /// (`ring_read::RingReads::read_adc`), once.
+    pub(crate) error_on_read: Option<(usize, usize)>,
+    /// The HAL's reads of each ADC ring (`read_adc`).
+    pub(crate) reads: [u32; 2],
 }
 
 /// The acquisition the rig runs: the firmware's sequence over the model.
@@ -156,6 +163,8 @@ impl AdcDmaModel {
                 misaligned_halves: 0,
                 violations: Vec::new(),
                 last_block_bad: [false; 2],
+                error_on_read: None,
+                reads: [0; 2],
             },
             ring_len: RING_LEN,
         }
@@ -472,5 +481,29 @@ impl AcqRegisters for AdcDmaModel {
     }
     fn trigger_start(&mut self) {
         self.trigger_on = true;
+    }
+}
+
+/// The sample task's reads on the model: a half is there at once; the HAL's `read` restarts
+/// a ring it finds off ([`AdcDmaModel::hal_read`], the violation it makes); a DMA error set
+/// up with `error_on_read` hits while the read of its ring is awaited.
+impl RingReads for AdcDmaModel {
+    fn start_wait(&mut self) {}
+
+    async fn read_adc(&mut self, i: usize, _buf: &mut [u16; DMA_HALF_LEN]) -> RingRead {
+        self.hal_read(i);
+        self.reads[i] += 1;
+        if let Some((ring, channel)) = self.error_on_read {
+            if ring == i {
+                self.error_on_read = None;
+                self.dma[channel].teif = true;
+                self.dma[channel].en = false;
+            }
+        }
+        RingRead::Data
+    }
+
+    async fn read_latch(&mut self, _buf: &mut [u16; LATCH_HALF_LEN]) -> RingRead {
+        RingRead::Data
     }
 }

@@ -2,10 +2,14 @@
 //!
 //! - `fw [--check]`: build the firmware ELF (the workspace's `firmware` profile: fat LTO,
 //!   one codegen unit, debug info) for `thumbv7em-none-eabihf`, then
-//!   read its section table and print flash and static RAM use against the goals
-//!   (128 KiB flash, 32 KiB RAM: the smallest STM32G4 part with the same peripherals), and
-//!   whether the stack lies below the statics (flip-link; `--check` fails otherwise).
-//!   `--check` exits 1 when a goal is missed.
+//!   read its section table and print flash and static RAM use against the budget of the
+//!   part (`budget`: `memory.x`'s bank 1, 256 KiB; a warning above 192 KiB, a failure above
+//!   224 KiB; 32 KiB of static RAM), whether every allocated section lies in bank 1 (bank 2,
+//!   from 0x0804_0000, is the records' and the reset log's) and whether the stack lies below
+//!   the statics (flip-link). `--check` exits 1 when any of these is missed.
+//! - `fw bring-up [--no-flash]`: flash the firmware with probe-rs, reset, and read back over
+//!   the probe every register the boot's self-check reads, each against its expected value
+//!   (`bring_up`; the user installs probe-rs). Exits 1 on a mismatch.
 //! - `qemu-core`: build `crates/core-on-m4` for `thumbv7em-none-eabihf`, check that its
 //!   vector table is at 0x0 (the mps2-an386 layout, not the G474's), and run it on
 //!   `qemu-system-arm -M mps2-an386 -cpu cortex-m4 -icount shift=0` with semihosting.
@@ -30,15 +34,18 @@
 //! Cargo runs this tool with the workspace root as the directory of the alias call; the
 //! tool locates the root from its own manifest directory, so it works from anywhere.
 
+mod bring_up;
+mod budget;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode, Stdio};
 use std::time::{Duration, Instant};
 
+use budget::{Budget, Verdict, BANK2_START};
+
 const TARGET: &str = "thumbv7em-none-eabihf";
-/// Flash goal: the smallest STM32G4 part with the G474's peripherals used here (ADC1/2,
-/// TIM1, TIM4, DMA, IWDG) has 128 KiB of flash and 32 KiB of RAM.
-const FLASH_GOAL: u64 = 128 * 1024;
-/// Static RAM goal (the stack not included), see [`FLASH_GOAL`].
+/// Static RAM goal (the stack not included): a quarter of the G474's 128 KiB, the rest the
+/// stack's room.
 const RAM_GOAL: u64 = 32 * 1024;
 
 fn root() -> PathBuf {
@@ -126,6 +133,8 @@ struct Usage {
     ram: u64,
     /// The lowest address of a static in RAM (`u64::MAX` without one).
     first_static: u64,
+    /// The highest address an allocated section outside RAM reaches (one past its end).
+    flash_end: u64,
 }
 
 /// Prints the ELF's allocated sections (name, bytes, address) and adds up what they take
@@ -135,6 +144,7 @@ fn usage(elf: &[u8]) -> Result<Usage, String> {
     // The lowest address of a static in RAM: with flip-link the stack lies below the
     // statics, from the start of RAM (docs/firmware.md, "The stack").
     let mut first_static = u64::MAX;
+    let mut flash_end = 0u64;
     println!("{:<16} {:>8} {:>10}", "section", "bytes", "address");
     for Section {
         name,
@@ -157,16 +167,19 @@ fn usage(elf: &[u8]) -> Result<Usage, String> {
             }
         } else {
             flash += u64::from(size);
+            flash_end = flash_end.max(u64::from(addr) + u64::from(size));
         }
     }
     Ok(Usage {
         flash,
         ram,
         first_static,
+        flash_end,
     })
 }
 
-fn fw(check: bool) -> Result<(), String> {
+/// Builds the firmware ELF (the `firmware` profile) and returns its path.
+fn build_firmware() -> Result<PathBuf, String> {
     let root = root();
     run(cargo().current_dir(&root).args([
         "build",
@@ -177,28 +190,75 @@ fn fw(check: bool) -> Result<(), String> {
         "-p",
         "drive-monitor",
     ]))?;
-    let elf_path = target_dir(&root)
+    Ok(target_dir(&root)
         .join(TARGET)
-        .join("firmware/drive-monitor");
+        .join("firmware/drive-monitor"))
+}
+
+fn fw(check: bool) -> Result<(), String> {
+    let elf_path = build_firmware()?;
     let elf = std::fs::read(&elf_path).map_err(|e| format!("{}: {e}", elf_path.display()))?;
+    let memory_x = root().join("memory.x");
+    let memory_x =
+        std::fs::read_to_string(&memory_x).map_err(|e| format!("{}: {e}", memory_x.display()))?;
+    let budget = Budget::of_bank(budget::flash_length(&memory_x)?);
     let Usage {
         flash,
         ram,
         first_static,
+        flash_end,
     } = usage(&elf)?;
     println!("ELF: {}", elf_path.display());
-    let verdict = |used: u64, goal: u64| if used <= goal { "ok" } else { "OVER GOAL" };
+    let verdict = budget.verdict(flash);
+    let in_bank1 = flash_end <= BANK2_START;
+    let stack_below = first_static != u64::MAX && first_static > 0x2000_0000;
+    print_usage(&budget, verdict, (flash, ram), (flash_end, first_static));
+    if check && (verdict == Verdict::Over || ram > RAM_GOAL) {
+        return Err("size budget missed".into());
+    }
+    if check && !in_bank1 {
+        return Err("a section lies in bank 2, the records' pages (memory.x)".into());
+    }
+    if check && !stack_below {
+        return Err("the statics start at the bottom of RAM: the firmware was not linked with flip-link (.cargo/config.toml)".into());
+    }
+    Ok(())
+}
+
+/// Prints the flash use against the `budget` (its `verdict`), the static RAM against its
+/// goal, where the code ends (`flash_end`: bank 1 or not) and where the stack lies (below
+/// the first static, `first_static`: flip-link).
+fn print_usage(
+    budget: &Budget,
+    verdict: Verdict,
+    (flash, ram): (u64, u64),
+    (flash_end, first_static): (u64, u64),
+) {
     println!(
-        "flash={flash} bytes ({:.1} KiB, goal {} KiB: {})",
+        "flash={flash} bytes ({:.1} KiB of bank 1's {} KiB in memory.x: {}; warn above {} KiB, fail above {} KiB)",
         flash as f64 / 1024.0,
-        FLASH_GOAL / 1024,
-        verdict(flash, FLASH_GOAL)
+        budget.bank / 1024,
+        match verdict {
+            Verdict::Ok => "ok",
+            Verdict::Warn => "WARNING: above three quarters of the bank",
+            Verdict::Over => "OVER BUDGET",
+        },
+        budget.warn_above / 1024,
+        budget.fail_above / 1024
     );
     println!(
         "ram={ram} bytes static ({:.1} KiB, goal {} KiB: {}; stack not included)",
         ram as f64 / 1024.0,
         RAM_GOAL / 1024,
-        verdict(ram, RAM_GOAL)
+        if ram <= RAM_GOAL { "ok" } else { "OVER GOAL" }
+    );
+    println!(
+        "code and constants end at {flash_end:#010x}: {}",
+        if flash_end <= BANK2_START {
+            "bank 1 (bank 2, from 0x08040000, is the records')"
+        } else {
+            "IN BANK 2"
+        }
     );
     let stack_below = first_static != u64::MAX && first_static > 0x2000_0000;
     println!(
@@ -216,13 +276,17 @@ fn fw(check: bool) -> Result<(), String> {
             "NOT flip-link"
         }
     );
-    if check && (flash > FLASH_GOAL || ram > RAM_GOAL) {
-        return Err("size goal missed".into());
-    }
-    if check && !stack_below {
-        return Err("the statics start at the bottom of RAM: the firmware was not linked with flip-link (.cargo/config.toml)".into());
-    }
-    Ok(())
+}
+
+/// `fw bring-up` (`bring_up`): the firmware built, flashed (unless `--no-flash`) and its
+/// registers read back over the probe.
+fn fw_bring_up(no_flash: bool) -> Result<ExitCode, String> {
+    let elf = build_firmware()?;
+    Ok(if bring_up::run(&elf, no_flash)? {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
 }
 
 /// ST's command-line programmer, which writes option bytes (probe-rs writes memory, not
@@ -350,11 +414,14 @@ fn main() -> ExitCode {
         Some("fw") if args.get(1).map(String::as_str) == Some("bor") => {
             bor(args.iter().any(|a| a == "--dry-run")).map(|()| ExitCode::SUCCESS)
         }
+        Some("fw") if args.get(1).map(String::as_str) == Some("bring-up") => {
+            fw_bring_up(args.iter().any(|a| a == "--no-flash"))
+        }
         Some("fw") => fw(args.iter().any(|a| a == "--check")).map(|()| ExitCode::SUCCESS),
         Some("qemu-core") => qemu_core(),
         Some("qemu-rtt") => qemu_rtt(&args[1..]),
         _ => Err(
-            "usage: fwtool fw [--check] | fw bor [--dry-run] | qemu-core | qemu-rtt [--blocking | --drop-on-contention]"
+            "usage: fwtool fw [--check] | fw bor [--dry-run] | fw bring-up [--no-flash] | qemu-core | qemu-rtt [--blocking | --drop-on-contention]"
                 .into(),
         ),
     };

@@ -9,7 +9,11 @@ pub type Inside = (&'static str, &'static [(&'static str, u8)]);
 /// The crates with more than one part, and the order of their modules (rule 1).
 pub const INSIDE: &[Inside] = &[
     // The firmware's library: the board's facts and the stored records at the bottom, the
-    // supervisor (`app`) above what it composes, the boot at the top.
+    // supervisor (`app`) above what it composes, the boot at the top. Issue 82's: the
+    // self-check's table beside the reset record (it reads the clock's and the supply's
+    // constants), the half's read above the recovery and the acquisition, the boot block
+    // above the reset record it reads, the start (the registers' sequence that hands the
+    // boot composition its facts) above the boot.
     (
         "src/",
         &[
@@ -26,11 +30,15 @@ pub const INSIDE: &[Inside] = &[
             ("offset_trim", 3),
             ("reset_record", 3),
             ("range_watch", 3),
+            ("self_check", 3),
+            ("ring_read", 3),
+            ("boot_block", 4),
             ("setup_guard", 4),
             ("fault_path", 4),
             ("app", 4),
             ("motor_source", 5),
             ("boot", 6),
+            ("startup", 7),
         ],
     ),
     // The parameter file below the logs and the nameplate estimate.

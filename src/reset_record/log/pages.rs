@@ -1,0 +1,217 @@
+//! The log's pages read and appended to (the module docs of `reset_record::log`): a page's
+//! scan, the page in use, an item appended after its last one or at the start of the next
+//! page in turn, and what a boot writes.
+
+use super::{
+    Entry, LogFlash, Mark, Totals, ENTRY_LEN, FULL_ENTRIES, HEADER_LEN, MARK_LEN, PAGES, PAGE_LEN,
+    UP,
+};
+use crate::reset_record::{PreviousRun, ResetKind, ResetSource};
+
+/// What a scan found of a page with a valid header.
+#[derive(Clone, Copy, Debug)]
+struct PageScan {
+    /// The page's sequence number (the page in use has the highest).
+    seq: u32,
+    /// The totals: the header's and the page's items'.
+    totals: Totals,
+    /// The first byte after the page's last item ([`PAGE_LEN`]: full, or unreadable from
+    /// there).
+    next_free: usize,
+}
+
+/// Scans page `page` (`None`: its header is not valid), calling `each` on its valid
+/// entries. The page is read whole (one read of [`PAGE_LEN`] bytes); when that read fails
+/// (an ECC double error somewhere in it), again a double word at a time, and the page ends
+/// at the first that fails.
+fn scan<F: LogFlash>(flash: &mut F, page: usize, mut each: impl FnMut(Entry)) -> Option<PageScan> {
+    let mut bytes = [0xFFu8; PAGE_LEN];
+    let readable = match flash.read(page, 0, &mut bytes) {
+        Ok(()) => PAGE_LEN,
+        Err(_) => read_until_error(flash, page, &mut bytes),
+    };
+    let (seq, mut totals) = Totals::decode_header(bytes.get(..HEADER_LEN)?)?;
+    let mut at = HEADER_LEN;
+    while at + MARK_LEN <= PAGE_LEN {
+        if at + MARK_LEN > readable {
+            // Unreadable from here (a torn double word's ECC error): the page is full.
+            at = PAGE_LEN;
+            break;
+        }
+        let dw = bytes.get(at..at + MARK_LEN).unwrap_or(&[]);
+        if dw.iter().all(|b| *b == 0xFF) {
+            break;
+        }
+        if dw.starts_with(&super::FORMAT.magic) {
+            if at + ENTRY_LEN > readable {
+                at = PAGE_LEN;
+                break;
+            }
+            if let Some(e) = bytes.get(at..at + ENTRY_LEN).and_then(Entry::decode) {
+                totals.add_entry(&e);
+                each(e);
+            }
+            at += ENTRY_LEN;
+        } else {
+            let mark = <[u8; MARK_LEN]>::try_from(dw).ok();
+            if let Some(m) = mark.as_ref().and_then(Mark::decode) {
+                totals.add_mark(&m);
+            }
+            // A torn item is skipped a double word at a time, never written over.
+            at += MARK_LEN;
+        }
+    }
+    Some(PageScan {
+        seq,
+        totals,
+        next_free: at,
+    })
+}
+
+/// Reads page `page` into `bytes` a double word at a time up to the first read that fails;
+/// the bytes read (a multiple of [`MARK_LEN`]).
+fn read_until_error<F: LogFlash>(flash: &mut F, page: usize, bytes: &mut [u8; PAGE_LEN]) -> usize {
+    let mut at = 0;
+    for dw in bytes.chunks_exact_mut(MARK_LEN) {
+        if flash.read(page, at, dw).is_err() {
+            return at;
+        }
+        at += MARK_LEN;
+    }
+    at
+}
+
+/// The page in use (the valid header with the highest sequence number) and its scan.
+fn locate<F: LogFlash>(flash: &mut F) -> Option<(usize, PageScan)> {
+    (0..PAGES)
+        .filter_map(|page| scan(flash, page, |_| {}).map(|s| (page, s)))
+        .max_by_key(|(_, s)| s.seq)
+}
+
+/// Appends `item` to the log whose page in use is `at` ([`locate`]): after its last item,
+/// or, when it does not fit (or no page is in use), at the start of the next page in turn,
+/// erased and headed with the totals so far.
+fn append<F: LogFlash>(
+    flash: &mut F,
+    at: Option<(usize, PageScan)>,
+    item: &[u8],
+) -> Result<(), F::Error> {
+    if let Some((page, s)) = at {
+        if s.next_free + item.len() <= PAGE_LEN {
+            return flash.write(page, s.next_free, item);
+        }
+    }
+    let (next, seq, totals) = match at {
+        Some((page, s)) => ((page + 1) % PAGES, s.seq.wrapping_add(1), s.totals),
+        None => (0, 1, Totals::default()),
+    };
+    flash.erase(next)?;
+    flash.write(next, 0, &totals.encode_header(seq))?;
+    flash.write(next, HEADER_LEN, item)
+}
+
+/// What the boot writes for the reset it follows ([`record_boot`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BootRecord {
+    /// Why the previous run ended.
+    pub previous: PreviousRun,
+    /// What reset the MCU.
+    pub source: ResetSource,
+    /// The reset's kind (`crate::boot_block::BootHistory::kind`).
+    pub kind: ResetKind,
+    /// The previous run was up for 10 minutes: the "up" mark first.
+    pub previous_long_up: bool,
+    /// This boot enters the safe mode.
+    pub safe_mode: bool,
+}
+
+/// What [`record_boot`] wrote.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Written {
+    /// A full entry, its sequence number.
+    Entry(u32),
+    /// A count mark; `failed`: a failed run beyond the rate limit.
+    Counted {
+        /// The run counted had failed.
+        failed: bool,
+    },
+}
+
+/// Writes the boot's item (module docs of `reset_record::log`): the "up" mark when the
+/// previous run was long up, then a full entry for a failed run within the rate limit
+/// ([`FULL_ENTRIES`] since the last "up"), else a count mark of the reset's kind.
+///
+/// # Errors
+/// The flash's error when an erase or a write failed (or was refused).
+pub fn record_boot<F: LogFlash>(flash: &mut F, boot: &BootRecord) -> Result<Written, F::Error> {
+    let mut at = locate(flash);
+    if boot.previous_long_up {
+        let up = Mark {
+            what: UP,
+            count: 1,
+            failed: false,
+            safe_mode: false,
+        };
+        append(flash, at, &up.encode())?;
+        at = locate(flash);
+    }
+    let totals = at.map(|(_, s)| s.totals).unwrap_or_default();
+    match Entry::of(&boot.previous) {
+        Some((ended, record, phase)) if totals.entries_since_up < FULL_ENTRIES => {
+            let entry = Entry {
+                seq: totals.last_entry.wrapping_add(1),
+                source: boot.source,
+                kind: boot.kind,
+                ended,
+                phase,
+                safe_mode: boot.safe_mode,
+                record,
+            };
+            append(flash, at, &entry.encode())?;
+            Ok(Written::Entry(entry.seq))
+        }
+        end => {
+            let mark = Mark {
+                what: boot.kind.index(),
+                count: 1,
+                failed: end.is_some(),
+                safe_mode: boot.safe_mode,
+            };
+            append(flash, at, &mark.encode())?;
+            Ok(Written::Counted {
+                failed: mark.failed,
+            })
+        }
+    }
+}
+
+/// Everything the log has counted (nothing for an empty log).
+pub fn totals<F: LogFlash>(flash: &mut F) -> Totals {
+    locate(flash).map(|(_, s)| s.totals).unwrap_or_default()
+}
+
+/// The newest `N` entries of the log, newest first (fewer when the log holds fewer).
+pub fn newest<F: LogFlash, const N: usize>(flash: &mut F) -> ([Option<Entry>; N], usize) {
+    let mut out: [Option<Entry>; N] = [None; N];
+    for page in 0..PAGES {
+        scan(flash, page, |e| {
+            // Insert keeping the newest first, the oldest dropped.
+            let mut carry = Some(e);
+            for slot in out.iter_mut() {
+                match (carry, *slot) {
+                    (Some(c), Some(s)) if c.seq > s.seq => {
+                        *slot = Some(c);
+                        carry = Some(s);
+                    }
+                    (Some(c), None) => {
+                        *slot = Some(c);
+                        carry = None;
+                    }
+                    _ => {}
+                }
+            }
+        });
+    }
+    let n = out.iter().filter(|e| e.is_some()).count();
+    (out, n)
+}
