@@ -58,6 +58,3 @@ pub use analysis::{
     Options, ParamValue, MAX_FIT_SAMPLES, MAX_ITER,
 };
 pub use base_range::base_implausible;
-// (The modules that still name these through the crate's root: `explain::ladder`.)
-use analysis::{align, coarsen, resolve};
-use base_range::base_newly_out_of_range;

@@ -202,7 +202,8 @@ pub fn settling_s(n: &MachineConstants) -> f64 {
 /// Why a library effect is not proposed on a log (`explain`'s `skipped`, and `compare`'s
 /// advice on the dynamics effects): the one rule both commands print
 /// ([`not_proposed`]).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error, Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum NotProposed {
     /// Effects it needs in the model first ([`EffectModel::requires`]).
     #[error("needs {} in the model first", names(.0))]

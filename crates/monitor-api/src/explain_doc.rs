@@ -89,7 +89,8 @@ pub fn explain(
 }
 
 /// `explain --ladder --json`'s document ([`monitor_analysis::explain::ladder`]): the
-/// ladder's steps from the configured model to the noise floor, and why it stopped.
+/// ladder's steps from the configured model to the noise floor, and why it stopped, each
+/// sentence spelled at the door beside its typed reason ([`monitor_words::ladder::document`]).
 ///
 /// # Errors
 /// As [`super::compare`].
@@ -101,7 +102,7 @@ pub fn ladder(
     let log = &log.into();
     let a = load_analysis(params, log, req, &mut |_| {})?;
     let report = a.ladder(&req.options(), &|_, _| {})?;
-    Ok(serde_json::to_value(&report).unwrap_or_default())
+    Ok(monitor_words::ladder::document(&report, &*req.words))
 }
 
 /// The verdict `diagnose` gives `log` with its defaults (no commissioning, no baseline; the

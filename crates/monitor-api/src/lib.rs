@@ -34,14 +34,14 @@ pub mod replay;
 /// The simulator for a front end (from `monitor-sim`).
 pub mod sim;
 mod turn_calibration;
-/// The one door: every sentence a crew reads, spelled from the engines' typed values (from
-/// `monitor-words`).
-pub use monitor_words as words;
 pub use error::{ApiError, ErrorKind};
 pub use explain_doc::{
     beside_verdict, explain, ladder, mcsa_beside, verdict_for_explain, ExplainDocument,
 };
 pub use log_source::LogSource;
+/// The one door: every sentence a crew reads, spelled from the engines' typed values (from
+/// `monitor-words`).
+pub use monitor_words as words;
 pub use outputs::{simulate_to_file, ScenarioSource};
 pub use turn_calibration::{learn_turn_calibration, Labelled, Learned};
 

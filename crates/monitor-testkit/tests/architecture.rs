@@ -82,7 +82,7 @@ const LONG_FUNCTIONS: &[(&str, &str, usize, &str)] = &[];
 const FOREIGN: [&str; 2] = [concat!("DESIGN", ".md"), concat!("..", "/shared")];
 /// The workspace's crates by the names code uses (every package, checked by
 /// [`the_crate_list_names_every_package`]).
-const WORKSPACE_CRATES: [&str; 16] = [
+const WORKSPACE_CRATES: [&str; 17] = [
     "drive_monitor",
     "sim_host",
     "monitor_core",
@@ -92,6 +92,7 @@ const WORKSPACE_CRATES: [&str; 16] = [
     "monitor_analysis",
     "monitor_studies",
     "monitor_api",
+    "monitor_words",
     "monitor_store",
     "monitor_testkit",
     "core_on_m4",

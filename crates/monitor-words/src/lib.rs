@@ -14,8 +14,13 @@
 //! function that spells; no options type carries words.
 //!
 //! Modules, one per engine:
+//! - [`analysis`]: what `compare` and `explain` share (why an effect was not fitted);
+//! - [`ladder`]: `explain --ladder` (why it stopped, why a candidate was not kept, each
+//!   step, the base changes, what was found, and its JSON document);
 //! - [`trend`]: a motor's trend (`sim-host trend`, Python's `trend`).
 
 #![forbid(unsafe_code)]
 
+pub mod analysis;
+pub mod ladder;
 pub mod trend;

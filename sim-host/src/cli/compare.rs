@@ -376,7 +376,8 @@ fn run_ladder(c: &Common) -> anyhow::Result<()> {
     pb.finish();
     render::html::write_ladder(c.plot.as_deref(), c.report.as_deref(), &c.log, &report)?;
     if c.json {
-        render::json::print(&mut crate::cli::out::stdout(), &report)
+        let doc = monitor_api::words::ladder::document(&report, &super::words::CliWords);
+        render::json::print(&mut crate::cli::out::stdout(), &doc)
     } else {
         render::text::ladder(&mut crate::cli::out::stdout(), &c.log, &report)
     }

@@ -48,6 +48,40 @@ pub const EXPLAINED_MIN: f64 = 0.5;
 /// fit's gain on windows it never saw is no more than extra freedom buys.
 pub const EXPLAINS_MIN: f64 = 0.05;
 
+/// An effect not fitted on a log, and why (JSON `skipped_reasons[]` of `explain` and of its
+/// ladder, beside the sentences `skipped`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Skipped {
+    /// The effect.
+    pub effect: EffectKind,
+    /// Why it was not fitted.
+    pub because: SkipReason,
+}
+
+/// Why an effect was not fitted on a log.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum SkipReason {
+    /// A dynamics effect the log's span does not propose, by the one rule `compare`'s
+    /// advice follows too ([`super::transients::not_proposed`]).
+    NotProposed {
+        /// Why not.
+        why: super::transients::NotProposed,
+    },
+    /// A channel it needs is missing, or the data refuse its set-up.
+    Setup {
+        /// Why not.
+        why: effects::SetupError,
+    },
+    /// It needs `effects` first, and one of them cannot be fitted on this log.
+    NeedsFirst {
+        /// What it needs first.
+        effects: Vec<EffectKind>,
+    },
+    /// A log without voltages: only the unbalance analysis ran.
+    NoVoltages,
+}
+
 /// Where a fitted candidate stands in `explain`'s report (JSON `standing`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "snake_case")]

@@ -132,7 +132,11 @@ fn ladder_html(log: &str, r: &LadderReport, charts: &[(String, String)]) -> Stri
     } else {
         effect_list(&r.start.effects)
     };
-    let _ = write!(h, "<p class=v>{}</p>", esc(&r.summary));
+    let _ = write!(
+        h,
+        "<p class=v>{}</p>",
+        esc(&monitor_api::words::ladder::summary(r))
+    );
     for (title, svg) in charts {
         let _ = write!(h, "<h3>{}</h3>{svg}", esc(title));
     }
@@ -145,24 +149,33 @@ fn ladder_html(log: &str, r: &LadderReport, charts: &[(String, String)]) -> Stri
         ladder_end_row(&mut h, f);
     }
     h.push_str("</table>");
-    let _ = write!(h, "<p>Stopped: {}</p>", esc(&r.stopped_because));
-    let _ = write!(h, "<p>The test: {}.</p>", esc(&r.test));
+    let _ = write!(
+        h,
+        "<p>Stopped: {}</p>",
+        esc(&monitor_api::words::ladder::stopped(r))
+    );
+    let _ = write!(
+        h,
+        "<p>The test: {}.</p>",
+        esc(&monitor_api::words::ladder::test(&r.test_rule))
+    );
     if !r.last_round.is_empty() {
         h.push_str("<h2>The last round's other candidates</h2><ul>");
         for t in &r.last_round {
             let _ = write!(
                 h,
                 "<li>{}: {}</li>",
-                esc(&monitor_api::analysis::tried_name(t)),
-                esc(&t.because)
+                esc(&monitor_api::words::ladder::tried_name(t)),
+                esc(&monitor_api::words::ladder::refusal(&t.refusal))
             );
         }
         h.push_str("</ul>");
     }
-    if !r.skipped.is_empty() {
+    if !r.skipped_reasons.is_empty() {
         h.push_str("<h2>Not fitted on this log</h2><ul>");
-        for s in &r.skipped {
-            let _ = write!(h, "<li>{}</li>", esc(s));
+        for s in &r.skipped_reasons {
+            let s = monitor_api::words::analysis::skipped(s, &crate::cli::words::CliWords);
+            let _ = write!(h, "<li>{}</li>", esc(&s));
         }
         h.push_str("</ul>");
     }
@@ -177,7 +190,7 @@ fn ladder_row(h: &mut String, k: usize, s: &LadderStep) {
         .base
         .iter()
         .filter(|c| c.changed)
-        .map(|c| c.spelled())
+        .map(monitor_api::words::ladder::base_change)
         .collect();
     let mut fitted: Vec<String> = s
         .fitted

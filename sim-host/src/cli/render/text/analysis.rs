@@ -3,8 +3,9 @@
 use super::diagnose::data_quality;
 use super::number;
 use monitor_api::analysis::CompareReport;
-use monitor_api::analysis::{tried_name, LadderReport};
+use monitor_api::analysis::LadderReport;
 use monitor_api::analysis::{ExplainReport, Standing, EXPLAINS_MIN};
+use monitor_api::words;
 use monitor_api::ExplainDocument;
 use std::io::Write;
 use std::path::Path;
@@ -266,7 +267,7 @@ pub fn ladder(
 ) -> anyhow::Result<()> {
     writeln!(out, "explain --ladder {}", log.display())?;
     data_quality(&mut out, &r.data_quality)?;
-    writeln!(out, "{}", r.summary)?;
+    writeln!(out, "{}", words::ladder::summary(r))?;
     writeln!(
         out,
         "  {:<4} {:<34} {:>8} {:>7} {:>9} {:>7} {:>11}  fitted (physical range)",
@@ -306,12 +307,23 @@ pub fn ladder(
         out,
         "  (explained: the share of the error beyond the noise floor the step removed, whole log / held-back windows)"
     )?;
-    writeln!(out, "stopped: {}", r.stopped_because)?;
-    writeln!(out, "  the test: {}", r.test)?;
+    ladder_end(out, r)
+}
+
+/// The ladder page's end: why it stopped, the test, the last round's other candidates and
+/// what could not be fitted.
+fn ladder_end(out: &mut dyn std::io::Write, r: &LadderReport) -> anyhow::Result<()> {
+    writeln!(out, "stopped: {}", words::ladder::stopped(r))?;
+    writeln!(out, "  the test: {}", words::ladder::test(&r.test_rule))?;
     for t in &r.last_round {
-        writeln!(out, "  not kept: {}: {}", tried_name(t), t.because)?;
+        let (name, why) = (
+            words::ladder::tried_name(t),
+            words::ladder::refusal(&t.refusal),
+        );
+        writeln!(out, "  not kept: {name}: {why}")?;
     }
-    for s in &r.skipped {
+    for s in &r.skipped_reasons {
+        let s = words::analysis::skipped(s, &crate::cli::words::CliWords);
         writeln!(out, "  not fitted: {s}")?;
     }
     Ok(())
@@ -324,7 +336,7 @@ fn ladder_row(k: usize, s: &monitor_api::analysis::LadderStep) -> String {
         .base
         .iter()
         .filter(|c| c.changed)
-        .map(|c| c.spelled())
+        .map(words::ladder::base_change)
         .collect();
     let mut name = if s.effect.is_none() {
         "base parameters refitted".to_string()
