@@ -272,7 +272,6 @@ fn analysis_request(
         no_fit,
         group,
         rotor_bars,
-        words: PY,
     })
 }
 
@@ -295,7 +294,8 @@ fn compare(
     let req = analysis_request(&effects, from_s, to_s, no_fit, group, None)?;
     let log = log_source(log, log_origin.as_deref())?;
     run(py, || {
-        json(&api::compare(params_source(&params, params_is_text), log, &req).map_err(to_py)?)
+        let doc = api::compare(params_source(&params, params_is_text), log, &req, &PyWords);
+        json(&doc.map_err(to_py)?)
     })
 }
 
@@ -322,9 +322,9 @@ fn explain(
     run(py, || {
         let params = params_source(&params, params_is_text);
         let doc = if ladder {
-            api::ladder(params, log, &req)
+            api::ladder(params, log, &req, &PyWords)
         } else {
-            api::explain(params, log, &req)
+            api::explain(params, log, &req, &PyWords)
         };
         json(&doc.map_err(to_py)?)
     })

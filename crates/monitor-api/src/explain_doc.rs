@@ -21,7 +21,7 @@ use monitor_analysis::Analysis;
 use monitor_core::verdict::FaultName;
 use monitor_core::EffectKind;
 use monitor_replay::verdict::fault_text;
-use monitor_replay::{DiagnoseReport, FindingReport, Verdict};
+use monitor_replay::{DiagnoseReport, FindingReport, Spelling, Verdict, Words};
 
 /// `explain`'s JSON document: the one verdict's headline, the report, how the ranking
 /// relates to the verdict's finding, and the motor current signature analysis.
@@ -64,7 +64,7 @@ pub fn mcsa_beside(a: &Analysis, report: &ExplainReport, rotor_bars: Option<u32>
     )
 }
 
-/// `explain --json`'s document.
+/// `explain --json`'s document, its sentences in the words of `spell` (the front end's).
 ///
 /// # Errors
 /// As [`super::compare`].
@@ -72,6 +72,7 @@ pub fn explain(
     params: ParamsSource<'_>,
     log: impl Into<LogSource>,
     req: &AnalysisRequest,
+    spell: &'static (dyn Spelling + Sync),
 ) -> Result<serde_json::Value, ApiError> {
     let log = &log.into();
     // The parameter file read once for both calls.
@@ -81,11 +82,11 @@ pub fn explain(
         columns: &columns,
     };
     let a = load_analysis(read, log, req, &mut |_| {})?;
-    let judged = verdict_for_explain(read, log, req.group.clone(), req.words);
+    let judged = verdict_for_explain(read, log, req.group.clone(), Words(spell));
     let out = a.explain(&req.options(), &|_| {})?;
     let rotor_asymmetry = mcsa_beside(&a, &out.report, req.rotor_bars);
-    let doc = ExplainDocument::new(judged.as_ref(), out.report, rotor_asymmetry);
-    Ok(serde_json::to_value(&doc).unwrap_or_default())
+    let doc = ExplainDocument::new(judged.as_ref(), out.report, rotor_asymmetry, spell);
+    Ok(doc.to_json(spell))
 }
 
 /// `explain --ladder --json`'s document ([`monitor_analysis::explain::ladder`]): the
@@ -98,11 +99,12 @@ pub fn ladder(
     params: ParamsSource<'_>,
     log: impl Into<LogSource>,
     req: &AnalysisRequest,
+    spell: &dyn Spelling,
 ) -> Result<serde_json::Value, ApiError> {
     let log = &log.into();
     let a = load_analysis(params, log, req, &mut |_| {})?;
     let report = a.ladder(&req.options(), &|_, _| {})?;
-    Ok(monitor_words::ladder::document(&report, &*req.words))
+    Ok(monitor_words::ladder::document(&report, spell))
 }
 
 /// The verdict `diagnose` gives `log` with its defaults (no commissioning, no baseline; the
@@ -126,12 +128,21 @@ pub fn verdict_for_explain(
 }
 
 impl ExplainDocument {
+    /// The document as JSON, the report's sentences spelled at the door beside its typed
+    /// values ([`monitor_words::explain::report_into`]) in the words of `spell`.
+    pub fn to_json(&self, spell: &dyn Spelling) -> serde_json::Value {
+        let mut v = serde_json::to_value(self).unwrap_or_default();
+        monitor_words::explain::report_into(&mut v, &self.report, spell);
+        v
+    }
+
     /// The document of an `explain` report beside the verdict `diagnose` gave the same log
     /// (`judged`; its error where it gave none).
     pub fn new(
         judged: Result<&DiagnoseReport, &ApiError>,
         report: ExplainReport,
         rotor_asymmetry: McsaReport,
+        spell: &dyn Spelling,
     ) -> Self {
         let (headline, motor_verdict, verdict_finding) = match judged {
             Ok(j) => (
@@ -147,7 +158,7 @@ impl ExplainDocument {
         };
         let beside = verdict_finding
             .as_ref()
-            .and_then(|f| beside_verdict(f, &report, &rotor_asymmetry));
+            .and_then(|f| beside_verdict(f, &report, &rotor_asymmetry, spell));
         ExplainDocument {
             headline,
             motor_verdict,
@@ -171,6 +182,7 @@ pub fn beside_verdict(
     finding: &FindingReport,
     report: &ExplainReport,
     mcsa: &McsaReport,
+    spell: &dyn Spelling,
 ) -> Option<String> {
     let named = finding.named()?;
     let fault = fault_text(named);
@@ -186,10 +198,10 @@ pub fn beside_verdict(
     if !report.baseline_normalized_rms_error.is_finite() {
         return Some(format!(
             "beside the verdict ({fault}): the model could not run on this log (no voltages), so explain ranks no effect; the verdict's analysis judged the motor, and the unbalance line below is the whole log's average ({})",
-            report.unbalance.summary
+            monitor_words::analysis::unbalance(&report.unbalance, spell)
         ));
     }
-    let place = place_of(effect, report);
+    let place = place_of(effect, report, spell);
     if place.agrees {
         return Some(format!(
             "beside the verdict ({fault}): the ranking agrees: {}",
@@ -229,7 +241,7 @@ struct Place {
 
 /// [`Place`] of `effect` in `report`: ranked, without effect, not plausible, skipped, in the
 /// model already, or not fitted (a log without voltages).
-fn place_of(effect: EffectKind, report: &ExplainReport) -> Place {
+fn place_of(effect: EffectKind, report: &ExplainReport, spell: &dyn Spelling) -> Place {
     let said = |words: String| Place {
         words,
         agrees: false,
@@ -240,9 +252,11 @@ fn place_of(effect: EffectKind, report: &ExplainReport) -> Place {
     if let Some(c) = report.ranking.iter().find(|c| c.effect == effect) {
         return placed(c);
     }
-    let prefix = format!("{effect}: ");
-    match report.skipped.iter().find_map(|s| s.strip_prefix(&prefix)) {
-        Some(why) => said(format!("{effect} is not fitted on this log ({why})")),
+    match report.skipped.iter().find(|s| s.effect == effect) {
+        Some(s) => said(format!(
+            "{effect} is not fitted on this log ({})",
+            monitor_words::analysis::skip_reason(&s.because, spell)
+        )),
         None => said(format!("{effect} was not fitted")),
     }
 }

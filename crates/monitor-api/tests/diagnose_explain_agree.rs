@@ -99,7 +99,7 @@ fn diagnose_and_explain_agree_on_twenty_logs() {
                 from_s: Some(1.5),
                 ..Default::default()
             };
-            let e = api::explain(ParamsSource::Path(&p), &log, &areq)
+            let e = api::explain(ParamsSource::Path(&p), &log, &areq, &monitor_replay::FieldNames)
                 .unwrap_or_else(|e| panic!("{motor} {}: explain: {e}", case.0));
             let verdict = e["verdict"].as_str().unwrap_or_default().to_string();
             let fault = d.report.verdict == Verdict::Fault;
@@ -172,7 +172,7 @@ fn a_healthy_motor_on_vf_steps_claims_no_effect() {
             from_s,
             ..Default::default()
         };
-        let e = api::explain(source(), &log, &req).expect("explains");
+        let e = api::explain(source(), &log, &req, &monitor_replay::FieldNames).expect("explains");
         let verdict = e["verdict"].as_str().unwrap_or_default();
         eprintln!(
             "from {from_s:?}: {}",

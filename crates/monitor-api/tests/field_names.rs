@@ -3,6 +3,7 @@
 //! `diagnose` (commission), `compare` (a later start, the effects to add) and `explain` (the
 //! effect to add) in the words a fleet table or a program passes.
 
+use monitor_replay::FieldNames;
 use monitor_api::{AnalysisRequest, DiagnoseRequest, ParamsSource};
 use std::path::PathBuf;
 
@@ -42,7 +43,7 @@ fn no_sentence_of_a_report_in_the_librarys_words_names_a_flag() {
         "{advice}"
     );
     // compare over the start: add the dynamics effects.
-    let c = monitor_api::compare(p, &log, &AnalysisRequest::default()).expect("compares");
+    let c = monitor_api::compare(p, &log, &AnalysisRequest::default(), &FieldNames).expect("compares");
     let text = c.to_string();
     assert!(flags(&text).is_empty(), "{:#?}", flags(&text));
     assert!(text.contains("(effects = "), "{}", c["advice"]);
@@ -51,7 +52,7 @@ fn no_sentence_of_a_report_in_the_librarys_words_names_a_flag() {
         from_s: Some(0.8),
         ..AnalysisRequest::default()
     };
-    let e = monitor_api::explain(p, &log, &req).expect("explains");
+    let e = monitor_api::explain(p, &log, &req, &FieldNames).expect("explains");
     let text = e.to_string();
     assert!(flags(&text).is_empty(), "{:#?}", flags(&text));
     let verdict = e["verdict"].as_str().unwrap_or_default();

@@ -1,12 +1,14 @@
-//! The words of the model-vs-measurement analyses (`compare`, `explain`), spelled from
-//! [`monitor_analysis`]'s typed values: why an effect was not fitted, why a dynamics effect
-//! is not proposed.
+//! The words the model-vs-measurement analyses (`compare`, `explain`, the ladder) share,
+//! spelled from [`monitor_analysis`]'s typed values: why an effect was not fitted, why a
+//! dynamics effect is not proposed, the unbalance analysis.
 
 use monitor_analysis::effects::SetupError;
 use monitor_analysis::explain::{SkipReason, Skipped};
 use monitor_analysis::transients::{NotProposed, STEP_MIN};
+use monitor_analysis::unbalance::{CannotJudgeUnbalance, UnbalanceAnalysis, UnbalanceFinding};
 use monitor_core::EffectKind;
 use monitor_replay::{OptionField, Spelling};
+use serde_json::Value;
 
 /// Effect names, comma separated.
 pub fn effect_names(kinds: &[EffectKind]) -> String {
@@ -55,5 +57,90 @@ pub fn not_proposed(n: &NotProposed, spell: &dyn Spelling) -> String {
             100.0 * STEP_MIN,
             1000.0 * tau_s
         ),
+    }
+}
+
+/// The unbalance analysis in one sentence (JSON `unbalance.summary`); `spell` names the
+/// option a healthy baseline is given by.
+pub fn unbalance(u: &UnbalanceAnalysis, spell: &dyn Spelling) -> String {
+    let baseline = || spell.command_with("diagnose", OptionField::Baseline);
+    match &u.finding {
+        UnbalanceFinding::CannotJudge { ratio, why } => format!(
+            "cannot judge the unbalance (negative sequence {:.1} %): {}",
+            100.0 * ratio,
+            cannot_judge(why)
+        ),
+        UnbalanceFinding::Winding {
+            ratio,
+            voltages,
+            phase,
+            shorted_fraction,
+            deviation,
+        } => format!(
+            "negative-sequence current {:.1} % of positive sequence{}: phase {} winding differs (shorted turns: at least {:.1} % of its turns, as a bolted short; its current is {:.1} % {} the mean)",
+            100.0 * ratio,
+            if *voltages { "" } else { " (current-only log: supply assumed balanced, from the parameter file)" },
+            phase.name(),
+            100.0 * shorted_fraction,
+            100.0 * deviation.abs(),
+            if *deviation > 0.0 { "above" } else { "below" },
+        ),
+        UnbalanceFinding::Supply {
+            ratio,
+            voltage_ratio,
+        } => format!(
+            "negative-sequence current {:.1} %, caused by the supply's {:.1} % voltage unbalance (no winding suspected)",
+            100.0 * ratio,
+            100.0 * voltage_ratio
+        ),
+        UnbalanceFinding::WithinHealthy {
+            ratio,
+            winding_ratio,
+            healthy,
+        } => format!(
+            "negative-sequence current {:.1} % of positive sequence, the winding's part of it {:.1} % (the supply's taken out): within a healthy machine's own asymmetry of {:.0} %, so no winding is named ({} with a healthy run of this motor judges a smaller change)",
+            100.0 * ratio,
+            100.0 * winding_ratio,
+            100.0 * healthy,
+            baseline()
+        ),
+        UnbalanceFinding::CurrentOnly { ratio, healthy } => format!(
+            "negative sequence {:.1} %: cannot judge the phase (a current-only log: below a healthy machine's own asymmetry of {:.0} % a winding cannot be told from the supply's unbalance or the machine's build; {} with a healthy log judges it)",
+            100.0 * ratio,
+            100.0 * healthy,
+            baseline()
+        ),
+        UnbalanceFinding::Balanced { ratio } => {
+            format!("currents balanced (negative sequence {:.2} %)", 100.0 * ratio)
+        }
+    }
+}
+
+/// Why a log cannot carry an unbalance claim (JSON `unbalance.cannot_judge_because`).
+pub fn cannot_judge(why: &CannotJudgeUnbalance) -> String {
+    match why {
+        CannotJudgeUnbalance::FewPeriods { periods, needed } => format!(
+            "{periods:.1} supply periods analysed, {needed} needed (give a longer log or window)"
+        ),
+        CannotJudgeUnbalance::CurrentVaries { variation, max } => format!(
+            "the current varies by {:.0} % RMS over the stretch analysed (a start or a load change; {:.0} % at most): its decaying terms look like a negative sequence",
+            100.0 * variation,
+            100.0 * max
+        ),
+        CannotJudgeUnbalance::InNoise {
+            mean_a,
+            noise_a,
+            factor,
+        } => format!("the current ({mean_a:.3} A) is within {factor}x its noise ({noise_a:.3} A)"),
+    }
+}
+
+/// The unbalance analysis' JSON object `v` (of `u`) with its sentences: `summary` and
+/// `cannot_judge_because` (null where judged).
+pub fn unbalance_into(v: &mut Value, u: &UnbalanceAnalysis, spell: &dyn Spelling) {
+    if let Some(o) = v.as_object_mut() {
+        o.insert("summary".into(), unbalance(u, spell).into());
+        let why = u.finding.cannot_judge().map(cannot_judge);
+        o.insert("cannot_judge_because".into(), why.into());
     }
 }

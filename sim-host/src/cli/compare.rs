@@ -128,7 +128,6 @@ impl Common {
             no_fit: self.no_fit,
             group: self.group.clone(),
             rotor_bars,
-            words: super::words::CLI,
         }
     }
 }
@@ -249,7 +248,8 @@ pub fn run_compare(args: &CompareArgs) -> anyhow::Result<()> {
     let out = a.compare(&c.options())?;
     render::html::write_compare(c.plot.as_deref(), c.report.as_deref(), &c.log, &a, &out)?;
     if c.json {
-        render::json::print(&mut crate::cli::out::stdout(), &out.report)
+        let doc = monitor_api::words::compare::document(&out.report, &super::words::CliWords);
+        render::json::print(&mut crate::cli::out::stdout(), &doc)
     } else {
         render::text::compare(&mut crate::cli::out::stdout(), &c.log, &out.report)
     }
@@ -333,7 +333,12 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
     let judged = judged?;
     // The motor current signature analysis, with the fitted rotor_asymmetry's delta.
     let mcsa = monitor_api::mcsa_beside(&a, &out.report, args.rotor_bars);
-    let doc = monitor_api::ExplainDocument::new(judged.as_ref(), out.report, mcsa);
+    let doc = monitor_api::ExplainDocument::new(
+        judged.as_ref(),
+        out.report,
+        mcsa,
+        &super::words::CliWords,
+    );
     render::html::write_explain(
         c.plot.as_deref(),
         c.report.as_deref(),
@@ -342,15 +347,16 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
         (&out.before, out.after.as_ref()),
         &doc,
     )?;
+    let words = &super::words::CliWords;
     match (c.json, compared) {
         (true, Some(cmp)) => render::json::print(
             &mut crate::cli::out::stdout(),
             &render::json::ExplainWithCompare {
-                compare: &cmp,
-                explain: &doc,
+                compare: &monitor_api::words::compare::document(&cmp, words),
+                explain: &doc.to_json(words),
             },
         ),
-        (true, None) => render::json::print(&mut crate::cli::out::stdout(), &doc),
+        (true, None) => render::json::print(&mut crate::cli::out::stdout(), &doc.to_json(words)),
         (false, _) => render::text::explain(&mut crate::cli::out::stdout(), &c.log, &doc),
     }
 }

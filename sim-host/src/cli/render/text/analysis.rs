@@ -6,6 +6,9 @@ use monitor_api::analysis::CompareReport;
 use monitor_api::analysis::LadderReport;
 use monitor_api::analysis::{ExplainReport, Standing, EXPLAINS_MIN};
 use monitor_api::words;
+
+/// The command line's words for the options advice names (`--from`, `--effects`).
+const CLI: &crate::cli::words::CliWords = &crate::cli::words::CliWords;
 use monitor_api::ExplainDocument;
 use std::io::Write;
 use std::path::Path;
@@ -63,13 +66,17 @@ pub fn compare(
     }
     worst_windows(&mut out, r)?;
     for a in &r.advice {
-        writeln!(out, "  advice: {a}")?;
+        writeln!(out, "  advice: {}", words::compare::advice(a, CLI))?;
     }
     fitted(&mut out, r)?;
     for s in &r.skipped {
-        writeln!(out, "  skipped: {s}")?;
+        writeln!(out, "  skipped: {}", words::compare::skipped(*s))?;
     }
-    writeln!(out, "  unbalance: {}", r.unbalance.summary)?;
+    writeln!(
+        out,
+        "  unbalance: {}",
+        words::analysis::unbalance(&r.unbalance, CLI)
+    )?;
     Ok(())
 }
 
@@ -117,7 +124,7 @@ fn fitted(out: &mut impl Write, r: &CompareReport) -> anyhow::Result<()> {
             if v.plausible { "" } else { "  [not plausible]" }
         )?;
     }
-    for w in &r.implausible_because {
+    for w in words::compare::implausible(r, CLI) {
         writeln!(out, "  not plausible: {w}")?;
     }
     if let Some(j) = &r.identifiability {
@@ -128,7 +135,7 @@ fn fitted(out: &mut impl Write, r: &CompareReport) -> anyhow::Result<()> {
         )?;
     }
     for w in &r.not_identified {
-        writeln!(out, "  {w}")?;
+        writeln!(out, "  {}", words::compare::not_identified(w))?;
     }
     Ok(())
 }
@@ -156,19 +163,23 @@ pub fn explain(
         number(r.noise_floor)
     )?;
     // Explain's own answer, then how it reads beside the verdict.
-    writeln!(out, "model's error: {}", r.verdict)?;
+    writeln!(out, "model's error: {}", words::explain::verdict(r, CLI))?;
     if let Some(b) = &doc.beside_verdict {
         writeln!(out, "  {b}")?;
     }
-    writeln!(out, "  unbalance: {}", r.unbalance.summary)?;
+    writeln!(
+        out,
+        "  unbalance: {}",
+        words::analysis::unbalance(&r.unbalance, CLI)
+    )?;
     write!(out, "{}", super::super::mcsa::text(&doc.rotor_asymmetry))?;
     ranking(&mut out, r)?;
     for s in &r.skipped {
-        writeln!(out, "  skipped: {s}")?;
+        writeln!(out, "  skipped: {}", words::analysis::skipped(s, CLI))?;
     }
-    if let Some(words) = r.base_refit.as_ref().map(|b| b.in_words()) {
-        if !words.is_empty() {
-            writeln!(out, "  {words}")?;
+    if let Some(said) = r.base_refit.as_ref().map(words::explain::base_refit) {
+        if !said.is_empty() {
+            writeln!(out, "  {said}")?;
         }
     }
     Ok(())
@@ -323,7 +334,7 @@ fn ladder_end(out: &mut dyn std::io::Write, r: &LadderReport) -> anyhow::Result<
         writeln!(out, "  not kept: {name}: {why}")?;
     }
     for s in &r.skipped_reasons {
-        let s = words::analysis::skipped(s, &crate::cli::words::CliWords);
+        let s = words::analysis::skipped(s, CLI);
         writeln!(out, "  not fitted: {s}")?;
     }
     Ok(())
