@@ -85,27 +85,6 @@ impl monitor_api::words::Spelling for PyWords {
     }
 }
 
-/// Python's words for the analyses' advice (until the analyses return typed advice the door
-/// spells).
-pub(crate) const PY: monitor_api::analysis::Words = monitor_api::analysis::Words(&PyWordsShim);
-
-/// Python's keywords for the analyses' advice (the same as [`PyWords`]).
-struct PyWordsShim;
-
-impl monitor_api::analysis::Spelling for PyWordsShim {
-    fn option(&self, field: monitor_api::replay::OptionField, value: &str) -> String {
-        monitor_api::words::Spelling::option(&PyWords, field, value)
-    }
-
-    fn hint(&self, field: monitor_api::replay::OptionField, value: &str) -> String {
-        monitor_api::words::Spelling::hint(&PyWords, field, value)
-    }
-
-    fn command_with(&self, command: &str, field: monitor_api::replay::OptionField) -> String {
-        monitor_api::words::Spelling::command_with(&PyWords, command, field)
-    }
-}
-
 /// The exception of an [`ApiError`], its message in Python's words ([`PyWords`]).
 fn to_py(e: ApiError) -> PyErr {
     let msg = e.spelled(&PyWords);
@@ -275,7 +254,6 @@ fn analysis_request(
         no_fit,
         group,
         rotor_bars,
-        words: PY,
     })
 }
 
@@ -298,7 +276,8 @@ fn compare(
     let req = analysis_request(&effects, from_s, to_s, no_fit, group, None)?;
     let log = log_source(log, log_origin.as_deref())?;
     run(py, || {
-        json(&api::compare(params_source(&params, params_is_text), log, &req).map_err(to_py)?)
+        let doc = api::compare(params_source(&params, params_is_text), log, &req, &PyWords);
+        json(&doc.map_err(to_py)?)
     })
 }
 
@@ -325,7 +304,7 @@ fn explain(
     run(py, || {
         let params = params_source(&params, params_is_text);
         let doc = if ladder {
-            api::ladder(params, log, &req)
+            api::ladder(params, log, &req, &PyWords)
         } else {
             api::explain(params, log, &req, &PyWords)
         };

@@ -280,7 +280,8 @@ fn the_ranking_reads_beside_the_verdicts_fault() {
         }
     };
     set(&mut report, Standing::NotPlausible, None);
-    let b = monitor_api::beside_verdict(&bars, &report, &mcsa).expect("a sentence");
+    let b = monitor_api::beside_verdict(&bars, &report, &mcsa, &monitor_api::words::FieldNames)
+        .expect("a sentence");
     assert!(
         b.contains("do not contradict") && b.contains("42.0 dB"),
         "{b}"
@@ -288,7 +289,8 @@ fn the_ranking_reads_beside_the_verdicts_fault() {
     assert!(b.contains("not physical") && !b.contains("agrees"), "{b}");
     assert!(b.contains("0.79 % of the current"), "{b}"); // 10^(-42/20)
     set(&mut report, Standing::Candidate, Some(1));
-    let b = monitor_api::beside_verdict(&bars, &report, &mcsa).expect("a sentence");
+    let b = monitor_api::beside_verdict(&bars, &report, &mcsa, &monitor_api::words::FieldNames)
+        .expect("a sentence");
     assert!(
         b.contains("the ranking agrees: rotor_asymmetry is rank 1"),
         "{b}"
@@ -298,7 +300,8 @@ fn the_ranking_reads_beside_the_verdicts_fault() {
         Size::OfPositiveSequence(0.05),
         FindingSource::Winding,
     );
-    let b = monitor_api::beside_verdict(&turns, &report, &mcsa).expect("a sentence");
+    let b = monitor_api::beside_verdict(&turns, &report, &mcsa, &monitor_api::words::FieldNames)
+        .expect("a sentence");
     assert!(
         b.contains("negative-sequence current") && b.contains("phase_asymmetry"),
         "{b}"
@@ -308,7 +311,8 @@ fn the_ranking_reads_beside_the_verdicts_fault() {
         Size::Relative(0.5),
         FindingSource::Residuals,
     );
-    let b = monitor_api::beside_verdict(&rs, &report, &mcsa).expect("a sentence");
+    let b = monitor_api::beside_verdict(&rs, &report, &mcsa, &monitor_api::words::FieldNames)
+        .expect("a sentence");
     assert!(b.contains("rs +50 %") && b.contains("refit"), "{b}");
     let healthy = FindingReport::new(
         FindingSource::Rotor,
@@ -316,10 +320,14 @@ fn the_ranking_reads_beside_the_verdicts_fault() {
         Against::Nothing,
         monitor_replay::Detail::Rotor,
     );
-    assert_eq!(monitor_api::beside_verdict(&healthy, &report, &mcsa), None);
+    assert_eq!(
+        monitor_api::beside_verdict(&healthy, &report, &mcsa, &monitor_api::words::FieldNames),
+        None
+    );
     // A log without voltages: no model, no ranking; the sentence says so.
     report.baseline_normalized_rms_error = f64::NAN;
-    let b = monitor_api::beside_verdict(&turns, &report, &mcsa).expect("a sentence");
+    let b = monitor_api::beside_verdict(&turns, &report, &mcsa, &monitor_api::words::FieldNames)
+        .expect("a sentence");
     assert!(
         b.contains("could not run") && b.contains("ranks no effect"),
         "{b}"

@@ -69,10 +69,6 @@ pub struct Analysis {
     pub params: monitor_io::params::ParamFile,
     /// What the data-quality stage found in the log and what the analysis did about it.
     pub quality: monitor_io::log::quality::DataQuality,
-    /// The words the reports' advice names a field in (`--from` on the command line,
-    /// `from_s=...` in Python): the front end's that asked; the library's own
-    /// ([`crate::words_shim::FieldNames`]) as loaded.
-    pub words: crate::words_shim::Words,
     /// The constants the effects are set up with when they are not `constants`: the user's
     /// file's, for a model the ladder rebased on refitted base parameters
     /// ([`Analysis::rebased`]), so that an effect's data-dependent set-up (the load
@@ -291,7 +287,6 @@ impl Analysis {
             constants: MachineConstants::from_params(&params),
             params,
             quality,
-            words: crate::words_shim::Words::LIBRARY,
             setup_origin: None,
         })
     }
@@ -524,7 +519,7 @@ pub(crate) fn align(active: &[ActiveEffect<'_>], mut f: FitResult) -> FitResult 
 impl Analysis {
     /// The unbalance / faulty-phase analysis ([`unbalance`]; needs only the currents).
     pub fn unbalance(&self) -> unbalance::UnbalanceAnalysis {
-        unbalance::analyse(&self.data, &self.constants, &*self.words)
+        unbalance::analyse(&self.data, &self.constants)
     }
 }
 
@@ -537,7 +532,6 @@ impl Analysis {
             constants: MachineConstants::from_params(&params),
             params,
             quality: self.quality.clone(),
-            words: self.words,
             setup_origin: None,
         }
     }

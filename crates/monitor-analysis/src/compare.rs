@@ -27,31 +27,100 @@ pub struct CompareReport {
     /// Where the model fails most.
     pub worst_windows: Vec<WorstWindow>,
     /// What to do when the worst windows are transients (a start, a step): the dynamics
-    /// effects that cover them and the `--from` past a start. Empty otherwise.
-    pub advice: Vec<String>,
+    /// effects that cover them and the window past a start. Empty otherwise. (JSON
+    /// `advice_values`, beside the sentences `advice`.)
+    #[serde(rename = "advice_values")]
+    pub advice: Vec<super::transients::Advice>,
     /// Fitted base parameters.
     pub base_parameters: std::collections::BTreeMap<String, ParamValue>,
     /// Fitted effects.
     pub fitted_effects: Vec<FittedEffect>,
     /// False when a fitted value (base parameter or effect) is outside its physical range.
     pub plausible: bool,
-    /// Why not (one line per value out of range; empty when plausible).
+    /// Why not: each base parameter and effect value out of range (a prediction that
+    /// diverged, `diverged_at_s`, is said before them at the door).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub implausible_because: Vec<String>,
     /// What the log identifies: rank and conditioning of the fit's Jacobian and each base
     /// parameter's sensitivity (null when the base parameters were not refitted).
     pub identifiability: Option<super::fit::Jacobian>,
-    /// The base parameters the log does not identify, in words ("j_kgm2 is not identified:
-    /// the speed never changes in this log"); their values stay near the nominal ones.
-    pub not_identified: Vec<String>,
-    /// Analyses that could not run and why.
-    pub skipped: Vec<String>,
+    /// The base parameters the log does not identify, each with why (JSON
+    /// `not_identified_values`, beside the sentences `not_identified`: "j_kgm2 is not
+    /// identified: the speed never changes in this log"); their values stay near the
+    /// nominal ones.
+    #[serde(rename = "not_identified_values")]
+    pub not_identified: Vec<NotIdentifiedBase>,
+    /// Analyses that could not run and why (JSON `skipped_reasons`, beside the sentences
+    /// `skipped`).
+    #[serde(rename = "skipped_reasons")]
+    pub skipped: Vec<CompareSkip>,
     /// Unbalance analysis.
     pub unbalance: UnbalanceAnalysis,
     /// Rows read, working rate, frame.
     pub data: DataInfo,
     /// What the data-quality stage found and what the analysis did about it.
     pub data_quality: monitor_io::log::quality::DataQuality,
+}
+
+/// An analysis `compare` could not run on a log.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CompareSkip {
+    /// The log has no speed column: omega_r is not compared (the model still predicts it).
+    NoSpeed,
+    /// The log has no voltages: the model's prediction is skipped (it is driven by V_qs);
+    /// the unbalance analysis ran on the currents.
+    NoVoltages,
+}
+
+/// A base parameter the log does not identify, with why and the numbers that decided.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct NotIdentifiedBase {
+    /// The parameter.
+    pub parameter: super::simplified_model::BaseParameter,
+    /// Why the log does not identify it.
+    pub because: NotIdentifiedWhy,
+    /// How much a 10 % change of it moves the model error.
+    pub error_change_per_10_percent: f64,
+    /// The least change that identifies a parameter ([`super::fit::IDENTIFIED_MIN`]).
+    pub identified_min: f64,
+}
+
+/// Why a log does not identify a base parameter: how little what identifies it changes.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum NotIdentifiedWhy {
+    /// J: the speed never changes (it spans `span` of its largest value).
+    SpeedConstant {
+        /// The speed's span over its largest value.
+        span: f64,
+    },
+    /// J: the speed changes too little or too slowly for the inertia torque to matter.
+    SpeedSlow,
+    /// J or B + Bl: no speed column, and the currents alone hardly depend on it.
+    NoSpeed,
+    /// B + Bl: the speed never changes (spans `span`, synchronous `sync_rpm`): a viscous
+    /// torque cannot be told from a constant one.
+    ViscousAtOneSpeed {
+        /// The speed's span over its largest value.
+        span: f64,
+        /// The log's highest synchronous speed [rpm].
+        sync_rpm: f64,
+    },
+    /// B + Bl: the speed-dependent load torque is too small next to the other torques.
+    ViscousSmall,
+    /// Ls: the flux current hardly changes (spans `span`).
+    FluxConstant {
+        /// The flux current's span over its largest value.
+        span: f64,
+    },
+    /// Ra: the load current hardly changes (spans `span`).
+    LoadConstant {
+        /// The load current's span over its largest value.
+        span: f64,
+    },
+    /// The other fitted parameters compensate its change.
+    Compensated,
 }
 
 /// Everything `compare` computed, for plots and the report.
@@ -78,7 +147,7 @@ impl Analysis {
         }
         let mut skipped = Vec::new();
         if !d.channels.speed {
-            skipped.push("omega_r not compared: the log has no wm_rad_s column (the model still predicts it)".into());
+            skipped.push(CompareSkip::NoSpeed);
         }
         let list = resolve(&opts.effects);
         let fitted = self.fit_for_compare(&list, opts)?;
@@ -88,7 +157,7 @@ impl Analysis {
         let f = align(&active, fitted.fit);
         let m = self.measure_compare(&active, &f, &list, fitted.span)?;
         let fitted_effects = self.fitted_effects(&active, &f)?;
-        let implausible_because = self.compare_implausible(&f, &m, &fitted_effects);
+        let implausible_because = self.compare_implausible(&f, &fitted_effects);
         Ok(CompareOutput {
             report: CompareReport {
                 effects: list.iter().map(|e| e.kind()).collect(),
@@ -100,7 +169,7 @@ impl Analysis {
                 advice: m.advice,
                 base_parameters: self.base_table(&f.base),
                 fitted_effects,
-                plausible: implausible_because.is_empty(),
+                plausible: m.diverged_at_s.is_none() && implausible_because.is_empty(),
                 implausible_because,
                 identifiability: fitted.jacobian,
                 not_identified: fitted.not_identified,
@@ -130,7 +199,7 @@ impl Analysis {
             super::fit::jacobian(&fd, &self.constants, &active_fit, &wf, &fit, opts.fit_base)?;
         let not_identified = jacobian
             .as_ref()
-            .map(|j| not_identified_in_words(j, &self.data, &self.constants))
+            .map(|j| not_identified(j, &self.data, &self.constants))
             .unwrap_or_default();
         Ok(FittedForCompare {
             fit,
@@ -161,7 +230,7 @@ impl Analysis {
         let in_model: Vec<EffectKind> = list.iter().map(|e| e.kind()).collect();
         let plan = super::transients::dynamics_plan(span, &self.constants, &in_model);
         let (tags, advice) =
-            super::transients::advice(d, &self.constants, &worst, &in_model, &plan, &*self.words);
+            super::transients::advice(d, &self.constants, &worst, &in_model, &plan);
         for (w, t) in worst.iter_mut().zip(tags) {
             w.transient = t;
         }
@@ -176,27 +245,15 @@ impl Analysis {
         })
     }
 
-    /// Why `compare`'s fit `f` is not plausible: a diverged prediction first, then the
-    /// base parameters and the fitted effects out of their physical ranges.
+    /// Why `compare`'s fit `f` is not plausible: the base parameters and the fitted effects
+    /// out of their physical ranges (a diverged prediction is the report's
+    /// `diverged_at_s`).
     fn compare_implausible(
         &self,
         f: &super::fit::FitResult,
-        m: &CompareMeasures,
         fitted_effects: &[FittedEffect],
     ) -> Vec<String> {
-        let mut why = super::base_implausible(&self.constants, &f.base, &self.data);
-        if let Some(t) = m.diverged_at_s {
-            why.insert(
-                0,
-                format!(
-                    "the model diverged at {t:.3} s (its predicted current left {}x the largest measured): the error \
-                     {:.4} measures nothing; add the effects the advice names, or leave the start out ({})",
-                    metrics::DIVERGED_CURRENT_RATIO,
-                    m.err.normalized_rms_error,
-                    self.words.hint(monitor_replay::OptionField::From, "")
-                ),
-            );
-        }
+        let mut why = super::base_range::base_implausible(&self.constants, &f.base, &self.data);
         for fe in fitted_effects {
             why.extend(
                 fe.implausible_because
@@ -214,8 +271,8 @@ struct FittedForCompare {
     fit: super::fit::FitResult,
     /// The fit's Jacobian (`None` when the base parameters were not fitted).
     jacobian: Option<super::fit::Jacobian>,
-    /// The base parameters not identified, in words.
-    not_identified: Vec<String>,
+    /// The base parameters not identified, with why.
+    not_identified: Vec<NotIdentifiedBase>,
     /// What the fit series offers the dynamics effects (the advice's rule).
     span: super::transients::Span,
 }
@@ -233,7 +290,7 @@ struct CompareMeasures {
     /// Every window.
     all_windows: Vec<WorstWindow>,
     /// The advice on the worst windows.
-    advice: Vec<String>,
+    advice: Vec<super::transients::Advice>,
     /// The prediction.
     prediction: Prediction,
 }
@@ -262,7 +319,7 @@ impl Analysis {
                 implausible_because: vec![],
                 identifiability: None,
                 not_identified: vec![],
-                skipped: vec!["model prediction (I_qs, omega_r, phase currents) skipped: the log has no voltage columns va_V, vb_V, vc_V, and the model is driven by V_qs; the unbalance analysis ran on the currents".into()],
+                skipped: vec![CompareSkip::NoVoltages],
                 unbalance,
                 data: info,
                 data_quality: self.quality.clone(),
@@ -307,54 +364,41 @@ impl Spans {
         }
     }
 
-    /// Why the log does not identify base parameter `p`, in words.
-    fn why_not(&self, p: super::simplified_model::BaseParameter) -> String {
+    /// Why the log does not identify base parameter `p`.
+    fn why_not(&self, p: super::simplified_model::BaseParameter) -> NotIdentifiedWhy {
         use super::simplified_model::BaseParameter::{BPlusBl, Ls, Ra, J};
         match (p, self.speed) {
-            (J, Some(s)) if s < 0.02 => format!(
-                "the speed never changes in this log (it spans {:.1} % of its largest value)",
-                100.0 * s
-            ),
-            (J, Some(_)) => "the speed changes too little or too slowly for the inertia torque to matter next to the other torques".into(),
-            (J | BPlusBl, None) => "the log has no speed column, and the currents alone hardly depend on it".into(),
-            (BPlusBl, Some(s)) if s < 0.02 => format!(
-                "the speed never changes in this log (spans {:.1} %, synchronous {:.0} rpm): a viscous torque cannot be told from a constant one",
-                100.0 * s,
-                self.sync_rpm
-            ),
-            (BPlusBl, Some(_)) => "the speed-dependent load torque is too small next to the other torques".into(),
-            (Ls, _) if self.flux < 0.05 => format!(
-                "the flux current hardly changes (spans {:.1} %), so Ls trades off against Ra at one operating point",
-                100.0 * self.flux
-            ),
-            (Ra, _) if self.load < 0.05 => format!(
-                "the load current hardly changes (spans {:.1} %), so Ra trades off against Ls at one operating point",
-                100.0 * self.load
-            ),
-            _ => "the other fitted parameters compensate its change".into(),
+            (J, Some(span)) if span < 0.02 => NotIdentifiedWhy::SpeedConstant { span },
+            (J, Some(_)) => NotIdentifiedWhy::SpeedSlow,
+            (J | BPlusBl, None) => NotIdentifiedWhy::NoSpeed,
+            (BPlusBl, Some(span)) if span < 0.02 => NotIdentifiedWhy::ViscousAtOneSpeed {
+                span,
+                sync_rpm: self.sync_rpm,
+            },
+            (BPlusBl, Some(_)) => NotIdentifiedWhy::ViscousSmall,
+            (Ls, _) if self.flux < 0.05 => NotIdentifiedWhy::FluxConstant { span: self.flux },
+            (Ra, _) if self.load < 0.05 => NotIdentifiedWhy::LoadConstant { span: self.load },
+            _ => NotIdentifiedWhy::Compensated,
         }
     }
 }
 
 /// The base parameters a Jacobian finds unidentified, each with the reason the log gives:
 /// how much the measured speed, flux current and load current change over it.
-fn not_identified_in_words(
+fn not_identified(
     j: &super::fit::Jacobian,
     d: &super::prep::Prepared,
     n: &super::simplified_model::MachineConstants,
-) -> Vec<String> {
+) -> Vec<NotIdentifiedBase> {
     let spans = Spans::of(d, n);
     j.base
         .iter()
         .filter(|p| !p.identified)
-        .map(|p| {
-            format!(
-                "{} is not identified: {} (a 10 % change moves the error by {:.4}, below {})",
-                p.parameter,
-                spans.why_not(p.parameter),
-                p.error_change_per_10_percent,
-                super::fit::IDENTIFIED_MIN
-            )
+        .map(|p| NotIdentifiedBase {
+            parameter: p.parameter,
+            because: spans.why_not(p.parameter),
+            error_change_per_10_percent: p.error_change_per_10_percent,
+            identified_min: super::fit::IDENTIFIED_MIN,
         })
         .collect()
 }

@@ -52,13 +52,9 @@ pub mod rotor_asymmetry;
 pub mod simplified_model;
 pub mod transients;
 pub mod unbalance;
-pub mod words_shim;
 
 pub use analysis::{
     known_effects, parse_effect, Analysis, AnalysisError, AnalysisFrame, DataInfo, FittedEffect,
     Options, ParamValue, MAX_FIT_SAMPLES, MAX_ITER,
 };
 pub use base_range::base_implausible;
-// (The modules that still name these through the crate's root: `explain::ladder`.)
-use analysis::{align, coarsen, resolve};
-use base_range::base_newly_out_of_range;

@@ -139,57 +139,18 @@ impl BaseRefit {
         q
     }
 
-    /// In words, for beside the verdict: which base parameters were refitted (changed by
-    /// [`REPORT_MIN_CHANGE`] or more), with their values, and which the log does not
-    /// identify. Empty when there is nothing to say.
-    pub fn in_words(&self) -> String {
-        let changed: Vec<String> = self
-            .parameters
+    /// The refitted parameters said beside the verdict: identified and changed by
+    /// [`REPORT_MIN_CHANGE`] or more.
+    pub fn changed(&self) -> impl Iterator<Item = &RefittedParameter> {
+        self.parameters
             .iter()
             .filter(|r| r.identified && r.change().abs() >= REPORT_MIN_CHANGE)
-            .map(|r| {
-                format!(
-                    "{} {} -> {} {} ({:+.0} %)",
-                    r.parameter,
-                    sig(r.configured),
-                    sig(r.refitted),
-                    r.unit,
-                    100.0 * r.change()
-                )
-            })
-            .collect();
-        let unidentified: Vec<&str> = self
-            .parameters
-            .iter()
-            .filter(|r| !r.identified)
-            .map(|r| r.parameter.key())
-            .collect();
-        let mut parts = Vec::new();
-        if self.recentred {
-            parts.push(format!(
-                "the parameter file does not fit this log ({}): the effects were judged against the model refitted to it ({})",
-                self.because.join("; "),
-                if changed.is_empty() { "no identified change".to_string() } else { changed.join(", ") }
-            ));
-        } else if !changed.is_empty() {
-            parts.push(format!(
-                "base parameters refitted to the log: {}",
-                changed.join(", ")
-            ));
-        }
-        if !unidentified.is_empty() {
-            parts.push(format!(
-                "not identified by this log (kept near the file's value): {}",
-                unidentified.join(", ")
-            ));
-        }
-        parts.join("; ")
     }
-}
 
-/// Four significant digits, as the rest of the analysis prints values.
-fn sig(v: f64) -> String {
-    super::effects::sig(v)
+    /// The parameters the log does not identify (kept near the file's values).
+    pub fn unidentified(&self) -> impl Iterator<Item = &RefittedParameter> {
+        self.parameters.iter().filter(|r| !r.identified)
+    }
 }
 
 #[cfg(test)]
@@ -242,15 +203,11 @@ mod tests {
         assert!((nq.btot_nms - 0.1).abs() < 1e-12);
         // J is not identified: kept.
         assert_eq!(q.motor.j_kgm2, p.motor.j_kgm2);
-        let words = r.in_words();
-        assert!(
-            words.contains("ra_ohm") && words.contains("+50 %"),
-            "{words}"
-        );
-        assert!(
-            words.contains("not identified") && words.contains("j_kgm2"),
-            "{words}"
-        );
+        // Said beside the verdict: Ra's +50 % among the changes, J as not identified.
+        let ra = r.changed().find(|x| x.parameter == BaseParameter::Ra);
+        assert!(ra.is_some_and(|x| (x.change() - 0.5).abs() < 1e-9), "{r:?}");
+        let unidentified: Vec<BaseParameter> = r.unidentified().map(|x| x.parameter).collect();
+        assert_eq!(unidentified, [BaseParameter::J], "{r:?}");
     }
 
     #[test]

@@ -9,9 +9,7 @@ use super::effects::{model_of, EffectModel};
 use super::metrics::WorstWindow;
 use super::prep::Prepared;
 use super::simplified_model::MachineConstants;
-use crate::words_shim::{FieldNames, Spelling};
 use monitor_core::EffectKind;
-use monitor_replay::OptionField;
 use serde::Serialize;
 
 /// A relative change of the supply voltage amplitude or frequency larger than this within a
@@ -202,15 +200,14 @@ pub fn settling_s(n: &MachineConstants) -> f64 {
 
 /// Why a library effect is not proposed on a log (`explain`'s `skipped`, and `compare`'s
 /// advice on the dynamics effects): the one rule both commands print
-/// ([`not_proposed`]).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+/// ([`not_proposed`]); the words are spelled at the door (`monitor-words`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum NotProposed {
     /// Effects it needs in the model first ([`EffectModel::requires`]).
-    #[error("needs {} in the model first", names(.0))]
     Requires(Vec<EffectKind>),
     /// Its time constant `tau_s` [s] is shorter than 3 samples of the fit series (period
-    /// `dt_s` [s]).
-    #[error("{}", self.spelled(&FieldNames))]
+    /// `dt_s` [s]): a shorter window of the log would resolve it.
     Unresolved {
         /// Sample period of the fit series [s].
         dt_s: f64,
@@ -218,38 +215,11 @@ pub enum NotProposed {
         tau_s: f64,
     },
     /// A dynamics effect (time constant `tau_s` [s]) on a log without a start or a supply
-    /// step.
-    #[error("no start or supply step in the analysed span (voltage and frequency within {:.0} %): its {:.1} ms dynamics have nothing to act on", 100.0 * STEP_MIN, 1000.0 * tau_s)]
+    /// step (voltage and frequency within [`STEP_MIN`]).
     NoTransient {
         /// The effect's time constant [s].
         tau_s: f64,
     },
-}
-
-impl NotProposed {
-    /// The reason with its advice in a front end's words (`words`: `--from/--to` on the
-    /// command line); `Display` says it in the library's ([`FieldNames`]).
-    pub fn spelled(&self, words: &dyn Spelling) -> String {
-        match self {
-            NotProposed::Unresolved { dt_s, tau_s } => format!(
-                "the fit series of this long log ({:.0} Hz) cannot resolve a {:.1} ms time constant; analyse a shorter window with {}/{}",
-                1.0 / dt_s,
-                1000.0 * tau_s,
-                words.hint(OptionField::From, ""),
-                words.hint(OptionField::To, "")
-            ),
-            other => other.to_string(),
-        }
-    }
-}
-
-/// Effect names, comma separated.
-pub(crate) fn names(kinds: &[EffectKind]) -> String {
-    kinds
-        .iter()
-        .map(|k| k.name())
-        .collect::<Vec<_>>()
-        .join(", ")
 }
 
 /// What the analysed span offers an effect with a time constant: the sample period of the
@@ -346,19 +316,78 @@ pub fn dynamics_plan(
         .collect()
 }
 
-/// The advice `compare` prints when its worst windows are transients: the dynamics effects
-/// not in the model that [`dynamics_plan`] proposes on this span (with the `--effects` that
-/// adds them), each one it does not propose with the reason `explain` gives for skipping it
-/// (`name: why`, the same words), and, after a start, the `--from` past it; the fields
-/// named in `words` (the front end's).
+/// What `compare` advises when its worst windows are transients (JSON `advice_values[]`,
+/// beside the sentences `advice`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Advice {
+    /// The worst windows that are transients, and what the model's dynamics effects do for
+    /// them.
+    Transients {
+        /// Each such window: its span [s] and its transient.
+        windows: Vec<TransientWindow>,
+        /// What the dynamics effects of the plan cover.
+        cover: Cover,
+    },
+    /// A dynamics effect the plan does not propose, with the reason `explain` gives for
+    /// skipping it (the same words).
+    NotProposed {
+        /// The effect.
+        effect: EffectKind,
+        /// Why not.
+        why: NotProposed,
+    },
+    /// After a start: analyse from `from_s` [s] (the start ends at about `start_end_s`,
+    /// plus five rotor time constants, rounded up to 0.1 s).
+    LeaveStartOut {
+        /// Where the analysed window may begin [s].
+        from_s: f64,
+        /// The start's end [s] ([`start_end_s`]).
+        start_end_s: f64,
+    },
+}
+
+/// A worst window of `compare` that is a transient.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TransientWindow {
+    /// Its start [s].
+    pub t_start_s: f64,
+    /// Its end [s].
+    pub t_end_s: f64,
+    /// The transient.
+    pub transient: Transient,
+}
+
+/// What the dynamics effects of a plan ([`dynamics_plan`]) do for transients.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Cover {
+    /// Every dynamics effect is already in the model: what remains there is another effect
+    /// or a parameter error.
+    AllInModel,
+    /// None is proposed on this span (why: [`Advice::NotProposed`]).
+    NoneProposed,
+    /// Add `proposed` (the model's `effects` with them).
+    Add {
+        /// The dynamics effects proposed.
+        proposed: Vec<EffectKind>,
+        /// The effects of the model with them (what `--effects` takes).
+        effects: Vec<EffectKind>,
+    },
+}
+
+/// The advice `compare` gives when its worst windows are transients: the dynamics effects
+/// not in the model that [`dynamics_plan`] proposes on this span (with the effects that add
+/// them), each one it does not propose with the reason `explain` gives for skipping it,
+/// and, after a start, the window past it. The windows' transients first (`None` for a
+/// window in none).
 pub fn advice(
     d: &Prepared,
     n: &MachineConstants,
     worst: &[WorstWindow],
     in_model: &[EffectKind],
     plan: &[(EffectKind, Option<NotProposed>)],
-    words: &dyn Spelling,
-) -> (Vec<Option<Transient>>, Vec<String>) {
+) -> (Vec<Option<Transient>>, Vec<Advice>) {
     let start = start_end_s(d);
     let look = settling_s(n);
     let tags: Vec<Option<Transient>> = worst
@@ -369,61 +398,52 @@ pub fn advice(
     if tags.iter().all(Option::is_none) {
         return (tags, out);
     }
-    let spans: Vec<String> = worst
+    let windows: Vec<TransientWindow> = worst
         .iter()
         .zip(&tags)
         .filter_map(|(w, t)| {
-            t.as_ref()
-                .map(|t| format!("{:.2}-{:.2} s: {}", w.t_start_s, w.t_end_s, t.description))
+            t.as_ref().map(|t| TransientWindow {
+                t_start_s: w.t_start_s,
+                t_end_s: w.t_end_s,
+                transient: t.clone(),
+            })
         })
         .collect();
-    out.push(format!(
-        "the worst windows are transients ({}); {}",
-        spans.join("; "),
-        cover(plan, in_model, words)
-    ));
-    out.extend(
-        plan.iter()
-            .filter_map(|(k, why)| why.as_ref().map(|w| format!("{k}: {}", w.spelled(words)))),
-    );
+    out.push(Advice::Transients {
+        windows,
+        cover: cover(plan, in_model),
+    });
+    out.extend(plan.iter().filter_map(|(k, why)| {
+        why.as_ref().map(|w| Advice::NotProposed {
+            effect: *k,
+            why: w.clone(),
+        })
+    }));
     if let Some(te) = start {
-        let from = ((te + look) * 10.0).ceil() / 10.0;
-        out.push(format!(
-            "or leave the start out: {} (the start ends at about {te:.2} s, plus five rotor time constants)",
-            words.hint(OptionField::From, &format!("{from:.1}"))
-        ));
+        out.push(Advice::LeaveStartOut {
+            from_s: ((te + look) * 10.0).ceil() / 10.0,
+            start_end_s: te,
+        });
     }
     (tags, out)
 }
 
-/// What the dynamics effects of `plan` do for the transients, in words: those proposed
-/// with the `--effects` that adds them to `in_model`, or why none is.
-fn cover(
-    plan: &[(EffectKind, Option<NotProposed>)],
-    in_model: &[EffectKind],
-    words: &dyn Spelling,
-) -> String {
-    let proposed: Vec<&str> = plan
+/// What the dynamics effects of `plan` do for the transients: those proposed, with the
+/// effects of `in_model` and them, or why none is.
+fn cover(plan: &[(EffectKind, Option<NotProposed>)], in_model: &[EffectKind]) -> Cover {
+    let proposed: Vec<EffectKind> = plan
         .iter()
         .filter(|(_, why)| why.is_none())
-        .map(|(k, _)| k.name())
+        .map(|(k, _)| *k)
         .collect();
     if plan.is_empty() {
-        return "every dynamics effect is already in the model; what remains there is another effect or a parameter error".to_string();
+        return Cover::AllInModel;
     }
     if proposed.is_empty() {
-        return "the dynamics effects are not proposed on this span (why below, as explain skips them)".to_string();
+        return Cover::NoneProposed;
     }
-    let all: Vec<&str> = in_model
-        .iter()
-        .map(|k| k.name())
-        .chain(proposed.iter().copied())
-        .collect();
-    format!(
-        "the model's dynamics effects cover a start or a supply step: add {} ({})",
-        proposed.join(", "),
-        words.hint(OptionField::Effects, &all.join(","))
-    )
+    let effects = in_model.iter().chain(&proposed).copied().collect();
+    Cover::Add { proposed, effects }
 }
 
 /// The samples of `d` that lie in a transient of the model's inputs: within the

@@ -15,11 +15,11 @@
 
 use super::prep::{Prepared, C64};
 use super::simplified_model::MachineConstants;
-use crate::words_shim::Spelling;
-use monitor_replay::OptionField;
 use serde::Serialize;
 
-/// Unbalance / faulty-phase analysis (JSON key `unbalance` of `compare` and `explain`).
+/// Unbalance / faulty-phase analysis (JSON key `unbalance` of `compare` and `explain`, with
+/// the sentences `summary` and `cannot_judge_because` spelled at the door beside the typed
+/// `finding`).
 #[derive(Debug, Clone, Serialize)]
 pub struct UnbalanceAnalysis {
     /// RMS negative-sequence current / RMS positive-sequence current.
@@ -32,12 +32,105 @@ pub struct UnbalanceAnalysis {
     pub suspect_phase: Option<String>,
     /// RMS phase currents [A] a, b, c.
     pub phase_rms_a: [f64; 3],
-    /// In words.
-    pub summary: String,
-    /// Why no phase or unbalance is claimed although the numbers exist: fewer than
-    /// [`MIN_STEADY_PERIODS`] supply periods analysed, or a positive-sequence current that
-    /// is not steady ([`MAX_CURRENT_VARIATION`]) or lies in the noise; null when judged.
-    pub cannot_judge_because: Option<String>,
+    /// What the analysis found, with its numbers.
+    pub finding: UnbalanceFinding,
+}
+
+/// What the unbalance analysis found on a log, with the numbers its sentence names.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum UnbalanceFinding {
+    /// The log cannot carry an unbalance claim although the numbers exist.
+    CannotJudge {
+        /// Negative over positive sequence current.
+        ratio: f64,
+        /// Why not.
+        why: CannotJudgeUnbalance,
+    },
+    /// A phase's winding differs.
+    Winding {
+        /// Negative over positive sequence current.
+        ratio: f64,
+        /// Whether the log has voltages (without them the supply is assumed balanced).
+        voltages: bool,
+        /// The phase.
+        phase: monitor_core::Phase,
+        /// The least fraction of its turns shorted (a bolted short).
+        shorted_fraction: f64,
+        /// Its RMS current against the phases' mean, as a fraction of the mean (signed).
+        deviation: f64,
+    },
+    /// The supply's voltage unbalance accounts for the current's; no winding suspected.
+    Supply {
+        /// Negative over positive sequence current.
+        ratio: f64,
+        /// Negative over positive sequence voltage.
+        voltage_ratio: f64,
+    },
+    /// A log with voltages: the winding's part is within a healthy machine's own
+    /// asymmetry (`healthy`), so no winding is named.
+    WithinHealthy {
+        /// Negative over positive sequence current.
+        ratio: f64,
+        /// The winding's part (the supply's taken out).
+        winding_ratio: f64,
+        /// A healthy machine's own asymmetry ([`NAMED_WINDING_MIN`]).
+        healthy: f64,
+    },
+    /// A current-only log: below a healthy machine's own asymmetry (`healthy`) a winding
+    /// cannot be told from the supply's unbalance or the machine's build.
+    CurrentOnly {
+        /// Negative over positive sequence current.
+        ratio: f64,
+        /// A healthy machine's own asymmetry
+        /// ([`monitor_core::sequence::INHERENT_ASYMMETRY_RATIO`]).
+        healthy: f64,
+    },
+    /// The currents are balanced (negative sequence under 1 %).
+    Balanced {
+        /// Negative over positive sequence current.
+        ratio: f64,
+    },
+}
+
+impl UnbalanceFinding {
+    /// Why no phase or unbalance is claimed although the numbers exist (`None`: judged).
+    pub fn cannot_judge(&self) -> Option<&CannotJudgeUnbalance> {
+        match self {
+            UnbalanceFinding::CannotJudge { why, .. } => Some(why),
+            _ => None,
+        }
+    }
+}
+
+/// Why a log cannot carry an unbalance claim.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum CannotJudgeUnbalance {
+    /// Fewer than `needed` supply periods analysed.
+    FewPeriods {
+        /// Supply periods analysed.
+        periods: f64,
+        /// Supply periods needed ([`MIN_STEADY_PERIODS`]).
+        needed: f64,
+    },
+    /// The positive-sequence current varies by `variation` (RMS over its mean), more than
+    /// `max` ([`MAX_CURRENT_VARIATION`]): a start or a load change.
+    CurrentVaries {
+        /// RMS variation over the mean.
+        variation: f64,
+        /// The most allowed.
+        max: f64,
+    },
+    /// The current's mean `mean_a` [A] is within `factor` x its noise `noise_a` [A].
+    InNoise {
+        /// Mean positive-sequence current [A].
+        mean_a: f64,
+        /// The currents' white noise [A].
+        noise_a: f64,
+        /// The factor ([`MIN_SIGNAL_OVER_NOISE`]).
+        factor: f64,
+    },
 }
 
 /// Supply periods the analysis needs (after the first 10 % of the series) to claim an
@@ -103,8 +196,7 @@ impl SequenceSums {
 }
 
 /// The analysis of a working series with the machine's constants.
-/// `words`: the words its advice names a field in.
-pub fn analyse(d: &Prepared, n: &MachineConstants, words: &dyn Spelling) -> UnbalanceAnalysis {
+pub fn analyse(d: &Prepared, n: &MachineConstants) -> UnbalanceAnalysis {
     let s = SequenceSums::new(d, d.len() / 10);
     let ratio = (s.i_neg2 / s.i_pos2.max(1e-12)).sqrt();
     let vratio = d
@@ -116,11 +208,8 @@ pub fn analyse(d: &Prepared, n: &MachineConstants, words: &dyn Spelling) -> Unba
     let (asym, eps) = winding_of(d, n, &s, w);
     let cannot_judge = cannot_judge(d, &s, w);
     let suspect = asym.suspect_phase.filter(|_| cannot_judge.is_none());
-    let summary = match &cannot_judge {
-        Some(why) => format!(
-            "cannot judge the unbalance (negative sequence {:.1} %): {why}",
-            100.0 * ratio,
-        ),
+    let finding = match cannot_judge {
+        Some(why) => UnbalanceFinding::CannotJudge { ratio, why },
         None => Found {
             ratio,
             vratio,
@@ -129,15 +218,14 @@ pub fn analyse(d: &Prepared, n: &MachineConstants, words: &dyn Spelling) -> Unba
             shorted_fraction: eps,
             phase_rms_a,
         }
-        .in_words(d, suspect, words),
+        .finding(d, suspect),
     };
     UnbalanceAnalysis {
         negative_sequence_ratio: ratio,
         voltage_negative_sequence_ratio: vratio,
         suspect_phase: suspect.map(|p| p.name().to_string()),
         phase_rms_a,
-        summary,
-        cannot_judge_because: cannot_judge,
+        finding,
     }
 }
 
@@ -217,77 +305,70 @@ struct Found {
 }
 
 impl Found {
-    /// The summary sentence, `suspect` the phase named (`words`: a field's, in advice).
-    fn in_words(
-        &self,
-        d: &Prepared,
-        suspect: Option<monitor_core::Phase>,
-        words: &dyn Spelling,
-    ) -> String {
-        let baseline = || words.command_with("diagnose", OptionField::Baseline);
+    /// What was found, `suspect` the phase named.
+    fn finding(&self, d: &Prepared, suspect: Option<monitor_core::Phase>) -> UnbalanceFinding {
         let ratio = self.ratio;
         match (suspect, self.supply_explains) {
-            (Some(p), _) => {
+            (Some(phase), _) => {
                 let mean_rms = self.phase_rms_a.iter().sum::<f64>() / 3.0;
-                let dev = self.phase_rms_a[p.index()] - mean_rms;
-                format!(
-                    "negative-sequence current {:.1} % of positive sequence{}: phase {} winding differs (shorted turns: at least {:.1} % of its turns, as a bolted short; its current is {:.1} % {} the mean)",
-                    100.0 * ratio,
-                    if d.channels.voltages { "" } else { " (current-only log: supply assumed balanced, from the parameter file)" },
-                    p.name(),
-                    100.0 * self.shorted_fraction,
-                    100.0 * dev.abs() / mean_rms.max(1e-12),
-                    if dev > 0.0 { "above" } else { "below" },
-                )
+                let dev = self.phase_rms_a[phase.index()] - mean_rms;
+                UnbalanceFinding::Winding {
+                    ratio,
+                    voltages: d.channels.voltages,
+                    phase,
+                    shorted_fraction: self.shorted_fraction,
+                    deviation: dev / mean_rms.max(1e-12),
+                }
             }
-            (None, true) => format!(
-                "negative-sequence current {:.1} %, caused by the supply's {:.1} % voltage unbalance (no winding suspected)",
-                100.0 * ratio,
-                100.0 * self.vratio.unwrap_or(0.0)
-            ),
-            (None, false) if d.channels.voltages && ratio >= 0.01 => format!(
-                "negative-sequence current {:.1} % of positive sequence, the winding's part of it {:.1} % (the supply's taken out): within a healthy machine's own asymmetry of {:.0} %, so no winding is named ({} with a healthy run of this motor judges a smaller change)",
-                100.0 * ratio,
-                100.0 * self.winding_ratio,
-                100.0 * NAMED_WINDING_MIN,
-                baseline()
-            ),
-            (None, false) if !d.channels.voltages && ratio >= 0.01 => format!(
-                "negative sequence {:.1} %: cannot judge the phase (a current-only log: below a healthy machine's own asymmetry of {:.0} % a winding cannot be told from the supply's unbalance or the machine's build; {} with a healthy log judges it)",
-                100.0 * ratio,
-                100.0 * monitor_core::sequence::INHERENT_ASYMMETRY_RATIO,
-                baseline()
-            ),
-            (None, false) => format!("currents balanced (negative sequence {:.2} %)", 100.0 * ratio),
+            (None, true) => UnbalanceFinding::Supply {
+                ratio,
+                voltage_ratio: self.vratio.unwrap_or(0.0),
+            },
+            (None, false) if d.channels.voltages && ratio >= 0.01 => {
+                UnbalanceFinding::WithinHealthy {
+                    ratio,
+                    winding_ratio: self.winding_ratio,
+                    healthy: NAMED_WINDING_MIN,
+                }
+            }
+            (None, false) if !d.channels.voltages && ratio >= 0.01 => {
+                UnbalanceFinding::CurrentOnly {
+                    ratio,
+                    healthy: f64::from(monitor_core::sequence::INHERENT_ASYMMETRY_RATIO),
+                }
+            }
+            (None, false) => UnbalanceFinding::Balanced { ratio },
         }
     }
 }
 
 /// Why the series cannot carry an unbalance claim (see
-/// [`UnbalanceAnalysis::cannot_judge_because`]); `None` when it can.
-fn cannot_judge(d: &Prepared, s: &SequenceSums, omega_s: f64) -> Option<String> {
+/// [`UnbalanceFinding::CannotJudge`]); `None` when it can.
+fn cannot_judge(d: &Prepared, s: &SequenceSums, omega_s: f64) -> Option<CannotJudgeUnbalance> {
     let periods = s.count * d.dt_s * omega_s.abs() / std::f64::consts::TAU;
     if periods.is_nan() || periods < MIN_STEADY_PERIODS {
-        return Some(format!(
-            "{periods:.1} supply periods analysed, {MIN_STEADY_PERIODS} needed (give a longer log or window)"
-        ));
+        return Some(CannotJudgeUnbalance::FewPeriods {
+            periods,
+            needed: MIN_STEADY_PERIODS,
+        });
     }
     let mean = s.i_pos / s.count;
     let var = (s.i_pos2 / s.count - mean * mean).max(0.0);
     if mean.is_nan() || var.sqrt() > MAX_CURRENT_VARIATION * mean {
-        return Some(format!(
-            "the current varies by {:.0} % RMS over the stretch analysed (a start or a load change; {:.0} % at most): its decaying terms look like a negative sequence",
-            100.0 * var.sqrt() / mean.max(1e-12),
-            100.0 * MAX_CURRENT_VARIATION
-        ));
+        return Some(CannotJudgeUnbalance::CurrentVaries {
+            variation: var.sqrt() / mean.max(1e-12),
+            max: MAX_CURRENT_VARIATION,
+        });
     }
     let from = d.len() / 10;
     let re: Vec<f64> = d.i_ab[from..].iter().map(|z| z.re).collect();
     let noise = super::metrics::white_noise_sigma(&re);
     if noise.is_nan() || mean <= MIN_SIGNAL_OVER_NOISE * noise {
-        return Some(format!(
-            "the current ({mean:.3} A) is within {MIN_SIGNAL_OVER_NOISE}x its noise ({noise:.3} A)"
-        ));
+        return Some(CannotJudgeUnbalance::InNoise {
+            mean_a: mean,
+            noise_a: noise,
+            factor: MIN_SIGNAL_OVER_NOISE,
+        });
     }
     None
 }

@@ -188,14 +188,18 @@ fn current_only_log_gets_the_unbalance_analysis() {
         "{:?}",
         cmp.unbalance
     );
-    assert!(
-        cmp.skipped.iter().any(|m| m.contains("va_V")),
+    assert_eq!(
+        cmp.skipped,
+        [monitor_analysis::compare::CompareSkip::NoVoltages],
         "{:?}",
         cmp.skipped
     );
     let ex = a.explain(&opts(&[]), &|_| {}).unwrap().report;
     assert_eq!(ex.unbalance.suspect_phase.as_deref(), Some("b"));
-    assert!(ex.skipped.iter().any(|m| m.contains("voltage")));
+    assert!(ex
+        .skipped
+        .iter()
+        .any(|m| m.because == monitor_analysis::explain::SkipReason::NoVoltages));
     // And a balanced current-only log suspects no phase.
     let s = scenario("2p2", None, 1);
     let log = write_log(dir.path(), "balanced", &truth, &s, true);
@@ -212,12 +216,12 @@ fn motulator_log_points_at_load_torque() {
     let p = monitor_io::params::ParamFile::load(&root.join("motulator_2p2kw_dol.toml")).unwrap();
     let a = analyse(&log, &p, 0.8);
     let ex = a.explain(&opts(&[]), &|_| {}).unwrap().report;
-    eprintln!("{}", ex.verdict);
+    eprintln!("{:?}", ex.conclusion);
     assert_eq!(
         ex.ranking[0].effect,
         EffectKind::LoadTorque,
-        "{}",
-        ex.verdict
+        "{:?}",
+        ex.conclusion
     );
     assert!(!ex.unexplained);
     let before = a.compare(&opts(&[])).unwrap().report.normalized_rms_error;
@@ -246,10 +250,15 @@ fn dynamics_effects_need_an_input_transient() {
         let log = write_log(dir.path(), name, &truth, &s, false);
         let a = analyse(&log, &nominal, from_for("3hp", name));
         let ex = a.explain(&opts(base), &|_| {}).unwrap().report;
-        let skipped = ex
-            .skipped
-            .iter()
-            .any(|m| m.starts_with("d_axis_dynamics: no start or supply step"));
+        let skipped = ex.skipped.iter().any(|m| {
+            m.effect == EffectKind::DAxisDynamics
+                && matches!(
+                    m.because,
+                    monitor_analysis::explain::SkipReason::NotProposed {
+                        why: monitor_analysis::transients::NotProposed::NoTransient { .. }
+                    }
+                )
+        });
         let ranked = ex
             .ranking
             .iter()

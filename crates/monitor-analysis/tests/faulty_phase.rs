@@ -137,7 +137,7 @@ fn diagnose_and_the_analysis_name_the_same_phase() {
         let a = Analysis::load(&path, p, opts, &mut |_| {}).expect("analysis");
         let u = a.unbalance();
         assert_eq!(rep.unbalance.suspect_phase.map(Phase::name), Some(name));
-        assert_eq!(u.suspect_phase.as_deref(), Some(name), "{}", u.summary);
+        assert_eq!(u.suspect_phase.as_deref(), Some(name), "{:?}", u.finding);
     }
 }
 

@@ -425,13 +425,13 @@ fn thermal_case(
         value("tau_s"),
     );
     eprintln!(
-        "{name}: top {} ({:.0} %), unexplained {}, rise {:.1} K, tau {:.2} s; {}",
+        "{name}: top {} ({:.0} %), unexplained {}, rise {:.1} K, tau {:.2} s; {:?}",
         r.0,
         100.0 * r.2,
         r.1,
         r.3,
         r.4,
-        ex.verdict
+        ex.conclusion
     );
     r
 }

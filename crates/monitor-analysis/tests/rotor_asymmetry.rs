@@ -202,7 +202,7 @@ fn analyse_case(which: &str, load: f64, delta: f64) -> (String, bool, f64, f64, 
         .map(|v| v.value);
     let m = mcsa(&a.data, a.constants.np, Some(28.0), fitted);
     eprintln!(
-        "{which} load {load} delta {delta}: first {first} (unexplained {}), compare {:.4} -> {:.4} (noise {:.4}), fitted delta {fitted:?}, sidebands {:?} / {:?} dB, bars {:?}; {}",
+        "{which} load {load} delta {delta}: first {first} (unexplained {}), compare {:.4} -> {:.4} (noise {:.4}), fitted delta {fitted:?}, sidebands {:?} / {:?} dB, bars {:?}; {:?}",
         r.unexplained,
         without.normalized_rms_error,
         with.normalized_rms_error,
@@ -210,7 +210,7 @@ fn analyse_case(which: &str, load: f64, delta: f64) -> (String, bool, f64, f64, 
         m.lower_sideband_db,
         m.upper_sideband_db,
         m.equivalent_broken_bars,
-        r.verdict
+        r.conclusion
     );
     (
         first,

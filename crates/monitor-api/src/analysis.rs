@@ -8,7 +8,7 @@
 pub use monitor_analysis::compare::{CompareOutput, CompareReport};
 pub use monitor_analysis::effects::sig;
 pub use monitor_analysis::explain::ladder::{
-    tried_name, BaseChange, FinalFit, LadderReport, LadderStep, Tried, FLOOR_BAND,
+    BaseChange, FinalFit, LadderReport, LadderStep, Tried, FLOOR_BAND,
 };
 pub use monitor_analysis::explain::{ExplainOutput, ExplainReport, Standing, EXPLAINS_MIN};
 pub use monitor_analysis::identify::{self, Identification};
@@ -16,5 +16,4 @@ pub use monitor_analysis::metrics::{self, WorstWindow};
 pub use monitor_analysis::prep::Prepared;
 pub use monitor_analysis::rotor_asymmetry::McsaReport;
 pub use monitor_analysis::simplified_model::Prediction;
-pub use monitor_analysis::words_shim::{Spelling, Words};
 pub use monitor_analysis::{parse_effect, Analysis, Options};

@@ -65,7 +65,7 @@ pub fn mcsa_beside(a: &Analysis, report: &ExplainReport, rotor_bars: Option<u32>
     )
 }
 
-/// `explain --json`'s document.
+/// `explain --json`'s document, its sentences in the words of `spell` (the front end's).
 ///
 /// # Errors
 /// As [`super::compare`].
@@ -91,7 +91,8 @@ pub fn explain(
 }
 
 /// `explain --ladder --json`'s document ([`monitor_analysis::explain::ladder`]): the
-/// ladder's steps from the configured model to the noise floor, and why it stopped.
+/// ladder's steps from the configured model to the noise floor, and why it stopped, each
+/// sentence spelled at the door beside its typed reason ([`monitor_words::ladder::document`]).
 ///
 /// # Errors
 /// As [`super::compare`].
@@ -99,11 +100,12 @@ pub fn ladder(
     params: ParamsSource<'_>,
     log: impl Into<LogSource>,
     req: &AnalysisRequest,
+    spell: &dyn Spelling,
 ) -> Result<serde_json::Value, ApiError> {
     let log = &log.into();
     let a = load_analysis(params, log, req, &mut |_| {})?;
     let report = a.ladder(&req.options(), &|_, _| {})?;
-    Ok(serde_json::to_value(&report).unwrap_or_default())
+    Ok(monitor_words::ladder::document(&report, spell))
 }
 
 /// The verdict `diagnose` gives `log` with its defaults (no commissioning, no baseline; the
@@ -125,6 +127,8 @@ pub fn verdict_for_explain(
 }
 
 impl ExplainDocument {
+    /// The document as JSON, the report's sentences spelled at the door beside its typed
+    /// values ([`monitor_words::explain::report_into`]) in the words of `spell`.
     /// The document of an `explain` report beside the verdict `diagnose` gave the same log
     /// (`judged`; its error where it gave none), its headline in `sp`'s words.
     pub fn new(
@@ -147,7 +151,7 @@ impl ExplainDocument {
         };
         let beside = verdict_finding
             .as_ref()
-            .and_then(|f| beside_verdict(f, &report, &rotor_asymmetry));
+            .and_then(|f| beside_verdict(f, &report, &rotor_asymmetry, sp));
         ExplainDocument {
             headline,
             motor_verdict,
@@ -164,6 +168,7 @@ impl ExplainDocument {
     /// comes from).
     pub fn json(&self, judged: Option<&DiagnoseReport>, sp: &dyn Spelling) -> serde_json::Value {
         let mut v = serde_json::to_value(self).unwrap_or_default();
+        monitor_words::explain::report_into(&mut v, &self.report, sp);
         if let (Some(j), Some(f), Some(vf)) = (
             judged,
             self.verdict_finding.as_ref(),
@@ -190,6 +195,7 @@ pub fn beside_verdict(
     finding: &FindingReport,
     report: &ExplainReport,
     mcsa: &McsaReport,
+    spell: &dyn Spelling,
 ) -> Option<String> {
     let named = finding.named()?;
     let fault = fault_text(named);
@@ -205,10 +211,10 @@ pub fn beside_verdict(
     if !report.baseline_normalized_rms_error.is_finite() {
         return Some(format!(
             "beside the verdict ({fault}): the model could not run on this log (no voltages), so explain ranks no effect; the verdict's analysis judged the motor, and the unbalance line below is the whole log's average ({})",
-            report.unbalance.summary
+            monitor_words::analysis::unbalance(&report.unbalance, spell)
         ));
     }
-    let place = place_of(effect, report);
+    let place = place_of(effect, report, spell);
     if place.agrees {
         return Some(format!(
             "beside the verdict ({fault}): the ranking agrees: {}",
@@ -248,7 +254,7 @@ struct Place {
 
 /// [`Place`] of `effect` in `report`: ranked, without effect, not plausible, skipped, in the
 /// model already, or not fitted (a log without voltages).
-fn place_of(effect: EffectKind, report: &ExplainReport) -> Place {
+fn place_of(effect: EffectKind, report: &ExplainReport, spell: &dyn Spelling) -> Place {
     let said = |words: String| Place {
         words,
         agrees: false,
@@ -259,9 +265,11 @@ fn place_of(effect: EffectKind, report: &ExplainReport) -> Place {
     if let Some(c) = report.ranking.iter().find(|c| c.effect == effect) {
         return placed(c);
     }
-    let prefix = format!("{effect}: ");
-    match report.skipped.iter().find_map(|s| s.strip_prefix(&prefix)) {
-        Some(why) => said(format!("{effect} is not fitted on this log ({why})")),
+    match report.skipped.iter().find(|s| s.effect == effect) {
+        Some(s) => said(format!(
+            "{effect} is not fitted on this log ({})",
+            monitor_words::analysis::skip_reason(&s.because, spell)
+        )),
         None => said(format!("{effect} was not fitted")),
     }
 }

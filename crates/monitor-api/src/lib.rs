@@ -9,7 +9,6 @@
 //! file, a bad log, a bad option, or an analysis that cannot run on this log.
 
 use monitor_analysis::prep::ReadOptions;
-use monitor_analysis::words_shim::Words;
 use monitor_analysis::{Analysis, Options};
 use monitor_core::EffectKind;
 use monitor_io::log::mapping::ColumnMapping;
@@ -19,6 +18,7 @@ use monitor_replay::{
     diagnose_log, HealthyReference, OptionError, OptionField, ReplayError, ReplayOptions,
     UnbalanceBaseline,
 };
+use monitor_words::Spelling;
 use std::path::{Path, PathBuf};
 
 /// Model against measurement for a front end (from `monitor-analysis`).
@@ -334,9 +334,6 @@ pub struct AnalysisRequest {
     pub group: Option<String>,
     /// `explain --rotor-bars`.
     pub rotor_bars: Option<u32>,
-    /// The words the reports' advice names a field in (the front end's; the library's
-    /// own by default): [`Analysis::words`].
-    pub words: Words,
 }
 
 /// Supply periods the analysed window of `compare` and `explain` must hold (0.5 s at
@@ -364,8 +361,7 @@ pub fn load_analysis(
         from_s: req.from_s.unwrap_or(f64::NEG_INFINITY),
         to_s: req.to_s.unwrap_or(f64::INFINITY),
     };
-    let mut a = Analysis::load_file(&file, params, opts, progress)?;
-    a.words = req.words;
+    let a = Analysis::load_file(&file, params, opts, progress)?;
     let span = match (a.data.t_s.first(), a.data.t_s.last()) {
         (Some(t0), Some(t1)) => t1 - t0,
         _ => 0.0,
@@ -392,7 +388,9 @@ impl AnalysisRequest {
     }
 }
 
-/// `compare --json`'s document.
+/// `compare --json`'s document, its sentences spelled at the door
+/// ([`monitor_words::compare::document`]) in the words of `spell` (the front end's: the
+/// command line's flags, Python's keywords).
 ///
 /// # Errors
 /// As [`load_analysis`], and an effect the log cannot carry.
@@ -400,10 +398,11 @@ pub fn compare(
     params: ParamsSource<'_>,
     log: impl Into<LogSource>,
     req: &AnalysisRequest,
+    spell: &dyn Spelling,
 ) -> Result<serde_json::Value, ApiError> {
     let a = load_analysis(params, log, req, &mut |_| {})?;
     let out = a.compare(&req.options())?;
-    Ok(serde_json::to_value(&out.report).unwrap_or_default())
+    Ok(monitor_words::compare::document(&out.report, spell))
 }
 
 /// `identify`'s result: the identification and the parameter file it writes.
@@ -470,7 +469,10 @@ pub fn identify(
         return Err(ApiError::Identify {
             what: "identify",
             log: log.shown(),
-            why: format!("{why}; no parameter file written"),
+            why: format!(
+                "{}; no parameter file written",
+                monitor_words::identify::refusal(&why)
+            ),
         });
     }
     let toml = monitor_analysis::identify::to_toml(&id, &start_text, &start_name, &log.shown());

@@ -1,8 +1,9 @@
-//! A report asked in the library's own words (`monitor_replay::FieldNames`, the default of
+//! A report asked in the library's own words (`monitor_api::words::FieldNames`, the default of
 //! a request) names fields, never a command line's flags (issue 64): the advice of
 //! `diagnose` (commission), `compare` (a later start, the effects to add) and `explain` (the
 //! effect to add) in the words a fleet table or a program passes.
 
+use monitor_api::words::FieldNames;
 use monitor_api::{AnalysisRequest, DiagnoseRequest, ParamsSource};
 use std::path::PathBuf;
 
@@ -46,7 +47,8 @@ fn no_sentence_of_a_report_in_the_librarys_words_names_a_flag() {
         "{advice}"
     );
     // compare over the start: add the dynamics effects.
-    let c = monitor_api::compare(p, &log, &AnalysisRequest::default()).expect("compares");
+    let c =
+        monitor_api::compare(p, &log, &AnalysisRequest::default(), &FieldNames).expect("compares");
     let text = c.to_string();
     assert!(flags(&text).is_empty(), "{:#?}", flags(&text));
     assert!(text.contains("(effects = "), "{}", c["advice"]);

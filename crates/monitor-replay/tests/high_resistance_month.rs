@@ -145,8 +145,8 @@ fn day_of(day: u32, r: &DiagnoseReport) -> Day {
         verdict: r.verdict,
         finding,
         names,
-        line: r.verdict_line.clone(),
-        isolation: r.isolation.verdict.clone(),
+        line: monitor_words::diagnose::verdict_line(r, &monitor_words::FieldNames),
+        isolation: monitor_words::diagnose::said(&r.isolation.said, &monitor_words::FieldNames),
     }
 }
 

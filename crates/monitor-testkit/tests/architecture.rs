@@ -30,6 +30,11 @@
 //!    team's design file or its shared folder ([`FOREIGN`]); a user who clones the
 //!    repository has neither. The paper is cited by its title, the design by `docs/`.
 //!
+//! 8. **Spelled only at the door**: an engine's non-test sources (`monitor-analysis`) name
+//!    none of the front ends' words (`Spelling`, `Words`, `OptionField`) and decide nothing
+//!    by reading a sentence back (`t.because.starts_with("...")`): its reasons are typed
+//!    values, spelled by `monitor-words` (`architecture_syntax::spelling`, with its tests).
+//!
 //! The tests' shared scenarios (`crates/monitor-testkit/src/`, a dev-only crate) are tests
 //! for rule 4 and for the unique type names (rule 7, below), and code for the others.
 //!
@@ -93,8 +98,8 @@ const WORKSPACE_CRATES: [&str; 17] = [
     "monitor_analysis",
     "monitor_studies",
     "monitor_api",
-    "monitor_store",
     "monitor_words",
+    "monitor_store",
     "monitor_testkit",
     "core_on_m4",
     "rtt_on_m4",

@@ -14,14 +14,28 @@
 //! options type carries words.
 //!
 //! Modules, one per engine:
+//! - [`analysis`]: what `compare`, `explain` and the ladder share (why an effect was not
+//!   fitted, why a dynamics effect is not proposed, the unbalance analysis);
+//! - [`compare`]: `compare` (its advice, what it could not run, what the log does not
+//!   identify, why its fit is not plausible, and its JSON document);
+//! - [`explain`]: `explain` (its conclusion, the base parameters refitted, its sentences
+//!   in its JSON document);
+//! - [`identify`]: `identify` (why an identification is not written);
+//! - [`ladder`]: `explain --ladder` (why it stopped, why a candidate was not kept, each
+//!   step, the base changes, what was found, and its JSON document);
 //! - [`diagnose`]: one log's report (`sim-host diagnose`, the demo, the HMI, Python's
 //!   `diagnose`), its [`diagnose::Story`] and its JSON document;
 //! - [`trend`]: a motor's trend (`sim-host trend`, Python's `trend`).
 
 #![forbid(unsafe_code)]
 
+pub mod analysis;
+pub mod compare;
 pub mod diagnose;
 mod errors;
+pub mod explain;
+pub mod identify;
+pub mod ladder;
 mod spelling;
 pub mod trend;
 

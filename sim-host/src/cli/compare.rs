@@ -128,7 +128,6 @@ impl Common {
             no_fit: self.no_fit,
             group: self.group.clone(),
             rotor_bars,
-            words: super::words::CLI,
         }
     }
 }
@@ -249,7 +248,8 @@ pub fn run_compare(args: &CompareArgs) -> anyhow::Result<()> {
     let out = a.compare(&c.options())?;
     render::html::write_compare(c.plot.as_deref(), c.report.as_deref(), &c.log, &a, &out)?;
     if c.json {
-        render::json::print(&mut crate::cli::out::stdout(), &out.report)
+        let doc = monitor_api::words::compare::document(&out.report, &super::words::CliWords);
+        render::json::print(&mut crate::cli::out::stdout(), &doc)
     } else {
         render::text::compare(&mut crate::cli::out::stdout(), &c.log, &out.report)
     }
@@ -362,7 +362,7 @@ fn print_explain(
         (Some(explain), Some(cmp)) => render::json::print(
             &mut crate::cli::out::stdout(),
             &render::json::ExplainWithCompare {
-                compare: cmp,
+                compare: &monitor_api::words::compare::document(cmp, &super::words::CliWords),
                 explain: &explain,
             },
         ),
@@ -392,7 +392,8 @@ fn run_ladder(c: &Common) -> anyhow::Result<()> {
     pb.finish();
     render::html::write_ladder(c.plot.as_deref(), c.report.as_deref(), &c.log, &report)?;
     if c.json {
-        render::json::print(&mut crate::cli::out::stdout(), &report)
+        let doc = monitor_api::words::ladder::document(&report, &super::words::CliWords);
+        render::json::print(&mut crate::cli::out::stdout(), &doc)
     } else {
         render::text::ladder(&mut crate::cli::out::stdout(), &c.log, &report)
     }

@@ -2,30 +2,10 @@
 //! (`commission` -> `--commission 4:2`), and the library's typed values are parsed by the
 //! library's one parser, their refusals shown as clap shows a bad value.
 
-use monitor_api::replay::{
-    CommissionWindow, OptionField, ParallelPaths, ReplayError, TimelineStep,
-};
+use monitor_api::replay::{CommissionWindow, ParallelPaths, ReplayError, TimelineStep};
 use monitor_api::words::Spelling;
 use monitor_api::ApiError;
 pub use sim_host::flags::CliWords;
-
-/// The command line's words for the analyses' advice (until the analyses return typed
-/// advice the door spells).
-pub const CLI: monitor_api::analysis::Words = monitor_api::analysis::Words(&CliWordsShim);
-
-/// The command line's flags for the analyses' advice (the same names as [`CliWords`]).
-#[derive(Debug, Clone, Copy, Default)]
-pub struct CliWordsShim;
-
-impl monitor_api::analysis::Spelling for CliWordsShim {
-    fn option(&self, field: OptionField, value: &str) -> String {
-        CliWords.option(field, value)
-    }
-
-    fn command_with(&self, command: &str, field: OptionField) -> String {
-        CliWords.command_with(command, field)
-    }
-}
 
 /// One error of a chain in the command line's words: a library error that names fields
 /// names their flags; any other as it displays.
@@ -74,6 +54,7 @@ mod tests {
 
     #[test]
     fn fields_are_named_by_their_flags() {
+        use monitor_api::replay::OptionField;
         let e = monitor_api::replay::CommissionWindow::new(4.0, 2.0).unwrap_err();
         assert_eq!(
             monitor_api::words::option_error(&e, &CliWords),

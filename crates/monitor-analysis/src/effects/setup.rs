@@ -10,7 +10,8 @@ use std::sync::Arc;
 
 /// Why an effect cannot be fitted on a log (one line, the effect's name put before it by
 /// the caller).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum SetupError {
     /// The log has no phase voltages (the model is driven by V_qs).
     #[error("needs the voltage columns va_V, vb_V, vc_V (the model is driven by V_qs)")]
@@ -146,7 +147,8 @@ pub fn declared_values<const N: usize>(
 }
 
 /// Fitted values that do not match the effects they are for: never dropped silently.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum EffectValuesError {
     /// An effect got another number of values than it has parameters.
     #[error("{effect}: {got} fitted values for its {expected} parameters")]

@@ -4,10 +4,10 @@
 
 use super::baseline::{ExplainBaseline, FullSeries};
 use super::ranking::RankedCandidate;
-use super::{explained_fraction, EffectCandidate, Standing};
+use super::{explained_fraction, EffectCandidate, SkipReason, Skipped, Standing};
 use crate::analysis::{align, Analysis, AnalysisError, FittedEffect, Options};
 use crate::base_range::base_newly_out_of_range;
-use crate::effects::{self, EffectModel, SetupError};
+use crate::effects::{self, EffectModel};
 use crate::fit::{self, ActiveEffect, FitResult};
 use crate::{metrics, transients};
 use monitor_core::EffectKind;
@@ -22,19 +22,6 @@ pub(super) fn candidates<'a>(
         .map(|e| e.as_ref())
         .filter(|e| !names.contains(&e.kind()))
         .collect()
-}
-
-/// Why `explain` does not rank a candidate on this log (the report's `skipped`).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub(super) enum NotRanked {
-    /// The rule `compare`'s advice follows too: an effect needed first, a time constant
-    /// the fit series cannot resolve, no start or supply step
-    /// ([`transients::not_proposed`]).
-    #[error(transparent)]
-    NotProposed(transients::NotProposed),
-    /// The log lacks a channel, or the set-up refuses the data.
-    #[error(transparent)]
-    Setup(SetupError),
 }
 
 /// The configured effects of `base`, each starting from its baseline fit, with candidate
@@ -68,15 +55,13 @@ impl Analysis {
         &self,
         cands: &[&dyn EffectModel],
         base: &ExplainBaseline<'_>,
-    ) -> Vec<String> {
+    ) -> Vec<Skipped> {
         cands
             .iter()
             .filter_map(|c| {
-                self.cannot_rank(*c, base).map(|m| match m {
-                    NotRanked::NotProposed(p) => {
-                        format!("{}: {}", c.kind(), p.spelled(&*self.words))
-                    }
-                    NotRanked::Setup(s) => format!("{}: {s}", c.kind()),
+                self.cannot_rank(*c, base).map(|because| Skipped {
+                    effect: c.kind(),
+                    because,
                 })
             })
             .collect()
@@ -85,15 +70,15 @@ impl Analysis {
     /// Why a candidate cannot be ranked on this log, if it cannot: the rule `compare`'s
     /// advice follows too ([`Analysis::not_proposed`]), a missing channel, or a set-up the
     /// data refuse (e.g. `load_torque` on a log without a load change: said, not dropped).
-    fn cannot_rank(&self, c: &dyn EffectModel, base: &ExplainBaseline<'_>) -> Option<NotRanked> {
+    fn cannot_rank(&self, c: &dyn EffectModel, base: &ExplainBaseline<'_>) -> Option<SkipReason> {
         if let Some(m) = self.not_proposed(c, base) {
-            return Some(NotRanked::NotProposed(m));
+            return Some(SkipReason::NotProposed { why: m });
         }
         let setup = c
             .needs()
             .met_by(&self.data)
             .and_then(|()| c.setup(&base.fit_series, &self.constants).map(|_| ()));
-        setup.err().map(NotRanked::Setup)
+        setup.err().map(|why| SkipReason::Setup { why })
     }
 
     /// Whether candidate `c` is proposed on the fit series of `base` with the configured

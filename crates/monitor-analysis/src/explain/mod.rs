@@ -48,6 +48,40 @@ pub const EXPLAINED_MIN: f64 = 0.5;
 /// fit's gain on windows it never saw is no more than extra freedom buys.
 pub const EXPLAINS_MIN: f64 = 0.05;
 
+/// An effect not fitted on a log, and why (JSON `skipped_reasons[]` of `explain` and of its
+/// ladder, beside the sentences `skipped`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Skipped {
+    /// The effect.
+    pub effect: EffectKind,
+    /// Why it was not fitted.
+    pub because: SkipReason,
+}
+
+/// Why an effect was not fitted on a log.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum SkipReason {
+    /// A dynamics effect the log's span does not propose, by the one rule `compare`'s
+    /// advice follows too ([`super::transients::not_proposed`]).
+    NotProposed {
+        /// Why not.
+        why: super::transients::NotProposed,
+    },
+    /// A channel it needs is missing, or the data refuse its set-up.
+    Setup {
+        /// Why not.
+        why: effects::SetupError,
+    },
+    /// It needs `effects` first, and one of them cannot be fitted on this log.
+    NeedsFirst {
+        /// What it needs first.
+        effects: Vec<EffectKind>,
+    },
+    /// A log without voltages: only the unbalance analysis ran.
+    NoVoltages,
+}
+
 /// Where a fitted candidate stands in `explain`'s report (JSON `standing`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -174,10 +208,21 @@ pub struct ExplainReport {
     pub no_effect: Vec<EffectKind>,
     /// True when no candidate explains the error well.
     pub unexplained: bool,
-    /// The conclusion in words.
-    pub verdict: String,
-    /// Candidates not evaluated and why.
-    pub skipped: Vec<String>,
+    /// The conclusion, with the numbers that decided (JSON `conclusion`, beside the
+    /// sentence `verdict` spelled at the door).
+    pub conclusion: ExplainConclusion,
+    /// The candidates whose fits are not physical that would have explained more than the
+    /// one named: not ranked and not named, each with its first reason.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub not_named: Vec<NotNamed>,
+    /// Why the configured model's own fit is not plausible (empty: it is): the base
+    /// parameters absorb an error the model cannot follow.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub model_implausible: Vec<String>,
+    /// Candidates not evaluated and why (JSON `skipped_reasons`, beside the sentences
+    /// `skipped`).
+    #[serde(rename = "skipped_reasons")]
+    pub skipped: Vec<Skipped>,
     /// Unbalance analysis.
     pub unbalance: UnbalanceAnalysis,
     /// Facts about the data.
@@ -189,6 +234,72 @@ pub struct ExplainReport {
     /// file's values did not fit ([`super::refit`]). `None` when the model did not run
     /// (a current-only log).
     pub base_refit: Option<BaseRefit>,
+}
+
+/// What `explain`'s ranking concludes (JSON `conclusion`), with the numbers that decided.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum ExplainConclusion {
+    /// A log without voltages: only the unbalance analysis ran.
+    CurrentOnly,
+    /// The configured model is within `margin` ([`NOISE_MARGIN`]) of its noise floor on
+    /// the whole log and on the held-back windows: nothing to explain.
+    NothingToExplain {
+        /// The whole-log error.
+        error: f64,
+        /// Its noise floor.
+        noise_floor: f64,
+        /// The held-back error.
+        heldback_error: f64,
+        /// Its noise floor.
+        heldback_noise_floor: f64,
+        /// The margin.
+        margin: f64,
+    },
+    /// A missing effect: the first plausible candidate explains enough.
+    Missing {
+        /// The effect.
+        effect: EffectKind,
+        /// The share of the held-back error beyond the floor it explains.
+        explained: f64,
+        /// The held-back error without it (on the fit series).
+        heldback_before: f64,
+        /// With it.
+        heldback_after: f64,
+        /// The model's effects with it (what to add).
+        effects: Vec<EffectKind>,
+    },
+    /// The best candidate explains less than `asks` ([`EXPLAINED_MIN`]).
+    TooLittle {
+        /// The effect.
+        effect: EffectKind,
+        /// The share it explains.
+        explained: f64,
+        /// The share a named effect must explain.
+        asks: f64,
+    },
+    /// No plausible effect explains `asks` ([`EXPLAINS_MIN`]) or more.
+    NoneExplains {
+        /// The share a candidate must explain.
+        asks: f64,
+    },
+    /// No candidate could be fitted with physically plausible values.
+    NothingPlausible,
+    /// The data-quality stage does not trust the log (its reasons are the report's
+    /// `data_quality`): the ranking is no verdict.
+    Untrusted,
+}
+
+/// A candidate not named because its fit is not physical, though it would have explained
+/// more than the one named.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct NotNamed {
+    /// The effect.
+    pub effect: EffectKind,
+    /// The share of the held-back error beyond the floor it would explain.
+    pub explained: f64,
+    /// Its first reason (a value out of its range).
+    pub because: Option<String>,
 }
 
 /// Everything `explain` computed.

@@ -4,16 +4,17 @@
 
 use super::baseline::{ExplainBaseline, FullSeries};
 use super::ranking::{CandidateOutcome, RankedCandidate};
-use super::{ExplainOutput, ExplainReport, Standing, EXPLAINED_MIN, EXPLAINS_MIN, NOISE_MARGIN};
+use super::{
+    ExplainConclusion, ExplainOutput, ExplainReport, NotNamed, SkipReason, Skipped, Standing,
+    EXPLAINED_MIN, EXPLAINS_MIN, NOISE_MARGIN,
+};
 use crate::analysis::{resolve, Analysis, AnalysisError, Options};
 use crate::base_range::{base_implausible, base_out_of_range};
-use crate::effects::SetupError;
 use crate::fit::{ActiveEffect, FittedModel};
 use crate::refit::BaseRefit;
 use crate::simplified_model::Prediction;
 use crate::unbalance::UnbalanceAnalysis;
 use monitor_core::EffectKind;
-use monitor_replay::OptionField;
 
 /// What stages 2 to 6 found on a log with voltages: the report's material.
 pub(super) struct ExplainFindings<'a> {
@@ -28,7 +29,7 @@ pub(super) struct ExplainFindings<'a> {
     /// What the ranking says.
     pub(super) outcome: CandidateOutcome,
     /// Candidates not ranked and why.
-    pub(super) skipped: Vec<String>,
+    pub(super) skipped: Vec<Skipped>,
     /// The unbalance analysis.
     pub(super) unbalance: UnbalanceAnalysis,
 }
@@ -41,17 +42,11 @@ impl Analysis {
         let skipped = EffectKind::ALL
             .iter()
             .filter(|k| !names.contains(k))
-            .map(|k| {
-                format!(
-                    "{k}: {}; see the unbalance analysis",
-                    SetupError::NoVoltages
-                )
+            .map(|&effect| Skipped {
+                effect,
+                because: SkipReason::NoVoltages,
             })
             .collect();
-        let verdict = format!(
-            "current-only log: only the unbalance analysis ran: {}",
-            unbalance.summary
-        );
         ExplainOutput {
             report: ExplainReport {
                 effects: names,
@@ -61,7 +56,9 @@ impl Analysis {
                 ranking: vec![],
                 no_effect: vec![],
                 unexplained: unbalance.suspect_phase.is_none(),
-                verdict,
+                conclusion: ExplainConclusion::CurrentOnly,
+                not_named: vec![],
+                model_implausible: vec![],
                 skipped,
                 unbalance,
                 data: self.info(),
@@ -121,7 +118,9 @@ impl Analysis {
         refit: BaseRefit,
     ) -> Result<ExplainOutput, AnalysisError> {
         let o = found.outcome;
-        let verdict = self.verdict(&found);
+        let conclusion = conclusion(&found);
+        let not_named = not_named(&found.ranked);
+        let model_implausible = base_implausible(&self.constants, &found.base.fit.base, &self.data);
         let after = match found.ranked.first() {
             Some(r) if !o.unexplained => {
                 Some((r.candidate.effect, self.predict_with(&found.names, r)?))
@@ -142,7 +141,9 @@ impl Analysis {
                     .collect(),
                 ranking: found.ranked.into_iter().map(|c| c.candidate).collect(),
                 unexplained: o.unexplained,
-                verdict,
+                conclusion,
+                not_named,
+                model_implausible,
                 skipped: found.skipped,
                 unbalance: found.unbalance,
                 data: self.info(),
@@ -152,23 +153,6 @@ impl Analysis {
             before: found.full.before,
             after,
         })
-    }
-
-    /// The verdict ([`verdict`]) with the notes on implausible candidates and on an
-    /// implausible fit of the configured model itself.
-    fn verdict(&self, found: &ExplainFindings<'_>) -> String {
-        let first_plausible = found.ranked.iter().find(|c| c.candidate.plausible);
-        let mut v = verdict(found, first_plausible, &*self.words);
-        v.push_str(&implausible_note(&found.ranked));
-        let base_why = base_implausible(&self.constants, &found.base.fit.base, &self.data);
-        if !base_why.is_empty() {
-            v.push_str(&format!(
-                ". The configured model's own fit is not plausible ({}): the base parameters absorb an error the model cannot follow; if the log has a start or steps, see compare's advice (dynamics effects or {})",
-                base_why.join("; "),
-                self.words.hint(monitor_replay::OptionField::From, "")
-            ));
-        }
-        v
     }
 
     /// The prediction of the configured model (`names`) with candidate `r` added, from
@@ -196,116 +180,71 @@ impl Analysis {
 }
 
 /// A verdict never rests on data the data-quality stage rejected: when the stage does not
-/// trust the log, the ranking stays in the report but the verdict says why no effect is
-/// named, and no effect is added.
+/// trust the log, the ranking stays in the report but the conclusion is that no effect is
+/// named (the stage's reasons are the report's `data_quality`), and no effect is added.
 pub(super) fn withhold_if_untrusted(mut out: ExplainOutput) -> ExplainOutput {
-    let q = &out.report.data_quality;
-    if q.trusted {
+    if out.report.data_quality.trusted {
         return out;
     }
-    out.report.verdict = format!(
-        "could not judge: the data-quality stage does not trust this log ({}); the ranking below is not a verdict",
-        q.not_trusted_because.join("; ")
-    );
+    out.report.conclusion = ExplainConclusion::Untrusted;
     out.report.unexplained = true;
     out.after = None;
     out
 }
 
-/// The verdict's note on candidates whose fits are not physically plausible: those that
-/// would have explained more than the one named (and at least [`EXPLAINS_MIN`]) are listed
-/// with the first reason, so that a user sees why they are not the answer.
-fn implausible_note(ranked: &[RankedCandidate]) -> String {
+/// The candidates whose fits are not physically plausible that would have explained more
+/// than the one named (and at least [`EXPLAINS_MIN`]), each with its first reason, so that
+/// a user sees why they are not the answer.
+fn not_named(ranked: &[RankedCandidate]) -> Vec<NotNamed> {
     let top_plausible = ranked
         .iter()
         .find(|c| c.candidate.plausible)
         .map(|c| c.score())
         .unwrap_or(f64::INFINITY);
-    let listed: Vec<String> = ranked
+    ranked
         .iter()
         .filter(|c| {
             !c.candidate.plausible
                 && c.score() < top_plausible
                 && c.candidate.explained_fraction >= EXPLAINS_MIN
         })
-        .map(|c| {
-            format!(
-                "{} would explain {:.0} % but {}",
-                c.candidate.effect,
-                100.0 * c.candidate.explained_fraction,
-                c.candidate
-                    .implausible_because
-                    .first()
-                    .map(String::as_str)
-                    .unwrap_or("a value is out of range")
-            )
+        .map(|c| NotNamed {
+            effect: c.candidate.effect,
+            explained: c.candidate.explained_fraction,
+            because: c.candidate.implausible_because.first().cloned(),
         })
-        .collect();
-    if listed.is_empty() {
-        String::new()
-    } else {
-        format!(
-            ". Not plausible, so not ranked and not named: {}",
-            listed.join("; ")
-        )
-    }
+        .collect()
 }
 
-/// The conclusion in words, `best` the first plausible candidate (`words`: a field's).
-fn verdict(
-    found: &ExplainFindings<'_>,
-    best: Option<&RankedCandidate>,
-    words: &dyn crate::words_shim::Spelling,
-) -> String {
+/// What the ranking concludes, with the numbers that decided: nothing to explain at the
+/// noise floor, a missing effect named (the first plausible candidate), or why none is.
+fn conclusion(found: &ExplainFindings<'_>) -> ExplainConclusion {
     let (full, o) = (&found.full, found.outcome);
+    let best = found.ranked.iter().find(|c| c.candidate.plausible);
     match best {
-        _ if o.near_noise => nothing_to_explain(full),
+        _ if o.near_noise => ExplainConclusion::NothingToExplain {
+            error: full.error,
+            noise_floor: full.noise,
+            heldback_error: full.heldback_error,
+            heldback_noise_floor: full.heldback_noise,
+            margin: NOISE_MARGIN,
+        },
         Some(r) if !o.unexplained => {
             let c = &r.candidate;
-            format!(
-                "missing effect: {} explains {:.0} % of the held-back error ({:.4} -> {:.4}); {}. Add it with {}",
-                c.effect,
-                100.0 * c.explained_fraction,
-                found.base.heldback_error_fit_series,
-                c.validation_normalized_rms_error,
-                c.summary,
-                words.hint(
-                    OptionField::Effects,
-                    &found
-                        .names
-                        .iter()
-                        .chain([&c.effect])
-                        .map(|e| e.name())
-                        .collect::<Vec<_>>()
-                        .join(",")
-                )
-            )
+            ExplainConclusion::Missing {
+                effect: c.effect,
+                explained: c.explained_fraction,
+                heldback_before: found.base.heldback_error_fit_series,
+                heldback_after: c.validation_normalized_rms_error,
+                effects: found.names.iter().copied().chain([c.effect]).collect(),
+            }
         }
-        Some(r) if r.candidate.standing == Standing::Candidate => format!(
-            "unexplained: the best candidate ({}) explains only {:.0} % of the held-back error (threshold {:.0} %); the error is not one of the library's effects",
-            r.candidate.effect,
-            100.0 * r.candidate.explained_fraction,
-            100.0 * EXPLAINED_MIN
-        ),
-        Some(_) => format!(
-            "unexplained: no plausible effect of the library explains {:.0} % of the held-back error or more; the error is not one of the library's effects",
-            100.0 * EXPLAINS_MIN
-        ),
-        None => "unexplained: no candidate could be fitted with physically plausible values".into(),
+        Some(r) if r.candidate.standing == Standing::Candidate => ExplainConclusion::TooLittle {
+            effect: r.candidate.effect,
+            explained: r.candidate.explained_fraction,
+            asks: EXPLAINED_MIN,
+        },
+        Some(_) => ExplainConclusion::NoneExplains { asks: EXPLAINS_MIN },
+        None => ExplainConclusion::NothingPlausible,
     }
-}
-
-/// The verdict when the configured model is at its noise floor ([`CandidateOutcome`]),
-/// naming the numbers that decided: the whole-log and the held-back error, each against
-/// its own floor.
-fn nothing_to_explain(full: &FullSeries) -> String {
-    format!(
-        "nothing to explain: the model's error {:.4} is {:.2}x its noise floor {:.4} and the held-back error {:.4} is {:.2}x its floor {:.4} (both within {NOISE_MARGIN}x)",
-        full.error,
-        full.error / full.noise,
-        full.noise,
-        full.heldback_error,
-        full.heldback_error / full.heldback_noise,
-        full.heldback_noise,
-    )
 }

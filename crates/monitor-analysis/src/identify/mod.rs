@@ -37,7 +37,7 @@ use monitor_io::params::ParamFile;
 use serde::Serialize;
 
 pub use output::{inverse_gamma_line, to_toml, without_columns, COLUMNS_COPIED};
-pub use refuse::{refusal, MAX_FIT_ERROR};
+pub use refuse::{refusal, IdentifyRefusal, MAX_FIT_ERROR};
 pub use samples::{IdentifyError, Samples, MIN_DURATION_S};
 
 /// The identified parameters' names, keys and units, in [`IdentifiedCircuit::to_vec`]'s order.

@@ -7,6 +7,39 @@ use super::{Identification, Samples};
 /// ten times what the noise and the model's simplifications leave on a good log (0.3-1 %).
 pub const MAX_FIT_ERROR: f64 = 0.1;
 
+/// Why an identification must not be written, with the numbers that decided (spelled at
+/// the door, `monitor-words`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum IdentifyRefusal {
+    /// The log's current (RMS of the current vector, `i_a`) is outside what the parameter
+    /// file's motor can draw, `low_a..high_a` [A] (a third of its no-load current to 1.2
+    /// times its locked-rotor current): a unit, a CT ratio or a `[columns]` mapping.
+    CurrentOutOfRange {
+        /// The log's current [A].
+        i_a: f64,
+        /// The least the motor draws [A].
+        low_a: f64,
+        /// The most [A].
+        high_a: f64,
+    },
+    /// The fit leaves `error` of the current's RMS (the solver ended `termination`): the
+    /// model does not fit this log.
+    PoorFit {
+        /// The current error's RMS over the current's.
+        error: f64,
+        /// How the solver ended.
+        termination: crate::lm::Termination,
+    },
+    /// An identified value is not one of a real machine (`key`: `message`).
+    NotAMachine {
+        /// The parameter file's key.
+        key: &'static str,
+        /// What is wrong with it.
+        message: String,
+    },
+}
+
 /// Why the identification must not be written, naming the likely cause; `None` when it
 /// may be.
 ///
@@ -21,7 +54,7 @@ pub fn refusal(
     params: &monitor_io::params::ParamFile,
     samples: &Samples,
     id: &Identification,
-) -> Option<String> {
+) -> Option<IdentifyRefusal> {
     let m = params.motor.model();
     let we = params.supply.omega_rad_s() as f32;
     let v = params.supply.v_phase_peak() as f32;
@@ -32,30 +65,24 @@ pub fn refusal(
     let (lo, hi) = (0.3 * i_at(1e-4), 1.2 * i_at(1.0));
     let i = samples.i_rms_a;
     if !(i >= lo && i <= hi) {
-        let ratio = if i > hi { i / hi } else { lo / i };
-        let hint = match (i > hi, ratio) {
-            (true, r) if r > 30.0 => " (about a thousand times: currents in mA read as A? give ia_A, ib_A, ic_A unit = \"mA\" in the parameter file's [columns])",
-            (false, r) if r > 30.0 => " (about a thousand times too small: currents in A given the unit mA in [columns]?)",
-            _ => " (a unit, a current transformer's ratio, or a [columns] mapping to another channel)",
-        };
-        return Some(format!(
-            "the log's current ({i:.3} A, RMS of the current vector) is {} what the parameter file's motor can draw ({lo:.3}..{hi:.3} A from a third of its no-load current to its locked-rotor current){hint}",
-            if i > hi { "far above" } else { "far below" }
-        ));
+        return Some(IdentifyRefusal::CurrentOutOfRange {
+            i_a: i,
+            low_a: lo,
+            high_a: hi,
+        });
     }
     let stalled = matches!(id.solver.termination, crate::lm::Termination::Stalled);
     if id.relative_rms_error > MAX_FIT_ERROR || (stalled && id.relative_rms_error > 0.03) {
-        return Some(format!(
-            "the fit leaves a current error of {:.1} % of its RMS (solver {}; a good log leaves under 1 %): the model does not fit this log: check the [columns] mapping and units, give from_s to leave out what the model cannot follow, or start from a parameter file of this machine",
-            100.0 * id.relative_rms_error,
-            id.solver.termination
-        ));
+        return Some(IdentifyRefusal::PoorFit {
+            error: id.relative_rms_error,
+            termination: id.solver.termination,
+        });
     }
     if let Err(e) = id.params.check_plausible() {
-        return Some(format!(
-            "an identified value is not one of a real machine ({}: {}): a unit or a mapping is likely wrong",
-            e.key, e.message
-        ));
+        return Some(IdentifyRefusal::NotAMachine {
+            key: e.key,
+            message: e.message,
+        });
     }
     None
 }

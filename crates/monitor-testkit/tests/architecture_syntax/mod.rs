@@ -1,11 +1,13 @@
 //! The syntax the architecture test (`tests/architecture.rs`) reads: every path and `use`
 //! of a file with the module it is written in ([`Paths`]), the top module a path reaches
-//! ([`top_module`]), a file's module path ([`module_of`]), and the long functions outside
-//! tests ([`LongFunctions`]).
+//! ([`top_module`]), a file's module path ([`module_of`]), the long functions outside
+//! tests ([`LongFunctions`]), and what an engine may not spell ([`spelling`], rule 8, with
+//! its tests).
 
 pub mod circles;
 pub mod files;
 pub mod layers;
+pub mod spelling;
 
 use syn::visit::Visit;
 

@@ -23,7 +23,8 @@ pub use findings::{brief, summary};
 pub use isolation::{channel_dropped, channel_use, event_line, group_reason, moved_note, said};
 pub use rotor::{band_words, load_unknown, load_words};
 pub use verdict::{
-    against_text, fault_text, judged, line as verdict_line, not_judged, pct, withheld_because,
+    against_text, fault_text, judged, line as verdict_line, not_judged, pct, why_watched,
+    withheld_because,
 };
 pub use winding::{
     describe_against, line as winding_line, operating_point_source, phase_not_judged, reach,

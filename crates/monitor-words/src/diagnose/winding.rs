@@ -287,13 +287,7 @@ pub fn summary(u: &UnbalanceReport, sp: &dyn Spelling) -> String {
     // Clear: the reach, then why no phase is named (the change and the least change that
     // would name one), each said once.
     let said = match &u.phase_not_judged {
-        Some(w) => {
-            let widened = u
-                .least_change_widened
-                .as_ref()
-                .map_or(String::new(), |w| format!("; {}", widened(w)));
-            format!("{}{widened}", reason_body(w, sp))
-        }
+        Some(w) => format!("{}{widened}", reason_body(w, sp)),
         None => change,
     };
     match &u.shorted_turns_reach {

@@ -78,7 +78,7 @@ pub fn ladder_chart(r: &LadderReport) -> Chart<'static> {
         scatter: false,
         dashed,
     };
-    let omitted = (!r.start.error.is_finite()).then(|| r.stopped_because.clone());
+    let omitted = (!r.start.error.is_finite()).then(|| monitor_api::words::ladder::stopped(r));
     Chart {
         stem: LADDER,
         title: "The ladder: the model's error after each step, onto the noise floor",

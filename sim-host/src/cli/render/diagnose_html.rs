@@ -13,8 +13,8 @@
 
 use super::plot::{self, Chart, Series};
 use crate::cli::words::CliWords;
-use monitor_api::replay::{DiagnoseReport, Diagnosed, FindingReport, IsolationEvent, RotorBand};
 use monitor_api::replay::Verdict;
+use monitor_api::replay::{DiagnoseReport, Diagnosed, FindingReport, IsolationEvent, RotorBand};
 use monitor_api::words::diagnose::{self as words, Story};
 use monitor_core::verdict::State;
 use std::fmt::Write as _;
@@ -132,7 +132,9 @@ fn verdict(h: &mut String, rep: &DiagnoseReport) {
     // A FAULT's confidence; a watched name's, with why it is watched, not a FAULT.
     let by = rep.verdict_finding.as_ref();
     let confidence = match (rep.verdict, by.and_then(|f| f.named().map(|n| (f, n)))) {
-        (Verdict::Watching, Some((f, n))) => format!("{}; ", words::why_watched(n, f.finding.against)),
+        (Verdict::Watching, Some((f, n))) => {
+            format!("{}; ", words::why_watched(n, f.finding.against))
+        }
         (_, Some((_, n))) => format!("confidence {:.2}; ", n.confidence),
         (_, None) => String::new(),
     };

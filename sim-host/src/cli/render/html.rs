@@ -10,7 +10,11 @@ use monitor_api::analysis::Prediction;
 use monitor_api::analysis::{CompareOutput, CompareReport};
 use monitor_api::analysis::{FinalFit, LadderReport, LadderStep};
 use monitor_api::files::DataQuality;
+use monitor_api::words;
 use monitor_api::ExplainDocument;
+
+/// The command line's words for the options advice names (`--from`, `--effects`).
+const CLI: &crate::cli::words::CliWords = &crate::cli::words::CliWords;
 use monitor_core::EffectKind;
 use plot::Chart;
 use std::fmt::Write as _;
@@ -132,7 +136,11 @@ fn ladder_html(log: &str, r: &LadderReport, charts: &[(String, String)]) -> Stri
     } else {
         effect_list(&r.start.effects)
     };
-    let _ = write!(h, "<p class=v>{}</p>", esc(&r.summary));
+    let _ = write!(
+        h,
+        "<p class=v>{}</p>",
+        esc(&monitor_api::words::ladder::summary(r))
+    );
     for (title, svg) in charts {
         let _ = write!(h, "<h3>{}</h3>{svg}", esc(title));
     }
@@ -145,24 +153,33 @@ fn ladder_html(log: &str, r: &LadderReport, charts: &[(String, String)]) -> Stri
         ladder_end_row(&mut h, f);
     }
     h.push_str("</table>");
-    let _ = write!(h, "<p>Stopped: {}</p>", esc(&r.stopped_because));
-    let _ = write!(h, "<p>The test: {}.</p>", esc(&r.test));
+    let _ = write!(
+        h,
+        "<p>Stopped: {}</p>",
+        esc(&monitor_api::words::ladder::stopped(r))
+    );
+    let _ = write!(
+        h,
+        "<p>The test: {}.</p>",
+        esc(&monitor_api::words::ladder::test(&r.test_rule))
+    );
     if !r.last_round.is_empty() {
         h.push_str("<h2>The last round's other candidates</h2><ul>");
         for t in &r.last_round {
             let _ = write!(
                 h,
                 "<li>{}: {}</li>",
-                esc(&monitor_api::analysis::tried_name(t)),
-                esc(&t.because)
+                esc(&monitor_api::words::ladder::tried_name(t)),
+                esc(&monitor_api::words::ladder::refusal(&t.refusal))
             );
         }
         h.push_str("</ul>");
     }
-    if !r.skipped.is_empty() {
+    if !r.skipped_reasons.is_empty() {
         h.push_str("<h2>Not fitted on this log</h2><ul>");
-        for s in &r.skipped {
-            let _ = write!(h, "<li>{}</li>", esc(s));
+        for s in &r.skipped_reasons {
+            let s = words::analysis::skipped(s, CLI);
+            let _ = write!(h, "<li>{}</li>", esc(&s));
         }
         h.push_str("</ul>");
     }
@@ -177,7 +194,7 @@ fn ladder_row(h: &mut String, k: usize, s: &LadderStep) {
         .base
         .iter()
         .filter(|c| c.changed)
-        .map(|c| c.spelled())
+        .map(monitor_api::words::ladder::base_change)
         .collect();
     let mut fitted: Vec<String> = s
         .fitted
@@ -230,20 +247,20 @@ fn compare_html(log: &str, out: &CompareOutput, charts: &[(String, String)]) -> 
     };
     let _ = write!(h, "<p class=v>Effects in the model: <b>{}</b>. Normalized RMS error <b>{:.4}</b> (noise floor {:.4}: a perfect model would score about this).</p>", esc(&eff), r.normalized_rms_error, r.noise_floor);
     for s in &r.skipped {
-        let _ = write!(h, "<p><i>{}</i></p>", esc(s));
+        let _ = write!(h, "<p><i>{}</i></p>", esc(&words::compare::skipped(*s)));
     }
     channels_table(&mut h, r);
     worst_windows_table(&mut h, r);
     if !r.advice.is_empty() {
         h.push_str("<h2>Advice</h2><ul>");
         for a in &r.advice {
-            let _ = write!(h, "<li>{}</li>", esc(a));
+            let _ = write!(h, "<li>{}</li>", esc(&words::compare::advice(a, CLI)));
         }
         h.push_str("</ul>");
     }
     base_parameters_table(&mut h, r);
-    for w in &r.implausible_because {
-        let _ = write!(h, "<p>not plausible: {}</p>", esc(w));
+    for w in words::compare::implausible(r, CLI) {
+        let _ = write!(h, "<p>not plausible: {}</p>", esc(&w));
     }
     if let Some(j) = &r.identifiability {
         let _ = write!(
@@ -253,12 +270,16 @@ fn compare_html(log: &str, out: &CompareOutput, charts: &[(String, String)]) -> 
         );
     }
     for w in &r.not_identified {
-        let _ = write!(h, "<p>{}</p>", esc(w));
+        let _ = write!(h, "<p>{}</p>", esc(&words::compare::not_identified(w)));
     }
     for e in &r.fitted_effects {
         let _ = write!(h, "<p><b>{}</b>: {}</p>", e.effect, esc(&e.summary));
     }
-    let _ = write!(h, "<h2>Unbalance</h2><p>{}</p>", esc(&r.unbalance.summary));
+    let _ = write!(
+        h,
+        "<h2>Unbalance</h2><p>{}</p>",
+        esc(&words::analysis::unbalance(&r.unbalance, CLI))
+    );
     for (title, svg) in charts {
         let _ = write!(h, "<h3>{}</h3>{svg}", esc(title));
     }
@@ -318,13 +339,17 @@ fn explain_html(log: &str, doc: &ExplainDocument, charts: &[(String, String)]) -
     let _ = write!(h, "<h1>Which physical effect is missing?</h1><p>Log <code>{}</code>. Effects already in the model: {}.</p>", esc(log), if r.effects.is_empty() { "none".into() } else { effect_list(&r.effects) });
     // The one verdict first, then explain's own answer and how the two relate.
     let _ = write!(h, "<p><b>{}</b></p>", esc(&doc.headline));
-    let _ = write!(h, "<p class=v>The model's error: {}</p>", esc(&r.verdict));
+    let _ = write!(
+        h,
+        "<p class=v>The model's error: {}</p>",
+        esc(&words::explain::verdict(r, CLI))
+    );
     if let Some(b) = &doc.beside_verdict {
         let _ = write!(h, "<p>{}</p>", esc(b));
     }
-    if let Some(words) = r.base_refit.as_ref().map(|b| b.in_words()) {
-        if !words.is_empty() {
-            let _ = write!(h, "<p>{}</p>", esc(&words));
+    if let Some(said) = r.base_refit.as_ref().map(words::explain::base_refit) {
+        if !said.is_empty() {
+            let _ = write!(h, "<p>{}</p>", esc(&said));
         }
     }
     data_quality(&mut h, &r.data_quality);
@@ -343,9 +368,17 @@ fn explain_html(log: &str, doc: &ExplainDocument, charts: &[(String, String)]) -
         let _ = write!(h, "<h2>Before / after</h2><table><tr><th class=l>model</th><th>held-back windows</th><th>whole log</th></tr><tr><td class=l>as configured</td><td>{:.4}</td><td>{:.4}</td></tr><tr><td class=l>+ {}</td><td>{:.4}</td><td>{:.4}</td></tr></table>", r.baseline_validation_normalized_rms_error, r.baseline_normalized_rms_error, c.effect, c.validation_normalized_rms_error, c.normalized_rms_error);
     }
     for s in &r.skipped {
-        let _ = write!(h, "<p><i>skipped: {}</i></p>", esc(s));
+        let _ = write!(
+            h,
+            "<p><i>skipped: {}</i></p>",
+            esc(&words::analysis::skipped(s, CLI))
+        );
     }
-    let _ = write!(h, "<h2>Unbalance</h2><p>{}</p>", esc(&r.unbalance.summary));
+    let _ = write!(
+        h,
+        "<h2>Unbalance</h2><p>{}</p>",
+        esc(&words::analysis::unbalance(&r.unbalance, CLI))
+    );
     let _ = write!(
         h,
         "<h2>Rotor asymmetry (motor current signature analysis)</h2><pre>{}</pre>",

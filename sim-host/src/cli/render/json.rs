@@ -1,7 +1,5 @@
 //! The JSON renderer: every command's `--json` document, printed the one way.
 
-use monitor_api::analysis::CompareReport;
-use monitor_api::analysis::ExplainReport;
 use monitor_api::replay::{FaultCandidate, TimelinePoint};
 use monitor_api::sim::SimSummary;
 use monitor_studies::bench::{BenchFigures, DetectionLimitCase};
@@ -138,13 +136,14 @@ pub struct Converted {
     pub wall_s: f64,
 }
 
-/// `explain --compare --json`: both documents.
+/// `explain --compare --json`: both documents (each with its sentences spelled at the
+/// door, `monitor_api::words`).
 #[derive(Serialize)]
-pub struct ExplainWithCompare<'a, E: Serialize = ExplainReport> {
+pub struct ExplainWithCompare<'a> {
     /// `compare`'s document.
-    pub compare: &'a CompareReport,
+    pub compare: &'a serde_json::Value,
     /// `explain`'s document.
-    pub explain: &'a E,
+    pub explain: &'a serde_json::Value,
 }
 
 /// `bench --json`.

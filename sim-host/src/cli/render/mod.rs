@@ -22,7 +22,7 @@ pub fn end_base(f: &monitor_api::analysis::FinalFit) -> String {
         .base
         .iter()
         .filter(|c| c.changed)
-        .map(|c| c.spelled())
+        .map(monitor_api::words::ladder::base_change)
         .collect();
     if changed.is_empty() {
         "base parameters as the file's".to_string()

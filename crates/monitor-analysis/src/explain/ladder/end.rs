@@ -1,5 +1,5 @@
 //! The ladder's end: the chosen model (its effects and its base parameters) refitted on the
-//! whole log, and the summary that opens with what was found.
+//! whole log.
 //!
 //! The steps are chosen on held-back windows and fitted on a thinned copy of the training
 //! windows: an honest choice, but short of what the chosen model reaches on the whole log
@@ -9,16 +9,16 @@
 //! as `compare`'s), from the last step's values, with the six base parameters free
 //! ([`crate::fit::machine`]): the base changes are read there, with their intervals.
 
-use super::base::{base_changes, base_in_words, BaseChange};
-use super::round::{LadderSeries, Rung};
-use super::LadderReport;
-use crate::effects::{self, EffectModel};
+use super::base::{base_changes, prior_weight, BaseChange};
+use super::climb::Ladder;
+use super::rung::{nested_from, setup_list};
+use crate::analysis::{align, Analysis, AnalysisError, FittedEffect, MAX_ITER};
+use crate::effects::EffectModel;
 use crate::fit::machine::{self, MachineFit};
 use crate::fit::{ActiveEffect, BaseSpec, FitResult};
 use crate::metrics::{self, Weights};
 use crate::prep::Prepared;
 use crate::simplified_model::BaseParams;
-use crate::{align, Analysis, AnalysisError, FittedEffect, MAX_ITER};
 use monitor_core::EffectKind;
 use serde::Serialize;
 
@@ -43,45 +43,24 @@ pub struct FinalFit {
     pub fit_samples: usize,
 }
 
-impl Analysis {
-    /// The end of the ladder that stopped at `rung`: the final refit on the whole log
-    /// ([`FinalFit`]), the base changes, and the summary (what was found, then why it
-    /// stopped). `self` is the analysis of the user's file; `progress` gets the fraction.
-    pub(super) fn finish(
-        &self,
-        rung: &Rung<'_>,
-        sr: &LadderSeries,
-        report: &mut LadderReport,
-        progress: &(dyn Fn(f64) + Sync),
-    ) -> Result<(), AnalysisError> {
-        progress(0.0);
-        let fin = self.final_fit(rung, sr, report.start.error)?;
-        progress(1.0);
-        report.summary = summary(report, fin.as_ref());
-        if let Some(f) = &fin {
-            report.base_changes = f.base.iter().filter(|c| c.changed).cloned().collect();
-        }
-        report.final_fit = fin;
-        Ok(())
-    }
-
-    /// The model of `rung` refitted on the whole working series (coarsened as `compare`'s
-    /// fit), from its values; `None` when a set-up refuses the series.
-    fn final_fit(
-        &self,
-        rung: &Rung<'_>,
-        sr: &LadderSeries,
-        start_error: f64,
-    ) -> Result<Option<FinalFit>, AnalysisError> {
-        let (fdata, _) = self.fit_data();
-        let an = self.rebased(rung.scales.apply(&sr.file));
-        let Some(set) = an.nested_from(&rung.models, &rung.fit.effect_params, &[], &fdata) else {
+impl Ladder<'_> {
+    /// The model of the rung the ladder stopped on refitted on the whole working series
+    /// (coarsened as `compare`'s fit), from its values (`start_error`: the start's
+    /// whole-log error); `None` when a set-up refuses the series.
+    ///
+    /// # Errors
+    /// A model that cannot be set up on the log.
+    pub(super) fn final_fit(&self, start_error: f64) -> Result<Option<FinalFit>, AnalysisError> {
+        let (file, rung, sr) = (self.file, &self.rung, &self.series);
+        let (fdata, _) = file.fit_data();
+        let an = file.rebased(rung.scales.apply(&sr.file));
+        let Some(set) = nested_from(&an, &rung.models, &rung.fit.effect_params, &[], &fdata) else {
             return Ok(None);
         };
-        let (mf, half) = an.machine_on(&fdata, rung, sr, &set)?;
-        let fin = self.rebased(mf.params(&sr.file));
+        let (mf, half) = self.machine_on(&an, &fdata, &set)?;
+        let fin = file.rebased(mf.params(&sr.file));
         let models: Vec<&dyn EffectModel> = rung.models.clone();
-        let active = fin.setup_list(&self.data, &models)?;
+        let active = setup_list(&fin, &file.data, &models)?;
         let fit = align(
             &active,
             FitResult {
@@ -90,10 +69,10 @@ impl Analysis {
                 report: mf.report,
             },
         );
-        let (pred, renoised) = fin.predict_and_renoised(&self.data, &active, &fit)?;
-        let all = Weights::new(&self.data, 0, usize::MAX);
-        let noise = metrics::noise_floor(&self.data, &all, Some((&pred, &renoised)));
-        let error = metrics::errors(&self.data, &pred, None).normalized_rms_error;
+        let (pred, renoised) = fin.predict_and_renoised(&file.data, &active, &fit)?;
+        let all = Weights::new(&file.data, 0, usize::MAX);
+        let noise = metrics::noise_floor(&file.data, &all, Some((&pred, &renoised)));
+        let error = metrics::errors(&file.data, &pred, None).normalized_rms_error;
         let fitted = fin.fitted_effects(&active, &fit)?;
         Ok(Some(FinalFit {
             effects: rung.kinds.clone(),
@@ -106,20 +85,19 @@ impl Analysis {
             fit_samples: fdata.len(),
         }))
     }
-}
 
-impl Analysis {
-    /// The model of `rung` (its effects set up as `set`) fitted on `fdata` from the last
-    /// step's values: with the six base parameters free beside its effects
-    /// ([`machine::fit_machine`], their 95 % half-widths), or, where the log cannot refit the
-    /// base parameters, its effects alone on the rung's base (no half-widths).
+    /// The model of the rung the ladder stopped on (its effects set up as `set`; `an` the
+    /// analysis of its base) fitted on `fdata` from the last step's values: with the six
+    /// base parameters free beside its effects ([`machine::fit_machine`], their 95 %
+    /// half-widths), or, where the log cannot refit the base parameters, its effects alone
+    /// on the rung's base (no half-widths).
     fn machine_on(
         &self,
+        an: &Analysis,
         fdata: &Prepared,
-        rung: &Rung<'_>,
-        sr: &LadderSeries,
         set: &[ActiveEffect<'_>],
     ) -> Result<(MachineFit, [Option<f64>; 6]), AnalysisError> {
+        let (rung, sr) = (&self.rung, &self.series);
         let w = Weights::new(fdata, 0, usize::MAX);
         if sr.fit_base {
             let mf = machine::fit_machine(
@@ -128,13 +106,13 @@ impl Analysis {
                 set,
                 &w,
                 &rung.scales.with_paper(&rung.fit.base),
-                super::base::prior_weight(rung.noise),
+                prior_weight(rung.noise),
                 MAX_ITER,
             )?;
             let half = machine::machine_half_widths(fdata, &sr.file, set, &w, &mf)?;
             return Ok((mf, half));
         }
-        let f = self.fit_spec(
+        let f = an.fit_spec(
             fdata,
             set,
             &w,
@@ -148,66 +126,4 @@ impl Analysis {
         };
         Ok((mf, [None; 6]))
     }
-}
-
-/// The ladder's summary: what was found (the base changes and the effects the steps added,
-/// with their sizes), where the chosen model ends on the whole log, then why it stopped.
-fn summary(r: &LadderReport, fin: Option<&FinalFit>) -> String {
-    let mut found: Vec<String> = Vec::new();
-    if let Some(f) = fin {
-        if f.base.iter().any(|c| c.changed) {
-            found.push(format!("base parameters: {}", base_in_words(&f.base)));
-        }
-        let dynamics: Vec<&str> = f
-            .fitted
-            .iter()
-            .filter(|e| e.effect.name().ends_with("_dynamics"))
-            .map(|e| e.effect.name())
-            .filter(|k| !r.start.effects.iter().any(|s| s.name() == *k))
-            .collect();
-        if !dynamics.is_empty() {
-            found.push(format!(
-                "the machine's own dynamics ({})",
-                dynamics.join(", ")
-            ));
-        }
-        for e in f.fitted.iter().filter(|e| {
-            !e.effect.name().ends_with("_dynamics") && !r.start.effects.contains(&e.effect)
-        }) {
-            found.push(format!("{}: {}", e.effect, e.summary));
-        }
-    } else {
-        for s in &r.ladder {
-            if let Some(e) = s.effect {
-                found.push(e.name().to_string());
-            }
-        }
-    }
-    let dropped: Vec<String> = r
-        .ladder
-        .iter()
-        .flat_map(|s| s.dropped.iter().map(|k| k.name().to_string()))
-        .collect();
-    let mut out = if found.is_empty() {
-        "found: nothing the model lacks on this log".to_string()
-    } else {
-        format!("found: {}", found.join("; "))
-    };
-    if !dropped.is_empty() {
-        out.push_str(&format!(
-            " (removed on the way: {}, explained better by a later step)",
-            dropped.join(", ")
-        ));
-    }
-    if let Some(f) = fin {
-        out.push_str(&format!(
-            ". The chosen model refitted on the whole log: error {} = {:.2}x its noise floor {}, {:.1}x below the start",
-            effects::sig(f.error),
-            f.ratio_to_floor,
-            effects::sig(f.noise_floor),
-            f.below_start
-        ));
-    }
-    out.push_str(&format!(". Stopped: {}", r.stopped_because));
-    out
 }

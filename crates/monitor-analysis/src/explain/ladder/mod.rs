@@ -1,7 +1,13 @@
 //! `explain --ladder`: forward selection over the effect library, from the configured model
 //! to the noise floor.
 //!
-//! Each step fits every effect of the library not yet in the model (the dynamics effects
+//! The ladder is a type of its own ([`climb`]'s `Ladder`): it holds the user's analysis,
+//! the effect library, the fit series with its held-back split, and where it stands (the
+//! rung, the analysis of that rung's base parameters, the steps so far). It climbs round by
+//! round; one function states a round's rung order (`Ladder::round`, [`round`]): the base
+//! rung (the six base parameters refitted) first, then the single effects, then pairs.
+//!
+//! Each round fits every effect of the library not yet in the model (the dynamics effects
 //! are candidates like the others; one that needs another first, such as
 //! `cross_coupling_dynamics` after `d_axis_dynamics`, is tried together with it), each
 //! starting from the previous step's fit (nested fits: the step's solver starts where the
@@ -9,7 +15,10 @@
 //! with the lowest held-back error (each parameter costing [`PARAM_PENALTY`] of it) is kept
 //! when the step passes its test ([`STEP_MIN`]) and lowers the whole-log error; the ladder
 //! stops when the error is within the noise-floor band ([`FLOOR_BAND`], on the whole log and
-//! on the held-back part) or when no plausible candidate passes, and says which.
+//! on the held-back part) or when no plausible candidate passes, and says which
+//! ([`StopReason`]). A candidate not kept carries why ([`Refusal`]), with the numbers that
+//! decided; the ladder decides by matching on these values, and the sentences a crew reads
+//! are spelled from them by `monitor-words`.
 //!
 //! # The held-back split
 //! The log is cut into strata by its events ([`strata`]: the start, supply or speed
@@ -33,30 +42,27 @@
 //! three sizes, starts and steps: under 10 %), doubled (docs/model-vs-measurement.md).
 
 mod base;
-mod choice;
+mod climb;
 mod end;
-mod passes;
+mod refusal;
 mod round;
-mod rounds;
+mod rung;
 mod split;
 mod stepwise;
 #[cfg(test)]
 mod tests;
 
-pub use base::{base_changes, base_in_words, BaseChange, BASE_CHANGE_MIN};
+pub use base::{base_changes, BaseChange, BASE_CHANGE_MIN};
 pub use end::FinalFit;
+pub use refusal::{Refusal, StopReason, WhatIsLeft, WhyNotPhysical};
 pub use split::stratified_heldback;
 
-use super::{NOISE_MARGIN, PARAM_PENALTY};
-use crate::effects::{self, EffectModel};
-use crate::fit::machine::MachineScales;
-use crate::simplified_model::BaseParams;
-use crate::DataInfo;
-use crate::{resolve, transients, Analysis, AnalysisError, Options};
+use super::{Skipped, NOISE_MARGIN, PARAM_PENALTY};
+use crate::analysis::{resolve, Analysis, AnalysisError, DataInfo, Options};
+use crate::effects;
+use climb::Ladder;
 use monitor_core::EffectKind;
-use round::{LadderSeries, Rung};
 use serde::Serialize;
-use split::{mask_on, weights_for};
 use std::collections::BTreeMap;
 
 /// A step must remove at least this share (10 %) of the held-back error beyond the noise
@@ -78,7 +84,7 @@ pub const EVENT_WINDOW_MAX_S: f64 = 0.08;
 /// ([`crate::MAX_FIT_SAMPLES`]): a round fits every candidate, a ladder has several rounds,
 /// and a few parameters are fitted as well from 20 000 samples (a 10 s log at 2 kHz still
 /// resolves the stator transient time constant, 3 samples or more of it: the dynamics
-/// effects are refused on a series that does not, [`transients::not_proposed`]).
+/// effects are refused on a series that does not, [`crate::transients::not_proposed`]).
 pub const LADDER_FIT_SAMPLES: usize = 20_000;
 /// Largest fit copy of a long log whose dynamics need more samples than
 /// [`LADDER_FIT_SAMPLES`] ([`fit_thinning`]): three times as many (a 60 s log at 2 kHz at
@@ -126,21 +132,29 @@ pub struct LadderStep {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub effect: Option<EffectKind>,
     /// Every effect the step added: `effect`, and before it one it needs first
-    /// ([`EffectModel::requires`]) when the model lacked it (empty on a base rung).
+    /// ([`crate::effects::EffectModel::requires`]) when the model lacked it (empty on a
+    /// base rung).
     pub added: Vec<EffectKind>,
     /// The base rung's six base parameters against the user's file, each with its change,
-    /// its 95 % interval and whether the rung names it (absent on an effect's step).
+    /// its 95 % interval and whether the rung names it; on an effect's step, the base
+    /// parameters refitted beside it where it names a change (else empty).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub base: Vec<BaseChange>,
     /// Effects of earlier steps the step removed: the step's effect explains what they stood
     /// in for (stepwise selection both ways, [`stepwise`]).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub dropped: Vec<EffectKind>,
+    /// Why each of `dropped` was removed, with the numbers that decided.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub dropped_because: Vec<Dropped>,
     /// The added effects' fitted values with their physical ranges, by parameter name
     /// (prefixed `effect.` when the step added two).
     pub fitted: BTreeMap<String, RangedValue>,
-    /// The effects' values in words.
-    pub summary: String,
+    /// Each added effect's values as the effect describes them
+    /// ([`crate::effects::FitSetup::describe`]); the step's sentence (JSON `summary`) is
+    /// spelled from them and the base changes at the door.
+    #[serde(skip)]
+    pub described: Vec<String>,
     /// `normalized_rms_error` over the whole log after the step.
     pub error: f64,
     /// `normalized_rms_error` on the held-back windows after the step.
@@ -162,6 +176,19 @@ pub struct LadderStep {
     pub heldback_explained: f64,
 }
 
+/// An effect a step removed (JSON `ladder[].dropped_because[]`): the model without it
+/// loses `loses` of its held-back error beyond the noise floor, less than the `asks` a step
+/// must earn ([`STEP_MIN`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Dropped {
+    /// The effect removed.
+    pub effect: EffectKind,
+    /// The share of the held-back error beyond the floor the model loses without it.
+    pub loses: f64,
+    /// The share a step must earn.
+    pub asks: f64,
+}
+
 /// Where the model stood before the first step (JSON `start`).
 #[derive(Debug, Clone, Serialize)]
 pub struct LadderStart {
@@ -180,7 +207,7 @@ pub struct LadderStart {
 }
 
 /// A candidate of the last round that was not kept, and why (JSON `last_round`).
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Tried {
     /// True for the base rung (the base parameters refitted; `added` is then empty).
     #[serde(skip_serializing_if = "std::ops::Not::not")]
@@ -192,7 +219,7 @@ pub struct Tried {
     /// Its test statistic ([`LadderStep::significance`]).
     pub significance: f64,
     /// Why it was not kept.
-    pub because: String,
+    pub refusal: Refusal,
 }
 
 /// Why the ladder stopped (JSON `stop`).
@@ -211,12 +238,23 @@ pub enum Stop {
     Untrusted,
 }
 
-/// The ladder's report (JSON of `explain --ladder`).
+/// The rule each step passed and the ladder stops by (JSON `test_rule`, beside the sentence
+/// `test`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TestRule {
+    /// The share of the held-back error beyond the floor a step must remove ([`STEP_MIN`]).
+    pub step_min: f64,
+    /// The held-back error each parameter costs ([`PARAM_PENALTY`]).
+    pub param_penalty: f64,
+    /// The noise-floor band the ladder stops within ([`FLOOR_BAND`]).
+    pub floor_band: f64,
+}
+
+/// The ladder's report (JSON of `explain --ladder`, with the sentences spelled beside the
+/// typed values at the door: `summary`, `stopped_because`, `skipped`, `test`,
+/// `ladder[].summary`, `last_round[].because`).
 #[derive(Debug, Clone, Serialize)]
 pub struct LadderReport {
-    /// What was found, then why it stopped: the base changes and the effects with their
-    /// sizes, the end against the noise floor, the stop.
-    pub summary: String,
     /// The base parameters that differ from the user's file, from the chosen model refitted
     /// on the whole log ([`FinalFit::base`]; only the named changes).
     pub base_changes: Vec<BaseChange>,
@@ -229,18 +267,18 @@ pub struct LadderReport {
     pub ladder: Vec<LadderStep>,
     /// Why it stopped ([`Stop`]).
     pub stop: Stop,
-    /// The same in words, naming the numbers that decided.
-    pub stopped_because: String,
+    /// The same with the numbers that decided.
+    pub stopped_reason: StopReason,
     /// The effects in the model at the end.
     pub final_effects: Vec<EffectKind>,
     /// The last round's candidates that were not kept, best first.
     pub last_round: Vec<Tried>,
-    /// Effects never fitted on this log, each as `name: why`.
-    pub skipped: Vec<String>,
+    /// Effects never fitted on this log, with why.
+    pub skipped_reasons: Vec<Skipped>,
     /// The held-back split: the strata of the log and how much of it is held back.
     pub split: SplitInfo,
-    /// The rule each step passed (in words, for the report).
-    pub test: String,
+    /// The rule each step passed.
+    pub test_rule: TestRule,
     /// Facts about the data.
     pub data: DataInfo,
     /// What the data-quality stage found and what the analysis did about it.
@@ -271,8 +309,8 @@ pub struct Stratum {
 
 impl Analysis {
     /// `explain --ladder`: forward selection over the effect library from the configured
-    /// model (module doc). `progress` gets the step (1-based) and the fraction of its
-    /// candidates fitted.
+    /// model (module doc; the climb is [`climb`]'s `Ladder`). `progress` gets the step
+    /// (1-based) and the fraction of its candidates fitted.
     ///
     /// # Errors
     /// A configured effect whose needs the log does not meet.
@@ -283,31 +321,17 @@ impl Analysis {
     ) -> Result<LadderReport, AnalysisError> {
         let (held, strata) = stratified_heldback(&self.data, &self.constants);
         let mut report = self.report_before(opts, &held, strata);
-        if let Some((stop, why)) = self.refused() {
-            report.stop = stop;
-            report.stopped_because = why.clone();
-            report.summary = why;
+        if let Some(reason) = self.ladder_refused() {
+            report.stop = reason.stop();
+            report.stopped_reason = reason;
             return Ok(report);
         }
-        let sr = self.ladder_series(held, opts.fit_base);
+        let library = effects::ladder_library();
         let configured = resolve(&opts.effects);
-        let active = self.setup_all(&sr.fd, &configured)?;
-        let nominal = BaseParams::nominal(&self.constants);
-        let f0 = self.fit_set(&sr.fd, &active, &sr.wf, &nominal, opts.fit_base)?;
-        let models: Vec<&dyn EffectModel> = configured.iter().map(|e| e.as_ref()).collect();
-        let rung = self.measure_rung(models, f0, &sr, MachineScales::of_file(&self.params))?;
-        let lib = effects::ladder_library();
-        report.start = LadderStart {
-            effects: opts.effects.clone(),
-            error: rung.error,
-            heldback_error: rung.heldback_error,
-            noise_floor: rung.noise,
-            heldback_noise_floor: rung.heldback_noise,
-            ratio_to_floor: rung.error / rung.noise,
-        };
-        let rung = self.walk(&lib, rung, &sr, opts, progress, &mut report)?;
-        let step_no = report.ladder.len() + 1;
-        self.finish(&rung, &sr, &mut report, &|f| progress(step_no, f))?;
+        let mut ladder = Ladder::start(self, &library, &configured, opts, held, progress)?;
+        report.start = ladder.start_figures();
+        let reason = ladder.climb()?;
+        ladder.report(reason, &mut report)?;
         Ok(report)
     }
 
@@ -315,7 +339,6 @@ impl Analysis {
     /// the data, no steps.
     fn report_before(&self, opts: &Options, held: &[bool], strata: Vec<Stratum>) -> LadderReport {
         LadderReport {
-            summary: String::new(),
             base_changes: Vec::new(),
             final_fit: None,
             start: LadderStart {
@@ -328,20 +351,20 @@ impl Analysis {
             },
             ladder: Vec::new(),
             stop: Stop::NoModel,
-            stopped_because: String::new(),
+            stopped_reason: StopReason::NoVoltages,
             final_effects: opts.effects.clone(),
             last_round: Vec::new(),
-            skipped: Vec::new(),
+            skipped_reasons: Vec::new(),
             split: SplitInfo {
                 heldback_share: held.iter().filter(|h| **h).count() as f64
                     / self.data.len().max(1) as f64,
                 strata,
             },
-            test: format!(
-                "a step is kept when it removes at least {:.0} % of the held-back error beyond the noise floor (each parameter costing {:.0} % of the held-back error) and lowers the whole-log error; the ladder stops within {FLOOR_BAND}x the noise floor on the whole log and the held-back part",
-                100.0 * STEP_MIN,
-                100.0 * PARAM_PENALTY
-            ),
+            test_rule: TestRule {
+                step_min: STEP_MIN,
+                param_penalty: PARAM_PENALTY,
+                floor_band: FLOOR_BAND,
+            },
             data: self.info(),
             data_quality: self.quality.clone(),
         }
@@ -349,125 +372,21 @@ impl Analysis {
 
     /// Why the ladder cannot start on this log, if it cannot: no voltages (the model cannot
     /// run), or a log the data-quality stage does not trust.
-    fn refused(&self) -> Option<(Stop, String)> {
+    fn ladder_refused(&self) -> Option<StopReason> {
         if !self.data.channels.voltages {
-            return Some((Stop::NoModel, "the log has no voltages: the model cannot run, so no effect can be added (the unbalance analysis needs only the currents: explain without the ladder gives it)".to_string()));
+            return Some(StopReason::NoVoltages);
         }
-        (!self.quality.trusted).then(|| {
-            (
-                Stop::Untrusted,
-                format!(
-                    "could not judge: the data-quality stage does not trust the log ({})",
-                    self.quality.not_trusted_because.join("; ")
-                ),
-            )
-        })
+        (!self.quality.trusted).then_some(StopReason::Untrusted)
     }
-
-    /// The series the ladder's fits run on: a copy of at most [`LADDER_FIT_SAMPLES`] samples
-    /// (a round fits every candidate, and a ladder has several rounds), thinned no further
-    /// than the machine's fastest dynamics allow ([`fit_thinning`]), with the held-back mask
-    /// `held` of the working series carried over.
-    fn ladder_series(&self, held: Vec<bool>, fit_base: bool) -> LadderSeries {
-        let m = fit_thinning(
-            self.data.len(),
-            self.data.dt_s,
-            fastest_dynamics_s(&self.constants),
-        );
-        let fd = crate::coarsen(&self.data, m);
-        let held_fd = if m == 1 {
-            held.clone()
-        } else {
-            mask_on(&fd, &self.data, &held)
-        };
-        LadderSeries {
-            wf: weights_for(&fd, &held_fd, LADDER_FIT_SAMPLES),
-            span: transients::Span::of(&fd, &self.constants),
-            file: self.params,
-            fit_base,
-            fd,
-            m,
-            held,
-            held_fd,
-        }
-    }
-
-    /// The steps from `rung` until the floor band or nothing helps, into `report`: each
-    /// round fits the candidates of `lib` and the base rung (then pairs, when no single one
-    /// passes), keeps at most one, and drops the earlier effects it explains better. The
-    /// rung the ladder ended on.
-    fn walk<'a>(
-        &self,
-        lib: &'a [Box<dyn EffectModel>],
-        mut rung: Rung<'a>,
-        sr: &LadderSeries,
-        opts: &Options,
-        progress: &(dyn Fn(usize, f64) + Sync),
-        report: &mut LadderReport,
-    ) -> Result<Rung<'a>, AnalysisError> {
-        let mut step_no = 0;
-        // The analysis of the rung's model: the file recentred on its base parameters
-        // (`None`: the file itself).
-        let mut recentred: Option<Analysis> = None;
-        let (stop, why) = loop {
-            let cur: &Analysis = recentred.as_ref().unwrap_or(self);
-            if let Some(why) = at_floor(&rung) {
-                break (Stop::NoiseFloor, why);
-            }
-            step_no += 1;
-            let base_after_base = report.ladder.last().is_some_and(|s| !s.base.is_empty());
-            let round = cur.round(lib, &rung, sr, !base_after_base, &|f| progress(step_no, f))?;
-            report.skipped = round.skipped;
-            report.last_round = round.tried;
-            if round.exhausted {
-                let why = "no effect of the library is left to add on this log";
-                break (Stop::LibraryExhausted, why.to_string());
-            }
-            let Some((next, step)) = round.kept else {
-                break (
-                    Stop::NothingHelps,
-                    nothing_helps(
-                        &rung,
-                        &report.last_round,
-                        round.base_tried || base_after_base,
-                        &report.skipped,
-                    ),
-                );
-            };
-            // The step's model is relative to its own base parameters.
-            let moved = next.scales != rung.scales;
-            let next_an = moved.then(|| self.rebased(next.scales.apply(&sr.file)));
-            let an = next_an.as_ref().unwrap_or(cur);
-            let (next, step) = an.drop_stand_ins(next, step, &rung, sr, &opts.effects)?;
-            report.ladder.push(step);
-            rung = next;
-            if moved {
-                recentred = next_an;
-            }
-        };
-        report.stop = stop;
-        report.stopped_because = why;
-        report.final_effects = rung.kinds.clone();
-        Ok(rung)
-    }
-}
-
-/// The fastest time constant of the library's dynamics effects on machine `n` [s] (the
-/// stator's transient sigma Ls / Ra: a few ms).
-fn fastest_dynamics_s(n: &crate::simplified_model::MachineConstants) -> f64 {
-    effects::library()
-        .iter()
-        .filter_map(|e| e.time_constant_s(n))
-        .filter(|t| t.is_finite() && *t > 0.0)
-        .fold(f64::INFINITY, f64::min)
 }
 
 /// The thinning factor of the fit copy of a working series of `len` samples at `dt_s`: the
 /// factor that brings it to [`LADDER_FIT_SAMPLES`], but never so coarse that the fastest
 /// dynamics time constant `tau_s` has fewer than 3 samples (the rule of
-/// [`transients::not_proposed`]) while the copy stays within [`LADDER_MAX_FIT_SAMPLES`]: a
-/// 24 s log at 2 kHz is fitted at 1 kHz (24 000 samples) where a factor of 3 (667 Hz) left
-/// a 3.6 ms stator transient unresolved and every dynamics effect refused.
+/// [`crate::transients::not_proposed`]) while the copy stays within
+/// [`LADDER_MAX_FIT_SAMPLES`]: a 24 s log at 2 kHz is fitted at 1 kHz (24 000 samples)
+/// where a factor of 3 (667 Hz) left a 3.6 ms stator transient unresolved and every
+/// dynamics effect refused.
 pub fn fit_thinning(len: usize, dt_s: f64, tau_s: f64) -> usize {
     let budget = len.div_ceil(LADDER_FIT_SAMPLES).max(1);
     let resolving = if tau_s.is_finite() && dt_s > 0.0 {
@@ -480,72 +399,4 @@ pub fn fit_thinning(len: usize, dt_s: f64, tau_s: f64) -> usize {
     } else {
         resolving.max(len.div_ceil(LADDER_MAX_FIT_SAMPLES).max(1))
     }
-}
-
-/// Why the ladder stops at `rung` for the noise floor, if it does: both the whole-log and
-/// the held-back error within [`FLOOR_BAND`] of their floors (the sentence names both).
-fn at_floor(rung: &Rung<'_>) -> Option<String> {
-    let r = rung.error / rung.noise;
-    let rh = rung.heldback_error / rung.heldback_noise;
-    (r <= FLOOR_BAND && rh <= FLOOR_BAND).then(|| {
-        format!(
-            "at the noise floor: the whole-log error {} is {r:.2}x its noise floor {} and the held-back error {} is {rh:.2}x its floor {} (both within {FLOOR_BAND}x): nothing is left to explain",
-            effects::sig(rung.error),
-            effects::sig(rung.noise),
-            effects::sig(rung.heldback_error),
-            effects::sig(rung.heldback_noise)
-        )
-    })
-}
-
-/// Why no candidate helps, naming the numbers that decided. "Beyond the effect library"
-/// only when the base rung was a candidate of the last round (the effects were tried on a
-/// refitted base) and every effect of the library could be fitted (`skipped` is empty);
-/// otherwise what was not tried.
-fn nothing_helps(rung: &Rung<'_>, tried: &[Tried], base_tried: bool, skipped: &[String]) -> String {
-    let r = rung.error / rung.noise;
-    let rh = rung.heldback_error / rung.heldback_noise;
-    // The plausible candidate that came closest to passing (else the first tried).
-    let closest = tried
-        .iter()
-        .filter(|t| !t.because.starts_with("not physical") && !t.because.contains("diverged"))
-        .max_by(|a, b| a.significance.total_cmp(&b.significance));
-    let best = closest
-        .or(tried.first())
-        .map(|t| format!("{} ({})", tried_name(t), t.because))
-        .unwrap_or_else(|| "no candidate could be fitted".into());
-    let what_is_left = if base_tried && skipped.is_empty() {
-        "What is left is beyond the effect library (or below what the log can show)".to_string()
-    } else if !skipped.is_empty() {
-        format!(
-            "What is left is not explained by the effects that could be fitted on this log; not tried: {}",
-            skipped
-                .iter()
-                .map(|s| s.split(':').next().unwrap_or(s))
-                .collect::<Vec<_>>()
-                .join(", ")
-        )
-    } else {
-        "What is left is not explained by the effects of the library on the file's base parameters"
-            .to_string()
-    };
-    format!(
-        "no plausible candidate passes the step's test: the whole-log error {} is {r:.2}x its noise floor and the held-back error {} is {rh:.2}x its floor; the best candidate was {best}. {what_is_left}",
-        effects::sig(rung.error),
-        effects::sig(rung.heldback_error),
-    )
-}
-
-/// A tried candidate's name: its effects joined with `+`, or `the base parameters
-/// refitted`.
-pub fn tried_name(t: &Tried) -> String {
-    // An effect fitted with the base parameters refitted beside it is named by its effects.
-    if t.added.is_empty() {
-        return "the base parameters refitted".to_string();
-    }
-    t.added
-        .iter()
-        .map(|k| k.name())
-        .collect::<Vec<_>>()
-        .join("+")
 }

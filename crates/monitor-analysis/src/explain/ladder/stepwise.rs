@@ -5,13 +5,14 @@
 //! regression, 1960, removes a term whose partial test fails after each addition; the test
 //! here is the ladder's own, on the held-back windows).
 
-use super::round::{LadderSeries, Rung};
-use super::{LadderStep, STEP_MIN};
+use super::climb::Ladder;
+use super::rung::{nested_from, Rung};
+use super::{Dropped, LadderStep, STEP_MIN};
+use crate::analysis::{Analysis, AnalysisError};
 use crate::effects::EffectModel;
 use crate::explain::{explained_fraction, PARAM_PENALTY};
 use crate::fit::{self, BaseSpec, FitResult};
 use crate::metrics;
-use crate::{Analysis, AnalysisError};
 use monitor_core::EffectKind;
 
 /// An effect of the model that may be dropped: added by an earlier step (not configured by
@@ -46,46 +47,44 @@ struct Without<'a> {
     significance: f64,
 }
 
-impl Analysis {
+impl<'a> Ladder<'a> {
     /// Drops, one at a time, the earlier effects of `next` (the model after `step`, taken
-    /// from `before`) that the model no longer needs: refitted without it, the model loses
-    /// less than [`STEP_MIN`] of its held-back error beyond the floor (each of the effect's
-    /// parameters costing [`PARAM_PENALTY`]), and the whole-log error stays below
-    /// `before`'s (the step as a whole still lowers it). The step records what it dropped.
-    /// `self` is the analysis of `next`'s base parameters.
-    pub(super) fn drop_stand_ins<'a>(
+    /// from `before`; `an` the analysis of `next`'s base) that the model no longer needs:
+    /// refitted without it, the model loses less than [`STEP_MIN`] of its held-back error
+    /// beyond the floor (each of the effect's parameters costing [`PARAM_PENALTY`]), and
+    /// the whole-log error stays below `before`'s (the step as a whole still lowers it).
+    /// The step records what it dropped and why.
+    pub(super) fn drop_stand_ins(
         &self,
+        an: &Analysis,
         mut next: Rung<'a>,
         mut step: LadderStep,
         before: &Rung<'a>,
-        sr: &LadderSeries,
-        configured: &[EffectKind],
     ) -> Result<(Rung<'a>, LadderStep), AnalysisError> {
         loop {
             let idx: Vec<usize> = (0..next.models.len())
-                .filter(|&i| droppable(&next.models, i, &step, configured, self))
+                .filter(|&i| droppable(&next.models, i, &step, &self.configured, an))
                 .collect();
             if idx.is_empty() {
                 break;
             }
-            let Some(w) = self.least_needed(&next, idx, sr)? else {
+            let Some(w) = self.least_needed(an, &next, idx)? else {
                 break;
             };
             if w.significance >= STEP_MIN {
                 break;
             }
             let gone = next.kinds[w.i];
-            let rung = self.measure_rung(w.models, w.fit, sr, next.scales)?;
+            let rung = self.series.measure(an, w.models, w.fit, next.scales)?;
             if !(rung.error < before.error && rung.error.is_finite()) {
                 break;
             }
             step.dropped.push(gone);
-            step.summary = format!(
-                "{}; {gone} removed: the model without it loses {:.0} % of the held-back error beyond the noise floor (a step must earn {:.0} %), this step explains what it stood in for",
-                step.summary,
-                100.0 * w.significance.max(0.0),
-                100.0 * STEP_MIN
-            );
+            step.dropped_because.push(Dropped {
+                effect: gone,
+                loses: w.significance,
+                asks: STEP_MIN,
+            });
             step.error = rung.error;
             step.heldback_error = rung.heldback_error;
             step.noise_floor = rung.noise;
@@ -105,15 +104,15 @@ impl Analysis {
 
     /// Of `next`'s effects at `idx`, the one whose removal costs the least held-back
     /// error, refitted without it (`None` when no refit could run).
-    fn least_needed<'a>(
+    fn least_needed(
         &self,
+        an: &Analysis,
         next: &Rung<'a>,
         idx: Vec<usize>,
-        sr: &LadderSeries,
     ) -> Result<Option<Without<'a>>, AnalysisError> {
         let mut best: Option<Without<'a>> = None;
         for i in idx {
-            let Some(w) = self.without(next, i, sr)? else {
+            let Some(w) = self.without(an, next, i)? else {
                 continue;
             };
             if best
@@ -128,12 +127,13 @@ impl Analysis {
 
     /// `next`'s model without its effect `i`, refitted nested on the fit series (`None`
     /// when a set-up refuses the series).
-    fn without<'a>(
+    fn without(
         &self,
+        an: &Analysis,
         next: &Rung<'a>,
         i: usize,
-        sr: &LadderSeries,
     ) -> Result<Option<Without<'a>>, AnalysisError> {
+        let sr = &self.series;
         let models: Vec<&'a dyn EffectModel> = next
             .models
             .iter()
@@ -149,12 +149,12 @@ impl Analysis {
             .filter(|(j, _)| *j != i)
             .map(|(_, p)| p.clone())
             .collect();
-        let Some(set) = self.nested_from(&models, &values, &[], &sr.fd) else {
+        let Some(set) = nested_from(an, &models, &values, &[], &sr.fd) else {
             return Ok(None);
         };
         let spec = BaseSpec::paper(sr.fit_base).for_effects(&set);
-        let f = self.fit_spec(&sr.fd, &set, &sr.wf, &next.fit.base, spec)?;
-        let pred = fit::predict(&sr.fd, &self.constants, &set, &f)?;
+        let f = an.fit_spec(&sr.fd, &set, &sr.wf, &next.fit.base, spec)?;
+        let pred = fit::predict(&sr.fd, &an.constants, &set, &f)?;
         let hb = metrics::errors(&sr.fd, &pred, Some(&sr.held_fd)).normalized_rms_error;
         if !hb.is_finite() {
             return Ok(None);

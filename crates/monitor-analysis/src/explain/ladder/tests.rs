@@ -1,10 +1,13 @@
 //! The ladder's own mechanisms on logs of the textbook machine (monitor-testkit: Krause's
 //! equations, written apart from this crate's model and the project's simulator).
 
-use super::round::Rung;
+use super::rung::{nested, setup_list, LadderSeries, Rung};
 use super::*;
+use crate::effects::EffectModel;
+use crate::fit::machine::MachineScales;
 use crate::fit::BaseSpec;
 use crate::prep::ReadOptions;
+use crate::simplified_model::BaseParams;
 use monitor_io::params::ParamFile;
 use monitor_testkit::textbook_machine::{write_log, Machine, Scenario, Supply};
 
@@ -30,6 +33,26 @@ fn fan_log(dir: &std::path::Path) -> Analysis {
     Analysis::load(&log, p, ReadOptions::default(), &mut |_| {}).expect("load")
 }
 
+/// No progress to show.
+static NO_PROGRESS: fn(usize, f64) = |_, _| {};
+
+/// The ladder on the log of `a` at its start, the user having configured `configured`
+/// (the effects it never drops).
+fn ladder_on<'a>(
+    a: &'a Analysis,
+    lib: &'a [Box<dyn EffectModel>],
+    configured: &[EffectKind],
+) -> Ladder<'a> {
+    let (held, _) = stratified_heldback(&a.data, &a.constants);
+    let opts = Options {
+        effects: configured.to_vec(),
+        fit_base: true,
+    };
+    // (The configured effects' models live as long as the ladder: leaked, in a test.)
+    let boxes: &'a [Box<dyn EffectModel>] = Box::leak(resolve(configured).into_boxed_slice());
+    Ladder::start(a, lib, boxes, &opts, held, &NO_PROGRESS).expect("start")
+}
+
 /// The model of `kinds` fitted nested from `from` (or from scratch) on the ladder's series.
 fn rung_of<'a>(
     a: &Analysis,
@@ -45,9 +68,9 @@ fn rung_of<'a>(
     let set = match from {
         Some(r) => {
             let extra: Vec<&'a dyn EffectModel> = models[r.models.len()..].to_vec();
-            a.nested(&extra, r, &sr.fd).expect("set-up")
+            nested(a, &extra, r, &sr.fd).expect("set-up")
         }
-        None => a.setup_list(&sr.fd, &models).expect("set-up"),
+        None => setup_list(a, &sr.fd, &models).expect("set-up"),
     };
     let start = from.map_or(BaseParams::nominal(&a.constants), |r| r.fit.base);
     let f = a
@@ -59,7 +82,7 @@ fn rung_of<'a>(
             BaseSpec::PAPER.for_effects(&set),
         )
         .expect("fit");
-    a.measure_rung(models, f, sr, MachineScales::of_file(&a.params))
+    sr.measure(a, models, f, MachineScales::of_file(&a.params))
         .expect("measure")
 }
 
@@ -70,9 +93,9 @@ fn rung_of<'a>(
 fn a_stand_in_a_later_step_explains_is_dropped() {
     let dir = tempfile::tempdir().expect("tempdir");
     let a = fan_log(dir.path());
-    let (held, _) = stratified_heldback(&a.data, &a.constants);
-    let sr = a.ladder_series(held, true);
     let lib = effects::ladder_library();
+    let ladder = ladder_on(&a, &lib, &[]);
+    let sr = &ladder.series;
     let full = [
         EffectKind::FluxDynamics,
         EffectKind::CurrentDynamics,
@@ -80,18 +103,19 @@ fn a_stand_in_a_later_step_explains_is_dropped() {
         EffectKind::CrossCouplingDynamics,
     ];
     let with_iron: Vec<EffectKind> = full.iter().copied().chain([EffectKind::IronLoss]).collect();
-    let before = rung_of(&a, &lib, &with_iron, None, &sr);
+    let before = rung_of(&a, &lib, &with_iron, None, sr);
     let mut all = with_iron.clone();
     all.push(EffectKind::Windage);
-    let next = rung_of(&a, &lib, &all, Some(&before), &sr);
+    let next = rung_of(&a, &lib, &all, Some(&before), sr);
     assert!(next.error < before.error, "{} {}", next.error, before.error);
     let step = LadderStep {
         effect: Some(EffectKind::Windage),
         added: vec![EffectKind::Windage],
         base: Vec::new(),
         dropped: Vec::new(),
+        dropped_because: Vec::new(),
         fitted: BTreeMap::new(),
-        summary: String::new(),
+        described: Vec::new(),
         error: next.error,
         heldback_error: next.heldback_error,
         noise_floor: next.noise,
@@ -102,18 +126,21 @@ fn a_stand_in_a_later_step_explains_is_dropped() {
         explained: 0.0,
         heldback_explained: 0.0,
     };
-    let (after, step) = a
-        .drop_stand_ins(next, step, &before, &sr, &[])
+    let (after, step) = ladder
+        .drop_stand_ins(&a, next, step, &before)
         .expect("drops");
-    assert_eq!(step.dropped, vec![EffectKind::IronLoss], "{}", step.summary);
+    assert_eq!(step.dropped, vec![EffectKind::IronLoss], "{step:?}");
     assert!(!after.kinds.contains(&EffectKind::IronLoss));
     assert!(after.kinds.contains(&EffectKind::Windage));
     // The step as a whole still lowers the whole-log error.
     assert!(after.error < before.error);
+    // Why: the model without it loses less than a step must earn.
+    let why = &step.dropped_because;
+    assert_eq!(why.len(), 1, "{why:?}");
+    assert_eq!(why[0].effect, EffectKind::IronLoss);
     assert!(
-        step.summary.contains("iron_loss removed"),
-        "{}",
-        step.summary
+        why[0].loses < why[0].asks && why[0].asks == STEP_MIN,
+        "{why:?}"
     );
 }
 
@@ -123,9 +150,9 @@ fn a_stand_in_a_later_step_explains_is_dropped() {
 fn what_the_user_configured_and_the_machine_order_stay() {
     let dir = tempfile::tempdir().expect("tempdir");
     let a = fan_log(dir.path());
-    let (held, _) = stratified_heldback(&a.data, &a.constants);
-    let sr = a.ladder_series(held, true);
     let lib = effects::ladder_library();
+    let ladder = ladder_on(&a, &lib, &[EffectKind::IronLoss]);
+    let sr = &ladder.series;
     let kinds = [
         EffectKind::FluxDynamics,
         EffectKind::CurrentDynamics,
@@ -134,15 +161,16 @@ fn what_the_user_configured_and_the_machine_order_stay() {
         EffectKind::IronLoss,
         EffectKind::Windage,
     ];
-    let before = rung_of(&a, &lib, &kinds[..5], None, &sr);
-    let next = rung_of(&a, &lib, &kinds, Some(&before), &sr);
+    let before = rung_of(&a, &lib, &kinds[..5], None, sr);
+    let next = rung_of(&a, &lib, &kinds, Some(&before), sr);
     let step = LadderStep {
         effect: Some(EffectKind::Windage),
         added: vec![EffectKind::Windage],
         base: Vec::new(),
         dropped: Vec::new(),
+        dropped_because: Vec::new(),
         fitted: BTreeMap::new(),
-        summary: String::new(),
+        described: Vec::new(),
         error: next.error,
         heldback_error: next.heldback_error,
         noise_floor: next.noise,
@@ -153,8 +181,8 @@ fn what_the_user_configured_and_the_machine_order_stay() {
         explained: 0.0,
         heldback_explained: 0.0,
     };
-    let (after, step) = a
-        .drop_stand_ins(next, step, &before, &sr, &[EffectKind::IronLoss])
+    let (after, step) = ladder
+        .drop_stand_ins(&a, next, step, &before)
         .expect("drops");
     assert!(step.dropped.is_empty(), "{:?}", step.dropped);
     assert_eq!(after.kinds, kinds.to_vec());

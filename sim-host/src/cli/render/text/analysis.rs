@@ -3,8 +3,12 @@
 use super::diagnose::data_quality;
 use super::number;
 use monitor_api::analysis::CompareReport;
-use monitor_api::analysis::{tried_name, LadderReport};
+use monitor_api::analysis::LadderReport;
 use monitor_api::analysis::{ExplainReport, Standing, EXPLAINS_MIN};
+use monitor_api::words;
+
+/// The command line's words for the options advice names (`--from`, `--effects`).
+const CLI: &crate::cli::words::CliWords = &crate::cli::words::CliWords;
 use monitor_api::ExplainDocument;
 use std::io::Write;
 use std::path::Path;
@@ -62,13 +66,17 @@ pub fn compare(
     }
     worst_windows(&mut out, r)?;
     for a in &r.advice {
-        writeln!(out, "  advice: {a}")?;
+        writeln!(out, "  advice: {}", words::compare::advice(a, CLI))?;
     }
     fitted(&mut out, r)?;
     for s in &r.skipped {
-        writeln!(out, "  skipped: {s}")?;
+        writeln!(out, "  skipped: {}", words::compare::skipped(*s))?;
     }
-    writeln!(out, "  unbalance: {}", r.unbalance.summary)?;
+    writeln!(
+        out,
+        "  unbalance: {}",
+        words::analysis::unbalance(&r.unbalance, CLI)
+    )?;
     Ok(())
 }
 
@@ -116,7 +124,7 @@ fn fitted(out: &mut impl Write, r: &CompareReport) -> anyhow::Result<()> {
             if v.plausible { "" } else { "  [not plausible]" }
         )?;
     }
-    for w in &r.implausible_because {
+    for w in words::compare::implausible(r, CLI) {
         writeln!(out, "  not plausible: {w}")?;
     }
     if let Some(j) = &r.identifiability {
@@ -127,7 +135,7 @@ fn fitted(out: &mut impl Write, r: &CompareReport) -> anyhow::Result<()> {
         )?;
     }
     for w in &r.not_identified {
-        writeln!(out, "  {w}")?;
+        writeln!(out, "  {}", words::compare::not_identified(w))?;
     }
     Ok(())
 }
@@ -155,19 +163,23 @@ pub fn explain(
         number(r.noise_floor)
     )?;
     // Explain's own answer, then how it reads beside the verdict.
-    writeln!(out, "model's error: {}", r.verdict)?;
+    writeln!(out, "model's error: {}", words::explain::verdict(r, CLI))?;
     if let Some(b) = &doc.beside_verdict {
         writeln!(out, "  {b}")?;
     }
-    writeln!(out, "  unbalance: {}", r.unbalance.summary)?;
+    writeln!(
+        out,
+        "  unbalance: {}",
+        words::analysis::unbalance(&r.unbalance, CLI)
+    )?;
     write!(out, "{}", super::super::mcsa::text(&doc.rotor_asymmetry))?;
     ranking(&mut out, r)?;
     for s in &r.skipped {
-        writeln!(out, "  skipped: {s}")?;
+        writeln!(out, "  skipped: {}", words::analysis::skipped(s, CLI))?;
     }
-    if let Some(words) = r.base_refit.as_ref().map(|b| b.in_words()) {
-        if !words.is_empty() {
-            writeln!(out, "  {words}")?;
+    if let Some(said) = r.base_refit.as_ref().map(words::explain::base_refit) {
+        if !said.is_empty() {
+            writeln!(out, "  {said}")?;
         }
     }
     Ok(())
@@ -266,7 +278,7 @@ pub fn ladder(
 ) -> anyhow::Result<()> {
     writeln!(out, "explain --ladder {}", log.display())?;
     data_quality(&mut out, &r.data_quality)?;
-    writeln!(out, "{}", r.summary)?;
+    writeln!(out, "{}", words::ladder::summary(r))?;
     writeln!(
         out,
         "  {:<4} {:<34} {:>8} {:>7} {:>9} {:>7} {:>11}  fitted (physical range)",
@@ -306,12 +318,23 @@ pub fn ladder(
         out,
         "  (explained: the share of the error beyond the noise floor the step removed, whole log / held-back windows)"
     )?;
-    writeln!(out, "stopped: {}", r.stopped_because)?;
-    writeln!(out, "  the test: {}", r.test)?;
+    ladder_end(out, r)
+}
+
+/// The ladder page's end: why it stopped, the test, the last round's other candidates and
+/// what could not be fitted.
+fn ladder_end(out: &mut dyn std::io::Write, r: &LadderReport) -> anyhow::Result<()> {
+    writeln!(out, "stopped: {}", words::ladder::stopped(r))?;
+    writeln!(out, "  the test: {}", words::ladder::test(&r.test_rule))?;
     for t in &r.last_round {
-        writeln!(out, "  not kept: {}: {}", tried_name(t), t.because)?;
+        let (name, why) = (
+            words::ladder::tried_name(t),
+            words::ladder::refusal(&t.refusal),
+        );
+        writeln!(out, "  not kept: {name}: {why}")?;
     }
-    for s in &r.skipped {
+    for s in &r.skipped_reasons {
+        let s = words::analysis::skipped(s, CLI);
         writeln!(out, "  not fitted: {s}")?;
     }
     Ok(())
@@ -324,7 +347,7 @@ fn ladder_row(k: usize, s: &monitor_api::analysis::LadderStep) -> String {
         .base
         .iter()
         .filter(|c| c.changed)
-        .map(|c| c.spelled())
+        .map(words::ladder::base_change)
         .collect();
     let mut name = if s.effect.is_none() {
         "base parameters refitted".to_string()

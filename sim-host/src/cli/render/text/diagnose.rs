@@ -4,9 +4,7 @@
 use super::{candidate_list, lamp, panel_text};
 use crate::cli::words::CliWords;
 use monitor_api::files::DataQuality;
-use monitor_api::replay::{
-    angle_source_name, Against, CommissioningReport, DiagnoseReport, Diagnosed,
-};
+use monitor_api::replay::{angle_source_name, CommissioningReport, DiagnoseReport, Diagnosed};
 use monitor_api::words::diagnose::{self as words, Story};
 use monitor_studies::demo::MonitorState;
 use std::io::Write;

@@ -1,24 +1,41 @@
-//! A round's three passes over its candidates: every one screened, the finalists fitted to
-//! convergence, the round's best refitted with every value of the model free.
+//! The fits of a round's candidates, in three passes: every one screened, the finalists
+//! fitted to convergence, the round's best refitted with every value of the model free.
 
-use super::round::{Fitted, LadderSeries, Rung, Starts};
-use super::{FINALISTS, SCREEN_ITER};
+use super::super::climb::Ladder;
+use super::super::rung::{implausible_step, nested, nested_from, Fitted, Rung};
+use super::super::{FINALISTS, SCREEN_ITER};
+use crate::analysis::{Analysis, AnalysisError, MAX_ITER};
 use crate::effects::EffectModel;
-use crate::fit::BaseSpec;
-use crate::{Analysis, AnalysisError};
+use crate::fit::{self, BaseSpec};
+use crate::metrics;
+use crate::simplified_model::BaseParams;
 use rayon::prelude::*;
 
 /// One slot per candidate of the round: its latest fit, or none where it could not run.
 type Slots<'a> = Vec<Option<Fitted<'a>>>;
 
-/// What a round's passes share: the candidates, the model they join and the fit series.
-pub(super) struct Round<'r, 'a> {
+/// Where a round's candidates of several effects start their last fit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Starts {
+    /// From where the model stood and from the nominal base parameters, the lower training
+    /// cost kept: the singles (an effect with what it needs first, the full-order
+    /// machine).
+    AlsoNominal,
+    /// From where the model stood only: the pairs. The second start doubled the round's
+    /// time and decided nothing measured: on the 52 logs of the test matrix no pair was
+    /// kept (22 pair rounds), and on the nine `effect_*` scenarios the one pair kept (flux
+    /// dynamics and a load torque, the windage scenario's second step) is kept with the
+    /// same fitted values to 1e-12 without it (docs/model-vs-measurement.md, "Time").
+    NestedOnly,
+}
+
+/// One kind of a round's candidates (the singles, or the pairs) and how they are fitted.
+#[derive(Clone, Copy)]
+pub(super) struct RoundFits<'r, 'a> {
     /// The candidates (effects to add, in order).
     pub(super) cands: &'r [Vec<&'a dyn EffectModel>],
     /// The model they are added to.
     pub(super) rung: &'r Rung<'a>,
-    /// The fit series with its held-back split.
-    pub(super) sr: &'r LadderSeries,
     /// The base parameters' freedom for the candidates' fits.
     pub(super) spec: BaseSpec,
     /// Where a best candidate of several effects starts its last fit.
@@ -27,7 +44,7 @@ pub(super) struct Round<'r, 'a> {
     pub(super) machine: bool,
 }
 
-impl Round<'_, '_> {
+impl RoundFits<'_, '_> {
     /// The screening's base specification: the model's own values held, only the
     /// candidate's and the base parameters move.
     fn screen_spec(&self) -> BaseSpec {
@@ -49,21 +66,23 @@ impl Round<'_, '_> {
     }
 }
 
-impl Analysis {
-    /// Every candidate of `round` added to the model of its rung, fitted from its fit on
-    /// the fit series (in parallel), with its held-back error there and what makes it
-    /// implausible. Three passes: every candidate screened ([`SCREEN_ITER`] iterations,
-    /// from where the model stood, the model's own values held), then the [`FINALISTS`]
-    /// best (plausible first, by their penalised held-back error, and the best of all)
-    /// fitted to convergence from there, and the round's best of them refitted with every
-    /// value of the model free (with `machine`, the six physical base parameters free
-    /// beside them, [`Analysis::joint_machine`]); `starts` says whether that one, of
-    /// several effects, is also fitted from the nominal base parameters ([`Starts`]). The
-    /// held values cost no simulation per iteration: in a late round the model holds a
-    /// dozen. `progress` is handed the share of the round done.
-    pub(super) fn fit_round<'a>(
+impl<'a> Ladder<'a> {
+    /// Every candidate of `round` added to the model of its rung (`an` the analysis of the
+    /// rung's base), fitted on the fit series (in parallel), with its held-back error there
+    /// and what makes it implausible. Three passes: every candidate screened
+    /// ([`SCREEN_ITER`] iterations, from where the model stood, the model's own values
+    /// held), then the [`FINALISTS`] best (plausible first, by their penalised held-back
+    /// error, and the best of all) fitted to convergence from there, and the round's best
+    /// of them refitted with every value of the model free (with `machine`, the six
+    /// physical base parameters free beside them, [`Ladder::joint_machine`]); `starts` says
+    /// whether that one, of several effects, is also fitted from the nominal base
+    /// parameters ([`Starts`]). The held values cost no simulation per iteration: in a
+    /// late round the model holds a dozen. `progress` is handed the share of the round
+    /// done.
+    pub(super) fn fit_round(
         &self,
-        round: &Round<'_, 'a>,
+        an: &Analysis,
+        round: &RoundFits<'_, 'a>,
         progress: &(dyn Fn(f64) + Sync),
     ) -> Result<Vec<Fitted<'a>>, AnalysisError> {
         let done = std::sync::atomic::AtomicUsize::new(0);
@@ -72,17 +91,18 @@ impl Analysis {
             let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             progress(k as f64 / total as f64);
         };
-        let screened = self.screen_pass(round, &tick)?;
-        let out = self.final_pass(round, screened, &tick)?;
-        let out = self.joint_pass(round, out)?;
+        let screened = self.screen_pass(an, round, &tick)?;
+        let out = self.final_pass(an, round, screened, &tick)?;
+        let out = self.joint_pass(an, round, out)?;
         Ok(out.into_iter().flatten().collect())
     }
 
     /// The first pass: every candidate fitted [`SCREEN_ITER`] iterations with the model's
     /// own values held.
-    fn screen_pass<'a>(
+    fn screen_pass(
         &self,
-        round: &Round<'_, 'a>,
+        an: &Analysis,
+        round: &RoundFits<'_, 'a>,
         tick: &(dyn Fn() + Sync),
     ) -> Result<Slots<'a>, AnalysisError> {
         let screen = round.screen_spec();
@@ -91,9 +111,9 @@ impl Analysis {
             .par_iter()
             .map(|c| {
                 let r = self.fit_candidate(
+                    an,
                     c,
                     round.rung,
-                    round.sr,
                     screen,
                     Starts::NestedOnly,
                     SCREEN_ITER,
@@ -107,9 +127,10 @@ impl Analysis {
 
     /// The second pass: the finalists ([`finalists`], and every candidate that trades
     /// values with an effect of the model) fitted to convergence from their screening.
-    fn final_pass<'a>(
+    fn final_pass(
         &self,
-        round: &Round<'_, 'a>,
+        an: &Analysis,
+        round: &RoundFits<'_, 'a>,
         screened: Slots<'a>,
         tick: &(dyn Fn() + Sync),
     ) -> Result<Slots<'a>, AnalysisError> {
@@ -126,12 +147,12 @@ impl Analysis {
                 let c = &round.cands[i];
                 let spec = if round.trades(c) { round.spec } else { screen };
                 let r = self.fit_candidate(
+                    an,
                     c,
                     round.rung,
-                    round.sr,
                     spec,
                     Starts::NestedOnly,
-                    crate::MAX_ITER,
+                    MAX_ITER,
                     screened[i].as_ref(),
                 );
                 tick();
@@ -153,23 +174,24 @@ impl Analysis {
     /// ended at a bound its own values' freedom leaves), refitted with every value of the
     /// model free: with the six base parameters beside them where the round's `machine`
     /// says so, else from the round's `starts`.
-    fn joint_pass<'a>(
+    fn joint_pass(
         &self,
-        round: &Round<'_, 'a>,
+        an: &Analysis,
+        round: &RoundFits<'_, 'a>,
         out: Slots<'a>,
     ) -> Result<Slots<'a>, AnalysisError> {
         let joint: Vec<(usize, Option<Fitted<'a>>)> = best_two(&out)
             .par_iter()
             .map(|&i| {
                 let r = match (round.machine, out[i].as_ref()) {
-                    (true, Some(f)) => self.joint_machine(f, round.rung, round.sr).map(Some),
+                    (true, Some(f)) => self.joint_machine(an, f, round.rung).map(Some),
                     _ => self.fit_candidate(
+                        an,
                         &round.cands[i],
                         round.rung,
-                        round.sr,
                         round.spec,
                         round.starts,
-                        crate::MAX_ITER,
+                        MAX_ITER,
                         out[i].as_ref(),
                     ),
                 };
@@ -177,6 +199,71 @@ impl Analysis {
             })
             .collect::<Result<_, _>>()?;
         Ok(replace(out, joint))
+    }
+
+    /// One candidate `c` (effects to add, in order) fitted with the model of `rung` (`an`
+    /// the analysis of its base), from the `starts` given, the base parameters as `spec`
+    /// says (for the candidate's effects, [`BaseSpec::for_effects`]), at most `max_iter`
+    /// iterations; from a screening fit `from`'s values where given, else from where the
+    /// model stood.
+    #[allow(clippy::too_many_arguments)]
+    fn fit_candidate(
+        &self,
+        an: &Analysis,
+        c: &[&'a dyn EffectModel],
+        rung: &Rung<'a>,
+        spec: BaseSpec,
+        starts: Starts,
+        max_iter: usize,
+        from: Option<&Fitted<'a>>,
+    ) -> Result<Option<Fitted<'a>>, AnalysisError> {
+        let sr = &self.series;
+        let set = match from {
+            Some(f) => nested_from(an, &f.models, &f.fit.effect_params, &[], &sr.fd),
+            None => nested(an, c, rung, &sr.fd),
+        };
+        let Some(set) = set else {
+            return Ok(None);
+        };
+        let start = from.map_or(rung.fit.base, |f| f.fit.base);
+        let n_parameters = set
+            .iter()
+            .skip(rung.models.len())
+            .map(|a| a.setup.len())
+            .sum();
+        let spec = spec.for_effects(&set);
+        // Nested: from where the model stood. An effect with what it needs first (or the
+        // full-order machine) can trade off against a base parameter (the B + Bl that
+        // absorbed a start's acceleration): where the fit frees the base parameters it is
+        // also fitted from the nominal ones, and the lower training cost wins, so the nested
+        // fit's cost is never exceeded. The two fits are independent and share the cores.
+        let frees_base = spec.free.iter().any(|f| *f);
+        let f = if frees_base && c.len() > 1 && starts == Starts::AlsoNominal {
+            let nominal = BaseParams::nominal(&an.constants);
+            let (f, g) = rayon::join(
+                || an.fit_spec_iter(&sr.fd, &set, &sr.wf, &start, spec, max_iter),
+                || an.fit_spec_iter(&sr.fd, &set, &sr.wf, &nominal, spec, max_iter),
+            );
+            let (f, g) = (f?, g?);
+            if g.report.cost < f.report.cost {
+                g
+            } else {
+                f
+            }
+        } else {
+            an.fit_spec_iter(&sr.fd, &set, &sr.wf, &start, spec, max_iter)?
+        };
+        let pred = fit::predict(&sr.fd, &an.constants, &set, &f)?;
+        let hb = metrics::errors(&sr.fd, &pred, Some(&sr.held_fd)).normalized_rms_error;
+        let why = implausible_step(an, &set, rung, &f, sr.m)?;
+        Ok(Some(Fitted {
+            models: set.iter().map(|a| a.effect).collect(),
+            fit: f,
+            n_parameters,
+            heldback_fit_series: hb,
+            implausible: why,
+            base: None,
+        }))
     }
 }
 
@@ -212,7 +299,8 @@ fn best_two(out: &[Option<Fitted<'_>>]) -> Vec<usize> {
     }
     joint_of
 }
-/// The screened candidates fitted in full ([`Analysis::fit_round`]): the first
+
+/// The screened candidates fitted in full ([`Ladder::fit_round`]): the first
 /// [`FINALISTS`] in the round's order (plausible first, then by penalised held-back
 /// error), and the best by that error alone (a screening fit not yet plausible may end
 /// plausible).

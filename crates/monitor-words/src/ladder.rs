@@ -1,0 +1,427 @@
+//! The ladder's words (`explain --ladder`), spelled from
+//! [`monitor_analysis::explain::ladder`]'s typed values: why it stopped, why a candidate was
+//! not kept, each step, the base changes, what was found, and the JSON document that
+//! carries each sentence beside the typed reason it is spelled from ([`document`]).
+
+use crate::analysis::{effect_names, skipped};
+use crate::Spelling;
+use monitor_analysis::effects::{sig, ALPHA_CU_PER_K};
+use monitor_analysis::explain::ladder::{
+    BaseChange, FinalFit, LadderReport, LadderStep, Refusal, StopReason, TestRule, Tried,
+    WhatIsLeft, WhyNotPhysical,
+};
+use monitor_analysis::fit::machine::BaseKey;
+use serde_json::Value;
+
+/// `explain --ladder --json`'s document: the report's typed values, with the sentences a
+/// crew reads beside them (`summary`, `stopped_because` beside `stopped_reason`, `skipped`
+/// beside `skipped_reasons`, `test` beside `test_rule`, each step's `summary`, each
+/// candidate's `because` beside its `refusal`); `spell` names the options advice refers to.
+pub fn document(r: &LadderReport, spell: &dyn Spelling) -> Value {
+    let mut doc = serde_json::to_value(r).unwrap_or_default();
+    let Some(obj) = doc.as_object_mut() else {
+        return doc;
+    };
+    obj.insert("summary".into(), summary(r).into());
+    obj.insert("stopped_because".into(), stopped(r).into());
+    obj.insert("test".into(), test(&r.test_rule).into());
+    let skipped: Vec<Value> = r
+        .skipped_reasons
+        .iter()
+        .map(|s| skipped(s, spell).into())
+        .collect();
+    obj.insert("skipped".into(), skipped.into());
+    if let Some(steps) = obj.get_mut("ladder").and_then(Value::as_array_mut) {
+        for (v, s) in steps.iter_mut().zip(&r.ladder) {
+            if let Some(o) = v.as_object_mut() {
+                o.insert("summary".into(), step(s).into());
+            }
+        }
+    }
+    if let Some(tried) = obj.get_mut("last_round").and_then(Value::as_array_mut) {
+        for (v, t) in tried.iter_mut().zip(&r.last_round) {
+            if let Some(o) = v.as_object_mut() {
+                o.insert("because".into(), refusal(&t.refusal).into());
+            }
+        }
+    }
+    doc
+}
+
+/// Why the ladder stopped, naming the numbers that decided (JSON `stopped_because`).
+pub fn stopped(r: &LadderReport) -> String {
+    match &r.stopped_reason {
+        StopReason::NoiseFloor {
+            error,
+            noise_floor,
+            heldback_error,
+            heldback_noise_floor,
+            band,
+        } => format!(
+            "at the noise floor: the whole-log error {} is {:.2}x its noise floor {} and the held-back error {} is {:.2}x its floor {} (both within {band}x): nothing is left to explain",
+            sig(*error),
+            error / noise_floor,
+            sig(*noise_floor),
+            sig(*heldback_error),
+            heldback_error / heldback_noise_floor,
+            sig(*heldback_noise_floor)
+        ),
+        StopReason::NothingHelps {
+            error,
+            noise_floor,
+            heldback_error,
+            heldback_noise_floor,
+            best,
+            left,
+        } => format!(
+            "no plausible candidate passes the step's test: the whole-log error {} is {:.2}x its noise floor and the held-back error {} is {:.2}x its floor; the best candidate was {}. {}",
+            sig(*error),
+            error / noise_floor,
+            sig(*heldback_error),
+            heldback_error / heldback_noise_floor,
+            best.as_ref().map_or_else(
+                || "no candidate could be fitted".to_string(),
+                |t| format!("{} ({})", tried_name(t), refusal(&t.refusal))
+            ),
+            what_is_left(left)
+        ),
+        StopReason::LibraryExhausted => {
+            "no effect of the library is left to add on this log".to_string()
+        }
+        StopReason::NoVoltages => "the log has no voltages: the model cannot run, so no effect can be added (the unbalance analysis needs only the currents: explain without the ladder gives it)".to_string(),
+        StopReason::Untrusted => format!(
+            "could not judge: the data-quality stage does not trust the log ({})",
+            r.data_quality.not_trusted_because.join("; ")
+        ),
+    }
+}
+
+/// What the error the ladder could not explain further is, as far as it can tell.
+fn what_is_left(left: &WhatIsLeft) -> String {
+    match left {
+        WhatIsLeft::BeyondLibrary => {
+            "What is left is beyond the effect library (or below what the log can show)".into()
+        }
+        WhatIsLeft::NotTried { effects } => format!(
+            "What is left is not explained by the effects that could be fitted on this log; not tried: {}",
+            effect_names(effects)
+        ),
+        WhatIsLeft::OnTheFileBase => {
+            "What is left is not explained by the effects of the library on the file's base parameters"
+                .into()
+        }
+    }
+}
+
+/// Why a candidate was not kept (JSON `last_round[].because`).
+pub fn refusal(r: &Refusal) -> String {
+    match r {
+        Refusal::Diverged => {
+            "the model with it could not be run through the log (it diverged)".into()
+        }
+        Refusal::NotPhysical { why } => format!(
+            "not physical: {}",
+            why.iter().map(not_physical).collect::<Vec<_>>().join("; ")
+        ),
+        Refusal::BelowTest { share, asks } => format!(
+            "removes {:.0} % of the held-back error beyond the noise floor (the test asks {:.0} %)",
+            100.0 * share,
+            100.0 * asks
+        ),
+        Refusal::DivergedOnWholeLog => {
+            "the model with it could not be run through the whole log (it diverged)".into()
+        }
+        Refusal::WholeLogRises { from, to } => format!(
+            "the whole-log error would rise {} -> {} (held-back windows only improved)",
+            sig(*from),
+            sig(*to)
+        ),
+        Refusal::BetterKept => "a better candidate was kept".into(),
+    }
+}
+
+/// Why a fitted step is not physical, one value.
+pub fn not_physical(w: &WhyNotPhysical) -> String {
+    match w {
+        WhyNotPhysical::Effect { effect, why } => format!("{effect}: {why}"),
+        WhyNotPhysical::AtBound {
+            effect,
+            parameter,
+            value,
+            unit,
+            low,
+            high,
+        } => format!(
+            "{effect}: {parameter} = {} {unit} is at the bound of its fit ({}..{}), not a value the log shows",
+            sig(*value),
+            sig(*low),
+            sig(*high)
+        ),
+        WhyNotPhysical::Contradicted { why, .. } | WhyNotPhysical::Base { why } => why.clone(),
+        WhyNotPhysical::BaseFactor {
+            parameter,
+            factor,
+            low,
+            high,
+            basis,
+        } => format!(
+            "base: {parameter} x{} is outside the physical range x{}..x{} ({basis})",
+            sig(*factor),
+            sig(*low),
+            sig(*high)
+        ),
+    }
+}
+
+/// A tried candidate's name: its effects joined with `+`, or `the base parameters
+/// refitted`.
+pub fn tried_name(t: &Tried) -> String {
+    // An effect fitted with the base parameters refitted beside it is named by its effects.
+    if t.added.is_empty() {
+        return "the base parameters refitted".to_string();
+    }
+    t.added
+        .iter()
+        .map(|k| k.name())
+        .collect::<Vec<_>>()
+        .join("+")
+}
+
+/// The rule each step passed and the ladder stops by (JSON `test`).
+pub fn test(rule: &TestRule) -> String {
+    format!(
+        "a step is kept when it removes at least {:.0} % of the held-back error beyond the noise floor (each parameter costing {:.0} % of the held-back error) and lowers the whole-log error; the ladder stops within {}x the noise floor on the whole log and the held-back part",
+        100.0 * rule.step_min,
+        100.0 * rule.param_penalty,
+        rule.floor_band
+    )
+}
+
+/// One step in words (JSON `ladder[].summary`): the base rung's changes, or the added
+/// effects' values (and the base refitted beside them where it changed); then each
+/// effect the step removed and why.
+pub fn step(s: &LadderStep) -> String {
+    let mut out = if s.effect.is_none() {
+        base_changes(&s.base)
+    } else if s.base.is_empty() {
+        s.described.join("; ")
+    } else {
+        format!(
+            "{}; on the refitted base: {}",
+            s.described.join("; "),
+            base_changes(&s.base)
+        )
+    };
+    for d in &s.dropped_because {
+        out = format!(
+            "{out}; {} removed: the model without it loses {:.0} % of the held-back error beyond the noise floor (a step must earn {:.0} %), this step explains what it stood in for",
+            d.effect,
+            100.0 * d.loses.max(0.0),
+            100.0 * d.asks
+        );
+    }
+    out
+}
+
+/// What the ladder found, then why it stopped (JSON `summary`): the base changes and the
+/// effects the steps added, with their sizes, where the chosen model ends on the whole log;
+/// where the ladder could not start, only why.
+pub fn summary(r: &LadderReport) -> String {
+    if matches!(
+        r.stopped_reason,
+        StopReason::NoVoltages | StopReason::Untrusted
+    ) {
+        return stopped(r);
+    }
+    let fin = r.final_fit.as_ref();
+    let found = match fin {
+        Some(f) => found(r, f),
+        None => r
+            .ladder
+            .iter()
+            .filter_map(|s| s.effect.map(|e| e.name().to_string()))
+            .collect(),
+    };
+    let dropped: Vec<String> = r
+        .ladder
+        .iter()
+        .flat_map(|s| s.dropped.iter().map(|k| k.name().to_string()))
+        .collect();
+    let mut out = if found.is_empty() {
+        "found: nothing the model lacks on this log".to_string()
+    } else {
+        format!("found: {}", found.join("; "))
+    };
+    if !dropped.is_empty() {
+        out.push_str(&format!(
+            " (removed on the way: {}, explained better by a later step)",
+            dropped.join(", ")
+        ));
+    }
+    if let Some(f) = fin {
+        out.push_str(&format!(
+            ". The chosen model refitted on the whole log: error {} = {:.2}x its noise floor {}, {:.1}x below the start",
+            sig(f.error),
+            f.ratio_to_floor,
+            sig(f.noise_floor),
+            f.below_start
+        ));
+    }
+    out.push_str(&format!(". Stopped: {}", stopped(r)));
+    out
+}
+
+/// What the chosen model refitted on the whole log (`f`) holds that the start did not: the
+/// base changes, the machine's own dynamics, each other effect with its values.
+fn found(r: &LadderReport, f: &FinalFit) -> Vec<String> {
+    let mut found = Vec::new();
+    if f.base.iter().any(|c| c.changed) {
+        found.push(format!("base parameters: {}", base_changes(&f.base)));
+    }
+    let dynamics: Vec<&str> = f
+        .fitted
+        .iter()
+        .filter(|e| e.effect.name().ends_with("_dynamics"))
+        .map(|e| e.effect.name())
+        .filter(|k| !r.start.effects.iter().any(|s| s.name() == *k))
+        .collect();
+    if !dynamics.is_empty() {
+        found.push(format!(
+            "the machine's own dynamics ({})",
+            dynamics.join(", ")
+        ));
+    }
+    for e in f
+        .fitted
+        .iter()
+        .filter(|e| !e.effect.name().ends_with("_dynamics") && !r.start.effects.contains(&e.effect))
+    {
+        found.push(format!("{}: {}", e.effect, e.summary));
+    }
+    found
+}
+
+/// One base change with its interval: `Rs +19 % (±2 %)`; B + Bl where the file holds none
+/// (or changed more than twofold) as its value.
+pub fn base_change(c: &BaseChange) -> String {
+    let half = c
+        .interval
+        .map(|[lo, hi]| 0.5 * (hi - lo))
+        .unwrap_or(f64::INFINITY);
+    if c.base == BaseKey::B && (c.file_value == 0.0 || c.change.abs() > 1.0) {
+        // A viscous load the file does not hold: the value, not a share of the file's
+        // bearing friction.
+        return format!(
+            "{} {} N m s/rad (the file's {})",
+            c.base.symbol(),
+            sig(c.value),
+            sig(c.file_value)
+        );
+    }
+    if half.is_finite() {
+        format!(
+            "{} {:+.0} % (±{:.0} %)",
+            c.base.symbol(),
+            100.0 * c.change,
+            (100.0 * half).max(1.0)
+        )
+    } else {
+        format!("{} {:+.0} %", c.base.symbol(), 100.0 * c.change)
+    }
+}
+
+/// What the base changes `c` mean, in a drive engineer's words: each named change with its
+/// interval and its likely reading, then the parameters the log does not identify.
+pub fn base_changes(c: &[BaseChange]) -> String {
+    let mut parts = resistances(c);
+    for (k, why) in OTHER_READINGS {
+        if let Some(x) = c.iter().find(|x| x.base == k && x.changed) {
+            parts.push(format!("{}: {why}", base_change(x)));
+        }
+    }
+    let unidentified: Vec<&str> = c
+        .iter()
+        .filter(|x| !x.identified)
+        .map(|x| x.base.symbol())
+        .collect();
+    let unchanged: Vec<&str> = c
+        .iter()
+        .filter(|x| x.identified && !x.changed)
+        .filter(|x| !matches!(x.base, BaseKey::Rs | BaseKey::Rr) || parts.is_empty())
+        .map(|x| x.base.symbol())
+        .collect();
+    if parts.is_empty() {
+        parts.push("no base parameter differs from the file's by more than this log shows".into());
+    }
+    if !unchanged.is_empty() {
+        parts.push(format!("unchanged: {}", unchanged.join(", ")));
+    }
+    if !unidentified.is_empty() {
+        parts.push(format!(
+            "not identified by this log (kept near the file's values): {}",
+            unidentified.join(", ")
+        ));
+    }
+    parts.join("; ")
+}
+
+/// The likely reading of a change of each base parameter other than the resistances.
+const OTHER_READINGS: [(BaseKey, &str); 4] = [
+    (
+        BaseKey::Lm,
+        "the magnetising inductance differs from the file's (a no-load test at another voltage, or saturation)",
+    ),
+    (
+        BaseKey::Leakage,
+        "the leakage inductances differ from the file's (a locked-rotor test's split or its saturated leakage paths)",
+    ),
+    (
+        BaseKey::J,
+        "the inertia differs from the file's (the coupled load's)",
+    ),
+    (
+        BaseKey::B,
+        "the viscous friction differs from the file's (a viscous load the file leaves out, bearings, seals)",
+    ),
+];
+
+/// The changes of Rs and Rr in `c` in words: both risen alike read as a warm machine (its
+/// rise in K at copper's 0.393 %/K), else each with its likely reading.
+fn resistances(c: &[BaseChange]) -> Vec<String> {
+    let get = |k: BaseKey| c.iter().find(|x| x.base == k);
+    let changed = |k: BaseKey| get(k).is_some_and(|x| x.changed);
+    let (rs, rr) = (get(BaseKey::Rs), get(BaseKey::Rr));
+    let spelled = |x: Option<&BaseChange>| x.map_or_else(String::new, base_change);
+    let (a, b) = (rs.map_or(0.0, |x| x.change), rr.map_or(0.0, |x| x.change));
+    let alike = a > 0.0 && b > 0.0 && (a - b).abs() <= 0.3 * a.max(b);
+    let (rs_changed, rr_changed) = (changed(BaseKey::Rs), changed(BaseKey::Rr));
+    if rs_changed && rr_changed && alike {
+        return vec![format!(
+            "{}, {}: both windings warmer than the file's values, about {:.0} K (copper 0.393 %/K)",
+            spelled(rs),
+            spelled(rr),
+            0.5 * (a + b) / ALPHA_CU_PER_K
+        )];
+    }
+    let mut parts = Vec::new();
+    if rs_changed {
+        parts.push(format!(
+            "{}{}: {}",
+            spelled(rs),
+            if rr_changed { "" } else { ", Rr unchanged" },
+            if a > 0.0 {
+                "the file's Rs is cold, or the stator is warm (a loosening connection adds to it too)"
+            } else {
+                "the file's Rs is higher than the winding's (measured warm, or with its leads)"
+            }
+        ));
+    }
+    if rr_changed {
+        parts.push(format!(
+            "{}{}: the rotor's resistance differs from the file's (a locked-rotor test at line frequency reads the skin effect's Rr; a warm cage)",
+            spelled(rr),
+            if rs_changed { "" } else { ", Rs unchanged" },
+        ));
+    }
+    parts
+}
