@@ -133,8 +133,8 @@ fn refitted_to_truth(which: &str, refit: &BaseRefit, key: BaseParameter, tol: f6
             r.refitted, r.identified
         ));
     }
-    if !said(&refit).contains(&key) {
-        f.push(format!("{which}: {key} not said: {:?}", said(&refit)));
+    if !said(refit).contains(&key) {
+        f.push(format!("{which}: {key} not said: {:?}", said(refit)));
     }
     f
 }

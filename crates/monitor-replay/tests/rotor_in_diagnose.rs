@@ -154,7 +154,7 @@ fn broken_bars_are_named_with_their_level_and_band() {
         let fs = 2.0 * s * p.supply.f_hz;
         let case =
             format!("{which} load {load} {broken} bars {record_s} s {rate} Hz noise {noisy}");
-        eprintln!("{case}: {}", said(&r));
+        eprintln!("{case}: {}", said(r));
         if rep.unbalance.suspect_phase.is_some() && rep.unbalance.phase_confidence >= 0.5 {
             failures.push(format!(
                 "{case}: the winding names phase {:?} at {:.2}",
@@ -181,10 +181,10 @@ fn broken_bars_are_named_with_their_level_and_band() {
         // Named as broken bars, with the level and a band past "watch".
         let named = r.judged
             && p_fault >= 0.5
-            && said(&r).contains("broken rotor bars")
-            && said(&r).contains(&format!("{:.1} dB below", -level));
+            && said(r).contains("broken rotor bars")
+            && said(r).contains(&format!("{:.1} dB below", -level));
         if !named || matches!(r.band, Some(RotorBand::NoSign | RotorBand::Watch) | None) {
-            failures.push(format!("{case}: not named: {}", said(&r)));
+            failures.push(format!("{case}: not named: {}", said(r)));
         }
         // The textbook's sum of the two sidebands, within 2 dB.
         let sum = 10f64.powf(level / 20.0) + 10f64.powf(upper / 20.0);

@@ -11,7 +11,7 @@ use crate::spelling::Spelling;
 
 /// The finding's sentence (JSON `findings[].summary`).
 pub fn summary(f: &FindingReport, rep: &DiagnoseReport, sp: &dyn Spelling) -> String {
-    summary_of(f.source(), &f.detail, rep, sp)
+    summary_of(&f.detail, rep, sp)
 }
 
 /// The isolation's verdict of the report.
@@ -19,13 +19,8 @@ fn iso(rep: &DiagnoseReport, sp: &dyn Spelling) -> String {
     isolation::said(&rep.isolation.said, sp)
 }
 
-/// The sentence of `detail`, a finding of `source` in `rep`.
-fn summary_of(
-    source: FindingSource,
-    detail: &Detail,
-    rep: &DiagnoseReport,
-    sp: &dyn Spelling,
-) -> String {
+/// The sentence of `detail`, a finding in `rep`.
+fn summary_of(detail: &Detail, rep: &DiagnoseReport, sp: &dyn Spelling) -> String {
     match detail {
         Detail::ResidualsSkipped { need } => need.map_or_else(
             || "residuals r1..r4: need the voltages and the speed".to_string(),
@@ -133,8 +128,8 @@ fn summary_of(
         }
         Detail::Distrusted { why, read } => format!(
             "not judged ({}); it read: {}",
-            summary_of(FindingSource::DataQuality, why, rep, sp),
-            summary_of(source, read, rep, sp)
+            summary_of(why, rep, sp),
+            summary_of(read, rep, sp)
         ),
     }
 }
@@ -167,11 +162,9 @@ pub fn brief(f: &FindingReport, rep: &DiagnoseReport, sp: &dyn Spelling) -> Stri
         )
     };
     match &f.detail {
-        Detail::Distrusted { why, .. } => format!(
-            "{}: {}",
-            source.name(),
-            summary_of(FindingSource::DataQuality, why, rep, sp)
-        ),
+        Detail::Distrusted { why, .. } => {
+            format!("{}: {}", source.name(), summary_of(why, rep, sp))
+        }
         Detail::ResidualsSkipped { .. }
         | Detail::ResidualsNotLearned(_)
         | Detail::ResidualsNeverEvaluated
