@@ -76,10 +76,8 @@ pub enum ApiError {
         what: &'static str,
         /// How messages name the log.
         log: String,
-        /// Why (the refusal ends "; no parameter file written"); it names the window's
-        /// fields as `from_s` and `to_s` ([`ApiError::spelled`] says them in a front
-        /// end's words).
-        why: String,
+        /// Why, typed ([`IdentifyWhy`]; spelled at the door, `monitor_words::identify`).
+        why: IdentifyWhy,
     },
     /// A labelled run for a turn calibration is wrong, or none named its phase.
     #[error("{0}")]
@@ -179,16 +177,40 @@ impl ApiError {
                 spell.option(OptionField::To, "")
             ),
             ApiError::Identify { what, log, why } => {
-                let mut why = why.clone();
-                for field in [OptionField::From, OptionField::To] {
-                    if let Some(at) = why.rfind(field.name()) {
-                        let said = spell.option(field, "");
-                        why.replace_range(at..at + field.name().len(), &said);
-                    }
-                }
-                format!("{what} {log}: {why}")
+                format!("{what} {log}: {}", why.spelled(spell))
             }
             e => e.to_string(),
         }
+    }
+}
+
+/// Why `identify` wrote no parameter file ([`ApiError::Identify`]): the identification could
+/// not run, or it ran and its result was refused.
+#[derive(Debug, Clone, PartialEq)]
+pub enum IdentifyWhy {
+    /// It could not run on the log (no voltages, too short, irregular samples, ...).
+    Failed(monitor_analysis::identify::IdentifyError),
+    /// It ran and refused its result (a current out of range, a poor fit, a value no real
+    /// machine has); no parameter file is written.
+    Refused(monitor_analysis::identify::IdentifyRefusal),
+}
+
+impl IdentifyWhy {
+    /// The reason in a front end's words (`spell` names the window's fields).
+    pub fn spelled(&self, spell: &dyn Spelling) -> String {
+        match self {
+            IdentifyWhy::Failed(e) => monitor_words::identify::failed(e, spell),
+            IdentifyWhy::Refused(r) => format!(
+                "{}; no parameter file written",
+                monitor_words::identify::refusal(r, spell)
+            ),
+        }
+    }
+}
+
+impl std::fmt::Display for IdentifyWhy {
+    /// In the library's own words ([`FieldNames`]).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.spelled(&FieldNames))
     }
 }

@@ -35,7 +35,7 @@ pub mod replay;
 /// The simulator for a front end (from `monitor-sim`).
 pub mod sim;
 mod turn_calibration;
-pub use error::{ApiError, ErrorKind};
+pub use error::{ApiError, ErrorKind, IdentifyWhy};
 pub use explain_doc::{
     beside_verdict, explain, ladder, mcsa_beside, verdict_for_explain, ExplainDocument,
 };
@@ -469,10 +469,7 @@ pub fn identify(
         return Err(ApiError::Identify {
             what: "identify",
             log: log.shown(),
-            why: format!(
-                "{}; no parameter file written",
-                monitor_words::identify::refusal(&why)
-            ),
+            why: IdentifyWhy::Refused(why),
         });
     }
     let toml = monitor_analysis::identify::to_toml(&id, &start_text, &start_name, &log.shown());
@@ -483,11 +480,11 @@ pub fn identify(
 }
 
 /// [`ApiError::Identify`]: the identification cannot run on `log`.
-fn cannot_identify(log: &LogSource, why: impl ToString) -> ApiError {
+fn cannot_identify(log: &LogSource, why: monitor_analysis::identify::IdentifyError) -> ApiError {
     ApiError::Identify {
         what: "cannot identify from",
         log: log.shown(),
-        why: why.to_string(),
+        why: IdentifyWhy::Failed(why),
     }
 }
 

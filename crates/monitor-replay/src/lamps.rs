@@ -21,7 +21,7 @@ pub use unsettled::HeldUnsettled;
 /// Why the residuals were skipped: the column the log lacks (the report's `skipped`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
-pub enum Skipped {
+pub enum SkippedAnalysis {
     /// The residuals need the voltages `va_V, vb_V, vc_V`.
     ResidualsNeedVoltages,
     /// The residuals need the speed (`wm_rad_s` or `enc_count`).
@@ -54,7 +54,7 @@ pub(crate) struct LampStage {
     /// The monitor's angle source (the report's).
     angle_source: AngleSource,
     /// The analyses the log's columns cannot feed (the report's `skipped`).
-    skipped: Vec<Skipped>,
+    skipped: Vec<SkippedAnalysis>,
     evaluated: bool,
     /// Seconds of running on which the lamps were judged: evaluated, quasi-steady, on
     /// thresholds in force (`MIN_JUDGED_S` for a healthy verdict).
@@ -134,7 +134,7 @@ pub(crate) struct LampsFinding {
     /// The monitor's angle source.
     pub(crate) angle_source: AngleSource,
     /// The analyses the log's columns cannot feed, with the column they need.
-    pub(crate) skipped: Vec<Skipped>,
+    pub(crate) skipped: Vec<SkippedAnalysis>,
 }
 
 impl LampStage {
@@ -394,11 +394,11 @@ impl Finish for LampStage {
 
 /// The analyses a log with `channels` cannot feed, with the column they need (the report's
 /// `skipped`).
-fn skipped_analyses(channels: Channels) -> Vec<Skipped> {
+fn skipped_analyses(channels: Channels) -> Vec<SkippedAnalysis> {
     if !channels.voltages {
-        vec![Skipped::ResidualsNeedVoltages]
+        vec![SkippedAnalysis::ResidualsNeedVoltages]
     } else if !(channels.speed || channels.encoder) {
-        vec![Skipped::ResidualsNeedSpeed]
+        vec![SkippedAnalysis::ResidualsNeedSpeed]
     } else {
         Vec::new()
     }

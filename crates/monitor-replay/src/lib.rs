@@ -96,7 +96,7 @@ pub use fields::{
     field_given, OptionError, OptionField, OptionSpec, OptionValue, Takes, DIAGNOSE_OPTIONS,
 };
 pub use timeline::{MonitorState, MovedWhy, Panel, TimelinePoint};
-pub use verdict::{Detail, FileMisfit, FindingReport, Rule, Skipped, Verdict};
+pub use verdict::{Detail, FileMisfit, FindingReport, Rule, SkippedAnalysis, Verdict};
 pub use winding::level::{LabelledRun, LevelBasis, ShortedTurns, TurnCalibration, TurnReach};
 pub use winding::{
     segments, Against, BaselineSource, OperatingPointSource, PhaseNotJudged, PhaseProbabilities,

@@ -57,7 +57,7 @@ pub struct DiagnoseReport {
     /// Analyses skipped for lack of a column, with the column (JSON `skipped_reasons`; the
     /// door spells them as `skipped`).
     #[serde(rename = "skipped_reasons")]
-    pub skipped: Vec<crate::verdict::Skipped>,
+    pub skipped: Vec<crate::verdict::SkippedAnalysis>,
     /// Angle source used (JSON: its command-line name, [`crate::angle_source_name`]).
     #[serde(serialize_with = "serialize_angle_source")]
     pub angle_source: AngleSource,

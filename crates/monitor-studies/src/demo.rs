@@ -3,12 +3,12 @@
 //! sensor streams replayed through the same core the firmware runs, and the lamps r1..r4
 //! and the fault candidates followed every 0.25 s.
 //!
-//! The default run is a day in service ([`Story::Service`]): the healthy residuals are
+//! The default run is a day in service ([`DemoStory::Service`]): the healthy residuals are
 //! learned (commissioning, 2-4 s); the load rises 40 % at 5 s and falls back at 6.5 s, which
 //! the monitor shows as what it is (the amber "operating point moved", a load move in the
 //! events, no fault); then the stator resistance rises 50 % at 8.5 s (a loose connection, a
 //! burnt contact), which lights the lamps and is named with its size. The load is an unknown
-//! input, as in service. [`Story::Paper`] is the paper's own protocol: one Table 1 fault at
+//! input, as in service. [`DemoStory::Paper`] is the paper's own protocol: one Table 1 fault at
 //! 5 s with the paper's fixed viscous load, under which a Bl change is a fault.
 
 use crate::experiment::ExperimentError;
@@ -43,7 +43,7 @@ pub struct DemoPoint {
 
 /// Which run the demo tells.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Story {
+pub enum DemoStory {
     /// A day in service (the default): commissioning, a load step and back, then `fault`
     /// of relative size `change` at [`SERVICE_FAULT_AT_S`]; the load an unknown input.
     Service {
@@ -72,10 +72,10 @@ pub const LOAD_BACK_AT_S: f64 = 6.5;
 /// When the service story's fault comes [s].
 pub const SERVICE_FAULT_AT_S: f64 = 8.5;
 
-impl Story {
+impl DemoStory {
     /// The default: the service story with the stator resistance +50 %.
     pub fn service() -> Self {
-        Story::Service {
+        DemoStory::Service {
             fault: Fault::Rs,
             change: 0.5,
         }
@@ -84,7 +84,9 @@ impl Story {
     /// The injected fault and its change.
     pub fn fault(self) -> (Fault, f64) {
         match self {
-            Story::Service { fault, change } | Story::Paper { fault, change } => (fault, change),
+            DemoStory::Service { fault, change } | DemoStory::Paper { fault, change } => {
+                (fault, change)
+            }
         }
     }
 }
@@ -93,7 +95,7 @@ impl Story {
 #[derive(Debug, Clone)]
 pub struct DemoRun {
     /// What was run.
-    pub story: Story,
+    pub story: DemoStory,
     /// The injected fault and its relative size (sensors: gain error).
     pub fault: Fault,
     /// Relative change (0.5 = +50 %).
@@ -126,7 +128,7 @@ impl DemoRun {
 ///
 /// # Errors
 /// Simulator or replay configuration errors (not expected for the reference motor).
-pub fn run(story: Story) -> Result<DemoRun, ExperimentError> {
+pub fn run(story: DemoStory) -> Result<DemoRun, ExperimentError> {
     let params = ParamFile::reference_3hp();
     let (fault, change) = story.fault();
     let (proto, load) = story.protocol();
@@ -176,13 +178,13 @@ pub fn run(story: Story) -> Result<DemoRun, ExperimentError> {
     })
 }
 
-impl Story {
+impl DemoStory {
     /// The protocol the story runs, and what the replay is told of the load: in service
     /// the load is an unknown input; the paper's scenario has its fixed viscous load, and
     /// a Bl change is a fault.
     fn protocol(self) -> (Protocol, monitor_replay::LoadModel) {
         match self {
-            Story::Service { .. } => (
+            DemoStory::Service { .. } => (
                 Protocol {
                     duration_s: 11.0,
                     fault_at_s: SERVICE_FAULT_AT_S,
@@ -190,7 +192,7 @@ impl Story {
                 },
                 monitor_replay::LoadModel::Unknown,
             ),
-            Story::Paper { .. } => (
+            DemoStory::Paper { .. } => (
                 Protocol {
                     duration_s: 8.0,
                     fault_at_s: 5.0,
@@ -204,8 +206,10 @@ impl Story {
     /// The story's load steps: (time [s], Bl as a multiple of the file's).
     fn load_steps(self) -> Vec<(f64, f64)> {
         match self {
-            Story::Service { .. } => vec![(LOAD_STEP_AT_S, LOAD_STEP_SCALE), (LOAD_BACK_AT_S, 1.0)],
-            Story::Paper { .. } => Vec::new(),
+            DemoStory::Service { .. } => {
+                vec![(LOAD_STEP_AT_S, LOAD_STEP_SCALE), (LOAD_BACK_AT_S, 1.0)]
+            }
+            DemoStory::Paper { .. } => Vec::new(),
         }
     }
 }

@@ -52,8 +52,8 @@ fn check(name: &str, listed: &[f64], steps: &[f64], must: &[f64]) -> Option<Stri
 
 #[test]
 fn the_demos_load_steps_are_listed_where_they_began() {
-    let run =
-        monitor_studies::demo::run(monitor_studies::demo::Story::service()).expect("the demo runs");
+    let run = monitor_studies::demo::run(monitor_studies::demo::DemoStory::service())
+        .expect("the demo runs");
     let steps = [
         monitor_studies::demo::LOAD_STEP_AT_S,
         monitor_studies::demo::LOAD_BACK_AT_S,

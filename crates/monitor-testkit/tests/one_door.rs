@@ -21,6 +21,8 @@
 mod architecture_syntax;
 
 use architecture_syntax::files::{files, is_code, is_test_file, read, verdict};
+use syn::spanned::Spanned;
+use syn::visit::Visit;
 
 /// The engine crates: they return typed values, never a front end's words.
 const ENGINES: [&str; 7] = [
@@ -67,6 +69,8 @@ fn sources(dirs: &[&str]) -> Vec<String> {
     files()
         .into_iter()
         .filter(|f| is_code(f) && !is_test_file(f))
+        // A test module in a file of its own (`mod tests;` under `#[cfg(test)]`).
+        .filter(|f| !(f.ends_with("/tests.rs") || f.ends_with("_tests.rs")))
         .filter(|f| dirs.iter().any(|d| f.starts_with(d)))
         .collect()
 }
@@ -114,19 +118,61 @@ fn the_words_are_spelled_in_one_crate() {
     verdict("the words are spelled in one crate", bad);
 }
 
-/// Rule 2's violations in `text` (of `rel`): a struct field holding a spelling.
+/// Whether a type names the words (`Words`, `Spelling`), however wrapped (`&dyn Spelling`,
+/// `&'static (dyn Spelling + Sync)`, `Option<Words>`).
+#[derive(Default)]
+struct NamesWords(bool);
+
+impl<'ast> Visit<'ast> for NamesWords {
+    fn visit_path_segment(&mut self, s: &'ast syn::PathSegment) {
+        self.0 |= s.ident == "Words" || s.ident == "Spelling";
+        syn::visit::visit_path_segment(self, s);
+    }
+}
+
+/// The fields (of structs, enum variants and unions) outside test modules whose type
+/// names the words.
+struct FieldsHoldingWords<'a> {
+    rel: &'a str,
+    found: Vec<String>,
+}
+
+impl<'ast> Visit<'ast> for FieldsHoldingWords<'_> {
+    fn visit_item_mod(&mut self, m: &'ast syn::ItemMod) {
+        if !architecture_syntax::is_cfg_test(&m.attrs) {
+            syn::visit::visit_item_mod(self, m);
+        }
+    }
+
+    fn visit_field(&mut self, f: &'ast syn::Field) {
+        let mut n = NamesWords::default();
+        n.visit_type(&f.ty);
+        if n.0 {
+            let name = f
+                .ident
+                .as_ref()
+                .map_or("(unnamed)".to_string(), |i| i.to_string());
+            self.found.push(format!(
+                "{}:{}: a field holding words: {name}",
+                self.rel,
+                f.span().start().line
+            ));
+        }
+        syn::visit::visit_field(self, f);
+    }
+}
+
+/// Rule 2's violations in `text` (of `rel`): a field of a type (a struct's, an enum
+/// variant's) holding a spelling; a function's parameter is how a spelling is passed, and
+/// is not one.
 fn fields_holding_words(rel: &str, text: &str) -> Vec<String> {
-    code_lines(text)
-        .filter(|(_, l)| {
-            let t = l.trim_start();
-            let field = t.starts_with("pub ") || t.starts_with("pub(crate) ") || !t.contains('(');
-            field
-                && t.contains(": ")
-                && t.trim_end().ends_with(',')
-                && (names(t, "Words") || t.contains("dyn Spelling"))
-        })
-        .map(|(n, l)| format!("{rel}:{n}: a field holding words: {}", l.trim()))
-        .collect()
+    let file = syn::parse_file(text).unwrap_or_else(|e| panic!("{rel}: cannot parse: {e}"));
+    let mut v = FieldsHoldingWords {
+        rel,
+        found: Vec::new(),
+    };
+    v.visit_file(&file);
+    v.found
 }
 
 #[test]
@@ -206,9 +252,8 @@ fn the_rules_catch_what_they_should() {
     let clean = |_: &str| "pub struct Options {\n    pub wordsmith: u8,\n}\n".to_string();
     assert!(engines_naming_words(&["x.rs".into()], &clean).is_empty());
     // Rule 2: a field holding a spelling, also as a reference.
-    let t =
-        "pub struct A {\n    pub words: Words,\n    spell: &'static (dyn Spelling + Sync),\n}\n";
-    assert_eq!(fields_holding_words("a.rs", t).len(), 2);
+    let t = "pub struct A {\n    pub words: Words,\n    spell: &'static (dyn Spelling + Sync),\n}\nenum B { C { sp: Option<Words> } }\nfn f(sp: &dyn Spelling) {}\n#[cfg(test)]\nmod tests { struct D { w: Words } }\n";
+    assert_eq!(fields_holding_words("a.rs", t).len(), 3, "{t}");
     // Rule 3: a reason read back, the ladder's old refusal among them; a name asked about
     // its text and test code are not.
     let t = "if !t.because.starts_with(\"not physical\") {}\nlet x = why.as_str().contains(\"y\");\nlet ok = name.starts_with(\"a\");\n#[cfg(test)]\nmod tests { fn f() { why.contains(\"z\"); } }\n";

@@ -1,10 +1,31 @@
 //! `identify`'s words, spelled from [`monitor_analysis::identify`]'s typed values: why an
 //! identification is not written.
 
-use monitor_analysis::identify::IdentifyRefusal;
+use crate::Spelling;
+use monitor_analysis::identify::{IdentifyError, IdentifyRefusal};
+use monitor_replay::OptionField;
 
-/// Why the identification is not written, naming the likely cause.
-pub fn refusal(r: &IdentifyRefusal) -> String {
+/// Why the identification could not run on a log: the error's own message, except where it
+/// names the analysed window's fields, which are spelled in the front end's words (`sp`:
+/// `--from`/`--to` on the command line, `from_s`/`to_s` in Python).
+pub fn failed(e: &IdentifyError, sp: &dyn Spelling) -> String {
+    match *e {
+        IdentifyError::Irregular {
+            at_s,
+            interval_s,
+            dt_s,
+        } => format!(
+            "the samples are not regular at t = {at_s} s (an interval of {interval_s:.3e} s where the rate gives {dt_s:.3e} s): give a window without gaps ({}/{})",
+            sp.option(OptionField::From, ""),
+            sp.option(OptionField::To, "")
+        ),
+        ref other => other.to_string(),
+    }
+}
+
+/// Why the identification is not written, naming the likely cause (`sp` names the window's
+/// start as the front end does).
+pub fn refusal(r: &IdentifyRefusal, sp: &dyn Spelling) -> String {
     match r {
         IdentifyRefusal::CurrentOutOfRange { i_a, low_a, high_a } => {
             let above = i_a > high_a;
@@ -20,8 +41,9 @@ pub fn refusal(r: &IdentifyRefusal) -> String {
             )
         }
         IdentifyRefusal::PoorFit { error, termination } => format!(
-            "the fit leaves a current error of {:.1} % of its RMS (solver {termination}; a good log leaves under 1 %): the model does not fit this log: check the [columns] mapping and units, give from_s to leave out what the model cannot follow, or start from a parameter file of this machine",
-            100.0 * error
+            "the fit leaves a current error of {:.1} % of its RMS (solver {termination}; a good log leaves under 1 %): the model does not fit this log: check the [columns] mapping and units, give {} to leave out what the model cannot follow, or start from a parameter file of this machine",
+            100.0 * error,
+            sp.option(OptionField::From, "")
         ),
         IdentifyRefusal::NotAMachine { key, message } => format!(
             "an identified value is not one of a real machine ({key}: {message}): a unit or a mapping is likely wrong"

@@ -53,14 +53,14 @@ fn parse_change(s: &str) -> Result<f64, String> {
 /// # Errors
 /// Simulator errors (not expected for the reference motor) or an I/O error on stdout.
 pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
-    use monitor_studies::demo::Story;
+    use monitor_studies::demo::DemoStory;
     let story = if args.paper {
-        Story::Paper {
+        DemoStory::Paper {
             fault: args.fault.unwrap_or(Fault::Bl),
             change: args.change,
         }
     } else {
-        Story::Service {
+        DemoStory::Service {
             fault: args.fault.unwrap_or(Fault::Rs),
             change: args.change,
         }

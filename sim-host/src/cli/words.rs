@@ -69,7 +69,13 @@ mod tests {
         let e = ApiError::Identify {
             what: "cannot identify from",
             log: "a.csv".into(),
-            why: "a gap: give a window without it (from_s/to_s)".into(),
+            why: monitor_api::IdentifyWhy::Failed(
+                monitor_api::analysis::identify::IdentifyError::Irregular {
+                    at_s: 1.0,
+                    interval_s: 2e-3,
+                    dt_s: 1e-3,
+                },
+            ),
         };
         assert!(e.spelled(&CliWords).ends_with("(--from/--to)"), "{e}");
         let e = ApiError::WindowOrder {

@@ -4,7 +4,7 @@
 
 use super::measured::{rotor_finding, sensor_flag_finding, winding_finding};
 use super::MIN_JUDGED_S;
-use super::{Detail, FindingReport, Skipped};
+use super::{Detail, FindingReport, SkippedAnalysis};
 use crate::isolation::IsolationFinding;
 use crate::isolation::{FaultCandidate, IsolationBaseline, IsolationName, IsolationReport};
 use crate::lamps::commission::FirstPointMisfit;
@@ -25,7 +25,7 @@ pub(crate) struct ResidualInputs<'a> {
     /// A lamp or the isolation detected a fault (after heating and load moves).
     pub detected: bool,
     /// The analyses the log could not feed (the report's `skipped`).
-    pub skipped: &'a [Skipped],
+    pub skipped: &'a [SkippedAnalysis],
 }
 
 /// What the isolation names, as the verdict reads it: a Table 1 fault with its candidate's

@@ -38,7 +38,7 @@ pub struct FindingReport {
     pub detail: Detail,
 }
 
-pub use crate::lamps::Skipped;
+pub use crate::lamps::SkippedAnalysis;
 
 /// What a finding rests on, with its numbers (JSON `findings[].reason`, `{"kind": ..}`).
 /// The winding's, the rotor's and the isolation's own reports carry theirs (the report's
@@ -50,7 +50,7 @@ pub enum Detail {
     /// speed both).
     ResidualsSkipped {
         /// Which column.
-        need: Option<Skipped>,
+        need: Option<SkippedAnalysis>,
     },
     /// The commissioning window asked for was not learned.
     ResidualsNotLearned(crate::lamps::commission::NotLearned),

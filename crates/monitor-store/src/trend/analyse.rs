@@ -1,11 +1,12 @@
 //! The trend's computation (the statistics in [`super::stats`], the rules in the module's
 //! documentation).
 
+use super::level::{fault_level_of, fault_level_run};
 use super::reference::{latched, normalisation_note, reference_stats};
 use super::stats::{least_squares, mad_sigma, median, theil_sen};
 use super::{
-    reference_rows, Direction, FaultLevel, Indicator, IndicatorTrend, MotorTrend, TrendOptions,
-    TrendPoint, TrendReason, ValueRange, INDICATORS, RISE,
+    reference_rows, Direction, Indicator, IndicatorTrend, MotorTrend, TrendOptions, TrendPoint,
+    TrendReason, ValueRange, INDICATORS, RISE,
 };
 use crate::row::{utc_day, StoredRow};
 
@@ -285,45 +286,6 @@ pub fn indicator_trend(
     t
 }
 
-/// The motor's last logs in a row at an indicator's FAULT level
-/// ([`TrendReason::FaultLevelInARow`]).
-pub(super) struct LevelRun {
-    /// How many (at least 1).
-    pub logs: usize,
-    /// The first one's UTC day.
-    pub first_day: String,
-    /// The last log's stored value.
-    pub value: f64,
-    /// Its FAULT level.
-    pub level: f64,
-}
-
-/// The run of logs at the FAULT level of `ind` that ends at the last of `rows` (by time):
-/// each log's stored value at or beyond its own level (a level column's value in the log,
-/// else the indicator's level over `rows`); a log without the value, or below its level,
-/// ends the run. `None` where the last log is not at the level or `ind` has none.
-pub(super) fn fault_level_run(ind: &Indicator, rows: &[&StoredRow]) -> Option<LevelRun> {
-    let common = fault_level_of(ind, rows);
-    let level_of = |r: &StoredRow| match ind.fault_level {
-        FaultLevel::Column(c) => r.f64(c).filter(|x| *x > 0.0).or(common),
-        _ => common,
-    };
-    let at = |r: &StoredRow| match (r.f64(ind.column), level_of(r)) {
-        (Some(v), Some(l)) if v.is_finite() && v >= l => Some((v, l)),
-        _ => None,
-    };
-    let last = rows.last()?;
-    let (value, level) = at(last)?;
-    let logs = rows.iter().rev().take_while(|r| at(r).is_some()).count();
-    let first = rows.get(rows.len() - logs)?;
-    Some(LevelRun {
-        logs,
-        first_day: first.str("day").unwrap_or_default().to_string(),
-        value,
-        level,
-    })
-}
-
 /// The indicator's points, normalised with `fit` where there is one: those from `start_s`
 /// on in the window, those of the reference mask (over `rows`) in the reference.
 fn series_of(
@@ -354,18 +316,6 @@ fn series_of(
             })
         })
         .collect()
-}
-
-/// The indicator's FAULT level for these rows, where it has one.
-fn fault_level_of(ind: &Indicator, rows: &[&StoredRow]) -> Option<f64> {
-    match ind.fault_level {
-        FaultLevel::None => None,
-        FaultLevel::Fixed(x) => Some(x),
-        FaultLevel::Column(c) => {
-            let mut v: Vec<f64> = rows.iter().filter_map(|r| r.f64(c)).collect();
-            median(&mut v).filter(|x| *x > 0.0)
-        }
-    }
 }
 
 /// The slope, scatter, alarm, projection and reason of `t` from its series.

@@ -373,6 +373,7 @@ pub struct TrendReference {
 }
 
 mod analyse;
+mod level;
 mod reason;
 mod reference;
 

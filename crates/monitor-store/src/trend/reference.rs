@@ -2,7 +2,7 @@
 //! normalisation did and why, and the alarm's hysteresis: raised on the trend, held until
 //! the indicator is back at the reference (the module's documentation, items 4 and 5).
 
-use super::analyse::fault_level_run;
+use super::level::fault_level_run;
 use super::stats::{mad_sigma, median};
 use super::{
     CovariateRange, Indicator, IndicatorTrend, Normalisation, ReferenceBasis, TrendOptions,

@@ -4,6 +4,7 @@
 //! tests ([`LongFunctions`]), and what an engine may not spell ([`spelling`], rule 8, with
 //! its tests).
 
+pub mod allowances;
 pub mod circles;
 pub mod files;
 pub mod layers;

@@ -4,7 +4,7 @@
 
 use monitor_replay::{
     CommissionAdvice, CommissioningReport, FirstPointMisfit, NotLearned, NotLearnedWhy,
-    RangeDeparture, RangeNote, RangeQuantity, Skipped, Thresholds,
+    RangeDeparture, RangeNote, RangeQuantity, SkippedAnalysis, Thresholds,
 };
 
 use crate::spelling::Spelling;
@@ -133,12 +133,12 @@ pub fn first_point_misfit(m: &FirstPointMisfit, sp: &dyn Spelling) -> String {
 }
 
 /// An analysis the log could not feed, with the column it needs (JSON `skipped`).
-pub fn skipped(s: Skipped) -> &'static str {
+pub fn skipped(s: SkippedAnalysis) -> &'static str {
     match s {
-        Skipped::ResidualsNeedVoltages => {
+        SkippedAnalysis::ResidualsNeedVoltages => {
             "residuals r1..r4 and fault signatures: need the voltages va_V, vb_V, vc_V (Vqs)"
         }
-        Skipped::ResidualsNeedSpeed => {
+        SkippedAnalysis::ResidualsNeedSpeed => {
             "residuals r1..r4 and fault signatures: need the speed (wm_rad_s or enc_count)"
         }
     }

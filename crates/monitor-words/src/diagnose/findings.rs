@@ -1,7 +1,7 @@
 //! A finding in words: its sentence (`summary`) and its brief phrase for the verdict's
 //! lists, spelled from what it rests on ([`Detail`]) and the report's own analyses.
 
-use super::verdict::{against_text, fault_text};
+use super::named::{against_text, fault_text};
 use super::{commissioning, isolation, rotor, winding};
 use monitor_core::verdict::{FindingSource, NamedFault};
 use monitor_io::log::quality::MAX_NOT_JUDGED_FRACTION;

@@ -11,6 +11,7 @@
 mod commissioning;
 mod findings;
 mod isolation;
+mod named;
 mod rotor;
 mod verdict;
 mod winding;
@@ -231,6 +232,11 @@ fn put_story(v: &mut Value, rep: &DiagnoseReport, story: &Story, sp: &dyn Spelli
             story.least_change_widened.clone(),
         );
     }
+    put_rotor_and_timeline(v, story);
+}
+
+/// The rotor's sentences and the timeline's notes of [`put_story`].
+fn put_rotor_and_timeline(v: &mut Value, story: &Story) {
     if let Some(r) = v.get_mut("rotor") {
         put(r, "sentence", story.rotor.clone());
         put(r, "cannot_judge_because", story.rotor_cannot.clone());

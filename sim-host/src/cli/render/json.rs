@@ -51,8 +51,8 @@ pub fn demo(run: &DemoRun) -> DemoReport<'_> {
     let doc = monitor_api::words::diagnose::document(&run.report, sp);
     DemoReport {
         story: match run.story {
-            monitor_studies::demo::Story::Service { .. } => "service",
-            monitor_studies::demo::Story::Paper { .. } => "paper",
+            monitor_studies::demo::DemoStory::Service { .. } => "service",
+            monitor_studies::demo::DemoStory::Paper { .. } => "paper",
         },
         fault_injected: run.fault.name(),
         change: run.change,

@@ -63,10 +63,10 @@ pub fn demo(mut out: &mut dyn std::io::Write, run: &DemoRun) -> anyhow::Result<(
 
 /// The demo's story: the motor, the load, the commissioning and the fault.
 fn demo_story(out: &mut impl Write, run: &DemoRun) -> anyhow::Result<()> {
-    use monitor_studies::demo::{Story, LOAD_BACK_AT_S, LOAD_STEP_AT_S, LOAD_STEP_SCALE};
+    use monitor_studies::demo::{DemoStory, LOAD_BACK_AT_S, LOAD_STEP_AT_S, LOAD_STEP_SCALE};
     let fault = format!("{} {:+.0} %", run.fault.name(), 100.0 * run.change);
     match run.story {
-        Story::Service { .. } => writeln!(
+        DemoStory::Service { .. } => writeln!(
             out,
             "3 hp induction motor, 220 V 60 Hz, started direct-on-line; 12-bit sensors with noise; the load is\n\
              an unknown input, as in service. Commissioning 2.0-4.0 s learns the healthy motor; the load rises\n\
@@ -74,7 +74,7 @@ fn demo_story(out: &mut impl Write, run: &DemoRun) -> anyhow::Result<()> {
             100.0 * (LOAD_STEP_SCALE - 1.0),
             run.fault_at_s,
         )?,
-        Story::Paper { .. } => writeln!(
+        DemoStory::Paper { .. } => writeln!(
             out,
             "3 hp induction motor, 220 V 60 Hz, direct-on-line start, the paper's fixed viscous load; 12-bit\n\
              sensors with noise. Commissioning 2.0-4.0 s learns the healthy residuals; at {:.1} s: {fault}.\n",
