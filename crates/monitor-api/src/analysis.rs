@@ -8,7 +8,7 @@
 pub use monitor_analysis::compare::{CompareOutput, CompareReport};
 pub use monitor_analysis::effects::sig;
 pub use monitor_analysis::explain::ladder::{
-    BaseChange, FinalFit, LadderReport, LadderStep, Tried, FLOOR_BAND,
+    BaseChange, FinalFit, LadderReport, LadderStep, Tried, FLOOR_BAND, STEP_MIN,
 };
 pub use monitor_analysis::explain::{ExplainOutput, ExplainReport, Standing, EXPLAINS_MIN};
 pub use monitor_analysis::identify::{self, Identification};

@@ -222,8 +222,9 @@ pub struct ExplainArgs {
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(6..))]
     pub rotor_bars: Option<u32>,
     /// Walk the ladder instead of ranking once: add the effect that lowers the held-back
-    /// error most, keep it when the step passes its test (it removes at least 20 % of the
-    /// held-back error beyond the noise floor and lowers the whole-log error), and go on
+    /// error most, keep it when the step passes its test (it removes at least the share of
+    /// the held-back error beyond the noise floor that the output's `test` states, and
+    /// lowers the whole-log error), and go on
     /// from the new model until the error is within the noise-floor band or nothing
     /// plausible helps. One row per step; --report draws the error falling onto the floor.
     /// JSON: start, ladder [{effect, added, fitted {name: {value, unit, low, high}}, error,
@@ -232,8 +233,18 @@ pub struct ExplainArgs {
     /// (noise_floor | nothing_helps | library_exhausted | no_model | untrusted),
     /// stopped_because, final_effects, last_round, skipped, split, test, data,
     /// data_quality.
-    #[arg(long, conflicts_with_all = ["compare", "rotor_bars"])]
+    #[arg(long, conflicts_with_all = ["compare", "rotor_bars"], long_help = ladder_help())]
     pub ladder: bool,
+}
+
+/// `explain --ladder`'s long help: the doc comment above with the step's test in the
+/// library's own figure ([`monitor_api::analysis::STEP_MIN`]), so the help and the output
+/// cannot disagree.
+fn ladder_help() -> String {
+    format!(
+        "Walk the ladder instead of ranking once: add the effect that lowers the held-back error most, keep it when the step passes its test (it removes at least {:.0} % of the held-back error beyond the noise floor and lowers the whole-log error), and go on from the new model until the error is within the noise-floor band or nothing plausible helps. One row per step; --report draws the error falling onto the floor. JSON: start, ladder [{{effect, added, fitted {{name: {{value, unit, low, high}}}}, error, heldback_error, noise_floor, heldback_noise_floor, ratio_to_floor, heldback_ratio_to_floor, significance, explained, heldback_explained}}], stop (noise_floor | nothing_helps | library_exhausted | no_model | untrusted), stopped_because, final_effects, last_round, skipped, split, test, data, data_quality.",
+        100.0 * monitor_api::analysis::STEP_MIN
+    )
 }
 
 /// Runs `compare`.
