@@ -326,6 +326,7 @@ def _analysis_kwargs(
     to_s: _Optional[float],
     no_fit: bool,
     group: _Optional[str],
+    laws: _Optional[PathLike] = None,
 ) -> _Dict[str, _Any]:
     names = _items(effects)
     for e in names:
@@ -337,7 +338,17 @@ def _analysis_kwargs(
         to_s=_number("to_s", to_s),
         no_fit=no_fit,
         group=group,
+        laws=_laws_path(laws),
     )
+
+
+def _laws_path(laws: _Optional[PathLike]) -> _Optional[str]:
+    """A law file's path (``laws=``), or None; a value that is not a path is a TypeError."""
+    if laws is None:
+        return None
+    if not isinstance(laws, (str, _os.PathLike)):
+        raise OptionTypeError(f"laws = {laws!r}: {_a_type(laws)}, not a path: give the law file's path")
+    return _os.fspath(laws)
 
 
 def compare(
@@ -348,13 +359,23 @@ def compare(
     to_s: _Optional[float] = None,
     no_fit: bool = False,
     group: _Optional[str] = None,
+    laws: _Optional[PathLike] = None,
 ) -> CompareResult:
     """Compare the paper's simplified model (with ``effects`` added) with the measurement:
     ``normalized_rms_error``, ``channels``, ``worst_windows`` (``sim-host compare``).
 
     ``effects`` names the effects already in the model: a list, or one name
-    (``effects="load_torque"`` is ``["load_torque"]``). ``from_s``/``to_s`` limit the
-    analysed window [s] (at least 25 supply periods).
+    (``effects="load_torque"`` is ``["load_torque"]``); with ``laws`` (a law file,
+    ``sim-host compare --laws``) the name of one of its laws too. ``from_s``/``to_s`` limit
+    the analysed window [s] (at least 25 supply periods).
+
+    Raises
+    ------
+    FileNotFoundError
+        ``laws`` names no file.
+    OptionError
+        A law file with a mistake (one line naming the law, the position and the problem),
+        or an effect name neither the library nor the laws have (with near matches).
     """
     p, is_text = _params(params)
     data, origin = _log(log)
@@ -363,7 +384,7 @@ def compare(
         p,
         log_origin=origin,
         params_is_text=is_text,
-        **_analysis_kwargs(effects, from_s, to_s, no_fit, group),
+        **_analysis_kwargs(effects, from_s, to_s, no_fit, group, laws),
     )
     return CompareResult(_json.loads(doc))
 
@@ -378,6 +399,7 @@ def explain(
     group: _Optional[str] = None,
     rotor_bars: _Optional[int] = None,
     ladder: bool = False,
+    laws: _Optional[PathLike] = None,
 ) -> _Union[ExplainResult, LadderResult]:
     """Rank the physical effects missing from the model by how much of its error each
     explains: ``ranking``, ``verdict``, ``unexplained`` (``sim-host explain``).
@@ -391,7 +413,12 @@ def explain(
     ``heldback_error``, ``noise_floor``, ``ratio_to_floor``, ``significance``, ...),
     ``base_changes``, ``final_fit`` (the chosen model refitted on the whole log), ``stop``
     and ``stopped_because``; ``.ladder_frame`` is the steps as a DataFrame, ``.base_frame``
-    the six base parameters against the file."""
+    the six base parameters against the file.
+
+    ``laws`` is a file of your own laws (``sim-host explain --laws``): each is a candidate
+    beside the library's effects, fitted and judged the same way and reported by its name.
+    A missing file raises ``FileNotFoundError``, a law with a mistake ``OptionError`` (a
+    ``ValueError``)."""
     p, is_text = _params(params)
     data, origin = _log(log)
     doc = _native.explain(
@@ -401,7 +428,7 @@ def explain(
         params_is_text=is_text,
         rotor_bars=_count("rotor_bars", rotor_bars),
         ladder=ladder,
-        **_analysis_kwargs(effects, from_s, to_s, no_fit, group),
+        **_analysis_kwargs(effects, from_s, to_s, no_fit, group, laws),
     )
     if ladder:
         return LadderResult(_json.loads(doc))
@@ -479,13 +506,15 @@ def simulate(
     params: ParamsLike,
     scenario: _Union[PathLike, str],
     out: _Optional[PathLike] = None,
+    laws: _Optional[PathLike] = None,
 ) -> "pd.DataFrame":
     """Simulate the motor of ``params`` through ``scenario`` (a scenario file, or its TOML
     text) with the project's simulator (``sim-host simulate``).
 
     Returns the log as a pandas DataFrame with the schema's columns (``t_s``, ``va_V``, ...,
     SI units), and writes it to ``out`` too when given (CSV, TDMS or Parquet by extension),
-    whole or not at all.
+    whole or not at all. ``laws`` (a law file, ``sim-host simulate --laws``) injects each of
+    its laws at its parameters' start values.
 
     Raises
     ------
@@ -501,7 +530,7 @@ def simulate(
         isinstance(scenario, str) and "\n" not in scenario and _Path(scenario).exists()
     )
     p, is_text = _params(params)
-    kwargs = dict(params_is_text=is_text, scenario_is_text=not is_file)
+    kwargs = dict(params_is_text=is_text, scenario_is_text=not is_file, laws=_laws_path(laws))
     if out is not None:
         # The library checks `out` against the parameter file and the scenario file before
         # anything is written (an OptionError naming both), then writes it atomically.

@@ -41,6 +41,7 @@ def compare(
     to_s: Optional[float] = ...,
     no_fit: bool = ...,
     group: Optional[str] = ...,
+    laws: Optional[str] = ...,
 ) -> str: ...
 def explain(
     log: Any,
@@ -54,6 +55,7 @@ def explain(
     group: Optional[str] = ...,
     rotor_bars: Optional[int] = ...,
     ladder: bool = ...,
+    laws: Optional[str] = ...,
 ) -> str: ...
 def identify(
     log: Any,
@@ -85,6 +87,7 @@ def simulate(
     out: str,
     params_is_text: bool = ...,
     scenario_is_text: bool = ...,
+    laws: Optional[str] = ...,
 ) -> str: ...
 def fleet_row(table_toml: str, base: str, log: str, shown: str) -> str: ...
 def fleet_columns() -> List[str]: ...

@@ -85,9 +85,13 @@ impl monitor_api::words::Spelling for PyWords {
     }
 }
 
-/// The exception of an [`ApiError`], its message in Python's words ([`PyWords`]).
+/// The exception of an [`ApiError`], its message in Python's words ([`PyWords`]); a law file
+/// that does not exist is Python's `FileNotFoundError`.
 fn to_py(e: ApiError) -> PyErr {
     let msg = e.spelled(&PyWords);
+    if let ApiError::Laws(monitor_api::laws::LawError::NotFound { .. }) = e {
+        return pyo3::exceptions::PyFileNotFoundError::new_err(msg);
+    }
     match e.kind() {
         ErrorKind::Params => ParamsError::new_err(msg),
         ErrorKind::Log => LogError::new_err(msg),
@@ -139,20 +143,22 @@ fn json<T: serde::Serialize>(v: &T) -> PyResult<String> {
     serde_json::to_string(v).map_err(|e| InternalError::new_err(e.to_string()))
 }
 
-/// The effects named, each by the library's list ([`monitor_core::EffectKind::ALL`]); an
-/// unknown name is refused with its near matches ([`api::files::near_names`]) and the list.
-fn effects_of(names: &[String]) -> PyResult<Vec<monitor_core::EffectKind>> {
-    let known: Vec<&str> = monitor_core::EffectKind::ALL
-        .iter()
-        .map(|e| e.name())
-        .collect();
-    names
-        .iter()
-        .map(|n| {
-            monitor_core::EffectKind::from_name(n)
-                .ok_or_else(|| OptionError::new_err(not_in_library("effect", n, &known)))
-        })
-        .collect()
+/// The effects named: the library's, checked here with near matches
+/// ([`api::files::near_names`]) when no law file is given; with one, the library resolves
+/// them against the laws too (an unknown name is then an `OptionError` of the request).
+fn effects_of(names: &[String], laws: bool) -> PyResult<Vec<String>> {
+    if !laws {
+        let known: Vec<&str> = monitor_core::EffectKind::ALL
+            .iter()
+            .map(|e| e.name())
+            .collect();
+        for n in names {
+            if monitor_core::EffectKind::from_name(n).is_none() {
+                return Err(OptionError::new_err(not_in_library("effect", n, &known)));
+            }
+        }
+    }
+    Ok(names.to_vec())
 }
 
 /// `effect 'load_torq' is not in the library; did you mean 'load_torque'? (the library's
@@ -241,6 +247,7 @@ fn diagnose(
 
 fn analysis_request(
     effects: &[String],
+    laws: Option<PathBuf>,
     from_s: Option<f64>,
     to_s: Option<f64>,
     no_fit: bool,
@@ -248,7 +255,8 @@ fn analysis_request(
     rotor_bars: Option<u32>,
 ) -> PyResult<api::AnalysisRequest> {
     Ok(api::AnalysisRequest {
-        effects: effects_of(effects)?,
+        effects: effects_of(effects, laws.is_some())?,
+        laws,
         from_s,
         to_s,
         no_fit,
@@ -259,7 +267,7 @@ fn analysis_request(
 
 /// `compare --json`.
 #[pyfunction]
-#[pyo3(signature = (log, params, log_origin=None, params_is_text=false, effects=Vec::new(), from_s=None, to_s=None, no_fit=false, group=None))]
+#[pyo3(signature = (log, params, log_origin=None, params_is_text=false, effects=Vec::new(), from_s=None, to_s=None, no_fit=false, group=None, laws=None))]
 #[allow(clippy::too_many_arguments)]
 fn compare(
     py: Python<'_>,
@@ -272,8 +280,9 @@ fn compare(
     to_s: Option<f64>,
     no_fit: bool,
     group: Option<String>,
+    laws: Option<PathBuf>,
 ) -> PyResult<String> {
-    let req = analysis_request(&effects, from_s, to_s, no_fit, group, None)?;
+    let req = analysis_request(&effects, laws, from_s, to_s, no_fit, group, None)?;
     let log = log_source(log, log_origin.as_deref())?;
     run(py, || {
         let doc = api::compare(params_source(&params, params_is_text), log, &req, &PyWords);
@@ -283,7 +292,7 @@ fn compare(
 
 /// `explain --json`, or with `ladder` `explain --ladder --json`.
 #[pyfunction]
-#[pyo3(signature = (log, params, log_origin=None, params_is_text=false, effects=Vec::new(), from_s=None, to_s=None, no_fit=false, group=None, rotor_bars=None, ladder=false))]
+#[pyo3(signature = (log, params, log_origin=None, params_is_text=false, effects=Vec::new(), from_s=None, to_s=None, no_fit=false, group=None, rotor_bars=None, ladder=false, laws=None))]
 #[allow(clippy::too_many_arguments)]
 fn explain(
     py: Python<'_>,
@@ -298,8 +307,9 @@ fn explain(
     group: Option<String>,
     rotor_bars: Option<u32>,
     ladder: bool,
+    laws: Option<PathBuf>,
 ) -> PyResult<String> {
-    let req = analysis_request(&effects, from_s, to_s, no_fit, group, rotor_bars)?;
+    let req = analysis_request(&effects, laws, from_s, to_s, no_fit, group, rotor_bars)?;
     let log = log_source(log, log_origin.as_deref())?;
     run(py, || {
         let params = params_source(&params, params_is_text);
@@ -421,7 +431,7 @@ fn params_from_nameplate(
 /// [`OptionError`] when `out` is an input ("refusing to overwrite the input ..."); as
 /// `monitor_api::simulate_to_file`.
 #[pyfunction]
-#[pyo3(signature = (params, scenario, out, params_is_text=false, scenario_is_text=true))]
+#[pyo3(signature = (params, scenario, out, params_is_text=false, scenario_is_text=true, laws=None))]
 fn simulate(
     py: Python<'_>,
     params: String,
@@ -429,6 +439,7 @@ fn simulate(
     out: PathBuf,
     params_is_text: bool,
     scenario_is_text: bool,
+    laws: Option<PathBuf>,
 ) -> PyResult<String> {
     run(py, || {
         let scenario = if scenario_is_text {
@@ -436,8 +447,13 @@ fn simulate(
         } else {
             api::ScenarioSource::Path(std::path::Path::new(&scenario))
         };
-        let s = api::simulate_to_file(params_source(&params, params_is_text), scenario, &out)
-            .map_err(to_py)?;
+        let s = api::simulate_to_file_with_laws(
+            params_source(&params, params_is_text),
+            scenario,
+            &out,
+            laws.as_deref(),
+        )
+        .map_err(to_py)?;
         json(&s)
     })
 }

@@ -272,7 +272,7 @@ fn the_ranking_reads_beside_the_verdicts_fault() {
         let c = r
             .ranking
             .iter_mut()
-            .find(|c| c.effect == monitor_core::EffectKind::RotorAsymmetry)
+            .find(|c| c.effect == EffectId::ROTOR_ASYMMETRY)
             .expect("rotor_asymmetry fitted");
         (c.standing, c.rank, c.plausible) = (s, k, s != Standing::NotPlausible);
         if !c.plausible && c.implausible_because.is_empty() {

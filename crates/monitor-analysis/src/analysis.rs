@@ -8,7 +8,7 @@ use crate::metrics::Weights;
 use crate::prep::{Prepared, ReadOptions, C64};
 use crate::simplified_model::{BaseParams, MachineConstants, Prediction};
 use crate::{effects, fit, metrics, prep, simplified_model, unbalance};
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 use serde::Serialize;
 use std::path::Path;
 
@@ -24,15 +24,20 @@ pub enum AnalysisError {
     /// Reading the log failed.
     #[error(transparent)]
     Log(#[from] monitor_io::log::LogError),
-    /// Unknown effect name.
-    #[error("unknown effect '{0}' (known: {known})", known = known_effects())]
-    UnknownEffect(String),
+    /// Unknown effect name (`known`: the library's and the user's laws, comma separated).
+    #[error("unknown effect '{name}' (known: {known})")]
+    UnknownEffect {
+        /// The name given.
+        name: String,
+        /// The names known.
+        known: String,
+    },
     /// A configured effect cannot be set up on the log (a channel it needs is missing, or
     /// the log holds nothing it could fit).
     #[error("effect {effect}: {source}")]
     Effect {
         /// Which effect.
-        effect: EffectKind,
+        effect: EffectId,
         /// Why not.
         source: effects::SetupError,
     },
@@ -41,21 +46,28 @@ pub enum AnalysisError {
     Values(#[from] effects::EffectValuesError),
 }
 
-/// The library's effect names, comma separated (for messages).
-pub fn known_effects() -> String {
-    EffectKind::ALL
+/// The effect names of `registry` (the library's, then the user's laws), comma separated
+/// (for messages).
+pub fn known_effects(registry: &effects::Registry) -> String {
+    registry
+        .names()
         .iter()
         .map(|e| e.name())
         .collect::<Vec<_>>()
         .join(", ")
 }
 
-/// Parses an effect name of the library.
+/// Parses an effect name of `registry` (the library's or a user's law).
 ///
 /// # Errors
 /// [`AnalysisError::UnknownEffect`] listing the known names.
-pub fn parse_effect(name: &str) -> Result<EffectKind, AnalysisError> {
-    EffectKind::from_name(name).ok_or_else(|| AnalysisError::UnknownEffect(name.to_string()))
+pub fn parse_effect(name: &str, registry: &effects::Registry) -> Result<EffectId, AnalysisError> {
+    registry
+        .find(name)
+        .ok_or_else(|| AnalysisError::UnknownEffect {
+            name: name.to_string(),
+            known: known_effects(registry),
+        })
 }
 
 /// A loaded log with its nominal parameters.
@@ -80,9 +92,11 @@ pub struct Analysis {
 #[derive(Debug, Clone)]
 pub struct Options {
     /// Effects already in the model.
-    pub effects: Vec<EffectKind>,
+    pub effects: Vec<EffectId>,
     /// Refit the base parameters (default true).
     pub fit_base: bool,
+    /// The effects the analysis may use: the library's and a user's laws (`--laws`).
+    pub laws: effects::Registry,
 }
 
 /// One fitted parameter.
@@ -107,7 +121,7 @@ pub struct ParamValue {
 #[derive(Debug, Clone, Serialize)]
 pub struct FittedEffect {
     /// Which effect.
-    pub effect: EffectKind,
+    pub effect: EffectId,
     /// Parameters.
     pub parameters: std::collections::BTreeMap<String, ParamValue>,
     /// In words; for values outside their physical range, that the fit is not physical
@@ -156,12 +170,17 @@ impl AnalysisFrame {
     }
 }
 
-/// The effect models of `kinds`, each once, in the order given.
-pub(crate) fn resolve(kinds: &[EffectKind]) -> Vec<Box<dyn EffectModel>> {
+/// The effect models of `kinds` in `registry`, each once, in the order given (a name the
+/// registry does not have is left out: names are parsed against it first,
+/// [`parse_effect`]).
+pub(crate) fn resolve(
+    kinds: &[EffectId],
+    registry: &effects::Registry,
+) -> Vec<Box<dyn EffectModel>> {
     let mut v: Vec<Box<dyn EffectModel>> = Vec::new();
     for &k in kinds {
         if !v.iter().any(|x| x.kind() == k) {
-            v.push(effects::model_of(k));
+            v.extend(registry.model_of(k));
         }
     }
     v

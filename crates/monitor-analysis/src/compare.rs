@@ -6,14 +6,14 @@ use super::analysis::{
 use super::metrics::{self, ErrorSummary, Weights, WorstWindow};
 use super::simplified_model::{BaseParams, Prediction};
 use super::unbalance::UnbalanceAnalysis;
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 use serde::Serialize;
 
 /// Result of `compare` (its JSON document).
 #[derive(Debug, Clone, Serialize)]
 pub struct CompareReport {
     /// Effects in the model.
-    pub effects: Vec<EffectKind>,
+    pub effects: Vec<EffectId>,
     /// Mean normalised RMS error over the channels.
     pub normalized_rms_error: f64,
     /// Where the model's prediction diverged [s] ([`metrics::diverged_at`]): then
@@ -149,7 +149,7 @@ impl Analysis {
         if !d.channels.speed {
             skipped.push(CompareSkip::NoSpeed);
         }
-        let list = resolve(&opts.effects);
+        let list = resolve(&opts.effects, &opts.laws);
         let fitted = self.fit_for_compare(&list, opts)?;
         let active = self.setup_all(d, &list)?;
         // Data-dependent set-ups (load steps) are recomputed on the full series; keep the
@@ -227,7 +227,7 @@ impl Analysis {
         let err: ErrorSummary = metrics::errors(d, &pred, None);
         let v_rated = self.params.supply.v_phase_peak();
         let (mut worst, all) = metrics::windows(d, &pred, &w, v_rated, self.constants.np, 40, 3);
-        let in_model: Vec<EffectKind> = list.iter().map(|e| e.kind()).collect();
+        let in_model: Vec<EffectId> = list.iter().map(|e| e.kind()).collect();
         let plan = super::transients::dynamics_plan(span, &self.constants, &in_model);
         let (tags, advice) =
             super::transients::advice(d, &self.constants, &worst, &in_model, &plan);

@@ -58,3 +58,5 @@ pub use analysis::{
     Options, ParamValue, MAX_FIT_SAMPLES, MAX_ITER,
 };
 pub use base_range::base_implausible;
+/// An effect's or a law's identity (the library's and a user's alike).
+pub use monitor_laws::EffectId;

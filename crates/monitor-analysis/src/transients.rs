@@ -5,11 +5,11 @@
 //! rule ([`not_proposed`]) whether a dynamics effect is proposed on a log, so that
 //! `compare`'s advice and `explain`'s `skipped` give the same reasons.
 
-use super::effects::{model_of, EffectModel};
+use super::effects::{library, EffectModel};
 use super::metrics::WorstWindow;
 use super::prep::Prepared;
 use super::simplified_model::MachineConstants;
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 use serde::Serialize;
 
 /// A relative change of the supply voltage amplitude or frequency larger than this within a
@@ -205,7 +205,7 @@ pub fn settling_s(n: &MachineConstants) -> f64 {
 #[serde(rename_all = "snake_case")]
 pub enum NotProposed {
     /// Effects it needs in the model first ([`EffectModel::requires`]).
-    Requires(Vec<EffectKind>),
+    Requires(Vec<EffectId>),
     /// Its time constant `tau_s` [s] is shorter than 3 samples of the fit series (period
     /// `dt_s` [s]): a shorter window of the log would resolve it.
     Unresolved {
@@ -258,7 +258,7 @@ pub fn not_proposed(
     e: &dyn EffectModel,
     span: Span,
     n: &MachineConstants,
-    in_model: &[EffectKind],
+    in_model: &[EffectId],
 ) -> Option<NotProposed> {
     if let Some(tau_s) = e.time_constant_s(n) {
         if span.dt_s > tau_s / 3.0 {
@@ -271,7 +271,7 @@ pub fn not_proposed(
             return Some(NotProposed::NoTransient { tau_s });
         }
     }
-    let missing: Vec<EffectKind> = e
+    let missing: Vec<EffectId> = e
         .requires()
         .iter()
         .copied()
@@ -292,27 +292,25 @@ pub fn not_proposed(
 pub fn dynamics_plan(
     span: Span,
     n: &MachineConstants,
-    in_model: &[EffectKind],
-) -> Vec<(EffectKind, Option<NotProposed>)> {
-    let missing: Vec<EffectKind> = EffectKind::ALL
-        .iter()
-        .copied()
-        .filter(|k| k.is_dynamics() && !in_model.contains(k))
+    in_model: &[EffectId],
+) -> Vec<(EffectId, Option<NotProposed>)> {
+    let missing: Vec<Box<dyn EffectModel>> = library()
+        .into_iter()
+        .filter(|m| m.kind().is_dynamics() && !in_model.contains(&m.kind()))
         .collect();
     // First without what they need: those the span itself allows.
-    let allowed: Vec<EffectKind> = missing
+    let allowed: Vec<EffectId> = missing
         .iter()
-        .copied()
-        .filter(|&k| {
-            let model = model_of(k);
-            let all: Vec<EffectKind> = in_model.iter().chain(model.requires()).copied().collect();
+        .filter(|model| {
+            let all: Vec<EffectId> = in_model.iter().chain(model.requires()).copied().collect();
             not_proposed(model.as_ref(), span, n, &all).is_none()
         })
+        .map(|m| m.kind())
         .collect();
-    let with: Vec<EffectKind> = in_model.iter().chain(&allowed).copied().collect();
+    let with: Vec<EffectId> = in_model.iter().chain(&allowed).copied().collect();
     missing
         .into_iter()
-        .map(|k| (k, not_proposed(model_of(k).as_ref(), span, n, &with)))
+        .map(|m| (m.kind(), not_proposed(m.as_ref(), span, n, &with)))
         .collect()
 }
 
@@ -333,7 +331,7 @@ pub enum Advice {
     /// skipping it (the same words).
     NotProposed {
         /// The effect.
-        effect: EffectKind,
+        effect: EffectId,
         /// Why not.
         why: NotProposed,
     },
@@ -370,9 +368,9 @@ pub enum Cover {
     /// Add `proposed` (the model's `effects` with them).
     Add {
         /// The dynamics effects proposed.
-        proposed: Vec<EffectKind>,
+        proposed: Vec<EffectId>,
         /// The effects of the model with them (what `--effects` takes).
-        effects: Vec<EffectKind>,
+        effects: Vec<EffectId>,
     },
 }
 
@@ -385,8 +383,8 @@ pub fn advice(
     d: &Prepared,
     n: &MachineConstants,
     worst: &[WorstWindow],
-    in_model: &[EffectKind],
-    plan: &[(EffectKind, Option<NotProposed>)],
+    in_model: &[EffectId],
+    plan: &[(EffectId, Option<NotProposed>)],
 ) -> (Vec<Option<Transient>>, Vec<Advice>) {
     let start = start_end_s(d);
     let look = settling_s(n);
@@ -430,8 +428,8 @@ pub fn advice(
 
 /// What the dynamics effects of `plan` do for the transients: those proposed, with the
 /// effects of `in_model` and them, or why none is.
-fn cover(plan: &[(EffectKind, Option<NotProposed>)], in_model: &[EffectKind]) -> Cover {
-    let proposed: Vec<EffectKind> = plan
+fn cover(plan: &[(EffectId, Option<NotProposed>)], in_model: &[EffectId]) -> Cover {
+    let proposed: Vec<EffectId> = plan
         .iter()
         .filter(|(_, why)| why.is_none())
         .map(|(k, _)| *k)

@@ -9,7 +9,7 @@ use monitor_analysis::explain::{ExplainReport, Standing, EXPLAINS_MIN};
 use monitor_analysis::simplified_model::BaseParameter;
 use monitor_analysis::transients::{Advice, Cover, NotProposed};
 use monitor_analysis::unbalance::UnbalanceFinding;
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 use monitor_sim::{LoadKind, LoadSpec, LoadStep, Scenario, SupplyStep};
 
 /// A direct-on-line start from standstill, then steady running: 3 s at 5 kHz.
@@ -35,7 +35,7 @@ fn a_start_is_named_with_the_dynamics_effects_and_a_from() {
     );
     let added = proposed(&c.advice);
     assert!(
-        added.contains(&EffectKind::FluxDynamics) && added.contains(&EffectKind::CurrentDynamics),
+        added.contains(&EffectId::FLUX_DYNAMICS) && added.contains(&EffectId::CURRENT_DYNAMICS),
         "{:?}",
         c.advice
     );
@@ -231,7 +231,7 @@ fn assert_standings(case: &str, ex: &ExplainReport) {
             assert!(!c.summary.contains("K of heating"), "{case}: {}", c.summary);
         }
     }
-    let no_effect: Vec<EffectKind> = ex
+    let no_effect: Vec<EffectId> = ex
         .ranking
         .iter()
         .filter(|c| c.plausible && c.explained_fraction < EXPLAINS_MIN)
@@ -373,7 +373,7 @@ fn compare_advice_and_explain_skipped_agree() {
     for (case, a, start) in cases {
         let c = a.compare(&opts(&[])).unwrap().report;
         let ex = a.explain(&opts(&[]), &|_| {}).unwrap().report;
-        let skipped: Vec<(EffectKind, Option<&NotProposed>)> = ex
+        let skipped: Vec<(EffectId, Option<&NotProposed>)> = ex
             .skipped
             .iter()
             .filter(|s| s.effect.is_dynamics())
@@ -382,7 +382,7 @@ fn compare_advice_and_explain_skipped_agree() {
                 _ => (s.effect, None),
             })
             .collect();
-        let held: Vec<(EffectKind, Option<&NotProposed>)> = c
+        let held: Vec<(EffectId, Option<&NotProposed>)> = c
             .advice
             .iter()
             .filter_map(|a| match a {
@@ -397,12 +397,12 @@ fn compare_advice_and_explain_skipped_agree() {
             "{case}: the worst windows are transients"
         );
         // Skipped only for what it needs first, and advised with it.
-        let with_its_needs = |s: &(EffectKind, Option<&NotProposed>)| {
+        let with_its_needs = |s: &(EffectId, Option<&NotProposed>)| {
             added.contains(&s.0)
                 && matches!(s.1, Some(NotProposed::Requires(needs))
                     if needs.iter().any(|r| *r != s.0 && added.contains(r)))
         };
-        let for_the_span: Vec<(EffectKind, Option<&NotProposed>)> = skipped
+        let for_the_span: Vec<(EffectId, Option<&NotProposed>)> = skipped
             .iter()
             .filter(|s| !with_its_needs(s))
             .copied()
@@ -432,7 +432,7 @@ fn compare_advice_and_explain_skipped_agree() {
 }
 
 /// The dynamics effects `compare`'s advice adds (its first advice, on the transients).
-fn proposed(advice: &[Advice]) -> Vec<EffectKind> {
+fn proposed(advice: &[Advice]) -> Vec<EffectId> {
     match advice.first() {
         Some(Advice::Transients {
             cover: Cover::Add { proposed, .. },

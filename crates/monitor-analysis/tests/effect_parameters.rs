@@ -106,7 +106,7 @@ fn a_count_that_does_not_match_is_an_error_not_a_dropped_effect() {
     assert_eq!(
         err,
         EffectValuesError::Count {
-            effect: monitor_core::EffectKind::Windage,
+            effect: EffectId::WINDAGE,
             expected: 1,
             got: 2
         }
@@ -120,7 +120,7 @@ fn a_count_that_does_not_match_is_an_error_not_a_dropped_effect() {
     // The set-up refuses it too, where the model is built from fitted values.
     let n = MachineConstants::from_params(&ParamFile::reference_2p2kw());
     let d = Prepared::default();
-    let setup = model_of(monitor_core::EffectKind::Windage)
+    let setup = model_of(EffectId::WINDAGE)
         .setup(&d, &n)
         .expect("windage sets up on any log");
     let mut terms = Default::default();

@@ -6,7 +6,7 @@
 //! may use.
 
 pub use monitor_analysis::compare::{CompareOutput, CompareReport};
-pub use monitor_analysis::effects::sig;
+pub use monitor_analysis::effects::{sig, Registry};
 pub use monitor_analysis::explain::ladder::{
     BaseChange, FinalFit, LadderReport, LadderStep, Tried, FLOOR_BAND, STEP_MIN,
 };
@@ -16,4 +16,4 @@ pub use monitor_analysis::metrics::{self, WorstWindow};
 pub use monitor_analysis::prep::Prepared;
 pub use monitor_analysis::rotor_asymmetry::McsaReport;
 pub use monitor_analysis::simplified_model::Prediction;
-pub use monitor_analysis::{parse_effect, Analysis, Options};
+pub use monitor_analysis::{parse_effect, Analysis, EffectId, Options};

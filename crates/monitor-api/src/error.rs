@@ -95,6 +95,21 @@ pub enum ApiError {
     /// nothing was written.
     #[error(transparent)]
     Overwrite(#[from] monitor_io::log::OverwriteError),
+    /// A user's law file refused (its first mistake, naming the law).
+    #[error(transparent)]
+    Laws(#[from] monitor_laws::LawError),
+    /// An effect name neither the library nor the law file has.
+    #[error("{}", self.spelled(&FieldNames))]
+    UnknownEffect {
+        /// The name given.
+        name: String,
+        /// Names spelled alike.
+        near: Vec<String>,
+        /// Every known name (the library's, then the laws').
+        known: Vec<String>,
+        /// True when a law file was given.
+        laws: bool,
+    },
     /// The scenario file cannot be read.
     #[error("cannot read the scenario {path}: {source}")]
     ScenarioIo {
@@ -139,6 +154,8 @@ impl ApiError {
             | ApiError::Simulation(_)
             | ApiError::Interrupted
             | ApiError::Overwrite(_)
+            | ApiError::Laws(_)
+            | ApiError::UnknownEffect { .. }
             | ApiError::ScenarioIo { .. } => ErrorKind::Option,
         }
     }
@@ -179,6 +196,12 @@ impl ApiError {
             ApiError::Identify { what, log, why } => {
                 format!("{what} {log}: {}", why.spelled(spell))
             }
+            ApiError::UnknownEffect {
+                name,
+                near,
+                known,
+                laws,
+            } => monitor_words::laws::unknown_effect(name, near, known, *laws, spell),
             e => e.to_string(),
         }
     }

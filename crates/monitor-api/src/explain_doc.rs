@@ -18,8 +18,8 @@ use super::{
 use monitor_analysis::explain::{EffectCandidate, ExplainReport, Standing};
 use monitor_analysis::rotor_asymmetry::{self, McsaReport};
 use monitor_analysis::Analysis;
+use monitor_analysis::EffectId;
 use monitor_core::verdict::FaultName;
-use monitor_core::EffectKind;
 use monitor_replay::{DiagnoseReport, FindingReport, Verdict};
 use monitor_words::diagnose::fault_text;
 use monitor_words::Spelling;
@@ -54,7 +54,7 @@ pub fn mcsa_beside(a: &Analysis, report: &ExplainReport, rotor_bars: Option<u32>
     let delta = report
         .ranking
         .iter()
-        .find(|r| r.effect == EffectKind::RotorAsymmetry)
+        .find(|r| r.effect == EffectId::ROTOR_ASYMMETRY)
         .and_then(|r| r.parameters.get("delta"))
         .map(|p| p.value);
     rotor_asymmetry::mcsa(
@@ -84,7 +84,7 @@ pub fn explain(
     };
     let a = load_analysis(read, log, req, &mut |_| {})?;
     let judged = verdict_for_explain(read, log, req.group.clone());
-    let out = a.explain(&req.options(), &|_| {})?;
+    let out = a.explain(&req.options(&a)?, &|_| {})?;
     let rotor_asymmetry = mcsa_beside(&a, &out.report, req.rotor_bars);
     let doc = ExplainDocument::new(judged.as_ref(), out.report, rotor_asymmetry, sp);
     Ok(doc.json(judged.as_ref().ok(), sp))
@@ -104,7 +104,7 @@ pub fn ladder(
 ) -> Result<serde_json::Value, ApiError> {
     let log = &log.into();
     let a = load_analysis(params, log, req, &mut |_| {})?;
-    let report = a.ladder(&req.options(), &|_, _| {})?;
+    let report = a.ladder(&req.options(&a)?, &|_, _| {})?;
     Ok(monitor_words::ladder::document(&report, spell))
 }
 
@@ -200,8 +200,8 @@ pub fn beside_verdict(
     let named = finding.named()?;
     let fault = fault_text(named);
     let effect = match named.fault {
-        FaultName::BrokenBars => EffectKind::RotorAsymmetry,
-        FaultName::ShortedTurns => EffectKind::PhaseAsymmetry,
+        FaultName::BrokenBars => EffectId::ROTOR_ASYMMETRY,
+        FaultName::ShortedTurns => EffectId::PHASE_ASYMMETRY,
         FaultName::Table1(_) | FaultName::Friction => {
             return Some(format!(
                 "beside the verdict ({fault}): a change of the machine's parameters or of a sensor, judged from the paper's residuals; explain refits the model's base parameters (Ra, Ls, B+Bl, J) to the log before it ranks effects, so such a change shows in the refit (below), and the ranking says what the refitted model still misses: the two do not contradict each other"
@@ -221,12 +221,13 @@ pub fn beside_verdict(
             place.words
         ));
     }
-    let (judged, part) = match effect {
-        EffectKind::RotorAsymmetry => (
+    let (judged, part) = if effect == EffectId::ROTOR_ASYMMETRY {
+        (
             "the current spectrum's (1 - 2s) f sideband",
             sideband_share(mcsa),
-        ),
-        _ => (
+        )
+    } else {
+        (
             "the negative-sequence current, stretch by stretch",
             format!(
                 "the negative sequence is {:.1} % of the current on average{}",
@@ -237,7 +238,7 @@ pub fn beside_verdict(
                     (None, _) => " (the unbalance line's average names no phase)".into(),
                 }
             ),
-        ),
+        )
     };
     Some(format!(
         "beside the verdict ({fault}): the verdict judges the motor from {judged}; the ranking explains the paper's model's error over the whole log, where {part}, and {}. The two answer different questions and do not contradict each other: a missing effect is no fault, and a fault need not be the model's largest error",
@@ -254,7 +255,7 @@ struct Place {
 
 /// [`Place`] of `effect` in `report`: ranked, without effect, not plausible, skipped, in the
 /// model already, or not fitted (a log without voltages).
-fn place_of(effect: EffectKind, report: &ExplainReport, spell: &dyn Spelling) -> Place {
+fn place_of(effect: EffectId, report: &ExplainReport, spell: &dyn Spelling) -> Place {
     let said = |words: String| Place {
         words,
         agrees: false,

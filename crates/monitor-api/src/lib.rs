@@ -10,7 +10,6 @@
 
 use monitor_analysis::prep::ReadOptions;
 use monitor_analysis::{Analysis, Options};
-use monitor_core::EffectKind;
 use monitor_io::log::mapping::ColumnMapping;
 use monitor_io::log::OpenOptions;
 use monitor_io::params::{ParamError, ParamFile};
@@ -28,6 +27,7 @@ mod explain_doc;
 /// The files a front end reads and writes (from `monitor-io`).
 pub mod files;
 pub mod fleet;
+pub mod laws;
 mod log_source;
 mod outputs;
 /// The replay of a log for a front end (from `monitor-replay`).
@@ -43,7 +43,7 @@ pub use log_source::LogSource;
 /// The one door: every sentence a crew reads, spelled from the engines' typed values (from
 /// `monitor-words`).
 pub use monitor_words as words;
-pub use outputs::{simulate_to_file, ScenarioSource};
+pub use outputs::{simulate_to_file, simulate_to_file_with_laws, ScenarioSource};
 pub use turn_calibration::{learn_turn_calibration, Labelled, Learned};
 
 /// A parameter file: its path, its TOML text, or its values already read (so that a
@@ -322,8 +322,11 @@ pub fn diagnose(
 /// What `compare` and `explain` are asked (their shared options).
 #[derive(Debug, Clone, Default)]
 pub struct AnalysisRequest {
-    /// `--effects`: effects already in the model.
-    pub effects: Vec<EffectKind>,
+    /// `--effects`: effects already in the model, by name (the library's or a law's of
+    /// `laws`).
+    pub effects: Vec<String>,
+    /// `--laws`: a user's law file; its laws are candidates beside the library's.
+    pub laws: Option<PathBuf>,
     /// `--from` [s].
     pub from_s: Option<f64>,
     /// `--to` [s].
@@ -379,12 +382,20 @@ pub fn load_analysis(
 }
 
 impl AnalysisRequest {
-    /// The analysis' options.
-    pub fn options(&self) -> Options {
-        Options {
-            effects: self.effects.clone(),
+    /// The analysis' options for the loaded log `a`: the law file read and checked against
+    /// its parameter file, the effect names resolved against the library and the laws.
+    ///
+    /// # Errors
+    /// [`ApiError::Laws`] (the law file), [`ApiError::UnknownEffect`] (a name).
+    pub fn options(&self, a: &Analysis) -> Result<Options, ApiError> {
+        let laws = laws::read_laws(self.laws.as_deref())?;
+        laws::check_laws(&laws, &a.params)?;
+        let registry = monitor_analysis::effects::Registry::with_laws(&laws);
+        Ok(Options {
+            effects: laws::effect_ids(&self.effects, &registry)?,
             fit_base: !self.no_fit,
-        }
+            laws: registry,
+        })
     }
 }
 
@@ -401,7 +412,7 @@ pub fn compare(
     spell: &dyn Spelling,
 ) -> Result<serde_json::Value, ApiError> {
     let a = load_analysis(params, log, req, &mut |_| {})?;
-    let out = a.compare(&req.options())?;
+    let out = a.compare(&req.options(&a)?)?;
     Ok(monitor_words::compare::document(&out.report, spell))
 }
 

@@ -74,13 +74,31 @@ pub fn simulate_to_file<'a>(
     scenario: impl Into<ScenarioSource<'a>>,
     out: &Path,
 ) -> Result<monitor_sim::SimSummary, ApiError> {
+    simulate_to_file_with_laws(params, scenario, out, None)
+}
+
+/// [`simulate_to_file`] with a user's law file (`simulate --laws`, Python's `laws=`): the run
+/// injects each law at its parameters' start values.
+///
+/// # Errors
+/// As [`simulate_to_file`], and [`ApiError::Laws`] for the law file (it may not be the
+/// output either).
+pub fn simulate_to_file_with_laws<'a>(
+    params: ParamsSource<'_>,
+    scenario: impl Into<ScenarioSource<'a>>,
+    out: &Path,
+    laws: Option<&Path>,
+) -> Result<monitor_sim::SimSummary, ApiError> {
     let scenario = scenario.into();
-    check_outputs(
-        &input_files(&params, &scenario),
-        &[NamedFile::new("out", out)],
-    )?;
+    let mut inputs = input_files(&params, &scenario);
+    if let Some(l) = laws {
+        inputs.push(NamedFile::new("laws", l));
+    }
+    check_outputs(&inputs, &[NamedFile::new("out", out)])?;
     let (params, _) = load_params(params)?;
-    let sc = match scenario {
+    let user_laws = crate::laws::read_laws(laws)?;
+    crate::laws::check_laws(&user_laws, &params)?;
+    let mut sc = match scenario {
         ScenarioSource::Toml { text, origin } => {
             monitor_sim::Scenario::from_toml_str(text, origin)?
         }
@@ -92,6 +110,12 @@ pub fn simulate_to_file<'a>(
             monitor_sim::Scenario::from_toml_str(&text, &p.display().to_string())?
         }
     };
+    sc.laws = monitor_sim::UserLaws(
+        user_laws
+            .into_iter()
+            .map(monitor_laws::BoundLaw::at_start)
+            .collect(),
+    );
     let mut w = monitor_io::log::LogWriter::create(out, sc.sensors.channels())?;
     let mut err = None;
     let summary = monitor_sim::simulate_while(&params, &sc, |r| match w.write_row(r) {

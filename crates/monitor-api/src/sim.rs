@@ -4,5 +4,5 @@
 
 pub use monitor_sim::{
     simulate_interactive, simulate_while, FaultSpec, LoadStep, Scenario, ScenarioEvent, SensorSpec,
-    SimError, SimSummary, SupplyStep, Workload,
+    SimError, SimSummary, SupplyStep, UserLaws, Workload,
 };

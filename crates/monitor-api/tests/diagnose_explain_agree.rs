@@ -157,7 +157,7 @@ fn a_healthy_motor_on_vf_steps_claims_no_effect() {
     let dir = tempfile::tempdir().expect("temp dir");
     let log = dir.path().join("vf.csv");
     api::simulate_to_file(source(), scenario, &log).expect("simulates");
-    let dynamics: Vec<monitor_core::EffectKind> = [
+    let dynamics: Vec<EffectId> = [
         "flux_dynamics",
         "current_dynamics",
         "d_axis_dynamics",

@@ -65,7 +65,7 @@ impl EffectKind {
 
     /// The name in scenario files, on the command line and in JSON reports
     /// (`thermal_drift`, ..., `cross_coupling_dynamics`).
-    pub fn name(self) -> &'static str {
+    pub const fn name(self) -> &'static str {
         match self {
             EffectKind::ThermalDrift => "thermal_drift",
             EffectKind::Saturation => "saturation",

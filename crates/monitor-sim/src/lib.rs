@@ -108,8 +108,8 @@ mod thermometer;
 pub use effect_spec::EffectSpec;
 pub use faults::{FaultSpec, SensorFaultMode};
 pub use scenario::{
-    LoadKind, LoadSpec, LoadStep, Scenario, SupplySpec, SupplyStep, Workload, DEFAULT_MAX_STEP_S,
-    MIN_STEP_S, SAMPLE_RATE_RANGE_HZ,
+    LoadKind, LoadSpec, LoadStep, Scenario, SupplySpec, SupplyStep, UserLaws, Workload,
+    DEFAULT_MAX_STEP_S, MIN_STEP_S, SAMPLE_RATE_RANGE_HZ,
 };
 pub use sensors::SensorSpec;
 pub use steady::{

@@ -37,7 +37,9 @@
 //! dpsi_r/dt = -R_r(theta_r) i_r + J omega_r psi_r (R_r is symmetric, so the rotational EMF
 //! term is unchanged). Rotor copper loss (3/2) i_r^T R_r i_r.
 
+use monitor_laws::{library, BoundLaw, LawInputs, MagnetisingCurve};
 use std::cell::Cell;
+use std::sync::Arc;
 
 /// Symmetric 2x2 matrix [[a, b], [b, c]].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -96,17 +98,48 @@ pub struct LoadLaw {
 }
 
 impl LoadLaw {
-    /// The load torque [N m] at mechanical speed `wm` [rad/s].
+    /// The load torque [N m] at mechanical speed `wm` [rad/s]: the viscous part, the
+    /// constant torque, dry friction and windage, the last two by the library's laws
+    /// ([`monitor_laws::library::coulomb_nm`], [`monitor_laws::library::windage_nm`]: the
+    /// functions the analysis fits).
     #[inline(always)]
     pub fn torque(&self, wm: f64) -> f64 {
         let mut t = self.bl_nms * wm + self.torque_nm;
         if self.coulomb_nm != 0.0 {
-            t += self.coulomb_nm * (wm * self.inv_w0).tanh();
+            t += library::coulomb_nm(self.coulomb_nm, 1.0 / self.inv_w0, wm);
         }
         if self.windage != 0.0 {
-            t += self.windage * wm * wm.abs();
+            t += library::windage_nm(self.windage, wm);
         }
         t
+    }
+}
+
+/// The magnetising inductance's law: the library's saturation or a user's law of the
+/// magnetising flux (an expression, or a no-load test's curve).
+#[derive(Debug, Clone)]
+pub enum MagLaw {
+    /// The library's saturation law ([`SatLaw`], from the machine's unsaturated Lm0).
+    Saturation(SatLaw),
+    /// A user's law Lm(psi_m) [H] (`acts_on = "magnetising_inductance"`).
+    Law(BoundLaw),
+    /// A no-load test's curve (`acts_on = "magnetising_curve"`).
+    Curve(Arc<MagnetisingCurve>),
+}
+
+impl MagLaw {
+    /// Lm [H] at the magnetising flux `psi_m` [Wb, peak] for a machine whose unsaturated
+    /// Lm is `lm0` [H] (read by the library's law only).
+    #[inline(always)]
+    pub fn lm_h(&self, lm0: f64, psi_m: f64) -> f64 {
+        match self {
+            MagLaw::Saturation(s) => library::saturation_lm_h(lm0, s.psi_sat_wb, s.exponent, psi_m),
+            MagLaw::Law(b) => b.eval(&LawInputs {
+                psi_m_wb: psi_m,
+                ..LawInputs::default()
+            }),
+            MagLaw::Curve(c) => c.lm_h(psi_m),
+        }
     }
 }
 
@@ -227,7 +260,7 @@ pub struct Machine {
     /// Unsaturated (or constant) magnetising inductance [H].
     pub lm0: f64,
     /// Main-flux saturation, if any.
-    pub sat: Option<SatLaw>,
+    pub sat: Option<MagLaw>,
     /// 1/Rfe [S], 0 without iron loss, and 1/(1 + Rs/Rfe).
     pub inv_rfe: f64,
     /// 1/(1 + Rs/Rfe) (1 without iron loss).
@@ -240,6 +273,11 @@ pub struct Machine {
     pub b: f64,
     /// The load's torque law.
     pub load: LoadLaw,
+    /// Users' load-torque laws of time, speed and the shaft's angle, added to `load`'s.
+    pub load_laws: Arc<[BoundLaw]>,
+    /// The largest Lm the magnetising law gives (at zero flux) or Lm0 [H]: the bound of the
+    /// saturation iteration.
+    lm_hi: f64,
     // Linear-case derived constants.
     minv: f64,
     kr: f64,
@@ -291,7 +329,7 @@ impl Machine {
         llr: f64,
         rr: f64,
         lm0: f64,
-        sat: Option<SatLaw>,
+        sat: Option<MagLaw>,
         rfe: Option<f64>,
         np: f64,
         j: f64,
@@ -305,6 +343,17 @@ impl Machine {
             }
         }
         let inv_rfe = rfe.map(|r| 1.0 / r).unwrap_or(0.0);
+        let lm_hi = match &sat {
+            Some(law @ (MagLaw::Law(_) | MagLaw::Curve(_))) => {
+                let l = law.lm_h(lm0, 0.0);
+                if l.is_finite() && l > 0.0 {
+                    l
+                } else {
+                    lm0
+                }
+            }
+            _ => lm0,
+        };
         Ok(Machine {
             rs,
             turn,
@@ -320,6 +369,8 @@ impl Machine {
             inv_j: 1.0 / j,
             b,
             load,
+            load_laws: Arc::from(Vec::new()),
+            lm_hi,
             minv,
             kr,
             inv_lr,
@@ -372,7 +423,7 @@ impl Machine {
     /// secant iteration on Lm to 1e-13 relative).
     #[inline(always)]
     pub fn currents(&self, ps: [f64; 2], pr: [f64; 2]) -> Currents {
-        let Some(sat) = self.sat else {
+        let Some(sat) = &self.sat else {
             let (i_s, i_r) = self.currents_lin(ps, pr);
             return Currents {
                 i_s,
@@ -380,23 +431,24 @@ impl Machine {
                 lm: self.lm0,
             };
         };
-        let law = |psi_m: f64| self.lm0 / (1.0 + (psi_m / sat.psi_sat_wb).powf(sat.exponent));
-        let lo = 1e-3 * self.lm0;
-        let tol = 1e-13 * self.lm0;
+        let law = |psi_m: f64| sat.lm_h(self.lm0, psi_m);
+        let hi = self.lm_hi;
+        let lo = 1e-3 * hi;
+        let tol = 1e-13 * hi;
         let g = |lm: f64| {
             let (_, _, pm) = self.currents_at_lm(ps, pr, lm);
             lm - law(pm)
         };
-        let mut x0 = self.lm_guess.get().clamp(lo, self.lm0);
+        let mut x0 = self.lm_guess.get().clamp(lo, hi);
         let mut g0 = g(x0);
-        let mut x1 = (x0 - g0).clamp(lo, self.lm0);
+        let mut x1 = (x0 - g0).clamp(lo, hi);
         if g0.abs() > tol {
             for _ in 0..60 {
                 let g1 = g(x1);
                 if g1.abs() <= tol || g1 == g0 {
                     break;
                 }
-                let x2 = (x1 - g1 * (x1 - x0) / (g1 - g0)).clamp(lo, self.lm0);
+                let x2 = (x1 - g1 * (x1 - x0) / (g1 - g0)).clamp(lo, hi);
                 x0 = x1;
                 g0 = g1;
                 x1 = x2;
@@ -437,9 +489,28 @@ impl Machine {
         1.5 * self.np * (pr[1] * ir[0] - pr[0] * ir[1])
     }
 
-    /// dx/dt at state `x` with supply voltage `v` (alpha-beta, V).
+    /// The load torque [N m] at time `t` [s], mechanical speed `wm` [rad/s] and shaft angle
+    /// `theta_m` [rad]: [`LoadLaw::torque`] plus the users' laws ([`Machine::load_laws`]).
     #[inline(always)]
-    pub fn deriv(&self, x: &[f64; 6], v: [f64; 2]) -> [f64; 6] {
+    pub fn load_torque(&self, t: f64, wm: f64, theta_m: f64) -> f64 {
+        let mut tl = self.load.torque(wm);
+        if !self.load_laws.is_empty() {
+            let x = LawInputs {
+                t_s: t,
+                w_rad_s: wm,
+                theta_rad: theta_m,
+                psi_m_wb: 0.0,
+            };
+            for l in self.load_laws.iter() {
+                tl += l.eval(&x);
+            }
+        }
+        tl
+    }
+
+    /// dx/dt at time `t` [s] and state `x` with supply voltage `v` (alpha-beta, V).
+    #[inline(always)]
+    pub fn deriv(&self, t: f64, x: &[f64; 6], v: [f64; 2]) -> [f64; 6] {
         let ps = [x[0], x[1]];
         let pr = [x[2], x[3]];
         let wm = x[4];
@@ -447,7 +518,7 @@ impl Machine {
         let u = self.u(v, c.i_s);
         let wr = self.np * wm;
         let te = self.torque(pr, c.i_r);
-        let tl = self.load.torque(wm);
+        let tl = self.load_torque(t, wm, x[5]);
         let rdrop = if self.rr_asym == 0.0 {
             [self.rr * c.i_r[0], self.rr * c.i_r[1]]
         } else {
@@ -463,24 +534,25 @@ impl Machine {
         ]
     }
 
-    /// One classic RK4 step of length `h` with the supply at the start, middle and end.
+    /// One classic RK4 step of length `h` from time `t` [s] with the supply at the start,
+    /// middle and end.
     #[inline(always)]
-    pub fn rk4(&self, x: &mut [f64; 6], h: f64, v0: [f64; 2], vm: [f64; 2], v1: [f64; 2]) {
-        let k1 = self.deriv(x, v0);
+    pub fn rk4(&self, x: &mut [f64; 6], t: f64, h: f64, v0: [f64; 2], vm: [f64; 2], v1: [f64; 2]) {
+        let k1 = self.deriv(t, x, v0);
         let mut y = [0.0; 6];
         let h2 = 0.5 * h;
         for i in 0..6 {
             y[i] = x[i] + h2 * k1[i];
         }
-        let k2 = self.deriv(&y, vm);
+        let k2 = self.deriv(t + h2, &y, vm);
         for i in 0..6 {
             y[i] = x[i] + h2 * k2[i];
         }
-        let k3 = self.deriv(&y, vm);
+        let k3 = self.deriv(t + h2, &y, vm);
         for i in 0..6 {
             y[i] = x[i] + h * k3[i];
         }
-        let k4 = self.deriv(&y, v1);
+        let k4 = self.deriv(t + h, &y, v1);
         let h6 = h / 6.0;
         for i in 0..6 {
             x[i] += h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);

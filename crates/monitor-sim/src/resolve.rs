@@ -2,11 +2,13 @@
 //! their machine-dependent defaults, the parameter changes in effect (faults, load steps,
 //! winding temperature) and the builder of the [`Machine`] they give.
 
-use super::machine::{LoadLaw, Machine, MachineError, SatLaw, TurnLoop};
+use super::machine::{LoadLaw, Machine, MachineError, MagLaw, SatLaw, TurnLoop};
 use super::{EffectSpec, FaultSpec, LoadKind, Scenario, ScenarioEvent, SimError};
 use monitor_core::{FaultTarget, MachineParameter, MotorParameters};
 use monitor_io::params::ParamFile;
+use monitor_laws::{ActsOn, BoundLaw, LawInputs};
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 /// The effects of a scenario, resolved to the numbers the machine and the loop need.
 #[derive(Debug, Clone, Default)]
@@ -27,6 +29,15 @@ pub(super) struct ResolvedEffects {
     /// ([`monitor_io::params::lm0_over_file`]: above 1 where the file holds the rated
     /// point's Lm); 0 read as 1 (no saturation).
     pub(super) lm0_over_file: f64,
+    /// A user's law of the magnetising inductance (an expression or a no-load curve), in
+    /// place of the library's saturation.
+    pub(super) mag_law: Option<MagLaw>,
+    /// Users' load-torque laws.
+    pub(super) load_laws: Arc<[BoundLaw]>,
+    /// Users' laws of the stator resistance (their product over the file's Rs scales it).
+    pub(super) stator_laws: Vec<BoundLaw>,
+    /// Users' laws of the rotor resistance.
+    pub(super) rotor_laws: Vec<BoundLaw>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -81,7 +92,73 @@ impl ResolvedEffects {
                 | EffectSpec::CrossCouplingDynamics {} => {}
             }
         }
+        eff.add_laws(scenario, m, rated)?;
         Ok(eff)
+    }
+
+    /// The scenario's user laws (`simulate --laws`), each at its parameters' values.
+    fn add_laws(
+        &mut self,
+        scenario: &Scenario,
+        m: &MotorParameters,
+        rated: RatedPoint,
+    ) -> Result<(), SimError> {
+        let mut load_laws = Vec::new();
+        for b in scenario.laws.iter() {
+            let key = || format!("laws.{}", b.law.id);
+            match b.law.acts_on {
+                ActsOn::LoadTorque => load_laws.push(b.clone()),
+                ActsOn::StatorResistance => self.stator_laws.push(b.clone()),
+                ActsOn::RotorResistance => self.rotor_laws.push(b.clone()),
+                ActsOn::MagnetisingInductance | ActsOn::MagnetisingCurve => {
+                    if self.sat.is_some() || self.mag_law.is_some() {
+                        return Err(SimError::Invalid {
+                            key: key(),
+                            message: "the magnetising inductance already follows a law (one law of Lm per run)".into(),
+                        });
+                    }
+                    self.mag_law = Some(match b.law.table() {
+                        None => MagLaw::Law(b.clone()),
+                        Some(t) => {
+                            let model = m.model::<f64>();
+                            let curve = t
+                                .curve(
+                                    m.rs_ohm,
+                                    model.lls_h(),
+                                    rated.vpk0 * 1.5f64.sqrt(),
+                                    rated.we0 / (2.0 * PI),
+                                )
+                                .map_err(|e| SimError::Invalid {
+                                    key: key(),
+                                    message: e.to_string(),
+                                })?;
+                            MagLaw::Curve(Arc::new(curve))
+                        }
+                    });
+                }
+            }
+        }
+        self.load_laws = Arc::from(load_laws);
+        Ok(())
+    }
+
+    /// True when a user's law sets a resistance.
+    pub(super) fn has_resistance_laws(&self) -> bool {
+        !self.stator_laws.is_empty() || !self.rotor_laws.is_empty()
+    }
+
+    /// The stator's and the rotor's resistance at time `t` [s] by the users' laws, over the
+    /// file's values (1 where no law acts).
+    pub(super) fn resistance_law_scales(&self, t: f64, m: &MotorParameters) -> (f64, f64) {
+        let x = LawInputs {
+            t_s: t,
+            ..LawInputs::default()
+        };
+        let scale = |laws: &[BoundLaw], r0: f64| laws.iter().fold(1.0, |a, l| a * l.eval(&x) / r0);
+        (
+            scale(&self.stator_laws, m.rs_ohm),
+            scale(&self.rotor_laws, m.rr_ohm),
+        )
     }
 
     /// The winding's temperature, the main flux's saturation (default: `psi_sat_ratio`
@@ -203,6 +280,9 @@ pub(super) struct ParameterScales {
     /// Thermal factors of the stator and rotor resistances.
     pub(super) th_s: f64,
     pub(super) th_r: f64,
+    /// The users' laws' factors of the stator and rotor resistances.
+    pub(super) law_s: f64,
+    pub(super) law_r: f64,
     /// Viscous load: Bl scale from load steps. Torque load: torque [N m].
     pub(super) bl_scale: f64,
     pub(super) torque_nm: f64,
@@ -219,6 +299,8 @@ impl Default for ParameterScales {
             bl: 1.0,
             th_s: 1.0,
             th_r: 1.0,
+            law_s: 1.0,
+            law_r: 1.0,
             bl_scale: 1.0,
             torque_nm: 0.0,
         }
@@ -257,8 +339,8 @@ impl MachineBuilder<'_> {
     pub(super) fn build(&self, md: &ParameterScales) -> Result<Machine, MachineError> {
         let m = self.m;
         let model = m.model::<f64>();
-        let rs = m.rs_ohm * md.rs * md.th_s;
-        let rr = m.rr_ohm * md.rr * md.th_r;
+        let rs = m.rs_ohm * md.rs * md.th_s * md.law_s;
+        let rr = m.rr_ohm * md.rr * md.th_r * md.law_r;
         let gamma_s = model.lls_h() <= 1e-9 * m.lm_h;
         let gamma_r = model.llr_h() <= 1e-9 * m.lm_h;
         let mut lm = m.lm_h
@@ -304,13 +386,17 @@ impl MachineBuilder<'_> {
             llr,
             rr,
             lm,
-            self.eff.sat,
+            self.eff
+                .mag_law
+                .clone()
+                .or(self.eff.sat.map(MagLaw::Saturation)),
             self.eff.rfe,
             model.np(),
             m.j_kgm2,
             m.b_nms * md.b,
             load,
         )?;
+        machine.load_laws = Arc::clone(&self.eff.load_laws);
         machine.rr_asym = 2.0 / 3.0 * rr * self.eff.rotor_delta;
         Ok(machine)
     }

@@ -86,12 +86,21 @@ impl Supply {
 
     /// Integrates `machine` over one output sample (`nsub` steps of `h`), and the shorted
     /// loop's current `i_f` of a turn fault (exact for the supply's sinusoid).
-    fn integrate(&mut self, machine: &Machine, x: &mut [f64; 6], i_f: &mut f64, nsub: u32) {
-        for _ in 0..nsub {
+    /// `t0` is the output sample's time [s] (the users' laws of time read it).
+    fn integrate(
+        &mut self,
+        machine: &Machine,
+        x: &mut [f64; 6],
+        i_f: &mut f64,
+        nsub: u32,
+        t0: f64,
+    ) {
+        for j in 0..nsub {
             let pm = Self::rotate(self.p, self.rot);
             let pe = Self::rotate(pm, self.rot);
             let (v0, v1) = (self.voltage(self.p), self.voltage(pe));
-            machine.rk4(x, self.h, v0, self.voltage(pm), v1);
+            let t = t0 + f64::from(j) * self.h;
+            machine.rk4(x, t, self.h, v0, self.voltage(pm), v1);
             if let Some(t) = &machine.turn {
                 *i_f = t.step(*i_f, v0, v1, self.we, self.h);
             }
@@ -353,7 +362,9 @@ impl<'a> SimRun<'a> {
     fn temperature_rise(&self, t: f64, k: u64, dtemp: f64, last_p_loss: f64) -> Option<f64> {
         let th = self.builder.eff.thermal?;
         let new = match th.rise_k {
-            Some(rise) if t >= th.at_s => rise * (1.0 - (-(t - th.at_s) / th.tau_s).exp()),
+            Some(rise) if t >= th.at_s => {
+                monitor_laws::library::heating_rise_k(rise, th.tau_s, th.at_s, t)
+            }
             Some(_) => 0.0,
             None if t >= th.at_s => {
                 let target = th.r_th * last_p_loss;
@@ -411,6 +422,15 @@ impl<'a> SimRun<'a> {
                 self.scales.th_r = if rotor { self.scales.th_s } else { 1.0 };
                 rebuild = true;
             }
+            // The users' laws of the resistances, once per output sample.
+            if self.builder.eff.has_resistance_laws() {
+                let (ls, lr) = self.builder.eff.resistance_law_scales(t, self.builder.m);
+                if (ls, lr) != (self.scales.law_s, self.scales.law_r) {
+                    self.scales.law_s = ls;
+                    self.scales.law_r = lr;
+                    rebuild = true;
+                }
+            }
             if rebuild {
                 let nm = self
                     .builder
@@ -436,7 +456,7 @@ impl<'a> SimRun<'a> {
             }
             // Integrate to t + dt.
             self.supply
-                .integrate(&self.machine, &mut x, &mut i_f, self.nsub);
+                .integrate(&self.machine, &mut x, &mut i_f, self.nsub, t);
             if !(x[0].is_finite() && x[2].is_finite() && x[4].is_finite()) {
                 return Err(SimError::Diverged {
                     t_s: t + self.dt,
@@ -553,7 +573,7 @@ fn truth(
         theta_m_rad: x[5],
         we_rad_s: we,
         te_nm: te,
-        t_load_nm: model.load.torque(wm),
+        t_load_nm: model.load_torque(t, wm, x[5]),
         rs_ohm: model.rs,
         rr_ohm: model.rr,
         lm_h: c.lm,

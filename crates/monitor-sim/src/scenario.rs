@@ -42,6 +42,36 @@ pub struct Scenario {
     /// Sensor chain (ADC, errors, noise, encoder). Default: [`SensorSpec::default`].
     #[serde(default)]
     pub sensors: SensorSpec,
+    /// Users' laws the run injects (`simulate --laws FILE`: each law of the file at its
+    /// parameters' start values); not written in a scenario file.
+    #[serde(skip)]
+    pub laws: UserLaws,
+}
+
+/// Users' laws a run injects ([`Scenario::laws`]): load torques of time, speed and the
+/// shaft's angle, resistances of time, the magnetising inductance of its flux (an
+/// expression or a no-load curve), evaluated by the same [`monitor_laws::Law`] the analysis
+/// fits.
+#[derive(Debug, Clone, Default)]
+pub struct UserLaws(pub Vec<monitor_laws::BoundLaw>);
+
+impl UserLaws {
+    /// The laws.
+    pub fn iter(&self) -> std::slice::Iter<'_, monitor_laws::BoundLaw> {
+        self.0.iter()
+    }
+}
+
+impl PartialEq for UserLaws {
+    /// The same laws (by name) at the same values.
+    fn eq(&self, other: &Self) -> bool {
+        self.0.len() == other.0.len()
+            && self
+                .0
+                .iter()
+                .zip(&other.0)
+                .all(|(a, b)| a.law.id == b.law.id && a.values == b.values)
+    }
 }
 
 /// Default largest integrator step [s].
@@ -165,6 +195,7 @@ impl Scenario {
             faults: Vec::new(),
             effects: Vec::new(),
             sensors: SensorSpec::ideal(),
+            laws: UserLaws::default(),
         }
     }
 

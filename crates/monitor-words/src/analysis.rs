@@ -7,12 +7,12 @@ use monitor_analysis::effects::SetupError;
 use monitor_analysis::explain::{SkipReason, Skipped};
 use monitor_analysis::transients::{NotProposed, STEP_MIN};
 use monitor_analysis::unbalance::{CannotJudgeUnbalance, UnbalanceAnalysis, UnbalanceFinding};
-use monitor_core::EffectKind;
+use monitor_analysis::EffectId;
 use monitor_replay::OptionField;
 use serde_json::Value;
 
 /// Effect names, comma separated.
-pub fn effect_names(kinds: &[EffectKind]) -> String {
+pub fn effect_names(kinds: &[EffectId]) -> String {
     kinds
         .iter()
         .map(|k| k.name())

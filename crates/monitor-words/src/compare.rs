@@ -81,7 +81,7 @@ fn cover(c: &Cover, spell: &dyn Spelling) -> String {
         Cover::AllInModel => "every dynamics effect is already in the model; what remains there is another effect or a parameter error".to_string(),
         Cover::NoneProposed => "the dynamics effects are not proposed on this span (why below, as explain skips them)".to_string(),
         Cover::Add { proposed, effects } => {
-            let names = |k: &[monitor_core::EffectKind], sep: &str| {
+            let names = |k: &[monitor_analysis::EffectId], sep: &str| {
                 k.iter().map(|e| e.name()).collect::<Vec<_>>().join(sep)
             };
             format!(

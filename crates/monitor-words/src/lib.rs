@@ -36,6 +36,7 @@ mod errors;
 pub mod explain;
 pub mod identify;
 pub mod ladder;
+pub mod laws;
 mod spelling;
 pub mod trend;
 

@@ -3,7 +3,7 @@
 //! time.
 
 use clap::ValueEnum;
-use monitor_core::{AngleSource, EffectKind, Fault, ResidualForm};
+use monitor_core::{AngleSource, Fault, ResidualForm};
 
 /// Frame angle source on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -98,11 +98,6 @@ pub fn parse_fault(s: &str) -> Result<Fault, String> {
         let names: Vec<&str> = Fault::ALL.iter().map(|f| f.name()).collect();
         format!("unknown fault '{s}' (one of {})", names.join(", "))
     })
-}
-
-/// Parses an effect name of the library.
-pub fn parse_effect(s: &str) -> Result<EffectKind, String> {
-    monitor_api::analysis::parse_effect(s.trim()).map_err(|e| e.to_string())
 }
 
 /// A time on the command line [s]: a finite number >= 0 (negative values reach this

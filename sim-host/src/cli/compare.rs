@@ -4,7 +4,6 @@
 use super::output_guard::OutputGuard;
 use super::{progress, render};
 use monitor_api::analysis::{Analysis, Options};
-use monitor_core::EffectKind;
 use std::path::PathBuf;
 
 /// A parameter file as read once: its values and its `[columns]` mapping.
@@ -25,9 +24,16 @@ pub struct Common {
     /// The TDMS group holding the channels (when the file has several).
     #[arg(long, value_name = "NAME")]
     pub group: Option<String>,
-    /// Effects already in the model, comma separated (e.g. `thermal_drift,load_torque`).
-    #[arg(long, value_delimiter = ',', value_parser = super::args::parse_effect)]
-    pub effects: Vec<EffectKind>,
+    /// Effects already in the model, comma separated (e.g. `thermal_drift,load_torque`): the
+    /// library's, or the name of a law of `--laws`.
+    #[arg(long, value_delimiter = ',')]
+    pub effects: Vec<String>,
+    /// A file of your own laws (TOML, `[[law]]` with name, acts_on, expr or table, and
+    /// `[law.parameters]`; docs/model-vs-measurement.md "Your own law"): each law is a
+    /// candidate beside the library's effects, fitted and judged the same way, reported by
+    /// its name, and `--effects NAME` puts it in the model.
+    #[arg(long, value_name = "FILE")]
+    pub laws: Option<PathBuf>,
     /// Print one JSON document on stdout instead of the table.
     #[arg(long)]
     pub json: bool,
@@ -50,15 +56,27 @@ pub struct Common {
 }
 
 impl Common {
-    /// The analysis options.
-    fn options(&self) -> Options {
-        self.request(None).options()
+    /// The analysis options for the loaded log `a` (the law file checked against its
+    /// parameter file, the effect names resolved).
+    fn options(&self, a: &Analysis) -> anyhow::Result<Options> {
+        Ok(self.request(None).options(a)?)
     }
 
     /// Refuses outputs that would overwrite an input, and a window that ends before it
     /// starts, before anything is read or written.
     fn check(&self, charts: &[&str]) -> anyhow::Result<()> {
-        let guard = OutputGuard::new(&[&self.log, &self.params]);
+        // The law file and the effect names first: a mistake there is said before a long
+        // log is read.
+        let laws = monitor_api::laws::read_laws(self.laws.as_deref())?;
+        monitor_api::laws::effect_ids(
+            &self.effects,
+            &monitor_api::analysis::Registry::with_laws(&laws),
+        )?;
+        let mut inputs: Vec<&std::path::Path> = vec![&self.log, &self.params];
+        if let Some(l) = &self.laws {
+            inputs.push(l);
+        }
+        let guard = OutputGuard::new(&inputs);
         let mut files = render::charts::file_names(charts);
         if let Some(dir) = &self.plot {
             guard.check_folder(dir, &files)?;
@@ -123,6 +141,7 @@ impl Common {
     fn request(&self, rotor_bars: Option<u32>) -> monitor_api::AnalysisRequest {
         monitor_api::AnalysisRequest {
             effects: self.effects.clone(),
+            laws: self.laws.clone(),
             from_s: self.from,
             to_s: self.to,
             no_fit: self.no_fit,
@@ -256,7 +275,7 @@ pub fn run_compare(args: &CompareArgs) -> anyhow::Result<()> {
     let c = &args.common;
     c.check(&render::charts::COMPARE)?;
     let (a, _) = c.load()?;
-    let out = a.compare(&c.options())?;
+    let out = a.compare(&c.options(&a)?)?;
     render::html::write_compare(c.plot.as_deref(), c.report.as_deref(), &c.log, &a, &out)?;
     if c.json {
         let doc = monitor_api::words::compare::document(&out.report, &super::words::CliWords);
@@ -284,7 +303,7 @@ fn explain_here(
 ) -> anyhow::Result<Explained> {
     let c = &args.common;
     let a = c.load_with(params, columns)?;
-    let opts = c.options();
+    let opts = c.options(&a)?;
     let compared = if args.compare {
         let out = a.compare(&opts)?;
         if !c.json {
@@ -397,7 +416,8 @@ fn run_ladder(c: &Common) -> anyhow::Result<()> {
         "ladder step 1: fitting candidates",
         std::time::Duration::from_secs(2),
     );
-    let report = a.ladder(&c.options(), &|step, f| {
+    let opts = c.options(&a)?;
+    let report = a.ladder(&opts, &|step, f| {
         pb.set(Some(format!("ladder step {step}: fitting")), f);
     })?;
     pb.finish();

@@ -70,6 +70,11 @@ pub struct SimulateArgs {
     /// Override the scenario's noise seed.
     #[arg(long)]
     pub seed: Option<u64>,
+    /// A file of your own laws (the format `compare --laws` reads): the run injects each law
+    /// at its parameters' start values (a load torque of t, w and theta, a resistance of t,
+    /// Lm of psi_m or a no-load test's curve), evaluated as the analysis fits them.
+    #[arg(long, value_name = "FILE")]
+    pub laws: Option<PathBuf>,
     /// Run even when the output is estimated above 20 GB or the run above 2e9 integrator
     /// steps.
     #[arg(long)]
@@ -86,12 +91,23 @@ pub struct SimulateArgs {
 /// input, a run too large without `--force`, an I/O error writing the output, or
 /// [`super::out::Interrupted`] after SIGINT/SIGTERM (the partial output removed).
 pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
-    OutputGuard::new(&[&args.params, &args.scenario]).check_files(&[&args.out])?;
+    let mut inputs: Vec<&Path> = vec![&args.params, &args.scenario];
+    if let Some(l) = &args.laws {
+        inputs.push(l);
+    }
+    OutputGuard::new(&inputs).check_files(&[&args.out])?;
     let params = ParamFile::load(&args.params)?;
     let mut sc = Scenario::load(&args.scenario)?;
     if let Some(s) = args.seed {
         sc.seed = s;
     }
+    let laws = monitor_api::laws::read_laws(args.laws.as_deref())?;
+    monitor_api::laws::check_laws(&laws, &params)?;
+    sc.laws = monitor_api::sim::UserLaws(
+        laws.into_iter()
+            .map(monitor_api::laws::BoundLaw::at_start)
+            .collect(),
+    );
     let work = sc.workload();
     let bytes = work.rows as f64
         * LogWriter::estimated_row_bytes_for(&args.out, sc.sensors.channels()) as f64;

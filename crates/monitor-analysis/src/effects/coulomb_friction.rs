@@ -6,7 +6,7 @@ use super::{
 };
 use crate::prep::Prepared;
 use crate::simplified_model::{MachineConstants, ModelTerms, SpeedTorque};
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 
 /// Dry friction.
 #[derive(Debug, Clone, Copy)]
@@ -32,7 +32,7 @@ pub struct CoulombFrictionValues {
 impl TryFrom<&[f64]> for CoulombFrictionValues {
     type Error = EffectValuesError;
     fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
-        let [torque_nm] = declared_values(EffectKind::CoulombFriction, &PARAMS, v)?;
+        let [torque_nm] = declared_values(EffectId::COULOMB_FRICTION, &PARAMS, v)?;
         Ok(CoulombFrictionValues { torque_nm })
     }
 }
@@ -45,19 +45,16 @@ struct DryFriction {
 }
 
 impl SpeedTorque for DryFriction {
+    /// The library's dry friction law over 1 rad/s ([`monitor_laws::library::coulomb_nm`],
+    /// the simulator's; no tanh when there is no dry friction).
     fn torque_nm(&self, wm_rad_s: f64) -> f64 {
-        // (No tanh when there is no dry friction: 0 x tanh(w) is 0.)
-        if self.torque_nm != 0.0 {
-            self.torque_nm * (wm_rad_s / 1.0).tanh()
-        } else {
-            0.0
-        }
+        monitor_laws::library::coulomb_nm(self.torque_nm, 1.0, wm_rad_s)
     }
 }
 
 /// What `CoulombFriction` is ([`About`]).
 const ABOUT: About = About {
-    kind: EffectKind::CoulombFriction,
+    kind: EffectId::COULOMB_FRICTION,
     description: "Dry friction (bearings, seals, brushes): a constant torque opposing rotation whatever the speed.",
     equations: "J dw_m/dt = Kf I_qs - (B + Bl) w_m - Tc tanh(w_m / 1 rad/s)  (eq. 29 plus a constant friction torque).",
     parameters: &PARAMS,
@@ -73,7 +70,7 @@ impl EffectModel for CoulombFriction {
     }
     fn confused_with(&self) -> &'static [Confusion] {
         &[Confusion {
-            with: EffectKind::LoadTorque,
+            with: EffectId::LOAD_TORQUE,
             within: 1.10,
         }]
     }

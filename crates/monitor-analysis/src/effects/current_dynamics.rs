@@ -6,7 +6,7 @@ use super::{
 };
 use crate::prep::Prepared;
 use crate::simplified_model::{MachineConstants, ModelTerms};
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 
 /// Stator current transient (La dI/dt).
 #[derive(Debug, Clone, Copy)]
@@ -32,14 +32,14 @@ pub struct CurrentDynamicsValues {
 impl TryFrom<&[f64]> for CurrentDynamicsValues {
     type Error = EffectValuesError;
     fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
-        let [la_h] = declared_values(EffectKind::CurrentDynamics, &PARAMS, v)?;
+        let [la_h] = declared_values(EffectId::CURRENT_DYNAMICS, &PARAMS, v)?;
         Ok(CurrentDynamicsValues { la_h })
     }
 }
 
 /// What `CurrentDynamics` is ([`About`]).
 const ABOUT: About = About {
-    kind: EffectKind::CurrentDynamics,
+    kind: EffectId::CURRENT_DYNAMICS,
     description: "The stator current cannot jump: the transient inductance La = sigma Ls delays I_qs by Ta = La/Ra (a few ms) after every voltage change.",
     equations: "La dI_qs/dt = V_qs - Ra I_qs - Psi omega_r (eq. 28 with its derivative term) instead of the quasi-static I_qs = (V_qs - Psi omega_r)/Ra.",
     parameters: &PARAMS,

@@ -6,7 +6,7 @@ use super::{
 };
 use crate::prep::Prepared;
 use crate::simplified_model::{MachineConstants, ModelTerms};
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 
 /// Rotor flux not constant.
 #[derive(Debug, Clone, Copy)]
@@ -32,14 +32,14 @@ pub struct FluxDynamicsValues {
 impl TryFrom<&[f64]> for FluxDynamicsValues {
     type Error = EffectValuesError;
     fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
-        let [tau_r_s] = declared_values(EffectKind::FluxDynamics, &PARAMS, v)?;
+        let [tau_r_s] = declared_values(EffectId::FLUX_DYNAMICS, &PARAMS, v)?;
         Ok(FluxDynamicsValues { tau_r_s })
     }
 }
 
 /// What `FluxDynamics` is ([`About`]).
 const ABOUT: About = About {
-    kind: EffectKind::FluxDynamics,
+    kind: EffectId::FLUX_DYNAMICS,
     description: "The rotor flux cannot change instantly: it follows the magnetising current with the rotor time constant Lr/Rr, so after a start or a supply step the model's Psi = Ls i_f is wrong for a few hundred ms.",
     equations: "phi = psi_r/Lm, dphi/dt = (i_f - phi)/tau_r; Psi' = sigma Ls i_f + (Lm^2/Lr) phi replaces Ls i_f in eq. (28), the slip term Rr (Ls/Lr) becomes Rr Psi'/(Lr phi), Kf uses phi instead of i_f.",
     parameters: &PARAMS,

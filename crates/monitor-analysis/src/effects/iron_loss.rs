@@ -6,7 +6,7 @@ use super::{
 };
 use crate::prep::Prepared;
 use crate::simplified_model::{MachineConstants, ModelTerms};
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 
 /// Core loss.
 #[derive(Debug, Clone, Copy)]
@@ -40,14 +40,14 @@ pub struct IronLossValues {
 impl TryFrom<&[f64]> for IronLossValues {
     type Error = EffectValuesError;
     fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
-        let [g_fe_s] = declared_values(EffectKind::IronLoss, &PARAMS, v)?;
+        let [g_fe_s] = declared_values(EffectId::IRON_LOSS, &PARAMS, v)?;
         Ok(IronLossValues { g_fe_s })
     }
 }
 
 /// What `IronLoss` is ([`About`]).
 const ABOUT: About = About {
-    kind: EffectKind::IronLoss,
+    kind: EffectId::IRON_LOSS,
     description: "Eddy-current and hysteresis losses in the core draw a current in phase with the air-gap voltage, modelled as a resistance Rfe across the magnetising branch.",
     equations: "I_qs(measured) = I_qs(torque, eq. 28) + omega_s Ls i_f / Rfe; only the torque part drives eq. (29); Rs carries the core-loss current too (V_qs - Rs i_fe in eq. 28); the flux current is I_ds + omega_s sigma Ls I_qs / Rfe; and the voltage-model frame, built from the terminal current, is turned by (Lr/Lm) sigma Ls omega_s Ls / (Lm Rfe) against the rotor flux, which the model undoes.",
     parameters: &PARAMS,

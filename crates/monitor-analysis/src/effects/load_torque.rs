@@ -7,7 +7,7 @@ use super::{
 use crate::change_point::{Cumulative, Search};
 use crate::prep::{Prepared, C64};
 use crate::simplified_model::{MachineConstants, ModelTerms};
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 
 /// Load as a torque input.
 #[derive(Debug, Clone, Copy)]
@@ -221,7 +221,7 @@ pub struct LoadLevels {
 
 /// What `LoadTorque` is ([`About`]).
 const ABOUT: About = About {
-    kind: EffectKind::LoadTorque,
+    kind: EffectId::LOAD_TORQUE,
     description: "The load is a torque imposed by the driven machine (possibly switched in steps), not the paper's viscous Bl*omega.",
     equations: "J dw_m/dt = Kf I_qs - (B + Bl) w_m - T_L(t), T_L piecewise constant; the step times come from change-point detection on the torque balance's residual (measured speed and current, current-model rotor flux), placed within their sample; the levels are fitted.",
     parameters: &PARAMS,
@@ -234,7 +234,7 @@ impl EffectModel for LoadTorque {
     fn confused_with(&self) -> &'static [Confusion] {
         // A constant load torque is dry friction's equation at positive speed.
         &[Confusion {
-            with: EffectKind::CoulombFriction,
+            with: EffectId::COULOMB_FRICTION,
             within: 1.10,
         }]
     }
@@ -281,7 +281,7 @@ impl Contribution for Steps {
     fn values(&self, v: &[f64]) -> Result<LoadLevels, EffectValuesError> {
         if v.len() != self.from_s.len() {
             return Err(EffectValuesError::Count {
-                effect: EffectKind::LoadTorque,
+                effect: EffectId::LOAD_TORQUE,
                 expected: self.from_s.len(),
                 got: v.len(),
             });

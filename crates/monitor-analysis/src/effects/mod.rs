@@ -1,6 +1,6 @@
 //! The effect library: named physical effects the simplified model can be extended with.
 //!
-//! Every effect implements [`EffectModel`]: which [`EffectKind`] it is (its name in the
+//! Every effect implements [`EffectModel`]: which [`EffectId`] it is (its name in the
 //! JSON documents and on the command line, `docs/design.md`), a physical description, the
 //! way it changes the model equations in words and its parameters, each declared once as
 //! an [`EffectParam`] (name, unit, meaning, physical range and its source; all declared
@@ -42,6 +42,7 @@ mod setup;
 mod supply_unbalance;
 mod switch;
 mod thermal_drift;
+mod user_law;
 mod windage;
 
 pub use coulomb_friction::{CoulombFriction, CoulombFrictionValues};
@@ -64,11 +65,14 @@ pub use switch::StateSwitch;
 pub use thermal_drift::{
     ThermalDrift, ThermalDriftValues, Windings, ALPHA_AL_PER_K, ALPHA_CU_PER_K,
 };
+pub use user_law::LawEffect;
 pub use windage::{Windage, WindageValues};
 
 use super::prep::Prepared;
 use super::simplified_model::MachineConstants;
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
+use monitor_laws::Law;
+use std::sync::Arc;
 
 /// What a log must carry for an effect to be fitted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -112,7 +116,7 @@ impl Needs {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Confusion {
     /// The other effect.
-    pub with: EffectKind,
+    pub with: EffectId,
     /// The other effect's score may be up to this factor above this one's (>= 1).
     pub within: f64,
 }
@@ -168,7 +172,7 @@ pub fn sig(x: f64) -> String {
 #[derive(Debug, Clone, Copy)]
 pub struct About {
     /// Which effect.
-    pub kind: EffectKind,
+    pub kind: EffectId,
     /// Physical description, one or two sentences.
     pub description: &'static str,
     /// How the effect changes the model equations (text with the equation).
@@ -185,20 +189,21 @@ pub trait EffectModel: Send + Sync {
     /// What the effect is, in words.
     fn about(&self) -> &About;
     /// Which effect (its name in the documents is `kind().name()`).
-    fn kind(&self) -> EffectKind {
+    fn kind(&self) -> EffectId {
         self.about().kind
     }
-    /// Physical description, one or two sentences.
-    fn description(&self) -> &'static str {
+    /// Physical description, one or two sentences (a user's law: its expression).
+    fn description(&self) -> &str {
         self.about().description
     }
-    /// How the effect changes the model equations (text with the equation).
-    fn equations(&self) -> &'static str {
+    /// How the effect changes the model equations (text with the equation; a user's law:
+    /// where it acts).
+    fn equations(&self) -> &str {
         self.about().equations
     }
     /// The parameters' declarations ([`EffectModel::setup`] gives the data-dependent
     /// list).
-    fn parameters(&self) -> &'static [EffectParam] {
+    fn parameters(&self) -> &[EffectParam] {
         self.about().parameters
     }
     /// Channels the log must have. Default: the voltages.
@@ -208,7 +213,7 @@ pub trait EffectModel: Send + Sync {
     /// Effects that must already be in the model before `explain` proposes this one (a
     /// rung of the dynamics ladder that is only a consistent machine on top of another).
     /// Default: none.
-    fn requires(&self) -> &'static [EffectKind] {
+    fn requires(&self) -> &'static [EffectId] {
         &[]
     }
     /// True for an effect whose law carries a speed-dependent shaft torque of its own
@@ -326,46 +331,113 @@ pub fn sync_speed_mech(d: &Prepared, n: &MachineConstants) -> f64 {
     (m / n.np).max(1.0)
 }
 
-/// The model of an effect of the library.
-pub fn model_of(kind: EffectKind) -> Box<dyn EffectModel> {
-    match kind {
-        EffectKind::ThermalDrift => Box::new(ThermalDrift::TOGETHER),
-        EffectKind::Saturation => Box::new(Saturation),
-        EffectKind::IronLoss => Box::new(IronLoss),
-        EffectKind::CoulombFriction => Box::new(CoulombFriction),
-        EffectKind::Windage => Box::new(Windage),
-        EffectKind::LoadTorque => Box::new(LoadTorque),
-        EffectKind::SupplyUnbalance => Box::new(SupplyUnbalance),
-        EffectKind::PhaseAsymmetry => Box::new(PhaseAsymmetry),
-        EffectKind::FluxDynamics => Box::new(FluxDynamics),
-        EffectKind::CurrentDynamics => Box::new(CurrentDynamics),
-        EffectKind::RotorAsymmetry => Box::new(RotorAsymmetry),
-        EffectKind::DAxisDynamics => Box::new(D_AXIS_DYNAMICS),
-        EffectKind::CrossCouplingDynamics => Box::new(CROSS_COUPLING_DYNAMICS),
-    }
+/// The library's effects, each once, in the library's order (the core's
+/// `EffectKind::ALL`), `thermal_drift` as `thermal` gives it.
+fn library_with(thermal: ThermalDrift) -> Vec<Box<dyn EffectModel>> {
+    vec![
+        Box::new(thermal),
+        Box::new(Saturation),
+        Box::new(IronLoss),
+        Box::new(CoulombFriction),
+        Box::new(Windage),
+        Box::new(LoadTorque),
+        Box::new(SupplyUnbalance),
+        Box::new(PhaseAsymmetry),
+        Box::new(FluxDynamics),
+        Box::new(CurrentDynamics),
+        Box::new(RotorAsymmetry),
+        Box::new(D_AXIS_DYNAMICS),
+        Box::new(CROSS_COUPLING_DYNAMICS),
+    ]
 }
 
-/// The whole library, in the order of [`EffectKind::ALL`].
+/// The model of an effect of the library (`None` for a name the library does not have: a
+/// user's law is found in a [`Registry`]).
+pub fn model_of(id: EffectId) -> Option<Box<dyn EffectModel>> {
+    library().into_iter().find(|m| m.kind() == id)
+}
+
+/// The whole library, in the library's order.
 pub fn library() -> Vec<Box<dyn EffectModel>> {
-    EffectKind::ALL.into_iter().map(model_of).collect()
+    library_with(ThermalDrift::TOGETHER)
 }
 
 /// The ladder's library: [`library`] with the windings' temperatures fitted apart
 /// ([`ThermalDrift::APART`]: the ladder reads Rs and Rr apart in its base rung, so a stator
 /// heating alone is not taken for both windings).
 pub fn ladder_library() -> Vec<Box<dyn EffectModel>> {
-    EffectKind::ALL
-        .into_iter()
-        .map(|k| match k {
-            EffectKind::ThermalDrift => Box::new(ThermalDrift::APART) as Box<dyn EffectModel>,
-            k => model_of(k),
+    library_with(ThermalDrift::APART)
+}
+
+/// The effects an analysis may use: the library's, then a user's laws ([`LawEffect`]), one
+/// list of entries of one kind. Its names are open: a user's law is named by its file.
+#[derive(Debug, Clone, Default)]
+pub struct Registry {
+    laws: Vec<Arc<Law>>,
+}
+
+impl Registry {
+    /// The library alone.
+    pub fn library() -> Registry {
+        Registry::default()
+    }
+
+    /// The library and the laws `laws` (a user's law file's).
+    pub fn with_laws(laws: &[Arc<Law>]) -> Registry {
+        Registry {
+            laws: laws.to_vec(),
+        }
+    }
+
+    /// The users' laws.
+    pub fn laws(&self) -> &[Arc<Law>] {
+        &self.laws
+    }
+
+    /// Every entry: the library's effects ([`library`]), then the users' laws.
+    pub fn models(&self) -> Vec<Box<dyn EffectModel>> {
+        self.with_library(library())
+    }
+
+    /// Every entry for the ladder: [`ladder_library`], then the users' laws.
+    pub fn ladder_models(&self) -> Vec<Box<dyn EffectModel>> {
+        self.with_library(ladder_library())
+    }
+
+    fn with_library(&self, mut v: Vec<Box<dyn EffectModel>>) -> Vec<Box<dyn EffectModel>> {
+        v.extend(
+            self.laws
+                .iter()
+                .map(|l| Box::new(LawEffect::new(Arc::clone(l))) as Box<dyn EffectModel>),
+        );
+        v
+    }
+
+    /// The entry named `id`.
+    pub fn model_of(&self, id: EffectId) -> Option<Box<dyn EffectModel>> {
+        model_of(id).or_else(|| {
+            self.laws
+                .iter()
+                .find(|l| l.id == id)
+                .map(|l| Box::new(LawEffect::new(Arc::clone(l))) as Box<dyn EffectModel>)
         })
-        .collect()
+    }
+
+    /// Every entry's name, the library's first.
+    pub fn names(&self) -> Vec<EffectId> {
+        self.models().iter().map(|m| m.kind()).collect()
+    }
+
+    /// The entry named `name`, `None` when neither the library nor a user's law has it.
+    pub fn find(&self, name: &str) -> Option<EffectId> {
+        self.names().into_iter().find(|id| id.name() == name)
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use monitor_core::EffectKind;
 
     /// The flux level of a log that begins with a start: the frame's frequency forms from
     /// 1.5 rad/s to 314 rad/s in the first 0.3 s while the voltage is already 325 V (the
@@ -400,11 +472,13 @@ mod tests {
     /// mutual, and the evidence tells each pair apart.
     #[test]
     fn confusable_effects_declare_each_other_and_their_evidence() {
-        for kind in EffectKind::ALL {
-            for c in model_of(kind).confused_with() {
+        for model in library() {
+            let kind = model.kind();
+            for c in model.confused_with() {
                 assert!(c.within >= 1.0, "{kind}");
                 assert!(
                     model_of(c.with)
+                        .expect("a library effect")
                         .confused_with()
                         .iter()
                         .any(|b| b.with == kind && b.within == c.within),
@@ -443,7 +517,7 @@ mod tests {
     #[test]
     fn every_effect_kind_has_its_model() {
         for kind in EffectKind::ALL {
-            assert_eq!(model_of(kind).kind(), kind);
+            assert_eq!(model_of(kind.into()).map(|m| m.kind()), Some(kind.into()));
         }
         assert_eq!(library().len(), EffectKind::ALL.len());
     }

@@ -8,7 +8,7 @@ use super::{
 use crate::prep::{Prepared, C64};
 use crate::simplified_model::{MachineConstants, ModelTerms, WindingAsymmetryTerm};
 use crate::unbalance::{operating_point, winding_named_by, NAMED_WINDING_MIN};
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 
 /// One stator winding differs.
 #[derive(Debug, Clone, Copy)]
@@ -71,14 +71,14 @@ pub struct PhaseAsymmetryValues {
 impl TryFrom<&[f64]> for PhaseAsymmetryValues {
     type Error = EffectValuesError;
     fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
-        let [c_re, c_im] = declared_values(EffectKind::PhaseAsymmetry, &PARAMS, v)?;
+        let [c_re, c_im] = declared_values(EffectId::PHASE_ASYMMETRY, &PARAMS, v)?;
         Ok(PhaseAsymmetryValues { c_re, c_im })
     }
 }
 
 /// What `PhaseAsymmetry` is ([`About`]).
 const ABOUT: About = About {
-    kind: EffectKind::PhaseAsymmetry,
+    kind: EffectId::PHASE_ASYMMETRY,
     description: "One stator winding differs from the other two (inter-turn short, bad joint): the machine draws a negative-sequence current proportional to its load current even from a balanced supply.",
     equations: "Reduced model: i_abc = balanced model current + i_neg, i_neg = (c_re + j c_im) conj(i_pos). Shorted turns (a fraction mu of phase k through r_f; Tallam, Habetler, Harley 2002) give c = (mu/(3 R_f)) e^{j 2 th_k} conj(Z1), R_f = Rs (1 - 2mu/3) + r_f/mu. Full-order model (all dynamics effects in): the machine stays symmetric and the terminals draw the shorted loop's current |y| v + y conj(v), y = c / conj(Z1) at the log's mean operating point, so c means the same in both.",
     parameters: &PARAMS,
@@ -90,7 +90,7 @@ impl EffectModel for PhaseAsymmetry {
     }
     fn confused_with(&self) -> &'static [Confusion] {
         &[Confusion {
-            with: EffectKind::SupplyUnbalance,
+            with: EffectId::SUPPLY_UNBALANCE,
             within: 1.25,
         }]
     }

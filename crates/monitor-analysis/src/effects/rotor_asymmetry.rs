@@ -41,7 +41,7 @@ use crate::prep::{zero_phase_lpf, Prepared, I_F_SMOOTH_HZ};
 use crate::rotor_asymmetry::{mcsa, spectrum_contradicts};
 use crate::simplified_model::{CageAsymmetry, MachineConstants, ModelTerms};
 use monitor_core::rotor_cage::broken_bars_of_delta;
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 use std::f64::consts::PI;
 
 /// Physical range of the fitted asymmetry delta: 0..1. One broken bar of a 28-bar cage is
@@ -87,7 +87,7 @@ pub struct RotorAsymmetryValues {
 impl TryFrom<&[f64]> for RotorAsymmetryValues {
     type Error = EffectValuesError;
     fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
-        let [delta, phi_rad] = declared_values(EffectKind::RotorAsymmetry, &PARAMS, v)?;
+        let [delta, phi_rad] = declared_values(EffectId::ROTOR_ASYMMETRY, &PARAMS, v)?;
         Ok(RotorAsymmetryValues { delta, phi_rad })
     }
 }
@@ -172,7 +172,7 @@ fn initial_estimate(d: &Prepared, ang: &[f64], id_ripple: &[f64]) -> (f64, f64) 
 
 /// What `RotorAsymmetry` is ([`About`]).
 const ABOUT: About = About {
-    kind: EffectKind::RotorAsymmetry,
+    kind: EffectId::ROTOR_ASYMMETRY,
     description: "The rotor cage is not symmetric (broken rotor bars, a cracked end ring): the rotor resistance seen by the stator field changes at twice the slip frequency, which modulates the torque and the current: (1 - 2s) f and (1 + 2s) f sidebands in the stator current, 2 s f ripple in speed.",
     equations: "Rr in Ra = Rs + (Ls/Lr) Rr is multiplied by 1 + (delta/3)(1 - cos(2 (Np theta_m - theta) + phi)): the q-q element of the rotor resistance matrix Rr I + (2/3) Rr delta u u^T, u along the faulty rotor phase; Np theta_m integrates the measured speed. In the full-order model (all dynamics effects in) the whole matrix acts in the rotor flux equation.",
     parameters: &PARAMS,

@@ -5,8 +5,8 @@ use super::{
     EffectValuesError, FitSetup, SetupError,
 };
 use crate::prep::Prepared;
-use crate::simplified_model::{MachineConstants, ModelTerms, SaturationLaw};
-use monitor_core::EffectKind;
+use crate::simplified_model::{MachineConstants, MagnetisingLaw, ModelTerms, SaturationLaw};
+use monitor_laws::EffectId;
 
 /// Main-flux saturation.
 #[derive(Debug, Clone, Copy)]
@@ -117,7 +117,7 @@ pub struct SaturationValues {
 impl TryFrom<&[f64]> for SaturationValues {
     type Error = EffectValuesError;
     fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
-        let [psi_sat_wb, exponent] = declared_values(EffectKind::Saturation, &PARAMS, v)?;
+        let [psi_sat_wb, exponent] = declared_values(EffectId::SATURATION, &PARAMS, v)?;
         Ok(SaturationValues {
             psi_sat_wb,
             exponent,
@@ -127,7 +127,7 @@ impl TryFrom<&[f64]> for SaturationValues {
 
 /// What `Saturation` is ([`About`]).
 const ABOUT: About = About {
-    kind: EffectKind::Saturation,
+    kind: EffectId::SATURATION,
     description: "The iron of the main flux path saturates: the magnetising inductance Lm falls as the magnetising current (the flux level) rises.",
     equations: "Lm(i_f) = Lm0 / (1 + (Lm(i_f) i_f / psi_sat)^n), solved per sample; Lm0 is the file's Lm where the file holds the unsaturated value (lm_at = \"unsaturated\"), else (a no-load test's rated point, the default) the file's Lm times 1 + (psi_m,rated / psi_sat)^n, so that the law gives the file's value at the rated flux; Ls = Lls + Lm and Kf (Lm^2/Lr) in eqs. (28)-(29) follow. In the full-order model (all dynamics effects in) the same law acts on the model's own magnetising flux |psi_m| = Lm |i_s + i_r|, the fluxes of the T-equivalent circuit being its states.",
     parameters: &PARAMS,
@@ -178,11 +178,11 @@ impl Contribution for SaturationOnLog {
                 .into_iter()
                 .map(|x| k0 * x),
         );
-        t.magnetising.law = Some(SaturationLaw {
+        t.magnetising.law = Some(MagnetisingLaw::Power(SaturationLaw {
             psi_sat_wb,
             exponent,
             lm0_over_file: k0,
-        });
+        }));
     }
     fn describe(&self, p: &SaturationValues, d: &Prepared, n: &MachineConstants) -> String {
         let (psi_sat, nexp) = (p.psi_sat_wb, p.exponent);

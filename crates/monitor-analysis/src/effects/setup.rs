@@ -4,8 +4,8 @@
 use super::sig;
 use crate::prep::Prepared;
 use crate::simplified_model::{MachineConstants, ModelTerms};
-use monitor_core::EffectKind;
 use monitor_io::params::PlausibleRange;
+use monitor_laws::EffectId;
 use std::sync::Arc;
 
 /// Why an effect cannot be fitted on a log (one line, the effect's name put before it by
@@ -26,6 +26,9 @@ pub enum SetupError {
     /// The log holds nothing the effect could fit (the reason in words).
     #[error("{0}")]
     NothingToFit(&'static str),
+    /// A user's law gives no number (NaN or infinity) on this log at its start values.
+    #[error("the law gives no number (NaN or infinity) on this log at its start values")]
+    NotFinite,
     /// The set-up's parameters do not match its contribution's typed values.
     #[error(transparent)]
     Values(#[from] EffectValuesError),
@@ -135,7 +138,7 @@ impl FitParam {
 /// # Errors
 /// [`EffectValuesError::Count`] when `values` does not hold one value per declaration.
 pub fn declared_values<const N: usize>(
-    effect: EffectKind,
+    effect: EffectId,
     declared: &[EffectParam; N],
     values: &[f64],
 ) -> Result<[f64; N], EffectValuesError> {
@@ -154,7 +157,7 @@ pub enum EffectValuesError {
     #[error("{effect}: {got} fitted values for its {expected} parameters")]
     Count {
         /// Which effect.
-        effect: EffectKind,
+        effect: EffectId,
         /// Its parameters on this log.
         expected: usize,
         /// The values given.

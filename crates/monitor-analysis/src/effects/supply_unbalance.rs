@@ -8,7 +8,7 @@ use super::{
 };
 use crate::prep::{Prepared, C64};
 use crate::simplified_model::{MachineConstants, ModelTerms};
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 
 /// Negative-sequence supply voltage.
 #[derive(Debug, Clone, Copy)]
@@ -46,14 +46,14 @@ pub struct SupplyUnbalanceValues {
 impl TryFrom<&[f64]> for SupplyUnbalanceValues {
     type Error = EffectValuesError;
     fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
-        let [y_re, y_im] = declared_values(EffectKind::SupplyUnbalance, &PARAMS, v)?;
+        let [y_re, y_im] = declared_values(EffectId::SUPPLY_UNBALANCE, &PARAMS, v)?;
         Ok(SupplyUnbalanceValues { y_re, y_im })
     }
 }
 
 /// What `SupplyUnbalance` is ([`About`]).
 const ABOUT: About = About {
-    kind: EffectKind::SupplyUnbalance,
+    kind: EffectId::SUPPLY_UNBALANCE,
     description: "The supply voltages are not balanced: a negative-sequence voltage drives a negative-sequence current through the machine's small negative-sequence impedance (2f ripple in the d-q frame).",
     equations: "i_abc = balanced model current + i_neg, i_neg = (y_re + j y_im) v_neg / conj(Z2(omega_s)), Z2 = Rs + j w Lls + (j w Lm)||(Rr/s2 + j w Llr) at the negative-sequence slip s2 = 1 + omega_r/omega_s (2 without a speed column); the balanced model is driven by the positive-sequence V_qs. Full-order model (all dynamics effects in): the machine is driven by V_pos + (y_re + j y_im) V_neg, and its own equations give the negative-sequence current (through a start, and with the 2f torque and speed ripple).",
     parameters: &PARAMS,
@@ -66,7 +66,7 @@ impl EffectModel for SupplyUnbalance {
     fn confused_with(&self) -> &'static [Confusion] {
         // Both add a negative-sequence current; at one operating point they fit alike.
         &[Confusion {
-            with: EffectKind::PhaseAsymmetry,
+            with: EffectId::PHASE_ASYMMETRY,
             within: 1.25,
         }]
     }

@@ -6,7 +6,7 @@ use super::{
 };
 use crate::prep::Prepared;
 use crate::simplified_model::{Dynamics, MachineConstants, ModelTerms};
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 
 /// An effect that only turns a state of the full-order machine on: no parameters, nothing
 /// precomputed; its contribution sets its state in [`ModelTerms::dynamics`]. Its time
@@ -17,7 +17,7 @@ pub struct StateSwitch {
     /// What it is (no parameters).
     pub about: About,
     /// Effects that must be in the model first ([`EffectModel::requires`]).
-    pub requires: &'static [EffectKind],
+    pub requires: &'static [EffectId],
     /// Turns the state on.
     pub switch_on: fn(&mut Dynamics),
     /// What it means on machine `n`, in words ([`Contribution::describe`]).
@@ -28,7 +28,7 @@ impl EffectModel for StateSwitch {
     fn about(&self) -> &About {
         &self.about
     }
-    fn requires(&self) -> &'static [EffectKind] {
+    fn requires(&self) -> &'static [EffectId] {
         self.requires
     }
     fn time_constant_s(&self, n: &MachineConstants) -> Option<f64> {

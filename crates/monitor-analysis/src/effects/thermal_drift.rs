@@ -6,7 +6,7 @@ use super::{
 };
 use crate::prep::Prepared;
 use crate::simplified_model::{MachineConstants, ModelTerms};
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 
 /// Copper temperature coefficient of resistance [1/K] (0.393 %/K at 20 C): the stator
 /// winding (IEC 60034-1's resistance method of temperature rise uses 235 K + T, the same
@@ -116,7 +116,7 @@ impl ThermalDrift {
     pub fn values_of(&self, v: &[f64]) -> Result<ThermalDriftValues, EffectValuesError> {
         match self.windings {
             Windings::Together => {
-                let [rise_k, tau_s] = declared_values(EffectKind::ThermalDrift, &PARAMS, v)?;
+                let [rise_k, tau_s] = declared_values(EffectId::THERMAL_DRIFT, &PARAMS, v)?;
                 // One rise of the resistances: the cage's aluminium takes it at its own
                 // coefficient.
                 Ok(ThermalDriftValues {
@@ -127,7 +127,7 @@ impl ThermalDrift {
             }
             Windings::Apart => {
                 let [stator_rise_k, rotor_rise_k, tau_s] =
-                    declared_values(EffectKind::ThermalDrift, &PARAMS_APART, v)?;
+                    declared_values(EffectId::THERMAL_DRIFT, &PARAMS_APART, v)?;
                 Ok(ThermalDriftValues {
                     stator_rise_k,
                     rotor_rise_k,
@@ -141,13 +141,13 @@ impl ThermalDrift {
 impl ThermalDriftValues {
     /// The rise at `t` [s] after the log's start of a final rise `rise` [K].
     fn rise_at(&self, rise: f64, t: f64) -> f64 {
-        rise * (1.0 - (-t.max(0.0) / self.tau_s.max(1e-6)).exp())
+        monitor_laws::library::heating_rise_k(rise, self.tau_s.max(1e-6), 0.0, t)
     }
 }
 
 /// What `ThermalDrift` is, both windings together ([`About`]).
 const ABOUT: About = About {
-    kind: EffectKind::ThermalDrift,
+    kind: EffectId::THERMAL_DRIFT,
     description: "The windings heat up with load, so the stator and rotor resistances rise (copper: +0.393 %/K; 20 -> 90 C is +27 %); a motor already warm when the log starts is a change of the base parameters, this is the rise on top of it.",
     equations: "Rs(t), Rr(t) = R (1 + 0.00393 dT(t)), dT(t) = rise_k (1 - exp(-(t - t0)/tau_s)) from the log's start t0; Ra = Rs + (Ls/Lr) Rr in eq. (28) follows; in the full-order model the rotor time constant Lr/Rr follows too. The ladder fits the stator and the rotor apart (stator_rise_k at copper's 0.393 %/K, rotor_rise_k at the cage's aluminium 0.403 %/K).",
     parameters: &PARAMS,
@@ -155,7 +155,7 @@ const ABOUT: About = About {
 
 /// What `ThermalDrift` is, the windings apart ([`About`]).
 const ABOUT_APART: About = About {
-    kind: EffectKind::ThermalDrift,
+    kind: EffectId::THERMAL_DRIFT,
     description: "The windings heat up with load, the stator and the rotor apart, so their resistances rise (stator copper +0.393 %/K, rotor aluminium +0.403 %/K); a motor already warm when the log starts is a change of the base parameters, this is the rise on top of it.",
     equations: "Rs(t) = Rs (1 + 0.00393 dTs(t)), Rr(t) = Rr (1 + 0.00403 dTr(t)), dTx(t) = x_rise_k (1 - exp(-(t - t0)/tau_s)) from the log's start t0; Ra = Rs + (Ls/Lr) Rr in eq. (28) follows; in the full-order model the rotor time constant Lr/Rr follows too.",
     parameters: &PARAMS_APART,

@@ -6,7 +6,7 @@ use super::{
 };
 use crate::prep::Prepared;
 use crate::simplified_model::{MachineConstants, ModelTerms, SpeedTorque};
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 
 /// Fan / windage torque.
 #[derive(Debug, Clone, Copy)]
@@ -32,7 +32,7 @@ pub struct WindageValues {
 impl TryFrom<&[f64]> for WindageValues {
     type Error = EffectValuesError;
     fn try_from(v: &[f64]) -> Result<Self, EffectValuesError> {
-        let [k_nms2] = declared_values(EffectKind::Windage, &PARAMS, v)?;
+        let [k_nms2] = declared_values(EffectId::WINDAGE, &PARAMS, v)?;
         Ok(WindageValues { k_nms2 })
     }
 }
@@ -51,14 +51,15 @@ struct Drag {
 }
 
 impl SpeedTorque for Drag {
+    /// The library's windage law ([`monitor_laws::library::windage_nm`], the simulator's).
     fn torque_nm(&self, wm_rad_s: f64) -> f64 {
-        self.k_nms2 * wm_rad_s * wm_rad_s.abs()
+        monitor_laws::library::windage_nm(self.k_nms2, wm_rad_s)
     }
 }
 
 /// What `Windage` is ([`About`]).
 const ABOUT: About = About {
-    kind: EffectKind::Windage,
+    kind: EffectId::WINDAGE,
     description: "Fan and air drag: a load torque growing with the square of speed.",
     equations: "J dw_m/dt = Kf I_qs - (B + Bl) w_m - k w_m |w_m|  (eq. 29 plus a quadratic drag).",
     parameters: &PARAMS,

@@ -11,7 +11,7 @@ use crate::prep::Prepared;
 use crate::refit::BaseRefit;
 use crate::simplified_model::{BaseParams, Prediction};
 use crate::transients;
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 
 /// The configured model fitted and measured: what every candidate is compared with.
 pub(super) struct ExplainBaseline<'a> {
@@ -71,9 +71,9 @@ pub(super) struct FullSeries {
 /// `current_dynamics`) flags its base parameters because they absorb what it cannot
 /// follow: the verdict says so, and recentring on them would judge effects against that
 /// error.
-pub(super) fn structural_error(base: &ExplainBaseline<'_>, names: &[EffectKind]) -> bool {
+pub(super) fn structural_error(base: &ExplainBaseline<'_>, names: &[EffectId]) -> bool {
     base.span.input_transient
-        && ![EffectKind::FluxDynamics, EffectKind::CurrentDynamics]
+        && ![EffectId::FLUX_DYNAMICS, EffectId::CURRENT_DYNAMICS]
             .iter()
             .all(|k| names.contains(k))
 }

@@ -10,13 +10,13 @@ use crate::base_range::base_newly_out_of_range;
 use crate::effects::{self, EffectModel};
 use crate::fit::{self, ActiveEffect, FitResult};
 use crate::{metrics, transients};
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 
 /// Stage 5: the effects of the library `lib` that are not in the model (`names`), the
 /// candidates `explain` tries.
 pub(super) fn candidates<'a>(
     lib: &'a [Box<dyn EffectModel>],
-    names: &[EffectKind],
+    names: &[EffectId],
 ) -> Vec<&'a dyn EffectModel> {
     lib.iter()
         .map(|e| e.as_ref())
@@ -88,7 +88,7 @@ impl Analysis {
         c: &dyn EffectModel,
         base: &ExplainBaseline<'_>,
     ) -> Option<transients::NotProposed> {
-        let in_model: Vec<EffectKind> = base.active.iter().map(|a| a.effect.kind()).collect();
+        let in_model: Vec<EffectId> = base.active.iter().map(|a| a.effect.kind()).collect();
         transients::not_proposed(c, base.span, &self.constants, &in_model)
     }
 

@@ -34,7 +34,7 @@ use super::simplified_model::Prediction;
 use super::unbalance::UnbalanceAnalysis;
 use baseline::structural_error;
 use candidates::candidates;
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 use ranking::{rank, stand, CandidateOutcome};
 use report::{withhold_if_untrusted, ExplainFindings};
 use serde::Serialize;
@@ -53,7 +53,7 @@ pub const EXPLAINS_MIN: f64 = 0.05;
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Skipped {
     /// The effect.
-    pub effect: EffectKind,
+    pub effect: EffectId,
     /// Why it was not fitted.
     pub because: SkipReason,
 }
@@ -76,7 +76,7 @@ pub enum SkipReason {
     /// It needs `effects` first, and one of them cannot be fitted on this log.
     NeedsFirst {
         /// What it needs first.
-        effects: Vec<EffectKind>,
+        effects: Vec<EffectId>,
     },
     /// A log without voltages: only the unbalance analysis ran.
     NoVoltages,
@@ -152,7 +152,7 @@ pub fn explained_fraction(e_base: f64, e_with: f64, noise: f64) -> f64 {
 #[derive(Debug, Clone, Serialize)]
 pub struct EffectCandidate {
     /// Which effect.
-    pub effect: EffectKind,
+    pub effect: EffectId,
     /// Its rank among the candidates (1 = best), null for a fit with no effect or not
     /// plausible ([`Standing`]).
     pub rank: Option<usize>,
@@ -193,7 +193,7 @@ pub struct EffectCandidate {
 #[derive(Debug, Clone, Serialize)]
 pub struct ExplainReport {
     /// Effects already in the model.
-    pub effects: Vec<EffectKind>,
+    pub effects: Vec<EffectId>,
     /// Error of the model as configured (whole log).
     pub baseline_normalized_rms_error: f64,
     /// Error of the model as configured on the held-back windows.
@@ -205,7 +205,7 @@ pub struct ExplainReport {
     pub ranking: Vec<EffectCandidate>,
     /// The plausible fits that explain less than [`EXPLAINS_MIN`] of the held-back error:
     /// no candidates (they are in `ranking` with `standing: no_effect` and no rank).
-    pub no_effect: Vec<EffectKind>,
+    pub no_effect: Vec<EffectId>,
     /// True when no candidate explains the error well.
     pub unexplained: bool,
     /// The conclusion, with the numbers that decided (JSON `conclusion`, beside the
@@ -259,7 +259,7 @@ pub enum ExplainConclusion {
     /// A missing effect: the first plausible candidate explains enough.
     Missing {
         /// The effect.
-        effect: EffectKind,
+        effect: EffectId,
         /// The share of the held-back error beyond the floor it explains.
         explained: f64,
         /// The held-back error without it (on the fit series).
@@ -267,12 +267,12 @@ pub enum ExplainConclusion {
         /// With it.
         heldback_after: f64,
         /// The model's effects with it (what to add).
-        effects: Vec<EffectKind>,
+        effects: Vec<EffectId>,
     },
     /// The best candidate explains less than `asks` ([`EXPLAINED_MIN`]).
     TooLittle {
         /// The effect.
-        effect: EffectKind,
+        effect: EffectId,
         /// The share it explains.
         explained: f64,
         /// The share a named effect must explain.
@@ -295,7 +295,7 @@ pub enum ExplainConclusion {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct NotNamed {
     /// The effect.
-    pub effect: EffectKind,
+    pub effect: EffectId,
     /// The share of the held-back error beyond the floor it would explain.
     pub explained: f64,
     /// Its first reason (a value out of its range).
@@ -309,7 +309,7 @@ pub struct ExplainOutput {
     /// Prediction of the configured model.
     pub before: Prediction,
     /// Prediction with the top-ranked candidate added (None when nothing was fitted).
-    pub after: Option<(EffectKind, Prediction)>,
+    pub after: Option<(EffectId, Prediction)>,
 }
 
 impl Analysis {
@@ -335,11 +335,13 @@ impl Analysis {
         progress: &(dyn Fn(f64) + Sync),
         may_recentre: bool,
     ) -> Result<ExplainOutput, AnalysisError> {
-        let configured = resolve(&opts.effects);
-        let names: Vec<EffectKind> = configured.iter().map(|e| e.kind()).collect();
+        let configured = resolve(&opts.effects, &opts.laws);
+        let names: Vec<EffectId> = configured.iter().map(|e| e.kind()).collect();
         // 1. Without voltages the model cannot run: the unbalance analysis only.
         if !self.data.channels.voltages {
-            return Ok(withhold_if_untrusted(self.explain_current_only(names)));
+            return Ok(withhold_if_untrusted(
+                self.explain_current_only(names, &opts.laws),
+            ));
         }
         // 2. The configured model fitted and measured: what candidates are compared with.
         let mut base = self.baseline(&configured, opts)?;
@@ -348,7 +350,7 @@ impl Analysis {
         // 4. Whether its error is structural (dynamics missing through a transient).
         let structural = structural_error(&base, &names);
         // 5. The library's effects not in the model; those that cannot be ranked, and why.
-        let lib = effects::library();
+        let lib = opts.laws.models();
         let cands = candidates(&lib, &names);
         let skipped = self.skipped(&cands, &base);
         // 6. Each candidate fitted and measured, then ranked.
@@ -366,6 +368,7 @@ impl Analysis {
             ranked,
             skipped,
             unbalance,
+            registry: &opts.laws,
         };
         // 7. Recentred on the refit when the file's model does not fit and nothing could
         // be named on it.

@@ -79,7 +79,10 @@ pub(super) fn rank(
         return;
     }
     let (first, second) = (&ranked[0], &ranked[1]);
-    let model = effects::model_of(first.candidate.effect);
+    // A user's law declares no confusion: only the library's effects are reordered.
+    let Some(model) = effects::model_of(first.candidate.effect) else {
+        return;
+    };
     let Some(conf) = model
         .confused_with()
         .iter()
@@ -92,11 +95,13 @@ pub(super) fn rank(
     }
     let says = |r: &RankedCandidate| {
         let fitted = r.fit.effect_params.last().map(Vec::as_slice).unwrap_or(&[]);
-        effects::model_of(r.candidate.effect).evidence(&EffectEvidence {
-            voltage_unbalance: unbalance.voltage_negative_sequence_ratio,
-            winding_suspected: unbalance.suspect_phase.is_some(),
-            torque_scale_nm,
-            fitted,
+        effects::model_of(r.candidate.effect).and_then(|m| {
+            m.evidence(&EffectEvidence {
+                voltage_unbalance: unbalance.voltage_negative_sequence_ratio,
+                winding_suspected: unbalance.suspect_phase.is_some(),
+                torque_scale_nm,
+                fitted,
+            })
         })
     };
     if says(first) == Some(false) && says(second) != Some(false) {

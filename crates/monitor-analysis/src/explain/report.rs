@@ -10,16 +10,17 @@ use super::{
 };
 use crate::analysis::{resolve, Analysis, AnalysisError, Options};
 use crate::base_range::{base_implausible, base_out_of_range};
+use crate::effects::Registry;
 use crate::fit::{ActiveEffect, FittedModel};
 use crate::refit::BaseRefit;
 use crate::simplified_model::Prediction;
 use crate::unbalance::UnbalanceAnalysis;
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 
 /// What stages 2 to 6 found on a log with voltages: the report's material.
 pub(super) struct ExplainFindings<'a> {
     /// The effects in the configured model.
-    pub(super) names: Vec<EffectKind>,
+    pub(super) names: Vec<EffectId>,
     /// The configured model fitted on the fit series.
     pub(super) base: ExplainBaseline<'a>,
     /// The configured model on the working series.
@@ -32,17 +33,24 @@ pub(super) struct ExplainFindings<'a> {
     pub(super) skipped: Vec<Skipped>,
     /// The unbalance analysis.
     pub(super) unbalance: UnbalanceAnalysis,
+    /// The effects the analysis may use (the library's and the user's laws).
+    pub(super) registry: &'a Registry,
 }
 
 impl Analysis {
     /// Stage 1: `explain` on a log without voltages: the model cannot run; only the
     /// unbalance analysis.
-    pub(super) fn explain_current_only(&self, names: Vec<EffectKind>) -> ExplainOutput {
+    pub(super) fn explain_current_only(
+        &self,
+        names: Vec<EffectId>,
+        registry: &Registry,
+    ) -> ExplainOutput {
         let unbalance = self.unbalance();
-        let skipped = EffectKind::ALL
-            .iter()
+        let skipped = registry
+            .names()
+            .into_iter()
             .filter(|k| !names.contains(k))
-            .map(|&effect| Skipped {
+            .map(|effect| Skipped {
                 effect,
                 because: SkipReason::NoVoltages,
             })
@@ -122,9 +130,10 @@ impl Analysis {
         let not_named = not_named(&found.ranked);
         let model_implausible = base_implausible(&self.constants, &found.base.fit.base, &self.data);
         let after = match found.ranked.first() {
-            Some(r) if !o.unexplained => {
-                Some((r.candidate.effect, self.predict_with(&found.names, r)?))
-            }
+            Some(r) if !o.unexplained => Some((
+                r.candidate.effect,
+                self.predict_with(&found.names, r, found.registry)?,
+            )),
             _ => None,
         };
         Ok(ExplainOutput {
@@ -159,11 +168,12 @@ impl Analysis {
     /// their fitted values, on the working series.
     fn predict_with(
         &self,
-        names: &[EffectKind],
+        names: &[EffectId],
         r: &RankedCandidate,
+        registry: &Registry,
     ) -> Result<Prediction, AnalysisError> {
-        let kinds: Vec<EffectKind> = names.iter().copied().chain([r.candidate.effect]).collect();
-        let boxes = resolve(&kinds);
+        let kinds: Vec<EffectId> = names.iter().copied().chain([r.candidate.effect]).collect();
+        let boxes = resolve(&kinds, registry);
         let model = FittedModel {
             effects: boxes
                 .iter()

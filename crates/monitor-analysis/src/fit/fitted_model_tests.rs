@@ -2,13 +2,13 @@
 
 use super::*;
 use crate::effects::model_of;
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 
 #[test]
 fn a_fitted_model_says_what_it_is() {
     let n = MachineConstants::from_params(&monitor_io::params::ParamFile::reference_2p2kw());
     let d = Prepared::default();
-    let cd = model_of(EffectKind::CurrentDynamics);
+    let cd = model_of(EffectId::CURRENT_DYNAMICS);
     let setup = cd.setup(&d, &n).unwrap();
     let m = FittedModel {
         effects: vec![ActiveEffect {

@@ -170,7 +170,7 @@ pub fn simulate(c: &IdentifiedCircuit, s: &Samples) -> Option<Trace> {
         if let Some(w) = wm_meas {
             x[4] = 0.5 * (w[k] + w[k + 1]);
         }
-        m.rk4(&mut x, s.dt_s, v0, vm, v1);
+        m.rk4(&mut x, k as f64 * s.dt_s, s.dt_s, v0, vm, v1);
         if let Some(w) = wm_meas {
             x[4] = w[k + 1];
         }

@@ -3,7 +3,9 @@
 //! machine at a sample, the initial state, the run's set-up ([`FullRun`]).
 
 use super::reduced::initial_state;
-use super::{BaseParams, MachineConstants, ModelMechanics, ModelRun, ModelTerms, Prediction};
+use super::{
+    BaseParams, MachineConstants, MagnetisingLaw, ModelMechanics, ModelRun, ModelTerms, Prediction,
+};
 use crate::prep::{Prepared, C64};
 
 /// The machine of the full-order form at one sample (inverse-Gamma equivalent of the
@@ -275,7 +277,11 @@ impl<'a> FullRun<'a> {
     pub(super) fn machine(&self, k: usize) -> FullMachine {
         let ModelRun { n, b, t, .. } = self.run;
         if self.unsaturated {
-            let lm0 = t.magnetising.law.map_or(1.0, |l| l.lm0_over_file);
+            let lm0 = t
+                .magnetising
+                .law
+                .as_ref()
+                .map_or(1.0, MagnetisingLaw::lm0_over_file);
             FullMachine::at_lm(n, b, t, k, lm0)
         } else {
             FullMachine::at(n, b, t, k)

@@ -41,8 +41,9 @@ mod stationary;
 mod terms;
 
 pub use terms::{
-    CageAsymmetry, Dynamics, Magnetising, ModelTerms, NegativeSequenceTerm, Resistance, RotorCage,
-    SaturationLaw, Shaft, SpeedTorque, WindingAsymmetryTerm,
+    CageAsymmetry, Dynamics, LmShape, Magnetising, MagnetisingLaw, ModelTerms,
+    NegativeSequenceTerm, Resistance, RotorCage, SampleTorque, SaturationLaw, Shaft, SpeedTorque,
+    WindingAsymmetryTerm,
 };
 
 use super::prep::{Prepared, C64};
@@ -87,6 +88,8 @@ pub struct MachineConstants {
     pub core_model: monitor_core::MotorModel,
     /// The parameter file's peak phase voltage [V].
     pub v_phase_peak: f64,
+    /// The parameter file's supply frequency [Hz] (a no-load test's table is taken at it).
+    pub f_hz: f64,
     /// Which magnetising inductance `lm_h` is (the file's `lm_at`): a saturation law takes
     /// its unsaturated Lm0 from it ([`monitor_io::params::lm0_over_file`]).
     pub lm_point: monitor_core::LmPoint,
@@ -137,6 +140,7 @@ impl MachineConstants {
             torque_scale_nm: t_rated,
             core_model: p.motor.model(),
             v_phase_peak: p.supply.v_phase_peak(),
+            f_hz: p.supply.f_hz,
             lm_point: p.motor.lm_point(),
             psi_m_rated_wb: monitor_io::params::rated_magnetising_flux_wb(&p.motor, &p.supply),
         }

@@ -4,7 +4,7 @@
 mod voltage;
 
 use super::full_order::{FullMachine, FullRun};
-use super::terms::{SaturationLaw, Shaft, WindingAsymmetryTerm};
+use super::terms::{LmShape, MagnetisingLaw, SaturationLaw, Shaft, WindingAsymmetryTerm};
 use super::{MachineConstants, ModelMechanics, ModelRun, ModelTerms, Prediction};
 use crate::prep::{Prepared, C64};
 pub(super) use voltage::StatVoltage;
@@ -79,6 +79,9 @@ struct SatMachine<'a> {
     rr: f64,
     psi_sat: f64,
     nexp: f64,
+    /// A user's law's shape `Lm(psi_m) / Lm(0)` in place of the power law
+    /// ([`MagnetisingLaw::Shape`]).
+    shape: Option<&'a LmShape>,
     /// The last solve's 1/Lm (0: none yet).
     guess: &'a std::cell::Cell<f64>,
 }
@@ -87,9 +90,20 @@ impl<'a> SatMachine<'a> {
     fn new(
         n: &MachineConstants,
         m: &FullMachine,
-        law: SaturationLaw,
+        law: &'a MagnetisingLaw,
         guess: &'a std::cell::Cell<f64>,
     ) -> Self {
+        let (power, shape) = match law {
+            MagnetisingLaw::Power(p) => (*p, None),
+            MagnetisingLaw::Shape(s) => (
+                SaturationLaw {
+                    psi_sat_wb: 1.0,
+                    exponent: 1.0,
+                    lm0_over_file: s.lm0_over_file,
+                },
+                Some(s),
+            ),
+        };
         let sigma_n = n.lls_h + n.lm_h * n.llr_h / (n.llr_h + n.lm_h);
         let scale = m.l_sigma / sigma_n.max(1e-12);
         let (lls, llr) = (n.lls_h * scale, n.llr_h * scale);
@@ -99,8 +113,9 @@ impl<'a> SatMachine<'a> {
             inv_llr: 1.0 / llr.max(1e-9),
             inv_lm0: 1.0 / lm0,
             rr: m.a * (llr + lm0),
-            psi_sat: law.psi_sat_wb.max(1e-9),
-            nexp: law.exponent,
+            psi_sat: power.psi_sat_wb.max(1e-9),
+            nexp: power.exponent,
+            shape,
             guess,
         }
     }
@@ -120,6 +135,11 @@ impl<'a> SatMachine<'a> {
     fn currents(&self, ps: C64, pr: C64) -> (C64, C64) {
         let w = ps * self.inv_lls + pr * self.inv_llr;
         let g = self.inv_lls + self.inv_llr;
+        if let Some(s) = self.shape {
+            let y = self.solve_shape(s, w.norm(), g);
+            let psi_m = w / (y + g);
+            return ((ps - psi_m) * self.inv_lls, (pr - psi_m) * self.inv_llr);
+        }
         let big_w = w.norm() / self.psi_sat;
         let mut y = self.guess.get().max(self.inv_lm0);
         for _ in 0..30 {
@@ -136,6 +156,58 @@ impl<'a> SatMachine<'a> {
         self.guess.set(y);
         let psi_m = w / (y + g);
         ((ps - psi_m) * self.inv_lls, (pr - psi_m) * self.inv_llr)
+    }
+}
+
+impl SatMachine<'_> {
+    /// `y = 1/Lm` of a user's law: `y = (1/Lm0) / shape(W / (y + G))` ([`SatMachine`]'s
+    /// equation with the law's shape), by the secant method from the last solve, kept
+    /// within a bracket (`y` from a hundredth to a thousand times 1/Lm0; bisection where a
+    /// secant step leaves it), to 1e-12 relative. A shape that is not finite and positive
+    /// leaves `y` at the bracket's end its sign points to.
+    fn solve_shape(&self, s: &LmShape, big_w: f64, g: f64) -> f64 {
+        let f = |y: f64| {
+            let sh = (s.shape)(big_w / (y + g));
+            let sh = if sh.is_finite() && sh > 0.0 {
+                sh
+            } else {
+                1e-12
+            };
+            y - self.inv_lm0 / sh
+        };
+        let (mut lo, mut hi) = (1e-2 * self.inv_lm0, 1e3 * self.inv_lm0);
+        let mut y0 = self.guess.get().clamp(lo, hi);
+        if y0 <= lo {
+            y0 = self.inv_lm0;
+        }
+        let mut f0 = f(y0);
+        let mut y1 = (y0 * 1.001).min(hi);
+        for _ in 0..60 {
+            let f1 = f(y1);
+            if f1 == 0.0 {
+                break;
+            }
+            if f1 > 0.0 {
+                hi = hi.min(y1);
+            } else {
+                lo = lo.max(y1);
+            }
+            let mut y2 = if f1 != f0 {
+                y1 - f1 * (y1 - y0) / (f1 - f0)
+            } else {
+                0.5 * (lo + hi)
+            };
+            if !(y2 > lo && y2 < hi) {
+                y2 = 0.5 * (lo + hi);
+            }
+            let done = (y2 - y1).abs() <= 1e-12 * y2;
+            (y0, f0, y1) = (y1, f1, y2);
+            if done {
+                break;
+            }
+        }
+        self.guess.set(y1);
+        y1
     }
 }
 
@@ -414,7 +486,7 @@ impl<'a> StatForm<'a> {
             cage,
             sat: None,
         };
-        match t.magnetising.law {
+        match &t.magnetising.law {
             Some(law) => {
                 let sat = SatMachine::new(n, &sm.m, law, lm_guess);
                 if k == 0 {

@@ -56,7 +56,7 @@ pub struct Magnetising {
     pub lm_scale: Vec<f64>,
     /// The law Lm follows on the model's own magnetising flux in the stationary-frame
     /// full-order model (`None`: linear); that model ignores `lm_scale`.
-    pub law: Option<SaturationLaw>,
+    pub law: Option<MagnetisingLaw>,
     /// Conductance across the magnetising branch, 1/Rfe [S] (0: no core loss); adds.
     pub core_loss_s: f64,
 }
@@ -74,11 +74,60 @@ pub struct SaturationLaw {
     pub lm0_over_file: f64,
 }
 
+/// The law Lm follows on the magnetising flux in the stationary-frame full-order model: the
+/// library's saturation law, or a user's law of any form (an expression of `psi_m`, a
+/// no-load test's curve).
+#[derive(Debug, Clone)]
+pub enum MagnetisingLaw {
+    /// The library's `Lm0 / (1 + (|psi_m| / psi_sat)^n)`.
+    Power(SaturationLaw),
+    /// A user's law, as its shape `Lm(psi_m) / Lm(0)` and its unsaturated value over the
+    /// file's `lm_h`: the model's Lm is the fitted unsaturated Lm0 times the shape, so that
+    /// a refitted Ls scales the user's curve as it scales the library's.
+    Shape(LmShape),
+}
+
+impl MagnetisingLaw {
+    /// Lm0 over the machine's `lm_h` (the unsaturated start of the full-order forms).
+    pub fn lm0_over_file(&self) -> f64 {
+        match self {
+            MagnetisingLaw::Power(l) => l.lm0_over_file,
+            MagnetisingLaw::Shape(s) => s.lm0_over_file,
+        }
+    }
+}
+
+/// A user's magnetising law as a shape ([`MagnetisingLaw::Shape`]).
+#[derive(Clone)]
+pub struct LmShape {
+    /// `Lm(psi_m) / Lm(0)` at the flux `psi_m` [Wb, peak] (finite and positive where the
+    /// law is physical).
+    pub shape: Arc<dyn Fn(f64) -> f64 + Send + Sync>,
+    /// `Lm(0)` over the file's `lm_h`.
+    pub lm0_over_file: f64,
+}
+
+impl std::fmt::Debug for LmShape {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LmShape")
+            .field("lm0_over_file", &self.lm0_over_file)
+            .finish_non_exhaustive()
+    }
+}
+
 /// A shaft torque that depends only on the speed (friction, drag).
 pub trait SpeedTorque: Send + Sync + std::fmt::Debug {
     /// The load torque at mechanical speed `wm_rad_s` [N m] (positive brakes a shaft
     /// turning forwards).
     fn torque_nm(&self, wm_rad_s: f64) -> f64;
+}
+
+/// A shaft torque of the working sample and the speed: a law of time, speed and the shaft's
+/// angle, each read at the sample (a user's `load_torque` law).
+pub trait SampleTorque: Send + Sync + std::fmt::Debug {
+    /// The load torque at working sample `k` and mechanical speed `wm_rad_s` [N m]
+    /// (positive brakes a shaft turning forwards).
+    fn torque_nm(&self, k: usize, wm_rad_s: f64) -> f64;
 }
 
 /// Torques on the shaft besides the electromagnetic torque and (B + Bl) w_m: in eq. (29),
@@ -89,6 +138,8 @@ pub struct Shaft {
     pub load_nm: Vec<f64>,
     /// Speed-dependent load torques, summed in order.
     pub speed_torques: Vec<Arc<dyn SpeedTorque>>,
+    /// Torques of the sample and the speed (users' laws), summed in order.
+    pub sample_torques: Vec<Arc<dyn SampleTorque>>,
 }
 
 impl Shaft {
@@ -100,7 +151,11 @@ impl Shaft {
             .speed_torques
             .iter()
             .fold(0.0, |a, s| a + s.torque_nm(w));
-        speed + self.load_nm.get(k).copied().unwrap_or(0.0)
+        let sample: f64 = self
+            .sample_torques
+            .iter()
+            .fold(0.0, |a, s| a + s.torque_nm(k, w));
+        speed + sample + self.load_nm.get(k).copied().unwrap_or(0.0)
     }
 }
 
@@ -220,6 +275,11 @@ impl ModelTerms {
     /// Adds a speed-dependent load torque ([`Shaft::speed_torques`]).
     pub fn add_speed_torque(&mut self, torque: impl SpeedTorque + 'static) {
         self.shaft.speed_torques.push(Arc::new(torque));
+    }
+
+    /// Adds a load torque of the sample and the speed ([`Shaft::sample_torques`]).
+    pub fn add_sample_torque(&mut self, torque: impl SampleTorque + 'static) {
+        self.shaft.sample_torques.push(Arc::new(torque));
     }
 
     /// Adds a negative-sequence current per sample, stationary frame [A]

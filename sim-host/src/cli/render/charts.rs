@@ -2,6 +2,7 @@
 
 use super::plot::{self, Chart, Series};
 use monitor_api::analysis::CompareOutput;
+use monitor_api::analysis::EffectId;
 use monitor_api::analysis::Prediction;
 use monitor_api::analysis::Prepared;
 use monitor_api::analysis::{metrics, WorstWindow};
@@ -512,7 +513,7 @@ fn condition_charts(d: &Prepared, all: &[WorstWindow]) -> Vec<Chart<'static>> {
 pub fn explain_charts(
     d: &Prepared,
     before_p: &Prediction,
-    after: Option<&(monitor_core::EffectKind, Prediction)>,
+    after: Option<&(EffectId, Prediction)>,
 ) -> Vec<Chart<'static>> {
     let mut v = Vec::new();
     if before_p.iq.is_empty() {
@@ -565,7 +566,7 @@ pub fn explain_charts(
 fn before_after_errors(
     d: &Prepared,
     before_p: &Prediction,
-    after: Option<&(monitor_core::EffectKind, Prediction)>,
+    after: Option<&(EffectId, Prediction)>,
 ) -> Vec<Chart<'static>> {
     let t = &d.t_s;
     let per = period_samples(d);

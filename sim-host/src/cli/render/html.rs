@@ -15,7 +15,7 @@ use monitor_api::ExplainDocument;
 
 /// The command line's words for the options advice names (`--from`, `--effects`).
 const CLI: &crate::cli::words::CliWords = &crate::cli::words::CliWords;
-use monitor_core::EffectKind;
+use monitor_api::analysis::EffectId;
 use plot::Chart;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -92,7 +92,7 @@ pub fn write_explain(
     report: Option<&Path>,
     log: &Path,
     a: &Analysis,
-    (before, after): (&Prediction, Option<&(EffectKind, Prediction)>),
+    (before, after): (&Prediction, Option<&(EffectId, Prediction)>),
     doc: &ExplainDocument,
 ) -> anyhow::Result<()> {
     let log = log.display().to_string();
@@ -410,6 +410,6 @@ fn data_quality(h: &mut String, q: &DataQuality) {
     }
 }
 
-fn effect_list(e: &[monitor_core::EffectKind]) -> String {
+fn effect_list(e: &[EffectId]) -> String {
     e.iter().map(|e| e.name()).collect::<Vec<_>>().join(", ")
 }

@@ -12,7 +12,7 @@ use crate::effects::EffectModel;
 use crate::explain::Skipped;
 use crate::fit::machine::MachineScales;
 use crate::simplified_model::BaseParams;
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 
 /// The ladder on one log: forward (and backward) selection over the effect library from
 /// the configured model to the noise floor (the module `ladder`'s doc).
@@ -24,7 +24,7 @@ pub(super) struct Ladder<'a> {
     /// The series the fits run on, with the held-back split.
     pub(super) series: LadderSeries,
     /// The effects the user configured: the start, never dropped.
-    pub(super) configured: Vec<EffectKind>,
+    pub(super) configured: Vec<EffectId>,
     /// Gets the step (1-based) and the fraction of its candidates fitted.
     pub(super) progress: &'a (dyn Fn(usize, f64) + Sync),
     /// The rung the ladder stands on.

@@ -19,14 +19,14 @@ use crate::fit::{ActiveEffect, BaseSpec, FitResult};
 use crate::metrics::{self, Weights};
 use crate::prep::Prepared;
 use crate::simplified_model::BaseParams;
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 use serde::Serialize;
 
 /// The chosen model refitted on the whole log (JSON `final_fit`).
 #[derive(Debug, Clone, Serialize)]
 pub struct FinalFit {
     /// The effects of the chosen model.
-    pub effects: Vec<EffectKind>,
+    pub effects: Vec<EffectId>,
     /// `normalized_rms_error` over the whole log.
     pub error: f64,
     /// The whole log's noise floor for the model.

@@ -59,9 +59,8 @@ pub use split::stratified_heldback;
 
 use super::{Skipped, NOISE_MARGIN, PARAM_PENALTY};
 use crate::analysis::{resolve, Analysis, AnalysisError, DataInfo, Options};
-use crate::effects;
 use climb::Ladder;
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -130,11 +129,11 @@ pub struct RangedValue {
 pub struct LadderStep {
     /// The effect added (for a pair, the one that needed the other); absent on a base rung.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub effect: Option<EffectKind>,
+    pub effect: Option<EffectId>,
     /// Every effect the step added: `effect`, and before it one it needs first
     /// ([`crate::effects::EffectModel::requires`]) when the model lacked it (empty on a
     /// base rung).
-    pub added: Vec<EffectKind>,
+    pub added: Vec<EffectId>,
     /// The base rung's six base parameters against the user's file, each with its change,
     /// its 95 % interval and whether the rung names it; on an effect's step, the base
     /// parameters refitted beside it where it names a change (else empty).
@@ -143,7 +142,7 @@ pub struct LadderStep {
     /// Effects of earlier steps the step removed: the step's effect explains what they stood
     /// in for (stepwise selection both ways, [`stepwise`]).
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub dropped: Vec<EffectKind>,
+    pub dropped: Vec<EffectId>,
     /// Why each of `dropped` was removed, with the numbers that decided.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub dropped_because: Vec<Dropped>,
@@ -182,7 +181,7 @@ pub struct LadderStep {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Dropped {
     /// The effect removed.
-    pub effect: EffectKind,
+    pub effect: EffectId,
     /// The share of the held-back error beyond the floor the model loses without it.
     pub loses: f64,
     /// The share a step must earn.
@@ -193,7 +192,7 @@ pub struct Dropped {
 #[derive(Debug, Clone, Serialize)]
 pub struct LadderStart {
     /// The configured effects.
-    pub effects: Vec<EffectKind>,
+    pub effects: Vec<EffectId>,
     /// `normalized_rms_error` over the whole log.
     pub error: f64,
     /// On the held-back windows.
@@ -213,7 +212,7 @@ pub struct Tried {
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub base: bool,
     /// The effect (with what it needed first, as in [`LadderStep::added`]).
-    pub added: Vec<EffectKind>,
+    pub added: Vec<EffectId>,
     /// Its held-back error.
     pub heldback_error: f64,
     /// Its test statistic ([`LadderStep::significance`]).
@@ -270,7 +269,7 @@ pub struct LadderReport {
     /// The same with the numbers that decided.
     pub stopped_reason: StopReason,
     /// The effects in the model at the end.
-    pub final_effects: Vec<EffectKind>,
+    pub final_effects: Vec<EffectId>,
     /// The last round's candidates that were not kept, best first.
     pub last_round: Vec<Tried>,
     /// Effects never fitted on this log, with why.
@@ -326,8 +325,8 @@ impl Analysis {
             report.stopped_reason = reason;
             return Ok(report);
         }
-        let library = effects::ladder_library();
-        let configured = resolve(&opts.effects);
+        let library = opts.laws.ladder_models();
+        let configured = resolve(&opts.effects, &opts.laws);
         let mut ladder = Ladder::start(self, &library, &configured, opts, held, progress)?;
         report.start = ladder.start_figures();
         let reason = ladder.climb()?;

@@ -4,7 +4,7 @@
 //! crew reads are spelled from them at the door (`monitor-words`).
 
 use super::{Stop, Tried};
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 use serde::Serialize;
 
 /// Why a candidate of a round was not kept (JSON `last_round[].refusal`, beside the
@@ -62,14 +62,14 @@ pub enum WhyNotPhysical {
     /// range, in its own words, [`crate::effects::FitSetup::implausible`]).
     Effect {
         /// The effect.
-        effect: EffectKind,
+        effect: EffectId,
         /// The value and its range.
         why: String,
     },
     /// An added effect's value at a bound of its fit: no minimum the log shows.
     AtBound {
         /// The effect.
-        effect: EffectKind,
+        effect: EffectId,
         /// The parameter's name.
         parameter: String,
         /// Its fitted value.
@@ -85,7 +85,7 @@ pub enum WhyNotPhysical {
     /// effect's words, [`crate::effects::EffectModel::contradicted_by`]).
     Contradicted {
         /// The effect.
-        effect: EffectKind,
+        effect: EffectId,
         /// The measurement and what it says.
         why: String,
     },
@@ -177,7 +177,7 @@ pub enum WhatIsLeft {
     /// Not explained by the effects that could be fitted; `effects` could not be.
     NotTried {
         /// The effects not fitted on this log.
-        effects: Vec<EffectKind>,
+        effects: Vec<EffectId>,
     },
     /// Not explained by the library's effects on the file's base parameters (the base
     /// rung was not a candidate).

@@ -14,8 +14,8 @@ use crate::fit::{ActiveEffect, FitResult};
 use crate::metrics::{self, Weights};
 use crate::prep::Prepared;
 use crate::transients;
-use monitor_core::EffectKind;
 use monitor_io::params::ParamFile;
+use monitor_laws::EffectId;
 
 /// The series a ladder's fits run on, with its held-back split.
 pub(super) struct LadderSeries {
@@ -43,7 +43,7 @@ pub(super) struct Rung<'a> {
     /// The base parameters of the model, as factors on the user's file (the analysis the
     /// rung's fit is relative to is the file with them, [`Analysis::recentred`]).
     pub(super) scales: MachineScales,
-    pub(super) kinds: Vec<EffectKind>,
+    pub(super) kinds: Vec<EffectId>,
     pub(super) models: Vec<&'a dyn EffectModel>,
     pub(super) fit: FitResult,
     /// Whole-log and held-back error and floors on the working series.
@@ -76,7 +76,7 @@ impl Fitted<'_> {
         self.heldback_fit_series * (1.0 + PARAM_PENALTY * self.n_parameters as f64)
     }
     /// The effects the candidate adds to a model of `before` effects.
-    pub(super) fn added(&self, before: usize) -> Vec<EffectKind> {
+    pub(super) fn added(&self, before: usize) -> Vec<EffectId> {
         self.models.iter().skip(before).map(|m| m.kind()).collect()
     }
 }
@@ -247,7 +247,7 @@ pub(super) fn implausible_step(
 /// minimum the log shows, the solver pushed it as far as it was let (a fit of the model's
 /// numerical residue). A bound at 0 does not count (no effect at all: the step's test
 /// refuses that).
-fn pinned(effect: EffectKind, setup: &effects::FitSetup, p: &[f64]) -> Vec<WhyNotPhysical> {
+fn pinned(effect: EffectId, setup: &effects::FitSetup, p: &[f64]) -> Vec<WhyNotPhysical> {
     let at = |v: f64, b: f64| b.is_finite() && b != 0.0 && (v - b).abs() <= 1e-3 * b.abs();
     setup
         .params

@@ -13,7 +13,7 @@ use crate::effects::EffectModel;
 use crate::explain::{explained_fraction, PARAM_PENALTY};
 use crate::fit::{self, BaseSpec, FitResult};
 use crate::metrics;
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 
 /// An effect of the model that may be dropped: added by an earlier step (not configured by
 /// the user, not added by this step), a steady-state effect (the dynamics effects are the
@@ -22,7 +22,7 @@ fn droppable(
     models: &[&dyn EffectModel],
     i: usize,
     step: &LadderStep,
-    configured: &[EffectKind],
+    configured: &[EffectId],
     an: &Analysis,
 ) -> bool {
     let Some(e) = models.get(i) else {

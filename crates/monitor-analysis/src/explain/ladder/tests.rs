@@ -41,7 +41,7 @@ static NO_PROGRESS: fn(usize, f64) = |_, _| {};
 fn ladder_on<'a>(
     a: &'a Analysis,
     lib: &'a [Box<dyn EffectModel>],
-    configured: &[EffectKind],
+    configured: &[EffectId],
 ) -> Ladder<'a> {
     let (held, _) = stratified_heldback(&a.data, &a.constants);
     let opts = Options {
@@ -57,7 +57,7 @@ fn ladder_on<'a>(
 fn rung_of<'a>(
     a: &Analysis,
     lib: &'a [Box<dyn EffectModel>],
-    kinds: &[EffectKind],
+    kinds: &[EffectId],
     from: Option<&Rung<'a>>,
     sr: &LadderSeries,
 ) -> Rung<'a> {
@@ -97,20 +97,20 @@ fn a_stand_in_a_later_step_explains_is_dropped() {
     let ladder = ladder_on(&a, &lib, &[]);
     let sr = &ladder.series;
     let full = [
-        EffectKind::FluxDynamics,
-        EffectKind::CurrentDynamics,
-        EffectKind::DAxisDynamics,
-        EffectKind::CrossCouplingDynamics,
+        EffectId::FLUX_DYNAMICS,
+        EffectId::CURRENT_DYNAMICS,
+        EffectId::D_AXIS_DYNAMICS,
+        EffectId::CROSS_COUPLING_DYNAMICS,
     ];
-    let with_iron: Vec<EffectKind> = full.iter().copied().chain([EffectKind::IronLoss]).collect();
+    let with_iron: Vec<EffectId> = full.iter().copied().chain([EffectId::IRON_LOSS]).collect();
     let before = rung_of(&a, &lib, &with_iron, None, sr);
     let mut all = with_iron.clone();
-    all.push(EffectKind::Windage);
+    all.push(EffectId::WINDAGE);
     let next = rung_of(&a, &lib, &all, Some(&before), sr);
     assert!(next.error < before.error, "{} {}", next.error, before.error);
     let step = LadderStep {
-        effect: Some(EffectKind::Windage),
-        added: vec![EffectKind::Windage],
+        effect: Some(EffectId::WINDAGE),
+        added: vec![EffectId::WINDAGE],
         base: Vec::new(),
         dropped: Vec::new(),
         dropped_because: Vec::new(),
@@ -129,15 +129,15 @@ fn a_stand_in_a_later_step_explains_is_dropped() {
     let (after, step) = ladder
         .drop_stand_ins(&a, next, step, &before)
         .expect("drops");
-    assert_eq!(step.dropped, vec![EffectKind::IronLoss], "{step:?}");
-    assert!(!after.kinds.contains(&EffectKind::IronLoss));
-    assert!(after.kinds.contains(&EffectKind::Windage));
+    assert_eq!(step.dropped, vec![EffectId::IRON_LOSS], "{step:?}");
+    assert!(!after.kinds.contains(&EffectId::IRON_LOSS));
+    assert!(after.kinds.contains(&EffectId::WINDAGE));
     // The step as a whole still lowers the whole-log error.
     assert!(after.error < before.error);
     // Why: the model without it loses less than a step must earn.
     let why = &step.dropped_because;
     assert_eq!(why.len(), 1, "{why:?}");
-    assert_eq!(why[0].effect, EffectKind::IronLoss);
+    assert_eq!(why[0].effect, EffectId::IRON_LOSS);
     assert!(
         why[0].loses < why[0].asks && why[0].asks == STEP_MIN,
         "{why:?}"
@@ -151,21 +151,21 @@ fn what_the_user_configured_and_the_machine_order_stay() {
     let dir = tempfile::tempdir().expect("tempdir");
     let a = fan_log(dir.path());
     let lib = effects::ladder_library();
-    let ladder = ladder_on(&a, &lib, &[EffectKind::IronLoss]);
+    let ladder = ladder_on(&a, &lib, &[EffectId::IRON_LOSS]);
     let sr = &ladder.series;
     let kinds = [
-        EffectKind::FluxDynamics,
-        EffectKind::CurrentDynamics,
-        EffectKind::DAxisDynamics,
-        EffectKind::CrossCouplingDynamics,
-        EffectKind::IronLoss,
-        EffectKind::Windage,
+        EffectId::FLUX_DYNAMICS,
+        EffectId::CURRENT_DYNAMICS,
+        EffectId::D_AXIS_DYNAMICS,
+        EffectId::CROSS_COUPLING_DYNAMICS,
+        EffectId::IRON_LOSS,
+        EffectId::WINDAGE,
     ];
     let before = rung_of(&a, &lib, &kinds[..5], None, sr);
     let next = rung_of(&a, &lib, &kinds, Some(&before), sr);
     let step = LadderStep {
-        effect: Some(EffectKind::Windage),
-        added: vec![EffectKind::Windage],
+        effect: Some(EffectId::WINDAGE),
+        added: vec![EffectId::WINDAGE],
         base: Vec::new(),
         dropped: Vec::new(),
         dropped_because: Vec::new(),

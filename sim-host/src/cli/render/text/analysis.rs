@@ -3,6 +3,7 @@
 use super::diagnose::data_quality;
 use super::number;
 use monitor_api::analysis::CompareReport;
+use monitor_api::analysis::EffectId;
 use monitor_api::analysis::LadderReport;
 use monitor_api::analysis::{ExplainReport, Standing, EXPLAINS_MIN};
 use monitor_api::words;
@@ -15,7 +16,7 @@ use std::path::Path;
 
 /// The effects of a model, as the text tables name it: `bare` without effects, else
 /// `prefix` and the names joined by `sep`.
-fn model_name(effects: &[monitor_core::EffectKind], bare: &str, prefix: &str, sep: &str) -> String {
+fn model_name(effects: &[EffectId], bare: &str, prefix: &str, sep: &str) -> String {
     if effects.is_empty() {
         bare.to_string()
     } else {

@@ -12,7 +12,7 @@ use crate::analysis::{Analysis, AnalysisError};
 use crate::effects::{self, EffectModel};
 use crate::explain::explained_fraction;
 use crate::simplified_model::MachineConstants;
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 use std::collections::BTreeMap;
 
 /// The step a round keeps: the model after it and the step's report.
@@ -193,7 +193,7 @@ fn evidence_decides<'a>(an: &Analysis, fitted: &mut [Fitted<'a>], before: usize)
 fn step_of(
     on: &Analysis,
     c: &Fitted<'_>,
-    added: &[EffectKind],
+    added: &[EffectId],
     rung: &Rung<'_>,
     next: &Rung<'_>,
     sig: f64,

@@ -24,7 +24,7 @@ use crate::simplified_model::MachineConstants;
 use crate::transients;
 use choice::Kept;
 use fits::{RoundFits, Starts};
-use monitor_core::EffectKind;
+use monitor_laws::EffectId;
 
 /// What a round found.
 pub(super) struct RoundOutcome<'a> {
@@ -165,7 +165,7 @@ impl<'a> Ladder<'a> {
     /// competes on any log (its held-back error decides), not only through a start or a
     /// supply step.
     fn cannot_fit(&self, an: &Analysis, e: &dyn EffectModel) -> Option<SkipReason> {
-        let all: Vec<EffectKind> = self.library.iter().map(|x| x.kind()).collect();
+        let all: Vec<EffectId> = self.library.iter().map(|x| x.kind()).collect();
         let resolvable = transients::Span {
             input_transient: true,
             ..self.series.span
@@ -236,11 +236,11 @@ impl<'a> Ladder<'a> {
 /// takes its time constant out of range to follow the others' part.
 fn full_order<'a>(
     lib: &'a [Box<dyn EffectModel>],
-    have: &[EffectKind],
+    have: &[EffectId],
     n: &MachineConstants,
     fits: &dyn Fn(&dyn EffectModel) -> bool,
 ) -> Vec<&'a dyn EffectModel> {
-    let timed = |k: EffectKind| {
+    let timed = |k: EffectId| {
         lib.iter()
             .any(|e| e.kind() == k && e.time_constant_s(n).is_some())
     };
